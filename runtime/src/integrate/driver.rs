@@ -1,0 +1,424 @@
+//! The integration loop every method shares: input checks, the fixed and adaptive step
+//! sequences, output sampling, statistics and the mapping of failures to errors.
+
+use std::time::Instant;
+
+use crate::ode::OdeSystem;
+
+use super::controller::{StepOutcome, StepSizeController};
+use super::error::{IntegrationError, IntegrationFailure};
+use super::options::{
+    ErrorWeights, IntegratorOptions, OutputTimes, check_initial_state, check_output_times,
+    check_step_sizes, check_time_span, check_tolerances,
+};
+use super::solution::Solution;
+use super::stepper::{CheckedRhs, StepFailure, Stepper};
+
+/// Number of fixed steps over `[t0, t_end]` when `dt` is not given.
+const DEFAULT_FIXED_STEPS: f64 = 1000.0;
+
+/// Most samples reserved up front for [`OutputTimes::Steps`]; beyond this the solution grows
+/// by amortised doubling.
+const MAX_RESERVED_SAMPLES: usize = 1 << 16;
+
+/// Samples reserved up front for adaptive [`OutputTimes::Steps`], whose count is unknown.
+const ADAPTIVE_RESERVED_SAMPLES: usize = 256;
+
+/// An integration problem, as [`Integrator::integrate`](super::Integrator::integrate)
+/// receives it.
+pub(crate) struct Problem<'a> {
+    pub(crate) t0: f64,
+    pub(crate) y0: &'a [f64],
+    pub(crate) t_end: f64,
+    pub(crate) output: &'a OutputTimes,
+    pub(crate) options: &'a IntegratorOptions,
+}
+
+/// How the step sizes are chosen.
+pub(crate) enum Control<'a> {
+    /// Constant steps `dt`, the last one shortened to land on `t_end`; no error control.
+    Fixed,
+    /// Steps chosen by `controller` from the embedded error estimate of order
+    /// `error_order`.
+    Adaptive {
+        controller: &'a mut dyn StepSizeController,
+        error_order: u32,
+    },
+}
+
+/// Integrates `problem` with the stepper `make_stepper(dim)` under `control`.
+///
+/// # Errors
+/// Every [`IntegrationError`]; the failure keeps the samples recorded before it and the
+/// statistics, including the wall time.
+pub(crate) fn run<S: Stepper>(
+    problem: &Problem<'_>,
+    system: &mut dyn OdeSystem,
+    control: Control<'_>,
+    make_stepper: impl FnOnce(usize) -> S,
+) -> Result<Solution, IntegrationFailure> {
+    let start = Instant::now();
+    let mut solution = Solution::new(system.dim());
+    let mut rhs = CheckedRhs::new(system);
+    let result = integrate_into(problem, &mut rhs, control, make_stepper, &mut solution);
+    solution.stats.rhs_evals = rhs.evals();
+    solution.stats.wall_time_s = start.elapsed().as_secs_f64();
+    match result {
+        Ok(()) => Ok(solution),
+        Err(error) => Err(IntegrationFailure {
+            error,
+            partial: Box::new(solution),
+        }),
+    }
+}
+
+/// The smallest usable step at time `t`: below `16 ε |t|` the step no longer changes `t` by
+/// more than a few bits, and `16 ε (t_end − t0)` is a floor near `t = 0` (a step of
+/// `10⁻¹⁵` of the interval only happens at a singularity).
+fn min_step(t: f64, span: f64) -> f64 {
+    16.0 * f64::EPSILON * t.abs().max(span)
+}
+
+fn integrate_into<S: Stepper>(
+    problem: &Problem<'_>,
+    rhs: &mut CheckedRhs<'_>,
+    control: Control<'_>,
+    make_stepper: impl FnOnce(usize) -> S,
+    solution: &mut Solution,
+) -> Result<(), IntegrationError> {
+    let dim = solution.dim;
+    check_time_span(problem.t0, problem.t_end)?;
+    check_initial_state(dim, problem.t0, problem.y0)?;
+    let weights = check_tolerances(problem.options, dim)?;
+    check_step_sizes(problem.options)?;
+    check_output_times(problem.output, problem.t0, problem.t_end)?;
+
+    let mut stepper = make_stepper(dim);
+    stepper
+        .reset(rhs, problem.t0, problem.y0)
+        .map_err(StepFailure::into_error)?;
+    let mut recorder = Recorder::new(problem.output);
+    match control {
+        Control::Fixed => {
+            let dt = fixed_step(problem);
+            if let OutputTimes::Steps = problem.output {
+                let steps = ((problem.t_end - problem.t0) / dt).ceil();
+                // Float-to-int `as` saturates (and maps NaN to 0); the reservation is a hint.
+                solution.reserve((steps as usize).min(MAX_RESERVED_SAMPLES) + 1);
+            }
+            recorder.start(solution, problem.t0, problem.y0);
+            fixed_steps(problem, dt, rhs, &mut stepper, &mut recorder, solution)
+        }
+        Control::Adaptive {
+            controller,
+            error_order,
+        } => {
+            if let OutputTimes::Steps = problem.output {
+                solution.reserve(ADAPTIVE_RESERVED_SAMPLES);
+            }
+            recorder.start(solution, problem.t0, problem.y0);
+            let adaptive = Adaptive {
+                weights: &weights,
+                controller,
+                error_order,
+            };
+            adaptive_steps(
+                problem,
+                adaptive,
+                rhs,
+                &mut stepper,
+                &mut recorder,
+                solution,
+            )
+        }
+    }
+}
+
+/// The fixed step: `dt` (default `(t_end − t0)/1000`), at most `dt_max`.
+fn fixed_step(problem: &Problem<'_>) -> f64 {
+    let span = problem.t_end - problem.t0;
+    let dt = problem.options.dt.unwrap_or(span / DEFAULT_FIXED_STEPS);
+    problem.options.dt_max.map_or(dt, |dt_max| dt.min(dt_max))
+}
+
+/// Constant steps of `dt`, step `k` ending at `t0 + k dt` (computed afresh, so the grid does
+/// not drift by accumulated rounding) and the last ending exactly at `t_end`.
+fn fixed_steps<S: Stepper>(
+    problem: &Problem<'_>,
+    dt: f64,
+    rhs: &mut CheckedRhs<'_>,
+    stepper: &mut S,
+    recorder: &mut Recorder<'_>,
+    solution: &mut Solution,
+) -> Result<(), IntegrationError> {
+    let (t0, t_end) = (problem.t0, problem.t_end);
+    let largest_t = t0.abs().max(t_end.abs());
+    if dt.is_nan() || dt < min_step(largest_t, t_end - t0) {
+        return Err(IntegrationError::StepSizeTooSmall { t: t0, dt });
+    }
+    // A grid point this close to t_end is taken as t_end, rather than leaving a sliver step
+    // made of rounding error (t0 + N dt misses t_end by a few ulps for most dt).
+    let snap = (1e-9 * dt).max(8.0 * f64::EPSILON * largest_t);
+    let mut k: u64 = 0;
+    while stepper.t() < t_end {
+        if solution.stats.steps >= problem.options.max_steps {
+            return Err(IntegrationError::TooManySteps {
+                t: stepper.t(),
+                max_steps: problem.options.max_steps,
+            });
+        }
+        k += 1;
+        let mut t_new = t0 + k as f64 * dt;
+        if t_new >= t_end - snap {
+            t_new = t_end;
+        }
+        stepper
+            .attempt(rhs, t_new, None)
+            .map_err(StepFailure::into_error)?;
+        stepper.accept(rhs).map_err(StepFailure::into_error)?;
+        solution.stats.steps += 1;
+        recorder.record_step(solution, stepper);
+    }
+    Ok(())
+}
+
+/// What adaptive stepping needs besides the problem.
+struct Adaptive<'a, 'c> {
+    weights: &'a ErrorWeights,
+    controller: &'c mut dyn StepSizeController,
+    error_order: u32,
+}
+
+/// Error-controlled steps: each attempt is accepted or rejected by the controller.
+///
+/// A step stretched by up to 1 % (but never beyond `dt_max`) lands on `t_end` rather than
+/// leaving a tiny last step (as Hairer's codes do). An attempt whose right-hand side or
+/// candidate is not finite counts as an infinite error, so the step shrinks; if that persists
+/// until the step is too small, the non-finite value is reported rather than
+/// [`IntegrationError::StepSizeTooSmall`].
+fn adaptive_steps<S: Stepper>(
+    problem: &Problem<'_>,
+    adaptive: Adaptive<'_, '_>,
+    rhs: &mut CheckedRhs<'_>,
+    stepper: &mut S,
+    recorder: &mut Recorder<'_>,
+    solution: &mut Solution,
+) -> Result<(), IntegrationError> {
+    let Adaptive {
+        weights,
+        controller,
+        error_order,
+    } = adaptive;
+    let (t0, t_end) = (problem.t0, problem.t_end);
+    let span = t_end - t0;
+    let max_steps = problem.options.max_steps;
+    let dt_max = problem
+        .options
+        .dt_max
+        .map_or(span, |dt_max| dt_max.min(span));
+    let mut dt = match problem.options.dt {
+        Some(dt) => dt.min(dt_max),
+        None => initial_step(rhs, stepper, weights, error_order, dt_max, span),
+    };
+    controller.reset();
+    let mut last_failure: Option<StepFailure> = None;
+    let mut attempts: usize = 0;
+    while stepper.t() < t_end {
+        let t = stepper.t();
+        if attempts >= max_steps {
+            return Err(IntegrationError::TooManySteps { t, max_steps });
+        }
+        // A NaN step (from a controller with NaN parameters) is too small as well.
+        if dt.is_nan() || dt < min_step(t, span) {
+            return Err(match last_failure {
+                Some(failure) => failure.into_error(),
+                None => IntegrationError::StepSizeTooSmall { t, dt },
+            });
+        }
+        let t_new = if t + 1.01 * dt >= t_end && t_end - t <= dt_max {
+            t_end
+        } else {
+            t + dt
+        };
+        attempts += 1;
+        let (error_norm, usable) = match stepper.attempt(rhs, t_new, Some(weights)) {
+            Ok(error_norm) => {
+                last_failure = None;
+                debug_assert!(error_norm.is_some(), "adaptive stepping needs an estimator");
+                (error_norm.unwrap_or(0.0), true)
+            }
+            Err(failure) if failure.is_recoverable() => {
+                last_failure = Some(failure);
+                (f64::INFINITY, false)
+            }
+            Err(failure) => return Err(failure.into_error()),
+        };
+        match controller.decide(t_new - t, error_norm) {
+            // `usable` guards against a controller that would accept an infinite error.
+            StepOutcome::Accepted { dt_next } if usable => {
+                stepper.accept(rhs).map_err(StepFailure::into_error)?;
+                solution.stats.steps += 1;
+                recorder.record_step(solution, stepper);
+                dt = dt_next.min(dt_max);
+            }
+            StepOutcome::Accepted { .. } => {
+                solution.stats.rejected += 1;
+                dt = 0.2 * (t_new - t);
+            }
+            StepOutcome::Rejected { dt_retry } => {
+                solution.stats.rejected += 1;
+                dt = dt_retry;
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Weighted RMS norm `√(Σᵢ (vᵢ / scaleᵢ)² / n)`; a zero entry counts as zero even where its
+/// scale is zero.
+fn weighted_rms(n: usize, mut ratio: impl FnMut(usize) -> (f64, f64)) -> f64 {
+    if n == 0 {
+        return 0.0;
+    }
+    let sum: f64 = (0..n)
+        .map(|i| {
+            let (value, scale) = ratio(i);
+            if value == 0.0 {
+                0.0
+            } else {
+                (value / scale).powi(2)
+            }
+        })
+        .sum();
+    (sum / n as f64).sqrt()
+}
+
+/// A first step for an adaptive method, from `F` at the start and one explicit Euler probe
+/// (one evaluation of `F`), following Hairer, Nørsett and Wanner.
+///
+/// With `‖·‖` the weighted RMS norm with scales `atolᵢ + rtolᵢ |y₀ᵢ|`:
+///
+/// ```text
+/// d₀ = ‖y₀‖, d₁ = ‖F(t₀, y₀)‖
+/// h₀ = 0.01 d₀/d₁                      (1e-6 if d₀ or d₁ < 1e-5)
+/// y₁ = y₀ + h₀ F(t₀, y₀),  d₂ = ‖F(t₀ + h₀, y₁) − F(t₀, y₀)‖ / h₀
+/// h₁ = (0.01 / max(d₁, d₂))^(1/(q+1))  (max(1e-6, 1e-3 h₀) if max(d₁, d₂) ≤ 1e-15)
+/// h  = min(100 h₀, h₁, dt_max)
+/// ```
+///
+/// with `q` the order of the error estimator. If the probe fails, `h₀` is used.
+///
+/// # References
+/// E. Hairer, S. P. Nørsett, G. Wanner, *Solving Ordinary Differential Equations I*, 2nd ed.,
+/// Springer, 1993, §II.4 ("Starting step size"), doi:10.1007/978-3-540-78862-1.
+fn initial_step<S: Stepper>(
+    rhs: &mut CheckedRhs<'_>,
+    stepper: &S,
+    weights: &ErrorWeights,
+    error_order: u32,
+    dt_max: f64,
+    span: f64,
+) -> f64 {
+    let (t0, y0, f0) = (stepper.t(), stepper.y(), stepper.derivative());
+    let n = y0.len();
+    let scale = |i: usize| weights.scale(i, y0[i].abs());
+    let d0 = weighted_rms(n, |i| (y0[i], scale(i)));
+    let d1 = weighted_rms(n, |i| (f0[i], scale(i)));
+    let mut h0 = if d0 < 1e-5 || d1 < 1e-5 {
+        1e-6
+    } else {
+        0.01 * d0 / d1
+    };
+    if !(h0.is_finite() && h0 > 0.0) {
+        h0 = 1e-6;
+    }
+    let dt_min = min_step(t0, span);
+    h0 = h0.min(dt_max).max(dt_min);
+    // Two buffers once per integration, not per step.
+    let y1: Vec<f64> = y0.iter().zip(f0).map(|(y, f)| y + h0 * f).collect();
+    let mut f1 = vec![0.0; n];
+    if rhs.eval(t0 + h0, &y1, &mut f1).is_err() {
+        return h0;
+    }
+    let d2 = weighted_rms(n, |i| (f1[i] - f0[i], scale(i))) / h0;
+    let d_max = d1.max(d2);
+    let h1 = if d_max <= 1e-15 {
+        (h0 * 1e-3).max(1e-6)
+    } else {
+        (0.01 / d_max).powf(1.0 / f64::from(error_order + 1))
+    };
+    // `f64::min`/`max` ignore a NaN operand, so the result is always a usable step.
+    (100.0 * h0).min(h1).min(dt_max).max(dt_min)
+}
+
+/// Records the samples [`OutputTimes`] asks for, as the steps go by.
+struct Recorder<'a> {
+    /// The requested times, or `None` to record every step.
+    times: Option<&'a [f64]>,
+    /// The first requested time not yet recorded.
+    next: usize,
+}
+
+impl<'a> Recorder<'a> {
+    fn new(output: &'a OutputTimes) -> Self {
+        let times = match output {
+            OutputTimes::Steps => None,
+            OutputTimes::At(times) => Some(times.as_slice()),
+        };
+        Self { times, next: 0 }
+    }
+
+    /// Records the initial state: as the first step sample, or for requested times at `t0`.
+    fn start(&mut self, solution: &mut Solution, t0: f64, y0: &[f64]) {
+        match self.times {
+            None => solution.push(t0, y0),
+            Some(times) => {
+                solution.reserve(times.len());
+                while self.next < times.len() && times[self.next] <= t0 {
+                    solution.push(times[self.next], y0);
+                    self.next += 1;
+                }
+            }
+        }
+    }
+
+    /// Records after an accepted step: its end, or the requested times it covers, by dense
+    /// output (a time equal to the step's end gets the step's state exactly).
+    fn record_step<S: Stepper>(&mut self, solution: &mut Solution, stepper: &S) {
+        let t = stepper.t();
+        match self.times {
+            None => solution.push(t, stepper.y()),
+            Some(times) => {
+                while self.next < times.len() && times[self.next] <= t {
+                    let t_out = times[self.next];
+                    debug_assert!(t_out >= stepper.interval().0);
+                    if t_out == t {
+                        solution.push(t, stepper.y());
+                    } else {
+                        solution.push_with(t_out, |out| stepper.interpolate(t_out, out));
+                    }
+                    self.next += 1;
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn min_step_scales_with_t_and_span() {
+        assert_eq!(min_step(0.0, 1.0), 16.0 * f64::EPSILON);
+        assert_eq!(min_step(-100.0, 1.0), 1600.0 * f64::EPSILON);
+    }
+
+    #[test]
+    fn weighted_rms_ignores_zeros_with_zero_scale() {
+        assert_eq!(weighted_rms(0, |_| (1.0, 1.0)), 0.0);
+        let norm = weighted_rms(2, |i| ([0.0, 3.0][i], [0.0, 1.0][i]));
+        assert!((norm - 4.5_f64.sqrt()).abs() < 1e-15);
+        assert_eq!(weighted_rms(1, |_| (1.0, 0.0)), f64::INFINITY);
+    }
+}

@@ -1,0 +1,200 @@
+//! Why an integration stopped: [`IntegrationError`], and [`IntegrationFailure`], which keeps
+//! the samples computed before it.
+
+use super::solution::Solution;
+
+/// Why an integration did not reach `t_end`.
+///
+/// The first group of variants rejects the input before any step is taken; the second
+/// reports a failure during the integration, at time `t` (see [`IntegrationError::t`]).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum IntegrationError {
+    /// The time span is empty, reversed or not finite: integration needs finite `t0 < t_end`.
+    #[error("the time span [{t0}, {t_end}] is empty, reversed or not finite (need t0 < t_end)")]
+    InvalidTimeSpan {
+        /// Initial time.
+        t0: f64,
+        /// Final time.
+        t_end: f64,
+    },
+    /// The initial state does not have the system's dimension.
+    #[error("the initial state has {found} components but the system has dimension {expected}")]
+    DimensionMismatch {
+        /// The system's dimension, [`OdeSystem::dim`](crate::OdeSystem::dim).
+        expected: usize,
+        /// The length of the initial state.
+        found: usize,
+    },
+    /// A per-component tolerance does not have one value per state component.
+    #[error("`{option}` has {found} components but the state has {expected}")]
+    ToleranceLengthMismatch {
+        /// Which option: `"rtol"` or `"atol"`.
+        option: &'static str,
+        /// The system's dimension.
+        expected: usize,
+        /// The number of values given.
+        found: usize,
+    },
+    /// A tolerance is negative or not finite.
+    #[error("`{option}` is {value} for component {index}; tolerances must be finite and >= 0")]
+    InvalidTolerance {
+        /// Which option: `"rtol"` or `"atol"`.
+        option: &'static str,
+        /// The component (0 for a scalar tolerance).
+        index: usize,
+        /// The offending value.
+        value: f64,
+    },
+    /// `rtol` and `atol` are both zero for a component, so its error scale can be zero.
+    #[error("`rtol` and `atol` are both zero for component {index}")]
+    ZeroTolerance {
+        /// The component.
+        index: usize,
+    },
+    /// `dt` or `dt_max` is zero, negative or not finite.
+    #[error("`{option}` is {value}; step sizes must be finite and positive")]
+    InvalidStepSize {
+        /// Which option: `"dt"` or `"dt_max"`.
+        option: &'static str,
+        /// The offending value.
+        value: f64,
+    },
+    /// A requested output time is earlier than the one before it.
+    #[error(
+        "output time {index} ({t}) is earlier than the one before it ({previous}); output times must be sorted"
+    )]
+    OutputTimesNotSorted {
+        /// Position of the offending time in the list.
+        index: usize,
+        /// The offending time.
+        t: f64,
+        /// The time before it.
+        previous: f64,
+    },
+    /// A requested output time lies outside `[t0, t_end]` (or is NaN).
+    #[error("output time {index} ({t}) lies outside [{t0}, {t_end}]")]
+    OutputTimeOutOfRange {
+        /// Position of the offending time in the list.
+        index: usize,
+        /// The offending time.
+        t: f64,
+        /// Initial time.
+        t0: f64,
+        /// Final time.
+        t_end: f64,
+    },
+    /// The step size fell below `16 ε · max(|t|, t_end − t0)`: the solution changes faster
+    /// than the method can follow (a singularity, or stiffness for an explicit method).
+    #[error("the step size {dt:e} fell below the smallest usable step at t = {t}")]
+    StepSizeTooSmall {
+        /// Time reached.
+        t: f64,
+        /// The step size that was too small.
+        dt: f64,
+    },
+    /// `max_steps` step attempts did not reach `t_end`.
+    #[error("{max_steps} step attempts did not reach t_end (stopped at t = {t})")]
+    TooManySteps {
+        /// Time reached.
+        t: f64,
+        /// The limit, [`IntegratorOptions::max_steps`](super::IntegratorOptions::max_steps).
+        max_steps: usize,
+    },
+    /// A component of the state is NaN or infinite, at `t0` (the initial state) or after a
+    /// step (overflow).
+    #[error("component {index} of the state is not finite at t = {t}")]
+    NonFiniteState {
+        /// Time of the non-finite state.
+        t: f64,
+        /// Index of the first non-finite component.
+        index: usize,
+    },
+    /// The right-hand side is NaN or infinite, as reported by the system
+    /// ([`RhsError::NonFinite`](crate::RhsError::NonFinite)) or found by the integrator.
+    #[error("component {index} of the right-hand side is not finite at t = {t}")]
+    RhsNonFinite {
+        /// Time at which the right-hand side was evaluated (a stage time of the failed step).
+        t: f64,
+        /// Index of the first non-finite component.
+        index: usize,
+    },
+    /// The mass matrix is not positive definite
+    /// ([`RhsError::SingularMassMatrix`](crate::RhsError::SingularMassMatrix)).
+    #[error("the mass matrix is not positive definite at t = {t}")]
+    SingularMassMatrix {
+        /// Time at which the right-hand side was evaluated (a stage time of the failed step).
+        t: f64,
+    },
+}
+
+impl IntegrationError {
+    /// The time at which the integration stopped, or `None` for invalid input.
+    pub fn t(&self) -> Option<f64> {
+        match *self {
+            IntegrationError::StepSizeTooSmall { t, .. }
+            | IntegrationError::TooManySteps { t, .. }
+            | IntegrationError::NonFiniteState { t, .. }
+            | IntegrationError::RhsNonFinite { t, .. }
+            | IntegrationError::SingularMassMatrix { t } => Some(t),
+            IntegrationError::InvalidTimeSpan { .. }
+            | IntegrationError::DimensionMismatch { .. }
+            | IntegrationError::ToleranceLengthMismatch { .. }
+            | IntegrationError::InvalidTolerance { .. }
+            | IntegrationError::ZeroTolerance { .. }
+            | IntegrationError::InvalidStepSize { .. }
+            | IntegrationError::OutputTimesNotSorted { .. }
+            | IntegrationError::OutputTimeOutOfRange { .. } => None,
+        }
+    }
+}
+
+/// A failed integration: what went wrong, and every sample recorded before it.
+///
+/// Displays as its [`error`](Self::error). `partial` holds the samples the requested
+/// [`OutputTimes`](super::OutputTimes) had produced up to the failure, all at times before the
+/// failure's `t` (at `t` itself for [`IntegrationError::TooManySteps`]; empty when the input
+/// was rejected), and the statistics of the work done.
+///
+/// The solution is boxed so that `Result<Solution, IntegrationFailure>` stays small on the
+/// success path (clippy's `result_large_err`); it reads like a `Solution` through `Deref`.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{error}")]
+pub struct IntegrationFailure {
+    /// Why the integration stopped.
+    pub error: IntegrationError,
+    /// The samples recorded before the failure, with the statistics of the attempt.
+    pub partial: Box<Solution>,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn messages_name_the_time() {
+        let error = IntegrationError::StepSizeTooSmall { t: 1.0, dt: 1e-16 };
+        assert_eq!(
+            error.to_string(),
+            "the step size 1e-16 fell below the smallest usable step at t = 1"
+        );
+        assert_eq!(error.t(), Some(1.0));
+        let invalid = IntegrationError::InvalidTimeSpan {
+            t0: 1.0,
+            t_end: 0.0,
+        };
+        assert_eq!(invalid.t(), None);
+    }
+
+    #[test]
+    fn failure_displays_as_its_error() {
+        let failure = IntegrationFailure {
+            error: IntegrationError::SingularMassMatrix { t: 0.5 },
+            partial: Box::new(Solution::new(2)),
+        };
+        assert_eq!(
+            failure.to_string(),
+            "the mass matrix is not positive definite at t = 0.5"
+        );
+    }
+}

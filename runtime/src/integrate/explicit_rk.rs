@@ -1,0 +1,286 @@
+//! One stepper for every explicit Runge–Kutta [`Tableau`]: stages, embedded error estimate,
+//! FSAL reuse and Hermite-based dense output.
+
+use std::mem::swap;
+
+use super::dense_output::{DenseOutput, hermite};
+use super::options::ErrorWeights;
+use super::stepper::{CheckedRhs, StepFailure, Stepper};
+use super::tableau::Tableau;
+
+/// An explicit Runge–Kutta method given by its tableau, with all buffers allocated once.
+///
+/// Stage 0 of a step is `F(t, y)` at the current state, kept in `f` (for an FSAL tableau it
+/// is the last stage of the previous step; otherwise it is evaluated when a step is accepted,
+/// which is also what the Hermite dense output needs). Stages `1 … s−1` live in `k`. After an
+/// accepted step, `y_prev`, `f_prev` and `k` describe that step for the dense output.
+#[derive(Debug, Clone)]
+pub(crate) struct ExplicitRk {
+    tableau: Tableau,
+    dim: usize,
+    /// Current time, start of the next step.
+    t: f64,
+    /// Start of the last accepted step.
+    t_prev: f64,
+    /// End of the last attempted step.
+    t_new: f64,
+    /// Current state.
+    y: Vec<f64>,
+    /// State at `t_prev`.
+    y_prev: Vec<f64>,
+    /// Candidate state at `t_new`.
+    y_new: Vec<f64>,
+    /// Stage input, then the error estimate.
+    scratch: Vec<f64>,
+    /// `F(t, y)`.
+    f: Vec<f64>,
+    /// `F(t_prev, y_prev)`.
+    f_prev: Vec<f64>,
+    /// Stages `1 … s−1`, row-major: `(s − 1) × dim`.
+    k: Vec<f64>,
+}
+
+impl ExplicitRk {
+    /// A stepper for `tableau` on a system of dimension `dim`.
+    pub(crate) fn new(tableau: Tableau, dim: usize) -> Self {
+        let stages = tableau.num_stages();
+        Self {
+            tableau,
+            dim,
+            t: 0.0,
+            t_prev: 0.0,
+            t_new: 0.0,
+            y: vec![0.0; dim],
+            y_prev: vec![0.0; dim],
+            y_new: vec![0.0; dim],
+            scratch: vec![0.0; dim],
+            f: vec![0.0; dim],
+            f_prev: vec![0.0; dim],
+            k: vec![0.0; stages.saturating_sub(1) * dim],
+        }
+    }
+}
+
+/// Stage `j` of a step whose first stage is `first` and whose later stages are the rows of `k`.
+#[inline]
+fn stage<'a>(first: &'a [f64], k: &'a [f64], dim: usize, j: usize) -> &'a [f64] {
+    if j == 0 {
+        first
+    } else {
+        &k[(j - 1) * dim..j * dim]
+    }
+}
+
+/// `out = Σⱼ wⱼ kⱼ` over the stages that have a weight (zero weights are skipped).
+///
+/// The increment is summed on its own before it is added to `y` (see [`combine`]), so that
+/// small stage contributions are not rounded against `|y|` one at a time.
+fn weighted_sum(out: &mut [f64], weights: &[f64], first: &[f64], k: &[f64], dim: usize) {
+    out.fill(0.0);
+    for (j, &w) in weights.iter().enumerate() {
+        if w != 0.0 {
+            for (o, &kj) in out.iter_mut().zip(stage(first, k, dim, j)) {
+                *o += w * kj;
+            }
+        }
+    }
+}
+
+/// `out = y + h Σⱼ wⱼ kⱼ`.
+fn combine(out: &mut [f64], y: &[f64], h: f64, weights: &[f64], first: &[f64], k: &[f64]) {
+    weighted_sum(out, weights, first, k, y.len());
+    for (o, &yi) in out.iter_mut().zip(y) {
+        *o = yi + h * *o;
+    }
+}
+
+impl DenseOutput for ExplicitRk {
+    fn interval(&self) -> (f64, f64) {
+        (self.t_prev, self.t)
+    }
+
+    fn interpolate(&self, t: f64, out: &mut [f64]) {
+        let h = self.t - self.t_prev;
+        if h == 0.0 {
+            out.copy_from_slice(&self.y);
+            return;
+        }
+        let theta = (t - self.t_prev) / h;
+        // `out` first holds Σ dᵢ kᵢ over the stages of the accepted step (stage 0 is
+        // f_prev), the quartic correction D = h Σ dᵢ kᵢ divided by h; zero without one.
+        match self.tableau.dense_correction() {
+            Some(d) => weighted_sum(out, d, &self.f_prev, &self.k, self.dim),
+            None => out.fill(0.0),
+        }
+        let ends = self.y_prev.iter().zip(&self.y);
+        let slopes = self.f_prev.iter().zip(&self.f);
+        for (o, ((&y0, &y1), (&f0, &f1))) in out.iter_mut().zip(ends.zip(slopes)) {
+            *o = hermite(theta, y0, y1, h * f0, h * f1, h * *o);
+        }
+    }
+}
+
+impl Stepper for ExplicitRk {
+    fn t(&self) -> f64 {
+        self.t
+    }
+
+    fn y(&self) -> &[f64] {
+        &self.y
+    }
+
+    fn derivative(&self) -> &[f64] {
+        &self.f
+    }
+
+    fn reset(&mut self, rhs: &mut CheckedRhs<'_>, t0: f64, y0: &[f64]) -> Result<(), StepFailure> {
+        self.t = t0;
+        self.t_prev = t0;
+        self.t_new = t0;
+        self.y.copy_from_slice(y0);
+        self.y_prev.copy_from_slice(y0);
+        rhs.eval(t0, y0, &mut self.f)?;
+        self.f_prev.copy_from_slice(&self.f);
+        Ok(())
+    }
+
+    fn attempt(
+        &mut self,
+        rhs: &mut CheckedRhs<'_>,
+        t_new: f64,
+        weights: Option<&ErrorWeights>,
+    ) -> Result<Option<f64>, StepFailure> {
+        let tableau = self.tableau;
+        let n = self.dim;
+        let s = tableau.num_stages();
+        let t = self.t;
+        let h = t_new - t;
+        self.t_new = t_new;
+        for i in 1..s {
+            let (earlier, rest) = self.k.split_at_mut((i - 1) * n);
+            let ki = &mut rest[..n];
+            // The last stage of an FSAL tableau is evaluated at the candidate itself.
+            let input = if tableau.is_fsal() && i == s - 1 {
+                &mut self.y_new
+            } else {
+                &mut self.scratch
+            };
+            combine(input, &self.y, h, tableau.a(i), &self.f, earlier);
+            let c = tableau.c()[i];
+            let t_stage = if c == 1.0 { t_new } else { t + c * h };
+            rhs.eval(t_stage, input, ki)?;
+        }
+        if !tableau.is_fsal() {
+            combine(&mut self.y_new, &self.y, h, tableau.b(), &self.f, &self.k);
+        }
+        if let Some(index) = self.y_new.iter().position(|v| !v.is_finite()) {
+            return Err(StepFailure::NonFiniteState { t: t_new, index });
+        }
+        let (Some(weights), Some(e)) = (weights, tableau.error_weights()) else {
+            return Ok(None);
+        };
+        if n == 0 {
+            return Ok(Some(0.0));
+        }
+        // Hairer's norm: RMS over i of errᵢ / (atolᵢ + rtolᵢ · max(|yᵢ|, |y_newᵢ|)).
+        weighted_sum(&mut self.scratch, e, &self.f, &self.k, n);
+        let mut sum = 0.0;
+        for i in 0..n {
+            let error = h * self.scratch[i];
+            let scale = weights.scale(i, self.y[i].abs().max(self.y_new[i].abs()));
+            // A zero error counts as zero even where the scale is zero (rtol only, y = 0);
+            // a non-zero error there is infinitely large, and the step is rejected.
+            let ratio = if error == 0.0 { 0.0 } else { error / scale };
+            sum += ratio * ratio;
+        }
+        Ok(Some((sum / n as f64).sqrt()))
+    }
+
+    fn accept(&mut self, rhs: &mut CheckedRhs<'_>) -> Result<(), StepFailure> {
+        let n = self.dim;
+        let s = self.tableau.num_stages();
+        // F at the candidate goes into f_prev first, whose old content is no longer needed,
+        // so that a failure leaves the current state untouched.
+        if self.tableau.is_fsal() {
+            self.f_prev
+                .copy_from_slice(&self.k[(s - 2) * n..(s - 1) * n]);
+        } else {
+            rhs.eval(self.t_new, &self.y_new, &mut self.f_prev)?;
+        }
+        swap(&mut self.f, &mut self.f_prev);
+        swap(&mut self.y_prev, &mut self.y);
+        swap(&mut self.y, &mut self.y_new);
+        self.t_prev = self.t;
+        self.t = self.t_new;
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::ode::OdeFn;
+
+    /// One RK4 step of ẏ = y from y = 1 is the degree-4 Taylor polynomial of eʰ.
+    #[test]
+    fn rk4_step_is_the_taylor_polynomial() {
+        let mut system = OdeFn::new(1, |_t: f64, y: &[f64], dy: &mut [f64]| dy[0] = y[0]);
+        let mut rhs = CheckedRhs::new(&mut system);
+        let mut stepper = ExplicitRk::new(Tableau::rk4(), 1);
+        stepper.reset(&mut rhs, 0.0, &[1.0]).unwrap();
+        let h: f64 = 0.1;
+        assert_eq!(stepper.attempt(&mut rhs, h, None).unwrap(), None);
+        stepper.accept(&mut rhs).unwrap();
+        let taylor = 1.0 + h + h * h / 2.0 + h.powi(3) / 6.0 + h.powi(4) / 24.0;
+        assert!((stepper.y()[0] - taylor).abs() < 1e-16);
+        // F at t0, stages 2–4, then F at the new state (the next step's first stage):
+        // four evaluations per step.
+        assert_eq!(rhs.evals(), 1 + 3 + 1);
+        assert_eq!(stepper.derivative()[0], stepper.y()[0]);
+        assert_eq!(stepper.interval(), (0.0, h));
+    }
+
+    /// DOPRI5 reuses its last stage: six evaluations per step.
+    #[test]
+    fn dopri5_step_is_fsal() {
+        let mut system = OdeFn::new(1, |t: f64, _y: &[f64], dy: &mut [f64]| dy[0] = t.cos());
+        let mut rhs = CheckedRhs::new(&mut system);
+        let mut stepper = ExplicitRk::new(Tableau::dopri5(), 1);
+        stepper.reset(&mut rhs, 0.0, &[0.0]).unwrap();
+        let weights = ErrorWeights {
+            rtol: vec![1e-6],
+            atol: vec![1e-9],
+        };
+        let error = stepper.attempt(&mut rhs, 0.1, Some(&weights)).unwrap();
+        assert!(error.unwrap() > 0.0);
+        stepper.accept(&mut rhs).unwrap();
+        assert_eq!(rhs.evals(), 1 + 6);
+        assert!((stepper.y()[0] - 0.1_f64.sin()).abs() < 1e-10);
+        assert_eq!(stepper.derivative()[0], 0.1_f64.cos());
+        // Dense output at the ends reproduces the step exactly.
+        let mut out = [0.0];
+        stepper.interpolate(0.0, &mut out);
+        assert_eq!(out[0], 0.0);
+        stepper.interpolate(0.1, &mut out);
+        assert_eq!(out[0], stepper.y()[0]);
+        stepper.interpolate(0.05, &mut out);
+        assert!((out[0] - 0.05_f64.sin()).abs() < 1e-9);
+    }
+
+    #[test]
+    fn a_rejected_attempt_leaves_the_state() {
+        let mut system = OdeFn::new(1, |t: f64, y: &[f64], dy: &mut [f64]| {
+            dy[0] = if t > 0.5 { f64::NAN } else { -y[0] };
+        });
+        let mut rhs = CheckedRhs::new(&mut system);
+        let mut stepper = ExplicitRk::new(Tableau::dopri5(), 1);
+        stepper.reset(&mut rhs, 0.0, &[1.0]).unwrap();
+        let failure = stepper.attempt(&mut rhs, 1.0, None).unwrap_err();
+        assert!(matches!(failure, StepFailure::Rhs { t, .. } if t > 0.5));
+        assert_eq!(stepper.t(), 0.0);
+        assert_eq!(stepper.y(), &[1.0]);
+        assert!(stepper.attempt(&mut rhs, 0.25, None).is_ok());
+        stepper.accept(&mut rhs).unwrap();
+        assert_eq!(stepper.t(), 0.25);
+    }
+}

@@ -1,0 +1,108 @@
+//! Numerical integration of first-order systems `ẏ = F(t, y)`: one [`Integrator`] trait and
+//! every method behind it.
+//!
+//! | method | type | order | steps | dense output ([`OutputTimes::At`]) |
+//! |---|---|---|---|---|
+//! | classical Runge–Kutta | [`RungeKutta4`] | 4 | fixed `dt` | cubic Hermite (order 3) |
+//! | Dormand–Prince 5(4) | [`DormandPrince54`] | 5 | adaptive ([`PiController`]) or fixed | Shampine's quartic (order 4) |
+//!
+//! An integration takes an [`OdeSystem`] (a hand-written [`OdeFn`](crate::OdeFn), or a model
+//! through [`FirstOrder`](crate::FirstOrder)), an interval `[t0, t_end]`, an initial state,
+//! the [`OutputTimes`] to record and [`IntegratorOptions`]. It returns a [`Solution`] with
+//! [`Stats`], or an [`IntegrationFailure`]: an [`IntegrationError`] together with every sample
+//! recorded before it. Bad input is an error, never a panic; a NaN is never returned.
+//!
+//! Inside, every method is a *stepper* (one step from the current state, an interpolant over
+//! the last accepted step) driven by one shared loop that checks the input, chooses the step
+//! sequence (fixed, or adaptive through a [`StepSizeController`]), samples the output and maps
+//! failures to errors. Explicit Runge–Kutta methods are one stepper parameterised by a
+//! [`Tableau`]. No heap allocation happens per step: buffers are allocated once per
+//! `integrate` call, and the solution grows by amortised doubling.
+//!
+//! # Examples
+//! ```
+//! use eomgen_runtime::{
+//!     DormandPrince54, Integrator, IntegratorOptions, OdeFn, OutputTimes, RungeKutta4,
+//! };
+//!
+//! // ẏ = −y + sin t, y(0) = 1: y(t) = (sin t − cos t)/2 + 3/2 e^(−t).
+//! let exact = |t: f64| (t.sin() - t.cos()) / 2.0 + 1.5 * (-t).exp();
+//! let mut system = OdeFn::new(1, |t: f64, y: &[f64], dy: &mut [f64]| dy[0] = -y[0] + t.sin());
+//! let output = OutputTimes::At(vec![0.5, 1.0, 2.0]);
+//! let options = IntegratorOptions::default().with_rtol(1e-8).with_atol(1e-8);
+//! let mut methods: Vec<Box<dyn Integrator>> =
+//!     vec![Box::new(RungeKutta4::new()), Box::new(DormandPrince54::new())];
+//! for method in &mut methods {
+//!     let solution = method.integrate(&mut system, 0.0, &[1.0], 2.0, &output, &options)?;
+//!     for (t, y) in solution.iter() {
+//!         assert!((y[0] - exact(t)).abs() < 1e-7, "{} at t = {t}", method.name());
+//!     }
+//! }
+//! # Ok::<(), eomgen_runtime::IntegrationFailure>(())
+//! ```
+
+mod controller;
+mod dense_output;
+mod dopri5;
+mod driver;
+mod error;
+mod explicit_rk;
+mod options;
+mod rk4;
+mod solution;
+mod stepper;
+mod tableau;
+
+pub use controller::{PiController, StepOutcome, StepSizeController};
+pub use dopri5::DormandPrince54;
+pub use error::{IntegrationError, IntegrationFailure};
+pub use options::{IntegratorOptions, OutputTimes, Tolerance};
+pub use rk4::RungeKutta4;
+pub use solution::{Solution, Stats};
+pub use tableau::Tableau;
+
+use crate::ode::OdeSystem;
+
+/// A method that integrates `ẏ = F(t, y)` forward in time.
+///
+/// Object safe: the CLI holds methods as `Box<dyn Integrator>`.
+pub trait Integrator {
+    /// Short name of the method (`"rk4"`, `"dopri5"`).
+    fn name(&self) -> &'static str;
+
+    /// Order of convergence `p` of the method: the global error at a fixed final time
+    /// behaves as `O(dtᵖ)`.
+    fn order(&self) -> u32;
+
+    /// Integrates `system` from `(t0, y0)` to `t_end`, recording the samples `output` asks
+    /// for.
+    ///
+    /// Only forward integration is supported: `t_end > t0`. The last step ends exactly at
+    /// `t_end`, so with [`OutputTimes::Steps`] the last sample is `(t_end, y(t_end))`.
+    ///
+    /// # Shapes
+    /// `y0` has `n = system.dim()` entries; the solution's `y` has `n` entries per sample.
+    ///
+    /// # Errors
+    /// An [`IntegrationFailure`] whose `partial` solution holds the samples recorded before
+    /// the failure, with one of these errors:
+    /// - invalid input, before any step: [`IntegrationError::InvalidTimeSpan`] (`t_end ≤ t0`
+    ///   or not finite), [`IntegrationError::DimensionMismatch`] (`y0`),
+    ///   [`IntegrationError::NonFiniteState`] (`y0` not finite),
+    ///   [`IntegrationError::ToleranceLengthMismatch`], [`IntegrationError::InvalidTolerance`],
+    ///   [`IntegrationError::ZeroTolerance`], [`IntegrationError::InvalidStepSize`],
+    ///   [`IntegrationError::OutputTimesNotSorted`],
+    ///   [`IntegrationError::OutputTimeOutOfRange`];
+    /// - during the integration: [`IntegrationError::StepSizeTooSmall`],
+    ///   [`IntegrationError::TooManySteps`], [`IntegrationError::NonFiniteState`],
+    ///   [`IntegrationError::RhsNonFinite`], [`IntegrationError::SingularMassMatrix`].
+    fn integrate(
+        &mut self,
+        system: &mut dyn OdeSystem,
+        t0: f64,
+        y0: &[f64],
+        t_end: f64,
+        output: &OutputTimes,
+        options: &IntegratorOptions,
+    ) -> Result<Solution, IntegrationFailure>;
+}

@@ -1,0 +1,379 @@
+//! Butcher tableaus of explicit Runge–Kutta methods, with the coefficients as exact rationals
+//! as printed in their sources.
+
+/// The coefficients of an explicit Runge–Kutta method, with an optional embedded error
+/// estimator and dense-output correction.
+///
+/// ```text
+///   c₁ = 0 |
+///   c₂     | a₂₁
+///   ⋮      | ⋮          ⋱
+///   cₛ     | aₛ₁  …  aₛ,ₛ₋₁
+///  --------+----------------------
+///          | b₁   …  bₛ₋₁   bₛ     order p   (the solution that is propagated)
+///          | b̂₁   …  b̂ₛ₋₁   b̂ₛ     order p̂   (the embedded solution, for error estimation)
+/// ```
+///
+/// One step of size `h` from `(t, y)`:
+///
+/// ```text
+/// kᵢ = F(t + cᵢ h, y + h Σⱼ<ᵢ aᵢⱼ kⱼ),   y₁ = y + h Σᵢ bᵢ kᵢ,   err = h Σᵢ (bᵢ − b̂ᵢ) kᵢ
+/// ```
+///
+/// A tableau is *FSAL* (first same as last) when its last row of `a` equals `b` and
+/// `cₛ = 1`: the last stage is then `F(t + h, y₁)`, the first stage of the next step.
+///
+/// Dense output over a step is the cubic Hermite interpolant of `(y, F(t, y))` and
+/// `(y₁, F(t + h, y₁))`, plus, when the tableau has one, a quartic correction
+/// `θ²(1 − θ)² h Σᵢ dᵢ kᵢ` at `t + θh` (this is how Hairer writes Shampine's continuous
+/// extension of the Dormand–Prince pair).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Tableau {
+    name: &'static str,
+    order: u32,
+    embedded_order: Option<u32>,
+    c: &'static [f64],
+    a: &'static [&'static [f64]],
+    b: &'static [f64],
+    b_embedded: Option<&'static [f64]>,
+    /// `b − b̂`, written as exact rationals rather than computed, to keep the error estimate
+    /// free of cancellation.
+    error_weights: Option<&'static [f64]>,
+    dense_correction: Option<&'static [f64]>,
+    fsal: bool,
+}
+
+/// Classical Runge–Kutta, `c`.
+static RK4_C: [f64; 4] = [0.0, 1.0 / 2.0, 1.0 / 2.0, 1.0];
+/// Classical Runge–Kutta, `a` (row `i` holds `aᵢ₁ … aᵢ,ᵢ₋₁`).
+static RK4_A: [&[f64]; 4] = [&[], &[1.0 / 2.0], &[0.0, 1.0 / 2.0], &[0.0, 0.0, 1.0]];
+/// Classical Runge–Kutta, `b`.
+static RK4_B: [f64; 4] = [1.0 / 6.0, 1.0 / 3.0, 1.0 / 3.0, 1.0 / 6.0];
+
+/// Dormand–Prince 5(4), `c`.
+static DOPRI5_C: [f64; 7] = [0.0, 1.0 / 5.0, 3.0 / 10.0, 4.0 / 5.0, 8.0 / 9.0, 1.0, 1.0];
+/// Dormand–Prince 5(4), `a` (row `i` holds `aᵢ₁ … aᵢ,ᵢ₋₁`).
+static DOPRI5_A: [&[f64]; 7] = [
+    &[],
+    &[1.0 / 5.0],
+    &[3.0 / 40.0, 9.0 / 40.0],
+    &[44.0 / 45.0, -56.0 / 15.0, 32.0 / 9.0],
+    &[
+        19372.0 / 6561.0,
+        -25360.0 / 2187.0,
+        64448.0 / 6561.0,
+        -212.0 / 729.0,
+    ],
+    &[
+        9017.0 / 3168.0,
+        -355.0 / 33.0,
+        46732.0 / 5247.0,
+        49.0 / 176.0,
+        -5103.0 / 18656.0,
+    ],
+    &[
+        35.0 / 384.0,
+        0.0,
+        500.0 / 1113.0,
+        125.0 / 192.0,
+        -2187.0 / 6784.0,
+        11.0 / 84.0,
+    ],
+];
+/// Dormand–Prince 5(4), `b` (fifth order; equal to the last row of `a`).
+static DOPRI5_B: [f64; 7] = [
+    35.0 / 384.0,
+    0.0,
+    500.0 / 1113.0,
+    125.0 / 192.0,
+    -2187.0 / 6784.0,
+    11.0 / 84.0,
+    0.0,
+];
+/// Dormand–Prince 5(4), `b̂` (fourth order).
+static DOPRI5_B_EMBEDDED: [f64; 7] = [
+    5179.0 / 57600.0,
+    0.0,
+    7571.0 / 16695.0,
+    393.0 / 640.0,
+    -92097.0 / 339200.0,
+    187.0 / 2100.0,
+    1.0 / 40.0,
+];
+/// Dormand–Prince 5(4), `b − b̂` in lowest terms.
+static DOPRI5_ERROR: [f64; 7] = [
+    71.0 / 57600.0,
+    0.0,
+    -71.0 / 16695.0,
+    71.0 / 1920.0,
+    -17253.0 / 339200.0,
+    22.0 / 525.0,
+    -1.0 / 40.0,
+];
+/// Shampine's continuous extension of Dormand–Prince 5(4), as Hairer's `dopri5.f` writes it.
+static DOPRI5_DENSE: [f64; 7] = [
+    -12715105075.0 / 11282082432.0,
+    0.0,
+    87487479700.0 / 32700410799.0,
+    -10690763975.0 / 1880347072.0,
+    701980252875.0 / 199316789632.0,
+    -1453857185.0 / 822651844.0,
+    69997945.0 / 29380423.0,
+];
+
+impl Tableau {
+    /// The classical fourth-order Runge–Kutta method ("RK4"): four stages, no error estimate.
+    ///
+    /// ```text
+    ///  0   |
+    ///  1/2 | 1/2
+    ///  1/2 | 0    1/2
+    ///  1   | 0    0    1
+    /// -----+--------------------
+    ///      | 1/6  1/3  1/3  1/6
+    /// ```
+    ///
+    /// Its dense output is the cubic Hermite interpolant (continuous extension of order 3).
+    ///
+    /// # References
+    /// W. Kutta, "Beitrag zur näherungsweisen Integration totaler Differentialgleichungen",
+    /// Zeitschrift für Mathematik und Physik 46, 435–453, 1901. (No DOI.)
+    pub fn rk4() -> Self {
+        Self {
+            name: "rk4",
+            order: 4,
+            embedded_order: None,
+            c: &RK4_C,
+            a: &RK4_A,
+            b: &RK4_B,
+            b_embedded: None,
+            error_weights: None,
+            dense_correction: None,
+            fsal: false,
+        }
+    }
+
+    /// The Dormand–Prince 5(4) pair ("DOPRI5"): seven stages (six per step, FSAL), fifth-order
+    /// solution, fourth-order embedded estimate, fourth-order dense output.
+    ///
+    /// ```text
+    ///  0    |
+    ///  1/5  | 1/5
+    ///  3/10 | 3/40        9/40
+    ///  4/5  | 44/45      −56/15       32/9
+    ///  8/9  | 19372/6561 −25360/2187  64448/6561  −212/729
+    ///  1    | 9017/3168  −355/33      46732/5247  49/176   −5103/18656
+    ///  1    | 35/384      0           500/1113    125/192  −2187/6784    11/84
+    /// ------+------------------------------------------------------------------------
+    ///   b   | 35/384      0           500/1113    125/192  −2187/6784    11/84     0
+    ///   b̂   | 5179/57600  0           7571/16695  393/640  −92097/339200 187/2100  1/40
+    /// ```
+    ///
+    /// The dense-output correction (see [`Tableau`]) has
+    /// `d = (−12715105075/11282082432, 0, 87487479700/32700410799,
+    /// −10690763975/1880347072, 701980252875/199316789632, −1453857185/822651844,
+    /// 69997945/29380423)`.
+    ///
+    /// # References
+    /// - J. R. Dormand, P. J. Prince, "A family of embedded Runge–Kutta formulae",
+    ///   J. Comput. Appl. Math. 6(1), 19–26, 1980, doi:10.1016/0771-050X(80)90013-3.
+    /// - L. F. Shampine, "Some practical Runge–Kutta formulas", Math. Comp. 46(173), 135–150,
+    ///   1986, doi:10.1090/S0025-5718-1986-0815836-3 (the continuous extension).
+    /// - E. Hairer, S. P. Nørsett, G. Wanner, *Solving Ordinary Differential Equations I*,
+    ///   2nd ed., Springer, 1993, §II.5–II.6, doi:10.1007/978-3-540-78862-1.
+    pub fn dopri5() -> Self {
+        Self {
+            name: "dopri5",
+            order: 5,
+            embedded_order: Some(4),
+            c: &DOPRI5_C,
+            a: &DOPRI5_A,
+            b: &DOPRI5_B,
+            b_embedded: Some(&DOPRI5_B_EMBEDDED),
+            error_weights: Some(&DOPRI5_ERROR),
+            dense_correction: Some(&DOPRI5_DENSE),
+            fsal: true,
+        }
+    }
+
+    /// Short name of the method (`"rk4"`, `"dopri5"`).
+    pub fn name(&self) -> &'static str {
+        self.name
+    }
+
+    /// Order `p` of the propagated solution.
+    pub fn order(&self) -> u32 {
+        self.order
+    }
+
+    /// Order `p̂` of the embedded solution, or `None` without an error estimator.
+    pub fn embedded_order(&self) -> Option<u32> {
+        self.embedded_order
+    }
+
+    /// Number of stages `s`.
+    pub fn num_stages(&self) -> usize {
+        self.c.len()
+    }
+
+    /// The nodes `c`, `s` entries.
+    pub fn c(&self) -> &'static [f64] {
+        self.c
+    }
+
+    /// Row `i` of `a` below the diagonal: `aᵢ₁ … aᵢ,ᵢ₋₁` (`i` entries, 0-based `i < s`).
+    ///
+    /// # Panics
+    /// If `i >= num_stages()`.
+    pub fn a(&self, i: usize) -> &'static [f64] {
+        self.a[i]
+    }
+
+    /// The weights `b` of the propagated solution, `s` entries.
+    pub fn b(&self) -> &'static [f64] {
+        self.b
+    }
+
+    /// The weights `b̂` of the embedded solution, `s` entries, if any.
+    pub fn b_embedded(&self) -> Option<&'static [f64]> {
+        self.b_embedded
+    }
+
+    /// Whether the last stage of a step is the first stage of the next (first same as last).
+    pub fn is_fsal(&self) -> bool {
+        self.fsal
+    }
+
+    /// The error weights `b − b̂`, `s` entries, if the tableau has an embedded solution.
+    pub(crate) fn error_weights(&self) -> Option<&'static [f64]> {
+        self.error_weights
+    }
+
+    /// The weights `d` of the quartic dense-output correction, `s` entries, if any.
+    pub(crate) fn dense_correction(&self) -> Option<&'static [f64]> {
+        self.dense_correction
+    }
+}
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use super::*;
+
+    /// `A c`, for the lower-triangular `a` of `tableau` and a vector `v`.
+    pub(crate) fn a_times(tableau: &Tableau, v: &[f64]) -> Vec<f64> {
+        (0..tableau.num_stages())
+            .map(|i| tableau.a(i).iter().zip(v).map(|(a, v)| a * v).sum())
+            .collect()
+    }
+
+    fn dot(u: &[f64], v: &[f64]) -> f64 {
+        u.iter().zip(v).map(|(u, v)| u * v).sum()
+    }
+
+    fn times(u: &[f64], v: &[f64]) -> Vec<f64> {
+        u.iter().zip(v).map(|(u, v)| u * v).collect()
+    }
+
+    /// The order conditions `Σ bᵢ Φᵢ(τ) = 1/γ(τ)` for every rooted tree `τ` with at most
+    /// `order` vertices (1 + 1 + 2 + 4 + 9 trees up to order 5), as `(weight, 1/γ)` pairs.
+    pub(crate) fn order_conditions(tableau: &Tableau, b: &[f64], order: u32) -> Vec<(f64, f64)> {
+        let c = tableau.c().to_vec();
+        let ones = vec![1.0; c.len()];
+        let c2 = times(&c, &c);
+        let c3 = times(&c2, &c);
+        let ac = a_times(tableau, &c);
+        let ac2 = a_times(tableau, &c2);
+        let aac = a_times(tableau, &ac);
+        let mut conditions = vec![(dot(b, &ones), 1.0)];
+        if order >= 2 {
+            conditions.push((dot(b, &c), 1.0 / 2.0));
+        }
+        if order >= 3 {
+            conditions.push((dot(b, &c2), 1.0 / 3.0));
+            conditions.push((dot(b, &ac), 1.0 / 6.0));
+        }
+        if order >= 4 {
+            conditions.push((dot(b, &c3), 1.0 / 4.0));
+            conditions.push((dot(b, &times(&c, &ac)), 1.0 / 8.0));
+            conditions.push((dot(b, &ac2), 1.0 / 12.0));
+            conditions.push((dot(b, &aac), 1.0 / 24.0));
+        }
+        if order >= 5 {
+            conditions.push((dot(b, &times(&c3, &c)), 1.0 / 5.0));
+            conditions.push((dot(b, &times(&c2, &ac)), 1.0 / 10.0));
+            conditions.push((dot(b, &times(&ac, &ac)), 1.0 / 20.0));
+            conditions.push((dot(b, &times(&c, &ac2)), 1.0 / 15.0));
+            conditions.push((dot(b, &times(&c, &aac)), 1.0 / 30.0));
+            conditions.push((dot(b, &a_times(tableau, &c3)), 1.0 / 20.0));
+            conditions.push((dot(b, &a_times(tableau, &times(&c, &ac))), 1.0 / 40.0));
+            conditions.push((dot(b, &a_times(tableau, &ac2)), 1.0 / 60.0));
+            conditions.push((dot(b, &a_times(tableau, &aac)), 1.0 / 120.0));
+        }
+        conditions
+    }
+
+    fn assert_order(tableau: &Tableau, b: &[f64], order: u32) {
+        for (k, (weight, expected)) in order_conditions(tableau, b, order).into_iter().enumerate() {
+            assert!(
+                (weight - expected).abs() < 1e-14,
+                "{}: condition {k}: {weight} != {expected}",
+                tableau.name()
+            );
+        }
+    }
+
+    fn check_shape(tableau: &Tableau) {
+        let s = tableau.num_stages();
+        assert_eq!(tableau.b().len(), s);
+        assert_eq!(tableau.c()[0], 0.0);
+        for i in 0..s {
+            let row = tableau.a(i);
+            assert_eq!(row.len(), i, "{}: row {i}", tableau.name());
+            // Row sums equal the nodes (the stages are consistent in t).
+            let sum: f64 = row.iter().sum();
+            assert!((sum - tableau.c()[i]).abs() < 1e-14, "row {i}: {sum}");
+        }
+        if tableau.is_fsal() {
+            assert_eq!(tableau.a(s - 1), &tableau.b()[..s - 1]);
+            assert_eq!(tableau.b()[s - 1], 0.0);
+            assert_eq!(tableau.c()[s - 1], 1.0);
+        }
+    }
+
+    #[test]
+    fn rk4_has_order_4() {
+        let tableau = Tableau::rk4();
+        check_shape(&tableau);
+        assert_order(&tableau, tableau.b(), tableau.order());
+        // …and not 5: at least one fifth-order condition fails.
+        assert!(
+            order_conditions(&tableau, tableau.b(), 5)
+                .iter()
+                .any(|(w, e)| (w - e).abs() > 1e-6)
+        );
+    }
+
+    #[test]
+    fn dopri5_has_orders_5_and_4() {
+        let tableau = Tableau::dopri5();
+        check_shape(&tableau);
+        assert_order(&tableau, tableau.b(), 5);
+        let embedded = tableau.b_embedded().unwrap();
+        assert_order(&tableau, embedded, 4);
+        assert!(
+            order_conditions(&tableau, embedded, 5)
+                .iter()
+                .any(|(w, e)| (w - e).abs() > 1e-6)
+        );
+        // The error weights written out are b − b̂.
+        for ((e, b), b_hat) in tableau
+            .error_weights()
+            .unwrap()
+            .iter()
+            .zip(tableau.b())
+            .zip(embedded)
+        {
+            assert!((e - (b - b_hat)).abs() < 1e-16);
+        }
+    }
+}

@@ -1,0 +1,18 @@
+//! The numeric half of eomgen.
+//!
+//! Generated code (from `eomgen::model!`) implements [`MechanicalSystem`]; the runtime turns
+//! `M(q, t) q̈ = F(q, q̇, t)` into the first-order system `ẏ = [q̇; M⁻¹F]` ([`FirstOrder`]) and
+//! integrates it with any [`Integrator`].
+#![warn(missing_docs)]
+
+pub mod integrate;
+pub mod ode;
+pub mod system;
+
+pub use integrate::{
+    DormandPrince54, IntegrationError, IntegrationFailure, Integrator, IntegratorOptions,
+    OutputTimes, PiController, RungeKutta4, Solution, Stats, StepOutcome, StepSizeController,
+    Tableau, Tolerance,
+};
+pub use ode::{OdeFn, OdeSystem, RhsError};
+pub use system::{FirstOrder, MechanicalSystem, ModelInfo, UnknownParameter};

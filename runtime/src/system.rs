@@ -1,0 +1,271 @@
+//! The interface between generated equations of motion and the runtime.
+//!
+//! [`MechanicalSystem`] is what `eomgen::model!` implements for every model file: the mass
+//! matrix `M(q, t)`, the forcing `F(q, q̇, t)` of `M q̈ = F`, their exact Jacobians, energies and
+//! point positions, all with compile-time sizes. [`FirstOrder`] turns it into the first-order
+//! system `y = [q; q̇]`, `ẏ = [q̇; M⁻¹F]` that integrators take, and erases the size so the CLI
+//! can hold any model as a `Box<dyn ModelInfo>`.
+
+use nalgebra::{SMatrix, SVector};
+
+use crate::ode::{OdeSystem, RhsError};
+
+/// A parameter name that the model does not have.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("model `{model}` has no parameter `{name}` (it has: {known})")]
+pub struct UnknownParameter {
+    /// The model's name.
+    pub model: String,
+    /// The name that was asked for.
+    pub name: String,
+    /// The model's parameter names, comma separated.
+    pub known: String,
+}
+
+/// Equations of motion `M(q, t) q̈ = F(q, q̇, t)` of a mechanism with `N` degrees of freedom.
+///
+/// Implemented by the code that `eomgen::model!` generates from a model file; the runtime
+/// never inverts `M` symbolically but factors it numerically at each state.
+///
+/// # Shapes
+/// `q`, `q̇` and `a` are `N`-vectors (generalized coordinates, velocities, and an arbitrary
+/// acceleration-like vector); matrices are `N × N`.
+///
+/// # Units
+/// SI, angles in rad; `F` and `Q` in N or N·m per coordinate; energies in J.
+///
+/// # References
+/// Lagrange's equations in the form of lecture 9 (syllabus), with
+/// `M = ∂²T/∂q̇∂q̇ᵀ` and `F = ∂T/∂q − ∂V/∂q − (∂²T/∂q̇∂qᵀ) q̇ − ∂²T/∂q̇∂t + Q`.
+pub trait MechanicalSystem<const N: usize> {
+    /// The model's name, as in its file (`double_pendulum`).
+    fn name(&self) -> &'static str;
+    /// One-line description from the model file.
+    fn description(&self) -> &'static str;
+    /// Names of the generalized coordinates `q`, in order.
+    fn coordinate_names(&self) -> [&'static str; N];
+    /// Names of the parameters, in file order.
+    fn parameter_names(&self) -> &'static [&'static str];
+    /// Current parameter values, in the order of [`Self::parameter_names`].
+    fn parameter_values(&self) -> Vec<f64>;
+    /// Sets parameter `name` to `value`.
+    ///
+    /// # Errors
+    /// [`UnknownParameter`] if the model has no such parameter.
+    fn set_parameter(&mut self, name: &str, value: f64) -> Result<(), UnknownParameter>;
+    /// Initial state `(q(0), q̇(0))` from the file's `initial:` block, evaluated with the
+    /// current parameter values (unlisted coordinates and rates start at 0).
+    fn initial_state(&self) -> (SVector<f64, N>, SVector<f64, N>);
+
+    /// Mass matrix `M(q, t)`, `N × N`, symmetric and (for a well-posed model) positive definite.
+    fn mass_matrix(&self, q: &SVector<f64, N>, t: f64) -> SMatrix<f64, N, N>;
+    /// Forcing `F(q, q̇, t)`: everything in `M q̈ = F` that is not inertia times `q̈`.
+    fn forcing(&self, q: &SVector<f64, N>, qdot: &SVector<f64, N>, t: f64) -> SVector<f64, N>;
+    /// `M` and `F` together, sharing subexpressions (the hot path of every integrator).
+    fn mass_matrix_and_forcing(
+        &self,
+        q: &SVector<f64, N>,
+        qdot: &SVector<f64, N>,
+        t: f64,
+    ) -> (SMatrix<f64, N, N>, SVector<f64, N>);
+    /// Exact Jacobian `∂F/∂q`, `N × N` (entry `(i, j)` is `∂Fᵢ/∂qⱼ`).
+    fn forcing_jacobian_q(
+        &self,
+        q: &SVector<f64, N>,
+        qdot: &SVector<f64, N>,
+        t: f64,
+    ) -> SMatrix<f64, N, N>;
+    /// Exact Jacobian `∂F/∂q̇`, `N × N`.
+    fn forcing_jacobian_qdot(
+        &self,
+        q: &SVector<f64, N>,
+        qdot: &SVector<f64, N>,
+        t: f64,
+    ) -> SMatrix<f64, N, N>;
+    /// Exact `∂(M(q, t) a)/∂q` for a fixed vector `a`, `N × N` (entry `(i, k)` is
+    /// `Σⱼ ∂Mᵢⱼ/∂qₖ aⱼ`), so that the Jacobian of `q̈ = M⁻¹F` is
+    /// `M⁻¹(∂F/∂q − ∂(M a)/∂q)` at `a = q̈`.
+    fn mass_matrix_product_jacobian(
+        &self,
+        q: &SVector<f64, N>,
+        t: f64,
+        a: &SVector<f64, N>,
+    ) -> SMatrix<f64, N, N>;
+    /// Kinetic energy `T(q, q̇, t)` (J).
+    fn kinetic_energy(&self, q: &SVector<f64, N>, qdot: &SVector<f64, N>, t: f64) -> f64;
+    /// Potential energy `V(q, t)` (J) of gravity and springs, plus the file's `potential`.
+    fn potential_energy(&self, q: &SVector<f64, N>, t: f64) -> f64;
+    /// Whether every load is conservative and nothing depends explicitly on `t`, so that
+    /// `T + V` is a constant of the motion.
+    fn is_conservative(&self) -> bool;
+    /// Names of the model's points, in file order (empty for the energy form).
+    fn point_names(&self) -> &'static [&'static str];
+    /// Positions of the points (m), `[x, y, z]` with `z = 0` for 2-D models, written into
+    /// `out` (length `point_names().len()`).
+    fn point_positions(&self, q: &SVector<f64, N>, t: f64, out: &mut [[f64; 3]]);
+    /// The derived equations as plain text (`M`, `F`, `T`, `V`).
+    fn equations_text(&self) -> &'static str;
+    /// The derived equations as LaTeX.
+    fn equations_latex(&self) -> &'static str;
+}
+
+/// The first-order form `y = [q; q̇]`, `ẏ = [q̇; M⁻¹F]` of a [`MechanicalSystem`].
+///
+/// `M q̈ = F` is solved at every evaluation by Cholesky factorisation; a mass matrix that is not
+/// positive definite is [`RhsError::SingularMassMatrix`], a non-finite `q̈` is
+/// [`RhsError::NonFinite`]. No heap allocation.
+#[derive(Debug, Clone)]
+pub struct FirstOrder<S, const N: usize> {
+    /// The wrapped system.
+    pub system: S,
+}
+
+impl<S: MechanicalSystem<N>, const N: usize> FirstOrder<S, N> {
+    /// Wraps `system`.
+    pub fn new(system: S) -> Self {
+        Self { system }
+    }
+
+    /// Generalized accelerations `q̈ = M⁻¹F` at `(q, q̇, t)`.
+    ///
+    /// # Errors
+    /// [`RhsError::SingularMassMatrix`] if `M` is not positive definite, [`RhsError::NonFinite`]
+    /// if `q̈` has a NaN or infinite component (index counted in `y`, so `N + i`).
+    pub fn generalized_accelerations(
+        &self,
+        q: &SVector<f64, N>,
+        qdot: &SVector<f64, N>,
+        t: f64,
+    ) -> Result<SVector<f64, N>, RhsError> {
+        let (m, f) = self.system.mass_matrix_and_forcing(q, qdot, t);
+        let chol = nalgebra::Cholesky::new(m).ok_or(RhsError::SingularMassMatrix)?;
+        let qdd = chol.solve(&f);
+        if let Some(i) = qdd.iter().position(|v| !v.is_finite()) {
+            return Err(RhsError::NonFinite { index: N + i });
+        }
+        Ok(qdd)
+    }
+}
+
+fn split<const N: usize>(y: &[f64]) -> (SVector<f64, N>, SVector<f64, N>) {
+    (
+        SVector::<f64, N>::from_column_slice(&y[..N]),
+        SVector::<f64, N>::from_column_slice(&y[N..2 * N]),
+    )
+}
+
+impl<S: MechanicalSystem<N>, const N: usize> OdeSystem for FirstOrder<S, N> {
+    fn dim(&self) -> usize {
+        2 * N
+    }
+
+    fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), RhsError> {
+        let (q, qdot) = split::<N>(y);
+        let qdd = self.generalized_accelerations(&q, &qdot, t)?;
+        dy[..N].copy_from_slice(qdot.as_slice());
+        dy[N..2 * N].copy_from_slice(qdd.as_slice());
+        Ok(())
+    }
+}
+
+/// A model with its size erased, as the CLI holds it: `Box<dyn ModelInfo>`.
+///
+/// Vectors here are runtime-sized; `y = [q; q̇]` has length `2 num_dofs()`.
+pub trait ModelInfo: OdeSystem {
+    /// The model's name.
+    fn name(&self) -> &'static str;
+    /// One-line description.
+    fn description(&self) -> &'static str;
+    /// Number of degrees of freedom `n`.
+    fn num_dofs(&self) -> usize;
+    /// Names of the generalized coordinates (length `n`).
+    fn coordinate_names(&self) -> Vec<&'static str>;
+    /// Parameter names, in file order.
+    fn parameter_names(&self) -> &'static [&'static str];
+    /// Current parameter values.
+    fn parameter_values(&self) -> Vec<f64>;
+    /// Sets a parameter by name.
+    ///
+    /// # Errors
+    /// [`UnknownParameter`] if there is no parameter `name`.
+    fn set_parameter(&mut self, name: &str, value: f64) -> Result<(), UnknownParameter>;
+    /// Initial state `y(0) = [q(0); q̇(0)]` (length `2n`).
+    fn initial_state(&self) -> Vec<f64>;
+    /// Kinetic energy `T` at `(t, y)` (J).
+    fn kinetic_energy(&self, t: f64, y: &[f64]) -> f64;
+    /// Potential energy `V` at `(t, y)` (J).
+    fn potential_energy(&self, t: f64, y: &[f64]) -> f64;
+    /// Total mechanical energy `T + V` (J).
+    fn energy(&self, t: f64, y: &[f64]) -> f64 {
+        self.kinetic_energy(t, y) + self.potential_energy(t, y)
+    }
+    /// Whether `T + V` is a constant of the motion.
+    fn is_conservative(&self) -> bool;
+    /// Names of the model's points.
+    fn point_names(&self) -> &'static [&'static str];
+    /// Positions of the points at `(t, y)`, `[x, y, z]` each (m).
+    fn point_positions(&self, t: f64, y: &[f64]) -> Vec<[f64; 3]>;
+    /// The derived equations as text.
+    fn equations_text(&self) -> &'static str;
+    /// The derived equations as LaTeX.
+    fn equations_latex(&self) -> &'static str;
+    /// Upcast to the first-order system for an integrator.
+    fn as_ode_mut(&mut self) -> &mut dyn OdeSystem;
+}
+
+impl<S: MechanicalSystem<N>, const N: usize> ModelInfo for FirstOrder<S, N> {
+    fn name(&self) -> &'static str {
+        self.system.name()
+    }
+    fn description(&self) -> &'static str {
+        self.system.description()
+    }
+    fn num_dofs(&self) -> usize {
+        N
+    }
+    fn coordinate_names(&self) -> Vec<&'static str> {
+        self.system.coordinate_names().to_vec()
+    }
+    fn parameter_names(&self) -> &'static [&'static str] {
+        self.system.parameter_names()
+    }
+    fn parameter_values(&self) -> Vec<f64> {
+        self.system.parameter_values()
+    }
+    fn set_parameter(&mut self, name: &str, value: f64) -> Result<(), UnknownParameter> {
+        self.system.set_parameter(name, value)
+    }
+    fn initial_state(&self) -> Vec<f64> {
+        let (q, qdot) = self.system.initial_state();
+        q.iter().chain(qdot.iter()).copied().collect()
+    }
+    fn kinetic_energy(&self, t: f64, y: &[f64]) -> f64 {
+        let (q, qdot) = split::<N>(y);
+        self.system.kinetic_energy(&q, &qdot, t)
+    }
+    fn potential_energy(&self, t: f64, y: &[f64]) -> f64 {
+        let (q, _) = split::<N>(y);
+        self.system.potential_energy(&q, t)
+    }
+    fn is_conservative(&self) -> bool {
+        self.system.is_conservative()
+    }
+    fn point_names(&self) -> &'static [&'static str] {
+        self.system.point_names()
+    }
+    fn point_positions(&self, t: f64, y: &[f64]) -> Vec<[f64; 3]> {
+        let (q, _) = split::<N>(y);
+        let mut out = vec![[0.0; 3]; self.system.point_names().len()];
+        self.system.point_positions(&q, t, &mut out);
+        out
+    }
+    fn equations_text(&self) -> &'static str {
+        self.system.equations_text()
+    }
+    fn equations_latex(&self) -> &'static str {
+        self.system.equations_latex()
+    }
+    fn as_ode_mut(&mut self) -> &mut dyn OdeSystem {
+        self
+    }
+}

@@ -1,0 +1,2 @@
+//! eomgen facade.
+pub use eomgen_runtime::*;

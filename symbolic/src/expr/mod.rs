@@ -1,0 +1,734 @@
+//! Hash-consed expression DAG with canonical construction.
+//!
+//! Every expression lives in an [`ExprArena`] as a [`Node`] whose children are [`ExprId`]s
+//! created before it (children precede parents, as in egg). Structurally equal nodes get the
+//! same id. Constructors canonicalise:
+//!
+//! - sums and products are flattened and their operands sorted by id, so `x + y` and `y + x`
+//!   are one node;
+//! - constants are folded (exactly, for rationals), `x·1`, `x + 0`, `x^1`, `x^0`, `0·x` fold;
+//! - like terms are collected (`2x + 3x = 5x`), like factors too (`x·x^2 = x^3`);
+//! - integer powers distribute over products (`(2x)^2 = 4x^2`) and nest (`(x^2)^3 = x^6`);
+//! - `sin`, `tan`, … are odd and `cos`, `cosh` even in a negated argument
+//!   (`cos(-θ) = cos θ`), so `sin θ` and `cos θ` of one angle are each one node and the code
+//!   generator can compute them with one `sin_cos`.
+//!
+//! Nothing here iterates a `HashMap`: every output order is id order or insertion order, so
+//! the same construction sequence gives byte-identical results.
+
+mod constant;
+pub mod cse;
+mod diff;
+pub mod eval;
+pub mod print;
+
+pub use constant::Constant;
+
+use rustc_hash::FxHashMap;
+
+/// Index of a node in an [`ExprArena`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub struct ExprId(pub u32);
+
+impl ExprId {
+    /// The index into the arena's node list.
+    pub fn index(self) -> usize {
+        self.0 as usize
+    }
+}
+
+/// Index of a symbol in an [`ExprArena`]'s symbol table.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub struct SymbolId(pub u32);
+
+impl SymbolId {
+    /// The index into the symbol table.
+    pub fn index(self) -> usize {
+        self.0 as usize
+    }
+}
+
+/// Elementary functions of one argument.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Func {
+    /// sine
+    Sin,
+    /// cosine
+    Cos,
+    /// tangent
+    Tan,
+    /// arcsine
+    Asin,
+    /// arccosine
+    Acos,
+    /// arctangent
+    Atan,
+    /// hyperbolic sine
+    Sinh,
+    /// hyperbolic cosine
+    Cosh,
+    /// hyperbolic tangent
+    Tanh,
+    /// exponential
+    Exp,
+    /// natural logarithm
+    Ln,
+    /// absolute value
+    Abs,
+    /// sign (−1, 0, 1)
+    Sign,
+    /// Heaviside step: 0 for `x < 0`, 1 for `x ≥ 0` (HW9's `H(t)`)
+    Step,
+}
+
+impl Func {
+    /// The name used in model files and text output.
+    pub fn name(self) -> &'static str {
+        match self {
+            Func::Sin => "sin",
+            Func::Cos => "cos",
+            Func::Tan => "tan",
+            Func::Asin => "asin",
+            Func::Acos => "acos",
+            Func::Atan => "atan",
+            Func::Sinh => "sinh",
+            Func::Cosh => "cosh",
+            Func::Tanh => "tanh",
+            Func::Exp => "exp",
+            Func::Ln => "ln",
+            Func::Abs => "abs",
+            Func::Sign => "sign",
+            Func::Step => "step",
+        }
+    }
+
+    /// The function named `name` in a model file (`sqrt` and `atan2` are not here: they are
+    /// a power and a two-argument node).
+    pub fn from_name(name: &str) -> Option<Func> {
+        Some(match name {
+            "sin" => Func::Sin,
+            "cos" => Func::Cos,
+            "tan" => Func::Tan,
+            "asin" => Func::Asin,
+            "acos" => Func::Acos,
+            "atan" => Func::Atan,
+            "sinh" => Func::Sinh,
+            "cosh" => Func::Cosh,
+            "tanh" => Func::Tanh,
+            "exp" => Func::Exp,
+            "ln" => Func::Ln,
+            "abs" => Func::Abs,
+            "sign" => Func::Sign,
+            "step" => Func::Step,
+            _ => return None,
+        })
+    }
+
+    /// Evaluates the function at `x`.
+    pub fn apply(self, x: f64) -> f64 {
+        match self {
+            Func::Sin => x.sin(),
+            Func::Cos => x.cos(),
+            Func::Tan => x.tan(),
+            Func::Asin => x.asin(),
+            Func::Acos => x.acos(),
+            Func::Atan => x.atan(),
+            Func::Sinh => x.sinh(),
+            Func::Cosh => x.cosh(),
+            Func::Tanh => x.tanh(),
+            Func::Exp => x.exp(),
+            Func::Ln => x.ln(),
+            Func::Abs => x.abs(),
+            Func::Sign => {
+                if x > 0.0 {
+                    1.0
+                } else if x < 0.0 {
+                    -1.0
+                } else {
+                    0.0
+                }
+            }
+            Func::Step => {
+                if x >= 0.0 {
+                    1.0
+                } else {
+                    0.0
+                }
+            }
+        }
+    }
+
+    /// `f(-x) = -f(x)`.
+    fn is_odd(self) -> bool {
+        matches!(
+            self,
+            Func::Sin | Func::Tan | Func::Asin | Func::Atan | Func::Sinh | Func::Tanh | Func::Sign
+        )
+    }
+
+    /// `f(-x) = f(x)`.
+    fn is_even(self) -> bool {
+        matches!(self, Func::Cos | Func::Cosh | Func::Abs)
+    }
+}
+
+/// One operation of the DAG.
+#[derive(Debug, Clone, PartialEq, Eq, Hash)]
+pub enum Node {
+    /// A number.
+    Const(Constant),
+    /// π.
+    Pi,
+    /// A symbol: parameter, coordinate, rate, acceleration or time.
+    Symbol(SymbolId),
+    /// Sum of at least two terms, canonical (see the module docs).
+    Add(Box<[ExprId]>),
+    /// Product of at least two factors; a constant coefficient, if any, comes first.
+    Mul(Box<[ExprId]>),
+    /// `base ^ exponent`.
+    Pow([ExprId; 2]),
+    /// A function of one argument.
+    Func(Func, ExprId),
+    /// `atan2(y, x)`.
+    Atan2([ExprId; 2]),
+}
+
+impl Node {
+    /// The children of this node, in order.
+    pub fn children(&self) -> &[ExprId] {
+        match self {
+            Node::Const(_) | Node::Pi | Node::Symbol(_) => &[],
+            Node::Add(c) | Node::Mul(c) => c,
+            Node::Pow(c) | Node::Atan2(c) => c,
+            Node::Func(_, c) => std::slice::from_ref(c),
+        }
+    }
+}
+
+/// What a symbol stands for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum SymbolKind {
+    /// A model parameter (constant in time).
+    Parameter,
+    /// Generalized coordinate `q_i`.
+    Coordinate(u32),
+    /// Generalized velocity `q̇_i`.
+    Velocity(u32),
+    /// Generalized acceleration `q̈_i`.
+    Acceleration(u32),
+    /// Time `t`.
+    Time,
+    /// Any other symbol (constant in time), e.g. the vector `a` of `∂(M a)/∂q`.
+    Auxiliary,
+}
+
+/// A named symbol.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Symbol {
+    /// Its name (`theta1`, `theta1_dot`, `t`).
+    pub name: String,
+    /// What it stands for.
+    pub kind: SymbolKind,
+}
+
+/// Owns every node and symbol; builds canonical, hash-consed expressions.
+#[derive(Debug, Default, Clone)]
+pub struct ExprArena {
+    nodes: Vec<Node>,
+    memo: FxHashMap<Node, ExprId>,
+    symbols: Vec<Symbol>,
+    symbol_ids: FxHashMap<String, SymbolId>,
+    /// `(q_i, q̇_i, q̈_i)` symbol ids per coordinate, in coordinate order.
+    coordinates: Vec<[SymbolId; 3]>,
+    time: Option<SymbolId>,
+    diff_memo: FxHashMap<(ExprId, SymbolId), ExprId>,
+    dt_memo: FxHashMap<ExprId, ExprId>,
+}
+
+impl ExprArena {
+    /// An empty arena.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Number of nodes.
+    pub fn len(&self) -> usize {
+        self.nodes.len()
+    }
+
+    /// Whether the arena has no nodes.
+    pub fn is_empty(&self) -> bool {
+        self.nodes.is_empty()
+    }
+
+    /// The node behind `id`.
+    pub fn node(&self, id: ExprId) -> &Node {
+        &self.nodes[id.index()]
+    }
+
+    /// The symbol table, indexed by [`SymbolId`].
+    pub fn symbols(&self) -> &[Symbol] {
+        &self.symbols
+    }
+
+    /// The symbol behind `id`.
+    pub fn symbol_info(&self, id: SymbolId) -> &Symbol {
+        &self.symbols[id.index()]
+    }
+
+    /// The symbol id of `name`, if declared.
+    pub fn symbol_id(&self, name: &str) -> Option<SymbolId> {
+        self.symbol_ids.get(name).copied()
+    }
+
+    /// Declares (or finds) a symbol and returns its expression.
+    ///
+    /// # Panics
+    /// If `name` was declared before with a different kind (a programmer error: the model
+    /// checks reject duplicate names).
+    pub fn symbol(&mut self, name: &str, kind: SymbolKind) -> ExprId {
+        let id = match self.symbol_ids.get(name) {
+            Some(&id) => {
+                assert_eq!(self.symbols[id.index()].kind, kind, "symbol `{name}` redeclared");
+                id
+            }
+            None => {
+                let id = SymbolId(self.symbols.len() as u32);
+                self.symbols.push(Symbol {
+                    name: name.to_string(),
+                    kind,
+                });
+                self.symbol_ids.insert(name.to_string(), id);
+                if kind == SymbolKind::Time {
+                    self.time = Some(id);
+                }
+                id
+            }
+        };
+        self.add(Node::Symbol(id))
+    }
+
+    /// Declares generalized coordinate number `coordinates().len()` named `name`, with its
+    /// rate `name_dot` and acceleration `name_ddot`; returns `[q, q̇, q̈]`.
+    pub fn coordinate(&mut self, name: &str) -> [ExprId; 3] {
+        let i = self.coordinates.len() as u32;
+        let q = self.symbol(name, SymbolKind::Coordinate(i));
+        let qd = self.symbol(&format!("{name}_dot"), SymbolKind::Velocity(i));
+        let qdd = self.symbol(&format!("{name}_ddot"), SymbolKind::Acceleration(i));
+        let ids = [q, qd, qdd].map(|e| match self.node(e) {
+            Node::Symbol(s) => *s,
+            _ => unreachable!("symbol() returns a symbol node"),
+        });
+        self.coordinates.push(ids);
+        [q, qd, qdd]
+    }
+
+    /// `(q, q̇, q̈)` symbol ids per coordinate.
+    pub fn coordinates(&self) -> &[[SymbolId; 3]] {
+        &self.coordinates
+    }
+
+    /// The time symbol `t` (declared on first use).
+    pub fn time(&mut self) -> ExprId {
+        self.symbol("t", SymbolKind::Time)
+    }
+
+    /// Expression for the symbol `id`.
+    pub fn symbol_expr(&mut self, id: SymbolId) -> ExprId {
+        self.add(Node::Symbol(id))
+    }
+
+    /// Interns `node` as is (no canonicalisation): the same node always gets the same id.
+    ///
+    /// Callers building arithmetic should use [`Self::sum`], [`Self::product`], [`Self::pow`]
+    /// etc., which canonicalise first.
+    pub fn add(&mut self, node: Node) -> ExprId {
+        if let Some(&id) = self.memo.get(&node) {
+            return id;
+        }
+        let id = ExprId(self.nodes.len() as u32);
+        debug_assert!(
+            node.children().iter().all(|c| *c < id),
+            "children must precede parents"
+        );
+        self.nodes.push(node.clone());
+        self.memo.insert(node, id);
+        id
+    }
+
+    /// A constant.
+    pub fn constant(&mut self, c: Constant) -> ExprId {
+        self.add(Node::Const(c))
+    }
+
+    /// The integer `n`.
+    pub fn int(&mut self, n: i64) -> ExprId {
+        self.constant(Constant::int(n))
+    }
+
+    /// A float constant; non-finite values become NaN-free by clamping to the largest finite
+    /// value of the same sign (they cannot arise from model files, which the checks reject).
+    pub fn float(&mut self, x: f64) -> ExprId {
+        let c = Constant::float(x).unwrap_or_else(|| {
+            Constant::float(if x > 0.0 { f64::MAX } else { f64::MIN }).unwrap_or(Constant::ZERO)
+        });
+        self.constant(c)
+    }
+
+    /// π.
+    pub fn pi(&mut self) -> ExprId {
+        self.add(Node::Pi)
+    }
+
+    /// The constant value of `id`, if it is a number.
+    pub fn as_constant(&self, id: ExprId) -> Option<Constant> {
+        match self.node(id) {
+            Node::Const(c) => Some(*c),
+            _ => None,
+        }
+    }
+
+    /// Whether `id` is the number zero.
+    pub fn is_zero(&self, id: ExprId) -> bool {
+        self.as_constant(id).is_some_and(Constant::is_zero)
+    }
+
+    /// Splits a term into `(coefficient, rest)` with `term = coefficient · rest`; `rest` is
+    /// `None` for a pure constant.
+    fn split_coefficient(&mut self, term: ExprId) -> (Constant, Option<ExprId>) {
+        match self.node(term).clone() {
+            Node::Const(c) => (c, None),
+            Node::Mul(factors) => match self.as_constant(factors[0]) {
+                Some(c) => {
+                    let rest = if factors.len() == 2 {
+                        factors[1]
+                    } else {
+                        self.add(Node::Mul(factors[1..].into()))
+                    };
+                    (c, Some(rest))
+                }
+                None => (Constant::ONE, Some(term)),
+            },
+            _ => (Constant::ONE, Some(term)),
+        }
+    }
+
+    /// Canonical sum of `terms`.
+    pub fn sum(&mut self, terms: &[ExprId]) -> ExprId {
+        let mut constant = Constant::ZERO;
+        let mut collected: indexmap::IndexMap<ExprId, Constant> = indexmap::IndexMap::new();
+        let mut stack: Vec<ExprId> = terms.iter().rev().copied().collect();
+        let mut float_fallback: Vec<ExprId> = Vec::new();
+        while let Some(term) = stack.pop() {
+            if let Node::Add(inner) = self.node(term) {
+                stack.extend(inner.iter().rev().copied());
+                continue;
+            }
+            let (c, rest) = self.split_coefficient(term);
+            match rest {
+                None => match constant.add(c) {
+                    Some(s) => constant = s,
+                    None => float_fallback.push(term),
+                },
+                Some(rest) => {
+                    let entry = collected.entry(rest).or_insert(Constant::ZERO);
+                    match entry.add(c) {
+                        Some(s) => *entry = s,
+                        None => float_fallback.push(term),
+                    }
+                }
+            }
+        }
+        let mut operands: Vec<ExprId> = Vec::with_capacity(collected.len() + 1);
+        let mut entries: Vec<(ExprId, Constant)> = collected.into_iter().collect();
+        entries.sort_by_key(|(rest, _)| *rest);
+        for (rest, c) in entries {
+            if c.is_zero() {
+                continue;
+            }
+            let coefficient = self.constant(c);
+            operands.push(self.product(&[coefficient, rest]));
+        }
+        operands.extend(float_fallback);
+        operands.sort();
+        if !constant.is_zero() {
+            operands.insert(0, self.constant(constant));
+        }
+        match operands.len() {
+            0 => self.int(0),
+            1 => operands[0],
+            _ => self.add(Node::Add(operands.into())),
+        }
+    }
+
+    /// Canonical product of `factors`.
+    pub fn product(&mut self, factors: &[ExprId]) -> ExprId {
+        let mut coefficient = Constant::ONE;
+        let mut bases: indexmap::IndexMap<ExprId, Vec<ExprId>> = indexmap::IndexMap::new();
+        let mut stack: Vec<ExprId> = factors.iter().rev().copied().collect();
+        while let Some(f) = stack.pop() {
+            match self.node(f).clone() {
+                Node::Mul(inner) => stack.extend(inner.iter().rev().copied()),
+                Node::Const(c) => {
+                    if c.is_zero() {
+                        return self.int(0);
+                    }
+                    coefficient = match coefficient.mul(c) {
+                        Some(p) => p,
+                        None => return self.int(0),
+                    };
+                }
+                Node::Pow([b, e]) => bases.entry(b).or_default().push(e),
+                _ => {
+                    let one = self.int(1);
+                    bases.entry(f).or_default().push(one);
+                }
+            }
+        }
+        let mut results: Vec<ExprId> = Vec::with_capacity(bases.len());
+        let mut needs_recanonicalisation = false;
+        let mut entries: Vec<(ExprId, Vec<ExprId>)> = bases.into_iter().collect();
+        entries.sort_by_key(|(b, _)| *b);
+        for (base, exponents) in entries {
+            let exponent = self.sum(&exponents);
+            let p = self.pow(base, exponent);
+            match self.node(p) {
+                Node::Const(c) => {
+                    let c = *c;
+                    if c.is_zero() {
+                        return self.int(0);
+                    }
+                    match coefficient.mul(c) {
+                        Some(v) => coefficient = v,
+                        None => results.push(p),
+                    }
+                }
+                Node::Mul(_) => {
+                    needs_recanonicalisation = true;
+                    results.push(p);
+                }
+                _ => results.push(p),
+            }
+        }
+        if needs_recanonicalisation {
+            let c = self.constant(coefficient);
+            results.push(c);
+            return self.product(&results);
+        }
+        results.sort();
+        if !coefficient.is_one() {
+            results.insert(0, self.constant(coefficient));
+        }
+        match results.len() {
+            0 => self.constant(coefficient),
+            1 => results[0],
+            _ => self.add(Node::Mul(results.into())),
+        }
+    }
+
+    /// `a + b`.
+    pub fn plus(&mut self, a: ExprId, b: ExprId) -> ExprId {
+        self.sum(&[a, b])
+    }
+
+    /// `a · b`.
+    pub fn times(&mut self, a: ExprId, b: ExprId) -> ExprId {
+        self.product(&[a, b])
+    }
+
+    /// `-a`.
+    pub fn neg(&mut self, a: ExprId) -> ExprId {
+        let m = self.int(-1);
+        self.product(&[m, a])
+    }
+
+    /// `a - b`.
+    pub fn minus(&mut self, a: ExprId, b: ExprId) -> ExprId {
+        let nb = self.neg(b);
+        self.sum(&[a, nb])
+    }
+
+    /// `a / b`.
+    pub fn divide(&mut self, a: ExprId, b: ExprId) -> ExprId {
+        let m = self.int(-1);
+        let inv = self.pow(b, m);
+        self.product(&[a, inv])
+    }
+
+    /// `√a` as `a^(1/2)`.
+    pub fn sqrt(&mut self, a: ExprId) -> ExprId {
+        let half = self.constant(Constant::Rational { num: 1, den: 2 });
+        self.pow(a, half)
+    }
+
+    /// Canonical `base ^ exponent`.
+    pub fn pow(&mut self, base: ExprId, exponent: ExprId) -> ExprId {
+        let e = self.as_constant(exponent);
+        if let Some(e) = e {
+            if e.is_zero() {
+                return self.int(1);
+            }
+            if e.is_one() {
+                return base;
+            }
+        }
+        if let Some(b) = self.as_constant(base) {
+            if b.is_one() {
+                return self.int(1);
+            }
+            if let Some(e) = e {
+                if let Some(v) = b.pow(e) {
+                    return self.constant(v);
+                }
+            }
+            if b.is_zero() && e.is_some_and(|e| !e.is_negative()) {
+                return self.int(0);
+            }
+        }
+        let integer_exponent = e.and_then(Constant::as_integer);
+        match self.node(base).clone() {
+            // (x^a)^n = x^(a n) for integer n.
+            Node::Pow([b, a]) if integer_exponent.is_some() => {
+                let product = self.times(a, exponent);
+                return self.pow(b, product);
+            }
+            // (x y)^n = x^n y^n for integer n.
+            Node::Mul(factors) if integer_exponent.is_some() => {
+                let powered: Vec<ExprId> =
+                    factors.iter().map(|&f| self.pow(f, exponent)).collect();
+                return self.product(&powered);
+            }
+            _ => {}
+        }
+        self.add(Node::Pow([base, exponent]))
+    }
+
+    /// If `arg = c · rest` with `c < 0`, returns `-arg` (= `|c| · rest`).
+    fn negated_if_negative(&mut self, arg: ExprId) -> Option<ExprId> {
+        let (c, rest) = self.split_coefficient(arg);
+        if c.is_negative() {
+            let positive = self.constant(c.neg());
+            Some(match rest {
+                Some(r) => self.times(positive, r),
+                None => positive,
+            })
+        } else {
+            None
+        }
+    }
+
+    /// Canonical `f(arg)`.
+    pub fn func(&mut self, f: Func, arg: ExprId) -> ExprId {
+        if let Some(c) = self.as_constant(arg) {
+            if c.is_zero() {
+                return match f {
+                    Func::Cos | Func::Cosh | Func::Exp | Func::Step => self.int(1),
+                    Func::Acos => {
+                        let pi = self.pi();
+                        let half = self.constant(Constant::Rational { num: 1, den: 2 });
+                        self.times(half, pi)
+                    }
+                    Func::Ln => self.add(Node::Func(f, arg)),
+                    _ => self.int(0),
+                };
+            }
+            if matches!(f, Func::Abs | Func::Sign | Func::Step) {
+                let v = f.apply(c.to_f64());
+                return self.float(v);
+            }
+        }
+        if f.is_odd() || f.is_even() {
+            if let Some(positive) = self.negated_if_negative(arg) {
+                let inner = self.func(f, positive);
+                return if f.is_odd() { self.neg(inner) } else { inner };
+            }
+        }
+        self.add(Node::Func(f, arg))
+    }
+
+    /// `sin(a)`.
+    pub fn sin(&mut self, a: ExprId) -> ExprId {
+        self.func(Func::Sin, a)
+    }
+
+    /// `cos(a)`.
+    pub fn cos(&mut self, a: ExprId) -> ExprId {
+        self.func(Func::Cos, a)
+    }
+
+    /// `atan2(y, x)`.
+    pub fn atan2(&mut self, y: ExprId, x: ExprId) -> ExprId {
+        self.add(Node::Atan2([y, x]))
+    }
+
+    /// Whether `expr` contains the symbol `s` (walks the sub-DAG once).
+    pub fn depends_on(&self, expr: ExprId, s: SymbolId) -> bool {
+        let target = Node::Symbol(s);
+        let Some(&sid) = self.memo.get(&target) else {
+            return false;
+        };
+        if sid > expr {
+            return false;
+        }
+        let mut seen = rustc_hash::FxHashSet::default();
+        let mut stack = vec![expr];
+        while let Some(e) = stack.pop() {
+            if e == sid {
+                return true;
+            }
+            if e < sid || !seen.insert(e) {
+                continue;
+            }
+            stack.extend(self.node(e).children().iter().copied());
+        }
+        false
+    }
+
+    /// Every node reachable from `roots`, in ascending id order (a topological order).
+    pub fn reachable(&self, roots: &[ExprId]) -> Vec<ExprId> {
+        let mut mark = vec![false; self.nodes.len()];
+        let mut stack: Vec<ExprId> = roots.to_vec();
+        while let Some(e) = stack.pop() {
+            if std::mem::replace(&mut mark[e.index()], true) {
+                continue;
+            }
+            stack.extend(self.node(e).children().iter().copied());
+        }
+        mark.iter()
+            .enumerate()
+            .filter(|(_, m)| **m)
+            .map(|(i, _)| ExprId(i as u32))
+            .collect()
+    }
+
+    /// Number of arithmetic operations to evaluate `roots` as trees (no sharing), saturating:
+    /// a sum or product of `k` operands counts `k − 1`, a power or function call 1.
+    pub fn tree_operation_count(&self, roots: &[ExprId]) -> u64 {
+        let order = self.reachable(roots);
+        let mut cost: FxHashMap<ExprId, u64> = FxHashMap::default();
+        for &e in &order {
+            let node = self.node(e);
+            let own = node_operation_count(node);
+            let c = node
+                .children()
+                .iter()
+                .fold(own, |acc, ch| acc.saturating_add(cost[ch]));
+            cost.insert(e, c);
+        }
+        roots
+            .iter()
+            .fold(0u64, |acc, r| acc.saturating_add(cost[r]))
+    }
+}
+
+/// Operations a node costs by itself.
+pub(crate) fn node_operation_count(node: &Node) -> u64 {
+    match node {
+        Node::Const(_) | Node::Pi | Node::Symbol(_) => 0,
+        Node::Add(c) | Node::Mul(c) => c.len() as u64 - 1,
+        Node::Pow(_) | Node::Func(..) | Node::Atan2(_) => 1,
+    }
+}
+
+#[cfg(test)]
+mod tests;

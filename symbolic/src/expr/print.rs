@@ -1,0 +1,441 @@
+//! Printing expressions as plain text, Rust source and LaTeX.
+//!
+//! One printer serves the three syntaxes; they differ only in how atoms, powers, quotients
+//! and calls are spelled. Sums print their non-constant terms first with negative
+//! coefficients as subtraction; products print negative powers as a denominator.
+
+use super::{Constant, ExprArena, ExprId, Func, Node, SymbolId};
+
+/// Target syntax of a [`Printer`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Syntax {
+    /// Model-file syntax (`m*l^2*theta_dot^2/2`); parses back with the model parser.
+    Text,
+    /// Rust `f64` source (`0.5 * m * l.powi(2)`); helper functions `sign` and `step` are
+    /// called through [`Printer::with_rust_helpers`]'s path.
+    Rust,
+    /// LaTeX math (`\frac{m l^{2} \dot{\theta}^{2}}{2}`).
+    Latex,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+enum Prec {
+    Sum = 1,
+    Product = 2,
+    Power = 3,
+    Atom = 4,
+}
+
+/// Prints expressions of one arena in one syntax.
+pub struct Printer<'a> {
+    arena: &'a ExprArena,
+    syntax: Syntax,
+    symbol_name: Box<dyn Fn(SymbolId) -> String + 'a>,
+    temporary: Box<dyn Fn(ExprId) -> Option<String> + 'a>,
+    helpers: String,
+}
+
+impl<'a> Printer<'a> {
+    /// A printer that names symbols by their declared name (LaTeX: [`latex_symbol`]).
+    pub fn new(arena: &'a ExprArena, syntax: Syntax) -> Self {
+        let symbol_name: Box<dyn Fn(SymbolId) -> String + 'a> = match syntax {
+            Syntax::Latex => Box::new(move |s| latex_symbol(&arena.symbol_info(s).name)),
+            _ => Box::new(move |s| arena.symbol_info(s).name.clone()),
+        };
+        Self {
+            arena,
+            syntax,
+            symbol_name,
+            temporary: Box::new(|_| None),
+            helpers: "crate".to_string(),
+        }
+    }
+
+    /// Names symbols with `f` instead.
+    pub fn with_symbol_names(mut self, f: impl Fn(SymbolId) -> String + 'a) -> Self {
+        self.symbol_name = Box::new(f);
+        self
+    }
+
+    /// Refers to subexpressions for which `f` returns a name by that name (CSE temporaries).
+    pub fn with_temporaries(mut self, f: impl Fn(ExprId) -> Option<String> + 'a) -> Self {
+        self.temporary = Box::new(f);
+        self
+    }
+
+    /// Path of the module that provides `sign(f64)` and `step(f64)` in Rust output.
+    pub fn with_rust_helpers(mut self, path: &str) -> Self {
+        self.helpers = path.to_string();
+        self
+    }
+
+    /// `expr` printed in full (temporaries still referenced by name if configured).
+    pub fn print(&self, expr: ExprId) -> String {
+        self.operand(expr).0
+    }
+
+    /// The definition of `expr` itself: its node printed with its children referenced, even
+    /// if `expr` is itself a temporary.
+    pub fn print_definition(&self, expr: ExprId) -> String {
+        self.node(expr).0
+    }
+
+    fn operand(&self, e: ExprId) -> (String, Prec) {
+        match (self.temporary)(e) {
+            Some(name) => (name, Prec::Atom),
+            None => self.node(e),
+        }
+    }
+
+    fn wrap(&self, (s, p): (String, Prec), min: Prec) -> String {
+        if p >= min {
+            s
+        } else if self.syntax == Syntax::Latex {
+            format!("\\left({s}\\right)")
+        } else {
+            format!("({s})")
+        }
+    }
+
+    fn constant(&self, c: Constant) -> (String, Prec) {
+        let negative = c.is_negative();
+        let text = match (self.syntax, c) {
+            (Syntax::Rust, _) => format!("{:?}_f64", c.to_f64().abs()),
+            (_, Constant::Rational { num, den: 1 }) => num.unsigned_abs().to_string(),
+            (Syntax::Text, Constant::Rational { num, den }) => {
+                format!("{}/{den}", num.unsigned_abs())
+            }
+            (Syntax::Latex, Constant::Rational { num, den }) => {
+                format!("\\frac{{{}}}{{{den}}}", num.unsigned_abs())
+            }
+            (_, Constant::Float(_)) => format!("{:?}", c.to_f64().abs()),
+        };
+        let prec = match (self.syntax, c) {
+            (Syntax::Text, Constant::Rational { den, .. }) if den != 1 => Prec::Product,
+            _ => Prec::Atom,
+        };
+        if negative {
+            (format!("-{text}"), Prec::Product)
+        } else {
+            (text, prec)
+        }
+    }
+
+    fn node(&self, e: ExprId) -> (String, Prec) {
+        match self.arena.node(e) {
+            Node::Const(c) => self.constant(*c),
+            Node::Pi => (
+                match self.syntax {
+                    Syntax::Text => "pi",
+                    Syntax::Rust => "::core::f64::consts::PI",
+                    Syntax::Latex => "\\pi",
+                }
+                .to_string(),
+                Prec::Atom,
+            ),
+            Node::Symbol(s) => ((self.symbol_name)(*s), Prec::Atom),
+            Node::Add(terms) => self.sum(terms),
+            Node::Mul(factors) => {
+                let (coefficient, rest) = self.split(factors);
+                let (s, p) = self.product(coefficient.abs_constant(), rest);
+                if coefficient.is_negative() {
+                    (format!("-{}", self.wrap((s, p), Prec::Product)), Prec::Product)
+                } else {
+                    (s, p)
+                }
+            }
+            Node::Pow([b, x]) => self.power(*b, PowerExponent::Expr(*x)),
+            Node::Func(f, u) => self.call(*f, *u),
+            Node::Atan2([y, x]) => {
+                let (ys, xs) = (self.operand(*y), self.operand(*x));
+                match self.syntax {
+                    Syntax::Text => (format!("atan2({}, {})", ys.0, xs.0), Prec::Atom),
+                    Syntax::Rust => (
+                        format!("{}.atan2({})", self.wrap(ys, Prec::Atom), xs.0),
+                        Prec::Atom,
+                    ),
+                    Syntax::Latex => (
+                        format!(
+                            "\\operatorname{{atan2}}\\left({}, {}\\right)",
+                            ys.0, xs.0
+                        ),
+                        Prec::Atom,
+                    ),
+                }
+            }
+        }
+    }
+
+    fn split<'b>(&self, factors: &'b [ExprId]) -> (Constant, &'b [ExprId]) {
+        match self.arena.as_constant(factors[0]) {
+            Some(c) if (self.temporary)(factors[0]).is_none() => (c, &factors[1..]),
+            _ => (Constant::ONE, factors),
+        }
+    }
+
+    fn sum(&self, terms: &[ExprId]) -> (String, Prec) {
+        let mut ordered: Vec<ExprId> = terms
+            .iter()
+            .copied()
+            .filter(|t| self.arena.as_constant(*t).is_none())
+            .collect();
+        ordered.extend(terms.iter().copied().filter(|t| self.arena.as_constant(*t).is_some()));
+        let mut out = String::new();
+        for (i, &t) in ordered.iter().enumerate() {
+            let (negative, magnitude) = self.signed_term(t);
+            let text = self.wrap(magnitude, Prec::Product);
+            match (i, negative) {
+                (0, false) => out.push_str(&text),
+                (0, true) => {
+                    out.push('-');
+                    out.push_str(&text);
+                }
+                (_, false) => {
+                    out.push_str(" + ");
+                    out.push_str(&text);
+                }
+                (_, true) => {
+                    out.push_str(" - ");
+                    out.push_str(&text);
+                }
+            }
+        }
+        (out, Prec::Sum)
+    }
+
+    /// A term of a sum as (is negative, printed magnitude).
+    fn signed_term(&self, t: ExprId) -> (bool, (String, Prec)) {
+        if (self.temporary)(t).is_some() {
+            return (false, self.operand(t));
+        }
+        match self.arena.node(t) {
+            Node::Const(c) => (c.is_negative(), self.constant(c.abs_constant())),
+            Node::Mul(factors) => {
+                let (c, rest) = self.split(factors);
+                (c.is_negative(), self.product(c.abs_constant(), rest))
+            }
+            _ => (false, self.operand(t)),
+        }
+    }
+
+    /// `coefficient · Π factors` with `coefficient ≥ 0`.
+    fn product(&self, coefficient: Constant, factors: &[ExprId]) -> (String, Prec) {
+        let mut numerator: Vec<(String, Prec)> = Vec::new();
+        let mut denominator: Vec<(String, Prec)> = Vec::new();
+        match (self.syntax, coefficient) {
+            (_, c) if c.is_one() => {}
+            (Syntax::Rust, c) | (_, c @ Constant::Float(_)) => numerator.push(self.constant(c)),
+            (_, Constant::Rational { num, den }) => {
+                if num != 1 {
+                    numerator.push((num.to_string(), Prec::Atom));
+                }
+                if den != 1 {
+                    denominator.push((den.to_string(), Prec::Atom));
+                }
+            }
+        }
+        for &f in factors {
+            if (self.temporary)(f).is_none() {
+                if let Node::Pow([b, x]) = self.arena.node(f) {
+                    if let Some(c) = self.arena.as_constant(*x) {
+                        if c.is_negative() {
+                            denominator.push(self.power(*b, PowerExponent::Constant(c.neg())));
+                            continue;
+                        }
+                    }
+                }
+            }
+            numerator.push(self.operand(f));
+        }
+        let join = |items: &[(String, Prec)]| -> (String, Prec) {
+            match items.len() {
+                0 => ("1".to_string(), Prec::Atom),
+                1 => items[0].clone(),
+                _ => {
+                    let sep = match self.syntax {
+                        Syntax::Text => "*",
+                        Syntax::Rust => " * ",
+                        Syntax::Latex => " ",
+                    };
+                    let parts: Vec<String> = items
+                        .iter()
+                        .map(|it| self.wrap(it.clone(), Prec::Power))
+                        .collect();
+                    let mut s = String::new();
+                    for (i, p) in parts.iter().enumerate() {
+                        if i > 0 {
+                            let digit_follows = p.starts_with(|c: char| c.is_ascii_digit());
+                            s.push_str(if self.syntax == Syntax::Latex && digit_follows {
+                                " \\cdot "
+                            } else {
+                                sep
+                            });
+                        }
+                        s.push_str(p);
+                    }
+                    (s, Prec::Product)
+                }
+            }
+        };
+        let num = join(&numerator);
+        if denominator.is_empty() {
+            if self.syntax == Syntax::Rust && numerator.is_empty() {
+                return ("1.0_f64".to_string(), Prec::Atom);
+            }
+            return num;
+        }
+        let den = join(&denominator);
+        match self.syntax {
+            Syntax::Latex => (format!("\\frac{{{}}}{{{}}}", num.0, den.0), Prec::Atom),
+            Syntax::Text | Syntax::Rust => {
+                let one = if self.syntax == Syntax::Rust {
+                    "1.0_f64"
+                } else {
+                    "1"
+                };
+                let n = if numerator.is_empty() {
+                    one.to_string()
+                } else {
+                    self.wrap(num, Prec::Product)
+                };
+                let d = self.wrap(den, Prec::Power);
+                let sep = if self.syntax == Syntax::Text { "/" } else { " / " };
+                (format!("{n}{sep}{d}"), Prec::Product)
+            }
+        }
+    }
+
+    fn power(&self, base: ExprId, exponent: PowerExponent) -> (String, Prec) {
+        let b = self.operand(base);
+        let constant = match exponent {
+            PowerExponent::Constant(c) => Some(c),
+            PowerExponent::Expr(x) => self.arena.as_constant(x),
+        };
+        let half = Constant::Rational { num: 1, den: 2 };
+        let minus_half = Constant::Rational { num: -1, den: 2 };
+        match self.syntax {
+            Syntax::Rust => {
+                let base = self.wrap(b, Prec::Atom);
+                match constant {
+                    Some(c) if c == half => (format!("{base}.sqrt()"), Prec::Atom),
+                    Some(c) if c == minus_half => (format!("(1.0_f64 / {base}.sqrt())"), Prec::Atom),
+                    Some(c) if c.as_integer().is_some_and(|n| n.unsigned_abs() <= i32::MAX as u64) => {
+                        (format!("{base}.powi({})", c.as_integer().unwrap_or(1)), Prec::Atom)
+                    }
+                    _ => {
+                        let x = match exponent {
+                            PowerExponent::Constant(c) => self.constant(c),
+                            PowerExponent::Expr(x) => self.operand(x),
+                        };
+                        (format!("{base}.powf({})", x.0), Prec::Atom)
+                    }
+                }
+            }
+            Syntax::Text | Syntax::Latex => {
+                if constant == Some(half) {
+                    return match self.syntax {
+                        Syntax::Latex => (format!("\\sqrt{{{}}}", b.0), Prec::Atom),
+                        _ => (format!("sqrt({})", b.0), Prec::Atom),
+                    };
+                }
+                let x = match exponent {
+                    PowerExponent::Constant(c) => self.constant(c),
+                    PowerExponent::Expr(x) => self.operand(x),
+                };
+                let base = self.wrap(b, Prec::Atom);
+                match self.syntax {
+                    Syntax::Latex => (format!("{base}^{{{}}}", x.0), Prec::Power),
+                    _ => (format!("{base}^{}", self.wrap(x, Prec::Atom)), Prec::Power),
+                }
+            }
+        }
+    }
+
+    fn call(&self, f: Func, u: ExprId) -> (String, Prec) {
+        let arg = self.operand(u);
+        match self.syntax {
+            Syntax::Text => (format!("{}({})", f.name(), arg.0), Prec::Atom),
+            Syntax::Rust => match f {
+                Func::Sign | Func::Step => (
+                    format!("{}::{}({})", self.helpers, f.name(), arg.0),
+                    Prec::Atom,
+                ),
+                _ => (
+                    format!("{}.{}()", self.wrap(arg, Prec::Atom), f.name()),
+                    Prec::Atom,
+                ),
+            },
+            Syntax::Latex => {
+                let s = match f {
+                    Func::Abs => format!("\\left|{}\\right|", arg.0),
+                    Func::Sign | Func::Step | Func::Asin | Func::Acos | Func::Atan => format!(
+                        "\\operatorname{{{}}}\\left({}\\right)",
+                        f.name(),
+                        arg.0
+                    ),
+                    _ => format!("\\{}\\left({}\\right)", f.name(), arg.0),
+                };
+                (s, Prec::Atom)
+            }
+        }
+    }
+}
+
+#[derive(Clone, Copy)]
+enum PowerExponent {
+    Constant(Constant),
+    Expr(ExprId),
+}
+
+impl Constant {
+    fn abs_constant(self) -> Constant {
+        if self.is_negative() { self.neg() } else { self }
+    }
+}
+
+const GREEK: &[&str] = &[
+    "alpha", "beta", "gamma", "delta", "epsilon", "zeta", "eta", "theta", "iota", "kappa",
+    "lambda", "mu", "nu", "xi", "pi", "rho", "sigma", "tau", "upsilon", "phi", "chi", "psi",
+    "omega", "Gamma", "Delta", "Theta", "Lambda", "Xi", "Pi", "Sigma", "Phi", "Psi", "Omega",
+];
+
+/// LaTeX for a symbol name: `theta1` → `\theta_{1}`, `x_dot` → `\dot{x}`,
+/// `theta1_ddot` → `\ddot{\theta}_{1}`, `m_cart` → `m_{\mathrm{cart}}`.
+pub fn latex_symbol(name: &str) -> String {
+    let (stem, accent) = if let Some(s) = name.strip_suffix("_ddot") {
+        (s, Some("\\ddot"))
+    } else if let Some(s) = name.strip_suffix("_dot") {
+        (s, Some("\\dot"))
+    } else {
+        (name, None)
+    };
+    let (base, subscript) = match stem.split_once('_') {
+        Some((b, s)) => (b.to_string(), Some(s.to_string())),
+        None => {
+            let digits = stem.trim_start_matches(|c: char| !c.is_ascii_digit());
+            let cut = stem.len() - digits.len();
+            if cut > 0 && !digits.is_empty() && digits.chars().all(|c| c.is_ascii_digit()) {
+                (stem[..cut].to_string(), Some(digits.to_string()))
+            } else {
+                (stem.to_string(), None)
+            }
+        }
+    };
+    let base = if GREEK.contains(&base.as_str()) {
+        format!("\\{base}")
+    } else if base.chars().count() > 1 {
+        format!("\\mathrm{{{base}}}")
+    } else {
+        base
+    };
+    let base = match accent {
+        Some(a) => format!("{a}{{{base}}}"),
+        None => base,
+    };
+    match subscript {
+        Some(s) if s.chars().all(|c| c.is_ascii_digit()) => format!("{base}_{{{s}}}"),
+        Some(s) if s.chars().count() == 1 => format!("{base}_{{{s}}}"),
+        Some(s) => format!("{base}_{{\\mathrm{{{s}}}}}"),
+        None => base,
+    }
+}

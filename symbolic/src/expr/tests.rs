@@ -1,0 +1,355 @@
+//! Tests of the expression engine: hash-consing, canonical forms, derivatives against
+//! central differences, CSE and printing preserve values.
+
+use super::cse::plan;
+use super::eval::Evaluator;
+use super::print::{Printer, Syntax};
+use super::*;
+use proptest::prelude::*;
+
+fn arena_xy() -> (ExprArena, ExprId, ExprId, SymbolId, SymbolId) {
+    let mut a = ExprArena::new();
+    let x = a.symbol("x", SymbolKind::Parameter);
+    let y = a.symbol("y", SymbolKind::Parameter);
+    let sx = SymbolId(0);
+    let sy = SymbolId(1);
+    (a, x, y, sx, sy)
+}
+
+#[test]
+fn hash_consing_gives_one_id_per_structure() {
+    let (mut a, x, y, _, _) = arena_xy();
+    let s1 = a.plus(x, y);
+    let s2 = a.plus(y, x);
+    assert_eq!(s1, s2);
+    let p1 = a.times(x, y);
+    let p2 = a.times(y, x);
+    assert_eq!(p1, p2);
+    let n = a.len();
+    let s3 = a.sin(s1);
+    let s4 = a.sin(s2);
+    assert_eq!(s3, s4);
+    assert_eq!(a.len(), n + 1);
+}
+
+#[test]
+fn canonical_folding() {
+    let (mut a, x, y, _, _) = arena_xy();
+    let zero = a.int(0);
+    let one = a.int(1);
+    assert_eq!(a.plus(x, zero), x);
+    assert_eq!(a.times(x, one), x);
+    assert_eq!(a.times(x, zero), zero);
+    assert_eq!(a.pow(x, one), x);
+    assert_eq!(a.pow(x, zero), one);
+    // like terms: 2x + 3x = 5x
+    let two = a.int(2);
+    let three = a.int(3);
+    let five = a.int(5);
+    let t2 = a.times(two, x);
+    let t3 = a.times(three, x);
+    let t5 = a.times(five, x);
+    assert_eq!(a.plus(t2, t3), t5);
+    // x - x = 0
+    assert_eq!(a.minus(x, x), zero);
+    // x * x = x^2; x^2 / x = x
+    let xx = a.times(x, x);
+    let x2 = a.pow(x, two);
+    assert_eq!(xx, x2);
+    assert_eq!(a.divide(x2, x), x);
+    // (2 x y)^2 = 4 x^2 y^2
+    let p = a.product(&[two, x, y]);
+    let sq = a.pow(p, two);
+    let four = a.int(4);
+    let y2 = a.pow(y, two);
+    assert_eq!(sq, a.product(&[four, x2, y2]));
+    // constants fold exactly: 1/2 + 1/2 = 1
+    let half = a.constant(Constant::rational(1, 2).unwrap());
+    assert_eq!(a.plus(half, half), one);
+    // nested sums flatten: (x + y) + x = 2x + y
+    let s = a.plus(x, y);
+    let s2 = a.plus(s, x);
+    let expected = a.plus(t2, y);
+    assert_eq!(s2, expected);
+}
+
+#[test]
+fn trig_parity_shares_one_node() {
+    let (mut a, x, _, _, _) = arena_xy();
+    let nx = a.neg(x);
+    let c1 = a.cos(nx);
+    let c2 = a.cos(x);
+    assert_eq!(c1, c2);
+    let s1 = a.sin(nx);
+    let s2 = a.sin(x);
+    assert_eq!(s1, a.neg(s2));
+}
+
+#[test]
+fn derivative_of_pendulum_energy() {
+    let (mut a, x, y, sx, _) = arena_xy();
+    // d/dx (x^2 sin y) = 2 x sin y
+    let two = a.int(2);
+    let x2 = a.pow(x, two);
+    let s = a.sin(y);
+    let e = a.times(x2, s);
+    let d = a.diff(e, sx);
+    let expected = a.product(&[two, x, s]);
+    assert_eq!(d, expected);
+}
+
+#[test]
+fn time_derivative_uses_chain_rule() {
+    let mut a = ExprArena::new();
+    let [q, qd, qdd] = a.coordinate("q");
+    let l = a.symbol("l", SymbolKind::Parameter);
+    // d/dt (l sin q) = l cos q q̇ ; d²/dt² = l (cos q q̈ − sin q q̇²)
+    let s = a.sin(q);
+    let x = a.times(l, s);
+    let v = a.time_derivative(x);
+    let c = a.cos(q);
+    assert_eq!(v, a.product(&[l, c, qd]));
+    let acc = a.time_derivative(v);
+    let two = a.int(2);
+    let qd2 = a.pow(qd, two);
+    let t1 = a.product(&[l, c, qdd]);
+    let t2 = a.product(&[l, s, qd2]);
+    assert_eq!(acc, a.minus(t1, t2));
+}
+
+/// A random expression tree over two symbols, built into an arena.
+#[derive(Debug, Clone)]
+enum Tree {
+    X,
+    Y,
+    Num(i8),
+    Add(Box<Tree>, Box<Tree>),
+    Mul(Box<Tree>, Box<Tree>),
+    Div(Box<Tree>, Box<Tree>),
+    Pow(Box<Tree>, i8),
+    Sqrt(Box<Tree>),
+    F(Func, Box<Tree>),
+    Atan2(Box<Tree>, Box<Tree>),
+}
+
+fn tree() -> impl Strategy<Value = Tree> {
+    let leaf = prop_oneof![Just(Tree::X), Just(Tree::Y), (-5i8..=5).prop_map(Tree::Num)];
+    leaf.prop_recursive(5, 40, 3, |inner| {
+        let smooth = prop_oneof![
+            Just(Func::Sin),
+            Just(Func::Cos),
+            Just(Func::Tan),
+            Just(Func::Atan),
+            Just(Func::Sinh),
+            Just(Func::Cosh),
+            Just(Func::Tanh),
+            Just(Func::Exp),
+        ];
+        prop_oneof![
+            (inner.clone(), inner.clone()).prop_map(|(a, b)| Tree::Add(a.into(), b.into())),
+            (inner.clone(), inner.clone()).prop_map(|(a, b)| Tree::Mul(a.into(), b.into())),
+            (inner.clone(), inner.clone()).prop_map(|(a, b)| Tree::Div(a.into(), b.into())),
+            (inner.clone(), -3i8..=3).prop_map(|(a, n)| Tree::Pow(a.into(), n)),
+            inner.clone().prop_map(|a| Tree::Sqrt(a.into())),
+            (smooth, inner.clone()).prop_map(|(f, a)| Tree::F(f, a.into())),
+            (inner.clone(), inner).prop_map(|(a, b)| Tree::Atan2(a.into(), b.into())),
+        ]
+    })
+}
+
+fn build(a: &mut ExprArena, t: &Tree, x: ExprId, y: ExprId) -> ExprId {
+    match t {
+        Tree::X => x,
+        Tree::Y => y,
+        Tree::Num(n) => a.int(i64::from(*n)),
+        Tree::Add(p, q) => {
+            let (p, q) = (build(a, p, x, y), build(a, q, x, y));
+            a.plus(p, q)
+        }
+        Tree::Mul(p, q) => {
+            let (p, q) = (build(a, p, x, y), build(a, q, x, y));
+            a.times(p, q)
+        }
+        Tree::Div(p, q) => {
+            let (p, q) = (build(a, p, x, y), build(a, q, x, y));
+            a.divide(p, q)
+        }
+        Tree::Pow(p, n) => {
+            let p = build(a, p, x, y);
+            let n = a.int(i64::from(*n));
+            a.pow(p, n)
+        }
+        Tree::Sqrt(p) => {
+            let p = build(a, p, x, y);
+            let sq = a.times(p, p);
+            let one = a.int(1);
+            let s = a.plus(sq, one);
+            a.sqrt(s)
+        }
+        Tree::F(f, p) => {
+            let p = build(a, p, x, y);
+            a.func(*f, p)
+        }
+        Tree::Atan2(p, q) => {
+            let (p, q) = (build(a, p, x, y), build(a, q, x, y));
+            a.atan2(p, q)
+        }
+    }
+}
+
+/// Direct evaluation of the tree, independent of the arena.
+fn eval_tree(t: &Tree, x: f64, y: f64) -> f64 {
+    match t {
+        Tree::X => x,
+        Tree::Y => y,
+        Tree::Num(n) => f64::from(*n),
+        Tree::Add(p, q) => eval_tree(p, x, y) + eval_tree(q, x, y),
+        Tree::Mul(p, q) => eval_tree(p, x, y) * eval_tree(q, x, y),
+        Tree::Div(p, q) => eval_tree(p, x, y) / eval_tree(q, x, y),
+        Tree::Pow(p, n) => eval_tree(p, x, y).powi(i32::from(*n)),
+        Tree::Sqrt(p) => {
+            let v = eval_tree(p, x, y);
+            (v * v + 1.0).sqrt()
+        }
+        Tree::F(f, p) => f.apply(eval_tree(p, x, y)),
+        Tree::Atan2(p, q) => eval_tree(p, x, y).atan2(eval_tree(q, x, y)),
+    }
+}
+
+fn close(a: f64, b: f64, rel: f64) -> bool {
+    (a - b).abs() <= rel * (1.0 + a.abs().max(b.abs()))
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 400, .. ProptestConfig::default() })]
+
+    /// Canonicalisation preserves values: the arena's evaluation equals direct evaluation of
+    /// the tree. Tolerance 1e-9 relative: canonical reordering changes rounding only.
+    #[test]
+    fn canonical_form_preserves_value(t in tree(), x in -2.0f64..2.0, y in -2.0f64..2.0) {
+        let direct = eval_tree(&t, x, y);
+        prop_assume!(direct.is_finite() && direct.abs() < 1e6);
+        let (mut a, ex, ey, _, _) = arena_xy();
+        let e = build(&mut a, &t, ex, ey);
+        let v = a.eval(e, &[x, y]);
+        prop_assert!(close(v, direct, 1e-9), "arena {v} vs direct {direct}");
+    }
+
+    /// `eval(diff(e, x))` equals the central difference `(e(x+h) − e(x−h))/2h`. With
+    /// h = 1e-5 the truncation error is O(h² e''') and roundoff O(ε|e|/h), about 1e-10 for
+    /// moderate e; we require 1e-5 relative, and skip states where e is huge or near a
+    /// singularity (the difference quotient itself is then meaningless).
+    #[test]
+    fn derivative_matches_central_difference(t in tree(), x in -2.0f64..2.0, y in -2.0f64..2.0) {
+        let h = 1e-5;
+        let f0 = eval_tree(&t, x, y);
+        let fp = eval_tree(&t, x + h, y);
+        let fm = eval_tree(&t, x - h, y);
+        let fpp = eval_tree(&t, x + 2.0 * h, y);
+        let fmm = eval_tree(&t, x - 2.0 * h, y);
+        prop_assume!([f0, fp, fm, fpp, fmm].iter().all(|v| v.is_finite() && v.abs() < 1e4));
+        let fd = (fp - fm) / (2.0 * h);
+        let fd2 = (fpp - fmm) / (4.0 * h);
+        // Skip near-singular points where two step sizes disagree.
+        prop_assume!(close(fd, fd2, 1e-6));
+        let (mut a, ex, ey, sx, _) = arena_xy();
+        let e = build(&mut a, &t, ex, ey);
+        let d = a.diff(e, sx);
+        let v = a.eval(d, &[x, y]);
+        prop_assert!(close(v, fd, 1e-5), "diff {v} vs central difference {fd}");
+    }
+
+    /// CSE preserves values: evaluating the plan's temporaries then roots (through the text
+    /// printer's definitions) equals direct evaluation; and the plan never costs more
+    /// operations than the trees.
+    #[test]
+    fn cse_plan_preserves_value(t in tree(), u in tree(), x in -2.0f64..2.0, y in -2.0f64..2.0) {
+        let (mut a, ex, ey, sx, _) = arena_xy();
+        let e1 = build(&mut a, &t, ex, ey);
+        let e2 = build(&mut a, &u, ex, ey);
+        let d = a.diff(e1, sx);
+        let roots = [e1, e2, d];
+        let p = plan(&a, &roots, "t");
+        prop_assert!(p.operation_count() <= a.tree_operation_count(&roots));
+        // Evaluate temporaries in order with a tiny interpreter over the plan.
+        let mut values: rustc_hash::FxHashMap<ExprId, f64> = Default::default();
+        let mut direct = Evaluator::new(&a, &roots);
+        let expected = direct.eval(&[x, y]);
+        for temp in &p.temporaries {
+            match *temp {
+                cse::Temporary::Single(e) => {
+                    let v = a.eval(e, &[x, y]);
+                    values.insert(e, v);
+                }
+                cse::Temporary::SinCos { arg, sin, cos } => {
+                    let (s, c) = a.eval(arg, &[x, y]).sin_cos();
+                    values.insert(sin, s);
+                    values.insert(cos, c);
+                }
+            }
+        }
+        for (r, ex) in roots.iter().zip(&expected) {
+            let v = values.get(r).copied().unwrap_or_else(|| a.eval(*r, &[x, y]));
+            prop_assert!(v == *ex || (v.is_nan() && ex.is_nan()) || close(v, *ex, 1e-12));
+        }
+    }
+}
+
+#[test]
+fn cse_shares_sin_cos_and_repeated_terms() {
+    let mut a = ExprArena::new();
+    let [q, qd, _] = a.coordinate("q");
+    let l = a.symbol("l", SymbolKind::Parameter);
+    let s = a.sin(q);
+    let c = a.cos(q);
+    let ls = a.times(l, s);
+    let lc = a.times(l, c);
+    let v = a.product(&[ls, qd]);
+    let w = a.product(&[lc, qd]);
+    let p = plan(&a, &[v, w, s], "t");
+    let pairs = p
+        .temporaries
+        .iter()
+        .filter(|t| matches!(t, cse::Temporary::SinCos { .. }))
+        .count();
+    assert_eq!(pairs, 1, "{:?}", p.temporaries);
+    assert_eq!(p.name_of(s), Some("t0_s"));
+}
+
+#[test]
+fn printing() {
+    let mut a = ExprArena::new();
+    let [q, qd, _] = a.coordinate("theta1");
+    let m = a.symbol("m", SymbolKind::Parameter);
+    let l = a.symbol("l", SymbolKind::Parameter);
+    let two = a.int(2);
+    let half = a.constant(Constant::rational(1, 2).unwrap());
+    let l2 = a.pow(l, two);
+    let qd2 = a.pow(qd, two);
+    let t = a.product(&[half, m, l2, qd2]);
+    let text = Printer::new(&a, Syntax::Text).print(t);
+    assert_eq!(text, "m*l^2*theta1_dot^2/2");
+    let rust = Printer::new(&a, Syntax::Rust).print(t);
+    assert_eq!(rust, "0.5_f64 * m * l.powi(2) * theta1_dot.powi(2)");
+    let latex = Printer::new(&a, Syntax::Latex).print(t);
+    assert_eq!(latex, "\\frac{m l^{2} \\dot{\\theta}_{1}^{2}}{2}");
+    let c = a.cos(q);
+    let v = a.times(m, c);
+    let g = a.symbol("g", SymbolKind::Parameter);
+    let mg = a.times(m, g);
+    let e = a.minus(mg, v);
+    assert_eq!(Printer::new(&a, Syntax::Text).print(e), "m*g - m*cos(theta1)");
+}
+
+#[test]
+fn operation_counts() {
+    let (mut a, x, y, _, _) = arena_xy();
+    let s = a.plus(x, y);
+    let p = a.times(s, s); // (x+y)^2: pow node
+    let q = a.sin(s);
+    let r = a.plus(p, q);
+    // trees: r = p + q: 1; p = s^2: 1 + s(1); q = sin s: 1 + s(1) → 5
+    assert_eq!(a.tree_operation_count(&[r]), 5);
+    // shared: s once → 4
+    assert_eq!(plan(&a, &[r], "t").operation_count(), 4);
+}

@@ -1,0 +1,5 @@
+//! The compile-time half of eomgen: expression DAG, model files, derivations, code generation.
+#![warn(missing_docs)]
+
+pub mod expr;
+pub mod model;

@@ -1,0 +1,173 @@
+//! The typed model file: what the schema pass builds from YAML and the checks validate.
+//!
+//! Every name and expression keeps its [`Location`] so that later stages can still report
+//! `file:line:col`. Maps of the YAML file keep file order (vectors here).
+
+use super::ast::Expr;
+use super::located::{Located, Location};
+
+/// A parameter with its default value (`m1: 1.0  # kg`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Parameter {
+    /// Name (an identifier).
+    pub name: Located<String>,
+    /// Default as written (a constant expression: numbers, `pi`, functions).
+    pub default: Expr,
+    /// Default evaluated.
+    pub value: f64,
+    /// The unit from the trailing YAML comment, if any (`kg` in `m1: 1.0  # kg`).
+    pub unit: Option<String>,
+}
+
+/// A generalized coordinate `q`. Its rate is written `<name>_dot`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Coordinate {
+    /// Name (an identifier).
+    pub name: Located<String>,
+    /// The text of a trailing YAML comment, if any (`# angle from +x`).
+    pub comment: Option<String>,
+}
+
+/// A named point: a position expression in `q` and `t` with 2 or 3 components.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Point {
+    /// Name.
+    pub name: Located<String>,
+    /// Components `[x, y]` or `[x, y, z]` (m).
+    pub position: Vec<Expr>,
+    /// Where the position list starts.
+    pub location: Location,
+}
+
+/// What kind of body.
+#[derive(Debug, Clone, PartialEq)]
+pub enum BodyKind {
+    /// A point mass at `at`: `{ mass: m, at: P }`.
+    Particle {
+        /// Mass (kg).
+        mass: Expr,
+        /// The point where the mass sits.
+        at: Located<String>,
+    },
+    /// A planar rigid body: `{ mass: m, inertia: I_G, com: G, angle: theta }`.
+    Rigid {
+        /// Mass (kg).
+        mass: Expr,
+        /// Centroidal moment of inertia about the axis normal to the plane (kg·m²).
+        inertia: Expr,
+        /// Centre-of-mass point.
+        com: Located<String>,
+        /// Orientation angle (rad), counter-clockwise; an expression in `q` and `t`.
+        angle: Expr,
+    },
+}
+
+/// A body of the kinematic form.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Body {
+    /// Name.
+    pub name: Located<String>,
+    /// Particle or planar rigid body.
+    pub kind: BodyKind,
+}
+
+/// A linear spring between two points: `{ between: [A, B], stiffness: k, rest_length: l0 }`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Spring {
+    /// Name.
+    pub name: Located<String>,
+    /// The two end points.
+    pub between: [Located<String>; 2],
+    /// Stiffness `k` (N/m).
+    pub stiffness: Expr,
+    /// Rest length `ℓ₀` (m); `None` means zero rest length.
+    pub rest_length: Option<Expr>,
+}
+
+/// A linear viscous damper between two points, acting along the line of the points:
+/// `{ between: [A, B], coefficient: c }`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Damper {
+    /// Name.
+    pub name: Located<String>,
+    /// The two end points.
+    pub between: [Located<String>; 2],
+    /// Damping coefficient `c` (N·s/m).
+    pub coefficient: Expr,
+}
+
+/// A force applied at a point: `{ at: P, vector: [Fx, Fy] }`, components any expression of
+/// `q`, `q̇` and `t`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Force {
+    /// Name.
+    pub name: Located<String>,
+    /// Point of application.
+    pub at: Located<String>,
+    /// Components (N), as many as the model's dimension.
+    pub vector: Vec<Expr>,
+    /// Where the vector list starts.
+    pub location: Location,
+}
+
+/// A torque on a planar rigid body: `{ body: B, value: tau }` (N·m, counter-clockwise).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Torque {
+    /// Name.
+    pub name: Located<String>,
+    /// The body it acts on.
+    pub body: Located<String>,
+    /// Torque (N·m).
+    pub value: Expr,
+}
+
+/// What an animation draws (`draw:`). Parsed and checked now; used by `animate` later.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Draw {
+    /// Line segments between named points.
+    pub lines: Vec<[Located<String>; 2]>,
+    /// Points whose trajectories are traced.
+    pub trace: Vec<Located<String>>,
+}
+
+/// A whole model file after the schema pass.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ModelFile {
+    /// The path as the user wrote it (used in messages).
+    pub path: String,
+    /// `name:` — a snake_case identifier; the generated struct is its UpperCamelCase.
+    pub name: Located<String>,
+    /// `description:` — one line.
+    pub description: String,
+    /// `parameters:`, in file order.
+    pub parameters: Vec<Parameter>,
+    /// `coordinates:`, in file order.
+    pub coordinates: Vec<Coordinate>,
+    /// `kinetic:` T (energy form).
+    pub kinetic: Option<Expr>,
+    /// `potential:` V (energy form).
+    pub potential: Option<Expr>,
+    /// `generalized_forces:` Q by coordinate name (energy form).
+    pub generalized_forces: Vec<(Located<String>, Expr)>,
+    /// `points:`.
+    pub points: Vec<Point>,
+    /// `bodies:`.
+    pub bodies: Vec<Body>,
+    /// `gravity:` acceleration vector (m/s²).
+    pub gravity: Option<Located<Vec<Expr>>>,
+    /// `springs:`.
+    pub springs: Vec<Spring>,
+    /// `dampers:`.
+    pub dampers: Vec<Damper>,
+    /// `forces:`.
+    pub forces: Vec<Force>,
+    /// `torques:`.
+    pub torques: Vec<Torque>,
+    /// `initial:` by coordinate or rate name (`theta1`, `theta1_dot`); expressions of the
+    /// parameters.
+    pub initial: Vec<(Located<String>, Expr)>,
+    /// `draw:`.
+    pub draw: Draw,
+    /// The spatial dimension of the points (2 or 3); `None` when there are no points.
+    pub dimension: Option<usize>,
+}
