@@ -1,2 +1,58 @@
-//! eomgen facade.
+//! eomgen: declarative models of mechanisms compiled into equations of motion, simulated and
+//! analysed.
+//!
+//! A model file (YAML) is turned at compile time by [`model!`] into a struct with an
+//! implementation of [`MechanicalSystem`]: mass matrix, forcing, exact Jacobians, energies,
+//! point positions, derived symbolically by Lagrange's equations. The runtime integrates
+//! them.
+//!
+//! ```
+//! use eomgen::{DormandPrince54, FirstOrder, Integrator, IntegratorOptions, MechanicalSystem,
+//!              OdeSystem, OutputTimes};
+//! use eomgen::models::DoublePendulum;
+//!
+//! let pendulum = DoublePendulum::default();
+//! let (q0, qdot0) = pendulum.initial_state();
+//! let mut system = FirstOrder::new(pendulum);
+//! let y0: Vec<f64> = q0.iter().chain(qdot0.iter()).copied().collect();
+//! let options = IntegratorOptions::default().with_rtol(1e-10).with_atol(1e-10);
+//! let solution = DormandPrince54::new()
+//!     .integrate(&mut system, 0.0, &y0, 1.0, &OutputTimes::At(vec![1.0]), &options)
+//!     .expect("the double pendulum integrates");
+//! assert_eq!(solution.len(), 1);
+//! ```
+#![warn(missing_docs)]
+
+extern crate self as eomgen;
+
+pub use eomgen_macros::model;
 pub use eomgen_runtime::*;
+
+/// Every model in `models/`, compiled in: one module and struct per file, and [`models::ALL`].
+pub mod models {
+    include!(concat!(env!("OUT_DIR"), "/models.rs"));
+}
+
+/// Support for generated code. Not part of the public API.
+#[doc(hidden)]
+pub mod __private {
+    pub use nalgebra;
+
+    /// Sign of `x`: −1, 0 or 1 (unlike `f64::signum`, 0 at 0).
+    #[inline]
+    pub fn sign(x: f64) -> f64 {
+        if x > 0.0 {
+            1.0
+        } else if x < 0.0 {
+            -1.0
+        } else {
+            0.0
+        }
+    }
+
+    /// Heaviside step: 1 for `x ≥ 0`, else 0.
+    #[inline]
+    pub fn step(x: f64) -> f64 {
+        if x >= 0.0 { 1.0 } else { 0.0 }
+    }
+}

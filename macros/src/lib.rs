@@ -1,1 +1,95 @@
-//! The `model!` proc macro.
+//! The `model!` proc macro: a thin shell around `eomgen-symbolic`.
+//!
+//! `eomgen::model!("models/double_pendulum.yaml")` reads the file (relative to the file that
+//! invokes the macro, like `include_str!`), validates it, derives the equations of motion by
+//! Lagrange, and emits a struct named after the model with an `impl MechanicalSystem`.
+//! Every problem in the file becomes a compile error `path:line:col: message`, all of them at
+//! once.
+
+use std::path::{Path, PathBuf};
+
+use proc_macro::TokenStream;
+use proc_macro2::Span;
+use syn::LitStr;
+
+use eomgen_symbolic::codegen::{self, EmitOptions};
+use eomgen_symbolic::mechanics::{Formulation, Jacobians, Lagrange, SymbolicModel};
+
+/// Generates the equations of motion of a model file at compile time.
+///
+/// The argument is a string literal: a path relative to the invoking source file (or
+/// absolute). The expansion is a `pub struct` named after the model's `name` in
+/// UpperCamelCase, with one `pub f64` field per parameter and `Default` from the file, and
+/// an `impl eomgen::MechanicalSystem<N>`.
+///
+/// # Errors
+/// A compile error for an unreadable file, and one per diagnostic of the model file, each
+/// starting `path:line:col:`.
+#[proc_macro]
+pub fn model(input: TokenStream) -> TokenStream {
+    expand(input.into())
+        .unwrap_or_else(syn::Error::into_compile_error)
+        .into()
+}
+
+fn base_dir() -> PathBuf {
+    let from_span = proc_macro::Span::call_site().local_file().and_then(|file| {
+        let file = if file.is_relative() {
+            // rustc reports paths relative to the working directory of the compilation,
+            // which cargo sets to the workspace root or the package root.
+            std::env::current_dir().ok()?.join(file)
+        } else {
+            file
+        };
+        file.parent().map(Path::to_path_buf)
+    });
+    from_span
+        .or_else(|| std::env::var_os("CARGO_MANIFEST_DIR").map(PathBuf::from))
+        .unwrap_or_default()
+}
+
+fn expand(input: proc_macro2::TokenStream) -> syn::Result<proc_macro2::TokenStream> {
+    let literal: LitStr = syn::parse2(input).map_err(|e| {
+        syn::Error::new(
+            e.span(),
+            "expected the path of a model file as a string literal: `model!(\"models/x.yaml\")`",
+        )
+    })?;
+    let written = literal.value();
+    let path = {
+        let p = PathBuf::from(&written);
+        if p.is_absolute() { p } else { base_dir().join(p) }
+    };
+    let source = std::fs::read_to_string(&path).map_err(|e| {
+        syn::Error::new(
+            literal.span(),
+            format!(
+                "cannot read model file `{written}` (looked at `{}`): {e}",
+                path.display()
+            ),
+        )
+    })?;
+    let errors = |diagnostics: Vec<eomgen_symbolic::model::Diagnostic>| {
+        let mut all: Option<syn::Error> = None;
+        for d in diagnostics {
+            let e = syn::Error::new(literal.span(), d.render(&written, &source));
+            match &mut all {
+                Some(a) => a.combine(e),
+                None => all = Some(e),
+            }
+        }
+        all.unwrap_or_else(|| syn::Error::new(Span::call_site(), "invalid model"))
+    };
+    let file = eomgen_symbolic::model::load(&written, &source).map_err(errors)?;
+    let mut model = SymbolicModel::from_file(&file).map_err(errors)?;
+    let eom = Lagrange.derive(&mut model);
+    let jacobians = Jacobians::of(&mut model, &eom);
+    let options = EmitOptions {
+        crate_path: "::eomgen".to_string(),
+        tracked_files: vec![path.to_string_lossy().into_owned()],
+        source_display: written.clone(),
+    };
+    let (tokens, _) = codegen::emit(&model, &eom, &jacobians, &options)
+        .map_err(|e| syn::Error::new(literal.span(), e))?;
+    Ok(tokens)
+}

@@ -1,0 +1,385 @@
+//! Equations → Rust tokens: a struct named after the model and an
+//! `impl MechanicalSystem<N>` with straight-line, CSE'd, allocation-free bodies.
+//!
+//! Each generated function is planned by [`crate::expr::cse::plan`] over exactly the
+//! expressions it returns, binds only the symbols it uses, computes `sin_cos` once per angle,
+//! and builds its nalgebra static matrix from a stack array. Output is deterministic: it
+//! depends only on the model file.
+
+use std::fmt::Write as _;
+
+use proc_macro2::TokenStream;
+
+use crate::expr::cse::{self, CsePlan, Temporary};
+use crate::expr::print::{Printer, Syntax};
+use crate::expr::{ExprArena, ExprId, SymbolId, SymbolKind};
+use crate::mechanics::{EquationsOfMotion, Jacobians, SymbolicModel};
+
+/// Where the generated code finds the runtime.
+#[derive(Debug, Clone)]
+pub struct EmitOptions {
+    /// Path of the facade crate that re-exports `MechanicalSystem` and has a hidden
+    /// `__private` module with `nalgebra`, `sign` and `step` (default `::eomgen`).
+    pub crate_path: String,
+    /// Absolute paths of files to track with `include_bytes!` so that editing them rebuilds.
+    pub tracked_files: Vec<String>,
+    /// How the model file is named in the generated docs.
+    pub source_display: String,
+}
+
+impl Default for EmitOptions {
+    fn default() -> Self {
+        Self {
+            crate_path: "::eomgen".to_string(),
+            tracked_files: Vec::new(),
+            source_display: String::new(),
+        }
+    }
+}
+
+/// Statistics of the generated code, for `eomgen check` and benchmarks.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct EmitStats {
+    /// Operations of `M` and `F` evaluated as trees (no sharing).
+    pub ops_before_cse: u64,
+    /// Operations of the CSE'd `mass_matrix_and_forcing`.
+    pub ops_after_cse: u64,
+}
+
+const RUST_KEYWORDS: &[&str] = &[
+    "as", "async", "await", "break", "const", "continue", "crate", "dyn", "else", "enum",
+    "extern", "false", "fn", "for", "gen", "if", "impl", "in", "let", "loop", "match", "mod",
+    "move", "mut", "pub", "ref", "return", "self", "Self", "static", "struct", "super", "trait",
+    "true", "type", "unsafe", "use", "where", "while", "abstract", "become", "box", "do",
+    "final", "macro", "override", "priv", "typeof", "unsized", "virtual", "yield", "try",
+];
+
+/// A symbol's local variable name in generated code (`r#`-free: keywords get a `_` suffix).
+pub fn local_name(name: &str) -> String {
+    if RUST_KEYWORDS.contains(&name) || name.starts_with("__") {
+        format!("{name}_")
+    } else {
+        name.to_string()
+    }
+}
+
+/// `double_pendulum` → `DoublePendulum`.
+pub fn struct_name(model_name: &str) -> String {
+    model_name
+        .split('_')
+        .filter(|p| !p.is_empty())
+        .map(|p| {
+            let mut c = p.chars();
+            match c.next() {
+                Some(f) => f.to_ascii_uppercase().to_string() + c.as_str(),
+                None => String::new(),
+            }
+        })
+        .collect()
+}
+
+/// Source of one function body: symbol bindings, temporaries, and the returned values
+/// (printed as Rust expressions, in root order).
+struct Body {
+    code: String,
+    values: Vec<String>,
+}
+
+fn body(model: &SymbolicModel, roots: &[ExprId], helpers: &str) -> (Body, CsePlan) {
+    let arena: &ExprArena = &model.arena;
+    let plan = cse::plan(arena, roots, "__e");
+    let reachable = arena.reachable(roots);
+    let mut code = String::new();
+    // Bind the symbols used, in symbol order.
+    let mut used: Vec<SymbolId> = reachable
+        .iter()
+        .filter_map(|e| match arena.node(*e) {
+            crate::expr::Node::Symbol(s) => Some(*s),
+            _ => None,
+        })
+        .collect();
+    used.sort();
+    for s in used {
+        let info = arena.symbol_info(s);
+        let local = local_name(&info.name);
+        let source = match info.kind {
+            SymbolKind::Parameter => format!("self.{}", field_name(&info.name)),
+            SymbolKind::Coordinate(i) => format!("__q[{i}]"),
+            SymbolKind::Velocity(i) => format!("__qdot[{i}]"),
+            SymbolKind::Acceleration(i) => format!("__a[{i}]"),
+            SymbolKind::Time => "__t".to_string(),
+            SymbolKind::Auxiliary => "0.0_f64".to_string(),
+        };
+        let _ = writeln!(code, "let {local}: f64 = {source};");
+    }
+    let plan_ref = &plan;
+    let names = move |e: ExprId| plan_ref.name_of(e).map(str::to_string);
+    let printer = Printer::new(arena, Syntax::Rust)
+        .with_symbol_names(|s| local_name(&arena.symbol_info(s).name))
+        .with_temporaries(names)
+        .with_rust_helpers(helpers);
+    for temp in &plan.temporaries {
+        match *temp {
+            Temporary::Single(e) => {
+                let (name, _) = plan.temporary_names(temp);
+                let _ = writeln!(code, "let {name}: f64 = {};", printer.print_definition(e));
+            }
+            Temporary::SinCos { arg, .. } => {
+                let (s, c) = plan.temporary_names(temp);
+                let c = c.unwrap_or_default();
+                let a = printer.print(arg);
+                let _ = writeln!(code, "let ({s}, {c}): (f64, f64) = ({a}).sin_cos();");
+            }
+        }
+    }
+    let values = roots.iter().map(|r| printer.print(*r)).collect();
+    drop(printer);
+    (Body { code, values }, plan)
+}
+
+fn field_name(name: &str) -> String {
+    if RUST_KEYWORDS.contains(&name) {
+        format!("r#{name}")
+    } else {
+        name.to_string()
+    }
+}
+
+fn string_literal(s: &str) -> String {
+    format!("{s:?}")
+}
+
+/// Generates the struct and its `MechanicalSystem` implementation.
+///
+/// # Errors
+/// Only if the printed code fails to tokenize, which would be a bug in the printer; the
+/// message carries the offending source.
+pub fn emit(
+    model: &SymbolicModel,
+    eom: &EquationsOfMotion,
+    jacobians: &Jacobians,
+    options: &EmitOptions,
+) -> Result<(TokenStream, EmitStats), String> {
+    let n = model.num_dofs();
+    let krate = &options.crate_path;
+    let private = format!("{krate}::__private");
+    let na = format!("{private}::nalgebra");
+    let name = struct_name(&model.name);
+    let vec_t = format!("{na}::SVector<f64, {n}>");
+    let mat_t = format!("{na}::SMatrix<f64, {n}, {n}>");
+    let mut src = String::new();
+
+    // The struct, one field per parameter.
+    let doc = format!(
+        "{}\n\nGenerated by `eomgen::model!` from `{}`: {} degree(s) of freedom ({}).",
+        model.description,
+        options.source_display,
+        n,
+        model.coordinate_names.join(", ")
+    );
+    let _ = writeln!(src, "#[doc = {}]", string_literal(&doc));
+    let _ = writeln!(src, "#[derive(Debug, Clone, Copy, PartialEq)]");
+    let _ = writeln!(src, "#[allow(non_snake_case)]");
+    let _ = writeln!(src, "pub struct {name} {{");
+    for p in &model.parameters {
+        let unit = p.unit.as_deref().map(|u| format!(" ({u})")).unwrap_or_default();
+        let _ = writeln!(
+            src,
+            "#[doc = {}] pub {}: f64,",
+            string_literal(&format!("Parameter `{}`{unit}; default {:?}.", p.name, p.default)),
+            field_name(&p.name)
+        );
+    }
+    let _ = writeln!(src, "}}");
+    let _ = writeln!(src, "#[automatically_derived] impl ::core::default::Default for {name} {{ fn default() -> Self {{ Self {{");
+    for p in &model.parameters {
+        let _ = writeln!(src, "{}: {:?}_f64,", field_name(&p.name), p.default);
+    }
+    let _ = writeln!(src, "}} }} }}");
+
+    // Tracking of the model file for rebuilds.
+    for f in &options.tracked_files {
+        let _ = writeln!(
+            src,
+            "const _: &[u8] = ::core::include_bytes!({});",
+            string_literal(f)
+        );
+    }
+
+    let mut imp = String::new();
+    let coord_names: Vec<String> = model.coordinate_names.iter().map(|c| string_literal(c)).collect();
+    let param_names: Vec<String> = model.parameters.iter().map(|p| string_literal(&p.name)).collect();
+    let point_names: Vec<String> = model.points.iter().map(|(p, _)| string_literal(p)).collect();
+    let _ = writeln!(imp, "fn name(&self) -> &'static str {{ {} }}", string_literal(&model.name));
+    let _ = writeln!(imp, "fn description(&self) -> &'static str {{ {} }}", string_literal(&model.description));
+    let _ = writeln!(imp, "fn coordinate_names(&self) -> [&'static str; {n}] {{ [{}] }}", coord_names.join(", "));
+    let _ = writeln!(imp, "fn parameter_names(&self) -> &'static [&'static str] {{ &[{}] }}", param_names.join(", "));
+    let values: Vec<String> = model.parameters.iter().map(|p| format!("self.{}", field_name(&p.name))).collect();
+    let _ = writeln!(imp, "fn parameter_values(&self) -> ::std::vec::Vec<f64> {{ ::std::vec![{}] }}", values.join(", "));
+    let _ = writeln!(imp, "fn set_parameter(&mut self, name: &str, value: f64) -> ::core::result::Result<(), {krate}::UnknownParameter> {{ match name {{");
+    for p in &model.parameters {
+        let _ = writeln!(imp, "{} => {{ self.{} = value; Ok(()) }}", string_literal(&p.name), field_name(&p.name));
+    }
+    let _ = writeln!(
+        imp,
+        "_ => Err({krate}::UnknownParameter {{ model: {}.to_string(), name: name.to_string(), known: {}.to_string() }}) }} }}",
+        string_literal(&model.name),
+        string_literal(&model.parameters.iter().map(|p| p.name.as_str()).collect::<Vec<_>>().join(", "))
+    );
+
+    let helpers = private.as_str();
+    let mut emit_fn = |signature: &str, roots: &[ExprId], build: &dyn Fn(&[String]) -> String| -> CsePlan {
+        let (b, plan) = body(model, roots, helpers);
+        let _ = writeln!(
+            imp,
+            "#[allow(unused_variables, non_snake_case, clippy::all)] #[inline] {signature} {{\n{}{}\n}}",
+            b.code,
+            build(&b.values)
+        );
+        plan
+    };
+
+    let mat_e = format!("{na}::SMatrix::<f64, {n}, {n}>");
+    let vec_e = format!("{na}::SVector::<f64, {n}>");
+    let matrix = |vals: &[String]| format!("{mat_e}::from_row_slice(&[{}])", vals.join(", "));
+    let vector = |vals: &[String]| format!("{vec_e}::from_column_slice(&[{}])", vals.join(", "));
+    let q_args = format!("__q: &{vec_t}");
+    let qd_args = format!("__q: &{vec_t}, __qdot: &{vec_t}");
+
+    emit_fn(
+        &format!("fn initial_state(&self) -> ({vec_t}, {vec_t})"),
+        &[model.initial_q.clone(), model.initial_qdot.clone()].concat(),
+        &|v| format!("({}, {})", vector(&v[..n]), vector(&v[n..])),
+    );
+    emit_fn(
+        &format!("fn mass_matrix(&self, {q_args}, __t: f64) -> {mat_t}"),
+        &eom.mass_matrix,
+        &|v| matrix(v),
+    );
+    emit_fn(
+        &format!("fn forcing(&self, {qd_args}, __t: f64) -> {vec_t}"),
+        &eom.forcing,
+        &|v| vector(v),
+    );
+    let both: Vec<ExprId> = [eom.mass_matrix.clone(), eom.forcing.clone()].concat();
+    let plan = emit_fn(
+        &format!("fn mass_matrix_and_forcing(&self, {qd_args}, __t: f64) -> ({mat_t}, {vec_t})"),
+        &both,
+        &|v| format!("({}, {})", matrix(&v[..n * n]), vector(&v[n * n..])),
+    );
+    let stats = EmitStats {
+        ops_before_cse: model.arena.tree_operation_count(&both),
+        ops_after_cse: plan.operation_count(),
+    };
+    emit_fn(
+        &format!("fn forcing_jacobian_q(&self, {qd_args}, __t: f64) -> {mat_t}"),
+        &jacobians.forcing_q,
+        &|v| matrix(v),
+    );
+    emit_fn(
+        &format!("fn forcing_jacobian_qdot(&self, {qd_args}, __t: f64) -> {mat_t}"),
+        &jacobians.forcing_qdot,
+        &|v| matrix(v),
+    );
+    emit_fn(
+        &format!("fn mass_matrix_product_jacobian(&self, {q_args}, __t: f64, __a: &{vec_t}) -> {mat_t}"),
+        &jacobians.mass_product_q,
+        &|v| matrix(v),
+    );
+    emit_fn(
+        &format!("fn kinetic_energy(&self, {qd_args}, __t: f64) -> f64"),
+        &[model.kinetic],
+        &|v| v[0].clone(),
+    );
+    emit_fn(
+        &format!("fn potential_energy(&self, {q_args}, __t: f64) -> f64"),
+        &[model.potential],
+        &|v| v[0].clone(),
+    );
+    let point_roots: Vec<ExprId> = model
+        .points
+        .iter()
+        .flat_map(|(_, r)| {
+            let mut r = r.clone();
+            r.resize(3, model.arena.as_constant(r[0]).map(|_| r[0]).unwrap_or(r[0]));
+            r
+        })
+        .collect();
+    let dims: Vec<usize> = model.points.iter().map(|(_, r)| r.len()).collect();
+    emit_fn(
+        &format!("fn point_positions(&self, {q_args}, __t: f64, __out: &mut [[f64; 3]])"),
+        &point_roots,
+        &|v| {
+            let mut s = String::new();
+            for (i, d) in dims.iter().enumerate() {
+                let c: Vec<String> = (0..3)
+                    .map(|k| if k < *d { v[3 * i + k].clone() } else { "0.0_f64".to_string() })
+                    .collect();
+                let _ = write!(s, "if let Some(__p) = __out.get_mut({i}) {{ *__p = [{}]; }}\n", c.join(", "));
+            }
+            s
+        },
+    );
+    let _ = writeln!(imp, "fn is_conservative(&self) -> bool {{ {} }}", model.conservative);
+    let _ = writeln!(imp, "fn point_names(&self) -> &'static [&'static str] {{ &[{}] }}", point_names.join(", "));
+    let _ = writeln!(imp, "fn equations_text(&self) -> &'static str {{ {} }}", string_literal(&equations_text(model, eom)));
+    let _ = writeln!(imp, "fn equations_latex(&self) -> &'static str {{ {} }}", string_literal(&equations_latex(model, eom)));
+
+    let _ = writeln!(
+        src,
+        "#[automatically_derived] impl {krate}::MechanicalSystem<{n}> for {name} {{\n{imp}\n}}"
+    );
+    let tokens: TokenStream = src
+        .parse()
+        .map_err(|e| format!("generated code does not tokenize ({e}):\n{src}"))?;
+    Ok((tokens, stats))
+}
+
+/// The equations as text: `T`, `V`, `Q`, then `M` and `F` entry by entry.
+pub fn equations_text(model: &SymbolicModel, eom: &EquationsOfMotion) -> String {
+    let p = Printer::new(&model.arena, Syntax::Text);
+    let n = eom.num_dofs;
+    let mut s = String::new();
+    let _ = writeln!(s, "q = [{}]", model.coordinate_names.join(", "));
+    let _ = writeln!(s, "T = {}", p.print(model.kinetic));
+    let _ = writeln!(s, "V = {}", p.print(model.potential));
+    for (i, q) in model.generalized_forces.iter().enumerate() {
+        if !model.arena.is_zero(*q) {
+            let _ = writeln!(s, "Q[{}] = {}", model.coordinate_names[i], p.print(*q));
+        }
+    }
+    let _ = writeln!(s, "M q'' = F with");
+    for i in 0..n {
+        for j in i..n {
+            let _ = writeln!(s, "  M[{i},{j}] = {}", p.print(eom.mass(i, j)));
+        }
+    }
+    for i in 0..n {
+        let _ = writeln!(s, "  F[{i}] = {}", p.print(eom.forcing[i]));
+    }
+    s
+}
+
+/// The equations as LaTeX (`amsmath`): `T`, `V` and `M(q) q̈ = F`.
+pub fn equations_latex(model: &SymbolicModel, eom: &EquationsOfMotion) -> String {
+    let p = Printer::new(&model.arena, Syntax::Latex);
+    let n = eom.num_dofs;
+    let mut s = String::new();
+    let _ = writeln!(s, "T = {}", p.print(model.kinetic));
+    let _ = writeln!(s, "\\\\\nV = {}", p.print(model.potential));
+    let rows: Vec<String> = (0..n)
+        .map(|i| (0..n).map(|j| p.print(eom.mass(i, j))).collect::<Vec<_>>().join(" & "))
+        .collect();
+    let acc: Vec<String> = (0..n)
+        .map(|i| p.print(model.coordinates[i][2]))
+        .collect();
+    let forcing: Vec<String> = eom.forcing.iter().map(|f| p.print(*f)).collect();
+    let _ = writeln!(
+        s,
+        "\\\\\n\\begin{{bmatrix}} {} \\end{{bmatrix}} \\begin{{bmatrix}} {} \\end{{bmatrix}} = \\begin{{bmatrix}} {} \\end{{bmatrix}}",
+        rows.join(" \\\\ "),
+        acc.join(" \\\\ "),
+        forcing.join(" \\\\ ")
+    );
+    s
+}

@@ -1,0 +1,446 @@
+//! Lowering a checked [`ModelFile`] into the expression arena: symbols for parameters,
+//! coordinates, rates and time; point positions; `T`, `V` and the generalized forces `Q`
+//! assembled from bodies, gravity, springs, dampers, forces and torques.
+
+use crate::expr::{Constant, ExprArena, ExprId, Func, SymbolId, SymbolKind};
+use crate::model::{BinOp, BodyKind, Diagnostic, Expr, ExprKind, ModelFile};
+
+/// A parameter of a lowered model.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ParameterInfo {
+    /// Name.
+    pub name: String,
+    /// Default value.
+    pub default: f64,
+    /// Unit from the model file's comment.
+    pub unit: Option<String>,
+    /// Its symbol.
+    pub symbol: SymbolId,
+}
+
+/// A model file turned into expressions: everything a [`super::Formulation`] needs.
+#[derive(Debug, Clone)]
+pub struct SymbolicModel {
+    /// The arena that owns every expression below.
+    pub arena: ExprArena,
+    /// Model name (snake_case).
+    pub name: String,
+    /// One-line description.
+    pub description: String,
+    /// Parameters in file order.
+    pub parameters: Vec<ParameterInfo>,
+    /// Coordinate names in order.
+    pub coordinate_names: Vec<String>,
+    /// `[q, q̇, q̈]` expressions per coordinate.
+    pub coordinates: Vec<[ExprId; 3]>,
+    /// The time symbol.
+    pub time: ExprId,
+    /// Named points and their position components (2 or 3).
+    pub points: Vec<(String, Vec<ExprId>)>,
+    /// Kinetic energy `T(q, q̇, t)` (J).
+    pub kinetic: ExprId,
+    /// Potential energy `V(q, t)` (J): gravity, springs and the file's `potential`.
+    pub potential: ExprId,
+    /// Non-potential generalized forces `Q` (one per coordinate): dampers, forces, torques
+    /// and the file's `generalized_forces`, projected on the partial velocities.
+    pub generalized_forces: Vec<ExprId>,
+    /// Initial `q(0)` per coordinate (expressions of the parameters; 0 if not given).
+    pub initial_q: Vec<ExprId>,
+    /// Initial `q̇(0)` per coordinate.
+    pub initial_qdot: Vec<ExprId>,
+    /// Whether `T + V` is conserved: no dampers, forces, torques or generalized forces, and
+    /// no explicit time dependence in `T` or `V`.
+    pub conservative: bool,
+    /// Spatial dimension of the points (2 or 3; 2 when there are none).
+    pub dimension: usize,
+    /// Line segments to draw, as point-index pairs.
+    pub draw_lines: Vec<[usize; 2]>,
+}
+
+impl SymbolicModel {
+    /// Number of degrees of freedom `n`.
+    pub fn num_dofs(&self) -> usize {
+        self.coordinates.len()
+    }
+
+    /// Symbol ids `(q, q̇, q̈)` of coordinate `i`.
+    pub fn coordinate_symbols(&self, i: usize) -> [SymbolId; 3] {
+        self.arena.coordinates()[i]
+    }
+
+    /// The time symbol id.
+    pub fn time_symbol(&self) -> SymbolId {
+        match self.arena.node(self.time) {
+            crate::expr::Node::Symbol(s) => *s,
+            _ => unreachable!("time is a symbol"),
+        }
+    }
+
+    /// Lowers a checked model file.
+    ///
+    /// # Errors
+    /// A diagnostic for anything the checks should have rejected (unknown name, wrong
+    /// dimension); with a model that passed [`crate::model::load`] this does not happen.
+    pub fn from_file(file: &ModelFile) -> Result<Self, Vec<Diagnostic>> {
+        Lowering::new(file).run()
+    }
+}
+
+struct Lowering<'f> {
+    file: &'f ModelFile,
+    arena: ExprArena,
+    errors: Vec<Diagnostic>,
+}
+
+impl<'f> Lowering<'f> {
+    fn new(file: &'f ModelFile) -> Self {
+        Self {
+            file,
+            arena: ExprArena::new(),
+            errors: Vec::new(),
+        }
+    }
+
+    fn expr(&mut self, e: &Expr) -> ExprId {
+        match &e.kind {
+            ExprKind::Number { value, text } => {
+                let c = Constant::parse_decimal(text)
+                    .or_else(|| Constant::float(*value))
+                    .unwrap_or(Constant::ZERO);
+                self.arena.constant(c)
+            }
+            ExprKind::Ident(name) => match name.as_str() {
+                "pi" => self.arena.pi(),
+                "t" => self.arena.time(),
+                _ => match self.arena.symbol_id(name) {
+                    Some(s)
+                        if !matches!(
+                            self.arena.symbol_info(s).kind,
+                            SymbolKind::Acceleration(_)
+                        ) =>
+                    {
+                        self.arena.symbol_expr(s)
+                    }
+                    _ => {
+                        self.errors.push(Diagnostic::new(
+                            e.location,
+                            format!("unknown name `{name}` in an expression"),
+                        ));
+                        self.arena.int(0)
+                    }
+                },
+            },
+            ExprKind::Neg(a) => {
+                let a = self.expr(a);
+                self.arena.neg(a)
+            }
+            ExprKind::Binary { op, lhs, rhs } => {
+                let (a, b) = (self.expr(lhs), self.expr(rhs));
+                match op {
+                    BinOp::Add => self.arena.plus(a, b),
+                    BinOp::Sub => self.arena.minus(a, b),
+                    BinOp::Mul => self.arena.times(a, b),
+                    BinOp::Div => self.arena.divide(a, b),
+                    BinOp::Pow => self.arena.pow(a, b),
+                }
+            }
+            ExprKind::Call { func, args } => {
+                let args: Vec<ExprId> = args.iter().map(|a| self.expr(a)).collect();
+                match (func.as_str(), args.as_slice()) {
+                    ("sqrt", [a]) => self.arena.sqrt(*a),
+                    ("atan2", [y, x]) => self.arena.atan2(*y, *x),
+                    (name, [a]) => match Func::from_name(name) {
+                        Some(f) => self.arena.func(f, *a),
+                        None => self.unknown_function(e, name),
+                    },
+                    (name, _) => self.unknown_function(e, name),
+                }
+            }
+        }
+    }
+
+    fn unknown_function(&mut self, e: &Expr, name: &str) -> ExprId {
+        self.errors.push(Diagnostic::new(
+            e.location,
+            format!("unknown function or wrong number of arguments in `{name}(…)`"),
+        ));
+        self.arena.int(0)
+    }
+
+    fn dot(&mut self, a: &[ExprId], b: &[ExprId]) -> ExprId {
+        let terms: Vec<ExprId> = a.iter().zip(b).map(|(x, y)| self.arena.times(*x, *y)).collect();
+        self.arena.sum(&terms)
+    }
+
+    fn difference(&mut self, a: &[ExprId], b: &[ExprId]) -> Vec<ExprId> {
+        a.iter().zip(b).map(|(x, y)| self.arena.minus(*x, *y)).collect()
+    }
+
+    fn run(mut self) -> Result<SymbolicModel, Vec<Diagnostic>> {
+        let file = self.file;
+        let time = self.arena.time();
+        let mut parameters = Vec::new();
+        for p in &file.parameters {
+            let e = self.arena.symbol(&p.name.value, SymbolKind::Parameter);
+            let symbol = match self.arena.node(e) {
+                crate::expr::Node::Symbol(s) => *s,
+                _ => unreachable!("symbol() returns a symbol node"),
+            };
+            parameters.push(ParameterInfo {
+                name: p.name.value.clone(),
+                default: p.value,
+                unit: p.unit.clone(),
+                symbol,
+            });
+        }
+        let coordinates: Vec<[ExprId; 3]> = file
+            .coordinates
+            .iter()
+            .map(|c| self.arena.coordinate(&c.name.value))
+            .collect();
+        let n = coordinates.len();
+        let coordinate_names: Vec<String> =
+            file.coordinates.iter().map(|c| c.name.value.clone()).collect();
+        let q_symbols: Vec<SymbolId> = self.arena.coordinates().iter().map(|c| c[0]).collect();
+
+        let points: Vec<(String, Vec<ExprId>)> = file
+            .points
+            .iter()
+            .map(|p| {
+                let r = p.position.iter().map(|c| self.expr(c)).collect();
+                (p.name.value.clone(), r)
+            })
+            .collect();
+        let dimension = file.dimension.unwrap_or(2);
+        let point = |name: &str| points.iter().position(|(p, _)| p == name);
+
+        let mut t_terms: Vec<ExprId> = Vec::new();
+        let mut v_terms: Vec<ExprId> = Vec::new();
+        let mut q_terms: Vec<Vec<ExprId>> = vec![Vec::new(); n];
+        let half = self.arena.constant(Constant::Rational { num: 1, den: 2 });
+
+        if let Some(k) = &file.kinetic {
+            let e = self.expr(k);
+            t_terms.push(e);
+        }
+        if let Some(v) = &file.potential {
+            let e = self.expr(v);
+            v_terms.push(e);
+        }
+        for (name, q) in &file.generalized_forces {
+            let e = self.expr(q);
+            match coordinate_names.iter().position(|c| *c == name.value) {
+                Some(i) => q_terms[i].push(e),
+                None => self.errors.push(Diagnostic::new(
+                    name.location,
+                    format!("`{}` is not a coordinate", name.value),
+                )),
+            }
+        }
+        let gravity: Option<Vec<ExprId>> = file
+            .gravity
+            .as_ref()
+            .map(|g| g.value.iter().map(|c| self.expr(c)).collect());
+
+        // Bodies: T = ½ m v_G·v_G (+ ½ I ω² for planar rigid bodies), V = −m g·r_G.
+        let mut angles: Vec<(String, ExprId)> = Vec::new();
+        for body in &file.bodies {
+            let (mass, at, rigid) = match &body.kind {
+                BodyKind::Particle { mass, at } => (mass, at, None),
+                BodyKind::Rigid {
+                    mass,
+                    inertia,
+                    com,
+                    angle,
+                } => (mass, com, Some((inertia, angle))),
+            };
+            let m = self.expr(mass);
+            let Some(ip) = point(&at.value) else {
+                self.errors.push(Diagnostic::new(
+                    at.location,
+                    format!("unknown point `{}`", at.value),
+                ));
+                continue;
+            };
+            let r = points[ip].1.clone();
+            let v: Vec<ExprId> = r.iter().map(|c| self.arena.time_derivative(*c)).collect();
+            let v2 = self.dot(&v, &v);
+            t_terms.push(self.arena.product(&[half, m, v2]));
+            if let Some(g) = &gravity {
+                let gr = self.dot(g, &r);
+                let mgr = self.arena.times(m, gr);
+                v_terms.push(self.arena.neg(mgr));
+            }
+            if let Some((inertia, angle)) = rigid {
+                let i = self.expr(inertia);
+                let th = self.expr(angle);
+                let w = self.arena.time_derivative(th);
+                let two = self.arena.int(2);
+                let w2 = self.arena.pow(w, two);
+                t_terms.push(self.arena.product(&[half, i, w2]));
+                angles.push((body.name.value.clone(), th));
+            }
+        }
+
+        // Springs: V = ½ k (|r_A − r_B| − ℓ₀)², or ½ k |r_A − r_B|² for zero rest length.
+        for s in &file.springs {
+            let (Some(a), Some(b)) = (point(&s.between[0].value), point(&s.between[1].value))
+            else {
+                self.errors.push(Diagnostic::new(
+                    s.name.location,
+                    format!("spring `{}` names an unknown point", s.name.value),
+                ));
+                continue;
+            };
+            let d = self.difference(&points[a].1, &points[b].1);
+            let d2 = self.dot(&d, &d);
+            let k = self.expr(&s.stiffness);
+            let stretch2 = match &s.rest_length {
+                None => d2,
+                Some(l0) => {
+                    let l0 = self.expr(l0);
+                    let len = self.arena.sqrt(d2);
+                    let st = self.arena.minus(len, l0);
+                    let two = self.arena.int(2);
+                    self.arena.pow(st, two)
+                }
+            };
+            v_terms.push(self.arena.product(&[half, k, stretch2]));
+        }
+
+        // Dampers along the line AB: F_A = −c (ḋ·e) e with d = r_A − r_B, e = d/|d|, so
+        // Qᵢ = F_A·∂d/∂qᵢ = −c (d·ḋ)(d·∂d/∂qᵢ)/(d·d).
+        for dmp in &file.dampers {
+            let (Some(a), Some(b)) = (point(&dmp.between[0].value), point(&dmp.between[1].value))
+            else {
+                self.errors.push(Diagnostic::new(
+                    dmp.name.location,
+                    format!("damper `{}` names an unknown point", dmp.name.value),
+                ));
+                continue;
+            };
+            let d = self.difference(&points[a].1, &points[b].1);
+            let dd: Vec<ExprId> = d.iter().map(|c| self.arena.time_derivative(*c)).collect();
+            let c = self.expr(&dmp.coefficient);
+            let d2 = self.dot(&d, &d);
+            let rate = self.dot(&d, &dd);
+            let c_rate = self.arena.times(c, rate);
+            let scale = self.arena.divide(c_rate, d2);
+            let scale = self.arena.neg(scale);
+            for (i, qs) in q_symbols.iter().enumerate() {
+                let partial: Vec<ExprId> = d.iter().map(|x| self.arena.diff(*x, *qs)).collect();
+                let proj = self.dot(&d, &partial);
+                if !self.arena.is_zero(proj) {
+                    q_terms[i].push(self.arena.times(scale, proj));
+                }
+            }
+        }
+
+        // Forces at points: Qᵢ = F·∂r_P/∂qᵢ (the partial velocity ∂v_P/∂q̇ᵢ).
+        for f in &file.forces {
+            let Some(ip) = point(&f.at.value) else {
+                self.errors.push(Diagnostic::new(
+                    f.at.location,
+                    format!("unknown point `{}`", f.at.value),
+                ));
+                continue;
+            };
+            let force: Vec<ExprId> = f.vector.iter().map(|c| self.expr(c)).collect();
+            let r = points[ip].1.clone();
+            for (i, qs) in q_symbols.iter().enumerate() {
+                let partial: Vec<ExprId> = r.iter().map(|x| self.arena.diff(*x, *qs)).collect();
+                let proj = self.dot(&force, &partial);
+                if !self.arena.is_zero(proj) {
+                    q_terms[i].push(proj);
+                }
+            }
+        }
+
+        // Torques on planar bodies: Qᵢ = τ ∂θ/∂qᵢ (partial angular velocity).
+        for tq in &file.torques {
+            let Some(th) = angles
+                .iter()
+                .find(|(b, _)| *b == tq.body.value)
+                .map(|(_, a)| *a)
+            else {
+                self.errors.push(Diagnostic::new(
+                    tq.body.location,
+                    format!("`{}` is not a planar rigid body", tq.body.value),
+                ));
+                continue;
+            };
+            let tau = self.expr(&tq.value);
+            for (i, qs) in q_symbols.iter().enumerate() {
+                let partial = self.arena.diff(th, *qs);
+                if !self.arena.is_zero(partial) {
+                    q_terms[i].push(self.arena.times(tau, partial));
+                }
+            }
+        }
+
+        let kinetic = self.arena.sum(&t_terms);
+        let potential = self.arena.sum(&v_terms);
+        let generalized_forces: Vec<ExprId> =
+            q_terms.iter().map(|terms| self.arena.sum(terms)).collect();
+
+        let mut initial_q = vec![self.arena.int(0); n];
+        let mut initial_qdot = vec![self.arena.int(0); n];
+        for (name, value) in &file.initial {
+            let e = self.expr(value);
+            if let Some(i) = coordinate_names.iter().position(|c| *c == name.value) {
+                initial_q[i] = e;
+            } else if let Some(i) = coordinate_names
+                .iter()
+                .position(|c| name.value.strip_suffix("_dot") == Some(c.as_str()))
+            {
+                initial_qdot[i] = e;
+            } else {
+                self.errors.push(Diagnostic::new(
+                    name.location,
+                    format!("`{}` is neither a coordinate nor a rate", name.value),
+                ));
+            }
+        }
+
+        let ts = match self.arena.node(time) {
+            crate::expr::Node::Symbol(s) => *s,
+            _ => unreachable!("time is a symbol"),
+        };
+        let explicit_time =
+            self.arena.depends_on(kinetic, ts) || self.arena.depends_on(potential, ts);
+        let conservative = file.dampers.is_empty()
+            && file.forces.is_empty()
+            && file.torques.is_empty()
+            && generalized_forces.iter().all(|q| self.arena.is_zero(*q))
+            && !explicit_time;
+
+        let draw_lines = file
+            .draw
+            .lines
+            .iter()
+            .filter_map(|[a, b]| Some([point(&a.value)?, point(&b.value)?]))
+            .collect();
+
+        if !self.errors.is_empty() {
+            return Err(self.errors);
+        }
+        Ok(SymbolicModel {
+            arena: self.arena,
+            name: file.name.value.clone(),
+            description: file.description.clone(),
+            parameters,
+            coordinate_names,
+            coordinates,
+            time,
+            points,
+            kinetic,
+            potential,
+            generalized_forces,
+            initial_q,
+            initial_qdot,
+            conservative,
+            dimension,
+            draw_lines,
+        })
+    }
+}

@@ -1,0 +1,85 @@
+//! Derivations: from a lowered model to `M(q, t) q̈ = F(q, q̇, t)` and its exact Jacobians.
+//!
+//! One [`Formulation`] interface serves every derivation (Lagrange now; momentum balance
+//! next), so the code generator and the cross-checks treat them alike.
+
+mod lagrange;
+mod lower;
+
+pub use lagrange::Lagrange;
+pub use lower::{ParameterInfo, SymbolicModel};
+
+use crate::expr::ExprId;
+
+/// `M(q, t) q̈ = F(q, q̇, t)` as expressions of one [`SymbolicModel`]'s arena.
+#[derive(Debug, Clone, PartialEq)]
+pub struct EquationsOfMotion {
+    /// Number of degrees of freedom `n`.
+    pub num_dofs: usize,
+    /// Mass matrix, `n × n` row-major (entry `(i, j)` at `i n + j`).
+    pub mass_matrix: Vec<ExprId>,
+    /// Forcing `F`, length `n`.
+    pub forcing: Vec<ExprId>,
+}
+
+impl EquationsOfMotion {
+    /// Entry `(i, j)` of the mass matrix.
+    pub fn mass(&self, i: usize, j: usize) -> ExprId {
+        self.mass_matrix[i * self.num_dofs + j]
+    }
+}
+
+/// A way of deriving equations of motion from a model.
+pub trait Formulation {
+    /// Short name (`lagrange`).
+    fn name(&self) -> &'static str;
+    /// Derives `M q̈ = F`, adding the expressions to the model's arena.
+    fn derive(&self, model: &mut SymbolicModel) -> EquationsOfMotion;
+}
+
+/// Exact Jacobians of the equations of motion, for implicit integrators and linearisation.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Jacobians {
+    /// `∂F/∂q`, `n × n` row-major (entry `(i, j)` = `∂Fᵢ/∂qⱼ`).
+    pub forcing_q: Vec<ExprId>,
+    /// `∂F/∂q̇`, `n × n` row-major.
+    pub forcing_qdot: Vec<ExprId>,
+    /// `∂(M a)/∂q`, `n × n` row-major (entry `(i, k)` = `Σⱼ ∂Mᵢⱼ/∂qₖ aⱼ`), where the vector
+    /// `a` is represented by the acceleration symbols `q̈ⱼ`.
+    pub mass_product_q: Vec<ExprId>,
+}
+
+impl Jacobians {
+    /// Differentiates `eom` exactly (symbolically) with respect to `q` and `q̇`.
+    pub fn of(model: &mut SymbolicModel, eom: &EquationsOfMotion) -> Self {
+        let n = eom.num_dofs;
+        let symbols: Vec<[crate::expr::SymbolId; 3]> = (0..n).map(|i| model.coordinate_symbols(i)).collect();
+        let arena = &mut model.arena;
+        let mut forcing_q = Vec::with_capacity(n * n);
+        let mut forcing_qdot = Vec::with_capacity(n * n);
+        for &f in &eom.forcing {
+            for s in &symbols {
+                forcing_q.push(arena.diff(f, s[0]));
+            }
+            for s in &symbols {
+                forcing_qdot.push(arena.diff(f, s[1]));
+            }
+        }
+        let accelerations: Vec<ExprId> = symbols.iter().map(|s| arena.symbol_expr(s[2])).collect();
+        let mut mass_product_q = Vec::with_capacity(n * n);
+        for i in 0..n {
+            let terms: Vec<ExprId> = (0..n)
+                .map(|j| arena.times(eom.mass(i, j), accelerations[j]))
+                .collect();
+            let row = arena.sum(&terms);
+            for s in &symbols {
+                mass_product_q.push(arena.diff(row, s[0]));
+            }
+        }
+        Self {
+            forcing_q,
+            forcing_qdot,
+            mass_product_q,
+        }
+    }
+}
