@@ -25,7 +25,14 @@ fn model_name(source: &str, stem: &str) -> String {
     source
         .lines()
         .find_map(|l| l.strip_prefix("name:"))
-        .map(|v| v.split('#').next().unwrap_or("").trim().trim_matches(['"', '\'']).to_string())
+        .map(|v| {
+            v.split('#')
+                .next()
+                .unwrap_or("")
+                .trim()
+                .trim_matches(['"', '\''])
+                .to_string()
+        })
         .filter(|v| !v.is_empty())
         .unwrap_or_else(|| stem.to_string())
 }
@@ -49,7 +56,13 @@ fn main() {
         let stem = f.file_stem().and_then(|s| s.to_str()).unwrap_or("model");
         let module: String = stem
             .chars()
-            .map(|c| if c.is_ascii_alphanumeric() { c.to_ascii_lowercase() } else { '_' })
+            .map(|c| {
+                if c.is_ascii_alphanumeric() {
+                    c.to_ascii_lowercase()
+                } else {
+                    '_'
+                }
+            })
             .collect();
         let source = std::fs::read_to_string(f).unwrap_or_default();
         let name = model_name(&source, stem);

@@ -1,1 +1,7 @@
-fn main() {}
+//! The `eomgen` command line: list, simulate (more commands arrive with later features).
+
+mod cli;
+
+fn main() -> std::process::ExitCode {
+    cli::run()
+}

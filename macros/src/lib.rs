@@ -58,7 +58,11 @@ fn expand(input: proc_macro2::TokenStream) -> syn::Result<proc_macro2::TokenStre
     let written = literal.value();
     let path = {
         let p = PathBuf::from(&written);
-        if p.is_absolute() { p } else { base_dir().join(p) }
+        if p.is_absolute() {
+            p
+        } else {
+            base_dir().join(p)
+        }
     };
     let source = std::fs::read_to_string(&path).map_err(|e| {
         syn::Error::new(

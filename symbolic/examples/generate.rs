@@ -23,14 +23,18 @@ fn main() {
         }
         std::process::exit(1);
     }
-    let file = eomgen_symbolic::model::load(&path, &source).unwrap_or_else(|d| report(&path, &source, d));
+    let file =
+        eomgen_symbolic::model::load(&path, &source).unwrap_or_else(|d| report(&path, &source, d));
     let mut model = SymbolicModel::from_file(&file).unwrap_or_else(|d| report(&path, &source, d));
     let eom = Lagrange.derive(&mut model);
     let jac = Jacobians::of(&mut model, &eom);
     match codegen::emit(&model, &eom, &jac, &EmitOptions::default()) {
         Ok((tokens, stats)) => {
             println!("{tokens}");
-            eprintln!("ops before CSE {}, after {}", stats.ops_before_cse, stats.ops_after_cse);
+            eprintln!(
+                "ops before CSE {}, after {}",
+                stats.ops_before_cse, stats.ops_after_cse
+            );
         }
         Err(e) => {
             eprintln!("{e}");

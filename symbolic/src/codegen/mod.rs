@@ -47,11 +47,11 @@ pub struct EmitStats {
 }
 
 const RUST_KEYWORDS: &[&str] = &[
-    "as", "async", "await", "break", "const", "continue", "crate", "dyn", "else", "enum",
-    "extern", "false", "fn", "for", "gen", "if", "impl", "in", "let", "loop", "match", "mod",
-    "move", "mut", "pub", "ref", "return", "self", "Self", "static", "struct", "super", "trait",
-    "true", "type", "unsafe", "use", "where", "while", "abstract", "become", "box", "do",
-    "final", "macro", "override", "priv", "typeof", "unsized", "virtual", "yield", "try",
+    "as", "async", "await", "break", "const", "continue", "crate", "dyn", "else", "enum", "extern",
+    "false", "fn", "for", "gen", "if", "impl", "in", "let", "loop", "match", "mod", "move", "mut",
+    "pub", "ref", "return", "self", "Self", "static", "struct", "super", "trait", "true", "type",
+    "unsafe", "use", "where", "while", "abstract", "become", "box", "do", "final", "macro",
+    "override", "priv", "typeof", "unsized", "virtual", "yield", "try",
 ];
 
 /// A symbol's local variable name in generated code (`r#`-free: keywords get a `_` suffix).
@@ -182,16 +182,26 @@ pub fn emit(
     let _ = writeln!(src, "#[allow(non_snake_case)]");
     let _ = writeln!(src, "pub struct {name} {{");
     for p in &model.parameters {
-        let unit = p.unit.as_deref().map(|u| format!(" ({u})")).unwrap_or_default();
+        let unit = p
+            .unit
+            .as_deref()
+            .map(|u| format!(" ({u})"))
+            .unwrap_or_default();
         let _ = writeln!(
             src,
             "#[doc = {}] pub {}: f64,",
-            string_literal(&format!("Parameter `{}`{unit}; default {:?}.", p.name, p.default)),
+            string_literal(&format!(
+                "Parameter `{}`{unit}; default {:?}.",
+                p.name, p.default
+            )),
             field_name(&p.name)
         );
     }
     let _ = writeln!(src, "}}");
-    let _ = writeln!(src, "#[automatically_derived] impl ::core::default::Default for {name} {{ fn default() -> Self {{ Self {{");
+    let _ = writeln!(
+        src,
+        "#[automatically_derived] impl ::core::default::Default for {name} {{ fn default() -> Self {{ Self {{"
+    );
     for p in &model.parameters {
         let _ = writeln!(src, "{}: {:?}_f64,", field_name(&p.name), p.default);
     }
@@ -207,28 +217,82 @@ pub fn emit(
     }
 
     let mut imp = String::new();
-    let coord_names: Vec<String> = model.coordinate_names.iter().map(|c| string_literal(c)).collect();
-    let param_names: Vec<String> = model.parameters.iter().map(|p| string_literal(&p.name)).collect();
-    let point_names: Vec<String> = model.points.iter().map(|(p, _)| string_literal(p)).collect();
-    let _ = writeln!(imp, "fn name(&self) -> &'static str {{ {} }}", string_literal(&model.name));
-    let _ = writeln!(imp, "fn description(&self) -> &'static str {{ {} }}", string_literal(&model.description));
-    let _ = writeln!(imp, "fn coordinate_names(&self) -> [&'static str; {n}] {{ [{}] }}", coord_names.join(", "));
-    let _ = writeln!(imp, "fn parameter_names(&self) -> &'static [&'static str] {{ &[{}] }}", param_names.join(", "));
-    let values: Vec<String> = model.parameters.iter().map(|p| format!("self.{}", field_name(&p.name))).collect();
-    let _ = writeln!(imp, "fn parameter_values(&self) -> ::std::vec::Vec<f64> {{ ::std::vec![{}] }}", values.join(", "));
-    let _ = writeln!(imp, "fn set_parameter(&mut self, name: &str, value: f64) -> ::core::result::Result<(), {krate}::UnknownParameter> {{ match name {{");
+    let coord_names: Vec<String> = model
+        .coordinate_names
+        .iter()
+        .map(|c| string_literal(c))
+        .collect();
+    let param_names: Vec<String> = model
+        .parameters
+        .iter()
+        .map(|p| string_literal(&p.name))
+        .collect();
+    let point_names: Vec<String> = model
+        .points
+        .iter()
+        .map(|(p, _)| string_literal(p))
+        .collect();
+    let _ = writeln!(
+        imp,
+        "fn name(&self) -> &'static str {{ {} }}",
+        string_literal(&model.name)
+    );
+    let _ = writeln!(
+        imp,
+        "fn description(&self) -> &'static str {{ {} }}",
+        string_literal(&model.description)
+    );
+    let _ = writeln!(
+        imp,
+        "fn coordinate_names(&self) -> [&'static str; {n}] {{ [{}] }}",
+        coord_names.join(", ")
+    );
+    let _ = writeln!(
+        imp,
+        "fn parameter_names(&self) -> &'static [&'static str] {{ &[{}] }}",
+        param_names.join(", ")
+    );
+    let values: Vec<String> = model
+        .parameters
+        .iter()
+        .map(|p| format!("self.{}", field_name(&p.name)))
+        .collect();
+    let _ = writeln!(
+        imp,
+        "fn parameter_values(&self) -> ::std::vec::Vec<f64> {{ ::std::vec![{}] }}",
+        values.join(", ")
+    );
+    let _ = writeln!(
+        imp,
+        "fn set_parameter(&mut self, name: &str, value: f64) -> ::core::result::Result<(), {krate}::UnknownParameter> {{ match name {{"
+    );
     for p in &model.parameters {
-        let _ = writeln!(imp, "{} => {{ self.{} = value; Ok(()) }}", string_literal(&p.name), field_name(&p.name));
+        let _ = writeln!(
+            imp,
+            "{} => {{ self.{} = value; Ok(()) }}",
+            string_literal(&p.name),
+            field_name(&p.name)
+        );
     }
     let _ = writeln!(
         imp,
         "_ => Err({krate}::UnknownParameter {{ model: {}.to_string(), name: name.to_string(), known: {}.to_string() }}) }} }}",
         string_literal(&model.name),
-        string_literal(&model.parameters.iter().map(|p| p.name.as_str()).collect::<Vec<_>>().join(", "))
+        string_literal(
+            &model
+                .parameters
+                .iter()
+                .map(|p| p.name.as_str())
+                .collect::<Vec<_>>()
+                .join(", ")
+        )
     );
 
     let helpers = private.as_str();
-    let mut emit_fn = |signature: &str, roots: &[ExprId], build: &dyn Fn(&[String]) -> String| -> CsePlan {
+    let mut emit_fn = |signature: &str,
+                       roots: &[ExprId],
+                       build: &dyn Fn(&[String]) -> String|
+     -> CsePlan {
         let (b, plan) = body(model, roots, helpers);
         let _ = writeln!(
             imp,
@@ -282,7 +346,9 @@ pub fn emit(
         &|v| matrix(v),
     );
     emit_fn(
-        &format!("fn mass_matrix_product_jacobian(&self, {q_args}, __t: f64, __a: &{vec_t}) -> {mat_t}"),
+        &format!(
+            "fn mass_matrix_product_jacobian(&self, {q_args}, __t: f64, __a: &{vec_t}) -> {mat_t}"
+        ),
         &jacobians.mass_product_q,
         &|v| matrix(v),
     );
@@ -301,7 +367,10 @@ pub fn emit(
         .iter()
         .flat_map(|(_, r)| {
             let mut r = r.clone();
-            r.resize(3, model.arena.as_constant(r[0]).map(|_| r[0]).unwrap_or(r[0]));
+            r.resize(
+                3,
+                model.arena.as_constant(r[0]).map(|_| r[0]).unwrap_or(r[0]),
+            );
             r
         })
         .collect();
@@ -313,17 +382,43 @@ pub fn emit(
             let mut s = String::new();
             for (i, d) in dims.iter().enumerate() {
                 let c: Vec<String> = (0..3)
-                    .map(|k| if k < *d { v[3 * i + k].clone() } else { "0.0_f64".to_string() })
+                    .map(|k| {
+                        if k < *d {
+                            v[3 * i + k].clone()
+                        } else {
+                            "0.0_f64".to_string()
+                        }
+                    })
                     .collect();
-                let _ = write!(s, "if let Some(__p) = __out.get_mut({i}) {{ *__p = [{}]; }}\n", c.join(", "));
+                let _ = write!(
+                    s,
+                    "if let Some(__p) = __out.get_mut({i}) {{ *__p = [{}]; }}\n",
+                    c.join(", ")
+                );
             }
             s
         },
     );
-    let _ = writeln!(imp, "fn is_conservative(&self) -> bool {{ {} }}", model.conservative);
-    let _ = writeln!(imp, "fn point_names(&self) -> &'static [&'static str] {{ &[{}] }}", point_names.join(", "));
-    let _ = writeln!(imp, "fn equations_text(&self) -> &'static str {{ {} }}", string_literal(&equations_text(model, eom)));
-    let _ = writeln!(imp, "fn equations_latex(&self) -> &'static str {{ {} }}", string_literal(&equations_latex(model, eom)));
+    let _ = writeln!(
+        imp,
+        "fn is_conservative(&self) -> bool {{ {} }}",
+        model.conservative
+    );
+    let _ = writeln!(
+        imp,
+        "fn point_names(&self) -> &'static [&'static str] {{ &[{}] }}",
+        point_names.join(", ")
+    );
+    let _ = writeln!(
+        imp,
+        "fn equations_text(&self) -> &'static str {{ {} }}",
+        string_literal(&equations_text(model, eom))
+    );
+    let _ = writeln!(
+        imp,
+        "fn equations_latex(&self) -> &'static str {{ {} }}",
+        string_literal(&equations_latex(model, eom))
+    );
 
     let _ = writeln!(
         src,
@@ -368,11 +463,14 @@ pub fn equations_latex(model: &SymbolicModel, eom: &EquationsOfMotion) -> String
     let _ = writeln!(s, "T = {}", p.print(model.kinetic));
     let _ = writeln!(s, "\\\\\nV = {}", p.print(model.potential));
     let rows: Vec<String> = (0..n)
-        .map(|i| (0..n).map(|j| p.print(eom.mass(i, j))).collect::<Vec<_>>().join(" & "))
+        .map(|i| {
+            (0..n)
+                .map(|j| p.print(eom.mass(i, j)))
+                .collect::<Vec<_>>()
+                .join(" & ")
+        })
         .collect();
-    let acc: Vec<String> = (0..n)
-        .map(|i| p.print(model.coordinates[i][2]))
-        .collect();
+    let acc: Vec<String> = (0..n).map(|i| p.print(model.coordinates[i][2])).collect();
     let forcing: Vec<String> = eom.forcing.iter().map(|f| p.print(*f)).collect();
     let _ = writeln!(
         s,

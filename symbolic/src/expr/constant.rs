@@ -148,10 +148,7 @@ impl Constant {
             let exact = (|| {
                 let g1 = gcd(a, d).max(1);
                 let g2 = gcd(c, b).max(1);
-                Constant::rational(
-                    (a / g1).checked_mul(c / g2)?,
-                    (b / g2).checked_mul(d / g1)?,
-                )
+                Constant::rational((a / g1).checked_mul(c / g2)?, (b / g2).checked_mul(d / g1)?)
             })();
             if exact.is_some() {
                 return exact;

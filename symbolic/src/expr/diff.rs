@@ -24,8 +24,7 @@ impl ExprArena {
             }
             Node::Mul(factors) => {
                 // Product rule: Σᵢ f'ᵢ Πⱼ≠ᵢ fⱼ, skipping factors that do not depend on var.
-                let derivatives: Vec<ExprId> =
-                    factors.iter().map(|&f| self.diff(f, var)).collect();
+                let derivatives: Vec<ExprId> = factors.iter().map(|&f| self.diff(f, var)).collect();
                 let mut terms = Vec::new();
                 for (i, &d) in derivatives.iter().enumerate() {
                     if self.is_zero(d) {

@@ -289,7 +289,11 @@ impl ExprArena {
     pub fn symbol(&mut self, name: &str, kind: SymbolKind) -> ExprId {
         let id = match self.symbol_ids.get(name) {
             Some(&id) => {
-                assert_eq!(self.symbols[id.index()].kind, kind, "symbol `{name}` redeclared");
+                assert_eq!(
+                    self.symbols[id.index()].kind,
+                    kind,
+                    "symbol `{name}` redeclared"
+                );
                 id
             }
             None => {
@@ -594,8 +598,7 @@ impl ExprArena {
             }
             // (x y)^n = x^n y^n for integer n.
             Node::Mul(factors) if integer_exponent.is_some() => {
-                let powered: Vec<ExprId> =
-                    factors.iter().map(|&f| self.pow(f, exponent)).collect();
+                let powered: Vec<ExprId> = factors.iter().map(|&f| self.pow(f, exponent)).collect();
                 return self.product(&powered);
             }
             _ => {}

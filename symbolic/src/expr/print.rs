@@ -139,7 +139,10 @@ impl<'a> Printer<'a> {
                 let (coefficient, rest) = self.split(factors);
                 let (s, p) = self.product(coefficient.abs_constant(), rest);
                 if coefficient.is_negative() {
-                    (format!("-{}", self.wrap((s, p), Prec::Product)), Prec::Product)
+                    (
+                        format!("-{}", self.wrap((s, p), Prec::Product)),
+                        Prec::Product,
+                    )
                 } else {
                     (s, p)
                 }
@@ -155,10 +158,7 @@ impl<'a> Printer<'a> {
                         Prec::Atom,
                     ),
                     Syntax::Latex => (
-                        format!(
-                            "\\operatorname{{atan2}}\\left({}, {}\\right)",
-                            ys.0, xs.0
-                        ),
+                        format!("\\operatorname{{atan2}}\\left({}, {}\\right)", ys.0, xs.0),
                         Prec::Atom,
                     ),
                 }
@@ -179,7 +179,12 @@ impl<'a> Printer<'a> {
             .copied()
             .filter(|t| self.arena.as_constant(*t).is_none())
             .collect();
-        ordered.extend(terms.iter().copied().filter(|t| self.arena.as_constant(*t).is_some()));
+        ordered.extend(
+            terms
+                .iter()
+                .copied()
+                .filter(|t| self.arena.as_constant(*t).is_some()),
+        );
         let mut out = String::new();
         for (i, &t) in ordered.iter().enumerate() {
             let (negative, magnitude) = self.signed_term(t);
@@ -299,7 +304,11 @@ impl<'a> Printer<'a> {
                     self.wrap(num, Prec::Product)
                 };
                 let d = self.wrap(den, Prec::Power);
-                let sep = if self.syntax == Syntax::Text { "/" } else { " / " };
+                let sep = if self.syntax == Syntax::Text {
+                    "/"
+                } else {
+                    " / "
+                };
                 (format!("{n}{sep}{d}"), Prec::Product)
             }
         }
@@ -318,9 +327,17 @@ impl<'a> Printer<'a> {
                 let base = self.wrap(b, Prec::Atom);
                 match constant {
                     Some(c) if c == half => (format!("{base}.sqrt()"), Prec::Atom),
-                    Some(c) if c == minus_half => (format!("(1.0_f64 / {base}.sqrt())"), Prec::Atom),
-                    Some(c) if c.as_integer().is_some_and(|n| n.unsigned_abs() <= i32::MAX as u64) => {
-                        (format!("{base}.powi({})", c.as_integer().unwrap_or(1)), Prec::Atom)
+                    Some(c) if c == minus_half => {
+                        (format!("(1.0_f64 / {base}.sqrt())"), Prec::Atom)
+                    }
+                    Some(c)
+                        if c.as_integer()
+                            .is_some_and(|n| n.unsigned_abs() <= i32::MAX as u64) =>
+                    {
+                        (
+                            format!("{base}.powi({})", c.as_integer().unwrap_or(1)),
+                            Prec::Atom,
+                        )
                     }
                     _ => {
                         let x = match exponent {
@@ -368,11 +385,9 @@ impl<'a> Printer<'a> {
             Syntax::Latex => {
                 let s = match f {
                     Func::Abs => format!("\\left|{}\\right|", arg.0),
-                    Func::Sign | Func::Step | Func::Asin | Func::Acos | Func::Atan => format!(
-                        "\\operatorname{{{}}}\\left({}\\right)",
-                        f.name(),
-                        arg.0
-                    ),
+                    Func::Sign | Func::Step | Func::Asin | Func::Acos | Func::Atan => {
+                        format!("\\operatorname{{{}}}\\left({}\\right)", f.name(), arg.0)
+                    }
                     _ => format!("\\{}\\left({}\\right)", f.name(), arg.0),
                 };
                 (s, Prec::Atom)

@@ -338,7 +338,10 @@ fn printing() {
     let g = a.symbol("g", SymbolKind::Parameter);
     let mg = a.times(m, g);
     let e = a.minus(mg, v);
-    assert_eq!(Printer::new(&a, Syntax::Text).print(e), "m*g - m*cos(theta1)");
+    assert_eq!(
+        Printer::new(&a, Syntax::Text).print(e),
+        "m*g - m*cos(theta1)"
+    );
 }
 
 #[test]

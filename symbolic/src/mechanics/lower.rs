@@ -168,12 +168,19 @@ impl<'f> Lowering<'f> {
     }
 
     fn dot(&mut self, a: &[ExprId], b: &[ExprId]) -> ExprId {
-        let terms: Vec<ExprId> = a.iter().zip(b).map(|(x, y)| self.arena.times(*x, *y)).collect();
+        let terms: Vec<ExprId> = a
+            .iter()
+            .zip(b)
+            .map(|(x, y)| self.arena.times(*x, *y))
+            .collect();
         self.arena.sum(&terms)
     }
 
     fn difference(&mut self, a: &[ExprId], b: &[ExprId]) -> Vec<ExprId> {
-        a.iter().zip(b).map(|(x, y)| self.arena.minus(*x, *y)).collect()
+        a.iter()
+            .zip(b)
+            .map(|(x, y)| self.arena.minus(*x, *y))
+            .collect()
     }
 
     fn run(mut self) -> Result<SymbolicModel, Vec<Diagnostic>> {
@@ -199,8 +206,11 @@ impl<'f> Lowering<'f> {
             .map(|c| self.arena.coordinate(&c.name.value))
             .collect();
         let n = coordinates.len();
-        let coordinate_names: Vec<String> =
-            file.coordinates.iter().map(|c| c.name.value.clone()).collect();
+        let coordinate_names: Vec<String> = file
+            .coordinates
+            .iter()
+            .map(|c| c.name.value.clone())
+            .collect();
         let q_symbols: Vec<SymbolId> = self.arena.coordinates().iter().map(|c| c[0]).collect();
 
         let points: Vec<(String, Vec<ExprId>)> = file

@@ -53,7 +53,8 @@ impl Jacobians {
     /// Differentiates `eom` exactly (symbolically) with respect to `q` and `q̇`.
     pub fn of(model: &mut SymbolicModel, eom: &EquationsOfMotion) -> Self {
         let n = eom.num_dofs;
-        let symbols: Vec<[crate::expr::SymbolId; 3]> = (0..n).map(|i| model.coordinate_symbols(i)).collect();
+        let symbols: Vec<[crate::expr::SymbolId; 3]> =
+            (0..n).map(|i| model.coordinate_symbols(i)).collect();
         let arena = &mut model.arena;
         let mut forcing_q = Vec::with_capacity(n * n);
         let mut forcing_qdot = Vec::with_capacity(n * n);

@@ -41,7 +41,10 @@ impl Diagnostic {
     /// The full form: headline, source line with a caret under the column, and help.
     pub fn render(&self, path: &str, source: &str) -> String {
         let mut out = self.headline(path);
-        if let Some(line) = source.lines().nth(self.location.line.saturating_sub(1) as usize) {
+        if let Some(line) = source
+            .lines()
+            .nth(self.location.line.saturating_sub(1) as usize)
+        {
             let number = self.location.line.to_string();
             let pad = " ".repeat(number.len());
             let caret_pad: String = line
@@ -49,7 +52,9 @@ impl Diagnostic {
                 .take(self.location.column.saturating_sub(1) as usize)
                 .map(|c| if c == '\t' { '\t' } else { ' ' })
                 .collect();
-            out.push_str(&format!("\n{pad} |\n{number} | {line}\n{pad} | {caret_pad}^"));
+            out.push_str(&format!(
+                "\n{pad} |\n{number} | {line}\n{pad} | {caret_pad}^"
+            ));
         }
         if let Some(help) = &self.help {
             out.push_str(&format!("\n= help: {help}"));

@@ -32,7 +32,9 @@ fn lex(text: &str, start: Location) -> Result<Lexer, Diagnostic> {
         let c = chars[i];
         if c.is_whitespace() {
             i += 1;
-        } else if c.is_ascii_digit() || (c == '.' && chars.get(i + 1).is_some_and(char::is_ascii_digit)) {
+        } else if c.is_ascii_digit()
+            || (c == '.' && chars.get(i + 1).is_some_and(char::is_ascii_digit))
+        {
             let s = i;
             while i < chars.len() && (chars[i].is_ascii_digit() || chars[i] == '.') {
                 i += 1;
@@ -53,8 +55,11 @@ fn lex(text: &str, start: Location) -> Result<Lexer, Diagnostic> {
             match lit.parse::<f64>() {
                 Ok(v) if v.is_finite() => toks.push((Tok::Num(v, lit), s)),
                 _ => {
-                    return Err(Diagnostic::new(start.offset(s), format!("`{lit}` is not a number"))
-                        .with_help("write numbers like `2`, `0.5` or `1e-3`"));
+                    return Err(Diagnostic::new(
+                        start.offset(s),
+                        format!("`{lit}` is not a number"),
+                    )
+                    .with_help("write numbers like `2`, `0.5` or `1e-3`"));
                 }
             }
         } else if c.is_ascii_alphabetic() || c == '_' {
@@ -72,8 +77,11 @@ fn lex(text: &str, start: Location) -> Result<Lexer, Diagnostic> {
                 '=' => "an expression has no `=`; write only its right-hand side",
                 _ => "expressions use numbers, names, `+ - * / ^`, parentheses and functions",
             };
-            return Err(Diagnostic::new(start.offset(i), format!("unexpected character `{c}` in an expression"))
-                .with_help(help));
+            return Err(Diagnostic::new(
+                start.offset(i),
+                format!("unexpected character `{c}` in an expression"),
+            )
+            .with_help(help));
         }
     }
     toks.push((Tok::End, chars.len()));
@@ -112,7 +120,10 @@ impl P<'_> {
     fn enter(&mut self) -> Result<(), Diagnostic> {
         self.depth += 1;
         if self.depth > MAX_DEPTH {
-            return Err(Diagnostic::new(self.at(), "expression is nested too deeply"));
+            return Err(Diagnostic::new(
+                self.at(),
+                "expression is nested too deeply",
+            ));
         }
         Ok(())
     }
@@ -149,8 +160,15 @@ impl P<'_> {
         Ok(lhs)
     }
 
-    fn operand_after(&mut self, op: BinOp, f: fn(&mut Self) -> Result<Expr, Diagnostic>) -> Result<Expr, Diagnostic> {
-        if matches!(self.peek(), Tok::End | Tok::Op(')') | Tok::Op(',') | Tok::Op('*') | Tok::Op('/') | Tok::Op('^')) {
+    fn operand_after(
+        &mut self,
+        op: BinOp,
+        f: fn(&mut Self) -> Result<Expr, Diagnostic>,
+    ) -> Result<Expr, Diagnostic> {
+        if matches!(
+            self.peek(),
+            Tok::End | Tok::Op(')') | Tok::Op(',') | Tok::Op('*') | Tok::Op('/') | Tok::Op('^')
+        ) {
             let sym = match op {
                 BinOp::Add => '+',
                 BinOp::Sub => '-',
@@ -158,7 +176,13 @@ impl P<'_> {
                 BinOp::Div => '/',
                 BinOp::Pow => '^',
             };
-            return Err(Diagnostic::new(self.at(), format!("expected an operand after `{sym}`, found {}", self.describe())));
+            return Err(Diagnostic::new(
+                self.at(),
+                format!(
+                    "expected an operand after `{sym}`, found {}",
+                    self.describe()
+                ),
+            ));
         }
         f(self)
     }
@@ -170,7 +194,10 @@ impl P<'_> {
                 let loc = self.at();
                 self.bump();
                 let inner = self.unary()?;
-                Ok(Expr { kind: ExprKind::Neg(Box::new(inner)), location: loc })
+                Ok(Expr {
+                    kind: ExprKind::Neg(Box::new(inner)),
+                    location: loc,
+                })
             }
             Tok::Op('+') => {
                 self.bump();
@@ -197,7 +224,10 @@ impl P<'_> {
         match self.peek().clone() {
             Tok::Num(value, text) => {
                 self.bump();
-                Ok(Expr { kind: ExprKind::Number { value, text }, location: loc })
+                Ok(Expr {
+                    kind: ExprKind::Number { value, text },
+                    location: loc,
+                })
             }
             Tok::Name(name) => {
                 self.bump();
@@ -224,40 +254,73 @@ impl P<'_> {
                             let known: Vec<&str> = FUNCTIONS.iter().map(|(f, _)| *f).collect();
                             let mut d = Diagnostic::new(loc, format!("unknown function `{name}`"));
                             d = match closest(&name, &known) {
-                                Some(c) => d.with_help(format!("did you mean `{c}`? known functions: {}", known.join(", "))),
-                                None => d.with_help(format!("known functions: {}", known.join(", "))),
+                                Some(c) => d.with_help(format!(
+                                    "did you mean `{c}`? known functions: {}",
+                                    known.join(", ")
+                                )),
+                                None => {
+                                    d.with_help(format!("known functions: {}", known.join(", ")))
+                                }
                             };
                             Err(d)
                         }
                         Some((_, arity)) if *arity != args.len() => Err(Diagnostic::new(
                             loc,
-                            format!("`{name}` takes {arity} argument{}, found {}", if *arity == 1 { "" } else { "s" }, args.len()),
+                            format!(
+                                "`{name}` takes {arity} argument{}, found {}",
+                                if *arity == 1 { "" } else { "s" },
+                                args.len()
+                            ),
                         )),
-                        Some(_) => Ok(Expr { kind: ExprKind::Call { func: name, args }, location: loc }),
+                        Some(_) => Ok(Expr {
+                            kind: ExprKind::Call { func: name, args },
+                            location: loc,
+                        }),
                     }
                 } else {
-                    Ok(Expr { kind: ExprKind::Ident(name), location: loc })
+                    Ok(Expr {
+                        kind: ExprKind::Ident(name),
+                        location: loc,
+                    })
                 }
             }
             Tok::Op('(') => {
                 self.bump();
                 let inner = self.sum()?;
                 if !matches!(self.peek(), Tok::Op(')')) {
-                    return Err(Diagnostic::new(self.at(), format!("expected `)`, found {}", self.describe()))
-                        .with_help(format!("unclosed `(` opened at column {}", loc.column)));
+                    return Err(Diagnostic::new(
+                        self.at(),
+                        format!("expected `)`, found {}", self.describe()),
+                    )
+                    .with_help(format!("unclosed `(` opened at column {}", loc.column)));
                 }
                 self.bump();
                 Ok(inner)
             }
-            Tok::Op(')') => Err(Diagnostic::new(loc, "unexpected `)`").with_help("it closes no `(`")),
-            _ => Err(Diagnostic::new(loc, format!("expected a number, a name or `(`, found {}", self.describe()))),
+            Tok::Op(')') => {
+                Err(Diagnostic::new(loc, "unexpected `)`").with_help("it closes no `(`"))
+            }
+            _ => Err(Diagnostic::new(
+                loc,
+                format!(
+                    "expected a number, a name or `(`, found {}",
+                    self.describe()
+                ),
+            )),
         }
     }
 }
 
 fn binary(op: BinOp, lhs: Expr, rhs: Expr) -> Expr {
     let location = lhs.location;
-    Expr { kind: ExprKind::Binary { op, lhs: Box::new(lhs), rhs: Box::new(rhs) }, location }
+    Expr {
+        kind: ExprKind::Binary {
+            op,
+            lhs: Box::new(lhs),
+            rhs: Box::new(rhs),
+        },
+        location,
+    }
 }
 
 /// The candidate within edit distance 2 of `word`, if any (for "did you mean").
@@ -292,9 +355,15 @@ pub fn edit_distance(a: &str, b: &str) -> usize {
 /// A diagnostic at the exact column of the first problem, saying what was expected.
 pub fn parse_expr(text: &str, start: Location) -> Result<Expr, Diagnostic> {
     let lexer = lex(text, start)?;
-    let mut p = P { toks: &lexer.toks, pos: 0, start, depth: 0 };
+    let mut p = P {
+        toks: &lexer.toks,
+        pos: 0,
+        start,
+        depth: 0,
+    };
     if matches!(p.peek(), Tok::End) {
-        return Err(Diagnostic::new(start, "empty expression").with_help("write a number or an expression such as `m*g*l`"));
+        return Err(Diagnostic::new(start, "empty expression")
+            .with_help("write a number or an expression such as `m*g*l`"));
     }
     let e = p.sum()?;
     if !matches!(p.peek(), Tok::End) {
@@ -303,7 +372,11 @@ pub fn parse_expr(text: &str, start: Location) -> Result<Expr, Diagnostic> {
         } else {
             "did you forget an operator such as `*`?".to_string()
         };
-        return Err(Diagnostic::new(p.at(), format!("unexpected {} after a complete expression", p.describe())).with_help(help));
+        return Err(Diagnostic::new(
+            p.at(),
+            format!("unexpected {} after a complete expression", p.describe()),
+        )
+        .with_help(help));
     }
     Ok(e)
 }
@@ -316,7 +389,9 @@ pub fn eval_expr(e: &Expr, lookup: &dyn Fn(&str) -> Option<f64>) -> Result<f64, 
     Ok(match &e.kind {
         ExprKind::Number { value, .. } => *value,
         ExprKind::Ident(n) if n == "pi" => std::f64::consts::PI,
-        ExprKind::Ident(n) => lookup(n).ok_or_else(|| Diagnostic::new(e.location, format!("unknown name `{n}`")))?,
+        ExprKind::Ident(n) => {
+            lookup(n).ok_or_else(|| Diagnostic::new(e.location, format!("unknown name `{n}`")))?
+        }
         ExprKind::Neg(a) => -eval_expr(a, lookup)?,
         ExprKind::Binary { op, lhs, rhs } => {
             let (a, b) = (eval_expr(lhs, lookup)?, eval_expr(rhs, lookup)?);
@@ -329,15 +404,28 @@ pub fn eval_expr(e: &Expr, lookup: &dyn Fn(&str) -> Option<f64>) -> Result<f64, 
             }
         }
         ExprKind::Call { func, args } => {
-            let v: Vec<f64> = args.iter().map(|a| eval_expr(a, lookup)).collect::<Result<_, _>>()?;
+            let v: Vec<f64> = args
+                .iter()
+                .map(|a| eval_expr(a, lookup))
+                .collect::<Result<_, _>>()?;
             match (func.as_str(), v.as_slice()) {
                 ("sqrt", [x]) => x.sqrt(),
                 ("atan2", [y, x]) => y.atan2(*x),
                 (name, [x]) => match crate::expr::Func::from_name(name) {
                     Some(f) => f.apply(*x),
-                    None => return Err(Diagnostic::new(e.location, format!("unknown function `{name}`"))),
+                    None => {
+                        return Err(Diagnostic::new(
+                            e.location,
+                            format!("unknown function `{name}`"),
+                        ));
+                    }
                 },
-                (name, _) => return Err(Diagnostic::new(e.location, format!("unknown function `{name}`"))),
+                (name, _) => {
+                    return Err(Diagnostic::new(
+                        e.location,
+                        format!("unknown function `{name}`"),
+                    ));
+                }
             }
         }
     })
@@ -367,17 +455,33 @@ mod tests {
             ExprKind::Ident(n) => n.clone(),
             ExprKind::Neg(a) => format!("(-{})", show(a)),
             ExprKind::Binary { op, lhs, rhs } => {
-                let o = match op { BinOp::Add => "+", BinOp::Sub => "-", BinOp::Mul => "*", BinOp::Div => "/", BinOp::Pow => "^" };
+                let o = match op {
+                    BinOp::Add => "+",
+                    BinOp::Sub => "-",
+                    BinOp::Mul => "*",
+                    BinOp::Div => "/",
+                    BinOp::Pow => "^",
+                };
                 format!("({} {o} {})", show(lhs), show(rhs))
             }
-            ExprKind::Call { func, args } => format!("{func}({})", args.iter().map(show).collect::<Vec<_>>().join(", ")),
+            ExprKind::Call { func, args } => format!(
+                "{func}({})",
+                args.iter().map(show).collect::<Vec<_>>().join(", ")
+            ),
         }
     }
     fn p(s: &str) -> String {
         show(&parse_expr(s, Location { line: 1, column: 1 }).unwrap())
     }
     fn err(s: &str) -> Diagnostic {
-        parse_expr(s, Location { line: 3, column: 10 }).unwrap_err()
+        parse_expr(
+            s,
+            Location {
+                line: 3,
+                column: 10,
+            },
+        )
+        .unwrap_err()
     }
 
     #[test]
@@ -394,7 +498,13 @@ mod tests {
     #[test]
     fn errors_point_at_the_column() {
         let e = err("m*");
-        assert_eq!(e.location, Location { line: 3, column: 12 });
+        assert_eq!(
+            e.location,
+            Location {
+                line: 3,
+                column: 12
+            }
+        );
         assert!(e.message.contains("expected an operand after `*`"));
         let e = err("sinn(x)");
         assert_eq!(e.location.column, 10);

@@ -79,11 +79,10 @@ pub fn parse(source: &str) -> Result<YamlNode, Vec<Diagnostic>> {
     let root = builder.document();
     if builder.errors.is_empty() {
         root.ok_or_else(|| {
-            vec![Diagnostic::new(
-                Location { line: 1, column: 1 },
-                "the model file is empty",
-            )
-            .with_help("start with `name: my_model` and `coordinates: [q]`")]
+            vec![
+                Diagnostic::new(Location { line: 1, column: 1 }, "the model file is empty")
+                    .with_help("start with `name: my_model` and `coordinates: [q]`"),
+            ]
         })
     } else {
         Err(builder.errors)
@@ -209,7 +208,10 @@ impl<'a> Builder<'a> {
                     if let Some((first, _)) = entries.iter().find(|(k, _)| k.value == key_text) {
                         self.errors.push(
                             Diagnostic::new(key.location, format!("duplicate key `{key_text}`"))
-                                .with_help(format!("`{key_text}` is already given at line {}; keep one", first.location.line)),
+                                .with_help(format!(
+                                    "`{key_text}` is already given at line {}; keep one",
+                                    first.location.line
+                                )),
                         );
                         continue;
                     }
@@ -222,8 +224,11 @@ impl<'a> Builder<'a> {
             }
             Event::Alias(_) => {
                 self.errors.push(
-                    Diagnostic::new(loc, "YAML aliases (`*name`) are not supported in model files")
-                        .with_help("write the value out where it is used"),
+                    Diagnostic::new(
+                        loc,
+                        "YAML aliases (`*name`) are not supported in model files",
+                    )
+                    .with_help("write the value out where it is used"),
                 );
                 YamlNode {
                     kind: YamlKind::Null,
@@ -268,10 +273,14 @@ mod tests {
     fn locations_are_one_based() {
         let src = "name: x\nparameters:\n  m: 1.0  # kg\n  s: 'a # b'\n";
         let root = parse(src).unwrap();
-        let YamlKind::Map(entries) = &root.kind else { panic!() };
+        let YamlKind::Map(entries) = &root.kind else {
+            panic!()
+        };
         assert_eq!(entries[0].0.location, Location { line: 1, column: 1 });
         assert_eq!(entries[0].1.location, Location { line: 1, column: 7 });
-        let YamlKind::Map(params) = &entries[1].1.kind else { panic!() };
+        let YamlKind::Map(params) = &entries[1].1.kind else {
+            panic!()
+        };
         assert_eq!(params[0].1.location, Location { line: 3, column: 6 });
         assert_eq!(params[1].1.location, Location { line: 4, column: 7 });
         assert_eq!(trailing_comment(src, 3).as_deref(), Some("kg"));

@@ -1,0 +1,110 @@
+//! Command-line interface (clap): parsing, dispatch, and the rendering of errors.
+
+mod plot;
+mod simulate;
+mod values;
+
+use clap::{Parser, Subcommand};
+use std::process::ExitCode;
+
+/// eomgen: equations of motion derived at compile time from model files, simulated.
+#[derive(Debug, Parser)]
+#[command(name = "eomgen", version, about, long_about = None)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {
+    /// List the bundled models: name, degrees of freedom, description.
+    List {
+        /// Print a JSON list of {"name", "dof", "description"}.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Integrate a model's equations of motion from its initial state.
+    Simulate(simulate::SimulateArgs),
+}
+
+/// A CLI failure: the message for stderr and the exit code.
+#[derive(Debug)]
+pub struct CliError {
+    /// What went wrong, with what would be right.
+    pub message: String,
+    /// Exit status (2 usage, 1 failure of the computation).
+    pub code: u8,
+}
+
+impl CliError {
+    fn usage(message: impl Into<String>) -> Self {
+        Self {
+            message: message.into(),
+            code: 2,
+        }
+    }
+    fn failure(message: impl Into<String>) -> Self {
+        Self {
+            message: message.into(),
+            code: 1,
+        }
+    }
+}
+
+/// Runs the CLI on the process arguments.
+pub fn run() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::List { json } => list(json),
+        Command::Simulate(args) => simulate::run(&args),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {}", e.message);
+            ExitCode::from(e.code)
+        }
+    }
+}
+
+fn list(json: bool) -> Result<(), CliError> {
+    let models: Vec<_> = eomgen::models::ALL.iter().map(|(_, make)| make()).collect();
+    if json {
+        let items: Vec<serde_json::Value> = models
+            .iter()
+            .map(|m| serde_json::json!({"name": m.name(), "dof": m.num_dofs(), "description": m.description()}))
+            .collect();
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&items).map_err(|e| CliError::failure(e.to_string()))?
+        );
+    } else {
+        let width = models.iter().map(|m| m.name().len()).max().unwrap_or(4);
+        println!("{:width$}  dof  description", "name");
+        for m in &models {
+            println!(
+                "{:width$}  {:>3}  {}",
+                m.name(),
+                m.num_dofs(),
+                m.description()
+            );
+        }
+    }
+    Ok(())
+}
+
+/// The bundled model named `name`, with its default parameters.
+fn find_model(name: &str) -> Result<Box<dyn eomgen::ModelInfo>, CliError> {
+    if let Some((_, make)) = eomgen::models::ALL.iter().find(|(n, _)| *n == name) {
+        return Ok(make());
+    }
+    let names: Vec<&str> = eomgen::models::ALL.iter().map(|(n, _)| *n).collect();
+    let hint = match eomgen_symbolic::model::parser::closest(name, &names) {
+        Some(c) => format!("did you mean `{c}`? "),
+        None => String::new(),
+    };
+    Err(CliError::usage(format!(
+        "no model named `{name}`; {hint}models are: {} (see `eomgen list`)",
+        names.join(", ")
+    )))
+}

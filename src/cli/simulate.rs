@@ -1,0 +1,301 @@
+//! `eomgen simulate MODEL`: integrate from the model's initial state and report.
+
+use std::io::Write as _;
+
+use clap::{Args, ValueEnum};
+use eomgen::{
+    DormandPrince54, IntegrationFailure, Integrator, IntegratorOptions, ModelInfo, OutputTimes,
+    RungeKutta4, Solution,
+};
+use serde_json::json;
+
+use super::values::{evaluate, split_assignment};
+use super::{CliError, find_model, plot};
+
+/// Integration method.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum Method {
+    /// Dormand–Prince 5(4), adaptive, dense output (default).
+    Dp54,
+    /// Classical Runge–Kutta 4, fixed step `--dt`.
+    Rk4,
+}
+
+/// Options of `eomgen simulate`.
+#[derive(Debug, Args)]
+pub struct SimulateArgs {
+    /// Model name (see `eomgen list`).
+    pub model: String,
+    /// End time (s).
+    #[arg(long, default_value_t = 10.0)]
+    pub t_end: f64,
+    /// Output times, comma separated (expressions allowed), e.g. `--t-out 1,2,2.5`; samples
+    /// come from dense output at exactly these times. Default: every accepted step.
+    #[arg(long, value_delimiter = ',')]
+    pub t_out: Vec<String>,
+    /// Integration method.
+    #[arg(long, value_enum, default_value_t = Method::Dp54)]
+    pub method: Method,
+    /// Relative tolerance (dp54).
+    #[arg(long, default_value_t = 1e-8)]
+    pub rtol: f64,
+    /// Absolute tolerance (dp54).
+    #[arg(long, default_value_t = 1e-10)]
+    pub atol: f64,
+    /// Step size: rk4's fixed step (default t_end/1000), dp54's initial step (default automatic).
+    #[arg(long)]
+    pub dt: Option<f64>,
+    /// Set a parameter, `NAME=VALUE` (value may be an expression of numbers, pi and the other
+    /// parameters); repeatable.
+    #[arg(long = "set", value_name = "NAME=VALUE")]
+    pub set: Vec<String>,
+    /// Set an initial coordinate or rate, `NAME=VALUE` (e.g. `theta1=pi/2`, `theta1_dot=0`);
+    /// repeatable.
+    #[arg(long = "init", value_name = "NAME=VALUE")]
+    pub init: Vec<String>,
+    /// Print the result as JSON on stdout.
+    #[arg(long)]
+    pub json: bool,
+    /// Write the samples as CSV (t, coordinates, rates, energy).
+    #[arg(long, value_name = "FILE")]
+    pub csv: Option<String>,
+    /// Plot the coordinates against time (.svg or .png).
+    #[arg(long, value_name = "FILE")]
+    pub plot: Option<String>,
+}
+
+fn parameter_lookup(model: &dyn ModelInfo) -> impl Fn(&str) -> Option<f64> + '_ {
+    let names = model.parameter_names();
+    let values = model.parameter_values();
+    move |n: &str| names.iter().position(|p| *p == n).map(|i| values[i])
+}
+
+/// Runs `simulate`.
+pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
+    let mut model = find_model(&args.model)?;
+    for s in &args.set {
+        let (name, text) = split_assignment(s, "--set")?;
+        let value = evaluate(
+            text,
+            &format!("--set {name}"),
+            &parameter_lookup(model.as_ref()),
+        )?;
+        model
+            .set_parameter(name, value)
+            .map_err(|e| CliError::usage(e.to_string()))?;
+    }
+    let n = model.num_dofs();
+    let coordinates = model.coordinate_names();
+    let mut y0 = model.initial_state();
+    for s in &args.init {
+        let (name, text) = split_assignment(s, "--init")?;
+        let value = evaluate(
+            text,
+            &format!("--init {name}"),
+            &parameter_lookup(model.as_ref()),
+        )?;
+        let index = coordinates
+            .iter()
+            .position(|c| *c == name)
+            .or_else(|| coordinates.iter().position(|c| name.strip_suffix("_dot") == Some(c)).map(|i| n + i))
+            .ok_or_else(|| {
+                let rates: Vec<String> = coordinates.iter().map(|c| format!("{c}_dot")).collect();
+                CliError::usage(format!(
+                    "--init {name}: `{}` has no coordinate or rate `{name}` (coordinates: {}; rates: {})",
+                    model.name(),
+                    coordinates.join(", "),
+                    rates.join(", ")
+                ))
+            })?;
+        y0[index] = value;
+    }
+    if !(args.t_end.is_finite() && args.t_end > 0.0) {
+        return Err(CliError::usage(format!(
+            "--t-end must be a positive number of seconds, got {}",
+            args.t_end
+        )));
+    }
+    let output = if args.t_out.is_empty() {
+        OutputTimes::Steps
+    } else {
+        let mut times = Vec::with_capacity(args.t_out.len());
+        for t in &args.t_out {
+            times.push(evaluate(t, "--t-out", &|_| None)?);
+        }
+        OutputTimes::At(times)
+    };
+    let mut options = IntegratorOptions::default()
+        .with_rtol(args.rtol)
+        .with_atol(args.atol);
+    if let Some(dt) = args.dt {
+        options = options.with_dt(dt);
+    }
+    let mut integrator: Box<dyn Integrator> = match args.method {
+        Method::Dp54 => Box::new(DormandPrince54::new()),
+        Method::Rk4 => Box::new(RungeKutta4::new()),
+    };
+    let result = integrator.integrate(model.as_ode_mut(), 0.0, &y0, args.t_end, &output, &options);
+    let (solution, failure) = match result {
+        Ok(s) => (s, None),
+        Err(IntegrationFailure { error, partial }) => (*partial, Some(error)),
+    };
+    let report = Report::new(model.as_ref(), &y0, &solution);
+    if let Some(path) = &args.csv {
+        write_csv(path, model.as_ref(), &solution, &report)?;
+    }
+    if let Some(path) = &args.plot {
+        plot::time_histories(path, model.as_ref(), &solution).map_err(CliError::failure)?;
+    }
+    if args.json {
+        let samples: Vec<serde_json::Value> = solution
+            .iter()
+            .zip(&report.energy)
+            .map(|((t, y), e)| json!({"t": t, "q": &y[..n], "qdot": &y[n..], "energy": e}))
+            .collect();
+        let mut out = json!({
+            "model": model.name(),
+            "coordinates": coordinates,
+            "parameters": model.parameter_names().iter().zip(model.parameter_values()).map(|(k, v)| (k.to_string(), json!(v))).collect::<serde_json::Map<_, _>>(),
+            "method": integrator.name(),
+            "rtol": args.rtol,
+            "atol": args.atol,
+            "samples": samples,
+            "initial_energy": report.initial,
+            "energy_drift": report.drift,
+            "conservative": model.is_conservative(),
+            "stats": {
+                "steps": solution.stats.steps,
+                "rejected": solution.stats.rejected,
+                "rhs_evals": solution.stats.rhs_evals,
+                "wall_time_s": solution.stats.wall_time_s,
+            },
+        });
+        if let Some(e) = &failure {
+            out["error"] = json!({"t": e.t(), "message": e.to_string()});
+        }
+        let text =
+            serde_json::to_string_pretty(&out).map_err(|e| CliError::failure(e.to_string()))?;
+        let mut stdout = std::io::stdout().lock();
+        let _ = writeln!(stdout, "{text}");
+    } else {
+        print_summary(model.as_ref(), integrator.name(), args, &solution, &report);
+    }
+    match failure {
+        None => Ok(()),
+        Some(e) => Err(CliError::failure(format!(
+            "integration of `{}` stopped: {e}; the {} samples computed before it were kept",
+            model.name(),
+            solution.len()
+        ))),
+    }
+}
+
+/// Energy per sample and the drift `max |E − E(0)| / E_scale`, with
+/// `E_scale = max (T + |V|)` over the initial state and the samples (so a zero initial energy still gives a
+/// meaningful relative figure).
+struct Report {
+    energy: Vec<f64>,
+    initial: f64,
+    drift: Option<f64>,
+}
+
+impl Report {
+    fn new(model: &dyn ModelInfo, y0: &[f64], solution: &Solution) -> Self {
+        let mut energy = Vec::with_capacity(solution.len());
+        let initial = model.energy(0.0, y0);
+        let mut scale: f64 = model.kinetic_energy(0.0, y0) + model.potential_energy(0.0, y0).abs();
+        for (t, y) in solution.iter() {
+            let (tk, v) = (model.kinetic_energy(t, y), model.potential_energy(t, y));
+            energy.push(tk + v);
+            scale = scale.max(tk + v.abs());
+        }
+        let drift = (!energy.is_empty()).then(|| {
+            let dev = energy
+                .iter()
+                .map(|e| (e - initial).abs())
+                .fold(0.0, f64::max);
+            if scale > 0.0 { dev / scale } else { dev }
+        });
+        Self {
+            energy,
+            initial,
+            drift,
+        }
+    }
+}
+
+fn print_summary(
+    model: &dyn ModelInfo,
+    method: &str,
+    args: &SimulateArgs,
+    solution: &Solution,
+    report: &Report,
+) {
+    println!(
+        "model      {} ({} dof): {}",
+        model.name(),
+        model.num_dofs(),
+        model.description()
+    );
+    println!(
+        "method     {method} (rtol {:e}, atol {:e})",
+        args.rtol, args.atol
+    );
+    if let Some((t, y)) = solution.last() {
+        let n = model.num_dofs();
+        let names = model.coordinate_names();
+        println!("final      t = {t}");
+        for (i, name) in names.iter().enumerate() {
+            println!(
+                "           {name:>12} = {:>22.15e}   {:>16} = {:>22.15e}",
+                y[i],
+                format!("{name}_dot"),
+                y[n + i]
+            );
+        }
+    }
+    if let (e0, Some(e1)) = (report.initial, report.energy.last()) {
+        println!("energy     E(0) = {e0:.12e} J, E(end) = {e1:.12e} J");
+        if let Some(d) = report.drift {
+            let note = if model.is_conservative() {
+                ""
+            } else {
+                " (not conserved: the model has non-conservative loads or explicit time dependence)"
+            };
+            println!("drift      max|E - E(0)| / max(T + |V|) = {d:.3e}{note}");
+        }
+    }
+    let s = &solution.stats;
+    println!(
+        "work       {} steps ({} rejected), {} RHS evaluations, {:.3} ms",
+        s.steps,
+        s.rejected,
+        s.rhs_evals,
+        s.wall_time_s * 1e3
+    );
+}
+
+fn write_csv(
+    path: &str,
+    model: &dyn ModelInfo,
+    solution: &Solution,
+    report: &Report,
+) -> Result<(), CliError> {
+    let mut out = String::from("t");
+    for c in model.coordinate_names() {
+        out.push(',');
+        out.push_str(c);
+    }
+    for c in model.coordinate_names() {
+        out.push_str(&format!(",{c}_dot"));
+    }
+    out.push_str(",energy\n");
+    for ((t, y), e) in solution.iter().zip(&report.energy) {
+        out.push_str(&format!("{t:e}"));
+        for v in y {
+            out.push_str(&format!(",{v:e}"));
+        }
+        out.push_str(&format!(",{e:e}\n"));
+    }
+    std::fs::write(path, out).map_err(|e| CliError::failure(format!("cannot write `{path}`: {e}")))
+}
