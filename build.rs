@@ -75,12 +75,13 @@ fn main() {
         );
         let _ = writeln!(
             registry,
-            "    ({name:?}, || ::std::boxed::Box::new(crate::FirstOrder::new({module}::{ty}::default()))),"
+            "    ModelEntry {{ name: {name:?}, path: {path:?}, make: || ::std::boxed::Box::new(crate::FirstOrder::new({module}::{ty}::default())) }},",
+            path = f.display().to_string(),
         );
     }
     let _ = writeln!(
         out,
-        "/// Every bundled model: its name and a constructor of its first-order form with the\n/// file's default parameters, sorted by file name.\npub const ALL: &[(&str, fn() -> ::std::boxed::Box<dyn crate::ModelInfo>)] = &[\n{registry}];"
+        "/// Every bundled model, sorted by file name.\npub const ALL: &[ModelEntry] = &[\n{registry}];"
     );
     let out_dir = std::env::var("OUT_DIR").unwrap_or_default();
     if let Err(e) = std::fs::write(Path::new(&out_dir).join("models.rs"), out) {

@@ -30,6 +30,23 @@ pub use eomgen_runtime::*;
 
 /// Every model in `models/`, compiled in: one module and struct per file, and [`models::ALL`].
 pub mod models {
+    /// A bundled model: its name, its file, and a constructor of its first-order form with
+    /// the file's default parameters.
+    #[derive(Debug, Clone, Copy)]
+    pub struct ModelEntry {
+        /// The model's `name`.
+        pub name: &'static str,
+        /// Absolute path of its YAML file at build time.
+        pub path: &'static str,
+        /// Builds the model with its default parameters.
+        pub make: fn() -> Box<dyn crate::ModelInfo>,
+    }
+
+    /// The bundled model named `name`.
+    pub fn find(name: &str) -> Option<&'static ModelEntry> {
+        ALL.iter().find(|e| e.name == name)
+    }
+
     include!(concat!(env!("OUT_DIR"), "/models.rs"));
 }
 

@@ -6,7 +6,7 @@
 //! system `y = [q; q̇]`, `ẏ = [q̇; M⁻¹F]` that integrators take, and erases the size so the CLI
 //! can hold any model as a `Box<dyn ModelInfo>`.
 
-use nalgebra::{SMatrix, SVector};
+use nalgebra::{DMatrix, DVector, SMatrix, SVector};
 
 use crate::ode::{OdeSystem, RhsError};
 
@@ -211,6 +211,12 @@ pub trait ModelInfo: OdeSystem {
     fn equations_latex(&self) -> &'static str;
     /// Upcast to the first-order system for an integrator.
     fn as_ode_mut(&mut self) -> &mut dyn OdeSystem;
+    /// `M` (`n × n`) and `F` (`n`) at `(t, y)`.
+    fn mass_matrix_and_forcing(&self, t: f64, y: &[f64]) -> (DMatrix<f64>, DVector<f64>);
+    /// The exact Jacobians `(∂F/∂q, ∂F/∂q̇)`, each `n × n`, at `(t, y)`.
+    fn forcing_jacobians(&self, t: f64, y: &[f64]) -> (DMatrix<f64>, DMatrix<f64>);
+    /// The exact `∂(M a)/∂q` (`n × n`) at `(t, q)` for the vector `a` (length `n`).
+    fn mass_matrix_product_jacobian(&self, t: f64, y: &[f64], a: &[f64]) -> DMatrix<f64>;
 }
 
 impl<S: MechanicalSystem<N>, const N: usize> ModelInfo for FirstOrder<S, N> {
@@ -267,5 +273,28 @@ impl<S: MechanicalSystem<N>, const N: usize> ModelInfo for FirstOrder<S, N> {
     }
     fn as_ode_mut(&mut self) -> &mut dyn OdeSystem {
         self
+    }
+    fn mass_matrix_and_forcing(&self, t: f64, y: &[f64]) -> (DMatrix<f64>, DVector<f64>) {
+        let (q, qdot) = split::<N>(y);
+        let (m, f) = self.system.mass_matrix_and_forcing(&q, &qdot, t);
+        (
+            DMatrix::from_column_slice(N, N, m.as_slice()),
+            DVector::from_column_slice(f.as_slice()),
+        )
+    }
+    fn forcing_jacobians(&self, t: f64, y: &[f64]) -> (DMatrix<f64>, DMatrix<f64>) {
+        let (q, qdot) = split::<N>(y);
+        let jq = self.system.forcing_jacobian_q(&q, &qdot, t);
+        let jqd = self.system.forcing_jacobian_qdot(&q, &qdot, t);
+        (
+            DMatrix::from_column_slice(N, N, jq.as_slice()),
+            DMatrix::from_column_slice(N, N, jqd.as_slice()),
+        )
+    }
+    fn mass_matrix_product_jacobian(&self, t: f64, y: &[f64], a: &[f64]) -> DMatrix<f64> {
+        let (q, _) = split::<N>(y);
+        let a = SVector::<f64, N>::from_column_slice(&a[..N]);
+        let j = self.system.mass_matrix_product_jacobian(&q, t, &a);
+        DMatrix::from_column_slice(N, N, j.as_slice())
     }
 }

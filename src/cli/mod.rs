@@ -68,7 +68,7 @@ pub fn run() -> ExitCode {
 }
 
 fn list(json: bool) -> Result<(), CliError> {
-    let models: Vec<_> = eomgen::models::ALL.iter().map(|(_, make)| make()).collect();
+    let models: Vec<_> = eomgen::models::ALL.iter().map(|e| (e.make)()).collect();
     if json {
         let items: Vec<serde_json::Value> = models
             .iter()
@@ -95,10 +95,10 @@ fn list(json: bool) -> Result<(), CliError> {
 
 /// The bundled model named `name`, with its default parameters.
 fn find_model(name: &str) -> Result<Box<dyn eomgen::ModelInfo>, CliError> {
-    if let Some((_, make)) = eomgen::models::ALL.iter().find(|(n, _)| *n == name) {
-        return Ok(make());
+    if let Some(entry) = eomgen::models::find(name) {
+        return Ok((entry.make)());
     }
-    let names: Vec<&str> = eomgen::models::ALL.iter().map(|(n, _)| *n).collect();
+    let names: Vec<&str> = eomgen::models::ALL.iter().map(|e| e.name).collect();
     let hint = match eomgen_symbolic::model::parser::closest(name, &names) {
         Some(c) => format!("did you mean `{c}`? "),
         None => String::new(),
