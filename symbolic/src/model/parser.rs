@@ -323,12 +323,14 @@ fn binary(op: BinOp, lhs: Expr, rhs: Expr) -> Expr {
     }
 }
 
-/// The candidate within edit distance 2 of `word`, if any (for "did you mean").
+/// The nearest candidate within edit distance 2 of `word` and closer than `word`'s own
+/// length (so `k` does not suggest `m`), if any (for "did you mean").
 pub fn closest<'a>(word: &str, candidates: &[&'a str]) -> Option<&'a str> {
+    let len = word.chars().count();
     candidates
         .iter()
         .map(|c| (edit_distance(word, c), *c))
-        .filter(|(d, _)| *d <= 2)
+        .filter(|(d, _)| *d <= 2 && *d < len)
         .min_by_key(|(d, _)| *d)
         .map(|(_, c)| c)
 }

@@ -67,7 +67,7 @@ pub fn parse(source: &str) -> Result<YamlNode, Vec<Diagnostic>> {
                 return Err(vec![Diagnostic::new(
                     Location::from_zero_based(m.line().saturating_sub(1), m.col()),
                     format!("YAML syntax error: {}", e.info()),
-                ).with_help("model files are YAML maps of `key: value`; check indentation, colons and brackets")]);
+                ).with_help("model files are YAML maps of `key: value`; check the indentation, the colons, and that every `[` and `{` before this point is closed")]);
             }
         }
     }

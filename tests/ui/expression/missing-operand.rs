@@ -1,0 +1,3 @@
+eomgen::model!("missing-operand.yaml");
+
+fn main() {}

@@ -1,0 +1,3 @@
+eomgen::model!("unclosed-paren.yaml");
+
+fn main() {}

@@ -1,0 +1,3 @@
+eomgen::model!("unknown-function.yaml");
+
+fn main() {}

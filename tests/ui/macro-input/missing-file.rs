@@ -1,0 +1,3 @@
+eomgen::model!("no-such-model.yaml");
+
+fn main() {}

@@ -1,0 +1,3 @@
+eomgen::model!(models / double_pendulum);
+
+fn main() {}

@@ -1,0 +1,3 @@
+eomgen::model!("body-without-mass.yaml");
+
+fn main() {}

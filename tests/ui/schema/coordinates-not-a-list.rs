@@ -1,0 +1,3 @@
+eomgen::model!("coordinates-not-a-list.yaml");
+
+fn main() {}

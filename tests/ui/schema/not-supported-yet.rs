@@ -1,0 +1,3 @@
+eomgen::model!("not-supported-yet.yaml");
+
+fn main() {}

@@ -1,0 +1,3 @@
+eomgen::model!("point-four-components.yaml");
+
+fn main() {}

@@ -1,0 +1,3 @@
+eomgen::model!("unknown-key.yaml");
+
+fn main() {}

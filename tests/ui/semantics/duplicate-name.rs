@@ -1,0 +1,3 @@
+eomgen::model!("duplicate-name.yaml");
+
+fn main() {}

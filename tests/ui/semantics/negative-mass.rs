@@ -1,0 +1,3 @@
+eomgen::model!("negative-mass.yaml");
+
+fn main() {}

@@ -1,0 +1,3 @@
+eomgen::model!("rate-in-position.yaml");
+
+fn main() {}

@@ -1,0 +1,3 @@
+eomgen::model!("rigid-body-in-3d.yaml");
+
+fn main() {}

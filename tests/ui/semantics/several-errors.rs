@@ -1,0 +1,3 @@
+eomgen::model!("several-errors.yaml");
+
+fn main() {}

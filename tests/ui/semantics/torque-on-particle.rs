@@ -1,0 +1,3 @@
+eomgen::model!("torque-on-particle.yaml");
+
+fn main() {}

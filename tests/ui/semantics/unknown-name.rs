@@ -1,0 +1,3 @@
+eomgen::model!("unknown-name.yaml");
+
+fn main() {}

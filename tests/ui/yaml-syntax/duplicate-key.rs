@@ -1,0 +1,3 @@
+eomgen::model!("duplicate-key.yaml");
+
+fn main() {}

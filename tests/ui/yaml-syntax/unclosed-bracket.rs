@@ -1,0 +1,3 @@
+eomgen::model!("unclosed-bracket.yaml");
+
+fn main() {}
