@@ -197,8 +197,15 @@ fn build(a: &mut ExprArena, t: &Tree, x: ExprId, y: ExprId) -> ExprId {
     }
 }
 
-/// Direct evaluation of the tree, independent of the arena.
+/// Direct evaluation of the tree, independent of the arena. Any non-finite intermediate
+/// value makes the result NaN (so the property tests skip the state): `atan2(y, x/0)` is
+/// finite, but its derivative at a division by an exact zero is not defined.
 fn eval_tree(t: &Tree, x: f64, y: f64) -> f64 {
+    let v = eval_node(t, x, y);
+    if v.is_finite() { v } else { f64::NAN }
+}
+
+fn eval_node(t: &Tree, x: f64, y: f64) -> f64 {
     match t {
         Tree::X => x,
         Tree::Y => y,
