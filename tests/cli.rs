@@ -1,0 +1,136 @@
+//! The `eomgen` binary end to end: `list --json`, `simulate --json` output contract, dense
+//! output at requested times, expressions in options, and clear usage errors.
+
+use std::process::Command;
+
+fn eomgen(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_eomgen"))
+        .args(args)
+        .output()
+        .expect("binary runs")
+}
+
+#[test]
+fn list_json_names_every_model() {
+    let out = eomgen(&["list", "--json"]);
+    assert!(out.status.success());
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let items = v.as_array().unwrap();
+    assert_eq!(items.len(), eomgen::models::ALL.len());
+    let dp = items
+        .iter()
+        .find(|i| i["name"] == "double_pendulum")
+        .unwrap();
+    assert_eq!(dp["dof"], 2);
+    assert!(dp["description"].as_str().unwrap().contains("HW19"));
+}
+
+#[test]
+fn simulate_json_samples_exactly_at_requested_times() {
+    let out = eomgen(&[
+        "simulate",
+        "simple_pendulum",
+        "--t-end",
+        "2",
+        "--t-out",
+        "0.5,1,pi/2",
+        "--rtol",
+        "1e-12",
+        "--atol",
+        "1e-12",
+        "--json",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["model"], "simple_pendulum");
+    assert_eq!(v["coordinates"], serde_json::json!(["q"]));
+    assert_eq!(v["method"], "dopri5");
+    let samples = v["samples"].as_array().unwrap();
+    let times: Vec<f64> = samples.iter().map(|s| s["t"].as_f64().unwrap()).collect();
+    assert_eq!(times, [0.5, 1.0, std::f64::consts::FRAC_PI_2]);
+    for s in samples {
+        assert_eq!(s["q"].as_array().unwrap().len(), 1);
+        assert_eq!(s["qdot"].as_array().unwrap().len(), 1);
+        // Conservative: E = 0 (starts horizontal at rest); drift at 1e-12 is < 1e-10 J.
+        assert!(s["energy"].as_f64().unwrap().abs() < 1e-10);
+    }
+    for key in ["steps", "rejected", "rhs_evals", "wall_time_s"] {
+        assert!(v["stats"][key].is_number(), "stats.{key}");
+    }
+}
+
+#[test]
+fn init_and_set_accept_expressions() {
+    let out = eomgen(&[
+        "simulate",
+        "simple_pendulum",
+        "--init",
+        "q=-pi/2",
+        "--set",
+        "g=2*5",
+        "--t-end",
+        "1",
+        "--t-out",
+        "1",
+        "--json",
+    ]);
+    assert!(out.status.success());
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    // Released at the hanging equilibrium it stays there.
+    let q = v["samples"][0]["q"][0].as_f64().unwrap();
+    assert!((q + std::f64::consts::FRAC_PI_2).abs() < 1e-12);
+    assert_eq!(v["parameters"]["g"], 10.0);
+}
+
+#[test]
+fn usage_errors_are_clear_and_exit_2() {
+    let out = eomgen(&["simulate", "double_pendulm"]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("did you mean `double_pendulum`"), "{err}");
+    let out = eomgen(&["simulate", "double_pendulum", "--init", "theta3=1"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("theta1_dot"));
+    let out = eomgen(&["simulate", "double_pendulum", "--set", "k=1"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("has no parameter `k`"));
+}
+
+#[test]
+fn rk4_and_plots_and_csv() {
+    let dir = std::env::temp_dir().join(format!("eomgen-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let svg = dir.join("p.svg");
+    let png = dir.join("p.png");
+    let csv = dir.join("p.csv");
+    for plot in [&svg, &png] {
+        let out = eomgen(&[
+            "simulate",
+            "two_masses",
+            "--method",
+            "rk4",
+            "--dt",
+            "0.01",
+            "--t-end",
+            "1",
+            "--plot",
+            plot.to_str().unwrap(),
+            "--csv",
+            csv.to_str().unwrap(),
+        ]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        assert!(std::fs::metadata(plot).unwrap().len() > 1000);
+    }
+    let text = std::fs::read_to_string(&csv).unwrap();
+    assert!(text.starts_with("t,x1,x2,x1_dot,x2_dot,energy\n"));
+    assert_eq!(text.lines().count(), 1 + 101, "header + t0 + 100 steps");
+    let _ = std::fs::remove_dir_all(&dir);
+}
