@@ -9,6 +9,8 @@
 //! - constants are folded (exactly, for rationals), `x·1`, `x + 0`, `x^1`, `x^0`, `0·x` fold;
 //! - like terms are collected (`2x + 3x = 5x`), like factors too (`x·x^2 = x^3`);
 //! - integer powers distribute over products (`(2x)^2 = 4x^2`) and nest (`(x^2)^3 = x^6`);
+//! - `c·X·sin²u + c·X·cos²u` collapses to `c·X` (the Pythagorean identity, which every
+//!   `½ m v·v` of a rotating point produces);
 //! - `sin`, `tan`, … are odd and `cos`, `cosh` even in a negated argument
 //!   (`cos(-θ) = cos θ`), so `sin θ` and `cos θ` of one angle are each one node and the code
 //!   generator can compute them with one `sin_cos`.
@@ -443,6 +445,7 @@ impl ExprArena {
                 }
             }
         }
+        self.collect_pythagorean(&mut collected, &mut constant);
         let mut operands: Vec<ExprId> = Vec::with_capacity(collected.len() + 1);
         let mut entries: Vec<(ExprId, Constant)> = collected.into_iter().collect();
         entries.sort_by_key(|(rest, _)| *rest);
@@ -462,6 +465,102 @@ impl ExprArena {
             0 => self.int(0),
             1 => operands[0],
             _ => self.add(Node::Add(operands.into())),
+        }
+    }
+
+    /// If `rest` is `sin²u · X` (a power or a product with such a factor), returns `u` and the
+    /// other factors `X` (sorted ids).
+    fn sine_square_factor(&self, rest: ExprId) -> Option<(ExprId, Vec<ExprId>)> {
+        let is_sin2 = |arena: &Self, f: ExprId| match arena.node(f) {
+            Node::Pow([b, e]) if arena.as_constant(*e) == Some(Constant::int(2)) => {
+                match arena.node(*b) {
+                    Node::Func(Func::Sin, u) => Some(*u),
+                    _ => None,
+                }
+            }
+            _ => None,
+        };
+        if let Some(u) = is_sin2(self, rest) {
+            return Some((u, Vec::new()));
+        }
+        if let Node::Mul(factors) = self.node(rest) {
+            for (i, &f) in factors.iter().enumerate() {
+                if let Some(u) = is_sin2(self, f) {
+                    let others = factors
+                        .iter()
+                        .enumerate()
+                        .filter(|(j, _)| *j != i)
+                        .map(|(_, x)| *x)
+                        .collect();
+                    return Some((u, others));
+                }
+            }
+        }
+        None
+    }
+
+    /// Pythagorean identity on collected sum terms: `c·X·sin²u + c·X·cos²u = c·X`.
+    ///
+    /// The partner term `X·cos²u` is looked up in the hash-cons table without creating nodes;
+    /// it can only be among the terms if it already exists. Terms whose coefficients differ are
+    /// left alone (that would need a choice of which square to keep).
+    fn collect_pythagorean(
+        &mut self,
+        collected: &mut indexmap::IndexMap<ExprId, Constant>,
+        constant: &mut Constant,
+    ) {
+        loop {
+            let mut found = None;
+            for (&rest, &c) in collected.iter() {
+                if c.is_zero() {
+                    continue;
+                }
+                let Some((u, others)) = self.sine_square_factor(rest) else {
+                    continue;
+                };
+                let Some(&cos) = self.memo.get(&Node::Func(Func::Cos, u)) else {
+                    continue;
+                };
+                let Some(&two) = self.memo.get(&Node::Const(Constant::int(2))) else {
+                    continue;
+                };
+                let Some(&cos2) = self.memo.get(&Node::Pow([cos, two])) else {
+                    continue;
+                };
+                let partner = if others.is_empty() {
+                    Some(cos2)
+                } else {
+                    let mut factors = others.clone();
+                    factors.push(cos2);
+                    factors.sort();
+                    self.memo.get(&Node::Mul(factors.into())).copied()
+                };
+                if let Some(partner) = partner {
+                    if collected.get(&partner) == Some(&c) {
+                        found = Some((rest, partner, others, c));
+                        break;
+                    }
+                }
+            }
+            let Some((rest, partner, others, c)) = found else {
+                return;
+            };
+            collected.shift_remove(&rest);
+            collected.shift_remove(&partner);
+            match others.len() {
+                0 => {
+                    *constant = constant.add(c).unwrap_or(*constant);
+                }
+                _ => {
+                    let x = if others.len() == 1 {
+                        others[0]
+                    } else {
+                        self.add(Node::Mul(others.into()))
+                    };
+                    let entry = collected.entry(x).or_insert(Constant::ZERO);
+                    *entry = entry.add(c).unwrap_or(*entry);
+                }
+            }
         }
     }
 

@@ -74,6 +74,35 @@ fn canonical_folding() {
 }
 
 #[test]
+fn pythagorean_identity_collapses_in_sums() {
+    let mut a = ExprArena::new();
+    let [q, qd, _] = a.coordinate("q");
+    let l = a.symbol("l", SymbolKind::Parameter);
+    // v = (−l sin q q̇, l cos q q̇): v·v = l² q̇²
+    let s = a.sin(q);
+    let c = a.cos(q);
+    let ls = a.product(&[l, s, qd]);
+    let vx = a.neg(ls);
+    let vy = a.product(&[l, c, qd]);
+    let two = a.int(2);
+    let vx2 = a.pow(vx, two);
+    let vy2 = a.pow(vy, two);
+    let v2 = a.plus(vx2, vy2);
+    let l2 = a.pow(l, two);
+    let qd2 = a.pow(qd, two);
+    assert_eq!(v2, a.times(l2, qd2));
+    // bare squares: sin² + cos² + 1 = 2
+    let s2 = a.pow(s, two);
+    let c2 = a.pow(c, two);
+    let one = a.int(1);
+    assert_eq!(a.sum(&[s2, c2, one]), two);
+    // unequal coefficients are left alone: 2 sin² + cos² is not folded
+    let t = a.times(two, s2);
+    let e = a.plus(t, c2);
+    assert!(matches!(a.node(e), Node::Add(_)));
+}
+
+#[test]
 fn trig_parity_shares_one_node() {
     let (mut a, x, _, _, _) = arena_xy();
     let nx = a.neg(x);
