@@ -5,36 +5,12 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-fn struct_name(model_name: &str) -> String {
-    model_name
-        .split('_')
-        .filter(|p| !p.is_empty())
-        .map(|p| {
-            let mut c = p.chars();
-            match c.next() {
-                Some(f) => f.to_ascii_uppercase().to_string() + c.as_str(),
-                None => String::new(),
-            }
-        })
-        .collect()
-}
-
-/// The `name:` of a model file, read from its top-level `name:` line (the macro validates
-/// the file properly; this only has to find the struct it will generate).
-fn model_name(source: &str, stem: &str) -> String {
-    source
-        .lines()
-        .find_map(|l| l.strip_prefix("name:"))
-        .map(|v| {
-            v.split('#')
-                .next()
-                .unwrap_or("")
-                .trim()
-                .trim_matches(['"', '\''])
-                .to_string()
-        })
-        .filter(|v| !v.is_empty())
-        .unwrap_or_else(|| stem.to_string())
+/// The model's `name` (for the struct the macro will generate), read with the same loader the
+/// macro uses; a broken file falls back to its stem, and the macro then reports the errors.
+fn model_name(path: &Path, source: &str, stem: &str) -> String {
+    eomgen_symbolic::model::load(&path.display().to_string(), source)
+        .map(|file| file.name.value)
+        .unwrap_or_else(|_| stem.to_string())
 }
 
 fn main() {
@@ -65,8 +41,8 @@ fn main() {
             })
             .collect();
         let source = std::fs::read_to_string(f).unwrap_or_default();
-        let name = model_name(&source, stem);
-        let ty = struct_name(&name);
+        let name = model_name(f, &source, stem);
+        let ty = eomgen_symbolic::codegen::struct_name(&name);
         let _ = writeln!(
             out,
             "/// Generated from `models/{stem}.{ext}`.\npub mod {module} {{ ::eomgen::model!({path:?}); }}\npub use {module}::{ty};",

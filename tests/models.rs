@@ -5,22 +5,14 @@
 //! Lagrange → Jacobians) and evaluates the expression DAG directly, with no code generation,
 //! printing or CSE in between; the generated side is the compiled `impl MechanicalSystem`.
 
+mod common;
+use common::Rng;
+
 use eomgen::models::ALL;
 use eomgen::{DormandPrince54, Integrator, IntegratorOptions, OutputTimes};
 use eomgen_symbolic::expr::SymbolKind;
 use eomgen_symbolic::expr::eval::Evaluator;
 use eomgen_symbolic::mechanics::{Formulation, Jacobians, Lagrange, SymbolicModel};
-
-/// Deterministic xorshift generator, so every run checks the same states.
-struct Rng(u64);
-impl Rng {
-    fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        lo + (hi - lo) * ((self.0 >> 11) as f64 / (1u64 << 53) as f64)
-    }
-}
 
 /// Agreement to 1e-9 relative to the larger magnitude (or 1): both sides evaluate the same
 /// expressions in f64, differing only in the order of operations after CSE, so they agree to

@@ -3,6 +3,9 @@
 //! Each test states its tolerance and why. References are computed here from formulas, never
 //! copied from a previous run.
 
+mod common;
+use common::Rng;
+
 use std::f64::consts::PI;
 
 use eomgen::models;
@@ -39,16 +42,6 @@ fn solve(
             options,
         )
         .unwrap_or_else(|e| panic!("{} failed: {e}", m.name()))
-}
-
-struct Rng(u64);
-impl Rng {
-    fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        lo + (hi - lo) * ((self.0 >> 11) as f64 / (1u64 << 53) as f64)
-    }
 }
 
 /// HW2: the closed form with linear drag, tau = m/c:

@@ -323,7 +323,7 @@ impl ExprArena {
         let qdd = self.symbol(&format!("{name}_ddot"), SymbolKind::Acceleration(i));
         let ids = [q, qd, qdd].map(|e| match self.node(e) {
             Node::Symbol(s) => *s,
-            _ => unreachable!("symbol() returns a symbol node"),
+            _ => unreachable!("symbol() returns a symbol node"), // cannot fail: symbol() interns a Node::Symbol
         });
         self.coordinates.push(ids);
         [q, qd, qdd]

@@ -72,7 +72,7 @@ impl SymbolicModel {
     pub fn time_symbol(&self) -> SymbolId {
         match self.arena.node(self.time) {
             crate::expr::Node::Symbol(s) => *s,
-            _ => unreachable!("time is a symbol"),
+            _ => unreachable!("time is a symbol"), // cannot fail: time() returns a symbol node
         }
     }
 
@@ -191,7 +191,7 @@ impl<'f> Lowering<'f> {
             let e = self.arena.symbol(&p.name.value, SymbolKind::Parameter);
             let symbol = match self.arena.node(e) {
                 crate::expr::Node::Symbol(s) => *s,
-                _ => unreachable!("symbol() returns a symbol node"),
+                _ => unreachable!("symbol() returns a symbol node"), // cannot fail: symbol() interns a Node::Symbol
             };
             parameters.push(ParameterInfo {
                 name: p.name.value.clone(),
@@ -414,7 +414,7 @@ impl<'f> Lowering<'f> {
 
         let ts = match self.arena.node(time) {
             crate::expr::Node::Symbol(s) => *s,
-            _ => unreachable!("time is a symbol"),
+            _ => unreachable!("time is a symbol"), // cannot fail: time() returns a symbol node
         };
         let explicit_time =
             self.arena.depends_on(kinetic, ts) || self.arena.depends_on(potential, ts);

@@ -1,0 +1,14 @@
+//! Helpers shared by the end-to-end tests.
+
+/// Deterministic xorshift64 generator, so every run checks the same states.
+pub struct Rng(pub u64);
+
+impl Rng {
+    /// A uniform sample in `[lo, hi)`.
+    pub fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 7;
+        self.0 ^= self.0 << 17;
+        lo + (hi - lo) * ((self.0 >> 11) as f64 / (1u64 << 53) as f64)
+    }
+}
