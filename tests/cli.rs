@@ -134,3 +134,16 @@ fn rk4_and_plots_and_csv() {
     assert_eq!(text.lines().count(), 1 + 101, "header + t0 + 100 steps");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn a_singular_mass_matrix_is_an_error_with_t_and_exit_1() {
+    let out = eomgen(&["simulate", "simple_pendulum", "--set", "m=0", "--json"]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("mass matrix is not positive definite at t = 0"),
+        "{err}"
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["error"]["t"], 0.0);
+}
