@@ -55,15 +55,25 @@ fn expand(input: proc_macro2::TokenStream) -> syn::Result<proc_macro2::TokenStre
             "expected the path of a model file as a string literal: `model!(\"models/x.yaml\")`",
         )
     })?;
-    let written = literal.value();
+    let literal_path = literal.value();
     let path = {
-        let p = PathBuf::from(&written);
+        let p = PathBuf::from(&literal_path);
         if p.is_absolute() {
             p
         } else {
             base_dir().join(p)
         }
     };
+    // Messages name the file as the user wrote it; an absolute path inside the package (as
+    // build.rs writes them) is shown relative to the package root: `models/x.yaml`.
+    let written = std::env::var_os("CARGO_MANIFEST_DIR")
+        .filter(|_| path.is_absolute() && Path::new(&literal_path).is_absolute())
+        .and_then(|root| {
+            path.strip_prefix(PathBuf::from(root))
+                .ok()
+                .map(|r| r.display().to_string())
+        })
+        .unwrap_or_else(|| literal_path.clone());
     let source = std::fs::read_to_string(&path).map_err(|e| {
         syn::Error::new(
             literal.span(),
