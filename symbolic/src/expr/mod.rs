@@ -22,6 +22,7 @@ mod constant;
 pub mod cse;
 mod diff;
 pub mod eval;
+mod expand;
 pub mod print;
 
 pub use constant::Constant;
@@ -245,6 +246,7 @@ pub struct ExprArena {
     time: Option<SymbolId>,
     diff_memo: FxHashMap<(ExprId, SymbolId), ExprId>,
     dt_memo: FxHashMap<ExprId, ExprId>,
+    expand_memo: FxHashMap<ExprId, ExprId>,
 }
 
 impl ExprArena {

@@ -295,6 +295,21 @@ proptest! {
         prop_assert!(close(v, fd, 1e-5), "diff {v} vs central difference {fd}");
     }
 
+    /// Distributive expansion preserves values. Multiplying out turns a few large factors into
+    /// many monomials whose sum may cancel, so rounding can grow to ~1e-10 of the value scale;
+    /// the bound is 1e-6·(1 + |value|), far below any wrong term (states where the tree has a
+    /// non-finite intermediate are skipped).
+    #[test]
+    fn expansion_preserves_value(t in tree(), x in -2.0f64..2.0, y in -2.0f64..2.0) {
+        let direct = eval_tree(&t, x, y);
+        prop_assume!(direct.is_finite() && direct.abs() < 1e4);
+        let (mut a, ex, ey, _, _) = arena_xy();
+        let e = build(&mut a, &t, ex, ey);
+        let expanded = a.expand(e);
+        let v = a.eval(expanded, &[x, y]);
+        prop_assert!((v - direct).abs() <= 1e-6 * (1.0 + direct.abs()), "expanded {v} vs direct {direct}");
+    }
+
     /// CSE preserves values: evaluating the plan's temporaries then roots (through the text
     /// printer's definitions) equals direct evaluation; and the plan never costs more
     /// operations than the trees.

@@ -37,6 +37,7 @@ impl Formulation for Lagrange {
         for i in 0..n {
             for j in i..n {
                 let m = arena.diff(momenta[i], symbols[j][1]);
+                let m = arena.expand_if_cheaper(m);
                 mass_matrix[i * n + j] = m;
                 mass_matrix[j * n + i] = m;
             }
@@ -58,7 +59,10 @@ impl Formulation for Lagrange {
             let dpt = arena.diff(momenta[i], ts);
             terms.push(arena.neg(dpt));
             terms.push(model.generalized_forces[i]);
-            forcing.push(arena.sum(&terms));
+            // ∂T/∂qᵢ and the (∂pᵢ/∂qⱼ) q̇ⱼ terms share products that cancel exactly; they
+            // only meet as like terms once multiplied out.
+            let f = arena.sum(&terms);
+            forcing.push(arena.expand_if_cheaper(f));
         }
         EquationsOfMotion {
             num_dofs: n,
