@@ -248,7 +248,16 @@ fn eval_node(t: &Tree, x: f64, y: f64) -> f64 {
             (v * v + 1.0).sqrt()
         }
         Tree::F(f, p) => f.apply(eval_tree(p, x, y)),
-        Tree::Atan2(p, q) => eval_tree(p, x, y).atan2(eval_tree(q, x, y)),
+        Tree::Atan2(p, q) => {
+            let (a, b) = (eval_tree(p, x, y), eval_tree(q, x, y));
+            // On the branch cut (a = ±0, b < 0) the value is ±π by the sign of zero, which
+            // canonical folding (x·0 = +0) does not keep: skip such states.
+            if a == 0.0 && b < 0.0 {
+                f64::NAN
+            } else {
+                a.atan2(b)
+            }
+        }
     }
 }
 
