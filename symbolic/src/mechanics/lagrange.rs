@@ -12,7 +12,9 @@ use crate::expr::ExprId;
 /// ```
 ///
 /// `M` is built from the upper triangle and mirrored, so it is exactly symmetric. Nothing is
-/// inverted symbolically.
+/// inverted symbolically. `M` and `F` are multiplied out ([`crate::expr::ExprArena::expand`])
+/// when that lowers their operation count after common-subexpression elimination, which
+/// removes the exactly cancelling terms of Lagrange's equations.
 ///
 /// # References
 /// D. T. Greenwood, *Advanced Dynamics*, Cambridge University Press, 2003, §1.4.
@@ -37,7 +39,6 @@ impl Formulation for Lagrange {
         for i in 0..n {
             for j in i..n {
                 let m = arena.diff(momenta[i], symbols[j][1]);
-                let m = arena.expand_if_cheaper(m);
                 mass_matrix[i * n + j] = m;
                 mass_matrix[j * n + i] = m;
             }
@@ -59,10 +60,26 @@ impl Formulation for Lagrange {
             let dpt = arena.diff(momenta[i], ts);
             terms.push(arena.neg(dpt));
             terms.push(model.generalized_forces[i]);
-            // ∂T/∂qᵢ and the (∂pᵢ/∂qⱼ) q̇ⱼ terms share products that cancel exactly; they
-            // only meet as like terms once multiplied out.
-            let f = arena.sum(&terms);
-            forcing.push(arena.expand_if_cheaper(f));
+            forcing.push(arena.sum(&terms));
+        }
+        // ∂T/∂qᵢ and the (∂pᵢ/∂qⱼ) q̇ⱼ terms share products that cancel exactly; they only
+        // meet as like terms once multiplied out. Expansion can also destroy sharing between
+        // entries, so keep whichever form of (M, F) costs fewer operations after CSE.
+        let expanded_mass: Vec<ExprId> = mass_matrix
+            .iter()
+            .map(|&m| arena.expand_if_cheaper(m))
+            .collect();
+        let expanded_forcing: Vec<ExprId> = forcing
+            .iter()
+            .map(|&f| arena.expand_if_cheaper(f))
+            .collect();
+        let cost = |arena: &crate::expr::ExprArena, m: &[ExprId], f: &[ExprId]| {
+            let roots: Vec<ExprId> = m.iter().chain(f).copied().collect();
+            crate::expr::cse::plan(arena, &roots, "t").operation_count()
+        };
+        if cost(arena, &expanded_mass, &expanded_forcing) < cost(arena, &mass_matrix, &forcing) {
+            mass_matrix = expanded_mass;
+            forcing = expanded_forcing;
         }
         EquationsOfMotion {
             num_dofs: n,
