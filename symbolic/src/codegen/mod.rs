@@ -362,17 +362,11 @@ pub fn emit(
         &[model.potential],
         &|v| v[0].clone(),
     );
+    // Point components, flattened; 2-D points get z = 0.
     let point_roots: Vec<ExprId> = model
         .points
         .iter()
-        .flat_map(|(_, r)| {
-            let mut r = r.clone();
-            r.resize(
-                3,
-                model.arena.as_constant(r[0]).map(|_| r[0]).unwrap_or(r[0]),
-            );
-            r
-        })
+        .flat_map(|(_, r)| r.iter().copied())
         .collect();
     let dims: Vec<usize> = model.points.iter().map(|(_, r)| r.len()).collect();
     emit_fn(
@@ -380,19 +374,21 @@ pub fn emit(
         &point_roots,
         &|v| {
             let mut s = String::new();
+            let mut offset = 0;
             for (i, d) in dims.iter().enumerate() {
                 let c: Vec<String> = (0..3)
                     .map(|k| {
                         if k < *d {
-                            v[3 * i + k].clone()
+                            v[offset + k].clone()
                         } else {
                             "0.0_f64".to_string()
                         }
                     })
                     .collect();
-                let _ = write!(
+                offset += d;
+                let _ = writeln!(
                     s,
-                    "if let Some(__p) = __out.get_mut({i}) {{ *__p = [{}]; }}\n",
+                    "if let Some(__p) = __out.get_mut({i}) {{ *__p = [{}]; }}",
                     c.join(", ")
                 );
             }

@@ -5,12 +5,70 @@
 //! product := unary (('*' | '/') unary)*
 //! unary   := '-' unary | '+' unary | power
 //! power   := atom ('^' unary)?          (right-associative; -x^2 = -(x^2); 2^-1 allowed)
-//! atom    := number | name | name '(' sum (',' sum)* ')' | '(' sum ')'
+//! atom    := number | name | function '(' sum (',' sum)* ')' | '(' sum ')'
+//! number  := digits ('.' digits?)? (('e' | 'E') ('+' | '-')? digits)?  |  '.' digits …
+//!          | '0x' hex digits | '0o' octal digits                        (YAML 1.2 numbers)
+//! name    := [A-Za-z_][A-Za-z0-9_]*
 //! ```
+//!
+//! Every node's location is the location of its first character (for a parenthesised
+//! expression, its `(`). Errors point at the exact column of the problem and say what was
+//! expected there.
 
 use super::ast::{BinOp, Expr, ExprKind, FUNCTIONS};
 use super::diagnostic::Diagnostic;
 use super::located::Location;
+
+/// Parses one expression whose first character is at `start`; the expression is on one
+/// line, so character `i` of `text` is at column `start.column + i`.
+///
+/// # Errors
+/// A diagnostic at the exact column of the first problem, saying what was expected.
+pub fn parse_expr(text: &str, start: Location) -> Result<Expr, Diagnostic> {
+    parse_expr_mapped(text, &|i| start.offset(i))
+}
+
+/// Parses one expression, with `locate(i)` giving the file location of character `i` of
+/// `text` (and `locate(text.chars().count())` the location just after it). Used for YAML
+/// scalars that span several lines.
+///
+/// # Errors
+/// As [`parse_expr`].
+pub fn parse_expr_mapped(
+    text: &str,
+    locate: &dyn Fn(usize) -> Location,
+) -> Result<Expr, Diagnostic> {
+    let toks = lex(text, locate)?;
+    let mut p = P {
+        toks: &toks,
+        pos: 0,
+        locate,
+        depth: 0,
+    };
+    if matches!(p.peek(), Tok::End) {
+        return Err(Diagnostic::new(locate(0), "empty expression")
+            .with_help("write a number or an expression such as `m*g*l`"));
+    }
+    let e = p.sum()?;
+    match p.peek() {
+        Tok::End => Ok(e),
+        Tok::Op(')') => Err(Diagnostic::new(p.at(), "unexpected `)`: it closes no `(`")
+            .with_help("remove it, or add the `(` it should close")),
+        Tok::Op(',') => Err(
+            Diagnostic::new(p.at(), "unexpected `,` after a complete expression")
+                .with_help("a `,` separates the arguments of a function such as `atan2(y, x)`"),
+        ),
+        Tok::Num(..) | Tok::Name(_) | Tok::Op('(') => Err(Diagnostic::new(
+            p.at(),
+            format!("unexpected {} after a complete expression", p.describe()),
+        )
+        .with_help("did you forget an operator? products are written with `*`, as in `2*x`")),
+        _ => Err(Diagnostic::new(
+            p.at(),
+            format!("unexpected {} after a complete expression", p.describe()),
+        )),
+    }
+}
 
 #[derive(Debug, Clone, PartialEq)]
 enum Tok {
@@ -20,21 +78,52 @@ enum Tok {
     End,
 }
 
-struct Lexer {
-    toks: Vec<(Tok, usize)>,
+/// Help for a character that cannot appear in an expression.
+fn help_for_character(c: char) -> String {
+    match c {
+        '[' | ']' | '{' | '}' => "use `(` and `)` for grouping".to_string(),
+        '=' => "an expression has no `=`; write only its right-hand side".to_string(),
+        '−' | '–' => "this is a typographic dash; type the ASCII minus `-`".to_string(),
+        '×' | '·' | '⋅' => "write products with `*`".to_string(),
+        '÷' => "write quotients with `/`".to_string(),
+        '²' => "write powers with `^`, as in `x^2`".to_string(),
+        '³' => "write powers with `^`, as in `x^3`".to_string(),
+        'π' => "write `pi`".to_string(),
+        c if c.is_alphabetic() => {
+            "names use ASCII letters, digits and `_`: write `theta` for θ".to_string()
+        }
+        _ => "expressions use numbers, names, `+ - * / ^`, parentheses and functions".to_string(),
+    }
 }
 
-fn lex(text: &str, start: Location) -> Result<Lexer, Diagnostic> {
+fn lex(text: &str, locate: &dyn Fn(usize) -> Location) -> Result<Vec<(Tok, usize)>, Diagnostic> {
     let chars: Vec<char> = text.chars().collect();
     let mut toks = Vec::new();
     let mut i = 0;
     while i < chars.len() {
         let c = chars[i];
+        let next = chars.get(i + 1).copied();
         if c.is_whitespace() {
             i += 1;
-        } else if c.is_ascii_digit()
-            || (c == '.' && chars.get(i + 1).is_some_and(char::is_ascii_digit))
-        {
+        } else if c == '0' && matches!(next, Some('x' | 'o')) {
+            // YAML 1.2 hexadecimal and octal integers.
+            let s = i;
+            let radix = if next == Some('x') { 16 } else { 8 };
+            i += 2;
+            while i < chars.len() && chars[i].is_ascii_alphanumeric() {
+                i += 1;
+            }
+            let lit: String = chars[s..i].iter().collect();
+            match u64::from_str_radix(&lit[2..], radix) {
+                Ok(v) => toks.push((Tok::Num(v as f64, v.to_string()), s)),
+                Err(_) => {
+                    return Err(
+                        Diagnostic::new(locate(s), format!("`{lit}` is not a number"))
+                            .with_help("write numbers like `2`, `0.5`, `1e-3` or `0x1F`"),
+                    );
+                }
+            }
+        } else if c.is_ascii_digit() || (c == '.' && next.is_some_and(|d| d.is_ascii_digit())) {
             let s = i;
             while i < chars.len() && (chars[i].is_ascii_digit() || chars[i] == '.') {
                 i += 1;
@@ -54,12 +143,18 @@ fn lex(text: &str, start: Location) -> Result<Lexer, Diagnostic> {
             let lit: String = chars[s..i].iter().collect();
             match lit.parse::<f64>() {
                 Ok(v) if v.is_finite() => toks.push((Tok::Num(v, lit), s)),
-                _ => {
+                Ok(_) => {
                     return Err(Diagnostic::new(
-                        start.offset(s),
-                        format!("`{lit}` is not a number"),
+                        locate(s),
+                        format!("the number `{lit}` is too large"),
                     )
-                    .with_help("write numbers like `2`, `0.5` or `1e-3`"));
+                    .with_help("numbers must be finite 64-bit floating-point values"));
+                }
+                Err(_) => {
+                    return Err(
+                        Diagnostic::new(locate(s), format!("`{lit}` is not a number"))
+                            .with_help("write numbers like `2`, `0.5` or `1e-3`"),
+                    );
                 }
             }
         } else if c.is_ascii_alphabetic() || c == '_' {
@@ -71,44 +166,72 @@ fn lex(text: &str, start: Location) -> Result<Lexer, Diagnostic> {
         } else if "+-*/^(),".contains(c) {
             toks.push((Tok::Op(c), i));
             i += 1;
-        } else {
-            let help = match c {
-                '[' | ']' | '{' | '}' => "use `(` and `)` for grouping",
-                '=' => "an expression has no `=`; write only its right-hand side",
-                _ => "expressions use numbers, names, `+ - * / ^`, parentheses and functions",
-            };
+        } else if c == '.' && next.is_some_and(|d| d.is_ascii_alphabetic()) {
             return Err(Diagnostic::new(
-                start.offset(i),
+                locate(i),
+                "unexpected `.` in an expression",
+            )
+            .with_help("infinite values (`.inf`) and `.nan` are not allowed; decimals are written `0.5`"));
+        } else {
+            return Err(Diagnostic::new(
+                locate(i),
                 format!("unexpected character `{c}` in an expression"),
             )
-            .with_help(help));
+            .with_help(help_for_character(c)));
         }
     }
     toks.push((Tok::End, chars.len()));
-    Ok(Lexer { toks })
+    Ok(toks)
 }
 
 struct P<'a> {
     toks: &'a [(Tok, usize)],
     pos: usize,
-    start: Location,
+    locate: &'a dyn Fn(usize) -> Location,
     depth: usize,
 }
 
-const MAX_DEPTH: usize = 200;
+/// Nesting limit (parentheses, unary signs, powers), so that no input overflows the stack.
+const MAX_DEPTH: usize = 100;
+
+fn symbol(op: BinOp) -> char {
+    match op {
+        BinOp::Add => '+',
+        BinOp::Sub => '-',
+        BinOp::Mul => '*',
+        BinOp::Div => '/',
+        BinOp::Pow => '^',
+    }
+}
+
+fn binary(op: BinOp, lhs: Expr, rhs: Expr) -> Expr {
+    let location = lhs.location;
+    Expr {
+        kind: ExprKind::Binary {
+            op,
+            lhs: Box::new(lhs),
+            rhs: Box::new(rhs),
+        },
+        location,
+    }
+}
 
 impl P<'_> {
     fn peek(&self) -> &Tok {
-        &self.toks[self.pos].0
+        self.toks.get(self.pos).map_or(&Tok::End, |t| &t.0)
     }
+
     fn at(&self) -> Location {
-        self.start.offset(self.toks[self.pos].1)
+        let i = self.toks.get(self.pos).map_or(0, |t| t.1);
+        (self.locate)(i)
     }
+
     fn bump(&mut self) {
         if self.pos + 1 < self.toks.len() {
             self.pos += 1;
         }
     }
+
     fn describe(&self) -> String {
         match self.peek() {
             Tok::Num(_, s) | Tok::Name(s) => format!("`{s}`"),
@@ -117,19 +240,22 @@ impl P<'_> {
         }
     }
 
-    fn enter(&mut self) -> Result<(), Diagnostic> {
-        self.depth += 1;
-        if self.depth > MAX_DEPTH {
-            return Err(Diagnostic::new(
-                self.at(),
-                "expression is nested too deeply",
-            ));
+    /// Runs `f` one nesting level deeper.
+    fn nested(&mut self, f: fn(&mut Self) -> Result<Expr, Diagnostic>) -> Result<Expr, Diagnostic> {
+        if self.depth >= MAX_DEPTH {
+            return Err(
+                Diagnostic::new(self.at(), "expression is nested too deeply").with_help(
+                    "split it with parameters, or remove redundant parentheses and signs",
+                ),
+            );
         }
-        Ok(())
+        self.depth += 1;
+        let r = f(self);
+        self.depth -= 1;
+        r
     }
 
     fn sum(&mut self) -> Result<Expr, Diagnostic> {
-        self.enter()?;
         let mut lhs = self.product()?;
         loop {
             let op = match self.peek() {
@@ -141,7 +267,6 @@ impl P<'_> {
             let rhs = self.operand_after(op, Self::product)?;
             lhs = binary(op, lhs, rhs);
         }
-        self.depth -= 1;
         Ok(lhs)
     }
 
@@ -160,40 +285,40 @@ impl P<'_> {
         Ok(lhs)
     }
 
+    /// The right operand of `op`, with a clear error when there is none.
     fn operand_after(
         &mut self,
         op: BinOp,
         f: fn(&mut Self) -> Result<Expr, Diagnostic>,
     ) -> Result<Expr, Diagnostic> {
-        if matches!(
-            self.peek(),
-            Tok::End | Tok::Op(')') | Tok::Op(',') | Tok::Op('*') | Tok::Op('/') | Tok::Op('^')
-        ) {
-            let sym = match op {
-                BinOp::Add => '+',
-                BinOp::Sub => '-',
-                BinOp::Mul => '*',
-                BinOp::Div => '/',
-                BinOp::Pow => '^',
-            };
-            return Err(Diagnostic::new(
+        if matches!(self.peek(), Tok::End | Tok::Op(')' | ',' | '*' | '/' | '^')) {
+            let d = Diagnostic::new(
                 self.at(),
                 format!(
-                    "expected an operand after `{sym}`, found {}",
+                    "expected an operand after `{}`, found {}",
+                    symbol(op),
                     self.describe()
                 ),
-            ));
+            );
+            return Err(match (op, self.peek()) {
+                (BinOp::Mul, Tok::Op('*')) => {
+                    d.with_help("powers are written with `^`, as in `x^2`")
+                }
+                _ => d.with_help(format!(
+                    "write a number, a name or a parenthesised expression after `{}`",
+                    symbol(op)
+                )),
+            });
         }
         f(self)
     }
 
     fn unary(&mut self) -> Result<Expr, Diagnostic> {
-        self.enter()?;
-        let r = match self.peek() {
+        match self.peek() {
             Tok::Op('-') => {
                 let loc = self.at();
                 self.bump();
-                let inner = self.unary()?;
+                let inner = self.operand_after(BinOp::Sub, |p| p.nested(Self::unary))?;
                 Ok(Expr {
                     kind: ExprKind::Neg(Box::new(inner)),
                     location: loc,
@@ -201,19 +326,17 @@ impl P<'_> {
             }
             Tok::Op('+') => {
                 self.bump();
-                self.unary()
+                self.operand_after(BinOp::Add, |p| p.nested(Self::unary))
             }
             _ => self.power(),
-        };
-        self.depth -= 1;
-        r
+        }
     }
 
     fn power(&mut self) -> Result<Expr, Diagnostic> {
         let base = self.atom()?;
         if matches!(self.peek(), Tok::Op('^')) {
             self.bump();
-            let exponent = self.operand_after(BinOp::Pow, Self::unary)?;
+            let exponent = self.operand_after(BinOp::Pow, |p| p.nested(Self::unary))?;
             return Ok(binary(BinOp::Pow, base, exponent));
         }
         Ok(base)
@@ -231,52 +354,18 @@ impl P<'_> {
             }
             Tok::Name(name) => {
                 self.bump();
+                let function = FUNCTIONS.iter().find(|(f, _)| *f == name);
                 if matches!(self.peek(), Tok::Op('(')) {
-                    let open = self.at();
-                    self.bump();
-                    let mut args = Vec::new();
-                    if !matches!(self.peek(), Tok::Op(')')) {
-                        loop {
-                            args.push(self.sum()?);
-                            match self.peek() {
-                                Tok::Op(',') => self.bump(),
-                                Tok::Op(')') => break,
-                                _ => {
-                                    return Err(Diagnostic::new(self.at(), format!("expected `,` or `)` in the arguments of `{name}`, found {}", self.describe()))
-                                        .with_help(format!("the call opened at column {} is not closed", open.column)));
-                                }
-                            }
-                        }
-                    }
-                    self.bump();
-                    match FUNCTIONS.iter().find(|(f, _)| *f == name) {
-                        None => {
-                            let known: Vec<&str> = FUNCTIONS.iter().map(|(f, _)| *f).collect();
-                            let mut d = Diagnostic::new(loc, format!("unknown function `{name}`"));
-                            d = match closest(&name, &known) {
-                                Some(c) => d.with_help(format!(
-                                    "did you mean `{c}`? known functions: {}",
-                                    known.join(", ")
-                                )),
-                                None => {
-                                    d.with_help(format!("known functions: {}", known.join(", ")))
-                                }
-                            };
-                            Err(d)
-                        }
-                        Some((_, arity)) if *arity != args.len() => Err(Diagnostic::new(
-                            loc,
-                            format!(
-                                "`{name}` takes {arity} argument{}, found {}",
-                                if *arity == 1 { "" } else { "s" },
-                                args.len()
-                            ),
-                        )),
-                        Some(_) => Ok(Expr {
-                            kind: ExprKind::Call { func: name, args },
-                            location: loc,
-                        }),
-                    }
+                    let Some(&(_, arity)) = function else {
+                        return Err(unknown_function(&name, loc));
+                    };
+                    self.call(name, arity, loc)
+                } else if function.is_some() {
+                    Err(Diagnostic::new(
+                        loc,
+                        format!("`{name}` is a function; its argument goes in parentheses"),
+                    )
+                    .with_help(format!("write `{name}(x)`")))
                 } else {
                     Ok(Expr {
                         kind: ExprKind::Ident(name),
@@ -286,40 +375,134 @@ impl P<'_> {
             }
             Tok::Op('(') => {
                 self.bump();
-                let inner = self.sum()?;
-                if !matches!(self.peek(), Tok::Op(')')) {
-                    return Err(Diagnostic::new(
-                        self.at(),
-                        format!("expected `)`, found {}", self.describe()),
-                    )
-                    .with_help(format!("unclosed `(` opened at column {}", loc.column)));
+                if matches!(self.peek(), Tok::Op(')')) {
+                    return Err(Diagnostic::new(loc, "empty parentheses `()`")
+                        .with_help("write an expression between `(` and `)`"));
+                }
+                let mut inner = self.nested(Self::sum)?;
+                match self.peek() {
+                    Tok::Op(')') => {}
+                    Tok::End => {
+                        return Err(Diagnostic::new(
+                            self.at(),
+                            format!(
+                                "unclosed `(` opened at {loc}: expected `)`, found the end of the expression"
+                            ),
+                        )
+                        .with_help("add the missing `)`"));
+                    }
+                    _ => {
+                        return Err(Diagnostic::new(
+                            self.at(),
+                            format!("expected an operator or `)`, found {}", self.describe()),
+                        )
+                        .with_help(format!(
+                            "the `(` opened at {loc} is still open; products are written with `*`"
+                        )));
+                    }
                 }
                 self.bump();
+                // The parenthesised expression starts at its `(`.
+                inner.location = loc;
                 Ok(inner)
             }
-            Tok::Op(')') => {
-                Err(Diagnostic::new(loc, "unexpected `)`").with_help("it closes no `(`"))
-            }
+            Tok::Op(')') => Err(Diagnostic::new(loc, "unexpected `)`: it closes no `(`")
+                .with_help("remove it, or add the `(` it should close")),
             _ => Err(Diagnostic::new(
                 loc,
                 format!(
                     "expected a number, a name or `(`, found {}",
                     self.describe()
                 ),
-            )),
+            )
+            .with_help("an expression such as `m*g*l*cos(theta)`")),
         }
+    }
+
+    /// The arguments of `name(`, with `(` the current token.
+    fn call(&mut self, name: String, arity: usize, loc: Location) -> Result<Expr, Diagnostic> {
+        let open = self.at();
+        self.bump();
+        let mut args = Vec::new();
+        if !matches!(self.peek(), Tok::Op(')')) {
+            loop {
+                if matches!(self.peek(), Tok::Op(')' | ',')) {
+                    return Err(Diagnostic::new(
+                        self.at(),
+                        format!(
+                            "expected an argument of `{name}`, found {}",
+                            self.describe()
+                        ),
+                    )
+                    .with_help(format!("`{name}` takes {}", arguments(arity))));
+                }
+                args.push(self.nested(Self::sum)?);
+                match self.peek() {
+                    Tok::Op(',') => self.bump(),
+                    Tok::Op(')') => break,
+                    Tok::End => {
+                        return Err(Diagnostic::new(
+                            self.at(),
+                            format!(
+                                "unclosed `(` of `{name}` opened at {open}: expected `,` or `)`, found the end of the expression"
+                            ),
+                        )
+                        .with_help("add the missing `)`"));
+                    }
+                    _ => {
+                        return Err(Diagnostic::new(
+                            self.at(),
+                            format!(
+                                "expected `,` or `)` in the arguments of `{name}`, found {}",
+                                self.describe()
+                            ),
+                        )
+                        .with_help(format!(
+                            "the `(` of `{name}` opened at {open} is still open"
+                        )));
+                    }
+                }
+            }
+        }
+        self.bump();
+        if args.len() != arity {
+            return Err(Diagnostic::new(
+                loc,
+                format!("`{name}` takes {}, found {}", arguments(arity), args.len()),
+            )
+            .with_help(if name == "atan2" {
+                "write `atan2(y, x)`".to_string()
+            } else {
+                format!("write `{name}(x)`")
+            }));
+        }
+        Ok(Expr {
+            kind: ExprKind::Call { func: name, args },
+            location: loc,
+        })
     }
 }
 
-fn binary(op: BinOp, lhs: Expr, rhs: Expr) -> Expr {
-    let location = lhs.location;
-    Expr {
-        kind: ExprKind::Binary {
-            op,
-            lhs: Box::new(lhs),
-            rhs: Box::new(rhs),
-        },
-        location,
+fn arguments(n: usize) -> String {
+    if n == 1 {
+        "1 argument".to_string()
+    } else {
+        format!("{n} arguments")
+    }
+}
+
+fn unknown_function(name: &str, loc: Location) -> Diagnostic {
+    let known: Vec<&str> = FUNCTIONS.iter().map(|(f, _)| *f).collect();
+    let d = Diagnostic::new(loc, format!("unknown function `{name}`"));
+    match closest(name, &known) {
+        Some(c) => d.with_help(format!(
+            "did you mean `{c}`? functions are: {}",
+            known.join(", ")
+        )),
+        None => d.with_help(format!(
+            "functions are: {}; to multiply, write `{name}*(…)`",
+            known.join(", ")
+        )),
     }
 }
 
@@ -351,42 +534,13 @@ pub fn edit_distance(a: &str, b: &str) -> usize {
     prev[b.len()]
 }
 
-/// Parses one expression whose first character is at `start`.
-///
-/// # Errors
-/// A diagnostic at the exact column of the first problem, saying what was expected.
-pub fn parse_expr(text: &str, start: Location) -> Result<Expr, Diagnostic> {
-    let lexer = lex(text, start)?;
-    let mut p = P {
-        toks: &lexer.toks,
-        pos: 0,
-        start,
-        depth: 0,
-    };
-    if matches!(p.peek(), Tok::End) {
-        return Err(Diagnostic::new(start, "empty expression")
-            .with_help("write a number or an expression such as `m*g*l`"));
-    }
-    let e = p.sum()?;
-    if !matches!(p.peek(), Tok::End) {
-        let help = if matches!(p.peek(), Tok::Op(')')) {
-            "it closes no `(`".to_string()
-        } else {
-            "did you forget an operator such as `*`?".to_string()
-        };
-        return Err(Diagnostic::new(
-            p.at(),
-            format!("unexpected {} after a complete expression", p.describe()),
-        )
-        .with_help(help));
-    }
-    Ok(e)
-}
-
 /// Evaluates an expression with names resolved by `lookup` (`pi` is built in).
 ///
+/// Functions and powers are evaluated exactly as the expression DAG evaluates them
+/// (`crate::expr`), so that a value checked here is the value used later.
+///
 /// # Errors
-/// A diagnostic at the first name `lookup` does not know.
+/// A diagnostic at the first name `lookup` does not know (message `unknown name `x``).
 pub fn eval_expr(e: &Expr, lookup: &dyn Fn(&str) -> Option<f64>) -> Result<f64, Diagnostic> {
     Ok(match &e.kind {
         ExprKind::Number { value, .. } => *value,
@@ -457,14 +611,7 @@ mod tests {
             ExprKind::Ident(n) => n.clone(),
             ExprKind::Neg(a) => format!("(-{})", show(a)),
             ExprKind::Binary { op, lhs, rhs } => {
-                let o = match op {
-                    BinOp::Add => "+",
-                    BinOp::Sub => "-",
-                    BinOp::Mul => "*",
-                    BinOp::Div => "/",
-                    BinOp::Pow => "^",
-                };
-                format!("({} {o} {})", show(lhs), show(rhs))
+                format!("({} {} {})", show(lhs), symbol(*op), show(rhs))
             }
             ExprKind::Call { func, args } => format!(
                 "{func}({})",
@@ -493,31 +640,92 @@ mod tests {
         assert_eq!(p("a-b-c"), "((a - b) - c)");
         assert_eq!(p("a/b/c"), "((a / b) / c)");
         assert_eq!(p("2^-1"), "(2 ^ (-1))");
+        assert_eq!(p("-2^-x^2"), "(-(2 ^ (-(x ^ 2))))");
         assert_eq!(p("m*l^2*q_dot^2/2"), "(((m * (l ^ 2)) * (q_dot ^ 2)) / 2)");
         assert_eq!(p("atan2(y, x) + 1e-3"), "(atan2(y, x) + 1e-3)");
+        assert_eq!(p("+a - -b"), "(a - (-b))");
+        assert_eq!(p("(a+b)*c"), "((a + b) * c)");
+    }
+
+    #[test]
+    fn yaml_numbers() {
+        assert_eq!(p("1.0"), "1.0");
+        assert_eq!(p("-2"), "(-2)");
+        assert_eq!(p("+3"), "3");
+        assert_eq!(p(".5"), ".5");
+        assert_eq!(p("6.02E23"), "6.02E23");
+        assert_eq!(p("1."), "1.");
+        assert_eq!(p("0x1F"), "31");
+        assert_eq!(p("0o17"), "15");
+        assert!(err("1e400").message.contains("too large"));
+        assert!(err(".inf").message.contains("unexpected `.`"));
+        assert!(err("1.2.3").message.contains("`1.2.3` is not a number"));
+    }
+
+    #[test]
+    fn every_node_is_located_at_its_first_character() {
+        let e = parse_expr("2*(a + b)", Location { line: 4, column: 5 }).unwrap();
+        assert_eq!(e.location.column, 5);
+        let ExprKind::Binary { rhs, .. } = &e.kind else {
+            panic!()
+        };
+        assert_eq!(rhs.location.column, 7);
+        let ExprKind::Binary { lhs, rhs: b, .. } = &rhs.kind else {
+            panic!()
+        };
+        assert_eq!((lhs.location.column, b.location.column), (8, 12));
+        let mut ids = Vec::new();
+        identifiers(&e, &mut ids);
+        let cols: Vec<u32> = ids.iter().map(|(_, l)| l.column).collect();
+        assert_eq!(cols, [8, 12]);
     }
 
     #[test]
     fn errors_point_at_the_column() {
+        let at = |d: &Diagnostic| (d.location.line, d.location.column);
         let e = err("m*");
-        assert_eq!(
-            e.location,
-            Location {
-                line: 3,
-                column: 12
-            }
-        );
+        assert_eq!(at(&e), (3, 12));
         assert!(e.message.contains("expected an operand after `*`"));
         let e = err("sinn(x)");
-        assert_eq!(e.location.column, 10);
+        assert_eq!(at(&e), (3, 10));
+        assert!(e.message.contains("unknown function `sinn`"));
         assert!(e.help.unwrap().contains("did you mean `sin`"));
-        assert!(err("atan2(x)").message.contains("takes 2 arguments"));
+        let e = err("1 + atan2(x)");
+        assert_eq!(at(&e), (3, 14));
+        assert!(e.message.contains("`atan2` takes 2 arguments, found 1"));
         let e = err("(a + b");
-        assert!(e.message.contains("expected `)`"));
-        assert_eq!(e.location.column, 16);
+        assert_eq!(at(&e), (3, 16));
+        assert!(e.message.contains("unclosed `(` opened at 3:10"));
+        let e = err("sin(a");
+        assert!(e.message.contains("unclosed `(` of `sin` opened at 3:13"));
         assert!(err("a b").message.contains("unexpected `b`"));
-        assert!(err("a)").message.contains("unexpected `)`"));
-        assert!(err("x $ 2").message.contains("unexpected character `$`"));
+        let e = err("a)");
+        assert_eq!(at(&e), (3, 11));
+        assert!(e.message.contains("unexpected `)`"));
+        assert!(err(")").message.contains("unexpected `)`"));
+        let e = err("x $ 2");
+        assert_eq!(at(&e), (3, 12));
+        assert!(e.message.contains("unexpected character `$`"));
+        assert!(err("x ** 2").help.unwrap().contains("`^`"));
+        assert!(err("sin").message.contains("is a function"));
+        assert!(err("()").message.contains("empty parentheses"));
+        assert!(err("atan2(x,)").message.contains("expected an argument"));
+        assert!(err("m(x+1)").help.unwrap().contains("`m*(…)`"));
+        assert!(err("   ").message.contains("empty expression"));
+        assert!(err("a, b").message.contains("unexpected `,`"));
+        assert!(err("θ").help.unwrap().contains("theta"));
+        assert!(err("x − 1").help.unwrap().contains("ASCII minus"));
+        assert!(err("-").message.contains("expected an operand after `-`"));
+    }
+
+    #[test]
+    fn mapped_locations_are_used() {
+        let locate = |i: usize| Location {
+            line: 10 + i as u32,
+            column: 1,
+        };
+        let e = parse_expr_mapped("a +", &locate).unwrap_err();
+        assert_eq!(e.location.line, 13);
     }
 
     #[test]
@@ -526,5 +734,28 @@ mod tests {
         assert!(err(&s).message.contains("nested too deeply"));
         let s = "-".repeat(10_000) + "x";
         assert!(err(&s).message.contains("nested too deeply"));
+        let s = "x^".repeat(10_000) + "x";
+        assert!(err(&s).message.contains("nested too deeply"));
+        let s = "sin(".repeat(10_000);
+        assert!(err(&s).message.contains("nested too deeply"));
+        // Moderate nesting is fine.
+        let s = "(".repeat(50) + "x" + &")".repeat(50);
+        assert_eq!(p(&s), "x");
+    }
+
+    #[test]
+    fn evaluation() {
+        let e = parse_expr("2*pi - sqrt(4) + atan2(0, 1) + a^2", Location::default()).unwrap();
+        let v = eval_expr(&e, &|n| (n == "a").then_some(3.0)).unwrap();
+        assert!((v - (2.0 * std::f64::consts::PI - 2.0 + 9.0)).abs() < 1e-12);
+        let e = parse_expr("b", Location::default()).unwrap();
+        assert!(eval_expr(&e, &|_| None).is_err());
+    }
+
+    #[test]
+    fn did_you_mean() {
+        assert_eq!(closest("mas", &["mass", "at"]), Some("mass"));
+        assert_eq!(closest("k", &["m"]), None);
+        assert_eq!(edit_distance("kitten", "sitting"), 3);
     }
 }

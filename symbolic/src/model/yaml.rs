@@ -484,7 +484,10 @@ pub fn char_locations(source: &str, start: Location, text: &str) -> Option<Vec<L
                 // Folding turned a line break (and indentation) into this whitespace.
                 None if c.is_whitespace() => {
                     out.push(here(line_no, col));
-                    current = lines.next().map(|l| l.chars().collect()).unwrap_or_default();
+                    current = lines
+                        .next()
+                        .map(|l| l.chars().collect())
+                        .unwrap_or_default();
                     line_no += 1;
                     col = 0;
                     while current.get(col).is_some_and(|s| s.is_whitespace()) {
@@ -598,7 +601,10 @@ mod tests {
         let top = entries(&root);
         assert_eq!(top[0].1.kind, YamlKind::Null);
         assert_eq!(top[1].1.kind, YamlKind::Null);
-        assert!(matches!(&top[2].1.kind, YamlKind::Scalar { quoted: true, .. }));
+        assert!(matches!(
+            &top[2].1.kind,
+            YamlKind::Scalar { quoted: true, .. }
+        ));
         assert_eq!(top[3].1.kind, YamlKind::Null);
     }
 
