@@ -200,7 +200,7 @@ pub fn emit(
     let _ = writeln!(src, "}}");
     let _ = writeln!(
         src,
-        "#[automatically_derived] impl ::core::default::Default for {name} {{ fn default() -> Self {{ Self {{"
+        "#[automatically_derived] #[allow(clippy::all, clippy::approx_constant, non_snake_case)] impl ::core::default::Default for {name} {{ fn default() -> Self {{ Self {{"
     );
     for p in &model.parameters {
         let _ = writeln!(src, "{}: {:?}_f64,", field_name(&p.name), p.default);
@@ -418,7 +418,7 @@ pub fn emit(
 
     let _ = writeln!(
         src,
-        "#[automatically_derived] impl {krate}::MechanicalSystem<{n}> for {name} {{\n{imp}\n}}"
+        "#[automatically_derived] #[allow(clippy::all, clippy::approx_constant, non_snake_case)] impl {krate}::MechanicalSystem<{n}> for {name} {{\n{imp}\n}}"
     );
     let tokens: TokenStream = src
         .parse()

@@ -1,413 +1,703 @@
 //! Cross-object rules of a model file, each stated above its check. Every violation is
 //! collected; nothing stops at the first.
+//!
+//! The rules run on what the schema pass built. Entries it left out (already reported) are
+//! listed in [`Incomplete`] and treated as present, so that one mistake gives one message.
 
 use super::ast::{Expr, FUNCTIONS};
-use super::diagnostic::Diagnostic;
-use super::file::{BodyKind, ModelFile};
-use super::located::Location;
+use super::diagnostic::{Diagnostic, Diagnostics};
+use super::file::{BodyKind, ModelFile, Parameter};
+use super::located::{Located, Location};
 use super::parser::{closest, eval_expr, identifiers};
-
-/// What a name in an expression may refer to, for one kind of expression.
-#[derive(Clone, Copy)]
-struct Allowed {
-    coordinates: bool,
-    rates: bool,
-    time: bool,
-}
-
-const CONSTANT: Allowed = Allowed {
-    coordinates: false,
-    rates: false,
-    time: false,
-};
-const POSITION: Allowed = Allowed {
-    coordinates: true,
-    rates: false,
-    time: true,
-};
-const ANY: Allowed = Allowed {
-    coordinates: true,
-    rates: true,
-    time: true,
-};
+use super::schema::Incomplete;
 
 /// Runs every rule on `file`.
 ///
 /// # Errors
-/// Every violation, in no particular order (the caller sorts by location).
+/// Every violation, sorted by location.
 pub fn check(file: &ModelFile) -> Result<(), Vec<Diagnostic>> {
-    let mut errors = Vec::new();
-    let params: Vec<&str> = file
-        .parameters
-        .iter()
-        .map(|p| p.name.value.as_str())
-        .collect();
-    let coords: Vec<&str> = file
-        .coordinates
-        .iter()
-        .map(|c| c.name.value.as_str())
-        .collect();
-    let rates: Vec<String> = coords.iter().map(|c| format!("{c}_dot")).collect();
-    let points: Vec<&str> = file.points.iter().map(|p| p.name.value.as_str()).collect();
+    check_partial(file, &Incomplete::default())
+}
+
+/// Runs every rule on a model that the schema pass built only in part, without reporting
+/// what depends on the entries it left out (see [`Incomplete`]).
+///
+/// # Errors
+/// Every violation, sorted by location.
+pub fn check_partial(file: &ModelFile, incomplete: &Incomplete) -> Result<(), Vec<Diagnostic>> {
+    let mut checker = Checker::new(file, incomplete);
+    checker.names();
+    checker.presence();
+    checker.expressions();
+    checker.dimensions();
+    checker.references();
+    checker.masses();
+    checker.diagnostics.finish()
+}
+
+/// The value of a constant expression at the parameters' defaults (`None` if it uses
+/// anything but numbers, `pi`, functions and these parameters).
+///
+/// A NaN or infinite result is returned as such (`1/0` is `inf`).
+pub fn evaluate(expr: &Expr, parameters: &[Parameter]) -> Option<f64> {
+    eval_expr(expr, &|n| {
+        parameters
+            .iter()
+            .find(|p| p.name.value == n)
+            .map(|p| p.value)
+    })
+    .ok()
+}
+
+/// What an expression may depend on.
+#[derive(Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+enum Depends {
+    /// Parameters, numbers, `pi` and functions.
+    Constant,
+    /// Also coordinates and `t` (a configuration).
+    Position,
+    /// Also rates (`x_dot`).
+    Motion,
+}
+
+struct Checker<'f> {
+    file: &'f ModelFile,
+    incomplete: &'f Incomplete,
+    diagnostics: Diagnostics,
+    params: Vec<&'f str>,
+    coords: Vec<&'f str>,
+    rates: Vec<String>,
+    points: Vec<&'f str>,
+    bodies: Vec<&'f str>,
+}
+
+impl<'f> Checker<'f> {
+    fn new(file: &'f ModelFile, incomplete: &'f Incomplete) -> Self {
+        let coords: Vec<&str> = file
+            .coordinates
+            .iter()
+            .map(|c| c.name.value.as_str())
+            .collect();
+        Self {
+            file,
+            incomplete,
+            diagnostics: Diagnostics::new(),
+            params: file
+                .parameters
+                .iter()
+                .map(|p| p.name.value.as_str())
+                .collect(),
+            rates: coords.iter().map(|c| format!("{c}_dot")).collect(),
+            coords,
+            points: file.points.iter().map(|p| p.name.value.as_str()).collect(),
+            bodies: file.bodies.iter().map(|b| b.name.value.as_str()).collect(),
+        }
+    }
+
+    fn error(&mut self, d: Diagnostic) {
+        self.diagnostics.push(d);
+    }
+
+    /// Whether a whole section may be missing from the model because of a reported error.
+    fn section_lost(&self, section: &str, built_empty: bool) -> bool {
+        built_empty && self.incomplete.has_section(section)
+    }
 
     // Rule: parameters, coordinates, points and bodies have distinct names, none of which is
-    // `t`, `pi`, a function name, or ends in `_dot` / `_ddot` (those spell rates).
-    let mut seen: Vec<(&str, Location, &str)> = Vec::new();
-    let named = file
-        .parameters
-        .iter()
-        .map(|p| (&p.name, "parameter"))
-        .chain(file.coordinates.iter().map(|c| (&c.name, "coordinate")))
-        .chain(file.points.iter().map(|p| (&p.name, "point")))
-        .chain(file.bodies.iter().map(|b| (&b.name, "body")));
-    for (name, kind) in named {
-        let n = name.value.as_str();
-        if n == "t" || n == "pi" || FUNCTIONS.iter().any(|(f, _)| *f == n) {
-            errors.push(
-                Diagnostic::new(name.location, format!("{kind} name `{n}` is reserved")).with_help(
-                    "`t` is time, `pi` is π, and function names are taken; choose another name",
-                ),
-            );
-        } else if n.ends_with("_dot") || n.ends_with("_ddot") {
-            errors.push(Diagnostic::new(name.location, format!("{kind} name `{n}` ends in `_dot`/`_ddot`, which spell rates")).with_help("rates of coordinates are written `<coordinate>_dot` automatically; choose another name"));
-        }
-        if let Some((_, first, first_kind)) = seen.iter().find(|(s, _, _)| *s == n) {
-            errors.push(
-                Diagnostic::new(
-                    name.location,
-                    format!(
-                        "`{n}` is already the name of a {first_kind} (line {})",
-                        first.line
+    // `t`, `pi` or a function name, or ends in `_dot` / `_ddot` (those spell rates and
+    // accelerations of coordinates).
+    fn names(&mut self) {
+        let file = self.file;
+        let mut seen: Vec<(&str, Location, &str)> = Vec::new();
+        let named = file
+            .parameters
+            .iter()
+            .map(|p| (&p.name, "parameter"))
+            .chain(file.coordinates.iter().map(|c| (&c.name, "coordinate")))
+            .chain(file.points.iter().map(|p| (&p.name, "point")))
+            .chain(file.bodies.iter().map(|b| (&b.name, "body")));
+        for (name, kind) in named {
+            let n = name.value.as_str();
+            if n == "t" || n == "pi" || FUNCTIONS.iter().any(|(f, _)| *f == n) {
+                let why = match n {
+                    "t" => "`t` is time".to_string(),
+                    "pi" => "`pi` is π".to_string(),
+                    _ => format!("`{n}` is a function"),
+                };
+                self.error(
+                    Diagnostic::new(
+                        name.location,
+                        format!("{kind} name `{n}` is reserved: {why}"),
+                    )
+                    .with_help("choose another name"),
+                );
+            } else if n.ends_with("_dot") || n.ends_with("_ddot") {
+                self.error(
+                    Diagnostic::new(
+                        name.location,
+                        format!("{kind} name `{n}` ends in `_dot` or `_ddot`, which spell rates"),
+                    )
+                    .with_help(
+                        "the rate of coordinate `x` is written `x_dot` without being declared; choose another name",
                     ),
-                )
-                .with_help("names of parameters, coordinates, points and bodies must all differ"),
-            );
-        } else {
-            seen.push((n, name.location, kind));
+                );
+            }
+            if let Some((_, first, first_kind)) = seen.iter().find(|(s, _, _)| *s == n) {
+                self.error(
+                    Diagnostic::new(
+                        name.location,
+                        format!("duplicate name `{n}`: already a {first_kind} at {first}"),
+                    )
+                    .with_help("parameters, coordinates, points and bodies share one namespace; rename one"),
+                );
+            } else {
+                seen.push((n, name.location, kind));
+            }
         }
     }
 
-    // Rule: the model has at least one coordinate, and inertia (`kinetic` or `bodies`).
-    if file.coordinates.is_empty() {
-        errors.push(
-            Diagnostic::new(file.name.location, "the model has no coordinates")
-                .with_help("list the generalized coordinates: `coordinates: [q]`"),
-        );
-    }
-    if file.kinetic.is_none() && file.bodies.is_empty() {
-        errors.push(
-            Diagnostic::new(file.name.location, "the model has no kinetic energy")
-                .with_help("give `kinetic:` (energy form) or `bodies:` (kinematic form)"),
-        );
+    // Rule: the model has at least one coordinate, and inertia: `kinetic` or at least one
+    // body.
+    fn presence(&mut self) {
+        let file = self.file;
+        if file.coordinates.is_empty() && !self.incomplete.has_section("coordinates") {
+            self.error(
+                Diagnostic::new(file.name.location, "the model has no coordinates")
+                    .with_help("list the generalized coordinates: `coordinates: [q]`"),
+            );
+        }
+        if file.kinetic.is_none()
+            && file.bodies.is_empty()
+            && !self.incomplete.has_section("kinetic")
+            && !self.incomplete.has_section("bodies")
+        {
+            self.error(
+                Diagnostic::new(
+                    file.name.location,
+                    "no kinetic energy: give `kinetic:` or `bodies:`",
+                )
+                .with_help("energy form: `kinetic: m*x_dot^2/2`; kinematic form: `bodies: { bob: { mass: m, at: P } }`"),
+            );
+        }
     }
 
-    // Rule: every name in an expression is a parameter, `t`, `pi`, and where the expression
-    // may depend on the motion, a coordinate or (for loads) a rate. Accelerations never.
-    let names = |e: &Expr, allowed: Allowed, what: &str, errors: &mut Vec<Diagnostic>| {
+    // Rule: every name in an expression is a parameter or `pi`, and where the expression may
+    // depend on the configuration, a coordinate or `t`, and where it may depend on the
+    // motion, a rate `<coordinate>_dot`:
+    // - constant: masses, inertias, `gravity`, initial values;
+    // - configuration (no rates): point positions, `potential`, body angles, stiffnesses,
+    //   rest lengths, damping coefficients;
+    // - motion: `kinetic`, generalized forces, forces, torques.
+    // Accelerations (`_ddot`) appear nowhere: the equations of motion are derived.
+    fn expressions(&mut self) {
+        let file = self.file;
+        if let Some(k) = &file.kinetic {
+            self.resolve(k, Depends::Motion, "`kinetic`");
+        }
+        if let Some(v) = &file.potential {
+            self.resolve(v, Depends::Position, "`potential`");
+        }
+        for (k, q) in &file.generalized_forces {
+            self.resolve(
+                q,
+                Depends::Motion,
+                &format!("the generalized force `{}`", k.value),
+            );
+        }
+        for p in &file.points {
+            for c in &p.position {
+                self.resolve(
+                    c,
+                    Depends::Position,
+                    &format!("the position of point `{}`", p.name.value),
+                );
+            }
+        }
+        for b in &file.bodies {
+            let name = &b.name.value;
+            match &b.kind {
+                BodyKind::Particle { mass, .. } => {
+                    self.resolve(
+                        mass,
+                        Depends::Constant,
+                        &format!("the mass of body `{name}`"),
+                    );
+                }
+                BodyKind::Rigid {
+                    mass,
+                    inertia,
+                    angle,
+                    ..
+                } => {
+                    self.resolve(
+                        mass,
+                        Depends::Constant,
+                        &format!("the mass of body `{name}`"),
+                    );
+                    self.resolve(
+                        inertia,
+                        Depends::Constant,
+                        &format!("the inertia of body `{name}`"),
+                    );
+                    self.resolve(
+                        angle,
+                        Depends::Position,
+                        &format!("the angle of body `{name}`"),
+                    );
+                }
+            }
+        }
+        if let Some(g) = &file.gravity {
+            for c in &g.value {
+                self.resolve(c, Depends::Constant, "`gravity`");
+            }
+        }
+        for s in &file.springs {
+            let name = &s.name.value;
+            self.resolve(
+                &s.stiffness,
+                Depends::Position,
+                &format!("the stiffness of spring `{name}`"),
+            );
+            if let Some(l) = &s.rest_length {
+                self.resolve(
+                    l,
+                    Depends::Position,
+                    &format!("the rest length of spring `{name}`"),
+                );
+            }
+        }
+        for d in &file.dampers {
+            self.resolve(
+                &d.coefficient,
+                Depends::Position,
+                &format!("the coefficient of damper `{}`", d.name.value),
+            );
+        }
+        for f in &file.forces {
+            for c in &f.vector {
+                self.resolve(c, Depends::Motion, &format!("force `{}`", f.name.value));
+            }
+        }
+        for t in &file.torques {
+            self.resolve(
+                &t.value,
+                Depends::Motion,
+                &format!("torque `{}`", t.name.value),
+            );
+        }
+        for (k, e) in &file.initial {
+            self.resolve(
+                e,
+                Depends::Constant,
+                &format!("the initial value of `{}`", k.value),
+            );
+        }
+    }
+
+    /// Reports every name in `e` that `depends` does not allow; `what` names the expression.
+    fn resolve(&mut self, e: &Expr, depends: Depends, what: &str) {
         let mut ids = Vec::new();
         identifiers(e, &mut ids);
-        for (n, loc) in ids {
-            let is_param = params.contains(&n.as_str()) || n == "pi";
-            let is_coord = coords.contains(&n.as_str());
-            let is_rate = rates.contains(&n);
-            let is_time = n == "t";
-            let ok = is_param
-                || (is_coord && allowed.coordinates)
-                || (is_rate && allowed.rates)
-                || (is_time && allowed.time);
-            if ok {
+        for (n, at) in ids {
+            let n = n.as_str();
+            let is_param = n == "pi" || self.params.contains(&n);
+            let is_coord = self.coords.contains(&n);
+            let is_rate = self.rates.iter().any(|r| r == n);
+            let needs = if is_param {
+                Depends::Constant
+            } else if is_coord || n == "t" {
+                Depends::Position
+            } else if is_rate {
+                Depends::Motion
+            } else {
+                self.unknown(n, at, depends, what);
+                continue;
+            };
+            if needs <= depends {
                 continue;
             }
-            let d = if is_coord || is_time {
-                Diagnostic::new(loc, format!("{what} cannot depend on `{n}`")).with_help(format!(
-                    "{what} must be constant: use parameters and numbers"
-                ))
-            } else if is_rate {
-                Diagnostic::new(loc, format!("{what} cannot depend on the rate `{n}`"))
-                    .with_help(format!("{what} may use coordinates and `t`, not rates"))
-            } else if n.ends_with("_ddot") {
+            let d = match (depends, needs) {
+                (Depends::Constant, _) => {
+                    let kind = match needs {
+                        Depends::Motion => "the rate ",
+                        _ if n == "t" => "the time ",
+                        _ => "the coordinate ",
+                    };
+                    Diagnostic::new(
+                        at,
+                        format!("{what} must be constant, but it uses {kind}`{n}`"),
+                    )
+                    .with_help("use parameters, numbers, `pi` and functions of them")
+                }
+                _ => Diagnostic::new(at, format!("{what} cannot depend on the rate `{n}`"))
+                    .with_help("it may use parameters, coordinates and `t`, not rates"),
+            };
+            self.error(d);
+        }
+    }
+
+    fn unknown(&mut self, n: &str, at: Location, depends: Depends, what: &str) {
+        if self.incomplete.has_name(n)
+            || n.strip_suffix("_dot")
+                .is_some_and(|q| self.incomplete.has_name(q))
+        {
+            return;
+        }
+        if n.ends_with("_ddot") {
+            self.error(
                 Diagnostic::new(
-                    loc,
+                    at,
                     format!("accelerations such as `{n}` cannot appear in a model file"),
                 )
                 .with_help(
-                    "the equations of motion are derived; give positions, energies and loads",
-                )
-            } else {
-                let mut candidates: Vec<&str> = params.clone();
-                if allowed.coordinates {
-                    candidates.extend(&coords);
-                }
-                if allowed.rates {
-                    candidates.extend(rates.iter().map(String::as_str));
-                }
-                let d = Diagnostic::new(loc, format!("unknown name `{n}` in {what}"));
-                match closest(&n, &candidates) {
-                    Some(c) => d.with_help(format!("did you mean `{c}`?")),
-                    None => d.with_help(format!(
-                        "names here are parameters ({}){}, `t` and `pi`",
-                        params.join(", "),
-                        if allowed.coordinates {
-                            format!(", coordinates ({})", coords.join(", "))
-                        } else {
-                            String::new()
-                        }
-                    )),
-                }
-            };
-            errors.push(d);
-        }
-    };
-    if let Some(k) = &file.kinetic {
-        names(k, ANY, "`kinetic`", &mut errors);
-    }
-    if let Some(v) = &file.potential {
-        names(v, POSITION, "`potential`", &mut errors);
-    }
-    for (_, q) in &file.generalized_forces {
-        names(q, ANY, "a generalized force", &mut errors);
-    }
-    for p in &file.points {
-        for c in &p.position {
-            names(
-                c,
-                POSITION,
-                &format!("the position of point `{}`", p.name.value),
-                &mut errors,
+                    "the equations of motion are derived: give positions or energies, and loads",
+                ),
             );
+            return;
         }
-    }
-    for b in &file.bodies {
-        match &b.kind {
-            BodyKind::Particle { mass, .. } => names(mass, CONSTANT, "a mass", &mut errors),
-            BodyKind::Rigid {
-                mass,
-                inertia,
-                angle,
-                ..
-            } => {
-                names(mass, CONSTANT, "a mass", &mut errors);
-                names(inertia, CONSTANT, "an inertia", &mut errors);
-                names(angle, POSITION, "a body angle", &mut errors);
-            }
+        if self.points.contains(&n) || self.bodies.contains(&n) {
+            let kind = if self.points.contains(&n) {
+                "point"
+            } else {
+                "body"
+            };
+            self.error(
+                Diagnostic::new(at, format!("`{n}` is a {kind}; {what} cannot use it as a value"))
+                    .with_help("expressions use parameters, coordinates, rates, `t` and `pi`; write the components out"),
+            );
+            return;
         }
-    }
-    if let Some(g) = &file.gravity {
-        for c in &g.value {
-            names(c, CONSTANT, "`gravity`", &mut errors);
+        if self.section_lost("parameters", self.file.parameters.is_empty())
+            || self.section_lost("coordinates", self.file.coordinates.is_empty())
+        {
+            return;
         }
-    }
-    for s in &file.springs {
-        names(&s.stiffness, CONSTANT, "a stiffness", &mut errors);
-        if let Some(l) = &s.rest_length {
-            names(l, CONSTANT, "a rest length", &mut errors);
+        let mut candidates: Vec<&str> = self.params.clone();
+        if depends >= Depends::Position {
+            candidates.extend(&self.coords);
+            candidates.push("t");
         }
-    }
-    for d in &file.dampers {
-        names(
-            &d.coefficient,
-            CONSTANT,
-            "a damping coefficient",
-            &mut errors,
-        );
-    }
-    for f in &file.forces {
-        for c in &f.vector {
-            names(c, ANY, "a force", &mut errors);
+        if depends >= Depends::Motion {
+            candidates.extend(self.rates.iter().map(String::as_str));
         }
-    }
-    for t in &file.torques {
-        names(&t.value, ANY, "a torque", &mut errors);
-    }
-    for (_, e) in &file.initial {
-        names(e, CONSTANT, "an initial value", &mut errors);
+        candidates.push("pi");
+        let d = Diagnostic::new(at, format!("unknown name `{n}` in {what}"));
+        let d = match closest(n, &candidates) {
+            Some(c) => d.with_help(format!("did you mean `{c}`?")),
+            None => d.with_help(format!(
+                "names here are: {}; declare parameters under `parameters:`",
+                candidates.join(", ")
+            )),
+        };
+        self.error(d);
     }
 
-    // Rule: all points have the same number of components (2 or 3), and so do gravity and
-    // forces; planar rigid bodies only exist in 2-D models.
-    let dim = file.dimension;
-    for p in &file.points {
-        if Some(p.position.len()) != dim {
-            errors.push(
+    // Rule: all points have the same number of components (2 or 3), and `gravity` and every
+    // force have as many; planar rigid bodies exist only in 2-D models; `gravity` needs
+    // points to act on.
+    fn dimensions(&mut self) {
+        let file = self.file;
+        let Some(first) = file.points.first() else {
+            if let Some(g) = &file.gravity
+                && !self.incomplete.has_section("points")
+            {
+                self.error(
+                    Diagnostic::new(g.location, "`gravity` acts on bodies, but the model has no points")
+                        .with_help("add `points:` and `bodies:`, or write the gravitational energy into `potential:`"),
+                );
+            }
+            return;
+        };
+        let dim = first.position.len();
+        for p in &file.points[1..] {
+            if p.position.len() != dim {
+                self.error(
+                    Diagnostic::new(
+                        p.location,
+                        format!(
+                            "point `{}` has {} components but point `{}` has {dim}",
+                            p.name.value,
+                            p.position.len(),
+                            first.name.value
+                        ),
+                    )
+                    .with_help("a model is either planar (`[x, y]`) or spatial (`[x, y, z]`)"),
+                );
+            }
+        }
+        if let Some(g) = &file.gravity
+            && g.value.len() != dim
+        {
+            let example = if dim == 2 { "[0, -g]" } else { "[0, 0, -g]" };
+            self.error(
                 Diagnostic::new(
-                    p.location,
+                    g.location,
                     format!(
-                        "point `{}` has {} components but the first point has {}",
-                        p.name.value,
-                        p.position.len(),
-                        dim.unwrap_or(0)
+                        "`gravity` has {} components but the points have {dim}",
+                        g.value.len()
                     ),
                 )
-                .with_help("a model is either planar ([x, y]) or spatial ([x, y, z])"),
+                .with_help(format!("write it like `{example}`")),
             );
         }
-    }
-    let dim_or = |n: usize| dim.unwrap_or(n);
-    if let Some(g) = &file.gravity {
-        if dim.is_none() {
-            errors.push(
-                Diagnostic::new(g.location, "`gravity` needs points and bodies to act on")
-                    .with_help("add `points:` and `bodies:`, or put gravity into `potential:`"),
-            );
-        } else if g.value.len() != dim_or(g.value.len()) {
-            errors.push(Diagnostic::new(
-                g.location,
-                format!(
-                    "`gravity` has {} components but the points have {}",
-                    g.value.len(),
-                    dim_or(0)
-                ),
-            ));
+        for f in &file.forces {
+            if f.vector.len() != dim {
+                self.error(Diagnostic::new(
+                    f.location,
+                    format!(
+                        "force `{}` has {} components but the points have {dim}",
+                        f.name.value,
+                        f.vector.len()
+                    ),
+                ));
+            }
         }
-    }
-    for f in &file.forces {
-        if f.vector.len() != dim_or(f.vector.len()) {
-            errors.push(Diagnostic::new(
-                f.location,
-                format!(
-                    "force `{}` has {} components but the points have {}",
-                    f.name.value,
-                    f.vector.len(),
-                    dim_or(0)
-                ),
-            ));
-        }
-    }
-
-    // Rule: every point named by a body, spring, damper, force or drawing exists; torques act
-    // on planar rigid bodies; generalized forces are keyed by coordinates; initial values by
-    // coordinates or rates.
-    let point_ref = |name: &super::located::Located<String>, errors: &mut Vec<Diagnostic>| {
-        if !points.contains(&name.value.as_str()) {
-            let d = Diagnostic::new(name.location, format!("unknown point `{}`", name.value));
-            errors.push(match closest(&name.value, &points) {
-                Some(c) => d.with_help(format!("did you mean `{c}`?")),
-                None => d.with_help(if points.is_empty() {
-                    "declare it under `points:`".to_string()
-                } else {
-                    format!("points are: {}", points.join(", "))
-                }),
-            });
-        }
-    };
-    for b in &file.bodies {
-        match &b.kind {
-            BodyKind::Particle { at, .. } => point_ref(at, &mut errors),
-            BodyKind::Rigid { com, .. } => {
-                point_ref(com, &mut errors);
-                if dim == Some(3) {
-                    errors.push(Diagnostic::new(b.name.location, format!("body `{}` is a planar rigid body in a 3-D model", b.name.value)).with_help("rigid bodies (with `inertia` and `angle`) are planar: use 2-component points, or model the body as particles"));
+        if dim == 3 {
+            for b in &file.bodies {
+                if matches!(b.kind, BodyKind::Rigid { .. }) {
+                    self.error(
+                        Diagnostic::new(
+                            b.name.location,
+                            format!("body `{}` is a planar rigid body, but the points are 3-D", b.name.value),
+                        )
+                        .with_help("rigid bodies (with `inertia` and `angle`) are planar: use 2-component points, or model the body as particles"),
+                    );
                 }
             }
         }
     }
-    for s in &file.springs {
-        for p in &s.between {
-            point_ref(p, &mut errors);
+
+    /// Reports `name` if it is not a point.
+    fn point(&mut self, name: &Located<String>) {
+        let n = name.value.as_str();
+        if self.points.contains(&n)
+            || self.incomplete.has_name(n)
+            || self.section_lost("points", self.points.is_empty())
+        {
+            return;
         }
+        let d = Diagnostic::new(name.location, format!("unknown point `{n}`"));
+        let d = match closest(n, &self.points) {
+            Some(c) => d.with_help(format!("did you mean `{c}`?")),
+            None if self.points.is_empty() => d.with_help("declare it under `points:`"),
+            None => d.with_help(format!("points are: {}", self.points.join(", "))),
+        };
+        self.error(d);
     }
-    for d in &file.dampers {
-        for p in &d.between {
-            point_ref(p, &mut errors);
+
+    // Rule: every point named by a body, spring, damper, force or drawing exists; torques
+    // act on planar rigid bodies; generalized forces are keyed by coordinates; initial
+    // values by coordinates or rates.
+    fn references(&mut self) {
+        let file = self.file;
+        for b in &file.bodies {
+            match &b.kind {
+                BodyKind::Particle { at, .. } => self.point(at),
+                BodyKind::Rigid { com, .. } => self.point(com),
+            }
         }
-    }
-    for f in &file.forces {
-        point_ref(&f.at, &mut errors);
-    }
-    for l in &file.draw.lines {
-        for p in l {
-            point_ref(p, &mut errors);
+        for s in &file.springs {
+            s.between.iter().for_each(|p| self.point(p));
         }
-    }
-    for p in &file.draw.trace {
-        point_ref(p, &mut errors);
-    }
-    for t in &file.torques {
-        match file.bodies.iter().find(|b| b.name.value == t.body.value) {
-            Some(b) if matches!(b.kind, BodyKind::Rigid { .. }) => {}
-            Some(_) => errors.push(Diagnostic::new(t.body.location, format!("torque `{}` acts on `{}`, a particle", t.name.value, t.body.value)).with_help("torques act on planar rigid bodies (with `inertia` and `angle`); apply forces to particles")),
-            None => errors.push(Diagnostic::new(t.body.location, format!("unknown body `{}`", t.body.value))),
+        for d in &file.dampers {
+            d.between.iter().for_each(|p| self.point(p));
         }
-    }
-    for (k, _) in &file.generalized_forces {
-        if !coords.contains(&k.value.as_str()) {
-            let d = Diagnostic::new(k.location, format!("`{}` is not a coordinate", k.value));
-            errors.push(match closest(&k.value, &coords) {
-                Some(c) => d.with_help(format!("did you mean `{c}`?")),
-                None => d.with_help(format!("coordinates are: {}", coords.join(", "))),
-            });
+        for f in &file.forces {
+            self.point(&f.at);
         }
-    }
-    let mut initial_seen: Vec<&str> = Vec::new();
-    for (k, _) in &file.initial {
-        if !coords.contains(&k.value.as_str()) && !rates.contains(&k.value) {
-            let mut cands: Vec<&str> = coords.clone();
-            cands.extend(rates.iter().map(String::as_str));
+        for l in &file.draw.lines {
+            l.iter().for_each(|p| self.point(p));
+        }
+        for p in &file.draw.trace {
+            self.point(p);
+        }
+        for t in &file.torques {
+            let name = &t.body.value;
+            match file.bodies.iter().find(|b| b.name.value == *name) {
+                Some(b) if matches!(b.kind, BodyKind::Rigid { .. }) => {}
+                Some(_) => self.error(
+                    Diagnostic::new(
+                        t.body.location,
+                        format!("torque `{}` acts on `{name}`, which is a particle", t.name.value),
+                    )
+                    .with_help("torques act on planar rigid bodies (with `inertia` and `angle`); apply a force to a particle"),
+                ),
+                None if self.incomplete.has_name(name)
+                    || self.section_lost("bodies", file.bodies.is_empty()) => {}
+                None => {
+                    let d = Diagnostic::new(t.body.location, format!("unknown body `{name}`"));
+                    let d = match closest(name, &self.bodies) {
+                        Some(c) => d.with_help(format!("did you mean `{c}`?")),
+                        None => d.with_help("declare it under `bodies:` as a planar rigid body"),
+                    };
+                    self.error(d);
+                }
+            }
+        }
+        let coordinates_lost = self.section_lost("coordinates", self.coords.is_empty());
+        for (k, _) in &file.generalized_forces {
+            let n = k.value.as_str();
+            if self.coords.contains(&n) || self.incomplete.has_name(n) || coordinates_lost {
+                continue;
+            }
             let d = Diagnostic::new(
                 k.location,
-                format!("`{}` is neither a coordinate nor a rate", k.value),
+                format!("`{n}` in `generalized_forces` is not a coordinate"),
             );
-            errors.push(match closest(&k.value, &cands) {
+            let d = match closest(n, &self.coords) {
+                Some(c) => d.with_help(format!("did you mean `{c}`?")),
+                None => d.with_help(format!("coordinates are: {}", self.coords.join(", "))),
+            };
+            self.error(d);
+        }
+        for (k, _) in &file.initial {
+            let n = k.value.as_str();
+            let base = n.strip_suffix("_dot").unwrap_or(n);
+            if self.coords.contains(&n)
+                || self.rates.iter().any(|r| r == n)
+                || self.incomplete.has_name(base)
+                || coordinates_lost
+            {
+                continue;
+            }
+            let mut candidates: Vec<&str> = self.coords.clone();
+            candidates.extend(self.rates.iter().map(String::as_str));
+            let d = Diagnostic::new(
+                k.location,
+                format!("`{n}` in `initial` is neither a coordinate nor a rate"),
+            );
+            let d = match closest(n, &candidates) {
                 Some(c) => d.with_help(format!("did you mean `{c}`?")),
                 None => d.with_help(format!(
                     "initial values are given for: {}",
-                    cands.join(", ")
+                    candidates.join(", ")
                 )),
-            });
-        } else if initial_seen.contains(&k.value.as_str()) {
-            errors.push(Diagnostic::new(
-                k.location,
-                format!("`{}` is given twice", k.value),
-            ));
+            };
+            self.error(d);
         }
-        initial_seen.push(k.value.as_str());
     }
 
-    // Rule: masses are positive and inertias non-negative at the default parameters.
-    let value = |e: &Expr| {
-        eval_expr(e, &|n| {
-            file.parameters
-                .iter()
-                .find(|p| p.name.value == n)
-                .map(|p| p.value)
-        })
-        .ok()
-    };
-    for b in &file.bodies {
-        let (mass, inertia) = match &b.kind {
-            BodyKind::Particle { mass, .. } => (mass, None),
-            BodyKind::Rigid { mass, inertia, .. } => (mass, Some(inertia)),
-        };
-        if let Some(m) = value(mass) {
-            if !(m > 0.0) {
-                errors.push(
+    // Rule: a body's mass is positive and its inertia non-negative, when they are constant
+    // expressions of the parameters (evaluated at the defaults).
+    fn masses(&mut self) {
+        let file = self.file;
+        for b in &file.bodies {
+            let (mass, inertia) = match &b.kind {
+                BodyKind::Particle { mass, .. } => (mass, None),
+                BodyKind::Rigid { mass, inertia, .. } => (mass, Some(inertia)),
+            };
+            if let Some(m) = evaluate(mass, &file.parameters)
+                && (m.is_nan() || m <= 0.0)
+            {
+                self.error(
                     Diagnostic::new(
                         mass.location,
-                        format!("body `{}` has non-positive mass `{m}` (kg)", b.name.value),
+                        format!("body `{}` has non-positive mass `{m:?}` (kg)", b.name.value),
                     )
-                    .with_help("masses must be positive"),
+                    .with_help("a mass must be positive (at the parameters' defaults)"),
                 );
             }
-        }
-        if let Some(i) = inertia.and_then(|i| value(i).map(|v| (i, v))) {
-            if !(i.1 >= 0.0) {
-                errors.push(
+            if let Some(inertia) = inertia
+                && let Some(i) = evaluate(inertia, &file.parameters)
+                && (i.is_nan() || i < 0.0)
+            {
+                self.error(
                     Diagnostic::new(
-                        i.0.location,
+                        inertia.location,
                         format!(
-                            "body `{}` has negative inertia `{}` (kg m^2)",
-                            b.name.value, i.1
+                            "body `{}` has negative inertia `{i:?}` (kg·m²)",
+                            b.name.value
                         ),
                     )
-                    .with_help("a centroidal moment of inertia is ≥ 0"),
+                    .with_help(
+                        "a centroidal moment of inertia is ≥ 0 (at the parameters' defaults)",
+                    ),
                 );
             }
         }
     }
+}
 
-    if errors.is_empty() {
-        Ok(())
-    } else {
-        Err(errors)
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::{schema, yaml};
+
+    fn errors(src: &str) -> Vec<String> {
+        let root = yaml::parse(src).unwrap();
+        let file = schema::build("t.yaml", src, &root).unwrap();
+        match check(&file) {
+            Ok(()) => Vec::new(),
+            Err(d) => d
+                .iter()
+                .map(|d| format!("{}: {}", d.location, d.message))
+                .collect(),
+        }
+    }
+
+    const HEAD: &str = "name: a\nparameters: { m: 1, l: 2 }\ncoordinates: [q]\n";
+
+    #[test]
+    fn a_valid_model_passes() {
+        let src = format!(
+            "{HEAD}points: {{ O: [0, 0], P: [l*sin(q), -l*cos(q)] }}\nbodies: {{ bob: {{ mass: m, at: P }} }}\ngravity: [0, -9.81]\ninitial: {{ q: pi/4, q_dot: 0 }}\n"
+        );
+        assert_eq!(errors(&src), Vec::<String>::new());
+    }
+
+    #[test]
+    fn dependencies_are_enforced() {
+        let src = format!(
+            "{HEAD}kinetic: m*q_dot^2/2 + q_ddot\npotential: q_dot\ninitial: {{ q: l*q }}\n"
+        );
+        assert_eq!(
+            errors(&src),
+            [
+                "4:24: accelerations such as `q_ddot` cannot appear in a model file",
+                "5:12: `potential` cannot depend on the rate `q_dot`",
+                "6:17: the initial value of `q` must be constant, but it uses the coordinate `q`",
+            ]
+        );
+    }
+
+    #[test]
+    fn reserved_and_duplicate_names() {
+        let src = "name: a\nparameters: { t: 1, q: 2, sin: 3, x_dot: 4 }\ncoordinates: [q]\nkinetic: q_dot^2\n";
+        assert_eq!(
+            errors(src),
+            [
+                "2:15: parameter name `t` is reserved: `t` is time",
+                "2:27: parameter name `sin` is reserved: `sin` is a function",
+                "2:35: parameter name `x_dot` ends in `_dot` or `_ddot`, which spell rates",
+                "3:15: duplicate name `q`: already a parameter at 2:21",
+            ]
+        );
+    }
+
+    #[test]
+    fn the_evaluator_uses_parameter_defaults() {
+        let src = "name: a\nparameters: { m: 2, l: 3 }\ncoordinates: [q]\nkinetic: q_dot^2\n";
+        let root = yaml::parse(src).unwrap();
+        let file = schema::build("t.yaml", src, &root).unwrap();
+        let e =
+            crate::model::parser::parse_expr("m*l^2/12 + cos(pi)", Location::default()).unwrap();
+        assert_eq!(evaluate(&e, &file.parameters), Some(2.0 * 9.0 / 12.0 - 1.0));
+        let e = crate::model::parser::parse_expr("m*q", Location::default()).unwrap();
+        assert_eq!(evaluate(&e, &file.parameters), None);
+    }
+
+    #[test]
+    fn masses_and_inertias() {
+        let src = format!(
+            "{HEAD}points: {{ P: [q, 0] }}\nbodies:\n  a: {{ mass: m - 1, at: P }}\n  b: {{ mass: m, inertia: -l, com: P, angle: q }}\n"
+        );
+        assert_eq!(
+            errors(&src),
+            [
+                "6:14: body `a` has non-positive mass `0.0` (kg)",
+                "7:26: body `b` has negative inertia `-2.0` (kg·m²)",
+            ]
+        );
     }
 }

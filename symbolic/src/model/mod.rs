@@ -20,18 +20,27 @@ pub use located::{Located, Location};
 
 /// Reads a model file: YAML → typed model → checks, reporting every problem at once.
 ///
-/// `path` is used only in messages (as the user wrote it).
+/// `path` is used only in messages (as the user wrote it). The schema pass and the
+/// cross-object checks both run even when the other finds problems; entries the schema pass
+/// had to leave out are not reported again by the checks.
 ///
 /// # Errors
-/// All diagnostics of the file sorted by location. A YAML syntax error stops early (there is
-/// no tree to check); schema errors are reported before the cross-object checks run.
+/// All diagnostics of the file, sorted by location. A YAML syntax error stops early (there
+/// is no tree to check).
 pub fn load(path: &str, source: &str) -> Result<ModelFile, Vec<Diagnostic>> {
-    let sort = |mut d: Vec<Diagnostic>| {
-        d.sort_by_key(|x| x.location);
-        d
-    };
-    let root = yaml::parse(source).map_err(sort)?;
-    let file = schema::build(path, source, &root).map_err(sort)?;
-    check::check(&file).map_err(sort)?;
-    Ok(file)
+    let (root, mut diagnostics) = yaml::parse_partial(source);
+    if let Some(root) = root {
+        let built = schema::build_partial(path, source, &root);
+        diagnostics.extend(built.diagnostics);
+        if let Some(file) = built.file {
+            if let Err(more) = check::check_partial(&file, &built.incomplete) {
+                diagnostics.extend(more);
+            }
+            if diagnostics.is_empty() {
+                return Ok(file);
+            }
+        }
+    }
+    diagnostics.sort_by_key(|d| d.location);
+    Err(diagnostics)
 }

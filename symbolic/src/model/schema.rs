@@ -1,12 +1,16 @@
 //! Located YAML tree → typed [`ModelFile`], reporting every unknown key, wrong type and
 //! malformed expression at once.
+//!
+//! The pass never stops at the first problem: an entry that cannot be built is reported and
+//! left out, and what was left out is recorded in [`Incomplete`] so that the cross-object
+//! checks ([`super::check`]) do not report its consequences a second time.
 
 use super::ast::Expr;
-use super::diagnostic::Diagnostic;
+use super::diagnostic::{Diagnostic, Diagnostics};
 use super::file::*;
 use super::located::{Located, Location};
-use super::parser::{closest, eval_expr, parse_expr};
-use super::yaml::{YamlKind, YamlNode, trailing_comment};
+use super::parser::{closest, eval_expr, identifiers, parse_expr_mapped};
+use super::yaml::{YamlKind, YamlNode, char_locations, trailing_comment};
 
 type Entries = [(Located<String>, YamlNode)];
 
@@ -30,7 +34,7 @@ pub const TOP_LEVEL_KEYS: &[&str] = &[
     "draw",
 ];
 
-/// Keys of the model format that this version does not implement yet.
+/// Keys of the model format (DESIGN.md) that this version does not implement yet.
 pub const LATER_KEYS: &[&str] = &[
     "constraints",
     "nonholonomic",
@@ -41,49 +45,266 @@ pub const LATER_KEYS: &[&str] = &[
     "checks",
 ];
 
+const BODY_KEYS: &[&str] = &["mass", "at", "inertia", "com", "angle"];
+const PARTICLE_EXAMPLE: &str = "{ mass: m, at: P }";
+const RIGID_EXAMPLE: &str = "{ mass: m, inertia: m*l^2/12, com: G, angle: theta }";
+
+/// What the schema pass built from a file, and what it had to leave out.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Built {
+    /// The typed model without the entries that had errors; `None` when the file is not a
+    /// map of `key: value` at all.
+    pub file: Option<ModelFile>,
+    /// What was left out of `file` because of a reported error.
+    pub incomplete: Incomplete,
+    /// Every problem found, sorted by location.
+    pub diagnostics: Vec<Diagnostic>,
+}
+
+/// Parts of a model that the schema pass left out because of an error it already reported.
+///
+/// The cross-object checks treat them as present, so that one mistake gives one message
+/// (a point with a malformed position is not also an "unknown point" for the body at it).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Incomplete {
+    /// Names of parameters, coordinates, points and bodies whose entries were left out.
+    pub names: Vec<String>,
+    /// Top-level keys with at least one reported error (including required keys that are
+    /// missing).
+    pub sections: Vec<String>,
+}
+
+impl Incomplete {
+    /// Whether the entry called `name` was left out.
+    pub fn has_name(&self, name: &str) -> bool {
+        self.names.iter().any(|n| n == name)
+    }
+
+    /// Whether the top-level key `section` had an error.
+    pub fn has_section(&self, section: &str) -> bool {
+        self.sections.iter().any(|s| s == section)
+    }
+}
+
+/// Builds the typed model from the YAML tree of `path`.
+///
+/// # Errors
+/// Every schema diagnostic of the file, sorted by location.
+pub fn build(path: &str, source: &str, root: &YamlNode) -> Result<ModelFile, Vec<Diagnostic>> {
+    let built = build_partial(path, source, root);
+    match built.file {
+        Some(file) if built.diagnostics.is_empty() => Ok(file),
+        _ => Err(built.diagnostics),
+    }
+}
+
+/// Builds as much of the typed model as the YAML tree allows, with every diagnostic and a
+/// record of what was left out (see [`Built`]).
+pub fn build_partial(path: &str, source: &str, root: &YamlNode) -> Built {
+    let mut cx = Ctx {
+        source,
+        diagnostics: Diagnostics::new(),
+        incomplete: Incomplete::default(),
+        section: "",
+    };
+    let file = cx.model(path, root);
+    let diagnostics = cx.diagnostics.finish().err().unwrap_or_default();
+    Built {
+        file,
+        incomplete: cx.incomplete,
+        diagnostics,
+    }
+}
+
+/// Whether `s` is a model-file name: a letter, then letters, digits and `_`.
+pub fn is_identifier(s: &str) -> bool {
+    let mut c = s.chars();
+    c.next().is_some_and(|f| f.is_ascii_alphabetic())
+        && c.all(|x| x.is_ascii_alphanumeric() || x == '_')
+}
+
+/// Whether `s` is a snake_case identifier: a lowercase letter, then lowercase letters,
+/// digits and `_`.
+pub fn is_snake_case(s: &str) -> bool {
+    let mut c = s.chars();
+    c.next().is_some_and(|f| f.is_ascii_lowercase())
+        && c.all(|x| x.is_ascii_lowercase() || x.is_ascii_digit() || x == '_')
+}
+
+/// A snake_case spelling of `s` for suggestions (`DoublePendulum` → `double_pendulum`).
+fn to_snake_case(s: &str) -> String {
+    let mut out = String::new();
+    let mut previous_lower = false;
+    for c in s.chars() {
+        if c.is_ascii_uppercase() {
+            if previous_lower {
+                out.push('_');
+            }
+            out.push(c.to_ascii_lowercase());
+            previous_lower = false;
+        } else if c.is_ascii_alphanumeric() {
+            out.push(c);
+            previous_lower = true;
+        } else {
+            out.push('_');
+            previous_lower = false;
+        }
+    }
+    let mut collapsed = String::new();
+    for c in out.chars() {
+        if !(c == '_' && collapsed.ends_with('_')) {
+            collapsed.push(c);
+        }
+    }
+    let trimmed = collapsed.trim_matches('_');
+    if trimmed.starts_with(|c: char| c.is_ascii_lowercase()) {
+        trimmed.to_string()
+    } else {
+        format!("model_{trimmed}").trim_end_matches('_').to_string()
+    }
+}
+
+fn get<'n>(entries: &'n Entries, key: &str) -> Option<&'n YamlNode> {
+    entries.iter().find(|(k, _)| k.value == key).map(|(_, v)| v)
+}
+
+/// Whether `entries` has a key that is a misspelling of the missing key `key`: it is then
+/// reported once, as an unknown key with "did you mean `key`?", not also as missing.
+fn misspelt(entries: &Entries, key: &str) -> bool {
+    entries
+        .iter()
+        .any(|(k, _)| k.value != key && closest(&k.value, &[key]).is_some())
+}
+
+fn get_key<'n>(entries: &'n Entries, key: &str) -> Option<&'n Located<String>> {
+    entries.iter().find(|(k, _)| k.value == key).map(|(k, _)| k)
+}
+
+/// The keys present, for messages: `` `inertia`, `com` ``.
+fn listed(entries: &Entries) -> String {
+    if entries.is_empty() {
+        return "nothing".to_string();
+    }
+    entries
+        .iter()
+        .map(|(k, _)| format!("`{}`", k.value))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// More `(` than `)`: an expression that may have been cut at a `,`.
+fn opens_more_than_it_closes(text: &str) -> bool {
+    text.matches('(').count() > text.matches(')').count()
+}
+
+/// Whether `text` closes a `(` it did not open: the rest of a cut expression.
+fn closes_first(text: &str) -> bool {
+    let mut depth = 0usize;
+    for c in text.chars() {
+        match c {
+            '(' => depth += 1,
+            ')' if depth == 0 => return true,
+            ')' => depth -= 1,
+            _ => {}
+        }
+    }
+    false
+}
+
+/// Whether the source after `end` is `, …)`: YAML ended a value at a `,` of a flow collection
+/// (`{ angle: atan2(y, x) }`) and the rest of the expression follows.
+fn cut_in_source(source: &str, end: Location) -> bool {
+    let Some(line) = source.lines().nth(end.line.saturating_sub(1) as usize) else {
+        return false;
+    };
+    let byte = line
+        .char_indices()
+        .nth(end.column.saturating_sub(1) as usize)
+        .map_or(line.len(), |(i, _)| i);
+    let offset = source
+        .lines()
+        .take(end.line.saturating_sub(1) as usize)
+        .map(|l| l.len() + 1)
+        .sum::<usize>()
+        + byte;
+    let Some(rest) = source.get(offset..) else {
+        return false;
+    };
+    let Some(after) = rest.trim_start().strip_prefix(',') else {
+        return false;
+    };
+    let piece: String = after
+        .chars()
+        .take_while(|c| !matches!(c, ',' | ']' | '}'))
+        .collect();
+    closes_first(&piece)
+}
+
 struct Ctx<'s> {
     source: &'s str,
-    errors: Vec<Diagnostic>,
+    diagnostics: Diagnostics,
+    incomplete: Incomplete,
+    /// The top-level key being read; every error marks it incomplete.
+    section: &'static str,
 }
 
 impl Ctx<'_> {
     fn error(&mut self, d: Diagnostic) {
-        self.errors.push(d);
+        self.diagnostics.push(d);
+        if !self.section.is_empty() && !self.incomplete.has_section(self.section) {
+            self.incomplete.sections.push(self.section.to_string());
+        }
     }
 
-    /// Checks that `entries` use only `allowed` keys and have every `required` one.
-    fn keys(
+    fn drop_name(&mut self, name: &str) {
+        if !self.incomplete.has_name(name) {
+            self.incomplete.names.push(name.to_string());
+        }
+    }
+
+    /// Reports every key of `entries` that is not in `allowed`.
+    fn unknown_keys(&mut self, entries: &Entries, what: &str, allowed: &[&str], listed: &[&str]) {
+        for (k, _) in entries {
+            if allowed.contains(&k.value.as_str()) {
+                continue;
+            }
+            let d = Diagnostic::new(k.location, format!("unknown key `{}` in {what}", k.value));
+            let d = match closest(&k.value, allowed) {
+                Some(c) => d.with_help(format!(
+                    "did you mean `{c}`? {what} takes: {}",
+                    listed.join(", ")
+                )),
+                None => d.with_help(format!("{what} takes: {}", listed.join(", "))),
+            };
+            self.error(d);
+        }
+    }
+
+    /// Reports every key of `required` missing from `entries`; `Ok` when none is missing.
+    fn require(
         &mut self,
         entries: &Entries,
         at: Location,
         what: &str,
-        allowed: &[&str],
         required: &[&str],
-    ) {
-        for (k, _) in entries {
-            if !allowed.contains(&k.value.as_str()) {
-                let mut d =
-                    Diagnostic::new(k.location, format!("unknown key `{}` in {what}", k.value));
-                d = match closest(&k.value, allowed) {
-                    Some(c) => d.with_help(format!(
-                        "did you mean `{c}`? {what} takes: {}",
-                        allowed.join(", ")
-                    )),
-                    None => d.with_help(format!("{what} takes: {}", allowed.join(", "))),
-                };
-                self.error(d);
-            }
-        }
+        example: &str,
+    ) -> bool {
+        let mut complete = true;
         for r in required {
-            if !entries.iter().any(|(k, _)| k.value == *r) {
+            if get(entries, r).is_none() {
+                complete = false;
+                if misspelt(entries, r) {
+                    continue;
+                }
                 self.error(
                     Diagnostic::new(at, format!("{what} has no `{r}`")).with_help(format!(
-                        "add `{r}: …`; {what} takes: {}",
-                        allowed.join(", ")
+                        "found {}; write it like `{example}`",
+                        listed(entries)
                     )),
                 );
             }
         }
+        complete
     }
 
     fn map<'n>(&mut self, node: &'n YamlNode, what: &str, example: &str) -> Option<&'n Entries> {
@@ -119,65 +340,166 @@ impl Ctx<'_> {
         }
     }
 
-    fn text(&mut self, node: &YamlNode, what: &str) -> Option<Located<String>> {
+    fn text(&mut self, node: &YamlNode, what: &str, example: &str) -> Option<Located<String>> {
         match &node.kind {
             YamlKind::Scalar { text, .. } => Some(Located::new(text.clone(), node.location)),
-            other => {
-                self.error(Diagnostic::new(
-                    node.location,
-                    format!("{what} must be a single value, found {}", other.describe()),
-                ));
-                None
-            }
-        }
-    }
-
-    fn name(&mut self, node: &YamlNode, what: &str) -> Option<Located<String>> {
-        let t = self.text(node, what)?;
-        if !is_identifier(&t.value) {
-            self.error(
-                Diagnostic::new(t.location, format!("{what} `{}` is not a name", t.value))
-                    .with_help("names start with a letter and contain letters, digits and `_`"),
-            );
-            return None;
-        }
-        Some(t)
-    }
-
-    fn expr(&mut self, node: &YamlNode, what: &str) -> Option<Expr> {
-        match &node.kind {
-            YamlKind::Scalar { text, .. } => match parse_expr(text, node.location) {
-                Ok(e) => Some(e),
-                Err(d) => {
-                    self.error(d);
-                    None
-                }
-            },
             other => {
                 self.error(
                     Diagnostic::new(
                         node.location,
-                        format!("{what} must be an expression, found {}", other.describe()),
+                        format!("{what} must be text, found {}", other.describe()),
                     )
-                    .with_help("write a number or an expression such as `m*g*l`"),
+                    .with_help(format!("write it like `{example}`")),
                 );
                 None
             }
         }
     }
 
-    fn vector(&mut self, node: &YamlNode, what: &str) -> Option<Vec<Expr>> {
-        let items = self.seq(node, what, "[x, y] or [x, y, z]")?;
+    /// A name (identifier) written as a value, such as the point of `at: P`.
+    fn name(&mut self, node: &YamlNode, what: &str) -> Option<Located<String>> {
+        let t = match &node.kind {
+            YamlKind::Scalar { text, .. } => Located::new(text.trim().to_string(), node.location),
+            other => {
+                self.error(
+                    Diagnostic::new(
+                        node.location,
+                        format!("{what} must be a name, found {}", other.describe()),
+                    )
+                    .with_help("a name starts with a letter and contains letters, digits and `_`"),
+                );
+                return None;
+            }
+        };
+        if !is_identifier(&t.value) {
+            self.error(
+                Diagnostic::new(t.location, format!("{what} `{}` is not a name", t.value))
+                    .with_help("a name starts with a letter and contains letters, digits and `_`"),
+            );
+            return None;
+        }
+        Some(t)
+    }
+
+    /// A name written as a key, such as a point's in `points: { P: … }`.
+    fn key_name(&mut self, key: &Located<String>, what: &str) -> bool {
+        if is_identifier(&key.value) {
+            return true;
+        }
+        self.error(
+            Diagnostic::new(
+                key.location,
+                format!("{what} `{}` is not a name", key.value),
+            )
+            .with_help("a name starts with a letter and contains letters, digits and `_`"),
+        );
+        false
+    }
+
+    /// An expression written as a scalar; its locations are exact even across lines.
+    fn expr(&mut self, node: &YamlNode, what: &str) -> Option<Expr> {
+        let text = match &node.kind {
+            YamlKind::Scalar { text, .. } => text,
+            other => {
+                self.error(
+                    Diagnostic::new(
+                        node.location,
+                        format!("{what} must be an expression, found {}", other.describe()),
+                    )
+                    .with_help("write a number or an expression such as `m*g*l*cos(theta)`"),
+                );
+                return None;
+            }
+        };
+        let start = node.location;
+        let locations = char_locations(self.source, start, text);
+        let locate = |i: usize| match &locations {
+            Some(l) => l.get(i).or(l.last()).copied().unwrap_or(start),
+            None => start.offset(i),
+        };
+        match parse_expr_mapped(text, &locate) {
+            Ok(e) => Some(e),
+            Err(d) => {
+                let end = locate(text.chars().count());
+                let cut = opens_more_than_it_closes(text)
+                    && !matches!(node.kind, YamlKind::Scalar { quoted: true, .. })
+                    && cut_in_source(self.source, end);
+                let d = if cut {
+                    d.with_help(
+                        "inside `[…]` or `{…}`, YAML splits values at every `,`: quote an expression that contains a `,`, as in `\"atan2(y, x)\"`",
+                    )
+                } else {
+                    d
+                };
+                self.error(d);
+                None
+            }
+        }
+    }
+
+    /// A list of 2 or 3 expressions.
+    fn vector(&mut self, node: &YamlNode, what: &str, example: &str) -> Option<Vec<Expr>> {
+        let items = match &node.kind {
+            YamlKind::Seq(items) => items,
+            other => {
+                self.error(
+                    Diagnostic::new(
+                        node.location,
+                        format!(
+                            "{what} must be a list of 2 or 3 expressions, found {}",
+                            other.describe()
+                        ),
+                    )
+                    .with_help(format!("write it like `{example}`")),
+                );
+                return None;
+            }
+        };
+        // `[atan2(y, x), 0]` reaches us as `atan2(y`, `x)`, `0`: say so rather than count.
+        let cut = items
+            .iter()
+            .enumerate()
+            .find(|(i, item)| {
+                let unquoted = |n: &YamlNode| match &n.kind {
+                    YamlKind::Scalar {
+                        text,
+                        quoted: false,
+                    } => Some(text.clone()),
+                    _ => None,
+                };
+                unquoted(item).is_some_and(|t| opens_more_than_it_closes(&t))
+                    && items
+                        .get(i + 1)
+                        .and_then(unquoted)
+                        .is_some_and(|t| closes_first(&t))
+            })
+            .map(|(_, item)| item);
+        if let Some(item) = cut {
+            self.error(
+                Diagnostic::new(
+                    item.location,
+                    format!(
+                        "{what}: {} is cut at a `,`",
+                        item.kind.describe()
+                    ),
+                )
+                .with_help(
+                    "inside `[…]`, YAML splits values at every `,`: quote a component that contains a `,`, as in `\"atan2(y, x)\"`",
+                ),
+            );
+            return None;
+        }
         if !(2..=3).contains(&items.len()) {
             self.error(
                 Diagnostic::new(
                     node.location,
                     format!(
-                        "{what} has {} components; expected 2 (planar) or 3 (spatial)",
-                        items.len()
+                        "{what} has {} component{}; expected 2 (planar) or 3 (spatial)",
+                        items.len(),
+                        if items.len() == 1 { "" } else { "s" }
                     ),
                 )
-                .with_help("write it like `[l*cos(q), l*sin(q)]`"),
+                .with_help(format!("write it like `{example}`")),
             );
             return None;
         }
@@ -185,6 +507,7 @@ impl Ctx<'_> {
         out.into_iter().collect()
     }
 
+    /// `[A, B]`: two point names.
     fn point_pair(&mut self, node: &YamlNode, what: &str) -> Option<[Located<String>; 2]> {
         let items = self.seq(node, what, "[A, B]")?;
         if items.len() != 2 {
@@ -197,385 +520,170 @@ impl Ctx<'_> {
             );
             return None;
         }
-        let a = self.name(&items[0], "a point")?;
-        let b = self.name(&items[1], "a point")?;
-        Some([a, b])
+        let a = self.name(&items[0], "a point");
+        let b = self.name(&items[1], "a point");
+        Some([a?, b?])
     }
-}
 
-/// Whether `s` is a model-file name: a letter, then letters, digits and `_`.
-pub fn is_identifier(s: &str) -> bool {
-    let mut c = s.chars();
-    c.next().is_some_and(|f| f.is_ascii_alphabetic())
-        && c.all(|x| x.is_ascii_alphanumeric() || x == '_')
-}
-
-fn get<'n>(entries: &'n Entries, key: &str) -> Option<&'n YamlNode> {
-    entries.iter().find(|(k, _)| k.value == key).map(|(_, v)| v)
-}
-
-/// Builds the typed model from the YAML tree of `path`.
-///
-/// # Errors
-/// Every schema diagnostic of the file.
-pub fn build(path: &str, source: &str, root: &YamlNode) -> Result<ModelFile, Vec<Diagnostic>> {
-    let mut cx = Ctx {
-        source,
-        errors: Vec::new(),
-    };
-    let Some(top) = cx.map(root, "a model file", "name: my_model") else {
-        return Err(cx.errors);
-    };
-    for (k, _) in top {
-        if LATER_KEYS.contains(&k.value.as_str()) {
-            cx.error(
+    fn model(&mut self, path: &str, root: &YamlNode) -> Option<ModelFile> {
+        let YamlKind::Map(top) = &root.kind else {
+            self.error(
                 Diagnostic::new(
-                    k.location,
+                    root.location,
                     format!(
-                        "`{}:` is not supported yet by this version of eomgen",
-                        k.value
+                        "a model file must be a map of `key: value`, found {}",
+                        root.kind.describe()
                     ),
                 )
-                .with_help("remove it for now; it is planned"),
+                .with_help("start with `name: my_model` and `coordinates: [q]`"),
             );
-        }
-    }
-    let allowed: Vec<&str> = TOP_LEVEL_KEYS.iter().chain(LATER_KEYS).copied().collect();
-    cx.keys(
-        top,
-        root.location,
-        "a model file",
-        &allowed,
-        &["name", "coordinates"],
-    );
+            return None;
+        };
 
-    let name = get(top, "name")
-        .and_then(|n| cx.name(n, "`name`"))
-        .unwrap_or_else(|| Located::new(String::new(), root.location));
-    let description = get(top, "description")
-        .and_then(|n| cx.text(n, "`description`"))
-        .map(|d| d.value)
-        .unwrap_or_default();
-
-    let mut parameters = Vec::new();
-    if let Some(node) = get(top, "parameters") {
-        if let Some(entries) = cx.map(node, "`parameters`", "parameters: { m: 1.0, g: 9.81 }") {
-            for (k, v) in entries {
-                if !is_identifier(&k.value) {
-                    cx.error(Diagnostic::new(
+        // Rule: keys planned for later versions are recognised and reported once each.
+        for (k, _) in top {
+            if LATER_KEYS.contains(&k.value.as_str()) {
+                self.error(
+                    Diagnostic::new(
                         k.location,
-                        format!("parameter `{}` is not a name", k.value),
-                    ));
-                    continue;
-                }
-                let Some(default) = cx.expr(v, "a parameter default") else {
-                    continue;
-                };
-                match eval_expr(&default, &|_| None) {
-                    Ok(value) if value.is_finite() => parameters.push(Parameter {
-                        name: k.clone(),
-                        default,
-                        value,
-                        unit: trailing_comment(cx.source, v.location.line)
-                            .filter(|_| v.location.line == k.location.line),
-                    }),
-                    Ok(value) => cx.error(Diagnostic::new(
-                        v.location,
                         format!(
-                            "parameter `{}` has the non-finite default `{value}`",
+                            "`{}:` is not supported yet by this version of eomgen",
                             k.value
                         ),
-                    )),
-                    Err(d) => cx.error(
-                        Diagnostic::new(
-                            d.location,
-                            format!("parameter defaults must be constant: {}", d.message),
-                        )
-                        .with_help("use numbers, `pi` and functions, e.g. `pi/4` or `9.81`"),
+                    )
+                    .with_help("it is planned; remove it for now"),
+                );
+            }
+        }
+        let allowed: Vec<&str> = TOP_LEVEL_KEYS.iter().chain(LATER_KEYS).copied().collect();
+        self.unknown_keys(top, "a model file", &allowed, TOP_LEVEL_KEYS);
+
+        self.section = "name";
+        let name = match get(top, "name") {
+            None if misspelt(top, "name") => None,
+            None => {
+                self.error(
+                    Diagnostic::new(root.location, "the model file has no `name`").with_help(
+                        "add `name: my_model` (snake_case; the generated struct is `MyModel`)",
                     ),
-                }
+                );
+                None
             }
-        }
-    }
-
-    let mut coordinates = Vec::new();
-    if let Some(node) = get(top, "coordinates") {
-        if let Some(items) = cx.seq(node, "`coordinates`", "coordinates: [theta1, theta2]") {
-            for item in items {
-                if let Some(n) = cx.name(item, "a coordinate") {
-                    // A trailing comment describes the coordinate only if it is alone on its line.
-                    let alone = items
-                        .iter()
-                        .filter(|o| o.location.line == item.location.line)
-                        .count()
-                        == 1;
-                    let comment = if alone {
-                        trailing_comment(cx.source, n.location.line)
-                    } else {
-                        None
-                    };
-                    coordinates.push(Coordinate { name: n, comment });
-                }
-            }
-        }
-    }
-
-    let kinetic = get(top, "kinetic").and_then(|n| cx.expr(n, "`kinetic`"));
-    let potential = get(top, "potential").and_then(|n| cx.expr(n, "`potential`"));
-    let mut generalized_forces = Vec::new();
-    if let Some(node) = get(top, "generalized_forces") {
-        if let Some(entries) = cx.map(
-            node,
-            "`generalized_forces`",
-            "generalized_forces: { x: -c*x_dot }",
-        ) {
-            for (k, v) in entries {
-                if let Some(e) = cx.expr(v, "a generalized force") {
-                    generalized_forces.push((k.clone(), e));
-                }
-            }
-        }
-    }
-
-    let mut points = Vec::new();
-    if let Some(node) = get(top, "points") {
-        if let Some(entries) = cx.map(node, "`points`", "points: { P: [l*cos(q), l*sin(q)] }") {
-            for (k, v) in entries {
-                if let Some(position) = cx.vector(v, &format!("point `{}`", k.value)) {
-                    points.push(Point {
-                        name: k.clone(),
-                        position,
-                        location: v.location,
-                    });
-                }
-            }
-        }
-    }
-
-    let mut bodies = Vec::new();
-    if let Some(node) = get(top, "bodies") {
-        if let Some(entries) = cx.map(node, "`bodies`", "bodies: { bob: { mass: m, at: P } }") {
-            for (k, v) in entries {
-                let what = format!("body `{}`", k.value);
-                let Some(f) = cx.map(
-                    v,
-                    &what,
-                    "{ mass: m, at: P } or { mass: m, inertia: m*l^2/12, com: G, angle: theta }",
-                ) else {
-                    continue;
-                };
-                let rigid = get(f, "inertia").is_some()
-                    || get(f, "com").is_some()
-                    || get(f, "angle").is_some();
-                if rigid {
-                    cx.keys(
-                        f,
-                        v.location,
-                        &format!("{what} (a planar rigid body)"),
-                        &["mass", "inertia", "com", "angle"],
-                        &["mass", "inertia", "com", "angle"],
-                    );
-                    let mass = get(f, "mass").and_then(|n| cx.expr(n, "`mass`"));
-                    let inertia = get(f, "inertia").and_then(|n| cx.expr(n, "`inertia`"));
-                    let com = get(f, "com").and_then(|n| cx.name(n, "`com`"));
-                    let angle = get(f, "angle").and_then(|n| cx.expr(n, "`angle`"));
-                    if let (Some(mass), Some(inertia), Some(com), Some(angle)) =
-                        (mass, inertia, com, angle)
-                    {
-                        bodies.push(Body {
-                            name: k.clone(),
-                            kind: BodyKind::Rigid {
-                                mass,
-                                inertia,
-                                com,
-                                angle,
-                            },
-                        });
-                    }
+            Some(n) => self.name(n, "`name`").and_then(|n| {
+                if is_snake_case(&n.value) {
+                    Some(n)
                 } else {
-                    cx.keys(
-                        f,
-                        v.location,
-                        &format!("{what} (a particle)"),
-                        &["mass", "at", "inertia", "com", "angle"],
-                        &["mass", "at"],
-                    );
-                    let mass = get(f, "mass").and_then(|n| cx.expr(n, "`mass`"));
-                    let at = get(f, "at").and_then(|n| cx.name(n, "`at`"));
-                    if let (Some(mass), Some(at)) = (mass, at) {
-                        bodies.push(Body {
-                            name: k.clone(),
-                            kind: BodyKind::Particle { mass, at },
-                        });
-                    }
+                    let d = Diagnostic::new(
+                        n.location,
+                        format!("`name` must be snake_case, found `{}`", n.value),
+                    )
+                    .with_help(format!(
+                        "write `name: {}`; the generated struct takes its UpperCamelCase form",
+                        to_snake_case(&n.value)
+                    ));
+                    self.error(d);
+                    None
                 }
-            }
+            }),
         }
-    }
+        .unwrap_or_else(|| Located::new(String::new(), root.location));
 
-    let gravity = get(top, "gravity").and_then(|n| {
-        cx.vector(n, "`gravity`")
-            .map(|g| Located::new(g, n.location))
-    });
+        self.section = "description";
+        let description = match get(top, "description") {
+            None => String::new(),
+            Some(YamlNode {
+                kind: YamlKind::Null,
+                ..
+            }) => String::new(),
+            // A folded (`>`) description ends with a line break; keep the text only.
+            Some(n) => self
+                .text(n, "`description`", "description: A pendulum of length l.")
+                .map(|d| d.value.trim().to_string())
+                .unwrap_or_default(),
+        };
 
-    let mut springs = Vec::new();
-    let mut dampers = Vec::new();
-    let mut forces = Vec::new();
-    let mut torques = Vec::new();
-    if let Some(node) = get(top, "springs") {
-        if let Some(entries) = cx.map(
-            node,
-            "`springs`",
-            "springs: { s: { between: [A, B], stiffness: k, rest_length: l0 } }",
-        ) {
-            for (k, v) in entries {
-                let what = format!("spring `{}`", k.value);
-                let Some(f) = cx.map(
-                    v,
-                    &what,
-                    "{ between: [A, B], stiffness: k, rest_length: l0 }",
-                ) else {
-                    continue;
-                };
-                cx.keys(
-                    f,
-                    v.location,
-                    &what,
-                    &["between", "stiffness", "rest_length"],
-                    &["between", "stiffness"],
+        self.section = "parameters";
+        let parameters = get(top, "parameters")
+            .map(|n| self.parameters(n))
+            .unwrap_or_default();
+        self.section = "coordinates";
+        let coordinates = match get(top, "coordinates") {
+            Some(n) => self.coordinates(n),
+            None if misspelt(top, "coordinates") => {
+                self.incomplete.sections.push("coordinates".to_string());
+                Vec::new()
+            }
+            None => {
+                self.error(
+                    Diagnostic::new(root.location, "the model file has no `coordinates`")
+                        .with_help("list the generalized coordinates: `coordinates: [theta]`"),
                 );
-                let between = get(f, "between").and_then(|n| cx.point_pair(n, "`between`"));
-                let stiffness = get(f, "stiffness").and_then(|n| cx.expr(n, "`stiffness`"));
-                let rest_length = get(f, "rest_length").and_then(|n| cx.expr(n, "`rest_length`"));
-                if let (Some(between), Some(stiffness)) = (between, stiffness) {
-                    springs.push(Spring {
-                        name: k.clone(),
-                        between,
-                        stiffness,
-                        rest_length,
-                    });
-                }
+                Vec::new()
             }
-        }
-    }
-    if let Some(node) = get(top, "dampers") {
-        if let Some(entries) = cx.map(
-            node,
-            "`dampers`",
-            "dampers: { d: { between: [A, B], coefficient: c } }",
-        ) {
-            for (k, v) in entries {
-                let what = format!("damper `{}`", k.value);
-                let Some(f) = cx.map(v, &what, "{ between: [A, B], coefficient: c }") else {
-                    continue;
-                };
-                cx.keys(
-                    f,
-                    v.location,
-                    &what,
-                    &["between", "coefficient"],
-                    &["between", "coefficient"],
-                );
-                let between = get(f, "between").and_then(|n| cx.point_pair(n, "`between`"));
-                let coefficient = get(f, "coefficient").and_then(|n| cx.expr(n, "`coefficient`"));
-                if let (Some(between), Some(coefficient)) = (between, coefficient) {
-                    dampers.push(Damper {
-                        name: k.clone(),
-                        between,
-                        coefficient,
-                    });
-                }
-            }
-        }
-    }
-    if let Some(node) = get(top, "forces") {
-        if let Some(entries) = cx.map(
-            node,
-            "`forces`",
-            "forces: { push: { at: P, vector: [F0*step(t), 0] } }",
-        ) {
-            for (k, v) in entries {
-                let what = format!("force `{}`", k.value);
-                let Some(f) = cx.map(v, &what, "{ at: P, vector: [Fx, Fy] }") else {
-                    continue;
-                };
-                cx.keys(f, v.location, &what, &["at", "vector"], &["at", "vector"]);
-                let at = get(f, "at").and_then(|n| cx.name(n, "`at`"));
-                let vector = get(f, "vector")
-                    .and_then(|n| cx.vector(n, "`vector`").map(|x| (x, n.location)));
-                if let (Some(at), Some((vector, location))) = (at, vector) {
-                    forces.push(Force {
-                        name: k.clone(),
-                        at,
-                        vector,
-                        location,
-                    });
-                }
-            }
-        }
-    }
-    if let Some(node) = get(top, "torques") {
-        if let Some(entries) = cx.map(
-            node,
-            "`torques`",
-            "torques: { motor: { body: arm, value: tau0 } }",
-        ) {
-            for (k, v) in entries {
-                let what = format!("torque `{}`", k.value);
-                let Some(f) = cx.map(v, &what, "{ body: B, value: tau }") else {
-                    continue;
-                };
-                cx.keys(f, v.location, &what, &["body", "value"], &["body", "value"]);
-                let body = get(f, "body").and_then(|n| cx.name(n, "`body`"));
-                let value = get(f, "value").and_then(|n| cx.expr(n, "`value`"));
-                if let (Some(body), Some(value)) = (body, value) {
-                    torques.push(Torque {
-                        name: k.clone(),
-                        body,
-                        value,
-                    });
-                }
-            }
-        }
-    }
+        };
 
-    let mut initial = Vec::new();
-    if let Some(node) = get(top, "initial") {
-        if let Some(entries) = cx.map(node, "`initial`", "initial: { theta: pi/2, theta_dot: 0 }") {
-            for (k, v) in entries {
-                if let Some(e) = cx.expr(v, "an initial value") {
-                    initial.push((k.clone(), e));
-                }
-            }
-        }
-    }
+        self.section = "kinetic";
+        let kinetic = get(top, "kinetic").and_then(|n| self.expr(n, "`kinetic`"));
+        self.section = "potential";
+        let potential = get(top, "potential").and_then(|n| self.expr(n, "`potential`"));
+        self.section = "generalized_forces";
+        let generalized_forces = get(top, "generalized_forces")
+            .map(|n| {
+                self.keyed_exprs(
+                    n,
+                    "`generalized_forces`",
+                    "generalized_forces: { x: -c*x_dot }",
+                    "a generalized force",
+                )
+            })
+            .unwrap_or_default();
 
-    let mut draw = Draw::default();
-    if let Some(node) = get(top, "draw") {
-        if let Some(f) = cx.map(node, "`draw`", "draw: { lines: [[O, P]], trace: [P] }") {
-            cx.keys(f, node.location, "`draw`", &["lines", "trace"], &[]);
-            if let Some(lines) =
-                get(f, "lines").and_then(|n| cx.seq(n, "`lines`", "lines: [[O, E], [E, H]]"))
-            {
-                for l in lines {
-                    if let Some(pair) = cx.point_pair(l, "a line") {
-                        draw.lines.push(pair);
-                    }
-                }
-            }
-            if let Some(trace) = get(f, "trace").and_then(|n| cx.seq(n, "`trace`", "trace: [H]")) {
-                for p in trace {
-                    if let Some(n) = cx.name(p, "a traced point") {
-                        draw.trace.push(n);
-                    }
-                }
-            }
-        }
-    }
+        self.section = "points";
+        let points = get(top, "points")
+            .map(|n| self.points(n))
+            .unwrap_or_default();
+        self.section = "bodies";
+        let bodies = get(top, "bodies")
+            .map(|n| self.bodies(n))
+            .unwrap_or_default();
+        self.section = "gravity";
+        let gravity = get(top, "gravity").and_then(|n| {
+            self.vector(n, "`gravity`", "gravity: [0, -g]")
+                .map(|g| Located::new(g, n.location))
+        });
+        self.section = "springs";
+        let springs = get(top, "springs")
+            .map(|n| self.springs(n))
+            .unwrap_or_default();
+        self.section = "dampers";
+        let dampers = get(top, "dampers")
+            .map(|n| self.dampers(n))
+            .unwrap_or_default();
+        self.section = "forces";
+        let forces = get(top, "forces")
+            .map(|n| self.forces(n))
+            .unwrap_or_default();
+        self.section = "torques";
+        let torques = get(top, "torques")
+            .map(|n| self.torques(n))
+            .unwrap_or_default();
+        self.section = "initial";
+        let initial = get(top, "initial")
+            .map(|n| {
+                self.keyed_exprs(
+                    n,
+                    "`initial`",
+                    "initial: { theta: pi/2, theta_dot: 0 }",
+                    "an initial value",
+                )
+            })
+            .unwrap_or_default();
+        self.section = "draw";
+        let draw = get(top, "draw").map(|n| self.draw(n)).unwrap_or_default();
+        self.section = "";
 
-    let dimension = points.first().map(|p| p.position.len());
-    if cx.errors.is_empty() {
-        Ok(ModelFile {
+        let dimension = points.first().map(|p: &Point| p.position.len());
+        Some(ModelFile {
             path: path.to_string(),
             name,
             description,
@@ -595,7 +703,621 @@ pub fn build(path: &str, source: &str, root: &YamlNode) -> Result<ModelFile, Vec
             draw,
             dimension,
         })
-    } else {
-        Err(cx.errors)
+    }
+
+    fn parameters(&mut self, node: &YamlNode) -> Vec<Parameter> {
+        let Some(entries) = self.map(node, "`parameters`", "parameters: { m: 1.0, g: 9.81 }")
+        else {
+            return Vec::new();
+        };
+        let mut out = Vec::new();
+        for (k, v) in entries {
+            if !self.key_name(k, "parameter") {
+                continue;
+            }
+            if let Some(p) = self.parameter(k, v, entries) {
+                out.push(p);
+            } else {
+                self.drop_name(&k.value);
+            }
+        }
+        out
+    }
+
+    fn parameter(
+        &mut self,
+        k: &Located<String>,
+        v: &YamlNode,
+        entries: &Entries,
+    ) -> Option<Parameter> {
+        if v.kind == YamlKind::Null {
+            self.error(
+                Diagnostic::new(
+                    k.location,
+                    format!("parameter `{}` has no default value", k.value),
+                )
+                .with_help(format!("give one, as in `{}: 1.0  # kg`", k.value)),
+            );
+            return None;
+        }
+        let default = self.expr(v, &format!("the default of parameter `{}`", k.value))?;
+        // Rule: parameter defaults are constant (numbers, `pi`, functions); they may not
+        // refer to other parameters, coordinates or `t`.
+        let mut names = Vec::new();
+        identifiers(&default, &mut names);
+        if let Some((n, at)) = names.into_iter().find(|(n, _)| n != "pi") {
+            self.error(
+                Diagnostic::new(
+                    at,
+                    format!(
+                        "parameter defaults must be constant, but the default of `{}` uses `{n}`",
+                        k.value
+                    ),
+                )
+                .with_help("use numbers, `pi` and functions of them, as in `9.81`, `pi/4` or `sqrt(2)`; a default cannot refer to another parameter or a coordinate"),
+            );
+            return None;
+        }
+        let value = match eval_expr(&default, &|_| None) {
+            Ok(value) => value,
+            Err(d) => {
+                self.error(d);
+                return None;
+            }
+        };
+        if !value.is_finite() {
+            self.error(
+                Diagnostic::new(
+                    v.location,
+                    format!(
+                        "parameter `{}` has the non-finite default `{value}`",
+                        k.value
+                    ),
+                )
+                .with_help("a default must evaluate to a finite number"),
+            );
+            return None;
+        }
+        // The unit is the comment at the end of the value's line, if no other parameter
+        // shares that line (`parameters: { m: 1, g: 9.81 }  # SI` names no unit).
+        let line = v.location.line;
+        let shared = entries
+            .iter()
+            .filter(|(ok, ov)| ok.location.line == line || ov.location.line == line)
+            .count()
+            > 1;
+        let unit = if shared {
+            None
+        } else {
+            trailing_comment(self.source, line)
+        };
+        Some(Parameter {
+            name: k.clone(),
+            default,
+            value,
+            unit,
+        })
+    }
+
+    fn coordinates(&mut self, node: &YamlNode) -> Vec<Coordinate> {
+        let items = match &node.kind {
+            YamlKind::Seq(items) => items,
+            other => {
+                self.error(
+                    Diagnostic::new(
+                        node.location,
+                        format!("`coordinates` must be a list of names, found {}", other.describe()),
+                    )
+                    .with_help("write `coordinates: [theta1, theta2]`, or one `- theta1  # comment` per line"),
+                );
+                return Vec::new();
+            }
+        };
+        let mut out = Vec::new();
+        for item in items {
+            let Some(n) = self.name(item, "a coordinate") else {
+                if let YamlKind::Scalar { text, .. } = &item.kind {
+                    self.drop_name(text);
+                }
+                continue;
+            };
+            // A trailing comment describes the coordinate only if it is alone on its line.
+            let alone = items
+                .iter()
+                .filter(|o| o.location.line == item.location.line)
+                .count()
+                == 1;
+            let comment = if alone {
+                trailing_comment(self.source, n.location.line)
+            } else {
+                None
+            };
+            out.push(Coordinate { name: n, comment });
+        }
+        out
+    }
+
+    /// A map of names to expressions (`generalized_forces`, `initial`).
+    fn keyed_exprs(
+        &mut self,
+        node: &YamlNode,
+        what: &str,
+        example: &str,
+        item: &str,
+    ) -> Vec<(Located<String>, Expr)> {
+        let Some(entries) = self.map(node, what, example) else {
+            return Vec::new();
+        };
+        let mut out = Vec::new();
+        for (k, v) in entries {
+            if let Some(e) = self.expr(v, &format!("{item} (`{}`)", k.value)) {
+                out.push((k.clone(), e));
+            }
+        }
+        out
+    }
+
+    fn points(&mut self, node: &YamlNode) -> Vec<Point> {
+        let Some(entries) = self.map(
+            node,
+            "`points`",
+            "points: { O: [0, 0], P: [l*cos(q), l*sin(q)] }",
+        ) else {
+            return Vec::new();
+        };
+        let mut out = Vec::new();
+        for (k, v) in entries {
+            if !self.key_name(k, "point") {
+                continue;
+            }
+            match self.vector(
+                v,
+                &format!("point `{}`", k.value),
+                "P: [l*cos(q), l*sin(q)]",
+            ) {
+                Some(position) => out.push(Point {
+                    name: k.clone(),
+                    position,
+                    location: v.location,
+                }),
+                None => self.drop_name(&k.value),
+            }
+        }
+        out
+    }
+
+    fn bodies(&mut self, node: &YamlNode) -> Vec<Body> {
+        let Some(entries) = self.map(node, "`bodies`", "bodies: { bob: { mass: m, at: P } }")
+        else {
+            return Vec::new();
+        };
+        let mut out = Vec::new();
+        for (k, v) in entries {
+            if !self.key_name(k, "body") {
+                continue;
+            }
+            match self.body(k, v) {
+                Some(b) => out.push(b),
+                None => self.drop_name(&k.value),
+            }
+        }
+        out
+    }
+
+    fn body(&mut self, k: &Located<String>, v: &YamlNode) -> Option<Body> {
+        let what = format!("body `{}`", k.value);
+        let f = self.map(v, &what, &format!("{}: {PARTICLE_EXAMPLE}", k.value))?;
+        self.unknown_keys(f, &what, BODY_KEYS, BODY_KEYS);
+        let rigid_key = ["inertia", "com", "angle"]
+            .into_iter()
+            .find(|r| get(f, r).is_some());
+        let Some(rigid_key) = rigid_key else {
+            // A particle: `{ mass, at }`.
+            let complete = self.require(
+                f,
+                k.location,
+                &what,
+                &["mass", "at"],
+                &format!("{}: {PARTICLE_EXAMPLE}", k.value),
+            );
+            let mass = get(f, "mass").and_then(|n| self.expr(n, "a mass"));
+            let at = get(f, "at").and_then(|n| self.name(n, "`at`"));
+            let (Some(mass), Some(at), true) = (mass, at, complete) else {
+                return None;
+            };
+            return Some(Body {
+                name: k.clone(),
+                kind: BodyKind::Particle { mass, at },
+            });
+        };
+        // A planar rigid body: `{ mass, inertia, com, angle }`.
+        if let Some(at) = get_key(f, "at") {
+            self.error(
+                Diagnostic::new(
+                    at.location,
+                    format!(
+                        "{what} has `{rigid_key}`, so it is a planar rigid body, which has no `at`"
+                    ),
+                )
+                .with_help(format!(
+                    "a rigid body's position is its centre of mass `com`: `{RIGID_EXAMPLE}`; a particle is `{PARTICLE_EXAMPLE}`"
+                )),
+            );
+        }
+        let complete = self.require(
+            f,
+            k.location,
+            &format!("{what} (a planar rigid body, as it has `{rigid_key}`)"),
+            &["mass", "inertia", "com", "angle"],
+            &format!("{}: {RIGID_EXAMPLE}", k.value),
+        );
+        let mass = get(f, "mass").and_then(|n| self.expr(n, "a mass"));
+        let inertia = get(f, "inertia").and_then(|n| self.expr(n, "an inertia"));
+        let com = get(f, "com").and_then(|n| self.name(n, "`com`"));
+        let angle = get(f, "angle").and_then(|n| self.expr(n, "a body angle"));
+        let (Some(mass), Some(inertia), Some(com), Some(angle), true) = (
+            mass,
+            inertia,
+            com,
+            angle,
+            complete && get(f, "at").is_none(),
+        ) else {
+            return None;
+        };
+        Some(Body {
+            name: k.clone(),
+            kind: BodyKind::Rigid {
+                mass,
+                inertia,
+                com,
+                angle,
+            },
+        })
+    }
+
+    /// The fields of one named load (spring, damper, force, torque), or `None` if it is not
+    /// a map or lacks a required field.
+    fn fields<'n>(
+        &mut self,
+        k: &Located<String>,
+        v: &'n YamlNode,
+        kind: &str,
+        allowed: &[&str],
+        required: &[&str],
+        example: &str,
+    ) -> Option<&'n Entries> {
+        let what = format!("{kind} `{}`", k.value);
+        let example = format!("{}: {example}", k.value);
+        let f = self.map(v, &what, &example)?;
+        self.unknown_keys(f, &what, allowed, allowed);
+        self.require(f, k.location, &what, required, &example)
+            .then_some(f)
+    }
+
+    fn springs(&mut self, node: &YamlNode) -> Vec<Spring> {
+        const EXAMPLE: &str = "{ between: [A, B], stiffness: k, rest_length: l0 }";
+        let Some(entries) = self.map(node, "`springs`", &format!("springs: {{ s: {EXAMPLE} }}"))
+        else {
+            return Vec::new();
+        };
+        let mut out = Vec::new();
+        for (k, v) in entries {
+            let Some(f) = self.fields(
+                k,
+                v,
+                "spring",
+                &["between", "stiffness", "rest_length"],
+                &["between", "stiffness"],
+                EXAMPLE,
+            ) else {
+                continue;
+            };
+            let between = get(f, "between").and_then(|n| self.point_pair(n, "`between`"));
+            let stiffness = get(f, "stiffness").and_then(|n| self.expr(n, "a stiffness"));
+            let rest_length = match get(f, "rest_length") {
+                Some(n) => self.expr(n, "a rest length").map(Some),
+                None => Some(None),
+            };
+            if let (Some(between), Some(stiffness), Some(rest_length)) =
+                (between, stiffness, rest_length)
+            {
+                out.push(Spring {
+                    name: k.clone(),
+                    between,
+                    stiffness,
+                    rest_length,
+                });
+            }
+        }
+        out
+    }
+
+    fn dampers(&mut self, node: &YamlNode) -> Vec<Damper> {
+        const EXAMPLE: &str = "{ between: [A, B], coefficient: c }";
+        let Some(entries) = self.map(node, "`dampers`", &format!("dampers: {{ d: {EXAMPLE} }}"))
+        else {
+            return Vec::new();
+        };
+        let mut out = Vec::new();
+        for (k, v) in entries {
+            let Some(f) = self.fields(
+                k,
+                v,
+                "damper",
+                &["between", "coefficient"],
+                &["between", "coefficient"],
+                EXAMPLE,
+            ) else {
+                continue;
+            };
+            let between = get(f, "between").and_then(|n| self.point_pair(n, "`between`"));
+            let coefficient =
+                get(f, "coefficient").and_then(|n| self.expr(n, "a damping coefficient"));
+            if let (Some(between), Some(coefficient)) = (between, coefficient) {
+                out.push(Damper {
+                    name: k.clone(),
+                    between,
+                    coefficient,
+                });
+            }
+        }
+        out
+    }
+
+    fn forces(&mut self, node: &YamlNode) -> Vec<Force> {
+        const EXAMPLE: &str = "{ at: P, vector: [F0*cos(w*t), 0] }";
+        let Some(entries) = self.map(node, "`forces`", &format!("forces: {{ push: {EXAMPLE} }}"))
+        else {
+            return Vec::new();
+        };
+        let mut out = Vec::new();
+        for (k, v) in entries {
+            let Some(f) = self.fields(k, v, "force", &["at", "vector"], &["at", "vector"], EXAMPLE)
+            else {
+                continue;
+            };
+            let at = get(f, "at").and_then(|n| self.name(n, "`at`"));
+            let vector = get(f, "vector").and_then(|n| {
+                self.vector(
+                    n,
+                    &format!("the vector of force `{}`", k.value),
+                    "vector: [Fx, Fy]",
+                )
+                .map(|x| (x, n.location))
+            });
+            if let (Some(at), Some((vector, location))) = (at, vector) {
+                out.push(Force {
+                    name: k.clone(),
+                    at,
+                    vector,
+                    location,
+                });
+            }
+        }
+        out
+    }
+
+    fn torques(&mut self, node: &YamlNode) -> Vec<Torque> {
+        const EXAMPLE: &str = "{ body: arm, value: tau0*sin(w*t) }";
+        let Some(entries) = self.map(
+            node,
+            "`torques`",
+            &format!("torques: {{ motor: {EXAMPLE} }}"),
+        ) else {
+            return Vec::new();
+        };
+        let mut out = Vec::new();
+        for (k, v) in entries {
+            let Some(f) = self.fields(
+                k,
+                v,
+                "torque",
+                &["body", "value"],
+                &["body", "value"],
+                EXAMPLE,
+            ) else {
+                continue;
+            };
+            let body = get(f, "body").and_then(|n| self.name(n, "`body`"));
+            let value = get(f, "value").and_then(|n| self.expr(n, "a torque"));
+            if let (Some(body), Some(value)) = (body, value) {
+                out.push(Torque {
+                    name: k.clone(),
+                    body,
+                    value,
+                });
+            }
+        }
+        out
+    }
+
+    fn draw(&mut self, node: &YamlNode) -> Draw {
+        let mut draw = Draw::default();
+        let Some(f) = self.map(node, "`draw`", "draw: { lines: [[O, P]], trace: [P] }") else {
+            return draw;
+        };
+        self.unknown_keys(f, "`draw`", &["lines", "trace"], &["lines", "trace"]);
+        if let Some(lines) =
+            get(f, "lines").and_then(|n| self.seq(n, "`lines`", "lines: [[O, E], [E, H]]"))
+        {
+            for l in lines {
+                if let Some(pair) = self.point_pair(l, "a line") {
+                    draw.lines.push(pair);
+                }
+            }
+        }
+        if let Some(trace) = get(f, "trace").and_then(|n| self.seq(n, "`trace`", "trace: [H]")) {
+            for p in trace {
+                if let Some(n) = self.name(p, "a traced point") {
+                    draw.trace.push(n);
+                }
+            }
+        }
+        draw
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::yaml;
+
+    fn built(src: &str) -> Built {
+        let root = yaml::parse(src).unwrap();
+        build_partial("t.yaml", src, &root)
+    }
+
+    fn messages(src: &str) -> Vec<String> {
+        built(src)
+            .diagnostics
+            .iter()
+            .map(|d| format!("{}: {}", d.location, d.message))
+            .collect()
+    }
+
+    #[test]
+    fn snake_case_names() {
+        assert!(is_snake_case("double_pendulum2"));
+        assert!(!is_snake_case("DoublePendulum"));
+        assert_eq!(to_snake_case("DoublePendulum"), "double_pendulum");
+        assert_eq!(to_snake_case("my-model"), "my_model");
+        assert_eq!(to_snake_case("2d"), "model_2d");
+        let m = messages("name: DoublePendulum\ncoordinates: [q]\n");
+        assert_eq!(
+            m,
+            ["1:7: `name` must be snake_case, found `DoublePendulum`"]
+        );
+    }
+
+    #[test]
+    fn parameter_units_and_constant_defaults() {
+        let src = "name: a\ncoordinates: [q]\nparameters:\n  m: 2.0  # kg\n  l: pi/4\n  k: 2*m\n";
+        let b = built(src);
+        let file = b.file.unwrap();
+        assert_eq!(file.parameters.len(), 2);
+        assert_eq!(file.parameters[0].unit.as_deref(), Some("kg"));
+        assert_eq!(file.parameters[1].unit, None);
+        assert!((file.parameters[1].value - std::f64::consts::FRAC_PI_4).abs() < 1e-15);
+        assert_eq!(b.diagnostics.len(), 1);
+        assert_eq!(b.diagnostics[0].location, Location { line: 6, column: 8 });
+        assert!(
+            b.diagnostics[0]
+                .message
+                .contains("parameter defaults must be constant")
+        );
+        assert_eq!(b.incomplete.names, ["k"]);
+        // Several parameters on one line: no unit.
+        let src = "name: a\ncoordinates: [q]\nparameters: { m: 1, g: 9.81 }  # SI\n";
+        let file = built(src).file.unwrap();
+        assert!(file.parameters.iter().all(|p| p.unit.is_none()));
+    }
+
+    #[test]
+    fn coordinate_comments() {
+        let src = "name: a\ncoordinates:\n  - x   # m, cart\n  - y\n";
+        let file = built(src).file.unwrap();
+        assert_eq!(file.coordinates[0].comment.as_deref(), Some("m, cart"));
+        assert_eq!(file.coordinates[1].comment, None);
+        let src = "name: a\ncoordinates: [x, y]  # both\n";
+        let file = built(src).file.unwrap();
+        assert!(file.coordinates.iter().all(|c| c.comment.is_none()));
+    }
+
+    #[test]
+    fn later_keys_and_unknown_keys() {
+        let m = messages("name: a\ncoordinates: [q]\nconstraints: []\nkinetc: q_dot^2\n");
+        assert_eq!(
+            m,
+            [
+                "3:1: `constraints:` is not supported yet by this version of eomgen",
+                "4:1: unknown key `kinetc` in a model file"
+            ]
+        );
+        let b = built("name: a\ncoordinates: [q]\nkinetc: q_dot^2\n");
+        assert!(
+            b.diagnostics[0]
+                .help
+                .as_deref()
+                .unwrap()
+                .starts_with("did you mean `kinetic`?")
+        );
+    }
+
+    #[test]
+    fn expressions_across_lines_keep_exact_locations() {
+        let src = "name: a\ncoordinates: [q]\nkinetic: q_dot^2/2\n  + 3*\n";
+        let m = messages(src);
+        assert_eq!(
+            m,
+            ["4:7: expected an operand after `*`, found the end of the expression"]
+        );
+        let src = "name: a\ncoordinates: [q]\npotential: >\n  q^2/2\n  + )\n";
+        let m = messages(src);
+        assert_eq!(m, ["5:5: expected an operand after `+`, found `)`"]);
+        let src = "name: a\ncoordinates: [q]\npotential: \"q^2 + $\"\n";
+        assert_eq!(
+            messages(src),
+            ["3:19: unexpected character `$` in an expression"]
+        );
+    }
+
+    #[test]
+    fn a_comma_inside_a_flow_list_is_explained() {
+        let src = "name: a\ncoordinates: [q]\npoints: { P: [atan2(q, 1), 0] }\n";
+        let b = built(src);
+        assert_eq!(b.diagnostics.len(), 1);
+        assert!(
+            b.diagnostics[0]
+                .message
+                .contains("`atan2(q` is cut at a `,`")
+        );
+        let src = "name: a\ncoordinates: [q]\npoints: { P: [\"atan2(q, 1)\", 0] }\n";
+        assert!(built(src).diagnostics.is_empty());
+    }
+
+    #[test]
+    fn a_comma_inside_a_flow_map_is_explained() {
+        let src = "name: a\ncoordinates: [q]\npoints: { P: [q, 0] }\nbodies: { b: { mass: 1, inertia: 1, com: P, angle: atan2(q, 1) } }\n";
+        let b = built(src);
+        let d = b
+            .diagnostics
+            .iter()
+            .find(|d| d.message.contains("unclosed"))
+            .unwrap();
+        assert!(
+            d.help
+                .as_deref()
+                .unwrap()
+                .contains("YAML splits values at every `,`")
+        );
+        // An unclosed parenthesis that YAML did not cut gets no such advice.
+        let src = "name: a\ncoordinates: [q]\npotential: (q + 1\n";
+        let b = built(src);
+        assert_eq!(b.diagnostics.len(), 1);
+        assert_eq!(
+            b.diagnostics[0].help.as_deref(),
+            Some("add the missing `)`")
+        );
+        let src = "name: a\ncoordinates: [q]\npoints: { P: [l*(q + 1, 0] }\n";
+        let b = built(src);
+        assert_eq!(b.diagnostics.len(), 1);
+        assert!(b.diagnostics[0].message.contains("unclosed"));
+    }
+
+    #[test]
+    fn bodies_particles_and_rigid() {
+        let src = "name: a\ncoordinates: [q]\nbodies:\n  b: { inertia: 1, com: G, angle: q }\n  c: { mass: 1, at: P, angle: q }\n  d: { mas: 1, at: P }\n";
+        let m = messages(src);
+        assert_eq!(
+            m,
+            [
+                "4:3: body `b` (a planar rigid body, as it has `inertia`) has no `mass`",
+                "5:3: body `c` (a planar rigid body, as it has `angle`) has no `inertia`",
+                "5:3: body `c` (a planar rigid body, as it has `angle`) has no `com`",
+                "5:17: body `c` has `angle`, so it is a planar rigid body, which has no `at`",
+                "6:8: unknown key `mas` in body `d`",
+            ]
+        );
+        assert_eq!(built(src).incomplete.names, ["b", "c", "d"]);
     }
 }

@@ -1,0 +1,151 @@
+//! Broken model files: each gives exactly the diagnostics its header announces.
+//!
+//! Every file in `tests/fixtures/broken/` starts with one `# expect: LINE:COL fragment` line
+//! per diagnostic, in file order, each optionally followed by `# help: fragment`. The
+//! loader must report exactly these: the same number, at these locations, with messages
+//! (and help) containing these fragments. Adding a case is adding a file.
+
+use std::path::Path;
+
+use eomgen_symbolic::model::{Diagnostic, load};
+
+struct Expected {
+    line: u32,
+    column: u32,
+    message: String,
+    help: Vec<String>,
+}
+
+fn expectations(source: &str) -> Vec<Expected> {
+    let mut out: Vec<Expected> = Vec::new();
+    for line in source.lines() {
+        if let Some(rest) = line.strip_prefix("# expect: ") {
+            let (at, message) = rest.split_once(' ').expect("`# expect: L:C message`");
+            let (l, c) = at.split_once(':').expect("`L:C`");
+            out.push(Expected {
+                line: l.parse().expect("line"),
+                column: c.parse().expect("column"),
+                message: message.to_string(),
+                help: Vec::new(),
+            });
+        } else if let Some(help) = line.strip_prefix("# help: ") {
+            out.last_mut()
+                .expect("`# help:` follows an `# expect:`")
+                .help
+                .push(help.to_string());
+        }
+    }
+    out
+}
+
+fn show(d: &[Diagnostic]) -> String {
+    d.iter()
+        .map(|d| {
+            format!(
+                "  {}: {}{}",
+                d.location,
+                d.message,
+                d.help
+                    .as_ref()
+                    .map(|h| format!("\n      help: {h}"))
+                    .unwrap_or_default()
+            )
+        })
+        .collect::<Vec<_>>()
+        .join("\n")
+}
+
+/// Checks one broken file; `Err` describes the mismatch.
+fn check_case(path: &Path) -> Result<(), String> {
+    let source = std::fs::read_to_string(path).map_err(|e| e.to_string())?;
+    let name = path.file_name().unwrap_or_default().to_string_lossy();
+    let expected = expectations(&source);
+    if expected.is_empty() {
+        return Err(format!("{name}: no `# expect:` header"));
+    }
+    let got = match load(&name, &source) {
+        Ok(_) => return Err(format!("{name}: loaded without errors")),
+        Err(d) => d,
+    };
+    let ok = got.len() == expected.len()
+        && got.iter().zip(&expected).all(|(d, e)| {
+            d.location.line == e.line
+                && d.location.column == e.column
+                && d.message.contains(&e.message)
+                && e.help
+                    .iter()
+                    .all(|h| d.help.as_deref().is_some_and(|dh| dh.contains(h.as_str())))
+        });
+    if ok {
+        Ok(())
+    } else {
+        let want = expected
+            .iter()
+            .map(|e| format!("  {}:{}: {} {:?}", e.line, e.column, e.message, e.help))
+            .collect::<Vec<_>>()
+            .join("\n");
+        Err(format!("{name}:\n expected\n{want}\n got\n{}", show(&got)))
+    }
+}
+
+#[test]
+fn every_broken_file_gives_exactly_its_expected_diagnostics() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/broken");
+    let mut paths: Vec<_> = std::fs::read_dir(&dir)
+        .expect("fixtures/broken exists")
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|x| x == "yaml"))
+        .collect();
+    paths.sort();
+    assert!(paths.len() >= 20, "only {} broken files", paths.len());
+    let failures: Vec<String> = paths.iter().filter_map(|p| check_case(p).err()).collect();
+    assert!(
+        failures.is_empty(),
+        "{} of {} broken files do not match:\n\n{}",
+        failures.len(),
+        paths.len(),
+        failures.join("\n\n")
+    );
+}
+
+#[test]
+fn a_diagnostic_renders_with_the_line_and_a_caret() {
+    let src = "name: pendulum\ncoordinates: [theta]\nkinetic: theta_dot^2/2 + l*\n";
+    let d = load("models/pendulum.yaml", src).unwrap_err();
+    assert_eq!(d.len(), 1);
+    assert_eq!(
+        d[0].render("models/pendulum.yaml", src),
+        "models/pendulum.yaml:3:28: expected an operand after `*`, found the end of the expression\n  \
+         |\n3 | kinetic: theta_dot^2/2 + l*\n  |                            ^\n\
+         = help: write a number, a name or a parenthesised expression after `*`"
+    );
+}
+
+#[test]
+fn schema_and_cross_object_errors_are_reported_together() {
+    // An unknown key (schema) and an unknown name (checks) in one run.
+    let src = "name: x\ncoordinates: [q]\nkinetic: q_dot^2/2 + a\npotential: b\nbogus: 1\n";
+    let errors = load("x.yaml", src).unwrap_err();
+    let at: Vec<String> = errors.iter().map(|d| d.location.to_string()).collect();
+    assert_eq!(at, ["3:22", "4:12", "5:1"], "{}", show(&errors));
+}
+
+#[test]
+fn a_point_left_out_by_the_schema_is_not_reported_again() {
+    // `P` has a malformed expression: one error, not also "unknown point `P`" for the body,
+    // the spring and the drawing.
+    let src = "name: x\nparameters: { m: 1, k: 1 }\ncoordinates: [q]\npoints: { O: [0, 0], P: [q +, 0] }\nbodies: { b: { mass: m, at: P } }\nsprings: { s: { between: [O, P], stiffness: k } }\ndraw: { lines: [[O, P]] }\n";
+    let errors = load("x.yaml", src).unwrap_err();
+    assert_eq!(errors.len(), 1, "{}", show(&errors));
+    assert_eq!(errors[0].location.to_string(), "4:29");
+}
+
+#[test]
+fn a_broken_parameter_is_not_an_unknown_name_later() {
+    let src = "name: x\nparameters: { m: , k: 2*m }\ncoordinates: [q]\nkinetic: m*q_dot^2/2\npotential: k*q^2/2\n";
+    let errors = load("x.yaml", src).unwrap_err();
+    let messages: Vec<&str> = errors.iter().map(|d| d.message.as_str()).collect();
+    assert_eq!(errors.len(), 2, "{}", show(&errors));
+    assert!(messages[0].contains("parameter `m` has no default value"));
+    assert!(messages[1].contains("parameter defaults must be constant"));
+}
