@@ -88,3 +88,60 @@ impl ExprArena {
         }
     }
 }
+
+impl ExprArena {
+    /// `e` with every symbol in `values` replaced by its expression, rebuilt canonically.
+    pub fn substitute(
+        &mut self,
+        e: ExprId,
+        values: &rustc_hash::FxHashMap<super::SymbolId, ExprId>,
+    ) -> ExprId {
+        let mut memo: rustc_hash::FxHashMap<ExprId, ExprId> = Default::default();
+        self.substitute_memo(e, values, &mut memo)
+    }
+
+    fn substitute_memo(
+        &mut self,
+        e: ExprId,
+        values: &rustc_hash::FxHashMap<super::SymbolId, ExprId>,
+        memo: &mut rustc_hash::FxHashMap<ExprId, ExprId>,
+    ) -> ExprId {
+        if let Some(&x) = memo.get(&e) {
+            return x;
+        }
+        let result = match self.node(e).clone() {
+            Node::Const(_) | Node::Pi => e,
+            Node::Symbol(s) => values.get(&s).copied().unwrap_or(e),
+            Node::Add(t) => {
+                let t: Vec<ExprId> = t
+                    .iter()
+                    .map(|&x| self.substitute_memo(x, values, memo))
+                    .collect();
+                self.sum(&t)
+            }
+            Node::Mul(f) => {
+                let f: Vec<ExprId> = f
+                    .iter()
+                    .map(|&x| self.substitute_memo(x, values, memo))
+                    .collect();
+                self.product(&f)
+            }
+            Node::Pow([b, x]) => {
+                let b = self.substitute_memo(b, values, memo);
+                let x = self.substitute_memo(x, values, memo);
+                self.pow(b, x)
+            }
+            Node::Func(f, u) => {
+                let u = self.substitute_memo(u, values, memo);
+                self.func(f, u)
+            }
+            Node::Atan2([y, x]) => {
+                let y = self.substitute_memo(y, values, memo);
+                let x = self.substitute_memo(x, values, memo);
+                self.atan2(y, x)
+            }
+        };
+        memo.insert(e, result);
+        result
+    }
+}

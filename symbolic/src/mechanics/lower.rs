@@ -18,6 +18,55 @@ pub struct ParameterInfo {
     pub symbol: SymbolId,
 }
 
+/// A body of the kinematic form, as expressions.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BodyInfo {
+    /// Name.
+    pub name: String,
+    /// Mass (kg).
+    pub mass: ExprId,
+    /// Index into [`SymbolicModel::points`] of the centre of mass (or the particle).
+    pub com: usize,
+    /// `(centroidal inertia, angle)` of a planar rigid body; `None` for a particle.
+    pub rotation: Option<(ExprId, ExprId)>,
+}
+
+/// A load of the kinematic form, kept as a force or torque (not a potential), for the
+/// momentum-balance derivation.
+#[derive(Debug, Clone, PartialEq)]
+pub enum LoadInfo {
+    /// A force vector at a point (index into [`SymbolicModel::points`]).
+    Force {
+        /// Point of application.
+        point: usize,
+        /// Components (N).
+        vector: Vec<ExprId>,
+    },
+    /// A torque (N·m) on a body whose angle is `angle`.
+    Torque {
+        /// The body's angle expression.
+        angle: ExprId,
+        /// Torque, counter-clockwise.
+        value: ExprId,
+    },
+    /// A linear spring between two points (equal and opposite forces along the line).
+    Spring {
+        /// End points.
+        between: [usize; 2],
+        /// Stiffness (N/m).
+        stiffness: ExprId,
+        /// Rest length (m); `None` for zero.
+        rest_length: Option<ExprId>,
+    },
+    /// A viscous damper along the line of two points.
+    Damper {
+        /// End points.
+        between: [usize; 2],
+        /// Coefficient (N·s/m).
+        coefficient: ExprId,
+    },
+}
+
 /// A model file turned into expressions: everything a [`super::Formulation`] needs.
 #[derive(Debug, Clone)]
 pub struct SymbolicModel {
@@ -55,6 +104,15 @@ pub struct SymbolicModel {
     pub dimension: usize,
     /// Line segments to draw, as point-index pairs.
     pub draw_lines: Vec<[usize; 2]>,
+    /// Bodies of the kinematic form.
+    pub bodies: Vec<BodyInfo>,
+    /// Gravity vector (m/s²), if given.
+    pub gravity: Option<Vec<ExprId>>,
+    /// Springs, dampers, forces and torques as loads.
+    pub loads: Vec<LoadInfo>,
+    /// Whether the file uses the energy form (`kinetic`, `potential` or
+    /// `generalized_forces`), which a derivation from the kinematics alone cannot use.
+    pub uses_energy_form: bool,
 }
 
 impl SymbolicModel {
@@ -254,6 +312,8 @@ impl<'f> Lowering<'f> {
 
         // Bodies: T = ½ m v_G·v_G (+ ½ I ω² for planar rigid bodies), V = −m g·r_G.
         let mut angles: Vec<(String, ExprId)> = Vec::new();
+        let mut body_infos: Vec<BodyInfo> = Vec::new();
+        let mut loads: Vec<LoadInfo> = Vec::new();
         for body in &file.bodies {
             let (mass, at, rigid) = match &body.kind {
                 BodyKind::Particle { mass, at } => (mass, at, None),
@@ -281,15 +341,23 @@ impl<'f> Lowering<'f> {
                 let mgr = self.arena.times(m, gr);
                 v_terms.push(self.arena.neg(mgr));
             }
+            let mut rotation = None;
             if let Some((inertia, angle)) = rigid {
                 let i = self.expr(inertia);
                 let th = self.expr(angle);
+                rotation = Some((i, th));
                 let w = self.arena.time_derivative(th);
                 let two = self.arena.int(2);
                 let w2 = self.arena.pow(w, two);
                 t_terms.push(self.arena.product(&[half, i, w2]));
                 angles.push((body.name.value.clone(), th));
             }
+            body_infos.push(BodyInfo {
+                name: body.name.value.clone(),
+                mass: m,
+                com: ip,
+                rotation,
+            });
         }
 
         // Springs: V = ½ k (|r_A − r_B| − ℓ₀)², or ½ k |r_A − r_B|² for zero rest length.
@@ -305,10 +373,15 @@ impl<'f> Lowering<'f> {
             let d = self.difference(&points[a].1, &points[b].1);
             let d2 = self.dot(&d, &d);
             let k = self.expr(&s.stiffness);
-            let stretch2 = match &s.rest_length {
+            let rest = s.rest_length.as_ref().map(|l| self.expr(l));
+            loads.push(LoadInfo::Spring {
+                between: [a, b],
+                stiffness: k,
+                rest_length: rest,
+            });
+            let stretch2 = match rest {
                 None => d2,
                 Some(l0) => {
-                    let l0 = self.expr(l0);
                     let len = self.arena.sqrt(d2);
                     let st = self.arena.minus(len, l0);
                     let two = self.arena.int(2);
@@ -332,6 +405,10 @@ impl<'f> Lowering<'f> {
             let d = self.difference(&points[a].1, &points[b].1);
             let dd: Vec<ExprId> = d.iter().map(|c| self.arena.time_derivative(*c)).collect();
             let c = self.expr(&dmp.coefficient);
+            loads.push(LoadInfo::Damper {
+                between: [a, b],
+                coefficient: c,
+            });
             let d2 = self.dot(&d, &d);
             let rate = self.dot(&d, &dd);
             let c_rate = self.arena.times(c, rate);
@@ -356,6 +433,10 @@ impl<'f> Lowering<'f> {
                 continue;
             };
             let force: Vec<ExprId> = f.vector.iter().map(|c| self.expr(c)).collect();
+            loads.push(LoadInfo::Force {
+                point: ip,
+                vector: force.clone(),
+            });
             let r = points[ip].1.clone();
             for (i, qs) in q_symbols.iter().enumerate() {
                 let partial: Vec<ExprId> = r.iter().map(|x| self.arena.diff(*x, *qs)).collect();
@@ -380,6 +461,10 @@ impl<'f> Lowering<'f> {
                 continue;
             };
             let tau = self.expr(&tq.value);
+            loads.push(LoadInfo::Torque {
+                angle: th,
+                value: tau,
+            });
             for (i, qs) in q_symbols.iter().enumerate() {
                 let partial = self.arena.diff(th, *qs);
                 if !self.arena.is_zero(partial) {
@@ -451,6 +536,12 @@ impl<'f> Lowering<'f> {
             conservative,
             dimension,
             draw_lines,
+            bodies: body_infos,
+            gravity,
+            loads,
+            uses_energy_form: file.kinetic.is_some()
+                || file.potential.is_some()
+                || !file.generalized_forces.is_empty(),
         })
     }
 }

@@ -5,9 +5,11 @@
 
 mod lagrange;
 mod lower;
+mod momentum;
 
 pub use lagrange::Lagrange;
-pub use lower::{ParameterInfo, SymbolicModel};
+pub use lower::{BodyInfo, LoadInfo, ParameterInfo, SymbolicModel};
+pub use momentum::MomentumBalance;
 
 use crate::expr::ExprId;
 
