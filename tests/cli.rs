@@ -147,3 +147,54 @@ fn a_singular_mass_matrix_is_an_error_with_t_and_exit_1() {
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(v["error"]["t"], 0.0);
 }
+
+/// `eomgen check` passes on every bundled model (Lagrange ≡ momentum balance where the model
+/// is kinematic; power balance), by name and by path, with the documented JSON keys.
+#[test]
+fn check_passes_on_every_model_and_accepts_paths() {
+    for entry in eomgen::models::ALL {
+        let out = eomgen(&["check", entry.name, "--states", "100", "--json"]);
+        assert!(
+            out.status.success(),
+            "{}: {}",
+            entry.name,
+            String::from_utf8_lossy(&out.stdout)
+        );
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        assert_eq!(v["model"], entry.name);
+        assert_eq!(v["passed"], true);
+        assert!(v["derivation"]["lagrange"]["ops_after_cse"].is_number());
+        for c in v["checks"].as_array().unwrap() {
+            assert!(c["max_rel_residual"].as_f64().unwrap() < 1e-8);
+            assert_eq!(c["a"], "lagrange");
+            assert_eq!(c["b"], "momentum");
+        }
+    }
+    let out = eomgen(&[
+        "check",
+        eomgen::models::find("double_pendulum").unwrap().path,
+        "--json",
+    ]);
+    assert!(out.status.success());
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["checks"][0]["symbolic_equal"], true);
+    assert!(v["power_balance"]["max_rel_residual"].as_f64().unwrap() < 1e-8);
+}
+
+/// A broken file given by path: the loader's diagnostics with file:line:col, exit 1.
+#[test]
+fn check_reports_model_file_errors() {
+    let dir = std::env::temp_dir().join(format!("eomgen-check-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("bad.yaml");
+    std::fs::write(
+        &path,
+        "name: bad\ncoordinates: [q]\nkinetic: q_dot^2/2 + k\n",
+    )
+    .unwrap();
+    let out = eomgen(&["check", path.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("bad.yaml:3:22: unknown name `k`"), "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -1,5 +1,6 @@
 //! Command-line interface (clap): parsing, dispatch, and the rendering of errors.
 
+mod check;
 mod plot;
 mod simulate;
 mod values;
@@ -25,6 +26,9 @@ enum Command {
     },
     /// Integrate a model's equations of motion from its initial state.
     Simulate(simulate::SimulateArgs),
+    /// Derive a model (bundled, or any YAML file) by Lagrange and by momentum balance at run
+    /// time and cross-check them and the power balance; exit 1 if a check fails.
+    Check(check::CheckArgs),
 }
 
 /// A CLI failure: the message for stderr and the exit code.
@@ -57,6 +61,7 @@ pub fn run() -> ExitCode {
     let result = match cli.command {
         Command::List { json } => list(json),
         Command::Simulate(args) => simulate::run(&args),
+        Command::Check(args) => check::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -3,6 +3,7 @@
 //! One [`Formulation`] interface serves every derivation (Lagrange now; momentum balance
 //! next), so the code generator and the cross-checks treat them alike.
 
+pub mod check;
 mod lagrange;
 mod lower;
 mod momentum;

@@ -1,0 +1,139 @@
+//! `eomgen check MODEL|FILE.yaml`: derive a model two ways at run time and cross-check.
+
+use clap::Args;
+use serde_json::json;
+
+use super::CliError;
+use eomgen_symbolic::mechanics::check::{CheckReport, check_model};
+
+/// Relative tolerance of every check: the derivations differ only by rounding (~1e-14).
+const TOLERANCE: f64 = 1e-8;
+
+/// Options of `eomgen check`.
+#[derive(Debug, Args)]
+pub struct CheckArgs {
+    /// A bundled model's name, or the path of any model file (`path/to/x.yaml`).
+    pub model: String,
+    /// Number of random states.
+    #[arg(long, default_value_t = 200)]
+    pub states: usize,
+    /// Print the report as JSON.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Runs `check`.
+pub fn run(args: &CheckArgs) -> Result<(), CliError> {
+    let is_path =
+        args.model.ends_with(".yaml") || args.model.ends_with(".yml") || args.model.contains('/');
+    let (display, path) = if is_path {
+        (args.model.clone(), args.model.clone())
+    } else {
+        let entry = eomgen::models::find(&args.model).ok_or_else(|| {
+            let names: Vec<&str> = eomgen::models::ALL.iter().map(|e| e.name).collect();
+            CliError::usage(format!(
+                "no model named `{}`; models are: {} (or give a path to a .yaml file)",
+                args.model,
+                names.join(", ")
+            ))
+        })?;
+        (
+            format!("models/{}.yaml", entry.name),
+            entry.path.to_string(),
+        )
+    };
+    let source = std::fs::read_to_string(&path)
+        .map_err(|e| CliError::usage(format!("cannot read `{display}`: {e}")))?;
+    let file = eomgen_symbolic::model::load(&display, &source).map_err(|diagnostics| {
+        let text: Vec<String> = diagnostics
+            .iter()
+            .map(|d| d.render(&display, &source))
+            .collect();
+        CliError::failure(format!(
+            "{} error(s) in the model file\n{}",
+            diagnostics.len(),
+            text.join("\n")
+        ))
+    })?;
+    let report = check_model(&file, args.states, 0x5EED).map_err(|diagnostics| {
+        let text: Vec<String> = diagnostics
+            .iter()
+            .map(|d| d.render(&display, &source))
+            .collect();
+        CliError::failure(text.join("\n"))
+    })?;
+    if args.json {
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&to_json(&report))
+                .map_err(|e| CliError::failure(e.to_string()))?
+        );
+    } else {
+        print_report(&report);
+    }
+    if report.passed(TOLERANCE) {
+        Ok(())
+    } else {
+        Err(CliError::failure(format!(
+            "`{}` failed a check (tolerance {TOLERANCE:e})",
+            report.model
+        )))
+    }
+}
+
+fn to_json(r: &CheckReport) -> serde_json::Value {
+    let derivation: serde_json::Map<String, serde_json::Value> = r
+        .derivations
+        .iter()
+        .map(|d| {
+            (
+                d.name.to_string(),
+                json!({"time_s": d.time_s, "ops": d.ops, "ops_after_cse": d.ops_after_cse}),
+            )
+        })
+        .collect();
+    json!({
+        "model": r.model,
+        "tolerance": TOLERANCE,
+        "passed": r.passed(TOLERANCE),
+        "checks": r.comparisons.iter().map(|c| json!({"a": c.a, "b": c.b, "max_rel_residual": c.max_rel_residual, "symbolic_equal": c.symbolic_equal, "states": c.states})).collect::<Vec<_>>(),
+        "power_balance": r.power_balance.as_ref().map(|p| json!({"max_rel_residual": p.max_rel_residual})),
+        "derivation": derivation,
+        "notes": r.notes,
+    })
+}
+
+fn print_report(r: &CheckReport) {
+    let mark = |ok: bool| if ok { "ok  " } else { "FAIL" };
+    println!("model {}", r.model);
+    for c in &r.comparisons {
+        println!(
+            "{} {} vs {}: max relative difference of q'' {:.2e} over {} states; symbolically equal: {}",
+            mark(c.max_rel_residual <= TOLERANCE),
+            c.a,
+            c.b,
+            c.max_rel_residual,
+            c.states,
+            if c.symbolic_equal { "yes" } else { "no" }
+        );
+    }
+    if let Some(p) = &r.power_balance {
+        println!(
+            "{} power balance dE/dt = Q·q': max relative residual {:.2e}",
+            mark(p.max_rel_residual <= TOLERANCE),
+            p.max_rel_residual
+        );
+    }
+    for d in &r.derivations {
+        println!(
+            "     {:<9} derived in {:.3} ms: {} operations, {} after CSE",
+            d.name,
+            d.time_s * 1e3,
+            d.ops,
+            d.ops_after_cse
+        );
+    }
+    for n in &r.notes {
+        println!("note {n}");
+    }
+}

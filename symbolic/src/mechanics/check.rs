@@ -1,0 +1,313 @@
+//! Cross-checks of a model at run time, with no code generation (issue 4; `eomgen check`):
+//! Lagrange against momentum balance, and the power balance `dE/dt = P`.
+
+use std::time::Instant;
+
+use rustc_hash::FxHashMap;
+
+use super::{EquationsOfMotion, Formulation, Lagrange, MomentumBalance, SymbolicModel};
+use crate::expr::eval::Evaluator;
+use crate::expr::{ExprId, SymbolKind, cse};
+use crate::model::{Diagnostic, ModelFile};
+
+/// Cost and time of one derivation.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DerivationStats {
+    /// Formulation name (`lagrange`, `momentum`).
+    pub name: &'static str,
+    /// Wall time of the derivation of `M` and `F` (s).
+    pub time_s: f64,
+    /// Operations of `M` and `F` as trees.
+    pub ops: u64,
+    /// Operations after common-subexpression elimination.
+    pub ops_after_cse: u64,
+}
+
+/// Two derivations compared.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Comparison {
+    /// First formulation.
+    pub a: &'static str,
+    /// Second formulation.
+    pub b: &'static str,
+    /// Largest `|q̈_a − q̈_b| / max(1, |q̈|)` over the random states.
+    pub max_rel_residual: f64,
+    /// Whether `M_a − M_b` and `F_a − F_b` simplify to zero after expansion.
+    pub symbolic_equal: bool,
+    /// Number of states compared.
+    pub states: usize,
+}
+
+/// The power balance `dE/dt = Σ Qᵢ q̇ᵢ`, with `E = T + V` and `Q` the non-potential forces.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PowerBalance {
+    /// Largest `|dE/dt − P| / max(|dE/dt|, |P|, Σ|Fᵢ q̇ᵢ|)` over the states.
+    pub max_rel_residual: f64,
+}
+
+/// Everything `eomgen check` reports for one model.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CheckReport {
+    /// Model name.
+    pub model: String,
+    /// Pairwise comparisons of derivations.
+    pub comparisons: Vec<Comparison>,
+    /// The power balance; `None` when it does not hold by construction (explicit time in `T`
+    /// or `V`, or `T` not quadratic in `q̇`, as for a driven base), with the reason in `notes`.
+    pub power_balance: Option<PowerBalance>,
+    /// Derivation statistics per formulation.
+    pub derivations: Vec<DerivationStats>,
+    /// Why a check was skipped.
+    pub notes: Vec<String>,
+}
+
+impl CheckReport {
+    /// Whether every check passed at relative tolerance `tolerance`.
+    pub fn passed(&self, tolerance: f64) -> bool {
+        self.comparisons
+            .iter()
+            .all(|c| c.max_rel_residual <= tolerance)
+            && self
+                .power_balance
+                .as_ref()
+                .is_none_or(|p| p.max_rel_residual <= tolerance)
+    }
+}
+
+/// xorshift64: reproducible random states.
+struct Rng(u64);
+impl Rng {
+    fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 7;
+        self.0 ^= self.0 << 17;
+        lo + (hi - lo) * ((self.0 >> 11) as f64 / (1u64 << 53) as f64)
+    }
+}
+
+/// Solves `m x = f` (n × n row-major) by Gaussian elimination with partial pivoting; `None`
+/// if a pivot vanishes.
+fn solve(mut m: Vec<f64>, mut f: Vec<f64>) -> Option<Vec<f64>> {
+    let n = f.len();
+    for c in 0..n {
+        let p = (c..n).max_by(|a, b| m[a * n + c].abs().total_cmp(&m[b * n + c].abs()))?;
+        if m[p * n + c] == 0.0 || !m[p * n + c].is_finite() {
+            return None;
+        }
+        for k in 0..n {
+            m.swap(c * n + k, p * n + k);
+        }
+        f.swap(c, p);
+        for r in c + 1..n {
+            let factor = m[r * n + c] / m[c * n + c];
+            for k in c..n {
+                m[r * n + k] -= factor * m[c * n + k];
+            }
+            f[r] -= factor * f[c];
+        }
+    }
+    let mut x = vec![0.0; n];
+    for r in (0..n).rev() {
+        let s: f64 = (r + 1..n).map(|k| m[r * n + k] * x[k]).sum();
+        x[r] = (f[r] - s) / m[r * n + r];
+    }
+    Some(x)
+}
+
+fn timed(model: &mut SymbolicModel, f: &dyn Formulation) -> (EquationsOfMotion, DerivationStats) {
+    let start = Instant::now();
+    let eom = f.derive(model);
+    let time_s = start.elapsed().as_secs_f64();
+    let roots: Vec<ExprId> = eom
+        .mass_matrix
+        .iter()
+        .chain(&eom.forcing)
+        .copied()
+        .collect();
+    let stats = DerivationStats {
+        name: f.name(),
+        time_s,
+        ops: model.arena.tree_operation_count(&roots),
+        ops_after_cse: cse::plan(&model.arena, &roots, "t").operation_count(),
+    };
+    (eom, stats)
+}
+
+/// Derives `file` by every applicable formulation and cross-checks them at `states` random
+/// states (q, q̇ in [−2, 2], t in [0, 5], parameters within ±10 % of their defaults).
+///
+/// # Errors
+/// The diagnostics of a model that does not lower.
+pub fn check_model(
+    file: &ModelFile,
+    states: usize,
+    seed: u64,
+) -> Result<CheckReport, Vec<Diagnostic>> {
+    let mut model = SymbolicModel::from_file(file)?;
+    let n = model.num_dofs();
+    let mut notes = Vec::new();
+    let (lagrange, lagrange_stats) = timed(&mut model, &Lagrange);
+    let mut derivations = vec![lagrange_stats];
+    let momentum = if MomentumBalance::applies_to(&model) {
+        let (eom, stats) = timed(&mut model, &MomentumBalance);
+        derivations.push(stats);
+        Some(eom)
+    } else {
+        notes.push("momentum balance needs the kinematic form (bodies and loads, no `kinetic`, `potential` or `generalized_forces`): compared nothing".to_string());
+        None
+    };
+
+    let symbolic_equal = momentum.as_ref().map(|b| {
+        let arena = &mut model.arena;
+        lagrange
+            .mass_matrix
+            .iter()
+            .zip(&b.mass_matrix)
+            .chain(lagrange.forcing.iter().zip(&b.forcing))
+            .all(|(x, y)| {
+                let d = arena.minus(*x, *y);
+                let e = arena.expand(d);
+                arena.is_zero(e)
+            })
+    });
+
+    // Power balance: d(T + V)/dt along the motion against Σ Qᵢ q̇ᵢ.
+    let energy = model.arena.plus(model.kinetic, model.potential);
+    let de_dt = model.arena.time_derivative(energy);
+    let rates: Vec<ExprId> = (0..n).map(|i| model.coordinates[i][1]).collect();
+    let power_terms: Vec<ExprId> = (0..n)
+        .map(|i| model.arena.times(model.generalized_forces[i], rates[i]))
+        .collect();
+    let power = model.arena.sum(&power_terms);
+    let ts = model.time_symbol();
+    let explicit_time =
+        model.arena.depends_on(model.kinetic, ts) || model.arena.depends_on(model.potential, ts);
+
+    let mut roots: Vec<ExprId> = lagrange
+        .mass_matrix
+        .iter()
+        .chain(&lagrange.forcing)
+        .copied()
+        .collect();
+    let lagrange_len = roots.len();
+    if let Some(b) = &momentum {
+        roots.extend(b.mass_matrix.iter().chain(&b.forcing));
+    }
+    roots.extend([de_dt, power, model.kinetic]);
+    let mut evaluator = Evaluator::new(&model.arena, &roots);
+    // T at doubled rates, for the homogeneity test T(q, 2q̇) = 4 T(q, q̇).
+    let mut kinetic_only = Evaluator::new(&model.arena, &[model.kinetic]);
+
+    let mut rng = Rng(seed);
+    let mut max_rel: f64 = 0.0;
+    let mut power_rel: f64 = 0.0;
+    let mut quadratic = true;
+    let symbols = model.arena.symbols().to_vec();
+    let defaults: FxHashMap<&str, f64> = model
+        .parameters
+        .iter()
+        .map(|p| (p.name.as_str(), p.default))
+        .collect();
+    let mut compared = 0;
+    for _ in 0..states {
+        let t = rng.uniform(0.0, 5.0);
+        let mut bindings = vec![0.0; symbols.len()];
+        for (i, s) in symbols.iter().enumerate() {
+            bindings[i] = match s.kind {
+                SymbolKind::Parameter => {
+                    defaults.get(s.name.as_str()).copied().unwrap_or(0.0) * rng.uniform(0.9, 1.1)
+                }
+                SymbolKind::Coordinate(_) | SymbolKind::Velocity(_) => rng.uniform(-2.0, 2.0),
+                SymbolKind::Time => t,
+                _ => 0.0,
+            };
+        }
+        let v = evaluator.eval(&bindings);
+        let nn = n * n;
+        let Some(qdd) = solve(v[..nn].to_vec(), v[nn..nn + n].to_vec()) else {
+            continue;
+        };
+        if !qdd.iter().all(|x| x.is_finite()) {
+            continue;
+        }
+        compared += 1;
+        if momentum.is_some() {
+            if let Some(other) = solve(
+                v[lagrange_len..lagrange_len + nn].to_vec(),
+                v[lagrange_len + nn..lagrange_len + nn + n].to_vec(),
+            ) {
+                let scale = qdd.iter().chain(&other).fold(1.0f64, |m, x| m.max(x.abs()));
+                for (a, b) in qdd.iter().zip(&other) {
+                    max_rel = max_rel.max((a - b).abs() / scale);
+                }
+            } else {
+                max_rel = f64::INFINITY;
+            }
+        }
+        // T homogeneous of degree 2 in q̇?
+        let t1 = v[v.len() - 1];
+        let mut doubled = bindings.clone();
+        for (i, s) in symbols.iter().enumerate() {
+            if let SymbolKind::Velocity(_) = s.kind {
+                doubled[i] *= 2.0;
+            }
+        }
+        let t2 = kinetic_only.eval(&doubled)[0];
+        if (t2 - 4.0 * t1).abs() > 1e-9 * (1.0 + t1.abs()) {
+            quadratic = false;
+        }
+        // dE/dt with the solved accelerations.
+        let mut with_acc = bindings.clone();
+        for (i, s) in symbols.iter().enumerate() {
+            if let SymbolKind::Acceleration(j) = s.kind {
+                with_acc[i] = qdd[j as usize];
+            }
+        }
+        let w = evaluator.eval(&with_acc);
+        let (de, p) = (w[w.len() - 3], w[w.len() - 2]);
+        let fq: f64 = (0..n)
+            .map(|i| (v[nn + i] * bindings_rate(&symbols, &bindings, i)).abs())
+            .sum();
+        let scale = de.abs().max(p.abs()).max(fq).max(f64::MIN_POSITIVE);
+        power_rel = power_rel.max((de - p).abs() / scale);
+    }
+    if compared == 0 {
+        notes.push("no random state had a solvable mass matrix".to_string());
+    }
+    let comparisons = match momentum {
+        Some(_) => vec![Comparison {
+            a: "lagrange",
+            b: "momentum",
+            max_rel_residual: max_rel,
+            symbolic_equal: symbolic_equal.unwrap_or(false),
+            states: compared,
+        }],
+        None => Vec::new(),
+    };
+    let power_balance = if explicit_time {
+        notes.push("power balance skipped: T or V depends explicitly on t".to_string());
+        None
+    } else if !quadratic {
+        notes.push("power balance skipped: T is not a quadratic form in the rates".to_string());
+        None
+    } else {
+        Some(PowerBalance {
+            max_rel_residual: power_rel,
+        })
+    };
+    Ok(CheckReport {
+        model: model.name.clone(),
+        comparisons,
+        power_balance,
+        derivations,
+        notes,
+    })
+}
+
+/// The value bound to the rate of coordinate `i`.
+fn bindings_rate(symbols: &[crate::expr::Symbol], bindings: &[f64], i: usize) -> f64 {
+    symbols
+        .iter()
+        .position(|s| s.kind == SymbolKind::Velocity(i as u32))
+        .map_or(0.0, |k| bindings[k])
+}
