@@ -198,3 +198,45 @@ fn check_reports_model_file_errors() {
     assert!(err.contains("bad.yaml:3:22: unknown name `k`"), "{err}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `eomgen new` prints files that load and check; `eomgen equations` prints M and F by either
+/// method, as text and LaTeX.
+#[test]
+fn new_and_equations() {
+    let out = eomgen(&["new", "n-link-pendulum", "3"]);
+    assert!(out.status.success());
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(text.contains("name: n_link_pendulum_3"));
+    let dir = std::env::temp_dir().join(format!("eomgen-new-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("triple.yaml");
+    std::fs::write(&path, &text).unwrap();
+    let out = eomgen(&["check", path.to_str().unwrap(), "--states", "50"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stdout)
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+
+    let out = eomgen(&["equations", "double_pendulum"]);
+    assert!(out.status.success());
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(text.contains("M[0,0] = m2*l1^2 + m1*l1^2/3"), "{text}");
+    let out = eomgen(&[
+        "equations",
+        "cart_pendulum",
+        "--method",
+        "momentum",
+        "--latex",
+    ]);
+    assert!(out.status.success());
+    assert!(
+        String::from_utf8(out.stdout)
+            .unwrap()
+            .contains("\\begin{bmatrix}")
+    );
+    let out = eomgen(&["equations", "simple_pendulum", "--method", "momentum"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert_eq!(eomgen(&["new", "n-mass-chain", "0"]).status.code(), Some(2));
+}

@@ -24,37 +24,9 @@ pub struct CheckArgs {
 
 /// Runs `check`.
 pub fn run(args: &CheckArgs) -> Result<(), CliError> {
-    let is_path =
-        args.model.ends_with(".yaml") || args.model.ends_with(".yml") || args.model.contains('/');
-    let (display, path) = if is_path {
-        (args.model.clone(), args.model.clone())
-    } else {
-        let entry = eomgen::models::find(&args.model).ok_or_else(|| {
-            let names: Vec<&str> = eomgen::models::ALL.iter().map(|e| e.name).collect();
-            CliError::usage(format!(
-                "no model named `{}`; models are: {} (or give a path to a .yaml file)",
-                args.model,
-                names.join(", ")
-            ))
-        })?;
-        (
-            format!("models/{}.yaml", entry.name),
-            entry.path.to_string(),
-        )
-    };
-    let source = std::fs::read_to_string(&path)
-        .map_err(|e| CliError::usage(format!("cannot read `{display}`: {e}")))?;
-    let file = eomgen_symbolic::model::load(&display, &source).map_err(|diagnostics| {
-        let text: Vec<String> = diagnostics
-            .iter()
-            .map(|d| d.render(&display, &source))
-            .collect();
-        CliError::failure(format!(
-            "{} error(s) in the model file\n{}",
-            diagnostics.len(),
-            text.join("\n")
-        ))
-    })?;
+    let (display, source) = super::equations::read_model(&args.model)?;
+    let file = eomgen_symbolic::model::load(&display, &source)
+        .map_err(|d| super::equations::render(&display, &source, &d))?;
     let report = check_model(&file, args.states, 0x5EED).map_err(|diagnostics| {
         let text: Vec<String> = diagnostics
             .iter()

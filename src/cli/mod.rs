@@ -1,6 +1,7 @@
 //! Command-line interface (clap): parsing, dispatch, and the rendering of errors.
 
 mod check;
+mod equations;
 mod plot;
 mod simulate;
 mod values;
@@ -29,6 +30,10 @@ enum Command {
     /// Derive a model (bundled, or any YAML file) by Lagrange and by momentum balance at run
     /// time and cross-check them and the power balance; exit 1 if a check fails.
     Check(check::CheckArgs),
+    /// Print a model's equations of motion M q'' = F (text or LaTeX), derived at run time.
+    Equations(equations::EquationsArgs),
+    /// Print a generated model file: `n-link-pendulum N` or `n-mass-chain N`.
+    New(equations::NewArgs),
 }
 
 /// A CLI failure: the message for stderr and the exit code.
@@ -62,6 +67,8 @@ pub fn run() -> ExitCode {
         Command::List { json } => list(json),
         Command::Simulate(args) => simulate::run(&args),
         Command::Check(args) => check::run(&args),
+        Command::Equations(args) => equations::run(&args),
+        Command::New(args) => equations::new(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -11,6 +11,7 @@ pub mod file;
 pub mod located;
 pub mod parser;
 pub mod schema;
+pub mod templates;
 pub mod yaml;
 
 pub use ast::{BinOp, Expr, ExprKind};

@@ -1,0 +1,122 @@
+//! `eomgen equations MODEL|FILE [--method lagrange|momentum] [--latex]` and
+//! `eomgen new TEMPLATE N`.
+
+use clap::{Args, ValueEnum};
+
+use super::CliError;
+use eomgen_symbolic::codegen::{equations_latex, equations_text};
+use eomgen_symbolic::mechanics::{Formulation, Lagrange, MomentumBalance, SymbolicModel};
+use eomgen_symbolic::model::templates;
+
+/// Which derivation to print.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum Method {
+    /// Lagrange's equations (from T, V and Q).
+    Lagrange,
+    /// Momentum balance projected on the partial velocities (kinematic form only).
+    Momentum,
+}
+
+/// Options of `eomgen equations`.
+#[derive(Debug, Args)]
+pub struct EquationsArgs {
+    /// A bundled model's name, or the path of a model file.
+    pub model: String,
+    /// Derivation.
+    #[arg(long, value_enum, default_value_t = Method::Lagrange)]
+    pub method: Method,
+    /// Print LaTeX (amsmath) instead of text.
+    #[arg(long)]
+    pub latex: bool,
+}
+
+/// Options of `eomgen new`.
+#[derive(Debug, Args)]
+pub struct NewArgs {
+    /// `n-link-pendulum` or `n-mass-chain`.
+    pub template: String,
+    /// Size (number of bars or masses), at least 1.
+    pub n: usize,
+}
+
+/// Reads a bundled model by name or any file by path: `(display path, source)`.
+pub fn read_model(model: &str) -> Result<(String, String), CliError> {
+    let is_path = model.ends_with(".yaml") || model.ends_with(".yml") || model.contains('/');
+    let (display, path) = if is_path {
+        (model.to_string(), model.to_string())
+    } else {
+        let entry = eomgen::models::find(model).ok_or_else(|| {
+            let names: Vec<&str> = eomgen::models::ALL.iter().map(|e| e.name).collect();
+            CliError::usage(format!(
+                "no model named `{model}`; models are: {} (or give a path to a .yaml file)",
+                names.join(", ")
+            ))
+        })?;
+        (
+            format!("models/{}.yaml", entry.name),
+            entry.path.to_string(),
+        )
+    };
+    let source = std::fs::read_to_string(&path)
+        .map_err(|e| CliError::usage(format!("cannot read `{display}`: {e}")))?;
+    Ok((display, source))
+}
+
+/// Renders diagnostics for the terminal.
+pub fn render(
+    display: &str,
+    source: &str,
+    diagnostics: &[eomgen_symbolic::model::Diagnostic],
+) -> CliError {
+    let text: Vec<String> = diagnostics
+        .iter()
+        .map(|d| d.render(display, source))
+        .collect();
+    CliError::failure(format!(
+        "{} error(s) in the model file\n{}",
+        diagnostics.len(),
+        text.join("\n")
+    ))
+}
+
+/// Runs `equations`.
+pub fn run(args: &EquationsArgs) -> Result<(), CliError> {
+    let (display, source) = read_model(&args.model)?;
+    let file = eomgen_symbolic::model::load(&display, &source)
+        .map_err(|d| render(&display, &source, &d))?;
+    let mut model = SymbolicModel::from_file(&file).map_err(|d| render(&display, &source, &d))?;
+    let eom = match args.method {
+        Method::Lagrange => Lagrange.derive(&mut model),
+        Method::Momentum => {
+            if !MomentumBalance::applies_to(&model) {
+                return Err(CliError::usage(format!(
+                    "`{}` uses the energy form (kinetic/potential/generalized_forces), which momentum balance cannot use; try --method lagrange",
+                    model.name
+                )));
+            }
+            MomentumBalance.derive(&mut model)
+        }
+    };
+    if args.latex {
+        print!("{}", equations_latex(&model, &eom));
+    } else {
+        print!("{}", equations_text(&model, &eom));
+    }
+    Ok(())
+}
+
+/// Runs `new`.
+pub fn new(args: &NewArgs) -> Result<(), CliError> {
+    match templates::generate(&args.template, args.n) {
+        Some(text) => {
+            print!("{text}");
+            Ok(())
+        }
+        None if args.n == 0 => Err(CliError::usage("N must be at least 1")),
+        None => Err(CliError::usage(format!(
+            "unknown template `{}`; templates are: {}",
+            args.template,
+            templates::TEMPLATES.join(", ")
+        ))),
+    }
+}
