@@ -458,3 +458,78 @@ fn double_pendulum_matches_independent_reference() {
         assert!(err < tol, "t = {t}: max difference {err}");
     }
 }
+
+/// Period of small oscillations of a 1-DOF model about the equilibrium `q_eq`, released from
+/// rest at `q_eq + amplitude`: twice the time between the first two crossings of `q_eq`.
+fn small_oscillation_period(name: &str, q_eq: f64, amplitude: f64, omega_guess: f64) -> f64 {
+    let mut m = model(name);
+    let y0 = vec![q_eq + amplitude, 0.0];
+    let period = 2.0 * PI / omega_guess;
+    let offset = |y: &[f64]| y[0] - q_eq;
+    let t1 = crossing(m.as_mut(), &y0, 0.1 * period, 0.5 * period, &offset);
+    let t3 = crossing(m.as_mut(), &y0, 0.6 * period, 0.9 * period, &offset);
+    2.0 * (t3 - t1)
+}
+
+/// Lecture 14: compound pendulum, ω² = m g d/(I + m d²) = 15 for a unit bar hinged at its end.
+/// Amplitude 1e-3: the nonlinear correction is θ0²/16 ≈ 6e-8; tolerance 1e-6 relative.
+/// HW22: bead on y = c x², ω = √(2 g c); the correction is O(c² x0²) = 1e-8 at x0 = 1e-4.
+/// HW26: rolling cylinder, ω² = 2 g/(3 (R − r)); amplitude 1e-3.
+#[test]
+fn small_oscillation_frequencies() {
+    let cases = [
+        (
+            "compound_pendulum",
+            0.0,
+            1e-3,
+            f64::sqrt(10.0 * 0.5 / (1.0 / 12.0 + 0.25)),
+        ),
+        ("bead_parabola", 0.0, 1e-4, (2.0f64 * 10.0 * 1.0).sqrt()),
+        (
+            "rolling_in_cylinder",
+            0.0,
+            1e-3,
+            (2.0 * 10.0 / (3.0 * (1.0 - 0.2f64))).sqrt(),
+        ),
+    ];
+    for (name, q_eq, amplitude, omega) in cases {
+        let measured = small_oscillation_period(name, q_eq, amplitude, omega);
+        let expected = 2.0 * PI / omega;
+        assert!(
+            (measured / expected - 1.0).abs() < 1e-6,
+            "{name}: period {measured} vs {expected}"
+        );
+    }
+}
+
+/// HW20: on the free turntable the angular momentum about O,
+/// H = I_t θ̇ + m_s (x ẏ − y ẋ) of the slider, is conserved (no external moment about the
+/// hinge). Tolerance 1e-10 at rtol 1e-12 over 10 s.
+#[test]
+fn turntable_conserves_angular_momentum() {
+    let mut m = model("turntable_slot");
+    let names = m.parameter_names();
+    let p = m.parameter_values();
+    let get = |n: &str| p[names.iter().position(|x| *x == n).unwrap()];
+    let (it, ms, d) = (get("I_t"), get("m_s"), get("d"));
+    let h = |y: &[f64]| {
+        let (th, s, w, sd) = (y[0], y[1], y[2], y[3]);
+        let (x, yy) = (d * th.sin() + s * th.cos(), -d * th.cos() + s * th.sin());
+        // Velocity of the slider by the chain rule.
+        let xd = d * th.cos() * w - s * th.sin() * w + sd * th.cos();
+        let yd = d * th.sin() * w + s * th.cos() * w + sd * th.sin();
+        it * w + ms * (x * yd - yy * xd)
+    };
+    let y0 = m.initial_state();
+    let h0 = h(&y0);
+    let s = solve(
+        m.as_mut(),
+        &y0,
+        10.0,
+        (1..=10).map(f64::from).collect(),
+        &tight(),
+    );
+    for (t, y) in s.iter() {
+        assert!((h(y) - h0).abs() < 1e-10, "t={t}: H {} vs {h0}", h(y));
+    }
+}
