@@ -13,7 +13,7 @@ use proc_macro2::Span;
 use syn::LitStr;
 
 use eomgen_symbolic::codegen::{self, EmitOptions};
-use eomgen_symbolic::mechanics::{Formulation, Jacobians, Lagrange, SymbolicModel};
+use eomgen_symbolic::mechanics::{Jacobians, SymbolicModel, cheapest_equations};
 
 /// Generates the equations of motion of a model file at compile time.
 ///
@@ -96,7 +96,7 @@ fn expand(input: proc_macro2::TokenStream) -> syn::Result<proc_macro2::TokenStre
     };
     let file = eomgen_symbolic::model::load(&written, &source).map_err(errors)?;
     let mut model = SymbolicModel::from_file(&file).map_err(errors)?;
-    let eom = Lagrange.derive(&mut model);
+    let (eom, _) = cheapest_equations(&mut model);
     let jacobians = Jacobians::of(&mut model, &eom);
     let options = EmitOptions {
         crate_path: "::eomgen".to_string(),
