@@ -86,7 +86,11 @@ fn print_report(r: &CheckReport) {
             c.b,
             c.max_rel_residual,
             c.states,
-            if c.symbolic_equal { "yes" } else { "no" }
+            match c.symbolic_equal {
+                Some(true) => "yes",
+                Some(false) => "no",
+                None => "not applicable",
+            }
         );
     }
     if let Some(p) = &r.power_balance {

@@ -250,9 +250,10 @@ fn eval_node(t: &Tree, x: f64, y: f64) -> f64 {
         Tree::F(f, p) => f.apply(eval_tree(p, x, y)),
         Tree::Atan2(p, q) => {
             let (a, b) = (eval_tree(p, x, y), eval_tree(q, x, y));
-            // On the branch cut (a = ±0, b < 0) the value is ±π by the sign of zero, which
-            // canonical folding (x·0 = +0) does not keep: skip such states.
-            if a == 0.0 && b < 0.0 {
+            // On the branch cut (a = ±0, b ≤ 0, including b = −0) the value is ±π or 0 by
+            // the signs of zeros, which canonical folding (x·0 = +0, 0/x = +0) does not keep:
+            // skip such states.
+            if a == 0.0 && b <= 0.0 {
                 f64::NAN
             } else {
                 a.atan2(b)

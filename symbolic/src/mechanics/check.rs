@@ -5,7 +5,9 @@ use std::time::Instant;
 
 use rustc_hash::FxHashMap;
 
-use super::{EquationsOfMotion, Formulation, Lagrange, MomentumBalance, SymbolicModel};
+use super::{
+    EquationsOfMotion, Formulation, Lagrange, MomentumBalance, SymbolicModel, UserBalances,
+};
 use crate::expr::eval::Evaluator;
 use crate::expr::{ExprId, SymbolKind, cse};
 use crate::model::{Diagnostic, ModelFile};
@@ -32,8 +34,9 @@ pub struct Comparison {
     pub b: &'static str,
     /// Largest `|q̈_a − q̈_b| / max(1, |q̈|)` over the random states.
     pub max_rel_residual: f64,
-    /// Whether `M_a − M_b` and `F_a − F_b` simplify to zero after expansion.
-    pub symbolic_equal: bool,
+    /// Whether `M_a − M_b` and `F_a − F_b` simplify to zero after expansion; `None` where
+    /// the rows are not expected to match (user balances are combinations of the equations).
+    pub symbolic_equal: Option<bool>,
     /// Number of states compared.
     pub states: usize,
 }
@@ -148,28 +151,37 @@ pub fn check_model(
     let mut notes = Vec::new();
     let (lagrange, lagrange_stats) = timed(&mut model, &Lagrange);
     let mut derivations = vec![lagrange_stats];
-    let momentum = if MomentumBalance::applies_to(&model) {
+    let mut others: Vec<(&'static str, EquationsOfMotion)> = Vec::new();
+    if MomentumBalance::applies_to(&model) {
         let (eom, stats) = timed(&mut model, &MomentumBalance);
         derivations.push(stats);
-        Some(eom)
+        others.push((MomentumBalance.name(), eom));
     } else {
         notes.push("momentum balance needs the kinematic form (bodies and loads, no `kinetic`, `potential` or `generalized_forces`): compared nothing".to_string());
-        None
-    };
-
-    let symbolic_equal = momentum.as_ref().map(|b| {
-        let arena = &mut model.arena;
-        lagrange
-            .mass_matrix
-            .iter()
-            .zip(&b.mass_matrix)
-            .chain(lagrange.forcing.iter().zip(&b.forcing))
-            .all(|(x, y)| {
-                let d = arena.minus(*x, *y);
-                let e = arena.expand(d);
-                arena.is_zero(e)
+    }
+    if UserBalances::applies_to(&model) {
+        let (eom, stats) = timed(&mut model, &UserBalances);
+        derivations.push(stats);
+        others.push((UserBalances.name(), eom));
+    }
+    let symbolic_equal: Vec<Option<bool>> = others
+        .iter()
+        .map(|(name, b)| {
+            (*name == MomentumBalance.name()).then(|| {
+                let arena = &mut model.arena;
+                lagrange
+                    .mass_matrix
+                    .iter()
+                    .zip(&b.mass_matrix)
+                    .chain(lagrange.forcing.iter().zip(&b.forcing))
+                    .all(|(x, y)| {
+                        let d = arena.minus(*x, *y);
+                        let e = arena.expand(d);
+                        arena.is_zero(e)
+                    })
             })
-    });
+        })
+        .collect();
 
     // Power balance: d(T + V)/dt along the motion against Σ Qᵢ q̇ᵢ.
     let energy = model.arena.plus(model.kinetic, model.potential);
@@ -190,7 +202,7 @@ pub fn check_model(
         .copied()
         .collect();
     let lagrange_len = roots.len();
-    if let Some(b) = &momentum {
+    for (_, b) in &others {
         roots.extend(b.mass_matrix.iter().chain(&b.forcing));
     }
     roots.extend([de_dt, power, model.kinetic]);
@@ -199,7 +211,7 @@ pub fn check_model(
     let mut kinetic_only = Evaluator::new(&model.arena, &[model.kinetic]);
 
     let mut rng = Rng(seed);
-    let mut max_rel: f64 = 0.0;
+    let mut max_rel: Vec<f64> = vec![0.0; others.len()];
     let mut power_rel: f64 = 0.0;
     let mut quadratic = true;
     let symbols = model.arena.symbols().to_vec();
@@ -231,17 +243,19 @@ pub fn check_model(
             continue;
         }
         compared += 1;
-        if momentum.is_some() {
-            if let Some(other) = solve(
-                v[lagrange_len..lagrange_len + nn].to_vec(),
-                v[lagrange_len + nn..lagrange_len + nn + n].to_vec(),
+        for (k, worst) in max_rel.iter_mut().enumerate() {
+            let base = lagrange_len + k * (nn + n);
+            match solve(
+                v[base..base + nn].to_vec(),
+                v[base + nn..base + nn + n].to_vec(),
             ) {
-                let scale = qdd.iter().chain(&other).fold(1.0f64, |m, x| m.max(x.abs()));
-                for (a, b) in qdd.iter().zip(&other) {
-                    max_rel = max_rel.max((a - b).abs() / scale);
+                Some(other) => {
+                    let scale = qdd.iter().chain(&other).fold(1.0f64, |m, x| m.max(x.abs()));
+                    for (a, b) in qdd.iter().zip(&other) {
+                        *worst = worst.max((a - b).abs() / scale);
+                    }
                 }
-            } else {
-                max_rel = f64::INFINITY;
+                None => *worst = f64::INFINITY,
             }
         }
         // T homogeneous of degree 2 in q̇?
@@ -274,16 +288,27 @@ pub fn check_model(
     if compared == 0 {
         notes.push("no random state had a solvable mass matrix".to_string());
     }
-    let comparisons = match momentum {
-        Some(_) => vec![Comparison {
+    let comparisons: Vec<Comparison> = others
+        .iter()
+        .zip(&max_rel)
+        .zip(&symbolic_equal)
+        .map(|(((name, _), worst), symbolic)| Comparison {
             a: "lagrange",
-            b: "momentum",
-            max_rel_residual: max_rel,
-            symbolic_equal: symbolic_equal.unwrap_or(false),
+            b: name,
+            max_rel_residual: *worst,
+            symbolic_equal: *symbolic,
             states: compared,
-        }],
-        None => Vec::new(),
-    };
+        })
+        .collect();
+    for c in &comparisons {
+        if c.b == UserBalances.name() && !(c.max_rel_residual <= 1e-8) {
+            notes.push(if c.max_rel_residual.is_finite() {
+                "the balances disagree with Lagrange: a chosen balance leaves a reaction force in, or misses a load (choose balances about the joints whose reactions they must eliminate)".to_string()
+            } else {
+                "the balances are not independent: their M′ is singular".to_string()
+            });
+        }
+    }
     let power_balance = if explicit_time {
         notes.push("power balance skipped: T or V depends explicitly on t".to_string());
         None

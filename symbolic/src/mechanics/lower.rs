@@ -44,6 +44,8 @@ pub enum LoadInfo {
     },
     /// A torque (N·m) on a body whose angle is `angle`.
     Torque {
+        /// Index into [`SymbolicModel::bodies`] of the body it acts on.
+        body: usize,
         /// The body's angle expression.
         angle: ExprId,
         /// Torque, counter-clockwise.
@@ -64,6 +66,26 @@ pub enum LoadInfo {
         between: [usize; 2],
         /// Coefficient (N·s/m).
         coefficient: ExprId,
+    },
+}
+
+/// A user-chosen momentum balance (`balances:`), as expressions.
+#[derive(Debug, Clone, PartialEq)]
+pub enum BalanceInfo {
+    /// Angular momentum balance about point `about` (index into [`SymbolicModel::points`]) of
+    /// the bodies `bodies` (indices into [`SymbolicModel::bodies`]).
+    Amb {
+        /// The point.
+        about: usize,
+        /// The bodies.
+        bodies: Vec<usize>,
+    },
+    /// Linear momentum balance of `bodies` along `along`.
+    Lmb {
+        /// The direction.
+        along: Vec<ExprId>,
+        /// The bodies.
+        bodies: Vec<usize>,
     },
 }
 
@@ -110,6 +132,8 @@ pub struct SymbolicModel {
     pub gravity: Option<Vec<ExprId>>,
     /// Springs, dampers, forces and torques as loads.
     pub loads: Vec<LoadInfo>,
+    /// The user's balances (empty if none).
+    pub balances: Vec<BalanceInfo>,
     /// Whether the file uses the energy form (`kinetic`, `potential` or
     /// `generalized_forces`), which a derivation from the kinematics alone cannot use.
     pub uses_energy_form: bool,
@@ -462,6 +486,10 @@ impl<'f> Lowering<'f> {
             };
             let tau = self.expr(&tq.value);
             loads.push(LoadInfo::Torque {
+                body: body_infos
+                    .iter()
+                    .position(|b| b.name == tq.body.value)
+                    .unwrap_or(0),
                 angle: th,
                 value: tau,
             });
@@ -469,6 +497,28 @@ impl<'f> Lowering<'f> {
                 let partial = self.arena.diff(th, *qs);
                 if !self.arena.is_zero(partial) {
                     q_terms[i].push(self.arena.times(tau, partial));
+                }
+            }
+        }
+
+        let mut balances = Vec::new();
+        for b in &file.balances {
+            let bodies: Vec<usize> = b
+                .bodies
+                .iter()
+                .filter_map(|name| body_infos.iter().position(|x| x.name == name.value))
+                .collect();
+            match &b.kind {
+                crate::model::BalanceKind::Amb { about } => match point(&about.value) {
+                    Some(about) => balances.push(BalanceInfo::Amb { about, bodies }),
+                    None => self.errors.push(Diagnostic::new(
+                        about.location,
+                        format!("unknown point `{}`", about.value),
+                    )),
+                },
+                crate::model::BalanceKind::Lmb { along } => {
+                    let along = along.iter().map(|e| self.expr(e)).collect();
+                    balances.push(BalanceInfo::Lmb { along, bodies });
                 }
             }
         }
@@ -539,6 +589,7 @@ impl<'f> Lowering<'f> {
             bodies: body_infos,
             gravity,
             loads,
+            balances,
             uses_energy_form: file.kinetic.is_some()
                 || file.potential.is_some()
                 || !file.generalized_forces.is_empty(),

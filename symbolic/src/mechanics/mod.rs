@@ -3,13 +3,15 @@
 //! One [`Formulation`] interface serves every derivation (Lagrange now; momentum balance
 //! next), so the code generator and the cross-checks treat them alike.
 
+mod balances;
 pub mod check;
 mod lagrange;
 mod lower;
 mod momentum;
 
+pub use balances::UserBalances;
 pub use lagrange::Lagrange;
-pub use lower::{BodyInfo, LoadInfo, ParameterInfo, SymbolicModel};
+pub use lower::{BalanceInfo, BodyInfo, LoadInfo, ParameterInfo, SymbolicModel};
 pub use momentum::MomentumBalance;
 
 use crate::expr::ExprId;

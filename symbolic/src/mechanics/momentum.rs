@@ -90,7 +90,7 @@ impl Formulation for MomentumBalance {
             let mut torque: Option<(ExprId, ExprId)> = None;
             match load {
                 LoadInfo::Force { point, vector } => forces.push((*point, vector.clone())),
-                LoadInfo::Torque { angle, value } => torque = Some((*angle, *value)),
+                LoadInfo::Torque { angle, value, .. } => torque = Some((*angle, *value)),
                 LoadInfo::Spring {
                     between: [pa, pb],
                     stiffness,
@@ -154,25 +154,34 @@ impl Formulation for MomentumBalance {
             }
         }
 
-        // Rᵢ is linear in q̈: M′ᵢⱼ = ∂Rᵢ/∂q̈ⱼ, F′ᵢ = −Rᵢ(q̈ = 0).
-        let zero = arena.int(0);
-        let at_rest: FxHashMap<_, _> = symbols.iter().map(|s| (s[2], zero)).collect();
-        let mut mass_matrix = Vec::with_capacity(n * n);
-        let mut forcing = Vec::with_capacity(n);
-        for terms in &residual {
-            let r = arena.sum(terms);
-            for s in &symbols {
-                let m = arena.diff(r, s[2]);
-                mass_matrix.push(arena.expand_if_cheaper(m));
-            }
-            let r0 = arena.substitute(r, &at_rest);
-            let f = arena.neg(r0);
-            forcing.push(arena.expand_if_cheaper(f));
+        linear_in_accelerations(arena, &residual, &symbols)
+    }
+}
+
+/// Equations `Rₖ(q, q̇, q̈, t) = 0`, each linear in `q̈`, as `M′ q̈ = F′`:
+/// `M′ₖⱼ = ∂Rₖ/∂q̈ⱼ`, `F′ₖ = −Rₖ(q̈ = 0)`, each multiplied out where that is cheaper.
+pub(crate) fn linear_in_accelerations(
+    arena: &mut crate::expr::ExprArena,
+    residual: &[Vec<ExprId>],
+    symbols: &[[crate::expr::SymbolId; 3]],
+) -> EquationsOfMotion {
+    let zero = arena.int(0);
+    let at_rest: FxHashMap<_, _> = symbols.iter().map(|s| (s[2], zero)).collect();
+    let mut mass_matrix = Vec::with_capacity(residual.len() * symbols.len());
+    let mut forcing = Vec::with_capacity(residual.len());
+    for terms in residual {
+        let r = arena.sum(terms);
+        for s in symbols {
+            let m = arena.diff(r, s[2]);
+            mass_matrix.push(arena.expand_if_cheaper(m));
         }
-        EquationsOfMotion {
-            num_dofs: n,
-            mass_matrix,
-            forcing,
-        }
+        let r0 = arena.substitute(r, &at_rest);
+        let f = arena.neg(r0);
+        forcing.push(arena.expand_if_cheaper(f));
+    }
+    EquationsOfMotion {
+        num_dofs: symbols.len(),
+        mass_matrix,
+        forcing,
     }
 }

@@ -6,7 +6,7 @@
 
 use super::ast::{Expr, FUNCTIONS};
 use super::diagnostic::{Diagnostic, Diagnostics};
-use super::file::{BodyKind, ModelFile, Parameter};
+use super::file::{BalanceKind, BodyKind, ModelFile, Parameter};
 use super::located::{Located, Location};
 use super::parser::{closest, eval_expr, identifiers};
 use super::schema::Incomplete;
@@ -32,6 +32,7 @@ pub fn check_partial(file: &ModelFile, incomplete: &Incomplete) -> Result<(), Ve
     checker.dimensions();
     checker.references();
     checker.masses();
+    checker.balances();
     checker.diagnostics.finish()
 }
 
@@ -575,6 +576,125 @@ impl<'f> Checker<'f> {
                 )),
             };
             self.error(d);
+        }
+    }
+
+    // Rule: user balances name existing bodies (each once per balance) and, for AMB, an
+    // existing point; AMB needs a planar model; an LMB direction has as many components as
+    // the points and depends only on parameters, coordinates and `t`; there are as many
+    // balances as coordinates; and, since only gravity (at each centre of mass) and torques
+    // (which name their body) can be assigned to the chosen bodies, a model with balances has
+    // no point loads (forces, springs, dampers) and no energy-form pieces.
+    fn balances(&mut self) {
+        let file = self.file;
+        if file.balances.is_empty() {
+            return;
+        }
+        let n = file.coordinates.len();
+        if file.balances.len() != n {
+            self.error(
+                Diagnostic::new(
+                    file.balances[0].location,
+                    format!("{} balance(s) for {n} coordinate(s): the balances must give one equation per coordinate", file.balances.len()),
+                )
+                .with_help("choose as many balances as coordinates, each free of reaction forces (HW19: AMB/O of both bars and AMB/E of the forearm)"),
+            );
+        }
+        let point_loads = file
+            .forces
+            .first()
+            .map(|f| (f.name.location, "force"))
+            .or_else(|| file.springs.first().map(|s| (s.name.location, "spring")))
+            .or_else(|| file.dampers.first().map(|d| (d.name.location, "damper")));
+        if let Some((location, what)) = point_loads {
+            self.error(
+                Diagnostic::new(location, format!("a {what} in a model with `balances` is not supported yet"))
+                    .with_help("a balance needs to know which body each load acts on; for now balances take gravity and torques only"),
+            );
+        }
+        if file.kinetic.is_some() || file.potential.is_some() || !file.generalized_forces.is_empty()
+        {
+            self.error(
+                Diagnostic::new(file.balances[0].location, "`balances` need the kinematic form, but the model gives `kinetic`, `potential` or `generalized_forces`")
+                    .with_help("describe the mechanism with `points`, `bodies` and loads"),
+            );
+        }
+        for b in &file.balances {
+            let mut seen: Vec<&str> = Vec::new();
+            for body in &b.bodies {
+                if !self.bodies.contains(&body.value.as_str()) {
+                    let d = Diagnostic::new(
+                        body.location,
+                        format!("unknown body `{}` in a balance", body.value),
+                    );
+                    let d = match closest(&body.value, &self.bodies) {
+                        Some(c) => d.with_help(format!("did you mean `{c}`?")),
+                        None => d.with_help(format!("bodies are: {}", self.bodies.join(", "))),
+                    };
+                    self.error(d);
+                } else if seen.contains(&body.value.as_str()) {
+                    self.error(Diagnostic::new(
+                        body.location,
+                        format!("body `{}` is listed twice in this balance", body.value),
+                    ));
+                }
+                seen.push(body.value.as_str());
+            }
+            match &b.kind {
+                BalanceKind::Amb { about } => {
+                    if !self.points.contains(&about.value.as_str()) {
+                        let d = Diagnostic::new(
+                            about.location,
+                            format!("unknown point `{}`", about.value),
+                        );
+                        let d = match closest(&about.value, &self.points) {
+                            Some(c) => d.with_help(format!("did you mean `{c}`?")),
+                            None => d.with_help(format!("points are: {}", self.points.join(", "))),
+                        };
+                        self.error(d);
+                    }
+                    if file.dimension == Some(3) {
+                        self.error(Diagnostic::new(
+                            b.location,
+                            "`amb` balances are planar, but the points are 3-D",
+                        ));
+                    }
+                }
+                BalanceKind::Lmb { along } => {
+                    if let Some(dim) = file.dimension {
+                        if along.len() != dim {
+                            self.error(Diagnostic::new(
+                                b.location,
+                                format!(
+                                    "`along` has {} components but the points have {dim}",
+                                    along.len()
+                                ),
+                            ));
+                        }
+                    }
+                    for e in along {
+                        let mut ids = Vec::new();
+                        identifiers(e, &mut ids);
+                        for (name, location) in ids {
+                            let ok = self.params.contains(&name.as_str())
+                                || self.coords.contains(&name.as_str())
+                                || name == "t"
+                                || name == "pi";
+                            if !ok {
+                                self.error(
+                                    Diagnostic::new(
+                                        location,
+                                        format!("`along` cannot use `{name}`"),
+                                    )
+                                    .with_help(
+                                        "a direction may use parameters, coordinates and `t`",
+                                    ),
+                                );
+                            }
+                        }
+                    }
+                }
+            }
         }
     }
 

@@ -121,6 +121,35 @@ pub struct Torque {
     pub value: Expr,
 }
 
+/// Which momentum balance a [`Balance`] writes.
+#[derive(Debug, Clone, PartialEq)]
+pub enum BalanceKind {
+    /// Angular momentum balance about a point (fixed or moving), planar models:
+    /// `Σ (r_G − r_A) × m a_G + I θ̈ = Σ (r_P − r_A) × F + Σ τ` over the chosen bodies.
+    Amb {
+        /// The point A.
+        about: Located<String>,
+    },
+    /// Linear momentum balance of the chosen bodies along a direction `e`:
+    /// `Σ m a_G·e = Σ F·e`.
+    Lmb {
+        /// The direction `e` (expressions of `q` and `t`, as many components as the points).
+        along: Vec<Expr>,
+    },
+}
+
+/// One momentum-balance equation chosen by the user (`balances:`), as the course writes them:
+/// `{ amb: { about: O, bodies: [upper, fore] } }` or `{ lmb: { bodies: [slider], along: [..] } }`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Balance {
+    /// AMB or LMB.
+    pub kind: BalanceKind,
+    /// The bodies whose momentum is balanced.
+    pub bodies: Vec<Located<String>>,
+    /// Where the entry starts.
+    pub location: Location,
+}
+
 /// What an animation draws (`draw:`). Parsed and checked now; used by `animate` later.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct Draw {
@@ -168,6 +197,8 @@ pub struct ModelFile {
     pub initial: Vec<(Located<String>, Expr)>,
     /// `draw:`.
     pub draw: Draw,
+    /// `balances:` — momentum-balance equations chosen by the user (empty if none).
+    pub balances: Vec<Balance>,
     /// The spatial dimension of the points (2 or 3); `None` when there are no points.
     pub dimension: Option<usize>,
 }

@@ -32,13 +32,13 @@ pub const TOP_LEVEL_KEYS: &[&str] = &[
     "torques",
     "initial",
     "draw",
+    "balances",
 ];
 
 /// Keys of the model format (DESIGN.md) that this version does not implement yet.
 pub const LATER_KEYS: &[&str] = &[
     "constraints",
     "nonholonomic",
-    "balances",
     "events",
     "equilibria",
     "outputs",
@@ -680,6 +680,10 @@ impl Ctx<'_> {
             .unwrap_or_default();
         self.section = "draw";
         let draw = get(top, "draw").map(|n| self.draw(n)).unwrap_or_default();
+        self.section = "balances";
+        let balances = get(top, "balances")
+            .map(|n| self.balances(n))
+            .unwrap_or_default();
         self.section = "";
 
         let dimension = points.first().map(|p: &Point| p.position.len());
@@ -702,7 +706,85 @@ impl Ctx<'_> {
             initial,
             draw,
             dimension,
+            balances,
         })
+    }
+
+    fn balances(&mut self, node: &YamlNode) -> Vec<Balance> {
+        const EXAMPLE: &str = "balances:\n  - { amb: { about: O, bodies: [upper, fore] } }\n  - { lmb: { bodies: [slider], along: [cos(theta), sin(theta)] } }";
+        let Some(items) = self.seq(node, "`balances`", EXAMPLE) else {
+            return Vec::new();
+        };
+        let mut out = Vec::new();
+        for item in items {
+            let Some(entries) = self.map(
+                item,
+                "a balance",
+                "{ amb: { about: O, bodies: [upper, fore] } }",
+            ) else {
+                continue;
+            };
+            if entries.len() != 1 || !matches!(entries[0].0.value.as_str(), "amb" | "lmb") {
+                self.error(
+                    Diagnostic::new(item.location, "a balance is one of `amb: {…}` (angular momentum balance) or `lmb: {…}` (linear momentum balance)")
+                        .with_help("write `{ amb: { about: O, bodies: [upper, fore] } }` or `{ lmb: { bodies: [slider], along: [1, 0] } }`"),
+                );
+                continue;
+            }
+            let (key, value) = &entries[0];
+            let amb = key.value == "amb";
+            let (allowed, example): (&[&str], &str) = if amb {
+                (&["about", "bodies"], "{ about: O, bodies: [upper, fore] }")
+            } else {
+                (
+                    &["bodies", "along"],
+                    "{ bodies: [slider], along: [cos(theta), sin(theta)] }",
+                )
+            };
+            let Some(f) = self.fields(
+                key,
+                value,
+                if amb {
+                    "angular momentum balance"
+                } else {
+                    "linear momentum balance"
+                },
+                allowed,
+                allowed,
+                example,
+            ) else {
+                continue;
+            };
+            let mut bodies = Vec::new();
+            if let Some(list) =
+                get(f, "bodies").and_then(|n| self.seq(n, "`bodies`", "bodies: [upper, fore]"))
+            {
+                for b in list {
+                    if let Some(name) = self.name(b, "a body") {
+                        bodies.push(name);
+                    }
+                }
+            }
+            let kind = if amb {
+                get(f, "about")
+                    .and_then(|n| self.name(n, "`about`"))
+                    .map(|about| BalanceKind::Amb { about })
+            } else {
+                get(f, "along")
+                    .and_then(|n| self.vector(n, "`along`", "along: [cos(theta), sin(theta)]"))
+                    .map(|along| BalanceKind::Lmb { along })
+            };
+            if let Some(kind) = kind {
+                if !bodies.is_empty() {
+                    out.push(Balance {
+                        kind,
+                        bodies,
+                        location: item.location,
+                    });
+                }
+            }
+        }
+        out
     }
 
     fn parameters(&mut self, node: &YamlNode) -> Vec<Parameter> {

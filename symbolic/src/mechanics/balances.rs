@@ -1,0 +1,111 @@
+//! The user's own momentum balances (`balances:`), written as the course writes them (HW19:
+//! AMB/O of the whole arm and AMB/E of the forearm; HW20: AMB/centre and LMB·î′).
+//!
+//! For a set S of bodies and a point A, fixed or moving, angular momentum balance in the plane
+//! with absolute accelerations is
+//!
+//! ```text
+//! Σ_{b∈S} [ (r_G − r_A) × m a_G + I θ̈ ] = Σ_{b∈S} (r_G − r_A) × m g + Σ τ_b  (+ reactions)
+//! ```
+//!
+//! which holds for any A because it uses `r_{G/A} × m a_G` (HW4, HW15 a). Linear momentum
+//! balance along `e` is `Σ m a_G·e = Σ m g·e (+ reactions)`. The user chooses balances whose
+//! reaction terms vanish; if they do not, the result differs from Lagrange's, which
+//! `eomgen check` reports. `M′` is in general not symmetric.
+
+use super::lower::{BalanceInfo, LoadInfo};
+use super::momentum::linear_in_accelerations;
+use super::{EquationsOfMotion, Formulation, SymbolicModel};
+use crate::expr::{ExprArena, ExprId};
+
+/// The model's `balances:` as equations of motion.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct UserBalances;
+
+impl UserBalances {
+    /// Whether the model gives one balance per coordinate.
+    pub fn applies_to(model: &SymbolicModel) -> bool {
+        !model.balances.is_empty() && model.balances.len() == model.num_dofs()
+    }
+}
+
+fn cross_z(arena: &mut ExprArena, a: &[ExprId], b: &[ExprId]) -> ExprId {
+    let p = arena.times(a[0], b[1]);
+    let q = arena.times(a[1], b[0]);
+    arena.minus(p, q)
+}
+
+impl Formulation for UserBalances {
+    fn name(&self) -> &'static str {
+        "balances"
+    }
+
+    fn derive(&self, model: &mut SymbolicModel) -> EquationsOfMotion {
+        let n = model.num_dofs();
+        let symbols: Vec<_> = (0..n).map(|i| model.coordinate_symbols(i)).collect();
+        let points: Vec<Vec<ExprId>> = model.points.iter().map(|(_, r)| r.clone()).collect();
+        let bodies = model.bodies.clone();
+        let loads = model.loads.clone();
+        let gravity = model.gravity.clone();
+        let balances = model.balances.clone();
+        let arena = &mut model.arena;
+        let mut residuals: Vec<Vec<ExprId>> = Vec::with_capacity(balances.len());
+        for balance in &balances {
+            let mut terms = Vec::new();
+            let (chosen, about, along) = match balance {
+                BalanceInfo::Amb { about, bodies } => (bodies, Some(*about), None),
+                BalanceInfo::Lmb { along, bodies } => (bodies, None, Some(along.clone())),
+            };
+            for &b in chosen {
+                let body = &bodies[b];
+                let r = &points[body.com];
+                let v: Vec<ExprId> = r.iter().map(|c| arena.time_derivative(*c)).collect();
+                let a: Vec<ExprId> = v.iter().map(|c| arena.time_derivative(*c)).collect();
+                let ma: Vec<ExprId> = a.iter().map(|c| arena.times(body.mass, *c)).collect();
+                let mg: Vec<ExprId> = gravity
+                    .as_ref()
+                    .map(|g| g.iter().map(|c| arena.times(body.mass, *c)).collect())
+                    .unwrap_or_default();
+                if let Some(about) = about {
+                    let rel: Vec<ExprId> = r
+                        .iter()
+                        .zip(&points[about])
+                        .map(|(x, y)| arena.minus(*x, *y))
+                        .collect();
+                    terms.push(cross_z(arena, &rel, &ma));
+                    if !mg.is_empty() {
+                        let m = cross_z(arena, &rel, &mg);
+                        terms.push(arena.neg(m));
+                    }
+                    if let Some((inertia, angle)) = body.rotation {
+                        let w = arena.time_derivative(angle);
+                        let alpha = arena.time_derivative(w);
+                        terms.push(arena.times(inertia, alpha));
+                    }
+                    for load in &loads {
+                        if let LoadInfo::Torque {
+                            body: on, value, ..
+                        } = load
+                        {
+                            if *on == b {
+                                terms.push(arena.neg(*value));
+                            }
+                        }
+                    }
+                } else if let Some(e) = &along {
+                    let t: Vec<ExprId> =
+                        ma.iter().zip(e).map(|(x, y)| arena.times(*x, *y)).collect();
+                    terms.push(arena.sum(&t));
+                    if !mg.is_empty() {
+                        let t: Vec<ExprId> =
+                            mg.iter().zip(e).map(|(x, y)| arena.times(*x, *y)).collect();
+                        let s = arena.sum(&t);
+                        terms.push(arena.neg(s));
+                    }
+                }
+            }
+            residuals.push(terms);
+        }
+        linear_in_accelerations(arena, &residuals, &symbols)
+    }
+}
