@@ -448,6 +448,7 @@ impl ExprArena {
             }
         }
         self.collect_pythagorean(&mut collected, &mut constant);
+        self.collect_angle_differences(&mut collected);
         let mut operands: Vec<ExprId> = Vec::with_capacity(collected.len() + 1);
         let mut entries: Vec<(ExprId, Constant)> = collected.into_iter().collect();
         entries.sort_by_key(|(rest, _)| *rest);
@@ -561,6 +562,110 @@ impl ExprArena {
                     };
                     let entry = collected.entry(x).or_insert(Constant::ZERO);
                     *entry = entry.add(c).unwrap_or(*entry);
+                }
+            }
+        }
+    }
+
+    /// Angle-difference identities on collected sum terms:
+    /// `c·X·cos u·cos v + c·X·sin u·sin v = c·X·cos(u − v)` and
+    /// `c·X·sin u·cos v − c·X·cos u·sin v = c·X·sin(u − v)`, with `u` the argument of smaller
+    /// id so that each difference has one canonical node. Partners are found by hash-cons
+    /// lookups only.
+    fn collect_angle_differences(&mut self, collected: &mut indexmap::IndexMap<ExprId, Constant>) {
+        loop {
+            let mut found: Option<(ExprId, ExprId, Vec<ExprId>, Constant, Func, ExprId, ExprId)> =
+                None;
+            'search: for (&rest, &c) in collected.iter() {
+                if c.is_zero() {
+                    continue;
+                }
+                let factors: Vec<ExprId> = match self.node(rest) {
+                    Node::Mul(f) => f.to_vec(),
+                    _ => vec![rest],
+                };
+                let trig: Vec<(usize, Func, ExprId)> = factors
+                    .iter()
+                    .enumerate()
+                    .filter_map(|(i, &f)| match self.node(f) {
+                        Node::Func(func @ (Func::Sin | Func::Cos), u) => Some((i, *func, *u)),
+                        _ => None,
+                    })
+                    .collect();
+                for &(i, fi, u) in &trig {
+                    for &(j, fj, v) in &trig {
+                        if i == j || u == v {
+                            continue;
+                        }
+                        // cos u cos v (u < v) pairs with sin u sin v; sin u cos v with cos u sin v.
+                        let (partner_i, partner_j, sign, result) = match (fi, fj) {
+                            (Func::Cos, Func::Cos) if u < v => {
+                                (Func::Sin, Func::Sin, Constant::ONE, Func::Cos)
+                            }
+                            (Func::Sin, Func::Cos) => {
+                                (Func::Cos, Func::Sin, Constant::MINUS_ONE, Func::Sin)
+                            }
+                            _ => continue,
+                        };
+                        let (Some(&pi), Some(&pj)) = (
+                            self.memo.get(&Node::Func(partner_i, u)),
+                            self.memo.get(&Node::Func(partner_j, v)),
+                        ) else {
+                            continue;
+                        };
+                        let mut others: Vec<ExprId> = factors
+                            .iter()
+                            .enumerate()
+                            .filter(|(k, _)| *k != i && *k != j)
+                            .map(|(_, f)| *f)
+                            .collect();
+                        let mut partner_factors = others.clone();
+                        partner_factors.push(pi);
+                        partner_factors.push(pj);
+                        partner_factors.sort();
+                        let partner = if partner_factors.len() == 1 {
+                            Some(partner_factors[0])
+                        } else {
+                            self.memo.get(&Node::Mul(partner_factors.into())).copied()
+                        };
+                        let Some(partner) = partner else { continue };
+                        let Some(expected) = c.mul(sign) else {
+                            continue;
+                        };
+                        if collected.get(&partner) == Some(&expected) {
+                            others.sort();
+                            found = Some((rest, partner, others, c, result, u, v));
+                            break 'search;
+                        }
+                    }
+                }
+            }
+            let Some((rest, partner, others, c, result, u, v)) = found else {
+                return;
+            };
+            collected.shift_remove(&rest);
+            collected.shift_remove(&partner);
+            // Canonical difference: smaller id first; sin(v − u) = −sin(u − v).
+            let (a, b, flip) = if u < v { (u, v, false) } else { (v, u, true) };
+            let diff = self.minus(a, b);
+            let f = self.func(result, diff);
+            let mut coefficient = c;
+            if flip && result == Func::Sin {
+                coefficient = c.neg();
+            }
+            let mut parts = others;
+            parts.push(f);
+            let term = self.product(&parts);
+            let (k, rest_term) = self.split_coefficient(term);
+            let total = coefficient.mul(k).unwrap_or(coefficient);
+            match rest_term {
+                Some(r) => {
+                    let entry = collected.entry(r).or_insert(Constant::ZERO);
+                    *entry = entry.add(total).unwrap_or(*entry);
+                }
+                None => {
+                    // A constant term cannot arise (f is not constant), but keep it safe.
+                    collected.insert(term, Constant::ONE);
                 }
             }
         }

@@ -63,24 +63,9 @@ impl Formulation for Lagrange {
             forcing.push(arena.sum(&terms));
         }
         // ∂T/∂qᵢ and the (∂pᵢ/∂qⱼ) q̇ⱼ terms share products that cancel exactly; they only
-        // meet as like terms once multiplied out. Expansion can also destroy sharing between
-        // entries, so keep whichever form of (M, F) costs fewer operations after CSE.
-        let expanded_mass: Vec<ExprId> = mass_matrix
-            .iter()
-            .map(|&m| arena.expand_if_cheaper(m))
-            .collect();
-        let expanded_forcing: Vec<ExprId> = forcing
-            .iter()
-            .map(|&f| arena.expand_if_cheaper(f))
-            .collect();
-        let cost = |arena: &crate::expr::ExprArena, m: &[ExprId], f: &[ExprId]| {
-            let roots: Vec<ExprId> = m.iter().chain(f).copied().collect();
-            crate::expr::cse::plan(arena, &roots, "t").operation_count()
-        };
-        if cost(arena, &expanded_mass, &expanded_forcing) < cost(arena, &mass_matrix, &forcing) {
-            mass_matrix = expanded_mass;
-            forcing = expanded_forcing;
-        }
+        // meet as like terms once multiplied out.
+        let (mass_matrix, forcing) =
+            super::cheaper_of_raw_and_expanded(arena, mass_matrix, forcing);
         EquationsOfMotion {
             num_dofs: n,
             mass_matrix,

@@ -116,3 +116,30 @@ pub fn cheapest_equations(model: &mut SymbolicModel) -> (EquationsOfMotion, &'st
         (lagrange, Lagrange.name())
     }
 }
+
+/// `(M, F)` as given or multiplied out entry by entry (where that is cheaper as a tree),
+/// whichever costs fewer operations after CSE as a whole: expansion exposes exact
+/// cancellations and angle-difference identities but can destroy sharing between entries.
+pub(crate) fn cheaper_of_raw_and_expanded(
+    arena: &mut crate::expr::ExprArena,
+    mass_matrix: Vec<ExprId>,
+    forcing: Vec<ExprId>,
+) -> (Vec<ExprId>, Vec<ExprId>) {
+    let expanded_mass: Vec<ExprId> = mass_matrix
+        .iter()
+        .map(|&m| arena.expand_if_cheaper(m))
+        .collect();
+    let expanded_forcing: Vec<ExprId> = forcing
+        .iter()
+        .map(|&f| arena.expand_if_cheaper(f))
+        .collect();
+    let cost = |arena: &crate::expr::ExprArena, m: &[ExprId], f: &[ExprId]| {
+        let roots: Vec<ExprId> = m.iter().chain(f).copied().collect();
+        crate::expr::cse::plan(arena, &roots, "t").operation_count()
+    };
+    if cost(arena, &expanded_mass, &expanded_forcing) < cost(arena, &mass_matrix, &forcing) {
+        (expanded_mass, expanded_forcing)
+    } else {
+        (mass_matrix, forcing)
+    }
+}

@@ -159,7 +159,7 @@ impl Formulation for MomentumBalance {
 }
 
 /// Equations `Rₖ(q, q̇, q̈, t) = 0`, each linear in `q̈`, as `M′ q̈ = F′`:
-/// `M′ₖⱼ = ∂Rₖ/∂q̈ⱼ`, `F′ₖ = −Rₖ(q̈ = 0)`, each multiplied out where that is cheaper.
+/// `M′ₖⱼ = ∂Rₖ/∂q̈ⱼ`, `F′ₖ = −Rₖ(q̈ = 0)`, multiplied out if that is cheaper after CSE.
 pub(crate) fn linear_in_accelerations(
     arena: &mut crate::expr::ExprArena,
     residual: &[Vec<ExprId>],
@@ -172,13 +172,12 @@ pub(crate) fn linear_in_accelerations(
     for terms in residual {
         let r = arena.sum(terms);
         for s in symbols {
-            let m = arena.diff(r, s[2]);
-            mass_matrix.push(arena.expand_if_cheaper(m));
+            mass_matrix.push(arena.diff(r, s[2]));
         }
         let r0 = arena.substitute(r, &at_rest);
-        let f = arena.neg(r0);
-        forcing.push(arena.expand_if_cheaper(f));
+        forcing.push(arena.neg(r0));
     }
+    let (mass_matrix, forcing) = super::cheaper_of_raw_and_expanded(arena, mass_matrix, forcing);
     EquationsOfMotion {
         num_dofs: symbols.len(),
         mass_matrix,
