@@ -38,7 +38,7 @@ use eomgen_symbolic::expr::ExprId;
 use eomgen_symbolic::expr::cse::{self, CsePlan};
 use eomgen_symbolic::expr::eval::Evaluator;
 use eomgen_symbolic::mechanics::{
-    EquationsOfMotion, Formulation, Jacobians, Lagrange, SymbolicModel,
+    EquationsOfMotion, Formulation, Jacobians, Lagrange, MomentumBalance, SymbolicModel,
 };
 use eomgen_symbolic::model;
 
@@ -287,5 +287,39 @@ fn derivation(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, derivation);
+/// Lagrange against momentum balance on the same lowered chain, N = 2 … 30 (issue 4's scaling
+/// table): only the derivation of `M` and `F` is timed; loading and lowering are setup.
+fn formulations(c: &mut Criterion) {
+    let mut group = c.benchmark_group("formulations");
+    group.sample_size(10);
+    for n in [2usize, 5, 10, 20, 30] {
+        let source = n_link_pendulum(n);
+        let file = model::load("chain.yaml", &source).expect("the generated chain loads");
+        let methods: [(&str, &dyn Formulation); 2] =
+            [("lagrange", &Lagrange), ("momentum", &MomentumBalance)];
+        for (name, method) in methods {
+            let mut lowered = SymbolicModel::from_file(&file).expect("lowers");
+            let eom = method.derive(&mut lowered);
+            let roots = mass_and_forcing_roots(&eom);
+            eprintln!(
+                "{name} n_link_pendulum_{n}: {} ops as trees, {} after CSE",
+                lowered.arena.tree_operation_count(&roots),
+                cse::plan(&lowered.arena, &roots, "t").operation_count()
+            );
+            group.bench_function(format!("{name}_n_link_pendulum_{n}"), |b| {
+                b.iter_batched(
+                    || SymbolicModel::from_file(&file).expect("lowers"),
+                    |mut m| {
+                        let eom = method.derive(&mut m);
+                        (m, eom)
+                    },
+                    BatchSize::LargeInput,
+                )
+            });
+        }
+    }
+    group.finish();
+}
+
+criterion_group!(benches, derivation, formulations);
 criterion_main!(benches);
