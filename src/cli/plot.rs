@@ -59,7 +59,8 @@ where
             }
         }
     }
-    if !(hi > lo) {
+    // No finite sample, or a constant signal: give the axis a unit range.
+    if hi.partial_cmp(&lo) != Some(std::cmp::Ordering::Greater) {
         lo -= 1.0;
         hi += 1.0;
     }

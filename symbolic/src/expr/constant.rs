@@ -124,7 +124,7 @@ impl Constant {
     }
 
     /// `self + other`, exact for rationals (falls back to `f64` on overflow).
-    pub fn add(self, other: Self) -> Option<Self> {
+    pub fn checked_add(self, other: Self) -> Option<Self> {
         if let (Constant::Rational { num: a, den: b }, Constant::Rational { num: c, den: d }) =
             (self, other)
         {
@@ -141,7 +141,7 @@ impl Constant {
     }
 
     /// `self · other`, exact for rationals (falls back to `f64` on overflow).
-    pub fn mul(self, other: Self) -> Option<Self> {
+    pub fn checked_mul(self, other: Self) -> Option<Self> {
         if let (Constant::Rational { num: a, den: b }, Constant::Rational { num: c, den: d }) =
             (self, other)
         {
@@ -158,7 +158,7 @@ impl Constant {
     }
 
     /// `-self`.
-    pub fn neg(self) -> Self {
+    pub fn negated(self) -> Self {
         match self {
             Constant::Rational { num, den } => match num.checked_neg() {
                 Some(n) => Constant::Rational { num: n, den },
@@ -229,9 +229,9 @@ mod tests {
     #[test]
     fn rational_arithmetic_is_exact() {
         let third = Constant::rational(1, 3).unwrap();
-        assert_eq!(third.mul(Constant::int(3)), Some(Constant::ONE));
+        assert_eq!(third.checked_mul(Constant::int(3)), Some(Constant::ONE));
         let half = Constant::rational(1, 2).unwrap();
-        assert_eq!(half.add(half), Some(Constant::ONE));
+        assert_eq!(half.checked_add(half), Some(Constant::ONE));
         assert_eq!(half.pow(Constant::int(-2)), Some(Constant::int(4)));
         assert_eq!(Constant::ZERO.pow(Constant::int(-1)), None);
     }
@@ -239,7 +239,7 @@ mod tests {
     #[test]
     fn overflow_falls_back_to_float() {
         let big = Constant::int(i64::MAX / 2);
-        let r = big.mul(Constant::int(4)).unwrap();
+        let r = big.checked_mul(Constant::int(4)).unwrap();
         assert!(matches!(r, Constant::Float(_)));
         assert_eq!(r.to_f64(), (i64::MAX / 2) as f64 * 4.0);
     }

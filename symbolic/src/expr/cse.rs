@@ -84,11 +84,11 @@ pub fn plan(arena: &ExprArena, roots: &[ExprId], prefix: &str) -> CsePlan {
         }
     }
     for &e in &reachable {
-        if let Node::Func(Func::Sin, u) = arena.node(e) {
-            if let Some(&c) = cos_of.get(u) {
-                partner.insert(e, c);
-                partner.insert(c, e);
-            }
+        if let Node::Func(Func::Sin, u) = arena.node(e)
+            && let Some(&c) = cos_of.get(u)
+        {
+            partner.insert(e, c);
+            partner.insert(c, e);
         }
     }
 

@@ -434,13 +434,13 @@ impl ExprArena {
             }
             let (c, rest) = self.split_coefficient(term);
             match rest {
-                None => match constant.add(c) {
+                None => match constant.checked_add(c) {
                     Some(s) => constant = s,
                     None => float_fallback.push(term),
                 },
                 Some(rest) => {
                     let entry = collected.entry(rest).or_insert(Constant::ZERO);
-                    match entry.add(c) {
+                    match entry.checked_add(c) {
                         Some(s) => *entry = s,
                         None => float_fallback.push(term),
                     }
@@ -538,11 +538,11 @@ impl ExprArena {
                     factors.sort();
                     self.memo.get(&Node::Mul(factors.into())).copied()
                 };
-                if let Some(partner) = partner {
-                    if collected.get(&partner) == Some(&c) {
-                        found = Some((rest, partner, others, c));
-                        break;
-                    }
+                if let Some(partner) = partner
+                    && collected.get(&partner) == Some(&c)
+                {
+                    found = Some((rest, partner, others, c));
+                    break;
                 }
             }
             let Some((rest, partner, others, c)) = found else {
@@ -552,7 +552,7 @@ impl ExprArena {
             collected.shift_remove(&partner);
             match others.len() {
                 0 => {
-                    *constant = constant.add(c).unwrap_or(*constant);
+                    *constant = constant.checked_add(c).unwrap_or(*constant);
                 }
                 _ => {
                     let x = if others.len() == 1 {
@@ -561,7 +561,7 @@ impl ExprArena {
                         self.add(Node::Mul(others.into()))
                     };
                     let entry = collected.entry(x).or_insert(Constant::ZERO);
-                    *entry = entry.add(c).unwrap_or(*entry);
+                    *entry = entry.checked_add(c).unwrap_or(*entry);
                 }
             }
         }
@@ -574,8 +574,7 @@ impl ExprArena {
     /// lookups only.
     fn collect_angle_differences(&mut self, collected: &mut indexmap::IndexMap<ExprId, Constant>) {
         loop {
-            let mut found: Option<(ExprId, ExprId, Vec<ExprId>, Constant, Func, ExprId, ExprId)> =
-                None;
+            let mut found: Option<AngleMatch> = None;
             'search: for (&rest, &c) in collected.iter() {
                 if c.is_zero() {
                     continue;
@@ -629,18 +628,35 @@ impl ExprArena {
                             self.memo.get(&Node::Mul(partner_factors.into())).copied()
                         };
                         let Some(partner) = partner else { continue };
-                        let Some(expected) = c.mul(sign) else {
+                        let Some(expected) = c.checked_mul(sign) else {
                             continue;
                         };
                         if collected.get(&partner) == Some(&expected) {
                             others.sort();
-                            found = Some((rest, partner, others, c, result, u, v));
+                            found = Some(AngleMatch {
+                                rest,
+                                partner,
+                                others,
+                                c,
+                                result,
+                                u,
+                                v,
+                            });
                             break 'search;
                         }
                     }
                 }
             }
-            let Some((rest, partner, others, c, result, u, v)) = found else {
+            let Some(AngleMatch {
+                rest,
+                partner,
+                others,
+                c,
+                result,
+                u,
+                v,
+            }) = found
+            else {
                 return;
             };
             collected.shift_remove(&rest);
@@ -651,17 +667,17 @@ impl ExprArena {
             let f = self.func(result, diff);
             let mut coefficient = c;
             if flip && result == Func::Sin {
-                coefficient = c.neg();
+                coefficient = c.negated();
             }
             let mut parts = others;
             parts.push(f);
             let term = self.product(&parts);
             let (k, rest_term) = self.split_coefficient(term);
-            let total = coefficient.mul(k).unwrap_or(coefficient);
+            let total = coefficient.checked_mul(k).unwrap_or(coefficient);
             match rest_term {
                 Some(r) => {
                     let entry = collected.entry(r).or_insert(Constant::ZERO);
-                    *entry = entry.add(total).unwrap_or(*entry);
+                    *entry = entry.checked_add(total).unwrap_or(*entry);
                 }
                 None => {
                     // A constant term cannot arise (f is not constant), but keep it safe.
@@ -683,7 +699,7 @@ impl ExprArena {
                     if c.is_zero() {
                         return self.int(0);
                     }
-                    coefficient = match coefficient.mul(c) {
+                    coefficient = match coefficient.checked_mul(c) {
                         Some(p) => p,
                         None => return self.int(0),
                     };
@@ -708,7 +724,7 @@ impl ExprArena {
                     if c.is_zero() {
                         return self.int(0);
                     }
-                    match coefficient.mul(c) {
+                    match coefficient.checked_mul(c) {
                         Some(v) => coefficient = v,
                         None => results.push(p),
                     }
@@ -786,10 +802,10 @@ impl ExprArena {
             if b.is_one() {
                 return self.int(1);
             }
-            if let Some(e) = e {
-                if let Some(v) = b.pow(e) {
-                    return self.constant(v);
-                }
+            if let Some(e) = e
+                && let Some(v) = b.pow(e)
+            {
+                return self.constant(v);
             }
             if b.is_zero() && e.is_some_and(|e| !e.is_negative()) {
                 return self.int(0);
@@ -816,7 +832,7 @@ impl ExprArena {
     fn negated_if_negative(&mut self, arg: ExprId) -> Option<ExprId> {
         let (c, rest) = self.split_coefficient(arg);
         if c.is_negative() {
-            let positive = self.constant(c.neg());
+            let positive = self.constant(c.negated());
             Some(match rest {
                 Some(r) => self.times(positive, r),
                 None => positive,
@@ -846,11 +862,11 @@ impl ExprArena {
                 return self.float(v);
             }
         }
-        if f.is_odd() || f.is_even() {
-            if let Some(positive) = self.negated_if_negative(arg) {
-                let inner = self.func(f, positive);
-                return if f.is_odd() { self.neg(inner) } else { inner };
-            }
+        if (f.is_odd() || f.is_even())
+            && let Some(positive) = self.negated_if_negative(arg)
+        {
+            let inner = self.func(f, positive);
+            return if f.is_odd() { self.neg(inner) } else { inner };
         }
         self.add(Node::Func(f, arg))
     }
@@ -928,6 +944,17 @@ impl ExprArena {
             .iter()
             .fold(0u64, |acc, r| acc.saturating_add(cost[r]))
     }
+}
+
+/// Two sum terms `c·X·f(u)·g(v)` and their partner that combine into `c·X·result(u − v)`.
+struct AngleMatch {
+    rest: ExprId,
+    partner: ExprId,
+    others: Vec<ExprId>,
+    c: Constant,
+    result: Func,
+    u: ExprId,
+    v: ExprId,
 }
 
 /// Operations a node costs by itself.

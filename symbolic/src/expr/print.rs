@@ -240,15 +240,13 @@ impl<'a> Printer<'a> {
             }
         }
         for &f in factors {
-            if (self.temporary)(f).is_none() {
-                if let Node::Pow([b, x]) = self.arena.node(f) {
-                    if let Some(c) = self.arena.as_constant(*x) {
-                        if c.is_negative() {
-                            denominator.push(self.power(*b, PowerExponent::Constant(c.neg())));
-                            continue;
-                        }
-                    }
-                }
+            if (self.temporary)(f).is_none()
+                && let Node::Pow([b, x]) = self.arena.node(f)
+                && let Some(c) = self.arena.as_constant(*x)
+                && c.is_negative()
+            {
+                denominator.push(self.power(*b, PowerExponent::Constant(c.negated())));
+                continue;
             }
             numerator.push(self.operand(f));
         }
@@ -404,7 +402,11 @@ enum PowerExponent {
 
 impl Constant {
     fn abs_constant(self) -> Constant {
-        if self.is_negative() { self.neg() } else { self }
+        if self.is_negative() {
+            self.negated()
+        } else {
+            self
+        }
     }
 }
 

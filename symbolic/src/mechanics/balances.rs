@@ -86,10 +86,9 @@ impl Formulation for UserBalances {
                         if let LoadInfo::Torque {
                             body: on, value, ..
                         } = load
+                            && *on == b
                         {
-                            if *on == b {
-                                terms.push(arena.neg(*value));
-                            }
+                            terms.push(arena.neg(*value));
                         }
                     }
                 } else if let Some(e) = &along {

@@ -301,7 +301,8 @@ pub fn check_model(
         })
         .collect();
     for c in &comparisons {
-        if c.b == UserBalances.name() && !(c.max_rel_residual <= 1e-8) {
+        if c.b == UserBalances.name() && (c.max_rel_residual.is_nan() || c.max_rel_residual > 1e-8)
+        {
             notes.push(if c.max_rel_residual.is_finite() {
                 "the balances disagree with Lagrange: a chosen balance leaves a reaction force in, or misses a load (choose balances about the joints whose reactions they must eliminate)".to_string()
             } else {

@@ -661,16 +661,16 @@ impl<'f> Checker<'f> {
                     }
                 }
                 BalanceKind::Lmb { along } => {
-                    if let Some(dim) = file.dimension {
-                        if along.len() != dim {
-                            self.error(Diagnostic::new(
-                                b.location,
-                                format!(
-                                    "`along` has {} components but the points have {dim}",
-                                    along.len()
-                                ),
-                            ));
-                        }
+                    if let Some(dim) = file.dimension
+                        && along.len() != dim
+                    {
+                        self.error(Diagnostic::new(
+                            b.location,
+                            format!(
+                                "`along` has {} components but the points have {dim}",
+                                along.len()
+                            ),
+                        ));
                     }
                     for e in along {
                         let mut ids = Vec::new();

@@ -774,14 +774,14 @@ impl Ctx<'_> {
                     .and_then(|n| self.vector(n, "`along`", "along: [cos(theta), sin(theta)]"))
                     .map(|along| BalanceKind::Lmb { along })
             };
-            if let Some(kind) = kind {
-                if !bodies.is_empty() {
-                    out.push(Balance {
-                        kind,
-                        bodies,
-                        location: item.location,
-                    });
-                }
+            if let Some(kind) = kind
+                && !bodies.is_empty()
+            {
+                out.push(Balance {
+                    kind,
+                    bodies,
+                    location: item.location,
+                });
             }
         }
         out
