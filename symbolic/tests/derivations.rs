@@ -3,6 +3,7 @@
 
 use eomgen_symbolic::expr::SymbolKind;
 use eomgen_symbolic::expr::eval::Evaluator;
+use eomgen_symbolic::mechanics::check::solve;
 use eomgen_symbolic::mechanics::{
     EquationsOfMotion, Formulation, Lagrange, MomentumBalance, SymbolicModel,
 };
@@ -15,33 +16,6 @@ impl Rng {
         self.0 ^= self.0 << 17;
         lo + (hi - lo) * ((self.0 >> 11) as f64 / (1u64 << 53) as f64)
     }
-}
-
-/// Solves `m x = f` (n × n row-major) by Gaussian elimination with partial pivoting.
-fn solve(mut m: Vec<f64>, mut f: Vec<f64>) -> Vec<f64> {
-    let n = f.len();
-    for c in 0..n {
-        let p = (c..n)
-            .max_by(|a, b| m[a * n + c].abs().total_cmp(&m[b * n + c].abs()))
-            .unwrap();
-        for k in 0..n {
-            m.swap(c * n + k, p * n + k);
-        }
-        f.swap(c, p);
-        for r in c + 1..n {
-            let factor = m[r * n + c] / m[c * n + c];
-            for k in c..n {
-                m[r * n + k] -= factor * m[c * n + k];
-            }
-            f[r] -= factor * f[c];
-        }
-    }
-    let mut x = vec![0.0; n];
-    for r in (0..n).rev() {
-        let s: f64 = (r + 1..n).map(|k| m[r * n + k] * x[k]).sum();
-        x[r] = (f[r] - s) / m[r * n + r];
-    }
-    x
 }
 
 fn derive(source: &str, formulation: &dyn Formulation) -> (SymbolicModel, EquationsOfMotion) {
@@ -61,7 +35,7 @@ fn accelerations(model: &SymbolicModel, eom: &EquationsOfMotion, bindings: &[f64
         .collect();
     let v = Evaluator::new(&model.arena, &roots).eval(bindings);
     let n = eom.num_dofs;
-    solve(v[..n * n].to_vec(), v[n * n..].to_vec())
+    solve(v[..n * n].to_vec(), v[n * n..].to_vec()).expect("M is regular at the sampled states")
 }
 
 /// Largest relative difference of q̈ between Lagrange on `a` and momentum balance on `b`

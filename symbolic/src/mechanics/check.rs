@@ -88,9 +88,9 @@ impl Rng {
     }
 }
 
-/// Solves `m x = f` (n × n row-major) by Gaussian elimination with partial pivoting; `None`
-/// if a pivot vanishes.
-fn solve(mut m: Vec<f64>, mut f: Vec<f64>) -> Option<Vec<f64>> {
+/// Solves `m x = f` (`m` is `n × n` row-major) by Gaussian elimination with partial pivoting;
+/// `None` if a pivot vanishes or is not finite.
+pub fn solve(mut m: Vec<f64>, mut f: Vec<f64>) -> Option<Vec<f64>> {
     let n = f.len();
     for c in 0..n {
         let p = (c..n).max_by(|a, b| m[a * n + c].abs().total_cmp(&m[b * n + c].abs()))?;

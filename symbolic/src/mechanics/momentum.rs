@@ -97,11 +97,7 @@ impl Formulation for MomentumBalance {
                     rest_length,
                 } => {
                     // F_A = −k (|d| − ℓ₀) d/|d| with d = r_A − r_B; F_B = −F_A.
-                    let d: Vec<ExprId> = points[*pa]
-                        .iter()
-                        .zip(&points[*pb])
-                        .map(|(x, y)| arena.minus(*x, *y))
-                        .collect();
+                    let d = separation(arena, &points, *pa, *pb);
                     let scale = match rest_length {
                         None => arena.neg(*stiffness),
                         Some(l0) => {
@@ -113,31 +109,21 @@ impl Formulation for MomentumBalance {
                             arena.times(*stiffness, s)
                         }
                     };
-                    let fa: Vec<ExprId> = d.iter().map(|c| arena.times(scale, *c)).collect();
-                    let fb: Vec<ExprId> = fa.iter().map(|c| arena.neg(*c)).collect();
-                    forces.push((*pa, fa));
-                    forces.push((*pb, fb));
+                    forces.extend(equal_and_opposite(arena, *pa, *pb, &d, scale));
                 }
                 LoadInfo::Damper {
                     between: [pa, pb],
                     coefficient,
                 } => {
                     // F_A = −c (ḋ·d) d/(d·d); F_B = −F_A.
-                    let d: Vec<ExprId> = points[*pa]
-                        .iter()
-                        .zip(&points[*pb])
-                        .map(|(x, y)| arena.minus(*x, *y))
-                        .collect();
+                    let d = separation(arena, &points, *pa, *pb);
                     let dd: Vec<ExprId> = d.iter().map(|c| arena.time_derivative(*c)).collect();
                     let rate = dot(arena, &d, &dd);
                     let d2 = dot(arena, &d, &d);
                     let cr = arena.times(*coefficient, rate);
                     let q = arena.divide(cr, d2);
                     let scale = arena.neg(q);
-                    let fa: Vec<ExprId> = d.iter().map(|c| arena.times(scale, *c)).collect();
-                    let fb: Vec<ExprId> = fa.iter().map(|c| arena.neg(*c)).collect();
-                    forces.push((*pa, fa));
-                    forces.push((*pb, fb));
+                    forces.extend(equal_and_opposite(arena, *pa, *pb, &d, scale));
                 }
             }
             for i in 0..n {
@@ -156,6 +142,33 @@ impl Formulation for MomentumBalance {
 
         linear_in_accelerations(arena, &residual, &symbols)
     }
+}
+
+/// `d = r_A − r_B` for points `a` and `b`.
+fn separation(
+    arena: &mut crate::expr::ExprArena,
+    points: &[Vec<ExprId>],
+    a: usize,
+    b: usize,
+) -> Vec<ExprId> {
+    points[a]
+        .iter()
+        .zip(&points[b])
+        .map(|(x, y)| arena.minus(*x, *y))
+        .collect()
+}
+
+/// The pair of forces `s·d` on `a` and `−s·d` on `b` (a spring or damper along the line).
+fn equal_and_opposite(
+    arena: &mut crate::expr::ExprArena,
+    a: usize,
+    b: usize,
+    d: &[ExprId],
+    scale: ExprId,
+) -> [(usize, Vec<ExprId>); 2] {
+    let fa: Vec<ExprId> = d.iter().map(|c| arena.times(scale, *c)).collect();
+    let fb: Vec<ExprId> = fa.iter().map(|c| arena.neg(*c)).collect();
+    [(a, fa), (b, fb)]
 }
 
 /// Equations `Rₖ(q, q̇, q̈, t) = 0`, each linear in `q̈`, as `M′ q̈ = F′`:
