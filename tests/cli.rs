@@ -167,7 +167,10 @@ fn check_passes_on_every_model_and_accepts_paths() {
         for c in v["checks"].as_array().unwrap() {
             assert!(c["max_rel_residual"].as_f64().unwrap() < 1e-8);
             assert_eq!(c["a"], "lagrange");
-            assert!(c["b"] == "momentum" || c["b"] == "balances", "{c}");
+            assert!(
+                ["momentum", "balances", "by_hand"].contains(&c["b"].as_str().unwrap()),
+                "{c}"
+            );
         }
     }
     let out = eomgen(&[
@@ -241,15 +244,20 @@ fn new_and_equations() {
     assert_eq!(eomgen(&["new", "n-mass-chain", "0"]).status.code(), Some(2));
 }
 
-/// Deliberately wrong balances are detected: a reaction left in (AMB about the elbow of both
-/// bars) and dependent balances (the same AMB twice) both fail `eomgen check` with exit 1 and
-/// a note saying why; HW19's own balances pass.
+/// Deliberately wrong derivations are detected, each with exit 1 and a note saying why: a
+/// reaction left in (AMB about the elbow of both bars), dependent balances (the same AMB
+/// twice), AMB about the moving elbow without the `v_E × m v_G` correction (HW4, HW15), hand
+/// equations with a dropped Coriolis term (HW20) and with a spring force of the wrong sign
+/// (HW9). HW19's own balances pass.
 #[test]
-fn check_detects_wrong_balances() {
+fn check_detects_wrong_derivations() {
     let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/wrong");
     for (file, note) in [
         ("reaction_left_in.yaml", "leaves a reaction force in"),
         ("dependent_balances.yaml", "not independent"),
+        ("h_dot_about_elbow.yaml", "misses v_A × m v_G"),
+        ("dropped_coriolis.yaml", "written by hand disagree"),
+        ("spring_sign.yaml", "written by hand disagree"),
     ] {
         let path = format!("{dir}/{file}");
         let out = eomgen(&["check", &path, "--states", "50", "--json"]);

@@ -133,3 +133,47 @@ fn the_comparison_detects_a_missing_inertia_term() {
         "a missing inertia went undetected (difference {d})"
     );
 }
+
+/// Runs `eomgen check`'s comparison on `source` and returns the largest residual of the
+/// user's balances against Lagrange.
+fn balances_residual(source: &str) -> f64 {
+    let file = eomgen_symbolic::model::load("m.yaml", source).expect("loads");
+    let report = eomgen_symbolic::mechanics::check::check_model(&file, 100, 11).expect("lowers");
+    report
+        .comparisons
+        .iter()
+        .find(|c| c.b == "balances")
+        .expect("balances compared")
+        .max_rel_residual
+}
+
+/// `form: h_dot` (Σ M_A = dH_A/dt) is right about a fixed point and about the centre of mass,
+/// and wrong about the moving elbow: HW19's balances pass with AMB/O written as dH_O/dt, and a
+/// pendulum with a motor torque passes AMB about its fixed hinge in both forms (torques
+/// enter the balances), while AMB/E in the `h_dot` form fails by O(1).
+#[test]
+fn h_dot_form_holds_about_fixed_points_only() {
+    let hw19 = include_str!("../../models/double_pendulum.yaml");
+    let fixed = hw19.replace(
+        "{ amb: { about: O, bodies: [upper, fore] } }",
+        "{ amb: { about: O, bodies: [upper, fore], form: h_dot } }",
+    );
+    assert_ne!(fixed, hw19);
+    assert!(balances_residual(&fixed) < 1e-10);
+    let moving = hw19.replace(
+        "{ amb: { about: E, bodies: [fore] } }",
+        "{ amb: { about: E, bodies: [fore], form: h_dot } }",
+    );
+    assert_ne!(moving, hw19);
+    assert!(balances_residual(&moving) > 1e-2);
+
+    let motor = "name: motor_pendulum\nparameters: { m: 2.0, l: 0.7, g: 9.81, tau0: 1.5 }\ncoordinates: [theta]\npoints:\n  O: [0, 0]\n  G: [l/2*sin(theta), -l/2*cos(theta)]\nbodies:\n  bar: { mass: m, inertia: m*l^2/12, com: G, angle: theta }\ngravity: [0, -g]\ntorques:\n  motor: { body: bar, value: tau0*cos(t) - 0.1*theta_dot }\nbalances:\n  - { amb: { about: O, bodies: [bar] } }\n";
+    assert!(balances_residual(motor) < 1e-10);
+    let motor_h_dot = motor.replace("bodies: [bar] }", "bodies: [bar], form: h_dot }");
+    assert!(balances_residual(&motor_h_dot) < 1e-10);
+    let about_g = motor.replace("about: O", "about: G");
+    assert!(
+        balances_residual(&about_g) > 1e-2,
+        "AMB about the centre of mass leaves the hinge reaction in"
+    );
+}

@@ -42,3 +42,30 @@ proptest! {
         pipeline(&src);
     }
 }
+
+/// An equation of motion written by hand must be linear in the accelerations: lowering
+/// rejects `x_ddot^2` and `x_ddot*y_ddot` at the entry's location, and accepts a linear
+/// equation written with a product that only cancels after expansion.
+#[test]
+fn hand_equations_must_be_linear_in_accelerations() {
+    let head = "name: a\nparameters: { m: 1.0, k: 1.0 }\ncoordinates: [x, y]\nkinetic: m*(x_dot^2 + y_dot^2)/2\npotential: k*(x^2 + y^2)/2\nchecks:\n  equations_of_motion:\n";
+    let bad = format!("{head}    - m*x_ddot^2 + k*x = 0\n    - m*y_ddot + k*y + x_ddot*y_ddot = 0\n");
+    let file = load("a.yaml", &bad).expect("loads");
+    let errors = SymbolicModel::from_file(&file).unwrap_err();
+    let found: Vec<String> = errors
+        .iter()
+        .map(|d| format!("{}: {}", d.location, d.message))
+        .collect();
+    assert_eq!(
+        found,
+        [
+            "8:7: this equation of motion is not linear in the accelerations",
+            "9:7: this equation of motion is not linear in the accelerations"
+        ]
+    );
+    let good = format!(
+        "{head}    - (x_ddot + 1)^2 - x_ddot^2 + 2*k*x/m - 1 = 0\n    - m*y_ddot = -k*y\n"
+    );
+    let file = load("a.yaml", &good).expect("loads");
+    assert!(SymbolicModel::from_file(&file).is_ok());
+}

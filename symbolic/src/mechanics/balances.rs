@@ -12,8 +12,18 @@
 //! balance along `e` is `Σ m a_G·e = Σ m g·e (+ reactions)`. The user chooses balances whose
 //! reaction terms vanish; if they do not, the result differs from Lagrange's, which
 //! `eomgen check` reports. `M′` is in general not symmetric.
+//!
+//! An `amb` entry with `form: h_dot` is written `Σ M_A = dH_A/dt` with
+//! `H_A = Σ (r_G − r_A) × m v_G + I θ̇` instead. Since
+//! `dH_A/dt = Σ (r_G − r_A) × m a_G + I θ̈ − v_A × m v_G`, that form is right only when
+//! `v_A × v_G = 0` — a fixed point or the centre of mass — and `eomgen check` catches it about
+//! any other moving point (the mistake HW4 and HW15 warn of).
+//!
+//! [`HandEquations`] are the file's own equations of motion (`checks: equations_of_motion`),
+//! written by hand: compared with Lagrange like any other derivation.
 
 use super::lower::{BalanceInfo, LoadInfo};
+use crate::model::AmbForm;
 use super::momentum::linear_in_accelerations;
 use super::{EquationsOfMotion, Formulation, SymbolicModel};
 use crate::expr::{ExprArena, ExprId};
@@ -52,9 +62,15 @@ impl Formulation for UserBalances {
         let mut residuals: Vec<Vec<ExprId>> = Vec::with_capacity(balances.len());
         for balance in &balances {
             let mut terms = Vec::new();
-            let (chosen, about, along) = match balance {
-                BalanceInfo::Amb { about, bodies } => (bodies, Some(*about), None),
-                BalanceInfo::Lmb { along, bodies } => (bodies, None, Some(along.clone())),
+            let (chosen, about, along, form) = match balance {
+                BalanceInfo::Amb {
+                    about,
+                    bodies,
+                    form,
+                } => (bodies, Some(*about), None, *form),
+                BalanceInfo::Lmb { along, bodies } => {
+                    (bodies, None, Some(along.clone()), AmbForm::RCrossMa)
+                }
             };
             for &b in chosen {
                 let body = &bodies[b];
@@ -72,15 +88,31 @@ impl Formulation for UserBalances {
                         .zip(&points[about])
                         .map(|(x, y)| arena.minus(*x, *y))
                         .collect();
-                    terms.push(cross_z(arena, &rel, &ma));
                     if !mg.is_empty() {
                         let m = cross_z(arena, &rel, &mg);
                         terms.push(arena.neg(m));
                     }
-                    if let Some((inertia, angle)) = body.rotation {
-                        let w = arena.time_derivative(angle);
-                        let alpha = arena.time_derivative(w);
-                        terms.push(arena.times(inertia, alpha));
+                    match form {
+                        AmbForm::RCrossMa => {
+                            terms.push(cross_z(arena, &rel, &ma));
+                            if let Some((inertia, angle)) = body.rotation {
+                                let w = arena.time_derivative(angle);
+                                let alpha = arena.time_derivative(w);
+                                terms.push(arena.times(inertia, alpha));
+                            }
+                        }
+                        AmbForm::HDot => {
+                            // H_A = r_G/A × m v_G + I ω, differentiated as a whole.
+                            let mv: Vec<ExprId> =
+                                v.iter().map(|c| arena.times(body.mass, *c)).collect();
+                            let mut h = cross_z(arena, &rel, &mv);
+                            if let Some((inertia, angle)) = body.rotation {
+                                let w = arena.time_derivative(angle);
+                                let iw = arena.times(inertia, w);
+                                h = arena.plus(h, iw);
+                            }
+                            terms.push(arena.time_derivative(h));
+                        }
                     }
                     for load in &loads {
                         if let LoadInfo::Torque {
@@ -106,5 +138,32 @@ impl Formulation for UserBalances {
             residuals.push(terms);
         }
         linear_in_accelerations(arena, &residuals, &symbols)
+    }
+}
+
+/// The equations of motion the file states as derived by hand (`checks:
+/// equations_of_motion`), each `lhs − rhs = 0` split into `M′ q̈ = f′` by its coefficients of
+/// the accelerations. Any set of independent combinations of the true equations passes the
+/// comparison in `eomgen check`; a dropped or wrong term does not.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct HandEquations;
+
+impl HandEquations {
+    /// Whether the model gives one equation per coordinate.
+    pub fn applies_to(model: &SymbolicModel) -> bool {
+        !model.hand_equations.is_empty() && model.hand_equations.len() == model.num_dofs()
+    }
+}
+
+impl Formulation for HandEquations {
+    fn name(&self) -> &'static str {
+        "by_hand"
+    }
+
+    fn derive(&self, model: &mut SymbolicModel) -> EquationsOfMotion {
+        let n = model.num_dofs();
+        let symbols: Vec<_> = (0..n).map(|i| model.coordinate_symbols(i)).collect();
+        let residuals: Vec<Vec<ExprId>> = model.hand_equations.iter().map(|r| vec![*r]).collect();
+        linear_in_accelerations(&mut model.arena, &residuals, &symbols)
     }
 }

@@ -6,11 +6,13 @@ use std::time::Instant;
 use rustc_hash::FxHashMap;
 
 use super::{
-    EquationsOfMotion, Formulation, Lagrange, MomentumBalance, SymbolicModel, UserBalances,
+    EquationsOfMotion, Formulation, HandEquations, Lagrange, MomentumBalance, SymbolicModel,
+    UserBalances,
 };
 use crate::expr::eval::Evaluator;
 use crate::expr::{ExprId, SymbolKind, cse};
-use crate::model::{Diagnostic, ModelFile};
+use super::BalanceInfo;
+use crate::model::{AmbForm, Diagnostic, ModelFile};
 
 /// Cost and time of one derivation.
 #[derive(Debug, Clone, PartialEq)]
@@ -164,6 +166,11 @@ pub fn check_model(
         derivations.push(stats);
         others.push((UserBalances.name(), eom));
     }
+    if HandEquations::applies_to(&model) {
+        let (eom, stats) = timed(&mut model, &HandEquations);
+        derivations.push(stats);
+        others.push((HandEquations.name(), eom));
+    }
     let symbolic_equal: Vec<Option<bool>> = others
         .iter()
         .map(|(name, b)| {
@@ -300,14 +307,35 @@ pub fn check_model(
             states: compared,
         })
         .collect();
+    let moving_h_dot = model.balances.iter().any(|b| match b {
+        BalanceInfo::Amb {
+            about,
+            form: AmbForm::HDot,
+            ..
+        } => model.points[*about]
+            .1
+            .iter()
+            .any(|c| (0..n).any(|i| model.arena.depends_on(*c, model.coordinate_symbols(i)[0]))),
+        _ => false,
+    });
     for c in &comparisons {
-        if c.b == UserBalances.name() && (c.max_rel_residual.is_nan() || c.max_rel_residual > 1e-8)
-        {
-            notes.push(if c.max_rel_residual.is_finite() {
-                "the balances disagree with Lagrange: a chosen balance leaves a reaction force in, or misses a load (choose balances about the joints whose reactions they must eliminate)".to_string()
-            } else {
-                "the balances are not independent: their M′ is singular".to_string()
-            });
+        if c.max_rel_residual.is_nan() || c.max_rel_residual > 1e-8 {
+            let singular = !c.max_rel_residual.is_finite();
+            if c.b == UserBalances.name() {
+                notes.push(if singular {
+                    "the balances are not independent: their M′ is singular".to_string()
+                } else if moving_h_dot {
+                    "the balances disagree with Lagrange: an `amb` with `form: h_dot` is taken about a moving point, where Σ M_A = dH_A/dt misses v_A × m v_G (HW4, HW15); use the default `form: r_x_ma` or a fixed point".to_string()
+                } else {
+                    "the balances disagree with Lagrange: a chosen balance leaves a reaction force in, or misses a load (choose balances about the joints whose reactions they must eliminate)".to_string()
+                });
+            } else if c.b == HandEquations.name() {
+                notes.push(if singular {
+                    "the equations of motion written by hand are not independent: their M′ is singular".to_string()
+                } else {
+                    "the equations of motion written by hand disagree with Lagrange: a term is missing, has the wrong sign or the wrong factor (`eomgen equations` prints Lagrange's)".to_string()
+                });
+            }
         }
     }
     let power_balance = if explicit_time {

@@ -79,6 +79,8 @@ pub enum BalanceInfo {
         about: usize,
         /// The bodies.
         bodies: Vec<usize>,
+        /// How the balance is written.
+        form: crate::model::AmbForm,
     },
     /// Linear momentum balance of `bodies` along `along`.
     Lmb {
@@ -137,6 +139,10 @@ pub struct SymbolicModel {
     /// Whether the file uses the energy form (`kinetic`, `potential` or
     /// `generalized_forces`), which a derivation from the kinematics alone cannot use.
     pub uses_energy_form: bool,
+    /// The residuals `lhs − rhs` of the file's equations of motion written by hand
+    /// (`checks: equations_of_motion`), in the coordinates, rates and accelerations; empty
+    /// when the file gives none.
+    pub hand_equations: Vec<ExprId>,
 }
 
 impl SymbolicModel {
@@ -172,6 +178,8 @@ struct Lowering<'f> {
     file: &'f ModelFile,
     arena: ExprArena,
     errors: Vec<Diagnostic>,
+    /// Whether accelerations (`x_ddot`) may appear: only in equations written by hand.
+    allow_accelerations: bool,
 }
 
 impl<'f> Lowering<'f> {
@@ -180,6 +188,7 @@ impl<'f> Lowering<'f> {
             file,
             arena: ExprArena::new(),
             errors: Vec::new(),
+            allow_accelerations: false,
         }
     }
 
@@ -196,10 +205,11 @@ impl<'f> Lowering<'f> {
                 "t" => self.arena.time(),
                 _ => match self.arena.symbol_id(name) {
                     Some(s)
-                        if !matches!(
-                            self.arena.symbol_info(s).kind,
-                            SymbolKind::Acceleration(_)
-                        ) =>
+                        if self.allow_accelerations
+                            || !matches!(
+                                self.arena.symbol_info(s).kind,
+                                SymbolKind::Acceleration(_)
+                            ) =>
                     {
                         self.arena.symbol_expr(s)
                     }
@@ -509,8 +519,12 @@ impl<'f> Lowering<'f> {
                 .filter_map(|name| body_infos.iter().position(|x| x.name == name.value))
                 .collect();
             match &b.kind {
-                crate::model::BalanceKind::Amb { about } => match point(&about.value) {
-                    Some(about) => balances.push(BalanceInfo::Amb { about, bodies }),
+                crate::model::BalanceKind::Amb { about, form } => match point(&about.value) {
+                    Some(about) => balances.push(BalanceInfo::Amb {
+                        about,
+                        bodies,
+                        form: *form,
+                    }),
                     None => self.errors.push(Diagnostic::new(
                         about.location,
                         format!("unknown point `{}`", about.value),
@@ -520,6 +534,39 @@ impl<'f> Lowering<'f> {
                     let along = along.iter().map(|e| self.expr(e)).collect();
                     balances.push(BalanceInfo::Lmb { along, bodies });
                 }
+            }
+        }
+
+        self.allow_accelerations = true;
+        let hand_equations: Vec<ExprId> = file
+            .checks
+            .equations_of_motion
+            .iter()
+            .map(|e| {
+                let lhs = self.expr(&e.lhs);
+                match &e.rhs {
+                    Some(rhs) => {
+                        let rhs = self.expr(rhs);
+                        self.arena.minus(lhs, rhs)
+                    }
+                    None => lhs,
+                }
+            })
+            .collect();
+        self.allow_accelerations = false;
+        // Each must be linear in the accelerations: no coefficient of a q̈ⱼ may depend on one.
+        let accelerations: Vec<SymbolId> = self.arena.coordinates().iter().map(|c| c[2]).collect();
+        for (e, r) in file.checks.equations_of_motion.iter().zip(&hand_equations) {
+            let nonlinear = accelerations.iter().any(|a| {
+                let c = self.arena.diff(*r, *a);
+                let c = self.arena.expand(c);
+                accelerations.iter().any(|b| self.arena.depends_on(c, *b))
+            });
+            if nonlinear {
+                self.errors.push(
+                    Diagnostic::new(e.location, "this equation of motion is not linear in the accelerations")
+                        .with_help("equations of motion are M(q, t) q̈ = f(q, q̇, t): each `x_ddot` appears only to the first power, times a function of q, q̇ and t"),
+                );
             }
         }
 
@@ -593,6 +640,7 @@ impl<'f> Lowering<'f> {
             uses_energy_form: file.kinetic.is_some()
                 || file.potential.is_some()
                 || !file.generalized_forces.is_empty(),
+            hand_equations,
         })
     }
 }

@@ -9,7 +9,7 @@ mod lagrange;
 mod lower;
 mod momentum;
 
-pub use balances::UserBalances;
+pub use balances::{HandEquations, UserBalances};
 pub use lagrange::Lagrange;
 pub use lower::{BalanceInfo, BodyInfo, LoadInfo, ParameterInfo, SymbolicModel};
 pub use momentum::MomentumBalance;

@@ -33,6 +33,7 @@ pub fn check_partial(file: &ModelFile, incomplete: &Incomplete) -> Result<(), Ve
     checker.references();
     checker.masses();
     checker.balances();
+    checker.hand_equations();
     checker.diagnostics.finish()
 }
 
@@ -59,6 +60,8 @@ enum Depends {
     Position,
     /// Also rates (`x_dot`).
     Motion,
+    /// Also accelerations (`x_ddot`): only equations of motion written by hand.
+    Acceleration,
 }
 
 struct Checker<'f> {
@@ -68,6 +71,7 @@ struct Checker<'f> {
     params: Vec<&'f str>,
     coords: Vec<&'f str>,
     rates: Vec<String>,
+    accelerations: Vec<String>,
     points: Vec<&'f str>,
     bodies: Vec<&'f str>,
 }
@@ -89,6 +93,7 @@ impl<'f> Checker<'f> {
                 .map(|p| p.name.value.as_str())
                 .collect(),
             rates: coords.iter().map(|c| format!("{c}_dot")).collect(),
+            accelerations: coords.iter().map(|c| format!("{c}_ddot")).collect(),
             coords,
             points: file.points.iter().map(|p| p.name.value.as_str()).collect(),
             bodies: file.bodies.iter().map(|b| b.name.value.as_str()).collect(),
@@ -305,12 +310,16 @@ impl<'f> Checker<'f> {
             let is_param = n == "pi" || self.params.contains(&n);
             let is_coord = self.coords.contains(&n);
             let is_rate = self.rates.iter().any(|r| r == n);
+            let is_acceleration = depends == Depends::Acceleration
+                && self.accelerations.iter().any(|r| r == n);
             let needs = if is_param {
                 Depends::Constant
             } else if is_coord || n == "t" {
                 Depends::Position
             } else if is_rate {
                 Depends::Motion
+            } else if is_acceleration {
+                Depends::Acceleration
             } else {
                 self.unknown(n, at, depends, what);
                 continue;
@@ -345,7 +354,7 @@ impl<'f> Checker<'f> {
         {
             return;
         }
-        if n.ends_with("_ddot") {
+        if n.ends_with("_ddot") && depends < Depends::Acceleration {
             self.error(
                 Diagnostic::new(
                     at,
@@ -381,6 +390,9 @@ impl<'f> Checker<'f> {
         }
         if depends >= Depends::Motion {
             candidates.extend(self.rates.iter().map(String::as_str));
+        }
+        if depends >= Depends::Acceleration {
+            candidates.extend(self.accelerations.iter().map(String::as_str));
         }
         candidates.push("pi");
         let d = Diagnostic::new(at, format!("unknown name `{n}` in {what}"));
@@ -579,6 +591,36 @@ impl<'f> Checker<'f> {
         }
     }
 
+    // Rule: equations of motion written by hand (`checks: equations_of_motion`) are one per
+    // coordinate and use parameters, coordinates, rates, accelerations and `t`.
+    fn hand_equations(&mut self) {
+        let file = self.file;
+        let equations = &file.checks.equations_of_motion;
+        let Some(first) = equations.first() else {
+            return;
+        };
+        let n = file.coordinates.len();
+        if equations.len() != n && !self.incomplete.has_section("checks") {
+            self.error(
+                Diagnostic::new(
+                    first.location,
+                    format!(
+                        "{} equation(s) of motion for {n} coordinate(s): give one per coordinate",
+                        equations.len()
+                    ),
+                )
+                .with_help("write each equation as `lhs = rhs` in the coordinates, rates (`x_dot`) and accelerations (`x_ddot`)"),
+            );
+        }
+        for (i, e) in equations.iter().enumerate() {
+            let what = format!("equation of motion {}", i + 1);
+            self.resolve(&e.lhs, Depends::Acceleration, &what);
+            if let Some(rhs) = &e.rhs {
+                self.resolve(rhs, Depends::Acceleration, &what);
+            }
+        }
+    }
+
     // Rule: user balances name existing bodies (each once per balance) and, for AMB, an
     // existing point; AMB needs a planar model; an LMB direction has as many components as
     // the points and depends only on parameters, coordinates and `t`; there are as many
@@ -641,7 +683,7 @@ impl<'f> Checker<'f> {
                 seen.push(body.value.as_str());
             }
             match &b.kind {
-                BalanceKind::Amb { about } => {
+                BalanceKind::Amb { about, .. } => {
                     if !self.points.contains(&about.value.as_str()) {
                         let d = Diagnostic::new(
                             about.location,

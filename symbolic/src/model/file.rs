@@ -129,6 +129,8 @@ pub enum BalanceKind {
     Amb {
         /// The point A.
         about: Located<String>,
+        /// How the balance is written (`form:`; default [`AmbForm::RCrossMa`]).
+        form: AmbForm,
     },
     /// Linear momentum balance of the chosen bodies along a direction `e`:
     /// `Σ m a_G·e = Σ F·e`.
@@ -136,6 +138,42 @@ pub enum BalanceKind {
         /// The direction `e` (expressions of `q` and `t`, as many components as the points).
         along: Vec<Expr>,
     },
+}
+
+/// How an angular momentum balance about a point A is written (`form:` of an `amb` entry).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum AmbForm {
+    /// `form: r_x_ma` (the default): `Σ M_A = Σ (r_G − r_A) × m a_G + I θ̈`, with absolute
+    /// accelerations, which holds about any point, fixed or moving (HW4, HW15 a).
+    #[default]
+    RCrossMa,
+    /// `form: h_dot`: `Σ M_A = dH_A/dt` with `H_A = Σ (r_G − r_A) × m v_G + I θ̇`, the
+    /// fixed-point form. It holds only when `v_A × v_G = 0` (A fixed, A the centre of mass, or
+    /// moving parallel to it); about any other moving point it misses `v_A × m v_G`, the
+    /// classic mistake of HW4 and HW15 that `eomgen check` detects.
+    HDot,
+}
+
+/// One equation of motion derived by hand (`checks: { equations_of_motion: [...] }`),
+/// `lhs = rhs` in the coordinates, their rates (`x_dot`) and accelerations (`x_ddot`), `t`
+/// and the parameters. `eomgen check` compares the set with Lagrange's equations; the
+/// generated code never uses them.
+#[derive(Debug, Clone, PartialEq)]
+pub struct HandEquation {
+    /// Left-hand side.
+    pub lhs: Expr,
+    /// Right-hand side (`0` when the entry has no `=`).
+    pub rhs: Option<Expr>,
+    /// Where the entry starts.
+    pub location: Location,
+}
+
+/// `checks:` — what the file claims about its own model, verified by `eomgen check`.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Checks {
+    /// `equations_of_motion:` — the equations of motion as derived by hand, one per
+    /// coordinate, linear in the accelerations (any combination of the true equations).
+    pub equations_of_motion: Vec<HandEquation>,
 }
 
 /// One momentum-balance equation chosen by the user (`balances:`), as the course writes them:
@@ -199,6 +237,8 @@ pub struct ModelFile {
     pub draw: Draw,
     /// `balances:` — momentum-balance equations chosen by the user (empty if none).
     pub balances: Vec<Balance>,
+    /// `checks:` — the file's claims about its own model (empty if none).
+    pub checks: Checks,
     /// The spatial dimension of the points (2 or 3); `None` when there are no points.
     pub dimension: Option<usize>,
 }

@@ -33,6 +33,7 @@ pub const TOP_LEVEL_KEYS: &[&str] = &[
     "initial",
     "draw",
     "balances",
+    "checks",
 ];
 
 /// Keys of the model format (DESIGN.md) that this version does not implement yet.
@@ -42,7 +43,6 @@ pub const LATER_KEYS: &[&str] = &[
     "events",
     "equilibria",
     "outputs",
-    "checks",
 ];
 
 const BODY_KEYS: &[&str] = &["mass", "at", "inertia", "com", "angle"];
@@ -398,6 +398,12 @@ impl Ctx<'_> {
 
     /// An expression written as a scalar; its locations are exact even across lines.
     fn expr(&mut self, node: &YamlNode, what: &str) -> Option<Expr> {
+        let text = self.scalar_expr_text(node, what)?;
+        self.parse_part(node, &text, 0, text.chars().count())
+    }
+
+    /// The text of a scalar that should hold an expression; reports anything else.
+    fn scalar_expr_text(&mut self, node: &YamlNode, what: &str) -> Option<String> {
         let text = match &node.kind {
             YamlKind::Scalar { text, .. } => text,
             other => {
@@ -411,17 +417,24 @@ impl Ctx<'_> {
                 return None;
             }
         };
+        Some(text.clone())
+    }
+
+    /// Parses characters `from..to` of the scalar `node` (whose text is `text`) as an
+    /// expression, with exact file locations.
+    fn parse_part(&mut self, node: &YamlNode, text: &str, from: usize, to: usize) -> Option<Expr> {
         let start = node.location;
         let locations = char_locations(self.source, start, text);
         let locate = |i: usize| match &locations {
-            Some(l) => l.get(i).or(l.last()).copied().unwrap_or(start),
-            None => start.offset(i),
+            Some(l) => l.get(from + i).or(l.last()).copied().unwrap_or(start),
+            None => start.offset(from + i),
         };
-        match parse_expr_mapped(text, &locate) {
+        let part: String = text.chars().skip(from).take(to - from).collect();
+        match parse_expr_mapped(&part, &locate) {
             Ok(e) => Some(e),
             Err(d) => {
-                let end = locate(text.chars().count());
-                let cut = opens_more_than_it_closes(text)
+                let end = locate(part.chars().count());
+                let cut = opens_more_than_it_closes(&part)
                     && !matches!(node.kind, YamlKind::Scalar { quoted: true, .. })
                     && cut_in_source(self.source, end);
                 let d = if cut {
@@ -684,6 +697,10 @@ impl Ctx<'_> {
         let balances = get(top, "balances")
             .map(|n| self.balances(n))
             .unwrap_or_default();
+        self.section = "checks";
+        let checks = get(top, "checks")
+            .map(|n| self.checks(n))
+            .unwrap_or_default();
         self.section = "";
 
         let dimension = points.first().map(|p: &Point| p.position.len());
@@ -707,7 +724,57 @@ impl Ctx<'_> {
             draw,
             dimension,
             balances,
+            checks,
         })
+    }
+
+    fn checks(&mut self, node: &YamlNode) -> Checks {
+        const EXAMPLE: &str =
+            "checks:\n  equations_of_motion:\n    - m*x_ddot + k*x = 0";
+        let mut checks = Checks::default();
+        let Some(entries) = self.map(node, "`checks`", EXAMPLE) else {
+            return checks;
+        };
+        self.unknown_keys(entries, "`checks`", &["equations_of_motion"], &["equations_of_motion"]);
+        if let Some(list) = get(entries, "equations_of_motion").and_then(|n| {
+            self.seq(n, "`equations_of_motion`", "equations_of_motion: [m*x_ddot + k*x = 0]")
+        }) {
+            for item in list {
+                if let Some(e) = self.equation(item) {
+                    checks.equations_of_motion.push(e);
+                }
+            }
+        }
+        checks
+    }
+
+    /// One `lhs = rhs` equation (or an expression meaning `= 0`).
+    fn equation(&mut self, node: &YamlNode) -> Option<HandEquation> {
+        let text = self.scalar_expr_text(node, "an equation of motion")?;
+        let chars: Vec<char> = text.chars().collect();
+        let equals: Vec<usize> = (0..chars.len()).filter(|&i| chars[i] == '=').collect();
+        match equals.as_slice() {
+            [] => {
+                let lhs = self.parse_part(node, &text, 0, chars.len())?;
+                Some(HandEquation { lhs, rhs: None, location: node.location })
+            }
+            [i] => {
+                let lhs = self.parse_part(node, &text, 0, *i);
+                let rhs = self.parse_part(node, &text, i + 1, chars.len());
+                Some(HandEquation { lhs: lhs?, rhs: Some(rhs?), location: node.location })
+            }
+            [_, second, ..] => {
+                let start = node.location;
+                let at = char_locations(self.source, start, &text)
+                    .and_then(|l| l.get(*second).copied())
+                    .unwrap_or_else(|| start.offset(*second));
+                self.error(
+                    Diagnostic::new(at, "an equation of motion has one `=`, this is a second")
+                        .with_help("write one equation per entry, such as `m*x_ddot + k*x = F`"),
+                );
+                None
+            }
+        }
     }
 
     fn balances(&mut self, node: &YamlNode) -> Vec<Balance> {
@@ -734,7 +801,7 @@ impl Ctx<'_> {
             let (key, value) = &entries[0];
             let amb = key.value == "amb";
             let (allowed, example): (&[&str], &str) = if amb {
-                (&["about", "bodies"], "{ about: O, bodies: [upper, fore] }")
+                (&["about", "bodies", "form"], "{ about: O, bodies: [upper, fore] }")
             } else {
                 (
                     &["bodies", "along"],
@@ -750,7 +817,7 @@ impl Ctx<'_> {
                     "linear momentum balance"
                 },
                 allowed,
-                allowed,
+                &allowed[..2],
                 example,
             ) else {
                 continue;
@@ -766,9 +833,24 @@ impl Ctx<'_> {
                 }
             }
             let kind = if amb {
+                let form = match get(f, "form") {
+                    None => Some(AmbForm::RCrossMa),
+                    Some(n) => match &n.kind {
+                        YamlKind::Scalar { text, .. } if text == "r_x_ma" => Some(AmbForm::RCrossMa),
+                        YamlKind::Scalar { text, .. } if text == "h_dot" => Some(AmbForm::HDot),
+                        _ => {
+                            self.error(
+                                Diagnostic::new(n.location, "`form` of an angular momentum balance is `r_x_ma` or `h_dot`")
+                                    .with_help("`r_x_ma` (the default): Σ M_A = Σ r_G/A × m a_G + I θ̈, valid about any point; `h_dot`: Σ M_A = dH_A/dt, valid about a fixed point or the centre of mass"),
+                            );
+                            None
+                        }
+                    },
+                };
                 get(f, "about")
                     .and_then(|n| self.name(n, "`about`"))
-                    .map(|about| BalanceKind::Amb { about })
+                    .zip(form)
+                    .map(|(about, form)| BalanceKind::Amb { about, form })
             } else {
                 get(f, "along")
                     .and_then(|n| self.vector(n, "`along`", "along: [cos(theta), sin(theta)]"))

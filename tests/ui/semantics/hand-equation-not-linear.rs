@@ -1,0 +1,3 @@
+eomgen::model!("hand-equation-not-linear.yaml");
+
+fn main() {}
