@@ -5,14 +5,16 @@
 //! integrates it with any [`Integrator`].
 #![warn(missing_docs)]
 
+pub mod constrained;
 pub mod integrate;
 pub mod ode;
 pub mod system;
 
+pub use constrained::{ConstraintWorkspace, ProjectionError, Stabilization};
 pub use integrate::{
     DormandPrince54, IntegrationError, IntegrationFailure, Integrator, IntegratorOptions,
     OutputTimes, PiController, RungeKutta4, Solution, Stats, StepOutcome, StepSizeController,
     Tableau, Tolerance,
 };
 pub use ode::{OdeFn, OdeSystem, RhsError};
-pub use system::{FirstOrder, MechanicalSystem, ModelInfo, UnknownParameter};
+pub use system::{ConstraintValues, FirstOrder, MechanicalSystem, ModelInfo, UnknownParameter};

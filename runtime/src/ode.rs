@@ -10,6 +10,13 @@ pub enum RhsError {
     /// `M q̈ = F` has no unique solution (Cholesky factorisation failed).
     #[error("the mass matrix is not positive definite (Cholesky failed)")]
     SingularMassMatrix,
+    /// The matrix `[M Jᵀ; J 0]` of a constrained system is singular at this state: redundant
+    /// constraints, a singular configuration of the mechanism, or `M` singular on the
+    /// motions the constraints allow.
+    #[error(
+        "the constrained system [M Jᵀ; J 0] is singular (redundant constraints or a singular configuration)"
+    )]
+    SingularConstraintMatrix,
     /// The right-hand side produced NaN or ±∞ in component `index`.
     #[error("the right-hand side is not finite in component {index}")]
     NonFinite {

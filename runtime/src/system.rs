@@ -8,6 +8,7 @@
 
 use nalgebra::{DMatrix, DVector, SMatrix, SVector};
 
+use crate::constrained::{ConstraintWorkspace, ProjectionError, Stabilization};
 use crate::ode::{OdeSystem, RhsError};
 
 /// A parameter name that the model does not have.
@@ -107,6 +108,58 @@ pub trait MechanicalSystem<const N: usize> {
     fn equations_text(&self) -> &'static str;
     /// The derived equations as LaTeX.
     fn equations_latex(&self) -> &'static str;
+
+    /// Names of the constraints, holonomic (`constraints:`) first, then non-holonomic
+    /// (`nonholonomic:`); `m` of them, none for an unconstrained model (the default).
+    ///
+    /// With constraints, the equations of motion are the index-1 DAE
+    /// `[M Jᵀ; J 0][q̈; λ] = [F; γ]` (lectures 8–11), so `M q̈ = F − Jᵀλ`: `λᵢ` is the
+    /// generalized force of constraint `i` along `−∇Φᵢ` — for a rod written
+    /// `Φ = |r_A − r_B| − ℓ`, its tension in N, positive in tension.
+    fn constraint_names(&self) -> &'static [&'static str] {
+        &[]
+    }
+    /// How many of [`Self::constraint_names`] are holonomic (they come first).
+    fn holonomic_constraint_count(&self) -> usize {
+        0
+    }
+    /// `Φ(q, t)` of the holonomic constraints, written into `out` (length
+    /// [`Self::holonomic_constraint_count`]); units of the file's expressions.
+    fn constraint_residuals(&self, q: &SVector<f64, N>, t: f64, out: &mut [f64]) {
+        let _ = (q, t, out);
+    }
+    /// The constraint Jacobian `J` (`m × N`, row-major into `out`): `∂Φ/∂q` rows, then the
+    /// rows `A(q, t)` of the non-holonomic constraints `A q̇ + b = 0`.
+    fn constraint_jacobian(&self, q: &SVector<f64, N>, t: f64, out: &mut [f64]) {
+        let _ = (q, t, out);
+    }
+    /// Velocity-level residuals (length `m`): `Φ̇ = J q̇ + Φ_t`, then `A q̇ + b`; zero on the
+    /// constraint manifold.
+    fn constraint_velocity_residuals(
+        &self,
+        q: &SVector<f64, N>,
+        qdot: &SVector<f64, N>,
+        t: f64,
+        out: &mut [f64],
+    ) {
+        let _ = (q, qdot, t, out);
+    }
+    /// `γ` (length `m`) of `J q̈ = γ`: `−(J q̇)_q q̇ − 2 J_t q̇ − Φ_tt` for holonomic rows and
+    /// `−(Ȧ q̇ + ḃ)` for non-holonomic rows.
+    fn constraint_gamma(
+        &self,
+        q: &SVector<f64, N>,
+        qdot: &SVector<f64, N>,
+        t: f64,
+        out: &mut [f64],
+    ) {
+        let _ = (q, qdot, t, out);
+    }
+    /// Indices of the coordinates whose initial values are guesses (`{ guess: … }` in the
+    /// file), to be solved with their rates from the constraints.
+    fn initial_guesses(&self) -> &'static [usize] {
+        &[]
+    }
 }
 
 /// The first-order form `y = [q; q̇]`, `ẏ = [q̇; M⁻¹F]` of a [`MechanicalSystem`].
@@ -114,16 +167,31 @@ pub trait MechanicalSystem<const N: usize> {
 /// `M q̈ = F` is solved at every evaluation by Cholesky factorisation; a mass matrix that is not
 /// positive definite is [`RhsError::SingularMassMatrix`], a non-finite `q̈` is
 /// [`RhsError::NonFinite`]. No heap allocation.
+///
+/// With constraints ([`MechanicalSystem::constraint_names`] not empty), `q̈` and the
+/// multipliers `λ` come from the index-1 system `[M Jᵀ; J 0][q̈; λ] = [F; γ]` instead, solved by
+/// LU with partial pivoting on buffers allocated in [`FirstOrder::new`]; the drift control is
+/// [`FirstOrder::stabilization`].
 #[derive(Debug, Clone)]
 pub struct FirstOrder<S, const N: usize> {
     /// The wrapped system.
     pub system: S,
+    /// Drift control of a constrained system (ignored without constraints).
+    pub stabilization: Stabilization,
+    /// Buffers and the last multipliers `λ` of a constrained system.
+    pub constraints: ConstraintWorkspace,
 }
 
 impl<S: MechanicalSystem<N>, const N: usize> FirstOrder<S, N> {
     /// Wraps `system`.
     pub fn new(system: S) -> Self {
-        Self { system }
+        let m = system.constraint_names().len();
+        let holonomic = system.holonomic_constraint_count();
+        Self {
+            system,
+            stabilization: Stabilization::None,
+            constraints: ConstraintWorkspace::new(N, m, holonomic),
+        }
     }
 
     /// Generalized accelerations `q̈ = M⁻¹F` at `(q, q̇, t)`.
@@ -161,7 +229,17 @@ impl<S: MechanicalSystem<N>, const N: usize> OdeSystem for FirstOrder<S, N> {
 
     fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), RhsError> {
         let (q, qdot) = split::<N>(y);
-        let qdd = self.generalized_accelerations(&q, &qdot, t)?;
+        let qdd = if self.constraints.is_empty() {
+            self.generalized_accelerations(&q, &qdot, t)?
+        } else {
+            let qdd =
+                self.constraints
+                    .accelerations(&self.system, &q, &qdot, t, self.stabilization)?;
+            if let Some(i) = qdd.iter().position(|v| !v.is_finite()) {
+                return Err(RhsError::NonFinite { index: N + i });
+            }
+            qdd
+        };
         dy[..N].copy_from_slice(qdot.as_slice());
         dy[N..2 * N].copy_from_slice(qdd.as_slice());
         Ok(())
@@ -217,6 +295,61 @@ pub trait ModelInfo: OdeSystem {
     fn forcing_jacobians(&self, t: f64, y: &[f64]) -> (DMatrix<f64>, DMatrix<f64>);
     /// The exact `∂(M a)/∂q` (`n × n`) at `(t, q)` for the vector `a` (length `n`).
     fn mass_matrix_product_jacobian(&self, t: f64, y: &[f64], a: &[f64]) -> DMatrix<f64>;
+    /// Names of the constraints (holonomic first); empty for an unconstrained model.
+    fn constraint_names(&self) -> &'static [&'static str];
+    /// How many constraints are holonomic.
+    fn holonomic_constraint_count(&self) -> usize;
+    /// Selects the drift control of a constrained model.
+    fn set_stabilization(&mut self, stabilization: Stabilization);
+    /// The constraint forces `λ` (length `m`; see [`MechanicalSystem::constraint_names`] for
+    /// their meaning and sign) and `q̈` at `(t, y)`.
+    ///
+    /// # Errors
+    /// As the right-hand side.
+    fn constraint_forces(&mut self, t: f64, y: &[f64]) -> Result<Vec<f64>, RhsError>;
+    /// Largest `|Φᵢ|` and largest velocity-level residual at `(t, y)`; `(0, 0)` without
+    /// constraints.
+    fn constraint_drift(&mut self, t: f64, y: &[f64]) -> (f64, f64);
+    /// Projects `y = [q; q̇]` onto the constraint manifold at `t`, moving only the coordinates
+    /// `free` (all when empty); see [`ConstraintWorkspace::project`].
+    ///
+    /// # Errors
+    /// [`ProjectionError`] when Newton does not converge.
+    fn project(&mut self, t: f64, y: &mut [f64], free: &[usize]) -> Result<usize, ProjectionError>;
+    /// Indices of the coordinates whose initial values are guesses.
+    fn initial_guesses(&self) -> &'static [usize];
+    /// `Φ` (length `m_h`), `J` (`m × n`), the velocity residuals and `γ` (length `m`) at
+    /// `(t, y)`; see [`MechanicalSystem::constraint_jacobian`] and siblings.
+    fn constraint_equations(&self, t: f64, y: &[f64]) -> ConstraintValues;
+    /// The initial state made consistent with the constraints (issue 5, item 3): the
+    /// coordinates marked `{ guess: … }` and their rates are solved by Newton from
+    /// `Φ(q, 0) = 0` and the velocity constraints, the others held. Equal to
+    /// [`Self::initial_state`] for an unconstrained model.
+    ///
+    /// # Errors
+    /// [`ProjectionError`] naming the constraint with the largest residual when Newton does
+    /// not converge, or (without guesses) when the given state violates the constraints by
+    /// more than 1e-9.
+    fn consistent_initial_state(&mut self) -> Result<Vec<f64>, ProjectionError> {
+        let mut y = self.initial_state();
+        if self.constraint_names().is_empty() {
+            return Ok(y);
+        }
+        let guesses = self.initial_guesses();
+        if guesses.is_empty() {
+            let (p, v) = self.constraint_drift(0.0, &y);
+            if p > 1e-9 || v > 1e-9 {
+                return Err(ProjectionError {
+                    constraint: 0,
+                    residual: p.max(v),
+                    iterations: 0,
+                });
+            }
+        } else {
+            self.project(0.0, &mut y, guesses)?;
+        }
+        Ok(y)
+    }
 }
 
 impl<S: MechanicalSystem<N>, const N: usize> ModelInfo for FirstOrder<S, N> {
@@ -297,4 +430,71 @@ impl<S: MechanicalSystem<N>, const N: usize> ModelInfo for FirstOrder<S, N> {
         let j = self.system.mass_matrix_product_jacobian(&q, t, &a);
         DMatrix::from_column_slice(N, N, j.as_slice())
     }
+    fn constraint_names(&self) -> &'static [&'static str] {
+        self.system.constraint_names()
+    }
+    fn holonomic_constraint_count(&self) -> usize {
+        self.system.holonomic_constraint_count()
+    }
+    fn set_stabilization(&mut self, stabilization: Stabilization) {
+        self.stabilization = stabilization;
+    }
+    fn constraint_forces(&mut self, t: f64, y: &[f64]) -> Result<Vec<f64>, RhsError> {
+        if self.constraints.is_empty() {
+            return Ok(Vec::new());
+        }
+        let (q, qdot) = split::<N>(y);
+        self.constraints
+            .accelerations(&self.system, &q, &qdot, t, self.stabilization)?;
+        Ok(self.constraints.multipliers.clone())
+    }
+    fn constraint_drift(&mut self, t: f64, y: &[f64]) -> (f64, f64) {
+        let (q, qdot) = split::<N>(y);
+        self.constraints.drift(&self.system, &q, &qdot, t)
+    }
+    fn project(&mut self, t: f64, y: &mut [f64], free: &[usize]) -> Result<usize, ProjectionError> {
+        let (mut q, mut qdot) = split::<N>(y);
+        let iterations =
+            self.constraints
+                .project(&self.system, &mut q, &mut qdot, t, free, 1e-12)?;
+        y[..N].copy_from_slice(q.as_slice());
+        y[N..2 * N].copy_from_slice(qdot.as_slice());
+        Ok(iterations)
+    }
+    fn initial_guesses(&self) -> &'static [usize] {
+        self.system.initial_guesses()
+    }
+    fn constraint_equations(&self, t: f64, y: &[f64]) -> ConstraintValues {
+        let (q, qdot) = split::<N>(y);
+        let m = self.system.constraint_names().len();
+        let h = self.system.holonomic_constraint_count();
+        let mut phi = vec![0.0; h];
+        let mut jacobian = vec![0.0; m * N];
+        let mut velocity = vec![0.0; m];
+        let mut gamma = vec![0.0; m];
+        self.system.constraint_residuals(&q, t, &mut phi);
+        self.system.constraint_jacobian(&q, t, &mut jacobian);
+        self.system
+            .constraint_velocity_residuals(&q, &qdot, t, &mut velocity);
+        self.system.constraint_gamma(&q, &qdot, t, &mut gamma);
+        ConstraintValues {
+            phi: DVector::from_vec(phi),
+            jacobian: DMatrix::from_row_slice(m, N, &jacobian),
+            velocity: DVector::from_vec(velocity),
+            gamma: DVector::from_vec(gamma),
+        }
+    }
+}
+
+/// The constraint functions of a model at one state ([`ModelInfo::constraint_equations`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ConstraintValues {
+    /// `Φ(q, t)` of the holonomic constraints (length `m_h`).
+    pub phi: DVector<f64>,
+    /// `J`, `m × n`: `∂Φ/∂q` rows, then the non-holonomic `A` rows.
+    pub jacobian: DMatrix<f64>,
+    /// Velocity residuals `J q̇ + Φ_t` and `A q̇ + b` (length `m`).
+    pub velocity: DVector<f64>,
+    /// `γ` of `J q̈ = γ` (length `m`).
+    pub gamma: DVector<f64>,
 }

@@ -10,6 +10,28 @@ fn register_font() -> Result<(), String> {
         .map_err(|_| "the bundled font could not be loaded".to_string())
 }
 
+/// One named line of a chart: `(x, y)` points in order.
+pub struct Series {
+    /// Legend label.
+    pub name: String,
+    /// The points.
+    pub points: Vec<(f64, f64)>,
+}
+
+/// A line chart: title, axis labels (with units) and which axes are logarithmic.
+pub struct Chart<'a> {
+    /// Caption.
+    pub title: &'a str,
+    /// x-axis label, with its unit.
+    pub x_desc: &'a str,
+    /// y-axis label, with its unit.
+    pub y_desc: &'a str,
+    /// Logarithmic x axis (points with x ≤ 0 are dropped).
+    pub log_x: bool,
+    /// Logarithmic y axis (points with y ≤ 0 are dropped).
+    pub log_y: bool,
+}
+
 /// Plots every coordinate against time, one line each, into `path` (`.svg` or `.png`).
 ///
 /// # Errors
@@ -22,86 +44,147 @@ pub fn time_histories(
     if solution.is_empty() {
         return Err("nothing to plot: the solution has no samples".to_string());
     }
+    let series: Vec<Series> = model
+        .coordinate_names()
+        .iter()
+        .enumerate()
+        .map(|(i, name)| Series {
+            name: (*name).to_string(),
+            points: solution.iter().map(|(t, y)| (t, y[i])).collect(),
+        })
+        .collect();
+    let title = format!("{}: coordinates against time", model.name());
+    lines(
+        path,
+        &Chart {
+            title: &title,
+            x_desc: "t (s)",
+            y_desc: "q (m or rad)",
+            log_x: false,
+            log_y: false,
+        },
+        &series,
+    )
+}
+
+/// Draws `series` as lines into `path` (`.svg` or `.png`), 960 × 600 px.
+///
+/// # Errors
+/// An unknown extension, no finite point, or a failure to write the file.
+pub fn lines(path: &str, chart: &Chart<'_>, series: &[Series]) -> Result<(), String> {
     register_font()?;
     let size = (960, 600);
     if path.ends_with(".svg") {
         let root = SVGBackend::new(path, size).into_drawing_area();
-        draw(root, model, solution)
+        draw(root, chart, series)
     } else if path.ends_with(".png") {
         let root = BitMapBackend::new(path, size).into_drawing_area();
-        draw(root, model, solution)
+        draw(root, chart, series)
     } else {
-        Err(format!(
-            "--plot `{path}`: the file must end in .svg or .png"
-        ))
+        Err(format!("`{path}`: a chart file must end in .svg or .png"))
+    }
+}
+
+/// The points of `s` that can be drawn on the chart's axes.
+fn usable<'s>(chart: &Chart<'_>, s: &'s Series) -> impl Iterator<Item = (f64, f64)> + 's {
+    let (log_x, log_y) = (chart.log_x, chart.log_y);
+    s.points.iter().copied().filter(move |(x, y)| {
+        x.is_finite() && y.is_finite() && (!log_x || *x > 0.0) && (!log_y || *y > 0.0)
+    })
+}
+
+/// `[lo, hi]` padded by 5 % (or a factor for log axes), with a unit range for a constant.
+fn range(lo: f64, hi: f64, log: bool) -> (f64, f64) {
+    if log {
+        if hi > lo {
+            (lo / 1.5, hi * 1.5)
+        } else {
+            (lo / 10.0, lo * 10.0)
+        }
+    } else if hi > lo {
+        let pad = 0.05 * (hi - lo);
+        (lo - pad, hi + pad)
+    } else {
+        (lo - 1.0, hi + 1.0)
     }
 }
 
 fn draw<DB: DrawingBackend>(
     root: DrawingArea<DB, plotters::coord::Shift>,
-    model: &dyn ModelInfo,
-    solution: &Solution,
+    chart: &Chart<'_>,
+    series: &[Series],
 ) -> Result<(), String>
 where
     DB::ErrorType: 'static,
 {
     let err = |e: DrawingAreaErrorKind<DB::ErrorType>| format!("plotting failed: {e}");
     root.fill(&WHITE).map_err(err)?;
-    let n = model.num_dofs();
-    let t0 = solution.t.first().copied().unwrap_or(0.0);
-    let t1 = solution.t.last().copied().unwrap_or(1.0).max(t0 + 1e-12);
-    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
-    for (_, y) in solution.iter() {
-        for v in &y[..n] {
-            if v.is_finite() {
-                lo = lo.min(*v);
-                hi = hi.max(*v);
-            }
+    let (mut x_lo, mut x_hi, mut y_lo, mut y_hi) = (
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+    );
+    for s in series {
+        for (x, y) in usable(chart, s) {
+            x_lo = x_lo.min(x);
+            x_hi = x_hi.max(x);
+            y_lo = y_lo.min(y);
+            y_hi = y_hi.max(y);
         }
     }
-    // No finite sample, or a constant signal: give the axis a unit range.
-    if hi.partial_cmp(&lo) != Some(std::cmp::Ordering::Greater) {
-        lo -= 1.0;
-        hi += 1.0;
+    if !(x_lo.is_finite() && y_lo.is_finite()) {
+        return Err(format!(
+            "nothing to plot in `{}`: no finite point",
+            chart.title
+        ));
     }
-    let pad = 0.05 * (hi - lo);
-    let mut chart = ChartBuilder::on(&root)
-        .caption(
-            format!("{}: coordinates against time", model.name()),
-            ("sans-serif", 22),
-        )
+    let (x0, x1) = if chart.log_x || x_hi > x_lo {
+        range(x_lo, x_hi, chart.log_x)
+    } else {
+        (x_lo, x_lo + 1.0)
+    };
+    let (y0, y1) = range(y_lo, y_hi, chart.log_y);
+    let mut builder = ChartBuilder::on(&root);
+    builder
+        .caption(chart.title, ("sans-serif", 22))
         .margin(12)
         .x_label_area_size(40)
-        .y_label_area_size(60)
-        .build_cartesian_2d(t0..t1, (lo - pad)..(hi + pad))
-        .map_err(err)?;
-    chart
-        .configure_mesh()
-        .x_desc("t (s)")
-        .y_desc("q (m or rad)")
-        .label_style(("sans-serif", 14))
-        .draw()
-        .map_err(err)?;
-    for (i, name) in model.coordinate_names().iter().enumerate() {
-        let color = Palette99::pick(i).to_rgba();
-        chart
-            .draw_series(LineSeries::new(
-                solution.iter().map(|(t, y)| (t, y[i])),
-                color.stroke_width(2),
-            ))
-            .map_err(err)?
-            .label(*name)
-            .legend(move |(x, y)| {
-                PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
-            });
+        .y_label_area_size(70);
+    macro_rules! finish {
+        ($ctx:expr) => {{
+            let mut ctx = $ctx.map_err(err)?;
+            ctx.configure_mesh()
+                .x_desc(chart.x_desc)
+                .y_desc(chart.y_desc)
+                .label_style(("sans-serif", 14))
+                .draw()
+                .map_err(err)?;
+            for (i, s) in series.iter().enumerate() {
+                let color = Palette99::pick(i).to_rgba();
+                ctx.draw_series(LineSeries::new(usable(chart, s), color.stroke_width(2)))
+                    .map_err(err)?
+                    .label(s.name.clone())
+                    .legend(move |(x, y)| {
+                        PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
+                    });
+            }
+            ctx.configure_series_labels()
+                .background_style(WHITE.mix(0.8))
+                .border_style(BLACK)
+                .label_font(("sans-serif", 14))
+                .draw()
+                .map_err(err)?;
+        }};
     }
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .label_font(("sans-serif", 14))
-        .draw()
-        .map_err(err)?;
+    match (chart.log_x, chart.log_y) {
+        (false, false) => finish!(builder.build_cartesian_2d(x0..x1, y0..y1)),
+        (true, false) => finish!(builder.build_cartesian_2d((x0..x1).log_scale(), y0..y1)),
+        (false, true) => finish!(builder.build_cartesian_2d(x0..x1, (y0..y1).log_scale())),
+        (true, true) => {
+            finish!(builder.build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale()))
+        }
+    }
     root.present().map_err(err)?;
     Ok(())
 }

@@ -11,6 +11,7 @@ use serde_json::json;
 
 use super::values::{evaluate, split_assignment};
 use super::{CliError, find_model, plot};
+use eomgen::Stabilization;
 
 /// Integration method.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -19,6 +20,17 @@ pub enum Method {
     Dp54,
     /// Classical Runge–Kutta 4, fixed step `--dt`.
     Rk4,
+}
+
+/// Drift control of a constrained model (`--stabilization`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum StabilizationArg {
+    /// None: the drift of Φ and Φ̇ is shown as it grows (HW10, HW12).
+    None,
+    /// Baumgarte's stabilisation with `--baumgarte ALPHA,BETA`.
+    Baumgarte,
+    /// Projection onto the constraint manifold after every accepted step.
+    Projection,
 }
 
 /// Options of `eomgen simulate`.
@@ -53,6 +65,14 @@ pub struct SimulateArgs {
     /// repeatable.
     #[arg(long = "init", value_name = "NAME=VALUE")]
     pub init: Vec<String>,
+    /// Drift control of a constrained model: `none` (show the drift), `baumgarte`
+    /// (Φ̈ + 2α Φ̇ + β² Φ = 0, see --baumgarte) or `projection` (onto Φ = 0 and the velocity
+    /// constraints after every step). Ignored without constraints.
+    #[arg(long, value_enum, default_value_t = StabilizationArg::None)]
+    pub stabilization: StabilizationArg,
+    /// Baumgarte's α and β (1/s), `ALPHA,BETA`.
+    #[arg(long, value_delimiter = ',', num_args = 2, default_values_t = [10.0, 10.0])]
+    pub baumgarte: Vec<f64>,
     /// Print the result as JSON on stdout.
     #[arg(long)]
     pub json: bool,
@@ -109,6 +129,16 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
             })?;
         y0[index] = value;
     }
+    consistent_initial_state(model.as_mut(), &mut y0)?;
+    let stabilization = match args.stabilization {
+        StabilizationArg::None => Stabilization::None,
+        StabilizationArg::Baumgarte => Stabilization::Baumgarte {
+            alpha: args.baumgarte[0],
+            beta: args.baumgarte[1],
+        },
+        StabilizationArg::Projection => Stabilization::Projection,
+    };
+    model.set_stabilization(stabilization);
     if !(args.t_end.is_finite() && args.t_end > 0.0) {
         return Err(CliError::usage(format!(
             "--t-end must be a positive number of seconds, got {}",
@@ -140,17 +170,33 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
         Err(IntegrationFailure { error, partial }) => (*partial, Some(error)),
     };
     let report = Report::new(model.as_ref(), &y0, &solution);
+    let constraints = ConstraintReport::new(model.as_mut(), &solution);
     if let Some(path) = &args.csv {
-        write_csv(path, model.as_ref(), &solution, &report)?;
+        write_csv(path, model.as_ref(), &solution, &report, &constraints)?;
     }
     if let Some(path) = &args.plot {
         plot::time_histories(path, model.as_ref(), &solution).map_err(CliError::failure)?;
+        if !constraints.names.is_empty() {
+            let drift_path = sibling(path, "drift");
+            constraints
+                .plot(&drift_path, model.name(), &solution)
+                .map_err(CliError::failure)?;
+        }
     }
     if args.json {
         let samples: Vec<serde_json::Value> = solution
             .iter()
             .zip(&report.energy)
-            .map(|((t, y), e)| json!({"t": t, "q": &y[..n], "qdot": &y[n..], "energy": e}))
+            .enumerate()
+            .map(|(k, ((t, y), e))| {
+                let mut sample = json!({"t": t, "q": &y[..n], "qdot": &y[n..], "energy": e});
+                if !constraints.names.is_empty() {
+                    sample["constraint_forces"] = json!(constraints.forces[k]);
+                    sample["constraint_drift"] =
+                        json!({"position": constraints.drift[k].0, "velocity": constraints.drift[k].1});
+                }
+                sample
+            })
             .collect();
         let mut out = json!({
             "model": model.name(),
@@ -170,6 +216,14 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
                 "wall_time_s": solution.stats.wall_time_s,
             },
         });
+        if !constraints.names.is_empty() {
+            out["constraints"] = json!(constraints.names);
+            out["stabilization"] = json!(format!("{:?}", args.stabilization).to_lowercase());
+            out["max_constraint_drift"] = json!({
+                "position": constraints.max_drift().0,
+                "velocity": constraints.max_drift().1,
+            });
+        }
         if let Some(e) = &failure {
             out["error"] = json!({"t": e.t(), "message": e.to_string()});
         }
@@ -179,6 +233,7 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
         let _ = writeln!(stdout, "{text}");
     } else {
         print_summary(model.as_ref(), integrator.name(), args, &solution, &report);
+        constraints.print_summary(args.stabilization);
     }
     match failure {
         None => Ok(()),
@@ -280,6 +335,7 @@ fn write_csv(
     model: &dyn ModelInfo,
     solution: &Solution,
     report: &Report,
+    constraints: &ConstraintReport,
 ) -> Result<(), CliError> {
     let mut out = String::from("t");
     for c in model.coordinate_names() {
@@ -289,13 +345,163 @@ fn write_csv(
     for c in model.coordinate_names() {
         out.push_str(&format!(",{c}_dot"));
     }
-    out.push_str(",energy\n");
-    for ((t, y), e) in solution.iter().zip(&report.energy) {
+    out.push_str(",energy");
+    for c in &constraints.names {
+        out.push_str(&format!(",lambda_{c}"));
+    }
+    if !constraints.names.is_empty() {
+        out.push_str(",drift_position,drift_velocity");
+    }
+    out.push('\n');
+    for (k, ((t, y), e)) in solution.iter().zip(&report.energy).enumerate() {
         out.push_str(&format!("{t:e}"));
         for v in y {
             out.push_str(&format!(",{v:e}"));
         }
-        out.push_str(&format!(",{e:e}\n"));
+        out.push_str(&format!(",{e:e}"));
+        if !constraints.names.is_empty() {
+            for l in &constraints.forces[k] {
+                out.push_str(&format!(",{l:e}"));
+            }
+            let (p, v) = constraints.drift[k];
+            out.push_str(&format!(",{p:e},{v:e}"));
+        }
+        out.push('\n');
     }
     std::fs::write(path, out).map_err(|e| CliError::failure(format!("cannot write `{path}`: {e}")))
+}
+
+/// `dir/name.svg` → `dir/name-{tag}.svg`.
+fn sibling(path: &str, tag: &str) -> String {
+    match path.rsplit_once('.') {
+        Some((stem, ext)) => format!("{stem}-{tag}.{ext}"),
+        None => format!("{path}-{tag}"),
+    }
+}
+
+/// Makes the initial state consistent with the constraints (issue 5, item 3): the
+/// coordinates marked `{ guess: … }` in the model file, and their rates, are solved by
+/// Newton from `Φ(q, 0) = 0` and the velocity constraints; without guesses the state must
+/// already satisfy them to 1e-9.
+///
+/// # Errors
+/// A failure naming the constraint with the largest residual.
+fn consistent_initial_state(model: &mut dyn ModelInfo, y0: &mut [f64]) -> Result<(), CliError> {
+    let names = model.constraint_names();
+    if names.is_empty() {
+        return Ok(());
+    }
+    let guesses = model.initial_guesses();
+    if guesses.is_empty() {
+        let (p, v) = model.constraint_drift(0.0, y0);
+        if p > 1e-9 || v > 1e-9 {
+            return Err(CliError::failure(format!(
+                "the initial state of `{}` violates its constraints (largest |Φ| = {p:.3e}, largest velocity residual = {v:.3e}); mark the dependent coordinates as `{{ guess: … }}` in `initial:` or fix the values",
+                model.name()
+            )));
+        }
+        return Ok(());
+    }
+    let holonomic = model.holonomic_constraint_count();
+    model.project(0.0, y0, guesses).map_err(|e| {
+        let name = names.get(e.constraint.min(holonomic.saturating_sub(1))).copied().unwrap_or("?");
+        CliError::failure(format!(
+            "no consistent initial state for `{}`: constraint `{name}` keeps a residual of {:.3e} after {} Newton iteration(s) from the guesses; try other guesses",
+            model.name(),
+            e.residual,
+            e.iterations
+        ))
+    })?;
+    Ok(())
+}
+
+/// Constraint forces `λ` and drift at every sample of a constrained model.
+struct ConstraintReport {
+    names: Vec<&'static str>,
+    forces: Vec<Vec<f64>>,
+    drift: Vec<(f64, f64)>,
+}
+
+impl ConstraintReport {
+    fn new(model: &mut dyn ModelInfo, solution: &Solution) -> Self {
+        let names = model.constraint_names().to_vec();
+        let mut forces = Vec::new();
+        let mut drift = Vec::new();
+        if !names.is_empty() {
+            for (t, y) in solution.iter() {
+                forces.push(
+                    model
+                        .constraint_forces(t, y)
+                        .unwrap_or_else(|_| vec![f64::NAN; names.len()]),
+                );
+                drift.push(model.constraint_drift(t, y));
+            }
+        }
+        Self {
+            names,
+            forces,
+            drift,
+        }
+    }
+
+    fn max_drift(&self) -> (f64, f64) {
+        self.drift
+            .iter()
+            .fold((0.0f64, 0.0f64), |(a, b), (p, v)| (a.max(*p), b.max(*v)))
+    }
+
+    fn print_summary(&self, stabilization: StabilizationArg) {
+        if self.names.is_empty() {
+            return;
+        }
+        if let Some(last) = self.forces.last() {
+            let forces: Vec<String> = self
+                .names
+                .iter()
+                .zip(last)
+                .map(|(n, l)| format!("{n} = {l:.9e}"))
+                .collect();
+            println!("lambda     at the end: {}", forces.join(", "));
+        }
+        let (p, v) = self.max_drift();
+        println!(
+            "drift      constraints ({}): max |Φ| = {p:.3e}, max |Φ̇| = {v:.3e}",
+            format!("{stabilization:?}").to_lowercase()
+        );
+    }
+
+    fn plot(&self, path: &str, model: &str, solution: &Solution) -> Result<(), String> {
+        let series = vec![
+            plot::Series {
+                name: "max |Φ|".to_string(),
+                points: solution
+                    .t
+                    .iter()
+                    .zip(&self.drift)
+                    .map(|(t, d)| (*t, d.0))
+                    .collect(),
+            },
+            plot::Series {
+                name: "max |Φ̇|".to_string(),
+                points: solution
+                    .t
+                    .iter()
+                    .zip(&self.drift)
+                    .map(|(t, d)| (*t, d.1))
+                    .collect(),
+            },
+        ];
+        let title = format!("{model}: constraint drift");
+        plot::lines(
+            path,
+            &plot::Chart {
+                title: &title,
+                x_desc: "t (s)",
+                y_desc: "residual (units of Φ, Φ̇)",
+                log_x: false,
+                log_y: true,
+            },
+            &series,
+        )
+    }
 }

@@ -49,7 +49,8 @@ proptest! {
 #[test]
 fn hand_equations_must_be_linear_in_accelerations() {
     let head = "name: a\nparameters: { m: 1.0, k: 1.0 }\ncoordinates: [x, y]\nkinetic: m*(x_dot^2 + y_dot^2)/2\npotential: k*(x^2 + y^2)/2\nchecks:\n  equations_of_motion:\n";
-    let bad = format!("{head}    - m*x_ddot^2 + k*x = 0\n    - m*y_ddot + k*y + x_ddot*y_ddot = 0\n");
+    let bad =
+        format!("{head}    - m*x_ddot^2 + k*x = 0\n    - m*y_ddot + k*y + x_ddot*y_ddot = 0\n");
     let file = load("a.yaml", &bad).expect("loads");
     let errors = SymbolicModel::from_file(&file).unwrap_err();
     let found: Vec<String> = errors
@@ -63,9 +64,8 @@ fn hand_equations_must_be_linear_in_accelerations() {
             "9:7: this equation of motion is not linear in the accelerations"
         ]
     );
-    let good = format!(
-        "{head}    - (x_ddot + 1)^2 - x_ddot^2 + 2*k*x/m - 1 = 0\n    - m*y_ddot = -k*y\n"
-    );
+    let good =
+        format!("{head}    - (x_ddot + 1)^2 - x_ddot^2 + 2*k*x/m - 1 = 0\n    - m*y_ddot = -k*y\n");
     let file = load("a.yaml", &good).expect("loads");
     assert!(SymbolicModel::from_file(&file).is_ok());
 }

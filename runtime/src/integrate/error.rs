@@ -126,6 +126,15 @@ pub enum IntegrationError {
         /// Time at which the right-hand side was evaluated (a stage time of the failed step).
         t: f64,
     },
+    /// The constrained system `[M Jᵀ; J 0]` is singular
+    /// ([`RhsError::SingularConstraintMatrix`](crate::RhsError::SingularConstraintMatrix)).
+    #[error(
+        "the constrained system [M Jᵀ; J 0] is singular at t = {t} (redundant constraints or a singular configuration)"
+    )]
+    SingularConstraintMatrix {
+        /// Time at which the right-hand side was evaluated (a stage time of the failed step).
+        t: f64,
+    },
 }
 
 impl IntegrationError {
@@ -136,7 +145,8 @@ impl IntegrationError {
             | IntegrationError::TooManySteps { t, .. }
             | IntegrationError::NonFiniteState { t, .. }
             | IntegrationError::RhsNonFinite { t, .. }
-            | IntegrationError::SingularMassMatrix { t } => Some(t),
+            | IntegrationError::SingularMassMatrix { t }
+            | IntegrationError::SingularConstraintMatrix { t } => Some(t),
             IntegrationError::InvalidTimeSpan { .. }
             | IntegrationError::DimensionMismatch { .. }
             | IntegrationError::ToleranceLengthMismatch { .. }

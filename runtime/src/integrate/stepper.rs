@@ -27,7 +27,7 @@ impl StepFailure {
     pub(crate) fn is_recoverable(&self) -> bool {
         match self {
             StepFailure::Rhs {
-                error: RhsError::SingularMassMatrix,
+                error: RhsError::SingularMassMatrix | RhsError::SingularConstraintMatrix,
                 ..
             } => false,
             StepFailure::Rhs {
@@ -45,6 +45,10 @@ impl StepFailure {
                 t,
                 error: RhsError::SingularMassMatrix,
             } => IntegrationError::SingularMassMatrix { t },
+            StepFailure::Rhs {
+                t,
+                error: RhsError::SingularConstraintMatrix,
+            } => IntegrationError::SingularConstraintMatrix { t },
             StepFailure::Rhs {
                 t,
                 error: RhsError::NonFinite { index },

@@ -395,6 +395,63 @@ pub fn emit(
             s
         },
     );
+    // Constraints: the trait's defaults stand for an unconstrained model.
+    let c = &model.constraints;
+    let mut constant_items = String::new();
+    if !c.is_empty() {
+        let names: Vec<String> = c.names.iter().map(|s| string_literal(s)).collect();
+        let _ = writeln!(
+            constant_items,
+            "fn constraint_names(&self) -> &'static [&'static str] {{ &[{}] }}",
+            names.join(", ")
+        );
+        let _ = writeln!(
+            constant_items,
+            "fn holonomic_constraint_count(&self) -> usize {{ {} }}",
+            c.holonomic
+        );
+        let write_out = |v: &[String]| {
+            v.iter()
+                .enumerate()
+                .map(|(i, x)| format!("if let Some(__o) = __out.get_mut({i}) {{ *__o = {x}; }}\n"))
+                .collect::<String>()
+        };
+        emit_fn(
+            &format!("fn constraint_residuals(&self, {q_args}, __t: f64, __out: &mut [f64])"),
+            &c.phi,
+            &|v| write_out(v),
+        );
+        emit_fn(
+            &format!("fn constraint_jacobian(&self, {q_args}, __t: f64, __out: &mut [f64])"),
+            &c.jacobian,
+            &|v| write_out(v),
+        );
+        emit_fn(
+            &format!(
+                "fn constraint_velocity_residuals(&self, {qd_args}, __t: f64, __out: &mut [f64])"
+            ),
+            &c.velocity,
+            &|v| write_out(v),
+        );
+        emit_fn(
+            &format!("fn constraint_gamma(&self, {qd_args}, __t: f64, __out: &mut [f64])"),
+            &c.gamma,
+            &|v| write_out(v),
+        );
+    }
+    if !model.initial_guesses.is_empty() {
+        let idx: Vec<String> = model
+            .initial_guesses
+            .iter()
+            .map(|i| i.to_string())
+            .collect();
+        let _ = writeln!(
+            constant_items,
+            "fn initial_guesses(&self) -> &'static [usize] {{ &[{}] }}",
+            idx.join(", ")
+        );
+    }
+    imp.push_str(&constant_items);
     let _ = writeln!(
         imp,
         "fn is_conservative(&self) -> bool {{ {} }}",

@@ -23,10 +23,10 @@
 //! written by hand: compared with Lagrange like any other derivation.
 
 use super::lower::{BalanceInfo, LoadInfo};
-use crate::model::AmbForm;
 use super::momentum::linear_in_accelerations;
 use super::{EquationsOfMotion, Formulation, SymbolicModel};
 use crate::expr::{ExprArena, ExprId};
+use crate::model::AmbForm;
 
 /// The model's `balances:` as equations of motion.
 #[derive(Debug, Clone, Copy, Default)]

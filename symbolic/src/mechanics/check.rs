@@ -5,13 +5,13 @@ use std::time::Instant;
 
 use rustc_hash::FxHashMap;
 
+use super::BalanceInfo;
 use super::{
     EquationsOfMotion, Formulation, HandEquations, Lagrange, MomentumBalance, SymbolicModel,
     UserBalances,
 };
 use crate::expr::eval::Evaluator;
 use crate::expr::{ExprId, SymbolKind, cse};
-use super::BalanceInfo;
 use crate::model::{AmbForm, Diagnostic, ModelFile};
 
 /// Cost and time of one derivation.

@@ -2,7 +2,9 @@
 //! coordinates, rates and time; point positions; `T`, `V` and the generalized forces `Q`
 //! assembled from bodies, gravity, springs, dampers, forces and torques.
 
+use super::constraints::{ConstraintEquations, linear_in_rates, redundant_rows};
 use crate::expr::{Constant, ExprArena, ExprId, Func, SymbolId, SymbolKind};
+use crate::model::Located;
 use crate::model::{BinOp, BodyKind, Diagnostic, Expr, ExprKind, ModelFile};
 
 /// A parameter of a lowered model.
@@ -143,6 +145,10 @@ pub struct SymbolicModel {
     /// (`checks: equations_of_motion`), in the coordinates, rates and accelerations; empty
     /// when the file gives none.
     pub hand_equations: Vec<ExprId>,
+    /// Holonomic and non-holonomic constraints at the acceleration level (empty if none).
+    pub constraints: ConstraintEquations,
+    /// Coordinates whose initial value is a guess to be solved from the constraints.
+    pub initial_guesses: Vec<usize>,
 }
 
 impl SymbolicModel {
@@ -190,6 +196,98 @@ impl<'f> Lowering<'f> {
             errors: Vec::new(),
             allow_accelerations: false,
         }
+    }
+
+    /// Lowers `constraints:` and `nonholonomic:`, differentiates them, and reports a
+    /// non-holonomic constraint that is not linear in the rates and constraints that are
+    /// redundant (dependent Jacobian rows at every sampled configuration).
+    fn constraints(
+        &mut self,
+        file: &ModelFile,
+        parameters: &[ParameterInfo],
+    ) -> ConstraintEquations {
+        let holonomic: Vec<(String, ExprId)> = file
+            .constraints
+            .iter()
+            .map(|(k, e)| (k.value.clone(), self.expr(e)))
+            .collect();
+        let nonholonomic: Vec<(String, ExprId)> = file
+            .nonholonomic
+            .iter()
+            .map(|(k, e)| (k.value.clone(), self.expr(e)))
+            .collect();
+        if holonomic.is_empty() && nonholonomic.is_empty() {
+            return ConstraintEquations::default();
+        }
+        let symbols: Vec<[SymbolId; 3]> = self.arena.coordinates().to_vec();
+        for ((k, _), (_, g)) in file.nonholonomic.iter().zip(&nonholonomic) {
+            if !linear_in_rates(&mut self.arena, *g, &symbols) {
+                self.errors.push(
+                    Diagnostic::new(k.location, format!("non-holonomic constraint `{}` is not linear in the rates", k.value))
+                        .with_help("write it as A(q, t) q̇ + b(q, t) = 0: each `x_dot` to the first power, times a function of q and t"),
+                );
+            }
+        }
+        let eqs = ConstraintEquations::derive(&mut self.arena, &symbols, &holonomic, &nonholonomic);
+        let (m, n) = (eqs.len(), symbols.len());
+        if m > n || !self.errors.is_empty() {
+            return eqs;
+        }
+        // Rank of J at a few random configurations (parameters at their defaults).
+        let mut evaluator = crate::expr::eval::Evaluator::new(&self.arena, &eqs.jacobian);
+        let mut rng: u64 = 0x9E37_79B9_7F4A_7C15;
+        let mut uniform = move || {
+            rng ^= rng << 13;
+            rng ^= rng >> 7;
+            rng ^= rng << 17;
+            (rng >> 11) as f64 / (1u64 << 53) as f64 * 4.0 - 2.0
+        };
+        let mut samples = Vec::new();
+        for _ in 0..60 {
+            if samples.len() == 6 {
+                break;
+            }
+            let mut bindings = vec![0.0; self.arena.symbols().len()];
+            for (i, s) in self.arena.symbols().iter().enumerate() {
+                bindings[i] = match s.kind {
+                    SymbolKind::Parameter => parameters
+                        .iter()
+                        .find(|p| p.name == s.name)
+                        .map_or(0.0, |p| p.default),
+                    _ => uniform(),
+                };
+            }
+            let values = evaluator.eval(&bindings).to_vec();
+            if values.iter().all(|v| v.is_finite()) {
+                samples.push(values);
+            }
+        }
+        let all: Vec<&(Located<String>, crate::model::Expr)> =
+            file.constraints.iter().chain(&file.nonholonomic).collect();
+        for (i, with) in redundant_rows(&samples, m, n) {
+            let (k, _) = all[i];
+            let others: Vec<String> = with
+                .iter()
+                .map(|j| format!("`{}`", all[*j].0.value))
+                .collect();
+            let message = if others.is_empty() {
+                format!(
+                    "constraint `{}` constrains nothing: its Jacobian row is zero",
+                    k.value
+                )
+            } else {
+                format!(
+                    "constraint `{}` is redundant with {}: its Jacobian row is a combination of theirs at every configuration tried",
+                    k.value,
+                    others.join(", ")
+                )
+            };
+            self.errors.push(
+                Diagnostic::new(k.location, message)
+                    .with_help("redundant constraints make the constraint forces indeterminate (the planar-loop trap); remove it"),
+            );
+        }
+        eqs
     }
 
     fn expr(&mut self, e: &Expr) -> ExprId {
@@ -570,6 +668,13 @@ impl<'f> Lowering<'f> {
             }
         }
 
+        let constraints = self.constraints(file, &parameters);
+        let initial_guesses: Vec<usize> = file
+            .initial_guesses
+            .iter()
+            .filter_map(|g| coordinate_names.iter().position(|c| *c == g.value))
+            .collect();
+
         let kinetic = self.arena.sum(&t_terms);
         let potential = self.arena.sum(&v_terms);
         let generalized_forces: Vec<ExprId> =
@@ -641,6 +746,8 @@ impl<'f> Lowering<'f> {
                 || file.potential.is_some()
                 || !file.generalized_forces.is_empty(),
             hand_equations,
+            constraints,
+            initial_guesses,
         })
     }
 }

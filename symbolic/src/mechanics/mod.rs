@@ -5,11 +5,13 @@
 
 mod balances;
 pub mod check;
+mod constraints;
 mod lagrange;
 mod lower;
 mod momentum;
 
 pub use balances::{HandEquations, UserBalances};
+pub use constraints::{ConstraintEquations, linear_in_rates, redundant_rows};
 pub use lagrange::Lagrange;
 pub use lower::{BalanceInfo, BodyInfo, LoadInfo, ParameterInfo, SymbolicModel};
 pub use momentum::MomentumBalance;

@@ -34,6 +34,7 @@ pub fn check_partial(file: &ModelFile, incomplete: &Incomplete) -> Result<(), Ve
     checker.masses();
     checker.balances();
     checker.hand_equations();
+    checker.constraints();
     checker.diagnostics.finish()
 }
 
@@ -310,8 +311,8 @@ impl<'f> Checker<'f> {
             let is_param = n == "pi" || self.params.contains(&n);
             let is_coord = self.coords.contains(&n);
             let is_rate = self.rates.iter().any(|r| r == n);
-            let is_acceleration = depends == Depends::Acceleration
-                && self.accelerations.iter().any(|r| r == n);
+            let is_acceleration =
+                depends == Depends::Acceleration && self.accelerations.iter().any(|r| r == n);
             let needs = if is_param {
                 Depends::Constant
             } else if is_coord || n == "t" {
@@ -588,6 +589,71 @@ impl<'f> Checker<'f> {
                 )),
             };
             self.error(d);
+        }
+    }
+
+    // Rule: constraints have distinct names; holonomic ones depend on q and t, non-holonomic
+    // ones also on the rates; there are no more constraints than coordinates; `guess` marks
+    // coordinates (not rates) of a model that has constraints.
+    fn constraints(&mut self) {
+        let file = self.file;
+        let mut seen: Vec<(&str, Location)> = Vec::new();
+        for (k, e) in &file.constraints {
+            self.resolve(e, Depends::Position, &format!("constraint `{}`", k.value));
+        }
+        for (k, e) in &file.nonholonomic {
+            self.resolve(e, Depends::Motion, &format!("constraint `{}`", k.value));
+        }
+        for (k, _) in file.constraints.iter().chain(&file.nonholonomic) {
+            if let Some((_, first)) = seen.iter().find(|(n, _)| *n == k.value) {
+                self.error(
+                    Diagnostic::new(k.location, format!("duplicate constraint name `{}`: already used at {first}", k.value))
+                        .with_help("constraints under `constraints` and `nonholonomic` share one namespace; rename one"),
+                );
+            } else {
+                seen.push((&k.value, k.location));
+            }
+        }
+        let m = file.constraints.len() + file.nonholonomic.len();
+        let n = file.coordinates.len();
+        if m > n && !self.incomplete.has_section("coordinates") {
+            let at = file
+                .constraints
+                .iter()
+                .chain(&file.nonholonomic)
+                .nth(n)
+                .map_or(file.name.location, |(k, _)| k.location);
+            self.error(
+                Diagnostic::new(at, format!("{m} constraints on {n} coordinate(s): more constraints than coordinates"))
+                    .with_help("each constraint removes one degree of freedom; remove redundant constraints or add coordinates"),
+            );
+        }
+        for g in &file.initial_guesses {
+            if !self.coords.contains(&g.value.as_str()) {
+                self.error(
+                    Diagnostic::new(
+                        g.location,
+                        format!(
+                            "`{}` is not a coordinate: only coordinates take `{{ guess: … }}`",
+                            g.value
+                        ),
+                    )
+                    .with_help(
+                        "the rates of guessed coordinates are solved from the velocity constraints",
+                    ),
+                );
+            } else if m == 0 && !self.incomplete.has_section("constraints") {
+                self.error(
+                    Diagnostic::new(
+                        g.location,
+                        format!(
+                            "`{}` is a guess, but the model has no constraints to solve it from",
+                            g.value
+                        ),
+                    )
+                    .with_help("give its value directly: `initial: { x: 0.5 }`"),
+                );
+            }
         }
     }
 

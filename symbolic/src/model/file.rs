@@ -237,6 +237,14 @@ pub struct ModelFile {
     pub draw: Draw,
     /// `balances:` — momentum-balance equations chosen by the user (empty if none).
     pub balances: Vec<Balance>,
+    /// `constraints:` — holonomic constraints `Φ(q, t) = 0` by name, in file order.
+    pub constraints: Vec<(Located<String>, Expr)>,
+    /// `nonholonomic:` — constraints `A(q, t) q̇ + b(q, t) = 0` by name (the expression is the
+    /// left-hand side, linear in the rates), in file order.
+    pub nonholonomic: Vec<(Located<String>, Expr)>,
+    /// Coordinates whose `initial:` value is only a guess (`theta2: { guess: 0.5 }`): the
+    /// runtime solves them, and their rates, from the constraints.
+    pub initial_guesses: Vec<Located<String>>,
     /// `checks:` — the file's claims about its own model (empty if none).
     pub checks: Checks,
     /// The spatial dimension of the points (2 or 3); `None` when there are no points.

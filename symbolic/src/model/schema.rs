@@ -14,6 +14,9 @@ use super::yaml::{YamlKind, YamlNode, char_locations, trailing_comment};
 
 type Entries = [(Located<String>, YamlNode)];
 
+/// Expressions by name, in file order.
+type KeyedExprs = Vec<(Located<String>, Expr)>;
+
 /// Top-level keys of a model file.
 pub const TOP_LEVEL_KEYS: &[&str] = &[
     "name",
@@ -34,16 +37,12 @@ pub const TOP_LEVEL_KEYS: &[&str] = &[
     "draw",
     "balances",
     "checks",
+    "constraints",
+    "nonholonomic",
 ];
 
 /// Keys of the model format (DESIGN.md) that this version does not implement yet.
-pub const LATER_KEYS: &[&str] = &[
-    "constraints",
-    "nonholonomic",
-    "events",
-    "equilibria",
-    "outputs",
-];
+pub const LATER_KEYS: &[&str] = &["events", "equilibria", "outputs"];
 
 const BODY_KEYS: &[&str] = &["mass", "at", "inertia", "com", "angle"];
 const PARTICLE_EXAMPLE: &str = "{ mass: m, at: P }";
@@ -680,16 +679,31 @@ impl Ctx<'_> {
         let torques = get(top, "torques")
             .map(|n| self.torques(n))
             .unwrap_or_default();
-        self.section = "initial";
-        let initial = get(top, "initial")
+        self.section = "constraints";
+        let constraints = get(top, "constraints")
             .map(|n| {
                 self.keyed_exprs(
                     n,
-                    "`initial`",
-                    "initial: { theta: pi/2, theta_dot: 0 }",
-                    "an initial value",
+                    "`constraints`",
+                    "constraints: { rod: sqrt(x^2 + y^2) - l }",
+                    "a holonomic constraint",
                 )
             })
+            .unwrap_or_default();
+        self.section = "nonholonomic";
+        let nonholonomic = get(top, "nonholonomic")
+            .map(|n| {
+                self.keyed_exprs(
+                    n,
+                    "`nonholonomic`",
+                    "nonholonomic: { no_side_slip: -sin(theta)*x_dot + cos(theta)*y_dot }",
+                    "a non-holonomic constraint",
+                )
+            })
+            .unwrap_or_default();
+        self.section = "initial";
+        let (initial, initial_guesses) = get(top, "initial")
+            .map(|n| self.initial(n))
             .unwrap_or_default();
         self.section = "draw";
         let draw = get(top, "draw").map(|n| self.draw(n)).unwrap_or_default();
@@ -725,19 +739,59 @@ impl Ctx<'_> {
             dimension,
             balances,
             checks,
+            constraints,
+            nonholonomic,
+            initial_guesses,
         })
     }
 
+    /// `initial:` — values, or `{ guess: value }` for coordinates solved from the constraints.
+    fn initial(&mut self, node: &YamlNode) -> (KeyedExprs, Vec<Located<String>>) {
+        let Some(entries) = self.map(node, "`initial`", "initial: { theta: pi/2, theta_dot: 0 }")
+        else {
+            return Default::default();
+        };
+        let mut values = Vec::new();
+        let mut guesses = Vec::new();
+        for (k, v) in entries {
+            let what = format!("an initial value (`{}`)", k.value);
+            if let YamlKind::Map(inner) = &v.kind {
+                if inner.len() == 1 && inner[0].0.value == "guess" {
+                    if let Some(e) = self.expr(&inner[0].1, &what) {
+                        values.push((k.clone(), e));
+                        guesses.push(k.clone());
+                    }
+                } else {
+                    self.error(
+                        Diagnostic::new(v.location, format!("{what} is an expression or `{{ guess: value }}`"))
+                            .with_help("`{ guess: 0.5 }` marks a starting guess that the runtime corrects to satisfy the constraints"),
+                    );
+                }
+            } else if let Some(e) = self.expr(v, &what) {
+                values.push((k.clone(), e));
+            }
+        }
+        (values, guesses)
+    }
+
     fn checks(&mut self, node: &YamlNode) -> Checks {
-        const EXAMPLE: &str =
-            "checks:\n  equations_of_motion:\n    - m*x_ddot + k*x = 0";
+        const EXAMPLE: &str = "checks:\n  equations_of_motion:\n    - m*x_ddot + k*x = 0";
         let mut checks = Checks::default();
         let Some(entries) = self.map(node, "`checks`", EXAMPLE) else {
             return checks;
         };
-        self.unknown_keys(entries, "`checks`", &["equations_of_motion"], &["equations_of_motion"]);
+        self.unknown_keys(
+            entries,
+            "`checks`",
+            &["equations_of_motion"],
+            &["equations_of_motion"],
+        );
         if let Some(list) = get(entries, "equations_of_motion").and_then(|n| {
-            self.seq(n, "`equations_of_motion`", "equations_of_motion: [m*x_ddot + k*x = 0]")
+            self.seq(
+                n,
+                "`equations_of_motion`",
+                "equations_of_motion: [m*x_ddot + k*x = 0]",
+            )
         }) {
             for item in list {
                 if let Some(e) = self.equation(item) {
@@ -756,12 +810,20 @@ impl Ctx<'_> {
         match equals.as_slice() {
             [] => {
                 let lhs = self.parse_part(node, &text, 0, chars.len())?;
-                Some(HandEquation { lhs, rhs: None, location: node.location })
+                Some(HandEquation {
+                    lhs,
+                    rhs: None,
+                    location: node.location,
+                })
             }
             [i] => {
                 let lhs = self.parse_part(node, &text, 0, *i);
                 let rhs = self.parse_part(node, &text, i + 1, chars.len());
-                Some(HandEquation { lhs: lhs?, rhs: Some(rhs?), location: node.location })
+                Some(HandEquation {
+                    lhs: lhs?,
+                    rhs: Some(rhs?),
+                    location: node.location,
+                })
             }
             [_, second, ..] => {
                 let start = node.location;
@@ -801,7 +863,10 @@ impl Ctx<'_> {
             let (key, value) = &entries[0];
             let amb = key.value == "amb";
             let (allowed, example): (&[&str], &str) = if amb {
-                (&["about", "bodies", "form"], "{ about: O, bodies: [upper, fore] }")
+                (
+                    &["about", "bodies", "form"],
+                    "{ about: O, bodies: [upper, fore] }",
+                )
             } else {
                 (
                     &["bodies", "along"],
@@ -836,7 +901,9 @@ impl Ctx<'_> {
                 let form = match get(f, "form") {
                     None => Some(AmbForm::RCrossMa),
                     Some(n) => match &n.kind {
-                        YamlKind::Scalar { text, .. } if text == "r_x_ma" => Some(AmbForm::RCrossMa),
+                        YamlKind::Scalar { text, .. } if text == "r_x_ma" => {
+                            Some(AmbForm::RCrossMa)
+                        }
                         YamlKind::Scalar { text, .. } if text == "h_dot" => Some(AmbForm::HDot),
                         _ => {
                             self.error(
@@ -1389,11 +1456,11 @@ mod tests {
 
     #[test]
     fn later_keys_and_unknown_keys() {
-        let m = messages("name: a\ncoordinates: [q]\nconstraints: []\nkinetc: q_dot^2\n");
+        let m = messages("name: a\ncoordinates: [q]\nevents: []\nkinetc: q_dot^2\n");
         assert_eq!(
             m,
             [
-                "3:1: `constraints:` is not supported yet by this version of eomgen",
+                "3:1: `events:` is not supported yet by this version of eomgen",
                 "4:1: unknown key `kinetc` in a model file"
             ]
         );

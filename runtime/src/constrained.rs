@@ -1,0 +1,330 @@
+//! Constrained equations of motion: the index-1 DAE `[M Jᵀ; J 0][q̈; λ] = [F; γ]`, drift
+//! control, projection onto the constraint manifold and consistent initial states
+//! (lectures 8–11 of the syllabus; HW10, HW12–HW14).
+//!
+//! Everything here works on buffers allocated once, in [`ConstraintWorkspace::new`], so an
+//! evaluation of the right-hand side allocates nothing.
+
+use nalgebra::SVector;
+
+use crate::ode::RhsError;
+use crate::system::MechanicalSystem;
+
+/// How constraint drift is controlled during an integration (selectable per run).
+///
+/// The index-1 form `J q̈ = γ` only keeps `Φ̈ = 0`, so round-off and truncation errors make
+/// `Φ` and `Φ̇` drift (HW10, HW12).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub enum Stabilization {
+    /// No control: the drift is shown as it is.
+    #[default]
+    None,
+    /// Baumgarte's stabilisation (Baumgarte 1972, *Comput. Methods Appl. Mech. Eng.* 1):
+    /// `Φ̈ + 2α Φ̇ + β² Φ = 0` replaces `Φ̈ = 0`, so the acceleration-level row becomes
+    /// `J q̈ = γ − 2α Φ̇ − β² Φ` (non-holonomic rows: `γ − 2α (A q̇ + b)`). `α`, `β` in 1/s.
+    Baumgarte {
+        /// Damping of the drift (1/s).
+        alpha: f64,
+        /// Stiffness of the drift (1/s).
+        beta: f64,
+    },
+    /// Projection after every accepted step: `q` onto `Φ(q, t) = 0` by Gauss–Newton with the
+    /// minimum-norm correction `Δq = −Jᵀ(J Jᵀ)⁻¹ Φ`, then `q̇` onto the velocity constraints
+    /// by the minimum-norm correction of `J q̇ + Φ_t` (and `A q̇ + b`).
+    Projection,
+}
+
+/// Scratch space of the constrained solve, sized for `n` coordinates and `m` constraints.
+#[derive(Debug, Clone)]
+pub struct ConstraintWorkspace {
+    n: usize,
+    m: usize,
+    holonomic: usize,
+    kkt: Vec<f64>,
+    rhs: Vec<f64>,
+    pivots: Vec<usize>,
+    jacobian: Vec<f64>,
+    gamma: Vec<f64>,
+    velocity: Vec<f64>,
+    phi: Vec<f64>,
+    small: Vec<f64>,
+    small_rhs: Vec<f64>,
+    small_pivots: Vec<usize>,
+    /// `λ` of the last solve (length `m`).
+    pub multipliers: Vec<f64>,
+}
+
+impl ConstraintWorkspace {
+    /// Buffers for `n` coordinates, `m` constraints of which the first `holonomic` are
+    /// holonomic.
+    pub fn new(n: usize, m: usize, holonomic: usize) -> Self {
+        let k = n + m;
+        Self {
+            n,
+            m,
+            holonomic,
+            kkt: vec![0.0; k * k],
+            rhs: vec![0.0; k],
+            pivots: vec![0; k],
+            jacobian: vec![0.0; m * n],
+            gamma: vec![0.0; m],
+            velocity: vec![0.0; m],
+            phi: vec![0.0; holonomic],
+            small: vec![0.0; m * m],
+            small_rhs: vec![0.0; m],
+            small_pivots: vec![0; m],
+            multipliers: vec![0.0; m],
+        }
+    }
+
+    /// Number of constraints `m`.
+    pub fn len(&self) -> usize {
+        self.m
+    }
+
+    /// Whether there are no constraints.
+    pub fn is_empty(&self) -> bool {
+        self.m == 0
+    }
+
+    /// Solves `[M Jᵀ; J 0][q̈; λ] = [F; γ̃]` at `(q, q̇, t)`, with `γ̃` stabilised as
+    /// `stabilization` says; `λ` is left in [`Self::multipliers`].
+    ///
+    /// # Errors
+    /// [`RhsError::SingularConstraintMatrix`] when the KKT matrix is singular (redundant
+    /// constraints, a singular configuration, or `M` singular on the null space of `J`).
+    pub fn accelerations<S: MechanicalSystem<N>, const N: usize>(
+        &mut self,
+        system: &S,
+        q: &SVector<f64, N>,
+        qdot: &SVector<f64, N>,
+        t: f64,
+        stabilization: Stabilization,
+    ) -> Result<SVector<f64, N>, RhsError> {
+        let (n, m) = (self.n, self.m);
+        let k = n + m;
+        let (mass, forcing) = system.mass_matrix_and_forcing(q, qdot, t);
+        system.constraint_jacobian(q, t, &mut self.jacobian);
+        system.constraint_gamma(q, qdot, t, &mut self.gamma);
+        if let Stabilization::Baumgarte { alpha, beta } = stabilization {
+            system.constraint_velocity_residuals(q, qdot, t, &mut self.velocity);
+            system.constraint_residuals(q, t, &mut self.phi);
+            for i in 0..m {
+                let position = if i < self.holonomic { self.phi[i] } else { 0.0 };
+                self.gamma[i] -= 2.0 * alpha * self.velocity[i] + beta * beta * position;
+            }
+        }
+        for r in 0..k {
+            for c in 0..k {
+                self.kkt[r * k + c] = match (r < n, c < n) {
+                    (true, true) => mass[(r, c)],
+                    (true, false) => self.jacobian[(c - n) * n + r],
+                    (false, true) => self.jacobian[(r - n) * n + c],
+                    (false, false) => 0.0,
+                };
+            }
+            self.rhs[r] = if r < n { forcing[r] } else { self.gamma[r - n] };
+        }
+        lu_solve(&mut self.kkt, &mut self.rhs, &mut self.pivots, k)
+            .ok_or(RhsError::SingularConstraintMatrix)?;
+        self.multipliers.copy_from_slice(&self.rhs[n..k]);
+        Ok(SVector::<f64, N>::from_column_slice(&self.rhs[..n]))
+    }
+
+    /// Largest `|Φᵢ|` and largest velocity residual `|Φ̇ᵢ|` (or `|A q̇ + b|`) at a state.
+    pub fn drift<S: MechanicalSystem<N>, const N: usize>(
+        &mut self,
+        system: &S,
+        q: &SVector<f64, N>,
+        qdot: &SVector<f64, N>,
+        t: f64,
+    ) -> (f64, f64) {
+        system.constraint_residuals(q, t, &mut self.phi);
+        system.constraint_velocity_residuals(q, qdot, t, &mut self.velocity);
+        let max = |v: &[f64]| v.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+        (max(&self.phi), max(&self.velocity))
+    }
+
+    /// Projects `(q, q̇)` onto the constraint manifold at time `t`: Gauss–Newton on
+    /// `Φ(q, t) = 0` over the coordinates `free` (all when `free` is empty) with the
+    /// minimum-norm step, then the minimum-norm correction of the velocity residuals over the
+    /// same coordinates. Returns the number of Newton iterations.
+    ///
+    /// # Errors
+    /// [`ProjectionError`] naming the constraint with the largest residual when Newton does
+    /// not reach `tolerance` in 50 iterations or `J Jᵀ` is singular.
+    pub fn project<S: MechanicalSystem<N>, const N: usize>(
+        &mut self,
+        system: &S,
+        q: &mut SVector<f64, N>,
+        qdot: &mut SVector<f64, N>,
+        t: f64,
+        free: &[usize],
+        tolerance: f64,
+    ) -> Result<usize, ProjectionError> {
+        let n = self.n;
+        let all: Vec<usize>;
+        let free = if free.is_empty() {
+            all = (0..n).collect();
+            &all[..]
+        } else {
+            free
+        };
+        let h = self.holonomic;
+        let mut iterations = 0;
+        if h > 0 {
+            loop {
+                system.constraint_residuals(q, t, &mut self.phi);
+                let (worst, residual) = largest(&self.phi);
+                if residual <= tolerance {
+                    break;
+                }
+                if iterations == 50 || !residual.is_finite() {
+                    return Err(ProjectionError {
+                        constraint: worst,
+                        residual,
+                        iterations,
+                    });
+                }
+                system.constraint_jacobian(q, t, &mut self.jacobian);
+                let rhs: Vec<f64> = self.phi.clone();
+                let step = self.minimum_norm(h, free, &rhs).ok_or(ProjectionError {
+                    constraint: worst,
+                    residual,
+                    iterations,
+                })?;
+                for (j, &c) in free.iter().enumerate() {
+                    q[c] -= step[j];
+                }
+                iterations += 1;
+            }
+        }
+        if self.m > 0 {
+            system.constraint_jacobian(q, t, &mut self.jacobian);
+            system.constraint_velocity_residuals(q, qdot, t, &mut self.velocity);
+            let rhs = self.velocity.clone();
+            let (worst, residual) = largest(&rhs);
+            let step = self
+                .minimum_norm(self.m, free, &rhs)
+                .ok_or(ProjectionError {
+                    constraint: worst,
+                    residual,
+                    iterations,
+                })?;
+            for (j, &c) in free.iter().enumerate() {
+                qdot[c] -= step[j];
+            }
+        }
+        Ok(iterations)
+    }
+
+    /// The minimum-norm `x` (over the columns `free`) of `J_rows x = rhs`, with `J_rows` the
+    /// first `rows` rows of the Jacobian buffer: `x = Jᵀ (J Jᵀ)⁻¹ rhs`.
+    fn minimum_norm(&mut self, rows: usize, free: &[usize], rhs: &[f64]) -> Option<Vec<f64>> {
+        let n = self.n;
+        let jac = &self.jacobian;
+        for a in 0..rows {
+            for b in 0..rows {
+                self.small[a * rows + b] =
+                    free.iter().map(|&c| jac[a * n + c] * jac[b * n + c]).sum();
+            }
+            self.small_rhs[a] = rhs[a];
+        }
+        lu_solve(
+            &mut self.small[..rows * rows],
+            &mut self.small_rhs[..rows],
+            &mut self.small_pivots[..rows],
+            rows,
+        )?;
+        Some(
+            free.iter()
+                .map(|&c| (0..rows).map(|a| jac[a * n + c] * self.small_rhs[a]).sum())
+                .collect(),
+        )
+    }
+}
+
+/// Projection onto the constraints failed.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error(
+    "could not satisfy constraint {constraint} (index among the holonomic constraints): residual {residual:e} after {iterations} Newton iteration(s)"
+)]
+pub struct ProjectionError {
+    /// Index of the constraint with the largest residual.
+    pub constraint: usize,
+    /// Its residual.
+    pub residual: f64,
+    /// Newton iterations done.
+    pub iterations: usize,
+}
+
+/// Index and absolute value of the largest-magnitude entry (NaN counts as largest).
+fn largest(v: &[f64]) -> (usize, f64) {
+    v.iter()
+        .enumerate()
+        .map(|(i, x)| (i, if x.is_nan() { f64::INFINITY } else { x.abs() }))
+        .fold((0, 0.0), |best, c| if c.1 > best.1 { c } else { best })
+}
+
+/// Solves `a x = b` in place (`a` is `k × k` row-major, overwritten by its LU factors; `b`
+/// becomes `x`) by Gaussian elimination with partial pivoting. `None` if a pivot is zero or
+/// not finite, or is below `1e-13` of the largest entry of its column (numerically singular).
+pub fn lu_solve(a: &mut [f64], b: &mut [f64], pivots: &mut [usize], k: usize) -> Option<()> {
+    let scale = a.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    for c in 0..k {
+        let mut p = c;
+        for r in c + 1..k {
+            if a[r * k + c].abs() > a[p * k + c].abs() {
+                p = r;
+            }
+        }
+        let pivot = a[p * k + c];
+        if !pivot.is_finite() || pivot.abs() <= 1e-13 * scale {
+            return None;
+        }
+        pivots[c] = p;
+        if p != c {
+            for j in 0..k {
+                a.swap(c * k + j, p * k + j);
+            }
+            b.swap(c, p);
+        }
+        for r in c + 1..k {
+            let f = a[r * k + c] / pivot;
+            if f != 0.0 {
+                for j in c..k {
+                    a[r * k + j] -= f * a[c * k + j];
+                }
+                b[r] -= f * b[c];
+            }
+        }
+    }
+    for r in (0..k).rev() {
+        let s: f64 = (r + 1..k).map(|j| a[r * k + j] * b[j]).sum();
+        b[r] = (b[r] - s) / a[r * k + r];
+    }
+    Some(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn lu_solves_a_system_that_needs_pivoting() {
+        // [0 1; 1 1] x = [1; 3] → x = [2, 1].
+        let mut a = vec![0.0, 1.0, 1.0, 1.0];
+        let mut b = vec![1.0, 3.0];
+        let mut p = vec![0; 2];
+        lu_solve(&mut a, &mut b, &mut p, 2).unwrap();
+        assert!((b[0] - 2.0).abs() < 1e-15 && (b[1] - 1.0).abs() < 1e-15);
+    }
+
+    #[test]
+    fn lu_rejects_a_singular_matrix() {
+        let mut a = vec![1.0, 2.0, 2.0, 4.0];
+        let mut b = vec![1.0, 2.0];
+        let mut p = vec![0; 2];
+        assert!(lu_solve(&mut a, &mut b, &mut p, 2).is_none());
+    }
+}
