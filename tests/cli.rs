@@ -278,3 +278,53 @@ fn check_detects_wrong_derivations() {
     assert!(balances["max_rel_residual"].as_f64().unwrap() < 1e-10);
     assert!(balances["symbolic_equal"].is_null());
 }
+
+/// A constrained model: `simulate` reports the constraint forces and drift (text, JSON, CSV),
+/// a start that violates the constraints is an error naming the residual (exit 1), and the
+/// drift chart is written next to the plot.
+#[test]
+fn simulate_reports_constraint_forces_and_rejects_inconsistent_starts() {
+    let out = eomgen(&[
+        "simulate",
+        "simple_pendulum_cartesian",
+        "--t-end",
+        "1",
+        "--json",
+    ]);
+    assert!(out.status.success());
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["constraints"][0], "rod");
+    let first = &v["samples"][0];
+    // At rest, horizontal: λ = m l q̇² + m g sin q = 0 at the start.
+    assert!(first["constraint_forces"][0].as_f64().unwrap().abs() < 1e-12);
+    assert!(v["max_constraint_drift"]["position"].as_f64().unwrap() < 1e-6);
+    let out = eomgen(&["simulate", "simple_pendulum_cartesian", "--init", "x=1.1"]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("violates its constraints"), "{err}");
+    let dir = std::env::temp_dir().join(format!("eomgen-drift-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let plot = dir.join("p.svg");
+    let csv = dir.join("p.csv");
+    let out = eomgen(&[
+        "simulate",
+        "four_bar",
+        "--t-end",
+        "1",
+        "--stabilization",
+        "baumgarte",
+        "--plot",
+        plot.to_str().unwrap(),
+        "--csv",
+        csv.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(dir.join("p-drift.svg").exists());
+    let header = std::fs::read_to_string(&csv).unwrap();
+    assert!(header.starts_with("t,theta1,theta2,theta3,theta1_dot,theta2_dot,theta3_dot,energy,lambda_loop_x,lambda_loop_y,drift_position,drift_velocity"));
+    let _ = std::fs::remove_dir_all(&dir);
+}

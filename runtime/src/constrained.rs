@@ -28,10 +28,6 @@ pub enum Stabilization {
         /// Stiffness of the drift (1/s).
         beta: f64,
     },
-    /// Projection after every accepted step: `q` onto `Φ(q, t) = 0` by Gauss–Newton with the
-    /// minimum-norm correction `Δq = −Jᵀ(J Jᵀ)⁻¹ Φ`, then `q̇` onto the velocity constraints
-    /// by the minimum-norm correction of `J q̇ + Φ_t` (and `A q̇ + b`).
-    Projection,
 }
 
 /// Scratch space of the constrained solve, sized for `n` coordinates and `m` constraints.

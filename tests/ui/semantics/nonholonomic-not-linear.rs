@@ -1,0 +1,3 @@
+eomgen::model!("nonholonomic-not-linear.yaml");
+
+fn main() {}

@@ -1,0 +1,3 @@
+eomgen::model!("redundant-constraint.yaml");
+
+fn main() {}
