@@ -4,6 +4,7 @@ mod check;
 mod equations;
 mod plot;
 mod simulate;
+mod study;
 mod values;
 
 use clap::{Parser, Subcommand};
@@ -34,6 +35,9 @@ enum Command {
     Equations(equations::EquationsArgs),
     /// Print a generated model file: `n-link-pendulum N` or `n-mass-chain N`.
     New(equations::NewArgs),
+    /// Numerical experiments comparing methods (`constraint-methods MODEL`).
+    #[command(subcommand)]
+    Study(study::Study),
 }
 
 /// A CLI failure: the message for stderr and the exit code.
@@ -69,6 +73,7 @@ pub fn run() -> ExitCode {
         Command::Check(args) => check::run(&args),
         Command::Equations(args) => equations::run(&args),
         Command::New(args) => equations::new(&args),
+        Command::Study(study) => study::run(&study),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
