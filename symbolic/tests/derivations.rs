@@ -177,3 +177,25 @@ fn h_dot_form_holds_about_fixed_points_only() {
         "AMB about the centre of mass leaves the hinge reaction in"
     );
 }
+
+/// `eomgen check` reports a non-holonomic constraint that is integrable (rolling on a line,
+/// ẋ + R θ̇ = 0, is x + R θ = const) and not the knife edge of the Chaplygin sleigh
+/// (−sin θ ẋ + cos θ ẏ = 0, for which ω ∧ dω = −dx∧dy∧dθ ≠ 0).
+#[test]
+fn integrable_nonholonomic_constraints_are_reported() {
+    let notes = |source: &str| {
+        let file = eomgen_symbolic::model::load("m.yaml", source).expect("loads");
+        eomgen_symbolic::mechanics::check::check_model(&file, 20, 5)
+            .expect("lowers")
+            .notes
+            .join("\n")
+    };
+    let rolling = "name: wheel\nparameters: { m: 1.0, I: 0.5, R: 0.3 }\ncoordinates: [x, y, theta]\npoints: { C: [x, y] }\nbodies: { wheel: { mass: m, inertia: I, com: C, angle: theta } }\nnonholonomic:\n  roll: x_dot + R*theta_dot\n";
+    assert!(
+        notes(rolling).contains("`roll` is integrable"),
+        "{}",
+        notes(rolling)
+    );
+    let sleigh = include_str!("../../models/chaplygin_sleigh.yaml");
+    assert!(!notes(sleigh).contains("integrable"), "{}", notes(sleigh));
+}
