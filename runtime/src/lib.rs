@@ -12,9 +12,10 @@ pub mod system;
 
 pub use constrained::{ConstraintWorkspace, ProjectionError, Stabilization};
 pub use integrate::{
-    DormandPrince54, IntegrationError, IntegrationFailure, Integrator, IntegratorOptions,
-    OutputTimes, PiController, RungeKutta4, Solution, Stats, StepOutcome, StepSizeController,
-    Tableau, Tolerance,
+    BogackiShampine32, DormandPrince54, DormandPrince853, ExplicitEuler, ExplicitMidpoint,
+    ImplicitMidpoint, IntegrationError, IntegrationFailure, Integrator, IntegratorOptions,
+    OutputTimes, PiController, PredictiveController, RadauIIA5, RungeKutta4, Solution, Stats,
+    StepOutcome, StepSizeController, StormerVerlet, SymplecticEuler, Tableau, Tolerance,
 };
 pub use ode::{OdeFn, OdeSystem, RhsError};
 pub use system::{ConstraintValues, FirstOrder, MechanicalSystem, ModelInfo, UnknownParameter};

@@ -17,10 +17,11 @@ pub enum RhsError {
         "the constrained system [M Jᵀ; J 0] is singular (redundant constraints or a singular configuration)"
     )]
     SingularConstraintMatrix,
-    /// The right-hand side produced NaN or ±∞ in component `index`.
+    /// The right-hand side (or its Jacobian) produced NaN or ±∞ in component `index`.
     #[error("the right-hand side is not finite in component {index}")]
     NonFinite {
-        /// Index into the state vector of the first non-finite component.
+        /// Index into the state vector of the first non-finite component (for a Jacobian, the
+        /// row: the component of `F` whose derivative is not finite).
         index: usize,
     },
 }
@@ -28,7 +29,14 @@ pub enum RhsError {
 /// A first-order system `ẏ = F(t, y)` of dimension `dim()`.
 ///
 /// Implementations write into a caller-owned buffer so that integrators need no heap
-/// allocation per step.
+/// allocation per step. Two optional pieces of structure serve particular methods:
+///
+/// - [`jacobian`](Self::jacobian), the exact `∂F/∂y`, for the implicit methods
+///   ([`ImplicitMidpoint`](crate::ImplicitMidpoint), [`RadauIIA5`](crate::RadauIIA5)); without
+///   it they difference `F`;
+/// - [`second_order_dim`](Self::second_order_dim), the split `y = [q; q̇]` with `q̇' = q̈(t, q, q̇)`,
+///   which the partitioned methods ([`SymplecticEuler`](crate::SymplecticEuler),
+///   [`StormerVerlet`](crate::StormerVerlet)) require.
 pub trait OdeSystem {
     /// Dimension of the state `y` (for a mechanical system with `n` DOF: `2n`).
     fn dim(&self) -> usize;
@@ -41,21 +49,78 @@ pub trait OdeSystem {
     /// # Errors
     /// [`RhsError`] when the right-hand side cannot be evaluated at `(t, y)`.
     fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), RhsError>;
+
+    /// Writes the Jacobian `∂F/∂y` at `(t, y)` into `jac` and returns `Ok(true)`, or returns
+    /// `Ok(false)` without writing to ask the caller to approximate it by finite differences
+    /// of [`rhs`](Self::rhs) (the default).
+    ///
+    /// The implicit integrators call this once per Jacobian they need; the finite-difference
+    /// fallback costs `dim()` evaluations of `F` and uses the increments of Hairer's RADAU5,
+    /// `δⱼ = √(ε · max(10⁻⁵, |yⱼ|))`.
+    ///
+    /// # Shapes
+    /// `y` has length `dim()`; `jac` has `dim()²` entries, column-major (nalgebra's storage
+    /// order): entry `(i, j) = ∂Fᵢ/∂yⱼ` is `jac[i + j · dim()]`.
+    ///
+    /// # Errors
+    /// [`RhsError`] when the Jacobian cannot be evaluated at `(t, y)`.
+    fn jacobian(&mut self, t: f64, y: &[f64], jac: &mut [f64]) -> Result<bool, RhsError> {
+        let _ = (t, y, jac);
+        Ok(false)
+    }
+
+    /// `Some(n)` when the system is second order: `dim() = 2n`, `y = [q; q̇]` with `q` and `q̇`
+    /// of length `n`, and `F(t, y) = [q̇; q̈(t, q, q̇)]`; `None` otherwise (the default).
+    ///
+    /// Partitioned methods rely on it: they advance `q` with `q̇` themselves and read only the
+    /// accelerations, the lower half of `F`.
+    fn second_order_dim(&self) -> Option<usize> {
+        None
+    }
 }
 
 /// A closure `|t, y, dy| { … }` is an [`OdeSystem`] of a given dimension.
 ///
 /// Used by tests and studies that integrate equations written by hand (`ẋ = x`, the test
-/// oscillator).
+/// oscillator). It has no exact Jacobian (implicit methods difference it).
 pub struct OdeFn<F> {
     dim: usize,
+    second_order_dim: Option<usize>,
     f: F,
 }
 
 impl<F: FnMut(f64, &[f64], &mut [f64])> OdeFn<F> {
     /// Wraps `f` as a system of dimension `dim`.
     pub fn new(dim: usize, f: F) -> Self {
-        Self { dim, f }
+        Self {
+            dim,
+            second_order_dim: None,
+            f,
+        }
+    }
+
+    /// Wraps `f` as a second-order system with `num_dofs` coordinates: `y = [q; q̇]` has
+    /// `2 num_dofs` entries and `f` must write `dy = [q̇; q̈]`, as
+    /// [`OdeSystem::second_order_dim`] states.
+    ///
+    /// # Examples
+    /// ```
+    /// use eomgen_runtime::{OdeFn, OdeSystem};
+    ///
+    /// // The pendulum q̈ = −sin q.
+    /// let pendulum = OdeFn::second_order(1, |_t: f64, y: &[f64], dy: &mut [f64]| {
+    ///     dy[0] = y[1];
+    ///     dy[1] = -y[0].sin();
+    /// });
+    /// assert_eq!(pendulum.dim(), 2);
+    /// assert_eq!(pendulum.second_order_dim(), Some(1));
+    /// ```
+    pub fn second_order(num_dofs: usize, f: F) -> Self {
+        Self {
+            dim: 2 * num_dofs,
+            second_order_dim: Some(num_dofs),
+            f,
+        }
     }
 }
 
@@ -67,5 +132,9 @@ impl<F: FnMut(f64, &[f64], &mut [f64])> OdeSystem for OdeFn<F> {
     fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), RhsError> {
         (self.f)(t, y, dy);
         Ok(())
+    }
+
+    fn second_order_dim(&self) -> Option<usize> {
+        self.second_order_dim
     }
 }

@@ -213,6 +213,52 @@ impl<S: MechanicalSystem<N>, const N: usize> FirstOrder<S, N> {
         }
         Ok(qdd)
     }
+
+    /// The Jacobians `(∂q̈/∂q, ∂q̈/∂q̇)` of `q̈ = M⁻¹F` at `(q, q̇, t)`, from the generated exact
+    /// derivatives.
+    ///
+    /// Differentiating `M(q, t) q̈ = F(q, q̇, t)` at fixed `t`:
+    ///
+    /// ```text
+    /// ∂q̈/∂q = M⁻¹ (∂F/∂q − ∂(M a)/∂q |_(a = q̈)),     ∂q̈/∂q̇ = M⁻¹ ∂F/∂q̇
+    /// ```
+    ///
+    /// where `∂(M a)/∂q` is [`MechanicalSystem::mass_matrix_product_jacobian`] (the derivative of
+    /// `M(q) a` with `a` held fixed). One Cholesky factorisation serves `q̈` and both solves;
+    /// no heap allocation.
+    ///
+    /// # Shapes
+    /// Both matrices are `N × N`; entry `(i, j)` of the first is `∂q̈ᵢ/∂qⱼ`.
+    ///
+    /// # Errors
+    /// [`RhsError::SingularMassMatrix`] if `M` is not positive definite; [`RhsError::NonFinite`]
+    /// if `q̈` or an entry of the Jacobians is not finite (index `N + i` for row `i`).
+    pub fn acceleration_jacobians(
+        &self,
+        q: &SVector<f64, N>,
+        qdot: &SVector<f64, N>,
+        t: f64,
+    ) -> Result<(SMatrix<f64, N, N>, SMatrix<f64, N, N>), RhsError> {
+        let (m, f) = self.system.mass_matrix_and_forcing(q, qdot, t);
+        let chol = nalgebra::Cholesky::new(m).ok_or(RhsError::SingularMassMatrix)?;
+        let qdd = chol.solve(&f);
+        let d_forcing_q = self.system.forcing_jacobian_q(q, qdot, t)
+            - self.system.mass_matrix_product_jacobian(q, t, &qdd);
+        let d_qdd_q = chol.solve(&d_forcing_q);
+        let d_qdd_qdot = chol.solve(&self.system.forcing_jacobian_qdot(q, qdot, t));
+        if let Some(i) = qdd.iter().position(|v| !v.is_finite()) {
+            return Err(RhsError::NonFinite { index: N + i });
+        }
+        for matrix in [&d_qdd_q, &d_qdd_qdot] {
+            let bad = matrix
+                .row_iter()
+                .position(|row| row.iter().any(|v| !v.is_finite()));
+            if let Some(i) = bad {
+                return Err(RhsError::NonFinite { index: N + i });
+            }
+        }
+        Ok((d_qdd_q, d_qdd_qdot))
+    }
 }
 
 fn split<const N: usize>(y: &[f64]) -> (SVector<f64, N>, SVector<f64, N>) {
@@ -243,6 +289,39 @@ impl<S: MechanicalSystem<N>, const N: usize> OdeSystem for FirstOrder<S, N> {
         dy[..N].copy_from_slice(qdot.as_slice());
         dy[N..2 * N].copy_from_slice(qdd.as_slice());
         Ok(())
+    }
+
+    /// The exact Jacobian of `ẏ = [q̇; q̈]`, from [`FirstOrder::acceleration_jacobians`]:
+    ///
+    /// ```text
+    /// ∂F/∂y = [ 0        I       ]
+    ///         [ ∂q̈/∂q    ∂q̈/∂q̇   ]
+    /// ```
+    ///
+    /// A constrained system returns `Ok(false)`: its `q̈` comes from the KKT system, whose
+    /// derivative needs `∂J/∂q` and `∂γ/∂(q, q̇)`, which are not generated; the implicit
+    /// methods then difference `F`.
+    fn jacobian(&mut self, t: f64, y: &[f64], jac: &mut [f64]) -> Result<bool, RhsError> {
+        if !self.constraints.is_empty() {
+            return Ok(false);
+        }
+        let (q, qdot) = split::<N>(y);
+        let (d_q, d_qdot) = self.acceleration_jacobians(&q, &qdot, t)?;
+        let dim = 2 * N;
+        jac[..dim * dim].fill(0.0);
+        for j in 0..N {
+            // Column N + j of the upper block row: ∂q̇ᵢ/∂q̇ⱼ = δᵢⱼ.
+            jac[j + (N + j) * dim] = 1.0;
+            for i in 0..N {
+                jac[N + i + j * dim] = d_q[(i, j)];
+                jac[N + i + (N + j) * dim] = d_qdot[(i, j)];
+            }
+        }
+        Ok(true)
+    }
+
+    fn second_order_dim(&self) -> Option<usize> {
+        Some(N)
     }
 }
 

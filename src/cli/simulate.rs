@@ -4,8 +4,9 @@ use std::io::Write as _;
 
 use clap::{Args, ValueEnum};
 use eomgen::{
-    DormandPrince54, IntegrationFailure, Integrator, IntegratorOptions, ModelInfo, OutputTimes,
-    RungeKutta4, Solution,
+    BogackiShampine32, DormandPrince54, DormandPrince853, ExplicitEuler, ExplicitMidpoint,
+    ImplicitMidpoint, IntegrationFailure, Integrator, IntegratorOptions, ModelInfo, OutputTimes,
+    RadauIIA5, RungeKutta4, Solution, StormerVerlet, SymplecticEuler,
 };
 use serde_json::json;
 
@@ -13,13 +14,33 @@ use super::values::{evaluate, split_assignment};
 use super::{CliError, find_model, plot};
 use eomgen::Stabilization;
 
-/// Integration method.
+/// Integration method. Adaptive methods use `--rtol`/`--atol` (and `--dt` as their first
+/// step); fixed-step methods use `--dt` (default `t_end/1000`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum Method {
-    /// Dormand–Prince 5(4), adaptive, dense output (default).
-    Dp54,
+    /// Explicit Euler, order 1, fixed step `--dt`.
+    Euler,
+    /// Explicit midpoint, order 2, fixed step `--dt`.
+    Midpoint,
     /// Classical Runge–Kutta 4, fixed step `--dt`.
     Rk4,
+    /// Bogacki–Shampine 3(2) (ode23), adaptive, Hermite dense output.
+    Bs32,
+    /// Dormand–Prince 5(4), adaptive, dense output (default).
+    Dp54,
+    /// DOP853, Hairer's Dormand–Prince 8(5,3), adaptive, order-7 dense output.
+    Dop853,
+    /// Symplectic Euler, order 1, fixed step `--dt` (symplectic for constant M and
+    /// velocity-independent forces).
+    SymplecticEuler,
+    /// Störmer–Verlet (leapfrog in q, q̇), order 2, fixed step `--dt` (symplectic for
+    /// constant M and velocity-independent forces).
+    StormerVerlet,
+    /// Implicit midpoint, order 2, fixed step `--dt`, Newton with the generated Jacobians
+    /// (symplectic for any M(q)).
+    ImplicitMidpoint,
+    /// Radau IIA order 5 (RADAU5), adaptive, L-stable, Newton with the generated Jacobians.
+    Radau5,
 }
 
 /// Drift control of a constrained model (`--stabilization`).
@@ -46,13 +67,15 @@ pub struct SimulateArgs {
     /// Integration method.
     #[arg(long, value_enum, default_value_t = Method::Dp54)]
     pub method: Method,
-    /// Relative tolerance (dp54).
+    /// Relative tolerance (adaptive methods: bs32, dp54, dop853, radau5).
     #[arg(long, default_value_t = 1e-8)]
     pub rtol: f64,
-    /// Absolute tolerance (dp54).
+    /// Absolute tolerance (adaptive methods; implicit-midpoint's scale for components near 0).
     #[arg(long, default_value_t = 1e-10)]
     pub atol: f64,
-    /// Step size: rk4's fixed step (default t_end/1000), dp54's initial step (default automatic).
+    /// Step size: the fixed step of euler, midpoint, rk4, symplectic-euler, stormer-verlet and
+    /// implicit-midpoint (default t_end/1000); the initial step of the adaptive methods
+    /// (default automatic).
     #[arg(long)]
     pub dt: Option<f64>,
     /// Set a parameter, `NAME=VALUE` (value may be an expression of numbers, pi and the other
@@ -157,8 +180,16 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
         options = options.with_dt(dt);
     }
     let mut integrator: Box<dyn Integrator> = match args.method {
-        Method::Dp54 => Box::new(DormandPrince54::new()),
+        Method::Euler => Box::new(ExplicitEuler::new()),
+        Method::Midpoint => Box::new(ExplicitMidpoint::new()),
         Method::Rk4 => Box::new(RungeKutta4::new()),
+        Method::Bs32 => Box::new(BogackiShampine32::new()),
+        Method::Dp54 => Box::new(DormandPrince54::new()),
+        Method::Dop853 => Box::new(DormandPrince853::new()),
+        Method::SymplecticEuler => Box::new(SymplecticEuler::new()),
+        Method::StormerVerlet => Box::new(StormerVerlet::new()),
+        Method::ImplicitMidpoint => Box::new(ImplicitMidpoint::new()),
+        Method::Radau5 => Box::new(RadauIIA5::new()),
     };
     let result = integrator.integrate(model.as_ode_mut(), 0.0, &y0, args.t_end, &output, &options);
     let (solution, failure) = match result {

@@ -99,8 +99,22 @@ impl PiController {
     /// Hairer's DOPRI5 settings, for a method whose error estimator has order 4:
     /// `beta = 0.04`, `alpha = 1/5 − 0.75 beta`, safety 0.9, step ratios in `[0.2, 10]`.
     pub fn dopri5() -> Self {
+        Self::for_error_order(4)
+    }
+
+    /// DOPRI5's rule for an error estimator of order `q` (the local error estimate behaves as
+    /// `O(h^(q+1))`): `beta = 0.04`, `alpha = 1/(q+1) − 0.75 beta`, safety 0.9, step ratios in
+    /// `[0.2, 10]`. [`Self::dopri5`] is `q = 4`; Bogacki–Shampine 3(2) uses `q = 2`.
+    pub fn for_error_order(error_order: u32) -> Self {
         let beta = 0.04;
-        Self::new(0.2 - 0.75 * beta, beta)
+        Self::new(1.0 / f64::from(error_order + 1) - 0.75 * beta, beta)
+    }
+
+    /// Hairer's DOP853 settings: the integral controller `alpha = 1/8`, `beta = 0` (DOP853's
+    /// error estimate behaves as `O(h⁸)`), safety 0.9, step ratios in `[1/3, 6]`
+    /// (`dop853.f`: `FAC1 = 0.333`, `FAC2 = 6`).
+    pub fn dop853() -> Self {
+        Self::new(1.0 / 8.0, 0.0).with_factor_bounds(0.333, 6.0)
     }
 
     /// Sets the safety factor.
@@ -141,6 +155,122 @@ impl StepSizeController for PiController {
             factor = factor.min(1.0);
         }
         self.error_previous = error_norm.max(ERROR_FLOOR);
+        self.rejected_last = false;
+        StepOutcome::Accepted {
+            dt_next: dt * factor,
+        }
+    }
+}
+
+/// Gustafsson's predictive step-size controller, as Hairer and Wanner's RADAU5 uses it.
+///
+/// With `errₙ` the error norm of the current step `hₙ` (exponent `1/(q+1)` for an error
+/// estimator of order `q`; RADAU5: `q = 3`, exponent 1/4), the classical proposal is
+/// `h · safety · errₙ^(−exponent)`. After an accepted step that follows an earlier accepted
+/// one (`hₙ₋₁`, `errₙ₋₁`), the predictive proposal
+///
+/// ```text
+/// h_pred = hₙ · safety · (hₙ/hₙ₋₁) · errₙ^(−exponent) · (errₙ₋₁/errₙ)^exponent
+/// ```
+///
+/// is taken when it is smaller. Every proposal is clamped to `[min_factor, max_factor]` times
+/// `h`. A rejected step is retried with the classical proposal, or with `h/10` if no step has
+/// been accepted yet; the step accepted right after a rejection does not grow. An accepted
+/// proposal within `[1, hold_max]` times `h` keeps `h` unchanged, so that an implicit method
+/// can keep its factorised iteration matrix (RADAU5's `QUOT1 = 1`, `QUOT2 = 1.2`).
+///
+/// RADAU5 also lowers the safety factor when the Newton iteration needed many iterations;
+/// this controller sees only the error norm and does not, relying on the method's own step
+/// reduction when Newton converges slowly.
+///
+/// # References
+/// - K. Gustafsson, "Control-theoretic techniques for stepsize selection in implicit
+///   Runge–Kutta methods", ACM Trans. Math. Softw. 20(4), 496–517, 1994,
+///   doi:10.1145/198429.198437.
+/// - E. Hairer, G. Wanner, *Solving Ordinary Differential Equations II*, 2nd ed., Springer,
+///   1996, §IV.8, eq. (8.25), doi:10.1007/978-3-642-05221-7; and the code `radau5.f`
+///   (`SAFE = 0.9`, `FACL = 5`, `FACR = 1/8`).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct PredictiveController {
+    /// Exponent of the error, `> 0` (RADAU5: 1/4).
+    pub exponent: f64,
+    /// Safety factor, in `(0, 1)` (default: 0.9).
+    pub safety: f64,
+    /// Smallest ratio of new to old step, in `(0, 1)` (default: 0.2).
+    pub min_factor: f64,
+    /// Largest ratio of new to old step, `> 1` (default: 8).
+    pub max_factor: f64,
+    /// Largest ratio of new to old step that keeps the old step, `≥ 1` (default: 1.2).
+    pub hold_max: f64,
+    /// Step and error norm (at least 1e-2) of the last accepted step, if any.
+    #[serde(skip)]
+    last_accepted: Option<(f64, f64)>,
+    /// Whether the last attempted step was rejected.
+    #[serde(skip)]
+    rejected_last: bool,
+}
+
+impl PredictiveController {
+    /// RADAU5's settings: exponent 1/4, safety 0.9, step ratios in `[0.2, 8]`, steps held for
+    /// proposals within `[1, 1.2]`.
+    pub fn radau5() -> Self {
+        Self {
+            exponent: 0.25,
+            safety: 0.9,
+            min_factor: 0.2,
+            max_factor: 8.0,
+            hold_max: 1.2,
+            last_accepted: None,
+            rejected_last: false,
+        }
+    }
+}
+
+impl Default for PredictiveController {
+    fn default() -> Self {
+        Self::radau5()
+    }
+}
+
+impl StepSizeController for PredictiveController {
+    fn reset(&mut self) {
+        self.last_accepted = None;
+        self.rejected_last = false;
+    }
+
+    fn decide(&mut self, dt: f64, error_norm: f64) -> StepOutcome {
+        let clamp = |factor: f64| factor.max(self.min_factor).min(self.max_factor);
+        // `∞^(−exponent) = 0` and NaN: `f64::max` returns `min_factor`.
+        let classical = clamp(self.safety * error_norm.powf(-self.exponent));
+        if error_norm.is_nan() || error_norm > 1.0 {
+            self.rejected_last = true;
+            let factor = if self.last_accepted.is_none() {
+                0.1
+            } else {
+                classical
+            };
+            return StepOutcome::Rejected {
+                dt_retry: dt * factor,
+            };
+        }
+        let error = error_norm.max(1e-10);
+        let mut factor = clamp(self.safety * error.powf(-self.exponent));
+        if let Some((dt_previous, error_previous)) = self.last_accepted {
+            let predictive = clamp(
+                self.safety
+                    * (dt / dt_previous)
+                    * (error_previous / error).powf(self.exponent)
+                    * error.powf(-self.exponent),
+            );
+            factor = factor.min(predictive);
+        }
+        if self.rejected_last {
+            factor = factor.min(1.0);
+        }
+        if (1.0..=self.hold_max).contains(&factor) {
+            factor = 1.0;
+        }
+        self.last_accepted = Some((dt, error.max(1e-2)));
         self.rejected_last = false;
         StepOutcome::Accepted {
             dt_next: dt * factor,
@@ -214,5 +344,50 @@ mod tests {
         controller.decide(1.0, 3.0);
         controller.reset();
         assert_eq!(accepted(controller.decide(1.0, 0.5)), fresh);
+    }
+
+    #[test]
+    fn exponents_follow_the_error_order() {
+        assert_eq!(PiController::for_error_order(4), PiController::dopri5());
+        let bs32 = PiController::for_error_order(2);
+        assert!((bs32.alpha - (1.0 / 3.0 - 0.03)).abs() < 1e-15);
+        let dop853 = PiController::dop853();
+        assert_eq!((dop853.alpha, dop853.beta), (0.125, 0.0));
+        assert_eq!((dop853.min_factor, dop853.max_factor), (0.333, 6.0));
+    }
+
+    /// The predictive controller follows RADAU5: h/10 after a first rejected step, the
+    /// classical proposal before any history, the smaller predictive one after, and holds the
+    /// step for proposals in [1, 1.2].
+    #[test]
+    fn predictive_controller_follows_radau5() {
+        let mut controller = PredictiveController::radau5();
+        assert_eq!(rejected(controller.decide(1.0, 2.0)), 0.1);
+        // No growth right after the rejection.
+        assert_eq!(accepted(controller.decide(0.1, 1e-6)), 0.1);
+        // With history: error shrinking by 16 → predictive factor
+        // 0.9 · (h/h_prev) · (err_prev/err)^(1/4) · err^(−1/4), here larger than the
+        // classical one, which is taken.
+        let mut controller = PredictiveController::radau5();
+        let first = accepted(controller.decide(1.0, 0.1));
+        assert!((first - 0.9 * 0.1_f64.powf(-0.25)).abs() < 1e-15);
+        let second = accepted(controller.decide(1.0, 0.1 / 16.0));
+        let classical = 0.9 * (0.1_f64 / 16.0).powf(-0.25);
+        let predictive = 0.9 * 16.0_f64.powf(0.25) * (0.1_f64 / 16.0).powf(-0.25);
+        assert!((second - classical.min(predictive)).abs() < 1e-14);
+        // A proposal within [1, 1.2] keeps the step.
+        let mut controller = PredictiveController::radau5();
+        assert_eq!(
+            accepted(controller.decide(2.0, 0.9 / 1.1_f64.powi(4) * 0.9_f64.powi(3))),
+            2.0
+        );
+        // Bounds.
+        let mut controller = PredictiveController::radau5();
+        assert_eq!(accepted(controller.decide(1.0, 0.0)), 8.0);
+        controller.decide(1.0, 0.5);
+        assert_eq!(rejected(controller.decide(1.0, f64::INFINITY)), 0.2);
+        assert_eq!(rejected(controller.decide(1.0, f64::NAN)), 0.2);
+        controller.reset();
+        assert_eq!(rejected(controller.decide(1.0, 3.0)), 0.1);
     }
 }

@@ -130,8 +130,8 @@ impl Integrator for DormandPrince54 {
                 error_order: ERROR_ORDER,
             }
         };
-        driver::run(&problem, system, control, |dim| {
-            ExplicitRk::new(Tableau::dopri5(), dim)
+        driver::run(&problem, system, control, |shape| {
+            Ok(ExplicitRk::new(Tableau::dopri5(), shape.dim))
         })
     }
 }

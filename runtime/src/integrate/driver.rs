@@ -12,7 +12,7 @@ use super::options::{
     check_step_sizes, check_time_span, check_tolerances,
 };
 use super::solution::Solution;
-use super::stepper::{CheckedRhs, StepFailure, Stepper};
+use super::stepper::{CheckedRhs, StepFailure, Stepper, SystemShape};
 
 /// Number of fixed steps over `[t0, t_end]` when `dt` is not given.
 const DEFAULT_FIXED_STEPS: f64 = 1000.0;
@@ -46,7 +46,11 @@ pub(crate) enum Control<'a> {
     },
 }
 
-/// Integrates `problem` with the stepper `make_stepper(dim)` under `control`.
+/// Integrates `problem` with the stepper `make_stepper(shape)` under `control`.
+///
+/// `make_stepper` runs after the input checks and allocates every buffer of the integration;
+/// it may refuse a system whose structure the method cannot use
+/// ([`IntegrationError::NotSecondOrder`]).
 ///
 /// # Errors
 /// Every [`IntegrationError`]; the failure keeps the samples recorded before it and the
@@ -55,13 +59,26 @@ pub(crate) fn run<S: Stepper>(
     problem: &Problem<'_>,
     system: &mut dyn OdeSystem,
     control: Control<'_>,
-    make_stepper: impl FnOnce(usize) -> S,
+    make_stepper: impl FnOnce(SystemShape) -> Result<S, IntegrationError>,
 ) -> Result<Solution, IntegrationFailure> {
     let start = Instant::now();
-    let mut solution = Solution::new(system.dim());
+    let shape = SystemShape {
+        dim: system.dim(),
+        second_order_dim: system.second_order_dim(),
+    };
+    let mut solution = Solution::new(shape.dim);
     let mut rhs = CheckedRhs::new(system);
-    let result = integrate_into(problem, &mut rhs, control, make_stepper, &mut solution);
+    let result = integrate_into(
+        problem,
+        &mut rhs,
+        control,
+        shape,
+        make_stepper,
+        &mut solution,
+    );
     solution.stats.rhs_evals = rhs.evals();
+    solution.stats.jacobian_evals = rhs.jacobian_evals();
+    solution.stats.lu_decompositions = rhs.lu_decompositions();
     solution.stats.wall_time_s = start.elapsed().as_secs_f64();
     match result {
         Ok(()) => Ok(solution),
@@ -83,7 +100,8 @@ fn integrate_into<S: Stepper>(
     problem: &Problem<'_>,
     rhs: &mut CheckedRhs<'_>,
     control: Control<'_>,
-    make_stepper: impl FnOnce(usize) -> S,
+    shape: SystemShape,
+    make_stepper: impl FnOnce(SystemShape) -> Result<S, IntegrationError>,
     solution: &mut Solution,
 ) -> Result<(), IntegrationError> {
     let dim = solution.dim;
@@ -93,7 +111,7 @@ fn integrate_into<S: Stepper>(
     check_step_sizes(problem.options)?;
     check_output_times(problem.output, problem.t0, problem.t_end)?;
 
-    let mut stepper = make_stepper(dim);
+    let mut stepper = make_stepper(shape)?;
     stepper
         .reset(rhs, problem.t0, problem.y0)
         .map_err(StepFailure::into_error)?;
@@ -107,7 +125,15 @@ fn integrate_into<S: Stepper>(
                 solution.reserve((steps as usize).min(MAX_RESERVED_SAMPLES) + 1);
             }
             recorder.start(solution, problem.t0, problem.y0);
-            fixed_steps(problem, dt, rhs, &mut stepper, &mut recorder, solution)
+            fixed_steps(
+                problem,
+                dt,
+                &weights,
+                rhs,
+                &mut stepper,
+                &mut recorder,
+                solution,
+            )
         }
         Control::Adaptive {
             controller,
@@ -146,6 +172,7 @@ fn fixed_step(problem: &Problem<'_>) -> f64 {
 fn fixed_steps<S: Stepper>(
     problem: &Problem<'_>,
     dt: f64,
+    weights: &ErrorWeights,
     rhs: &mut CheckedRhs<'_>,
     stepper: &mut S,
     recorder: &mut Recorder<'_>,
@@ -173,11 +200,13 @@ fn fixed_steps<S: Stepper>(
             t_new = t_end;
         }
         stepper
-            .attempt(rhs, t_new, None)
+            .attempt(rhs, t_new, weights, false)
             .map_err(StepFailure::into_error)?;
         stepper.accept(rhs).map_err(StepFailure::into_error)?;
         solution.stats.steps += 1;
-        recorder.record_step(solution, stepper);
+        recorder
+            .record_step(solution, stepper, rhs)
+            .map_err(StepFailure::into_error)?;
     }
     Ok(())
 }
@@ -193,9 +222,10 @@ struct Adaptive<'a, 'c> {
 ///
 /// A step stretched by up to 1 % (but never beyond `dt_max`) lands on `t_end` rather than
 /// leaving a tiny last step (as Hairer's codes do). An attempt whose right-hand side or
-/// candidate is not finite counts as an infinite error, so the step shrinks; if that persists
-/// until the step is too small, the non-finite value is reported rather than
-/// [`IntegrationError::StepSizeTooSmall`].
+/// candidate is not finite, or whose Newton iteration fails, counts as an infinite error, so
+/// the step shrinks (by the factor the method proposes for a Newton failure, else by the
+/// controller's); if that persists until the step is too small, that failure is reported
+/// rather than [`IntegrationError::StepSizeTooSmall`].
 fn adaptive_steps<S: Stepper>(
     problem: &Problem<'_>,
     adaptive: Adaptive<'_, '_>,
@@ -241,7 +271,7 @@ fn adaptive_steps<S: Stepper>(
             t + dt
         };
         attempts += 1;
-        let (error_norm, usable) = match stepper.attempt(rhs, t_new, Some(weights)) {
+        let (error_norm, usable) = match stepper.attempt(rhs, t_new, weights, true) {
             Ok(error_norm) => {
                 last_failure = None;
                 debug_assert!(error_norm.is_some(), "adaptive stepping needs an estimator");
@@ -258,7 +288,9 @@ fn adaptive_steps<S: Stepper>(
             StepOutcome::Accepted { dt_next } if usable => {
                 stepper.accept(rhs).map_err(StepFailure::into_error)?;
                 solution.stats.steps += 1;
-                recorder.record_step(solution, stepper);
+                recorder
+                    .record_step(solution, stepper, rhs)
+                    .map_err(StepFailure::into_error)?;
                 dt = dt_next.min(dt_max);
             }
             StepOutcome::Accepted { .. } => {
@@ -269,6 +301,9 @@ fn adaptive_steps<S: Stepper>(
                 solution.stats.rejected += 1;
                 dt = dt_retry;
             }
+        }
+        if let Some(factor) = last_failure.as_ref().and_then(StepFailure::retry_factor) {
+            dt = factor * (t_new - t);
         }
     }
     Ok(())
@@ -383,24 +418,39 @@ impl<'a> Recorder<'a> {
     }
 
     /// Records after an accepted step: its end, or the requested times it covers, by dense
-    /// output (a time equal to the step's end gets the step's state exactly).
-    fn record_step<S: Stepper>(&mut self, solution: &mut Solution, stepper: &S) {
+    /// output (a time equal to the step's end gets the step's state exactly). The dense output
+    /// is completed ([`Stepper::prepare_dense_output`]) only for a step that needs it.
+    ///
+    /// # Errors
+    /// The failure of an evaluation that completes the dense output.
+    fn record_step<S: Stepper>(
+        &mut self,
+        solution: &mut Solution,
+        stepper: &mut S,
+        rhs: &mut CheckedRhs<'_>,
+    ) -> Result<(), StepFailure> {
         let t = stepper.t();
         match self.times {
             None => solution.push(t, stepper.y()),
             Some(times) => {
+                let mut prepared = false;
                 while self.next < times.len() && times[self.next] <= t {
                     let t_out = times[self.next];
                     debug_assert!(t_out >= stepper.interval().0);
                     if t_out == t {
                         solution.push(t, stepper.y());
                     } else {
+                        if !prepared {
+                            stepper.prepare_dense_output(rhs)?;
+                            prepared = true;
+                        }
                         solution.push_with(t_out, |out| stepper.interpolate(t_out, out));
                     }
                     self.next += 1;
                 }
             }
         }
+        Ok(())
     }
 }
 

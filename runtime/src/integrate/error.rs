@@ -84,6 +84,16 @@ pub enum IntegrationError {
         /// Final time.
         t_end: f64,
     },
+    /// The method needs a second-order system `y = [q; q̇]`
+    /// ([`OdeSystem::second_order_dim`](crate::OdeSystem::second_order_dim)), and this one
+    /// does not declare that structure (or declares one that does not match its dimension).
+    #[error(
+        "`{method}` needs a second-order system y = [q; q̇] (OdeSystem::second_order_dim), and this one is not"
+    )]
+    NotSecondOrder {
+        /// The method's [`name`](super::Integrator::name).
+        method: &'static str,
+    },
     /// The step size fell below `16 ε · max(|t|, t_end − t0)`: the solution changes faster
     /// than the method can follow (a singularity, or stiffness for an explicit method).
     #[error("the step size {dt:e} fell below the smallest usable step at t = {t}")]
@@ -135,6 +145,32 @@ pub enum IntegrationError {
         /// Time at which the right-hand side was evaluated (a stage time of the failed step).
         t: f64,
     },
+    /// The Newton iteration of an implicit method did not converge for the step from `t`:
+    /// with a fixed step at once; with adaptive steps after the step was shrunk until it
+    /// was too small.
+    #[error(
+        "the Newton iteration did not converge for the step from t = {t} ({iterations} iterations, residual norm {residual_norm:e})"
+    )]
+    NewtonDidNotConverge {
+        /// Start of the step whose stage equations could not be solved.
+        t: f64,
+        /// Newton iterations of the last attempt.
+        iterations: usize,
+        /// How far from converged the last iterate was: for
+        /// [`RadauIIA5`](crate::RadauIIA5) the weighted RMS norm of the last Newton update
+        /// (scales `atolᵢ + rtolᵢ |yᵢ|`), for [`ImplicitMidpoint`](crate::ImplicitMidpoint) the
+        /// relative max norm of the residual of the stage equation; `∞` or NaN if it
+        /// diverged.
+        residual_norm: f64,
+    },
+    /// The Newton iteration matrix (`I − (h/2) J` for implicit midpoint, `γ/h I − J` and its
+    /// complex twin for Radau IIA) was exactly singular at the step from `t`, and a smaller
+    /// step did not help.
+    #[error("the Newton iteration matrix is singular at t = {t}")]
+    SingularIterationMatrix {
+        /// Start of the step.
+        t: f64,
+    },
 }
 
 impl IntegrationError {
@@ -146,7 +182,9 @@ impl IntegrationError {
             | IntegrationError::NonFiniteState { t, .. }
             | IntegrationError::RhsNonFinite { t, .. }
             | IntegrationError::SingularMassMatrix { t }
-            | IntegrationError::SingularConstraintMatrix { t } => Some(t),
+            | IntegrationError::SingularConstraintMatrix { t }
+            | IntegrationError::NewtonDidNotConverge { t, .. }
+            | IntegrationError::SingularIterationMatrix { t } => Some(t),
             IntegrationError::InvalidTimeSpan { .. }
             | IntegrationError::DimensionMismatch { .. }
             | IntegrationError::ToleranceLengthMismatch { .. }
@@ -154,7 +192,8 @@ impl IntegrationError {
             | IntegrationError::ZeroTolerance { .. }
             | IntegrationError::InvalidStepSize { .. }
             | IntegrationError::OutputTimesNotSorted { .. }
-            | IntegrationError::OutputTimeOutOfRange { .. } => None,
+            | IntegrationError::OutputTimeOutOfRange { .. }
+            | IntegrationError::NotSecondOrder { .. } => None,
         }
     }
 }

@@ -148,7 +148,8 @@ impl Stepper for ExplicitRk {
         &mut self,
         rhs: &mut CheckedRhs<'_>,
         t_new: f64,
-        weights: Option<&ErrorWeights>,
+        weights: &ErrorWeights,
+        estimate_error: bool,
     ) -> Result<Option<f64>, StepFailure> {
         let tableau = self.tableau;
         let n = self.dim;
@@ -176,7 +177,7 @@ impl Stepper for ExplicitRk {
         if let Some(index) = self.y_new.iter().position(|v| !v.is_finite()) {
             return Err(StepFailure::NonFiniteState { t: t_new, index });
         }
-        let (Some(weights), Some(e)) = (weights, tableau.error_weights()) else {
+        let (true, Some(e)) = (estimate_error, tableau.error_weights()) else {
             return Ok(None);
         };
         if n == 0 {
@@ -229,7 +230,8 @@ mod tests {
         let mut stepper = ExplicitRk::new(Tableau::rk4(), 1);
         stepper.reset(&mut rhs, 0.0, &[1.0]).unwrap();
         let h: f64 = 0.1;
-        assert_eq!(stepper.attempt(&mut rhs, h, None).unwrap(), None);
+        let weights = ErrorWeights::uniform(1, 1e-6, 1e-9);
+        assert_eq!(stepper.attempt(&mut rhs, h, &weights, true).unwrap(), None);
         stepper.accept(&mut rhs).unwrap();
         let taylor = 1.0 + h + h * h / 2.0 + h.powi(3) / 6.0 + h.powi(4) / 24.0;
         assert!((stepper.y()[0] - taylor).abs() < 1e-16);
@@ -247,11 +249,8 @@ mod tests {
         let mut rhs = CheckedRhs::new(&mut system);
         let mut stepper = ExplicitRk::new(Tableau::dopri5(), 1);
         stepper.reset(&mut rhs, 0.0, &[0.0]).unwrap();
-        let weights = ErrorWeights {
-            rtol: vec![1e-6],
-            atol: vec![1e-9],
-        };
-        let error = stepper.attempt(&mut rhs, 0.1, Some(&weights)).unwrap();
+        let weights = ErrorWeights::uniform(1, 1e-6, 1e-9);
+        let error = stepper.attempt(&mut rhs, 0.1, &weights, true).unwrap();
         assert!(error.unwrap() > 0.0);
         stepper.accept(&mut rhs).unwrap();
         assert_eq!(rhs.evals(), 1 + 6);
@@ -275,11 +274,12 @@ mod tests {
         let mut rhs = CheckedRhs::new(&mut system);
         let mut stepper = ExplicitRk::new(Tableau::dopri5(), 1);
         stepper.reset(&mut rhs, 0.0, &[1.0]).unwrap();
-        let failure = stepper.attempt(&mut rhs, 1.0, None).unwrap_err();
+        let weights = ErrorWeights::uniform(1, 1e-6, 1e-9);
+        let failure = stepper.attempt(&mut rhs, 1.0, &weights, false).unwrap_err();
         assert!(matches!(failure, StepFailure::Rhs { t, .. } if t > 0.5));
         assert_eq!(stepper.t(), 0.0);
         assert_eq!(stepper.y(), &[1.0]);
-        assert!(stepper.attempt(&mut rhs, 0.25, None).is_ok());
+        assert!(stepper.attempt(&mut rhs, 0.25, &weights, false).is_ok());
         stepper.accept(&mut rhs).unwrap();
         assert_eq!(stepper.t(), 0.25);
     }

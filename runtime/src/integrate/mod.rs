@@ -3,8 +3,22 @@
 //!
 //! | method | type | order | steps | dense output ([`OutputTimes::At`]) |
 //! |---|---|---|---|---|
+//! | explicit Euler | [`ExplicitEuler`] | 1 | fixed `dt` | cubic Hermite (order 3) |
+//! | explicit midpoint | [`ExplicitMidpoint`] | 2 | fixed `dt` | cubic Hermite (order 3) |
 //! | classical Runge–Kutta | [`RungeKutta4`] | 4 | fixed `dt` | cubic Hermite (order 3) |
+//! | Bogacki–Shampine 3(2) | [`BogackiShampine32`] | 3 | adaptive ([`PiController`]) or fixed | cubic Hermite (order 3) |
 //! | Dormand–Prince 5(4) | [`DormandPrince54`] | 5 | adaptive ([`PiController`]) or fixed | Shampine's quartic (order 4) |
+//! | DOP853 | [`DormandPrince853`] | 8 | adaptive ([`PiController`]) or fixed | Hairer's septic (order 7) |
+//! | symplectic Euler | [`SymplecticEuler`] | 1 | fixed `dt`, `y = [q; q̇]` | cubic Hermite |
+//! | Störmer–Verlet | [`StormerVerlet`] | 2 | fixed `dt`, `y = [q; q̇]` | cubic Hermite |
+//! | implicit midpoint | [`ImplicitMidpoint`] | 2 | fixed `dt`, Newton with `∂F/∂y` | cubic Hermite (order 3) |
+//! | Radau IIA | [`RadauIIA5`] | 5 | adaptive ([`PredictiveController`]) or fixed, Newton with `∂F/∂y` | collocation polynomial (order 3) |
+//!
+//! The symplectic methods are symplectic (bounded energy error, no drift) for a constant mass
+//! matrix and velocity-independent forces; implicit midpoint is symplectic for any `M(q)` and
+//! conserves quadratic invariants; Radau IIA is L-stable, for stiff problems. The implicit
+//! methods use the exact Jacobian of [`OdeSystem::jacobian`] (generated for every model) and
+//! difference `F` otherwise.
 //!
 //! An integration takes an [`OdeSystem`] (a hand-written [`OdeFn`](crate::OdeFn), or a model
 //! through [`FirstOrder`](crate::FirstOrder)), an interval `[t0, t_end]`, an initial state,
@@ -16,8 +30,10 @@
 //! the last accepted step) driven by one shared loop that checks the input, chooses the step
 //! sequence (fixed, or adaptive through a [`StepSizeController`]), samples the output and maps
 //! failures to errors. Explicit Runge–Kutta methods are one stepper parameterised by a
-//! [`Tableau`]. No heap allocation happens per step: buffers are allocated once per
-//! `integrate` call, and the solution grows by amortised doubling.
+//! [`Tableau`]; DOP853, the partitioned methods, implicit midpoint and Radau IIA are steppers of
+//! their own. No heap allocation happens per step: buffers (Jacobians and LU factors
+//! included) are allocated once per `integrate` call, and the solution grows by amortised
+//! doubling.
 //!
 //! # Examples
 //! ```
@@ -41,24 +57,39 @@
 //! # Ok::<(), eomgen_runtime::IntegrationFailure>(())
 //! ```
 
+mod bs32;
 mod controller;
 mod dense_output;
+mod dop853;
 mod dopri5;
 mod driver;
 mod error;
+mod euler;
 mod explicit_rk;
+mod implicit_midpoint;
+mod linear;
+mod midpoint;
 mod options;
+mod radau5;
 mod rk4;
 mod solution;
 mod stepper;
+mod symplectic;
 mod tableau;
 
-pub use controller::{PiController, StepOutcome, StepSizeController};
+pub use bs32::BogackiShampine32;
+pub use controller::{PiController, PredictiveController, StepOutcome, StepSizeController};
+pub use dop853::DormandPrince853;
 pub use dopri5::DormandPrince54;
 pub use error::{IntegrationError, IntegrationFailure};
+pub use euler::ExplicitEuler;
+pub use implicit_midpoint::ImplicitMidpoint;
+pub use midpoint::ExplicitMidpoint;
 pub use options::{IntegratorOptions, OutputTimes, Tolerance};
+pub use radau5::RadauIIA5;
 pub use rk4::RungeKutta4;
 pub use solution::{Solution, Stats};
+pub use symplectic::{StormerVerlet, SymplecticEuler};
 pub use tableau::Tableau;
 
 use crate::ode::OdeSystem;
@@ -67,7 +98,9 @@ use crate::ode::OdeSystem;
 ///
 /// Object safe: the CLI holds methods as `Box<dyn Integrator>`.
 pub trait Integrator {
-    /// Short name of the method (`"rk4"`, `"dopri5"`).
+    /// Short name of the method (`"euler"`, `"midpoint"`, `"rk4"`, `"bs32"`, `"dopri5"`,
+    /// `"dop853"`, `"symplectic-euler"`, `"stormer-verlet"`, `"implicit-midpoint"`,
+    /// `"radau5"`).
     fn name(&self) -> &'static str;
 
     /// Order of convergence `p` of the method: the global error at a fixed final time
@@ -92,10 +125,14 @@ pub trait Integrator {
     ///   [`IntegrationError::ToleranceLengthMismatch`], [`IntegrationError::InvalidTolerance`],
     ///   [`IntegrationError::ZeroTolerance`], [`IntegrationError::InvalidStepSize`],
     ///   [`IntegrationError::OutputTimesNotSorted`],
-    ///   [`IntegrationError::OutputTimeOutOfRange`];
+    ///   [`IntegrationError::OutputTimeOutOfRange`], and for the partitioned methods
+    ///   [`IntegrationError::NotSecondOrder`];
     /// - during the integration: [`IntegrationError::StepSizeTooSmall`],
     ///   [`IntegrationError::TooManySteps`], [`IntegrationError::NonFiniteState`],
-    ///   [`IntegrationError::RhsNonFinite`], [`IntegrationError::SingularMassMatrix`].
+    ///   [`IntegrationError::RhsNonFinite`], [`IntegrationError::SingularMassMatrix`],
+    ///   [`IntegrationError::SingularConstraintMatrix`], and for the implicit methods
+    ///   [`IntegrationError::NewtonDidNotConverge`] and
+    ///   [`IntegrationError::SingularIterationMatrix`].
     fn integrate(
         &mut self,
         system: &mut dyn OdeSystem,

@@ -54,8 +54,12 @@ pub enum OutputTimes {
 /// How an [`Integrator`](super::Integrator) steps: tolerances, step sizes and limits.
 ///
 /// Options a method does not use are still checked, so that one set of options is valid or
-/// invalid for every method alike. The fixed-step methods ([`RungeKutta4`](super::RungeKutta4),
-/// and [`DormandPrince54`](super::DormandPrince54) with `fixed_step`) ignore `rtol` and `atol`.
+/// invalid for every method alike. The explicit fixed-step methods (Euler, midpoint,
+/// [`RungeKutta4`](super::RungeKutta4), the partitioned methods, and the adaptive ones with
+/// `fixed_step`) ignore `rtol` and `atol`; the implicit methods also use them, with fixed
+/// steps, to stop their Newton iterations ([`RadauIIA5`](super::RadauIIA5): relative to
+/// `atol + rtol |y|`; [`ImplicitMidpoint`](super::ImplicitMidpoint): `atol` as the scale of
+/// components near zero).
 ///
 /// # Units
 /// `dt` and `dt_max` are in the units of `t` (s for mechanical models); `rtol` is
@@ -69,7 +73,10 @@ pub enum OutputTimes {
 ///   ([`IntegrationError::StepSizeTooSmall`]); for fixed steps this is checked once, on `dt`;
 /// - the right-hand side fails ([`IntegrationError::SingularMassMatrix`], and
 ///   [`IntegrationError::RhsNonFinite`], which adaptive methods first answer by shrinking the
-///   step) or the state stops being finite ([`IntegrationError::NonFiniteState`]).
+///   step) or the state stops being finite ([`IntegrationError::NonFiniteState`]);
+/// - the Newton iteration of an implicit method does not converge
+///   ([`IntegrationError::NewtonDidNotConverge`]; adaptive methods first shrink the step) or
+///   its iteration matrix is singular ([`IntegrationError::SingularIterationMatrix`]).
 ///
 /// # Examples
 /// ```
@@ -97,8 +104,9 @@ pub struct IntegratorOptions {
     pub dt_max: Option<f64>,
     /// Most step attempts, accepted and rejected, before giving up (default: 1 000 000).
     pub max_steps: usize,
-    /// Whether an adaptive method takes constant steps `dt` with no error control, as
-    /// convergence-order studies need (default: `false`).
+    /// Whether an adaptive method (Bogacki–Shampine, Dormand–Prince, DOP853, Radau IIA) takes
+    /// constant steps `dt` with no error control, as convergence-order studies need
+    /// (default: `false`).
     pub fixed_step: bool,
 }
 
@@ -162,6 +170,15 @@ pub(crate) struct ErrorWeights {
 }
 
 impl ErrorWeights {
+    /// The same `rtol` and `atol` for each of `dim` components (for unit tests of steppers).
+    #[cfg(test)]
+    pub(crate) fn uniform(dim: usize, rtol: f64, atol: f64) -> Self {
+        Self {
+            rtol: vec![rtol; dim],
+            atol: vec![atol; dim],
+        }
+    }
+
     /// The error scale `atol_i + rtol_i · |y_i|` of component `index` at a magnitude `|y_i|`.
     #[inline]
     pub(crate) fn scale(&self, index: usize, magnitude: f64) -> f64 {

@@ -76,8 +76,8 @@ impl Integrator for RungeKutta4 {
             output,
             options,
         };
-        driver::run(&problem, system, Control::Fixed, |dim| {
-            ExplicitRk::new(Tableau::rk4(), dim)
+        driver::run(&problem, system, Control::Fixed, |shape| {
+            Ok(ExplicitRk::new(Tableau::rk4(), shape.dim))
         })
     }
 }

@@ -13,6 +13,12 @@ pub struct Stats {
     /// Evaluations of the right-hand side `F(t, y)`, including those of the initial-step
     /// selection and of rejected steps.
     pub rhs_evals: usize,
+    /// Jacobians `∂F/∂y` computed by implicit methods, exact or by finite differences (whose
+    /// evaluations of `F` are also counted in `rhs_evals`).
+    pub jacobian_evals: usize,
+    /// LU factorisations of Newton iteration matrices by implicit methods (Radau IIA's real
+    /// and complex matrices together count once).
+    pub lu_decompositions: usize,
     /// Wall-clock time of the whole `integrate` call (s).
     pub wall_time_s: f64,
 }

@@ -5,6 +5,8 @@
 //! implicit methods are steppers of their own) implements [`Stepper`] and reuses the loop in
 //! `driver`: validation, fixed and adaptive step sequences, output, statistics and errors.
 
+use nalgebra::DMatrix;
+
 use crate::ode::{OdeSystem, RhsError};
 
 use super::dense_output::DenseOutput;
@@ -14,16 +16,29 @@ use super::options::ErrorWeights;
 /// Why a step attempt produced no usable candidate.
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) enum StepFailure {
-    /// The right-hand side failed, or was not finite, at time `t`.
+    /// The right-hand side (or its Jacobian) failed, or was not finite, at time `t`.
     Rhs { t: f64, error: RhsError },
     /// The candidate state is not finite at time `t`.
     NonFiniteState { t: f64, index: usize },
+    /// The Newton iteration for the stages of the step from `t` diverged, converged too
+    /// slowly, or used up its iterations; a step `retry_factor` times as large may converge.
+    Newton {
+        t: f64,
+        iterations: usize,
+        residual_norm: f64,
+        retry_factor: f64,
+    },
+    /// The Newton iteration matrix of the step from `t` was exactly singular (an eigenvalue
+    /// of the Jacobian coincides with one of the method's shifted eigenvalues); a different
+    /// step size moves the shift.
+    SingularIterationMatrix { t: f64 },
 }
 
 impl StepFailure {
     /// Whether a smaller step may succeed: non-finite values often come from a step so large
-    /// that a stage leaves the region where `F` is defined, whereas a singular mass matrix is
-    /// a property of the model at that configuration.
+    /// that a stage leaves the region where `F` is defined, and Newton converges for small
+    /// enough steps, whereas a singular mass matrix is a property of the model at that
+    /// configuration.
     pub(crate) fn is_recoverable(&self) -> bool {
         match self {
             StepFailure::Rhs {
@@ -34,7 +49,19 @@ impl StepFailure {
                 error: RhsError::NonFinite { .. },
                 ..
             }
-            | StepFailure::NonFiniteState { .. } => true,
+            | StepFailure::NonFiniteState { .. }
+            | StepFailure::Newton { .. }
+            | StepFailure::SingularIterationMatrix { .. } => true,
+        }
+    }
+
+    /// The factor by which the failed step should shrink, when the method knows better than
+    /// the step-size controller (which otherwise sees an infinite error).
+    pub(crate) fn retry_factor(&self) -> Option<f64> {
+        match self {
+            StepFailure::Newton { retry_factor, .. } => Some(*retry_factor),
+            StepFailure::SingularIterationMatrix { .. } => Some(0.5),
+            StepFailure::Rhs { .. } | StepFailure::NonFiniteState { .. } => None,
         }
     }
 
@@ -56,26 +83,63 @@ impl StepFailure {
             StepFailure::NonFiniteState { t, index } => {
                 IntegrationError::NonFiniteState { t, index }
             }
+            StepFailure::Newton {
+                t,
+                iterations,
+                residual_norm,
+                ..
+            } => IntegrationError::NewtonDidNotConverge {
+                t,
+                iterations,
+                residual_norm,
+            },
+            StepFailure::SingularIterationMatrix { t } => {
+                IntegrationError::SingularIterationMatrix { t }
+            }
         }
     }
 }
 
-/// The right-hand side as a stepper sees it: every evaluation counted and its result checked
-/// for finiteness, so that no method can forget either.
+/// The system as a stepper sees it: every evaluation of `F` counted and checked for
+/// finiteness, so that no method can forget either; Jacobians (exact, or differenced when the
+/// system has none) and factorisations of iteration matrices counted as well.
 pub(crate) struct CheckedRhs<'a> {
     system: &'a mut dyn OdeSystem,
     evals: usize,
+    jacobian_evals: usize,
+    lu_decompositions: usize,
 }
 
 impl<'a> CheckedRhs<'a> {
-    /// Wraps `system`, with no evaluations counted yet.
+    /// Wraps `system`, with nothing counted yet.
     pub(crate) fn new(system: &'a mut dyn OdeSystem) -> Self {
-        Self { system, evals: 0 }
+        Self {
+            system,
+            evals: 0,
+            jacobian_evals: 0,
+            lu_decompositions: 0,
+        }
     }
 
-    /// Number of evaluations so far.
+    /// Number of evaluations of `F` so far (including those of differenced Jacobians).
     pub(crate) fn evals(&self) -> usize {
         self.evals
+    }
+
+    /// Number of Jacobians so far.
+    pub(crate) fn jacobian_evals(&self) -> usize {
+        self.jacobian_evals
+    }
+
+    /// Number of factorisations counted with [`count_lu`](Self::count_lu) so far.
+    pub(crate) fn lu_decompositions(&self) -> usize {
+        self.lu_decompositions
+    }
+
+    /// Counts one factorisation of an iteration matrix (for an implicit Runge–Kutta method,
+    /// the real and the complex one together count once, as in Hairer's RADAU5).
+    pub(crate) fn count_lu(&mut self) {
+        self.lu_decompositions += 1;
     }
 
     /// Evaluates `dy = F(t, y)`.
@@ -96,6 +160,61 @@ impl<'a> CheckedRhs<'a> {
             None => Ok(()),
         }
     }
+
+    /// The Jacobian `∂F/∂y` at `(t, y)` into `jac` (`dim × dim`): the system's own, or forward
+    /// differences of `F` from `f = F(t, y)` with RADAU5's increments
+    /// `δⱼ = √(ε · max(10⁻⁵, |yⱼ|))` (`dim` evaluations of `F`, counted as such).
+    ///
+    /// `work_y` and `work_f` are `dim`-entry scratch buffers.
+    ///
+    /// # Errors
+    /// [`StepFailure::Rhs`] at `t` if the system fails or an entry is not finite (index: the
+    /// row).
+    pub(crate) fn jacobian(
+        &mut self,
+        t: f64,
+        y: &[f64],
+        f: &[f64],
+        jac: &mut DMatrix<f64>,
+        work_y: &mut [f64],
+        work_f: &mut [f64],
+    ) -> Result<(), StepFailure> {
+        self.jacobian_evals += 1;
+        let n = y.len();
+        let exact = self
+            .system
+            .jacobian(t, y, jac.as_mut_slice())
+            .map_err(|error| StepFailure::Rhs { t, error })?;
+        if !exact {
+            work_y.copy_from_slice(y);
+            for j in 0..n {
+                let delta = (f64::EPSILON * y[j].abs().max(1e-5)).sqrt();
+                work_y[j] = y[j] + delta;
+                self.eval(t, work_y, work_f)?;
+                work_y[j] = y[j];
+                for i in 0..n {
+                    jac[(i, j)] = (work_f[i] - f[i]) / delta;
+                }
+            }
+        }
+        let bad = (0..n).find(|&i| (0..n).any(|j| !jac[(i, j)].is_finite()));
+        match bad {
+            Some(index) => Err(StepFailure::Rhs {
+                t,
+                error: RhsError::NonFinite { index },
+            }),
+            None => Ok(()),
+        }
+    }
+}
+
+/// What the stepper is given about the system before the first step.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct SystemShape {
+    /// [`OdeSystem::dim`].
+    pub(crate) dim: usize,
+    /// [`OdeSystem::second_order_dim`].
+    pub(crate) second_order_dim: Option<usize>,
 }
 
 /// One method's state between steps: the current `(t, y)`, `F(t, y)`, work buffers allocated
@@ -123,16 +242,19 @@ pub(crate) trait Stepper: DenseOutput {
     /// Computes a candidate step from the current state to `t_new > t`.
     ///
     /// Returns the weighted RMS norm of the local error estimate (`≤ 1` meets the
-    /// tolerances) when `weights` is given and the method has an error estimator, else
-    /// `None`.
+    /// tolerances) when `estimate_error` is set and the method has an error estimator, else
+    /// `None`. `weights` are the tolerances, which implicit methods also use to stop their
+    /// Newton iterations.
     ///
     /// # Errors
-    /// A failed or non-finite right-hand side at a stage, or a non-finite candidate.
+    /// A failed or non-finite right-hand side at a stage, a non-finite candidate, or a Newton
+    /// iteration that did not converge.
     fn attempt(
         &mut self,
         rhs: &mut CheckedRhs<'_>,
         t_new: f64,
-        weights: Option<&ErrorWeights>,
+        weights: &ErrorWeights,
+        estimate_error: bool,
     ) -> Result<Option<f64>, StepFailure>;
 
     /// Makes the last candidate the current state, with `F` there (reused from the last stage
@@ -141,12 +263,88 @@ pub(crate) trait Stepper: DenseOutput {
     /// # Errors
     /// The failure of evaluating `F` at the candidate; the state is then unchanged.
     fn accept(&mut self, rhs: &mut CheckedRhs<'_>) -> Result<(), StepFailure>;
+
+    /// Completes the dense output over the last accepted step, for methods whose
+    /// interpolant needs more evaluations of `F` than the step (DOP853's three extra stages).
+    /// Called only for steps that contain a requested output time; the default does nothing.
+    ///
+    /// # Errors
+    /// The failure of one of those evaluations.
+    fn prepare_dense_output(&mut self, rhs: &mut CheckedRhs<'_>) -> Result<(), StepFailure> {
+        let _ = rhs;
+        Ok(())
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::ode::OdeFn;
+
+    /// Without an exact Jacobian, `jacobian` differences `F` (one evaluation per column,
+    /// counted) to about √ε relative accuracy; a non-finite entry is reported by its row.
+    #[test]
+    fn jacobian_falls_back_to_finite_differences() {
+        let mut system = OdeFn::new(2, |_t: f64, y: &[f64], dy: &mut [f64]| {
+            dy[0] = y[0] * y[1];
+            dy[1] = y[0].sin() + 3.0 * y[1];
+        });
+        let mut rhs = CheckedRhs::new(&mut system);
+        let y = [0.7, -1.3];
+        let mut f = [0.0; 2];
+        rhs.eval(0.0, &y, &mut f).unwrap();
+        let mut jac = DMatrix::zeros(2, 2);
+        let (mut work_y, mut work_f) = ([0.0; 2], [0.0; 2]);
+        rhs.jacobian(0.0, &y, &f, &mut jac, &mut work_y, &mut work_f)
+            .unwrap();
+        let exact = DMatrix::from_row_slice(2, 2, &[y[1], y[0], y[0].cos(), 3.0]);
+        assert!((jac - exact).amax() < 1e-7);
+        assert_eq!(rhs.evals(), 1 + 2);
+        assert_eq!(rhs.jacobian_evals(), 1);
+
+        let mut blows_up = OdeFn::new(1, |_t: f64, y: &[f64], dy: &mut [f64]| {
+            dy[0] = if y[0] > 1.0 { f64::INFINITY } else { y[0] };
+        });
+        let mut rhs = CheckedRhs::new(&mut blows_up);
+        let mut jac = DMatrix::zeros(1, 1);
+        let failure = rhs
+            .jacobian(0.0, &[1.0], &[1.0], &mut jac, &mut [0.0], &mut [0.0])
+            .unwrap_err();
+        assert!(matches!(
+            failure,
+            StepFailure::Rhs {
+                error: RhsError::NonFinite { index: 0 },
+                ..
+            }
+        ));
+    }
+
+    #[test]
+    fn newton_failures_are_recoverable_with_their_factor() {
+        let newton = StepFailure::Newton {
+            t: 1.0,
+            iterations: 7,
+            residual_norm: 3.0,
+            retry_factor: 0.3,
+        };
+        assert!(newton.is_recoverable());
+        assert_eq!(newton.retry_factor(), Some(0.3));
+        assert_eq!(
+            newton.into_error(),
+            IntegrationError::NewtonDidNotConverge {
+                t: 1.0,
+                iterations: 7,
+                residual_norm: 3.0
+            }
+        );
+        let singular = StepFailure::SingularIterationMatrix { t: 2.0 };
+        assert!(singular.is_recoverable());
+        assert_eq!(singular.retry_factor(), Some(0.5));
+        assert_eq!(
+            singular.into_error(),
+            IntegrationError::SingularIterationMatrix { t: 2.0 }
+        );
+    }
 
     #[test]
     fn checked_rhs_counts_and_checks() {

@@ -43,6 +43,36 @@ pub struct Tableau {
     fsal: bool,
 }
 
+/// Explicit Euler, `c`.
+static EULER_C: [f64; 1] = [0.0];
+/// Explicit Euler, `a`.
+static EULER_A: [&[f64]; 1] = [&[]];
+/// Explicit Euler, `b`.
+static EULER_B: [f64; 1] = [1.0];
+
+/// Explicit midpoint, `c`.
+static MIDPOINT_C: [f64; 2] = [0.0, 1.0 / 2.0];
+/// Explicit midpoint, `a`.
+static MIDPOINT_A: [&[f64]; 2] = [&[], &[1.0 / 2.0]];
+/// Explicit midpoint, `b`.
+static MIDPOINT_B: [f64; 2] = [0.0, 1.0];
+
+/// Bogacki–Shampine 3(2), `c`.
+static BS32_C: [f64; 4] = [0.0, 1.0 / 2.0, 3.0 / 4.0, 1.0];
+/// Bogacki–Shampine 3(2), `a` (row `i` holds `aᵢ₁ … aᵢ,ᵢ₋₁`).
+static BS32_A: [&[f64]; 4] = [
+    &[],
+    &[1.0 / 2.0],
+    &[0.0, 3.0 / 4.0],
+    &[2.0 / 9.0, 1.0 / 3.0, 4.0 / 9.0],
+];
+/// Bogacki–Shampine 3(2), `b` (third order; equal to the last row of `a`).
+static BS32_B: [f64; 4] = [2.0 / 9.0, 1.0 / 3.0, 4.0 / 9.0, 0.0];
+/// Bogacki–Shampine 3(2), `b̂` (second order).
+static BS32_B_EMBEDDED: [f64; 4] = [7.0 / 24.0, 1.0 / 4.0, 1.0 / 3.0, 1.0 / 8.0];
+/// Bogacki–Shampine 3(2), `b − b̂` in lowest terms.
+static BS32_ERROR: [f64; 4] = [-5.0 / 72.0, 1.0 / 12.0, 1.0 / 9.0, -1.0 / 8.0];
+
 /// Classical Runge–Kutta, `c`.
 static RK4_C: [f64; 4] = [0.0, 1.0 / 2.0, 1.0 / 2.0, 1.0];
 /// Classical Runge–Kutta, `a` (row `i` holds `aᵢ₁ … aᵢ,ᵢ₋₁`).
@@ -122,6 +152,95 @@ static DOPRI5_DENSE: [f64; 7] = [
 ];
 
 impl Tableau {
+    /// The explicit (forward) Euler method: one stage, first order, no error estimate.
+    ///
+    /// ```text
+    ///  0 |
+    /// ---+---
+    ///    | 1
+    /// ```
+    ///
+    /// # References
+    /// L. Euler, *Institutionum calculi integralis* I, §650, 1768; E. Hairer, S. P. Nørsett,
+    /// G. Wanner, *Solving Ordinary Differential Equations I*, 2nd ed., Springer, 1993, §I.7,
+    /// doi:10.1007/978-3-540-78862-1.
+    pub fn euler() -> Self {
+        Self {
+            name: "euler",
+            order: 1,
+            embedded_order: None,
+            c: &EULER_C,
+            a: &EULER_A,
+            b: &EULER_B,
+            b_embedded: None,
+            error_weights: None,
+            dense_correction: None,
+            fsal: false,
+        }
+    }
+
+    /// The explicit midpoint rule (Runge's second-order method): two stages, no error estimate.
+    ///
+    /// ```text
+    ///  0   |
+    ///  1/2 | 1/2
+    /// -----+---------
+    ///      | 0    1
+    /// ```
+    ///
+    /// # References
+    /// C. Runge, "Über die numerische Auflösung von Differentialgleichungen", Math. Ann. 46,
+    /// 167–178, 1895, doi:10.1007/BF01446807; Hairer, Nørsett, Wanner I, §II.1.
+    pub fn midpoint() -> Self {
+        Self {
+            name: "midpoint",
+            order: 2,
+            embedded_order: None,
+            c: &MIDPOINT_C,
+            a: &MIDPOINT_A,
+            b: &MIDPOINT_B,
+            b_embedded: None,
+            error_weights: None,
+            dense_correction: None,
+            fsal: false,
+        }
+    }
+
+    /// The Bogacki–Shampine 3(2) pair (MATLAB's `ode23`): four stages (three per step, FSAL),
+    /// third-order solution, second-order embedded estimate.
+    ///
+    /// ```text
+    ///  0   |
+    ///  1/2 | 1/2
+    ///  3/4 | 0     3/4
+    ///  1   | 2/9   1/3   4/9
+    /// -----+------------------------
+    ///   b  | 2/9   1/3   4/9   0
+    ///   b̂  | 7/24  1/4   1/3   1/8
+    /// ```
+    ///
+    /// Its dense output is the cubic Hermite interpolant of the step's end values and
+    /// derivatives (both are stages of the step, so it costs no evaluation); it is the
+    /// third-order continuous extension that Bogacki and Shampine give for the pair.
+    ///
+    /// # References
+    /// P. Bogacki, L. F. Shampine, "A 3(2) pair of Runge–Kutta formulas", Appl. Math. Lett.
+    /// 2(4), 321–325, 1989, doi:10.1016/0893-9659(89)90079-7.
+    pub fn bs32() -> Self {
+        Self {
+            name: "bs32",
+            order: 3,
+            embedded_order: Some(2),
+            c: &BS32_C,
+            a: &BS32_A,
+            b: &BS32_B,
+            b_embedded: Some(&BS32_B_EMBEDDED),
+            error_weights: Some(&BS32_ERROR),
+            dense_correction: None,
+            fsal: true,
+        }
+    }
+
     /// The classical fourth-order Runge–Kutta method ("RK4"): four stages, no error estimate.
     ///
     /// ```text
@@ -196,7 +315,7 @@ impl Tableau {
         }
     }
 
-    /// Short name of the method (`"rk4"`, `"dopri5"`).
+    /// Short name of the method (`"euler"`, `"midpoint"`, `"rk4"`, `"bs32"`, `"dopri5"`).
     pub fn name(&self) -> &'static str {
         self.name
     }
@@ -310,6 +429,203 @@ pub(crate) mod tests {
             conditions.push((dot(b, &a_times(tableau, &aac)), 1.0 / 120.0));
         }
         conditions
+    }
+
+    /// A rooted tree (Butcher's trees, which index the order conditions of Runge–Kutta
+    /// methods): its subtrees as indices into the list it belongs to, its order `|τ|` (number
+    /// of vertices) and its density `γ(τ) = |τ| Π γ(subtrees)`.
+    pub(crate) struct RootedTree {
+        pub(crate) children: Vec<usize>,
+        pub(crate) order: u32,
+        pub(crate) density: f64,
+    }
+
+    /// Every rooted tree with at most `max_order` vertices, each once, by increasing order:
+    /// a tree of order `n` is a root with a multiset of trees whose orders sum to `n − 1`
+    /// (generated as non-decreasing index sequences, so no multiset appears twice).
+    /// There are 1, 1, 2, 4, 9, 20, 48, 115 trees of orders 1 … 8 (OEIS A000081).
+    pub(crate) fn rooted_trees(max_order: u32) -> Vec<RootedTree> {
+        fn children_sets(
+            trees: &[RootedTree],
+            available: usize,
+            remaining: u32,
+            first: usize,
+            current: &mut Vec<usize>,
+            out: &mut Vec<Vec<usize>>,
+        ) {
+            if remaining == 0 {
+                out.push(current.clone());
+                return;
+            }
+            for index in first..available {
+                if trees[index].order <= remaining {
+                    current.push(index);
+                    let rest = remaining - trees[index].order;
+                    children_sets(trees, available, rest, index, current, out);
+                    current.pop();
+                }
+            }
+        }
+        let mut trees: Vec<RootedTree> = Vec::new();
+        for order in 1..=max_order {
+            let available = trees.len();
+            let mut sets = Vec::new();
+            children_sets(&trees, available, order - 1, 0, &mut Vec::new(), &mut sets);
+            for children in sets {
+                let density =
+                    f64::from(order) * children.iter().map(|&c| trees[c].density).product::<f64>();
+                trees.push(RootedTree {
+                    children,
+                    order,
+                    density,
+                });
+            }
+        }
+        trees
+    }
+
+    /// The order conditions of the method `(A, b)` (any `A`, explicit or implicit, given as
+    /// full rows) for every tree up to `max_order`, as residuals
+    /// `Σᵢ bᵢ Φᵢ(τ) − θ^|τ|/γ(τ)` paired with `|τ|`, where
+    /// `Φᵢ(τ) = Πₖ (A Φ(τₖ))ᵢ` over the subtrees `τₖ` (Butcher; Hairer–Nørsett–Wanner I,
+    /// §II.2, Theorem 2.13). With `θ = 1` they are the conditions for order `max_order`;
+    /// with `b = b(θ)` the weights of a continuous extension at `θ`, those for its order.
+    pub(crate) fn tree_residuals(
+        a: &[Vec<f64>],
+        b: &[f64],
+        max_order: u32,
+        theta: f64,
+    ) -> Vec<(u32, f64)> {
+        let s = b.len();
+        let trees = rooted_trees(max_order);
+        let mut phi: Vec<Vec<f64>> = Vec::with_capacity(trees.len());
+        // A Φ(τ) for each tree, reused by its parents.
+        let mut a_phi: Vec<Vec<f64>> = Vec::with_capacity(trees.len());
+        let mut residuals = Vec::with_capacity(trees.len());
+        for tree in &trees {
+            let mut p = vec![1.0; s];
+            for &child in &tree.children {
+                for (pi, api) in p.iter_mut().zip(&a_phi[child]) {
+                    *pi *= api;
+                }
+            }
+            let ap: Vec<f64> = (0..s)
+                .map(|i| (0..s).map(|j| a[i][j] * p[j]).sum())
+                .collect();
+            let weight: f64 = b.iter().zip(&p).map(|(b, p)| b * p).sum();
+            residuals.push((
+                tree.order,
+                weight - theta.powi(tree.order as i32) / tree.density,
+            ));
+            phi.push(p);
+            a_phi.push(ap);
+        }
+        residuals
+    }
+
+    /// The full `s × s` matrix `A` of an explicit tableau.
+    pub(crate) fn full_a(tableau: &Tableau) -> Vec<Vec<f64>> {
+        let s = tableau.num_stages();
+        (0..s)
+            .map(|i| {
+                let mut row = vec![0.0; s];
+                row[..i].copy_from_slice(tableau.a(i));
+                row
+            })
+            .collect()
+    }
+
+    /// Asserts that `b` satisfies every condition up to `order` to `tolerance`, and (for
+    /// `strict`) that some condition of order `order + 1` fails.
+    pub(crate) fn assert_tree_order(
+        label: &str,
+        a: &[Vec<f64>],
+        b: &[f64],
+        order: u32,
+        tolerance: f64,
+        strict: bool,
+    ) {
+        for (k, (o, residual)) in tree_residuals(a, b, order, 1.0).into_iter().enumerate() {
+            assert!(
+                residual.abs() < tolerance,
+                "{label}: tree {k} of order {o}: residual {residual:e}"
+            );
+        }
+        if strict {
+            let fails = tree_residuals(a, b, order + 1, 1.0)
+                .into_iter()
+                .any(|(o, residual)| o == order + 1 && residual.abs() > 1e-6);
+            assert!(fails, "{label}: has order {} too", order + 1);
+        }
+    }
+
+    #[test]
+    fn tree_counts_are_those_of_oeis_a000081() {
+        let trees = rooted_trees(8);
+        let counts: Vec<usize> = (1..=8)
+            .map(|o| trees.iter().filter(|t| t.order == o).count())
+            .collect();
+        assert_eq!(counts, vec![1, 1, 2, 4, 9, 20, 48, 115]);
+        // The bushy tree of order 4 (root with three leaves) has density 4; the tall one 24.
+        let densities: Vec<f64> = trees
+            .iter()
+            .filter(|t| t.order == 4)
+            .map(|t| t.density)
+            .collect();
+        assert!(densities.contains(&4.0) && densities.contains(&24.0));
+    }
+
+    /// The tree conditions agree with the hand-written ones up to order 5.
+    #[test]
+    fn tree_conditions_agree_with_the_explicit_list() {
+        let tableau = Tableau::dopri5();
+        let residuals = tree_residuals(&full_a(&tableau), tableau.b(), 5, 1.0);
+        let explicit = order_conditions(&tableau, tableau.b(), 5);
+        assert_eq!(residuals.len(), explicit.len());
+        let mut from_trees: Vec<f64> = residuals.iter().map(|(_, r)| *r).collect();
+        let mut listed: Vec<f64> = explicit.iter().map(|(w, e)| w - e).collect();
+        from_trees.sort_by(f64::total_cmp);
+        listed.sort_by(f64::total_cmp);
+        for (x, y) in from_trees.iter().zip(&listed) {
+            assert!((x - y).abs() < 1e-15);
+        }
+    }
+
+    /// Every explicit tableau: row sums `Σⱼ aᵢⱼ = cᵢ`, the shape rules, and the order
+    /// conditions of its propagated and embedded weights (exactly its order, not one more).
+    #[test]
+    fn every_tableau_has_its_orders() {
+        for tableau in [
+            Tableau::euler(),
+            Tableau::midpoint(),
+            Tableau::rk4(),
+            Tableau::bs32(),
+            Tableau::dopri5(),
+        ] {
+            check_shape(&tableau);
+            let a = full_a(&tableau);
+            assert_tree_order(
+                tableau.name(),
+                &a,
+                tableau.b(),
+                tableau.order(),
+                1e-14,
+                true,
+            );
+            if let (Some(b_hat), Some(order)) = (tableau.b_embedded(), tableau.embedded_order()) {
+                let label = format!("{} embedded", tableau.name());
+                assert_tree_order(&label, &a, b_hat, order, 1e-14, true);
+                for ((e, b), b_hat) in tableau
+                    .error_weights()
+                    .unwrap()
+                    .iter()
+                    .zip(tableau.b())
+                    .zip(b_hat)
+                {
+                    assert!((e - (b - b_hat)).abs() < 1e-16, "{}", tableau.name());
+                }
+            }
+        }
     }
 
     fn assert_order(tableau: &Tableau, b: &[f64], order: u32) {
