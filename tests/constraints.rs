@@ -245,3 +245,31 @@ fn four_bar_consistent_initialisation_closure_and_energy() {
         );
     }
 }
+
+/// Projection after every step (any method): the Cartesian pendulum's rod length stays
+/// within 1e-10 of ℓ over 50 s at rtol 1e-7, where the unstabilised DAE drifts by far more
+/// (measured in the same test), and HW39's four-bar loop stays closed to 1e-10 over 10 s.
+#[test]
+fn projection_holds_the_constraints() {
+    let drift_at_end = |stab: Stabilization| {
+        let mut m = model("simple_pendulum_cartesian");
+        m.set_stabilization(stab);
+        let s = run(m.as_mut(), 50.0, grid(50.0, 50), 1e-7);
+        s.iter()
+            .map(|(t, y)| m.constraint_drift(t, y).0)
+            .fold(0.0f64, f64::max)
+    };
+    let projected = drift_at_end(Stabilization::Projection);
+    let free = drift_at_end(Stabilization::None);
+    assert!(projected < 1e-10, "projected drift {projected}");
+    assert!(
+        free > 100.0 * projected,
+        "free {free} vs projected {projected}"
+    );
+    let mut m = model("four_bar");
+    m.set_stabilization(Stabilization::Projection);
+    let s = run(m.as_mut(), 10.0, grid(10.0, 100), 1e-8);
+    for (t, y) in s.iter() {
+        assert!(m.constraint_drift(t, y).0 < 1e-10, "loop at t = {t}");
+    }
+}

@@ -28,6 +28,13 @@ pub enum Stabilization {
         /// Stiffness of the drift (1/s).
         beta: f64,
     },
+    /// Projection after every accepted step (Hairer, Lubich & Wanner, *Geometric Numerical
+    /// Integration*, §IV.4; Eich 1993): `q` onto `Φ(q, t) = 0` by Gauss–Newton with the
+    /// minimum-norm correction `Δq = −Jᵀ(J Jᵀ)⁻¹ Φ`, then `q̇` onto the velocity constraints
+    /// by the minimum-norm correction of `J q̇ + Φ_t` (and `A q̇ + b`). The integrators call it
+    /// through [`crate::OdeSystem::after_step`], which projects the step's samples too; a
+    /// projected step restarts the method there (one more evaluation of `F`).
+    Projection,
     /// Not a stabilisation of the DAE but method I of lectures 8–11 in its place: each
     /// holonomic constraint becomes a stiff spring and damper on `Φ`, `λ = k Φ + c Φ̇`
     /// (non-holonomic rows: `λ = c (A q̇ + b)`), and `M q̈ = F − Jᵀ λ` is an ODE again. The
@@ -178,6 +185,8 @@ impl ConstraintWorkspace {
     /// # Errors
     /// [`ProjectionError`] naming the constraint with the largest residual when Newton does
     /// not reach `tolerance` in 50 iterations or `J Jᵀ` is singular.
+    ///
+    /// No heap allocation (it runs after every step under [`Stabilization::Projection`]).
     pub fn project<S: MechanicalSystem<N>, const N: usize>(
         &mut self,
         system: &S,
@@ -187,14 +196,8 @@ impl ConstraintWorkspace {
         free: &[usize],
         tolerance: f64,
     ) -> Result<usize, ProjectionError> {
-        let n = self.n;
-        let all: Vec<usize>;
-        let free = if free.is_empty() {
-            all = (0..n).collect();
-            &all[..]
-        } else {
-            free
-        };
+        let count = if free.is_empty() { self.n } else { free.len() };
+        let column = |j: usize| if free.is_empty() { j } else { free[j] };
         let h = self.holonomic;
         let mut iterations = 0;
         if h > 0 {
@@ -204,22 +207,19 @@ impl ConstraintWorkspace {
                 if residual <= tolerance {
                     break;
                 }
-                if iterations == 50 || !residual.is_finite() {
-                    return Err(ProjectionError {
-                        constraint: worst,
-                        residual,
-                        iterations,
-                    });
-                }
-                system.constraint_jacobian(q, t, &mut self.jacobian);
-                let rhs: Vec<f64> = self.phi.clone();
-                let step = self.minimum_norm(h, free, &rhs).ok_or(ProjectionError {
+                let failure = ProjectionError {
                     constraint: worst,
                     residual,
                     iterations,
-                })?;
-                for (j, &c) in free.iter().enumerate() {
-                    q[c] -= step[j];
+                };
+                if iterations == 50 || !residual.is_finite() {
+                    return Err(failure);
+                }
+                system.constraint_jacobian(q, t, &mut self.jacobian);
+                self.minimum_norm(h, free, false).ok_or(failure)?;
+                for j in 0..count {
+                    let c = column(j);
+                    q[c] -= self.step_component(h, c);
                 }
                 iterations += 1;
             }
@@ -227,45 +227,54 @@ impl ConstraintWorkspace {
         if self.m > 0 {
             system.constraint_jacobian(q, t, &mut self.jacobian);
             system.constraint_velocity_residuals(q, qdot, t, &mut self.velocity);
-            let rhs = self.velocity.clone();
-            let (worst, residual) = largest(&rhs);
-            let step = self
-                .minimum_norm(self.m, free, &rhs)
+            let (worst, residual) = largest(&self.velocity);
+            self.minimum_norm(self.m, free, true)
                 .ok_or(ProjectionError {
                     constraint: worst,
                     residual,
                     iterations,
                 })?;
-            for (j, &c) in free.iter().enumerate() {
-                qdot[c] -= step[j];
+            for j in 0..count {
+                let c = column(j);
+                qdot[c] -= self.step_component(self.m, c);
             }
         }
         Ok(iterations)
     }
 
-    /// The minimum-norm `x` (over the columns `free`) of `J_rows x = rhs`, with `J_rows` the
-    /// first `rows` rows of the Jacobian buffer: `x = Jᵀ (J Jᵀ)⁻¹ rhs`.
-    fn minimum_norm(&mut self, rows: usize, free: &[usize], rhs: &[f64]) -> Option<Vec<f64>> {
+    /// Solves `(J Jᵀ) z = r` over the first `rows` rows of the Jacobian buffer and the columns
+    /// `free` (all when empty), with `r` the position residuals `Φ` or (`velocity`) the
+    /// velocity residuals; `z` is left in `small_rhs`, and the minimum-norm correction is
+    /// `Jᵀ z` ([`Self::step_component`]). No allocation.
+    fn minimum_norm(&mut self, rows: usize, free: &[usize], velocity: bool) -> Option<()> {
         let n = self.n;
-        let jac = &self.jacobian;
+        let count = if free.is_empty() { n } else { free.len() };
+        let column = |j: usize| if free.is_empty() { j } else { free[j] };
         for a in 0..rows {
             for b in 0..rows {
-                self.small[a * rows + b] =
-                    free.iter().map(|&c| jac[a * n + c] * jac[b * n + c]).sum();
+                self.small[a * rows + b] = (0..count)
+                    .map(|j| self.jacobian[a * n + column(j)] * self.jacobian[b * n + column(j)])
+                    .sum();
             }
-            self.small_rhs[a] = rhs[a];
+            self.small_rhs[a] = if velocity {
+                self.velocity[a]
+            } else {
+                self.phi[a]
+            };
         }
         lu_solve(
             &mut self.small[..rows * rows],
             &mut self.small_rhs[..rows],
             &mut self.small_pivots[..rows],
             rows,
-        )?;
-        Some(
-            free.iter()
-                .map(|&c| (0..rows).map(|a| jac[a * n + c] * self.small_rhs[a]).sum())
-                .collect(),
         )
+    }
+
+    /// Component `c` of `Jᵀ z` after [`Self::minimum_norm`] over `rows` rows.
+    fn step_component(&self, rows: usize, c: usize) -> f64 {
+        (0..rows)
+            .map(|a| self.jacobian[a * self.n + c] * self.small_rhs[a])
+            .sum()
     }
 }
 

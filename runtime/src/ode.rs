@@ -17,6 +17,13 @@ pub enum RhsError {
         "the constrained system [M Jᵀ; J 0] is singular (redundant constraints or a singular configuration)"
     )]
     SingularConstraintMatrix,
+    /// Projection onto the constraints failed: Newton left residual `residual` in some
+    /// constraint.
+    #[error("projection onto the constraints failed (residual {residual:e})")]
+    ProjectionFailed {
+        /// The largest constraint residual left.
+        residual: f64,
+    },
     /// The right-hand side (or its Jacobian) produced NaN or ±∞ in component `index`.
     #[error("the right-hand side is not finite in component {index}")]
     NonFinite {
@@ -76,6 +83,19 @@ pub trait OdeSystem {
     /// accelerations, the lower half of `F`.
     fn second_order_dim(&self) -> Option<usize> {
         None
+    }
+
+    /// Called by every integrator after each accepted step, with the new state `y` at `t`;
+    /// may change `y` (projection of a constrained system onto its constraint manifold) and
+    /// returns whether it did, in which case the method restarts from the changed state. The
+    /// default does nothing.
+    ///
+    /// # Errors
+    /// [`RhsError`] when the state cannot be corrected (a projection whose Newton iteration
+    /// fails).
+    fn after_step(&mut self, t: f64, y: &mut [f64]) -> Result<bool, RhsError> {
+        let _ = (t, y);
+        Ok(false)
     }
 }
 

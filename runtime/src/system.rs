@@ -301,6 +301,21 @@ impl<S: MechanicalSystem<N>, const N: usize> OdeSystem for FirstOrder<S, N> {
     /// A constrained system returns `Ok(false)`: its `q̈` comes from the KKT system, whose
     /// derivative needs `∂J/∂q` and `∂γ/∂(q, q̇)`, which are not generated; the implicit
     /// methods then difference `F`.
+    fn after_step(&mut self, t: f64, y: &mut [f64]) -> Result<bool, RhsError> {
+        if self.constraints.is_empty() || self.stabilization != Stabilization::Projection {
+            return Ok(false);
+        }
+        let (mut q, mut qdot) = split::<N>(y);
+        self.constraints
+            .project(&self.system, &mut q, &mut qdot, t, &[], 1e-12)
+            .map_err(|e| RhsError::ProjectionFailed {
+                residual: e.residual,
+            })?;
+        y[..N].copy_from_slice(q.as_slice());
+        y[N..2 * N].copy_from_slice(qdot.as_slice());
+        Ok(true)
+    }
+
     fn jacobian(&mut self, t: f64, y: &[f64], jac: &mut [f64]) -> Result<bool, RhsError> {
         if !self.constraints.is_empty() {
             return Ok(false);

@@ -50,6 +50,8 @@ pub enum StabilizationArg {
     None,
     /// Baumgarte's stabilisation with `--baumgarte ALPHA,BETA`.
     Baumgarte,
+    /// Projection onto Φ = 0 and the velocity constraints after every accepted step.
+    Projection,
 }
 
 /// Options of `eomgen simulate`.
@@ -86,8 +88,9 @@ pub struct SimulateArgs {
     /// repeatable.
     #[arg(long = "init", value_name = "NAME=VALUE")]
     pub init: Vec<String>,
-    /// Drift control of a constrained model: `none` (show the drift) or `baumgarte`
-    /// (Φ̈ + 2α Φ̇ + β² Φ = 0, see --baumgarte). Ignored without constraints.
+    /// Drift control of a constrained model: `none` (show the drift), `baumgarte`
+    /// (Φ̈ + 2α Φ̇ + β² Φ = 0, see --baumgarte) or `projection` (onto Φ = 0 and the velocity
+    /// constraints after every step). Ignored without constraints.
     #[arg(long, value_enum, default_value_t = StabilizationArg::None)]
     pub stabilization: StabilizationArg,
     /// Baumgarte's α and β (1/s), `ALPHA,BETA`.
@@ -156,6 +159,7 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
             alpha: args.baumgarte[0],
             beta: args.baumgarte[1],
         },
+        StabilizationArg::Projection => Stabilization::Projection,
     };
     model.set_stabilization(stabilization);
     if !(args.t_end.is_finite() && args.t_end > 0.0) {

@@ -179,6 +179,7 @@ fn fixed_steps<S: Stepper>(
     solution: &mut Solution,
 ) -> Result<(), IntegrationError> {
     let (t0, t_end) = (problem.t0, problem.t_end);
+    let mut corrected = vec![0.0; stepper.y().len()];
     let largest_t = t0.abs().max(t_end.abs());
     if dt.is_nan() || dt < min_step(largest_t, t_end - t0) {
         return Err(IntegrationError::StepSizeTooSmall { t: t0, dt });
@@ -204,8 +205,11 @@ fn fixed_steps<S: Stepper>(
             .map_err(StepFailure::into_error)?;
         stepper.accept(rhs).map_err(StepFailure::into_error)?;
         solution.stats.steps += 1;
+        let first_sample = solution.t.len();
         recorder
             .record_step(solution, stepper, rhs)
+            .map_err(StepFailure::into_error)?;
+        after_step(rhs, stepper, &mut corrected, solution, first_sample)
             .map_err(StepFailure::into_error)?;
     }
     Ok(())
@@ -240,6 +244,7 @@ fn adaptive_steps<S: Stepper>(
         error_order,
     } = adaptive;
     let (t0, t_end) = (problem.t0, problem.t_end);
+    let mut corrected = vec![0.0; stepper.y().len()];
     let span = t_end - t0;
     let max_steps = problem.options.max_steps;
     let dt_max = problem
@@ -288,8 +293,11 @@ fn adaptive_steps<S: Stepper>(
             StepOutcome::Accepted { dt_next } if usable => {
                 stepper.accept(rhs).map_err(StepFailure::into_error)?;
                 solution.stats.steps += 1;
+                let first_sample = solution.t.len();
                 recorder
                     .record_step(solution, stepper, rhs)
+                    .map_err(StepFailure::into_error)?;
+                after_step(rhs, stepper, &mut corrected, solution, first_sample)
                     .map_err(StepFailure::into_error)?;
                 dt = dt_next.min(dt_max);
             }
@@ -452,6 +460,34 @@ impl<'a> Recorder<'a> {
         }
         Ok(())
     }
+}
+
+/// Lets the system correct the state after an accepted step ([`OdeSystem::after_step`]:
+/// projection onto a constrained system's manifold) and, if it did, restarts the stepper
+/// there. The samples recorded during the step (from `first_sample` on, interpolated before
+/// the correction) get the same correction, so the output satisfies what the state does.
+/// `corrected` is a `dim`-entry scratch buffer.
+fn after_step<S: Stepper>(
+    rhs: &mut CheckedRhs<'_>,
+    stepper: &mut S,
+    corrected: &mut [f64],
+    solution: &mut Solution,
+    first_sample: usize,
+) -> Result<(), StepFailure> {
+    let dim = corrected.len();
+    for i in first_sample..solution.t.len() {
+        let row = &mut solution.y[i * dim..(i + 1) * dim];
+        corrected.copy_from_slice(row);
+        if rhs.after_step(solution.t[i], corrected)? {
+            row.copy_from_slice(corrected);
+        }
+    }
+    let t = stepper.t();
+    corrected.copy_from_slice(stepper.y());
+    if rhs.after_step(t, corrected)? {
+        stepper.reset(rhs, t, corrected)?;
+    }
+    Ok(())
 }
 
 #[cfg(test)]

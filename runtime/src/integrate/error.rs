@@ -145,6 +145,15 @@ pub enum IntegrationError {
         /// Time at which the right-hand side was evaluated (a stage time of the failed step).
         t: f64,
     },
+    /// Projection onto the constraints after the step ending at `t` failed
+    /// ([`RhsError::ProjectionFailed`](crate::RhsError::ProjectionFailed)).
+    #[error("projection onto the constraints failed at t = {t}: residual {residual:e} left")]
+    ProjectionFailed {
+        /// End of the step whose state could not be projected.
+        t: f64,
+        /// The largest constraint residual left.
+        residual: f64,
+    },
     /// The Newton iteration of an implicit method did not converge for the step from `t`:
     /// with a fixed step at once; with adaptive steps after the step was shrunk until it
     /// was too small.
@@ -183,6 +192,7 @@ impl IntegrationError {
             | IntegrationError::RhsNonFinite { t, .. }
             | IntegrationError::SingularMassMatrix { t }
             | IntegrationError::SingularConstraintMatrix { t }
+            | IntegrationError::ProjectionFailed { t, .. }
             | IntegrationError::NewtonDidNotConverge { t, .. }
             | IntegrationError::SingularIterationMatrix { t } => Some(t),
             IntegrationError::InvalidTimeSpan { .. }

@@ -42,7 +42,10 @@ impl StepFailure {
     pub(crate) fn is_recoverable(&self) -> bool {
         match self {
             StepFailure::Rhs {
-                error: RhsError::SingularMassMatrix | RhsError::SingularConstraintMatrix,
+                error:
+                    RhsError::SingularMassMatrix
+                    | RhsError::SingularConstraintMatrix
+                    | RhsError::ProjectionFailed { .. },
                 ..
             } => false,
             StepFailure::Rhs {
@@ -76,6 +79,10 @@ impl StepFailure {
                 t,
                 error: RhsError::SingularConstraintMatrix,
             } => IntegrationError::SingularConstraintMatrix { t },
+            StepFailure::Rhs {
+                t,
+                error: RhsError::ProjectionFailed { residual },
+            } => IntegrationError::ProjectionFailed { t, residual },
             StepFailure::Rhs {
                 t,
                 error: RhsError::NonFinite { index },
@@ -140,6 +147,17 @@ impl<'a> CheckedRhs<'a> {
     /// the real and the complex one together count once, as in Hairer's RADAU5).
     pub(crate) fn count_lu(&mut self) {
         self.lu_decompositions += 1;
+    }
+
+    /// The system's correction after an accepted step ([`OdeSystem::after_step`]), applied
+    /// to `y` (a copy of the stepper's state).
+    ///
+    /// # Errors
+    /// [`StepFailure::Rhs`] at `t` if the correction fails.
+    pub(crate) fn after_step(&mut self, t: f64, y: &mut [f64]) -> Result<bool, StepFailure> {
+        self.system
+            .after_step(t, y)
+            .map_err(|error| StepFailure::Rhs { t, error })
     }
 
     /// Evaluates `dy = F(t, y)`.
