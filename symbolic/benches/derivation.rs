@@ -7,7 +7,8 @@
 //! ```text
 //! model::load (YAML → typed, checked ModelFile)
 //!   → SymbolicModel::from_file (points, T, V, Q in the arena)
-//!   → Lagrange.derive (M = ∂²T/∂q̇∂q̇ᵀ, F)
+//!   → cheapest_equations (Lagrange and, for a kinematic model, momentum balance; the one
+//!     with fewer operations after CSE)
 //!   → Jacobians::of (∂F/∂q, ∂F/∂q̇, ∂(M a)/∂q)
 //!   → cse::plan over [M; F] (the plan of the hot `mass_matrix_and_forcing`)
 //! ```
@@ -19,15 +20,21 @@
 //!   derivation time and expression size scale with `n` (the mass matrix is dense, so `F`
 //!   has `O(n²)` velocity-product terms and `M` `O(n²)` entries);
 //! - `emit_n_link_pendulum_10` times code generation alone ([`codegen::emit`]: CSE plans
-//!   and printing of every generated function) on an already derived 10-link chain.
+//!   and printing of every generated function) on an already derived 10-link chain;
+//! - the `formulations` group (issue 4's scaling table) times each formulation on its own,
+//!   Lagrange and momentum balance for `n` = 2, 5, 10, 20, 30: `{method}_n_link_pendulum_{n}`
+//!   derives `M` and `F`, `{method}_and_jacobians_n_link_pendulum_{n}` also `Jacobians::of`
+//!   (what the macro derives from the equations it keeps); loading and lowering are setup.
 //!
 //! Before timing, each size is derived once and reported on stderr: operations of `M` and `F`
 //! evaluated as trees and after CSE (the same figures as [`codegen::EmitStats`]), and the
-//! wall time of each stage of that one run. The derived `M` and `F` of every chain are also
-//! checked against the closed form (see [`check_against_closed_form`]), so a wrong generator
-//! cannot produce plausible timings.
+//! wall time of each stage of that one run. The derived `M` and `F` of every chain, by every
+//! formulation, are also checked against the closed form (see [`check_against_closed_form`]),
+//! so a wrong generator cannot produce plausible timings.
 //!
-//! Run with `cargo bench -p eomgen-symbolic --bench derivation`.
+//! Run with `cargo bench -p eomgen-symbolic --bench derivation`; the side-by-side SymPy
+//! figures come from `tools/sympy_n_link.py`, the compile time of the generated code from
+//! `tools/compile_time.sh`.
 
 use std::hint::black_box;
 use std::time::{Duration, Instant};
@@ -39,6 +46,7 @@ use eomgen_symbolic::expr::cse::{self, CsePlan};
 use eomgen_symbolic::expr::eval::Evaluator;
 use eomgen_symbolic::mechanics::{
     EquationsOfMotion, Formulation, Jacobians, Lagrange, MomentumBalance, SymbolicModel,
+    cheapest_equations,
 };
 use eomgen_symbolic::model;
 
@@ -68,6 +76,8 @@ fn n_link_pendulum(n: usize) -> String {
 struct Derived {
     model: SymbolicModel,
     eom: EquationsOfMotion,
+    /// The formulation `cheapest_equations` kept.
+    method: &'static str,
     jacobians: Jacobians,
     plan: CsePlan,
 }
@@ -77,14 +87,14 @@ struct Derived {
 struct StageTimes {
     load: Duration,
     lower: Duration,
-    lagrange: Duration,
+    equations: Duration,
     jacobians: Duration,
     cse: Duration,
 }
 
 impl StageTimes {
     fn total(&self) -> Duration {
-        self.load + self.lower + self.lagrange + self.jacobians + self.cse
+        self.load + self.lower + self.equations + self.jacobians + self.cse
     }
 }
 
@@ -98,7 +108,8 @@ fn mass_and_forcing_roots(eom: &EquationsOfMotion) -> Vec<ExprId> {
         .collect()
 }
 
-/// Runs load → lower → Lagrange → Jacobians → CSE plan of `[M; F]`, timing each stage.
+/// Runs load → lower → cheapest equations → Jacobians → CSE plan of `[M; F]`, timing each
+/// stage.
 ///
 /// # Panics
 /// If the model file is rejected (the generator and the bundled model are valid).
@@ -113,8 +124,8 @@ fn derive_timed(path: &str, source: &str) -> (Derived, StageTimes) {
     times.lower = start.elapsed();
 
     let start = Instant::now();
-    let eom = Lagrange.derive(&mut model);
-    times.lagrange = start.elapsed();
+    let (eom, method) = cheapest_equations(&mut model);
+    times.equations = start.elapsed();
 
     let start = Instant::now();
     let jacobians = Jacobians::of(&mut model, &eom);
@@ -128,6 +139,7 @@ fn derive_timed(path: &str, source: &str) -> (Derived, StageTimes) {
     let derived = Derived {
         model,
         eom,
+        method,
         jacobians,
         plan,
     };
@@ -138,13 +150,14 @@ fn derive_timed(path: &str, source: &str) -> (Derived, StageTimes) {
 fn derive(path: &str, source: &str) -> Derived {
     let file = model::load(path, source).unwrap_or_else(|d| panic!("{path}: {d:?}"));
     let mut model = SymbolicModel::from_file(&file).unwrap_or_else(|d| panic!("{path}: {d:?}"));
-    let eom = Lagrange.derive(&mut model);
+    let (eom, method) = cheapest_equations(&mut model);
     let jacobians = Jacobians::of(&mut model, &eom);
     let roots = mass_and_forcing_roots(&eom);
     let plan = cse::plan(&model.arena, &roots, "t");
     Derived {
         model,
         eom,
+        method,
         jacobians,
         plan,
     }
@@ -157,15 +170,16 @@ fn report(label: &str, path: &str, source: &str) -> Derived {
     let before = derived.model.arena.tree_operation_count(&roots);
     let after = derived.plan.operation_count();
     eprintln!(
-        "{label}: M and F: {before} ops as trees, {after} after CSE ({} temporaries, \
-         {} arena nodes); one derivation {:.3?} (load {:.3?}, lower {:.3?}, Lagrange {:.3?}, \
+        "{label}: M and F by {}: {before} ops as trees, {after} after CSE ({} temporaries, \
+         {} arena nodes); one derivation {:.3?} (load {:.3?}, lower {:.3?}, equations {:.3?}, \
          Jacobians {:.3?}, CSE {:.3?})",
+        derived.method,
         derived.plan.temporaries.len(),
         derived.model.arena.len(),
         times.total(),
         times.load,
         times.lower,
-        times.lagrange,
+        times.equations,
         times.jacobians,
         times.cse,
     );
@@ -186,8 +200,7 @@ fn report(label: &str, path: &str, source: &str) -> Derived {
 ///
 /// # Panics
 /// If an entry differs.
-fn check_against_closed_form(derived: &Derived, n: usize) {
-    let model = &derived.model;
+fn check_against_closed_form(model: &SymbolicModel, eom: &EquationsOfMotion, n: usize) {
     let g = 10.0;
     let theta: Vec<f64> = (0..n).map(|i| 0.3 + 0.71 * i as f64).collect();
     let omega: Vec<f64> = (0..n).map(|i| -1.1 + 0.53 * i as f64).collect();
@@ -200,7 +213,7 @@ fn check_against_closed_form(derived: &Derived, n: usize) {
         bindings[q.index()] = theta[i];
         bindings[qdot.index()] = omega[i];
     }
-    let roots = mass_and_forcing_roots(&derived.eom);
+    let roots = mass_and_forcing_roots(eom);
     let values = Evaluator::new(&model.arena, &roots).eval(&bindings);
 
     // 0-based: μᵢ = n − 1 − i unit bars below joint i.
@@ -242,7 +255,7 @@ fn derivation(c: &mut Criterion) {
         let source = n_link_pendulum(n);
         let path = format!("n_link_pendulum_{n}.yaml");
         let derived = report(&format!("n_link_pendulum_{n}"), &path, &source);
-        check_against_closed_form(&derived, n);
+        check_against_closed_form(&derived.model, &derived.eom, n);
         drop(derived);
         if n >= 10 {
             // Each run takes long enough that criterion's minimum of 10 samples is plenty.
@@ -287,31 +300,65 @@ fn derivation(c: &mut Criterion) {
     group.finish();
 }
 
+/// Chain sizes of the `formulations` group.
+const SCALING_SIZES: [usize; 5] = [2, 5, 10, 20, 30];
+
 /// Lagrange against momentum balance on the same lowered chain, N = 2 … 30 (issue 4's scaling
-/// table): only the derivation of `M` and `F` is timed; loading and lowering are setup.
+/// table): the derivation of `M` and `F` alone, and followed by [`Jacobians::of`]; loading and
+/// lowering are setup. Before the timed runs, one run per size and method reports operation
+/// counts and its wall times on stderr and checks `M` and `F` against the closed form.
 fn formulations(c: &mut Criterion) {
     let mut group = c.benchmark_group("formulations");
     group.sample_size(10);
-    for n in [2usize, 5, 10, 20, 30] {
+    for n in SCALING_SIZES {
         let source = n_link_pendulum(n);
         let file = model::load("chain.yaml", &source).expect("the generated chain loads");
         let methods: [(&str, &dyn Formulation); 2] =
             [("lagrange", &Lagrange), ("momentum", &MomentumBalance)];
         for (name, method) in methods {
             let mut lowered = SymbolicModel::from_file(&file).expect("lowers");
+            let start = Instant::now();
             let eom = method.derive(&mut lowered);
+            let equations = start.elapsed();
+            let start = Instant::now();
+            let jacobians = Jacobians::of(&mut lowered, &eom);
+            let derivatives = start.elapsed();
+            check_against_closed_form(&lowered, &eom, n);
             let roots = mass_and_forcing_roots(&eom);
+            let jacobian_roots: Vec<ExprId> = jacobians
+                .forcing_q
+                .iter()
+                .chain(&jacobians.forcing_qdot)
+                .copied()
+                .collect();
             eprintln!(
-                "{name} n_link_pendulum_{n}: {} ops as trees, {} after CSE",
+                "{name} n_link_pendulum_{n}: M and F {} ops as trees, {} after CSE; \
+                 ∂F/∂q and ∂F/∂q̇ {} ops after CSE; one run: M and F {equations:.3?}, \
+                 Jacobians {derivatives:.3?}, together {:.3?}",
                 lowered.arena.tree_operation_count(&roots),
-                cse::plan(&lowered.arena, &roots, "t").operation_count()
+                cse::plan(&lowered.arena, &roots, "t").operation_count(),
+                cse::plan(&lowered.arena, &jacobian_roots, "t").operation_count(),
+                equations + derivatives,
             );
+            drop(lowered);
+            // The derived model is returned, so its arena is freed outside the timing.
             group.bench_function(format!("{name}_n_link_pendulum_{n}"), |b| {
                 b.iter_batched(
                     || SymbolicModel::from_file(&file).expect("lowers"),
                     |mut m| {
                         let eom = method.derive(&mut m);
                         (m, eom)
+                    },
+                    BatchSize::LargeInput,
+                )
+            });
+            group.bench_function(format!("{name}_and_jacobians_n_link_pendulum_{n}"), |b| {
+                b.iter_batched(
+                    || SymbolicModel::from_file(&file).expect("lowers"),
+                    |mut m| {
+                        let eom = method.derive(&mut m);
+                        let jacobians = Jacobians::of(&mut m, &eom);
+                        (m, eom, jacobians)
                     },
                     BatchSize::LargeInput,
                 )

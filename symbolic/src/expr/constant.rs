@@ -102,17 +102,26 @@ impl Constant {
 
     /// Whether this is exactly zero.
     pub fn is_zero(self) -> bool {
-        self.to_f64() == 0.0
+        match self {
+            Constant::Rational { num, .. } => num == 0,
+            Constant::Float(_) => self.to_f64() == 0.0,
+        }
     }
 
     /// Whether this is exactly one.
     pub fn is_one(self) -> bool {
-        self.to_f64() == 1.0
+        match self {
+            Constant::Rational { num, den } => num == den,
+            Constant::Float(_) => self.to_f64() == 1.0,
+        }
     }
 
     /// Whether this is negative.
     pub fn is_negative(self) -> bool {
-        self.to_f64() < 0.0
+        match self {
+            Constant::Rational { num, .. } => num < 0,
+            Constant::Float(_) => self.to_f64() < 0.0,
+        }
     }
 
     /// The integer value, if this is an integral rational.

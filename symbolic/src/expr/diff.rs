@@ -6,6 +6,9 @@ impl ExprArena {
     /// `∂expr/∂var`, canonical and memoised: each `(expr, var)` pair is differentiated once,
     /// so shared subexpressions are differentiated once.
     pub fn diff(&mut self, expr: ExprId, var: SymbolId) -> ExprId {
+        if !self.may_depend_on(expr, var) {
+            return self.int(0);
+        }
         if let Some(&d) = self.diff_memo.get(&(expr, var)) {
             return d;
         }

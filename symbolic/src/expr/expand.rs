@@ -1,44 +1,69 @@
-//! Distributive expansion, used where exact cancellation matters (the Lagrange forcing).
+//! Distributive expansion, used where exact cancellation matters (the Lagrange forcing) and
+//! where products of sines and cosines must meet (momentum balance).
 //!
 //! `x·(a + b)` → `x·a + x·b` and `(a + b)^n` (n = 2, 3) multiplied out, recursively through
 //! sums and products but not into function arguments, so that terms which cancel exactly
 //! (∂T/∂q against the (∂²T/∂q̇∂q) q̇ term of Lagrange's equations) meet as like terms in one
 //! canonical sum and vanish. Expansion can also swell an expression, so it is capped, and
-//! [`ExprArena::expand_if_cheaper`] keeps whichever form costs fewer operations.
+//! [`ExprArena::expand_if_cheaper`] keeps whichever form costs fewer operations;
+//! [`ExprArena::expand_time_varying`] leaves constant-in-time sums alone.
 
 use super::{ExprArena, ExprId, Node};
 
 /// Most terms an expansion may produce before the product is left unexpanded.
 const MAX_TERMS: usize = 512;
 
-impl ExprArena {
-    /// The terms of `e` as a sum (itself if it is not a sum).
-    fn terms_of(&self, e: ExprId) -> Vec<ExprId> {
-        match self.node(e) {
-            Node::Add(t) => t.to_vec(),
-            _ => vec![e],
-        }
-    }
+/// Which sums [`ExprArena::expand`] multiplies out.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Expansion {
+    /// Every sum.
+    Full,
+    /// Only sums that change in time; a constant-in-time sum such as `R − r` stays a factor.
+    TimeVarying,
+}
 
+impl ExprArena {
     /// `e` with products of sums and small powers of sums multiplied out (memoised).
     pub fn expand(&mut self, e: ExprId) -> ExprId {
-        if let Some(&x) = self.expand_memo.get(&e) {
+        self.expand_as(e, Expansion::Full)
+    }
+
+    /// `e` with products of time-varying sums multiplied out, constant-in-time sums kept as
+    /// factors (memoised): enough to bring products of sines and cosines together (and the
+    /// angle-difference and Pythagorean identities to apply) without multiplying out
+    /// parameter expressions like `(R − r)²`, which are computed once anyway.
+    pub fn expand_time_varying(&mut self, e: ExprId) -> ExprId {
+        self.expand_as(e, Expansion::TimeVarying)
+    }
+
+    fn expand_as(&mut self, e: ExprId, mode: Expansion) -> ExprId {
+        if mode == Expansion::TimeVarying && !self.contains_time_varying(e) {
+            return e;
+        }
+        let memo = match mode {
+            Expansion::Full => &self.expand_memo,
+            Expansion::TimeVarying => &self.expand_time_varying_memo,
+        };
+        if let Some(&x) = memo.get(&e) {
             return x;
         }
-        let result = match self.node(e).clone() {
+        let result = match self.node(e) {
             Node::Add(terms) => {
-                let t: Vec<ExprId> = terms.iter().map(|&t| self.expand(t)).collect();
+                let terms = terms.to_vec();
+                let t: Vec<ExprId> = terms.iter().map(|&t| self.expand_as(t, mode)).collect();
                 self.sum(&t)
             }
             Node::Mul(factors) => {
-                let expanded: Vec<ExprId> = factors.iter().map(|&f| self.expand(f)).collect();
-                self.multiply_out(&expanded)
+                let factors = factors.to_vec();
+                let expanded: Vec<ExprId> =
+                    factors.iter().map(|&f| self.expand_as(f, mode)).collect();
+                self.multiply_out(&expanded, mode)
             }
-            Node::Pow([b, n]) => match self.as_constant(n).and_then(|c| c.as_integer()) {
+            &Node::Pow([b, n]) => match self.as_constant(n).and_then(|c| c.as_integer()) {
                 Some(k @ 2..=3) => {
-                    let base = self.expand(b);
-                    if matches!(self.node(base), Node::Add(_)) {
-                        self.multiply_out(&vec![base; k as usize])
+                    let base = self.expand_as(b, mode);
+                    if self.is_distributed(base, mode) {
+                        self.multiply_out(&vec![base; k as usize], mode)
                     } else {
                         self.pow(base, n)
                     }
@@ -47,35 +72,63 @@ impl ExprArena {
             },
             _ => e,
         };
-        self.expand_memo.insert(e, result);
+        match mode {
+            Expansion::Full => self.expand_memo.insert(e, result),
+            Expansion::TimeVarying => self.expand_time_varying_memo.insert(e, result),
+        };
         result
     }
 
-    /// Π factors with every sum factor distributed, unless that makes more than
-    /// [`MAX_TERMS`] terms.
-    fn multiply_out(&mut self, factors: &[ExprId]) -> ExprId {
+    /// Whether `e` is a sum that `mode` multiplies out.
+    fn is_distributed(&self, e: ExprId, mode: Expansion) -> bool {
+        matches!(self.node(e), Node::Add(_))
+            && (mode == Expansion::Full || self.contains_time_varying(e))
+    }
+
+    /// Π factors with every sum factor (that `mode` multiplies out) distributed, unless that
+    /// makes more than [`MAX_TERMS`] terms.
+    fn multiply_out(&mut self, factors: &[ExprId], mode: Expansion) -> ExprId {
+        // The factors that are not distributed are common to every term of the result.
+        let mut common: Vec<ExprId> = Vec::with_capacity(factors.len());
+        let mut sums: Vec<Vec<ExprId>> = Vec::new();
         let mut count = 1usize;
         for &f in factors {
-            count = count.saturating_mul(self.terms_of(f).len());
+            match self.node(f) {
+                Node::Add(t) if self.is_distributed(f, mode) => {
+                    count = count.saturating_mul(t.len());
+                    sums.push(t.to_vec());
+                }
+                _ => common.push(f),
+            }
         }
         if count > MAX_TERMS {
             return self.product(factors);
         }
-        let mut partial: Vec<Vec<ExprId>> = vec![Vec::new()];
-        for &f in factors {
-            let terms = self.terms_of(f);
-            let mut next = Vec::with_capacity(partial.len() * terms.len());
-            for p in &partial {
-                for &t in &terms {
-                    let mut q = p.clone();
-                    q.push(t);
-                    next.push(q);
-                }
-            }
-            partial = next;
+        if sums.is_empty() {
+            return self.product(&common);
         }
-        let monomials: Vec<ExprId> = partial.iter().map(|p| self.product(p)).collect();
-        self.sum(&monomials)
+        // One term per choice of a term from each sum (an odometer over the sums).
+        let width = common.len();
+        let mut choice = vec![0usize; sums.len()];
+        let mut monomials: Vec<ExprId> = Vec::with_capacity(count);
+        let mut parts = common;
+        loop {
+            parts.truncate(width);
+            parts.extend(sums.iter().zip(&choice).map(|(terms, &k)| terms[k]));
+            monomials.push(self.product(&parts));
+            let mut digit = 0;
+            loop {
+                if digit == sums.len() {
+                    return self.sum(&monomials);
+                }
+                choice[digit] += 1;
+                if choice[digit] < sums[digit].len() {
+                    break;
+                }
+                choice[digit] = 0;
+                digit += 1;
+            }
+        }
     }
 
     /// The expansion of `e` if it evaluates with fewer operations (as a tree), else `e`.

@@ -15,9 +15,20 @@
 //!   (`cos(-θ) = cos θ`), so `sin θ` and `cos θ` of one angle are each one node and the code
 //!   generator can compute them with one `sin_cos`.
 //!
+//! Besides canonical construction, [`ExprArena::expand`] (and
+//! [`ExprArena::expand_time_varying`]) multiply out, and
+//! [`ExprArena::collect_time_varying`] groups a multiplied-out sum by its time-varying factors
+//! and pulls common factors out (the compact form of the equations of a chain).
+//!
+//! The arena keeps, per node, what the derivations ask about it most often: which symbols it
+//! may contain (so most `∂e/∂x` are known to be zero without a walk), whether it changes in
+//! time, and its operation count as a tree. Hash-cons lookups take a borrowed node, so finding
+//! an existing node allocates nothing.
+//!
 //! Nothing here iterates a `HashMap`: every output order is id order or insertion order, so
 //! the same construction sequence gives byte-identical results.
 
+mod collect;
 mod constant;
 pub mod cse;
 mod diff;
@@ -176,7 +187,7 @@ impl Func {
 }
 
 /// One operation of the DAG.
-#[derive(Debug, Clone, PartialEq, Eq, Hash)]
+#[derive(Debug, Clone, PartialEq, Eq)]
 pub enum Node {
     /// A number.
     Const(Constant),
@@ -205,6 +216,62 @@ impl Node {
             Node::Pow(c) | Node::Atan2(c) => c,
             Node::Func(_, c) => std::slice::from_ref(c),
         }
+    }
+
+    /// The node as a [`NodeRef`] (same hash, same equality).
+    fn as_ref(&self) -> NodeRef<'_> {
+        match self {
+            Node::Const(c) => NodeRef::Const(*c),
+            Node::Pi => NodeRef::Pi,
+            Node::Symbol(s) => NodeRef::Symbol(*s),
+            Node::Add(c) => NodeRef::Add(c),
+            Node::Mul(c) => NodeRef::Mul(c),
+            Node::Pow(c) => NodeRef::Pow(*c),
+            Node::Func(f, u) => NodeRef::Func(*f, *u),
+            Node::Atan2(c) => NodeRef::Atan2(*c),
+        }
+    }
+}
+
+impl std::hash::Hash for Node {
+    fn hash<H: std::hash::Hasher>(&self, state: &mut H) {
+        self.as_ref().hash(state);
+    }
+}
+
+/// A [`Node`] whose children are borrowed, to look nodes up in the hash-cons table without
+/// allocating one.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+enum NodeRef<'a> {
+    Const(Constant),
+    Pi,
+    Symbol(SymbolId),
+    Add(&'a [ExprId]),
+    Mul(&'a [ExprId]),
+    Pow([ExprId; 2]),
+    Func(Func, ExprId),
+    Atan2([ExprId; 2]),
+}
+
+impl NodeRef<'_> {
+    /// An owned copy.
+    fn to_node(self) -> Node {
+        match self {
+            NodeRef::Const(c) => Node::Const(c),
+            NodeRef::Pi => Node::Pi,
+            NodeRef::Symbol(s) => Node::Symbol(s),
+            NodeRef::Add(c) => Node::Add(c.into()),
+            NodeRef::Mul(c) => Node::Mul(c.into()),
+            NodeRef::Pow(c) => Node::Pow(c),
+            NodeRef::Func(f, u) => Node::Func(f, u),
+            NodeRef::Atan2(c) => Node::Atan2(c),
+        }
+    }
+}
+
+impl indexmap::Equivalent<Node> for NodeRef<'_> {
+    fn equivalent(&self, key: &Node) -> bool {
+        *self == key.as_ref()
     }
 }
 
@@ -237,16 +304,27 @@ pub struct Symbol {
 /// Owns every node and symbol; builds canonical, hash-consed expressions.
 #[derive(Debug, Default, Clone)]
 pub struct ExprArena {
-    nodes: Vec<Node>,
-    memo: FxHashMap<Node, ExprId>,
+    /// Every node once; a node's index is its [`ExprId`] (the hash-cons table and the node
+    /// list in one).
+    nodes: indexmap::IndexSet<Node, rustc_hash::FxBuildHasher>,
     symbols: Vec<Symbol>,
     symbol_ids: FxHashMap<String, SymbolId>,
     /// `(q_i, q̇_i, q̈_i)` symbol ids per coordinate, in coordinate order.
     coordinates: Vec<[SymbolId; 3]>,
     time: Option<SymbolId>,
+    /// Per node, a 128-bit summary of the symbols it contains (bit `id mod 128` of each
+    /// symbol): a clear bit proves independence, so [`Self::diff`] and [`Self::depends_on`]
+    /// answer most queries without walking the sub-DAG.
+    symbol_bits: Vec<u128>,
+    /// Per node, whether it contains a time-varying symbol (see [`Self::is_time_varying`]).
+    time_varying: Vec<bool>,
+    /// Per node, its operation count as a tree (saturating), so that
+    /// [`Self::tree_operation_count`] costs one lookup per root.
+    tree_costs: Vec<u64>,
     diff_memo: FxHashMap<(ExprId, SymbolId), ExprId>,
     dt_memo: FxHashMap<ExprId, ExprId>,
     expand_memo: FxHashMap<ExprId, ExprId>,
+    expand_time_varying_memo: FxHashMap<ExprId, ExprId>,
 }
 
 impl ExprArena {
@@ -351,17 +429,46 @@ impl ExprArena {
     /// Callers building arithmetic should use [`Self::sum`], [`Self::product`], [`Self::pow`]
     /// etc., which canonicalise first.
     pub fn add(&mut self, node: Node) -> ExprId {
-        if let Some(&id) = self.memo.get(&node) {
+        let (index, new) = self.nodes.insert_full(node);
+        let id = ExprId(index as u32);
+        if !new {
             return id;
         }
-        let id = ExprId(self.nodes.len() as u32);
+        let node = &self.nodes[index];
         debug_assert!(
             node.children().iter().all(|c| *c < id),
             "children must precede parents"
         );
-        self.nodes.push(node.clone());
-        self.memo.insert(node, id);
+        let (bits, varying, cost) = match *node {
+            Node::Symbol(s) => (symbol_bit(s), self.is_time_varying(s), 0),
+            _ => node.children().iter().fold(
+                (0, false, node_operation_count(node)),
+                |(bits, varying, cost), c| {
+                    (
+                        bits | self.symbol_bits[c.index()],
+                        varying || self.time_varying[c.index()],
+                        cost.saturating_add(self.tree_costs[c.index()]),
+                    )
+                },
+            ),
+        };
+        self.symbol_bits.push(bits);
+        self.time_varying.push(varying);
+        self.tree_costs.push(cost);
         id
+    }
+
+    /// The id of `node` if it is in the arena.
+    fn lookup(&self, node: NodeRef<'_>) -> Option<ExprId> {
+        self.nodes.get_index_of(&node).map(|i| ExprId(i as u32))
+    }
+
+    /// [`Self::add`] of a borrowed node, which allocates only if the node is new.
+    fn add_ref(&mut self, node: NodeRef<'_>) -> ExprId {
+        match self.lookup(node) {
+            Some(id) => id,
+            None => self.add(node.to_node()),
+        }
     }
 
     /// A constant.
@@ -404,60 +511,114 @@ impl ExprArena {
     /// Splits a term into `(coefficient, rest)` with `term = coefficient · rest`; `rest` is
     /// `None` for a pure constant.
     fn split_coefficient(&mut self, term: ExprId) -> (Constant, Option<ExprId>) {
-        match self.node(term).clone() {
-            Node::Const(c) => (c, None),
+        let (c, rest) = match self.node(term) {
+            Node::Const(c) => return (*c, None),
             Node::Mul(factors) => match self.as_constant(factors[0]) {
-                Some(c) => {
-                    let rest = if factors.len() == 2 {
-                        factors[1]
-                    } else {
-                        self.add(Node::Mul(factors[1..].into()))
-                    };
-                    (c, Some(rest))
-                }
-                None => (Constant::ONE, Some(term)),
+                Some(c) if factors.len() == 2 => return (c, Some(factors[1])),
+                Some(c) => match self.lookup(NodeRef::Mul(&factors[1..])) {
+                    Some(rest) => return (c, Some(rest)),
+                    None => (c, Node::Mul(factors[1..].into())),
+                },
+                None => return (Constant::ONE, Some(term)),
             },
-            _ => (Constant::ONE, Some(term)),
+            _ => return (Constant::ONE, Some(term)),
+        };
+        (c, Some(self.add(rest)))
+    }
+
+    /// `c · rest` for a non-constant `rest` without a numeric factor (as
+    /// [`Self::split_coefficient`] returns it): the canonical product, built directly.
+    fn with_coefficient(&mut self, c: Constant, rest: ExprId) -> ExprId {
+        if c.is_one() {
+            return rest;
         }
+        let coefficient = self.constant(c);
+        let factors: Vec<ExprId> = match self.node(rest) {
+            Node::Mul(f) => std::iter::once(coefficient)
+                .chain(f.iter().copied())
+                .collect(),
+            _ => vec![coefficient, rest],
+        };
+        self.add_ref(NodeRef::Mul(&factors))
     }
 
     /// Canonical sum of `terms`.
     pub fn sum(&mut self, terms: &[ExprId]) -> ExprId {
         let mut constant = Constant::ZERO;
-        let mut collected: indexmap::IndexMap<ExprId, Constant> = indexmap::IndexMap::new();
-        let mut stack: Vec<ExprId> = terms.iter().rev().copied().collect();
+        let mut flat: Vec<ExprId> = Vec::with_capacity(terms.len());
+        self.flatten_sum(terms, &mut flat);
+        // (rest, coefficient, the term itself while it is the only one with this rest)
+        let mut merged: Vec<(ExprId, Constant, Option<ExprId>)> = Vec::with_capacity(flat.len());
         let mut float_fallback: Vec<ExprId> = Vec::new();
-        while let Some(term) = stack.pop() {
-            if let Node::Add(inner) = self.node(term) {
-                stack.extend(inner.iter().rev().copied());
-                continue;
-            }
-            let (c, rest) = self.split_coefficient(term);
-            match rest {
-                None => match constant.checked_add(c) {
+        for term in flat {
+            match self.split_coefficient(term) {
+                (c, None) => match constant.checked_add(c) {
                     Some(s) => constant = s,
                     None => float_fallback.push(term),
                 },
-                Some(rest) => {
-                    let entry = collected.entry(rest).or_insert(Constant::ZERO);
-                    match entry.checked_add(c) {
-                        Some(s) => *entry = s,
-                        None => float_fallback.push(term),
-                    }
-                }
+                (c, Some(rest)) => merged.push((rest, c, Some(term))),
             }
         }
-        self.collect_pythagorean(&mut collected, &mut constant);
-        self.collect_angle_differences(&mut collected);
-        let mut operands: Vec<ExprId> = Vec::with_capacity(collected.len() + 1);
-        let mut entries: Vec<(ExprId, Constant)> = collected.into_iter().collect();
-        entries.sort_by_key(|(rest, _)| *rest);
-        for (rest, c) in entries {
+        // Like terms: sorted by rest (stably, so in input order within a rest), then merged.
+        merged.sort_by_key(|(rest, _, _)| *rest);
+        let mut kept = 0;
+        for k in 0..merged.len() {
+            let (rest, c, original) = merged[k];
+            if kept > 0 && merged[kept - 1].0 == rest {
+                let (_, total, o) = &mut merged[kept - 1];
+                match total.checked_add(c) {
+                    Some(s) => {
+                        *total = s;
+                        *o = None;
+                    }
+                    None => float_fallback.extend(original),
+                }
+            } else {
+                merged[kept] = (rest, c, original);
+                kept += 1;
+            }
+        }
+        merged.truncate(kept);
+        let sines = merged
+            .iter()
+            .any(|(rest, _, _)| self.has_sine_square(*rest));
+        let products = merged
+            .iter()
+            .filter(|(rest, _, _)| self.has_two_trig_factors(*rest))
+            .nth(1)
+            .is_some();
+        if sines || products {
+            let mut collected: indexmap::IndexMap<ExprId, Constant> =
+                merged.iter().map(|(rest, c, _)| (*rest, *c)).collect();
+            if sines {
+                self.collect_pythagorean(&mut collected, &mut constant);
+            }
+            if products {
+                self.collect_angle_differences(&mut collected);
+            }
+            let mut entries: Vec<(ExprId, Constant)> = collected.into_iter().collect();
+            entries.sort_by_key(|(rest, _)| *rest);
+            // A term that the identities left alone keeps its node.
+            let original = |rest: ExprId, c: Constant| {
+                merged
+                    .binary_search_by_key(&rest, |(r, _, _)| *r)
+                    .ok()
+                    .and_then(|k| (merged[k].1 == c).then_some(merged[k].2).flatten())
+            };
+            merged = entries
+                .into_iter()
+                .map(|(rest, c)| (rest, c, original(rest, c)))
+                .collect();
+        }
+        let mut operands: Vec<ExprId> = Vec::with_capacity(merged.len() + 1);
+        for (rest, c, original) in merged {
             if c.is_zero() {
                 continue;
             }
-            let coefficient = self.constant(c);
-            operands.push(self.product(&[coefficient, rest]));
+            operands.push(match original {
+                Some(term) => term,
+                None => self.with_coefficient(c, rest),
+            });
         }
         operands.extend(float_fallback);
         operands.sort();
@@ -467,7 +628,7 @@ impl ExprArena {
         match operands.len() {
             0 => self.int(0),
             1 => operands[0],
-            _ => self.add(Node::Add(operands.into())),
+            _ => self.add_ref(NodeRef::Add(&operands)),
         }
     }
 
@@ -512,41 +673,42 @@ impl ExprArena {
         collected: &mut indexmap::IndexMap<ExprId, Constant>,
         constant: &mut Constant,
     ) {
-        loop {
-            let mut found = None;
-            for (&rest, &c) in collected.iter() {
-                if c.is_zero() {
-                    continue;
-                }
-                let Some((u, others)) = self.sine_square_factor(rest) else {
-                    continue;
-                };
-                let Some(&cos) = self.memo.get(&Node::Func(Func::Cos, u)) else {
-                    continue;
-                };
-                let Some(&two) = self.memo.get(&Node::Const(Constant::int(2))) else {
-                    continue;
-                };
-                let Some(&cos2) = self.memo.get(&Node::Pow([cos, two])) else {
-                    continue;
-                };
-                let partner = if others.is_empty() {
-                    Some(cos2)
-                } else {
-                    let mut factors = others.clone();
-                    factors.push(cos2);
-                    factors.sort();
-                    self.memo.get(&Node::Mul(factors.into())).copied()
-                };
-                if let Some(partner) = partner
-                    && collected.get(&partner) == Some(&c)
-                {
-                    found = Some((rest, partner, others, c));
-                    break;
-                }
+        // One pass over the terms with a sin² factor; a term this creates is examined in turn.
+        let mut pending: Vec<ExprId> = collected
+            .keys()
+            .copied()
+            .filter(|&rest| self.has_sine_square(rest))
+            .collect();
+        pending.reverse();
+        while let Some(rest) = pending.pop() {
+            let Some(&c) = collected.get(&rest) else {
+                continue;
+            };
+            if c.is_zero() {
+                continue;
             }
-            let Some((rest, partner, others, c)) = found else {
-                return;
+            let Some((u, others)) = self.sine_square_factor(rest) else {
+                continue;
+            };
+            let Some(cos) = self.lookup(NodeRef::Func(Func::Cos, u)) else {
+                continue;
+            };
+            let Some(two) = self.lookup(NodeRef::Const(Constant::int(2))) else {
+                continue;
+            };
+            let Some(cos2) = self.lookup(NodeRef::Pow([cos, two])) else {
+                continue;
+            };
+            let partner = if others.is_empty() {
+                Some(cos2)
+            } else {
+                let mut factors = others.clone();
+                factors.push(cos2);
+                factors.sort();
+                self.lookup(NodeRef::Mul(&factors))
+            };
+            let Some(partner) = partner.filter(|p| collected.get(p) == Some(&c)) else {
+                continue;
             };
             collected.shift_remove(&rest);
             collected.shift_remove(&partner);
@@ -562,9 +724,43 @@ impl ExprArena {
                     };
                     let entry = collected.entry(x).or_insert(Constant::ZERO);
                     *entry = entry.checked_add(c).unwrap_or(*entry);
+                    if self.has_sine_square(x) {
+                        pending.push(x);
+                    }
                 }
             }
         }
+    }
+
+    /// Whether `rest` is `sin²u` or a product with such a factor (a cheap pre-filter of
+    /// [`Self::sine_square_factor`]).
+    fn has_sine_square(&self, rest: ExprId) -> bool {
+        let is_sin2 = |f: &ExprId| match self.node(*f) {
+            Node::Pow([b, _]) => matches!(self.node(*b), Node::Func(Func::Sin, _)),
+            _ => false,
+        };
+        match self.node(rest) {
+            Node::Mul(factors) => factors.iter().any(is_sin2),
+            _ => is_sin2(&rest),
+        }
+    }
+
+    /// Whether the term `rest` has sine or cosine factors of two different arguments (a
+    /// cheap pre-filter of [`Self::collect_angle_differences`]).
+    fn has_two_trig_factors(&self, rest: ExprId) -> bool {
+        let Node::Mul(factors) = self.node(rest) else {
+            return false;
+        };
+        let mut first: Option<ExprId> = None;
+        for f in factors.iter() {
+            if let Node::Func(Func::Sin | Func::Cos, u) = self.node(*f) {
+                match first {
+                    Some(v) if v != *u => return true,
+                    _ => first = Some(*u),
+                }
+            }
+        }
+        false
     }
 
     /// Angle-difference identities on collected sum terms:
@@ -573,80 +769,21 @@ impl ExprArena {
     /// id so that each difference has one canonical node. Partners are found by hash-cons
     /// lookups only.
     fn collect_angle_differences(&mut self, collected: &mut indexmap::IndexMap<ExprId, Constant>) {
-        loop {
-            let mut found: Option<AngleMatch> = None;
-            'search: for (&rest, &c) in collected.iter() {
-                if c.is_zero() {
-                    continue;
-                }
-                let factors: Vec<ExprId> = match self.node(rest) {
-                    Node::Mul(f) => f.to_vec(),
-                    _ => vec![rest],
-                };
-                let trig: Vec<(usize, Func, ExprId)> = factors
-                    .iter()
-                    .enumerate()
-                    .filter_map(|(i, &f)| match self.node(f) {
-                        Node::Func(func @ (Func::Sin | Func::Cos), u) => Some((i, *func, *u)),
-                        _ => None,
-                    })
-                    .collect();
-                for &(i, fi, u) in &trig {
-                    for &(j, fj, v) in &trig {
-                        if i == j || u == v {
-                            continue;
-                        }
-                        // cos u cos v (u < v) pairs with sin u sin v; sin u cos v with cos u sin v.
-                        let (partner_i, partner_j, sign, result) = match (fi, fj) {
-                            (Func::Cos, Func::Cos) if u < v => {
-                                (Func::Sin, Func::Sin, Constant::ONE, Func::Cos)
-                            }
-                            (Func::Sin, Func::Cos) => {
-                                (Func::Cos, Func::Sin, Constant::MINUS_ONE, Func::Sin)
-                            }
-                            _ => continue,
-                        };
-                        let (Some(&pi), Some(&pj)) = (
-                            self.memo.get(&Node::Func(partner_i, u)),
-                            self.memo.get(&Node::Func(partner_j, v)),
-                        ) else {
-                            continue;
-                        };
-                        let mut others: Vec<ExprId> = factors
-                            .iter()
-                            .enumerate()
-                            .filter(|(k, _)| *k != i && *k != j)
-                            .map(|(_, f)| *f)
-                            .collect();
-                        let mut partner_factors = others.clone();
-                        partner_factors.push(pi);
-                        partner_factors.push(pj);
-                        partner_factors.sort();
-                        let partner = if partner_factors.len() == 1 {
-                            Some(partner_factors[0])
-                        } else {
-                            self.memo.get(&Node::Mul(partner_factors.into())).copied()
-                        };
-                        let Some(partner) = partner else { continue };
-                        let Some(expected) = c.checked_mul(sign) else {
-                            continue;
-                        };
-                        if collected.get(&partner) == Some(&expected) {
-                            others.sort();
-                            found = Some(AngleMatch {
-                                rest,
-                                partner,
-                                others,
-                                c,
-                                result,
-                                u,
-                                v,
-                            });
-                            break 'search;
-                        }
-                    }
-                }
-            }
+        // One pass over the terms with two trigonometric factors; a term this creates is
+        // examined in turn (cos(u − v)·cos w + sin(u − v)·sin w folds again).
+        let mut pending: Vec<ExprId> = collected
+            .keys()
+            .copied()
+            .filter(|&rest| self.has_two_trig_factors(rest))
+            .collect();
+        if pending.len() < 2 {
+            return;
+        }
+        pending.reverse();
+        while let Some(rest) = pending.pop() {
+            let Some(&c) = collected.get(&rest) else {
+                continue;
+            };
             let Some(AngleMatch {
                 rest,
                 partner,
@@ -655,9 +792,9 @@ impl ExprArena {
                 result,
                 u,
                 v,
-            }) = found
+            }) = self.angle_partner(rest, c, collected)
             else {
-                return;
+                continue;
             };
             collected.shift_remove(&rest);
             collected.shift_remove(&partner);
@@ -678,6 +815,9 @@ impl ExprArena {
                 Some(r) => {
                     let entry = collected.entry(r).or_insert(Constant::ZERO);
                     *entry = entry.checked_add(total).unwrap_or(*entry);
+                    if self.has_two_trig_factors(r) {
+                        pending.push(r);
+                    }
                 }
                 None => {
                     // A constant term cannot arise (f is not constant), but keep it safe.
@@ -687,35 +827,114 @@ impl ExprArena {
         }
     }
 
-    /// Canonical product of `factors`.
-    pub fn product(&mut self, factors: &[ExprId]) -> ExprId {
-        let mut coefficient = Constant::ONE;
-        let mut bases: indexmap::IndexMap<ExprId, Vec<ExprId>> = indexmap::IndexMap::new();
-        let mut stack: Vec<ExprId> = factors.iter().rev().copied().collect();
-        while let Some(f) = stack.pop() {
-            match self.node(f).clone() {
-                Node::Mul(inner) => stack.extend(inner.iter().rev().copied()),
-                Node::Const(c) => {
-                    if c.is_zero() {
-                        return self.int(0);
-                    }
-                    coefficient = match coefficient.checked_mul(c) {
-                        Some(p) => p,
-                        None => return self.int(0),
-                    };
+    /// The term of `collected` that combines with `c·rest` by an angle-difference identity
+    /// (see [`Self::collect_angle_differences`]), found by hash-cons lookups only.
+    fn angle_partner(
+        &self,
+        rest: ExprId,
+        c: Constant,
+        collected: &indexmap::IndexMap<ExprId, Constant>,
+    ) -> Option<AngleMatch> {
+        if c.is_zero() {
+            return None;
+        }
+        let Node::Mul(factors) = self.node(rest) else {
+            return None;
+        };
+        let trig: Vec<(usize, Func, ExprId)> = factors
+            .iter()
+            .enumerate()
+            .filter_map(|(i, &f)| match self.node(f) {
+                Node::Func(func @ (Func::Sin | Func::Cos), u) => Some((i, *func, *u)),
+                _ => None,
+            })
+            .collect();
+        for &(i, fi, u) in &trig {
+            for &(j, fj, v) in &trig {
+                if i == j || u == v {
+                    continue;
                 }
-                Node::Pow([b, e]) => bases.entry(b).or_default().push(e),
-                _ => {
-                    let one = self.int(1);
-                    bases.entry(f).or_default().push(one);
+                // cos u cos v (u < v) pairs with sin u sin v; sin u cos v with cos u sin v.
+                let (partner_i, partner_j, sign, result) = match (fi, fj) {
+                    (Func::Cos, Func::Cos) if u < v => {
+                        (Func::Sin, Func::Sin, Constant::ONE, Func::Cos)
+                    }
+                    (Func::Sin, Func::Cos) => {
+                        (Func::Cos, Func::Sin, Constant::MINUS_ONE, Func::Sin)
+                    }
+                    _ => continue,
+                };
+                let (Some(pi), Some(pj)) = (
+                    self.lookup(NodeRef::Func(partner_i, u)),
+                    self.lookup(NodeRef::Func(partner_j, v)),
+                ) else {
+                    continue;
+                };
+                let mut others: Vec<ExprId> = factors
+                    .iter()
+                    .enumerate()
+                    .filter(|(k, _)| *k != i && *k != j)
+                    .map(|(_, f)| *f)
+                    .collect();
+                let mut partner_factors = others.clone();
+                partner_factors.push(pi);
+                partner_factors.push(pj);
+                partner_factors.sort();
+                let Some(partner) = self.lookup(NodeRef::Mul(&partner_factors)) else {
+                    continue;
+                };
+                let Some(expected) = c.checked_mul(sign) else {
+                    continue;
+                };
+                if collected.get(&partner) == Some(&expected) {
+                    others.sort();
+                    return Some(AngleMatch {
+                        rest,
+                        partner,
+                        others,
+                        c,
+                        result,
+                        u,
+                        v,
+                    });
                 }
             }
         }
-        let mut results: Vec<ExprId> = Vec::with_capacity(bases.len());
+        None
+    }
+
+    /// Canonical product of `factors`.
+    pub fn product(&mut self, factors: &[ExprId]) -> ExprId {
+        // (base, exponent (`None` for 1), the factor itself)
+        let mut powers: Vec<(ExprId, Option<ExprId>, ExprId)> =
+            Vec::with_capacity(factors.len() + 2);
+        let Some(mut coefficient) = self.gather_factors(factors, &mut powers) else {
+            return self.int(0);
+        };
+        // Like factors: sorted by base (stably), then merged by adding their exponents.
+        powers.sort_by_key(|(base, _, _)| *base);
+        let mut results: Vec<ExprId> = Vec::with_capacity(powers.len());
         let mut needs_recanonicalisation = false;
-        let mut entries: Vec<(ExprId, Vec<ExprId>)> = bases.into_iter().collect();
-        entries.sort_by_key(|(b, _)| *b);
-        for (base, exponents) in entries {
+        let mut start = 0;
+        while start < powers.len() {
+            let base = powers[start].0;
+            let end = start
+                + powers[start..]
+                    .iter()
+                    .take_while(|(b, _, _)| *b == base)
+                    .count();
+            if end == start + 1 {
+                // A single canonical factor stays as it is.
+                results.push(powers[start].2);
+                start = end;
+                continue;
+            }
+            let one = self.int(1);
+            let exponents: Vec<ExprId> = powers[start..end]
+                .iter()
+                .map(|(_, e, _)| e.unwrap_or(one))
+                .collect();
+            start = end;
             let exponent = self.sum(&exponents);
             let p = self.pow(base, exponent);
             match self.node(p) {
@@ -748,8 +967,40 @@ impl ExprArena {
         match results.len() {
             0 => self.constant(coefficient),
             1 => results[0],
-            _ => self.add(Node::Mul(results.into())),
+            _ => self.add_ref(NodeRef::Mul(&results)),
         }
+    }
+
+    /// `terms` with nested sums flattened into their terms, in order.
+    fn flatten_sum(&self, terms: &[ExprId], out: &mut Vec<ExprId>) {
+        for &t in terms {
+            match self.node(t) {
+                Node::Add(inner) => self.flatten_sum(inner, out),
+                _ => out.push(t),
+            }
+        }
+    }
+
+    /// The factors of `Π factors` as `(base, exponent, factor)` in `powers` (nested products
+    /// flattened), and the product of their numbers; `None` if that is zero.
+    fn gather_factors(
+        &self,
+        factors: &[ExprId],
+        powers: &mut Vec<(ExprId, Option<ExprId>, ExprId)>,
+    ) -> Option<Constant> {
+        let mut coefficient = Constant::ONE;
+        for &f in factors {
+            match self.node(f) {
+                Node::Mul(inner) => {
+                    coefficient = coefficient.checked_mul(self.gather_factors(inner, powers)?)?
+                }
+                Node::Const(c) if c.is_zero() => return None,
+                Node::Const(c) => coefficient = coefficient.checked_mul(*c)?,
+                Node::Pow([b, e]) => powers.push((*b, Some(*e), f)),
+                _ => powers.push((f, None, f)),
+            }
+        }
+        (!coefficient.is_zero()).then_some(coefficient)
     }
 
     /// `a + b`.
@@ -886,10 +1137,24 @@ impl ExprArena {
         self.add(Node::Atan2([y, x]))
     }
 
-    /// Whether `expr` contains the symbol `s` (walks the sub-DAG once).
+    /// Whether `expr` may contain the symbol `s`: `false` proves that it does not (one
+    /// lookup); `true` may be a false positive (another symbol with the same id mod 128).
+    pub(crate) fn may_depend_on(&self, expr: ExprId, s: SymbolId) -> bool {
+        self.symbol_bits[expr.index()] & symbol_bit(s) != 0
+    }
+
+    /// Whether `expr` contains a symbol that changes in time (coordinate, rate, acceleration
+    /// or `t`); one lookup.
+    pub fn contains_time_varying(&self, expr: ExprId) -> bool {
+        self.time_varying[expr.index()]
+    }
+
+    /// Whether `expr` contains the symbol `s` (walks the sub-DAG at most once).
     pub fn depends_on(&self, expr: ExprId, s: SymbolId) -> bool {
-        let target = Node::Symbol(s);
-        let Some(&sid) = self.memo.get(&target) else {
+        if !self.may_depend_on(expr, s) {
+            return false;
+        }
+        let Some(sid) = self.lookup(NodeRef::Symbol(s)) else {
             return false;
         };
         if sid > expr {
@@ -929,20 +1194,9 @@ impl ExprArena {
     /// Number of arithmetic operations to evaluate `roots` as trees (no sharing), saturating:
     /// a sum or product of `k` operands counts `k − 1`, a power or function call 1.
     pub fn tree_operation_count(&self, roots: &[ExprId]) -> u64 {
-        let order = self.reachable(roots);
-        let mut cost: FxHashMap<ExprId, u64> = FxHashMap::default();
-        for &e in &order {
-            let node = self.node(e);
-            let own = node_operation_count(node);
-            let c = node
-                .children()
-                .iter()
-                .fold(own, |acc, ch| acc.saturating_add(cost[ch]));
-            cost.insert(e, c);
-        }
-        roots
-            .iter()
-            .fold(0u64, |acc, r| acc.saturating_add(cost[r]))
+        roots.iter().fold(0u64, |acc, r| {
+            acc.saturating_add(self.tree_costs[r.index()])
+        })
     }
 }
 
@@ -955,6 +1209,11 @@ struct AngleMatch {
     result: Func,
     u: ExprId,
     v: ExprId,
+}
+
+/// The bit of symbol `s` in [`ExprArena`]'s per-node symbol summaries.
+fn symbol_bit(s: SymbolId) -> u128 {
+    1 << (s.0 % 128)
 }
 
 /// Operations a node costs by itself.

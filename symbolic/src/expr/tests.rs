@@ -146,6 +146,75 @@ fn time_derivative_uses_chain_rule() {
     assert_eq!(acc, a.minus(t1, t2));
 }
 
+/// The terms of a chain's `M₂₃`, one per bar below the joint, collect into
+/// `l₂ l₃ (½ m₃ + m₄) cos(θ₂ − θ₃)`, and the negated sum shares the inner sum of masses.
+#[test]
+fn collection_factors_the_mass_below_a_joint() {
+    let mut a = ExprArena::new();
+    let [q2, _, _] = a.coordinate("theta2");
+    let [q3, _, _] = a.coordinate("theta3");
+    let [m3, m4, l2, l3] = ["m3", "m4", "l2", "l3"].map(|p| a.symbol(p, SymbolKind::Parameter));
+    let d = a.minus(q2, q3);
+    let c = a.cos(d);
+    let half = a.constant(Constant::rational(1, 2).unwrap());
+    let t3 = a.product(&[half, m3, l2, l3, c]);
+    let t4 = a.product(&[m4, l2, l3, c]);
+    let e = a.plus(t3, t4);
+    let collected = a.collect_time_varying(e);
+    let h3 = a.times(half, m3);
+    let masses = a.plus(h3, m4);
+    assert_eq!(collected, a.product(&[l2, l3, masses, c]));
+    assert!(a.tree_operation_count(&[collected]) < a.tree_operation_count(&[e]));
+    let ne = a.neg(e);
+    let ne = a.expand_time_varying(ne);
+    let n_collected = a.collect_time_varying(ne);
+    let minus_one = a.int(-1);
+    assert_eq!(n_collected, a.product(&[minus_one, l2, l3, masses, c]));
+}
+
+/// Expansion of the time-varying part only keeps a sum of parameters as one factor:
+/// `((R − r) sin φ)²` → `(R − r)² sin² φ`, not `R² sin² φ − 2 R r sin² φ + r² sin² φ`.
+#[test]
+fn time_varying_expansion_keeps_parameter_sums() {
+    let mut a = ExprArena::new();
+    let [phi, _, _] = a.coordinate("phi");
+    let big = a.symbol("R", SymbolKind::Parameter);
+    let small = a.symbol("r", SymbolKind::Parameter);
+    let arm = a.minus(big, small);
+    let s = a.sin(phi);
+    let c = a.cos(phi);
+    let x = a.times(arm, s);
+    let y = a.times(arm, c);
+    let two = a.int(2);
+    let x2 = a.pow(x, two);
+    let y2 = a.pow(y, two);
+    let v2 = a.plus(x2, y2);
+    // The Pythagorean identity applies to the multiplied-out time-varying part.
+    assert_eq!(a.expand_time_varying(v2), a.pow(arm, two));
+    let full = a.expand(v2);
+    assert!(matches!(a.node(full), Node::Add(_)));
+}
+
+/// The per-node summaries agree with a walk: `depends_on` and `diff` see the same
+/// dependencies, and `tree_operation_count` is the tree count.
+#[test]
+fn node_summaries() {
+    let mut a = ExprArena::new();
+    let [q, qd, _] = a.coordinate("q");
+    let l = a.symbol("l", SymbolKind::Parameter);
+    let s = a.sin(q);
+    let e = a.product(&[l, s, qd]);
+    let ids: Vec<SymbolId> = (0..a.symbols().len() as u32).map(SymbolId).collect();
+    assert!(a.depends_on(e, ids[0]) && a.depends_on(e, ids[1]) && !a.depends_on(e, ids[2]));
+    assert!(a.contains_time_varying(e) && !a.contains_time_varying(l));
+    let d = a.diff(e, ids[2]);
+    assert!(a.is_zero(d));
+    // l·sin(q)·q̇ twice: 2 multiplications and 1 call per tree, plus the sum.
+    let twice = a.plus(e, s);
+    assert_eq!(a.tree_operation_count(&[e]), 3);
+    assert_eq!(a.tree_operation_count(&[twice]), 5);
+}
+
 /// A random expression tree over two symbols, built into an arena.
 #[derive(Debug, Clone)]
 enum Tree {
@@ -318,6 +387,25 @@ proptest! {
         let expanded = a.expand(e);
         let v = a.eval(expanded, &[x, y]);
         prop_assert!((v - direct).abs() <= 1e-6 * (1.0 + direct.abs()), "expanded {v} vs direct {direct}");
+    }
+
+    /// Collection by time-varying factors (after multiplying out) preserves values, with `x`
+    /// a coordinate and `y` a parameter so that both kinds of factor occur.
+    #[test]
+    fn collection_preserves_value(t in tree(), x in -2.0f64..2.0, y in -2.0f64..2.0) {
+        let direct = eval_tree(&t, x, y);
+        prop_assume!(direct.is_finite() && direct.abs() < 1e4);
+        let mut a = ExprArena::new();
+        let [ex, _, _] = a.coordinate("x");
+        let ey = a.symbol("y", SymbolKind::Parameter);
+        let e = build(&mut a, &t, ex, ey);
+        let expanded = a.expand_time_varying(e);
+        let collected = a.collect_time_varying(expanded);
+        let mut bindings = vec![0.0; a.symbols().len()];
+        bindings[0] = x;
+        bindings[3] = y;
+        let v = a.eval(collected, &bindings);
+        prop_assert!((v - direct).abs() <= 1e-6 * (1.0 + direct.abs()), "collected {v} vs direct {direct}");
     }
 
     /// CSE preserves values: evaluating the plan's temporaries then roots (through the text

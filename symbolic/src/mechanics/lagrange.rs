@@ -44,6 +44,10 @@ impl Formulation for Lagrange {
             }
         }
 
+        // F from T multiplied out (v·v as a sum of monomials): its derivatives are sums of
+        // monomials too, in which the terms of F that cancel meet at once.
+        let kinetic = arena.expand_time_varying(kinetic);
+        let momenta: Vec<ExprId> = symbols.iter().map(|s| arena.diff(kinetic, s[1])).collect();
         let mut forcing = Vec::with_capacity(n);
         for i in 0..n {
             let mut terms = Vec::new();
