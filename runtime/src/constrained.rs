@@ -281,10 +281,11 @@ impl ConstraintWorkspace {
 /// Projection onto the constraints failed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[error(
-    "could not satisfy constraint {constraint} (index among the holonomic constraints): residual {residual:e} after {iterations} Newton iteration(s)"
+    "could not satisfy constraint {constraint} (index into the model's constraints): residual {residual:e} after {iterations} Newton iteration(s)"
 )]
 pub struct ProjectionError {
-    /// Index of the constraint with the largest residual.
+    /// Index of the constraint with the largest residual, into
+    /// [`crate::MechanicalSystem::constraint_names`].
     pub constraint: usize,
     /// Its residual.
     pub residual: f64,

@@ -415,33 +415,46 @@ pub trait ModelInfo: OdeSystem {
     /// `Φ` (length `m_h`), `J` (`m × n`), the velocity residuals and `γ` (length `m`) at
     /// `(t, y)`; see [`MechanicalSystem::constraint_jacobian`] and siblings.
     fn constraint_equations(&self, t: f64, y: &[f64]) -> ConstraintValues;
-    /// The initial state made consistent with the constraints (issue 5, item 3): the
+    /// Makes `y = [q; q̇]` (at `t = 0`) consistent with the constraints (issue 5, item 3): the
     /// coordinates marked `{ guess: … }` and their rates are solved by Newton from
-    /// `Φ(q, 0) = 0` and the velocity constraints, the others held. Equal to
-    /// [`Self::initial_state`] for an unconstrained model.
+    /// `Φ(q, 0) = 0` and the velocity constraints, the others held. Without guesses, `y` must
+    /// already satisfy the constraints to 1e-9. Nothing to do without constraints.
     ///
     /// # Errors
-    /// [`ProjectionError`] naming the constraint with the largest residual when Newton does
-    /// not converge, or (without guesses) when the given state violates the constraints by
-    /// more than 1e-9.
-    fn consistent_initial_state(&mut self) -> Result<Vec<f64>, ProjectionError> {
-        let mut y = self.initial_state();
+    /// [`ProjectionError`] naming the constraint with the largest residual: Newton did not
+    /// converge, or (without guesses, `iterations` = 0) the given state violates it.
+    fn make_consistent(&mut self, y: &mut [f64]) -> Result<(), ProjectionError> {
         if self.constraint_names().is_empty() {
-            return Ok(y);
+            return Ok(());
         }
         let guesses = self.initial_guesses();
-        if guesses.is_empty() {
-            let (p, v) = self.constraint_drift(0.0, &y);
-            if p > 1e-9 || v > 1e-9 {
-                return Err(ProjectionError {
-                    constraint: 0,
-                    residual: p.max(v),
-                    iterations: 0,
-                });
-            }
-        } else {
-            self.project(0.0, &mut y, guesses)?;
+        if !guesses.is_empty() {
+            return self.project(0.0, y, guesses).map(|_| ());
         }
+        let c = self.constraint_equations(0.0, y);
+        let worst = c
+            .phi
+            .iter()
+            .map(|v| v.abs())
+            .enumerate()
+            .chain(c.velocity.iter().map(|v| v.abs()).enumerate())
+            .fold((0, 0.0f64), |best, x| if x.1 > best.1 { x } else { best });
+        if worst.1 > 1e-9 || worst.1.is_nan() {
+            return Err(ProjectionError {
+                constraint: worst.0,
+                residual: worst.1,
+                iterations: 0,
+            });
+        }
+        Ok(())
+    }
+    /// [`Self::initial_state`] made consistent by [`Self::make_consistent`].
+    ///
+    /// # Errors
+    /// As [`Self::make_consistent`].
+    fn consistent_initial_state(&mut self) -> Result<Vec<f64>, ProjectionError> {
+        let mut y = self.initial_state();
+        self.make_consistent(&mut y)?;
         Ok(y)
     }
 }

@@ -391,8 +391,10 @@ fn write_csv(
         }
         out.push_str(&format!(",{e:e}"));
         if !constraints.names.is_empty() {
-            for l in &constraints.forces[k] {
-                out.push_str(&format!(",{l:e}"));
+            // A state where λ cannot be solved (singular KKT matrix) leaves empty cells.
+            match &constraints.forces[k] {
+                Some(forces) => forces.iter().for_each(|l| out.push_str(&format!(",{l:e}"))),
+                None => out.push_str(&",".repeat(constraints.names.len())),
             }
             let (p, v) = constraints.drift[k];
             out.push_str(&format!(",{p:e},{v:e}"));
@@ -418,38 +420,30 @@ fn sibling(path: &str, tag: &str) -> String {
 /// # Errors
 /// A failure naming the constraint with the largest residual.
 fn consistent_initial_state(model: &mut dyn ModelInfo, y0: &mut [f64]) -> Result<(), CliError> {
-    let names = model.constraint_names();
-    if names.is_empty() {
-        return Ok(());
-    }
-    let guesses = model.initial_guesses();
-    if guesses.is_empty() {
-        let (p, v) = model.constraint_drift(0.0, y0);
-        if p > 1e-9 || v > 1e-9 {
-            return Err(CliError::failure(format!(
-                "the initial state of `{}` violates its constraints (largest |Φ| = {p:.3e}, largest velocity residual = {v:.3e}); mark the dependent coordinates as `{{ guess: … }}` in `initial:` or fix the values",
-                model.name()
-            )));
-        }
-        return Ok(());
-    }
-    let holonomic = model.holonomic_constraint_count();
-    model.project(0.0, y0, guesses).map_err(|e| {
-        let name = names.get(e.constraint.min(holonomic.saturating_sub(1))).copied().unwrap_or("?");
-        CliError::failure(format!(
-            "no consistent initial state for `{}`: constraint `{name}` keeps a residual of {:.3e} after {} Newton iteration(s) from the guesses; try other guesses",
-            model.name(),
-            e.residual,
-            e.iterations
-        ))
-    })?;
-    Ok(())
+    model.make_consistent(y0).map_err(|e| {
+        let name = model.constraint_names().get(e.constraint).copied().unwrap_or("?");
+        CliError::failure(if model.initial_guesses().is_empty() {
+            format!(
+                "the initial state of `{}` violates its constraints: `{name}` has a residual of {:.3e}; mark the dependent coordinates as `{{ guess: … }}` in `initial:` or fix the values",
+                model.name(),
+                e.residual
+            )
+        } else {
+            format!(
+                "no consistent initial state for `{}`: constraint `{name}` keeps a residual of {:.3e} after {} Newton iteration(s) from the guesses; try other guesses",
+                model.name(),
+                e.residual,
+                e.iterations
+            )
+        })
+    })
 }
 
 /// Constraint forces `λ` and drift at every sample of a constrained model.
 struct ConstraintReport {
     names: Vec<&'static str>,
-    forces: Vec<Vec<f64>>,
+    /// `λ` per sample; `None` where the constrained system is singular (JSON `null`).
+    forces: Vec<Option<Vec<f64>>>,
     drift: Vec<(f64, f64)>,
 }
 
@@ -460,11 +454,7 @@ impl ConstraintReport {
         let mut drift = Vec::new();
         if !names.is_empty() {
             for (t, y) in solution.iter() {
-                forces.push(
-                    model
-                        .constraint_forces(t, y)
-                        .unwrap_or_else(|_| vec![f64::NAN; names.len()]),
-                );
+                forces.push(model.constraint_forces(t, y).ok());
                 drift.push(model.constraint_drift(t, y));
             }
         }
@@ -485,7 +475,7 @@ impl ConstraintReport {
         if self.names.is_empty() {
             return;
         }
-        if let Some(last) = self.forces.last() {
+        if let Some(Some(last)) = self.forces.last() {
             let forces: Vec<String> = self
                 .names
                 .iter()

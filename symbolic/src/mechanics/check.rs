@@ -80,9 +80,10 @@ impl CheckReport {
 }
 
 /// xorshift64: reproducible random states.
-struct Rng(u64);
+pub(crate) struct Rng(pub(crate) u64);
 impl Rng {
-    fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
+    /// The next number, uniform in `[lo, hi)`.
+    pub(crate) fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
         self.0 ^= self.0 << 13;
         self.0 ^= self.0 >> 7;
         self.0 ^= self.0 << 17;
