@@ -15,7 +15,7 @@ use super::driver::{self, Control, Problem};
 use super::error::IntegrationFailure;
 use super::options::{ErrorWeights, IntegratorOptions, OutputTimes};
 use super::solution::Solution;
-use super::stepper::{CheckedRhs, StepFailure, Stepper};
+use super::stepper::{CheckedRhs, StepEnds, StepFailure, Stepper};
 
 /// Number of stages of a step (the twelfth at `c = 1`; `F` at the new state is a thirteenth,
 /// shared with the next step).
@@ -326,18 +326,13 @@ fn weighted_sum<'a>(out: &mut [f64], weights: &[f64], stage: impl Fn(usize) -> &
 #[derive(Debug, Clone)]
 pub(crate) struct Dop853Stepper {
     dim: usize,
-    t: f64,
-    t_prev: f64,
-    t_new: f64,
-    y: Vec<f64>,
-    y_prev: Vec<f64>,
+    /// Ends of the last accepted step and the candidate's time.
+    ends: StepEnds,
     y_new: Vec<f64>,
     /// Stage input, then error terms.
     scratch: Vec<f64>,
     /// `Σ bᵢ kᵢ` of the last attempt.
     increment: Vec<f64>,
-    f: Vec<f64>,
-    f_prev: Vec<f64>,
     /// Stages 1–11 and 13–15, row-major: `14 × dim`.
     k: Vec<f64>,
     /// `h Σ dᵣⱼ kⱼ` for `r = 4 … 7`, row-major `4 × dim`, once prepared.
@@ -350,16 +345,10 @@ impl Dop853Stepper {
     pub(crate) fn new(dim: usize) -> Self {
         Self {
             dim,
-            t: 0.0,
-            t_prev: 0.0,
-            t_new: 0.0,
-            y: vec![0.0; dim],
-            y_prev: vec![0.0; dim],
+            ends: StepEnds::new(dim),
             y_new: vec![0.0; dim],
             scratch: vec![0.0; dim],
             increment: vec![0.0; dim],
-            f: vec![0.0; dim],
-            f_prev: vec![0.0; dim],
             k: vec![0.0; (EXTENDED_STAGES - 2) * dim],
             dense: vec![0.0; 4 * dim],
             dense_ready: false,
@@ -376,18 +365,18 @@ fn k_row(j: usize) -> usize {
 
 impl DenseOutput for Dop853Stepper {
     fn interval(&self) -> (f64, f64) {
-        (self.t_prev, self.t)
+        self.ends.interval()
     }
 
     fn interpolate(&self, t: f64, out: &mut [f64]) {
-        let h = self.t - self.t_prev;
+        let h = self.ends.t - self.ends.t_prev;
         if h == 0.0 {
-            out.copy_from_slice(&self.y);
+            out.copy_from_slice(&self.ends.y);
             return;
         }
         debug_assert!(self.dense_ready, "prepare_dense_output before interpolate");
         let n = self.dim;
-        let theta = (t - self.t_prev) / h;
+        let theta = (t - self.ends.t_prev) / h;
         let theta1 = 1.0 - theta;
         let d = |r: usize, i: usize| self.dense[r * n + i];
         for (i, o) in out.iter_mut().enumerate() {
@@ -396,10 +385,10 @@ impl DenseOutput for Dop853Stepper {
             let correction = d(0, i) + theta * (d(1, i) + theta1 * (d(2, i) + theta * d(3, i)));
             *o = hermite(
                 theta,
-                self.y_prev[i],
-                self.y[i],
-                h * self.f_prev[i],
-                h * self.f[i],
+                self.ends.y_prev[i],
+                self.ends.y[i],
+                h * self.ends.f_prev[i],
+                h * self.ends.f[i],
                 correction,
             );
         }
@@ -408,25 +397,19 @@ impl DenseOutput for Dop853Stepper {
 
 impl Stepper for Dop853Stepper {
     fn t(&self) -> f64 {
-        self.t
+        self.ends.t
     }
 
     fn y(&self) -> &[f64] {
-        &self.y
+        &self.ends.y
     }
 
     fn derivative(&self) -> &[f64] {
-        &self.f
+        &self.ends.f
     }
 
     fn reset(&mut self, rhs: &mut CheckedRhs<'_>, t0: f64, y0: &[f64]) -> Result<(), StepFailure> {
-        self.t = t0;
-        self.t_prev = t0;
-        self.t_new = t0;
-        self.y.copy_from_slice(y0);
-        self.y_prev.copy_from_slice(y0);
-        rhs.eval(t0, y0, &mut self.f)?;
-        self.f_prev.copy_from_slice(&self.f);
+        self.ends.reset(rhs, t0, y0)?;
         self.dense_ready = false;
         Ok(())
     }
@@ -439,13 +422,13 @@ impl Stepper for Dop853Stepper {
         estimate_error: bool,
     ) -> Result<Option<f64>, StepFailure> {
         let n = self.dim;
-        let t = self.t;
+        let t = self.ends.t;
         let h = t_new - t;
-        self.t_new = t_new;
+        self.ends.t_new = t_new;
         self.dense_ready = false;
         for i in 1..STAGES {
             {
-                let (f, k) = (&self.f, &self.k);
+                let (f, k) = (&self.ends.f, &self.k);
                 let stage = |j: usize| {
                     if j == 0 {
                         f.as_slice()
@@ -455,14 +438,14 @@ impl Stepper for Dop853Stepper {
                 };
                 weighted_sum(&mut self.scratch, A[i], stage);
             }
-            for (s, &yi) in self.scratch.iter_mut().zip(&self.y) {
+            for (s, &yi) in self.scratch.iter_mut().zip(&self.ends.y) {
                 *s = yi + h * *s;
             }
             let t_stage = if C[i] == 1.0 { t_new } else { t + C[i] * h };
             let row = k_row(i);
             rhs.eval(t_stage, &self.scratch, &mut self.k[row * n..(row + 1) * n])?;
         }
-        let (f, k) = (&self.f, &self.k);
+        let (f, k) = (&self.ends.f, &self.k);
         let stage = |j: usize| {
             if j == 0 {
                 f.as_slice()
@@ -471,7 +454,7 @@ impl Stepper for Dop853Stepper {
             }
         };
         weighted_sum(&mut self.increment, &B, stage);
-        for ((y_new, &yi), &inc) in self.y_new.iter_mut().zip(&self.y).zip(&self.increment) {
+        for ((y_new, &yi), &inc) in self.y_new.iter_mut().zip(&self.ends.y).zip(&self.increment) {
             *y_new = yi + h * inc;
         }
         if let Some(index) = self.y_new.iter().position(|v| !v.is_finite()) {
@@ -490,7 +473,7 @@ impl Stepper for Dop853Stepper {
         weighted_sum(&mut self.scratch, &ERROR_FIFTH, stage);
         let (mut fifth, mut third) = (0.0, 0.0);
         for i in 0..n {
-            let scale = weights.scale(i, self.y[i].abs().max(self.y_new[i].abs()));
+            let scale = weights.scale(i, self.ends.y[i].abs().max(self.y_new[i].abs()));
             let mut e3 = self.increment[i];
             for &(j, w) in &B_THIRD {
                 e3 -= w * stage(j)[i];
@@ -507,12 +490,12 @@ impl Stepper for Dop853Stepper {
     }
 
     fn accept(&mut self, rhs: &mut CheckedRhs<'_>) -> Result<(), StepFailure> {
-        rhs.eval(self.t_new, &self.y_new, &mut self.f_prev)?;
-        swap(&mut self.f, &mut self.f_prev);
-        swap(&mut self.y_prev, &mut self.y);
-        swap(&mut self.y, &mut self.y_new);
-        self.t_prev = self.t;
-        self.t = self.t_new;
+        rhs.eval(self.ends.t_new, &self.y_new, &mut self.ends.f_prev)?;
+        swap(&mut self.ends.f, &mut self.ends.f_prev);
+        swap(&mut self.ends.y_prev, &mut self.ends.y);
+        swap(&mut self.ends.y, &mut self.y_new);
+        self.ends.t_prev = self.ends.t;
+        self.ends.t = self.ends.t_new;
         self.dense_ready = false;
         Ok(())
     }
@@ -520,14 +503,14 @@ impl Stepper for Dop853Stepper {
     /// The three extra stages of the step (at `c = 0.1, 0.2, 7/9`) and the coefficients
     /// `h Σ dᵣⱼ kⱼ`, as `dop853.f` computes them when dense output is requested.
     fn prepare_dense_output(&mut self, rhs: &mut CheckedRhs<'_>) -> Result<(), StepFailure> {
-        if self.dense_ready || self.t == self.t_prev {
+        if self.dense_ready || self.ends.t == self.ends.t_prev {
             return Ok(());
         }
         let n = self.dim;
-        let h = self.t - self.t_prev;
+        let h = self.ends.t - self.ends.t_prev;
         for i in STAGES + 1..EXTENDED_STAGES {
             {
-                let (f_prev, f, k) = (&self.f_prev, &self.f, &self.k);
+                let (f_prev, f, k) = (&self.ends.f_prev, &self.ends.f, &self.k);
                 let stage = |j: usize| match j {
                     0 => f_prev.as_slice(),
                     STAGES => f.as_slice(),
@@ -535,17 +518,17 @@ impl Stepper for Dop853Stepper {
                 };
                 weighted_sum(&mut self.scratch, A[i], stage);
             }
-            for (s, &yi) in self.scratch.iter_mut().zip(&self.y_prev) {
+            for (s, &yi) in self.scratch.iter_mut().zip(&self.ends.y_prev) {
                 *s = yi + h * *s;
             }
             let row = k_row(i);
             rhs.eval(
-                self.t_prev + C[i] * h,
+                self.ends.t_prev + C[i] * h,
                 &self.scratch,
                 &mut self.k[row * n..(row + 1) * n],
             )?;
         }
-        let (f_prev, f, k) = (&self.f_prev, &self.f, &self.k);
+        let (f_prev, f, k) = (&self.ends.f_prev, &self.ends.f, &self.k);
         let stage = |j: usize| match j {
             0 => f_prev.as_slice(),
             STAGES => f.as_slice(),

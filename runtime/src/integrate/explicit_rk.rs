@@ -5,7 +5,7 @@ use std::mem::swap;
 
 use super::dense_output::{DenseOutput, hermite};
 use super::options::ErrorWeights;
-use super::stepper::{CheckedRhs, StepFailure, Stepper};
+use super::stepper::{CheckedRhs, StepEnds, StepFailure, Stepper};
 use super::tableau::Tableau;
 
 /// An explicit Runge–Kutta method given by its tableau, with all buffers allocated once.
@@ -18,24 +18,12 @@ use super::tableau::Tableau;
 pub(crate) struct ExplicitRk {
     tableau: Tableau,
     dim: usize,
-    /// Current time, start of the next step.
-    t: f64,
-    /// Start of the last accepted step.
-    t_prev: f64,
-    /// End of the last attempted step.
-    t_new: f64,
-    /// Current state.
-    y: Vec<f64>,
-    /// State at `t_prev`.
-    y_prev: Vec<f64>,
+    /// Ends of the last accepted step and the candidate's time.
+    ends: StepEnds,
     /// Candidate state at `t_new`.
     y_new: Vec<f64>,
     /// Stage input, then the error estimate.
     scratch: Vec<f64>,
-    /// `F(t, y)`.
-    f: Vec<f64>,
-    /// `F(t_prev, y_prev)`.
-    f_prev: Vec<f64>,
     /// Stages `1 … s−1`, row-major: `(s − 1) × dim`.
     k: Vec<f64>,
 }
@@ -47,15 +35,9 @@ impl ExplicitRk {
         Self {
             tableau,
             dim,
-            t: 0.0,
-            t_prev: 0.0,
-            t_new: 0.0,
-            y: vec![0.0; dim],
-            y_prev: vec![0.0; dim],
+            ends: StepEnds::new(dim),
             y_new: vec![0.0; dim],
             scratch: vec![0.0; dim],
-            f: vec![0.0; dim],
-            f_prev: vec![0.0; dim],
             k: vec![0.0; stages.saturating_sub(1) * dim],
         }
     }
@@ -96,24 +78,24 @@ fn combine(out: &mut [f64], y: &[f64], h: f64, weights: &[f64], first: &[f64], k
 
 impl DenseOutput for ExplicitRk {
     fn interval(&self) -> (f64, f64) {
-        (self.t_prev, self.t)
+        self.ends.interval()
     }
 
     fn interpolate(&self, t: f64, out: &mut [f64]) {
-        let h = self.t - self.t_prev;
+        let h = self.ends.t - self.ends.t_prev;
         if h == 0.0 {
-            out.copy_from_slice(&self.y);
+            out.copy_from_slice(&self.ends.y);
             return;
         }
-        let theta = (t - self.t_prev) / h;
+        let theta = (t - self.ends.t_prev) / h;
         // `out` first holds Σ dᵢ kᵢ over the stages of the accepted step (stage 0 is
         // f_prev), the quartic correction D = h Σ dᵢ kᵢ divided by h; zero without one.
         match self.tableau.dense_correction() {
-            Some(d) => weighted_sum(out, d, &self.f_prev, &self.k, self.dim),
+            Some(d) => weighted_sum(out, d, &self.ends.f_prev, &self.k, self.dim),
             None => out.fill(0.0),
         }
-        let ends = self.y_prev.iter().zip(&self.y);
-        let slopes = self.f_prev.iter().zip(&self.f);
+        let ends = self.ends.y_prev.iter().zip(&self.ends.y);
+        let slopes = self.ends.f_prev.iter().zip(&self.ends.f);
         for (o, ((&y0, &y1), (&f0, &f1))) in out.iter_mut().zip(ends.zip(slopes)) {
             *o = hermite(theta, y0, y1, h * f0, h * f1, h * *o);
         }
@@ -122,25 +104,19 @@ impl DenseOutput for ExplicitRk {
 
 impl Stepper for ExplicitRk {
     fn t(&self) -> f64 {
-        self.t
+        self.ends.t
     }
 
     fn y(&self) -> &[f64] {
-        &self.y
+        &self.ends.y
     }
 
     fn derivative(&self) -> &[f64] {
-        &self.f
+        &self.ends.f
     }
 
     fn reset(&mut self, rhs: &mut CheckedRhs<'_>, t0: f64, y0: &[f64]) -> Result<(), StepFailure> {
-        self.t = t0;
-        self.t_prev = t0;
-        self.t_new = t0;
-        self.y.copy_from_slice(y0);
-        self.y_prev.copy_from_slice(y0);
-        rhs.eval(t0, y0, &mut self.f)?;
-        self.f_prev.copy_from_slice(&self.f);
+        self.ends.reset(rhs, t0, y0)?;
         Ok(())
     }
 
@@ -154,9 +130,9 @@ impl Stepper for ExplicitRk {
         let tableau = self.tableau;
         let n = self.dim;
         let s = tableau.num_stages();
-        let t = self.t;
+        let t = self.ends.t;
         let h = t_new - t;
-        self.t_new = t_new;
+        self.ends.t_new = t_new;
         for i in 1..s {
             let (earlier, rest) = self.k.split_at_mut((i - 1) * n);
             let ki = &mut rest[..n];
@@ -166,13 +142,20 @@ impl Stepper for ExplicitRk {
             } else {
                 &mut self.scratch
             };
-            combine(input, &self.y, h, tableau.a(i), &self.f, earlier);
+            combine(input, &self.ends.y, h, tableau.a(i), &self.ends.f, earlier);
             let c = tableau.c()[i];
             let t_stage = if c == 1.0 { t_new } else { t + c * h };
             rhs.eval(t_stage, input, ki)?;
         }
         if !tableau.is_fsal() {
-            combine(&mut self.y_new, &self.y, h, tableau.b(), &self.f, &self.k);
+            combine(
+                &mut self.y_new,
+                &self.ends.y,
+                h,
+                tableau.b(),
+                &self.ends.f,
+                &self.k,
+            );
         }
         if let Some(index) = self.y_new.iter().position(|v| !v.is_finite()) {
             return Err(StepFailure::NonFiniteState { t: t_new, index });
@@ -184,11 +167,11 @@ impl Stepper for ExplicitRk {
             return Ok(Some(0.0));
         }
         // Hairer's norm: RMS over i of errᵢ / (atolᵢ + rtolᵢ · max(|yᵢ|, |y_newᵢ|)).
-        weighted_sum(&mut self.scratch, e, &self.f, &self.k, n);
+        weighted_sum(&mut self.scratch, e, &self.ends.f, &self.k, n);
         let mut sum = 0.0;
         for i in 0..n {
             let error = h * self.scratch[i];
-            let scale = weights.scale(i, self.y[i].abs().max(self.y_new[i].abs()));
+            let scale = weights.scale(i, self.ends.y[i].abs().max(self.y_new[i].abs()));
             // A zero error counts as zero even where the scale is zero (rtol only, y = 0);
             // a non-zero error there is infinitely large, and the step is rejected.
             let ratio = if error == 0.0 { 0.0 } else { error / scale };
@@ -203,16 +186,17 @@ impl Stepper for ExplicitRk {
         // F at the candidate goes into f_prev first, whose old content is no longer needed,
         // so that a failure leaves the current state untouched.
         if self.tableau.is_fsal() {
-            self.f_prev
+            self.ends
+                .f_prev
                 .copy_from_slice(&self.k[(s - 2) * n..(s - 1) * n]);
         } else {
-            rhs.eval(self.t_new, &self.y_new, &mut self.f_prev)?;
+            rhs.eval(self.ends.t_new, &self.y_new, &mut self.ends.f_prev)?;
         }
-        swap(&mut self.f, &mut self.f_prev);
-        swap(&mut self.y_prev, &mut self.y);
-        swap(&mut self.y, &mut self.y_new);
-        self.t_prev = self.t;
-        self.t = self.t_new;
+        swap(&mut self.ends.f, &mut self.ends.f_prev);
+        swap(&mut self.ends.y_prev, &mut self.ends.y);
+        swap(&mut self.ends.y, &mut self.y_new);
+        self.ends.t_prev = self.ends.t;
+        self.ends.t = self.ends.t_new;
         Ok(())
     }
 }

@@ -8,13 +8,13 @@ use nalgebra::DMatrix;
 use crate::ode::OdeSystem;
 
 use super::Integrator;
-use super::dense_output::{DenseOutput, hermite};
+use super::dense_output::DenseOutput;
 use super::driver::{self, Control, Problem};
 use super::error::IntegrationFailure;
 use super::linear::{LuFactors, SAME_STEP};
 use super::options::{ErrorWeights, IntegratorOptions, OutputTimes};
 use super::solution::Solution;
-use super::stepper::{CheckedRhs, StepFailure, Stepper};
+use super::stepper::{CheckedRhs, StepEnds, StepFailure, Stepper};
 
 /// Newton stops when the residual of the stage equation, relative to
 /// `max(|yᵢ|, |y_newᵢ|, atolᵢ)`, is below this (default of [`ImplicitMidpoint`]).
@@ -34,14 +34,9 @@ pub(crate) struct MidpointStepper {
     dim: usize,
     newton_tolerance: f64,
     max_iterations: usize,
-    t: f64,
-    t_prev: f64,
-    t_new: f64,
-    y: Vec<f64>,
-    y_prev: Vec<f64>,
+    /// Ends of the last accepted step and the candidate's time.
+    ends: StepEnds,
     y_new: Vec<f64>,
-    f: Vec<f64>,
-    f_prev: Vec<f64>,
     /// The increment `z = y_new − y`.
     z: Vec<f64>,
     /// Newton right-hand side, then update.
@@ -68,14 +63,8 @@ impl MidpointStepper {
             dim,
             newton_tolerance,
             max_iterations,
-            t: 0.0,
-            t_prev: 0.0,
-            t_new: 0.0,
-            y: vec![0.0; dim],
-            y_prev: vec![0.0; dim],
+            ends: StepEnds::new(dim),
             y_new: vec![0.0; dim],
-            f: vec![0.0; dim],
-            f_prev: vec![0.0; dim],
             z: vec![0.0; dim],
             delta: vec![0.0; dim],
             stage: vec![0.0; dim],
@@ -92,9 +81,9 @@ impl MidpointStepper {
     /// Computes `∂F/∂y` at the current state.
     fn update_jacobian(&mut self, rhs: &mut CheckedRhs<'_>) -> Result<(), StepFailure> {
         rhs.jacobian(
-            self.t,
-            &self.y,
-            &self.f,
+            self.ends.t,
+            &self.ends.y,
+            &self.ends.f,
             &mut self.jac,
             &mut self.stage,
             &mut self.k,
@@ -123,7 +112,7 @@ impl MidpointStepper {
         self.lu_h = f64::NAN;
         self.lu
             .factor()
-            .map_err(|_| StepFailure::SingularIterationMatrix { t: self.t })?;
+            .map_err(|_| StepFailure::SingularIterationMatrix { t: self.ends.t })?;
         self.lu_h = h;
         Ok(())
     }
@@ -142,23 +131,23 @@ impl MidpointStepper {
         weights: &ErrorWeights,
     ) -> Result<Result<usize, (usize, f64)>, StepFailure> {
         let n = self.dim;
-        let t_mid = self.t + 0.5 * h;
-        for (z, &f) in self.z.iter_mut().zip(&self.f) {
+        let t_mid = self.ends.t + 0.5 * h;
+        for (z, &f) in self.z.iter_mut().zip(&self.ends.f) {
             *z = h * f;
         }
         let mut previous = f64::NAN;
         for iteration in 1..=self.max_iterations {
             for i in 0..n {
-                self.stage[i] = self.y[i] + 0.5 * self.z[i];
+                self.stage[i] = self.ends.y[i] + 0.5 * self.z[i];
             }
             rhs.eval(t_mid, &self.stage, &mut self.k)?;
             let mut residual: f64 = 0.0;
             for i in 0..n {
                 self.delta[i] = h * self.k[i] - self.z[i];
                 if self.delta[i] != 0.0 {
-                    let scale = self.y[i]
+                    let scale = self.ends.y[i]
                         .abs()
-                        .max((self.y[i] + self.z[i]).abs())
+                        .max((self.ends.y[i] + self.z[i]).abs())
                         .max(weights.atol[i]);
                     residual = residual.max(self.delta[i].abs() / scale);
                 }
@@ -190,52 +179,31 @@ impl MidpointStepper {
 
 impl DenseOutput for MidpointStepper {
     fn interval(&self) -> (f64, f64) {
-        (self.t_prev, self.t)
+        self.ends.interval()
     }
 
     /// The cubic Hermite interpolant of the step's ends and derivatives (order 3, above the
     /// method's 2).
     fn interpolate(&self, t: f64, out: &mut [f64]) {
-        let h = self.t - self.t_prev;
-        if h == 0.0 {
-            out.copy_from_slice(&self.y);
-            return;
-        }
-        let theta = (t - self.t_prev) / h;
-        for (i, o) in out.iter_mut().enumerate() {
-            *o = hermite(
-                theta,
-                self.y_prev[i],
-                self.y[i],
-                h * self.f_prev[i],
-                h * self.f[i],
-                0.0,
-            );
-        }
+        self.ends.hermite(t, out);
     }
 }
 
 impl Stepper for MidpointStepper {
     fn t(&self) -> f64 {
-        self.t
+        self.ends.t
     }
 
     fn y(&self) -> &[f64] {
-        &self.y
+        &self.ends.y
     }
 
     fn derivative(&self) -> &[f64] {
-        &self.f
+        &self.ends.f
     }
 
     fn reset(&mut self, rhs: &mut CheckedRhs<'_>, t0: f64, y0: &[f64]) -> Result<(), StepFailure> {
-        self.t = t0;
-        self.t_prev = t0;
-        self.t_new = t0;
-        self.y.copy_from_slice(y0);
-        self.y_prev.copy_from_slice(y0);
-        rhs.eval(t0, y0, &mut self.f)?;
-        self.f_prev.copy_from_slice(&self.f);
+        self.ends.reset(rhs, t0, y0)?;
         self.jac_valid = false;
         self.jac_current = false;
         self.lu_h = f64::NAN;
@@ -249,8 +217,8 @@ impl Stepper for MidpointStepper {
         weights: &ErrorWeights,
         _estimate_error: bool,
     ) -> Result<Option<f64>, StepFailure> {
-        let h = t_new - self.t;
-        self.t_new = t_new;
+        let h = t_new - self.ends.t;
+        self.ends.t_new = t_new;
         loop {
             if !self.jac_valid || (self.jac_refresh && !self.jac_current) {
                 self.update_jacobian(rhs)?;
@@ -270,7 +238,7 @@ impl Stepper for MidpointStepper {
                 Err(_) if !self.jac_current => self.jac_refresh = true,
                 Err((iterations, residual_norm)) => {
                     return Err(StepFailure::Newton {
-                        t: self.t,
+                        t: self.ends.t,
                         iterations,
                         residual_norm,
                         retry_factor: 0.5,
@@ -279,7 +247,7 @@ impl Stepper for MidpointStepper {
             }
         }
         for i in 0..self.dim {
-            self.y_new[i] = self.y[i] + self.z[i];
+            self.y_new[i] = self.ends.y[i] + self.z[i];
         }
         if let Some(index) = self.y_new.iter().position(|v| !v.is_finite()) {
             return Err(StepFailure::NonFiniteState { t: t_new, index });
@@ -288,12 +256,12 @@ impl Stepper for MidpointStepper {
     }
 
     fn accept(&mut self, rhs: &mut CheckedRhs<'_>) -> Result<(), StepFailure> {
-        rhs.eval(self.t_new, &self.y_new, &mut self.f_prev)?;
-        swap(&mut self.f, &mut self.f_prev);
-        swap(&mut self.y_prev, &mut self.y);
-        swap(&mut self.y, &mut self.y_new);
-        self.t_prev = self.t;
-        self.t = self.t_new;
+        rhs.eval(self.ends.t_new, &self.y_new, &mut self.ends.f_prev)?;
+        swap(&mut self.ends.f, &mut self.ends.f_prev);
+        swap(&mut self.ends.y_prev, &mut self.ends.y);
+        swap(&mut self.ends.y, &mut self.y_new);
+        self.ends.t_prev = self.ends.t;
+        self.ends.t = self.ends.t_new;
         self.jac_current = false;
         Ok(())
     }

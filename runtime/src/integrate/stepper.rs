@@ -9,7 +9,7 @@ use nalgebra::DMatrix;
 
 use crate::ode::{OdeSystem, RhsError};
 
-use super::dense_output::DenseOutput;
+use super::dense_output::{DenseOutput, hermite};
 use super::error::IntegrationError;
 use super::options::ErrorWeights;
 
@@ -389,5 +389,86 @@ mod tests {
             singular.into_error(),
             IntegrationError::SingularMassMatrix { t: 0.5 }
         );
+    }
+}
+
+/// The two ends of the last accepted step `[t_prev, t]` (states and derivatives) and the time
+/// `t_new` of the candidate being attempted: the state every one-step method keeps, with its
+/// start, and the cubic Hermite interpolant that most of them use as dense output.
+#[derive(Debug, Clone)]
+pub(crate) struct StepEnds {
+    /// Current time (end of the last accepted step).
+    pub(crate) t: f64,
+    /// Start of the last accepted step.
+    pub(crate) t_prev: f64,
+    /// End of the candidate step.
+    pub(crate) t_new: f64,
+    /// Current state.
+    pub(crate) y: Vec<f64>,
+    /// State at `t_prev`.
+    pub(crate) y_prev: Vec<f64>,
+    /// `F(t, y)`.
+    pub(crate) f: Vec<f64>,
+    /// `F(t_prev, y_prev)`.
+    pub(crate) f_prev: Vec<f64>,
+}
+
+impl StepEnds {
+    /// Buffers for a system of dimension `dim`.
+    pub(crate) fn new(dim: usize) -> Self {
+        Self {
+            t: 0.0,
+            t_prev: 0.0,
+            t_new: 0.0,
+            y: vec![0.0; dim],
+            y_prev: vec![0.0; dim],
+            f: vec![0.0; dim],
+            f_prev: vec![0.0; dim],
+        }
+    }
+
+    /// Starts at `(t0, y0)`: both ends there, `F(t0, y0)` evaluated.
+    ///
+    /// # Errors
+    /// The failure of that evaluation.
+    pub(crate) fn reset(
+        &mut self,
+        rhs: &mut CheckedRhs<'_>,
+        t0: f64,
+        y0: &[f64],
+    ) -> Result<(), StepFailure> {
+        self.t = t0;
+        self.t_prev = t0;
+        self.t_new = t0;
+        self.y.copy_from_slice(y0);
+        self.y_prev.copy_from_slice(y0);
+        rhs.eval(t0, y0, &mut self.f)?;
+        self.f_prev.copy_from_slice(&self.f);
+        Ok(())
+    }
+
+    /// The last accepted step `(t_prev, t)`.
+    pub(crate) fn interval(&self) -> (f64, f64) {
+        (self.t_prev, self.t)
+    }
+
+    /// The cubic Hermite interpolant of the step's ends and derivatives at `t` (order 3).
+    pub(crate) fn hermite(&self, t: f64, out: &mut [f64]) {
+        let h = self.t - self.t_prev;
+        if h == 0.0 {
+            out.copy_from_slice(&self.y);
+            return;
+        }
+        let theta = (t - self.t_prev) / h;
+        for (i, o) in out.iter_mut().enumerate() {
+            *o = hermite(
+                theta,
+                self.y_prev[i],
+                self.y[i],
+                h * self.f_prev[i],
+                h * self.f[i],
+                0.0,
+            );
+        }
     }
 }

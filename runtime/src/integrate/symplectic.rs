@@ -15,12 +15,12 @@ use std::mem::swap;
 use crate::ode::OdeSystem;
 
 use super::Integrator;
-use super::dense_output::{DenseOutput, hermite};
+use super::dense_output::DenseOutput;
 use super::driver::{self, Control, Problem};
 use super::error::{IntegrationError, IntegrationFailure};
 use super::options::{ErrorWeights, IntegratorOptions, OutputTimes};
 use super::solution::Solution;
-use super::stepper::{CheckedRhs, StepFailure, Stepper, SystemShape};
+use super::stepper::{CheckedRhs, StepEnds, StepFailure, Stepper, SystemShape};
 
 /// Which partitioned scheme a [`Partitioned`] stepper takes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -40,14 +40,9 @@ pub(crate) enum Scheme {
 pub(crate) struct Partitioned {
     scheme: Scheme,
     n: usize,
-    t: f64,
-    t_prev: f64,
-    t_new: f64,
-    y: Vec<f64>,
-    y_prev: Vec<f64>,
+    /// Ends of the last accepted step and the candidate's time.
+    ends: StepEnds,
     y_new: Vec<f64>,
-    f: Vec<f64>,
-    f_prev: Vec<f64>,
     f_new: Vec<f64>,
     /// Stage input `[q₁; ṽ]` (Störmer–Verlet).
     stage: Vec<f64>,
@@ -69,14 +64,8 @@ impl Partitioned {
         Ok(Self {
             scheme,
             n,
-            t: 0.0,
-            t_prev: 0.0,
-            t_new: 0.0,
-            y: vec![0.0; dim],
-            y_prev: vec![0.0; dim],
+            ends: StepEnds::new(dim),
             y_new: vec![0.0; dim],
-            f: vec![0.0; dim],
-            f_prev: vec![0.0; dim],
             f_new: vec![0.0; dim],
             stage: vec![0.0; dim],
         })
@@ -85,52 +74,31 @@ impl Partitioned {
 
 impl DenseOutput for Partitioned {
     fn interval(&self) -> (f64, f64) {
-        (self.t_prev, self.t)
+        self.ends.interval()
     }
 
     /// The cubic Hermite interpolant of the step's ends `(y, [v; a])`, accurate to `O(h³)`
     /// (`O(h⁴)` where the accelerations are exact), at least the order of the methods.
     fn interpolate(&self, t: f64, out: &mut [f64]) {
-        let h = self.t - self.t_prev;
-        if h == 0.0 {
-            out.copy_from_slice(&self.y);
-            return;
-        }
-        let theta = (t - self.t_prev) / h;
-        for (i, o) in out.iter_mut().enumerate() {
-            *o = hermite(
-                theta,
-                self.y_prev[i],
-                self.y[i],
-                h * self.f_prev[i],
-                h * self.f[i],
-                0.0,
-            );
-        }
+        self.ends.hermite(t, out);
     }
 }
 
 impl Stepper for Partitioned {
     fn t(&self) -> f64 {
-        self.t
+        self.ends.t
     }
 
     fn y(&self) -> &[f64] {
-        &self.y
+        &self.ends.y
     }
 
     fn derivative(&self) -> &[f64] {
-        &self.f
+        &self.ends.f
     }
 
     fn reset(&mut self, rhs: &mut CheckedRhs<'_>, t0: f64, y0: &[f64]) -> Result<(), StepFailure> {
-        self.t = t0;
-        self.t_prev = t0;
-        self.t_new = t0;
-        self.y.copy_from_slice(y0);
-        self.y_prev.copy_from_slice(y0);
-        rhs.eval(t0, y0, &mut self.f)?;
-        self.f_prev.copy_from_slice(&self.f);
+        self.ends.reset(rhs, t0, y0)?;
         Ok(())
     }
 
@@ -142,10 +110,10 @@ impl Stepper for Partitioned {
         _estimate_error: bool,
     ) -> Result<Option<f64>, StepFailure> {
         let n = self.n;
-        let h = t_new - self.t;
-        self.t_new = t_new;
-        let (q, v) = self.y.split_at(n);
-        let a = &self.f[n..];
+        let h = t_new - self.ends.t;
+        self.ends.t_new = t_new;
+        let (q, v) = self.ends.y.split_at(n);
+        let a = &self.ends.f[n..];
         let (q_new, v_new) = self.y_new.split_at_mut(n);
         match self.scheme {
             Scheme::SymplecticEuler => {
@@ -181,14 +149,14 @@ impl Stepper for Partitioned {
 
     fn accept(&mut self, rhs: &mut CheckedRhs<'_>) -> Result<(), StepFailure> {
         if self.scheme == Scheme::SymplecticEuler {
-            rhs.eval(self.t_new, &self.y_new, &mut self.f_new)?;
+            rhs.eval(self.ends.t_new, &self.y_new, &mut self.f_new)?;
         }
-        swap(&mut self.f_prev, &mut self.f);
-        swap(&mut self.f, &mut self.f_new);
-        swap(&mut self.y_prev, &mut self.y);
-        swap(&mut self.y, &mut self.y_new);
-        self.t_prev = self.t;
-        self.t = self.t_new;
+        swap(&mut self.ends.f_prev, &mut self.ends.f);
+        swap(&mut self.ends.f, &mut self.f_new);
+        swap(&mut self.ends.y_prev, &mut self.ends.y);
+        swap(&mut self.ends.y, &mut self.y_new);
+        self.ends.t_prev = self.ends.t;
+        self.ends.t = self.ends.t_new;
         Ok(())
     }
 }
