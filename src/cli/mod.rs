@@ -3,9 +3,12 @@
 mod check;
 mod equations;
 mod plot;
+mod roundoff;
 mod simulate;
+mod stability;
 mod study;
 mod values;
+mod work_precision;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -35,7 +38,8 @@ enum Command {
     Equations(equations::EquationsArgs),
     /// Print a generated model file: `n-link-pendulum N` or `n-mass-chain N`.
     New(equations::NewArgs),
-    /// Numerical experiments comparing methods (`constraint-methods MODEL`).
+    /// Numerical experiments comparing methods: `constraint-methods MODEL`,
+    /// `work-precision MODEL`, `stability`, `euler-roundoff`.
     #[command(subcommand)]
     Study(study::Study),
 }

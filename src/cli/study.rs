@@ -23,6 +23,16 @@ pub enum Study {
     /// minimal coordinates: accuracy of the point positions, constraint drift, RHS
     /// evaluations and time, as a table, JSON and a chart.
     ConstraintMethods(ConstraintMethodsArgs),
+    /// Error against work for every integration method on a model: error of the state at
+    /// the output times against a verified reference, RHS evaluations, wall time and energy
+    /// drift, per tolerance (or step size); a table, JSON and log–log charts.
+    WorkPrecision(super::work_precision::WorkPrecisionArgs),
+    /// Where each method fails: stability limits on the oscillator against theory, energy
+    /// growth over 10⁴ periods, a stiff two-mass spring, step-size underflow.
+    Stability(super::stability::StabilityArgs),
+    /// HW1: explicit Euler on ẋ = x with h = 10⁻ⁿ, truncation against roundoff error and
+    /// the optimal n.
+    EulerRoundoff(super::roundoff::EulerRoundoffArgs),
 }
 
 /// Options of `eomgen study constraint-methods`.
@@ -51,6 +61,9 @@ pub struct ConstraintMethodsArgs {
 pub fn run(study: &Study) -> Result<(), CliError> {
     match study {
         Study::ConstraintMethods(args) => constraint_methods(args),
+        Study::WorkPrecision(args) => super::work_precision::run(args),
+        Study::Stability(args) => super::stability::run(args),
+        Study::EulerRoundoff(args) => super::roundoff::run(args),
     }
 }
 
