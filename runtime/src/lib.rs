@@ -12,10 +12,11 @@ pub mod system;
 
 pub use constrained::{ConstraintWorkspace, ProjectionError, Stabilization};
 pub use integrate::{
-    BogackiShampine32, DormandPrince54, DormandPrince853, ExplicitEuler, ExplicitMidpoint,
-    ImplicitMidpoint, IntegrationError, IntegrationFailure, Integrator, IntegratorOptions,
-    OutputTimes, PiController, PredictiveController, RadauIIA5, RungeKutta4, Solution, Stats,
-    StepOutcome, StepSizeController, StormerVerlet, SymplecticEuler, Tableau, Tolerance,
+    BogackiShampine32, DormandPrince54, DormandPrince853, Event, EventDirection, EventSpec,
+    ExplicitEuler, ExplicitMidpoint, ImplicitMidpoint, IntegrationError, IntegrationFailure,
+    Integrator, IntegratorOptions, OutputTimes, PiController, PredictiveController, RadauIIA5,
+    RungeKutta4, Solution, Stats, StepOutcome, StepSizeController, StormerVerlet, SymplecticEuler,
+    Tableau, Tolerance,
 };
-pub use ode::{OdeFn, OdeSystem, RhsError};
+pub use ode::{OdeFn, OdeSystem, RhsError, WithEvents};
 pub use system::{ConstraintValues, FirstOrder, MechanicalSystem, ModelInfo, UnknownParameter};

@@ -1,5 +1,7 @@
 //! First-order ordinary differential equations `ẏ = F(t, y)`, the form every integrator takes.
 
+use crate::integrate::EventSpec;
+
 /// Why a right-hand side could not be evaluated at a state.
 ///
 /// The integrator wraps this into an [`crate::IntegrationError`] that also carries `t`.
@@ -23,6 +25,12 @@ pub enum RhsError {
     ProjectionFailed {
         /// The largest constraint residual left.
         residual: f64,
+    },
+    /// Event function `index` ([`OdeSystem::event_values`]) is NaN.
+    #[error("event function {index} is NaN")]
+    EventNotFinite {
+        /// Index of the event function.
+        index: usize,
     },
     /// The right-hand side (or its Jacobian) produced NaN or ±∞ in component `index`.
     #[error("the right-hand side is not finite in component {index}")]
@@ -97,6 +105,25 @@ pub trait OdeSystem {
         let _ = (t, y);
         Ok(false)
     }
+
+    /// The event functions `gᵢ(t, y)` whose zeros every integrator locates, with their names,
+    /// directions and whether they stop the integration ([`Solution::events`](crate::Solution::events));
+    /// none by default.
+    fn event_specs(&self) -> &[EventSpec] {
+        &[]
+    }
+
+    /// Evaluates the event functions at `(t, y)` into `g` (one entry per
+    /// [`event_specs`](Self::event_specs) entry). Called once per accepted step and during
+    /// root finding, at states of the method's dense output.
+    ///
+    /// # Errors
+    /// [`RhsError`] when they cannot be evaluated (a model event that needs `q̈` or the
+    /// constraint forces at a state where `M` is singular).
+    fn event_values(&mut self, t: f64, y: &[f64], g: &mut [f64]) -> Result<(), RhsError> {
+        let _ = (t, y, g);
+        Ok(())
+    }
 }
 
 /// A closure `|t, y, dy| { … }` is an [`OdeSystem`] of a given dimension.
@@ -156,5 +183,100 @@ impl<F: FnMut(f64, &[f64], &mut [f64])> OdeSystem for OdeFn<F> {
 
     fn second_order_dim(&self) -> Option<usize> {
         self.second_order_dim
+    }
+}
+
+/// A system with event functions added to its own: `g` writes the added functions' values
+/// and may read the system (for a model: `q̈` or the constraint forces).
+///
+/// The added events come after the system's own ([`OdeSystem::event_specs`]); everything
+/// else is the system's.
+///
+/// # Examples
+/// ```
+/// use eomgen_runtime::{
+///     DormandPrince853, EventDirection, EventSpec, Integrator, IntegratorOptions, OdeFn,
+///     OutputTimes, WithEvents,
+/// };
+///
+/// // A ball thrown up at 10 m/s under g = 10 m/s², stopped when it lands: t = 2 s.
+/// let mut ball = OdeFn::second_order(1, |_t: f64, y: &[f64], dy: &mut [f64]| {
+///     dy[0] = y[1];
+///     dy[1] = -10.0;
+/// });
+/// let landing = EventSpec::new("landing", EventDirection::Falling, true);
+/// let mut system = WithEvents::new(&mut ball, vec![landing], |_ball: &mut OdeFn<_>, _t, y: &[f64], g: &mut [f64]| {
+///     g[0] = y[0];
+///     Ok(())
+/// });
+/// let solution = DormandPrince853::new().integrate(
+///     &mut system, 0.0, &[0.0, 10.0], 5.0, &OutputTimes::Steps, &IntegratorOptions::default(),
+/// )?;
+/// let landed = &solution.events[0];
+/// assert!((landed.t - 2.0).abs() < 1e-12);
+/// assert_eq!(solution.terminated_by_event, Some(0));
+/// assert_eq!(solution.last().map(|(t, _)| t), Some(landed.t));
+/// # Ok::<(), eomgen_runtime::IntegrationFailure>(())
+/// ```
+pub struct WithEvents<'a, S: ?Sized, G> {
+    system: &'a mut S,
+    specs: Vec<EventSpec>,
+    own: usize,
+    g: G,
+}
+
+impl<'a, S, G> WithEvents<'a, S, G>
+where
+    S: OdeSystem + ?Sized,
+    G: FnMut(&mut S, f64, &[f64], &mut [f64]) -> Result<(), RhsError>,
+{
+    /// `system` with the events `added`, whose values `g(system, t, y, out)` writes into
+    /// `out` (one entry per added spec).
+    pub fn new(system: &'a mut S, added: Vec<EventSpec>, g: G) -> Self {
+        let mut specs = system.event_specs().to_vec();
+        let own = specs.len();
+        specs.extend(added);
+        Self {
+            system,
+            specs,
+            own,
+            g,
+        }
+    }
+}
+
+impl<S, G> OdeSystem for WithEvents<'_, S, G>
+where
+    S: OdeSystem + ?Sized,
+    G: FnMut(&mut S, f64, &[f64], &mut [f64]) -> Result<(), RhsError>,
+{
+    fn dim(&self) -> usize {
+        self.system.dim()
+    }
+
+    fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), RhsError> {
+        self.system.rhs(t, y, dy)
+    }
+
+    fn jacobian(&mut self, t: f64, y: &[f64], jac: &mut [f64]) -> Result<bool, RhsError> {
+        self.system.jacobian(t, y, jac)
+    }
+
+    fn second_order_dim(&self) -> Option<usize> {
+        self.system.second_order_dim()
+    }
+
+    fn after_step(&mut self, t: f64, y: &mut [f64]) -> Result<bool, RhsError> {
+        self.system.after_step(t, y)
+    }
+
+    fn event_specs(&self) -> &[EventSpec] {
+        &self.specs
+    }
+
+    fn event_values(&mut self, t: f64, y: &[f64], g: &mut [f64]) -> Result<(), RhsError> {
+        let (own, added) = g.split_at_mut(self.own.min(g.len()));
+        self.system.event_values(t, y, own)?;
+        (self.g)(self.system, t, y, added)
     }
 }

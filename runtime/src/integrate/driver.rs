@@ -7,6 +7,7 @@ use crate::ode::OdeSystem;
 
 use super::controller::{StepOutcome, StepSizeController};
 use super::error::{IntegrationError, IntegrationFailure};
+use super::events::EventTracker;
 use super::options::{
     ErrorWeights, IntegratorOptions, OutputTimes, check_initial_state, check_output_times,
     check_step_sizes, check_time_span, check_tolerances,
@@ -79,6 +80,7 @@ pub(crate) fn run<S: Stepper>(
     solution.stats.rhs_evals = rhs.evals();
     solution.stats.jacobian_evals = rhs.jacobian_evals();
     solution.stats.lu_decompositions = rhs.lu_decompositions();
+    solution.stats.event_evals = rhs.event_evals();
     solution.stats.wall_time_s = start.elapsed().as_secs_f64();
     match result {
         Ok(()) => Ok(solution),
@@ -116,6 +118,16 @@ fn integrate_into<S: Stepper>(
         .reset(rhs, problem.t0, problem.y0)
         .map_err(StepFailure::into_error)?;
     let mut recorder = Recorder::new(problem.output);
+    let mut events = EventTracker::new(rhs, dim);
+    if let Some(events) = events.as_mut() {
+        events
+            .start(rhs, problem.t0, problem.y0)
+            .map_err(StepFailure::into_error)?;
+    }
+    let mut finish = Finish {
+        recorder: &mut recorder,
+        events: events.as_mut(),
+    };
     match control {
         Control::Fixed => {
             let dt = fixed_step(problem);
@@ -124,14 +136,14 @@ fn integrate_into<S: Stepper>(
                 // Float-to-int `as` saturates (and maps NaN to 0); the reservation is a hint.
                 solution.reserve((steps as usize).min(MAX_RESERVED_SAMPLES) + 1);
             }
-            recorder.start(solution, problem.t0, problem.y0);
+            finish.recorder.start(solution, problem.t0, problem.y0);
             fixed_steps(
                 problem,
                 dt,
                 &weights,
                 rhs,
                 &mut stepper,
-                &mut recorder,
+                &mut finish,
                 solution,
             )
         }
@@ -142,20 +154,13 @@ fn integrate_into<S: Stepper>(
             if let OutputTimes::Steps = problem.output {
                 solution.reserve(ADAPTIVE_RESERVED_SAMPLES);
             }
-            recorder.start(solution, problem.t0, problem.y0);
+            finish.recorder.start(solution, problem.t0, problem.y0);
             let adaptive = Adaptive {
                 weights: &weights,
                 controller,
                 error_order,
             };
-            adaptive_steps(
-                problem,
-                adaptive,
-                rhs,
-                &mut stepper,
-                &mut recorder,
-                solution,
-            )
+            adaptive_steps(problem, adaptive, rhs, &mut stepper, &mut finish, solution)
         }
     }
 }
@@ -175,7 +180,7 @@ fn fixed_steps<S: Stepper>(
     weights: &ErrorWeights,
     rhs: &mut CheckedRhs<'_>,
     stepper: &mut S,
-    recorder: &mut Recorder<'_>,
+    finish: &mut Finish<'_, '_>,
     solution: &mut Solution,
 ) -> Result<(), IntegrationError> {
     let (t0, t_end) = (problem.t0, problem.t_end);
@@ -205,12 +210,12 @@ fn fixed_steps<S: Stepper>(
             .map_err(StepFailure::into_error)?;
         stepper.accept(rhs).map_err(StepFailure::into_error)?;
         solution.stats.steps += 1;
-        let first_sample = solution.t.len();
-        recorder
-            .record_step(solution, stepper, rhs)
-            .map_err(StepFailure::into_error)?;
-        after_step(rhs, stepper, &mut corrected, solution, first_sample)
-            .map_err(StepFailure::into_error)?;
+        if finish
+            .step(rhs, stepper, &mut corrected, solution)
+            .map_err(StepFailure::into_error)?
+        {
+            return Ok(());
+        }
     }
     Ok(())
 }
@@ -235,7 +240,7 @@ fn adaptive_steps<S: Stepper>(
     adaptive: Adaptive<'_, '_>,
     rhs: &mut CheckedRhs<'_>,
     stepper: &mut S,
-    recorder: &mut Recorder<'_>,
+    finish: &mut Finish<'_, '_>,
     solution: &mut Solution,
 ) -> Result<(), IntegrationError> {
     let Adaptive {
@@ -293,12 +298,12 @@ fn adaptive_steps<S: Stepper>(
             StepOutcome::Accepted { dt_next } if usable => {
                 stepper.accept(rhs).map_err(StepFailure::into_error)?;
                 solution.stats.steps += 1;
-                let first_sample = solution.t.len();
-                recorder
-                    .record_step(solution, stepper, rhs)
-                    .map_err(StepFailure::into_error)?;
-                after_step(rhs, stepper, &mut corrected, solution, first_sample)
-                    .map_err(StepFailure::into_error)?;
+                if finish
+                    .step(rhs, stepper, &mut corrected, solution)
+                    .map_err(StepFailure::into_error)?
+                {
+                    return Ok(());
+                }
                 dt = dt_next.min(dt_max);
             }
             StepOutcome::Accepted { .. } => {
@@ -394,6 +399,49 @@ fn initial_step<S: Stepper>(
     (100.0 * h0).min(h1).min(dt_max).max(dt_min)
 }
 
+/// What happens after every accepted step: events are looked for, the samples recorded and
+/// the state corrected ([`OdeSystem::after_step`]).
+struct Finish<'r, 'e> {
+    recorder: &'r mut Recorder<'r>,
+    events: Option<&'e mut EventTracker>,
+}
+
+impl Finish<'_, '_> {
+    /// Handles the step the stepper has just accepted; returns whether a terminal event ended
+    /// the integration (its samples then end at the event).
+    fn step<S: Stepper>(
+        &mut self,
+        rhs: &mut CheckedRhs<'_>,
+        stepper: &mut S,
+        corrected: &mut [f64],
+        solution: &mut Solution,
+    ) -> Result<bool, StepFailure> {
+        let stop_at = match self.events.as_deref_mut() {
+            Some(events) => events.check_step(rhs, stepper, solution)?,
+            None => None,
+        };
+        let first_sample = solution.t.len();
+        match stop_at {
+            Some(t_event) => {
+                self.recorder
+                    .record_until(solution, stepper, rhs, t_event)?;
+                project_samples(rhs, corrected, solution, first_sample)?;
+                Ok(true)
+            }
+            None => {
+                self.recorder.record_step(solution, stepper, rhs)?;
+                project_samples(rhs, corrected, solution, first_sample)?;
+                if correct_state(rhs, stepper, corrected)?
+                    && let Some(events) = self.events.as_deref_mut()
+                {
+                    events.start(rhs, stepper.t(), stepper.y())?;
+                }
+                Ok(false)
+            }
+        }
+    }
+}
+
 /// Records the samples [`OutputTimes`] asks for, as the steps go by.
 struct Recorder<'a> {
     /// The requested times, or `None` to record every step.
@@ -460,16 +508,49 @@ impl<'a> Recorder<'a> {
         }
         Ok(())
     }
+
+    /// Records after the step in which a terminal event at `t_event` ended the integration:
+    /// the requested times up to `t_event` by dense output, or (recording every step) the
+    /// event's state as the last sample.
+    ///
+    /// # Errors
+    /// The failure of an evaluation that completes the dense output.
+    fn record_until<S: Stepper>(
+        &mut self,
+        solution: &mut Solution,
+        stepper: &mut S,
+        rhs: &mut CheckedRhs<'_>,
+        t_event: f64,
+    ) -> Result<(), StepFailure> {
+        let (t_step, t_end) = (stepper.t(), t_event);
+        let sample = |t: f64, out: &mut [f64], stepper: &S| {
+            if t == t_step {
+                out.copy_from_slice(stepper.y());
+            } else {
+                stepper.interpolate(t, out);
+            }
+        };
+        stepper.prepare_dense_output(rhs)?;
+        match self.times {
+            None => solution.push_with(t_end, |out| sample(t_end, out, stepper)),
+            Some(times) => {
+                while self.next < times.len() && times[self.next] <= t_end {
+                    let t_out = times[self.next];
+                    solution.push_with(t_out, |out| sample(t_out, out, stepper));
+                    self.next += 1;
+                }
+            }
+        }
+        Ok(())
+    }
 }
 
-/// Lets the system correct the state after an accepted step ([`OdeSystem::after_step`]:
-/// projection onto a constrained system's manifold) and, if it did, restarts the stepper
-/// there. The samples recorded during the step (from `first_sample` on, interpolated before
-/// the correction) get the same correction, so the output satisfies what the state does.
-/// `corrected` is a `dim`-entry scratch buffer.
-fn after_step<S: Stepper>(
+/// Gives the samples recorded during a step (from `first_sample` on, interpolated before any
+/// correction of the state) the system's correction after a step ([`OdeSystem::after_step`]:
+/// projection onto a constrained system's manifold), so the output satisfies what the state
+/// does. `corrected` is a `dim`-entry scratch buffer.
+fn project_samples(
     rhs: &mut CheckedRhs<'_>,
-    stepper: &mut S,
     corrected: &mut [f64],
     solution: &mut Solution,
     first_sample: usize,
@@ -482,12 +563,23 @@ fn after_step<S: Stepper>(
             row.copy_from_slice(corrected);
         }
     }
+    Ok(())
+}
+
+/// Lets the system correct the state after an accepted step ([`OdeSystem::after_step`]) and,
+/// if it did, restarts the stepper there; returns whether it did.
+fn correct_state<S: Stepper>(
+    rhs: &mut CheckedRhs<'_>,
+    stepper: &mut S,
+    corrected: &mut [f64],
+) -> Result<bool, StepFailure> {
     let t = stepper.t();
     corrected.copy_from_slice(stepper.y());
     if rhs.after_step(t, corrected)? {
         stepper.reset(rhs, t, corrected)?;
+        return Ok(true);
     }
-    Ok(())
+    Ok(false)
 }
 
 #[cfg(test)]

@@ -154,6 +154,16 @@ pub enum IntegrationError {
         /// The largest constraint residual left.
         residual: f64,
     },
+    /// An event function ([`OdeSystem::event_values`](crate::OdeSystem::event_values)) is NaN
+    /// at `t`, so its sign, and whether it crossed zero, is unknown
+    /// ([`RhsError::EventNotFinite`](crate::RhsError::EventNotFinite)).
+    #[error("event function {index} is NaN at t = {t}")]
+    EventNotFinite {
+        /// Time at which the event functions were evaluated.
+        t: f64,
+        /// Index of the event function.
+        index: usize,
+    },
     /// The Newton iteration of an implicit method did not converge for the step from `t`:
     /// with a fixed step at once; with adaptive steps after the step was shrunk until it
     /// was too small.
@@ -193,6 +203,7 @@ impl IntegrationError {
             | IntegrationError::SingularMassMatrix { t }
             | IntegrationError::SingularConstraintMatrix { t }
             | IntegrationError::ProjectionFailed { t, .. }
+            | IntegrationError::EventNotFinite { t, .. }
             | IntegrationError::NewtonDidNotConverge { t, .. }
             | IntegrationError::SingularIterationMatrix { t } => Some(t),
             IntegrationError::InvalidTimeSpan { .. }

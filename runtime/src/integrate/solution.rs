@@ -2,6 +2,8 @@
 
 use serde::Serialize;
 
+use super::events::Event;
+
 /// The work an integration did.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
 #[non_exhaustive]
@@ -19,6 +21,9 @@ pub struct Stats {
     /// LU factorisations of Newton iteration matrices by implicit methods (Radau IIA's real
     /// and complex matrices together count once).
     pub lu_decompositions: usize,
+    /// Evaluations of the event functions `g(t, y)` (one per accepted step and one per
+    /// root-finding iteration; none without events).
+    pub event_evals: usize,
     /// Wall-clock time of the whole `integrate` call (s).
     pub wall_time_s: f64,
 }
@@ -58,6 +63,14 @@ pub struct Solution {
     pub dim: usize,
     /// The work done.
     pub stats: Stats,
+    /// The zeros of the system's event functions, in time order
+    /// ([`OdeSystem::event_specs`](crate::OdeSystem::event_specs)); empty without events.
+    pub events: Vec<Event>,
+    /// Index into `events` of the terminal event that ended the integration before `t_end`,
+    /// if one did; the last sample is then at that event's time (with
+    /// [`OutputTimes::Steps`](super::OutputTimes::Steps)), and requested times after it are
+    /// not sampled.
+    pub terminated_by_event: Option<usize>,
 }
 
 impl Solution {
@@ -68,6 +81,8 @@ impl Solution {
             y: Vec::new(),
             dim,
             stats: Stats::default(),
+            events: Vec::new(),
+            terminated_by_event: None,
         }
     }
 

@@ -11,6 +11,7 @@ use crate::ode::{OdeSystem, RhsError};
 
 use super::dense_output::{DenseOutput, hermite};
 use super::error::IntegrationError;
+use super::events::EventSpec;
 use super::options::ErrorWeights;
 
 /// Why a step attempt produced no usable candidate.
@@ -45,7 +46,8 @@ impl StepFailure {
                 error:
                     RhsError::SingularMassMatrix
                     | RhsError::SingularConstraintMatrix
-                    | RhsError::ProjectionFailed { .. },
+                    | RhsError::ProjectionFailed { .. }
+                    | RhsError::EventNotFinite { .. },
                 ..
             } => false,
             StepFailure::Rhs {
@@ -87,6 +89,10 @@ impl StepFailure {
                 t,
                 error: RhsError::NonFinite { index },
             } => IntegrationError::RhsNonFinite { t, index },
+            StepFailure::Rhs {
+                t,
+                error: RhsError::EventNotFinite { index },
+            } => IntegrationError::EventNotFinite { t, index },
             StepFailure::NonFiniteState { t, index } => {
                 IntegrationError::NonFiniteState { t, index }
             }
@@ -115,6 +121,7 @@ pub(crate) struct CheckedRhs<'a> {
     evals: usize,
     jacobian_evals: usize,
     lu_decompositions: usize,
+    event_evals: usize,
 }
 
 impl<'a> CheckedRhs<'a> {
@@ -125,6 +132,7 @@ impl<'a> CheckedRhs<'a> {
             evals: 0,
             jacobian_evals: 0,
             lu_decompositions: 0,
+            event_evals: 0,
         }
     }
 
@@ -141,6 +149,40 @@ impl<'a> CheckedRhs<'a> {
     /// Number of factorisations counted with [`count_lu`](Self::count_lu) so far.
     pub(crate) fn lu_decompositions(&self) -> usize {
         self.lu_decompositions
+    }
+
+    /// Number of evaluations of the event functions so far.
+    pub(crate) fn event_evals(&self) -> usize {
+        self.event_evals
+    }
+
+    /// The system's event functions ([`OdeSystem::event_specs`]).
+    pub(crate) fn event_specs(&self) -> &[EventSpec] {
+        self.system.event_specs()
+    }
+
+    /// Evaluates the event functions `g(t, y)` into `g`.
+    ///
+    /// # Errors
+    /// [`StepFailure::Rhs`] at `t` if the system fails or a value is NaN (an infinite value
+    /// still has a sign and is allowed).
+    pub(crate) fn event_values(
+        &mut self,
+        t: f64,
+        y: &[f64],
+        g: &mut [f64],
+    ) -> Result<(), StepFailure> {
+        self.event_evals += 1;
+        self.system
+            .event_values(t, y, g)
+            .map_err(|error| StepFailure::Rhs { t, error })?;
+        match g.iter().position(|v| v.is_nan()) {
+            Some(index) => Err(StepFailure::Rhs {
+                t,
+                error: RhsError::EventNotFinite { index },
+            }),
+            None => Ok(()),
+        }
     }
 
     /// Counts one factorisation of an iteration matrix (for an implicit Runge–Kutta method,

@@ -1,0 +1,294 @@
+//! Event location (issue 6, item 2; lecture 17, HW21): zeros of g(t, y) found on each
+//! method's dense output, with direction and terminal events.
+
+use eomgen_runtime::{
+    BogackiShampine32, DormandPrince54, DormandPrince853, EventDirection, EventSpec, ExplicitEuler,
+    ExplicitMidpoint, ImplicitMidpoint, IntegrationError, Integrator, IntegratorOptions, OdeFn,
+    OdeSystem, OutputTimes, RadauIIA5, RhsError, RungeKutta4, Solution, StormerVerlet,
+    SymplecticEuler, WithEvents,
+};
+
+/// Complete elliptic integral of the first kind `K(k) = π / (2 AGM(1, √(1 − k²)))`
+/// (Abramowitz & Stegun 17.6), to machine precision.
+fn elliptic_k(k: f64) -> f64 {
+    let (mut a, mut b) = (1.0_f64, (1.0 - k * k).sqrt());
+    for _ in 0..40 {
+        let (a1, b1) = (0.5 * (a + b), (a * b).sqrt());
+        a = a1;
+        b = b1;
+    }
+    std::f64::consts::PI / (a + b)
+}
+
+/// The pendulum θ̈ = −(g/l) sin θ with g/l = 10 1/s², released at rest from `theta0`; its
+/// period is `4 √(l/g) K(sin(θ₀/2))`.
+fn pendulum() -> OdeFn<impl FnMut(f64, &[f64], &mut [f64])> {
+    OdeFn::second_order(1, |_t: f64, y: &[f64], dy: &mut [f64]| {
+        dy[0] = y[1];
+        dy[1] = -10.0 * y[0].sin();
+    })
+}
+
+fn exact_period(theta0: f64) -> f64 {
+    4.0 * (0.1_f64).sqrt() * elliptic_k((theta0 / 2.0).sin())
+}
+
+/// Integrates the pendulum with `method`, locating "θ̇ reaches zero from above" (HW21: the
+/// velocity's falling zeros are the returns to θ₀, one per period).
+fn returns(method: &mut dyn Integrator, theta0: f64, options: &IntegratorOptions) -> Solution {
+    let mut p = pendulum();
+    let spec = EventSpec::new("return", EventDirection::Falling, false);
+    let mut system = WithEvents::new(
+        &mut p,
+        vec![spec],
+        |_: &mut _, _t, y: &[f64], g: &mut [f64]| {
+            g[0] = y[1];
+            Ok(())
+        },
+    );
+    let t_end = 5.5 * exact_period(theta0);
+    method
+        .integrate(
+            &mut system,
+            0.0,
+            &[theta0, 0.0],
+            t_end,
+            &OutputTimes::At(vec![t_end]),
+            options,
+        )
+        .unwrap_or_else(|f| panic!("{}: {f}", method.name()))
+}
+
+/// The issue's test: the pendulum period from events against the exact elliptic-integral
+/// period to 1e-10 (relative), for a large amplitude (θ₀ = 2.5 rad, T = 3.28 × the small-angle
+/// period's 1.99 s). DOP853 at tol 1e-13 has global errors ~1e-12 over 5 periods and its
+/// order-7 dense output is as accurate, so 1e-10 leaves room while failing for any error in
+/// the root finding or interpolation (a Hermite-cubic location would be off by ~1e-8 here).
+#[test]
+fn pendulum_period_from_events_matches_the_elliptic_integral() {
+    let theta0 = 2.5;
+    let exact = exact_period(theta0);
+    let options = IntegratorOptions::default()
+        .with_rtol(1e-13)
+        .with_atol(1e-13);
+    let solution = returns(&mut DormandPrince853::new(), theta0, &options);
+    let times: Vec<f64> = solution.events.iter().map(|e| e.t).collect();
+    assert_eq!(times.len(), 5, "five returns in 5.5 periods: {times:?}");
+    for (k, t) in times.iter().enumerate() {
+        let expected = (k + 1) as f64 * exact;
+        assert!(
+            ((t - expected) / expected).abs() < 1e-10,
+            "return {k}: {t} vs {expected}"
+        );
+        let e = &solution.events[k];
+        assert_eq!(e.direction, EventDirection::Falling);
+        assert!(!e.terminal);
+        // The state at the event: θ back at θ₀, θ̇ = 0 (to the solution's accuracy).
+        assert!(
+            (e.y[0] - theta0).abs() < 1e-9 && e.y[1].abs() < 1e-9,
+            "{:?}",
+            e.y
+        );
+    }
+    // Successive periods agree with each other, too.
+    let periods: Vec<f64> = times.windows(2).map(|w| w[1] - w[0]).collect();
+    for p in &periods {
+        assert!(((p - exact) / exact).abs() < 1e-10);
+    }
+    assert_eq!(solution.terminated_by_event, None);
+    assert!(solution.stats.event_evals > solution.stats.steps);
+}
+
+/// Every method locates the events: the period error is what its order and the dense output
+/// allow. Tolerances are 2–5 times the errors measured when this was written, per method
+/// (fixed steps h = T/200 for the fixed-step methods, tol 1e-8 for the adaptive ones): from
+/// 5e-2 for explicit Euler to 2e-11 for Radau IIA over five periods.
+#[test]
+fn every_method_locates_the_returns() {
+    let theta0 = 1.0;
+    let exact = exact_period(theta0);
+    let h = exact / 200.0;
+    let adaptive = IntegratorOptions::default().with_rtol(1e-8).with_atol(1e-8);
+    let fixed = IntegratorOptions::default()
+        .with_dt(h)
+        .with_rtol(1e-10)
+        .with_atol(1e-10);
+    let cases: Vec<(Box<dyn Integrator>, &IntegratorOptions, f64)> = vec![
+        (Box::new(ExplicitEuler::new()), &fixed, 0.1),
+        (Box::new(ExplicitMidpoint::new()), &fixed, 5e-4),
+        (Box::new(RungeKutta4::new()), &fixed, 3e-8),
+        (Box::new(SymplecticEuler::new()), &fixed, 1e-4),
+        (Box::new(StormerVerlet::new()), &fixed, 2e-4),
+        (Box::new(ImplicitMidpoint::new()), &fixed, 2e-4),
+        (Box::new(BogackiShampine32::new()), &adaptive, 2e-7),
+        (Box::new(DormandPrince54::new()), &adaptive, 5e-8),
+        (Box::new(DormandPrince853::new()), &adaptive, 2e-9),
+        (Box::new(RadauIIA5::new()), &adaptive, 1e-10),
+    ];
+    for (mut method, options, tolerance) in cases {
+        let solution = returns(method.as_mut(), theta0, options);
+        let name = method.name();
+        assert_eq!(solution.events.len(), 5, "{name}");
+        let last = solution.events[4].t;
+        let error = ((last - 5.0 * exact) / (5.0 * exact)).abs();
+        assert!(error < tolerance, "{name}: relative error {error:e} of 5 T");
+    }
+}
+
+/// A terminal event ends the integration at the event: samples stop there (every-step
+/// output ends with the event's state; requested times after it are not sampled), and the
+/// location is exact for a solution the interpolant represents exactly (a parabola).
+#[test]
+fn terminal_events_stop_the_integration() {
+    let mut ball = OdeFn::second_order(1, |_t: f64, y: &[f64], dy: &mut [f64]| {
+        dy[0] = y[1];
+        dy[1] = -10.0;
+    });
+    let specs = vec![
+        EventSpec::new("apex", EventDirection::Falling, false),
+        EventSpec::new("landing", EventDirection::Falling, true),
+        EventSpec::new("below", EventDirection::Both, false),
+    ];
+    let mut system = WithEvents::new(
+        &mut ball,
+        specs,
+        |_: &mut _, _t, y: &[f64], g: &mut [f64]| {
+            g[0] = y[1];
+            g[1] = y[0];
+            g[2] = y[0] + 1.0;
+            Ok(())
+        },
+    );
+    let options = IntegratorOptions::default().with_dt(0.3);
+    for output in [
+        OutputTimes::Steps,
+        OutputTimes::At(vec![0.5, 1.0, 1.9, 2.5, 3.0]),
+    ] {
+        let solution = RungeKutta4::new()
+            .integrate(&mut system, 0.0, &[0.0, 10.0], 5.0, &output, &options)
+            .unwrap();
+        let names: Vec<&str> = solution.events.iter().map(|e| e.name.as_str()).collect();
+        assert_eq!(
+            names,
+            ["apex", "landing"],
+            "the event after landing is never reached"
+        );
+        assert!((solution.events[0].t - 1.0).abs() < 1e-14);
+        assert!((solution.events[1].t - 2.0).abs() < 1e-14);
+        assert_eq!(solution.terminated_by_event, Some(1));
+        let (t_last, y_last) = solution.last().unwrap();
+        match output {
+            OutputTimes::Steps => {
+                assert_eq!(t_last, solution.events[1].t);
+                assert!(y_last[0].abs() < 1e-13 && (y_last[1] + 10.0).abs() < 1e-13);
+            }
+            OutputTimes::At(_) => assert_eq!(solution.t, [0.5, 1.0, 1.9]),
+        }
+    }
+}
+
+/// Several zeros in one step come out in time order, whatever the order of the functions.
+#[test]
+fn zeros_within_one_step_are_ordered() {
+    let mut clock = OdeFn::new(1, |_t: f64, _y: &[f64], dy: &mut [f64]| dy[0] = 1.0);
+    let specs = vec![
+        EventSpec::new("late", EventDirection::Rising, false),
+        EventSpec::new("early", EventDirection::Rising, false),
+    ];
+    let mut system = WithEvents::new(
+        &mut clock,
+        specs,
+        |_: &mut _, _t, y: &[f64], g: &mut [f64]| {
+            g[0] = y[0] - 0.7;
+            g[1] = y[0] - 0.2;
+            Ok(())
+        },
+    );
+    let options = IntegratorOptions::default().with_dt(1.0);
+    let solution = ExplicitEuler::new()
+        .integrate(&mut system, 0.0, &[0.0], 1.0, &OutputTimes::Steps, &options)
+        .unwrap();
+    let found: Vec<(&str, f64)> = solution
+        .events
+        .iter()
+        .map(|e| (e.name.as_str(), e.t))
+        .collect();
+    assert_eq!(found.len(), 2);
+    assert_eq!(found[0].0, "early");
+    assert!((found[0].1 - 0.2).abs() < 1e-15 && (found[1].1 - 0.7).abs() < 1e-15);
+}
+
+/// A zero at the start is not an event, and a rising-only event ignores falling crossings.
+#[test]
+fn start_zeros_and_directions() {
+    let mut p = pendulum();
+    let specs = vec![EventSpec::new("rising", EventDirection::Rising, false)];
+    let mut system = WithEvents::new(&mut p, specs, |_: &mut _, _t, y: &[f64], g: &mut [f64]| {
+        g[0] = y[1];
+        Ok(())
+    });
+    let theta0 = 0.5;
+    let exact = exact_period(theta0);
+    let options = IntegratorOptions::default()
+        .with_rtol(1e-12)
+        .with_atol(1e-12);
+    let solution = DormandPrince853::new()
+        .integrate(
+            &mut system,
+            0.0,
+            &[theta0, 0.0],
+            1.2 * exact,
+            &OutputTimes::Steps,
+            &options,
+        )
+        .unwrap();
+    // θ̇ starts at 0 (not an event), goes negative, rises through 0 at T/2, falls at T.
+    assert_eq!(solution.events.len(), 1);
+    assert!((solution.events[0].t - exact / 2.0).abs() < 1e-10);
+    assert_eq!(solution.events[0].direction, EventDirection::Rising);
+}
+
+/// A NaN event function is an error with t and the function, keeping the samples.
+#[test]
+fn nan_event_functions_are_errors() {
+    let mut clock = OdeFn::new(1, |_t: f64, _y: &[f64], dy: &mut [f64]| dy[0] = 1.0);
+    let specs = vec![EventSpec::new("sqrt", EventDirection::Both, false)];
+    let mut system = WithEvents::new(
+        &mut clock,
+        specs,
+        |_: &mut _, _t, y: &[f64], g: &mut [f64]| {
+            g[0] = (0.5 - y[0]).sqrt();
+            Ok(())
+        },
+    );
+    let options = IntegratorOptions::default().with_dt(0.1);
+    let failure = RungeKutta4::new()
+        .integrate(&mut system, 0.0, &[0.0], 1.0, &OutputTimes::Steps, &options)
+        .unwrap_err();
+    match failure.error {
+        IntegrationError::EventNotFinite { t, index: 0 } => assert!((t - 0.6).abs() < 1e-12),
+        other => panic!("{other:?}"),
+    }
+    assert_eq!(failure.partial.t.len(), 6, "samples up to t = 0.5 are kept");
+    // And a system error in an event function is reported as such.
+    let mut clock = OdeFn::new(1, |_t: f64, _y: &[f64], dy: &mut [f64]| dy[0] = 1.0);
+    let specs = vec![EventSpec::new("fails", EventDirection::Both, false)];
+    let mut system = WithEvents::new(
+        &mut clock,
+        specs,
+        |_: &mut _, t: f64, _y: &[f64], _g: &mut [f64]| {
+            if t > 0.25 {
+                Err(RhsError::SingularMassMatrix)
+            } else {
+                Ok(())
+            }
+        },
+    );
+    let failure = RungeKutta4::new()
+        .integrate(&mut system, 0.0, &[0.0], 1.0, &OutputTimes::Steps, &options)
+        .unwrap_err();
+    assert!(
+        matches!(failure.error, IntegrationError::SingularMassMatrix { t } if (t - 0.3).abs() < 1e-12)
+    );
+    assert!(system.event_specs().len() == 1);
+}
