@@ -9,6 +9,7 @@
 use nalgebra::{DMatrix, DVector, SMatrix, SVector};
 
 use crate::constrained::{ConstraintWorkspace, ProjectionError, Stabilization};
+use crate::integrate::EventSpec;
 use crate::ode::{OdeSystem, RhsError};
 
 /// A parameter name that the model does not have.
@@ -160,6 +161,37 @@ pub trait MechanicalSystem<const N: usize> {
     fn initial_guesses(&self) -> &'static [usize] {
         &[]
     }
+
+    /// The model file's `events:` (issue 6, item 2; lecture 17, HW21, HW36): names,
+    /// directions and whether each ends the integration, in file order; empty by default.
+    fn event_specs(&self) -> &'static [EventSpec] {
+        &[]
+    }
+
+    /// Whether an event function uses the accelerations `q̈` or the constraint forces `λ`
+    /// (then [`FirstOrder`] solves for them before calling [`Self::event_values`]).
+    fn events_need_accelerations(&self) -> bool {
+        false
+    }
+
+    /// The event functions `gᵢ(q, q̇, q̈, λ, t)` into `out` (one per [`Self::event_specs`]
+    /// entry).
+    ///
+    /// # Shapes
+    /// `qddot`: `N` (zeros unless [`Self::events_need_accelerations`]); `lambda`: the `m`
+    /// constraint forces (see [`Self::constraint_names`]; empty unless needed, and a function
+    /// that reads a missing one gets NaN); `out`: one entry per event.
+    fn event_values(
+        &self,
+        q: &SVector<f64, N>,
+        qdot: &SVector<f64, N>,
+        t: f64,
+        qddot: &SVector<f64, N>,
+        lambda: &[f64],
+        out: &mut [f64],
+    ) {
+        let _ = (q, qdot, t, qddot, lambda, out);
+    }
 }
 
 /// The first-order form `y = [q; q̇]`, `ẏ = [q̇; M⁻¹F]` of a [`MechanicalSystem`].
@@ -180,6 +212,9 @@ pub struct FirstOrder<S, const N: usize> {
     pub stabilization: Stabilization,
     /// Buffers and the last multipliers `λ` of a constrained system.
     pub constraints: ConstraintWorkspace,
+    /// The model's events ([`MechanicalSystem::event_specs`]), whose `terminal` flags may be
+    /// changed ([`ModelInfo::set_event_terminal`]).
+    pub events: Vec<EventSpec>,
 }
 
 impl<S: MechanicalSystem<N>, const N: usize> FirstOrder<S, N> {
@@ -187,10 +222,12 @@ impl<S: MechanicalSystem<N>, const N: usize> FirstOrder<S, N> {
     pub fn new(system: S) -> Self {
         let m = system.constraint_names().len();
         let holonomic = system.holonomic_constraint_count();
+        let events = system.event_specs().to_vec();
         Self {
             system,
             stabilization: Stabilization::None,
             constraints: ConstraintWorkspace::new(N, m, holonomic),
+            events,
         }
     }
 
@@ -338,6 +375,33 @@ impl<S: MechanicalSystem<N>, const N: usize> OdeSystem for FirstOrder<S, N> {
     fn second_order_dim(&self) -> Option<usize> {
         Some(N)
     }
+
+    fn event_specs(&self) -> &[EventSpec] {
+        &self.events
+    }
+
+    fn event_values(&mut self, t: f64, y: &[f64], g: &mut [f64]) -> Result<(), RhsError> {
+        if self.events.is_empty() {
+            return Ok(());
+        }
+        let (q, qdot) = split::<N>(y);
+        if !self.system.events_need_accelerations() {
+            let zero = SVector::<f64, N>::zeros();
+            self.system.event_values(&q, &qdot, t, &zero, &[], g);
+            return Ok(());
+        }
+        if self.constraints.is_empty() {
+            let qdd = self.generalized_accelerations(&q, &qdot, t)?;
+            self.system.event_values(&q, &qdot, t, &qdd, &[], g);
+        } else {
+            let qdd =
+                self.constraints
+                    .accelerations(&self.system, &q, &qdot, t, self.stabilization)?;
+            self.system
+                .event_values(&q, &qdot, t, &qdd, &self.constraints.multipliers, g);
+        }
+        Ok(())
+    }
 }
 
 /// A model with its size erased, as the CLI holds it: `Box<dyn ModelInfo>`.
@@ -412,6 +476,9 @@ pub trait ModelInfo: OdeSystem {
     fn project(&mut self, t: f64, y: &mut [f64], free: &[usize]) -> Result<usize, ProjectionError>;
     /// Indices of the coordinates whose initial values are guesses.
     fn initial_guesses(&self) -> &'static [usize];
+    /// Makes the model event `name` terminal or not (`eomgen simulate --stop-when NAME`);
+    /// returns `false` if the model has no event `name`.
+    fn set_event_terminal(&mut self, name: &str, terminal: bool) -> bool;
     /// `Φ` (length `m_h`), `J` (`m × n`), the velocity residuals and `γ` (length `m`) at
     /// `(t, y)`; see [`MechanicalSystem::constraint_jacobian`] and siblings.
     fn constraint_equations(&self, t: f64, y: &[f64]) -> ConstraintValues;
@@ -570,6 +637,15 @@ impl<S: MechanicalSystem<N>, const N: usize> ModelInfo for FirstOrder<S, N> {
     }
     fn initial_guesses(&self) -> &'static [usize] {
         self.system.initial_guesses()
+    }
+    fn set_event_terminal(&mut self, name: &str, terminal: bool) -> bool {
+        match self.events.iter_mut().find(|e| e.name == name) {
+            Some(e) => {
+                e.terminal = terminal;
+                true
+            }
+            None => false,
+        }
     }
     fn constraint_equations(&self, t: f64, y: &[f64]) -> ConstraintValues {
         let (q, qdot) = split::<N>(y);

@@ -2,6 +2,7 @@
 
 mod check;
 mod equations;
+mod events;
 mod plot;
 mod roundoff;
 mod simulate;

@@ -6,10 +6,11 @@ use clap::{Args, ValueEnum};
 use eomgen::{
     BogackiShampine32, DormandPrince54, DormandPrince853, ExplicitEuler, ExplicitMidpoint,
     ImplicitMidpoint, IntegrationFailure, Integrator, IntegratorOptions, ModelInfo, OutputTimes,
-    RadauIIA5, RungeKutta4, Solution, StormerVerlet, SymplecticEuler,
+    RadauIIA5, RungeKutta4, Solution, StormerVerlet, SymplecticEuler, WithEvents,
 };
 use serde_json::json;
 
+use super::events::CliEvents;
 use super::values::{evaluate, split_assignment};
 use super::{CliError, find_model, plot};
 use eomgen::Stabilization;
@@ -105,6 +106,17 @@ pub struct SimulateArgs {
     /// Plot the coordinates against time (.svg or .png).
     #[arg(long, value_name = "FILE")]
     pub plot: Option<String>,
+    /// Stop at the first zero of a function: a model event's name (`--stop-when lift_off`)
+    /// or `EXPR` / `LHS = RHS`, optionally followed by `, rising`, `, falling` or `, both`
+    /// (e.g. `--stop-when "theta_dot = 0, falling"`); names: parameters, coordinates, `t`,
+    /// rates `x_dot`, accelerations `x_ddot`, constraint forces `lambda_<constraint>`;
+    /// repeatable (the first to occur stops).
+    #[arg(long = "stop-when", value_name = "EVENT")]
+    pub stop_when: Vec<String>,
+    /// Locate the zeros of a function without stopping (same syntax as --stop-when);
+    /// repeatable. The model file's own `events:` are always located.
+    #[arg(long = "event", value_name = "EVENT")]
+    pub event: Vec<String>,
 }
 
 fn parameter_lookup(model: &dyn ModelInfo) -> impl Fn(&str) -> Option<f64> + '_ {
@@ -195,7 +207,20 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
         Method::ImplicitMidpoint => Box::new(ImplicitMidpoint::new()),
         Method::Radau5 => Box::new(RadauIIA5::new()),
     };
-    let result = integrator.integrate(model.as_ode_mut(), 0.0, &y0, args.t_end, &output, &options);
+    let mut added = CliEvents::parse(model.as_mut(), &args.stop_when, &args.event)?;
+    let result = if added.is_empty() {
+        integrator.integrate(model.as_ode_mut(), 0.0, &y0, args.t_end, &output, &options)
+    } else {
+        let specs = added.specs();
+        let mut system = WithEvents::new(
+            model.as_mut(),
+            specs,
+            |m: &mut (dyn ModelInfo + 'static), t: f64, y: &[f64], g: &mut [f64]| {
+                added.values(m, t, y, g)
+            },
+        );
+        integrator.integrate(&mut system, 0.0, &y0, args.t_end, &output, &options)
+    };
     let (solution, failure) = match result {
         Ok(s) => (s, None),
         Err(IntegrationFailure { error, partial }) => (*partial, Some(error)),
@@ -204,6 +229,9 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
     let constraints = ConstraintReport::new(model.as_mut(), &solution);
     if let Some(path) = &args.csv {
         write_csv(path, model.as_ref(), &solution, &report, &constraints)?;
+        if !solution.events.is_empty() {
+            write_events_csv(&sibling(path, "events"), model.as_ref(), &solution)?;
+        }
     }
     if let Some(path) = &args.plot {
         plot::time_histories(path, model.as_ref(), &solution).map_err(CliError::failure)?;
@@ -255,6 +283,27 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
                 "velocity": constraints.max_drift().1,
             });
         }
+        if !solution.events.is_empty() || !args.stop_when.is_empty() || !args.event.is_empty() {
+            out["events"] = json!(
+                solution
+                    .events
+                    .iter()
+                    .map(|e| json!({
+                        "name": e.name,
+                        "t": e.t,
+                        "direction": e.direction.name(),
+                        "terminal": e.terminal,
+                        "q": &e.y[..n],
+                        "qdot": &e.y[n..],
+                    }))
+                    .collect::<Vec<_>>()
+            );
+            out["terminated_by_event"] = json!(
+                solution
+                    .terminated_by_event
+                    .map(|k| solution.events[k].name.clone())
+            );
+        }
         if let Some(e) = &failure {
             out["error"] = json!({"t": e.t(), "message": e.to_string()});
         }
@@ -265,6 +314,7 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
     } else {
         print_summary(model.as_ref(), integrator.name(), args, &solution, &report);
         constraints.print_summary(args.stabilization);
+        print_events(model.as_ref(), &solution);
     }
     match failure {
         None => Ok(()),
@@ -398,6 +448,89 @@ fn write_csv(
             }
             let (p, v) = constraints.drift[k];
             out.push_str(&format!(",{p:e},{v:e}"));
+        }
+        out.push('\n');
+    }
+    std::fs::write(path, out).map_err(|e| CliError::failure(format!("cannot write `{path}`: {e}")))
+}
+
+/// The located events: name, direction, time and state, and the intervals between
+/// successive zeros of the same function (HW21: the period from successive peaks).
+fn print_events(model: &dyn ModelInfo, solution: &Solution) {
+    if solution.events.is_empty() {
+        return;
+    }
+    let n = model.num_dofs();
+    let names = model.coordinate_names();
+    println!("events     {} located:", solution.events.len());
+    for e in &solution.events {
+        let state: Vec<String> = names
+            .iter()
+            .enumerate()
+            .map(|(i, c)| format!("{c} = {:.9e}, {c}_dot = {:.9e}", e.y[i], e.y[n + i]))
+            .collect();
+        println!(
+            "           {:<16} {:<8} t = {:.15e}   {}",
+            e.name,
+            e.direction.name(),
+            e.t,
+            state.join(", ")
+        );
+    }
+    let mut seen: Vec<&str> = Vec::new();
+    for e in &solution.events {
+        if seen.contains(&e.name.as_str()) {
+            continue;
+        }
+        seen.push(&e.name);
+        let times: Vec<f64> = solution
+            .events
+            .iter()
+            .filter(|x| x.name == e.name)
+            .map(|x| x.t)
+            .collect();
+        if times.len() >= 2 {
+            let intervals: Vec<String> = times
+                .windows(2)
+                .map(|w| format!("{:.12e}", w[1] - w[0]))
+                .collect();
+            println!(
+                "intervals  between successive `{}`: {} s",
+                e.name,
+                intervals.join(", ")
+            );
+        }
+    }
+    if let Some(k) = solution.terminated_by_event {
+        let e = &solution.events[k];
+        println!("stopped    at t = {:.15e} by event `{}`", e.t, e.name);
+    }
+}
+
+/// The located events as CSV: name, direction, t, coordinates, rates.
+fn write_events_csv(
+    path: &str,
+    model: &dyn ModelInfo,
+    solution: &Solution,
+) -> Result<(), CliError> {
+    let mut out = String::from("event,direction,terminal,t");
+    for c in model.coordinate_names() {
+        out.push_str(&format!(",{c}"));
+    }
+    for c in model.coordinate_names() {
+        out.push_str(&format!(",{c}_dot"));
+    }
+    out.push('\n');
+    for e in &solution.events {
+        out.push_str(&format!(
+            "{},{},{},{:e}",
+            e.name,
+            e.direction.name(),
+            e.terminal,
+            e.t
+        ));
+        for v in &e.y {
+            out.push_str(&format!(",{v:e}"));
         }
         out.push('\n');
     }

@@ -109,6 +109,7 @@ fn body(model: &SymbolicModel, roots: &[ExprId], helpers: &str) -> (Body, CsePla
             SymbolKind::Acceleration(i) => format!("__a[{i}]"),
             SymbolKind::Time => "__t".to_string(),
             SymbolKind::Auxiliary => "0.0_f64".to_string(),
+            SymbolKind::Multiplier(i) => format!("__lambda.get({i}).copied().unwrap_or(f64::NAN)"),
         };
         let _ = writeln!(code, "let {local}: f64 = {source};");
     }
@@ -143,6 +144,16 @@ fn field_name(name: &str) -> String {
     } else {
         name.to_string()
     }
+}
+
+/// Statements that write `values` into the slice `__out` (entries beyond its length are
+/// skipped, so a short slice cannot panic).
+fn write_out(values: &[String]) -> String {
+    values
+        .iter()
+        .enumerate()
+        .map(|(i, x)| format!("if let Some(__o) = __out.get_mut({i}) {{ *__o = {x}; }}\n"))
+        .collect()
 }
 
 fn string_literal(s: &str) -> String {
@@ -410,12 +421,6 @@ pub fn emit(
             "fn holonomic_constraint_count(&self) -> usize {{ {} }}",
             c.holonomic
         );
-        let write_out = |v: &[String]| {
-            v.iter()
-                .enumerate()
-                .map(|(i, x)| format!("if let Some(__o) = __out.get_mut({i}) {{ *__o = {x}; }}\n"))
-                .collect::<String>()
-        };
         emit_fn(
             &format!("fn constraint_residuals(&self, {q_args}, __t: f64, __out: &mut [f64])"),
             &c.phi,
@@ -449,6 +454,43 @@ pub fn emit(
             constant_items,
             "fn initial_guesses(&self) -> &'static [usize] {{ &[{}] }}",
             idx.join(", ")
+        );
+    }
+    if !model.events.is_empty() {
+        let specs: Vec<String> = model
+            .events
+            .iter()
+            .map(|e| {
+                let direction = match e.direction {
+                    crate::model::Crossing::Rising => "Rising",
+                    crate::model::Crossing::Falling => "Falling",
+                    crate::model::Crossing::Both => "Both",
+                };
+                format!(
+                    "{krate}::EventSpec {{ name: ::std::borrow::Cow::Borrowed({}), direction: {krate}::EventDirection::{direction}, terminal: {} }}",
+                    string_literal(&e.name),
+                    e.terminal
+                )
+            })
+            .collect();
+        let _ = writeln!(
+            constant_items,
+            "fn event_specs(&self) -> &'static [{krate}::EventSpec] {{ static EVENTS: [{krate}::EventSpec; {}] = [{}]; &EVENTS }}",
+            specs.len(),
+            specs.join(", ")
+        );
+        let _ = writeln!(
+            constant_items,
+            "fn events_need_accelerations(&self) -> bool {{ {} }}",
+            model.events_need_accelerations()
+        );
+        let roots: Vec<ExprId> = model.events.iter().map(|e| e.function).collect();
+        emit_fn(
+            &format!(
+                "fn event_values(&self, {qd_args}, __t: f64, __a: &{vec_t}, __lambda: &[f64], __out: &mut [f64])"
+            ),
+            &roots,
+            &|v| write_out(v),
         );
     }
     imp.push_str(&constant_items);

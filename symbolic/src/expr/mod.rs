@@ -290,6 +290,9 @@ pub enum SymbolKind {
     Time,
     /// Any other symbol (constant in time), e.g. the vector `a` of `∂(M a)/∂q`.
     Auxiliary,
+    /// The Lagrange multiplier (constraint force) `λ_i` of constraint `i` (holonomic first),
+    /// `lambda_<constraint>`: only in event functions.
+    Multiplier(u32),
 }
 
 /// A named symbol.

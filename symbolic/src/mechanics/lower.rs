@@ -149,6 +149,38 @@ pub struct SymbolicModel {
     pub constraints: ConstraintEquations,
     /// Coordinates whose initial value is a guess to be solved from the constraints.
     pub initial_guesses: Vec<usize>,
+    /// The file's `events:` (empty if none).
+    pub events: Vec<EventInfo>,
+}
+
+/// One lowered `events:` entry.
+#[derive(Debug, Clone, PartialEq)]
+pub struct EventInfo {
+    /// Its name.
+    pub name: String,
+    /// The event function `g(q, q̇, q̈, λ, t)`.
+    pub function: ExprId,
+    /// Which crossings count.
+    pub direction: crate::model::Crossing,
+    /// Whether it ends the integration.
+    pub terminal: bool,
+}
+
+impl SymbolicModel {
+    /// Whether an event function uses an acceleration or a constraint force, so that the
+    /// runtime must solve for them before evaluating it.
+    pub fn events_need_accelerations(&self) -> bool {
+        let roots: Vec<ExprId> = self.events.iter().map(|e| e.function).collect();
+        self.arena.reachable(&roots).iter().any(|e| {
+            matches!(
+                self.arena.node(*e),
+                crate::expr::Node::Symbol(s) if matches!(
+                    self.arena.symbol_info(*s).kind,
+                    SymbolKind::Acceleration(_) | SymbolKind::Multiplier(_)
+                )
+            )
+        })
+    }
 }
 
 impl SymbolicModel {
@@ -664,6 +696,24 @@ impl<'f> Lowering<'f> {
         }
 
         let constraints = self.constraints(file, &parameters);
+        if !file.events.is_empty() {
+            for (i, name) in constraints.names.iter().enumerate() {
+                self.arena
+                    .symbol(&format!("lambda_{name}"), SymbolKind::Multiplier(i as u32));
+            }
+        }
+        self.allow_accelerations = true;
+        let events: Vec<EventInfo> = file
+            .events
+            .iter()
+            .map(|e| EventInfo {
+                name: e.name.value.clone(),
+                function: self.expr(&e.when),
+                direction: e.direction,
+                terminal: e.terminal,
+            })
+            .collect();
+        self.allow_accelerations = false;
         let initial_guesses: Vec<usize> = file
             .initial_guesses
             .iter()
@@ -743,6 +793,7 @@ impl<'f> Lowering<'f> {
             hand_equations,
             constraints,
             initial_guesses,
+            events,
         })
     }
 }

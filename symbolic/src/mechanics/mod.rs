@@ -13,7 +13,7 @@ mod momentum;
 pub use balances::{HandEquations, UserBalances};
 pub use constraints::{ConstraintEquations, linear_in_rates, redundant_rows};
 pub use lagrange::Lagrange;
-pub use lower::{BalanceInfo, BodyInfo, LoadInfo, ParameterInfo, SymbolicModel};
+pub use lower::{BalanceInfo, BodyInfo, EventInfo, LoadInfo, ParameterInfo, SymbolicModel};
 pub use momentum::MomentumBalance;
 
 use crate::expr::ExprId;

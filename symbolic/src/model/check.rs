@@ -63,6 +63,8 @@ enum Depends {
     Motion,
     /// Also accelerations (`x_ddot`): only equations of motion written by hand.
     Acceleration,
+    /// Also constraint forces (`lambda_<constraint>`): only event functions.
+    Event,
 }
 
 struct Checker<'f> {
@@ -73,6 +75,7 @@ struct Checker<'f> {
     coords: Vec<&'f str>,
     rates: Vec<String>,
     accelerations: Vec<String>,
+    multipliers: Vec<String>,
     points: Vec<&'f str>,
     bodies: Vec<&'f str>,
 }
@@ -95,6 +98,12 @@ impl<'f> Checker<'f> {
                 .collect(),
             rates: coords.iter().map(|c| format!("{c}_dot")).collect(),
             accelerations: coords.iter().map(|c| format!("{c}_ddot")).collect(),
+            multipliers: file
+                .constraints
+                .iter()
+                .chain(&file.nonholonomic)
+                .map(|(k, _)| format!("lambda_{}", k.value))
+                .collect(),
             coords,
             points: file.points.iter().map(|p| p.name.value.as_str()).collect(),
             bodies: file.bodies.iter().map(|b| b.name.value.as_str()).collect(),
@@ -300,6 +309,13 @@ impl<'f> Checker<'f> {
                 &format!("the initial value of `{}`", k.value),
             );
         }
+        for e in &file.events {
+            self.resolve(
+                &e.when,
+                Depends::Event,
+                &format!("the function of event `{}`", e.name.value),
+            );
+        }
     }
 
     /// Reports every name in `e` that `depends` does not allow; `what` names the expression.
@@ -312,7 +328,9 @@ impl<'f> Checker<'f> {
             let is_coord = self.coords.contains(&n);
             let is_rate = self.rates.iter().any(|r| r == n);
             let is_acceleration =
-                depends == Depends::Acceleration && self.accelerations.iter().any(|r| r == n);
+                depends >= Depends::Acceleration && self.accelerations.iter().any(|r| r == n);
+            let is_multiplier =
+                depends >= Depends::Event && self.multipliers.iter().any(|r| r == n);
             let needs = if is_param {
                 Depends::Constant
             } else if is_coord || n == "t" {
@@ -321,6 +339,8 @@ impl<'f> Checker<'f> {
                 Depends::Motion
             } else if is_acceleration {
                 Depends::Acceleration
+            } else if is_multiplier {
+                Depends::Event
             } else {
                 self.unknown(n, at, depends, what);
                 continue;
@@ -394,6 +414,9 @@ impl<'f> Checker<'f> {
         }
         if depends >= Depends::Acceleration {
             candidates.extend(self.accelerations.iter().map(String::as_str));
+        }
+        if depends >= Depends::Event {
+            candidates.extend(self.multipliers.iter().map(String::as_str));
         }
         candidates.push("pi");
         let d = Diagnostic::new(at, format!("unknown name `{n}` in {what}"));

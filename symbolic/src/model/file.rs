@@ -197,6 +197,45 @@ pub struct Draw {
     pub trace: Vec<Located<String>>,
 }
 
+/// Which zero crossings of an event function count (`direction:` of an `events:` entry).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Crossing {
+    /// From negative to non-negative.
+    Rising,
+    /// From positive to non-positive ("reaches zero from above").
+    Falling,
+    /// Either (the default).
+    #[default]
+    Both,
+}
+
+impl Crossing {
+    /// `rising`, `falling` or `both`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Crossing::Rising => "rising",
+            Crossing::Falling => "falling",
+            Crossing::Both => "both",
+        }
+    }
+}
+
+/// One `events:` entry: `name: { when: g, direction: falling, terminal: true }`, or
+/// `name: g` (both directions, not terminal). The integrators locate the zeros of `g`
+/// (lecture 17, HW21, HW36).
+#[derive(Debug, Clone, PartialEq)]
+pub struct EventDef {
+    /// The event's name.
+    pub name: Located<String>,
+    /// The event function `g`: parameters, coordinates, `t`, rates, accelerations (`x_ddot`)
+    /// and constraint forces (`lambda_<constraint>`).
+    pub when: Expr,
+    /// Which crossings count.
+    pub direction: Crossing,
+    /// Whether the first crossing ends the integration.
+    pub terminal: bool,
+}
+
 /// A whole model file after the schema pass.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ModelFile {
@@ -247,6 +286,8 @@ pub struct ModelFile {
     pub initial_guesses: Vec<Located<String>>,
     /// `checks:` — the file's claims about its own model (empty if none).
     pub checks: Checks,
+    /// `events:` — functions whose zeros the integrators locate, in file order.
+    pub events: Vec<EventDef>,
     /// The spatial dimension of the points (2 or 3); `None` when there are no points.
     pub dimension: Option<usize>,
 }

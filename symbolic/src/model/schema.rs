@@ -39,10 +39,11 @@ pub const TOP_LEVEL_KEYS: &[&str] = &[
     "checks",
     "constraints",
     "nonholonomic",
+    "events",
 ];
 
 /// Keys of the model format (DESIGN.md) that this version does not implement yet.
-pub const LATER_KEYS: &[&str] = &["events", "equilibria", "outputs"];
+pub const LATER_KEYS: &[&str] = &["equilibria", "outputs"];
 
 const BODY_KEYS: &[&str] = &["mass", "at", "inertia", "com", "angle"];
 const PARTICLE_EXAMPLE: &str = "{ mass: m, at: P }";
@@ -715,6 +716,10 @@ impl Ctx<'_> {
         let checks = get(top, "checks")
             .map(|n| self.checks(n))
             .unwrap_or_default();
+        self.section = "events";
+        let events = get(top, "events")
+            .map(|n| self.events(n))
+            .unwrap_or_default();
         self.section = "";
 
         let dimension = points.first().map(|p: &Point| p.position.len());
@@ -742,7 +747,104 @@ impl Ctx<'_> {
             constraints,
             nonholonomic,
             initial_guesses,
+            events,
         })
+    }
+
+    /// `events:` — `name: g` or `name: { when: g, direction: rising|falling|both,
+    /// terminal: true|false }`.
+    fn events(&mut self, node: &YamlNode) -> Vec<EventDef> {
+        const EXAMPLE: &str = "{ when: theta_dot, direction: falling, terminal: false }";
+        let Some(entries) = self.map(node, "`events`", &format!("events: {{ peak: {EXAMPLE} }}"))
+        else {
+            return Vec::new();
+        };
+        let mut out = Vec::new();
+        for (k, v) in entries {
+            if !self.key_name(k, "event") {
+                continue;
+            }
+            let what = format!("the function of event `{}`", k.value);
+            if !matches!(v.kind, YamlKind::Map(_)) {
+                if let Some(when) = self.expr(v, &what) {
+                    out.push(EventDef {
+                        name: k.clone(),
+                        when,
+                        direction: Crossing::Both,
+                        terminal: false,
+                    });
+                }
+                continue;
+            }
+            let Some(f) = self.fields(
+                k,
+                v,
+                "event",
+                &["when", "direction", "terminal"],
+                &["when"],
+                EXAMPLE,
+            ) else {
+                continue;
+            };
+            let when = get(f, "when").and_then(|n| self.expr(n, &what));
+            let direction = match get(f, "direction") {
+                None => Some(Crossing::Both),
+                Some(n) => self.choice(
+                    n,
+                    &format!("the direction of event `{}`", k.value),
+                    &[
+                        ("rising", Crossing::Rising),
+                        ("falling", Crossing::Falling),
+                        ("both", Crossing::Both),
+                    ],
+                ),
+            };
+            let terminal = match get(f, "terminal") {
+                None => Some(false),
+                Some(n) => self.choice(
+                    n,
+                    &format!("`terminal` of event `{}`", k.value),
+                    &[("true", true), ("false", false)],
+                ),
+            };
+            if let (Some(when), Some(direction), Some(terminal)) = (when, direction, terminal) {
+                out.push(EventDef {
+                    name: k.clone(),
+                    when,
+                    direction,
+                    terminal,
+                });
+            }
+        }
+        out
+    }
+
+    /// One of a few words, as a scalar; an error lists them (with a "did you mean").
+    fn choice<T: Copy>(&mut self, node: &YamlNode, what: &str, options: &[(&str, T)]) -> Option<T> {
+        let words: Vec<&str> = options.iter().map(|(w, _)| *w).collect();
+        let text = match &node.kind {
+            YamlKind::Scalar { text, .. } => text.trim(),
+            _ => "",
+        };
+        if let Some((_, value)) = options.iter().find(|(w, _)| *w == text) {
+            return Some(*value);
+        }
+        let help = match closest(text, &words) {
+            Some(c) if !text.is_empty() => format!("did you mean `{c}`?"),
+            _ => format!("write one of: {}", words.join(", ")),
+        };
+        self.error(
+            Diagnostic::new(
+                node.location,
+                format!(
+                    "{what} must be one of {}, found {}",
+                    words.join(", "),
+                    node.kind.describe()
+                ),
+            )
+            .with_help(help),
+        );
+        None
     }
 
     /// `initial:` — values, or `{ guess: value }` for coordinates solved from the constraints.
@@ -1456,11 +1558,11 @@ mod tests {
 
     #[test]
     fn later_keys_and_unknown_keys() {
-        let m = messages("name: a\ncoordinates: [q]\nevents: []\nkinetc: q_dot^2\n");
+        let m = messages("name: a\ncoordinates: [q]\nequilibria: []\nkinetc: q_dot^2\n");
         assert_eq!(
             m,
             [
-                "3:1: `events:` is not supported yet by this version of eomgen",
+                "3:1: `equilibria:` is not supported yet by this version of eomgen",
                 "4:1: unknown key `kinetc` in a model file"
             ]
         );
@@ -1471,6 +1573,33 @@ mod tests {
                 .as_deref()
                 .unwrap()
                 .starts_with("did you mean `kinetic`?")
+        );
+    }
+
+    #[test]
+    fn events_short_and_full_forms() {
+        let src = "name: a\ncoordinates: [q]\nkinetic: q_dot^2/2\nevents:\n  cross: q\n  peak: { when: q_dot, direction: falling, terminal: true }\n";
+        let file = built(src).file.unwrap();
+        assert_eq!(file.events.len(), 2);
+        assert_eq!(file.events[0].name.value, "cross");
+        assert_eq!(
+            (file.events[0].direction, file.events[0].terminal),
+            (Crossing::Both, false)
+        );
+        assert_eq!(
+            (file.events[1].direction, file.events[1].terminal),
+            (Crossing::Falling, true)
+        );
+        let m = messages(
+            "name: a\ncoordinates: [q]\nkinetic: q_dot^2/2\nevents:\n  peak: { when: q_dot, terminal: yes, directon: up }\n  bare: { direction: rising }\n",
+        );
+        assert_eq!(
+            m,
+            [
+                "5:34: `terminal` of event `peak` must be one of true, false, found `yes`",
+                "5:39: unknown key `directon` in event `peak`",
+                "6:3: event `bare` has no `when`"
+            ]
         );
     }
 

@@ -1,0 +1,3 @@
+eomgen::model!("event-unknown-name.yaml");
+
+fn main() {}

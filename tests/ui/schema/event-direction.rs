@@ -1,0 +1,3 @@
+eomgen::model!("event-direction.yaml");
+
+fn main() {}
