@@ -272,6 +272,9 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
                 "steps": solution.stats.steps,
                 "rejected": solution.stats.rejected,
                 "rhs_evals": solution.stats.rhs_evals,
+                "jacobian_evals": solution.stats.jacobian_evals,
+                "lu_decompositions": solution.stats.lu_decompositions,
+                "event_evals": solution.stats.event_evals,
                 "wall_time_s": solution.stats.wall_time_s,
             },
         });
@@ -373,10 +376,19 @@ fn print_summary(
         model.num_dofs(),
         model.description()
     );
-    println!(
-        "method     {method} (rtol {:e}, atol {:e})",
-        args.rtol, args.atol
+    let adaptive = matches!(
+        args.method,
+        Method::Bs32 | Method::Dp54 | Method::Dop853 | Method::Radau5
     );
+    if adaptive {
+        println!(
+            "method     {method} (rtol {:e}, atol {:e})",
+            args.rtol, args.atol
+        );
+    } else {
+        let dt = args.dt.unwrap_or(args.t_end / 1000.0);
+        println!("method     {method} (fixed step dt = {dt:e} s)");
+    }
     if let Some((t, y)) = solution.last() {
         let n = model.num_dofs();
         let names = model.coordinate_names();
@@ -402,8 +414,16 @@ fn print_summary(
         }
     }
     let s = &solution.stats;
+    let implicit = if s.jacobian_evals > 0 {
+        format!(
+            ", {} Jacobians, {} LU factorisations",
+            s.jacobian_evals, s.lu_decompositions
+        )
+    } else {
+        String::new()
+    };
     println!(
-        "work       {} steps ({} rejected), {} RHS evaluations, {:.3} ms",
+        "work       {} steps ({} rejected), {} RHS evaluations{implicit}, {:.3} ms",
         s.steps,
         s.rejected,
         s.rhs_evals,
