@@ -7,6 +7,7 @@
 
 pub mod constrained;
 pub mod integrate;
+pub mod modal;
 pub mod ode;
 pub mod system;
 
@@ -17,6 +18,10 @@ pub use integrate::{
     Integrator, IntegratorOptions, OutputTimes, PiController, PredictiveController, RadauIIA5,
     RungeKutta4, Solution, Stats, StepOutcome, StepSizeController, StormerVerlet, SymplecticEuler,
     Tableau, Tolerance,
+};
+pub use modal::{
+    Equilibrium, Linearization, ModalError, ModeKind, NormalModes, damped_modes,
+    eigenvalues_of_m_inv_k, find_equilibrium, linearize, normal_modes,
 };
 pub use ode::{OdeFn, OdeSystem, RhsError, WithEvents};
 pub use system::{ConstraintValues, FirstOrder, MechanicalSystem, ModelInfo, UnknownParameter};

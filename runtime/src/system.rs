@@ -162,6 +162,18 @@ pub trait MechanicalSystem<const N: usize> {
         &[]
     }
 
+    /// The model file's `equilibria:` names, in file order (issue 7; lecture 25); empty by
+    /// default.
+    fn equilibrium_names(&self) -> &'static [&'static str] {
+        &[]
+    }
+
+    /// The guesses of [`Self::equilibrium_names`], `N` coordinates each, one after the other
+    /// (`out` has `N · equilibrium_names().len()` entries).
+    fn equilibrium_guesses(&self, out: &mut [f64]) {
+        let _ = out;
+    }
+
     /// The model file's `events:` (issue 6, item 2; lecture 17, HW21, HW36): names,
     /// directions and whether each ends the integration, in file order; empty by default.
     fn event_specs(&self) -> &'static [EventSpec] {
@@ -476,6 +488,8 @@ pub trait ModelInfo: OdeSystem {
     fn project(&mut self, t: f64, y: &mut [f64], free: &[usize]) -> Result<usize, ProjectionError>;
     /// Indices of the coordinates whose initial values are guesses.
     fn initial_guesses(&self) -> &'static [usize];
+    /// The model's named equilibrium guesses `(name, q)` ([`MechanicalSystem::equilibrium_names`]).
+    fn equilibrium_guesses(&self) -> Vec<(&'static str, Vec<f64>)>;
     /// Makes the model event `name` terminal or not (`eomgen simulate --stop-when NAME`);
     /// returns `false` if the model has no event `name`.
     fn set_event_terminal(&mut self, name: &str, terminal: bool) -> bool;
@@ -637,6 +651,16 @@ impl<S: MechanicalSystem<N>, const N: usize> ModelInfo for FirstOrder<S, N> {
     }
     fn initial_guesses(&self) -> &'static [usize] {
         self.system.initial_guesses()
+    }
+    fn equilibrium_guesses(&self) -> Vec<(&'static str, Vec<f64>)> {
+        let names = self.system.equilibrium_names();
+        let mut values = vec![0.0; N * names.len()];
+        self.system.equilibrium_guesses(&mut values);
+        names
+            .iter()
+            .zip(values.chunks(N.max(1)))
+            .map(|(name, q)| (*name, q.to_vec()))
+            .collect()
     }
     fn set_event_terminal(&mut self, name: &str, terminal: bool) -> bool {
         match self.events.iter_mut().find(|e| e.name == name) {

@@ -3,6 +3,7 @@
 mod check;
 mod equations;
 mod events;
+mod modes;
 mod plot;
 mod roundoff;
 mod simulate;
@@ -37,6 +38,9 @@ enum Command {
     Check(check::CheckArgs),
     /// Print a model's equations of motion M q'' = F (text or LaTeX), derived at run time.
     Equations(equations::EquationsArgs),
+    /// Equilibrium, exact linearisation (M, C, K), natural frequencies, mode shapes and
+    /// damping ratios at an operating point (`--at hanging`).
+    Modes(modes::ModesArgs),
     /// Print a generated model file: `n-link-pendulum N` or `n-mass-chain N`.
     New(equations::NewArgs),
     /// Numerical experiments comparing methods: `constraint-methods MODEL`,
@@ -78,6 +82,7 @@ pub fn run() -> ExitCode {
         Command::Check(args) => check::run(&args),
         Command::Equations(args) => equations::run(&args),
         Command::New(args) => equations::new(&args),
+        Command::Modes(args) => modes::run(&args),
         Command::Study(study) => study::run(&study),
     };
     match result {

@@ -493,6 +493,28 @@ pub fn emit(
             &|v| write_out(v),
         );
     }
+    if !model.equilibria.is_empty() {
+        let names: Vec<String> = model
+            .equilibria
+            .iter()
+            .map(|(name, _)| string_literal(name))
+            .collect();
+        let _ = writeln!(
+            constant_items,
+            "fn equilibrium_names(&self) -> &'static [&'static str] {{ &[{}] }}",
+            names.join(", ")
+        );
+        let roots: Vec<ExprId> = model
+            .equilibria
+            .iter()
+            .flat_map(|(_, guess)| guess.iter().copied())
+            .collect();
+        emit_fn(
+            "fn equilibrium_guesses(&self, __out: &mut [f64])",
+            &roots,
+            &|v| write_out(v),
+        );
+    }
     imp.push_str(&constant_items);
     let _ = writeln!(
         imp,

@@ -151,6 +151,8 @@ pub struct SymbolicModel {
     pub initial_guesses: Vec<usize>,
     /// The file's `events:` (empty if none).
     pub events: Vec<EventInfo>,
+    /// The file's `equilibria:`: name and a guess per coordinate (0 where not given).
+    pub equilibria: Vec<(String, Vec<ExprId>)>,
 }
 
 /// One lowered `events:` entry.
@@ -714,6 +716,20 @@ impl<'f> Lowering<'f> {
             })
             .collect();
         self.allow_accelerations = false;
+        let equilibria: Vec<(String, Vec<ExprId>)> = file
+            .equilibria
+            .iter()
+            .map(|q| {
+                let mut guess = vec![self.arena.int(0); n];
+                for (c, e) in &q.values {
+                    let value = self.expr(e);
+                    if let Some(i) = coordinate_names.iter().position(|x| *x == c.value) {
+                        guess[i] = value;
+                    }
+                }
+                (q.name.value.clone(), guess)
+            })
+            .collect();
         let initial_guesses: Vec<usize> = file
             .initial_guesses
             .iter()
@@ -794,6 +810,7 @@ impl<'f> Lowering<'f> {
             constraints,
             initial_guesses,
             events,
+            equilibria,
         })
     }
 }

@@ -316,6 +316,15 @@ impl<'f> Checker<'f> {
                 &format!("the function of event `{}`", e.name.value),
             );
         }
+        for q in &file.equilibria {
+            for (c, e) in &q.values {
+                self.resolve(
+                    e,
+                    Depends::Constant,
+                    &format!("`{}` of equilibrium `{}`", c.value, q.name.value),
+                );
+            }
+        }
     }
 
     /// Reports every name in `e` that `depends` does not allow; `what` names the expression.
@@ -587,6 +596,28 @@ impl<'f> Checker<'f> {
                 None => d.with_help(format!("coordinates are: {}", self.coords.join(", "))),
             };
             self.error(d);
+        }
+        for q in &file.equilibria {
+            for (k, _) in &q.values {
+                let n = k.value.as_str();
+                if self.coords.contains(&n) || self.incomplete.has_name(n) || coordinates_lost {
+                    continue;
+                }
+                let d = Diagnostic::new(
+                    k.location,
+                    format!(
+                        "`{n}` in equilibrium `{}` is not a coordinate",
+                        q.name.value
+                    ),
+                );
+                let d = match closest(n, &self.coords) {
+                    Some(c) => d.with_help(format!(
+                        "did you mean `{c}`? an equilibrium gives coordinates only (rates are 0)"
+                    )),
+                    None => d.with_help(format!("coordinates are: {}", self.coords.join(", "))),
+                };
+                self.error(d);
+            }
         }
         for (k, _) in &file.initial {
             let n = k.value.as_str();

@@ -236,6 +236,16 @@ pub struct EventDef {
     pub terminal: bool,
 }
 
+/// One `equilibria:` entry: a named starting guess for the equilibrium search (issue 7;
+/// lecture 25), `hanging: { theta1: 0, theta2: 0 }`; coordinates not listed start at 0.
+#[derive(Debug, Clone, PartialEq)]
+pub struct EquilibriumDef {
+    /// Its name (`hanging`, `upright`).
+    pub name: Located<String>,
+    /// Guessed coordinate values by coordinate name (constant expressions).
+    pub values: Vec<(Located<String>, Expr)>,
+}
+
 /// A whole model file after the schema pass.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ModelFile {
@@ -288,6 +298,8 @@ pub struct ModelFile {
     pub checks: Checks,
     /// `events:` — functions whose zeros the integrators locate, in file order.
     pub events: Vec<EventDef>,
+    /// `equilibria:` — named guesses for equilibrium searches, in file order.
+    pub equilibria: Vec<EquilibriumDef>,
     /// The spatial dimension of the points (2 or 3); `None` when there are no points.
     pub dimension: Option<usize>,
 }

@@ -40,10 +40,11 @@ pub const TOP_LEVEL_KEYS: &[&str] = &[
     "constraints",
     "nonholonomic",
     "events",
+    "equilibria",
 ];
 
 /// Keys of the model format (DESIGN.md) that this version does not implement yet.
-pub const LATER_KEYS: &[&str] = &["equilibria", "outputs"];
+pub const LATER_KEYS: &[&str] = &["outputs"];
 
 const BODY_KEYS: &[&str] = &["mass", "at", "inertia", "com", "angle"];
 const PARTICLE_EXAMPLE: &str = "{ mass: m, at: P }";
@@ -720,6 +721,10 @@ impl Ctx<'_> {
         let events = get(top, "events")
             .map(|n| self.events(n))
             .unwrap_or_default();
+        self.section = "equilibria";
+        let equilibria = get(top, "equilibria")
+            .map(|n| self.equilibria(n))
+            .unwrap_or_default();
         self.section = "";
 
         let dimension = points.first().map(|p: &Point| p.position.len());
@@ -748,7 +753,38 @@ impl Ctx<'_> {
             nonholonomic,
             initial_guesses,
             events,
+            equilibria,
         })
+    }
+
+    /// `equilibria:` — `name: { coordinate: value, … }`.
+    fn equilibria(&mut self, node: &YamlNode) -> Vec<EquilibriumDef> {
+        const EXAMPLE: &str = "equilibria: { hanging: { theta: 0 }, upright: { theta: pi } }";
+        let Some(entries) = self.map(node, "`equilibria`", EXAMPLE) else {
+            return Vec::new();
+        };
+        let mut out = Vec::new();
+        for (k, v) in entries {
+            if !self.key_name(k, "equilibrium") {
+                continue;
+            }
+            let what = format!("equilibrium `{}`", k.value);
+            let Some(values) = self.map(v, &what, &format!("{}: {{ theta: pi }}", k.value)) else {
+                continue;
+            };
+            let values = values
+                .iter()
+                .filter_map(|(c, e)| {
+                    let e = self.expr(e, &format!("the value of `{}` in {what}", c.value))?;
+                    Some((c.clone(), e))
+                })
+                .collect();
+            out.push(EquilibriumDef {
+                name: k.clone(),
+                values,
+            });
+        }
+        out
     }
 
     /// `events:` — `name: g` or `name: { when: g, direction: rising|falling|both,
@@ -1558,11 +1594,11 @@ mod tests {
 
     #[test]
     fn later_keys_and_unknown_keys() {
-        let m = messages("name: a\ncoordinates: [q]\nequilibria: []\nkinetc: q_dot^2\n");
+        let m = messages("name: a\ncoordinates: [q]\noutputs: []\nkinetc: q_dot^2\n");
         assert_eq!(
             m,
             [
-                "3:1: `equilibria:` is not supported yet by this version of eomgen",
+                "3:1: `outputs:` is not supported yet by this version of eomgen",
                 "4:1: unknown key `kinetc` in a model file"
             ]
         );

@@ -1,0 +1,239 @@
+//! `eomgen modes MODEL`: equilibrium, exact linearisation `M δq̈ + C δq̇ + K δq = 0`, normal
+//! modes and damping (issue 7; lectures 22–26, 30).
+
+use std::io::Write as _;
+
+use clap::Args;
+use eomgen::{ModeKind, ModelInfo, damped_modes, eigenvalues_of_m_inv_k, find_equilibrium};
+use nalgebra::DMatrix;
+use serde_json::json;
+
+use super::values::{evaluate, split_assignment};
+use super::{CliError, find_model};
+
+/// Options of `eomgen modes`.
+#[derive(Debug, Args)]
+pub struct ModesArgs {
+    /// Model name (see `eomgen list`).
+    pub model: String,
+    /// Operating point: a name from the model's `equilibria:` (`hanging`, `upright`), or
+    /// guesses `q1=VALUE,q2=VALUE` (others 0). Default: the model's first equilibrium, else
+    /// q = 0. Newton on F(q, 0) = 0 starts there.
+    #[arg(long)]
+    pub at: Option<String>,
+    /// Set a parameter, `NAME=VALUE`; repeatable.
+    #[arg(long = "set", value_name = "NAME=VALUE")]
+    pub set: Vec<String>,
+    /// Print JSON.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Runs `modes`.
+pub fn run(args: &ModesArgs) -> Result<(), CliError> {
+    let mut model = find_model(&args.model)?;
+    for s in &args.set {
+        let (name, text) = split_assignment(s, "--set")?;
+        let names = model.parameter_names();
+        let values = model.parameter_values();
+        let lookup = |n: &str| names.iter().position(|p| *p == n).map(|i| values[i]);
+        let value = evaluate(text, &format!("--set {name}"), &lookup)?;
+        model
+            .set_parameter(name, value)
+            .map_err(|e| CliError::usage(e.to_string()))?;
+    }
+    let (label, guess) = operating_point(model.as_ref(), args.at.as_deref())?;
+    let fail = |e: eomgen::ModalError| CliError::failure(format!("`{}`: {e}", model.name()));
+    let equilibrium = find_equilibrium(model.as_ref(), &guess, 0.0).map_err(fail)?;
+    let n = model.num_dofs();
+    let lin =
+        eomgen::linearize(model.as_ref(), &equilibrium.q, &vec![0.0; n], 0.0).map_err(fail)?;
+    let modes = eomgen::normal_modes(&lin).map_err(fail)?;
+    let route22 = eigenvalues_of_m_inv_k(&lin).map_err(fail)?;
+    let damped = damped_modes(&lin).map_err(fail)?;
+    let names = model.coordinate_names();
+    let undamped = lin.damping_matrix.amax() == 0.0;
+    let damping_ratios: Vec<f64> = if undamped {
+        vec![0.0; n]
+    } else {
+        damped.iter().map(|d| d.1).collect()
+    };
+    let scale = modes.eigenvalues.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let route_difference = modes
+        .eigenvalues
+        .iter()
+        .zip(&route22)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0f64, f64::max)
+        / scale.max(f64::MIN_POSITIVE);
+    let kind = |k: &ModeKind| match k {
+        ModeKind::Oscillatory => json!({"kind": "oscillatory"}),
+        ModeKind::ZeroFrequency => json!({"kind": "zero_frequency"}),
+        ModeKind::Unstable { growth_rate } => {
+            json!({"kind": "unstable", "growth_rate": growth_rate})
+        }
+    };
+    let rows = |m: &DMatrix<f64>| -> Vec<Vec<f64>> {
+        (0..m.nrows())
+            .map(|i| m.row(i).iter().copied().collect())
+            .collect()
+    };
+    let shapes: Vec<Vec<f64>> = (0..n)
+        .map(|k| modes.mode_shapes.column(k).iter().copied().collect())
+        .collect();
+    let mut stdout = std::io::stdout().lock();
+    if args.json {
+        let out = json!({
+            "model": model.name(),
+            "coordinates": names,
+            "operating_point": {
+                "name": label,
+                "q": names.iter().zip(&equilibrium.q).map(|(c, v)| (c.to_string(), json!(v))).collect::<serde_json::Map<_, _>>(),
+                "newton_iterations": equilibrium.iterations,
+                "residual": equilibrium.residual,
+            },
+            "natural_frequencies": modes.natural_frequencies,
+            "frequencies_hz": modes.natural_frequencies.iter().map(|w| w / std::f64::consts::TAU).collect::<Vec<_>>(),
+            "eigenvalues": modes.eigenvalues,
+            "kinds": modes.kinds.iter().map(kind).collect::<Vec<_>>(),
+            "damping_ratios": damping_ratios,
+            "damped_modes": damped.iter().map(|(s, zeta, wd)| json!({"re": s.re, "im": s.im, "damping_ratio": zeta, "damped_frequency": wd})).collect::<Vec<_>>(),
+            "mode_shapes": shapes,
+            "mass_matrix": rows(&lin.mass_matrix),
+            "stiffness_matrix": rows(&lin.stiffness_matrix),
+            "damping_matrix": rows(&lin.damping_matrix),
+            "stiffness_asymmetry": modes.stiffness_asymmetry,
+            "m_inv_k_eigenvalues": route22,
+            "m_inv_k_relative_difference": route_difference,
+        });
+        let text =
+            serde_json::to_string_pretty(&out).map_err(|e| CliError::failure(e.to_string()))?;
+        let _ = writeln!(stdout, "{text}");
+        return Ok(());
+    }
+    let _ = writeln!(stdout, "model      {} ({} dof)", model.name(), n);
+    let point: Vec<String> = names
+        .iter()
+        .zip(&equilibrium.q)
+        .map(|(c, v)| format!("{c} = {v:.12e}"))
+        .collect();
+    let _ = writeln!(
+        stdout,
+        "equilibrium {label}: {} (Newton: {} iterations, max |F| = {:.1e})",
+        point.join(", "),
+        equilibrium.iterations,
+        equilibrium.residual
+    );
+    print_matrix(&mut stdout, "M", &lin.mass_matrix);
+    print_matrix(&mut stdout, "K", &lin.stiffness_matrix);
+    if !undamped {
+        print_matrix(&mut stdout, "C", &lin.damping_matrix);
+    }
+    if modes.stiffness_asymmetry > 1e-12 {
+        let _ = writeln!(
+            stdout,
+            "note       K is not symmetric (‖K − Kᵀ‖/‖K‖ = {:.2e}); its symmetric part is used",
+            modes.stiffness_asymmetry
+        );
+    }
+    let _ = writeln!(
+        stdout,
+        "{:>4}  {:>16}  {:>14}  {:>10}  mode shape (mass-normalised; {})",
+        "mode",
+        "ω (rad/s)",
+        "f (Hz)",
+        "ζ",
+        names.join(", ")
+    );
+    for (k, shape) in shapes.iter().enumerate() {
+        let w = modes.natural_frequencies[k];
+        let note = match modes.kinds[k] {
+            ModeKind::Oscillatory => String::new(),
+            ModeKind::ZeroFrequency => "  zero-frequency".to_string(),
+            ModeKind::Unstable { growth_rate } => {
+                format!("  unstable, grows as e^({growth_rate:.6e} t)")
+            }
+        };
+        let shape: Vec<String> = shape.iter().map(|v| format!("{v:>11.4e}")).collect();
+        let zeta = damping_ratios
+            .get(k)
+            .map_or("-".to_string(), |z| format!("{z:.4e}"));
+        let _ = writeln!(
+            stdout,
+            "{:>4}  {:>16.10e}  {:>14.6e}  {:>10}  [{}]{note}",
+            k + 1,
+            w,
+            w / std::f64::consts::TAU,
+            zeta,
+            shape.join(", ")
+        );
+    }
+    let _ = writeln!(
+        stdout,
+        "check      eigenvalues of M⁻¹K (lecture 22) vs the symmetric Cholesky route (lecture 24): max difference {route_difference:.1e} of max |ω²|"
+    );
+    Ok(())
+}
+
+fn print_matrix(out: &mut impl std::io::Write, name: &str, m: &DMatrix<f64>) {
+    for i in 0..m.nrows() {
+        let row: Vec<String> = m.row(i).iter().map(|v| format!("{v:>13.6e}")).collect();
+        let label = if i == 0 {
+            format!("{name} =")
+        } else {
+            String::new()
+        };
+        let _ = writeln!(out, "{label:<10} [{}]", row.join(", "));
+    }
+}
+
+/// The starting guess of the equilibrium search and its label.
+fn operating_point(
+    model: &dyn ModelInfo,
+    at: Option<&str>,
+) -> Result<(String, Vec<f64>), CliError> {
+    let n = model.num_dofs();
+    let named = model.equilibrium_guesses();
+    let Some(at) = at else {
+        return Ok(match named.first() {
+            Some((name, q)) => (name.to_string(), q.clone()),
+            None => ("q = 0".to_string(), vec![0.0; n]),
+        });
+    };
+    if let Some((name, q)) = named.iter().find(|(name, _)| *name == at) {
+        return Ok((name.to_string(), q.clone()));
+    }
+    if !at.contains('=') {
+        let list: Vec<&str> = named.iter().map(|(n, _)| *n).collect();
+        return Err(CliError::usage(format!(
+            "--at {at}: `{}` has no equilibrium `{at}` ({}); or give guesses like `--at {}=0`",
+            model.name(),
+            if list.is_empty() {
+                "it names none".to_string()
+            } else {
+                format!("it names: {}", list.join(", "))
+            },
+            model.coordinate_names().first().copied().unwrap_or("q")
+        )));
+    }
+    let names = model.parameter_names();
+    let values = model.parameter_values();
+    let lookup = |p: &str| names.iter().position(|x| *x == p).map(|i| values[i]);
+    let mut q = vec![0.0; n];
+    for part in at.split(',') {
+        let (name, text) = split_assignment(part, "--at")?;
+        let index = model
+            .coordinate_names()
+            .iter()
+            .position(|c| *c == name)
+            .ok_or_else(|| {
+                CliError::usage(format!(
+                    "--at: `{name}` is not a coordinate of `{}` (coordinates: {})",
+                    model.name(),
+                    model.coordinate_names().join(", ")
+                ))
+            })?;
+        q[index] = evaluate(text, &format!("--at {name}"), &lookup)?;
+    }
+    Ok((at.to_string(), q))
+}

@@ -1,0 +1,252 @@
+//! Equilibria, exact linearisation and normal modes (issue 7, items 1–3) against analytic
+//! frequencies and independent hand derivations.
+
+use std::process::Command;
+
+use eomgen::{
+    ModalError, ModeKind, ModelInfo, eigenvalues_of_m_inv_k, find_equilibrium, linearize,
+    normal_modes,
+};
+use nalgebra::{DMatrix, Matrix2};
+
+fn model(name: &str) -> Box<dyn ModelInfo> {
+    (eomgen::models::find(name).expect("bundled model").make)()
+}
+
+fn guess(model: &dyn ModelInfo, name: &str) -> Vec<f64> {
+    model
+        .equilibrium_guesses()
+        .into_iter()
+        .find(|(n, _)| *n == name)
+        .unwrap_or_else(|| panic!("{} names `{name}`", model.name()))
+        .1
+}
+
+/// Natural frequencies (rad/s), mode shapes and the linearisation at a named equilibrium.
+fn modes_at(
+    name: &str,
+    at: &str,
+) -> (
+    Vec<f64>,
+    DMatrix<f64>,
+    eomgen::Linearization,
+    eomgen::NormalModes,
+) {
+    let m = model(name);
+    let q = find_equilibrium(m.as_ref(), &guess(m.as_ref(), at), 0.0)
+        .unwrap()
+        .q;
+    let lin = linearize(m.as_ref(), &q, &vec![0.0; q.len()], 0.0).unwrap();
+    let modes = normal_modes(&lin).unwrap();
+    (
+        modes.natural_frequencies.clone(),
+        modes.mode_shapes.clone(),
+        lin,
+        modes,
+    )
+}
+
+fn close(a: f64, b: f64, tol: f64) -> bool {
+    (a - b).abs() <= tol * b.abs().max(1.0)
+}
+
+/// ΨᵀMΨ = I to 1e-12 (Cholesky reduction in double precision on matrices of order 1).
+fn assert_mass_normalised(shapes: &DMatrix<f64>, m: &DMatrix<f64>) {
+    let g = shapes.transpose() * m * shapes;
+    let err = (g - DMatrix::identity(m.nrows(), m.nrows())).amax();
+    assert!(err < 1e-12, "ΨᵀMΨ − I = {err:e}");
+}
+
+/// HW23: three equal masses, four springs: ω = √(2 − √2), √2, √(2 + √2) · √(k/m) with shapes
+/// [1, √2, 1], [1, 0, −1], [1, −√2, 1]. Exact arithmetic would give equality; 1e-12 allows
+/// for the symmetric eigensolver's rounding.
+#[test]
+fn three_masses_analytic_frequencies_and_shapes() {
+    let (w, shapes, lin, _) = modes_at("three_masses", "rest");
+    let s2 = 2f64.sqrt();
+    for (wi, exact) in w.iter().zip([(2.0 - s2).sqrt(), s2, (2.0 + s2).sqrt()]) {
+        assert!(close(*wi, exact, 1e-12), "{wi} vs {exact}");
+    }
+    assert_mass_normalised(&shapes, &lin.mass_matrix);
+    for (k, exact) in [[1.0, s2, 1.0], [1.0, 0.0, -1.0], [1.0, -s2, 1.0]]
+        .iter()
+        .enumerate()
+    {
+        let psi = shapes.column(k);
+        let ratio = psi[0] / exact[0];
+        for i in 0..3 {
+            assert!(
+                (psi[i] - ratio * exact[i]).abs() < 1e-12,
+                "mode {k}: {psi:?}"
+            );
+        }
+    }
+}
+
+/// HW27–28: the cart–pendulum has one zero-frequency mode (the cart's free translation) and
+/// ω² = g (m1 + m2)/(m1 ℓ) = 20 1/s².
+#[test]
+fn cart_pendulum_zero_mode_and_swing() {
+    let (w, shapes, lin, modes) = modes_at("cart_pendulum", "hanging");
+    assert_eq!(modes.kinds[0], ModeKind::ZeroFrequency);
+    assert_eq!(w[0], 0.0);
+    assert!(close(w[1], 20f64.sqrt(), 1e-12));
+    assert_mass_normalised(&shapes, &lin.mass_matrix);
+    // The zero mode is a pure translation of the whole (θ = 0).
+    assert!(shapes[(1, 0)].abs() < 1e-12);
+}
+
+/// The double pendulum of two uniform bars (m = 1, ℓ = 1, g = 10) hanging: M and K derived by
+/// hand (T = ½(m1/3 + m2) ℓ1² θ̇1² + ½ m2 ℓ1 ℓ2 cos(θ1 − θ2) θ̇1 θ̇2 + ⅙ m2 ℓ2² θ̇2², V from the
+/// bars' centres), ω² the roots of det(K − ω² M) = 0; upright, K changes sign so the same
+/// numbers become growth rates.
+#[test]
+fn double_pendulum_hanging_and_upright() {
+    let (m1, m2, l1, l2, g): (f64, f64, f64, f64, f64) = (1.0, 1.0, 1.0, 1.0, 10.0);
+    let mh = Matrix2::new(
+        (m1 / 3.0 + m2) * l1 * l1,
+        m2 * l1 * l2 / 2.0,
+        m2 * l1 * l2 / 2.0,
+        m2 * l2 * l2 / 3.0,
+    );
+    let kh = Matrix2::new((m1 / 2.0 + m2) * g * l1, 0.0, 0.0, m2 * g * l2 / 2.0);
+    // det(K − λM) = a λ² + b λ + c.
+    let a = mh.determinant();
+    let b = -(kh[(0, 0)] * mh[(1, 1)] + kh[(1, 1)] * mh[(0, 0)]);
+    let c = kh.determinant();
+    let disc = (b * b - 4.0 * a * c).sqrt();
+    let exact = [
+        ((-b - disc) / (2.0 * a)).sqrt(),
+        ((-b + disc) / (2.0 * a)).sqrt(),
+    ];
+    let (w, shapes, lin, _) = modes_at("double_pendulum", "hanging");
+    for (wi, e) in w.iter().zip(exact) {
+        assert!(close(*wi, e, 1e-12), "{wi} vs {e}");
+    }
+    assert!(
+        (lin.mass_matrix.clone() - DMatrix::from_row_slice(2, 2, mh.as_slice())).amax() < 1e-14
+    );
+    assert_mass_normalised(&shapes, &lin.mass_matrix);
+    let (_, _, _, upright) = modes_at("double_pendulum", "upright");
+    let mut rates: Vec<f64> = upright
+        .kinds
+        .iter()
+        .map(|k| match k {
+            ModeKind::Unstable { growth_rate } => *growth_rate,
+            other => panic!("upright should be unstable: {other:?}"),
+        })
+        .collect();
+    rates.sort_by(f64::total_cmp);
+    for (r, e) in rates.iter().zip(exact) {
+        assert!(close(*r, e, 1e-12));
+    }
+}
+
+/// One-degree-of-freedom classics: compound pendulum ω² = m g d/(I + m d²) = 15; bead on
+/// y = c x², ω = √(2 g c); cylinder rolling in a cylinder (HW26), ω² = 2 g/(3 (R − r)).
+#[test]
+fn single_dof_frequencies() {
+    for (name, at, exact) in [
+        ("compound_pendulum", "hanging", 15f64.sqrt()),
+        ("bead_parabola", "bottom", 20f64.sqrt()),
+        (
+            "rolling_in_cylinder",
+            "bottom",
+            (2.0 * 10.0 / (3.0 * 0.8f64)).sqrt(),
+        ),
+        ("simple_pendulum", "hanging", 10f64.sqrt()),
+    ] {
+        let (w, _, _, _) = modes_at(name, at);
+        assert!(close(w[0], exact, 1e-12), "{name}: {} vs {exact}", w[0]);
+    }
+}
+
+/// Both routes to the frequencies agree: eigenvalues of the non-symmetric M⁻¹K (lecture 22)
+/// and the symmetric Cholesky reduction (lecture 24), to 1e-12 of the largest.
+#[test]
+fn m_inverse_k_and_symmetric_routes_agree() {
+    for (name, at) in [
+        ("triple_pendulum", "hanging"),
+        ("double_pendulum", "upright"),
+        ("three_masses", "rest"),
+    ] {
+        let (_, _, lin, modes) = modes_at(name, at);
+        let other = eigenvalues_of_m_inv_k(&lin).unwrap();
+        let scale = modes.eigenvalues.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        for (a, b) in modes.eigenvalues.iter().zip(&other) {
+            assert!((a - b).abs() < 1e-12 * scale, "{name}: {a} vs {b}");
+        }
+        assert!(modes.stiffness_asymmetry < 1e-14, "{name}");
+    }
+}
+
+/// Newton finds the equilibrium from a rough guess; a model without one (the cannonball
+/// falls forever) and a constrained one are clear errors.
+#[test]
+fn equilibrium_search_and_its_errors() {
+    let m = model("triple_pendulum");
+    let e = find_equilibrium(m.as_ref(), &[-1.2, -2.0, -1.3], 0.0).unwrap();
+    for q in &e.q {
+        assert!((q + std::f64::consts::FRAC_PI_2).abs() < 1e-12, "{:?}", e.q);
+    }
+    assert!(e.iterations > 0 && e.residual < 1e-10);
+    let ball = model("cannonball");
+    let err = find_equilibrium(ball.as_ref(), &vec![0.0; ball.num_dofs()], 0.0).unwrap_err();
+    assert!(
+        matches!(err, ModalError::EquilibriumNotFound { .. }),
+        "{err}"
+    );
+    let bar = model("four_bar");
+    let err = find_equilibrium(bar.as_ref(), &vec![0.0; bar.num_dofs()], 0.0).unwrap_err();
+    assert!(matches!(err, ModalError::Constrained { .. }));
+}
+
+/// A damped oscillator's ζ = c/(2√(k m)) from the eigenvalues of A.
+#[test]
+fn damping_ratio_from_the_state_matrix() {
+    let mut m = model("forced_oscillator");
+    m.set_parameter("A", 0.0).unwrap();
+    m.set_parameter("c", 0.3).unwrap();
+    let lin = linearize(m.as_ref(), &[0.0], &[0.0], 0.0).unwrap();
+    let damped = eomgen::damped_modes(&lin).unwrap();
+    assert_eq!(damped.len(), 1);
+    assert!(close(damped[0].1, 0.15, 1e-12));
+    assert!(close(damped[0].2, (1.0f64 - 0.15 * 0.15).sqrt(), 1e-12));
+}
+
+#[test]
+fn modes_cli_json_contract_and_errors() {
+    let out = Command::new(env!("CARGO_BIN_EXE_eomgen"))
+        .args(["modes", "cart_pendulum", "--at", "hanging", "--json"])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["model"], "cart_pendulum");
+    assert_eq!(v["operating_point"]["name"], "hanging");
+    assert_eq!(v["natural_frequencies"].as_array().unwrap().len(), 2);
+    assert_eq!(v["damping_ratios"].as_array().unwrap().len(), 2);
+    assert_eq!(v["mode_shapes"].as_array().unwrap().len(), 2);
+    assert_eq!(v["kinds"][0]["kind"], "zero_frequency");
+    let out = Command::new(env!("CARGO_BIN_EXE_eomgen"))
+        .args(["modes", "double_pendulum", "--at", "sideways"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("it names: hanging, upright"));
+    let out = Command::new(env!("CARGO_BIN_EXE_eomgen"))
+        .args([
+            "modes",
+            "double_pendulum",
+            "--at",
+            "theta1=-1.4,theta2=-1.7",
+        ])
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    assert!(String::from_utf8_lossy(&out.stdout).contains("theta1 = -1.570796326795e0"));
+}
