@@ -227,17 +227,24 @@ impl Linearization {
         asymmetry(&self.stiffness_matrix)
     }
 
+    /// The Cholesky factorisation of `M`.
+    ///
+    /// # Errors
+    /// [`ModalError::SingularMassMatrix`] if `M` is not positive definite.
+    pub fn mass_cholesky(&self) -> Result<nalgebra::Cholesky<f64, nalgebra::Dyn>, ModalError> {
+        self.mass_matrix
+            .clone()
+            .cholesky()
+            .ok_or_else(|| ModalError::SingularMassMatrix { q: self.q.clone() })
+    }
+
     /// The state matrix `A = [0 I; −M⁻¹K −M⁻¹C]` (`2n × 2n`) of `δẏ = A δy`, `y = [q; q̇]`.
     ///
     /// # Errors
     /// [`ModalError::SingularMassMatrix`] if `M` is not positive definite.
     pub fn state_matrix(&self) -> Result<DMatrix<f64>, ModalError> {
         let n = self.q.len();
-        let chol = self
-            .mass_matrix
-            .clone()
-            .cholesky()
-            .ok_or_else(|| ModalError::SingularMassMatrix { q: self.q.clone() })?;
+        let chol = self.mass_cholesky()?;
         let mk = chol.solve(&self.stiffness_matrix);
         let mc = chol.solve(&self.damping_matrix);
         let mut a = DMatrix::zeros(2 * n, 2 * n);
@@ -343,11 +350,7 @@ pub struct NormalModes {
 pub fn normal_modes(lin: &Linearization) -> Result<NormalModes, ModalError> {
     let n = lin.q.len();
     let k_sym = (&lin.stiffness_matrix + lin.stiffness_matrix.transpose()) * 0.5;
-    let chol = lin
-        .mass_matrix
-        .clone()
-        .cholesky()
-        .ok_or_else(|| ModalError::SingularMassMatrix { q: lin.q.clone() })?;
+    let chol = lin.mass_cholesky()?;
     let l = chol.l();
     // K̃ = L⁻¹ K L⁻ᵀ: solve L X = K, then L Y = Xᵀ (Y = L⁻¹ (L⁻¹ K)ᵀ = L⁻¹ K L⁻ᵀ for symmetric K).
     let x = l
@@ -413,11 +416,7 @@ pub fn normal_modes(lin: &Linearization) -> Result<NormalModes, ModalError> {
 /// # Errors
 /// [`ModalError::SingularMassMatrix`].
 pub fn eigenvalues_of_m_inv_k(lin: &Linearization) -> Result<Vec<f64>, ModalError> {
-    let chol = lin
-        .mass_matrix
-        .clone()
-        .cholesky()
-        .ok_or_else(|| ModalError::SingularMassMatrix { q: lin.q.clone() })?;
+    let chol = lin.mass_cholesky()?;
     let mk = chol.solve(&lin.stiffness_matrix);
     let mut values: Vec<f64> = mk.complex_eigenvalues().iter().map(|c| c.re).collect();
     values.sort_by(f64::total_cmp);
