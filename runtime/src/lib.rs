@@ -21,7 +21,7 @@ pub use integrate::{
 };
 pub use modal::{
     Equilibrium, Linearization, ModalError, ModeKind, NormalModes, damped_modes,
-    eigenvalues_of_m_inv_k, find_equilibrium, linearize, normal_modes,
+    eigenvalues_of_m_inv_k, find_equilibrium, linearize, matrix_exponential, normal_modes,
 };
 pub use ode::{OdeFn, OdeSystem, RhsError, WithEvents};
 pub use system::{ConstraintValues, FirstOrder, MechanicalSystem, ModelInfo, UnknownParameter};
