@@ -25,7 +25,7 @@
 //! the MuJoCo anchor of issue 6 (RK4 at `dt = 1e-3`: about 60 ms for 10 s of the double
 //! pendulum at a state error of about 5e-4).
 
-use std::io::Write as _;
+use std::io::Write;
 
 use clap::{Args, ValueEnum};
 use eomgen::{IntegrationFailure, Integrator, IntegratorOptions, ModelInfo, OutputTimes, Solution};
@@ -148,6 +148,9 @@ struct Measured {
     energy_drift: Option<f64>,
 }
 
+/// A measure of work of a run: RHS evaluations, steps or wall time.
+type Work = fn(&Measured) -> f64;
+
 /// One setting of one method.
 struct Run {
     setting: Setting,
@@ -241,7 +244,9 @@ fn parse_tols(text: &str) -> Result<Vec<f64>, CliError> {
         // exponent so that `1e-3..1e-12` gives exactly 1e-3, 1e-4, …, 1e-12.
         let decades = (hi / lo).log10().round() as i32;
         if ((hi / lo).log10() - f64::from(decades)).abs() > 1e-9 {
-            return Err(bad("the two ends of a range must be a whole number of decades apart"));
+            return Err(bad(
+                "the two ends of a range must be a whole number of decades apart",
+            ));
         }
         (0..=decades)
             .map(|k| {
@@ -315,23 +320,6 @@ fn state_error(solution: &Solution, reference: &Solution) -> f64 {
         .fold(0.0, f64::max)
 }
 
-/// Integrates the model once from `y0` over `[0, t_end]`, sampled at `times`.
-fn integrate(
-    integrator: &mut dyn Integrator,
-    model: &mut dyn ModelInfo,
-    y0: &[f64],
-    t_end: f64,
-    times: &OutputTimes,
-    options: &IntegratorOptions,
-) -> Result<Solution, Failure> {
-    integrator
-        .integrate(model.as_ode_mut(), 0.0, y0, t_end, times, options)
-        .map_err(|IntegrationFailure { error, .. }| Failure {
-            t: error.t(),
-            message: error.to_string(),
-        })
-}
-
 /// Timing rule of the study: at least `repeats` runs, and more until they total
 /// `min_time_s`, at most [`MAX_REPEATS`].
 #[derive(Debug, Clone, Copy)]
@@ -351,51 +339,63 @@ fn median(values: &mut [f64]) -> f64 {
     }
 }
 
-/// Problem shared by every run: the model, its initial state, the interval and output
-/// times, and the reference samples.
+/// Problem shared by every run: the model, its initial state, the interval and the output
+/// times.
 struct Problem {
     model: Box<dyn ModelInfo>,
     y0: Vec<f64>,
     t_end: f64,
     times: OutputTimes,
-    reference: Solution,
 }
 
 impl Problem {
-    /// Runs `method` at `setting`: the error and work of its first run, the median time of
-    /// `timing`'s repetitions.
-    fn run(&mut self, method: Method, setting: Setting, timing: Timing) -> Run {
+    /// Integrates the model once from `y0` over `[0, t_end]`, sampled at the output times.
+    fn solve(
+        &mut self,
+        integrator: &mut dyn Integrator,
+        options: &IntegratorOptions,
+    ) -> Result<Solution, Failure> {
+        integrator
+            .integrate(
+                self.model.as_ode_mut(),
+                0.0,
+                &self.y0,
+                self.t_end,
+                &self.times,
+                options,
+            )
+            .map_err(|IntegrationFailure { error, .. }| Failure {
+                t: error.t(),
+                message: error.to_string(),
+            })
+    }
+
+    /// Runs `method` at `setting`: the error against `reference` and the work of its first
+    /// run, the median time of `timing`'s repetitions.
+    fn run(
+        &mut self,
+        method: Method,
+        setting: Setting,
+        timing: Timing,
+        reference: &Solution,
+    ) -> Run {
         let options = setting.options();
         let mut integrator = method.integrator();
-        let first = integrate(
-            integrator.as_mut(),
-            self.model.as_mut(),
-            &self.y0,
-            self.t_end,
-            &self.times,
-            &options,
-        );
+        let first = self.solve(integrator.as_mut(), &options);
         let outcome = first.map(|solution| {
             let mut times = vec![solution.stats.wall_time_s];
             while times.len() < timing.repeats.max(1)
                 || (times.iter().sum::<f64>() < timing.min_time_s && times.len() < MAX_REPEATS)
             {
                 // The runs are identical (deterministic steps); only the clock differs.
-                match integrate(
-                    integrator.as_mut(),
-                    self.model.as_mut(),
-                    &self.y0,
-                    self.t_end,
-                    &self.times,
-                    &options,
-                ) {
+                match self.solve(integrator.as_mut(), &options) {
                     Ok(again) => times.push(again.stats.wall_time_s),
                     Err(_) => break,
                 }
             }
             let report = Report::new(self.model.as_ref(), &self.y0, &solution);
             Measured {
-                error: state_error(&solution, &self.reference),
+                error: state_error(&solution, reference),
                 rhs_evals: solution.stats.rhs_evals,
                 steps: solution.stats.steps,
                 rejected: solution.stats.rejected,
@@ -439,7 +439,7 @@ fn at_target(runs: &[Run], target: f64) -> AtTarget {
             wall_time_s: first.wall_time_s,
         };
     }
-    let series = |work: fn(&Measured) -> f64| -> Vec<(f64, f64)> {
+    let series = |work: Work| -> Vec<(f64, f64)> {
         measured
             .iter()
             .map(|m| m.map_or((f64::NAN, f64::NAN), |m| (m.error, work(m))))
@@ -532,52 +532,37 @@ pub fn run(args: &WorkPrecisionArgs) -> Result<(), CliError> {
         .with_rtol(args.reference_tol)
         .with_atol(args.reference_tol)
         .with_max_steps(MAX_STEPS);
-    let reference = integrate(
-        Method::Dop853.integrator().as_mut(),
-        model.as_mut(),
-        &y0,
-        args.t_end,
-        &times,
-        &reference_options,
-    )
-    .map_err(|f| {
-        CliError::failure(format!(
-            "the reference solution (DOP853 at rtol = atol = {:e}) failed: {}; try a looser --reference-tol or a shorter --t-end",
-            args.reference_tol, f.message
-        ))
-    })?;
-    let check = integrate(
-        Method::Dp54.integrator().as_mut(),
-        model.as_mut(),
-        &y0,
-        args.t_end,
-        &times,
-        &reference_options,
-    )
-    .map_err(|f| {
-        CliError::failure(format!(
-            "the check of the reference (Dormand–Prince 5(4) at rtol = atol = {:e}) failed: {}; try a looser --reference-tol or a shorter --t-end",
-            args.reference_tol, f.message
-        ))
-    })?;
-    let agreement = state_error(&check, &reference);
-    if !(agreement <= args.target_error / 100.0) {
-        return Err(CliError::failure(format!(
-            "the reference is not verified: DOP853 and Dormand–Prince 5(4) at rtol = atol = {:e} differ by {agreement:.3e}, not far below the target error {:e} (need ≤ 1/100 of it); try a shorter --t-end, a larger --target-error or another --reference-tol",
-            args.reference_tol, args.target_error
-        )));
-    }
-    let reference_stats = reference.stats;
     let mut problem = Problem {
         model,
         y0,
         t_end: args.t_end,
         times,
-        reference,
     };
+    let mut solve = |method: Method, role: &str| {
+        problem
+            .solve(method.integrator().as_mut(), &reference_options)
+            .map_err(|f| {
+                CliError::failure(format!(
+                    "{role} ({} at rtol = atol = {:e}) failed: {}; try a looser --reference-tol or a shorter --t-end",
+                    display_name(method),
+                    args.reference_tol,
+                    f.message
+                ))
+            })
+    };
+    let reference = solve(Method::Dop853, "the reference solution")?;
+    let check = solve(Method::Dp54, "the check of the reference")?;
+    let agreement = state_error(&check, &reference);
+    if agreement.is_nan() || agreement > args.target_error / 100.0 {
+        return Err(CliError::failure(format!(
+            "the reference is not verified: DOP853 and Dormand–Prince 5(4) at rtol = atol = {:e} differ by {agreement:.3e}, not far below the target error {:e} (need ≤ 1/100 of it); try a shorter --t-end, a larger --target-error or another --reference-tol",
+            args.reference_tol, args.target_error
+        )));
+    }
+    let reference_steps = reference.stats.steps;
 
     let timing = Timing {
-        repeats: args.repeats,
+        repeats: args.repeats.max(1),
         min_time_s: args.min_time_ms * 1e-3,
     };
     let results: Vec<MethodRuns> = methods
@@ -598,7 +583,7 @@ pub fn run(args: &WorkPrecisionArgs) -> Result<(), CliError> {
             };
             let runs: Vec<Run> = settings
                 .into_iter()
-                .map(|s| problem.run(method, s, timing))
+                .map(|s| problem.run(method, s, timing, &reference))
                 .collect();
             let at_target = at_target(&runs, args.target_error);
             MethodRuns {
@@ -609,195 +594,234 @@ pub fn run(args: &WorkPrecisionArgs) -> Result<(), CliError> {
         })
         .collect();
 
-    // A run whose error is within 10× of the reference's agreement measures the reference as
-    // much as the method: flag it.
-    let unresolved = |m: &Measured| m.error < 10.0 * agreement;
-    let num_unresolved = results
+    let study = Study {
+        args,
+        model: problem.model.as_ref(),
+        dim: problem.y0.len(),
+        agreement,
+        reference_steps,
+        timing,
+        results,
+    };
+    let num_unresolved = study
+        .results
         .iter()
         .flat_map(|r| &r.runs)
-        .filter(|r| r.outcome.as_ref().is_ok_and(unresolved))
+        .filter(|r| r.outcome.as_ref().is_ok_and(|m| study.unresolved(m)))
         .count();
     if num_unresolved > 0 {
         eprintln!(
             "warning: {num_unresolved} run(s) have an error below 10 × the reference's agreement ({agreement:.2e}): the reference does not resolve them, their errors are upper bounds at best (marked `!` in the table, `\"resolved\": false` in JSON)"
         );
     }
-
     if let Some(prefix) = &args.plot {
-        write_charts(prefix, problem.model.name(), &results)?;
+        write_charts(prefix, study.model.name(), &study.results)?;
+    }
+    let mut stdout = std::io::stdout().lock();
+    // A closed stdout (a pipe into `head`) is not an error of the study.
+    let _ = if args.json {
+        serde_json::to_string_pretty(&study.to_json())
+            .map_err(|e| CliError::failure(e.to_string()))
+            .map(|text| writeln!(stdout, "{text}"))?
+    } else {
+        study.write_text(&mut stdout)
+    };
+    Ok(())
+}
+
+/// Everything the study measured, for the table and the JSON.
+struct Study<'a> {
+    args: &'a WorkPrecisionArgs,
+    model: &'a dyn ModelInfo,
+    /// State dimension `2n`.
+    dim: usize,
+    /// The study's error norm between the reference and its check.
+    agreement: f64,
+    reference_steps: usize,
+    timing: Timing,
+    results: Vec<MethodRuns>,
+}
+
+impl Study<'_> {
+    /// Whether a run's error is within 10× of the reference's agreement, so that it measures
+    /// the reference as much as the method.
+    fn unresolved(&self, m: &Measured) -> bool {
+        m.error < 10.0 * self.agreement
     }
 
-    let model = problem.model.as_ref();
-    let dim = problem.y0.len();
-    let mut stdout = std::io::stdout().lock();
-    if args.json {
-        let methods_json: Vec<serde_json::Value> = results
+    /// The JSON document of `--json` (schema in the README).
+    fn to_json(&self) -> serde_json::Value {
+        let args = self.args;
+        let methods: Vec<serde_json::Value> = self
+            .results
             .iter()
             .map(|r| {
-                let runs: Vec<serde_json::Value> = r
-                    .runs
-                    .iter()
-                    .map(|run| {
-                        let (tol, steps_requested, dt) = match run.setting {
-                            Setting::Tolerance(tol) => (json!(tol), json!(null), json!(null)),
-                            Setting::Steps { steps, dt } => (json!(null), json!(steps), json!(dt)),
-                        };
-                        // Every run has every key; a failed run has nulls and `failure`.
-                        let m = run.outcome.as_ref().ok();
-                        let failure = run.outcome.as_ref().err().map(|f| {
-                            json!({"t": f.t.filter(|t| t.is_finite()), "message": f.message})
-                        });
-                        json!({
-                            "tol": tol,
-                            "num_steps": steps_requested,
-                            "dt": dt,
-                            "error": m.map(|m| finite(m.error)),
-                            "resolved": m.map(|m| !unresolved(m)),
-                            "rhs_evals": m.map(|m| m.rhs_evals),
-                            "steps": m.map(|m| m.steps),
-                            "rejected": m.map(|m| m.rejected),
-                            "wall_time_s": m.map(|m| finite(m.wall_time_s)),
-                            "repeats": m.map(|m| m.repeats),
-                            "energy_drift": m.and_then(|m| m.energy_drift),
-                            "failure": failure,
-                        })
-                    })
-                    .collect();
-                let target = match r.at_target {
-                    AtTarget::Reached { rhs_evals, steps, wall_time_s } => json!({
-                        "reached": true,
-                        "rhs_evals": finite(rhs_evals),
-                        "steps": finite(steps),
-                        "wall_time_s": finite(wall_time_s),
-                        "baseline_ratio": args.baseline_ms.map(|b| finite(b * 1e-3 / wall_time_s)),
-                        "note": null,
-                    }),
-                    AtTarget::BelowAtLoosest { rhs_evals, wall_time_s } => json!({
-                        "reached": true,
-                        "rhs_evals": null,
-                        "steps": null,
-                        "wall_time_s": null,
-                        "baseline_ratio": null,
-                        "note": format!("below the target already at the loosest setting ({rhs_evals} RHS evaluations, {:.3} ms): add looser settings", wall_time_s * 1e3),
-                    }),
-                    AtTarget::NotReached => json!({
-                        "reached": false,
-                        "rhs_evals": null,
-                        "steps": null,
-                        "wall_time_s": null,
-                        "baseline_ratio": null,
-                        "note": "no two consecutive settings bracket the target error",
-                    }),
-                };
+                let runs: Vec<serde_json::Value> =
+                    r.runs.iter().map(|run| self.run_json(run)).collect();
                 json!({
                     "method": cli_name(r.method),
                     "name": display_name(r.method),
                     "order": r.method.integrator().order(),
                     "adaptive": is_adaptive(r.method),
                     "runs": runs,
-                    "at_target": target,
+                    "at_target": self.target_json(&r.at_target),
                 })
             })
             .collect();
-        let out = json!({
-            "model": model.name(),
+        json!({
+            "model": self.model.name(),
             "t_end": args.t_end,
             "samples": args.samples,
-            "error_norm": format!("max over the {} output times k·T/{} (k = 1…{}) and over all {dim} components of y = [q; q̇] of |y − y_ref|", args.samples, args.samples, args.samples),
-            "conservative": model.is_conservative(),
+            "error_norm": format!("max over the {s} output times k·T/{s} (k = 1…{s}) and over all {} components of y = [q; q̇] of |y − y_ref|", self.dim, s = args.samples),
+            "conservative": self.model.is_conservative(),
             "target_error": args.target_error,
             "baseline_ms": args.baseline_ms,
-            "timing": {"statistic": "median", "min_repeats": timing.repeats.max(1), "min_total_s": timing.min_time_s, "max_repeats": MAX_REPEATS},
+            "timing": {
+                "statistic": "median",
+                "min_repeats": self.timing.repeats,
+                "min_total_s": self.timing.min_time_s,
+                "max_repeats": MAX_REPEATS,
+            },
             "reference": {
                 "method": "dop853",
                 "rtol": args.reference_tol,
                 "atol": args.reference_tol,
-                "steps": reference_stats.steps,
+                "steps": self.reference_steps,
                 "check_method": "dp54",
-                "agreement": agreement,
+                "agreement": self.agreement,
             },
-            "methods": methods_json,
-        });
-        let text =
-            serde_json::to_string_pretty(&out).map_err(|e| CliError::failure(e.to_string()))?;
-        let _ = writeln!(stdout, "{text}");
-    } else {
-        let _ = writeln!(
-            stdout,
+            "methods": methods,
+        })
+    }
+
+    /// One run: every key always present, `null` where a failed run has no value.
+    fn run_json(&self, run: &Run) -> serde_json::Value {
+        let (tol, num_steps, dt) = match run.setting {
+            Setting::Tolerance(tol) => (Some(tol), None, None),
+            Setting::Steps { steps, dt } => (None, Some(steps), Some(dt)),
+        };
+        let m = run.outcome.as_ref().ok();
+        let failure = run
+            .outcome
+            .as_ref()
+            .err()
+            .map(|f| json!({"t": f.t.filter(|t| t.is_finite()), "message": f.message}));
+        json!({
+            "tol": tol,
+            "num_steps": num_steps,
+            "dt": dt,
+            "error": m.map(|m| finite(m.error)),
+            "resolved": m.map(|m| !self.unresolved(m)),
+            "rhs_evals": m.map(|m| m.rhs_evals),
+            "steps": m.map(|m| m.steps),
+            "rejected": m.map(|m| m.rejected),
+            "wall_time_s": m.map(|m| finite(m.wall_time_s)),
+            "repeats": m.map(|m| m.repeats),
+            "energy_drift": m.and_then(|m| m.energy_drift),
+            "failure": failure,
+        })
+    }
+
+    /// The work at the target error: interpolated values, or `null`s and a note.
+    fn target_json(&self, target: &AtTarget) -> serde_json::Value {
+        let (reached, evals, steps, time, note) = match *target {
+            AtTarget::Reached {
+                rhs_evals,
+                steps,
+                wall_time_s,
+            } => (true, Some(rhs_evals), Some(steps), Some(wall_time_s), None),
+            AtTarget::BelowAtLoosest { .. } | AtTarget::NotReached => (
+                !matches!(target, AtTarget::NotReached),
+                None,
+                None,
+                None,
+                Some(target.note()),
+            ),
+        };
+        json!({
+            "reached": reached,
+            "rhs_evals": evals.map(finite),
+            "steps": steps.map(finite),
+            "wall_time_s": time.map(finite),
+            "baseline_ratio": time.zip(self.args.baseline_ms).map(|(t, b)| finite(b * 1e-3 / t)),
+            "note": note,
+        })
+    }
+
+    /// The header, the table of runs and the table of work at the target error.
+    fn write_text(&self, out: &mut impl Write) -> std::io::Result<()> {
+        let args = self.args;
+        writeln!(
+            out,
             "model      {} ({} dof) over 0 ≤ t ≤ {} s",
-            model.name(),
-            model.num_dofs(),
+            self.model.name(),
+            self.model.num_dofs(),
             args.t_end
-        );
-        let _ = writeln!(
-            stdout,
-            "error      max over the {s} output times k·T/{s} and over all {dim} components of y = [q; q̇] of |y − y_ref|",
+        )?;
+        writeln!(
+            out,
+            "error      max over the {s} output times k·T/{s} and over all {} components of y = [q; q̇] of |y − y_ref|",
+            self.dim,
             s = args.samples
-        );
-        let _ = writeln!(
-            stdout,
-            "reference  DOP853 at rtol = atol = {:e} ({} steps); Dormand–Prince 5(4) at the same tolerance agrees to {agreement:.2e}",
-            args.reference_tol, reference_stats.steps
-        );
-        let _ = writeln!(
-            stdout,
+        )?;
+        writeln!(
+            out,
+            "reference  DOP853 at rtol = atol = {:e} ({} steps); Dormand–Prince 5(4) at the same tolerance agrees to {:.2e}",
+            args.reference_tol, self.reference_steps, self.agreement
+        )?;
+        writeln!(
+            out,
             "time       median wall time of ≥ {} identical runs totalling ≥ {} ms (at most {MAX_REPEATS} runs)",
-            timing.repeats.max(1),
-            args.min_time_ms
-        );
-        let drift_note = if model.is_conservative() {
+            self.timing.repeats, args.min_time_ms
+        )?;
+        let drift_note = if self.model.is_conservative() {
             ""
         } else {
             " (not conserved: the model has non-conservative loads or explicit time dependence)"
         };
-        let _ = writeln!(
-            stdout,
-            "drift      energy drift max|E − E(0)| / max(T + |V|) over the output times{drift_note}"
-        );
-        let _ = writeln!(stdout);
-        let _ = writeln!(
-            stdout,
+        writeln!(
+            out,
+            "drift      energy drift max|E − E(0)| / max(T + |V|) over the output times{drift_note}\n"
+        )?;
+        writeln!(
+            out,
             "{:<22} {:>13} {:>10} {:>11} {:>9} {:>11} {:>12}",
             "method", "tol or h", "error", "RHS evals", "steps", "time (ms)", "energy drift"
-        );
-        for r in &results {
+        )?;
+        for r in &self.results {
+            let name = display_name(r.method);
             for run in &r.runs {
-                let name = display_name(r.method);
                 let setting = run.setting.label();
                 match &run.outcome {
-                    Ok(m) => {
-                        let _ = writeln!(
-                            stdout,
-                            "{name:<22} {setting:>13} {:>9.2e}{} {:>11} {:>9} {:>11.3} {:>12}",
-                            m.error,
-                            if unresolved(m) { "!" } else { " " },
-                            m.rhs_evals,
-                            m.steps,
-                            m.wall_time_s * 1e3,
-                            m.energy_drift.map_or("-".to_string(), |d| format!("{d:.2e}"))
-                        );
-                    }
-                    Err(f) => {
-                        let _ = writeln!(stdout, "{name:<22} {setting:>13}   failed: {}", f.message);
-                    }
+                    Ok(m) => writeln!(
+                        out,
+                        "{name:<22} {setting:>13} {:>9.2e}{} {:>11} {:>9} {:>11.3} {:>12}",
+                        m.error,
+                        if self.unresolved(m) { "!" } else { " " },
+                        m.rhs_evals,
+                        m.steps,
+                        m.wall_time_s * 1e3,
+                        m.energy_drift
+                            .map_or("-".to_string(), |d| format!("{d:.2e}"))
+                    )?,
+                    Err(f) => writeln!(out, "{name:<22} {setting:>13}   failed: {}", f.message)?,
                 }
             }
         }
-        let _ = writeln!(stdout);
-        let _ = writeln!(
-            stdout,
-            "work to reach an error of {:e} (log–log interpolation between the bracketing settings)",
+        writeln!(
+            out,
+            "\nwork to reach an error of {:e} (log–log interpolation between the bracketing settings)",
             args.target_error
-        );
-        let baseline_header = args
-            .baseline_ms
-            .map_or(String::new(), |b| format!(" {:>16}", format!("{b} ms / time")));
-        let _ = writeln!(
-            stdout,
+        )?;
+        let baseline_header = args.baseline_ms.map_or(String::new(), |b| {
+            format!(" {:>16}", format!("{b} ms / time"))
+        });
+        writeln!(
+            out,
             "{:<22} {:>11} {:>9} {:>11}{baseline_header}",
             "method", "RHS evals", "steps", "time (ms)"
-        );
-        for r in &results {
+        )?;
+        for r in &self.results {
             let name = display_name(r.method);
             match r.at_target {
                 AtTarget::Reached {
@@ -808,38 +832,43 @@ pub fn run(args: &WorkPrecisionArgs) -> Result<(), CliError> {
                     let ratio = args.baseline_ms.map_or(String::new(), |b| {
                         format!(" {:>16.1}", b * 1e-3 / wall_time_s)
                     });
-                    let _ = writeln!(
-                        stdout,
+                    writeln!(
+                        out,
                         "{name:<22} {rhs_evals:>11.0} {steps:>9.0} {:>11.3}{ratio}",
                         wall_time_s * 1e3
-                    );
+                    )?;
                 }
-                AtTarget::BelowAtLoosest {
-                    rhs_evals,
-                    wall_time_s,
-                } => {
-                    let _ = writeln!(
-                        stdout,
-                        "{name:<22} below the target already at the loosest setting (≤ {rhs_evals} RHS evals, ≤ {:.3} ms): add looser settings",
-                        wall_time_s * 1e3
-                    );
-                }
-                AtTarget::NotReached => {
-                    let _ = writeln!(
-                        stdout,
-                        "{name:<22} not bracketed by two consecutive settings"
-                    );
-                }
+                _ => writeln!(out, "{name:<22} {}", r.at_target.note())?,
+            }
+        }
+        Ok(())
+    }
+}
+
+impl AtTarget {
+    /// Why there is no interpolated work (empty when there is).
+    fn note(&self) -> String {
+        match *self {
+            AtTarget::Reached { .. } => String::new(),
+            AtTarget::BelowAtLoosest {
+                rhs_evals,
+                wall_time_s,
+            } => format!(
+                "below the target already at the loosest setting (≤ {rhs_evals} RHS evals, ≤ {:.3} ms): add looser settings",
+                wall_time_s * 1e3
+            ),
+            AtTarget::NotReached => {
+                "not bracketed by two consecutive settings: add tighter settings or smaller steps"
+                    .to_string()
             }
         }
     }
-    Ok(())
 }
 
 /// Writes `PREFIX-evals.{svg,png}` and `PREFIX-time.{svg,png}`: the error of every
 /// successful run against its RHS evaluations and its median wall time, log–log.
 fn write_charts(prefix: &str, model: &str, results: &[MethodRuns]) -> Result<(), CliError> {
-    let series = |work: fn(&Measured) -> f64| -> Vec<plot::Series> {
+    let series = |work: Work| -> Vec<plot::Series> {
         results
             .iter()
             .map(|r| plot::Series {
@@ -853,7 +882,7 @@ fn write_charts(prefix: &str, model: &str, results: &[MethodRuns]) -> Result<(),
             })
             .collect()
     };
-    let charts: [(&str, &str, fn(&Measured) -> f64); 2] = [
+    let charts: [(&str, &str, Work); 2] = [
         ("evals", "RHS evaluations", |m| m.rhs_evals as f64),
         ("time", "median wall time (ms)", |m| m.wall_time_s * 1e3),
     ];
@@ -889,7 +918,16 @@ mod tests {
         assert_eq!(parse_tols("1e-6..1e-3").unwrap(), [1e-3, 1e-4, 1e-5, 1e-6]);
         assert_eq!(parse_tols("1e-8,1e-4,1e-4").unwrap(), [1e-4, 1e-8]);
         assert_eq!(parse_tols("2e-3..2e-5").unwrap().len(), 3);
-        for bad in ["", "abc", "1e-3..", "0", "1..1e-3", "1e-3..3e-5", "nan", "-1e-3"] {
+        for bad in [
+            "",
+            "abc",
+            "1e-3..",
+            "0",
+            "1..1e-3",
+            "1e-3..3e-5",
+            "nan",
+            "-1e-3",
+        ] {
             let e = parse_tols(bad).unwrap_err();
             assert_eq!(e.code, 2, "{bad}");
             assert!(e.message.contains("--tols"), "{}", e.message);
