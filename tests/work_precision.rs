@@ -208,6 +208,8 @@ fn json_has_the_promised_keys() {
                 "rhs_evals",
                 "steps",
                 "rejected",
+                "jacobian_evals",
+                "lu_decompositions",
                 "wall_time_s",
                 "repeats",
                 "energy_drift",

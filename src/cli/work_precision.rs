@@ -141,6 +141,9 @@ struct Measured {
     rhs_evals: usize,
     steps: usize,
     rejected: usize,
+    /// Jacobians `∂F/∂y` and LU factorisations of the implicit methods (0 for explicit ones).
+    jacobian_evals: usize,
+    lu_decompositions: usize,
     /// Median over `repeats` identical runs (s).
     wall_time_s: f64,
     repeats: usize,
@@ -399,6 +402,8 @@ impl Problem {
                 rhs_evals: solution.stats.rhs_evals,
                 steps: solution.stats.steps,
                 rejected: solution.stats.rejected,
+                jacobian_evals: solution.stats.jacobian_evals,
+                lu_decompositions: solution.stats.lu_decompositions,
                 repeats: times.len(),
                 wall_time_s: median(&mut times),
                 energy_drift: report.drift.filter(|d| d.is_finite()),
@@ -715,6 +720,8 @@ impl Study<'_> {
             "rhs_evals": m.map(|m| m.rhs_evals),
             "steps": m.map(|m| m.steps),
             "rejected": m.map(|m| m.rejected),
+            "jacobian_evals": m.map(|m| m.jacobian_evals),
+            "lu_decompositions": m.map(|m| m.lu_decompositions),
             "wall_time_s": m.map(|m| finite(m.wall_time_s)),
             "repeats": m.map(|m| m.repeats),
             "energy_drift": m.and_then(|m| m.energy_drift),
