@@ -44,6 +44,24 @@ pub enum Method {
     Radau5,
 }
 
+impl Method {
+    /// A new integrator of this method.
+    pub(crate) fn integrator(self) -> Box<dyn Integrator> {
+        match self {
+            Method::Euler => Box::new(ExplicitEuler::new()),
+            Method::Midpoint => Box::new(ExplicitMidpoint::new()),
+            Method::Rk4 => Box::new(RungeKutta4::new()),
+            Method::Bs32 => Box::new(BogackiShampine32::new()),
+            Method::Dp54 => Box::new(DormandPrince54::new()),
+            Method::Dop853 => Box::new(DormandPrince853::new()),
+            Method::SymplecticEuler => Box::new(SymplecticEuler::new()),
+            Method::StormerVerlet => Box::new(StormerVerlet::new()),
+            Method::ImplicitMidpoint => Box::new(ImplicitMidpoint::new()),
+            Method::Radau5 => Box::new(RadauIIA5::new()),
+        }
+    }
+}
+
 /// Drift control of a constrained model (`--stabilization`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum StabilizationArg {
@@ -195,18 +213,7 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
     if let Some(dt) = args.dt {
         options = options.with_dt(dt);
     }
-    let mut integrator: Box<dyn Integrator> = match args.method {
-        Method::Euler => Box::new(ExplicitEuler::new()),
-        Method::Midpoint => Box::new(ExplicitMidpoint::new()),
-        Method::Rk4 => Box::new(RungeKutta4::new()),
-        Method::Bs32 => Box::new(BogackiShampine32::new()),
-        Method::Dp54 => Box::new(DormandPrince54::new()),
-        Method::Dop853 => Box::new(DormandPrince853::new()),
-        Method::SymplecticEuler => Box::new(SymplecticEuler::new()),
-        Method::StormerVerlet => Box::new(StormerVerlet::new()),
-        Method::ImplicitMidpoint => Box::new(ImplicitMidpoint::new()),
-        Method::Radau5 => Box::new(RadauIIA5::new()),
-    };
+    let mut integrator = args.method.integrator();
     let mut added = CliEvents::parse(model.as_mut(), &args.stop_when, &args.event)?;
     let result = if added.is_empty() {
         integrator.integrate(model.as_ode_mut(), 0.0, &y0, args.t_end, &output, &options)
@@ -332,14 +339,14 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
 /// Energy per sample and the drift `max |E − E(0)| / E_scale`, with
 /// `E_scale = max (T + |V|)` over the initial state and the samples (so a zero initial energy still gives a
 /// meaningful relative figure).
-struct Report {
+pub(crate) struct Report {
     energy: Vec<f64>,
     initial: f64,
-    drift: Option<f64>,
+    pub(crate) drift: Option<f64>,
 }
 
 impl Report {
-    fn new(model: &dyn ModelInfo, y0: &[f64], solution: &Solution) -> Self {
+    pub(crate) fn new(model: &dyn ModelInfo, y0: &[f64], solution: &Solution) -> Self {
         let mut energy = Vec::with_capacity(solution.len());
         let initial = model.energy(0.0, y0);
         let mut scale: f64 = model.kinetic_energy(0.0, y0) + model.potential_energy(0.0, y0).abs();
@@ -572,7 +579,10 @@ fn sibling(path: &str, tag: &str) -> String {
 ///
 /// # Errors
 /// A failure naming the constraint with the largest residual.
-fn consistent_initial_state(model: &mut dyn ModelInfo, y0: &mut [f64]) -> Result<(), CliError> {
+pub(crate) fn consistent_initial_state(
+    model: &mut dyn ModelInfo,
+    y0: &mut [f64],
+) -> Result<(), CliError> {
     model.make_consistent(y0).map_err(|e| {
         let name = model.constraint_names().get(e.constraint).copied().unwrap_or("?");
         CliError::failure(if model.initial_guesses().is_empty() {
