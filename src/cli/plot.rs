@@ -93,6 +93,30 @@ fn usable<'s>(chart: &Chart<'_>, s: &'s Series) -> impl Iterator<Item = (f64, f6
     })
 }
 
+/// A tick label: `1e-5` on a log axis (plotters' default prints `9999999e-5`), else a
+/// short decimal.
+fn tick(v: f64, log: bool) -> String {
+    if log {
+        let e = v.log10().round();
+        if (v.log10() - e).abs() < 1e-6 {
+            return format!("1e{e}");
+        }
+        return format!("{v:.1e}");
+    }
+    let a = v.abs();
+    if a != 0.0 && !(1e-3..1e5).contains(&a) {
+        format!("{v:.1e}")
+    } else {
+        let s = format!("{v:.4}");
+        let s = s.trim_end_matches('0').trim_end_matches('.');
+        if s == "-0" {
+            "0".to_string()
+        } else {
+            s.to_string()
+        }
+    }
+}
+
 /// `[lo, hi]` padded by 5 % (or a factor for log axes), with a unit range for a constant.
 fn range(lo: f64, hi: f64, log: bool) -> (f64, f64) {
     if log {
@@ -149,14 +173,17 @@ where
     builder
         .caption(chart.title, ("sans-serif", 22))
         .margin(12)
-        .x_label_area_size(40)
-        .y_label_area_size(70);
+        .x_label_area_size(45)
+        .y_label_area_size(90);
     macro_rules! finish {
         ($ctx:expr) => {{
             let mut ctx = $ctx.map_err(err)?;
+            let (log_x, log_y) = (chart.log_x, chart.log_y);
             ctx.configure_mesh()
                 .x_desc(chart.x_desc)
                 .y_desc(chart.y_desc)
+                .x_label_formatter(&|v| tick(*v, log_x))
+                .y_label_formatter(&|v| tick(*v, log_y))
                 .label_style(("sans-serif", 14))
                 .draw()
                 .map_err(err)?;
