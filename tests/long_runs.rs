@@ -247,9 +247,9 @@ fn figure_eight_returns_after_one_period_and_keeps_its_invariants() {
 /// Störmer–Verlet over three periods at `dt = T/1000`: the energy error stays `O(dt²)`
 /// (tolerance 1e-4 relative: `dt² |∂³V| ~ 4e-5 · O(1)`, measured 2.4e-5), and the angular and
 /// linear momenta stay at their initial value 0 up to roundoff (tolerance 1e-13: ~3000 steps
-/// of ~1e-16 rounding each, added at random; measured 4e-15 and 9e-15). A force that is not pairwise central, or a
-/// scheme that is not a composition of drifts and kicks, breaks the angular momentum by
-/// ~`dt²`, i.e. 1e-5.
+/// of ~1e-16 rounding each, added at random; measured 4e-15 and 9e-15). A force that is not
+/// pairwise central, or a scheme that is not a composition of drifts and kicks, breaks the
+/// angular momentum by ~`dt²`, i.e. 1e-5.
 #[test]
 fn stormer_verlet_keeps_angular_momentum_to_roundoff() {
     let (mut system, y0) = figure_eight();
