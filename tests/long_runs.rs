@@ -31,8 +31,8 @@
 
 use eomgen::models::FigureEight;
 use eomgen::{
-    DormandPrince853, FirstOrder, Integrator, IntegratorOptions, ModelInfo,
-    OutputTimes, Solution, StormerVerlet,
+    DormandPrince853, FirstOrder, Integrator, IntegratorOptions, ModelInfo, OutputTimes, Solution,
+    StormerVerlet,
 };
 
 /// Period of the figure eight from the HW7 initial conditions, C. Simó's value as quoted by
@@ -63,10 +63,7 @@ fn angular_momentum(m: f64, y: &[f64]) -> f64 {
 /// Total linear momentum `P = Σ m vᵢ` of the state `y` (mass units × length/time).
 fn linear_momentum(m: f64, y: &[f64]) -> [f64; 2] {
     let v = &y[6..];
-    [
-        m * (v[0] + v[2] + v[4]),
-        m * (v[1] + v[3] + v[5]),
-    ]
+    [m * (v[0] + v[2] + v[4]), m * (v[1] + v[3] + v[5])]
 }
 
 /// How far the invariants of a solution stray from their initial values.
@@ -322,7 +319,11 @@ fn hundred_periods_dop853_drifts_stormer_verlet_does_not() {
         rows.push((all, early, late));
     }
     eprintln!("Störmer–Verlet step dt = {dt:.3e}");
-    let [(_, dop_early, dop_late), (verlet_all, verlet_early, verlet_late)] = rows[..] else {
+    let [
+        (_, dop_early, dop_late),
+        (verlet_all, verlet_early, verlet_late),
+    ] = rows[..]
+    else {
         unreachable!("two methods");
     };
     assert!(
