@@ -109,6 +109,30 @@ fn invariant_errors(
     errors
 }
 
+/// Integrates the figure eight with `method` from its initial state to `t_end`, recording
+/// every step, and returns the solution with its invariants' errors over `[0, t_end]`.
+///
+/// # Panics
+/// If the integration fails.
+fn run_steps(
+    method: &mut dyn Integrator,
+    t_end: f64,
+    options: &IntegratorOptions,
+) -> (Solution, Invariants) {
+    let (mut system, y0) = figure_eight();
+    let solution = method
+        .integrate(&mut system, 0.0, &y0, t_end, &OutputTimes::Steps, options)
+        .unwrap_or_else(|e| panic!("{} on the figure eight: {e}", method.name()));
+    let errors = invariant_errors(&system, &solution, 0.0, t_end);
+    eprintln!(
+        "{} to t = {t_end:.2}: {} steps, {} RHS; {errors:?}",
+        method.name(),
+        solution.stats.steps,
+        solution.stats.rhs_evals
+    );
+    (solution, errors)
+}
+
 /// Euclidean distance `|y − y0|` in the 12-dimensional state space.
 fn distance(y: &[f64], y0: &[f64]) -> f64 {
     y.iter()
@@ -221,21 +245,7 @@ fn figure_eight_returns_after_one_period_and_keeps_its_invariants() {
     );
     assert!(closest <= 1e-7, "|y(T) − y(0)| = {closest:e}");
 
-    let solution = DormandPrince853::new()
-        .integrate(
-            &mut system,
-            0.0,
-            &y0,
-            3.0 * period,
-            &OutputTimes::Steps,
-            &options,
-        )
-        .expect("three periods integrate");
-    let errors = invariant_errors(&system, &solution, 0.0, 3.0 * period);
-    eprintln!(
-        "DOP853 1e-12, 3 periods: {} steps, {} RHS; {errors:?}",
-        solution.stats.steps, solution.stats.rhs_evals
-    );
+    let (_, errors) = run_steps(&mut DormandPrince853::new(), 3.0 * period, &options);
     assert!(errors.energy <= 1e-10, "{errors:?}");
     assert!(errors.angular_momentum <= 1e-10, "{errors:?}");
     assert!(errors.linear_momentum <= 1e-13, "{errors:?}");
@@ -249,17 +259,8 @@ fn figure_eight_returns_after_one_period_and_keeps_its_invariants() {
 /// angular momentum by ~`dt²`, i.e. 1e-5.
 #[test]
 fn stormer_verlet_keeps_angular_momentum_to_roundoff() {
-    let (mut system, y0) = figure_eight();
-    let t_end = 3.0 * PERIOD_LITERATURE;
     let options = IntegratorOptions::default().with_dt(PERIOD_LITERATURE / 1000.0);
-    let solution = StormerVerlet::new()
-        .integrate(&mut system, 0.0, &y0, t_end, &OutputTimes::Steps, &options)
-        .expect("the figure eight integrates");
-    let errors = invariant_errors(&system, &solution, 0.0, t_end);
-    eprintln!(
-        "Störmer–Verlet dt = T/1000, 3 periods: {} RHS; {errors:?}",
-        solution.stats.rhs_evals
-    );
+    let (_, errors) = run_steps(&mut StormerVerlet::new(), 3.0 * PERIOD_LITERATURE, &options);
     assert!(errors.energy <= 1e-4, "{errors:?}");
     assert!(errors.angular_momentum <= 1e-13, "{errors:?}");
     assert!(errors.linear_momentum <= 1e-13, "{errors:?}");
@@ -284,20 +285,16 @@ fn stormer_verlet_keeps_angular_momentum_to_roundoff() {
 /// About 3 s in a debug build.
 #[test]
 fn hundred_periods_dop853_drifts_stormer_verlet_does_not() {
-    let (mut system, y0) = figure_eight();
+    let (system, _) = figure_eight();
     let period = PERIOD_LITERATURE;
     let t_end = 100.0 * period;
     let (first, last) = ((0.0, 10.0 * period), (90.0 * period, t_end));
     let adaptive = IntegratorOptions::default().with_rtol(1e-8).with_atol(1e-8);
-    let dop853 = DormandPrince853::new()
-        .integrate(&mut system, 0.0, &y0, t_end, &OutputTimes::Steps, &adaptive)
-        .expect("DOP853 integrates 100 periods");
+    let (dop853, _) = run_steps(&mut DormandPrince853::new(), t_end, &adaptive);
     // The same work: one evaluation per Störmer–Verlet step.
     let dt = t_end / dop853.stats.rhs_evals as f64;
     let fixed = IntegratorOptions::default().with_dt(dt);
-    let verlet = StormerVerlet::new()
-        .integrate(&mut system, 0.0, &y0, t_end, &OutputTimes::Steps, &fixed)
-        .expect("Störmer–Verlet integrates 100 periods");
+    let (verlet, _) = run_steps(&mut StormerVerlet::new(), t_end, &fixed);
     let mut rows = Vec::new();
     for (name, solution) in [("dop853 1e-8", &dop853), ("stormer-verlet", &verlet)] {
         let all = invariant_errors(&system, solution, 0.0, t_end);
