@@ -87,6 +87,9 @@ struct Row {
 struct SinglePrecision {
     x: f64,
     error: f64,
+    /// `x(1) − (1 + h)ᴺ` with the `f32` step `h` in exact arithmetic: the accumulated rounding
+    /// of the additions alone.
+    roundoff: f64,
     /// `ε₃₂ √N`.
     epsilon_sqrt_steps: f64,
     /// `ε₃₂ N`.
@@ -103,9 +106,11 @@ fn single_precision_euler(steps: usize) -> SinglePrecision {
         x += h * x;
     }
     let epsilon = f64::from(f32::EPSILON);
+    let exact_arithmetic = (steps as f64 * f64::from(h).ln_1p()).exp();
     SinglePrecision {
         x: f64::from(x),
         error: f64::from(x) - E,
+        roundoff: f64::from(x) - exact_arithmetic,
         epsilon_sqrt_steps: epsilon * (steps as f64).sqrt(),
         epsilon_steps: epsilon * steps as f64,
     }
@@ -117,6 +122,8 @@ struct Summary {
     method: &'static str,
     optimal_n: u32,
     smallest_error: f64,
+    /// The first `n` whose error is below `100 ε` (rounding level), if any.
+    first_n_at_rounding_level: Option<u32>,
     /// Exponent `a` of `|roundoff| ∝ Nᵃ` fitted (least squares in log–log) over the `n` whose
     /// roundoff exceeds `100 ε` (`None` with fewer than two such `n`).
     roundoff_exponent: Option<f64>,
@@ -301,8 +308,13 @@ fn summary(rows: &[Row], index: usize) -> Summary {
             points.push(((r.steps as f64).log10(), run.roundoff.abs().log10()));
         }
     }
+    let first_n_at_rounding_level = rows
+        .iter()
+        .find(|r| r.runs[index].error.abs() < ROUNDOFF_FLOOR * f64::EPSILON)
+        .map(|r| r.n);
     Summary {
         method,
+        first_n_at_rounding_level,
         optimal_n: best.0,
         smallest_error: best.1,
         roundoff_exponent: slope(&points),
@@ -334,7 +346,12 @@ fn notes(rows: &[Row], summaries: &[Summary]) -> Vec<String> {
             || "too few n with roundoff above 100 ε to fit its growth".to_string(),
             |a| format!("fitted roundoff ∝ N^{a:.2} (0.5 for independent rounding errors, 1 for errors of one sign)"),
         );
-        let optimum = if s.optimal_n == max_n {
+        let optimum = if let Some(n) = s.first_n_at_rounding_level {
+            format!(
+                "|error| below 100 ε from n = {n} on (smallest {:.2e} at n = {}): truncation is below roundoff there, and the optimum is wherever the rounding happens to cancel",
+                s.smallest_error, s.optimal_n
+            )
+        } else if s.optimal_n == max_n {
             format!(
                 "smallest error at the largest n tried ({max_n}): roundoff has not overtaken truncation"
             )
@@ -355,14 +372,15 @@ fn notes(rows: &[Row], summaries: &[Summary]) -> Vec<String> {
             single(best)
         ));
     }
+    let roundoff = |r: &Row| r.single_precision_euler.roundoff.abs();
     if let Some(r) = rows
         .iter()
-        .find(|r| r.n > 0 && single(r) > 0.1 * r.single_precision_euler.epsilon_steps)
+        .find(|r| r.n > 0 && roundoff(r) > 0.1 * r.single_precision_euler.epsilon_steps)
     {
         notes.push(format!(
-            "euler in f32 at n = {}: error {:.2e}, of the size ε₃₂N = {:.2e} rather than ε₃₂√N = {:.2e}: h·x is within a few units in the last place of x, so every x + h·x rounds the same way (systematic, not random)",
+            "euler in f32 at n = {}: roundoff {:.2e}, of the size ε₃₂N = {:.2e} rather than ε₃₂√N = {:.2e}: h·x is within a few units in the last place of x, so every x + h·x rounds the same way (systematic, not random)",
             r.n,
-            single(r),
+            roundoff(r),
             r.single_precision_euler.epsilon_steps,
             r.single_precision_euler.epsilon_sqrt_steps
         ));
