@@ -9,13 +9,12 @@ use std::f64::consts::E;
 use std::process::Command;
 
 use eomgen::integrate::stability::{
-    GrowthTest, StabilityPolynomial, TestEquation, amplification, measured_limit,
-    partitioned_oscillator_growth_limit, radau_iia5_stability,
+    GrowthTest, StabilityPolynomial, TestEquation, amplification, explicit_tableau_methods,
+    measured_limit, partitioned_oscillator_growth_limit, radau_iia5_stability,
 };
 use eomgen::{
-    BogackiShampine32, DormandPrince54, DormandPrince853, ExplicitEuler, ExplicitMidpoint,
-    Integrator, IntegratorOptions, OutputTimes, RadauIIA5, RungeKutta4, StormerVerlet,
-    SymplecticEuler, Tableau,
+    DormandPrince54, DormandPrince853, ExplicitEuler, ExplicitMidpoint, Integrator,
+    IntegratorOptions, OutputTimes, RadauIIA5, StormerVerlet, SymplecticEuler, Tableau,
 };
 use nalgebra::Complex;
 
@@ -52,13 +51,7 @@ const TEST: GrowthTest = GrowthTest {
 #[test]
 fn explicit_stability_limits_match_theory_to_one_percent() {
     let detected = TEST.smallest_detected_growth();
-    let tableau_methods: [(Tableau, Box<dyn Integrator>); 5] = [
-        (Tableau::euler(), Box::new(ExplicitEuler::new())),
-        (Tableau::midpoint(), Box::new(ExplicitMidpoint::new())),
-        (Tableau::rk4(), Box::new(RungeKutta4::new())),
-        (Tableau::bs32(), Box::new(BogackiShampine32::new())),
-        (Tableau::dopri5(), Box::new(DormandPrince54::new())),
-    ];
+    let tableau_methods = explicit_tableau_methods();
     let mut methods: Vec<(StabilityPolynomial, Box<dyn Integrator>)> = tableau_methods
         .into_iter()
         .map(|(t, m)| (StabilityPolynomial::of_tableau(&t), m))
@@ -157,14 +150,7 @@ fn stability_polynomials_give_the_textbook_intervals() {
 /// implemented methods.
 #[test]
 fn tableau_polynomials_match_the_implementations() {
-    let methods: [(Tableau, Box<dyn Integrator>); 5] = [
-        (Tableau::euler(), Box::new(ExplicitEuler::new())),
-        (Tableau::midpoint(), Box::new(ExplicitMidpoint::new())),
-        (Tableau::rk4(), Box::new(RungeKutta4::new())),
-        (Tableau::bs32(), Box::new(BogackiShampine32::new())),
-        (Tableau::dopri5(), Box::new(DormandPrince54::new())),
-    ];
-    for (tableau, mut method) in methods {
+    for (tableau, mut method) in explicit_tableau_methods() {
         let from_tableau = StabilityPolynomial::of_tableau(&tableau);
         let stepped =
             StabilityPolynomial::of_method(method.as_mut(), tableau.num_stages()).unwrap();
@@ -299,11 +285,11 @@ fn euler_roundoff_study_shows_truncation_and_roundoff() {
     let rows = v["rows"].as_array().unwrap();
     assert_eq!(rows.len(), 7);
     let error = |n: usize, method: usize| rows[n]["runs"][method]["error"].as_f64().unwrap();
-    for n in 2..6 {
+    for (n, row) in rows.iter().enumerate().take(6).skip(2) {
         let ratio = error(n, 0) / error(n + 1, 0);
         assert!((ratio / 10.0 - 1.0).abs() < 0.02, "n = {n}: {ratio}");
-        let truncation = rows[n]["runs"][0]["truncation"].as_f64().unwrap();
-        let h = rows[n]["h"].as_f64().unwrap();
+        let truncation = row["runs"][0]["truncation"].as_f64().unwrap();
+        let h = row["h"].as_f64().unwrap();
         assert!((truncation / (-E * h / 2.0) - 1.0).abs() < 0.02);
     }
     let summary = v["summary"].as_array().unwrap();

@@ -29,6 +29,7 @@ use eomgen::{
 use serde::Serialize;
 use serde_json::json;
 
+use super::stability::{log_y_chart, print_json};
 use super::{CliError, plot};
 
 /// Options of `eomgen study euler-roundoff`.
@@ -192,9 +193,7 @@ pub fn run(args: &EulerRoundoffArgs) -> Result<(), CliError> {
             "summary": summaries,
             "notes": notes,
         });
-        let text =
-            serde_json::to_string_pretty(&out).map_err(|e| CliError::failure(e.to_string()))?;
-        let _ = writeln!(stdout, "{text}");
+        print_json(&out)?;
     } else {
         let _ = writeln!(
             stdout,
@@ -421,16 +420,14 @@ fn plot_errors(path: &str, rows: &[Row]) -> Result<(), CliError> {
     series.push(line("ε₃₂ √N", &|r| {
         r.single_precision_euler.epsilon_sqrt_steps
     }));
-    plot::lines(
+    log_y_chart(
         path,
-        &plot::Chart {
-            title: "x' = x on [0, 1], h = 10⁻ⁿ: truncation falls, roundoff rises",
-            x_desc: "n (h = 10⁻ⁿ, N = 10ⁿ steps)",
-            y_desc: "|x(1) − e|",
-            log_x: false,
-            log_y: true,
-        },
+        [
+            "x' = x on [0, 1], h = 10⁻ⁿ: truncation falls, roundoff rises",
+            "n (h = 10⁻ⁿ, N = 10ⁿ steps)",
+            "|x(1) − e|",
+        ],
+        false,
         &series,
     )
-    .map_err(CliError::failure)
 }

@@ -16,14 +16,14 @@ use std::io::Write as _;
 
 use clap::Args;
 use eomgen::integrate::stability::{
-    GrowthTest, StabilityPolynomial, TestEquation, amplification, implicit_midpoint_stability,
-    measured_limit, partitioned_oscillator_growth_limit, partitioned_oscillator_spectral_radius,
-    radau_iia5_stability,
+    GrowthTest, StabilityPolynomial, TestEquation, amplification, explicit_tableau_methods,
+    implicit_midpoint_stability, measured_limit, partitioned_oscillator_growth_limit,
+    partitioned_oscillator_spectral_radius, radau_iia5_stability,
 };
 use eomgen::{
-    BogackiShampine32, DormandPrince54, DormandPrince853, ExplicitEuler, ExplicitMidpoint,
-    ImplicitMidpoint, IntegrationFailure, Integrator, IntegratorOptions, OdeFn, OutputTimes,
-    RadauIIA5, RungeKutta4, Solution, StormerVerlet, SymplecticEuler, Tableau,
+    BogackiShampine32, DormandPrince54, DormandPrince853, ExplicitEuler, ImplicitMidpoint,
+    IntegrationFailure, Integrator, IntegratorOptions, OdeFn, OutputTimes, RadauIIA5, RungeKutta4,
+    Solution, StormerVerlet, SymplecticEuler, Tableau,
 };
 use nalgebra::Complex;
 use serde::Serialize;
@@ -254,7 +254,6 @@ pub fn run(args: &StabilityArgs) -> Result<(), CliError> {
         plot_energy(&chart_path(prefix, "energy"), &energy)?;
         plot_stiff(&chart_path(prefix, "stiff"), &stiff)?;
     }
-    let mut stdout = std::io::stdout().lock();
     if args.json {
         let out = json!({
             "limits": {
@@ -282,16 +281,14 @@ pub fn run(args: &StabilityArgs) -> Result<(), CliError> {
             },
             "underflow": underflow,
         });
-        let text =
-            serde_json::to_string_pretty(&out).map_err(|e| CliError::failure(e.to_string()))?;
-        let _ = writeln!(stdout, "{text}");
+        print_json(&out)?;
     } else {
         let mut text = String::new();
         write_limits(&mut text, &test, &limits);
         write_energy(&mut text, args.periods, &energy);
         write_stiff(&mut text, args, &modes, &stiff);
         write_underflow(&mut text, &underflow);
-        let _ = write!(stdout, "{text}");
+        let _ = write!(std::io::stdout().lock(), "{text}");
     }
     Ok(())
 }
@@ -305,6 +302,35 @@ fn chart_path(prefix: &str, name: &str) -> String {
         format!("{stem}-{name}.svg")
     }
 }
+
+/// Draws `series` into `path` with a logarithmic y axis; `labels` are the title and the x and
+/// y axis descriptions.
+pub(super) fn log_y_chart(
+    path: &str,
+    labels: [&str; 3],
+    log_x: bool,
+    series: &[plot::Series],
+) -> Result<(), CliError> {
+    let [title, x_desc, y_desc] = labels;
+    let chart = plot::Chart {
+        title,
+        x_desc,
+        y_desc,
+        log_x,
+        log_y: true,
+    };
+    plot::lines(path, &chart, series).map_err(CliError::failure)
+}
+
+/// Prints `value` as pretty JSON on stdout.
+pub(super) fn print_json(value: &serde_json::Value) -> Result<(), CliError> {
+    let text = serde_json::to_string_pretty(value).map_err(|e| CliError::failure(e.to_string()))?;
+    let _ = writeln!(std::io::stdout().lock(), "{text}");
+    Ok(())
+}
+
+/// A stability function `R(z)`.
+type StabilityFunction = fn(Complex<f64>) -> Complex<f64>;
 
 /// An explicit method with its stability polynomial.
 struct ExplicitMethod {
@@ -322,14 +348,7 @@ fn explicit_methods() -> Result<Vec<ExplicitMethod>, CliError> {
     let failed =
         |e: IntegrationFailure| CliError::failure(format!("a polynomial step failed: {e}"));
     let mut methods = Vec::new();
-    let tableau_methods: [(Tableau, Box<dyn Integrator>); 5] = [
-        (Tableau::euler(), Box::new(ExplicitEuler::new())),
-        (Tableau::midpoint(), Box::new(ExplicitMidpoint::new())),
-        (Tableau::rk4(), Box::new(RungeKutta4::new())),
-        (Tableau::bs32(), Box::new(BogackiShampine32::new())),
-        (Tableau::dopri5(), Box::new(DormandPrince54::new())),
-    ];
-    for (tableau, mut method) in tableau_methods {
+    for (tableau, mut method) in explicit_tableau_methods() {
         let polynomial = StabilityPolynomial::of_tableau(&tableau);
         let stepped = StabilityPolynomial::of_method(method.as_mut(), tableau.num_stages())
             .map_err(failed)?;
@@ -495,7 +514,7 @@ fn stability_limits(test: &GrowthTest) -> Result<Limits, CliError> {
         };
         rows.push(limit_row(method.as_mut(), "imaginary", theory, test)?);
     }
-    let implicit: [(Box<dyn Integrator>, fn(Complex<f64>) -> Complex<f64>); 2] = [
+    let implicit: [(Box<dyn Integrator>, StabilityFunction); 2] = [
         // Its default Newton tolerance (1e-12 relative) is below the rounding of h·F at
         // h = 1000 (about 1000 ε), where Newton would report non-convergence.
         (
@@ -1012,18 +1031,16 @@ fn plot_limits(path: &str, methods: &mut [ExplicitMethod]) -> Result<(), CliErro
             points,
         });
     }
-    plot::lines(
+    log_y_chart(
         path,
-        &plot::Chart {
-            title: "per-step amplification on x'' = −ω²x: |R(ihω)| and measured (stable where ≤ 1)",
-            x_desc: "hω",
-            y_desc: "amplification per step",
-            log_x: false,
-            log_y: true,
-        },
+        [
+            "per-step amplification on x'' = −ω²x: |R(ihω)| and measured (stable where ≤ 1)",
+            "hω",
+            "amplification per step",
+        ],
+        false,
         &series,
     )
-    .map_err(CliError::failure)
 }
 
 fn plot_energy(path: &str, rows: &[EnergyRow]) -> Result<(), CliError> {
@@ -1034,18 +1051,16 @@ fn plot_energy(path: &str, rows: &[EnergyRow]) -> Result<(), CliError> {
             points: r.history.clone(),
         })
         .collect();
-    plot::lines(
+    log_y_chart(
         path,
-        &plot::Chart {
-            title: "energy of x'' = −x: explicit Euler grows, RK4 decays, Störmer–Verlet bounded (E/E₀ ≤ 1e200 drawn)",
-            x_desc: "t/T (periods)",
-            y_desc: "E/E₀",
-            log_x: false,
-            log_y: true,
-        },
+        [
+            "energy of x'' = −x: explicit Euler grows, RK4 decays, Störmer–Verlet bounded (E/E₀ ≤ 1e200 drawn)",
+            "t/T (periods)",
+            "E/E₀",
+        ],
+        false,
         &series,
     )
-    .map_err(CliError::failure)
 }
 
 fn plot_stiff(path: &str, rows: &[StiffRow]) -> Result<(), CliError> {
@@ -1066,16 +1081,14 @@ fn plot_stiff(path: &str, rows: &[StiffRow]) -> Result<(), CliError> {
                 .collect(),
         })
         .collect();
-    plot::lines(
+    log_y_chart(
         path,
-        &plot::Chart {
-            title: "stiff two-mass spring: accepted steps against k/m",
-            x_desc: "k/m (1/s²)",
-            y_desc: "steps",
-            log_x: true,
-            log_y: true,
-        },
+        [
+            "stiff two-mass spring: accepted steps against k/m",
+            "k/m (1/s²)",
+            "steps",
+        ],
+        true,
         &series,
     )
-    .map_err(CliError::failure)
 }

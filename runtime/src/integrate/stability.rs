@@ -30,10 +30,12 @@
 
 use nalgebra::Complex;
 
-use super::Integrator;
 use super::error::{IntegrationError, IntegrationFailure};
 use super::options::{IntegratorOptions, OutputTimes};
 use super::tableau::Tableau;
+use super::{
+    BogackiShampine32, DormandPrince54, ExplicitEuler, ExplicitMidpoint, Integrator, RungeKutta4,
+};
 use crate::ode::OdeFn;
 
 /// Relative agreement with `1/k!` below which a coefficient `rₖ` counts as matching the
@@ -102,8 +104,8 @@ impl StabilityPolynomial {
     ) -> Result<Self, IntegrationFailure> {
         let dim = num_stages + 1;
         let mut shift = OdeFn::new(dim, |_t: f64, y: &[f64], dy: &mut [f64]| {
-            for i in 0..y.len() {
-                dy[i] = y.get(i + 1).copied().unwrap_or(0.0);
+            for (i, d) in dy.iter_mut().enumerate() {
+                *d = y.get(i + 1).copied().unwrap_or(0.0);
             }
         });
         let mut y0 = vec![0.0; dim];
@@ -178,7 +180,11 @@ impl StabilityPolynomial {
         let r = &self.coefficients[..=d];
         // R(iy) = Σ rₖ iᵏ yᵏ: real part from even k (sign (−1)^(k/2)), imaginary from odd k.
         let signed = |k: usize| {
-            if (k / 2) % 2 == 0 { r[k] } else { -r[k] }
+            if (k / 2).is_multiple_of(2) {
+                r[k]
+            } else {
+                -r[k]
+            }
         };
         let mut e = vec![0.0; 2 * d + 1];
         for j in 0..=d {
@@ -248,6 +254,18 @@ impl StabilityPolynomial {
         let level = (1.0 + growth.max(0.0)).powi(2);
         first_crossing(|x| self.eval_real(-x).powi(2) - level, 2.0 * d * d + 1.0)
     }
+}
+
+/// The explicit Runge–Kutta methods whose tableau is public, each with its integrator:
+/// explicit Euler, explicit midpoint, RK4, Bogacki–Shampine 3(2), Dormand–Prince 5(4).
+pub fn explicit_tableau_methods() -> [(Tableau, Box<dyn Integrator>); 5] {
+    [
+        (Tableau::euler(), Box::new(ExplicitEuler::new())),
+        (Tableau::midpoint(), Box::new(ExplicitMidpoint::new())),
+        (Tableau::rk4(), Box::new(RungeKutta4::new())),
+        (Tableau::bs32(), Box::new(BogackiShampine32::new())),
+        (Tableau::dopri5(), Box::new(DormandPrince54::new())),
+    ]
 }
 
 /// The first `x > 0` in `(0, bound]` where `f` turns positive (`f ≤ 0` just above 0), refined
