@@ -74,6 +74,7 @@ mod options;
 mod radau5;
 mod rk4;
 mod solution;
+pub mod stability;
 mod stepper;
 mod symplectic;
 mod tableau;

@@ -1,0 +1,549 @@
+//! Linear stability of the integrators, in theory and measured.
+//!
+//! Applied to the test equation `ẏ = λy`, one step of a Runge–Kutta method of size `h`
+//! multiplies `y` by its *stability function* `R(z)`, `z = hλ`:
+//!
+//! ```text
+//! R(z) = 1 + z bᵀ(I − zA)⁻¹𝟙 = 1 + Σₖ≥₁ (bᵀAᵏ⁻¹𝟙) zᵏ
+//! ```
+//!
+//! a polynomial of degree at most `s` (the number of stages) for an explicit method, whose
+//! strictly lower-triangular `A` is nilpotent ([`StabilityPolynomial`]). The undamped
+//! oscillator `ẍ = −ω²x` has `λ = ±iω`, so a method is stable on it for the `hω` with
+//! `|R(ihω)| ≤ 1` ([`StabilityPolynomial::imaginary_axis_limit`]); the decay `ẋ = −λx` needs
+//! `|R(−hλ)| ≤ 1` ([`StabilityPolynomial::real_axis_limit`]). The implicit methods have
+//! rational `R` ([`implicit_midpoint_stability`], [`radau_iia5_stability`]); the partitioned
+//! methods are not Runge–Kutta methods and have a `2 × 2` step matrix on the oscillator
+//! ([`partitioned_oscillator_spectral_radius`]).
+//!
+//! The measured side runs a method itself, with constant steps, on a [`TestEquation`]:
+//! [`amplification`] (the per-step growth of `‖y‖`) and [`measured_limit`] (the largest
+//! stable `h`, by bisection on a [`GrowthTest`]).
+//!
+//! # References
+//! E. Hairer, G. Wanner, *Solving Ordinary Differential Equations II*, 2nd ed., Springer, 1996,
+//! §IV.2 (stability functions, Prop. 2.11 `R(z) = 1 + z bᵀ(I − zA)⁻¹𝟙`), §IV.3 (A-stability),
+//! §IV.5 (Radau IIA), doi:10.1007/978-3-642-05221-7; E. Hairer, C. Lubich, G. Wanner,
+//! *Geometric Numerical Integration*, 2nd ed., Springer, 2006, §I.5 and §IX.8 (linear
+//! stability of the Störmer–Verlet method), doi:10.1007/3-540-30666-8. Syllabus lecture 4
+//! (integration methods).
+
+use nalgebra::Complex;
+
+use super::error::{IntegrationError, IntegrationFailure};
+use super::options::{IntegratorOptions, OutputTimes};
+use super::tableau::Tableau;
+use super::{
+    BogackiShampine32, DormandPrince54, ExplicitEuler, ExplicitMidpoint, Integrator, RungeKutta4,
+};
+use crate::ode::OdeFn;
+
+/// Relative agreement with `1/k!` below which a coefficient `rₖ` counts as matching the
+/// exponential (an order condition); real mismatches of these methods are of order 1.
+const ORDER_MATCH: f64 = 1e-10;
+/// Grid points of the scan for the first crossing of `|R| = 1`.
+const SCAN_POINTS: usize = 100_000;
+
+/// The stability function `R(z) = Σₖ rₖ zᵏ` of an explicit Runge–Kutta method.
+///
+/// # Shapes
+/// `coefficients()` has `s + 1` entries `r₀ … rₛ` (`r₀ = 1`), `s` the number of stages;
+/// trailing coefficients may be zero (Bogacki–Shampine's fourth stage has weight 0).
+///
+/// # Examples
+/// ```
+/// use eomgen_runtime::Tableau;
+/// use eomgen_runtime::integrate::stability::StabilityPolynomial;
+///
+/// // RK4: R(z) = 1 + z + z²/2 + z³/6 + z⁴/24, stable on the imaginary axis up to 2√2.
+/// let rk4 = StabilityPolynomial::of_tableau(&Tableau::rk4());
+/// assert_eq!(rk4.order(), 4);
+/// assert!((rk4.imaginary_axis_limit() - 8f64.sqrt()).abs() < 1e-12);
+/// ```
+#[derive(Debug, Clone, PartialEq)]
+pub struct StabilityPolynomial {
+    coefficients: Vec<f64>,
+}
+
+impl StabilityPolynomial {
+    /// The polynomial with coefficients `r₀ … r_d`.
+    pub fn from_coefficients(coefficients: Vec<f64>) -> Self {
+        Self { coefficients }
+    }
+
+    /// `R(z)` of an explicit tableau: `rₖ = bᵀAᵏ⁻¹𝟙` (Hairer–Wanner II, Prop. IV.2.11,
+    /// expanded as a Neumann series, which terminates because `A` is strictly lower
+    /// triangular).
+    pub fn of_tableau(tableau: &Tableau) -> Self {
+        let s = tableau.num_stages();
+        let b = tableau.b();
+        let mut power = vec![1.0; s]; // Aᵏ⁻¹𝟙
+        let mut coefficients = vec![1.0];
+        for _ in 0..s {
+            coefficients.push(b.iter().zip(&power).map(|(b, p)| b * p).sum());
+            power = (0..s)
+                .map(|i| tableau.a(i).iter().zip(&power).map(|(a, p)| a * p).sum())
+                .collect();
+        }
+        Self { coefficients }
+    }
+
+    /// `R(z)` of an explicit method read off one step of its implementation, for methods whose
+    /// tableau is not public (DOP853).
+    ///
+    /// On `ẏ = Jy` with `J` the `(s + 1) × (s + 1)` shift (`(Jy)ᵢ = yᵢ₊₁`, nilpotent), one step
+    /// of size 1 from the last unit vector `e_s` gives `R(J) e_s = Σₖ rₖ e_{s−k}`: the
+    /// coefficients appear in reverse order in the new state, exactly, since `Jˢ⁺¹ = 0`.
+    /// The method is run with [`IntegratorOptions::fixed_step`].
+    ///
+    /// # Errors
+    /// The [`IntegrationFailure`] of that step (none for an explicit method).
+    pub fn of_method(
+        method: &mut dyn Integrator,
+        num_stages: usize,
+    ) -> Result<Self, IntegrationFailure> {
+        let dim = num_stages + 1;
+        let mut shift = OdeFn::new(dim, |_t: f64, y: &[f64], dy: &mut [f64]| {
+            for (i, d) in dy.iter_mut().enumerate() {
+                *d = y.get(i + 1).copied().unwrap_or(0.0);
+            }
+        });
+        let mut y0 = vec![0.0; dim];
+        y0[num_stages] = 1.0;
+        let options = IntegratorOptions::default()
+            .with_fixed_step(true)
+            .with_dt(1.0);
+        let solution = method.integrate(
+            &mut shift,
+            0.0,
+            &y0,
+            1.0,
+            &OutputTimes::At(vec![1.0]),
+            &options,
+        )?;
+        let coefficients = solution.state(0).iter().rev().copied().collect();
+        Ok(Self { coefficients })
+    }
+
+    /// The coefficients `r₀ … r_d`.
+    pub fn coefficients(&self) -> &[f64] {
+        &self.coefficients
+    }
+
+    /// `R(z)` at a complex `z` (Horner).
+    pub fn eval(&self, z: Complex<f64>) -> Complex<f64> {
+        self.coefficients
+            .iter()
+            .rev()
+            .fold(Complex::new(0.0, 0.0), |acc, &r| acc * z + r)
+    }
+
+    /// `R(x)` at a real `x` (Horner).
+    pub fn eval_real(&self, x: f64) -> f64 {
+        self.coefficients
+            .iter()
+            .rev()
+            .fold(0.0, |acc, &r| acc * x + r)
+    }
+
+    /// The order `p` of `R` as an approximation of `eᶻ`: the largest `p` with
+    /// `rₖ = 1/k!` for every `k ≤ p` (to 1e-10 relative). For a Runge–Kutta method this is at
+    /// least the method's order.
+    pub fn order(&self) -> usize {
+        let mut factorial = 1.0;
+        let mut p = 0;
+        for (k, &r) in self.coefficients.iter().enumerate().skip(1) {
+            factorial *= k as f64;
+            if (r * factorial - 1.0).abs() > ORDER_MATCH {
+                break;
+            }
+            p = k;
+        }
+        p
+    }
+
+    /// Degree `d` of `R` (highest non-zero coefficient).
+    pub fn degree(&self) -> usize {
+        self.coefficients
+            .iter()
+            .rposition(|&r| r != 0.0)
+            .unwrap_or(0)
+    }
+
+    /// The coefficients `e₀ … e_2d` of `E(y) = |R(iy)|² − 1`, an even polynomial in `y`.
+    ///
+    /// The order conditions make `E(y) = O(y^(p+1))`: the coefficients up to `y^p` cancel
+    /// exactly in theory and are set to zero here rather than left as rounding noise, whose
+    /// sign would decide the stability near `y = 0`.
+    pub fn imaginary_axis_excess(&self) -> Vec<f64> {
+        let d = self.degree();
+        let r = &self.coefficients[..=d];
+        // R(iy) = Σ rₖ iᵏ yᵏ: real part from even k (sign (−1)^(k/2)), imaginary from odd k.
+        let signed = |k: usize| {
+            if (k / 2).is_multiple_of(2) {
+                r[k]
+            } else {
+                -r[k]
+            }
+        };
+        let mut e = vec![0.0; 2 * d + 1];
+        for j in 0..=d {
+            for k in 0..=d {
+                if j % 2 == k % 2 {
+                    e[j + k] += signed(j) * signed(k);
+                }
+            }
+        }
+        e[0] -= 1.0;
+        let p = self.order();
+        for coefficient in e.iter_mut().take(p + 1) {
+            *coefficient = 0.0;
+        }
+        e
+    }
+
+    /// The stability interval on the imaginary axis: the largest `y` with `|R(iy)| ≤ 1` on all
+    /// of `[0, y]`; `0` when `|R(iy)| > 1` for every small `y > 0` (explicit Euler, explicit
+    /// midpoint); `∞` only for `R ≡ 1`.
+    ///
+    /// The first non-zero coefficient of [`imaginary_axis_excess`](Self::imaginary_axis_excess)
+    /// decides the sign near 0. Otherwise `E(y)` is scanned on 10⁵ points of `[0, d + 1]`
+    /// (an explicit method whose `R` has degree `d` has an imaginary interval of at most
+    /// `d − 1`: I. P. E. Kinnmark, W. G. Gray, "One step integration methods with maximum
+    /// stability regions", Math. Comput. Simul. 26, 87–92, 1984) for its first positive value,
+    /// and the crossing is refined by bisection to rounding. A tangency `E = 0⁺` narrower than
+    /// the grid spacing would be missed.
+    pub fn imaginary_axis_limit(&self) -> f64 {
+        self.imaginary_axis_growth_limit(0.0)
+    }
+
+    /// The first `y > 0` with `|R(iy)| > 1 + growth` (`growth ≥ 0`): the limit a measurement
+    /// that detects a per-step growth above `growth` finds ([`GrowthTest`]); for `growth = 0`,
+    /// [`imaginary_axis_limit`](Self::imaginary_axis_limit). Scanned on `[0, 2(d + 1)]` for
+    /// `growth > 0`; that bound is returned if there is no crossing below it.
+    pub fn imaginary_axis_growth_limit(&self, growth: f64) -> f64 {
+        let e = self.imaginary_axis_excess();
+        if growth <= 0.0 {
+            match e.iter().find(|&&c| c != 0.0) {
+                None => return f64::INFINITY,
+                Some(&c) if c > 0.0 => return 0.0,
+                Some(_) => {}
+            }
+        }
+        let level = growth.max(0.0) * (2.0 + growth.max(0.0));
+        let excess = |y: f64| e.iter().rev().fold(0.0, |acc, &c| acc * y + c) - level;
+        let bound = self.degree() as f64 + 1.0;
+        first_crossing(excess, if growth > 0.0 { 2.0 * bound } else { bound })
+    }
+
+    /// The stability interval on the negative real axis: the largest `x` with `|R(−x)| ≤ 1` on
+    /// all of `[0, x]` (the stable `hλ` for `ẋ = −λx`).
+    ///
+    /// `R(−x)² − 1` is scanned on 10⁵ points of `[0, 2d² + 1]` (an explicit method of degree
+    /// `d` has a real interval of at most `2d²`, reached by shifted Chebyshev polynomials:
+    /// Hairer–Wanner II, §IV.2, stabilized explicit methods) for its first positive value;
+    /// the crossing is refined by bisection.
+    pub fn real_axis_limit(&self) -> f64 {
+        self.real_axis_growth_limit(0.0)
+    }
+
+    /// The first `x > 0` with `|R(−x)| > 1 + growth` (`growth ≥ 0`), scanned on
+    /// `[0, 2d² + 1]` like [`real_axis_limit`](Self::real_axis_limit).
+    pub fn real_axis_growth_limit(&self, growth: f64) -> f64 {
+        let d = self.degree() as f64;
+        let level = (1.0 + growth.max(0.0)).powi(2);
+        first_crossing(|x| self.eval_real(-x).powi(2) - level, 2.0 * d * d + 1.0)
+    }
+}
+
+/// The explicit Runge–Kutta methods whose tableau is public, each with its integrator:
+/// explicit Euler, explicit midpoint, RK4, Bogacki–Shampine 3(2), Dormand–Prince 5(4).
+pub fn explicit_tableau_methods() -> [(Tableau, Box<dyn Integrator>); 5] {
+    [
+        (Tableau::euler(), Box::new(ExplicitEuler::new())),
+        (Tableau::midpoint(), Box::new(ExplicitMidpoint::new())),
+        (Tableau::rk4(), Box::new(RungeKutta4::new())),
+        (Tableau::bs32(), Box::new(BogackiShampine32::new())),
+        (Tableau::dopri5(), Box::new(DormandPrince54::new())),
+    ]
+}
+
+/// The first `x > 0` in `(0, bound]` where `f` turns positive (`f ≤ 0` just above 0), refined
+/// by bisection to adjacent floating-point numbers; `bound` if there is none.
+fn first_crossing(f: impl Fn(f64) -> f64, bound: f64) -> f64 {
+    let step = bound / SCAN_POINTS as f64;
+    let Some(index) = (1..=SCAN_POINTS).find(|&i| f(i as f64 * step) > 0.0) else {
+        return bound;
+    };
+    let (mut lo, mut hi) = ((index - 1) as f64 * step, index as f64 * step);
+    while hi - lo > 4.0 * f64::EPSILON * hi {
+        let mid = 0.5 * (lo + hi);
+        if f(mid) > 0.0 {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    0.5 * (lo + hi)
+}
+
+/// The stability function of the implicit midpoint rule (the one-stage Gauss method),
+/// `R(z) = (1 + z/2)/(1 − z/2)`: `|R(iy)| = 1` for every real `y` (A-stable, and it keeps the
+/// oscillator's amplitude exactly).
+///
+/// # References
+/// Hairer–Wanner II, §IV.3 (the diagonal Padé approximants are A-stable).
+pub fn implicit_midpoint_stability(z: Complex<f64>) -> Complex<f64> {
+    (1.0 + z / 2.0) / (1.0 - z / 2.0)
+}
+
+/// The stability function of Radau IIA of order 5, the (2,3) Padé approximant of `eᶻ`,
+/// `R(z) = (1 + 2z/5 + z²/20)/(1 − 3z/5 + 3z²/20 − z³/60)`: `|R(iy)| < 1` for `y ≠ 0`
+/// (A-stable) and `R(∞) = 0` (L-stable), so `|R(iy)| ≈ 3/y` for large `y`.
+///
+/// # References
+/// Hairer–Wanner II, §IV.3 (Padé approximations of `eᶻ`) and §IV.5 (the stability function
+/// of the `s`-stage Radau IIA method is the `(s − 1, s)` Padé approximant: L-stable).
+pub fn radau_iia5_stability(z: Complex<f64>) -> Complex<f64> {
+    let numerator = 1.0 + z * 2.0 / 5.0 + z * z / 20.0;
+    let denominator = 1.0 - z * 3.0 / 5.0 + z * z * 3.0 / 20.0 - z * z * z / 60.0;
+    numerator / denominator
+}
+
+/// The spectral radius of the step matrix of symplectic Euler and of Störmer–Verlet on
+/// `ẍ = −ω²x`, as a function of `θ = hω`.
+///
+/// Both step matrices (on `(x, ẋ/ω)`) have determinant 1 (they are symplectic) and trace
+/// `2 − θ²`, so their eigenvalues lie on the unit circle while `|2 − θ²| ≤ 2`, that is for
+/// `θ ≤ 2`, and are real with `ρ = |tr|/2 + √(tr²/4 − 1) > 1` beyond. At `θ = 2` the
+/// eigenvalue `−1` is double and the amplitude grows linearly.
+///
+/// # References
+/// Hairer–Lubich–Wanner, *Geometric Numerical Integration*, §I.5.2 and §IX.8 (the
+/// Störmer–Verlet method is stable for `hω < 2`).
+pub fn partitioned_oscillator_spectral_radius(h_omega: f64) -> f64 {
+    let half_trace = 1.0 - h_omega * h_omega / 2.0;
+    if half_trace.abs() <= 1.0 {
+        1.0
+    } else {
+        half_trace.abs() + (half_trace * half_trace - 1.0).sqrt()
+    }
+}
+
+/// The `hω` beyond which [`partitioned_oscillator_spectral_radius`] exceeds `1 + growth`
+/// (`growth ≥ 0`): `hω = √(2 + ρ + 1/ρ)` with `ρ = 1 + growth`, 2 for `growth = 0`.
+pub fn partitioned_oscillator_growth_limit(growth: f64) -> f64 {
+    let rho = 1.0 + growth.max(0.0);
+    (2.0 + rho + 1.0 / rho).sqrt()
+}
+
+/// A linear test equation for the measurements, with `ω = λ = 1` so that the step `h` is `hω`
+/// (or `hλ`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum TestEquation {
+    /// The undamped oscillator `ẍ = −x` as the second-order system `y = [x, ẋ]` (which the
+    /// partitioned methods need), from `(1, 0)`. A Runge–Kutta method multiplies
+    /// `‖y‖ = √(x² + ẋ²)` by exactly `|R(ih)|` per step (its step matrix is `|R|` times a
+    /// rotation); a partitioned method keeps `‖y‖ ≤ 1` from this start while `h < 2` (its
+    /// modified energy `(1 − h²/4)x² + ẋ²` is conserved: Störmer–Verlet), or bounded by
+    /// `1/√(1 − h/2)` (symplectic Euler).
+    Oscillator,
+    /// The decay `ẋ = −x`, from `x = 1`: multiplied by `R(−h)` per step.
+    Decay,
+}
+
+impl TestEquation {
+    /// Integrates `steps` constant steps of size `h` and returns `‖y‖` at the end (the initial
+    /// state has `‖y‖ = 1`).
+    ///
+    /// The tolerances are `rtol = 1e-10`, `atol = 1e-14`: only the implicit methods use them,
+    /// to stop their Newton iterations, so their `‖y‖` is accurate to about 1e-10 relative
+    /// while it stays above 1e-14.
+    ///
+    /// # Errors
+    /// The [`IntegrationFailure`] of the run.
+    pub fn final_norm(
+        self,
+        method: &mut dyn Integrator,
+        h: f64,
+        steps: usize,
+    ) -> Result<f64, IntegrationFailure> {
+        let t_end = h * steps as f64;
+        // The tolerances only stop the Newton iterations of the implicit methods: their
+        // amplitudes are accurate to about 1e-10 relative while above 1e-14.
+        let options = IntegratorOptions::default()
+            .with_fixed_step(true)
+            .with_dt(h)
+            .with_rtol(1e-10)
+            .with_atol(1e-14)
+            .with_max_steps(steps + 2);
+        let output = OutputTimes::At(vec![t_end]);
+        let solution = match self {
+            TestEquation::Oscillator => {
+                let mut system = OdeFn::second_order(1, |_t: f64, y: &[f64], dy: &mut [f64]| {
+                    dy[0] = y[1];
+                    dy[1] = -y[0];
+                });
+                method.integrate(&mut system, 0.0, &[1.0, 0.0], t_end, &output, &options)?
+            }
+            TestEquation::Decay => {
+                let mut system = OdeFn::new(1, |_t: f64, y: &[f64], dy: &mut [f64]| dy[0] = -y[0]);
+                method.integrate(&mut system, 0.0, &[1.0], t_end, &output, &options)?
+            }
+        };
+        Ok(solution.state(0).iter().map(|v| v * v).sum::<f64>().sqrt())
+    }
+}
+
+/// The measured per-step amplification `(‖y_N‖/‖y₀‖)^(1/N)` of `method` with `N = steps`
+/// constant steps of size `h` on `equation`. For a Runge–Kutta method on the oscillator it
+/// is `|R(ih)|`, on the decay `|R(−h)|`.
+///
+/// # Errors
+/// The [`IntegrationFailure`] of the run, e.g. [`IntegrationError::NonFiniteState`] when
+/// `‖y‖` overflows (`steps` too large for the growth).
+pub fn amplification(
+    method: &mut dyn Integrator,
+    equation: TestEquation,
+    h: f64,
+    steps: usize,
+) -> Result<f64, IntegrationFailure> {
+    let norm = equation.final_norm(method, h, steps)?;
+    Ok(norm.powf(1.0 / steps as f64))
+}
+
+/// When a constant-step run counts as unstable: `‖y‖` grows beyond `threshold` (from 1)
+/// within `steps` steps, or overflows.
+///
+/// A per-step growth `1 + δ` is detected when `(1 + δ)^steps > threshold`, that is for
+/// `δ ≳ ln(threshold)/steps` ([`GrowthTest::smallest_detected_growth`]). `threshold` must
+/// exceed the bounded transient of a stable but non-normal step matrix (symplectic Euler:
+/// `1/√(1 − h/2)` from `(1, 0)`, 100 at 0.01 % below its limit).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GrowthTest {
+    /// Number of constant steps of each run.
+    pub steps: usize,
+    /// Growth of `‖y‖` that counts as unstable (dimensionless, `> 1`).
+    pub threshold: f64,
+}
+
+impl GrowthTest {
+    /// The smallest per-step growth `δ` this test detects: `threshold^(1/steps) − 1`.
+    pub fn smallest_detected_growth(&self) -> f64 {
+        self.threshold.powf(1.0 / self.steps as f64) - 1.0
+    }
+
+    /// The number of steps needed to detect a per-step growth `1 + δ`:
+    /// `⌈ln(threshold)/ln(1 + δ)⌉` (`usize::MAX` for `δ ≤ 0`).
+    pub fn steps_to_detect(&self, growth: f64) -> usize {
+        if growth > 0.0 {
+            (self.threshold.ln() / growth.ln_1p()).ceil() as usize
+        } else {
+            usize::MAX
+        }
+    }
+
+    /// Whether `method` with step `h` on `equation` stays within `threshold` for `steps` steps.
+    ///
+    /// # Errors
+    /// The [`IntegrationFailure`] of the run, unless it is an overflow
+    /// ([`IntegrationError::NonFiniteState`], [`IntegrationError::RhsNonFinite`]), which
+    /// counts as unstable.
+    pub fn is_stable(
+        &self,
+        method: &mut dyn Integrator,
+        equation: TestEquation,
+        h: f64,
+    ) -> Result<bool, IntegrationFailure> {
+        match equation.final_norm(method, h, self.steps) {
+            Ok(norm) => Ok(norm <= self.threshold),
+            Err(IntegrationFailure {
+                error:
+                    IntegrationError::NonFiniteState { .. } | IntegrationError::RhsNonFinite { .. },
+                ..
+            }) => Ok(false),
+            Err(failure) => Err(failure),
+        }
+    }
+}
+
+/// The largest stable step `h` (in units of `1/ω` or `1/λ`) of `method` on `equation`, as
+/// measured by `test`: steps `h = 0.1 · 1.25ᵏ` are tried until one is unstable, then the
+/// bracket is bisected until its width is below `relative_tolerance · h`; the midpoint is
+/// returned. `None` if every `h ≤ 1000` is stable (A-stable methods); `Some(0.0)` if already
+/// `h = 0.1` is unstable.
+///
+/// With a per-step growth `1 + δ(h)` above the limit, the result exceeds the true limit by
+/// the `Δh` at which `δ` reaches [`GrowthTest::smallest_detected_growth`].
+///
+/// # Errors
+/// An [`IntegrationFailure`] other than an overflow (see [`GrowthTest::is_stable`]).
+pub fn measured_limit(
+    method: &mut dyn Integrator,
+    equation: TestEquation,
+    test: &GrowthTest,
+    relative_tolerance: f64,
+) -> Result<Option<f64>, IntegrationFailure> {
+    let mut lo = 0.0;
+    let mut hi = 0.1;
+    while test.is_stable(method, equation, hi)? {
+        lo = hi;
+        hi *= 1.25;
+        if hi > 1000.0 {
+            return Ok(None);
+        }
+    }
+    if lo == 0.0 {
+        return Ok(Some(0.0));
+    }
+    while hi - lo > relative_tolerance * hi {
+        let mid = 0.5 * (lo + hi);
+        if test.is_stable(method, equation, mid)? {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    Ok(Some(0.5 * (lo + hi)))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `|R(iy)|²` from the excess polynomial agrees with direct evaluation of `R`.
+    #[test]
+    fn excess_is_the_squared_modulus_minus_one() {
+        for tableau in [
+            Tableau::euler(),
+            Tableau::midpoint(),
+            Tableau::bs32(),
+            Tableau::dopri5(),
+        ] {
+            let r = StabilityPolynomial::of_tableau(&tableau);
+            let e = r.imaginary_axis_excess();
+            for y in [0.3, 1.0, 2.5] {
+                let direct = r.eval(Complex::new(0.0, y)).norm_sqr() - 1.0;
+                let from_e = e.iter().rev().fold(0.0, |acc, &c| acc * y + c);
+                assert!((direct - from_e).abs() < 1e-12, "{} at {y}", tableau.name());
+            }
+        }
+    }
+
+    /// Closed forms: Euler `R = 1 + z` (real interval 2, imaginary empty), RK4 imaginary `2√2`,
+    /// Bogacki–Shampine (`R = 1 + z + z²/2 + z³/6`) imaginary `√3`.
+    #[test]
+    fn limits_of_closed_forms() {
+        let euler = StabilityPolynomial::of_tableau(&Tableau::euler());
+        assert_eq!(euler.imaginary_axis_limit(), 0.0);
+        assert!((euler.real_axis_limit() - 2.0).abs() < 1e-12);
+        let bs32 = StabilityPolynomial::of_tableau(&Tableau::bs32());
+        assert_eq!(bs32.degree(), 3);
+        assert!((bs32.imaginary_axis_limit() - 3f64.sqrt()).abs() < 1e-12);
+        assert_eq!(partitioned_oscillator_spectral_radius(1.99), 1.0);
+        assert_eq!(partitioned_oscillator_growth_limit(0.0), 2.0);
+        let beyond = partitioned_oscillator_growth_limit(0.1);
+        assert!((partitioned_oscillator_spectral_radius(beyond) - 1.1).abs() < 1e-12);
+        assert!(partitioned_oscillator_spectral_radius(2.01) > 1.0);
+    }
+}
