@@ -120,11 +120,14 @@ fn tick(v: f64, log: bool) -> String {
 /// `[lo, hi]` padded by 5 % (or a factor for log axes), with a unit range for a constant.
 fn range(lo: f64, hi: f64, log: bool) -> (f64, f64) {
     if log {
-        if hi > lo {
-            (lo / 1.5, hi * 1.5)
-        } else {
-            (lo / 10.0, lo * 10.0)
-        }
+        // Padding by a factor must not overflow to ∞ (plotters never returns on an infinite
+        // log range) or underflow to 0.
+        let (lo_pad, hi_pad) = if hi > lo { (1.5, 1.5) } else { (10.0, 10.0) };
+        let hi = if hi > lo { hi } else { lo };
+        (
+            (lo / lo_pad).max(f64::MIN_POSITIVE),
+            (hi * hi_pad).min(f64::MAX),
+        )
     } else if hi > lo {
         let pad = 0.05 * (hi - lo);
         (lo - pad, hi + pad)
