@@ -44,27 +44,29 @@ impl ExplicitRk {
 }
 
 /// Stage `j` of a step whose first stage is `first` and whose later stages are the rows of `k`.
-#[inline]
-fn stage<'a>(first: &'a [f64], k: &'a [f64], dim: usize, j: usize) -> &'a [f64] {
-    if j == 0 {
-        first
-    } else {
-        &k[(j - 1) * dim..j * dim]
-    }
-}
-
 /// `out = Σⱼ wⱼ kⱼ` over the stages that have a weight (zero weights are skipped).
 ///
 /// The increment is summed on its own before it is added to `y` (see [`combine`]), so that
 /// small stage contributions are not rounded against `|y|` one at a time.
+///
+/// Summed component by component with each sum in a register: summing stage by stage into
+/// `out` makes every addition wait for the previous stage's store to memory, which cost more
+/// than the right-hand side itself on small systems (measured on the double pendulum).
 fn weighted_sum(out: &mut [f64], weights: &[f64], first: &[f64], k: &[f64], dim: usize) {
-    out.fill(0.0);
-    for (j, &w) in weights.iter().enumerate() {
-        if w != 0.0 {
-            for (o, &kj) in out.iter_mut().zip(stage(first, k, dim, j)) {
-                *o += w * kj;
+    let Some((&w0, rest)) = weights.split_first() else {
+        out.fill(0.0);
+        return;
+    };
+    let used = rest.len().min(k.len().checked_div(dim).unwrap_or(0));
+    let k = &k[..used * dim];
+    for (i, (o, &f)) in out.iter_mut().zip(first).enumerate() {
+        let mut acc = if w0 == 0.0 { 0.0 } else { w0 * f };
+        for (&w, kj) in rest.iter().zip(k.chunks_exact(dim.max(1))) {
+            if w != 0.0 {
+                acc += w * kj[i];
             }
         }
+        *o = acc;
     }
 }
 
