@@ -8,7 +8,7 @@ use eomgen::{ModeKind, ModelInfo, damped_modes, eigenvalues_of_m_inv_k, find_equ
 use nalgebra::DMatrix;
 use serde_json::json;
 
-use super::values::{evaluate, split_assignment};
+use super::values::{evaluate, parameter_lookup, set_parameters, split_assignment};
 use super::{CliError, find_model};
 
 /// Options of `eomgen modes`.
@@ -32,16 +32,7 @@ pub struct ModesArgs {
 /// Runs `modes`.
 pub fn run(args: &ModesArgs) -> Result<(), CliError> {
     let mut model = find_model(&args.model)?;
-    for s in &args.set {
-        let (name, text) = split_assignment(s, "--set")?;
-        let names = model.parameter_names();
-        let values = model.parameter_values();
-        let lookup = |n: &str| names.iter().position(|p| *p == n).map(|i| values[i]);
-        let value = evaluate(text, &format!("--set {name}"), &lookup)?;
-        model
-            .set_parameter(name, value)
-            .map_err(|e| CliError::usage(e.to_string()))?;
-    }
+    set_parameters(model.as_mut(), &args.set)?;
     let (label, guess) = operating_point(model.as_ref(), args.at.as_deref())?;
     let fail = |e: eomgen::ModalError| CliError::failure(format!("`{}`: {e}", model.name()));
     let equilibrium = find_equilibrium(model.as_ref(), &guess, 0.0).map_err(fail)?;
@@ -216,9 +207,7 @@ fn operating_point(
             model.coordinate_names().first().copied().unwrap_or("q")
         )));
     }
-    let names = model.parameter_names();
-    let values = model.parameter_values();
-    let lookup = |p: &str| names.iter().position(|x| *x == p).map(|i| values[i]);
+    let lookup = parameter_lookup(model);
     let mut q = vec![0.0; n];
     for part in at.split(',') {
         let (name, text) = split_assignment(part, "--at")?;

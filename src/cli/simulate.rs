@@ -11,7 +11,7 @@ use eomgen::{
 use serde_json::json;
 
 use super::events::CliEvents;
-use super::values::{evaluate, split_assignment};
+use super::values::{evaluate, parameter_lookup, set_parameters, split_assignment};
 use super::{CliError, find_model, plot};
 use eomgen::Stabilization;
 
@@ -137,26 +137,10 @@ pub struct SimulateArgs {
     pub event: Vec<String>,
 }
 
-fn parameter_lookup(model: &dyn ModelInfo) -> impl Fn(&str) -> Option<f64> + '_ {
-    let names = model.parameter_names();
-    let values = model.parameter_values();
-    move |n: &str| names.iter().position(|p| *p == n).map(|i| values[i])
-}
-
 /// Runs `simulate`.
 pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
     let mut model = find_model(&args.model)?;
-    for s in &args.set {
-        let (name, text) = split_assignment(s, "--set")?;
-        let value = evaluate(
-            text,
-            &format!("--set {name}"),
-            &parameter_lookup(model.as_ref()),
-        )?;
-        model
-            .set_parameter(name, value)
-            .map_err(|e| CliError::usage(e.to_string()))?;
-    }
+    set_parameters(model.as_mut(), &args.set)?;
     let n = model.num_dofs();
     let coordinates = model.coordinate_names();
     let mut y0 = model.initial_state();

@@ -1,6 +1,7 @@
 //! `NAME=VALUE` arguments whose values are expressions (`theta1=pi/2`, `k=4*10^2`).
 
 use super::CliError;
+use eomgen::ModelInfo;
 use eomgen_symbolic::model::Location;
 use eomgen_symbolic::model::parser::{eval_expr, parse_expr};
 
@@ -38,4 +39,26 @@ pub fn split_assignment<'a>(arg: &'a str, option: &str) -> Result<(&'a str, &'a 
                 "{option} takes NAME=VALUE, got `{arg}` (for example `{option} theta1=pi/2`)"
             ))
         })
+}
+
+/// Looks up `model`'s current parameter values by name (for expressions in options).
+pub fn parameter_lookup(model: &dyn ModelInfo) -> impl Fn(&str) -> Option<f64> + '_ {
+    let names = model.parameter_names();
+    let values = model.parameter_values();
+    move |n: &str| names.iter().position(|p| *p == n).map(|i| values[i])
+}
+
+/// Applies `--set NAME=VALUE` arguments in order (a value may use the parameters set before).
+///
+/// # Errors
+/// A usage error for a malformed argument, a bad expression or an unknown parameter.
+pub fn set_parameters(model: &mut dyn ModelInfo, sets: &[String]) -> Result<(), CliError> {
+    for s in sets {
+        let (name, text) = split_assignment(s, "--set")?;
+        let value = evaluate(text, &format!("--set {name}"), &parameter_lookup(model))?;
+        model
+            .set_parameter(name, value)
+            .map_err(|e| CliError::usage(e.to_string()))?;
+    }
+    Ok(())
 }
