@@ -198,7 +198,13 @@ fn equilibrium_search_and_its_errors() {
     );
     let bar = model("four_bar");
     let err = find_equilibrium(bar.as_ref(), &vec![0.0; bar.num_dofs()], 0.0).unwrap_err();
-    assert!(matches!(err, ModalError::Constrained { .. }));
+    assert!(
+        matches!(err, ModalError::EquilibriumNotFound { .. }),
+        "{err}"
+    );
+    let sleigh = model("chaplygin_sleigh");
+    let err = find_equilibrium(sleigh.as_ref(), &vec![0.0; sleigh.num_dofs()], 0.0).unwrap_err();
+    assert!(matches!(err, ModalError::NonHolonomic { .. }), "{err}");
 }
 
 /// A damped oscillator's ζ = c/(2√(k m)) from the eigenvalues of A.
@@ -249,6 +255,17 @@ fn modes_cli_json_contract_and_errors() {
         .unwrap();
     assert!(out.status.success());
     assert!(String::from_utf8_lossy(&out.stdout).contains("theta1 = -1.570796326795e0"));
+    // A constrained model: shapes in all n coordinates, one per minimal coordinate.
+    let out = Command::new(env!("CARGO_BIN_EXE_eomgen"))
+        .args(["modes", "simple_pendulum_cartesian", "--json"])
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["minimal_coordinates"], serde_json::json!(["x"]));
+    assert_eq!(v["mode_shapes"].as_array().unwrap().len(), 1);
+    assert_eq!(v["mode_shapes"][0].as_array().unwrap().len(), 2);
+    assert!((v["lagrange_multipliers"]["rod"].as_f64().unwrap() - 10.0).abs() < 1e-12);
 }
 
 /// HW32: e^{At} against an independent closed form and against integration. A = S D S⁻¹ with
@@ -322,4 +339,102 @@ fn matrix_exponential_against_closed_form_and_integration() {
             );
         }
     }
+}
+
+/// The Cartesian pendulum (HW12) linearised on its constraint: the rod tension's curvature
+/// term λ∇²Φ is the whole stiffness, so ω = √(g/l) hanging and a growth rate √(g/l) upright;
+/// λ = ±m g (tension hanging, compression upright). Exact in floating point up to rounding.
+#[test]
+fn cartesian_pendulum_linearised_on_its_constraint() {
+    let m = model("simple_pendulum_cartesian");
+    let (g, l, mass) = (10.0f64, 1.0f64, 1.0f64);
+    let w = (g / l).sqrt();
+    for (at, sign) in [("hanging", 1.0), ("upright", -1.0)] {
+        let e = find_equilibrium(m.as_ref(), &guess(m.as_ref(), at), 0.0).unwrap();
+        assert!((e.lagrange_multipliers[0] - sign * mass * g).abs() < 1e-12);
+        let lin = linearize(m.as_ref(), &e.q, &[0.0, 0.0], 0.0).unwrap();
+        assert_eq!(
+            lin.independent_coordinates,
+            vec![0],
+            "x is the minimal coordinate"
+        );
+        let modes = normal_modes(&lin).unwrap();
+        match (at, modes.kinds[0]) {
+            ("hanging", ModeKind::Oscillatory) => {
+                assert!((modes.natural_frequencies[0] - w).abs() < 1e-12 * w);
+            }
+            ("upright", ModeKind::Unstable { growth_rate }) => {
+                assert!((growth_rate - w).abs() < 1e-12 * w);
+            }
+            other => panic!("unexpected mode {other:?}"),
+        }
+        // The shape in (x, y): horizontal, mass-normalised with the full M = m I.
+        let psi = lin.to_coordinates(&modes.mode_shapes);
+        assert!((psi[(0, 0)] - 1.0 / mass.sqrt()).abs() < 1e-12 && psi[(1, 0)].abs() < 1e-12);
+    }
+    // Off the constraint, the linearisation refuses.
+    let err = linearize(m.as_ref(), &[0.0, -1.1], &[0.0, 0.0], 0.0).unwrap_err();
+    assert!(matches!(err, ModalError::OffConstraints { .. }), "{err}");
+}
+
+/// The four-bar (HW39) at rest under gravity: its one mode from the projected linearisation
+/// against an independent energy method written here by hand — the loop closed by Newton for
+/// the coupler and rocker angles given the crank's, `V(θ1)` and the effective inertia
+/// `m_eff(θ1) = Σ m|v_G|² + Iω²` per unit crank rate from the closure's derivative, and
+/// `ω² = V''/m_eff` with `V''` by central differences (h = 1e-4: truncation ~1e-9, rounding
+/// ~1e-8 relative), so the bound is 1e-6. `V'(θ1*) = 0` checks the equilibrium itself.
+#[test]
+fn four_bar_mode_matches_an_energy_method() {
+    let m = model("four_bar");
+    let e = find_equilibrium(m.as_ref(), &guess(m.as_ref(), "hanging"), 0.0).unwrap();
+    let lin = linearize(m.as_ref(), &e.q, &[0.0; 3], 0.0).unwrap();
+    assert_eq!(lin.num_minimal_coordinates(), 1);
+    let modes = normal_modes(&lin).unwrap();
+    let (l1, l2, l3, d, rho, g) = (0.2f64, 0.6f64, 0.5f64, 0.6f64, 1.0f64, 9.81f64);
+    // Coupler and rocker angles closing the loop for crank angle a, from the guess (b, c).
+    let close = |a: f64, mut b: f64, mut c: f64| -> (f64, f64) {
+        for _ in 0..50 {
+            let r1 = l1 * a.cos() + l2 * b.cos() - d - l3 * c.cos();
+            let r2 = l1 * a.sin() + l2 * b.sin() - l3 * c.sin();
+            let (j11, j12, j21, j22) = (-l2 * b.sin(), l3 * c.sin(), l2 * b.cos(), -l3 * c.cos());
+            let det = j11 * j22 - j12 * j21;
+            b -= (j22 * r1 - j12 * r2) / det;
+            c -= (-j21 * r1 + j11 * r2) / det;
+        }
+        (b, c)
+    };
+    let potential = |a: f64| -> f64 {
+        let (b, c) = close(a, e.q[1], e.q[2]);
+        let y1 = l1 / 2.0 * a.sin();
+        let y2 = l1 * a.sin() + l2 / 2.0 * b.sin();
+        let y3 = l3 / 2.0 * c.sin();
+        g * rho * (l1 * y1 + l2 * y2 + l3 * y3)
+    };
+    let a = e.q[0];
+    let (b, c) = close(a, e.q[1], e.q[2]);
+    // Rates per unit crank rate: l2 sin b ḃ − l3 sin c ċ = −l1 sin a, −l2 cos b ḃ + l3 cos c ċ = l1 cos a.
+    let (j11, j12, j21, j22) = (l2 * b.sin(), -l3 * c.sin(), -l2 * b.cos(), l3 * c.cos());
+    let (r1, r2) = (-l1 * a.sin(), l1 * a.cos());
+    let det = j11 * j22 - j12 * j21;
+    let bd = (j22 * r1 - j12 * r2) / det;
+    let cd = (-j21 * r1 + j11 * r2) / det;
+    let v1 = (l1 / 2.0).powi(2);
+    let v2 = (l1 * a.sin() + l2 / 2.0 * b.sin() * bd).powi(2)
+        + (l1 * a.cos() + l2 / 2.0 * b.cos() * bd).powi(2);
+    let v3 = (l3 / 2.0 * cd).powi(2);
+    let bar = |l: f64, v2: f64, w: f64| rho * l * v2 + rho * l.powi(3) / 12.0 * w * w;
+    let m_eff = bar(l1, v1, 1.0) + bar(l2, v2, bd) + bar(l3, v3, cd);
+    let h = 1e-4;
+    let dv = (potential(a + h) - potential(a - h)) / (2.0 * h);
+    let ddv = (potential(a + h) - 2.0 * potential(a) + potential(a - h)) / (h * h);
+    assert!(dv.abs() < 1e-9, "V'(θ1*) = {dv:e}");
+    let w_energy = (ddv / m_eff).sqrt();
+    let w = modes.natural_frequencies[0];
+    assert!(
+        (w - w_energy).abs() < 1e-6 * w_energy,
+        "{w} vs energy method {w_energy}"
+    );
+    // The minimal-coordinate mass is the effective inertia of the crank coordinate.
+    assert_eq!(lin.independent_coordinates, vec![0]);
+    assert!((lin.mass_matrix[(0, 0)] - m_eff).abs() < 1e-12 * m_eff);
 }

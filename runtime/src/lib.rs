@@ -20,8 +20,9 @@ pub use integrate::{
     Tableau, Tolerance,
 };
 pub use modal::{
-    Equilibrium, Linearization, ModalError, ModeKind, NormalModes, damped_modes,
-    eigenvalues_of_m_inv_k, find_equilibrium, linearize, matrix_exponential, normal_modes,
+    Equilibrium, Linearization, ModalError, ModeKind, NormalModes, constraint_hessians,
+    damped_modes, eigenvalues_of_m_inv_k, find_equilibrium, linearize, matrix_exponential,
+    normal_modes,
 };
 pub use ode::{OdeFn, OdeSystem, RhsError, WithEvents};
 pub use system::{ConstraintValues, FirstOrder, MechanicalSystem, ModelInfo, UnknownParameter};

@@ -18,8 +18,9 @@
 //! symmetric at an equilibrium; an asymmetry (a follower load, or an operating point that is
 //! not an equilibrium) is reported, then `K` is symmetrised (lecture 24, item 1).
 //!
-//! Constrained models are not linearised here yet (projection onto the null space of `J` is
-//! the plan); [`ModalError::Constrained`] says so.
+//! With holonomic constraints the linearisation is projected onto the null space of the
+//! constraint Jacobian (minimal coordinates; see [`Linearization`]); non-holonomic constraints
+//! are refused ([`ModalError::NonHolonomic`]).
 
 use nalgebra::{DMatrix, DVector, SymmetricEigen};
 
@@ -53,13 +54,33 @@ pub enum ModalError {
         /// The operating point.
         q: Vec<f64>,
     },
-    /// The model has constraints; linearising them is not supported yet.
+    /// The model has non-holonomic constraints, which restrict the velocities but not the
+    /// configuration: its equilibria are not isolated and the linearisation in `q` is not a
+    /// second-order system `M δq̈ + C δq̇ + K δq = 0`.
     #[error(
-        "`{model}` has constraints; linearisation of constrained models (onto the null space of J) is not supported yet"
+        "`{model}` has the non-holonomic constraint `{constraint}`; equilibria and modes are computed for holonomic constraints only"
     )]
-    Constrained {
+    NonHolonomic {
         /// The model.
         model: String,
+        /// The first non-holonomic constraint.
+        constraint: String,
+    },
+    /// The operating point violates the holonomic constraints.
+    #[error("the operating point violates the constraint `{constraint}` (|Φ| = {residual:e})")]
+    OffConstraints {
+        /// The constraint with the largest residual.
+        constraint: String,
+        /// Its `|Φ|`.
+        residual: f64,
+    },
+    /// A constrained model linearised at a moving operating point.
+    #[error(
+        "constrained models are linearised at rest only (q̇ = 0); the operating point has |q̇| = {speed:e}"
+    )]
+    ConstrainedMotion {
+        /// The largest `|q̇ᵢ|` given.
+        speed: f64,
     },
     /// The operating point has the wrong number of coordinates.
     #[error("the operating point has {found} coordinates, the model {expected}")]
@@ -71,30 +92,44 @@ pub enum ModalError {
     },
 }
 
-/// An equilibrium `F(q*, 0, t) = 0` found by Newton's method.
+/// An equilibrium `F(q*, 0, t) = 0` (with constraints: `F(q*, 0, t) = Jᵀλ*`, `Φ(q*, t) = 0`)
+/// found by Newton's method.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Equilibrium {
     /// The coordinates `q*` (length `n`).
     pub q: Vec<f64>,
+    /// `lagrange_multipliers` `λ*` of the holonomic constraints at `q*` (length `m`; empty
+    /// for an unconstrained model): the constraint forces that hold the mechanism at rest, in
+    /// the sign convention of [`MechanicalSystem::constraint_names`](crate::MechanicalSystem::constraint_names).
+    pub lagrange_multipliers: Vec<f64>,
     /// Newton iterations used.
     pub iterations: usize,
-    /// Largest `|Fᵢ(q*, 0, t)|` (units of the generalized forces).
+    /// Largest `|Fᵢ − (Jᵀλ)ᵢ|` and `|Φⱼ|` left (units of the generalized forces and of the
+    /// constraint expressions).
     pub residual: f64,
 }
 
-/// Finds an equilibrium `F(q, 0, t) = 0` of `model` near `guess` by Newton's method with the
-/// generated `∂F/∂q`.
+/// Finds an equilibrium of `model` near `guess` by Newton's method with the generated
+/// Jacobians (issue 7, item 1; lecture 25).
 ///
-/// Each step solves `(∂F/∂q) Δq = −F` in the least-squares, minimum-norm sense (SVD with
+/// Unconstrained, the unknowns are `q` and the residual is `F(q, 0, t)` with Jacobian `∂F/∂q`.
+/// With holonomic constraints `Φ(q, t) = 0` (lectures 8–11), the unknowns are `(q, λ)` and the
+/// residual is `[F(q, 0, t) − J(q)ᵀλ; Φ(q, t)]` with Jacobian
+/// `[∂F/∂q − Σᵢ λᵢ ∇²Φᵢ, −Jᵀ; J, 0]`; `λ` starts from the least-squares solution of
+/// `Jᵀλ = F` at the guess, and the constraint Hessians `∇²Φᵢ` are exact (see
+/// [`constraint_hessians`]).
+///
+/// Each step solves the linear system in the least-squares, minimum-norm sense (SVD with
 /// singular values below `1e-12 σ_max` dropped), so neutral directions (a free cart's
-/// position, a rigid-body rotation) stay at their guess; steps are halved while `|F|` does
-/// not decrease (at most 30 halvings). Converged when `max |Fᵢ| ≤ 1e-12 (1 + F_scale)`, with
-/// `F_scale` the largest `|Fᵢ|` at the guess, or when the step is below `1e-14 (1 + |q|)`
-/// with `|F|` small (`≤ 1e-8 (1 + F_scale)`).
+/// position, a rigid-body rotation) stay at their guess; steps are halved while the residual
+/// does not decrease (at most 30 halvings). Converged when the largest residual is at most
+/// `1e-12 (1 + r₀)`, with `r₀` the largest at the guess, or when the step is below
+/// `1e-14 (1 + |x|)` with the residual small (`≤ 1e-8 (1 + r₀)`).
 ///
 /// # Errors
-/// [`ModalError::EquilibriumNotFound`] after 100 iterations or when no halving decreases `|F|`;
-/// [`ModalError::Constrained`] for a constrained model; [`ModalError::DimensionMismatch`].
+/// [`ModalError::EquilibriumNotFound`] after 100 iterations or when no halving decreases the
+/// residual; [`ModalError::NonHolonomic`] for a model with non-holonomic constraints;
+/// [`ModalError::DimensionMismatch`].
 pub fn find_equilibrium(
     model: &dyn ModelInfo,
     guess: &[f64],
@@ -102,56 +137,124 @@ pub fn find_equilibrium(
 ) -> Result<Equilibrium, ModalError> {
     let n = model.num_dofs();
     check_point(model, guess)?;
+    let m = model.holonomic_constraint_count();
     let state = |q: &[f64]| -> Vec<f64> {
         q.iter()
             .copied()
             .chain(std::iter::repeat_n(0.0, n))
             .collect()
     };
-    let residual_of = |q: &[f64]| -> (DVector<f64>, f64) {
-        let (_, f) = model.mass_matrix_and_forcing(t, &state(q));
-        let r = f.amax();
-        (f, if r.is_nan() { f64::INFINITY } else { r })
+    // x = [q; λ]; the residual [F − Jᵀλ; Φ].
+    let residual_of = |x: &[f64]| -> DVector<f64> {
+        let y = state(&x[..n]);
+        let (_, f) = model.mass_matrix_and_forcing(t, &y);
+        if m == 0 {
+            return f;
+        }
+        let c = model.constraint_equations(t, &y);
+        let j = c.jacobian.rows(0, m);
+        let lambda = DVector::from_column_slice(&x[n..]);
+        let mut r = DVector::zeros(n + m);
+        r.rows_mut(0, n).copy_from(&(f - j.transpose() * lambda));
+        r.rows_mut(n, m).copy_from(&c.phi);
+        r
     };
-    let mut q = guess.to_vec();
-    let (mut f, mut r) = residual_of(&q);
+    let jacobian_of = |x: &[f64]| -> DMatrix<f64> {
+        let y = state(&x[..n]);
+        let (jq, _) = model.forcing_jacobians(t, &y);
+        if m == 0 {
+            return jq;
+        }
+        let c = model.constraint_equations(t, &y);
+        let mut a = DMatrix::zeros(n + m, n + m);
+        let mut top = jq;
+        for (lambda, h) in x[n..].iter().zip(constraint_hessians(model, &x[..n], t)) {
+            top -= h * *lambda;
+        }
+        a.view_mut((0, 0), (n, n)).copy_from(&top);
+        let j = c.jacobian.rows(0, m).into_owned();
+        a.view_mut((0, n), (n, m)).copy_from(&(-j.transpose()));
+        a.view_mut((n, 0), (m, n)).copy_from(&j);
+        a
+    };
+    let mut x0 = guess.to_vec();
+    if m > 0 {
+        // λ from the least-squares solution of Jᵀλ = F at the guess.
+        let y = state(guess);
+        let (_, f) = model.mass_matrix_and_forcing(t, &y);
+        let j = model
+            .constraint_equations(t, &y)
+            .jacobian
+            .rows(0, m)
+            .into_owned();
+        let svd = j.transpose().svd(true, true);
+        let eps = 1e-12 * svd.singular_values.max();
+        let lambda = svd.solve(&f, eps).unwrap_or_else(|_| DVector::zeros(m));
+        x0.extend(lambda.iter());
+    }
+    let (x, iterations, residual) =
+        newton(&x0, residual_of, jacobian_of).map_err(|(iterations, residual)| {
+            ModalError::EquilibriumNotFound {
+                iterations,
+                residual,
+                guess: guess.to_vec(),
+            }
+        })?;
+    Ok(Equilibrium {
+        q: x[..n].to_vec(),
+        lagrange_multipliers: x[n..].to_vec(),
+        iterations,
+        residual,
+    })
+}
+
+/// Damped Newton with minimum-norm SVD steps (see [`find_equilibrium`]): returns the root,
+/// the iterations and the largest residual, or `(iterations, residual)` on failure.
+fn newton(
+    x0: &[f64],
+    residual_of: impl Fn(&[f64]) -> DVector<f64>,
+    jacobian_of: impl Fn(&[f64]) -> DMatrix<f64>,
+) -> Result<(Vec<f64>, usize, f64), (usize, f64)> {
+    let norm = |f: &DVector<f64>| {
+        let r = f.amax();
+        if r.is_nan() { f64::INFINITY } else { r }
+    };
+    let mut x = x0.to_vec();
+    let mut f = residual_of(&x);
+    let mut r = norm(&f);
     let scale = if r.is_finite() { r } else { 0.0 };
     for iteration in 0..100 {
         if r <= 1e-12 * (1.0 + scale) {
-            return Ok(Equilibrium {
-                q,
-                iterations: iteration,
-                residual: r,
-            });
+            return Ok((x, iteration, r));
         }
-        let (jq, _) = model.forcing_jacobians(t, &state(&q));
-        let svd = jq.svd(true, true);
+        let jac = jacobian_of(&x);
+        if !jac.iter().all(|v| v.is_finite()) {
+            return Err((iteration, r));
+        }
+        let svd = jac.svd(true, true);
         let eps = 1e-12 * svd.singular_values.max();
         let Ok(step) = svd.solve(&(-&f), eps) else {
-            break;
+            return Err((iteration, r));
         };
         let mut lambda = 1.0;
         let mut accepted = false;
         for _ in 0..30 {
-            let trial: Vec<f64> = q
+            let trial: Vec<f64> = x
                 .iter()
                 .zip(step.iter())
                 .map(|(a, d)| a + lambda * d)
                 .collect();
-            let (f_trial, r_trial) = residual_of(&trial);
+            let f_trial = residual_of(&trial);
+            let r_trial = norm(&f_trial);
             if r_trial < r || r_trial <= 1e-12 * (1.0 + scale) {
                 let small = lambda * step.amax()
-                    <= 1e-14 * (1.0 + q.iter().fold(0.0f64, |m, v| m.max(v.abs())));
-                q = trial;
+                    <= 1e-14 * (1.0 + x.iter().fold(0.0f64, |m, v| m.max(v.abs())));
+                x = trial;
                 f = f_trial;
                 r = r_trial;
                 accepted = true;
                 if small && r <= 1e-8 * (1.0 + scale) {
-                    return Ok(Equilibrium {
-                        q,
-                        iterations: iteration + 1,
-                        residual: r,
-                    });
+                    return Ok((x, iteration + 1, r));
                 }
                 break;
             }
@@ -161,37 +264,65 @@ pub fn find_equilibrium(
             // No decrease along the Newton direction: converged as far as rounding allows,
             // or stuck.
             if r <= 1e-8 * (1.0 + scale) {
-                return Ok(Equilibrium {
-                    q,
-                    iterations: iteration + 1,
-                    residual: r,
-                });
+                return Ok((x, iteration + 1, r));
             }
-            return Err(ModalError::EquilibriumNotFound {
-                iterations: iteration + 1,
-                residual: r,
-                guess: guess.to_vec(),
-            });
+            return Err((iteration + 1, r));
         }
     }
     if r <= 1e-12 * (1.0 + scale) {
-        return Ok(Equilibrium {
-            q,
-            iterations: 100,
-            residual: r,
-        });
+        return Ok((x, 100, r));
     }
-    Err(ModalError::EquilibriumNotFound {
-        iterations: 100,
-        residual: r,
-        guess: guess.to_vec(),
-    })
+    Err((100, r))
+}
+
+/// The Hessians `∇²Φᵢ(q, t)` (`n × n` each, one per holonomic constraint), exact.
+///
+/// They are read off the generated `γ` of `J q̈ = γ`, whose dependence on `q̇` is
+/// `γᵢ(q̇) = −q̇ᵀ ∇²Φᵢ q̇ + (linear in q̇) + const` (the linear and constant parts come from
+/// an explicit time dependence), by polarisation:
+/// `(∇²Φᵢ)ⱼₖ = −[γᵢ(eⱼ + eₖ) − γᵢ(eⱼ) − γᵢ(eₖ) + γᵢ(0)] / 2` — exact up to rounding because
+/// `γ` is exactly quadratic in `q̇`.
+pub fn constraint_hessians(model: &dyn ModelInfo, q: &[f64], t: f64) -> Vec<DMatrix<f64>> {
+    let n = model.num_dofs();
+    let m = model.holonomic_constraint_count();
+    let gamma = |v: &[(usize, f64)]| -> DVector<f64> {
+        let mut y: Vec<f64> = q
+            .iter()
+            .copied()
+            .chain(std::iter::repeat_n(0.0, n))
+            .collect();
+        for &(j, a) in v {
+            y[n + j] += a;
+        }
+        model
+            .constraint_equations(t, &y)
+            .gamma
+            .rows(0, m)
+            .into_owned()
+    };
+    let g0 = gamma(&[]);
+    let single: Vec<DVector<f64>> = (0..n).map(|j| gamma(&[(j, 1.0)])).collect();
+    let mut out = vec![DMatrix::zeros(n, n); m];
+    for j in 0..n {
+        for k in j..n {
+            let both = gamma(&[(j, 1.0), (k, 1.0)]);
+            for (i, h) in out.iter_mut().enumerate() {
+                let v = -(both[i] - single[j][i] - single[k][i] + g0[i]) / 2.0;
+                h[(j, k)] = v;
+                h[(k, j)] = v;
+            }
+        }
+    }
+    out
 }
 
 fn check_point(model: &dyn ModelInfo, q: &[f64]) -> Result<(), ModalError> {
-    if !model.constraint_names().is_empty() {
-        return Err(ModalError::Constrained {
+    let names = model.constraint_names();
+    let h = model.holonomic_constraint_count();
+    if names.len() > h {
+        return Err(ModalError::NonHolonomic {
             model: model.name().to_string(),
+            constraint: names[h].to_string(),
         });
     }
     if q.len() != model.num_dofs() {
@@ -204,6 +335,15 @@ fn check_point(model: &dyn ModelInfo, q: &[f64]) -> Result<(), ModalError> {
 }
 
 /// The linearised equations `M δq̈ + C δq̇ + K δq = 0` at an operating point.
+///
+/// Without constraints the unknowns are `δq` itself. With holonomic constraints they are `r`
+/// minimal coordinates `z` (lecture 25 with lectures 8–11): `δq = N z`, where the columns of
+/// the `n × r` [`Self::coordinate_basis`] `N` span the null space of the constraint Jacobian
+/// `J(q*)` and `z` are the increments of the [`Self::independent_coordinates`] (coordinate
+/// partitioning: `N` restricted to those rows is the identity). Then `M`, `C`, `K` are
+/// `r × r`: `Nᵀ M N`, `Nᵀ C N` and `Nᵀ (∂(M q̈*)/∂q − ∂F/∂q + Σᵢ λᵢ ∇²Φᵢ) N` — the last term
+/// is the stiffness of the constraint forces (a rod's tension makes the Cartesian pendulum
+/// swing).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Linearization {
     /// The operating point's coordinates `q*` (length `n`).
@@ -212,13 +352,21 @@ pub struct Linearization {
     pub qdot: Vec<f64>,
     /// Its time (s).
     pub t: f64,
-    /// `mass_matrix` `M(q*)`, `n × n`, symmetric positive definite.
+    /// `mass_matrix` `M(q*)` (`r × r`, `r = n` without constraints), symmetric positive
+    /// definite.
     pub mass_matrix: DMatrix<f64>,
-    /// `stiffness_matrix` `K`, `n × n`, as derived (not symmetrised).
+    /// `stiffness_matrix` `K`, `r × r`, as derived (not symmetrised).
     pub stiffness_matrix: DMatrix<f64>,
-    /// `damping_matrix` `C = −∂F/∂q̇`, `n × n` (velocity-dependent gyroscopic terms make it
+    /// `damping_matrix` `C = −∂F/∂q̇` (`r × r`; velocity-dependent gyroscopic terms make it
     /// non-symmetric).
     pub damping_matrix: DMatrix<f64>,
+    /// `N` (`n × r`): `δq = N z`; the identity without constraints.
+    pub coordinate_basis: DMatrix<f64>,
+    /// Indices (into `q`, ascending) of the `r` coordinates whose increments are `z`.
+    pub independent_coordinates: Vec<usize>,
+    /// `lagrange_multipliers` `λ*` at the operating point (length `m`; empty without
+    /// constraints).
+    pub lagrange_multipliers: Vec<f64>,
 }
 
 impl Linearization {
@@ -243,7 +391,7 @@ impl Linearization {
     /// # Errors
     /// [`ModalError::SingularMassMatrix`] if `M` is not positive definite.
     pub fn state_matrix(&self) -> Result<DMatrix<f64>, ModalError> {
-        let n = self.q.len();
+        let n = self.mass_matrix.nrows();
         let chol = self.mass_cholesky()?;
         let mk = chol.solve(&self.stiffness_matrix);
         let mc = chol.solve(&self.damping_matrix);
@@ -257,6 +405,17 @@ impl Linearization {
         }
         Ok(a)
     }
+
+    /// Number of minimal coordinates `r` (the size of `M`, `C`, `K`).
+    pub fn num_minimal_coordinates(&self) -> usize {
+        self.mass_matrix.nrows()
+    }
+
+    /// Vectors in the minimal coordinates (`r × k`, e.g. mode shapes) expressed in the model's
+    /// coordinates: `N Z` (`n × k`).
+    pub fn to_coordinates(&self, z: &DMatrix<f64>) -> DMatrix<f64> {
+        &self.coordinate_basis * z
+    }
 }
 
 fn asymmetry(k: &DMatrix<f64>) -> f64 {
@@ -267,12 +426,21 @@ fn asymmetry(k: &DMatrix<f64>) -> f64 {
     (k - k.transpose()).amax() / scale
 }
 
-/// Linearises `model` at `(q, q̇, t)` exactly, from the generated `M`, `∂F/∂q`, `∂F/∂q̇` and
-/// `∂(M a)/∂q`.
+/// Linearises `model` at `(q, q̇, t)` exactly, from the generated `M`, `∂F/∂q`, `∂F/∂q̇`,
+/// `∂(M a)/∂q` and, with holonomic constraints, `J` and the constraint Hessians (issue 7,
+/// item 2; lecture 25).
+///
+/// Unconstrained: `M = M(q*)`, `K = ∂(M q̈*)/∂q − ∂F/∂q`, `C = −∂F/∂q̇` with
+/// `q̈* = M⁻¹F`. With holonomic constraints (at rest only): `q̈*` and `λ*` from
+/// `[M Jᵀ; J 0][q̈; λ] = [F; γ]`, the minimal coordinates by coordinate partitioning of `J`
+/// (Gaussian elimination with complete pivoting picks the `rank J` best-conditioned dependent
+/// coordinates), and the projected matrices described at [`Linearization`].
 ///
 /// # Errors
-/// [`ModalError::Constrained`], [`ModalError::DimensionMismatch`],
-/// [`ModalError::SingularMassMatrix`], [`ModalError::NonFinite`].
+/// [`ModalError::NonHolonomic`], [`ModalError::DimensionMismatch`],
+/// [`ModalError::ConstrainedMotion`] (constrained and `q̇ ≠ 0`),
+/// [`ModalError::OffConstraints`] (`|Φ| > 1e-8`), [`ModalError::SingularMassMatrix`],
+/// [`ModalError::NonFinite`].
 pub fn linearize(
     model: &dyn ModelInfo,
     q: &[f64],
@@ -286,29 +454,163 @@ pub fn linearize(
             found: qdot.len(),
         });
     }
+    let n = q.len();
+    let m = model.holonomic_constraint_count();
     let y: Vec<f64> = q.iter().chain(qdot).copied().collect();
-    let (m, f) = model.mass_matrix_and_forcing(t, &y);
-    let chol = m
-        .clone()
-        .cholesky()
-        .ok_or_else(|| ModalError::SingularMassMatrix { q: q.to_vec() })?;
-    let qdd = chol.solve(&f);
+    let (mass, f) = model.mass_matrix_and_forcing(t, &y);
     let (jq, jqd) = model.forcing_jacobians(t, &y);
-    let ma = model.mass_matrix_product_jacobian(t, &y, qdd.as_slice());
-    let stiffness_matrix = ma - jq;
-    let damping_matrix = -jqd;
     let finite = |a: &DMatrix<f64>| a.iter().all(|v| v.is_finite());
-    if !(finite(&m) && finite(&stiffness_matrix) && finite(&damping_matrix)) {
+    if m == 0 {
+        let chol = mass
+            .clone()
+            .cholesky()
+            .ok_or_else(|| ModalError::SingularMassMatrix { q: q.to_vec() })?;
+        let qdd = chol.solve(&f);
+        let ma = model.mass_matrix_product_jacobian(t, &y, qdd.as_slice());
+        let stiffness_matrix = ma - jq;
+        let damping_matrix = -jqd;
+        if !(finite(&mass) && finite(&stiffness_matrix) && finite(&damping_matrix)) {
+            return Err(ModalError::NonFinite { q: q.to_vec() });
+        }
+        return Ok(Linearization {
+            q: q.to_vec(),
+            qdot: qdot.to_vec(),
+            t,
+            mass_matrix: mass,
+            stiffness_matrix,
+            damping_matrix,
+            coordinate_basis: DMatrix::identity(n, n),
+            independent_coordinates: (0..n).collect(),
+            lagrange_multipliers: Vec::new(),
+        });
+    }
+    let speed = qdot.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+    if speed != 0.0 {
+        return Err(ModalError::ConstrainedMotion { speed });
+    }
+    let c = model.constraint_equations(t, &y);
+    let (worst, residual) = c
+        .phi
+        .iter()
+        .map(|v| if v.is_nan() { f64::INFINITY } else { v.abs() })
+        .enumerate()
+        .fold((0, 0.0f64), |b, x| if x.1 > b.1 { x } else { b });
+    if residual > 1e-8 {
+        return Err(ModalError::OffConstraints {
+            constraint: model.constraint_names()[worst].to_string(),
+            residual,
+        });
+    }
+    let j = c.jacobian.rows(0, m).into_owned();
+    if !(finite(&mass) && finite(&j) && finite(&jq) && finite(&jqd)) {
+        return Err(ModalError::NonFinite { q: q.to_vec() });
+    }
+    // [M Jᵀ; J 0][q̈; λ] = [F; γ] in the minimum-norm sense (redundant constraints leave λ
+    // undetermined; the minimum-norm λ is then used).
+    let mut kkt = DMatrix::zeros(n + m, n + m);
+    kkt.view_mut((0, 0), (n, n)).copy_from(&mass);
+    kkt.view_mut((0, n), (n, m)).copy_from(&j.transpose());
+    kkt.view_mut((n, 0), (m, n)).copy_from(&j);
+    let mut rhs = DVector::zeros(n + m);
+    rhs.rows_mut(0, n).copy_from(&f);
+    rhs.rows_mut(n, m).copy_from(&c.gamma.rows(0, m));
+    let svd = kkt.svd(true, true);
+    let eps = 1e-12 * svd.singular_values.max();
+    let solution = svd
+        .solve(&rhs, eps)
+        .map_err(|_| ModalError::SingularMassMatrix { q: q.to_vec() })?;
+    let qdd = solution.rows(0, n).into_owned();
+    let lambda: Vec<f64> = solution.rows(n, m).iter().copied().collect();
+    let mut k_full = model.mass_matrix_product_jacobian(t, &y, qdd.as_slice()) - jq;
+    for (l, h) in lambda.iter().zip(constraint_hessians(model, q, t)) {
+        k_full += h * *l;
+    }
+    let (basis, independent) = null_space_by_partitioning(&j);
+    let nt = basis.transpose();
+    let mass_matrix = &nt * &mass * &basis;
+    let stiffness_matrix = &nt * &k_full * &basis;
+    let damping_matrix = &nt * (-jqd) * &basis;
+    if !(finite(&mass_matrix) && finite(&stiffness_matrix) && finite(&damping_matrix)) {
         return Err(ModalError::NonFinite { q: q.to_vec() });
     }
     Ok(Linearization {
         q: q.to_vec(),
         qdot: qdot.to_vec(),
         t,
-        mass_matrix: m,
+        mass_matrix,
         stiffness_matrix,
         damping_matrix,
+        coordinate_basis: basis,
+        independent_coordinates: independent,
+        lagrange_multipliers: lambda,
     })
+}
+
+/// A basis `N` (`n × r`) of the null space of `J` (`m × n`) by coordinate partitioning:
+/// Gaussian elimination with complete pivoting picks `rank J` dependent coordinates (pivots
+/// below `1e-10` of the first are rank deficiency); the other `r` are independent and `N` is
+/// the identity on them and `−J_d⁻¹ J_i` on the dependent ones. Returns `N` and the
+/// independent indices (ascending).
+fn null_space_by_partitioning(j: &DMatrix<f64>) -> (DMatrix<f64>, Vec<usize>) {
+    let (m, n) = j.shape();
+    let mut a = j.clone();
+    let mut rows: Vec<usize> = (0..m).collect();
+    let mut cols: Vec<usize> = (0..n).collect();
+    let mut first = 0.0f64;
+    let mut rank = 0;
+    for k in 0..m.min(n) {
+        // Largest remaining entry (first in row-major order on ties).
+        let (mut bi, mut bj, mut best) = (k, k, 0.0f64);
+        for i in k..m {
+            for jj in k..n {
+                let v = a[(rows[i], cols[jj])].abs();
+                if v > best {
+                    (bi, bj, best) = (i, jj, v);
+                }
+            }
+        }
+        if k == 0 {
+            first = best;
+        }
+        if best == 0.0 || best <= 1e-10 * first {
+            break;
+        }
+        rows.swap(k, bi);
+        cols.swap(k, bj);
+        let (pr, pc) = (rows[k], cols[k]);
+        for &r in &rows[k + 1..] {
+            let factor = a[(r, pc)] / a[(pr, pc)];
+            if factor != 0.0 {
+                for &cc in &cols {
+                    let v = a[(pr, cc)];
+                    a[(r, cc)] -= factor * v;
+                }
+            }
+        }
+        rank += 1;
+    }
+    let mut dependent: Vec<usize> = cols[..rank].to_vec();
+    let mut independent: Vec<usize> = cols[rank..].to_vec();
+    dependent.sort_unstable();
+    independent.sort_unstable();
+    let pivot_rows: Vec<usize> = rows[..rank].to_vec();
+    // J_d (rank × rank) on the pivot rows and dependent columns, J_i the rest of those rows.
+    let jd = DMatrix::from_fn(rank, rank, |r, c| j[(pivot_rows[r], dependent[c])]);
+    let ji = DMatrix::from_fn(rank, independent.len(), |r, c| {
+        j[(pivot_rows[r], independent[c])]
+    });
+    let solved = jd
+        .lu()
+        .solve(&ji)
+        .unwrap_or_else(|| DMatrix::from_element(rank, independent.len(), f64::NAN));
+    let mut basis = DMatrix::zeros(n, independent.len());
+    for (c, &i) in independent.iter().enumerate() {
+        basis[(i, c)] = 1.0;
+        for (r, &d) in dependent.iter().enumerate() {
+            basis[(d, c)] = -solved[(r, c)];
+        }
+    }
+    (basis, independent)
 }
 
 /// What a mode is.
@@ -335,7 +637,8 @@ pub struct NormalModes {
     pub natural_frequencies: Vec<f64>,
     /// What each mode is.
     pub kinds: Vec<ModeKind>,
-    /// `mode_shapes`, `n × n`, column `k` the shape of mode `k`, mass-normalised:
+    /// `mode_shapes`, `r × r` in the linearisation's coordinates ([`Linearization::to_coordinates`] gives
+    /// them in `q`), column `k` the shape of mode `k`, mass-normalised:
     /// `ΨᵀMΨ = I`; sign fixed so that the largest-magnitude entry is positive.
     pub mode_shapes: DMatrix<f64>,
     /// `‖K − Kᵀ‖_max / ‖K‖_max` before symmetrisation.
@@ -348,7 +651,7 @@ pub struct NormalModes {
 /// [`ModalError::SingularMassMatrix`] if `M` is not positive definite;
 /// [`ModalError::NonFinite`] if the eigensolver fails.
 pub fn normal_modes(lin: &Linearization) -> Result<NormalModes, ModalError> {
-    let n = lin.q.len();
+    let n = lin.mass_matrix.nrows();
     let k_sym = (&lin.stiffness_matrix + lin.stiffness_matrix.transpose()) * 0.5;
     let chol = lin.mass_cholesky()?;
     let l = chol.l();

@@ -43,9 +43,10 @@ pub fn run(args: &ModesArgs) -> Result<(), CliError> {
     let route22 = eigenvalues_of_m_inv_k(&lin).map_err(fail)?;
     let damped = damped_modes(&lin).map_err(fail)?;
     let names = model.coordinate_names();
+    let r = lin.num_minimal_coordinates();
     let undamped = lin.damping_matrix.amax() == 0.0;
     let damping_ratios: Vec<f64> = if undamped {
-        vec![0.0; n]
+        vec![0.0; r]
     } else {
         damped.iter().map(|d| d.1).collect()
     };
@@ -69,8 +70,21 @@ pub fn run(args: &ModesArgs) -> Result<(), CliError> {
             .map(|i| m.row(i).iter().copied().collect())
             .collect()
     };
-    let shapes: Vec<Vec<f64>> = (0..n)
-        .map(|k| modes.mode_shapes.column(k).iter().copied().collect())
+    // Mode shapes in the model's coordinates (δq = N z with constraints).
+    let shapes_q = lin.to_coordinates(&modes.mode_shapes);
+    let shapes: Vec<Vec<f64>> = (0..r)
+        .map(|k| shapes_q.column(k).iter().copied().collect())
+        .collect();
+    let minimal: Vec<&str> = lin
+        .independent_coordinates
+        .iter()
+        .map(|&i| names[i])
+        .collect();
+    let multipliers: serde_json::Map<String, serde_json::Value> = model
+        .constraint_names()
+        .iter()
+        .zip(&lin.lagrange_multipliers)
+        .map(|(c, v)| (c.to_string(), json!(v)))
         .collect();
     let mut stdout = std::io::stdout().lock();
     if args.json {
@@ -90,6 +104,8 @@ pub fn run(args: &ModesArgs) -> Result<(), CliError> {
             "damping_ratios": damping_ratios,
             "damped_modes": damped.iter().map(|(s, zeta, wd)| json!({"re": s.re, "im": s.im, "damping_ratio": zeta, "damped_frequency": wd})).collect::<Vec<_>>(),
             "mode_shapes": shapes,
+            "minimal_coordinates": minimal,
+            "lagrange_multipliers": multipliers,
             "mass_matrix": rows(&lin.mass_matrix),
             "stiffness_matrix": rows(&lin.stiffness_matrix),
             "damping_matrix": rows(&lin.damping_matrix),
@@ -115,6 +131,18 @@ pub fn run(args: &ModesArgs) -> Result<(), CliError> {
         equilibrium.iterations,
         equilibrium.residual
     );
+    if !lin.lagrange_multipliers.is_empty() {
+        let forces: Vec<String> = multipliers
+            .iter()
+            .map(|(c, v)| format!("λ_{c} = {:.6e}", v.as_f64().unwrap_or(f64::NAN)))
+            .collect();
+        let _ = writeln!(
+            stdout,
+            "constraints {} at rest; M, K, C below are in the minimal coordinates {} (δq = N z, N spanning the null space of J)",
+            forces.join(", "),
+            minimal.join(", ")
+        );
+    }
     print_matrix(&mut stdout, "M", &lin.mass_matrix);
     print_matrix(&mut stdout, "K", &lin.stiffness_matrix);
     if !undamped {
@@ -145,7 +173,10 @@ pub fn run(args: &ModesArgs) -> Result<(), CliError> {
                 format!("  unstable, grows as e^({growth_rate:.6e} t)")
             }
         };
-        let shape: Vec<String> = shape.iter().map(|v| format!("{v:>11.4e}")).collect();
+        let shape: Vec<String> = shape
+            .iter()
+            .map(|v| format!("{:>11.4e}", v + 0.0))
+            .collect();
         let zeta = damping_ratios
             .get(k)
             .map_or("-".to_string(), |z| format!("{z:.4e}"));
