@@ -129,7 +129,10 @@ fn body(model: &SymbolicModel, roots: &[ExprId], helpers: &str) -> (Body, CsePla
                 let (s, c) = plan.temporary_names(temp);
                 let c = c.unwrap_or_default();
                 let a = printer.print(arg);
-                let _ = writeln!(code, "let ({s}, {c}): (f64, f64) = ({a}).sin_cos();");
+                let _ = writeln!(
+                    code,
+                    "let ({s}, {c}): (f64, f64) = {helpers}::sin_cos({a});"
+                );
             }
         }
     }

@@ -11,8 +11,8 @@ use super::{Constant, ExprArena, ExprId, Func, Node, SymbolId};
 pub enum Syntax {
     /// Model-file syntax (`m*l^2*theta_dot^2/2`); parses back with the model parser.
     Text,
-    /// Rust `f64` source (`0.5 * m * l.powi(2)`); helper functions `sign` and `step` are
-    /// called through [`Printer::with_rust_helpers`]'s path.
+    /// Rust `f64` source (`0.5 * m * l.powi(2)`); the helper functions `sign`, `step`, `sin` and `cos`
+    /// (and `sin_cos` for shared pairs) are called through [`Printer::with_rust_helpers`]'s path.
     Rust,
     /// LaTeX math (`\frac{m l^{2} \dot{\theta}^{2}}{2}`).
     Latex,
@@ -371,7 +371,7 @@ impl<'a> Printer<'a> {
         match self.syntax {
             Syntax::Text => (format!("{}({})", f.name(), arg.0), Prec::Atom),
             Syntax::Rust => match f {
-                Func::Sign | Func::Step => (
+                Func::Sign | Func::Step | Func::Sin | Func::Cos => (
                     format!("{}::{}({})", self.helpers, f.name(), arg.0),
                     Prec::Atom,
                 ),
