@@ -331,7 +331,8 @@ fn solve_ldlt<const N: usize>(
         for k in 0..j {
             dj -= l[j][k] * l[j][k] * d[k];
         }
-        if !(dj > 0.0) {
+        // Not positive, or NaN.
+        if dj.is_nan() || dj <= 0.0 {
             return None;
         }
         d[j] = dj;

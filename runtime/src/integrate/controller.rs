@@ -73,9 +73,9 @@ pub struct PiController {
     pub min_factor: f64,
     /// Largest ratio of new to old step, `> 1` (default: 10).
     pub max_factor: f64,
-    /// Error norm of the previous accepted step, at least [`ERROR_FLOOR`].
+    /// `ln` of the error norm of the previous accepted step (at least [`ERROR_FLOOR`]).
     #[serde(skip)]
-    error_previous: f64,
+    ln_error_previous: f64,
     /// Whether the last attempted step was rejected.
     #[serde(skip)]
     rejected_last: bool,
@@ -91,7 +91,7 @@ impl PiController {
             safety: 0.9,
             min_factor: 0.2,
             max_factor: 10.0,
-            error_previous: ERROR_FLOOR,
+            ln_error_previous: ERROR_FLOOR.ln(),
             rejected_last: false,
         }
     }
@@ -133,7 +133,7 @@ impl PiController {
 
 impl StepSizeController for PiController {
     fn reset(&mut self) {
-        self.error_previous = ERROR_FLOOR;
+        self.ln_error_previous = ERROR_FLOOR.ln();
         self.rejected_last = false;
     }
 
@@ -146,15 +146,22 @@ impl StepSizeController for PiController {
                 dt_retry: dt * factor,
             };
         }
-        // errₙ = 0 gives ∞ here, which the clamp turns into `max_factor`.
-        let mut factor =
-            (self.safety * error_norm.powf(-self.alpha) * self.error_previous.powf(self.beta))
-                .max(self.min_factor)
-                .min(self.max_factor);
+        // errₙ^(−alpha) errₙ₋₁^beta as one exponential of logarithms, with ln errₙ₋₁ kept
+        // from the previous step: one `ln` and one `exp` per step instead of two `powf`.
+        // errₙ = 0 gives ln = −∞ and ∞ here, which the clamp turns into `max_factor`.
+        let ln_error = error_norm.ln();
+        let mut factor = (self.safety
+            * (self.beta * self.ln_error_previous - self.alpha * ln_error).exp())
+        .max(self.min_factor)
+        .min(self.max_factor);
         if self.rejected_last {
             factor = factor.min(1.0);
         }
-        self.error_previous = error_norm.max(ERROR_FLOOR);
+        self.ln_error_previous = if error_norm >= ERROR_FLOOR {
+            ln_error
+        } else {
+            ERROR_FLOOR.ln()
+        };
         self.rejected_last = false;
         StepOutcome::Accepted {
             dt_next: dt * factor,
