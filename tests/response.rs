@@ -312,13 +312,9 @@ fn three_masses_damped_modal_approximation_against_exact() {
     let s2 = 2f64.sqrt();
     let w = [(2.0 - s2).sqrt(), s2, (2.0 + s2).sqrt()];
     let analytic = [c / (8.0 * w[0]), c / (4.0 * w[1]), c / (8.0 * w[2])];
-    for k in 0..3 {
+    for (k, expected) in analytic.iter().enumerate() {
         let z = approx.damping_ratios[k].unwrap();
-        assert!(
-            (z - analytic[k]).abs() < 1e-14,
-            "mode {k}: {z} vs {}",
-            analytic[k]
-        );
+        assert!((z - expected).abs() < 1e-14, "mode {k}: {z} vs {expected}");
     }
     assert!(
         (approx.coupling - 1.0 / s2).abs() < 1e-12,

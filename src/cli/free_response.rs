@@ -55,9 +55,13 @@ pub struct FreeResponseArgs {
 
 /// The linearisation at the operating point `--at` and what to call it.
 pub(super) struct OperatingPoint {
+    /// The model, with `--set` applied.
     pub model: Box<dyn ModelInfo>,
+    /// The equilibrium's name, or the `--at` guesses as given.
     pub label: String,
+    /// The exact linearisation at the equilibrium Newton found.
     pub lin: Linearization,
+    /// Its normal modes.
     pub modes: NormalModes,
 }
 
@@ -168,8 +172,11 @@ pub(super) fn kind_json(kind: &ModeKind) -> serde_json::Value {
 /// One panel of a stacked chart: an optional caption, the y-axis label (with units) and the
 /// lines against time.
 pub(super) struct Panel {
+    /// Shown above the panel.
     pub caption: Option<String>,
+    /// The y-axis label, with its unit.
     pub y_desc: String,
+    /// The lines, drawn in this order.
     pub series: Vec<Series>,
 }
 

@@ -337,7 +337,7 @@ pub fn run(args: &ModalDampingArgs) -> Result<(), CliError> {
             .modal_damping_matrix
             .row(i)
             .iter()
-            .map(|v| format!("{v:>12.5e}"))
+            .map(|v| format!("{:>12.5e}", v + 0.0)) // −0 prints as 0
             .collect();
         let _ = writeln!(stdout, "           [{}]", row.join(", "));
     }
@@ -357,7 +357,7 @@ pub fn run(args: &ModalDampingArgs) -> Result<(), CliError> {
         }
     }
     let opt = |v: Option<f64>, width: usize| match v {
-        Some(x) => format!("{x:>width$.6e}"),
+        Some(x) => format!("{:>width$.6e}", x + 0.0),
         None => format!("{:>width$}", "-"),
     };
     let _ = writeln!(
@@ -372,7 +372,7 @@ pub fn run(args: &ModalDampingArgs) -> Result<(), CliError> {
         "ζ Rayleigh",
         "ω_d Rayleigh"
     );
-    for k in 0..n {
+    for (k, exact_k) in exact.iter().enumerate() {
         let w = modes.natural_frequencies[k];
         let z_r = match (&rayleigh, modes.kinds[k]) {
             (Some((_, fit)), ModeKind::Oscillatory) => Some(fit.damping_ratio(w)),
@@ -383,8 +383,8 @@ pub fn run(args: &ModalDampingArgs) -> Result<(), CliError> {
             "{:>4} {:>13.6e} | {} {} | {} {} | {} {}",
             k + 1,
             w,
-            opt(exact[k].map(|d| d.damping_ratio), 13),
-            opt(exact[k].map(|d| d.damped_frequency), 13),
+            opt(exact_k.map(|d| d.damping_ratio), 13),
+            opt(exact_k.map(|d| d.damped_frequency), 13),
             opt(approx.damping_ratios[k], 13),
             opt(approx.damped_frequencies[k], 13),
             opt(z_r, 13),
