@@ -271,7 +271,8 @@ fn modes_cli_json_contract_and_errors() {
 /// HW32: e^{At} against an independent closed form and against integration. A = S D S⁻¹ with
 /// a random well-conditioned S and eigenvalues D (complex pairs written as 2 × 2 real
 /// blocks [σ ω; −ω σ], whose exponential is e^{σt}[cos ωt sin ωt; −sin ωt cos ωt]) gives
-/// e^{At} = S e^{Dt} S⁻¹ exactly; DOP853 at tol 1e-13 integrates ẏ = A y. All three agree to
+/// e^{At} = S e^{Dt} S⁻¹ exactly; DOP853 at tol 1e-13 integrates ẏ = A y; the eigenvectors of
+/// A superpose e^{λt} v (`state_response_by_eigenvectors`). All four agree to
 /// 1e-10 relative to the largest entry (the tolerance; the Padé approximant is
 /// accurate to ~1e-15 times the condition of S).
 #[test]
@@ -312,6 +313,18 @@ fn matrix_exponential_against_closed_form_and_integration() {
         "{:e}",
         (&expm - &exact).amax()
     );
+    // Superposition of the complex eigenvector solutions e^{λt} v (lectures 32–33), with
+    // eigenvectors computed from A alone, column by column of e^{At}.
+    for j in 0..n {
+        let y0: Vec<f64> = (0..n).map(|i| if i == j { 1.0 } else { 0.0 }).collect();
+        let y = eomgen::state_response_by_eigenvectors(&a, &y0, &[t]).unwrap();
+        for i in 0..n {
+            assert!(
+                (y[0][i] - exact[(i, j)]).abs() < 1e-10 * scale,
+                "eigenvectors ({i}, {j})"
+            );
+        }
+    }
     let a_rhs = a.clone();
     let mut system = OdeFn::new(n, move |_t: f64, y: &[f64], dy: &mut [f64]| {
         let v = &a_rhs * nalgebra::DVector::from_column_slice(y);

@@ -9,6 +9,7 @@ pub mod constrained;
 pub mod integrate;
 pub mod modal;
 pub mod ode;
+pub mod response;
 pub mod system;
 
 pub use constrained::{ConstraintWorkspace, ProjectionError, Stabilization};
@@ -25,4 +26,11 @@ pub use modal::{
     normal_modes,
 };
 pub use ode::{OdeFn, OdeSystem, RhsError, WithEvents};
+pub use response::{
+    DampedMode, FreeResponse, LinearOde, MInvKModes, ModalDamping, RayleighDamping, ResponseError,
+    exact_damped_modes, modal_damping, modes_of_m_inv_k, response_by_exponential,
+    response_by_integration, response_by_m_inv_k_modes, response_by_normal_modes,
+    response_with_modal_damping, state_response_by_eigenvectors, state_response_by_exponential,
+    state_response_by_integration,
+};
 pub use system::{ConstraintValues, FirstOrder, MechanicalSystem, ModelInfo, UnknownParameter};

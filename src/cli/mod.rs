@@ -3,6 +3,8 @@
 mod check;
 mod equations;
 mod events;
+mod free_response;
+mod modal_damping;
 mod modes;
 mod plot;
 mod roundoff;

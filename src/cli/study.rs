@@ -33,6 +33,12 @@ pub enum Study {
     /// HW1: explicit Euler on ẋ = x with h = 10⁻ⁿ, truncation against roundoff error and
     /// the optimal n.
     EulerRoundoff(super::roundoff::EulerRoundoffArgs),
+    /// HW28: the free response of the linearised, undamped equations four ways (integration,
+    /// e^{At}, modes of M⁻¹K, mass-normalised modes), their differences and a chart.
+    FreeResponse(super::free_response::FreeResponseArgs),
+    /// HW34: damping ratios exact (eigenvalues of A) vs the diagonal of Ĉ = ΨᵀCΨ vs Rayleigh
+    /// damping fitted to two modes, and the free responses from each mode shape.
+    ModalDamping(super::modal_damping::ModalDampingArgs),
 }
 
 /// Options of `eomgen study constraint-methods`.
@@ -64,6 +70,8 @@ pub fn run(study: &Study) -> Result<(), CliError> {
         Study::WorkPrecision(args) => super::work_precision::run(args),
         Study::Stability(args) => super::stability::run(args),
         Study::EulerRoundoff(args) => super::roundoff::run(args),
+        Study::FreeResponse(args) => super::free_response::run(args),
+        Study::ModalDamping(args) => super::modal_damping::run(args),
     }
 }
 

@@ -1,0 +1,479 @@
+//! `eomgen study free-response MODEL` (HW28, lectures 22–26): the free response of the
+//! linearised, undamped equations `M δq̈ + K δq = 0` at an equilibrium computed four ways —
+//! DOP853 on the linear equations, `e^{At}`, superposed modes of `M⁻¹K` and superposed
+//! mass-normalised modes — their largest differences, and a chart of every coordinate.
+//!
+//! Also the pieces `study modal-damping` shares: the operating point and linearisation,
+//! `--init` parsing, the default time span and the stacked charts.
+
+use std::io::Write as _;
+
+use clap::Args;
+use eomgen::{FreeResponse, Linearization, ModeKind, ModelInfo, NormalModes};
+use plotters::prelude::*;
+use serde_json::json;
+
+use super::modes::operating_point;
+use super::plot::{self, Series};
+use super::values::{evaluate, parameter_lookup, set_parameters, split_assignment};
+use super::{CliError, find_model};
+
+/// Options of `eomgen study free-response`.
+#[derive(Debug, Args)]
+pub struct FreeResponseArgs {
+    /// Model name (see `eomgen list`).
+    pub model: String,
+    /// Operating point: a name from the model's `equilibria:`, or guesses `q1=VALUE,…`
+    /// (as for `eomgen modes`). Default: the model's first equilibrium, else q = 0.
+    #[arg(long)]
+    pub at: Option<String>,
+    /// Set a parameter, `NAME=VALUE`; repeatable.
+    #[arg(long = "set", value_name = "NAME=VALUE")]
+    pub set: Vec<String>,
+    /// Initial deviation from the operating point: `NAME=VALUE` for a coordinate (`x=0.1`) or a
+    /// rate (`x_dot=0.2`), comma separated or repeated; the others 0. Default: 0.1 (m or rad)
+    /// for every coordinate, at rest.
+    #[arg(long, value_name = "NAME=VALUE,…")]
+    pub init: Vec<String>,
+    /// End time (s). Default: four periods of the slowest oscillatory mode, or the time an
+    /// unstable mode grows by e⁵ if that is shorter, else 10 s.
+    #[arg(long)]
+    pub t_end: Option<f64>,
+    /// Number of output times, evenly spaced from 0 to the end time.
+    #[arg(long, default_value_t = 401)]
+    pub samples: usize,
+    /// Relative and absolute tolerance of the DOP853 integration.
+    #[arg(long, default_value_t = 1e-13)]
+    pub tol: f64,
+    /// Print JSON instead of the table.
+    #[arg(long)]
+    pub json: bool,
+    /// Chart of each coordinate against time, the four responses overlaid (.svg or .png).
+    #[arg(long, value_name = "FILE")]
+    pub plot: Option<String>,
+}
+
+/// The linearisation at the operating point `--at` and what to call it.
+pub(super) struct OperatingPoint {
+    /// The model, with `--set` applied.
+    pub model: Box<dyn ModelInfo>,
+    /// The equilibrium's name, or the `--at` guesses as given.
+    pub label: String,
+    /// The exact linearisation at the equilibrium Newton found.
+    pub lin: Linearization,
+    /// Its normal modes.
+    pub modes: NormalModes,
+}
+
+/// Finds the equilibrium from `--at`, linearises there and computes the normal modes.
+pub(super) fn operating_point_of(
+    model_name: &str,
+    at: Option<&str>,
+    sets: &[String],
+) -> Result<OperatingPoint, CliError> {
+    let mut model = find_model(model_name)?;
+    set_parameters(model.as_mut(), sets)?;
+    let (label, guess) = operating_point(model.as_ref(), at)?;
+    let fail = |e: eomgen::ModalError| CliError::failure(format!("`{}`: {e}", model.name()));
+    let equilibrium = eomgen::find_equilibrium(model.as_ref(), &guess, 0.0).map_err(fail)?;
+    let n = model.num_dofs();
+    let lin =
+        eomgen::linearize(model.as_ref(), &equilibrium.q, &vec![0.0; n], 0.0).map_err(fail)?;
+    let modes = eomgen::normal_modes(&lin).map_err(fail)?;
+    Ok(OperatingPoint {
+        model,
+        label,
+        lin,
+        modes,
+    })
+}
+
+/// Parses `--init NAME=VALUE,…` into `(δq₀, δq̇₀)`, starting from zeros.
+pub(super) fn parse_init(
+    model: &dyn ModelInfo,
+    init: &[String],
+) -> Result<(Vec<f64>, Vec<f64>), CliError> {
+    let n = model.num_dofs();
+    let coordinates = model.coordinate_names();
+    let lookup = parameter_lookup(model);
+    let (mut q0, mut v0) = (vec![0.0; n], vec![0.0; n]);
+    for part in init.iter().flat_map(|s| s.split(',')) {
+        let (name, text) = split_assignment(part, "--init")?;
+        let value = evaluate(text, &format!("--init {name}"), &lookup)?;
+        if let Some(i) = coordinates.iter().position(|c| *c == name) {
+            q0[i] = value;
+        } else if let Some(i) = coordinates
+            .iter()
+            .position(|c| name.strip_suffix("_dot") == Some(c))
+        {
+            v0[i] = value;
+        } else {
+            let rates: Vec<String> = coordinates.iter().map(|c| format!("{c}_dot")).collect();
+            return Err(CliError::usage(format!(
+                "--init {name}: `{}` has no coordinate or rate `{name}` (coordinates: {}; rates: {})",
+                model.name(),
+                coordinates.join(", "),
+                rates.join(", ")
+            )));
+        }
+    }
+    Ok((q0, v0))
+}
+
+/// `samples` evenly spaced times on `[0, t_end]`, after checking both.
+pub(super) fn time_grid(t_end: f64, samples: usize) -> Result<Vec<f64>, CliError> {
+    if !(t_end.is_finite() && t_end > 0.0) {
+        return Err(CliError::usage(format!(
+            "--t-end must be positive and finite, got {t_end}"
+        )));
+    }
+    if samples < 2 {
+        return Err(CliError::usage("--samples must be at least 2"));
+    }
+    Ok((0..samples)
+        .map(|i| t_end * i as f64 / (samples - 1) as f64)
+        .collect())
+}
+
+/// `periods` periods of the slowest oscillatory mode, or the time the fastest unstable mode
+/// grows by `e^growth` if shorter; 10 s if neither exists.
+pub(super) fn default_t_end(modes: &NormalModes, periods: f64, growth: f64) -> f64 {
+    let mut slowest = 0.0f64;
+    let mut growth_time = f64::INFINITY;
+    for (k, kind) in modes.kinds.iter().enumerate() {
+        match kind {
+            ModeKind::Oscillatory => {
+                slowest =
+                    slowest.max(periods * std::f64::consts::TAU / modes.natural_frequencies[k]);
+            }
+            ModeKind::Unstable { growth_rate } => {
+                growth_time = growth_time.min(growth / growth_rate)
+            }
+            ModeKind::ZeroFrequency => {}
+        }
+    }
+    let t = if slowest > 0.0 {
+        slowest.min(growth_time)
+    } else {
+        growth_time
+    };
+    if t.is_finite() && t > 0.0 { t } else { 10.0 }
+}
+
+/// The JSON description of a mode kind.
+pub(super) fn kind_json(kind: &ModeKind) -> serde_json::Value {
+    match kind {
+        ModeKind::Oscillatory => json!("oscillatory"),
+        ModeKind::ZeroFrequency => json!("zero_frequency"),
+        ModeKind::Unstable { .. } => json!("unstable"),
+    }
+}
+
+/// One panel of a stacked chart: an optional caption, the y-axis label (with units) and the
+/// lines against time.
+pub(super) struct Panel {
+    /// Shown above the panel.
+    pub caption: Option<String>,
+    /// The y-axis label, with its unit.
+    pub y_desc: String,
+    /// The lines, drawn in this order.
+    pub series: Vec<Series>,
+}
+
+/// A chart of stacked panels sharing the time axis, each with its own y label and lines
+/// (drawn thick to thin, so that coinciding lines all stay visible), into `path` (`.svg` or
+/// `.png`).
+///
+/// # Errors
+/// An unknown extension, a panel with no finite point, or a failure to write the file.
+pub(super) fn panels(path: &str, title: &str, panels: &[Panel]) -> Result<(), String> {
+    plot::register_font()?;
+    let size = (960, 60 + 260 * panels.len().max(1) as u32);
+    if path.ends_with(".svg") {
+        draw_panels(
+            SVGBackend::new(path, size).into_drawing_area(),
+            title,
+            panels,
+        )
+    } else if path.ends_with(".png") {
+        draw_panels(
+            BitMapBackend::new(path, size).into_drawing_area(),
+            title,
+            panels,
+        )
+    } else {
+        Err(format!("`{path}`: a chart file must end in .svg or .png"))
+    }
+}
+
+fn draw_panels<DB: DrawingBackend>(
+    root: DrawingArea<DB, plotters::coord::Shift>,
+    title: &str,
+    panels: &[Panel],
+) -> Result<(), String>
+where
+    DB::ErrorType: 'static,
+{
+    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| format!("plotting failed: {e}");
+    root.fill(&WHITE).map_err(err)?;
+    let root = root.titled(title, ("sans-serif", 22)).map_err(err)?;
+    let areas = root.split_evenly((panels.len().max(1), 1));
+    for (panel, area) in panels.iter().zip(&areas) {
+        let (y_desc, series) = (&panel.y_desc, &panel.series);
+        let finite = || {
+            series
+                .iter()
+                .flat_map(|s| s.points.iter())
+                .filter(|(x, y)| x.is_finite() && y.is_finite())
+        };
+        let (mut x0, mut x1, mut y0, mut y1) = (
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+        );
+        for (x, y) in finite() {
+            x0 = x0.min(*x);
+            x1 = x1.max(*x);
+            y0 = y0.min(*y);
+            y1 = y1.max(*y);
+        }
+        if !(x0.is_finite() && y0.is_finite()) {
+            return Err(format!("nothing to plot for `{y_desc}`: no finite point"));
+        }
+        let (x0, x1) = plot::range(x0, x1, false);
+        let (y0, y1) = plot::range(y0, y1, false);
+        let mut builder = ChartBuilder::on(area);
+        builder
+            .margin(10)
+            .x_label_area_size(40)
+            .y_label_area_size(90);
+        if let Some(caption) = &panel.caption {
+            builder.caption(caption, ("sans-serif", 16));
+        }
+        let mut ctx = builder.build_cartesian_2d(x0..x1, y0..y1).map_err(err)?;
+        // Ticks within rounding of zero print as 0, not as 1e-17.
+        let snap = |v: f64, span: f64| if v.abs() < 1e-9 * span { 0.0 } else { v };
+        let (x_span, y_span) = (x1 - x0, y1 - y0);
+        ctx.configure_mesh()
+            .x_desc("t (s)")
+            .y_desc(y_desc.as_str())
+            .x_label_formatter(&|v| plot::tick(snap(*v, x_span), false))
+            .y_label_formatter(&|v| plot::tick(snap(*v, y_span), false))
+            .label_style(("sans-serif", 14))
+            .draw()
+            .map_err(err)?;
+        let count = series.len();
+        for (i, s) in series.iter().enumerate() {
+            let color = Palette99::pick(i).to_rgba();
+            let width = 1 + 2 * (count - 1 - i) as u32;
+            let points = s
+                .points
+                .iter()
+                .copied()
+                .filter(|(x, y)| x.is_finite() && y.is_finite());
+            ctx.draw_series(LineSeries::new(points, color.stroke_width(width)))
+                .map_err(err)?
+                .label(s.name.clone())
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(width))
+                });
+        }
+        ctx.configure_series_labels()
+            .position(SeriesLabelPosition::UpperRight)
+            .background_style(WHITE.mix(0.8))
+            .border_style(BLACK)
+            .label_font(("sans-serif", 13))
+            .draw()
+            .map_err(err)?;
+    }
+    root.present().map_err(err)?;
+    Ok(())
+}
+
+/// The four routes, in the order printed.
+const METHODS: [(&str, &str); 4] = [
+    (
+        "integration",
+        "DOP853 on δẏ = A δy (numerical, to the tolerance)",
+    ),
+    ("exponential", "e^{At} δy₀, Padé 13 (exact to rounding)"),
+    (
+        "m_inv_k_modes",
+        "superposed modes of M⁻¹K, P a = δq₀ solved (lecture 22)",
+    ),
+    (
+        "normal_modes",
+        "superposed mass-normalised modes, η₀ = ΨᵀM δq₀ (lecture 24)",
+    ),
+];
+
+/// Runs `study free-response`.
+pub fn run(args: &FreeResponseArgs) -> Result<(), CliError> {
+    let OperatingPoint {
+        model,
+        label,
+        mut lin,
+        modes,
+    } = operating_point_of(&args.model, args.at.as_deref(), &args.set)?;
+    let n = model.num_dofs();
+    let names = model.coordinate_names();
+    let ignored_damping = lin.damping_matrix.amax();
+    lin.damping_matrix.fill(0.0);
+    let (q0, v0) = if args.init.is_empty() {
+        (vec![0.1; n], vec![0.0; n])
+    } else {
+        parse_init(model.as_ref(), &args.init)?
+    };
+    if !(args.tol.is_finite() && args.tol > 0.0) {
+        return Err(CliError::usage("--tol must be positive"));
+    }
+    let t_end = args
+        .t_end
+        .unwrap_or_else(|| default_t_end(&modes, 4.0, 5.0));
+    let times = time_grid(t_end, args.samples)?;
+    let fail = |e: eomgen::ResponseError| CliError::failure(format!("`{}`: {e}", model.name()));
+    let responses: Vec<FreeResponse> = vec![
+        eomgen::response_by_integration(&lin, &q0, &v0, &times, args.tol).map_err(fail)?,
+        eomgen::response_by_exponential(&lin, &q0, &v0, &times).map_err(fail)?,
+        eomgen::response_by_m_inv_k_modes(&lin, &q0, &v0, &times).map_err(fail)?,
+        eomgen::response_by_normal_modes(&lin, &q0, &v0, &times).map_err(fail)?,
+    ];
+    let q_scale = responses[1].max_displacement();
+    let v_scale = responses[1].max_velocity();
+    let relative = |d: f64, s: f64| if s > 0.0 { d / s } else { d };
+    let mut differences = Vec::new();
+    for i in 0..4 {
+        for j in i + 1..4 {
+            let dq = responses[i]
+                .max_displacement_difference(&responses[j])
+                .unwrap_or(f64::INFINITY);
+            let dv = responses[i]
+                .max_velocity_difference(&responses[j])
+                .unwrap_or(f64::INFINITY);
+            differences.push((i, j, dq, dv));
+        }
+    }
+    if let Some(path) = &args.plot {
+        let panel_list: Vec<Panel> = (0..n)
+            .map(|j| {
+                let series = METHODS
+                    .iter()
+                    .zip(&responses)
+                    .map(|((name, _), r)| Series {
+                        name: (*name).to_string(),
+                        points: r.coordinate_history(j),
+                    })
+                    .collect();
+                Panel {
+                    caption: None,
+                    y_desc: format!("δ{} (m or rad)", names[j]),
+                    series,
+                }
+            })
+            .collect();
+        let title = format!(
+            "{} at {label}: free response four ways (HW28)",
+            model.name()
+        );
+        panels(path, &title, &panel_list).map_err(CliError::failure)?;
+    }
+    let mut stdout = std::io::stdout().lock();
+    if args.json {
+        let out = json!({
+            "model": model.name(),
+            "coordinates": names,
+            "operating_point": {
+                "name": label,
+                "q": names.iter().zip(&lin.q).map(|(c, v)| (c.to_string(), json!(v))).collect::<serde_json::Map<_, _>>(),
+            },
+            "ignored_damping": ignored_damping,
+            "modes": (0..n).map(|k| json!({
+                "kind": kind_json(&modes.kinds[k]),
+                "eigenvalue": modes.eigenvalues[k],
+                "natural_frequency": modes.natural_frequencies[k],
+                "growth_rate": match modes.kinds[k] { ModeKind::Unstable { growth_rate } => Some(growth_rate), _ => None },
+            })).collect::<Vec<_>>(),
+            "initial": {"q": q0, "qdot": v0},
+            "t_end": t_end,
+            "samples": times.len(),
+            "tol": args.tol,
+            "methods": METHODS.iter().map(|(name, description)| json!({"name": name, "description": description})).collect::<Vec<_>>(),
+            "max_displacement": q_scale,
+            "max_velocity": v_scale,
+            "max_differences": differences.iter().map(|(i, j, dq, dv)| json!({
+                "a": METHODS[*i].0,
+                "b": METHODS[*j].0,
+                "displacement": dq,
+                "velocity": dv,
+                "displacement_relative": relative(*dq, q_scale),
+                "velocity_relative": relative(*dv, v_scale),
+            })).collect::<Vec<_>>(),
+            "final": METHODS.iter().zip(&responses).map(|((name, _), r)| json!({
+                "method": name,
+                "q": r.displacements.last(),
+                "qdot": r.velocities.last(),
+            })).collect::<Vec<_>>(),
+        });
+        let text =
+            serde_json::to_string_pretty(&out).map_err(|e| CliError::failure(e.to_string()))?;
+        let _ = writeln!(stdout, "{text}");
+        return Ok(());
+    }
+    let _ = writeln!(
+        stdout,
+        "model      {} ({} dof) at {label}: M δq̈ + K δq = 0, 0 ≤ t ≤ {t_end:.6} s, {} samples",
+        model.name(),
+        n,
+        times.len()
+    );
+    if ignored_damping > 0.0 {
+        let _ = writeln!(
+            stdout,
+            "note       the damping matrix (max |C| = {ignored_damping:.3e}) is left out here; see `eomgen study modal-damping`"
+        );
+    }
+    let fmt = |v: &[f64]| -> String {
+        names
+            .iter()
+            .zip(v)
+            .map(|(c, x)| format!("{c} = {x:.6e}"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let _ = writeln!(stdout, "initial    δq: {}", fmt(&q0));
+    let _ = writeln!(stdout, "           δq̇: {}", fmt(&v0));
+    for k in 0..n {
+        let what = match modes.kinds[k] {
+            ModeKind::Oscillatory => format!(
+                "ω = {:.10e} rad/s: a cos ωt + b sin ωt/ω",
+                modes.natural_frequencies[k]
+            ),
+            ModeKind::ZeroFrequency => "zero-frequency: a + b t".to_string(),
+            ModeKind::Unstable { growth_rate } => {
+                format!("unstable, σ = {growth_rate:.10e} 1/s: a cosh σt + b sinh σt/σ")
+            }
+        };
+        let _ = writeln!(stdout, "mode {:<5} {what}", k + 1);
+    }
+    for (i, (name, description)) in METHODS.iter().enumerate() {
+        let _ = writeln!(stdout, "method {}    {name}: {description}", i + 1);
+    }
+    let _ = writeln!(
+        stdout,
+        "largest |δq| = {q_scale:.6e}, |δq̇| = {v_scale:.6e}; max differences (absolute, relative):"
+    );
+    for (i, j, dq, dv) in &differences {
+        let _ = writeln!(
+            stdout,
+            "  {:<14} vs {:<14} δq {:>9.2e} ({:>8.1e})   δq̇ {:>9.2e} ({:>8.1e})",
+            METHODS[*i].0,
+            METHODS[*j].0,
+            dq,
+            relative(*dq, q_scale),
+            dv,
+            relative(*dv, v_scale)
+        );
+    }
+    Ok(())
+}
