@@ -3,6 +3,7 @@
 mod check;
 mod equations;
 mod events;
+mod mode_plot;
 mod modes;
 mod plot;
 mod roundoff;

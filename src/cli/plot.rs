@@ -5,7 +5,8 @@ use plotters::prelude::*;
 
 static FONT: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
 
-fn register_font() -> Result<(), String> {
+/// Registers the bundled DejaVu Sans as plotters' `sans-serif`.
+pub(super) fn register_font() -> Result<(), String> {
     plotters::style::register_font("sans-serif", FontStyle::Normal, FONT)
         .map_err(|_| "the bundled font could not be loaded".to_string())
 }
@@ -95,7 +96,7 @@ fn usable<'s>(chart: &Chart<'_>, s: &'s Series) -> impl Iterator<Item = (f64, f6
 
 /// A tick label: `1e-5` on a log axis (plotters' default prints `9999999e-5`), else a
 /// short decimal.
-fn tick(v: f64, log: bool) -> String {
+pub(super) fn tick(v: f64, log: bool) -> String {
     if log {
         let e = v.log10().round();
         if (v.log10() - e).abs() < 1e-6 {
