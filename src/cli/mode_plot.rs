@@ -177,18 +177,28 @@ pub fn mode_charts(
     let three_d = std::iter::once(q.to_vec())
         .chain((0..n).map(|k| {
             let psi = modes.mode_shapes.column(k);
-            q.iter().zip(psi.iter()).map(|(a, p)| a + 1e-3 * p).collect()
+            q.iter()
+                .zip(psi.iter())
+                .map(|(a, p)| a + 1e-3 * p)
+                .collect()
         }))
         .any(|qk| positions(model, &qk).iter().any(|p| p[2] != 0.0));
     let layout = Layout::of(model, three_d);
     let rest = frame(model, &layout, q);
-    let (mut lo, mut hi) = ((f64::INFINITY, f64::INFINITY), (f64::NEG_INFINITY, f64::NEG_INFINITY));
+    let (mut lo, mut hi) = (
+        (f64::INFINITY, f64::INFINITY),
+        (f64::NEG_INFINITY, f64::NEG_INFINITY),
+    );
     for &i in &layout.dots {
         lo = (lo.0.min(rest[i].0), lo.1.min(rest[i].1));
         hi = (hi.0.max(rest[i].0), hi.1.max(rest[i].1));
     }
     let size = (hi.0 - lo.0).max(hi.1 - lo.1);
-    let size = if size.is_finite() && size > 0.0 { size } else { 1.0 };
+    let size = if size.is_finite() && size > 0.0 {
+        size
+    } else {
+        1.0
+    };
     let q_scale = 1.0 + q.iter().fold(0.0f64, |m, v| m.max(v.abs()));
     let mut paths = Vec::with_capacity(modes.natural_frequencies.len());
     for (k, (&omega, &kind)) in modes
@@ -322,7 +332,10 @@ where
         .build_cartesian_2d(x0..x1, y0..y1)
         .map_err(err)?;
     let (x_desc, y_desc) = if layout.three_d {
-        ("isometric view: (x − y) cos 30° (m)", "z + (x + y) sin 30° (m)")
+        (
+            "isometric view: (x − y) cos 30° (m)",
+            "z + (x + y) sin 30° (m)",
+        )
     } else {
         ("x (m)", "y (m)")
     };
@@ -336,8 +349,11 @@ where
         .draw()
         .map_err(err)?;
     let grey = RGBColor(150, 150, 150);
-    let mut styled: Vec<(&Frame, RGBAColor, String)> =
-        vec![(&drawing.equilibrium, grey.to_rgba(), "equilibrium q*".to_string())];
+    let mut styled: Vec<(&Frame, RGBAColor, String)> = vec![(
+        &drawing.equilibrium,
+        grey.to_rgba(),
+        "equilibrium q*".to_string(),
+    )];
     if let Some([plus, minus]) = &drawing.displaced {
         styled.push((&plus.0, RGBColor(214, 39, 40).to_rgba(), plus.1.clone()));
         styled.push((&minus.0, RGBColor(31, 119, 180).to_rgba(), minus.1.clone()));
