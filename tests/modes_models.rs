@@ -807,15 +807,31 @@ fn mode_charts_are_written() {
     let line = std::fs::read_to_string(dir.join("spring_line_three-mode1.svg")).unwrap();
     assert!(line.contains("zero-frequency"));
 
-    let png = dir.join("pair.png");
-    let out = eomgen(&["modes", "spring_pair_3d", "--plot", png.to_str().unwrap()]);
+    // A 3-D model is drawn in an isometric view.
+    let prefix = dir.join("pair");
+    let out = eomgen(&[
+        "modes",
+        "spring_pair_3d",
+        "--plot",
+        prefix.to_str().unwrap(),
+    ]);
     assert!(
         out.status.success(),
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    for k in 1..=6 {
-        let bytes = std::fs::read(dir.join(format!("pair-mode{k}.png"))).unwrap();
+    let pair = std::fs::read_to_string(dir.join("pair-mode6.svg")).unwrap();
+    assert!(pair.contains("isometric view"));
+
+    let png = dir.join("pipe.png");
+    let out = eomgen(&["modes", "cylinder_in_pipe", "--plot", png.to_str().unwrap()]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    for k in 1..=2 {
+        let bytes = std::fs::read(dir.join(format!("pipe-mode{k}.png"))).unwrap();
         assert!(
             bytes.starts_with(b"\x89PNG\r\n\x1a\n"),
             "mode {k}: a PNG file"
