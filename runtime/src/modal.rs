@@ -370,6 +370,28 @@ pub struct Linearization {
 }
 
 impl Linearization {
+    /// A linearisation given by its matrices (`n × n` each), at rest at `q = 0`, `t = 0`,
+    /// without constraints: for systems assembled by hand (lectures 27–29's stiffness
+    /// assembly, HW32's matrices).
+    pub fn from_matrices(
+        mass_matrix: DMatrix<f64>,
+        stiffness_matrix: DMatrix<f64>,
+        damping_matrix: DMatrix<f64>,
+    ) -> Self {
+        let n = mass_matrix.nrows();
+        Self {
+            q: vec![0.0; n],
+            qdot: vec![0.0; n],
+            t: 0.0,
+            mass_matrix,
+            stiffness_matrix,
+            damping_matrix,
+            coordinate_basis: DMatrix::identity(n, n),
+            independent_coordinates: (0..n).collect(),
+            lagrange_multipliers: Vec::new(),
+        }
+    }
+
     /// `‖K − Kᵀ‖_max / ‖K‖_max` (0 for a symmetric `K`; 0 when `K = 0`).
     pub fn stiffness_asymmetry(&self) -> f64 {
         asymmetry(&self.stiffness_matrix)

@@ -303,7 +303,7 @@ fn initial_state(
     q0: &[f64],
     qdot0: &[f64],
 ) -> Result<Vec<f64>, ResponseError> {
-    let n = lin.q.len();
+    let n = lin.num_minimal_coordinates();
     check_vector(q0, n, "displacements")?;
     check_vector(qdot0, n, "velocities")?;
     Ok(q0.iter().chain(qdot0).copied().collect())
@@ -534,7 +534,11 @@ pub fn response_by_integration(
     let y0 = initial_state(lin, q0, qdot0)?;
     let a = lin.state_matrix()?;
     let states = state_response_by_integration(&a, &y0, times, tolerance)?;
-    Ok(FreeResponse::from_states(times, states, lin.q.len()))
+    Ok(FreeResponse::from_states(
+        times,
+        states,
+        lin.num_minimal_coordinates(),
+    ))
 }
 
 /// The free response of `M δq̈ + C δq̇ + K δq = 0` as `δy(t) = e^{At} δy₀` (lecture 31, HW34
@@ -551,7 +555,11 @@ pub fn response_by_exponential(
     let y0 = initial_state(lin, q0, qdot0)?;
     let a = lin.state_matrix()?;
     let states = state_response_by_exponential(&a, &y0, times)?;
-    Ok(FreeResponse::from_states(times, states, lin.q.len()))
+    Ok(FreeResponse::from_states(
+        times,
+        states,
+        lin.num_minimal_coordinates(),
+    ))
 }
 
 /// The modes of the non-symmetric `M⁻¹K` (lecture 22's route).
@@ -579,7 +587,7 @@ pub struct MInvKModes {
 /// an eigenvalue has fewer eigenvectors than its multiplicity or the eigenvector matrix has
 /// `σ_min/σ_max < 1e-6`.
 pub fn modes_of_m_inv_k(lin: &Linearization) -> Result<MInvKModes, ResponseError> {
-    let n = lin.q.len();
+    let n = lin.num_minimal_coordinates();
     let chol = lin.mass_cholesky()?;
     let b = chol.solve(&lin.stiffness_matrix);
     if !b.iter().all(|v| v.is_finite()) {

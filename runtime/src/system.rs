@@ -105,6 +105,16 @@ pub trait MechanicalSystem<const N: usize> {
     /// Positions of the points (m), `[x, y, z]` with `z = 0` for 2-D models, written into
     /// `out` (length `point_names().len()`).
     fn point_positions(&self, q: &SVector<f64, N>, t: f64, out: &mut [[f64; 3]]);
+    /// The file's `draw: lines`: segments between named points (names from
+    /// [`Self::point_names`]), in file order; empty by default.
+    fn draw_lines(&self) -> &'static [[&'static str; 2]] {
+        &[]
+    }
+    /// The file's `draw: trace`: points whose trajectories are traced, in file order; empty by
+    /// default.
+    fn trace_points(&self) -> &'static [&'static str] {
+        &[]
+    }
     /// The derived equations as plain text (`M`, `F`, `T`, `V`).
     fn equations_text(&self) -> &'static str;
     /// The derived equations as LaTeX.
@@ -505,6 +515,14 @@ pub trait ModelInfo: OdeSystem {
     fn point_names(&self) -> &'static [&'static str];
     /// Positions of the points at `(t, y)`, `[x, y, z]` each (m).
     fn point_positions(&self, t: f64, y: &[f64]) -> Vec<[f64; 3]>;
+    /// The `draw: lines` segments as pairs of point names ([`MechanicalSystem::draw_lines`]).
+    fn draw_lines(&self) -> &'static [[&'static str; 2]] {
+        &[]
+    }
+    /// The `draw: trace` point names ([`MechanicalSystem::trace_points`]).
+    fn trace_points(&self) -> &'static [&'static str] {
+        &[]
+    }
     /// The derived equations as text.
     fn equations_text(&self) -> &'static str;
     /// The derived equations as LaTeX.
@@ -637,6 +655,12 @@ impl<S: MechanicalSystem<N>, const N: usize> ModelInfo for FirstOrder<S, N> {
         let mut out = vec![[0.0; 3]; self.system.point_names().len()];
         self.system.point_positions(&q, t, &mut out);
         out
+    }
+    fn draw_lines(&self) -> &'static [[&'static str; 2]] {
+        self.system.draw_lines()
+    }
+    fn trace_points(&self) -> &'static [&'static str] {
+        self.system.trace_points()
     }
     fn equations_text(&self) -> &'static str {
         self.system.equations_text()

@@ -73,6 +73,15 @@ pub(super) fn operating_point_of(
 ) -> Result<OperatingPoint, CliError> {
     let mut model = find_model(model_name)?;
     set_parameters(model.as_mut(), sets)?;
+    if !model.constraint_names().is_empty() {
+        // The responses and their initial conditions are in the model's coordinates; a
+        // constrained model's linearisation is in minimal coordinates (δq = N z).
+        return Err(CliError::usage(format!(
+            "`{}` has constraints; this study takes unconstrained models (`eomgen modes {}` gives its modes in minimal coordinates)",
+            model.name(),
+            model.name()
+        )));
+    }
     let (label, guess) = operating_point(model.as_ref(), at)?;
     let fail = |e: eomgen::ModalError| CliError::failure(format!("`{}`: {e}", model.name()));
     let equilibrium = eomgen::find_equilibrium(model.as_ref(), &guess, 0.0).map_err(fail)?;

@@ -5,6 +5,7 @@ mod equations;
 mod events;
 mod free_response;
 mod modal_damping;
+mod mode_plot;
 mod modes;
 mod plot;
 mod roundoff;

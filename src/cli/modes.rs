@@ -27,12 +27,19 @@ pub struct ModesArgs {
     /// Print JSON.
     #[arg(long)]
     pub json: bool,
+    /// Draw each mode shape on the mechanism: `PREFIX-mode<k>.svg` (`.png` when PREFIX ends
+    /// in .png).
+    #[arg(long, value_name = "PREFIX")]
+    pub plot: Option<String>,
 }
 
 /// Runs `modes`.
 pub fn run(args: &ModesArgs) -> Result<(), CliError> {
     let mut model = find_model(&args.model)?;
     set_parameters(model.as_mut(), &args.set)?;
+    if args.plot.is_some() {
+        super::mode_plot::check_drawable(model.as_ref())?;
+    }
     let (label, guess) = operating_point(model.as_ref(), args.at.as_deref())?;
     let fail = |e: eomgen::ModalError| CliError::failure(format!("`{}`: {e}", model.name()));
     let equilibrium = find_equilibrium(model.as_ref(), &guess, 0.0).map_err(fail)?;
@@ -86,6 +93,16 @@ pub fn run(args: &ModesArgs) -> Result<(), CliError> {
         .zip(&lin.lagrange_multipliers)
         .map(|(c, v)| (c.to_string(), json!(v)))
         .collect();
+    let charts = match &args.plot {
+        Some(prefix) => super::mode_plot::mode_charts(
+            prefix,
+            model.as_ref(),
+            &equilibrium.q,
+            &modes,
+            &shapes_q,
+        )?,
+        None => Vec::new(),
+    };
     let mut stdout = std::io::stdout().lock();
     if args.json {
         let out = json!({
@@ -112,6 +129,7 @@ pub fn run(args: &ModesArgs) -> Result<(), CliError> {
             "stiffness_asymmetry": modes.stiffness_asymmetry,
             "m_inv_k_eigenvalues": route22,
             "m_inv_k_relative_difference": route_difference,
+            "charts": charts,
         });
         let text =
             serde_json::to_string_pretty(&out).map_err(|e| CliError::failure(e.to_string()))?;
@@ -194,6 +212,9 @@ pub fn run(args: &ModesArgs) -> Result<(), CliError> {
         stdout,
         "check      eigenvalues of M⁻¹K (lecture 22) vs the symmetric Cholesky route (lecture 24): max difference {route_difference:.1e} of max |ω²|"
     );
+    for path in &charts {
+        let _ = writeln!(stdout, "chart      {path}");
+    }
     Ok(())
 }
 

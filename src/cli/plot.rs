@@ -5,6 +5,7 @@ use plotters::prelude::*;
 
 static FONT: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
 
+/// Registers the bundled DejaVu Sans as plotters' `sans-serif`.
 pub(super) fn register_font() -> Result<(), String> {
     plotters::style::register_font("sans-serif", FontStyle::Normal, FONT)
         .map_err(|_| "the bundled font could not be loaded".to_string())

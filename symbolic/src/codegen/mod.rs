@@ -518,6 +518,33 @@ pub fn emit(
             &|v| write_out(v),
         );
     }
+    if !model.draw_lines.is_empty() {
+        let lines: Vec<String> = model
+            .draw_lines
+            .iter()
+            .filter_map(|[a, b]| {
+                let (a, b) = (&model.points.get(*a)?.0, &model.points.get(*b)?.0);
+                Some(format!("[{}, {}]", string_literal(a), string_literal(b)))
+            })
+            .collect();
+        let _ = writeln!(
+            constant_items,
+            "fn draw_lines(&self) -> &'static [[&'static str; 2]] {{ &[{}] }}",
+            lines.join(", ")
+        );
+    }
+    if !model.trace_points.is_empty() {
+        let names: Vec<String> = model
+            .trace_points
+            .iter()
+            .filter_map(|p| Some(string_literal(&model.points.get(*p)?.0)))
+            .collect();
+        let _ = writeln!(
+            constant_items,
+            "fn trace_points(&self) -> &'static [&'static str] {{ &[{}] }}",
+            names.join(", ")
+        );
+    }
     imp.push_str(&constant_items);
     let _ = writeln!(
         imp,

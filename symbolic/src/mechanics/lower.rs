@@ -130,6 +130,8 @@ pub struct SymbolicModel {
     pub dimension: usize,
     /// Line segments to draw, as point-index pairs.
     pub draw_lines: Vec<[usize; 2]>,
+    /// Points whose trajectories are traced (`draw: trace`), as point indices.
+    pub trace_points: Vec<usize>,
     /// Bodies of the kinematic form.
     pub bodies: Vec<BodyInfo>,
     /// Gravity vector (m/s²), if given.
@@ -778,6 +780,12 @@ impl<'f> Lowering<'f> {
             .iter()
             .filter_map(|[a, b]| Some([point(&a.value)?, point(&b.value)?]))
             .collect();
+        let trace_points = file
+            .draw
+            .trace
+            .iter()
+            .filter_map(|p| point(&p.value))
+            .collect();
 
         if !self.errors.is_empty() {
             return Err(self.errors);
@@ -799,6 +807,7 @@ impl<'f> Lowering<'f> {
             conservative,
             dimension,
             draw_lines,
+            trace_points,
             bodies: body_infos,
             gravity,
             loads,
