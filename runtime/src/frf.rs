@@ -276,7 +276,11 @@ fn linearize_with_inputs_inner(
         if !(deviation <= LINEARITY_TOLERANCE * scale) {
             return Err(FrfError::NonlinearInput {
                 input: input.to_string(),
-                deviation: if scale > 0.0 { deviation / scale } else { deviation },
+                deviation: if scale > 0.0 {
+                    deviation / scale
+                } else {
+                    deviation
+                },
             });
         }
         if (&m1 - &m0).amax() > LINEARITY_TOLERANCE * m0.amax() {
@@ -326,6 +330,12 @@ pub fn dynamic_stiffness(lin: &Linearization, frequency: f64) -> DMatrix<Complex
     })
 }
 
+/// A pivot of the LU factors of `K − ω²M + iωC` below this fraction of its largest entry
+/// makes it singular to rounding: the response would be `≳ 10¹³` times the static one, an
+/// undamped resonance hit to within rounding (`ω = √2` evaluated in floating point is
+/// `√2 (1 + 1.6e-16)`, and would otherwise give `|H| ≈ 10¹⁵`).
+const SINGULAR_PIVOT: f64 = 1e-13;
+
 /// The frequency response `H(ω) = (K − ω²M + iωC)⁻¹ B` at one frequency, by complex LU with
 /// partial pivoting.
 ///
@@ -338,7 +348,8 @@ pub fn dynamic_stiffness(lin: &Linearization, frequency: f64) -> DMatrix<Complex
 ///
 /// # Errors
 /// [`FrfError::InvalidFrequency`]; [`FrfError::DimensionMismatch`];
-/// [`FrfError::Singular`] at an undamped resonance (or `ω = 0` with a rigid-body mode).
+/// [`FrfError::Singular`] at an undamped resonance (or `ω = 0` with a rigid-body mode): when
+/// a pivot of the LU factors is below `1e-13` of the largest entry of `K − ω²M + iωC`.
 ///
 /// # References
 /// Lecture 21 (one degree of freedom), HW37 (three masses).
@@ -358,10 +369,19 @@ pub fn frequency_response(
         });
     }
     let b = input_matrix.map(|v| Complex::new(v, 0.0));
-    let h = dynamic_stiffness(lin, frequency)
-        .lu()
-        .solve(&b)
-        .ok_or(FrfError::Singular { frequency })?;
+    let z = dynamic_stiffness(lin, frequency);
+    let scale = z.iter().map(|v| v.norm()).fold(0.0f64, f64::max);
+    let lu = z.lu();
+    let smallest_pivot = lu
+        .u()
+        .diagonal()
+        .iter()
+        .map(|v| v.norm())
+        .fold(f64::INFINITY, f64::min);
+    if !(smallest_pivot > SINGULAR_PIVOT * scale) {
+        return Err(FrfError::Singular { frequency });
+    }
+    let h = lu.solve(&b).ok_or(FrfError::Singular { frequency })?;
     if h.iter().all(|v| v.re.is_finite() && v.im.is_finite()) {
         Ok(h)
     } else {
@@ -385,7 +405,7 @@ pub struct ResonancePeak {
     pub frequency: f64,
     /// `|H|` there.
     pub amplitude: PeakAmplitude,
-    /// `arg H` there (degrees, in `(−180, 180]`); `None` for an unbounded peak.
+    /// `arg H` there (degrees, in `[−180, 180)`); `None` for an unbounded peak.
     pub phase_deg: Option<f64>,
 }
 
@@ -398,7 +418,7 @@ pub struct FrequencySweep {
     /// exactly).
     pub response: Vec<Option<Complex<f64>>>,
     /// `arg H` in degrees, unwrapped along the sweep so that it is continuous where the
-    /// response is (starts in `(−180, 180]`; `None` where `response` is).
+    /// response is (starts in `[−180, 180)`; `None` where `response` is).
     pub phases_deg: Vec<Option<f64>>,
     /// The resonance peaks inside `[min ω, max ω]`, ascending.
     pub peaks: Vec<ResonancePeak>,
@@ -434,13 +454,14 @@ pub fn log_frequencies(lo: f64, hi: f64, n: usize) -> Result<Vec<f64>, FrfError>
     })
 }
 
-/// `arg z` in degrees in `(−180, 180]`, with a negative real number (an undamped response in
-/// antiphase) at `−180`: a lag, as the damped response approaches it.
-fn phase_deg(z: Complex<f64>) -> f64 {
+/// `arg z` in degrees in `[−180, 180)`: a negative real number (an undamped response in
+/// antiphase) is at `−180`, a lag, as the damped response approaches it; `−0` is `0`.
+pub fn phase_degrees(z: Complex<f64>) -> f64 {
     if z.im == 0.0 && z.re < 0.0 {
         return -180.0;
     }
-    z.im.atan2(z.re).to_degrees()
+    let p = z.im.atan2(z.re).to_degrees() + 0.0;
+    if p == 180.0 { -180.0 } else { p }
 }
 
 /// The frequency response from input column `input` of `input_matrix` to coordinate
@@ -501,7 +522,7 @@ pub fn frequency_sweep(
     let mut previous: Option<f64> = None;
     for h in &response {
         let phase = h.map(|h| {
-            let mut p = phase_deg(h);
+            let mut p = phase_degrees(h);
             if let Some(prev) = previous {
                 while p - prev > 180.0 {
                     p -= 360.0;
@@ -638,7 +659,7 @@ fn find_peaks(
             peaks.push(ResonancePeak {
                 frequency: w,
                 amplitude: PeakAmplitude::Finite(h.norm()),
-                phase_deg: Some(phase_deg(h)),
+                phase_deg: Some(phase_degrees(h)),
             });
         }
     }
@@ -757,7 +778,8 @@ pub struct ModalResponse {
 ///
 /// # Errors
 /// [`FrfError::InvalidFrequency`]; [`FrfError::DimensionMismatch`];
-/// [`FrfError::Singular`] when a mode's denominator vanishes (an undamped resonance).
+/// [`FrfError::Singular`] when a mode's denominator is below `1e-13 max(|ω_k²|, ω²)` (an
+/// undamped resonance to rounding).
 ///
 /// # References
 /// HW37 (c): modal forcing of the three-mass system; HW34 (modal damping).
@@ -791,7 +813,7 @@ pub fn modal_frequency_response(
             modes.eigenvalues[mode] - w * w,
             w * damping.modal_damping_matrix[(mode, mode)],
         );
-        if denominator.norm() == 0.0 {
+        if !(denominator.norm() > SINGULAR_PIVOT * modes.eigenvalues[mode].abs().max(w * w)) {
             return Err(FrfError::Singular { frequency });
         }
         let eta = Complex::new(force, 0.0) / denominator;
@@ -833,7 +855,11 @@ pub fn settling_time(lin: &Linearization, reduction: f64) -> Result<f64, FrfErro
         .map(|s| -s.re)
         .fold(f64::INFINITY, f64::min);
     // A decay rate at rounding level of the largest eigenvalue is no decay.
-    let largest = a.complex_eigenvalues().iter().map(|s| s.norm()).fold(0.0f64, f64::max);
+    let largest = a
+        .complex_eigenvalues()
+        .iter()
+        .map(|s| s.norm())
+        .fold(0.0f64, f64::max);
     if !(slowest > 1e-10 * largest) {
         return Err(FrfError::NoSteadyState {
             slowest_decay_rate: slowest,
@@ -968,8 +994,18 @@ fn simulate_inner(
             settling_time.is_finite() && settling_time >= 0.0,
             "finite and ≥ 0",
         ),
-        ("rtol", options.rtol, options.rtol > 0.0 && options.rtol.is_finite(), "finite and > 0"),
-        ("atol", options.atol, options.atol > 0.0 && options.atol.is_finite(), "finite and > 0"),
+        (
+            "rtol",
+            options.rtol,
+            options.rtol > 0.0 && options.rtol.is_finite(),
+            "finite and > 0",
+        ),
+        (
+            "atol",
+            options.atol,
+            options.atol > 0.0 && options.atol.is_finite(),
+            "finite and > 0",
+        ),
         (
             "samples_per_period",
             options.samples_per_period as f64,

@@ -17,7 +17,7 @@ pub use frf::{
     ForcedLinearization, FrequencySweep, FrfError, HarmonicForcing, ModalDamping, ModalResponse,
     PeakAmplitude, ResonancePeak, SteadyState, SteadyStateOptions, frequency_response,
     frequency_sweep, linearize_with_inputs, log_frequencies, modal_damping,
-    modal_frequency_response, settling_time, simulate_steady_state,
+    modal_frequency_response, phase_degrees, settling_time, simulate_steady_state,
 };
 pub use integrate::{
     BogackiShampine32, DormandPrince54, DormandPrince853, Event, EventDirection, EventSpec,

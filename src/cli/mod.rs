@@ -3,6 +3,7 @@
 mod check;
 mod equations;
 mod events;
+mod frf;
 mod modes;
 mod plot;
 mod roundoff;
@@ -41,6 +42,9 @@ enum Command {
     /// Equilibrium, exact linearisation (M, C, K), natural frequencies, mode shapes and
     /// damping ratios at an operating point (`--at hanging`).
     Modes(modes::ModesArgs),
+    /// Frequency response from a load parameter to coordinates: Bode chart, resonance peaks,
+    /// modal contributions (`--modal`), points checked by simulation (`--simulate K`).
+    Frf(frf::FrfArgs),
     /// Print a generated model file: `n-link-pendulum N` or `n-mass-chain N`.
     New(equations::NewArgs),
     /// Numerical experiments comparing methods: `constraint-methods MODEL`,
@@ -83,6 +87,7 @@ pub fn run() -> ExitCode {
         Command::Equations(args) => equations::run(&args),
         Command::New(args) => equations::new(&args),
         Command::Modes(args) => modes::run(&args),
+        Command::Frf(args) => frf::run(&args),
         Command::Study(study) => study::run(&study),
     };
     match result {

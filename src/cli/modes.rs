@@ -179,7 +179,7 @@ fn print_matrix(out: &mut impl std::io::Write, name: &str, m: &DMatrix<f64>) {
 }
 
 /// The starting guess of the equilibrium search and its label.
-fn operating_point(
+pub fn operating_point(
     model: &dyn ModelInfo,
     at: Option<&str>,
 ) -> Result<(String, Vec<f64>), CliError> {

@@ -5,7 +5,7 @@ use plotters::prelude::*;
 
 static FONT: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
 
-fn register_font() -> Result<(), String> {
+pub fn register_font() -> Result<(), String> {
     plotters::style::register_font("sans-serif", FontStyle::Normal, FONT)
         .map_err(|_| "the bundled font could not be loaded".to_string())
 }
@@ -95,7 +95,7 @@ fn usable<'s>(chart: &Chart<'_>, s: &'s Series) -> impl Iterator<Item = (f64, f6
 
 /// A tick label: `1e-5` on a log axis (plotters' default prints `9999999e-5`), else a
 /// short decimal.
-fn tick(v: f64, log: bool) -> String {
+pub fn tick(v: f64, log: bool) -> String {
     if log {
         let e = v.log10().round();
         if (v.log10() - e).abs() < 1e-6 {
@@ -118,7 +118,7 @@ fn tick(v: f64, log: bool) -> String {
 }
 
 /// `[lo, hi]` padded by 5 % (or a factor for log axes), with a unit range for a constant.
-fn range(lo: f64, hi: f64, log: bool) -> (f64, f64) {
+pub fn range(lo: f64, hi: f64, log: bool) -> (f64, f64) {
     if log {
         // Padding by a factor must not overflow to ∞ (plotters never returns on an infinite
         // log range) or underflow to 0.
