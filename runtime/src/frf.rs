@@ -273,7 +273,7 @@ fn linearize_with_inputs_inner(
         let d2 = &f2 - &f1;
         let scale = f0.amax().max(f1.amax()).max(f2.amax());
         let deviation = (&d2 - &d1).amax();
-        if !(deviation <= LINEARITY_TOLERANCE * scale) {
+        if deviation.is_nan() || deviation > LINEARITY_TOLERANCE * scale {
             return Err(FrfError::NonlinearInput {
                 input: input.to_string(),
                 deviation: if scale > 0.0 {
@@ -378,7 +378,7 @@ pub fn frequency_response(
         .iter()
         .map(|v| v.norm())
         .fold(f64::INFINITY, f64::min);
-    if !(smallest_pivot > SINGULAR_PIVOT * scale) {
+    if smallest_pivot.is_nan() || smallest_pivot <= SINGULAR_PIVOT * scale {
         return Err(FrfError::Singular { frequency });
     }
     let h = lu.solve(&b).ok_or(FrfError::Singular { frequency })?;
@@ -813,7 +813,8 @@ pub fn modal_frequency_response(
             modes.eigenvalues[mode] - w * w,
             w * damping.modal_damping_matrix[(mode, mode)],
         );
-        if !(denominator.norm() > SINGULAR_PIVOT * modes.eigenvalues[mode].abs().max(w * w)) {
+        let floor = SINGULAR_PIVOT * modes.eigenvalues[mode].abs().max(w * w);
+        if denominator.norm().is_nan() || denominator.norm() <= floor {
             return Err(FrfError::Singular { frequency });
         }
         let eta = Complex::new(force, 0.0) / denominator;
@@ -860,7 +861,7 @@ pub fn settling_time(lin: &Linearization, reduction: f64) -> Result<f64, FrfErro
         .iter()
         .map(|s| s.norm())
         .fold(0.0f64, f64::max);
-    if !(slowest > 1e-10 * largest) {
+    if slowest.is_nan() || slowest <= 1e-10 * largest {
         return Err(FrfError::NoSteadyState {
             slowest_decay_rate: slowest,
         });

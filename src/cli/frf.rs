@@ -181,7 +181,7 @@ pub fn run(args: &FrfArgs) -> Result<(), CliError> {
     let mut evaluation_frequencies = Vec::new();
     for text in &args.frequencies {
         let w = evaluate(text, &format!("--frequency {text}"), &lookup)?;
-        if !(w >= 0.0) {
+        if w < 0.0 {
             return Err(CliError::usage(format!(
                 "--frequency {text}: {w} rad/s is negative"
             )));
