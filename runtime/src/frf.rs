@@ -81,7 +81,7 @@ pub enum FrfError {
     },
     /// Changing `p` leaves `F(q*, 0, 0)` unchanged: its column of `B` would be zero.
     #[error(
-        "input `{input}` does not change the forcing at the equilibrium at t = 0 (its column of B is zero): an input is a load amplitude whose time function is nonzero at t = 0, like `A` in `A*cos(w*t)` (not `B` in `B*sin(w*t)`, nor a stiffness, damping or frequency)"
+        "input `{input}` does not change the forcing at the equilibrium at t = 0 (its column of the input matrix is zero): an input is a load amplitude whose time function is nonzero at t = 0, like `A` in `A*cos(w*t)` (not `B` in `B*sin(w*t)`, nor a stiffness, damping or frequency)"
     )]
     InputNotInForcing {
         /// The parameter.
