@@ -780,6 +780,20 @@ where
                 }
             }
         }
+        // Undamped resonances: |H| → ∞, marked by a thin vertical line.
+        for (i, s) in sweeps.iter().enumerate() {
+            let c = color(i).mix(0.5);
+            for p in &s.peaks {
+                if p.amplitude == PeakAmplitude::Unbounded {
+                    chart
+                        .draw_series(LineSeries::new(
+                            [(p.frequency, a0), (p.frequency, a1)],
+                            c.stroke_width(1),
+                        ))
+                        .map_err(err)?;
+                }
+            }
+        }
         if let Some(points) = simulated {
             let mut first = true;
             for (i, _) in outputs.iter().enumerate() {
