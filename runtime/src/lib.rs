@@ -6,6 +6,7 @@
 #![warn(missing_docs)]
 
 pub mod constrained;
+pub mod frf;
 pub mod integrate;
 pub mod modal;
 pub mod ode;
@@ -13,6 +14,12 @@ pub mod response;
 pub mod system;
 
 pub use constrained::{ConstraintWorkspace, ProjectionError, Stabilization};
+pub use frf::{
+    ForcedLinearization, FrequencySweep, FrfError, HarmonicForcing, ModalResponse, PeakAmplitude,
+    ResonancePeak, SteadyState, SteadyStateOptions, frequency_response, frequency_sweep,
+    linearize_with_inputs, log_frequencies, modal_frequency_response, phase_degrees, settling_time,
+    simulate_steady_state,
+};
 pub use integrate::{
     BogackiShampine32, DormandPrince54, DormandPrince853, Event, EventDirection, EventSpec,
     ExplicitEuler, ExplicitMidpoint, ImplicitMidpoint, IntegrationError, IntegrationFailure,

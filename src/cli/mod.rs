@@ -4,6 +4,7 @@ mod check;
 mod equations;
 mod events;
 mod free_response;
+mod frf;
 mod modal_damping;
 mod mode_plot;
 mod modes;
@@ -44,6 +45,9 @@ enum Command {
     /// Equilibrium, exact linearisation (M, C, K), natural frequencies, mode shapes and
     /// damping ratios at an operating point (`--at hanging`).
     Modes(modes::ModesArgs),
+    /// Frequency response from a load parameter to coordinates: Bode chart, resonance peaks,
+    /// modal contributions (`--modal`), points checked by simulation (`--simulate K`).
+    Frf(frf::FrfArgs),
     /// Print a generated model file: `n-link-pendulum N` or `n-mass-chain N`.
     New(equations::NewArgs),
     /// Numerical experiments comparing methods: `constraint-methods MODEL`,
@@ -86,6 +90,7 @@ pub fn run() -> ExitCode {
         Command::Equations(args) => equations::run(&args),
         Command::New(args) => equations::new(&args),
         Command::Modes(args) => modes::run(&args),
+        Command::Frf(args) => frf::run(&args),
         Command::Study(study) => study::run(&study),
     };
     match result {
