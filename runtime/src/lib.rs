@@ -6,12 +6,17 @@
 #![warn(missing_docs)]
 
 pub mod constrained;
+pub mod floquet;
 pub mod integrate;
 pub mod modal;
 pub mod ode;
 pub mod system;
 
 pub use constrained::{ConstraintWorkspace, ProjectionError, Stabilization};
+pub use floquet::{
+    FloquetAnalysis, FloquetError, FloquetOptions, FloquetStability, check_periodic_equilibrium,
+    floquet_analysis, floquet_multipliers, monodromy_matrix,
+};
 pub use integrate::{
     BogackiShampine32, DormandPrince54, DormandPrince853, Event, EventDirection, EventSpec,
     ExplicitEuler, ExplicitMidpoint, ImplicitMidpoint, IntegrationError, IntegrationFailure,

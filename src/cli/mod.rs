@@ -3,6 +3,7 @@
 mod check;
 mod equations;
 mod events;
+mod floquet;
 mod modes;
 mod plot;
 mod roundoff;

@@ -33,6 +33,9 @@ pub enum Study {
     /// HW1: explicit Euler on ẋ = x with h = 10⁻ⁿ, truncation against roundoff error and
     /// the optimal n.
     EulerRoundoff(super::roundoff::EulerRoundoffArgs),
+    /// Floquet multipliers of a time-periodic model about an equilibrium (the Mathieu
+    /// inverted pendulum), and its stability chart over two parameters (`--sweep`).
+    Floquet(super::floquet::FloquetArgs),
 }
 
 /// Options of `eomgen study constraint-methods`.
@@ -64,6 +67,7 @@ pub fn run(study: &Study) -> Result<(), CliError> {
         Study::WorkPrecision(args) => super::work_precision::run(args),
         Study::Stability(args) => super::stability::run(args),
         Study::EulerRoundoff(args) => super::roundoff::run(args),
+        Study::Floquet(args) => super::floquet::run(args),
     }
 }
 
