@@ -382,6 +382,8 @@ pub fn monodromy_matrix(
         return Err(FloquetError::JacobianUnavailable);
     }
     let solution = result?;
+    // A successful integration samples every requested time, so `t_end` is there; were it
+    // missing, the integration did not reach it.
     let Some((_, end)) = solution.last() else {
         return Err(FloquetError::IntegrationFailed {
             t: Some(t0),

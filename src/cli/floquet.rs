@@ -95,10 +95,10 @@ pub fn run(args: &FloquetArgs) -> Result<(), CliError> {
             model.parameter_names().join(", ")
         )));
     }
-    let positive = |x: f64| x.is_finite() && x > 0.0;
-    if !positive(args.tol)
-        || !(args.stability_tolerance.is_finite() && args.stability_tolerance >= 0.0)
-    {
+    let valid_tol = args.tol.is_finite() && args.tol > 0.0;
+    let valid_stability_tolerance =
+        args.stability_tolerance.is_finite() && args.stability_tolerance >= 0.0;
+    if !(valid_tol && valid_stability_tolerance) {
         return Err(CliError::usage(
             "--tol must be positive and --stability-tolerance finite and >= 0",
         ));
@@ -777,6 +777,9 @@ where
     Ok(())
 }
 
+/// A labelled, coloured polyline of the chart.
+type Curve = (String, RGBColor, Vec<(f64, f64)>);
+
 /// Upright: Kapitza's boundary `a w = √(2 g l)` and the series edges `δ = a₀(q)`,
 /// `δ = b₁(q)` of the Mathieu chart (`q = 2a/l`, `δ = −4g/(l w²)`, so `w = √(−4g/(l δ))`
 /// where `δ < 0`); hanging: the edges `δ = b₁(q)`, `δ = a₁(q)` of the first resonance tongue
@@ -788,7 +791,7 @@ fn reference_curves(
     y: &Axis,
     (x0, x1): (f64, f64),
     (y0, y1): (f64, f64),
-) -> Vec<(String, RGBColor, Vec<(f64, f64)>)> {
+) -> Vec<Curve> {
     let a_on_x = match (x.name.as_str(), y.name.as_str()) {
         ("a", "w") => true,
         ("w", "a") => false,
@@ -830,7 +833,7 @@ fn reference_curves(
     vec![
         (
             "Kapitza a w = √(2 g l)".to_string(),
-            BLACK.into(),
+            BLACK,
             along(&|a| Some(k.critical_a_w() / a)),
         ),
         (
