@@ -1,14 +1,8 @@
 //! The `eomgen` binary end to end: `list --json`, `simulate --json` output contract, dense
 //! output at requested times, expressions in options, and clear usage errors.
 
-use std::process::Command;
-
-fn eomgen(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_eomgen"))
-        .args(args)
-        .output()
-        .expect("binary runs")
-}
+mod common;
+use common::eomgen;
 
 #[test]
 fn list_json_names_every_model() {

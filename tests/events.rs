@@ -2,19 +2,13 @@
 //! (exact elliptic integral), HW21's damped period and logarithmic decrement from successive
 //! peaks, HW36's lift-off where the normal force reaches zero, and `--stop-when`/`--event`.
 
-use std::process::Command;
+mod common;
+use common::eomgen;
 
 use eomgen::{
     DormandPrince853, EventDirection, Integrator, IntegratorOptions, ModelInfo, OutputTimes,
     RadauIIA5, Solution,
 };
-
-fn eomgen(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_eomgen"))
-        .args(args)
-        .output()
-        .expect("binary runs")
-}
 
 fn model(name: &str) -> Box<dyn ModelInfo> {
     (eomgen::models::find(name).expect("bundled model").make)()

@@ -2,7 +2,8 @@
 //! parameter, the frequency response against closed forms and against simulations of the
 //! full model, modal forcing against the direct solve, and `eomgen frf`.
 
-use std::process::Command;
+mod common;
+use common::eomgen;
 
 use eomgen::{
     FrfError, HarmonicForcing, MechanicalSystem, ModelInfo, PeakAmplitude, SteadyStateOptions,
@@ -344,13 +345,6 @@ fn simulated_steady_state_matches_frf_hw37_damping() {
         1e-3,
         &[0.3, 0.7620582161, 1.0, 1.4095590611, 1.8761065400, 4.0],
     );
-}
-
-fn eomgen(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_eomgen"))
-        .args(args)
-        .output()
-        .expect("binary runs")
 }
 
 /// `eomgen frf --json`: the documented keys, the peak at the closed-form frequency, the

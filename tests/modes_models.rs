@@ -9,8 +9,10 @@
 //! largest frequency) covers every model here. Zero-frequency modes are those with
 //! `|ω²| ≤ 1e-9 max |ω²|` (the library's rule); the exact ones come out at ~1e-16.
 
+mod common;
+use common::eomgen;
+
 use std::f64::consts::PI;
-use std::process::Command;
 
 use eomgen::models::DoublePendulumPoints;
 use eomgen::{
@@ -741,13 +743,6 @@ fn double_pendulum_points_mode_gives_synchronous_motion() {
     }
     let (off_mode, _) = run(0.01, 0.0);
     assert!(off_mode > 0.5, "off the mode: shape error {off_mode}");
-}
-
-fn eomgen(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_eomgen"))
-        .args(args)
-        .output()
-        .expect("binary runs")
 }
 
 /// `eomgen modes MODEL --plot PREFIX` writes one valid SVG per mode: for every one of the

@@ -5,8 +5,10 @@
 //! Every tolerance is stated next to its assertion with the reason for its size. The heavy
 //! variants are `#[ignore]`d: `cargo test --release --test stability -- --ignored`.
 
+mod common;
+use common::eomgen;
+
 use std::f64::consts::E;
-use std::process::Command;
 
 use eomgen::integrate::stability::{
     GrowthTest, StabilityPolynomial, TestEquation, amplification, explicit_tableau_methods,
@@ -17,13 +19,6 @@ use eomgen::{
     IntegratorOptions, OutputTimes, RadauIIA5, StormerVerlet, SymplecticEuler, Tableau,
 };
 use nalgebra::Complex;
-
-fn eomgen(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_eomgen"))
-        .args(args)
-        .output()
-        .expect("binary runs")
-}
 
 /// The growth test of the limit measurements: 2000 steps and a threshold of 10⁴ detect a
 /// per-step growth of 4.6e-3. One percent above each limit tested here the growth is at least

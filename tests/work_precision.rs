@@ -6,16 +6,10 @@
 //! settings and `--repeats 1 --min-time-ms 0`, so the file stays fast in the debug profile.
 //! No assertion involves a wall time.
 
-use std::process::Command;
+mod common;
+use common::eomgen;
 
 use serde_json::Value;
-
-fn eomgen(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_eomgen"))
-        .args(args)
-        .output()
-        .expect("binary runs")
-}
 
 /// Runs the study with the fastest timing (one run per setting); it must succeed.
 fn study(args: &[&str]) -> std::process::Output {

@@ -6,6 +6,7 @@
 #![warn(missing_docs)]
 
 pub mod constrained;
+pub mod floquet;
 pub mod frf;
 pub mod integrate;
 pub mod modal;
@@ -14,6 +15,10 @@ pub mod response;
 pub mod system;
 
 pub use constrained::{ConstraintWorkspace, ProjectionError, Stabilization};
+pub use floquet::{
+    FloquetAnalysis, FloquetError, FloquetOptions, FloquetStability, check_periodic_equilibrium,
+    floquet_analysis, floquet_multipliers, monodromy_matrix,
+};
 pub use frf::{
     ForcedLinearization, FrequencySweep, FrfError, HarmonicForcing, ModalResponse, PeakAmplitude,
     ResonancePeak, SteadyState, SteadyStateOptions, frequency_response, frequency_sweep,

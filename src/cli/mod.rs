@@ -3,6 +3,7 @@
 mod check;
 mod equations;
 mod events;
+mod floquet;
 mod free_response;
 mod frf;
 mod modal_damping;

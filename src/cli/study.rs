@@ -39,6 +39,9 @@ pub enum Study {
     /// HW34: damping ratios exact (eigenvalues of A) vs the diagonal of Ĉ = ΨᵀCΨ vs Rayleigh
     /// damping fitted to two modes, and the free responses from each mode shape.
     ModalDamping(super::modal_damping::ModalDampingArgs),
+    /// Floquet multipliers of a time-periodic model about an equilibrium (the Mathieu
+    /// inverted pendulum), and its stability chart over two parameters (`--sweep`).
+    Floquet(super::floquet::FloquetArgs),
 }
 
 /// Options of `eomgen study constraint-methods`.
@@ -72,6 +75,7 @@ pub fn run(study: &Study) -> Result<(), CliError> {
         Study::EulerRoundoff(args) => super::roundoff::run(args),
         Study::FreeResponse(args) => super::free_response::run(args),
         Study::ModalDamping(args) => super::modal_damping::run(args),
+        Study::Floquet(args) => super::floquet::run(args),
     }
 }
 

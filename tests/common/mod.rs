@@ -1,4 +1,5 @@
-//! Helpers shared by the end-to-end tests.
+//! Helpers shared by the end-to-end tests (each test file uses some of them).
+#![allow(dead_code)]
 
 /// Deterministic xorshift64 generator, so every run checks the same states.
 pub struct Rng(pub u64);
@@ -11,4 +12,12 @@ impl Rng {
         self.0 ^= self.0 << 17;
         lo + (hi - lo) * ((self.0 >> 11) as f64 / (1u64 << 53) as f64)
     }
+}
+
+/// Runs the `eomgen` binary built for the tests with `args`.
+pub fn eomgen(args: &[&str]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_eomgen"))
+        .args(args)
+        .output()
+        .expect("binary runs")
 }

@@ -1,0 +1,879 @@
+//! `eomgen study floquet MODEL`: Floquet multipliers of a time-periodic model about an
+//! equilibrium, and its stability chart over two parameters (issue 7, item 7; lectures 19 and
+//! 21, the Mathieu inverted pendulum).
+//!
+//! The period is `T = 2π/w` with `w` the value of `--period-parameter`; the operating point
+//! is the model's named equilibrium (Newton at `t = 0`), which must stay an equilibrium for
+//! every `t` of the period (`F(q*, 0, t) = 0`, checked at 65 times). The monodromy matrix
+//! comes from the variational equations with the generated Jacobians
+//! ([`eomgen::floquet_analysis`]). `--sweep a=LO..HI:N,w=LO..HI:N` repeats the analysis on a
+//! grid, in parallel (rayon), and charts stable against unstable cells, coloured by the
+//! spectral radius. For a pendulum model (parameters `g`, `l`, `a`, `w`, pivot moving as
+//! `a cos(w t)`, like `mathieu_pendulum`) swept over `a` and `w`, the reference curves are
+//! drawn on it: at the equilibrium named `upright`, Kapitza's boundary `a w = √(2 g l)` and the
+//! series edges `a₀(q)`, `b₁(q)` of the Mathieu chart (Abramowitz & Stegun 20.2.25,
+//! `q = 2a/l`, `δ = −4g/(l w²)`); at `hanging`, the edges `b₁(q)`, `a₁(q)` of the first
+//! parametric-resonance tongue (`δ = 4g/(l w²)`).
+
+use std::f64::consts::TAU;
+use std::io::Write as _;
+
+use clap::Args;
+use eomgen::{
+    FloquetAnalysis, FloquetOptions, FloquetStability, ModelInfo, check_periodic_equilibrium,
+    find_equilibrium, floquet_analysis,
+};
+use plotters::prelude::*;
+use rayon::prelude::*;
+use serde_json::{Value, json};
+
+use super::modes::operating_point;
+use super::plot::{register_font, tick};
+use super::values::{evaluate, parameter_lookup, set_parameters, split_assignment};
+use super::{CliError, find_model};
+
+/// Options of `eomgen study floquet`.
+#[derive(Debug, Args)]
+pub struct FloquetArgs {
+    /// A model whose forcing has period 2π/w (`mathieu_pendulum`).
+    pub model: String,
+    /// Operating point: a name from the model's `equilibria:` (`upright`, `hanging`), or
+    /// guesses `q1=VALUE,…` (others 0). Default: the model's first equilibrium, else q = 0.
+    #[arg(long)]
+    pub at: Option<String>,
+    /// The parameter that is the forcing frequency w (rad/s); the period is T = 2π/w.
+    #[arg(long, default_value = "w")]
+    pub period_parameter: String,
+    /// Set a parameter, `NAME=VALUE`; repeatable.
+    #[arg(long = "set", value_name = "NAME=VALUE")]
+    pub set: Vec<String>,
+    /// Stability chart over two parameters, `X=LO..HI:N,Y=LO..HI:N` (N values each, ends
+    /// included; `a=0..0.3:61,w=10..100:61`): the x axis first.
+    #[arg(long, value_name = "X=LO..HI:N,Y=LO..HI:N")]
+    pub sweep: Option<String>,
+    /// Tolerance on |μ| = 1: stable means every |μ| ≤ 1 + tol (marginal when within tol of 1).
+    #[arg(long, default_value_t = 1e-6)]
+    pub stability_tolerance: f64,
+    /// Relative and absolute tolerance of DOP853 on the state and the variational equations.
+    #[arg(long, default_value_t = 1e-12)]
+    pub tol: f64,
+    /// Print JSON.
+    #[arg(long)]
+    pub json: bool,
+    /// Chart (.svg or .png): with --sweep the stability chart, else the multipliers in the
+    /// complex plane with the unit circle.
+    #[arg(long, value_name = "FILE")]
+    pub plot: Option<String>,
+}
+
+/// One swept parameter: `name=LO..HI:N`.
+#[derive(Debug, Clone)]
+struct Axis {
+    name: String,
+    values: Vec<f64>,
+}
+
+/// The analysis at one parameter set: the equilibrium and its Floquet multipliers.
+struct Point {
+    q: Vec<f64>,
+    frequency: f64,
+    residual: f64,
+    floquet: FloquetAnalysis,
+}
+
+/// Runs `study floquet`.
+pub fn run(args: &FloquetArgs) -> Result<(), CliError> {
+    let mut model = find_model(&args.model)?;
+    set_parameters(model.as_mut(), &args.set)?;
+    if !model
+        .parameter_names()
+        .contains(&args.period_parameter.as_str())
+    {
+        return Err(CliError::usage(format!(
+            "--period-parameter {}: `{}` has no parameter `{}` (it has: {}); name the forcing frequency w (rad/s), T = 2π/w",
+            args.period_parameter,
+            model.name(),
+            args.period_parameter,
+            model.parameter_names().join(", ")
+        )));
+    }
+    let valid_tol = args.tol.is_finite() && args.tol > 0.0;
+    let valid_stability_tolerance =
+        args.stability_tolerance.is_finite() && args.stability_tolerance >= 0.0;
+    if !(valid_tol && valid_stability_tolerance) {
+        return Err(CliError::usage(
+            "--tol must be positive and --stability-tolerance finite and >= 0",
+        ));
+    }
+    let (label, guess) = operating_point(model.as_ref(), args.at.as_deref())?;
+    let options = FloquetOptions {
+        rtol: args.tol,
+        atol: args.tol,
+        stability_tolerance: args.stability_tolerance,
+        ..FloquetOptions::default()
+    };
+    let axes = args
+        .sweep
+        .as_deref()
+        .map(|s| parse_sweep(s, model.as_ref()))
+        .transpose()?;
+    let point = analyse(model.as_mut(), &guess, &args.period_parameter, &options)
+        .map_err(|e| CliError::failure(format!("`{}` at {label}: {e}", model.name())))?;
+    let sweep = match &axes {
+        Some((x, y)) => Some(run_sweep(args, &guess, x, y, &options)?),
+        None => None,
+    };
+    let reference = kapitza(model.as_ref(), &label);
+
+    if let Some(path) = &args.plot {
+        match (&axes, &sweep) {
+            (Some((x, y)), Some(grid)) => {
+                let title = format!(
+                    "{} at {label}: Floquet stability over {} and {}",
+                    model.name(),
+                    x.name,
+                    y.name
+                );
+                let labels = [
+                    axis_label(&x.name, &args.period_parameter, reference.is_some()),
+                    axis_label(&y.name, &args.period_parameter, reference.is_some()),
+                ];
+                stability_chart(path, &title, [x, y], &labels, grid, reference.as_ref())
+            }
+            _ => {
+                let title = format!("{} at {label}: Floquet multipliers", model.name());
+                multiplier_chart(path, &title, &point.floquet)
+            }
+        }
+        .map_err(CliError::failure)?;
+    }
+
+    let names = model.coordinate_names();
+    let mut stdout = std::io::stdout().lock();
+    if args.json {
+        let complex =
+            |c: &nalgebra::Complex<f64>| json!({"re": c.re, "im": c.im, "modulus": c.norm()});
+        let f = &point.floquet;
+        let monodromy: Vec<Vec<f64>> = (0..f.monodromy_matrix.nrows())
+            .map(|i| f.monodromy_matrix.row(i).iter().copied().collect())
+            .collect();
+        let mut out = json!({
+            "model": model.name(),
+            "coordinates": names,
+            "operating_point": {
+                "name": label,
+                "q": names.iter().zip(&point.q).map(|(c, v)| (c.to_string(), json!(v))).collect::<serde_json::Map<_, _>>(),
+                "max_forcing_residual": point.residual,
+            },
+            "period_parameter": args.period_parameter,
+            "frequency": point.frequency,
+            "period": f.period,
+            "monodromy_matrix": monodromy,
+            "multipliers": f.multipliers.iter().map(complex).collect::<Vec<_>>(),
+            "exponents": f.exponents.iter().map(|c| json!({"re": c.re, "im": c.im})).collect::<Vec<_>>(),
+            "spectral_radius": f.spectral_radius,
+            "determinant": f.determinant,
+            "stability": f.stability.as_str(),
+            "stable": f.stability.is_stable(),
+            "stability_tolerance": args.stability_tolerance,
+            "closure_error": f.closure_error,
+            "integration": {"method": "dop853", "tol": args.tol, "steps": f.stats.steps, "rhs_evals": f.stats.rhs_evals},
+        });
+        if let Some(k) = reference.as_ref().filter(|k| !k.hanging) {
+            out["kapitza"] = json!({
+                "a_w": k.a * k.w,
+                "critical_a_w": k.critical_a_w(),
+                "predicts_stable_upright": k.a * k.w > k.critical_a_w(),
+            });
+        }
+        if let (Some((x, y)), Some(grid)) = (&axes, &sweep) {
+            out["sweep"] = sweep_json(x, y, grid);
+        }
+        let text =
+            serde_json::to_string_pretty(&out).map_err(|e| CliError::failure(e.to_string()))?;
+        let _ = writeln!(stdout, "{text}");
+        return Ok(());
+    }
+    let f = &point.floquet;
+    let q: Vec<String> = names
+        .iter()
+        .zip(&point.q)
+        .map(|(c, v)| format!("{c} = {v:.12e}"))
+        .collect();
+    let _ = writeln!(
+        stdout,
+        "model        {} ({} dof)",
+        model.name(),
+        names.len()
+    );
+    let _ = writeln!(
+        stdout,
+        "equilibrium  {label}: {} (for all t: max |F(q, 0, t)| = {:.1e})",
+        q.join(", "),
+        point.residual
+    );
+    let _ = writeln!(
+        stdout,
+        "period       T = 2π/{} = {:.12e} s ({} = {} rad/s); DOP853 at tol {:e}: {} steps, {} RHS evaluations",
+        args.period_parameter,
+        f.period,
+        args.period_parameter,
+        point.frequency,
+        args.tol,
+        f.stats.steps,
+        f.stats.rhs_evals
+    );
+    let _ = writeln!(
+        stdout,
+        "{:>3}  {:>22}  {:>22}  {:>16}  {:>16}  {:>16}",
+        "k", "Re μ", "Im μ", "|μ|", "Re ln(μ)/T (1/s)", "Im ln(μ)/T"
+    );
+    for (k, (m, e)) in f.multipliers.iter().zip(&f.exponents).enumerate() {
+        let _ = writeln!(
+            stdout,
+            "{:>3}  {:>22.14e}  {:>22.14e}  {:>16.10e}  {:>16.8e}  {:>16.8e}",
+            k + 1,
+            m.re,
+            m.im,
+            m.norm(),
+            e.re,
+            e.im
+        );
+    }
+    let _ = writeln!(
+        stdout,
+        "result       spectral radius ρ = {:.12e}, det Φ(T) = {:.12e}: {} (tolerance {:e} on |μ| = 1)",
+        f.spectral_radius,
+        f.determinant,
+        f.stability.as_str().replace('_', " "),
+        args.stability_tolerance
+    );
+    if let Some(k) = reference.as_ref().filter(|k| !k.hanging) {
+        let _ = writeln!(
+            stdout,
+            "kapitza      a w = {:.6e} against √(2 g l) = {:.6e}: averaging predicts upright {} (for a ≪ l)",
+            k.a * k.w,
+            k.critical_a_w(),
+            if k.a * k.w > k.critical_a_w() {
+                "stable"
+            } else {
+                "unstable"
+            }
+        );
+    }
+    if let (Some((x, y)), Some(grid)) = (&axes, &sweep) {
+        print_map(&mut stdout, x, y, grid);
+    }
+    Ok(())
+}
+
+/// Equilibrium at `t = 0` from `guess`, the check that it stays one over the period, and the
+/// Floquet analysis there.
+fn analyse(
+    model: &mut dyn ModelInfo,
+    guess: &[f64],
+    period_parameter: &str,
+    options: &FloquetOptions,
+) -> Result<Point, String> {
+    let index = model
+        .parameter_names()
+        .iter()
+        .position(|p| *p == period_parameter)
+        .ok_or_else(|| format!("no parameter `{period_parameter}`"))?;
+    let frequency = model.parameter_values()[index];
+    if !(frequency.is_finite() && frequency > 0.0) {
+        return Err(format!(
+            "the forcing frequency {period_parameter} = {frequency} must be positive (T = 2π/{period_parameter})"
+        ));
+    }
+    let period = TAU / frequency;
+    let equilibrium = find_equilibrium(model, guess, 0.0).map_err(|e| e.to_string())?;
+    let residual = check_periodic_equilibrium(model, &equilibrium.q, 0.0, period)
+        .map_err(|e| e.to_string())?;
+    let n = model.num_dofs();
+    let y0: Vec<f64> = equilibrium
+        .q
+        .iter()
+        .copied()
+        .chain(std::iter::repeat_n(0.0, n))
+        .collect();
+    let floquet = floquet_analysis(model.as_ode_mut(), &y0, 0.0, period, options)
+        .map_err(|e| e.to_string())?;
+    Ok(Point {
+        q: equilibrium.q,
+        frequency,
+        residual,
+        floquet,
+    })
+}
+
+/// One grid cell's outcome: `(spectral radius, stability)` or the failure.
+type Cell = Result<(f64, FloquetStability), String>;
+
+/// The analyses on the grid `x × y`, in parallel; `cells[i][j]` at `(x[i], y[j])`.
+fn run_sweep(
+    args: &FloquetArgs,
+    guess: &[f64],
+    x: &Axis,
+    y: &Axis,
+    options: &FloquetOptions,
+) -> Result<Vec<Vec<Cell>>, CliError> {
+    let entry = eomgen::models::find(&args.model)
+        .ok_or_else(|| CliError::usage(format!("no model named `{}`", args.model)))?;
+    let total = x.values.len() * y.values.len();
+    let bar = indicatif::ProgressBar::new(total as u64);
+    if let Ok(style) = indicatif::ProgressStyle::with_template(
+        "{msg} [{bar:40}] {pos}/{len} analyses, {elapsed} (eta {eta})",
+    ) {
+        bar.set_style(style.progress_chars("=> "));
+    }
+    bar.set_message("floquet");
+    let flat: Vec<Cell> = (0..total)
+        .into_par_iter()
+        .map(|k| {
+            let (i, j) = (k / y.values.len(), k % y.values.len());
+            let mut model = (entry.make)();
+            let cell = (|| {
+                set_parameters(model.as_mut(), &args.set).map_err(|e| e.message)?;
+                for (axis, value) in [(x, x.values[i]), (y, y.values[j])] {
+                    model
+                        .set_parameter(&axis.name, value)
+                        .map_err(|e| e.to_string())?;
+                }
+                let p = analyse(model.as_mut(), guess, &args.period_parameter, options)?;
+                Ok((p.floquet.spectral_radius, p.floquet.stability))
+            })();
+            bar.inc(1);
+            cell
+        })
+        .collect();
+    bar.finish_and_clear();
+    Ok(flat.chunks(y.values.len()).map(<[Cell]>::to_vec).collect())
+}
+
+fn sweep_json(x: &Axis, y: &Axis, grid: &[Vec<Cell>]) -> Value {
+    let rho: Vec<Vec<Value>> = grid
+        .iter()
+        .map(|col| {
+            col.iter()
+                .map(|c| c.as_ref().map_or(Value::Null, |(r, _)| json!(r)))
+                .collect()
+        })
+        .collect();
+    let stability: Vec<Vec<Value>> = grid
+        .iter()
+        .map(|col| {
+            col.iter()
+                .map(|c| c.as_ref().map_or(Value::Null, |(_, s)| json!(s.as_str())))
+                .collect()
+        })
+        .collect();
+    let mut failures = Vec::new();
+    for (i, col) in grid.iter().enumerate() {
+        for (j, c) in col.iter().enumerate() {
+            if let Err(e) = c {
+                failures.push(
+                    json!({x.name.as_str(): x.values[i], y.name.as_str(): y.values[j], "error": e}),
+                );
+            }
+        }
+    }
+    let stable = grid
+        .iter()
+        .flatten()
+        .filter(|c| matches!(c, Ok((_, s)) if s.is_stable()))
+        .count();
+    json!({
+        "x": {"name": x.name, "values": x.values},
+        "y": {"name": y.name, "values": y.values},
+        "layout": "spectral_radius[i][j] and stability[i][j] at (x[i], y[j]); null where the analysis failed",
+        "spectral_radius": rho,
+        "stability": stability,
+        "stable_points": stable,
+        "failures": failures,
+    })
+}
+
+/// The sweep as characters, y descending: `·` stable, `#` unstable, `?` failed.
+fn print_map(out: &mut impl std::io::Write, x: &Axis, y: &Axis, grid: &[Vec<Cell>]) {
+    let stable = grid
+        .iter()
+        .flatten()
+        .filter(|c| matches!(c, Ok((_, s)) if s.is_stable()))
+        .count();
+    let failed = grid.iter().flatten().filter(|c| c.is_err()).count();
+    let _ = writeln!(
+        out,
+        "sweep        {} × {} points: {stable} stable, {failed} failed ('·' stable, '#' unstable, '?' failed; {} across, {} up)",
+        x.values.len(),
+        y.values.len(),
+        x.name,
+        y.name
+    );
+    if x.values.len() > 120 {
+        return;
+    }
+    for j in (0..y.values.len()).rev() {
+        let row: String = grid
+            .iter()
+            .map(|col| match &col[j] {
+                Ok((_, s)) if s.is_stable() => '·',
+                Ok(_) => '#',
+                Err(_) => '?',
+            })
+            .collect();
+        let _ = writeln!(out, "{:>12.4e} {row}", y.values[j]);
+    }
+    let _ = writeln!(
+        out,
+        "{:>12} {} = {:.4e} … {:.4e}",
+        "",
+        x.name,
+        x.values.first().copied().unwrap_or(f64::NAN),
+        x.values.last().copied().unwrap_or(f64::NAN)
+    );
+}
+
+/// `X=LO..HI:N,Y=LO..HI:N`.
+fn parse_sweep(spec: &str, model: &dyn ModelInfo) -> Result<(Axis, Axis), CliError> {
+    let lookup = parameter_lookup(model);
+    let mut axes = Vec::new();
+    for part in spec.split(',') {
+        let (name, rest) = split_assignment(part, "--sweep")?;
+        if !model.parameter_names().contains(&name) {
+            return Err(CliError::usage(format!(
+                "--sweep: `{}` has no parameter `{name}` (it has: {})",
+                model.name(),
+                model.parameter_names().join(", ")
+            )));
+        }
+        let bad = || {
+            CliError::usage(format!(
+                "--sweep: `{part}` is not NAME=LO..HI:N (for example `a=0..0.3:31`)"
+            ))
+        };
+        let (range, count) = rest.rsplit_once(':').ok_or_else(bad)?;
+        let (lo, hi) = range.split_once("..").ok_or_else(bad)?;
+        let lo = evaluate(lo.trim(), &format!("--sweep {name}"), &lookup)?;
+        let hi = evaluate(hi.trim(), &format!("--sweep {name}"), &lookup)?;
+        let count: usize = count.trim().parse().map_err(|_| bad())?;
+        if !(1..=10_000).contains(&count) || (count > 1 && hi <= lo) {
+            return Err(CliError::usage(format!(
+                "--sweep {name}: need 1 ≤ N ≤ 10000 values and LO < HI, got `{rest}`"
+            )));
+        }
+        let values = if count == 1 {
+            vec![lo]
+        } else {
+            (0..count)
+                .map(|k| lo + (hi - lo) * k as f64 / (count - 1) as f64)
+                .collect()
+        };
+        axes.push(Axis {
+            name: name.to_string(),
+            values,
+        });
+    }
+    match <[Axis; 2]>::try_from(axes) {
+        Ok([x, y]) if x.name != y.name => Ok((x, y)),
+        _ => Err(CliError::usage(
+            "--sweep takes two different parameters, `X=LO..HI:N,Y=LO..HI:N` (for example `a=0..0.3:31,w=10..100:31`)",
+        )),
+    }
+}
+
+/// The reference results for a pendulum of length `l` under gravity `g` whose pivot moves as
+/// `a cos(w t)` (the parameters `g`, `l`, `a`, `w` of the model), at the equilibrium named
+/// `upright` (Kapitza's averaging, the band `a₀(q) < δ < b₁(q)` of the Mathieu chart with
+/// `δ = −4g/(l w²)`) or `hanging` (the first parametric-resonance tongue
+/// `b₁(q) < δ < a₁(q)` with `δ = 4g/(l w²)`); `q = 2a/l`.
+struct Kapitza {
+    g: f64,
+    l: f64,
+    a: f64,
+    w: f64,
+    hanging: bool,
+}
+
+impl Kapitza {
+    /// `√(2 g l)`: upright is stable for `a w` above it (a ≪ l).
+    fn critical_a_w(&self) -> f64 {
+        (2.0 * self.g * self.l).sqrt()
+    }
+}
+
+fn kapitza(model: &dyn ModelInfo, equilibrium: &str) -> Option<Kapitza> {
+    let hanging = match equilibrium {
+        "upright" => false,
+        "hanging" => true,
+        _ => return None,
+    };
+    let lookup = parameter_lookup(model);
+    let (g, l, a, w) = (lookup("g")?, lookup("l")?, lookup("a")?, lookup("w")?);
+    (g > 0.0 && l > 0.0).then_some(Kapitza {
+        g,
+        l,
+        a,
+        w,
+        hanging,
+    })
+}
+
+/// `a₀(q)` and `b₁(q)` of Mathieu's equation `y'' + (δ − 2q cos 2τ) y = 0` by their power
+/// series (Abramowitz & Stegun 20.2.25), the lower and upper edges of the stable band that
+/// contains the upright pendulum at small `q`.
+fn mathieu_a0(q: f64) -> f64 {
+    let q2 = q * q;
+    -q2 / 2.0 + 7.0 * q2 * q2 / 128.0 - 29.0 * q2 * q2 * q2 / 2304.0
+        + 68_687.0 * q2.powi(4) / 18_874_368.0
+}
+
+fn mathieu_a1(q: f64) -> f64 {
+    1.0 + q - q * q / 8.0 - q.powi(3) / 64.0 - q.powi(4) / 1536.0 + 11.0 * q.powi(5) / 36_864.0
+}
+
+fn mathieu_b1(q: f64) -> f64 {
+    1.0 - q - q * q / 8.0 + q.powi(3) / 64.0 - q.powi(4) / 1536.0 - 11.0 * q.powi(5) / 36_864.0
+}
+
+/// The stability chart: one rectangle per grid point, stable cells blue (lighter for
+/// marginal), unstable ones yellow to red with `log₁₀ ρ`, failed ones grey; Kapitza's
+/// boundary and the `a₀`, `b₁` series curves where they apply.
+fn stability_chart(
+    path: &str,
+    title: &str,
+    axes: [&Axis; 2],
+    labels: &[String; 2],
+    grid: &[Vec<Cell>],
+    reference: Option<&Kapitza>,
+) -> Result<(), String> {
+    register_font()?;
+    let size = (960, 720);
+    if path.ends_with(".svg") {
+        let root = SVGBackend::new(path, size).into_drawing_area();
+        draw_stability(root, title, axes, labels, grid, reference)
+    } else if path.ends_with(".png") {
+        let root = BitMapBackend::new(path, size).into_drawing_area();
+        draw_stability(root, title, axes, labels, grid, reference)
+    } else {
+        Err(format!("`{path}`: a chart file must end in .svg or .png"))
+    }
+}
+
+/// An axis label with the unit where it is known: the period parameter is a frequency in
+/// rad/s; with Kapitza's reference (a pendulum model) `a`, `l` are lengths in m.
+fn axis_label(name: &str, period_parameter: &str, pendulum: bool) -> String {
+    if name == period_parameter {
+        format!("{name} (rad/s)")
+    } else if pendulum && (name == "a" || name == "l") {
+        format!("{name} (m)")
+    } else {
+        name.to_string()
+    }
+}
+
+/// Cell edges: midpoints between neighbouring values, half a spacing beyond the ends.
+fn edges(values: &[f64]) -> Vec<f64> {
+    if values.len() == 1 {
+        let v = values[0];
+        let h = if v == 0.0 { 0.5 } else { 0.1 * v.abs() };
+        return vec![v - h, v + h];
+    }
+    let mut e = Vec::with_capacity(values.len() + 1);
+    e.push(values[0] - 0.5 * (values[1] - values[0]));
+    for w in values.windows(2) {
+        e.push(0.5 * (w[0] + w[1]));
+    }
+    let n = values.len();
+    e.push(values[n - 1] + 0.5 * (values[n - 1] - values[n - 2]));
+    e
+}
+
+fn draw_stability<DB: DrawingBackend>(
+    root: DrawingArea<DB, plotters::coord::Shift>,
+    title: &str,
+    [x, y]: [&Axis; 2],
+    labels: &[String; 2],
+    grid: &[Vec<Cell>],
+    reference: Option<&Kapitza>,
+) -> Result<(), String>
+where
+    DB::ErrorType: 'static,
+{
+    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| format!("plotting failed: {e}");
+    root.fill(&WHITE).map_err(err)?;
+    let (xe, ye) = (edges(&x.values), edges(&y.values));
+    let (x0, x1) = (xe[0], xe[xe.len() - 1]);
+    let (y0, y1) = (ye[0], ye[ye.len() - 1]);
+    let mut chart = ChartBuilder::on(&root)
+        .caption(title, ("sans-serif", 20))
+        .margin(12)
+        .x_label_area_size(45)
+        .y_label_area_size(70)
+        .build_cartesian_2d(x0..x1, y0..y1)
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .disable_mesh()
+        .x_desc(labels[0].as_str())
+        .y_desc(labels[1].as_str())
+        .x_label_formatter(&|v| tick(*v, false))
+        .y_label_formatter(&|v| tick(*v, false))
+        .label_style(("sans-serif", 14))
+        .draw()
+        .map_err(err)?;
+    let log_max = grid
+        .iter()
+        .flatten()
+        .filter_map(|c| c.as_ref().ok())
+        .map(|(r, _)| r.log10())
+        .filter(|v| v.is_finite())
+        .fold(0.0f64, f64::max)
+        .max(1e-3);
+    let stable_color = RGBColor(70, 110, 200);
+    let marginal_color = RGBColor(150, 190, 240);
+    let unstable = |rho: f64| {
+        // Yellow (ρ just above 1) to dark red (the largest ρ on the chart), by log₁₀ ρ.
+        let s = (rho.log10() / log_max).clamp(0.0, 1.0);
+        RGBColor(
+            (250.0 - 90.0 * s) as u8,
+            (220.0 * (1.0 - s)) as u8,
+            (60.0 * (1.0 - s)) as u8,
+        )
+    };
+    let mut cells = |pick: &dyn Fn(&Cell) -> Option<RGBColor>, label: &str, legend: RGBColor| {
+        let rects: Vec<_> = grid
+            .iter()
+            .enumerate()
+            .flat_map(|(i, col)| {
+                col.iter()
+                    .enumerate()
+                    .filter_map(move |(j, c)| pick(c).map(|color| (i, j, color)))
+            })
+            .map(|(i, j, color)| {
+                Rectangle::new([(xe[i], ye[j]), (xe[i + 1], ye[j + 1])], color.filled())
+            })
+            .collect();
+        if rects.is_empty() {
+            return Ok(());
+        }
+        chart
+            .draw_series(rects)
+            .map_err(err)?
+            .label(label)
+            .legend(move |(px, py)| {
+                Rectangle::new([(px, py - 6), (px + 16, py + 6)], legend.filled())
+            });
+        Ok::<(), String>(())
+    };
+    cells(
+        &|c| matches!(c, Ok((_, FloquetStability::AsymptoticallyStable))).then_some(stable_color),
+        "asymptotically stable (ρ < 1)",
+        stable_color,
+    )?;
+    cells(
+        &|c| matches!(c, Ok((_, FloquetStability::Marginal))).then_some(marginal_color),
+        "marginal (|μ| = 1 within tol): stable",
+        marginal_color,
+    )?;
+    cells(
+        &|c| match c {
+            Ok((rho, FloquetStability::Unstable)) => Some(unstable(*rho)),
+            _ => None,
+        },
+        &format!("unstable, yellow→red with log₁₀ ρ up to {log_max:.2}"),
+        unstable(10f64.powf(0.5 * log_max)),
+    )?;
+    cells(
+        &|c| c.is_err().then_some(RGBColor(160, 160, 160)),
+        "analysis failed",
+        RGBColor(160, 160, 160),
+    )?;
+    if let Some(k) = reference {
+        let curves = reference_curves(k, x, y, (x0, x1), (y0, y1));
+        for (label, color, points) in curves {
+            if points.len() < 2 {
+                continue;
+            }
+            chart
+                .draw_series(LineSeries::new(points, color.stroke_width(3)))
+                .map_err(err)?
+                .label(label)
+                .legend(move |(px, py)| {
+                    PathElement::new(vec![(px, py), (px + 16, py)], color.stroke_width(3))
+                });
+        }
+    }
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperMiddle)
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .label_font(("sans-serif", 14))
+        .draw()
+        .map_err(err)?;
+    root.present().map_err(err)?;
+    Ok(())
+}
+
+/// A labelled, coloured polyline of the chart.
+type Curve = (String, RGBColor, Vec<(f64, f64)>);
+
+/// Upright: Kapitza's boundary `a w = √(2 g l)` and the series edges `δ = a₀(q)`,
+/// `δ = b₁(q)` of the Mathieu chart (`q = 2a/l`, `δ = −4g/(l w²)`, so `w = √(−4g/(l δ))`
+/// where `δ < 0`); hanging: the edges `δ = b₁(q)`, `δ = a₁(q)` of the first resonance tongue
+/// (`δ = 4g/(l w²)`). Polylines in the chart's `(x, y)`, when the axes are `a` and `w` in
+/// either order.
+fn reference_curves(
+    k: &Kapitza,
+    x: &Axis,
+    y: &Axis,
+    (x0, x1): (f64, f64),
+    (y0, y1): (f64, f64),
+) -> Vec<Curve> {
+    let a_on_x = match (x.name.as_str(), y.name.as_str()) {
+        ("a", "w") => true,
+        ("w", "a") => false,
+        _ => return Vec::new(),
+    };
+    let (a_lo, a_hi) = if a_on_x { (x0, x1) } else { (y0, y1) };
+    let (w_lo, w_hi) = if a_on_x { (y0, y1) } else { (x0, x1) };
+    let inside = |a: f64, w: f64| a > 0.0 && a >= a_lo && a <= a_hi && w >= w_lo && w <= w_hi;
+    let place = |a: f64, w: f64| if a_on_x { (a, w) } else { (w, a) };
+    let samples = 4000;
+    let along = |f: &dyn Fn(f64) -> Option<f64>| -> Vec<(f64, f64)> {
+        (0..=samples)
+            .filter_map(|i| {
+                let a = a_lo.max(0.0) + (a_hi - a_lo.max(0.0)) * f64::from(i) / f64::from(samples);
+                let w = f(a)?;
+                (w.is_finite() && inside(a, w)).then(|| place(a, w))
+            })
+            .collect()
+    };
+    // w from δ = ∓4g/(l w²): upright needs δ < 0, hanging δ > 0.
+    let sign = if k.hanging { 1.0 } else { -1.0 };
+    let series_w =
+        |delta: f64| (sign * delta > 0.0).then(|| (sign * 4.0 * k.g / (k.l * delta)).sqrt());
+    let q_of = |a: f64| 2.0 * a / k.l;
+    if k.hanging {
+        return vec![
+            (
+                "δ = b₁(q), A&S 20.2.25 series (tongue edge)".to_string(),
+                RGBColor(150, 0, 150),
+                along(&|a| series_w(mathieu_b1(q_of(a)))),
+            ),
+            (
+                "δ = a₁(q), A&S 20.2.25 series (tongue edge)".to_string(),
+                RGBColor(0, 150, 60),
+                along(&|a| series_w(mathieu_a1(q_of(a)))),
+            ),
+        ];
+    }
+    vec![
+        (
+            "Kapitza a w = √(2 g l)".to_string(),
+            BLACK,
+            along(&|a| Some(k.critical_a_w() / a)),
+        ),
+        (
+            "δ = a₀(q), A&S 20.2.25 series (lower edge)".to_string(),
+            RGBColor(0, 150, 60),
+            along(&|a| series_w(mathieu_a0(q_of(a)))),
+        ),
+        (
+            "δ = b₁(q), A&S 20.2.25 series (upper edge)".to_string(),
+            RGBColor(150, 0, 150),
+            along(&|a| {
+                (q_of(a) <= 1.5)
+                    .then(|| series_w(mathieu_b1(q_of(a))))
+                    .flatten()
+            }),
+        ),
+    ]
+}
+
+/// The multipliers in the complex plane, with the unit circle.
+fn multiplier_chart(path: &str, title: &str, floquet: &FloquetAnalysis) -> Result<(), String> {
+    register_font()?;
+    let size = (720, 720);
+    if path.ends_with(".svg") {
+        let root = SVGBackend::new(path, size).into_drawing_area();
+        draw_multipliers(root, title, floquet)
+    } else if path.ends_with(".png") {
+        let root = BitMapBackend::new(path, size).into_drawing_area();
+        draw_multipliers(root, title, floquet)
+    } else {
+        Err(format!("`{path}`: a chart file must end in .svg or .png"))
+    }
+}
+
+fn draw_multipliers<DB: DrawingBackend>(
+    root: DrawingArea<DB, plotters::coord::Shift>,
+    title: &str,
+    floquet: &FloquetAnalysis,
+) -> Result<(), String>
+where
+    DB::ErrorType: 'static,
+{
+    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| format!("plotting failed: {e}");
+    root.fill(&WHITE).map_err(err)?;
+    let r = floquet
+        .multipliers
+        .iter()
+        .map(|m| m.norm())
+        .filter(|v| v.is_finite())
+        .fold(1.0f64, f64::max)
+        * 1.15;
+    let mut chart = ChartBuilder::on(&root)
+        .caption(title, ("sans-serif", 20))
+        .margin(12)
+        .x_label_area_size(45)
+        .y_label_area_size(70)
+        .build_cartesian_2d(-r..r, -r..r)
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .x_desc("Re μ")
+        .y_desc("Im μ")
+        .x_label_formatter(&|v| tick(*v, false))
+        .y_label_formatter(&|v| tick(*v, false))
+        .label_style(("sans-serif", 14))
+        .draw()
+        .map_err(err)?;
+    let circle: Vec<(f64, f64)> = (0..=360)
+        .map(|k| {
+            let phi = TAU * f64::from(k) / 360.0;
+            (phi.cos(), phi.sin())
+        })
+        .collect();
+    chart
+        .draw_series(LineSeries::new(circle, BLACK.stroke_width(2)))
+        .map_err(err)?
+        .label("|μ| = 1")
+        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], BLACK.stroke_width(2)));
+    let color = RGBColor(200, 30, 30);
+    chart
+        .draw_series(
+            floquet
+                .multipliers
+                .iter()
+                .filter(|m| m.re.is_finite() && m.im.is_finite())
+                .map(|m| Circle::new((m.re, m.im), 6, color.filled())),
+        )
+        .map_err(err)?
+        .label(format!(
+            "multipliers μ (ρ = {:.6}, {})",
+            floquet.spectral_radius,
+            floquet.stability.as_str().replace('_', " ")
+        ))
+        .legend(move |(x, y)| Circle::new((x + 8, y), 5, color.filled()));
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .label_font(("sans-serif", 14))
+        .draw()
+        .map_err(err)?;
+    root.present().map_err(err)?;
+    Ok(())
+}

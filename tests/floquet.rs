@@ -1,0 +1,569 @@
+//! Floquet analysis and the Mathieu inverted pendulum (issue 7, item 7; lectures 19 and 21):
+//! the monodromy matrix against `e^{AT}`, Liouville's formula, the analytic multipliers of the
+//! unshaken pendulum, Kapitza's stability region confirmed by nonlinear simulation, the
+//! computed stability boundary against Kapitza and the Mathieu series, and the CLI.
+
+mod common;
+use common::eomgen;
+
+use std::f64::consts::TAU;
+
+use eomgen::{
+    DormandPrince853, FloquetError, FloquetOptions, FloquetStability, Integrator,
+    IntegratorOptions, ModelInfo, OdeSystem, OutputTimes, RhsError, check_periodic_equilibrium,
+    find_equilibrium, floquet_analysis, linearize, matrix_exponential,
+};
+use nalgebra::DMatrix;
+
+fn model(name: &str) -> Box<dyn ModelInfo> {
+    (eomgen::models::find(name).expect("bundled model").make)()
+}
+
+/// `ẏ = A y` with the exact Jacobian `A`.
+struct Linear(DMatrix<f64>);
+
+impl OdeSystem for Linear {
+    fn dim(&self) -> usize {
+        self.0.nrows()
+    }
+    fn rhs(&mut self, _t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), RhsError> {
+        for (i, d) in dy.iter_mut().enumerate() {
+            *d = self.0.row(i).iter().zip(y).map(|(a, b)| a * b).sum();
+        }
+        Ok(())
+    }
+    fn jacobian(&mut self, _t: f64, _y: &[f64], jac: &mut [f64]) -> Result<bool, RhsError> {
+        jac.copy_from_slice(self.0.as_slice());
+        Ok(true)
+    }
+}
+
+/// The damped Mathieu equation `ẍ + 2ζ ẋ + (δ + ε cos t) x = 0`, period 2π, written by hand.
+struct Mathieu {
+    delta: f64,
+    epsilon: f64,
+    zeta: f64,
+}
+
+impl OdeSystem for Mathieu {
+    fn dim(&self) -> usize {
+        2
+    }
+    fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), RhsError> {
+        dy[0] = y[1];
+        dy[1] = -2.0 * self.zeta * y[1] - (self.delta + self.epsilon * t.cos()) * y[0];
+        Ok(())
+    }
+    fn jacobian(&mut self, t: f64, _y: &[f64], jac: &mut [f64]) -> Result<bool, RhsError> {
+        // Column-major [0 1; −(δ + ε cos t) −2ζ].
+        jac.copy_from_slice(&[
+            0.0,
+            -(self.delta + self.epsilon * t.cos()),
+            1.0,
+            -2.0 * self.zeta,
+        ]);
+        Ok(true)
+    }
+}
+
+/// Floquet analysis of `mathieu_pendulum` about `upright` with parameters `set`.
+fn pendulum_floquet(set: &[(&str, f64)]) -> eomgen::FloquetAnalysis {
+    let mut m = model("mathieu_pendulum");
+    for (name, value) in set {
+        m.set_parameter(name, *value).unwrap();
+    }
+    let w = parameter(m.as_ref(), "w");
+    let q = find_equilibrium(m.as_ref(), &[0.0], 0.0).unwrap().q;
+    check_periodic_equilibrium(m.as_ref(), &q, 0.0, TAU / w).unwrap();
+    floquet_analysis(
+        m.as_ode_mut(),
+        &[q[0], 0.0],
+        0.0,
+        TAU / w,
+        &FloquetOptions::default(),
+    )
+    .unwrap()
+}
+
+fn parameter(m: &dyn ModelInfo, name: &str) -> f64 {
+    let i = m.parameter_names().iter().position(|p| *p == name).unwrap();
+    m.parameter_values()[i]
+}
+
+/// For constant coefficients `Φ(T) = e^{AT}`. A hand-written 4 × 4 `A` (a damped, gyroscopic
+/// two-mass system), and the double pendulum's generated Jacobian at `hanging` against
+/// `e^{AT}` from its exact linearisation. Tolerance 1e-10 relative to `‖Φ‖`: DOP853 at 1e-12
+/// over one period leaves a global error of order 1e-11; Padé 13 is exact to rounding.
+#[test]
+fn monodromy_of_a_constant_coefficient_system_is_the_matrix_exponential() {
+    #[rustfmt::skip]
+    let a = DMatrix::from_row_slice(4, 4, &[
+        0.0, 0.0, 1.0, 0.0,
+        0.0, 0.0, 0.0, 1.0,
+        -3.0, 1.0, -0.2, 0.5,
+        1.0, -2.0, -0.5, -0.1,
+    ]);
+    let period = 1.7;
+    let f = floquet_analysis(
+        &mut Linear(a.clone()),
+        &[0.0; 4],
+        0.3,
+        period,
+        &FloquetOptions::default(),
+    )
+    .unwrap();
+    let expected = matrix_exponential(&(&a * period));
+    let err = (&f.monodromy_matrix - &expected).amax() / expected.amax();
+    eprintln!("hand-written A: |Φ(T) − e^(AT)|/|e^(AT)| = {err:.1e}");
+    assert!(err < 1e-10, "hand-written A: |Φ − e^(AT)| = {err:e}");
+    // Liouville: det e^{AT} = e^{T tr A}.
+    let det = (period * a.trace()).exp();
+    assert!(
+        (f.determinant - det).abs() < 1e-10 * det,
+        "{} vs {det}",
+        f.determinant
+    );
+    assert_eq!(f.stability, FloquetStability::AsymptoticallyStable);
+
+    let mut m = model("double_pendulum");
+    let guess = m
+        .equilibrium_guesses()
+        .into_iter()
+        .find(|(name, _)| *name == "hanging")
+        .expect("the double pendulum names `hanging`")
+        .1;
+    let q = find_equilibrium(m.as_ref(), &guess, 0.0).unwrap().q;
+    let a = linearize(m.as_ref(), &q, &[0.0, 0.0], 0.0)
+        .unwrap()
+        .state_matrix()
+        .unwrap();
+    let y0: Vec<f64> = q.iter().copied().chain([0.0, 0.0]).collect();
+    let period = 0.9;
+    let f = floquet_analysis(m.as_ode_mut(), &y0, 0.0, period, &FloquetOptions::default()).unwrap();
+    let expected = matrix_exponential(&(&a * period));
+    let err = (&f.monodromy_matrix - &expected).amax() / expected.amax();
+    eprintln!("double pendulum at hanging: |Φ(T) − e^(AT)|/|e^(AT)| = {err:.1e}");
+    assert!(err < 1e-10, "double pendulum: |Φ − e^(AT)| = {err:e}");
+    // The equilibrium stays put up to the rounding of cos(−π/2) in its forcing.
+    assert!(
+        f.closure_error < 1e-12,
+        "closure error {:e}",
+        f.closure_error
+    );
+}
+
+/// Liouville's formula `det Φ(T) = exp ∫ tr J dt`: 1 for the undamped Mathieu equation (the
+/// product of its multipliers), `e^{−2ζT}` with damping, and 1 for the undamped
+/// `mathieu_pendulum`, `e^{−cT/(m l²)}` with hinge damping. Tolerance 1e-10: the integration
+/// error of DOP853 at 1e-12 over one period.
+#[test]
+fn liouville_determinant_and_multiplier_product() {
+    for (delta, epsilon) in [(0.3, 0.2), (1.0, 0.5), (-0.2, 1.0), (2.5, 3.0)] {
+        let f = floquet_analysis(
+            &mut Mathieu {
+                delta,
+                epsilon,
+                zeta: 0.0,
+            },
+            &[0.0, 0.0],
+            0.0,
+            TAU,
+            &FloquetOptions::default(),
+        )
+        .unwrap();
+        let product = f.multipliers[0] * f.multipliers[1];
+        eprintln!(
+            "Mathieu δ = {delta}, ε = {epsilon}: μ = {:.6}, {:.6}; |μ₁μ₂ − 1| = {:.1e}",
+            f.multipliers[0],
+            f.multipliers[1],
+            (product - 1.0).norm()
+        );
+        assert!(
+            (product.re - 1.0).abs() < 1e-10 && product.im.abs() < 1e-10,
+            "δ = {delta}, ε = {epsilon}: μ₁μ₂ = {product}"
+        );
+        assert!((f.determinant - 1.0).abs() < 1e-10);
+        assert!(f.stability != FloquetStability::AsymptoticallyStable);
+    }
+    let zeta = 0.05;
+    let f = floquet_analysis(
+        &mut Mathieu {
+            delta: 0.3,
+            epsilon: 0.2,
+            zeta,
+        },
+        &[0.0, 0.0],
+        0.0,
+        TAU,
+        &FloquetOptions::default(),
+    )
+    .unwrap();
+    let det = (-2.0 * zeta * TAU).exp();
+    assert!(
+        (f.determinant - det).abs() < 1e-10,
+        "{} vs {det}",
+        f.determinant
+    );
+
+    let f = pendulum_floquet(&[]);
+    assert!((f.determinant - 1.0).abs() < 1e-10, "{}", f.determinant);
+    let (c, m, l) = (0.3, 2.0, 0.8);
+    let f = pendulum_floquet(&[("c", c), ("m", m), ("l", l)]);
+    let det = (-c * f.period / (m * l * l)).exp();
+    assert!(
+        (f.determinant - det).abs() < 1e-10,
+        "{} vs {det}",
+        f.determinant
+    );
+}
+
+/// Without shaking the upright pendulum is the unstable `θ̈ = (g/l) θ`, whose multipliers over
+/// any `T` are `e^{±√(g/l) T}`; relative tolerance 1e-8 (rtol 1e-12 of DOP853, with room).
+#[test]
+fn unshaken_upright_pendulum_has_analytic_multipliers() {
+    let (g, l, w) = (10.0, 0.5, 7.0);
+    let f = pendulum_floquet(&[("a", 0.0), ("g", g), ("l", l), ("w", w)]);
+    let growth = (g / l).sqrt() * TAU / w;
+    eprintln!(
+        "unshaken: μ₁ = {:.12e} against e^(√(g/l) T) = {:.12e}",
+        f.multipliers[0].re,
+        growth.exp()
+    );
+    for (mu, exact) in f.multipliers.iter().zip([growth.exp(), (-growth).exp()]) {
+        assert!(
+            mu.im.abs() < 1e-12 && (mu.re - exact).abs() < 1e-8 * exact,
+            "{mu} vs {exact}"
+        );
+    }
+    assert!((f.exponents[0].re - (g / l).sqrt()).abs() < 1e-8);
+    assert_eq!(f.stability, FloquetStability::Unstable);
+}
+
+/// Largest `|θ|` (rad) of the nonlinear `mathieu_pendulum` released at rest from `θ₀` near
+/// upright, over `t_end` seconds (DOP853 at 1e-10, every step recorded).
+fn largest_angle(set: &[(&str, f64)], theta0: f64, t_end: f64) -> f64 {
+    let mut m = model("mathieu_pendulum");
+    for (name, value) in set {
+        m.set_parameter(name, *value).unwrap();
+    }
+    let options = IntegratorOptions::default()
+        .with_rtol(1e-10)
+        .with_atol(1e-10);
+    let solution = DormandPrince853::new()
+        .integrate(
+            m.as_ode_mut(),
+            0.0,
+            &[theta0, 0.0],
+            t_end,
+            &OutputTimes::Steps,
+            &options,
+        )
+        .unwrap();
+    solution.iter().map(|(_, y)| y[0].abs()).fold(0.0, f64::max)
+}
+
+/// Kapitza's pendulum: with `a = 0.1 l`, `w = 60` rad/s (`a w = 6` against `√(2gl) = 4.47`,
+/// `q = 0.2`, well inside the band) the multipliers lie on the unit circle, and the nonlinear
+/// pendulum released 0.1 rad from upright stays within 0.2 rad over 10 s (about 95 forcing
+/// periods and 4 slow oscillations at `Ω = √(a²w²/2l² − g/l) = 2.83` rad/s; averaging
+/// predicts an amplitude of 0.1 rad plus a fast jitter of about `(a/l) θ = 0.01`). Without
+/// shaking, or shaken below Kapitza's condition (`w = 30`, `a w = 3`), Floquet says unstable
+/// and the pendulum falls past 1 rad within 10 s.
+#[test]
+fn kapitza_region_is_stable_and_confirmed_by_simulation() {
+    let inside = pendulum_floquet(&[]);
+    assert!(inside.stability.is_stable(), "{:?}", inside.multipliers);
+    assert!((inside.spectral_radius - 1.0).abs() < 1e-9);
+    let theta = largest_angle(&[], 0.1, 10.0);
+    eprintln!(
+        "a = 0.1, w = 60: μ = {:.10}, slow frequency Im ln(μ)/T = {:.6} rad/s (Kapitza √8 = {:.6}); largest |θ| over 10 s = {theta:.4} rad",
+        inside.multipliers[0],
+        inside.exponents[0].im,
+        8f64.sqrt()
+    );
+    assert!(
+        theta < 0.2,
+        "inside Kapitza's region the pendulum reached {theta} rad"
+    );
+
+    for set in [[("a", 0.0)], [("w", 30.0)]] {
+        let f = pendulum_floquet(&set);
+        assert_eq!(f.stability, FloquetStability::Unstable, "{set:?}");
+        let theta = largest_angle(&set, 0.1, 10.0);
+        eprintln!(
+            "{set:?}: ρ = {:.6}, largest |θ| over 10 s = {theta:.3} rad",
+            f.spectral_radius
+        );
+        assert!(
+            theta > 1.0,
+            "{set:?}: the pendulum stayed within {theta} rad"
+        );
+    }
+}
+
+/// The stability boundary at small amplitude, by bisection on `w` with the Floquet
+/// classification, against
+/// - the exact edge `δ = a₀(q)` of the Mathieu chart from its series (Abramowitz & Stegun
+///   20.2.25, terms to `q⁸`; truncation below 1e-13 at `q ≤ 0.1`), to 1e-8 relative — the
+///   bisection is converged to 1e-12 and the classification near a double multiplier is
+///   blurred only over a parameter range of order (1e-6)²;
+/// - Kapitza's averaging condition `a w = √(2 g l)`, which the series shows to be right to
+///   relative order `(a/l)²`: `a w_c = √(2gl) (1 + (7/32)(a/l)² + O((a/l)⁴))`. Checked: the
+///   relative difference is `(7/32)(a/l)²` within 1 %.
+#[test]
+fn stability_boundary_at_small_amplitude_agrees_with_kapitza() {
+    let (g, l): (f64, f64) = (10.0, 1.0);
+    let kapitza = (2.0 * g * l).sqrt();
+    for a in [0.02, 0.05] {
+        let stable = |w: f64| {
+            pendulum_floquet(&[("a", a), ("w", w)])
+                .stability
+                .is_stable()
+        };
+        let (mut lo, mut hi) = (0.9 * kapitza / a, 1.1 * kapitza / a);
+        assert!(
+            !stable(lo) && stable(hi),
+            "a = {a}: no boundary in [{lo}, {hi}]"
+        );
+        while hi - lo > 1e-12 * hi {
+            let mid = 0.5 * (lo + hi);
+            if stable(mid) {
+                hi = mid;
+            } else {
+                lo = mid;
+            }
+        }
+        let w_c = 0.5 * (lo + hi);
+        // δ = −4g/(l w²) = a₀(q), q = 2a/l.
+        let q: f64 = 2.0 * a / l;
+        let a0 = -q.powi(2) / 2.0 + 7.0 * q.powi(4) / 128.0 - 29.0 * q.powi(6) / 2304.0
+            + 68_687.0 * q.powi(8) / 18_874_368.0;
+        let w_series = (-4.0 * g / (l * a0)).sqrt();
+        assert!(
+            (w_c - w_series).abs() < 1e-8 * w_series,
+            "a = {a}: Floquet boundary w = {w_c}, series {w_series}"
+        );
+        let relative = a * w_c / kapitza - 1.0;
+        let predicted = 7.0 / 32.0 * (a / l).powi(2);
+        eprintln!(
+            "a = {a}: Floquet w_c = {w_c:.12}, series a₀ {w_series:.12}, Kapitza {:.12}; a w_c/√(2gl) − 1 = {relative:.6e} against (7/32)(a/l)² = {predicted:.6e}",
+            kapitza / a
+        );
+        assert!(
+            (relative - predicted).abs() < 0.01 * predicted,
+            "a = {a}: a w_c/√(2gl) − 1 = {relative:e}, averaging correction {predicted:e}"
+        );
+    }
+}
+
+/// Inside the band the multipliers are `e^{±iνπ}`, with `ν` the characteristic exponent of the
+/// Mathieu equation in `τ = w t/2`, so the slow oscillation has `Ω = Im ln(μ)/T = ν w/2`.
+/// Against `ν` from the series `δ = ν² + q²/(2(ν²−1)) + (5ν²+7)q⁴/(32(ν²−1)³(ν²−4)) +
+/// (9ν⁴+58ν²+29)q⁶/(64(ν²−1)⁵(ν²−4)(ν²−9))` (DLMF 28.15.1), solved for `ν²` by bisection:
+/// agreement to 1e-5 relative (the omitted `q⁸` term is of order 1e-7 in `δ` at `q = 0.2`).
+/// Kapitza's averaging keeps only `δ = ν² − q²/2`, `Ω = √(a²w²/(2l²) − g/l)`, and is off
+/// by a relative `O((a/l)²)` (0.5 % at `a = 0.1 l`).
+#[test]
+fn slow_frequency_matches_the_mathieu_characteristic_exponent() {
+    let (g, l): (f64, f64) = (10.0, 1.0);
+    for (a, w) in [(0.1, 60.0), (0.05, 150.0)] {
+        let f = pendulum_floquet(&[("a", a), ("w", w)]);
+        let omega = f.exponents[0].im;
+        let (delta, q) = (-4.0 * g / (l * w * w), 2.0 * a / l);
+        let series = |x: f64| {
+            x + q.powi(2) / (2.0 * (x - 1.0))
+                + (5.0 * x + 7.0) * q.powi(4) / (32.0 * (x - 1.0).powi(3) * (x - 4.0))
+                + (9.0 * x * x + 58.0 * x + 29.0) * q.powi(6)
+                    / (64.0 * (x - 1.0).powi(5) * (x - 4.0) * (x - 9.0))
+        };
+        let (mut lo, mut hi) = (0.0, 0.5);
+        for _ in 0..100 {
+            let mid = 0.5 * (lo + hi);
+            if series(mid) < delta {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        let omega_series = (0.5 * (lo + hi)).sqrt() * w / 2.0;
+        let omega_kapitza = (a * a * w * w / (2.0 * l * l) - g / l).sqrt();
+        eprintln!(
+            "a = {a}, w = {w}: Ω = {omega:.9} rad/s, DLMF 28.15.1 series {omega_series:.9}, Kapitza {omega_kapitza:.9}"
+        );
+        assert!(
+            (omega - omega_series).abs() < 1e-5 * omega_series,
+            "Ω = {omega}, series {omega_series}"
+        );
+        let off = (omega / omega_kapitza - 1.0).abs();
+        assert!(off < (a / l).powi(2), "Kapitza is off by {off:e}");
+    }
+}
+
+/// Hanging, the pendulum shaken at twice its natural frequency `2√(g/l)` is in the first
+/// parametric-resonance tongue (`δ = 1` lies between `b₁(q)` and `a₁(q)` for `q = 2a/l =
+/// 0.1`), and unstable; far from resonance (`w = 3√(g/l)`) it is stable. The equilibrium
+/// check refuses a point that is not at rest for all `t`.
+#[test]
+fn hanging_parametric_resonance_and_bad_operating_points() {
+    let mut m = model("mathieu_pendulum");
+    m.set_parameter("a", 0.05).unwrap();
+    for (w, unstable) in [(2.0 * 10f64.sqrt(), true), (3.0 * 10f64.sqrt(), false)] {
+        m.set_parameter("w", w).unwrap();
+        let f = floquet_analysis(
+            m.as_ode_mut(),
+            &[std::f64::consts::PI, 0.0],
+            0.0,
+            TAU / w,
+            &FloquetOptions::default(),
+        )
+        .unwrap();
+        assert_eq!(
+            f.stability == FloquetStability::Unstable,
+            unstable,
+            "w = {w}: {:?}",
+            f.multipliers
+        );
+    }
+    // θ = 0.3 at rest is no equilibrium: F = m l (g − a w² cos wt) sin 0.3 ≠ 0.
+    assert!(matches!(
+        check_periodic_equilibrium(m.as_ref(), &[0.3], 0.0, 1.0),
+        Err(FloquetError::NotAnEquilibrium { .. })
+    ));
+    // The forced oscillator's static deflection under A cos(w t) at t = 0 moves with t.
+    let forced = model("forced_oscillator");
+    let q = find_equilibrium(forced.as_ref(), &[0.0], 0.0).unwrap().q;
+    assert!(matches!(
+        check_periodic_equilibrium(forced.as_ref(), &q, 0.0, TAU / 0.8),
+        Err(FloquetError::NotAnEquilibrium { .. })
+    ));
+    assert!(matches!(
+        floquet_analysis(
+            m.as_ode_mut(),
+            &[0.0, 0.0],
+            0.0,
+            -1.0,
+            &FloquetOptions::default()
+        ),
+        Err(FloquetError::InvalidPeriod { .. })
+    ));
+    assert!(matches!(
+        floquet_analysis(m.as_ode_mut(), &[0.0], 0.0, 1.0, &FloquetOptions::default()),
+        Err(FloquetError::DimensionMismatch {
+            expected: 2,
+            found: 1
+        })
+    ));
+}
+
+/// `eomgen study floquet --json --sweep --plot`: the documented keys, a grid of the right
+/// shape with the unshaken column unstable, and the chart file; clear errors for a model
+/// without the period parameter and for an operating point that moves with `t`.
+#[test]
+fn cli_study_floquet_json_and_chart() {
+    let dir = std::env::temp_dir().join(format!("eomgen-floquet-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let chart = dir.join("chart.svg");
+    let out = eomgen(&[
+        "study",
+        "floquet",
+        "mathieu_pendulum",
+        "--at",
+        "upright",
+        "--json",
+        "--sweep",
+        "a=0..0.2:3,w=30..60:2",
+        "--plot",
+        chart.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    for key in [
+        "model",
+        "operating_point",
+        "period",
+        "monodromy_matrix",
+        "multipliers",
+        "exponents",
+        "spectral_radius",
+        "determinant",
+        "stability",
+        "stable",
+        "kapitza",
+        "sweep",
+    ] {
+        assert!(v.get(key).is_some(), "missing `{key}` in {v}");
+    }
+    assert_eq!(v["model"], "mathieu_pendulum");
+    assert!((v["period"].as_f64().unwrap() - TAU / 60.0).abs() < 1e-15);
+    assert_eq!(v["multipliers"].as_array().unwrap().len(), 2);
+    assert_eq!(v["stable"], true);
+    let rho = v["sweep"]["spectral_radius"].as_array().unwrap();
+    assert_eq!(rho.len(), 3);
+    assert_eq!(rho[0].as_array().unwrap().len(), 2);
+    // a = 0: ρ = e^{√10 T} at both frequencies.
+    for (j, w) in [30.0, 60.0].iter().enumerate() {
+        let exact = (10f64.sqrt() * TAU / w).exp();
+        let r = rho[0][j].as_f64().unwrap();
+        assert!((r - exact).abs() < 1e-8 * exact, "{r} vs {exact}");
+        assert_eq!(v["sweep"]["stability"][0][j], "unstable");
+    }
+    let svg = std::fs::read_to_string(&chart).unwrap();
+    assert!(svg.contains("<svg") && svg.contains("Kapitza"));
+
+    let out = eomgen(&["study", "floquet", "simple_pendulum"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("no parameter `w`"));
+    let out = eomgen(&["study", "floquet", "forced_oscillator"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("not an equilibrium for all t"));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The upper edge of the stable band: at `w = 400` rad/s (`δ = −2.5e-4`) shaking harder than
+/// `a ≈ 0.454 l` destabilises upright again; the Floquet edge (bisection on `a`) against the
+/// root of `δ = b₁(q)` from the series of Abramowitz & Stegun 20.2.25 (truncated after `q⁵`;
+/// the next term is of order `q⁶/10⁵`, so 1e-4 in `a`).
+#[test]
+fn upper_edge_of_the_stable_band() {
+    let w = 400.0;
+    let stable = |a: f64| {
+        pendulum_floquet(&[("a", a), ("w", w)])
+            .stability
+            .is_stable()
+    };
+    let (mut lo, mut hi) = (0.3, 0.6);
+    assert!(stable(lo) && !stable(hi));
+    while hi - lo > 1e-9 {
+        let mid = 0.5 * (lo + hi);
+        if stable(mid) {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    // δ = −4g/(l w²) = b₁(q): solve the series for q by bisection too.
+    let delta = -4.0 * 10.0 / 400.0f64.powi(2);
+    let b1 = |q: f64| {
+        1.0 - q - q * q / 8.0 + q.powi(3) / 64.0 - q.powi(4) / 1536.0 - 11.0 * q.powi(5) / 36_864.0
+    };
+    let (mut qa, mut qb) = (0.5, 1.2);
+    for _ in 0..60 {
+        let mid = 0.5 * (qa + qb);
+        if b1(mid) > delta {
+            qa = mid;
+        } else {
+            qb = mid;
+        }
+    }
+    let a_series = 0.5 * (qa + qb) / 2.0;
+    eprintln!("upper edge at w = 400: Floquet a = {lo:.8}, b₁ series a = {a_series:.8}");
+    // The b₁ series is truncated at q⁵: its next term is of order q⁶/10⁵ ≈ 1e-5.
+    assert!(
+        (lo - a_series).abs() < 1e-4,
+        "Floquet {lo}, series {a_series}"
+    );
+}
