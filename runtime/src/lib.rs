@@ -45,4 +45,6 @@ pub use response::{
     response_with_modal_damping, state_response_by_eigenvectors, state_response_by_exponential,
     state_response_by_integration,
 };
-pub use system::{ConstraintValues, FirstOrder, MechanicalSystem, ModelInfo, UnknownParameter};
+pub use system::{
+    ConstraintValues, FirstOrder, MechanicalSystem, ModelInfo, UnknownParameter, solve_spd,
+};

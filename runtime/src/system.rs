@@ -265,7 +265,7 @@ impl<S: MechanicalSystem<N>, const N: usize> FirstOrder<S, N> {
         t: f64,
     ) -> Result<SVector<f64, N>, RhsError> {
         let (m, f) = self.system.mass_matrix_and_forcing(q, qdot, t);
-        let qdd = solve_ldlt(&m, &f).ok_or(RhsError::SingularMassMatrix)?;
+        let qdd = solve_spd(&m, &f).ok_or(RhsError::SingularMassMatrix)?;
         if let Some(i) = qdd.iter().position(|v| !v.is_finite()) {
             return Err(RhsError::NonFinite { index: N + i });
         }
@@ -322,14 +322,14 @@ impl<S: MechanicalSystem<N>, const N: usize> FirstOrder<S, N> {
 /// Solves `M x = f` for a symmetric positive definite `M` (`N × N`, lower triangle read) by
 /// the square-root-free factorisation `M = L D Lᵀ` (`L` unit lower triangular, `D` diagonal;
 /// Golub & Van Loan, *Matrix Computations*, 4th ed., §4.1.2), the hot path of every
-/// unconstrained right-hand side.
+/// unconstrained right-hand side ([`FirstOrder::rhs`](crate::OdeSystem::rhs)).
 ///
 /// Returns `None` when a pivot `dⱼ` is not positive (or is NaN): `M` is not positive definite.
 /// Like Cholesky, it needs no pivoting for a positive definite `M` and is backward stable;
 /// unlike nalgebra's Cholesky it takes no square roots and one division per column (the
 /// reciprocal pivots are reused), which on the double pendulum shortened the dependency chain
 /// of `q̈ = M⁻¹F` from two square roots and five divisions to two divisions.
-fn solve_ldlt<const N: usize>(
+pub fn solve_spd<const N: usize>(
     m: &SMatrix<f64, N, N>,
     f: &SVector<f64, N>,
 ) -> Option<SVector<f64, N>> {
