@@ -472,3 +472,49 @@ fn cli_frf_undamped_and_bad_inputs() {
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("input `B`"));
 }
+
+/// A coordinate as the input: a unit generalized force on it, so every model has an FRF.
+/// `three_masses` (no load parameter) driven on x1: H = (K − ω²M)⁻¹ e₁ with the hand-written
+/// K = k[[2, −1, 0], [−1, 2, −1], [0, −1, 2]], M = m I (HW23), to 1e-12 relative; the CLI
+/// accepts `--input x1` and refuses `--simulate` for it (nothing in the model to drive).
+#[test]
+fn a_coordinate_input_is_a_unit_generalized_force() {
+    let mut model = (eomgen::models::find("three_masses").unwrap().make)();
+    let f = forced(model.as_mut(), "x1");
+    assert_eq!(f.input_matrix.column(0).as_slice(), &[1.0, 0.0, 0.0]);
+    let k = DMatrix::from_row_slice(3, 3, &[2.0, -1.0, 0.0, -1.0, 2.0, -1.0, 0.0, -1.0, 2.0]);
+    for w in [0.3, 1.0, 1.7, 2.5] {
+        let h = frequency_response(&f.linearization, &f.input_matrix, w).unwrap();
+        let dynamic = &k - DMatrix::identity(3, 3) * (w * w);
+        let expected = dynamic
+            .lu()
+            .solve(&DVector::from_column_slice(&[1.0, 0.0, 0.0]))
+            .unwrap();
+        for i in 0..3 {
+            assert!(h[(i, 0)].im.abs() < 1e-15);
+            assert!(
+                (h[(i, 0)].re - expected[i]).abs() < 1e-12 * expected.amax(),
+                "ω = {w}: {} vs {}",
+                h[(i, 0)].re,
+                expected[i]
+            );
+        }
+    }
+    let out = eomgen(&[
+        "frf",
+        "three_masses",
+        "--input",
+        "x1",
+        "--output",
+        "x3",
+        "--json",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let out = eomgen(&["frf", "three_masses", "--input", "x1", "--simulate", "2"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("needs a load parameter"));
+}

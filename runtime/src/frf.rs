@@ -226,6 +226,10 @@ const LINEARITY_TOLERANCE: f64 = 1e-10;
 /// Finds the equilibrium of `model` near `guess` with the `inputs` set to 0, linearises there
 /// at `t = 0`, and builds the input matrix `B` of the inputs (see the [module](self) docs).
 ///
+/// An input is a parameter that enters the forcing linearly, or a coordinate's name: a unit
+/// generalized force on that coordinate (column `eᵢ` of `B`; N or N·m per unit input), which
+/// gives every model a frequency response (a parameter of the same name takes precedence).
+///
 /// The model's parameter values are restored before returning, on success and on error.
 ///
 /// # Shapes
@@ -268,8 +272,11 @@ fn linearize_with_inputs_inner(
             model: model.name().to_string(),
         });
     }
+    let coordinates = model.coordinate_names();
     for input in inputs {
-        model.set_parameter(input, 0.0)?;
+        if model.parameter_names().contains(input) || !coordinates.contains(input) {
+            model.set_parameter(input, 0.0)?;
+        }
     }
     let n = model.num_dofs();
     let equilibrium = find_equilibrium(&*model, guess, 0.0)?;
@@ -278,6 +285,13 @@ fn linearize_with_inputs_inner(
     let y: Vec<f64> = equilibrium.q.iter().chain(&zeros).copied().collect();
     let mut input_matrix = DMatrix::zeros(n, inputs.len());
     for (j, input) in inputs.iter().enumerate() {
+        if !model.parameter_names().contains(input)
+            && let Some(i) = coordinates.iter().position(|c| c == input)
+        {
+            // A unit generalized force on coordinate `i` (N or N·m per unit input).
+            input_matrix[(i, j)] = 1.0;
+            continue;
+        }
         let (m0, f0) = model.mass_matrix_and_forcing(0.0, &y);
         model.set_parameter(input, 1.0)?;
         let (m1, f1) = model.mass_matrix_and_forcing(0.0, &y);

@@ -27,8 +27,9 @@ pub struct FrfArgs {
     /// Model name (see `eomgen list`).
     pub model: String,
     /// The input: a parameter that enters the forcing linearly (a load amplitude, `A` in
-    /// `A*cos(w*t)`). Its time function is taken at t = 0, so for `A*cos(w*t)` the response is
-    /// the steady state under `A cos(ω t)`.
+    /// `A*cos(w*t)`; its time function is taken at t = 0, so for `A*cos(w*t)` the response is
+    /// the steady state under `A cos(ω t)`), or a coordinate's name: a unit generalized force
+    /// on that coordinate (no `--simulate` then: the model has no load to drive).
     #[arg(long)]
     pub input: String,
     /// An output coordinate; repeatable (default: every coordinate).
@@ -100,13 +101,21 @@ pub fn run(args: &FrfArgs) -> Result<(), CliError> {
     if args.points < 2 {
         return Err(CliError::usage("--points must be at least 2"));
     }
-    if !model.parameter_names().contains(&args.input.as_str()) {
+    let parameter_input = model.parameter_names().contains(&args.input.as_str());
+    if !parameter_input && !model.coordinate_names().contains(&args.input.as_str()) {
         return Err(CliError::usage(format!(
-            "--input {}: `{}` has no parameter `{}` (parameters: {})",
+            "--input {}: `{}` has no parameter or coordinate `{}` (parameters: {}; coordinates: {})",
             args.input,
             model.name(),
             args.input,
-            model.parameter_names().join(", ")
+            model.parameter_names().join(", "),
+            model.coordinate_names().join(", ")
+        )));
+    }
+    if !parameter_input && args.simulate.is_some() {
+        return Err(CliError::usage(format!(
+            "--simulate needs a load parameter as --input (`{}` is a coordinate: a unit generalized force has no load in the model to drive)",
+            args.input
         )));
     }
     let name = model.name();
