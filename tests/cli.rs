@@ -390,3 +390,50 @@ fn study_constraint_methods_compares_springs_dae_and_minimal() {
             .any(|m| m["method"].as_str().unwrap().starts_with("II.3"))
     );
 }
+
+/// A failed integration (issue 8, item 3): exit 1, the reason with t, a `help:` line that
+/// fits the reason and the method, and the samples before the failure kept in `--json`
+/// (all finite: nothing non-finite is written). Explicit Euler at h = 100 on the cannonball
+/// (drag rate c/m = 0.5/s, so h·c/m = 50 is far beyond Euler's limit 2) diverges
+/// geometrically until it overflows.
+#[test]
+fn failed_integrations_explain_themselves_and_keep_their_samples() {
+    let args = [
+        "simulate",
+        "cannonball",
+        "--method",
+        "euler",
+        "--dt",
+        "100",
+        "--t-end",
+        "1e6",
+    ];
+    let out = eomgen(&args);
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("is not finite at t = "), "{err}");
+    assert!(err.contains("help: the state blew up"), "{err}");
+    let mut json_args = args.to_vec();
+    json_args.push("--json");
+    let out = eomgen(&json_args);
+    assert_eq!(out.status.code(), Some(1));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let t_fail = v["error"]["t"].as_f64().unwrap();
+    let samples = v["samples"].as_array().unwrap();
+    assert!(samples.len() > 10);
+    for s in samples {
+        assert!(s["t"].as_f64().unwrap() < t_fail);
+        for x in s["q"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .chain(s["qdot"].as_array().unwrap())
+        {
+            assert!(x.as_f64().is_some_and(f64::is_finite), "{s}");
+        }
+    }
+    // A singular mass matrix at the start: the coordinate's own singularity is named.
+    let out = eomgen(&["simulate", "simple_pendulum_y", "--init", "y=1"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("help: "));
+}

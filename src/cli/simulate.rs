@@ -5,8 +5,9 @@ use std::io::Write as _;
 use clap::{Args, ValueEnum};
 use eomgen::{
     BogackiShampine32, DormandPrince54, DormandPrince853, ExplicitEuler, ExplicitMidpoint,
-    ImplicitMidpoint, IntegrationFailure, Integrator, IntegratorOptions, ModelInfo, OutputTimes,
-    RadauIIA5, RungeKutta4, Solution, StormerVerlet, SymplecticEuler, WithEvents,
+    ImplicitMidpoint, IntegrationError, IntegrationFailure, Integrator, IntegratorOptions,
+    ModelInfo, OutputTimes, RadauIIA5, RungeKutta4, Solution, StormerVerlet, SymplecticEuler,
+    WithEvents,
 };
 use serde_json::json;
 
@@ -319,10 +320,56 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
     match failure {
         None => Ok(()),
         Some(e) => Err(CliError::failure(format!(
-            "integration of `{}` stopped: {e}; the {} samples computed before it were kept",
+            "integration of `{}` stopped: {e}; the {} samples computed before it were kept\nhelp: {}",
             model.name(),
-            solution.len()
+            solution.len(),
+            failure_hint(&e, args.method)
         ))),
+    }
+}
+
+/// What to try after a failed integration (issue 8, item 3), by the reason and the method.
+fn failure_hint(error: &IntegrationError, method: Method) -> &'static str {
+    let explicit = !matches!(method, Method::Radau5 | Method::ImplicitMidpoint);
+    let adaptive = matches!(
+        method,
+        Method::Bs32 | Method::Dp54 | Method::Dop853 | Method::Radau5
+    );
+    match error {
+        IntegrationError::StepSizeTooSmall { .. } | IntegrationError::TooManySteps { .. }
+            if explicit && adaptive =>
+        {
+            "the model may be stiff (a fast mode forces tiny steps on an explicit method); try --method radau5"
+        }
+        IntegrationError::StepSizeTooSmall { .. } => {
+            "the solution may have a singularity there (it blows up or loses smoothness); check the model and the initial state near that t"
+        }
+        IntegrationError::TooManySteps { .. } => {
+            "the run needs more steps than allowed: loosen --rtol/--atol, shorten --t-end, or use --method radau5 if the model is stiff"
+        }
+        IntegrationError::NonFiniteState { .. } | IntegrationError::RhsNonFinite { .. }
+            if !adaptive =>
+        {
+            "the state blew up: the fixed step may be beyond the method's stability limit (`eomgen study stability`); try a smaller --dt or an adaptive method"
+        }
+        IntegrationError::NonFiniteState { .. } | IntegrationError::RhsNonFinite { .. } => {
+            "a right-hand side or state became infinite or NaN: the model may divide by zero or leave the domain of a function (sqrt, log, asin) there"
+        }
+        IntegrationError::SingularMassMatrix { .. } => {
+            "the coordinates are singular at that configuration (M loses rank); choose coordinates that stay regular, or add the motion as a constraint"
+        }
+        IntegrationError::SingularConstraintMatrix { .. }
+        | IntegrationError::ProjectionFailed { .. } => {
+            "the constraints are redundant or the mechanism reaches a singular configuration there; try --stabilization projection or check the constraints"
+        }
+        IntegrationError::NewtonDidNotConverge { .. }
+        | IntegrationError::SingularIterationMatrix { .. } => {
+            "the implicit step did not converge: try a smaller --dt (or tighter --rtol with radau5)"
+        }
+        IntegrationError::EventNotFinite { .. } => {
+            "an event function is NaN there: check its expression (division by zero, sqrt of a negative)"
+        }
+        _ => "check the options against `eomgen simulate --help`",
     }
 }
 
