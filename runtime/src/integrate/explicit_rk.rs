@@ -52,7 +52,7 @@ impl ExplicitRk {
 /// Summed component by component with each sum in a register: summing stage by stage into
 /// `out` makes every addition wait for the previous stage's store to memory, which cost more
 /// than the right-hand side itself on small systems (measured on the double pendulum).
-fn weighted_sum(out: &mut [f64], weights: &[f64], first: &[f64], k: &[f64], dim: usize) {
+pub(super) fn weighted_sum(out: &mut [f64], weights: &[f64], first: &[f64], k: &[f64], dim: usize) {
     // Small systems (most mechanisms) get a copy with the dimension fixed at compile time:
     // the accumulators live in registers (one vector register for dim 4) and the loops are
     // unrolled, which on the double pendulum halved the time spent outside the right-hand side.
@@ -116,10 +116,48 @@ fn weighted_sum_any(out: &mut [f64], weights: &[f64], first: &[f64], k: &[f64], 
 }
 
 /// `out = y + h Σⱼ wⱼ kⱼ`.
-fn combine(out: &mut [f64], y: &[f64], h: f64, weights: &[f64], first: &[f64], k: &[f64]) {
-    weighted_sum(out, weights, first, k, y.len());
-    for (o, &yi) in out.iter_mut().zip(y) {
-        *o = yi + h * *o;
+pub(super) fn combine(
+    out: &mut [f64],
+    y: &[f64],
+    h: f64,
+    weights: &[f64],
+    first: &[f64],
+    k: &[f64],
+) {
+    match y.len() {
+        2 => combine_fixed::<2>(out, y, h, weights, first, k),
+        4 => combine_fixed::<4>(out, y, h, weights, first, k),
+        6 => combine_fixed::<6>(out, y, h, weights, first, k),
+        8 => combine_fixed::<8>(out, y, h, weights, first, k),
+        _ => {
+            weighted_sum(out, weights, first, k, y.len());
+            for (o, &yi) in out.iter_mut().zip(y) {
+                *o = yi + h * *o;
+            }
+        }
+    }
+}
+
+/// [`combine`] for `D` components, the sum and the update in registers.
+#[inline(always)]
+fn combine_fixed<const D: usize>(
+    out: &mut [f64],
+    y: &[f64],
+    h: f64,
+    weights: &[f64],
+    first: &[f64],
+    k: &[f64],
+) {
+    let mut sum = [0.0f64; D];
+    weighted_sum_fixed::<D>(&mut sum, weights, first, k);
+    let (Ok(out), Ok(y)) = (
+        <&mut [f64; D]>::try_from(&mut out[..D]),
+        <&[f64; D]>::try_from(&y[..D]),
+    ) else {
+        return;
+    };
+    for i in 0..D {
+        out[i] = y[i] + h * sum[i];
     }
 }
 
