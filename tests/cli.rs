@@ -437,3 +437,42 @@ fn failed_integrations_explain_themselves_and_keep_their_samples() {
     assert_eq!(out.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&out.stderr).contains("help: "));
 }
+
+/// `eomgen check` on every broken file of the compile-fail suite (`tests/ui/<category>/`)
+/// prints the same diagnostics as the compile error: each `error: FILE:line:col: message`
+/// headline of the recorded `.stderr` appears in `check`'s output for that file (the path
+/// prefix differs: the macro names the file as written in `model!`), and the exit status is 1.
+#[test]
+fn check_prints_the_compile_errors_of_every_ui_case() {
+    let root = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/ui");
+    let mut checked = 0;
+    let mut categories: Vec<_> = std::fs::read_dir(root).unwrap().flatten().collect();
+    categories.sort_by_key(|e| e.path());
+    for category in categories {
+        let mut files: Vec<_> = std::fs::read_dir(category.path())
+            .unwrap()
+            .flatten()
+            .map(|e| e.path())
+            .filter(|p| p.extension().is_some_and(|x| x == "yaml"))
+            .collect();
+        files.sort();
+        for yaml in files {
+            let expected = std::fs::read_to_string(yaml.with_extension("stderr")).unwrap();
+            let out = eomgen(&["check", yaml.to_str().unwrap()]);
+            assert_eq!(out.status.code(), Some(1), "{}", yaml.display());
+            let got = String::from_utf8_lossy(&out.stderr);
+            for line in expected.lines().filter(|l| l.starts_with("error: ")) {
+                let Some((_, rest)) = line.split_once(".yaml:") else {
+                    continue;
+                };
+                assert!(
+                    got.contains(&format!(".yaml:{rest}")),
+                    "{}: `check` does not print `{rest}`:\n{got}",
+                    yaml.display()
+                );
+            }
+            checked += 1;
+        }
+    }
+    assert!(checked >= 28, "only {checked} ui cases");
+}

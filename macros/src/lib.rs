@@ -13,7 +13,9 @@ use proc_macro2::Span;
 use syn::LitStr;
 
 use eomgen_symbolic::codegen::{self, EmitOptions};
-use eomgen_symbolic::mechanics::{Jacobians, SymbolicModel, cheapest_equations};
+use eomgen_symbolic::mechanics::{
+    Jacobians, SymbolicModel, cheapest_equations, mass_matrix_diagnostics,
+};
 
 /// Generates the equations of motion of a model file at compile time.
 ///
@@ -97,6 +99,10 @@ fn expand(input: proc_macro2::TokenStream) -> syn::Result<proc_macro2::TokenStre
     let file = eomgen_symbolic::model::load(&written, &source).map_err(errors)?;
     let mut model = SymbolicModel::from_file(&file).map_err(errors)?;
     let (eom, _) = cheapest_equations(&mut model);
+    let problems = mass_matrix_diagnostics(&model, &eom, &file);
+    if !problems.is_empty() {
+        return Err(errors(problems));
+    }
     let jacobians = Jacobians::of(&mut model, &eom);
     let options = EmitOptions {
         crate_path: "::eomgen".to_string(),

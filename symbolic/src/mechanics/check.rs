@@ -153,6 +153,10 @@ pub fn check_model(
     let n = model.num_dofs();
     let mut notes = Vec::new();
     let (lagrange, lagrange_stats) = timed(&mut model, &Lagrange);
+    let problems = super::mass_matrix_diagnostics(&model, &lagrange, file);
+    if !problems.is_empty() {
+        return Err(problems);
+    }
     let mut derivations = vec![lagrange_stats];
     let mut others: Vec<(&'static str, EquationsOfMotion)> = Vec::new();
     if MomentumBalance::applies_to(&model) {

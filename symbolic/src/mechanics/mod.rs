@@ -8,12 +8,14 @@ pub mod check;
 mod constraints;
 mod lagrange;
 mod lower;
+mod mass;
 mod momentum;
 
 pub use balances::{HandEquations, UserBalances};
 pub use constraints::{ConstraintEquations, linear_in_rates, redundant_rows};
 pub use lagrange::Lagrange;
 pub use lower::{BalanceInfo, BodyInfo, EventInfo, LoadInfo, ParameterInfo, SymbolicModel};
+pub use mass::mass_matrix_diagnostics;
 pub use momentum::MomentumBalance;
 
 use crate::expr::ExprId;

@@ -1,0 +1,190 @@
+//! Mass-matrix diagnostics (issue 8, item 2): a model whose mass matrix `M = ∂²T/∂q̇∂q̇ᵀ` is
+//! singular cannot be integrated as `M q̈ = F`, so the macro and `eomgen check` refuse it with
+//! the reason:
+//!
+//! - a coordinate without inertia (its row of `M` is identically zero), and whether it
+//!   appears in no energy and no load at all;
+//! - `M` singular at every one of 16 random states (a combination of rates that carries no
+//!   kinetic energy, as `T = m (ẋ + ẏ)²/2`);
+//! - `M` singular at the file's initial state (the coordinates' own singularity, as the
+//!   horizontal-position coordinate of a pendulum at the horizontal).
+//!
+//! Models with constraints are not checked here: their `M` may be singular while the
+//! constrained system `[M Jᵀ; J 0]` is not.
+
+use crate::expr::SymbolKind;
+use crate::expr::eval::Evaluator;
+use crate::model::{Diagnostic, ModelFile};
+
+use super::check::Rng;
+use super::{EquationsOfMotion, SymbolicModel};
+
+/// Random states tried for "singular everywhere".
+const STATES: usize = 16;
+
+/// Whether the symmetric `m` (`n × n`, row-major) is positive definite: every pivot of its
+/// `L D Lᵀ` factorisation above `1e-12` of the largest diagonal entry.
+fn positive_definite(m: &[f64], n: usize) -> bool {
+    let scale = (0..n).map(|i| m[i * n + i].abs()).fold(0.0f64, f64::max);
+    if !(scale > 0.0 && scale.is_finite()) {
+        return false;
+    }
+    let mut l = vec![0.0f64; n * n];
+    let mut d = vec![0.0f64; n];
+    for j in 0..n {
+        let dj = m[j * n + j] - (0..j).map(|k| l[j * n + k].powi(2) * d[k]).sum::<f64>();
+        if dj.is_nan() || dj <= 1e-12 * scale {
+            return false;
+        }
+        d[j] = dj;
+        for i in j + 1..n {
+            let v = m[i * n + j]
+                - (0..j)
+                    .map(|k| l[i * n + k] * l[j * n + k] * d[k])
+                    .sum::<f64>();
+            l[i * n + j] = v / dj;
+        }
+    }
+    true
+}
+
+/// The diagnostics of a singular mass matrix of `eom` (derived from `file`); empty when `M`
+/// is fine or the model has constraints.
+pub fn mass_matrix_diagnostics(
+    model: &SymbolicModel,
+    eom: &EquationsOfMotion,
+    file: &ModelFile,
+) -> Vec<Diagnostic> {
+    if !file.constraints.is_empty() || !file.nonholonomic.is_empty() {
+        return Vec::new();
+    }
+    let n = eom.num_dofs;
+    let arena = &model.arena;
+    let mut out = Vec::new();
+    for (i, coordinate) in file.coordinates.iter().enumerate().take(n) {
+        if !(0..n).all(|j| arena.is_zero(eom.mass(i, j))) {
+            continue;
+        }
+        let name = &coordinate.name.value;
+        let [q, _, _] = model.coordinate_symbols(i);
+        let unused = arena.is_zero(eom.forcing[i]) && !arena.depends_on(model.potential, q);
+        let message = if unused {
+            format!(
+                "coordinate `{name}` appears in no energy and no load: its row of the mass matrix and its generalized force are zero"
+            )
+        } else {
+            format!(
+                "coordinate `{name}` has no inertia: the kinetic energy does not depend on `{name}_dot`, so the mass matrix is singular everywhere"
+            )
+        };
+        out.push(Diagnostic::new(coordinate.name.location, message).with_help(
+            "give it inertia (a body that moves with it, or a term in `kinetic`), or remove the coordinate",
+        ));
+    }
+    if !out.is_empty() || n == 0 {
+        return out;
+    }
+
+    // Numerically: at random states, then at the initial state.
+    let symbols = arena.symbols().to_vec();
+    let defaults: Vec<(usize, f64)> = symbols
+        .iter()
+        .enumerate()
+        .filter(|(_, s)| s.kind == SymbolKind::Parameter)
+        .map(|(k, s)| {
+            let value = model
+                .parameters
+                .iter()
+                .find(|p| p.name == s.name)
+                .map_or(0.0, |p| p.default);
+            (k, value)
+        })
+        .collect();
+    let mut evaluator = Evaluator::new(arena, &eom.mass_matrix);
+    let mut bindings = vec![0.0; symbols.len()];
+    for &(k, v) in &defaults {
+        bindings[k] = v;
+    }
+    let mut rng = Rng(0x6d61_7373);
+    let mut regular = 0;
+    for _ in 0..STATES {
+        for (k, s) in symbols.iter().enumerate() {
+            match s.kind {
+                SymbolKind::Coordinate(_) | SymbolKind::Velocity(_) => {
+                    bindings[k] = rng.uniform(-2.0, 2.0);
+                }
+                SymbolKind::Time => bindings[k] = rng.uniform(0.0, 5.0),
+                _ => {}
+            }
+        }
+        if positive_definite(&evaluator.eval(&bindings), n) {
+            regular += 1;
+        }
+    }
+    let first = file.coordinates.first().map(|c| c.name.location);
+    if regular == 0 {
+        if let Some(location) = first {
+            let rates: Vec<String> = file
+                .coordinates
+                .iter()
+                .map(|c| format!("`{}_dot`", c.name.value))
+                .collect();
+            out.push(
+                Diagnostic::new(
+                    location,
+                    format!(
+                        "the mass matrix is singular at every state tried ({STATES} random states): some combination of {} carries no kinetic energy",
+                        rates.join(", ")
+                    ),
+                )
+                .with_help(
+                    "M = ∂²T/∂q̇∂q̇ must be positive definite; use independent coordinates, or make a dependent one a constraint",
+                ),
+            );
+        }
+        return out;
+    }
+    // The initial state: q from `initial:` (rates do not enter M), t = 0.
+    let mut initial = Evaluator::new(arena, &model.initial_q);
+    for (k, s) in symbols.iter().enumerate() {
+        if matches!(
+            s.kind,
+            SymbolKind::Coordinate(_) | SymbolKind::Velocity(_) | SymbolKind::Time
+        ) {
+            bindings[k] = 0.0;
+        }
+    }
+    let q0 = initial.eval(&bindings);
+    for (i, &v) in q0.iter().enumerate().take(n) {
+        let [q, _, _] = model.coordinate_symbols(i);
+        bindings[q.index()] = v;
+    }
+    if !positive_definite(&evaluator.eval(&bindings), n) {
+        let location = file
+            .initial
+            .first()
+            .map(|(name, _)| name.location)
+            .or(first);
+        if let Some(location) = location {
+            let point: Vec<String> = file
+                .coordinates
+                .iter()
+                .zip(&q0)
+                .map(|(c, v)| format!("{} = {v}", c.name.value))
+                .collect();
+            out.push(
+                Diagnostic::new(
+                    location,
+                    format!(
+                        "the mass matrix is singular or not finite at the initial state ({})",
+                        point.join(", ")
+                    ),
+                )
+                .with_help(
+                    "the coordinates are singular there; start elsewhere, or choose coordinates that stay regular along the motion",
+                ),
+            );
+        }
+    }
+    out
+}

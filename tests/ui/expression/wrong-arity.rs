@@ -1,0 +1,3 @@
+eomgen::model!("wrong-arity.yaml");
+
+fn main() {}

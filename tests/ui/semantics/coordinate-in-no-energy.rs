@@ -1,0 +1,3 @@
+eomgen::model!("coordinate-in-no-energy.yaml");
+
+fn main() {}

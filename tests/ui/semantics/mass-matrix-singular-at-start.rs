@@ -1,0 +1,3 @@
+eomgen::model!("mass-matrix-singular-at-start.yaml");
+
+fn main() {}

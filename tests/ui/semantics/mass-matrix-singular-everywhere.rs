@@ -1,0 +1,3 @@
+eomgen::model!("mass-matrix-singular-everywhere.yaml");
+
+fn main() {}

@@ -1,0 +1,3 @@
+eomgen::model!("too-many-constraints.yaml");
+
+fn main() {}

@@ -1,0 +1,3 @@
+eomgen::model!("unknown-point.yaml");
+
+fn main() {}
