@@ -824,18 +824,13 @@ pub fn settling_time(lin: &Linearization, reduction: f64) -> Result<f64, FrfErro
             expected: "0 < reduction < 1",
         });
     }
-    let a = lin.state_matrix()?;
-    let slowest = a
-        .complex_eigenvalues()
+    let eigenvalues = lin.state_matrix()?.complex_eigenvalues();
+    let slowest = eigenvalues
         .iter()
         .map(|s| -s.re)
         .fold(f64::INFINITY, f64::min);
     // A decay rate at rounding level of the largest eigenvalue is no decay.
-    let largest = a
-        .complex_eigenvalues()
-        .iter()
-        .map(|s| s.norm())
-        .fold(0.0f64, f64::max);
+    let largest = eigenvalues.iter().map(|s| s.norm()).fold(0.0f64, f64::max);
     if slowest.is_nan() || slowest <= 1e-10 * largest {
         return Err(FrfError::NoSteadyState {
             slowest_decay_rate: slowest,

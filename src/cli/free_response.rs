@@ -9,14 +9,14 @@
 use std::io::Write as _;
 
 use clap::Args;
-use eomgen::{FreeResponse, Linearization, ModeKind, ModelInfo, NormalModes};
+use eomgen::{FreeResponse, ModeKind, ModelInfo, NormalModes};
 use plotters::prelude::*;
 use serde_json::json;
 
-use super::modes::operating_point;
+use super::CliError;
+use super::modes::{OperatingPoint, operating_point_of};
 use super::plot::{self, Series};
-use super::values::{evaluate, parameter_lookup, set_parameters, split_assignment};
-use super::{CliError, find_model};
+use super::values::{evaluate, parameter_lookup, split_assignment};
 
 /// Options of `eomgen study free-response`.
 #[derive(Debug, Args)]
@@ -53,48 +53,21 @@ pub struct FreeResponseArgs {
     pub plot: Option<String>,
 }
 
-/// The linearisation at the operating point `--at` and what to call it.
-pub(super) struct OperatingPoint {
-    /// The model, with `--set` applied.
-    pub model: Box<dyn ModelInfo>,
-    /// The equilibrium's name, or the `--at` guesses as given.
-    pub label: String,
-    /// The exact linearisation at the equilibrium Newton found.
-    pub lin: Linearization,
-    /// Its normal modes.
-    pub modes: NormalModes,
-}
-
-/// Finds the equilibrium from `--at`, linearises there and computes the normal modes.
-pub(super) fn operating_point_of(
+/// The operating point of a study of the model's own coordinates: constrained models are
+/// refused (their linearisation is in minimal coordinates, `δq = N z`).
+pub(super) fn unconstrained_operating_point(
     model_name: &str,
     at: Option<&str>,
     sets: &[String],
 ) -> Result<OperatingPoint, CliError> {
-    let mut model = find_model(model_name)?;
-    set_parameters(model.as_mut(), sets)?;
-    if !model.constraint_names().is_empty() {
-        // The responses and their initial conditions are in the model's coordinates; a
-        // constrained model's linearisation is in minimal coordinates (δq = N z).
+    let point = operating_point_of(model_name, at, sets)?;
+    if point.lin.num_minimal_coordinates() != point.model.num_dofs() {
+        let name = point.model.name();
         return Err(CliError::usage(format!(
-            "`{}` has constraints; this study takes unconstrained models (`eomgen modes {}` gives its modes in minimal coordinates)",
-            model.name(),
-            model.name()
+            "`{name}` has constraints; this study takes unconstrained models (`eomgen modes {name}` gives its modes in minimal coordinates)"
         )));
     }
-    let (label, guess) = operating_point(model.as_ref(), at)?;
-    let fail = |e: eomgen::ModalError| CliError::failure(format!("`{}`: {e}", model.name()));
-    let equilibrium = eomgen::find_equilibrium(model.as_ref(), &guess, 0.0).map_err(fail)?;
-    let n = model.num_dofs();
-    let lin =
-        eomgen::linearize(model.as_ref(), &equilibrium.q, &vec![0.0; n], 0.0).map_err(fail)?;
-    let modes = eomgen::normal_modes(&lin).map_err(fail)?;
-    Ok(OperatingPoint {
-        model,
-        label,
-        lin,
-        modes,
-    })
+    Ok(point)
 }
 
 /// Parses `--init NAME=VALUE,…` into `(δq₀, δq̇₀)`, starting from zeros.
@@ -324,7 +297,8 @@ pub fn run(args: &FreeResponseArgs) -> Result<(), CliError> {
         label,
         mut lin,
         modes,
-    } = operating_point_of(&args.model, args.at.as_deref(), &args.set)?;
+        ..
+    } = unconstrained_operating_point(&args.model, args.at.as_deref(), &args.set)?;
     let n = model.num_dofs();
     let names = model.coordinate_names();
     let ignored_damping = lin.damping_matrix.amax();

@@ -13,9 +13,9 @@ use serde_json::json;
 
 use super::CliError;
 use super::free_response::{
-    OperatingPoint, Panel, default_t_end, kind_json, operating_point_of, panels, parse_init,
-    time_grid,
+    Panel, default_t_end, kind_json, panels, parse_init, time_grid, unconstrained_operating_point,
 };
+use super::modes::OperatingPoint;
 use super::plot::Series;
 
 /// Options of `eomgen study modal-damping`.
@@ -86,7 +86,8 @@ pub fn run(args: &ModalDampingArgs) -> Result<(), CliError> {
         label,
         lin,
         modes,
-    } = operating_point_of(&args.model, args.at.as_deref(), &args.set)?;
+        ..
+    } = unconstrained_operating_point(&args.model, args.at.as_deref(), &args.set)?;
     let n = model.num_dofs();
     let names = model.coordinate_names();
     let fail = |e: eomgen::ResponseError| CliError::failure(format!("`{}`: {e}", model.name()));

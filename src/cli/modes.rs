@@ -4,7 +4,10 @@
 use std::io::Write as _;
 
 use clap::Args;
-use eomgen::{ModeKind, ModelInfo, damped_modes, eigenvalues_of_m_inv_k, find_equilibrium};
+use eomgen::{
+    Equilibrium, Linearization, ModeKind, ModelInfo, NormalModes, damped_modes,
+    eigenvalues_of_m_inv_k, find_equilibrium,
+};
 use nalgebra::DMatrix;
 use serde_json::json;
 
@@ -35,18 +38,18 @@ pub struct ModesArgs {
 
 /// Runs `modes`.
 pub fn run(args: &ModesArgs) -> Result<(), CliError> {
-    let mut model = find_model(&args.model)?;
-    set_parameters(model.as_mut(), &args.set)?;
+    let OperatingPoint {
+        model,
+        label,
+        equilibrium,
+        lin,
+        modes,
+    } = operating_point_of(&args.model, args.at.as_deref(), &args.set)?;
     if args.plot.is_some() {
         super::mode_plot::check_drawable(model.as_ref())?;
     }
-    let (label, guess) = operating_point(model.as_ref(), args.at.as_deref())?;
     let fail = |e: eomgen::ModalError| CliError::failure(format!("`{}`: {e}", model.name()));
-    let equilibrium = find_equilibrium(model.as_ref(), &guess, 0.0).map_err(fail)?;
     let n = model.num_dofs();
-    let lin =
-        eomgen::linearize(model.as_ref(), &equilibrium.q, &vec![0.0; n], 0.0).map_err(fail)?;
-    let modes = eomgen::normal_modes(&lin).map_err(fail)?;
     let route22 = eigenvalues_of_m_inv_k(&lin).map_err(fail)?;
     let damped = damped_modes(&lin).map_err(fail)?;
     let names = model.coordinate_names();
@@ -228,6 +231,45 @@ fn print_matrix(out: &mut impl std::io::Write, name: &str, m: &DMatrix<f64>) {
         };
         let _ = writeln!(out, "{label:<10} [{}]", row.join(", "));
     }
+}
+
+/// The linearisation at the operating point `--at` and what to call it.
+pub(super) struct OperatingPoint {
+    /// The model, with `--set` applied.
+    pub model: Box<dyn ModelInfo>,
+    /// The equilibrium's name, or the `--at` guesses as given.
+    pub label: String,
+    /// The equilibrium Newton found (with the constraint forces at rest).
+    pub equilibrium: Equilibrium,
+    /// The exact linearisation at the equilibrium Newton found.
+    pub lin: Linearization,
+    /// Its normal modes.
+    pub modes: NormalModes,
+}
+
+/// Finds the equilibrium from `--at` (after `--set`), linearises there and computes the
+/// normal modes: the start of `modes` and of the modal studies.
+pub(super) fn operating_point_of(
+    model_name: &str,
+    at: Option<&str>,
+    sets: &[String],
+) -> Result<OperatingPoint, CliError> {
+    let mut model = find_model(model_name)?;
+    set_parameters(model.as_mut(), sets)?;
+    let (label, guess) = operating_point(model.as_ref(), at)?;
+    let fail = |e: eomgen::ModalError| CliError::failure(format!("`{}`: {e}", model.name()));
+    let equilibrium = find_equilibrium(model.as_ref(), &guess, 0.0).map_err(fail)?;
+    let n = model.num_dofs();
+    let lin =
+        eomgen::linearize(model.as_ref(), &equilibrium.q, &vec![0.0; n], 0.0).map_err(fail)?;
+    let modes = eomgen::normal_modes(&lin).map_err(fail)?;
+    Ok(OperatingPoint {
+        model,
+        label,
+        equilibrium,
+        lin,
+        modes,
+    })
 }
 
 /// The starting guess of the equilibrium search and its label.

@@ -307,50 +307,17 @@ static DENSE: [[f64; EXTENDED_STAGES]; 4] = [
     ],
 ];
 
-/// `out = Σⱼ wⱼ stage(j)` over the `j` with a non-zero weight.
-///
-/// Small systems get a copy with the dimension fixed at compile time, whose accumulators stay
-/// in registers (summing into `out` stage by stage makes each addition wait for the previous
-/// store; on the double pendulum this halved DOP853's time outside the right-hand side).
+/// `out = Σⱼ wⱼ stage(j)` over the `j` with a non-zero weight: the dense-output stages, which
+/// are not contiguous (the step's own stages go through the explicit Runge–Kutta stage sum).
 fn weighted_sum<'a>(out: &mut [f64], weights: &[f64], stage: impl Fn(usize) -> &'a [f64]) {
-    match out.len() {
-        1 => weighted_sum_fixed::<1>(out, weights, stage),
-        2 => weighted_sum_fixed::<2>(out, weights, stage),
-        3 => weighted_sum_fixed::<3>(out, weights, stage),
-        4 => weighted_sum_fixed::<4>(out, weights, stage),
-        6 => weighted_sum_fixed::<6>(out, weights, stage),
-        8 => weighted_sum_fixed::<8>(out, weights, stage),
-        _ => {
-            out.fill(0.0);
-            for (j, &w) in weights.iter().enumerate() {
-                if w != 0.0 {
-                    for (o, &kj) in out.iter_mut().zip(stage(j)) {
-                        *o += w * kj;
-                    }
-                }
-            }
-        }
-    }
-}
-
-/// [`weighted_sum`] for `D` components.
-#[inline(always)]
-fn weighted_sum_fixed<'a, const D: usize>(
-    out: &mut [f64],
-    weights: &[f64],
-    stage: impl Fn(usize) -> &'a [f64],
-) {
-    let mut acc = [0.0f64; D];
+    out.fill(0.0);
     for (j, &w) in weights.iter().enumerate() {
-        if w != 0.0
-            && let Ok(kj) = <&[f64; D]>::try_from(stage(j))
-        {
-            for i in 0..D {
-                acc[i] += w * kj[i];
+        if w != 0.0 {
+            for (o, &kj) in out.iter_mut().zip(stage(j)) {
+                *o += w * kj;
             }
         }
     }
-    out[..D].copy_from_slice(&acc);
 }
 
 /// The DOP853 stepper, with all buffers allocated once.
