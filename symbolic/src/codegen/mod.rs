@@ -12,7 +12,7 @@ use proc_macro2::TokenStream;
 
 use crate::expr::cse::{self, CsePlan, Temporary};
 use crate::expr::print::{Printer, Syntax};
-use crate::expr::{ExprArena, ExprId, SymbolId, SymbolKind};
+use crate::expr::{ExprArena, ExprId, SymbolId, SymbolKind, trig};
 use crate::mechanics::{EquationsOfMotion, Jacobians, SymbolicModel};
 
 /// Where the generated code finds the runtime.
@@ -85,8 +85,9 @@ struct Body {
     values: Vec<String>,
 }
 
-fn body(model: &SymbolicModel, roots: &[ExprId], helpers: &str) -> (Body, CsePlan) {
-    let arena: &ExprArena = &model.arena;
+fn body(arena: &mut ExprArena, roots: &[ExprId], helpers: &str) -> (Body, CsePlan) {
+    let roots = &trig::expand_angle_sums(arena, roots)[..];
+    let arena: &ExprArena = arena;
     let plan = cse::plan(arena, roots, "__e");
     let reachable = arena.reachable(roots);
     let mut code = String::new();
@@ -303,11 +304,13 @@ pub fn emit(
     );
 
     let helpers = private.as_str();
+    // The bodies may add nodes (the angle-sum rewrite); the model's own arena stays as it is.
+    let mut arena = model.arena.clone();
     let mut emit_fn = |signature: &str,
                        roots: &[ExprId],
                        build: &dyn Fn(&[String]) -> String|
      -> CsePlan {
-        let (b, plan) = body(model, roots, helpers);
+        let (b, plan) = body(&mut arena, roots, helpers);
         let _ = writeln!(
             imp,
             "#[allow(unused_variables, non_snake_case, clippy::all)] #[inline] {signature} {{\n{}{}\n}}",
