@@ -77,7 +77,8 @@ pub mod __private {
     // musl's correctly range-reduced fdlibm kernels, < 1 ulp) rather than the platform's libm
     // behind `f64::sin`: the same bits on every platform, inlinable, and a `sincos` that
     // shares one range reduction. On the double pendulum the right-hand side's four calls
-    // (cos θ1, cos θ2, sin and cos of θ1 − θ2) took 40 % of an integration through glibc.
+    // (cos θ1, cos θ2, sin and cos of θ1 − θ2; two `sin_cos` since the codegen expands angle
+    // sums) took 40 % of an integration through glibc.
 
     /// `sin x` (`libm::sin`).
     #[inline]
@@ -96,4 +97,8 @@ pub mod __private {
     pub fn sin_cos(x: f64) -> (f64, f64) {
         libm::sincos(x)
     }
+
+    pub use super::model_with_errors::ModelWithErrors;
 }
+
+mod model_with_errors;

@@ -29,9 +29,67 @@ use eomgen_symbolic::mechanics::{
 /// starting `path:line:col:`.
 #[proc_macro]
 pub fn model(input: TokenStream) -> TokenStream {
-    expand(input.into())
-        .unwrap_or_else(syn::Error::into_compile_error)
-        .into()
+    match expand(input.into()) {
+        Ok(tokens) => tokens.into(),
+        Err(failure) => failure.into_tokens().into(),
+    }
+}
+
+/// Why a model could not be generated, and what stands in for it.
+struct Failure {
+    error: syn::Error,
+    /// `(struct name, number of coordinates)` when the file names its model: the expansion
+    /// then also defines the name (as `eomgen::__private::ModelWithErrors<N>`), so that the
+    /// code using the model raises no further errors ("cannot find type") after the file's.
+    stand_in: Option<(String, usize)>,
+}
+
+impl Failure {
+    fn into_tokens(self) -> proc_macro2::TokenStream {
+        let mut tokens = self.error.into_compile_error();
+        if let Some((name, n)) = self.stand_in {
+            let ident = proc_macro2::Ident::new(&name, Span::call_site());
+            let n = proc_macro2::Literal::usize_unsuffixed(n);
+            tokens.extend(quote::quote! {
+                #[doc(hidden)]
+                pub type #ident = ::eomgen::__private::ModelWithErrors<#n>;
+            });
+        }
+        tokens
+    }
+}
+
+impl From<syn::Error> for Failure {
+    fn from(error: syn::Error) -> Self {
+        Self {
+            error,
+            stand_in: None,
+        }
+    }
+}
+
+/// The stand-in's name and size: from the loaded file, or (when it does not load) from a
+/// top-level `name:` line, with one coordinate.
+fn stand_in(
+    source: &str,
+    file: Option<&eomgen_symbolic::model::ModelFile>,
+) -> Option<(String, usize)> {
+    let (name, n) = match file {
+        Some(f) => (f.name.value.clone(), f.coordinates.len().max(1)),
+        None => {
+            let line = source.lines().find_map(|l| l.strip_prefix("name:"))?;
+            let value = line
+                .split('#')
+                .next()?
+                .trim()
+                .trim_matches(|c| c == '"' || c == '\'');
+            (value.to_string(), 1)
+        }
+    };
+    let name = codegen::struct_name(&name);
+    let valid = name.chars().next().is_some_and(|c| c.is_ascii_alphabetic())
+        && name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_');
+    valid.then_some((name, n))
 }
 
 fn base_dir() -> PathBuf {
@@ -50,7 +108,7 @@ fn base_dir() -> PathBuf {
         .unwrap_or_default()
 }
 
-fn expand(input: proc_macro2::TokenStream) -> syn::Result<proc_macro2::TokenStream> {
+fn expand(input: proc_macro2::TokenStream) -> Result<proc_macro2::TokenStream, Failure> {
     let literal: LitStr = syn::parse2(input).map_err(|e| {
         syn::Error::new(
             e.span(),
@@ -96,12 +154,19 @@ fn expand(input: proc_macro2::TokenStream) -> syn::Result<proc_macro2::TokenStre
         }
         all.unwrap_or_else(|| syn::Error::new(Span::call_site(), "invalid model"))
     };
-    let file = eomgen_symbolic::model::load(&written, &source).map_err(errors)?;
-    let mut model = SymbolicModel::from_file(&file).map_err(errors)?;
+    let file = eomgen_symbolic::model::load(&written, &source).map_err(|d| Failure {
+        error: errors(d),
+        stand_in: stand_in(&source, None),
+    })?;
+    let failure = |d| Failure {
+        error: errors(d),
+        stand_in: stand_in(&source, Some(&file)),
+    };
+    let mut model = SymbolicModel::from_file(&file).map_err(failure)?;
     let (eom, _) = cheapest_equations(&mut model);
     let problems = mass_matrix_diagnostics(&model, &eom, &file);
     if !problems.is_empty() {
-        return Err(errors(problems));
+        return Err(failure(problems));
     }
     let jacobians = Jacobians::of(&mut model, &eom);
     let options = EmitOptions {
@@ -110,6 +175,6 @@ fn expand(input: proc_macro2::TokenStream) -> syn::Result<proc_macro2::TokenStre
         source_display: written.clone(),
     };
     let (tokens, _) = codegen::emit(&model, &eom, &jacobians, &options)
-        .map_err(|e| syn::Error::new(literal.span(), e))?;
+        .map_err(|e| Failure::from(syn::Error::new(literal.span(), e)))?;
     Ok(tokens)
 }
