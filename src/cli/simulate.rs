@@ -248,7 +248,10 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
                 "velocity": constraints.max_drift().1,
             });
         }
-        if !solution.events.is_empty() || !args.run.stop_when.is_empty() || !args.run.event.is_empty() {
+        if !solution.events.is_empty()
+            || !args.run.stop_when.is_empty()
+            || !args.run.event.is_empty()
+        {
             out["events"] = json!(
                 solution
                     .events
@@ -287,7 +290,10 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
             model.name(),
             &e,
             args.run.method,
-            &format!("the {} samples computed before it were kept", solution.len()),
+            &format!(
+                "the {} samples computed before it were kept",
+                solution.len()
+            ),
         )),
     }
 }
