@@ -79,12 +79,13 @@ pub fn run(args: &AnimateArgs) -> Result<(), CliError> {
     let Some(animation) = animation else {
         return Err(failure.unwrap_or_else(|| CliError::failure("no frame was computed")));
     };
-    write(&args.output, &animation.to_html())?;
+    let html = animation.to_html();
+    write(&args.output, &html)?;
     println!(
         "animation  {} ({} frames, {:.1} kB)",
         args.output,
         animation.clips[0].t.len(),
-        animation.to_html().len() as f64 / 1e3
+        html.len() as f64 / 1e3
     );
     if let Some(path) = &args.gif {
         animation.write_gif(path, 0)?;
@@ -293,21 +294,25 @@ pub(crate) fn simulation(
         method_name,
     } = integrate(model_name, args, OutputTimes::At(times))?;
     let model = model.as_ref();
+    // Whole frames only: the samples up to the last one at a frame time.
+    let samples = match solution.len() {
+        0 => 0,
+        m => (m - 1) / sub * sub + 1,
+    };
     let failure = failure.map(|e| {
-        let kept = match solution.last() {
-            Some((t, _)) => format!(
-                "the {} frames computed before it (t ≤ {t:.6} s) are in the animation",
-                solution.len()
+        let kept = match samples {
+            0 => "no frame was computed, so no animation was written".to_string(),
+            m => format!(
+                "the {} frames computed before it (t = 0 … {} s) are in the animation",
+                (m - 1) / sub + 1,
+                short(solution.t[m - 1])
             ),
-            None => "no frame was computed, so no animation was written".to_string(),
         };
         failure_error(model.name(), &e, args.method, &kept)
     });
-    // Whole frames only: the samples up to the last one at a frame time.
-    let samples = match solution.len() {
-        0 => return Ok((None, failure)),
-        m => (m - 1) / sub * sub + 1,
-    };
+    if samples == 0 {
+        return Ok((None, failure));
+    }
     let mut scene = scene;
     scene.three_d = solution
         .iter()
