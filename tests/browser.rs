@@ -357,3 +357,52 @@ fn errors_in_the_page_are_seen() {
         assert!(errors.contains(expected), "{name}: `{errors}`");
     }
 }
+
+/// The controls: a space key press pauses the player (the frame stays where it was and the
+/// button offers "Play"), the scrubber shows the frame it is moved to, and the speed
+/// selector scales the page's clock (at 4× a 3 s budget plays 10 s; the run is 10 s long,
+/// so t wraps to the start once: t ≤ 12 − 10 s).
+#[test]
+fn controls_work_in_chromium() {
+    if !chromium_present() {
+        return;
+    }
+    let dir = scratch_dir("controls");
+    let good = page(&dir, "good.html", &["animate", "triple_pendulum", "-o"]);
+    let html = std::fs::read_to_string(&good).expect("page");
+    let inject = |name: &str, script: &str| {
+        let path = dir.join(name);
+        let injected = html.replacen("</body>", &format!("<script>{script}</script>\n</body>"), 1);
+        std::fs::write(&path, injected).expect("write");
+        let dom = dom_after_budget(&path);
+        let errors = text(&dom, "errors").unwrap_or("?");
+        assert!(errors.trim().is_empty(), "{name}: {errors}");
+        let frame: usize = attribute(&dom, "frame", "data-frame")
+            .and_then(|v| v.parse().ok())
+            .expect("data-frame");
+        let t: f64 = attribute(&dom, "time", "data-t")
+            .and_then(|v| v.parse().ok())
+            .expect("data-t");
+        (dom, frame, t)
+    };
+    let (dom, frame, _) = inject(
+        "space.html",
+        "document.dispatchEvent(new KeyboardEvent('keydown', {key: ' ', code: 'Space', bubbles: true}));",
+    );
+    assert_eq!(frame, 0, "space did not pause");
+    assert_eq!(text(&dom, "play"), Some("Play"));
+    let (_, frame, t) = inject(
+        "scrub.html",
+        "var s = document.getElementById('scrub'); s.value = '150'; s.dispatchEvent(new Event('input'));",
+    );
+    assert_eq!(
+        (frame, t),
+        (150, 5.0),
+        "the scrubber moved to frame 150 (t = 5 s) and paused"
+    );
+    let (_, _, t) = inject(
+        "speed.html",
+        "var v = document.getElementById('speed'); v.value = '4'; v.dispatchEvent(new Event('change'));",
+    );
+    assert!(t > 0.0 && t <= 2.0 + 1e-9, "at 4× after 3 s: t = {t}");
+}
