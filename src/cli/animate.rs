@@ -268,8 +268,9 @@ pub(crate) fn simulation(
             "--fps must be a positive number of frames per second, got {fps}"
         )));
     }
-    let frames = (args.t_end * fps * (1.0 + 1e-12)).floor();
-    if !(frames.is_finite() && frames >= 0.0 && frames < MAX_FRAMES as f64) {
+    // (A `--t-end` that is not positive is `integrate`'s usage error.)
+    let frames = (args.t_end * fps * (1.0 + 1e-12)).floor().max(0.0);
+    if frames >= MAX_FRAMES as f64 {
         return Err(CliError::usage(format!(
             "--t-end {} at --fps {fps} gives more than {MAX_FRAMES} frames; lower --fps",
             args.t_end
