@@ -367,8 +367,10 @@ pub(crate) fn simulation(
     } else {
         " (not conserved: non-conservative loads or explicit time dependence)"
     };
+    // A minus sign, not a hyphen, in the exponent: no line break inside the number.
+    let max_drift = format!("{max_drift:.2e}").replace('-', "−");
     let info = format!(
-        "{method}; {} frames at {} fps of simulated time, t = 0 … {} s; E(0) = {} J, max |E − E₀| / max(T + |V|) = {max_drift:.2e}{conserved}{}",
+        "{method}; {} frames at {} fps of simulated time, t = 0 … {} s; E(0) = {} J, max |E − E₀| / max(T + |V|) = {max_drift}{conserved}{}",
         t.len(),
         short(fps),
         short(t[t.len() - 1]),
