@@ -1,5 +1,6 @@
 //! Command-line interface (clap): parsing, dispatch, and the rendering of errors.
 
+mod animate;
 mod check;
 mod equations;
 mod events;
@@ -38,6 +39,9 @@ enum Command {
     },
     /// Integrate a model's equations of motion from its initial state.
     Simulate(simulate::SimulateArgs),
+    /// Simulate a model and write its `draw:` lines moving as one self-contained HTML page
+    /// (play/pause, speed, time scrubber, t and energy), optionally also a GIF.
+    Animate(animate::AnimateArgs),
     /// Derive a model (bundled, or any YAML file) by Lagrange and by momentum balance at run
     /// time and cross-check them and the power balance; exit 1 if a check fails.
     Check(check::CheckArgs),
@@ -87,6 +91,7 @@ pub fn run() -> ExitCode {
     let result = match cli.command {
         Command::List { json } => list(json),
         Command::Simulate(args) => simulate::run(&args),
+        Command::Animate(args) => animate::run(&args),
         Command::Check(args) => check::run(&args),
         Command::Equations(args) => equations::run(&args),
         Command::New(args) => equations::new(&args),

@@ -50,20 +50,23 @@ pub fn check_drawable(model: &dyn ModelInfo) -> Result<(), CliError> {
 }
 
 /// The drawing of one configuration: 2-D coordinates of every point (m).
-type Frame = Vec<(f64, f64)>;
+pub(super) type Frame = Vec<(f64, f64)>;
 
 /// What the charts draw: the point pairs of the lines and the points marked with a dot.
-struct Layout {
-    lines: Vec<[usize; 2]>,
-    dots: Vec<usize>,
-    three_d: bool,
+pub(super) struct Layout {
+    /// Point indices of the `draw:` lines.
+    pub(super) lines: Vec<[usize; 2]>,
+    /// Indices of the points marked with a dot.
+    pub(super) dots: Vec<usize>,
+    /// Whether the view is isometric (a 3-D model).
+    pub(super) three_d: bool,
 }
 
 impl Layout {
     /// The model's `draw:` lines and trace points as indices; the points marked are the
     /// lines' ends and the traced points, or every point when the file draws nothing.
     /// `three_d`: whether any point leaves the plane z = 0.
-    fn of(model: &dyn ModelInfo, three_d: bool) -> Self {
+    pub(super) fn of(model: &dyn ModelInfo, three_d: bool) -> Self {
         let names = model.point_names();
         let index = |n: &str| names.iter().position(|p| *p == n);
         let lines: Vec<[usize; 2]> = model
@@ -87,7 +90,7 @@ impl Layout {
 
     /// The chart coordinates of a point: `(x, y)`, or for a 3-D model the isometric view
     /// `((x − y) cos 30°, z + (x + y) sin 30°)`.
-    fn project(&self, p: [f64; 3]) -> (f64, f64) {
+    pub(super) fn project(&self, p: [f64; 3]) -> (f64, f64) {
         if self.three_d {
             let c = 30f64.to_radians();
             ((p[0] - p[1]) * c.cos(), p[2] + (p[0] + p[1]) * c.sin())
@@ -98,7 +101,7 @@ impl Layout {
 }
 
 /// Positions of every point at `q` (m; the rates do not matter).
-fn positions(model: &dyn ModelInfo, q: &[f64]) -> Vec<[f64; 3]> {
+pub(super) fn positions(model: &dyn ModelInfo, q: &[f64]) -> Vec<[f64; 3]> {
     let y: Vec<f64> = q
         .iter()
         .copied()
@@ -108,7 +111,7 @@ fn positions(model: &dyn ModelInfo, q: &[f64]) -> Vec<[f64; 3]> {
 }
 
 /// Positions of every point at `q`, projected.
-fn frame(model: &dyn ModelInfo, layout: &Layout, q: &[f64]) -> Frame {
+pub(super) fn frame(model: &dyn ModelInfo, layout: &Layout, q: &[f64]) -> Frame {
     positions(model, q)
         .into_iter()
         .map(|p| layout.project(p))
@@ -123,7 +126,7 @@ fn largest_distance(a: &Frame, b: &Frame, which: &[usize]) -> f64 {
 }
 
 /// What each mode's chart says about the mode, for its title.
-fn describe(k: usize, omega: f64, kind: ModeKind) -> String {
+pub(super) fn describe(k: usize, omega: f64, kind: ModeKind) -> String {
     let hz = omega / std::f64::consts::TAU;
     match kind {
         ModeKind::Oscillatory => format!(
@@ -142,7 +145,7 @@ fn describe(k: usize, omega: f64, kind: ModeKind) -> String {
 }
 
 /// Six significant digits.
-fn significant(v: f64) -> String {
+pub(super) fn significant(v: f64) -> String {
     if v == 0.0 || !(1e-3..1e5).contains(&v.abs()) {
         format!("{v:.5e}")
     } else {
@@ -176,33 +179,9 @@ pub fn mode_charts(
 ) -> Result<Vec<String>, CliError> {
     check_drawable(model)?;
     register_font().map_err(CliError::failure)?;
-    // A 3-D model: a point off the plane z = 0 at q* or along some mode.
-    let three_d = std::iter::once(q.to_vec())
-        .chain((0..shapes.ncols()).map(|k| {
-            let psi = shapes.column(k);
-            q.iter()
-                .zip(psi.iter())
-                .map(|(a, p)| a + 1e-3 * p)
-                .collect()
-        }))
-        .any(|qk| positions(model, &qk).iter().any(|p| p[2] != 0.0));
-    let layout = Layout::of(model, three_d);
+    let layout = Layout::of(model, is_three_d(model, q, shapes));
     let rest = frame(model, &layout, q);
-    let (mut lo, mut hi) = (
-        (f64::INFINITY, f64::INFINITY),
-        (f64::NEG_INFINITY, f64::NEG_INFINITY),
-    );
-    for &i in &layout.dots {
-        lo = (lo.0.min(rest[i].0), lo.1.min(rest[i].1));
-        hi = (hi.0.max(rest[i].0), hi.1.max(rest[i].1));
-    }
-    let size = (hi.0 - lo.0).max(hi.1 - lo.1);
-    let size = if size.is_finite() && size > 0.0 {
-        size
-    } else {
-        1.0
-    };
-    let q_scale = 1.0 + q.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let size = drawing_size(&rest, &layout.dots);
     let mut paths = Vec::with_capacity(modes.natural_frequencies.len());
     for (k, (&omega, &kind)) in modes
         .natural_frequencies
@@ -212,18 +191,8 @@ pub fn mode_charts(
     {
         let psi: Vec<f64> = shapes.column(k).iter().copied().collect();
         let at = |s: f64| -> Vec<f64> { q.iter().zip(&psi).map(|(a, p)| a + s * p).collect() };
-        // The linearised displacement of the points per unit of s, by a central difference
-        // with a step small against q.
-        let psi_max = psi.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-        let h = 1e-6 * q_scale / psi_max.max(f64::MIN_POSITIVE);
-        let rate = largest_distance(
-            &frame(model, &layout, &at(h)),
-            &frame(model, &layout, &at(-h)),
-            &layout.dots,
-        ) / (2.0 * h);
         let mut title = format!("{}, {}", model.name(), describe(k + 1, omega, kind));
-        let displaced = if rate.is_finite() && rate > 0.0 {
-            let s = AMPLITUDE_FRACTION * size / rate;
+        let displaced = if let Some(s) = mode_scale(model, &layout, q, &psi, size) {
             let plus = frame(model, &layout, &at(s));
             let minus = frame(model, &layout, &at(-s));
             let finite = |f: &Frame| f.iter().all(|(x, y)| x.is_finite() && y.is_finite());
@@ -265,6 +234,62 @@ pub fn mode_charts(
         paths.push(path);
     }
     Ok(paths)
+}
+
+/// Whether a 3-D view is needed: a point off the plane z = 0 at `q` or along some column of
+/// `shapes` (`n × r`).
+pub(super) fn is_three_d(model: &dyn ModelInfo, q: &[f64], shapes: &DMatrix<f64>) -> bool {
+    std::iter::once(q.to_vec())
+        .chain((0..shapes.ncols()).map(|k| {
+            let psi = shapes.column(k);
+            q.iter()
+                .zip(psi.iter())
+                .map(|(a, p)| a + 1e-3 * p)
+                .collect()
+        }))
+        .any(|qk| positions(model, &qk).iter().any(|p| p[2] != 0.0))
+}
+
+/// The mechanism's size (m): the larger side of the bounding box of the points `which` of
+/// `frame`, or 1 when it is empty or degenerate.
+pub(super) fn drawing_size(frame: &Frame, which: &[usize]) -> f64 {
+    let (mut lo, mut hi) = (
+        (f64::INFINITY, f64::INFINITY),
+        (f64::NEG_INFINITY, f64::NEG_INFINITY),
+    );
+    for &i in which {
+        lo = (lo.0.min(frame[i].0), lo.1.min(frame[i].1));
+        hi = (hi.0.max(frame[i].0), hi.1.max(frame[i].1));
+    }
+    let size = (hi.0 - lo.0).max(hi.1 - lo.1);
+    if size.is_finite() && size > 0.0 {
+        size
+    } else {
+        1.0
+    }
+}
+
+/// The scale `s` of a drawn mode `q* + s ψ`: the largest linearised point displacement is
+/// [`AMPLITUDE_FRACTION`] of `size`; `None` when the mode moves no drawn point.
+pub(super) fn mode_scale(
+    model: &dyn ModelInfo,
+    layout: &Layout,
+    q: &[f64],
+    psi: &[f64],
+    size: f64,
+) -> Option<f64> {
+    let at = |s: f64| -> Vec<f64> { q.iter().zip(psi).map(|(a, p)| a + s * p).collect() };
+    // The linearised displacement of the points per unit of s, by a central difference with
+    // a step small against q.
+    let q_scale = 1.0 + q.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let psi_max = psi.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let h = 1e-6 * q_scale / psi_max.max(f64::MIN_POSITIVE);
+    let rate = largest_distance(
+        &frame(model, layout, &at(h)),
+        &frame(model, layout, &at(-h)),
+        &layout.dots,
+    ) / (2.0 * h);
+    (rate.is_finite() && rate > 0.0).then(|| AMPLITUDE_FRACTION * size / rate)
 }
 
 /// A tick label; a tick within rounding of 0 (`1e-16` from the range arithmetic) reads `0`.

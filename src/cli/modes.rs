@@ -34,6 +34,10 @@ pub struct ModesArgs {
     /// in .png).
     #[arg(long, value_name = "PREFIX")]
     pub plot: Option<String>,
+    /// Write the mode shapes moving, `q* + s ψₖ sin(ωₖ t)`, as one self-contained HTML page
+    /// with a mode selector.
+    #[arg(long, value_name = "FILE.html")]
+    pub animate: Option<String>,
 }
 
 /// Runs `modes`.
@@ -106,6 +110,11 @@ pub fn run(args: &ModesArgs) -> Result<(), CliError> {
         )?,
         None => Vec::new(),
     };
+    if let Some(path) = &args.animate {
+        let page = super::animate::modes(model.as_ref(), &equilibrium.q, &modes, &shapes_q)?;
+        std::fs::write(path, page.to_html())
+            .map_err(|e| CliError::failure(format!("cannot write `{path}`: {e}")))?;
+    }
     let mut stdout = std::io::stdout().lock();
     if args.json {
         let out = json!({
@@ -133,6 +142,7 @@ pub fn run(args: &ModesArgs) -> Result<(), CliError> {
             "m_inv_k_eigenvalues": route22,
             "m_inv_k_relative_difference": route_difference,
             "charts": charts,
+            "animation": args.animate,
         });
         let text =
             serde_json::to_string_pretty(&out).map_err(|e| CliError::failure(e.to_string()))?;
@@ -217,6 +227,9 @@ pub fn run(args: &ModesArgs) -> Result<(), CliError> {
     );
     for path in &charts {
         let _ = writeln!(stdout, "chart      {path}");
+    }
+    if let Some(path) = &args.animate {
+        let _ = writeln!(stdout, "animation  {path}");
     }
     Ok(())
 }

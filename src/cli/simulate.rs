@@ -79,13 +79,35 @@ pub enum StabilizationArg {
 pub struct SimulateArgs {
     /// Model name (see `eomgen list`).
     pub model: String,
-    /// End time (s).
-    #[arg(long, default_value_t = 10.0)]
-    pub t_end: f64,
     /// Output times, comma separated (expressions allowed), e.g. `--t-out 1,2,2.5`; samples
     /// come from dense output at exactly these times. Default: every accepted step.
     #[arg(long, value_delimiter = ',')]
     pub t_out: Vec<String>,
+    /// What to integrate and how.
+    #[command(flatten)]
+    pub run: IntegrationArgs,
+    /// Print the result as JSON on stdout (byte-identical across runs: the wall time is left
+    /// out unless `--timing` is given).
+    #[arg(long)]
+    pub json: bool,
+    /// Add the wall time (`stats.wall_time_s`) to the JSON output.
+    #[arg(long)]
+    pub timing: bool,
+    /// Write the samples as CSV (t, coordinates, rates, energy).
+    #[arg(long, value_name = "FILE")]
+    pub csv: Option<String>,
+    /// Plot the coordinates against time (.svg or .png).
+    #[arg(long, value_name = "FILE")]
+    pub plot: Option<String>,
+}
+
+/// The integration options that `simulate` and `animate` share: end time, method,
+/// tolerances, parameters, initial state, drift control and events.
+#[derive(Debug, Args)]
+pub struct IntegrationArgs {
+    /// End time (s).
+    #[arg(long, default_value_t = 10.0)]
+    pub t_end: f64,
     /// Integration method.
     #[arg(long, value_enum, default_value_t = Method::Dp54)]
     pub method: Method,
@@ -116,19 +138,6 @@ pub struct SimulateArgs {
     /// Baumgarte's α and β (1/s), `ALPHA,BETA`.
     #[arg(long, value_delimiter = ',', num_args = 2, default_values_t = [10.0, 10.0])]
     pub baumgarte: Vec<f64>,
-    /// Print the result as JSON on stdout (byte-identical across runs: the wall time is left
-    /// out unless `--timing` is given).
-    #[arg(long)]
-    pub json: bool,
-    /// Add the wall time (`stats.wall_time_s`) to the JSON output.
-    #[arg(long)]
-    pub timing: bool,
-    /// Write the samples as CSV (t, coordinates, rates, energy).
-    #[arg(long, value_name = "FILE")]
-    pub csv: Option<String>,
-    /// Plot the coordinates against time (.svg or .png).
-    #[arg(long, value_name = "FILE")]
-    pub plot: Option<String>,
     /// Stop at the first zero of a function: a model event's name (`--stop-when lift_off`)
     /// or `EXPR` / `LHS = RHS`, optionally followed by `, rising`, `, falling` or `, both`
     /// (e.g. `--stop-when "theta_dot = 0, falling"`); names: parameters, coordinates, `t`,
@@ -142,9 +151,168 @@ pub struct SimulateArgs {
     pub event: Vec<String>,
 }
 
+/// One integration of a model from its initial state, as `simulate` and `animate` run it.
+pub(crate) struct Run {
+    /// The model, with `--set` and the drift control applied.
+    pub model: Box<dyn ModelInfo>,
+    /// The consistent initial state `[q; q̇]`.
+    pub y0: Vec<f64>,
+    /// The samples: all of them, or those computed before a failure.
+    pub solution: Solution,
+    /// Why the integration stopped early, if it did.
+    pub failure: Option<IntegrationError>,
+    /// The integrator's name (`dopri5`).
+    pub method_name: &'static str,
+}
+
 /// Runs `simulate`.
 pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
-    let mut model = find_model(&args.model)?;
+    let mut times = Vec::with_capacity(args.t_out.len());
+    for t in &args.t_out {
+        times.push(evaluate(t, "--t-out", &|_| None)?);
+    }
+    let output = if times.is_empty() {
+        OutputTimes::Steps
+    } else {
+        OutputTimes::At(times)
+    };
+    let Run {
+        mut model,
+        y0,
+        solution,
+        failure,
+        method_name,
+    } = integrate(&args.model, &args.run, output)?;
+    let n = model.num_dofs();
+    let coordinates = model.coordinate_names();
+    let report = Report::new(model.as_ref(), &y0, &solution);
+    let constraints = ConstraintReport::new(model.as_mut(), &solution);
+    if let Some(path) = &args.csv {
+        write_csv(path, model.as_ref(), &solution, &report, &constraints)?;
+        if !solution.events.is_empty() {
+            write_events_csv(&sibling(path, "events"), model.as_ref(), &solution)?;
+        }
+    }
+    if let Some(path) = &args.plot {
+        plot::time_histories(path, model.as_ref(), &solution).map_err(CliError::failure)?;
+        if !constraints.names.is_empty() {
+            let drift_path = sibling(path, "drift");
+            constraints
+                .plot(&drift_path, model.name(), &solution)
+                .map_err(CliError::failure)?;
+        }
+    }
+    if args.json {
+        let samples: Vec<serde_json::Value> = solution
+            .iter()
+            .zip(&report.energy)
+            .enumerate()
+            .map(|(k, ((t, y), e))| {
+                let mut sample = json!({"t": t, "q": &y[..n], "qdot": &y[n..], "energy": e});
+                if !constraints.names.is_empty() {
+                    sample["constraint_forces"] = json!(constraints.forces[k]);
+                    sample["constraint_drift"] =
+                        json!({"position": constraints.drift[k].0, "velocity": constraints.drift[k].1});
+                }
+                sample
+            })
+            .collect();
+        let mut out = json!({
+            "model": model.name(),
+            "coordinates": coordinates,
+            "parameters": model.parameter_names().iter().zip(model.parameter_values()).map(|(k, v)| (k.to_string(), json!(v))).collect::<serde_json::Map<_, _>>(),
+            "method": method_name,
+            "rtol": args.run.rtol,
+            "atol": args.run.atol,
+            "samples": samples,
+            "initial_energy": report.initial,
+            "energy_drift": report.drift,
+            "conservative": model.is_conservative(),
+            "stats": {
+                "steps": solution.stats.steps,
+                "rejected": solution.stats.rejected,
+                "rhs_evals": solution.stats.rhs_evals,
+                "jacobian_evals": solution.stats.jacobian_evals,
+                "lu_decompositions": solution.stats.lu_decompositions,
+                "event_evals": solution.stats.event_evals,
+            },
+        });
+        if args.timing {
+            out["stats"]["wall_time_s"] = json!(solution.stats.wall_time_s);
+        }
+        if !constraints.names.is_empty() {
+            out["constraints"] = json!(constraints.names);
+            out["stabilization"] = json!(format!("{:?}", args.run.stabilization).to_lowercase());
+            out["max_constraint_drift"] = json!({
+                "position": constraints.max_drift().0,
+                "velocity": constraints.max_drift().1,
+            });
+        }
+        if !solution.events.is_empty()
+            || !args.run.stop_when.is_empty()
+            || !args.run.event.is_empty()
+        {
+            out["events"] = json!(
+                solution
+                    .events
+                    .iter()
+                    .map(|e| json!({
+                        "name": e.name,
+                        "t": e.t,
+                        "direction": e.direction.name(),
+                        "terminal": e.terminal,
+                        "q": &e.y[..n],
+                        "qdot": &e.y[n..],
+                    }))
+                    .collect::<Vec<_>>()
+            );
+            out["terminated_by_event"] = json!(
+                solution
+                    .terminated_by_event
+                    .map(|k| solution.events[k].name.clone())
+            );
+        }
+        if let Some(e) = &failure {
+            out["error"] = json!({"t": e.t(), "message": e.to_string()});
+        }
+        let text =
+            serde_json::to_string_pretty(&out).map_err(|e| CliError::failure(e.to_string()))?;
+        let mut stdout = std::io::stdout().lock();
+        let _ = writeln!(stdout, "{text}");
+    } else {
+        print_summary(model.as_ref(), method_name, &args.run, &solution, &report);
+        constraints.print_summary(args.run.stabilization);
+        print_events(model.as_ref(), &solution);
+    }
+    match failure {
+        None => Ok(()),
+        Some(e) => Err(failure_error(
+            model.name(),
+            &e,
+            args.run.method,
+            &format!(
+                "the {} samples computed before it were kept",
+                solution.len()
+            ),
+        )),
+    }
+}
+
+/// Integrates `model_name` (a bundled model) with `args` from its initial state (with
+/// `--set` and `--init` applied and made consistent with the constraints), sampling at
+/// `output`: the shared start of `simulate` and `animate`.
+///
+/// # Errors
+/// A usage error for an unknown model, parameter, coordinate or event, or a `--t-end` that
+/// is not a positive number; a failure when no consistent initial state exists. A failed
+/// integration is not an error here: it is [`Run::failure`], with the samples computed
+/// before it (report it with [`failure_error`]).
+pub(crate) fn integrate(
+    model_name: &str,
+    args: &IntegrationArgs,
+    output: OutputTimes,
+) -> Result<Run, CliError> {
+    let mut model = find_model(model_name)?;
     set_parameters(model.as_mut(), &args.set)?;
     let n = model.num_dofs();
     let coordinates = model.coordinate_names();
@@ -187,15 +355,6 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
             args.t_end
         )));
     }
-    let output = if args.t_out.is_empty() {
-        OutputTimes::Steps
-    } else {
-        let mut times = Vec::with_capacity(args.t_out.len());
-        for t in &args.t_out {
-            times.push(evaluate(t, "--t-out", &|_| None)?);
-        }
-        OutputTimes::At(times)
-    };
     let mut options = IntegratorOptions::default()
         .with_rtol(args.rtol)
         .with_atol(args.atol);
@@ -221,111 +380,27 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
         Ok(s) => (s, None),
         Err(IntegrationFailure { error, partial }) => (*partial, Some(error)),
     };
-    let report = Report::new(model.as_ref(), &y0, &solution);
-    let constraints = ConstraintReport::new(model.as_mut(), &solution);
-    if let Some(path) = &args.csv {
-        write_csv(path, model.as_ref(), &solution, &report, &constraints)?;
-        if !solution.events.is_empty() {
-            write_events_csv(&sibling(path, "events"), model.as_ref(), &solution)?;
-        }
-    }
-    if let Some(path) = &args.plot {
-        plot::time_histories(path, model.as_ref(), &solution).map_err(CliError::failure)?;
-        if !constraints.names.is_empty() {
-            let drift_path = sibling(path, "drift");
-            constraints
-                .plot(&drift_path, model.name(), &solution)
-                .map_err(CliError::failure)?;
-        }
-    }
-    if args.json {
-        let samples: Vec<serde_json::Value> = solution
-            .iter()
-            .zip(&report.energy)
-            .enumerate()
-            .map(|(k, ((t, y), e))| {
-                let mut sample = json!({"t": t, "q": &y[..n], "qdot": &y[n..], "energy": e});
-                if !constraints.names.is_empty() {
-                    sample["constraint_forces"] = json!(constraints.forces[k]);
-                    sample["constraint_drift"] =
-                        json!({"position": constraints.drift[k].0, "velocity": constraints.drift[k].1});
-                }
-                sample
-            })
-            .collect();
-        let mut out = json!({
-            "model": model.name(),
-            "coordinates": coordinates,
-            "parameters": model.parameter_names().iter().zip(model.parameter_values()).map(|(k, v)| (k.to_string(), json!(v))).collect::<serde_json::Map<_, _>>(),
-            "method": integrator.name(),
-            "rtol": args.rtol,
-            "atol": args.atol,
-            "samples": samples,
-            "initial_energy": report.initial,
-            "energy_drift": report.drift,
-            "conservative": model.is_conservative(),
-            "stats": {
-                "steps": solution.stats.steps,
-                "rejected": solution.stats.rejected,
-                "rhs_evals": solution.stats.rhs_evals,
-                "jacobian_evals": solution.stats.jacobian_evals,
-                "lu_decompositions": solution.stats.lu_decompositions,
-                "event_evals": solution.stats.event_evals,
-            },
-        });
-        if args.timing {
-            out["stats"]["wall_time_s"] = json!(solution.stats.wall_time_s);
-        }
-        if !constraints.names.is_empty() {
-            out["constraints"] = json!(constraints.names);
-            out["stabilization"] = json!(format!("{:?}", args.stabilization).to_lowercase());
-            out["max_constraint_drift"] = json!({
-                "position": constraints.max_drift().0,
-                "velocity": constraints.max_drift().1,
-            });
-        }
-        if !solution.events.is_empty() || !args.stop_when.is_empty() || !args.event.is_empty() {
-            out["events"] = json!(
-                solution
-                    .events
-                    .iter()
-                    .map(|e| json!({
-                        "name": e.name,
-                        "t": e.t,
-                        "direction": e.direction.name(),
-                        "terminal": e.terminal,
-                        "q": &e.y[..n],
-                        "qdot": &e.y[n..],
-                    }))
-                    .collect::<Vec<_>>()
-            );
-            out["terminated_by_event"] = json!(
-                solution
-                    .terminated_by_event
-                    .map(|k| solution.events[k].name.clone())
-            );
-        }
-        if let Some(e) = &failure {
-            out["error"] = json!({"t": e.t(), "message": e.to_string()});
-        }
-        let text =
-            serde_json::to_string_pretty(&out).map_err(|e| CliError::failure(e.to_string()))?;
-        let mut stdout = std::io::stdout().lock();
-        let _ = writeln!(stdout, "{text}");
-    } else {
-        print_summary(model.as_ref(), integrator.name(), args, &solution, &report);
-        constraints.print_summary(args.stabilization);
-        print_events(model.as_ref(), &solution);
-    }
-    match failure {
-        None => Ok(()),
-        Some(e) => Err(CliError::failure(format!(
-            "integration of `{}` stopped: {e}; the {} samples computed before it were kept\nhelp: {}",
-            model.name(),
-            solution.len(),
-            failure_hint(&e, args.method)
-        ))),
-    }
+    Ok(Run {
+        model,
+        y0,
+        solution,
+        failure,
+        method_name: integrator.name(),
+    })
+}
+
+/// The error of a failed integration of `model`: where and why it stopped, what became of
+/// the samples (`kept`), and what to try.
+pub(crate) fn failure_error(
+    model: &str,
+    error: &IntegrationError,
+    method: Method,
+    kept: &str,
+) -> CliError {
+    CliError::failure(format!(
+        "integration of `{model}` stopped: {error}; {kept}\nhelp: {}",
+        failure_hint(error, method)
+    ))
 }
 
 /// What to try after a failed integration (issue 8, item 3), by the reason and the method.
@@ -410,7 +485,7 @@ impl Report {
 fn print_summary(
     model: &dyn ModelInfo,
     method: &str,
-    args: &SimulateArgs,
+    args: &IntegrationArgs,
     solution: &Solution,
     report: &Report,
 ) {

@@ -1,0 +1,1111 @@
+//! `eomgen animate MODEL -o FILE.html` and `eomgen modes MODEL --animate FILE.html`: the
+//! mechanism's `draw:` lines moving in one self-contained HTML page (HW39's "simulate and
+//! animate"; lecture 17's line-drawing animations; HW19's trace of the end of the forearm).
+//!
+//! The page needs no network: the frames (positions of the drawn points at uniform times,
+//! sampled by the integrator's dense output, with `t` and the energy), a small stylesheet and
+//! a small script are inline, and the drawing is inline SVG whose view box is the bounding
+//! box of the whole run, so that both axes have one scale and nothing leaves the picture.
+//! 3-D models are drawn in the isometric view of the mode-shape charts
+//! ([`mode_plot::Layout::project`]). Numbers are written with a fixed number of decimals
+//! (positions to 10⁻¹¹ of the picture's size; times and energies to full precision), so the
+//! file is byte-identical across runs. `--gif` writes the same animation as an animated GIF
+//! for slides.
+
+use std::fmt::Write as _;
+
+use clap::Args;
+use eomgen::{ModeKind, ModelInfo, NormalModes, OutputTimes};
+use nalgebra::DMatrix;
+use plotters::prelude::*;
+
+use super::mode_plot::{self, Frame, Layout};
+use super::simulate::{IntegrationArgs, Run, failure_error, integrate};
+use super::{CliError, plot};
+
+/// The stylesheet, the error hooks (first script: they record script errors and
+/// `console.error` into `#errors`) and the player.
+const STYLE: &str = include_str!("animate.css");
+const HOOKS: &str = include_str!("animate_hooks.js");
+const PLAYER: &str = include_str!("animate.js");
+
+/// Most frames an animation may have (`t_end · fps + 1`).
+const MAX_FRAMES: usize = 100_000;
+/// Frames per cycle of a mode-shape animation, and the real seconds one cycle takes at 1×.
+const MODE_FRAMES: usize = 60;
+const MODE_CYCLE_SECONDS: f64 = 2.0;
+/// Samples of a traced path per frame (a power of 2, so that frame `k`'s time `k / fps`
+/// is sample `4k`'s time `4k / (4 fps)` to the last bit).
+const TRACE_SUBSTEPS: usize = 4;
+/// Decimal digits kept of the picture's size in the positions: 10⁻¹¹ of it.
+const POSITION_DIGITS: i32 = 11;
+/// The GIF: largest side of the drawing (px), band for the caption (px), frames per second
+/// and frame count at most.
+const GIF_SIDE: u32 = 440;
+const GIF_CAPTION: u32 = 30;
+const GIF_MAX_FPS: f64 = 25.0;
+const GIF_MAX_FRAMES: usize = 600;
+/// Colours of the page's links, joints and traces (the GIF uses the same).
+const LINK: (u8, u8, u8) = (0x2b, 0x59, 0xc3);
+const JOINT: (u8, u8, u8) = (0x1b, 0x1b, 0x1b);
+const TRACE: (u8, u8, u8) = (0xe8, 0x87, 0x1e);
+const GRID: (u8, u8, u8) = (0xe8, 0xe8, 0xe8);
+
+/// Options of `eomgen animate`.
+#[derive(Debug, Args)]
+pub struct AnimateArgs {
+    /// Model name (see `eomgen list`); it needs a `draw:` block.
+    pub model: String,
+    /// What to integrate and how (as `eomgen simulate`).
+    #[command(flatten)]
+    pub run: IntegrationArgs,
+    /// The HTML file to write (self-contained: no network needed to view it).
+    #[arg(short = 'o', long = "output", value_name = "FILE.html")]
+    pub output: String,
+    /// Frames per second of simulated time (frames at t = k / fps, from dense output).
+    #[arg(long, default_value_t = 30.0)]
+    pub fps: f64,
+    /// Points whose paths are traced, comma separated (default: the file's `draw: trace`).
+    #[arg(long, value_delimiter = ',', value_name = "P1,P2")]
+    pub trace: Vec<String>,
+    /// Also write the animation as an animated GIF (for slides).
+    #[arg(long, value_name = "FILE.gif")]
+    pub gif: Option<String>,
+}
+
+/// Runs `animate`.
+pub fn run(args: &AnimateArgs) -> Result<(), CliError> {
+    let (animation, failure) = simulation(&args.model, &args.run, args.fps, &args.trace)?;
+    let Some(animation) = animation else {
+        return Err(failure.unwrap_or_else(|| CliError::failure("no frame was computed")));
+    };
+    let html = animation.to_html();
+    write(&args.output, &html)?;
+    println!(
+        "animation  {} ({} frames, {:.1} kB)",
+        args.output,
+        animation.clips[0].t.len(),
+        html.len() as f64 / 1e3
+    );
+    if let Some(path) = &args.gif {
+        animation.write_gif(path, 0)?;
+        println!("gif        {path}");
+    }
+    match failure {
+        None => Ok(()),
+        Some(e) => Err(e),
+    }
+}
+
+fn write(path: &str, text: &str) -> Result<(), CliError> {
+    std::fs::write(path, text).map_err(|e| CliError::failure(format!("cannot write `{path}`: {e}")))
+}
+
+/// What every frame draws: the points used, the segments between them, the points marked
+/// with a dot and the points whose paths are traced.
+pub(crate) struct Scene {
+    /// The model's name.
+    pub model: &'static str,
+    /// Heading of the page: the model and its description.
+    pub title: String,
+    /// The drawn points' names, in the model's order (indices below count in this list).
+    pub names: Vec<&'static str>,
+    /// The `draw:` lines.
+    pub lines: Vec<[usize; 2]>,
+    /// The points marked with a dot: the lines' ends and the traced points.
+    pub dots: Vec<usize>,
+    /// The traced points.
+    pub traces: Vec<usize>,
+    /// Isometric view of a 3-D model.
+    pub three_d: bool,
+    /// Indices of the drawn points among the model's points.
+    model_points: Vec<usize>,
+}
+
+impl Scene {
+    /// The scene of `model`'s `draw:` block, with `trace` (point names) instead of its
+    /// `draw: trace` when not empty.
+    ///
+    /// # Errors
+    /// A usage error when the model has no points, no `draw:` lines and nothing to trace,
+    /// or a traced name is not one of its points.
+    fn of(model: &dyn ModelInfo, trace: &[String]) -> Result<Self, CliError> {
+        let all = model.point_names();
+        if all.is_empty() {
+            return Err(CliError::usage(format!(
+                "`{}` has no points, so there is no mechanism to animate; give its model file `points:` and `draw: {{ lines: [[A, B]], trace: [B] }}`",
+                model.name()
+            )));
+        }
+        let index = |n: &str| all.iter().position(|p| *p == n);
+        let traced: Vec<usize> = if trace.is_empty() {
+            model
+                .trace_points()
+                .iter()
+                .filter_map(|p| index(p))
+                .collect()
+        } else {
+            let mut out = Vec::with_capacity(trace.len());
+            for name in trace {
+                let i = index(name.trim()).ok_or_else(|| {
+                    CliError::usage(format!(
+                        "--trace {name}: `{}` has no point `{}` (points: {})",
+                        model.name(),
+                        name.trim(),
+                        all.join(", ")
+                    ))
+                })?;
+                if !out.contains(&i) {
+                    out.push(i);
+                }
+            }
+            out
+        };
+        let lines: Vec<[usize; 2]> = model
+            .draw_lines()
+            .iter()
+            .filter_map(|[a, b]| Some([index(a)?, index(b)?]))
+            .collect();
+        if lines.is_empty() && traced.is_empty() {
+            return Err(CliError::usage(format!(
+                "`{}` has no `draw:` block, so there is nothing to animate; add `draw: {{ lines: [[{a}, {b}]], trace: [{b}] }}` to its model file, with lines between its points ({}), or pass --trace POINT",
+                model.name(),
+                all.join(", "),
+                a = all[0],
+                b = all[all.len() - 1],
+            )));
+        }
+        let mut used: Vec<usize> = lines.iter().flatten().copied().collect();
+        used.extend(&traced);
+        used.sort_unstable();
+        used.dedup();
+        let local = |i: usize| used.iter().position(|&u| u == i).unwrap_or(0);
+        let mut dots: Vec<usize> = used.iter().map(|&i| local(i)).collect();
+        dots.sort_unstable();
+        Ok(Self {
+            model: model.name(),
+            title: format!("{} — {}", model.name(), model.description()),
+            names: used.iter().map(|&i| all[i]).collect(),
+            lines: lines.iter().map(|[a, b]| [local(*a), local(*b)]).collect(),
+            dots,
+            traces: traced.iter().map(|&i| local(i)).collect(),
+            three_d: false,
+            model_points: used,
+        })
+    }
+
+    /// The projection of the drawn points' positions (`[x, y, z]` of every model point).
+    fn project(&self, positions: &[[f64; 3]]) -> Frame {
+        let layout = Layout {
+            lines: Vec::new(),
+            dots: Vec::new(),
+            three_d: self.three_d,
+        };
+        self.model_points
+            .iter()
+            .map(|&i| layout.project(positions[i]))
+            .collect()
+    }
+}
+
+/// Energy per frame: `E = T + V` (J) and its drift `(E − E₀) / max(T + |V|)` (the scale
+/// of `eomgen simulate`'s drift, so a zero `E₀` still gives a relative figure).
+pub(crate) struct Energy {
+    /// `E` per frame (J).
+    pub energy: Vec<f64>,
+    /// `(E − E₀) / max(T + |V|)` per frame, the maximum over the initial state and the frames.
+    pub drift: Vec<f64>,
+}
+
+/// One animation the page can play: frame times, positions and what to say about it.
+pub(crate) struct Clip {
+    /// Its name in the clip selector.
+    pub label: String,
+    /// The line under the heading (method, frames, energy; or the mode's frequency).
+    pub info: String,
+    /// Frame times (s), increasing.
+    pub t: Vec<f64>,
+    /// Per frame, the projected position of every drawn point (m), in [`Scene::names`] order.
+    pub frames: Vec<Frame>,
+    /// Per traced point ([`Scene::traces`]), its path sampled [`Clip::sub`] times per frame
+    /// (`(frames − 1) · sub + 1` positions, m).
+    pub trail: Vec<Vec<(f64, f64)>>,
+    /// Samples of [`Clip::trail`] per frame.
+    pub sub: usize,
+    /// Energy per frame, for a simulation.
+    pub energy: Option<Energy>,
+    /// Seconds of `t` per real second at 1× (1 for a simulation).
+    pub rate: f64,
+    /// The period of a mode's cycle (s; the clip loops over one cycle).
+    pub period: Option<f64>,
+}
+
+/// A scene and its clips: one page, one GIF.
+pub(crate) struct Animation {
+    /// What is drawn.
+    pub scene: Scene,
+    /// The clips (one for a simulation, one per mode); at least one, each with a frame.
+    pub clips: Vec<Clip>,
+}
+
+/// The animation of a simulation of `model_name` with `args`, frames at `t = k / fps`.
+///
+/// Returns the animation (`None` when not even the first frame was computed) and, when the
+/// integration failed, its error (as `simulate` reports it, saying that the frames before
+/// it are in the animation).
+///
+/// # Errors
+/// Usage errors of `simulate`, an `fps` that is not positive or gives more than
+/// [`MAX_FRAMES`] frames, a model without `draw:`; a failure when a position is not finite.
+pub(crate) fn simulation(
+    model_name: &str,
+    args: &IntegrationArgs,
+    fps: f64,
+    trace: &[String],
+) -> Result<(Option<Animation>, Option<CliError>), CliError> {
+    if !(fps.is_finite() && fps > 0.0) {
+        return Err(CliError::usage(format!(
+            "--fps must be a positive number of frames per second, got {fps}"
+        )));
+    }
+    // (A `--t-end` that is not positive is `integrate`'s usage error.)
+    let frames = (args.t_end * fps * (1.0 + 1e-12)).floor().max(0.0);
+    if frames >= MAX_FRAMES as f64 {
+        return Err(CliError::usage(format!(
+            "--t-end {} at --fps {fps} gives more than {MAX_FRAMES} frames; lower --fps",
+            args.t_end
+        )));
+    }
+    // Check the model's drawing before integrating.
+    let scene = Scene::of(super::find_model(model_name)?.as_ref(), trace)?;
+    let sub = if scene.traces.is_empty() {
+        1
+    } else {
+        TRACE_SUBSTEPS
+    };
+    let rate = fps * sub as f64;
+    let times: Vec<f64> = (0..=frames as usize * sub)
+        .map(|j| j as f64 / rate)
+        .collect();
+    let Run {
+        model,
+        y0,
+        solution,
+        failure,
+        method_name,
+    } = integrate(model_name, args, OutputTimes::At(times))?;
+    let model = model.as_ref();
+    // Whole frames only: the samples up to the last one at a frame time.
+    let samples = match solution.len() {
+        0 => 0,
+        m => (m - 1) / sub * sub + 1,
+    };
+    let failure = failure.map(|e| {
+        let kept = match samples {
+            0 => "no frame was computed, so no animation was written".to_string(),
+            m => format!(
+                "the {} frames computed before it (t = 0 … {} s) are in the animation",
+                (m - 1) / sub + 1,
+                short(solution.t[m - 1])
+            ),
+        };
+        failure_error(model.name(), &e, args.method, &kept)
+    });
+    if samples == 0 {
+        return Ok((None, failure));
+    }
+    let mut scene = scene;
+    scene.three_d = solution
+        .iter()
+        .any(|(t, y)| model.point_positions(t, y).iter().any(|p| p[2] != 0.0));
+    let mut t = Vec::with_capacity(samples / sub + 1);
+    let mut frames = Vec::with_capacity(samples / sub + 1);
+    let mut energy = Vec::with_capacity(samples / sub + 1);
+    let mut trail = vec![Vec::with_capacity(samples); scene.traces.len()];
+    let mut scale = model.kinetic_energy(0.0, &y0) + model.potential_energy(0.0, &y0).abs();
+    for (j, (tk, y)) in solution.iter().take(samples).enumerate() {
+        let frame = scene.project(&model.point_positions(tk, y));
+        for (path, &p) in trail.iter_mut().zip(&scene.traces) {
+            path.push(frame[p]);
+        }
+        if j % sub != 0 {
+            continue;
+        }
+        t.push(tk);
+        frames.push(frame);
+        let (kinetic, potential) = (model.kinetic_energy(tk, y), model.potential_energy(tk, y));
+        energy.push(kinetic + potential);
+        scale = scale.max(kinetic + potential.abs());
+    }
+    let e0 = model.energy(0.0, &y0);
+    let drift: Vec<f64> = energy
+        .iter()
+        .map(|e| {
+            if scale > 0.0 {
+                (e - e0) / scale
+            } else {
+                e - e0
+            }
+        })
+        .collect();
+    let max_drift = drift.iter().fold(0.0f64, |m, d| m.max(d.abs()));
+    let adaptive = matches!(
+        args.method,
+        super::simulate::Method::Bs32
+            | super::simulate::Method::Dp54
+            | super::simulate::Method::Dop853
+            | super::simulate::Method::Radau5
+    );
+    let method = if adaptive {
+        format!("{method_name} (rtol {:e}, atol {:e})", args.rtol, args.atol)
+    } else {
+        let dt = args.dt.unwrap_or(args.t_end / 1000.0);
+        format!("{method_name} (dt = {dt:e} s)")
+    };
+    let conserved = if model.is_conservative() {
+        ""
+    } else {
+        " (not conserved: non-conservative loads or explicit time dependence)"
+    };
+    // A minus sign, not a hyphen, in the exponent: no line break inside the number.
+    let max_drift = format!("{max_drift:.2e}").replace('-', "−");
+    let info = format!(
+        "{method}; {} frames at {} fps of simulated time, t = 0 … {} s; E(0) = {} J, max |E − E₀| / max(T + |V|) = {max_drift}{conserved}{}",
+        t.len(),
+        short(fps),
+        short(t[t.len() - 1]),
+        short(e0),
+        if scene.three_d {
+            "; isometric view"
+        } else {
+            ""
+        }
+    );
+    check_finite(model.name(), &frames)?;
+    check_finite(model.name(), &trail)?;
+    let clip = Clip {
+        label: "simulation".to_string(),
+        info,
+        t,
+        frames,
+        trail,
+        sub,
+        energy: Some(Energy { energy, drift }),
+        rate: 1.0,
+        period: None,
+    };
+    Ok((
+        Some(Animation {
+            scene,
+            clips: vec![clip],
+        }),
+        failure,
+    ))
+}
+
+fn check_finite(model: &str, frames: &[Frame]) -> Result<(), CliError> {
+    if let Some(k) = frames
+        .iter()
+        .position(|f| f.iter().any(|(x, y)| !(x.is_finite() && y.is_finite())))
+    {
+        return Err(CliError::failure(format!(
+            "`{model}`: a drawn point is not finite at frame {k}; the model leaves its domain there"
+        )));
+    }
+    Ok(())
+}
+
+/// The animation of the normal modes at the equilibrium `q` (length `n`): one clip per
+/// mode, `q* + s ψₖ sin(ωₖ t)` over one period with [`MODE_FRAMES`] frames, played at one
+/// cycle per [`MODE_CYCLE_SECONDS`] at 1×, `s` as in the mode-shape charts (the largest
+/// point displacement a fifth of the mechanism's size). Zero-frequency and unstable modes
+/// swing their shape over a nominal 2 s cycle. `shapes`: `n × r` in the model's coordinates.
+///
+/// # Errors
+/// A usage error for a model that cannot be drawn ([`Scene::of`]); a failure when a
+/// displaced configuration is not finite.
+pub(crate) fn modes(
+    model: &dyn ModelInfo,
+    q: &[f64],
+    modes: &NormalModes,
+    shapes: &DMatrix<f64>,
+) -> Result<Animation, CliError> {
+    let mut scene = Scene::of(model, &[])?;
+    scene.three_d = mode_plot::is_three_d(model, q, shapes);
+    // The mode scale measures the displacement of the drawn points.
+    let layout = Layout {
+        lines: Vec::new(),
+        dots: scene.model_points.clone(),
+        three_d: scene.three_d,
+    };
+    let positions = |qk: &[f64]| mode_plot::positions(model, qk);
+    let rest = scene.project(&positions(q));
+    let size = mode_plot::drawing_size(&rest, &(0..rest.len()).collect::<Vec<_>>());
+    let mut clips = Vec::with_capacity(shapes.ncols());
+    for (k, (&omega, &kind)) in modes
+        .natural_frequencies
+        .iter()
+        .zip(&modes.kinds)
+        .enumerate()
+    {
+        let psi: Vec<f64> = shapes.column(k).iter().copied().collect();
+        let oscillatory = matches!(kind, ModeKind::Oscillatory) && omega > 0.0;
+        let period = if oscillatory {
+            std::f64::consts::TAU / omega
+        } else {
+            MODE_CYCLE_SECONDS
+        };
+        let s = mode_plot::mode_scale(model, &layout, q, &psi, size);
+        let t: Vec<f64> = (0..=MODE_FRAMES)
+            .map(|j| period * j as f64 / MODE_FRAMES as f64)
+            .collect();
+        let frames: Vec<Frame> = t
+            .iter()
+            .enumerate()
+            .map(|(j, _)| {
+                let phase = std::f64::consts::TAU * j as f64 / MODE_FRAMES as f64;
+                let amplitude = s.unwrap_or(0.0) * phase.sin();
+                let qk: Vec<f64> = q.iter().zip(&psi).map(|(a, p)| a + amplitude * p).collect();
+                scene.project(&positions(&qk))
+            })
+            .collect();
+        check_finite(model.name(), &frames)?;
+        let described = mode_plot::describe(k + 1, omega, kind);
+        let motion = match s {
+            Some(s) => format!("q* + {} ψ{} sin(ω t)", short(s), k + 1),
+            None => "it moves no drawn point".to_string(),
+        };
+        let pace = if oscillatory {
+            format!(
+                "period {} s, shown at one cycle per {MODE_CYCLE_SECONDS} s at 1×",
+                short(period)
+            )
+        } else {
+            format!("shape only, one swing per {MODE_CYCLE_SECONDS} s at 1×")
+        };
+        let trail = scene
+            .traces
+            .iter()
+            .map(|&p| frames.iter().map(|f| f[p]).collect())
+            .collect();
+        let label = match kind {
+            ModeKind::Oscillatory => format!("mode {}: ω = {} rad/s", k + 1, short(omega)),
+            ModeKind::ZeroFrequency => format!("mode {}: zero-frequency", k + 1),
+            ModeKind::Unstable { .. } => format!("mode {}: unstable", k + 1),
+        };
+        clips.push(Clip {
+            label,
+            info: format!("{described}; {motion}; {pace}"),
+            t,
+            frames,
+            trail,
+            sub: 1,
+            energy: None,
+            rate: period / MODE_CYCLE_SECONDS,
+            period: Some(period),
+        });
+    }
+    if clips.is_empty() {
+        return Err(CliError::failure(format!(
+            "`{}` has no modes to animate",
+            model.name()
+        )));
+    }
+    Ok(Animation { scene, clips })
+}
+
+/// Six significant digits without trailing zeros (`30`, `0.5`, `6.398`).
+fn short(v: f64) -> String {
+    let s = mode_plot::significant(v);
+    if s.contains('.') && !s.contains('e') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        s
+    }
+}
+
+/// `v` with `decimals` decimals, trailing zeros dropped, `-0` as `0`.
+fn fixed(v: f64, decimals: usize) -> String {
+    let s = format!("{v:.decimals$}");
+    let s = if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.')
+    } else {
+        &s
+    };
+    if s == "-0" {
+        "0".to_string()
+    } else {
+        s.to_string()
+    }
+}
+
+/// A JSON string literal safe inside `<script>` (no `</script>`).
+fn json_string(s: &str) -> String {
+    serde_json::Value::from(s)
+        .to_string()
+        .replace('<', "\\u003c")
+}
+
+/// Text escaped for HTML.
+fn html_text(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+        .replace('"', "&quot;")
+}
+
+/// A round grid spacing: 1, 2 or 5 × 10ᵏ, near `span / 10`.
+fn grid_step(span: f64) -> f64 {
+    let raw = span / 10.0;
+    let power = 10f64.powf(raw.log10().floor());
+    let m = raw / power;
+    power
+        * if m < 1.5 {
+            1.0
+        } else if m < 3.5 {
+            2.0
+        } else if m < 7.5 {
+            5.0
+        } else {
+            10.0
+        }
+}
+
+/// The picture's box `[x0, x1] × [y0, y1]` (m): every drawn point of every frame of every
+/// clip, with a border of 6 % of the larger side.
+fn bounding_box(clips: &[Clip]) -> (f64, f64, f64, f64) {
+    let (mut x0, mut x1, mut y0, mut y1) = (
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+    );
+    for (x, y) in clips
+        .iter()
+        .flat_map(|c| c.frames.iter().chain(&c.trail).flatten())
+    {
+        x0 = x0.min(*x);
+        x1 = x1.max(*x);
+        y0 = y0.min(*y);
+        y1 = y1.max(*y);
+    }
+    let span = (x1 - x0).max(y1 - y0);
+    let span = if span > 0.0 { span } else { 1.0 };
+    let pad = 0.06 * span;
+    (x0 - pad, x1 + pad, y0 - pad, y1 + pad)
+}
+
+impl Animation {
+    /// The page: HTML with the data, stylesheet and player inline, deterministic.
+    pub(crate) fn to_html(&self) -> String {
+        let scene = &self.scene;
+        let (x0, x1, y0, y1) = bounding_box(&self.clips);
+        let span = (x1 - x0).max(y1 - y0);
+        let magnitude = span.log10().floor() as i32;
+        let decimals = (POSITION_DIGITS - magnitude).clamp(0, 17) as usize;
+        let view_decimals = (5 - magnitude).clamp(0, 17) as usize;
+        let p = |v: f64| fixed(v, decimals);
+        let v = |v: f64| fixed(v, view_decimals);
+        let mut data = String::new();
+        let names: Vec<String> = scene.names.iter().map(|n| json_string(n)).collect();
+        let pairs = |list: &[usize]| {
+            list.iter()
+                .map(usize::to_string)
+                .collect::<Vec<_>>()
+                .join(",")
+        };
+        let _ = write!(
+            data,
+            "{{\"title\":{},\"names\":[{}],\"lines\":[{}],\"dots\":[{}],\"traces\":[{}],\"clips\":[",
+            json_string(&scene.title),
+            names.join(","),
+            scene
+                .lines
+                .iter()
+                .map(|[a, b]| format!("[{a},{b}]"))
+                .collect::<Vec<_>>()
+                .join(","),
+            pairs(&scene.dots),
+            pairs(&scene.traces),
+        );
+        for (c, clip) in self.clips.iter().enumerate() {
+            if c > 0 {
+                data.push(',');
+            }
+            let _ = write!(
+                data,
+                "\n{{\"label\":{},\"info\":{},\"rate\":{:e},\"period\":{},\"t\":[{}],\n\"xy\":[",
+                json_string(&clip.label),
+                json_string(&clip.info),
+                clip.rate,
+                clip.period.map_or("null".to_string(), |p| format!("{p:e}")),
+                clip.t
+                    .iter()
+                    .map(|t| format!("{t:e}"))
+                    .collect::<Vec<_>>()
+                    .join(","),
+            );
+            for (k, f) in clip.frames.iter().enumerate() {
+                if k > 0 {
+                    data.push_str(",\n");
+                }
+                data.push('[');
+                for (i, (x, y)) in f.iter().enumerate() {
+                    if i > 0 {
+                        data.push(',');
+                    }
+                    let _ = write!(data, "{},{}", p(*x), p(*y));
+                }
+                data.push(']');
+            }
+            data.push_str("],\n\"trail\":[");
+            for (i, path) in clip.trail.iter().enumerate() {
+                if i > 0 {
+                    data.push_str(",\n");
+                }
+                let xy: Vec<String> = path
+                    .iter()
+                    .map(|(x, y)| format!("{},{}", p(*x), p(*y)))
+                    .collect();
+                let _ = write!(data, "[{}]", xy.join(","));
+            }
+            let _ = write!(data, "],\"sub\":{}", clip.sub);
+            if let Some(e) = &clip.energy {
+                let _ = write!(
+                    data,
+                    ",\n\"e\":[{}],\n\"de\":[{}]",
+                    e.energy
+                        .iter()
+                        .map(|v| format!("{v:e}"))
+                        .collect::<Vec<_>>()
+                        .join(","),
+                    e.drift
+                        .iter()
+                        .map(|v| format!("{v:.2e}"))
+                        .collect::<Vec<_>>()
+                        .join(",")
+                );
+            }
+            data.push('}');
+        }
+        data.push_str("]}");
+
+        // The picture: y up (a flipped group), the view box of the whole run.
+        let mut svg = String::new();
+        let _ = write!(
+            svg,
+            "<svg id=\"scene\" viewBox=\"{} {} {} {}\" role=\"img\" aria-label=\"{}\">\n<g transform=\"scale(1,-1)\">\n<g class=\"grid\">",
+            v(x0),
+            v(-y1),
+            v(x1 - x0),
+            v(y1 - y0),
+            html_text(&scene.title)
+        );
+        // The grid covers twice the box about its centre, so it fills a view box widened to
+        // the page's shape.
+        let step = grid_step(span);
+        let (cx, cy) = (0.5 * (x0 + x1), 0.5 * (y0 + y1));
+        let (gx0, gx1, gy0, gy1) = (cx - span, cx + span, cy - span, cy + span);
+        let first = |lo: f64| (lo / step).ceil() as i64;
+        let last = |hi: f64| (hi / step).floor() as i64;
+        for i in first(gx0)..=last(gx1) {
+            let x = i as f64 * step;
+            let class = if i == 0 { " class=\"axis\"" } else { "" };
+            let _ = write!(
+                svg,
+                "<line{class} x1=\"{}\" y1=\"{}\" x2=\"{}\" y2=\"{}\"/>",
+                v(x),
+                v(gy0),
+                v(x),
+                v(gy1)
+            );
+        }
+        for i in first(gy0)..=last(gy1) {
+            let y = i as f64 * step;
+            let class = if i == 0 { " class=\"axis\"" } else { "" };
+            let _ = write!(
+                svg,
+                "<line{class} x1=\"{}\" y1=\"{}\" x2=\"{}\" y2=\"{}\"/>",
+                v(gx0),
+                v(y),
+                v(gx1),
+                v(y)
+            );
+        }
+        svg.push_str("</g>\n");
+        let f0 = &self.clips[0].frames[0];
+        for i in 0..scene.traces.len() {
+            let _ = write!(svg, "<polyline id=\"tr{i}\" class=\"trace\" points=\"\"/>");
+        }
+        for (i, [a, b]) in scene.lines.iter().enumerate() {
+            let _ = write!(
+                svg,
+                "<line id=\"l{i}\" class=\"link\" x1=\"{}\" y1=\"{}\" x2=\"{}\" y2=\"{}\"/>",
+                p(f0[*a].0),
+                p(f0[*a].1),
+                p(f0[*b].0),
+                p(f0[*b].1)
+            );
+        }
+        let radius = v(0.012 * span);
+        for (i, d) in scene.dots.iter().enumerate() {
+            let _ = write!(
+                svg,
+                "<circle id=\"d{i}\" class=\"joint\" cx=\"{}\" cy=\"{}\" r=\"{radius}\"><title>{}</title></circle>",
+                p(f0[*d].0),
+                p(f0[*d].1),
+                html_text(scene.names[*d])
+            );
+        }
+        svg.push_str("\n</g>\n</svg>");
+
+        let choice = if self.clips.len() > 1 || self.clips[0].period.is_some() {
+            let options: Vec<String> = self
+                .clips
+                .iter()
+                .enumerate()
+                .map(|(i, c)| format!("<option value=\"{i}\">{}</option>", html_text(&c.label)))
+                .collect();
+            format!(
+                "<select id=\"clip\" aria-label=\"mode\">{}</select>",
+                options.join("")
+            )
+        } else {
+            String::new()
+        };
+        let speeds = [0.25, 0.5, 1.0, 2.0, 4.0]
+            .iter()
+            .map(|s| {
+                let selected = if *s == 1.0 { " selected" } else { "" };
+                format!("<option value=\"{s}\"{selected}>{s}×</option>")
+            })
+            .collect::<Vec<_>>()
+            .join("");
+        let last_frame = self.clips[0].t.len() - 1;
+        let view = if scene.three_d {
+            "isometric view: across (x − y) cos 30°, up z + (x + y) sin 30°; "
+        } else {
+            ""
+        };
+        format!(
+            r#"<!DOCTYPE html>
+<html lang="en">
+<head>
+<meta charset="utf-8">
+<meta name="viewport" content="width=device-width, initial-scale=1">
+<title>{title}</title>
+<script>
+{HOOKS}</script>
+<style>
+{STYLE}</style>
+</head>
+<body>
+<h1>{title}</h1>
+<p id="info">{info}</p>
+{svg}
+<div class="controls">
+{choice}
+<button id="play" type="button" title="play or pause (space)">Pause</button>
+<label>speed <select id="speed">{speeds}</select></label>
+<input id="scrub" type="range" min="0" max="{last_frame}" step="1" value="0" aria-label="frame">
+</div>
+<div class="readout"><span id="time" data-t="0">t = 0 s</span><span id="energy"></span><span id="drift"></span><span id="frame" data-frame="0">frame 1 / {frames}</span><span class="hint">{view}grid {grid} m · space: play/pause · ←/→: step</span></div>
+<pre id="errors"></pre>
+<script>
+const DATA = {data};
+</script>
+<script>
+{PLAYER}</script>
+</body>
+</html>
+"#,
+            title = html_text(&scene.title),
+            info = html_text(&self.clips[0].info),
+            frames = last_frame + 1,
+            grid = short(step),
+        )
+    }
+
+    /// Writes clip `clip` as an animated GIF: the same picture (equal scales, the whole run's
+    /// box), at most [`GIF_MAX_FPS`] frames per second of `t` and [`GIF_MAX_FRAMES`] frames,
+    /// played in real time, looping.
+    ///
+    /// # Errors
+    /// A failure when drawing or writing the file fails.
+    pub(crate) fn write_gif(&self, path: &str, clip: usize) -> Result<(), CliError> {
+        let fail = |e: String| CliError::failure(format!("`{path}`: {e}"));
+        plot::register_font().map_err(fail)?;
+        let scene = &self.scene;
+        let clip = &self.clips[clip];
+        let (x0, x1, y0, y1) = bounding_box(&self.clips);
+        let per_pixel = (x1 - x0).max(y1 - y0) / f64::from(GIF_SIDE);
+        let width = ((x1 - x0) / per_pixel).round().max(240.0) as u32;
+        let height = ((y1 - y0) / per_pixel).round().max(80.0) as u32 + GIF_CAPTION;
+        // The frame step: a frame interval of at least 1/GIF_MAX_FPS s and at most
+        // GIF_MAX_FRAMES frames.
+        let n = clip.t.len();
+        let dt = if n > 1 {
+            (clip.t[n - 1] - clip.t[0]) / (n - 1) as f64
+        } else {
+            1.0
+        };
+        let step = ((1.0 / (GIF_MAX_FPS * dt)).ceil() as usize)
+            .max(n.div_ceil(GIF_MAX_FRAMES))
+            .max(1);
+        let delay = (100.0 * dt * step as f64 / clip.rate)
+            .round()
+            .clamp(2.0, 6000.0) as u16;
+        let palette = Palette::new();
+        let file = std::fs::File::create(path).map_err(|e| fail(e.to_string()))?;
+        let mut encoder = gif::Encoder::new(
+            std::io::BufWriter::new(file),
+            width as u16,
+            height as u16,
+            &palette.rgb,
+        )
+        .map_err(|e| fail(e.to_string()))?;
+        encoder
+            .set_repeat(gif::Repeat::Infinite)
+            .map_err(|e| fail(e.to_string()))?;
+        let to_pixel = |(x, y): (f64, f64)| -> (i32, i32) {
+            (
+                ((x - x0) / per_pixel).round() as i32,
+                (GIF_CAPTION as f64 + (y1 - y) / per_pixel).round() as i32,
+            )
+        };
+        let mut buffer = vec![0u8; (width * height * 3) as usize];
+        let rgb = |(r, g, b): (u8, u8, u8)| RGBColor(r, g, b);
+        let mut previous: Vec<u8> = Vec::new();
+        let mut k = 0;
+        while k < n {
+            {
+                let root =
+                    BitMapBackend::with_buffer(&mut buffer, (width, height)).into_drawing_area();
+                let err = |e: DrawingAreaErrorKind<_>| fail(format!("drawing failed: {e}"));
+                root.fill(&WHITE).map_err(err)?;
+                let step_m = grid_step((x1 - x0).max(y1 - y0));
+                for i in (x0 / step_m).ceil() as i64..=(x1 / step_m).floor() as i64 {
+                    let x = i as f64 * step_m;
+                    root.draw(&PathElement::new(
+                        vec![to_pixel((x, y0)), to_pixel((x, y1))],
+                        rgb(GRID),
+                    ))
+                    .map_err(err)?;
+                }
+                for i in (y0 / step_m).ceil() as i64..=(y1 / step_m).floor() as i64 {
+                    let y = i as f64 * step_m;
+                    root.draw(&PathElement::new(
+                        vec![to_pixel((x0, y)), to_pixel((x1, y))],
+                        rgb(GRID),
+                    ))
+                    .map_err(err)?;
+                }
+                let frame = &clip.frames[k];
+                for trail in &clip.trail {
+                    let path: Vec<(i32, i32)> = trail[..=k * clip.sub]
+                        .iter()
+                        .map(|p| to_pixel(*p))
+                        .collect();
+                    root.draw(&PathElement::new(path, rgb(TRACE).stroke_width(2)))
+                        .map_err(err)?;
+                }
+                for [a, b] in &scene.lines {
+                    root.draw(&PathElement::new(
+                        vec![to_pixel(frame[*a]), to_pixel(frame[*b])],
+                        rgb(LINK).stroke_width(5),
+                    ))
+                    .map_err(err)?;
+                }
+                for &d in &scene.dots {
+                    root.draw(&Circle::new(to_pixel(frame[d]), 5, rgb(JOINT).filled()))
+                        .map_err(err)?;
+                }
+                let caption = match &clip.energy {
+                    Some(e) => format!(
+                        "{}   t = {:.2} s   E = {} J",
+                        scene.model,
+                        clip.t[k],
+                        mode_plot::significant(e.energy[k])
+                    ),
+                    None => format!("{}, {}   t = {:.3} s", scene.model, clip.label, clip.t[k]),
+                };
+                root.draw(&Text::new(caption, (10, 7), ("sans-serif", 16).into_font()))
+                    .map_err(err)?;
+                root.present().map_err(err)?;
+            }
+            let indices = palette.map(&buffer);
+            let mut frame = changed_rectangle(&previous, &indices, width as usize);
+            frame.delay = delay;
+            frame.dispose = gif::DisposalMethod::Keep;
+            encoder
+                .write_frame(&frame)
+                .map_err(|e| fail(e.to_string()))?;
+            previous = indices;
+            k += step;
+        }
+        encoder.into_inner().map_err(|e| fail(e.to_string()))?;
+        Ok(())
+    }
+}
+
+/// A GIF frame of the pixels of `current` (palette indices, rows of `width`) inside the
+/// smallest rectangle holding every pixel that differs from `previous` (the whole image when
+/// `previous` is empty; one pixel when nothing changed), to be drawn over the previous frame.
+fn changed_rectangle(previous: &[u8], current: &[u8], width: usize) -> gif::Frame<'static> {
+    let height = current.len() / width;
+    let (mut x0, mut x1, mut y0, mut y1) = (width, 0, height, 0);
+    if previous.len() == current.len() {
+        for (i, (a, b)) in previous.iter().zip(current).enumerate() {
+            if a != b {
+                let (x, y) = (i % width, i / width);
+                x0 = x0.min(x);
+                x1 = x1.max(x);
+                y0 = y0.min(y);
+                y1 = y1.max(y);
+            }
+        }
+        if x0 > x1 {
+            (x0, x1, y0, y1) = (0, 0, 0, 0);
+        }
+    } else {
+        (x0, x1, y0, y1) = (0, width - 1, 0, height - 1);
+    }
+    let pixels: Vec<u8> = (y0..=y1)
+        .flat_map(|y| current[y * width + x0..=y * width + x1].iter().copied())
+        .collect();
+    let mut frame =
+        gif::Frame::from_indexed_pixels((x1 - x0 + 1) as u16, (y1 - y0 + 1) as u16, pixels, None);
+    frame.left = x0 as u16;
+    frame.top = y0 as u16;
+    frame
+}
+
+/// The GIF's global palette: white, a grey ramp (text, joints, grid) and ramps from white
+/// to each drawing colour (anti-aliased edges), with a lookup table from 5-bit RGB to the
+/// nearest entry — fixed, so the file is deterministic and no quantiser is needed.
+struct Palette {
+    rgb: Vec<u8>,
+    table: Vec<u8>,
+}
+
+impl Palette {
+    fn new() -> Self {
+        let mut colours: Vec<(u8, u8, u8)> = Vec::new();
+        for i in 0..32u32 {
+            let g = (255 * i / 31) as u8;
+            colours.push((g, g, g));
+        }
+        for c in [LINK, TRACE] {
+            for i in 1..=16u32 {
+                let mix = |from: u8, to: u8| {
+                    (f64::from(from) + (f64::from(to) - f64::from(from)) * f64::from(i) / 16.0)
+                        .round() as u8
+                };
+                colours.push((mix(255, c.0), mix(255, c.1), mix(255, c.2)));
+            }
+        }
+        let rgb: Vec<u8> = colours.iter().flat_map(|c| [c.0, c.1, c.2]).collect();
+        let mut table = vec![0u8; 1 << 15];
+        for (key, entry) in table.iter_mut().enumerate() {
+            let channel = |shift: usize| (((key >> shift) & 31) * 255 / 31) as i32;
+            let (r, g, b) = (channel(10), channel(5), channel(0));
+            let nearest = colours
+                .iter()
+                .enumerate()
+                .min_by_key(|(_, c)| {
+                    let d = |a: u8, b: i32| (i32::from(a) - b).pow(2);
+                    d(c.0, r) + d(c.1, g) + d(c.2, b)
+                })
+                .map_or(0, |(i, _)| i);
+            *entry = nearest as u8;
+        }
+        Self { rgb, table }
+    }
+
+    /// Palette indices of an RGB buffer.
+    fn map(&self, buffer: &[u8]) -> Vec<u8> {
+        buffer
+            .chunks_exact(3)
+            .map(|p| {
+                let key = (usize::from(p[0] >> 3) << 10)
+                    | (usize::from(p[1] >> 3) << 5)
+                    | usize::from(p[2] >> 3);
+                self.table[key]
+            })
+            .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    mod undrawn {
+        eomgen::model!("../../tests/fixtures/undrawn_pendulum.yaml");
+    }
+    mod energy_form {
+        eomgen::model!("../../symbolic/tests/fixtures/damped_oscillator.yaml");
+    }
+
+    /// A model with points but no `draw:` block: a usage error (exit 2) that says what to
+    /// add, naming the model's points.
+    #[test]
+    fn a_model_without_draw_gets_an_error_naming_what_to_add() {
+        let model = eomgen::FirstOrder::new(undrawn::UndrawnPendulum::default());
+        let e = Scene::of(&model, &[]).err().expect("no draw: block");
+        assert_eq!(e.code, 2);
+        assert!(e.message.contains("has no `draw:` block"), "{}", e.message);
+        assert!(
+            e.message.contains("draw: { lines: [[O, P]]"),
+            "{}",
+            e.message
+        );
+        // Tracing a point is enough to animate it; a misspelt point is an error.
+        let scene = Scene::of(&model, &["P".to_string()]).expect("traced point");
+        assert_eq!(scene.names, ["P"]);
+        let e = Scene::of(&model, &["Q".to_string()])
+            .err()
+            .expect("no such point");
+        assert!(
+            e.message.contains("has no point `Q` (points: O, P)"),
+            "{}",
+            e.message
+        );
+    }
+
+    /// An energy-form model has no points at all.
+    #[test]
+    fn a_model_without_points_gets_an_error() {
+        let model = eomgen::FirstOrder::new(energy_form::DampedOscillator::default());
+        let e = Scene::of(&model, &[]).err().expect("no points");
+        assert!(e.message.contains("has no points"), "{}", e.message);
+    }
+
+    #[test]
+    fn numbers_are_trimmed_and_grid_steps_are_round() {
+        assert_eq!(fixed(-0.0000000000001, 11), "0");
+        assert_eq!(fixed(1.5, 11), "1.5");
+        assert_eq!(fixed(-2.0, 3), "-2");
+        assert_eq!(fixed(12.0, 0), "12");
+        assert_eq!(grid_step(6.0), 0.5);
+        assert_eq!(grid_step(1.2), 0.1);
+        assert_eq!(grid_step(30.0), 2.0);
+    }
+
+    /// The palette maps its own colours to themselves (drawn pixels keep their colour).
+    #[test]
+    fn palette_keeps_the_drawing_colours() {
+        let palette = Palette::new();
+        for c in [LINK, TRACE, (255, 255, 255), (0, 0, 0)] {
+            let i = usize::from(palette.map(&[c.0, c.1, c.2])[0]);
+            let entry = &palette.rgb[3 * i..3 * i + 3];
+            // 5-bit keys: within 8 per channel of the colour.
+            for (a, b) in entry.iter().zip([c.0, c.1, c.2]) {
+                assert!(
+                    (i32::from(*a) - i32::from(b)).abs() <= 8,
+                    "{c:?} → {entry:?}"
+                );
+            }
+        }
+    }
+}

@@ -1,0 +1,409 @@
+//! The animation pages in a real browser: headless Chromium (Debian's `chromium`, which
+//! `.ci/run` installs) loads `eomgen animate` pages for the triple pendulum and the
+//! four-bar and a `modes --animate` page, and the test checks that the page's script ran
+//! without an error or a `console.error`, that the animation advanced in (virtual) time at
+//! the speed of time, and that a screenshot shows the drawing. Without `/usr/bin/chromium`
+//! every test prints that it was skipped and passes.
+//!
+//! Chromium runs with a new empty profile, without network services, under a time limit (a
+//! hung browser fails the test instead of hanging it). The page's first script records
+//! script errors and `console.error` calls into `<pre id="errors">`, read from the DOM that
+//! `--dump-dom` prints once `--virtual-time-budget` ms of page time have passed (timers run
+//! in virtual time, so the check does not depend on the machine's speed).
+
+mod common;
+
+use std::io::{Read as _, Write as _};
+use std::os::unix::process::CommandExt as _;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::time::{Duration, Instant};
+
+const CHROMIUM: &str = "/usr/bin/chromium";
+/// Longest a browser may run before the test kills it and fails.
+const TIME_LIMIT: Duration = Duration::from_secs(90);
+/// Page time the player runs before the DOM is read (ms).
+const BUDGET_MS: u32 = 3000;
+/// The page's colours: the links (#2b59c3), the traced path (#e8871e), the picture's
+/// background (#fcfcfc).
+const LINK: [u8; 3] = [0x2b, 0x59, 0xc3];
+const TRACE: [u8; 3] = [0xe8, 0x87, 0x1e];
+const BACKGROUND: [u8; 3] = [0xfc, 0xfc, 0xfc];
+
+/// The flags of every Chromium run.
+const FLAGS: &[&str] = &[
+    "--headless",
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-quic",
+    "--no-first-run",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+];
+
+/// Whether Chromium is there; prints why the test is skipped when not (on the real stderr,
+/// which the test harness does not capture).
+fn chromium_present() -> bool {
+    if Path::new(CHROMIUM).exists() {
+        return true;
+    }
+    let _ = writeln!(
+        std::io::stderr(),
+        "skipped: chromium not found (apt-get install chromium)"
+    );
+    false
+}
+
+/// A new empty directory for this test run.
+fn scratch_dir(tag: &str) -> PathBuf {
+    static COUNT: AtomicUsize = AtomicUsize::new(0);
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(format!(
+        "browser-{tag}-{}-{}",
+        std::process::id(),
+        COUNT.fetch_add(1, Ordering::Relaxed)
+    ));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("scratch directory");
+    dir
+}
+
+/// Runs Chromium on `page` with `extra` flags, a new empty profile and the time limit;
+/// returns its stdout. Panics (with the end of stderr) when it fails or runs too long.
+fn chromium(page: &Path, extra: &[String]) -> String {
+    let profile = scratch_dir("profile");
+    let url = format!("file://{}", page.display());
+    let mut child = Command::new(CHROMIUM)
+        .args(FLAGS)
+        .arg(format!("--user-data-dir={}", profile.display()))
+        .args(extra)
+        .arg(&url)
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        // Its own process group, so that a hung browser is killed with its helpers.
+        .process_group(0)
+        .spawn()
+        .expect("chromium starts");
+    let mut stdout = child.stdout.take().expect("stdout");
+    let mut stderr = child.stderr.take().expect("stderr");
+    let out = std::thread::spawn(move || {
+        let mut s = String::new();
+        let _ = stdout.read_to_string(&mut s);
+        s
+    });
+    let err = std::thread::spawn(move || {
+        let mut s = String::new();
+        let _ = stderr.read_to_string(&mut s);
+        s
+    });
+    let start = Instant::now();
+    let status = loop {
+        if let Some(status) = child.try_wait().expect("wait for chromium") {
+            break status;
+        }
+        if start.elapsed() > TIME_LIMIT {
+            let _ = Command::new("kill")
+                .args(["-KILL", &format!("-{}", child.id())])
+                .status();
+            let _ = child.kill();
+            let _ = child.wait();
+            panic!("chromium did not finish within {TIME_LIMIT:?} on {url}");
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    };
+    let stdout = out.join().unwrap_or_default();
+    let stderr = err.join().unwrap_or_default();
+    let _ = std::fs::remove_dir_all(&profile);
+    let tail: String = stderr.lines().rev().take(15).collect::<Vec<_>>().join("\n");
+    assert!(
+        status.success(),
+        "chromium failed on {url} ({status}):\n{tail}"
+    );
+    stdout
+}
+
+/// The value of attribute `name` on the element with `id` in `dom`.
+fn attribute<'a>(dom: &'a str, id: &str, name: &str) -> Option<&'a str> {
+    let at = dom.find(&format!("id=\"{id}\""))?;
+    let tag_start = dom[..at].rfind('<')?;
+    let tag = &dom[tag_start..tag_start + dom[tag_start..].find('>')?];
+    let key = format!("{name}=\"");
+    let from = tag.find(&key)? + key.len();
+    Some(&tag[from..from + tag[from..].find('"')?])
+}
+
+/// The text inside the element with `id` (up to its first child tag or its end).
+fn text<'a>(dom: &'a str, id: &str) -> Option<&'a str> {
+    let at = dom.find(&format!("id=\"{id}\""))?;
+    let from = at + dom[at..].find('>')? + 1;
+    Some(&dom[from..from + dom[from..].find('<')?])
+}
+
+/// What the page shows after the virtual-time budget: its DOM.
+fn dom_after_budget(page: &Path) -> String {
+    chromium(
+        page,
+        &[
+            format!("--virtual-time-budget={BUDGET_MS}"),
+            "--dump-dom".to_string(),
+        ],
+    )
+}
+
+/// Loads `page` and checks: the player started (`data-state="ready"`), no error was
+/// recorded, and after `BUDGET_MS` of page time the frame index and `t` have advanced —
+/// by no more than the budget at 1× (the player follows the clock; 10 % allowed for the
+/// page time Chromium lets pass beyond the budget, seen up to 1 %), and by at least a sixth
+/// of it (it was not stuck). Returns the DOM.
+fn check_page_plays(page: &Path, seconds_per_second: f64) -> String {
+    let dom = dom_after_budget(page);
+    assert!(
+        dom.contains("<pre id=\"errors\">"),
+        "no error element in {}:\n{dom}",
+        page.display()
+    );
+    let errors = text(&dom, "errors").unwrap_or("?");
+    assert!(errors.trim().is_empty(), "{}: {errors}", page.display());
+    assert!(
+        dom.contains("<body data-state=\"ready\">"),
+        "the player did not start: {}",
+        page.display()
+    );
+    let frame: usize = attribute(&dom, "frame", "data-frame")
+        .and_then(|v| v.parse().ok())
+        .expect("data-frame");
+    let t: f64 = attribute(&dom, "time", "data-t")
+        .and_then(|v| v.parse().ok())
+        .expect("data-t");
+    let budget = f64::from(BUDGET_MS) / 1000.0 * seconds_per_second;
+    assert!(
+        frame > 0,
+        "the animation did not advance ({})",
+        page.display()
+    );
+    assert!(
+        t > budget / 6.0 && t <= budget * 1.1,
+        "t = {t} s after {budget} s of page time ({})",
+        page.display()
+    );
+    assert!(text(&dom, "time").is_some_and(|s| s.starts_with("t = ") && s != "t = 0 s"));
+    dom
+}
+
+/// Screenshot of `page` (1000 × 800) after half the budget, decoded: `(width, height, RGB
+/// rows)`.
+fn screenshot(page: &Path, dir: &Path) -> (u32, u32, Vec<u8>) {
+    let png_path = dir.join(format!(
+        "{}.png",
+        page.file_stem().and_then(|s| s.to_str()).unwrap_or("page")
+    ));
+    chromium(
+        page,
+        &[
+            format!("--virtual-time-budget={}", BUDGET_MS / 2),
+            "--window-size=1000,800".to_string(),
+            "--hide-scrollbars".to_string(),
+            format!("--screenshot={}", png_path.display()),
+        ],
+    );
+    let decoder = png::Decoder::new(std::io::BufReader::new(
+        std::fs::File::open(&png_path).expect("screenshot written"),
+    ));
+    let mut reader = decoder.read_info().expect("a PNG");
+    let mut buffer = vec![0; reader.output_buffer_size()];
+    let info = reader.next_frame(&mut buffer).expect("PNG decodes");
+    let channels = info.color_type.samples();
+    assert!(channels >= 3, "{:?}", info.color_type);
+    let rgb: Vec<u8> = buffer[..info.buffer_size()]
+        .chunks(channels)
+        .flat_map(|p| [p[0], p[1], p[2]])
+        .collect();
+    (info.width, info.height, rgb)
+}
+
+fn near(p: &[u8], c: [u8; 3], tolerance: i32) -> bool {
+    p.iter()
+        .zip(c)
+        .all(|(a, b)| (i32::from(*a) - i32::from(b)).abs() <= tolerance)
+}
+
+/// The screenshot is not blank: the picture's background covers part of it, a good share
+/// of the pixels are neither white nor that background, and the links' (and, if asked,
+/// the trace's) colour is drawn.
+fn check_screenshot(page: &Path, dir: &Path, traced: bool) {
+    let (width, height, rgb) = screenshot(page, dir);
+    assert_eq!((width, height), (1000, 800));
+    let pixels = rgb.len() / 3;
+    let count = |f: &dyn Fn(&[u8]) -> bool| rgb.chunks(3).filter(|p| f(p)).count();
+    let background = count(&|p| near(p, BACKGROUND, 1));
+    let ink = count(&|p| !near(p, [255, 255, 255], 2) && !near(p, BACKGROUND, 2));
+    let link = count(&|p| near(p, LINK, 24));
+    let trace = count(&|p| near(p, TRACE, 24));
+    let name = page.display();
+    // The picture fills most of the window; grid, links, joints, text and controls cover a
+    // few per cent of it; 4 px links over a metre or more are thousands of pixels.
+    assert!(
+        background > pixels / 4,
+        "{name}: background {background} of {pixels}"
+    );
+    assert!(
+        ink > pixels / 50,
+        "{name}: only {ink} of {pixels} pixels drawn"
+    );
+    assert!(link > 1000, "{name}: {link} pixels of the links' colour");
+    if traced {
+        assert!(trace > 100, "{name}: {trace} pixels of the trace's colour");
+    }
+}
+
+/// Writes `eomgen args… -o/--animate PATH` into `dir` and returns the path.
+fn page(dir: &Path, name: &str, args: &[&str]) -> PathBuf {
+    let path = dir.join(name);
+    let path_text = path.to_str().expect("UTF-8 path");
+    let mut all: Vec<&str> = args.to_vec();
+    all.push(path_text);
+    let out = common::eomgen(&all);
+    assert!(
+        out.status.success(),
+        "eomgen {}: {}",
+        all.join(" "),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    path
+}
+
+#[test]
+fn triple_pendulum_plays_in_chromium() {
+    if !chromium_present() {
+        return;
+    }
+    let dir = scratch_dir("triple");
+    let path = page(
+        &dir,
+        "triple_pendulum.html",
+        &["animate", "triple_pendulum", "-o"],
+    );
+    check_page_plays(&path, 1.0);
+    check_screenshot(&path, &dir, true);
+}
+
+#[test]
+fn four_bar_plays_in_chromium() {
+    if !chromium_present() {
+        return;
+    }
+    let dir = scratch_dir("four-bar");
+    let path = page(&dir, "four_bar.html", &["animate", "four_bar", "-o"]);
+    let dom = check_page_plays(&path, 1.0);
+    // The energy and its drift are shown.
+    assert!(text(&dom, "energy").is_some_and(|s| s.starts_with("E = ") && s.ends_with(" J")));
+    assert!(text(&dom, "drift").is_some_and(|s| s.contains("E₀")));
+    check_screenshot(&path, &dir, true);
+}
+
+/// The four-bar's one mode (6.398 rad/s, period 0.982 s) plays at one cycle per 2 s, so
+/// after the budget `t` has advanced by at most budget × 0.982 / 2 modulo the period.
+#[test]
+fn mode_shapes_play_in_chromium() {
+    if !chromium_present() {
+        return;
+    }
+    let dir = scratch_dir("modes");
+    let path = page(
+        &dir,
+        "four_bar_modes.html",
+        &["modes", "four_bar", "--animate"],
+    );
+    let dom = dom_after_budget(&path);
+    let errors = text(&dom, "errors").unwrap_or("?");
+    assert!(errors.trim().is_empty(), "{errors}");
+    assert!(dom.contains("<body data-state=\"ready\">"));
+    let frame: usize = attribute(&dom, "frame", "data-frame")
+        .and_then(|v| v.parse().ok())
+        .expect("data-frame");
+    assert!(frame > 0, "the mode did not move");
+    assert!(dom.contains("<select id=\"clip\""), "a mode selector");
+    check_screenshot(&path, &dir, false);
+}
+
+/// The check can fail: a page with a script error, and one that calls `console.error`,
+/// have their messages in `#errors`.
+#[test]
+fn errors_in_the_page_are_seen() {
+    if !chromium_present() {
+        return;
+    }
+    let dir = scratch_dir("errors");
+    let good = page(
+        &dir,
+        "good.html",
+        &["animate", "four_bar", "--t-end", "1", "-o"],
+    );
+    let html = std::fs::read_to_string(&good).expect("page");
+    for (name, script, expected) in [
+        ("thrown.html", "no_such_function();", "no_such_function"),
+        (
+            "logged.html",
+            "console.error('bad frame');",
+            "console.error: bad frame",
+        ),
+    ] {
+        let broken = dir.join(name);
+        let injected = html.replacen("</body>", &format!("<script>{script}</script>\n</body>"), 1);
+        std::fs::write(&broken, injected).expect("write");
+        let dom = dom_after_budget(&broken);
+        let errors = text(&dom, "errors").unwrap_or("");
+        assert!(errors.contains(expected), "{name}: `{errors}`");
+    }
+}
+
+/// The controls: a space key press pauses the player (the frame stays where it was and the
+/// button offers "Play"), the scrubber shows the frame it is moved to, and the speed
+/// selector scales the page's clock (at 0.25× a 3 s budget plays 0.75 s, against 3 s at
+/// 1×; the bounds allow 10 % of extra page time and a slow start).
+#[test]
+fn controls_work_in_chromium() {
+    if !chromium_present() {
+        return;
+    }
+    let dir = scratch_dir("controls");
+    let good = page(&dir, "good.html", &["animate", "triple_pendulum", "-o"]);
+    let html = std::fs::read_to_string(&good).expect("page");
+    let inject = |name: &str, script: &str| {
+        let path = dir.join(name);
+        let injected = html.replacen("</body>", &format!("<script>{script}</script>\n</body>"), 1);
+        std::fs::write(&path, injected).expect("write");
+        let dom = dom_after_budget(&path);
+        let errors = text(&dom, "errors").unwrap_or("?");
+        assert!(errors.trim().is_empty(), "{name}: {errors}");
+        let frame: usize = attribute(&dom, "frame", "data-frame")
+            .and_then(|v| v.parse().ok())
+            .expect("data-frame");
+        let t: f64 = attribute(&dom, "time", "data-t")
+            .and_then(|v| v.parse().ok())
+            .expect("data-t");
+        (dom, frame, t)
+    };
+    let (dom, frame, _) = inject(
+        "space.html",
+        "document.dispatchEvent(new KeyboardEvent('keydown', {key: ' ', code: 'Space', bubbles: true}));",
+    );
+    assert_eq!(frame, 0, "space did not pause");
+    assert_eq!(text(&dom, "play"), Some("Play"));
+    let (_, frame, t) = inject(
+        "scrub.html",
+        "var s = document.getElementById('scrub'); s.value = '150'; s.dispatchEvent(new Event('input'));",
+    );
+    assert_eq!(
+        (frame, t),
+        (150, 5.0),
+        "the scrubber moved to frame 150 (t = 5 s) and paused"
+    );
+    let (_, _, t) = inject(
+        "speed.html",
+        "var v = document.getElementById('speed'); v.value = '0.25'; v.dispatchEvent(new Event('change'));",
+    );
+    assert!(t > 0.4 && t <= 0.825, "at 0.25× after 3 s: t = {t}");
+}
