@@ -126,9 +126,16 @@ pub struct SimulateArgs {
     /// Write the samples as CSV (t, coordinates, rates, energy).
     #[arg(long, value_name = "FILE")]
     pub csv: Option<String>,
-    /// Plot the coordinates against time (.svg or .png).
+    /// Plot the coordinates against time (.svg or .png); a constrained model also gets its
+    /// constraint drift in `FILE-drift.svg`.
     #[arg(long, value_name = "FILE")]
     pub plot: Option<String>,
+    /// Plot the phase portrait, each rate against its coordinate (.svg or .png).
+    #[arg(long, value_name = "FILE")]
+    pub plot_phase: Option<String>,
+    /// Plot the energy drift E(t) − E(0) against time (.svg or .png).
+    #[arg(long, value_name = "FILE")]
+    pub plot_energy: Option<String>,
     /// Stop at the first zero of a function: a model event's name (`--stop-when lift_off`)
     /// or `EXPR` / `LHS = RHS`, optionally followed by `, rising`, `, falling` or `, both`
     /// (e.g. `--stop-when "theta_dot = 0, falling"`); names: parameters, coordinates, `t`,
@@ -237,6 +244,12 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
                 .plot(&drift_path, model.name(), &solution)
                 .map_err(CliError::failure)?;
         }
+    }
+    if let Some(path) = &args.plot_phase {
+        plot::phase_portrait(path, model.as_ref(), &solution).map_err(CliError::failure)?;
+    }
+    if let Some(path) = &args.plot_energy {
+        plot::energy_drift(path, model.as_ref(), &solution).map_err(CliError::failure)?;
     }
     if args.json {
         let samples: Vec<serde_json::Value> = solution
@@ -692,37 +705,6 @@ impl ConstraintReport {
     }
 
     fn plot(&self, path: &str, model: &str, solution: &Solution) -> Result<(), String> {
-        let series = vec![
-            plot::Series {
-                name: "max |Φ|".to_string(),
-                points: solution
-                    .t
-                    .iter()
-                    .zip(&self.drift)
-                    .map(|(t, d)| (*t, d.0))
-                    .collect(),
-            },
-            plot::Series {
-                name: "max |Φ̇|".to_string(),
-                points: solution
-                    .t
-                    .iter()
-                    .zip(&self.drift)
-                    .map(|(t, d)| (*t, d.1))
-                    .collect(),
-            },
-        ];
-        let title = format!("{model}: constraint drift");
-        plot::lines(
-            path,
-            &plot::Chart {
-                title: &title,
-                x_desc: "t (s)",
-                y_desc: "residual (units of Φ, Φ̇)",
-                log_x: false,
-                log_y: true,
-            },
-            &series,
-        )
+        plot::constraint_drift(path, model, &solution.t, &self.drift)
     }
 }

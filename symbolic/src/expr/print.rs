@@ -402,6 +402,10 @@ impl<'a> Printer<'a> {
                 }
             }
             Syntax::Text | Syntax::Latex | Syntax::MathMl => {
+                // `1/x` reaches here as the denominator `x^1` of `x^-1`.
+                if constant.is_some_and(|c| c.is_one()) {
+                    return b;
+                }
                 if constant == Some(half) {
                     return match self.syntax {
                         Syntax::Latex => (format!("\\sqrt{{{}}}", b.0), Prec::Atom),
