@@ -47,7 +47,11 @@ fn report_on_three_models_writes_the_page_and_json_and_passes() {
         "-o",
         dir.to_str().unwrap(),
     ]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let report = read_json(&dir);
     let names: Vec<&str> = report["models"]
         .as_array()
@@ -55,7 +59,11 @@ fn report_on_three_models_writes_the_page_and_json_and_passes() {
         .iter()
         .map(|m| m["name"].as_str().unwrap())
         .collect();
-    assert_eq!(names, ["dumbbell", "simple_pendulum", "three_masses"], "sorted");
+    assert_eq!(
+        names,
+        ["dumbbell", "simple_pendulum", "three_masses"],
+        "sorted"
+    );
     for name in names {
         let rows = checks(&report, name);
         assert!(!rows.is_empty());
@@ -64,8 +72,10 @@ fn report_on_three_models_writes_the_page_and_json_and_passes() {
         }
         // The generic checks are there for every model.
         assert!(
-            rows.iter()
-                .any(|c| c["check"].as_str().unwrap().starts_with("derivations agree")),
+            rows.iter().any(|c| c["check"]
+                .as_str()
+                .unwrap()
+                .starts_with("derivations agree")),
             "{name}"
         );
     }
@@ -76,7 +86,12 @@ fn report_on_three_models_writes_the_page_and_json_and_passes() {
     let pendulum = checks(&report, "simple_pendulum");
     let w = pendulum
         .iter()
-        .find(|c| c["check"].as_str().unwrap().starts_with("natural_frequencies[1]"))
+        .find(|c| {
+            c["check"]
+                .as_str()
+                .unwrap()
+                .starts_with("natural_frequencies[1]")
+        })
         .expect("natural frequency row");
     assert!((w["expected"].as_f64().unwrap() - 10f64.sqrt()).abs() < 1e-15);
     let masses = checks(&report, "three_masses");
@@ -95,7 +110,11 @@ fn report_on_three_models_writes_the_page_and_json_and_passes() {
     }
     // The dumbbell is constrained and conservative: energy and constraint drift both run.
     let dumbbell = checks(&report, "dumbbell");
-    for what in ["energy drift", "constraint drift", "conserved `angular_momentum`"] {
+    for what in [
+        "energy drift",
+        "constraint drift",
+        "conserved `angular_momentum`",
+    ] {
         assert!(
             dumbbell
                 .iter()
@@ -109,13 +128,19 @@ fn report_on_three_models_writes_the_page_and_json_and_passes() {
         assert!(html.contains(&format!("<section id=\"{id}\">")), "{id}");
     }
     assert!(html.contains("<math display=\"block\">"));
-    assert!(!html.contains("http://") && !html.contains("https://"), "no network");
+    assert!(
+        !html.contains("http://") && !html.contains("https://"),
+        "no network"
+    );
     for m in report["models"].as_array().unwrap() {
         let figures = m["figures"].as_array().unwrap();
         assert!(figures.len() >= 3, "{}: time, phase, energy", m["name"]);
         for f in figures {
             let file = f["file"].as_str().unwrap();
-            assert!(html.contains(&format!("src=\"{file}\"")), "{file} on the page");
+            assert!(
+                html.contains(&format!("src=\"{file}\"")),
+                "{file} on the page"
+            );
             let svg = std::fs::read_to_string(dir.join(file)).expect("figure written");
             assert!(svg.starts_with("<svg"), "{file}");
         }
@@ -129,7 +154,10 @@ fn report_on_three_models_writes_the_page_and_json_and_passes() {
 #[test]
 fn wrong_reference_values_fail_the_report() {
     let dir = out_dir("wrong");
-    let fixture = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/report_wrong_values.yaml");
+    let fixture = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/fixtures/report_wrong_values.yaml"
+    );
     let out = eomgen(&["report", "--models", fixture, "-o", dir.to_str().unwrap()]);
     assert_eq!(out.status.code(), Some(1), "a failed check exits 1");
     let stderr = String::from_utf8_lossy(&out.stderr);
@@ -140,7 +168,12 @@ fn wrong_reference_values_fail_the_report() {
     let rows = checks(&report, "compound_pendulum");
     let w = rows
         .iter()
-        .find(|c| c["check"].as_str().unwrap().starts_with("natural_frequencies[1]"))
+        .find(|c| {
+            c["check"]
+                .as_str()
+                .unwrap()
+                .starts_with("natural_frequencies[1]")
+        })
         .expect("row");
     assert_eq!(w["passed"], false);
     assert_eq!(w["expected"], 4.0);
@@ -152,7 +185,10 @@ fn wrong_reference_values_fail_the_report() {
         .find(|c| c["check"].as_str().unwrap().starts_with("conserved `rate`"))
         .expect("row");
     assert_eq!(rate["passed"], false);
-    assert!(rate["computed"].as_f64().unwrap() > 0.1, "θ̇ swings through 0");
+    assert!(
+        rate["computed"].as_f64().unwrap() > 0.1,
+        "θ̇ swings through 0"
+    );
     for c in rows {
         let check = c["check"].as_str().unwrap();
         if !check.starts_with("natural_frequencies") && !check.starts_with("conserved") {
@@ -314,7 +350,11 @@ fn report_is_byte_identical_across_runs() {
             "-o",
             dir.to_str().unwrap(),
         ]);
-        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
     }
     let mut files = Vec::new();
     let mut stack = vec![a.clone()];
@@ -356,7 +396,11 @@ fn simulate_draws_phase_portrait_and_energy_drift() {
         "--plot-energy",
         energy.to_str().unwrap(),
     ]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let phase = std::fs::read_to_string(&phase).expect("phase portrait written");
     assert!(phase.starts_with("<svg") && phase.contains("phase portrait"));
     assert!(phase.contains("q̇ (m/s or rad/s)") && phase.contains("q (m or rad)"));
@@ -372,7 +416,11 @@ fn simulate_draws_phase_portrait_and_energy_drift() {
 fn full_report_passes_on_every_model() {
     let dir = out_dir("all");
     let out = eomgen(&["report", "-o", dir.to_str().unwrap()]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let report = read_json(&dir);
     assert_eq!(
         report["summary"]["models"].as_u64().unwrap() as usize,

@@ -170,9 +170,8 @@ struct Source {
 /// Runs `report`.
 pub fn run(args: &ReportArgs) -> Result<(), CliError> {
     let sources = sources(&args.models)?;
-    std::fs::create_dir_all(&args.out).map_err(|e| {
-        CliError::failure(format!("cannot create `{}`: {e}", args.out.display()))
-    })?;
+    std::fs::create_dir_all(&args.out)
+        .map_err(|e| CliError::failure(format!("cannot create `{}`: {e}", args.out.display())))?;
     let bar = if args.json || !std::io::stderr().is_terminal() {
         indicatif::ProgressBar::hidden()
     } else {
@@ -242,7 +241,10 @@ pub fn run(args: &ReportArgs) -> Result<(), CliError> {
 /// The models named by `--models` (every bundled model when empty), loaded.
 fn sources(models: &[String]) -> Result<Vec<Source>, CliError> {
     let names: Vec<String> = if models.is_empty() {
-        eomgen::models::ALL.iter().map(|e| e.name.to_string()).collect()
+        eomgen::models::ALL
+            .iter()
+            .map(|e| e.name.to_string())
+            .collect()
     } else {
         models.iter().map(|m| m.trim().to_string()).collect()
     };
@@ -268,8 +270,7 @@ fn sources(models: &[String]) -> Result<Vec<Source>, CliError> {
             .iter()
             .map(|p| p.name.value.as_str())
             .collect();
-        if coordinates != compiled.coordinate_names() || parameters != compiled.parameter_names()
-        {
+        if coordinates != compiled.coordinate_names() || parameters != compiled.parameter_names() {
             return Err(CliError::usage(format!(
                 "`{display}` has other coordinates or parameters than the bundled `{}`: the report can only run its checks on the compiled model",
                 entry.name
@@ -383,7 +384,12 @@ struct Runs {
 }
 
 impl Runs {
-    fn get(&mut self, model: &mut dyn ModelInfo, y0: &[f64], run: Run) -> Result<&Solution, String> {
+    fn get(
+        &mut self,
+        model: &mut dyn ModelInfo,
+        y0: &[f64],
+        run: Run,
+    ) -> Result<&Solution, String> {
         let k = match self.done.iter().position(|(r, _)| *r == run) {
             Some(k) => k,
             None => {
@@ -400,8 +406,10 @@ impl Runs {
 fn expected(e: &Expr, model: &dyn ModelInfo) -> Result<f64, String> {
     let names = model.parameter_names();
     let values = model.parameter_values();
-    eval_expr(e, &|n| names.iter().position(|p| *p == n).map(|i| values[i]))
-        .map_err(|d| d.message)
+    eval_expr(e, &|n| {
+        names.iter().position(|p| *p == n).map(|i| values[i])
+    })
+    .map_err(|d| d.message)
 }
 
 /// Evaluates a function of the parameters, coordinates, rates and `t` at `(t, y)`.
@@ -421,7 +429,10 @@ fn state_value(e: &Expr, model: &dyn ModelInfo, t: f64, y: &[f64]) -> Result<f64
             return Some(y[i]);
         }
         let base = name.strip_suffix("_dot")?;
-        coordinates.iter().position(|c| *c == base).map(|i| y[n + i])
+        coordinates
+            .iter()
+            .position(|c| *c == base)
+            .map(|i| y[n + i])
     })
     .map_err(|d| d.message)
 }
@@ -476,7 +487,11 @@ fn modal_rows(
     for (k, e) in check.values.iter().enumerate() {
         let what = format!("{key}[{}] at {label}{unit}", k + 1);
         let value = values.get(k).copied().ok_or_else(|| {
-            format!("the model has {} value(s), the file states {}", values.len(), check.values.len())
+            format!(
+                "the model has {} value(s), the file states {}",
+                values.len(),
+                check.values.len()
+            )
         });
         match expected(e, model) {
             Ok(x) => rows.push(CheckRow::compare(what, value, x, check.tolerance)),
@@ -521,7 +536,10 @@ fn report_model(source: &Source, dir: &Path) -> ModelReport {
         Ok(r) => {
             for c in &r.comparisons {
                 checks.push(CheckRow::compare(
-                    format!("derivations agree: {} vs {} (max relative q̈ difference)", c.a, c.b),
+                    format!(
+                        "derivations agree: {} vs {} (max relative q̈ difference)",
+                        c.a, c.b
+                    ),
                     Ok(c.max_rel_residual),
                     0.0,
                     DERIVATION_TOLERANCE,
@@ -557,7 +575,15 @@ fn report_model(source: &Source, dir: &Path) -> ModelReport {
                 0.0,
                 0.0,
             ));
-            return finish(source, model.as_ref(), equations, figures, checks, notes, started);
+            return finish(
+                source,
+                model.as_ref(),
+                equations,
+                figures,
+                checks,
+                notes,
+                started,
+            );
         }
     };
     let mut runs = Runs { done: Vec::new() };
@@ -619,16 +645,21 @@ fn report_model(source: &Source, dir: &Path) -> ModelReport {
     // Generic: energy conservation (conservative models, or where the file asks for it).
     let energy = &file.checks.energy_drift;
     if model.is_conservative() || energy.is_some() {
-        let (bound, run) = energy.as_ref().map_or((DEFAULT_ENERGY_DRIFT, default_run), |d| {
-            (d.max, Run::of(&d.run))
-        });
+        let (bound, run) = energy
+            .as_ref()
+            .map_or((DEFAULT_ENERGY_DRIFT, default_run), |d| {
+                (d.max, Run::of(&d.run))
+            });
         let computed = runs.get(model.as_mut(), &y0, run).and_then(|s| {
             EnergyReport::new(model.as_ref(), &y0, s)
                 .drift
                 .ok_or_else(|| "no samples".to_string())
         });
         checks.push(CheckRow::compare(
-            format!("energy drift max|E − E(0)|/max(T + |V|) ({})", run.describe()),
+            format!(
+                "energy drift max|E − E(0)|/max(T + |V|) ({})",
+                run.describe()
+            ),
             computed,
             0.0,
             bound,
@@ -640,8 +671,10 @@ fn report_model(source: &Source, dir: &Path) -> ModelReport {
     if !model.constraint_names().is_empty() || constraint.is_some() {
         let (bound, run) = constraint
             .as_ref()
-            .map_or((DEFAULT_CONSTRAINT_DRIFT, default_run), |d| (d.max, Run::of(&d.run)));
-        let computed = runs.get(model.as_mut(), &y0, run).map(Clone::clone).map(|s| {
+            .map_or((DEFAULT_CONSTRAINT_DRIFT, default_run), |d| {
+                (d.max, Run::of(&d.run))
+            });
+        let computed = runs.get(model.as_mut(), &y0, run).cloned().map(|s| {
             s.iter()
                 .map(|(t, y)| {
                     let (p, v) = model.constraint_drift(t, y);
@@ -650,7 +683,10 @@ fn report_model(source: &Source, dir: &Path) -> ModelReport {
                 .fold(0.0f64, f64::max)
         });
         checks.push(CheckRow::compare(
-            format!("constraint drift max(|Φ|, |Φ̇|), no stabilisation ({})", run.describe()),
+            format!(
+                "constraint drift max(|Φ|, |Φ̇|), no stabilisation ({})",
+                run.describe()
+            ),
             computed,
             0.0,
             bound,
@@ -676,13 +712,24 @@ fn report_model(source: &Source, dir: &Path) -> ModelReport {
                     .map(|d| (label, d.iter().map(|m| m.1).collect()))
                     .map_err(|e| e.to_string())
             });
-        checks.extend(modal_rows("damping_ratios", "", check, model.as_ref(), computed));
+        checks.extend(modal_rows(
+            "damping_ratios",
+            "",
+            check,
+            model.as_ref(),
+            computed,
+        ));
     }
     if let Some(check) = &file.checks.period {
         let run = Run::of(&check.run);
         let event = check.event.value.as_str();
         let computed = runs.get(model.as_mut(), &y0, run).and_then(|s| {
-            let times: Vec<f64> = s.events.iter().filter(|e| e.name == event).map(|e| e.t).collect();
+            let times: Vec<f64> = s
+                .events
+                .iter()
+                .filter(|e| e.name == event)
+                .map(|e| e.t)
+                .collect();
             match times.as_slice() {
                 [.., a, b] => Ok(b - a),
                 _ => Err(format!(
@@ -692,7 +739,10 @@ fn report_model(source: &Source, dir: &Path) -> ModelReport {
                 )),
             }
         });
-        let what = format!("period between the last two `{event}` events (s) ({})", run.describe());
+        let what = format!(
+            "period between the last two `{event}` events (s) ({})",
+            run.describe()
+        );
         match expected(&check.value, model.as_ref()) {
             Ok(x) => checks.push(CheckRow::compare(what, computed, x, check.tolerance)),
             Err(e) => checks.push(CheckRow::compare(what, Err(e), f64::NAN, check.tolerance)),
@@ -728,9 +778,12 @@ fn report_model(source: &Source, dir: &Path) -> ModelReport {
                     let what = format!("{} at t = {} s ({})", k.value, short(t), run.describe());
                     match expected(e, model.as_ref()) {
                         Ok(x) => checks.push(CheckRow::compare(what, computed, x, check.tolerance)),
-                        Err(err) => {
-                            checks.push(CheckRow::compare(what, Err(err), f64::NAN, check.tolerance))
-                        }
+                        Err(err) => checks.push(CheckRow::compare(
+                            what,
+                            Err(err),
+                            f64::NAN,
+                            check.tolerance,
+                        )),
                     }
                 }
             }
@@ -740,7 +793,12 @@ fn report_model(source: &Source, dir: &Path) -> ModelReport {
                 f64::NAN,
                 check.tolerance,
             )),
-            Err(e) => checks.push(CheckRow::compare("final_state", Err(e), f64::NAN, check.tolerance)),
+            Err(e) => checks.push(CheckRow::compare(
+                "final_state",
+                Err(e),
+                f64::NAN,
+                check.tolerance,
+            )),
         }
     }
     for c in &file.checks.conserved {
@@ -796,7 +854,11 @@ fn report_model(source: &Source, dir: &Path) -> ModelReport {
                                 caption: format!(
                                     "Mode {} at {label}: ω = {:.6} rad/s",
                                     k + 1,
-                                    modes.natural_frequencies[k]
+                                    modes
+                                        .natural_frequencies
+                                        .get(k)
+                                        .copied()
+                                        .unwrap_or(f64::NAN)
                                 ),
                             });
                         }
@@ -807,7 +869,15 @@ fn report_model(source: &Source, dir: &Path) -> ModelReport {
             Err(e) => notes.push(format!("mode shapes: {e}")),
         }
     }
-    finish(source, model.as_ref(), equations, figures, checks, notes, started)
+    finish(
+        source,
+        model.as_ref(),
+        equations,
+        figures,
+        checks,
+        notes,
+        started,
+    )
 }
 
 fn finish(

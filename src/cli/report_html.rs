@@ -30,7 +30,8 @@ tr.failed td { background: #ffebe9; }
 details { margin: .4rem 0; }
 details pre { background: #f6f8fa; padding: .6rem; overflow-x: auto; font-size: .8rem; }
 .equations { overflow-x: auto; border-left: 3px solid var(--line); padding-left: .8rem; }
-.equations math { font-size: 1.1rem; margin: .35rem 0; text-align: left; }
+.equations div { margin: .35rem 0; white-space: nowrap; }
+.equations math { font-size: 1.1rem; display: inline math; }
 .figures { display: grid; grid-template-columns: repeat(auto-fill, minmax(360px, 1fr)); gap: 1rem; }
 figure { margin: 0; border: 1px solid var(--line); padding: .3rem; }
 figure img { width: 100%; height: auto; display: block; }
@@ -60,7 +61,7 @@ fn escape(s: &str) -> String {
 /// exponent form; `—` for a missing or non-finite value.
 fn number(v: Option<f64>) -> String {
     match v {
-        Some(v) if v == 0.0 => "0".to_string(),
+        Some(0.0) => "0".to_string(),
         Some(v) if v.is_finite() && (1e-3..1e5).contains(&v.abs()) => {
             let s = format!("{v:.10}");
             s.trim_end_matches('0').trim_end_matches('.').to_string()
@@ -146,8 +147,9 @@ fn section(h: &mut String, r: &ModelReport) {
     if !r.equations.is_empty() {
         h.push_str("<h3>Equations of motion (Lagrange)</h3>\n<div class=\"equations\">\n");
         for e in &r.equations {
-            h.push_str(e);
-            h.push('\n');
+            // One line each, left-aligned and scrollable: block math would be centred and
+            // clipped on the left when wider than the page.
+            let _ = writeln!(h, "<div>{e}</div>");
         }
         h.push_str("</div>\n");
     }

@@ -113,7 +113,10 @@ impl<'a> Printer<'a> {
                 format!("<mn>{}</mn>", num.unsigned_abs())
             }
             (Syntax::MathMl, Constant::Rational { num, den }) => {
-                format!("<mfrac><mn>{}</mn><mn>{den}</mn></mfrac>", num.unsigned_abs())
+                format!(
+                    "<mfrac><mn>{}</mn><mn>{den}</mn></mfrac>",
+                    num.unsigned_abs()
+                )
             }
             (Syntax::MathMl, Constant::Float(_)) => format!("<mn>{:?}</mn>", c.to_f64().abs()),
             (_, Constant::Rational { num, den: 1 }) => num.unsigned_abs().to_string(),

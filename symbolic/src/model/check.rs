@@ -759,11 +759,19 @@ impl<'f> Checker<'f> {
                 self.resolve(v, Depends::Constant, &format!("value {} of `{key}`", i + 1));
             }
             if let Some(at) = &modal.at {
-                let names: Vec<&str> = file.equilibria.iter().map(|e| e.name.value.as_str()).collect();
-                if !names.contains(&at.value.as_str()) && !self.incomplete.has_section("equilibria") {
+                let names: Vec<&str> = file
+                    .equilibria
+                    .iter()
+                    .map(|e| e.name.value.as_str())
+                    .collect();
+                if !names.contains(&at.value.as_str()) && !self.incomplete.has_section("equilibria")
+                {
                     let d = Diagnostic::new(
                         at.location,
-                        format!("`at: {}` of `{key}` is not an equilibrium of the model", at.value),
+                        format!(
+                            "`at: {}` of `{key}` is not an equilibrium of the model",
+                            at.value
+                        ),
                     );
                     let d = match closest(&at.value, &names) {
                         Some(c) => d.with_help(format!("did you mean `{c}`?")),
@@ -775,7 +783,10 @@ impl<'f> Checker<'f> {
                     self.error(d);
                 }
             }
-            let modes = file.coordinates.len().saturating_sub(file.constraints.len());
+            let modes = file
+                .coordinates
+                .len()
+                .saturating_sub(file.constraints.len());
             if key == "natural_frequencies"
                 && file.nonholonomic.is_empty()
                 && modal.values.len() != modes
@@ -797,10 +808,15 @@ impl<'f> Checker<'f> {
         if let Some(period) = &checks.period {
             self.resolve(&period.value, Depends::Constant, "the `value` of `period`");
             let names: Vec<&str> = file.events.iter().map(|e| e.name.value.as_str()).collect();
-            if !names.contains(&period.event.value.as_str()) && !self.incomplete.has_section("events") {
+            if !names.contains(&period.event.value.as_str())
+                && !self.incomplete.has_section("events")
+            {
                 let d = Diagnostic::new(
                     period.event.location,
-                    format!("`event: {}` of `period` is not an event of the model", period.event.value),
+                    format!(
+                        "`event: {}` of `period` is not an event of the model",
+                        period.event.value
+                    ),
                 );
                 let d = match closest(&period.event.value, &names) {
                     Some(c) => d.with_help(format!("did you mean `{c}`?")),
@@ -815,7 +831,11 @@ impl<'f> Checker<'f> {
         if let Some(state) = &checks.final_state {
             self.resolve(&state.t, Depends::Constant, "the time `t` of `final_state`");
             for (k, v) in &state.values {
-                self.resolve(v, Depends::Constant, &format!("the value of `{}` in `final_state`", k.value));
+                self.resolve(
+                    v,
+                    Depends::Constant,
+                    &format!("the value of `{}` in `final_state`", k.value),
+                );
                 let n = k.value.as_str();
                 if self.coords.contains(&n)
                     || self.rates.iter().any(|r| r == n)
@@ -831,13 +851,20 @@ impl<'f> Checker<'f> {
                 );
                 let d = match closest(n, &candidates) {
                     Some(c) => d.with_help(format!("did you mean `{c}`?")),
-                    None => d.with_help(format!("coordinates and rates are: {}", candidates.join(", "))),
+                    None => d.with_help(format!(
+                        "coordinates and rates are: {}",
+                        candidates.join(", ")
+                    )),
                 };
                 self.error(d);
             }
         }
         for c in &checks.conserved {
-            self.resolve(&c.value, Depends::Motion, &format!("conserved quantity `{}`", c.name.value));
+            self.resolve(
+                &c.value,
+                Depends::Motion,
+                &format!("conserved quantity `{}`", c.name.value),
+            );
         }
     }
 

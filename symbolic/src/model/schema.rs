@@ -1001,19 +1001,26 @@ impl Ctx<'_> {
         let method = match get(f, "method") {
             None => Some(None),
             Some(n) => {
-                let options: Vec<(&str, usize)> =
-                    CHECK_METHODS.iter().enumerate().map(|(i, m)| (*m, i)).collect();
+                let options: Vec<(&str, usize)> = CHECK_METHODS
+                    .iter()
+                    .enumerate()
+                    .map(|(i, m)| (*m, i))
+                    .collect();
                 self.choice(n, &format!("`method` of {what}"), &options)
                     .map(|i| Some(Located::new(CHECK_METHODS[i].to_string(), n.location)))
             }
         };
         let rtol = match get(f, "rtol") {
             None => Some(None),
-            Some(n) => self.positive_number(n, &format!("`rtol` of {what}")).map(Some),
+            Some(n) => self
+                .positive_number(n, &format!("`rtol` of {what}"))
+                .map(Some),
         };
         let t_end = match get(f, "t_end") {
             None => Some(None),
-            Some(n) => self.positive_number(n, &format!("`t_end` of {what}")).map(Some),
+            Some(n) => self
+                .positive_number(n, &format!("`t_end` of {what}"))
+                .map(Some),
         };
         Some(RunSettings {
             method: method?,
@@ -1051,9 +1058,8 @@ impl Ctx<'_> {
             None => Some(None),
             Some(n) => self.name(n, &format!("`at` of {what}")).map(Some),
         };
-        let values = get(f, "values").and_then(|n| {
-            self.expr_list(n, &format!("`values` of {what}"), "values: [sqrt(g/l)]")
-        });
+        let values = get(f, "values")
+            .and_then(|n| self.expr_list(n, &format!("`values` of {what}"), "values: [sqrt(g/l)]"));
         let tolerance = self.number_or(f, "tolerance", &what, DEFAULT_CHECK_TOLERANCE);
         Some(ModalCheck {
             at: at?,
@@ -1165,7 +1171,12 @@ impl Ctx<'_> {
     }
 
     /// `energy_drift:` or `constraint_drift:` — `{ max, method, rtol, t_end }`.
-    fn drift_check(&mut self, k: &Located<String>, v: &YamlNode, default: f64) -> Option<DriftCheck> {
+    fn drift_check(
+        &mut self,
+        k: &Located<String>,
+        v: &YamlNode,
+        default: f64,
+    ) -> Option<DriftCheck> {
         let what = format!("check `{}`", k.value);
         let f = self.fields(
             k,
