@@ -1,10 +1,8 @@
 //! `eomgen report`: the page and the JSON are written, the bundled models' reference checks
 //! pass, a file with wrong reference values fails (so the checks can fail), the MathML of a
 //! known equation has the expected structure, the output is byte-identical across runs, and
-//! `simulate` draws the phase portrait and the energy drift.
-//!
-//! The full report on every model is `#[ignore]`d:
-//! `cargo test --release --test report -- --ignored`.
+//! `simulate` draws the phase portrait and the energy drift. The full report on every bundled
+//! model runs too (under a second in a debug build).
 
 mod common;
 use common::eomgen;
@@ -409,10 +407,9 @@ fn simulate_draws_phase_portrait_and_energy_drift() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-/// Every bundled model's report passes (about 2 s in a debug build; run with
-/// `cargo test --release --test report -- --ignored`).
+/// Every bundled model's report passes: the catalogue's reference values, conservation and
+/// drift checks (under a second in a debug build).
 #[test]
-#[ignore]
 fn full_report_passes_on_every_model() {
     let dir = out_dir("all");
     let out = eomgen(&["report", "-o", dir.to_str().unwrap()]);
