@@ -1868,6 +1868,36 @@ mod tests {
     }
 
     #[test]
+    fn reference_checks_with_their_defaults() {
+        let src = "name: a\nparameters: { k: 1.0 }\ncoordinates: [q]\nkinetic: q_dot^2/2\npotential: k*q^2/2\nchecks:\n  natural_frequencies: { at: rest, values: [sqrt(k)] }\n  damping_ratios: { values: [0], tolerance: 1e-6 }\n  period: { event: peak, value: 2*pi, method: rk4, rtol: 1e-9, t_end: 20 }\n  final_state: { t: pi, values: { q: -1, q_dot: 0 } }\n  conserved: { p: q_dot, e: { value: q_dot^2 + k*q^2, tolerance: 1e-8 } }\n  energy_drift: {}\n  constraint_drift: { max: 1e-6 }\n";
+        let built = built(src);
+        assert!(built.diagnostics.is_empty(), "{:?}", built.diagnostics);
+        let c = built.file.unwrap().checks;
+        let w = c.natural_frequencies.unwrap();
+        assert_eq!(w.at.unwrap().value, "rest");
+        assert_eq!((w.values.len(), w.tolerance), (1, DEFAULT_CHECK_TOLERANCE));
+        let z = c.damping_ratios.unwrap();
+        assert!(z.at.is_none());
+        assert_eq!(z.tolerance, 1e-6);
+        let p = c.period.unwrap();
+        assert_eq!(p.event.value, "peak");
+        assert_eq!(p.run.method.unwrap().value, "rk4");
+        assert_eq!((p.run.rtol, p.run.t_end), (Some(1e-9), Some(20.0)));
+        let f = c.final_state.unwrap();
+        let names: Vec<&str> = f.values.iter().map(|(k, _)| k.value.as_str()).collect();
+        assert_eq!(names, ["q", "q_dot"]);
+        assert_eq!(f.run, RunSettings::default());
+        let tolerances: Vec<(&str, f64)> = c
+            .conserved
+            .iter()
+            .map(|q| (q.name.value.as_str(), q.tolerance))
+            .collect();
+        assert_eq!(tolerances, [("p", DEFAULT_CHECK_TOLERANCE), ("e", 1e-8)]);
+        assert_eq!(c.energy_drift.unwrap().max, DEFAULT_ENERGY_DRIFT);
+        assert_eq!(c.constraint_drift.unwrap().max, 1e-6);
+    }
+
+    #[test]
     fn events_short_and_full_forms() {
         let src = "name: a\ncoordinates: [q]\nkinetic: q_dot^2/2\nevents:\n  cross: q\n  peak: { when: q_dot, direction: falling, terminal: true }\n";
         let file = built(src).file.unwrap();
