@@ -407,3 +407,35 @@ fn controls_work_in_chromium() {
     );
     assert!(t > 0.4 && t <= 0.825, "at 0.25× after 3 s: t = {t}");
 }
+
+/// The course report (`eomgen report`) loads in Chromium with its sections and MathML, and
+/// the animation it embeds plays like one written by `eomgen animate`.
+#[test]
+fn report_loads_and_its_animation_plays_in_chromium() {
+    if !chromium_present() {
+        return;
+    }
+    let dir = scratch_dir("report");
+    let out = common::eomgen(&[
+        "report",
+        "--models",
+        "triple_pendulum,four_bar",
+        "-o",
+        dir.to_str().expect("UTF-8 path"),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let dom = dom_after_budget(&dir.join("index.html"));
+    for id in ["triple_pendulum", "four_bar"] {
+        assert!(dom.contains(&format!("<section id=\"{id}\">")), "{id}");
+        assert!(
+            dom.contains(&format!("src=\"{id}/animation.html\"")),
+            "{id}: animation embedded"
+        );
+    }
+    assert!(dom.contains("<math"), "MathML equations");
+    check_page_plays(&dir.join("triple_pendulum").join("animation.html"), 1.0);
+}

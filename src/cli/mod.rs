@@ -11,6 +11,8 @@ mod modal_damping;
 mod mode_plot;
 mod modes;
 mod plot;
+mod report;
+mod report_html;
 mod roundoff;
 mod simulate;
 mod stability;
@@ -55,6 +57,10 @@ enum Command {
     Frf(frf::FrfArgs),
     /// Print a generated model file: `n-link-pendulum N` or `n-mass-chain N`.
     New(equations::NewArgs),
+    /// Run every model's checks (derivations, conservation, the reference values of its
+    /// `checks:`) and write DIR/index.html (equations, figures, pass/fail tables) and
+    /// DIR/report.json; exit 1 if a check fails.
+    Report(report::ReportArgs),
     /// Numerical experiments comparing methods: `constraint-methods MODEL`,
     /// `work-precision MODEL`, `stability`, `euler-roundoff`.
     #[command(subcommand)]
@@ -97,6 +103,7 @@ pub fn run() -> ExitCode {
         Command::New(args) => equations::new(&args),
         Command::Modes(args) => modes::run(&args),
         Command::Frf(args) => frf::run(&args),
+        Command::Report(args) => report::run(&args),
         Command::Study(study) => study::run(&study),
     };
     match result {

@@ -219,3 +219,117 @@ where
     root.present().map_err(err)?;
     Ok(())
 }
+
+/// Plots the phase portrait of every coordinate, `q̇ᵢ` against `qᵢ`, one line each, into
+/// `path` (`.svg` or `.png`) — lecture 17's picture of a trajectory in the state plane.
+///
+/// # Errors
+/// An unknown extension, an empty solution, or a failure to write the file.
+pub fn phase_portrait(
+    path: &str,
+    model: &dyn ModelInfo,
+    solution: &Solution,
+) -> Result<(), String> {
+    if solution.is_empty() {
+        return Err("nothing to plot: the solution has no samples".to_string());
+    }
+    let n = model.num_dofs();
+    let series: Vec<Series> = model
+        .coordinate_names()
+        .iter()
+        .enumerate()
+        .map(|(i, name)| Series {
+            name: format!("{name}_dot vs {name}"),
+            points: solution.iter().map(|(_, y)| (y[i], y[n + i])).collect(),
+        })
+        .collect();
+    let title = format!("{}: phase portrait", model.name());
+    lines(
+        path,
+        &Chart {
+            title: &title,
+            x_desc: "q (m or rad)",
+            y_desc: "q̇ (m/s or rad/s)",
+            log_x: false,
+            log_y: false,
+        },
+        &series,
+    )
+}
+
+/// Plots the energy drift `E(t) − E(0)` (J) against time into `path` (`.svg` or `.png`),
+/// `E = T + V` of the model at every sample and `E(0)` at the first sample. Constant for a
+/// conservative model up to the integration error; for others it is the work of the
+/// non-conservative loads.
+///
+/// # Errors
+/// An unknown extension, an empty solution, or a failure to write the file.
+pub fn energy_drift(path: &str, model: &dyn ModelInfo, solution: &Solution) -> Result<(), String> {
+    let Some((t0, y0)) = solution.iter().next() else {
+        return Err("nothing to plot: the solution has no samples".to_string());
+    };
+    let e0 = model.energy(t0, y0);
+    let series = [Series {
+        name: "E − E(0)".to_string(),
+        points: solution
+            .iter()
+            .map(|(t, y)| (t, model.energy(t, y) - e0))
+            .collect(),
+    }];
+    let title = format!("{}: energy drift", model.name());
+    lines(
+        path,
+        &Chart {
+            title: &title,
+            x_desc: "t (s)",
+            y_desc: "E − E(0) (J)",
+            log_x: false,
+            log_y: false,
+        },
+        &series,
+    )
+}
+
+/// Plots the constraint drift of a constrained model against time into `path` (`.svg` or
+/// `.png`), on a logarithmic axis: `max |Φᵢ|` and the largest velocity-level residual at each
+/// time (`drift[k] = (position, velocity)` at `t[k]`, as [`ModelInfo::constraint_drift`]
+/// gives them; exact zeros are left out of the log axis).
+///
+/// # Errors
+/// Unequal lengths, an unknown extension, no positive value, or a failure to write the file.
+pub fn constraint_drift(
+    path: &str,
+    model: &str,
+    t: &[f64],
+    drift: &[(f64, f64)],
+) -> Result<(), String> {
+    if t.len() != drift.len() {
+        return Err(format!(
+            "constraint drift: {} times but {} residuals",
+            t.len(),
+            drift.len()
+        ));
+    }
+    let series = [
+        Series {
+            name: "max |Φ|".to_string(),
+            points: t.iter().zip(drift).map(|(t, d)| (*t, d.0)).collect(),
+        },
+        Series {
+            name: "max |Φ̇|".to_string(),
+            points: t.iter().zip(drift).map(|(t, d)| (*t, d.1)).collect(),
+        },
+    ];
+    let title = format!("{model}: constraint drift");
+    lines(
+        path,
+        &Chart {
+            title: &title,
+            x_desc: "t (s)",
+            y_desc: "residual (units of Φ, Φ̇)",
+            log_x: false,
+            log_y: true,
+        },
+        &series,
+    )
+}

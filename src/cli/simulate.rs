@@ -96,9 +96,16 @@ pub struct SimulateArgs {
     /// Write the samples as CSV (t, coordinates, rates, energy).
     #[arg(long, value_name = "FILE")]
     pub csv: Option<String>,
-    /// Plot the coordinates against time (.svg or .png).
+    /// Plot the coordinates against time (.svg or .png); a constrained model also gets its
+    /// constraint drift in `FILE-drift.svg`.
     #[arg(long, value_name = "FILE")]
     pub plot: Option<String>,
+    /// Plot the phase portrait, each rate against its coordinate (.svg or .png).
+    #[arg(long, value_name = "FILE")]
+    pub plot_phase: Option<String>,
+    /// Plot the energy drift E(t) − E(0) against time (.svg or .png).
+    #[arg(long, value_name = "FILE")]
+    pub plot_energy: Option<String>,
 }
 
 /// The integration options that `simulate` and `animate` share: end time, method,
@@ -151,6 +158,23 @@ pub struct IntegrationArgs {
     pub event: Vec<String>,
 }
 
+impl IntegrationArgs {
+    /// The command line's defaults, as `eomgen simulate MODEL` without options.
+    ///
+    /// # Errors
+    /// None in practice: parsing an empty command line only fails if a default is invalid.
+    pub(crate) fn defaults() -> Result<Self, CliError> {
+        #[derive(clap::Parser)]
+        struct Defaults {
+            #[command(flatten)]
+            args: IntegrationArgs,
+        }
+        <Defaults as clap::Parser>::try_parse_from(["eomgen"])
+            .map(|d| d.args)
+            .map_err(|e| CliError::failure(format!("default integration options: {e}")))
+    }
+}
+
 /// One integration of a model from its initial state, as `simulate` and `animate` run it.
 pub(crate) struct Run {
     /// The model, with `--set` and the drift control applied.
@@ -201,6 +225,12 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
                 .plot(&drift_path, model.name(), &solution)
                 .map_err(CliError::failure)?;
         }
+    }
+    if let Some(path) = &args.plot_phase {
+        plot::phase_portrait(path, model.as_ref(), &solution).map_err(CliError::failure)?;
+    }
+    if let Some(path) = &args.plot_energy {
+        plot::energy_drift(path, model.as_ref(), &solution).map_err(CliError::failure)?;
     }
     if args.json {
         let samples: Vec<serde_json::Value> = solution
@@ -767,37 +797,6 @@ impl ConstraintReport {
     }
 
     fn plot(&self, path: &str, model: &str, solution: &Solution) -> Result<(), String> {
-        let series = vec![
-            plot::Series {
-                name: "max |Φ|".to_string(),
-                points: solution
-                    .t
-                    .iter()
-                    .zip(&self.drift)
-                    .map(|(t, d)| (*t, d.0))
-                    .collect(),
-            },
-            plot::Series {
-                name: "max |Φ̇|".to_string(),
-                points: solution
-                    .t
-                    .iter()
-                    .zip(&self.drift)
-                    .map(|(t, d)| (*t, d.1))
-                    .collect(),
-            },
-        ];
-        let title = format!("{model}: constraint drift");
-        plot::lines(
-            path,
-            &plot::Chart {
-                title: &title,
-                x_desc: "t (s)",
-                y_desc: "residual (units of Φ, Φ̇)",
-                log_x: false,
-                log_y: true,
-            },
-            &series,
-        )
+        plot::constraint_drift(path, model, &solution.t, &self.drift)
     }
 }

@@ -1,6 +1,6 @@
-//! Printing expressions as plain text, Rust source and LaTeX.
+//! Printing expressions as plain text, Rust source, LaTeX and MathML.
 //!
-//! One printer serves the three syntaxes; they differ only in how atoms, powers, quotients
+//! One printer serves the four syntaxes; they differ only in how atoms, powers, quotients
 //! and calls are spelled. Sums print their non-constant terms first with negative
 //! coefficients as subtraction; products print negative powers as a denominator.
 
@@ -16,6 +16,11 @@ pub enum Syntax {
     Rust,
     /// LaTeX math (`\frac{m l^{2} \dot{\theta}^{2}}{2}`).
     Latex,
+    /// MathML Core presentation markup, the content of a `<math>` element
+    /// (`<mfrac><mrow><mi>m</mi>…</mrow><mn>2</mn></mfrac>`): every printed expression is one
+    /// element (`<mrow>` around sequences), so it can be the child of `<msup>` or `<mfrac>`.
+    /// Browsers render it without scripts or network.
+    MathMl,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
@@ -40,6 +45,7 @@ impl<'a> Printer<'a> {
     pub fn new(arena: &'a ExprArena, syntax: Syntax) -> Self {
         let symbol_name: Box<dyn Fn(SymbolId) -> String + 'a> = match syntax {
             Syntax::Latex => Box::new(move |s| latex_symbol(&arena.symbol_info(s).name)),
+            Syntax::MathMl => Box::new(move |s| mathml_symbol(&arena.symbol_info(s).name)),
             _ => Box::new(move |s| arena.symbol_info(s).name.clone()),
         };
         Self {
@@ -92,6 +98,8 @@ impl<'a> Printer<'a> {
             s
         } else if self.syntax == Syntax::Latex {
             format!("\\left({s}\\right)")
+        } else if self.syntax == Syntax::MathMl {
+            format!("<mrow><mo>(</mo>{s}<mo>)</mo></mrow>")
         } else {
             format!("({s})")
         }
@@ -101,6 +109,16 @@ impl<'a> Printer<'a> {
         let negative = c.is_negative();
         let text = match (self.syntax, c) {
             (Syntax::Rust, _) => format!("{:?}_f64", c.to_f64().abs()),
+            (Syntax::MathMl, Constant::Rational { num, den: 1 }) => {
+                format!("<mn>{}</mn>", num.unsigned_abs())
+            }
+            (Syntax::MathMl, Constant::Rational { num, den }) => {
+                format!(
+                    "<mfrac><mn>{}</mn><mn>{den}</mn></mfrac>",
+                    num.unsigned_abs()
+                )
+            }
+            (Syntax::MathMl, Constant::Float(_)) => format!("<mn>{:?}</mn>", c.to_f64().abs()),
             (_, Constant::Rational { num, den: 1 }) => num.unsigned_abs().to_string(),
             (Syntax::Text, Constant::Rational { num, den }) => {
                 format!("{}/{den}", num.unsigned_abs())
@@ -115,9 +133,27 @@ impl<'a> Printer<'a> {
             _ => Prec::Atom,
         };
         if negative {
-            (format!("-{text}"), Prec::Product)
+            (self.negated(&text), Prec::Product)
         } else {
             (text, prec)
+        }
+    }
+
+    /// `-x` in the printer's syntax (`x` printed as a factor already).
+    fn negated(&self, x: &str) -> String {
+        if self.syntax == Syntax::MathMl {
+            format!("<mrow><mo>\u{2212}</mo>{x}</mrow>")
+        } else {
+            format!("-{x}")
+        }
+    }
+
+    /// A number in the printer's syntax (`<mn>2</mn>` in MathML).
+    fn number(&self, text: String) -> String {
+        if self.syntax == Syntax::MathMl {
+            format!("<mn>{text}</mn>")
+        } else {
+            text
         }
     }
 
@@ -129,6 +165,7 @@ impl<'a> Printer<'a> {
                     Syntax::Text => "pi",
                     Syntax::Rust => "::core::f64::consts::PI",
                     Syntax::Latex => "\\pi",
+                    Syntax::MathMl => "<mi>\u{3c0}</mi>",
                 }
                 .to_string(),
                 Prec::Atom,
@@ -140,7 +177,7 @@ impl<'a> Printer<'a> {
                 let (s, p) = self.product(coefficient.abs_constant(), rest);
                 if coefficient.is_negative() {
                     (
-                        format!("-{}", self.wrap((s, p), Prec::Product)),
+                        self.negated(&self.wrap((s, p), Prec::Product)),
                         Prec::Product,
                     )
                 } else {
@@ -159,6 +196,13 @@ impl<'a> Printer<'a> {
                     ),
                     Syntax::Latex => (
                         format!("\\operatorname{{atan2}}\\left({}, {}\\right)", ys.0, xs.0),
+                        Prec::Atom,
+                    ),
+                    Syntax::MathMl => (
+                        format!(
+                            "<mrow><mi>atan2</mi><mo>\u{2061}</mo><mrow><mo>(</mo>{}<mo>,</mo>{}<mo>)</mo></mrow></mrow>",
+                            ys.0, xs.0
+                        ),
                         Prec::Atom,
                     ),
                 }
@@ -185,6 +229,12 @@ impl<'a> Printer<'a> {
                 .copied()
                 .filter(|t| self.arena.as_constant(*t).is_some()),
         );
+        let mathml = self.syntax == Syntax::MathMl;
+        let (minus, plus, between_minus) = if mathml {
+            ("<mo>\u{2212}</mo>", "<mo>+</mo>", "<mo>\u{2212}</mo>")
+        } else {
+            ("-", " + ", " - ")
+        };
         let mut out = String::new();
         for (i, &t) in ordered.iter().enumerate() {
             let (negative, magnitude) = self.signed_term(t);
@@ -192,18 +242,21 @@ impl<'a> Printer<'a> {
             match (i, negative) {
                 (0, false) => out.push_str(&text),
                 (0, true) => {
-                    out.push('-');
+                    out.push_str(minus);
                     out.push_str(&text);
                 }
                 (_, false) => {
-                    out.push_str(" + ");
+                    out.push_str(plus);
                     out.push_str(&text);
                 }
                 (_, true) => {
-                    out.push_str(" - ");
+                    out.push_str(between_minus);
                     out.push_str(&text);
                 }
             }
+        }
+        if mathml {
+            out = format!("<mrow>{out}</mrow>");
         }
         (out, Prec::Sum)
     }
@@ -232,10 +285,10 @@ impl<'a> Printer<'a> {
             (Syntax::Rust, c) | (_, c @ Constant::Float(_)) => numerator.push(self.constant(c)),
             (_, Constant::Rational { num, den }) => {
                 if num != 1 {
-                    numerator.push((num.to_string(), Prec::Atom));
+                    numerator.push((self.number(num.to_string()), Prec::Atom));
                 }
                 if den != 1 {
-                    denominator.push((den.to_string(), Prec::Atom));
+                    denominator.push((self.number(den.to_string()), Prec::Atom));
                 }
             }
         }
@@ -252,13 +305,14 @@ impl<'a> Printer<'a> {
         }
         let join = |items: &[(String, Prec)]| -> (String, Prec) {
             match items.len() {
-                0 => ("1".to_string(), Prec::Atom),
+                0 => (self.number("1".to_string()), Prec::Atom),
                 1 => items[0].clone(),
                 _ => {
                     let sep = match self.syntax {
                         Syntax::Text => "*",
                         Syntax::Rust => " * ",
                         Syntax::Latex => " ",
+                        Syntax::MathMl => "<mo>\u{2062}</mo>",
                     };
                     let parts: Vec<String> = items
                         .iter()
@@ -268,13 +322,16 @@ impl<'a> Printer<'a> {
                     for (i, p) in parts.iter().enumerate() {
                         if i > 0 {
                             let digit_follows = p.starts_with(|c: char| c.is_ascii_digit());
-                            s.push_str(if self.syntax == Syntax::Latex && digit_follows {
-                                " \\cdot "
-                            } else {
-                                sep
+                            s.push_str(match self.syntax {
+                                Syntax::Latex if digit_follows => " \\cdot ",
+                                Syntax::MathMl if p.starts_with("<mn>") => "<mo>\u{22c5}</mo>",
+                                _ => sep,
                             });
                         }
                         s.push_str(p);
+                    }
+                    if self.syntax == Syntax::MathMl {
+                        s = format!("<mrow>{s}</mrow>");
                     }
                     (s, Prec::Product)
                 }
@@ -290,6 +347,7 @@ impl<'a> Printer<'a> {
         let den = join(&denominator);
         match self.syntax {
             Syntax::Latex => (format!("\\frac{{{}}}{{{}}}", num.0, den.0), Prec::Atom),
+            Syntax::MathMl => (format!("<mfrac>{}{}</mfrac>", num.0, den.0), Prec::Atom),
             Syntax::Text | Syntax::Rust => {
                 let one = if self.syntax == Syntax::Rust {
                     "1.0_f64"
@@ -346,10 +404,15 @@ impl<'a> Printer<'a> {
                     }
                 }
             }
-            Syntax::Text | Syntax::Latex => {
+            Syntax::Text | Syntax::Latex | Syntax::MathMl => {
+                // `1/x` reaches here as the denominator `x^1` of `x^-1`.
+                if constant.is_some_and(|c| c.is_one()) {
+                    return b;
+                }
                 if constant == Some(half) {
                     return match self.syntax {
                         Syntax::Latex => (format!("\\sqrt{{{}}}", b.0), Prec::Atom),
+                        Syntax::MathMl => (format!("<msqrt>{}</msqrt>", b.0), Prec::Atom),
                         _ => (format!("sqrt({})", b.0), Prec::Atom),
                     };
                 }
@@ -360,6 +423,7 @@ impl<'a> Printer<'a> {
                 let base = self.wrap(b, Prec::Atom);
                 match self.syntax {
                     Syntax::Latex => (format!("{base}^{{{}}}", x.0), Prec::Power),
+                    Syntax::MathMl => (format!("<msup>{base}{}</msup>", x.0), Prec::Power),
                     _ => (format!("{base}^{}", self.wrap(x, Prec::Atom)), Prec::Power),
                 }
             }
@@ -390,6 +454,17 @@ impl<'a> Printer<'a> {
                 };
                 (s, Prec::Atom)
             }
+            Syntax::MathMl => {
+                let s = match f {
+                    Func::Abs => format!("<mrow><mo>|</mo>{}<mo>|</mo></mrow>", arg.0),
+                    _ => format!(
+                        "<mrow><mi>{}</mi><mo>\u{2061}</mo><mrow><mo>(</mo>{}<mo>)</mo></mrow></mrow>",
+                        f.name(),
+                        arg.0
+                    ),
+                };
+                (s, Prec::Atom)
+            }
         }
     }
 }
@@ -416,15 +491,15 @@ const GREEK: &[&str] = &[
     "omega", "Gamma", "Delta", "Theta", "Lambda", "Xi", "Pi", "Sigma", "Phi", "Psi", "Omega",
 ];
 
-/// LaTeX for a symbol name: `theta1` → `\theta_{1}`, `x_dot` → `\dot{x}`,
-/// `theta1_ddot` → `\ddot{\theta}_{1}`, `m_cart` → `m_{\mathrm{cart}}`.
-pub fn latex_symbol(name: &str) -> String {
+/// The parts of a symbol name: base, accent (`_dot` 1, `_ddot` 2) and subscript
+/// (`theta1` → `theta`, 0, `1`; `x_dot` → `x`, 1, none; `m_cart` → `m`, 0, `cart`).
+fn symbol_parts(name: &str) -> (String, u8, Option<String>) {
     let (stem, accent) = if let Some(s) = name.strip_suffix("_ddot") {
-        (s, Some("\\ddot"))
+        (s, 2)
     } else if let Some(s) = name.strip_suffix("_dot") {
-        (s, Some("\\dot"))
+        (s, 1)
     } else {
-        (name, None)
+        (name, 0)
     };
     let (base, subscript) = match stem.split_once('_') {
         Some((b, s)) => (b.to_string(), Some(s.to_string())),
@@ -438,6 +513,13 @@ pub fn latex_symbol(name: &str) -> String {
             }
         }
     };
+    (base, accent, subscript)
+}
+
+/// LaTeX for a symbol name: `theta1` → `\theta_{1}`, `x_dot` → `\dot{x}`,
+/// `theta1_ddot` → `\ddot{\theta}_{1}`, `m_cart` → `m_{\mathrm{cart}}`.
+pub fn latex_symbol(name: &str) -> String {
+    let (base, accent, subscript) = symbol_parts(name);
     let base = if GREEK.contains(&base.as_str()) {
         format!("\\{base}")
     } else if base.chars().count() > 1 {
@@ -446,13 +528,44 @@ pub fn latex_symbol(name: &str) -> String {
         base
     };
     let base = match accent {
-        Some(a) => format!("{a}{{{base}}}"),
-        None => base,
+        1 => format!("\\dot{{{base}}}"),
+        2 => format!("\\ddot{{{base}}}"),
+        _ => base,
     };
     match subscript {
         Some(s) if s.chars().all(|c| c.is_ascii_digit()) => format!("{base}_{{{s}}}"),
         Some(s) if s.chars().count() == 1 => format!("{base}_{{{s}}}"),
         Some(s) => format!("{base}_{{\\mathrm{{{s}}}}}"),
+        None => base,
+    }
+}
+
+/// Greek letters as characters, in the order of [`GREEK`].
+const GREEK_LETTERS: &[char] = &[
+    'α', 'β', 'γ', 'δ', 'ε', 'ζ', 'η', 'θ', 'ι', 'κ', 'λ', 'μ', 'ν', 'ξ', 'π', 'ρ', 'σ', 'τ', 'υ',
+    'φ', 'χ', 'ψ', 'ω', 'Γ', 'Δ', 'Θ', 'Λ', 'Ξ', 'Π', 'Σ', 'Φ', 'Ψ', 'Ω',
+];
+
+/// MathML for a symbol name, one element: `theta1` → `<msub><mi>θ</mi><mn>1</mn></msub>`,
+/// `x_dot` → `<mover accent="true"><mi>x</mi><mo>˙</mo></mover>`, `theta1_ddot` →
+/// `<msub><mover accent="true"><mi>θ</mi><mo>¨</mo></mover><mn>1</mn></msub>`, `m_cart` →
+/// `<msub><mi>m</mi><mi>cart</mi></msub>` (a multi-letter `<mi>` renders upright).
+pub fn mathml_symbol(name: &str) -> String {
+    let (base, accent, subscript) = symbol_parts(name);
+    let base = match GREEK.iter().position(|g| *g == base) {
+        Some(i) => format!("<mi>{}</mi>", GREEK_LETTERS[i]),
+        None => format!("<mi>{base}</mi>"),
+    };
+    let base = match accent {
+        1 => format!("<mover accent=\"true\">{base}<mo>\u{2d9}</mo></mover>"),
+        2 => format!("<mover accent=\"true\">{base}<mo>\u{a8}</mo></mover>"),
+        _ => base,
+    };
+    match subscript {
+        Some(s) if s.chars().all(|c| c.is_ascii_digit()) => {
+            format!("<msub>{base}<mn>{s}</mn></msub>")
+        }
+        Some(s) => format!("<msub>{base}<mi>{s}</mi></msub>"),
         None => base,
     }
 }

@@ -491,6 +491,16 @@ fn printing() {
         Printer::new(&a, Syntax::Text).print(e),
         "m*g - m*cos(theta1)"
     );
+    // MathML: the same structure as the LaTeX, every subexpression one element.
+    let mathml = Printer::new(&a, Syntax::MathMl).print(t);
+    assert_eq!(
+        mathml,
+        "<mfrac><mrow><mi>m</mi><mo>\u{2062}</mo><msup><mi>l</mi><mn>2</mn></msup><mo>\u{2062}</mo><msup><msub><mover accent=\"true\"><mi>θ</mi><mo>\u{2d9}</mo></mover><mn>1</mn></msub><mn>2</mn></msup></mrow><mn>2</mn></mfrac>"
+    );
+    assert_eq!(
+        Printer::new(&a, Syntax::MathMl).print(e),
+        "<mrow><mrow><mi>m</mi><mo>\u{2062}</mo><mi>g</mi></mrow><mo>\u{2212}</mo><mrow><mi>m</mi><mo>\u{2062}</mo><mrow><mi>cos</mi><mo>\u{2061}</mo><mrow><mo>(</mo><msub><mi>θ</mi><mn>1</mn></msub><mo>)</mo></mrow></mrow></mrow></mrow>"
+    );
 }
 
 #[test]

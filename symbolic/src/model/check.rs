@@ -34,6 +34,7 @@ pub fn check_partial(file: &ModelFile, incomplete: &Incomplete) -> Result<(), Ve
     checker.masses();
     checker.balances();
     checker.hand_equations();
+    checker.reference_checks();
     checker.constraints();
     checker.diagnostics.finish()
 }
@@ -738,6 +739,132 @@ impl<'f> Checker<'f> {
             if let Some(rhs) = &e.rhs {
                 self.resolve(rhs, Depends::Acceleration, &what);
             }
+        }
+    }
+
+    // Rule: the reference values of `checks:` are expressions of the parameters (a conserved
+    // quantity may also use coordinates, rates and `t`); `at:` names an entry of
+    // `equilibria:`, `event:` an entry of `events:`, and `final_state` gives coordinates and
+    // rates; `natural_frequencies` lists one value per mode (coordinates minus holonomic
+    // constraints, when there are no non-holonomic ones).
+    fn reference_checks(&mut self) {
+        let file = self.file;
+        let checks = &file.checks;
+        for (key, modal) in [
+            ("natural_frequencies", &checks.natural_frequencies),
+            ("damping_ratios", &checks.damping_ratios),
+        ] {
+            let Some(modal) = modal else { continue };
+            for (i, v) in modal.values.iter().enumerate() {
+                self.resolve(v, Depends::Constant, &format!("value {} of `{key}`", i + 1));
+            }
+            if let Some(at) = &modal.at {
+                let names: Vec<&str> = file
+                    .equilibria
+                    .iter()
+                    .map(|e| e.name.value.as_str())
+                    .collect();
+                if !names.contains(&at.value.as_str()) && !self.incomplete.has_section("equilibria")
+                {
+                    let d = Diagnostic::new(
+                        at.location,
+                        format!(
+                            "`at: {}` of `{key}` is not an equilibrium of the model",
+                            at.value
+                        ),
+                    );
+                    let d = match closest(&at.value, &names) {
+                        Some(c) => d.with_help(format!("did you mean `{c}`?")),
+                        None if names.is_empty() => d.with_help(
+                            "name the operating point in `equilibria:`, as in `equilibria: { hanging: { theta: 0 } }`",
+                        ),
+                        None => d.with_help(format!("equilibria are: {}", names.join(", "))),
+                    };
+                    self.error(d);
+                }
+            }
+            let modes = file
+                .coordinates
+                .len()
+                .saturating_sub(file.constraints.len());
+            if key == "natural_frequencies"
+                && file.nonholonomic.is_empty()
+                && modal.values.len() != modes
+                && !self.incomplete.has_section("coordinates")
+                && !self.incomplete.has_section("constraints")
+            {
+                self.error(
+                    Diagnostic::new(
+                        modal.location,
+                        format!(
+                            "`natural_frequencies` lists {} value(s), but the model has {modes} mode(s)",
+                            modal.values.len()
+                        ),
+                    )
+                    .with_help("give every natural frequency in rad/s, ascending, zero-frequency modes as 0"),
+                );
+            }
+        }
+        if let Some(period) = &checks.period {
+            self.resolve(&period.value, Depends::Constant, "the `value` of `period`");
+            let names: Vec<&str> = file.events.iter().map(|e| e.name.value.as_str()).collect();
+            if !names.contains(&period.event.value.as_str())
+                && !self.incomplete.has_section("events")
+            {
+                let d = Diagnostic::new(
+                    period.event.location,
+                    format!(
+                        "`event: {}` of `period` is not an event of the model",
+                        period.event.value
+                    ),
+                );
+                let d = match closest(&period.event.value, &names) {
+                    Some(c) => d.with_help(format!("did you mean `{c}`?")),
+                    None if names.is_empty() => d.with_help(
+                        "define it in `events:`, as in `events: { peak: { when: x_dot, direction: falling } }`",
+                    ),
+                    None => d.with_help(format!("events are: {}", names.join(", "))),
+                };
+                self.error(d);
+            }
+        }
+        if let Some(state) = &checks.final_state {
+            self.resolve(&state.t, Depends::Constant, "the time `t` of `final_state`");
+            for (k, v) in &state.values {
+                self.resolve(
+                    v,
+                    Depends::Constant,
+                    &format!("the value of `{}` in `final_state`", k.value),
+                );
+                let n = k.value.as_str();
+                if self.coords.contains(&n)
+                    || self.rates.iter().any(|r| r == n)
+                    || self.incomplete.has_section("coordinates")
+                {
+                    continue;
+                }
+                let mut candidates: Vec<&str> = self.coords.clone();
+                candidates.extend(self.rates.iter().map(String::as_str));
+                let d = Diagnostic::new(
+                    k.location,
+                    format!("`{n}` in `final_state` is neither a coordinate nor a rate"),
+                );
+                let d = match closest(n, &candidates) {
+                    Some(c) => d.with_help(format!("did you mean `{c}`?")),
+                    None => d.with_help(format!(
+                        "coordinates and rates are: {}",
+                        candidates.join(", ")
+                    )),
+                };
+                self.error(d);
+            }
+        }
+        for c in &checks.conserved {
+            self.resolve(
+                &c.value,
+                Depends::Motion,
+                &format!("conserved quantity `{}`", c.name.value),
+            );
         }
     }
 

@@ -168,12 +168,155 @@ pub struct HandEquation {
     pub location: Location,
 }
 
-/// `checks:` — what the file claims about its own model, verified by `eomgen check`.
+/// `checks:` — what the file claims about its own model: hand-derived equations, verified by
+/// `eomgen check`, and reference values, verified by `eomgen report`.
+///
+/// The reference vocabulary (every `tolerance` is optional, default 1e-9; a value passes when
+/// `|computed − expected| ≤ tolerance · max(1, |expected|)`; expected values are expressions
+/// of the parameters, evaluated at the parameters' values):
+///
+/// ```yaml
+/// checks:
+///   natural_frequencies: { at: hanging, values: [sqrt(g/l)], tolerance: 1e-9 }  # rad/s, ascending
+///   damping_ratios: { at: rest, values: [0.5] }          # ζ of the linearisation, by |s|
+///   period: { event: return, value: 2*pi*sqrt(l/g) }     # between the last two occurrences
+///   final_state: { t: 2, values: { x: 1, x_dot: 0 } }    # coordinates and rates at t
+///   conserved: { momentum: m*x_dot }                     # or { value: …, tolerance: … }
+///   energy_drift: { max: 1e-9, method: dop853, rtol: 1e-12, t_end: 10 }
+///   constraint_drift: { max: 1e-8 }
+/// ```
+///
+/// `at:` names an entry of `equilibria:` (default: the first, else q = 0). Simulations start
+/// from `initial:` and use `method` (default `dop853`), `rtol` = `atol` (default 1e-12) and
+/// `t_end` (default 10 s) where the entry takes them (`period`, `final_state`,
+/// `energy_drift`, `constraint_drift`); `conserved` uses the defaults. `energy_drift` is
+/// `max |E − E(0)| / max(T + |V|)` and `constraint_drift` the largest `|Φ|` or velocity
+/// residual over the run; `eomgen report` runs both by default (energy on conservative models,
+/// drift on constrained ones), and these entries change their bounds and settings.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct Checks {
     /// `equations_of_motion:` — the equations of motion as derived by hand, one per
     /// coordinate, linear in the accelerations (any combination of the true equations).
     pub equations_of_motion: Vec<HandEquation>,
+    /// `natural_frequencies:` — the undamped natural frequencies (rad/s) at an equilibrium.
+    pub natural_frequencies: Option<ModalCheck>,
+    /// `damping_ratios:` — the damping ratios of the linearisation at an equilibrium.
+    pub damping_ratios: Option<ModalCheck>,
+    /// `period:` — the interval between occurrences of an event (s).
+    pub period: Option<PeriodCheck>,
+    /// `final_state:` — coordinates and rates at a time.
+    pub final_state: Option<FinalStateCheck>,
+    /// `conserved:` — constants of the motion, in file order.
+    pub conserved: Vec<ConservedCheck>,
+    /// `energy_drift:` — bound and settings of the energy-conservation check.
+    pub energy_drift: Option<DriftCheck>,
+    /// `constraint_drift:` — bound and settings of the constraint-drift check.
+    pub constraint_drift: Option<DriftCheck>,
+}
+
+/// Default `tolerance` of a reference value in `checks:`.
+pub const DEFAULT_CHECK_TOLERANCE: f64 = 1e-9;
+
+/// Default `max` of `energy_drift:`: DOP853 at rtol = atol = 1e-12 keeps the relative drift
+/// over 10 s near 1e-11 on every bundled conservative model; 1e-9 leaves a factor of 100.
+pub const DEFAULT_ENERGY_DRIFT: f64 = 1e-9;
+
+/// Default `max` of `constraint_drift:`: the unstabilised drift of `Φ` and `Φ̇` at
+/// rtol = atol = 1e-12 over 10 s stays below 1e-10 on every bundled constrained model.
+pub const DEFAULT_CONSTRAINT_DRIFT: f64 = 1e-8;
+
+/// Integration methods a check may name (`method:`), as `eomgen simulate --method` spells
+/// them.
+pub const CHECK_METHODS: &[&str] = &[
+    "euler",
+    "midpoint",
+    "rk4",
+    "bs32",
+    "dp54",
+    "dop853",
+    "symplectic-euler",
+    "stormer-verlet",
+    "implicit-midpoint",
+    "radau5",
+];
+
+/// How a check integrates (`method:`, `rtol:`, `t_end:`); `None` means the default
+/// (`dop853`, 1e-12, 10 s).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct RunSettings {
+    /// One of [`CHECK_METHODS`].
+    pub method: Option<Located<String>>,
+    /// Relative and absolute tolerance.
+    pub rtol: Option<f64>,
+    /// End time (s).
+    pub t_end: Option<f64>,
+}
+
+/// `natural_frequencies:` or `damping_ratios:` — `{ at: hanging, values: [...], tolerance }`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ModalCheck {
+    /// The equilibrium (an `equilibria:` name); `None`: the first, else q = 0.
+    pub at: Option<Located<String>>,
+    /// Expected values, ascending as computed (expressions of the parameters).
+    pub values: Vec<Expr>,
+    /// Relative tolerance (see [`Checks`]).
+    pub tolerance: f64,
+    /// Where the entry's key is.
+    pub location: Location,
+}
+
+/// `period:` — `{ event: return, value: 2*pi*sqrt(l/g), tolerance, method, rtol, t_end }`:
+/// the interval between the last two occurrences of the event within `t_end`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PeriodCheck {
+    /// The event (an `events:` name).
+    pub event: Located<String>,
+    /// Expected period (s), an expression of the parameters.
+    pub value: Expr,
+    /// Relative tolerance.
+    pub tolerance: f64,
+    /// Integration settings.
+    pub run: RunSettings,
+    /// Where the entry's key is.
+    pub location: Location,
+}
+
+/// `final_state:` — `{ t: 2, values: { x: 1, x_dot: 0 }, tolerance, method, rtol }`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FinalStateCheck {
+    /// The time (s), an expression of the parameters.
+    pub t: Expr,
+    /// Expected values by coordinate or rate name (expressions of the parameters).
+    pub values: Vec<(Located<String>, Expr)>,
+    /// Relative tolerance.
+    pub tolerance: f64,
+    /// Integration settings (`t_end` is `t`).
+    pub run: RunSettings,
+    /// Where the entry's key is.
+    pub location: Location,
+}
+
+/// One `conserved:` entry: `name: expr` or `name: { value: expr, tolerance: 1e-9 }`, a
+/// function of the parameters, coordinates, rates and `t` that stays constant.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ConservedCheck {
+    /// Its name (`momentum`).
+    pub name: Located<String>,
+    /// The quantity.
+    pub value: Expr,
+    /// Bound on `max |Q(t) − Q(0)| / max(1, |Q(0)|)`.
+    pub tolerance: f64,
+}
+
+/// `energy_drift:` or `constraint_drift:` — `{ max: 1e-9, method, rtol, t_end }`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DriftCheck {
+    /// The bound.
+    pub max: f64,
+    /// Integration settings.
+    pub run: RunSettings,
+    /// Where the entry's key is.
+    pub location: Location,
 }
 
 /// One momentum-balance equation chosen by the user (`balances:`), as the course writes them:

@@ -46,6 +46,18 @@ pub const TOP_LEVEL_KEYS: &[&str] = &[
 /// Keys of the model format (DESIGN.md) that this version does not implement yet.
 pub const LATER_KEYS: &[&str] = &["outputs"];
 
+/// Keys of `checks:`.
+pub const CHECK_KEYS: &[&str] = &[
+    "equations_of_motion",
+    "natural_frequencies",
+    "damping_ratios",
+    "period",
+    "final_state",
+    "conserved",
+    "energy_drift",
+    "constraint_drift",
+];
+
 const BODY_KEYS: &[&str] = &["mass", "at", "inertia", "com", "angle"];
 const PARTICLE_EXAMPLE: &str = "{ mass: m, at: P }";
 const RIGID_EXAMPLE: &str = "{ mass: m, inertia: m*l^2/12, com: G, angle: theta }";
@@ -913,17 +925,13 @@ impl Ctx<'_> {
     }
 
     fn checks(&mut self, node: &YamlNode) -> Checks {
-        const EXAMPLE: &str = "checks:\n  equations_of_motion:\n    - m*x_ddot + k*x = 0";
+        const EXAMPLE: &str =
+            "checks:\n  natural_frequencies: { at: hanging, values: [sqrt(g/l)] }";
         let mut checks = Checks::default();
         let Some(entries) = self.map(node, "`checks`", EXAMPLE) else {
             return checks;
         };
-        self.unknown_keys(
-            entries,
-            "`checks`",
-            &["equations_of_motion"],
-            &["equations_of_motion"],
-        );
+        self.unknown_keys(entries, "`checks`", CHECK_KEYS, CHECK_KEYS);
         if let Some(list) = get(entries, "equations_of_motion").and_then(|n| {
             self.seq(
                 n,
@@ -937,7 +945,254 @@ impl Ctx<'_> {
                 }
             }
         }
+        for (k, v) in entries {
+            match k.value.as_str() {
+                "natural_frequencies" => checks.natural_frequencies = self.modal_check(k, v),
+                "damping_ratios" => checks.damping_ratios = self.modal_check(k, v),
+                "period" => checks.period = self.period_check(k, v),
+                "final_state" => checks.final_state = self.final_state_check(k, v),
+                "conserved" => checks.conserved = self.conserved_checks(v),
+                "energy_drift" => {
+                    checks.energy_drift = self.drift_check(k, v, DEFAULT_ENERGY_DRIFT)
+                }
+                "constraint_drift" => {
+                    checks.constraint_drift = self.drift_check(k, v, DEFAULT_CONSTRAINT_DRIFT)
+                }
+                _ => {}
+            }
+        }
         checks
+    }
+
+    /// A positive finite number written as a plain scalar (`1e-9`).
+    fn positive_number(&mut self, node: &YamlNode, what: &str) -> Option<f64> {
+        let value = match &node.kind {
+            YamlKind::Scalar { text, .. } => text.trim().parse::<f64>().ok(),
+            _ => None,
+        };
+        match value {
+            Some(v) if v.is_finite() && v > 0.0 => Some(v),
+            _ => {
+                self.error(
+                    Diagnostic::new(
+                        node.location,
+                        format!(
+                            "{what} must be a positive number, found {}",
+                            node.kind.describe()
+                        ),
+                    )
+                    .with_help("write a number such as `1e-9`"),
+                );
+                None
+            }
+        }
+    }
+
+    /// The optional positive number `key` of `f`, `default` when absent.
+    fn number_or(&mut self, f: &Entries, key: &str, what: &str, default: f64) -> Option<f64> {
+        match get(f, key) {
+            None => Some(default),
+            Some(n) => self.positive_number(n, &format!("`{key}` of {what}")),
+        }
+    }
+
+    /// `method:`, `rtol:` and `t_end:` of a check, each optional.
+    fn run_settings(&mut self, f: &Entries, what: &str) -> Option<RunSettings> {
+        let method = match get(f, "method") {
+            None => Some(None),
+            Some(n) => {
+                let options: Vec<(&str, usize)> = CHECK_METHODS
+                    .iter()
+                    .enumerate()
+                    .map(|(i, m)| (*m, i))
+                    .collect();
+                self.choice(n, &format!("`method` of {what}"), &options)
+                    .map(|i| Some(Located::new(CHECK_METHODS[i].to_string(), n.location)))
+            }
+        };
+        let rtol = match get(f, "rtol") {
+            None => Some(None),
+            Some(n) => self
+                .positive_number(n, &format!("`rtol` of {what}"))
+                .map(Some),
+        };
+        let t_end = match get(f, "t_end") {
+            None => Some(None),
+            Some(n) => self
+                .positive_number(n, &format!("`t_end` of {what}"))
+                .map(Some),
+        };
+        Some(RunSettings {
+            method: method?,
+            rtol: rtol?,
+            t_end: t_end?,
+        })
+    }
+
+    /// A list of expressions.
+    fn expr_list(&mut self, node: &YamlNode, what: &str, example: &str) -> Option<Vec<Expr>> {
+        let items = self.seq(node, what, example)?;
+        let mut out = Vec::with_capacity(items.len());
+        let mut complete = true;
+        for item in items {
+            match self.expr(item, &format!("a value of {what}")) {
+                Some(e) => out.push(e),
+                None => complete = false,
+            }
+        }
+        complete.then_some(out)
+    }
+
+    /// `natural_frequencies:` or `damping_ratios:` — `{ at, values, tolerance }`.
+    fn modal_check(&mut self, k: &Located<String>, v: &YamlNode) -> Option<ModalCheck> {
+        let what = format!("check `{}`", k.value);
+        let f = self.fields(
+            k,
+            v,
+            "check",
+            &["at", "values", "tolerance"],
+            &["values"],
+            "{ at: hanging, values: [sqrt(g/l)], tolerance: 1e-9 }",
+        )?;
+        let at = match get(f, "at") {
+            None => Some(None),
+            Some(n) => self.name(n, &format!("`at` of {what}")).map(Some),
+        };
+        let values = get(f, "values")
+            .and_then(|n| self.expr_list(n, &format!("`values` of {what}"), "values: [sqrt(g/l)]"));
+        let tolerance = self.number_or(f, "tolerance", &what, DEFAULT_CHECK_TOLERANCE);
+        Some(ModalCheck {
+            at: at?,
+            values: values?,
+            tolerance: tolerance?,
+            location: k.location,
+        })
+    }
+
+    /// `period:` — `{ event, value, tolerance, method, rtol, t_end }`.
+    fn period_check(&mut self, k: &Located<String>, v: &YamlNode) -> Option<PeriodCheck> {
+        let what = format!("check `{}`", k.value);
+        let f = self.fields(
+            k,
+            v,
+            "check",
+            &["event", "value", "tolerance", "method", "rtol", "t_end"],
+            &["event", "value"],
+            "{ event: return, value: 2*pi*sqrt(l/g), tolerance: 1e-9 }",
+        )?;
+        let event = get(f, "event").and_then(|n| self.name(n, &format!("`event` of {what}")));
+        let value = get(f, "value").and_then(|n| self.expr(n, &format!("`value` of {what}")));
+        let tolerance = self.number_or(f, "tolerance", &what, DEFAULT_CHECK_TOLERANCE);
+        let run = self.run_settings(f, &what);
+        Some(PeriodCheck {
+            event: event?,
+            value: value?,
+            tolerance: tolerance?,
+            run: run?,
+            location: k.location,
+        })
+    }
+
+    /// `final_state:` — `{ t, values: { x: …, x_dot: … }, tolerance, method, rtol }`.
+    fn final_state_check(&mut self, k: &Located<String>, v: &YamlNode) -> Option<FinalStateCheck> {
+        let what = format!("check `{}`", k.value);
+        let f = self.fields(
+            k,
+            v,
+            "check",
+            &["t", "values", "tolerance", "method", "rtol"],
+            &["t", "values"],
+            "{ t: 2, values: { x: 1, x_dot: 0 }, tolerance: 1e-9 }",
+        )?;
+        let t = get(f, "t").and_then(|n| self.expr(n, &format!("`t` of {what}")));
+        let values = get(f, "values").and_then(|n| {
+            self.keyed_exprs(
+                n,
+                &format!("`values` of {what}"),
+                "values: { x: 1, x_dot: 0 }",
+                "an expected value",
+            )
+            .into()
+        });
+        let tolerance = self.number_or(f, "tolerance", &what, DEFAULT_CHECK_TOLERANCE);
+        let run = self.run_settings(f, &what);
+        Some(FinalStateCheck {
+            t: t?,
+            values: values?,
+            tolerance: tolerance?,
+            run: run?,
+            location: k.location,
+        })
+    }
+
+    /// `conserved:` — `name: expr` or `name: { value: expr, tolerance: 1e-9 }`.
+    fn conserved_checks(&mut self, node: &YamlNode) -> Vec<ConservedCheck> {
+        const EXAMPLE: &str = "conserved: { momentum: (m1 + m2)*x_dot }";
+        let Some(entries) = self.map(node, "`conserved`", EXAMPLE) else {
+            return Vec::new();
+        };
+        let mut out = Vec::new();
+        for (k, v) in entries {
+            if !self.key_name(k, "conserved quantity") {
+                continue;
+            }
+            let what = format!("conserved quantity `{}`", k.value);
+            if !matches!(v.kind, YamlKind::Map(_)) {
+                if let Some(value) = self.expr(v, &what) {
+                    out.push(ConservedCheck {
+                        name: k.clone(),
+                        value,
+                        tolerance: DEFAULT_CHECK_TOLERANCE,
+                    });
+                }
+                continue;
+            }
+            let Some(f) = self.fields(
+                k,
+                v,
+                "conserved quantity",
+                &["value", "tolerance"],
+                &["value"],
+                "{ value: m*x_dot, tolerance: 1e-9 }",
+            ) else {
+                continue;
+            };
+            let value = get(f, "value").and_then(|n| self.expr(n, &what));
+            let tolerance = self.number_or(f, "tolerance", &what, DEFAULT_CHECK_TOLERANCE);
+            if let (Some(value), Some(tolerance)) = (value, tolerance) {
+                out.push(ConservedCheck {
+                    name: k.clone(),
+                    value,
+                    tolerance,
+                });
+            }
+        }
+        out
+    }
+
+    /// `energy_drift:` or `constraint_drift:` — `{ max, method, rtol, t_end }`.
+    fn drift_check(
+        &mut self,
+        k: &Located<String>,
+        v: &YamlNode,
+        default: f64,
+    ) -> Option<DriftCheck> {
+        let what = format!("check `{}`", k.value);
+        let f = self.fields(
+            k,
+            v,
+            "check",
+            &["max", "method", "rtol", "t_end"],
+            &[],
+            "{ max: 1e-9, method: dop853, rtol: 1e-12, t_end: 10 }",
+        )?;
+        let max = self.number_or(f, "max", &what, default);
+        let run = self.run_settings(f, &what);
+        Some(DriftCheck {
+            max: max?,
+            run: run?,
+            location: k.location,
+        })
     }
 
     /// One `lhs = rhs` equation (or an expression meaning `= 0`).
@@ -1610,6 +1865,36 @@ mod tests {
                 .unwrap()
                 .starts_with("did you mean `kinetic`?")
         );
+    }
+
+    #[test]
+    fn reference_checks_with_their_defaults() {
+        let src = "name: a\nparameters: { k: 1.0 }\ncoordinates: [q]\nkinetic: q_dot^2/2\npotential: k*q^2/2\nchecks:\n  natural_frequencies: { at: rest, values: [sqrt(k)] }\n  damping_ratios: { values: [0], tolerance: 1e-6 }\n  period: { event: peak, value: 2*pi, method: rk4, rtol: 1e-9, t_end: 20 }\n  final_state: { t: pi, values: { q: -1, q_dot: 0 } }\n  conserved: { p: q_dot, e: { value: q_dot^2 + k*q^2, tolerance: 1e-8 } }\n  energy_drift: {}\n  constraint_drift: { max: 1e-6 }\n";
+        let built = built(src);
+        assert!(built.diagnostics.is_empty(), "{:?}", built.diagnostics);
+        let c = built.file.unwrap().checks;
+        let w = c.natural_frequencies.unwrap();
+        assert_eq!(w.at.unwrap().value, "rest");
+        assert_eq!((w.values.len(), w.tolerance), (1, DEFAULT_CHECK_TOLERANCE));
+        let z = c.damping_ratios.unwrap();
+        assert!(z.at.is_none());
+        assert_eq!(z.tolerance, 1e-6);
+        let p = c.period.unwrap();
+        assert_eq!(p.event.value, "peak");
+        assert_eq!(p.run.method.unwrap().value, "rk4");
+        assert_eq!((p.run.rtol, p.run.t_end), (Some(1e-9), Some(20.0)));
+        let f = c.final_state.unwrap();
+        let names: Vec<&str> = f.values.iter().map(|(k, _)| k.value.as_str()).collect();
+        assert_eq!(names, ["q", "q_dot"]);
+        assert_eq!(f.run, RunSettings::default());
+        let tolerances: Vec<(&str, f64)> = c
+            .conserved
+            .iter()
+            .map(|q| (q.name.value.as_str(), q.tolerance))
+            .collect();
+        assert_eq!(tolerances, [("p", DEFAULT_CHECK_TOLERANCE), ("e", 1e-8)]);
+        assert_eq!(c.energy_drift.unwrap().max, DEFAULT_ENERGY_DRIFT);
+        assert_eq!(c.constraint_drift.unwrap().max, 1e-6);
     }
 
     #[test]

@@ -1,0 +1,446 @@
+//! `eomgen report`: the page and the JSON are written, the bundled models' reference checks
+//! pass, a file with wrong reference values fails (so the checks can fail), the MathML of a
+//! known equation has the expected structure, the output is byte-identical across runs, and
+//! `simulate` draws the phase portrait and the energy drift. The full report on every bundled
+//! model runs too (under a second in a debug build).
+
+mod common;
+use common::eomgen;
+
+use std::path::{Path, PathBuf};
+
+use eomgen_symbolic::codegen::equations_mathml;
+use eomgen_symbolic::mechanics::{Formulation, Lagrange, SymbolicModel};
+
+fn out_dir(tag: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("eomgen-report-{tag}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    dir
+}
+
+fn read_json(dir: &Path) -> serde_json::Value {
+    let text = std::fs::read_to_string(dir.join("report.json")).expect("report.json written");
+    serde_json::from_str(&text).expect("report.json is JSON")
+}
+
+/// The rows of `model` in `report`.
+fn checks<'a>(report: &'a serde_json::Value, model: &str) -> &'a Vec<serde_json::Value> {
+    report["models"]
+        .as_array()
+        .expect("models")
+        .iter()
+        .find(|m| m["name"] == model)
+        .unwrap_or_else(|| panic!("no section for {model}"))["checks"]
+        .as_array()
+        .expect("checks")
+}
+
+/// The row of `rows` whose check name starts with `prefix` (`what` names it in the panic).
+fn row<'a>(
+    rows: &'a [serde_json::Value],
+    prefix: impl AsRef<str>,
+    what: &str,
+) -> &'a serde_json::Value {
+    rows.iter()
+        .find(|c| {
+            c["check"]
+                .as_str()
+                .unwrap_or_default()
+                .starts_with(prefix.as_ref())
+        })
+        .unwrap_or_else(|| panic!("{what}: no check starting `{}`", prefix.as_ref()))
+}
+
+#[test]
+fn report_on_three_models_writes_the_page_and_json_and_passes() {
+    let dir = out_dir("three");
+    let out = eomgen(&[
+        "report",
+        "--models",
+        "three_masses,simple_pendulum,dumbbell",
+        "-o",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let report = read_json(&dir);
+    let names: Vec<&str> = report["models"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|m| m["name"].as_str().unwrap())
+        .collect();
+    assert_eq!(
+        names,
+        ["dumbbell", "simple_pendulum", "three_masses"],
+        "sorted"
+    );
+    for name in names {
+        let rows = checks(&report, name);
+        assert!(!rows.is_empty());
+        for c in rows {
+            assert_eq!(c["passed"], true, "{name}: {c}");
+        }
+        // The generic checks are there for every model.
+        assert!(
+            rows.iter().any(|c| c["check"]
+                .as_str()
+                .unwrap()
+                .starts_with("derivations agree")),
+            "{name}"
+        );
+    }
+    assert_eq!(report["summary"]["failed"], 0);
+    // The expected values are the files' expressions evaluated at the defaults; recompute
+    // them here: sqrt(g/l) with g = 10, l = 1, and omega^2 = (2 -+ sqrt 2, 2) k/m for the
+    // three masses (k = m = 1), to 1e-15 (only the evaluation order differs).
+    let pendulum = checks(&report, "simple_pendulum");
+    let w = row(pendulum, "natural_frequencies[1]", "natural frequency row");
+    assert!((w["expected"].as_f64().unwrap() - 10f64.sqrt()).abs() < 1e-15);
+    let masses = checks(&report, "three_masses");
+    let s2 = 2f64.sqrt();
+    for (k, w2) in [2.0 - s2, 2.0, 2.0 + s2].iter().enumerate() {
+        let row = masses
+            .iter()
+            .find(|c| {
+                c["check"]
+                    .as_str()
+                    .unwrap()
+                    .starts_with(&format!("natural_frequencies[{}]", k + 1))
+            })
+            .expect("row");
+        assert!((row["expected"].as_f64().unwrap() - w2.sqrt()).abs() < 1e-15);
+    }
+    // The dumbbell is constrained and conservative: energy and constraint drift both run.
+    let dumbbell = checks(&report, "dumbbell");
+    for what in [
+        "energy drift",
+        "constraint drift",
+        "conserved `angular_momentum`",
+    ] {
+        assert!(
+            dumbbell
+                .iter()
+                .any(|c| c["check"].as_str().unwrap().starts_with(what)),
+            "{what}"
+        );
+    }
+    // The page: a section per model, MathML equations, figures that exist next to it.
+    let html = std::fs::read_to_string(dir.join("index.html")).expect("index.html written");
+    for id in ["dumbbell", "simple_pendulum", "three_masses"] {
+        assert!(html.contains(&format!("<section id=\"{id}\">")), "{id}");
+    }
+    assert!(html.contains("<math display=\"block\">"));
+    assert!(
+        !html.contains("http://") && !html.contains("https://"),
+        "no network"
+    );
+    for m in report["models"].as_array().unwrap() {
+        let figures = m["figures"].as_array().unwrap();
+        assert!(figures.len() >= 3, "{}: time, phase, energy", m["name"]);
+        for f in figures {
+            let file = f["file"].as_str().unwrap();
+            assert!(
+                html.contains(&format!("src=\"{file}\"")),
+                "{file} on the page"
+            );
+            let svg = std::fs::read_to_string(dir.join(file)).expect("figure written");
+            assert!(svg.starts_with("<svg"), "{file}");
+        }
+        // A model whose file draws something has its animation next to the page, shown in
+        // an iframe; the others have none.
+        let name = m["name"].as_str().unwrap();
+        let drawn = eomgen::models::find(name).is_some_and(|entry| {
+            let model = (entry.make)();
+            !model.draw_lines().is_empty() || !model.trace_points().is_empty()
+        });
+        match m["animation"].as_str() {
+            Some(file) => {
+                assert!(drawn, "{name}: animated without draw:");
+                assert!(html.contains(&format!("<iframe class=\"animation\" src=\"{file}\"")));
+                let page = std::fs::read_to_string(dir.join(file)).expect("animation written");
+                assert!(
+                    page.starts_with("<!DOCTYPE html>") && page.contains(name),
+                    "{file}"
+                );
+            }
+            None => assert!(!drawn, "{name}: draws but has no animation"),
+        }
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A file whose `checks:` state a wrong natural frequency (4 rad/s against the true √15) and a
+/// quantity that is not conserved: both rows fail, the others pass, and the command exits 1.
+#[test]
+fn wrong_reference_values_fail_the_report() {
+    let dir = out_dir("wrong");
+    let fixture = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/fixtures/report_wrong_values.yaml"
+    );
+    let out = eomgen(&["report", "--models", fixture, "-o", dir.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(1), "a failed check exits 1");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("2 of"), "{stderr}");
+    assert!(stderr.contains("natural_frequencies[1]"), "{stderr}");
+    let report = read_json(&dir);
+    assert_eq!(report["summary"]["failed"], 2);
+    let rows = checks(&report, "compound_pendulum");
+    let w = row(rows, "natural_frequencies[1]", "row");
+    assert_eq!(w["passed"], false);
+    assert_eq!(w["expected"], 4.0);
+    // What was computed is the true √(m g d/(I + m d²)) = √15 (to 1e-12: the eigenvalue of
+    // a 1 × 1 problem, exact to rounding).
+    assert!((w["computed"].as_f64().unwrap() - 15f64.sqrt()).abs() < 1e-12);
+    let rate = rows
+        .iter()
+        .find(|c| c["check"].as_str().unwrap().starts_with("conserved `rate`"))
+        .expect("row");
+    assert_eq!(rate["passed"], false);
+    assert!(
+        rate["computed"].as_f64().unwrap() > 0.1,
+        "θ̇ swings through 0"
+    );
+    for c in rows {
+        let check = c["check"].as_str().unwrap();
+        if !check.starts_with("natural_frequencies") && !check.starts_with("conserved") {
+            assert_eq!(c["passed"], true, "{c}");
+        }
+    }
+    let html = std::fs::read_to_string(dir.join("index.html")).unwrap();
+    assert!(html.contains("FAIL"));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A file naming a model that is not bundled is a usage error (exit 2), not a report.
+#[test]
+fn a_file_of_an_unbundled_model_is_a_usage_error() {
+    let dir = out_dir("unbundled");
+    let fixture = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/frf_loads.yaml");
+    let out = eomgen(&["report", "--models", fixture, "-o", dir.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("not bundled"));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A tiny XML tree of MathML: tag and children, or text.
+#[derive(Debug, PartialEq)]
+enum Node {
+    Element(String, Vec<Node>),
+    Text(String),
+}
+
+/// Parses well-formed MathML as written by the printer (no attributes other than
+/// `display` and `accent`, no self-closing tags); panics on mismatched tags.
+fn parse(s: &str) -> Node {
+    fn element(s: &str, i: &mut usize) -> Node {
+        assert_eq!(&s[*i..*i + 1], "<");
+        let end = s[*i..].find('>').unwrap() + *i;
+        let tag = s[*i + 1..end].split(' ').next().unwrap().to_string();
+        *i = end + 1;
+        let mut children = Vec::new();
+        loop {
+            if s[*i..].starts_with("</") {
+                let close = s[*i..].find('>').unwrap() + *i;
+                assert_eq!(&s[*i + 2..close], tag, "mismatched close tag");
+                *i = close + 1;
+                return Node::Element(tag, children);
+            } else if s[*i..].starts_with('<') {
+                children.push(element(s, i));
+            } else {
+                let next = s[*i..].find('<').unwrap() + *i;
+                children.push(Node::Text(s[*i..next].to_string()));
+                *i = next;
+            }
+        }
+    }
+    let mut i = 0;
+    let node = element(s, &mut i);
+    assert_eq!(i, s.len(), "one root element");
+    node
+}
+
+fn tag(n: &Node) -> &str {
+    match n {
+        Node::Element(t, _) => t,
+        Node::Text(_) => "#text",
+    }
+}
+
+fn children(n: &Node) -> &[Node] {
+    match n {
+        Node::Element(_, c) => c,
+        Node::Text(_) => &[],
+    }
+}
+
+/// The text of a leaf element (`<mi>m</mi>` → `m`).
+fn text(n: &Node) -> String {
+    match children(n) {
+        [Node::Text(t)] => t.clone(),
+        _ => String::new(),
+    }
+}
+
+/// The factors of a product `<mrow>a<mo>⁢</mo>b…</mrow>`, printed back compactly, sorted.
+fn factors(n: &Node) -> Vec<String> {
+    assert_eq!(tag(n), "mrow");
+    let mut out: Vec<String> = children(n)
+        .iter()
+        .filter(|c| !(tag(c) == "mo" && text(c) == "\u{2062}"))
+        .map(compact)
+        .collect();
+    out.sort();
+    out
+}
+
+/// `n` printed as `tag(children)` or leaf text, for comparisons.
+fn compact(n: &Node) -> String {
+    match n {
+        Node::Text(t) => t.clone(),
+        Node::Element(t, c) if c.len() == 1 && matches!(c[0], Node::Text(_)) => {
+            format!("{t}:{}", text(n))
+        }
+        Node::Element(t, c) => format!(
+            "{t}({})",
+            c.iter().map(compact).collect::<Vec<_>>().join(",")
+        ),
+    }
+}
+
+/// Lecture 10's pendulum in the energy form, T = m l² q̇²/2, V = m g l sin q: Lagrange gives
+/// m l² q̈ = −m g l cos q. Its MathML line is `<math>` with the product m·q̈·l², `=`, and minus
+/// the product m·l·g·cos(q), every accent and power in its own element.
+#[test]
+fn mathml_of_the_simple_pendulum_equation() {
+    let entry = eomgen::models::find("simple_pendulum").expect("bundled");
+    let source = std::fs::read_to_string(entry.path).unwrap();
+    let file = eomgen_symbolic::model::load(entry.path, &source).expect("loads");
+    let mut model = SymbolicModel::from_file(&file).expect("lowers");
+    let eom = Lagrange.derive(&mut model);
+    let lines = equations_mathml(&mut model, &eom);
+    assert_eq!(lines.len(), 3, "T, V and one equation: {lines:#?}");
+    let root = parse(&lines[2]);
+    assert_eq!(tag(&root), "math");
+    assert!(lines[2].starts_with("<math display=\"block\">"));
+    let parts = children(&root);
+    assert_eq!(parts.len(), 3, "lhs = rhs");
+    assert_eq!(compact(&parts[1]), "mo:=");
+    assert_eq!(
+        factors(&parts[0]),
+        ["mi:m", "mover(mi:q,mo:\u{a8})", "msup(mi:l,mn:2)"],
+        "m q̈ l²"
+    );
+    let rhs = children(&parts[2]);
+    assert_eq!(tag(&parts[2]), "mrow");
+    assert_eq!(rhs.len(), 2, "minus, product");
+    assert_eq!(compact(&rhs[0]), "mo:\u{2212}");
+    assert_eq!(
+        factors(&rhs[1]),
+        [
+            "mi:g",
+            "mi:l",
+            "mi:m",
+            "mrow(mi:cos,mo:\u{2061},mrow(mo:(,mi:q,mo:)))"
+        ],
+        "m l g cos(q)"
+    );
+    // The accent is declared as one, so browsers stack it over the q.
+    assert!(lines[2].contains("<mover accent=\"true\"><mi>q</mi><mo>\u{a8}</mo></mover>"));
+}
+
+/// Two runs of the same report give byte-identical files (no timings, no hash order).
+#[test]
+fn report_is_byte_identical_across_runs() {
+    let a = out_dir("det-a");
+    let b = out_dir("det-b");
+    for dir in [&a, &b] {
+        let out = eomgen(&[
+            "report",
+            "--models",
+            "cart_pendulum,two_masses_rod",
+            "-o",
+            dir.to_str().unwrap(),
+        ]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+    let mut files = Vec::new();
+    let mut stack = vec![a.clone()];
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(&d).unwrap().flatten() {
+            let p = e.path();
+            if p.is_dir() {
+                stack.push(p);
+            } else {
+                files.push(p.strip_prefix(&a).unwrap().to_path_buf());
+            }
+        }
+    }
+    files.sort();
+    assert!(files.len() >= 8, "{files:?}");
+    for f in &files {
+        let x = std::fs::read(a.join(f)).unwrap();
+        let y = std::fs::read(b.join(f)).unwrap_or_default();
+        assert!(x == y, "{} differs between runs", f.display());
+    }
+    let _ = std::fs::remove_dir_all(&a);
+    let _ = std::fs::remove_dir_all(&b);
+}
+
+/// `simulate --plot-phase` and `--plot-energy` write SVG charts with labelled axes.
+#[test]
+fn simulate_draws_phase_portrait_and_energy_drift() {
+    let dir = out_dir("simulate");
+    std::fs::create_dir_all(&dir).unwrap();
+    let phase = dir.join("phase.svg");
+    let energy = dir.join("energy.svg");
+    let out = eomgen(&[
+        "simulate",
+        "simple_pendulum",
+        "--t-end",
+        "2",
+        "--plot-phase",
+        phase.to_str().unwrap(),
+        "--plot-energy",
+        energy.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let phase = std::fs::read_to_string(&phase).expect("phase portrait written");
+    assert!(phase.starts_with("<svg") && phase.contains("phase portrait"));
+    assert!(phase.contains("q̇ (m/s or rad/s)") && phase.contains("q (m or rad)"));
+    let energy = std::fs::read_to_string(&energy).expect("energy chart written");
+    assert!(energy.contains("E − E(0) (J)") && energy.contains("t (s)"));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Every bundled model's report passes: the catalogue's reference values, conservation and
+/// drift checks (under a second in a debug build).
+#[test]
+fn full_report_passes_on_every_model() {
+    let dir = out_dir("all");
+    let out = eomgen(&["report", "-o", dir.to_str().unwrap()]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let report = read_json(&dir);
+    assert_eq!(
+        report["summary"]["models"].as_u64().unwrap() as usize,
+        eomgen::models::ALL.len()
+    );
+    assert_eq!(report["summary"]["failed"], 0);
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -1,0 +1,3 @@
+eomgen::model!("check-bad-entry.yaml");
+
+fn main() {}
