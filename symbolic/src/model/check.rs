@@ -397,6 +397,38 @@ impl<'f> Checker<'f> {
             );
             return;
         }
+        // The rate (or acceleration) of something that is not a coordinate: a parameter, `t`,
+        // a point or a body.
+        let stem = n
+            .strip_suffix("_ddot")
+            .or_else(|| n.strip_suffix("_dot"))
+            .filter(|s| !self.coords.contains(s));
+        if let Some(stem) = stem {
+            let kind = if self.params.contains(&stem) {
+                Some("a parameter, which is constant")
+            } else if stem == "t" {
+                Some("the time")
+            } else if self.points.contains(&stem) {
+                Some("a point")
+            } else if self.bodies.contains(&stem) {
+                Some("a body")
+            } else {
+                None
+            };
+            if let Some(kind) = kind {
+                let coordinates = self.coords.join(", ");
+                self.error(
+                    Diagnostic::new(
+                        at,
+                        format!("`{n}` in {what} is a rate of `{stem}`, {kind}, not a coordinate"),
+                    )
+                    .with_help(format!(
+                        "only coordinates have rates (`<coordinate>_dot`; the coordinates are {coordinates}); a quantity that changes in time is a coordinate or a function of `t`"
+                    )),
+                );
+                return;
+            }
+        }
         if self.points.contains(&n) || self.bodies.contains(&n) {
             let kind = if self.points.contains(&n) {
                 "point"

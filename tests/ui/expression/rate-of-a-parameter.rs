@@ -1,0 +1,3 @@
+eomgen::model!("rate-of-a-parameter.yaml");
+
+fn main() {}
