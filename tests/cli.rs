@@ -146,6 +146,44 @@ fn a_singular_mass_matrix_is_an_error_with_t_and_exit_1() {
     assert_eq!(v["error"]["t"], 0.0);
 }
 
+/// Failed equilibrium searches say why Newton stopped and what to try, in every command that
+/// needs an equilibrium, and exit 1: a cannonball has none (its forces do not depend on q),
+/// and a simple pendulum started at q = 1e308 cannot reach one.
+#[test]
+fn failed_equilibrium_searches_explain_themselves() {
+    for args in [
+        &["modes", "cannonball"][..],
+        &["frf", "cannonball", "--input", "x"],
+        &["study", "free-response", "cannonball"],
+    ] {
+        let out = eomgen(args);
+        assert_eq!(out.status.code(), Some(1), "{args:?}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains("no equilibrium found"), "{err}");
+        assert!(err.contains("the forces do not depend on q"), "{err}");
+        assert!(err.contains("help: ") && err.contains("free fall"), "{err}");
+    }
+    let out = eomgen(&["modes", "simple_pendulum", "--at", "q=1e308"]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("no step reduces |F|"), "{err}");
+    assert!(
+        err.contains("help: start Newton nearer an equilibrium"),
+        "{err}"
+    );
+    assert!(
+        err.contains("(hanging, upright)"),
+        "the file's equilibria are named: {err}"
+    );
+    let out = eomgen(&["modes", "braking_car"]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("non-holonomic") && err.contains("help: "),
+        "{err}"
+    );
+}
+
 /// `eomgen check` passes on every bundled model (Lagrange ≡ momentum balance where the model
 /// is kinematic; power balance), by name and by path, with the documented JSON keys.
 #[test]

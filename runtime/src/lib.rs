@@ -33,7 +33,7 @@ pub use integrate::{
     Tableau, Tolerance,
 };
 pub use modal::{
-    Equilibrium, Linearization, ModalError, ModeKind, NormalModes, constraint_hessians,
+    Equilibrium, Linearization, ModalError, ModeKind, NewtonStop, NormalModes, constraint_hessians,
     damped_modes, eigenvalues_of_m_inv_k, find_equilibrium, linearize, matrix_exponential,
     normal_modes,
 };

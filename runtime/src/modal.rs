@@ -32,11 +32,13 @@ use crate::system::ModelInfo;
 pub enum ModalError {
     /// Newton's method on `F(q, 0, t) = 0` did not converge.
     #[error(
-        "no equilibrium found: Newton stopped after {iterations} iterations with |F| = {residual:e} (from the guess {guess:?})"
+        "no equilibrium found: Newton stopped after {iterations} iterations ({reason}) with |F| = {residual:e} (from the guess {guess:?})"
     )]
     EquilibriumNotFound {
         /// Iterations made.
         iterations: usize,
+        /// Why it stopped.
+        reason: NewtonStop,
         /// Largest `|Fᵢ|` left (units of the generalized forces).
         residual: f64,
         /// The starting guess.
@@ -90,6 +92,26 @@ pub enum ModalError {
         /// Given.
         found: usize,
     },
+}
+
+/// Why Newton's method on the equilibrium equations stopped short of a root.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+#[non_exhaustive]
+pub enum NewtonStop {
+    /// `∂F/∂q` has a NaN or infinite entry at the iterate.
+    #[error("the Jacobian ∂F/∂q is not finite")]
+    NonFiniteJacobian,
+    /// `∂F/∂q` is zero at the iterate: the forces do not depend on the configuration there
+    /// (no restoring force), so nothing points to an equilibrium.
+    #[error("the Jacobian ∂F/∂q is zero: the forces do not depend on q here")]
+    ZeroJacobian,
+    /// No step along the Newton direction, halved 30 times, reduces `max |F|`: a non-zero
+    /// local minimum of `|F|`, or a singular `∂F/∂q` whose null space the residual leaves.
+    #[error("no step reduces |F|: a non-zero minimum of |F| or a singular ∂F/∂q")]
+    NoDecrease,
+    /// 100 iterations without convergence.
+    #[error("iteration limit")]
+    IterationLimit,
 }
 
 /// An equilibrium `F(q*, 0, t) = 0` (with constraints: `F(q*, 0, t) = Jᵀλ*`, `Φ(q*, t) = 0`)
@@ -193,9 +215,10 @@ pub fn find_equilibrium(
         x0.extend(lambda.iter());
     }
     let (x, iterations, residual) =
-        newton(&x0, residual_of, jacobian_of).map_err(|(iterations, residual)| {
+        newton(&x0, residual_of, jacobian_of).map_err(|(iterations, residual, reason)| {
             ModalError::EquilibriumNotFound {
                 iterations,
+                reason,
                 residual,
                 guess: guess.to_vec(),
             }
@@ -209,12 +232,12 @@ pub fn find_equilibrium(
 }
 
 /// Damped Newton with minimum-norm SVD steps (see [`find_equilibrium`]): returns the root,
-/// the iterations and the largest residual, or `(iterations, residual)` on failure.
+/// the iterations and the largest residual, or `(iterations, residual, why)` on failure.
 fn newton(
     x0: &[f64],
     residual_of: impl Fn(&[f64]) -> DVector<f64>,
     jacobian_of: impl Fn(&[f64]) -> DMatrix<f64>,
-) -> Result<(Vec<f64>, usize, f64), (usize, f64)> {
+) -> Result<(Vec<f64>, usize, f64), (usize, f64, NewtonStop)> {
     let norm = |f: &DVector<f64>| {
         let r = f.amax();
         if r.is_nan() { f64::INFINITY } else { r }
@@ -229,12 +252,15 @@ fn newton(
         }
         let jac = jacobian_of(&x);
         if !jac.iter().all(|v| v.is_finite()) {
-            return Err((iteration, r));
+            return Err((iteration, r, NewtonStop::NonFiniteJacobian));
+        }
+        if jac.iter().all(|v| *v == 0.0) {
+            return Err((iteration, r, NewtonStop::ZeroJacobian));
         }
         let svd = jac.svd(true, true);
         let eps = 1e-12 * svd.singular_values.max();
         let Ok(step) = svd.solve(&(-&f), eps) else {
-            return Err((iteration, r));
+            return Err((iteration, r, NewtonStop::NonFiniteJacobian));
         };
         let mut lambda = 1.0;
         let mut accepted = false;
@@ -266,13 +292,13 @@ fn newton(
             if r <= 1e-8 * (1.0 + scale) {
                 return Ok((x, iteration + 1, r));
             }
-            return Err((iteration + 1, r));
+            return Err((iteration + 1, r, NewtonStop::NoDecrease));
         }
     }
     if r <= 1e-12 * (1.0 + scale) {
         return Ok((x, 100, r));
     }
-    Err((100, r))
+    Err((100, r, NewtonStop::IterationLimit))
 }
 
 /// The Hessians `∇²Φᵢ(q, t)` (`n × n` each, one per holonomic constraint), exact.

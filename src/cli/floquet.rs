@@ -287,7 +287,8 @@ fn analyse(
         ));
     }
     let period = TAU / frequency;
-    let equilibrium = find_equilibrium(model, guess, 0.0).map_err(|e| e.to_string())?;
+    let equilibrium = find_equilibrium(model, guess, 0.0)
+        .map_err(|e| format!("{e}\nhelp: {}", super::modes::modal_hint(model, &e)))?;
     let residual = check_periodic_equilibrium(model, &equilibrium.q, 0.0, period)
         .map_err(|e| e.to_string())?;
     let n = model.num_dofs();

@@ -315,7 +315,7 @@ pub fn run(args: &FreeResponseArgs) -> Result<(), CliError> {
         .t_end
         .unwrap_or_else(|| default_t_end(&modes, 4.0, 5.0));
     let times = time_grid(t_end, args.samples)?;
-    let fail = |e: eomgen::ResponseError| CliError::failure(format!("`{}`: {e}", model.name()));
+    let fail = |e: eomgen::ResponseError| response_failure(model.as_ref(), &e);
     let responses: Vec<FreeResponse> = vec![
         eomgen::response_by_integration(&lin, &q0, &v0, &times, args.tol).map_err(fail)?,
         eomgen::response_by_exponential(&lin, &q0, &v0, &times).map_err(fail)?,
@@ -459,4 +459,13 @@ pub fn run(args: &FreeResponseArgs) -> Result<(), CliError> {
         );
     }
     Ok(())
+}
+
+/// The error of a failed response computation of `model`; a modal failure gets its hint
+/// ([`super::modes::modal_failure`]).
+pub(super) fn response_failure(model: &dyn ModelInfo, e: &eomgen::ResponseError) -> CliError {
+    match e {
+        eomgen::ResponseError::Modal(m) => super::modes::modal_failure(model, m),
+        e => CliError::failure(format!("`{}`: {e}", model.name())),
+    }
 }

@@ -127,6 +127,7 @@ pub fn run(args: &FrfArgs) -> Result<(), CliError> {
             | FrfError::InputChangesMassMatrix { .. } => {
                 CliError::usage(format!("--input {}: {e}", args.input))
             }
+            FrfError::Modal(m) => super::modes::modal_failure(model.as_ref(), &m),
             e => fail(name)(e),
         },
     )?;
@@ -148,7 +149,7 @@ pub fn run(args: &FrfArgs) -> Result<(), CliError> {
         }
         list
     };
-    let modes = normal_modes(lin).map_err(|e| fail(name)(e.into()))?;
+    let modes = normal_modes(lin).map_err(|e| super::modes::modal_failure(model.as_ref(), &e))?;
     let damping = modal_damping(lin, &modes);
     let lookup = parameter_lookup(model.as_ref());
     let (lo, hi) = match &args.freqs {

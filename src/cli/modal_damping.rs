@@ -90,7 +90,8 @@ pub fn run(args: &ModalDampingArgs) -> Result<(), CliError> {
     } = unconstrained_operating_point(&args.model, args.at.as_deref(), &args.set)?;
     let n = model.num_dofs();
     let names = model.coordinate_names();
-    let fail = |e: eomgen::ResponseError| CliError::failure(format!("`{}`: {e}", model.name()));
+    let fail =
+        |e: eomgen::ResponseError| super::free_response::response_failure(model.as_ref(), &e);
     let approx = eomgen::modal_damping(&lin, &modes);
     let exact = eomgen::exact_damped_modes(&lin, &modes).map_err(fail)?;
     let oscillatory: Vec<usize> = (0..n)

@@ -52,7 +52,7 @@ pub fn run(args: &ModesArgs) -> Result<(), CliError> {
     if args.plot.is_some() {
         super::mode_plot::check_drawable(model.as_ref())?;
     }
-    let fail = |e: eomgen::ModalError| CliError::failure(format!("`{}`: {e}", model.name()));
+    let fail = |e: eomgen::ModalError| modal_failure(model.as_ref(), &e);
     let n = model.num_dofs();
     let route22 = eigenvalues_of_m_inv_k(&lin).map_err(fail)?;
     let damped = damped_modes(&lin).map_err(fail)?;
@@ -270,7 +270,7 @@ pub(super) fn operating_point_of(
     let mut model = find_model(model_name)?;
     set_parameters(model.as_mut(), sets)?;
     let (label, guess) = operating_point(model.as_ref(), at)?;
-    let fail = |e: eomgen::ModalError| CliError::failure(format!("`{}`: {e}", model.name()));
+    let fail = |e: eomgen::ModalError| modal_failure(model.as_ref(), &e);
     let equilibrium = find_equilibrium(model.as_ref(), &guess, 0.0).map_err(fail)?;
     let n = model.num_dofs();
     let lin =
@@ -283,6 +283,70 @@ pub(super) fn operating_point_of(
         lin,
         modes,
     })
+}
+
+/// The error of a failed equilibrium search, linearisation or modal analysis of `model`: the
+/// reason, then a `help:` line with what to try (issue 8's numerical failures).
+pub(super) fn modal_failure(model: &dyn ModelInfo, e: &eomgen::ModalError) -> CliError {
+    CliError::failure(format!(
+        "`{}`: {e}\nhelp: {}",
+        model.name(),
+        modal_hint(model, e)
+    ))
+}
+
+/// What to try after `e` (see [`modal_failure`]).
+pub(super) fn modal_hint(model: &dyn ModelInfo, e: &eomgen::ModalError) -> String {
+    use eomgen::{ModalError, NewtonStop};
+    let name = model.name();
+    let named: Vec<&str> = model
+        .equilibrium_guesses()
+        .iter()
+        .map(|(n, _)| *n)
+        .collect();
+    let start = if named.is_empty() {
+        format!(
+            "--at {}=…, one value per coordinate",
+            model.coordinate_names().join("=…,")
+        )
+    } else {
+        format!(
+            "--at NAME with one of the file's `equilibria:` ({}), or --at {}=…",
+            named.join(", "),
+            model.coordinate_names().join("=…,")
+        )
+    };
+    match e {
+        ModalError::EquilibriumNotFound {
+            reason: NewtonStop::ZeroJacobian,
+            ..
+        } => format!(
+            "nothing here depends on the configuration, so nothing can balance the loads: a body in free fall or under a constant load has no equilibrium, and modes need one; to linearise along a motion, simulate it (`eomgen simulate {name}`); if the model has an equilibrium elsewhere, start there: {start}"
+        ),
+        ModalError::EquilibriumNotFound { .. } => format!(
+            "start Newton nearer an equilibrium: {start}; a model whose loads cannot be balanced (a driven or falling body) has none"
+        ),
+        ModalError::SingularMassMatrix { .. } => format!(
+            "a coordinate has no inertia at this configuration (the mass matrix loses rank there, e.g. an angle of a point at its pivot): choose another operating point, {start}"
+        ),
+        ModalError::NonFinite { .. } => format!(
+            "the model's forces or mass matrix are singular at this configuration (a division by zero, a root of a negative number): choose another operating point, {start}"
+        ),
+        ModalError::NonHolonomic { .. } => format!(
+            "its motion is computed by `eomgen simulate {name}`; the stability of its steady motions is not a normal-mode problem"
+        ),
+        ModalError::OffConstraints { .. } => format!(
+            "give an operating point that satisfies the constraints, or a guess from which Newton finds one: {start}"
+        ),
+        ModalError::ConstrainedMotion { .. } => {
+            "linearise the constrained model at rest (all rates 0)".to_string()
+        }
+        ModalError::DimensionMismatch { .. } => format!(
+            "give one value per coordinate ({})",
+            model.coordinate_names().join(", ")
+        ),
+        _ => format!("choose another operating point: {start}"),
+    }
 }
 
 /// The starting guess of the equilibrium search and its label.
