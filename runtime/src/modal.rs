@@ -233,6 +233,7 @@ pub fn find_equilibrium(
 
 /// Damped Newton with minimum-norm SVD steps (see [`find_equilibrium`]): returns the root,
 /// the iterations and the largest residual, or `(iterations, residual, why)` on failure.
+#[allow(clippy::type_complexity)]
 fn newton(
     x0: &[f64],
     residual_of: impl Fn(&[f64]) -> DVector<f64>,
