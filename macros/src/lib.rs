@@ -12,10 +12,7 @@ use proc_macro::TokenStream;
 use proc_macro2::Span;
 use syn::LitStr;
 
-use eomgen_symbolic::codegen::{self, EmitOptions};
-use eomgen_symbolic::mechanics::{
-    Jacobians, SymbolicModel, cheapest_equations, mass_matrix_diagnostics,
-};
+use eomgen_symbolic::codegen::{self, EmitOptions, GenerateError};
 
 /// Generates the equations of motion of a model file at compile time.
 ///
@@ -158,23 +155,20 @@ fn expand(input: proc_macro2::TokenStream) -> Result<proc_macro2::TokenStream, F
         error: errors(d),
         stand_in: stand_in(&source, None),
     })?;
-    let failure = |d| Failure {
-        error: errors(d),
-        stand_in: stand_in(&source, Some(&file)),
-    };
-    let mut model = SymbolicModel::from_file(&file).map_err(failure)?;
-    let (eom, _) = cheapest_equations(&mut model);
-    let problems = mass_matrix_diagnostics(&model, &eom, &file);
-    if !problems.is_empty() {
-        return Err(failure(problems));
-    }
-    let jacobians = Jacobians::of(&mut model, &eom);
     let options = EmitOptions {
         crate_path: "::eomgen".to_string(),
         tracked_files: vec![path.to_string_lossy().into_owned()],
         source_display: written.clone(),
     };
-    let (tokens, _) = codegen::emit(&model, &eom, &jacobians, &options)
-        .map_err(|e| Failure::from(syn::Error::new(literal.span(), e)))?;
+    let tokens = codegen::generate(&file, &options).map_err(|e| match e {
+        GenerateError::Diagnostics(d) => Failure {
+            error: errors(d),
+            stand_in: stand_in(&source, Some(&file)),
+        },
+        GenerateError::Emit(message) => Failure {
+            error: syn::Error::new(literal.span(), message),
+            stand_in: stand_in(&source, Some(&file)),
+        },
+    })?;
     Ok(tokens)
 }

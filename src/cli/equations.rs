@@ -1,10 +1,10 @@
-//! `eomgen equations MODEL|FILE [--method lagrange|momentum] [--latex]` and
+//! `eomgen equations MODEL|FILE [--method lagrange|momentum] [--latex|--rust]` and
 //! `eomgen new TEMPLATE N`.
 
 use clap::{Args, ValueEnum};
 
 use super::CliError;
-use eomgen_symbolic::codegen::{equations_latex, equations_text};
+use eomgen_symbolic::codegen::{GenerateError, equations_latex, equations_text};
 use eomgen_symbolic::mechanics::{Formulation, Lagrange, MomentumBalance, SymbolicModel};
 use eomgen_symbolic::model::templates;
 
@@ -26,8 +26,12 @@ pub struct EquationsArgs {
     #[arg(long, value_enum, default_value_t = Method::Lagrange)]
     pub method: Method,
     /// Print LaTeX (amsmath) instead of text.
-    #[arg(long)]
+    #[arg(long, conflicts_with = "rust")]
     pub latex: bool,
+    /// Print the Rust that `eomgen::model!` generates for the file (formatted; the same
+    /// pipeline as the macro, with the file tracked by its path as shown).
+    #[arg(long, conflicts_with = "method")]
+    pub rust: bool,
 }
 
 /// Options of `eomgen new`.
@@ -84,6 +88,21 @@ pub fn run(args: &EquationsArgs) -> Result<(), CliError> {
     let (display, source) = read_model(&args.model)?;
     let file = eomgen_symbolic::model::load(&display, &source)
         .map_err(|d| render(&display, &source, &d))?;
+    if args.rust {
+        let options = eomgen_symbolic::codegen::EmitOptions {
+            crate_path: "::eomgen".to_string(),
+            tracked_files: vec![display.clone()],
+            source_display: display.clone(),
+        };
+        let tokens = eomgen_symbolic::codegen::generate(&file, &options).map_err(|e| match e {
+            GenerateError::Diagnostics(d) => render(&display, &source, &d),
+            GenerateError::Emit(message) => CliError::failure(message),
+        })?;
+        let code = syn::parse2::<syn::File>(tokens)
+            .map_err(|e| CliError::failure(format!("the generated code does not parse: {e}")))?;
+        print!("{}", prettyplease::unparse(&code));
+        return Ok(());
+    }
     let mut model = SymbolicModel::from_file(&file).map_err(|d| render(&display, &source, &d))?;
     let eom = match args.method {
         Method::Lagrange => Lagrange.derive(&mut model),

@@ -15,6 +15,40 @@ use crate::expr::print::{Printer, Syntax};
 use crate::expr::{ExprArena, ExprId, SymbolId, SymbolKind, trig};
 use crate::mechanics::{EquationsOfMotion, Jacobians, SymbolicModel};
 
+/// Why [`generate`] produced no code.
+#[derive(Debug, Clone)]
+pub enum GenerateError {
+    /// Mistakes of the model file found after loading it (lowering, singular mass matrix),
+    /// each located in the file.
+    Diagnostics(Vec<crate::model::Diagnostic>),
+    /// The printed code did not tokenize (a bug of the printer; the message has the source).
+    Emit(String),
+}
+
+/// The code `eomgen::model!` generates for a loaded model file: lowering, the cheaper of the
+/// two derivations, the mass-matrix diagnostics, the exact Jacobians, then [`emit`]. The macro
+/// and `eomgen equations --rust` both call this, so what the CLI prints is what is compiled.
+///
+/// # Errors
+/// [`GenerateError::Diagnostics`] for a model that cannot be lowered or whose mass matrix is
+/// singular ([`crate::mechanics::mass_matrix_diagnostics`]); [`GenerateError::Emit`] as
+/// [`emit`].
+pub fn generate(
+    file: &crate::model::ModelFile,
+    options: &EmitOptions,
+) -> Result<TokenStream, GenerateError> {
+    let mut model = SymbolicModel::from_file(file).map_err(GenerateError::Diagnostics)?;
+    let (eom, _) = crate::mechanics::cheapest_equations(&mut model);
+    let problems = crate::mechanics::mass_matrix_diagnostics(&model, &eom, file);
+    if !problems.is_empty() {
+        return Err(GenerateError::Diagnostics(problems));
+    }
+    let jacobians = Jacobians::of(&mut model, &eom);
+    emit(&model, &eom, &jacobians, options)
+        .map(|(tokens, _)| tokens)
+        .map_err(GenerateError::Emit)
+}
+
 /// Where the generated code finds the runtime.
 #[derive(Debug, Clone)]
 pub struct EmitOptions {
