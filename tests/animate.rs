@@ -49,6 +49,21 @@ fn frame(clip: &Value, k: usize) -> Vec<(f64, f64)> {
         .collect()
 }
 
+/// Frame `k`'s positions of the points named `wanted` (by the page's `names`).
+fn named(data: &Value, clip: &Value, k: usize, wanted: &[&str]) -> Vec<(f64, f64)> {
+    let names: Vec<&str> = data["names"]
+        .as_array()
+        .expect("names")
+        .iter()
+        .map(|n| n.as_str().expect("name"))
+        .collect();
+    let all = frame(clip, k);
+    wanted
+        .iter()
+        .map(|w| all[names.iter().position(|n| n == w).expect("a drawn point")])
+        .collect()
+}
+
 fn distance(a: (f64, f64), b: (f64, f64)) -> f64 {
     (a.0 - b.0).hypot(a.1 - b.1)
 }
@@ -131,15 +146,21 @@ fn triple_pendulum_frames_are_the_mechanism_at_simulated_states() {
     ]);
     assert!(printed.contains("101 frames"), "{printed}");
     let data = data_of(&std::fs::read_to_string(&path).expect("page"));
-    assert_eq!(data["names"], serde_json::json!(["P0", "P1", "P2", "P3"]));
-    assert_eq!(data["lines"], serde_json::json!([[0, 1], [1, 2], [2, 3]]));
-    assert_eq!(data["traces"], serde_json::json!([3]));
+    // The hinges and the bars' centres of mass (rings: the model's bodies), in file order.
+    assert_eq!(
+        data["names"],
+        serde_json::json!(["P0", "G1", "P1", "G2", "P2", "G3", "P3"])
+    );
+    assert_eq!(data["lines"], serde_json::json!([[0, 2], [2, 4], [4, 6]]));
+    assert_eq!(data["traces"], serde_json::json!([6]));
+    assert_eq!(data["centres"], serde_json::json!([1, 3, 5]));
     let clip = &data["clips"][0];
     let t = numbers(&clip["t"]);
     assert_eq!(t.len(), 101);
     for (k, tk) in t.iter().enumerate() {
         assert_eq!(*tk, k as f64 / 25.0, "frame {k} time");
-        let p = frame(clip, k);
+        let p = named(&data, clip, k, &["P0", "P1", "P2", "P3"]);
+        let g = named(&data, clip, k, &["G1", "G2", "G3"]);
         assert!(distance(p[0], (0.0, 0.0)) < 1e-9, "frame {k}: pivot moved");
         for i in 1..4 {
             let length = distance(p[i - 1], p[i]);
@@ -147,6 +168,9 @@ fn triple_pendulum_frames_are_the_mechanism_at_simulated_states() {
                 (length - 1.0).abs() < 1e-9,
                 "frame {k}: bar {i} is {length} m"
             );
+            // A uniform bar's centre of mass is its midpoint.
+            let middle = ((p[i - 1].0 + p[i].0) / 2.0, (p[i - 1].1 + p[i].1) / 2.0);
+            assert!(distance(g[i - 1], middle) < 1e-9, "frame {k}: G{i}");
         }
     }
     // The traced tip: 4 samples per frame, through the frames' tips, never beyond 3 m.
@@ -154,7 +178,10 @@ fn triple_pendulum_frames_are_the_mechanism_at_simulated_states() {
     assert_eq!(clip["sub"], 4);
     assert_eq!(trail.len(), 2 * (4 * 100 + 1));
     for k in [0, 37, 100] {
-        assert_eq!((trail[8 * k], trail[8 * k + 1]), frame(clip, k)[3]);
+        assert_eq!(
+            (trail[8 * k], trail[8 * k + 1]),
+            named(&data, clip, k, &["P3"])[0]
+        );
     }
     assert!(trail.chunks(2).all(|p| p[0].hypot(p[1]) <= 3.0 + 1e-9));
 
@@ -178,7 +205,10 @@ fn triple_pendulum_frames_are_the_mechanism_at_simulated_states() {
         .zip(&frames)
     {
         let (points, e) = triple_pendulum(&numbers(&sample["q"]), &numbers(&sample["qdot"]));
-        for (page, exact) in frame(clip, k).iter().zip(&points) {
+        for (page, exact) in named(&data, clip, k, &["P0", "P1", "P2", "P3"])
+            .iter()
+            .zip(&points)
+        {
             assert!(
                 distance(*page, *exact) < 1e-9,
                 "frame {k}: {page:?} vs {exact:?}"
@@ -232,13 +262,13 @@ fn four_bar_frames_close_the_loop() {
         .iter()
         .map(|n| n.as_str().expect("name"))
         .collect();
-    assert_eq!(names, ["O", "D", "B", "C"]);
+    assert_eq!(names, ["O", "D", "B", "C", "G1", "G2", "G3"]);
     assert_eq!(data["traces"], serde_json::json!([3, 2]));
     let clip = &data["clips"][0];
     let frames = clip["xy"].as_array().expect("frames").len();
     assert_eq!(frames, 91);
     for k in 0..frames {
-        let p = frame(clip, k);
+        let p = named(&data, clip, k, &["O", "D", "B", "C"]);
         let (o, d, b, c) = (p[0], p[1], p[2], p[3]);
         assert!(distance(o, (0.0, 0.0)) < 1e-12 && distance(d, (0.6, 0.0)) < 1e-12);
         for (length, exact) in [
@@ -297,7 +327,10 @@ fn mode_shapes_move_over_one_period() {
                 .map(|(a, p)| a + amplitude * p)
                 .collect();
             let (exact, _) = triple_pendulum(&q, &[0.0; 3]);
-            for (page, exact) in frame(clip, k).iter().zip(&exact) {
+            for (page, exact) in named(&data, clip, k, &["P0", "P1", "P2", "P3"])
+                .iter()
+                .zip(&exact)
+            {
                 assert!(
                     distance(*page, *exact) < 1e-8,
                     "mode {}, frame {k}: {page:?} vs {exact:?}",

@@ -46,5 +46,6 @@ pub use response::{
     state_response_by_integration,
 };
 pub use system::{
-    ConstraintValues, FirstOrder, MechanicalSystem, ModelInfo, UnknownParameter, solve_spd,
+    BodyCentre, ConstraintValues, FirstOrder, MechanicalSystem, ModelInfo, UnknownParameter,
+    solve_spd,
 };

@@ -24,6 +24,18 @@ pub struct UnknownParameter {
     pub known: String,
 }
 
+/// A body of a model's kinematic form and the point at its centre of mass, for drawings
+/// (`eomgen animate` marks it).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct BodyCentre {
+    /// The body's name in the model file.
+    pub body: &'static str,
+    /// The point at its centre of mass (one of [`MechanicalSystem::point_names`]).
+    pub point: &'static str,
+    /// A planar rigid body (`true`) or a particle.
+    pub rigid: bool,
+}
+
 /// Equations of motion `M(q, t) q̈ = F(q, q̇, t)` of a mechanism with `N` degrees of freedom.
 ///
 /// Implemented by the code that `eomgen::model!` generates from a model file; the runtime
@@ -113,6 +125,11 @@ pub trait MechanicalSystem<const N: usize> {
     /// The file's `draw: trace`: points whose trajectories are traced, in file order; empty by
     /// default.
     fn trace_points(&self) -> &'static [&'static str] {
+        &[]
+    }
+    /// Where each body of the kinematic form sits: its centre of mass (a rigid body's `com`,
+    /// a particle's `at`), in file order; empty for the energy form.
+    fn body_centres(&self) -> &'static [BodyCentre] {
         &[]
     }
     /// The derived equations as plain text (`M`, `F`, `T`, `V`).
@@ -523,6 +540,10 @@ pub trait ModelInfo: OdeSystem {
     fn trace_points(&self) -> &'static [&'static str] {
         &[]
     }
+    /// The bodies' centres of mass ([`MechanicalSystem::body_centres`]).
+    fn body_centres(&self) -> &'static [BodyCentre] {
+        &[]
+    }
     /// The derived equations as text.
     fn equations_text(&self) -> &'static str;
     /// The derived equations as LaTeX.
@@ -661,6 +682,9 @@ impl<S: MechanicalSystem<N>, const N: usize> ModelInfo for FirstOrder<S, N> {
     }
     fn trace_points(&self) -> &'static [&'static str] {
         self.system.trace_points()
+    }
+    fn body_centres(&self) -> &'static [BodyCentre] {
+        self.system.body_centres()
     }
     fn equations_text(&self) -> &'static str {
         self.system.equations_text()

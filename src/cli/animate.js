@@ -8,6 +8,7 @@
   var links = D.lines.map(function (_, i) { return $('l' + i); });
   var joints = D.dots.map(function (_, i) { return $('d' + i); });
   var traces = D.traces.map(function (_, i) { return $('tr' + i); });
+  var centres = D.centres.map(function (_, i) { return $('c' + i); });
   var play = $('play'), speed = $('speed'), scrub = $('scrub'), choice = $('clip');
   var time = $('time'), frame = $('frame'), energy = $('energy'), drift = $('drift');
   var clip = null, k = 0, clock = 0, playing = true, last = null, paths = [];
@@ -36,6 +37,9 @@
     });
     D.dots.forEach(function (p, i) {
       joints[i].setAttribute('cx', xy[2 * p]); joints[i].setAttribute('cy', xy[2 * p + 1]);
+    });
+    D.centres.forEach(function (p, i) {
+      centres[i].setAttribute('cx', xy[2 * p]); centres[i].setAttribute('cy', xy[2 * p + 1]);
     });
     traces.forEach(function (e, i) { e.setAttribute('points', paths[i].slice(0, j * clip.sub + 1).join(' ')); });
     scrub.value = String(j);

@@ -116,6 +116,9 @@ pub(crate) struct Scene {
     pub dots: Vec<usize>,
     /// The traced points.
     pub traces: Vec<usize>,
+    /// The bodies' centres of mass (points marked with a ring), with whether the body is
+    /// rigid, and the body's name.
+    pub centres: Vec<(usize, bool, &'static str)>,
     /// Isometric view of a 3-D model.
     pub three_d: bool,
     /// Indices of the drawn points among the model's points.
@@ -175,13 +178,26 @@ impl Scene {
                 b = all[all.len() - 1],
             )));
         }
+        let centres: Vec<(usize, bool, &'static str)> = model
+            .body_centres()
+            .iter()
+            .filter_map(|c| Some((index(c.point)?, c.rigid, c.body)))
+            .collect();
         let mut used: Vec<usize> = lines.iter().flatten().copied().collect();
         used.extend(&traced);
+        used.extend(centres.iter().map(|c| c.0));
         used.sort_unstable();
         used.dedup();
         let local = |i: usize| used.iter().position(|&u| u == i).unwrap_or(0);
-        let mut dots: Vec<usize> = used.iter().map(|&i| local(i)).collect();
+        // Joints: the lines' ends and the traced points (a body's centre alone gets a ring).
+        let mut dots: Vec<usize> = lines
+            .iter()
+            .flatten()
+            .chain(&traced)
+            .map(|&i| local(i))
+            .collect();
         dots.sort_unstable();
+        dots.dedup();
         Ok(Self {
             model: model.name(),
             title: format!("{} — {}", model.name(), model.description()),
@@ -189,6 +205,10 @@ impl Scene {
             lines: lines.iter().map(|[a, b]| [local(*a), local(*b)]).collect(),
             dots,
             traces: traced.iter().map(|&i| local(i)).collect(),
+            centres: centres
+                .iter()
+                .map(|&(i, rigid, body)| (local(i), rigid, body))
+                .collect(),
             three_d: false,
             model_points: used,
         })
@@ -616,7 +636,7 @@ impl Animation {
         };
         let _ = write!(
             data,
-            "{{\"title\":{},\"names\":[{}],\"lines\":[{}],\"dots\":[{}],\"traces\":[{}],\"clips\":[",
+            "{{\"title\":{},\"names\":[{}],\"lines\":[{}],\"dots\":[{}],\"traces\":[{}],\"centres\":[{}],\"clips\":[",
             json_string(&scene.title),
             names.join(","),
             scene
@@ -627,6 +647,7 @@ impl Animation {
                 .join(","),
             pairs(&scene.dots),
             pairs(&scene.traces),
+            pairs(&scene.centres.iter().map(|c| c.0).collect::<Vec<_>>()),
         );
         for (c, clip) in self.clips.iter().enumerate() {
             if c > 0 {
@@ -755,6 +776,18 @@ impl Animation {
                 p(f0[*d].0),
                 p(f0[*d].1),
                 html_text(scene.names[*d])
+            );
+        }
+        for (i, (c, rigid, body)) in scene.centres.iter().enumerate() {
+            let kind = if *rigid { "rigid body" } else { "particle" };
+            let _ = write!(
+                svg,
+                "<circle id=\"c{i}\" class=\"centre\" cx=\"{}\" cy=\"{}\" r=\"{}\"><title>{} ({kind}), centre of mass {}</title></circle>",
+                p(f0[*c].0),
+                p(f0[*c].1),
+                v(0.022 * span),
+                html_text(body),
+                html_text(scene.names[*c])
             );
         }
         svg.push_str("\n</g>\n</svg>");
@@ -919,6 +952,14 @@ const DATA = {data};
                 for &d in &scene.dots {
                     root.draw(&Circle::new(to_pixel(frame[d]), 5, rgb(JOINT).filled()))
                         .map_err(err)?;
+                }
+                for &(c, _, _) in &scene.centres {
+                    root.draw(&Circle::new(
+                        to_pixel(frame[c]),
+                        8,
+                        rgb(JOINT).stroke_width(2),
+                    ))
+                    .map_err(err)?;
                 }
                 let caption = match &clip.energy {
                     Some(e) => format!(

@@ -582,6 +582,25 @@ pub fn emit(
             names.join(", ")
         );
     }
+    if !model.bodies.is_empty() {
+        let centres: Vec<String> = model
+            .bodies
+            .iter()
+            .filter_map(|b| {
+                Some(format!(
+                    "{krate}::BodyCentre {{ body: {}, point: {}, rigid: {} }}",
+                    string_literal(&b.name),
+                    string_literal(&model.points.get(b.com)?.0),
+                    b.rotation.is_some()
+                ))
+            })
+            .collect();
+        let _ = writeln!(
+            constant_items,
+            "fn body_centres(&self) -> &'static [{krate}::BodyCentre] {{ &[{}] }}",
+            centres.join(", ")
+        );
+    }
     imp.push_str(&constant_items);
     let _ = writeln!(
         imp,
