@@ -36,6 +36,9 @@ pub fn check_partial(file: &ModelFile, incomplete: &Incomplete) -> Result<(), Ve
     checker.hand_equations();
     checker.reference_checks();
     checker.constraints();
+    for d in super::unit_check::check(file) {
+        checker.error(d);
+    }
     checker.diagnostics.finish()
 }
 

@@ -12,6 +12,8 @@ pub mod located;
 pub mod parser;
 pub mod schema;
 pub mod templates;
+pub mod unit_check;
+pub mod units;
 pub mod yaml;
 
 pub use ast::{BinOp, Expr, ExprKind};
