@@ -160,6 +160,8 @@ struct Equation {
     dim: Dim,
     origin: String,
     at: Location,
+    /// How the key spells its unit (`N*s/m`), when the expression is a lone name.
+    spelling: Option<String>,
 }
 
 /// An unknown unit solved from an equation.
@@ -168,6 +170,14 @@ struct Solved {
     unit: Dimension,
     origin: String,
     at: Location,
+    spelling: Option<String>,
+}
+
+impl Solved {
+    /// The unit as its key spells it (`N*s/m`), else canonical (`kg/s`).
+    fn text(&self) -> String {
+        self.spelling.clone().unwrap_or_else(|| show(self.unit))
+    }
 }
 
 struct Checker<'f> {
@@ -180,6 +190,11 @@ struct Checker<'f> {
     unknowns: Vec<(bool, usize)>,
     /// Pass 1: requirements with unknowns.
     equations: Vec<Equation>,
+    /// The units of the constraints visited so far in this pass, for their multipliers
+    /// (`lambda_<name>`): `(name, unit, holonomic)`.
+    constraints: Vec<(String, Option<Dim>, bool)>,
+    /// How the key being checked spells its unit, while its value is a lone name.
+    spelling: Option<String>,
     solution: Vec<Option<Solved>>,
 }
 
@@ -378,6 +393,8 @@ impl<'f> Checker<'f> {
             solution: vec![None; unknowns.len()],
             unknowns,
             equations: Vec::new(),
+            constraints: Vec::new(),
+            spelling: None,
         }
     }
 
@@ -430,7 +447,19 @@ impl<'f> Checker<'f> {
         if let Some(i) = self.file.parameters.iter().position(|p| p.name.value == n) {
             return self.unit(self.parameters.get(i).copied().unwrap_or(Unit::Any));
         }
-        // Constraint forces (`lambda_c`) and names already reported take any unit.
+        if let Some(c) = n.strip_prefix("lambda_")
+            && let Some((_, unit, holonomic)) = self.constraints.iter().find(|(k, _, _)| k == c)
+        {
+            // `M q̈ = F − Jᵀ λ` with `J = ∂Φ/∂q` (holonomic) or `∂g/∂q̇` (non-holonomic):
+            // `λ` is J per unit of `Φ`, or W per unit of `g`.
+            let work = if *holonomic {
+                Dimension::JOULE
+            } else {
+                Dimension::WATT
+            };
+            return Dim::of(work).div(unit.as_ref()?);
+        }
+        // Names already reported take any unit.
         self.motion(n).flatten()
     }
 
@@ -456,6 +485,7 @@ impl<'f> Checker<'f> {
                         dim,
                         origin: what.to_string(),
                         at,
+                        spelling: self.spelling.clone(),
                     });
                 }
             }
@@ -490,7 +520,7 @@ impl<'f> Checker<'f> {
         };
         Some(format!(
             "the unit of `{name}`, {}, is inferred from {} at {}; declare the unit of `{name}` if it is another",
-            show(solved.unit),
+            solved.text(),
             solved.origin,
             solved.at
         ))
@@ -615,8 +645,8 @@ impl<'f> Checker<'f> {
                         ),
                     )
                     .with_help(format!(
-                        "`{func}` takes a pure number such as an angle: `{arg_text}` needs to be divided by a quantity of unit {}, or the units of its parameters are wrong",
-                        show(got)
+                        "`{func}` takes a pure number, such as an angle in rad: `{arg_text}` lacks a factor of unit {}, or a parameter in it has the wrong unit",
+                        Dimension::ONE.div(got).map_or_else(|| "?".to_string(), show)
                     ))
                 });
                 Some(one)
@@ -648,19 +678,22 @@ impl<'f> Checker<'f> {
             ExprKind::Ident(n) => self.file.parameters.iter().find(|p| &p.name.value == n),
             _ => None,
         };
+        let spelling = want_text.split(" (").next().unwrap_or(want_text);
         let advice = match lone {
             Some(p) => format!(
-                "{help}; declare `{n}` in {want_text}: `{n}: {}  # {want_text}`",
+                "{help}; if `{n}` is one, declare it so: `{n}: {}  # {spelling}`",
                 write_expr(&p.default, 0),
                 n = p.name.value
             ),
             None => help.to_string(),
         };
         let at = e.location;
+        self.spelling = lone.map(|_| spelling.to_string());
         self.key(e, Some(Dim::of(want)), what, |got, _| {
             Diagnostic::new(at, format!("{what} is {}, but {kind} is {want_text}", show(got)))
                 .with_help(advice)
         });
+        self.spelling = None;
     }
 
     /// Checks a value of coordinate `name` or of its rate (`initial:`, `equilibria:`,
@@ -728,7 +761,7 @@ impl<'f> Checker<'f> {
                     ),
                 )
                 .with_help(format!(
-                    "the virtual work Q δ{name} is an energy (J): a generalized force is N for a length coordinate and N*m for an angle"
+                    "the virtual work `Q δ{name}` is an energy (J), so a generalized force is J per unit of its coordinate: N for a length, N*m for an angle"
                 ))
             });
         }
@@ -847,8 +880,12 @@ impl<'f> Checker<'f> {
                 "a torque is force × lever arm, N*m",
             );
         }
-        for (k, e) in file.constraints.iter().chain(&file.nonholonomic) {
-            self.homogeneous(e, &format!("constraint `{}`", k.value));
+        self.constraints.clear();
+        for (holonomic, list) in [(true, &file.constraints), (false, &file.nonholonomic)] {
+            for (k, e) in list {
+                let unit = self.dim(e, &format!("constraint `{}`", k.value));
+                self.constraints.push((k.value.clone(), unit, holonomic));
+            }
         }
         for (k, e) in &file.initial {
             self.value_of(&k.value, e, &format!("the initial value of `{}`", k.value));
@@ -974,6 +1011,7 @@ impl<'f> Checker<'f> {
                         unit: x,
                         origin: eq.origin.clone(),
                         at: eq.at,
+                        spelling: eq.spelling.clone(),
                     };
                     best = Some((votes, eq.priority, i, solved));
                 }
@@ -1026,7 +1064,7 @@ impl<'f> Checker<'f> {
     fn undeclared(&mut self) {
         let file = self.file;
         for (k, &(is_coordinate, i)) in self.unknowns.iter().enumerate() {
-            let implied = self.solution.get(k).cloned().flatten().map(|s| s.unit);
+            let implied = self.solution.get(k).cloned().flatten();
             if is_coordinate {
                 if implied.is_some() {
                     continue;
@@ -1054,9 +1092,8 @@ impl<'f> Checker<'f> {
             let line = if shared { " on a line of its own" } else { "" };
             let help = match implied {
                 Some(u) => format!(
-                    "write `{n}: {value}  # {}`{line} (the unit its use implies), or `{n}: {{ value: {value}, unit: {} }}`",
-                    show(u),
-                    show(u)
+                    "write `{n}: {value}  # {u}`{line} (the unit its use implies), or `{n}: {{ value: {value}, unit: {u} }}`",
+                    u = u.text()
                 ),
                 None => format!(
                     "write its unit in a trailing comment, `{n}: {value}  # N/m`{line}, or `{n}: {{ value: {value}, unit: N/m }}` (`1` for a pure number)"
@@ -1173,6 +1210,31 @@ mod tests {
                 "5:15: unknown unit `mm` in the unit of parameter `k`",
                 "8:22: unknown unit `furlong` in the unit of coordinate `y`",
             ]
+        );
+    }
+
+    #[test]
+    fn constraint_forces_numbers_and_equations() {
+        // The rod's multiplier is J per m of `Φ` = N: comparing it with a weight is right,
+        // with a mass wrong. A number alone is in the unit of its key; inside an expression
+        // it is a pure number, except 0.
+        let src = "name: a\nunits: SI\nparameters:\n  m: 1.0  # kg\n  l: 1.0  # m\n  g: 9.81  # m/s^2\ncoordinates:\n  - x  # m\n  - y  # m\npoints: { O: [0, 0], P: [x, y], Q: [x - 1, y + 0] }\nbodies: { bob: { mass: m, at: P } }\ngravity: [0, -g]\nconstraints: { rod: sqrt(x^2 + y^2) - l }\nevents:\n  taut: lambda_rod - m*g\n  wrong: lambda_rod - m\ninitial: { x: 1, y: 0 }\nchecks:\n  equations_of_motion:\n    - m*x_ddot = -m*g*x/l\n    - m*y_ddot = -m*g*l\n";
+        assert_eq!(
+            errors(src),
+            [
+                "10:41: sum of unlike units in the x component of point `Q`: `x` is m but `1` is 1",
+                "16:23: sum of unlike units in the function of event `wrong`: `lambda_rod` is N but `m` is kg",
+                "21:18: the sides of equation of motion 2 have unlike units: `m*y_ddot` is N but `-m*g*l` is J",
+            ]
+        );
+    }
+
+    #[test]
+    fn bad_units_key() {
+        let src = "name: a\nunits: imperial\ncoordinates: [x]\nkinetic: x_dot^2\n";
+        assert_eq!(
+            errors(src),
+            ["2:8: `units` must be one of SI, found `imperial`"]
         );
     }
 }
