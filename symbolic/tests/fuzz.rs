@@ -185,10 +185,10 @@ fn run_one(src: &str) -> Result<bool, String> {
         for line in src.lines() {
             let text = line.split_once(':').map_or(line, |(_, v)| v);
             let _ = parse_expr(text, Location { line: 1, column: 1 });
-            if let Some((_, comment)) = line.split_once('#') {
-                if let Ok(d) = parse_unit(comment.trim()) {
-                    let _ = d.to_string();
-                }
+            if let Some((_, comment)) = line.split_once('#')
+                && let Ok(d) = parse_unit(comment.trim())
+            {
+                let _ = d.to_string();
             }
         }
         loaded

@@ -81,12 +81,18 @@ fn every_declared_unit_is_binding() {
     for (path, source, file) in with_units() {
         let mut places = Vec::new();
         for p in &file.parameters {
-            let unit = p.unit.as_ref().expect("a units file gives every parameter a unit");
+            let unit = p
+                .unit
+                .as_ref()
+                .expect("a units file gives every parameter a unit");
             places.push((format!("parameter `{}`", p.name.value), unit.location));
         }
         for c in &file.coordinates {
             // A coordinate's unit is the start of its comment in these files.
-            let line = source.lines().nth(c.name.location.line as usize - 1).unwrap();
+            let line = source
+                .lines()
+                .nth(c.name.location.line as usize - 1)
+                .unwrap();
             if let Some(hash) = line.find("# ") {
                 let column = line[..hash + 2].chars().count() as u32 + 1;
                 let location = eomgen_symbolic::model::Location {

@@ -1888,7 +1888,13 @@ mod tests {
         assert_eq!(file.parameters.len(), 2);
         let unit = file.parameters[0].unit.as_ref().unwrap();
         assert_eq!(unit.value, "kg");
-        assert_eq!(unit.location, Location { line: 4, column: 13 });
+        assert_eq!(
+            unit.location,
+            Location {
+                line: 4,
+                column: 13
+            }
+        );
         assert_eq!(file.parameters[1].unit, None);
         assert!((file.parameters[1].value - std::f64::consts::FRAC_PI_4).abs() < 1e-15);
         assert_eq!(b.diagnostics.len(), 1);

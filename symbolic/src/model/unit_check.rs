@@ -82,9 +82,9 @@ impl Dim {
 
     fn combine(&self, o: &Self, sign: Rational) -> Option<Self> {
         let known = if sign == Rational::ONE {
-            self.known.mul(o.known)?
+            self.known.checked_mul(o.known)?
         } else {
-            self.known.div(o.known)?
+            self.known.checked_div(o.known)?
         };
         let mut unknowns = self.unknowns.clone();
         for &(i, c) in &o.unknowns {
@@ -264,10 +264,7 @@ fn write_expr(e: &Expr, outer: u8) -> String {
                     1,
                 )
             }
-            BinOp::Pow => (
-                format!("{}^{}", write_expr(lhs, 3), write_expr(rhs, 2)),
-                3,
-            ),
+            BinOp::Pow => (format!("{}^{}", write_expr(lhs, 3), write_expr(rhs, 2)), 3),
         },
     };
     if own < outer { format!("({s})") } else { s }
@@ -490,15 +487,16 @@ impl<'f> Checker<'f> {
                 }
             }
             Mode::Report => {
-                if got.unknowns.is_empty() && want.unknowns.is_empty() && got.known != want.known
-                {
+                if got.unknowns.is_empty() && want.unknowns.is_empty() && got.known != want.known {
                     let mut d = report(got.known, want.known);
                     let mut inferred = got.inferred.clone();
                     inferred.extend(&want.inferred);
                     inferred.sort_unstable();
                     inferred.dedup();
-                    let notes: Vec<String> =
-                        inferred.iter().filter_map(|&i| self.inference_note(i)).collect();
+                    let notes: Vec<String> = inferred
+                        .iter()
+                        .filter_map(|&i| self.inference_note(i))
+                        .collect();
                     if !notes.is_empty() {
                         let help = d.help.take().unwrap_or_default();
                         d.help = Some(format!("{help} ({})", notes.join("; ")));
@@ -646,7 +644,7 @@ impl<'f> Checker<'f> {
                     )
                     .with_help(format!(
                         "`{func}` takes a pure number, such as an angle in rad: `{arg_text}` lacks a factor of unit {}, or a parameter in it has the wrong unit",
-                        Dimension::ONE.div(got).map_or_else(|| "?".to_string(), show)
+                        Dimension::ONE.checked_div(got).map_or_else(|| "?".to_string(), show)
                     ))
                 });
                 Some(one)
@@ -673,7 +671,15 @@ impl<'f> Checker<'f> {
 
     /// Checks `e` against a fixed unit: "`what` is got, but `kind` is want_text" with `help`,
     /// plus the parameter's declaration when `e` is a lone parameter.
-    fn fixed(&mut self, e: &Expr, want: Dimension, what: &str, kind: &str, want_text: &str, help: &str) {
+    fn fixed(
+        &mut self,
+        e: &Expr,
+        want: Dimension,
+        what: &str,
+        kind: &str,
+        want_text: &str,
+        help: &str,
+    ) {
         let lone = match &e.kind {
             ExprKind::Ident(n) => self.file.parameters.iter().find(|p| &p.name.value == n),
             _ => None,
@@ -690,8 +696,11 @@ impl<'f> Checker<'f> {
         let at = e.location;
         self.spelling = lone.map(|_| spelling.to_string());
         self.key(e, Some(Dim::of(want)), what, |got, _| {
-            Diagnostic::new(at, format!("{what} is {}, but {kind} is {want_text}", show(got)))
-                .with_help(advice)
+            Diagnostic::new(
+                at,
+                format!("{what} is {}, but {kind} is {want_text}", show(got)),
+            )
+            .with_help(advice)
         });
         self.spelling = None;
     }
@@ -707,9 +716,15 @@ impl<'f> Checker<'f> {
         self.key(e, Some(want), what, |got, want| {
             Diagnostic::new(
                 at,
-                format!("{what} is {}, but `{name}` is {}", show(got), show_coordinate(want)),
+                format!(
+                    "{what} is {}, but `{name}` is {}",
+                    show(got),
+                    show_coordinate(want)
+                ),
             )
-            .with_help(format!("write it in the unit of `{name}`, or fix the units of its parameters"))
+            .with_help(format!(
+                "write it in the unit of `{name}`, or fix the units of its parameters"
+            ))
         });
     }
 
@@ -756,7 +771,7 @@ impl<'f> Checker<'f> {
                     format!(
                         "{what} is {}, but `{name}` is {}, so it must be {}",
                         show(got),
-                        show_coordinate(j.div(want).unwrap_or(Dimension::ONE)),
+                        show_coordinate(j.checked_div(want).unwrap_or(Dimension::ONE)),
                         show_load(want)
                     ),
                 )
@@ -900,7 +915,10 @@ impl<'f> Checker<'f> {
             }
         }
         for e in &file.events {
-            self.homogeneous(&e.when, &format!("the function of event `{}`", e.name.value));
+            self.homogeneous(
+                &e.when,
+                &format!("the function of event `{}`", e.name.value),
+            );
         }
         for b in &file.balances {
             if let BalanceKind::Lmb { along } = &b.kind {
@@ -942,7 +960,12 @@ impl<'f> Checker<'f> {
                 Dimension::FREQUENCY,
                 "rad/s",
             ),
-            ("damping_ratios", &checks.damping_ratios, Dimension::ONE, "1"),
+            (
+                "damping_ratios",
+                &checks.damping_ratios,
+                Dimension::ONE,
+                "1",
+            ),
         ] {
             let Some(check) = check else { continue };
             for v in &check.values {
@@ -976,7 +999,11 @@ impl<'f> Checker<'f> {
                 "`t` is the time of the state, in s",
             );
             for (k, v) in &state.values {
-                self.value_of(&k.value, v, &format!("the value of `{}` in `final_state`", k.value));
+                self.value_of(
+                    &k.value,
+                    v,
+                    &format!("the value of `{}` in `final_state`", k.value),
+                );
             }
         }
         for c in &checks.conserved {
@@ -1003,9 +1030,9 @@ impl<'f> Checker<'f> {
                     continue;
                 };
                 let votes = self.votes(i, x);
-                let better = best.as_ref().is_none_or(|(v, p, _, _)| {
-                    votes > *v || (votes == *v && eq.priority < *p)
-                });
+                let better = best
+                    .as_ref()
+                    .is_none_or(|(v, p, _, _)| votes > *v || (votes == *v && eq.priority < *p));
                 if better {
                     let solved = Solved {
                         unit: x,
@@ -1016,7 +1043,9 @@ impl<'f> Checker<'f> {
                     best = Some((votes, eq.priority, i, solved));
                 }
             }
-            let Some((_, _, i, solved)) = best else { return };
+            let Some((_, _, i, solved)) = best else {
+                return;
+            };
             if let Some(s) = self.solution.get_mut(i) {
                 *s = Some(solved);
             }
@@ -1036,7 +1065,7 @@ impl<'f> Checker<'f> {
                     if j != i {
                         return false;
                     }
-                    match x.pow(c).and_then(|x| known.mul(x)) {
+                    match x.pow(c).and_then(|x| known.checked_mul(x)) {
                         Some(k) => known = k,
                         None => return false,
                     }
@@ -1053,7 +1082,7 @@ impl<'f> Checker<'f> {
         let mut left = Vec::new();
         for &(i, c) in &eq.unknowns {
             match self.solution.get(i).and_then(Option::as_ref) {
-                Some(x) => known = known.mul(x.unit.pow(c)?)?,
+                Some(x) => known = known.checked_mul(x.unit.pow(c)?)?,
                 None => left.push((i, c)),
             }
         }
@@ -1069,7 +1098,9 @@ impl<'f> Checker<'f> {
                 if implied.is_some() {
                     continue;
                 }
-                let Some(c) = file.coordinates.get(i) else { continue };
+                let Some(c) = file.coordinates.get(i) else {
+                    continue;
+                };
                 let n = &c.name.value;
                 self.diagnostics.push(
                     Diagnostic::new(
@@ -1082,7 +1113,9 @@ impl<'f> Checker<'f> {
                 );
                 continue;
             }
-            let Some(p) = file.parameters.get(i) else { continue };
+            let Some(p) = file.parameters.get(i) else {
+                continue;
+            };
             let n = &p.name.value;
             let value = write_expr(&p.default, 0);
             let shared = file
@@ -1143,7 +1176,8 @@ mod tests {
 
     #[test]
     fn without_units_nothing_is_checked() {
-        let src = "name: a\nparameters: { m: 1, k: 2 }\ncoordinates: [x]\nkinetic: (m + k)*x_dot^2\n";
+        let src =
+            "name: a\nparameters: { m: 1, k: 2 }\ncoordinates: [x]\nkinetic: (m + k)*x_dot^2\n";
         assert_eq!(errors(src), Vec::<String>::new());
     }
 
@@ -1167,7 +1201,10 @@ mod tests {
         let src = format!(
             "{OSCILLATOR}kinetic: m*x_dot/2\npotential: k*x^2/2\npoints: {{ P: [x, 0] }}\n"
         );
-        assert_eq!(errors(&src), ["8:10: `kinetic` is kg*m/s, but an energy is J"]);
+        assert_eq!(
+            errors(&src),
+            ["8:10: `kinetic` is kg*m/s, but an energy is J"]
+        );
         let help = &helps(&src)[0];
         assert!(
             help.ends_with("(the unit of `x`, m, is inferred from `potential` at 9:12; declare the unit of `x` if it is another)"),
@@ -1197,7 +1234,9 @@ mod tests {
         assert_eq!(errors(src), ["5:3: parameter `k` has no unit"]);
         assert_eq!(
             helps(src),
-            ["write `k: 100.0  # N/m` (the unit its use implies), or `k: { value: 100.0, unit: N/m }`"]
+            [
+                "write `k: 100.0  # N/m` (the unit its use implies), or `k: { value: 100.0, unit: N/m }`"
+            ]
         );
     }
 

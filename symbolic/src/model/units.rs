@@ -137,7 +137,10 @@ impl Rational {
         };
         let (whole, fraction) = mantissa.split_once('.').unwrap_or((mantissa, ""));
         if whole.is_empty() && fraction.is_empty()
-            || !whole.chars().chain(fraction.chars()).all(|c| c.is_ascii_digit())
+            || !whole
+                .chars()
+                .chain(fraction.chars())
+                .all(|c| c.is_ascii_digit())
         {
             return None;
         }
@@ -225,12 +228,12 @@ impl Dimension {
     }
 
     /// The dimension of a product; `None` on exponent overflow.
-    pub fn mul(self, o: Self) -> Option<Self> {
+    pub fn checked_mul(self, o: Self) -> Option<Self> {
         self.zip(o, Rational::checked_add)
     }
 
     /// The dimension of a quotient; `None` on exponent overflow.
-    pub fn div(self, o: Self) -> Option<Self> {
+    pub fn checked_div(self, o: Self) -> Option<Self> {
         self.zip(o, Rational::checked_sub)
     }
 
@@ -320,7 +323,7 @@ impl fmt::Display for Dimension {
         let mut best: Option<((usize, u64), String)> = None;
         if !self.mass.is_zero() {
             for (name, unit) in DISPLAY_NAMES {
-                let Some(rest) = unit.pow(self.mass).and_then(|u| self.div(u)) else {
+                let Some(rest) = unit.pow(self.mass).and_then(|u| self.checked_div(u)) else {
                     continue;
                 };
                 if !rest.time.is_zero() {
@@ -363,8 +366,7 @@ pub struct UnitError {
 }
 
 /// Help shared by unit errors: what a unit may be made of.
-pub const UNIT_HELP: &str =
-    "a unit is a product or quotient of m, kg, s, N, J, W, Pa, Hz, rad and 1, as in `N/m`, `N*s/m` or `kg*m^2`";
+pub const UNIT_HELP: &str = "a unit is a product or quotient of m, kg, s, N, J, W, Pa, Hz, rad and 1, as in `N/m`, `N*s/m` or `kg*m^2`";
 
 /// Parses unit text (grammar in the module documentation).
 ///
@@ -400,7 +402,7 @@ pub fn parse_unit(text: &str) -> Result<Dimension, UnitError> {
 /// `Nm` → `N*m`, `kgm` → `kg*m`: a short word made of two or more unit names written
 /// together.
 fn split_names(word: &str) -> Option<String> {
-    fn split<'w>(word: &'w str, out: &mut Vec<&'static str>) -> bool {
+    fn split(word: &str, out: &mut Vec<&'static str>) -> bool {
         if word.is_empty() {
             return true;
         }
@@ -465,17 +467,17 @@ impl UnitParser<'_> {
                     self.pos += 1;
                     self.skip_space();
                     let f = self.factor()?;
-                    d = d.mul(f).ok_or_else(|| self.overflow())?;
+                    d = d.checked_mul(f).ok_or_else(|| self.overflow())?;
                 }
                 Some('/') => {
                     self.pos += 1;
                     self.skip_space();
                     let f = self.factor()?;
-                    d = d.div(f).ok_or_else(|| self.overflow())?;
+                    d = d.checked_div(f).ok_or_else(|| self.overflow())?;
                 }
                 Some(c) if spaced && (c.is_alphanumeric() || c == '(') => {
                     let f = self.factor()?;
-                    d = d.mul(f).ok_or_else(|| self.overflow())?;
+                    d = d.checked_mul(f).ok_or_else(|| self.overflow())?;
                 }
                 _ => return Ok(d),
             }
@@ -574,9 +576,9 @@ impl UnitParser<'_> {
             "g" | "mm" | "cm" | "km" | "kN" | "ms" | "min" | "h" => {
                 "values are in coherent SI units without prefixes: m, kg, s".to_string()
             }
-            _ => match split_names(name).or_else(|| {
-                super::parser::closest(name, &names).map(str::to_string)
-            }) {
+            _ => match split_names(name)
+                .or_else(|| super::parser::closest(name, &names).map(str::to_string))
+            {
                 Some(c) => format!("did you mean `{c}`? {UNIT_HELP}"),
                 None => UNIT_HELP.to_string(),
             },
@@ -662,7 +664,10 @@ mod tests {
         assert_eq!(Rational::new(i64::MIN, -1), None);
         assert_eq!(Rational::from_decimal("0.5"), Some(r(1, 2)));
         assert_eq!(Rational::from_decimal("1e-3"), Some(r(1, 1000)));
-        assert_eq!(Rational::from_decimal("1.5E2"), Some(Rational::integer(150)));
+        assert_eq!(
+            Rational::from_decimal("1.5E2"),
+            Some(Rational::integer(150))
+        );
         assert_eq!(Rational::from_decimal("007"), Some(Rational::integer(7)));
         assert_eq!(Rational::from_decimal("1e400"), None);
         assert_eq!(Rational::from_decimal("0x10"), None);
@@ -700,10 +705,16 @@ mod tests {
         assert_eq!(root.length, r(1, 2));
         assert_eq!(unit("(m^(-3/2))^2"), Dimension::integers(-3, 0, 0));
         assert_eq!(
-            unit("m").mul(unit("m")).unwrap().div(unit("s^2")),
+            unit("m")
+                .checked_mul(unit("m"))
+                .unwrap()
+                .checked_div(unit("s^2")),
             Some(unit("m^2/s^2"))
         );
-        assert_eq!(unit("N/m").pow(r(1, 2)).unwrap().pow(Rational::integer(2)), Some(unit("N/m")));
+        assert_eq!(
+            unit("N/m").pow(r(1, 2)).unwrap().pow(Rational::integer(2)),
+            Some(unit("N/m"))
+        );
         assert_ne!(unit("N"), unit("N/m"));
     }
 
@@ -720,10 +731,19 @@ mod tests {
         assert_eq!(parse_unit("deg").unwrap_err().message, "unknown unit `deg`");
         assert_eq!(parse_unit("").unwrap_err().message, "empty unit");
         assert_eq!(parse_unit("kg*").unwrap_err().offset, 3);
-        assert_eq!(parse_unit("(m").unwrap_err().message, "unclosed `(` in the unit");
+        assert_eq!(
+            parse_unit("(m").unwrap_err().message,
+            "unclosed `(` in the unit"
+        );
         assert_eq!(parse_unit("m)").unwrap_err().offset, 1);
-        assert_eq!(parse_unit("2*m").unwrap_err().message, "the number `2` is not a unit");
-        assert_eq!(parse_unit("m^").unwrap_err().message, "expected an integer exponent");
+        assert_eq!(
+            parse_unit("2*m").unwrap_err().message,
+            "the number `2` is not a unit"
+        );
+        assert_eq!(
+            parse_unit("m^").unwrap_err().message,
+            "expected an integer exponent"
+        );
         assert!(parse_unit("m^99999999999999999999").is_err());
         assert!(parse_unit("m^(1/0)").is_err());
         assert!(parse_unit(&"(".repeat(100)).is_err());
