@@ -2,7 +2,8 @@
 //! corpus is every file in `models/`; each input is one of them with 1–8 random edits
 //! (inserted YAML and expression tokens, deleted, duplicated, swapped or truncated spans,
 //! replaced characters), loaded in full (YAML → schema → checks, every diagnostic rendered),
-//! lowered to expressions when it loads, and each of its lines parsed as an expression. A
+//! lowered to expressions when it loads, each of its lines parsed as an expression and each
+//! comment as a unit. The corpus declares `units: SI`, so the dimensional checks run too. A
 //! panic anywhere is a failure; the count of inputs, panics and how many still loaded is
 //! printed.
 //!
@@ -18,7 +19,7 @@ use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::path::PathBuf;
 
 use eomgen_symbolic::mechanics::SymbolicModel;
-use eomgen_symbolic::model::{Location, load, parser::parse_expr};
+use eomgen_symbolic::model::{Location, load, parser::parse_expr, units::parse_unit};
 
 /// Tokens inserted by the mutator: YAML structure, expression syntax and names that occur
 /// in the models, so that edits reach past the YAML layer.
@@ -96,6 +97,17 @@ const TOKENS: &[&str] = &[
     "true",
     "nan",
     "inf",
+    "units: SI\n",
+    "units: ",
+    "  # N/m",
+    "# kg*m^2, ",
+    "^(1/",
+    "^-",
+    "/(",
+    "²",
+    "rad",
+    "{ value: 1, unit: ",
+    "{ name: x, unit: ",
 ];
 
 /// xorshift64*, deterministic for a seed.
@@ -173,6 +185,11 @@ fn run_one(src: &str) -> Result<bool, String> {
         for line in src.lines() {
             let text = line.split_once(':').map_or(line, |(_, v)| v);
             let _ = parse_expr(text, Location { line: 1, column: 1 });
+            if let Some((_, comment)) = line.split_once('#')
+                && let Ok(d) = parse_unit(comment.trim())
+            {
+                let _ = d.to_string();
+            }
         }
         loaded
     }))

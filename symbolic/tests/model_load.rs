@@ -128,7 +128,12 @@ fn an_energy_form_file_loads_with_units_and_comments() {
     let units: Vec<(&str, Option<&str>)> = file
         .parameters
         .iter()
-        .map(|p| (p.name.value.as_str(), p.unit.as_deref()))
+        .map(|p| {
+            (
+                p.name.value.as_str(),
+                p.unit.as_ref().map(|u| u.value.as_str()),
+            )
+        })
         .collect();
     assert_eq!(
         units,

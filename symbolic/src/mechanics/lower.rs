@@ -417,7 +417,7 @@ impl<'f> Lowering<'f> {
             parameters.push(ParameterInfo {
                 name: p.name.value.clone(),
                 default: p.value,
-                unit: p.unit.clone(),
+                unit: p.unit.as_ref().map(|u| u.value.clone()),
                 symbol,
             });
         }

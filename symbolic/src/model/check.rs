@@ -36,7 +36,17 @@ pub fn check_partial(file: &ModelFile, incomplete: &Incomplete) -> Result<(), Ve
     checker.hand_equations();
     checker.reference_checks();
     checker.constraints();
-    checker.diagnostics.finish()
+    let units = super::unit_check::check(file);
+    // A unit mistake at the place of another mistake is its consequence (`initial: { theta:
+    // x }` is not constant, and so not in rad either): one message per mistake.
+    let mut list = checker.diagnostics.finish().err().unwrap_or_default();
+    let taken: Vec<Location> = list.iter().map(|d| d.location).collect();
+    list.extend(units.into_iter().filter(|d| !taken.contains(&d.location)));
+    if list.is_empty() {
+        return Ok(());
+    }
+    list.sort_by_key(|d| d.location);
+    Err(list)
 }
 
 /// The value of a constant expression at the parameters' defaults (`None` if it uses

@@ -6,7 +6,16 @@
 use super::ast::Expr;
 use super::located::{Located, Location};
 
-/// A parameter with its default value (`m1: 1.0  # kg`).
+/// The unit system a model file declares with `units:` (see [`ModelFile::units`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum UnitSystem {
+    /// `units: SI` — coherent SI units (m, kg, s, and the derived N, J, W, Pa; rad is a pure
+    /// number), checked by [`super::unit_check`].
+    Si,
+}
+
+/// A parameter with its default value: `m1: 1.0  # kg, upper arm` or
+/// `m1: { value: 1.0, unit: kg }`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Parameter {
     /// Name (an identifier).
@@ -15,17 +24,27 @@ pub struct Parameter {
     pub default: Expr,
     /// Default evaluated.
     pub value: f64,
-    /// The unit from the trailing YAML comment, if any (`kg` in `m1: 1.0  # kg`).
-    pub unit: Option<String>,
+    /// The unit as written, with where it starts: the `unit:` of the map form, else the
+    /// trailing YAML comment of the value's line when no other parameter shares the line
+    /// (`kg, upper arm` in `m1: 1.0  # kg, upper arm`). In a file with `units: SI` the text
+    /// before the first `,` is the binding unit ([`super::units::parse_unit`]); otherwise it
+    /// is documentation only.
+    pub unit: Option<Located<String>>,
 }
 
-/// A generalized coordinate `q`. Its rate is written `<name>_dot`.
+/// A generalized coordinate `q`: `- q  # rad, from +x` or `- { name: q, unit: rad }`. Its
+/// rate is written `<name>_dot`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Coordinate {
     /// Name (an identifier).
     pub name: Located<String>,
     /// The text of a trailing YAML comment, if any (`# angle from +x`).
     pub comment: Option<String>,
+    /// The `unit:` of the map form `{ name: x, unit: m }`, if given. In a file with
+    /// `units: SI` a coordinate's unit is this, else the start of its comment (before the
+    /// first `,`) when that parses as a unit, else inferred from its use
+    /// ([`super::unit_check`]).
+    pub unit: Option<Located<String>>,
 }
 
 /// A named point: a position expression in `q` and `t` with 2 or 3 components.
@@ -398,6 +417,10 @@ pub struct ModelFile {
     pub name: Located<String>,
     /// `description:` — one line.
     pub description: String,
+    /// `units: SI` — opts the file in to dimensional checks ([`super::unit_check`]): every
+    /// parameter must then carry a unit, and every expression must be dimensionally
+    /// consistent with its key. `None`: units are documentation only.
+    pub units: Option<Located<UnitSystem>>,
     /// `parameters:`, in file order.
     pub parameters: Vec<Parameter>,
     /// `coordinates:`, in file order.

@@ -2,7 +2,9 @@
 //!
 //! Pipeline: [`yaml`] (located YAML tree) → [`parser`] (expressions) → [`schema`] (typed
 //! model, every unknown key / wrong type reported) → [`check`] (cross-references and
-//! semantics). [`load`] runs all of it and reports every diagnostic of a file at once.
+//! semantics, and [`unit_check`] — dimensional analysis with the algebra of [`units`] — when
+//! the file declares `units: SI`). [`load`] runs all of it and reports every diagnostic of a
+//! file at once.
 
 pub mod ast;
 pub mod check;
@@ -12,6 +14,8 @@ pub mod located;
 pub mod parser;
 pub mod schema;
 pub mod templates;
+pub mod unit_check;
+pub mod units;
 pub mod yaml;
 
 pub use ast::{BinOp, Expr, ExprKind};

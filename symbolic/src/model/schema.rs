@@ -21,6 +21,7 @@ type KeyedExprs = Vec<(Located<String>, Expr)>;
 pub const TOP_LEVEL_KEYS: &[&str] = &[
     "name",
     "description",
+    "units",
     "parameters",
     "coordinates",
     "kinetic",
@@ -126,6 +127,21 @@ pub fn build_partial(path: &str, source: &str, root: &YamlNode) -> Built {
         file,
         incomplete: cx.incomplete,
         diagnostics,
+    }
+}
+
+/// Where the text `comment` of the trailing comment of `line` starts (it ends the line).
+fn comment_location(source: &str, line: u32, comment: &str) -> Location {
+    let text = source
+        .lines()
+        .nth(line.saturating_sub(1) as usize)
+        .unwrap_or_default()
+        .trim_end();
+    let byte = text.len().saturating_sub(comment.len());
+    let column = text.get(..byte).map_or(0, |p| p.chars().count());
+    Location {
+        line,
+        column: column as u32 + 1,
     }
 }
 
@@ -628,6 +644,12 @@ impl Ctx<'_> {
                 .unwrap_or_default(),
         };
 
+        self.section = "units";
+        let units = get(top, "units").and_then(|n| {
+            self.choice(n, "`units`", &[("SI", UnitSystem::Si)])
+                .map(|u| Located::new(u, n.location))
+        });
+
         self.section = "parameters";
         let parameters = get(top, "parameters")
             .map(|n| self.parameters(n))
@@ -744,6 +766,7 @@ impl Ctx<'_> {
             path: path.to_string(),
             name,
             description,
+            units,
             parameters,
             coordinates,
             kinetic,
@@ -1354,6 +1377,25 @@ impl Ctx<'_> {
         v: &YamlNode,
         entries: &Entries,
     ) -> Option<Parameter> {
+        // The map form `{ value: 1.0, unit: N/m }`.
+        let mut unit_key = None;
+        let v = if let YamlKind::Map(_) = &v.kind {
+            let f = self.fields(
+                k,
+                v,
+                "parameter",
+                &["value", "unit"],
+                &["value"],
+                "{ value: 1.0, unit: kg }",
+            )?;
+            if let Some(u) = get(f, "unit") {
+                let what = format!("the unit of parameter `{}`", k.value);
+                unit_key = Some(self.text(u, &what, "unit: N/m")?);
+            }
+            get(f, "value")?
+        } else {
+            v
+        };
         if v.kind == YamlKind::Null {
             self.error(
                 Diagnostic::new(
@@ -1410,10 +1452,13 @@ impl Ctx<'_> {
             .filter(|(ok, ov)| ok.location.line == line || ov.location.line == line)
             .count()
             > 1;
-        let unit = if shared {
-            None
+        let unit = if unit_key.is_some() || shared {
+            unit_key
         } else {
-            trailing_comment(self.source, line)
+            trailing_comment(self.source, line).map(|c| {
+                let at = comment_location(self.source, line, &c);
+                Located::new(c, at)
+            })
         };
         Some(Parameter {
             name: k.clone(),
@@ -1439,8 +1484,26 @@ impl Ctx<'_> {
         };
         let mut out = Vec::new();
         for item in items {
-            let Some(n) = self.name(item, "a coordinate") else {
-                if let YamlKind::Scalar { text, .. } = &item.kind {
+            // The map form `{ name: x, unit: m }`.
+            let mut unit = None;
+            let named = if let YamlKind::Map(f) = &item.kind {
+                const EXAMPLE: &str = "{ name: x, unit: m }";
+                self.unknown_keys(f, "a coordinate", &["name", "unit"], &["name", "unit"]);
+                if !self.require(f, item.location, "a coordinate", &["name"], EXAMPLE) {
+                    continue;
+                }
+                if let Some(u) = get(f, "unit") {
+                    unit = self.text(u, "the unit of a coordinate", "unit: m");
+                }
+                match get(f, "name") {
+                    Some(n) => n,
+                    None => continue,
+                }
+            } else {
+                item
+            };
+            let Some(n) = self.name(named, "a coordinate") else {
+                if let YamlKind::Scalar { text, .. } = &named.kind {
                     self.drop_name(text);
                 }
                 continue;
@@ -1456,7 +1519,11 @@ impl Ctx<'_> {
             } else {
                 None
             };
-            out.push(Coordinate { name: n, comment });
+            out.push(Coordinate {
+                name: n,
+                comment,
+                unit,
+            });
         }
         out
     }
@@ -1819,7 +1886,15 @@ mod tests {
         let b = built(src);
         let file = b.file.unwrap();
         assert_eq!(file.parameters.len(), 2);
-        assert_eq!(file.parameters[0].unit.as_deref(), Some("kg"));
+        let unit = file.parameters[0].unit.as_ref().unwrap();
+        assert_eq!(unit.value, "kg");
+        assert_eq!(
+            unit.location,
+            Location {
+                line: 4,
+                column: 13
+            }
+        );
         assert_eq!(file.parameters[1].unit, None);
         assert!((file.parameters[1].value - std::f64::consts::FRAC_PI_4).abs() < 1e-15);
         assert_eq!(b.diagnostics.len(), 1);

@@ -1,0 +1,1279 @@
+//! Dimensional checks of a model file that declares `units: SI`.
+//!
+//! A file opts in with the top-level key `units: SI`. Then:
+//!
+//! - every parameter has a unit, written in its trailing comment before the first `,`
+//!   (`k: 100.0  # N/m, spring`) or as `k: { value: 100.0, unit: N/m }`
+//!   ([`super::units::parse_unit`] gives the syntax);
+//! - a coordinate's unit is the `unit:` of `- { name: x, unit: m }`, else the start of its
+//!   trailing comment when that is a unit (`- x  # m, cart position`), else it is inferred
+//!   from its use (a point `[x, 0]` makes `x` a length, `sin(theta)` makes `theta` a pure
+//!   number); rates `x_dot` are the unit of `x` per s, accelerations `x_ddot` per s²; `t` is
+//!   in s;
+//! - every expression is dimensionally consistent: the terms of a sum and the sides of an
+//!   equation alike, the arguments of `sin`, `cos`, `exp`, `ln`, … pure numbers (rad is a
+//!   pure number), powers with numeric exponents (`sqrt` is `^(1/2)`);
+//! - every key has its physical unit: `kinetic` and `potential` J, point positions m,
+//!   `gravity` m/s², masses kg, inertias kg·m², body angles rad, spring stiffnesses N/m,
+//!   rest lengths m, damping coefficients N·s/m, forces N, torques N·m, a generalized force
+//!   J per unit of its coordinate (N for a length, N·m for an angle), initial values and
+//!   equilibria the unit of their coordinate (per s for a rate), and in `checks:` natural
+//!   frequencies rad/s, damping ratios 1, a period and `t` s;
+//! - a value written with numbers only (`0`, `-1`, `pi/2`) is in the unit of its key; inside
+//!   a larger expression a number is a pure number, except that `0` fits any unit.
+//!
+//! Unknown units (coordinates not declared, parameters without a unit) are solved from the
+//! requirements, key units first, then homogeneity, one unknown at a time; a parameter
+//! without a unit is still an error, whose help names the unit its use implies. All
+//! problems of a file are reported at once. Without `units:`, nothing here runs and units
+//! are documentation.
+
+use super::ast::{BinOp, Expr, ExprKind};
+use super::diagnostic::Diagnostic;
+use super::file::{BalanceKind, BodyKind, ModelFile};
+use super::located::Location;
+use super::parser::identifiers;
+use super::units::{Dimension, Rational, parse_unit};
+
+/// Checks the units of `file` if it declares `units:`; an empty list otherwise.
+///
+/// Names the schema pass left out (already reported) take any unit, so that one mistake
+/// gives one message.
+pub fn check(file: &ModelFile) -> Vec<Diagnostic> {
+    if file.units.is_none() {
+        return Vec::new();
+    }
+    let mut cx = Checker::new(file);
+    // Pass 1: requirements in the unknowns; solve them.
+    cx.walk();
+    cx.solve();
+    // Pass 2: every unknown solved or left free; report.
+    cx.mode = Mode::Report;
+    cx.walk();
+    cx.undeclared();
+    cx.diagnostics
+}
+
+/// A dimension `known · Π xᵢ^cᵢ` in the unknown units `xᵢ` (sorted by index, no zero `cᵢ`).
+#[derive(Debug, Clone, PartialEq)]
+struct Dim {
+    known: Dimension,
+    unknowns: Vec<(usize, Rational)>,
+    /// Pass 2: the solved unknowns that `known` depends on (for the help of a message).
+    inferred: Vec<usize>,
+}
+
+impl Dim {
+    fn of(known: Dimension) -> Self {
+        Self {
+            known,
+            unknowns: Vec::new(),
+            inferred: Vec::new(),
+        }
+    }
+
+    fn var(i: usize) -> Self {
+        Self {
+            known: Dimension::ONE,
+            unknowns: vec![(i, Rational::ONE)],
+            inferred: Vec::new(),
+        }
+    }
+
+    fn combine(&self, o: &Self, sign: Rational) -> Option<Self> {
+        let known = if sign == Rational::ONE {
+            self.known.checked_mul(o.known)?
+        } else {
+            self.known.checked_div(o.known)?
+        };
+        let mut unknowns = self.unknowns.clone();
+        for &(i, c) in &o.unknowns {
+            let c = c.checked_mul(sign)?;
+            match unknowns.iter_mut().find(|(j, _)| *j == i) {
+                Some((_, d)) => *d = d.checked_add(c)?,
+                None => unknowns.push((i, c)),
+            }
+        }
+        unknowns.retain(|(_, c)| !c.is_zero());
+        unknowns.sort_by_key(|(i, _)| *i);
+        let mut inferred = self.inferred.clone();
+        inferred.extend(&o.inferred);
+        inferred.sort_unstable();
+        inferred.dedup();
+        Some(Self {
+            known,
+            unknowns,
+            inferred,
+        })
+    }
+
+    fn mul(&self, o: &Self) -> Option<Self> {
+        self.combine(o, Rational::ONE)
+    }
+
+    fn div(&self, o: &Self) -> Option<Self> {
+        self.combine(o, Rational::integer(-1))
+    }
+
+    fn pow(&self, p: Rational) -> Option<Self> {
+        let mut unknowns = Vec::new();
+        for &(i, c) in &self.unknowns {
+            let c = c.checked_mul(p)?;
+            if !c.is_zero() {
+                unknowns.push((i, c));
+            }
+        }
+        Some(Self {
+            known: self.known.pow(p)?,
+            unknowns,
+            inferred: self.inferred.clone(),
+        })
+    }
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Mode {
+    /// Collect requirements that involve unknowns.
+    Infer,
+    /// Report requirements that fail.
+    Report,
+}
+
+/// What a name's unit is.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Unit {
+    /// Declared or solved.
+    Known(Dimension),
+    /// Unknown number `i` (pass 1 only).
+    Var(usize),
+    /// Anything: an unknown left unsolved, or a unit that did not parse (already reported).
+    Any,
+}
+
+/// Requirements against a key's unit are solved before homogeneity requirements.
+const KEY: u8 = 0;
+const HOMOGENEITY: u8 = 1;
+
+/// A requirement `dim = 1` with unknowns, and where it comes from.
+struct Equation {
+    priority: u8,
+    dim: Dim,
+    origin: String,
+    at: Location,
+    /// How the key spells its unit (`N*s/m`), when the expression is a lone name.
+    spelling: Option<String>,
+}
+
+/// An unknown unit solved from an equation.
+#[derive(Debug, Clone)]
+struct Solved {
+    unit: Dimension,
+    origin: String,
+    at: Location,
+    spelling: Option<String>,
+}
+
+impl Solved {
+    /// The unit as its key spells it (`N*s/m`), else canonical (`kg/s`).
+    fn text(&self) -> String {
+        self.spelling.clone().unwrap_or_else(|| show(self.unit))
+    }
+}
+
+struct Checker<'f> {
+    file: &'f ModelFile,
+    mode: Mode,
+    diagnostics: Vec<Diagnostic>,
+    parameters: Vec<Unit>,
+    coordinates: Vec<Unit>,
+    /// For each unknown: is it a coordinate (else a parameter), and its index there.
+    unknowns: Vec<(bool, usize)>,
+    /// Pass 1: requirements with unknowns.
+    equations: Vec<Equation>,
+    /// The units of the constraints visited so far in this pass, for their multipliers
+    /// (`lambda_<name>`): `(name, unit, holonomic)`.
+    constraints: Vec<(String, Option<Dim>, bool)>,
+    /// How the key being checked spells its unit, while its value is a lone name.
+    spelling: Option<String>,
+    solution: Vec<Option<Solved>>,
+}
+
+/// `kg`, `N/m`: a dimension for messages.
+fn show(d: Dimension) -> String {
+    d.to_string()
+}
+
+/// A load's unit: `N*m` rather than `J` for a torque.
+fn show_load(d: Dimension) -> String {
+    if d == Dimension::JOULE {
+        "N*m".to_string()
+    } else {
+        show(d)
+    }
+}
+
+/// A coordinate's unit in prose: `m`, `a pure number (rad)`.
+fn show_coordinate(d: Dimension) -> String {
+    if d.is_one() {
+        "a pure number (rad)".to_string()
+    } else {
+        show(d)
+    }
+}
+
+/// An expression as text for messages (shortened past 48 characters).
+fn text(e: &Expr) -> String {
+    let full = write_expr(e, 0);
+    if full.chars().count() > 48 {
+        let short: String = full.chars().take(45).collect();
+        format!("{short}...")
+    } else {
+        full
+    }
+}
+
+/// Writes `e` with the parentheses its operators need inside a context of precedence
+/// `outer` (0 sum, 1 product, 2 unary minus, 3 power base).
+fn write_expr(e: &Expr, outer: u8) -> String {
+    let (s, own) = match &e.kind {
+        ExprKind::Number { text, .. } => (text.clone(), 4),
+        ExprKind::Ident(n) => (n.clone(), 4),
+        ExprKind::Neg(a) => (format!("-{}", write_expr(a, 2)), 2),
+        ExprKind::Call { func, args } => (
+            format!(
+                "{func}({})",
+                args.iter()
+                    .map(|a| write_expr(a, 0))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
+            4,
+        ),
+        ExprKind::Binary { op, lhs, rhs } => match op {
+            BinOp::Add | BinOp::Sub => {
+                let sign = if *op == BinOp::Add { " + " } else { " - " };
+                (
+                    format!("{}{sign}{}", write_expr(lhs, 0), write_expr(rhs, 1)),
+                    0,
+                )
+            }
+            BinOp::Mul | BinOp::Div => {
+                let sign = if *op == BinOp::Mul { "*" } else { "/" };
+                (
+                    format!("{}{sign}{}", write_expr(lhs, 1), write_expr(rhs, 2)),
+                    1,
+                )
+            }
+            BinOp::Pow => (format!("{}^{}", write_expr(lhs, 3), write_expr(rhs, 2)), 3),
+        },
+    };
+    if own < outer { format!("({s})") } else { s }
+}
+
+/// Whether `e` is written with numbers only (then it takes the unit of its key).
+fn numbers_only(e: &Expr) -> bool {
+    let mut ids = Vec::new();
+    identifiers(e, &mut ids);
+    ids.iter().all(|(n, _)| n == "pi")
+}
+
+/// The exact value of an exponent written with numbers and `+ - * /` (`2`, `-1`, `1/2`).
+fn numeric_exponent(e: &Expr) -> Option<Rational> {
+    match &e.kind {
+        ExprKind::Number { text, .. } => Rational::from_decimal(text),
+        ExprKind::Neg(a) => numeric_exponent(a)?.checked_neg(),
+        ExprKind::Binary { op, lhs, rhs } => {
+            let (a, b) = (numeric_exponent(lhs)?, numeric_exponent(rhs)?);
+            match op {
+                BinOp::Add => a.checked_add(b),
+                BinOp::Sub => a.checked_sub(b),
+                BinOp::Mul => a.checked_mul(b),
+                BinOp::Div => a.checked_div(b),
+                BinOp::Pow => None,
+            }
+        }
+        _ => None,
+    }
+}
+
+/// The terms of a sum `a + b - c` (signs dropped: they do not change units).
+fn terms<'e>(e: &'e Expr, out: &mut Vec<&'e Expr>) {
+    match &e.kind {
+        ExprKind::Binary {
+            op: BinOp::Add | BinOp::Sub,
+            lhs,
+            rhs,
+        } => {
+            terms(lhs, out);
+            terms(rhs, out);
+        }
+        _ => out.push(e),
+    }
+}
+
+/// The unit text of a parameter's comment or `unit:`: what precedes the first `,`.
+fn unit_part(text: &str) -> &str {
+    text.split(',').next().unwrap_or_default()
+}
+
+/// Component names for messages.
+const AXES: [&str; 3] = ["x", "y", "z"];
+
+impl<'f> Checker<'f> {
+    fn new(file: &'f ModelFile) -> Self {
+        let mut diagnostics = Vec::new();
+        let mut unknowns = Vec::new();
+        let mut parameters = Vec::new();
+        for (i, p) in file.parameters.iter().enumerate() {
+            let unit = match &p.unit {
+                None => {
+                    unknowns.push((false, i));
+                    Unit::Var(unknowns.len() - 1)
+                }
+                Some(u) => match parse_unit(unit_part(&u.value)) {
+                    Ok(d) => Unit::Known(d),
+                    Err(e) => {
+                        let mut d = Diagnostic::new(
+                            u.location.offset(e.offset),
+                            format!("{} in the unit of parameter `{}`", e.message, p.name.value),
+                        )
+                        .with_help(e.help);
+                        if u.value.contains(' ') && !u.value.contains(',') {
+                            d.help = d.help.map(|h| {
+                                format!("{h}; a comment gives the unit first, then a `,` and any description: `# N/m, spring`")
+                            });
+                        }
+                        diagnostics.push(d);
+                        Unit::Any
+                    }
+                },
+            };
+            parameters.push(unit);
+        }
+        let mut coordinates = Vec::new();
+        for (i, c) in file.coordinates.iter().enumerate() {
+            let declared = match &c.unit {
+                Some(u) => match parse_unit(&u.value) {
+                    Ok(d) => Some(Unit::Known(d)),
+                    Err(e) => {
+                        diagnostics.push(
+                            Diagnostic::new(
+                                u.location.offset(e.offset),
+                                format!(
+                                    "{} in the unit of coordinate `{}`",
+                                    e.message, c.name.value
+                                ),
+                            )
+                            .with_help(e.help),
+                        );
+                        Some(Unit::Any)
+                    }
+                },
+                // A comment that does not start with a unit only describes the coordinate.
+                None => c
+                    .comment
+                    .as_deref()
+                    .and_then(|t| parse_unit(unit_part(t)).ok())
+                    .map(Unit::Known),
+            };
+            coordinates.push(declared.unwrap_or_else(|| {
+                unknowns.push((true, i));
+                Unit::Var(unknowns.len() - 1)
+            }));
+        }
+        Self {
+            file,
+            mode: Mode::Infer,
+            diagnostics,
+            parameters,
+            coordinates,
+            solution: vec![None; unknowns.len()],
+            unknowns,
+            equations: Vec::new(),
+            constraints: Vec::new(),
+            spelling: None,
+        }
+    }
+
+    /// The unit of `u` in the current pass.
+    fn unit(&self, u: Unit) -> Option<Dim> {
+        match (u, self.mode) {
+            (Unit::Known(d), _) => Some(Dim::of(d)),
+            (Unit::Var(i), Mode::Infer) => Some(Dim::var(i)),
+            (Unit::Var(i), Mode::Report) => {
+                let solved = self.solution.get(i).cloned().flatten()?;
+                Some(Dim {
+                    inferred: vec![i],
+                    ..Dim::of(solved.unit)
+                })
+            }
+            (Unit::Any, _) => None,
+        }
+    }
+
+    fn coordinate(&self, name: &str) -> Option<usize> {
+        self.file
+            .coordinates
+            .iter()
+            .position(|c| c.name.value == name)
+    }
+
+    /// The unit of a coordinate (`x`), rate (`x_dot`) or acceleration (`x_ddot`).
+    fn motion(&self, name: &str) -> Option<Option<Dim>> {
+        let (base, per) = if let Some(b) = name.strip_suffix("_ddot") {
+            (b, -2)
+        } else if let Some(b) = name.strip_suffix("_dot") {
+            (b, -1)
+        } else {
+            (name, 0)
+        };
+        let i = self.coordinate(base)?;
+        let u = self.coordinates.get(i).copied().unwrap_or(Unit::Any);
+        Some(
+            self.unit(u)
+                .and_then(|d| d.mul(&Dim::of(Dimension::integers(0, 0, per)))),
+        )
+    }
+
+    fn name(&self, n: &str) -> Option<Dim> {
+        match n {
+            "pi" => return Some(Dim::of(Dimension::ONE)),
+            "t" => return Some(Dim::of(Dimension::SECOND)),
+            _ => {}
+        }
+        if let Some(i) = self.file.parameters.iter().position(|p| p.name.value == n) {
+            return self.unit(self.parameters.get(i).copied().unwrap_or(Unit::Any));
+        }
+        if let Some(c) = n.strip_prefix("lambda_")
+            && let Some((_, unit, holonomic)) = self.constraints.iter().find(|(k, _, _)| k == c)
+        {
+            // `M q̈ = F − Jᵀ λ` with `J = ∂Φ/∂q` (holonomic) or `∂g/∂q̇` (non-holonomic):
+            // `λ` is J per unit of `Φ`, or W per unit of `g`.
+            let work = if *holonomic {
+                Dimension::JOULE
+            } else {
+                Dimension::WATT
+            };
+            return Dim::of(work).div(unit.as_ref()?);
+        }
+        // Names already reported take any unit.
+        self.motion(n).flatten()
+    }
+
+    /// Requires `got = want` (`what` at `at` says where); `report` builds the diagnostic
+    /// from the two units.
+    fn require(
+        &mut self,
+        got: Option<&Dim>,
+        want: Option<&Dim>,
+        (priority, what, at): (u8, &str, Location),
+        report: impl FnOnce(Dimension, Dimension) -> Diagnostic,
+    ) {
+        let (Some(got), Some(want)) = (got, want) else {
+            return;
+        };
+        match self.mode {
+            Mode::Infer => {
+                if let Some(dim) = got.div(want)
+                    && !dim.unknowns.is_empty()
+                {
+                    self.equations.push(Equation {
+                        priority,
+                        dim,
+                        origin: what.to_string(),
+                        at,
+                        spelling: self.spelling.clone(),
+                    });
+                }
+            }
+            Mode::Report => {
+                if got.unknowns.is_empty() && want.unknowns.is_empty() && got.known != want.known {
+                    let mut d = report(got.known, want.known);
+                    let mut inferred = got.inferred.clone();
+                    inferred.extend(&want.inferred);
+                    inferred.sort_unstable();
+                    inferred.dedup();
+                    let notes: Vec<String> = inferred
+                        .iter()
+                        .filter_map(|&i| self.inference_note(i))
+                        .collect();
+                    if !notes.is_empty() {
+                        let help = d.help.take().unwrap_or_default();
+                        d.help = Some(format!("{help} ({})", notes.join("; ")));
+                    }
+                    self.diagnostics.push(d);
+                }
+            }
+        }
+    }
+
+    /// "`x` is taken to be m^2/s from `kinetic` at 8:10; declare its unit if it is not".
+    fn inference_note(&self, i: usize) -> Option<String> {
+        let solved = self.solution.get(i).cloned().flatten()?;
+        let &(is_coordinate, index) = self.unknowns.get(i)?;
+        let name = if is_coordinate {
+            &self.file.coordinates.get(index)?.name.value
+        } else {
+            &self.file.parameters.get(index)?.name.value
+        };
+        Some(format!(
+            "the unit of `{name}`, {}, is inferred from {} at {}; declare the unit of `{name}` if it is another",
+            solved.text(),
+            solved.origin,
+            solved.at
+        ))
+    }
+
+    /// The unit of `e`, checking its sums, function arguments and powers; `None` when it
+    /// can be anything (`0`, a name already reported, an inconsistent sum).
+    fn dim(&mut self, e: &Expr, what: &str) -> Option<Dim> {
+        match &e.kind {
+            ExprKind::Number { value, .. } => (*value != 0.0).then(|| Dim::of(Dimension::ONE)),
+            ExprKind::Ident(n) => self.name(n),
+            ExprKind::Neg(a) => self.dim(a, what),
+            ExprKind::Binary {
+                op: BinOp::Add | BinOp::Sub,
+                ..
+            } => self.sum(e, what),
+            ExprKind::Binary {
+                op: op @ (BinOp::Mul | BinOp::Div),
+                lhs,
+                rhs,
+            } => {
+                let a = self.dim(lhs, what);
+                let b = self.dim(rhs, what);
+                match op {
+                    BinOp::Mul => a?.mul(&b?),
+                    _ => a?.div(&b?),
+                }
+            }
+            ExprKind::Binary { lhs, rhs, .. } => self.power(e, lhs, rhs, what),
+            ExprKind::Call { func, args } => self.call(func, args, what),
+        }
+    }
+
+    fn sum(&mut self, e: &Expr, what: &str) -> Option<Dim> {
+        let mut parts = Vec::new();
+        terms(e, &mut parts);
+        let dims: Vec<Option<Dim>> = parts.iter().map(|t| self.dim(t, what)).collect();
+        let (first, reference) = parts
+            .iter()
+            .zip(&dims)
+            .find_map(|(t, d)| d.as_ref().map(|d| (*t, d.clone())))?;
+        let before = self.diagnostics.len();
+        for (t, d) in parts.iter().zip(&dims) {
+            if std::ptr::eq(*t, first) {
+                continue;
+            }
+            let (first_text, term_text, at) = (text(first), text(t), t.location);
+            self.require(d.as_ref(), Some(&reference), (HOMOGENEITY, what, at), |got, want| {
+                Diagnostic::new(
+                    at,
+                    format!(
+                        "sum of unlike units in {what}: `{first_text}` is {} but `{term_text}` is {}",
+                        show(want),
+                        show(got)
+                    ),
+                )
+                .with_help("every term of a sum has the same unit; check the formula and the units of its parameters")
+            });
+        }
+        // An inconsistent sum has no unit: no second message about the same mistake.
+        (self.diagnostics.len() == before).then_some(reference)
+    }
+
+    fn power(&mut self, e: &Expr, base: &Expr, exponent: &Expr, what: &str) -> Option<Dim> {
+        let b = self.dim(base, what);
+        if let Some(p) = numeric_exponent(exponent) {
+            return b?.pow(p);
+        }
+        let x = self.dim(exponent, what);
+        let one = Dim::of(Dimension::ONE);
+        let before = self.diagnostics.len();
+        let (exponent_text, power_text, at) = (text(exponent), text(e), exponent.location);
+        self.require(x.as_ref(), Some(&one), (HOMOGENEITY, what, at), |got, _| {
+            Diagnostic::new(
+                at,
+                format!("the exponent `{exponent_text}` in {what} is {}, but an exponent is a pure number", show(got)),
+            )
+            .with_help("divide it by a quantity of the same unit")
+        });
+        let base_text = text(base);
+        self.require(b.as_ref(), Some(&one), (HOMOGENEITY, what, base.location), |got, _| {
+            Diagnostic::new(
+                base.location,
+                format!("`{power_text}` in {what} raises `{base_text}`, which is {}, to a power that is not a number", show(got)),
+            )
+            .with_help("only a pure number can be raised to a symbolic power; write the exponent as a number, as in `x^2` or `x^(1/2)`")
+        });
+        // A wrong power has no unit: no second message about the same mistake.
+        (self.diagnostics.len() == before).then_some(one)
+    }
+
+    fn call(&mut self, func: &str, args: &[Expr], what: &str) -> Option<Dim> {
+        let dims: Vec<Option<Dim>> = args.iter().map(|a| self.dim(a, what)).collect();
+        let one = Dim::of(Dimension::ONE);
+        match (func, args, dims.as_slice()) {
+            ("sqrt", _, [d]) => d.as_ref()?.pow(Rational::new(1, 2)?),
+            ("abs", _, [d]) => d.clone(),
+            ("sign" | "step", _, _) => Some(one),
+            ("atan2", [y, x], [dy, dx]) => {
+                let (y_text, x_text, at) = (text(y), text(x), x.location);
+                self.require(dx.as_ref(), dy.as_ref(), (HOMOGENEITY, what, at), |got, want| {
+                    Diagnostic::new(
+                        at,
+                        format!(
+                            "the arguments of `atan2` in {what} have unlike units: `{y_text}` is {} but `{x_text}` is {}",
+                            show(want),
+                            show(got)
+                        ),
+                    )
+                    .with_help("`atan2(y, x)` is the angle of the vector (x, y): both components have one unit")
+                });
+                Some(one)
+            }
+            (_, [a], [d]) => {
+                let (arg_text, at) = (text(a), a.location);
+                self.require(d.as_ref(), Some(&one), (HOMOGENEITY, what, at), |got, _| {
+                    Diagnostic::new(
+                        at,
+                        format!(
+                            "the argument of `{func}` in {what} is {}, but it must be a pure number (rad)",
+                            show(got)
+                        ),
+                    )
+                    .with_help(format!(
+                        "`{func}` takes a pure number, such as an angle in rad: `{arg_text}` lacks a factor of unit {}, or a parameter in it has the wrong unit",
+                        Dimension::ONE.checked_div(got).map_or_else(|| "?".to_string(), show)
+                    ))
+                });
+                Some(one)
+            }
+            _ => None,
+        }
+    }
+
+    /// Checks `e` against the unit its key requires; a value written with numbers only is
+    /// in that unit.
+    fn key(
+        &mut self,
+        e: &Expr,
+        want: Option<Dim>,
+        what: &str,
+        report: impl FnOnce(Dimension, Dimension) -> Diagnostic,
+    ) {
+        if numbers_only(e) {
+            return;
+        }
+        let got = self.dim(e, what);
+        self.require(got.as_ref(), want.as_ref(), (KEY, what, e.location), report);
+    }
+
+    /// Checks `e` against a fixed unit: "`what` is got, but `kind` is want_text" with `help`,
+    /// plus the parameter's declaration when `e` is a lone parameter.
+    fn fixed(
+        &mut self,
+        e: &Expr,
+        want: Dimension,
+        what: &str,
+        kind: &str,
+        want_text: &str,
+        help: &str,
+    ) {
+        let lone = match &e.kind {
+            ExprKind::Ident(n) => self.file.parameters.iter().find(|p| &p.name.value == n),
+            _ => None,
+        };
+        let spelling = want_text.split(" (").next().unwrap_or(want_text);
+        let advice = match lone {
+            Some(p) => format!(
+                "{help}; if `{n}` is one, declare it so: `{n}: {}  # {spelling}`",
+                write_expr(&p.default, 0),
+                n = p.name.value
+            ),
+            None => help.to_string(),
+        };
+        let at = e.location;
+        self.spelling = lone.map(|_| spelling.to_string());
+        self.key(e, Some(Dim::of(want)), what, |got, _| {
+            Diagnostic::new(
+                at,
+                format!("{what} is {}, but {kind} is {want_text}", show(got)),
+            )
+            .with_help(advice)
+        });
+        self.spelling = None;
+    }
+
+    /// Checks a value of coordinate `name` or of its rate (`initial:`, `equilibria:`,
+    /// `final_state:`).
+    fn value_of(&mut self, name: &str, e: &Expr, what: &str) {
+        let Some(want) = self.motion(name).flatten() else {
+            return;
+        };
+        let at = e.location;
+        let name = name.to_string();
+        self.key(e, Some(want), what, |got, want| {
+            Diagnostic::new(
+                at,
+                format!(
+                    "{what} is {}, but `{name}` is {}",
+                    show(got),
+                    show_coordinate(want)
+                ),
+            )
+            .with_help(format!(
+                "write it in the unit of `{name}`, or fix the units of its parameters"
+            ))
+        });
+    }
+
+    /// Checks that `e` is consistent in itself (its sums, functions and powers).
+    fn homogeneous(&mut self, e: &Expr, what: &str) {
+        self.dim(e, what);
+    }
+
+    /// Both passes visit every expression of the file in the same order.
+    fn walk(&mut self) {
+        let file = self.file;
+        let j = Dimension::JOULE;
+        if let Some(k) = &file.kinetic {
+            self.fixed(
+                k,
+                j,
+                "`kinetic`",
+                "an energy",
+                "J",
+                "kinetic energy is mass × speed² / 2, kg*(m/s)^2 = J: check the powers of the rates and the units of the parameters",
+            );
+        }
+        if let Some(v) = &file.potential {
+            self.fixed(
+                v,
+                j,
+                "`potential`",
+                "an energy",
+                "J",
+                "potential energy is force × length, N*m = J, as in `m*g*h` or `k*x^2/2`",
+            );
+        }
+        for (k, q) in &file.generalized_forces {
+            let Some(coordinate) = self.motion(&k.value).flatten() else {
+                self.homogeneous(q, &format!("the generalized force of `{}`", k.value));
+                continue;
+            };
+            let want = Dim::of(j).div(&coordinate);
+            let (name, at) = (k.value.clone(), q.location);
+            let what = format!("the generalized force of `{name}`");
+            self.key(q, want, &what, |got, want| {
+                Diagnostic::new(
+                    at,
+                    format!(
+                        "{what} is {}, but `{name}` is {}, so it must be {}",
+                        show(got),
+                        show_coordinate(j.checked_div(want).unwrap_or(Dimension::ONE)),
+                        show_load(want)
+                    ),
+                )
+                .with_help(format!(
+                    "the virtual work `Q δ{name}` is an energy (J), so a generalized force is J per unit of its coordinate: N for a length, N*m for an angle"
+                ))
+            });
+        }
+        for p in &file.points {
+            for (axis, c) in AXES.iter().zip(&p.position) {
+                self.fixed(
+                    c,
+                    Dimension::METRE,
+                    &format!("the {axis} component of point `{}`", p.name.value),
+                    "a position",
+                    "m",
+                    "positions are lengths: check the units of the parameters in it",
+                );
+            }
+        }
+        for b in &file.bodies {
+            let name = &b.name.value;
+            let (mass, inertia_angle) = match &b.kind {
+                BodyKind::Particle { mass, .. } => (mass, None),
+                BodyKind::Rigid {
+                    mass,
+                    inertia,
+                    angle,
+                    ..
+                } => (mass, Some((inertia, angle))),
+            };
+            self.fixed(
+                mass,
+                Dimension::KILOGRAM,
+                &format!("the mass of body `{name}`"),
+                "a mass",
+                "kg",
+                "a body's mass is in kg",
+            );
+            if let Some((inertia, angle)) = inertia_angle {
+                self.fixed(
+                    inertia,
+                    Dimension::INERTIA,
+                    &format!("the inertia of body `{name}`"),
+                    "a moment of inertia",
+                    "kg*m^2",
+                    "a moment of inertia is mass × length², as in `m*l^2/12` for a uniform bar about its centre",
+                );
+                self.fixed(
+                    angle,
+                    Dimension::ONE,
+                    &format!("the angle of body `{name}`"),
+                    "an angle",
+                    "rad (a pure number)",
+                    "a body's angle is an angle coordinate, or a function of the coordinates that gives a pure number",
+                );
+            }
+        }
+        if let Some(g) = &file.gravity {
+            for (axis, c) in AXES.iter().zip(&g.value) {
+                self.fixed(
+                    c,
+                    Dimension::ACCELERATION,
+                    &format!("the {axis} component of `gravity`"),
+                    "an acceleration",
+                    "m/s^2",
+                    "gravity is the acceleration of free fall, as in `[0, -g]` with `g: 9.81  # m/s^2`",
+                );
+            }
+        }
+        for s in &file.springs {
+            let name = &s.name.value;
+            self.fixed(
+                &s.stiffness,
+                Dimension::STIFFNESS,
+                &format!("the stiffness of spring `{name}`"),
+                "a spring stiffness",
+                "N/m",
+                "a spring pulls with stiffness × stretch, N/m × m = N",
+            );
+            if let Some(l) = &s.rest_length {
+                self.fixed(
+                    l,
+                    Dimension::METRE,
+                    &format!("the rest length of spring `{name}`"),
+                    "a length",
+                    "m",
+                    "a rest length is the distance between the spring's points when it is relaxed",
+                );
+            }
+        }
+        for d in &file.dampers {
+            self.fixed(
+                &d.coefficient,
+                Dimension::DAMPING,
+                &format!("the coefficient of damper `{}`", d.name.value),
+                "a damping coefficient",
+                "N*s/m",
+                "a damper pushes with coefficient × rate of stretch, N*s/m × m/s = N",
+            );
+        }
+        for f in &file.forces {
+            for (axis, c) in AXES.iter().zip(&f.vector) {
+                self.fixed(
+                    c,
+                    Dimension::NEWTON,
+                    &format!("the {axis} component of force `{}`", f.name.value),
+                    "a force",
+                    "N",
+                    "a force is mass × acceleration, kg*m/s^2 = N",
+                );
+            }
+        }
+        for t in &file.torques {
+            self.fixed(
+                &t.value,
+                Dimension::JOULE,
+                &format!("torque `{}`", t.name.value),
+                "a torque",
+                "N*m",
+                "a torque is force × lever arm, N*m",
+            );
+        }
+        self.constraints.clear();
+        for (holonomic, list) in [(true, &file.constraints), (false, &file.nonholonomic)] {
+            for (k, e) in list {
+                let unit = self.dim(e, &format!("constraint `{}`", k.value));
+                self.constraints.push((k.value.clone(), unit, holonomic));
+            }
+        }
+        for (k, e) in &file.initial {
+            self.value_of(&k.value, e, &format!("the initial value of `{}`", k.value));
+        }
+        for q in &file.equilibria {
+            for (c, e) in &q.values {
+                self.value_of(
+                    &c.value,
+                    e,
+                    &format!("`{}` of equilibrium `{}`", c.value, q.name.value),
+                );
+            }
+        }
+        for e in &file.events {
+            self.homogeneous(
+                &e.when,
+                &format!("the function of event `{}`", e.name.value),
+            );
+        }
+        for b in &file.balances {
+            if let BalanceKind::Lmb { along } = &b.kind {
+                for e in along {
+                    self.homogeneous(e, "`along`");
+                }
+            }
+        }
+        self.checks();
+    }
+
+    fn checks(&mut self) {
+        let checks = &self.file.checks;
+        for (i, eq) in checks.equations_of_motion.iter().enumerate() {
+            let what = format!("equation of motion {}", i + 1);
+            let lhs = self.dim(&eq.lhs, &what);
+            let Some(rhs_expr) = &eq.rhs else { continue };
+            let rhs = self.dim(rhs_expr, &what);
+            if numbers_only(&eq.lhs) || numbers_only(rhs_expr) {
+                continue;
+            }
+            let (l, r, at) = (text(&eq.lhs), text(rhs_expr), rhs_expr.location);
+            self.require(rhs.as_ref(), lhs.as_ref(), (HOMOGENEITY, &what, at), |got, want| {
+                Diagnostic::new(
+                    at,
+                    format!(
+                        "the sides of {what} have unlike units: `{l}` is {} but `{r}` is {}",
+                        show(want),
+                        show(got)
+                    ),
+                )
+                .with_help("both sides are a generalized force of one coordinate: N for a length, N*m for an angle")
+            });
+        }
+        for (key, check, want, want_text) in [
+            (
+                "natural_frequencies",
+                &checks.natural_frequencies,
+                Dimension::FREQUENCY,
+                "rad/s",
+            ),
+            (
+                "damping_ratios",
+                &checks.damping_ratios,
+                Dimension::ONE,
+                "1",
+            ),
+        ] {
+            let Some(check) = check else { continue };
+            for v in &check.values {
+                self.fixed(
+                    v,
+                    want,
+                    &format!("a value of `{key}`"),
+                    "it",
+                    want_text,
+                    "natural frequencies are in rad/s, as in `sqrt(k/m)`; damping ratios are pure numbers, as in `c/(2*sqrt(k*m))`",
+                );
+            }
+        }
+        if let Some(p) = &checks.period {
+            self.fixed(
+                &p.value,
+                Dimension::SECOND,
+                "the `value` of `period`",
+                "a period",
+                "s",
+                "a period is a time, as in `2*pi*sqrt(l/g)`",
+            );
+        }
+        if let Some(state) = &checks.final_state {
+            self.fixed(
+                &state.t,
+                Dimension::SECOND,
+                "the time `t` of `final_state`",
+                "a time",
+                "s",
+                "`t` is the time of the state, in s",
+            );
+            for (k, v) in &state.values {
+                self.value_of(
+                    &k.value,
+                    v,
+                    &format!("the value of `{}` in `final_state`", k.value),
+                );
+            }
+        }
+        for c in &checks.conserved {
+            self.homogeneous(&c.value, &format!("conserved quantity `{}`", c.name.value));
+        }
+    }
+
+    /// Solves the unknowns one at a time. Every equation with exactly one unknown left,
+    /// `known · x^c = 1`, proposes `x = known^(-1/c)`; the proposal that satisfies the most
+    /// equations wins (ties: key requirements first, then file order), so that one wrong
+    /// formula does not outvote the others.
+    fn solve(&mut self) {
+        loop {
+            let mut best: Option<(usize, u8, usize, Solved)> = None;
+            for eq in &self.equations {
+                let Some((known, left)) = self.reduce(&eq.dim) else {
+                    continue;
+                };
+                let [(i, c)] = left[..] else { continue };
+                let Some(x) = Rational::integer(-1)
+                    .checked_div(c)
+                    .and_then(|p| known.pow(p))
+                else {
+                    continue;
+                };
+                let votes = self.votes(i, x);
+                let better = best
+                    .as_ref()
+                    .is_none_or(|(v, p, _, _)| votes > *v || (votes == *v && eq.priority < *p));
+                if better {
+                    let solved = Solved {
+                        unit: x,
+                        origin: eq.origin.clone(),
+                        at: eq.at,
+                        spelling: eq.spelling.clone(),
+                    };
+                    best = Some((votes, eq.priority, i, solved));
+                }
+            }
+            let Some((_, _, i, solved)) = best else {
+                return;
+            };
+            if let Some(s) = self.solution.get_mut(i) {
+                *s = Some(solved);
+            }
+        }
+    }
+
+    /// How many equations hold with unknown `i` set to `x` (those left with other unknowns
+    /// do not count).
+    fn votes(&self, i: usize, x: Dimension) -> usize {
+        self.equations
+            .iter()
+            .filter(|eq| {
+                let Some((mut known, left)) = self.reduce(&eq.dim) else {
+                    return false;
+                };
+                for &(j, c) in &left {
+                    if j != i {
+                        return false;
+                    }
+                    match x.pow(c).and_then(|x| known.checked_mul(x)) {
+                        Some(k) => known = k,
+                        None => return false,
+                    }
+                }
+                known.is_one()
+            })
+            .count()
+    }
+
+    /// An equation with the solved unknowns substituted: its known part and the unknowns
+    /// left (`None` on exponent overflow).
+    fn reduce(&self, eq: &Dim) -> Option<(Dimension, Vec<(usize, Rational)>)> {
+        let mut known = eq.known;
+        let mut left = Vec::new();
+        for &(i, c) in &eq.unknowns {
+            match self.solution.get(i).and_then(Option::as_ref) {
+                Some(x) => known = known.checked_mul(x.unit.pow(c)?)?,
+                None => left.push((i, c)),
+            }
+        }
+        Some((known, left))
+    }
+
+    /// Parameters without a unit, and coordinates whose unit could not be inferred.
+    fn undeclared(&mut self) {
+        let file = self.file;
+        for (k, &(is_coordinate, i)) in self.unknowns.iter().enumerate() {
+            let implied = self.solution.get(k).cloned().flatten();
+            if is_coordinate {
+                if implied.is_some() {
+                    continue;
+                }
+                let Some(c) = file.coordinates.get(i) else {
+                    continue;
+                };
+                let n = &c.name.value;
+                self.diagnostics.push(
+                    Diagnostic::new(
+                        c.name.location,
+                        format!("the unit of coordinate `{n}` is neither declared nor implied by its use"),
+                    )
+                    .with_help(format!(
+                        "declare it at the start of its comment, `- {n}  # m`, or as `- {{ name: {n}, unit: m }}`"
+                    )),
+                );
+                continue;
+            }
+            let Some(p) = file.parameters.get(i) else {
+                continue;
+            };
+            let n = &p.name.value;
+            let value = write_expr(&p.default, 0);
+            let shared = file
+                .parameters
+                .iter()
+                .any(|o| o.name.location.line == p.name.location.line && o.name.value != *n);
+            let line = if shared { " on a line of its own" } else { "" };
+            let help = match implied {
+                Some(u) => format!(
+                    "write `{n}: {value}  # {u}`{line} (the unit its use implies), or `{n}: {{ value: {value}, unit: {u} }}`",
+                    u = u.text()
+                ),
+                None => format!(
+                    "write its unit in a trailing comment, `{n}: {value}  # N/m`{line}, or `{n}: {{ value: {value}, unit: N/m }}` (`1` for a pure number)"
+                ),
+            };
+            self.diagnostics.push(
+                Diagnostic::new(p.name.location, format!("parameter `{n}` has no unit"))
+                    .with_help(help),
+            );
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::model::load;
+
+    /// `line:col: message` of every diagnostic of `src`.
+    fn errors(src: &str) -> Vec<String> {
+        match load("t.yaml", src) {
+            Ok(_) => Vec::new(),
+            Err(d) => d
+                .iter()
+                .map(|d| format!("{}: {}", d.location, d.message))
+                .collect(),
+        }
+    }
+
+    fn helps(src: &str) -> Vec<String> {
+        load("t.yaml", src)
+            .err()
+            .unwrap_or_default()
+            .into_iter()
+            .filter_map(|d| d.help)
+            .collect()
+    }
+
+    const OSCILLATOR: &str = "name: a\nunits: SI\nparameters:\n  m: 1.0  # kg\n  k: 4.0  # N/m\n  c: 0.1  # N*s/m\ncoordinates: [x]\n";
+
+    #[test]
+    fn a_consistent_file_passes_and_infers_its_coordinate() {
+        let src = format!(
+            "{OSCILLATOR}kinetic: m*x_dot^2/2\npotential: k*x^2/2\ngeneralized_forces: {{ x: -c*x_dot }}\ninitial: {{ x: 0.1 }}\n"
+        );
+        assert_eq!(errors(&src), Vec::<String>::new());
+    }
+
+    #[test]
+    fn without_units_nothing_is_checked() {
+        let src =
+            "name: a\nparameters: { m: 1, k: 2 }\ncoordinates: [x]\nkinetic: (m + k)*x_dot^2\n";
+        assert_eq!(errors(src), Vec::<String>::new());
+    }
+
+    #[test]
+    fn energies_and_sums() {
+        let src = format!("{OSCILLATOR}  - x  # m\nkinetic: m*x_dot/2\npotential: k*x^2/2 + m\n");
+        let src = src.replace("coordinates: [x]\n", "coordinates:\n");
+        assert_eq!(
+            errors(&src),
+            [
+                "9:10: `kinetic` is kg*m/s, but an energy is J",
+                "10:22: sum of unlike units in `potential`: `k*x^2/2` is J but `m` is kg",
+            ]
+        );
+    }
+
+    #[test]
+    fn an_inferred_unit_comes_from_the_most_uses_and_is_named_in_the_help() {
+        // `x` is a length by its point and its potential energy (two votes), not m^2/s by
+        // the wrong kinetic energy (one vote).
+        let src = format!(
+            "{OSCILLATOR}kinetic: m*x_dot/2\npotential: k*x^2/2\npoints: {{ P: [x, 0] }}\n"
+        );
+        assert_eq!(
+            errors(&src),
+            ["8:10: `kinetic` is kg*m/s, but an energy is J"]
+        );
+        let help = &helps(&src)[0];
+        assert!(
+            help.ends_with("(the unit of `x`, m, is inferred from `potential` at 9:12; declare the unit of `x` if it is another)"),
+            "{help}"
+        );
+    }
+
+    #[test]
+    fn functions_and_powers() {
+        let src = "name: a\nunits: SI\nparameters:\n  m: 1.0  # kg\n  l: 1.0  # m\n  g: 9.81  # m/s^2\ncoordinates:\n  - x  # m\nkinetic: m*x_dot^2/2\npotential: m*g*l*cos(x) + m*g*l*exp(x/l) + m*g*l^x/l^x + m*g*sqrt(l*x) + m*g*l*atan2(x, t)\n";
+        assert_eq!(
+            errors(src),
+            [
+                "10:22: the argument of `cos` in `potential` is m, but it must be a pure number (rad)",
+                "10:48: `l^x` in `potential` raises `l`, which is m, to a power that is not a number",
+                "10:50: the exponent `x` in `potential` is m, but an exponent is a pure number",
+                "10:52: `l^x` in `potential` raises `l`, which is m, to a power that is not a number",
+                "10:54: the exponent `x` in `potential` is m, but an exponent is a pure number",
+                "10:89: the arguments of `atan2` in `potential` have unlike units: `x` is m but `t` is s",
+            ]
+        );
+    }
+
+    #[test]
+    fn parameters_without_a_unit_name_the_unit_their_use_implies() {
+        let src = "name: a\nunits: SI\nparameters:\n  m: 1.0  # kg\n  k: 100.0\ncoordinates:\n  - x  # m\nkinetic: m*x_dot^2/2\npotential: k*x^2/2\n";
+        assert_eq!(errors(src), ["5:3: parameter `k` has no unit"]);
+        assert_eq!(
+            helps(src),
+            [
+                "write `k: 100.0  # N/m` (the unit its use implies), or `k: { value: 100.0, unit: N/m }`"
+            ]
+        );
+    }
+
+    #[test]
+    fn map_forms_and_bad_units() {
+        let src = "name: a\nunits: SI\nparameters:\n  m: { value: 1.0, unit: kg }\n  k: 4.0  # N/mm, spring\ncoordinates:\n  - { name: x, unit: m }\n  - { name: y, unit: furlong }\nkinetic: m*(x_dot^2 + y_dot^2)/2\n";
+        assert_eq!(
+            errors(src),
+            [
+                "5:15: unknown unit `mm` in the unit of parameter `k`",
+                "8:22: unknown unit `furlong` in the unit of coordinate `y`",
+            ]
+        );
+    }
+
+    #[test]
+    fn constraint_forces_numbers_and_equations() {
+        // The rod's multiplier is J per m of `Φ` = N: comparing it with a weight is right,
+        // with a mass wrong. A number alone is in the unit of its key; inside an expression
+        // it is a pure number, except 0.
+        let src = "name: a\nunits: SI\nparameters:\n  m: 1.0  # kg\n  l: 1.0  # m\n  g: 9.81  # m/s^2\ncoordinates:\n  - x  # m\n  - y  # m\npoints: { O: [0, 0], P: [x, y], Q: [x - 1, y + 0] }\nbodies: { bob: { mass: m, at: P } }\ngravity: [0, -g]\nconstraints: { rod: sqrt(x^2 + y^2) - l }\nevents:\n  taut: lambda_rod - m*g\n  wrong: lambda_rod - m\ninitial: { x: 1, y: 0 }\nchecks:\n  equations_of_motion:\n    - m*x_ddot = -m*g*x/l\n    - m*y_ddot = -m*g*l\n";
+        assert_eq!(
+            errors(src),
+            [
+                "10:41: sum of unlike units in the x component of point `Q`: `x` is m but `1` is 1",
+                "16:23: sum of unlike units in the function of event `wrong`: `lambda_rod` is N but `m` is kg",
+                "21:18: the sides of equation of motion 2 have unlike units: `m*y_ddot` is N but `-m*g*l` is J",
+            ]
+        );
+    }
+
+    #[test]
+    fn bad_units_key() {
+        let src = "name: a\nunits: imperial\ncoordinates: [x]\nkinetic: x_dot^2\n";
+        assert_eq!(
+            errors(src),
+            ["2:8: `units` must be one of SI, found `imperial`"]
+        );
+    }
+}

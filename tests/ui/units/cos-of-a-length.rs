@@ -1,0 +1,3 @@
+eomgen::model!("cos-of-a-length.yaml");
+
+fn main() {}

@@ -1,0 +1,3 @@
+eomgen::model!("generalized-force-of-an-angle.yaml");
+
+fn main() {}

@@ -1,0 +1,3 @@
+eomgen::model!("kinetic-energy-not-joules.yaml");
+
+fn main() {}

@@ -1,0 +1,3 @@
+eomgen::model!("parameter-without-unit.yaml");
+
+fn main() {}

@@ -1,0 +1,3 @@
+eomgen::model!("spring-stiffness-in-newtons.yaml");
+
+fn main() {}

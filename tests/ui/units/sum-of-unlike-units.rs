@@ -1,0 +1,3 @@
+eomgen::model!("sum-of-unlike-units.yaml");
+
+fn main() {}

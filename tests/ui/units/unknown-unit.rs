@@ -1,0 +1,3 @@
+eomgen::model!("unknown-unit.yaml");
+
+fn main() {}
