@@ -37,6 +37,7 @@ pub fn n_link_pendulum(n: usize) -> String {
     let _ = writeln!(w, "# Gravity is -y. Reference values: T + V is conserved.");
     let _ = writeln!(w, "name: n_link_pendulum_{n}");
     let _ = writeln!(w, "description: Chain of {n} uniform bars hinged at O.");
+    let _ = writeln!(w, "units: SI");
     let _ = writeln!(w, "parameters:");
     for i in 1..=n {
         let _ = writeln!(w, "  m{i}: 1.0    # kg, bar {i}");
@@ -102,6 +103,7 @@ pub fn n_mass_chain(n: usize) -> String {
         "description: {n} equal masses and {} equal springs between two walls.",
         n + 1
     );
+    let _ = writeln!(w, "units: SI");
     let _ = writeln!(w, "parameters:");
     let _ = writeln!(w, "  m: 1.0    # kg");
     let _ = writeln!(w, "  k: 1.0    # N/m");
@@ -156,6 +158,8 @@ mod tests {
         for n in [1, 2, 5] {
             for t in TEMPLATES {
                 let src = generate(t, n).unwrap();
+                // The files declare their units, so loading them also checks those.
+                assert!(src.contains("\nunits: SI\n"), "{t} {n}");
                 let file = crate::model::load("gen.yaml", &src)
                     .unwrap_or_else(|d| panic!("{t} {n}: {d:?}\n{src}"));
                 assert_eq!(file.coordinates.len(), n);
