@@ -17,6 +17,7 @@
 
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::path::PathBuf;
+use std::sync::Mutex;
 
 use eomgen_symbolic::mechanics::SymbolicModel;
 use eomgen_symbolic::model::{Location, load, parser::parse_expr, units::parse_unit};
@@ -166,40 +167,43 @@ fn mutate(src: &mut String, rng: &mut Rng) {
     }
 }
 
-/// Runs one input through the loader, lowering and the expression parser; `Err` if any of
-/// them panicked. Returns whether the input loaded.
-fn run_one(src: &str) -> Result<bool, String> {
-    catch_unwind(AssertUnwindSafe(|| {
-        let loaded = match load("fuzz.yaml", src) {
-            Ok(file) => {
-                let _ = SymbolicModel::from_file(&file);
-                true
-            }
-            Err(diagnostics) => {
-                for d in &diagnostics {
-                    let _ = d.render("fuzz.yaml", src);
-                }
-                false
-            }
-        };
-        for line in src.lines() {
-            let text = line.split_once(':').map_or(line, |(_, v)| v);
-            let _ = parse_expr(text, Location { line: 1, column: 1 });
-            if let Some((_, comment)) = line.split_once('#')
-                && let Ok(d) = parse_unit(comment.trim())
-            {
-                let _ = d.to_string();
-            }
-        }
-        loaded
-    }))
-    .map_err(|payload| {
+/// Runs `target` on one input; `Err` with the panic's message if it panicked, else what
+/// `target` returned (whether the input loaded).
+fn run_one(src: &str, target: fn(&str) -> bool) -> Result<bool, String> {
+    catch_unwind(AssertUnwindSafe(|| target(src))).map_err(|payload| {
         payload
             .downcast_ref::<String>()
             .cloned()
             .or_else(|| payload.downcast_ref::<&str>().map(|s| s.to_string()))
             .unwrap_or_default()
     })
+}
+
+/// The code under test: the loader, lowering and the expression and unit parsers on one
+/// input. Returns whether the input loaded.
+fn load_everything(src: &str) -> bool {
+    let loaded = match load("fuzz.yaml", src) {
+        Ok(file) => {
+            let _ = SymbolicModel::from_file(&file);
+            true
+        }
+        Err(diagnostics) => {
+            for d in &diagnostics {
+                let _ = d.render("fuzz.yaml", src);
+            }
+            false
+        }
+    };
+    for line in src.lines() {
+        let text = line.split_once(':').map_or(line, |(_, v)| v);
+        let _ = parse_expr(text, Location { line: 1, column: 1 });
+        if let Some((_, comment)) = line.split_once('#')
+            && let Ok(d) = parse_unit(comment.trim())
+        {
+            let _ = d.to_string();
+        }
+    }
+    loaded
 }
 
 /// Every model file of the project.
@@ -219,15 +223,20 @@ fn corpus() -> Vec<(String, String)> {
     files
 }
 
-/// Fuzzes `cases` inputs from `seed`; returns (inputs that still loaded, panics with their
-/// inputs).
-fn fuzz(cases: usize, seed: u64) -> (usize, Vec<(String, String)>) {
+/// Held while a fuzzing run has replaced the panic hook (tests run in parallel threads).
+static SILENCED: Mutex<()> = Mutex::new(());
+
+/// Fuzzes `target` with `cases` inputs from `seed`; returns (inputs that still loaded,
+/// panics with their inputs).
+fn fuzz(cases: usize, seed: u64, target: fn(&str) -> bool) -> (usize, Vec<(String, String)>) {
     let corpus = corpus();
     assert!(corpus.len() >= 20, "the corpus is every file in models/");
     // The corpus itself loads (so mutations start from valid files).
     for (path, text) in &corpus {
-        assert_eq!(run_one(text), Ok(true), "{path}");
+        assert_eq!(run_one(text, target), Ok(true), "{path}");
     }
+    // The panic hook is the process's: one fuzzing run at a time silences it.
+    let _silenced = SILENCED.lock().unwrap_or_else(|e| e.into_inner());
     let previous = std::panic::take_hook();
     std::panic::set_hook(Box::new(|_| {}));
     let mut rng = Rng(seed);
@@ -238,7 +247,7 @@ fn fuzz(cases: usize, seed: u64) -> (usize, Vec<(String, String)>) {
         for _ in 0..1 + rng.below(8) {
             mutate(&mut src, &mut rng);
         }
-        match run_one(&src) {
+        match run_one(&src, target) {
             Ok(true) => loaded += 1,
             Ok(false) => {}
             Err(message) => panics.push((message, src)),
@@ -264,7 +273,7 @@ fn report(cases: usize, loaded: usize, panics: &[(String, String)]) {
 #[test]
 fn mutated_models_never_panic() {
     let cases = 3000;
-    let (loaded, panics) = fuzz(cases, 0x5eed_2026_1121);
+    let (loaded, panics) = fuzz(cases, 0x5eed_2026_1121, load_everything);
     report(cases, loaded, &panics);
     assert!(loaded > cases / 50, "only {loaded} of {cases} loaded");
 }
@@ -282,7 +291,31 @@ fn a_million_mutated_models_never_panic() {
         .and_then(|v| v.parse().ok())
         .unwrap_or(1);
     let start = std::time::Instant::now();
-    let (loaded, panics) = fuzz(cases, seed);
+    let (loaded, panics) = fuzz(cases, seed, load_everything);
     println!("{:.1} s", start.elapsed().as_secs_f64());
     report(cases, loaded, &panics);
+}
+
+/// The harness can fail: a target that panics on some mutated inputs (those that gained a
+/// NUL, one of the mutator's tokens and in no model file) is caught, its panic reported with
+/// the input, and `report` fails.
+#[test]
+fn a_panicking_target_is_caught_and_reported() {
+    fn panics_on_nul(src: &str) -> bool {
+        assert!(!src.contains('\0'), "NUL in the input");
+        load_everything(src)
+    }
+    let cases = 1000;
+    let (_, panics) = fuzz(cases, 0x5eed_2026_1121, panics_on_nul);
+    assert!(!panics.is_empty(), "no input of {cases} gained a NUL");
+    for (message, src) in &panics {
+        assert_eq!(message, "NUL in the input");
+        assert!(src.contains('\0'));
+    }
+    let reported = catch_unwind(|| report(cases, 0, &panics));
+    assert!(
+        reported.is_err(),
+        "report passed with {} panics",
+        panics.len()
+    );
 }
