@@ -214,6 +214,63 @@ mod tests {
         }
     }
 
+    /// Repeated angles and coefficients: `θ1 + θ1` is the canonical `2·θ1`, a term of its own;
+    /// `cos(2θ1 − θ2)` is split when `sin 2θ1` and `cos θ2` are computed anyway, while in
+    /// `sin(θ1 − 2θ2)` the term `−2θ2` is neither `±` an angle whose sine is computed nor
+    /// split further, so that call is kept. Values agree with the direct form (tolerance as
+    /// in the test above: |angles| ≤ 30).
+    #[test]
+    fn repeated_angles_and_coefficients() {
+        let mut a = ExprArena::new();
+        let [t1, _, _] = a.coordinate("theta1");
+        let [t2, _, _] = a.coordinate("theta2");
+        let twice = a.sum(&[t1, t1]);
+        let two = a.int(2);
+        assert_eq!(twice, a.times(two, t1), "θ1 + θ1 is 2·θ1");
+        let s2 = a.sin(twice);
+        let c2 = a.cos(t2);
+        let d = a.minus(twice, t2);
+        let split = a.cos(d);
+        let two_t2 = a.times(two, t2);
+        let e = a.minus(t1, two_t2);
+        let kept = a.sin(e);
+        let s1 = a.sin(t1);
+        let roots = [s2, c2, split, kept, s1];
+        let new = expand_angle_sums(&mut a, &roots);
+        assert_ne!(new[2], roots[2], "cos(2θ1 − θ2) is split");
+        assert_eq!(new[3], roots[3], "sin(θ1 − 2θ2) is kept");
+        let arguments: Vec<ExprId> = trig_calls(&a, &new)
+            .into_iter()
+            .map(|c| match a.node(c) {
+                Node::Func(_, u) => *u,
+                _ => unreachable!(),
+            })
+            .collect();
+        let mut expected = vec![twice, t1, t2, e];
+        expected.sort();
+        let mut arguments = arguments;
+        arguments.sort();
+        arguments.dedup();
+        assert_eq!(arguments, expected);
+        for k in 0..100 {
+            let values = [0.37 * k as f64 - 15.0, 11.0 - 0.29 * k as f64];
+            let mut bindings = vec![0.0; a.symbols().len()];
+            let ids: Vec<usize> = a
+                .symbols()
+                .iter()
+                .enumerate()
+                .filter(|(_, s)| s.name == "theta1" || s.name == "theta2")
+                .map(|(i, _)| i)
+                .collect();
+            bindings[ids[0]] = values[0];
+            bindings[ids[1]] = values[1];
+            for (r, n) in roots.iter().zip(&new) {
+                let (x, y) = (a.eval(*r, &bindings), a.eval(*n, &bindings));
+                assert!((x - y).abs() <= 64.0 * f64::EPSILON * 30.0, "{x} vs {y}");
+            }
+        }
+    }
+
     /// An angle whose own sine and cosine are not computed is not split: the rewrite never
     /// adds a call.
     #[test]
