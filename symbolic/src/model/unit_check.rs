@@ -96,14 +96,10 @@ impl Dim {
         }
         unknowns.retain(|(_, c)| !c.is_zero());
         unknowns.sort_by_key(|(i, _)| *i);
-        let mut inferred = self.inferred.clone();
-        inferred.extend(&o.inferred);
-        inferred.sort_unstable();
-        inferred.dedup();
         Some(Self {
             known,
             unknowns,
-            inferred,
+            inferred: union(&self.inferred, &o.inferred),
         })
     }
 
@@ -129,6 +125,14 @@ impl Dim {
             inferred: self.inferred.clone(),
         })
     }
+}
+
+/// The sorted union of two lists of unknowns.
+fn union(a: &[usize], b: &[usize]) -> Vec<usize> {
+    let mut all = [a, b].concat();
+    all.sort_unstable();
+    all.dedup();
+    all
 }
 
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -489,11 +493,7 @@ impl<'f> Checker<'f> {
             Mode::Report => {
                 if got.unknowns.is_empty() && want.unknowns.is_empty() && got.known != want.known {
                     let mut d = report(got.known, want.known);
-                    let mut inferred = got.inferred.clone();
-                    inferred.extend(&want.inferred);
-                    inferred.sort_unstable();
-                    inferred.dedup();
-                    let notes: Vec<String> = inferred
+                    let notes: Vec<String> = union(&got.inferred, &want.inferred)
                         .iter()
                         .filter_map(|&i| self.inference_note(i))
                         .collect();
