@@ -805,3 +805,30 @@ pub struct ConstraintValues {
     /// `γ` of `J q̈ = γ` (length `m`).
     pub gamma: DVector<f64>,
 }
+
+#[cfg(test)]
+mod tests {
+    use nalgebra::{Matrix3, Vector3};
+
+    use super::*;
+
+    /// `solve_spd` against nalgebra's Cholesky solve on a positive definite `M = BᵀB + I`
+    /// (condition ~10): the two backward-stable solves agree to a few ulps of `|x|`, so 1e-13
+    /// relative; and `None` for an indefinite, a singular and a NaN matrix.
+    #[test]
+    fn solve_spd_matches_cholesky_and_refuses_what_is_not_positive_definite() {
+        let b = Matrix3::new(1.0, 0.3, -0.7, 0.2, 1.5, 0.4, -0.6, 0.1, 0.9);
+        let m = b.transpose() * b + Matrix3::identity();
+        let f = Vector3::new(0.7, -1.3, 2.1);
+        let x = solve_spd(&m, &f).unwrap();
+        let expected = nalgebra::Cholesky::new(m).unwrap().solve(&f);
+        assert!((x - expected).amax() <= 1e-13 * expected.amax(), "{x} vs {expected}");
+        let indefinite = Matrix3::new(1.0, 2.0, 0.0, 2.0, 1.0, 0.0, 0.0, 0.0, 1.0);
+        assert_eq!(solve_spd(&indefinite, &f), None);
+        let singular = Matrix3::new(1.0, 1.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0, 1.0);
+        assert_eq!(solve_spd(&singular, &f), None);
+        let mut nan = m;
+        nan[(1, 1)] = f64::NAN;
+        assert_eq!(solve_spd(&nan, &f), None);
+    }
+}
