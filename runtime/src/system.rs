@@ -533,17 +533,11 @@ pub trait ModelInfo: OdeSystem {
     /// Positions of the points at `(t, y)`, `[x, y, z]` each (m).
     fn point_positions(&self, t: f64, y: &[f64]) -> Vec<[f64; 3]>;
     /// The `draw: lines` segments as pairs of point names ([`MechanicalSystem::draw_lines`]).
-    fn draw_lines(&self) -> &'static [[&'static str; 2]] {
-        &[]
-    }
+    fn draw_lines(&self) -> &'static [[&'static str; 2]];
     /// The `draw: trace` point names ([`MechanicalSystem::trace_points`]).
-    fn trace_points(&self) -> &'static [&'static str] {
-        &[]
-    }
+    fn trace_points(&self) -> &'static [&'static str];
     /// The bodies' centres of mass ([`MechanicalSystem::body_centres`]).
-    fn body_centres(&self) -> &'static [BodyCentre] {
-        &[]
-    }
+    fn body_centres(&self) -> &'static [BodyCentre];
     /// The derived equations as text.
     fn equations_text(&self) -> &'static str;
     /// The derived equations as LaTeX.
