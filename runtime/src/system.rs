@@ -816,7 +816,10 @@ mod tests {
         let f = Vector3::new(0.7, -1.3, 2.1);
         let x = solve_spd(&m, &f).unwrap();
         let expected = nalgebra::Cholesky::new(m).unwrap().solve(&f);
-        assert!((x - expected).amax() <= 1e-13 * expected.amax(), "{x} vs {expected}");
+        assert!(
+            (x - expected).amax() <= 1e-13 * expected.amax(),
+            "{x} vs {expected}"
+        );
         let indefinite = Matrix3::new(1.0, 2.0, 0.0, 2.0, 1.0, 0.0, 0.0, 0.0, 1.0);
         assert_eq!(solve_spd(&indefinite, &f), None);
         let singular = Matrix3::new(1.0, 1.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0, 1.0);
