@@ -419,16 +419,6 @@ impl<S: MechanicalSystem<N>, const N: usize> OdeSystem for FirstOrder<S, N> {
         Ok(())
     }
 
-    /// The exact Jacobian of `ẏ = [q̇; q̈]`, from [`FirstOrder::acceleration_jacobians`]:
-    ///
-    /// ```text
-    /// ∂F/∂y = [ 0        I       ]
-    ///         [ ∂q̈/∂q    ∂q̈/∂q̇   ]
-    /// ```
-    ///
-    /// A constrained system returns `Ok(false)`: its `q̈` comes from the KKT system, whose
-    /// derivative needs `∂J/∂q` and `∂γ/∂(q, q̇)`, which are not generated; the implicit
-    /// methods then difference `F`.
     fn after_step(&mut self, t: f64, y: &mut [f64]) -> Result<bool, RhsError> {
         if self.constraints.is_empty() || self.stabilization != Stabilization::Projection {
             return Ok(false);
@@ -444,6 +434,16 @@ impl<S: MechanicalSystem<N>, const N: usize> OdeSystem for FirstOrder<S, N> {
         Ok(true)
     }
 
+    /// The exact Jacobian of `ẏ = [q̇; q̈]`, from [`FirstOrder::acceleration_jacobians`]:
+    ///
+    /// ```text
+    /// ∂F/∂y = [ 0        I       ]
+    ///         [ ∂q̈/∂q    ∂q̈/∂q̇   ]
+    /// ```
+    ///
+    /// A constrained system returns `Ok(false)`: its `q̈` comes from the KKT system, whose
+    /// derivative needs `∂J/∂q` and `∂γ/∂(q, q̇)`, which are not generated; the implicit
+    /// methods then difference `F`.
     fn jacobian(&mut self, t: f64, y: &[f64], jac: &mut [f64]) -> Result<bool, RhsError> {
         if !self.constraints.is_empty() {
             return Ok(false);
