@@ -1,7 +1,8 @@
 //! Equilibria, exact linearisation and normal modes (issue 7, items 1–3) against analytic
 //! frequencies and independent hand derivations.
 
-use std::process::Command;
+mod common;
+use common::eomgen;
 
 use eomgen::{
     ModalError, ModeKind, ModelInfo, eigenvalues_of_m_inv_k, find_equilibrium, linearize,
@@ -229,10 +230,7 @@ fn damping_ratio_from_the_state_matrix() {
 
 #[test]
 fn modes_cli_json_contract_and_errors() {
-    let out = Command::new(env!("CARGO_BIN_EXE_eomgen"))
-        .args(["modes", "cart_pendulum", "--at", "hanging", "--json"])
-        .output()
-        .unwrap();
+    let out = eomgen(&["modes", "cart_pendulum", "--at", "hanging", "--json"]);
     assert!(
         out.status.success(),
         "{}",
@@ -245,28 +243,19 @@ fn modes_cli_json_contract_and_errors() {
     assert_eq!(v["damping_ratios"].as_array().unwrap().len(), 2);
     assert_eq!(v["mode_shapes"].as_array().unwrap().len(), 2);
     assert_eq!(v["kinds"][0]["kind"], "zero_frequency");
-    let out = Command::new(env!("CARGO_BIN_EXE_eomgen"))
-        .args(["modes", "double_pendulum", "--at", "sideways"])
-        .output()
-        .unwrap();
+    let out = eomgen(&["modes", "double_pendulum", "--at", "sideways"]);
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("it names: hanging, upright"));
-    let out = Command::new(env!("CARGO_BIN_EXE_eomgen"))
-        .args([
-            "modes",
-            "double_pendulum",
-            "--at",
-            "theta1=-1.4,theta2=-1.7",
-        ])
-        .output()
-        .unwrap();
+    let out = eomgen(&[
+        "modes",
+        "double_pendulum",
+        "--at",
+        "theta1=-1.4,theta2=-1.7",
+    ]);
     assert!(out.status.success());
     assert!(String::from_utf8_lossy(&out.stdout).contains("theta1 = -1.570796326795e0"));
     // A constrained model: shapes in all n coordinates, one per minimal coordinate.
-    let out = Command::new(env!("CARGO_BIN_EXE_eomgen"))
-        .args(["modes", "simple_pendulum_cartesian", "--json"])
-        .output()
-        .unwrap();
+    let out = eomgen(&["modes", "simple_pendulum_cartesian", "--json"]);
     assert!(out.status.success());
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(v["minimal_coordinates"], serde_json::json!(["x"]));
@@ -285,13 +274,8 @@ fn modes_cli_json_contract_and_errors() {
 #[test]
 fn matrix_exponential_against_closed_form_and_integration() {
     use eomgen::{DormandPrince853, Integrator, IntegratorOptions, OdeFn, OutputTimes};
-    let mut state = 0x2545_f491_4f6c_dd1d_u64;
-    let mut uniform = move || {
-        state ^= state << 13;
-        state ^= state >> 7;
-        state ^= state << 17;
-        (state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
-    };
+    let mut rng = common::Rng(0x2545_f491_4f6c_dd1d);
+    let mut uniform = move || rng.uniform(-1.0, 1.0);
     let n = 10;
     let s = DMatrix::from_fn(n, n, |i, j| uniform() + if i == j { 3.0 } else { 0.0 });
     let s_inv = s.clone().try_inverse().unwrap();

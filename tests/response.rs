@@ -1,7 +1,8 @@
 //! Free response three ways (HW28) and damping models compared (HW34): the routes against
 //! each other and against closed forms written here from hand-derived M, C, K.
 
-use std::process::Command;
+mod common;
+use common::eomgen;
 
 use eomgen::{
     FreeResponse, Linearization, ModelInfo, RayleighDamping, exact_damped_modes, find_equilibrium,
@@ -448,23 +449,20 @@ fn free_response_cli() {
     let dir = std::env::temp_dir().join(format!("eomgen-free-response-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let chart = dir.join("free.svg");
-    let out = Command::new(env!("CARGO_BIN_EXE_eomgen"))
-        .args([
-            "study",
-            "free-response",
-            "cart_pendulum",
-            "--at",
-            "upright",
-            "--init",
-            "x=0.1,theta=0.05,x_dot=0.2",
-            "--t-end",
-            "2",
-            "--json",
-            "--plot",
-        ])
-        .arg(&chart)
-        .output()
-        .unwrap();
+    let out = eomgen(&[
+        "study",
+        "free-response",
+        "cart_pendulum",
+        "--at",
+        "upright",
+        "--init",
+        "x=0.1,theta=0.05,x_dot=0.2",
+        "--t-end",
+        "2",
+        "--json",
+        "--plot",
+        chart.to_str().unwrap(),
+    ]);
     assert!(
         out.status.success(),
         "{}",
@@ -487,10 +485,7 @@ fn free_response_cli() {
     let svg = std::fs::read_to_string(&chart).unwrap();
     assert!(svg.contains("<svg") && svg.contains("theta"));
     // A bad --init name is a usage error.
-    let out = Command::new(env!("CARGO_BIN_EXE_eomgen"))
-        .args(["study", "free-response", "cart_pendulum", "--init", "y=1"])
-        .output()
-        .unwrap();
+    let out = eomgen(&["study", "free-response", "cart_pendulum", "--init", "y=1"]);
     assert_eq!(out.status.code(), Some(2));
     let _ = std::fs::remove_dir_all(&dir);
 }
@@ -502,19 +497,16 @@ fn modal_damping_cli() {
     let dir = std::env::temp_dir().join(format!("eomgen-modal-damping-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let chart = dir.join("damping.png");
-    let out = Command::new(env!("CARGO_BIN_EXE_eomgen"))
-        .args([
-            "study",
-            "modal-damping",
-            "three_masses_damped",
-            "--rayleigh-modes",
-            "1,3",
-            "--json",
-            "--plot",
-        ])
-        .arg(&chart)
-        .output()
-        .unwrap();
+    let out = eomgen(&[
+        "study",
+        "modal-damping",
+        "three_masses_damped",
+        "--rayleigh-modes",
+        "1,3",
+        "--json",
+        "--plot",
+        chart.to_str().unwrap(),
+    ]);
     assert!(
         out.status.success(),
         "{}",
@@ -544,16 +536,13 @@ fn modal_damping_cli() {
     }
     let png = std::fs::read(&chart).unwrap();
     assert_eq!(&png[1..4], b"PNG");
-    let out = Command::new(env!("CARGO_BIN_EXE_eomgen"))
-        .args([
-            "study",
-            "modal-damping",
-            "three_masses_damped",
-            "--rayleigh-modes",
-            "1,1",
-        ])
-        .output()
-        .unwrap();
+    let out = eomgen(&[
+        "study",
+        "modal-damping",
+        "three_masses_damped",
+        "--rayleigh-modes",
+        "1,1",
+    ]);
     assert_eq!(out.status.code(), Some(2));
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -387,16 +387,7 @@ pub fn frequency_response(
     input_matrix: &DMatrix<f64>,
     frequency: f64,
 ) -> Result<DMatrix<Complex<f64>>, FrfError> {
-    let n = lin.mass_matrix.nrows();
-    if !(frequency.is_finite() && frequency >= 0.0) {
-        return Err(FrfError::InvalidFrequency { frequency });
-    }
-    if input_matrix.nrows() != n {
-        return Err(FrfError::DimensionMismatch {
-            expected: n,
-            found: input_matrix.nrows(),
-        });
-    }
+    check_forcing(lin, input_matrix.nrows(), frequency)?;
     let b = input_matrix.map(|v| Complex::new(v, 0.0));
     let z = dynamic_stiffness(lin, frequency);
     let scale = z.iter().map(|v| v.norm()).fold(0.0f64, f64::max);
@@ -764,16 +755,8 @@ pub fn modal_frequency_response(
     b: &DVector<f64>,
     frequency: f64,
 ) -> Result<ModalResponse, FrfError> {
-    let n = lin.mass_matrix.nrows();
-    if !(frequency.is_finite() && frequency >= 0.0) {
-        return Err(FrfError::InvalidFrequency { frequency });
-    }
-    if b.len() != n {
-        return Err(FrfError::DimensionMismatch {
-            expected: n,
-            found: b.len(),
-        });
-    }
+    check_forcing(lin, b.len(), frequency)?;
+    let n = b.len();
     let damping = modal_damping(lin, modes);
     let psi = &modes.mode_shapes;
     let k = psi.ncols();
@@ -807,6 +790,23 @@ pub fn modal_frequency_response(
         contributions,
         response,
     })
+}
+
+/// The checks shared by [`frequency_response`] and [`modal_frequency_response`]: a finite
+/// `frequency ≥ 0` and a forcing with `rows` entries per input for the `n` coordinates of
+/// `lin`.
+fn check_forcing(lin: &Linearization, rows: usize, frequency: f64) -> Result<(), FrfError> {
+    let n = lin.mass_matrix.nrows();
+    if !(frequency.is_finite() && frequency >= 0.0) {
+        return Err(FrfError::InvalidFrequency { frequency });
+    }
+    if rows != n {
+        return Err(FrfError::DimensionMismatch {
+            expected: n,
+            found: rows,
+        });
+    }
+    Ok(())
 }
 
 /// The time for the slowest free decay to shrink by `reduction`: `ln(1/reduction) / σ_min`

@@ -407,32 +407,44 @@ fn clusters<T: Copy>(values: &[T], distance: impl Fn(T, T) -> f64, tol: f64) -> 
 /// through them would lose more than six digits (error ≈ ε/ratio).
 const MIN_SINGULAR_RATIO: f64 = 1e-6;
 
-/// A right singular vector of `B − λI` is an eigenvector only if its singular value is
-/// negligible (`≤ 1e-6 σ_max`); otherwise the eigenvalue's eigenspace is smaller than its
-/// multiplicity (a Jordan block).
-fn null_vector_check(
-    singular_value: f64,
+/// The rows of `Vᵀ` (right singular vectors of `B − λI`) for the `count` smallest singular
+/// values, where `count` is the multiplicity of the eigenvalue `λ`. Each is an eigenvector only
+/// if its singular value is negligible (`≤ 1e-6 σ_max`); otherwise the eigenvalue's
+/// eigenspace is smaller than its multiplicity (a Jordan block): [`ResponseError::Defective`].
+fn null_vectors(
     singular_values: &DVector<f64>,
+    count: usize,
     matrix: &'static str,
-) -> Result<(), ResponseError> {
+) -> Result<Vec<usize>, ResponseError> {
     let max = singular_values.max();
-    if singular_value > 1e-6 * max {
+    let mut order: Vec<usize> = (0..singular_values.len()).collect();
+    order.sort_by(|&i, &j| singular_values[i].total_cmp(&singular_values[j]));
+    order.truncate(count);
+    if let Some(&k) = order.iter().find(|&&k| singular_values[k] > 1e-6 * max) {
         return Err(ResponseError::Defective {
             matrix,
-            ratio: singular_value / max,
+            ratio: singular_values[k] / max,
         });
     }
-    Ok(())
+    Ok(order)
 }
 
-/// `σ_min/σ_max` of a (real or complex) matrix.
-fn singular_ratio(singular_values: &DVector<f64>) -> f64 {
+/// `σ_min/σ_max` of an eigenvector matrix (real or complex), refused below
+/// [`MIN_SINGULAR_RATIO`] as [`ResponseError::Defective`].
+fn spanning_ratio(
+    singular_values: &DVector<f64>,
+    matrix: &'static str,
+) -> Result<f64, ResponseError> {
     let max = singular_values.max();
-    if max > 0.0 {
+    let ratio = if max > 0.0 {
         singular_values.min() / max
     } else {
         0.0
+    };
+    if ratio < MIN_SINGULAR_RATIO {
+        return Err(ResponseError::Defective { matrix, ratio });
     }
+    Ok(ratio)
 }
 
 /// `y(t) = Re Σ_k c_k e^{λ_k t} v_k` with the complex eigenpairs `(λ_k, v_k)` of `A` and `V c =
@@ -476,10 +488,7 @@ pub fn state_response_by_eigenvectors(
                 ratio: 0.0,
             });
         };
-        let mut order: Vec<usize> = (0..m).collect();
-        order.sort_by(|&i, &j| svd.singular_values[i].total_cmp(&svd.singular_values[j]));
-        for &k in order.iter().take(cluster.len()) {
-            null_vector_check(svd.singular_values[k], &svd.singular_values, "A")?;
+        for k in null_vectors(&svd.singular_values, cluster.len(), "A")? {
             let col = values.len();
             for i in 0..m {
                 vectors[(i, col)] = v_t[(k, i)].conj();
@@ -487,10 +496,7 @@ pub fn state_response_by_eigenvectors(
             values.push(mean);
         }
     }
-    let ratio = singular_ratio(&vectors.clone().svd(false, false).singular_values);
-    if ratio < MIN_SINGULAR_RATIO {
-        return Err(ResponseError::Defective { matrix: "A", ratio });
-    }
+    let ratio = spanning_ratio(&vectors.clone().svd(false, false).singular_values, "A")?;
     let y0c = DVector::from_iterator(m, y0.iter().map(|v| Complex::new(*v, 0.0)));
     let coefficients = vectors
         .clone()
@@ -615,8 +621,6 @@ pub fn modes_of_m_inv_k(lin: &Linearization) -> Result<MInvKModes, ResponseError
                 ratio: 0.0,
             });
         };
-        let mut order: Vec<usize> = (0..n).collect();
-        order.sort_by(|&i, &j| svd.singular_values[i].total_cmp(&svd.singular_values[j]));
         let (value, kind) = if mean.abs() <= 1e-9 * scale || scale == 0.0 {
             (0.0, ModeKind::ZeroFrequency)
         } else if mean < 0.0 {
@@ -629,8 +633,7 @@ pub fn modes_of_m_inv_k(lin: &Linearization) -> Result<MInvKModes, ResponseError
         } else {
             (mean, ModeKind::Oscillatory)
         };
-        for &k in order.iter().take(cluster.len()) {
-            null_vector_check(svd.singular_values[k], &svd.singular_values, "M⁻¹K")?;
+        for k in null_vectors(&svd.singular_values, cluster.len(), "M⁻¹K")? {
             let col = eigenvalues.len();
             let mut u: DVector<f64> = v_t.row(k).transpose();
             let imax = u.iamax();
@@ -642,13 +645,7 @@ pub fn modes_of_m_inv_k(lin: &Linearization) -> Result<MInvKModes, ResponseError
             kinds.push(kind);
         }
     }
-    let ratio = singular_ratio(&vectors.clone().svd(false, false).singular_values);
-    if ratio < MIN_SINGULAR_RATIO {
-        return Err(ResponseError::Defective {
-            matrix: "M⁻¹K",
-            ratio,
-        });
-    }
+    spanning_ratio(&vectors.clone().svd(false, false).singular_values, "M⁻¹K")?;
     Ok(MInvKModes {
         eigenvalues,
         kinds,

@@ -419,16 +419,6 @@ impl<S: MechanicalSystem<N>, const N: usize> OdeSystem for FirstOrder<S, N> {
         Ok(())
     }
 
-    /// The exact Jacobian of `ẏ = [q̇; q̈]`, from [`FirstOrder::acceleration_jacobians`]:
-    ///
-    /// ```text
-    /// ∂F/∂y = [ 0        I       ]
-    ///         [ ∂q̈/∂q    ∂q̈/∂q̇   ]
-    /// ```
-    ///
-    /// A constrained system returns `Ok(false)`: its `q̈` comes from the KKT system, whose
-    /// derivative needs `∂J/∂q` and `∂γ/∂(q, q̇)`, which are not generated; the implicit
-    /// methods then difference `F`.
     fn after_step(&mut self, t: f64, y: &mut [f64]) -> Result<bool, RhsError> {
         if self.constraints.is_empty() || self.stabilization != Stabilization::Projection {
             return Ok(false);
@@ -444,6 +434,16 @@ impl<S: MechanicalSystem<N>, const N: usize> OdeSystem for FirstOrder<S, N> {
         Ok(true)
     }
 
+    /// The exact Jacobian of `ẏ = [q̇; q̈]`, from [`FirstOrder::acceleration_jacobians`]:
+    ///
+    /// ```text
+    /// ∂F/∂y = [ 0        I       ]
+    ///         [ ∂q̈/∂q    ∂q̈/∂q̇   ]
+    /// ```
+    ///
+    /// A constrained system returns `Ok(false)`: its `q̈` comes from the KKT system, whose
+    /// derivative needs `∂J/∂q` and `∂γ/∂(q, q̇)`, which are not generated; the implicit
+    /// methods then difference `F`.
     fn jacobian(&mut self, t: f64, y: &[f64], jac: &mut [f64]) -> Result<bool, RhsError> {
         if !self.constraints.is_empty() {
             return Ok(false);
@@ -533,17 +533,11 @@ pub trait ModelInfo: OdeSystem {
     /// Positions of the points at `(t, y)`, `[x, y, z]` each (m).
     fn point_positions(&self, t: f64, y: &[f64]) -> Vec<[f64; 3]>;
     /// The `draw: lines` segments as pairs of point names ([`MechanicalSystem::draw_lines`]).
-    fn draw_lines(&self) -> &'static [[&'static str; 2]] {
-        &[]
-    }
+    fn draw_lines(&self) -> &'static [[&'static str; 2]];
     /// The `draw: trace` point names ([`MechanicalSystem::trace_points`]).
-    fn trace_points(&self) -> &'static [&'static str] {
-        &[]
-    }
+    fn trace_points(&self) -> &'static [&'static str];
     /// The bodies' centres of mass ([`MechanicalSystem::body_centres`]).
-    fn body_centres(&self) -> &'static [BodyCentre] {
-        &[]
-    }
+    fn body_centres(&self) -> &'static [BodyCentre];
     /// The derived equations as text.
     fn equations_text(&self) -> &'static str;
     /// The derived equations as LaTeX.
@@ -804,4 +798,34 @@ pub struct ConstraintValues {
     pub velocity: DVector<f64>,
     /// `γ` of `J q̈ = γ` (length `m`).
     pub gamma: DVector<f64>,
+}
+
+#[cfg(test)]
+mod tests {
+    use nalgebra::{Matrix3, Vector3};
+
+    use super::*;
+
+    /// `solve_spd` against nalgebra's Cholesky solve on a positive definite `M = BᵀB + I`
+    /// (condition ~10): the two backward-stable solves agree to a few ulps of `|x|`, so 1e-13
+    /// relative; and `None` for an indefinite, a singular and a NaN matrix.
+    #[test]
+    fn solve_spd_matches_cholesky_and_refuses_what_is_not_positive_definite() {
+        let b = Matrix3::new(1.0, 0.3, -0.7, 0.2, 1.5, 0.4, -0.6, 0.1, 0.9);
+        let m = b.transpose() * b + Matrix3::identity();
+        let f = Vector3::new(0.7, -1.3, 2.1);
+        let x = solve_spd(&m, &f).unwrap();
+        let expected = nalgebra::Cholesky::new(m).unwrap().solve(&f);
+        assert!(
+            (x - expected).amax() <= 1e-13 * expected.amax(),
+            "{x} vs {expected}"
+        );
+        let indefinite = Matrix3::new(1.0, 2.0, 0.0, 2.0, 1.0, 0.0, 0.0, 0.0, 1.0);
+        assert_eq!(solve_spd(&indefinite, &f), None);
+        let singular = Matrix3::new(1.0, 1.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0, 1.0);
+        assert_eq!(solve_spd(&singular, &f), None);
+        let mut nan = m;
+        nan[(1, 1)] = f64::NAN;
+        assert_eq!(solve_spd(&nan, &f), None);
+    }
 }

@@ -43,8 +43,8 @@ impl ExplicitRk {
     }
 }
 
-/// Stage `j` of a step whose first stage is `first` and whose later stages are the rows of `k`.
-/// `out = Σⱼ wⱼ kⱼ` over the stages that have a weight (zero weights are skipped).
+/// `out = Σⱼ wⱼ kⱼ` over the stages that have a weight (zero weights are skipped), where stage
+/// 0 is `first` and stage `j ≥ 1` is row `j − 1` of `k` (rows of `dim`).
 ///
 /// The increment is summed on its own before it is added to `y` (see [`combine`]), so that
 /// small stage contributions are not rounded against `|y|` one at a time.
@@ -70,17 +70,18 @@ pub(super) fn weighted_sum(out: &mut [f64], weights: &[f64], first: &[f64], k: &
 /// [`weighted_sum`] for `D` components (`out`, `first` of length `D`, `k` rows of `D`).
 #[inline(always)]
 fn weighted_sum_fixed<const D: usize>(out: &mut [f64], weights: &[f64], first: &[f64], k: &[f64]) {
-    let Some((&w0, rest)) = weights.split_first() else {
-        out.fill(0.0);
-        return;
-    };
-    let (Ok(out), Ok(first)) = (
-        <&mut [f64; D]>::try_from(&mut out[..D]),
-        <&[f64; D]>::try_from(&first[..D]),
-    ) else {
-        return;
-    };
+    out[..D].copy_from_slice(&sum_fixed::<D>(weights, first, k));
+}
+
+/// `Σⱼ wⱼ kⱼ` for `D` components, accumulated in an array the compiler keeps in registers.
+#[inline(always)]
+fn sum_fixed<const D: usize>(weights: &[f64], first: &[f64], k: &[f64]) -> [f64; D] {
     let mut acc = [0.0f64; D];
+    let Some((&w0, rest)) = weights.split_first() else {
+        return acc;
+    };
+    // Sliced to `D` so that the indexing below needs no bounds checks.
+    let first = &first[..D];
     if w0 != 0.0 {
         for i in 0..D {
             acc[i] = w0 * first[i];
@@ -93,7 +94,7 @@ fn weighted_sum_fixed<const D: usize>(out: &mut [f64], weights: &[f64], first: &
             }
         }
     }
-    *out = acc;
+    acc
 }
 
 /// [`weighted_sum`] for any dimension.
@@ -102,11 +103,10 @@ fn weighted_sum_any(out: &mut [f64], weights: &[f64], first: &[f64], k: &[f64], 
         out.fill(0.0);
         return;
     };
-    let used = rest.len().min(k.len().checked_div(dim).unwrap_or(0));
-    let k = &k[..used * dim];
+    // `out` has `dim` components, so the loop (and the chunking) runs only for `dim ≥ 1`.
     for (i, (o, &f)) in out.iter_mut().zip(first).enumerate() {
         let mut acc = if w0 == 0.0 { 0.0 } else { w0 * f };
-        for (&w, kj) in rest.iter().zip(k.chunks_exact(dim.max(1))) {
+        for (&w, kj) in rest.iter().zip(k.chunks_exact(dim)) {
             if w != 0.0 {
                 acc += w * kj[i];
             }
@@ -148,14 +148,8 @@ fn combine_fixed<const D: usize>(
     first: &[f64],
     k: &[f64],
 ) {
-    let mut sum = [0.0f64; D];
-    weighted_sum_fixed::<D>(&mut sum, weights, first, k);
-    let (Ok(out), Ok(y)) = (
-        <&mut [f64; D]>::try_from(&mut out[..D]),
-        <&[f64; D]>::try_from(&y[..D]),
-    ) else {
-        return;
-    };
+    let sum = sum_fixed::<D>(weights, first, k);
+    let (out, y) = (&mut out[..D], &y[..D]);
     for i in 0..D {
         out[i] = y[i] + h * sum[i];
     }
