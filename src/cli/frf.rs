@@ -17,9 +17,9 @@ use plotters::prelude::*;
 use rayon::prelude::*;
 use serde_json::{Value, json};
 
-use super::modes::operating_point;
-use super::values::{evaluate, parameter_lookup, set_parameters};
-use super::{CliError, find_model, plot};
+use super::modes::OperatingPointArgs;
+use super::values::{evaluate, parameter_lookup};
+use super::{CliError, plot};
 
 /// Options of `eomgen frf`.
 #[derive(Debug, Args)]
@@ -29,19 +29,15 @@ pub struct FrfArgs {
     /// The input: a parameter that enters the forcing linearly (a load amplitude, `A` in
     /// `A*cos(w*t)`; its time function is taken at t = 0, so for `A*cos(w*t)` the response is
     /// the steady state under `A cos(ω t)`), or a coordinate's name: a unit generalized force
-    /// on that coordinate (no `--simulate` then: the model has no load to drive).
+    /// on that coordinate (no `--simulate` then: the model has no load to drive). The
+    /// equilibrium (`--at`) is found with the input set to 0.
     #[arg(long)]
     pub input: String,
     /// An output coordinate; repeatable (default: every coordinate).
     #[arg(long = "output", value_name = "NAME")]
     pub outputs: Vec<String>,
-    /// Operating point guess: a name from the model's `equilibria:` or `q1=VALUE,…` (as in
-    /// `eomgen modes`); the equilibrium is found with the input set to 0.
-    #[arg(long)]
-    pub at: Option<String>,
-    /// Set a parameter, `NAME=VALUE`; repeatable.
-    #[arg(long = "set", value_name = "NAME=VALUE")]
-    pub set: Vec<String>,
+    #[command(flatten)]
+    pub point: OperatingPointArgs,
     /// Frequency range `LO..HI` (rad/s, expressions of the parameters allowed; default: a
     /// decade below the lowest to a decade above the highest natural frequency).
     #[arg(long, value_name = "LO..HI")]
@@ -96,8 +92,7 @@ fn fail(model: &str) -> impl Fn(FrfError) -> CliError + '_ {
 
 /// Runs `frf`.
 pub fn run(args: &FrfArgs) -> Result<(), CliError> {
-    let mut model = find_model(&args.model)?;
-    set_parameters(model.as_mut(), &args.set)?;
+    let mut model = args.point.model(&args.model)?;
     if args.points < 2 {
         return Err(CliError::usage("--points must be at least 2"));
     }
@@ -119,7 +114,7 @@ pub fn run(args: &FrfArgs) -> Result<(), CliError> {
         )));
     }
     let name = model.name();
-    let (label, guess) = operating_point(model.as_ref(), args.at.as_deref())?;
+    let (label, guess) = args.point.guess(model.as_ref())?;
     let forced = linearize_with_inputs(model.as_mut(), &guess, &[args.input.as_str()]).map_err(
         |e| match e {
             FrfError::NonlinearInput { .. }
@@ -625,8 +620,7 @@ fn simulate_points(
         .par_iter()
         .map(|&w| {
             let result = (|| {
-                let mut model = find_model(&args.model)?;
-                set_parameters(model.as_mut(), &args.set)?;
+                let mut model = args.point.model(&args.model)?;
                 let h = frequency_response(lin, &b, w).map_err(fail(name))?;
                 let scale = h.iter().map(|z| z.norm()).fold(0.0f64, f64::max)
                     * args.amplitude.abs()

@@ -15,7 +15,7 @@ use super::CliError;
 use super::free_response::{
     Panel, default_t_end, kind_json, panels, parse_init, time_grid, unconstrained_operating_point,
 };
-use super::modes::OperatingPoint;
+use super::modes::{OperatingPoint, OperatingPointArgs};
 use super::plot::Series;
 
 /// Options of `eomgen study modal-damping`.
@@ -23,13 +23,8 @@ use super::plot::Series;
 pub struct ModalDampingArgs {
     /// Model name (see `eomgen list`), with a damping matrix (`three_masses_damped`).
     pub model: String,
-    /// Operating point: a name from the model's `equilibria:`, or guesses `q1=VALUE,…`.
-    /// Default: the model's first equilibrium, else q = 0.
-    #[arg(long)]
-    pub at: Option<String>,
-    /// Set a parameter, `NAME=VALUE`; repeatable.
-    #[arg(long = "set", value_name = "NAME=VALUE")]
-    pub set: Vec<String>,
+    #[command(flatten)]
+    pub point: OperatingPointArgs,
     /// The two modes (1-based, ascending frequency) whose exact damping ratios the Rayleigh
     /// damping C = αM + βK reproduces. Default: the slowest and the fastest oscillatory modes
     /// (HW34).
@@ -87,7 +82,7 @@ pub fn run(args: &ModalDampingArgs) -> Result<(), CliError> {
         lin,
         modes,
         ..
-    } = unconstrained_operating_point(&args.model, args.at.as_deref(), &args.set)?;
+    } = unconstrained_operating_point(&args.model, &args.point)?;
     let n = model.num_dofs();
     let names = model.coordinate_names();
     let fail =
