@@ -148,9 +148,7 @@ pub fn run(args: &FloquetArgs) -> Result<(), CliError> {
         let complex =
             |c: &nalgebra::Complex<f64>| json!({"re": c.re, "im": c.im, "modulus": c.norm()});
         let f = &point.floquet;
-        let monodromy: Vec<Vec<f64>> = (0..f.monodromy_matrix.nrows())
-            .map(|i| f.monodromy_matrix.row(i).iter().copied().collect())
-            .collect();
+        let monodromy = super::modes::matrix_rows(&f.monodromy_matrix);
         let mut out = json!({
             "model": model.name(),
             "coordinates": names,

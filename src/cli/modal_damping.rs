@@ -8,14 +8,13 @@ use std::io::Write as _;
 
 use clap::Args;
 use eomgen::{FreeResponse, ModeKind, RayleighDamping};
-use nalgebra::DMatrix;
 use serde_json::json;
 
 use super::CliError;
 use super::free_response::{
     Panel, default_t_end, kind_json, panels, parse_init, time_grid, unconstrained_operating_point,
 };
-use super::modes::{OperatingPoint, OperatingPointArgs};
+use super::modes::{OperatingPoint, OperatingPointArgs, matrix_rows};
 use super::plot::Series;
 
 /// Options of `eomgen study modal-damping`.
@@ -66,12 +65,6 @@ struct Case {
 /// `ζ` and `ω_d = ω√(1 − ζ²)` of a mode of natural frequency `ω` (`None` when overdamped).
 fn damped_frequency(omega: f64, zeta: f64) -> Option<f64> {
     (zeta.abs() < 1.0).then(|| omega * (1.0 - zeta * zeta).sqrt())
-}
-
-fn rows(m: &DMatrix<f64>) -> Vec<Vec<f64>> {
-    (0..m.nrows())
-        .map(|i| m.row(i).iter().copied().collect())
-        .collect()
 }
 
 /// Runs `study modal-damping`.
@@ -259,10 +252,10 @@ pub fn run(args: &ModalDampingArgs) -> Result<(), CliError> {
                 "name": label,
                 "q": names.iter().zip(&lin.q).map(|(c, v)| (c.to_string(), json!(v))).collect::<serde_json::Map<_, _>>(),
             },
-            "mass_matrix": rows(&lin.mass_matrix),
-            "stiffness_matrix": rows(&lin.stiffness_matrix),
-            "damping_matrix": rows(&lin.damping_matrix),
-            "modal_damping_matrix": rows(&approx.modal_damping_matrix),
+            "mass_matrix": matrix_rows(&lin.mass_matrix),
+            "stiffness_matrix": matrix_rows(&lin.stiffness_matrix),
+            "damping_matrix": matrix_rows(&lin.damping_matrix),
+            "modal_damping_matrix": matrix_rows(&approx.modal_damping_matrix),
             "coupling": approx.coupling,
             "rayleigh": rayleigh.as_ref().map(|(m, fit)| json!({
                 "modes": m,

@@ -107,11 +107,6 @@ pub fn run(args: &ModesArgs) -> Result<(), CliError> {
             json!({"kind": "unstable", "growth_rate": growth_rate})
         }
     };
-    let rows = |m: &DMatrix<f64>| -> Vec<Vec<f64>> {
-        (0..m.nrows())
-            .map(|i| m.row(i).iter().copied().collect())
-            .collect()
-    };
     // Mode shapes in the model's coordinates (δq = N z with constraints).
     let shapes_q = lin.to_coordinates(&modes.mode_shapes);
     let shapes: Vec<Vec<f64>> = (0..r)
@@ -163,9 +158,9 @@ pub fn run(args: &ModesArgs) -> Result<(), CliError> {
             "mode_shapes": shapes,
             "minimal_coordinates": minimal,
             "lagrange_multipliers": multipliers,
-            "mass_matrix": rows(&lin.mass_matrix),
-            "stiffness_matrix": rows(&lin.stiffness_matrix),
-            "damping_matrix": rows(&lin.damping_matrix),
+            "mass_matrix": matrix_rows(&lin.mass_matrix),
+            "stiffness_matrix": matrix_rows(&lin.stiffness_matrix),
+            "damping_matrix": matrix_rows(&lin.damping_matrix),
             "stiffness_asymmetry": modes.stiffness_asymmetry,
             "m_inv_k_eigenvalues": route22,
             "m_inv_k_relative_difference": route_difference,
@@ -260,6 +255,11 @@ pub fn run(args: &ModesArgs) -> Result<(), CliError> {
         let _ = writeln!(stdout, "animation  {path}");
     }
     Ok(())
+}
+
+/// `m` as a list of rows, for JSON.
+pub(super) fn matrix_rows(m: &DMatrix<f64>) -> Vec<Vec<f64>> {
+    m.row_iter().map(|r| r.iter().copied().collect()).collect()
 }
 
 fn print_matrix(out: &mut impl std::io::Write, name: &str, m: &DMatrix<f64>) {
