@@ -12,7 +12,7 @@ use eomgen::{
     log_frequencies, modal_damping, modal_frequency_response, normal_modes, phase_degrees,
     settling_time, simulate_steady_state,
 };
-use nalgebra::{Complex, DMatrix};
+use nalgebra::Complex;
 use plotters::prelude::*;
 use rayon::prelude::*;
 use serde_json::{Value, json};
@@ -179,9 +179,10 @@ pub fn run(args: &FrfArgs) -> Result<(), CliError> {
     let frequencies = log_frequencies(lo, hi, args.points)
         .map_err(|e| CliError::usage(format!("--freqs: {e}")))?;
     let mut sweeps: Vec<FrequencySweep> = Vec::with_capacity(outputs.len());
-    let b_matrix = DMatrix::from_column_slice(b.len(), 1, b.as_slice());
+    // The one input's column, `n × 1`.
+    let b_matrix = &forced.input_matrix;
     for (_, i) in &outputs {
-        sweeps.push(frequency_sweep(lin, &b_matrix, 0, *i, &frequencies).map_err(fail(name))?);
+        sweeps.push(frequency_sweep(lin, b_matrix, 0, *i, &frequencies).map_err(fail(name))?);
     }
     let mut evaluation_frequencies = Vec::new();
     for text in &args.frequencies {
@@ -209,7 +210,7 @@ pub fn run(args: &FrfArgs) -> Result<(), CliError> {
     // The response (direct and, with --modal, mode by mode) at the evaluation frequencies.
     let mut evaluations = Vec::new();
     for &w in &evaluation_frequencies {
-        let direct = match frequency_response(lin, &b_matrix, w) {
+        let direct = match frequency_response(lin, b_matrix, w) {
             Ok(h) => Some(h.column(0).into_owned()),
             Err(FrfError::Singular { .. }) => None,
             Err(e) => return Err(fail(name)(e)),
@@ -250,7 +251,7 @@ pub fn run(args: &FrfArgs) -> Result<(), CliError> {
     let n = model.num_dofs();
     let amp_phase = |z: Complex<f64>| json!({"re": z.re, "im": z.im, "amplitude": z.norm(), "phase_deg": phase_degrees(z)});
     let modal_json = |r: &ModalResponse| {
-        let direct = frequency_response(lin, &b_matrix, r.frequency).ok();
+        let direct = frequency_response(lin, b_matrix, r.frequency).ok();
         let difference = direct.map(|d| {
             (0..n)
                 .map(|i| (d[(i, 0)] - r.response[i]).norm())
@@ -597,11 +598,7 @@ fn simulate_points(
         e => fail(name)(e),
     })?;
     let frequencies = log_frequencies(lo, hi, k).map_err(|e| CliError::usage(e.to_string()))?;
-    let b = DMatrix::from_column_slice(
-        forced.input_matrix.nrows(),
-        1,
-        forced.input_matrix.column(0).as_slice(),
-    );
+    let b = &forced.input_matrix;
     let progress = if args.json || !std::io::stderr().is_terminal() {
         indicatif::ProgressBar::hidden()
     } else {
@@ -621,7 +618,7 @@ fn simulate_points(
         .map(|&w| {
             let result = (|| {
                 let mut model = args.point.model(&args.model)?;
-                let h = frequency_response(lin, &b, w).map_err(fail(name))?;
+                let h = frequency_response(lin, b, w).map_err(fail(name))?;
                 let scale = h.iter().map(|z| z.norm()).fold(0.0f64, f64::max)
                     * args.amplitude.abs()
                     * w.max(1.0);
