@@ -155,6 +155,7 @@ fn failed_equilibrium_searches_explain_themselves() {
         &["modes", "cannonball"][..],
         &["frf", "cannonball", "--input", "x"],
         &["study", "free-response", "cannonball"],
+        &["study", "modal-damping", "cannonball"],
     ] {
         let out = eomgen(args);
         assert_eq!(out.status.code(), Some(1), "{args:?}");

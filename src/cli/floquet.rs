@@ -27,26 +27,21 @@ use plotters::prelude::*;
 use rayon::prelude::*;
 use serde_json::{Value, json};
 
-use super::modes::operating_point;
+use super::CliError;
+use super::modes::OperatingPointArgs;
 use super::plot::{register_font, tick};
 use super::values::{evaluate, parameter_lookup, set_parameters, split_assignment};
-use super::{CliError, find_model};
 
 /// Options of `eomgen study floquet`.
 #[derive(Debug, Args)]
 pub struct FloquetArgs {
     /// A model whose forcing has period 2π/w (`mathieu_pendulum`).
     pub model: String,
-    /// Operating point: a name from the model's `equilibria:` (`upright`, `hanging`), or
-    /// guesses `q1=VALUE,…` (others 0). Default: the model's first equilibrium, else q = 0.
-    #[arg(long)]
-    pub at: Option<String>,
+    #[command(flatten)]
+    pub point: OperatingPointArgs,
     /// The parameter that is the forcing frequency w (rad/s); the period is T = 2π/w.
     #[arg(long, default_value = "w")]
     pub period_parameter: String,
-    /// Set a parameter, `NAME=VALUE`; repeatable.
-    #[arg(long = "set", value_name = "NAME=VALUE")]
-    pub set: Vec<String>,
     /// Stability chart over two parameters, `X=LO..HI:N,Y=LO..HI:N` (N values each, ends
     /// included; `a=0..0.3:61,w=10..100:61`): the x axis first.
     #[arg(long, value_name = "X=LO..HI:N,Y=LO..HI:N")]
@@ -83,8 +78,7 @@ struct Point {
 
 /// Runs `study floquet`.
 pub fn run(args: &FloquetArgs) -> Result<(), CliError> {
-    let mut model = find_model(&args.model)?;
-    set_parameters(model.as_mut(), &args.set)?;
+    let mut model = args.point.model(&args.model)?;
     if !model
         .parameter_names()
         .contains(&args.period_parameter.as_str())
@@ -105,7 +99,7 @@ pub fn run(args: &FloquetArgs) -> Result<(), CliError> {
             "--tol must be positive and --stability-tolerance finite and >= 0",
         ));
     }
-    let (label, guess) = operating_point(model.as_ref(), args.at.as_deref())?;
+    let (label, guess) = args.point.guess(model.as_ref())?;
     let options = FloquetOptions {
         rtol: args.tol,
         atol: args.tol,
@@ -154,9 +148,7 @@ pub fn run(args: &FloquetArgs) -> Result<(), CliError> {
         let complex =
             |c: &nalgebra::Complex<f64>| json!({"re": c.re, "im": c.im, "modulus": c.norm()});
         let f = &point.floquet;
-        let monodromy: Vec<Vec<f64>> = (0..f.monodromy_matrix.nrows())
-            .map(|i| f.monodromy_matrix.row(i).iter().copied().collect())
-            .collect();
+        let monodromy = super::modes::matrix_rows(&f.monodromy_matrix);
         let mut out = json!({
             "model": model.name(),
             "coordinates": names,
@@ -335,7 +327,7 @@ fn run_sweep(
             let (i, j) = (k / y.values.len(), k % y.values.len());
             let mut model = (entry.make)();
             let cell = (|| {
-                set_parameters(model.as_mut(), &args.set).map_err(|e| e.message)?;
+                set_parameters(model.as_mut(), &args.point.set).map_err(|e| e.message)?;
                 for (axis, value) in [(x, x.values[i]), (y, y.values[j])] {
                     model
                         .set_parameter(&axis.name, value)

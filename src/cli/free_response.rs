@@ -14,7 +14,7 @@ use plotters::prelude::*;
 use serde_json::json;
 
 use super::CliError;
-use super::modes::{OperatingPoint, operating_point_of};
+use super::modes::{OperatingPoint, OperatingPointArgs, operating_point_of};
 use super::plot::{self, Series};
 use super::values::{evaluate, parameter_lookup, split_assignment};
 
@@ -23,13 +23,8 @@ use super::values::{evaluate, parameter_lookup, split_assignment};
 pub struct FreeResponseArgs {
     /// Model name (see `eomgen list`).
     pub model: String,
-    /// Operating point: a name from the model's `equilibria:`, or guesses `q1=VALUE,…`
-    /// (as for `eomgen modes`). Default: the model's first equilibrium, else q = 0.
-    #[arg(long)]
-    pub at: Option<String>,
-    /// Set a parameter, `NAME=VALUE`; repeatable.
-    #[arg(long = "set", value_name = "NAME=VALUE")]
-    pub set: Vec<String>,
+    #[command(flatten)]
+    pub point: OperatingPointArgs,
     /// Initial deviation from the operating point: `NAME=VALUE` for a coordinate (`x=0.1`) or a
     /// rate (`x_dot=0.2`), comma separated or repeated; the others 0. Default: 0.1 (m or rad)
     /// for every coordinate, at rest.
@@ -57,10 +52,9 @@ pub struct FreeResponseArgs {
 /// refused (their linearisation is in minimal coordinates, `δq = N z`).
 pub(super) fn unconstrained_operating_point(
     model_name: &str,
-    at: Option<&str>,
-    sets: &[String],
+    args: &OperatingPointArgs,
 ) -> Result<OperatingPoint, CliError> {
-    let point = operating_point_of(model_name, at, sets)?;
+    let point = operating_point_of(model_name, args)?;
     if point.lin.num_minimal_coordinates() != point.model.num_dofs() {
         let name = point.model.name();
         return Err(CliError::usage(format!(
@@ -298,7 +292,7 @@ pub fn run(args: &FreeResponseArgs) -> Result<(), CliError> {
         mut lin,
         modes,
         ..
-    } = unconstrained_operating_point(&args.model, args.at.as_deref(), &args.set)?;
+    } = unconstrained_operating_point(&args.model, &args.point)?;
     let n = model.num_dofs();
     let names = model.coordinate_names();
     let ignored_damping = lin.damping_matrix.amax();

@@ -12,14 +12,14 @@ use eomgen::{
     log_frequencies, modal_damping, modal_frequency_response, normal_modes, phase_degrees,
     settling_time, simulate_steady_state,
 };
-use nalgebra::{Complex, DMatrix};
+use nalgebra::Complex;
 use plotters::prelude::*;
 use rayon::prelude::*;
 use serde_json::{Value, json};
 
-use super::modes::operating_point;
-use super::values::{evaluate, parameter_lookup, set_parameters};
-use super::{CliError, find_model, plot};
+use super::modes::OperatingPointArgs;
+use super::values::{evaluate, parameter_lookup};
+use super::{CliError, plot};
 
 /// Options of `eomgen frf`.
 #[derive(Debug, Args)]
@@ -29,19 +29,15 @@ pub struct FrfArgs {
     /// The input: a parameter that enters the forcing linearly (a load amplitude, `A` in
     /// `A*cos(w*t)`; its time function is taken at t = 0, so for `A*cos(w*t)` the response is
     /// the steady state under `A cos(ω t)`), or a coordinate's name: a unit generalized force
-    /// on that coordinate (no `--simulate` then: the model has no load to drive).
+    /// on that coordinate (no `--simulate` then: the model has no load to drive). The
+    /// equilibrium (`--at`) is found with the input set to 0.
     #[arg(long)]
     pub input: String,
     /// An output coordinate; repeatable (default: every coordinate).
     #[arg(long = "output", value_name = "NAME")]
     pub outputs: Vec<String>,
-    /// Operating point guess: a name from the model's `equilibria:` or `q1=VALUE,…` (as in
-    /// `eomgen modes`); the equilibrium is found with the input set to 0.
-    #[arg(long)]
-    pub at: Option<String>,
-    /// Set a parameter, `NAME=VALUE`; repeatable.
-    #[arg(long = "set", value_name = "NAME=VALUE")]
-    pub set: Vec<String>,
+    #[command(flatten)]
+    pub point: OperatingPointArgs,
     /// Frequency range `LO..HI` (rad/s, expressions of the parameters allowed; default: a
     /// decade below the lowest to a decade above the highest natural frequency).
     #[arg(long, value_name = "LO..HI")]
@@ -96,8 +92,7 @@ fn fail(model: &str) -> impl Fn(FrfError) -> CliError + '_ {
 
 /// Runs `frf`.
 pub fn run(args: &FrfArgs) -> Result<(), CliError> {
-    let mut model = find_model(&args.model)?;
-    set_parameters(model.as_mut(), &args.set)?;
+    let mut model = args.point.model(&args.model)?;
     if args.points < 2 {
         return Err(CliError::usage("--points must be at least 2"));
     }
@@ -119,7 +114,7 @@ pub fn run(args: &FrfArgs) -> Result<(), CliError> {
         )));
     }
     let name = model.name();
-    let (label, guess) = operating_point(model.as_ref(), args.at.as_deref())?;
+    let (label, guess) = args.point.guess(model.as_ref())?;
     let forced = linearize_with_inputs(model.as_mut(), &guess, &[args.input.as_str()]).map_err(
         |e| match e {
             FrfError::NonlinearInput { .. }
@@ -184,9 +179,10 @@ pub fn run(args: &FrfArgs) -> Result<(), CliError> {
     let frequencies = log_frequencies(lo, hi, args.points)
         .map_err(|e| CliError::usage(format!("--freqs: {e}")))?;
     let mut sweeps: Vec<FrequencySweep> = Vec::with_capacity(outputs.len());
-    let b_matrix = DMatrix::from_column_slice(b.len(), 1, b.as_slice());
+    // The one input's column, `n × 1`.
+    let b_matrix = &forced.input_matrix;
     for (_, i) in &outputs {
-        sweeps.push(frequency_sweep(lin, &b_matrix, 0, *i, &frequencies).map_err(fail(name))?);
+        sweeps.push(frequency_sweep(lin, b_matrix, 0, *i, &frequencies).map_err(fail(name))?);
     }
     let mut evaluation_frequencies = Vec::new();
     for text in &args.frequencies {
@@ -214,7 +210,7 @@ pub fn run(args: &FrfArgs) -> Result<(), CliError> {
     // The response (direct and, with --modal, mode by mode) at the evaluation frequencies.
     let mut evaluations = Vec::new();
     for &w in &evaluation_frequencies {
-        let direct = match frequency_response(lin, &b_matrix, w) {
+        let direct = match frequency_response(lin, b_matrix, w) {
             Ok(h) => Some(h.column(0).into_owned()),
             Err(FrfError::Singular { .. }) => None,
             Err(e) => return Err(fail(name)(e)),
@@ -255,7 +251,7 @@ pub fn run(args: &FrfArgs) -> Result<(), CliError> {
     let n = model.num_dofs();
     let amp_phase = |z: Complex<f64>| json!({"re": z.re, "im": z.im, "amplitude": z.norm(), "phase_deg": phase_degrees(z)});
     let modal_json = |r: &ModalResponse| {
-        let direct = frequency_response(lin, &b_matrix, r.frequency).ok();
+        let direct = frequency_response(lin, b_matrix, r.frequency).ok();
         let difference = direct.map(|d| {
             (0..n)
                 .map(|i| (d[(i, 0)] - r.response[i]).norm())
@@ -602,11 +598,7 @@ fn simulate_points(
         e => fail(name)(e),
     })?;
     let frequencies = log_frequencies(lo, hi, k).map_err(|e| CliError::usage(e.to_string()))?;
-    let b = DMatrix::from_column_slice(
-        forced.input_matrix.nrows(),
-        1,
-        forced.input_matrix.column(0).as_slice(),
-    );
+    let b = &forced.input_matrix;
     let progress = if args.json || !std::io::stderr().is_terminal() {
         indicatif::ProgressBar::hidden()
     } else {
@@ -625,9 +617,8 @@ fn simulate_points(
         .par_iter()
         .map(|&w| {
             let result = (|| {
-                let mut model = find_model(&args.model)?;
-                set_parameters(model.as_mut(), &args.set)?;
-                let h = frequency_response(lin, &b, w).map_err(fail(name))?;
+                let mut model = args.point.model(&args.model)?;
+                let h = frequency_response(lin, b, w).map_err(fail(name))?;
                 let scale = h.iter().map(|z| z.norm()).fold(0.0f64, f64::max)
                     * args.amplitude.abs()
                     * w.max(1.0);

@@ -8,14 +8,13 @@ use std::io::Write as _;
 
 use clap::Args;
 use eomgen::{FreeResponse, ModeKind, RayleighDamping};
-use nalgebra::DMatrix;
 use serde_json::json;
 
 use super::CliError;
 use super::free_response::{
     Panel, default_t_end, kind_json, panels, parse_init, time_grid, unconstrained_operating_point,
 };
-use super::modes::OperatingPoint;
+use super::modes::{OperatingPoint, OperatingPointArgs, matrix_rows};
 use super::plot::Series;
 
 /// Options of `eomgen study modal-damping`.
@@ -23,13 +22,8 @@ use super::plot::Series;
 pub struct ModalDampingArgs {
     /// Model name (see `eomgen list`), with a damping matrix (`three_masses_damped`).
     pub model: String,
-    /// Operating point: a name from the model's `equilibria:`, or guesses `q1=VALUE,…`.
-    /// Default: the model's first equilibrium, else q = 0.
-    #[arg(long)]
-    pub at: Option<String>,
-    /// Set a parameter, `NAME=VALUE`; repeatable.
-    #[arg(long = "set", value_name = "NAME=VALUE")]
-    pub set: Vec<String>,
+    #[command(flatten)]
+    pub point: OperatingPointArgs,
     /// The two modes (1-based, ascending frequency) whose exact damping ratios the Rayleigh
     /// damping C = αM + βK reproduces. Default: the slowest and the fastest oscillatory modes
     /// (HW34).
@@ -73,12 +67,6 @@ fn damped_frequency(omega: f64, zeta: f64) -> Option<f64> {
     (zeta.abs() < 1.0).then(|| omega * (1.0 - zeta * zeta).sqrt())
 }
 
-fn rows(m: &DMatrix<f64>) -> Vec<Vec<f64>> {
-    (0..m.nrows())
-        .map(|i| m.row(i).iter().copied().collect())
-        .collect()
-}
-
 /// Runs `study modal-damping`.
 pub fn run(args: &ModalDampingArgs) -> Result<(), CliError> {
     let OperatingPoint {
@@ -87,7 +75,7 @@ pub fn run(args: &ModalDampingArgs) -> Result<(), CliError> {
         lin,
         modes,
         ..
-    } = unconstrained_operating_point(&args.model, args.at.as_deref(), &args.set)?;
+    } = unconstrained_operating_point(&args.model, &args.point)?;
     let n = model.num_dofs();
     let names = model.coordinate_names();
     let fail =
@@ -264,10 +252,10 @@ pub fn run(args: &ModalDampingArgs) -> Result<(), CliError> {
                 "name": label,
                 "q": names.iter().zip(&lin.q).map(|(c, v)| (c.to_string(), json!(v))).collect::<serde_json::Map<_, _>>(),
             },
-            "mass_matrix": rows(&lin.mass_matrix),
-            "stiffness_matrix": rows(&lin.stiffness_matrix),
-            "damping_matrix": rows(&lin.damping_matrix),
-            "modal_damping_matrix": rows(&approx.modal_damping_matrix),
+            "mass_matrix": matrix_rows(&lin.mass_matrix),
+            "stiffness_matrix": matrix_rows(&lin.stiffness_matrix),
+            "damping_matrix": matrix_rows(&lin.damping_matrix),
+            "modal_damping_matrix": matrix_rows(&approx.modal_damping_matrix),
             "coupling": approx.coupling,
             "rayleigh": rayleigh.as_ref().map(|(m, fit)| json!({
                 "modes": m,

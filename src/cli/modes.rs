@@ -19,14 +19,8 @@ use super::{CliError, find_model};
 pub struct ModesArgs {
     /// Model name (see `eomgen list`).
     pub model: String,
-    /// Operating point: a name from the model's `equilibria:` (`hanging`, `upright`), or
-    /// guesses `q1=VALUE,q2=VALUE` (others 0). Default: the model's first equilibrium, else
-    /// q = 0. Newton on F(q, 0) = 0 starts there.
-    #[arg(long)]
-    pub at: Option<String>,
-    /// Set a parameter, `NAME=VALUE`; repeatable.
-    #[arg(long = "set", value_name = "NAME=VALUE")]
-    pub set: Vec<String>,
+    #[command(flatten)]
+    pub point: OperatingPointArgs,
     /// Print JSON.
     #[arg(long)]
     pub json: bool,
@@ -40,6 +34,40 @@ pub struct ModesArgs {
     pub animate: Option<String>,
 }
 
+/// `--at` and `--set`, the same in `modes`, `frf` and the modal studies (`free-response`,
+/// `modal-damping`, `floquet`).
+#[derive(Debug, Args)]
+pub struct OperatingPointArgs {
+    /// Operating point: a name from the model's `equilibria:` (`hanging`, `upright`), or
+    /// guesses `q1=VALUE,q2=VALUE` (others 0). Default: the model's first equilibrium, else
+    /// q = 0. Newton on F(q, 0) = 0 starts there.
+    #[arg(long)]
+    pub at: Option<String>,
+    /// Set a parameter, `NAME=VALUE`; repeatable.
+    #[arg(long = "set", value_name = "NAME=VALUE")]
+    pub set: Vec<String>,
+}
+
+impl OperatingPointArgs {
+    /// The bundled model `name` with `--set` applied.
+    ///
+    /// # Errors
+    /// An unknown model, or a bad `--set` (see [`set_parameters`]).
+    pub(super) fn model(&self, name: &str) -> Result<Box<dyn ModelInfo>, CliError> {
+        let mut model = find_model(name)?;
+        set_parameters(model.as_mut(), &self.set)?;
+        Ok(model)
+    }
+
+    /// The label and starting guess of `--at` for `model` (see [`operating_point`]).
+    ///
+    /// # Errors
+    /// An unknown equilibrium name or a bad guess.
+    pub(super) fn guess(&self, model: &dyn ModelInfo) -> Result<(String, Vec<f64>), CliError> {
+        operating_point(model, self.at.as_deref())
+    }
+}
+
 /// Runs `modes`.
 pub fn run(args: &ModesArgs) -> Result<(), CliError> {
     let OperatingPoint {
@@ -48,7 +76,7 @@ pub fn run(args: &ModesArgs) -> Result<(), CliError> {
         equilibrium,
         lin,
         modes,
-    } = operating_point_of(&args.model, args.at.as_deref(), &args.set)?;
+    } = operating_point_of(&args.model, &args.point)?;
     if args.plot.is_some() {
         super::mode_plot::check_drawable(model.as_ref())?;
     }
@@ -78,11 +106,6 @@ pub fn run(args: &ModesArgs) -> Result<(), CliError> {
         ModeKind::Unstable { growth_rate } => {
             json!({"kind": "unstable", "growth_rate": growth_rate})
         }
-    };
-    let rows = |m: &DMatrix<f64>| -> Vec<Vec<f64>> {
-        (0..m.nrows())
-            .map(|i| m.row(i).iter().copied().collect())
-            .collect()
     };
     // Mode shapes in the model's coordinates (δq = N z with constraints).
     let shapes_q = lin.to_coordinates(&modes.mode_shapes);
@@ -135,9 +158,9 @@ pub fn run(args: &ModesArgs) -> Result<(), CliError> {
             "mode_shapes": shapes,
             "minimal_coordinates": minimal,
             "lagrange_multipliers": multipliers,
-            "mass_matrix": rows(&lin.mass_matrix),
-            "stiffness_matrix": rows(&lin.stiffness_matrix),
-            "damping_matrix": rows(&lin.damping_matrix),
+            "mass_matrix": matrix_rows(&lin.mass_matrix),
+            "stiffness_matrix": matrix_rows(&lin.stiffness_matrix),
+            "damping_matrix": matrix_rows(&lin.damping_matrix),
             "stiffness_asymmetry": modes.stiffness_asymmetry,
             "m_inv_k_eigenvalues": route22,
             "m_inv_k_relative_difference": route_difference,
@@ -234,6 +257,11 @@ pub fn run(args: &ModesArgs) -> Result<(), CliError> {
     Ok(())
 }
 
+/// `m` as a list of rows, for JSON.
+pub(super) fn matrix_rows(m: &DMatrix<f64>) -> Vec<Vec<f64>> {
+    m.row_iter().map(|r| r.iter().copied().collect()).collect()
+}
+
 fn print_matrix(out: &mut impl std::io::Write, name: &str, m: &DMatrix<f64>) {
     for i in 0..m.nrows() {
         let row: Vec<String> = m.row(i).iter().map(|v| format!("{v:>13.6e}")).collect();
@@ -264,12 +292,10 @@ pub(super) struct OperatingPoint {
 /// normal modes: the start of `modes` and of the modal studies.
 pub(super) fn operating_point_of(
     model_name: &str,
-    at: Option<&str>,
-    sets: &[String],
+    point: &OperatingPointArgs,
 ) -> Result<OperatingPoint, CliError> {
-    let mut model = find_model(model_name)?;
-    set_parameters(model.as_mut(), sets)?;
-    let (label, guess) = operating_point(model.as_ref(), at)?;
+    let model = point.model(model_name)?;
+    let (label, guess) = point.guess(model.as_ref())?;
     let fail = |e: eomgen::ModalError| modal_failure(model.as_ref(), &e);
     let equilibrium = find_equilibrium(model.as_ref(), &guess, 0.0).map_err(fail)?;
     let n = model.num_dofs();
