@@ -369,19 +369,7 @@ pub(crate) fn simulation(
         })
         .collect();
     let max_drift = drift.iter().fold(0.0f64, |m, d| m.max(d.abs()));
-    let adaptive = matches!(
-        args.method,
-        super::simulate::Method::Bs32
-            | super::simulate::Method::Dp54
-            | super::simulate::Method::Dop853
-            | super::simulate::Method::Radau5
-    );
-    let method = if adaptive {
-        format!("{method_name} (rtol {:e}, atol {:e})", args.rtol, args.atol)
-    } else {
-        let dt = args.dt.unwrap_or(args.t_end / 1000.0);
-        format!("{method_name} (dt = {dt:e} s)")
-    };
+    let method = format!("{method_name} ({})", args.step_control());
     let conserved = if model.is_conservative() {
         ""
     } else {
