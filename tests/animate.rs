@@ -49,14 +49,19 @@ fn frame(clip: &Value, k: usize) -> Vec<(f64, f64)> {
         .collect()
 }
 
-/// Frame `k`'s positions of the points named `wanted` (by the page's `names`).
-fn named(data: &Value, clip: &Value, k: usize, wanted: &[&str]) -> Vec<(f64, f64)> {
-    let names: Vec<&str> = data["names"]
+/// The page's drawn points' names, in the frames' order.
+fn names(data: &Value) -> Vec<&str> {
+    data["names"]
         .as_array()
         .expect("names")
         .iter()
         .map(|n| n.as_str().expect("name"))
-        .collect();
+        .collect()
+}
+
+/// Frame `k`'s positions of the points named `wanted` (by the page's `names`).
+fn named(data: &Value, clip: &Value, k: usize, wanted: &[&str]) -> Vec<(f64, f64)> {
+    let names = names(data);
     let all = frame(clip, k);
     wanted
         .iter()
@@ -256,13 +261,7 @@ fn four_bar_frames_close_the_loop() {
         &path,
     ]);
     let data = data_of(&std::fs::read_to_string(&path).expect("page"));
-    let names: Vec<&str> = data["names"]
-        .as_array()
-        .expect("names")
-        .iter()
-        .map(|n| n.as_str().expect("name"))
-        .collect();
-    assert_eq!(names, ["O", "D", "B", "C", "G1", "G2", "G3"]);
+    assert_eq!(names(&data), ["O", "D", "B", "C", "G1", "G2", "G3"]);
     assert_eq!(data["traces"], serde_json::json!([3, 2]));
     let clip = &data["clips"][0];
     let frames = clip["xy"].as_array().expect("frames").len();

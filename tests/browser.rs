@@ -152,6 +152,32 @@ fn dom_after_budget(page: &Path) -> String {
     )
 }
 
+/// Asserts that the page recorded no script error or `console.error` (`what` names it).
+fn assert_no_errors(dom: &str, what: &str) {
+    let errors = text(dom, "errors").unwrap_or("?");
+    assert!(errors.trim().is_empty(), "{what}: {errors}");
+}
+
+/// The frame index (`data-frame` of `#frame`) and the time (`data-t` of `#time`, s) the
+/// page shows.
+fn frame_and_time(dom: &str) -> (usize, f64) {
+    let frame = attribute(dom, "frame", "data-frame")
+        .and_then(|v| v.parse().ok())
+        .expect("data-frame");
+    let t = attribute(dom, "time", "data-t")
+        .and_then(|v| v.parse().ok())
+        .expect("data-t");
+    (frame, t)
+}
+
+/// Writes `html` with `script` run at the end of its body as `dir/name`; returns the path.
+fn inject(dir: &Path, name: &str, html: &str, script: &str) -> PathBuf {
+    let path = dir.join(name);
+    let injected = html.replacen("</body>", &format!("<script>{script}</script>\n</body>"), 1);
+    std::fs::write(&path, injected).expect("write");
+    path
+}
+
 /// Loads `page` and checks: the player started (`data-state="ready"`), no error was
 /// recorded, and after `BUDGET_MS` of page time the frame index and `t` have advanced —
 /// by no more than the budget at 1× (the player follows the clock; 10 % allowed for the
@@ -164,19 +190,13 @@ fn check_page_plays(page: &Path, seconds_per_second: f64) -> String {
         "no error element in {}:\n{dom}",
         page.display()
     );
-    let errors = text(&dom, "errors").unwrap_or("?");
-    assert!(errors.trim().is_empty(), "{}: {errors}", page.display());
+    assert_no_errors(&dom, &page.display().to_string());
     assert!(
         dom.contains("<body data-state=\"ready\">"),
         "the player did not start: {}",
         page.display()
     );
-    let frame: usize = attribute(&dom, "frame", "data-frame")
-        .and_then(|v| v.parse().ok())
-        .expect("data-frame");
-    let t: f64 = attribute(&dom, "time", "data-t")
-        .and_then(|v| v.parse().ok())
-        .expect("data-t");
+    let (frame, t) = frame_and_time(&dom);
     let budget = f64::from(BUDGET_MS) / 1000.0 * seconds_per_second;
     assert!(
         frame > 0,
@@ -317,12 +337,9 @@ fn mode_shapes_play_in_chromium() {
         &["modes", "four_bar", "--animate"],
     );
     let dom = dom_after_budget(&path);
-    let errors = text(&dom, "errors").unwrap_or("?");
-    assert!(errors.trim().is_empty(), "{errors}");
+    assert_no_errors(&dom, "modes page");
     assert!(dom.contains("<body data-state=\"ready\">"));
-    let frame: usize = attribute(&dom, "frame", "data-frame")
-        .and_then(|v| v.parse().ok())
-        .expect("data-frame");
+    let (frame, _) = frame_and_time(&dom);
     assert!(frame > 0, "the mode did not move");
     assert!(dom.contains("<select id=\"clip\""), "a mode selector");
     check_screenshot(&path, &dir, false);
@@ -350,10 +367,7 @@ fn errors_in_the_page_are_seen() {
             "console.error: bad frame",
         ),
     ] {
-        let broken = dir.join(name);
-        let injected = html.replacen("</body>", &format!("<script>{script}</script>\n</body>"), 1);
-        std::fs::write(&broken, injected).expect("write");
-        let dom = dom_after_budget(&broken);
+        let dom = dom_after_budget(&inject(&dir, name, &html, script));
         let errors = text(&dom, "errors").unwrap_or("");
         assert!(errors.contains(expected), "{name}: `{errors}`");
     }
@@ -371,28 +385,19 @@ fn controls_work_in_chromium() {
     let dir = scratch_dir("controls");
     let good = page(&dir, "good.html", &["animate", "triple_pendulum", "-o"]);
     let html = std::fs::read_to_string(&good).expect("page");
-    let inject = |name: &str, script: &str| {
-        let path = dir.join(name);
-        let injected = html.replacen("</body>", &format!("<script>{script}</script>\n</body>"), 1);
-        std::fs::write(&path, injected).expect("write");
-        let dom = dom_after_budget(&path);
-        let errors = text(&dom, "errors").unwrap_or("?");
-        assert!(errors.trim().is_empty(), "{name}: {errors}");
-        let frame: usize = attribute(&dom, "frame", "data-frame")
-            .and_then(|v| v.parse().ok())
-            .expect("data-frame");
-        let t: f64 = attribute(&dom, "time", "data-t")
-            .and_then(|v| v.parse().ok())
-            .expect("data-t");
+    let run = |name: &str, script: &str| {
+        let dom = dom_after_budget(&inject(&dir, name, &html, script));
+        assert_no_errors(&dom, name);
+        let (frame, t) = frame_and_time(&dom);
         (dom, frame, t)
     };
-    let (dom, frame, _) = inject(
+    let (dom, frame, _) = run(
         "space.html",
         "document.dispatchEvent(new KeyboardEvent('keydown', {key: ' ', code: 'Space', bubbles: true}));",
     );
     assert_eq!(frame, 0, "space did not pause");
     assert_eq!(text(&dom, "play"), Some("Play"));
-    let (_, frame, t) = inject(
+    let (_, frame, t) = run(
         "scrub.html",
         "var s = document.getElementById('scrub'); s.value = '150'; s.dispatchEvent(new Event('input'));",
     );
@@ -401,7 +406,7 @@ fn controls_work_in_chromium() {
         (150, 5.0),
         "the scrubber moved to frame 150 (t = 5 s) and paused"
     );
-    let (_, _, t) = inject(
+    let (_, _, t) = run(
         "speed.html",
         "var v = document.getElementById('speed'); v.value = '0.25'; v.dispatchEvent(new Event('change'));",
     );

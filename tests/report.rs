@@ -23,6 +23,21 @@ fn read_json(dir: &Path) -> serde_json::Value {
     serde_json::from_str(&text).expect("report.json is JSON")
 }
 
+/// Runs `eomgen report [--models MODELS] -o DIR`, asserting success.
+fn report_ok(models: Option<&str>, dir: &Path) {
+    let mut args = vec!["report"];
+    if let Some(models) = models {
+        args.extend(["--models", models]);
+    }
+    args.extend(["-o", dir.to_str().expect("UTF-8 path")]);
+    let out = eomgen(&args);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
 /// The rows of `model` in `report`.
 fn checks<'a>(report: &'a serde_json::Value, model: &str) -> &'a Vec<serde_json::Value> {
     report["models"]
@@ -54,18 +69,7 @@ fn row<'a>(
 #[test]
 fn report_on_three_models_writes_the_page_and_json_and_passes() {
     let dir = out_dir("three");
-    let out = eomgen(&[
-        "report",
-        "--models",
-        "three_masses,simple_pendulum,dumbbell",
-        "-o",
-        dir.to_str().unwrap(),
-    ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    report_ok(Some("three_masses,simple_pendulum,dumbbell"), &dir);
     let report = read_json(&dir);
     let names: Vec<&str> = report["models"]
         .as_array()
@@ -103,15 +107,7 @@ fn report_on_three_models_writes_the_page_and_json_and_passes() {
     let masses = checks(&report, "three_masses");
     let s2 = 2f64.sqrt();
     for (k, w2) in [2.0 - s2, 2.0, 2.0 + s2].iter().enumerate() {
-        let row = masses
-            .iter()
-            .find(|c| {
-                c["check"]
-                    .as_str()
-                    .unwrap()
-                    .starts_with(&format!("natural_frequencies[{}]", k + 1))
-            })
-            .expect("row");
+        let row = row(masses, format!("natural_frequencies[{}]", k + 1), "row");
         assert!((row["expected"].as_f64().unwrap() - w2.sqrt()).abs() < 1e-15);
     }
     // The dumbbell is constrained and conservative: energy and constraint drift both run.
@@ -196,10 +192,7 @@ fn wrong_reference_values_fail_the_report() {
     // What was computed is the true √(m g d/(I + m d²)) = √15 (to 1e-12: the eigenvalue of
     // a 1 × 1 problem, exact to rounding).
     assert!((w["computed"].as_f64().unwrap() - 15f64.sqrt()).abs() < 1e-12);
-    let rate = rows
-        .iter()
-        .find(|c| c["check"].as_str().unwrap().starts_with("conserved `rate`"))
-        .expect("row");
+    let rate = row(rows, "conserved `rate`", "row");
     assert_eq!(rate["passed"], false);
     assert!(
         rate["computed"].as_f64().unwrap() > 0.1,
@@ -359,18 +352,7 @@ fn report_is_byte_identical_across_runs() {
     let a = out_dir("det-a");
     let b = out_dir("det-b");
     for dir in [&a, &b] {
-        let out = eomgen(&[
-            "report",
-            "--models",
-            "cart_pendulum,two_masses_rod",
-            "-o",
-            dir.to_str().unwrap(),
-        ]);
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+        report_ok(Some("cart_pendulum,two_masses_rod"), dir);
     }
     let mut files = Vec::new();
     let mut stack = vec![a.clone()];
@@ -430,12 +412,7 @@ fn simulate_draws_phase_portrait_and_energy_drift() {
 #[test]
 fn full_report_passes_on_every_model() {
     let dir = out_dir("all");
-    let out = eomgen(&["report", "-o", dir.to_str().unwrap()]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    report_ok(None, &dir);
     let report = read_json(&dir);
     assert_eq!(
         report["summary"]["models"].as_u64().unwrap() as usize,

@@ -369,19 +369,7 @@ pub(crate) fn simulation(
         })
         .collect();
     let max_drift = drift.iter().fold(0.0f64, |m, d| m.max(d.abs()));
-    let adaptive = matches!(
-        args.method,
-        super::simulate::Method::Bs32
-            | super::simulate::Method::Dp54
-            | super::simulate::Method::Dop853
-            | super::simulate::Method::Radau5
-    );
-    let method = if adaptive {
-        format!("{method_name} (rtol {:e}, atol {:e})", args.rtol, args.atol)
-    } else {
-        let dt = args.dt.unwrap_or(args.t_end / 1000.0);
-        format!("{method_name} (dt = {dt:e} s)")
-    };
+    let method = format!("{method_name} ({})", args.step_control());
     let conserved = if model.is_conservative() {
         ""
     } else {
@@ -462,13 +450,7 @@ pub(crate) fn modes(
     let rest = scene.project(&positions(q));
     let size = mode_plot::drawing_size(&rest, &(0..rest.len()).collect::<Vec<_>>());
     let mut clips = Vec::with_capacity(shapes.ncols());
-    for (k, (&omega, &kind)) in modes
-        .natural_frequencies
-        .iter()
-        .zip(&modes.kinds)
-        .enumerate()
-    {
-        let psi: Vec<f64> = shapes.column(k).iter().copied().collect();
+    for (k, omega, kind, psi) in mode_plot::each_mode(modes, shapes) {
         let oscillatory = matches!(kind, ModeKind::Oscillatory) && omega > 0.0;
         let period = if oscillatory {
             std::f64::consts::TAU / omega
@@ -485,8 +467,7 @@ pub(crate) fn modes(
             .map(|(j, _)| {
                 let phase = std::f64::consts::TAU * j as f64 / MODE_FRAMES as f64;
                 let amplitude = s.unwrap_or(0.0) * phase.sin();
-                let qk: Vec<f64> = q.iter().zip(&psi).map(|(a, p)| a + amplitude * p).collect();
-                scene.project(&positions(&qk))
+                scene.project(&positions(&mode_plot::displaced(q, &psi, amplitude)))
             })
             .collect();
         check_finite(model.name(), &frames)?;

@@ -110,6 +110,25 @@ pub(super) fn positions(model: &dyn ModelInfo, q: &[f64]) -> Vec<[f64; 3]> {
     model.point_positions(0.0, &y)
 }
 
+/// The configuration `q + s ψ`.
+pub(super) fn displaced(q: &[f64], psi: &[f64], s: f64) -> Vec<f64> {
+    q.iter().zip(psi).map(|(a, p)| a + s * p).collect()
+}
+
+/// Every mode of `modes` as `(k, ω, kind, ψ)`: its index from 0, frequency (rad/s), kind and
+/// shape (column `k` of `shapes`, `n × r` in the model's coordinates).
+pub(super) fn each_mode<'a>(
+    modes: &'a NormalModes,
+    shapes: &'a DMatrix<f64>,
+) -> impl Iterator<Item = (usize, f64, ModeKind, Vec<f64>)> + 'a {
+    modes
+        .natural_frequencies
+        .iter()
+        .zip(&modes.kinds)
+        .enumerate()
+        .map(|(k, (&omega, &kind))| (k, omega, kind, shapes.column(k).iter().copied().collect()))
+}
+
 /// Positions of every point at `q`, projected.
 pub(super) fn frame(model: &dyn ModelInfo, layout: &Layout, q: &[f64]) -> Frame {
     positions(model, q)
@@ -183,14 +202,8 @@ pub fn mode_charts(
     let rest = frame(model, &layout, q);
     let size = drawing_size(&rest, &layout.dots);
     let mut paths = Vec::with_capacity(modes.natural_frequencies.len());
-    for (k, (&omega, &kind)) in modes
-        .natural_frequencies
-        .iter()
-        .zip(&modes.kinds)
-        .enumerate()
-    {
-        let psi: Vec<f64> = shapes.column(k).iter().copied().collect();
-        let at = |s: f64| -> Vec<f64> { q.iter().zip(&psi).map(|(a, p)| a + s * p).collect() };
+    for (k, omega, kind, psi) in each_mode(modes, shapes) {
+        let at = |s: f64| displaced(q, &psi, s);
         let mut title = format!("{}, {}", model.name(), describe(k + 1, omega, kind));
         let displaced = if let Some(s) = mode_scale(model, &layout, q, &psi, size) {
             let plus = frame(model, &layout, &at(s));
@@ -241,11 +254,8 @@ pub fn mode_charts(
 pub(super) fn is_three_d(model: &dyn ModelInfo, q: &[f64], shapes: &DMatrix<f64>) -> bool {
     std::iter::once(q.to_vec())
         .chain((0..shapes.ncols()).map(|k| {
-            let psi = shapes.column(k);
-            q.iter()
-                .zip(psi.iter())
-                .map(|(a, p)| a + 1e-3 * p)
-                .collect()
+            let psi: Vec<f64> = shapes.column(k).iter().copied().collect();
+            displaced(q, &psi, 1e-3)
         }))
         .any(|qk| positions(model, &qk).iter().any(|p| p[2] != 0.0))
 }
@@ -278,7 +288,7 @@ pub(super) fn mode_scale(
     psi: &[f64],
     size: f64,
 ) -> Option<f64> {
-    let at = |s: f64| -> Vec<f64> { q.iter().zip(psi).map(|(a, p)| a + s * p).collect() };
+    let at = |s: f64| displaced(q, psi, s);
     // The linearised displacement of the points per unit of s, by a central difference with
     // a step small against q.
     let q_scale = 1.0 + q.iter().fold(0.0f64, |m, v| m.max(v.abs()));

@@ -33,6 +33,19 @@ pub struct Chart<'a> {
     pub log_y: bool,
 }
 
+impl<'a> Chart<'a> {
+    /// A chart with linear axes.
+    pub fn linear(title: &'a str, x_desc: &'a str, y_desc: &'a str) -> Self {
+        Self {
+            title,
+            x_desc,
+            y_desc,
+            log_x: false,
+            log_y: false,
+        }
+    }
+}
+
 /// Plots every coordinate against time, one line each, into `path` (`.svg` or `.png`).
 ///
 /// # Errors
@@ -42,30 +55,44 @@ pub fn time_histories(
     model: &dyn ModelInfo,
     solution: &Solution,
 ) -> Result<(), String> {
+    let title = format!("{}: coordinates against time", model.name());
+    per_coordinate(
+        path,
+        &Chart::linear(&title, "t (s)", "q (m or rad)"),
+        model,
+        solution,
+        |name| name.to_string(),
+        |t, y, i, _| (t, y[i]),
+    )
+}
+
+/// Draws one line per coordinate `i` of `model` into `path`: its name `name(coordinate)`,
+/// its points `point(t, y, i, n)` at every sample `(t, y)` of `solution` (`n` coordinates).
+///
+/// # Errors
+/// An empty solution, or the errors of [`lines`].
+fn per_coordinate(
+    path: &str,
+    chart: &Chart<'_>,
+    model: &dyn ModelInfo,
+    solution: &Solution,
+    name: impl Fn(&str) -> String,
+    point: impl Fn(f64, &[f64], usize, usize) -> (f64, f64),
+) -> Result<(), String> {
     if solution.is_empty() {
         return Err("nothing to plot: the solution has no samples".to_string());
     }
+    let n = model.num_dofs();
     let series: Vec<Series> = model
         .coordinate_names()
         .iter()
         .enumerate()
-        .map(|(i, name)| Series {
-            name: (*name).to_string(),
-            points: solution.iter().map(|(t, y)| (t, y[i])).collect(),
+        .map(|(i, coordinate)| Series {
+            name: name(coordinate),
+            points: solution.iter().map(|(t, y)| point(t, y, i, n)).collect(),
         })
         .collect();
-    let title = format!("{}: coordinates against time", model.name());
-    lines(
-        path,
-        &Chart {
-            title: &title,
-            x_desc: "t (s)",
-            y_desc: "q (m or rad)",
-            log_x: false,
-            log_y: false,
-        },
-        &series,
-    )
+    lines(path, chart, &series)
 }
 
 /// Draws `series` as lines into `path` (`.svg` or `.png`), 960 × 600 px.
@@ -230,30 +257,14 @@ pub fn phase_portrait(
     model: &dyn ModelInfo,
     solution: &Solution,
 ) -> Result<(), String> {
-    if solution.is_empty() {
-        return Err("nothing to plot: the solution has no samples".to_string());
-    }
-    let n = model.num_dofs();
-    let series: Vec<Series> = model
-        .coordinate_names()
-        .iter()
-        .enumerate()
-        .map(|(i, name)| Series {
-            name: format!("{name}_dot vs {name}"),
-            points: solution.iter().map(|(_, y)| (y[i], y[n + i])).collect(),
-        })
-        .collect();
     let title = format!("{}: phase portrait", model.name());
-    lines(
+    per_coordinate(
         path,
-        &Chart {
-            title: &title,
-            x_desc: "q (m or rad)",
-            y_desc: "q̇ (m/s or rad/s)",
-            log_x: false,
-            log_y: false,
-        },
-        &series,
+        &Chart::linear(&title, "q (m or rad)", "q̇ (m/s or rad/s)"),
+        model,
+        solution,
+        |name| format!("{name}_dot vs {name}"),
+        |_, y, i, n| (y[i], y[n + i]),
     )
 }
 
@@ -279,13 +290,7 @@ pub fn energy_drift(path: &str, model: &dyn ModelInfo, solution: &Solution) -> R
     let title = format!("{}: energy drift", model.name());
     lines(
         path,
-        &Chart {
-            title: &title,
-            x_desc: "t (s)",
-            y_desc: "E − E(0) (J)",
-            log_x: false,
-            log_y: false,
-        },
+        &Chart::linear(&title, "t (s)", "E − E(0) (J)"),
         &series,
     )
 }

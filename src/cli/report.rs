@@ -25,10 +25,7 @@ use rayon::prelude::*;
 use serde_json::json;
 
 use eomgen::models::ModelEntry;
-use eomgen::{
-    IntegrationFailure, IntegratorOptions, ModelInfo, OutputTimes, Solution, damped_modes,
-    find_equilibrium, linearize, normal_modes,
-};
+use eomgen::{ModelInfo, OutputTimes, Solution, damped_modes};
 use eomgen_symbolic::codegen::equations_mathml;
 use eomgen_symbolic::mechanics::check::check_model;
 use eomgen_symbolic::mechanics::{Formulation, Lagrange, SymbolicModel};
@@ -37,7 +34,9 @@ use eomgen_symbolic::model::{
     DEFAULT_CONSTRAINT_DRIFT, DEFAULT_ENERGY_DRIFT, Expr, ModalCheck, ModelFile, RunSettings,
 };
 
-use super::simulate::{Method, Report as EnergyReport};
+use super::modes::{OperatingPoint, operating_point_of};
+use super::simulate::{IntegrationArgs, Method, Report as EnergyReport, integrate};
+use super::values::parameter_lookup;
 use super::{CliError, plot};
 
 /// Relative tolerance of the derivation cross-checks, as `eomgen check`: the derivations
@@ -349,52 +348,48 @@ impl Default for Run {
     }
 }
 
-/// Integrates `model` from `y0` with `run`, sampled at `times` (default: [`SAMPLES`] uniform
-/// times); the model file's events are located on the way.
-fn simulate(
-    model: &mut dyn ModelInfo,
-    y0: &[f64],
-    run: Run,
-    times: Option<Vec<f64>>,
-) -> Result<Solution, String> {
+/// Integrates the bundled model `name` from its initial state as `eomgen simulate` does
+/// ([`integrate`], no drift control), with `run`'s method, end time and `rtol` = `atol`,
+/// sampled at `times` (default: [`SAMPLES`] uniform times); the model file's events are
+/// located on the way.
+fn simulate(name: &str, run: Run, times: Option<Vec<f64>>) -> Result<Solution, String> {
     let times = times.unwrap_or_else(|| {
         (0..SAMPLES)
             .map(|k| run.t_end * k as f64 / (SAMPLES - 1) as f64)
             .collect()
     });
-    let options = IntegratorOptions::default()
-        .with_rtol(run.rtol)
-        .with_atol(run.rtol);
-    run.method
-        .integrator()
-        .integrate(
-            model.as_ode_mut(),
-            0.0,
-            y0,
-            run.t_end,
-            &OutputTimes::At(times),
-            &options,
-        )
-        .map_err(|IntegrationFailure { error, .. }| format!("the integration failed: {error}"))
+    let args = IntegrationArgs {
+        t_end: run.t_end,
+        method: run.method,
+        rtol: run.rtol,
+        atol: run.rtol,
+        ..IntegrationArgs::defaults().map_err(|e| e.message)?
+    };
+    let result = integrate(name, &args, OutputTimes::At(times)).map_err(|e| e.message)?;
+    match result.failure {
+        None => Ok(result.solution),
+        Some(error) => Err(format!("the integration failed: {error}")),
+    }
 }
 
-/// The simulations of one model, each run once.
-struct Runs {
-    done: Vec<(Run, Result<Solution, String>)>,
+/// Results computed once per key (a model's simulations, its operating points), failures
+/// included.
+struct Memo<K, V> {
+    done: Vec<(K, Result<V, String>)>,
 }
 
-impl Runs {
-    fn get(
-        &mut self,
-        model: &mut dyn ModelInfo,
-        y0: &[f64],
-        run: Run,
-    ) -> Result<&Solution, String> {
-        let k = match self.done.iter().position(|(r, _)| *r == run) {
+impl<K: PartialEq, V> Memo<K, V> {
+    fn new() -> Self {
+        Self { done: Vec::new() }
+    }
+
+    /// The result for `key`, computed by `compute` the first time.
+    fn get(&mut self, key: K, compute: impl FnOnce(&K) -> Result<V, String>) -> Result<&V, String> {
+        let k = match self.done.iter().position(|(d, _)| *d == key) {
             Some(k) => k,
             None => {
-                let s = simulate(model, y0, run, None);
-                self.done.push((run, s));
+                let value = compute(&key);
+                self.done.push((key, value));
                 self.done.len() - 1
             }
         };
@@ -404,26 +399,26 @@ impl Runs {
 
 /// Evaluates an expected value (an expression of the parameters).
 fn expected(e: &Expr, model: &dyn ModelInfo) -> Result<f64, String> {
-    let names = model.parameter_names();
-    let values = model.parameter_values();
-    eval_expr(e, &|n| {
-        names.iter().position(|p| *p == n).map(|i| values[i])
-    })
-    .map_err(|d| d.message)
+    eval_expr(e, &parameter_lookup(model)).map_err(|d| d.message)
 }
 
-/// Evaluates a function of the parameters, coordinates, rates and `t` at `(t, y)`.
-fn state_value(e: &Expr, model: &dyn ModelInfo, t: f64, y: &[f64]) -> Result<f64, String> {
-    let names = model.parameter_names();
-    let values = model.parameter_values();
+/// Evaluates a function of the parameters (`parameters`), coordinates, rates and `t` at
+/// `(t, y)` of `model`.
+fn state_value(
+    e: &Expr,
+    model: &dyn ModelInfo,
+    parameters: &dyn Fn(&str) -> Option<f64>,
+    t: f64,
+    y: &[f64],
+) -> Result<f64, String> {
     let coordinates = model.coordinate_names();
     let n = coordinates.len();
     eval_expr(e, &|name| {
         if name == "t" {
             return Some(t);
         }
-        if let Some(i) = names.iter().position(|p| *p == name) {
-            return Some(values[i]);
+        if let Some(v) = parameters(name) {
+            return Some(v);
         }
         if let Some(i) = coordinates.iter().position(|c| *c == name) {
             return Some(y[i]);
@@ -435,31 +430,6 @@ fn state_value(e: &Expr, model: &dyn ModelInfo, t: f64, y: &[f64]) -> Result<f64
             .map(|i| y[n + i])
     })
     .map_err(|d| d.message)
-}
-
-/// The equilibrium named `at` (default: the model's first, else q = 0), its linearisation and
-/// normal modes.
-fn operating_point(
-    model: &dyn ModelInfo,
-    at: Option<&str>,
-) -> Result<(String, Vec<f64>, eomgen::Linearization, eomgen::NormalModes), String> {
-    let named = model.equilibrium_guesses();
-    let (label, guess) = match at {
-        Some(name) => named
-            .iter()
-            .find(|(n, _)| *n == name)
-            .map(|(n, q)| (n.to_string(), q.clone()))
-            .ok_or_else(|| format!("no equilibrium `{name}`"))?,
-        None => named
-            .first()
-            .map(|(n, q)| (n.to_string(), q.clone()))
-            .unwrap_or_else(|| ("q = 0".to_string(), vec![0.0; model.num_dofs()])),
-    };
-    let equilibrium = find_equilibrium(model, &guess, 0.0).map_err(|e| e.to_string())?;
-    let lin = linearize(model, &equilibrium.q, &vec![0.0; model.num_dofs()], 0.0)
-        .map_err(|e| e.to_string())?;
-    let modes = normal_modes(&lin).map_err(|e| e.to_string())?;
-    Ok((label, equilibrium.q, lin, modes))
 }
 
 /// Rows comparing a list of computed modal values with a `natural_frequencies:` or
@@ -514,28 +484,35 @@ fn report_model(source: &Source, dir: &Path) -> ModelReport {
     let started = Instant::now();
     let file = &source.file;
     let mut model = (source.entry.make)();
-    let name = model.name().to_string();
-    let mut checks: Vec<CheckRow> = Vec::new();
-    let mut notes: Vec<String> = Vec::new();
-    let mut figures: Vec<Figure> = Vec::new();
+    let mut report = ModelReport {
+        name: model.name().to_string(),
+        description: model.description().to_string(),
+        header: header_comment(&source.text),
+        dof: model.num_dofs(),
+        equations: Vec::new(),
+        figures: Vec::new(),
+        animation: None,
+        checks: Vec::new(),
+        notes: Vec::new(),
+        time_s: 0.0,
+    };
 
     // The equations, derived at run time from the file, as MathML.
-    let equations = match SymbolicModel::from_file(file) {
+    match SymbolicModel::from_file(file) {
         Ok(mut symbolic) => {
             let eom = Lagrange.derive(&mut symbolic);
-            equations_mathml(&mut symbolic, &eom)
+            report.equations = equations_mathml(&mut symbolic, &eom);
         }
-        Err(d) => {
-            notes.push(super::equations::render(&source.display, &source.text, &d).message);
-            Vec::new()
-        }
-    };
+        Err(d) => report
+            .notes
+            .push(super::equations::render(&source.display, &source.text, &d).message),
+    }
 
     // Generic: the derivations agree (the checks of `eomgen check`).
     match check_model(file, DERIVATION_STATES, 0x5EED) {
         Ok(r) => {
             for c in &r.comparisons {
-                checks.push(CheckRow::compare(
+                report.checks.push(CheckRow::compare(
                     format!(
                         "derivations agree: {} vs {} (max relative q̈ difference)",
                         c.a, c.b
@@ -546,16 +523,16 @@ fn report_model(source: &Source, dir: &Path) -> ModelReport {
                 ));
             }
             if let Some(p) = &r.power_balance {
-                checks.push(CheckRow::compare(
+                report.checks.push(CheckRow::compare(
                     "power balance dE/dt = Q·q̇ (max relative residual)",
                     Ok(p.max_rel_residual),
                     0.0,
                     DERIVATION_TOLERANCE,
                 ));
             }
-            notes.extend(r.notes.iter().cloned());
+            report.notes.extend(r.notes.iter().cloned());
         }
-        Err(d) => checks.push(CheckRow::compare(
+        Err(d) => report.checks.push(CheckRow::compare(
             "derivations agree",
             Err(super::equations::render(&source.display, &source.text, &d).message),
             0.0,
@@ -563,30 +540,45 @@ fn report_model(source: &Source, dir: &Path) -> ModelReport {
         )),
     }
 
-    let y0 = match model.consistent_initial_state() {
-        Ok(y) => y,
-        Err(e) => {
-            checks.push(CheckRow::compare(
-                "consistent initial state",
-                Err(format!(
-                    "constraint {} keeps a residual of {:.3e}",
-                    e.constraint, e.residual
-                )),
-                0.0,
-                0.0,
-            ));
-            return finish(
-                source,
-                model.as_ref(),
-                equations,
-                figures,
-                checks,
-                notes,
-                started,
-            );
-        }
-    };
-    let mut runs = Runs { done: Vec::new() };
+    match model.consistent_initial_state() {
+        Ok(y0) => motion_checks(source, model.as_mut(), &y0, dir, &mut report),
+        Err(e) => report.checks.push(CheckRow::compare(
+            "consistent initial state",
+            Err(format!(
+                "constraint {} keeps a residual of {:.3e}",
+                e.constraint, e.residual
+            )),
+            0.0,
+            0.0,
+        )),
+    }
+    report.time_s = started.elapsed().as_secs_f64();
+    report
+}
+
+/// The checks and figures that need a motion or an equilibrium of `model` (from the
+/// consistent initial state `y0`), added to `report`; the figures and the animation go into
+/// `dir/<name>/`.
+fn motion_checks(
+    source: &Source,
+    model: &mut dyn ModelInfo,
+    y0: &[f64],
+    dir: &Path,
+    report: &mut ModelReport,
+) {
+    let file = &source.file;
+    let name = report.name.clone();
+    let ModelReport {
+        checks,
+        figures,
+        notes,
+        ..
+    } = report;
+    let mut runs: Memo<Run, Solution> = Memo::new();
+    let simulated = |run: &Run| simulate(&name, *run, None);
+    let mut operating_points: Memo<Option<String>, OperatingPoint> = Memo::new();
+    let operating_point =
+        |at: &Option<String>| operating_point_of(&name, at.as_deref(), &[]).map_err(|e| e.message);
     let default_run = Run::default();
 
     // Figures of the default run.
@@ -596,41 +588,37 @@ fn report_model(source: &Source, dir: &Path) -> ModelReport {
     }
     let mut drawn: Vec<(&str, String, Result<(), String>)> = Vec::new();
     let path = |file: &str| model_dir.join(file).to_string_lossy().to_string();
-    match runs.get(model.as_mut(), &y0, default_run) {
+    match runs.get(default_run, simulated) {
         Ok(solution) => {
-            let m = model.as_ref();
             let run = default_run.describe();
             drawn.push((
                 "time.svg",
                 format!("Coordinates against time ({run})"),
-                plot::time_histories(&path("time.svg"), m, solution),
+                plot::time_histories(&path("time.svg"), model, solution),
             ));
             drawn.push((
                 "phase.svg",
                 "Phase portrait: each rate against its coordinate".to_string(),
-                plot::phase_portrait(&path("phase.svg"), m, solution),
+                plot::phase_portrait(&path("phase.svg"), model, solution),
             ));
             drawn.push((
                 "energy.svg",
                 "Energy drift E(t) − E(0)".to_string(),
-                plot::energy_drift(&path("energy.svg"), m, solution),
+                plot::energy_drift(&path("energy.svg"), model, solution),
             ));
+            if !model.constraint_names().is_empty() {
+                let drift: Vec<(f64, f64)> = solution
+                    .iter()
+                    .map(|(t, y)| model.constraint_drift(t, y))
+                    .collect();
+                drawn.push((
+                    "constraints.svg",
+                    "Constraint drift max |Φ|, max |Φ̇|, no stabilisation".to_string(),
+                    plot::constraint_drift(&path("constraints.svg"), &name, &solution.t, &drift),
+                ));
+            }
         }
         Err(e) => notes.push(format!("no figures: {e}")),
-    }
-    if !model.constraint_names().is_empty()
-        && let Ok(solution) = runs.get(model.as_mut(), &y0, default_run)
-    {
-        let solution = solution.clone();
-        let drift: Vec<(f64, f64)> = solution
-            .iter()
-            .map(|(t, y)| model.constraint_drift(t, y))
-            .collect();
-        drawn.push((
-            "constraints.svg",
-            "Constraint drift max |Φ|, max |Φ̇|, no stabilisation".to_string(),
-            plot::constraint_drift(&path("constraints.svg"), &name, &solution.t, &drift),
-        ));
     }
     for (file, caption, result) in drawn {
         match result {
@@ -650,8 +638,8 @@ fn report_model(source: &Source, dir: &Path) -> ModelReport {
             .map_or((DEFAULT_ENERGY_DRIFT, default_run), |d| {
                 (d.max, Run::of(&d.run))
             });
-        let computed = runs.get(model.as_mut(), &y0, run).and_then(|s| {
-            EnergyReport::new(model.as_ref(), &y0, s)
+        let computed = runs.get(run, simulated).and_then(|s| {
+            EnergyReport::new(model, y0, s)
                 .drift
                 .ok_or_else(|| "no samples".to_string())
         });
@@ -674,7 +662,7 @@ fn report_model(source: &Source, dir: &Path) -> ModelReport {
             .map_or((DEFAULT_CONSTRAINT_DRIFT, default_run), |d| {
                 (d.max, Run::of(&d.run))
             });
-        let computed = runs.get(model.as_mut(), &y0, run).cloned().map(|s| {
+        let computed = runs.get(run, simulated).map(|s| {
             s.iter()
                 .map(|(t, y)| {
                     let (p, v) = model.constraint_drift(t, y);
@@ -694,36 +682,33 @@ fn report_model(source: &Source, dir: &Path) -> ModelReport {
     }
 
     // Reference values stated in the file.
+    let at_of = |check: &ModalCheck| check.at.as_ref().map(|a| a.value.clone());
     if let Some(check) = &file.checks.natural_frequencies {
-        let computed = operating_point(model.as_ref(), check.at.as_ref().map(|a| a.value.as_str()))
-            .map(|(label, _, _, modes)| (label, modes.natural_frequencies));
+        let computed = operating_points
+            .get(at_of(check), operating_point)
+            .map(|op| (op.label.clone(), op.modes.natural_frequencies.clone()));
         checks.extend(modal_rows(
             "natural_frequencies",
             " (rad/s)",
             check,
-            model.as_ref(),
+            model,
             computed,
         ));
     }
     if let Some(check) = &file.checks.damping_ratios {
-        let computed = operating_point(model.as_ref(), check.at.as_ref().map(|a| a.value.as_str()))
-            .and_then(|(label, _, lin, _)| {
-                damped_modes(&lin)
-                    .map(|d| (label, d.iter().map(|m| m.1).collect()))
+        let computed = operating_points
+            .get(at_of(check), operating_point)
+            .and_then(|op| {
+                damped_modes(&op.lin)
+                    .map(|d| (op.label.clone(), d.iter().map(|m| m.1).collect()))
                     .map_err(|e| e.to_string())
             });
-        checks.extend(modal_rows(
-            "damping_ratios",
-            "",
-            check,
-            model.as_ref(),
-            computed,
-        ));
+        checks.extend(modal_rows("damping_ratios", "", check, model, computed));
     }
     if let Some(check) = &file.checks.period {
         let run = Run::of(&check.run);
         let event = check.event.value.as_str();
-        let computed = runs.get(model.as_mut(), &y0, run).and_then(|s| {
+        let computed = runs.get(run, simulated).and_then(|s| {
             let times: Vec<f64> = s
                 .events
                 .iter()
@@ -743,19 +728,19 @@ fn report_model(source: &Source, dir: &Path) -> ModelReport {
             "period between the last two `{event}` events (s) ({})",
             run.describe()
         );
-        match expected(&check.value, model.as_ref()) {
+        match expected(&check.value, model) {
             Ok(x) => checks.push(CheckRow::compare(what, computed, x, check.tolerance)),
             Err(e) => checks.push(CheckRow::compare(what, Err(e), f64::NAN, check.tolerance)),
         }
     }
     if let Some(check) = &file.checks.final_state {
-        match expected(&check.t, model.as_ref()) {
+        match expected(&check.t, model) {
             Ok(t) if t.is_finite() && t > 0.0 => {
                 let run = Run {
                     t_end: t,
                     ..Run::of(&check.run)
                 };
-                let state = simulate(model.as_mut(), &y0, run, Some(vec![t])).and_then(|s| {
+                let state = simulate(&name, run, Some(vec![t])).and_then(|s| {
                     s.last()
                         .filter(|(ts, _)| *ts == t)
                         .map(|(_, y)| y.to_vec())
@@ -776,7 +761,7 @@ fn report_model(source: &Source, dir: &Path) -> ModelReport {
                             .ok_or_else(|| format!("`{}` is not a coordinate or rate", k.value))
                     });
                     let what = format!("{} at t = {} s ({})", k.value, short(t), run.describe());
-                    match expected(e, model.as_ref()) {
+                    match expected(e, model) {
                         Ok(x) => checks.push(CheckRow::compare(what, computed, x, check.tolerance)),
                         Err(err) => checks.push(CheckRow::compare(
                             what,
@@ -801,12 +786,13 @@ fn report_model(source: &Source, dir: &Path) -> ModelReport {
             )),
         }
     }
+    let parameters = parameter_lookup(model);
     for c in &file.checks.conserved {
-        let computed = runs.get(model.as_mut(), &y0, default_run).and_then(|s| {
+        let computed = runs.get(default_run, simulated).and_then(|s| {
             let mut q0 = None;
             let mut worst: f64 = 0.0;
             for (t, y) in s.iter() {
-                let q = state_value(&c.value, model.as_ref(), t, y)?;
+                let q = state_value(&c.value, model, &parameters, t, y)?;
                 let q0 = *q0.get_or_insert(q);
                 worst = worst.max((q - q0).abs() / q0.abs().max(1.0));
             }
@@ -824,27 +810,25 @@ fn report_model(source: &Source, dir: &Path) -> ModelReport {
         ));
     }
 
-    // Mode shapes where `eomgen modes` applies: named equilibria and points to draw on.
+    // Mode shapes where `eomgen modes` applies: named equilibria and points to draw on (at
+    // the equilibrium of the frequency check).
     if !model.equilibrium_guesses().is_empty() && !model.point_names().is_empty() {
-        let at = file
-            .checks
-            .natural_frequencies
-            .as_ref()
-            .and_then(|c| c.at.as_ref())
-            .map(|a| a.value.as_str());
-        match operating_point(model.as_ref(), at) {
-            Ok((label, q, lin, modes)) => {
-                let shapes = lin.to_coordinates(&modes.mode_shapes);
+        let at = file.checks.natural_frequencies.as_ref().and_then(at_of);
+        match operating_points.get(at, operating_point) {
+            Ok(op) => {
+                let shapes = op.lin.to_coordinates(&op.modes.mode_shapes);
                 let prefix = model_dir.join("shape.svg");
                 match super::mode_plot::mode_charts(
                     &prefix.to_string_lossy(),
-                    model.as_ref(),
-                    &q,
-                    &modes,
+                    model,
+                    &op.equilibrium.q,
+                    &op.modes,
                     &shapes,
                 ) {
                     Ok(paths) => {
-                        for (k, path) in paths.iter().enumerate() {
+                        for (k, (path, omega)) in
+                            paths.iter().zip(&op.modes.natural_frequencies).enumerate()
+                        {
                             let file_name = Path::new(path)
                                 .file_name()
                                 .map(|f| f.to_string_lossy().to_string())
@@ -852,13 +836,9 @@ fn report_model(source: &Source, dir: &Path) -> ModelReport {
                             figures.push(Figure {
                                 file: format!("{name}/{file_name}"),
                                 caption: format!(
-                                    "Mode {} at {label}: ω = {:.6} rad/s",
+                                    "Mode {} at {}: ω = {omega:.6} rad/s",
                                     k + 1,
-                                    modes
-                                        .natural_frequencies
-                                        .get(k)
-                                        .copied()
-                                        .unwrap_or(f64::NAN)
+                                    op.label
                                 ),
                             });
                         }
@@ -869,18 +849,7 @@ fn report_model(source: &Source, dir: &Path) -> ModelReport {
             Err(e) => notes.push(format!("mode shapes: {e}")),
         }
     }
-    let animation = animation(&name, &model_dir, &mut notes);
-    let mut report = finish(
-        source,
-        model.as_ref(),
-        equations,
-        figures,
-        checks,
-        notes,
-        started,
-    );
-    report.animation = animation;
-    report
+    report.animation = animation(&name, &model_dir, &mut report.notes);
 }
 
 /// Writes the model's animation, `NAME/animation.html` (`eomgen animate NAME` with the
@@ -921,29 +890,6 @@ fn animation(name: &str, model_dir: &Path, notes: &mut Vec<String>) -> Option<St
             notes.push(format!("animation: {}", e.message));
             None
         }
-    }
-}
-
-fn finish(
-    source: &Source,
-    model: &dyn ModelInfo,
-    equations: Vec<String>,
-    figures: Vec<Figure>,
-    checks: Vec<CheckRow>,
-    notes: Vec<String>,
-    started: Instant,
-) -> ModelReport {
-    ModelReport {
-        name: model.name().to_string(),
-        description: model.description().to_string(),
-        header: header_comment(&source.text),
-        dof: model.num_dofs(),
-        equations,
-        figures,
-        animation: None,
-        checks,
-        notes,
-        time_s: started.elapsed().as_secs_f64(),
     }
 }
 

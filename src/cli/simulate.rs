@@ -61,6 +61,15 @@ impl Method {
             Method::Radau5 => Box::new(RadauIIA5::new()),
         }
     }
+
+    /// Whether the method controls its step by `--rtol`/`--atol` (otherwise it takes the
+    /// fixed step `--dt`).
+    pub(crate) fn is_adaptive(self) -> bool {
+        matches!(
+            self,
+            Method::Bs32 | Method::Dp54 | Method::Dop853 | Method::Radau5
+        )
+    }
 }
 
 /// Drift control of a constrained model (`--stabilization`).
@@ -172,6 +181,17 @@ impl IntegrationArgs {
         <Defaults as clap::Parser>::try_parse_from(["eomgen"])
             .map(|d| d.args)
             .map_err(|e| CliError::failure(format!("default integration options: {e}")))
+    }
+
+    /// How the method controls its step: `rtol 1e-8, atol 1e-10` for an adaptive method,
+    /// `fixed step dt = 1e-2 s` otherwise (`--dt`, default `t_end/1000`).
+    pub(crate) fn step_control(&self) -> String {
+        if self.method.is_adaptive() {
+            format!("rtol {:e}, atol {:e}", self.rtol, self.atol)
+        } else {
+            let dt = self.dt.unwrap_or(self.t_end / 1000.0);
+            format!("fixed step dt = {dt:e} s")
+        }
     }
 }
 
@@ -436,10 +456,7 @@ pub(crate) fn failure_error(
 /// What to try after a failed integration (issue 8, item 3), by the reason and the method.
 fn failure_hint(error: &IntegrationError, method: Method) -> &'static str {
     let explicit = !matches!(method, Method::Radau5 | Method::ImplicitMidpoint);
-    let adaptive = matches!(
-        method,
-        Method::Bs32 | Method::Dp54 | Method::Dop853 | Method::Radau5
-    );
+    let adaptive = method.is_adaptive();
     match error {
         IntegrationError::StepSizeTooSmall { .. } | IntegrationError::TooManySteps { .. }
             if explicit && adaptive =>
@@ -525,19 +542,7 @@ fn print_summary(
         model.num_dofs(),
         model.description()
     );
-    let adaptive = matches!(
-        args.method,
-        Method::Bs32 | Method::Dp54 | Method::Dop853 | Method::Radau5
-    );
-    if adaptive {
-        println!(
-            "method     {method} (rtol {:e}, atol {:e})",
-            args.rtol, args.atol
-        );
-    } else {
-        let dt = args.dt.unwrap_or(args.t_end / 1000.0);
-        println!("method     {method} (fixed step dt = {dt:e} s)");
-    }
+    println!("method     {method} ({})", args.step_control());
     if let Some((t, y)) = solution.last() {
         let n = model.num_dofs();
         let names = model.coordinate_names();
