@@ -577,8 +577,13 @@ fn motion_checks(
     let mut runs: Memo<Run, Solution> = Memo::new();
     let simulated = |run: &Run| simulate(&name, *run, None);
     let mut operating_points: Memo<Option<String>, OperatingPoint> = Memo::new();
-    let operating_point =
-        |at: &Option<String>| operating_point_of(&name, at.as_deref(), &[]).map_err(|e| e.message);
+    let operating_point = |at: &Option<String>| {
+        let point = super::modes::OperatingPointArgs {
+            at: at.clone(),
+            set: Vec::new(),
+        };
+        operating_point_of(&name, &point).map_err(|e| e.message)
+    };
     let default_run = Run::default();
 
     // Figures of the default run.

@@ -210,14 +210,6 @@ fn display_name(method: Method) -> &'static str {
     }
 }
 
-/// Whether the method controls its step by a tolerance (otherwise it takes `h = T/N`).
-fn is_adaptive(method: Method) -> bool {
-    matches!(
-        method,
-        Method::Bs32 | Method::Dp54 | Method::Dop853 | Method::Radau5
-    )
-}
-
 /// Parses `--tols`: `A..B` (every decade from A towards B, either direction) or a comma list.
 /// Returned loosest first, without repeats.
 ///
@@ -573,7 +565,7 @@ pub fn run(args: &WorkPrecisionArgs) -> Result<(), CliError> {
     let results: Vec<MethodRuns> = methods
         .iter()
         .map(|&method| {
-            let settings: Vec<Setting> = if is_adaptive(method) {
+            let settings: Vec<Setting> = if method.is_adaptive() {
                 tols.iter().map(|&tol| Setting::Tolerance(tol)).collect()
             } else {
                 step_counts
@@ -667,7 +659,7 @@ impl Study<'_> {
                     "method": cli_name(r.method),
                     "name": display_name(r.method),
                     "order": r.method.integrator().order(),
-                    "adaptive": is_adaptive(r.method),
+                    "adaptive": r.method.is_adaptive(),
                     "runs": runs,
                     "at_target": self.target_json(&r.at_target),
                 })
