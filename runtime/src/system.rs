@@ -346,10 +346,39 @@ impl<S: MechanicalSystem<N>, const N: usize> FirstOrder<S, N> {
 /// unlike nalgebra's Cholesky it takes no square roots and one division per column (the
 /// reciprocal pivots are reused), which on the double pendulum shortened the dependency chain
 /// of `q̈ = M⁻¹F` from two square roots and five divisions to two divisions.
+///
+/// One and two degrees of freedom are solved in closed form instead: `x = f/m`, and for
+/// `M = [a b; b c]` Cramer's rule `x = [c f₀ − b f₁, a f₁ − b f₀] / (a c − b²)`, positive
+/// definite exactly when `a > 0` and `a c − b² > 0` (Sylvester's criterion). Its determinant
+/// is the product `a · d₁` of the two pivots above, so it is as accurate, but the two
+/// numerators are formed while the one division runs, where the factorisation divides twice
+/// in sequence; an integration waits for each right-hand side before the next stage can
+/// start, and this shorter chain made a DOP853 run of the double pendulum ~4 % faster.
 pub fn solve_spd<const N: usize>(
     m: &SMatrix<f64, N, N>,
     f: &SVector<f64, N>,
 ) -> Option<SVector<f64, N>> {
+    match N {
+        1 => {
+            let a = m[(0, 0)];
+            // Not positive, or NaN.
+            return (a > 0.0).then(|| f / a);
+        }
+        2 => {
+            let (a, b, c) = (m[(0, 0)], m[(1, 0)], m[(1, 1)]);
+            let det = a * c - b * b;
+            // Not positive definite, or NaN.
+            if a.is_nan() || a <= 0.0 || det.is_nan() || det <= 0.0 {
+                return None;
+            }
+            let inverse = 1.0 / det;
+            let mut x = *f;
+            x[0] = (c * f[0] - b * f[1]) * inverse;
+            x[1] = (a * f[1] - b * f[0]) * inverse;
+            return Some(x);
+        }
+        _ => {}
+    }
     let mut l = [[0.0f64; N]; N];
     let mut inv_d = [0.0f64; N];
     let mut d = [0.0f64; N];
@@ -802,13 +831,56 @@ pub struct ConstraintValues {
 
 #[cfg(test)]
 mod tests {
-    use nalgebra::{Matrix3, Vector3};
+    use nalgebra::{Matrix2, Matrix3, Vector2, Vector3};
 
     use super::*;
 
     /// `solve_spd` against nalgebra's Cholesky solve on a positive definite `M = BᵀB + I`
     /// (condition ~10): the two backward-stable solves agree to a few ulps of `|x|`, so 1e-13
     /// relative; and `None` for an indefinite, a singular and a NaN matrix.
+    #[test]
+    fn solve_spd_closed_forms_match_cholesky_and_refuse_what_is_not_positive_definite() {
+        // 2 × 2, well and badly conditioned (κ ≈ 4e8): the closed form against nalgebra's
+        // Cholesky to a few ulps of κ.
+        for (m, f) in [
+            (Matrix2::new(2.3, -0.7, -0.7, 0.9), Vector2::new(0.4, -1.1)),
+            (
+                Matrix2::new(1.0, 0.99999999, 0.99999999, 1.0),
+                Vector2::new(1.0, 2.0),
+            ),
+        ] {
+            let x = solve_spd(&m, &f).unwrap();
+            let expected = nalgebra::Cholesky::new(m).unwrap().solve(&f);
+            let condition = m.norm() * m.try_inverse().unwrap().norm();
+            assert!(
+                (x - expected).amax() <= 8.0 * f64::EPSILON * condition * expected.amax(),
+                "{x} vs {expected}"
+            );
+            assert!(
+                (m * x - f).amax() <= 1e-12 * f.amax() * condition,
+                "residual"
+            );
+        }
+        for bad in [
+            Matrix2::new(1.0, 2.0, 2.0, 1.0),
+            Matrix2::new(1.0, 1.0, 1.0, 1.0),
+            Matrix2::new(-1.0, 0.0, 0.0, -1.0),
+            Matrix2::new(f64::NAN, 0.0, 0.0, 1.0),
+            Matrix2::new(1.0, 0.0, 0.0, f64::NAN),
+        ] {
+            assert_eq!(solve_spd(&bad, &Vector2::new(1.0, 1.0)), None, "{bad}");
+        }
+        let one = nalgebra::Matrix1::new(4.0);
+        assert_eq!(
+            solve_spd(&one, &nalgebra::Vector1::new(2.0)),
+            Some(nalgebra::Vector1::new(0.5))
+        );
+        for bad in [0.0, -1.0, f64::NAN] {
+            let m = nalgebra::Matrix1::new(bad);
+            assert_eq!(solve_spd(&m, &nalgebra::Vector1::new(1.0)), None);
+        }
+    }
+
     #[test]
     fn solve_spd_matches_cholesky_and_refuses_what_is_not_positive_definite() {
         let b = Matrix3::new(1.0, 0.3, -0.7, 0.2, 1.5, 0.4, -0.6, 0.1, 0.9);

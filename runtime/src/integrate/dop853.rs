@@ -16,7 +16,7 @@ use super::error::IntegrationFailure;
 use super::explicit_rk::{combine, weighted_sum as stage_sum};
 use super::options::{ErrorWeights, IntegratorOptions, OutputTimes};
 use super::solution::Solution;
-use super::stepper::{CheckedRhs, StepEnds, StepFailure, Stepper};
+use super::stepper::{CheckedRhs, StepEnds, StepFailure, Stepper, first_non_finite};
 
 /// Number of stages of a step (the twelfth at `c = 1`; `F` at the new state is a thirteenth,
 /// shared with the next step).
@@ -428,6 +428,14 @@ impl Stepper for Dop853Stepper {
         let h = t_new - t;
         self.ends.t_new = t_new;
         self.dense_ready = false;
+        // Row r of k is stage r + 1.
+        let stage_time = |r: usize| {
+            if C[r + 1] == 1.0 {
+                t_new
+            } else {
+                t + C[r + 1] * h
+            }
+        };
         // Stages 0–11: f, then rows 0–10 of k, contiguous, so the sums run over chunks (the
         // stage-by-stage slicing of `stage(j)` cost ~100 ns per step on the double pendulum).
         for i in 1..STAGES {
@@ -441,15 +449,18 @@ impl Stepper for Dop853Stepper {
                 earlier,
             );
             let t_stage = if C[i] == 1.0 { t_new } else { t + C[i] * h };
-            rhs.eval(t_stage, &self.scratch, &mut rest[..n])?;
+            if let Err(failure) = rhs.eval_stage(t_stage, &self.scratch, &mut rest[..n]) {
+                return Err(CheckedRhs::stage_failure(earlier, n, stage_time, failure));
+            }
         }
         let stages = &self.k[..(STAGES - 1) * n];
+        CheckedRhs::check_stages(stages, n, stage_time)?;
         let f = &self.ends.f;
         stage_sum(&mut self.increment, &B, f, stages, n);
         for ((y_new, &yi), &inc) in self.y_new.iter_mut().zip(&self.ends.y).zip(&self.increment) {
             *y_new = yi + h * inc;
         }
-        if let Some(index) = self.y_new.iter().position(|v| !v.is_finite()) {
+        if let Some(index) = first_non_finite(&self.y_new) {
             return Err(StepFailure::NonFiniteState { t: t_new, index });
         }
         if !estimate_error {

@@ -5,7 +5,7 @@ use std::mem::swap;
 
 use super::dense_output::{DenseOutput, hermite};
 use super::options::ErrorWeights;
-use super::stepper::{CheckedRhs, StepEnds, StepFailure, Stepper};
+use super::stepper::{CheckedRhs, StepEnds, StepFailure, Stepper, first_non_finite};
 use super::tableau::Tableau;
 
 /// An explicit Runge–Kutta method given by its tableau, with all buffers allocated once.
@@ -212,7 +212,16 @@ impl Stepper for ExplicitRk {
         let t = self.ends.t;
         let h = t_new - t;
         self.ends.t_new = t_new;
-        for i in 1..s {
+        // Row r of k is stage r + 1.
+        let c = tableau.c();
+        let stage_time = |r: usize| {
+            if c[r + 1] == 1.0 {
+                t_new
+            } else {
+                t + c[r + 1] * h
+            }
+        };
+        for (i, &ci) in c.iter().enumerate().take(s).skip(1) {
             let (earlier, rest) = self.k.split_at_mut((i - 1) * n);
             let ki = &mut rest[..n];
             // The last stage of an FSAL tableau is evaluated at the candidate itself.
@@ -222,10 +231,12 @@ impl Stepper for ExplicitRk {
                 &mut self.scratch
             };
             combine(input, &self.ends.y, h, tableau.a(i), &self.ends.f, earlier);
-            let c = tableau.c()[i];
-            let t_stage = if c == 1.0 { t_new } else { t + c * h };
-            rhs.eval(t_stage, input, ki)?;
+            let t_stage = if ci == 1.0 { t_new } else { t + ci * h };
+            if let Err(failure) = rhs.eval_stage(t_stage, input, ki) {
+                return Err(CheckedRhs::stage_failure(earlier, n, stage_time, failure));
+            }
         }
+        CheckedRhs::check_stages(&self.k, n, stage_time)?;
         if !tableau.is_fsal() {
             combine(
                 &mut self.y_new,
@@ -236,7 +247,7 @@ impl Stepper for ExplicitRk {
                 &self.k,
             );
         }
-        if let Some(index) = self.y_new.iter().position(|v| !v.is_finite()) {
+        if let Some(index) = first_non_finite(&self.y_new) {
             return Err(StepFailure::NonFiniteState { t: t_new, index });
         }
         let (true, Some(e)) = (estimate_error, tableau.error_weights()) else {

@@ -113,6 +113,29 @@ impl StepFailure {
     }
 }
 
+/// Index of the first entry of `values` that is NaN or infinite, if any.
+///
+/// The common case (all finite) takes one branch: `0 · x` is ±0 for a finite `x` and NaN for
+/// ±∞ or NaN, so the sum of those products (in four independent partial sums) is 0 exactly
+/// when every entry is finite; otherwise the entry is searched for.
+#[inline]
+pub(crate) fn first_non_finite(values: &[f64]) -> Option<usize> {
+    let chunks = values.chunks_exact(4);
+    let mut total = chunks.remainder().iter().fold(0.0, |s, &x| s + 0.0 * x);
+    let mut partial = [0.0f64; 4];
+    for chunk in chunks {
+        for (p, &x) in partial.iter_mut().zip(chunk) {
+            *p += 0.0 * x;
+        }
+    }
+    total += (partial[0] + partial[1]) + (partial[2] + partial[3]);
+    if total == 0.0 {
+        None
+    } else {
+        values.iter().position(|v| !v.is_finite())
+    }
+}
+
 /// The system as a stepper sees it: every evaluation of `F` counted and checked for
 /// finiteness, so that no method can forget either; Jacobians (exact, or differenced when the
 /// system has none) and factorisations of iteration matrices counted as well.
@@ -212,13 +235,76 @@ impl<'a> CheckedRhs<'a> {
         self.system
             .rhs(t, y, dy)
             .map_err(|error| StepFailure::Rhs { t, error })?;
-        match dy.iter().position(|v| !v.is_finite()) {
+        match first_non_finite(dy) {
             Some(index) => Err(StepFailure::Rhs {
                 t,
                 error: RhsError::NonFinite { index },
             }),
             None => Ok(()),
         }
+    }
+
+    /// Evaluates stage `dy = F(t, y)` of an explicit Runge–Kutta step, counted but *not*
+    /// checked for finiteness: the stepper checks all its stages at once with
+    /// [`check_stages`](Self::check_stages) before it uses any of them for the new state or
+    /// the error estimate, and hands a failure of a later stage to
+    /// [`stage_failure`](Self::stage_failure), so that a stage that was not finite is still
+    /// reported at its own time and component.
+    ///
+    /// A search for non-finite entries after every evaluation branches on data that is ready
+    /// only when `F` is; on the double pendulum, checking once per attempt instead made DOP853
+    /// and DP5(4) runs ~2 % faster (interleaved best-of-300 timings against ode_solvers on the
+    /// same right-hand side, issue 6).
+    ///
+    /// # Errors
+    /// [`StepFailure::Rhs`] at `t` if the system reports an error.
+    #[inline]
+    pub(crate) fn eval_stage(
+        &mut self,
+        t: f64,
+        y: &[f64],
+        dy: &mut [f64],
+    ) -> Result<(), StepFailure> {
+        self.evals += 1;
+        self.system
+            .rhs(t, y, dy)
+            .map_err(|error| StepFailure::Rhs { t, error })
+    }
+
+    /// Checks stages evaluated by [`eval_stage`](Self::eval_stage): `stages` holds rows of
+    /// `dim` values, row `r` evaluated at time `stage_time(r)`.
+    ///
+    /// # Errors
+    /// [`StepFailure::Rhs`] with [`RhsError::NonFinite`] for the first row with a NaN or
+    /// infinite entry, at that row's time (index: the component).
+    pub(crate) fn check_stages(
+        stages: &[f64],
+        dim: usize,
+        stage_time: impl Fn(usize) -> f64,
+    ) -> Result<(), StepFailure> {
+        match first_non_finite(stages) {
+            None => Ok(()),
+            Some(at) => Err(StepFailure::Rhs {
+                t: stage_time(at / dim),
+                error: RhsError::NonFinite { index: at % dim },
+            }),
+        }
+    }
+
+    /// The failure to report when evaluating a stage failed with `failure` after the stages
+    /// in `earlier` (as for [`check_stages`](Self::check_stages)): a non-finite earlier stage
+    /// comes first, since the later stage was evaluated at an input made from it (a singular
+    /// mass matrix at a NaN configuration is then a symptom, and the step can be retried
+    /// smaller).
+    pub(crate) fn stage_failure(
+        earlier: &[f64],
+        dim: usize,
+        stage_time: impl Fn(usize) -> f64,
+        failure: StepFailure,
+    ) -> StepFailure {
+        Self::check_stages(earlier, dim, stage_time)
+            .err()
+            .unwrap_or(failure)
     }
 
     /// The Jacobian `∂F/∂y` at `(t, y)` into `jac` (`dim × dim`): the system's own, or forward
@@ -339,7 +425,92 @@ pub(crate) trait Stepper: DenseOutput {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::integrate::dop853::Dop853Stepper;
+    use crate::integrate::explicit_rk::ExplicitRk;
+    use crate::integrate::tableau::Tableau;
     use crate::ode::OdeFn;
+
+    #[test]
+    fn first_non_finite_finds_the_first_nan_or_infinity_in_any_position() {
+        for len in 0..11 {
+            let finite: Vec<f64> = (0..len).map(|i| i as f64 * 1e300 - 3e300).collect();
+            assert_eq!(first_non_finite(&finite), None, "{finite:?}");
+            for at in 0..len {
+                for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+                    let mut v = finite.clone();
+                    v[at] = bad;
+                    if at + 1 < len {
+                        v[len - 1] = f64::NAN;
+                    }
+                    assert_eq!(first_non_finite(&v), Some(at), "{v:?}");
+                }
+            }
+        }
+    }
+
+    /// `ẏ = 1`, except that `F` is NaN for `t` in `(0.065, 0.066)`, and that it refuses a NaN
+    /// state as a model with a singular mass matrix there would.
+    struct NanWindow;
+
+    impl OdeSystem for NanWindow {
+        fn dim(&self) -> usize {
+            2
+        }
+
+        fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), RhsError> {
+            if y.iter().any(|v| v.is_nan()) {
+                return Err(RhsError::SingularMassMatrix);
+            }
+            let value = if t > 0.065 && t < 0.066 {
+                f64::NAN
+            } else {
+                1.0
+            };
+            dy.fill(value);
+            Ok(())
+        }
+    }
+
+    /// Stages are checked once per attempt, yet a non-finite stage is reported at its own
+    /// time, as recoverable, and ahead of the failure it causes in a later stage (here the
+    /// stage at `c = 0.651…` of DOP853 and the one at `c = 4/5` of DP5(4); the stages after
+    /// them see NaN inputs).
+    #[test]
+    fn a_non_finite_stage_is_reported_at_its_time_before_what_it_causes() {
+        let weights = ErrorWeights::uniform(2, 1e-6, 1e-6);
+        // DOP853 from t = 0 with h = 0.1: stage 8 (c₈ = 0.6512820512820513) lands in the
+        // window; the following stages see NaN inputs.
+        let mut system = NanWindow;
+        let mut rhs = CheckedRhs::new(&mut system);
+        let mut stepper = Dop853Stepper::new(2);
+        stepper.reset(&mut rhs, 0.0, &[0.0, 0.0]).unwrap();
+        let failure = stepper.attempt(&mut rhs, 0.1, &weights, true).unwrap_err();
+        assert!(failure.is_recoverable());
+        match failure {
+            StepFailure::Rhs {
+                t,
+                error: RhsError::NonFinite { index: 0 },
+            } => assert!((t - 0.06512820512820513).abs() < 1e-15, "t = {t}"),
+            other => panic!("{other:?}"),
+        }
+        // DP5(4) from t = 0 with h = 0.0819: stage c = 4/5 is at 0.06552; its successor
+        // (c = 8/9) sees NaN and refuses it, but the NaN stage is what is reported.
+        let mut system = NanWindow;
+        let mut rhs = CheckedRhs::new(&mut system);
+        let mut stepper = ExplicitRk::new(Tableau::dopri5(), 2);
+        stepper.reset(&mut rhs, 0.0, &[0.0, 0.0]).unwrap();
+        let failure = stepper
+            .attempt(&mut rhs, 0.0819, &weights, true)
+            .unwrap_err();
+        assert!(failure.is_recoverable());
+        match failure {
+            StepFailure::Rhs {
+                t,
+                error: RhsError::NonFinite { index: 0 },
+            } => assert!((t - 0.8 * 0.0819).abs() < 1e-15, "t = {t}"),
+            other => panic!("{other:?}"),
+        }
+    }
 
     /// Without an exact Jacobian, `jacobian` differences `F` (one evaluation per column,
     /// counted) to about √ε relative accuracy; a non-finite entry is reported by its row.
