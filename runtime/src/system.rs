@@ -235,7 +235,8 @@ pub trait MechanicalSystem<const N: usize> {
 
 /// The first-order form `y = [q; q̇]`, `ẏ = [q̇; M⁻¹F]` of a [`MechanicalSystem`].
 ///
-/// `M q̈ = F` is solved at every evaluation by an `L D Lᵀ` factorisation; a mass matrix that is not
+/// `M q̈ = F` is solved at every evaluation by [`solve_spd`] (in closed form for one or two
+/// degrees of freedom, else an `L D Lᵀ` factorisation); a mass matrix that is not
 /// positive definite is [`RhsError::SingularMassMatrix`], a non-finite `q̈` is
 /// [`RhsError::NonFinite`]. No heap allocation.
 ///
