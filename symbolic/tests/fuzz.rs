@@ -2,10 +2,13 @@
 //! corpus is every file in `models/`; each input is one of them with 1–8 random edits
 //! (inserted YAML and expression tokens, deleted, duplicated, swapped or truncated spans,
 //! replaced characters), loaded in full (YAML → schema → checks, every diagnostic rendered),
-//! lowered to expressions when it loads, each of its lines parsed as an expression and each
-//! comment as a unit. The corpus declares `units: SI`, so the dimensional checks run too. A
-//! panic anywhere is a failure; the count of inputs, panics and how many still loaded is
-//! printed.
+//! taken through the whole code generation of `eomgen::model!` when it loads
+//! ([`codegen::generate`]: lowering, both derivations, the mass-matrix checks, the Jacobians,
+//! the printer), each of its lines parsed as an expression and each comment as a unit. The
+//! corpus declares `units: SI`, so the dimensional checks run too. A panic anywhere is a
+//! failure, and so is generated code that is not a Rust file (the printer's own
+//! [`GenerateError::Emit`], or tokens that `syn` does not parse as one); the count of inputs,
+//! failures and how many still loaded is printed.
 //!
 //! Stable Rust has no coverage-guided fuzzer without extra tooling, so this is a seeded
 //! mutation fuzzer (xorshift, deterministic for a seed). `cargo test` runs 3,000 inputs;
@@ -19,7 +22,7 @@ use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::path::PathBuf;
 use std::sync::Mutex;
 
-use eomgen_symbolic::mechanics::SymbolicModel;
+use eomgen_symbolic::codegen::{self, EmitOptions, GenerateError};
 use eomgen_symbolic::model::{Location, load, parser::parse_expr, units::parse_unit};
 
 /// Tokens inserted by the mutator: YAML structure, expression syntax and names that occur
@@ -179,12 +182,27 @@ fn run_one(src: &str, target: fn(&str) -> bool) -> Result<bool, String> {
     })
 }
 
-/// The code under test: the loader, lowering and the expression and unit parsers on one
-/// input. Returns whether the input loaded.
+/// The code under test: the loader, code generation and the expression and unit parsers on
+/// one input. Returns whether the input loaded; panics (a failure of the run) if the generated
+/// code is not a Rust file.
 fn load_everything(src: &str) -> bool {
     let loaded = match load("fuzz.yaml", src) {
         Ok(file) => {
-            let _ = SymbolicModel::from_file(&file);
+            match codegen::generate(&file, &EmitOptions::default()) {
+                Ok(tokens) => {
+                    if let Err(e) = syn::parse2::<syn::File>(tokens) {
+                        panic!("generated code does not parse: {e}");
+                    }
+                }
+                Err(GenerateError::Diagnostics(diagnostics)) => {
+                    for d in &diagnostics {
+                        let _ = d.render("fuzz.yaml", src);
+                    }
+                }
+                Err(GenerateError::Emit(message)) => {
+                    panic!("generated code does not tokenize: {message}")
+                }
+            }
             true
         }
         Err(diagnostics) => {
