@@ -13,7 +13,7 @@ use super::controller::PiController;
 use super::dense_output::{DenseOutput, hermite};
 use super::driver::{self, Control, Problem};
 use super::error::IntegrationFailure;
-use super::explicit_rk::{combine, weighted_sum as stage_sum};
+use super::explicit_rk::{combine, sum_fixed, weighted_sum as stage_sum, write_update};
 use super::options::{ErrorWeights, IntegratorOptions, OutputTimes};
 use super::solution::Solution;
 use super::stepper::{CheckedRhs, StepEnds, StepFailure, Stepper, first_non_finite};
@@ -397,6 +397,106 @@ impl DenseOutput for Dop853Stepper {
     }
 }
 
+impl Dop853Stepper {
+    /// Stage `I` (1 … 11) for `D` components: its input `y + h Σⱼ aᵢⱼ kⱼ` into `scratch`,
+    /// then `F` there into row `I − 1` of `k`, unchecked (see [`CheckedRhs::eval_stage`]).
+    #[inline(always)]
+    fn stage_fixed<const I: usize, const D: usize>(
+        &mut self,
+        rhs: &mut CheckedRhs<'_>,
+        (t, h, t_new): (f64, f64, f64),
+    ) -> Result<(), StepFailure> {
+        let (earlier, rest) = self.k.split_at_mut((I - 1) * D);
+        let sum = sum_fixed::<D>(A[I], &self.ends.f, earlier);
+        write_update::<D>(&mut self.scratch, &self.ends.y, h, &sum);
+        let t_stage = if C[I] == 1.0 { t_new } else { t + C[I] * h };
+        match rhs.eval_stage(t_stage, &self.scratch[..D], &mut rest[..D]) {
+            Ok(()) => Ok(()),
+            Err(failure) => Err(CheckedRhs::stage_failure(
+                earlier,
+                D,
+                |r| stage_time(t, h, t_new, r),
+                failure,
+            )),
+        }
+    }
+
+    /// Stages 1 … 11, then `increment = Σ bᵢ kᵢ` and `y_new = y + h · increment`, for `D`
+    /// components, unrolled: with the stage index and the dimension known to the compiler,
+    /// each stage input is a fixed sequence of multiply–adds with the non-zero coefficients
+    /// of [`A`] as constants, in registers, instead of a loop over the row that tests every
+    /// coefficient. On the double pendulum this executes ~85 fewer instructions per
+    /// evaluation of `F` (callgrind) and made a run ~8 % faster.
+    fn stages_fixed<const D: usize>(
+        &mut self,
+        rhs: &mut CheckedRhs<'_>,
+        t: f64,
+        h: f64,
+        t_new: f64,
+    ) -> Result<(), StepFailure> {
+        let times = (t, h, t_new);
+        self.stage_fixed::<1, D>(rhs, times)?;
+        self.stage_fixed::<2, D>(rhs, times)?;
+        self.stage_fixed::<3, D>(rhs, times)?;
+        self.stage_fixed::<4, D>(rhs, times)?;
+        self.stage_fixed::<5, D>(rhs, times)?;
+        self.stage_fixed::<6, D>(rhs, times)?;
+        self.stage_fixed::<7, D>(rhs, times)?;
+        self.stage_fixed::<8, D>(rhs, times)?;
+        self.stage_fixed::<9, D>(rhs, times)?;
+        self.stage_fixed::<10, D>(rhs, times)?;
+        self.stage_fixed::<11, D>(rhs, times)?;
+        let increment = sum_fixed::<D>(&B, &self.ends.f, &self.k[..(STAGES - 1) * D]);
+        self.increment[..D].copy_from_slice(&increment);
+        write_update::<D>(&mut self.y_new, &self.ends.y, h, &increment);
+        Ok(())
+    }
+
+    /// [`stages_fixed`](Self::stages_fixed) for any dimension. Stages 0–11 are `f`, then
+    /// rows 0–10 of `k`, contiguous, so the sums run over chunks (the stage-by-stage slicing
+    /// of `stage(j)` cost ~100 ns per step on the double pendulum).
+    fn stages_any(
+        &mut self,
+        rhs: &mut CheckedRhs<'_>,
+        t: f64,
+        h: f64,
+        t_new: f64,
+    ) -> Result<(), StepFailure> {
+        let n = self.dim;
+        for i in 1..STAGES {
+            let (earlier, rest) = self.k.split_at_mut((i - 1) * n);
+            combine(
+                &mut self.scratch,
+                &self.ends.y,
+                h,
+                A[i],
+                &self.ends.f,
+                earlier,
+            );
+            let t_stage = if C[i] == 1.0 { t_new } else { t + C[i] * h };
+            if let Err(failure) = rhs.eval_stage(t_stage, &self.scratch, &mut rest[..n]) {
+                let time = |r| stage_time(t, h, t_new, r);
+                return Err(CheckedRhs::stage_failure(earlier, n, time, failure));
+            }
+        }
+        let stages = &self.k[..(STAGES - 1) * n];
+        stage_sum(&mut self.increment, &B, &self.ends.f, stages, n);
+        for ((y_new, &yi), &inc) in self.y_new.iter_mut().zip(&self.ends.y).zip(&self.increment) {
+            *y_new = yi + h * inc;
+        }
+        Ok(())
+    }
+}
+
+/// Time of row `r` of `k` (stage `r + 1`) in an attempt from `t` to `t_new = t + h`.
+fn stage_time(t: f64, h: f64, t_new: f64, r: usize) -> f64 {
+    if C[r + 1] == 1.0 {
+        t_new
+    } else {
+        t + C[r + 1] * h
+    }
+}
+
 impl Stepper for Dop853Stepper {
     fn t(&self) -> f64 {
         self.ends.t
@@ -428,38 +528,16 @@ impl Stepper for Dop853Stepper {
         let h = t_new - t;
         self.ends.t_new = t_new;
         self.dense_ready = false;
-        // Row r of k is stage r + 1.
-        let stage_time = |r: usize| {
-            if C[r + 1] == 1.0 {
-                t_new
-            } else {
-                t + C[r + 1] * h
-            }
-        };
-        // Stages 0–11: f, then rows 0–10 of k, contiguous, so the sums run over chunks (the
-        // stage-by-stage slicing of `stage(j)` cost ~100 ns per step on the double pendulum).
-        for i in 1..STAGES {
-            let (earlier, rest) = self.k.split_at_mut((i - 1) * n);
-            combine(
-                &mut self.scratch,
-                &self.ends.y,
-                h,
-                A[i],
-                &self.ends.f,
-                earlier,
-            );
-            let t_stage = if C[i] == 1.0 { t_new } else { t + C[i] * h };
-            if let Err(failure) = rhs.eval_stage(t_stage, &self.scratch, &mut rest[..n]) {
-                return Err(CheckedRhs::stage_failure(earlier, n, stage_time, failure));
-            }
+        match n {
+            2 => self.stages_fixed::<2>(rhs, t, h, t_new)?,
+            4 => self.stages_fixed::<4>(rhs, t, h, t_new)?,
+            6 => self.stages_fixed::<6>(rhs, t, h, t_new)?,
+            8 => self.stages_fixed::<8>(rhs, t, h, t_new)?,
+            _ => self.stages_any(rhs, t, h, t_new)?,
         }
         let stages = &self.k[..(STAGES - 1) * n];
-        CheckedRhs::check_stages(stages, n, stage_time)?;
+        CheckedRhs::check_stages(stages, n, |r| stage_time(t, h, t_new, r))?;
         let f = &self.ends.f;
-        stage_sum(&mut self.increment, &B, f, stages, n);
-        for ((y_new, &yi), &inc) in self.y_new.iter_mut().zip(&self.ends.y).zip(&self.increment) {
-            *y_new = yi + h * inc;
-        }
         if let Some(index) = first_non_finite(&self.y_new) {
             return Err(StepFailure::NonFiniteState { t: t_new, index });
         }

@@ -448,13 +448,13 @@ mod tests {
         }
     }
 
-    /// `ẏ = 1`, except that `F` is NaN for `t` in `(0.065, 0.066)`, and that it refuses a NaN
-    /// state as a model with a singular mass matrix there would.
-    struct NanWindow;
+    /// `ẏ = 1` in `.0` components, except that `F` is NaN for `t` in `(0.065, 0.066)`, and
+    /// that it refuses a NaN state as a model with a singular mass matrix there would.
+    struct NanWindow(usize);
 
     impl OdeSystem for NanWindow {
         fn dim(&self) -> usize {
-            2
+            self.0
         }
 
         fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), RhsError> {
@@ -474,41 +474,84 @@ mod tests {
     /// Stages are checked once per attempt, yet a non-finite stage is reported at its own
     /// time, as recoverable, and ahead of the failure it causes in a later stage (here the
     /// stage at `c = 0.651…` of DOP853 and the one at `c = 4/5` of DP5(4); the stages after
-    /// them see NaN inputs).
+    /// them see NaN inputs). Dimension 2 takes the stages compiled for a fixed dimension, 3
+    /// the general ones.
     #[test]
     fn a_non_finite_stage_is_reported_at_its_time_before_what_it_causes() {
-        let weights = ErrorWeights::uniform(2, 1e-6, 1e-6);
-        // DOP853 from t = 0 with h = 0.1: stage 8 (c₈ = 0.6512820512820513) lands in the
-        // window; the following stages see NaN inputs.
-        let mut system = NanWindow;
-        let mut rhs = CheckedRhs::new(&mut system);
-        let mut stepper = Dop853Stepper::new(2);
-        stepper.reset(&mut rhs, 0.0, &[0.0, 0.0]).unwrap();
-        let failure = stepper.attempt(&mut rhs, 0.1, &weights, true).unwrap_err();
-        assert!(failure.is_recoverable());
-        match failure {
-            StepFailure::Rhs {
-                t,
-                error: RhsError::NonFinite { index: 0 },
-            } => assert!((t - 0.06512820512820513).abs() < 1e-15, "t = {t}"),
-            other => panic!("{other:?}"),
+        let expect_nan_stage_at = |failure: StepFailure, t_nan: f64| {
+            assert!(failure.is_recoverable(), "{failure:?}");
+            match failure {
+                StepFailure::Rhs {
+                    t,
+                    error: RhsError::NonFinite { index: 0 },
+                } => assert!((t - t_nan).abs() < 1e-15, "t = {t}"),
+                other => panic!("{other:?}"),
+            }
+        };
+        for dim in [2, 3] {
+            let weights = ErrorWeights::uniform(dim, 1e-6, 1e-6);
+            let y0 = vec![0.0; dim];
+            // DOP853 from t = 0 with h = 0.1: stage 8 (c₈ = 0.6512820512820513) lands in the
+            // window; the following stages see NaN inputs.
+            let mut system = NanWindow(dim);
+            let mut rhs = CheckedRhs::new(&mut system);
+            let mut stepper = Dop853Stepper::new(dim);
+            stepper.reset(&mut rhs, 0.0, &y0).unwrap();
+            let failure = stepper.attempt(&mut rhs, 0.1, &weights, true).unwrap_err();
+            expect_nan_stage_at(failure, 0.06512820512820513);
+            // DP5(4) from t = 0 with h = 0.0819: stage c = 4/5 is at 0.06552; its successor
+            // (c = 8/9) sees NaN and refuses it, but the NaN stage is what is reported.
+            let mut system = NanWindow(dim);
+            let mut rhs = CheckedRhs::new(&mut system);
+            let mut stepper = ExplicitRk::new(Tableau::dopri5(), dim);
+            stepper.reset(&mut rhs, 0.0, &y0).unwrap();
+            let failure = stepper
+                .attempt(&mut rhs, 0.0819, &weights, true)
+                .unwrap_err();
+            expect_nan_stage_at(failure, 0.8 * 0.0819);
         }
-        // DP5(4) from t = 0 with h = 0.0819: stage c = 4/5 is at 0.06552; its successor
-        // (c = 8/9) sees NaN and refuses it, but the NaN stage is what is reported.
-        let mut system = NanWindow;
-        let mut rhs = CheckedRhs::new(&mut system);
-        let mut stepper = ExplicitRk::new(Tableau::dopri5(), 2);
-        stepper.reset(&mut rhs, 0.0, &[0.0, 0.0]).unwrap();
-        let failure = stepper
-            .attempt(&mut rhs, 0.0819, &weights, true)
-            .unwrap_err();
-        assert!(failure.is_recoverable());
-        match failure {
-            StepFailure::Rhs {
-                t,
-                error: RhsError::NonFinite { index: 0 },
-            } => assert!((t - 0.8 * 0.0819).abs() < 1e-15, "t = {t}"),
-            other => panic!("{other:?}"),
+    }
+
+    /// The stages compiled for a fixed dimension (DOP853 for 2, 4, 6, 8 components, DP5(4)
+    /// likewise) compute the same step as the general ones: a four-component system, and the
+    /// same system with a fifth, constant component (which takes the general path), give the
+    /// same candidate state to a few ulps over one step.
+    #[test]
+    fn fixed_dimension_stages_match_the_general_ones() {
+        let field = |_t: f64, y: &[f64], dy: &mut [f64]| {
+            dy[0] = y[2];
+            dy[1] = y[3];
+            dy[2] = -y[0].sin() + 0.3 * y[1];
+            dy[3] = -y[1] - 0.1 * y[3] * y[0];
+            if y.len() > 4 {
+                dy[4] = 0.0;
+            }
+        };
+        let y0 = [0.7, -0.2, 0.4, 1.1, 0.0];
+        let h = 0.3;
+        let steppers: [fn(usize) -> Box<dyn Stepper>; 2] = [
+            |dim| Box::new(Dop853Stepper::new(dim)),
+            |dim| Box::new(ExplicitRk::new(Tableau::dopri5(), dim)),
+        ];
+        for make in steppers {
+            let mut candidates = Vec::new();
+            for dim in [4, 5] {
+                let mut system = OdeFn::new(dim, field);
+                let mut rhs = CheckedRhs::new(&mut system);
+                let mut stepper = make(dim);
+                stepper.reset(&mut rhs, 0.0, &y0[..dim]).unwrap();
+                let weights = ErrorWeights::uniform(dim, 1e-6, 1e-6);
+                stepper.attempt(&mut rhs, h, &weights, true).unwrap();
+                stepper.accept(&mut rhs).unwrap();
+                candidates.push(stepper.y()[..4].to_vec());
+            }
+            for (a, b) in candidates[0].iter().zip(&candidates[1]) {
+                assert!(
+                    (a - b).abs() <= 4.0 * f64::EPSILON * a.abs().max(1.0),
+                    "{a} vs {b}"
+                );
+            }
+            assert_ne!(candidates[0], y0[..4].to_vec(), "the step moved");
         }
     }
 
