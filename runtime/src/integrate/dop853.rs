@@ -16,7 +16,7 @@ use super::error::IntegrationFailure;
 use super::explicit_rk::{combine, sum_fixed, weighted_sum as stage_sum, write_update};
 use super::options::{ErrorWeights, IntegratorOptions, OutputTimes};
 use super::solution::Solution;
-use super::stepper::{CheckedRhs, StepEnds, StepFailure, Stepper, first_non_finite};
+use super::stepper::{AttemptTimes, CheckedRhs, StepEnds, StepFailure, Stepper, first_non_finite};
 
 /// Number of stages of a step (the twelfth at `c = 1`; `F` at the new state is a thirteenth,
 /// shared with the next step).
@@ -404,18 +404,17 @@ impl Dop853Stepper {
     fn stage_fixed<const I: usize, const D: usize>(
         &mut self,
         rhs: &mut CheckedRhs<'_>,
-        (t, h, t_new): (f64, f64, f64),
+        times: AttemptTimes,
     ) -> Result<(), StepFailure> {
         let (earlier, rest) = self.k.split_at_mut((I - 1) * D);
         let sum = sum_fixed::<D>(A[I], &self.ends.f, earlier);
-        write_update::<D>(&mut self.scratch, &self.ends.y, h, &sum);
-        let t_stage = if C[I] == 1.0 { t_new } else { t + C[I] * h };
-        match rhs.eval_stage(t_stage, &self.scratch[..D], &mut rest[..D]) {
+        write_update::<D>(&mut self.scratch, &self.ends.y, times.h, &sum);
+        match rhs.eval_stage(times.at(C[I]), &self.scratch[..D], &mut rest[..D]) {
             Ok(()) => Ok(()),
             Err(failure) => Err(CheckedRhs::stage_failure(
                 earlier,
                 D,
-                |r| stage_time(t, h, t_new, r),
+                |r| row_time(times, r),
                 failure,
             )),
         }
@@ -430,11 +429,8 @@ impl Dop853Stepper {
     fn stages_fixed<const D: usize>(
         &mut self,
         rhs: &mut CheckedRhs<'_>,
-        t: f64,
-        h: f64,
-        t_new: f64,
+        times: AttemptTimes,
     ) -> Result<(), StepFailure> {
-        let times = (t, h, t_new);
         self.stage_fixed::<1, D>(rhs, times)?;
         self.stage_fixed::<2, D>(rhs, times)?;
         self.stage_fixed::<3, D>(rhs, times)?;
@@ -448,7 +444,7 @@ impl Dop853Stepper {
         self.stage_fixed::<11, D>(rhs, times)?;
         let increment = sum_fixed::<D>(&B, &self.ends.f, &self.k[..(STAGES - 1) * D]);
         self.increment[..D].copy_from_slice(&increment);
-        write_update::<D>(&mut self.y_new, &self.ends.y, h, &increment);
+        write_update::<D>(&mut self.y_new, &self.ends.y, times.h, &increment);
         Ok(())
     }
 
@@ -458,11 +454,10 @@ impl Dop853Stepper {
     fn stages_any(
         &mut self,
         rhs: &mut CheckedRhs<'_>,
-        t: f64,
-        h: f64,
-        t_new: f64,
+        times: AttemptTimes,
     ) -> Result<(), StepFailure> {
         let n = self.dim;
+        let h = times.h;
         for i in 1..STAGES {
             let (earlier, rest) = self.k.split_at_mut((i - 1) * n);
             combine(
@@ -473,9 +468,8 @@ impl Dop853Stepper {
                 &self.ends.f,
                 earlier,
             );
-            let t_stage = if C[i] == 1.0 { t_new } else { t + C[i] * h };
-            if let Err(failure) = rhs.eval_stage(t_stage, &self.scratch, &mut rest[..n]) {
-                let time = |r| stage_time(t, h, t_new, r);
+            if let Err(failure) = rhs.eval_stage(times.at(C[i]), &self.scratch, &mut rest[..n]) {
+                let time = |r| row_time(times, r);
                 return Err(CheckedRhs::stage_failure(earlier, n, time, failure));
             }
         }
@@ -488,13 +482,9 @@ impl Dop853Stepper {
     }
 }
 
-/// Time of row `r` of `k` (stage `r + 1`) in an attempt from `t` to `t_new = t + h`.
-fn stage_time(t: f64, h: f64, t_new: f64, r: usize) -> f64 {
-    if C[r + 1] == 1.0 {
-        t_new
-    } else {
-        t + C[r + 1] * h
-    }
+/// Time of row `r` of `k`, which holds stage `r + 1`.
+fn row_time(times: AttemptTimes, r: usize) -> f64 {
+    times.at(C[r + 1])
 }
 
 impl Stepper for Dop853Stepper {
@@ -524,19 +514,19 @@ impl Stepper for Dop853Stepper {
         estimate_error: bool,
     ) -> Result<Option<f64>, StepFailure> {
         let n = self.dim;
-        let t = self.ends.t;
-        let h = t_new - t;
+        let times = AttemptTimes::new(self.ends.t, t_new);
+        let h = times.h;
         self.ends.t_new = t_new;
         self.dense_ready = false;
         match n {
-            2 => self.stages_fixed::<2>(rhs, t, h, t_new)?,
-            4 => self.stages_fixed::<4>(rhs, t, h, t_new)?,
-            6 => self.stages_fixed::<6>(rhs, t, h, t_new)?,
-            8 => self.stages_fixed::<8>(rhs, t, h, t_new)?,
-            _ => self.stages_any(rhs, t, h, t_new)?,
+            2 => self.stages_fixed::<2>(rhs, times)?,
+            4 => self.stages_fixed::<4>(rhs, times)?,
+            6 => self.stages_fixed::<6>(rhs, times)?,
+            8 => self.stages_fixed::<8>(rhs, times)?,
+            _ => self.stages_any(rhs, times)?,
         }
         let stages = &self.k[..(STAGES - 1) * n];
-        CheckedRhs::check_stages(stages, n, |r| stage_time(t, h, t_new, r))?;
+        CheckedRhs::check_stages(stages, n, |r| row_time(times, r))?;
         let f = &self.ends.f;
         if let Some(index) = first_non_finite(&self.y_new) {
             return Err(StepFailure::NonFiniteState { t: t_new, index });

@@ -113,6 +113,38 @@ impl StepFailure {
     }
 }
 
+/// The times of one step attempt of an explicit Runge–Kutta method: from `t` to `t_new`, of
+/// size `h = t_new − t`.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct AttemptTimes {
+    pub(crate) t: f64,
+    pub(crate) h: f64,
+    pub(crate) t_new: f64,
+}
+
+impl AttemptTimes {
+    /// The attempt from `t` to `t_new`.
+    pub(crate) fn new(t: f64, t_new: f64) -> Self {
+        Self {
+            t,
+            h: t_new - t,
+            t_new,
+        }
+    }
+
+    /// The time of a stage at node `c`: `t + c h`, and exactly `t_new` for `c = 1` (so that
+    /// the last stages of a step are evaluated at the time the step ends on, not one rounding
+    /// away from it).
+    #[inline(always)]
+    pub(crate) fn at(self, c: f64) -> f64 {
+        if c == 1.0 {
+            self.t_new
+        } else {
+            self.t + c * self.h
+        }
+    }
+}
+
 /// Index of the first entry of `values` that is NaN or infinite, if any.
 ///
 /// The common case (all finite) takes one branch: `0 · x` is ±0 for a finite `x` and NaN for
