@@ -430,11 +430,22 @@ impl Finish<'_, '_> {
             }
             None => {
                 self.recorder.record_step(solution, stepper, rhs)?;
-                project_samples(rhs, corrected, solution, first_sample)?;
-                if correct_state(rhs, stepper, corrected)?
-                    && let Some(events) = self.events.as_deref_mut()
-                {
-                    events.start(rhs, stepper.t(), stepper.y())?;
+                // When the step's one sample is its end (every step recorded), the correction
+                // of the state serves the sample too: one call of `after_step`, not two.
+                let end_only =
+                    solution.t.len() == first_sample + 1 && solution.t[first_sample] == stepper.t();
+                if !end_only {
+                    project_samples(rhs, corrected, solution, first_sample)?;
+                }
+                if correct_state(rhs, stepper, corrected)? {
+                    if end_only {
+                        let dim = corrected.len();
+                        let row = first_sample * dim..(first_sample + 1) * dim;
+                        solution.y[row].copy_from_slice(corrected);
+                    }
+                    if let Some(events) = self.events.as_deref_mut() {
+                        events.start(rhs, stepper.t(), stepper.y())?;
+                    }
                 }
                 Ok(false)
             }
