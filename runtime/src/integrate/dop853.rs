@@ -561,7 +561,10 @@ impl Stepper for Dop853Stepper {
             return Ok(Some(0.0));
         }
         let denominator = fifth + 0.01 * third;
-        Ok(Some(h.abs() * fifth / (n as f64 * denominator).sqrt()))
+        // The square of the estimate, which needs no square root (the controller takes its
+        // logarithm).
+        let scaled = h * fifth;
+        Ok(Some(scaled * scaled / (n as f64 * denominator)))
     }
 
     fn accept(&mut self, rhs: &mut CheckedRhs<'_>) -> Result<(), StepFailure> {

@@ -281,11 +281,14 @@ fn adaptive_steps<S: Stepper>(
             t + dt
         };
         attempts += 1;
-        let (error_norm, usable) = match stepper.attempt(rhs, t_new, weights, true) {
-            Ok(error_norm) => {
+        let (error_squared, usable) = match stepper.attempt(rhs, t_new, weights, true) {
+            Ok(error_squared) => {
                 last_failure = None;
-                debug_assert!(error_norm.is_some(), "adaptive stepping needs an estimator");
-                (error_norm.unwrap_or(0.0), true)
+                debug_assert!(
+                    error_squared.is_some(),
+                    "adaptive stepping needs an estimator"
+                );
+                (error_squared.unwrap_or(0.0), true)
             }
             Err(failure) if failure.is_recoverable() => {
                 last_failure = Some(failure);
@@ -293,7 +296,7 @@ fn adaptive_steps<S: Stepper>(
             }
             Err(failure) => return Err(failure.into_error()),
         };
-        match controller.decide(t_new - t, error_norm) {
+        match controller.decide_squared(t_new - t, error_squared) {
             // `usable` guards against a controller that would accept an infinite error.
             StepOutcome::Accepted { dt_next } if usable => {
                 stepper.accept(rhs).map_err(StepFailure::into_error)?;

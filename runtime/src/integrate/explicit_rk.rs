@@ -412,13 +412,14 @@ impl Stepper for ExplicitRk {
             let ratio = if error == 0.0 { 0.0 } else { error * inverse };
             sum += ratio * ratio;
         }
-        let norm = (sum / n as f64).sqrt();
-        if !norm.is_finite() {
+        // The square of the norm (the controller takes its logarithm).
+        let squared = sum / n as f64;
+        if !squared.is_finite() {
             // A non-finite stage in the estimate (reported at its time); else a non-zero
             // error where the scale is zero, which is an infinite error.
             CheckedRhs::check_stages(&self.k, n, stage_time)?;
         }
-        Ok(Some(norm))
+        Ok(Some(squared))
     }
 
     fn accept(&mut self, rhs: &mut CheckedRhs<'_>) -> Result<(), StepFailure> {

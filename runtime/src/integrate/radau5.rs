@@ -555,7 +555,9 @@ impl Stepper for RadauStepper {
             return Ok(None);
         }
         let refine = !self.accepted_any || rejected;
-        self.error_estimate(rhs, h, refine).map(Some)
+        // Squared, as the driver expects (`√(e²) = e` exactly for the controller).
+        self.error_estimate(rhs, h, refine)
+            .map(|error| Some(error * error))
     }
 
     fn accept(&mut self, rhs: &mut CheckedRhs<'_>) -> Result<(), StepFailure> {

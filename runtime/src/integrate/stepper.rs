@@ -419,9 +419,10 @@ pub(crate) trait Stepper: DenseOutput {
 
     /// Computes a candidate step from the current state to `t_new > t`.
     ///
-    /// Returns the weighted RMS norm of the local error estimate (`≤ 1` meets the
-    /// tolerances) when `estimate_error` is set and the method has an error estimator, else
-    /// `None`. `weights` are the tolerances, which implicit methods also use to stop their
+    /// Returns the *square* of the weighted RMS norm of the local error estimate (`≤ 1` meets
+    /// the tolerances; squared because the controller needs only its logarithm, see
+    /// [`StepSizeController::decide_squared`](super::StepSizeController::decide_squared)) when
+    /// `estimate_error` is set and the method has an error estimator, else `None`. `weights` are the tolerances, which implicit methods also use to stop their
     /// Newton iterations.
     ///
     /// # Errors
