@@ -208,6 +208,11 @@ static B: [f64; STAGES] = [
     4.47106157277725905176885569043e-2,
 ];
 
+/// Stages 1–4 (rows 0–3 of the stepper's `k`) have no weight in `b`, nor in either error
+/// estimate: of a step's stages, only these are checked for finiteness on their own when the
+/// error is estimated (a non-finite value elsewhere shows in the candidate).
+const UNWEIGHTED_ROWS: usize = 4;
+
 /// Weights of the third-order embedded solution, on stages 0, 8 and 11 (`BHH1` … `BHH3`).
 static B_THIRD: [(usize, f64); 3] = [
     (0, 0.244094488188976377952755905512e+00),
@@ -442,9 +447,13 @@ impl Dop853Stepper {
         self.stage_fixed::<9, D>(rhs, times)?;
         self.stage_fixed::<10, D>(rhs, times)?;
         self.stage_fixed::<11, D>(rhs, times)?;
-        let increment = sum_fixed::<D>(&B, &self.ends.f, &self.k[..(STAGES - 1) * D]);
+        let stages = &self.k[..(STAGES - 1) * D];
+        let increment = sum_fixed::<D>(&B, &self.ends.f, stages);
         self.increment[..D].copy_from_slice(&increment);
         write_update::<D>(&mut self.y_new, &self.ends.y, times.h, &increment);
+        // The fifth-order error estimate's sum, with its weights folded in as constants too.
+        let error = sum_fixed::<D>(&ERROR_FIFTH, &self.ends.f, stages);
+        self.scratch[..D].copy_from_slice(&error);
         Ok(())
     }
 
@@ -526,9 +535,18 @@ impl Stepper for Dop853Stepper {
             _ => self.stages_any(rhs, times)?,
         }
         let stages = &self.k[..(STAGES - 1) * n];
-        CheckedRhs::check_stages(stages, n, |r| row_time(times, r))?;
+        let stage_time = |r| row_time(times, r);
+        if estimate_error {
+            // Every other stage has a weight in the candidate (and so in both estimates);
+            // a non-finite one shows there, and is then searched for.
+            CheckedRhs::check_stages(&stages[..UNWEIGHTED_ROWS * n], n, stage_time)?;
+        } else {
+            CheckedRhs::check_stages(stages, n, stage_time)?;
+        }
         let f = &self.ends.f;
         if let Some(index) = first_non_finite(&self.y_new) {
+            // A non-finite stage that made it so is reported at its own time.
+            CheckedRhs::check_stages(stages, n, stage_time)?;
             return Err(StepFailure::NonFiniteState { t: t_new, index });
         }
         if !estimate_error {
@@ -541,10 +559,15 @@ impl Stepper for Dop853Stepper {
         // in the weighted norm (sums of squares E₅², E₃²),
         // err = |h| E₅² / √(n (E₅² + 0.01 E₃²)), which behaves as O(h⁸) (err₅ ~ h⁶, err₃ ~ h⁴)
         // and is large when either estimate is.
-        stage_sum(&mut self.scratch, &ERROR_FIFTH, f, stages, n);
+        if !matches!(n, 2 | 4 | 6 | 8) {
+            // (The compiled stages have summed it already.)
+            stage_sum(&mut self.scratch, &ERROR_FIFTH, f, stages, n);
+        }
         let (mut fifth, mut third) = (0.0, 0.0);
         for i in 0..n {
-            let scale = weights.scale(i, self.ends.y[i].abs().max(self.y_new[i].abs()));
+            // The reciprocal of the scale is ready before the last stage is; the errors then
+            // wait for a multiplication instead of a division.
+            let inverse = 1.0 / weights.scale(i, self.ends.y[i].abs().max(self.y_new[i].abs()));
             let mut e3 = self.increment[i];
             for &(j, w) in &B_THIRD {
                 e3 -= w * if j == 0 {
@@ -553,7 +576,7 @@ impl Stepper for Dop853Stepper {
                     stages[(j - 1) * n + i]
                 };
             }
-            let ratio = |e: f64| if e == 0.0 { 0.0 } else { e / scale };
+            let ratio = |e: f64| if e == 0.0 { 0.0 } else { e * inverse };
             fifth += ratio(self.scratch[i]).powi(2);
             third += ratio(e3).powi(2);
         }
@@ -564,7 +587,13 @@ impl Stepper for Dop853Stepper {
         // The square of the estimate, which needs no square root (the controller takes its
         // logarithm).
         let scaled = h * fifth;
-        Ok(Some(scaled * scaled / (n as f64 * denominator)))
+        let squared = scaled * scaled / (n as f64 * denominator);
+        if !squared.is_finite() {
+            // A non-finite stage in an estimate only (reported at its time); else an error
+            // where the scale is zero, which is infinite.
+            CheckedRhs::check_stages(stages, n, stage_time)?;
+        }
+        Ok(Some(squared))
     }
 
     fn accept(&mut self, rhs: &mut CheckedRhs<'_>) -> Result<(), StepFailure> {
@@ -761,6 +790,43 @@ mod tests {
                 row
             })
             .collect()
+    }
+
+    /// Exactly the stages before row `UNWEIGHTED_ROWS` of `k` have no weight in `b`, in the
+    /// fifth-order and in the third-order estimate.
+    #[test]
+    fn unweighted_rows_are_the_stages_without_any_weight() {
+        for j in 1..STAGES {
+            let third = B_THIRD.iter().any(|&(s, _)| s == j);
+            let without = B[j] == 0.0 && ERROR_FIFTH[j] == 0.0 && !third;
+            assert_eq!(without, j - 1 < UNWEIGHTED_ROWS, "stage {j}");
+        }
+    }
+
+    /// A NaN in stage 2 (`c₂ = 0.0789…`, no weight anywhere) is found by the check of the
+    /// unweighted rows, at its time, with compiled (4) and general (3) stages; `F` ignores
+    /// `y`, so nothing else could show it.
+    #[test]
+    fn a_non_finite_stage_without_weight_is_still_reported() {
+        for dim in [3, 4] {
+            let mut system = OdeFn::new(dim, |t: f64, _y: &[f64], dy: &mut [f64]| {
+                let window = t > 0.0788 && t < 0.0790;
+                dy.fill(if window { f64::NAN } else { 1.0 });
+            });
+            let mut rhs = CheckedRhs::new(&mut system);
+            let mut stepper = Dop853Stepper::new(dim);
+            stepper.reset(&mut rhs, 0.0, &vec![0.0; dim]).unwrap();
+            let weights = ErrorWeights::uniform(dim, 1e-6, 1e-6);
+            match stepper.attempt(&mut rhs, 1.0, &weights, true).unwrap_err() {
+                StepFailure::Rhs {
+                    t,
+                    error: crate::ode::RhsError::NonFinite { index: 0 },
+                } => assert!((t - C[2]).abs() < 1e-15, "t = {t}"),
+                other => panic!("{other:?}"),
+            }
+            stepper.reset(&mut rhs, 2.0, &vec![0.0; dim]).unwrap();
+            assert!(stepper.attempt(&mut rhs, 3.0, &weights, true).is_ok());
+        }
     }
 
     /// Residual bound of the order conditions: the coefficients carry 30 digits but are
