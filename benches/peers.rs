@@ -44,16 +44,19 @@
 //!
 //! Output: the table of errors and evaluations with the equal-error evaluation ratios is
 //! printed to stderr before timing; after timing, the same table with the criterion medians and
-//! the equal-error time ratios is printed and written to `<criterion dir>/peers-table.txt`
-//! (`target/criterion/` unless `CRITERION_HOME` or `CARGO_TARGET_DIR` says otherwise).
+//! the equal-error time ratios, then again with the medians of an interleaved timing (every
+//! configuration run once per round, 300 rounds, so that a drift of the machine's speed cannot
+//! fall between eomgen's runs and the peer's), is printed and written to
+//! `<criterion dir>/peers-table.txt` (`target/criterion/` unless `CRITERION_HOME` or
+//! `CARGO_TARGET_DIR` says otherwise).
 //!
-//! Run with `cargo bench --bench peers` (about 80 s on the 2-core development machine).
+//! Run with `cargo bench --bench peers` (about 90 s on the 2-core development machine).
 
 use std::cell::{Cell, RefCell};
 use std::fmt::Write as _;
 use std::hint::black_box;
 use std::path::PathBuf;
-use std::time::{Duration, SystemTime};
+use std::time::{Duration, Instant, SystemTime};
 
 use criterion::{BenchmarkId, Criterion};
 use eomgen::models::DoublePendulum;
@@ -398,6 +401,39 @@ fn pair_table(title: &str, ours: &[Outcome], theirs: &[Outcome]) -> String {
     out
 }
 
+/// Rounds of the interleaved timing.
+const ROUNDS: usize = 300;
+
+/// The median time (s) of each of `runs`, measured in [`ROUNDS`] rounds that each run every
+/// configuration once, in the listed order on even rounds and reversed on odd ones.
+///
+/// Criterion times one configuration after another, so a drift of the machine's speed (a
+/// few per cent over a minute on the 2-core VM) lands between eomgen's runs and the peer's
+/// and shows in their ratio. Interleaved, a drift slows every configuration alike; the
+/// medians' ratios are then steady to ~1 % between invocations.
+fn interleaved_medians(runs: &[Run], rhs: &CountedRhs, y0: &[f64; 4]) -> Vec<f64> {
+    let mut times = vec![Vec::with_capacity(ROUNDS); runs.len()];
+    for round in 0..ROUNDS {
+        let order: Vec<usize> = if round % 2 == 0 {
+            (0..runs.len()).collect()
+        } else {
+            (0..runs.len()).rev().collect()
+        };
+        for i in order {
+            let start = Instant::now();
+            black_box(runs[i].final_state(rhs, black_box(y0)));
+            times[i].push(start.elapsed().as_secs_f64());
+        }
+    }
+    times
+        .into_iter()
+        .map(|mut t| {
+            t.sort_by(f64::total_cmp);
+            t[t.len() / 2]
+        })
+        .collect()
+}
+
 /// The whole report: both pairs and the anchor.
 fn report(
     reference_note: &str,
@@ -533,7 +569,30 @@ fn main() {
     for outcome in &mut anchor {
         outcome.median = criterion_median(ANCHOR_GROUP, outcome.run, started);
     }
-    let table = report(&reference_note, &pairs, &anchor);
+    let mut table = report(&reference_note, &pairs, &anchor);
+
+    // The same comparisons timed interleaved (see `interleaved_medians`).
+    let mut runs: Vec<Run> = pairs
+        .iter()
+        .flat_map(|(_, ours, theirs)| ours.iter().zip(theirs).flat_map(|(a, b)| [a.run, b.run]))
+        .collect();
+    runs.extend(anchor.iter().map(|o| o.run));
+    let medians = interleaved_medians(&runs, &rhs, &y0);
+    let median_of = |run: Run| runs.iter().position(|&r| r == run).map(|i| medians[i]);
+    for (_, ours, theirs) in &mut pairs {
+        for outcome in ours.iter_mut().chain(theirs.iter_mut()) {
+            outcome.median = median_of(outcome.run);
+        }
+    }
+    for outcome in &mut anchor {
+        outcome.median = median_of(outcome.run);
+    }
+    let _ = writeln!(
+        table,
+        "\nInterleaved: medians of {ROUNDS} rounds, each running every configuration once \
+         (eomgen and peer alternating)\n"
+    );
+    table.push_str(&report(&reference_note, &pairs, &anchor));
     eprintln!("{table}");
     let path = criterion_dir().join("peers-table.txt");
     match std::fs::create_dir_all(criterion_dir()).and_then(|()| std::fs::write(&path, &table)) {
