@@ -401,19 +401,132 @@ fn pair_table(title: &str, ours: &[Outcome], theirs: &[Outcome]) -> String {
     out
 }
 
+/// Exponents `k` of the fine tolerance grid `10^(−k/8)` (1e-6 … 1e-12) of the fitted
+/// comparison of evaluations.
+const FIT_GRID: std::ops::RangeInclusive<i32> = 48..=96;
+
+/// Errors at which the fitted evaluations are compared.
+const FIT_ERRORS: [f64; 3] = [1e-3, 1e-5, 1e-7];
+
+/// Rounds of the interleaved timing on the fine grid.
+const FIT_ROUNDS: usize = 60;
+
+/// Least-squares line `ln work = a + b ln error` through `(error, work)` points.
+struct LogLogFit {
+    a: f64,
+    b: f64,
+    n: f64,
+    mean_x: f64,
+    sxx: f64,
+    /// Residual variance `Σ r² / (n − 2)`.
+    variance: f64,
+}
+
+impl LogLogFit {
+    fn new(points: &[(f64, f64)]) -> Self {
+        let n = points.len() as f64;
+        let (xs, ys): (Vec<f64>, Vec<f64>) = points.iter().map(|(e, w)| (e.ln(), w.ln())).unzip();
+        let (mean_x, mean_y) = (xs.iter().sum::<f64>() / n, ys.iter().sum::<f64>() / n);
+        let sxy: f64 = xs
+            .iter()
+            .zip(&ys)
+            .map(|(x, y)| (x - mean_x) * (y - mean_y))
+            .sum();
+        let sxx: f64 = xs.iter().map(|x| (x - mean_x).powi(2)).sum();
+        let b = sxy / sxx;
+        let a = mean_y - b * mean_x;
+        let residuals: f64 = xs
+            .iter()
+            .zip(&ys)
+            .map(|(x, y)| (y - a - b * x).powi(2))
+            .sum();
+        Self {
+            a,
+            b,
+            n,
+            mean_x,
+            sxx,
+            variance: residuals / (n - 2.0),
+        }
+    }
+
+    /// `ln work` on the line at `error`, and its standard error.
+    fn at(&self, error: f64) -> (f64, f64) {
+        let x = error.ln();
+        let se = (self.variance * (1.0 / self.n + (x - self.mean_x).powi(2) / self.sxx)).sqrt();
+        (self.a + self.b * x, se)
+    }
+}
+
+/// Work at equal error from fitted lines: on this chaotic problem the final-state error of a
+/// run scatters by tens of per cent around its trend (two correct codes at the same tolerance
+/// differ that much), so a ratio interpolated between single runs scatters as well. Both codes
+/// run on the fine grid [`FIT_GRID`] (evaluations counted, times by [`interleaved_medians`]
+/// in [`FIT_ROUNDS`] rounds); `ln(work)` is fitted against `ln(error)` by least squares for
+/// each, and the fits are compared at [`FIT_ERRORS`] as peer / eomgen with a factor of two
+/// standard errors (the ratio's 95 % band).
+fn fitted_comparison(
+    title: &str,
+    ours: fn(f64) -> Run,
+    theirs: fn(f64) -> Run,
+    rhs: &CountedRhs,
+    y0: &[f64; 4],
+    reference: &[f64; 4],
+) -> String {
+    let tolerances: Vec<f64> = FIT_GRID.map(|k| 10f64.powf(-f64::from(k) / 8.0)).collect();
+    let runs: Vec<Run> = tolerances
+        .iter()
+        .flat_map(|&tol| [ours(tol), theirs(tol)])
+        .collect();
+    let outcomes: Vec<Outcome> = runs.iter().map(|&r| outcome(r, y0, reference)).collect();
+    let medians = interleaved_medians(&runs, rhs, y0, FIT_ROUNDS);
+    let fit = |side: usize, work: &dyn Fn(usize) -> f64| {
+        let points: Vec<(f64, f64)> = (side..runs.len())
+            .step_by(2)
+            .map(|i| (outcomes[i].error, work(i)))
+            .collect();
+        LogLogFit::new(&points)
+    };
+    let mut out = format!(
+        "{title}, fitted over {} tolerances 1e-6 … 1e-12 (ln work = a + b ln error; peer / \
+         eomgen at equal error, × or ÷ the 95 % band):\n",
+        tolerances.len()
+    );
+    let evals = |i: usize| outcomes[i].rhs_evals as f64;
+    let times = |i: usize| medians[i];
+    for (what, work) in [
+        ("RHS", &evals as &dyn Fn(usize) -> f64),
+        ("time", &times as &dyn Fn(usize) -> f64),
+    ] {
+        let (eomgen, peer) = (fit(0, work), fit(1, work));
+        let _ = write!(
+            out,
+            "  {what}: slope b eomgen {:.4}, peer {:.4};",
+            eomgen.b, peer.b
+        );
+        for error in FIT_ERRORS {
+            let ((w0, s0), (w1, s1)) = (eomgen.at(error), peer.at(error));
+            let band = (2.0 * (s0 * s0 + s1 * s1).sqrt()).exp();
+            let _ = write!(out, " at {error:e}: {:.3} (×÷{band:.3});", (w1 - w0).exp());
+        }
+        out.push('\n');
+    }
+    out
+}
+
 /// Rounds of the interleaved timing.
 const ROUNDS: usize = 300;
 
-/// The median time (s) of each of `runs`, measured in [`ROUNDS`] rounds that each run every
+/// The median time (s) of each of `runs`, measured in `rounds` rounds that each run every
 /// configuration once, in the listed order on even rounds and reversed on odd ones.
 ///
 /// Criterion times one configuration after another, so a drift of the machine's speed (a
 /// few per cent over a minute on the 2-core VM) lands between eomgen's runs and the peer's
 /// and shows in their ratio. Interleaved, a drift slows every configuration alike; the
 /// medians' ratios are then steady to ~1 % between invocations.
-fn interleaved_medians(runs: &[Run], rhs: &CountedRhs, y0: &[f64; 4]) -> Vec<f64> {
-    let mut times = vec![Vec::with_capacity(ROUNDS); runs.len()];
-    for round in 0..ROUNDS {
+fn interleaved_medians(runs: &[Run], rhs: &CountedRhs, y0: &[f64; 4], rounds: usize) -> Vec<f64> {
+    let mut times = vec![Vec::with_capacity(rounds); runs.len()];
+    for round in 0..rounds {
         let order: Vec<usize> = if round % 2 == 0 {
             (0..runs.len()).collect()
         } else {
@@ -577,7 +690,7 @@ fn main() {
         .flat_map(|(_, ours, theirs)| ours.iter().zip(theirs).flat_map(|(a, b)| [a.run, b.run]))
         .collect();
     runs.extend(anchor.iter().map(|o| o.run));
-    let medians = interleaved_medians(&runs, &rhs, &y0);
+    let medians = interleaved_medians(&runs, &rhs, &y0, ROUNDS);
     let median_of = |run: Run| runs.iter().position(|&r| r == run).map(|i| medians[i]);
     for (_, ours, theirs) in &mut pairs {
         for outcome in ours.iter_mut().chain(theirs.iter_mut()) {
@@ -593,6 +706,23 @@ fn main() {
          (eomgen and peer alternating)\n"
     );
     table.push_str(&report(&reference_note, &pairs, &anchor));
+    table.push('\n');
+    table.push_str(&fitted_comparison(
+        "Dormand–Prince 5(4)",
+        Run::EomgenDp54,
+        Run::PeerDopri5,
+        &rhs,
+        &y0,
+        &reference,
+    ));
+    table.push_str(&fitted_comparison(
+        "DOP853",
+        Run::EomgenDop853,
+        Run::PeerDop853,
+        &rhs,
+        &y0,
+        &reference,
+    ));
     eprintln!("{table}");
     let path = criterion_dir().join("peers-table.txt");
     match std::fs::create_dir_all(criterion_dir()).and_then(|()| std::fs::write(&path, &table)) {
