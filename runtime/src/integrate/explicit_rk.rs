@@ -413,7 +413,7 @@ impl Stepper for ExplicitRk {
             sum += ratio * ratio;
         }
         // The square of the norm (the controller takes its logarithm).
-        let squared = sum / n as f64;
+        let squared = sum * (1.0 / n as f64);
         if !squared.is_finite() {
             // A non-finite stage in the estimate (reported at its time); else a non-zero
             // error where the scale is zero, which is an infinite error.
