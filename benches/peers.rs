@@ -46,7 +46,9 @@
 //! printed to stderr before timing; after timing, the same table with the criterion medians and
 //! the equal-error time ratios, then again with the medians of an interleaved timing (every
 //! configuration run once per round, 300 rounds, so that a drift of the machine's speed cannot
-//! fall between eomgen's runs and the peer's), is printed and written to
+//! fall between eomgen's runs and the peer's), and last a comparison of least-squares lines of
+//! `ln work` against `ln error` over 49 tolerances 1e-6 … 1e-12 (evaluations, and interleaved
+//! times; see `fitted_comparison`), is printed and written to
 //! `<criterion dir>/peers-table.txt` (`target/criterion/` unless `CRITERION_HOME` or
 //! `CARGO_TARGET_DIR` says otherwise).
 //!
@@ -484,6 +486,7 @@ fn fitted_comparison(
         let points: Vec<(f64, f64)> = (side..runs.len())
             .step_by(2)
             .map(|i| (outcomes[i].error, work(i)))
+            .filter(|&(e, w)| e > 0.0 && w > 0.0)
             .collect();
         LogLogFit::new(&points)
     };

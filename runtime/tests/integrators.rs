@@ -593,6 +593,151 @@ fn per_component_tolerances_are_used() {
     assert!(loose < mixed && mixed <= tight, "{loose} {mixed} {tight}");
 }
 
+/// A pure relative tolerance (`atol = 0`) follows `ẏ = −y` from 1 down past 1e-308, where
+/// `rtol · |y|` is subnormal: the weighted errors stay finite there (the adaptive methods form
+/// `error / scale` by a reciprocal scale, which overflows below ~5.6e-309, and must then
+/// divide). The step count stays that of a smooth decay (a few thousand steps; with an
+/// overflowing reciprocal DOP853 failed with a step-size underflow near t = 697 and DP5(4) took
+/// 52,643 steps with 34,860 rejections); the relative error at t = 720 stays small (the
+/// solution, e^−720 ≈ 3e-313, is subnormal, so only ~3 significant digits are left: 1e-2).
+#[test]
+fn pure_relative_tolerance_follows_a_decay_into_subnormal_numbers() {
+    let methods: Vec<Box<dyn Integrator>> = vec![
+        Box::new(DormandPrince54::new()),
+        Box::new(DormandPrince853::new()),
+        Box::new(BogackiShampine32::new()),
+    ];
+    for mut method in methods {
+        let mut decay = OdeFn::new(1, |_t: f64, y: &[f64], dy: &mut [f64]| dy[0] = -y[0]);
+        let options = IntegratorOptions::default()
+            .with_rtol(1e-6)
+            .with_atol(0.0)
+            .with_max_steps(1_000_000);
+        let t_end = 720.0;
+        let solution = method
+            .integrate(
+                &mut decay,
+                0.0,
+                &[1.0],
+                t_end,
+                &OutputTimes::Steps,
+                &options,
+            )
+            .unwrap_or_else(|f| panic!("{}: {}", method.name(), f.error));
+        let (t, y) = solution.last().expect("a final sample");
+        assert_eq!(t, t_end);
+        let exact = (-t_end).exp();
+        assert!(
+            ((y[0] - exact) / exact).abs() < 1e-2,
+            "{}: {} vs {exact}",
+            method.name(),
+            y[0]
+        );
+        // BS32 (third order) needs the most: ~25,000 steps at rtol 1e-6 over 720 time units.
+        assert!(
+            solution.stats.steps < 40_000 && solution.stats.rejected < solution.stats.steps / 10,
+            "{}: {} steps, {} rejected",
+            method.name(),
+            solution.stats.steps,
+            solution.stats.rejected
+        );
+    }
+}
+
+/// A spiral `ẏ = [0.1 y₀ − y₁, y₀ + 0.1 y₁]` whose state the system corrects after every step
+/// ([`OdeSystem::after_step`]) back onto the unit circle, counting the corrections.
+struct ProjectedSpiral {
+    corrections: usize,
+}
+
+impl OdeSystem for ProjectedSpiral {
+    fn dim(&self) -> usize {
+        2
+    }
+
+    fn rhs(&mut self, _t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), RhsError> {
+        dy[0] = 0.1 * y[0] - y[1];
+        dy[1] = y[0] + 0.1 * y[1];
+        Ok(())
+    }
+
+    fn after_step(&mut self, _t: f64, y: &mut [f64]) -> Result<bool, RhsError> {
+        self.corrections += 1;
+        let r = y[0].hypot(y[1]);
+        y[0] /= r;
+        y[1] /= r;
+        Ok(true)
+    }
+}
+
+/// With every step recorded, each sample is the corrected state (on the circle to roundoff,
+/// where the uncorrected one is off by ~0.1 h), the integration goes on from it (the angle
+/// advances as on the circle, `t` rad), and the correction runs once per step, for the state
+/// and its sample together. With requested times, the interpolated samples are corrected too.
+#[test]
+fn corrected_states_are_the_recorded_samples() {
+    let methods: Vec<Box<dyn Integrator>> = vec![
+        Box::new(DormandPrince54::new()),
+        Box::new(DormandPrince853::new()),
+        Box::new(RungeKutta4::new()),
+    ];
+    for mut method in methods {
+        let options = IntegratorOptions::default()
+            .with_rtol(1e-9)
+            .with_atol(1e-9)
+            .with_dt(0.01);
+        let t_end = 2.0;
+        let mut spiral = ProjectedSpiral { corrections: 0 };
+        let solution = method
+            .integrate(
+                &mut spiral,
+                0.0,
+                &[1.0, 0.0],
+                t_end,
+                &OutputTimes::Steps,
+                &options,
+            )
+            .unwrap_or_else(|f| panic!("{}: {}", method.name(), f.error));
+        for (t, y) in solution.iter() {
+            let r = y[0].hypot(y[1]);
+            assert!(
+                (r - 1.0).abs() < 4.0 * f64::EPSILON,
+                "{}: |y({t})| = {r}",
+                method.name()
+            );
+        }
+        let (_, y) = solution.last().expect("a final sample");
+        assert!((y[1].atan2(y[0]) - t_end).abs() < 1e-6, "{}", method.name());
+        assert_eq!(
+            spiral.corrections,
+            solution.stats.steps,
+            "{}",
+            method.name()
+        );
+
+        let times: Vec<f64> = (1..=8).map(|k| 0.25 * f64::from(k) - 0.1).collect();
+        let mut spiral = ProjectedSpiral { corrections: 0 };
+        let sampled = method
+            .integrate(
+                &mut spiral,
+                0.0,
+                &[1.0, 0.0],
+                t_end,
+                &OutputTimes::At(times),
+                &options,
+            )
+            .unwrap_or_else(|f| panic!("{}: {}", method.name(), f.error));
+        for (t, y) in sampled.iter() {
+            let r = y[0].hypot(y[1]);
+            assert!(
+                (r - 1.0).abs() < 4.0 * f64::EPSILON,
+                "{}: |y({t})| = {r}",
+                method.name()
+            );
+        }
+    }
+}
+
 /// A zero-dimensional system integrates trivially.
 #[test]
 fn zero_dimensional_systems_integrate() {

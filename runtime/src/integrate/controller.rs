@@ -21,7 +21,8 @@ pub enum StepOutcome {
 /// size.
 ///
 /// The integrator calls [`reset`](Self::reset) before an integration and
-/// [`decide`](Self::decide) after every attempted step.
+/// [`decide_squared`](Self::decide_squared) (whose default calls [`decide`](Self::decide))
+/// after every attempted step.
 pub trait StepSizeController {
     /// Forgets the history of earlier steps.
     fn reset(&mut self);
@@ -34,8 +35,8 @@ pub trait StepSizeController {
     fn decide(&mut self, dt: f64, error_norm: f64) -> StepOutcome;
 
     /// [`decide`](Self::decide) given the *square* of the error norm, `error_norm²` (what
-    /// the integrators compute: the mean of the squared weighted errors, whose square root is
-    /// then left to the controller). The integrators call this one.
+    /// the integrators hand over: for an RMS norm the mean of the squared weighted errors,
+    /// whose square root is then left to the controller). The integrators call this one.
     ///
     /// The default takes the square root and calls [`decide`](Self::decide). A controller
     /// that works with `ln(error_norm)` takes `ln(error_norm²)/2` instead: the step size is
@@ -145,8 +146,9 @@ impl PiController {
 
 impl PiController {
     /// [`StepSizeController::decide`] from `value = error_normᵖ` with `p = 1/power` (1 for
-    /// the norm, 2 for its square): the tests `error_norm > 1` and `error_norm ≥ 1e-4` hold
-    /// for `value` as for the norm, and `ln error_norm = power · ln value`.
+    /// the norm, 2 for its square): `error_norm > 1` exactly when `value > 1`, and
+    /// `ln error_norm = power · ln value`, which is what the error floor (1e-4 on the norm)
+    /// and the step-size formula use.
     fn decide_power(&mut self, dt: f64, value: f64, power: f64) -> StepOutcome {
         if value.is_nan() || value > 1.0 {
             self.rejected_last = true;
@@ -422,8 +424,9 @@ mod tests {
     /// The integrators hand the controllers the square of the error norm. Fed the squares of
     /// the same errors, both controllers decide as they do on the norms: the PI controller
     /// (which takes `ln(err²)/2` instead of `ln err`) to a few ulps over a sequence that
-    /// crosses the error floor 1e-4, the rejection bound 1 and the zero, infinite and NaN
-    /// errors; RADAU5's controller (the default, `√(err²) = err` exactly) bit for bit.
+    /// crosses the error floor 1e-4 (with an error between it and its square root, 3e-3,
+    /// followed by one that remembers it), the rejection bound 1 and the zero, infinite and
+    /// NaN errors; RADAU5's controller (the default, `√(err²) = err` exactly) bit for bit.
     #[test]
     fn squared_error_norms_give_the_same_decisions() {
         let errors = [
@@ -444,6 +447,8 @@ mod tests {
             0.8,
             1e-5,
             0.6,
+            3e-3,
+            0.5,
         ];
         let close = |a: StepOutcome, b: StepOutcome| match (a, b) {
             (StepOutcome::Accepted { dt_next: x }, StepOutcome::Accepted { dt_next: y })

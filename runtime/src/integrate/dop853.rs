@@ -13,7 +13,9 @@ use super::controller::PiController;
 use super::dense_output::{DenseOutput, hermite};
 use super::driver::{self, Control, Problem};
 use super::error::IntegrationFailure;
-use super::explicit_rk::{combine, sum_fixed, weighted_sum as stage_sum, write_update};
+use super::explicit_rk::{
+    combine, error_ratio, sum_fixed, weighted_sum as stage_sum, write_update,
+};
 use super::options::{ErrorWeights, IntegratorOptions, OutputTimes};
 use super::solution::Solution;
 use super::stepper::{AttemptTimes, CheckedRhs, StepEnds, StepFailure, Stepper, first_non_finite};
@@ -527,13 +529,14 @@ impl Stepper for Dop853Stepper {
         let h = times.h;
         self.ends.t_new = t_new;
         self.dense_ready = false;
-        match n {
-            2 => self.stages_fixed::<2>(rhs, times)?,
-            4 => self.stages_fixed::<4>(rhs, times)?,
-            6 => self.stages_fixed::<6>(rhs, times)?,
-            8 => self.stages_fixed::<8>(rhs, times)?,
-            _ => self.stages_any(rhs, times)?,
-        }
+        // The compiled stages also leave the fifth-order error sum in `scratch`.
+        let compiled = match n {
+            2 => self.stages_fixed::<2>(rhs, times).map(|()| true)?,
+            4 => self.stages_fixed::<4>(rhs, times).map(|()| true)?,
+            6 => self.stages_fixed::<6>(rhs, times).map(|()| true)?,
+            8 => self.stages_fixed::<8>(rhs, times).map(|()| true)?,
+            _ => self.stages_any(rhs, times).map(|()| false)?,
+        };
         let stages = &self.k[..(STAGES - 1) * n];
         let stage_time = |r| row_time(times, r);
         if estimate_error {
@@ -559,15 +562,13 @@ impl Stepper for Dop853Stepper {
         // in the weighted norm (sums of squares E₅², E₃²),
         // err = |h| E₅² / √(n (E₅² + 0.01 E₃²)), which behaves as O(h⁸) (err₅ ~ h⁶, err₃ ~ h⁴)
         // and is large when either estimate is.
-        if !matches!(n, 2 | 4 | 6 | 8) {
-            // (The compiled stages have summed it already.)
+        if !compiled {
             stage_sum(&mut self.scratch, &ERROR_FIFTH, f, stages, n);
         }
         let (mut fifth, mut third) = (0.0, 0.0);
         for i in 0..n {
-            // The reciprocal of the scale is ready before the last stage is; the errors then
-            // wait for a multiplication instead of a division.
-            let inverse = 1.0 / weights.scale(i, self.ends.y[i].abs().max(self.y_new[i].abs()));
+            let scale = weights.scale(i, self.ends.y[i].abs().max(self.y_new[i].abs()));
+            let inverse = 1.0 / scale;
             let mut e3 = self.increment[i];
             for &(j, w) in &B_THIRD {
                 e3 -= w * if j == 0 {
@@ -576,7 +577,7 @@ impl Stepper for Dop853Stepper {
                     stages[(j - 1) * n + i]
                 };
             }
-            let ratio = |e: f64| if e == 0.0 { 0.0 } else { e * inverse };
+            let ratio = |e: f64| error_ratio(e, scale, inverse);
             fifth += ratio(self.scratch[i]).powi(2);
             third += ratio(e3).powi(2);
         }
@@ -586,11 +587,12 @@ impl Stepper for Dop853Stepper {
         let denominator = fifth + 0.01 * third;
         // The square of the estimate, which needs no square root (the controller takes its
         // logarithm).
-        let scaled = h * fifth;
-        let squared = scaled * scaled / (n as f64 * denominator);
+        // (h E₅²)² / (n D) without forming (h E₅²)², which could overflow first.
+        let squared = h * h * fifth * (fifth / (n as f64 * denominator));
         if !squared.is_finite() {
-            // A non-finite stage in an estimate only (reported at its time); else an error
-            // where the scale is zero, which is infinite.
+            // Every stage here has a weight in the candidate, which was finite, so a
+            // non-finite norm comes from an error where the scale is zero (infinite) or from
+            // overflow; the search is a safeguard.
             CheckedRhs::check_stages(stages, n, stage_time)?;
         }
         Ok(Some(squared))

@@ -51,7 +51,8 @@ fn unweighted_rows(tableau: &Tableau) -> Vec<usize> {
 }
 
 /// Stages `1 … s−1` of an attempt, compiled for one tableau and one dimension: see
-/// [`dopri5_stages`].
+/// [`dopri5_stages`]. A kernel also leaves the error estimate's sum `Σ eᵢ kᵢ` in `scratch`
+/// (the attempt then does not form it again).
 ///
 /// The times come as `(t, t_new)` in registers rather than as an [`AttemptTimes`] in memory
 /// (measured: DP5(4) on the double pendulum ~5 % faster this way).
@@ -217,6 +218,28 @@ fn weighted_sum_any(out: &mut [f64], weights: &[f64], first: &[f64], k: &[f64], 
             }
         }
         *o = acc;
+    }
+}
+
+/// `error / scale`, the weighted error of one component, by the multiplication
+/// `error · inverse` with `inverse = 1/scale`.
+///
+/// The reciprocal depends only on the ends of the step, so it is formed while the last stage
+/// is evaluated, and the error, which waits for that stage, then waits for a multiplication
+/// instead of a division (on the path from the last stage to the next step's first). Where
+/// the reciprocal overflows (a pure relative tolerance, `atol = 0`, on a component below
+/// ~1e-308 in magnitude) the division is taken instead, so that the error stays finite there
+/// (measured: ẏ = −y with rtol 1e-6, atol 0 fails with a step-size underflow near t = 697
+/// without it). A zero error counts as zero even where the scale is zero (rtol only, y = 0);
+/// a non-zero error there is infinitely large, and the step is rejected.
+#[inline(always)]
+pub(super) fn error_ratio(error: f64, scale: f64, inverse: f64) -> f64 {
+    if error == 0.0 {
+        0.0
+    } else if inverse.is_finite() {
+        error * inverse
+    } else {
+        error / scale
     }
 }
 
@@ -402,14 +425,8 @@ impl Stepper for ExplicitRk {
         }
         let mut sum = 0.0;
         for i in 0..n {
-            let error = h * self.scratch[i];
-            // The reciprocal of the scale depends only on the ends of the step, so it is
-            // computed while the last stage is evaluated; the error then waits for one
-            // multiplication instead of a division.
-            let inverse = 1.0 / weights.scale(i, self.ends.y[i].abs().max(self.y_new[i].abs()));
-            // A zero error counts as zero even where the scale is zero (rtol only, y = 0);
-            // a non-zero error there is infinitely large, and the step is rejected.
-            let ratio = if error == 0.0 { 0.0 } else { error * inverse };
+            let scale = weights.scale(i, self.ends.y[i].abs().max(self.y_new[i].abs()));
+            let ratio = error_ratio(h * self.scratch[i], scale, 1.0 / scale);
             sum += ratio * ratio;
         }
         // The square of the norm (the controller takes its logarithm).
@@ -495,7 +512,7 @@ mod tests {
     /// A stage with no weight in the candidate nor in the error estimate (DP5(4)'s second, at
     /// `c = 1/5`) is checked on its own: here `F` ignores `y`, so its NaN reaches neither the
     /// later stages, nor the candidate, nor the error norm, and only that check can find it.
-    /// Without the check the attempt would succeed with a NaN stage kept for the dense output.
+    /// Without the check the attempt would succeed, the NaN never reported.
     #[test]
     fn a_non_finite_stage_without_weight_is_still_reported() {
         assert_eq!(unweighted_rows(&Tableau::dopri5()), vec![0]);
@@ -519,6 +536,32 @@ mod tests {
             // Away from the window the same step succeeds.
             stepper.reset(&mut rhs, 0.5, &vec![0.0; dim]).unwrap();
             assert!(stepper.attempt(&mut rhs, 0.6, &weights, true).is_ok());
+        }
+    }
+
+    /// A NaN stage with a weight in the candidate (DP5(4)'s third, `c = 3/10`) makes the
+    /// candidate NaN; all stages are then searched, and the NaN stage is reported at its own
+    /// time rather than as a non-finite state at the end of the step. `F` ignores `y`, so no
+    /// later stage fails first.
+    #[test]
+    fn a_non_finite_weighted_stage_is_reported_at_its_time() {
+        for dim in [2, 3] {
+            let mut system = OdeFn::new(dim, |t: f64, _y: &[f64], dy: &mut [f64]| {
+                let nan_window = t > 0.029 && t < 0.031;
+                dy.fill(if nan_window { f64::NAN } else { 1.0 });
+            });
+            let mut rhs = CheckedRhs::new(&mut system);
+            let mut stepper = ExplicitRk::new(Tableau::dopri5(), dim);
+            stepper.reset(&mut rhs, 0.0, &vec![0.0; dim]).unwrap();
+            let weights = ErrorWeights::uniform(dim, 1e-6, 1e-6);
+            let failure = stepper.attempt(&mut rhs, 0.1, &weights, true).unwrap_err();
+            match failure {
+                StepFailure::Rhs {
+                    t,
+                    error: RhsError::NonFinite { index: 0 },
+                } => assert!((t - 0.03).abs() < 1e-15, "t = {t}"),
+                other => panic!("{other:?}"),
+            }
         }
     }
 

@@ -277,9 +277,10 @@ impl<'a> CheckedRhs<'a> {
     }
 
     /// Evaluates stage `dy = F(t, y)` of an explicit Runge–Kutta step, counted but *not*
-    /// checked for finiteness: the stepper checks all its stages at once with
-    /// [`check_stages`](Self::check_stages) before it uses any of them for the new state or
-    /// the error estimate, and hands a failure of a later stage to
+    /// checked for finiteness: the stepper checks its stages once per attempt with
+    /// [`check_stages`](Self::check_stages) (when it estimates the error, only the stages
+    /// without weight in the candidate and the estimate, and all of them once the candidate
+    /// or the error norm is not finite), and hands a failure of a later stage to
     /// [`stage_failure`](Self::stage_failure), so that a stage that was not finite is still
     /// reported at its own time and component.
     ///
