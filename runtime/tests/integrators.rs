@@ -681,6 +681,15 @@ fn corrected_states_are_the_recorded_samples() {
         Box::new(DormandPrince853::new()),
         Box::new(RungeKutta4::new()),
     ];
+    let on_circle = |name: &str, solution: &Solution| {
+        for (t, y) in solution.iter() {
+            let r = y[0].hypot(y[1]);
+            assert!(
+                (r - 1.0).abs() < 4.0 * f64::EPSILON,
+                "{name}: |y({t})| = {r}"
+            );
+        }
+    };
     for mut method in methods {
         let options = IntegratorOptions::default()
             .with_rtol(1e-9)
@@ -698,14 +707,7 @@ fn corrected_states_are_the_recorded_samples() {
                 &options,
             )
             .unwrap_or_else(|f| panic!("{}: {}", method.name(), f.error));
-        for (t, y) in solution.iter() {
-            let r = y[0].hypot(y[1]);
-            assert!(
-                (r - 1.0).abs() < 4.0 * f64::EPSILON,
-                "{}: |y({t})| = {r}",
-                method.name()
-            );
-        }
+        on_circle(method.name(), &solution);
         let (_, y) = solution.last().expect("a final sample");
         assert!((y[1].atan2(y[0]) - t_end).abs() < 1e-6, "{}", method.name());
         assert_eq!(
@@ -727,14 +729,7 @@ fn corrected_states_are_the_recorded_samples() {
                 &options,
             )
             .unwrap_or_else(|f| panic!("{}: {}", method.name(), f.error));
-        for (t, y) in sampled.iter() {
-            let r = y[0].hypot(y[1]);
-            assert!(
-                (r - 1.0).abs() < 4.0 * f64::EPSILON,
-                "{}: |y({t})| = {r}",
-                method.name()
-            );
-        }
+        on_circle(method.name(), &sampled);
     }
 }
 

@@ -509,59 +509,50 @@ mod tests {
         assert!((out[0] - 0.05_f64.sin()).abs() < 1e-9);
     }
 
+    /// One error-controlled DP5(4) attempt from `t = 0` to `0.1` in `dim` components, where
+    /// `F` (which ignores `y`) is NaN for `t` within 1e-3 of `t_nan` and 1 elsewhere: the
+    /// failure must be a non-finite stage at `t_nan`. Then, away from the window, the same
+    /// step succeeds.
+    fn expect_nan_stage_at(dim: usize, t_nan: f64) {
+        let mut system = OdeFn::new(dim, move |t: f64, _y: &[f64], dy: &mut [f64]| {
+            let nan_window = (t - t_nan).abs() < 1e-3;
+            dy.fill(if nan_window { f64::NAN } else { 1.0 });
+        });
+        let mut rhs = CheckedRhs::new(&mut system);
+        let mut stepper = ExplicitRk::new(Tableau::dopri5(), dim);
+        stepper.reset(&mut rhs, 0.0, &vec![0.0; dim]).unwrap();
+        let weights = ErrorWeights::uniform(dim, 1e-6, 1e-6);
+        match stepper.attempt(&mut rhs, 0.1, &weights, true).unwrap_err() {
+            StepFailure::Rhs {
+                t,
+                error: RhsError::NonFinite { index: 0 },
+            } => assert!((t - t_nan).abs() < 1e-15, "t = {t}"),
+            other => panic!("{other:?}"),
+        }
+        stepper.reset(&mut rhs, 0.5, &vec![0.0; dim]).unwrap();
+        assert!(stepper.attempt(&mut rhs, 0.6, &weights, true).is_ok());
+    }
+
     /// A stage with no weight in the candidate nor in the error estimate (DP5(4)'s second, at
-    /// `c = 1/5`) is checked on its own: here `F` ignores `y`, so its NaN reaches neither the
-    /// later stages, nor the candidate, nor the error norm, and only that check can find it.
-    /// Without the check the attempt would succeed, the NaN never reported.
+    /// `c = 1/5`) is checked on its own: `F` ignores `y`, so its NaN reaches neither the later
+    /// stages, nor the candidate, nor the error norm, and only that check can find it. Without
+    /// the check the attempt would succeed, the NaN never reported. Dimension 2 takes the
+    /// compiled stages, 3 the general ones.
     #[test]
     fn a_non_finite_stage_without_weight_is_still_reported() {
         assert_eq!(unweighted_rows(&Tableau::dopri5()), vec![0]);
         for dim in [2, 3] {
-            let mut system = OdeFn::new(dim, |t: f64, _y: &[f64], dy: &mut [f64]| {
-                let nan_window = t > 0.019 && t < 0.021;
-                dy.fill(if nan_window { f64::NAN } else { 1.0 });
-            });
-            let mut rhs = CheckedRhs::new(&mut system);
-            let mut stepper = ExplicitRk::new(Tableau::dopri5(), dim);
-            stepper.reset(&mut rhs, 0.0, &vec![0.0; dim]).unwrap();
-            let weights = ErrorWeights::uniform(dim, 1e-6, 1e-6);
-            let failure = stepper.attempt(&mut rhs, 0.1, &weights, true).unwrap_err();
-            match failure {
-                StepFailure::Rhs {
-                    t,
-                    error: RhsError::NonFinite { index: 0 },
-                } => assert!((t - 0.02).abs() < 1e-15, "t = {t}"),
-                other => panic!("{other:?}"),
-            }
-            // Away from the window the same step succeeds.
-            stepper.reset(&mut rhs, 0.5, &vec![0.0; dim]).unwrap();
-            assert!(stepper.attempt(&mut rhs, 0.6, &weights, true).is_ok());
+            expect_nan_stage_at(dim, 0.2 * 0.1);
         }
     }
 
     /// A NaN stage with a weight in the candidate (DP5(4)'s third, `c = 3/10`) makes the
     /// candidate NaN; all stages are then searched, and the NaN stage is reported at its own
-    /// time rather than as a non-finite state at the end of the step. `F` ignores `y`, so no
-    /// later stage fails first.
+    /// time rather than as a non-finite state at the end of the step.
     #[test]
     fn a_non_finite_weighted_stage_is_reported_at_its_time() {
         for dim in [2, 3] {
-            let mut system = OdeFn::new(dim, |t: f64, _y: &[f64], dy: &mut [f64]| {
-                let nan_window = t > 0.029 && t < 0.031;
-                dy.fill(if nan_window { f64::NAN } else { 1.0 });
-            });
-            let mut rhs = CheckedRhs::new(&mut system);
-            let mut stepper = ExplicitRk::new(Tableau::dopri5(), dim);
-            stepper.reset(&mut rhs, 0.0, &vec![0.0; dim]).unwrap();
-            let weights = ErrorWeights::uniform(dim, 1e-6, 1e-6);
-            let failure = stepper.attempt(&mut rhs, 0.1, &weights, true).unwrap_err();
-            match failure {
-                StepFailure::Rhs {
-                    t,
-                    error: RhsError::NonFinite { index: 0 },
-                } => assert!((t - 0.03).abs() < 1e-15, "t = {t}"),
-                other => panic!("{other:?}"),
-            }
+            expect_nan_stage_at(dim, 0.3 * 0.1);
         }
     }
 
