@@ -373,7 +373,17 @@ impl ExprArena {
     /// If `name` was declared before with a different kind (a programmer error: the model
     /// checks reject duplicate names).
     pub fn symbol(&mut self, name: &str, kind: SymbolKind) -> ExprId {
-        let id = match self.symbol_ids.get(name) {
+        let id = self.declare(name, kind);
+        self.add(Node::Symbol(id))
+    }
+
+    /// Declares (or finds) a symbol and returns its id ([`symbol`](Self::symbol) without the
+    /// expression).
+    ///
+    /// # Panics
+    /// As [`symbol`](Self::symbol).
+    pub fn declare(&mut self, name: &str, kind: SymbolKind) -> SymbolId {
+        match self.symbol_ids.get(name) {
             Some(&id) => {
                 assert_eq!(
                     self.symbols[id.index()].kind,
@@ -394,23 +404,20 @@ impl ExprArena {
                 }
                 id
             }
-        };
-        self.add(Node::Symbol(id))
+        }
     }
 
     /// Declares generalized coordinate number `coordinates().len()` named `name`, with its
     /// rate `name_dot` and acceleration `name_ddot`; returns `[q, q̇, q̈]`.
     pub fn coordinate(&mut self, name: &str) -> [ExprId; 3] {
         let i = self.coordinates.len() as u32;
-        let q = self.symbol(name, SymbolKind::Coordinate(i));
-        let qd = self.symbol(&format!("{name}_dot"), SymbolKind::Velocity(i));
-        let qdd = self.symbol(&format!("{name}_ddot"), SymbolKind::Acceleration(i));
-        let ids = [q, qd, qdd].map(|e| match self.node(e) {
-            Node::Symbol(s) => *s,
-            _ => unreachable!("symbol() returns a symbol node"), // cannot fail: symbol() interns a Node::Symbol
-        });
+        let ids = [
+            self.declare(name, SymbolKind::Coordinate(i)),
+            self.declare(&format!("{name}_dot"), SymbolKind::Velocity(i)),
+            self.declare(&format!("{name}_ddot"), SymbolKind::Acceleration(i)),
+        ];
         self.coordinates.push(ids);
-        [q, qd, qdd]
+        ids.map(|id| self.add(Node::Symbol(id)))
     }
 
     /// `(q, q̇, q̈)` symbol ids per coordinate.
@@ -421,6 +428,11 @@ impl ExprArena {
     /// The time symbol `t` (declared on first use).
     pub fn time(&mut self) -> ExprId {
         self.symbol("t", SymbolKind::Time)
+    }
+
+    /// The id of the time symbol `t` (declared on first use).
+    pub fn time_id(&mut self) -> SymbolId {
+        self.declare("t", SymbolKind::Time)
     }
 
     /// Expression for the symbol `id`.

@@ -110,6 +110,8 @@ pub struct SymbolicModel {
     pub coordinates: Vec<[ExprId; 3]>,
     /// The time symbol.
     pub time: ExprId,
+    /// The time symbol's id.
+    pub time_id: SymbolId,
     /// Named points and their position components (2 or 3).
     pub points: Vec<(String, Vec<ExprId>)>,
     /// Kinetic energy `T(q, q̇, t)` (J).
@@ -200,10 +202,7 @@ impl SymbolicModel {
 
     /// The time symbol id.
     pub fn time_symbol(&self) -> SymbolId {
-        match self.arena.node(self.time) {
-            crate::expr::Node::Symbol(s) => *s,
-            _ => unreachable!("time is a symbol"), // cannot fail: time() returns a symbol node
-        }
+        self.time_id
     }
 
     /// Lowers a checked model file.
@@ -406,14 +405,13 @@ impl<'f> Lowering<'f> {
 
     fn run(mut self) -> Result<SymbolicModel, Vec<Diagnostic>> {
         let file = self.file;
-        let time = self.arena.time();
+        let time_id = self.arena.time_id();
+        let time = self.arena.symbol_expr(time_id);
         let mut parameters = Vec::new();
         for p in &file.parameters {
-            let e = self.arena.symbol(&p.name.value, SymbolKind::Parameter);
-            let symbol = match self.arena.node(e) {
-                crate::expr::Node::Symbol(s) => *s,
-                _ => unreachable!("symbol() returns a symbol node"), // cannot fail: symbol() interns a Node::Symbol
-            };
+            let symbol = self.arena.declare(&p.name.value, SymbolKind::Parameter);
+            // Interned now, in file order, as the expressions' canonical order follows it.
+            self.arena.symbol_expr(symbol);
             parameters.push(ParameterInfo {
                 name: p.name.value.clone(),
                 default: p.value,
@@ -762,10 +760,7 @@ impl<'f> Lowering<'f> {
             }
         }
 
-        let ts = match self.arena.node(time) {
-            crate::expr::Node::Symbol(s) => *s,
-            _ => unreachable!("time is a symbol"), // cannot fail: time() returns a symbol node
-        };
+        let ts = time_id;
         let explicit_time =
             self.arena.depends_on(kinetic, ts) || self.arena.depends_on(potential, ts);
         let conservative = file.dampers.is_empty()
@@ -798,6 +793,7 @@ impl<'f> Lowering<'f> {
             coordinate_names,
             coordinates,
             time,
+            time_id,
             points,
             kinetic,
             potential,
