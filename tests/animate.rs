@@ -4,26 +4,22 @@
 //! `simulate --t-out` states), its energies are the closed-form energy, and the GIF decodes.
 
 mod common;
-use common::eomgen;
+use common::{eomgen, eomgen_ok};
 
 use serde_json::Value;
 use std::f64::consts::TAU;
 
-/// A file in the tests' scratch directory.
+/// A file in the tests' scratch directory, removed if an earlier run left it (so that a test
+/// never reads a file it did not write).
 fn scratch(name: &str) -> String {
-    format!("{}/animate-{name}", env!("CARGO_TARGET_TMPDIR"))
+    let path = format!("{}/animate-{name}", env!("CARGO_TARGET_TMPDIR"));
+    let _ = std::fs::remove_file(&path);
+    path
 }
 
 /// Runs `eomgen args`, asserting success, and returns stdout.
 fn run_ok(args: &[&str]) -> String {
-    let out = eomgen(args);
-    assert!(
-        out.status.success(),
-        "eomgen {}: {}",
-        args.join(" "),
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8_lossy(&out.stdout).into_owned()
+    String::from_utf8_lossy(&eomgen_ok(args).stdout).into_owned()
 }
 
 /// The page's `const DATA = …;` as JSON.
@@ -412,6 +408,10 @@ fn errors_are_clear() {
         let stderr = String::from_utf8_lossy(&out.stderr);
         assert_eq!(out.status.code(), Some(2), "{stderr}");
         assert!(stderr.contains(expected), "{stderr}");
+        assert!(
+            !std::path::Path::new(&path).exists(),
+            "written before the usage error"
+        );
     }
     // RK4 with a step of 0.5 s leaves its stability region on the triple pendulum.
     let out = eomgen(&[

@@ -2,7 +2,7 @@
 //! frequencies and independent hand derivations.
 
 mod common;
-use common::eomgen;
+use common::{eomgen, eomgen_ok};
 
 use eomgen::{
     ModalError, ModeKind, ModelInfo, eigenvalues_of_m_inv_k, find_equilibrium, linearize,
@@ -230,12 +230,7 @@ fn damping_ratio_from_the_state_matrix() {
 
 #[test]
 fn modes_cli_json_contract_and_errors() {
-    let out = eomgen(&["modes", "cart_pendulum", "--at", "hanging", "--json"]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let out = eomgen_ok(&["modes", "cart_pendulum", "--at", "hanging", "--json"]);
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(v["model"], "cart_pendulum");
     assert_eq!(v["operating_point"]["name"], "hanging");

@@ -10,7 +10,7 @@
 //! `|ω²| ≤ 1e-9 max |ω²|` (the library's rule); the exact ones come out at ~1e-16.
 
 mod common;
-use common::eomgen;
+use common::eomgen_ok;
 
 use std::f64::consts::PI;
 
@@ -762,12 +762,7 @@ fn mode_charts_are_written() {
         ("spring_line_three", 2, 3),
     ] {
         let prefix = dir.join(name);
-        let out = eomgen(&["modes", name, "--plot", prefix.to_str().unwrap(), "--json"]);
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+        let out = eomgen_ok(&["modes", name, "--plot", prefix.to_str().unwrap(), "--json"]);
         let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
         let charts = json["charts"].as_array().unwrap();
         assert_eq!(charts.len(), modes);
@@ -797,27 +792,17 @@ fn mode_charts_are_written() {
 
     // A 3-D model is drawn in an isometric view.
     let prefix = dir.join("pair");
-    let out = eomgen(&[
+    eomgen_ok(&[
         "modes",
         "spring_pair_3d",
         "--plot",
         prefix.to_str().unwrap(),
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
     let pair = std::fs::read_to_string(dir.join("pair-mode6.svg")).unwrap();
     assert!(pair.contains("isometric view"));
 
     let png = dir.join("pipe.png");
-    let out = eomgen(&["modes", "cylinder_in_pipe", "--plot", png.to_str().unwrap()]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    eomgen_ok(&["modes", "cylinder_in_pipe", "--plot", png.to_str().unwrap()]);
     for k in 1..=2 {
         let bytes = std::fs::read(dir.join(format!("pipe-mode{k}.png"))).unwrap();
         assert!(

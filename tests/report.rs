@@ -5,7 +5,7 @@
 //! model runs too (under a second in a debug build).
 
 mod common;
-use common::eomgen;
+use common::{eomgen, eomgen_ok};
 
 use std::path::{Path, PathBuf};
 
@@ -30,12 +30,7 @@ fn report_ok(models: Option<&str>, dir: &Path) {
         args.extend(["--models", models]);
     }
     args.extend(["-o", dir.to_str().expect("UTF-8 path")]);
-    let out = eomgen(&args);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    eomgen_ok(&args);
 }
 
 /// The rows of `model` in `report`.
@@ -354,23 +349,29 @@ fn report_is_byte_identical_across_runs() {
     for dir in [&a, &b] {
         report_ok(Some("cart_pendulum,two_masses_rod"), dir);
     }
-    let mut files = Vec::new();
-    let mut stack = vec![a.clone()];
-    while let Some(d) = stack.pop() {
-        for e in std::fs::read_dir(&d).unwrap().flatten() {
-            let p = e.path();
-            if p.is_dir() {
-                stack.push(p);
-            } else {
-                files.push(p.strip_prefix(&a).unwrap().to_path_buf());
+    // Every file under `root`, relative to it, sorted.
+    let listing = |root: &std::path::Path| {
+        let mut files = Vec::new();
+        let mut stack = vec![root.to_path_buf()];
+        while let Some(d) = stack.pop() {
+            for e in std::fs::read_dir(&d).unwrap().flatten() {
+                let p = e.path();
+                if p.is_dir() {
+                    stack.push(p);
+                } else {
+                    files.push(p.strip_prefix(root).unwrap().to_path_buf());
+                }
             }
         }
-    }
-    files.sort();
+        files.sort();
+        files
+    };
+    let files = listing(&a);
     assert!(files.len() >= 8, "{files:?}");
+    assert_eq!(files, listing(&b), "the runs wrote different files");
     for f in &files {
         let x = std::fs::read(a.join(f)).unwrap();
-        let y = std::fs::read(b.join(f)).unwrap_or_default();
+        let y = std::fs::read(b.join(f)).unwrap();
         assert!(x == y, "{} differs between runs", f.display());
     }
     let _ = std::fs::remove_dir_all(&a);

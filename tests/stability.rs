@@ -6,7 +6,7 @@
 //! variants are `#[ignore]`d: `cargo test --release --test stability -- --ignored`.
 
 mod common;
-use common::eomgen;
+use common::{eomgen, eomgen_ok};
 
 use std::f64::consts::E;
 
@@ -269,12 +269,7 @@ fn radau_on_the_stiff_spring_matches_dop853_with_ten_times_fewer_steps() {
 /// some n (roundoff); the JSON has the documented keys.
 #[test]
 fn euler_roundoff_study_shows_truncation_and_roundoff() {
-    let out = eomgen(&["study", "euler-roundoff", "--max-n", "6", "--json"]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let out = eomgen_ok(&["study", "euler-roundoff", "--max-n", "6", "--json"]);
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(v["exact"].as_f64().unwrap(), E);
     let rows = v["rows"].as_array().unwrap();

@@ -7,7 +7,7 @@
 //! No assertion involves a wall time.
 
 mod common;
-use common::eomgen;
+use common::{eomgen, eomgen_ok};
 
 use serde_json::Value;
 
@@ -16,13 +16,7 @@ fn study(args: &[&str]) -> std::process::Output {
     let mut all = vec!["study", "work-precision"];
     all.extend_from_slice(args);
     all.extend_from_slice(&["--repeats", "1", "--min-time-ms", "0"]);
-    let out = eomgen(&all);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    out
+    eomgen_ok(&all)
 }
 
 /// Runs the study with `--json` and the fastest timing, and parses its output.

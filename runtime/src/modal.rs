@@ -149,8 +149,9 @@ pub struct Equilibrium {
 /// `1e-14 (1 + |x|)` with the residual small (`≤ 1e-8 (1 + r₀)`).
 ///
 /// # Errors
-/// [`ModalError::EquilibriumNotFound`] after 100 iterations or when no halving decreases the
-/// residual; [`ModalError::NonHolonomic`] for a model with non-holonomic constraints;
+/// [`ModalError::EquilibriumNotFound`] after 100 iterations, when no halving decreases the
+/// residual, or when the Jacobian is zero (the forces do not depend on `q`: no equilibrium
+/// unless they vanish) or not finite; [`ModalError::NonHolonomic`] for a model with non-holonomic constraints;
 /// [`ModalError::DimensionMismatch`].
 pub fn find_equilibrium(
     model: &dyn ModelInfo,
@@ -255,13 +256,14 @@ fn newton(
         if !jac.iter().all(|v| v.is_finite()) {
             return Err((iteration, r, NewtonStop::NonFiniteJacobian));
         }
-        if jac.iter().all(|v| *v == 0.0) {
+        let svd = jac.svd(true, true);
+        let largest = svd.singular_values.max();
+        if largest == 0.0 {
             return Err((iteration, r, NewtonStop::ZeroJacobian));
         }
-        let svd = jac.svd(true, true);
-        let eps = 1e-12 * svd.singular_values.max();
-        let Ok(step) = svd.solve(&(-&f), eps) else {
-            return Err((iteration, r, NewtonStop::NonFiniteJacobian));
+        // Fails only for a negative tolerance or without U and V, neither of which occurs.
+        let Ok(step) = svd.solve(&(-&f), 1e-12 * largest) else {
+            return Err((iteration, r, NewtonStop::NoDecrease));
         };
         let mut lambda = 1.0;
         let mut accepted = false;

@@ -21,3 +21,15 @@ pub fn eomgen(args: &[&str]) -> std::process::Output {
         .output()
         .expect("binary runs")
 }
+
+/// [`eomgen`], asserting that it succeeds (the message names the arguments and has stderr).
+pub fn eomgen_ok(args: &[&str]) -> std::process::Output {
+    let out = eomgen(args);
+    assert!(
+        out.status.success(),
+        "eomgen {}: {}",
+        args.join(" "),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
