@@ -319,9 +319,10 @@ fn a_million_mutated_models_never_panic() {
 /// the input, and `report` fails.
 #[test]
 fn a_panicking_target_is_caught_and_reported() {
+    // The target does no work of its own: what is tested is the harness, not the loader.
     fn panics_on_nul(src: &str) -> bool {
         assert!(!src.contains('\0'), "NUL in the input");
-        load_everything(src)
+        true
     }
     let cases = 1000;
     let (_, panics) = fuzz(cases, 0x5eed_2026_1121, panics_on_nul);

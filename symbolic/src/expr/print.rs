@@ -298,7 +298,13 @@ impl<'a> Printer<'a> {
                 && let Some(c) = self.arena.as_constant(*x)
                 && c.is_negative()
             {
-                denominator.push(self.power(*b, PowerExponent::Constant(c.negated())));
+                let power = c.negated();
+                // `x^-1` is the denominator `x`, not `x^1`.
+                denominator.push(if power.is_one() {
+                    self.operand(*b)
+                } else {
+                    self.power(*b, PowerExponent::Constant(power))
+                });
                 continue;
             }
             numerator.push(self.operand(f));
@@ -405,10 +411,6 @@ impl<'a> Printer<'a> {
                 }
             }
             Syntax::Text | Syntax::Latex | Syntax::MathMl => {
-                // `1/x` reaches here as the denominator `x^1` of `x^-1`.
-                if constant.is_some_and(|c| c.is_one()) {
-                    return b;
-                }
                 if constant == Some(half) {
                     return match self.syntax {
                         Syntax::Latex => (format!("\\sqrt{{{}}}", b.0), Prec::Atom),

@@ -25,6 +25,8 @@
 
 use std::fmt;
 
+use crate::expr::Constant;
+
 /// An exact rational number `num/den` with `den > 0` and no common factor; arithmetic is
 /// checked (`None` on `i64` overflow), so that no input can make it panic.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -131,32 +133,9 @@ impl Rational {
     /// The exact value of a decimal literal as the expression parser accepts it (`2`, `0.5`,
     /// `1e-3`, `1.5E2`); `None` for anything else or when it does not fit.
     pub fn from_decimal(text: &str) -> Option<Self> {
-        let (mantissa, exponent) = match text.find(['e', 'E']) {
-            Some(i) => (&text[..i], text[i + 1..].parse::<i32>().ok()?),
-            None => (text, 0),
-        };
-        let (whole, fraction) = mantissa.split_once('.').unwrap_or((mantissa, ""));
-        if whole.is_empty() && fraction.is_empty()
-            || !whole
-                .chars()
-                .chain(fraction.chars())
-                .all(|c| c.is_ascii_digit())
-        {
-            return None;
-        }
-        let digits = format!("{whole}{fraction}");
-        let digits = digits.trim_start_matches('0');
-        let n: i64 = if digits.is_empty() {
-            0
-        } else {
-            digits.parse().ok()?
-        };
-        let scale = exponent.checked_sub(i32::try_from(fraction.len()).ok()?)?;
-        let power = 10i64.checked_pow(scale.unsigned_abs())?;
-        if scale >= 0 {
-            Self::new(n.checked_mul(power)?, 1)
-        } else {
-            Self::new(n, power)
+        match Constant::parse_decimal(text)? {
+            Constant::Rational { num, den } => Self::new(num, den),
+            Constant::Float(_) => None,
         }
     }
 }
