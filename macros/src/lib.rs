@@ -84,9 +84,7 @@ fn stand_in(
         }
     };
     let name = codegen::struct_name(&name);
-    let valid = name.chars().next().is_some_and(|c| c.is_ascii_alphabetic())
-        && name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_');
-    valid.then_some((name, n))
+    eomgen_symbolic::model::schema::is_identifier(&name).then_some((name, n))
 }
 
 fn base_dir() -> PathBuf {
@@ -160,15 +158,12 @@ fn expand(input: proc_macro2::TokenStream) -> Result<proc_macro2::TokenStream, F
         tracked_files: vec![path.to_string_lossy().into_owned()],
         source_display: written.clone(),
     };
-    let tokens = codegen::generate(&file, &options).map_err(|e| match e {
-        GenerateError::Diagnostics(d) => Failure {
-            error: errors(d),
-            stand_in: stand_in(&source, Some(&file)),
+    let tokens = codegen::generate(&file, &options).map_err(|e| Failure {
+        error: match e {
+            GenerateError::Diagnostics(d) => errors(d),
+            GenerateError::Emit(message) => syn::Error::new(literal.span(), message),
         },
-        GenerateError::Emit(message) => Failure {
-            error: syn::Error::new(literal.span(), message),
-            stand_in: stand_in(&source, Some(&file)),
-        },
+        stand_in: stand_in(&source, Some(&file)),
     })?;
     Ok(tokens)
 }
