@@ -389,6 +389,24 @@ fn gif_decodes_and_moves() {
     assert!(moved, "later frames change nothing");
 }
 
+/// A `--t-end` a rounding below a frame time (0.1 s at 30 fps) keeps that frame, clamped onto
+/// `t_end`, instead of asking the integrator for a time past its end and failing.
+#[test]
+fn t_end_just_below_a_frame_time() {
+    let path = scratch("t-end.html");
+    let stdout = run_ok(&[
+        "animate",
+        "double_pendulum",
+        "--t-end",
+        "0.09999999999999",
+        "--fps",
+        "30",
+        "-o",
+        &path,
+    ]);
+    assert!(stdout.contains("(4 frames"), "{stdout}");
+}
+
 /// Bad input: clear usage errors (exit 2) before anything is written; a failed integration
 /// exits 1, says where and why, and keeps the frames before it in the page.
 #[test]

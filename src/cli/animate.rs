@@ -20,6 +20,7 @@ use nalgebra::DMatrix;
 use plotters::prelude::*;
 
 use super::mode_plot::{self, Frame, Layout};
+use super::report_html::escape;
 use super::simulate::{IntegrationArgs, Run, failure_error, integrate};
 use super::{CliError, plot};
 
@@ -304,8 +305,10 @@ pub(crate) fn simulation(
         TRACE_SUBSTEPS
     };
     let rate = fps * sub as f64;
+    // The fudge above lets `t_end` a rounding below a frame time keep that frame, which is
+    // then clamped onto `t_end` (output times may not pass it).
     let times: Vec<f64> = (0..=frames as usize * sub)
-        .map(|j| j as f64 / rate)
+        .map(|j| (j as f64 / rate).min(args.t_end))
         .collect();
     let Run {
         model,
@@ -526,7 +529,7 @@ fn short(v: f64) -> String {
 }
 
 /// `v` with `decimals` decimals, trailing zeros dropped, `-0` as `0`.
-fn fixed(v: f64, decimals: usize) -> String {
+pub(super) fn fixed(v: f64, decimals: usize) -> String {
     let s = format!("{v:.decimals$}");
     let s = if s.contains('.') {
         s.trim_end_matches('0').trim_end_matches('.')
@@ -545,14 +548,6 @@ fn json_string(s: &str) -> String {
     serde_json::Value::from(s)
         .to_string()
         .replace('<', "\\u003c")
-}
-
-/// Text escaped for HTML.
-fn html_text(s: &str) -> String {
-    s.replace('&', "&amp;")
-        .replace('<', "&lt;")
-        .replace('>', "&gt;")
-        .replace('"', "&quot;")
 }
 
 /// A round grid spacing: 1, 2 or 5 × 10ᵏ, near `span / 10`.
@@ -701,7 +696,7 @@ impl Animation {
             v(-y1),
             v(x1 - x0),
             v(y1 - y0),
-            html_text(&scene.title)
+            escape(&scene.title)
         );
         // The grid covers twice the box about its centre, so it fills a view box widened to
         // the page's shape.
@@ -756,7 +751,7 @@ impl Animation {
                 "<circle id=\"d{i}\" class=\"joint\" cx=\"{}\" cy=\"{}\" r=\"{radius}\"><title>{}</title></circle>",
                 p(f0[*d].0),
                 p(f0[*d].1),
-                html_text(scene.names[*d])
+                escape(scene.names[*d])
             );
         }
         for (i, (c, rigid, body)) in scene.centres.iter().enumerate() {
@@ -767,8 +762,8 @@ impl Animation {
                 p(f0[*c].0),
                 p(f0[*c].1),
                 v(0.022 * span),
-                html_text(body),
-                html_text(scene.names[*c])
+                escape(body),
+                escape(scene.names[*c])
             );
         }
         svg.push_str("\n</g>\n</svg>");
@@ -778,7 +773,7 @@ impl Animation {
                 .clips
                 .iter()
                 .enumerate()
-                .map(|(i, c)| format!("<option value=\"{i}\">{}</option>", html_text(&c.label)))
+                .map(|(i, c)| format!("<option value=\"{i}\">{}</option>", escape(&c.label)))
                 .collect();
             format!(
                 "<select id=\"clip\" aria-label=\"mode\">{}</select>",
@@ -833,8 +828,8 @@ const DATA = {data};
 </body>
 </html>
 "#,
-            title = html_text(&scene.title),
-            info = html_text(&self.clips[0].info),
+            title = escape(&scene.title),
+            info = escape(&self.clips[0].info),
             frames = last_frame + 1,
             grid = short(step),
         )

@@ -268,26 +268,33 @@ pub fn phase_portrait(
     )
 }
 
-/// Plots the energy drift `E(t) − E(0)` (J) against time into `path` (`.svg` or `.png`),
-/// `E = T + V` of the model at every sample and `E(0)` at the first sample. Constant for a
-/// conservative model up to the integration error; for others it is the work of the
-/// non-conservative loads.
+/// Plots the energy drift `E(t) − E(0)` (J) against time into `path` (`.svg` or `.png`):
+/// `energy[k] = T + V` at `t[k]` and `initial = E(0)`, the energy of the initial state (which
+/// need not be a sample: with requested output times the first may come later), as
+/// [`simulate::Report`](super::simulate::Report) computes them. Constant for a conservative
+/// model up to the integration error; for others it is the work of the non-conservative loads.
 ///
 /// # Errors
-/// An unknown extension, an empty solution, or a failure to write the file.
-pub fn energy_drift(path: &str, model: &dyn ModelInfo, solution: &Solution) -> Result<(), String> {
-    let Some((t0, y0)) = solution.iter().next() else {
+/// An unknown extension, no samples, or a failure to write the file.
+pub fn energy_drift(
+    path: &str,
+    name: &str,
+    t: &[f64],
+    energy: &[f64],
+    initial: f64,
+) -> Result<(), String> {
+    if t.is_empty() {
         return Err("nothing to plot: the solution has no samples".to_string());
-    };
-    let e0 = model.energy(t0, y0);
+    }
     let series = [Series {
         name: "E − E(0)".to_string(),
-        points: solution
+        points: t
             .iter()
-            .map(|(t, y)| (t, model.energy(t, y) - e0))
+            .zip(energy)
+            .map(|(&t, e)| (t, e - initial))
             .collect(),
     }];
-    let title = format!("{}: energy drift", model.name());
+    let title = format!("{name}: energy drift");
     lines(
         path,
         &Chart::linear(&title, "t (s)", "E − E(0) (J)"),

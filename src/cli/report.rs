@@ -34,6 +34,7 @@ use eomgen_symbolic::model::{
     DEFAULT_CONSTRAINT_DRIFT, DEFAULT_ENERGY_DRIFT, Expr, ModalCheck, ModelFile, RunSettings,
 };
 
+use super::animate::fixed;
 use super::modes::{OperatingPoint, operating_point_of};
 use super::simulate::{IntegrationArgs, Method, Report as EnergyReport, integrate};
 use super::values::parameter_lookup;
@@ -304,12 +305,6 @@ fn header_comment(source: &str) -> String {
         .join("\n")
 }
 
-/// `v` with at most six decimals, trailing zeros dropped (`1.570796`, `2`).
-fn short(v: f64) -> String {
-    let s = format!("{v:.6}");
-    s.trim_end_matches('0').trim_end_matches('.').to_string()
-}
-
 /// How a check integrates.
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct Run {
@@ -338,7 +333,7 @@ impl Run {
             .to_possible_value()
             .map(|v| v.get_name().to_string())
             .unwrap_or_default();
-        format!("{method}, rtol {:e}, {} s", self.rtol, short(self.t_end))
+        format!("{method}, rtol {:e}, {} s", self.rtol, fixed(self.t_end, 6))
     }
 }
 
@@ -606,11 +601,16 @@ fn motion_checks(
                 "Phase portrait: each rate against its coordinate".to_string(),
                 plot::phase_portrait(&path("phase.svg"), model, solution),
             ));
-            drawn.push((
-                "energy.svg",
-                "Energy drift E(t) − E(0)".to_string(),
-                plot::energy_drift(&path("energy.svg"), model, solution),
-            ));
+            drawn.push(("energy.svg", "Energy drift E(t) − E(0)".to_string(), {
+                let energy = EnergyReport::new(model, y0, solution);
+                plot::energy_drift(
+                    &path("energy.svg"),
+                    model.name(),
+                    &solution.t,
+                    &energy.energy,
+                    energy.initial,
+                )
+            }));
             if !model.constraint_names().is_empty() {
                 let drift: Vec<(f64, f64)> = solution
                     .iter()
@@ -765,7 +765,7 @@ fn motion_checks(
                             .map(|i| y[i])
                             .ok_or_else(|| format!("`{}` is not a coordinate or rate", k.value))
                     });
-                    let what = format!("{} at t = {} s ({})", k.value, short(t), run.describe());
+                    let what = format!("{} at t = {} s ({})", k.value, fixed(t, 6), run.describe());
                     match expected(e, model) {
                         Ok(x) => checks.push(CheckRow::compare(what, computed, x, check.tolerance)),
                         Err(err) => checks.push(CheckRow::compare(

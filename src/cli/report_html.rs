@@ -42,7 +42,7 @@ footer { max-width: 1200px; margin: 2rem auto; padding: 0 1.5rem 2rem; color: va
 "#;
 
 /// Escapes text for HTML content and attribute values.
-fn escape(s: &str) -> String {
+pub(super) fn escape(s: &str) -> String {
     let mut out = String::with_capacity(s.len());
     for c in s.chars() {
         match c {

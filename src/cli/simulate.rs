@@ -250,7 +250,14 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
         plot::phase_portrait(path, model.as_ref(), &solution).map_err(CliError::failure)?;
     }
     if let Some(path) = &args.plot_energy {
-        plot::energy_drift(path, model.as_ref(), &solution).map_err(CliError::failure)?;
+        plot::energy_drift(
+            path,
+            model.name(),
+            &solution.t,
+            &report.energy,
+            report.initial,
+        )
+        .map_err(CliError::failure)?;
     }
     if args.json {
         let samples: Vec<serde_json::Value> = solution
@@ -499,8 +506,8 @@ fn failure_hint(error: &IntegrationError, method: Method) -> &'static str {
 /// `E_scale = max (T + |V|)` over the initial state and the samples (so a zero initial energy still gives a
 /// meaningful relative figure).
 pub(crate) struct Report {
-    energy: Vec<f64>,
-    initial: f64,
+    pub(crate) energy: Vec<f64>,
+    pub(crate) initial: f64,
     pub(crate) drift: Option<f64>,
 }
 
