@@ -6,6 +6,9 @@
 //! and builds its nalgebra static matrix from a stack array. Output is deterministic: it
 //! depends only on the model file.
 
+pub mod program;
+pub mod tape;
+
 use std::fmt::Write as _;
 
 use proc_macro2::TokenStream;

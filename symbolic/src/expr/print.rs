@@ -478,7 +478,8 @@ enum PowerExponent {
 }
 
 impl Constant {
-    fn abs_constant(self) -> Constant {
+    /// `|c|`.
+    pub(crate) fn abs_constant(self) -> Constant {
         if self.is_negative() {
             self.negated()
         } else {

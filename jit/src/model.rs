@@ -1,0 +1,541 @@
+//! [`JitModel`]: a model file loaded, derived and compiled at run time.
+
+use std::borrow::Cow;
+use std::cell::RefCell;
+use std::sync::Arc;
+
+use eomgen_runtime::{
+    BodyCentre, DynMechanicalSystem, EventDirection, EventSpec, UnknownParameter,
+};
+use eomgen_symbolic::codegen::GenerateError;
+use eomgen_symbolic::codegen::program::{FunctionTape, ModelProgram};
+use eomgen_symbolic::codegen::tape::{Input, Instruction};
+use eomgen_symbolic::model::{Crossing, Diagnostic};
+
+use crate::native::{CompileError, NativeCode};
+use crate::{Backend, Inputs, interpret, native};
+
+/// Why a model file could not be made into a run-time model.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum LoadError {
+    /// The file could not be read.
+    #[error("cannot read `{path}`: {source}")]
+    Read {
+        /// The path as given.
+        path: String,
+        /// The operating system's error.
+        source: std::io::Error,
+    },
+    /// The file has mistakes: the located diagnostics `eomgen::model!` reports for it (YAML,
+    /// schema, cross-object rules, units, and after the derivation a singular mass matrix).
+    #[error("{} error(s) in the model file `{path}`", diagnostics.len())]
+    Diagnostics {
+        /// The path as given (the diagnostics' file name).
+        path: String,
+        /// The file's text, for rendering the diagnostics with their source lines
+        /// ([`Diagnostic::render`]).
+        source: String,
+        /// Every mistake found, in file order.
+        diagnostics: Vec<Diagnostic>,
+    },
+    /// A function of the model could not be compiled to native code.
+    #[error(transparent)]
+    Compile(#[from] CompileError),
+    /// The derived code could not be planned (a bug of the code generator; the message says
+    /// where).
+    #[error("{0}")]
+    Generate(String),
+}
+
+/// How [`JitModel::load_with`] builds a model.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct LoadOptions {
+    /// Force a backend: `None` (the default) compiles to native code and falls back to the
+    /// interpreter only where Cranelift has no code generator for the host;
+    /// `Some(Backend::Interpreter)` never compiles; `Some(Backend::Native)` makes an
+    /// unsupported host an error ([`CompileError::UnsupportedHost`]).
+    pub backend: Option<Backend>,
+}
+
+/// The functions of a model in the order of [`ModelProgram::functions`].
+#[derive(Debug, Clone, Copy)]
+enum Routine {
+    InitialState = 0,
+    MassMatrixAndForcing = 1,
+    ForcingJacobianQ = 2,
+    ForcingJacobianQdot = 3,
+    MassMatrixProductJacobian = 4,
+    KineticEnergy = 5,
+    PotentialEnergy = 6,
+    PointPositions = 7,
+    ConstraintResiduals = 8,
+    ConstraintJacobian = 9,
+    ConstraintVelocityResiduals = 10,
+    ConstraintGamma = 11,
+    EventValues = 12,
+    EquilibriumGuesses = 13,
+}
+
+/// How many values a function reads from each input and writes to each output buffer
+/// (largest index + 1), checked before native code is called.
+#[derive(Debug, Clone, Copy, Default)]
+struct Extent {
+    parameters: usize,
+    q: usize,
+    qdot: usize,
+    acceleration: usize,
+    lambda: usize,
+    out0: usize,
+    out1: usize,
+}
+
+impl Extent {
+    fn of(function: &FunctionTape) -> Extent {
+        let mut e = Extent::default();
+        for instruction in &function.tape.instructions {
+            if let Instruction::Input(input) = instruction {
+                let (slot, i) = match *input {
+                    Input::Parameter(i) => (&mut e.parameters, i),
+                    Input::Coordinate(i) => (&mut e.q, i),
+                    Input::Velocity(i) => (&mut e.qdot, i),
+                    Input::Acceleration(i) => (&mut e.acceleration, i),
+                    Input::Multiplier(i) => (&mut e.lambda, i),
+                    Input::Time => continue,
+                };
+                *slot = (*slot).max(i as usize + 1);
+            }
+        }
+        let split = function.split.min(function.tape.outputs.len());
+        e.out0 = split;
+        e.out1 = function.tape.outputs.len() - split;
+        e
+    }
+
+    fn admits(&self, inputs: &Inputs<'_>, out0: usize, out1: usize) -> bool {
+        inputs.parameters.len() >= self.parameters
+            && inputs.q.len() >= self.q
+            && inputs.qdot.len() >= self.qdot
+            && inputs.acceleration.len() >= self.acceleration
+            && inputs.lambda.len() >= self.lambda
+            && out0 >= self.out0
+            && out1 >= self.out1
+    }
+}
+
+/// What clones of a model share: the planned functions and their native code.
+#[derive(Debug)]
+struct Code {
+    program: ModelProgram,
+    extents: Vec<Extent>,
+    native: Option<NativeCode>,
+    fallback_reason: Option<CompileError>,
+    events: Vec<EventSpec>,
+}
+
+thread_local! {
+    /// The interpreter's values, reused between evaluations on a thread.
+    static SCRATCH: RefCell<Vec<f64>> = const { RefCell::new(Vec::new()) };
+}
+
+/// A model file compiled at run time: the equations of motion of any file, with no rebuild.
+///
+/// Built by [`JitModel::load`] (or [`JitModel::from_source`]); implements
+/// [`DynMechanicalSystem`], so [`eomgen_runtime::DynFirstOrder::new`] makes it a
+/// [`eomgen_runtime::ModelInfo`] for every analysis. Parameters start at the file's defaults
+/// and are set by name ([`DynMechanicalSystem::set_parameter`]). Cloning is cheap: clones
+/// share the compiled code (and each has its own parameter values).
+///
+/// # Panics
+/// The evaluation methods panic if a slice is shorter than the shapes of
+/// [`DynMechanicalSystem`] require (a programmer error; the native code is never called
+/// with too short a buffer).
+#[derive(Debug, Clone)]
+pub struct JitModel {
+    code: Arc<Code>,
+    parameters: Vec<f64>,
+}
+
+impl JitModel {
+    /// Loads, checks, derives and compiles the model file at `path` (native code, or the
+    /// interpreter where the host has no code generator).
+    ///
+    /// # Errors
+    /// [`LoadError::Read`] if the file cannot be read; [`LoadError::Diagnostics`] with every
+    /// located mistake of the file, as `eomgen::model!` reports them; [`LoadError::Compile`]
+    /// naming the function that could not be compiled.
+    pub fn load(path: impl AsRef<std::path::Path>) -> Result<JitModel, LoadError> {
+        Self::load_with(path, LoadOptions::default())
+    }
+
+    /// [`Self::load`] with options.
+    ///
+    /// # Errors
+    /// As [`Self::load`].
+    pub fn load_with(
+        path: impl AsRef<std::path::Path>,
+        options: LoadOptions,
+    ) -> Result<JitModel, LoadError> {
+        let path = path.as_ref();
+        let display = path.display().to_string();
+        let source = std::fs::read_to_string(path).map_err(|source| LoadError::Read {
+            path: display.clone(),
+            source,
+        })?;
+        Self::from_source_with(&display, &source, options)
+    }
+
+    /// Builds the model of a file's text; `path` names the file in diagnostics.
+    ///
+    /// # Errors
+    /// As [`Self::load`], but for reading.
+    pub fn from_source(path: &str, source: &str) -> Result<JitModel, LoadError> {
+        Self::from_source_with(path, source, LoadOptions::default())
+    }
+
+    /// [`Self::from_source`] with options.
+    ///
+    /// # Errors
+    /// As [`Self::load`], but for reading.
+    pub fn from_source_with(
+        path: &str,
+        source: &str,
+        options: LoadOptions,
+    ) -> Result<JitModel, LoadError> {
+        let diagnostics = |diagnostics: Vec<Diagnostic>| LoadError::Diagnostics {
+            path: path.to_string(),
+            source: source.to_string(),
+            diagnostics,
+        };
+        let file = eomgen_symbolic::model::load(path, source).map_err(diagnostics)?;
+        let program = ModelProgram::from_file(&file).map_err(|e| match e {
+            GenerateError::Diagnostics(d) => diagnostics(d),
+            GenerateError::Emit(message) => LoadError::Generate(message),
+        })?;
+        Self::from_program(program, options)
+    }
+
+    /// Compiles a planned model ([`ModelProgram::from_file`]).
+    ///
+    /// # Errors
+    /// [`LoadError::Compile`] naming the function that could not be compiled (or the host,
+    /// with `Some(Backend::Native)`).
+    pub fn from_program(program: ModelProgram, options: LoadOptions) -> Result<JitModel, LoadError> {
+        let (native, fallback_reason) = match options.backend {
+            Some(Backend::Interpreter) => (None, None),
+            forced => match native::compile(&program) {
+                Ok(code) => (Some(code), None),
+                Err(reason @ CompileError::UnsupportedHost { .. })
+                    if forced != Some(Backend::Native) =>
+                {
+                    (None, Some(reason))
+                }
+                Err(e) => return Err(e.into()),
+            },
+        };
+        let extents = program
+            .functions()
+            .iter()
+            .map(|(_, f)| Extent::of(f))
+            .collect();
+        let events = program
+            .events
+            .iter()
+            .map(|e| EventSpec {
+                name: Cow::Owned(e.name.clone()),
+                direction: match e.direction {
+                    Crossing::Rising => EventDirection::Rising,
+                    Crossing::Falling => EventDirection::Falling,
+                    Crossing::Both => EventDirection::Both,
+                },
+                terminal: e.terminal,
+            })
+            .collect();
+        let parameters = program.parameters.iter().map(|(_, v)| *v).collect();
+        Ok(JitModel {
+            code: Arc::new(Code {
+                program,
+                extents,
+                native,
+                fallback_reason,
+                events,
+            }),
+            parameters,
+        })
+    }
+
+    /// Which evaluator runs this model's functions.
+    pub fn backend(&self) -> Backend {
+        if self.code.native.is_some() {
+            Backend::Native
+        } else {
+            Backend::Interpreter
+        }
+    }
+
+    /// Why the model is interpreted although native code was asked for (`None` when it runs
+    /// natively, or when the interpreter was chosen).
+    pub fn fallback_reason(&self) -> Option<&CompileError> {
+        self.code.fallback_reason.as_ref()
+    }
+
+    /// Bytes of machine code of the model's functions (0 when interpreted); the executable
+    /// memory mapped for them is this rounded up to whole pages, and is unmapped when the
+    /// last clone of the model is dropped.
+    pub fn code_bytes(&self) -> usize {
+        self.code.native.as_ref().map_or(0, |n| n.code_bytes)
+    }
+
+    /// The planned functions (straight-line programs) this model evaluates.
+    pub fn program(&self) -> &ModelProgram {
+        &self.code.program
+    }
+
+    /// The same model evaluated by the interpreter (sharing nothing with `self` but the
+    /// plan): the reference that tests compare the native code with.
+    pub fn interpreted(&self) -> JitModel {
+        let mut model = match Self::from_program(
+            self.code.program.clone(),
+            LoadOptions {
+                backend: Some(Backend::Interpreter),
+            },
+        ) {
+            Ok(m) => m,
+            // Interpretation compiles nothing and cannot fail.
+            Err(_) => return self.clone(),
+        };
+        model.parameters.clone_from(&self.parameters);
+        model
+    }
+
+    fn run(&self, routine: Routine, inputs: Inputs<'_>, out0: &mut [f64], out1: &mut [f64]) {
+        let index = routine as usize;
+        let extent = self.code.extents[index];
+        assert!(
+            extent.admits(&inputs, out0.len(), out1.len()),
+            "model `{}`: a slice passed to {routine:?} is shorter than its shape",
+            self.code.program.name
+        );
+        match self.code.native.as_ref().and_then(|n| n.functions[index]) {
+            Some(f) => {
+                // SAFETY: `f` was compiled from this routine's tape, which reads at most
+                // `extent` values of each input and writes `extent.out0`/`out1` values, and
+                // `admits` checked that every slice is at least that long.
+                unsafe {
+                    f(
+                        inputs.parameters.as_ptr(),
+                        inputs.q.as_ptr(),
+                        inputs.qdot.as_ptr(),
+                        inputs.acceleration.as_ptr(),
+                        inputs.lambda.as_ptr(),
+                        inputs.t,
+                        out0.as_mut_ptr(),
+                        out1.as_mut_ptr(),
+                    )
+                }
+            }
+            None => {
+                let (_, function) = self.code.program.functions()[index];
+                SCRATCH.with(|scratch| match scratch.try_borrow_mut() {
+                    Ok(mut values) => {
+                        interpret::evaluate(function, &inputs, &mut values, out0, out1)
+                    }
+                    // Re-entered on this thread (cannot happen: evaluation calls no model
+                    // code); use a fresh buffer rather than fail.
+                    Err(_) => {
+                        interpret::evaluate(function, &inputs, &mut Vec::new(), out0, out1)
+                    }
+                });
+            }
+        }
+    }
+
+    fn inputs<'a>(&'a self, q: &'a [f64], qdot: &'a [f64], t: f64) -> Inputs<'a> {
+        Inputs {
+            parameters: &self.parameters,
+            q,
+            qdot,
+            acceleration: &[],
+            lambda: &[],
+            t,
+        }
+    }
+}
+
+impl DynMechanicalSystem for JitModel {
+    fn name(&self) -> &str {
+        &self.code.program.name
+    }
+    fn description(&self) -> &str {
+        &self.code.program.description
+    }
+    fn num_dofs(&self) -> usize {
+        self.code.program.num_dofs()
+    }
+    fn coordinate_names(&self) -> Vec<&str> {
+        self.code.program.coordinate_names.iter().map(String::as_str).collect()
+    }
+    fn parameter_names(&self) -> Vec<&str> {
+        self.code.program.parameters.iter().map(|(n, _)| n.as_str()).collect()
+    }
+    fn parameter_values(&self) -> Vec<f64> {
+        self.parameters.clone()
+    }
+    fn set_parameter(&mut self, name: &str, value: f64) -> Result<(), UnknownParameter> {
+        let parameters = &self.code.program.parameters;
+        match parameters.iter().position(|(n, _)| n == name) {
+            Some(i) => {
+                self.parameters[i] = value;
+                Ok(())
+            }
+            None => Err(UnknownParameter {
+                model: self.code.program.name.clone(),
+                name: name.to_string(),
+                known: parameters
+                    .iter()
+                    .map(|(n, _)| n.as_str())
+                    .collect::<Vec<_>>()
+                    .join(", "),
+            }),
+        }
+    }
+    fn initial_state(&self, q: &mut [f64], qdot: &mut [f64]) {
+        let n = self.num_dofs();
+        let mut out = vec![0.0; 2 * n];
+        self.run(Routine::InitialState, self.inputs(&[], &[], 0.0), &mut out, &mut []);
+        q[..n].copy_from_slice(&out[..n]);
+        qdot[..n].copy_from_slice(&out[n..]);
+    }
+    fn mass_matrix_and_forcing(
+        &self,
+        q: &[f64],
+        qdot: &[f64],
+        t: f64,
+        mass: &mut [f64],
+        forcing: &mut [f64],
+    ) {
+        self.run(Routine::MassMatrixAndForcing, self.inputs(q, qdot, t), mass, forcing);
+    }
+    fn forcing_jacobian_q(&self, q: &[f64], qdot: &[f64], t: f64, out: &mut [f64]) {
+        self.run(Routine::ForcingJacobianQ, self.inputs(q, qdot, t), out, &mut []);
+    }
+    fn forcing_jacobian_qdot(&self, q: &[f64], qdot: &[f64], t: f64, out: &mut [f64]) {
+        self.run(Routine::ForcingJacobianQdot, self.inputs(q, qdot, t), out, &mut []);
+    }
+    fn mass_matrix_product_jacobian(&self, q: &[f64], t: f64, a: &[f64], out: &mut [f64]) {
+        let inputs = Inputs {
+            acceleration: a,
+            ..self.inputs(q, &[], t)
+        };
+        self.run(Routine::MassMatrixProductJacobian, inputs, out, &mut []);
+    }
+    fn kinetic_energy(&self, q: &[f64], qdot: &[f64], t: f64) -> f64 {
+        let mut out = [0.0];
+        self.run(Routine::KineticEnergy, self.inputs(q, qdot, t), &mut out, &mut []);
+        out[0]
+    }
+    fn potential_energy(&self, q: &[f64], t: f64) -> f64 {
+        let mut out = [0.0];
+        self.run(Routine::PotentialEnergy, self.inputs(q, &[], t), &mut out, &mut []);
+        out[0]
+    }
+    fn is_conservative(&self) -> bool {
+        self.code.program.conservative
+    }
+    fn point_names(&self) -> Vec<&str> {
+        self.code.program.point_names.iter().map(String::as_str).collect()
+    }
+    fn point_positions(&self, q: &[f64], t: f64, out: &mut [[f64; 3]]) {
+        let flat = out.as_flattened_mut();
+        self.run(Routine::PointPositions, self.inputs(q, &[], t), flat, &mut []);
+    }
+    fn draw_lines(&self) -> Vec<[&str; 2]> {
+        self.code
+            .program
+            .draw_lines
+            .iter()
+            .map(|[a, b]| [a.as_str(), b.as_str()])
+            .collect()
+    }
+    fn trace_points(&self) -> Vec<&str> {
+        self.code.program.trace_points.iter().map(String::as_str).collect()
+    }
+    fn body_centres(&self) -> Vec<BodyCentre<'_>> {
+        self.code
+            .program
+            .body_centres
+            .iter()
+            .map(|b| BodyCentre {
+                body: &b.body,
+                point: &b.point,
+                rigid: b.rigid,
+            })
+            .collect()
+    }
+    fn equations_text(&self) -> &str {
+        &self.code.program.equations_text
+    }
+    fn equations_latex(&self) -> &str {
+        &self.code.program.equations_latex
+    }
+    fn constraint_names(&self) -> Vec<&str> {
+        self.code.program.constraint_names.iter().map(String::as_str).collect()
+    }
+    fn holonomic_constraint_count(&self) -> usize {
+        self.code.program.holonomic_constraint_count
+    }
+    fn constraint_residuals(&self, q: &[f64], t: f64, out: &mut [f64]) {
+        self.run(Routine::ConstraintResiduals, self.inputs(q, &[], t), out, &mut []);
+    }
+    fn constraint_jacobian(&self, q: &[f64], t: f64, out: &mut [f64]) {
+        self.run(Routine::ConstraintJacobian, self.inputs(q, &[], t), out, &mut []);
+    }
+    fn constraint_velocity_residuals(&self, q: &[f64], qdot: &[f64], t: f64, out: &mut [f64]) {
+        self.run(Routine::ConstraintVelocityResiduals, self.inputs(q, qdot, t), out, &mut []);
+    }
+    fn constraint_gamma(&self, q: &[f64], qdot: &[f64], t: f64, out: &mut [f64]) {
+        self.run(Routine::ConstraintGamma, self.inputs(q, qdot, t), out, &mut []);
+    }
+    fn initial_guesses(&self) -> &[usize] {
+        &self.code.program.initial_guesses
+    }
+    fn equilibrium_names(&self) -> Vec<&str> {
+        self.code.program.equilibrium_names.iter().map(String::as_str).collect()
+    }
+    fn equilibrium_guesses(&self, out: &mut [f64]) {
+        self.run(Routine::EquilibriumGuesses, self.inputs(&[], &[], 0.0), out, &mut []);
+    }
+    fn event_specs(&self) -> Vec<EventSpec> {
+        self.code.events.clone()
+    }
+    fn events_need_accelerations(&self) -> bool {
+        self.code.program.events_need_accelerations
+    }
+    fn event_values(
+        &self,
+        q: &[f64],
+        qdot: &[f64],
+        t: f64,
+        qddot: &[f64],
+        lambda: &[f64],
+        out: &mut [f64],
+    ) {
+        let needed = self.code.extents[Routine::EventValues as usize];
+        // A multiplier the caller does not have reads NaN, as in the compiled model.
+        let padded: Vec<f64>;
+        let lambda = if lambda.len() >= needed.lambda {
+            lambda
+        } else {
+            padded = (0..needed.lambda)
+                .map(|i| lambda.get(i).copied().unwrap_or(f64::NAN))
+                .collect();
+            &padded
+        };
+        let inputs = Inputs {
+            acceleration: qddot,
+            lambda,
+            ..self.inputs(q, qdot, t)
+        };
+        self.run(Routine::EventValues, inputs, out, &mut []);
+    }
+}

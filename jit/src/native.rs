@@ -1,0 +1,414 @@
+//! Tapes compiled to native code by Cranelift.
+//!
+//! # What is compiled
+//! Every [`FunctionTape`] of a [`ModelProgram`] becomes one function with the signature
+//! [`NativeFn`] (the platform's C calling convention):
+//!
+//! ```text
+//! fn(parameters, q, qdot, acceleration, lambda: *const f64, t: f64, out0, out1: *mut f64)
+//! ```
+//!
+//! Its body is the tape, instruction for instruction, in one basic block: inputs are loads
+//! at fixed offsets, arithmetic and `sqrt`/`abs` are the IEEE instructions, `sign` and `step`
+//! are compare-and-select, and the transcendentals are calls of the functions of
+//! [`crate::math`] (the same library functions the code of `eomgen::model!` calls) through
+//! absolute addresses; `sin_cos` returns its pair in two registers. Outputs are stores at
+//! fixed offsets. Cranelift's optimiser (`opt_level = speed`) and register allocator do the
+//! rest; nothing is reassociated or contracted into fused multiply–adds, so the results are
+//! the interpreter's to the bit.
+//!
+//! # Memory
+//! All functions of a model live in one [`JITModule`]; [`NativeCode`] owns it and frees the
+//! executable pages when it is dropped (the function pointers die with it: the run-time
+//! model holds both in one `Arc`).
+
+use std::sync::Mutex;
+
+use cranelift_codegen::ir;
+use cranelift_codegen::ir::condcodes::FloatCC;
+use cranelift_codegen::ir::{AbiParam, InstBuilder, MemFlagsData, Signature, UserFuncName, types};
+use cranelift_codegen::settings::{self, Configurable};
+use cranelift_frontend::{FunctionBuilder, FunctionBuilderContext};
+use cranelift_jit::{JITBuilder, JITModule};
+use cranelift_module::{FuncId, Linkage, Module, default_libcall_names};
+
+use eomgen_symbolic::codegen::program::{FunctionTape, ModelProgram};
+use eomgen_symbolic::codegen::tape::{Function, Input, Instruction};
+
+use crate::math;
+
+/// A compiled function: see the module documentation for its arguments.
+///
+/// # Safety
+/// Callers pass pointers to at least as many `f64`s as the tape reads from each input (its
+/// largest index + 1) and writes to each output buffer.
+pub(crate) type NativeFn = unsafe extern "C" fn(
+    *const f64,
+    *const f64,
+    *const f64,
+    *const f64,
+    *const f64,
+    f64,
+    *mut f64,
+    *mut f64,
+);
+
+/// Why the model's functions could not be compiled to native code.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[non_exhaustive]
+pub enum CompileError {
+    /// Cranelift has no code generator for this host (the run-time model then interprets
+    /// its tapes).
+    #[error("no native code generator for this host: {reason}")]
+    UnsupportedHost {
+        /// Cranelift's explanation.
+        reason: String,
+    },
+    /// Cranelift failed on one function.
+    #[error("could not compile `{function}` to native code: {reason}")]
+    Function {
+        /// The function of the model (`mass_matrix_and_forcing`, …).
+        function: String,
+        /// Cranelift's message.
+        reason: String,
+    },
+    /// The compiled code could not be made executable (mapping or protecting memory failed).
+    #[error("could not make the compiled code executable: {reason}")]
+    Finalize {
+        /// The operating system's or Cranelift's message.
+        reason: String,
+    },
+}
+
+/// The native code of a model's functions and the memory that holds it.
+pub(crate) struct NativeCode {
+    /// One entry per function of [`ModelProgram::functions`], `None` for an empty tape.
+    pub(crate) functions: Vec<Option<NativeFn>>,
+    /// Bytes of machine code (without alignment padding and the module's bookkeeping).
+    pub(crate) code_bytes: usize,
+    /// The module that owns the executable memory, freed on drop.
+    module: Mutex<Option<JITModule>>,
+}
+
+impl std::fmt::Debug for NativeCode {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("NativeCode")
+            .field("functions", &self.functions.len())
+            .field("code_bytes", &self.code_bytes)
+            .finish()
+    }
+}
+
+// SAFETY: after `finalize_definitions` the module is never used again except to free its
+// memory in `Drop`, which has exclusive access; the code itself is immutable and reentrant
+// (it reads only its arguments and writes only its output buffers), so calling it from
+// several threads at once is sound. The `Mutex` makes the module's own `Sync` moot.
+unsafe impl Send for NativeCode {}
+// SAFETY: as above.
+unsafe impl Sync for NativeCode {}
+
+impl Drop for NativeCode {
+    fn drop(&mut self) {
+        let module = match self.module.get_mut() {
+            Ok(m) => m.take(),
+            Err(poisoned) => poisoned.into_inner().take(),
+        };
+        if let Some(module) = module {
+            // SAFETY: the function pointers into this memory are in `self.functions`, which
+            // is being dropped with it; nothing else holds them (they never leave the crate).
+            unsafe { module.free_memory() };
+        }
+    }
+}
+
+/// Which helper functions the code calls, by symbol name.
+const HELPERS: [(&str, Function); 13] = [
+    ("eomgen_sin", Function::Sin),
+    ("eomgen_cos", Function::Cos),
+    ("eomgen_tan", Function::Tan),
+    ("eomgen_asin", Function::Asin),
+    ("eomgen_acos", Function::Acos),
+    ("eomgen_atan", Function::Atan),
+    ("eomgen_sinh", Function::Sinh),
+    ("eomgen_cosh", Function::Cosh),
+    ("eomgen_tanh", Function::Tanh),
+    ("eomgen_exp", Function::Exp),
+    ("eomgen_ln", Function::Ln),
+    ("eomgen_sign", Function::Sign),
+    ("eomgen_step", Function::Step),
+];
+
+struct Imports {
+    unary: Vec<(Function, FuncId)>,
+    sin_cos: FuncId,
+    powf: FuncId,
+    atan2: FuncId,
+}
+
+/// Compiles every function of `program`.
+///
+/// # Errors
+/// [`CompileError`] naming the host or the function Cranelift could not handle.
+pub(crate) fn compile(program: &ModelProgram) -> Result<NativeCode, CompileError> {
+    let mut flags = settings::builder();
+    let set = |flags: &mut settings::Builder, name: &str, value: &str| {
+        flags
+            .set(name, value)
+            .map_err(|e| CompileError::UnsupportedHost {
+                reason: format!("setting {name}={value}: {e}"),
+            })
+    };
+    set(&mut flags, "opt_level", "speed")?;
+    set(&mut flags, "use_colocated_libcalls", "false")?;
+    set(&mut flags, "is_pic", "false")?;
+    // The tapes are built correct by construction; the verifier doubles compile time.
+    set(
+        &mut flags,
+        "enable_verifier",
+        if cfg!(debug_assertions) {
+            "true"
+        } else {
+            "false"
+        },
+    )?;
+    let isa = cranelift_native::builder()
+        .map_err(|reason| CompileError::UnsupportedHost {
+            reason: reason.to_string(),
+        })?
+        .finish(settings::Flags::new(flags))
+        .map_err(|e| CompileError::UnsupportedHost {
+            reason: e.to_string(),
+        })?;
+    let mut builder = JITBuilder::with_isa(isa, default_libcall_names());
+    for (name, f) in HELPERS {
+        builder.symbol(name, math::unary(f) as *const u8);
+    }
+    builder.symbol("eomgen_sin_cos", math::sin_cos as *const u8);
+    builder.symbol("eomgen_powf", math::powf as *const u8);
+    builder.symbol("eomgen_atan2", math::atan2 as *const u8);
+    let mut module = JITModule::new(builder);
+
+    let failure = |function: &str, e: &dyn std::fmt::Display| CompileError::Function {
+        function: function.to_string(),
+        reason: e.to_string(),
+    };
+    let call_conv = module.isa().default_call_conv();
+    let float_signature = |args: usize, returns: usize| {
+        let mut s = Signature::new(call_conv);
+        s.params
+            .extend((0..args).map(|_| AbiParam::new(types::F64)));
+        s.returns
+            .extend((0..returns).map(|_| AbiParam::new(types::F64)));
+        s
+    };
+    let declare = |module: &mut JITModule, name: &str, signature: &Signature| {
+        module
+            .declare_function(name, Linkage::Import, signature)
+            .map_err(|e| failure(name, &e))
+    };
+    let mut unary = Vec::new();
+    for (name, f) in HELPERS {
+        unary.push((f, declare(&mut module, name, &float_signature(1, 1))?));
+    }
+    let imports = Imports {
+        unary,
+        sin_cos: declare(&mut module, "eomgen_sin_cos", &float_signature(1, 2))?,
+        powf: declare(&mut module, "eomgen_powf", &float_signature(2, 1))?,
+        atan2: declare(&mut module, "eomgen_atan2", &float_signature(2, 1))?,
+    };
+
+    let pointer = module.target_config().pointer_type();
+    let mut signature = Signature::new(call_conv);
+    for _ in 0..5 {
+        signature.params.push(AbiParam::new(pointer));
+    }
+    signature.params.push(AbiParam::new(types::F64));
+    signature.params.push(AbiParam::new(pointer));
+    signature.params.push(AbiParam::new(pointer));
+
+    let mut context = module.make_context();
+    let mut builder_context = FunctionBuilderContext::new();
+    let mut ids: Vec<Option<FuncId>> = Vec::new();
+    let mut code_bytes = 0usize;
+    for (index, (name, function)) in program.functions().into_iter().enumerate() {
+        if function.tape.outputs.is_empty() {
+            ids.push(None);
+            continue;
+        }
+        let id = module
+            .declare_function(name, Linkage::Local, &signature)
+            .map_err(|e| failure(name, &e))?;
+        context.func.signature = signature.clone();
+        context.func.name = UserFuncName::user(0, index as u32);
+        build(
+            &mut module,
+            &mut context.func,
+            &mut builder_context,
+            function,
+            &imports,
+        );
+        module
+            .define_function(id, &mut context)
+            .map_err(|e| failure(name, &e))?;
+        code_bytes += context
+            .compiled_code()
+            .map(|c| c.buffer.total_size() as usize)
+            .unwrap_or(0);
+        module.clear_context(&mut context);
+        ids.push(Some(id));
+    }
+    module
+        .finalize_definitions()
+        .map_err(|e| CompileError::Finalize {
+            reason: e.to_string(),
+        })?;
+    let functions = ids
+        .iter()
+        .map(|id| {
+            id.map(|id| {
+                let address = module.get_finalized_function(id);
+                // SAFETY: `address` is the entry of a function compiled above with exactly the
+                // signature of `NativeFn` in the platform's default (C) calling convention.
+                unsafe { std::mem::transmute::<*const u8, NativeFn>(address) }
+            })
+        })
+        .collect();
+    Ok(NativeCode {
+        functions,
+        code_bytes,
+        module: Mutex::new(Some(module)),
+    })
+}
+
+/// Writes the body of one tape into `func`.
+fn build(
+    module: &mut JITModule,
+    func: &mut ir::Function,
+    builder_context: &mut FunctionBuilderContext,
+    function: &FunctionTape,
+    imports: &Imports,
+) {
+    let mut b = FunctionBuilder::new(func, builder_context);
+    let block = b.create_block();
+    b.append_block_params_for_function_params(block);
+    b.switch_to_block(block);
+    b.seal_block(block);
+    let params = b.block_params(block).to_vec();
+    let (parameters, q, qdot, acceleration, lambda, t, out0, out1) = (
+        params[0], params[1], params[2], params[3], params[4], params[5], params[6], params[7],
+    );
+    // Inputs and outputs are aligned, in bounds (the caller's contract) and never alias the
+    // code's own memory.
+    let flags = MemFlagsData::trusted();
+    let mut unary_refs: Vec<(Function, ir::FuncRef)> = Vec::new();
+    let mut sin_cos_ref = None;
+    let mut powf_ref = None;
+    let mut atan2_ref = None;
+    let tape = &function.tape;
+    let mut values: Vec<ir::Value> = Vec::with_capacity(tape.instructions.len());
+    let offset = |i: u32| (i as i32) * 8;
+    for (k, instruction) in tape.instructions.iter().enumerate() {
+        let v = |x: u32| values[x as usize];
+        let value = match *instruction {
+            Instruction::Input(input) => {
+                let (base, i) = match input {
+                    Input::Parameter(i) => (parameters, i),
+                    Input::Coordinate(i) => (q, i),
+                    Input::Velocity(i) => (qdot, i),
+                    Input::Acceleration(i) => (acceleration, i),
+                    Input::Multiplier(i) => (lambda, i),
+                    Input::Time => {
+                        values.push(t);
+                        continue;
+                    }
+                };
+                b.ins().load(types::F64, flags, base, offset(i))
+            }
+            Instruction::Const(c) => b.ins().f64const(c),
+            Instruction::Neg(x) => b.ins().fneg(v(x)),
+            Instruction::Add(x, y) => b.ins().fadd(v(x), v(y)),
+            Instruction::Sub(x, y) => b.ins().fsub(v(x), v(y)),
+            Instruction::Mul(x, y) => b.ins().fmul(v(x), v(y)),
+            Instruction::Div(x, y) => b.ins().fdiv(v(x), v(y)),
+            Instruction::Sqrt(x) => b.ins().sqrt(v(x)),
+            Instruction::Abs(x) => b.ins().fabs(v(x)),
+            Instruction::Call(Function::Sign, x) => {
+                // −1, 0 or 1; NaN compares false both ways and gives 0, as `sign` does.
+                let x = v(x);
+                let zero = b.ins().f64const(0.0);
+                let one = b.ins().f64const(1.0);
+                let minus_one = b.ins().f64const(-1.0);
+                let positive = b.ins().fcmp(FloatCC::GreaterThan, x, zero);
+                let negative = b.ins().fcmp(FloatCC::LessThan, x, zero);
+                let low = b.ins().select(negative, minus_one, zero);
+                b.ins().select(positive, one, low)
+            }
+            Instruction::Call(Function::Step, x) => {
+                let x = v(x);
+                let zero = b.ins().f64const(0.0);
+                let one = b.ins().f64const(1.0);
+                let nonnegative = b.ins().fcmp(FloatCC::GreaterThanOrEqual, x, zero);
+                b.ins().select(nonnegative, one, zero)
+            }
+            Instruction::Call(f, x) => {
+                let callee = match unary_refs.iter().find(|(g, _)| *g == f) {
+                    Some((_, r)) => *r,
+                    None => {
+                        let id = imports
+                            .unary
+                            .iter()
+                            .find(|(g, _)| *g == f)
+                            .map(|(_, id)| *id);
+                        let Some(id) = id else {
+                            values.push(b.ins().f64const(f64::NAN));
+                            continue;
+                        };
+                        let r = module.declare_func_in_func(id, b.func);
+                        unary_refs.push((f, r));
+                        r
+                    }
+                };
+                let call = b.ins().call(callee, &[v(x)]);
+                b.inst_results(call)[0]
+            }
+            Instruction::Powf(x, y) => {
+                let callee = *powf_ref
+                    .get_or_insert_with(|| module.declare_func_in_func(imports.powf, b.func));
+                let call = b.ins().call(callee, &[v(x), v(y)]);
+                b.inst_results(call)[0]
+            }
+            Instruction::Atan2(y, x) => {
+                let callee = *atan2_ref
+                    .get_or_insert_with(|| module.declare_func_in_func(imports.atan2, b.func));
+                let call = b.ins().call(callee, &[v(y), v(x)]);
+                b.inst_results(call)[0]
+            }
+            Instruction::SinCos(x) => {
+                let callee = *sin_cos_ref
+                    .get_or_insert_with(|| module.declare_func_in_func(imports.sin_cos, b.func));
+                let call = b.ins().call(callee, &[v(x)]);
+                let results = b.inst_results(call);
+                let (s, c) = (results[0], results[1]);
+                values.push(s);
+                values.push(c);
+                continue;
+            }
+            // Pushed with its `SinCos`.
+            Instruction::CosOfSinCos(_) => continue,
+        };
+        debug_assert_eq!(values.len(), k);
+        values.push(value);
+    }
+    let split = function.split.min(tape.outputs.len());
+    for (j, &x) in tape.outputs.iter().enumerate() {
+        let (base, slot) = if j < split {
+            (out0, j)
+        } else {
+            (out1, j - split)
+        };
+        b.ins()
+            .store(flags, values[x as usize], base, (slot as i32) * 8);
+    }
+    b.ins().return_(&[]);
+    b.finalize(module.target_config());
+}

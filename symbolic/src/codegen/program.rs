@@ -1,0 +1,380 @@
+//! A model file as straight-line programs, one per generated function, with the data the
+//! generated struct returns as constants: what a model compiled at run time is built from.
+//!
+//! [`ModelProgram::from_file`] runs the pipeline of [`super::generate`] (lowering, the
+//! formulation choice of [`crate::mechanics::cheapest_equations`], the mass-matrix
+//! diagnostics, the exact Jacobians) and plans every function exactly as [`super::emit`]
+//! does — angle sums expanded ([`crate::expr::trig::expand_angle_sums`]), one CSE plan per
+//! function over exactly its roots, on one copy of the arena in the same order — then lowers
+//! each plan to a [`Tape`]. A backend that evaluates the tapes therefore computes what the
+//! `model!` macro's code computes, operation for operation.
+
+use crate::expr::cse;
+use crate::expr::trig;
+use crate::expr::{ExprArena, ExprId, SymbolId};
+use crate::mechanics::{EquationsOfMotion, Jacobians, SymbolicModel};
+use crate::model::{Crossing, ModelFile};
+
+use super::GenerateError;
+use super::tape::{Instruction, Tape};
+
+/// One function of a model, as a tape and the layout of its outputs.
+///
+/// The tape's outputs go to the first output buffer up to `split`, the rest to the second
+/// (only [`ModelProgram::mass_matrix_and_forcing`] has two: `M`, then `F`).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct FunctionTape {
+    /// The program.
+    pub tape: Tape,
+    /// Outputs `..split` go to the first buffer, `split..` to the second.
+    pub split: usize,
+}
+
+impl FunctionTape {
+    fn single(tape: Tape) -> Self {
+        let split = tape.outputs.len();
+        Self { tape, split }
+    }
+}
+
+/// An event of the model file (`events:`).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct EventDeclaration {
+    /// Its name.
+    pub name: String,
+    /// Which zero crossings count.
+    pub direction: Crossing,
+    /// Whether it ends the integration.
+    pub terminal: bool,
+}
+
+/// A body's centre of mass, for drawings.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct BodyCentreDeclaration {
+    /// The body's name.
+    pub body: String,
+    /// The point at its centre of mass.
+    pub point: String,
+    /// A planar rigid body (`true`) or a particle.
+    pub rigid: bool,
+}
+
+/// Every function the `model!` macro generates for a model file, as tapes, and the constants
+/// it returns (names, events, drawing data, the equations as text).
+///
+/// # Shapes
+/// With `n` degrees of freedom, `m` constraints of which `m_h` holonomic, `p` points and `e`
+/// events; the inputs of every tape are named by [`super::tape::Input`]. Matrices are written
+/// **column-major** (entry `(i, j)` at `i + j n`) except the constraint Jacobian, row-major as
+/// in `MechanicalSystem::constraint_jacobian`:
+///
+/// | function | outputs |
+/// |---|---|
+/// | `initial_state` | `q(0)` (n), then `q̇(0)` (n) |
+/// | `mass_matrix_and_forcing` | `M` (n × n), then (second buffer) `F` (n) |
+/// | `forcing_jacobian_q`, `forcing_jacobian_qdot` | `∂F/∂q`, `∂F/∂q̇` (n × n) |
+/// | `mass_matrix_product_jacobian` | `∂(M a)/∂q` (n × n), `a` read as the acceleration inputs |
+/// | `kinetic_energy`, `potential_energy` | `T`, `V` (1) |
+/// | `point_positions` | `[x, y, z]` per point (3 p; `z = 0` in 2-D) |
+/// | `constraint_residuals` | `Φ` (m_h) |
+/// | `constraint_jacobian` | `J` (m × n, row-major) |
+/// | `constraint_velocity_residuals`, `constraint_gamma` | (m) |
+/// | `event_values` | `g` (e); `q̈` as the acceleration inputs, `λ` as the multipliers |
+/// | `equilibrium_guesses` | `n` per named equilibrium |
+#[derive(Debug, Clone, PartialEq)]
+pub struct ModelProgram {
+    /// The model's name.
+    pub name: String,
+    /// Its one-line description.
+    pub description: String,
+    /// Which derivation the equations come from (`lagrange`, `momentum balance`).
+    pub formulation: &'static str,
+    /// Coordinate names (n).
+    pub coordinate_names: Vec<String>,
+    /// Parameter names and default values, in file order.
+    pub parameters: Vec<(String, f64)>,
+    /// Point names, in file order.
+    pub point_names: Vec<String>,
+    /// `draw: lines` as pairs of point names.
+    pub draw_lines: Vec<[String; 2]>,
+    /// `draw: trace` point names.
+    pub trace_points: Vec<String>,
+    /// The bodies' centres of mass.
+    pub body_centres: Vec<BodyCentreDeclaration>,
+    /// Constraint names, holonomic first.
+    pub constraint_names: Vec<String>,
+    /// How many constraints are holonomic.
+    pub holonomic_constraint_count: usize,
+    /// Coordinates whose initial values are guesses.
+    pub initial_guesses: Vec<usize>,
+    /// The `equilibria:` names.
+    pub equilibrium_names: Vec<String>,
+    /// The `events:`.
+    pub events: Vec<EventDeclaration>,
+    /// Whether an event function reads `q̈` or `λ`.
+    pub events_need_accelerations: bool,
+    /// Whether `T + V` is a constant of the motion.
+    pub conservative: bool,
+    /// The equations as text ([`super::equations_text`]).
+    pub equations_text: String,
+    /// The equations as LaTeX ([`super::equations_latex`]).
+    pub equations_latex: String,
+    /// `q(0)`, `q̇(0)`.
+    pub initial_state: FunctionTape,
+    /// `M`, `F`.
+    pub mass_matrix_and_forcing: FunctionTape,
+    /// `∂F/∂q`.
+    pub forcing_jacobian_q: FunctionTape,
+    /// `∂F/∂q̇`.
+    pub forcing_jacobian_qdot: FunctionTape,
+    /// `∂(M a)/∂q`.
+    pub mass_matrix_product_jacobian: FunctionTape,
+    /// `T`.
+    pub kinetic_energy: FunctionTape,
+    /// `V`.
+    pub potential_energy: FunctionTape,
+    /// Point positions.
+    pub point_positions: FunctionTape,
+    /// `Φ`.
+    pub constraint_residuals: FunctionTape,
+    /// `J`.
+    pub constraint_jacobian: FunctionTape,
+    /// Velocity residuals.
+    pub constraint_velocity_residuals: FunctionTape,
+    /// `γ`.
+    pub constraint_gamma: FunctionTape,
+    /// Event functions.
+    pub event_values: FunctionTape,
+    /// Equilibrium guesses.
+    pub equilibrium_guesses: FunctionTape,
+}
+
+impl ModelProgram {
+    /// Derives and plans the model of a loaded file, as `eomgen::model!` does.
+    ///
+    /// # Errors
+    /// [`GenerateError::Diagnostics`] for a model that cannot be lowered or whose mass matrix
+    /// is singular, with the same located diagnostics as the macro.
+    pub fn from_file(file: &ModelFile) -> Result<ModelProgram, GenerateError> {
+        let mut model = SymbolicModel::from_file(file).map_err(GenerateError::Diagnostics)?;
+        let (eom, formulation) = crate::mechanics::cheapest_equations(&mut model);
+        let problems = crate::mechanics::mass_matrix_diagnostics(&model, &eom, file);
+        if !problems.is_empty() {
+            return Err(GenerateError::Diagnostics(problems));
+        }
+        let jacobians = Jacobians::of(&mut model, &eom);
+        Ok(Self::plan(&model, &eom, &jacobians, formulation))
+    }
+
+    /// The tapes of a derived model (the run-time twin of [`super::emit`]).
+    pub fn plan(
+        model: &SymbolicModel,
+        eom: &EquationsOfMotion,
+        jacobians: &Jacobians,
+        formulation: &'static str,
+    ) -> ModelProgram {
+        let n = model.num_dofs();
+        let parameters: Vec<SymbolId> = model.parameters.iter().map(|p| p.symbol).collect();
+        // One copy of the arena, functions planned in `emit`'s order: the angle-sum rewrite
+        // adds nodes to it, as it does for the Rust source.
+        let mut arena = model.arena.clone();
+        let mut planner = Planner {
+            arena: &mut arena,
+            parameters: &parameters,
+        };
+        let column_major = |tape: Tape| FunctionTape::single(transposed(tape, n));
+
+        let initial_state =
+            planner.tape(&[model.initial_q.clone(), model.initial_qdot.clone()].concat());
+        let both: Vec<ExprId> = [eom.mass_matrix.clone(), eom.forcing.clone()].concat();
+        let mut mass_and_forcing = planner.tape(&both);
+        // `M` column-major, then `F`.
+        let (mass, forcing) = mass_and_forcing.outputs.split_at(n * n);
+        let mut outputs = column_major_order(mass, n);
+        outputs.extend_from_slice(forcing);
+        mass_and_forcing.outputs = outputs;
+        let mass_matrix_and_forcing = FunctionTape {
+            tape: mass_and_forcing,
+            split: n * n,
+        };
+        let forcing_jacobian_q = column_major(planner.tape(&jacobians.forcing_q));
+        let forcing_jacobian_qdot = column_major(planner.tape(&jacobians.forcing_qdot));
+        let mass_matrix_product_jacobian = column_major(planner.tape(&jacobians.mass_product_q));
+        let kinetic_energy = FunctionTape::single(planner.tape(&[model.kinetic]));
+        let potential_energy = FunctionTape::single(planner.tape(&[model.potential]));
+        let point_roots: Vec<ExprId> = model
+            .points
+            .iter()
+            .flat_map(|(_, r)| r.iter().copied())
+            .collect();
+        let mut points = planner.tape(&point_roots);
+        // `[x, y, z]` per point, `z = 0` for 2-D points.
+        let zero = points.instructions.len() as u32;
+        points.instructions.push(Instruction::Const(0.0));
+        let mut components = points.outputs.iter().copied();
+        let mut outputs = Vec::with_capacity(3 * model.points.len());
+        for (_, r) in &model.points {
+            for k in 0..3 {
+                let v = if k < r.len() { components.next() } else { None };
+                outputs.push(v.unwrap_or(zero));
+            }
+        }
+        points.outputs = outputs;
+        let point_positions = FunctionTape::single(points);
+        let c = &model.constraints;
+        let mut single = |roots: &[ExprId]| FunctionTape::single(planner.tape(roots));
+        let (
+            constraint_residuals,
+            constraint_jacobian,
+            constraint_velocity_residuals,
+            constraint_gamma,
+        ) = if c.is_empty() {
+            Default::default()
+        } else {
+            (
+                single(&c.phi),
+                single(&c.jacobian),
+                single(&c.velocity),
+                single(&c.gamma),
+            )
+        };
+        let event_roots: Vec<ExprId> = model.events.iter().map(|e| e.function).collect();
+        let event_values = if event_roots.is_empty() {
+            FunctionTape::default()
+        } else {
+            single(&event_roots)
+        };
+        let guess_roots: Vec<ExprId> = model
+            .equilibria
+            .iter()
+            .flat_map(|(_, guess)| guess.iter().copied())
+            .collect();
+        let equilibrium_guesses = if guess_roots.is_empty() {
+            FunctionTape::default()
+        } else {
+            single(&guess_roots)
+        };
+        let point_name = |i: usize| model.points.get(i).map(|(p, _)| p.clone());
+        ModelProgram {
+            name: model.name.clone(),
+            description: model.description.clone(),
+            formulation,
+            coordinate_names: model.coordinate_names.clone(),
+            parameters: model
+                .parameters
+                .iter()
+                .map(|p| (p.name.clone(), p.default))
+                .collect(),
+            point_names: model.points.iter().map(|(p, _)| p.clone()).collect(),
+            draw_lines: model
+                .draw_lines
+                .iter()
+                .filter_map(|[a, b]| Some([point_name(*a)?, point_name(*b)?]))
+                .collect(),
+            trace_points: model
+                .trace_points
+                .iter()
+                .filter_map(|p| point_name(*p))
+                .collect(),
+            body_centres: model
+                .bodies
+                .iter()
+                .filter_map(|b| {
+                    Some(BodyCentreDeclaration {
+                        body: b.name.clone(),
+                        point: point_name(b.com)?,
+                        rigid: b.rotation.is_some(),
+                    })
+                })
+                .collect(),
+            constraint_names: c.names.clone(),
+            holonomic_constraint_count: c.holonomic,
+            initial_guesses: model.initial_guesses.clone(),
+            equilibrium_names: model.equilibria.iter().map(|(n, _)| n.clone()).collect(),
+            events: model
+                .events
+                .iter()
+                .map(|e| EventDeclaration {
+                    name: e.name.clone(),
+                    direction: e.direction,
+                    terminal: e.terminal,
+                })
+                .collect(),
+            events_need_accelerations: model.events_need_accelerations(),
+            conservative: model.conservative,
+            equations_text: super::equations_text(model, eom),
+            equations_latex: super::equations_latex(model, eom),
+            initial_state: FunctionTape::single(initial_state),
+            mass_matrix_and_forcing,
+            forcing_jacobian_q,
+            forcing_jacobian_qdot,
+            mass_matrix_product_jacobian,
+            kinetic_energy,
+            potential_energy,
+            point_positions,
+            constraint_residuals,
+            constraint_jacobian,
+            constraint_velocity_residuals,
+            constraint_gamma,
+            event_values,
+            equilibrium_guesses,
+        }
+    }
+
+    /// Number of degrees of freedom `n`.
+    pub fn num_dofs(&self) -> usize {
+        self.coordinate_names.len()
+    }
+
+    /// Every function with its name, in the order of the table above.
+    pub fn functions(&self) -> [(&'static str, &FunctionTape); 14] {
+        [
+            ("initial_state", &self.initial_state),
+            ("mass_matrix_and_forcing", &self.mass_matrix_and_forcing),
+            ("forcing_jacobian_q", &self.forcing_jacobian_q),
+            ("forcing_jacobian_qdot", &self.forcing_jacobian_qdot),
+            (
+                "mass_matrix_product_jacobian",
+                &self.mass_matrix_product_jacobian,
+            ),
+            ("kinetic_energy", &self.kinetic_energy),
+            ("potential_energy", &self.potential_energy),
+            ("point_positions", &self.point_positions),
+            ("constraint_residuals", &self.constraint_residuals),
+            ("constraint_jacobian", &self.constraint_jacobian),
+            (
+                "constraint_velocity_residuals",
+                &self.constraint_velocity_residuals,
+            ),
+            ("constraint_gamma", &self.constraint_gamma),
+            ("event_values", &self.event_values),
+            ("equilibrium_guesses", &self.equilibrium_guesses),
+        ]
+    }
+}
+
+/// Plans functions one after the other on one arena, as `emit`'s `body` does.
+struct Planner<'a> {
+    arena: &'a mut ExprArena,
+    parameters: &'a [SymbolId],
+}
+
+impl Planner<'_> {
+    fn tape(&mut self, roots: &[ExprId]) -> Tape {
+        let roots = trig::expand_angle_sums(self.arena, roots);
+        let plan = cse::plan(self.arena, &roots, "__e");
+        Tape::from_plan(self.arena, &plan, self.parameters)
+    }
+}
+
+/// The outputs of a row-major `n × n` matrix in column-major order.
+fn column_major_order(row_major: &[u32], n: usize) -> Vec<u32> {
+    (0..n * n)
+        .filter_map(|k| row_major.get((k % n) * n + k / n).copied())
+        .collect()
+}
+
+fn transposed(mut tape: Tape, n: usize) -> Tape {
+    tape.outputs = column_major_order(&tape.outputs, n);
+    tape
+}
