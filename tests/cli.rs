@@ -472,12 +472,14 @@ fn failed_integrations_explain_themselves_and_keep_their_samples() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("help: "));
 }
 
-/// `eomgen check` on every broken file of the compile-fail suite (`tests/ui/<category>/`)
-/// prints the same diagnostics as the compile error: each `error: FILE:line:col: message`
-/// headline of the recorded `.stderr` appears in `check`'s output for that file (the path
-/// prefix differs: the macro names the file as written in `model!`), and the exit status is 1.
+/// `eomgen check` (which derives the file at run time) and `eomgen simulate` (which compiles
+/// it at run time) on every broken file of the compile-fail suite (`tests/ui/<category>/`)
+/// print the same diagnostics as the compile error: each `error: FILE:line:col: message`
+/// headline of the recorded `.stderr` appears in the output for that file (the path prefix
+/// differs: the macro names the file as written in `model!`), the exit status is 2, and with
+/// `--json` standard output is the JSON object of the diagnostics, one entry per headline.
 #[test]
-fn check_prints_the_compile_errors_of_every_ui_case() {
+fn check_and_simulate_print_the_compile_errors_of_every_ui_case() {
     let root = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/ui");
     let mut checked = 0;
     let mut categories: Vec<_> = std::fs::read_dir(root).unwrap().flatten().collect();
@@ -492,16 +494,39 @@ fn check_prints_the_compile_errors_of_every_ui_case() {
         files.sort();
         for yaml in files {
             let expected = std::fs::read_to_string(yaml.with_extension("stderr")).unwrap();
-            let out = eomgen(&["check", yaml.to_str().unwrap()]);
-            assert_eq!(out.status.code(), Some(1), "{}", yaml.display());
-            let got = String::from_utf8_lossy(&out.stderr);
-            for line in expected.lines().filter(|l| l.starts_with("error: ")) {
-                let Some((_, rest)) = line.split_once(".yaml:") else {
-                    continue;
-                };
+            let headlines: Vec<&str> = expected
+                .lines()
+                .filter(|l| l.starts_with("error: "))
+                .filter_map(|l| l.split_once(".yaml:").map(|(_, rest)| rest))
+                .collect();
+            let path = yaml.to_str().unwrap();
+            for command in ["check", "simulate"] {
+                let out = eomgen(&[command, path]);
+                assert_eq!(out.status.code(), Some(2), "{command} {}", yaml.display());
+                let got = String::from_utf8_lossy(&out.stderr);
+                for rest in &headlines {
+                    assert!(
+                        got.contains(&format!(".yaml:{rest}")),
+                        "{}: `{command}` does not print `{rest}`:\n{got}",
+                        yaml.display()
+                    );
+                }
+            }
+            let out = eomgen(&["simulate", path, "--json"]);
+            assert_eq!(out.status.code(), Some(2), "{}", yaml.display());
+            let json: serde_json::Value = serde_json::from_slice(&out.stdout)
+                .unwrap_or_else(|e| panic!("{}: not JSON ({e})", yaml.display()));
+            let diagnostics = json["diagnostics"].as_array().unwrap();
+            assert!(json["error"].is_string());
+            for rest in &headlines {
                 assert!(
-                    got.contains(&format!(".yaml:{rest}")),
-                    "{}: `check` does not print `{rest}`:\n{got}",
+                    diagnostics.iter().any(|d| {
+                        let (line, column) = (d["line"].as_u64().unwrap(), d["column"].as_u64().unwrap());
+                        let message = d["message"].as_str().unwrap();
+                        *rest == format!("{line}:{column}: {message}")
+                            && d["file"].as_str() == Some(path)
+                    }),
+                    "{}: JSON lacks `{rest}`: {json}",
                     yaml.display()
                 );
             }

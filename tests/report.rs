@@ -422,3 +422,45 @@ fn full_report_passes_on_every_model() {
     assert_eq!(report["summary"]["failed"], 0);
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `report --models FILE` runs the file's own equations, compiled at run time, even when the
+/// file is a copy of a bundled model (issue 18): a copy of `double_pendulum.yaml` with
+/// `g: 1000` reports natural frequencies √100 = 10 times the bundled model's (ω ∝ √g), and
+/// its `checks:`, whose reference values are expressions of `g`, pass.
+#[test]
+fn report_on_a_file_runs_the_files_own_equations() {
+    let source = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/models/double_pendulum.yaml"
+    ))
+    .unwrap();
+    assert!(source.contains("  g: 10.0"));
+    let dir = out_dir("file-model");
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("heavy_gravity.yaml");
+    std::fs::write(&file, source.replace("  g: 10.0", "  g: 1000.0")).unwrap();
+    let bundled = out_dir("file-model-bundled");
+    report_ok(Some("double_pendulum"), &bundled);
+    let copied = dir.join("report");
+    report_ok(Some(file.to_str().unwrap()), &copied);
+    let frequency = |dir: &Path| -> Vec<f64> {
+        let report = read_json(dir);
+        checks(&report, "double_pendulum")
+            .iter()
+            .filter(|c| c["check"].as_str().unwrap_or_default().contains("natural frequenc"))
+            .map(|c| c["computed"].as_f64().expect("computed"))
+            .collect()
+    };
+    let (slow, fast) = (frequency(&bundled), frequency(&copied));
+    assert!(!slow.is_empty() && slow.len() == fast.len(), "{slow:?} {fast:?}");
+    for (s, f) in slow.iter().zip(&fast) {
+        assert!((f / s - 10.0).abs() < 1e-9, "ω ratio {} (bundled {s}, file {f})", f / s);
+    }
+    let report = read_json(&copied);
+    assert!(
+        checks(&report, "double_pendulum")
+            .iter()
+            .all(|c| c["passed"] == true),
+        "{report}"
+    );
+}

@@ -88,7 +88,7 @@ pub struct Inputs<'a> {
 
 #[cfg(test)]
 mod tests {
-    use eomgen_symbolic::codegen::program::ModelProgram;
+    use eomgen_symbolic::codegen::program::{JacobianProgram, ModelProgram};
 
     use super::*;
 
@@ -107,7 +107,7 @@ mod tests {
         }
     }
 
-    pub(crate) fn bundled_programs() -> Vec<(String, ModelProgram)> {
+    pub(crate) fn bundled_programs() -> Vec<(String, ModelProgram, JacobianProgram)> {
         let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../models");
         let mut paths: Vec<_> = std::fs::read_dir(dir)
             .expect("models/ is readable")
@@ -123,9 +123,9 @@ mod tests {
                 let source = std::fs::read_to_string(&path).expect("model file is readable");
                 let file = eomgen_symbolic::model::load(&display, &source)
                     .unwrap_or_else(|d| panic!("{display}: {d:?}"));
-                let program =
+                let (program, derivation) =
                     ModelProgram::from_file(&file).unwrap_or_else(|e| panic!("{display}: {e:?}"));
-                (display, program)
+                (display, program, derivation.jacobians())
             })
             .collect()
     }
@@ -139,11 +139,16 @@ mod tests {
     fn native_code_equals_the_interpreter_bit_for_bit_on_every_bundled_model() {
         let mut random = Random(0x9E37_79B9_7F4A_7C15);
         let mut compared = 0usize;
-        for (display, program) in bundled_programs() {
-            let code = native::compile(&program).unwrap_or_else(|e| panic!("{display}: {e}"));
+        for (display, program, jacobians) in bundled_programs() {
+            let functions: Vec<_> = program
+                .functions()
+                .into_iter()
+                .chain(jacobians.functions())
+                .collect();
+            let code = native::compile(&functions).unwrap_or_else(|e| panic!("{display}: {e}"));
             let n = program.num_dofs();
             let m = program.constraint_names.len();
-            for (index, (name, function)) in program.functions().into_iter().enumerate() {
+            for (index, (name, function)) in functions.into_iter().enumerate() {
                 let Some(compiled) = code.functions[index] else {
                     assert!(function.tape.outputs.is_empty(), "{display}: {name}");
                     continue;

@@ -2,13 +2,13 @@
 
 use std::borrow::Cow;
 use std::cell::RefCell;
-use std::sync::Arc;
+use std::sync::{Arc, Mutex, OnceLock};
 
 use eomgen_runtime::{
     BodyCentre, DynMechanicalSystem, EventDirection, EventSpec, UnknownParameter,
 };
 use eomgen_symbolic::codegen::GenerateError;
-use eomgen_symbolic::codegen::program::{FunctionTape, ModelProgram};
+use eomgen_symbolic::codegen::program::{Derivation, FunctionTape, JacobianProgram, ModelProgram};
 use eomgen_symbolic::codegen::tape::{Input, Instruction};
 use eomgen_symbolic::model::{Crossing, Diagnostic};
 
@@ -56,26 +56,34 @@ pub struct LoadOptions {
     /// `Some(Backend::Interpreter)` never compiles; `Some(Backend::Native)` makes an
     /// unsupported host an error ([`CompileError::UnsupportedHost`]).
     pub backend: Option<Backend>,
+    /// Derive and compile the exact Jacobians (`∂F/∂q`, `∂F/∂q̇`, `∂(M a)/∂q`) at load time
+    /// rather than when first used (the default: simulation with an explicit method never
+    /// uses them, and for a 40-link chain they are three quarters of the code).
+    pub eager_jacobians: bool,
 }
 
-/// The functions of a model in the order of [`ModelProgram::functions`].
-#[derive(Debug, Clone, Copy)]
+/// The functions of a model: the first eleven in the order of [`ModelProgram::functions`],
+/// then the Jacobians in the order of [`JacobianProgram::functions`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Routine {
     InitialState = 0,
     MassMatrixAndForcing = 1,
-    ForcingJacobianQ = 2,
-    ForcingJacobianQdot = 3,
-    MassMatrixProductJacobian = 4,
-    KineticEnergy = 5,
-    PotentialEnergy = 6,
-    PointPositions = 7,
-    ConstraintResiduals = 8,
-    ConstraintJacobian = 9,
-    ConstraintVelocityResiduals = 10,
-    ConstraintGamma = 11,
-    EventValues = 12,
-    EquilibriumGuesses = 13,
+    KineticEnergy = 2,
+    PotentialEnergy = 3,
+    PointPositions = 4,
+    ConstraintResiduals = 5,
+    ConstraintJacobian = 6,
+    ConstraintVelocityResiduals = 7,
+    ConstraintGamma = 8,
+    EventValues = 9,
+    EquilibriumGuesses = 10,
+    ForcingJacobianQ = 11,
+    ForcingJacobianQdot = 12,
+    MassMatrixProductJacobian = 13,
 }
+
+/// Index of the first Jacobian routine.
+const JACOBIANS: usize = Routine::ForcingJacobianQ as usize;
 
 /// How many values a function reads from each input and writes to each output buffer
 /// (largest index + 1), checked before native code is called.
@@ -123,14 +131,91 @@ impl Extent {
     }
 }
 
+/// Functions as tapes, with their extents and (unless interpreted) native code.
+#[derive(Debug)]
+struct Compiled {
+    tapes: Vec<FunctionTape>,
+    extents: Vec<Extent>,
+    native: Option<NativeCode>,
+}
+
+impl Compiled {
+    /// Compiles `functions` with `backend` (`None`: native, interpreting on an unsupported
+    /// host, whose reason is returned).
+    fn new(
+        functions: &[(&str, &FunctionTape)],
+        backend: Option<Backend>,
+    ) -> Result<(Compiled, Option<CompileError>), CompileError> {
+        let (native, fallback_reason) = match backend {
+            Some(Backend::Interpreter) => (None, None),
+            forced => match native::compile(functions) {
+                Ok(code) => (Some(code), None),
+                Err(reason @ CompileError::UnsupportedHost { .. })
+                    if forced != Some(Backend::Native) =>
+                {
+                    (None, Some(reason))
+                }
+                Err(e) => return Err(e),
+            },
+        };
+        let mut compiled = Compiled::interpreted(functions);
+        compiled.native = native;
+        Ok((compiled, fallback_reason))
+    }
+
+    /// The same functions for the interpreter.
+    fn interpreted(functions: &[(&str, &FunctionTape)]) -> Compiled {
+        Compiled {
+            tapes: functions.iter().map(|(_, f)| (*f).clone()).collect(),
+            extents: functions.iter().map(|(_, f)| Extent::of(f)).collect(),
+            native: None,
+        }
+    }
+}
+
+/// The Jacobians, compiled when first needed, and why they are interpreted if they are.
+#[derive(Debug)]
+struct LazyJacobians {
+    compiled: Compiled,
+    fallback_reason: Option<CompileError>,
+}
+
 /// What clones of a model share: the planned functions and their native code.
 #[derive(Debug)]
 struct Code {
     program: ModelProgram,
-    extents: Vec<Extent>,
-    native: Option<NativeCode>,
+    core: Compiled,
+    backend: Option<Backend>,
     fallback_reason: Option<CompileError>,
     events: Vec<EventSpec>,
+    /// The derivation the Jacobians come from, until they are compiled.
+    derivation: Mutex<Option<Derivation>>,
+    jacobians: OnceLock<LazyJacobians>,
+}
+
+impl Code {
+    /// The Jacobians, derived and compiled on first use. A function Cranelift cannot compile
+    /// is interpreted instead (the reason is kept: [`JitModel::fallback_reason`]).
+    fn jacobians(&self) -> &LazyJacobians {
+        self.jacobians.get_or_init(|| {
+            let derivation = match self.derivation.lock() {
+                Ok(mut d) => d.take(),
+                Err(poisoned) => poisoned.into_inner().take(),
+            };
+            let program = derivation.map(Derivation::jacobians).unwrap_or_default();
+            let functions = program.functions();
+            match Compiled::new(&functions, self.backend) {
+                Ok((compiled, fallback_reason)) => LazyJacobians {
+                    compiled,
+                    fallback_reason,
+                },
+                Err(reason) => LazyJacobians {
+                    compiled: Compiled::interpreted(&functions),
+                    fallback_reason: Some(reason),
+                },
+            }
+        })
+    }
 }
 
 thread_local! {
@@ -208,36 +293,28 @@ impl JitModel {
             diagnostics,
         };
         let file = eomgen_symbolic::model::load(path, source).map_err(diagnostics)?;
-        let program = ModelProgram::from_file(&file).map_err(|e| match e {
+        let (program, derivation) = ModelProgram::from_file(&file).map_err(|e| match e {
             GenerateError::Diagnostics(d) => diagnostics(d),
             GenerateError::Emit(message) => LoadError::Generate(message),
         })?;
-        Self::from_program(program, options)
+        Self::from_program(program, derivation, options)
     }
 
-    /// Compiles a planned model ([`ModelProgram::from_file`]).
+    /// Compiles a planned model ([`ModelProgram::from_file`]); the Jacobians are derived from
+    /// `derivation` when first used (or now, with [`LoadOptions::eager_jacobians`]).
     ///
     /// # Errors
     /// [`LoadError::Compile`] naming the function that could not be compiled (or the host,
     /// with `Some(Backend::Native)`).
-    pub fn from_program(program: ModelProgram, options: LoadOptions) -> Result<JitModel, LoadError> {
-        let (native, fallback_reason) = match options.backend {
-            Some(Backend::Interpreter) => (None, None),
-            forced => match native::compile(&program) {
-                Ok(code) => (Some(code), None),
-                Err(reason @ CompileError::UnsupportedHost { .. })
-                    if forced != Some(Backend::Native) =>
-                {
-                    (None, Some(reason))
-                }
-                Err(e) => return Err(e.into()),
-            },
-        };
-        let extents = program
-            .functions()
-            .iter()
-            .map(|(_, f)| Extent::of(f))
-            .collect();
+    pub fn from_program(
+        program: ModelProgram,
+        derivation: Derivation,
+        options: LoadOptions,
+    ) -> Result<JitModel, LoadError> {
+        let (core, fallback_reason) = Compiled::new(&program.functions(), options.backend)?;
+        // The tapes live on in `core`; the program keeps the names and constants.
+        let mut program = program;
+        program.clear_tapes();
         let events = program
             .events
             .iter()
@@ -252,71 +329,74 @@ impl JitModel {
             })
             .collect();
         let parameters = program.parameters.iter().map(|(_, v)| *v).collect();
-        Ok(JitModel {
-            code: Arc::new(Code {
-                program,
-                extents,
-                native,
-                fallback_reason,
-                events,
-            }),
-            parameters,
-        })
+        let code = Arc::new(Code {
+            program,
+            core,
+            backend: options.backend,
+            fallback_reason,
+            events,
+            derivation: Mutex::new(Some(derivation)),
+            jacobians: OnceLock::new(),
+        });
+        if options.eager_jacobians
+            && let Some(e @ CompileError::Function { .. }) = &code.jacobians().fallback_reason
+        {
+            return Err(e.clone().into());
+        }
+        Ok(JitModel { code, parameters })
     }
 
-    /// Which evaluator runs this model's functions.
+    /// Which evaluator runs this model's functions (its Jacobians, compiled when first used,
+    /// run natively too unless [`Self::fallback_reason`] says otherwise).
     pub fn backend(&self) -> Backend {
-        if self.code.native.is_some() {
+        if self.code.core.native.is_some() {
             Backend::Native
         } else {
             Backend::Interpreter
         }
     }
 
-    /// Why the model is interpreted although native code was asked for (`None` when it runs
-    /// natively, or when the interpreter was chosen).
+    /// Why functions of the model are interpreted although native code was asked for: the
+    /// host has no code generator, or (for the Jacobians, compiled on first use) Cranelift
+    /// failed on one; `None` when everything compiled so far runs natively or the
+    /// interpreter was chosen.
     pub fn fallback_reason(&self) -> Option<&CompileError> {
-        self.code.fallback_reason.as_ref()
+        self.code.fallback_reason.as_ref().or_else(|| {
+            self.code
+                .jacobians
+                .get()
+                .and_then(|j| j.fallback_reason.as_ref())
+        })
     }
 
-    /// Bytes of machine code of the model's functions (0 when interpreted); the executable
-    /// memory mapped for them is this rounded up to whole pages, and is unmapped when the
-    /// last clone of the model is dropped.
+    /// Bytes of machine code of the model's functions so far (0 when interpreted; the
+    /// Jacobians count once compiled). The executable memory mapped for them is this rounded
+    /// up to whole pages, and is unmapped when the last clone of the model is dropped.
     pub fn code_bytes(&self) -> usize {
-        self.code.native.as_ref().map_or(0, |n| n.code_bytes)
-    }
-
-    /// The planned functions (straight-line programs) this model evaluates.
-    pub fn program(&self) -> &ModelProgram {
-        &self.code.program
-    }
-
-    /// The same model evaluated by the interpreter (sharing nothing with `self` but the
-    /// plan): the reference that tests compare the native code with.
-    pub fn interpreted(&self) -> JitModel {
-        let mut model = match Self::from_program(
-            self.code.program.clone(),
-            LoadOptions {
-                backend: Some(Backend::Interpreter),
-            },
-        ) {
-            Ok(m) => m,
-            // Interpretation compiles nothing and cannot fail.
-            Err(_) => return self.clone(),
-        };
-        model.parameters.clone_from(&self.parameters);
-        model
+        let bytes = |c: &Compiled| c.native.as_ref().map_or(0, |n| n.code_bytes);
+        bytes(&self.code.core)
+            + self
+                .code
+                .jacobians
+                .get()
+                .map_or(0, |j| bytes(&j.compiled))
     }
 
     fn run(&self, routine: Routine, inputs: Inputs<'_>, out0: &mut [f64], out1: &mut [f64]) {
-        let index = routine as usize;
-        let extent = self.code.extents[index];
+        let (compiled, index) = match routine as usize {
+            i if i < JACOBIANS => (&self.code.core, i),
+            i => (&self.code.jacobians().compiled, i - JACOBIANS),
+        };
+        let (Some(extent), Some(tape)) = (compiled.extents.get(index), compiled.tapes.get(index))
+        else {
+            return;
+        };
         assert!(
             extent.admits(&inputs, out0.len(), out1.len()),
             "model `{}`: a slice passed to {routine:?} is shorter than its shape",
             self.code.program.name
         );
-        match self.code.native.as_ref().and_then(|n| n.functions[index]) {
+        match compiled.native.as_ref().and_then(|n| n.functions[index]) {
             Some(f) => {
                 // SAFETY: `f` was compiled from this routine's tape, which reads at most
                 // `extent` values of each input and writes `extent.out0`/`out1` values, and
@@ -334,19 +414,12 @@ impl JitModel {
                     )
                 }
             }
-            None => {
-                let (_, function) = self.code.program.functions()[index];
-                SCRATCH.with(|scratch| match scratch.try_borrow_mut() {
-                    Ok(mut values) => {
-                        interpret::evaluate(function, &inputs, &mut values, out0, out1)
-                    }
-                    // Re-entered on this thread (cannot happen: evaluation calls no model
-                    // code); use a fresh buffer rather than fail.
-                    Err(_) => {
-                        interpret::evaluate(function, &inputs, &mut Vec::new(), out0, out1)
-                    }
-                });
-            }
+            None => SCRATCH.with(|scratch| match scratch.try_borrow_mut() {
+                Ok(mut values) => interpret::evaluate(tape, &inputs, &mut values, out0, out1),
+                // Re-entered on this thread (cannot happen: evaluation calls no model code);
+                // use a fresh buffer rather than fail.
+                Err(_) => interpret::evaluate(tape, &inputs, &mut Vec::new(), out0, out1),
+            }),
         }
     }
 
@@ -520,7 +593,7 @@ impl DynMechanicalSystem for JitModel {
         lambda: &[f64],
         out: &mut [f64],
     ) {
-        let needed = self.code.extents[Routine::EventValues as usize];
+        let needed = self.code.core.extents[Routine::EventValues as usize];
         // A multiplier the caller does not have reads NaN, as in the compiled model.
         let padded: Vec<f64>;
         let lambda = if lambda.len() >= needed.lambda {

@@ -1,7 +1,8 @@
 //! Tapes compiled to native code by Cranelift.
 //!
 //! # What is compiled
-//! Every [`FunctionTape`] of a [`ModelProgram`] becomes one function with the signature
+//! Every [`FunctionTape`] of a model (`eomgen_symbolic::codegen::program::ModelProgram`, and
+//! the Jacobians apart) becomes one function with the signature
 //! [`NativeFn`] (the platform's C calling convention):
 //!
 //! ```text
@@ -32,7 +33,7 @@ use cranelift_frontend::{FunctionBuilder, FunctionBuilderContext};
 use cranelift_jit::{JITBuilder, JITModule};
 use cranelift_module::{FuncId, Linkage, Module, default_libcall_names};
 
-use eomgen_symbolic::codegen::program::{FunctionTape, ModelProgram};
+use eomgen_symbolic::codegen::program::FunctionTape;
 use eomgen_symbolic::codegen::tape::{Function, Input, Instruction};
 
 use crate::math;
@@ -82,7 +83,7 @@ pub enum CompileError {
 
 /// The native code of a model's functions and the memory that holds it.
 pub(crate) struct NativeCode {
-    /// One entry per function of [`ModelProgram::functions`], `None` for an empty tape.
+    /// One entry per function compiled, `None` for an empty tape.
     pub(crate) functions: Vec<Option<NativeFn>>,
     /// Bytes of machine code (without alignment padding and the module's bookkeeping).
     pub(crate) code_bytes: usize,
@@ -145,11 +146,11 @@ struct Imports {
     atan2: FuncId,
 }
 
-/// Compiles every function of `program`.
+/// Compiles `functions` (named for errors) into one module; an empty tape gets no code.
 ///
 /// # Errors
 /// [`CompileError`] naming the host or the function Cranelift could not handle.
-pub(crate) fn compile(program: &ModelProgram) -> Result<NativeCode, CompileError> {
+pub(crate) fn compile(functions: &[(&str, &FunctionTape)]) -> Result<NativeCode, CompileError> {
     let mut flags = settings::builder();
     let set = |flags: &mut settings::Builder, name: &str, value: &str| {
         flags
@@ -230,7 +231,7 @@ pub(crate) fn compile(program: &ModelProgram) -> Result<NativeCode, CompileError
     let mut builder_context = FunctionBuilderContext::new();
     let mut ids: Vec<Option<FuncId>> = Vec::new();
     let mut code_bytes = 0usize;
-    for (index, (name, function)) in program.functions().into_iter().enumerate() {
+    for (index, &(name, function)) in functions.iter().enumerate() {
         if function.tape.outputs.is_empty() {
             ids.push(None);
             continue;

@@ -55,7 +55,8 @@ const GRID: (u8, u8, u8) = (0xe8, 0xe8, 0xe8);
 /// Options of `eomgen animate`.
 #[derive(Debug, Args)]
 pub struct AnimateArgs {
-    /// Model name (see `eomgen list`); it needs a `draw:` block.
+    /// A bundled model's name (see `eomgen list`) or the path of any model file; it needs a
+    /// `draw:` block.
     pub model: String,
     /// What to integrate and how (as `eomgen simulate`).
     #[command(flatten)]

@@ -31,13 +31,8 @@ pub fn run(args: &CheckArgs) -> Result<(), CliError> {
     let (display, source) = super::equations::read_model(&args.model)?;
     let file = eomgen_symbolic::model::load(&display, &source)
         .map_err(|d| super::equations::render(&display, &source, &d))?;
-    let report = check_model(&file, args.states, 0x5EED).map_err(|diagnostics| {
-        let text: Vec<String> = diagnostics
-            .iter()
-            .map(|d| d.render(&display, &source))
-            .collect();
-        CliError::failure(text.join("\n"))
-    })?;
+    let report = check_model(&file, args.states, 0x5EED)
+        .map_err(|diagnostics| super::diagnostics_error(&display, &source, &diagnostics))?;
     if args.json {
         println!(
             "{}",

@@ -45,42 +45,25 @@ pub struct NewArgs {
 
 /// Reads a bundled model by name or any file by path: `(display path, source)`.
 pub fn read_model(model: &str) -> Result<(String, String), CliError> {
-    let is_path = model.ends_with(".yaml") || model.ends_with(".yml") || model.contains('/');
-    let (display, path) = if is_path {
-        (model.to_string(), model.to_string())
-    } else {
-        let entry = eomgen::models::find(model).ok_or_else(|| {
-            let names: Vec<&str> = eomgen::models::ALL.iter().map(|e| e.name).collect();
-            CliError::usage(format!(
-                "no model named `{model}`; models are: {} (or give a path to a .yaml file)",
-                names.join(", ")
-            ))
-        })?;
-        (
+    let (display, path) = match eomgen::resolve(model).map_err(super::open_error)? {
+        eomgen::Resolved::File(path) => (path.clone(), path),
+        eomgen::Resolved::Bundled(entry) => (
             format!("models/{}.yaml", entry.name),
             entry.path.to_string(),
-        )
+        ),
     };
     let source = std::fs::read_to_string(&path)
         .map_err(|e| CliError::usage(format!("cannot read `{display}`: {e}")))?;
     Ok((display, source))
 }
 
-/// Renders diagnostics for the terminal.
+/// Renders diagnostics for the terminal (exit 2; JSON with `--json`).
 pub fn render(
     display: &str,
     source: &str,
     diagnostics: &[eomgen_symbolic::model::Diagnostic],
 ) -> CliError {
-    let text: Vec<String> = diagnostics
-        .iter()
-        .map(|d| d.render(display, source))
-        .collect();
-    CliError::failure(format!(
-        "{} error(s) in the model file\n{}",
-        diagnostics.len(),
-        text.join("\n")
-    ))
+    super::diagnostics_error(display, source, diagnostics)
 }
 
 /// Runs `equations`.

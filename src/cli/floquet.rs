@@ -35,7 +35,8 @@ use super::values::{evaluate, parameter_lookup, set_parameters, split_assignment
 /// Options of `eomgen study floquet`.
 #[derive(Debug, Args)]
 pub struct FloquetArgs {
-    /// A model whose forcing has period 2π/w (`mathieu_pendulum`).
+    /// A model whose forcing has period 2π/w (`mathieu_pendulum`): a bundled name or the path
+    /// of any model file.
     pub model: String,
     #[command(flatten)]
     pub point: OperatingPointArgs,
@@ -311,8 +312,7 @@ fn run_sweep(
     y: &Axis,
     options: &FloquetOptions,
 ) -> Result<Vec<Vec<Cell>>, CliError> {
-    let entry = eomgen::models::find(&args.model)
-        .ok_or_else(|| CliError::usage(format!("no model named `{}`", args.model)))?;
+    let source = super::open_model(&args.model)?;
     let total = x.values.len() * y.values.len();
     let bar = indicatif::ProgressBar::new(total as u64);
     if let Ok(style) = indicatif::ProgressStyle::with_template(
@@ -325,7 +325,7 @@ fn run_sweep(
         .into_par_iter()
         .map(|k| {
             let (i, j) = (k / y.values.len(), k % y.values.len());
-            let mut model = (entry.make)();
+            let mut model = source.instantiate();
             let cell = (|| {
                 set_parameters(model.as_mut(), &args.point.set).map_err(|e| e.message)?;
                 for (axis, value) in [(x, x.values[i]), (y, y.values[j])] {

@@ -21,7 +21,7 @@ use super::values::{evaluate, parameter_lookup, split_assignment};
 /// Options of `eomgen study free-response`.
 #[derive(Debug, Args)]
 pub struct FreeResponseArgs {
-    /// Model name (see `eomgen list`).
+    /// A bundled model's name (see `eomgen list`) or the path of any model file.
     pub model: String,
     #[command(flatten)]
     pub point: OperatingPointArgs,

@@ -24,7 +24,7 @@ use super::{CliError, plot};
 /// Options of `eomgen frf`.
 #[derive(Debug, Args)]
 pub struct FrfArgs {
-    /// Model name (see `eomgen list`).
+    /// A bundled model's name (see `eomgen list`) or the path of any model file.
     pub model: String,
     /// The input: a parameter that enters the forcing linearly (a load amplitude, `A` in
     /// `A*cos(w*t)`; its time function is taken at t = 0, so for `A*cos(w*t)` the response is

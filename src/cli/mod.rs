@@ -74,6 +74,8 @@ pub struct CliError {
     pub message: String,
     /// Exit status (2 usage, 1 failure of the computation).
     pub code: u8,
+    /// What `--json` prints on standard output for this error (model-file diagnostics).
+    pub json: Option<serde_json::Value>,
 }
 
 impl CliError {
@@ -81,12 +83,14 @@ impl CliError {
         Self {
             message: message.into(),
             code: 2,
+            json: None,
         }
     }
     fn failure(message: impl Into<String>) -> Self {
         Self {
             message: message.into(),
             code: 1,
+            json: None,
         }
     }
 }
@@ -109,6 +113,13 @@ pub fn run() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
+            // Every command that reports numbers takes `--json`; an error with a JSON form
+            // (a model file's diagnostics) is then printed as JSON on standard output too.
+            if let Some(json) = &e.json
+                && std::env::args().any(|a| a == "--json")
+            {
+                println!("{}", serde_json::to_string_pretty(json).unwrap_or_default());
+            }
             eprintln!("error: {}", e.message);
             ExitCode::from(e.code)
         }
@@ -141,18 +152,80 @@ fn list(json: bool) -> Result<(), CliError> {
     Ok(())
 }
 
-/// The bundled model named `name`, with its default parameters.
-fn find_model(name: &str) -> Result<Box<dyn eomgen::ModelInfo>, CliError> {
-    if let Some(entry) = eomgen::models::find(name) {
-        return Ok((entry.make)());
-    }
-    let names: Vec<&str> = eomgen::models::ALL.iter().map(|e| e.name).collect();
-    let hint = match eomgen_symbolic::model::parser::closest(name, &names) {
-        Some(c) => format!("did you mean `{c}`? "),
-        None => String::new(),
+/// The model `name_or_path` names, with its default parameters: a bundled model, or a model
+/// file compiled at run time ([`eomgen::ModelSource::open`]).
+fn find_model(name_or_path: &str) -> Result<Box<dyn eomgen::ModelInfo>, CliError> {
+    Ok(open_model(name_or_path)?.instantiate())
+}
+
+/// [`eomgen::ModelSource::open`] with its errors as the CLI reports them. A file is loaded
+/// and compiled once per process: the commands that simulate a model several times (`report`,
+/// the studies, `animate`) name it again by its path, and each use gets a fresh instance of
+/// the same compiled code.
+fn open_model(name_or_path: &str) -> Result<eomgen::ModelSource, CliError> {
+    static FILES: std::sync::Mutex<Vec<(String, eomgen::ModelSource)>> =
+        std::sync::Mutex::new(Vec::new());
+    let cached = |files: &[(String, eomgen::ModelSource)]| {
+        files
+            .iter()
+            .find(|(path, _)| path == name_or_path)
+            .map(|(_, s)| s.clone())
     };
-    Err(CliError::usage(format!(
-        "no model named `{name}`; {hint}models are: {} (see `eomgen list`)",
-        names.join(", ")
-    )))
+    if let Ok(files) = FILES.lock()
+        && let Some(source) = cached(&files)
+    {
+        return Ok(source);
+    }
+    let source = eomgen::ModelSource::open(name_or_path).map_err(open_error)?;
+    if source.is_file()
+        && let Ok(mut files) = FILES.lock()
+    {
+        files.push((name_or_path.to_string(), source.clone()));
+    }
+    Ok(source)
+}
+
+/// A model that could not be opened: an unknown name or an unreadable file is a usage error
+/// (exit 2), and so is a file with mistakes, whose located diagnostics are rendered with
+/// their source lines (and, for `--json`, given as JSON on standard output).
+fn open_error(error: eomgen::OpenError) -> CliError {
+    match error {
+        eomgen::OpenError::Load(eomgen::LoadError::Diagnostics {
+            path,
+            source,
+            diagnostics,
+        }) => diagnostics_error(&path, &source, &diagnostics),
+        eomgen::OpenError::Load(e @ eomgen::LoadError::Compile(_))
+        | eomgen::OpenError::Load(e @ eomgen::LoadError::Generate(_)) => {
+            CliError::failure(e.to_string())
+        }
+        other => CliError::usage(other.to_string()),
+    }
+}
+
+/// The error of a model file with mistakes: every diagnostic rendered for the terminal, exit
+/// 2, and the JSON object `{"error", "diagnostics": [{"file", "line", "column", "message",
+/// "help"}]}` for `--json`.
+fn diagnostics_error(
+    path: &str,
+    source: &str,
+    diagnostics: &[eomgen_symbolic::model::Diagnostic],
+) -> CliError {
+    let text: Vec<String> = diagnostics.iter().map(|d| d.render(path, source)).collect();
+    let summary = format!("{} error(s) in the model file `{path}`", diagnostics.len());
+    let json = serde_json::json!({
+        "error": summary,
+        "diagnostics": diagnostics.iter().map(|d| serde_json::json!({
+            "file": path,
+            "line": d.location.line,
+            "column": d.location.column,
+            "message": d.message,
+            "help": d.help,
+        })).collect::<Vec<_>>(),
+    });
+    CliError {
+        message: format!("{summary}\n{}", text.join("\n")),
+        code: 2,
+        json: Some(json),
+    }
 }

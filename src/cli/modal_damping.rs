@@ -20,7 +20,8 @@ use super::plot::Series;
 /// Options of `eomgen study modal-damping`.
 #[derive(Debug, Args)]
 pub struct ModalDampingArgs {
-    /// Model name (see `eomgen list`), with a damping matrix (`three_masses_damped`).
+    /// A bundled model's name (see `eomgen list`) or the path of any model file, with a
+    /// damping matrix (`three_masses_damped`).
     pub model: String,
     #[command(flatten)]
     pub point: OperatingPointArgs,

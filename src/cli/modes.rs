@@ -17,7 +17,7 @@ use super::{CliError, find_model};
 /// Options of `eomgen modes`.
 #[derive(Debug, Args)]
 pub struct ModesArgs {
-    /// Model name (see `eomgen list`).
+    /// A bundled model's name (see `eomgen list`) or the path of any model file.
     pub model: String,
     #[command(flatten)]
     pub point: OperatingPointArgs,

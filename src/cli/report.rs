@@ -24,7 +24,6 @@ use clap::{Args, ValueEnum};
 use rayon::prelude::*;
 use serde_json::json;
 
-use eomgen::models::ModelEntry;
 use eomgen::{ModelInfo, OutputTimes, Solution, damped_modes};
 use eomgen_symbolic::codegen::equations_mathml;
 use eomgen_symbolic::mechanics::check::check_model;
@@ -55,8 +54,8 @@ const SAMPLES: usize = 1001;
 /// Options of `eomgen report`.
 #[derive(Debug, Args)]
 pub struct ReportArgs {
-    /// Models, comma separated: bundled names, or paths of model files whose `name:` is a
-    /// bundled model's (the file's `checks:` then run on that model's compiled equations).
+    /// Models, comma separated: bundled names (their compiled equations), or paths of any
+    /// model files (each file's own equations, compiled at run time, and its `checks:`).
     /// Default: every bundled model.
     #[arg(long, value_delimiter = ',')]
     pub models: Vec<String>,
@@ -159,12 +158,13 @@ impl ModelReport {
     }
 }
 
-/// A model to report on: its file and its compiled equations.
+/// A model to report on: its file and its compiled equations (bundled, or the file's own
+/// compiled at run time).
 struct Source {
     display: String,
     text: String,
     file: ModelFile,
-    entry: &'static ModelEntry,
+    model: eomgen::ModelSource,
 }
 
 /// Runs `report`.
@@ -253,40 +253,20 @@ fn sources(models: &[String]) -> Result<Vec<Source>, CliError> {
         let (display, text) = super::equations::read_model(name)?;
         let file = eomgen_symbolic::model::load(&display, &text)
             .map_err(|d| super::equations::render(&display, &text, &d))?;
-        let entry = eomgen::models::find(&file.name.value).ok_or_else(|| {
-            CliError::usage(format!(
-                "`{display}` names the model `{}`, which is not bundled: the report runs the compiled equations of a bundled model (see `eomgen list`)",
-                file.name.value
-            ))
-        })?;
-        let compiled = (entry.make)();
-        let coordinates: Vec<&str> = file
-            .coordinates
-            .iter()
-            .map(|c| c.name.value.as_str())
-            .collect();
-        let parameters: Vec<&str> = file
-            .parameters
-            .iter()
-            .map(|p| p.name.value.as_str())
-            .collect();
-        if coordinates != compiled.coordinate_names() || parameters != compiled.parameter_names() {
-            return Err(CliError::usage(format!(
-                "`{display}` has other coordinates or parameters than the bundled `{}`: the report can only run its checks on the compiled model",
-                entry.name
-            )));
-        }
-        if out.iter().any(|s| s.entry.name == entry.name) {
+        // A bundled name runs the compiled model; a path runs the file's own equations,
+        // compiled at run time (even for a copy of a bundled model).
+        let model = super::open_model(name)?;
+        if out.iter().any(|s| s.model.name() == model.name()) {
             return Err(CliError::usage(format!(
                 "`{}` is named twice in --models",
-                entry.name
+                model.name()
             )));
         }
         out.push(Source {
             display,
             text,
             file,
-            entry,
+            model,
         });
     }
     Ok(out)
@@ -478,7 +458,7 @@ fn modal_rows(
 fn report_model(source: &Source, dir: &Path) -> ModelReport {
     let started = Instant::now();
     let file = &source.file;
-    let mut model = (source.entry.make)();
+    let mut model = source.model.instantiate();
     let mut report = ModelReport {
         name: model.name().to_string(),
         description: model.description().to_string(),
@@ -563,6 +543,8 @@ fn motion_checks(
 ) {
     let file = &source.file;
     let name = report.name.clone();
+    // How the CLI names this model again: a bundled name, or the file's path.
+    let spec = source.model.argument().to_string();
     let ModelReport {
         checks,
         figures,
@@ -570,14 +552,14 @@ fn motion_checks(
         ..
     } = report;
     let mut runs: Memo<Run, Solution> = Memo::new();
-    let simulated = |run: &Run| simulate(&name, *run, None);
+    let simulated = |run: &Run| simulate(&spec, *run, None);
     let mut operating_points: Memo<Option<String>, OperatingPoint> = Memo::new();
     let operating_point = |at: &Option<String>| {
         let point = super::modes::OperatingPointArgs {
             at: at.clone(),
             set: Vec::new(),
         };
-        operating_point_of(&name, &point).map_err(|e| e.message)
+        operating_point_of(&spec, &point).map_err(|e| e.message)
     };
     let default_run = Run::default();
 
@@ -745,7 +727,7 @@ fn motion_checks(
                     t_end: t,
                     ..Run::of(&check.run)
                 };
-                let state = simulate(&name, run, Some(vec![t])).and_then(|s| {
+                let state = simulate(&spec, run, Some(vec![t])).and_then(|s| {
                     s.last()
                         .filter(|(ts, _)| *ts == t)
                         .map(|(_, y)| y.to_vec())
@@ -854,7 +836,7 @@ fn motion_checks(
             Err(e) => notes.push(format!("mode shapes: {e}")),
         }
     }
-    report.animation = animation(&name, &model_dir, &mut report.notes);
+    report.animation = animation(&spec, &model_dir, &mut report.notes);
 }
 
 /// Writes the model's animation, `NAME/animation.html` (`eomgen animate NAME` with the

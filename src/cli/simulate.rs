@@ -86,7 +86,7 @@ pub enum StabilizationArg {
 /// Options of `eomgen simulate`.
 #[derive(Debug, Args)]
 pub struct SimulateArgs {
-    /// Model name (see `eomgen list`).
+    /// A bundled model's name (see `eomgen list`) or the path of any model file.
     pub model: String,
     /// Output times, comma separated (expressions allowed), e.g. `--t-out 1,2,2.5`; samples
     /// come from dense output at exactly these times. Default: every accepted step.

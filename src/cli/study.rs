@@ -47,7 +47,8 @@ pub enum Study {
 /// Options of `eomgen study constraint-methods`.
 #[derive(Debug, Args)]
 pub struct ConstraintMethodsArgs {
-    /// A model with holonomic constraints (`simple_pendulum_cartesian`, `two_masses_rod`, …).
+    /// A model with holonomic constraints (`simple_pendulum_cartesian`, `two_masses_rod`, …):
+    /// a bundled name or the path of any model file.
     pub model: String,
     /// End time (s).
     #[arg(long, default_value_t = 10.0)]

@@ -55,7 +55,7 @@ const MAX_REPEATS: usize = 1000;
 /// Options of `eomgen study work-precision MODEL`.
 #[derive(Debug, Args)]
 pub struct WorkPrecisionArgs {
-    /// Model name (see `eomgen list`).
+    /// A bundled model's name (see `eomgen list`) or the path of any model file.
     pub model: String,
     /// Methods to compare, comma separated (default: bs32, dp54, dop853, radau5, rk4,
     /// stormer-verlet).

@@ -72,8 +72,8 @@ pub struct BodyCentreDeclaration {
 /// |---|---|
 /// | `initial_state` | `q(0)` (n), then `q̇(0)` (n) |
 /// | `mass_matrix_and_forcing` | `M` (n × n), then (second buffer) `F` (n) |
-/// | `forcing_jacobian_q`, `forcing_jacobian_qdot` | `∂F/∂q`, `∂F/∂q̇` (n × n) |
-/// | `mass_matrix_product_jacobian` | `∂(M a)/∂q` (n × n), `a` read as the acceleration inputs |
+/// | ([`JacobianProgram`]) `forcing_jacobian_q`, `forcing_jacobian_qdot` | `∂F/∂q`, `∂F/∂q̇` (n × n) |
+/// | ([`JacobianProgram`]) `mass_matrix_product_jacobian` | `∂(M a)/∂q` (n × n), `a` read as the acceleration inputs |
 /// | `kinetic_energy`, `potential_energy` | `T`, `V` (1) |
 /// | `point_positions` | `[x, y, z]` per point (3 p; `z = 0` in 2-D) |
 /// | `constraint_residuals` | `Φ` (m_h) |
@@ -123,12 +123,6 @@ pub struct ModelProgram {
     pub initial_state: FunctionTape,
     /// `M`, `F`.
     pub mass_matrix_and_forcing: FunctionTape,
-    /// `∂F/∂q`.
-    pub forcing_jacobian_q: FunctionTape,
-    /// `∂F/∂q̇`.
-    pub forcing_jacobian_qdot: FunctionTape,
-    /// `∂(M a)/∂q`.
-    pub mass_matrix_product_jacobian: FunctionTape,
     /// `T`.
     pub kinetic_energy: FunctionTape,
     /// `V`.
@@ -150,27 +144,28 @@ pub struct ModelProgram {
 }
 
 impl ModelProgram {
-    /// Derives and plans the model of a loaded file, as `eomgen::model!` does.
+    /// Derives and plans the model of a loaded file, as `eomgen::model!` does, all but the
+    /// exact Jacobians, which only the implicit integrators and the linearisation use: the
+    /// returned [`Derivation`] plans them when they are needed ([`Derivation::jacobians`]).
     ///
     /// # Errors
     /// [`GenerateError::Diagnostics`] for a model that cannot be lowered or whose mass matrix
     /// is singular, with the same located diagnostics as the macro.
-    pub fn from_file(file: &ModelFile) -> Result<ModelProgram, GenerateError> {
+    pub fn from_file(file: &ModelFile) -> Result<(ModelProgram, Derivation), GenerateError> {
         let mut model = SymbolicModel::from_file(file).map_err(GenerateError::Diagnostics)?;
         let (eom, formulation) = crate::mechanics::cheapest_equations(&mut model);
         let problems = crate::mechanics::mass_matrix_diagnostics(&model, &eom, file);
         if !problems.is_empty() {
             return Err(GenerateError::Diagnostics(problems));
         }
-        let jacobians = Jacobians::of(&mut model, &eom);
-        Ok(Self::plan(&model, &eom, &jacobians, formulation))
+        let program = Self::plan(&model, &eom, formulation);
+        Ok((program, Derivation { model, eom }))
     }
 
-    /// The tapes of a derived model (the run-time twin of [`super::emit`]).
+    /// The tapes of a derived model but its Jacobians (the run-time twin of [`super::emit`]).
     pub fn plan(
         model: &SymbolicModel,
         eom: &EquationsOfMotion,
-        jacobians: &Jacobians,
         formulation: &'static str,
     ) -> ModelProgram {
         let n = model.num_dofs();
@@ -182,7 +177,6 @@ impl ModelProgram {
             arena: &mut arena,
             parameters: &parameters,
         };
-        let column_major = |tape: Tape| FunctionTape::single(transposed(tape, n));
 
         let initial_state =
             planner.tape(&[model.initial_q.clone(), model.initial_qdot.clone()].concat());
@@ -197,9 +191,6 @@ impl ModelProgram {
             tape: mass_and_forcing,
             split: n * n,
         };
-        let forcing_jacobian_q = column_major(planner.tape(&jacobians.forcing_q));
-        let forcing_jacobian_qdot = column_major(planner.tape(&jacobians.forcing_qdot));
-        let mass_matrix_product_jacobian = column_major(planner.tape(&jacobians.mass_product_q));
         let kinetic_energy = FunctionTape::single(planner.tape(&[model.kinetic]));
         let potential_energy = FunctionTape::single(planner.tape(&[model.potential]));
         let point_roots: Vec<ExprId> = model
@@ -306,9 +297,6 @@ impl ModelProgram {
             equations_latex: super::equations_latex(model, eom),
             initial_state: FunctionTape::single(initial_state),
             mass_matrix_and_forcing,
-            forcing_jacobian_q,
-            forcing_jacobian_qdot,
-            mass_matrix_product_jacobian,
             kinetic_energy,
             potential_energy,
             point_positions,
@@ -321,22 +309,37 @@ impl ModelProgram {
         }
     }
 
+    /// Drops the tapes, keeping the names and constants (for a backend that has taken its own
+    /// copy of the functions).
+    pub fn clear_tapes(&mut self) {
+        for tape in [
+            &mut self.initial_state,
+            &mut self.mass_matrix_and_forcing,
+            &mut self.kinetic_energy,
+            &mut self.potential_energy,
+            &mut self.point_positions,
+            &mut self.constraint_residuals,
+            &mut self.constraint_jacobian,
+            &mut self.constraint_velocity_residuals,
+            &mut self.constraint_gamma,
+            &mut self.event_values,
+            &mut self.equilibrium_guesses,
+        ] {
+            *tape = FunctionTape::default();
+        }
+    }
+
     /// Number of degrees of freedom `n`.
     pub fn num_dofs(&self) -> usize {
         self.coordinate_names.len()
     }
 
-    /// Every function with its name, in the order of the table above.
-    pub fn functions(&self) -> [(&'static str, &FunctionTape); 14] {
+    /// Every function with its name, in the order of the table above (the Jacobians, planned
+    /// apart, not among them).
+    pub fn functions(&self) -> [(&'static str, &FunctionTape); 11] {
         [
             ("initial_state", &self.initial_state),
             ("mass_matrix_and_forcing", &self.mass_matrix_and_forcing),
-            ("forcing_jacobian_q", &self.forcing_jacobian_q),
-            ("forcing_jacobian_qdot", &self.forcing_jacobian_qdot),
-            (
-                "mass_matrix_product_jacobian",
-                &self.mass_matrix_product_jacobian,
-            ),
             ("kinetic_energy", &self.kinetic_energy),
             ("potential_energy", &self.potential_energy),
             ("point_positions", &self.point_positions),
@@ -350,6 +353,65 @@ impl ModelProgram {
             ("event_values", &self.event_values),
             ("equilibrium_guesses", &self.equilibrium_guesses),
         ]
+    }
+}
+
+/// The derived equations of a model, kept so that its exact Jacobians can be derived and
+/// planned when something first needs them ([`Derivation::jacobians`]): simulation with an
+/// explicit method never does, and for a 40-link chain they are three quarters of the code.
+#[derive(Debug, Clone)]
+pub struct Derivation {
+    model: SymbolicModel,
+    eom: EquationsOfMotion,
+}
+
+/// The exact Jacobians of a model as tapes (column-major `n × n` outputs).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct JacobianProgram {
+    /// `∂F/∂q`.
+    pub forcing_jacobian_q: FunctionTape,
+    /// `∂F/∂q̇`.
+    pub forcing_jacobian_qdot: FunctionTape,
+    /// `∂(M a)/∂q`, `a` read as the acceleration inputs.
+    pub mass_matrix_product_jacobian: FunctionTape,
+}
+
+impl JacobianProgram {
+    /// The three functions with their names.
+    pub fn functions(&self) -> [(&'static str, &FunctionTape); 3] {
+        [
+            ("forcing_jacobian_q", &self.forcing_jacobian_q),
+            ("forcing_jacobian_qdot", &self.forcing_jacobian_qdot),
+            (
+                "mass_matrix_product_jacobian",
+                &self.mass_matrix_product_jacobian,
+            ),
+        ]
+    }
+}
+
+impl Derivation {
+    /// Derives the exact Jacobians `∂F/∂q`, `∂F/∂q̇`, `∂(M a)/∂q`
+    /// ([`crate::mechanics::Jacobians::of`]) and plans them as [`super::emit`] does.
+    pub fn jacobians(mut self) -> JacobianProgram {
+        let n = self.eom.num_dofs;
+        let jacobians = Jacobians::of(&mut self.model, &self.eom);
+        let parameters: Vec<SymbolId> =
+            self.model.parameters.iter().map(|p| p.symbol).collect();
+        let mut planner = Planner {
+            arena: &mut self.model.arena,
+            parameters: &parameters,
+        };
+        let mut column_major = |roots: &[ExprId]| {
+            let mut tape = planner.tape(roots);
+            tape.outputs = column_major_order(&tape.outputs, n);
+            FunctionTape::single(tape)
+        };
+        JacobianProgram {
+            forcing_jacobian_q: column_major(&jacobians.forcing_q),
+            forcing_jacobian_qdot: column_major(&jacobians.forcing_qdot),
+            mass_matrix_product_jacobian: column_major(&jacobians.mass_product_q),
+        }
     }
 }
 
@@ -372,9 +434,4 @@ fn column_major_order(row_major: &[u32], n: usize) -> Vec<u32> {
     (0..n * n)
         .filter_map(|k| row_major.get((k % n) * n + k / n).copied())
         .collect()
-}
-
-fn transposed(mut tape: Tape, n: usize) -> Tape {
-    tape.outputs = column_major_order(&tape.outputs, n);
-    tape
 }

@@ -1,0 +1,144 @@
+//! A model compiled at run time against the same file compiled by `eomgen::model!`, side by
+//! side in one run (issue 18's figures).
+//!
+//! - `load_compile/*`: [`JitModel::load`] of a model file — read, check, derive (the cheaper
+//!   formulation), plan and compile to native code — for the bundled double pendulum and
+//!   the 10-, 20- and 40-link pendulums of `eomgen new n-link-pendulum N` (written to a
+//!   temporary directory). The exact Jacobians are derived and compiled when first used, so
+//!   this is what `eomgen simulate FILE` pays before its first step; `load_compile_eager/*`
+//!   includes them (what `eomgen modes FILE` pays).
+//! - `rhs/*`: one evaluation of the first-order right-hand side `ẏ = [q̇; M⁻¹F]` of the double
+//!   pendulum at a generic state: compiled ([`FirstOrder`]) and run-time ([`DynFirstOrder`]
+//!   over [`JitModel`], native code, and the interpreter).
+//! - `dp54/*`, `dop853/*`: a whole Dormand–Prince 5(4) and DOP853 integration of the double
+//!   pendulum to `t = 10 s` at `rtol = atol = 1e-10`, compiled and run-time.
+//!
+//! Before timing, the run-time right-hand side is checked equal to the compiled one to the bit.
+//!
+//! Run with `cargo bench --bench runtime_model`.
+
+use std::hint::black_box;
+use std::path::PathBuf;
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use eomgen::models::DoublePendulum;
+use eomgen::{
+    Backend, DormandPrince54, DormandPrince853, DynFirstOrder, FirstOrder, Integrator,
+    IntegratorOptions, JitModel, LoadOptions, ModelInfo, OdeSystem, OutputTimes,
+};
+
+/// `[θ₁, θ₂, θ̇₁, θ̇₂]` (rad, rad/s), as in `benches/rhs.rs`.
+const STATE: [f64; 4] = [0.4, 1.9, -0.8, 1.3];
+
+fn double_pendulum_file() -> PathBuf {
+    PathBuf::from(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/models/double_pendulum.yaml"
+    ))
+}
+
+/// Writes `eomgen new n-link-pendulum N` into `dir` and returns its path.
+fn chain_file(dir: &std::path::Path, n: usize) -> PathBuf {
+    let source = eomgen_symbolic::model::templates::n_link_pendulum(n);
+    let path = dir.join(format!("pendulum_{n}.yaml"));
+    std::fs::write(&path, source).expect("the temporary directory is writable");
+    path
+}
+
+fn load_compile(c: &mut Criterion) {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let files: Vec<(String, PathBuf)> = std::iter::once((
+        "double_pendulum".to_string(),
+        double_pendulum_file(),
+    ))
+    .chain([10, 20, 40].map(|n| (format!("{n}_link"), chain_file(dir.path(), n))))
+    .collect();
+    let mut group = c.benchmark_group("load_compile");
+    group.sample_size(10);
+    for (name, path) in &files {
+        group.bench_function(name.as_str(), |b| {
+            b.iter(|| JitModel::load(black_box(path)).expect("loads"))
+        });
+    }
+    group.finish();
+    let mut group = c.benchmark_group("load_compile_eager");
+    group.sample_size(10);
+    let eager = LoadOptions {
+        eager_jacobians: true,
+        ..LoadOptions::default()
+    };
+    for (name, path) in &files[..3] {
+        group.bench_function(name.as_str(), |b| {
+            b.iter(|| JitModel::load_with(black_box(path), eager).expect("loads"))
+        });
+    }
+    group.finish();
+    for (name, path) in &files {
+        let model = JitModel::load_with(path, eager).expect("loads");
+        println!("{name}: {} bytes of machine code", model.code_bytes());
+    }
+}
+
+fn runtime(backend: Option<Backend>) -> DynFirstOrder<JitModel> {
+    let options = LoadOptions {
+        backend,
+        ..LoadOptions::default()
+    };
+    DynFirstOrder::new(JitModel::load_with(double_pendulum_file(), options).expect("loads"))
+}
+
+fn rhs(c: &mut Criterion) {
+    let mut compiled = FirstOrder::new(DoublePendulum::default());
+    let mut native = runtime(None);
+    let mut interpreted = runtime(Some(Backend::Interpreter));
+    let (mut a, mut b) = ([0.0; 4], [0.0; 4]);
+    compiled.rhs(0.0, &STATE, &mut a).expect("evaluates");
+    native.rhs(0.0, &STATE, &mut b).expect("evaluates");
+    assert_eq!(a.map(f64::to_bits), b.map(f64::to_bits), "run-time rhs differs");
+    let mut group = c.benchmark_group("rhs");
+    let mut dy = [0.0; 4];
+    group.bench_function("compiled", |bench| {
+        bench.iter(|| compiled.rhs(0.0, black_box(&STATE), &mut dy))
+    });
+    group.bench_function("runtime_native", |bench| {
+        bench.iter(|| native.rhs(0.0, black_box(&STATE), &mut dy))
+    });
+    group.bench_function("runtime_interpreter", |bench| {
+        bench.iter(|| interpreted.rhs(0.0, black_box(&STATE), &mut dy))
+    });
+    group.finish();
+}
+
+fn integrate(integrator: &dyn Integrator, system: &mut dyn OdeSystem, y0: &[f64]) -> usize {
+    let options = IntegratorOptions::default()
+        .with_rtol(1e-10)
+        .with_atol(1e-10);
+    integrator
+        .integrate(system, 0.0, y0, 10.0, &OutputTimes::Steps, &options)
+        .expect("integrates")
+        .len()
+}
+
+fn runs(c: &mut Criterion) {
+    let mut compiled = FirstOrder::new(DoublePendulum::default());
+    let mut native = runtime(None);
+    let y0 = ModelInfo::initial_state(&compiled);
+    assert_eq!(y0, native.initial_state());
+    let methods: [(&str, Box<dyn Integrator>); 2] = [
+        ("dp54", Box::new(DormandPrince54::new())),
+        ("dop853", Box::new(DormandPrince853::new())),
+    ];
+    for (name, method) in &methods {
+        let mut group = c.benchmark_group(*name);
+        group.bench_function("compiled", |b| {
+            b.iter(|| integrate(method.as_ref(), &mut compiled, black_box(&y0)))
+        });
+        group.bench_function("runtime_native", |b| {
+            b.iter(|| integrate(method.as_ref(), &mut native, black_box(&y0)))
+        });
+        group.finish();
+    }
+}
+
+criterion_group!(benches, rhs, runs, load_compile);
+criterion_main!(benches);

@@ -1,0 +1,154 @@
+//! Naming a model: a bundled model's name, or the path of any model file, compiled at run
+//! time.
+
+use crate::models::ModelEntry;
+use crate::{DynFirstOrder, JitModel, LoadError, ModelInfo};
+
+/// A model named by a user: bundled (compiled into the crate by `eomgen::model!`) or a model
+/// file compiled at run time ([`JitModel`]). Both give the same [`ModelInfo`], so every
+/// analysis takes either.
+///
+/// # Examples
+/// ```
+/// let bundled = eomgen::ModelSource::open("double_pendulum")?;
+/// let model = bundled.instantiate();
+/// assert_eq!(model.num_dofs(), 2);
+/// # Ok::<(), eomgen::OpenError>(())
+/// ```
+#[derive(Debug, Clone)]
+pub enum ModelSource {
+    /// A model of `models/`, compiled in.
+    Bundled(&'static ModelEntry),
+    /// A model file loaded, derived and compiled at run time.
+    File {
+        /// The path as the user gave it.
+        path: String,
+        /// The compiled model (with the file's default parameters).
+        model: JitModel,
+    },
+}
+
+/// Why a model could not be opened by [`ModelSource::open`].
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum OpenError {
+    /// Neither a bundled model nor a file.
+    #[error(
+        "no model named `{name}`: it is not a bundled model ({}models are: {}; see `eomgen list`) nor a file; a path to a model file (`path/to/model.yaml`) works too",
+        suggestion.as_ref().map(|s| format!("did you mean `{s}`? ")).unwrap_or_default(),
+        known.join(", ")
+    )]
+    UnknownModel {
+        /// What was asked for.
+        name: String,
+        /// The closest bundled name, if one is close.
+        suggestion: Option<String>,
+        /// The bundled models' names.
+        known: Vec<String>,
+    },
+    /// The file could not be loaded (read, checked or compiled).
+    #[error(transparent)]
+    Load(#[from] LoadError),
+}
+
+impl ModelSource {
+    /// Opens `name_or_path`: a bundled model's name gives the compiled model; a path (ending
+    /// in `.yaml` or `.yml`, containing a `/`, or naming an existing file) loads that file at
+    /// run time — even if the file is a copy of a bundled model, its own equations run.
+    ///
+    /// # Errors
+    /// [`OpenError::UnknownModel`] for a name that is neither bundled nor a file;
+    /// [`OpenError::Load`] for a file that cannot be read, has mistakes (located
+    /// diagnostics) or cannot be compiled.
+    pub fn open(name_or_path: &str) -> Result<ModelSource, OpenError> {
+        match resolve(name_or_path)? {
+            Resolved::Bundled(entry) => Ok(ModelSource::Bundled(entry)),
+            Resolved::File(path) => {
+                let model = JitModel::load(&path)?;
+                Ok(ModelSource::File { path, model })
+            }
+        }
+    }
+
+    /// A new instance with the file's default parameters.
+    pub fn instantiate(&self) -> Box<dyn ModelInfo> {
+        match self {
+            ModelSource::Bundled(entry) => (entry.make)(),
+            ModelSource::File { model, .. } => Box::new(DynFirstOrder::new(model.clone())),
+        }
+    }
+
+    /// The model's name (its file's `name:`).
+    pub fn name(&self) -> &str {
+        match self {
+            ModelSource::Bundled(entry) => entry.name,
+            ModelSource::File { model, .. } => crate::DynMechanicalSystem::name(model),
+        }
+    }
+
+    /// The model file: a bundled model's file at build time, or the path given.
+    pub fn path(&self) -> &str {
+        match self {
+            ModelSource::Bundled(entry) => entry.path,
+            ModelSource::File { path, .. } => path,
+        }
+    }
+
+    /// How to name this model again on a command line or to [`ModelSource::open`]: a bundled
+    /// model's name, or the file's path.
+    pub fn argument(&self) -> &str {
+        match self {
+            ModelSource::Bundled(entry) => entry.name,
+            ModelSource::File { path, .. } => path,
+        }
+    }
+
+    /// Whether the model was compiled at run time from a file.
+    pub fn is_file(&self) -> bool {
+        matches!(self, ModelSource::File { .. })
+    }
+}
+
+/// What a model name on a command line names, before anything is loaded.
+#[derive(Debug, Clone)]
+pub enum Resolved {
+    /// A bundled model.
+    Bundled(&'static ModelEntry),
+    /// A model file, by the path given.
+    File(String),
+}
+
+/// Resolves `name_or_path` as [`ModelSource::open`] does, without loading anything: a path
+/// (ending in `.yaml` or `.yml`, containing a path separator, or naming an existing file) is
+/// a file, else a bundled model's name.
+///
+/// # Errors
+/// [`OpenError::UnknownModel`] for a name that is neither bundled nor a file.
+pub fn resolve(name_or_path: &str) -> Result<Resolved, OpenError> {
+    let looks_like_path = name_or_path.ends_with(".yaml")
+        || name_or_path.ends_with(".yml")
+        || name_or_path.contains('/')
+        || name_or_path.contains(std::path::MAIN_SEPARATOR);
+    if !looks_like_path && let Some(entry) = crate::models::find(name_or_path) {
+        return Ok(Resolved::Bundled(entry));
+    }
+    if looks_like_path || std::path::Path::new(name_or_path).is_file() {
+        return Ok(Resolved::File(name_or_path.to_string()));
+    }
+    let known: Vec<&str> = crate::models::ALL.iter().map(|e| e.name).collect();
+    Err(OpenError::UnknownModel {
+        name: name_or_path.to_string(),
+        suggestion: eomgen_symbolic::model::parser::closest(name_or_path, &known)
+            .map(str::to_string),
+        known: known.iter().map(|s| s.to_string()).collect(),
+    })
+}
+
+/// Opens `name_or_path` ([`ModelSource::open`]) and instantiates it with its default
+/// parameters.
+///
+/// # Errors
+/// As [`ModelSource::open`].
+pub fn open_model(name_or_path: &str) -> Result<Box<dyn ModelInfo>, OpenError> {
+    Ok(ModelSource::open(name_or_path)?.instantiate())
+}
