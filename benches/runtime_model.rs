@@ -47,12 +47,10 @@ fn chain_file(dir: &std::path::Path, n: usize) -> PathBuf {
 
 fn load_compile(c: &mut Criterion) {
     let dir = tempfile::tempdir().expect("a temporary directory");
-    let files: Vec<(String, PathBuf)> = std::iter::once((
-        "double_pendulum".to_string(),
-        double_pendulum_file(),
-    ))
-    .chain([10, 20, 40].map(|n| (format!("{n}_link"), chain_file(dir.path(), n))))
-    .collect();
+    let files: Vec<(String, PathBuf)> =
+        std::iter::once(("double_pendulum".to_string(), double_pendulum_file()))
+            .chain([10, 20, 40].map(|n| (format!("{n}_link"), chain_file(dir.path(), n))))
+            .collect();
     let mut group = c.benchmark_group("load_compile");
     group.sample_size(10);
     for (name, path) in &files {
@@ -94,7 +92,11 @@ fn rhs(c: &mut Criterion) {
     let (mut a, mut b) = ([0.0; 4], [0.0; 4]);
     compiled.rhs(0.0, &STATE, &mut a).expect("evaluates");
     native.rhs(0.0, &STATE, &mut b).expect("evaluates");
-    assert_eq!(a.map(f64::to_bits), b.map(f64::to_bits), "run-time rhs differs");
+    assert_eq!(
+        a.map(f64::to_bits),
+        b.map(f64::to_bits),
+        "run-time rhs differs"
+    );
     let mut group = c.benchmark_group("rhs");
     let mut dy = [0.0; 4];
     group.bench_function("compiled", |bench| {

@@ -521,7 +521,8 @@ fn check_and_simulate_print_the_compile_errors_of_every_ui_case() {
             for rest in &headlines {
                 assert!(
                     diagnostics.iter().any(|d| {
-                        let (line, column) = (d["line"].as_u64().unwrap(), d["column"].as_u64().unwrap());
+                        let (line, column) =
+                            (d["line"].as_u64().unwrap(), d["column"].as_u64().unwrap());
                         let message = d["message"].as_str().unwrap();
                         *rest == format!("{line}:{column}: {message}")
                             && d["file"].as_str() == Some(path)

@@ -447,14 +447,26 @@ fn report_on_a_file_runs_the_files_own_equations() {
         let report = read_json(dir);
         checks(&report, "double_pendulum")
             .iter()
-            .filter(|c| c["check"].as_str().unwrap_or_default().contains("natural frequenc"))
+            .filter(|c| {
+                c["check"]
+                    .as_str()
+                    .unwrap_or_default()
+                    .contains("natural frequenc")
+            })
             .map(|c| c["computed"].as_f64().expect("computed"))
             .collect()
     };
     let (slow, fast) = (frequency(&bundled), frequency(&copied));
-    assert!(!slow.is_empty() && slow.len() == fast.len(), "{slow:?} {fast:?}");
+    assert!(
+        !slow.is_empty() && slow.len() == fast.len(),
+        "{slow:?} {fast:?}"
+    );
     for (s, f) in slow.iter().zip(&fast) {
-        assert!((f / s - 10.0).abs() < 1e-9, "ω ratio {} (bundled {s}, file {f})", f / s);
+        assert!(
+            (f / s - 10.0).abs() < 1e-9,
+            "ω ratio {} (bundled {s}, file {f})",
+            f / s
+        );
     }
     let report = read_json(&copied);
     assert!(

@@ -57,7 +57,10 @@ fn compare(name: &str, compiled: &mut dyn ModelInfo, runtime: &mut dyn ModelInfo
         &compiled.initial_state(),
         &runtime.initial_state(),
     );
-    let (a, b) = (compiled.equilibrium_guesses(), runtime.equilibrium_guesses());
+    let (a, b) = (
+        compiled.equilibrium_guesses(),
+        runtime.equilibrium_guesses(),
+    );
     assert_eq!(a.len(), b.len());
     for ((na, qa), (nb, qb)) in a.iter().zip(&b) {
         assert_eq!(na, nb);
@@ -85,13 +88,26 @@ fn compare(name: &str, compiled: &mut dyn ModelInfo, runtime: &mut dyn ModelInfo
             compiled.mass_matrix_product_jacobian(t, &y, &a).as_slice(),
             runtime.mass_matrix_product_jacobian(t, &y, &a).as_slice(),
         );
-        assert!(same(compiled.kinetic_energy(t, &y), runtime.kinetic_energy(t, &y)), "{}", at("T"));
         assert!(
-            same(compiled.potential_energy(t, &y), runtime.potential_energy(t, &y)),
+            same(
+                compiled.kinetic_energy(t, &y),
+                runtime.kinetic_energy(t, &y)
+            ),
+            "{}",
+            at("T")
+        );
+        assert!(
+            same(
+                compiled.potential_energy(t, &y),
+                runtime.potential_energy(t, &y)
+            ),
             "{}",
             at("V")
         );
-        let (pc, pr) = (compiled.point_positions(t, &y), runtime.point_positions(t, &y));
+        let (pc, pr) = (
+            compiled.point_positions(t, &y),
+            runtime.point_positions(t, &y),
+        );
         assert_same(&at("points"), pc.as_flattened(), pr.as_flattened());
         let (cc, cr) = (
             compiled.constraint_equations(t, &y),
@@ -99,7 +115,11 @@ fn compare(name: &str, compiled: &mut dyn ModelInfo, runtime: &mut dyn ModelInfo
         );
         assert_same(&at("Phi"), cc.phi.as_slice(), cr.phi.as_slice());
         assert_same(&at("J"), cc.jacobian.as_slice(), cr.jacobian.as_slice());
-        assert_same(&at("Phi_dot"), cc.velocity.as_slice(), cr.velocity.as_slice());
+        assert_same(
+            &at("Phi_dot"),
+            cc.velocity.as_slice(),
+            cr.velocity.as_slice(),
+        );
         assert_same(&at("gamma"), cc.gamma.as_slice(), cr.gamma.as_slice());
 
         let (mut dc, mut dr) = (vec![0.0; dim], vec![0.0; dim]);
@@ -137,7 +157,12 @@ fn runtime_model(path: &str, backend: Option<Backend>) -> Box<dyn ModelInfo> {
     let model = JitModel::load_with(path, LoadOptions { backend })
         .unwrap_or_else(|e| panic!("{path}: {e}"));
     if backend.is_none() {
-        assert_eq!(model.backend(), Backend::Native, "{path}: {:?}", model.fallback_reason());
+        assert_eq!(
+            model.backend(),
+            Backend::Native,
+            "{path}: {:?}",
+            model.fallback_reason()
+        );
     }
     Box::new(DynFirstOrder::new(model))
 }
@@ -169,7 +194,11 @@ fn parameters_set_by_name_agree() {
     for entry in eomgen::models::ALL {
         let mut compiled = (entry.make)();
         let mut runtime = runtime_model(entry.path, None);
-        let names: Vec<String> = compiled.parameter_names().iter().map(|s| s.to_string()).collect();
+        let names: Vec<String> = compiled
+            .parameter_names()
+            .iter()
+            .map(|s| s.to_string())
+            .collect();
         for name in &names {
             let value = random.uniform(0.5, 3.0);
             compiled.set_parameter(name, value).unwrap();
@@ -177,6 +206,11 @@ fn parameters_set_by_name_agree() {
         }
         compare(entry.name, compiled.as_mut(), runtime.as_mut(), 5);
         let error = runtime.set_parameter("no_such_parameter", 1.0).unwrap_err();
-        assert_eq!(error, compiled.set_parameter("no_such_parameter", 1.0).unwrap_err());
+        assert_eq!(
+            error,
+            compiled
+                .set_parameter("no_such_parameter", 1.0)
+                .unwrap_err()
+        );
     }
 }

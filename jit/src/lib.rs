@@ -48,10 +48,10 @@
 
 mod interpret;
 mod math;
-// mod model;
+mod model;
 mod native;
 
-// pub use model::{JitModel, LoadError, LoadOptions};
+pub use model::{JitModel, LoadError, LoadOptions};
 pub use native::CompileError;
 
 /// Which evaluator runs a run-time model's functions.

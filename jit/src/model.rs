@@ -8,7 +8,7 @@ use eomgen_runtime::{
     BodyCentre, DynMechanicalSystem, EventDirection, EventSpec, UnknownParameter,
 };
 use eomgen_symbolic::codegen::GenerateError;
-use eomgen_symbolic::codegen::program::{Derivation, FunctionTape, JacobianProgram, ModelProgram};
+use eomgen_symbolic::codegen::program::{Derivation, FunctionTape, ModelProgram};
 use eomgen_symbolic::codegen::tape::{Input, Instruction};
 use eomgen_symbolic::model::{Crossing, Diagnostic};
 
@@ -35,7 +35,7 @@ pub enum LoadError {
         path: String,
         /// The file's text, for rendering the diagnostics with their source lines
         /// ([`Diagnostic::render`]).
-        source: String,
+        text: String,
         /// Every mistake found, in file order.
         diagnostics: Vec<Diagnostic>,
     },
@@ -63,7 +63,8 @@ pub struct LoadOptions {
 }
 
 /// The functions of a model: the first eleven in the order of [`ModelProgram::functions`],
-/// then the Jacobians in the order of [`JacobianProgram::functions`].
+/// then the Jacobians in the order of
+/// [`JacobianProgram::functions`](eomgen_symbolic::codegen::program::JacobianProgram::functions).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Routine {
     InitialState = 0,
@@ -289,7 +290,7 @@ impl JitModel {
     ) -> Result<JitModel, LoadError> {
         let diagnostics = |diagnostics: Vec<Diagnostic>| LoadError::Diagnostics {
             path: path.to_string(),
-            source: source.to_string(),
+            text: source.to_string(),
             diagnostics,
         };
         let file = eomgen_symbolic::model::load(path, source).map_err(diagnostics)?;
@@ -374,12 +375,7 @@ impl JitModel {
     /// up to whole pages, and is unmapped when the last clone of the model is dropped.
     pub fn code_bytes(&self) -> usize {
         let bytes = |c: &Compiled| c.native.as_ref().map_or(0, |n| n.code_bytes);
-        bytes(&self.code.core)
-            + self
-                .code
-                .jacobians
-                .get()
-                .map_or(0, |j| bytes(&j.compiled))
+        bytes(&self.code.core) + self.code.jacobians.get().map_or(0, |j| bytes(&j.compiled))
     }
 
     fn run(&self, routine: Routine, inputs: Inputs<'_>, out0: &mut [f64], out1: &mut [f64]) {
@@ -446,10 +442,20 @@ impl DynMechanicalSystem for JitModel {
         self.code.program.num_dofs()
     }
     fn coordinate_names(&self) -> Vec<&str> {
-        self.code.program.coordinate_names.iter().map(String::as_str).collect()
+        self.code
+            .program
+            .coordinate_names
+            .iter()
+            .map(String::as_str)
+            .collect()
     }
     fn parameter_names(&self) -> Vec<&str> {
-        self.code.program.parameters.iter().map(|(n, _)| n.as_str()).collect()
+        self.code
+            .program
+            .parameters
+            .iter()
+            .map(|(n, _)| n.as_str())
+            .collect()
     }
     fn parameter_values(&self) -> Vec<f64> {
         self.parameters.clone()
@@ -475,7 +481,12 @@ impl DynMechanicalSystem for JitModel {
     fn initial_state(&self, q: &mut [f64], qdot: &mut [f64]) {
         let n = self.num_dofs();
         let mut out = vec![0.0; 2 * n];
-        self.run(Routine::InitialState, self.inputs(&[], &[], 0.0), &mut out, &mut []);
+        self.run(
+            Routine::InitialState,
+            self.inputs(&[], &[], 0.0),
+            &mut out,
+            &mut [],
+        );
         q[..n].copy_from_slice(&out[..n]);
         qdot[..n].copy_from_slice(&out[n..]);
     }
@@ -487,13 +498,28 @@ impl DynMechanicalSystem for JitModel {
         mass: &mut [f64],
         forcing: &mut [f64],
     ) {
-        self.run(Routine::MassMatrixAndForcing, self.inputs(q, qdot, t), mass, forcing);
+        self.run(
+            Routine::MassMatrixAndForcing,
+            self.inputs(q, qdot, t),
+            mass,
+            forcing,
+        );
     }
     fn forcing_jacobian_q(&self, q: &[f64], qdot: &[f64], t: f64, out: &mut [f64]) {
-        self.run(Routine::ForcingJacobianQ, self.inputs(q, qdot, t), out, &mut []);
+        self.run(
+            Routine::ForcingJacobianQ,
+            self.inputs(q, qdot, t),
+            out,
+            &mut [],
+        );
     }
     fn forcing_jacobian_qdot(&self, q: &[f64], qdot: &[f64], t: f64, out: &mut [f64]) {
-        self.run(Routine::ForcingJacobianQdot, self.inputs(q, qdot, t), out, &mut []);
+        self.run(
+            Routine::ForcingJacobianQdot,
+            self.inputs(q, qdot, t),
+            out,
+            &mut [],
+        );
     }
     fn mass_matrix_product_jacobian(&self, q: &[f64], t: f64, a: &[f64], out: &mut [f64]) {
         let inputs = Inputs {
@@ -504,23 +530,43 @@ impl DynMechanicalSystem for JitModel {
     }
     fn kinetic_energy(&self, q: &[f64], qdot: &[f64], t: f64) -> f64 {
         let mut out = [0.0];
-        self.run(Routine::KineticEnergy, self.inputs(q, qdot, t), &mut out, &mut []);
+        self.run(
+            Routine::KineticEnergy,
+            self.inputs(q, qdot, t),
+            &mut out,
+            &mut [],
+        );
         out[0]
     }
     fn potential_energy(&self, q: &[f64], t: f64) -> f64 {
         let mut out = [0.0];
-        self.run(Routine::PotentialEnergy, self.inputs(q, &[], t), &mut out, &mut []);
+        self.run(
+            Routine::PotentialEnergy,
+            self.inputs(q, &[], t),
+            &mut out,
+            &mut [],
+        );
         out[0]
     }
     fn is_conservative(&self) -> bool {
         self.code.program.conservative
     }
     fn point_names(&self) -> Vec<&str> {
-        self.code.program.point_names.iter().map(String::as_str).collect()
+        self.code
+            .program
+            .point_names
+            .iter()
+            .map(String::as_str)
+            .collect()
     }
     fn point_positions(&self, q: &[f64], t: f64, out: &mut [[f64; 3]]) {
         let flat = out.as_flattened_mut();
-        self.run(Routine::PointPositions, self.inputs(q, &[], t), flat, &mut []);
+        self.run(
+            Routine::PointPositions,
+            self.inputs(q, &[], t),
+            flat,
+            &mut [],
+        );
     }
     fn draw_lines(&self) -> Vec<[&str; 2]> {
         self.code
@@ -531,7 +577,12 @@ impl DynMechanicalSystem for JitModel {
             .collect()
     }
     fn trace_points(&self) -> Vec<&str> {
-        self.code.program.trace_points.iter().map(String::as_str).collect()
+        self.code
+            .program
+            .trace_points
+            .iter()
+            .map(String::as_str)
+            .collect()
     }
     fn body_centres(&self) -> Vec<BodyCentre<'_>> {
         self.code
@@ -552,31 +603,66 @@ impl DynMechanicalSystem for JitModel {
         &self.code.program.equations_latex
     }
     fn constraint_names(&self) -> Vec<&str> {
-        self.code.program.constraint_names.iter().map(String::as_str).collect()
+        self.code
+            .program
+            .constraint_names
+            .iter()
+            .map(String::as_str)
+            .collect()
     }
     fn holonomic_constraint_count(&self) -> usize {
         self.code.program.holonomic_constraint_count
     }
     fn constraint_residuals(&self, q: &[f64], t: f64, out: &mut [f64]) {
-        self.run(Routine::ConstraintResiduals, self.inputs(q, &[], t), out, &mut []);
+        self.run(
+            Routine::ConstraintResiduals,
+            self.inputs(q, &[], t),
+            out,
+            &mut [],
+        );
     }
     fn constraint_jacobian(&self, q: &[f64], t: f64, out: &mut [f64]) {
-        self.run(Routine::ConstraintJacobian, self.inputs(q, &[], t), out, &mut []);
+        self.run(
+            Routine::ConstraintJacobian,
+            self.inputs(q, &[], t),
+            out,
+            &mut [],
+        );
     }
     fn constraint_velocity_residuals(&self, q: &[f64], qdot: &[f64], t: f64, out: &mut [f64]) {
-        self.run(Routine::ConstraintVelocityResiduals, self.inputs(q, qdot, t), out, &mut []);
+        self.run(
+            Routine::ConstraintVelocityResiduals,
+            self.inputs(q, qdot, t),
+            out,
+            &mut [],
+        );
     }
     fn constraint_gamma(&self, q: &[f64], qdot: &[f64], t: f64, out: &mut [f64]) {
-        self.run(Routine::ConstraintGamma, self.inputs(q, qdot, t), out, &mut []);
+        self.run(
+            Routine::ConstraintGamma,
+            self.inputs(q, qdot, t),
+            out,
+            &mut [],
+        );
     }
     fn initial_guesses(&self) -> &[usize] {
         &self.code.program.initial_guesses
     }
     fn equilibrium_names(&self) -> Vec<&str> {
-        self.code.program.equilibrium_names.iter().map(String::as_str).collect()
+        self.code
+            .program
+            .equilibrium_names
+            .iter()
+            .map(String::as_str)
+            .collect()
     }
     fn equilibrium_guesses(&self, out: &mut [f64]) {
-        self.run(Routine::EquilibriumGuesses, self.inputs(&[], &[], 0.0), out, &mut []);
+        self.run(
+            Routine::EquilibriumGuesses,
+            self.inputs(&[], &[], 0.0),
+            out,
+            &mut [],
+        );
     }
     fn event_specs(&self) -> Vec<EventSpec> {
         self.code.events.clone()

@@ -7,8 +7,101 @@
 
 use nalgebra::SVector;
 
+use crate::dynamic::DynMechanicalSystem;
 use crate::ode::RhsError;
-use crate::system::MechanicalSystem;
+use crate::system::{MechanicalSystem, solve_spd_in_place};
+
+/// The functions of a constrained mechanical system the workspace evaluates, on slices
+/// (shapes as [`DynMechanicalSystem`]: `M` column-major, `J` row-major).
+///
+/// Implemented by every [`DynMechanicalSystem`] and, through the adapter
+/// [`StaticSystem`], by every [`MechanicalSystem<N>`], so that the constrained solve, the
+/// drift and the projection are written once for the models compiled by `eomgen::model!` and
+/// those compiled at run time.
+pub trait ConstraintFunctions {
+    /// `M` (`n × n`, column-major) and `F` (length `n`).
+    fn mass_matrix_and_forcing(
+        &self,
+        q: &[f64],
+        qdot: &[f64],
+        t: f64,
+        mass: &mut [f64],
+        forcing: &mut [f64],
+    );
+    /// `Φ(q, t)` (length `m_h`).
+    fn constraint_residuals(&self, q: &[f64], t: f64, out: &mut [f64]);
+    /// `J` (`m × n`, row-major).
+    fn constraint_jacobian(&self, q: &[f64], t: f64, out: &mut [f64]);
+    /// The velocity residuals (length `m`).
+    fn constraint_velocity_residuals(&self, q: &[f64], qdot: &[f64], t: f64, out: &mut [f64]);
+    /// `γ` (length `m`).
+    fn constraint_gamma(&self, q: &[f64], qdot: &[f64], t: f64, out: &mut [f64]);
+}
+
+impl<S: DynMechanicalSystem + ?Sized> ConstraintFunctions for S {
+    fn mass_matrix_and_forcing(
+        &self,
+        q: &[f64],
+        qdot: &[f64],
+        t: f64,
+        mass: &mut [f64],
+        forcing: &mut [f64],
+    ) {
+        DynMechanicalSystem::mass_matrix_and_forcing(self, q, qdot, t, mass, forcing);
+    }
+    fn constraint_residuals(&self, q: &[f64], t: f64, out: &mut [f64]) {
+        DynMechanicalSystem::constraint_residuals(self, q, t, out);
+    }
+    fn constraint_jacobian(&self, q: &[f64], t: f64, out: &mut [f64]) {
+        DynMechanicalSystem::constraint_jacobian(self, q, t, out);
+    }
+    fn constraint_velocity_residuals(&self, q: &[f64], qdot: &[f64], t: f64, out: &mut [f64]) {
+        DynMechanicalSystem::constraint_velocity_residuals(self, q, qdot, t, out);
+    }
+    fn constraint_gamma(&self, q: &[f64], qdot: &[f64], t: f64, out: &mut [f64]) {
+        DynMechanicalSystem::constraint_gamma(self, q, qdot, t, out);
+    }
+}
+
+/// A [`MechanicalSystem<N>`] seen through [`ConstraintFunctions`] (static vectors and
+/// matrices copied from and to the slices).
+#[derive(Debug, Clone, Copy)]
+pub struct StaticSystem<'a, S, const N: usize>(pub &'a S);
+
+impl<S: MechanicalSystem<N>, const N: usize> ConstraintFunctions for StaticSystem<'_, S, N> {
+    fn mass_matrix_and_forcing(
+        &self,
+        q: &[f64],
+        qdot: &[f64],
+        t: f64,
+        mass: &mut [f64],
+        forcing: &mut [f64],
+    ) {
+        let (m, f) = self
+            .0
+            .mass_matrix_and_forcing(&vector::<N>(q), &vector::<N>(qdot), t);
+        mass[..N * N].copy_from_slice(m.as_slice());
+        forcing[..N].copy_from_slice(f.as_slice());
+    }
+    fn constraint_residuals(&self, q: &[f64], t: f64, out: &mut [f64]) {
+        self.0.constraint_residuals(&vector::<N>(q), t, out);
+    }
+    fn constraint_jacobian(&self, q: &[f64], t: f64, out: &mut [f64]) {
+        self.0.constraint_jacobian(&vector::<N>(q), t, out);
+    }
+    fn constraint_velocity_residuals(&self, q: &[f64], qdot: &[f64], t: f64, out: &mut [f64]) {
+        self.0
+            .constraint_velocity_residuals(&vector::<N>(q), &vector::<N>(qdot), t, out);
+    }
+    fn constraint_gamma(&self, q: &[f64], qdot: &[f64], t: f64, out: &mut [f64]) {
+        self.0
+            .constraint_gamma(&vector::<N>(q), &vector::<N>(qdot), t, out);
+    }
+}
+
+fn vector<const N: usize>(x: &[f64]) -> SVector<f64, N> {
+    SVector::<f64, N>::from_column_slice(&x[..N])
+}
 
 /// How constraint drift is controlled during an integration (selectable per run).
 ///
@@ -64,6 +157,9 @@ pub struct ConstraintWorkspace {
     small: Vec<f64>,
     small_rhs: Vec<f64>,
     small_pivots: Vec<usize>,
+    mass: Vec<f64>,
+    forcing: Vec<f64>,
+    spd: Vec<f64>,
     /// `λ` of the last solve (length `m`).
     pub multipliers: Vec<f64>,
 }
@@ -87,6 +183,9 @@ impl ConstraintWorkspace {
             small: vec![0.0; m * m],
             small_rhs: vec![0.0; m],
             small_pivots: vec![0; m],
+            mass: vec![0.0; n * n],
+            forcing: vec![0.0; n],
+            spd: vec![0.0; n * n + 2 * n],
             multipliers: vec![0.0; m],
         }
     }
@@ -103,13 +202,11 @@ impl ConstraintWorkspace {
 
     /// Solves `[M Jᵀ; J 0][q̈; λ] = [F; γ̃]` at `(q, q̇, t)`, with `γ̃` stabilised as
     /// `stabilization` says (or, for [`Stabilization::Penalty`], `M q̈ = F − Jᵀ λ` with the
-    /// penalty forces); `λ` is left in [`Self::multipliers`].
+    /// penalty forces); `λ` is left in [`Self::multipliers`]. A [`MechanicalSystem<N>`]'s
+    /// static-size twin of [`Self::accelerations_into`].
     ///
     /// # Errors
-    /// [`RhsError::SingularConstraintMatrix`] when the KKT matrix is singular (redundant
-    /// constraints, a singular configuration, or `M` singular on the null space of `J`);
-    /// [`RhsError::SingularMassMatrix`] when a penalty solve meets an `M` that is not
-    /// positive definite.
+    /// As [`Self::accelerations_into`].
     pub fn accelerations<S: MechanicalSystem<N>, const N: usize>(
         &mut self,
         system: &S,
@@ -118,24 +215,56 @@ impl ConstraintWorkspace {
         t: f64,
         stabilization: Stabilization,
     ) -> Result<SVector<f64, N>, RhsError> {
+        let mut qddot = SVector::<f64, N>::zeros();
+        self.accelerations_into(
+            &StaticSystem(system),
+            q.as_slice(),
+            qdot.as_slice(),
+            t,
+            stabilization,
+            qddot.as_mut_slice(),
+        )?;
+        Ok(qddot)
+    }
+
+    /// Solves `[M Jᵀ; J 0][q̈; λ] = [F; γ̃]` at `(q, q̇, t)` into `qddot` (length `n`), with
+    /// `γ̃` stabilised as `stabilization` says (or, for [`Stabilization::Penalty`],
+    /// `M q̈ = F − Jᵀ λ` with the penalty forces, by [`solve_spd_in_place`]); `λ` is left in
+    /// [`Self::multipliers`]. No heap allocation.
+    ///
+    /// # Errors
+    /// [`RhsError::SingularConstraintMatrix`] when the KKT matrix is singular (redundant
+    /// constraints, a singular configuration, or `M` singular on the null space of `J`);
+    /// [`RhsError::SingularMassMatrix`] when a penalty solve meets an `M` that is not
+    /// positive definite.
+    pub fn accelerations_into<C: ConstraintFunctions + ?Sized>(
+        &mut self,
+        system: &C,
+        q: &[f64],
+        qdot: &[f64],
+        t: f64,
+        stabilization: Stabilization,
+        qddot: &mut [f64],
+    ) -> Result<(), RhsError> {
         let (n, m) = (self.n, self.m);
         let k = n + m;
-        let (mass, forcing) = system.mass_matrix_and_forcing(q, qdot, t);
+        system.mass_matrix_and_forcing(q, qdot, t, &mut self.mass, &mut self.forcing);
         system.constraint_jacobian(q, t, &mut self.jacobian);
         if let Stabilization::Penalty { stiffness, damping } = stabilization {
             system.constraint_velocity_residuals(q, qdot, t, &mut self.velocity);
             system.constraint_residuals(q, t, &mut self.phi);
-            let mut f = forcing;
             for i in 0..m {
                 let position = if i < self.holonomic { self.phi[i] } else { 0.0 };
                 let lambda = stiffness * position + damping * self.velocity[i];
                 self.multipliers[i] = lambda;
                 for c in 0..n {
-                    f[c] -= self.jacobian[i * n + c] * lambda;
+                    self.forcing[c] -= self.jacobian[i * n + c] * lambda;
                 }
             }
-            let chol = nalgebra::Cholesky::new(mass).ok_or(RhsError::SingularMassMatrix)?;
-            return Ok(chol.solve(&f));
+            solve_spd_in_place(n, &self.mass, &mut self.forcing, &mut self.spd)
+                .ok_or(RhsError::SingularMassMatrix)?;
+            qddot[..n].copy_from_slice(&self.forcing);
+            return Ok(());
         }
         system.constraint_gamma(q, qdot, t, &mut self.gamma);
         if let Stabilization::Baumgarte { alpha, beta } = stabilization {
@@ -149,26 +278,31 @@ impl ConstraintWorkspace {
         for r in 0..k {
             for c in 0..k {
                 self.kkt[r * k + c] = match (r < n, c < n) {
-                    (true, true) => mass[(r, c)],
+                    (true, true) => self.mass[r + c * n],
                     (true, false) => self.jacobian[(c - n) * n + r],
                     (false, true) => self.jacobian[(r - n) * n + c],
                     (false, false) => 0.0,
                 };
             }
-            self.rhs[r] = if r < n { forcing[r] } else { self.gamma[r - n] };
+            self.rhs[r] = if r < n {
+                self.forcing[r]
+            } else {
+                self.gamma[r - n]
+            };
         }
         lu_solve(&mut self.kkt, &mut self.rhs, &mut self.pivots, k)
             .ok_or(RhsError::SingularConstraintMatrix)?;
         self.multipliers.copy_from_slice(&self.rhs[n..k]);
-        Ok(SVector::<f64, N>::from_column_slice(&self.rhs[..n]))
+        qddot[..n].copy_from_slice(&self.rhs[..n]);
+        Ok(())
     }
 
     /// Largest `|Φᵢ|` and largest velocity residual `|Φ̇ᵢ|` (or `|A q̇ + b|`) at a state.
-    pub fn drift<S: MechanicalSystem<N>, const N: usize>(
+    pub fn drift<C: ConstraintFunctions + ?Sized>(
         &mut self,
-        system: &S,
-        q: &SVector<f64, N>,
-        qdot: &SVector<f64, N>,
+        system: &C,
+        q: &[f64],
+        qdot: &[f64],
         t: f64,
     ) -> (f64, f64) {
         system.constraint_residuals(q, t, &mut self.phi);
@@ -187,11 +321,11 @@ impl ConstraintWorkspace {
     /// not reach `tolerance` in 50 iterations or `J Jᵀ` is singular.
     ///
     /// No heap allocation (it runs after every step under [`Stabilization::Projection`]).
-    pub fn project<S: MechanicalSystem<N>, const N: usize>(
+    pub fn project<C: ConstraintFunctions + ?Sized>(
         &mut self,
-        system: &S,
-        q: &mut SVector<f64, N>,
-        qdot: &mut SVector<f64, N>,
+        system: &C,
+        q: &mut [f64],
+        qdot: &mut [f64],
         t: f64,
         free: &[usize],
         tolerance: f64,

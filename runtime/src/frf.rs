@@ -255,7 +255,11 @@ pub fn linearize_with_inputs(
 }
 
 fn restore(model: &mut dyn ModelInfo, values: &[f64]) {
-    let names = model.parameter_names();
+    let names: Vec<String> = model
+        .parameter_names()
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
     for (name, value) in names.iter().zip(values) {
         // The names come from the model itself, so setting them cannot fail.
         let _ = model.set_parameter(name, *value);
@@ -272,9 +276,13 @@ fn linearize_with_inputs_inner(
             model: model.name().to_string(),
         });
     }
-    let coordinates = model.coordinate_names();
+    let coordinates: Vec<String> = model
+        .coordinate_names()
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
     for input in inputs {
-        if model.parameter_names().contains(input) || !coordinates.contains(input) {
+        if model.parameter_names().contains(input) || !coordinates.iter().any(|c| c == input) {
             model.set_parameter(input, 0.0)?;
         }
     }

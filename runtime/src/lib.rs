@@ -6,6 +6,7 @@
 #![warn(missing_docs)]
 
 pub mod constrained;
+pub mod dynamic;
 pub mod floquet;
 pub mod frf;
 pub mod integrate;
@@ -14,7 +15,10 @@ pub mod ode;
 pub mod response;
 pub mod system;
 
-pub use constrained::{ConstraintWorkspace, ProjectionError, Stabilization};
+pub use constrained::{
+    ConstraintFunctions, ConstraintWorkspace, ProjectionError, Stabilization, StaticSystem,
+};
+pub use dynamic::{DynFirstOrder, DynMechanicalSystem};
 pub use floquet::{
     FloquetAnalysis, FloquetError, FloquetOptions, FloquetStability, check_periodic_equilibrium,
     floquet_analysis, floquet_multipliers, monodromy_matrix,
@@ -47,5 +51,5 @@ pub use response::{
 };
 pub use system::{
     BodyCentre, ConstraintValues, FirstOrder, MechanicalSystem, ModelInfo, UnknownParameter,
-    solve_spd,
+    solve_spd, solve_spd_in_place,
 };

@@ -8,7 +8,7 @@
 
 use nalgebra::{DMatrix, DVector, SMatrix, SVector};
 
-use crate::constrained::{ConstraintWorkspace, ProjectionError, Stabilization};
+use crate::constrained::{ConstraintWorkspace, ProjectionError, Stabilization, StaticSystem};
 use crate::integrate::EventSpec;
 use crate::ode::{OdeSystem, RhsError};
 
@@ -27,11 +27,11 @@ pub struct UnknownParameter {
 /// A body of a model's kinematic form and the point at its centre of mass, for drawings
 /// (`eomgen animate` marks it).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct BodyCentre {
+pub struct BodyCentre<'a> {
     /// The body's name in the model file.
-    pub body: &'static str,
+    pub body: &'a str,
     /// The point at its centre of mass (one of [`MechanicalSystem::point_names`]).
-    pub point: &'static str,
+    pub point: &'a str,
     /// A planar rigid body (`true`) or a particle.
     pub rigid: bool,
 }
@@ -129,7 +129,7 @@ pub trait MechanicalSystem<const N: usize> {
     }
     /// Where each body of the kinematic form sits: its centre of mass (a rigid body's `com`,
     /// a particle's `at`), in file order; empty for the energy form.
-    fn body_centres(&self) -> &'static [BodyCentre] {
+    fn body_centres(&self) -> &'static [BodyCentre<'static>] {
         &[]
     }
     /// The derived equations as plain text (`M`, `F`, `T`, `V`).
@@ -419,6 +419,84 @@ pub fn solve_spd<const N: usize>(
     Some(x)
 }
 
+/// [`solve_spd`] for a size known at run time: solves `M x = f` in place (`f` becomes `x`)
+/// for a symmetric positive definite `M` (`n × n`, column-major, lower triangle read), with
+/// the same closed forms for `n = 1, 2` and the same `L D Lᵀ` factorisation in the same
+/// operation order, so the two agree to the bit; `work` holds at least `n² + 2n` values.
+/// No heap allocation.
+///
+/// `solve_spd` keeps its own copy with stack arrays and a compile-time `N`, which the
+/// compiler unrolls for the hot path of the compiled models (`benches/rhs.rs`).
+///
+/// Returns `None` when `M` is not positive definite (a pivot is not positive, or is NaN).
+///
+/// # Panics
+/// If `mass` has fewer than `n²` entries, `f` fewer than `n` or `work` fewer than `n² + 2n`.
+pub fn solve_spd_in_place(n: usize, mass: &[f64], f: &mut [f64], work: &mut [f64]) -> Option<()> {
+    let m = |i: usize, j: usize| mass[i + j * n];
+    match n {
+        1 => {
+            let a = m(0, 0);
+            // Not positive, or NaN.
+            if !(a > 0.0) {
+                return None;
+            }
+            f[0] /= a;
+            return Some(());
+        }
+        2 => {
+            let (a, b, c) = (m(0, 0), m(1, 0), m(1, 1));
+            let det = a * c - b * b;
+            // Not positive definite, or NaN.
+            if a.is_nan() || a <= 0.0 || det.is_nan() || det <= 0.0 {
+                return None;
+            }
+            let inverse = 1.0 / det;
+            let (f0, f1) = (f[0], f[1]);
+            f[0] = (c * f0 - b * f1) * inverse;
+            f[1] = (a * f1 - b * f0) * inverse;
+            return Some(());
+        }
+        _ => {}
+    }
+    let (l, rest) = work.split_at_mut(n * n);
+    let (d, inv_d) = rest.split_at_mut(n);
+    // `l[i][k]` of `solve_spd` is `l[i * n + k]`.
+    for j in 0..n {
+        let mut dj = m(j, j);
+        for k in 0..j {
+            dj -= l[j * n + k] * l[j * n + k] * d[k];
+        }
+        // Not positive, or NaN.
+        if dj.is_nan() || dj <= 0.0 {
+            return None;
+        }
+        d[j] = dj;
+        inv_d[j] = 1.0 / dj;
+        for i in j + 1..n {
+            let mut v = m(i, j);
+            for k in 0..j {
+                v -= l[i * n + k] * l[j * n + k] * d[k];
+            }
+            l[i * n + j] = v * inv_d[j];
+        }
+    }
+    for i in 0..n {
+        for k in 0..i {
+            f[i] -= l[i * n + k] * f[k];
+        }
+    }
+    for i in 0..n {
+        f[i] *= inv_d[i];
+    }
+    for i in (0..n).rev() {
+        for k in i + 1..n {
+            f[i] -= l[k * n + i] * f[k];
+        }
+    }
+    Some(())
+}
+
 fn split<const N: usize>(y: &[f64]) -> (SVector<f64, N>, SVector<f64, N>) {
     (
         SVector::<f64, N>::from_column_slice(&y[..N]),
@@ -453,14 +531,19 @@ impl<S: MechanicalSystem<N>, const N: usize> OdeSystem for FirstOrder<S, N> {
         if self.constraints.is_empty() || self.stabilization != Stabilization::Projection {
             return Ok(false);
         }
-        let (mut q, mut qdot) = split::<N>(y);
+        let (q, qdot) = y.split_at_mut(N);
         self.constraints
-            .project(&self.system, &mut q, &mut qdot, t, &[], 1e-12)
+            .project(
+                &StaticSystem(&self.system),
+                q,
+                &mut qdot[..N],
+                t,
+                &[],
+                1e-12,
+            )
             .map_err(|e| RhsError::ProjectionFailed {
                 residual: e.residual,
             })?;
-        y[..N].copy_from_slice(q.as_slice());
-        y[N..2 * N].copy_from_slice(qdot.as_slice());
         Ok(true)
     }
 
@@ -527,18 +610,22 @@ impl<S: MechanicalSystem<N>, const N: usize> OdeSystem for FirstOrder<S, N> {
 
 /// A model with its size erased, as the CLI holds it: `Box<dyn ModelInfo>`.
 ///
+/// Implemented by [`FirstOrder`] for every model compiled by `eomgen::model!` and by
+/// [`DynFirstOrder`](crate::DynFirstOrder) for a model compiled at run time; names are
+/// borrowed from the model (which owns them in the second case).
+///
 /// Vectors here are runtime-sized; `y = [q; q̇]` has length `2 num_dofs()`.
 pub trait ModelInfo: OdeSystem {
     /// The model's name.
-    fn name(&self) -> &'static str;
+    fn name(&self) -> &str;
     /// One-line description.
-    fn description(&self) -> &'static str;
+    fn description(&self) -> &str;
     /// Number of degrees of freedom `n`.
     fn num_dofs(&self) -> usize;
     /// Names of the generalized coordinates (length `n`).
-    fn coordinate_names(&self) -> Vec<&'static str>;
+    fn coordinate_names(&self) -> Vec<&str>;
     /// Parameter names, in file order.
-    fn parameter_names(&self) -> &'static [&'static str];
+    fn parameter_names(&self) -> Vec<&str>;
     /// Current parameter values.
     fn parameter_values(&self) -> Vec<f64>;
     /// Sets a parameter by name.
@@ -559,19 +646,19 @@ pub trait ModelInfo: OdeSystem {
     /// Whether `T + V` is a constant of the motion.
     fn is_conservative(&self) -> bool;
     /// Names of the model's points.
-    fn point_names(&self) -> &'static [&'static str];
+    fn point_names(&self) -> Vec<&str>;
     /// Positions of the points at `(t, y)`, `[x, y, z]` each (m).
     fn point_positions(&self, t: f64, y: &[f64]) -> Vec<[f64; 3]>;
     /// The `draw: lines` segments as pairs of point names ([`MechanicalSystem::draw_lines`]).
-    fn draw_lines(&self) -> &'static [[&'static str; 2]];
+    fn draw_lines(&self) -> Vec<[&str; 2]>;
     /// The `draw: trace` point names ([`MechanicalSystem::trace_points`]).
-    fn trace_points(&self) -> &'static [&'static str];
+    fn trace_points(&self) -> Vec<&str>;
     /// The bodies' centres of mass ([`MechanicalSystem::body_centres`]).
-    fn body_centres(&self) -> &'static [BodyCentre];
+    fn body_centres(&self) -> Vec<BodyCentre<'_>>;
     /// The derived equations as text.
-    fn equations_text(&self) -> &'static str;
+    fn equations_text(&self) -> &str;
     /// The derived equations as LaTeX.
-    fn equations_latex(&self) -> &'static str;
+    fn equations_latex(&self) -> &str;
     /// Upcast to the first-order system for an integrator.
     fn as_ode_mut(&mut self) -> &mut dyn OdeSystem;
     /// `M` (`n × n`) and `F` (`n`) at `(t, y)`.
@@ -581,7 +668,7 @@ pub trait ModelInfo: OdeSystem {
     /// The exact `∂(M a)/∂q` (`n × n`) at `(t, q)` for the vector `a` (length `n`).
     fn mass_matrix_product_jacobian(&self, t: f64, y: &[f64], a: &[f64]) -> DMatrix<f64>;
     /// Names of the constraints (holonomic first); empty for an unconstrained model.
-    fn constraint_names(&self) -> &'static [&'static str];
+    fn constraint_names(&self) -> Vec<&str>;
     /// How many constraints are holonomic.
     fn holonomic_constraint_count(&self) -> usize;
     /// Selects the drift control of a constrained model.
@@ -602,9 +689,9 @@ pub trait ModelInfo: OdeSystem {
     /// [`ProjectionError`] when Newton does not converge.
     fn project(&mut self, t: f64, y: &mut [f64], free: &[usize]) -> Result<usize, ProjectionError>;
     /// Indices of the coordinates whose initial values are guesses.
-    fn initial_guesses(&self) -> &'static [usize];
+    fn initial_guesses(&self) -> &[usize];
     /// The model's named equilibrium guesses `(name, q)` ([`MechanicalSystem::equilibrium_names`]).
-    fn equilibrium_guesses(&self) -> Vec<(&'static str, Vec<f64>)>;
+    fn equilibrium_guesses(&self) -> Vec<(&str, Vec<f64>)>;
     /// Makes the model event `name` terminal or not (`eomgen simulate --stop-when NAME`);
     /// returns `false` if the model has no event `name`.
     fn set_event_terminal(&mut self, name: &str, terminal: bool) -> bool;
@@ -623,9 +710,9 @@ pub trait ModelInfo: OdeSystem {
         if self.constraint_names().is_empty() {
             return Ok(());
         }
-        let guesses = self.initial_guesses();
+        let guesses = self.initial_guesses().to_vec();
         if !guesses.is_empty() {
-            return self.project(0.0, y, guesses).map(|_| ());
+            return self.project(0.0, y, &guesses).map(|_| ());
         }
         let c = self.constraint_equations(0.0, y);
         let worst = c
@@ -656,20 +743,20 @@ pub trait ModelInfo: OdeSystem {
 }
 
 impl<S: MechanicalSystem<N>, const N: usize> ModelInfo for FirstOrder<S, N> {
-    fn name(&self) -> &'static str {
+    fn name(&self) -> &str {
         self.system.name()
     }
-    fn description(&self) -> &'static str {
+    fn description(&self) -> &str {
         self.system.description()
     }
     fn num_dofs(&self) -> usize {
         N
     }
-    fn coordinate_names(&self) -> Vec<&'static str> {
+    fn coordinate_names(&self) -> Vec<&str> {
         self.system.coordinate_names().to_vec()
     }
-    fn parameter_names(&self) -> &'static [&'static str] {
-        self.system.parameter_names()
+    fn parameter_names(&self) -> Vec<&str> {
+        self.system.parameter_names().to_vec()
     }
     fn parameter_values(&self) -> Vec<f64> {
         self.system.parameter_values()
@@ -692,8 +779,8 @@ impl<S: MechanicalSystem<N>, const N: usize> ModelInfo for FirstOrder<S, N> {
     fn is_conservative(&self) -> bool {
         self.system.is_conservative()
     }
-    fn point_names(&self) -> &'static [&'static str] {
-        self.system.point_names()
+    fn point_names(&self) -> Vec<&str> {
+        self.system.point_names().to_vec()
     }
     fn point_positions(&self, t: f64, y: &[f64]) -> Vec<[f64; 3]> {
         let (q, _) = split::<N>(y);
@@ -701,19 +788,19 @@ impl<S: MechanicalSystem<N>, const N: usize> ModelInfo for FirstOrder<S, N> {
         self.system.point_positions(&q, t, &mut out);
         out
     }
-    fn draw_lines(&self) -> &'static [[&'static str; 2]] {
-        self.system.draw_lines()
+    fn draw_lines(&self) -> Vec<[&str; 2]> {
+        self.system.draw_lines().to_vec()
     }
-    fn trace_points(&self) -> &'static [&'static str] {
-        self.system.trace_points()
+    fn trace_points(&self) -> Vec<&str> {
+        self.system.trace_points().to_vec()
     }
-    fn body_centres(&self) -> &'static [BodyCentre] {
-        self.system.body_centres()
+    fn body_centres(&self) -> Vec<BodyCentre<'_>> {
+        self.system.body_centres().to_vec()
     }
-    fn equations_text(&self) -> &'static str {
+    fn equations_text(&self) -> &str {
         self.system.equations_text()
     }
-    fn equations_latex(&self) -> &'static str {
+    fn equations_latex(&self) -> &str {
         self.system.equations_latex()
     }
     fn as_ode_mut(&mut self) -> &mut dyn OdeSystem {
@@ -742,8 +829,8 @@ impl<S: MechanicalSystem<N>, const N: usize> ModelInfo for FirstOrder<S, N> {
         let j = self.system.mass_matrix_product_jacobian(&q, t, &a);
         DMatrix::from_column_slice(N, N, j.as_slice())
     }
-    fn constraint_names(&self) -> &'static [&'static str] {
-        self.system.constraint_names()
+    fn constraint_names(&self) -> Vec<&str> {
+        self.system.constraint_names().to_vec()
     }
     fn holonomic_constraint_count(&self) -> usize {
         self.system.holonomic_constraint_count()
@@ -761,22 +848,24 @@ impl<S: MechanicalSystem<N>, const N: usize> ModelInfo for FirstOrder<S, N> {
         Ok(self.constraints.multipliers.clone())
     }
     fn constraint_drift(&mut self, t: f64, y: &[f64]) -> (f64, f64) {
-        let (q, qdot) = split::<N>(y);
-        self.constraints.drift(&self.system, &q, &qdot, t)
+        self.constraints
+            .drift(&StaticSystem(&self.system), &y[..N], &y[N..2 * N], t)
     }
     fn project(&mut self, t: f64, y: &mut [f64], free: &[usize]) -> Result<usize, ProjectionError> {
-        let (mut q, mut qdot) = split::<N>(y);
-        let iterations =
-            self.constraints
-                .project(&self.system, &mut q, &mut qdot, t, free, 1e-12)?;
-        y[..N].copy_from_slice(q.as_slice());
-        y[N..2 * N].copy_from_slice(qdot.as_slice());
-        Ok(iterations)
+        let (q, qdot) = y.split_at_mut(N);
+        self.constraints.project(
+            &StaticSystem(&self.system),
+            q,
+            &mut qdot[..N],
+            t,
+            free,
+            1e-12,
+        )
     }
-    fn initial_guesses(&self) -> &'static [usize] {
+    fn initial_guesses(&self) -> &[usize] {
         self.system.initial_guesses()
     }
-    fn equilibrium_guesses(&self) -> Vec<(&'static str, Vec<f64>)> {
+    fn equilibrium_guesses(&self) -> Vec<(&str, Vec<f64>)> {
         let names = self.system.equilibrium_names();
         let mut values = vec![0.0; N * names.len()];
         self.system.equilibrium_guesses(&mut values);

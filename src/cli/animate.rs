@@ -107,11 +107,11 @@ fn write(path: &str, text: &str) -> Result<(), CliError> {
 /// with a dot and the points whose paths are traced.
 pub(crate) struct Scene {
     /// The model's name.
-    pub model: &'static str,
+    pub model: String,
     /// Heading of the page: the model and its description.
     pub title: String,
     /// The drawn points' names, in the model's order (indices below count in this list).
-    pub names: Vec<&'static str>,
+    pub names: Vec<String>,
     /// The `draw:` lines.
     pub lines: Vec<[usize; 2]>,
     /// The points marked with a dot: the lines' ends and the traced points.
@@ -120,7 +120,7 @@ pub(crate) struct Scene {
     pub traces: Vec<usize>,
     /// The bodies' centres of mass (points marked with a ring), with whether the body is
     /// rigid, and the body's name.
-    pub centres: Vec<(usize, bool, &'static str)>,
+    pub centres: Vec<(usize, bool, String)>,
     /// Isometric view of a 3-D model.
     pub three_d: bool,
     /// Indices of the drawn points among the model's points.
@@ -180,10 +180,10 @@ impl Scene {
                 b = all[all.len() - 1],
             )));
         }
-        let centres: Vec<(usize, bool, &'static str)> = model
+        let centres: Vec<(usize, bool, String)> = model
             .body_centres()
             .iter()
-            .filter_map(|c| Some((index(c.point)?, c.rigid, c.body)))
+            .filter_map(|c| Some((index(c.point)?, c.rigid, c.body.to_string())))
             .collect();
         let mut used: Vec<usize> = lines.iter().flatten().copied().collect();
         used.extend(&traced);
@@ -201,15 +201,15 @@ impl Scene {
         dots.sort_unstable();
         dots.dedup();
         Ok(Self {
-            model: model.name(),
+            model: model.name().to_string(),
             title: format!("{} — {}", model.name(), model.description()),
-            names: used.iter().map(|&i| all[i]).collect(),
+            names: used.iter().map(|&i| all[i].to_string()).collect(),
             lines: lines.iter().map(|[a, b]| [local(*a), local(*b)]).collect(),
             dots,
             traces: traced.iter().map(|&i| local(i)).collect(),
             centres: centres
                 .iter()
-                .map(|&(i, rigid, body)| (local(i), rigid, body))
+                .map(|(i, rigid, body)| (local(*i), *rigid, body.clone()))
                 .collect(),
             three_d: false,
             model_points: used,
@@ -752,7 +752,7 @@ impl Animation {
                 "<circle id=\"d{i}\" class=\"joint\" cx=\"{}\" cy=\"{}\" r=\"{radius}\"><title>{}</title></circle>",
                 p(f0[*d].0),
                 p(f0[*d].1),
-                escape(scene.names[*d])
+                escape(&scene.names[*d])
             );
         }
         for (i, (c, rigid, body)) in scene.centres.iter().enumerate() {
@@ -764,7 +764,7 @@ impl Animation {
                 p(f0[*c].1),
                 v(0.022 * span),
                 escape(body),
-                escape(scene.names[*c])
+                escape(&scene.names[*c])
             );
         }
         svg.push_str("\n</g>\n</svg>");

@@ -113,7 +113,8 @@ pub fn run(args: &FrfArgs) -> Result<(), CliError> {
             args.input
         )));
     }
-    let name = model.name();
+    let name = model.name().to_string();
+    let name = name.as_str();
     let (label, guess) = args.point.guess(model.as_ref())?;
     let forced = linearize_with_inputs(model.as_mut(), &guess, &[args.input.as_str()]).map_err(
         |e| match e {
@@ -128,7 +129,11 @@ pub fn run(args: &FrfArgs) -> Result<(), CliError> {
     )?;
     let lin = &forced.linearization;
     let b = forced.input_matrix.column(0).into_owned();
-    let coordinates = model.coordinate_names();
+    let coordinates: Vec<String> = model
+        .coordinate_names()
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
     let outputs: Vec<(String, usize)> = if args.outputs.is_empty() {
         coordinates
             .iter()

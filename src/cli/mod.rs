@@ -192,9 +192,9 @@ fn open_error(error: eomgen::OpenError) -> CliError {
     match error {
         eomgen::OpenError::Load(eomgen::LoadError::Diagnostics {
             path,
-            source,
+            text,
             diagnostics,
-        }) => diagnostics_error(&path, &source, &diagnostics),
+        }) => diagnostics_error(&path, &text, &diagnostics),
         eomgen::OpenError::Load(e @ eomgen::LoadError::Compile(_))
         | eomgen::OpenError::Load(e @ eomgen::LoadError::Generate(_)) => {
             CliError::failure(e.to_string())

@@ -228,7 +228,11 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
         method_name,
     } = integrate(&args.model, &args.run, output)?;
     let n = model.num_dofs();
-    let coordinates = model.coordinate_names();
+    let coordinates: Vec<String> = model
+        .coordinate_names()
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
     let report = Report::new(model.as_ref(), &y0, &solution);
     let constraints = ConstraintReport::new(model.as_mut(), &solution);
     if let Some(path) = &args.csv {
@@ -372,7 +376,11 @@ pub(crate) fn integrate(
     let mut model = find_model(model_name)?;
     set_parameters(model.as_mut(), &args.set)?;
     let n = model.num_dofs();
-    let coordinates = model.coordinate_names();
+    let coordinates: Vec<String> = model
+        .coordinate_names()
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
     let mut y0 = model.initial_state();
     for s in &args.init {
         let (name, text) = split_assignment(s, "--init")?;
@@ -758,7 +766,7 @@ pub(crate) fn consistent_initial_state(
 
 /// Constraint forces `λ` and drift at every sample of a constrained model.
 struct ConstraintReport {
-    names: Vec<&'static str>,
+    names: Vec<String>,
     /// `λ` per sample; `None` where the constrained system is singular (JSON `null`).
     forces: Vec<Option<Vec<f64>>>,
     drift: Vec<(f64, f64)>,
@@ -766,7 +774,11 @@ struct ConstraintReport {
 
 impl ConstraintReport {
     fn new(model: &mut dyn ModelInfo, solution: &Solution) -> Self {
-        let names = model.constraint_names().to_vec();
+        let names: Vec<String> = model
+            .constraint_names()
+            .iter()
+            .map(|s| s.to_string())
+            .collect();
         let mut forces = Vec::new();
         let mut drift = Vec::new();
         if !names.is_empty() {

@@ -202,7 +202,8 @@ fn constraint_methods(args: &ConstraintMethodsArgs) -> Result<(), CliError> {
     let times: Vec<f64> = (1..=200)
         .map(|i| args.t_end * f64::from(i) / 200.0)
         .collect();
-    let names: Vec<&'static str> = model.point_names().to_vec();
+    let owned: Vec<String> = model.point_names().iter().map(|s| s.to_string()).collect();
+    let names: Vec<&str> = owned.iter().map(String::as_str).collect();
 
     // Reference: the DAE with Baumgarte at rtol = atol = 1e-13, checked against the
     // unstabilised DAE at the same tolerance (their agreement is printed).

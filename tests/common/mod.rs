@@ -57,7 +57,11 @@ fn with_model_files(args: &[&str]) -> Option<Vec<String>> {
         .map(|(i, a)| {
             // The first argument is the command; `--models a,b` lists names.
             let names: Vec<&str> = a.split(',').collect();
-            if i > 0 && names.iter().all(|n| eomgen::models::find(n.trim()).is_some()) {
+            if i > 0
+                && names
+                    .iter()
+                    .all(|n| eomgen::models::find(n.trim()).is_some())
+            {
                 replaced = true;
                 names
                     .iter()

@@ -600,7 +600,7 @@ pub fn emit(
             .collect();
         let _ = writeln!(
             constant_items,
-            "fn body_centres(&self) -> &'static [{krate}::BodyCentre] {{ &[{}] }}",
+            "fn body_centres(&self) -> &'static [{krate}::BodyCentre<'static>] {{ &[{}] }}",
             centres.join(", ")
         );
     }

@@ -396,8 +396,7 @@ impl Derivation {
     pub fn jacobians(mut self) -> JacobianProgram {
         let n = self.eom.num_dofs;
         let jacobians = Jacobians::of(&mut self.model, &self.eom);
-        let parameters: Vec<SymbolId> =
-            self.model.parameters.iter().map(|p| p.symbol).collect();
+        let parameters: Vec<SymbolId> = self.model.parameters.iter().map(|p| p.symbol).collect();
         let mut planner = Planner {
             arena: &mut self.model.arena,
             parameters: &parameters,
