@@ -9,7 +9,7 @@
 //! a NaN), which is stricter than the 1e-13 relative: any difference at all is a
 //! lowering or compilation bug. The interpreter is compared the same way.
 
-use eomgen::{DynFirstOrder, JitModel, LoadOptions, ModelInfo, OdeSystem};
+use eomgen::{DynFirstOrder, JitModel, LoadOptions, ModelInfo};
 use eomgen_jit::Backend;
 
 mod common;
@@ -154,7 +154,11 @@ fn compare(name: &str, compiled: &mut dyn ModelInfo, runtime: &mut dyn ModelInfo
 }
 
 fn runtime_model(path: &str, backend: Option<Backend>) -> Box<dyn ModelInfo> {
-    let model = JitModel::load_with(path, LoadOptions { backend })
+    let options = LoadOptions {
+        backend,
+        ..LoadOptions::default()
+    };
+    let model = JitModel::load_with(path, options)
         .unwrap_or_else(|e| panic!("{path}: {e}"));
     if backend.is_none() {
         assert_eq!(
