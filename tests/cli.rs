@@ -232,8 +232,9 @@ fn check_reports_model_file_errors() {
         "name: bad\ncoordinates: [q]\nkinetic: q_dot^2/2 + k\n",
     )
     .unwrap();
+    // A model file with mistakes is a usage error (exit 2), as every command reports it.
     let out = eomgen(&["check", path.to_str().unwrap()]);
-    assert_eq!(out.status.code(), Some(1));
+    assert_eq!(out.status.code(), Some(2));
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("bad.yaml:3:22: unknown name `k`"), "{err}");
     let _ = std::fs::remove_dir_all(&dir);

@@ -127,7 +127,11 @@ fn eccentric_cylinder_lifts_off_where_the_normal_force_vanishes() {
     let event = &solution.events[k];
     assert_eq!(event.name, "lift_off");
     assert_eq!(solution.last().map(|(t, _)| t), Some(event.t));
-    let names = cylinder.parameter_names();
+    let names: Vec<String> = cylinder
+        .parameter_names()
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
     let values = cylinder.parameter_values();
     let p = |n: &str| values[names.iter().position(|x| *x == n).unwrap()];
     let mut dy = vec![0.0; 6];

@@ -65,7 +65,8 @@ pub enum CompileError {
         /// Cranelift's explanation.
         reason: String,
     },
-    /// Cranelift failed on one function.
+    /// A function could not be compiled: Cranelift failed on it, or its program is
+    /// malformed.
     #[error("could not compile `{function}` to native code: {reason}")]
     Function {
         /// The function of the model (`mass_matrix_and_forcing`, …).
@@ -236,6 +237,10 @@ pub(crate) fn compile(functions: &[(&str, &FunctionTape)]) -> Result<NativeCode,
             ids.push(None);
             continue;
         }
+        function
+            .tape
+            .validate()
+            .map_err(|reason| failure(name, &reason))?;
         let id = module
             .declare_function(name, Linkage::Local, &signature)
             .map_err(|e| failure(name, &e))?;
@@ -412,4 +417,81 @@ fn build(
     }
     b.ins().return_(&[]);
     b.finalize(module.target_config());
+}
+
+#[cfg(test)]
+mod tests {
+    use eomgen_symbolic::codegen::program::FunctionTape;
+    use eomgen_symbolic::codegen::tape::{Input, Instruction, Tape};
+
+    use super::*;
+
+    fn tape(instructions: Vec<Instruction>, outputs: Vec<u32>) -> FunctionTape {
+        let split = outputs.len();
+        FunctionTape {
+            tape: Tape {
+                instructions,
+                outputs,
+            },
+            split,
+        }
+    }
+
+    /// A function whose program cannot be compiled is an error that names it — never a panic
+    /// — and the functions before it do not leak (the module is dropped with the error).
+    #[test]
+    fn a_function_that_cannot_be_compiled_is_an_error_naming_it() {
+        let good = tape(
+            vec![
+                Instruction::Input(Input::Coordinate(0)),
+                Instruction::Mul(0, 0),
+            ],
+            vec![1],
+        );
+        let forward_reference = tape(
+            vec![
+                Instruction::Input(Input::Coordinate(0)),
+                Instruction::Add(0, 2),
+                Instruction::Const(1.0),
+            ],
+            vec![1],
+        );
+        let lone_cosine = tape(
+            vec![Instruction::Input(Input::Time), Instruction::CosOfSinCos(0)],
+            vec![1],
+        );
+        let missing_output = tape(vec![Instruction::Const(1.0)], vec![3]);
+        for (bad, what) in [
+            (&forward_reference, "not computed before"),
+            (&lone_cosine, "sin_cos"),
+            (&missing_output, "instructions"),
+        ] {
+            let error = compile(&[("kinetic_energy", &good), ("potential_energy", bad)])
+                .err()
+                .expect("a malformed tape does not compile");
+            let CompileError::Function { function, reason } = &error else {
+                panic!("{error}");
+            };
+            assert_eq!(function, "potential_energy");
+            assert!(reason.contains(what), "{reason}");
+            assert!(error.to_string().contains("`potential_energy`"), "{error}");
+        }
+        let code = compile(&[("kinetic_energy", &good)]).expect("a good tape compiles");
+        let f = code.functions[0].expect("compiled");
+        let (q, mut out) = ([3.0], [0.0]);
+        // SAFETY: the tape reads q[0] and writes out[0].
+        unsafe {
+            f(
+                [].as_ptr(),
+                q.as_ptr(),
+                [].as_ptr(),
+                [].as_ptr(),
+                [].as_ptr(),
+                0.0,
+                out.as_mut_ptr(),
+                [].as_mut_ptr(),
+            )
+        };
+        assert_eq!(out[0], 9.0);
+    }
 }

@@ -836,14 +836,14 @@ fn motion_checks(
             Err(e) => notes.push(format!("mode shapes: {e}")),
         }
     }
-    report.animation = animation(&spec, &model_dir, &mut report.notes);
+    report.animation = animation(&spec, &name, &model_dir, &mut report.notes);
 }
 
 /// Writes the model's animation, `NAME/animation.html` (`eomgen animate NAME` with the
 /// default options, 30 frames per second), when its file draws something; returns its path
 /// relative to the report. A failure becomes a note.
-fn animation(name: &str, model_dir: &Path, notes: &mut Vec<String>) -> Option<String> {
-    let model = super::find_model(name).ok()?;
+fn animation(spec: &str, name: &str, model_dir: &Path, notes: &mut Vec<String>) -> Option<String> {
+    let model = super::find_model(spec).ok()?;
     if model.draw_lines().is_empty() && model.trace_points().is_empty() {
         return None;
     }
@@ -854,7 +854,7 @@ fn animation(name: &str, model_dir: &Path, notes: &mut Vec<String>) -> Option<St
             return None;
         }
     };
-    match super::animate::simulation(name, &args, 30.0, &[]) {
+    match super::animate::simulation(spec, &args, 30.0, &[]) {
         Ok((Some(animation), failure)) => {
             if let Some(e) = failure {
                 notes.push(format!("animation: {}", e.message));

@@ -162,6 +162,68 @@ impl Tape {
             .count()
     }
 
+    /// Checks the tape's shape: every operand precedes its user, every
+    /// [`Instruction::SinCos`] is followed by its [`Instruction::CosOfSinCos`] (and only there),
+    /// and every output names an instruction. A backend checks this before it compiles a tape
+    /// it did not build itself.
+    ///
+    /// # Errors
+    /// The first violation, as a sentence naming the instruction.
+    pub fn validate(&self) -> Result<(), String> {
+        let count = self.instructions.len();
+        for (k, instruction) in self.instructions.iter().enumerate() {
+            let operands: &[Value] = match instruction {
+                Instruction::Input(_) | Instruction::Const(_) => &[],
+                Instruction::Neg(x)
+                | Instruction::Sqrt(x)
+                | Instruction::Abs(x)
+                | Instruction::Call(_, x)
+                | Instruction::SinCos(x) => std::slice::from_ref(x),
+                Instruction::CosOfSinCos(x) => {
+                    if *x as usize + 1 != k
+                        || !matches!(self.instructions[*x as usize], Instruction::SinCos(_))
+                    {
+                        return Err(format!(
+                            "instruction {k} takes the cosine of instruction {x}, which is not the `sin_cos` just before it"
+                        ));
+                    }
+                    &[]
+                }
+                Instruction::Add(x, y)
+                | Instruction::Sub(x, y)
+                | Instruction::Mul(x, y)
+                | Instruction::Div(x, y)
+                | Instruction::Powf(x, y)
+                | Instruction::Atan2(x, y) => {
+                    if *x as usize >= k || *y as usize >= k {
+                        return Err(format!(
+                            "instruction {k} uses a value ({x} or {y}) that is not computed before it"
+                        ));
+                    }
+                    &[]
+                }
+            };
+            if let Some(x) = operands.iter().find(|x| **x as usize >= k) {
+                return Err(format!(
+                    "instruction {k} uses value {x}, which is not computed before it"
+                ));
+            }
+            if matches!(instruction, Instruction::SinCos(_))
+                && !matches!(self.instructions.get(k + 1), Some(Instruction::CosOfSinCos(s)) if *s as usize == k)
+            {
+                return Err(format!(
+                    "the `sin_cos` of instruction {k} is not followed by its cosine"
+                ));
+            }
+        }
+        match self.outputs.iter().find(|x| **x as usize >= count) {
+            Some(x) => Err(format!(
+                "output names value {x}, but the tape has {count} instructions"
+            )),
+            None => Ok(()),
+        }
+    }
+
     /// Lowers `plan` (made by [`crate::expr::cse::plan`] over `arena`) to a tape that
     /// computes what the Rust code [`super::emit`] prints for the same plan computes, in the
     /// same order. `parameters` are the parameters' symbols in file order: parameter symbol
