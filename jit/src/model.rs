@@ -12,7 +12,7 @@ use eomgen_symbolic::codegen::program::{Derivation, FunctionTape, ModelProgram};
 use eomgen_symbolic::codegen::tape::{Input, Instruction};
 use eomgen_symbolic::model::{Crossing, Diagnostic};
 
-use crate::native::{CompileError, NativeCode};
+use crate::native::{CompileError, NativeCode, NativeFn};
 use crate::{Backend, Inputs, interpret, native};
 
 /// Why a model file could not be made into a run-time model.
@@ -121,6 +121,7 @@ impl Extent {
         e
     }
 
+    #[inline]
     fn admits(&self, inputs: &Inputs<'_>, out0: usize, out1: usize) -> bool {
         inputs.parameters.len() >= self.parameters
             && inputs.q.len() >= self.q
@@ -240,6 +241,9 @@ thread_local! {
 pub struct JitModel {
     code: Arc<Code>,
     parameters: Vec<f64>,
+    /// The native `mass_matrix_and_forcing` and its extent, held here rather than behind the
+    /// `Arc` because every right-hand side calls it.
+    mass_and_forcing: Option<(NativeFn, Extent)>,
 }
 
 impl JitModel {
@@ -344,7 +348,18 @@ impl JitModel {
         {
             return Err(e.clone().into());
         }
-        Ok(JitModel { code, parameters })
+        let index = Routine::MassMatrixAndForcing as usize;
+        let mass_and_forcing = code
+            .core
+            .native
+            .as_ref()
+            .and_then(|n| n.functions[index])
+            .map(|f| (f, code.core.extents[index]));
+        Ok(JitModel {
+            code,
+            parameters,
+            mass_and_forcing,
+        })
     }
 
     /// Which evaluator runs this model's functions (its Jacobians, compiled when first used,
@@ -419,6 +434,7 @@ impl JitModel {
         }
     }
 
+    #[inline]
     fn inputs<'a>(&'a self, q: &'a [f64], qdot: &'a [f64], t: f64) -> Inputs<'a> {
         Inputs {
             parameters: &self.parameters,
@@ -490,6 +506,8 @@ impl DynMechanicalSystem for JitModel {
         q[..n].copy_from_slice(&out[..n]);
         qdot[..n].copy_from_slice(&out[n..]);
     }
+    // Inlined into the caller's right-hand side (another crate), where most sizes are known.
+    #[inline]
     fn mass_matrix_and_forcing(
         &self,
         q: &[f64],
@@ -498,12 +516,28 @@ impl DynMechanicalSystem for JitModel {
         mass: &mut [f64],
         forcing: &mut [f64],
     ) {
-        self.run(
-            Routine::MassMatrixAndForcing,
-            self.inputs(q, qdot, t),
-            mass,
-            forcing,
-        );
+        let inputs = self.inputs(q, qdot, t);
+        match self.mass_and_forcing {
+            Some((f, extent)) if extent.admits(&inputs, mass.len(), forcing.len()) => {
+                // SAFETY: `f` is the native code of this routine's tape, which reads at most
+                // `extent` values of each input and writes `extent.out0` and `extent.out1`
+                // values, and `admits` checked every slice is at least that long.
+                unsafe {
+                    f(
+                        inputs.parameters.as_ptr(),
+                        q.as_ptr(),
+                        qdot.as_ptr(),
+                        inputs.acceleration.as_ptr(),
+                        inputs.lambda.as_ptr(),
+                        t,
+                        mass.as_mut_ptr(),
+                        forcing.as_mut_ptr(),
+                    )
+                }
+            }
+            // Interpreted, or a slice too short (which `run` reports).
+            _ => self.run(Routine::MassMatrixAndForcing, inputs, mass, forcing),
+        }
     }
     fn forcing_jacobian_q(&self, q: &[f64], qdot: &[f64], t: f64, out: &mut [f64]) {
         self.run(

@@ -18,6 +18,9 @@
 //! rest; nothing is reassociated or contracted into fused multiply–adds, so the results are
 //! the interpreter's to the bit.
 //!
+//! With the environment variable `EOMGEN_JIT_DISASM` set, every function's machine code is
+//! printed to standard error as it is compiled (`examples/disassemble.rs`).
+//!
 //! # Memory
 //! All functions of a model live in one [`JITModule`]; [`NativeCode`] owns it and frees the
 //! executable pages when it is dropped (the function pointers die with it: the run-time
@@ -253,9 +256,17 @@ pub(crate) fn compile(functions: &[(&str, &FunctionTape)]) -> Result<NativeCode,
             function,
             &imports,
         );
+        if std::env::var_os("EOMGEN_JIT_DISASM").is_some() {
+            context.set_disasm(true);
+        }
         module
             .define_function(id, &mut context)
             .map_err(|e| failure(name, &e))?;
+        if let Some(vcode) = context.compiled_code().and_then(|c| c.vcode.as_ref())
+            && std::env::var_os("EOMGEN_JIT_DISASM").is_some()
+        {
+            eprintln!("== {name}\n{vcode}");
+        }
         code_bytes += context
             .compiled_code()
             .map(|c| c.buffer.total_size() as usize)
@@ -286,6 +297,64 @@ pub(crate) fn compile(functions: &[(&str, &FunctionTape)]) -> Result<NativeCode,
     })
 }
 
+/// The function's arguments as Cranelift values.
+struct Arguments {
+    parameters: ir::Value,
+    q: ir::Value,
+    qdot: ir::Value,
+    acceleration: ir::Value,
+    lambda: ir::Value,
+    t: ir::Value,
+}
+
+/// Tape values as Cranelift values, inputs loaded where they are used.
+///
+/// Inputs are not loaded where the tape lists them (all at its top) but at their uses: every
+/// floating-point register is caller-saved, so a value loaded before a call of `sin_cos` and
+/// used after it would be spilled to the stack and reloaded, and a load from the input itself
+/// is as cheap. An input is loaded once between two calls.
+struct Values {
+    values: Vec<Option<ir::Value>>,
+    /// Per input instruction: its value and the number of calls emitted before its load.
+    loaded: Vec<Option<(u32, ir::Value)>>,
+    calls: u32,
+}
+
+impl Values {
+    fn get(
+        &mut self,
+        b: &mut FunctionBuilder,
+        tape: &eomgen_symbolic::codegen::tape::Tape,
+        arguments: &Arguments,
+        x: u32,
+    ) -> ir::Value {
+        let x = x as usize;
+        let Instruction::Input(input) = tape.instructions[x] else {
+            // Defined before use (the tape is validated), so never the placeholder.
+            return self.values[x].unwrap_or(arguments.t);
+        };
+        if let Some((at, value)) = self.loaded[x]
+            && at == self.calls
+        {
+            return value;
+        }
+        let (base, i) = match input {
+            Input::Parameter(i) => (arguments.parameters, i),
+            Input::Coordinate(i) => (arguments.q, i),
+            Input::Velocity(i) => (arguments.qdot, i),
+            Input::Acceleration(i) => (arguments.acceleration, i),
+            Input::Multiplier(i) => (arguments.lambda, i),
+            Input::Time => return arguments.t,
+        };
+        // Inputs are aligned, in bounds (the caller's contract) and never alias the outputs.
+        let value = b
+            .ins()
+            .load(types::F64, MemFlagsData::trusted(), base, (i as i32) * 8);
+        self.loaded[x] = Some((self.calls, value));
+        value
+    }
+}
+
 /// Writes the body of one tape into `func`.
 fn build(
     module: &mut JITModule,
@@ -300,47 +369,63 @@ fn build(
     b.switch_to_block(block);
     b.seal_block(block);
     let params = b.block_params(block).to_vec();
-    let (parameters, q, qdot, acceleration, lambda, t, out0, out1) = (
-        params[0], params[1], params[2], params[3], params[4], params[5], params[6], params[7],
-    );
-    // Inputs and outputs are aligned, in bounds (the caller's contract) and never alias the
-    // code's own memory.
-    let flags = MemFlagsData::trusted();
+    let arguments = Arguments {
+        parameters: params[0],
+        q: params[1],
+        qdot: params[2],
+        acceleration: params[3],
+        lambda: params[4],
+        t: params[5],
+    };
+    let (out0, out1) = (params[6], params[7]);
     let mut unary_refs: Vec<(Function, ir::FuncRef)> = Vec::new();
     let mut sin_cos_ref = None;
     let mut powf_ref = None;
     let mut atan2_ref = None;
     let tape = &function.tape;
-    let mut values: Vec<ir::Value> = Vec::with_capacity(tape.instructions.len());
-    let offset = |i: u32| (i as i32) * 8;
+    let count = tape.instructions.len();
+    let mut values = Values {
+        values: vec![None; count],
+        loaded: vec![None; count],
+        calls: 0,
+    };
     for (k, instruction) in tape.instructions.iter().enumerate() {
-        let v = |x: u32| values[x as usize];
+        let mut v = |b: &mut FunctionBuilder, x: u32| values.get(b, tape, &arguments, x);
         let value = match *instruction {
-            Instruction::Input(input) => {
-                let (base, i) = match input {
-                    Input::Parameter(i) => (parameters, i),
-                    Input::Coordinate(i) => (q, i),
-                    Input::Velocity(i) => (qdot, i),
-                    Input::Acceleration(i) => (acceleration, i),
-                    Input::Multiplier(i) => (lambda, i),
-                    Input::Time => {
-                        values.push(t);
-                        continue;
-                    }
-                };
-                b.ins().load(types::F64, flags, base, offset(i))
-            }
+            // Loaded at its uses.
+            Instruction::Input(_) => continue,
             Instruction::Const(c) => b.ins().f64const(c),
-            Instruction::Neg(x) => b.ins().fneg(v(x)),
-            Instruction::Add(x, y) => b.ins().fadd(v(x), v(y)),
-            Instruction::Sub(x, y) => b.ins().fsub(v(x), v(y)),
-            Instruction::Mul(x, y) => b.ins().fmul(v(x), v(y)),
-            Instruction::Div(x, y) => b.ins().fdiv(v(x), v(y)),
-            Instruction::Sqrt(x) => b.ins().sqrt(v(x)),
-            Instruction::Abs(x) => b.ins().fabs(v(x)),
+            Instruction::Neg(x) => {
+                let x = v(&mut b, x);
+                b.ins().fneg(x)
+            }
+            Instruction::Add(x, y) => {
+                let (x, y) = (v(&mut b, x), v(&mut b, y));
+                b.ins().fadd(x, y)
+            }
+            Instruction::Sub(x, y) => {
+                let (x, y) = (v(&mut b, x), v(&mut b, y));
+                b.ins().fsub(x, y)
+            }
+            Instruction::Mul(x, y) => {
+                let (x, y) = (v(&mut b, x), v(&mut b, y));
+                b.ins().fmul(x, y)
+            }
+            Instruction::Div(x, y) => {
+                let (x, y) = (v(&mut b, x), v(&mut b, y));
+                b.ins().fdiv(x, y)
+            }
+            Instruction::Sqrt(x) => {
+                let x = v(&mut b, x);
+                b.ins().sqrt(x)
+            }
+            Instruction::Abs(x) => {
+                let x = v(&mut b, x);
+                b.ins().fabs(x)
+            }
             Instruction::Call(Function::Sign, x) => {
                 // −1, 0 or 1; NaN compares false both ways and gives 0, as `sign` does.
-                let x = v(x);
+                let x = v(&mut b, x);
                 let zero = b.ins().f64const(0.0);
                 let one = b.ins().f64const(1.0);
                 let minus_one = b.ins().f64const(-1.0);
@@ -350,70 +435,91 @@ fn build(
                 b.ins().select(positive, one, low)
             }
             Instruction::Call(Function::Step, x) => {
-                let x = v(x);
+                let x = v(&mut b, x);
                 let zero = b.ins().f64const(0.0);
                 let one = b.ins().f64const(1.0);
                 let nonnegative = b.ins().fcmp(FloatCC::GreaterThanOrEqual, x, zero);
                 b.ins().select(nonnegative, one, zero)
             }
             Instruction::Call(f, x) => {
+                let x = v(&mut b, x);
                 let callee = match unary_refs.iter().find(|(g, _)| *g == f) {
-                    Some((_, r)) => *r,
-                    None => {
-                        let id = imports
-                            .unary
-                            .iter()
-                            .find(|(g, _)| *g == f)
-                            .map(|(_, id)| *id);
-                        let Some(id) = id else {
-                            values.push(b.ins().f64const(f64::NAN));
-                            continue;
-                        };
-                        let r = module.declare_func_in_func(id, b.func);
+                    Some((_, r)) => Some(*r),
+                    None => imports.unary.iter().find(|(g, _)| *g == f).map(|(_, id)| {
+                        let r = module.declare_func_in_func(*id, b.func);
                         unary_refs.push((f, r));
                         r
-                    }
+                    }),
                 };
-                let call = b.ins().call(callee, &[v(x)]);
+                // Every function of one argument is imported, so `callee` is always found.
+                let Some(callee) = callee else {
+                    continue;
+                };
+                let call = b.ins().call(callee, &[x]);
+                values.calls += 1;
                 b.inst_results(call)[0]
             }
             Instruction::Powf(x, y) => {
+                let (x, y) = (v(&mut b, x), v(&mut b, y));
                 let callee = *powf_ref
                     .get_or_insert_with(|| module.declare_func_in_func(imports.powf, b.func));
-                let call = b.ins().call(callee, &[v(x), v(y)]);
+                let call = b.ins().call(callee, &[x, y]);
+                values.calls += 1;
                 b.inst_results(call)[0]
             }
             Instruction::Atan2(y, x) => {
+                let (y, x) = (v(&mut b, y), v(&mut b, x));
                 let callee = *atan2_ref
                     .get_or_insert_with(|| module.declare_func_in_func(imports.atan2, b.func));
-                let call = b.ins().call(callee, &[v(y), v(x)]);
+                let call = b.ins().call(callee, &[y, x]);
+                values.calls += 1;
                 b.inst_results(call)[0]
             }
             Instruction::SinCos(x) => {
+                let x = v(&mut b, x);
                 let callee = *sin_cos_ref
                     .get_or_insert_with(|| module.declare_func_in_func(imports.sin_cos, b.func));
-                let call = b.ins().call(callee, &[v(x)]);
+                let call = b.ins().call(callee, &[x]);
+                values.calls += 1;
                 let results = b.inst_results(call);
                 let (s, c) = (results[0], results[1]);
-                values.push(s);
-                values.push(c);
+                values.values[k] = Some(s);
+                if let Some(slot) = values.values.get_mut(k + 1) {
+                    *slot = Some(c);
+                }
                 continue;
             }
-            // Pushed with its `SinCos`.
+            // Set with its `SinCos`.
             Instruction::CosOfSinCos(_) => continue,
         };
-        debug_assert_eq!(values.len(), k);
-        values.push(value);
+        values.values[k] = Some(value);
     }
+    // Outputs are stored two at a time (slots 2k and 2k + 1 of a buffer as one 16-byte
+    // store): the caller reads them back at once, often 16 bytes at a time (nalgebra's
+    // copies, the solve of `M q̈ = F`), and a 16-byte load of two 8-byte stores cannot be
+    // forwarded from the store buffer — it waits ~12 cycles for the stores to retire, while a
+    // load within one wider store is forwarded. On the double pendulum's right-hand side this
+    // was worth ~4 ns (`benches/runtime_model.rs`).
     let split = function.split.min(tape.outputs.len());
-    for (j, &x) in tape.outputs.iter().enumerate() {
-        let (base, slot) = if j < split {
-            (out0, j)
-        } else {
-            (out1, j - split)
-        };
-        b.ins()
-            .store(flags, values[x as usize], base, (slot as i32) * 8);
+    for (base, outputs) in [
+        (out0, &tape.outputs[..split]),
+        (out1, &tape.outputs[split..]),
+    ] {
+        for (pair, chunk) in outputs.chunks(2).enumerate() {
+            let offset = (pair as i32) * 16;
+            let first = values.get(&mut b, tape, &arguments, chunk[0]);
+            match chunk.get(1) {
+                Some(&second) => {
+                    let second = values.get(&mut b, tape, &arguments, second);
+                    let vector = b.ins().scalar_to_vector(types::F64X2, first);
+                    let vector = b.ins().insertlane(vector, second, 1);
+                    b.ins().store(MemFlagsData::trusted(), vector, base, offset);
+                }
+                None => {
+                    b.ins().store(MemFlagsData::trusted(), first, base, offset);
+                }
+            }
+        }
     }
     b.ins().return_(&[]);
     b.finalize(module.target_config());
