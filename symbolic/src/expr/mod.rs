@@ -612,6 +612,9 @@ impl ExprArena {
             if products {
                 self.collect_angle_differences(&mut collected);
             }
+            // The identities remove terms with `swap_remove` (O(1); `shift_remove` made a sum of
+            // many folded terms quadratic): the order of `collected` is not kept, and the
+            // terms are sorted here, so it does not matter.
             let mut entries: Vec<(ExprId, Constant)> = collected.into_iter().collect();
             entries.sort_by_key(|(rest, _)| *rest);
             // A term that the identities left alone keeps its node.
@@ -726,8 +729,8 @@ impl ExprArena {
             let Some(partner) = partner.filter(|p| collected.get(p) == Some(&c)) else {
                 continue;
             };
-            collected.shift_remove(&rest);
-            collected.shift_remove(&partner);
+            collected.swap_remove(&rest);
+            collected.swap_remove(&partner);
             match others.len() {
                 0 => {
                     *constant = constant.checked_add(c).unwrap_or(*constant);
@@ -812,8 +815,8 @@ impl ExprArena {
             else {
                 continue;
             };
-            collected.shift_remove(&rest);
-            collected.shift_remove(&partner);
+            collected.swap_remove(&rest);
+            collected.swap_remove(&partner);
             // Canonical difference: smaller id first; sin(v − u) = −sin(u − v).
             let (a, b, flip) = if u < v { (u, v, false) } else { (v, u, true) };
             let diff = self.minus(a, b);
