@@ -537,3 +537,30 @@ fn check_and_simulate_print_the_compile_errors_of_every_ui_case() {
     }
     assert!(checked >= 28, "only {checked} ui cases");
 }
+
+/// A file written by `eomgen new` runs through `simulate` with no rebuild (issue 18): the
+/// 5-link pendulum's file is derived and compiled at run time, integrated, and keeps its
+/// energy (a conservative chain: drift below 1e-6 at the default tolerances); an unknown name
+/// that is not a file says so and that a path works too (exit 2).
+#[test]
+fn a_file_from_new_simulates_and_an_unknown_name_says_a_path_works() {
+    let dir = std::env::temp_dir().join(format!("eomgen-new-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let out = eomgen_ok(&["new", "n-link-pendulum", "5"]);
+    let path = dir.join("p5.yaml");
+    std::fs::write(&path, &out.stdout).unwrap();
+    let out = eomgen_ok(&["simulate", path.to_str().unwrap(), "--json"]);
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["model"], "n_link_pendulum_5");
+    assert_eq!(v["coordinates"].as_array().map(Vec::len), Some(5));
+    let drift = v["energy_drift"]
+        .as_f64()
+        .unwrap_or_else(|| panic!("no energy drift in {v}"));
+    assert!(drift < 1e-6, "drift {drift}");
+    let out = eomgen(&["simulate", "n_link_pendulum_5"]);
+    assert_eq!(out.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("no model named `n_link_pendulum_5`"), "{stderr}");
+    assert!(stderr.contains("a path to a model file"), "{stderr}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -135,11 +135,24 @@ mod tests {
     /// order and call the same library functions, so any difference is a miscompilation
     /// (an operand swapped, a load from the wrong offset, a wrong register for `cos` of a
     /// `sin_cos` pair).
+    ///
+    /// The 15-link pendulum and the 40-mass chain of `eomgen new` are compared too: their
+    /// larger functions keep shared values in the scratch buffer (`native::build`).
     #[test]
     fn native_code_equals_the_interpreter_bit_for_bit_on_every_bundled_model() {
         let mut random = Random(0x9E37_79B9_7F4A_7C15);
         let mut compared = 0usize;
-        for (display, program, jacobians) in bundled_programs() {
+        let mut scratched = 0usize;
+        let generated = [
+            eomgen_symbolic::model::templates::n_link_pendulum(15),
+            eomgen_symbolic::model::templates::n_mass_chain(40),
+        ]
+        .map(|source| {
+            let file = eomgen_symbolic::model::load("generated.yaml", &source).expect("loads");
+            let (program, derivation) = ModelProgram::from_file(&file).expect("derives");
+            ("generated.yaml".to_string(), program, derivation.jacobians())
+        });
+        for (display, program, jacobians) in bundled_programs().into_iter().chain(generated) {
             let functions: Vec<_> = program
                 .functions()
                 .into_iter()
@@ -177,8 +190,10 @@ mod tests {
                     let (mut a0, mut a1) = (vec![0.0; split], vec![0.0; rest]);
                     interpret::evaluate(function, &inputs, &mut values, &mut a0, &mut a1);
                     let (mut b0, mut b1) = (vec![f64::NAN; split], vec![f64::NAN; rest]);
-                    // SAFETY: every input has the model's full length and the outputs the
-                    // tape's, so the code reads and writes in bounds.
+                    let mut scratch = vec![f64::NAN; code.scratch[index]];
+                    // SAFETY: every input has the model's full length, the outputs the tape's
+                    // and the scratch the length the compiler asked for, so the code reads
+                    // and writes in bounds.
                     unsafe {
                         compiled(
                             parameters.as_ptr(),
@@ -189,8 +204,10 @@ mod tests {
                             inputs.t,
                             b0.as_mut_ptr(),
                             b1.as_mut_ptr(),
+                            scratch.as_mut_ptr(),
                         )
                     };
+                    scratched += usize::from(!scratch.is_empty());
                     for (k, (a, b)) in a0.iter().chain(&a1).zip(b0.iter().chain(&b1)).enumerate() {
                         assert!(
                             a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan()),
@@ -202,5 +219,6 @@ mod tests {
             }
         }
         assert!(compared > 10_000, "only {compared} values compared");
+        assert!(scratched > 100, "the scratch buffer was used {scratched} times");
     }
 }

@@ -97,6 +97,8 @@ struct Extent {
     lambda: usize,
     out0: usize,
     out1: usize,
+    /// `f64`s of scratch space the native code needs (0 for none).
+    scratch: usize,
 }
 
 impl Extent {
@@ -161,6 +163,11 @@ impl Compiled {
             },
         };
         let mut compiled = Compiled::interpreted(functions);
+        if let Some(native) = &native {
+            for (extent, &scratch) in compiled.extents.iter_mut().zip(&native.scratch) {
+                extent.scratch = scratch;
+            }
+        }
         compiled.native = native;
         Ok((compiled, fallback_reason))
     }
@@ -221,8 +228,56 @@ impl Code {
 }
 
 thread_local! {
-    /// The interpreter's values, reused between evaluations on a thread.
+    /// The interpreter's values, and the scratch space of large native functions, reused
+    /// between evaluations on a thread.
     static SCRATCH: RefCell<Vec<f64>> = const { RefCell::new(Vec::new()) };
+}
+
+/// Calls native code `f` of a routine whose extent is `extent`.
+///
+/// # Safety
+/// `f` must be the native code compiled from the tape `extent` was computed from, and
+/// `extent.admits(inputs, out0.len(), out1.len())` must hold.
+#[inline]
+unsafe fn call_native(
+    f: NativeFn,
+    extent: &Extent,
+    inputs: &Inputs<'_>,
+    out0: &mut [f64],
+    out1: &mut [f64],
+) {
+    let (out0, out1) = (out0.as_mut_ptr(), out1.as_mut_ptr());
+    let call = |scratch: *mut f64| {
+        // SAFETY: the tape reads at most `extent` values of each input, writes `extent.out0`
+        // and `extent.out1` values and uses `extent.scratch` values of scratch space; the
+        // caller checked the slices, and `scratch` has that many values.
+        unsafe {
+            f(
+                inputs.parameters.as_ptr(),
+                inputs.q.as_ptr(),
+                inputs.qdot.as_ptr(),
+                inputs.acceleration.as_ptr(),
+                inputs.lambda.as_ptr(),
+                inputs.t,
+                out0,
+                out1,
+                scratch,
+            )
+        }
+    };
+    if extent.scratch == 0 {
+        return call(std::ptr::null_mut());
+    }
+    SCRATCH.with(|buffer| match buffer.try_borrow_mut() {
+        Ok(mut buffer) => {
+            if buffer.len() < extent.scratch {
+                buffer.resize(extent.scratch, 0.0);
+            }
+            call(buffer.as_mut_ptr())
+        }
+        // Re-entered on this thread (cannot happen: the code calls no model code).
+        Err(_) => call(vec![0.0; extent.scratch].as_mut_ptr()),
+    });
 }
 
 /// A model file compiled at run time: the equations of motion of any file, with no rebuild.
@@ -408,23 +463,9 @@ impl JitModel {
             self.code.program.name
         );
         match compiled.native.as_ref().and_then(|n| n.functions[index]) {
-            Some(f) => {
-                // SAFETY: `f` was compiled from this routine's tape, which reads at most
-                // `extent` values of each input and writes `extent.out0`/`out1` values, and
-                // `admits` checked that every slice is at least that long.
-                unsafe {
-                    f(
-                        inputs.parameters.as_ptr(),
-                        inputs.q.as_ptr(),
-                        inputs.qdot.as_ptr(),
-                        inputs.acceleration.as_ptr(),
-                        inputs.lambda.as_ptr(),
-                        inputs.t,
-                        out0.as_mut_ptr(),
-                        out1.as_mut_ptr(),
-                    )
-                }
-            }
+            // SAFETY: `f` was compiled from this routine's tape, of which `extent` is the
+            // extent, and `admits` checked every slice above.
+            Some(f) => unsafe { call_native(f, extent, &inputs, out0, out1) },
             None => SCRATCH.with(|scratch| match scratch.try_borrow_mut() {
                 Ok(mut values) => interpret::evaluate(tape, &inputs, &mut values, out0, out1),
                 // Re-entered on this thread (cannot happen: evaluation calls no model code);
@@ -519,21 +560,9 @@ impl DynMechanicalSystem for JitModel {
         let inputs = self.inputs(q, qdot, t);
         match self.mass_and_forcing {
             Some((f, extent)) if extent.admits(&inputs, mass.len(), forcing.len()) => {
-                // SAFETY: `f` is the native code of this routine's tape, which reads at most
-                // `extent` values of each input and writes `extent.out0` and `extent.out1`
-                // values, and `admits` checked every slice is at least that long.
-                unsafe {
-                    f(
-                        inputs.parameters.as_ptr(),
-                        q.as_ptr(),
-                        qdot.as_ptr(),
-                        inputs.acceleration.as_ptr(),
-                        inputs.lambda.as_ptr(),
-                        t,
-                        mass.as_mut_ptr(),
-                        forcing.as_mut_ptr(),
-                    )
-                }
+                // SAFETY: `f` is the native code of this routine's tape, of which `extent` is
+                // the extent, and `admits` checked every slice.
+                unsafe { call_native(f, &extent, &inputs, mass, forcing) }
             }
             // Interpreted, or a slice too short (which `run` reports).
             _ => self.run(Routine::MassMatrixAndForcing, inputs, mass, forcing),

@@ -6,7 +6,8 @@
 //! [`NativeFn`] (the platform's C calling convention):
 //!
 //! ```text
-//! fn(parameters, q, qdot, acceleration, lambda: *const f64, t: f64, out0, out1: *mut f64)
+//! fn(parameters, q, qdot, acceleration, lambda: *const f64, t: f64,
+//!    out0, out1, scratch: *mut f64)
 //! ```
 //!
 //! Its body is the tape, instruction for instruction, in one basic block: inputs are loads
@@ -55,7 +56,12 @@ pub(crate) type NativeFn = unsafe extern "C" fn(
     f64,
     *mut f64,
     *mut f64,
+    *mut f64,
 );
+
+/// Functions of more instructions than this keep their shared values in a scratch buffer
+/// instead of registers (see [`build`]).
+const SCRATCH_FROM_INSTRUCTIONS: usize = 1500;
 
 /// Why the model's functions could not be compiled to native code.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
@@ -89,6 +95,8 @@ pub enum CompileError {
 pub(crate) struct NativeCode {
     /// One entry per function compiled, `None` for an empty tape.
     pub(crate) functions: Vec<Option<NativeFn>>,
+    /// Per function: how many `f64`s of scratch space it needs (0: none, pass null).
+    pub(crate) scratch: Vec<usize>,
     /// Bytes of machine code (without alignment padding and the module's bookkeeping).
     pub(crate) code_bytes: usize,
     /// The module that owns the executable memory, freed on drop.
@@ -228,16 +236,19 @@ pub(crate) fn compile(functions: &[(&str, &FunctionTape)]) -> Result<NativeCode,
         signature.params.push(AbiParam::new(pointer));
     }
     signature.params.push(AbiParam::new(types::F64));
-    signature.params.push(AbiParam::new(pointer));
-    signature.params.push(AbiParam::new(pointer));
+    for _ in 0..3 {
+        signature.params.push(AbiParam::new(pointer));
+    }
 
     let mut context = module.make_context();
     let mut builder_context = FunctionBuilderContext::new();
     let mut ids: Vec<Option<FuncId>> = Vec::new();
+    let mut scratch = Vec::new();
     let mut code_bytes = 0usize;
     for (index, &(name, function)) in functions.iter().enumerate() {
         if function.tape.outputs.is_empty() {
             ids.push(None);
+            scratch.push(0);
             continue;
         }
         function
@@ -249,13 +260,13 @@ pub(crate) fn compile(functions: &[(&str, &FunctionTape)]) -> Result<NativeCode,
             .map_err(|e| failure(name, &e))?;
         context.func.signature = signature.clone();
         context.func.name = UserFuncName::user(0, index as u32);
-        build(
+        scratch.push(build(
             &mut module,
             &mut context.func,
             &mut builder_context,
             function,
             &imports,
-        );
+        ));
         if std::env::var_os("EOMGEN_JIT_DISASM").is_some() {
             context.set_disasm(true);
         }
@@ -292,6 +303,7 @@ pub(crate) fn compile(functions: &[(&str, &FunctionTape)]) -> Result<NativeCode,
         .collect();
     Ok(NativeCode {
         functions,
+        scratch,
         code_bytes,
         module: Mutex::new(Some(module)),
     })
@@ -318,6 +330,8 @@ struct Values {
     /// Per input instruction: its value and the number of calls emitted before its load.
     loaded: Vec<Option<(u32, ir::Value)>>,
     calls: u32,
+    /// In a large function, the scratch buffer and each shared value's slot in it.
+    scratch: Option<(ir::Value, Vec<Option<u32>>)>,
 }
 
 impl Values {
@@ -330,11 +344,23 @@ impl Values {
     ) -> ir::Value {
         let x = x as usize;
         let Instruction::Input(input) = tape.instructions[x] else {
+            if let Some((buffer, slots)) = &self.scratch
+                && let Some(slot) = slots[x]
+            {
+                return b.ins().load(
+                    types::F64,
+                    MemFlagsData::trusted(),
+                    *buffer,
+                    (slot as i32) * 8,
+                );
+            }
             // Defined before use (the tape is validated), so never the placeholder.
             return self.values[x].unwrap_or(arguments.t);
         };
+        // A large function loads an input at every use (a short live range each).
         if let Some((at, value)) = self.loaded[x]
             && at == self.calls
+            && self.scratch.is_none()
         {
             return value;
         }
@@ -355,14 +381,22 @@ impl Values {
     }
 }
 
-/// Writes the body of one tape into `func`.
+/// Writes the body of one tape into `func`; returns how many `f64`s of scratch space it needs.
+///
+/// A large function (more than [`SCRATCH_FROM_INSTRUCTIONS`] instructions: a chain of dozens
+/// of links) keeps every value used more than once in a scratch buffer the caller passes,
+/// stored once and loaded at each use, and loads its inputs at each use: every value then
+/// lives for a few instructions, and the register allocator's work grows linearly with the
+/// function. With the values in registers, as for small functions, the allocator spends
+/// quadratic time on the long, overlapping live ranges (a 60-link pendulum: 64 % of 4.1 s in
+/// `try_to_allocate_bundle_to_reg`).
 fn build(
     module: &mut JITModule,
     func: &mut ir::Function,
     builder_context: &mut FunctionBuilderContext,
     function: &FunctionTape,
     imports: &Imports,
-) {
+) -> usize {
     let mut b = FunctionBuilder::new(func, builder_context);
     let block = b.create_block();
     b.append_block_params_for_function_params(block);
@@ -377,17 +411,53 @@ fn build(
         lambda: params[4],
         t: params[5],
     };
-    let (out0, out1) = (params[6], params[7]);
+    let (out0, out1, buffer) = (params[6], params[7], params[8]);
     let mut unary_refs: Vec<(Function, ir::FuncRef)> = Vec::new();
     let mut sin_cos_ref = None;
     let mut powf_ref = None;
     let mut atan2_ref = None;
     let tape = &function.tape;
     let count = tape.instructions.len();
+    let mut slots_used = 0u32;
+    let scratch = (count > SCRATCH_FROM_INSTRUCTIONS).then(|| {
+        let mut uses = vec![0u32; count];
+        for instruction in &tape.instructions {
+            for x in operands(instruction) {
+                uses[x as usize] += 1;
+            }
+        }
+        for &x in &tape.outputs {
+            uses[x as usize] += 1;
+        }
+        let slots: Vec<Option<u32>> = tape
+            .instructions
+            .iter()
+            .zip(&uses)
+            .map(|(instruction, &n)| {
+                let shared = n >= 2 || matches!(instruction, Instruction::SinCos(_));
+                let kept = !matches!(instruction, Instruction::Input(_) | Instruction::Const(_));
+                (shared && kept).then(|| {
+                    slots_used += 1;
+                    slots_used - 1
+                })
+            })
+            .collect();
+        (buffer, slots)
+    });
     let mut values = Values {
         values: vec![None; count],
         loaded: vec![None; count],
         calls: 0,
+        scratch,
+    };
+    // Stores `value` (instruction `k`) to its scratch slot, if it has one.
+    let spill = |b: &mut FunctionBuilder, values: &Values, k: usize, value: ir::Value| {
+        if let Some((buffer, slots)) = &values.scratch
+            && let Some(slot) = slots[k]
+        {
+            b.ins()
+                .store(MemFlagsData::trusted(), value, *buffer, (slot as i32) * 8);
+        }
     };
     for (k, instruction) in tape.instructions.iter().enumerate() {
         let mut v = |b: &mut FunctionBuilder, x: u32| values.get(b, tape, &arguments, x);
@@ -487,12 +557,15 @@ fn build(
                 if let Some(slot) = values.values.get_mut(k + 1) {
                     *slot = Some(c);
                 }
+                spill(&mut b, &values, k, s);
+                spill(&mut b, &values, k + 1, c);
                 continue;
             }
             // Set with its `SinCos`.
             Instruction::CosOfSinCos(_) => continue,
         };
         values.values[k] = Some(value);
+        spill(&mut b, &values, k, value);
     }
     // Outputs are stored two at a time (slots 2k and 2k + 1 of a buffer as one 16-byte
     // store): the caller reads them back at once, often 16 bytes at a time (nalgebra's
@@ -523,6 +596,25 @@ fn build(
     }
     b.ins().return_(&[]);
     b.finalize(module.target_config());
+    slots_used as usize
+}
+
+/// The values an instruction reads.
+fn operands(instruction: &Instruction) -> Vec<u32> {
+    match *instruction {
+        Instruction::Input(_) | Instruction::Const(_) | Instruction::CosOfSinCos(_) => Vec::new(),
+        Instruction::Neg(x)
+        | Instruction::Sqrt(x)
+        | Instruction::Abs(x)
+        | Instruction::Call(_, x)
+        | Instruction::SinCos(x) => vec![x],
+        Instruction::Add(x, y)
+        | Instruction::Sub(x, y)
+        | Instruction::Mul(x, y)
+        | Instruction::Div(x, y)
+        | Instruction::Powf(x, y)
+        | Instruction::Atan2(x, y) => vec![x, y],
+    }
 }
 
 #[cfg(test)]
@@ -596,6 +688,7 @@ mod tests {
                 0.0,
                 out.as_mut_ptr(),
                 [].as_mut_ptr(),
+                std::ptr::null_mut(),
             )
         };
         assert_eq!(out[0], 9.0);

@@ -177,6 +177,12 @@ fn open_model(name_or_path: &str) -> Result<eomgen::ModelSource, CliError> {
         return Ok(source);
     }
     let source = eomgen::ModelSource::open(name_or_path).map_err(open_error)?;
+    if let eomgen::ModelSource::File { path, model } = &source
+        && let Some(reason) = model.fallback_reason()
+    {
+        // Slower, but the same numbers: say so rather than run silently interpreted.
+        eprintln!("note: `{path}` runs on the interpreter: {reason}");
+    }
     if source.is_file()
         && let Ok(mut files) = FILES.lock()
     {
