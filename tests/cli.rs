@@ -560,7 +560,10 @@ fn a_file_from_new_simulates_and_an_unknown_name_says_a_path_works() {
     let out = eomgen(&["simulate", "n_link_pendulum_5"]);
     assert_eq!(out.status.code(), Some(2));
     let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(stderr.contains("no model named `n_link_pendulum_5`"), "{stderr}");
+    assert!(
+        stderr.contains("no model named `n_link_pendulum_5`"),
+        "{stderr}"
+    );
     assert!(stderr.contains("a path to a model file"), "{stderr}");
     let _ = std::fs::remove_dir_all(&dir);
 }

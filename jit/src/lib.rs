@@ -150,7 +150,11 @@ mod tests {
         .map(|source| {
             let file = eomgen_symbolic::model::load("generated.yaml", &source).expect("loads");
             let (program, derivation) = ModelProgram::from_file(&file).expect("derives");
-            ("generated.yaml".to_string(), program, derivation.jacobians())
+            (
+                "generated.yaml".to_string(),
+                program,
+                derivation.jacobians(),
+            )
         });
         for (display, program, jacobians) in bundled_programs().into_iter().chain(generated) {
             let functions: Vec<_> = program
@@ -219,6 +223,9 @@ mod tests {
             }
         }
         assert!(compared > 10_000, "only {compared} values compared");
-        assert!(scratched > 100, "the scratch buffer was used {scratched} times");
+        assert!(
+            scratched > 100,
+            "the scratch buffer was used {scratched} times"
+        );
     }
 }

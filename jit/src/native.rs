@@ -450,13 +450,33 @@ fn build(
         calls: 0,
         scratch,
     };
-    // Stores `value` (instruction `k`) to its scratch slot, if it has one.
+    // In a large function each output is stored as soon as it is computed (kept to the end,
+    // every output would live through the rest of the function): per instruction, the
+    // (buffer, byte offset) of the outputs it is.
+    let split = function.split.min(tape.outputs.len());
+    let mut destinations: Vec<Vec<(ir::Value, i32)>> = Vec::new();
+    if values.scratch.is_some() {
+        destinations = vec![Vec::new(); count];
+        for (j, &x) in tape.outputs.iter().enumerate() {
+            let (base, slot) = if j < split {
+                (out0, j)
+            } else {
+                (out1, j - split)
+            };
+            destinations[x as usize].push((base, (slot as i32) * 8));
+        }
+    }
+    // Stores `value` (instruction `k`) to its scratch slot, if it has one, and to the outputs
+    // it is, in a large function.
     let spill = |b: &mut FunctionBuilder, values: &Values, k: usize, value: ir::Value| {
-        if let Some((buffer, slots)) = &values.scratch
-            && let Some(slot) = slots[k]
-        {
-            b.ins()
-                .store(MemFlagsData::trusted(), value, *buffer, (slot as i32) * 8);
+        if let Some((buffer, slots)) = &values.scratch {
+            if let Some(slot) = slots[k] {
+                b.ins()
+                    .store(MemFlagsData::trusted(), value, *buffer, (slot as i32) * 8);
+            }
+            for &(base, offset) in &destinations[k] {
+                b.ins().store(MemFlagsData::trusted(), value, base, offset);
+            }
         }
     };
     for (k, instruction) in tape.instructions.iter().enumerate() {
@@ -573,7 +593,28 @@ fn build(
     // forwarded from the store buffer — it waits ~12 cycles for the stores to retire, while a
     // load within one wider store is forwarded. On the double pendulum's right-hand side this
     // was worth ~4 ns (`benches/runtime_model.rs`).
-    let split = function.split.min(tape.outputs.len());
+    if values.scratch.is_some() {
+        // Computed outputs are stored already; inputs and constants still are to be.
+        for (j, &x) in tape.outputs.iter().enumerate() {
+            if !matches!(
+                tape.instructions[x as usize],
+                Instruction::Input(_) | Instruction::Const(_)
+            ) {
+                continue;
+            }
+            let (base, slot) = if j < split {
+                (out0, j)
+            } else {
+                (out1, j - split)
+            };
+            let value = values.get(&mut b, tape, &arguments, x);
+            b.ins()
+                .store(MemFlagsData::trusted(), value, base, (slot as i32) * 8);
+        }
+        b.ins().return_(&[]);
+        b.finalize(module.target_config());
+        return slots_used as usize;
+    }
     for (base, outputs) in [
         (out0, &tape.outputs[..split]),
         (out1, &tape.outputs[split..]),
