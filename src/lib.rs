@@ -59,23 +59,7 @@ pub mod models {
 pub mod __private {
     pub use nalgebra;
 
-    /// Sign of `x`: −1, 0 or 1 (unlike `f64::signum`, 0 at 0).
-    #[inline]
-    pub fn sign(x: f64) -> f64 {
-        if x > 0.0 {
-            1.0
-        } else if x < 0.0 {
-            -1.0
-        } else {
-            0.0
-        }
-    }
-
-    /// Heaviside step: 1 for `x ≥ 0`, else 0.
-    #[inline]
-    pub fn step(x: f64) -> f64 {
-        if x >= 0.0 { 1.0 } else { 0.0 }
-    }
+    pub use eomgen_runtime::functions::{sign, step};
 
     // The generated code's sine and cosine come from the `libm` crate (a pure-Rust port of
     // musl's correctly range-reduced fdlibm kernels, < 1 ulp) rather than the platform's libm

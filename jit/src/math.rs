@@ -6,7 +6,7 @@
 //! the compiled one: sine and cosine from the `libm` crate, the other transcendentals from
 //! the platform's libm behind `f64::exp` and friends.
 
-use eomgen_symbolic::codegen::tape::Function;
+use eomgen_symbolic::expr::Func;
 
 /// `sin x` and `cos x` of one `libm::sincos` call, returned in two floating-point registers
 /// (the C ABI of a struct of two `double`s on x86-64 System V and AArch64).
@@ -55,19 +55,16 @@ extern "C" fn exp(x: f64) -> f64 {
 extern "C" fn ln(x: f64) -> f64 {
     x.ln()
 }
-/// −1, 0 or 1 (0 at 0 and for NaN), as `eomgen::__private::sign`.
+/// `eomgen::__private::sign`, which is this very function.
 extern "C" fn sign(x: f64) -> f64 {
-    if x > 0.0 {
-        1.0
-    } else if x < 0.0 {
-        -1.0
-    } else {
-        0.0
-    }
+    eomgen_runtime::functions::sign(x)
 }
-/// 1 for `x ≥ 0`, else 0 (also for NaN), as `eomgen::__private::step`.
+/// `eomgen::__private::step`, which is this very function.
 extern "C" fn step(x: f64) -> f64 {
-    if x >= 0.0 { 1.0 } else { 0.0 }
+    eomgen_runtime::functions::step(x)
+}
+extern "C" fn abs(x: f64) -> f64 {
+    x.abs()
 }
 pub(crate) extern "C" fn powf(x: f64, y: f64) -> f64 {
     x.powf(y)
@@ -77,20 +74,21 @@ pub(crate) extern "C" fn atan2(y: f64, x: f64) -> f64 {
 }
 
 /// The function of one argument behind `function`.
-pub(crate) fn unary(function: Function) -> extern "C" fn(f64) -> f64 {
+pub(crate) fn unary(function: Func) -> extern "C" fn(f64) -> f64 {
     match function {
-        Function::Sin => sin,
-        Function::Cos => cos,
-        Function::Tan => tan,
-        Function::Asin => asin,
-        Function::Acos => acos,
-        Function::Atan => atan,
-        Function::Sinh => sinh,
-        Function::Cosh => cosh,
-        Function::Tanh => tanh,
-        Function::Exp => exp,
-        Function::Ln => ln,
-        Function::Sign => sign,
-        Function::Step => step,
+        Func::Sin => sin,
+        Func::Cos => cos,
+        Func::Tan => tan,
+        Func::Asin => asin,
+        Func::Acos => acos,
+        Func::Atan => atan,
+        Func::Sinh => sinh,
+        Func::Cosh => cosh,
+        Func::Tanh => tanh,
+        Func::Exp => exp,
+        Func::Ln => ln,
+        Func::Sign => sign,
+        Func::Step => step,
+        Func::Abs => abs,
     }
 }

@@ -38,7 +38,8 @@ use cranelift_jit::{JITBuilder, JITModule};
 use cranelift_module::{FuncId, Linkage, Module, default_libcall_names};
 
 use eomgen_symbolic::codegen::program::FunctionTape;
-use eomgen_symbolic::codegen::tape::{Function, Input, Instruction};
+use eomgen_symbolic::codegen::tape::{Input, Instruction};
+use eomgen_symbolic::expr::Func;
 
 use crate::math;
 
@@ -135,24 +136,24 @@ impl Drop for NativeCode {
 }
 
 /// Which helper functions the code calls, by symbol name.
-const HELPERS: [(&str, Function); 13] = [
-    ("eomgen_sin", Function::Sin),
-    ("eomgen_cos", Function::Cos),
-    ("eomgen_tan", Function::Tan),
-    ("eomgen_asin", Function::Asin),
-    ("eomgen_acos", Function::Acos),
-    ("eomgen_atan", Function::Atan),
-    ("eomgen_sinh", Function::Sinh),
-    ("eomgen_cosh", Function::Cosh),
-    ("eomgen_tanh", Function::Tanh),
-    ("eomgen_exp", Function::Exp),
-    ("eomgen_ln", Function::Ln),
-    ("eomgen_sign", Function::Sign),
-    ("eomgen_step", Function::Step),
+const HELPERS: [(&str, Func); 13] = [
+    ("eomgen_sin", Func::Sin),
+    ("eomgen_cos", Func::Cos),
+    ("eomgen_tan", Func::Tan),
+    ("eomgen_asin", Func::Asin),
+    ("eomgen_acos", Func::Acos),
+    ("eomgen_atan", Func::Atan),
+    ("eomgen_sinh", Func::Sinh),
+    ("eomgen_cosh", Func::Cosh),
+    ("eomgen_tanh", Func::Tanh),
+    ("eomgen_exp", Func::Exp),
+    ("eomgen_ln", Func::Ln),
+    ("eomgen_sign", Func::Sign),
+    ("eomgen_step", Func::Step),
 ];
 
 struct Imports {
-    unary: Vec<(Function, FuncId)>,
+    unary: Vec<(Func, FuncId)>,
     sin_cos: FuncId,
     powf: FuncId,
     atan2: FuncId,
@@ -412,7 +413,7 @@ fn build(
         t: params[5],
     };
     let (out0, out1, buffer) = (params[6], params[7], params[8]);
-    let mut unary_refs: Vec<(Function, ir::FuncRef)> = Vec::new();
+    let mut unary_refs: Vec<(Func, ir::FuncRef)> = Vec::new();
     let mut sin_cos_ref = None;
     let mut powf_ref = None;
     let mut atan2_ref = None;
@@ -509,11 +510,11 @@ fn build(
                 let x = v(&mut b, x);
                 b.ins().sqrt(x)
             }
-            Instruction::Abs(x) => {
+            Instruction::Abs(x) | Instruction::Call(Func::Abs, x) => {
                 let x = v(&mut b, x);
                 b.ins().fabs(x)
             }
-            Instruction::Call(Function::Sign, x) => {
+            Instruction::Call(Func::Sign, x) => {
                 // −1, 0 or 1; NaN compares false both ways and gives 0, as `sign` does.
                 let x = v(&mut b, x);
                 let zero = b.ins().f64const(0.0);
@@ -524,7 +525,7 @@ fn build(
                 let low = b.ins().select(negative, minus_one, zero);
                 b.ins().select(positive, one, low)
             }
-            Instruction::Call(Function::Step, x) => {
+            Instruction::Call(Func::Step, x) => {
                 let x = v(&mut b, x);
                 let zero = b.ins().f64const(0.0);
                 let one = b.ins().f64const(1.0);
@@ -705,9 +706,10 @@ mod tests {
             (&lone_cosine, "sin_cos"),
             (&missing_output, "instructions"),
         ] {
-            let error = compile(&[("kinetic_energy", &good), ("potential_energy", bad)])
-                .err()
-                .expect("a malformed tape does not compile");
+            let Err(error) = compile(&[("kinetic_energy", &good), ("potential_energy", bad)])
+            else {
+                panic!("a malformed tape does not compile");
+            };
             let CompileError::Function { function, reason } = &error else {
                 panic!("{error}");
             };

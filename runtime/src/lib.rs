@@ -9,6 +9,7 @@ pub mod constrained;
 pub mod dynamic;
 pub mod floquet;
 pub mod frf;
+pub mod functions;
 pub mod integrate;
 pub mod modal;
 pub mod ode;

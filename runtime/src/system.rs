@@ -438,7 +438,7 @@ pub fn solve_spd_in_place(n: usize, mass: &[f64], f: &mut [f64], work: &mut [f64
         1 => {
             let a = m(0, 0);
             // Not positive, or NaN.
-            if !(a > 0.0) {
+            if a.is_nan() || a <= 0.0 {
                 return None;
             }
             f[0] /= a;

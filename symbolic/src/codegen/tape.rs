@@ -38,75 +38,6 @@ pub enum Input {
     Time,
 }
 
-/// A library function of one argument, called as the generated Rust calls it.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum Function {
-    /// `libm::sin` (the `libm` crate, as `__private::sin`).
-    Sin,
-    /// `libm::cos`.
-    Cos,
-    /// `f64::tan`.
-    Tan,
-    /// `f64::asin`.
-    Asin,
-    /// `f64::acos`.
-    Acos,
-    /// `f64::atan`.
-    Atan,
-    /// `f64::sinh`.
-    Sinh,
-    /// `f64::cosh`.
-    Cosh,
-    /// `f64::tanh`.
-    Tanh,
-    /// `f64::exp`.
-    Exp,
-    /// `f64::ln`.
-    Ln,
-    /// `__private::sign`: −1, 0 or 1.
-    Sign,
-    /// `__private::step`: 1 for `x ≥ 0`, else 0.
-    Step,
-}
-
-impl Function {
-    /// Every function, in declaration order.
-    pub const ALL: [Function; 13] = [
-        Function::Sin,
-        Function::Cos,
-        Function::Tan,
-        Function::Asin,
-        Function::Acos,
-        Function::Atan,
-        Function::Sinh,
-        Function::Cosh,
-        Function::Tanh,
-        Function::Exp,
-        Function::Ln,
-        Function::Sign,
-        Function::Step,
-    ];
-
-    /// The name of the function in model files (`sin`, `ln`, …).
-    pub fn name(self) -> &'static str {
-        match self {
-            Function::Sin => "sin",
-            Function::Cos => "cos",
-            Function::Tan => "tan",
-            Function::Asin => "asin",
-            Function::Acos => "acos",
-            Function::Atan => "atan",
-            Function::Sinh => "sinh",
-            Function::Cosh => "cosh",
-            Function::Tanh => "tanh",
-            Function::Exp => "exp",
-            Function::Ln => "ln",
-            Function::Sign => "sign",
-            Function::Step => "step",
-        }
-    }
-}
-
 /// One operation; each defines the [`Value`] of its index.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Instruction {
@@ -128,8 +59,10 @@ pub enum Instruction {
     Sqrt(Value),
     /// `|x|`.
     Abs(Value),
-    /// A library function of one argument.
-    Call(Function, Value),
+    /// A function of one argument other than `abs` (which is [`Instruction::Abs`]), called
+    /// as the generated Rust calls it: `sin` and `cos` from the `libm` crate, `sign` and `step`
+    /// as `eomgen::__private` defines them, the others as the `f64` methods of their names.
+    Call(Func, Value),
     /// `xʸ` (`f64::powf`).
     Powf(Value, Value),
     /// `atan2(y, x)` (`f64::atan2`), arguments in that order.
@@ -361,23 +294,10 @@ impl Lowering<'_> {
             }
             Node::Func(f, u) => {
                 let a = self.operand(*u);
-                let function = match f {
-                    Func::Abs => return self.push(Instruction::Abs(a)),
-                    Func::Sin => Function::Sin,
-                    Func::Cos => Function::Cos,
-                    Func::Tan => Function::Tan,
-                    Func::Asin => Function::Asin,
-                    Func::Acos => Function::Acos,
-                    Func::Atan => Function::Atan,
-                    Func::Sinh => Function::Sinh,
-                    Func::Cosh => Function::Cosh,
-                    Func::Tanh => Function::Tanh,
-                    Func::Exp => Function::Exp,
-                    Func::Ln => Function::Ln,
-                    Func::Sign => Function::Sign,
-                    Func::Step => Function::Step,
-                };
-                self.push(Instruction::Call(function, a))
+                match f {
+                    Func::Abs => self.push(Instruction::Abs(a)),
+                    f => self.push(Instruction::Call(*f, a)),
+                }
             }
             Node::Atan2([y, x]) => {
                 let y = self.operand(*y);
