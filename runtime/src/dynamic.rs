@@ -3,7 +3,7 @@
 //! [`DynMechanicalSystem`] is [`MechanicalSystem`](crate::MechanicalSystem) with slices in
 //! place of nalgebra's static vectors and matrices: what a model compiled at run time (from any
 //! model file, with no rebuild) implements. [`DynFirstOrder`] is its first-order form and
-//! implements [`ModelInfo`](crate::ModelInfo), so every analysis that takes a
+//! implements [`ModelInfo`], so every analysis that takes a
 //! `Box<dyn ModelInfo>` takes such a model unchanged.
 
 use nalgebra::{DMatrix, DVector, SMatrix, SVector};
