@@ -726,8 +726,10 @@ impl ExprArena {
             let Some(partner) = partner.filter(|p| collected.get(p) == Some(&c)) else {
                 continue;
             };
-            collected.shift_remove(&rest);
-            collected.shift_remove(&partner);
+            // Zeroed, not removed: removing from the middle of an `IndexMap` moves every later
+            // entry, quadratic in the number of terms; zero terms are dropped at the end.
+            zero_term(collected, rest);
+            zero_term(collected, partner);
             match others.len() {
                 0 => {
                     *constant = constant.checked_add(c).unwrap_or(*constant);
@@ -812,8 +814,8 @@ impl ExprArena {
             else {
                 continue;
             };
-            collected.shift_remove(&rest);
-            collected.shift_remove(&partner);
+            zero_term(collected, rest);
+            zero_term(collected, partner);
             // Canonical difference: smaller id first; sin(v − u) = −sin(u − v).
             let (a, b, flip) = if u < v { (u, v, false) } else { (v, u, true) };
             let diff = self.minus(a, b);
@@ -1225,6 +1227,14 @@ struct AngleMatch {
     result: Func,
     u: ExprId,
     v: ExprId,
+}
+
+/// Sets the coefficient of `rest` among collected sum terms to zero (the term is dropped when
+/// the sum is built; a zero coefficient never matches a partner's).
+fn zero_term(collected: &mut indexmap::IndexMap<ExprId, Constant>, rest: ExprId) {
+    if let Some(c) = collected.get_mut(&rest) {
+        *c = Constant::ZERO;
+    }
 }
 
 /// The bit of symbol `s` in [`ExprArena`]'s per-node symbol summaries.

@@ -420,6 +420,8 @@ proptest! {
         let roots = [e1, e2, d];
         let p = plan(&a, &roots, "t");
         prop_assert!(p.operation_count() <= a.tree_operation_count(&roots));
+        // The count alone (for choosing between forms) is the plan's.
+        prop_assert_eq!(cse::operation_count(&a, &roots), p.operation_count());
         // Evaluate temporaries in order with a tiny interpreter over the plan.
         let mut values: rustc_hash::FxHashMap<ExprId, f64> = Default::default();
         let mut direct = Evaluator::new(&a, &roots);
@@ -463,6 +465,7 @@ fn cse_shares_sin_cos_and_repeated_terms() {
         .count();
     assert_eq!(pairs, 1, "{:?}", p.temporaries);
     assert_eq!(p.name_of(s), Some("t0_s"));
+    assert_eq!(cse::operation_count(&a, &[v, w, s]), p.operation_count());
 }
 
 #[test]

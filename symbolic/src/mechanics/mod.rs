@@ -112,7 +112,7 @@ pub fn cheapest_equations(model: &mut SymbolicModel) -> (EquationsOfMotion, &'st
             .chain(&eom.forcing)
             .copied()
             .collect();
-        crate::expr::cse::plan(&model.arena, &roots, "t").operation_count()
+        crate::expr::cse::operation_count(&model.arena, &roots)
     };
     if cost(&momentum) < cost(&lagrange) {
         (momentum, MomentumBalance.name())
@@ -139,7 +139,7 @@ pub(crate) fn cheaper_of_raw_and_expanded(
         .collect();
     let cost = |arena: &crate::expr::ExprArena, m: &[ExprId], f: &[ExprId]| {
         let roots: Vec<ExprId> = m.iter().chain(f).copied().collect();
-        crate::expr::cse::plan(arena, &roots, "t").operation_count()
+        crate::expr::cse::operation_count(arena, &roots)
     };
     if cost(arena, &expanded_mass, &expanded_forcing) < cost(arena, &mass_matrix, &forcing) {
         (expanded_mass, expanded_forcing)

@@ -441,7 +441,7 @@ fn cheaper_of_raw_and_collected(
     let collected_forcing: Vec<ExprId> = forcing.iter().map(|&f| compact(f)).collect();
     let cost = |arena: &ExprArena, m: &[ExprId], f: &[ExprId]| {
         let roots: Vec<ExprId> = m.iter().chain(f).copied().collect();
-        crate::expr::cse::plan(arena, &roots, "t").operation_count()
+        crate::expr::cse::operation_count(arena, &roots)
     };
     if cost(arena, &collected_mass, &collected_forcing) <= cost(arena, &mass_matrix, &forcing) {
         (collected_mass, collected_forcing)
