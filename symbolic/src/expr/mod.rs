@@ -329,6 +329,14 @@ pub struct ExprArena {
     dt_memo: FxHashMap<ExprId, ExprId>,
     expand_memo: FxHashMap<ExprId, ExprId>,
     expand_time_varying_memo: FxHashMap<ExprId, ExprId>,
+    /// Canonical sums of two terms, by their (ordered) terms: collecting a chain adds one mass
+    /// to the same long sum of masses once per joint above it, and each such sum would
+    /// otherwise flatten, sort and merge the long one again.
+    pair_sum_memo: FxHashMap<(ExprId, ExprId), ExprId>,
+    /// The nodes of the integers −1, 0, 1 and 2 once created: every derivative that vanishes
+    /// and every negation asks for one, and a hash-cons lookup per request was a tenth of a
+    /// long chain's Lagrange derivation.
+    small_ints: [Option<ExprId>; 4],
 }
 
 impl ExprArena {
@@ -494,7 +502,18 @@ impl ExprArena {
 
     /// The integer `n`.
     pub fn int(&mut self, n: i64) -> ExprId {
-        self.constant(Constant::int(n))
+        let Some(slot) = usize::try_from(n + 1)
+            .ok()
+            .filter(|k| *k < self.small_ints.len())
+        else {
+            return self.constant(Constant::int(n));
+        };
+        if let Some(id) = self.small_ints[slot] {
+            return id;
+        }
+        let id = self.constant(Constant::int(n));
+        self.small_ints[slot] = Some(id);
+        id
     }
 
     /// A float constant; non-finite values become NaN-free by clamping to the largest finite
@@ -560,6 +579,22 @@ impl ExprArena {
 
     /// Canonical sum of `terms`.
     pub fn sum(&mut self, terms: &[ExprId]) -> ExprId {
+        // The canonical sum does not depend on the order of the terms (they are sorted and
+        // merged), so `a + b` and `b + a` share one memo entry.
+        if let &[a, b] = terms {
+            let key = (a.min(b), a.max(b));
+            if let Some(&s) = self.pair_sum_memo.get(&key) {
+                return s;
+            }
+            let s = self.sum_uncached(terms);
+            self.pair_sum_memo.insert(key, s);
+            return s;
+        }
+        self.sum_uncached(terms)
+    }
+
+    /// [`Self::sum`] without the memo.
+    fn sum_uncached(&mut self, terms: &[ExprId]) -> ExprId {
         let mut constant = Constant::ZERO;
         let mut flat: Vec<ExprId> = Vec::with_capacity(terms.len());
         self.flatten_sum(terms, &mut flat);
