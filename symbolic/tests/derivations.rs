@@ -230,3 +230,33 @@ fn issue_18_lagrange_is_compact_on_long_chains() {
         ops("momentum")
     );
 }
+
+/// The formulation generated code uses is chosen without deriving: momentum balance for a
+/// kinematic-form model, Lagrange for an energy-form one, and `preferred_equations` derives
+/// that one only (its arena ends as large as after that derivation alone).
+#[test]
+fn preferred_formulation_needs_no_derivation() {
+    use eomgen_symbolic::mechanics::{preferred_equations, preferred_formulation};
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../models/");
+    for (path, expected) in [
+        ("double_pendulum.yaml", "momentum"),
+        ("spring_line_three.yaml", "momentum"),
+        ("simple_pendulum.yaml", "lagrange"),
+        ("figure_eight.yaml", "lagrange"),
+    ] {
+        let source = std::fs::read_to_string(format!("{dir}{path}")).expect("bundled");
+        let file = eomgen_symbolic::model::load(path, &source).expect("loads");
+        let mut model = SymbolicModel::from_file(&file).expect("lowers");
+        let (_, name) = preferred_equations(&mut model);
+        assert_eq!(name, expected, "{path}");
+        let mut alone = SymbolicModel::from_file(&file).expect("lowers");
+        let formulation = preferred_formulation(&alone);
+        assert_eq!(formulation.name(), expected, "{path}");
+        formulation.derive(&mut alone);
+        assert_eq!(
+            model.arena.len(),
+            alone.arena.len(),
+            "{path}: more than one derivation"
+        );
+    }
+}
