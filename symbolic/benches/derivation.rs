@@ -7,22 +7,23 @@
 //! ```text
 //! model::load (YAML → typed, checked ModelFile)
 //!   → SymbolicModel::from_file (points, T, V, Q in the arena)
-//!   → cheapest_equations (Lagrange and, for a kinematic model, momentum balance; the one
-//!     with fewer operations after CSE)
+//!   → preferred_equations (momentum balance for a kinematic model, else Lagrange: one
+//!     derivation)
 //!   → Jacobians::of (∂F/∂q, ∂F/∂q̇, ∂(M a)/∂q)
 //!   → cse::plan over [M; F] (the plan of the hot `mass_matrix_and_forcing`)
 //! ```
 //!
 //! - `derive_double_pendulum` is the bundled `models/double_pendulum.yaml`, what a user
 //!   compiles;
-//! - `derive_n_link_pendulum_{2,5,10}` run the same pipeline on generated chains of `n`
+//! - `derive_n_link_pendulum_{2,5,10,20,40}` run the same pipeline on generated chains of `n`
 //!   uniform bars ([`n_link_pendulum`], after sympy's `n_link_pendulum_on_cart`), to show how
 //!   derivation time and expression size scale with `n` (the mass matrix is dense, so `F`
 //!   has `O(n²)` velocity-product terms and `M` `O(n²)` entries);
 //! - `emit_n_link_pendulum_10` times code generation alone ([`codegen::emit`]: CSE plans
 //!   and printing of every generated function) on an already derived 10-link chain;
 //! - the `formulations` group (issue 4's scaling table) times each formulation on its own,
-//!   Lagrange and momentum balance for `n` = 2, 5, 10, 20, 30: `{method}_n_link_pendulum_{n}`
+//!   Lagrange and momentum balance for `n` = 2, 5, 10, 20, 30, 40, 80:
+//!   `{method}_n_link_pendulum_{n}`
 //!   derives `M` and `F`, `{method}_and_jacobians_n_link_pendulum_{n}` also `Jacobians::of`
 //!   (what the macro derives from the equations it keeps); loading and lowering are setup.
 //!
@@ -46,7 +47,7 @@ use eomgen_symbolic::expr::cse::{self, CsePlan};
 use eomgen_symbolic::expr::eval::Evaluator;
 use eomgen_symbolic::mechanics::{
     EquationsOfMotion, Formulation, Jacobians, Lagrange, MomentumBalance, SymbolicModel,
-    cheapest_equations,
+    preferred_equations,
 };
 use eomgen_symbolic::model;
 
@@ -54,7 +55,7 @@ use eomgen_symbolic::model;
 const DOUBLE_PENDULUM: &str = include_str!("../../models/double_pendulum.yaml");
 
 /// Chain sizes of the `derive_n_link_pendulum_{n}` benches.
-const SIZES: [usize; 3] = [2, 5, 10];
+const SIZES: [usize; 5] = [2, 5, 10, 20, 40];
 
 /// Model file of an `n`-link planar pendulum of uniform bars, in the convention of
 /// `models/double_pendulum.yaml`.
@@ -76,7 +77,7 @@ fn n_link_pendulum(n: usize) -> String {
 struct Derived {
     model: SymbolicModel,
     eom: EquationsOfMotion,
-    /// The formulation `cheapest_equations` kept.
+    /// The formulation `preferred_equations` chose.
     method: &'static str,
     jacobians: Jacobians,
     plan: CsePlan,
@@ -108,7 +109,7 @@ fn mass_and_forcing_roots(eom: &EquationsOfMotion) -> Vec<ExprId> {
         .collect()
 }
 
-/// Runs load → lower → cheapest equations → Jacobians → CSE plan of `[M; F]`, timing each
+/// Runs load → lower → preferred equations → Jacobians → CSE plan of `[M; F]`, timing each
 /// stage.
 ///
 /// # Panics
@@ -124,7 +125,7 @@ fn derive_timed(path: &str, source: &str) -> (Derived, StageTimes) {
     times.lower = start.elapsed();
 
     let start = Instant::now();
-    let (eom, method) = cheapest_equations(&mut model);
+    let (eom, method) = preferred_equations(&mut model);
     times.equations = start.elapsed();
 
     let start = Instant::now();
@@ -150,7 +151,7 @@ fn derive_timed(path: &str, source: &str) -> (Derived, StageTimes) {
 fn derive(path: &str, source: &str) -> Derived {
     let file = model::load(path, source).unwrap_or_else(|d| panic!("{path}: {d:?}"));
     let mut model = SymbolicModel::from_file(&file).unwrap_or_else(|d| panic!("{path}: {d:?}"));
-    let (eom, method) = cheapest_equations(&mut model);
+    let (eom, method) = preferred_equations(&mut model);
     let jacobians = Jacobians::of(&mut model, &eom);
     let roots = mass_and_forcing_roots(&eom);
     let plan = cse::plan(&model.arena, &roots, "t");
@@ -301,9 +302,9 @@ fn derivation(c: &mut Criterion) {
 }
 
 /// Chain sizes of the `formulations` group.
-const SCALING_SIZES: [usize; 5] = [2, 5, 10, 20, 30];
+const SCALING_SIZES: [usize; 7] = [2, 5, 10, 20, 30, 40, 80];
 
-/// Lagrange against momentum balance on the same lowered chain, N = 2 … 30 (issue 4's scaling
+/// Lagrange against momentum balance on the same lowered chain, N = 2 … 80 (issue 4's scaling
 /// table): the derivation of `M` and `F` alone, and followed by [`Jacobians::of`]; loading and
 /// lowering are setup. Before the timed runs, one run per size and method reports operation
 /// counts and its wall times on stderr and checks `M` and `F` against the closed form.

@@ -3,7 +3,7 @@
 //! `cargo run -p eomgen-symbolic --example generate -- models/double_pendulum.yaml`
 
 use eomgen_symbolic::codegen::{self, EmitOptions};
-use eomgen_symbolic::mechanics::{Jacobians, SymbolicModel, cheapest_equations};
+use eomgen_symbolic::mechanics::{Jacobians, SymbolicModel, preferred_equations};
 
 fn main() {
     let Some(path) = std::env::args().nth(1) else {
@@ -26,7 +26,7 @@ fn main() {
     let file =
         eomgen_symbolic::model::load(&path, &source).unwrap_or_else(|d| report(&path, &source, d));
     let mut model = SymbolicModel::from_file(&file).unwrap_or_else(|d| report(&path, &source, d));
-    let (eom, method) = cheapest_equations(&mut model);
+    let (eom, method) = preferred_equations(&mut model);
     eprintln!("equations from {method}");
     let jac = Jacobians::of(&mut model, &eom);
     match codegen::emit(&model, &eom, &jac, &EmitOptions::default()) {

@@ -199,3 +199,64 @@ fn integrable_nonholonomic_constraints_are_reported() {
     let sleigh = include_str!("../../models/chaplygin_sleigh.yaml");
     assert!(!notes(sleigh).contains("integrable"), "{}", notes(sleigh));
 }
+
+/// Issue 18 ("derive only what is used", item 3): Lagrange's equations of a long chain are
+/// as compact as momentum balance's. Before, `T` was multiplied out into `O(n³)` terms that
+/// every derivative rebuilt, and past about 22 links the square of a bar's velocity exceeded
+/// the expansion's term limit, so the equations stayed unexpanded: at 40 links Lagrange's
+/// `M` and `F` cost 227,243 operations after CSE against momentum balance's 12,579, and
+/// their symbolic comparison failed. Now both give the same expressions.
+#[test]
+fn issue_18_lagrange_is_compact_on_long_chains() {
+    let source = eomgen_symbolic::model::templates::n_link_pendulum(40);
+    let file = eomgen_symbolic::model::load("chain.yaml", &source).expect("loads");
+    let report = eomgen_symbolic::mechanics::check::check_model(&file, 5, 7).expect("lowers");
+    let comparison = &report.comparisons[0];
+    assert_eq!(comparison.b, "momentum");
+    assert_eq!(comparison.symbolic_equal, Some(true), "{report:?}");
+    assert!(comparison.max_rel_residual < 1e-10, "{report:?}");
+    let ops = |name: &str| {
+        report
+            .derivations
+            .iter()
+            .find(|d| d.name == name)
+            .map(|d| d.ops_after_cse)
+            .expect("derived")
+    };
+    assert!(
+        ops("lagrange") <= ops("momentum"),
+        "Lagrange {} against momentum balance {} operations after CSE",
+        ops("lagrange"),
+        ops("momentum")
+    );
+}
+
+/// The formulation generated code uses is chosen without deriving: momentum balance for a
+/// kinematic-form model, Lagrange for an energy-form one, and `preferred_equations` derives
+/// that one only (its arena ends as large as after that derivation alone).
+#[test]
+fn preferred_formulation_needs_no_derivation() {
+    use eomgen_symbolic::mechanics::{preferred_equations, preferred_formulation};
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../models/");
+    for (path, expected) in [
+        ("double_pendulum.yaml", "momentum"),
+        ("spring_line_three.yaml", "momentum"),
+        ("simple_pendulum.yaml", "lagrange"),
+        ("figure_eight.yaml", "lagrange"),
+    ] {
+        let source = std::fs::read_to_string(format!("{dir}{path}")).expect("bundled");
+        let file = eomgen_symbolic::model::load(path, &source).expect("loads");
+        let mut model = SymbolicModel::from_file(&file).expect("lowers");
+        let (_, name) = preferred_equations(&mut model);
+        assert_eq!(name, expected, "{path}");
+        let mut alone = SymbolicModel::from_file(&file).expect("lowers");
+        let formulation = preferred_formulation(&alone);
+        assert_eq!(formulation.name(), expected, "{path}");
+        formulation.derive(&mut alone);
+        assert_eq!(
+            model.arena.len(),
+            alone.arena.len(),
+            "{path}: more than one derivation"
+        );
+    }
+}

@@ -41,7 +41,7 @@ pub fn generate(
     options: &EmitOptions,
 ) -> Result<TokenStream, GenerateError> {
     let mut model = SymbolicModel::from_file(file).map_err(GenerateError::Diagnostics)?;
-    let (eom, _) = crate::mechanics::cheapest_equations(&mut model);
+    let (eom, _) = crate::mechanics::preferred_equations(&mut model);
     let problems = crate::mechanics::mass_matrix_diagnostics(&model, &eom, file);
     if !problems.is_empty() {
         return Err(GenerateError::Diagnostics(problems));

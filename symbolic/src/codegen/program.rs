@@ -2,7 +2,7 @@
 //! generated struct returns as constants: what a model compiled at run time is built from.
 //!
 //! [`ModelProgram::from_file`] runs the pipeline of [`super::generate`] (lowering, the
-//! formulation choice of [`crate::mechanics::cheapest_equations`], the mass-matrix
+//! formulation choice of [`crate::mechanics::preferred_equations`], the mass-matrix
 //! diagnostics, the exact Jacobians) and plans every function exactly as [`super::emit`]
 //! does — angle sums expanded ([`crate::expr::trig::expand_angle_sums`]), one CSE plan per
 //! function over exactly its roots, on one copy of the arena in the same order — then lowers
@@ -153,7 +153,7 @@ impl ModelProgram {
     /// is singular, with the same located diagnostics as the macro.
     pub fn from_file(file: &ModelFile) -> Result<(ModelProgram, Derivation), GenerateError> {
         let mut model = SymbolicModel::from_file(file).map_err(GenerateError::Diagnostics)?;
-        let (eom, formulation) = crate::mechanics::cheapest_equations(&mut model);
+        let (eom, formulation) = crate::mechanics::preferred_equations(&mut model);
         let problems = crate::mechanics::mass_matrix_diagnostics(&model, &eom, file);
         if !problems.is_empty() {
             return Err(GenerateError::Diagnostics(problems));

@@ -38,7 +38,14 @@ impl ExprArena {
     /// same node only if their multiplied-out forms are one node).
     pub fn collect_time_varying(&mut self, e: ExprId) -> ExprId {
         let Node::Add(terms) = self.node(e) else {
-            return e;
+            // One term: only its number may move into a sum of masses.
+            let (coefficient, varying) = self.split_time_varying(e);
+            let absorbed = self.absorb_number(coefficient);
+            return if absorbed == coefficient {
+                e
+            } else {
+                self.times(absorbed, varying)
+            };
         };
         let terms = terms.to_vec();
         let mut groups: Vec<(ExprId, Vec<ExprId>)> = Vec::new();
@@ -52,13 +59,20 @@ impl ExprArena {
             groups[k].1.push(coefficient);
         }
         if groups.len() == 1 && groups[0].1.len() == 1 {
-            return e;
+            let coefficient = groups[0].1[0];
+            let absorbed = self.absorb_number(coefficient);
+            return if absorbed == coefficient {
+                e
+            } else {
+                self.times(absorbed, groups[0].0)
+            };
         }
         groups.sort_by_key(|(varying, _)| *varying);
         let collected: Vec<ExprId> = groups
             .into_iter()
             .map(|(varying, coefficients)| {
                 let c = self.factor_terms(&coefficients);
+                let c = self.absorb_number(c);
                 self.times(c, varying)
             })
             .collect();
@@ -69,8 +83,9 @@ impl ExprArena {
     /// a sign pulled out when most terms (or, on a tie, the first in canonical order) are
     /// negative, so that a sum and its negation share one inner node.
     ///
-    /// Common factors are bases with positive integer exponents (`l₂`, `l₂²`); constants
-    /// other than the sign stay inside.
+    /// Common factors are bases with positive integer exponents (`l₂`, `l₂²`); a number is
+    /// pulled out only when every term has it, up to sign (`½ m₁ + ½ m₂ → ½ (m₁ + m₂)`, one
+    /// multiplication instead of two; `½ m₁ + m₂` keeps its coefficients).
     fn factor_terms(&mut self, terms: &[ExprId]) -> ExprId {
         if terms.len() < 2 {
             return self.sum(terms);
@@ -95,19 +110,43 @@ impl ExprArena {
         let negative = split.iter().filter(|(c, _)| c.is_negative()).count();
         let positive = split.len() - negative;
         let flip = negative > positive || (negative == positive && self.leads_negative(terms));
-        if common.is_empty() && !flip {
+        let magnitude = if split[0].0.is_negative() {
+            split[0].0.negated()
+        } else {
+            split[0].0
+        };
+        let shared_magnitude = !magnitude.is_one()
+            && split
+                .iter()
+                .all(|(c, _)| *c == magnitude || c.negated() == magnitude);
+        if common.is_empty() && !flip && !shared_magnitude {
             return self.sum(terms);
         }
-        let sign = if flip {
-            Constant::MINUS_ONE
+        let unit = |negative: bool| {
+            if negative {
+                Constant::MINUS_ONE
+            } else {
+                Constant::ONE
+            }
+        };
+        let sign = unit(flip);
+        // The number pulled out, and each term's coefficient divided by it (exactly, as the
+        // magnitudes are equal).
+        let scale = if shared_magnitude {
+            if flip { magnitude.negated() } else { magnitude }
         } else {
-            Constant::ONE
+            sign
         };
         let reduced: Vec<ExprId> = split
             .into_iter()
             .map(|(c, factors)| {
                 let mut parts = Vec::with_capacity(factors.len() + 1);
-                parts.push(self.constant(c.checked_mul(sign).unwrap_or(c)));
+                let coefficient = if shared_magnitude {
+                    unit(c.is_negative() != flip)
+                } else {
+                    c.checked_mul(sign).unwrap_or(c)
+                };
+                parts.push(self.constant(coefficient));
                 for (base, k) in factors {
                     let left = k - common
                         .iter()
@@ -122,12 +161,69 @@ impl ExprArena {
             })
             .collect();
         let mut parts: Vec<ExprId> = Vec::with_capacity(common.len() + 2);
-        parts.push(self.constant(sign));
+        parts.push(self.constant(scale));
         for (base, k) in common {
             let exponent = self.int(k);
             parts.push(self.pow(base, exponent));
         }
         parts.push(self.sum(&reduced));
+        self.product(&parts)
+    }
+
+    /// A constant-in-time coefficient `c · X · (Σ cₖ yₖ)` with a number `c ≠ ±1` and one sum
+    /// among its factors, as `X · (Σ c cₖ yₖ)` when that leaves no more non-unit numbers in
+    /// the sum than it had (one multiplication fewer): the mass matrix of a chain, derived
+    /// from a collected `T`, has `2 l₁² (m₁/6 + m₂/2)`, which is `l₁² (m₁/3 + m₂)`, the form
+    /// that momentum balance and the rest of the chain's entries share. A sign alone stays
+    /// outside, so that a sum and its negation share one node (see [`Self::factor_terms`]).
+    fn absorb_number(&mut self, coefficient: ExprId) -> ExprId {
+        let Node::Mul(factors) = self.node(coefficient) else {
+            return coefficient;
+        };
+        let Some(c) = self.as_constant(factors[0]) else {
+            return coefficient;
+        };
+        if c.is_one() || c.negated().is_one() {
+            return coefficient;
+        }
+        let mut sums = factors[1..]
+            .iter()
+            .enumerate()
+            .filter(|(_, f)| matches!(self.node(**f), Node::Add(_)));
+        let (Some((k, &sum)), None) = (sums.next(), sums.next()) else {
+            return coefficient;
+        };
+        let others: Vec<ExprId> = factors[1..]
+            .iter()
+            .enumerate()
+            .filter(|(j, _)| *j != k)
+            .map(|(_, f)| *f)
+            .collect();
+        let Node::Add(terms) = self.node(sum) else {
+            return coefficient;
+        };
+        let terms = terms.to_vec();
+        let is_unit = |x: Constant| x.is_one() || x.negated().is_one();
+        let mut before = 0;
+        let mut after = 0;
+        let mut scaled = Vec::with_capacity(terms.len());
+        for t in terms {
+            let (ct, rest) = self.split_coefficient(t);
+            let Some(product) = ct.checked_mul(c) else {
+                return coefficient;
+            };
+            before += usize::from(!is_unit(ct));
+            after += usize::from(!is_unit(product));
+            scaled.push(match rest {
+                Some(r) => self.with_coefficient(product, r),
+                None => self.constant(product),
+            });
+        }
+        if after > before {
+            return coefficient;
+        }
+        let mut parts = others;
+        parts.push(self.sum(&scaled));
         self.product(&parts)
     }
 

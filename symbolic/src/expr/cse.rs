@@ -59,6 +59,28 @@ impl CsePlan {
     }
 }
 
+/// The operations [`plan`] would count for `roots` ([`CsePlan::operation_count`]), without
+/// building the plan: for choosing between candidate forms of an expression, where only the
+/// cost matters.
+pub fn operation_count(arena: &ExprArena, roots: &[ExprId]) -> u64 {
+    let reachable = arena.reachable(roots);
+    let mut operations = 0u64;
+    let mut cosines: rustc_hash::FxHashSet<ExprId> = Default::default();
+    for &e in &reachable {
+        let node = arena.node(e);
+        operations += node_operation_count(node);
+        if let Node::Func(Func::Cos, u) = node {
+            cosines.insert(*u);
+        }
+    }
+    // One `sin_cos` call computes a sine and a cosine of the same argument.
+    let pairs = reachable
+        .iter()
+        .filter(|&&e| matches!(arena.node(e), Node::Func(Func::Sin, u) if cosines.contains(u)))
+        .count() as u64;
+    operations - pairs
+}
+
 /// Plans the evaluation of `roots`; temporaries are named `{prefix}{k}` (`{prefix}{k}_s` and
 /// `{prefix}{k}_c` for a sine–cosine pair).
 pub fn plan(arena: &ExprArena, roots: &[ExprId], prefix: &str) -> CsePlan {

@@ -1,6 +1,6 @@
 //! Numerical evaluation of expressions in `f64`.
 
-use super::{ExprArena, ExprId, Node};
+use super::{ExprArena, ExprId, Func, Node};
 use rustc_hash::FxHashMap;
 
 /// Values of symbols, indexed by [`super::SymbolId`]; symbols beyond the slice are 0.
@@ -8,73 +8,96 @@ pub type Bindings<'a> = &'a [f64];
 
 /// Evaluates a fixed set of root expressions at many bindings.
 ///
-/// Built once (the reachable sub-DAG in topological order, each node's children as indices
-/// into that order), then each [`Evaluator::eval`] is one pass over that list. Used by
-/// `eomgen check`, tests and runtime `--init` values.
+/// Built once (the reachable sub-DAG in topological order, compiled to instructions that
+/// address their operands by slot), then each [`Evaluator::eval`] is one pass over that
+/// list with no hashing. Used by `eomgen check`, tests and runtime `--init` values.
 #[derive(Debug, Clone)]
 pub struct Evaluator {
-    order: Vec<Step>,
+    /// One instruction per reachable node, children first; instruction `k` writes slot `k`.
+    program: Vec<Instruction>,
+    /// The operand slots of the sums and products, each a range of this list.
+    operands: Vec<u32>,
     roots: Vec<usize>,
     values: Vec<f64>,
 }
 
-/// One node with its children as slots of [`Evaluator::order`] (no hashing while evaluating:
-/// `eomgen check` of an 80-link chain evaluates a DAG of over a million nodes 200 times).
-#[derive(Debug, Clone)]
-enum Step {
-    Const(f64),
+/// One node of an [`Evaluator`]'s program, its operands given as slots.
+#[derive(Debug, Clone, Copy)]
+enum Instruction {
+    Value(f64),
     Symbol(usize),
-    Add(Box<[usize]>),
-    Mul(Box<[usize]>),
-    Pow(usize, usize),
-    Func(super::Func, usize),
-    Atan2(usize, usize),
+    /// Sum of the slots `operands[start..end]`.
+    Add(u32, u32),
+    /// Product of the slots `operands[start..end]`.
+    Mul(u32, u32),
+    Pow(u32, u32),
+    Func(Func, u32),
+    Atan2(u32, u32),
 }
 
 impl Evaluator {
     /// Prepares evaluation of `roots`.
     pub fn new(arena: &ExprArena, roots: &[ExprId]) -> Self {
         let reachable = arena.reachable(roots);
-        let slot: FxHashMap<ExprId, usize> =
-            reachable.iter().enumerate().map(|(i, e)| (*e, i)).collect();
-        let slots =
-            |children: &[ExprId]| -> Box<[usize]> { children.iter().map(|c| slot[c]).collect() };
-        let order = reachable
+        let slot: FxHashMap<ExprId, u32> = reachable
+            .iter()
+            .enumerate()
+            .map(|(i, e)| (*e, i as u32))
+            .collect();
+        let mut operands: Vec<u32> = Vec::new();
+        let mut range = |children: &[ExprId]| {
+            let start = operands.len() as u32;
+            operands.extend(children.iter().map(|c| slot[c]));
+            (start, operands.len() as u32)
+        };
+        let program = reachable
             .iter()
             .map(|&e| match arena.node(e) {
-                Node::Const(c) => Step::Const(c.to_f64()),
-                Node::Pi => Step::Const(std::f64::consts::PI),
-                Node::Symbol(s) => Step::Symbol(s.index()),
-                Node::Add(terms) => Step::Add(slots(terms)),
-                Node::Mul(factors) => Step::Mul(slots(factors)),
-                Node::Pow([b, x]) => Step::Pow(slot[b], slot[x]),
-                Node::Func(f, u) => Step::Func(*f, slot[u]),
-                Node::Atan2([y, x]) => Step::Atan2(slot[y], slot[x]),
+                Node::Const(c) => Instruction::Value(c.to_f64()),
+                Node::Pi => Instruction::Value(std::f64::consts::PI),
+                Node::Symbol(s) => Instruction::Symbol(s.index()),
+                Node::Add(terms) => {
+                    let (start, end) = range(terms);
+                    Instruction::Add(start, end)
+                }
+                Node::Mul(factors) => {
+                    let (start, end) = range(factors);
+                    Instruction::Mul(start, end)
+                }
+                Node::Pow([b, x]) => Instruction::Pow(slot[b], slot[x]),
+                Node::Func(f, u) => Instruction::Func(*f, slot[u]),
+                Node::Atan2([y, x]) => Instruction::Atan2(slot[y], slot[x]),
             })
             .collect();
-        let roots = roots.iter().map(|r| slot[r]).collect();
+        let roots = roots.iter().map(|r| slot[r] as usize).collect();
         Self {
             values: vec![0.0; reachable.len()],
-            order,
+            program,
+            operands,
             roots,
         }
     }
 
     /// Values of the roots at `bindings` (written into `out`, one per root).
     pub fn eval_into(&mut self, bindings: Bindings<'_>, out: &mut [f64]) {
-        for i in 0..self.order.len() {
-            let values = &self.values;
-            let value = |k: &usize| values[*k];
-            let v = match &self.order[i] {
-                Step::Const(c) => *c,
-                Step::Symbol(s) => bindings.get(*s).copied().unwrap_or(0.0),
-                Step::Add(terms) => terms.iter().map(value).sum(),
-                Step::Mul(factors) => factors.iter().map(value).product(),
-                Step::Pow(b, e) => pow(values[*b], values[*e]),
-                Step::Func(f, u) => f.apply(values[*u]),
-                Step::Atan2(y, x) => values[*y].atan2(values[*x]),
+        let values = &mut self.values;
+        for (i, instruction) in self.program.iter().enumerate() {
+            let slots = |start: u32, end: u32| &self.operands[start as usize..end as usize];
+            let v = match *instruction {
+                Instruction::Value(v) => v,
+                Instruction::Symbol(s) => bindings.get(s).copied().unwrap_or(0.0),
+                Instruction::Add(start, end) => {
+                    slots(start, end).iter().map(|&k| values[k as usize]).sum()
+                }
+                Instruction::Mul(start, end) => slots(start, end)
+                    .iter()
+                    .map(|&k| values[k as usize])
+                    .product(),
+                Instruction::Pow(b, e) => pow(values[b as usize], values[e as usize]),
+                Instruction::Func(f, u) => f.apply(values[u as usize]),
+                Instruction::Atan2(y, x) => values[y as usize].atan2(values[x as usize]),
             };
-            self.values[i] = v;
+            values[i] = v;
         }
         for (o, &r) in out.iter_mut().zip(&self.roots) {
             *o = self.values[r];

@@ -10,8 +10,15 @@
 
 use super::{ExprArena, ExprId, Node};
 
-/// Most terms an expansion may produce before the product is left unexpanded.
+/// Most terms an expansion of a product of three or more sums may produce before the product
+/// is left unexpanded (unless the count is within [`MAX_QUADRATIC_TERMS`] and the square of
+/// the input's terms): the guard against exponential growth.
 const MAX_TERMS: usize = 512;
+
+/// Most terms an expansion may produce at all. A product of two sums (a square, as every
+/// `v·v` of a kinetic energy) is expanded up to this many: its result grows only with the
+/// square of its input, and a 40-link chain's `|v|²` alone has 1600 terms.
+const MAX_QUADRATIC_TERMS: usize = 1 << 16;
 
 /// Which sums [`ExprArena::expand`] multiplies out.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -92,20 +99,28 @@ impl ExprArena {
         let mut common: Vec<ExprId> = Vec::with_capacity(factors.len());
         let mut sums: Vec<Vec<ExprId>> = Vec::new();
         let mut count = 1usize;
+        let mut inputs = 0usize;
         for &f in factors {
             match self.node(f) {
                 Node::Add(t) if self.is_distributed(f, mode) => {
                     count = count.saturating_mul(t.len());
+                    inputs += t.len();
                     sums.push(t.to_vec());
                 }
                 _ => common.push(f),
             }
         }
-        if count > MAX_TERMS {
+        let quadratic = count <= MAX_QUADRATIC_TERMS && count <= inputs.saturating_mul(inputs);
+        if count > MAX_TERMS && !quadratic {
             return self.product(factors);
         }
         if sums.is_empty() {
             return self.product(&common);
+        }
+        if let [a, b] = &sums[..]
+            && a == b
+        {
+            return self.square_out(common, a);
         }
         // One term per choice of a term from each sum (an odometer over the sums).
         let width = common.len();
@@ -129,6 +144,25 @@ impl ExprArena {
                 digit += 1;
             }
         }
+    }
+
+    /// `Π common · (Σ terms)²` multiplied out as `Σₖ tₖ² + Σₖ<ₗ 2 tₖ tₗ`: half the products of
+    /// the general odometer, which would build `tₖ tₗ` and `tₗ tₖ` and merge them.
+    fn square_out(&mut self, mut common: Vec<ExprId>, terms: &[ExprId]) -> ExprId {
+        let two = self.int(2);
+        let width = common.len();
+        let mut monomials = Vec::with_capacity(terms.len() * (terms.len() + 1) / 2);
+        for (k, &a) in terms.iter().enumerate() {
+            for (l, &b) in terms.iter().enumerate().skip(k) {
+                common.truncate(width);
+                common.extend([a, b]);
+                if l > k {
+                    common.push(two);
+                }
+                monomials.push(self.product(&common));
+            }
+        }
+        self.sum(&monomials)
     }
 
     /// The expansion of `e` if it evaluates with fewer operations (as a tree), else `e`.

@@ -329,6 +329,14 @@ pub struct ExprArena {
     dt_memo: FxHashMap<ExprId, ExprId>,
     expand_memo: FxHashMap<ExprId, ExprId>,
     expand_time_varying_memo: FxHashMap<ExprId, ExprId>,
+    /// Canonical sums of two terms, by their (ordered) terms: collecting a chain adds one mass
+    /// to the same long sum of masses once per joint above it, and each such sum would
+    /// otherwise flatten, sort and merge the long one again.
+    pair_sum_memo: FxHashMap<(ExprId, ExprId), ExprId>,
+    /// The nodes of the integers −1, 0, 1 and 2 once created: every derivative that vanishes
+    /// and every negation asks for one, and a hash-cons lookup per request was a tenth of a
+    /// long chain's Lagrange derivation.
+    small_ints: [Option<ExprId>; 4],
 }
 
 impl ExprArena {
@@ -494,7 +502,18 @@ impl ExprArena {
 
     /// The integer `n`.
     pub fn int(&mut self, n: i64) -> ExprId {
-        self.constant(Constant::int(n))
+        let Some(slot) = usize::try_from(n + 1)
+            .ok()
+            .filter(|k| *k < self.small_ints.len())
+        else {
+            return self.constant(Constant::int(n));
+        };
+        if let Some(id) = self.small_ints[slot] {
+            return id;
+        }
+        let id = self.constant(Constant::int(n));
+        self.small_ints[slot] = Some(id);
+        id
     }
 
     /// A float constant; non-finite values become NaN-free by clamping to the largest finite
@@ -560,6 +579,22 @@ impl ExprArena {
 
     /// Canonical sum of `terms`.
     pub fn sum(&mut self, terms: &[ExprId]) -> ExprId {
+        // The canonical sum does not depend on the order of the terms (they are sorted and
+        // merged), so `a + b` and `b + a` share one memo entry.
+        if let &[a, b] = terms {
+            let key = (a.min(b), a.max(b));
+            if let Some(&s) = self.pair_sum_memo.get(&key) {
+                return s;
+            }
+            let s = self.sum_uncached(terms);
+            self.pair_sum_memo.insert(key, s);
+            return s;
+        }
+        self.sum_uncached(terms)
+    }
+
+    /// [`Self::sum`] without the memo.
+    fn sum_uncached(&mut self, terms: &[ExprId]) -> ExprId {
         let mut constant = Constant::ZERO;
         let mut flat: Vec<ExprId> = Vec::with_capacity(terms.len());
         self.flatten_sum(terms, &mut flat);
@@ -612,9 +647,6 @@ impl ExprArena {
             if products {
                 self.collect_angle_differences(&mut collected);
             }
-            // The identities remove terms with `swap_remove` (O(1); `shift_remove` made a sum of
-            // many folded terms quadratic): the order of `collected` is not kept, and the
-            // terms are sorted here, so it does not matter.
             let mut entries: Vec<(ExprId, Constant)> = collected.into_iter().collect();
             entries.sort_by_key(|(rest, _)| *rest);
             // A term that the identities left alone keeps its node.
@@ -729,8 +761,10 @@ impl ExprArena {
             let Some(partner) = partner.filter(|p| collected.get(p) == Some(&c)) else {
                 continue;
             };
-            collected.swap_remove(&rest);
-            collected.swap_remove(&partner);
+            // Zeroed, not removed: removing from the middle of an `IndexMap` moves every later
+            // entry, quadratic in the number of terms; zero terms are dropped at the end.
+            zero_term(collected, rest);
+            zero_term(collected, partner);
             match others.len() {
                 0 => {
                     *constant = constant.checked_add(c).unwrap_or(*constant);
@@ -815,8 +849,8 @@ impl ExprArena {
             else {
                 continue;
             };
-            collected.swap_remove(&rest);
-            collected.swap_remove(&partner);
+            zero_term(collected, rest);
+            zero_term(collected, partner);
             // Canonical difference: smaller id first; sin(v − u) = −sin(u − v).
             let (a, b, flip) = if u < v { (u, v, false) } else { (v, u, true) };
             let diff = self.minus(a, b);
@@ -1228,6 +1262,14 @@ struct AngleMatch {
     result: Func,
     u: ExprId,
     v: ExprId,
+}
+
+/// Sets the coefficient of `rest` among collected sum terms to zero (the term is dropped when
+/// the sum is built; a zero coefficient never matches a partner's).
+fn zero_term(collected: &mut indexmap::IndexMap<ExprId, Constant>, rest: ExprId) {
+    if let Some(c) = collected.get_mut(&rest) {
+        *c = Constant::ZERO;
+    }
 }
 
 /// The bit of symbol `s` in [`ExprArena`]'s per-node symbol summaries.

@@ -172,6 +172,99 @@ fn collection_factors_the_mass_below_a_joint() {
     assert_eq!(n_collected, a.product(&[minus_one, l2, l3, masses, c]));
 }
 
+/// A number every coefficient of a group shares comes out of the sum of masses:
+/// `½ m₁ ẋ² + ½ m₂ ẋ²` → `½ (m₁ + m₂) ẋ²`; a sign stays the only number pulled out of
+/// `½ m₁ ẋ² + m₂ ẋ²`.
+#[test]
+fn collection_pulls_out_a_shared_number() {
+    let mut a = ExprArena::new();
+    let [_, xd, _] = a.coordinate("x");
+    let [m1, m2] = ["m1", "m2"].map(|p| a.symbol(p, SymbolKind::Parameter));
+    let half = a.constant(Constant::rational(1, 2).unwrap());
+    let two = a.int(2);
+    let xd2 = a.pow(xd, two);
+    let t1 = a.product(&[half, m1, xd2]);
+    let t2 = a.product(&[half, m2, xd2]);
+    let e = a.plus(t1, t2);
+    let collected = a.collect_time_varying(e);
+    let masses = a.plus(m1, m2);
+    assert_eq!(collected, a.product(&[half, masses, xd2]));
+    let t2 = a.product(&[m2, xd2]);
+    let e = a.plus(t1, t2);
+    let collected = a.collect_time_varying(e);
+    let h1 = a.times(half, m1);
+    let masses = a.plus(h1, m2);
+    assert_eq!(collected, a.product(&[masses, xd2]));
+}
+
+/// A number multiplying a sum of masses moves into it when that leaves fewer non-unit
+/// coefficients: `2 l² (m₁/6 + m₂/2) θ̇` → `l² (m₁/3 + m₂) θ̇` (the mass matrix of a chain
+/// from its collected `T`), while `½ (m₁ + m₂)` and `−(m₁ + m₂)` keep their number outside.
+#[test]
+fn collection_absorbs_a_number_into_a_sum_of_masses() {
+    let mut a = ExprArena::new();
+    let [_, qd, _] = a.coordinate("theta");
+    let [m1, m2, l] = ["m1", "m2", "l"].map(|p| a.symbol(p, SymbolKind::Parameter));
+    let c = |a: &mut ExprArena, n: i64, d: i64| a.constant(Constant::rational(n, d).unwrap());
+    let two = a.int(2);
+    let l2 = a.pow(l, two);
+    let (sixth, half, third) = (c(&mut a, 1, 6), c(&mut a, 1, 2), c(&mut a, 1, 3));
+    let s1 = a.times(sixth, m1);
+    let s2 = a.times(half, m2);
+    let masses = a.plus(s1, s2);
+    let e = a.product(&[two, l2, masses, qd]);
+    let absorbed = a.collect_time_varying(e);
+    let t1 = a.times(third, m1);
+    let expected_masses = a.plus(t1, m2);
+    assert_eq!(absorbed, a.product(&[l2, expected_masses, qd]));
+    assert!(a.tree_operation_count(&[absorbed]) < a.tree_operation_count(&[e]));
+    let plain = a.plus(m1, m2);
+    for number in [half, a.int(-1)] {
+        let e = a.product(&[number, plain, qd]);
+        assert_eq!(a.collect_time_varying(e), e);
+    }
+}
+
+/// A square of a long sum (a chain's `|v|²`) is multiplied out, with each cross term once:
+/// 40 terms give 820, beyond the 512-term guard against products of many sums.
+#[test]
+fn long_squares_are_multiplied_out() {
+    let mut a = ExprArena::new();
+    let rates: Vec<ExprId> = (0..40).map(|i| a.coordinate(&format!("q{i}"))[1]).collect();
+    let v = a.sum(&rates);
+    let two = a.int(2);
+    let v2 = a.pow(v, two);
+    let x = a.expand(v2);
+    let Node::Add(terms) = a.node(x) else {
+        panic!("not multiplied out: {:?}", a.node(x));
+    };
+    assert_eq!(terms.len(), 40 * 41 / 2);
+    let bindings: Vec<f64> = (0..a.symbols().len())
+        .map(|k| 0.1 * k as f64 - 2.0)
+        .collect();
+    assert!(close(a.eval(x, &bindings), a.eval(v2, &bindings), 1e-12));
+    // Three sums of 10 terms (1000 products) stay a product.
+    let short: Vec<ExprId> = rates[..10].to_vec();
+    let w = a.sum(&short);
+    let three = a.int(3);
+    let w3 = a.pow(w, three);
+    assert_eq!(a.expand(w3), w3);
+}
+
+/// A sum of two terms is one node whatever their order (the pair memo is keyed by the
+/// ordered pair).
+#[test]
+fn two_term_sums_ignore_order() {
+    let (mut a, x, y, _, _) = arena_xy();
+    let s = a.sin(x);
+    let xy = a.times(x, y);
+    let u = a.plus(s, xy);
+    let v = a.plus(xy, s);
+    assert_eq!(u, v);
+    let zero = a.int(0);
+    assert_eq!(a.sum(&[s, xy]), a.sum(&[xy, s, zero]));
+}
+
 /// Expansion of the time-varying part only keeps a sum of parameters as one factor:
 /// `((R − r) sin φ)²` → `(R − r)² sin² φ`, not `R² sin² φ − 2 R r sin² φ + r² sin² φ`.
 #[test]
@@ -420,6 +513,8 @@ proptest! {
         let roots = [e1, e2, d];
         let p = plan(&a, &roots, "t");
         prop_assert!(p.operation_count() <= a.tree_operation_count(&roots));
+        // The count alone (for choosing between forms) is the plan's.
+        prop_assert_eq!(cse::operation_count(&a, &roots), p.operation_count());
         // Evaluate temporaries in order with a tiny interpreter over the plan.
         let mut values: rustc_hash::FxHashMap<ExprId, f64> = Default::default();
         let mut direct = Evaluator::new(&a, &roots);
@@ -463,6 +558,7 @@ fn cse_shares_sin_cos_and_repeated_terms() {
         .count();
     assert_eq!(pairs, 1, "{:?}", p.temporaries);
     assert_eq!(p.name_of(s), Some("t0_s"));
+    assert_eq!(cse::operation_count(&a, &[v, w, s]), p.operation_count());
 }
 
 #[test]

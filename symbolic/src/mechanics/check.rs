@@ -134,7 +134,7 @@ fn timed(model: &mut SymbolicModel, f: &dyn Formulation) -> (EquationsOfMotion, 
         name: f.name(),
         time_s,
         ops: model.arena.tree_operation_count(&roots),
-        ops_after_cse: cse::plan(&model.arena, &roots, "t").operation_count(),
+        ops_after_cse: cse::operation_count(&model.arena, &roots),
     };
     (eom, stats)
 }

@@ -1,7 +1,7 @@
 //! Lagrange's equations (syllabus lecture 9; HW11 g, HW19 b).
 
 use super::{EquationsOfMotion, Formulation, SymbolicModel};
-use crate::expr::ExprId;
+use crate::expr::{ExprArena, ExprId};
 
 /// Lagrange's equations of the second kind with non-potential generalized forces:
 ///
@@ -12,9 +12,22 @@ use crate::expr::ExprId;
 /// ```
 ///
 /// `M` is built from the upper triangle and mirrored, so it is exactly symmetric. Nothing is
-/// inverted symbolically. `M` and `F` are multiplied out ([`crate::expr::ExprArena::expand`])
-/// when that lowers their operation count after common-subexpression elimination, which
-/// removes the exactly cancelling terms of Lagrange's equations.
+/// inverted symbolically.
+///
+/// `T` is first multiplied out where it changes in time and collected by its time-varying
+/// factors ([`crate::expr::ExprArena::collect_time_varying`]): a quadratic form in `q̇` with
+/// one coefficient per distinct product of rates and functions of `q`, the masses of every
+/// body that contributes to it summed into that coefficient. For an `n`-link chain this is
+/// `O(n²)` terms (the `O(n³)` terms of `Σ ½ m v·v` multiplied out are summed once, here), so
+/// each `∂T/∂q̇ᵢ` has `O(n)` terms and every later step works on expressions of the size of
+/// the result. Differentiating the multiplied-out form instead built the `O(n³)` terms again
+/// for every derivative.
+///
+/// `∂T/∂qᵢ` and the `(∂pᵢ/∂qⱼ) q̇ⱼ` terms share products that cancel exactly; they meet as like
+/// terms once multiplied out. So `M` and `F` are then kept as derived or multiplied out and
+/// collected again, entry by entry, whichever costs fewer operations after CSE (see
+/// `cheapest_forms`): the collected form removes the cancelling terms and shares the mass
+/// sums between entries, the derived one keeps a spring's `∂V/∂q` in its compact form.
 ///
 /// # References
 /// D. T. Greenwood, *Advanced Dynamics*, Cambridge University Press, 2003, §1.4.
@@ -30,8 +43,9 @@ impl Formulation for Lagrange {
         let n = model.num_dofs();
         let symbols: Vec<_> = (0..n).map(|i| model.coordinate_symbols(i)).collect();
         let ts = model.time_symbol();
-        let (kinetic, potential) = (model.kinetic, model.potential);
         let arena = &mut model.arena;
+        let kinetic = compact(arena, model.kinetic);
+        let potential = model.potential;
         let rates: Vec<ExprId> = symbols.iter().map(|s| arena.symbol_expr(s[1])).collect();
         let momenta: Vec<ExprId> = symbols.iter().map(|s| arena.diff(kinetic, s[1])).collect();
 
@@ -43,17 +57,12 @@ impl Formulation for Lagrange {
                 mass_matrix[j * n + i] = m;
             }
         }
-
-        // F from T multiplied out (v·v as a sum of monomials): its derivatives are sums of
-        // monomials too, in which the terms of F that cancel meet at once.
-        let kinetic = arena.expand_time_varying(kinetic);
-        let momenta: Vec<ExprId> = symbols.iter().map(|s| arena.diff(kinetic, s[1])).collect();
-        let mut forcing = Vec::with_capacity(n);
+        // F = K + P: the terms from T (where the cancellations are) and those from V and Q.
+        let mut inertial = Vec::with_capacity(n);
+        let mut applied = Vec::with_capacity(n);
         for i in 0..n {
             let mut terms = Vec::new();
             terms.push(arena.diff(kinetic, symbols[i][0]));
-            let dv = arena.diff(potential, symbols[i][0]);
-            terms.push(arena.neg(dv));
             for j in 0..n {
                 let dp = arena.diff(momenta[i], symbols[j][0]);
                 if !arena.is_zero(dp) {
@@ -63,17 +72,71 @@ impl Formulation for Lagrange {
             }
             let dpt = arena.diff(momenta[i], ts);
             terms.push(arena.neg(dpt));
-            terms.push(model.generalized_forces[i]);
-            forcing.push(arena.sum(&terms));
+            inertial.push(arena.sum(&terms));
+            let dv = arena.diff(potential, symbols[i][0]);
+            let ndv = arena.neg(dv);
+            applied.push(arena.plus(ndv, model.generalized_forces[i]));
         }
-        // ∂T/∂qᵢ and the (∂pᵢ/∂qⱼ) q̇ⱼ terms share products that cancel exactly; they only
-        // meet as like terms once multiplied out.
-        let (mass_matrix, forcing) =
-            super::cheaper_of_raw_and_expanded(arena, mass_matrix, forcing);
+        let (mass_matrix, forcing) = cheapest_forms(arena, mass_matrix, inertial, applied);
         EquationsOfMotion {
             num_dofs: n,
             mass_matrix,
             forcing,
         }
     }
+}
+
+/// `e` multiplied out where it changes in time and collected by its time-varying factors.
+fn compact(arena: &mut ExprArena, e: ExprId) -> ExprId {
+    let x = arena.expand_time_varying(e);
+    arena.collect_time_varying(x)
+}
+
+/// `(M, F)` from `M`, the inertial part `K` and the applied part `P` of `F = K + P`, in the
+/// combination that costs the fewest operations after CSE (the first of the cheapest, in the
+/// order below): `M` [`compact`]ed or as derived; `F` compacted as a whole, or as `K + P`
+/// with each part compacted or as derived.
+///
+/// Compacting removes the cancelling terms of `K` and factors the sums of masses of a chain,
+/// but it multiplies out `P`, which for a spring (`∂V/∂q` of `½ k (|d| − ℓ₀)²`) is smaller as
+/// derived; trying the parts separately keeps the better form of each.
+fn cheapest_forms(
+    arena: &mut ExprArena,
+    mass_matrix: Vec<ExprId>,
+    inertial: Vec<ExprId>,
+    applied: Vec<ExprId>,
+) -> (Vec<ExprId>, Vec<ExprId>) {
+    let compact_all = |arena: &mut ExprArena, v: &[ExprId]| -> Vec<ExprId> {
+        v.iter().map(|&e| compact(arena, e)).collect()
+    };
+    let add = |arena: &mut ExprArena, a: &[ExprId], b: &[ExprId]| -> Vec<ExprId> {
+        a.iter().zip(b).map(|(x, y)| arena.plus(*x, *y)).collect()
+    };
+    let compact_mass = compact_all(arena, &mass_matrix);
+    let compact_inertial = compact_all(arena, &inertial);
+    let compact_applied = compact_all(arena, &applied);
+    let raw_forcing = add(arena, &inertial, &applied);
+    let mut masses = [compact_mass, mass_matrix];
+    let mut forcings = [
+        compact_all(arena, &raw_forcing),
+        add(arena, &compact_inertial, &compact_applied),
+        add(arena, &compact_inertial, &applied),
+        add(arena, &inertial, &compact_applied),
+        raw_forcing,
+    ];
+    let mut best = (u64::MAX, 0, 0);
+    for (a, m) in masses.iter().enumerate() {
+        for (b, f) in forcings.iter().enumerate() {
+            let roots: Vec<ExprId> = m.iter().chain(f).copied().collect();
+            let cost = crate::expr::cse::operation_count(arena, &roots);
+            if cost < best.0 {
+                best = (cost, a, b);
+            }
+        }
+    }
+    let (_, a, b) = best;
+    (
+        std::mem::take(&mut masses[a]),
+        std::mem::take(&mut forcings[b]),
+    )
 }

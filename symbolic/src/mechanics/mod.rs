@@ -1,7 +1,9 @@
 //! Derivations: from a lowered model to `M(q, t) q̈ = F(q, q̇, t)` and its exact Jacobians.
 //!
-//! One [`Formulation`] interface serves every derivation (Lagrange now; momentum balance
-//! next), so the code generator and the cross-checks treat them alike.
+//! One [`Formulation`] interface serves every derivation (Lagrange, momentum balance, the
+//! file's own balances and hand-written equations), so the code generator and the
+//! cross-checks treat them alike; [`preferred_formulation`] picks the one generated code
+//! uses.
 
 mod balances;
 pub mod check;
@@ -94,48 +96,31 @@ impl Jacobians {
     }
 }
 
-/// From this many degrees of freedom on, [`cheapest_equations`] takes momentum balance for a
-/// kinematic model without deriving Lagrange's equations to compare (every bundled model of
-/// five or more coordinates that allows both chooses momentum balance when both are derived).
-pub const MOMENTUM_ONLY_FROM_DOFS: usize = 5;
-
-/// The equations to generate code from: Lagrange's, or momentum balance's when the model is
-/// kinematic and they cost fewer operations after CSE. Both are the same equations (the test
-/// suite and `eomgen check` verify that they agree symbolically and numerically); Kane's form
-/// shares the partial velocities and is usually smaller for chains (10-link pendulum: 819
-/// against 3024 operations after CSE). Returns the equations and the formulation's name.
+/// The formulation whose equations generated code uses: momentum balance for a model in the
+/// kinematic form ([`MomentumBalance::applies_to`]), Lagrange otherwise.
 ///
-/// Only one derivation is made when the choice is clear beforehand: the energy form allows
-/// only Lagrange, and from [`MOMENTUM_ONLY_FROM_DOFS`] degrees of freedom on a kinematic
-/// model takes momentum balance without deriving Lagrange, whose equations grow much faster
-/// (`N`-link pendulum after CSE: 449 against 214 operations at N = 5, 72 074 against 7 109 at
-/// N = 30, and 5 s against 0.6 s to derive at N = 80). Below it both are derived and the
-/// cheaper kept (for ten of the bundled models with one to four coordinates that is
-/// Lagrange's, by a few operations).
-pub fn cheapest_equations(model: &mut SymbolicModel) -> (EquationsOfMotion, &'static str) {
-    let momentum_applies = MomentumBalance::applies_to(model);
-    if momentum_applies && model.num_dofs() >= MOMENTUM_ONLY_FROM_DOFS {
-        return (MomentumBalance.derive(model), MomentumBalance.name());
-    }
-    let lagrange = Lagrange.derive(model);
-    if !momentum_applies {
-        return (lagrange, Lagrange.name());
-    }
-    let momentum = MomentumBalance.derive(model);
-    let cost = |eom: &EquationsOfMotion| {
-        let roots: Vec<ExprId> = eom
-            .mass_matrix
-            .iter()
-            .chain(&eom.forcing)
-            .copied()
-            .collect();
-        crate::expr::cse::plan(&model.arena, &roots, "t").operation_count()
-    };
-    if cost(&momentum) < cost(&lagrange) {
-        (momentum, MomentumBalance.name())
+/// The rule needs no derivation, so a model is derived once however it is loaded (the
+/// `model!` macro and the run-time loader both go through [`preferred_equations`]). Both
+/// formulations give the same equations (the test suite and `eomgen check` compare them
+/// symbolically and numerically); momentum balance is chosen because its projections on
+/// shared partial velocities are never larger than Lagrange's derivatives of `T` on the
+/// bundled models and are usually smaller, in `M` and `F` and more so in their Jacobians:
+/// against deriving both and keeping the one with fewer operations of `M` and `F` after CSE
+/// (the rule before issue 18), no bundled model gets more than one more operation, and the
+/// 3-spring line loses 26 in its Jacobians for its one operation in `F`.
+pub fn preferred_formulation(model: &SymbolicModel) -> &'static dyn Formulation {
+    if MomentumBalance::applies_to(model) {
+        &MomentumBalance
     } else {
-        (lagrange, Lagrange.name())
+        &Lagrange
     }
+}
+
+/// The equations to generate code from, derived by [`preferred_formulation`] alone; returns
+/// them and the formulation's name.
+pub fn preferred_equations(model: &mut SymbolicModel) -> (EquationsOfMotion, &'static str) {
+    let formulation = preferred_formulation(model);
+    (formulation.derive(model), formulation.name())
 }
 
 /// `(M, F)` as given or multiplied out entry by entry (where that is cheaper as a tree),
@@ -156,7 +141,7 @@ pub(crate) fn cheaper_of_raw_and_expanded(
         .collect();
     let cost = |arena: &crate::expr::ExprArena, m: &[ExprId], f: &[ExprId]| {
         let roots: Vec<ExprId> = m.iter().chain(f).copied().collect();
-        crate::expr::cse::plan(arena, &roots, "t").operation_count()
+        crate::expr::cse::operation_count(arena, &roots)
     };
     if cost(arena, &expanded_mass, &expanded_forcing) < cost(arena, &mass_matrix, &forcing) {
         (expanded_mass, expanded_forcing)

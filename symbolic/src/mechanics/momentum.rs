@@ -301,6 +301,23 @@ impl Formulation for MomentumBalance {
             .map(|b| kinematics.partials(arena, b.com))
             .collect();
 
+        // Σ m a₀ of every set of bodies that shares a partial velocity, smallest sets first,
+        // so that each is built from the largest subset already summed. (In the order of the
+        // coordinates, the bars below joint 1 would come first, and with no subset yet
+        // summed every set would be summed from scratch: `O(n³)` terms for a chain.)
+        let mut sets: Vec<Vec<usize>> = Vec::new();
+        for groups in (0..n).map(|i| group_bodies(bodies.len(), |b| partials[b][i])) {
+            for (_, set) in groups {
+                if !sets.contains(&set) {
+                    sets.push(set);
+                }
+            }
+        }
+        sets.sort_by_key(Vec::len);
+        for set in &sets {
+            sums.weighted_acceleration(arena, &mut kinematics, &bodies, set);
+        }
+
         // Terms of Mᵢⱼ (i ≤ j, row-major) and of Fᵢ. Bodies with the same partial velocities
         // (all the bars below a joint) are projected together, as one mass `Σ m` and one
         // `Σ m a₀`: Kane's generalized inertia forces of a chain, by hand.
@@ -441,7 +458,7 @@ fn cheaper_of_raw_and_collected(
     let collected_forcing: Vec<ExprId> = forcing.iter().map(|&f| compact(f)).collect();
     let cost = |arena: &ExprArena, m: &[ExprId], f: &[ExprId]| {
         let roots: Vec<ExprId> = m.iter().chain(f).copied().collect();
-        crate::expr::cse::plan(arena, &roots, "t").operation_count()
+        crate::expr::cse::operation_count(arena, &roots)
     };
     if cost(arena, &collected_mass, &collected_forcing) <= cost(arena, &mass_matrix, &forcing) {
         (collected_mass, collected_forcing)
