@@ -262,7 +262,7 @@ fn new_and_equations() {
     let out = eomgen(&["equations", "double_pendulum"]);
     assert!(out.status.success());
     let text = String::from_utf8(out.stdout).unwrap();
-    assert!(text.contains("M[0,0] = m2*l1^2 + m1*l1^2/3"), "{text}");
+    assert!(text.contains("M[0,0] = l1^2*(m2 + m1/3)"), "{text}");
     let out = eomgen(&[
         "equations",
         "cart_pendulum",
