@@ -502,10 +502,11 @@ impl ExprArena {
 
     /// The integer `n`.
     pub fn int(&mut self, n: i64) -> ExprId {
-        let Some(slot) = usize::try_from(n + 1)
-            .ok()
-            .filter(|k| *k < self.small_ints.len())
-        else {
+        let slot = n
+            .checked_add(1)
+            .and_then(|k| usize::try_from(k).ok())
+            .filter(|k| *k < self.small_ints.len());
+        let Some(slot) = slot else {
             return self.constant(Constant::int(n));
         };
         if let Some(id) = self.small_ints[slot] {

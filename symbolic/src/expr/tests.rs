@@ -251,6 +251,18 @@ fn long_squares_are_multiplied_out() {
     assert_eq!(a.expand(w3), w3);
 }
 
+/// The cached small integers are the hash-consed constants, and integers at the ends of the
+/// range do not overflow the cache's slot arithmetic.
+#[test]
+fn small_integers_are_the_constants() {
+    let mut a = ExprArena::new();
+    for n in [-2, -1, 0, 1, 2, 3, i64::MIN, i64::MAX] {
+        let cached = a.int(n);
+        assert_eq!(a.int(n), cached);
+        assert_eq!(a.constant(Constant::int(n)), cached, "{n}");
+    }
+}
+
 /// A sum of two terms is one node whatever their order (the pair memo is keyed by the
 /// ordered pair).
 #[test]
