@@ -28,9 +28,11 @@ pub enum GenerateError {
     Emit(String),
 }
 
-/// The code `eomgen::model!` generates for a loaded model file: lowering, the cheaper of the
-/// two derivations, the mass-matrix diagnostics, the exact Jacobians, then [`emit`]. The macro
-/// and `eomgen equations --rust` both call this, so what the CLI prints is what is compiled.
+/// The code `eomgen::model!` generates for a loaded model file: lowering, one derivation
+/// ([`crate::mechanics::preferred_equations`]), the mass-matrix diagnostics, the exact
+/// Jacobians, then [`emit`]. The macro and `eomgen equations --rust` both call this, so what the
+/// CLI prints is what is compiled; a model compiled at run time is planned from the same steps
+/// ([`program::ModelProgram::from_file`]).
 ///
 /// # Errors
 /// [`GenerateError::Diagnostics`] for a model that cannot be lowered or whose mass matrix is

@@ -2,7 +2,7 @@
 //! generated struct returns as constants: what a model compiled at run time is built from.
 //!
 //! [`ModelProgram::from_file`] runs the pipeline of [`super::generate`] (lowering, the
-//! formulation choice of [`crate::mechanics::preferred_equations`], the mass-matrix
+//! formulation of [`crate::mechanics::preferred_equations`], the mass-matrix
 //! diagnostics, the exact Jacobians) and plans every function exactly as [`super::emit`]
 //! does — angle sums expanded ([`crate::expr::trig::expand_angle_sums`]), one CSE plan per
 //! function over exactly its roots, on one copy of the arena in the same order — then lowers
