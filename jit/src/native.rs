@@ -626,7 +626,7 @@ fn build(
             match chunk.get(1) {
                 Some(&second) => {
                     let second = values.get(&mut b, tape, &arguments, second);
-                    let vector = b.ins().scalar_to_vector(types::F64X2, first);
+                    let vector = b.ins().splat(types::F64X2, first);
                     let vector = b.ins().insertlane(vector, second, 1);
                     b.ins().store(MemFlagsData::trusted(), vector, base, offset);
                 }

@@ -321,6 +321,8 @@ impl ConstraintWorkspace {
     /// not reach `tolerance` in 50 iterations or `J Jᵀ` is singular.
     ///
     /// No heap allocation (it runs after every step under [`Stabilization::Projection`]).
+    /// `q` and `q̇` are changed in place, also by a projection that then fails: project a
+    /// copy where the state must survive a failure (the integrators hand it a scratch copy).
     pub fn project<C: ConstraintFunctions + ?Sized>(
         &mut self,
         system: &C,

@@ -52,7 +52,8 @@ pub trait DynMechanicalSystem {
     fn initial_state(&self, q: &mut [f64], qdot: &mut [f64]);
 
     /// `M(q, t)` (`n × n`, column-major) into `mass` and `F(q, q̇, t)` (length `n`) into
-    /// `forcing`, sharing subexpressions (the hot path of every integrator).
+    /// `forcing`, sharing subexpressions (the hot path of every integrator). Every entry is
+    /// written, both triangles of `M`: callers reuse their buffers.
     fn mass_matrix_and_forcing(
         &self,
         q: &[f64],
@@ -507,10 +508,15 @@ impl<S: DynMechanicalSystem> ModelInfo for DynFirstOrder<S> {
             .drift(&self.system, &y[..n], &y[n..2 * n], t)
     }
     fn project(&mut self, t: f64, y: &mut [f64], free: &[usize]) -> Result<usize, ProjectionError> {
+        // On a copy, so that a projection that fails leaves `y` as it was.
         let n = self.n;
-        let (q, qdot) = y.split_at_mut(n);
-        self.constraints
-            .project(&self.system, q, &mut qdot[..n], t, free, 1e-12)
+        let mut projected = y[..2 * n].to_vec();
+        let (q, qdot) = projected.split_at_mut(n);
+        let iterations = self
+            .constraints
+            .project(&self.system, q, qdot, t, free, 1e-12)?;
+        y[..2 * n].copy_from_slice(&projected);
+        Ok(iterations)
     }
     fn initial_guesses(&self) -> &[usize] {
         self.system.initial_guesses()

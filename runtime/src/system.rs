@@ -852,15 +852,14 @@ impl<S: MechanicalSystem<N>, const N: usize> ModelInfo for FirstOrder<S, N> {
             .drift(&StaticSystem(&self.system), &y[..N], &y[N..2 * N], t)
     }
     fn project(&mut self, t: f64, y: &mut [f64], free: &[usize]) -> Result<usize, ProjectionError> {
-        let (q, qdot) = y.split_at_mut(N);
-        self.constraints.project(
-            &StaticSystem(&self.system),
-            q,
-            &mut qdot[..N],
-            t,
-            free,
-            1e-12,
-        )
+        // On a copy, so that a projection that fails leaves `y` as it was.
+        let mut projected = y[..2 * N].to_vec();
+        let (q, qdot) = projected.split_at_mut(N);
+        let iterations =
+            self.constraints
+                .project(&StaticSystem(&self.system), q, qdot, t, free, 1e-12)?;
+        y[..2 * N].copy_from_slice(&projected);
+        Ok(iterations)
     }
     fn initial_guesses(&self) -> &[usize] {
         self.system.initial_guesses()
