@@ -646,7 +646,7 @@ impl Study<'_> {
         m.error < 10.0 * self.agreement
     }
 
-    /// The JSON document of `--json` (schema in the README).
+    /// The JSON document of `--json` (schema in docs/cli.md).
     fn to_json(&self) -> serde_json::Value {
         let args = self.args;
         let methods: Vec<serde_json::Value> = self
