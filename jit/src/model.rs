@@ -135,9 +135,11 @@ impl Extent {
     }
 }
 
-/// Functions as tapes, with their extents and (unless interpreted) native code.
+/// Functions as native code, or as tapes for the interpreter, with their extents.
 #[derive(Debug)]
 struct Compiled {
+    /// The tapes, kept only when there is no native code (they are what the interpreter
+    /// runs; with native code they would only take memory: megabytes for a long chain).
     tapes: Vec<FunctionTape>,
     extents: Vec<Extent>,
     native: Option<NativeCode>,
@@ -167,6 +169,7 @@ impl Compiled {
             for (extent, &scratch) in compiled.extents.iter_mut().zip(&native.scratch) {
                 extent.scratch = scratch;
             }
+            compiled.tapes = Vec::new();
         }
         compiled.native = native;
         Ok((compiled, fallback_reason))
@@ -453,8 +456,7 @@ impl JitModel {
             i if i < JACOBIANS => (&self.code.core, i),
             i => (&self.code.jacobians().compiled, i - JACOBIANS),
         };
-        let (Some(extent), Some(tape)) = (compiled.extents.get(index), compiled.tapes.get(index))
-        else {
+        let Some(extent) = compiled.extents.get(index) else {
             return;
         };
         assert!(
@@ -462,17 +464,25 @@ impl JitModel {
             "model `{}`: a slice passed to {routine:?} is shorter than its shape",
             self.code.program.name
         );
-        match compiled.native.as_ref().and_then(|n| n.functions[index]) {
-            // SAFETY: `f` was compiled from this routine's tape, of which `extent` is the
-            // extent, and `admits` checked every slice above.
-            Some(f) => unsafe { call_native(f, extent, &inputs, out0, out1) },
-            None => SCRATCH.with(|scratch| match scratch.try_borrow_mut() {
-                Ok(mut values) => interpret::evaluate(tape, &inputs, &mut values, out0, out1),
-                // Re-entered on this thread (cannot happen: evaluation calls no model code);
-                // use a fresh buffer rather than fail.
-                Err(_) => interpret::evaluate(tape, &inputs, &mut Vec::new(), out0, out1),
-            }),
+        if let Some(native) = &compiled.native {
+            // An empty tape (a model without constraints, events, …) has no code and no
+            // outputs to write.
+            if let Some(f) = native.functions[index] {
+                // SAFETY: `f` was compiled from this routine's tape, of which `extent` is the
+                // extent, and `admits` checked every slice above.
+                unsafe { call_native(f, extent, &inputs, out0, out1) }
+            }
+            return;
         }
+        let Some(tape) = compiled.tapes.get(index) else {
+            return;
+        };
+        SCRATCH.with(|scratch| match scratch.try_borrow_mut() {
+            Ok(mut values) => interpret::evaluate(tape, &inputs, &mut values, out0, out1),
+            // Re-entered on this thread (cannot happen: evaluation calls no model code); use a
+            // fresh buffer rather than fail.
+            Err(_) => interpret::evaluate(tape, &inputs, &mut Vec::new(), out0, out1),
+        });
     }
 
     #[inline]
