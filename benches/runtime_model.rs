@@ -223,11 +223,7 @@ fn alternated(_: &mut Criterion) {
     for (name, method) in &mut methods {
         let (c, r) = fastest_alternated(40, |run_time| {
             per_call(1, || {
-                let system: &mut dyn OdeSystem = if run_time {
-                    &mut native
-                } else {
-                    &mut compiled
-                };
+                let system: &mut dyn OdeSystem = if run_time { &mut native } else { &mut compiled };
                 black_box(integrate(method.as_mut(), system, &y0));
             })
         });

@@ -19,10 +19,7 @@ use eomgen::{
 eomgen::model!("wall_springs.yaml");
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let model = WallSprings {
-        m: 2.0,
-        k: 50.0,
-    };
+    let model = WallSprings { m: 2.0, k: 50.0 };
     let (m, k) = (model.m, model.k);
     let (q0, qdot0) = model.initial_state();
     let mut system = FirstOrder::new(model);

@@ -5,7 +5,7 @@
 //! left out, and what was left out is recorded in [`Incomplete`] so that the cross-object
 //! checks ([`super::check`]) do not report its consequences a second time.
 
-use super::ast::Expr;
+use super::ast::{BinOp, Expr, ExprKind};
 use super::diagnostic::{Diagnostic, Diagnostics};
 use super::file::*;
 use super::located::{Located, Location};
@@ -823,7 +823,8 @@ impl Ctx<'_> {
     }
 
     /// `events:` — `name: g` or `name: { when: g, direction: rising|falling|both,
-    /// terminal: true|false }`.
+    /// terminal: true|false }`, where `g` is an expression (the event is `g = 0`) or an
+    /// equation `lhs = rhs`.
     fn events(&mut self, node: &YamlNode) -> Vec<EventDef> {
         const EXAMPLE: &str = "{ when: theta_dot, direction: falling, terminal: false }";
         let Some(entries) = self.map(node, "`events`", &format!("events: {{ peak: {EXAMPLE} }}"))
@@ -837,7 +838,7 @@ impl Ctx<'_> {
             }
             let what = format!("the function of event `{}`", k.value);
             if !matches!(v.kind, YamlKind::Map(_)) {
-                if let Some(when) = self.expr(v, &what) {
+                if let Some(when) = self.event_function(v, &what) {
                     out.push(EventDef {
                         name: k.clone(),
                         when,
@@ -857,7 +858,7 @@ impl Ctx<'_> {
             ) else {
                 continue;
             };
-            let when = get(f, "when").and_then(|n| self.expr(n, &what));
+            let when = get(f, "when").and_then(|n| self.event_function(n, &what));
             let direction = match get(f, "direction") {
                 None => Some(Crossing::Both),
                 Some(n) => self.choice(
@@ -1220,26 +1221,31 @@ impl Ctx<'_> {
 
     /// One `lhs = rhs` equation (or an expression meaning `= 0`).
     fn equation(&mut self, node: &YamlNode) -> Option<HandEquation> {
-        let text = self.scalar_expr_text(node, "an equation of motion")?;
+        let (lhs, rhs) = self.sides(
+            node,
+            "an equation of motion",
+            "write one equation per entry, such as `m*x_ddot + k*x = F`",
+        )?;
+        Some(HandEquation {
+            lhs,
+            rhs,
+            location: node.location,
+        })
+    }
+
+    /// The two sides of `lhs = rhs` in the scalar `node`, or the expression alone (`rhs`
+    /// `None`) when it has no `=`. `what` names the value and `help` says what to write when
+    /// it has two `=`.
+    fn sides(&mut self, node: &YamlNode, what: &str, help: &str) -> Option<(Expr, Option<Expr>)> {
+        let text = self.scalar_expr_text(node, what)?;
         let chars: Vec<char> = text.chars().collect();
         let equals: Vec<usize> = (0..chars.len()).filter(|&i| chars[i] == '=').collect();
         match equals.as_slice() {
-            [] => {
-                let lhs = self.parse_part(node, &text, 0, chars.len())?;
-                Some(HandEquation {
-                    lhs,
-                    rhs: None,
-                    location: node.location,
-                })
-            }
+            [] => Some((self.parse_part(node, &text, 0, chars.len())?, None)),
             [i] => {
                 let lhs = self.parse_part(node, &text, 0, *i);
                 let rhs = self.parse_part(node, &text, i + 1, chars.len());
-                Some(HandEquation {
-                    lhs: lhs?,
-                    rhs: Some(rhs?),
-                    location: node.location,
-                })
+                Some((lhs?, Some(rhs?)))
             }
             [_, second, ..] => {
                 let start = node.location;
@@ -1247,12 +1253,33 @@ impl Ctx<'_> {
                     .and_then(|l| l.get(*second).copied())
                     .unwrap_or_else(|| start.offset(*second));
                 self.error(
-                    Diagnostic::new(at, "an equation of motion has one `=`, this is a second")
-                        .with_help("write one equation per entry, such as `m*x_ddot + k*x = F`"),
+                    Diagnostic::new(at, format!("{what} has one `=`, this is a second"))
+                        .with_help(help),
                 );
                 None
             }
         }
+    }
+
+    /// The function of an event: an expression `g` (the event is `g = 0`), or an equation
+    /// `lhs = rhs`, which means `lhs − rhs = 0` (as `--stop-when "y = 0"` on the command line).
+    fn event_function(&mut self, node: &YamlNode, what: &str) -> Option<Expr> {
+        let (lhs, rhs) = self.sides(
+            node,
+            what,
+            "write the event as one expression that crosses zero, such as `y` or `x = l`",
+        )?;
+        Some(match rhs {
+            None => lhs,
+            Some(rhs) => Expr {
+                location: lhs.location,
+                kind: ExprKind::Binary {
+                    op: BinOp::Sub,
+                    lhs: Box::new(lhs),
+                    rhs: Box::new(rhs),
+                },
+            },
+        })
     }
 
     fn balances(&mut self, node: &YamlNode) -> Vec<Balance> {
@@ -1996,6 +2023,38 @@ mod tests {
                 "5:39: unknown key `directon` in event `peak`",
                 "6:3: event `bare` has no `when`"
             ]
+        );
+    }
+
+    /// `when: lhs = rhs` means `lhs − rhs = 0`, as `--stop-when "lhs = rhs"` does; a second
+    /// `=` is an error at its column.
+    #[test]
+    fn an_event_may_be_written_as_an_equation() {
+        let src = "name: a\ncoordinates: [y]\nkinetic: y_dot^2/2\nevents:\n  ground: { when: y = 0.5, terminal: true }\n  level: y_dot = -1\n";
+        let file = built(src).file.unwrap();
+        let at = |y: f64, y_dot: f64| {
+            move |name: &str| match name {
+                "y" => Some(y),
+                "y_dot" => Some(y_dot),
+                _ => None,
+            }
+        };
+        let ground = &file.events[0].when;
+        assert_eq!(eval_expr(ground, &at(2.0, 0.0)).unwrap(), 1.5);
+        assert_eq!(eval_expr(ground, &at(0.5, 0.0)).unwrap(), 0.0);
+        assert_eq!(eval_expr(&file.events[1].when, &at(0.0, 3.0)).unwrap(), 4.0);
+        assert_eq!(
+            ground.location,
+            Location {
+                line: 5,
+                column: 19
+            }
+        );
+        let m =
+            messages("name: a\ncoordinates: [y]\nkinetic: y_dot^2/2\nevents:\n  e: y = 1 = 2\n");
+        assert_eq!(
+            m,
+            ["5:12: the function of event `e` has one `=`, this is a second"]
         );
     }
 
