@@ -538,6 +538,31 @@ fn check_and_simulate_print_the_compile_errors_of_every_ui_case() {
     assert!(checked >= 28, "only {checked} ui cases");
 }
 
+/// With `--json`, a model that cannot be opened (a missing file, an unknown name) is still
+/// JSON on standard output, `{"error": …}` with the message of standard error, exit 2: a
+/// script that reads the output never gets nothing.
+#[test]
+fn json_output_of_a_model_that_cannot_be_opened() {
+    let dir = tempfile::tempdir().unwrap();
+    let missing = dir.path().join("missing.yaml");
+    let missing = missing.to_str().unwrap();
+    for args in [
+        vec!["check", "--json", missing],
+        vec!["simulate", missing, "--json"],
+        vec!["modes", "no_such_model", "--json"],
+    ] {
+        let out = eomgen(&args);
+        assert_eq!(out.status.code(), Some(2), "{args:?}");
+        let json: serde_json::Value = serde_json::from_slice(&out.stdout)
+            .unwrap_or_else(|e| panic!("{args:?}: not JSON ({e})"));
+        let error = json["error"].as_str().unwrap();
+        assert!(
+            String::from_utf8_lossy(&out.stderr).contains(error),
+            "{args:?}: {error}"
+        );
+    }
+}
+
 /// A file written by `eomgen new` runs through `simulate` with no rebuild (issue 18): the
 /// 5-link pendulum's file is derived and compiled at run time, integrated, and keeps its
 /// energy (a conservative chain: drift below 1e-6 at the default tolerances); an unknown name

@@ -53,7 +53,7 @@ pub fn read_model(model: &str) -> Result<(String, String), CliError> {
         ),
     };
     let source = std::fs::read_to_string(&path)
-        .map_err(|e| CliError::usage(format!("cannot read `{display}`: {e}")))?;
+        .map_err(|e| CliError::usage(format!("cannot read `{display}`: {e}")).before_output())?;
     Ok((display, source))
 }
 

@@ -93,6 +93,15 @@ impl CliError {
             json: None,
         }
     }
+    /// The error of a model that could not be opened or read, which happens before any
+    /// output: with `--json`, `{"error": message}` on standard output (the form of a model
+    /// file's diagnostics, without them), so that a script reading the output always gets JSON.
+    fn before_output(mut self) -> Self {
+        if self.json.is_none() {
+            self.json = Some(serde_json::json!({ "error": self.message }));
+        }
+        self
+    }
 }
 
 /// Runs the CLI on the process arguments.
@@ -195,7 +204,7 @@ fn open_model(name_or_path: &str) -> Result<eomgen::ModelSource, CliError> {
 /// (exit 2), and so is a file with mistakes, whose located diagnostics are rendered with
 /// their source lines (and, for `--json`, given as JSON on standard output).
 fn open_error(error: eomgen::OpenError) -> CliError {
-    match error {
+    let error = match error {
         eomgen::OpenError::Load(eomgen::LoadError::Diagnostics {
             path,
             text,
@@ -206,7 +215,8 @@ fn open_error(error: eomgen::OpenError) -> CliError {
             CliError::failure(e.to_string())
         }
         other => CliError::usage(other.to_string()),
-    }
+    };
+    error.before_output()
 }
 
 /// The error of a model file with mistakes: every diagnostic rendered for the terminal, exit
