@@ -20,7 +20,7 @@ use nalgebra::DMatrix;
 use plotters::prelude::*;
 
 use super::mode_plot::{self, Frame, Layout};
-use super::report_html::escape;
+use super::render::escape;
 use super::simulate::{IntegrationArgs, Run, failure_error, integrate};
 use super::{CliError, plot};
 
@@ -379,10 +379,12 @@ pub(crate) fn simulation(
     } else {
         " (not conserved: non-conservative loads or explicit time dependence)"
     };
+    // "Over the frames": the drift sampled at the frame times, which can be smaller than
+    // `eomgen simulate`'s, taken over every step.
     // A minus sign, not a hyphen, in the exponent: no line break inside the number.
     let max_drift = format!("{max_drift:.2e}").replace('-', "−");
     let info = format!(
-        "{method}; {} frames at {} fps of simulated time, t = 0 … {} s; E(0) = {} J, max |E − E₀| / max(T + |V|) = {max_drift}{conserved}{}",
+        "{method}; {} frames at {} fps of simulated time, t = 0 … {} s; E(0) = {} J, max |E − E₀| / max(T + |V|) over the frames = {max_drift}{conserved}{}",
         t.len(),
         short(fps),
         short(t[t.len() - 1]),

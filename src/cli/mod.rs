@@ -11,6 +11,7 @@ mod modal_damping;
 mod mode_plot;
 mod modes;
 mod plot;
+mod render;
 mod report;
 mod report_html;
 mod roundoff;
