@@ -18,4 +18,3 @@ pub(super) fn escape(s: &str) -> String {
     }
     out
 }
-
