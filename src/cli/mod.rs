@@ -62,8 +62,8 @@ enum Command {
     /// `checks:`) and write DIR/index.html (equations, figures, pass/fail tables) and
     /// DIR/report.json; exit 1 if a check fails.
     Report(report::ReportArgs),
-    /// Numerical experiments comparing methods: `constraint-methods MODEL`,
-    /// `work-precision MODEL`, `stability`, `euler-roundoff`.
+    /// Numerical experiments: `work-precision`, `stability`, `euler-roundoff`,
+    /// `constraint-methods`, `free-response`, `modal-damping`, `floquet`.
     #[command(subcommand)]
     Study(study::Study),
 }

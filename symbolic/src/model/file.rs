@@ -350,7 +350,7 @@ pub struct Balance {
     pub location: Location,
 }
 
-/// What an animation draws (`draw:`). Parsed and checked now; used by `animate` later.
+/// What an animation draws (`draw:`): the lines and traced points of `eomgen animate`.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct Draw {
     /// Line segments between named points.
