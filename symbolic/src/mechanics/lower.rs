@@ -438,7 +438,7 @@ impl<'f> Lowering<'f> {
             self.arena.as_constant(b).map(Constant::to_f64),
         );
         match (op, x, y) {
-            (BinOp::Div, _, Some(y)) if y == 0.0 => {
+            (BinOp::Div, _, Some(0.0)) => {
                 self.undefined(e, "division by zero", "the divisor is 0 here");
             }
             (BinOp::Pow, Some(x), Some(y)) if x == 0.0 && y <= 0.0 => {
