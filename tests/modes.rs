@@ -215,6 +215,69 @@ fn equilibrium_search_and_its_errors() {
     assert!(matches!(err, ModalError::NonHolonomic { .. }), "{err}");
 }
 
+/// The library's operating point: the file's first name by default, a named equilibrium, an
+/// explicit guess, and its typed errors (an unknown name lists the known ones).
+#[test]
+fn operating_point_from_names_and_guesses() {
+    use eomgen::vibration::{
+        EquilibriumStart, OperatingPointError, OperatingPointOptions, operating_point,
+    };
+    let m = model("double_pendulum");
+    let at = |start: EquilibriumStart| {
+        operating_point(
+            m.as_ref(),
+            &OperatingPointOptions {
+                start,
+                ..OperatingPointOptions::default()
+            },
+        )
+    };
+    let half_pi = std::f64::consts::FRAC_PI_2;
+    let first = at(EquilibriumStart::FirstNamed).unwrap();
+    assert_eq!(first.name, "hanging");
+    assert_eq!(first.coordinates, ["theta1", "theta2"]);
+    assert!(first.q().iter().all(|q| (q + half_pi).abs() < 1e-12));
+    let up = at(EquilibriumStart::Named("upright".into())).unwrap();
+    assert!(up.q().iter().all(|q| (q - half_pi).abs() < 1e-12));
+    let guessed = at(EquilibriumStart::Guess {
+        label: "near upright".into(),
+        q: vec![1.4, 1.7],
+    })
+    .unwrap();
+    assert_eq!(guessed.name, "near upright");
+    assert_eq!(guessed.guess, [1.4, 1.7]);
+    assert!(guessed.q().iter().all(|q| (q - half_pi).abs() < 1e-12));
+    let err = at(EquilibriumStart::Named("sideways".into())).unwrap_err();
+    assert_eq!(
+        err,
+        OperatingPointError::UnknownEquilibrium {
+            model: "double_pendulum".into(),
+            name: "sideways".into(),
+            known: vec!["hanging".into(), "upright".into()],
+        }
+    );
+    let err = at(EquilibriumStart::Guess {
+        label: "short".into(),
+        q: vec![0.0],
+    })
+    .unwrap_err();
+    assert!(matches!(
+        err,
+        OperatingPointError::Modal(ModalError::DimensionMismatch {
+            expected: 2,
+            found: 1
+        })
+    ));
+    // No `equilibria:` in the file: Newton from q = 0, under that name.
+    let mut oscillator = model("forced_oscillator");
+    oscillator.set_parameter("A", 0.0).unwrap();
+    let point = operating_point(oscillator.as_ref(), &OperatingPointOptions::default()).unwrap();
+    assert_eq!(point.name, "q = 0");
+    assert_eq!(point.q(), [0.0]);
+    let json = serde_json::to_value(&point).unwrap();
+    assert_eq!(json["equilibrium"]["q"], serde_json::json!([0.0]));
+}
+
 /// A damped oscillator's ζ = c/(2√(k m)) from the eigenvalues of A.
 #[test]
 fn damping_ratio_from_the_state_matrix() {

@@ -116,7 +116,7 @@ pub enum NewtonStop {
 
 /// An equilibrium `F(q*, 0, t) = 0` (with constraints: `F(q*, 0, t) = Jᵀλ*`, `Φ(q*, t) = 0`)
 /// found by Newton's method.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct Equilibrium {
     /// The coordinates `q*` (length `n`).
     pub q: Vec<f64>,

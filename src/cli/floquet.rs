@@ -28,7 +28,7 @@ use rayon::prelude::*;
 use serde_json::{Value, json};
 
 use super::CliError;
-use super::modes::OperatingPointArgs;
+use super::modes::{OperatingPointArgs, point_json};
 use super::plot::{register_font, tick};
 use super::values::{evaluate, parameter_lookup, set_parameters, split_assignment};
 
@@ -150,14 +150,12 @@ pub fn run(args: &FloquetArgs) -> Result<(), CliError> {
             |c: &nalgebra::Complex<f64>| json!({"re": c.re, "im": c.im, "modulus": c.norm()});
         let f = &point.floquet;
         let monodromy = super::modes::matrix_rows(&f.monodromy_matrix);
+        let mut operating_point = point_json(&label, &names, &point.q);
+        operating_point["max_forcing_residual"] = json!(point.residual);
         let mut out = json!({
             "model": model.name(),
             "coordinates": names,
-            "operating_point": {
-                "name": label,
-                "q": names.iter().zip(&point.q).map(|(c, v)| (c.to_string(), json!(v))).collect::<serde_json::Map<_, _>>(),
-                "max_forcing_residual": point.residual,
-            },
+            "operating_point": operating_point,
             "period_parameter": args.period_parameter,
             "frequency": point.frequency,
             "period": f.period,

@@ -14,7 +14,7 @@ use plotters::prelude::*;
 use serde_json::json;
 
 use super::CliError;
-use super::modes::{OperatingPoint, OperatingPointArgs, operating_point_of};
+use super::modes::{OperatingPoint, OperatingPointArgs, operating_point_of, point_json};
 use super::plot::{self, Series};
 use super::values::{evaluate, parameter_lookup, split_assignment};
 
@@ -360,10 +360,7 @@ pub fn run(args: &FreeResponseArgs) -> Result<(), CliError> {
         let out = json!({
             "model": model.name(),
             "coordinates": names,
-            "operating_point": {
-                "name": label,
-                "q": names.iter().zip(&lin.q).map(|(c, v)| (c.to_string(), json!(v))).collect::<serde_json::Map<_, _>>(),
-            },
+            "operating_point": point_json(&label, &names, &lin.q),
             "ignored_damping": ignored_damping,
             "modes": (0..n).map(|k| json!({
                 "kind": kind_json(&modes.kinds[k]),

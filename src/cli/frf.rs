@@ -17,7 +17,7 @@ use plotters::prelude::*;
 use rayon::prelude::*;
 use serde_json::{Value, json};
 
-use super::modes::OperatingPointArgs;
+use super::modes::{OperatingPointArgs, point_json};
 use super::values::{evaluate, parameter_lookup};
 use super::{CliError, plot};
 
@@ -292,10 +292,7 @@ pub fn run(args: &FrfArgs) -> Result<(), CliError> {
             "model": name,
             "input": args.input,
             "outputs": outputs.iter().map(|(o, _)| o.clone()).collect::<Vec<_>>(),
-            "operating_point": {
-                "name": label,
-                "q": coordinates.iter().zip(&forced.equilibrium.q).map(|(c, v)| (c.to_string(), json!(v))).collect::<serde_json::Map<_, _>>(),
-            },
+            "operating_point": point_json(&label, &model.coordinate_names(), &forced.equilibrium.q),
             "input_matrix": b.iter().copied().collect::<Vec<f64>>(),
             "natural_frequencies": modes.natural_frequencies,
             "damping_ratios": damping.damping_ratios,

@@ -14,7 +14,7 @@ use super::CliError;
 use super::free_response::{
     Panel, default_t_end, kind_json, panels, parse_init, time_grid, unconstrained_operating_point,
 };
-use super::modes::{OperatingPoint, OperatingPointArgs, matrix_rows};
+use super::modes::{OperatingPoint, OperatingPointArgs, matrix_rows, point_json};
 use super::plot::Series;
 
 /// Options of `eomgen study modal-damping`.
@@ -249,10 +249,7 @@ pub fn run(args: &ModalDampingArgs) -> Result<(), CliError> {
         let out = json!({
             "model": model.name(),
             "coordinates": names,
-            "operating_point": {
-                "name": label,
-                "q": names.iter().zip(&lin.q).map(|(c, v)| (c.to_string(), json!(v))).collect::<serde_json::Map<_, _>>(),
-            },
+            "operating_point": point_json(&label, &names, &lin.q),
             "mass_matrix": matrix_rows(&lin.mass_matrix),
             "stiffness_matrix": matrix_rows(&lin.stiffness_matrix),
             "damping_matrix": matrix_rows(&lin.damping_matrix),

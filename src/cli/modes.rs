@@ -4,9 +4,10 @@
 use std::io::Write as _;
 
 use clap::Args;
+use eomgen::vibration::{self, EquilibriumStart, OperatingPointError, OperatingPointOptions};
 use eomgen::{
     Equilibrium, Linearization, ModeKind, ModelInfo, NormalModes, damped_modes,
-    eigenvalues_of_m_inv_k, find_equilibrium,
+    eigenvalues_of_m_inv_k,
 };
 use nalgebra::DMatrix;
 use serde_json::json;
@@ -59,12 +60,29 @@ impl OperatingPointArgs {
         Ok(model)
     }
 
-    /// The label and starting guess of `--at` for `model` (see [`operating_point`]).
+    /// The label and starting guess of `--at` for `model` (see [`equilibrium_start`]).
     ///
     /// # Errors
     /// An unknown equilibrium name or a bad guess.
     pub(super) fn guess(&self, model: &dyn ModelInfo) -> Result<(String, Vec<f64>), CliError> {
-        operating_point(model, self.at.as_deref())
+        equilibrium_start(model, self.at.as_deref())?
+            .resolve(model)
+            .map_err(|e| point_failure(model, &e))
+    }
+
+    /// The operating point `--at` of `model` ([`eomgen::vibration::operating_point`]).
+    ///
+    /// # Errors
+    /// A bad `--at` (usage) or a failed equilibrium search (with a hint).
+    pub(super) fn find(
+        &self,
+        model: &dyn ModelInfo,
+    ) -> Result<vibration::OperatingPoint, CliError> {
+        let options = OperatingPointOptions {
+            start: equilibrium_start(model, self.at.as_deref())?,
+            ..OperatingPointOptions::default()
+        };
+        vibration::operating_point(model, &options).map_err(|e| point_failure(model, &e))
     }
 }
 
@@ -140,15 +158,13 @@ pub fn run(args: &ModesArgs) -> Result<(), CliError> {
     }
     let mut stdout = std::io::stdout().lock();
     if args.json {
+        let mut point = point_json(&label, &names, &equilibrium.q);
+        point["newton_iterations"] = json!(equilibrium.iterations);
+        point["residual"] = json!(equilibrium.residual);
         let out = json!({
             "model": model.name(),
             "coordinates": names,
-            "operating_point": {
-                "name": label,
-                "q": names.iter().zip(&equilibrium.q).map(|(c, v)| (c.to_string(), json!(v))).collect::<serde_json::Map<_, _>>(),
-                "newton_iterations": equilibrium.iterations,
-                "residual": equilibrium.residual,
-            },
+            "operating_point": point,
             "natural_frequencies": modes.natural_frequencies,
             "frequencies_hz": modes.natural_frequencies.iter().map(|w| w / std::f64::consts::TAU).collect::<Vec<_>>(),
             "eigenvalues": modes.eigenvalues,
@@ -295,9 +311,12 @@ pub(super) fn operating_point_of(
     point: &OperatingPointArgs,
 ) -> Result<OperatingPoint, CliError> {
     let model = point.model(model_name)?;
-    let (label, guess) = point.guess(model.as_ref())?;
+    let vibration::OperatingPoint {
+        name: label,
+        equilibrium,
+        ..
+    } = point.find(model.as_ref())?;
     let fail = |e: eomgen::ModalError| modal_failure(model.as_ref(), &e);
-    let equilibrium = find_equilibrium(model.as_ref(), &guess, 0.0).map_err(fail)?;
     let n = model.num_dofs();
     let lin =
         eomgen::linearize(model.as_ref(), &equilibrium.q, &vec![0.0; n], 0.0).map_err(fail)?;
@@ -375,37 +394,29 @@ pub(super) fn modal_hint(model: &dyn ModelInfo, e: &eomgen::ModalError) -> Strin
     }
 }
 
-/// The starting guess of the equilibrium search and its label.
-pub(super) fn operating_point(
+/// The start of the equilibrium search that `--at` names: a name from the file's
+/// `equilibria:`, guesses `q1=VALUE,…` (expressions of the parameters; others 0), or the
+/// default (the file's first equilibrium, else q = 0).
+///
+/// # Errors
+/// A usage error for a bad guess (an unknown coordinate, a bad expression).
+pub(super) fn equilibrium_start(
     model: &dyn ModelInfo,
     at: Option<&str>,
-) -> Result<(String, Vec<f64>), CliError> {
-    let n = model.num_dofs();
-    let named = model.equilibrium_guesses();
+) -> Result<EquilibriumStart, CliError> {
     let Some(at) = at else {
-        return Ok(match named.first() {
-            Some((name, q)) => (name.to_string(), q.clone()),
-            None => ("q = 0".to_string(), vec![0.0; n]),
-        });
+        return Ok(EquilibriumStart::FirstNamed);
     };
-    if let Some((name, q)) = named.iter().find(|(name, _)| *name == at) {
-        return Ok((name.to_string(), q.clone()));
-    }
-    if !at.contains('=') {
-        let list: Vec<&str> = named.iter().map(|(n, _)| *n).collect();
-        return Err(CliError::usage(format!(
-            "--at {at}: `{}` has no equilibrium `{at}` ({}); or give guesses like `--at {}=0`",
-            model.name(),
-            if list.is_empty() {
-                "it names none".to_string()
-            } else {
-                format!("it names: {}", list.join(", "))
-            },
-            model.coordinate_names().first().copied().unwrap_or("q")
-        )));
+    if !at.contains('=')
+        || model
+            .equilibrium_guesses()
+            .iter()
+            .any(|(name, _)| *name == at)
+    {
+        return Ok(EquilibriumStart::Named(at.to_string()));
     }
     let lookup = parameter_lookup(model);
-    let mut q = vec![0.0; n];
+    let mut q = vec![0.0; model.num_dofs()];
     for part in at.split(',') {
         let (name, text) = split_assignment(part, "--at")?;
         let index = model
@@ -421,5 +432,30 @@ pub(super) fn operating_point(
             })?;
         q[index] = evaluate(text, &format!("--at {name}"), &lookup)?;
     }
-    Ok((at.to_string(), q))
+    Ok(EquilibriumStart::Guess {
+        label: at.to_string(),
+        q,
+    })
+}
+
+/// The error of a failed operating point of `model`: an unknown `--at` name is a usage error,
+/// a failed search gets its hint ([`modal_failure`]).
+pub(super) fn point_failure(model: &dyn ModelInfo, e: &OperatingPointError) -> CliError {
+    match e {
+        OperatingPointError::UnknownEquilibrium { name, .. } => CliError::usage(format!(
+            "--at {name}: {e}; or give guesses like `--at {}=0`",
+            model.coordinate_names().first().copied().unwrap_or("q")
+        )),
+        OperatingPointError::Modal(m) => modal_failure(model, m),
+        e => CliError::failure(format!("`{}`: {e}", model.name())),
+    }
+}
+
+/// The JSON of an operating point, `{"name", "q": {coordinate: value}}`, which each command
+/// extends with its own fields.
+pub(super) fn point_json(name: &str, coordinates: &[&str], q: &[f64]) -> serde_json::Value {
+    json!({
+        "name": name,
+        "q": coordinates.iter().zip(q).map(|(c, v)| (c.to_string(), json!(v))).collect::<serde_json::Map<_, _>>(),
+    })
 }
