@@ -4,11 +4,10 @@
 use std::io::Write as _;
 
 use clap::Args;
-use eomgen::vibration::{self, EquilibriumStart, OperatingPointError, OperatingPointOptions};
-use eomgen::{
-    Equilibrium, Linearization, ModeKind, ModelInfo, NormalModes, damped_modes,
-    eigenvalues_of_m_inv_k,
+use eomgen::vibration::{
+    self, EquilibriumStart, ModalAnalysis, ModalOptions, OperatingPointError, OperatingPointOptions,
 };
+use eomgen::{Equilibrium, Linearization, ModeKind, ModelInfo, NormalModes};
 use nalgebra::DMatrix;
 use serde_json::json;
 
@@ -70,71 +69,41 @@ impl OperatingPointArgs {
             .map_err(|e| point_failure(model, &e))
     }
 
-    /// The operating point `--at` of `model` ([`eomgen::vibration::operating_point`]).
+    /// The library's options for `--at` on `model`.
     ///
     /// # Errors
-    /// A bad `--at` (usage) or a failed equilibrium search (with a hint).
-    pub(super) fn find(
-        &self,
-        model: &dyn ModelInfo,
-    ) -> Result<vibration::OperatingPoint, CliError> {
-        let options = OperatingPointOptions {
+    /// A bad guess (usage).
+    pub(super) fn options(&self, model: &dyn ModelInfo) -> Result<OperatingPointOptions, CliError> {
+        Ok(OperatingPointOptions {
             start: equilibrium_start(model, self.at.as_deref())?,
             ..OperatingPointOptions::default()
-        };
-        vibration::operating_point(model, &options).map_err(|e| point_failure(model, &e))
+        })
     }
 }
 
 /// Runs `modes`.
 pub fn run(args: &ModesArgs) -> Result<(), CliError> {
-    let OperatingPoint {
-        model,
-        label,
-        equilibrium,
-        lin,
-        modes,
-    } = operating_point_of(&args.model, &args.point)?;
+    let (model, modal) = analysis_of(&args.model, &args.point)?;
     if args.plot.is_some() {
         super::mode_plot::check_drawable(model.as_ref())?;
     }
-    let fail = |e: eomgen::ModalError| modal_failure(model.as_ref(), &e);
+    let ModalAnalysis {
+        operating_point: point,
+        linearization: lin,
+        normal_modes: modes,
+        mode_shapes: shapes,
+        minimal_coordinates: minimal,
+        damped_modes: damped,
+        damping_ratios,
+        m_inv_k_eigenvalues: route22,
+        m_inv_k_relative_difference: route_difference,
+    } = &modal;
+    let (label, equilibrium) = (&point.name, &point.equilibrium);
     let n = model.num_dofs();
-    let route22 = eigenvalues_of_m_inv_k(&lin).map_err(fail)?;
-    let damped = damped_modes(&lin).map_err(fail)?;
     let names = model.coordinate_names();
-    let r = lin.num_minimal_coordinates();
-    let undamped = lin.damping_matrix.amax() == 0.0;
-    let damping_ratios: Vec<f64> = if undamped {
-        vec![0.0; r]
-    } else {
-        damped.iter().map(|d| d.1).collect()
-    };
-    let scale = modes.eigenvalues.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-    let route_difference = modes
-        .eigenvalues
-        .iter()
-        .zip(&route22)
-        .map(|(a, b)| (a - b).abs())
-        .fold(0.0f64, f64::max)
-        / scale.max(f64::MIN_POSITIVE);
-    let kind = |k: &ModeKind| match k {
-        ModeKind::Oscillatory => json!({"kind": "oscillatory"}),
-        ModeKind::ZeroFrequency => json!({"kind": "zero_frequency"}),
-        ModeKind::Unstable { growth_rate } => {
-            json!({"kind": "unstable", "growth_rate": growth_rate})
-        }
-    };
+    let undamped = modal.is_undamped();
     // Mode shapes in the model's coordinates (δq = N z with constraints).
-    let shapes_q = lin.to_coordinates(&modes.mode_shapes);
-    let shapes: Vec<Vec<f64>> = (0..r)
-        .map(|k| shapes_q.column(k).iter().copied().collect())
-        .collect();
-    let minimal: Vec<&str> = lin
-        .independent_coordinates
-        .iter()
-        .map(|&i| names[i])
-        .collect();
+    let shapes_q = modal.mode_shape_matrix();
     let multipliers: serde_json::Map<String, serde_json::Value> = model
         .constraint_names()
         .iter()
@@ -142,23 +111,19 @@ pub fn run(args: &ModesArgs) -> Result<(), CliError> {
         .map(|(c, v)| (c.to_string(), json!(v)))
         .collect();
     let charts = match &args.plot {
-        Some(prefix) => super::mode_plot::mode_charts(
-            prefix,
-            model.as_ref(),
-            &equilibrium.q,
-            &modes,
-            &shapes_q,
-        )?,
+        Some(prefix) => {
+            super::mode_plot::mode_charts(prefix, model.as_ref(), &equilibrium.q, modes, &shapes_q)?
+        }
         None => Vec::new(),
     };
     if let Some(path) = &args.animate {
-        let page = super::animate::modes(model.as_ref(), &equilibrium.q, &modes, &shapes_q)?;
+        let page = super::animate::modes(model.as_ref(), &equilibrium.q, modes, &shapes_q)?;
         std::fs::write(path, page.to_html())
             .map_err(|e| CliError::failure(format!("cannot write `{path}`: {e}")))?;
     }
     let mut stdout = std::io::stdout().lock();
     if args.json {
-        let mut point = point_json(&label, &names, &equilibrium.q);
+        let mut point = point_json(label, &names, &equilibrium.q);
         point["newton_iterations"] = json!(equilibrium.iterations);
         point["residual"] = json!(equilibrium.residual);
         let out = json!({
@@ -168,9 +133,9 @@ pub fn run(args: &ModesArgs) -> Result<(), CliError> {
             "natural_frequencies": modes.natural_frequencies,
             "frequencies_hz": modes.natural_frequencies.iter().map(|w| w / std::f64::consts::TAU).collect::<Vec<_>>(),
             "eigenvalues": modes.eigenvalues,
-            "kinds": modes.kinds.iter().map(kind).collect::<Vec<_>>(),
+            "kinds": modes.kinds,
             "damping_ratios": damping_ratios,
-            "damped_modes": damped.iter().map(|(s, zeta, wd)| json!({"re": s.re, "im": s.im, "damping_ratio": zeta, "damped_frequency": wd})).collect::<Vec<_>>(),
+            "damped_modes": damped.iter().map(|d| json!({"re": d.eigenvalue.re, "im": d.eigenvalue.im, "damping_ratio": d.damping_ratio, "damped_frequency": d.damped_frequency})).collect::<Vec<_>>(),
             "mode_shapes": shapes,
             "minimal_coordinates": minimal,
             "lagrange_multipliers": multipliers,
@@ -304,29 +269,37 @@ pub(super) struct OperatingPoint {
     pub modes: NormalModes,
 }
 
+/// The model `model_name` with `--set` applied and its modal analysis at `--at`
+/// ([`eomgen::vibration::modal_analysis`]).
+///
+/// # Errors
+/// A bad `--set` or `--at` (usage), a failed search or analysis (with a hint).
+pub(super) fn analysis_of(
+    model_name: &str,
+    point: &OperatingPointArgs,
+) -> Result<(Box<dyn ModelInfo>, ModalAnalysis), CliError> {
+    let model = point.model(model_name)?;
+    let options = ModalOptions {
+        operating_point: point.options(model.as_ref())?,
+    };
+    let modal = vibration::modal_analysis(model.as_ref(), &options)
+        .map_err(|e| point_failure(model.as_ref(), &e))?;
+    Ok((model, modal))
+}
+
 /// Finds the equilibrium from `--at` (after `--set`), linearises there and computes the
-/// normal modes: the start of `modes` and of the modal studies.
+/// normal modes: the start of the modal studies and of the report's modal checks.
 pub(super) fn operating_point_of(
     model_name: &str,
     point: &OperatingPointArgs,
 ) -> Result<OperatingPoint, CliError> {
-    let model = point.model(model_name)?;
-    let vibration::OperatingPoint {
-        name: label,
-        equilibrium,
-        ..
-    } = point.find(model.as_ref())?;
-    let fail = |e: eomgen::ModalError| modal_failure(model.as_ref(), &e);
-    let n = model.num_dofs();
-    let lin =
-        eomgen::linearize(model.as_ref(), &equilibrium.q, &vec![0.0; n], 0.0).map_err(fail)?;
-    let modes = eomgen::normal_modes(&lin).map_err(fail)?;
+    let (model, modal) = analysis_of(model_name, point)?;
     Ok(OperatingPoint {
         model,
-        label,
-        equilibrium,
-        lin,
-        modes,
+        label: modal.operating_point.name,
+        equilibrium: modal.operating_point.equilibrium,
+        lin: modal.linearization,
+        modes: modal.normal_modes,
     })
 }
 

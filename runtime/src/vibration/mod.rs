@@ -5,13 +5,18 @@
 //!
 //! - [`operating_point`]: the equilibrium an analysis linearises about, from a name in the
 //!   model file's `equilibria:` or an explicit guess (Newton on `F(q, 0, t) = 0`).
+//! - [`modal_analysis`]: the exact linearisation `M δq̈ + C δq̇ + K δq = 0` there, natural
+//!   frequencies, mass-normalised mode shapes, damping ratios (`eomgen modes`).
 //!
 //! The building blocks (linearisation, normal modes, responses, `H(ω)`, monodromy) are in
 //! [`modal`](crate::modal), [`response`](crate::response), [`frf`](crate::frf) and
 //! [`floquet`](crate::floquet).
 
+pub mod modes;
 pub mod operating_point;
+pub(crate) mod serde_matrix;
 
+pub use modes::{DampedEigenvalue, ModalAnalysis, ModalOptions, modal_analysis};
 pub use operating_point::{
     EquilibriumStart, OperatingPoint, OperatingPointError, OperatingPointOptions, operating_point,
 };
