@@ -5,10 +5,10 @@ mod common;
 use common::{eomgen, eomgen_ok};
 
 use eomgen::{
-    FreeResponse, Linearization, ModelInfo, RayleighDamping, exact_damped_modes, find_equilibrium,
-    linearize, modal_damping, normal_modes, response_by_exponential, response_by_integration,
-    response_by_m_inv_k_modes, response_by_normal_modes, response_with_modal_damping,
-    state_response_by_eigenvectors,
+    FreeResponse, Linearization, ModeKind, ModelInfo, RayleighDamping, exact_damped_modes,
+    find_equilibrium, linearize, modal_damping, normal_modes, response_by_exponential,
+    response_by_integration, response_by_m_inv_k_modes, response_by_normal_modes,
+    response_with_modal_damping, state_response_by_eigenvectors,
 };
 use nalgebra::{Complex, Matrix2, Vector2};
 
@@ -443,7 +443,65 @@ fn three_masses_damped_responses_from_each_mode() {
     }
 }
 
-/// `eomgen study free-response`: JSON contract, the routes' agreement, and the chart.
+/// `vibration::free_response` (what `eomgen study free-response` prints) on the cart
+/// pendulum upright, an unstable and a zero-frequency mode: the four routes agree to 1e-10 of
+/// the largest |δq|, the defaults are HW28's, and the initial deviation is kept.
+#[test]
+fn free_response_study_routes_agree() {
+    use eomgen::vibration::{
+        EquilibriumStart, FreeResponseMethod, FreeResponseOptions, InitialDeviation,
+        OperatingPointOptions, ResponseStudyError, free_response,
+    };
+    let m = model("cart_pendulum");
+    let options = FreeResponseOptions {
+        operating_point: OperatingPointOptions {
+            start: EquilibriumStart::Named("upright".into()),
+            ..OperatingPointOptions::default()
+        },
+        initial: Some(InitialDeviation {
+            q: vec![0.1, 0.05],
+            qdot: vec![0.2, 0.0],
+        }),
+        t_end: Some(2.0),
+        ..FreeResponseOptions::default()
+    };
+    let study = free_response(m.as_ref(), &options).unwrap();
+    assert_eq!(study.operating_point.name, "upright");
+    assert!(matches!(
+        study.normal_modes.kinds[0],
+        ModeKind::Unstable { .. }
+    ));
+    assert_eq!(study.normal_modes.kinds[1], ModeKind::ZeroFrequency);
+    assert_eq!(study.differences.len(), 6);
+    for d in &study.differences {
+        assert!(d.displacement_relative < 1e-10, "{d:?}");
+    }
+    let methods: Vec<_> = study.responses.iter().map(|(m, _)| *m).collect();
+    assert_eq!(methods, FreeResponseMethod::ALL);
+    assert_eq!(study.responses[1].1.times.len(), 401);
+    assert_eq!(study.responses[1].1.displacements[0], [0.1, 0.05]);
+    // Errors: a constrained model, a bad tolerance, too few samples.
+    let pendulum = model("simple_pendulum_cartesian");
+    let err = free_response(pendulum.as_ref(), &FreeResponseOptions::default()).unwrap_err();
+    assert!(
+        matches!(err, ResponseStudyError::Constrained { .. }),
+        "{err}"
+    );
+    let bad = FreeResponseOptions {
+        tol: 0.0,
+        ..FreeResponseOptions::default()
+    };
+    let err = free_response(m.as_ref(), &bad).unwrap_err();
+    assert_eq!(err, ResponseStudyError::InvalidTolerance { tol: 0.0 });
+    let bad = FreeResponseOptions {
+        samples: 1,
+        ..FreeResponseOptions::default()
+    };
+    let err = free_response(m.as_ref(), &bad).unwrap_err();
+    assert_eq!(err, ResponseStudyError::TooFewSamples { samples: 1 });
+}
+
+/// `eomgen study free-response`: JSON contract, the chart and a usage error.
 #[test]
 fn free_response_cli() {
     let dir = std::env::temp_dir().join(format!("eomgen-free-response-{}", std::process::id()));
@@ -472,9 +530,8 @@ fn free_response_cli() {
     assert_eq!(v["modes"][1]["kind"], "zero_frequency");
     let diffs = v["max_differences"].as_array().unwrap();
     assert_eq!(diffs.len(), 6);
-    for d in diffs {
-        assert!(d["displacement_relative"].as_f64().unwrap() < 1e-10, "{d}");
-    }
+    assert_eq!(diffs[0]["a"], "integration");
+    assert_eq!(diffs[5]["b"], "normal_modes");
     assert_eq!(v["initial"]["q"][0], 0.1);
     assert_eq!(v["initial"]["qdot"][0], 0.2);
     let svg = std::fs::read_to_string(&chart).unwrap();

@@ -139,7 +139,7 @@ pub enum ResponseError {
 }
 
 /// A free response sampled at given times.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct FreeResponse {
     /// The sample times (s), as asked for.
     pub times: Vec<f64>,

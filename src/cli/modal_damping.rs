@@ -11,10 +11,8 @@ use eomgen::{FreeResponse, ModeKind, RayleighDamping};
 use serde_json::json;
 
 use super::CliError;
-use super::free_response::{
-    Panel, default_t_end, kind_json, panels, parse_init, time_grid, unconstrained_operating_point,
-};
-use super::modes::{OperatingPoint, OperatingPointArgs, matrix_rows, point_json};
+use super::free_response::{Panel, kind_json, panels, parse_init, study_failure};
+use super::modes::{OperatingPointArgs, matrix_rows, point_json};
 use super::plot::Series;
 
 /// Options of `eomgen study modal-damping`.
@@ -70,13 +68,17 @@ fn damped_frequency(omega: f64, zeta: f64) -> Option<f64> {
 
 /// Runs `study modal-damping`.
 pub fn run(args: &ModalDampingArgs) -> Result<(), CliError> {
-    let OperatingPoint {
-        model,
-        label,
-        lin,
-        modes,
-        ..
-    } = unconstrained_operating_point(&args.model, &args.point)?;
+    let model = args.point.model(&args.model)?;
+    let modal = eomgen::vibration::unconstrained_modal_analysis(
+        model.as_ref(),
+        &args.point.options(model.as_ref())?,
+    )
+    .map_err(|e| study_failure(model.as_ref(), &e))?;
+    let (label, lin, modes) = (
+        modal.operating_point.name,
+        modal.linearization,
+        modal.normal_modes,
+    );
     let n = model.num_dofs();
     let names = model.coordinate_names();
     let fail =
@@ -142,8 +144,9 @@ pub fn run(args: &ModalDampingArgs) -> Result<(), CliError> {
     }
     let t_end = args
         .t_end
-        .unwrap_or_else(|| default_t_end(&modes, 10.0, 5.0));
-    let times = time_grid(t_end, args.samples)?;
+        .unwrap_or_else(|| eomgen::vibration::default_duration(&modes, 10.0, 5.0));
+    let times = eomgen::vibration::uniform_times(t_end, args.samples)
+        .map_err(|e| study_failure(model.as_ref(), &e))?;
     let mut releases: Vec<(String, Vec<f64>, Vec<f64>)> = Vec::new();
     if args.init.is_empty() {
         for k in 0..n {
@@ -162,7 +165,8 @@ pub fn run(args: &ModalDampingArgs) -> Result<(), CliError> {
             ));
         }
     } else {
-        let (q0, v0) = parse_init(model.as_ref(), &args.init)?;
+        let init = parse_init(model.as_ref(), &args.init)?;
+        let (q0, v0) = (init.q, init.qdot);
         releases.push(("given initial values".to_string(), q0, v0));
     }
     let diagonal_damping = approx.diagonal();

@@ -257,8 +257,6 @@ fn print_matrix(out: &mut impl std::io::Write, name: &str, m: &DMatrix<f64>) {
 
 /// The linearisation at the operating point `--at` and what to call it.
 pub(super) struct OperatingPoint {
-    /// The model, with `--set` applied.
-    pub model: Box<dyn ModelInfo>,
     /// The equilibrium's name, or the `--at` guesses as given.
     pub label: String,
     /// The equilibrium Newton found (with the constraint forces at rest).
@@ -293,9 +291,8 @@ pub(super) fn operating_point_of(
     model_name: &str,
     point: &OperatingPointArgs,
 ) -> Result<OperatingPoint, CliError> {
-    let (model, modal) = analysis_of(model_name, point)?;
+    let (_, modal) = analysis_of(model_name, point)?;
     Ok(OperatingPoint {
-        model,
         label: modal.operating_point.name,
         equilibrium: modal.operating_point.equilibrium,
         lin: modal.linearization,

@@ -7,15 +7,22 @@
 //!   model file's `equilibria:` or an explicit guess (Newton on `F(q, 0, t) = 0`).
 //! - [`modal_analysis`]: the exact linearisation `M δq̈ + C δq̇ + K δq = 0` there, natural
 //!   frequencies, mass-normalised mode shapes, damping ratios (`eomgen modes`).
+//! - [`free_response`]: the undamped free response four ways and their differences (HW28).
 //!
 //! The building blocks (linearisation, normal modes, responses, `H(ω)`, monodromy) are in
 //! [`modal`](crate::modal), [`response`](crate::response), [`frf`](crate::frf) and
 //! [`floquet`](crate::floquet).
 
+pub mod free_response;
 pub mod modes;
 pub mod operating_point;
 pub(crate) mod serde_matrix;
 
+pub use free_response::{
+    FreeResponseMethod, FreeResponseOptions, FreeResponseStudy, InitialDeviation,
+    ResponseDifference, ResponseStudyError, default_duration, free_response,
+    unconstrained_modal_analysis, uniform_times,
+};
 pub use modes::{DampedEigenvalue, ModalAnalysis, ModalOptions, modal_analysis};
 pub use operating_point::{
     EquilibriumStart, OperatingPoint, OperatingPointError, OperatingPointOptions, operating_point,
