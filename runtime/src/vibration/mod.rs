@@ -8,12 +8,15 @@
 //! - [`modal_analysis`]: the exact linearisation `M δq̈ + C δq̇ + K δq = 0` there, natural
 //!   frequencies, mass-normalised mode shapes, damping ratios (`eomgen modes`).
 //! - [`free_response`]: the undamped free response four ways and their differences (HW28).
+//! - [`modal_damping_study`]: damping ratios exact, by the diagonal of `ΨᵀCΨ` and by a
+//!   Rayleigh fit, and the damped responses from each mode shape (HW34).
 //!
 //! The building blocks (linearisation, normal modes, responses, `H(ω)`, monodromy) are in
 //! [`modal`](crate::modal), [`response`](crate::response), [`frf`](crate::frf) and
 //! [`floquet`](crate::floquet).
 
 pub mod free_response;
+pub mod modal_damping;
 pub mod modes;
 pub mod operating_point;
 pub(crate) mod serde_matrix;
@@ -22,6 +25,10 @@ pub use free_response::{
     FreeResponseMethod, FreeResponseOptions, FreeResponseStudy, InitialDeviation,
     ResponseDifference, ResponseStudyError, default_duration, free_response,
     unconstrained_modal_analysis, uniform_times,
+};
+pub use modal_damping::{
+    ModalDampingOptions, ModalDampingStudy, ModalRatio, ModeDamping, RayleighFit, Release,
+    modal_damping_study,
 };
 pub use modes::{DampedEigenvalue, ModalAnalysis, ModalOptions, modal_analysis};
 pub use operating_point::{
