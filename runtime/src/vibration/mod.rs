@@ -10,12 +10,16 @@
 //! - [`free_response`]: the undamped free response four ways and their differences (HW28).
 //! - [`modal_damping_study`]: damping ratios exact, by the diagonal of `ΨᵀCΨ` and by a
 //!   Rayleigh fit, and the damped responses from each mode shape (HW34).
+//! - [`frequency_response_analysis`]: `H(ω)` from one input over a sweep, its peaks, its modal
+//!   sum; [`plan_simulation`] and [`simulate_point`] check points of the curve by simulating
+//!   the full model to steady state (lecture 21, HW37).
 //!
 //! The building blocks (linearisation, normal modes, responses, `H(ω)`, monodromy) are in
 //! [`modal`](crate::modal), [`response`](crate::response), [`frf`](crate::frf) and
 //! [`floquet`](crate::floquet).
 
 pub mod free_response;
+pub mod frf;
 pub mod modal_damping;
 pub mod modes;
 pub mod operating_point;
@@ -25,6 +29,11 @@ pub use free_response::{
     FreeResponseMethod, FreeResponseOptions, FreeResponseStudy, InitialDeviation,
     ResponseDifference, ResponseStudyError, default_duration, free_response,
     unconstrained_modal_analysis, uniform_times,
+};
+pub use frf::{
+    FrfAnalysis, FrfAnalysisError, FrfEvaluation, FrfOptions, FrfOutput, FrfSimulationOptions,
+    FrfSimulationPlan, SimulatedPoint, SimulatedValue, frequency_response_analysis,
+    max_simulation_error, plan_simulation, simulate_point,
 };
 pub use modal_damping::{
     ModalDampingOptions, ModalDampingStudy, ModalRatio, ModeDamping, RayleighFit, Release,
