@@ -19,10 +19,8 @@ use std::f64::consts::TAU;
 use std::io::Write as _;
 
 use clap::Args;
-use eomgen::{
-    FloquetAnalysis, FloquetOptions, FloquetStability, ModelInfo, check_periodic_equilibrium,
-    find_equilibrium, floquet_analysis,
-};
+use eomgen::vibration::{self, FloquetStudyError, FloquetStudyOptions, SweepAxis};
+use eomgen::{FloquetAnalysis, FloquetOptions, FloquetStability, ModelInfo};
 use plotters::prelude::*;
 use rayon::prelude::*;
 use serde_json::{Value, json};
@@ -62,58 +60,51 @@ pub struct FloquetArgs {
     pub plot: Option<String>,
 }
 
-/// One swept parameter: `name=LO..HI:N`.
-#[derive(Debug, Clone)]
-struct Axis {
-    name: String,
-    values: Vec<f64>,
-}
-
-/// The analysis at one parameter set: the equilibrium and its Floquet multipliers.
-struct Point {
-    q: Vec<f64>,
-    frequency: f64,
-    residual: f64,
-    floquet: FloquetAnalysis,
+/// The text of a failed analysis (a point or a cell) of `model`: a failed equilibrium search
+/// gets its hint.
+fn analysis_text(model: &dyn ModelInfo, e: &FloquetStudyError) -> String {
+    match e {
+        FloquetStudyError::Equilibrium(m) => {
+            format!("{m}\nhelp: {}", super::modes::modal_hint(model, m))
+        }
+        e => e.to_string(),
+    }
 }
 
 /// Runs `study floquet`.
 pub fn run(args: &FloquetArgs) -> Result<(), CliError> {
     let mut model = args.point.model(&args.model)?;
-    if !model
-        .parameter_names()
-        .contains(&args.period_parameter.as_str())
-    {
-        return Err(CliError::usage(format!(
-            "--period-parameter {}: `{}` has no parameter `{}` (it has: {}); name the forcing frequency w (rad/s), T = 2π/w",
-            args.period_parameter,
-            model.name(),
-            args.period_parameter,
-            model.parameter_names().join(", ")
-        )));
-    }
-    let valid_tol = args.tol.is_finite() && args.tol > 0.0;
-    let valid_stability_tolerance =
-        args.stability_tolerance.is_finite() && args.stability_tolerance >= 0.0;
-    if !(valid_tol && valid_stability_tolerance) {
-        return Err(CliError::usage(
-            "--tol must be positive and --stability-tolerance finite and >= 0",
-        ));
-    }
-    let (label, guess) = args.point.guess(model.as_ref())?;
-    let options = FloquetOptions {
-        rtol: args.tol,
-        atol: args.tol,
-        stability_tolerance: args.stability_tolerance,
-        ..FloquetOptions::default()
+    let options = FloquetStudyOptions {
+        operating_point: args.point.options(model.as_ref())?,
+        period_parameter: args.period_parameter.clone(),
+        floquet: FloquetOptions {
+            rtol: args.tol,
+            atol: args.tol,
+            stability_tolerance: args.stability_tolerance,
+            ..FloquetOptions::default()
+        },
     };
+    let (label, guess) = args.point.guess(model.as_ref())?;
     let axes = args
         .sweep
         .as_deref()
         .map(|s| parse_sweep(s, model.as_ref()))
         .transpose()?;
-    let point = analyse(model.as_mut(), &guess, &args.period_parameter, &options)
-        .map_err(|e| CliError::failure(format!("`{}` at {label}: {e}", model.name())))?;
+    let point =
+        vibration::floquet_at_equilibrium(model.as_mut(), &options).map_err(|e| match e {
+            FloquetStudyError::UnknownPeriodParameter { ref name, .. } => CliError::usage(format!(
+                "--period-parameter {name}: {e}; name the forcing frequency w (rad/s), T = 2π/w"
+            )),
+            FloquetStudyError::InvalidTolerance { .. } => {
+                CliError::usage("--tol must be positive and --stability-tolerance finite and >= 0")
+            }
+            FloquetStudyError::OperatingPoint(e) => super::modes::point_failure(model.as_ref(), &e),
+            e => CliError::failure(format!(
+                "`{}` at {label}: {}",
+                model.name(),
+                analysis_text(model.as_ref(), &e)
+            )),
+        })?;
     let sweep = match &axes {
         Some((x, y)) => Some(run_sweep(args, &guess, x, y, &options)?),
         None => None,
@@ -258,49 +249,11 @@ pub fn run(args: &FloquetArgs) -> Result<(), CliError> {
     Ok(())
 }
 
-/// Equilibrium at `t = 0` from `guess`, the check that it stays one over the period, and the
-/// Floquet analysis there.
-fn analyse(
-    model: &mut dyn ModelInfo,
-    guess: &[f64],
-    period_parameter: &str,
-    options: &FloquetOptions,
-) -> Result<Point, String> {
-    let index = model
-        .parameter_names()
-        .iter()
-        .position(|p| *p == period_parameter)
-        .ok_or_else(|| format!("no parameter `{period_parameter}`"))?;
-    let frequency = model.parameter_values()[index];
-    if !(frequency.is_finite() && frequency > 0.0) {
-        return Err(format!(
-            "the forcing frequency {period_parameter} = {frequency} must be positive (T = 2π/{period_parameter})"
-        ));
-    }
-    let period = TAU / frequency;
-    let equilibrium = find_equilibrium(model, guess, 0.0)
-        .map_err(|e| format!("{e}\nhelp: {}", super::modes::modal_hint(model, &e)))?;
-    let residual = check_periodic_equilibrium(model, &equilibrium.q, 0.0, period)
-        .map_err(|e| e.to_string())?;
-    let n = model.num_dofs();
-    let y0: Vec<f64> = equilibrium
-        .q
-        .iter()
-        .copied()
-        .chain(std::iter::repeat_n(0.0, n))
-        .collect();
-    let floquet = floquet_analysis(model.as_ode_mut(), &y0, 0.0, period, options)
-        .map_err(|e| e.to_string())?;
-    Ok(Point {
-        q: equilibrium.q,
-        frequency,
-        residual,
-        floquet,
-    })
-}
-
 /// One grid cell's outcome: `(spectral radius, stability)` or the failure.
 type Cell = Result<(f64, FloquetStability), String>;
+
+/// One swept parameter.
+type Axis = SweepAxis;
 
 /// The analyses on the grid `x × y`, in parallel; `cells[i][j]` at `(x[i], y[j])`.
 fn run_sweep(
@@ -308,7 +261,7 @@ fn run_sweep(
     guess: &[f64],
     x: &Axis,
     y: &Axis,
-    options: &FloquetOptions,
+    options: &FloquetStudyOptions,
 ) -> Result<Vec<Vec<Cell>>, CliError> {
     let source = super::open_model(&args.model)?;
     let total = x.values.len() * y.values.len();
@@ -326,13 +279,13 @@ fn run_sweep(
             let mut model = source.instantiate();
             let cell = (|| {
                 set_parameters(model.as_mut(), &args.point.set).map_err(|e| e.message)?;
-                for (axis, value) in [(x, x.values[i]), (y, y.values[j])] {
-                    model
-                        .set_parameter(&axis.name, value)
-                        .map_err(|e| e.to_string())?;
-                }
-                let p = analyse(model.as_mut(), guess, &args.period_parameter, options)?;
-                Ok((p.floquet.spectral_radius, p.floquet.stability))
+                let values = [
+                    (x.name.as_str(), x.values[i]),
+                    (y.name.as_str(), y.values[j]),
+                ];
+                vibration::floquet_cell(model.as_mut(), guess, &values, options)
+                    .map(|c| (c.spectral_radius, c.stability))
+                    .map_err(|e| analysis_text(model.as_ref(), &e))
             })();
             bar.inc(1);
             cell
@@ -448,22 +401,12 @@ fn parse_sweep(spec: &str, model: &dyn ModelInfo) -> Result<(Axis, Axis), CliErr
         let lo = evaluate(lo.trim(), &format!("--sweep {name}"), &lookup)?;
         let hi = evaluate(hi.trim(), &format!("--sweep {name}"), &lookup)?;
         let count: usize = count.trim().parse().map_err(|_| bad())?;
-        if !(1..=10_000).contains(&count) || (count > 1 && hi <= lo) {
-            return Err(CliError::usage(format!(
+        let axis = SweepAxis::linear(name, lo, hi, count).map_err(|_| {
+            CliError::usage(format!(
                 "--sweep {name}: need 1 ≤ N ≤ 10000 values and LO < HI, got `{rest}`"
-            )));
-        }
-        let values = if count == 1 {
-            vec![lo]
-        } else {
-            (0..count)
-                .map(|k| lo + (hi - lo) * k as f64 / (count - 1) as f64)
-                .collect()
-        };
-        axes.push(Axis {
-            name: name.to_string(),
-            values,
-        });
+            ))
+        })?;
+        axes.push(axis);
     }
     match <[Axis; 2]>::try_from(axes) {
         Ok([x, y]) if x.name != y.name => Ok((x, y)),

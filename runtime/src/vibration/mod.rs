@@ -13,11 +13,15 @@
 //! - [`frequency_response_analysis`]: `H(ω)` from one input over a sweep, its peaks, its modal
 //!   sum; [`plan_simulation`] and [`simulate_point`] check points of the curve by simulating
 //!   the full model to steady state (lecture 21, HW37).
+//! - [`floquet_at_equilibrium`]: the Floquet multipliers of a time-periodic model about an
+//!   equilibrium; [`floquet_cell`], one cell of a stability chart over two parameters
+//!   (lectures 19, 21).
 //!
 //! The building blocks (linearisation, normal modes, responses, `H(ω)`, monodromy) are in
 //! [`modal`](crate::modal), [`response`](crate::response), [`frf`](crate::frf) and
 //! [`floquet`](crate::floquet).
 
+pub mod floquet;
 pub mod free_response;
 pub mod frf;
 pub mod modal_damping;
@@ -25,6 +29,10 @@ pub mod modes;
 pub mod operating_point;
 pub(crate) mod serde_matrix;
 
+pub use floquet::{
+    FloquetCell, FloquetPoint, FloquetStudyError, FloquetStudyOptions, SweepAxis,
+    floquet_at_equilibrium, floquet_cell,
+};
 pub use free_response::{
     FreeResponseMethod, FreeResponseOptions, FreeResponseStudy, InitialDeviation,
     ResponseDifference, ResponseStudyError, default_duration, free_response,
