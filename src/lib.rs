@@ -28,8 +28,12 @@ extern crate self as eomgen;
 pub use eomgen_jit::{Backend, CompileError, JitModel, LoadError, LoadOptions};
 pub use eomgen_macros::model;
 pub use eomgen_runtime::*;
+pub use floquet_references::{
+    ChartAxis, FloquetReferences, ReferenceCurvePoints, ReferenceError, ThresholdPrediction,
+};
 pub use source::{ModelSource, OpenError, Resolved, open_model, resolve};
 
+mod floquet_references;
 mod source;
 
 /// Every model in `models/`, compiled in: one module and struct per file, and [`models::ALL`].
