@@ -189,8 +189,9 @@ impl FloquetReferences {
                 .filter_map(|i| {
                     let s = start + (a.hi - start) * f64::from(i) / f64::from(SAMPLES);
                     let lookup = |n: &str| if n == along { Some(s) } else { values(n) };
+                    // Drawn where `where:` is ≥ 0; a NaN there is no point either.
                     if let Some(domain) = &c.domain
-                        && !(eval(domain, &lookup) >= 0.0)
+                        && eval(domain, &lookup).partial_cmp(&0.0).is_none_or(|o| o.is_lt())
                     {
                         return None;
                     }

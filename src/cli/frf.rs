@@ -188,8 +188,41 @@ pub fn run(args: &FrfArgs) -> Result<(), CliError> {
         }
         _ => None,
     };
+    let simulated = simulated.as_ref().map(|(points, plan)| (points.as_slice(), plan));
+    if let Some(path) = &args.plot {
+        bode_chart(
+            path,
+            &format!("{}: frequency response from {}", model.name(), args.input),
+            &frf.outputs,
+            &frf.sweeps,
+            simulated.map(|(s, _)| s),
+        )
+        .map_err(CliError::failure)?;
+    }
+    if args.json {
+        let text = serde_json::to_string_pretty(&json_report(args, model.as_ref(), &frf, simulated))
+            .map_err(|e| CliError::failure(e.to_string()))?;
+        let _ = writeln!(std::io::stdout().lock(), "{text}");
+        return Ok(());
+    }
+    print_report(
+        &mut std::io::stdout().lock(),
+        args,
+        model.as_ref(),
+        &frf,
+        simulated,
+    );
+    Ok(())
+}
+
+/// The JSON of `frf` (and of the simulated points).
+fn json_report(
+    args: &FrfArgs,
+    model: &dyn ModelInfo,
+    frf: &FrfAnalysis,
+    simulated: Option<(&[SimulatedPoint], &FrfSimulationPlan)>,
+) -> Value {
     let name = model.name();
-    let (lo, hi) = frf.frequency_range;
     let FrfAnalysis {
         operating_point: point,
         outputs,
@@ -199,20 +232,9 @@ pub fn run(args: &FrfArgs) -> Result<(), CliError> {
         sweeps,
         evaluations,
         ..
-    } = &frf;
+    } = frf;
     let label = &point.name;
     let b: Vec<f64> = forced.input_matrix.column(0).iter().copied().collect();
-    if let Some(path) = &args.plot {
-        bode_chart(
-            path,
-            &format!("{name}: frequency response from {}", args.input),
-            outputs,
-            sweeps,
-            simulated.as_ref().map(|(s, _)| s.as_slice()),
-        )
-        .map_err(CliError::failure)?;
-    }
-    let n = model.num_dofs();
     let amp_phase = |z: Complex<f64>| json!({"re": z.re, "im": z.im, "amplitude": z.norm(), "phase_deg": phase_degrees(z)});
     let modal_json = |r: &ModalResponse, difference: Option<f64>| {
         json!({
@@ -228,61 +250,79 @@ pub fn run(args: &FrfArgs) -> Result<(), CliError> {
             "max_relative_difference_from_direct": difference,
         })
     };
-    if args.json {
-        let peak_json = |p: &eomgen::ResonancePeak| match p.amplitude {
-            PeakAmplitude::Finite(a) => {
-                json!({"frequency": p.frequency, "amplitude": a, "unbounded": false, "phase_deg": p.phase_deg})
-            }
-            PeakAmplitude::Unbounded => {
-                json!({"frequency": p.frequency, "amplitude": Value::Null, "unbounded": true, "phase_deg": Value::Null})
-            }
-        };
-        let out = json!({
-            "model": name,
-            "input": args.input,
-            "outputs": outputs.iter().map(|o| o.name.clone()).collect::<Vec<_>>(),
-            "operating_point": point_json(label, &model.coordinate_names(), &forced.equilibrium.q),
-            "input_matrix": b,
-            "natural_frequencies": modes.natural_frequencies,
-            "damping_ratios": damping.damping_ratios,
-            "modal_damping_coupling": damping.coupling,
-            "frequencies": frf.frequencies,
-            "responses": outputs.iter().zip(sweeps).map(|(o, s)| json!({
-                "output": o.name,
-                "amplitude": s.amplitudes(),
-                "phase_deg": s.phases_deg,
-                "peaks": s.peaks.iter().map(peak_json).collect::<Vec<_>>(),
+    let peak_json = |p: &eomgen::ResonancePeak| match p.amplitude {
+        PeakAmplitude::Finite(a) => {
+            json!({"frequency": p.frequency, "amplitude": a, "unbounded": false, "phase_deg": p.phase_deg})
+        }
+        PeakAmplitude::Unbounded => {
+            json!({"frequency": p.frequency, "amplitude": Value::Null, "unbounded": true, "phase_deg": Value::Null})
+        }
+    };
+    json!({
+        "model": name,
+        "input": args.input,
+        "outputs": outputs.iter().map(|o| o.name.clone()).collect::<Vec<_>>(),
+        "operating_point": point_json(label, &model.coordinate_names(), &forced.equilibrium.q),
+        "input_matrix": b,
+        "natural_frequencies": modes.natural_frequencies,
+        "damping_ratios": damping.damping_ratios,
+        "modal_damping_coupling": damping.coupling,
+        "frequencies": frf.frequencies,
+        "responses": outputs.iter().zip(sweeps).map(|(o, s)| json!({
+            "output": o.name,
+            "amplitude": s.amplitudes(),
+            "phase_deg": s.phases_deg,
+            "peaks": s.peaks.iter().map(peak_json).collect::<Vec<_>>(),
+        })).collect::<Vec<_>>(),
+        "evaluations": evaluations.iter().map(|e| json!({
+            "frequency": e.frequency,
+            "response": e.response.as_ref().map(|d| outputs.iter().map(|o| (o.name.clone(), amp_phase(d[o.index]))).collect::<serde_json::Map<_, _>>()),
+            "unbounded": e.response.is_none(),
+            "modal": e.modal.as_ref().map(|r| modal_json(r, e.modal_difference)),
+        })).collect::<Vec<_>>(),
+        "simulation": simulated.map(|(points, plan)| json!({
+            "amplitude": args.amplitude,
+            "frequency_parameter": plan.frequency_parameter,
+            "rtol": args.rtol,
+            "points": points.iter().map(|p| json!({
+                "frequency": p.frequency,
+                "settling_time": p.settling_time,
+                "steps": p.steps,
+                "rhs_evals": p.rhs_evals,
+                "outputs": outputs.iter().zip(&p.values).map(|(o, v)| (o.name.clone(), json!({
+                    "simulated": amp_phase(v.simulated),
+                    "predicted": amp_phase(v.predicted),
+                    "relative_error": v.relative_error(),
+                }))).collect::<serde_json::Map<_, _>>(),
             })).collect::<Vec<_>>(),
-            "evaluations": evaluations.iter().map(|e| json!({
-                "frequency": e.frequency,
-                "response": e.response.as_ref().map(|d| outputs.iter().map(|o| (o.name.clone(), amp_phase(d[o.index]))).collect::<serde_json::Map<_, _>>()),
-                "unbounded": e.response.is_none(),
-                "modal": e.modal.as_ref().map(|r| modal_json(r, e.modal_difference)),
-            })).collect::<Vec<_>>(),
-            "simulation": simulated.as_ref().map(|(points, plan)| json!({
-                "amplitude": args.amplitude,
-                "frequency_parameter": plan.frequency_parameter,
-                "rtol": args.rtol,
-                "points": points.iter().map(|p| json!({
-                    "frequency": p.frequency,
-                    "settling_time": p.settling_time,
-                    "steps": p.steps,
-                    "rhs_evals": p.rhs_evals,
-                    "outputs": outputs.iter().zip(&p.values).map(|(o, v)| (o.name.clone(), json!({
-                        "simulated": amp_phase(v.simulated),
-                        "predicted": amp_phase(v.predicted),
-                        "relative_error": v.relative_error(),
-                    }))).collect::<serde_json::Map<_, _>>(),
-                })).collect::<Vec<_>>(),
-                "max_relative_error": max_simulation_error(points),
-            })),
-        });
-        let text =
-            serde_json::to_string_pretty(&out).map_err(|e| CliError::failure(e.to_string()))?;
-        let _ = writeln!(std::io::stdout().lock(), "{text}");
-        return Ok(());
-    }
-    let mut out = std::io::stdout().lock();
+            "max_relative_error": max_simulation_error(points),
+        })),
+    })
+}
+
+/// The text of `frf` (and of the simulated points).
+fn print_report(
+    out: &mut impl std::io::Write,
+    args: &FrfArgs,
+    model: &dyn ModelInfo,
+    frf: &FrfAnalysis,
+    simulated: Option<(&[SimulatedPoint], &FrfSimulationPlan)>,
+) {
+    let name = model.name();
+    let (lo, hi) = frf.frequency_range;
+    let FrfAnalysis {
+        operating_point: point,
+        outputs,
+        forced,
+        normal_modes: modes,
+        modal_damping: damping,
+        sweeps,
+        evaluations,
+        ..
+    } = frf;
+    let label = &point.name;
+    let b: Vec<f64> = forced.input_matrix.column(0).iter().copied().collect();
+    let n = model.num_dofs();
     let _ = writeln!(out, "model      {name} ({n} dof), input {}", args.input);
     let point: Vec<String> = model
         .coordinate_names()
@@ -359,7 +399,7 @@ pub fn run(args: &FrfArgs) -> Result<(), CliError> {
         }
         if let Some(r) = &e.modal {
             write_modal(
-                &mut out,
+                out,
                 outputs,
                 &modes.natural_frequencies,
                 &damping.damping_ratios,
@@ -379,7 +419,7 @@ pub fn run(args: &FrfArgs) -> Result<(), CliError> {
             );
         }
     }
-    if let Some((points, plan)) = &simulated {
+    if let Some((points, plan)) = simulated {
         let _ = writeln!(
             out,
             "simulate   {} = {:e}, {} = ω, DOP853 rtol {:e}, from rest at the equilibrium to steady state",
@@ -413,7 +453,6 @@ pub fn run(args: &FrfArgs) -> Result<(), CliError> {
     if let Some(path) = &args.plot {
         let _ = writeln!(out, "chart      {path}");
     }
-    Ok(())
 }
 
 fn polar(z: Complex<f64>) -> String {
@@ -688,12 +727,33 @@ where
             .map_err(err)?;
     }
     let (_, _, p_lo, p_hi) = bounds(&phase, &[]);
+    draw_phase(&lower, (x0, x1), (p_lo, p_hi), &phase, outputs, sweeps, simulated)?;
+    root.present().map_err(err)?;
+    Ok(())
+}
+
+/// The Bode chart's lower panel: the phase in degrees over log ω (`phase` in segments, the
+/// simulated points as circles on the curve's branch).
+fn draw_phase<DB: DrawingBackend>(
+    lower: &DrawingArea<DB, plotters::coord::Shift>,
+    (x0, x1): (f64, f64),
+    (p_lo, p_hi): (f64, f64),
+    phase: &[Vec<Vec<(f64, f64)>>],
+    outputs: &[FrfOutput],
+    sweeps: &[FrequencySweep],
+    simulated: Option<&[SimulatedPoint]>,
+) -> Result<(), String>
+where
+    DB::ErrorType: 'static,
+{
+    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| format!("plotting failed: {e}");
+    let color = |i: usize| Palette99::pick(i).to_rgba();
     let (p0, p1) = if p_lo.is_finite() {
         plot::range(p_lo, p_hi, false)
     } else {
         (-190.0, 10.0)
     };
-    let mut chart = ChartBuilder::on(&lower)
+    let mut chart = ChartBuilder::on(lower)
         .margin(12)
         .x_label_area_size(45)
         .y_label_area_size(90)
@@ -747,6 +807,5 @@ where
                 .map_err(err)?;
         }
     }
-    root.present().map_err(err)?;
     Ok(())
 }
