@@ -191,7 +191,9 @@ impl FloquetReferences {
                     let lookup = |n: &str| if n == along { Some(s) } else { values(n) };
                     // Drawn where `where:` is ≥ 0; a NaN there is no point either.
                     if let Some(domain) = &c.domain
-                        && eval(domain, &lookup).partial_cmp(&0.0).is_none_or(|o| o.is_lt())
+                        && eval(domain, &lookup)
+                            .partial_cmp(&0.0)
+                            .is_none_or(|o| o.is_lt())
                     {
                         return None;
                     }

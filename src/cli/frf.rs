@@ -188,7 +188,9 @@ pub fn run(args: &FrfArgs) -> Result<(), CliError> {
         }
         _ => None,
     };
-    let simulated = simulated.as_ref().map(|(points, plan)| (points.as_slice(), plan));
+    let simulated = simulated
+        .as_ref()
+        .map(|(points, plan)| (points.as_slice(), plan));
     if let Some(path) = &args.plot {
         bode_chart(
             path,
@@ -200,8 +202,9 @@ pub fn run(args: &FrfArgs) -> Result<(), CliError> {
         .map_err(CliError::failure)?;
     }
     if args.json {
-        let text = serde_json::to_string_pretty(&json_report(args, model.as_ref(), &frf, simulated))
-            .map_err(|e| CliError::failure(e.to_string()))?;
+        let text =
+            serde_json::to_string_pretty(&json_report(args, model.as_ref(), &frf, simulated))
+                .map_err(|e| CliError::failure(e.to_string()))?;
         let _ = writeln!(std::io::stdout().lock(), "{text}");
         return Ok(());
     }
@@ -727,7 +730,15 @@ where
             .map_err(err)?;
     }
     let (_, _, p_lo, p_hi) = bounds(&phase, &[]);
-    draw_phase(&lower, (x0, x1), (p_lo, p_hi), &phase, outputs, sweeps, simulated)?;
+    draw_phase(
+        &lower,
+        (x0, x1),
+        (p_lo, p_hi),
+        &phase,
+        outputs,
+        sweeps,
+        simulated,
+    )?;
     root.present().map_err(err)?;
     Ok(())
 }

@@ -7,6 +7,7 @@
 use std::io::Write as _;
 
 use clap::Args;
+use eomgen::ModelInfo;
 use eomgen::vibration::{ModalDampingOptions, ModalDampingStudy, RayleighFit};
 use serde_json::json;
 
@@ -81,19 +82,12 @@ pub fn run(args: &ModalDampingArgs) -> Result<(), CliError> {
         .map_err(|e| study_failure(model.as_ref(), &e))?;
     let ModalDampingStudy {
         operating_point: point,
-        linearization: lin,
-        modal_damping: approx,
         rayleigh,
-        modes: per_mode,
-        t_end,
         releases: cases,
         ..
     } = &study;
     let label = &point.name;
-    let n = model.num_dofs();
     let names = model.coordinate_names();
-    let samples = cases.first().map_or(args.samples, |c| c.exact.times.len());
-
     if let Some(path) = &args.plot {
         let panel_list: Vec<Panel> = cases
             .iter()
@@ -132,48 +126,87 @@ pub fn run(args: &ModalDampingArgs) -> Result<(), CliError> {
 
     let mut stdout = std::io::stdout().lock();
     if args.json {
-        let out = json!({
-            "model": model.name(),
-            "coordinates": names,
-            "operating_point": point_json(label, &names, &lin.q),
-            "mass_matrix": matrix_rows(&lin.mass_matrix),
-            "stiffness_matrix": matrix_rows(&lin.stiffness_matrix),
-            "damping_matrix": matrix_rows(&lin.damping_matrix),
-            "modal_damping_matrix": matrix_rows(&approx.modal_damping_matrix),
-            "coupling": approx.coupling,
-            "rayleigh": rayleigh,
-            "modes": per_mode.iter().map(|m| json!({
-                "mode": m.mode,
-                "kind": kind_json(&m.kind),
-                "natural_frequency": m.natural_frequency,
-                "exact": m.exact.map(|d| json!({
-                    "re": d.eigenvalue.re,
-                    "im": d.eigenvalue.im,
-                    "damping_ratio": d.damping_ratio,
-                    "damped_frequency": d.damped_frequency,
-                })),
-                "diagonal": m.diagonal,
-                "rayleigh": m.rayleigh,
-            })).collect::<Vec<_>>(),
-            "t_end": t_end,
-            "samples": samples,
-            "tol": study.tol,
-            "cases": cases.iter().map(|c| json!({
-                "name": c.name,
-                "q0": c.q0,
-                "qdot0": c.qdot0,
-                "amplitude": c.amplitude,
-                "integration_vs_exact": c.integration_vs_exact,
-                "diagonal_vs_exact": c.diagonal_vs_exact,
-                "rayleigh_vs_exact": c.rayleigh_vs_exact,
-            })).collect::<Vec<_>>(),
-        });
-        let text =
-            serde_json::to_string_pretty(&out).map_err(|e| CliError::failure(e.to_string()))?;
+        let text = serde_json::to_string_pretty(&json_report(model.as_ref(), &study))
+            .map_err(|e| CliError::failure(e.to_string()))?;
         let _ = writeln!(stdout, "{text}");
         return Ok(());
     }
+    print_report(&mut stdout, model.as_ref(), &study);
+    Ok(())
+}
 
+/// The JSON of `study`.
+fn json_report(model: &dyn ModelInfo, study: &ModalDampingStudy) -> serde_json::Value {
+    let ModalDampingStudy {
+        operating_point: point,
+        linearization: lin,
+        modal_damping: approx,
+        rayleigh,
+        modes: per_mode,
+        t_end,
+        releases: cases,
+        ..
+    } = study;
+    let label = &point.name;
+    let names = model.coordinate_names();
+    let samples = cases.first().map_or(0, |c| c.exact.times.len());
+
+    json!({
+        "model": model.name(),
+        "coordinates": names,
+        "operating_point": point_json(label, &names, &lin.q),
+        "mass_matrix": matrix_rows(&lin.mass_matrix),
+        "stiffness_matrix": matrix_rows(&lin.stiffness_matrix),
+        "damping_matrix": matrix_rows(&lin.damping_matrix),
+        "modal_damping_matrix": matrix_rows(&approx.modal_damping_matrix),
+        "coupling": approx.coupling,
+        "rayleigh": rayleigh,
+        "modes": per_mode.iter().map(|m| json!({
+            "mode": m.mode,
+            "kind": kind_json(&m.kind),
+            "natural_frequency": m.natural_frequency,
+            "exact": m.exact.map(|d| json!({
+                "re": d.eigenvalue.re,
+                "im": d.eigenvalue.im,
+                "damping_ratio": d.damping_ratio,
+                "damped_frequency": d.damped_frequency,
+            })),
+            "diagonal": m.diagonal,
+            "rayleigh": m.rayleigh,
+        })).collect::<Vec<_>>(),
+        "t_end": t_end,
+        "samples": samples,
+        "tol": study.tol,
+        "cases": cases.iter().map(|c| json!({
+            "name": c.name,
+            "q0": c.q0,
+            "qdot0": c.qdot0,
+            "amplitude": c.amplitude,
+            "integration_vs_exact": c.integration_vs_exact,
+            "diagonal_vs_exact": c.diagonal_vs_exact,
+            "rayleigh_vs_exact": c.rayleigh_vs_exact,
+        })).collect::<Vec<_>>(),
+    })
+}
+
+/// The text of `study`.
+fn print_report(
+    stdout: &mut impl std::io::Write,
+    model: &dyn ModelInfo,
+    study: &ModalDampingStudy,
+) {
+    let ModalDampingStudy {
+        operating_point: point,
+        modal_damping: approx,
+        rayleigh,
+        modes: per_mode,
+        t_end,
+        releases: cases,
+        ..
+    } = study;
+    let label = &point.name;
+    let n = model.num_dofs();
+    let samples = cases.first().map_or(0, |c| c.exact.times.len());
     let _ = writeln!(
         stdout,
         "model      {} ({} dof) at {label}: M δq̈ + C δq̇ + K δq = 0",
@@ -267,5 +300,4 @@ pub fn run(args: &ModalDampingArgs) -> Result<(), CliError> {
                 .map_or("-".to_string(), |r| format!("{r:.2e}"))
         );
     }
-    Ok(())
 }
