@@ -13,9 +13,10 @@ use std::f64::consts::TAU;
 use std::io::Write as _;
 
 use clap::Args;
-use eomgen::vibration::{self, FloquetStudyError, FloquetStudyOptions, SweepAxis};
+use eomgen::vibration::{self, FloquetPoint, FloquetStudyError, FloquetStudyOptions, SweepAxis};
 use eomgen::{
     ChartAxis, FloquetAnalysis, FloquetOptions, FloquetReferences, FloquetStability, ModelInfo,
+    ThresholdPrediction,
 };
 use plotters::prelude::*;
 use rayon::prelude::*;
@@ -136,48 +137,96 @@ pub fn run(args: &FloquetArgs) -> Result<(), CliError> {
         .map_err(CliError::failure)?;
     }
 
-    let names = model.coordinate_names();
+    let report = Report {
+        args,
+        model: model.as_ref(),
+        label: &label,
+        point: &point,
+        thresholds: &thresholds,
+        sweep: match (&axes, &sweep) {
+            (Some((x, y)), Some(grid)) => Some((x, y, grid.as_slice())),
+            _ => None,
+        },
+    };
     let mut stdout = std::io::stdout().lock();
     if args.json {
-        let complex =
-            |c: &nalgebra::Complex<f64>| json!({"re": c.re, "im": c.im, "modulus": c.norm()});
-        let f = &point.floquet;
-        let monodromy = super::modes::matrix_rows(&f.monodromy_matrix);
-        let mut operating_point = point_json(&label, &names, &point.q);
-        operating_point["max_forcing_residual"] = json!(point.residual);
-        let mut out = json!({
-            "model": model.name(),
-            "coordinates": names,
-            "operating_point": operating_point,
-            "period_parameter": args.period_parameter,
-            "frequency": point.frequency,
-            "period": f.period,
-            "monodromy_matrix": monodromy,
-            "multipliers": f.multipliers.iter().map(complex).collect::<Vec<_>>(),
-            "exponents": f.exponents.iter().map(|c| json!({"re": c.re, "im": c.im})).collect::<Vec<_>>(),
-            "spectral_radius": f.spectral_radius,
-            "determinant": f.determinant,
-            "stability": f.stability.as_str(),
-            "stable": f.stability.is_stable(),
-            "stability_tolerance": args.stability_tolerance,
-            "closure_error": f.closure_error,
-            "integration": {"method": "dop853", "tol": args.tol, "steps": f.stats.steps, "rhs_evals": f.stats.rhs_evals},
-        });
-        for t in &thresholds {
-            let mut prediction = serde_json::Map::new();
-            prediction.insert(t.key.clone(), json!(t.value));
-            prediction.insert(format!("critical_{}", t.key), json!(t.critical));
-            prediction.insert(format!("predicts_stable_{label}"), json!(t.predicts_stable));
-            out[t.name.as_str()] = Value::Object(prediction);
-        }
-        if let (Some((x, y)), Some(grid)) = (&axes, &sweep) {
-            out["sweep"] = sweep_json(x, y, grid);
-        }
-        let text =
-            serde_json::to_string_pretty(&out).map_err(|e| CliError::failure(e.to_string()))?;
+        let text = serde_json::to_string_pretty(&json_report(&report))
+            .map_err(|e| CliError::failure(e.to_string()))?;
         let _ = writeln!(stdout, "{text}");
         return Ok(());
     }
+    print_report(&mut stdout, &report);
+    Ok(())
+}
+
+/// What `study floquet` prints.
+struct Report<'a> {
+    args: &'a FloquetArgs,
+    model: &'a dyn ModelInfo,
+    label: &'a str,
+    point: &'a FloquetPoint,
+    thresholds: &'a [ThresholdPrediction],
+    sweep: Option<(&'a Axis, &'a Axis, &'a [Vec<Cell>])>,
+}
+
+/// The JSON of `report`.
+fn json_report(report: &Report<'_>) -> Value {
+    let Report {
+        args,
+        model,
+        label,
+        point,
+        thresholds,
+        sweep,
+    } = *report;
+    let names = model.coordinate_names();
+    let complex = |c: &nalgebra::Complex<f64>| json!({"re": c.re, "im": c.im, "modulus": c.norm()});
+    let f = &point.floquet;
+    let monodromy = super::modes::matrix_rows(&f.monodromy_matrix);
+    let mut operating_point = point_json(label, &names, &point.q);
+    operating_point["max_forcing_residual"] = json!(point.residual);
+    let mut out = json!({
+        "model": model.name(),
+        "coordinates": names,
+        "operating_point": operating_point,
+        "period_parameter": args.period_parameter,
+        "frequency": point.frequency,
+        "period": f.period,
+        "monodromy_matrix": monodromy,
+        "multipliers": f.multipliers.iter().map(complex).collect::<Vec<_>>(),
+        "exponents": f.exponents.iter().map(|c| json!({"re": c.re, "im": c.im})).collect::<Vec<_>>(),
+        "spectral_radius": f.spectral_radius,
+        "determinant": f.determinant,
+        "stability": f.stability.as_str(),
+        "stable": f.stability.is_stable(),
+        "stability_tolerance": args.stability_tolerance,
+        "closure_error": f.closure_error,
+        "integration": {"method": "dop853", "tol": args.tol, "steps": f.stats.steps, "rhs_evals": f.stats.rhs_evals},
+    });
+    for t in thresholds {
+        let mut prediction = serde_json::Map::new();
+        prediction.insert(t.key.clone(), json!(t.value));
+        prediction.insert(format!("critical_{}", t.key), json!(t.critical));
+        prediction.insert(format!("predicts_stable_{label}"), json!(t.predicts_stable));
+        out[t.name.as_str()] = Value::Object(prediction);
+    }
+    if let Some((x, y, grid)) = sweep {
+        out["sweep"] = sweep_json(x, y, grid);
+    }
+    out
+}
+
+/// The text of `report`.
+fn print_report(stdout: &mut impl std::io::Write, report: &Report<'_>) {
+    let Report {
+        args,
+        model,
+        label,
+        point,
+        thresholds,
+        sweep,
+    } = *report;
+    let names = model.coordinate_names();
     let f = &point.floquet;
     let q: Vec<String> = names
         .iter()
@@ -232,7 +281,7 @@ pub fn run(args: &FloquetArgs) -> Result<(), CliError> {
         f.stability.as_str().replace('_', " "),
         args.stability_tolerance
     );
-    for t in &thresholds {
+    for t in thresholds {
         let _ = writeln!(
             stdout,
             "{:<12} {} = {:.6e} against {} = {:.6e}: {} predicts {label} {} ({})",
@@ -250,10 +299,9 @@ pub fn run(args: &FloquetArgs) -> Result<(), CliError> {
             t.note
         );
     }
-    if let (Some((x, y)), Some(grid)) = (&axes, &sweep) {
-        print_map(&mut stdout, x, y, grid);
+    if let Some((x, y, grid)) = sweep {
+        print_map(stdout, x, y, grid);
     }
-    Ok(())
 }
 
 /// One grid cell's outcome: `(spectral radius, stability)` or the failure.
