@@ -171,14 +171,7 @@ struct Report<'a> {
 
 /// The JSON of `report`.
 fn json_report(report: &Report<'_>) -> Value {
-    let Report {
-        args,
-        model,
-        label,
-        point,
-        thresholds,
-        sweep,
-    } = *report;
+    let (args, model, label, point) = (report.args, report.model, report.label, report.point);
     let names = model.coordinate_names();
     let complex = |c: &nalgebra::Complex<f64>| json!({"re": c.re, "im": c.im, "modulus": c.norm()});
     let f = &point.floquet;
@@ -203,14 +196,14 @@ fn json_report(report: &Report<'_>) -> Value {
         "closure_error": f.closure_error,
         "integration": {"method": "dop853", "tol": args.tol, "steps": f.stats.steps, "rhs_evals": f.stats.rhs_evals},
     });
-    for t in thresholds {
+    for t in report.thresholds {
         let mut prediction = serde_json::Map::new();
         prediction.insert(t.key.clone(), json!(t.value));
         prediction.insert(format!("critical_{}", t.key), json!(t.critical));
         prediction.insert(format!("predicts_stable_{label}"), json!(t.predicts_stable));
         out[t.name.as_str()] = Value::Object(prediction);
     }
-    if let Some((x, y, grid)) = sweep {
+    if let Some((x, y, grid)) = report.sweep {
         out["sweep"] = sweep_json(x, y, grid);
     }
     out

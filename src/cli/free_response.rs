@@ -53,11 +53,15 @@ pub struct FreeResponseArgs {
     pub plot: Option<String>,
 }
 
-/// Parses `--init NAME=VALUE,…` into `(δq₀, δq̇₀)`, starting from zeros.
+/// Parses `--init NAME=VALUE,…` into `(δq₀, δq̇₀)`, starting from zeros (`None` without
+/// `--init`: the study's default).
 pub(super) fn parse_init(
     model: &dyn ModelInfo,
     init: &[String],
-) -> Result<InitialDeviation, CliError> {
+) -> Result<Option<InitialDeviation>, CliError> {
+    if init.is_empty() {
+        return Ok(None);
+    }
     let n = model.num_dofs();
     let coordinates = model.coordinate_names();
     let lookup = parameter_lookup(model);
@@ -82,7 +86,7 @@ pub(super) fn parse_init(
             )));
         }
     }
-    Ok(InitialDeviation { q: q0, qdot: v0 })
+    Ok(Some(InitialDeviation { q: q0, qdot: v0 }))
 }
 
 /// The error of a failed free-response or modal-damping study of `model`, in the words of
@@ -246,11 +250,7 @@ pub fn run(args: &FreeResponseArgs) -> Result<(), CliError> {
     let model = args.point.model(&args.model)?;
     let options = FreeResponseOptions {
         operating_point: args.point.options(model.as_ref())?,
-        initial: if args.init.is_empty() {
-            None
-        } else {
-            Some(parse_init(model.as_ref(), &args.init)?)
-        },
+        initial: parse_init(model.as_ref(), &args.init)?,
         t_end: args.t_end,
         samples: args.samples,
         tol: args.tol,

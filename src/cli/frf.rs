@@ -226,17 +226,8 @@ fn json_report(
     simulated: Option<(&[SimulatedPoint], &FrfSimulationPlan)>,
 ) -> Value {
     let name = model.name();
-    let FrfAnalysis {
-        operating_point: point,
-        outputs,
-        forced,
-        normal_modes: modes,
-        modal_damping: damping,
-        sweeps,
-        evaluations,
-        ..
-    } = frf;
-    let label = &point.name;
+    let (outputs, forced) = (&frf.outputs, &frf.forced);
+    let (modes, damping) = (&frf.normal_modes, &frf.modal_damping);
     let b: Vec<f64> = forced.input_matrix.column(0).iter().copied().collect();
     let amp_phase = |z: Complex<f64>| json!({"re": z.re, "im": z.im, "amplitude": z.norm(), "phase_deg": phase_degrees(z)});
     let modal_json = |r: &ModalResponse, difference: Option<f64>| {
@@ -265,19 +256,19 @@ fn json_report(
         "model": name,
         "input": args.input,
         "outputs": outputs.iter().map(|o| o.name.clone()).collect::<Vec<_>>(),
-        "operating_point": point_json(label, &model.coordinate_names(), &forced.equilibrium.q),
+        "operating_point": point_json(&frf.operating_point.name, &model.coordinate_names(), &forced.equilibrium.q),
         "input_matrix": b,
         "natural_frequencies": modes.natural_frequencies,
         "damping_ratios": damping.damping_ratios,
         "modal_damping_coupling": damping.coupling,
         "frequencies": frf.frequencies,
-        "responses": outputs.iter().zip(sweeps).map(|(o, s)| json!({
+        "responses": outputs.iter().zip(&frf.sweeps).map(|(o, s)| json!({
             "output": o.name,
             "amplitude": s.amplitudes(),
             "phase_deg": s.phases_deg,
             "peaks": s.peaks.iter().map(peak_json).collect::<Vec<_>>(),
         })).collect::<Vec<_>>(),
-        "evaluations": evaluations.iter().map(|e| json!({
+        "evaluations": frf.evaluations.iter().map(|e| json!({
             "frequency": e.frequency,
             "response": e.response.as_ref().map(|d| outputs.iter().map(|o| (o.name.clone(), amp_phase(d[o.index]))).collect::<serde_json::Map<_, _>>()),
             "unbounded": e.response.is_none(),

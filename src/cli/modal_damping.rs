@@ -69,11 +69,7 @@ pub fn run(args: &ModalDampingArgs) -> Result<(), CliError> {
     let options = ModalDampingOptions {
         operating_point: args.point.options(model.as_ref())?,
         rayleigh_modes,
-        initial: if args.init.is_empty() {
-            None
-        } else {
-            Some(parse_init(model.as_ref(), &args.init)?)
-        },
+        initial: parse_init(model.as_ref(), &args.init)?,
         t_end: args.t_end,
         samples: args.samples,
         tol: args.tol,
@@ -137,31 +133,21 @@ pub fn run(args: &ModalDampingArgs) -> Result<(), CliError> {
 
 /// The JSON of `study`.
 fn json_report(model: &dyn ModelInfo, study: &ModalDampingStudy) -> serde_json::Value {
-    let ModalDampingStudy {
-        operating_point: point,
-        linearization: lin,
-        modal_damping: approx,
-        rayleigh,
-        modes: per_mode,
-        t_end,
-        releases: cases,
-        ..
-    } = study;
-    let label = &point.name;
+    let (lin, approx, cases) = (&study.linearization, &study.modal_damping, &study.releases);
     let names = model.coordinate_names();
     let samples = cases.first().map_or(0, |c| c.exact.times.len());
 
     json!({
         "model": model.name(),
         "coordinates": names,
-        "operating_point": point_json(label, &names, &lin.q),
+        "operating_point": point_json(&study.operating_point.name, &names, &lin.q),
         "mass_matrix": matrix_rows(&lin.mass_matrix),
         "stiffness_matrix": matrix_rows(&lin.stiffness_matrix),
         "damping_matrix": matrix_rows(&lin.damping_matrix),
         "modal_damping_matrix": matrix_rows(&approx.modal_damping_matrix),
         "coupling": approx.coupling,
-        "rayleigh": rayleigh,
-        "modes": per_mode.iter().map(|m| json!({
+        "rayleigh": study.rayleigh,
+        "modes": study.modes.iter().map(|m| json!({
             "mode": m.mode,
             "kind": kind_json(&m.kind),
             "natural_frequency": m.natural_frequency,
@@ -174,7 +160,7 @@ fn json_report(model: &dyn ModelInfo, study: &ModalDampingStudy) -> serde_json::
             "diagonal": m.diagonal,
             "rayleigh": m.rayleigh,
         })).collect::<Vec<_>>(),
-        "t_end": t_end,
+        "t_end": study.t_end,
         "samples": samples,
         "tol": study.tol,
         "cases": cases.iter().map(|c| json!({
