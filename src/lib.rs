@@ -40,6 +40,14 @@ pub use nalgebra;
 #[cfg(feature = "jit")]
 mod source;
 
+#[cfg(feature = "jit")]
+pub use floquet_references::{
+    ChartAxis, FloquetReferences, ReferenceCurvePoints, ReferenceError, ThresholdPrediction,
+};
+
+#[cfg(feature = "jit")]
+mod floquet_references;
+
 /// The README's Rust examples, compiled and run by `cargo test --doc`.
 #[cfg(all(doctest, feature = "jit"))]
 #[doc = include_str!("../README.md")]

@@ -15,6 +15,7 @@ pub mod modal;
 pub mod ode;
 pub mod response;
 pub mod system;
+pub mod vibration;
 
 pub use constrained::{
     ConstraintFunctions, ConstraintWorkspace, ProjectionError, Stabilization, StaticSystem,

@@ -42,6 +42,7 @@ pub const TOP_LEVEL_KEYS: &[&str] = &[
     "nonholonomic",
     "events",
     "equilibria",
+    "floquet",
 ];
 
 /// Keys of the model format (DESIGN.md) that this version does not implement yet.
@@ -759,6 +760,10 @@ impl Ctx<'_> {
         let equilibria = get(top, "equilibria")
             .map(|n| self.equilibria(n))
             .unwrap_or_default();
+        self.section = "floquet";
+        let floquet = get(top, "floquet")
+            .map(|n| self.floquet(n))
+            .unwrap_or_default();
         self.section = "";
 
         let dimension = points.first().map(|p: &Point| p.position.len());
@@ -789,7 +794,186 @@ impl Ctx<'_> {
             initial_guesses,
             events,
             equilibria,
+            floquet,
         })
+    }
+
+    /// `floquet:` — `equilibrium: { axis_units: { p: unit }, thresholds: { name: { … } },
+    /// curves: { name: { … } } }`.
+    fn floquet(&mut self, node: &YamlNode) -> Vec<FloquetReference> {
+        const EXAMPLE: &str = "{ axis_units: { a: m }, curves: { kapitza: { label: Kapitza, color: [0, 0, 0], along: a, gives: w, value: sqrt(2*g*l)/a } } }";
+        let Some(entries) = self.map(
+            node,
+            "`floquet`",
+            &format!("floquet: {{ upright: {EXAMPLE} }}"),
+        ) else {
+            return Vec::new();
+        };
+        let mut out = Vec::new();
+        for (k, v) in entries {
+            if !self.key_name(k, "equilibrium") {
+                continue;
+            }
+            let Some(f) = self.fields(
+                k,
+                v,
+                "the Floquet references at",
+                &["axis_units", "thresholds", "curves"],
+                &[],
+                EXAMPLE,
+            ) else {
+                continue;
+            };
+            let axis_units = get(f, "axis_units")
+                .and_then(|n| self.map(n, "`axis_units`", "axis_units: { a: m, w: rad/s }"))
+                .map(|units| {
+                    units
+                        .iter()
+                        .filter_map(|(p, u)| {
+                            let u = self.text(u, &format!("the unit of `{}`", p.value), "m")?;
+                            Some((p.clone(), u))
+                        })
+                        .collect()
+                })
+                .unwrap_or_default();
+            let thresholds = get(f, "thresholds")
+                .map(|n| self.floquet_thresholds(n))
+                .unwrap_or_default();
+            let curves = get(f, "curves")
+                .map(|n| self.reference_curves(n))
+                .unwrap_or_default();
+            out.push(FloquetReference {
+                at: k.clone(),
+                axis_units,
+                thresholds,
+                curves,
+            });
+        }
+        out
+    }
+
+    /// `thresholds:` of a `floquet:` entry.
+    fn floquet_thresholds(&mut self, node: &YamlNode) -> Vec<FloquetThreshold> {
+        const EXAMPLE: &str = "{ key: a_w, label: a w, value: a*w, critical: sqrt(2*g*l), critical_label: √(2 g l), by: averaging, note: for a ≪ l }";
+        let Some(entries) = self.map(
+            node,
+            "`thresholds`",
+            &format!("thresholds: {{ kapitza: {EXAMPLE} }}"),
+        ) else {
+            return Vec::new();
+        };
+        let keys = [
+            "key",
+            "label",
+            "value",
+            "critical",
+            "critical_label",
+            "by",
+            "note",
+        ];
+        let mut out = Vec::new();
+        for (k, v) in entries {
+            if !self.key_name(k, "threshold") {
+                continue;
+            }
+            let Some(f) = self.fields(k, v, "threshold", &keys, &keys, EXAMPLE) else {
+                continue;
+            };
+            let what = |field: &str| format!("`{field}` of threshold `{}`", k.value);
+            let key = get(f, "key").and_then(|n| self.name(n, &what("key")));
+            let mut texts = ["label", "critical_label", "by", "note"]
+                .map(|field| get(f, field).and_then(|n| self.text(n, &what(field), "a w")));
+            let value = get(f, "value").and_then(|n| self.expr(n, &what("value")));
+            let critical = get(f, "critical").and_then(|n| self.expr(n, &what("critical")));
+            let [Some(label), Some(critical_label), Some(by), Some(note)] =
+                texts.each_mut().map(Option::take)
+            else {
+                continue;
+            };
+            let (Some(key), Some(value), Some(critical)) = (key, value, critical) else {
+                continue;
+            };
+            out.push(FloquetThreshold {
+                name: k.clone(),
+                key,
+                label: label.value,
+                value,
+                critical,
+                critical_label: critical_label.value,
+                by: by.value,
+                note: note.value,
+            });
+        }
+        out
+    }
+
+    /// `curves:` of a `floquet:` entry.
+    fn reference_curves(&mut self, node: &YamlNode) -> Vec<ReferenceCurve> {
+        const EXAMPLE: &str =
+            "{ label: Kapitza, color: [0, 0, 0], along: a, gives: w, value: sqrt(2*g*l)/a }";
+        let Some(entries) = self.map(
+            node,
+            "`curves`",
+            &format!("curves: {{ kapitza: {EXAMPLE} }}"),
+        ) else {
+            return Vec::new();
+        };
+        let mut out = Vec::new();
+        for (k, v) in entries {
+            if !self.key_name(k, "curve") {
+                continue;
+            }
+            let Some(f) = self.fields(
+                k,
+                v,
+                "curve",
+                &["label", "color", "along", "gives", "value", "where"],
+                &["label", "color", "along", "gives", "value"],
+                EXAMPLE,
+            ) else {
+                continue;
+            };
+            let what = |field: &str| format!("`{field}` of curve `{}`", k.value);
+            let label = get(f, "label").and_then(|n| self.text(n, &what("label"), "Kapitza"));
+            let color = get(f, "color").and_then(|n| {
+                let items = self.seq(n, &what("color"), "color: [0, 150, 60]")?;
+                if items.len() != 3 {
+                    self.error(
+                        Diagnostic::new(
+                            n.location,
+                            format!("{} has {} entries, not 3", what("color"), items.len()),
+                        )
+                        .with_help(
+                            "write red, green and blue from 0 to 255: `color: [0, 150, 60]`",
+                        ),
+                    );
+                    return None;
+                }
+                items
+                    .iter()
+                    .map(|c| self.expr(c, &what("color")))
+                    .collect::<Option<Vec<Expr>>>()
+            });
+            let along = get(f, "along").and_then(|n| self.name(n, &what("along")));
+            let gives = get(f, "gives").and_then(|n| self.name(n, &what("gives")));
+            let value = get(f, "value").and_then(|n| self.expr(n, &what("value")));
+            let domain = get(f, "where").and_then(|n| self.expr(n, &what("where")));
+            let (Some(label), Some(color), Some(along), Some(gives), Some(value)) =
+                (label, color, along, gives, value)
+            else {
+                continue;
+            };
+            out.push(ReferenceCurve {
+                name: k.clone(),
+                label: label.value,
+                color,
+                along,
+                gives,
+                value,
+                domain,
+            });
+        }
+        out
     }
 
     /// `equilibria:` — `name: { coordinate: value, … }`.
