@@ -3,11 +3,11 @@
 //! the CLI (`eomgen modes`, `frf`, `study free-response`, `modal-damping`, `floquet`), a Rust
 //! program and the Python bindings reach the same code.
 //!
-//! - [`operating_point`]: the equilibrium an analysis linearises about, from a name in the
+//! - [`operating_point()`]: the equilibrium an analysis linearises about, from a name in the
 //!   model file's `equilibria:` or an explicit guess (Newton on `F(q, 0, t) = 0`).
 //! - [`modal_analysis`]: the exact linearisation `M δq̈ + C δq̇ + K δq = 0` there, natural
 //!   frequencies, mass-normalised mode shapes, damping ratios (`eomgen modes`).
-//! - [`free_response`]: the undamped free response four ways and their differences (HW28).
+//! - [`free_response()`]: the undamped free response four ways and their differences (HW28).
 //! - [`modal_damping_study`]: damping ratios exact, by the diagonal of `ΨᵀCΨ` and by a
 //!   Rayleigh fit, and the damped responses from each mode shape (HW34).
 //! - [`frequency_response_analysis`]: `H(ω)` from one input over a sweep, its peaks, its modal
