@@ -386,6 +386,9 @@ fn sweep_json(x: &Axis, y: &Axis, grid: &[Vec<Cell>]) -> Value {
     })
 }
 
+/// The widest sweep whose map is printed as text, one character per point.
+const MAP_COLUMNS: usize = 120;
+
 /// The sweep as characters, y descending: `·` stable, `#` unstable, `?` failed.
 fn print_map(out: &mut impl std::io::Write, x: &Axis, y: &Axis, grid: &[Vec<Cell>]) {
     let stable = grid
@@ -394,17 +397,21 @@ fn print_map(out: &mut impl std::io::Write, x: &Axis, y: &Axis, grid: &[Vec<Cell
         .filter(|c| matches!(c, Ok((_, s)) if s.is_stable()))
         .count();
     let failed = grid.iter().flatten().filter(|c| c.is_err()).count();
+    let (columns, rows) = (x.values.len(), y.values.len());
+    if columns > MAP_COLUMNS {
+        // Too wide for a terminal: the counts only (the chart of `--plot` has the map).
+        let _ = writeln!(
+            out,
+            "sweep        {columns} × {rows} points: {stable} stable, {failed} failed (the map is printed for at most {MAP_COLUMNS} points across)"
+        );
+        return;
+    }
     let _ = writeln!(
         out,
-        "sweep        {} × {} points: {stable} stable, {failed} failed ('·' stable, '#' unstable, '?' failed; {} across, {} up)",
-        x.values.len(),
-        y.values.len(),
+        "sweep        {columns} × {rows} points: {stable} stable, {failed} failed ('·' stable, '#' unstable, '?' failed; {} across, {} up)",
         x.name,
         y.name
     );
-    if x.values.len() > 120 {
-        return;
-    }
     for j in (0..y.values.len()).rev() {
         let row: String = grid
             .iter()
