@@ -100,7 +100,7 @@ pub fn run(args: &AnimateArgs) -> Result<(), CliError> {
 }
 
 fn write(path: &str, text: &str) -> Result<(), CliError> {
-    std::fs::write(path, text).map_err(|e| CliError::failure(format!("cannot write `{path}`: {e}")))
+    super::render::write_file(path, text).map_err(CliError::failure)
 }
 
 /// What every frame draws: the points used, the segments between them, the points marked
@@ -868,14 +868,10 @@ const DATA = {data};
             .round()
             .clamp(2.0, 6000.0) as u16;
         let palette = Palette::new();
-        let file = std::fs::File::create(path).map_err(|e| fail(e.to_string()))?;
-        let mut encoder = gif::Encoder::new(
-            std::io::BufWriter::new(file),
-            width as u16,
-            height as u16,
-            &palette.rgb,
-        )
-        .map_err(|e| fail(e.to_string()))?;
+        // Encoded in memory (at most GIF_MAX_FRAMES frames of a small picture) and written
+        // atomically.
+        let mut encoder = gif::Encoder::new(Vec::new(), width as u16, height as u16, &palette.rgb)
+            .map_err(|e| fail(e.to_string()))?;
         encoder
             .set_repeat(gif::Repeat::Infinite)
             .map_err(|e| fail(e.to_string()))?;
@@ -963,8 +959,8 @@ const DATA = {data};
             previous = indices;
             k += step;
         }
-        encoder.into_inner().map_err(|e| fail(e.to_string()))?;
-        Ok(())
+        let bytes = encoder.into_inner().map_err(|e| fail(e.to_string()))?;
+        super::render::write_file(path, bytes).map_err(CliError::failure)
     }
 }
 

@@ -409,8 +409,7 @@ fn print_map(out: &mut impl std::io::Write, x: &Axis, y: &Axis, grid: &[Vec<Cell
     let _ = writeln!(
         out,
         "sweep        {columns} × {rows} points: {stable} stable, {failed} failed ('·' stable, '#' unstable, '?' failed; {} across, {} up)",
-        x.name,
-        y.name
+        x.name, y.name
     );
     for j in (0..y.values.len()).rev() {
         let row: String = grid
@@ -485,11 +484,15 @@ fn stability_chart(
     register_font()?;
     let size = (960, 720);
     if path.ends_with(".svg") {
-        let root = SVGBackend::new(path, size).into_drawing_area();
-        draw_stability(root, title, axes, labels, grid, references)
+        super::render::atomically(path, |file| {
+            let root = SVGBackend::new(file, size).into_drawing_area();
+            draw_stability(root, title, axes, labels, grid, references)
+        })
     } else if path.ends_with(".png") {
-        let root = BitMapBackend::new(path, size).into_drawing_area();
-        draw_stability(root, title, axes, labels, grid, references)
+        super::render::atomically(path, |file| {
+            let root = BitMapBackend::new(file, size).into_drawing_area();
+            draw_stability(root, title, axes, labels, grid, references)
+        })
     } else {
         Err(format!("`{path}`: a chart file must end in .svg or .png"))
     }
@@ -674,11 +677,21 @@ fn multiplier_chart(path: &str, title: &str, floquet: &FloquetAnalysis) -> Resul
     register_font()?;
     let size = (720, 720);
     if path.ends_with(".svg") {
-        let root = SVGBackend::new(path, size).into_drawing_area();
-        draw_multipliers(root, title, floquet)
+        super::render::atomically(path, |file| {
+            draw_multipliers(
+                SVGBackend::new(file, size).into_drawing_area(),
+                title,
+                floquet,
+            )
+        })
     } else if path.ends_with(".png") {
-        let root = BitMapBackend::new(path, size).into_drawing_area();
-        draw_multipliers(root, title, floquet)
+        super::render::atomically(path, |file| {
+            draw_multipliers(
+                BitMapBackend::new(file, size).into_drawing_area(),
+                title,
+                floquet,
+            )
+        })
     } else {
         Err(format!("`{path}`: a chart file must end in .svg or .png"))
     }

@@ -144,17 +144,21 @@ pub(super) fn panels(path: &str, title: &str, panels: &[Panel]) -> Result<(), St
     plot::register_font()?;
     let size = (960, 60 + 260 * panels.len().max(1) as u32);
     if path.ends_with(".svg") {
-        draw_panels(
-            SVGBackend::new(path, size).into_drawing_area(),
-            title,
-            panels,
-        )
+        super::render::atomically(path, |file| {
+            draw_panels(
+                SVGBackend::new(file, size).into_drawing_area(),
+                title,
+                panels,
+            )
+        })
     } else if path.ends_with(".png") {
-        draw_panels(
-            BitMapBackend::new(path, size).into_drawing_area(),
-            title,
-            panels,
-        )
+        super::render::atomically(path, |file| {
+            draw_panels(
+                BitMapBackend::new(file, size).into_drawing_area(),
+                title,
+                panels,
+            )
+        })
     } else {
         Err(format!("`{path}`: a chart file must end in .svg or .png"))
     }

@@ -558,11 +558,15 @@ fn bode_chart(
     plot::register_font()?;
     let size = (960, 720);
     if path.ends_with(".svg") {
-        let root = SVGBackend::new(path, size).into_drawing_area();
-        draw_bode(root, title, outputs, sweeps, simulated)
+        super::render::atomically(path, |file| {
+            let root = SVGBackend::new(file, size).into_drawing_area();
+            draw_bode(root, title, outputs, sweeps, simulated)
+        })
     } else if path.ends_with(".png") {
-        let root = BitMapBackend::new(path, size).into_drawing_area();
-        draw_bode(root, title, outputs, sweeps, simulated)
+        super::render::atomically(path, |file| {
+            let root = BitMapBackend::new(file, size).into_drawing_area();
+            draw_bode(root, title, outputs, sweeps, simulated)
+        })
     } else {
         Err(format!("`{path}`: a chart file must end in .svg or .png"))
     }

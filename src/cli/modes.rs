@@ -118,8 +118,7 @@ pub fn run(args: &ModesArgs) -> Result<(), CliError> {
     };
     if let Some(path) = &args.animate {
         let page = super::animate::modes(model.as_ref(), &equilibrium.q, modes, &shapes_q)?;
-        std::fs::write(path, page.to_html())
-            .map_err(|e| CliError::failure(format!("cannot write `{path}`: {e}")))?;
+        super::render::write_file(path, page.to_html()).map_err(CliError::failure)?;
     }
     let mut stdout = std::io::stdout().lock();
     if args.json {
