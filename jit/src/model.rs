@@ -392,11 +392,17 @@ impl JitModel {
     ) -> Result<JitModel, LoadError> {
         let path = path.as_ref();
         let display = path.display().to_string();
-        let source = std::fs::read_to_string(path).map_err(|source| LoadError::Read {
+        let bytes = std::fs::read(path).map_err(|source| LoadError::Read {
             path: display.clone(),
             source,
         })?;
-        Self::from_source_with(&display, &source, options)
+        let source =
+            eomgen_symbolic::model::decode(&bytes).map_err(|d| LoadError::Diagnostics {
+                path: display.clone(),
+                text: String::from_utf8_lossy(&bytes).into_owned(),
+                diagnostics: vec![d],
+            })?;
+        Self::from_source_with(&display, source, options)
     }
 
     /// Builds the model of a file's text; `path` names the file in diagnostics.

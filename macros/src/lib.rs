@@ -129,7 +129,7 @@ fn expand(input: proc_macro2::TokenStream) -> Result<proc_macro2::TokenStream, F
                 .map(|r| r.display().to_string())
         })
         .unwrap_or_else(|| literal_path.clone());
-    let source = std::fs::read_to_string(&path).map_err(|e| {
+    let bytes = std::fs::read(&path).map_err(|e| {
         syn::Error::new(
             literal.span(),
             format!(
@@ -138,6 +138,14 @@ fn expand(input: proc_macro2::TokenStream) -> Result<proc_macro2::TokenStream, F
             ),
         )
     })?;
+    let source = eomgen_symbolic::model::decode(&bytes)
+        .map_err(|d| {
+            syn::Error::new(
+                literal.span(),
+                d.render(&written, &String::from_utf8_lossy(&bytes)),
+            )
+        })?
+        .to_string();
     let errors = |diagnostics: Vec<eomgen_symbolic::model::Diagnostic>| {
         let mut all: Option<syn::Error> = None;
         for d in diagnostics {

@@ -52,8 +52,11 @@ pub fn read_model(model: &str) -> Result<(String, String), CliError> {
             entry.path.to_string(),
         ),
     };
-    let source = std::fs::read_to_string(&path)
+    let bytes = std::fs::read(&path)
         .map_err(|e| CliError::usage(format!("cannot read `{display}`: {e}")).before_output())?;
+    let source = eomgen_symbolic::model::decode(&bytes)
+        .map_err(|d| super::diagnostics_error(&display, &String::from_utf8_lossy(&bytes), &[d]))?
+        .to_string();
     Ok((display, source))
 }
 

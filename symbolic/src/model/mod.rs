@@ -22,6 +22,7 @@ pub use ast::{BinOp, Expr, ExprKind};
 pub use diagnostic::{Diagnostic, Diagnostics};
 pub use file::*;
 pub use located::{Located, Location};
+pub use yaml::decode;
 
 /// Reads a model file: YAML → typed model → checks, reporting every problem at once.
 ///

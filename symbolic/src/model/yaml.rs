@@ -112,7 +112,8 @@ pub fn parse_partial(source: &str) -> (Option<YamlNode>, Vec<Diagnostic>) {
                             "close it with `{close}` before this point; inside `{open}…{close}`, items are separated by `,`"
                         ))
                     }
-                    None => syntax_error(at, e.info()),
+                    None => character_error(source, at, e.info())
+                        .unwrap_or_else(|| syntax_error(at, e.info())),
                 };
                 return (None, vec![d]);
             }
@@ -135,6 +136,86 @@ pub fn parse_partial(source: &str) -> (Option<YamlNode>, Vec<Diagnostic>) {
 fn empty_file() -> Diagnostic {
     Diagnostic::new(Location { line: 1, column: 1 }, "the model file is empty")
         .with_help("start with `name: my_model` and `coordinates: [q]`")
+}
+
+/// A syntax error about one character, located at that character: a control character
+/// (such as NUL), which the parser calls "unprintable" at the end of the value it was
+/// scanning, and a tab, which it may report at the end of the line before the one that
+/// starts with it. `None` for other errors.
+fn character_error(source: &str, at: Location, info: &str) -> Option<Diagnostic> {
+    let (what, help, found): (String, &str, fn(char) -> bool) = if info.contains("unprintable") {
+        (
+            "a control character is not allowed in a model file".to_string(),
+            "model files are plain text: remove it (it may come from a copy and paste or a binary file)",
+            |c| c.is_control() && !matches!(c, '\t' | '\n' | '\r'),
+        )
+    } else if info.contains("tab") {
+        (
+            "a tab is used for indentation".to_string(),
+            "indent with spaces",
+            |c| c == '\t',
+        )
+    } else {
+        return None;
+    };
+    // The first such character at or after the reported position.
+    let (line, column) = source
+        .lines()
+        .enumerate()
+        .skip(at.line.saturating_sub(1) as usize)
+        .find_map(|(i, text)| {
+            let from = if i + 1 == at.line as usize {
+                at.column.saturating_sub(1) as usize
+            } else {
+                0
+            };
+            text.chars()
+                .enumerate()
+                .skip(from)
+                .find(|(_, c)| found(*c))
+                .map(|(j, _)| (i as u32 + 1, j as u32 + 1))
+        })?;
+    let c = source
+        .lines()
+        .nth(line as usize - 1)?
+        .chars()
+        .nth(column as usize - 1)?;
+    let what = if c == '\t' {
+        what
+    } else {
+        format!("{what} (U+{:04X})", c as u32)
+    };
+    Some(
+        Diagnostic::new(
+            Location { line, column },
+            format!("YAML syntax error: {what}"),
+        )
+        .with_help(help),
+    )
+}
+
+/// The text of a model file from its bytes, or a located error at the first byte that is not
+/// UTF-8 (with the line and column of the text before it).
+///
+/// # Errors
+/// The diagnostic at the first invalid byte.
+pub fn decode(bytes: &[u8]) -> Result<&str, Diagnostic> {
+    std::str::from_utf8(bytes).map_err(|e| {
+        let valid = &bytes[..e.valid_up_to()];
+        // Valid UTF-8 up to here, so this cannot fail.
+        let before = std::str::from_utf8(valid).unwrap_or_default();
+        let line = before.matches('\n').count() as u32 + 1;
+        let column = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) as u32 + 1;
+        Diagnostic::new(
+            Location { line, column },
+            format!(
+                "the file is not UTF-8 text: byte 0x{:02X} (byte {} of the file) starts no character",
+                bytes[e.valid_up_to()],
+                e.valid_up_to() + 1
+            ),
+        )
+        .with_help("save the file as UTF-8 (model files are plain text)")
+    })
 }
 
 /// A syntax error in the words of a model-file author, keeping the parser's own words at the
