@@ -20,7 +20,7 @@ use std::io::IsTerminal as _;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use clap::{Args, ValueEnum};
+use clap::Args;
 use rayon::prelude::*;
 use serde_json::json;
 
@@ -298,7 +298,7 @@ impl Run {
         let method = settings
             .method
             .as_ref()
-            .and_then(|m| Method::from_str(&m.value, false).ok())
+            .and_then(|m| m.value.parse::<Method>().ok())
             .unwrap_or(Method::Dop853);
         Self {
             method,
@@ -308,11 +308,7 @@ impl Run {
     }
 
     fn describe(&self) -> String {
-        let method = self
-            .method
-            .to_possible_value()
-            .map(|v| v.get_name().to_string())
-            .unwrap_or_default();
+        let method = self.method.name();
         format!("{method}, rtol {:e}, {} s", self.rtol, fixed(self.t_end, 6))
     }
 }

@@ -3,10 +3,9 @@
 use std::io::Write as _;
 
 use clap::{Args, ValueEnum};
+pub(crate) use eomgen::Method;
 use eomgen::{
-    BogackiShampine32, DormandPrince54, DormandPrince853, ExplicitEuler, ExplicitMidpoint,
-    ImplicitMidpoint, IntegrationError, IntegrationFailure, Integrator, IntegratorOptions,
-    ModelInfo, OutputTimes, RadauIIA5, RungeKutta4, Solution, StormerVerlet, SymplecticEuler,
+    IntegrationError, IntegrationFailure, IntegratorOptions, ModelInfo, OutputTimes, Solution,
     WithEvents,
 };
 use serde_json::json;
@@ -16,60 +15,43 @@ use super::values::{evaluate, parameter_lookup, set_parameters, split_assignment
 use super::{CliError, find_model, plot};
 use eomgen::Stabilization;
 
-/// Integration method. Adaptive methods use `--rtol`/`--atol` (and `--dt` as their first
-/// step); fixed-step methods use `--dt` (default `t_end/1000`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum Method {
-    /// Explicit Euler, order 1, fixed step `--dt`.
-    Euler,
-    /// Explicit midpoint, order 2, fixed step `--dt`.
-    Midpoint,
-    /// Classical Runge–Kutta 4, fixed step `--dt`.
-    Rk4,
-    /// Bogacki–Shampine 3(2) (ode23), adaptive, Hermite dense output.
-    Bs32,
-    /// Dormand–Prince 5(4), adaptive, dense output (default).
-    Dp54,
-    /// DOP853, Hairer's Dormand–Prince 8(5,3), adaptive, order-7 dense output.
-    Dop853,
-    /// Symplectic Euler, order 1, fixed step `--dt` (symplectic for constant M and
-    /// velocity-independent forces).
-    SymplecticEuler,
-    /// Störmer–Verlet (leapfrog in q, q̇), order 2, fixed step `--dt` (symplectic for
-    /// constant M and velocity-independent forces).
-    StormerVerlet,
-    /// Implicit midpoint, order 2, fixed step `--dt`, Newton with the generated Jacobians
-    /// (symplectic for any M(q)).
-    ImplicitMidpoint,
-    /// Radau IIA order 5 (RADAU5), adaptive, L-stable, Newton with the generated Jacobians.
-    Radau5,
-}
-
-impl Method {
-    /// A new integrator of this method.
-    pub(crate) fn integrator(self) -> Box<dyn Integrator> {
-        match self {
-            Method::Euler => Box::new(ExplicitEuler::new()),
-            Method::Midpoint => Box::new(ExplicitMidpoint::new()),
-            Method::Rk4 => Box::new(RungeKutta4::new()),
-            Method::Bs32 => Box::new(BogackiShampine32::new()),
-            Method::Dp54 => Box::new(DormandPrince54::new()),
-            Method::Dop853 => Box::new(DormandPrince853::new()),
-            Method::SymplecticEuler => Box::new(SymplecticEuler::new()),
-            Method::StormerVerlet => Box::new(StormerVerlet::new()),
-            Method::ImplicitMidpoint => Box::new(ImplicitMidpoint::new()),
-            Method::Radau5 => Box::new(RadauIIA5::new()),
+/// The `--method` help of each method (clap lists them under "Possible values"; the
+/// methods themselves are [`Method`]).
+fn method_help(method: Method) -> &'static str {
+    match method {
+        Method::Euler => "Explicit Euler, order 1, fixed step `--dt`",
+        Method::Midpoint => "Explicit midpoint, order 2, fixed step `--dt`",
+        Method::Rk4 => "Classical Runge–Kutta 4, fixed step `--dt`",
+        Method::Bs32 => "Bogacki–Shampine 3(2) (ode23), adaptive, Hermite dense output",
+        Method::Dp54 => "Dormand–Prince 5(4), adaptive, dense output (default)",
+        Method::Dop853 => {
+            "DOP853, Hairer's Dormand–Prince 8(5,3), adaptive, order-7 dense output"
+        }
+        Method::SymplecticEuler => {
+            "Symplectic Euler, order 1, fixed step `--dt` (symplectic for constant M and velocity-independent forces)"
+        }
+        Method::StormerVerlet => {
+            "Störmer–Verlet (leapfrog in q, q̇), order 2, fixed step `--dt` (symplectic for constant M and velocity-independent forces)"
+        }
+        Method::ImplicitMidpoint => {
+            "Implicit midpoint, order 2, fixed step `--dt`, Newton with the generated Jacobians (symplectic for any M(q))"
+        }
+        Method::Radau5 => {
+            "Radau IIA order 5 (RADAU5), adaptive, L-stable, Newton with the generated Jacobians"
         }
     }
+}
 
-    /// Whether the method controls its step by `--rtol`/`--atol` (otherwise it takes the
-    /// fixed step `--dt`).
-    pub(crate) fn is_adaptive(self) -> bool {
-        matches!(
-            self,
-            Method::Bs32 | Method::Dp54 | Method::Dop853 | Method::Radau5
-        )
-    }
+/// clap's parser of a method name (`--method`, `--methods`): the names of [`Method::ALL`]
+/// with their help, parsed by [`Method`]'s `FromStr`. Adaptive methods use
+/// `--rtol`/`--atol` (and `--dt` as their first step); fixed-step methods use `--dt`
+/// (default `t_end/1000`).
+pub(crate) fn method_parser() -> impl clap::builder::TypedValueParser<Value = Method> {
+    use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser as _};
+    PossibleValuesParser::new(
+        Method::ALL.map(|m| PossibleValue::new(m.name()).help(method_help(m))),
+    )
+    .try_map(|name| name.parse::<Method>())
 }
 
 /// Drift control of a constrained model (`--stabilization`).
@@ -125,7 +107,7 @@ pub struct IntegrationArgs {
     #[arg(long, default_value_t = 10.0)]
     pub t_end: f64,
     /// Integration method.
-    #[arg(long, value_enum, default_value_t = Method::Dp54)]
+    #[arg(long, value_parser = method_parser(), default_value_t = Method::Dp54)]
     pub method: Method,
     /// Relative tolerance (adaptive methods: bs32, dp54, dop853, radau5).
     #[arg(long, default_value_t = 1e-8)]
@@ -470,7 +452,7 @@ pub(crate) fn failure_error(
 
 /// What to try after a failed integration (issue 8, item 3), by the reason and the method.
 fn failure_hint(error: &IntegrationError, method: Method) -> &'static str {
-    let explicit = !matches!(method, Method::Radau5 | Method::ImplicitMidpoint);
+    let explicit = !method.is_implicit();
     let adaptive = method.is_adaptive();
     match error {
         IntegrationError::StepSizeTooSmall { .. } | IntegrationError::TooManySteps { .. }

@@ -27,7 +27,7 @@
 
 use std::io::Write;
 
-use clap::{Args, ValueEnum};
+use clap::Args;
 use eomgen::{IntegrationFailure, Integrator, IntegratorOptions, ModelInfo, OutputTimes, Solution};
 use serde_json::json;
 
@@ -59,7 +59,7 @@ pub struct WorkPrecisionArgs {
     pub model: String,
     /// Methods to compare, comma separated (default: bs32, dp54, dop853, radau5, rk4,
     /// stormer-verlet).
-    #[arg(long, value_enum, value_delimiter = ',', default_values_t = DEFAULT_METHODS)]
+    #[arg(long, value_parser = super::simulate::method_parser(), value_delimiter = ',', default_values_t = DEFAULT_METHODS)]
     pub methods: Vec<Method>,
     /// Tolerances of the adaptive methods (`rtol = atol = tol`): `A..B`, every decade from A
     /// to B (e.g. `1e-3..1e-12`), or a comma-separated list; each in (0, 1).
@@ -185,29 +185,6 @@ enum AtTarget {
     BelowAtLoosest { rhs_evals: usize, wall_time_s: f64 },
     /// No pair of consecutive settings brackets the target.
     NotReached,
-}
-
-/// The command-line name of a method (`dp54`).
-fn cli_name(method: Method) -> String {
-    method
-        .to_possible_value()
-        .map_or_else(|| format!("{method:?}"), |v| v.get_name().to_string())
-}
-
-/// The literature's name of a method.
-fn display_name(method: Method) -> &'static str {
-    match method {
-        Method::Euler => "explicit Euler",
-        Method::Midpoint => "explicit midpoint",
-        Method::Rk4 => "RK4",
-        Method::Bs32 => "Bogacki–Shampine 3(2)",
-        Method::Dp54 => "Dormand–Prince 5(4)",
-        Method::Dop853 => "DOP853",
-        Method::SymplecticEuler => "symplectic Euler",
-        Method::StormerVerlet => "Störmer–Verlet",
-        Method::ImplicitMidpoint => "implicit midpoint",
-        Method::Radau5 => "Radau IIA 5",
-    }
 }
 
 /// Parses `--tols`: `A..B` (every decade from A towards B, either direction) or a comma list.
@@ -541,7 +518,7 @@ pub fn run(args: &WorkPrecisionArgs) -> Result<(), CliError> {
             .map_err(|f| {
                 CliError::failure(format!(
                     "{role} ({} at rtol = atol = {:e}) failed: {}; try a looser --reference-tol or a shorter --t-end",
-                    display_name(method),
+                    method.display_name(),
                     args.reference_tol,
                     f.message
                 ))
@@ -656,8 +633,8 @@ impl Study<'_> {
                 let runs: Vec<serde_json::Value> =
                     r.runs.iter().map(|run| self.run_json(run)).collect();
                 json!({
-                    "method": cli_name(r.method),
-                    "name": display_name(r.method),
+                    "method": r.method.name(),
+                    "name": r.method.display_name(),
                     "order": r.method.integrator().order(),
                     "adaptive": r.method.is_adaptive(),
                     "runs": runs,
@@ -788,7 +765,7 @@ impl Study<'_> {
             "method", "tol or h", "error", "RHS evals", "steps", "time (ms)", "energy drift"
         )?;
         for r in &self.results {
-            let name = display_name(r.method);
+            let name = r.method.display_name();
             for run in &r.runs {
                 let setting = run.setting.label();
                 match &run.outcome {
@@ -821,7 +798,7 @@ impl Study<'_> {
             "method", "RHS evals", "steps", "time (ms)"
         )?;
         for r in &self.results {
-            let name = display_name(r.method);
+            let name = r.method.display_name();
             match r.at_target {
                 AtTarget::Reached {
                     rhs_evals,
@@ -871,7 +848,7 @@ fn write_charts(prefix: &str, model: &str, results: &[MethodRuns]) -> Result<(),
         results
             .iter()
             .map(|r| plot::Series {
-                name: display_name(r.method).to_string(),
+                name: r.method.display_name().to_string(),
                 points: r
                     .runs
                     .iter()
