@@ -35,7 +35,8 @@ use eomgen_symbolic::model::{
 
 use super::animate::fixed;
 use super::modes::{OperatingPoint, operating_point_of};
-use super::simulate::{IntegrationArgs, Method, Report as EnergyReport, integrate};
+use super::simulate::{IntegrationArgs, Method, integrate};
+use eomgen::analysis::energy_drift;
 use super::values::parameter_lookup;
 use super::{CliError, plot};
 
@@ -580,13 +581,13 @@ fn motion_checks(
                 plot::phase_portrait(&path("phase.svg"), model, solution),
             ));
             drawn.push(("energy.svg", "Energy drift E(t) − E(0)".to_string(), {
-                let energy = EnergyReport::new(model, y0, solution);
+                let energy = energy_drift(model, y0, solution);
                 plot::energy_drift(
                     &path("energy.svg"),
                     model.name(),
                     &solution.t,
                     &energy.energy,
-                    energy.initial,
+                    energy.initial_energy,
                 )
             }));
             if !model.constraint_names().is_empty() {
@@ -622,7 +623,7 @@ fn motion_checks(
                 (d.max, Run::of(&d.run))
             });
         let computed = runs.get(run, simulated).and_then(|s| {
-            EnergyReport::new(model, y0, s)
+            energy_drift(model, y0, s)
                 .drift
                 .ok_or_else(|| "no samples".to_string())
         });

@@ -4,6 +4,7 @@ use std::io::Write as _;
 
 use clap::{Args, ValueEnum};
 pub(crate) use eomgen::Method;
+use eomgen::analysis::{ConstraintDrift, EnergyDrift, constraint_drift, energy_drift};
 use eomgen::{
     IntegrationError, IntegrationFailure, IntegratorOptions, ModelInfo, OutputTimes, Solution,
     WithEvents,
@@ -215,8 +216,8 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
         .iter()
         .map(|s| s.to_string())
         .collect();
-    let report = Report::new(model.as_ref(), &y0, &solution);
-    let constraints = ConstraintReport::new(model.as_mut(), &solution);
+    let report = energy_drift(model.as_ref(), &y0, &solution);
+    let constraints = constraint_drift(model.as_mut(), &solution);
     if let Some(path) = &args.csv {
         write_csv(path, model.as_ref(), &solution, &report, &constraints)?;
         if !solution.events.is_empty() {
@@ -225,10 +226,9 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
     }
     if let Some(path) = &args.plot {
         plot::time_histories(path, model.as_ref(), &solution).map_err(CliError::failure)?;
-        if !constraints.names.is_empty() {
+        if !constraints.is_empty() {
             let drift_path = sibling(path, "drift");
-            constraints
-                .plot(&drift_path, model.name(), &solution)
+            plot::constraint_drift(&drift_path, model.name(), &solution.t, &constraints.drift)
                 .map_err(CliError::failure)?;
         }
     }
@@ -241,7 +241,7 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
             model.name(),
             &solution.t,
             &report.energy,
-            report.initial,
+            report.initial_energy,
         )
         .map_err(CliError::failure)?;
     }
@@ -252,8 +252,8 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
             .enumerate()
             .map(|(k, ((t, y), e))| {
                 let mut sample = json!({"t": t, "q": &y[..n], "qdot": &y[n..], "energy": e});
-                if !constraints.names.is_empty() {
-                    sample["constraint_forces"] = json!(constraints.forces[k]);
+                if !constraints.is_empty() {
+                    sample["constraint_forces"] = json!(constraints.lagrange_multipliers[k]);
                     sample["constraint_drift"] =
                         json!({"position": constraints.drift[k].0, "velocity": constraints.drift[k].1});
                 }
@@ -268,7 +268,7 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
             "rtol": args.run.rtol,
             "atol": args.run.atol,
             "samples": samples,
-            "initial_energy": report.initial,
+            "initial_energy": report.initial_energy,
             "energy_drift": report.drift,
             "conservative": model.is_conservative(),
             "stats": {
@@ -283,8 +283,8 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
         if args.timing {
             out["stats"]["wall_time_s"] = json!(solution.stats.wall_time_s);
         }
-        if !constraints.names.is_empty() {
-            out["constraints"] = json!(constraints.names);
+        if !constraints.is_empty() {
+            out["constraints"] = json!(constraints.constraint_names);
             out["stabilization"] = json!(format!("{:?}", args.run.stabilization).to_lowercase());
             out["max_constraint_drift"] = json!({
                 "position": constraints.max_drift().0,
@@ -324,7 +324,7 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
         let _ = writeln!(stdout, "{text}");
     } else {
         print_summary(model.as_ref(), method_name, &args.run, &solution, &report);
-        constraints.print_summary(args.run.stabilization);
+        print_constraint_summary(&constraints, args.run.stabilization);
         print_events(model.as_ref(), &solution);
     }
     match failure {
@@ -492,46 +492,12 @@ fn failure_hint(error: &IntegrationError, method: Method) -> &'static str {
     }
 }
 
-/// Energy per sample and the drift `max |E − E(0)| / E_scale`, with
-/// `E_scale = max (T + |V|)` over the initial state and the samples (so a zero initial energy still gives a
-/// meaningful relative figure).
-pub(crate) struct Report {
-    pub(crate) energy: Vec<f64>,
-    pub(crate) initial: f64,
-    pub(crate) drift: Option<f64>,
-}
-
-impl Report {
-    pub(crate) fn new(model: &dyn ModelInfo, y0: &[f64], solution: &Solution) -> Self {
-        let mut energy = Vec::with_capacity(solution.len());
-        let initial = model.energy(0.0, y0);
-        let mut scale: f64 = model.kinetic_energy(0.0, y0) + model.potential_energy(0.0, y0).abs();
-        for (t, y) in solution.iter() {
-            let (tk, v) = (model.kinetic_energy(t, y), model.potential_energy(t, y));
-            energy.push(tk + v);
-            scale = scale.max(tk + v.abs());
-        }
-        let drift = (!energy.is_empty()).then(|| {
-            let dev = energy
-                .iter()
-                .map(|e| (e - initial).abs())
-                .fold(0.0, f64::max);
-            if scale > 0.0 { dev / scale } else { dev }
-        });
-        Self {
-            energy,
-            initial,
-            drift,
-        }
-    }
-}
-
 fn print_summary(
     model: &dyn ModelInfo,
     method: &str,
     args: &IntegrationArgs,
     solution: &Solution,
-    report: &Report,
+    report: &EnergyDrift,
 ) {
     println!(
         "model      {} ({} dof): {}",
@@ -553,7 +519,7 @@ fn print_summary(
             );
         }
     }
-    if let (e0, Some(e1)) = (report.initial, report.energy.last()) {
+    if let (e0, Some(e1)) = (report.initial_energy, report.energy.last()) {
         println!("energy     E(0) = {e0:.12e} J, E(end) = {e1:.12e} J");
         if let Some(d) = report.drift {
             let note = if model.is_conservative() {
@@ -586,8 +552,8 @@ fn write_csv(
     path: &str,
     model: &dyn ModelInfo,
     solution: &Solution,
-    report: &Report,
-    constraints: &ConstraintReport,
+    report: &EnergyDrift,
+    constraints: &ConstraintDrift,
 ) -> Result<(), CliError> {
     let mut out = String::from("t");
     for c in model.coordinate_names() {
@@ -598,10 +564,10 @@ fn write_csv(
         out.push_str(&format!(",{c}_dot"));
     }
     out.push_str(",energy");
-    for c in &constraints.names {
+    for c in &constraints.constraint_names {
         out.push_str(&format!(",lambda_{c}"));
     }
-    if !constraints.names.is_empty() {
+    if !constraints.is_empty() {
         out.push_str(",drift_position,drift_velocity");
     }
     out.push('\n');
@@ -611,11 +577,11 @@ fn write_csv(
             out.push_str(&format!(",{v:e}"));
         }
         out.push_str(&format!(",{e:e}"));
-        if !constraints.names.is_empty() {
+        if !constraints.is_empty() {
             // A state where λ cannot be solved (singular KKT matrix) leaves empty cells.
-            match &constraints.forces[k] {
+            match &constraints.lagrange_multipliers[k] {
                 Some(forces) => forces.iter().for_each(|l| out.push_str(&format!(",{l:e}"))),
-                None => out.push_str(&",".repeat(constraints.names.len())),
+                None => out.push_str(&",".repeat(constraints.constraint_names.len())),
             }
             let (p, v) = constraints.drift[k];
             out.push_str(&format!(",{p:e},{v:e}"));
@@ -746,63 +712,23 @@ pub(crate) fn consistent_initial_state(
     })
 }
 
-/// Constraint forces `λ` and drift at every sample of a constrained model.
-struct ConstraintReport {
-    names: Vec<String>,
-    /// `λ` per sample; `None` where the constrained system is singular (JSON `null`).
-    forces: Vec<Option<Vec<f64>>>,
-    drift: Vec<(f64, f64)>,
-}
-
-impl ConstraintReport {
-    fn new(model: &mut dyn ModelInfo, solution: &Solution) -> Self {
-        let names: Vec<String> = model
-            .constraint_names()
+/// The constraint forces at the end and the largest drift, under `stabilization`.
+fn print_constraint_summary(constraints: &ConstraintDrift, stabilization: StabilizationArg) {
+    if constraints.is_empty() {
+        return;
+    }
+    if let Some(Some(last)) = constraints.lagrange_multipliers.last() {
+        let forces: Vec<String> = constraints
+            .constraint_names
             .iter()
-            .map(|s| s.to_string())
+            .zip(last)
+            .map(|(n, l)| format!("{n} = {l:.9e}"))
             .collect();
-        let mut forces = Vec::new();
-        let mut drift = Vec::new();
-        if !names.is_empty() {
-            for (t, y) in solution.iter() {
-                forces.push(model.constraint_forces(t, y).ok());
-                drift.push(model.constraint_drift(t, y));
-            }
-        }
-        Self {
-            names,
-            forces,
-            drift,
-        }
+        println!("lambda     at the end: {}", forces.join(", "));
     }
-
-    fn max_drift(&self) -> (f64, f64) {
-        self.drift
-            .iter()
-            .fold((0.0f64, 0.0f64), |(a, b), (p, v)| (a.max(*p), b.max(*v)))
-    }
-
-    fn print_summary(&self, stabilization: StabilizationArg) {
-        if self.names.is_empty() {
-            return;
-        }
-        if let Some(Some(last)) = self.forces.last() {
-            let forces: Vec<String> = self
-                .names
-                .iter()
-                .zip(last)
-                .map(|(n, l)| format!("{n} = {l:.9e}"))
-                .collect();
-            println!("lambda     at the end: {}", forces.join(", "));
-        }
-        let (p, v) = self.max_drift();
-        println!(
-            "drift      constraints ({}): max |Φ| = {p:.3e}, max |Φ̇| = {v:.3e}",
-            format!("{stabilization:?}").to_lowercase()
-        );
-    }
-
-    fn plot(&self, path: &str, model: &str, solution: &Solution) -> Result<(), String> {
-        plot::constraint_drift(path, model, &solution.t, &self.drift)
-    }
+    let (p, v) = constraints.max_drift();
+    println!(
+        "drift      constraints ({}): max |Φ| = {p:.3e}, max |Φ̇| = {v:.3e}",
+        format!("{stabilization:?}").to_lowercase()
+    );
 }

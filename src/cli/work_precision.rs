@@ -31,7 +31,8 @@ use clap::Args;
 use eomgen::{IntegrationFailure, Integrator, IntegratorOptions, ModelInfo, OutputTimes, Solution};
 use serde_json::json;
 
-use super::simulate::{Method, Report, consistent_initial_state};
+use super::simulate::{Method, consistent_initial_state};
+use eomgen::analysis::energy_drift;
 use super::{CliError, find_model, plot};
 
 /// The methods compared when `--methods` is not given: every adaptive method, and the
@@ -365,7 +366,7 @@ impl Problem {
                     Err(_) => break,
                 }
             }
-            let report = Report::new(self.model.as_ref(), &self.y0, &solution);
+            let report = energy_drift(self.model.as_ref(), &self.y0, &solution);
             Measured {
                 error: state_error(&solution, reference),
                 rhs_evals: solution.stats.rhs_evals,

@@ -5,6 +5,8 @@
 //! Every analysis is a function with a typed options struct, a `Serialize` report and a
 //! typed error, so that a front end only parses its input and renders the report.
 
+pub mod drift;
 pub mod methods;
 
+pub use drift::{ConstraintDrift, EnergyDrift, constraint_drift, energy_drift};
 pub use methods::{Method, UnknownMethod};
