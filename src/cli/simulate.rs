@@ -4,15 +4,15 @@ use std::io::Write as _;
 
 use clap::{Args, ValueEnum};
 pub(crate) use eomgen::Method;
-use eomgen::analysis::{ConstraintDrift, EnergyDrift, constraint_drift, energy_drift};
-use eomgen::{
-    IntegrationError, IntegrationFailure, IntegratorOptions, ModelInfo, OutputTimes, Solution,
-    WithEvents,
+use eomgen::analysis::{
+    AddedEvents, ConstraintDrift, EnergyDrift, Simulation, SimulationError, SimulationOptions,
+    simulate_with_events,
 };
+use eomgen::expressions::{ExpressionEvents, set_initial_values};
+use eomgen::{IntegrationError, ModelInfo, OutputTimes, Solution};
 use serde_json::json;
 
-use super::events::CliEvents;
-use super::values::{evaluate, parameter_lookup, set_parameters, split_assignment};
+use super::values::{evaluate, set_parameters, usage};
 use super::{CliError, find_model, plot};
 use eomgen::Stabilization;
 
@@ -203,21 +203,21 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
     } else {
         OutputTimes::At(times)
     };
-    let Run {
-        mut model,
-        y0,
+    let (model, simulation) = simulation(&args.model, &args.run, output)?;
+    let Simulation {
         solution,
+        energy: report,
+        constraints,
         failure,
-        method_name,
-    } = integrate(&args.model, &args.run, output)?;
+        integrator: method_name,
+        ..
+    } = simulation;
     let n = model.num_dofs();
     let coordinates: Vec<String> = model
         .coordinate_names()
         .iter()
         .map(|s| s.to_string())
         .collect();
-    let report = energy_drift(model.as_ref(), &y0, &solution);
-    let constraints = constraint_drift(model.as_mut(), &solution);
     if let Some(path) = &args.csv {
         write_csv(path, model.as_ref(), &solution, &report, &constraints)?;
         if !solution.events.is_empty() {
@@ -341,98 +341,120 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
     }
 }
 
-/// Integrates `model_name` (a bundled model) with `args` from its initial state (with
-/// `--set` and `--init` applied and made consistent with the constraints), sampling at
-/// `output`: the shared start of `simulate` and `animate`.
+impl IntegrationArgs {
+    /// The library's options of these arguments, sampled at `output`, from the initial state
+    /// `y0`.
+    fn simulation_options(&self, output: OutputTimes, y0: Vec<f64>) -> SimulationOptions {
+        SimulationOptions {
+            method: self.method,
+            t_end: self.t_end,
+            rtol: self.rtol,
+            atol: self.atol,
+            dt: self.dt,
+            output,
+            stabilization: match self.stabilization {
+                StabilizationArg::None => Stabilization::None,
+                StabilizationArg::Baumgarte => Stabilization::Baumgarte {
+                    alpha: self.baumgarte[0],
+                    beta: self.baumgarte[1],
+                },
+                StabilizationArg::Projection => Stabilization::Projection,
+            },
+            initial_state: Some(y0),
+        }
+    }
+}
+
+/// Simulates `model_name` (a bundled model or a model file) with `args`: `--set` and
+/// `--init` applied, the events of `--stop-when` and `--event` added, then one call of
+/// [`simulate_with_events`].
 ///
 /// # Errors
 /// A usage error for an unknown model, parameter, coordinate or event, or a `--t-end` that
 /// is not a positive number; a failure when no consistent initial state exists. A failed
-/// integration is not an error here: it is [`Run::failure`], with the samples computed
-/// before it (report it with [`failure_error`]).
+/// integration is not an error here: it is [`Simulation::failure`], with the samples
+/// computed before it.
+fn simulation(
+    model_name: &str,
+    args: &IntegrationArgs,
+    output: OutputTimes,
+) -> Result<(Box<dyn ModelInfo>, Simulation), CliError> {
+    let mut model = find_model(model_name)?;
+    set_parameters(model.as_mut(), &args.set)?;
+    let mut y0 = model.initial_state();
+    set_initial_values(model.as_ref(), &mut y0, &args.init).map_err(usage)?;
+    let mut added = ExpressionEvents::parse(model.as_mut(), &args.stop_when, &args.event)
+        .map_err(usage)?;
+    let options = args.simulation_options(output, y0);
+    let added: Option<&mut dyn AddedEvents> = if added.is_empty() {
+        None
+    } else {
+        Some(&mut added)
+    };
+    let simulation =
+        simulate_with_events(model.as_mut(), &options, added).map_err(simulation_error)?;
+    Ok((model, simulation))
+}
+
+/// A simulation that could not start, as the CLI reports it.
+fn simulation_error(error: SimulationError) -> CliError {
+    match error {
+        SimulationError::InvalidEndTime { t_end } => CliError::usage(format!(
+            "--t-end must be a positive number of seconds, got {t_end}"
+        )),
+        SimulationError::InconsistentInitialState {
+            model,
+            constraint,
+            residual,
+            iterations,
+            has_guesses,
+        } => CliError::failure(inconsistent_message(
+            &model,
+            &constraint,
+            residual,
+            iterations,
+            has_guesses,
+        )),
+        other => CliError::usage(other.to_string()),
+    }
+}
+
+/// What to say when no consistent initial state was found.
+fn inconsistent_message(
+    model: &str,
+    constraint: &str,
+    residual: f64,
+    iterations: usize,
+    has_guesses: bool,
+) -> String {
+    if has_guesses {
+        format!(
+            "no consistent initial state for `{model}`: constraint `{constraint}` keeps a residual of {residual:.3e} after {iterations} Newton iteration(s) from the guesses; try other guesses"
+        )
+    } else {
+        format!(
+            "the initial state of `{model}` violates its constraints: `{constraint}` has a residual of {residual:.3e}; mark the dependent coordinates as `{{ guess: … }}` in `initial:` or fix the values"
+        )
+    }
+}
+
+/// Integrates `model_name` with `args` as `simulate` does (see [`simulation`]), sampled at
+/// `output`: the shared start of `simulate`, `animate` and `report`.
+///
+/// # Errors
+/// As [`simulation`]; report a failed integration with [`failure_error`].
 pub(crate) fn integrate(
     model_name: &str,
     args: &IntegrationArgs,
     output: OutputTimes,
 ) -> Result<Run, CliError> {
-    let mut model = find_model(model_name)?;
-    set_parameters(model.as_mut(), &args.set)?;
-    let n = model.num_dofs();
-    let coordinates: Vec<String> = model
-        .coordinate_names()
-        .iter()
-        .map(|s| s.to_string())
-        .collect();
-    let mut y0 = model.initial_state();
-    for s in &args.init {
-        let (name, text) = split_assignment(s, "--init")?;
-        let value = evaluate(
-            text,
-            &format!("--init {name}"),
-            &parameter_lookup(model.as_ref()),
-        )?;
-        let index = coordinates
-            .iter()
-            .position(|c| *c == name)
-            .or_else(|| coordinates.iter().position(|c| name.strip_suffix("_dot") == Some(c)).map(|i| n + i))
-            .ok_or_else(|| {
-                let rates: Vec<String> = coordinates.iter().map(|c| format!("{c}_dot")).collect();
-                CliError::usage(format!(
-                    "--init {name}: `{}` has no coordinate or rate `{name}` (coordinates: {}; rates: {})",
-                    model.name(),
-                    coordinates.join(", "),
-                    rates.join(", ")
-                ))
-            })?;
-        y0[index] = value;
-    }
-    consistent_initial_state(model.as_mut(), &mut y0)?;
-    let stabilization = match args.stabilization {
-        StabilizationArg::None => Stabilization::None,
-        StabilizationArg::Baumgarte => Stabilization::Baumgarte {
-            alpha: args.baumgarte[0],
-            beta: args.baumgarte[1],
-        },
-        StabilizationArg::Projection => Stabilization::Projection,
-    };
-    model.set_stabilization(stabilization);
-    if !(args.t_end.is_finite() && args.t_end > 0.0) {
-        return Err(CliError::usage(format!(
-            "--t-end must be a positive number of seconds, got {}",
-            args.t_end
-        )));
-    }
-    let mut options = IntegratorOptions::default()
-        .with_rtol(args.rtol)
-        .with_atol(args.atol);
-    if let Some(dt) = args.dt {
-        options = options.with_dt(dt);
-    }
-    let mut integrator = args.method.integrator();
-    let mut added = CliEvents::parse(model.as_mut(), &args.stop_when, &args.event)?;
-    let result = if added.is_empty() {
-        integrator.integrate(model.as_ode_mut(), 0.0, &y0, args.t_end, &output, &options)
-    } else {
-        let specs = added.specs();
-        let mut system = WithEvents::new(
-            model.as_mut(),
-            specs,
-            |m: &mut (dyn ModelInfo + 'static), t: f64, y: &[f64], g: &mut [f64]| {
-                added.values(m, t, y, g)
-            },
-        );
-        integrator.integrate(&mut system, 0.0, &y0, args.t_end, &output, &options)
-    };
-    let (solution, failure) = match result {
-        Ok(s) => (s, None),
-        Err(IntegrationFailure { error, partial }) => (*partial, Some(error)),
-    };
+    let (model, simulation) = simulation(model_name, args, output)?;
     Ok(Run {
         model,
-        y0,
-        solution,
-        failure,
-        method_name: integrator.name(),
+        y0: simulation.initial_state,
+        solution: simulation.solution,
+        failure: simulation.failure,
+        method_name: simulation.integrator,
     })
 }
 
@@ -682,10 +704,8 @@ fn sibling(path: &str, tag: &str) -> String {
     }
 }
 
-/// Makes the initial state consistent with the constraints (issue 5, item 3): the
-/// coordinates marked `{ guess: … }` in the model file, and their rates, are solved by
-/// Newton from `Φ(q, 0) = 0` and the velocity constraints; without guesses the state must
-/// already satisfy them to 1e-9.
+/// Makes the initial state consistent with the constraints (issue 5, item 3,
+/// [`ModelInfo::make_consistent`]) with the CLI's message on failure.
 ///
 /// # Errors
 /// A failure naming the constraint with the largest residual.
@@ -695,20 +715,13 @@ pub(crate) fn consistent_initial_state(
 ) -> Result<(), CliError> {
     model.make_consistent(y0).map_err(|e| {
         let name = model.constraint_names().get(e.constraint).copied().unwrap_or("?");
-        CliError::failure(if model.initial_guesses().is_empty() {
-            format!(
-                "the initial state of `{}` violates its constraints: `{name}` has a residual of {:.3e}; mark the dependent coordinates as `{{ guess: … }}` in `initial:` or fix the values",
-                model.name(),
-                e.residual
-            )
-        } else {
-            format!(
-                "no consistent initial state for `{}`: constraint `{name}` keeps a residual of {:.3e} after {} Newton iteration(s) from the guesses; try other guesses",
-                model.name(),
-                e.residual,
-                e.iterations
-            )
-        })
+        CliError::failure(inconsistent_message(
+            model.name(),
+            name,
+            e.residual,
+            e.iterations,
+            !model.initial_guesses().is_empty(),
+        ))
     })
 }
 

@@ -7,6 +7,10 @@
 
 pub mod drift;
 pub mod methods;
+pub mod simulation;
 
 pub use drift::{ConstraintDrift, EnergyDrift, constraint_drift, energy_drift};
 pub use methods::{Method, UnknownMethod};
+pub use simulation::{
+    AddedEvents, Simulation, SimulationError, SimulationOptions, simulate, simulate_with_events,
+};
