@@ -30,6 +30,7 @@ pub use eomgen_macros::model;
 pub use eomgen_runtime::*;
 pub use source::{ModelSource, OpenError, Resolved, open_model, resolve};
 
+pub mod checks;
 pub mod expressions;
 mod source;
 
