@@ -397,7 +397,7 @@ fn simulation(
 }
 
 /// A simulation that could not start, as the CLI reports it.
-fn simulation_error(error: SimulationError) -> CliError {
+pub(crate) fn simulation_error(error: SimulationError) -> CliError {
     match error {
         SimulationError::InvalidEndTime { t_end } => CliError::usage(format!(
             "--t-end must be a positive number of seconds, got {t_end}"
@@ -702,27 +702,6 @@ fn sibling(path: &str, tag: &str) -> String {
         Some((stem, ext)) => format!("{stem}-{tag}.{ext}"),
         None => format!("{path}-{tag}"),
     }
-}
-
-/// Makes the initial state consistent with the constraints (issue 5, item 3,
-/// [`ModelInfo::make_consistent`]) with the CLI's message on failure.
-///
-/// # Errors
-/// A failure naming the constraint with the largest residual.
-pub(crate) fn consistent_initial_state(
-    model: &mut dyn ModelInfo,
-    y0: &mut [f64],
-) -> Result<(), CliError> {
-    model.make_consistent(y0).map_err(|e| {
-        let name = model.constraint_names().get(e.constraint).copied().unwrap_or("?");
-        CliError::failure(inconsistent_message(
-            model.name(),
-            name,
-            e.residual,
-            e.iterations,
-            !model.initial_guesses().is_empty(),
-        ))
-    })
 }
 
 /// The constraint forces at the end and the largest drift, under `stabilization`.

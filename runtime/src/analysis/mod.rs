@@ -8,9 +8,14 @@
 pub mod drift;
 pub mod methods;
 pub mod simulation;
+pub mod work_precision;
 
 pub use drift::{ConstraintDrift, EnergyDrift, constraint_drift, energy_drift};
 pub use methods::{Method, UnknownMethod};
 pub use simulation::{
     AddedEvents, Simulation, SimulationError, SimulationOptions, simulate, simulate_with_events,
+};
+pub use work_precision::{
+    AtTarget, Measured, MethodRuns, RunFailure, Setting, SettingRun, WorkPrecision,
+    WorkPrecisionError, WorkPrecisionOptions, work_precision,
 };

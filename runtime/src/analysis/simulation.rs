@@ -315,7 +315,7 @@ pub fn simulate_with_events(
 }
 
 /// The typed error of a failed [`ModelInfo::make_consistent`].
-fn inconsistent(model: &dyn ModelInfo, e: &ProjectionError) -> SimulationError {
+pub(crate) fn inconsistent(model: &dyn ModelInfo, e: &ProjectionError) -> SimulationError {
     SimulationError::InconsistentInitialState {
         model: model.name().to_string(),
         constraint: model
