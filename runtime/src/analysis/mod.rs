@@ -8,6 +8,7 @@
 pub mod drift;
 pub mod methods;
 pub mod simulation;
+pub mod stability;
 pub mod work_precision;
 
 pub use drift::{ConstraintDrift, EnergyDrift, constraint_drift, energy_drift};
@@ -15,6 +16,7 @@ pub use methods::{Method, UnknownMethod};
 pub use simulation::{
     AddedEvents, Simulation, SimulationError, SimulationOptions, simulate, simulate_with_events,
 };
+pub use stability::{StabilityError, StabilityOptions, StabilityStudy, stability_study};
 pub use work_precision::{
     AtTarget, Measured, MethodRuns, RunFailure, Setting, SettingRun, WorkPrecision,
     WorkPrecisionError, WorkPrecisionOptions, work_precision,
