@@ -269,37 +269,31 @@ fn radau_on_the_stiff_spring_matches_dop853_with_ten_times_fewer_steps() {
 /// some n (roundoff); the JSON has the documented keys.
 #[test]
 fn euler_roundoff_study_shows_truncation_and_roundoff() {
-    let out = eomgen_ok(&["study", "euler-roundoff", "--max-n", "6", "--json"]);
-    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-    assert_eq!(v["exact"].as_f64().unwrap(), E);
-    let rows = v["rows"].as_array().unwrap();
+    use eomgen::analysis::{RoundoffOptions, euler_roundoff};
+    let study = euler_roundoff(&RoundoffOptions { max_n: 6 }).unwrap();
+    let rows = &study.rows;
     assert_eq!(rows.len(), 7);
-    let error = |n: usize, method: usize| rows[n]["runs"][method]["error"].as_f64().unwrap();
+    let error = |n: usize, method: usize| rows[n].runs[method].error;
     for (n, row) in rows.iter().enumerate().take(6).skip(2) {
         let ratio = error(n, 0) / error(n + 1, 0);
         assert!((ratio / 10.0 - 1.0).abs() < 0.02, "n = {n}: {ratio}");
-        let truncation = row["runs"][0]["truncation"].as_f64().unwrap();
-        let h = row["h"].as_f64().unwrap();
-        assert!((truncation / (-E * h / 2.0) - 1.0).abs() < 0.02);
+        let truncation = row.runs[0].truncation;
+        assert!((truncation / (-E * row.h / 2.0) - 1.0).abs() < 0.02);
     }
-    let summary = v["summary"].as_array().unwrap();
-    let rk4 = summary.iter().find(|s| s["method"] == "rk4").unwrap();
-    assert!(
-        rk4["first_n_at_rounding_level"].as_u64().unwrap() <= 4,
-        "{rk4}"
-    );
-    let single = |n: usize| {
-        rows[n]["single_precision_euler"]["error"]
-            .as_f64()
-            .unwrap()
-            .abs()
-    };
+    let rk4 = study.summary.iter().find(|s| s.method == "rk4").unwrap();
+    assert!(rk4.first_n_at_rounding_level.unwrap() <= 4, "{rk4:?}");
+    let single = |n: usize| rows[n].single_precision_euler.error.abs();
     let optimum = (0..=6)
         .min_by(|&a, &b| single(a).total_cmp(&single(b)))
         .unwrap();
     assert!((4..=5).contains(&optimum), "{optimum}");
     assert!(single(6) > 2.0 * single(optimum));
-    for key in ["epsilon", "notes"] {
+    assert!(!study.notes.is_empty());
+    // The CLI renders it: the documented keys.
+    let out = eomgen_ok(&["study", "euler-roundoff", "--max-n", "2", "--json"]);
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["exact"].as_f64().unwrap(), E);
+    for key in ["epsilon", "notes", "rows", "summary"] {
         assert!(!v[key].is_null(), "{key}");
     }
 }
@@ -309,12 +303,10 @@ fn euler_roundoff_study_shows_truncation_and_roundoff() {
 #[test]
 #[ignore = "10⁸ steps per method; run in release"]
 fn euler_roundoff_full_range() {
-    let out = eomgen(&["study", "euler-roundoff", "--max-n", "8", "--json"]);
-    assert!(out.status.success());
-    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-    let rows = v["rows"].as_array().unwrap();
+    use eomgen::analysis::{RoundoffOptions, euler_roundoff};
+    let rows = euler_roundoff(&RoundoffOptions { max_n: 8 }).unwrap().rows;
     // Euler's roundoff at n = 8 (1e-12 observed) exceeds its value at n = 4 (1e-15).
-    let roundoff = |n: usize| rows[n]["runs"][0]["roundoff"].as_f64().unwrap().abs();
+    let roundoff = |n: usize| rows[n].runs[0].roundoff.abs();
     assert!(roundoff(8) > 10.0 * roundoff(4));
 }
 

@@ -7,12 +7,14 @@
 
 pub mod drift;
 pub mod methods;
+pub mod roundoff;
 pub mod simulation;
 pub mod stability;
 pub mod work_precision;
 
 pub use drift::{ConstraintDrift, EnergyDrift, constraint_drift, energy_drift};
 pub use methods::{Method, UnknownMethod};
+pub use roundoff::{EulerRoundoff, RoundoffError, RoundoffOptions, euler_roundoff};
 pub use simulation::{
     AddedEvents, Simulation, SimulationError, SimulationOptions, simulate, simulate_with_events,
 };
