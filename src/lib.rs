@@ -33,6 +33,7 @@ pub use source::{ModelSource, OpenError, Resolved, open_model, resolve};
 pub mod checks;
 pub mod expressions;
 mod source;
+pub mod studies;
 
 /// Every model in `models/`, compiled in: one module and struct per file, and [`models::ALL`].
 pub mod models {

@@ -5,6 +5,7 @@
 //! Every analysis is a function with a typed options struct, a `Serialize` report and a
 //! typed error, so that a front end only parses its input and renders the report.
 
+pub mod constraint_methods;
 pub mod drift;
 pub mod methods;
 pub mod roundoff;
@@ -12,6 +13,10 @@ pub mod simulation;
 pub mod stability;
 pub mod work_precision;
 
+pub use constraint_methods::{
+    ConstraintMethodRow, ConstraintMethods, ConstraintMethodsError, ConstraintMethodsOptions,
+    constraint_methods,
+};
 pub use drift::{ConstraintDrift, EnergyDrift, constraint_drift, energy_drift};
 pub use methods::{Method, UnknownMethod};
 pub use roundoff::{EulerRoundoff, RoundoffError, RoundoffOptions, euler_roundoff};
