@@ -129,8 +129,9 @@ impl Default for CheckRun {
     }
 }
 
-/// `v` with `decimals` decimals, trailing zeros dropped, `-0` as `0`.
-fn fixed(v: f64, decimals: usize) -> String {
+/// `v` with `decimals` decimals, trailing zeros dropped, `-0` as `0` (`fixed(10.0, 6)` is
+/// `10`, `fixed(0.25, 6)` is `0.25`), as the rows write times.
+pub fn fixed(v: f64, decimals: usize) -> String {
     let s = format!("{v:.decimals$}");
     let s = if s.contains('.') {
         s.trim_end_matches('0').trim_end_matches('.')
