@@ -1,6 +1,6 @@
 //! What the studies need from a model's file beyond its compiled equations: the model it
 //! names as its minimal-coordinate twin (`minimal_twin:`), for
-//! [`analysis::constraint_methods`](crate::analysis::constraint_methods).
+//! [`analysis::constraint_methods`](crate::analysis::constraint_methods()).
 
 use crate::{ModelSource, OpenError};
 
@@ -31,8 +31,8 @@ pub enum TwinError {
         model: String,
         /// The twin's name.
         name: String,
-        /// Why.
-        source: OpenError,
+        /// Why (boxed: an open error carries the file's diagnostics).
+        source: Box<OpenError>,
     },
 }
 
@@ -72,7 +72,7 @@ pub fn minimal_twin(source: &ModelSource) -> Result<Option<(String, ModelSource)
     let twin = ModelSource::open(&name.value).map_err(|e| TwinError::Open {
         model: file.name.value.clone(),
         name: name.value.clone(),
-        source: e,
+        source: Box::new(e),
     })?;
     Ok(Some((name.value, twin)))
 }

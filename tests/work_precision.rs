@@ -50,20 +50,6 @@ fn method<'v>(v: &'v Value, name: &str) -> &'v Value {
         .unwrap_or_else(|| panic!("no method {name} in {v}"))
 }
 
-/// The numbers `key` of a method's runs, in order (loosest first); every run must have one.
-fn column(m: &Value, key: &str) -> Vec<f64> {
-    m["runs"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|r| {
-            r[key]
-                .as_f64()
-                .unwrap_or_else(|| panic!("run without `{key}`: {r}"))
-        })
-        .collect()
-}
-
 /// Simple pendulum released horizontally, 2 s (one swing): the reference (DOP853 at 1e-14)
 /// and its Dormand–Prince 5(4) check agree to about 2e-13 (seen: 1.6e-13), so the bound
 /// 1e-11 leaves two orders of margin while still failing for a wrong or unchecked reference.

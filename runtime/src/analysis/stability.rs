@@ -673,7 +673,7 @@ fn stability_limits(test: &GrowthTest) -> Result<Limits, StabilityError> {
         .map(|m| PolynomialRow {
             method: m.name,
             coefficients: m.polynomial.coefficients().to_vec(),
-            order: m.polynomial.order() as usize,
+            order: m.polynomial.order(),
             implementation_difference: m.implementation_difference,
         })
         .collect();
