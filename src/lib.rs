@@ -25,15 +25,45 @@
 
 extern crate self as eomgen;
 
+#[cfg(feature = "jit")]
 pub use eomgen_jit::{Backend, CompileError, JitModel, LoadError, LoadOptions};
 pub use eomgen_macros::model;
 pub use eomgen_runtime::*;
+#[cfg(feature = "jit")]
 pub use source::{ModelSource, OpenError, Resolved, open_model, resolve};
 
+/// nalgebra, the linear algebra of the generated code and the runtime (`SVector`, `SMatrix`,
+/// `DMatrix`, …), re-exported so that a program using eomgen needs no dependency of its own
+/// on a matching version.
+pub use nalgebra;
+
+#[cfg(feature = "jit")]
+mod source;
+
+// The rows of a model file's `checks:` need the run-time loader for the file's model.
+#[cfg(feature = "jit")]
 pub mod checks;
 pub mod expressions;
-mod source;
+#[cfg(feature = "jit")]
 pub mod studies;
+
+#[cfg(feature = "jit")]
+pub use floquet_references::{
+    ChartAxis, FloquetReferences, ReferenceCurvePoints, ReferenceError, ThresholdPrediction,
+};
+
+#[cfg(feature = "jit")]
+mod floquet_references;
+
+/// The README's Rust examples, compiled and run by `cargo test --doc`.
+#[cfg(all(doctest, feature = "jit"))]
+#[doc = include_str!("../README.md")]
+pub struct ReadmeDoctests;
+
+/// The examples of `docs/rust.md`, compiled and run by `cargo test --doc`.
+#[cfg(all(doctest, feature = "jit"))]
+#[doc = include_str!("../docs/rust.md")]
+pub struct RustPageDoctests;
 
 /// Every model in `models/`, compiled in: one module and struct per file, and [`models::ALL`].
 pub mod models {

@@ -504,6 +504,85 @@ fn check_and_simulate_print_the_compile_errors_of_every_ui_case() {
     assert!(checked >= 28, "only {checked} ui cases");
 }
 
+/// Files are written to a temporary file beside them and renamed into place: after a run the
+/// directory holds exactly the files asked for (no temporary file left), readable by others
+/// as any new file is (not a temporary file's 0600), and a file in a missing directory is an
+/// error naming the path the user gave (exit 1).
+#[test]
+fn files_are_replaced_whole() {
+    let dir = tempfile::tempdir().unwrap();
+    let page = dir.path().join("a.html");
+    std::fs::write(&page, "previous").unwrap();
+    let out = eomgen(&[
+        "animate",
+        "simple_pendulum",
+        "-o",
+        page.to_str().unwrap(),
+        "--t-end",
+        "1",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let names: Vec<String> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    assert_eq!(names, ["a.html"]);
+    assert!(
+        std::fs::read_to_string(&page)
+            .unwrap()
+            .ends_with("</html>\n")
+    );
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        let mode = std::fs::metadata(&page).unwrap().permissions().mode();
+        assert_ne!(mode & 0o044, 0, "mode {mode:o}");
+    }
+    let missing = dir.path().join("no_such_dir").join("a.html");
+    let out = eomgen(&[
+        "animate",
+        "simple_pendulum",
+        "-o",
+        missing.to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains(&format!("cannot write `{}`", missing.display())),
+        "{stderr}"
+    );
+    assert!(!stderr.contains(".eomgen-"), "{stderr}");
+}
+
+/// With `--json`, a model that cannot be opened (a missing file, an unknown name) is still
+/// JSON on standard output, `{"error": …}` with the message of standard error, exit 2: a
+/// script that reads the output never gets nothing.
+#[test]
+fn json_output_of_a_model_that_cannot_be_opened() {
+    let dir = tempfile::tempdir().unwrap();
+    let missing = dir.path().join("missing.yaml");
+    let missing = missing.to_str().unwrap();
+    for args in [
+        vec!["check", "--json", missing],
+        vec!["simulate", missing, "--json"],
+        vec!["modes", "no_such_model", "--json"],
+    ] {
+        let out = eomgen(&args);
+        assert_eq!(out.status.code(), Some(2), "{args:?}");
+        let json: serde_json::Value = serde_json::from_slice(&out.stdout)
+            .unwrap_or_else(|e| panic!("{args:?}: not JSON ({e})"));
+        let error = json["error"].as_str().unwrap();
+        assert!(
+            String::from_utf8_lossy(&out.stderr).contains(error),
+            "{args:?}: {error}"
+        );
+    }
+}
+
 /// A file written by `eomgen new` runs through `simulate` with no rebuild (issue 18): the
 /// 5-link pendulum's file is derived and compiled at run time, integrated, and keeps its
 /// energy (a conservative chain: drift below 1e-6 at the default tolerances); an unknown name

@@ -455,9 +455,70 @@ fn hanging_parametric_resonance_and_bad_operating_points() {
     ));
 }
 
+/// The library's study (what `eomgen study floquet` prints): at `upright` with the defaults
+/// (Kapitza's region) the multipliers lie on the unit circle (marginal, 1e-6); chart cells
+/// without shaking (`a = 0`) have ρ = e^{√(g/l) T} at every `w` (1e-8 relative, DOP853 at
+/// 1e-12); typed errors for a missing period parameter, bad tolerances, an unknown swept
+/// parameter and an operating point that moves with `t`.
+#[test]
+fn floquet_study_point_and_cells() {
+    use eomgen::vibration::{
+        EquilibriumStart, FloquetStudyError, FloquetStudyOptions, SweepAxis,
+        floquet_at_equilibrium, floquet_cell,
+    };
+    let mut m = model("mathieu_pendulum");
+    let options = FloquetStudyOptions::default();
+    let point = floquet_at_equilibrium(m.as_mut(), &options).unwrap();
+    assert_eq!(point.name, "upright");
+    assert_eq!(point.floquet.stability, FloquetStability::Marginal);
+    assert!((point.floquet.spectral_radius - 1.0).abs() < 1e-6);
+    assert_eq!(point.frequency, 60.0);
+    let (_, guess) = EquilibriumStart::Named("upright".into())
+        .resolve(m.as_ref())
+        .unwrap();
+    let w_axis = SweepAxis::linear("w", 30.0, 60.0, 2).unwrap();
+    assert_eq!(w_axis.values, [30.0, 60.0]);
+    for &w in &w_axis.values {
+        let mut fresh = model("mathieu_pendulum");
+        let cell = floquet_cell(fresh.as_mut(), &guess, &[("a", 0.0), ("w", w)], &options).unwrap();
+        let exact = (10f64.sqrt() * TAU / w).exp();
+        assert!(
+            (cell.spectral_radius - exact).abs() < 1e-8 * exact,
+            "{} vs {exact}",
+            cell.spectral_radius
+        );
+        assert_eq!(cell.stability, FloquetStability::Unstable);
+    }
+    assert!(SweepAxis::linear("a", 0.3, 0.1, 3).is_err());
+    let err = floquet_cell(m.as_mut(), &guess, &[("zz", 1.0)], &options).unwrap_err();
+    assert!(matches!(err, FloquetStudyError::Parameter(_)), "{err}");
+    let mut pendulum = model("simple_pendulum");
+    let err = floquet_at_equilibrium(pendulum.as_mut(), &options).unwrap_err();
+    assert!(
+        matches!(err, FloquetStudyError::UnknownPeriodParameter { .. }),
+        "{err}"
+    );
+    let mut bad = options.clone();
+    bad.floquet.rtol = 0.0;
+    let err = floquet_at_equilibrium(m.as_mut(), &bad).unwrap_err();
+    assert!(
+        matches!(err, FloquetStudyError::InvalidTolerance { .. }),
+        "{err}"
+    );
+    let mut forced = model("forced_oscillator");
+    let err = floquet_at_equilibrium(forced.as_mut(), &options).unwrap_err();
+    assert!(
+        matches!(
+            err,
+            FloquetStudyError::Floquet(FloquetError::NotAnEquilibrium { .. })
+        ),
+        "{err}"
+    );
+}
+
 /// `eomgen study floquet --json --sweep --plot`: the documented keys, a grid of the right
-/// shape with the unshaken column unstable, and the chart file; clear errors for a model
-/// without the period parameter and for an operating point that moves with `t`.
+/// shape with the unshaken column unstable, and the chart file; clear errors (exit codes) for
+/// a model without the period parameter and for an operating point that moves with `t`.
 #[test]
 fn cli_study_floquet_json_and_chart() {
     let dir = std::env::temp_dir().join(format!("eomgen-floquet-{}", std::process::id()));
@@ -499,11 +560,8 @@ fn cli_study_floquet_json_and_chart() {
     let rho = v["sweep"]["spectral_radius"].as_array().unwrap();
     assert_eq!(rho.len(), 3);
     assert_eq!(rho[0].as_array().unwrap().len(), 2);
-    // a = 0: ρ = e^{√10 T} at both frequencies.
-    for (j, w) in [30.0, 60.0].iter().enumerate() {
-        let exact = (10f64.sqrt() * TAU / w).exp();
-        let r = rho[0][j].as_f64().unwrap();
-        assert!((r - exact).abs() < 1e-8 * exact, "{r} vs {exact}");
+    for j in 0..2 {
+        assert!(rho[0][j].is_f64());
         assert_eq!(v["sweep"]["stability"][0][j], "unstable");
     }
     let svg = std::fs::read_to_string(&chart).unwrap();
@@ -560,5 +618,100 @@ fn upper_edge_of_the_stable_band() {
     assert!(
         (lo - a_series).abs() < 1e-4,
         "Floquet {lo}, series {a_series}"
+    );
+}
+
+/// The Mathieu pendulum file's `floquet:` references, evaluated by the library, against the
+/// formulas written here: Kapitza's threshold `a w > √(2 g l)` and curve `w = √(2 g l)/a`,
+/// and the A&S 20.2.25 series edges `δ = a₀(q)`, `b₁(q)` (upright, `δ = −4g/(l w²)`) and
+/// `b₁(q)`, `a₁(q)` (hanging, `δ = 4g/(l w²)`) with `q = 2a/l`, each point to 1e-12
+/// relative; points stay inside the chart, and the upper edge stops at `q = 1.5`.
+#[test]
+fn mathieu_pendulum_references_from_its_file() {
+    use eomgen::{ChartAxis, FloquetReferences, ModelSource};
+    let source = ModelSource::open("mathieu_pendulum").unwrap();
+    let model = source.instantiate();
+    let (g, l) = (10.0f64, 1.0f64);
+    let upright = FloquetReferences::of(&source, "upright").unwrap().unwrap();
+    assert_eq!(upright.axis_unit("a"), Some("m"));
+    assert_eq!(upright.axis_unit("w"), None);
+    let t = &upright.thresholds(model.as_ref())[0];
+    assert_eq!((t.name.as_str(), t.key.as_str()), ("kapitza", "a_w"));
+    assert_eq!(t.value, 0.1 * 60.0);
+    assert_eq!(t.critical, (2.0 * g * l).sqrt());
+    assert!(t.predicts_stable);
+    let a0 = |q: f64| {
+        let q2 = q * q;
+        -q2 / 2.0 + 7.0 * q2 * q2 / 128.0 - 29.0 * q2 * q2 * q2 / 2304.0
+            + 68_687.0 * q2.powi(4) / 18_874_368.0
+    };
+    let a1 = |q: f64| {
+        1.0 + q - q * q / 8.0 - q.powi(3) / 64.0 - q.powi(4) / 1536.0 + 11.0 * q.powi(5) / 36_864.0
+    };
+    let b1 = |q: f64| {
+        1.0 - q - q * q / 8.0 + q.powi(3) / 64.0 - q.powi(4) / 1536.0 - 11.0 * q.powi(5) / 36_864.0
+    };
+    let w_of = move |sign: f64, delta: f64| (sign * 4.0 * g / (l * delta)).sqrt();
+    let (x, y) = (
+        ChartAxis {
+            name: "a",
+            lo: 0.0,
+            hi: 1.0,
+        },
+        ChartAxis {
+            name: "w",
+            lo: 1.0,
+            hi: 500.0,
+        },
+    );
+    let curves = upright.curves(model.as_ref(), x, y);
+    assert_eq!(curves.len(), 3);
+    type Exact = Box<dyn Fn(f64) -> f64>;
+    let exact: [Exact; 3] = [
+        Box::new(move |a| (2.0 * g * l).sqrt() / a),
+        Box::new(move |a| w_of(-1.0, a0(2.0 * a / l))),
+        Box::new(move |a| w_of(-1.0, b1(2.0 * a / l))),
+    ];
+    for (curve, f) in curves.iter().zip(&exact) {
+        assert!(curve.points.len() > 10, "{}", curve.label);
+        for &(a, w) in &curve.points {
+            assert!((w - f(a)).abs() <= 1e-12 * w, "{}: a = {a}", curve.label);
+            assert!(a > 0.0 && a <= 1.0 && (1.0..=500.0).contains(&w));
+        }
+    }
+    assert!(curves[2].points.iter().all(|(a, _)| 2.0 * a / l <= 1.5));
+    // Axes swapped: the same curve with x and y exchanged.
+    let swapped = upright.curves(model.as_ref(), y, x);
+    assert_eq!(
+        swapped[0].points[0],
+        (curves[0].points[0].1, curves[0].points[0].0)
+    );
+    // Other axes: no curve.
+    let other = ChartAxis {
+        name: "l",
+        lo: 0.5,
+        hi: 2.0,
+    };
+    assert!(upright.curves(model.as_ref(), other, y).is_empty());
+
+    let hanging = FloquetReferences::of(&source, "hanging").unwrap().unwrap();
+    assert!(hanging.thresholds(model.as_ref()).is_empty());
+    let curves = hanging.curves(model.as_ref(), x, y);
+    assert_eq!(curves.len(), 2);
+    for (curve, f) in curves.iter().zip([b1, a1]) {
+        assert!(curve.points.len() > 10, "{}", curve.label);
+        for &(a, w) in &curve.points {
+            let expected = w_of(1.0, f(2.0 * a / l));
+            assert!(
+                (w - expected).abs() <= 1e-12 * w,
+                "{}: a = {a}",
+                curve.label
+            );
+        }
+    }
+    assert!(
+        FloquetReferences::of(&source, "sideways")
+            .unwrap()
+            .is_none()
     );
 }

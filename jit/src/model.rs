@@ -123,7 +123,7 @@ impl Extent {
         e
     }
 
-    #[inline]
+    #[inline(always)]
     fn admits(&self, inputs: &Inputs<'_>, out0: usize, out1: usize) -> bool {
         inputs.parameters.len() >= self.parameters
             && inputs.q.len() >= self.q
@@ -241,7 +241,7 @@ thread_local! {
 /// # Safety
 /// `f` must be the native code compiled from the tape `extent` was computed from, and
 /// `extent.admits(inputs, out0.len(), out1.len())` must hold.
-#[inline]
+#[inline(always)]
 unsafe fn call_native(
     f: NativeFn,
     extent: &Extent,
@@ -250,36 +250,71 @@ unsafe fn call_native(
     out1: &mut [f64],
 ) {
     let (out0, out1) = (out0.as_mut_ptr(), out1.as_mut_ptr());
-    let call = |scratch: *mut f64| {
-        // SAFETY: the tape reads at most `extent` values of each input, writes `extent.out0`
-        // and `extent.out1` values and uses `extent.scratch` values of scratch space; the
-        // caller checked the slices, and `scratch` has that many values.
-        unsafe {
-            f(
-                inputs.parameters.as_ptr(),
-                inputs.q.as_ptr(),
-                inputs.qdot.as_ptr(),
-                inputs.acceleration.as_ptr(),
-                inputs.lambda.as_ptr(),
-                inputs.t,
-                out0,
-                out1,
-                scratch,
-            )
-        }
-    };
     if extent.scratch == 0 {
-        return call(std::ptr::null_mut());
+        // SAFETY: the tape reads at most `extent` values of each input and writes
+        // `extent.out0` and `extent.out1` values; the caller checked the slices. It uses no
+        // scratch space.
+        unsafe { call(f, inputs, out0, out1, std::ptr::null_mut()) }
+    } else {
+        // SAFETY: as above; `with_scratch` supplies `extent.scratch` values of scratch space.
+        unsafe { with_scratch(f, extent.scratch, inputs, out0, out1) }
     }
+}
+
+/// The call itself.
+///
+/// # Safety
+/// As [`call_native`], with `scratch` holding the scratch values the code uses.
+#[inline(always)]
+unsafe fn call(
+    f: NativeFn,
+    inputs: &Inputs<'_>,
+    out0: *mut f64,
+    out1: *mut f64,
+    scratch: *mut f64,
+) {
+    // SAFETY: guaranteed by the caller.
+    unsafe {
+        f(
+            inputs.parameters.as_ptr(),
+            inputs.q.as_ptr(),
+            inputs.qdot.as_ptr(),
+            inputs.acceleration.as_ptr(),
+            inputs.lambda.as_ptr(),
+            inputs.t,
+            out0,
+            out1,
+            scratch,
+        )
+    }
+}
+
+/// A call of code that keeps values in the per-thread scratch buffer (functions of more than
+/// 1,500 instructions, `native.rs`): out of line, so that the small functions' calls, inlined
+/// into the caller's right-hand side, stay short.
+///
+/// # Safety
+/// As [`call_native`], with `scratch` the code's scratch size.
+#[cold]
+#[inline(never)]
+unsafe fn with_scratch(
+    f: NativeFn,
+    scratch: usize,
+    inputs: &Inputs<'_>,
+    out0: *mut f64,
+    out1: *mut f64,
+) {
     SCRATCH.with(|buffer| match buffer.try_borrow_mut() {
         Ok(mut buffer) => {
-            if buffer.len() < extent.scratch {
-                buffer.resize(extent.scratch, 0.0);
+            if buffer.len() < scratch {
+                buffer.resize(scratch, 0.0);
             }
-            call(buffer.as_mut_ptr())
+            // SAFETY: guaranteed by the caller; the buffer holds `scratch` values.
+            unsafe { call(f, inputs, out0, out1, buffer.as_mut_ptr()) }
         }
         // Re-entered on this thread (cannot happen: the code calls no model code).
-        Err(_) => call(vec![0.0; extent.scratch].as_mut_ptr()),
+        // SAFETY: as above, with a buffer of its own.
+        Err(_) => unsafe { call(f, inputs, out0, out1, vec![0.0; scratch].as_mut_ptr()) },
     });
 }
 
@@ -299,9 +334,40 @@ unsafe fn call_native(
 pub struct JitModel {
     code: Arc<Code>,
     parameters: Vec<f64>,
-    /// The native `mass_matrix_and_forcing` and its extent, held here rather than behind the
-    /// `Arc` because every right-hand side calls it.
-    mass_and_forcing: Option<(NativeFn, Extent)>,
+    /// The native `mass_matrix_and_forcing`, held here rather than behind the `Arc` because
+    /// every right-hand side calls it.
+    mass_and_forcing: Option<HotRoutine>,
+}
+
+/// Native code whose call needs only the lengths of `q`, `q̇` and the two outputs checked: it
+/// reads at most the model's parameters (whose number is fixed), no accelerations, no
+/// multipliers, and uses no scratch space. Checking four lengths rather than the whole
+/// [`Extent`] and skipping the scratch buffer keeps the right-hand side's call of
+/// `mass_matrix_and_forcing` short (`benches/runtime_model.rs`).
+#[derive(Debug, Clone, Copy)]
+struct HotRoutine {
+    f: NativeFn,
+    q: usize,
+    qdot: usize,
+    out0: usize,
+    out1: usize,
+}
+
+impl HotRoutine {
+    /// `f` with `extent`, if its call needs no more than four lengths checked (see above).
+    fn new(f: NativeFn, extent: &Extent, parameters: usize) -> Option<HotRoutine> {
+        let simple = extent.parameters <= parameters
+            && extent.acceleration == 0
+            && extent.lambda == 0
+            && extent.scratch == 0;
+        simple.then_some(HotRoutine {
+            f,
+            q: extent.q,
+            qdot: extent.qdot,
+            out0: extent.out0,
+            out1: extent.out1,
+        })
+    }
 }
 
 impl JitModel {
@@ -391,7 +457,7 @@ impl JitModel {
                 terminal: e.terminal,
             })
             .collect();
-        let parameters = program.parameters.iter().map(|(_, v)| *v).collect();
+        let parameters: Vec<f64> = program.parameters.iter().map(|(_, v)| *v).collect();
         let code = Arc::new(Code {
             program,
             core,
@@ -412,7 +478,7 @@ impl JitModel {
             .native
             .as_ref()
             .and_then(|n| n.functions[index])
-            .map(|f| (f, code.core.extents[index]));
+            .and_then(|f| HotRoutine::new(f, &code.core.extents[index], parameters.len()));
         Ok(JitModel {
             code,
             parameters,
@@ -451,6 +517,22 @@ impl JitModel {
         bytes(&self.code.core) + self.code.jacobians.get().map_or(0, |j| bytes(&j.compiled))
     }
 
+    /// [`Self::run`] out of the caller's line: the path of the hot routine when it is not
+    /// native.
+    #[cold]
+    #[inline(never)]
+    fn run_cold(
+        &self,
+        routine: Routine,
+        q: &[f64],
+        qdot: &[f64],
+        t: f64,
+        out0: &mut [f64],
+        out1: &mut [f64],
+    ) {
+        self.run(routine, self.inputs(q, qdot, t), out0, out1);
+    }
+
     fn run(&self, routine: Routine, inputs: Inputs<'_>, out0: &mut [f64], out1: &mut [f64]) {
         let (compiled, index) = match routine as usize {
             i if i < JACOBIANS => (&self.code.core, i),
@@ -485,7 +567,7 @@ impl JitModel {
         });
     }
 
-    #[inline]
+    #[inline(always)]
     fn inputs<'a>(&'a self, q: &'a [f64], qdot: &'a [f64], t: f64) -> Inputs<'a> {
         Inputs {
             parameters: &self.parameters,
@@ -557,8 +639,9 @@ impl DynMechanicalSystem for JitModel {
         q[..n].copy_from_slice(&out[..n]);
         qdot[..n].copy_from_slice(&out[n..]);
     }
-    // Inlined into the caller's right-hand side (another crate), where most sizes are known.
-    #[inline]
+    // Inlined into the caller's right-hand side (another crate), where most sizes are known:
+    // a call level less on the hot path of every integrator.
+    #[inline(always)]
     fn mass_matrix_and_forcing(
         &self,
         q: &[f64],
@@ -567,15 +650,29 @@ impl DynMechanicalSystem for JitModel {
         mass: &mut [f64],
         forcing: &mut [f64],
     ) {
-        let inputs = self.inputs(q, qdot, t);
-        match self.mass_and_forcing {
-            Some((f, extent)) if extent.admits(&inputs, mass.len(), forcing.len()) => {
-                // SAFETY: `f` is the native code of this routine's tape, of which `extent` is
-                // the extent, and `admits` checked every slice.
-                unsafe { call_native(f, &extent, &inputs, mass, forcing) }
+        if let Some(hot) = self.mass_and_forcing
+            && q.len() >= hot.q
+            && qdot.len() >= hot.qdot
+            && mass.len() >= hot.out0
+            && forcing.len() >= hot.out1
+        {
+            let inputs = self.inputs(q, qdot, t);
+            // SAFETY: `hot.f` is the native code of this routine's tape; it reads at most
+            // `hot.q` and `hot.qdot` values of `q` and `q̇` (checked above), at most the
+            // model's parameters and no accelerations or multipliers (`HotRoutine::new`),
+            // writes `hot.out0` and `hot.out1` values (checked above) and uses no scratch.
+            unsafe {
+                call(
+                    hot.f,
+                    &inputs,
+                    mass.as_mut_ptr(),
+                    forcing.as_mut_ptr(),
+                    std::ptr::null_mut(),
+                )
             }
-            // Interpreted, or a slice too short (which `run` reports).
-            _ => self.run(Routine::MassMatrixAndForcing, inputs, mass, forcing),
+        } else {
+            // Interpreted, a large function, or a slice too short (which `run` reports).
+            self.run_cold(Routine::MassMatrixAndForcing, q, qdot, t, mass, forcing);
         }
     }
     fn forcing_jacobian_q(&self, q: &[f64], qdot: &[f64], t: f64, out: &mut [f64]) {

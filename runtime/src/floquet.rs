@@ -187,8 +187,9 @@ impl Default for FloquetOptions {
     }
 }
 
-/// The result of a Floquet analysis over one period.
-#[derive(Debug, Clone, PartialEq)]
+/// The result of a Floquet analysis over one period (serialised with the matrix as a list of
+/// rows and complex numbers as `{"re", "im"}`).
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct FloquetAnalysis {
     /// The period `T` (s).
     pub period: f64,
@@ -196,13 +197,16 @@ pub struct FloquetAnalysis {
     pub t0: f64,
     /// The monodromy matrix `Φ(t₀ + T)`, `n × n` with `n = dim()` (`2 num_dofs()` for a model,
     /// `y = [q; q̇]`); column `j` is the deviation after one period that starts as `eⱼ`.
+    #[serde(serialize_with = "crate::vibration::serde_matrix::rows")]
     pub monodromy_matrix: DMatrix<f64>,
     /// The Floquet multipliers `μ` (eigenvalues of the monodromy matrix), `n` of them, sorted
     /// by modulus, largest first (ties: larger imaginary part first). Dimensionless.
+    #[serde(serialize_with = "crate::vibration::serde_matrix::complex_list")]
     pub multipliers: Vec<Complex<f64>>,
     /// The Floquet exponents `ln(μ)/T` (principal logarithm), in the order of
     /// `multipliers`: real part the growth rate (1/s), imaginary part a frequency (rad/s)
     /// determined modulo `2π/T`. A zero multiplier gives a real part of `−∞`.
+    #[serde(serialize_with = "crate::vibration::serde_matrix::complex_list")]
     pub exponents: Vec<Complex<f64>>,
     /// The spectral radius `ρ = max |μ|`.
     pub spectral_radius: f64,

@@ -184,8 +184,8 @@ pub enum FrfError {
 }
 
 /// The linearisation of a forced model at its unforced equilibrium, with the input matrix of
-/// its named load parameters.
-#[derive(Debug, Clone, PartialEq)]
+/// its named load parameters (serialised with the input matrix as a list of rows).
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct ForcedLinearization {
     /// The equilibrium `q*`, found with every input set to 0.
     pub equilibrium: Equilibrium,
@@ -196,6 +196,7 @@ pub struct ForcedLinearization {
     /// `B = ∂F/∂u`, `n × r`: column `j` is the generalized force per unit of input `j` at
     /// `t = 0` (N or N·m per unit of the parameter). The state-space input matrix is
     /// [`ForcedLinearization::state_input_matrix`].
+    #[serde(serialize_with = "crate::vibration::serde_matrix::rows")]
     pub input_matrix: DMatrix<f64>,
 }
 
@@ -418,7 +419,8 @@ pub fn frequency_response(
 }
 
 /// The height of a resonance peak.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
 pub enum PeakAmplitude {
     /// A damped peak: the largest `|H|` nearby (output units per unit input).
     Finite(f64),
@@ -427,7 +429,7 @@ pub enum PeakAmplitude {
 }
 
 /// A resonance peak of one entry of `H(ω)`.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct ResonancePeak {
     /// Where `|H|` is largest (rad/s); for an unbounded peak, the undamped natural frequency.
     pub frequency: f64,
@@ -437,13 +439,15 @@ pub struct ResonancePeak {
     pub phase_deg: Option<f64>,
 }
 
-/// One entry `H_ij(ω)` of the frequency response over a list of frequencies, with its peaks.
-#[derive(Debug, Clone, PartialEq)]
+/// One entry `H_ij(ω)` of the frequency response over a list of frequencies, with its peaks
+/// (serialised with each `H` as `{"re", "im"}` or `null`).
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct FrequencySweep {
     /// The frequencies (rad/s), as given.
     pub frequencies: Vec<f64>,
     /// `H(ω)` at each; `None` where `K − ω²M + iωC` is singular (an undamped resonance hit
     /// exactly).
+    #[serde(serialize_with = "crate::vibration::serde_matrix::option_complex_list")]
     pub response: Vec<Option<Complex<f64>>>,
     /// `arg H` in degrees, unwrapped along the sweep so that it is continuous where the
     /// response is (starts in `[−180, 180)`; `None` where `response` is).
@@ -724,18 +728,22 @@ fn golden_section_max(f: impl Fn(f64) -> f64, mut a: f64, mut b: f64) -> f64 {
     if f1 >= f2 { x1 } else { x2 }
 }
 
-/// The steady-state response assembled mode by mode at one frequency (modal forcing).
-#[derive(Debug, Clone, PartialEq)]
+/// The steady-state response assembled mode by mode at one frequency (modal forcing;
+/// serialised with complex numbers as `{"re", "im"}`, matrices as lists of rows).
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct ModalResponse {
     /// The frequency (rad/s).
     pub frequency: f64,
     /// The modal forces `ψ_kᵀ b` per unit input, one per mode.
     pub modal_forces: Vec<f64>,
     /// The modal coordinates `η_k = ψ_kᵀ b / (ω_k² − ω² + iω Ĉ_kk)` per unit input (complex).
+    #[serde(serialize_with = "crate::vibration::serde_matrix::complex_list")]
     pub modal_coordinates: Vec<Complex<f64>>,
     /// `n × k` (complex): column `k` is mode `k`'s contribution `ψ_k η_k` to the coordinates.
+    #[serde(serialize_with = "crate::vibration::serde_matrix::complex_rows")]
     pub contributions: DMatrix<Complex<f64>>,
     /// `Σ_k ψ_k η_k` (length `n`, complex): the response per unit input.
+    #[serde(serialize_with = "crate::vibration::serde_matrix::complex_vector")]
     pub response: DVector<Complex<f64>>,
 }
 
@@ -887,8 +895,9 @@ impl Default for SteadyStateOptions {
     }
 }
 
-/// The steady-state response measured by simulation.
-#[derive(Debug, Clone, PartialEq)]
+/// The steady-state response measured by simulation (complex amplitudes serialised as
+/// `{"re", "im"}`).
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct SteadyState {
     /// The forcing frequency (rad/s).
     pub frequency: f64,
@@ -899,6 +908,7 @@ pub struct SteadyState {
     /// The complex amplitudes `Xᵢ` of the coordinates at the forcing frequency, one per
     /// coordinate: `qᵢ(t) ≈ q̄ᵢ + Re(Xᵢ e^{iωt})` (m or rad). `Xᵢ / amplitude` estimates
     /// `Hᵢ(ω)`.
+    #[serde(serialize_with = "crate::vibration::serde_matrix::complex_list")]
     pub complex_amplitudes: Vec<Complex<f64>>,
     /// The means `q̄ᵢ` over the window (m or rad).
     pub means: Vec<f64>,

@@ -16,6 +16,7 @@ pub mod modal;
 pub mod ode;
 pub mod response;
 pub mod system;
+pub mod vibration;
 
 pub use analysis::{Method, UnknownMethod};
 pub use constrained::{

@@ -116,7 +116,7 @@ pub enum NewtonStop {
 
 /// An equilibrium `F(q*, 0, t) = 0` (with constraints: `F(q*, 0, t) = Jᵀλ*`, `Φ(q*, t) = 0`)
 /// found by Newton's method.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct Equilibrium {
     /// The coordinates `q*` (length `n`).
     pub q: Vec<f64>,
@@ -373,7 +373,9 @@ fn check_point(model: &dyn ModelInfo, q: &[f64]) -> Result<(), ModalError> {
 /// `r × r`: `Nᵀ M N`, `Nᵀ C N` and `Nᵀ (∂(M q̈*)/∂q − ∂F/∂q + Σᵢ λᵢ ∇²Φᵢ) N` — the last term
 /// is the stiffness of the constraint forces (a rod's tension makes the Cartesian pendulum
 /// swing).
-#[derive(Debug, Clone, PartialEq)]
+///
+/// Serialised with each matrix as a list of rows.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct Linearization {
     /// The operating point's coordinates `q*` (length `n`).
     pub q: Vec<f64>,
@@ -383,13 +385,17 @@ pub struct Linearization {
     pub t: f64,
     /// `mass_matrix` `M(q*)` (`r × r`, `r = n` without constraints), symmetric positive
     /// definite.
+    #[serde(serialize_with = "crate::vibration::serde_matrix::rows")]
     pub mass_matrix: DMatrix<f64>,
     /// `stiffness_matrix` `K`, `r × r`, as derived (not symmetrised).
+    #[serde(serialize_with = "crate::vibration::serde_matrix::rows")]
     pub stiffness_matrix: DMatrix<f64>,
     /// `damping_matrix` `C = −∂F/∂q̇` (`r × r`; velocity-dependent gyroscopic terms make it
     /// non-symmetric).
+    #[serde(serialize_with = "crate::vibration::serde_matrix::rows")]
     pub damping_matrix: DMatrix<f64>,
     /// `N` (`n × r`): `δq = N z`; the identity without constraints.
+    #[serde(serialize_with = "crate::vibration::serde_matrix::rows")]
     pub coordinate_basis: DMatrix<f64>,
     /// Indices (into `q`, ascending) of the `r` coordinates whose increments are `z`.
     pub independent_coordinates: Vec<usize>,
@@ -664,8 +670,10 @@ fn null_space_by_partitioning(j: &DMatrix<f64>) -> (DMatrix<f64>, Vec<usize>) {
     (basis, independent)
 }
 
-/// What a mode is.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// What a mode is; serialised as `{"kind": "oscillatory"}`, `{"kind": "zero_frequency"}` or
+/// `{"kind": "unstable", "growth_rate": σ}`.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
 pub enum ModeKind {
     /// `ω² > 0`: an oscillation at `ω` rad/s.
     Oscillatory,
@@ -678,8 +686,9 @@ pub enum ModeKind {
     },
 }
 
-/// The undamped normal modes `K ψ = ω² M ψ` at an operating point.
-#[derive(Debug, Clone, PartialEq)]
+/// The undamped normal modes `K ψ = ω² M ψ` at an operating point (serialised with the mode
+/// shapes as a list of rows).
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct NormalModes {
     /// The eigenvalues `ω²` (1/s²), ascending; zero-frequency ones are set to 0.
     pub eigenvalues: Vec<f64>,
@@ -691,6 +700,7 @@ pub struct NormalModes {
     /// `mode_shapes`, `r × r` in the linearisation's coordinates ([`Linearization::to_coordinates`] gives
     /// them in `q`), column `k` the shape of mode `k`, mass-normalised:
     /// `ΨᵀMΨ = I`; sign fixed so that the largest-magnitude entry is positive.
+    #[serde(serialize_with = "crate::vibration::serde_matrix::rows")]
     pub mode_shapes: DMatrix<f64>,
     /// `‖K − Kᵀ‖_max / ‖K‖_max` before symmetrisation.
     pub stiffness_asymmetry: f64,

@@ -139,7 +139,7 @@ pub enum ResponseError {
 }
 
 /// A free response sampled at given times.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct FreeResponse {
     /// The sample times (s), as asked for.
     pub times: Vec<f64>,
@@ -867,7 +867,7 @@ pub fn response_with_modal_damping(
 
 /// Rayleigh (proportional) damping `C = αM + βK` (HW34 (c) i; Inman §4.5): in modal
 /// coordinates `Ĉ = α I + β Λ` is diagonal and `ζ_k = α/(2ω_k) + β ω_k/2`.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct RayleighDamping {
     /// The mass-proportional coefficient `α` (1/s).
     pub alpha: f64,
@@ -929,9 +929,11 @@ impl RayleighDamping {
 }
 
 /// The damping matrix in modal coordinates and the modal-damping approximation (HW34 (c) ii).
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct ModalDamping {
-    /// `Ĉ = ΨᵀCΨ` (`n × n`, 1/s; the same as `Pᵀ M^{-1/2} C M^{-1/2} P` with orthonormal `P`).
+    /// `Ĉ = ΨᵀCΨ` (`n × n`, 1/s; the same as `Pᵀ M^{-1/2} C M^{-1/2} P` with orthonormal `P`),
+    /// serialised as a list of rows.
+    #[serde(serialize_with = "crate::vibration::serde_matrix::rows")]
     pub modal_damping_matrix: DMatrix<f64>,
     /// The approximation's `damping_ratios` `ζ_k = Ĉ_kk/(2ω_k)` of the oscillatory modes
     /// (`None` for zero-frequency and unstable modes, where `ζ` is not defined).
@@ -996,9 +998,10 @@ pub fn modal_damping(lin: &Linearization, modes: &NormalModes) -> ModalDamping {
 }
 
 /// A mode's exact complex eigenvalue `s` of the state matrix (one of the pair `s`, `s̄`).
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct DampedMode {
-    /// The eigenvalue `s` with `Im s > 0` (1/s).
+    /// The eigenvalue `s` with `Im s > 0` (1/s), serialised as `{"re", "im"}`.
+    #[serde(serialize_with = "crate::vibration::serde_matrix::complex")]
     pub eigenvalue: Complex<f64>,
     /// `ζ = −Re s/|s|`.
     pub damping_ratio: f64,

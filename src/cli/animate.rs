@@ -20,7 +20,7 @@ use nalgebra::DMatrix;
 use plotters::prelude::*;
 
 use super::mode_plot::{self, Frame, Layout};
-use super::report_html::escape;
+use super::render::escape;
 use super::simulate::{IntegrationArgs, Run, failure_error, integrate};
 use super::{CliError, plot};
 
@@ -100,7 +100,7 @@ pub fn run(args: &AnimateArgs) -> Result<(), CliError> {
 }
 
 fn write(path: &str, text: &str) -> Result<(), CliError> {
-    std::fs::write(path, text).map_err(|e| CliError::failure(format!("cannot write `{path}`: {e}")))
+    super::render::write_file(path, text).map_err(CliError::failure)
 }
 
 /// What every frame draws: the points used, the segments between them, the points marked
@@ -379,10 +379,12 @@ pub(crate) fn simulation(
     } else {
         " (not conserved: non-conservative loads or explicit time dependence)"
     };
+    // "Over the frames": the drift sampled at the frame times, which can be smaller than
+    // `eomgen simulate`'s, taken over every step.
     // A minus sign, not a hyphen, in the exponent: no line break inside the number.
     let max_drift = format!("{max_drift:.2e}").replace('-', "−");
     let info = format!(
-        "{method}; {} frames at {} fps of simulated time, t = 0 … {} s; E(0) = {} J, max |E − E₀| / max(T + |V|) = {max_drift}{conserved}{}",
+        "{method}; {} frames at {} fps of simulated time, t = 0 … {} s; E(0) = {} J, max |E − E₀| / max(T + |V|) over the frames = {max_drift}{conserved}{}",
         t.len(),
         short(fps),
         short(t[t.len() - 1]),
@@ -854,14 +856,10 @@ const DATA = {data};
             .round()
             .clamp(2.0, 6000.0) as u16;
         let palette = Palette::new();
-        let file = std::fs::File::create(path).map_err(|e| fail(e.to_string()))?;
-        let mut encoder = gif::Encoder::new(
-            std::io::BufWriter::new(file),
-            width as u16,
-            height as u16,
-            &palette.rgb,
-        )
-        .map_err(|e| fail(e.to_string()))?;
+        // Encoded in memory (at most GIF_MAX_FRAMES frames of a small picture) and written
+        // atomically.
+        let mut encoder = gif::Encoder::new(Vec::new(), width as u16, height as u16, &palette.rgb)
+            .map_err(|e| fail(e.to_string()))?;
         encoder
             .set_repeat(gif::Repeat::Infinite)
             .map_err(|e| fail(e.to_string()))?;
@@ -949,8 +947,8 @@ const DATA = {data};
             previous = indices;
             k += step;
         }
-        encoder.into_inner().map_err(|e| fail(e.to_string()))?;
-        Ok(())
+        let bytes = encoder.into_inner().map_err(|e| fail(e.to_string()))?;
+        super::render::write_file(path, bytes).map_err(CliError::failure)
     }
 }
 

@@ -53,7 +53,7 @@ pub fn read_model(model: &str) -> Result<(String, String), CliError> {
         ),
     };
     let source = std::fs::read_to_string(&path)
-        .map_err(|e| CliError::usage(format!("cannot read `{display}`: {e}")))?;
+        .map_err(|e| CliError::usage(format!("cannot read `{display}`: {e}")).before_output())?;
     Ok((display, source))
 }
 
@@ -109,16 +109,8 @@ pub fn run(args: &EquationsArgs) -> Result<(), CliError> {
 
 /// Runs `new`.
 pub fn new(args: &NewArgs) -> Result<(), CliError> {
-    match templates::generate(&args.template, args.n) {
-        Some(text) => {
-            print!("{text}");
-            Ok(())
-        }
-        None if args.n == 0 => Err(CliError::usage("N must be at least 1")),
-        None => Err(CliError::usage(format!(
-            "unknown template `{}`; templates are: {}",
-            args.template,
-            templates::TEMPLATES.join(", ")
-        ))),
-    }
+    let text =
+        templates::generate(&args.template, args.n).map_err(|e| CliError::usage(e.to_string()))?;
+    print!("{text}");
+    Ok(())
 }

@@ -2,33 +2,28 @@
 //! equilibrium, and its stability chart over two parameters (issue 7, item 7; lectures 19 and
 //! 21, the Mathieu inverted pendulum).
 //!
-//! The period is `T = 2π/w` with `w` the value of `--period-parameter`; the operating point
-//! is the model's named equilibrium (Newton at `t = 0`), which must stay an equilibrium for
-//! every `t` of the period (`F(q*, 0, t) = 0`, checked at 65 times). The monodromy matrix
-//! comes from the variational equations with the generated Jacobians
-//! ([`eomgen::floquet_analysis`]). `--sweep a=LO..HI:N,w=LO..HI:N` repeats the analysis on a
-//! grid, in parallel (rayon), and charts stable against unstable cells, coloured by the
-//! spectral radius. For a pendulum model (parameters `g`, `l`, `a`, `w`, pivot moving as
-//! `a cos(w t)`, like `mathieu_pendulum`) swept over `a` and `w`, the reference curves are
-//! drawn on it: at the equilibrium named `upright`, Kapitza's boundary `a w = √(2 g l)` and the
-//! series edges `a₀(q)`, `b₁(q)` of the Mathieu chart (Abramowitz & Stegun 20.2.25,
-//! `q = 2a/l`, `δ = −4g/(l w²)`); at `hanging`, the edges `b₁(q)`, `a₁(q)` of the first
-//! parametric-resonance tongue (`δ = 4g/(l w²)`).
+//! The numbers come from [`eomgen::vibration::floquet_at_equilibrium`] and, for
+//! `--sweep a=LO..HI:N,w=LO..HI:N`, [`eomgen::vibration::floquet_cell`] on every point of the
+//! grid, run here in parallel (rayon); the chart shows stable against unstable cells,
+//! coloured by the spectral radius. What the model file's `floquet:` block gives at the
+//! operating point ([`eomgen::FloquetReferences`]) is drawn and printed with it: for
+//! `mathieu_pendulum`, Kapitza's boundary and the series edges of the Mathieu chart.
 
 use std::f64::consts::TAU;
 use std::io::Write as _;
 
 use clap::Args;
+use eomgen::vibration::{self, FloquetPoint, FloquetStudyError, FloquetStudyOptions, SweepAxis};
 use eomgen::{
-    FloquetAnalysis, FloquetOptions, FloquetStability, ModelInfo, check_periodic_equilibrium,
-    find_equilibrium, floquet_analysis,
+    ChartAxis, FloquetAnalysis, FloquetOptions, FloquetReferences, FloquetStability, ModelInfo,
+    ThresholdPrediction,
 };
 use plotters::prelude::*;
 use rayon::prelude::*;
 use serde_json::{Value, json};
 
 use super::CliError;
-use super::modes::OperatingPointArgs;
+use super::modes::{OperatingPointArgs, point_json};
 use super::plot::{register_font, tick};
 use super::values::{evaluate, parameter_lookup, set_parameters, split_assignment};
 
@@ -62,63 +57,61 @@ pub struct FloquetArgs {
     pub plot: Option<String>,
 }
 
-/// One swept parameter: `name=LO..HI:N`.
-#[derive(Debug, Clone)]
-struct Axis {
-    name: String,
-    values: Vec<f64>,
-}
-
-/// The analysis at one parameter set: the equilibrium and its Floquet multipliers.
-struct Point {
-    q: Vec<f64>,
-    frequency: f64,
-    residual: f64,
-    floquet: FloquetAnalysis,
+/// The text of a failed analysis (a point or a cell) of `model`: a failed equilibrium search
+/// gets its hint.
+fn analysis_text(model: &dyn ModelInfo, e: &FloquetStudyError) -> String {
+    match e {
+        FloquetStudyError::Equilibrium(m) => {
+            format!("{m}\nhelp: {}", super::modes::modal_hint(model, m))
+        }
+        e => e.to_string(),
+    }
 }
 
 /// Runs `study floquet`.
 pub fn run(args: &FloquetArgs) -> Result<(), CliError> {
     let mut model = args.point.model(&args.model)?;
-    if !model
-        .parameter_names()
-        .contains(&args.period_parameter.as_str())
-    {
-        return Err(CliError::usage(format!(
-            "--period-parameter {}: `{}` has no parameter `{}` (it has: {}); name the forcing frequency w (rad/s), T = 2π/w",
-            args.period_parameter,
-            model.name(),
-            args.period_parameter,
-            model.parameter_names().join(", ")
-        )));
-    }
-    let valid_tol = args.tol.is_finite() && args.tol > 0.0;
-    let valid_stability_tolerance =
-        args.stability_tolerance.is_finite() && args.stability_tolerance >= 0.0;
-    if !(valid_tol && valid_stability_tolerance) {
-        return Err(CliError::usage(
-            "--tol must be positive and --stability-tolerance finite and >= 0",
-        ));
-    }
-    let (label, guess) = args.point.guess(model.as_ref())?;
-    let options = FloquetOptions {
-        rtol: args.tol,
-        atol: args.tol,
-        stability_tolerance: args.stability_tolerance,
-        ..FloquetOptions::default()
+    let options = FloquetStudyOptions {
+        operating_point: args.point.options(model.as_ref())?,
+        period_parameter: args.period_parameter.clone(),
+        floquet: FloquetOptions {
+            rtol: args.tol,
+            atol: args.tol,
+            stability_tolerance: args.stability_tolerance,
+            ..FloquetOptions::default()
+        },
     };
+    let (label, guess) = args.point.guess(model.as_ref())?;
     let axes = args
         .sweep
         .as_deref()
         .map(|s| parse_sweep(s, model.as_ref()))
         .transpose()?;
-    let point = analyse(model.as_mut(), &guess, &args.period_parameter, &options)
-        .map_err(|e| CliError::failure(format!("`{}` at {label}: {e}", model.name())))?;
+    let point =
+        vibration::floquet_at_equilibrium(model.as_mut(), &options).map_err(|e| match e {
+            FloquetStudyError::UnknownPeriodParameter { ref name, .. } => CliError::usage(format!(
+                "--period-parameter {name}: {e}; name the forcing frequency w (rad/s), T = 2π/w"
+            )),
+            FloquetStudyError::InvalidTolerance { .. } => {
+                CliError::usage("--tol must be positive and --stability-tolerance finite and >= 0")
+            }
+            FloquetStudyError::OperatingPoint(e) => super::modes::point_failure(model.as_ref(), &e),
+            e => CliError::failure(format!(
+                "`{}` at {label}: {}",
+                model.name(),
+                analysis_text(model.as_ref(), &e)
+            )),
+        })?;
     let sweep = match &axes {
         Some((x, y)) => Some(run_sweep(args, &guess, x, y, &options)?),
         None => None,
     };
-    let reference = kapitza(model.as_ref(), &label);
+    let references = FloquetReferences::of(&super::open_model(&args.model)?, &label)
+        .map_err(|e| CliError::failure(e.to_string()))?;
+    let thresholds = references
+        .as_ref()
+        .map(|r| r.thresholds(model.as_ref()))
+        .unwrap_or_default();
 
     if let Some(path) = &args.plot {
         match (&axes, &sweep) {
@@ -130,10 +123,11 @@ pub fn run(args: &FloquetArgs) -> Result<(), CliError> {
                     y.name
                 );
                 let labels = [
-                    axis_label(&x.name, &args.period_parameter, reference.is_some()),
-                    axis_label(&y.name, &args.period_parameter, reference.is_some()),
+                    axis_label(&x.name, &args.period_parameter, references.as_ref()),
+                    axis_label(&y.name, &args.period_parameter, references.as_ref()),
                 ];
-                stability_chart(path, &title, [x, y], &labels, grid, reference.as_ref())
+                let curves = references.as_ref().map(|r| (r, model.as_ref()));
+                stability_chart(path, &title, [x, y], &labels, grid, curves)
             }
             _ => {
                 let title = format!("{} at {label}: Floquet multipliers", model.name());
@@ -143,50 +137,89 @@ pub fn run(args: &FloquetArgs) -> Result<(), CliError> {
         .map_err(CliError::failure)?;
     }
 
-    let names = model.coordinate_names();
+    let report = Report {
+        args,
+        model: model.as_ref(),
+        label: &label,
+        point: &point,
+        thresholds: &thresholds,
+        sweep: match (&axes, &sweep) {
+            (Some((x, y)), Some(grid)) => Some((x, y, grid.as_slice())),
+            _ => None,
+        },
+    };
     let mut stdout = std::io::stdout().lock();
     if args.json {
-        let complex =
-            |c: &nalgebra::Complex<f64>| json!({"re": c.re, "im": c.im, "modulus": c.norm()});
-        let f = &point.floquet;
-        let monodromy = super::modes::matrix_rows(&f.monodromy_matrix);
-        let mut out = json!({
-            "model": model.name(),
-            "coordinates": names,
-            "operating_point": {
-                "name": label,
-                "q": names.iter().zip(&point.q).map(|(c, v)| (c.to_string(), json!(v))).collect::<serde_json::Map<_, _>>(),
-                "max_forcing_residual": point.residual,
-            },
-            "period_parameter": args.period_parameter,
-            "frequency": point.frequency,
-            "period": f.period,
-            "monodromy_matrix": monodromy,
-            "multipliers": f.multipliers.iter().map(complex).collect::<Vec<_>>(),
-            "exponents": f.exponents.iter().map(|c| json!({"re": c.re, "im": c.im})).collect::<Vec<_>>(),
-            "spectral_radius": f.spectral_radius,
-            "determinant": f.determinant,
-            "stability": f.stability.as_str(),
-            "stable": f.stability.is_stable(),
-            "stability_tolerance": args.stability_tolerance,
-            "closure_error": f.closure_error,
-            "integration": {"method": "dop853", "tol": args.tol, "steps": f.stats.steps, "rhs_evals": f.stats.rhs_evals},
-        });
-        if let Some(k) = reference.as_ref().filter(|k| !k.hanging) {
-            out["kapitza"] = json!({
-                "a_w": k.a * k.w,
-                "critical_a_w": k.critical_a_w(),
-                "predicts_stable_upright": k.a * k.w > k.critical_a_w(),
-            });
-        }
-        if let (Some((x, y)), Some(grid)) = (&axes, &sweep) {
-            out["sweep"] = sweep_json(x, y, grid);
-        }
-        let text =
-            serde_json::to_string_pretty(&out).map_err(|e| CliError::failure(e.to_string()))?;
+        let text = serde_json::to_string_pretty(&json_report(&report))
+            .map_err(|e| CliError::failure(e.to_string()))?;
         let _ = writeln!(stdout, "{text}");
         return Ok(());
     }
+    print_report(&mut stdout, &report);
+    Ok(())
+}
+
+/// What `study floquet` prints.
+struct Report<'a> {
+    args: &'a FloquetArgs,
+    model: &'a dyn ModelInfo,
+    label: &'a str,
+    point: &'a FloquetPoint,
+    thresholds: &'a [ThresholdPrediction],
+    sweep: Option<(&'a Axis, &'a Axis, &'a [Vec<Cell>])>,
+}
+
+/// The JSON of `report`.
+fn json_report(report: &Report<'_>) -> Value {
+    let (args, model, label, point) = (report.args, report.model, report.label, report.point);
+    let names = model.coordinate_names();
+    let complex = |c: &nalgebra::Complex<f64>| json!({"re": c.re, "im": c.im, "modulus": c.norm()});
+    let f = &point.floquet;
+    let monodromy = super::modes::matrix_rows(&f.monodromy_matrix);
+    let mut operating_point = point_json(label, &names, &point.q);
+    operating_point["max_forcing_residual"] = json!(point.residual);
+    let mut out = json!({
+        "model": model.name(),
+        "coordinates": names,
+        "operating_point": operating_point,
+        "period_parameter": args.period_parameter,
+        "frequency": point.frequency,
+        "period": f.period,
+        "monodromy_matrix": monodromy,
+        "multipliers": f.multipliers.iter().map(complex).collect::<Vec<_>>(),
+        "exponents": f.exponents.iter().map(|c| json!({"re": c.re, "im": c.im})).collect::<Vec<_>>(),
+        "spectral_radius": f.spectral_radius,
+        "determinant": f.determinant,
+        "stability": f.stability.as_str(),
+        "stable": f.stability.is_stable(),
+        "stability_tolerance": args.stability_tolerance,
+        "closure_error": f.closure_error,
+        "integration": {"method": "dop853", "tol": args.tol, "steps": f.stats.steps, "rhs_evals": f.stats.rhs_evals},
+    });
+    for t in report.thresholds {
+        let mut prediction = serde_json::Map::new();
+        prediction.insert(t.key.clone(), json!(t.value));
+        prediction.insert(format!("critical_{}", t.key), json!(t.critical));
+        prediction.insert(format!("predicts_stable_{label}"), json!(t.predicts_stable));
+        out[t.name.as_str()] = Value::Object(prediction);
+    }
+    if let Some((x, y, grid)) = report.sweep {
+        out["sweep"] = sweep_json(x, y, grid);
+    }
+    out
+}
+
+/// The text of `report`.
+fn print_report(stdout: &mut impl std::io::Write, report: &Report<'_>) {
+    let Report {
+        args,
+        model,
+        label,
+        point,
+        thresholds,
+        sweep,
+    } = *report;
+    let names = model.coordinate_names();
     let f = &point.floquet;
     let q: Vec<String> = names
         .iter()
@@ -241,68 +274,34 @@ pub fn run(args: &FloquetArgs) -> Result<(), CliError> {
         f.stability.as_str().replace('_', " "),
         args.stability_tolerance
     );
-    if let Some(k) = reference.as_ref().filter(|k| !k.hanging) {
+    for t in thresholds {
         let _ = writeln!(
             stdout,
-            "kapitza      a w = {:.6e} against √(2 g l) = {:.6e}: averaging predicts upright {} (for a ≪ l)",
-            k.a * k.w,
-            k.critical_a_w(),
-            if k.a * k.w > k.critical_a_w() {
+            "{:<12} {} = {:.6e} against {} = {:.6e}: {} predicts {label} {} ({})",
+            t.name,
+            t.label,
+            t.value,
+            t.critical_label,
+            t.critical,
+            t.by,
+            if t.predicts_stable {
                 "stable"
             } else {
                 "unstable"
-            }
+            },
+            t.note
         );
     }
-    if let (Some((x, y)), Some(grid)) = (&axes, &sweep) {
-        print_map(&mut stdout, x, y, grid);
+    if let Some((x, y, grid)) = sweep {
+        print_map(stdout, x, y, grid);
     }
-    Ok(())
-}
-
-/// Equilibrium at `t = 0` from `guess`, the check that it stays one over the period, and the
-/// Floquet analysis there.
-fn analyse(
-    model: &mut dyn ModelInfo,
-    guess: &[f64],
-    period_parameter: &str,
-    options: &FloquetOptions,
-) -> Result<Point, String> {
-    let index = model
-        .parameter_names()
-        .iter()
-        .position(|p| *p == period_parameter)
-        .ok_or_else(|| format!("no parameter `{period_parameter}`"))?;
-    let frequency = model.parameter_values()[index];
-    if !(frequency.is_finite() && frequency > 0.0) {
-        return Err(format!(
-            "the forcing frequency {period_parameter} = {frequency} must be positive (T = 2π/{period_parameter})"
-        ));
-    }
-    let period = TAU / frequency;
-    let equilibrium = find_equilibrium(model, guess, 0.0)
-        .map_err(|e| format!("{e}\nhelp: {}", super::modes::modal_hint(model, &e)))?;
-    let residual = check_periodic_equilibrium(model, &equilibrium.q, 0.0, period)
-        .map_err(|e| e.to_string())?;
-    let n = model.num_dofs();
-    let y0: Vec<f64> = equilibrium
-        .q
-        .iter()
-        .copied()
-        .chain(std::iter::repeat_n(0.0, n))
-        .collect();
-    let floquet = floquet_analysis(model.as_ode_mut(), &y0, 0.0, period, options)
-        .map_err(|e| e.to_string())?;
-    Ok(Point {
-        q: equilibrium.q,
-        frequency,
-        residual,
-        floquet,
-    })
 }
 
 /// One grid cell's outcome: `(spectral radius, stability)` or the failure.
 type Cell = Result<(f64, FloquetStability), String>;
+
+/// One swept parameter.
+type Axis = SweepAxis;
 
 /// The analyses on the grid `x × y`, in parallel; `cells[i][j]` at `(x[i], y[j])`.
 fn run_sweep(
@@ -310,7 +309,7 @@ fn run_sweep(
     guess: &[f64],
     x: &Axis,
     y: &Axis,
-    options: &FloquetOptions,
+    options: &FloquetStudyOptions,
 ) -> Result<Vec<Vec<Cell>>, CliError> {
     let source = super::open_model(&args.model)?;
     let total = x.values.len() * y.values.len();
@@ -328,13 +327,13 @@ fn run_sweep(
             let mut model = source.instantiate();
             let cell = (|| {
                 set_parameters(model.as_mut(), &args.point.set).map_err(|e| e.message)?;
-                for (axis, value) in [(x, x.values[i]), (y, y.values[j])] {
-                    model
-                        .set_parameter(&axis.name, value)
-                        .map_err(|e| e.to_string())?;
-                }
-                let p = analyse(model.as_mut(), guess, &args.period_parameter, options)?;
-                Ok((p.floquet.spectral_radius, p.floquet.stability))
+                let values = [
+                    (x.name.as_str(), x.values[i]),
+                    (y.name.as_str(), y.values[j]),
+                ];
+                vibration::floquet_cell(model.as_mut(), guess, &values, options)
+                    .map(|c| (c.spectral_radius, c.stability))
+                    .map_err(|e| analysis_text(model.as_ref(), &e))
             })();
             bar.inc(1);
             cell
@@ -387,6 +386,9 @@ fn sweep_json(x: &Axis, y: &Axis, grid: &[Vec<Cell>]) -> Value {
     })
 }
 
+/// The widest sweep whose map is printed as text, one character per point.
+const MAP_COLUMNS: usize = 120;
+
 /// The sweep as characters, y descending: `·` stable, `#` unstable, `?` failed.
 fn print_map(out: &mut impl std::io::Write, x: &Axis, y: &Axis, grid: &[Vec<Cell>]) {
     let stable = grid
@@ -395,17 +397,20 @@ fn print_map(out: &mut impl std::io::Write, x: &Axis, y: &Axis, grid: &[Vec<Cell
         .filter(|c| matches!(c, Ok((_, s)) if s.is_stable()))
         .count();
     let failed = grid.iter().flatten().filter(|c| c.is_err()).count();
-    let _ = writeln!(
-        out,
-        "sweep        {} × {} points: {stable} stable, {failed} failed ('·' stable, '#' unstable, '?' failed; {} across, {} up)",
-        x.values.len(),
-        y.values.len(),
-        x.name,
-        y.name
-    );
-    if x.values.len() > 120 {
+    let (columns, rows) = (x.values.len(), y.values.len());
+    if columns > MAP_COLUMNS {
+        // Too wide for a terminal: the counts only (the chart of `--plot` has the map).
+        let _ = writeln!(
+            out,
+            "sweep        {columns} × {rows} points: {stable} stable, {failed} failed (the map is printed for at most {MAP_COLUMNS} points across)"
+        );
         return;
     }
+    let _ = writeln!(
+        out,
+        "sweep        {columns} × {rows} points: {stable} stable, {failed} failed ('·' stable, '#' unstable, '?' failed; {} across, {} up)",
+        x.name, y.name
+    );
     for j in (0..y.values.len()).rev() {
         let row: String = grid
             .iter()
@@ -450,22 +455,12 @@ fn parse_sweep(spec: &str, model: &dyn ModelInfo) -> Result<(Axis, Axis), CliErr
         let lo = evaluate(lo.trim(), &format!("--sweep {name}"), &lookup)?;
         let hi = evaluate(hi.trim(), &format!("--sweep {name}"), &lookup)?;
         let count: usize = count.trim().parse().map_err(|_| bad())?;
-        if !(1..=10_000).contains(&count) || (count > 1 && hi <= lo) {
-            return Err(CliError::usage(format!(
+        let axis = SweepAxis::linear(name, lo, hi, count).map_err(|_| {
+            CliError::usage(format!(
                 "--sweep {name}: need 1 ≤ N ≤ 10000 values and LO < HI, got `{rest}`"
-            )));
-        }
-        let values = if count == 1 {
-            vec![lo]
-        } else {
-            (0..count)
-                .map(|k| lo + (hi - lo) * k as f64 / (count - 1) as f64)
-                .collect()
-        };
-        axes.push(Axis {
-            name: name.to_string(),
-            values,
-        });
+            ))
+        })?;
+        axes.push(axis);
     }
     match <[Axis; 2]>::try_from(axes) {
         Ok([x, y]) if x.name != y.name => Ok((x, y)),
@@ -473,60 +468,6 @@ fn parse_sweep(spec: &str, model: &dyn ModelInfo) -> Result<(Axis, Axis), CliErr
             "--sweep takes two different parameters, `X=LO..HI:N,Y=LO..HI:N` (for example `a=0..0.3:31,w=10..100:31`)",
         )),
     }
-}
-
-/// The reference results for a pendulum of length `l` under gravity `g` whose pivot moves as
-/// `a cos(w t)` (the parameters `g`, `l`, `a`, `w` of the model), at the equilibrium named
-/// `upright` (Kapitza's averaging, the band `a₀(q) < δ < b₁(q)` of the Mathieu chart with
-/// `δ = −4g/(l w²)`) or `hanging` (the first parametric-resonance tongue
-/// `b₁(q) < δ < a₁(q)` with `δ = 4g/(l w²)`); `q = 2a/l`.
-struct Kapitza {
-    g: f64,
-    l: f64,
-    a: f64,
-    w: f64,
-    hanging: bool,
-}
-
-impl Kapitza {
-    /// `√(2 g l)`: upright is stable for `a w` above it (a ≪ l).
-    fn critical_a_w(&self) -> f64 {
-        (2.0 * self.g * self.l).sqrt()
-    }
-}
-
-fn kapitza(model: &dyn ModelInfo, equilibrium: &str) -> Option<Kapitza> {
-    let hanging = match equilibrium {
-        "upright" => false,
-        "hanging" => true,
-        _ => return None,
-    };
-    let lookup = parameter_lookup(model);
-    let (g, l, a, w) = (lookup("g")?, lookup("l")?, lookup("a")?, lookup("w")?);
-    (g > 0.0 && l > 0.0).then_some(Kapitza {
-        g,
-        l,
-        a,
-        w,
-        hanging,
-    })
-}
-
-/// `a₀(q)` and `b₁(q)` of Mathieu's equation `y'' + (δ − 2q cos 2τ) y = 0` by their power
-/// series (Abramowitz & Stegun 20.2.25), the lower and upper edges of the stable band that
-/// contains the upright pendulum at small `q`.
-fn mathieu_a0(q: f64) -> f64 {
-    let q2 = q * q;
-    -q2 / 2.0 + 7.0 * q2 * q2 / 128.0 - 29.0 * q2 * q2 * q2 / 2304.0
-        + 68_687.0 * q2.powi(4) / 18_874_368.0
-}
-
-fn mathieu_a1(q: f64) -> f64 {
-    1.0 + q - q * q / 8.0 - q.powi(3) / 64.0 - q.powi(4) / 1536.0 + 11.0 * q.powi(5) / 36_864.0
-}
-
-fn mathieu_b1(q: f64) -> f64 {
-    1.0 - q - q * q / 8.0 + q.powi(3) / 64.0 - q.powi(4) / 1536.0 - 11.0 * q.powi(5) / 36_864.0
 }
 
 /// The stability chart: one rectangle per grid point, stable cells blue (lighter for
@@ -538,28 +479,36 @@ fn stability_chart(
     axes: [&Axis; 2],
     labels: &[String; 2],
     grid: &[Vec<Cell>],
-    reference: Option<&Kapitza>,
+    references: Option<(&FloquetReferences, &dyn ModelInfo)>,
 ) -> Result<(), String> {
     register_font()?;
     let size = (960, 720);
     if path.ends_with(".svg") {
-        let root = SVGBackend::new(path, size).into_drawing_area();
-        draw_stability(root, title, axes, labels, grid, reference)
+        super::render::atomically(path, |file| {
+            let root = SVGBackend::new(file, size).into_drawing_area();
+            draw_stability(root, title, axes, labels, grid, references)
+        })
     } else if path.ends_with(".png") {
-        let root = BitMapBackend::new(path, size).into_drawing_area();
-        draw_stability(root, title, axes, labels, grid, reference)
+        super::render::atomically(path, |file| {
+            let root = BitMapBackend::new(file, size).into_drawing_area();
+            draw_stability(root, title, axes, labels, grid, references)
+        })
     } else {
         Err(format!("`{path}`: a chart file must end in .svg or .png"))
     }
 }
 
 /// An axis label with the unit where it is known: the period parameter is a frequency in
-/// rad/s; with Kapitza's reference (a pendulum model) `a`, `l` are lengths in m.
-fn axis_label(name: &str, period_parameter: &str, pendulum: bool) -> String {
+/// rad/s; the model file's `floquet:` references give others (`axis_units`).
+fn axis_label(
+    name: &str,
+    period_parameter: &str,
+    references: Option<&FloquetReferences>,
+) -> String {
     if name == period_parameter {
         format!("{name} (rad/s)")
-    } else if pendulum && (name == "a" || name == "l") {
-        format!("{name} (m)")
+    } else if let Some(unit) = references.and_then(|r| r.axis_unit(name)) {
+        format!("{name} ({unit})")
     } else {
         name.to_string()
     }
@@ -588,7 +537,7 @@ fn draw_stability<DB: DrawingBackend>(
     [x, y]: [&Axis; 2],
     labels: &[String; 2],
     grid: &[Vec<Cell>],
-    reference: Option<&Kapitza>,
+    references: Option<(&FloquetReferences, &dyn ModelInfo)>,
 ) -> Result<(), String>
 where
     DB::ErrorType: 'static,
@@ -682,16 +631,30 @@ where
         "analysis failed",
         RGBColor(160, 160, 160),
     )?;
-    if let Some(k) = reference {
-        let curves = reference_curves(k, x, y, (x0, x1), (y0, y1));
-        for (label, color, points) in curves {
-            if points.len() < 2 {
+    if let Some((references, model)) = references {
+        let curves = references.curves(
+            model,
+            ChartAxis {
+                name: &x.name,
+                lo: x0,
+                hi: x1,
+            },
+            ChartAxis {
+                name: &y.name,
+                lo: y0,
+                hi: y1,
+            },
+        );
+        for curve in curves {
+            if curve.points.len() < 2 {
                 continue;
             }
+            let [r, g, b] = curve.color;
+            let color = RGBColor(r, g, b);
             chart
-                .draw_series(LineSeries::new(points, color.stroke_width(3)))
+                .draw_series(LineSeries::new(curve.points, color.stroke_width(3)))
                 .map_err(err)?
-                .label(label)
+                .label(curve.label)
                 .legend(move |(px, py)| {
                     PathElement::new(vec![(px, py), (px + 16, py)], color.stroke_width(3))
                 });
@@ -709,92 +672,26 @@ where
     Ok(())
 }
 
-/// A labelled, coloured polyline of the chart.
-type Curve = (String, RGBColor, Vec<(f64, f64)>);
-
-/// Upright: Kapitza's boundary `a w = √(2 g l)` and the series edges `δ = a₀(q)`,
-/// `δ = b₁(q)` of the Mathieu chart (`q = 2a/l`, `δ = −4g/(l w²)`, so `w = √(−4g/(l δ))`
-/// where `δ < 0`); hanging: the edges `δ = b₁(q)`, `δ = a₁(q)` of the first resonance tongue
-/// (`δ = 4g/(l w²)`). Polylines in the chart's `(x, y)`, when the axes are `a` and `w` in
-/// either order.
-fn reference_curves(
-    k: &Kapitza,
-    x: &Axis,
-    y: &Axis,
-    (x0, x1): (f64, f64),
-    (y0, y1): (f64, f64),
-) -> Vec<Curve> {
-    let a_on_x = match (x.name.as_str(), y.name.as_str()) {
-        ("a", "w") => true,
-        ("w", "a") => false,
-        _ => return Vec::new(),
-    };
-    let (a_lo, a_hi) = if a_on_x { (x0, x1) } else { (y0, y1) };
-    let (w_lo, w_hi) = if a_on_x { (y0, y1) } else { (x0, x1) };
-    let inside = |a: f64, w: f64| a > 0.0 && a >= a_lo && a <= a_hi && w >= w_lo && w <= w_hi;
-    let place = |a: f64, w: f64| if a_on_x { (a, w) } else { (w, a) };
-    let samples = 4000;
-    let along = |f: &dyn Fn(f64) -> Option<f64>| -> Vec<(f64, f64)> {
-        (0..=samples)
-            .filter_map(|i| {
-                let a = a_lo.max(0.0) + (a_hi - a_lo.max(0.0)) * f64::from(i) / f64::from(samples);
-                let w = f(a)?;
-                (w.is_finite() && inside(a, w)).then(|| place(a, w))
-            })
-            .collect()
-    };
-    // w from δ = ∓4g/(l w²): upright needs δ < 0, hanging δ > 0.
-    let sign = if k.hanging { 1.0 } else { -1.0 };
-    let series_w =
-        |delta: f64| (sign * delta > 0.0).then(|| (sign * 4.0 * k.g / (k.l * delta)).sqrt());
-    let q_of = |a: f64| 2.0 * a / k.l;
-    if k.hanging {
-        return vec![
-            (
-                "δ = b₁(q), A&S 20.2.25 series (tongue edge)".to_string(),
-                RGBColor(150, 0, 150),
-                along(&|a| series_w(mathieu_b1(q_of(a)))),
-            ),
-            (
-                "δ = a₁(q), A&S 20.2.25 series (tongue edge)".to_string(),
-                RGBColor(0, 150, 60),
-                along(&|a| series_w(mathieu_a1(q_of(a)))),
-            ),
-        ];
-    }
-    vec![
-        (
-            "Kapitza a w = √(2 g l)".to_string(),
-            BLACK,
-            along(&|a| Some(k.critical_a_w() / a)),
-        ),
-        (
-            "δ = a₀(q), A&S 20.2.25 series (lower edge)".to_string(),
-            RGBColor(0, 150, 60),
-            along(&|a| series_w(mathieu_a0(q_of(a)))),
-        ),
-        (
-            "δ = b₁(q), A&S 20.2.25 series (upper edge)".to_string(),
-            RGBColor(150, 0, 150),
-            along(&|a| {
-                (q_of(a) <= 1.5)
-                    .then(|| series_w(mathieu_b1(q_of(a))))
-                    .flatten()
-            }),
-        ),
-    ]
-}
-
 /// The multipliers in the complex plane, with the unit circle.
 fn multiplier_chart(path: &str, title: &str, floquet: &FloquetAnalysis) -> Result<(), String> {
     register_font()?;
     let size = (720, 720);
     if path.ends_with(".svg") {
-        let root = SVGBackend::new(path, size).into_drawing_area();
-        draw_multipliers(root, title, floquet)
+        super::render::atomically(path, |file| {
+            draw_multipliers(
+                SVGBackend::new(file, size).into_drawing_area(),
+                title,
+                floquet,
+            )
+        })
     } else if path.ends_with(".png") {
-        let root = BitMapBackend::new(path, size).into_drawing_area();
-        draw_multipliers(root, title, floquet)
+        super::render::atomically(path, |file| {
+            draw_multipliers(
+                BitMapBackend::new(file, size).into_drawing_area(),
+                title,
+                floquet,
+            )
+        })
     } else {
         Err(format!("`{path}`: a chart file must end in .svg or .png"))
     }

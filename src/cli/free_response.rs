@@ -3,18 +3,23 @@
 //! DOP853 on the linear equations, `e^{At}`, superposed modes of `M⁻¹K` and superposed
 //! mass-normalised modes — their largest differences, and a chart of every coordinate.
 //!
-//! Also the pieces `study modal-damping` shares: the operating point and linearisation,
-//! `--init` parsing, the default time span and the stacked charts.
+//! The numbers come from [`eomgen::vibration::free_response`]; this module renders them. Also
+//! the pieces `study modal-damping` shares: `--init` parsing, the errors in the options' words
+//! and the stacked charts.
 
 use std::io::Write as _;
 
 use clap::Args;
-use eomgen::{FreeResponse, ModeKind, ModelInfo, NormalModes};
+use eomgen::vibration::{
+    self, FreeResponseMethod, FreeResponseOptions, FreeResponseStudy, InitialDeviation,
+    ResponseStudyError,
+};
+use eomgen::{ModeKind, ModelInfo};
 use plotters::prelude::*;
 use serde_json::json;
 
 use super::CliError;
-use super::modes::{OperatingPoint, OperatingPointArgs, operating_point_of};
+use super::modes::{OperatingPointArgs, point_json};
 use super::plot::{self, Series};
 use super::values::{evaluate, parameter_lookup, split_assignment};
 
@@ -48,27 +53,15 @@ pub struct FreeResponseArgs {
     pub plot: Option<String>,
 }
 
-/// The operating point of a study of the model's own coordinates: constrained models are
-/// refused (their linearisation is in minimal coordinates, `δq = N z`).
-pub(super) fn unconstrained_operating_point(
-    model_name: &str,
-    args: &OperatingPointArgs,
-) -> Result<OperatingPoint, CliError> {
-    let point = operating_point_of(model_name, args)?;
-    if point.lin.num_minimal_coordinates() != point.model.num_dofs() {
-        let name = point.model.name();
-        return Err(CliError::usage(format!(
-            "`{name}` has constraints; this study takes unconstrained models (`eomgen modes {name}` gives its modes in minimal coordinates)"
-        )));
-    }
-    Ok(point)
-}
-
-/// Parses `--init NAME=VALUE,…` into `(δq₀, δq̇₀)`, starting from zeros.
+/// Parses `--init NAME=VALUE,…` into `(δq₀, δq̇₀)`, starting from zeros (`None` without
+/// `--init`: the study's default).
 pub(super) fn parse_init(
     model: &dyn ModelInfo,
     init: &[String],
-) -> Result<(Vec<f64>, Vec<f64>), CliError> {
+) -> Result<Option<InitialDeviation>, CliError> {
+    if init.is_empty() {
+        return Ok(None);
+    }
     let n = model.num_dofs();
     let coordinates = model.coordinate_names();
     let lookup = parameter_lookup(model);
@@ -93,47 +86,32 @@ pub(super) fn parse_init(
             )));
         }
     }
-    Ok((q0, v0))
+    Ok(Some(InitialDeviation { q: q0, qdot: v0 }))
 }
 
-/// `samples` evenly spaced times on `[0, t_end]`, after checking both.
-pub(super) fn time_grid(t_end: f64, samples: usize) -> Result<Vec<f64>, CliError> {
-    if !(t_end.is_finite() && t_end > 0.0) {
-        return Err(CliError::usage(format!(
-            "--t-end must be positive and finite, got {t_end}"
-        )));
-    }
-    if samples < 2 {
-        return Err(CliError::usage("--samples must be at least 2"));
-    }
-    Ok((0..samples)
-        .map(|i| t_end * i as f64 / (samples - 1) as f64)
-        .collect())
-}
-
-/// `periods` periods of the slowest oscillatory mode, or the time the fastest unstable mode
-/// grows by `e^growth` if shorter; 10 s if neither exists.
-pub(super) fn default_t_end(modes: &NormalModes, periods: f64, growth: f64) -> f64 {
-    let mut slowest = 0.0f64;
-    let mut growth_time = f64::INFINITY;
-    for (k, kind) in modes.kinds.iter().enumerate() {
-        match kind {
-            ModeKind::Oscillatory => {
-                slowest =
-                    slowest.max(periods * std::f64::consts::TAU / modes.natural_frequencies[k]);
-            }
-            ModeKind::Unstable { growth_rate } => {
-                growth_time = growth_time.min(growth / growth_rate)
-            }
-            ModeKind::ZeroFrequency => {}
+/// The error of a failed free-response or modal-damping study of `model`, in the words of
+/// the options (`--tol`, `--t-end`, `--rayleigh-modes`); failed searches get their hint.
+pub(super) fn study_failure(model: &dyn ModelInfo, e: &ResponseStudyError) -> CliError {
+    match e {
+        ResponseStudyError::OperatingPoint(e) => super::modes::point_failure(model, e),
+        ResponseStudyError::Constrained { model: name } => CliError::usage(format!(
+            "`{name}` has constraints; this study takes unconstrained models (`eomgen modes {name}` gives its modes in minimal coordinates)"
+        )),
+        ResponseStudyError::InvalidTolerance { .. } => CliError::usage("--tol must be positive"),
+        ResponseStudyError::InvalidEndTime { t_end } => {
+            CliError::usage(format!("--t-end must be positive and finite, got {t_end}"))
         }
+        ResponseStudyError::TooFewSamples { .. } => CliError::usage("--samples must be at least 2"),
+        ResponseStudyError::NoSuchMode { .. } | ResponseStudyError::NotUnderdamped { .. } => {
+            CliError::usage(format!("--rayleigh-modes: {e}"))
+        }
+        ResponseStudyError::RayleighFit {
+            modes: [a, b],
+            source,
+        } => CliError::usage(format!("--rayleigh-modes {a},{b}: {source}")),
+        ResponseStudyError::Response(e) => response_failure(model, e),
+        e => CliError::failure(format!("`{}`: {e}", model.name())),
     }
-    let t = if slowest > 0.0 {
-        slowest.min(growth_time)
-    } else {
-        growth_time
-    };
-    if t.is_finite() && t > 0.0 { t } else { 10.0 }
 }
 
 /// The JSON description of a mode kind.
@@ -166,17 +144,21 @@ pub(super) fn panels(path: &str, title: &str, panels: &[Panel]) -> Result<(), St
     plot::register_font()?;
     let size = (960, 60 + 260 * panels.len().max(1) as u32);
     if path.ends_with(".svg") {
-        draw_panels(
-            SVGBackend::new(path, size).into_drawing_area(),
-            title,
-            panels,
-        )
+        super::render::atomically(path, |file| {
+            draw_panels(
+                SVGBackend::new(file, size).into_drawing_area(),
+                title,
+                panels,
+            )
+        })
     } else if path.ends_with(".png") {
-        draw_panels(
-            BitMapBackend::new(path, size).into_drawing_area(),
-            title,
-            panels,
-        )
+        super::render::atomically(path, |file| {
+            draw_panels(
+                BitMapBackend::new(file, size).into_drawing_area(),
+                title,
+                panels,
+            )
+        })
     } else {
         Err(format!("`{path}`: a chart file must end in .svg or .png"))
     }
@@ -267,78 +249,41 @@ where
     Ok(())
 }
 
-/// The four routes, in the order printed.
-const METHODS: [(&str, &str); 4] = [
-    (
-        "integration",
-        "DOP853 on δẏ = A δy (numerical, to the tolerance)",
-    ),
-    ("exponential", "e^{At} δy₀, Padé 13 (exact to rounding)"),
-    (
-        "m_inv_k_modes",
-        "superposed modes of M⁻¹K, P a = δq₀ solved (lecture 22)",
-    ),
-    (
-        "normal_modes",
-        "superposed mass-normalised modes, η₀ = ΨᵀM δq₀ (lecture 24)",
-    ),
-];
-
 /// Runs `study free-response`.
 pub fn run(args: &FreeResponseArgs) -> Result<(), CliError> {
-    let OperatingPoint {
-        model,
-        label,
-        mut lin,
-        modes,
+    let model = args.point.model(&args.model)?;
+    let options = FreeResponseOptions {
+        operating_point: args.point.options(model.as_ref())?,
+        initial: parse_init(model.as_ref(), &args.init)?,
+        t_end: args.t_end,
+        samples: args.samples,
+        tol: args.tol,
+    };
+    let study = vibration::free_response(model.as_ref(), &options)
+        .map_err(|e| study_failure(model.as_ref(), &e))?;
+    let FreeResponseStudy {
+        operating_point: point,
+        normal_modes: modes,
+        ignored_damping,
+        initial,
+        t_end,
+        responses,
+        max_displacement: q_scale,
+        max_velocity: v_scale,
+        differences,
         ..
-    } = unconstrained_operating_point(&args.model, &args.point)?;
+    } = &study;
+    let (label, (q0, v0)) = (&point.name, (&initial.q, &initial.qdot));
     let n = model.num_dofs();
     let names = model.coordinate_names();
-    let ignored_damping = lin.damping_matrix.amax();
-    lin.damping_matrix.fill(0.0);
-    let (q0, v0) = if args.init.is_empty() {
-        (vec![0.1; n], vec![0.0; n])
-    } else {
-        parse_init(model.as_ref(), &args.init)?
-    };
-    if !(args.tol.is_finite() && args.tol > 0.0) {
-        return Err(CliError::usage("--tol must be positive"));
-    }
-    let t_end = args
-        .t_end
-        .unwrap_or_else(|| default_t_end(&modes, 4.0, 5.0));
-    let times = time_grid(t_end, args.samples)?;
-    let fail = |e: eomgen::ResponseError| response_failure(model.as_ref(), &e);
-    let responses: Vec<FreeResponse> = vec![
-        eomgen::response_by_integration(&lin, &q0, &v0, &times, args.tol).map_err(fail)?,
-        eomgen::response_by_exponential(&lin, &q0, &v0, &times).map_err(fail)?,
-        eomgen::response_by_m_inv_k_modes(&lin, &q0, &v0, &times).map_err(fail)?,
-        eomgen::response_by_normal_modes(&lin, &q0, &v0, &times).map_err(fail)?,
-    ];
-    let q_scale = responses[1].max_displacement();
-    let v_scale = responses[1].max_velocity();
-    let relative = |d: f64, s: f64| if s > 0.0 { d / s } else { d };
-    let mut differences = Vec::new();
-    for i in 0..4 {
-        for j in i + 1..4 {
-            let dq = responses[i]
-                .max_displacement_difference(&responses[j])
-                .unwrap_or(f64::INFINITY);
-            let dv = responses[i]
-                .max_velocity_difference(&responses[j])
-                .unwrap_or(f64::INFINITY);
-            differences.push((i, j, dq, dv));
-        }
-    }
+    let samples = responses[0].1.times.len();
     if let Some(path) = &args.plot {
         let panel_list: Vec<Panel> = (0..n)
             .map(|j| {
-                let series = METHODS
+                let series = responses
                     .iter()
-                    .zip(&responses)
-                    .map(|((name, _), r)| Series {
-                        name: (*name).to_string(),
+                    .map(|(method, r)| Series {
+                        name: method.name().to_string(),
                         points: r.coordinate_history(j),
                     })
                     .collect();
@@ -360,10 +305,7 @@ pub fn run(args: &FreeResponseArgs) -> Result<(), CliError> {
         let out = json!({
             "model": model.name(),
             "coordinates": names,
-            "operating_point": {
-                "name": label,
-                "q": names.iter().zip(&lin.q).map(|(c, v)| (c.to_string(), json!(v))).collect::<serde_json::Map<_, _>>(),
-            },
+            "operating_point": point_json(label, &names, &study.linearization.q),
             "ignored_damping": ignored_damping,
             "modes": (0..n).map(|k| json!({
                 "kind": kind_json(&modes.kinds[k]),
@@ -373,21 +315,21 @@ pub fn run(args: &FreeResponseArgs) -> Result<(), CliError> {
             })).collect::<Vec<_>>(),
             "initial": {"q": q0, "qdot": v0},
             "t_end": t_end,
-            "samples": times.len(),
-            "tol": args.tol,
-            "methods": METHODS.iter().map(|(name, description)| json!({"name": name, "description": description})).collect::<Vec<_>>(),
+            "samples": samples,
+            "tol": study.tol,
+            "methods": FreeResponseMethod::ALL.iter().map(|m| json!({"name": m.name(), "description": m.description()})).collect::<Vec<_>>(),
             "max_displacement": q_scale,
             "max_velocity": v_scale,
-            "max_differences": differences.iter().map(|(i, j, dq, dv)| json!({
-                "a": METHODS[*i].0,
-                "b": METHODS[*j].0,
-                "displacement": dq,
-                "velocity": dv,
-                "displacement_relative": relative(*dq, q_scale),
-                "velocity_relative": relative(*dv, v_scale),
+            "max_differences": differences.iter().map(|d| json!({
+                "a": d.a.name(),
+                "b": d.b.name(),
+                "displacement": d.displacement,
+                "velocity": d.velocity,
+                "displacement_relative": d.displacement_relative,
+                "velocity_relative": d.velocity_relative,
             })).collect::<Vec<_>>(),
-            "final": METHODS.iter().zip(&responses).map(|((name, _), r)| json!({
-                "method": name,
+            "final": responses.iter().map(|(method, r)| json!({
+                "method": method.name(),
                 "q": r.displacements.last(),
                 "qdot": r.velocities.last(),
             })).collect::<Vec<_>>(),
@@ -402,9 +344,9 @@ pub fn run(args: &FreeResponseArgs) -> Result<(), CliError> {
         "model      {} ({} dof) at {label}: M δq̈ + K δq = 0, 0 ≤ t ≤ {t_end:.6} s, {} samples",
         model.name(),
         n,
-        times.len()
+        samples
     );
-    if ignored_damping > 0.0 {
+    if *ignored_damping > 0.0 {
         let _ = writeln!(
             stdout,
             "note       the damping matrix (max |C| = {ignored_damping:.3e}) is left out here; see `eomgen study modal-damping`"
@@ -418,8 +360,8 @@ pub fn run(args: &FreeResponseArgs) -> Result<(), CliError> {
             .collect::<Vec<_>>()
             .join(", ")
     };
-    let _ = writeln!(stdout, "initial    δq: {}", fmt(&q0));
-    let _ = writeln!(stdout, "           δq̇: {}", fmt(&v0));
+    let _ = writeln!(stdout, "initial    δq: {}", fmt(q0));
+    let _ = writeln!(stdout, "           δq̇: {}", fmt(v0));
     for k in 0..n {
         let what = match modes.kinds[k] {
             ModeKind::Oscillatory => format!(
@@ -433,23 +375,29 @@ pub fn run(args: &FreeResponseArgs) -> Result<(), CliError> {
         };
         let _ = writeln!(stdout, "mode {:<5} {what}", k + 1);
     }
-    for (i, (name, description)) in METHODS.iter().enumerate() {
-        let _ = writeln!(stdout, "method {}    {name}: {description}", i + 1);
+    for (i, method) in FreeResponseMethod::ALL.iter().enumerate() {
+        let _ = writeln!(
+            stdout,
+            "method {}    {}: {}",
+            i + 1,
+            method.name(),
+            method.description()
+        );
     }
     let _ = writeln!(
         stdout,
         "largest |δq| = {q_scale:.6e}, |δq̇| = {v_scale:.6e}; max differences (absolute, relative):"
     );
-    for (i, j, dq, dv) in &differences {
+    for d in differences {
         let _ = writeln!(
             stdout,
             "  {:<14} vs {:<14} δq {:>9.2e} ({:>8.1e})   δq̇ {:>9.2e} ({:>8.1e})",
-            METHODS[*i].0,
-            METHODS[*j].0,
-            dq,
-            relative(*dq, q_scale),
-            dv,
-            relative(*dv, v_scale)
+            d.a.name(),
+            d.b.name(),
+            d.displacement,
+            d.displacement_relative,
+            d.velocity,
+            d.velocity_relative
         );
     }
     Ok(())

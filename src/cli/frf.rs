@@ -1,23 +1,24 @@
 //! `eomgen frf MODEL --input NAME`: the frequency response `H(ω) = (K − ω²M + iωC)⁻¹ B` from
 //! a load parameter to coordinates, its resonance peaks, a Bode chart, the response assembled
 //! mode by mode (`--modal`), and points of the curve checked by simulating the full model
-//! (`--simulate K`) (lecture 21, HW21, HW34, HW37).
+//! (`--simulate K`) (lecture 21, HW21, HW34, HW37). The numbers come from
+//! [`eomgen::vibration::frequency_response_analysis`] and its simulated points; this module
+//! runs those in parallel and renders text, JSON and the chart.
 
 use std::io::{IsTerminal as _, Write as _};
 
 use clap::Args;
-use eomgen::{
-    FrequencySweep, FrfError, HarmonicForcing, ModalResponse, ModelInfo, PeakAmplitude,
-    SteadyStateOptions, frequency_response, frequency_sweep, linearize_with_inputs,
-    log_frequencies, modal_damping, modal_frequency_response, normal_modes, phase_degrees,
-    settling_time, simulate_steady_state,
+use eomgen::vibration::{
+    self, FrfAnalysis, FrfAnalysisError, FrfOptions, FrfOutput, FrfSimulationOptions,
+    FrfSimulationPlan, SimulatedPoint, max_simulation_error,
 };
+use eomgen::{FrequencySweep, FrfError, ModalResponse, ModelInfo, PeakAmplitude, phase_degrees};
 use nalgebra::Complex;
 use plotters::prelude::*;
 use rayon::prelude::*;
 use serde_json::{Value, json};
 
-use super::modes::OperatingPointArgs;
+use super::modes::{OperatingPointArgs, point_json};
 use super::values::{evaluate, parameter_lookup};
 use super::{CliError, plot};
 
@@ -76,120 +77,81 @@ pub struct FrfArgs {
     pub plot: Option<String>,
 }
 
-/// One simulated point.
-struct Simulated {
-    frequency: f64,
-    settling_time: f64,
-    /// Per output: (simulated X / amplitude, predicted H).
-    values: Vec<(Complex<f64>, Complex<f64>)>,
-    steps: usize,
-    rhs_evals: usize,
-}
-
-fn fail(model: &str) -> impl Fn(FrfError) -> CliError + '_ {
-    move |e| CliError::failure(format!("`{model}`: {e}"))
+/// The error of a failed analysis of `model`, in the words of the options.
+fn failure(model: &dyn ModelInfo, e: FrfAnalysisError) -> CliError {
+    let name = model.name();
+    match e {
+        FrfAnalysisError::TooFewPoints { .. } => CliError::usage("--points must be at least 2"),
+        FrfAnalysisError::UnknownInput { ref input, .. } => {
+            CliError::usage(format!("--input {input}: {e}"))
+        }
+        FrfAnalysisError::SimulationNeedsParameter { input } => CliError::usage(format!(
+            "--simulate needs a load parameter as --input (`{input}` is a coordinate: a unit generalized force has no load in the model to drive)"
+        )),
+        FrfAnalysisError::OperatingPoint(e) => super::modes::point_failure(model, &e),
+        FrfAnalysisError::Input(ref source) => {
+            let input = match source {
+                FrfError::NonlinearInput { input, .. }
+                | FrfError::InputNotInForcing { input }
+                | FrfError::InputChangesMassMatrix { input } => input.as_str(),
+                _ => "",
+            };
+            CliError::usage(format!("--input {input}: {e}"))
+        }
+        FrfAnalysisError::Output { output, source } => {
+            CliError::usage(format!("--output {output}: {source}"))
+        }
+        FrfAnalysisError::NoFrequencyRange {
+            model,
+            operating_point,
+        } => CliError::usage(format!(
+            "`{model}` has no oscillatory mode at `{operating_point}` to choose a frequency range from; give --freqs LO..HI"
+        )),
+        FrfAnalysisError::FrequencyRange(e) => CliError::usage(format!("--freqs: {e}")),
+        FrfAnalysisError::NoFrequencyParameter { parameters, .. } => CliError::usage(format!(
+            "--simulate: `{name}` has no parameter `w`; name the forcing frequency's parameter with --frequency-parameter (parameters: {parameters})"
+        )),
+        FrfAnalysisError::UnknownFrequencyParameter {
+            name: parameter,
+            parameters,
+            ..
+        } => CliError::usage(format!(
+            "--frequency-parameter {parameter}: `{name}` has no such parameter (parameters: {parameters})"
+        )),
+        FrfAnalysisError::FrequencyParameterIsInput => {
+            CliError::usage("--frequency-parameter must differ from --input")
+        }
+        FrfAnalysisError::InvalidAmplitude { .. } => {
+            CliError::usage("--amplitude must be finite and nonzero")
+        }
+        FrfAnalysisError::InvalidTolerance { .. } => CliError::usage("--rtol must be in (0, 1)"),
+        FrfAnalysisError::NoSteadyState(e) => {
+            CliError::usage(format!("--simulate: `{name}`: {e}; add damping with --set"))
+        }
+        FrfAnalysisError::Frf(FrfError::Modal(m)) => super::modes::modal_failure(model, &m),
+        e => CliError::failure(format!("`{name}`: {e}")),
+    }
 }
 
 /// Runs `frf`.
 pub fn run(args: &FrfArgs) -> Result<(), CliError> {
     let mut model = args.point.model(&args.model)?;
-    if args.points < 2 {
-        return Err(CliError::usage("--points must be at least 2"));
-    }
-    let parameter_input = model.parameter_names().contains(&args.input.as_str());
-    if !parameter_input && !model.coordinate_names().contains(&args.input.as_str()) {
-        return Err(CliError::usage(format!(
-            "--input {}: `{}` has no parameter or coordinate `{}` (parameters: {}; coordinates: {})",
-            args.input,
-            model.name(),
-            args.input,
-            model.parameter_names().join(", "),
-            model.coordinate_names().join(", ")
-        )));
-    }
-    if !parameter_input && args.simulate.is_some() {
-        return Err(CliError::usage(format!(
-            "--simulate needs a load parameter as --input (`{}` is a coordinate: a unit generalized force has no load in the model to drive)",
-            args.input
-        )));
-    }
-    let name = model.name().to_string();
-    let name = name.as_str();
-    let (label, guess) = args.point.guess(model.as_ref())?;
-    let forced = linearize_with_inputs(model.as_mut(), &guess, &[args.input.as_str()]).map_err(
-        |e| match e {
-            FrfError::NonlinearInput { .. }
-            | FrfError::InputNotInForcing { .. }
-            | FrfError::InputChangesMassMatrix { .. } => {
-                CliError::usage(format!("--input {}: {e}", args.input))
-            }
-            FrfError::Modal(m) => super::modes::modal_failure(model.as_ref(), &m),
-            e => fail(name)(e),
-        },
-    )?;
-    let lin = &forced.linearization;
-    let b = forced.input_matrix.column(0).into_owned();
-    let coordinates: Vec<String> = model
-        .coordinate_names()
-        .iter()
-        .map(|s| s.to_string())
-        .collect();
-    let outputs: Vec<(String, usize)> = if args.outputs.is_empty() {
-        coordinates
-            .iter()
-            .enumerate()
-            .map(|(i, c)| (c.to_string(), i))
-            .collect()
-    } else {
-        let mut list = Vec::new();
-        for o in &args.outputs {
-            let i = eomgen::frf::output_index(model.as_ref(), o)
-                .map_err(|e| CliError::usage(format!("--output {o}: {e}")))?;
-            list.push((o.clone(), i));
-        }
-        list
-    };
-    let modes = normal_modes(lin).map_err(|e| super::modes::modal_failure(model.as_ref(), &e))?;
-    let damping = modal_damping(lin, &modes);
     let lookup = parameter_lookup(model.as_ref());
-    let (lo, hi) = match &args.freqs {
+    let frequency_range = match &args.freqs {
         Some(text) => {
             let (a, b) = text.split_once("..").ok_or_else(|| {
                 CliError::usage(format!(
                     "--freqs takes LO..HI in rad/s, got `{text}` (for example `--freqs 0.1..10`)"
                 ))
             })?;
-            (
+            Some((
                 evaluate(a.trim(), "--freqs LO", &lookup)?,
                 evaluate(b.trim(), "--freqs HI", &lookup)?,
-            )
+            ))
         }
-        None => {
-            let positive: Vec<f64> = modes
-                .natural_frequencies
-                .iter()
-                .copied()
-                .filter(|w| *w > 0.0)
-                .collect();
-            match (positive.first(), positive.last()) {
-                (Some(a), Some(b)) => (a / 10.0, b * 10.0),
-                _ => {
-                    return Err(CliError::usage(format!(
-                        "`{name}` has no oscillatory mode at `{label}` to choose a frequency range from; give --freqs LO..HI"
-                    )));
-                }
-            }
-        }
+        None => None,
     };
-    let frequencies = log_frequencies(lo, hi, args.points)
-        .map_err(|e| CliError::usage(format!("--freqs: {e}")))?;
-    let mut sweeps: Vec<FrequencySweep> = Vec::with_capacity(outputs.len());
-    // The one input's column, `n × 1`.
-    let b_matrix = &forced.input_matrix;
-    for (_, i) in &outputs {
-        sweeps.push(frequency_sweep(lin, b_matrix, 0, *i, &frequencies).map_err(fail(name))?);
-    }
-    let mut evaluation_frequencies = Vec::new();
+    let mut frequencies = Vec::new();
     for text in &args.frequencies {
         let w = evaluate(text, &format!("--frequency {text}"), &lookup)?;
         if w < 0.0 {
@@ -197,75 +159,78 @@ pub fn run(args: &FrfArgs) -> Result<(), CliError> {
                 "--frequency {text}: {w} rad/s is negative"
             )));
         }
-        evaluation_frequencies.push(w);
+        frequencies.push(w);
     }
     drop(lookup);
-    if args.modal && evaluation_frequencies.is_empty() {
-        for peak in sweeps.iter().flat_map(|s| &s.peaks) {
-            if matches!(peak.amplitude, PeakAmplitude::Finite(_))
-                && !evaluation_frequencies
-                    .iter()
-                    .any(|w: &f64| (w - peak.frequency).abs() <= 1e-6 * peak.frequency)
-            {
-                evaluation_frequencies.push(peak.frequency);
-            }
+    let simulation = args.simulate.map(|count| FrfSimulationOptions {
+        count,
+        frequency_parameter: args.frequency_parameter.clone(),
+        amplitude: args.amplitude,
+        rtol: args.rtol,
+    });
+    let options = FrfOptions {
+        operating_point: args.point.options(model.as_ref())?,
+        input: args.input.clone(),
+        outputs: args.outputs.clone(),
+        frequency_range,
+        points: args.points,
+        frequencies,
+        modal: args.modal,
+        simulation: simulation.clone(),
+    };
+    let frf = vibration::frequency_response_analysis(model.as_mut(), &options)
+        .map_err(|e| failure(model.as_ref(), e))?;
+    let simulated = match simulation {
+        Some(sim) if sim.count > 0 => {
+            let plan = vibration::plan_simulation(model.as_ref(), &frf, &sim)
+                .map_err(|e| failure(model.as_ref(), e))?;
+            Some((simulate_points(args, model.as_ref(), &frf, &plan)?, plan))
         }
-        evaluation_frequencies.sort_by(f64::total_cmp);
-    }
-    // The response (direct and, with --modal, mode by mode) at the evaluation frequencies.
-    let mut evaluations = Vec::new();
-    for &w in &evaluation_frequencies {
-        let direct = match frequency_response(lin, b_matrix, w) {
-            Ok(h) => Some(h.column(0).into_owned()),
-            Err(FrfError::Singular { .. }) => None,
-            Err(e) => return Err(fail(name)(e)),
-        };
-        let modal = if args.modal {
-            match modal_frequency_response(lin, &modes, &b, w) {
-                Ok(r) => Some(r),
-                Err(FrfError::Singular { .. }) => None,
-                Err(e) => return Err(fail(name)(e)),
-            }
-        } else {
-            None
-        };
-        evaluations.push((w, direct, modal));
-    }
-    let simulated = match args.simulate {
-        Some(k) if k > 0 => Some(simulate_points(
-            args,
-            model.as_mut(),
-            &forced,
-            &outputs,
-            lo,
-            hi,
-            k,
-        )?),
         _ => None,
     };
+    let simulated = simulated
+        .as_ref()
+        .map(|(points, plan)| (points.as_slice(), plan));
     if let Some(path) = &args.plot {
         bode_chart(
             path,
-            &format!("{name}: frequency response from {}", args.input),
-            &outputs,
-            &sweeps,
-            simulated.as_ref().map(|(s, _)| s.as_slice()),
+            &format!("{}: frequency response from {}", model.name(), args.input),
+            &frf.outputs,
+            &frf.sweeps,
+            simulated.map(|(s, _)| s),
         )
         .map_err(CliError::failure)?;
     }
-    let n = model.num_dofs();
+    if args.json {
+        let text =
+            serde_json::to_string_pretty(&json_report(args, model.as_ref(), &frf, simulated))
+                .map_err(|e| CliError::failure(e.to_string()))?;
+        let _ = writeln!(std::io::stdout().lock(), "{text}");
+        return Ok(());
+    }
+    print_report(
+        &mut std::io::stdout().lock(),
+        args,
+        model.as_ref(),
+        &frf,
+        simulated,
+    );
+    Ok(())
+}
+
+/// The JSON of `frf` (and of the simulated points).
+fn json_report(
+    args: &FrfArgs,
+    model: &dyn ModelInfo,
+    frf: &FrfAnalysis,
+    simulated: Option<(&[SimulatedPoint], &FrfSimulationPlan)>,
+) -> Value {
+    let name = model.name();
+    let (outputs, forced) = (&frf.outputs, &frf.forced);
+    let (modes, damping) = (&frf.normal_modes, &frf.modal_damping);
+    let b: Vec<f64> = forced.input_matrix.column(0).iter().copied().collect();
     let amp_phase = |z: Complex<f64>| json!({"re": z.re, "im": z.im, "amplitude": z.norm(), "phase_deg": phase_degrees(z)});
-    let modal_json = |r: &ModalResponse| {
-        let direct = frequency_response(lin, b_matrix, r.frequency).ok();
-        let difference = direct.map(|d| {
-            (0..n)
-                .map(|i| (d[(i, 0)] - r.response[i]).norm())
-                .fold(0.0f64, f64::max)
-                / (0..n)
-                    .map(|i| d[(i, 0)].norm())
-                    .fold(0.0f64, f64::max)
-                    .max(f64::MIN_POSITIVE)
-        });
+    let modal_json = |r: &ModalResponse, difference: Option<f64>| {
         json!({
             "modes": (0..modes.natural_frequencies.len()).map(|k| json!({
                 "mode": k + 1,
@@ -273,72 +238,88 @@ pub fn run(args: &FrfArgs) -> Result<(), CliError> {
                 "damping_ratio": damping.damping_ratios[k],
                 "modal_force": r.modal_forces[k],
                 "modal_coordinate": amp_phase(r.modal_coordinates[k]),
-                "contributions": outputs.iter().map(|(o, i)| (o.clone(), amp_phase(r.contributions[(*i, k)]))).collect::<serde_json::Map<_, _>>(),
+                "contributions": outputs.iter().map(|o| (o.name.clone(), amp_phase(r.contributions[(o.index, k)]))).collect::<serde_json::Map<_, _>>(),
             })).collect::<Vec<_>>(),
-            "sum": outputs.iter().map(|(o, i)| (o.clone(), amp_phase(r.response[*i]))).collect::<serde_json::Map<_, _>>(),
+            "sum": outputs.iter().map(|o| (o.name.clone(), amp_phase(r.response[o.index]))).collect::<serde_json::Map<_, _>>(),
             "max_relative_difference_from_direct": difference,
         })
     };
-    if args.json {
-        let peak_json = |p: &eomgen::ResonancePeak| match p.amplitude {
-            PeakAmplitude::Finite(a) => {
-                json!({"frequency": p.frequency, "amplitude": a, "unbounded": false, "phase_deg": p.phase_deg})
-            }
-            PeakAmplitude::Unbounded => {
-                json!({"frequency": p.frequency, "amplitude": Value::Null, "unbounded": true, "phase_deg": Value::Null})
-            }
-        };
-        let out = json!({
-            "model": name,
-            "input": args.input,
-            "outputs": outputs.iter().map(|(o, _)| o.clone()).collect::<Vec<_>>(),
-            "operating_point": {
-                "name": label,
-                "q": coordinates.iter().zip(&forced.equilibrium.q).map(|(c, v)| (c.to_string(), json!(v))).collect::<serde_json::Map<_, _>>(),
-            },
-            "input_matrix": b.iter().copied().collect::<Vec<f64>>(),
-            "natural_frequencies": modes.natural_frequencies,
-            "damping_ratios": damping.damping_ratios,
-            "modal_damping_coupling": damping.coupling,
-            "frequencies": frequencies,
-            "responses": outputs.iter().zip(&sweeps).map(|((o, _), s)| json!({
-                "output": o,
-                "amplitude": s.amplitudes(),
-                "phase_deg": s.phases_deg,
-                "peaks": s.peaks.iter().map(peak_json).collect::<Vec<_>>(),
+    let peak_json = |p: &eomgen::ResonancePeak| match p.amplitude {
+        PeakAmplitude::Finite(a) => {
+            json!({"frequency": p.frequency, "amplitude": a, "unbounded": false, "phase_deg": p.phase_deg})
+        }
+        PeakAmplitude::Unbounded => {
+            json!({"frequency": p.frequency, "amplitude": Value::Null, "unbounded": true, "phase_deg": Value::Null})
+        }
+    };
+    json!({
+        "model": name,
+        "input": args.input,
+        "outputs": outputs.iter().map(|o| o.name.clone()).collect::<Vec<_>>(),
+        "operating_point": point_json(&frf.operating_point.name, &model.coordinate_names(), &forced.equilibrium.q),
+        "input_matrix": b,
+        "natural_frequencies": modes.natural_frequencies,
+        "damping_ratios": damping.damping_ratios,
+        "modal_damping_coupling": damping.coupling,
+        "frequencies": frf.frequencies,
+        "responses": outputs.iter().zip(&frf.sweeps).map(|(o, s)| json!({
+            "output": o.name,
+            "amplitude": s.amplitudes(),
+            "phase_deg": s.phases_deg,
+            "peaks": s.peaks.iter().map(peak_json).collect::<Vec<_>>(),
+        })).collect::<Vec<_>>(),
+        "evaluations": frf.evaluations.iter().map(|e| json!({
+            "frequency": e.frequency,
+            "response": e.response.as_ref().map(|d| outputs.iter().map(|o| (o.name.clone(), amp_phase(d[o.index]))).collect::<serde_json::Map<_, _>>()),
+            "unbounded": e.response.is_none(),
+            "modal": e.modal.as_ref().map(|r| modal_json(r, e.modal_difference)),
+        })).collect::<Vec<_>>(),
+        "simulation": simulated.map(|(points, plan)| json!({
+            "amplitude": args.amplitude,
+            "frequency_parameter": plan.frequency_parameter,
+            "rtol": args.rtol,
+            "points": points.iter().map(|p| json!({
+                "frequency": p.frequency,
+                "settling_time": p.settling_time,
+                "steps": p.steps,
+                "rhs_evals": p.rhs_evals,
+                "outputs": outputs.iter().zip(&p.values).map(|(o, v)| (o.name.clone(), json!({
+                    "simulated": amp_phase(v.simulated),
+                    "predicted": amp_phase(v.predicted),
+                    "relative_error": v.relative_error(),
+                }))).collect::<serde_json::Map<_, _>>(),
             })).collect::<Vec<_>>(),
-            "evaluations": evaluations.iter().map(|(w, direct, modal)| json!({
-                "frequency": w,
-                "response": direct.as_ref().map(|d| outputs.iter().map(|(o, i)| (o.clone(), amp_phase(d[*i]))).collect::<serde_json::Map<_, _>>()),
-                "unbounded": direct.is_none(),
-                "modal": modal.as_ref().map(modal_json),
-            })).collect::<Vec<_>>(),
-            "simulation": simulated.as_ref().map(|(points, frequency_parameter)| json!({
-                "amplitude": args.amplitude,
-                "frequency_parameter": frequency_parameter,
-                "rtol": args.rtol,
-                "points": points.iter().map(|p| json!({
-                    "frequency": p.frequency,
-                    "settling_time": p.settling_time,
-                    "steps": p.steps,
-                    "rhs_evals": p.rhs_evals,
-                    "outputs": outputs.iter().zip(&p.values).map(|((o, _), (sim, pred))| (o.clone(), json!({
-                        "simulated": amp_phase(*sim),
-                        "predicted": amp_phase(*pred),
-                        "relative_error": relative_error(*sim, *pred),
-                    }))).collect::<serde_json::Map<_, _>>(),
-                })).collect::<Vec<_>>(),
-                "max_relative_error": max_error(points),
-            })),
-        });
-        let text =
-            serde_json::to_string_pretty(&out).map_err(|e| CliError::failure(e.to_string()))?;
-        let _ = writeln!(std::io::stdout().lock(), "{text}");
-        return Ok(());
-    }
-    let mut out = std::io::stdout().lock();
+            "max_relative_error": max_simulation_error(points),
+        })),
+    })
+}
+
+/// The text of `frf` (and of the simulated points).
+fn print_report(
+    out: &mut impl std::io::Write,
+    args: &FrfArgs,
+    model: &dyn ModelInfo,
+    frf: &FrfAnalysis,
+    simulated: Option<(&[SimulatedPoint], &FrfSimulationPlan)>,
+) {
+    let name = model.name();
+    let (lo, hi) = frf.frequency_range;
+    let FrfAnalysis {
+        operating_point: point,
+        outputs,
+        forced,
+        normal_modes: modes,
+        modal_damping: damping,
+        sweeps,
+        evaluations,
+        ..
+    } = frf;
+    let label = &point.name;
+    let b: Vec<f64> = forced.input_matrix.column(0).iter().copied().collect();
+    let n = model.num_dofs();
     let _ = writeln!(out, "model      {name} ({n} dof), input {}", args.input);
-    let point: Vec<String> = coordinates
+    let point: Vec<String> = model
+        .coordinate_names()
         .iter()
         .zip(&forced.equilibrium.q)
         .map(|(c, v)| format!("{c} = {v:.6e}"))
@@ -366,9 +347,10 @@ pub fn run(args: &FrfArgs) -> Result<(), CliError> {
     let _ = writeln!(
         out,
         "sweep      {} frequencies from {lo:.6e} to {hi:.6e} rad/s",
-        frequencies.len()
+        frf.frequencies.len()
     );
-    for ((o, _), s) in outputs.iter().zip(&sweeps) {
+    for (o, s) in outputs.iter().zip(sweeps) {
+        let o = &o.name;
         if s.peaks.is_empty() {
             let _ = writeln!(out, "peaks {o:<4} none in the range");
         }
@@ -392,12 +374,13 @@ pub fn run(args: &FrfArgs) -> Result<(), CliError> {
             }
         }
     }
-    for (w, direct, modal) in &evaluations {
-        match direct {
+    for e in evaluations {
+        let w = e.frequency;
+        match &e.response {
             Some(d) => {
                 let cells: Vec<String> = outputs
                     .iter()
-                    .map(|(o, i)| format!("{o}: {}", polar(d[*i])))
+                    .map(|o| format!("{}: {}", o.name, polar(d[o.index])))
                     .collect();
                 let _ = writeln!(out, "H(ω = {w:.10e})  {}", cells.join(", "));
             }
@@ -408,15 +391,16 @@ pub fn run(args: &FrfArgs) -> Result<(), CliError> {
                 );
             }
         }
-        if let Some(r) = modal {
+        if let Some(r) = &e.modal {
             write_modal(
-                &mut out,
-                &outputs,
+                out,
+                outputs,
                 &modes.natural_frequencies,
                 &damping.damping_ratios,
                 r,
             );
-            if let Some(diff) = modal_json(r)["max_relative_difference_from_direct"].as_f64() {
+            // As the JSON has it: a non-finite difference is no number.
+            if let Some(diff) = e.modal_difference.filter(|d| d.is_finite()) {
                 let _ = writeln!(
                     out,
                     "           modal sum vs direct solve: max difference {diff:.2e} of max |H|"
@@ -429,11 +413,11 @@ pub fn run(args: &FrfArgs) -> Result<(), CliError> {
             );
         }
     }
-    if let Some((points, frequency_parameter)) = &simulated {
+    if let Some((points, plan)) = simulated {
         let _ = writeln!(
             out,
-            "simulate   {} = {:e}, {frequency_parameter} = ω, DOP853 rtol {:e}, from rest at the equilibrium to steady state",
-            args.input, args.amplitude, args.rtol
+            "simulate   {} = {:e}, {} = ω, DOP853 rtol {:e}, from rest at the equilibrium to steady state",
+            args.input, args.amplitude, plan.frequency_parameter, args.rtol
         );
         let _ = writeln!(
             out,
@@ -441,74 +425,44 @@ pub fn run(args: &FrfArgs) -> Result<(), CliError> {
             "ω (rad/s)", "out", "t_settle", "simulated X/amplitude", "H(ω)", "rel. err"
         );
         for p in points {
-            for ((o, _), (sim, pred)) in outputs.iter().zip(&p.values) {
+            for (o, v) in outputs.iter().zip(&p.values) {
                 let _ = writeln!(
                     out,
-                    "{:>16.10e}  {o:>5}  {:>10.1}  {:>36}  {:>36}  {:>9.2e}",
+                    "{:>16.10e}  {:>5}  {:>10.1}  {:>36}  {:>36}  {:>9.2e}",
                     p.frequency,
+                    o.name,
                     p.settling_time,
-                    polar(*sim),
-                    polar(*pred),
-                    relative_error(*sim, *pred)
+                    polar(v.simulated),
+                    polar(v.predicted),
+                    v.relative_error()
                 );
             }
         }
         let _ = writeln!(
             out,
             "check      max relative error of the simulated steady state against H: {:.2e}",
-            max_error(points)
+            max_simulation_error(points)
         );
     }
     if let Some(path) = &args.plot {
         let _ = writeln!(out, "chart      {path}");
     }
-    Ok(())
 }
 
 fn polar(z: Complex<f64>) -> String {
     format!("{:.9e} ∠ {:>9.4}°", z.norm(), phase_degrees(z))
 }
 
-/// `|sim − pred| / |pred|`, or `|sim − pred|` for a zero prediction.
-fn relative_error(sim: Complex<f64>, pred: Complex<f64>) -> f64 {
-    let d = (sim - pred).norm();
-    if pred.norm() > 0.0 {
-        d / pred.norm()
-    } else {
-        d
-    }
-}
-
-/// The largest relative error over the points, each output's error taken against the largest
-/// predicted amplitude at that frequency (an output near an antiresonance, or one the mode
-/// shape leaves still, would make a relative error meaningless).
-fn max_error(points: &[Simulated]) -> f64 {
-    points
-        .iter()
-        .map(|p| {
-            let scale = p
-                .values
-                .iter()
-                .map(|(_, h)| h.norm())
-                .fold(0.0f64, f64::max);
-            p.values
-                .iter()
-                .map(|(s, h)| (s - h).norm() / scale.max(f64::MIN_POSITIVE))
-                .fold(0.0f64, f64::max)
-        })
-        .fold(0.0f64, f64::max)
-}
-
 fn write_modal(
     out: &mut impl std::io::Write,
-    outputs: &[(String, usize)],
+    outputs: &[FrfOutput],
     natural_frequencies: &[f64],
     damping_ratios: &[Option<f64>],
     r: &ModalResponse,
 ) {
     let header: Vec<String> = outputs
         .iter()
-        .map(|(o, _)| format!("{:>34}", format!("contribution to {o}")))
+        .map(|o| format!("{:>34}", format!("contribution to {}", o.name)))
         .collect();
     let _ = writeln!(
         out,
@@ -523,7 +477,7 @@ fn write_modal(
     for k in 0..r.modal_forces.len() {
         let cells: Vec<String> = outputs
             .iter()
-            .map(|(_, i)| format!("{:>34}", polar(r.contributions[(*i, k)])))
+            .map(|o| format!("{:>34}", polar(r.contributions[(o.index, k)])))
             .collect();
         let _ = writeln!(
             out,
@@ -538,7 +492,7 @@ fn write_modal(
     }
     let sum: Vec<String> = outputs
         .iter()
-        .map(|(_, i)| format!("{:>34}", polar(r.response[*i])))
+        .map(|o| format!("{:>34}", polar(r.response[o.index])))
         .collect();
     let _ = writeln!(
         out,
@@ -552,58 +506,17 @@ fn write_modal(
     );
 }
 
-/// Simulates `k` log-spaced frequencies of `[lo, hi]` to steady state in parallel and returns
-/// the points with the frequency parameter's name.
+/// Runs the planned steady-state simulations in parallel (rayon), each on its own instance of
+/// the model with `--set` applied ([`vibration::simulate_point`]), with a progress bar on a
+/// terminal.
 fn simulate_points(
     args: &FrfArgs,
-    model: &mut dyn ModelInfo,
-    forced: &eomgen::ForcedLinearization,
-    outputs: &[(String, usize)],
-    lo: f64,
-    hi: f64,
-    k: usize,
-) -> Result<(Vec<Simulated>, String), CliError> {
+    model: &dyn ModelInfo,
+    frf: &FrfAnalysis,
+    plan: &FrfSimulationPlan,
+) -> Result<Vec<SimulatedPoint>, CliError> {
     let name = model.name();
-    let frequency_parameter = match &args.frequency_parameter {
-        Some(p) => p.clone(),
-        None if model.parameter_names().contains(&"w") => "w".to_string(),
-        None => {
-            return Err(CliError::usage(format!(
-                "--simulate: `{name}` has no parameter `w`; name the forcing frequency's parameter with --frequency-parameter (parameters: {})",
-                model.parameter_names().join(", ")
-            )));
-        }
-    };
-    if !model
-        .parameter_names()
-        .contains(&frequency_parameter.as_str())
-    {
-        return Err(CliError::usage(format!(
-            "--frequency-parameter {frequency_parameter}: `{name}` has no such parameter (parameters: {})",
-            model.parameter_names().join(", ")
-        )));
-    }
-    if frequency_parameter == args.input {
-        return Err(CliError::usage(
-            "--frequency-parameter must differ from --input",
-        ));
-    }
-    if !(args.amplitude.is_finite() && args.amplitude != 0.0) {
-        return Err(CliError::usage("--amplitude must be finite and nonzero"));
-    }
-    if !(args.rtol > 0.0 && args.rtol < 1.0) {
-        return Err(CliError::usage("--rtol must be in (0, 1)"));
-    }
-    let lin = &forced.linearization;
-    // Wait until the slowest free decay has shrunk by 1e-10 relative to the response.
-    let settle = settling_time(lin, 1e-10).map_err(|e| match e {
-        FrfError::NoSteadyState { .. } => {
-            CliError::usage(format!("--simulate: `{name}`: {e}; add damping with --set"))
-        }
-        e => fail(name)(e),
-    })?;
-    let frequencies = log_frequencies(lo, hi, k).map_err(|e| CliError::usage(e.to_string()))?;
-    let b = &forced.input_matrix;
+    let k = plan.frequencies.len();
     let progress = if args.json || !std::io::stderr().is_terminal() {
         indicatif::ProgressBar::hidden()
     } else {
@@ -617,49 +530,20 @@ fn simulate_points(
         bar.set_message("steady-state simulations");
         bar
     };
-    let q_star = forced.equilibrium.q.clone();
-    let results: Vec<Result<Simulated, CliError>> = frequencies
+    let results: Vec<Result<SimulatedPoint, CliError>> = plan
+        .frequencies
         .par_iter()
         .map(|&w| {
-            let result = (|| {
-                let mut model = args.point.model(&args.model)?;
-                let h = frequency_response(lin, b, w).map_err(fail(name))?;
-                let scale = h.iter().map(|z| z.norm()).fold(0.0f64, f64::max)
-                    * args.amplitude.abs()
-                    * w.max(1.0);
-                let options = SteadyStateOptions {
-                    rtol: args.rtol,
-                    atol: args.rtol * scale.max(f64::MIN_POSITIVE),
-                    ..SteadyStateOptions::default()
-                };
-                let forcing = HarmonicForcing {
-                    input: &args.input,
-                    amplitude: args.amplitude,
-                    frequency_parameter: &frequency_parameter,
-                    frequency: w,
-                };
-                let steady =
-                    simulate_steady_state(model.as_mut(), &q_star, &forcing, settle, &options)
-                        .map_err(fail(name))?;
-                let values = outputs
-                    .iter()
-                    .map(|(_, i)| (steady.complex_amplitudes[*i] / args.amplitude, h[(*i, 0)]))
-                    .collect();
-                Ok(Simulated {
-                    frequency: w,
-                    settling_time: settle,
-                    values,
-                    steps: steady.steps,
-                    rhs_evals: steady.rhs_evals,
-                })
-            })();
+            let result = args.point.model(&args.model).and_then(|mut model| {
+                vibration::simulate_point(model.as_mut(), frf, plan, w)
+                    .map_err(|e| CliError::failure(format!("`{name}`: {e}")))
+            });
             progress.inc(1);
             result
         })
         .collect();
     progress.finish_and_clear();
-    let points = results.into_iter().collect::<Result<Vec<_>, _>>()?;
-    Ok((points, frequency_parameter))
+    results.into_iter().collect()
 }
 
 /// The Bode chart: |H| (log) over log ω above, the phase in degrees below; simulated points
@@ -667,18 +551,22 @@ fn simulate_points(
 fn bode_chart(
     path: &str,
     title: &str,
-    outputs: &[(String, usize)],
+    outputs: &[FrfOutput],
     sweeps: &[FrequencySweep],
-    simulated: Option<&[Simulated]>,
+    simulated: Option<&[SimulatedPoint]>,
 ) -> Result<(), String> {
     plot::register_font()?;
     let size = (960, 720);
     if path.ends_with(".svg") {
-        let root = SVGBackend::new(path, size).into_drawing_area();
-        draw_bode(root, title, outputs, sweeps, simulated)
+        super::render::atomically(path, |file| {
+            let root = SVGBackend::new(file, size).into_drawing_area();
+            draw_bode(root, title, outputs, sweeps, simulated)
+        })
     } else if path.ends_with(".png") {
-        let root = BitMapBackend::new(path, size).into_drawing_area();
-        draw_bode(root, title, outputs, sweeps, simulated)
+        super::render::atomically(path, |file| {
+            let root = BitMapBackend::new(file, size).into_drawing_area();
+            draw_bode(root, title, outputs, sweeps, simulated)
+        })
     } else {
         Err(format!("`{path}`: a chart file must end in .svg or .png"))
     }
@@ -706,9 +594,9 @@ fn segments(points: impl Iterator<Item = (f64, Option<f64>)>, log_y: bool) -> Ve
 fn draw_bode<DB: DrawingBackend>(
     root: DrawingArea<DB, plotters::coord::Shift>,
     title: &str,
-    outputs: &[(String, usize)],
+    outputs: &[FrfOutput],
     sweeps: &[FrequencySweep],
-    simulated: Option<&[Simulated]>,
+    simulated: Option<&[SimulatedPoint]>,
 ) -> Result<(), String>
 where
     DB::ErrorType: 'static,
@@ -748,7 +636,11 @@ where
     let sim_amp: Vec<(f64, f64)> = simulated
         .unwrap_or(&[])
         .iter()
-        .flat_map(|p| p.values.iter().map(move |(s, _)| (p.frequency, s.norm())))
+        .flat_map(|p| {
+            p.values
+                .iter()
+                .map(move |v| (p.frequency, v.simulated.norm()))
+        })
         .filter(|(_, a)| *a > 0.0)
         .collect();
     let (x_lo, x_hi, a_lo, a_hi) = bounds(&amplitude, &sim_amp);
@@ -780,7 +672,7 @@ where
                     .draw_series(LineSeries::new(seg.iter().copied(), c.stroke_width(2)))
                     .map_err(err)?;
                 if j == 0 {
-                    series.label(outputs[i].0.clone()).legend(move |(x, y)| {
+                    series.label(outputs[i].name.clone()).legend(move |(x, y)| {
                         PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(2))
                     });
                 }
@@ -806,7 +698,7 @@ where
                 let c = color(i);
                 let dots: Vec<(f64, f64)> = points
                     .iter()
-                    .map(|p| (p.frequency, p.values[i].0.norm()))
+                    .map(|p| (p.frequency, p.values[i].simulated.norm()))
                     .filter(|(_, a)| *a > 0.0)
                     .collect();
                 let series = chart
@@ -833,12 +725,41 @@ where
             .map_err(err)?;
     }
     let (_, _, p_lo, p_hi) = bounds(&phase, &[]);
+    draw_phase(
+        &lower,
+        (x0, x1),
+        (p_lo, p_hi),
+        &phase,
+        outputs,
+        sweeps,
+        simulated,
+    )?;
+    root.present().map_err(err)?;
+    Ok(())
+}
+
+/// The Bode chart's lower panel: the phase in degrees over log ω (`phase` in segments, the
+/// simulated points as circles on the curve's branch).
+fn draw_phase<DB: DrawingBackend>(
+    lower: &DrawingArea<DB, plotters::coord::Shift>,
+    (x0, x1): (f64, f64),
+    (p_lo, p_hi): (f64, f64),
+    phase: &[Vec<Vec<(f64, f64)>>],
+    outputs: &[FrfOutput],
+    sweeps: &[FrequencySweep],
+    simulated: Option<&[SimulatedPoint]>,
+) -> Result<(), String>
+where
+    DB::ErrorType: 'static,
+{
+    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| format!("plotting failed: {e}");
+    let color = |i: usize| Palette99::pick(i).to_rgba();
     let (p0, p1) = if p_lo.is_finite() {
         plot::range(p_lo, p_hi, false)
     } else {
         (-190.0, 10.0)
     };
-    let mut chart = ChartBuilder::on(&lower)
+    let mut chart = ChartBuilder::on(lower)
         .margin(12)
         .x_label_area_size(45)
         .y_label_area_size(90)
@@ -868,7 +789,7 @@ where
             let dots: Vec<(f64, f64)> = points
                 .iter()
                 .filter_map(|p| {
-                    let (s, h) = p.values[i];
+                    let (s, h) = (p.values[i].simulated, p.values[i].predicted);
                     if s.norm() == 0.0 {
                         return None;
                     }
@@ -892,6 +813,5 @@ where
                 .map_err(err)?;
         }
     }
-    root.present().map_err(err)?;
     Ok(())
 }

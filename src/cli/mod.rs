@@ -10,6 +10,7 @@ mod modal_damping;
 mod mode_plot;
 mod modes;
 mod plot;
+mod render;
 mod report;
 mod report_html;
 mod roundoff;
@@ -60,8 +61,8 @@ enum Command {
     /// `checks:`) and write DIR/index.html (equations, figures, pass/fail tables) and
     /// DIR/report.json; exit 1 if a check fails.
     Report(report::ReportArgs),
-    /// Numerical experiments comparing methods: `constraint-methods MODEL`,
-    /// `work-precision MODEL`, `stability`, `euler-roundoff`.
+    /// Numerical experiments: `work-precision`, `stability`, `euler-roundoff`,
+    /// `constraint-methods`, `free-response`, `modal-damping`, `floquet`.
     #[command(subcommand)]
     Study(study::Study),
 }
@@ -91,6 +92,15 @@ impl CliError {
             code: 1,
             json: None,
         }
+    }
+    /// The error of a model that could not be opened or read, which happens before any
+    /// output: with `--json`, `{"error": message}` on standard output (the form of a model
+    /// file's diagnostics, without them), so that a script reading the output always gets JSON.
+    fn before_output(mut self) -> Self {
+        if self.json.is_none() {
+            self.json = Some(serde_json::json!({ "error": self.message }));
+        }
+        self
     }
 }
 
@@ -194,7 +204,7 @@ fn open_model(name_or_path: &str) -> Result<eomgen::ModelSource, CliError> {
 /// (exit 2), and so is a file with mistakes, whose located diagnostics are rendered with
 /// their source lines (and, for `--json`, given as JSON on standard output).
 fn open_error(error: eomgen::OpenError) -> CliError {
-    match error {
+    let error = match error {
         eomgen::OpenError::Load(eomgen::LoadError::Diagnostics {
             path,
             text,
@@ -205,7 +215,8 @@ fn open_error(error: eomgen::OpenError) -> CliError {
             CliError::failure(e.to_string())
         }
         other => CliError::usage(other.to_string()),
-    }
+    };
+    error.before_output()
 }
 
 /// The error of a model file with mistakes: every diagnostic rendered for the terminal, exit

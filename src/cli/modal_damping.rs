@@ -7,14 +7,13 @@
 use std::io::Write as _;
 
 use clap::Args;
-use eomgen::{FreeResponse, ModeKind, RayleighDamping};
+use eomgen::ModelInfo;
+use eomgen::vibration::{ModalDampingOptions, ModalDampingStudy, RayleighFit};
 use serde_json::json;
 
 use super::CliError;
-use super::free_response::{
-    Panel, default_t_end, kind_json, panels, parse_init, time_grid, unconstrained_operating_point,
-};
-use super::modes::{OperatingPoint, OperatingPointArgs, matrix_rows};
+use super::free_response::{Panel, kind_json, panels, parse_init, study_failure};
+use super::modes::{OperatingPointArgs, matrix_rows, point_json};
 use super::plot::Series;
 
 /// Options of `eomgen study modal-damping`.
@@ -52,163 +51,39 @@ pub struct ModalDampingArgs {
     pub plot: Option<String>,
 }
 
-/// One release: its initial values and the four responses.
-struct Case {
-    name: String,
-    q0: Vec<f64>,
-    v0: Vec<f64>,
-    exact: FreeResponse,
-    integrated: FreeResponse,
-    diagonal: FreeResponse,
-    rayleigh: Option<FreeResponse>,
-}
-
-/// `ζ` and `ω_d = ω√(1 − ζ²)` of a mode of natural frequency `ω` (`None` when overdamped).
-fn damped_frequency(omega: f64, zeta: f64) -> Option<f64> {
-    (zeta.abs() < 1.0).then(|| omega * (1.0 - zeta * zeta).sqrt())
-}
-
 /// Runs `study modal-damping`.
 pub fn run(args: &ModalDampingArgs) -> Result<(), CliError> {
-    let OperatingPoint {
-        model,
-        label,
-        lin,
-        modes,
-        ..
-    } = unconstrained_operating_point(&args.model, &args.point)?;
-    let n = model.num_dofs();
-    let names = model.coordinate_names();
-    let fail =
-        |e: eomgen::ResponseError| super::free_response::response_failure(model.as_ref(), &e);
-    let approx = eomgen::modal_damping(&lin, &modes);
-    let exact = eomgen::exact_damped_modes(&lin, &modes).map_err(fail)?;
-    let oscillatory: Vec<usize> = (0..n)
-        .filter(|&k| modes.kinds[k] == ModeKind::Oscillatory)
-        .collect();
-
-    // The Rayleigh fit: explicit modes must be usable; by default the slowest and fastest
-    // oscillatory modes, if there are two with exact damping ratios.
-    let chosen: Option<[usize; 2]> = match &args.rayleigh_modes {
-        Some(list) => {
-            let [a, b] = list.as_slice() else {
+    let model = args.point.model(&args.model)?;
+    let rayleigh_modes = match &args.rayleigh_modes {
+        Some(list) => match list.as_slice() {
+            [a, b] => Some([*a, *b]),
+            _ => {
                 return Err(CliError::usage(format!(
                     "--rayleigh-modes takes two modes (like 1,3), got {} numbers",
                     list.len()
                 )));
-            };
-            for &k in [a, b] {
-                if k == 0 || k > n {
-                    return Err(CliError::usage(format!(
-                        "--rayleigh-modes: mode {k} does not exist; `{}` has modes 1 to {n}",
-                        model.name()
-                    )));
-                }
-                if exact[k - 1].is_none() {
-                    return Err(CliError::usage(format!(
-                        "--rayleigh-modes: mode {k} is not an underdamped oscillation (no complex eigenvalue to fit)"
-                    )));
-                }
             }
-            Some([*a, *b])
-        }
-        None => match (oscillatory.first(), oscillatory.last()) {
-            (Some(&a), Some(&b)) if a != b && exact[a].is_some() && exact[b].is_some() => {
-                Some([a + 1, b + 1])
-            }
-            _ => None,
         },
-    };
-    let rayleigh = match chosen {
-        Some([a, b]) => {
-            let zeta = |k: usize| exact[k - 1].map_or(f64::NAN, |d| d.damping_ratio);
-            let fit = RayleighDamping::fit(
-                [
-                    modes.natural_frequencies[a - 1],
-                    modes.natural_frequencies[b - 1],
-                ],
-                [zeta(a), zeta(b)],
-            )
-            .map_err(|e| CliError::usage(format!("--rayleigh-modes {a},{b}: {e}")))?;
-            Some(([a, b], fit))
-        }
         None => None,
     };
-
-    // The releases: HW34's mode shapes (first coordinate 1, or the largest entry if the
-    // first is zero), or one given deviation.
-    if !(args.tol.is_finite() && args.tol > 0.0) {
-        return Err(CliError::usage("--tol must be positive"));
-    }
-    let t_end = args
-        .t_end
-        .unwrap_or_else(|| default_t_end(&modes, 10.0, 5.0));
-    let times = time_grid(t_end, args.samples)?;
-    let mut releases: Vec<(String, Vec<f64>, Vec<f64>)> = Vec::new();
-    if args.init.is_empty() {
-        for k in 0..n {
-            let shape = modes.mode_shapes.column(k);
-            let largest = shape.amax();
-            let j = if shape[0].abs() > 1e-8 * largest {
-                0
-            } else {
-                shape.iamax()
-            };
-            let q0: Vec<f64> = shape.iter().map(|v| v / shape[j]).collect();
-            releases.push((
-                format!("mode {} shape, {} = 1", k + 1, names[j]),
-                q0,
-                vec![0.0; n],
-            ));
-        }
-    } else {
-        let (q0, v0) = parse_init(model.as_ref(), &args.init)?;
-        releases.push(("given initial values".to_string(), q0, v0));
-    }
-    let diagonal_damping = approx.diagonal();
-    let mut cases = Vec::new();
-    for (name, q0, v0) in releases {
-        let exact_response =
-            eomgen::response_by_exponential(&lin, &q0, &v0, &times).map_err(fail)?;
-        let integrated =
-            eomgen::response_by_integration(&lin, &q0, &v0, &times, args.tol).map_err(fail)?;
-        let diagonal =
-            eomgen::response_with_modal_damping(&lin, &modes, &diagonal_damping, &q0, &v0, &times)
-                .map_err(fail)?;
-        let rayleigh_response = match &rayleigh {
-            Some((_, fit)) => Some(
-                eomgen::response_with_modal_damping(
-                    &lin,
-                    &modes,
-                    &fit.modal_damping(&modes),
-                    &q0,
-                    &v0,
-                    &times,
-                )
-                .map_err(fail)?,
-            ),
-            None => None,
-        };
-        cases.push(Case {
-            name,
-            q0,
-            v0,
-            exact: exact_response,
-            integrated,
-            diagonal,
-            rayleigh: rayleigh_response,
-        });
-    }
-    // Differences from the exact response, relative to its largest |δq|.
-    let versus = |case: &Case, other: &FreeResponse| -> f64 {
-        let scale = case.exact.max_displacement();
-        let d = case
-            .exact
-            .max_displacement_difference(other)
-            .unwrap_or(f64::INFINITY);
-        if scale > 0.0 { d / scale } else { d }
+    let options = ModalDampingOptions {
+        operating_point: args.point.options(model.as_ref())?,
+        rayleigh_modes,
+        initial: parse_init(model.as_ref(), &args.init)?,
+        t_end: args.t_end,
+        samples: args.samples,
+        tol: args.tol,
     };
-
+    let study = eomgen::vibration::modal_damping_study(model.as_ref(), &options)
+        .map_err(|e| study_failure(model.as_ref(), &e))?;
+    let ModalDampingStudy {
+        operating_point: point,
+        rayleigh,
+        releases: cases,
+        ..
+    } = &study;
+    let label = &point.name;
+    let names = model.coordinate_names();
     if let Some(path) = &args.plot {
         let panel_list: Vec<Panel> = cases
             .iter()
@@ -227,7 +102,8 @@ pub fn run(args: &ModalDampingArgs) -> Result<(), CliError> {
                         points: c.diagonal.coordinate_history(0),
                     },
                 ];
-                if let (Some(r), Some(([a, b], _))) = (&c.rayleigh, &rayleigh) {
+                if let (Some(r), Some(RayleighFit { modes: [a, b], .. })) = (&c.rayleigh, rayleigh)
+                {
                     series.push(Series {
                         name: format!("Rayleigh, modes {a} and {b}"),
                         points: r.coordinate_history(0),
@@ -246,67 +122,77 @@ pub fn run(args: &ModalDampingArgs) -> Result<(), CliError> {
 
     let mut stdout = std::io::stdout().lock();
     if args.json {
-        let out = json!({
-            "model": model.name(),
-            "coordinates": names,
-            "operating_point": {
-                "name": label,
-                "q": names.iter().zip(&lin.q).map(|(c, v)| (c.to_string(), json!(v))).collect::<serde_json::Map<_, _>>(),
-            },
-            "mass_matrix": matrix_rows(&lin.mass_matrix),
-            "stiffness_matrix": matrix_rows(&lin.stiffness_matrix),
-            "damping_matrix": matrix_rows(&lin.damping_matrix),
-            "modal_damping_matrix": matrix_rows(&approx.modal_damping_matrix),
-            "coupling": approx.coupling,
-            "rayleigh": rayleigh.as_ref().map(|(m, fit)| json!({
-                "modes": m,
-                "alpha": fit.alpha,
-                "beta": fit.beta,
-            })),
-            "modes": (0..n).map(|k| {
-                let w = modes.natural_frequencies[k];
-                json!({
-                    "mode": k + 1,
-                    "kind": kind_json(&modes.kinds[k]),
-                    "natural_frequency": w,
-                    "exact": exact[k].map(|d| json!({
-                        "re": d.eigenvalue.re,
-                        "im": d.eigenvalue.im,
-                        "damping_ratio": d.damping_ratio,
-                        "damped_frequency": d.damped_frequency,
-                    })),
-                    "diagonal": approx.damping_ratios[k].map(|z| json!({
-                        "damping_ratio": z,
-                        "damped_frequency": approx.damped_frequencies[k],
-                    })),
-                    "rayleigh": match (&rayleigh, modes.kinds[k]) {
-                        (Some((_, fit)), ModeKind::Oscillatory) => {
-                            let z = fit.damping_ratio(w);
-                            json!({"damping_ratio": z, "damped_frequency": damped_frequency(w, z)})
-                        }
-                        _ => serde_json::Value::Null,
-                    },
-                })
-            }).collect::<Vec<_>>(),
-            "t_end": t_end,
-            "samples": times.len(),
-            "tol": args.tol,
-            "cases": cases.iter().map(|c| json!({
-                "name": c.name,
-                "q0": c.q0,
-                "qdot0": c.v0,
-                "amplitude": c.exact.max_displacement(),
-                "integration_vs_exact": versus(c, &c.integrated),
-                "diagonal_vs_exact": versus(c, &c.diagonal),
-                "rayleigh_vs_exact": c.rayleigh.as_ref().map(|r| versus(c, r)),
-            })).collect::<Vec<_>>(),
-        });
-        let text =
-            serde_json::to_string_pretty(&out).map_err(|e| CliError::failure(e.to_string()))?;
+        let text = serde_json::to_string_pretty(&json_report(model.as_ref(), &study))
+            .map_err(|e| CliError::failure(e.to_string()))?;
         let _ = writeln!(stdout, "{text}");
         return Ok(());
     }
+    print_report(&mut stdout, model.as_ref(), &study);
+    Ok(())
+}
 
+/// The JSON of `study`.
+fn json_report(model: &dyn ModelInfo, study: &ModalDampingStudy) -> serde_json::Value {
+    let (lin, approx, cases) = (&study.linearization, &study.modal_damping, &study.releases);
+    let names = model.coordinate_names();
+    let samples = cases.first().map_or(0, |c| c.exact.times.len());
+
+    json!({
+        "model": model.name(),
+        "coordinates": names,
+        "operating_point": point_json(&study.operating_point.name, &names, &lin.q),
+        "mass_matrix": matrix_rows(&lin.mass_matrix),
+        "stiffness_matrix": matrix_rows(&lin.stiffness_matrix),
+        "damping_matrix": matrix_rows(&lin.damping_matrix),
+        "modal_damping_matrix": matrix_rows(&approx.modal_damping_matrix),
+        "coupling": approx.coupling,
+        "rayleigh": study.rayleigh,
+        "modes": study.modes.iter().map(|m| json!({
+            "mode": m.mode,
+            "kind": kind_json(&m.kind),
+            "natural_frequency": m.natural_frequency,
+            "exact": m.exact.map(|d| json!({
+                "re": d.eigenvalue.re,
+                "im": d.eigenvalue.im,
+                "damping_ratio": d.damping_ratio,
+                "damped_frequency": d.damped_frequency,
+            })),
+            "diagonal": m.diagonal,
+            "rayleigh": m.rayleigh,
+        })).collect::<Vec<_>>(),
+        "t_end": study.t_end,
+        "samples": samples,
+        "tol": study.tol,
+        "cases": cases.iter().map(|c| json!({
+            "name": c.name,
+            "q0": c.q0,
+            "qdot0": c.qdot0,
+            "amplitude": c.amplitude,
+            "integration_vs_exact": c.integration_vs_exact,
+            "diagonal_vs_exact": c.diagonal_vs_exact,
+            "rayleigh_vs_exact": c.rayleigh_vs_exact,
+        })).collect::<Vec<_>>(),
+    })
+}
+
+/// The text of `study`.
+fn print_report(
+    stdout: &mut impl std::io::Write,
+    model: &dyn ModelInfo,
+    study: &ModalDampingStudy,
+) {
+    let ModalDampingStudy {
+        operating_point: point,
+        modal_damping: approx,
+        rayleigh,
+        modes: per_mode,
+        t_end,
+        releases: cases,
+        ..
+    } = study;
+    let label = &point.name;
+    let n = model.num_dofs();
+    let samples = cases.first().map_or(0, |c| c.exact.times.len());
     let _ = writeln!(
         stdout,
         "model      {} ({} dof) at {label}: M δq̈ + C δq̇ + K δq = 0",
@@ -332,8 +218,11 @@ pub fn run(args: &ModalDampingArgs) -> Result<(), CliError> {
             .collect();
         let _ = writeln!(stdout, "           [{}]", row.join(", "));
     }
-    match &rayleigh {
-        Some(([a, b], fit)) => {
+    match rayleigh {
+        Some(RayleighFit {
+            modes: [a, b],
+            damping: fit,
+        }) => {
             let _ = writeln!(
                 stdout,
                 "Rayleigh   C = αM + βK fitted to the exact ζ of modes {a} and {b}: α = {:.6e} 1/s, β = {:.6e} s",
@@ -363,46 +252,38 @@ pub fn run(args: &ModalDampingArgs) -> Result<(), CliError> {
         "ζ Rayleigh",
         "ω_d Rayleigh"
     );
-    for (k, exact_k) in exact.iter().enumerate() {
-        let w = modes.natural_frequencies[k];
-        let z_r = match (&rayleigh, modes.kinds[k]) {
-            (Some((_, fit)), ModeKind::Oscillatory) => Some(fit.damping_ratio(w)),
-            _ => None,
-        };
+    for m in per_mode {
         let _ = writeln!(
             stdout,
             "{:>4} {:>13.6e} | {} {} | {} {} | {} {}",
-            k + 1,
-            w,
-            opt(exact_k.map(|d| d.damping_ratio), 13),
-            opt(exact_k.map(|d| d.damped_frequency), 13),
-            opt(approx.damping_ratios[k], 13),
-            opt(approx.damped_frequencies[k], 13),
-            opt(z_r, 13),
-            opt(z_r.and_then(|z| damped_frequency(w, z)), 13),
+            m.mode,
+            m.natural_frequency,
+            opt(m.exact.map(|d| d.damping_ratio), 13),
+            opt(m.exact.map(|d| d.damped_frequency), 13),
+            opt(m.diagonal.map(|d| d.damping_ratio), 13),
+            opt(m.diagonal.and_then(|d| d.damped_frequency), 13),
+            opt(m.rayleigh.map(|d| d.damping_ratio), 13),
+            opt(m.rayleigh.and_then(|d| d.damped_frequency), 13),
         );
     }
     let _ = writeln!(
         stdout,
-        "responses  0 ≤ t ≤ {t_end:.4} s, {} samples; max |δq| differences from e^{{At}}, relative to its largest |δq|:",
-        times.len()
+        "responses  0 ≤ t ≤ {t_end:.4} s, {samples} samples; max |δq| differences from e^{{At}}, relative to its largest |δq|:"
     );
     let _ = writeln!(
         stdout,
         "  {:<36} {:>12} {:>14} {:>12}",
         "release", "DOP853", "diagonal Ĉ", "Rayleigh"
     );
-    for c in &cases {
+    for c in cases {
         let _ = writeln!(
             stdout,
             "  {:<36} {:>12.2e} {:>14.2e} {:>12}",
             c.name,
-            versus(c, &c.integrated),
-            versus(c, &c.diagonal),
-            c.rayleigh
-                .as_ref()
-                .map_or("-".to_string(), |r| format!("{:.2e}", versus(c, r)))
+            c.integration_vs_exact,
+            c.diagonal_vs_exact,
+            c.rayleigh_vs_exact
+                .map_or("-".to_string(), |r| format!("{r:.2e}"))
         );
     }
-    Ok(())
 }

@@ -230,19 +230,21 @@ pub fn mode_charts(
             equilibrium: rest.clone(),
             displaced,
         };
-        let result = if path.ends_with(".png") {
-            draw(
-                BitMapBackend::new(&path, SIZE).into_drawing_area(),
-                &layout,
-                &drawing,
-            )
-        } else {
-            draw(
-                SVGBackend::new(&path, SIZE).into_drawing_area(),
-                &layout,
-                &drawing,
-            )
-        };
+        let result = super::render::atomically(&path, |file| {
+            if path.ends_with(".png") {
+                draw(
+                    BitMapBackend::new(file, SIZE).into_drawing_area(),
+                    &layout,
+                    &drawing,
+                )
+            } else {
+                draw(
+                    SVGBackend::new(file, SIZE).into_drawing_area(),
+                    &layout,
+                    &drawing,
+                )
+            }
+        });
         result.map_err(|e| CliError::failure(format!("`{path}`: {e}")))?;
         paths.push(path);
     }

@@ -4,10 +4,10 @@
 use std::io::Write as _;
 
 use clap::Args;
-use eomgen::{
-    Equilibrium, Linearization, ModeKind, ModelInfo, NormalModes, damped_modes,
-    eigenvalues_of_m_inv_k, find_equilibrium,
+use eomgen::vibration::{
+    self, EquilibriumStart, ModalAnalysis, ModalOptions, OperatingPointError, OperatingPointOptions,
 };
+use eomgen::{Equilibrium, Linearization, ModeKind, ModelInfo, NormalModes};
 use nalgebra::DMatrix;
 use serde_json::json;
 
@@ -59,64 +59,51 @@ impl OperatingPointArgs {
         Ok(model)
     }
 
-    /// The label and starting guess of `--at` for `model` (see [`operating_point`]).
+    /// The label and starting guess of `--at` for `model` (see [`equilibrium_start`]).
     ///
     /// # Errors
     /// An unknown equilibrium name or a bad guess.
     pub(super) fn guess(&self, model: &dyn ModelInfo) -> Result<(String, Vec<f64>), CliError> {
-        operating_point(model, self.at.as_deref())
+        equilibrium_start(model, self.at.as_deref())?
+            .resolve(model)
+            .map_err(|e| point_failure(model, &e))
+    }
+
+    /// The library's options for `--at` on `model`.
+    ///
+    /// # Errors
+    /// A bad guess (usage).
+    pub(super) fn options(&self, model: &dyn ModelInfo) -> Result<OperatingPointOptions, CliError> {
+        Ok(OperatingPointOptions {
+            start: equilibrium_start(model, self.at.as_deref())?,
+            ..OperatingPointOptions::default()
+        })
     }
 }
 
 /// Runs `modes`.
 pub fn run(args: &ModesArgs) -> Result<(), CliError> {
-    let OperatingPoint {
-        model,
-        label,
-        equilibrium,
-        lin,
-        modes,
-    } = operating_point_of(&args.model, &args.point)?;
+    let (model, modal) = analysis_of(&args.model, &args.point)?;
     if args.plot.is_some() {
         super::mode_plot::check_drawable(model.as_ref())?;
     }
-    let fail = |e: eomgen::ModalError| modal_failure(model.as_ref(), &e);
+    let ModalAnalysis {
+        operating_point: point,
+        linearization: lin,
+        normal_modes: modes,
+        mode_shapes: shapes,
+        minimal_coordinates: minimal,
+        damped_modes: damped,
+        damping_ratios,
+        m_inv_k_eigenvalues: route22,
+        m_inv_k_relative_difference: route_difference,
+    } = &modal;
+    let (label, equilibrium) = (&point.name, &point.equilibrium);
     let n = model.num_dofs();
-    let route22 = eigenvalues_of_m_inv_k(&lin).map_err(fail)?;
-    let damped = damped_modes(&lin).map_err(fail)?;
     let names = model.coordinate_names();
-    let r = lin.num_minimal_coordinates();
-    let undamped = lin.damping_matrix.amax() == 0.0;
-    let damping_ratios: Vec<f64> = if undamped {
-        vec![0.0; r]
-    } else {
-        damped.iter().map(|d| d.1).collect()
-    };
-    let scale = modes.eigenvalues.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-    let route_difference = modes
-        .eigenvalues
-        .iter()
-        .zip(&route22)
-        .map(|(a, b)| (a - b).abs())
-        .fold(0.0f64, f64::max)
-        / scale.max(f64::MIN_POSITIVE);
-    let kind = |k: &ModeKind| match k {
-        ModeKind::Oscillatory => json!({"kind": "oscillatory"}),
-        ModeKind::ZeroFrequency => json!({"kind": "zero_frequency"}),
-        ModeKind::Unstable { growth_rate } => {
-            json!({"kind": "unstable", "growth_rate": growth_rate})
-        }
-    };
+    let undamped = modal.is_undamped();
     // Mode shapes in the model's coordinates (δq = N z with constraints).
-    let shapes_q = lin.to_coordinates(&modes.mode_shapes);
-    let shapes: Vec<Vec<f64>> = (0..r)
-        .map(|k| shapes_q.column(k).iter().copied().collect())
-        .collect();
-    let minimal: Vec<&str> = lin
-        .independent_coordinates
-        .iter()
-        .map(|&i| names[i])
-        .collect();
+    let shapes_q = modal.mode_shape_matrix();
     let multipliers: serde_json::Map<String, serde_json::Value> = model
         .constraint_names()
         .iter()
@@ -124,37 +111,30 @@ pub fn run(args: &ModesArgs) -> Result<(), CliError> {
         .map(|(c, v)| (c.to_string(), json!(v)))
         .collect();
     let charts = match &args.plot {
-        Some(prefix) => super::mode_plot::mode_charts(
-            prefix,
-            model.as_ref(),
-            &equilibrium.q,
-            &modes,
-            &shapes_q,
-        )?,
+        Some(prefix) => {
+            super::mode_plot::mode_charts(prefix, model.as_ref(), &equilibrium.q, modes, &shapes_q)?
+        }
         None => Vec::new(),
     };
     if let Some(path) = &args.animate {
-        let page = super::animate::modes(model.as_ref(), &equilibrium.q, &modes, &shapes_q)?;
-        std::fs::write(path, page.to_html())
-            .map_err(|e| CliError::failure(format!("cannot write `{path}`: {e}")))?;
+        let page = super::animate::modes(model.as_ref(), &equilibrium.q, modes, &shapes_q)?;
+        super::render::write_file(path, page.to_html()).map_err(CliError::failure)?;
     }
     let mut stdout = std::io::stdout().lock();
     if args.json {
+        let mut point = point_json(label, &names, &equilibrium.q);
+        point["newton_iterations"] = json!(equilibrium.iterations);
+        point["residual"] = json!(equilibrium.residual);
         let out = json!({
             "model": model.name(),
             "coordinates": names,
-            "operating_point": {
-                "name": label,
-                "q": names.iter().zip(&equilibrium.q).map(|(c, v)| (c.to_string(), json!(v))).collect::<serde_json::Map<_, _>>(),
-                "newton_iterations": equilibrium.iterations,
-                "residual": equilibrium.residual,
-            },
+            "operating_point": point,
             "natural_frequencies": modes.natural_frequencies,
             "frequencies_hz": modes.natural_frequencies.iter().map(|w| w / std::f64::consts::TAU).collect::<Vec<_>>(),
             "eigenvalues": modes.eigenvalues,
-            "kinds": modes.kinds.iter().map(kind).collect::<Vec<_>>(),
+            "kinds": modes.kinds,
             "damping_ratios": damping_ratios,
-            "damped_modes": damped.iter().map(|(s, zeta, wd)| json!({"re": s.re, "im": s.im, "damping_ratio": zeta, "damped_frequency": wd})).collect::<Vec<_>>(),
+            "damped_modes": damped.iter().map(|d| json!({"re": d.eigenvalue.re, "im": d.eigenvalue.im, "damping_ratio": d.damping_ratio, "damped_frequency": d.damped_frequency})).collect::<Vec<_>>(),
             "mode_shapes": shapes,
             "minimal_coordinates": minimal,
             "lagrange_multipliers": multipliers,
@@ -276,8 +256,6 @@ fn print_matrix(out: &mut impl std::io::Write, name: &str, m: &DMatrix<f64>) {
 
 /// The linearisation at the operating point `--at` and what to call it.
 pub(super) struct OperatingPoint {
-    /// The model, with `--set` applied.
-    pub model: Box<dyn ModelInfo>,
     /// The equilibrium's name, or the `--at` guesses as given.
     pub label: String,
     /// The equilibrium Newton found (with the constraint forces at rest).
@@ -288,26 +266,36 @@ pub(super) struct OperatingPoint {
     pub modes: NormalModes,
 }
 
+/// The model `model_name` with `--set` applied and its modal analysis at `--at`
+/// ([`eomgen::vibration::modal_analysis`]).
+///
+/// # Errors
+/// A bad `--set` or `--at` (usage), a failed search or analysis (with a hint).
+pub(super) fn analysis_of(
+    model_name: &str,
+    point: &OperatingPointArgs,
+) -> Result<(Box<dyn ModelInfo>, ModalAnalysis), CliError> {
+    let model = point.model(model_name)?;
+    let options = ModalOptions {
+        operating_point: point.options(model.as_ref())?,
+    };
+    let modal = vibration::modal_analysis(model.as_ref(), &options)
+        .map_err(|e| point_failure(model.as_ref(), &e))?;
+    Ok((model, modal))
+}
+
 /// Finds the equilibrium from `--at` (after `--set`), linearises there and computes the
-/// normal modes: the start of `modes` and of the modal studies.
+/// normal modes: the start of the modal studies and of the report's modal checks.
 pub(super) fn operating_point_of(
     model_name: &str,
     point: &OperatingPointArgs,
 ) -> Result<OperatingPoint, CliError> {
-    let model = point.model(model_name)?;
-    let (label, guess) = point.guess(model.as_ref())?;
-    let fail = |e: eomgen::ModalError| modal_failure(model.as_ref(), &e);
-    let equilibrium = find_equilibrium(model.as_ref(), &guess, 0.0).map_err(fail)?;
-    let n = model.num_dofs();
-    let lin =
-        eomgen::linearize(model.as_ref(), &equilibrium.q, &vec![0.0; n], 0.0).map_err(fail)?;
-    let modes = eomgen::normal_modes(&lin).map_err(fail)?;
+    let (_, modal) = analysis_of(model_name, point)?;
     Ok(OperatingPoint {
-        model,
-        label,
-        equilibrium,
-        lin,
-        modes,
+        label: modal.operating_point.name,
+        equilibrium: modal.operating_point.equilibrium,
+        lin: modal.linearization,
+        modes: modal.normal_modes,
     })
 }
 
@@ -375,37 +363,29 @@ pub(super) fn modal_hint(model: &dyn ModelInfo, e: &eomgen::ModalError) -> Strin
     }
 }
 
-/// The starting guess of the equilibrium search and its label.
-pub(super) fn operating_point(
+/// The start of the equilibrium search that `--at` names: a name from the file's
+/// `equilibria:`, guesses `q1=VALUE,…` (expressions of the parameters; others 0), or the
+/// default (the file's first equilibrium, else q = 0).
+///
+/// # Errors
+/// A usage error for a bad guess (an unknown coordinate, a bad expression).
+pub(super) fn equilibrium_start(
     model: &dyn ModelInfo,
     at: Option<&str>,
-) -> Result<(String, Vec<f64>), CliError> {
-    let n = model.num_dofs();
-    let named = model.equilibrium_guesses();
+) -> Result<EquilibriumStart, CliError> {
     let Some(at) = at else {
-        return Ok(match named.first() {
-            Some((name, q)) => (name.to_string(), q.clone()),
-            None => ("q = 0".to_string(), vec![0.0; n]),
-        });
+        return Ok(EquilibriumStart::FirstNamed);
     };
-    if let Some((name, q)) = named.iter().find(|(name, _)| *name == at) {
-        return Ok((name.to_string(), q.clone()));
-    }
-    if !at.contains('=') {
-        let list: Vec<&str> = named.iter().map(|(n, _)| *n).collect();
-        return Err(CliError::usage(format!(
-            "--at {at}: `{}` has no equilibrium `{at}` ({}); or give guesses like `--at {}=0`",
-            model.name(),
-            if list.is_empty() {
-                "it names none".to_string()
-            } else {
-                format!("it names: {}", list.join(", "))
-            },
-            model.coordinate_names().first().copied().unwrap_or("q")
-        )));
+    if !at.contains('=')
+        || model
+            .equilibrium_guesses()
+            .iter()
+            .any(|(name, _)| *name == at)
+    {
+        return Ok(EquilibriumStart::Named(at.to_string()));
     }
     let lookup = parameter_lookup(model);
-    let mut q = vec![0.0; n];
+    let mut q = vec![0.0; model.num_dofs()];
     for part in at.split(',') {
         let (name, text) = split_assignment(part, "--at")?;
         let index = model
@@ -421,5 +401,30 @@ pub(super) fn operating_point(
             })?;
         q[index] = evaluate(text, &format!("--at {name}"), &lookup)?;
     }
-    Ok((at.to_string(), q))
+    Ok(EquilibriumStart::Guess {
+        label: at.to_string(),
+        q,
+    })
+}
+
+/// The error of a failed operating point of `model`: an unknown `--at` name is a usage error,
+/// a failed search gets its hint ([`modal_failure`]).
+pub(super) fn point_failure(model: &dyn ModelInfo, e: &OperatingPointError) -> CliError {
+    match e {
+        OperatingPointError::UnknownEquilibrium { name, .. } => CliError::usage(format!(
+            "--at {name}: {e}; or give guesses like `--at {}=0`",
+            model.coordinate_names().first().copied().unwrap_or("q")
+        )),
+        OperatingPointError::Modal(m) => modal_failure(model, m),
+        e => CliError::failure(format!("`{}`: {e}", model.name())),
+    }
+}
+
+/// The JSON of an operating point, `{"name", "q": {coordinate: value}}`, which each command
+/// extends with its own fields.
+pub(super) fn point_json(name: &str, coordinates: &[&str], q: &[f64]) -> serde_json::Value {
+    json!({
+        "name": name,
+        "q": coordinates.iter().zip(q).map(|(c, v)| (c.to_string(), json!(v))).collect::<serde_json::Map<_, _>>(),
+    })
 }

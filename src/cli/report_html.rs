@@ -5,6 +5,7 @@
 
 use std::fmt::Write as _;
 
+use super::render::escape;
 use super::report::{CheckRow, ModelReport};
 
 const STYLE: &str = r#"
@@ -40,22 +41,6 @@ iframe.animation { width: 100%; height: 520px; border: 1px solid var(--line); }
 ul.notes { font-size: .85rem; color: var(--muted); }
 footer { max-width: 1200px; margin: 2rem auto; padding: 0 1.5rem 2rem; color: var(--muted); font-size: .85rem; }
 "#;
-
-/// Escapes text for HTML content and attribute values.
-pub(super) fn escape(s: &str) -> String {
-    let mut out = String::with_capacity(s.len());
-    for c in s.chars() {
-        match c {
-            '&' => out.push_str("&amp;"),
-            '<' => out.push_str("&lt;"),
-            '>' => out.push_str("&gt;"),
-            '"' => out.push_str("&quot;"),
-            '\'' => out.push_str("&#39;"),
-            _ => out.push(c),
-        }
-    }
-    out
-}
 
 /// A number for the tables: ten decimals in `[1e-3, 1e5)`, else four significant digits in
 /// exponent form; `—` for a missing or non-finite value.

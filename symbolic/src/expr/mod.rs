@@ -337,6 +337,10 @@ pub struct ExprArena {
     /// and every negation asks for one, and a hash-cons lookup per request was a tenth of a
     /// long chain's Lagrange derivation.
     small_ints: [Option<ExprId>; 4],
+    /// Set when folding constants gave a value beyond `f64` (a product or sum of constants
+    /// over ±1.8e308), which cannot be a node: the fold is then incomplete, and lowering a
+    /// model file turns this into a located error ([`Self::take_constant_overflow`]).
+    constant_overflow: std::cell::Cell<bool>,
 }
 
 impl ExprArena {
@@ -353,6 +357,12 @@ impl ExprArena {
     /// Whether the arena has no nodes.
     pub fn is_empty(&self) -> bool {
         self.nodes.is_empty()
+    }
+
+    /// Whether folding constants overflowed `f64` since the last call (and clears it). The
+    /// expression built then is not the one asked for: its caller reports an error.
+    pub fn take_constant_overflow(&mut self) -> bool {
+        self.constant_overflow.replace(false)
     }
 
     /// The node behind `id`.
@@ -606,7 +616,10 @@ impl ExprArena {
             match self.split_coefficient(term) {
                 (c, None) => match constant.checked_add(c) {
                     Some(s) => constant = s,
-                    None => float_fallback.push(term),
+                    None => {
+                        self.constant_overflow.set(true);
+                        float_fallback.push(term);
+                    }
                 },
                 (c, Some(rest)) => merged.push((rest, c, Some(term))),
             }
@@ -623,7 +636,10 @@ impl ExprArena {
                         *total = s;
                         *o = None;
                     }
-                    None => float_fallback.extend(original),
+                    None => {
+                        self.constant_overflow.set(true);
+                        float_fallback.extend(original);
+                    }
                 }
             } else {
                 merged[kept] = (rest, c, original);
@@ -768,7 +784,10 @@ impl ExprArena {
             zero_term(collected, partner);
             match others.len() {
                 0 => {
-                    *constant = constant.checked_add(c).unwrap_or(*constant);
+                    *constant = constant.checked_add(c).unwrap_or_else(|| {
+                        self.constant_overflow.set(true);
+                        *constant
+                    });
                 }
                 _ => {
                     let x = if others.len() == 1 {
@@ -999,7 +1018,10 @@ impl ExprArena {
                     }
                     match coefficient.checked_mul(c) {
                         Some(v) => coefficient = v,
-                        None => results.push(p),
+                        None => {
+                            self.constant_overflow.set(true);
+                            results.push(p);
+                        }
                     }
                 }
                 Node::Mul(_) => {
@@ -1036,7 +1058,8 @@ impl ExprArena {
     }
 
     /// The factors of `Π factors` as `(base, exponent, factor)` in `powers` (nested products
-    /// flattened), and the product of their numbers; `None` if that is zero.
+    /// flattened), and the product of their numbers; `None` if that is zero. A product of
+    /// numbers beyond `f64` sets the overflow flag and leaves out the factor that overflowed.
     fn gather_factors(
         &self,
         factors: &[ExprId],
@@ -1046,15 +1069,24 @@ impl ExprArena {
         for &f in factors {
             match self.node(f) {
                 Node::Mul(inner) => {
-                    coefficient = coefficient.checked_mul(self.gather_factors(inner, powers)?)?
+                    let inner = self.gather_factors(inner, powers)?;
+                    coefficient = self.folded_product(coefficient, inner);
                 }
                 Node::Const(c) if c.is_zero() => return None,
-                Node::Const(c) => coefficient = coefficient.checked_mul(*c)?,
+                Node::Const(c) => coefficient = self.folded_product(coefficient, *c),
                 Node::Pow([b, e]) => powers.push((*b, Some(*e), f)),
                 _ => powers.push((f, None, f)),
             }
         }
         (!coefficient.is_zero()).then_some(coefficient)
+    }
+
+    /// `a · b` of two numbers, or `a` with the overflow flag set when it is beyond `f64`.
+    fn folded_product(&self, a: Constant, b: Constant) -> Constant {
+        a.checked_mul(b).unwrap_or_else(|| {
+            self.constant_overflow.set(true);
+            a
+        })
     }
 
     /// `a + b`.

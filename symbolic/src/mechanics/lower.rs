@@ -320,7 +320,19 @@ impl<'f> Lowering<'f> {
         eqs
     }
 
+    /// The expression `e` of the model file in the arena. Constants must come out exact or
+    /// not at all: an operation on constants that is undefined (division by zero, `0^0`, the
+    /// logarithm of a non-positive number, a root of a negative one) or that overflows `f64`
+    /// is a located error (see [`Self::check_constants`]), never a silent 0, NaN or ∞ in the
+    /// equations.
     fn expr(&mut self, e: &Expr) -> ExprId {
+        // The flag may be left from an expression built outside a model file's.
+        self.arena.take_constant_overflow();
+        self.lower(e)
+    }
+
+    /// [`Self::expr`] of a sub-expression.
+    fn lower(&mut self, e: &Expr) -> ExprId {
         match &e.kind {
             ExprKind::Number { value, text } => {
                 let c = Constant::parse_decimal(text)
@@ -351,21 +363,59 @@ impl<'f> Lowering<'f> {
                 },
             },
             ExprKind::Neg(a) => {
-                let a = self.expr(a);
+                let a = self.lower(a);
                 self.arena.neg(a)
             }
             ExprKind::Binary { op, lhs, rhs } => {
-                let (a, b) = (self.expr(lhs), self.expr(rhs));
-                match op {
+                let (a, b) = (self.lower(lhs), self.lower(rhs));
+                self.check_constants(e, *op, a, b);
+                let result = match op {
                     BinOp::Add => self.arena.plus(a, b),
                     BinOp::Sub => self.arena.minus(a, b),
                     BinOp::Mul => self.arena.times(a, b),
                     BinOp::Div => self.arena.divide(a, b),
                     BinOp::Pow => self.arena.pow(a, b),
+                };
+                if self.arena.take_constant_overflow() {
+                    self.errors.push(
+                        Diagnostic::new(
+                            e.location,
+                            format!(
+                                "the numbers in this {} overflow: their value is beyond ±1.8e308, the largest a double holds",
+                                match op {
+                                    BinOp::Add | BinOp::Sub => "sum",
+                                    BinOp::Mul | BinOp::Div => "product",
+                                    BinOp::Pow => "power",
+                                }
+                            ),
+                        )
+                        .with_help("check the exponents of the numbers; rescale the units if the values are real"),
+                    );
                 }
+                result
             }
             ExprKind::Call { func, args } => {
-                let args: Vec<ExprId> = args.iter().map(|a| self.expr(a)).collect();
+                let args: Vec<ExprId> = args.iter().map(|a| self.lower(a)).collect();
+                if let [a] = args.as_slice()
+                    && let Some(x) = self.arena.as_constant(*a).map(Constant::to_f64)
+                {
+                    let value = match func.as_str() {
+                        "sqrt" => Some(x.sqrt()),
+                        name => Func::from_name(name).map(|f| f.apply(x)),
+                    };
+                    if value.is_some_and(|v| !v.is_finite()) {
+                        self.undefined(
+                            e,
+                            &format!("`{func}({x})` is not a finite real number"),
+                            match func.as_str() {
+                                "ln" => "the logarithm takes a positive argument",
+                                "sqrt" => "the square root takes a non-negative argument",
+                                "asin" | "acos" => "the argument must lie in [-1, 1]",
+                                _ => "check the argument",
+                            },
+                        );
+                    }
+                }
                 match (func.as_str(), args.as_slice()) {
                     ("sqrt", [a]) => self.arena.sqrt(*a),
                     ("atan2", [y, x]) => self.arena.atan2(*y, *x),
@@ -377,6 +427,51 @@ impl<'f> Lowering<'f> {
                 }
             }
         }
+    }
+
+    /// Reports `a op b` (the node `e`) when its value is undefined for the numbers it is
+    /// given: `a / 0`, `0 ^ b` with `b ≤ 0`, a negative number to a non-integer power, or a
+    /// power of numbers that overflows.
+    fn check_constants(&mut self, e: &Expr, op: BinOp, a: ExprId, b: ExprId) {
+        let (x, y) = (
+            self.arena.as_constant(a).map(Constant::to_f64),
+            self.arena.as_constant(b).map(Constant::to_f64),
+        );
+        match (op, x, y) {
+            (BinOp::Div, _, Some(0.0)) => {
+                self.undefined(e, "division by zero", "the divisor is 0 here");
+            }
+            (BinOp::Pow, Some(x), Some(y)) if x == 0.0 && y <= 0.0 => {
+                self.undefined(
+                    e,
+                    &format!("`0^{y}` is undefined"),
+                    "zero has no power of a non-positive exponent",
+                );
+            }
+            (BinOp::Pow, Some(x), Some(y)) if x < 0.0 && y.fract() != 0.0 => {
+                self.undefined(
+                    e,
+                    &format!("`({x})^{y}` is not a real number"),
+                    "a negative number has only integer powers",
+                );
+            }
+            (BinOp::Pow, Some(x), Some(y)) if !x.powf(y).is_finite() => {
+                self.errors.push(
+                    Diagnostic::new(
+                        e.location,
+                        format!("`{x}^{y}` overflows: its value is beyond ±1.8e308, the largest a double holds"),
+                    )
+                    .with_help("check the exponent; rescale the units if the values are real"),
+                );
+            }
+            _ => {}
+        }
+    }
+
+    /// A located error: an operation on numbers whose result is undefined.
+    fn undefined(&mut self, e: &Expr, what: &str, help: &str) {
+        self.errors
+            .push(Diagnostic::new(e.location, what.to_string()).with_help(help.to_string()));
     }
 
     fn unknown_function(&mut self, e: &Expr, name: &str) -> ExprId {

@@ -35,6 +35,7 @@ pub fn check_partial(file: &ModelFile, incomplete: &Incomplete) -> Result<(), Ve
     checker.balances();
     checker.hand_equations();
     checker.reference_checks();
+    checker.floquet_references();
     checker.constraints();
     let units = super::unit_check::check(file);
     // A unit mistake at the place of another mistake is its consequence (`initial: { theta:
@@ -782,6 +783,97 @@ impl<'f> Checker<'f> {
                 self.resolve(rhs, Depends::Acceleration, &what);
             }
         }
+    }
+
+    // Rule (`floquet:`): each entry names an equilibrium; `axis_units`, `along` and `gives`
+    // name parameters (`along` ≠ `gives`); every expression is a constant of the parameters;
+    // colour components are whole numbers from 0 to 255.
+    fn floquet_references(&mut self) {
+        let file = self.file;
+        let equilibria: Vec<&str> = file
+            .equilibria
+            .iter()
+            .map(|e| e.name.value.as_str())
+            .collect();
+        for entry in &file.floquet {
+            let at = &entry.at;
+            if !equilibria.contains(&at.value.as_str())
+                && !self.incomplete.has_section("equilibria")
+            {
+                let d = Diagnostic::new(
+                    at.location,
+                    format!(
+                        "`floquet:` names `{}`, which is not an equilibrium of the model",
+                        at.value
+                    ),
+                );
+                let d = match closest(&at.value, &equilibria) {
+                    Some(c) => d.with_help(format!("did you mean `{c}`?")),
+                    None => d.with_help(
+                        "a `floquet:` entry is keyed by a name of `equilibria:`, as in `equilibria: { upright: { theta: 0 } }`",
+                    ),
+                };
+                self.error(d);
+            }
+            let what = format!("`floquet:` at `{}`", at.value);
+            for (p, _) in &entry.axis_units {
+                self.parameter_name(p, &format!("`axis_units` of {what}"));
+            }
+            for t in &entry.thresholds {
+                let of = format!("threshold `{}` of {what}", t.name.value);
+                self.resolve(&t.value, Depends::Constant, &format!("the value of {of}"));
+                self.resolve(
+                    &t.critical,
+                    Depends::Constant,
+                    &format!("the critical value of {of}"),
+                );
+            }
+            for c in &entry.curves {
+                let of = format!("curve `{}` of {what}", c.name.value);
+                self.parameter_name(&c.along, &format!("`along` of {of}"));
+                self.parameter_name(&c.gives, &format!("`gives` of {of}"));
+                if c.along.value == c.gives.value {
+                    self.error(
+                        Diagnostic::new(
+                            c.gives.location,
+                            format!("{of} gives `{}` along itself", c.gives.value),
+                        )
+                        .with_help("`along` and `gives` name the chart's two parameters: `along: a, gives: w`"),
+                    );
+                }
+                self.resolve(&c.value, Depends::Constant, &format!("the value of {of}"));
+                if let Some(domain) = &c.domain {
+                    self.resolve(domain, Depends::Constant, &format!("`where` of {of}"));
+                }
+                for e in &c.color {
+                    self.resolve(e, Depends::Constant, &format!("the colour of {of}"));
+                    let value = evaluate(e, &file.parameters);
+                    if value.is_some_and(|v| !(0.0..=255.0).contains(&v) || v.fract() != 0.0) {
+                        self.error(
+                            Diagnostic::new(
+                                e.location,
+                                format!("the colour of {of} has a component outside 0 to 255"),
+                            )
+                            .with_help("write red, green and blue as whole numbers from 0 to 255: `color: [0, 150, 60]`"),
+                        );
+                    }
+                }
+            }
+        }
+    }
+
+    /// Reports `name` unless it is a parameter; `what` says where it was written.
+    fn parameter_name(&mut self, name: &Located<String>, what: &str) {
+        let n = name.value.as_str();
+        if self.params.contains(&n) || self.incomplete.has_name(n) {
+            return;
+        }
+        let d = Diagnostic::new(name.location, format!("{what}: `{n}` is not a parameter"));
+        let d = match closest(n, &self.params) {
+            Some(c) => d.with_help(format!("did you mean `{c}`?")),
+            None => d.with_help(format!("parameters are: {}", self.params.join(", "))),
+        };
+        self.error(d);
     }
 
     // Rule: the reference values of `checks:` are expressions of the parameters (a conserved

@@ -350,7 +350,7 @@ pub struct Balance {
     pub location: Location,
 }
 
-/// What an animation draws (`draw:`). Parsed and checked now; used by `animate` later.
+/// What an animation draws (`draw:`): the lines and traced points of `eomgen animate`.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct Draw {
     /// Line segments between named points.
@@ -406,6 +406,75 @@ pub struct EquilibriumDef {
     pub name: Located<String>,
     /// Guessed coordinate values by coordinate name (constant expressions).
     pub values: Vec<(Located<String>, Expr)>,
+}
+
+/// One entry of `floquet:`: the reference results that `eomgen study floquet` draws on its
+/// stability chart and prints at the equilibrium `at` (lectures 19, 21), such as the
+/// Mathieu pendulum's Kapitza condition and the edges of its stable band:
+///
+/// ```yaml
+/// floquet:
+///   upright:
+///     axis_units: { a: m }
+///     thresholds:
+///       kapitza: { key: a_w, label: a w, value: a*w, critical: sqrt(2*g*l),
+///                  critical_label: √(2 g l), by: averaging, note: for a ≪ l }
+///     curves:
+///       kapitza: { label: Kapitza a w = √(2 g l), color: [0, 0, 0], along: a, gives: w,
+///                  value: sqrt(2*g*l)/a }
+/// ```
+#[derive(Debug, Clone, PartialEq)]
+pub struct FloquetReference {
+    /// The equilibrium (a name of `equilibria:`) the references hold at.
+    pub at: Located<String>,
+    /// Units shown on the chart's axes for these parameters (`a: m`).
+    pub axis_units: Vec<(Located<String>, Located<String>)>,
+    /// Predictions of stability by a threshold, printed and in the JSON.
+    pub thresholds: Vec<FloquetThreshold>,
+    /// Curves drawn on a chart over the two parameters `along` and `gives`.
+    pub curves: Vec<ReferenceCurve>,
+}
+
+/// A stability prediction `value > critical` at an equilibrium (`floquet:` … `thresholds:`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct FloquetThreshold {
+    /// Its name, the JSON key of its object and the label of its text line (`kapitza`).
+    pub name: Located<String>,
+    /// The JSON name of the value (`a_w`); the critical value is `critical_<key>`.
+    pub key: Located<String>,
+    /// How the text names the value (`a w`).
+    pub label: String,
+    /// The value, an expression of the parameters.
+    pub value: Expr,
+    /// The critical value above which the equilibrium is predicted stable.
+    pub critical: Expr,
+    /// How the text names the critical value (`√(2 g l)`).
+    pub critical_label: String,
+    /// What predicts it (`averaging`).
+    pub by: String,
+    /// When the prediction holds (`for a ≪ l`).
+    pub note: String,
+}
+
+/// A reference curve of a stability chart (`floquet:` … `curves:`): the parameter `gives` as
+/// a function of the parameter `along`, sampled over the positive part of `along`'s axis.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ReferenceCurve {
+    /// Its name in the file.
+    pub name: Located<String>,
+    /// Its legend.
+    pub label: String,
+    /// Its colour `[r, g, b]`, each 0 to 255 (constant expressions).
+    pub color: Vec<Expr>,
+    /// The parameter the curve is sampled along.
+    pub along: Located<String>,
+    /// The parameter it gives.
+    pub gives: Located<String>,
+    /// The value of `gives`, an expression of the parameters (with `along` at each sample);
+    /// samples where it is not finite are left out.
+    pub value: Expr,
+    /// `where:` — the curve is drawn where this expression is ≥ 0 (default: everywhere).
+    pub domain: Option<Expr>,
 }
 
 /// A whole model file after the schema pass.
@@ -470,6 +539,8 @@ pub struct ModelFile {
     pub events: Vec<EventDef>,
     /// `equilibria:` — named guesses for equilibrium searches, in file order.
     pub equilibria: Vec<EquilibriumDef>,
+    /// `floquet:` — reference results of Floquet charts by equilibrium, in file order.
+    pub floquet: Vec<FloquetReference>,
     /// The spatial dimension of the points (2 or 3); `None` when there are no points.
     pub dimension: Option<usize>,
 }

@@ -49,7 +49,7 @@ pub fn parse_expr_mapped(
         return Err(Diagnostic::new(locate(0), "empty expression")
             .with_help("write a number or an expression such as `m*g*l`"));
     }
-    let e = p.sum()?;
+    let (e, _) = p.sum()?;
     match p.peek() {
         Tok::End => Ok(e),
         Tok::Op(')') => Err(Diagnostic::new(p.at(), "unexpected `)`: it closes no `(`")
@@ -194,6 +194,19 @@ struct P<'a> {
 /// Nesting limit (parentheses, unary signs, powers), so that no input overflows the stack.
 const MAX_DEPTH: usize = 100;
 
+/// Height limit of an expression's tree. A chain `a + b + c + …` is a left-deep tree as tall
+/// as it is long, and the passes over the tree (the load's evaluation and unit checks,
+/// lowering, dropping it) recurse along it, so an expression of any length must not make a
+/// tree that outgrows the stack. The deepest pass takes ~240 bytes a level (evaluation
+/// overflowed a 2 MiB stack at ~8,600 levels), so 2,000 levels take about a quarter of the
+/// smallest stack the pipeline runs on (2 MiB, a spawned thread's default), leaving the rest
+/// to the caller. Two thousand operations in one chain are beyond any hand-written model, and
+/// `eomgen new` keeps its chains shorter; the limit is a located error, not a crash.
+pub const MAX_TREE_HEIGHT: usize = 2_000;
+
+/// A parsed sub-expression and the height of its tree (1 for a leaf).
+type Parsed = Result<(Expr, usize), Diagnostic>;
+
 fn symbol(op: BinOp) -> char {
     match op {
         BinOp::Add => '+',
@@ -204,16 +217,33 @@ fn symbol(op: BinOp) -> char {
     }
 }
 
-fn binary(op: BinOp, lhs: Expr, rhs: Expr) -> Expr {
-    let location = lhs.location;
-    Expr {
-        kind: ExprKind::Binary {
-            op,
-            lhs: Box::new(lhs),
-            rhs: Box::new(rhs),
-        },
-        location,
+/// `lhs op rhs`, with its height; an error at `at` (the operator) when it would be taller
+/// than [`MAX_TREE_HEIGHT`].
+fn binary(op: BinOp, (lhs, lh): (Expr, usize), (rhs, rh): (Expr, usize), at: Location) -> Parsed {
+    let height = 1 + lh.max(rh);
+    if height > MAX_TREE_HEIGHT {
+        return Err(Diagnostic::new(
+            at,
+            format!(
+                "expression is too long: its operations chain more than {MAX_TREE_HEIGHT} deep here"
+            ),
+        )
+        .with_help(
+            "spread a long sum over several entries (springs, dampers, forces, points), or shorten it",
+        ));
     }
+    let location = lhs.location;
+    Ok((
+        Expr {
+            kind: ExprKind::Binary {
+                op,
+                lhs: Box::new(lhs),
+                rhs: Box::new(rhs),
+            },
+            location,
+        },
+        height,
+    ))
 }
 
 impl P<'_> {
@@ -241,7 +271,7 @@ impl P<'_> {
     }
 
     /// Runs `f` one nesting level deeper.
-    fn nested(&mut self, f: fn(&mut Self) -> Result<Expr, Diagnostic>) -> Result<Expr, Diagnostic> {
+    fn nested(&mut self, f: fn(&mut Self) -> Parsed) -> Parsed {
         if self.depth >= MAX_DEPTH {
             return Err(
                 Diagnostic::new(self.at(), "expression is nested too deeply").with_help(
@@ -255,7 +285,7 @@ impl P<'_> {
         r
     }
 
-    fn sum(&mut self) -> Result<Expr, Diagnostic> {
+    fn sum(&mut self) -> Parsed {
         let mut lhs = self.product()?;
         loop {
             let op = match self.peek() {
@@ -263,14 +293,15 @@ impl P<'_> {
                 Tok::Op('-') => BinOp::Sub,
                 _ => break,
             };
+            let at = self.at();
             self.bump();
             let rhs = self.operand_after(op, Self::product)?;
-            lhs = binary(op, lhs, rhs);
+            lhs = binary(op, lhs, rhs, at)?;
         }
         Ok(lhs)
     }
 
-    fn product(&mut self) -> Result<Expr, Diagnostic> {
+    fn product(&mut self) -> Parsed {
         let mut lhs = self.unary()?;
         loop {
             let op = match self.peek() {
@@ -278,19 +309,16 @@ impl P<'_> {
                 Tok::Op('/') => BinOp::Div,
                 _ => break,
             };
+            let at = self.at();
             self.bump();
             let rhs = self.operand_after(op, Self::unary)?;
-            lhs = binary(op, lhs, rhs);
+            lhs = binary(op, lhs, rhs, at)?;
         }
         Ok(lhs)
     }
 
     /// The right operand of `op`, with a clear error when there is none.
-    fn operand_after(
-        &mut self,
-        op: BinOp,
-        f: fn(&mut Self) -> Result<Expr, Diagnostic>,
-    ) -> Result<Expr, Diagnostic> {
+    fn operand_after(&mut self, op: BinOp, f: fn(&mut Self) -> Parsed) -> Parsed {
         if matches!(self.peek(), Tok::End | Tok::Op(')' | ',' | '*' | '/' | '^')) {
             let d = Diagnostic::new(
                 self.at(),
@@ -313,16 +341,19 @@ impl P<'_> {
         f(self)
     }
 
-    fn unary(&mut self) -> Result<Expr, Diagnostic> {
+    fn unary(&mut self) -> Parsed {
         match self.peek() {
             Tok::Op('-') => {
                 let loc = self.at();
                 self.bump();
-                let inner = self.operand_after(BinOp::Sub, |p| p.nested(Self::unary))?;
-                Ok(Expr {
-                    kind: ExprKind::Neg(Box::new(inner)),
-                    location: loc,
-                })
+                let (inner, height) = self.operand_after(BinOp::Sub, |p| p.nested(Self::unary))?;
+                Ok((
+                    Expr {
+                        kind: ExprKind::Neg(Box::new(inner)),
+                        location: loc,
+                    },
+                    height + 1,
+                ))
             }
             Tok::Op('+') => {
                 self.bump();
@@ -332,25 +363,29 @@ impl P<'_> {
         }
     }
 
-    fn power(&mut self) -> Result<Expr, Diagnostic> {
+    fn power(&mut self) -> Parsed {
         let base = self.atom()?;
         if matches!(self.peek(), Tok::Op('^')) {
+            let at = self.at();
             self.bump();
             let exponent = self.operand_after(BinOp::Pow, |p| p.nested(Self::unary))?;
-            return Ok(binary(BinOp::Pow, base, exponent));
+            return binary(BinOp::Pow, base, exponent, at);
         }
         Ok(base)
     }
 
-    fn atom(&mut self) -> Result<Expr, Diagnostic> {
+    fn atom(&mut self) -> Parsed {
         let loc = self.at();
         match self.peek().clone() {
             Tok::Num(value, text) => {
                 self.bump();
-                Ok(Expr {
-                    kind: ExprKind::Number { value, text },
-                    location: loc,
-                })
+                Ok((
+                    Expr {
+                        kind: ExprKind::Number { value, text },
+                        location: loc,
+                    },
+                    1,
+                ))
             }
             Tok::Name(name) => {
                 self.bump();
@@ -367,10 +402,13 @@ impl P<'_> {
                     )
                     .with_help(format!("write `{name}(x)`")))
                 } else {
-                    Ok(Expr {
-                        kind: ExprKind::Ident(name),
-                        location: loc,
-                    })
+                    Ok((
+                        Expr {
+                            kind: ExprKind::Ident(name),
+                            location: loc,
+                        },
+                        1,
+                    ))
                 }
             }
             Tok::Op('(') => {
@@ -379,7 +417,7 @@ impl P<'_> {
                     return Err(Diagnostic::new(loc, "empty parentheses `()`")
                         .with_help("write an expression between `(` and `)`"));
                 }
-                let mut inner = self.nested(Self::sum)?;
+                let (mut inner, height) = self.nested(Self::sum)?;
                 match self.peek() {
                     Tok::Op(')') => {}
                     Tok::End => {
@@ -404,7 +442,7 @@ impl P<'_> {
                 self.bump();
                 // The parenthesised expression starts at its `(`.
                 inner.location = loc;
-                Ok(inner)
+                Ok((inner, height))
             }
             Tok::Op(')') => Err(Diagnostic::new(loc, "unexpected `)`: it closes no `(`")
                 .with_help("remove it, or add the `(` it should close")),
@@ -420,10 +458,11 @@ impl P<'_> {
     }
 
     /// The arguments of `name(`, with `(` the current token.
-    fn call(&mut self, name: String, arity: usize, loc: Location) -> Result<Expr, Diagnostic> {
+    fn call(&mut self, name: String, arity: usize, loc: Location) -> Parsed {
         let open = self.at();
         self.bump();
         let mut args = Vec::new();
+        let mut height = 0;
         if !matches!(self.peek(), Tok::Op(')')) {
             loop {
                 if matches!(self.peek(), Tok::Op(')' | ',')) {
@@ -436,7 +475,9 @@ impl P<'_> {
                     )
                     .with_help(format!("`{name}` takes {}", arguments(arity))));
                 }
-                args.push(self.nested(Self::sum)?);
+                let (arg, h) = self.nested(Self::sum)?;
+                args.push(arg);
+                height = height.max(h);
                 match self.peek() {
                     Tok::Op(',') => self.bump(),
                     Tok::Op(')') => break,
@@ -476,10 +517,13 @@ impl P<'_> {
                 format!("write `{name}(x)`")
             }));
         }
-        Ok(Expr {
-            kind: ExprKind::Call { func: name, args },
-            location: loc,
-        })
+        Ok((
+            Expr {
+                kind: ExprKind::Call { func: name, args },
+                location: loc,
+            },
+            height + 1,
+        ))
     }
 }
 

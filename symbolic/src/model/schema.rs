@@ -5,7 +5,7 @@
 //! left out, and what was left out is recorded in [`Incomplete`] so that the cross-object
 //! checks ([`super::check`]) do not report its consequences a second time.
 
-use super::ast::Expr;
+use super::ast::{BinOp, Expr, ExprKind};
 use super::diagnostic::{Diagnostic, Diagnostics};
 use super::file::*;
 use super::located::{Located, Location};
@@ -42,6 +42,7 @@ pub const TOP_LEVEL_KEYS: &[&str] = &[
     "nonholonomic",
     "events",
     "equilibria",
+    "floquet",
     "minimal_twin",
 ];
 
@@ -765,6 +766,10 @@ impl Ctx<'_> {
         let equilibria = get(top, "equilibria")
             .map(|n| self.equilibria(n))
             .unwrap_or_default();
+        self.section = "floquet";
+        let floquet = get(top, "floquet")
+            .map(|n| self.floquet(n))
+            .unwrap_or_default();
         self.section = "";
 
         let dimension = points.first().map(|p: &Point| p.position.len());
@@ -796,7 +801,186 @@ impl Ctx<'_> {
             initial_guesses,
             events,
             equilibria,
+            floquet,
         })
+    }
+
+    /// `floquet:` — `equilibrium: { axis_units: { p: unit }, thresholds: { name: { … } },
+    /// curves: { name: { … } } }`.
+    fn floquet(&mut self, node: &YamlNode) -> Vec<FloquetReference> {
+        const EXAMPLE: &str = "{ axis_units: { a: m }, curves: { kapitza: { label: Kapitza, color: [0, 0, 0], along: a, gives: w, value: sqrt(2*g*l)/a } } }";
+        let Some(entries) = self.map(
+            node,
+            "`floquet`",
+            &format!("floquet: {{ upright: {EXAMPLE} }}"),
+        ) else {
+            return Vec::new();
+        };
+        let mut out = Vec::new();
+        for (k, v) in entries {
+            if !self.key_name(k, "equilibrium") {
+                continue;
+            }
+            let Some(f) = self.fields(
+                k,
+                v,
+                "the Floquet references at",
+                &["axis_units", "thresholds", "curves"],
+                &[],
+                EXAMPLE,
+            ) else {
+                continue;
+            };
+            let axis_units = get(f, "axis_units")
+                .and_then(|n| self.map(n, "`axis_units`", "axis_units: { a: m, w: rad/s }"))
+                .map(|units| {
+                    units
+                        .iter()
+                        .filter_map(|(p, u)| {
+                            let u = self.text(u, &format!("the unit of `{}`", p.value), "m")?;
+                            Some((p.clone(), u))
+                        })
+                        .collect()
+                })
+                .unwrap_or_default();
+            let thresholds = get(f, "thresholds")
+                .map(|n| self.floquet_thresholds(n))
+                .unwrap_or_default();
+            let curves = get(f, "curves")
+                .map(|n| self.reference_curves(n))
+                .unwrap_or_default();
+            out.push(FloquetReference {
+                at: k.clone(),
+                axis_units,
+                thresholds,
+                curves,
+            });
+        }
+        out
+    }
+
+    /// `thresholds:` of a `floquet:` entry.
+    fn floquet_thresholds(&mut self, node: &YamlNode) -> Vec<FloquetThreshold> {
+        const EXAMPLE: &str = "{ key: a_w, label: a w, value: a*w, critical: sqrt(2*g*l), critical_label: √(2 g l), by: averaging, note: for a ≪ l }";
+        let Some(entries) = self.map(
+            node,
+            "`thresholds`",
+            &format!("thresholds: {{ kapitza: {EXAMPLE} }}"),
+        ) else {
+            return Vec::new();
+        };
+        let keys = [
+            "key",
+            "label",
+            "value",
+            "critical",
+            "critical_label",
+            "by",
+            "note",
+        ];
+        let mut out = Vec::new();
+        for (k, v) in entries {
+            if !self.key_name(k, "threshold") {
+                continue;
+            }
+            let Some(f) = self.fields(k, v, "threshold", &keys, &keys, EXAMPLE) else {
+                continue;
+            };
+            let what = |field: &str| format!("`{field}` of threshold `{}`", k.value);
+            let key = get(f, "key").and_then(|n| self.name(n, &what("key")));
+            let mut texts = ["label", "critical_label", "by", "note"]
+                .map(|field| get(f, field).and_then(|n| self.text(n, &what(field), "a w")));
+            let value = get(f, "value").and_then(|n| self.expr(n, &what("value")));
+            let critical = get(f, "critical").and_then(|n| self.expr(n, &what("critical")));
+            let [Some(label), Some(critical_label), Some(by), Some(note)] =
+                texts.each_mut().map(Option::take)
+            else {
+                continue;
+            };
+            let (Some(key), Some(value), Some(critical)) = (key, value, critical) else {
+                continue;
+            };
+            out.push(FloquetThreshold {
+                name: k.clone(),
+                key,
+                label: label.value,
+                value,
+                critical,
+                critical_label: critical_label.value,
+                by: by.value,
+                note: note.value,
+            });
+        }
+        out
+    }
+
+    /// `curves:` of a `floquet:` entry.
+    fn reference_curves(&mut self, node: &YamlNode) -> Vec<ReferenceCurve> {
+        const EXAMPLE: &str =
+            "{ label: Kapitza, color: [0, 0, 0], along: a, gives: w, value: sqrt(2*g*l)/a }";
+        let Some(entries) = self.map(
+            node,
+            "`curves`",
+            &format!("curves: {{ kapitza: {EXAMPLE} }}"),
+        ) else {
+            return Vec::new();
+        };
+        let mut out = Vec::new();
+        for (k, v) in entries {
+            if !self.key_name(k, "curve") {
+                continue;
+            }
+            let Some(f) = self.fields(
+                k,
+                v,
+                "curve",
+                &["label", "color", "along", "gives", "value", "where"],
+                &["label", "color", "along", "gives", "value"],
+                EXAMPLE,
+            ) else {
+                continue;
+            };
+            let what = |field: &str| format!("`{field}` of curve `{}`", k.value);
+            let label = get(f, "label").and_then(|n| self.text(n, &what("label"), "Kapitza"));
+            let color = get(f, "color").and_then(|n| {
+                let items = self.seq(n, &what("color"), "color: [0, 150, 60]")?;
+                if items.len() != 3 {
+                    self.error(
+                        Diagnostic::new(
+                            n.location,
+                            format!("{} has {} entries, not 3", what("color"), items.len()),
+                        )
+                        .with_help(
+                            "write red, green and blue from 0 to 255: `color: [0, 150, 60]`",
+                        ),
+                    );
+                    return None;
+                }
+                items
+                    .iter()
+                    .map(|c| self.expr(c, &what("color")))
+                    .collect::<Option<Vec<Expr>>>()
+            });
+            let along = get(f, "along").and_then(|n| self.name(n, &what("along")));
+            let gives = get(f, "gives").and_then(|n| self.name(n, &what("gives")));
+            let value = get(f, "value").and_then(|n| self.expr(n, &what("value")));
+            let domain = get(f, "where").and_then(|n| self.expr(n, &what("where")));
+            let (Some(label), Some(color), Some(along), Some(gives), Some(value)) =
+                (label, color, along, gives, value)
+            else {
+                continue;
+            };
+            out.push(ReferenceCurve {
+                name: k.clone(),
+                label: label.value,
+                color,
+                along,
+                gives,
+                value,
+                domain,
+            });
+        }
+        out
     }
 
     /// `minimal_twin:` — the snake_case name of another model, the same mechanism in minimal
@@ -861,7 +1045,8 @@ impl Ctx<'_> {
     }
 
     /// `events:` — `name: g` or `name: { when: g, direction: rising|falling|both,
-    /// terminal: true|false }`.
+    /// terminal: true|false }`, where `g` is an expression (the event is `g = 0`) or an
+    /// equation `lhs = rhs`.
     fn events(&mut self, node: &YamlNode) -> Vec<EventDef> {
         const EXAMPLE: &str = "{ when: theta_dot, direction: falling, terminal: false }";
         let Some(entries) = self.map(node, "`events`", &format!("events: {{ peak: {EXAMPLE} }}"))
@@ -875,7 +1060,7 @@ impl Ctx<'_> {
             }
             let what = format!("the function of event `{}`", k.value);
             if !matches!(v.kind, YamlKind::Map(_)) {
-                if let Some(when) = self.expr(v, &what) {
+                if let Some(when) = self.event_function(v, &what) {
                     out.push(EventDef {
                         name: k.clone(),
                         when,
@@ -895,7 +1080,7 @@ impl Ctx<'_> {
             ) else {
                 continue;
             };
-            let when = get(f, "when").and_then(|n| self.expr(n, &what));
+            let when = get(f, "when").and_then(|n| self.event_function(n, &what));
             let direction = match get(f, "direction") {
                 None => Some(Crossing::Both),
                 Some(n) => self.choice(
@@ -1258,26 +1443,31 @@ impl Ctx<'_> {
 
     /// One `lhs = rhs` equation (or an expression meaning `= 0`).
     fn equation(&mut self, node: &YamlNode) -> Option<HandEquation> {
-        let text = self.scalar_expr_text(node, "an equation of motion")?;
+        let (lhs, rhs) = self.sides(
+            node,
+            "an equation of motion",
+            "write one equation per entry, such as `m*x_ddot + k*x = F`",
+        )?;
+        Some(HandEquation {
+            lhs,
+            rhs,
+            location: node.location,
+        })
+    }
+
+    /// The two sides of `lhs = rhs` in the scalar `node`, or the expression alone (`rhs`
+    /// `None`) when it has no `=`. `what` names the value and `help` says what to write when
+    /// it has two `=`.
+    fn sides(&mut self, node: &YamlNode, what: &str, help: &str) -> Option<(Expr, Option<Expr>)> {
+        let text = self.scalar_expr_text(node, what)?;
         let chars: Vec<char> = text.chars().collect();
         let equals: Vec<usize> = (0..chars.len()).filter(|&i| chars[i] == '=').collect();
         match equals.as_slice() {
-            [] => {
-                let lhs = self.parse_part(node, &text, 0, chars.len())?;
-                Some(HandEquation {
-                    lhs,
-                    rhs: None,
-                    location: node.location,
-                })
-            }
+            [] => Some((self.parse_part(node, &text, 0, chars.len())?, None)),
             [i] => {
                 let lhs = self.parse_part(node, &text, 0, *i);
                 let rhs = self.parse_part(node, &text, i + 1, chars.len());
-                Some(HandEquation {
-                    lhs: lhs?,
-                    rhs: Some(rhs?),
-                    location: node.location,
-                })
+                Some((lhs?, Some(rhs?)))
             }
             [_, second, ..] => {
                 let start = node.location;
@@ -1285,12 +1475,33 @@ impl Ctx<'_> {
                     .and_then(|l| l.get(*second).copied())
                     .unwrap_or_else(|| start.offset(*second));
                 self.error(
-                    Diagnostic::new(at, "an equation of motion has one `=`, this is a second")
-                        .with_help("write one equation per entry, such as `m*x_ddot + k*x = F`"),
+                    Diagnostic::new(at, format!("{what} has one `=`, this is a second"))
+                        .with_help(help),
                 );
                 None
             }
         }
+    }
+
+    /// The function of an event: an expression `g` (the event is `g = 0`), or an equation
+    /// `lhs = rhs`, which means `lhs − rhs = 0` (as `--stop-when "y = 0"` on the command line).
+    fn event_function(&mut self, node: &YamlNode, what: &str) -> Option<Expr> {
+        let (lhs, rhs) = self.sides(
+            node,
+            what,
+            "write the event as one expression that crosses zero, such as `y` or `x = l`",
+        )?;
+        Some(match rhs {
+            None => lhs,
+            Some(rhs) => Expr {
+                location: lhs.location,
+                kind: ExprKind::Binary {
+                    op: BinOp::Sub,
+                    lhs: Box::new(lhs),
+                    rhs: Box::new(rhs),
+                },
+            },
+        })
     }
 
     fn balances(&mut self, node: &YamlNode) -> Vec<Balance> {
@@ -2034,6 +2245,38 @@ mod tests {
                 "5:39: unknown key `directon` in event `peak`",
                 "6:3: event `bare` has no `when`"
             ]
+        );
+    }
+
+    /// `when: lhs = rhs` means `lhs − rhs = 0`, as `--stop-when "lhs = rhs"` does; a second
+    /// `=` is an error at its column.
+    #[test]
+    fn an_event_may_be_written_as_an_equation() {
+        let src = "name: a\ncoordinates: [y]\nkinetic: y_dot^2/2\nevents:\n  ground: { when: y = 0.5, terminal: true }\n  level: y_dot = -1\n";
+        let file = built(src).file.unwrap();
+        let at = |y: f64, y_dot: f64| {
+            move |name: &str| match name {
+                "y" => Some(y),
+                "y_dot" => Some(y_dot),
+                _ => None,
+            }
+        };
+        let ground = &file.events[0].when;
+        assert_eq!(eval_expr(ground, &at(2.0, 0.0)).unwrap(), 1.5);
+        assert_eq!(eval_expr(ground, &at(0.5, 0.0)).unwrap(), 0.0);
+        assert_eq!(eval_expr(&file.events[1].when, &at(0.0, 3.0)).unwrap(), 4.0);
+        assert_eq!(
+            ground.location,
+            Location {
+                line: 5,
+                column: 19
+            }
+        );
+        let m =
+            messages("name: a\ncoordinates: [y]\nkinetic: y_dot^2/2\nevents:\n  e: y = 1 = 2\n");
+        assert_eq!(
+            m,
+            ["5:12: the function of event `e` has one `=`, this is a second"]
         );
     }
 

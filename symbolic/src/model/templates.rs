@@ -6,14 +6,53 @@ use std::fmt::Write as _;
 /// The template names `eomgen new` accepts.
 pub const TEMPLATES: &[&str] = &["n-link-pendulum", "n-mass-chain"];
 
-/// The model file of template `name` with size `n`, or `None` for an unknown template or
-/// `n = 0`.
-pub fn generate(name: &str, n: usize) -> Option<String> {
-    match (name, n) {
-        (_, 0) => None,
-        ("n-link-pendulum", n) => Some(n_link_pendulum(n)),
-        ("n-mass-chain", n) => Some(n_mass_chain(n)),
-        _ => None,
+/// The largest size each template is generated for, in [`TEMPLATES`] order. The `n`-link
+/// pendulum writes every point's position out in full, so its file grows as `n²` (200 links:
+/// 1.7 MB, and its longest expression, a chain of 200 terms, is far below
+/// [`MAX_TREE_HEIGHT`](super::parser::MAX_TREE_HEIGHT)); a 100-link pendulum already takes
+/// seconds to derive. The mass chain's file grows as `n`, and loading it as `n²` for now.
+pub const MAX_SIZES: [usize; 2] = [200, 1_000];
+
+/// Why [`generate`] wrote no file.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum TemplateError {
+    /// The name is not one of [`TEMPLATES`].
+    #[error("unknown template `{0}`; templates are: {templates}", templates = TEMPLATES.join(", "))]
+    Unknown(String),
+    /// `n = 0`.
+    #[error("N must be at least 1")]
+    Empty,
+    /// `n` above the template's entry of [`MAX_SIZES`].
+    #[error("N = {n} is more than the largest size of `{template}`, {max}")]
+    TooLarge {
+        /// The template.
+        template: String,
+        /// The size asked for.
+        n: usize,
+        /// The largest size.
+        max: usize,
+    },
+}
+
+/// The model file of template `name` (one of [`TEMPLATES`]) with size `n`.
+///
+/// # Errors
+/// [`TemplateError`]: an unknown name, `n = 0`, or `n` above the template's largest size
+/// ([`MAX_SIZES`]).
+pub fn generate(name: &str, n: usize) -> Result<String, TemplateError> {
+    let (make, max): (fn(usize) -> String, usize) = match name {
+        "n-link-pendulum" => (n_link_pendulum, MAX_SIZES[0]),
+        "n-mass-chain" => (n_mass_chain, MAX_SIZES[1]),
+        _ => return Err(TemplateError::Unknown(name.to_string())),
+    };
+    match n {
+        0 => Err(TemplateError::Empty),
+        n if n > max => Err(TemplateError::TooLarge {
+            template: name.to_string(),
+            n,
+            max,
+        }),
+        n => Ok(make(n)),
     }
 }
 
@@ -165,7 +204,10 @@ mod tests {
                 assert_eq!(file.coordinates.len(), n);
             }
         }
-        assert!(generate("n-link-pendulum", 0).is_none());
-        assert!(generate("nope", 3).is_none());
+        assert_eq!(generate("n-link-pendulum", 0), Err(TemplateError::Empty));
+        assert_eq!(
+            generate("nope", 3),
+            Err(TemplateError::Unknown("nope".into()))
+        );
     }
 }

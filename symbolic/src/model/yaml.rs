@@ -10,7 +10,7 @@
 //! is kept.
 //!
 //! Locations: saphyr's markers have 1-based lines and 0-based columns counted in characters.
-//! They become [`Location`]s only through [`Location::from_zero_based`], in [`location`]. A
+//! They become [`Location`]s only through [`Location::from_zero_based`], in `location`. A
 //! node's location is its first character; for a quoted scalar, the first character *inside*
 //! the quotes, so that offsets into the scalar's text are columns in the file.
 

@@ -1,0 +1,624 @@
+//! `eomgen frf` as library calls (lecture 21, HW21, HW34, HW37): the frequency response
+//! `H(ω) = (K − ω²M + iωC)⁻¹ B` from one input to coordinates over a sweep, its resonance
+//! peaks, the response assembled mode by mode at chosen frequencies, and points of the curve
+//! checked by simulating the full model to steady state.
+//!
+//! [`frequency_response_analysis`] computes everything but the simulations;
+//! [`plan_simulation`] checks their options and picks the frequencies, and
+//! [`simulate_point`] runs one (independent of the others, so a caller may run them in
+//! parallel, each on its own instance of the model).
+
+use nalgebra::{Complex, DVector};
+use serde::Serialize;
+
+use super::operating_point::{OperatingPoint, OperatingPointError, OperatingPointOptions};
+use crate::frf::{
+    ForcedLinearization, FrequencySweep, FrfError, HarmonicForcing, ModalResponse, PeakAmplitude,
+    SteadyStateOptions, frequency_response, frequency_sweep, linearize_with_inputs,
+    log_frequencies, modal_frequency_response, output_index, settling_time, simulate_steady_state,
+};
+use crate::modal::{NormalModes, normal_modes};
+use crate::response::{ModalDamping, modal_damping};
+use crate::system::ModelInfo;
+
+/// Why a frequency-response analysis failed.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum FrfAnalysisError {
+    /// Fewer than two sweep frequencies.
+    #[error("the sweep needs at least 2 frequencies, got {points}")]
+    TooFewPoints {
+        /// Given.
+        points: usize,
+    },
+    /// The input is neither a parameter nor a coordinate.
+    #[error(
+        "`{model}` has no parameter or coordinate `{input}` (parameters: {parameters}; coordinates: {coordinates})"
+    )]
+    UnknownInput {
+        /// The model.
+        model: String,
+        /// The input asked for.
+        input: String,
+        /// Its parameters, comma separated.
+        parameters: String,
+        /// Its coordinates, comma separated.
+        coordinates: String,
+    },
+    /// A simulation was asked for with a coordinate as the input (a unit generalized force
+    /// has no load in the model to drive).
+    #[error("simulation needs a load parameter as the input (`{input}` is a coordinate)")]
+    SimulationNeedsParameter {
+        /// The input.
+        input: String,
+    },
+    /// The operating point's start is unknown.
+    #[error(transparent)]
+    OperatingPoint(#[from] OperatingPointError),
+    /// The input is a parameter but not a load amplitude (nonlinear, absent at `t = 0`, or
+    /// in the mass matrix).
+    #[error(transparent)]
+    Input(FrfError),
+    /// An output that is not a coordinate.
+    #[error("{source}")]
+    Output {
+        /// The output asked for.
+        output: String,
+        /// Why.
+        source: FrfError,
+    },
+    /// No frequency range was given and no mode is oscillatory.
+    #[error(
+        "`{model}` has no oscillatory mode at `{operating_point}` to choose a frequency range from"
+    )]
+    NoFrequencyRange {
+        /// The model.
+        model: String,
+        /// The operating point's name.
+        operating_point: String,
+    },
+    /// The frequency range is not `0 < lo < hi < ∞`.
+    #[error(transparent)]
+    FrequencyRange(FrfError),
+    /// No frequency parameter was named and the model has no `w`.
+    #[error(
+        "`{model}` has no parameter `w`; name the forcing frequency's parameter (parameters: {parameters})"
+    )]
+    NoFrequencyParameter {
+        /// The model.
+        model: String,
+        /// Its parameters, comma separated.
+        parameters: String,
+    },
+    /// The frequency parameter is not a parameter.
+    #[error("`{model}` has no such parameter (parameters: {parameters})")]
+    UnknownFrequencyParameter {
+        /// The model.
+        model: String,
+        /// The name given.
+        name: String,
+        /// Its parameters, comma separated.
+        parameters: String,
+    },
+    /// The frequency parameter is the input itself.
+    #[error("the frequency parameter must differ from the input")]
+    FrequencyParameterIsInput,
+    /// The simulation's input amplitude is zero or not finite.
+    #[error("the amplitude must be finite and nonzero, got {amplitude}")]
+    InvalidAmplitude {
+        /// Given.
+        amplitude: f64,
+    },
+    /// The simulation's relative tolerance is not in `(0, 1)`.
+    #[error("the relative tolerance must be in (0, 1), got {rtol}")]
+    InvalidTolerance {
+        /// Given.
+        rtol: f64,
+    },
+    /// The free response does not decay: no steady state to simulate.
+    #[error(transparent)]
+    NoSteadyState(FrfError),
+    /// The linearisation, a response or a simulation failed.
+    #[error(transparent)]
+    Frf(#[from] FrfError),
+}
+
+/// Options of the steady-state simulations that check the curve.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FrfSimulationOptions {
+    /// How many frequencies, log-spaced over the sweep's range (0: none).
+    pub count: usize,
+    /// The parameter holding the forcing frequency, set to each `ω` (default: `w` if the
+    /// model has it).
+    pub frequency_parameter: Option<String>,
+    /// The input's value in the runs, small so that the nonlinear model stays near its
+    /// linearisation (default: 1e-3).
+    pub amplitude: f64,
+    /// Relative tolerance of DOP853, in `(0, 1)` (default: 1e-11); the absolute tolerance is
+    /// `rtol` times the predicted response's scale `max|H| |amplitude| max(ω, 1)`.
+    pub rtol: f64,
+}
+
+impl Default for FrfSimulationOptions {
+    fn default() -> Self {
+        Self {
+            count: 0,
+            frequency_parameter: None,
+            amplitude: 1e-3,
+            rtol: 1e-11,
+        }
+    }
+}
+
+/// Options of [`frequency_response_analysis`].
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FrfOptions {
+    /// Where the equilibrium search starts (it runs with the input set to 0).
+    pub operating_point: OperatingPointOptions,
+    /// The input: a parameter that enters the forcing linearly (a load amplitude), or a
+    /// coordinate's name (a unit generalized force on it).
+    pub input: String,
+    /// The output coordinates (default, empty: every coordinate).
+    pub outputs: Vec<String>,
+    /// The sweep's range `(lo, hi)` in rad/s (default: a decade below the lowest to a decade
+    /// above the highest natural frequency).
+    pub frequency_range: Option<(f64, f64)>,
+    /// Frequencies of the sweep, log-spaced (default: 400; at least 2).
+    pub points: usize,
+    /// Frequencies (rad/s) at which the response is also evaluated.
+    pub frequencies: Vec<f64>,
+    /// Also assemble the response mode by mode at those frequencies (default: at the damped
+    /// peaks when `frequencies` is empty).
+    pub modal: bool,
+    /// The steady-state simulations, checked (their frequency parameter, amplitude and
+    /// tolerance) by [`plan_simulation`]; only whether they are asked for matters here.
+    pub simulation: Option<FrfSimulationOptions>,
+}
+
+impl Default for FrfOptions {
+    fn default() -> Self {
+        Self {
+            operating_point: OperatingPointOptions::default(),
+            input: String::new(),
+            outputs: Vec::new(),
+            frequency_range: None,
+            points: 400,
+            frequencies: Vec::new(),
+            modal: false,
+            simulation: None,
+        }
+    }
+}
+
+/// An output coordinate.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+pub struct FrfOutput {
+    /// Its name.
+    pub name: String,
+    /// Its index in `q`.
+    pub index: usize,
+}
+
+/// The response at one evaluation frequency.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FrfEvaluation {
+    /// `ω` (rad/s).
+    pub frequency: f64,
+    /// `H(ω)` for the input, one entry per coordinate (length `n`); `None` at an undamped
+    /// resonance (unbounded).
+    #[serde(serialize_with = "option_complex_vector")]
+    pub response: Option<DVector<Complex<f64>>>,
+    /// The modal sum (with `modal`); `None` without it or where a mode is undamped at `ω`.
+    pub modal: Option<ModalResponse>,
+    /// `max_i |H_i − Σ_k (ψ_k η_k)_i| / max_i |H_i|` at `ω` (with a modal sum and a bounded
+    /// direct solve).
+    pub modal_difference: Option<f64>,
+}
+
+fn option_complex_vector<S: serde::Serializer>(
+    v: &Option<DVector<Complex<f64>>>,
+    s: S,
+) -> Result<S::Ok, S::Error> {
+    match v {
+        Some(v) => super::serde_matrix::complex_vector(v, s),
+        None => s.serialize_none(),
+    }
+}
+
+/// What [`frequency_response_analysis`] computed.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FrfAnalysis {
+    /// The unforced equilibrium and its name.
+    pub operating_point: OperatingPoint,
+    /// The input.
+    pub input: String,
+    /// The outputs, in the order asked for.
+    pub outputs: Vec<FrfOutput>,
+    /// `M`, `C`, `K` at the equilibrium and the input column `B` (`n × 1`).
+    pub forced: ForcedLinearization,
+    /// The undamped modes.
+    pub normal_modes: NormalModes,
+    /// `ΨᵀCΨ` and the modal damping ratios.
+    pub modal_damping: ModalDamping,
+    /// The sweep's range (rad/s).
+    pub frequency_range: (f64, f64),
+    /// The sweep's frequencies (rad/s, log-spaced).
+    pub frequencies: Vec<f64>,
+    /// One sweep per output.
+    pub sweeps: Vec<FrequencySweep>,
+    /// The response at the evaluation frequencies.
+    pub evaluations: Vec<FrfEvaluation>,
+}
+
+/// Finds the unforced equilibrium, linearises with the input's column of `B`, sweeps `H(ω)`
+/// from the input to each output, finds the resonance peaks and evaluates the response (and,
+/// with `modal`, its modal sum) at the evaluation frequencies.
+///
+/// # Errors
+/// [`FrfAnalysisError::TooFewPoints`], [`FrfAnalysisError::UnknownInput`],
+/// [`FrfAnalysisError::SimulationNeedsParameter`], [`FrfAnalysisError::OperatingPoint`],
+/// [`FrfAnalysisError::Input`] (not a load amplitude), [`FrfAnalysisError::Output`],
+/// [`FrfAnalysisError::NoFrequencyRange`], [`FrfAnalysisError::FrequencyRange`],
+/// [`FrfAnalysisError::Frf`] (a failed linearisation or response).
+///
+/// # Examples
+/// The forced oscillator (`m = k = c = 1`): `|H(ω)| = 1/√((k − mω²)² + (cω)²)`.
+/// ```
+/// use eomgen_runtime::vibration::{FrfOptions, frequency_response_analysis};
+/// let mut model = (eomgen::models::find("forced_oscillator").unwrap().make)();
+/// let options = FrfOptions {
+///     input: "A".to_string(),
+///     frequencies: vec![2.0],
+///     ..FrfOptions::default()
+/// };
+/// let frf = frequency_response_analysis(model.as_mut(), &options)?;
+/// let h = frf.evaluations[0].response.as_ref().unwrap()[0];
+/// assert!((h.norm() - 1.0 / ((1.0f64 - 4.0).powi(2) + 4.0).sqrt()).abs() < 1e-14);
+/// # Ok::<(), eomgen_runtime::vibration::FrfAnalysisError>(())
+/// ```
+///
+/// # References
+/// Lecture 21 and HW21 (one degree of freedom), HW37 (modal forcing), HW34 (modal damping).
+pub fn frequency_response_analysis(
+    model: &mut dyn ModelInfo,
+    options: &FrfOptions,
+) -> Result<FrfAnalysis, FrfAnalysisError> {
+    if options.points < 2 {
+        return Err(FrfAnalysisError::TooFewPoints {
+            points: options.points,
+        });
+    }
+    let input = options.input.as_str();
+    let parameter_input = model.parameter_names().contains(&input);
+    if !parameter_input && !model.coordinate_names().contains(&input) {
+        return Err(FrfAnalysisError::UnknownInput {
+            model: model.name().to_string(),
+            input: input.to_string(),
+            parameters: model.parameter_names().join(", "),
+            coordinates: model.coordinate_names().join(", "),
+        });
+    }
+    if !parameter_input && options.simulation.is_some() {
+        return Err(FrfAnalysisError::SimulationNeedsParameter {
+            input: input.to_string(),
+        });
+    }
+    let (label, guess) = options.operating_point.start.resolve(model)?;
+    let forced = linearize_with_inputs(model, &guess, &[input]).map_err(|e| match e {
+        FrfError::NonlinearInput { .. }
+        | FrfError::InputNotInForcing { .. }
+        | FrfError::InputChangesMassMatrix { .. } => FrfAnalysisError::Input(e),
+        e => FrfAnalysisError::Frf(e),
+    })?;
+    let coordinates: Vec<String> = model
+        .coordinate_names()
+        .iter()
+        .map(|c| c.to_string())
+        .collect();
+    let outputs: Vec<FrfOutput> = if options.outputs.is_empty() {
+        coordinates
+            .iter()
+            .enumerate()
+            .map(|(index, name)| FrfOutput {
+                name: name.clone(),
+                index,
+            })
+            .collect()
+    } else {
+        let mut list = Vec::new();
+        for o in &options.outputs {
+            let index = output_index(model, o).map_err(|source| FrfAnalysisError::Output {
+                output: o.clone(),
+                source,
+            })?;
+            list.push(FrfOutput {
+                name: o.clone(),
+                index,
+            });
+        }
+        list
+    };
+    let lin = &forced.linearization;
+    let modes = normal_modes(lin).map_err(FrfError::from)?;
+    let damping = modal_damping(lin, &modes);
+    let (lo, hi) = match options.frequency_range {
+        Some(range) => range,
+        None => {
+            let positive: Vec<f64> = modes
+                .natural_frequencies
+                .iter()
+                .copied()
+                .filter(|w| *w > 0.0)
+                .collect();
+            match (positive.first(), positive.last()) {
+                (Some(a), Some(b)) => (a / 10.0, b * 10.0),
+                _ => {
+                    return Err(FrfAnalysisError::NoFrequencyRange {
+                        model: model.name().to_string(),
+                        operating_point: label,
+                    });
+                }
+            }
+        }
+    };
+    let frequencies =
+        log_frequencies(lo, hi, options.points).map_err(FrfAnalysisError::FrequencyRange)?;
+    // The one input's column, `n × 1`.
+    let b_matrix = &forced.input_matrix;
+    let mut sweeps = Vec::with_capacity(outputs.len());
+    for o in &outputs {
+        sweeps.push(frequency_sweep(lin, b_matrix, 0, o.index, &frequencies)?);
+    }
+    let mut evaluation_frequencies = options.frequencies.clone();
+    if options.modal && evaluation_frequencies.is_empty() {
+        for peak in sweeps.iter().flat_map(|s| &s.peaks) {
+            if matches!(peak.amplitude, PeakAmplitude::Finite(_))
+                && !evaluation_frequencies
+                    .iter()
+                    .any(|w: &f64| (w - peak.frequency).abs() <= 1e-6 * peak.frequency)
+            {
+                evaluation_frequencies.push(peak.frequency);
+            }
+        }
+        evaluation_frequencies.sort_by(f64::total_cmp);
+    }
+    let b = forced.input_matrix.column(0).into_owned();
+    let mut evaluations = Vec::with_capacity(evaluation_frequencies.len());
+    for w in evaluation_frequencies {
+        let response = match frequency_response(lin, b_matrix, w) {
+            Ok(h) => Some(h.column(0).into_owned()),
+            Err(FrfError::Singular { .. }) => None,
+            Err(e) => return Err(e.into()),
+        };
+        let modal = if options.modal {
+            match modal_frequency_response(lin, &modes, &b, w) {
+                Ok(r) => Some(r),
+                Err(FrfError::Singular { .. }) => None,
+                Err(e) => return Err(e.into()),
+            }
+        } else {
+            None
+        };
+        let modal_difference = match (&response, &modal) {
+            (Some(d), Some(r)) => {
+                let largest = d.iter().map(|z| z.norm()).fold(0.0f64, f64::max);
+                let difference = d
+                    .iter()
+                    .zip(r.response.iter())
+                    .map(|(a, b)| (a - b).norm())
+                    .fold(0.0f64, f64::max);
+                Some(difference / largest.max(f64::MIN_POSITIVE))
+            }
+            _ => None,
+        };
+        evaluations.push(FrfEvaluation {
+            frequency: w,
+            response,
+            modal,
+            modal_difference,
+        });
+    }
+    let operating_point = OperatingPoint {
+        name: label,
+        coordinates,
+        guess,
+        t: 0.0,
+        equilibrium: forced.equilibrium.clone(),
+    };
+    Ok(FrfAnalysis {
+        operating_point,
+        input: input.to_string(),
+        outputs,
+        normal_modes: modes,
+        modal_damping: damping,
+        frequency_range: (lo, hi),
+        frequencies,
+        sweeps,
+        evaluations,
+        forced,
+    })
+}
+
+/// The checked plan of the steady-state simulations.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FrfSimulationPlan {
+    /// The parameter set to each `ω`.
+    pub frequency_parameter: String,
+    /// The time to wait before measuring (s): the slowest free decay shrinks by `1e-10`.
+    pub settling_time: f64,
+    /// The frequencies (rad/s), log-spaced over the sweep's range.
+    pub frequencies: Vec<f64>,
+    /// The options, as given.
+    pub options: FrfSimulationOptions,
+}
+
+/// Checks the simulation options against `model` and `analysis` and picks the frequencies
+/// and the settling time.
+///
+/// # Errors
+/// [`FrfAnalysisError::NoFrequencyParameter`], [`FrfAnalysisError::UnknownFrequencyParameter`],
+/// [`FrfAnalysisError::FrequencyParameterIsInput`], [`FrfAnalysisError::InvalidAmplitude`],
+/// [`FrfAnalysisError::InvalidTolerance`], [`FrfAnalysisError::NoSteadyState`] (a mode
+/// without damping), [`FrfAnalysisError::FrequencyRange`], [`FrfAnalysisError::Frf`].
+pub fn plan_simulation(
+    model: &dyn ModelInfo,
+    analysis: &FrfAnalysis,
+    options: &FrfSimulationOptions,
+) -> Result<FrfSimulationPlan, FrfAnalysisError> {
+    let parameters = model.parameter_names();
+    let frequency_parameter = match &options.frequency_parameter {
+        Some(p) => p.clone(),
+        None if parameters.contains(&"w") => "w".to_string(),
+        None => {
+            return Err(FrfAnalysisError::NoFrequencyParameter {
+                model: model.name().to_string(),
+                parameters: parameters.join(", "),
+            });
+        }
+    };
+    if !parameters.contains(&frequency_parameter.as_str()) {
+        return Err(FrfAnalysisError::UnknownFrequencyParameter {
+            model: model.name().to_string(),
+            name: frequency_parameter,
+            parameters: parameters.join(", "),
+        });
+    }
+    if frequency_parameter == analysis.input {
+        return Err(FrfAnalysisError::FrequencyParameterIsInput);
+    }
+    if !(options.amplitude.is_finite() && options.amplitude != 0.0) {
+        return Err(FrfAnalysisError::InvalidAmplitude {
+            amplitude: options.amplitude,
+        });
+    }
+    if !(options.rtol > 0.0 && options.rtol < 1.0) {
+        return Err(FrfAnalysisError::InvalidTolerance { rtol: options.rtol });
+    }
+    // Wait until the slowest free decay has shrunk by 1e-10 relative to the response.
+    let settle = settling_time(&analysis.forced.linearization, 1e-10).map_err(|e| match e {
+        FrfError::NoSteadyState { .. } => FrfAnalysisError::NoSteadyState(e),
+        e => FrfAnalysisError::Frf(e),
+    })?;
+    let (lo, hi) = analysis.frequency_range;
+    let frequencies =
+        log_frequencies(lo, hi, options.count).map_err(FrfAnalysisError::FrequencyRange)?;
+    Ok(FrfSimulationPlan {
+        frequency_parameter,
+        settling_time: settle,
+        frequencies,
+        options: options.clone(),
+    })
+}
+
+/// One output at one simulated frequency.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct SimulatedValue {
+    /// The simulated complex amplitude over the input's amplitude (`{"re", "im"}`).
+    #[serde(serialize_with = "super::serde_matrix::complex")]
+    pub simulated: Complex<f64>,
+    /// The predicted `H(ω)` (`{"re", "im"}`).
+    #[serde(serialize_with = "super::serde_matrix::complex")]
+    pub predicted: Complex<f64>,
+}
+
+impl SimulatedValue {
+    /// `|simulated − predicted| / |predicted|`, or `|simulated − predicted|` for a zero
+    /// prediction.
+    pub fn relative_error(&self) -> f64 {
+        let d = (self.simulated - self.predicted).norm();
+        let p = self.predicted.norm();
+        if p > 0.0 { d / p } else { d }
+    }
+}
+
+/// One simulated frequency.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SimulatedPoint {
+    /// `ω` (rad/s).
+    pub frequency: f64,
+    /// The settling time used (s).
+    pub settling_time: f64,
+    /// One value per output, in the analysis's order.
+    pub values: Vec<SimulatedValue>,
+    /// DOP853 steps.
+    pub steps: usize,
+    /// Right-hand-side evaluations.
+    pub rhs_evals: usize,
+}
+
+/// Simulates `model` (the analysed one, or a fresh instance with the same parameters) forced
+/// at `frequency` from rest at the equilibrium to steady state and measures each output's
+/// complex amplitude at the forcing frequency ([`simulate_steady_state`]), beside the
+/// predicted `H(ω)`.
+///
+/// # Errors
+/// [`FrfError`] from `H(ω)` or the simulation.
+pub fn simulate_point(
+    model: &mut dyn ModelInfo,
+    analysis: &FrfAnalysis,
+    plan: &FrfSimulationPlan,
+    frequency: f64,
+) -> Result<SimulatedPoint, FrfError> {
+    let w = frequency;
+    let amplitude = plan.options.amplitude;
+    let h = frequency_response(
+        &analysis.forced.linearization,
+        &analysis.forced.input_matrix,
+        w,
+    )?;
+    let scale = h.iter().map(|z| z.norm()).fold(0.0f64, f64::max) * amplitude.abs() * w.max(1.0);
+    let options = SteadyStateOptions {
+        rtol: plan.options.rtol,
+        atol: plan.options.rtol * scale.max(f64::MIN_POSITIVE),
+        ..SteadyStateOptions::default()
+    };
+    let forcing = HarmonicForcing {
+        input: &analysis.input,
+        amplitude,
+        frequency_parameter: &plan.frequency_parameter,
+        frequency: w,
+    };
+    let steady = simulate_steady_state(
+        model,
+        &analysis.forced.equilibrium.q,
+        &forcing,
+        plan.settling_time,
+        &options,
+    )?;
+    let values = analysis
+        .outputs
+        .iter()
+        .map(|o| SimulatedValue {
+            simulated: steady.complex_amplitudes[o.index] / amplitude,
+            predicted: h[(o.index, 0)],
+        })
+        .collect();
+    Ok(SimulatedPoint {
+        frequency: w,
+        settling_time: plan.settling_time,
+        values,
+        steps: steady.steps,
+        rhs_evals: steady.rhs_evals,
+    })
+}
+
+/// The largest error of the simulated points: at each frequency, `|simulated − predicted|`
+/// against the largest predicted amplitude at that frequency (an output near an
+/// antiresonance, or one the mode shape leaves still, would make a relative error
+/// meaningless).
+pub fn max_simulation_error(points: &[SimulatedPoint]) -> f64 {
+    points
+        .iter()
+        .map(|p| {
+            let scale = p
+                .values
+                .iter()
+                .map(|v| v.predicted.norm())
+                .fold(0.0f64, f64::max);
+            p.values
+                .iter()
+                .map(|v| (v.simulated - v.predicted).norm() / scale.max(f64::MIN_POSITIVE))
+                .fold(0.0f64, f64::max)
+        })
+        .fold(0.0f64, f64::max)
+}

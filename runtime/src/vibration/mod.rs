@@ -1,0 +1,53 @@
+//! The vibration analyses of a model, each one library call with typed options, a
+//! `Serialize` report and a typed error, on the size-erased [`ModelInfo`](crate::ModelInfo):
+//! the CLI (`eomgen modes`, `frf`, `study free-response`, `modal-damping`, `floquet`), a Rust
+//! program and the Python bindings reach the same code.
+//!
+//! - [`operating_point()`]: the equilibrium an analysis linearises about, from a name in the
+//!   model file's `equilibria:` or an explicit guess (Newton on `F(q, 0, t) = 0`).
+//! - [`modal_analysis`]: the exact linearisation `M δq̈ + C δq̇ + K δq = 0` there, natural
+//!   frequencies, mass-normalised mode shapes, damping ratios (`eomgen modes`).
+//! - [`free_response()`]: the undamped free response four ways and their differences (HW28).
+//! - [`modal_damping_study`]: damping ratios exact, by the diagonal of `ΨᵀCΨ` and by a
+//!   Rayleigh fit, and the damped responses from each mode shape (HW34).
+//! - [`frequency_response_analysis`]: `H(ω)` from one input over a sweep, its peaks, its modal
+//!   sum; [`plan_simulation`] and [`simulate_point`] check points of the curve by simulating
+//!   the full model to steady state (lecture 21, HW37).
+//! - [`floquet_at_equilibrium`]: the Floquet multipliers of a time-periodic model about an
+//!   equilibrium; [`floquet_cell`], one cell of a stability chart over two parameters
+//!   (lectures 19, 21).
+//!
+//! The building blocks (linearisation, normal modes, responses, `H(ω)`, monodromy) are in
+//! [`modal`](crate::modal), [`response`](crate::response), [`frf`](crate::frf) and
+//! [`floquet`](crate::floquet).
+
+pub mod floquet;
+pub mod free_response;
+pub mod frf;
+pub mod modal_damping;
+pub mod modes;
+pub mod operating_point;
+pub(crate) mod serde_matrix;
+
+pub use floquet::{
+    FloquetCell, FloquetPoint, FloquetStudyError, FloquetStudyOptions, SweepAxis,
+    floquet_at_equilibrium, floquet_cell,
+};
+pub use free_response::{
+    FreeResponseMethod, FreeResponseOptions, FreeResponseStudy, InitialDeviation,
+    ResponseDifference, ResponseStudyError, default_duration, free_response,
+    unconstrained_modal_analysis, uniform_times,
+};
+pub use frf::{
+    FrfAnalysis, FrfAnalysisError, FrfEvaluation, FrfOptions, FrfOutput, FrfSimulationOptions,
+    FrfSimulationPlan, SimulatedPoint, SimulatedValue, frequency_response_analysis,
+    max_simulation_error, plan_simulation, simulate_point,
+};
+pub use modal_damping::{
+    ModalDampingOptions, ModalDampingStudy, ModalRatio, ModeDamping, RayleighFit, Release,
+    modal_damping_study,
+};
+pub use modes::{DampedEigenvalue, ModalAnalysis, ModalOptions, modal_analysis};
+pub use operating_point::{
+    EquilibriumStart, OperatingPoint, OperatingPointError, OperatingPointOptions, operating_point,
+};

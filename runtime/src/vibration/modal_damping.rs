@@ -1,0 +1,344 @@
+//! `eomgen study modal-damping` as one call (HW34, lectures 30–33): damping ratios and damped
+//! frequencies of each mode three ways — exact (complex eigenvalues of `A`), the
+//! modal-damping approximation (diagonal of `Ĉ = ΨᵀCΨ`) and Rayleigh damping `C = αM + βK`
+//! fitted to two modes — and the free responses from each mode shape: exact (`e^{At}`, checked
+//! by DOP853) against the two approximations.
+
+use serde::Serialize;
+
+use super::free_response::{
+    InitialDeviation, ResponseStudyError, check_tolerance, default_duration,
+    unconstrained_modal_analysis, uniform_times,
+};
+use super::operating_point::{OperatingPoint, OperatingPointOptions};
+use crate::modal::{Linearization, ModeKind, NormalModes};
+use crate::response::{
+    DampedMode, FreeResponse, ModalDamping, RayleighDamping, exact_damped_modes, modal_damping,
+    response_by_exponential, response_by_integration, response_with_modal_damping,
+};
+use crate::system::ModelInfo;
+
+/// Options of [`modal_damping_study`].
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ModalDampingOptions {
+    /// The operating point (default: the file's first named equilibrium, else `q = 0`).
+    pub operating_point: OperatingPointOptions,
+    /// The two modes (1-based, ascending frequency) whose exact damping ratios the Rayleigh
+    /// damping reproduces (default: the slowest and the fastest oscillatory modes, when both
+    /// are underdamped; HW34).
+    pub rayleigh_modes: Option<[usize; 2]>,
+    /// One initial deviation instead of HW34's releases from each mode shape at rest
+    /// (default: the releases).
+    pub initial: Option<InitialDeviation>,
+    /// End time (s) (default: ten periods of the slowest oscillatory mode, or the time an
+    /// unstable mode grows by `e⁵` if that is shorter, else 10 s).
+    pub t_end: Option<f64>,
+    /// Number of output times, evenly spaced on `[0, t_end]` (default: 801; at least 2).
+    pub samples: usize,
+    /// Relative and absolute tolerance of the DOP853 check of the exact response (default:
+    /// 1e-12; positive).
+    pub tol: f64,
+}
+
+impl Default for ModalDampingOptions {
+    fn default() -> Self {
+        Self {
+            operating_point: OperatingPointOptions::default(),
+            rayleigh_modes: None,
+            initial: None,
+            t_end: None,
+            samples: 801,
+            tol: 1e-12,
+        }
+    }
+}
+
+/// The Rayleigh damping fitted to two modes.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct RayleighFit {
+    /// The two 1-based modes whose exact `ζ` it reproduces.
+    pub modes: [usize; 2],
+    /// `α` (1/s) and `β` (s).
+    #[serde(flatten)]
+    pub damping: RayleighDamping,
+}
+
+/// A damping ratio and the damped frequency it gives.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct ModalRatio {
+    /// `ζ`.
+    pub damping_ratio: f64,
+    /// `ω √(1 − ζ²)` (rad/s; `None` when `|ζ| ≥ 1`).
+    pub damped_frequency: Option<f64>,
+}
+
+/// One mode's damping three ways.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct ModeDamping {
+    /// The mode, 1-based.
+    pub mode: usize,
+    /// What it is.
+    pub kind: ModeKind,
+    /// Its undamped natural frequency (rad/s).
+    pub natural_frequency: f64,
+    /// The exact complex eigenvalue (`None` unless an underdamped oscillation).
+    pub exact: Option<DampedMode>,
+    /// The diagonal-`Ĉ` approximation (`None` unless oscillatory).
+    pub diagonal: Option<ModalRatio>,
+    /// The Rayleigh damping's (`None` without a fit or unless oscillatory).
+    pub rayleigh: Option<ModalRatio>,
+}
+
+/// One release and its responses.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Release {
+    /// What it is: `mode k shape, x1 = 1` or `given initial values`.
+    pub name: String,
+    /// `δq₀` (m or rad).
+    pub q0: Vec<f64>,
+    /// `δq̇₀` (m/s or rad/s).
+    pub qdot0: Vec<f64>,
+    /// The exact damped response `e^{At} δy₀`.
+    pub exact: FreeResponse,
+    /// DOP853 on `δẏ = A δy`.
+    pub integrated: FreeResponse,
+    /// The modal-damping approximation (diagonal of `Ĉ`).
+    pub diagonal: FreeResponse,
+    /// The Rayleigh damping's response (with a fit).
+    pub rayleigh: Option<FreeResponse>,
+    /// The exact response's largest `|δq|` (m or rad).
+    pub amplitude: f64,
+    /// `max |δq_DOP853 − δq_exact|` over `amplitude` (absolute when it is 0).
+    pub integration_vs_exact: f64,
+    /// The same for the diagonal approximation.
+    pub diagonal_vs_exact: f64,
+    /// The same for the Rayleigh damping.
+    pub rayleigh_vs_exact: Option<f64>,
+}
+
+/// What [`modal_damping_study`] computed.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ModalDampingStudy {
+    /// The equilibrium.
+    pub operating_point: OperatingPoint,
+    /// `M`, `C`, `K` there (`n × n`).
+    pub linearization: Linearization,
+    /// The undamped normal modes.
+    pub normal_modes: NormalModes,
+    /// `Ĉ = ΨᵀCΨ`, the diagonal approximation and the coupling of `Ĉ`.
+    pub modal_damping: ModalDamping,
+    /// The Rayleigh fit (`None` with fewer than two underdamped oscillatory modes).
+    pub rayleigh: Option<RayleighFit>,
+    /// Each mode's damping three ways.
+    pub modes: Vec<ModeDamping>,
+    /// The end time (s).
+    pub t_end: f64,
+    /// The DOP853 tolerance.
+    pub tol: f64,
+    /// The releases.
+    pub releases: Vec<Release>,
+}
+
+/// `ω √(1 − ζ²)` (`None` when `|ζ| ≥ 1`).
+fn damped_frequency(omega: f64, zeta: f64) -> Option<f64> {
+    (zeta.abs() < 1.0).then(|| omega * (1.0 - zeta * zeta).sqrt())
+}
+
+/// Damping ratios exact, by the diagonal of `Ĉ` and by a Rayleigh fit, and the free responses
+/// from each mode shape (or one given deviation), exact against both approximations (HW34).
+///
+/// # Errors
+/// [`ResponseStudyError::OperatingPoint`], [`ResponseStudyError::Constrained`],
+/// [`ResponseStudyError::NoSuchMode`], [`ResponseStudyError::NotUnderdamped`] and
+/// [`ResponseStudyError::RayleighFit`] for the Rayleigh modes,
+/// [`ResponseStudyError::InvalidTolerance`], [`ResponseStudyError::InvalidEndTime`],
+/// [`ResponseStudyError::TooFewSamples`], [`ResponseStudyError::Response`].
+///
+/// # Examples
+/// ```
+/// use eomgen_runtime::vibration::{ModalDampingOptions, modal_damping_study};
+/// let model = (eomgen::models::find("three_masses_damped").unwrap().make)();
+/// let study = modal_damping_study(model.as_ref(), &ModalDampingOptions::default())?;
+/// // Rayleigh damping fitted to modes 1 and 3 reproduces their exact ζ.
+/// let fit = study.rayleigh.unwrap();
+/// assert_eq!(fit.modes, [1, 3]);
+/// for k in [0, 2] {
+///     let mode = &study.modes[k];
+///     let exact = mode.exact.unwrap().damping_ratio;
+///     assert!((mode.rayleigh.unwrap().damping_ratio - exact).abs() < 1e-14);
+/// }
+/// # Ok::<(), eomgen_runtime::vibration::ResponseStudyError>(())
+/// ```
+///
+/// # References
+/// HW34; lectures 30–33; D. J. Inman, *Engineering Vibration*, 4th ed., §4.5 (Rayleigh
+/// damping).
+pub fn modal_damping_study(
+    model: &dyn ModelInfo,
+    options: &ModalDampingOptions,
+) -> Result<ModalDampingStudy, ResponseStudyError> {
+    let modal = unconstrained_modal_analysis(model, &options.operating_point)?;
+    let (lin, modes) = (&modal.linearization, &modal.normal_modes);
+    let n = model.num_dofs();
+    let approx = modal_damping(lin, modes);
+    let exact = exact_damped_modes(lin, modes)?;
+    let oscillatory: Vec<usize> = (0..n)
+        .filter(|&k| modes.kinds[k] == ModeKind::Oscillatory)
+        .collect();
+    // The Rayleigh fit: explicit modes must be usable; by default the slowest and fastest
+    // oscillatory modes, if there are two with exact damping ratios.
+    let chosen: Option<[usize; 2]> = match options.rayleigh_modes {
+        Some(pair) => {
+            for k in pair {
+                if k == 0 || k > n {
+                    return Err(ResponseStudyError::NoSuchMode {
+                        model: model.name().to_string(),
+                        mode: k,
+                        count: n,
+                    });
+                }
+                if exact[k - 1].is_none() {
+                    return Err(ResponseStudyError::NotUnderdamped { mode: k });
+                }
+            }
+            Some(pair)
+        }
+        None => match (oscillatory.first(), oscillatory.last()) {
+            (Some(&a), Some(&b)) if a != b && exact[a].is_some() && exact[b].is_some() => {
+                Some([a + 1, b + 1])
+            }
+            _ => None,
+        },
+    };
+    let rayleigh = match chosen {
+        Some([a, b]) => {
+            let zeta = |k: usize| exact[k - 1].map_or(f64::NAN, |d| d.damping_ratio);
+            let damping = RayleighDamping::fit(
+                [
+                    modes.natural_frequencies[a - 1],
+                    modes.natural_frequencies[b - 1],
+                ],
+                [zeta(a), zeta(b)],
+            )
+            .map_err(|source| ResponseStudyError::RayleighFit {
+                modes: [a, b],
+                source,
+            })?;
+            Some(RayleighFit {
+                modes: [a, b],
+                damping,
+            })
+        }
+        None => None,
+    };
+    let per_mode = (0..n)
+        .map(|k| {
+            let w = modes.natural_frequencies[k];
+            ModeDamping {
+                mode: k + 1,
+                kind: modes.kinds[k],
+                natural_frequency: w,
+                exact: exact[k],
+                diagonal: approx.damping_ratios[k].map(|z| ModalRatio {
+                    damping_ratio: z,
+                    damped_frequency: approx.damped_frequencies[k],
+                }),
+                rayleigh: match (&rayleigh, modes.kinds[k]) {
+                    (Some(fit), ModeKind::Oscillatory) => {
+                        let z = fit.damping.damping_ratio(w);
+                        Some(ModalRatio {
+                            damping_ratio: z,
+                            damped_frequency: damped_frequency(w, z),
+                        })
+                    }
+                    _ => None,
+                },
+            }
+        })
+        .collect();
+
+    // The releases: HW34's mode shapes (first coordinate 1, or the largest entry if the
+    // first is zero), or one given deviation.
+    check_tolerance(options.tol)?;
+    let t_end = options
+        .t_end
+        .unwrap_or_else(|| default_duration(modes, 10.0, 5.0));
+    let times = uniform_times(t_end, options.samples)?;
+    let names = model.coordinate_names();
+    let mut starts: Vec<(String, Vec<f64>, Vec<f64>)> = Vec::new();
+    match &options.initial {
+        None => {
+            for k in 0..n {
+                let shape = modes.mode_shapes.column(k);
+                let largest = shape.amax();
+                let j = if shape[0].abs() > 1e-8 * largest {
+                    0
+                } else {
+                    shape.iamax()
+                };
+                let q0: Vec<f64> = shape.iter().map(|v| v / shape[j]).collect();
+                starts.push((
+                    format!("mode {} shape, {} = 1", k + 1, names[j]),
+                    q0,
+                    vec![0.0; n],
+                ));
+            }
+        }
+        Some(initial) => starts.push((
+            "given initial values".to_string(),
+            initial.q.clone(),
+            initial.qdot.clone(),
+        )),
+    }
+    let diagonal_damping = approx.diagonal();
+    let mut releases = Vec::new();
+    for (name, q0, v0) in starts {
+        let exact_response = response_by_exponential(lin, &q0, &v0, &times)?;
+        let integrated = response_by_integration(lin, &q0, &v0, &times, options.tol)?;
+        let diagonal =
+            response_with_modal_damping(lin, modes, &diagonal_damping, &q0, &v0, &times)?;
+        let rayleigh_response = match &rayleigh {
+            Some(fit) => Some(response_with_modal_damping(
+                lin,
+                modes,
+                &fit.damping.modal_damping(modes),
+                &q0,
+                &v0,
+                &times,
+            )?),
+            None => None,
+        };
+        // Differences from the exact response, relative to its largest |δq|.
+        let amplitude = exact_response.max_displacement();
+        let versus = |other: &FreeResponse| -> f64 {
+            let d = exact_response
+                .max_displacement_difference(other)
+                .unwrap_or(f64::INFINITY);
+            if amplitude > 0.0 { d / amplitude } else { d }
+        };
+        releases.push(Release {
+            integration_vs_exact: versus(&integrated),
+            diagonal_vs_exact: versus(&diagonal),
+            rayleigh_vs_exact: rayleigh_response.as_ref().map(versus),
+            name,
+            q0,
+            qdot0: v0,
+            amplitude,
+            exact: exact_response,
+            integrated,
+            diagonal,
+            rayleigh: rayleigh_response,
+        });
+    }
+    Ok(ModalDampingStudy {
+        operating_point: modal.operating_point,
+        linearization: modal.linearization,
+        normal_modes: modal.normal_modes,
+        modal_damping: approx,
+        rayleigh,
+        modes: per_mode,
+        t_end,
+        tol: options.tol,
+        releases,
+    })
+}

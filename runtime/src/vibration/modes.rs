@@ -1,0 +1,161 @@
+//! `eomgen modes` as one call: the equilibrium, the exact linearisation
+//! `M δq̈ + C δq̇ + K δq = 0` there, the undamped normal modes and the damped eigenvalues
+//! (issue 7; lectures 22–26, 30).
+
+use nalgebra::{Complex, DMatrix};
+use serde::Serialize;
+
+use super::operating_point::{
+    OperatingPoint, OperatingPointError, OperatingPointOptions, operating_point,
+};
+use crate::modal::{
+    Linearization, NormalModes, damped_modes, eigenvalues_of_m_inv_k, linearize, normal_modes,
+};
+use crate::system::ModelInfo;
+
+/// Options of [`modal_analysis`].
+#[derive(Debug, Clone, PartialEq, Default, Serialize)]
+pub struct ModalOptions {
+    /// The operating point (default: the file's first named equilibrium, else `q = 0`, at
+    /// `t = 0`).
+    pub operating_point: OperatingPointOptions,
+}
+
+/// One eigenvalue `s` of the state matrix `A = [0 I; −M⁻¹K −M⁻¹C]` with `Im s ≥ 0`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct DampedEigenvalue {
+    /// The eigenvalue `s` (1/s), serialised as `{"re", "im"}`.
+    #[serde(serialize_with = "super::serde_matrix::complex")]
+    pub eigenvalue: Complex<f64>,
+    /// `ζ = −Re s/|s|` (0 for `s = 0`).
+    pub damping_ratio: f64,
+    /// `ω_d = |Im s|` (rad/s; 0 for a real eigenvalue).
+    pub damped_frequency: f64,
+}
+
+/// The modal analysis of a model at an operating point: what `eomgen modes` prints.
+///
+/// `n` is the number of coordinates, `r` the number of minimal coordinates (`r = n` without
+/// constraints; see [`Linearization`]).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ModalAnalysis {
+    /// The equilibrium.
+    pub operating_point: OperatingPoint,
+    /// `M`, `C`, `K` (`r × r`) at the equilibrium, with the constraint basis `N` (`n × r`).
+    pub linearization: Linearization,
+    /// The undamped modes: `natural_frequencies` (rad/s, ascending), kinds, mode shapes in
+    /// the minimal coordinates (mass-normalised, `ΨᵀMΨ = I`).
+    pub normal_modes: NormalModes,
+    /// The mass-normalised `mode_shapes` in the model's coordinates, `δq = N ψ`:
+    /// `mode_shapes[k]` (length `n`) is mode `k`'s.
+    pub mode_shapes: Vec<Vec<f64>>,
+    /// The names of the `r` minimal coordinates (all `n` coordinates without constraints).
+    pub minimal_coordinates: Vec<String>,
+    /// The eigenvalues `s` of `A` with `Im s ≥ 0`, sorted by `|s|` (a complex pair once, each
+    /// real eigenvalue once).
+    pub damped_modes: Vec<DampedEigenvalue>,
+    /// `damping_ratios`: `ζ` of each entry of `damped_modes`; `r` zeros when `C = 0`.
+    pub damping_ratios: Vec<f64>,
+    /// The eigenvalues `ω²` of the non-symmetric `M⁻¹K` (1/s², lecture 22's route), ascending.
+    pub m_inv_k_eigenvalues: Vec<f64>,
+    /// The largest difference between them and `normal_modes.eigenvalues` (lecture 24's
+    /// symmetric route), relative to the largest `|ω²|`.
+    pub m_inv_k_relative_difference: f64,
+}
+
+impl ModalAnalysis {
+    /// `true` when the damping matrix is zero (the text leaves `C` out then).
+    pub fn is_undamped(&self) -> bool {
+        self.linearization.damping_matrix.amax() == 0.0
+    }
+
+    /// The mode shapes in the model's coordinates as one `n × r` matrix `N Ψ`, column `k`
+    /// mode `k`'s.
+    pub fn mode_shape_matrix(&self) -> DMatrix<f64> {
+        self.linearization
+            .to_coordinates(&self.normal_modes.mode_shapes)
+    }
+}
+
+/// Finds the operating point, linearises there exactly (`q̇ = 0`) and computes the normal
+/// modes, the damped eigenvalues and lecture 22's `M⁻¹K` check: `eomgen modes` and the start
+/// of the modal studies.
+///
+/// # Errors
+/// [`OperatingPointError::UnknownEquilibrium`]; [`OperatingPointError::Modal`] when the
+/// equilibrium search, the linearisation (constraints violated, singular or non-finite
+/// matrices) or the eigenproblems fail.
+///
+/// # Examples
+/// Three equal masses between four equal springs (`three_masses`, HW28): `ω² = (2 − √2) k/m`,
+/// `2k/m`, `(2 + √2) k/m`.
+/// ```
+/// use eomgen_runtime::vibration::{ModalOptions, modal_analysis};
+/// let model = (eomgen::models::find("three_masses").unwrap().make)();
+/// let modal = modal_analysis(model.as_ref(), &ModalOptions::default())?;
+/// let (k, m) = (1.0, 1.0);
+/// let expected = [(2.0 - 2f64.sqrt()) * k / m, 2.0 * k / m, (2.0 + 2f64.sqrt()) * k / m];
+/// for (w, w2) in modal.normal_modes.natural_frequencies.iter().zip(expected) {
+///     assert!((w - w2.sqrt()).abs() < 1e-12);
+/// }
+/// assert!(modal.is_undamped());
+/// # Ok::<(), eomgen_runtime::vibration::OperatingPointError>(())
+/// ```
+///
+/// # References
+/// Lectures 22 (`M⁻¹K`), 24 (mass-normalised modes by the symmetric route), 25
+/// (linearisation about an equilibrium), 30 (damping ratios from the eigenvalues of `A`).
+pub fn modal_analysis(
+    model: &dyn ModelInfo,
+    options: &ModalOptions,
+) -> Result<ModalAnalysis, OperatingPointError> {
+    let point = operating_point(model, &options.operating_point)?;
+    let n = model.num_dofs();
+    let linearization = linearize(model, point.q(), &vec![0.0; n], point.t)?;
+    let modes = normal_modes(&linearization)?;
+    let m_inv_k_eigenvalues = eigenvalues_of_m_inv_k(&linearization)?;
+    let damped_modes: Vec<DampedEigenvalue> = damped_modes(&linearization)?
+        .into_iter()
+        .map(|(s, zeta, wd)| DampedEigenvalue {
+            eigenvalue: s,
+            damping_ratio: zeta,
+            damped_frequency: wd,
+        })
+        .collect();
+    let r = linearization.num_minimal_coordinates();
+    let damping_ratios = if linearization.damping_matrix.amax() == 0.0 {
+        vec![0.0; r]
+    } else {
+        damped_modes.iter().map(|d| d.damping_ratio).collect()
+    };
+    let scale = modes.eigenvalues.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let m_inv_k_relative_difference = modes
+        .eigenvalues
+        .iter()
+        .zip(&m_inv_k_eigenvalues)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0f64, f64::max)
+        / scale.max(f64::MIN_POSITIVE);
+    let shapes = linearization.to_coordinates(&modes.mode_shapes);
+    // Column by column, as `mode_shape_matrix` gives them.
+    let mode_shapes = (0..r)
+        .map(|k| shapes.column(k).iter().copied().collect())
+        .collect();
+    let names = model.coordinate_names();
+    let minimal_coordinates = linearization
+        .independent_coordinates
+        .iter()
+        .map(|&i| names[i].to_string())
+        .collect();
+    Ok(ModalAnalysis {
+        operating_point: point,
+        linearization,
+        normal_modes: modes,
+        mode_shapes,
+        minimal_coordinates,
+        damped_modes,
+        damping_ratios,
+        m_inv_k_eigenvalues,
+        m_inv_k_relative_difference,
+    })
+}

@@ -1,0 +1,164 @@
+//! The operating point of a vibration analysis: an equilibrium `F(q*, 0, t) = 0` (with
+//! holonomic constraints `F = Jᵀλ*`, `Φ(q*, t) = 0`) found by Newton's method from a named
+//! guess of the model file's `equilibria:` or from explicit coordinates (lecture 25).
+
+use serde::Serialize;
+
+use crate::modal::{Equilibrium, ModalError, find_equilibrium};
+use crate::system::ModelInfo;
+
+/// Where Newton's search for the equilibrium starts.
+#[derive(Debug, Clone, PartialEq, Default, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum EquilibriumStart {
+    /// The model file's first `equilibria:` entry; `q = 0` (named `q = 0`) when it has none
+    /// (default).
+    #[default]
+    FirstNamed,
+    /// The entry of this name in the model file's `equilibria:` (`hanging`, `upright`).
+    Named(String),
+    /// Explicit coordinates `q` (length `n`, m or rad) under a label for reports (the CLI
+    /// uses the `--at` text, `theta=pi/2`).
+    Guess {
+        /// What to call the operating point.
+        label: String,
+        /// The starting coordinates (length `n = num_dofs()`).
+        q: Vec<f64>,
+    },
+}
+
+impl EquilibriumStart {
+    /// The label and the starting coordinates (length `n`) of this start for `model`.
+    ///
+    /// # Errors
+    /// [`OperatingPointError::UnknownEquilibrium`] for a name the file's `equilibria:` does
+    /// not have; [`OperatingPointError::Modal`] with [`ModalError::DimensionMismatch`] for a
+    /// guess of the wrong length.
+    pub fn resolve(
+        &self,
+        model: &dyn ModelInfo,
+    ) -> Result<(String, Vec<f64>), OperatingPointError> {
+        let named = model.equilibrium_guesses();
+        match self {
+            Self::FirstNamed => Ok(match named.first() {
+                Some((name, q)) => (name.to_string(), q.clone()),
+                None => ("q = 0".to_string(), vec![0.0; model.num_dofs()]),
+            }),
+            Self::Named(name) => named
+                .iter()
+                .find(|(n, _)| n == name)
+                .map(|(n, q)| (n.to_string(), q.clone()))
+                .ok_or_else(|| OperatingPointError::UnknownEquilibrium {
+                    model: model.name().to_string(),
+                    name: name.clone(),
+                    known: named.iter().map(|(n, _)| n.to_string()).collect(),
+                }),
+            Self::Guess { label, q } => {
+                if q.len() != model.num_dofs() {
+                    return Err(ModalError::DimensionMismatch {
+                        expected: model.num_dofs(),
+                        found: q.len(),
+                    }
+                    .into());
+                }
+                Ok((label.clone(), q.clone()))
+            }
+        }
+    }
+}
+
+/// Options of [`operating_point`].
+#[derive(Debug, Clone, PartialEq, Default, Serialize)]
+pub struct OperatingPointOptions {
+    /// Where Newton starts (default: the file's first named equilibrium, else `q = 0`).
+    pub start: EquilibriumStart,
+    /// The time `t` (s) at which `F(q, 0, t) = 0` is solved (default: 0).
+    pub t: f64,
+}
+
+/// An operating point: the equilibrium found and what it is called.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct OperatingPoint {
+    /// The equilibrium's name from `equilibria:`, the guess's label, or `q = 0`.
+    pub name: String,
+    /// The model's `coordinate_names` (length `n`), the order of `q` and `guess`.
+    pub coordinates: Vec<String>,
+    /// Newton's starting coordinates (length `n`).
+    pub guess: Vec<f64>,
+    /// The time (s) of the equilibrium equations.
+    pub t: f64,
+    /// The equilibrium `q*`, `λ*`, Newton's iterations and residual.
+    pub equilibrium: Equilibrium,
+}
+
+impl OperatingPoint {
+    /// The equilibrium's coordinates `q*` (length `n`).
+    pub fn q(&self) -> &[f64] {
+        &self.equilibrium.q
+    }
+}
+
+/// Why no operating point was found.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum OperatingPointError {
+    /// [`EquilibriumStart::Named`] names no entry of the file's `equilibria:`.
+    #[error("`{model}` has no equilibrium `{name}` ({})", if known.is_empty() { "it names none".to_string() } else { format!("it names: {}", known.join(", ")) })]
+    UnknownEquilibrium {
+        /// The model.
+        model: String,
+        /// The name asked for.
+        name: String,
+        /// The names the file gives, in its order.
+        known: Vec<String>,
+    },
+    /// The search or a later linearisation failed.
+    #[error(transparent)]
+    Modal(#[from] ModalError),
+}
+
+/// Finds the equilibrium of `model` from `options.start` by Newton's method with the exact
+/// Jacobians ([`find_equilibrium`]): the start of `eomgen modes`, `frf`, the modal studies and
+/// the `checks:` of a model file that name an operating point (`at: hanging`).
+///
+/// # Errors
+/// [`OperatingPointError::UnknownEquilibrium`]; [`OperatingPointError::Modal`] with
+/// [`ModalError::EquilibriumNotFound`], [`ModalError::NonHolonomic`] or
+/// [`ModalError::DimensionMismatch`].
+///
+/// # Examples
+/// ```
+/// use eomgen_runtime::vibration::{EquilibriumStart, OperatingPointOptions, operating_point};
+/// let mut model = (eomgen::models::find("double_pendulum").unwrap().make)();
+/// let options = OperatingPointOptions {
+///     start: EquilibriumStart::Named("hanging".to_string()),
+///     ..OperatingPointOptions::default()
+/// };
+/// let point = operating_point(model.as_mut(), &options)?;
+/// // Both bars straight down (angles from +x).
+/// for theta in point.q() {
+///     assert!((theta + std::f64::consts::FRAC_PI_2).abs() < 1e-12);
+/// }
+/// # Ok::<(), eomgen_runtime::vibration::OperatingPointError>(())
+/// ```
+///
+/// # References
+/// Lecture 25 (equilibria and linearisation); Newton's method as in [`find_equilibrium`].
+pub fn operating_point(
+    model: &dyn ModelInfo,
+    options: &OperatingPointOptions,
+) -> Result<OperatingPoint, OperatingPointError> {
+    let (name, guess) = options.start.resolve(model)?;
+    let equilibrium = find_equilibrium(model, &guess, options.t)?;
+    Ok(OperatingPoint {
+        name,
+        coordinates: model
+            .coordinate_names()
+            .iter()
+            .map(|c| c.to_string())
+            .collect(),
+        guess,
+        t: options.t,
+        equilibrium,
+    })
+}

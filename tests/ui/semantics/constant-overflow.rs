@@ -1,0 +1,3 @@
+eomgen::model!("constant-overflow.yaml");
+
+fn main() {}

@@ -1,0 +1,3 @@
+eomgen::model!("constant-power-overflow.yaml");
+
+fn main() {}

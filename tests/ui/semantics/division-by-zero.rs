@@ -1,0 +1,3 @@
+eomgen::model!("division-by-zero.yaml");
+
+fn main() {}

@@ -1,0 +1,3 @@
+eomgen::model!("zero-to-the-zero.yaml");
+
+fn main() {}
