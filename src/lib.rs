@@ -40,6 +40,13 @@ pub use nalgebra;
 #[cfg(feature = "jit")]
 mod source;
 
+// The rows of a model file's `checks:` need the run-time loader for the file's model.
+#[cfg(feature = "jit")]
+pub mod checks;
+pub mod expressions;
+#[cfg(feature = "jit")]
+pub mod studies;
+
 #[cfg(feature = "jit")]
 pub use floquet_references::{
     ChartAxis, FloquetReferences, ReferenceCurvePoints, ReferenceError, ThresholdPrediction,

@@ -272,3 +272,55 @@ fn projection_holds_the_constraints() {
         assert!(m.constraint_drift(t, y).0 < 1e-10, "loop at t = {t}");
     }
 }
+
+/// The constraint methods on HW10's rod, through the library `study constraint-methods`
+/// calls: the DAE is both more accurate and cheaper than every stiff spring, and the
+/// springs' constraint error falls as 1/k (HW9's "nearly a single mass": the stretch F/k
+/// falls by 100 per step of k, within a factor 2). The rod has no minimal twin; the
+/// cartesian pendulum names `simple_pendulum`, whose row follows the reference to 1e-6 m.
+#[test]
+fn constraint_methods_compare_springs_dae_and_minimal() {
+    use eomgen::analysis::{ConstraintMethodsOptions, constraint_methods};
+    use eomgen::studies::minimal_twin;
+    let options = ConstraintMethodsOptions {
+        t_end: 2.0,
+        ..ConstraintMethodsOptions::default()
+    };
+    let rod = eomgen::ModelSource::open("two_masses_rod").unwrap();
+    assert!(minimal_twin(&rod).unwrap().is_none());
+    let study = constraint_methods(&mut || rod.instantiate(), None, &options).unwrap();
+    let get = |prefix: &str| {
+        study
+            .rows
+            .iter()
+            .find(|r| r.method.starts_with(prefix))
+            .unwrap_or_else(|| panic!("no {prefix}"))
+    };
+    let dae = get("II.1: DAE, no");
+    let springs: Vec<_> = study
+        .rows
+        .iter()
+        .filter(|r| r.method.starts_with("I: stiff"))
+        .collect();
+    assert_eq!(springs.len(), 3);
+    for s in &springs {
+        assert!(s.position_error > dae.position_error);
+        assert!(s.rhs_evals > dae.rhs_evals);
+    }
+    for w in springs.windows(2) {
+        let ratio = w[0].drift.unwrap() / w[1].drift.unwrap();
+        assert!((50.0..200.0).contains(&ratio), "ratio {ratio}");
+    }
+    let cartesian = eomgen::ModelSource::open("simple_pendulum_cartesian").unwrap();
+    let (name, twin) = minimal_twin(&cartesian).unwrap().expect("a twin");
+    let study = constraint_methods(
+        &mut || cartesian.instantiate(),
+        Some((name.as_str(), twin.instantiate())),
+        &options,
+    )
+    .unwrap();
+    let minimal = study.rows.last().unwrap();
+    assert_eq!(minimal.method, "II.3: minimal coordinates (simple_pendulum)");
+    assert!(minimal.drift.is_none());
+    assert!(minimal.position_error < 1e-6, "{}", minimal.position_error);
+}

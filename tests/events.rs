@@ -5,6 +5,8 @@
 mod common;
 use common::{eomgen, eomgen_ok};
 
+use eomgen::analysis::{SimulationOptions, simulate_with_events};
+use eomgen::expressions::{ExpressionError, ExpressionEvents};
 use eomgen::{
     DormandPrince853, EventDirection, Integrator, IntegratorOptions, ModelInfo, OutputTimes,
     RadauIIA5, Solution,
@@ -149,10 +151,55 @@ fn eccentric_cylinder_lifts_off_where_the_normal_force_vanishes() {
     assert!((t_radau - event.t).abs() < 1e-8, "{t_radau} vs {}", event.t);
 }
 
+/// Event functions written as expressions (`--stop-when`, `--event`), through the library
+/// the CLI calls: an expression with a direction, a model event made terminal by name, and
+/// functions of the accelerations and constraint forces.
 #[test]
-fn stop_when_and_event_on_the_command_line() {
-    // An expression with a direction: the double pendulum's forearm passes straight down
-    // (θ2 = 0) while turning clockwise.
+fn stop_when_and_event_expressions() {
+    // The double pendulum's forearm passes straight down (θ2 = 0) while turning clockwise.
+    let mut m = model("double_pendulum");
+    let mut events =
+        ExpressionEvents::parse(m.as_mut(), &["theta2 = 0, falling"], &["theta1_dot"]).unwrap();
+    let run = simulate_with_events(m.as_mut(), &SimulationOptions::default(), Some(&mut events))
+        .unwrap();
+    let s = &run.solution;
+    let last = &s.events[s.terminated_by_event.expect("stopped")];
+    assert_eq!(last.name, "stop_when_1");
+    assert_eq!(last.direction, EventDirection::Falling);
+    assert!(last.y[1].abs() < 1e-12, "theta2 = {}", last.y[1]);
+    assert!(last.y[3] < 0.0);
+    assert_eq!(s.t.last(), Some(&last.t));
+    assert!(s.events.iter().all(|e| ["stop_when_1", "event_2"].contains(&e.name.as_str())));
+    // A model event made terminal by name: nothing is added. The return of the pendulum
+    // released from the horizontal comes after a whole period, 4 K(1/√2) √(l/g).
+    let mut m = model("simple_pendulum");
+    let mut events = ExpressionEvents::parse(m.as_mut(), &["return"], &[] as &[&str]).unwrap();
+    assert!(events.is_empty());
+    let run = simulate_with_events(m.as_mut(), &SimulationOptions::default(), Some(&mut events))
+        .unwrap();
+    let stop = &run.solution.events[run.solution.terminated_by_event.expect("stopped")];
+    assert_eq!(stop.name, "return");
+    let period = 4.0 * elliptic_k(1.0 / 2f64.sqrt()) * (1.0f64 / 10.0).sqrt();
+    assert!((stop.t - period).abs() < 1e-7, "{} vs {period}", stop.t);
+    // Accelerations and constraint forces are allowed in the functions too.
+    let mut m = model("eccentric_cylinder");
+    let mut events =
+        ExpressionEvents::parse(m.as_mut(), &["lambda_contact - 5, falling"], &[] as &[&str])
+            .unwrap();
+    let run = simulate_with_events(m.as_mut(), &SimulationOptions::default(), Some(&mut events))
+        .unwrap();
+    assert_eq!(
+        run.solution.terminated_by_event.map(|k| run.solution.events[k].name.as_str()),
+        Some("stop_when_1")
+    );
+    let last = run.constraints.lagrange_multipliers.last().unwrap().as_ref().unwrap();
+    assert!((last[0] - 5.0).abs() < 1e-6, "lambda = {}", last[0]);
+}
+
+/// The CLI renders the events: the JSON names the terminal one, the text says where the run
+/// stopped.
+#[test]
+fn stop_when_on_the_command_line() {
     let out = eomgen_ok(&[
         "simulate",
         "double_pendulum",
@@ -163,32 +210,31 @@ fn stop_when_and_event_on_the_command_line() {
         "--json",
     ]);
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-    let events = v["events"].as_array().unwrap();
     assert_eq!(v["terminated_by_event"], "stop_when_1");
-    let last = events.last().unwrap();
+    let last = v["events"].as_array().unwrap().last().unwrap().clone();
     assert_eq!(last["name"], "stop_when_1");
     assert_eq!(last["direction"], "falling");
-    assert!(last["q"][1].as_f64().unwrap().abs() < 1e-12);
-    assert!(last["qdot"][1].as_f64().unwrap() < 0.0);
-    let samples = v["samples"].as_array().unwrap();
-    assert_eq!(samples.last().unwrap()["t"], last["t"]);
-    // A model event made terminal by name; the text output names it.
+    assert_eq!(v["samples"].as_array().unwrap().last().unwrap()["t"], last["t"]);
     let out = eomgen(&["simulate", "simple_pendulum", "--stop-when", "return"]);
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(out.status.success());
     assert!(text.contains("stopped    at t = 2.3452395"), "{text}");
-    // Accelerations and constraint forces are allowed in command-line functions too.
-    let out = eomgen(&[
-        "simulate",
-        "eccentric_cylinder",
-        "--stop-when",
-        "lambda_contact - 5, falling",
-        "--json",
-    ]);
-    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-    assert_eq!(v["terminated_by_event"], "stop_when_1");
-    let last = v["samples"].as_array().unwrap().last().unwrap().clone();
-    assert!((last["constraint_forces"][0].as_f64().unwrap() - 5.0).abs() < 1e-6);
+}
+
+/// Mistakes in event functions are typed errors naming the column and what would be right.
+#[test]
+fn bad_event_expressions_are_typed_errors() {
+    let mut m = model("double_pendulum");
+    let error = ExpressionEvents::parse(m.as_mut(), &["x + theta2_dott"], &[] as &[&str]).unwrap_err();
+    match error {
+        ExpressionError::EventUnknownName { column, name, .. } => {
+            assert_eq!((column, name.as_str()), (1, "x"));
+        }
+        other => panic!("{other:?}"),
+    }
+    let error = ExpressionEvents::parse(m.as_mut(), &["theta2", "theta2, up"], &[] as &[&str])
+        .unwrap_err();
+    assert!(matches!(error, ExpressionError::EventDirection { ref word, .. } if word == "up"));
 }
 
 #[test]

@@ -8,6 +8,7 @@ use common::Rng;
 
 use std::f64::consts::PI;
 
+use eomgen::analysis::energy_drift;
 use eomgen::models;
 use eomgen::{
     DormandPrince54, Integrator, IntegratorOptions, ModelInfo, OutputTimes, RungeKutta4, Solution,
@@ -238,25 +239,45 @@ fn conservative_models_conserve_energy() {
             .unwrap_or_else(|e| panic!("{}: {e}", entry.name));
         let times: Vec<f64> = (1..=100).map(|i| 0.1 * f64::from(i)).collect();
         let s = solve(m.as_mut(), &y0, 10.0, times, &tight());
-        let e0 = m.energy(0.0, &y0);
-        let mut scale = m.kinetic_energy(0.0, &y0) + m.potential_energy(0.0, &y0).abs();
-        let mut drift: f64 = 0.0;
-        for (t, y) in s.iter() {
-            scale = scale.max(m.kinetic_energy(t, y) + m.potential_energy(t, y).abs());
-            drift = drift.max((m.energy(t, y) - e0).abs());
-        }
-        assert!(scale > 0.0, "{}: motion has no energy scale", entry.name);
+        let drift = energy_drift(m.as_ref(), &y0, &s);
+        assert!(drift.scale > 0.0, "{}: motion has no energy scale", entry.name);
+        let relative = drift.drift.expect("samples");
         assert!(
-            drift / scale <= 1e-10,
-            "{}: relative energy drift {}",
+            relative <= 1e-10,
+            "{}: relative energy drift {relative}",
             entry.name,
-            drift / scale
         );
     }
     assert!(
         checked >= 4,
         "expected the pendulums and the spring chain to be conservative"
     );
+}
+
+/// The drift measure itself, on samples of the simple pendulum (m = l = 1, g = 10,
+/// `E = q̇²/2 + 10 sin q`) chosen by hand: from `E(0) = 0` the largest deviation is 10 (at
+/// `q = π/2`) and the largest `T + |V|` is 10.5 (at `q = −π/2, q̇ = 1`), so the drift is
+/// 10/10.5 (to rounding, 1e-15).
+#[test]
+fn energy_drift_is_the_largest_deviation_over_the_energy_scale() {
+    let m = model("simple_pendulum");
+    let samples = [[0.0, 2.0], [PI / 2.0, 0.0], [-PI / 2.0, 1.0]];
+    let solution = Solution {
+        t: vec![1.0, 2.0, 3.0],
+        y: samples.concat(),
+        dim: 2,
+        stats: Default::default(),
+        events: Vec::new(),
+        terminated_by_event: None,
+    };
+    let drift = energy_drift(m.as_ref(), &[0.0, 0.0], &solution);
+    assert_eq!(drift.initial_energy, 0.0);
+    let expected = [2.0, 10.0, -9.5];
+    for (e, x) in drift.energy.iter().zip(expected) {
+        assert!((e - x).abs() < 1e-14, "E = {e}, expected {x}");
+    }
+    assert!((drift.scale - 10.5).abs() < 1e-14);
+    assert!((drift.drift.unwrap() - 10.0 / 10.5).abs() < 1e-15);
 }
 
 /// HW19b: the generated double pendulum equals equations derived by hand for two uniform bars

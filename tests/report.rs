@@ -492,3 +492,47 @@ fn report_on_a_file_runs_the_files_own_equations() {
         "{report}"
     );
 }
+
+/// The rows of the wrong-values file through the library the report calls
+/// (`eomgen::checks`): the derivations agree; the natural frequency is the true
+/// `√(m g d/(I + m d²)) = √15` (to 1e-12) against the stated 4, so it fails; `θ̇` is not
+/// conserved; the energy is (DOP853 at 1e-12 keeps the drift below 1e-9).
+#[test]
+fn checks_of_a_file_through_the_library() {
+    use eomgen::checks::{ModesAt, Simulations, derivation_checks, motion_checks};
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/fixtures/report_wrong_values.yaml"
+    );
+    let text = std::fs::read_to_string(path).unwrap();
+    let file = eomgen_symbolic::model::load(path, &text).expect("loads");
+    let (rows, _notes) = derivation_checks(&file).expect("derives");
+    assert!(!rows.is_empty() && rows.iter().all(|r| r.passed), "{rows:?}");
+    let source = eomgen::ModelSource::open(path).expect("compiles");
+    let mut model = source.instantiate();
+    let y0 = model.consistent_initial_state().unwrap();
+    let modes_model = source.instantiate();
+    let mut modes = |at: Option<&str>| {
+        assert_eq!(at, Some("hanging"));
+        let eq = eomgen::find_equilibrium(modes_model.as_ref(), &[0.0], 0.0).unwrap();
+        let lin = eomgen::linearize(modes_model.as_ref(), &eq.q, &[0.0], 0.0).unwrap();
+        let modes = eomgen::normal_modes(&lin).unwrap();
+        Ok(ModesAt {
+            label: "hanging".to_string(),
+            natural_frequencies: modes.natural_frequencies.clone(),
+            linearization: lin,
+        })
+    };
+    let mut simulations = Simulations::new(source);
+    let rows = motion_checks(&file, model.as_mut(), &y0, &mut simulations, &mut modes);
+    let find = |prefix: &str| rows.iter().find(|r| r.check.starts_with(prefix)).unwrap();
+    let w = find("natural_frequencies[1] at hanging");
+    assert!(!w.passed);
+    assert_eq!(w.expected, 4.0);
+    assert!((w.computed.unwrap() - 15f64.sqrt()).abs() < 1e-12);
+    let rate = find("conserved `rate`");
+    assert!(!rate.passed && rate.computed.unwrap() > 0.1);
+    let energy = find("energy drift");
+    assert!(energy.passed && energy.computed.unwrap() < 1e-9);
+    assert_eq!(rows.iter().filter(|r| !r.passed).count(), 2);
+}

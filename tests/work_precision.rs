@@ -9,6 +9,9 @@
 mod common;
 use common::{eomgen, eomgen_ok};
 
+use eomgen::analysis::{
+    Measured, Method, Setting, WorkPrecision, WorkPrecisionOptions, work_precision,
+};
 use serde_json::Value;
 
 /// Runs the study with the fastest timing (one run per setting); it must succeed.
@@ -47,20 +50,6 @@ fn method<'v>(v: &'v Value, name: &str) -> &'v Value {
         .unwrap_or_else(|| panic!("no method {name} in {v}"))
 }
 
-/// The numbers `key` of a method's runs, in order (loosest first); every run must have one.
-fn column(m: &Value, key: &str) -> Vec<f64> {
-    m["runs"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|r| {
-            r[key]
-                .as_f64()
-                .unwrap_or_else(|| panic!("run without `{key}`: {r}"))
-        })
-        .collect()
-}
-
 /// Simple pendulum released horizontally, 2 s (one swing): the reference (DOP853 at 1e-14)
 /// and its Dormand–Prince 5(4) check agree to about 2e-13 (seen: 1.6e-13), so the bound
 /// 1e-11 leaves two orders of margin while still failing for a wrong or unchecked reference.
@@ -70,34 +59,36 @@ fn column(m: &Value, key: &str) -> Vec<f64> {
 /// smallest ones (~1e-9) are resolved by the reference.
 #[test]
 fn reference_is_verified_and_adaptive_errors_fall_with_the_tolerance() {
-    let v = study_json(&[
-        "simple_pendulum",
-        "--t-end",
-        "2",
-        "--methods",
-        "bs32,dp54,dop853,radau5",
-        "--tols",
-        "1e-4,1e-7,1e-10",
-    ]);
-    let agreement = v["reference"]["agreement"].as_f64().unwrap();
-    assert!((0.0..1e-11).contains(&agreement), "agreement {agreement}");
-    assert_eq!(v["reference"]["method"], "dop853");
-    assert_eq!(v["reference"]["check_method"], "dp54");
-    for name in ["bs32", "dp54", "dop853", "radau5"] {
-        let m = method(&v, name);
-        assert_eq!(m["adaptive"], true);
-        let tols = column(m, "tol");
-        assert_eq!(tols, [1e-4, 1e-7, 1e-10], "{name}: loosest first");
-        let e = column(m, "error");
-        assert!(e[2] * 100.0 <= e[0], "{name}: errors {e:?}");
+    let methods = [Method::Bs32, Method::Dp54, Method::Dop853, Method::Radau5];
+    let study = library_study(WorkPrecisionOptions {
+        methods: methods.to_vec(),
+        tolerances: vec![1e-4, 1e-7, 1e-10],
+        ..fast_options()
+    });
+    assert!(
+        (0.0..1e-11).contains(&study.agreement),
+        "agreement {}",
+        study.agreement
+    );
+    for (r, method) in study.results.iter().zip(methods) {
+        assert_eq!(r.method, method);
+        let tols: Vec<f64> = r
+            .runs
+            .iter()
+            .map(|run| match run.setting {
+                Setting::Tolerance(tol) => tol,
+                other => panic!("{method}: {other:?}"),
+            })
+            .collect();
+        assert_eq!(tols, [1e-4, 1e-7, 1e-10], "{method}: loosest first");
+        let measured: Vec<&Measured> = r.runs.iter().map(|run| run.outcome.as_ref().unwrap()).collect();
+        let e: Vec<f64> = measured.iter().map(|m| m.error).collect();
+        assert!(e[2] * 100.0 <= e[0], "{method}: errors {e:?}");
         for (err, tol) in e.iter().zip(&tols) {
-            assert!(
-                *err > 0.0 && *err < 100.0 * tol,
-                "{name}: {err} at tol {tol}"
-            );
+            assert!(*err > 0.0 && *err < 100.0 * tol, "{method}: {err} at tol {tol}");
         }
-        for r in m["runs"].as_array().unwrap() {
-            assert_eq!(r["resolved"], true, "{name}: {r}");
+        for m in measured {
+            assert!(!study.unresolved(m), "{method}: {m:?}");
         }
     }
 }
@@ -111,35 +102,56 @@ fn reference_is_verified_and_adaptive_errors_fall_with_the_tolerance() {
 /// output times too.
 #[test]
 fn fixed_step_errors_fall_at_the_method_order() {
-    let v = study_json(&[
-        "simple_pendulum",
-        "--t-end",
-        "2",
-        "--methods",
-        "rk4,stormer-verlet,euler,implicit-midpoint",
-        "--steps",
-        "32..256",
-    ]);
-    for (name, order) in [
-        ("rk4", 4),
-        ("stormer-verlet", 2),
-        ("euler", 1),
-        ("implicit-midpoint", 2),
-    ] {
-        let m = method(&v, name);
-        assert_eq!(m["adaptive"], false);
-        assert_eq!(m["order"], order);
-        assert_eq!(column(m, "num_steps"), [32.0, 64.0, 128.0, 256.0], "{name}");
+    let methods = [
+        (Method::Rk4, 4),
+        (Method::StormerVerlet, 2),
+        (Method::Euler, 1),
+        (Method::ImplicitMidpoint, 2),
+    ];
+    let study = library_study(WorkPrecisionOptions {
+        methods: methods.iter().map(|(m, _)| *m).collect(),
+        steps: Some(vec![32, 64, 128, 256]),
+        ..fast_options()
+    });
+    for (r, (method, order)) in study.results.iter().zip(methods) {
+        assert_eq!(r.method, method);
+        assert!(!method.is_adaptive());
+        assert_eq!(method.integrator().order(), order);
+        let steps: Vec<usize> = r
+            .runs
+            .iter()
+            .map(|run| match run.setting {
+                Setting::Steps { steps, .. } => steps,
+                other => panic!("{method}: {other:?}"),
+            })
+            .collect();
+        assert_eq!(steps, [32, 64, 128, 256], "{method}");
         let expected = f64::from(1u32 << order);
-        let e = column(m, "error");
+        let e: Vec<f64> = r.runs.iter().map(|run| run.outcome.as_ref().unwrap().error).collect();
         for pair in e.windows(2) {
             let ratio = pair[0] / pair[1];
             assert!(
                 ratio > expected / 1.4 && ratio < expected * 1.4,
-                "{name}: error ratio {ratio} between halvings, expected ≈ {expected} ({e:?})"
+                "{method}: error ratio {ratio} between halvings, expected ≈ {expected} ({e:?})"
             );
         }
     }
+}
+
+/// The library's options for the simple pendulum over 2 s with the fastest timing.
+fn fast_options() -> WorkPrecisionOptions {
+    WorkPrecisionOptions {
+        t_end: 2.0,
+        repeats: 1,
+        min_time_s: 0.0,
+        ..WorkPrecisionOptions::default()
+    }
+}
+
+/// The study of the simple pendulum through the library the CLI calls.
+fn library_study(options: WorkPrecisionOptions) -> WorkPrecision {
+    let mut model = (eomgen::models::find("simple_pendulum").unwrap().make)();
+    work_precision(model.as_mut(), &options, &mut |_, _| {}).expect("the study runs")
 }
 
 /// The JSON contract: the promised keys at the top, per method, per run and at the target;

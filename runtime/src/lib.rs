@@ -5,6 +5,7 @@
 //! integrates it with any [`Integrator`].
 #![warn(missing_docs)]
 
+pub mod analysis;
 pub mod constrained;
 pub mod dynamic;
 pub mod floquet;
@@ -17,6 +18,7 @@ pub mod response;
 pub mod system;
 pub mod vibration;
 
+pub use analysis::{Method, UnknownMethod};
 pub use constrained::{
     ConstraintFunctions, ConstraintWorkspace, ProjectionError, Stabilization, StaticSystem,
 };

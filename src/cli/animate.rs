@@ -532,19 +532,7 @@ fn short(v: f64) -> String {
 }
 
 /// `v` with `decimals` decimals, trailing zeros dropped, `-0` as `0`.
-pub(super) fn fixed(v: f64, decimals: usize) -> String {
-    let s = format!("{v:.decimals$}");
-    let s = if s.contains('.') {
-        s.trim_end_matches('0').trim_end_matches('.')
-    } else {
-        &s
-    };
-    if s == "-0" {
-        "0".to_string()
-    } else {
-        s.to_string()
-    }
-}
+pub(super) use eomgen::checks::fixed;
 
 /// A JSON string literal safe inside `<script>` (no `</script>`).
 fn json_string(s: &str) -> String {

@@ -3,7 +3,6 @@
 mod animate;
 mod check;
 mod equations;
-mod events;
 mod floquet;
 mod free_response;
 mod frf;

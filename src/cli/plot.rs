@@ -271,7 +271,7 @@ pub fn phase_portrait(
 /// Plots the energy drift `E(t) − E(0)` (J) against time into `path` (`.svg` or `.png`):
 /// `energy[k] = T + V` at `t[k]` and `initial = E(0)`, the energy of the initial state (which
 /// need not be a sample: with requested output times the first may come later), as
-/// [`simulate::Report`](super::simulate::Report) computes them. Constant for a conservative
+/// [`eomgen::analysis::energy_drift`] computes them. Constant for a conservative
 /// model up to the integration error; for others it is the work of the non-conservative loads.
 ///
 /// # Errors

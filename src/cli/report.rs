@@ -20,36 +20,20 @@ use std::io::IsTerminal as _;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use clap::{Args, ValueEnum};
+use clap::Args;
 use rayon::prelude::*;
 use serde_json::json;
 
-use eomgen::{ModelInfo, OutputTimes, Solution, damped_modes};
+pub(super) use eomgen::checks::CheckRow;
+use eomgen::ModelInfo;
+use eomgen::analysis::{constraint_drift, energy_drift};
+use eomgen::checks::{CheckRun, DERIVATION_TOLERANCE, ModesAt, Simulations, derivation_checks};
 use eomgen_symbolic::codegen::equations_mathml;
-use eomgen_symbolic::mechanics::check::check_model;
 use eomgen_symbolic::mechanics::{Formulation, Lagrange, SymbolicModel};
-use eomgen_symbolic::model::parser::eval_expr;
-use eomgen_symbolic::model::{
-    DEFAULT_CONSTRAINT_DRIFT, DEFAULT_ENERGY_DRIFT, Expr, ModalCheck, ModelFile, RunSettings,
-};
+use eomgen_symbolic::model::ModelFile;
 
-use super::animate::fixed;
 use super::modes::{OperatingPoint, operating_point_of};
-use super::simulate::{IntegrationArgs, Method, Report as EnergyReport, integrate};
-use super::values::parameter_lookup;
 use super::{CliError, plot};
-
-/// Relative tolerance of the derivation cross-checks, as `eomgen check`: the derivations
-/// differ only by rounding (~1e-14).
-const DERIVATION_TOLERANCE: f64 = 1e-8;
-/// Random states of the derivation cross-checks.
-const DERIVATION_STATES: usize = 100;
-/// Default end time of the simulations (s).
-const DEFAULT_T_END: f64 = 10.0;
-/// Default relative and absolute tolerance of the simulations.
-const DEFAULT_RTOL: f64 = 1e-12;
-/// Samples of a simulation (uniform in t, both ends included), for the charts and drifts.
-const SAMPLES: usize = 1001;
 
 /// Options of `eomgen report`.
 #[derive(Debug, Args)]
@@ -70,49 +54,6 @@ pub struct ReportArgs {
     /// byte-identical across runs).
     #[arg(long)]
     pub timing: bool,
-}
-
-/// One row of a model's pass/fail table.
-#[derive(Debug, Clone)]
-pub(super) struct CheckRow {
-    /// What was checked, with its unit or settings.
-    pub check: String,
-    /// The computed value; `None` when it could not be computed (see `note`).
-    pub computed: Option<f64>,
-    /// The expected value.
-    pub expected: f64,
-    /// The tolerance: passes when `|computed − expected| ≤ tolerance · max(1, |expected|)`.
-    pub tolerance: f64,
-    /// Whether it passed.
-    pub passed: bool,
-    /// Why it could not be computed, if so.
-    pub note: Option<String>,
-}
-
-impl CheckRow {
-    /// Compares `computed` with `expected` (a failure to compute is a failed check).
-    fn compare(
-        check: impl Into<String>,
-        computed: Result<f64, String>,
-        expected: f64,
-        tolerance: f64,
-    ) -> Self {
-        let (computed, note) = match computed {
-            Ok(v) => (Some(v), None),
-            Err(e) => (None, Some(e)),
-        };
-        let passed = computed.is_some_and(|c| {
-            c.is_finite() && (c - expected).abs() <= tolerance * expected.abs().max(1.0)
-        });
-        Self {
-            check: check.into(),
-            computed,
-            expected,
-            tolerance,
-            passed,
-            note,
-        }
-    }
 }
 
 /// A figure of a model's section: the file (relative to the report's directory) and what
@@ -285,68 +226,6 @@ fn header_comment(source: &str) -> String {
         .join("\n")
 }
 
-/// How a check integrates.
-#[derive(Debug, Clone, Copy, PartialEq)]
-struct Run {
-    method: Method,
-    rtol: f64,
-    t_end: f64,
-}
-
-impl Run {
-    fn of(settings: &RunSettings) -> Self {
-        let method = settings
-            .method
-            .as_ref()
-            .and_then(|m| Method::from_str(&m.value, false).ok())
-            .unwrap_or(Method::Dop853);
-        Self {
-            method,
-            rtol: settings.rtol.unwrap_or(DEFAULT_RTOL),
-            t_end: settings.t_end.unwrap_or(DEFAULT_T_END),
-        }
-    }
-
-    fn describe(&self) -> String {
-        let method = self
-            .method
-            .to_possible_value()
-            .map(|v| v.get_name().to_string())
-            .unwrap_or_default();
-        format!("{method}, rtol {:e}, {} s", self.rtol, fixed(self.t_end, 6))
-    }
-}
-
-impl Default for Run {
-    fn default() -> Self {
-        Self::of(&RunSettings::default())
-    }
-}
-
-/// Integrates the bundled model `name` from its initial state as `eomgen simulate` does
-/// ([`integrate`], no drift control), with `run`'s method, end time and `rtol` = `atol`,
-/// sampled at `times` (default: [`SAMPLES`] uniform times); the model file's events are
-/// located on the way.
-fn simulate(name: &str, run: Run, times: Option<Vec<f64>>) -> Result<Solution, String> {
-    let times = times.unwrap_or_else(|| {
-        (0..SAMPLES)
-            .map(|k| run.t_end * k as f64 / (SAMPLES - 1) as f64)
-            .collect()
-    });
-    let args = IntegrationArgs {
-        t_end: run.t_end,
-        method: run.method,
-        rtol: run.rtol,
-        atol: run.rtol,
-        ..IntegrationArgs::defaults().map_err(|e| e.message)?
-    };
-    let result = integrate(name, &args, OutputTimes::At(times)).map_err(|e| e.message)?;
-    match result.failure {
-        None => Ok(result.solution),
-        Some(error) => Err(format!("the integration failed: {error}")),
-    }
-}
-
 /// Results computed once per key (a model's simulations, its operating points), failures
 /// included.
 struct Memo<K, V> {
@@ -370,88 +249,6 @@ impl<K: PartialEq, V> Memo<K, V> {
         };
         self.done[k].1.as_ref().map_err(Clone::clone)
     }
-}
-
-/// Evaluates an expected value (an expression of the parameters).
-fn expected(e: &Expr, model: &dyn ModelInfo) -> Result<f64, String> {
-    eval_expr(e, &parameter_lookup(model)).map_err(|d| d.message)
-}
-
-/// Evaluates a function of the parameters (`parameters`), coordinates, rates and `t` at
-/// `(t, y)` of `model`.
-fn state_value(
-    e: &Expr,
-    model: &dyn ModelInfo,
-    parameters: &dyn Fn(&str) -> Option<f64>,
-    t: f64,
-    y: &[f64],
-) -> Result<f64, String> {
-    let coordinates = model.coordinate_names();
-    let n = coordinates.len();
-    eval_expr(e, &|name| {
-        if name == "t" {
-            return Some(t);
-        }
-        if let Some(v) = parameters(name) {
-            return Some(v);
-        }
-        if let Some(i) = coordinates.iter().position(|c| *c == name) {
-            return Some(y[i]);
-        }
-        let base = name.strip_suffix("_dot")?;
-        coordinates
-            .iter()
-            .position(|c| *c == base)
-            .map(|i| y[n + i])
-    })
-    .map_err(|d| d.message)
-}
-
-/// Rows comparing a list of computed modal values with a `natural_frequencies:` or
-/// `damping_ratios:` entry.
-fn modal_rows(
-    key: &str,
-    unit: &str,
-    check: &ModalCheck,
-    model: &dyn ModelInfo,
-    computed: Result<(String, Vec<f64>), String>,
-) -> Vec<CheckRow> {
-    let at = check.at.as_ref().map_or("", |a| a.value.as_str());
-    let (label, values) = match computed {
-        Ok(c) => c,
-        Err(e) => {
-            return vec![CheckRow::compare(
-                format!("{key} at {at}"),
-                Err(e),
-                f64::NAN,
-                check.tolerance,
-            )];
-        }
-    };
-    let mut rows = Vec::new();
-    for (k, e) in check.values.iter().enumerate() {
-        let what = format!("{key}[{}] at {label}{unit}", k + 1);
-        let value = values.get(k).copied().ok_or_else(|| {
-            format!(
-                "the model has {} value(s), the file states {}",
-                values.len(),
-                check.values.len()
-            )
-        });
-        match expected(e, model) {
-            Ok(x) => rows.push(CheckRow::compare(what, value, x, check.tolerance)),
-            Err(err) => rows.push(CheckRow::compare(what, Err(err), f64::NAN, check.tolerance)),
-        }
-    }
-    if values.len() > check.values.len() {
-        rows.push(CheckRow::compare(
-            format!("number of {key} at {label}"),
-            Ok(values.len() as f64),
-            check.values.len() as f64,
-            0.0,
-        ));
-    }
-    rows
 }
 
 /// Runs every check of one model and draws its figures into `dir/<name>/`.
@@ -484,28 +281,10 @@ fn report_model(source: &Source, dir: &Path) -> ModelReport {
     }
 
     // Generic: the derivations agree (the checks of `eomgen check`).
-    match check_model(file, DERIVATION_STATES, 0x5EED) {
-        Ok(r) => {
-            for c in &r.comparisons {
-                report.checks.push(CheckRow::compare(
-                    format!(
-                        "derivations agree: {} vs {} (max relative q̈ difference)",
-                        c.a, c.b
-                    ),
-                    Ok(c.max_rel_residual),
-                    0.0,
-                    DERIVATION_TOLERANCE,
-                ));
-            }
-            if let Some(p) = &r.power_balance {
-                report.checks.push(CheckRow::compare(
-                    "power balance dE/dt = Q·q̇ (max relative residual)",
-                    Ok(p.max_rel_residual),
-                    0.0,
-                    DERIVATION_TOLERANCE,
-                ));
-            }
-            report.notes.extend(r.notes.iter().cloned());
+    match derivation_checks(file) {
+        Ok((rows, notes)) => {
+            report.checks.extend(rows);
+            report.notes.extend(notes);
         }
         Err(d) => report.checks.push(CheckRow::compare(
             "derivations agree",
@@ -532,8 +311,9 @@ fn report_model(source: &Source, dir: &Path) -> ModelReport {
 }
 
 /// The checks and figures that need a motion or an equilibrium of `model` (from the
-/// consistent initial state `y0`), added to `report`; the figures and the animation go into
-/// `dir/<name>/`.
+/// consistent initial state `y0`), added to `report`: the figures of the default run, the
+/// rows of [`eomgen::checks::motion_checks`], the mode shapes; the figures and the animation
+/// go into `dir/<name>/`.
 fn motion_checks(
     source: &Source,
     model: &mut dyn ModelInfo,
@@ -551,8 +331,7 @@ fn motion_checks(
         notes,
         ..
     } = report;
-    let mut runs: Memo<Run, Solution> = Memo::new();
-    let simulated = |run: &Run| simulate(&spec, *run, None);
+    let mut simulations = Simulations::new(source.model.clone());
     let mut operating_points: Memo<Option<String>, OperatingPoint> = Memo::new();
     let operating_point = |at: &Option<String>| {
         let point = super::modes::OperatingPointArgs {
@@ -561,7 +340,7 @@ fn motion_checks(
         };
         operating_point_of(&spec, &point).map_err(|e| e.message)
     };
-    let default_run = Run::default();
+    let default_run = CheckRun::default();
 
     // Figures of the default run.
     let model_dir = dir.join(&name);
@@ -570,7 +349,7 @@ fn motion_checks(
     }
     let mut drawn: Vec<(&str, String, Result<(), String>)> = Vec::new();
     let path = |file: &str| model_dir.join(file).to_string_lossy().to_string();
-    match runs.get(default_run, simulated) {
+    match simulations.get(default_run) {
         Ok(solution) => {
             let run = default_run.describe();
             drawn.push((
@@ -584,20 +363,17 @@ fn motion_checks(
                 plot::phase_portrait(&path("phase.svg"), model, solution),
             ));
             drawn.push(("energy.svg", "Energy drift E(t) − E(0)".to_string(), {
-                let energy = EnergyReport::new(model, y0, solution);
+                let energy = energy_drift(model, y0, solution);
                 plot::energy_drift(
                     &path("energy.svg"),
                     model.name(),
                     &solution.t,
                     &energy.energy,
-                    energy.initial,
+                    energy.initial_energy,
                 )
             }));
             if !model.constraint_names().is_empty() {
-                let drift: Vec<(f64, f64)> = solution
-                    .iter()
-                    .map(|(t, y)| model.constraint_drift(t, y))
-                    .collect();
+                let drift = constraint_drift(model, solution).drift;
                 drawn.push((
                     "constraints.svg",
                     "Constraint drift max |Φ|, max |Φ̇|, no stabilisation".to_string(),
@@ -617,190 +393,30 @@ fn motion_checks(
         }
     }
 
-    // Generic: energy conservation (conservative models, or where the file asks for it).
-    let energy = &file.checks.energy_drift;
-    if model.is_conservative() || energy.is_some() {
-        let (bound, run) = energy
-            .as_ref()
-            .map_or((DEFAULT_ENERGY_DRIFT, default_run), |d| {
-                (d.max, Run::of(&d.run))
-            });
-        let computed = runs.get(run, simulated).and_then(|s| {
-            EnergyReport::new(model, y0, s)
-                .drift
-                .ok_or_else(|| "no samples".to_string())
-        });
-        checks.push(CheckRow::compare(
-            format!(
-                "energy drift max|E − E(0)|/max(T + |V|) ({})",
-                run.describe()
-            ),
-            computed,
-            0.0,
-            bound,
-        ));
-    }
-
-    // Generic: constraint drift (constrained models).
-    let constraint = &file.checks.constraint_drift;
-    if !model.constraint_names().is_empty() || constraint.is_some() {
-        let (bound, run) = constraint
-            .as_ref()
-            .map_or((DEFAULT_CONSTRAINT_DRIFT, default_run), |d| {
-                (d.max, Run::of(&d.run))
-            });
-        let computed = runs.get(run, simulated).map(|s| {
-            s.iter()
-                .map(|(t, y)| {
-                    let (p, v) = model.constraint_drift(t, y);
-                    p.max(v)
+    checks.extend(eomgen::checks::motion_checks(
+        file,
+        model,
+        y0,
+        &mut simulations,
+        &mut |at| {
+            operating_points
+                .get(at.map(str::to_string), operating_point)
+                .map(|op| ModesAt {
+                    label: op.label.clone(),
+                    natural_frequencies: op.modes.natural_frequencies.clone(),
+                    linearization: op.lin.clone(),
                 })
-                .fold(0.0f64, f64::max)
-        });
-        checks.push(CheckRow::compare(
-            format!(
-                "constraint drift max(|Φ|, |Φ̇|), no stabilisation ({})",
-                run.describe()
-            ),
-            computed,
-            0.0,
-            bound,
-        ));
-    }
-
-    // Reference values stated in the file.
-    let at_of = |check: &ModalCheck| check.at.as_ref().map(|a| a.value.clone());
-    if let Some(check) = &file.checks.natural_frequencies {
-        let computed = operating_points
-            .get(at_of(check), operating_point)
-            .map(|op| (op.label.clone(), op.modes.natural_frequencies.clone()));
-        checks.extend(modal_rows(
-            "natural_frequencies",
-            " (rad/s)",
-            check,
-            model,
-            computed,
-        ));
-    }
-    if let Some(check) = &file.checks.damping_ratios {
-        let computed = operating_points
-            .get(at_of(check), operating_point)
-            .and_then(|op| {
-                damped_modes(&op.lin)
-                    .map(|d| (op.label.clone(), d.iter().map(|m| m.1).collect()))
-                    .map_err(|e| e.to_string())
-            });
-        checks.extend(modal_rows("damping_ratios", "", check, model, computed));
-    }
-    if let Some(check) = &file.checks.period {
-        let run = Run::of(&check.run);
-        let event = check.event.value.as_str();
-        let computed = runs.get(run, simulated).and_then(|s| {
-            let times: Vec<f64> = s
-                .events
-                .iter()
-                .filter(|e| e.name == event)
-                .map(|e| e.t)
-                .collect();
-            match times.as_slice() {
-                [.., a, b] => Ok(b - a),
-                _ => Err(format!(
-                    "event `{event}` occurred {} time(s) in {} s; a period needs two",
-                    times.len(),
-                    run.t_end
-                )),
-            }
-        });
-        let what = format!(
-            "period between the last two `{event}` events (s) ({})",
-            run.describe()
-        );
-        match expected(&check.value, model) {
-            Ok(x) => checks.push(CheckRow::compare(what, computed, x, check.tolerance)),
-            Err(e) => checks.push(CheckRow::compare(what, Err(e), f64::NAN, check.tolerance)),
-        }
-    }
-    if let Some(check) = &file.checks.final_state {
-        match expected(&check.t, model) {
-            Ok(t) if t.is_finite() && t > 0.0 => {
-                let run = Run {
-                    t_end: t,
-                    ..Run::of(&check.run)
-                };
-                let state = simulate(&spec, run, Some(vec![t])).and_then(|s| {
-                    s.last()
-                        .filter(|(ts, _)| *ts == t)
-                        .map(|(_, y)| y.to_vec())
-                        .ok_or_else(|| format!("the integration stopped before t = {t}"))
-                });
-                let coordinates = model.coordinate_names();
-                let n = coordinates.len();
-                for (k, e) in &check.values {
-                    let index = coordinates.iter().position(|c| *c == k.value).or_else(|| {
-                        k.value
-                            .strip_suffix("_dot")
-                            .and_then(|b| coordinates.iter().position(|c| *c == b))
-                            .map(|i| n + i)
-                    });
-                    let computed = state.clone().and_then(|y| {
-                        index
-                            .map(|i| y[i])
-                            .ok_or_else(|| format!("`{}` is not a coordinate or rate", k.value))
-                    });
-                    let what = format!("{} at t = {} s ({})", k.value, fixed(t, 6), run.describe());
-                    match expected(e, model) {
-                        Ok(x) => checks.push(CheckRow::compare(what, computed, x, check.tolerance)),
-                        Err(err) => checks.push(CheckRow::compare(
-                            what,
-                            Err(err),
-                            f64::NAN,
-                            check.tolerance,
-                        )),
-                    }
-                }
-            }
-            Ok(t) => checks.push(CheckRow::compare(
-                "final_state",
-                Err(format!("t = {t} is not a positive time")),
-                f64::NAN,
-                check.tolerance,
-            )),
-            Err(e) => checks.push(CheckRow::compare(
-                "final_state",
-                Err(e),
-                f64::NAN,
-                check.tolerance,
-            )),
-        }
-    }
-    let parameters = parameter_lookup(model);
-    for c in &file.checks.conserved {
-        let computed = runs.get(default_run, simulated).and_then(|s| {
-            let mut q0 = None;
-            let mut worst: f64 = 0.0;
-            for (t, y) in s.iter() {
-                let q = state_value(&c.value, model, &parameters, t, y)?;
-                let q0 = *q0.get_or_insert(q);
-                worst = worst.max((q - q0).abs() / q0.abs().max(1.0));
-            }
-            Ok(worst)
-        });
-        checks.push(CheckRow::compare(
-            format!(
-                "conserved `{}`: max |Q − Q(0)|/max(1, |Q(0)|) ({})",
-                c.name.value,
-                default_run.describe()
-            ),
-            computed,
-            0.0,
-            c.tolerance,
-        ));
-    }
+        },
+    ));
 
     // Mode shapes where `eomgen modes` applies: named equilibria and points to draw on (at
     // the equilibrium of the frequency check).
     if !model.equilibrium_guesses().is_empty() && !model.point_names().is_empty() {
-        let at = file.checks.natural_frequencies.as_ref().and_then(at_of);
+        let at = file
+            .checks
+            .natural_frequencies
+            .as_ref()
+            .and_then(|check| check.at.as_ref().map(|a| a.value.clone()));
         match operating_points.get(at, operating_point) {
             Ok(op) => {
                 let shapes = op.lin.to_coordinates(&op.modes.mode_shapes);

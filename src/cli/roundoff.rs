@@ -1,32 +1,14 @@
-//! `eomgen study euler-roundoff` (HW1; syllabus lecture 4, "Euler's method vs midpoint
-//! method: truncation (method) errors and roundoff errors … the random cancellation, thus
-//! √n, aspect of roundoff error").
-//!
-//! `ẋ = x`, `x(0) = 1` on `[0, 1]` (`x(1) = e`) with explicit Euler, explicit midpoint and
-//! RK4 at `h = 10⁻ⁿ`, `n = 0 … N`. The error at `t = 1` splits exactly into
-//!
-//! ```text
-//! x_N − e = (Φ(h)ᴺ − e)   +   (x_N − Φ(h)ᴺ)
-//!           truncation        roundoff
-//! ```
-//!
-//! where `Φ(h)` is the method's step factor in exact arithmetic (`1 + h`, `1 + h + h²/2`,
-//! `1 + h + … + h⁴/24`, the stability polynomial at `z = h`) and `Φ(h)ᴺ` is evaluated as
-//! `exp(N ln(1 + (Φ − 1)))` with `ln_1p`, accurate to a few units of `ε e` (`ε = 2⁻⁵²`).
-//! Truncation falls as `e h/2` (Euler), `e h²/6` (midpoint), `e h⁴/120` (RK4); roundoff
-//! grows with the number of steps, as `ε √N` if the rounding errors of the steps were
-//! independent and as `ε N` if they keep one sign.
+//! `eomgen study euler-roundoff` (HW1; syllabus lecture 4): the study is
+//! [`eomgen::analysis::euler_roundoff`] (its module docs give the split of the error into
+//! truncation and roundoff); this module renders its table, JSON and chart.
 
 use std::f64::consts::E;
 use std::io::Write as _;
 
 use clap::Args;
-use eomgen::integrate::stability::StabilityPolynomial;
-use eomgen::{
-    ExplicitEuler, ExplicitMidpoint, Integrator, IntegratorOptions, OdeFn, OutputTimes,
-    RungeKutta4, Tableau,
+use eomgen::analysis::roundoff::{
+    EulerRoundoff, RoundoffError, RoundoffOptions, RoundoffRow, euler_roundoff,
 };
-use serde::Serialize;
 use serde_json::json;
 
 use super::stability::{log_y_chart, print_json};
@@ -47,138 +29,18 @@ pub struct EulerRoundoffArgs {
     pub plot: Option<String>,
 }
 
-/// Largest accepted `--max-n`: 10¹⁰ Euler steps take minutes.
-const LARGEST_N: u32 = 10;
-/// Roundoff below this multiple of `ε` is within the accuracy of `Φ(h)ᴺ` and is left out of
-/// the fitted growth exponent.
-const ROUNDOFF_FLOOR: f64 = 100.0;
-
-/// One method at one `h`.
-#[derive(Debug, Clone, Serialize)]
-struct Run {
-    method: &'static str,
-    /// `x(1)` computed.
-    x: f64,
-    /// `x(1) − e`.
-    error: f64,
-    /// `Φ(h)ᴺ − e`, the error in exact arithmetic.
-    truncation: f64,
-    /// `x(1) − Φ(h)ᴺ`, the accumulated rounding error.
-    roundoff: f64,
-}
-
-/// All methods at one `n`.
-#[derive(Debug, Serialize)]
-struct Row {
-    n: u32,
-    h: f64,
-    steps: usize,
-    /// `ε √N`.
-    epsilon_sqrt_steps: f64,
-    /// `ε N`.
-    epsilon_steps: f64,
-    runs: Vec<Run>,
-    /// Explicit Euler as a hand-written loop `x ← x + h x` in single precision (`f32`,
-    /// `ε₃₂ = 2⁻²³`): `x(1)` and `x(1) − e`.
-    single_precision_euler: SinglePrecision,
-}
-
-/// The single-precision Euler loop at one `n`.
-#[derive(Debug, Serialize)]
-struct SinglePrecision {
-    x: f64,
-    error: f64,
-    /// `x(1) − (1 + h)ᴺ` with the `f32` step `h` in exact arithmetic: the accumulated rounding
-    /// of the additions alone.
-    roundoff: f64,
-    /// `ε₃₂ √N`.
-    epsilon_sqrt_steps: f64,
-    /// `ε₃₂ N`.
-    epsilon_steps: f64,
-}
-
-/// Explicit Euler on `ẋ = x` in single precision: `steps` steps of `x ← x + h x`, `h` the
-/// `f32` nearest to `1/steps` (its representation error, up to `2⁻²⁴` relative, shifts the
-/// end time by as much and is part of the roundoff).
-fn single_precision_euler(steps: usize) -> SinglePrecision {
-    let h = (1.0 / steps as f64) as f32;
-    let mut x = 1.0f32;
-    for _ in 0..steps {
-        x += h * x;
-    }
-    let epsilon = f64::from(f32::EPSILON);
-    let exact_arithmetic = (steps as f64 * f64::from(h).ln_1p()).exp();
-    SinglePrecision {
-        x: f64::from(x),
-        error: f64::from(x) - E,
-        roundoff: f64::from(x) - exact_arithmetic,
-        epsilon_sqrt_steps: epsilon * (steps as f64).sqrt(),
-        epsilon_steps: epsilon * steps as f64,
-    }
-}
-
-/// The smallest error of a method over `n`, and how its roundoff grows.
-#[derive(Debug, Serialize)]
-struct Summary {
-    method: &'static str,
-    optimal_n: u32,
-    smallest_error: f64,
-    /// The first `n` whose error is below `100 ε` (rounding level), if any.
-    first_n_at_rounding_level: Option<u32>,
-    /// Exponent `a` of `|roundoff| ∝ Nᵃ` fitted (least squares in log–log) over the `n` whose
-    /// roundoff exceeds `100 ε` (`None` with fewer than two such `n`).
-    roundoff_exponent: Option<f64>,
-}
-
 /// Runs `eomgen study euler-roundoff`.
 pub fn run(args: &EulerRoundoffArgs) -> Result<(), CliError> {
-    if args.max_n > LARGEST_N {
-        return Err(CliError::usage(format!(
-            "--max-n must be at most {LARGEST_N} (10ⁿ steps per method)"
-        )));
-    }
-    let tableaus = [Tableau::euler(), Tableau::midpoint(), Tableau::rk4()];
-    let polynomials: Vec<StabilityPolynomial> = tableaus
-        .iter()
-        .map(StabilityPolynomial::of_tableau)
-        .collect();
-    let mut rows = Vec::new();
-    for n in 0..=args.max_n {
-        // Parsed rather than computed, so that h is the double nearest to 10⁻ⁿ.
-        let h: f64 = format!("1e-{n}")
-            .parse()
-            .map_err(|_| CliError::failure("10⁻ⁿ did not parse"))?;
-        let steps = 10usize.pow(n);
-        let methods: [Box<dyn Integrator>; 3] = [
-            Box::new(ExplicitEuler::new()),
-            Box::new(ExplicitMidpoint::new()),
-            Box::new(RungeKutta4::new()),
-        ];
-        let mut runs = Vec::new();
-        for (mut method, polynomial) in methods.into_iter().zip(&polynomials) {
-            let x = x_at_one(method.as_mut(), h, steps)?;
-            let exact_arithmetic = exact_arithmetic(polynomial, steps);
-            runs.push(Run {
-                method: method.name(),
-                x,
-                error: x - E,
-                truncation: exact_arithmetic - E,
-                roundoff: x - exact_arithmetic,
-            });
-        }
-        let epsilon = f64::EPSILON;
-        rows.push(Row {
-            n,
-            h,
-            steps,
-            epsilon_sqrt_steps: epsilon * (steps as f64).sqrt(),
-            epsilon_steps: epsilon * steps as f64,
-            runs,
-            single_precision_euler: single_precision_euler(steps),
-        });
-    }
-    let summaries: Vec<Summary> = (0..tableaus.len()).map(|i| summary(&rows, i)).collect();
-    let notes = notes(&rows, &summaries);
+    let EulerRoundoff {
+        rows,
+        summary: summaries,
+        notes,
+    } = euler_roundoff(&RoundoffOptions { max_n: args.max_n }).map_err(|e| match e {
+        RoundoffError::MaxNTooLarge { largest, .. } => CliError::usage(format!(
+            "--max-n must be at most {largest} (10ⁿ steps per method)"
+        )),
+        other => CliError::failure(other.to_string()),
+    })?;
 
     if let Some(path) = &args.plot {
         plot_errors(path, &rows)?;
@@ -259,144 +121,7 @@ pub fn run(args: &EulerRoundoffArgs) -> Result<(), CliError> {
     Ok(())
 }
 
-/// `x(1)` by `steps` constant steps of size `h` (the last snapped to `t = 1`).
-fn x_at_one(method: &mut dyn Integrator, h: f64, steps: usize) -> Result<f64, CliError> {
-    let mut growth = OdeFn::new(1, |_t: f64, x: &[f64], dx: &mut [f64]| dx[0] = x[0]);
-    let options = IntegratorOptions::default()
-        .with_dt(h)
-        .with_max_steps(steps + 10);
-    let solution = method
-        .integrate(
-            &mut growth,
-            0.0,
-            &[1.0],
-            1.0,
-            &OutputTimes::At(vec![1.0]),
-            &options,
-        )
-        .map_err(|e| CliError::failure(format!("{} with h = {h:e}: {e}", method.name())))?;
-    Ok(solution.state(0)[0])
-}
-
-/// `Φ(1/N)ᴺ` in exact arithmetic, to a few `ε e`: `exp(N ln_1p(Φ − 1))` with `Φ − 1` summed
-/// from the small terms up (no cancellation against 1).
-fn exact_arithmetic(polynomial: &StabilityPolynomial, steps: usize) -> f64 {
-    let h = 1.0 / steps as f64;
-    let increment: f64 = polynomial
-        .coefficients()
-        .iter()
-        .enumerate()
-        .skip(1)
-        .rev()
-        .map(|(k, r)| r * h.powi(k as i32))
-        .sum();
-    (steps as f64 * increment.ln_1p()).exp()
-}
-
-fn summary(rows: &[Row], index: usize) -> Summary {
-    let mut best = (0, f64::INFINITY);
-    let mut points = Vec::new();
-    let mut method = "";
-    for r in rows {
-        let run = &r.runs[index];
-        method = run.method;
-        if run.error.abs() < best.1 {
-            best = (r.n, run.error.abs());
-        }
-        if run.roundoff.abs() > ROUNDOFF_FLOOR * f64::EPSILON {
-            points.push(((r.steps as f64).log10(), run.roundoff.abs().log10()));
-        }
-    }
-    let first_n_at_rounding_level = rows
-        .iter()
-        .find(|r| r.runs[index].error.abs() < ROUNDOFF_FLOOR * f64::EPSILON)
-        .map(|r| r.n);
-    Summary {
-        method,
-        first_n_at_rounding_level,
-        optimal_n: best.0,
-        smallest_error: best.1,
-        roundoff_exponent: slope(&points),
-    }
-}
-
-/// Least-squares slope of `points`, `None` with fewer than two.
-fn slope(points: &[(f64, f64)]) -> Option<f64> {
-    if points.len() < 2 {
-        return None;
-    }
-    let count = points.len() as f64;
-    let mean_x = points.iter().map(|p| p.0).sum::<f64>() / count;
-    let mean_y = points.iter().map(|p| p.1).sum::<f64>() / count;
-    let sxy: f64 = points.iter().map(|p| (p.0 - mean_x) * (p.1 - mean_y)).sum();
-    let sxx: f64 = points.iter().map(|p| (p.0 - mean_x).powi(2)).sum();
-    Some(sxy / sxx)
-}
-
-/// What the figures show, in words that follow the figures.
-fn notes(rows: &[Row], summaries: &[Summary]) -> Vec<String> {
-    let max_n = rows.last().map_or(0, |r| r.n);
-    let mut notes = vec![
-        "truncation is the exact-arithmetic error Φ(h)^N − e; it falls as e h/2 (euler), e h²/6 (midpoint), e h⁴/120 (rk4) until it is below the roundoff".to_string(),
-        "roundoff is x(1) − Φ(h)^N: each step rounds x + h·F to the nearest double (error ≤ ε x/2), and an error made at t is amplified by e^(1−t)".to_string(),
-    ];
-    for s in summaries {
-        let exponent = s.roundoff_exponent.map_or_else(
-            || "too few n with roundoff above 100 ε to fit its growth".to_string(),
-            |a| format!("fitted roundoff ∝ N^{a:.2} (0.5 for independent rounding errors, 1 for errors of one sign)"),
-        );
-        let optimum = if let Some(n) = s.first_n_at_rounding_level {
-            format!(
-                "|error| below 100 ε from n = {n} on (smallest {:.2e} at n = {}): truncation is below roundoff there, and the optimum is wherever the rounding happens to cancel",
-                s.smallest_error, s.optimal_n
-            )
-        } else if s.optimal_n == max_n {
-            format!(
-                "smallest error at the largest n tried ({max_n}): roundoff has not overtaken truncation"
-            )
-        } else {
-            format!(
-                "optimal n = {} (|error| {:.2e})",
-                s.optimal_n, s.smallest_error
-            )
-        };
-        notes.push(format!("{} in f64: {optimum}; {exponent}", s.method));
-    }
-    let single = |r: &Row| r.single_precision_euler.error.abs();
-    if let Some(best) = rows.iter().min_by(|a, b| single(a).total_cmp(&single(b))) {
-        notes.push(format!(
-            "euler in f32 (ε₃₂ = {:.2e}): optimal n = {} (|error| {:.2e}), the textbook trade-off at a reachable n",
-            f32::EPSILON,
-            best.n,
-            single(best)
-        ));
-    }
-    let roundoff = |r: &Row| r.single_precision_euler.roundoff.abs();
-    if let Some(r) = rows
-        .iter()
-        .find(|r| r.n > 0 && roundoff(r) > 0.1 * r.single_precision_euler.epsilon_steps)
-    {
-        notes.push(format!(
-            "euler in f32 at n = {}: roundoff {:.2e}, of the size ε₃₂N = {:.2e} rather than ε₃₂√N = {:.2e}: h·x is within a few units in the last place of x, so every x + h·x rounds the same way (systematic, not random)",
-            r.n,
-            roundoff(r),
-            r.single_precision_euler.epsilon_steps,
-            r.single_precision_euler.epsilon_sqrt_steps
-        ));
-    }
-    if let Some(r) = rows
-        .iter()
-        .find(|r| r.n > 0 && r.single_precision_euler.x == 1.0)
-    {
-        notes.push(format!(
-            "euler in f32 from n = {}: h·x is below half a unit in the last place of x = 1, x + h·x rounds back to x, and x never leaves 1 (error 1 − e)",
-            r.n
-        ));
-    }
-    notes
-}
-
-fn plot_errors(path: &str, rows: &[Row]) -> Result<(), CliError> {
+fn plot_errors(path: &str, rows: &[RoundoffRow]) -> Result<(), CliError> {
     let mut series: Vec<plot::Series> = (0..3)
         .map(|i| plot::Series {
             name: format!("{} |x(1) − e|", rows[0].runs[i].method),
@@ -406,7 +131,7 @@ fn plot_errors(path: &str, rows: &[Row]) -> Result<(), CliError> {
                 .collect(),
         })
         .collect();
-    let line = |name: &str, f: &dyn Fn(&Row) -> f64| plot::Series {
+    let line = |name: &str, f: &dyn Fn(&RoundoffRow) -> f64| plot::Series {
         name: name.to_string(),
         points: rows.iter().map(|r| (f64::from(r.n), f(r))).collect(),
     };

@@ -3,73 +3,56 @@
 use std::io::Write as _;
 
 use clap::{Args, ValueEnum};
-use eomgen::{
-    BogackiShampine32, DormandPrince54, DormandPrince853, ExplicitEuler, ExplicitMidpoint,
-    ImplicitMidpoint, IntegrationError, IntegrationFailure, Integrator, IntegratorOptions,
-    ModelInfo, OutputTimes, RadauIIA5, RungeKutta4, Solution, StormerVerlet, SymplecticEuler,
-    WithEvents,
+pub(crate) use eomgen::Method;
+use eomgen::analysis::{
+    AddedEvents, ConstraintDrift, EnergyDrift, Simulation, SimulationError, SimulationOptions,
+    simulate_with_events,
 };
+use eomgen::expressions::{ExpressionEvents, set_initial_values};
+use eomgen::{IntegrationError, ModelInfo, OutputTimes, Solution};
 use serde_json::json;
 
-use super::events::CliEvents;
-use super::values::{evaluate, parameter_lookup, set_parameters, split_assignment};
+use super::values::{evaluate, set_parameters, usage};
 use super::{CliError, find_model, plot};
 use eomgen::Stabilization;
 
-/// Integration method. Adaptive methods use `--rtol`/`--atol` (and `--dt` as their first
-/// step); fixed-step methods use `--dt` (default `t_end/1000`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum Method {
-    /// Explicit Euler, order 1, fixed step `--dt`.
-    Euler,
-    /// Explicit midpoint, order 2, fixed step `--dt`.
-    Midpoint,
-    /// Classical Runge–Kutta 4, fixed step `--dt`.
-    Rk4,
-    /// Bogacki–Shampine 3(2) (ode23), adaptive, Hermite dense output.
-    Bs32,
-    /// Dormand–Prince 5(4), adaptive, dense output (default).
-    Dp54,
-    /// DOP853, Hairer's Dormand–Prince 8(5,3), adaptive, order-7 dense output.
-    Dop853,
-    /// Symplectic Euler, order 1, fixed step `--dt` (symplectic for constant M and
-    /// velocity-independent forces).
-    SymplecticEuler,
-    /// Störmer–Verlet (leapfrog in q, q̇), order 2, fixed step `--dt` (symplectic for
-    /// constant M and velocity-independent forces).
-    StormerVerlet,
-    /// Implicit midpoint, order 2, fixed step `--dt`, Newton with the generated Jacobians
-    /// (symplectic for any M(q)).
-    ImplicitMidpoint,
-    /// Radau IIA order 5 (RADAU5), adaptive, L-stable, Newton with the generated Jacobians.
-    Radau5,
-}
-
-impl Method {
-    /// A new integrator of this method.
-    pub(crate) fn integrator(self) -> Box<dyn Integrator> {
-        match self {
-            Method::Euler => Box::new(ExplicitEuler::new()),
-            Method::Midpoint => Box::new(ExplicitMidpoint::new()),
-            Method::Rk4 => Box::new(RungeKutta4::new()),
-            Method::Bs32 => Box::new(BogackiShampine32::new()),
-            Method::Dp54 => Box::new(DormandPrince54::new()),
-            Method::Dop853 => Box::new(DormandPrince853::new()),
-            Method::SymplecticEuler => Box::new(SymplecticEuler::new()),
-            Method::StormerVerlet => Box::new(StormerVerlet::new()),
-            Method::ImplicitMidpoint => Box::new(ImplicitMidpoint::new()),
-            Method::Radau5 => Box::new(RadauIIA5::new()),
+/// The `--method` help of each method (clap lists them under "Possible values"; the
+/// methods themselves are [`Method`]).
+fn method_help(method: Method) -> &'static str {
+    match method {
+        Method::Euler => "Explicit Euler, order 1, fixed step `--dt`",
+        Method::Midpoint => "Explicit midpoint, order 2, fixed step `--dt`",
+        Method::Rk4 => "Classical Runge–Kutta 4, fixed step `--dt`",
+        Method::Bs32 => "Bogacki–Shampine 3(2) (ode23), adaptive, Hermite dense output",
+        Method::Dp54 => "Dormand–Prince 5(4), adaptive, dense output (default)",
+        Method::Dop853 => {
+            "DOP853, Hairer's Dormand–Prince 8(5,3), adaptive, order-7 dense output"
+        }
+        Method::SymplecticEuler => {
+            "Symplectic Euler, order 1, fixed step `--dt` (symplectic for constant M and velocity-independent forces)"
+        }
+        Method::StormerVerlet => {
+            "Störmer–Verlet (leapfrog in q, q̇), order 2, fixed step `--dt` (symplectic for constant M and velocity-independent forces)"
+        }
+        Method::ImplicitMidpoint => {
+            "Implicit midpoint, order 2, fixed step `--dt`, Newton with the generated Jacobians (symplectic for any M(q))"
+        }
+        Method::Radau5 => {
+            "Radau IIA order 5 (RADAU5), adaptive, L-stable, Newton with the generated Jacobians"
         }
     }
+}
 
-    /// Whether the method controls its step by `--rtol`/`--atol` (otherwise it takes the
-    /// fixed step `--dt`).
-    pub(crate) fn is_adaptive(self) -> bool {
-        matches!(
-            self,
-            Method::Bs32 | Method::Dp54 | Method::Dop853 | Method::Radau5
-        )
-    }
+/// clap's parser of a method name (`--method`, `--methods`): the names of [`Method::ALL`]
+/// with their help, parsed by [`Method`]'s `FromStr`. Adaptive methods use
+/// `--rtol`/`--atol` (and `--dt` as their first step); fixed-step methods use `--dt`
+/// (default `t_end/1000`).
+pub(crate) fn method_parser() -> impl clap::builder::TypedValueParser<Value = Method> {
+    use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser as _};
+    PossibleValuesParser::new(
+        Method::ALL.map(|m| PossibleValue::new(m.name()).help(method_help(m))),
+    )
+    .try_map(|name| name.parse::<Method>())
 }
 
 /// Drift control of a constrained model (`--stabilization`).
@@ -125,7 +108,7 @@ pub struct IntegrationArgs {
     #[arg(long, default_value_t = 10.0)]
     pub t_end: f64,
     /// Integration method.
-    #[arg(long, value_enum, default_value_t = Method::Dp54)]
+    #[arg(long, value_parser = method_parser(), default_value_t = Method::Dp54)]
     pub method: Method,
     /// Relative tolerance (adaptive methods: bs32, dp54, dop853, radau5).
     #[arg(long, default_value_t = 1e-8)]
@@ -220,21 +203,21 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
     } else {
         OutputTimes::At(times)
     };
-    let Run {
-        mut model,
-        y0,
+    let (model, simulation) = simulation(&args.model, &args.run, output)?;
+    let Simulation {
         solution,
+        energy: report,
+        constraints,
         failure,
-        method_name,
-    } = integrate(&args.model, &args.run, output)?;
+        integrator: method_name,
+        ..
+    } = simulation;
     let n = model.num_dofs();
     let coordinates: Vec<String> = model
         .coordinate_names()
         .iter()
         .map(|s| s.to_string())
         .collect();
-    let report = Report::new(model.as_ref(), &y0, &solution);
-    let constraints = ConstraintReport::new(model.as_mut(), &solution);
     if let Some(path) = &args.csv {
         write_csv(path, model.as_ref(), &solution, &report, &constraints)?;
         if !solution.events.is_empty() {
@@ -243,10 +226,9 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
     }
     if let Some(path) = &args.plot {
         plot::time_histories(path, model.as_ref(), &solution).map_err(CliError::failure)?;
-        if !constraints.names.is_empty() {
+        if !constraints.is_empty() {
             let drift_path = sibling(path, "drift");
-            constraints
-                .plot(&drift_path, model.name(), &solution)
+            plot::constraint_drift(&drift_path, model.name(), &solution.t, &constraints.drift)
                 .map_err(CliError::failure)?;
         }
     }
@@ -259,7 +241,7 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
             model.name(),
             &solution.t,
             &report.energy,
-            report.initial,
+            report.initial_energy,
         )
         .map_err(CliError::failure)?;
     }
@@ -270,8 +252,8 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
             .enumerate()
             .map(|(k, ((t, y), e))| {
                 let mut sample = json!({"t": t, "q": &y[..n], "qdot": &y[n..], "energy": e});
-                if !constraints.names.is_empty() {
-                    sample["constraint_forces"] = json!(constraints.forces[k]);
+                if !constraints.is_empty() {
+                    sample["constraint_forces"] = json!(constraints.lagrange_multipliers[k]);
                     sample["constraint_drift"] =
                         json!({"position": constraints.drift[k].0, "velocity": constraints.drift[k].1});
                 }
@@ -286,7 +268,7 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
             "rtol": args.run.rtol,
             "atol": args.run.atol,
             "samples": samples,
-            "initial_energy": report.initial,
+            "initial_energy": report.initial_energy,
             "energy_drift": report.drift,
             "conservative": model.is_conservative(),
             "stats": {
@@ -301,8 +283,8 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
         if args.timing {
             out["stats"]["wall_time_s"] = json!(solution.stats.wall_time_s);
         }
-        if !constraints.names.is_empty() {
-            out["constraints"] = json!(constraints.names);
+        if !constraints.is_empty() {
+            out["constraints"] = json!(constraints.constraint_names);
             out["stabilization"] = json!(format!("{:?}", args.run.stabilization).to_lowercase());
             out["max_constraint_drift"] = json!({
                 "position": constraints.max_drift().0,
@@ -342,7 +324,7 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
         let _ = writeln!(stdout, "{text}");
     } else {
         print_summary(model.as_ref(), method_name, &args.run, &solution, &report);
-        constraints.print_summary(args.run.stabilization);
+        print_constraint_summary(&constraints, args.run.stabilization);
         print_events(model.as_ref(), &solution);
     }
     match failure {
@@ -359,98 +341,120 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
     }
 }
 
-/// Integrates `model_name` (a bundled model) with `args` from its initial state (with
-/// `--set` and `--init` applied and made consistent with the constraints), sampling at
-/// `output`: the shared start of `simulate` and `animate`.
+impl IntegrationArgs {
+    /// The library's options of these arguments, sampled at `output`, from the initial state
+    /// `y0`.
+    fn simulation_options(&self, output: OutputTimes, y0: Vec<f64>) -> SimulationOptions {
+        SimulationOptions {
+            method: self.method,
+            t_end: self.t_end,
+            rtol: self.rtol,
+            atol: self.atol,
+            dt: self.dt,
+            output,
+            stabilization: match self.stabilization {
+                StabilizationArg::None => Stabilization::None,
+                StabilizationArg::Baumgarte => Stabilization::Baumgarte {
+                    alpha: self.baumgarte[0],
+                    beta: self.baumgarte[1],
+                },
+                StabilizationArg::Projection => Stabilization::Projection,
+            },
+            initial_state: Some(y0),
+        }
+    }
+}
+
+/// Simulates `model_name` (a bundled model or a model file) with `args`: `--set` and
+/// `--init` applied, the events of `--stop-when` and `--event` added, then one call of
+/// [`simulate_with_events`].
 ///
 /// # Errors
 /// A usage error for an unknown model, parameter, coordinate or event, or a `--t-end` that
 /// is not a positive number; a failure when no consistent initial state exists. A failed
-/// integration is not an error here: it is [`Run::failure`], with the samples computed
-/// before it (report it with [`failure_error`]).
+/// integration is not an error here: it is [`Simulation::failure`], with the samples
+/// computed before it.
+fn simulation(
+    model_name: &str,
+    args: &IntegrationArgs,
+    output: OutputTimes,
+) -> Result<(Box<dyn ModelInfo>, Simulation), CliError> {
+    let mut model = find_model(model_name)?;
+    set_parameters(model.as_mut(), &args.set)?;
+    let mut y0 = model.initial_state();
+    set_initial_values(model.as_ref(), &mut y0, &args.init).map_err(usage)?;
+    let mut added = ExpressionEvents::parse(model.as_mut(), &args.stop_when, &args.event)
+        .map_err(usage)?;
+    let options = args.simulation_options(output, y0);
+    let added: Option<&mut dyn AddedEvents> = if added.is_empty() {
+        None
+    } else {
+        Some(&mut added)
+    };
+    let simulation =
+        simulate_with_events(model.as_mut(), &options, added).map_err(simulation_error)?;
+    Ok((model, simulation))
+}
+
+/// A simulation that could not start, as the CLI reports it.
+pub(crate) fn simulation_error(error: SimulationError) -> CliError {
+    match error {
+        SimulationError::InvalidEndTime { t_end } => CliError::usage(format!(
+            "--t-end must be a positive number of seconds, got {t_end}"
+        )),
+        SimulationError::InconsistentInitialState {
+            model,
+            constraint,
+            residual,
+            iterations,
+            has_guesses,
+        } => CliError::failure(inconsistent_message(
+            &model,
+            &constraint,
+            residual,
+            iterations,
+            has_guesses,
+        )),
+        other => CliError::usage(other.to_string()),
+    }
+}
+
+/// What to say when no consistent initial state was found.
+fn inconsistent_message(
+    model: &str,
+    constraint: &str,
+    residual: f64,
+    iterations: usize,
+    has_guesses: bool,
+) -> String {
+    if has_guesses {
+        format!(
+            "no consistent initial state for `{model}`: constraint `{constraint}` keeps a residual of {residual:.3e} after {iterations} Newton iteration(s) from the guesses; try other guesses"
+        )
+    } else {
+        format!(
+            "the initial state of `{model}` violates its constraints: `{constraint}` has a residual of {residual:.3e}; mark the dependent coordinates as `{{ guess: … }}` in `initial:` or fix the values"
+        )
+    }
+}
+
+/// Integrates `model_name` with `args` as `simulate` does (see [`simulation`]), sampled at
+/// `output`: the shared start of `simulate`, `animate` and `report`.
+///
+/// # Errors
+/// As [`simulation`]; report a failed integration with [`failure_error`].
 pub(crate) fn integrate(
     model_name: &str,
     args: &IntegrationArgs,
     output: OutputTimes,
 ) -> Result<Run, CliError> {
-    let mut model = find_model(model_name)?;
-    set_parameters(model.as_mut(), &args.set)?;
-    let n = model.num_dofs();
-    let coordinates: Vec<String> = model
-        .coordinate_names()
-        .iter()
-        .map(|s| s.to_string())
-        .collect();
-    let mut y0 = model.initial_state();
-    for s in &args.init {
-        let (name, text) = split_assignment(s, "--init")?;
-        let value = evaluate(
-            text,
-            &format!("--init {name}"),
-            &parameter_lookup(model.as_ref()),
-        )?;
-        let index = coordinates
-            .iter()
-            .position(|c| *c == name)
-            .or_else(|| coordinates.iter().position(|c| name.strip_suffix("_dot") == Some(c)).map(|i| n + i))
-            .ok_or_else(|| {
-                let rates: Vec<String> = coordinates.iter().map(|c| format!("{c}_dot")).collect();
-                CliError::usage(format!(
-                    "--init {name}: `{}` has no coordinate or rate `{name}` (coordinates: {}; rates: {})",
-                    model.name(),
-                    coordinates.join(", "),
-                    rates.join(", ")
-                ))
-            })?;
-        y0[index] = value;
-    }
-    consistent_initial_state(model.as_mut(), &mut y0)?;
-    let stabilization = match args.stabilization {
-        StabilizationArg::None => Stabilization::None,
-        StabilizationArg::Baumgarte => Stabilization::Baumgarte {
-            alpha: args.baumgarte[0],
-            beta: args.baumgarte[1],
-        },
-        StabilizationArg::Projection => Stabilization::Projection,
-    };
-    model.set_stabilization(stabilization);
-    if !(args.t_end.is_finite() && args.t_end > 0.0) {
-        return Err(CliError::usage(format!(
-            "--t-end must be a positive number of seconds, got {}",
-            args.t_end
-        )));
-    }
-    let mut options = IntegratorOptions::default()
-        .with_rtol(args.rtol)
-        .with_atol(args.atol);
-    if let Some(dt) = args.dt {
-        options = options.with_dt(dt);
-    }
-    let mut integrator = args.method.integrator();
-    let mut added = CliEvents::parse(model.as_mut(), &args.stop_when, &args.event)?;
-    let result = if added.is_empty() {
-        integrator.integrate(model.as_ode_mut(), 0.0, &y0, args.t_end, &output, &options)
-    } else {
-        let specs = added.specs();
-        let mut system = WithEvents::new(
-            model.as_mut(),
-            specs,
-            |m: &mut (dyn ModelInfo + 'static), t: f64, y: &[f64], g: &mut [f64]| {
-                added.values(m, t, y, g)
-            },
-        );
-        integrator.integrate(&mut system, 0.0, &y0, args.t_end, &output, &options)
-    };
-    let (solution, failure) = match result {
-        Ok(s) => (s, None),
-        Err(IntegrationFailure { error, partial }) => (*partial, Some(error)),
-    };
+    let (model, simulation) = simulation(model_name, args, output)?;
     Ok(Run {
         model,
-        y0,
-        solution,
-        failure,
-        method_name: integrator.name(),
+        y0: simulation.initial_state,
+        solution: simulation.solution,
+        failure: simulation.failure,
+        method_name: simulation.integrator,
     })
 }
 
@@ -470,7 +474,7 @@ pub(crate) fn failure_error(
 
 /// What to try after a failed integration (issue 8, item 3), by the reason and the method.
 fn failure_hint(error: &IntegrationError, method: Method) -> &'static str {
-    let explicit = !matches!(method, Method::Radau5 | Method::ImplicitMidpoint);
+    let explicit = !method.is_implicit();
     let adaptive = method.is_adaptive();
     match error {
         IntegrationError::StepSizeTooSmall { .. } | IntegrationError::TooManySteps { .. }
@@ -510,46 +514,12 @@ fn failure_hint(error: &IntegrationError, method: Method) -> &'static str {
     }
 }
 
-/// Energy per sample and the drift `max |E − E(0)| / E_scale`, with
-/// `E_scale = max (T + |V|)` over the initial state and the samples (so a zero initial energy still gives a
-/// meaningful relative figure).
-pub(crate) struct Report {
-    pub(crate) energy: Vec<f64>,
-    pub(crate) initial: f64,
-    pub(crate) drift: Option<f64>,
-}
-
-impl Report {
-    pub(crate) fn new(model: &dyn ModelInfo, y0: &[f64], solution: &Solution) -> Self {
-        let mut energy = Vec::with_capacity(solution.len());
-        let initial = model.energy(0.0, y0);
-        let mut scale: f64 = model.kinetic_energy(0.0, y0) + model.potential_energy(0.0, y0).abs();
-        for (t, y) in solution.iter() {
-            let (tk, v) = (model.kinetic_energy(t, y), model.potential_energy(t, y));
-            energy.push(tk + v);
-            scale = scale.max(tk + v.abs());
-        }
-        let drift = (!energy.is_empty()).then(|| {
-            let dev = energy
-                .iter()
-                .map(|e| (e - initial).abs())
-                .fold(0.0, f64::max);
-            if scale > 0.0 { dev / scale } else { dev }
-        });
-        Self {
-            energy,
-            initial,
-            drift,
-        }
-    }
-}
-
 fn print_summary(
     model: &dyn ModelInfo,
     method: &str,
     args: &IntegrationArgs,
     solution: &Solution,
-    report: &Report,
+    report: &EnergyDrift,
 ) {
     println!(
         "model      {} ({} dof): {}",
@@ -571,7 +541,7 @@ fn print_summary(
             );
         }
     }
-    if let (e0, Some(e1)) = (report.initial, report.energy.last()) {
+    if let (e0, Some(e1)) = (report.initial_energy, report.energy.last()) {
         println!("energy     E(0) = {e0:.12e} J, E(end) = {e1:.12e} J");
         if let Some(d) = report.drift {
             let note = if model.is_conservative() {
@@ -604,8 +574,8 @@ fn write_csv(
     path: &str,
     model: &dyn ModelInfo,
     solution: &Solution,
-    report: &Report,
-    constraints: &ConstraintReport,
+    report: &EnergyDrift,
+    constraints: &ConstraintDrift,
 ) -> Result<(), CliError> {
     let mut out = String::from("t");
     for c in model.coordinate_names() {
@@ -616,10 +586,10 @@ fn write_csv(
         out.push_str(&format!(",{c}_dot"));
     }
     out.push_str(",energy");
-    for c in &constraints.names {
+    for c in &constraints.constraint_names {
         out.push_str(&format!(",lambda_{c}"));
     }
-    if !constraints.names.is_empty() {
+    if !constraints.is_empty() {
         out.push_str(",drift_position,drift_velocity");
     }
     out.push('\n');
@@ -629,11 +599,11 @@ fn write_csv(
             out.push_str(&format!(",{v:e}"));
         }
         out.push_str(&format!(",{e:e}"));
-        if !constraints.names.is_empty() {
+        if !constraints.is_empty() {
             // A state where λ cannot be solved (singular KKT matrix) leaves empty cells.
-            match &constraints.forces[k] {
+            match &constraints.lagrange_multipliers[k] {
                 Some(forces) => forces.iter().for_each(|l| out.push_str(&format!(",{l:e}"))),
-                None => out.push_str(&",".repeat(constraints.names.len())),
+                None => out.push_str(&",".repeat(constraints.constraint_names.len())),
             }
             let (p, v) = constraints.drift[k];
             out.push_str(&format!(",{p:e},{v:e}"));
@@ -734,93 +704,23 @@ fn sibling(path: &str, tag: &str) -> String {
     }
 }
 
-/// Makes the initial state consistent with the constraints (issue 5, item 3): the
-/// coordinates marked `{ guess: … }` in the model file, and their rates, are solved by
-/// Newton from `Φ(q, 0) = 0` and the velocity constraints; without guesses the state must
-/// already satisfy them to 1e-9.
-///
-/// # Errors
-/// A failure naming the constraint with the largest residual.
-pub(crate) fn consistent_initial_state(
-    model: &mut dyn ModelInfo,
-    y0: &mut [f64],
-) -> Result<(), CliError> {
-    model.make_consistent(y0).map_err(|e| {
-        let name = model.constraint_names().get(e.constraint).copied().unwrap_or("?");
-        CliError::failure(if model.initial_guesses().is_empty() {
-            format!(
-                "the initial state of `{}` violates its constraints: `{name}` has a residual of {:.3e}; mark the dependent coordinates as `{{ guess: … }}` in `initial:` or fix the values",
-                model.name(),
-                e.residual
-            )
-        } else {
-            format!(
-                "no consistent initial state for `{}`: constraint `{name}` keeps a residual of {:.3e} after {} Newton iteration(s) from the guesses; try other guesses",
-                model.name(),
-                e.residual,
-                e.iterations
-            )
-        })
-    })
-}
-
-/// Constraint forces `λ` and drift at every sample of a constrained model.
-struct ConstraintReport {
-    names: Vec<String>,
-    /// `λ` per sample; `None` where the constrained system is singular (JSON `null`).
-    forces: Vec<Option<Vec<f64>>>,
-    drift: Vec<(f64, f64)>,
-}
-
-impl ConstraintReport {
-    fn new(model: &mut dyn ModelInfo, solution: &Solution) -> Self {
-        let names: Vec<String> = model
-            .constraint_names()
+/// The constraint forces at the end and the largest drift, under `stabilization`.
+fn print_constraint_summary(constraints: &ConstraintDrift, stabilization: StabilizationArg) {
+    if constraints.is_empty() {
+        return;
+    }
+    if let Some(Some(last)) = constraints.lagrange_multipliers.last() {
+        let forces: Vec<String> = constraints
+            .constraint_names
             .iter()
-            .map(|s| s.to_string())
+            .zip(last)
+            .map(|(n, l)| format!("{n} = {l:.9e}"))
             .collect();
-        let mut forces = Vec::new();
-        let mut drift = Vec::new();
-        if !names.is_empty() {
-            for (t, y) in solution.iter() {
-                forces.push(model.constraint_forces(t, y).ok());
-                drift.push(model.constraint_drift(t, y));
-            }
-        }
-        Self {
-            names,
-            forces,
-            drift,
-        }
+        println!("lambda     at the end: {}", forces.join(", "));
     }
-
-    fn max_drift(&self) -> (f64, f64) {
-        self.drift
-            .iter()
-            .fold((0.0f64, 0.0f64), |(a, b), (p, v)| (a.max(*p), b.max(*v)))
-    }
-
-    fn print_summary(&self, stabilization: StabilizationArg) {
-        if self.names.is_empty() {
-            return;
-        }
-        if let Some(Some(last)) = self.forces.last() {
-            let forces: Vec<String> = self
-                .names
-                .iter()
-                .zip(last)
-                .map(|(n, l)| format!("{n} = {l:.9e}"))
-                .collect();
-            println!("lambda     at the end: {}", forces.join(", "));
-        }
-        let (p, v) = self.max_drift();
-        println!(
-            "drift      constraints ({}): max |Φ| = {p:.3e}, max |Φ̇| = {v:.3e}",
-            format!("{stabilization:?}").to_lowercase()
-        );
-    }
-
-    fn plot(&self, path: &str, model: &str, solution: &Solution) -> Result<(), String> {
-        plot::constraint_drift(path, model, &solution.t, &self.drift)
-    }
+    let (p, v) = constraints.max_drift();
+    println!(
+        "drift      constraints ({}): max |Φ| = {p:.3e}, max |Φ̇| = {v:.3e}",
+        format!("{stabilization:?}").to_lowercase()
+    );
 }

@@ -11,22 +11,16 @@
 //! d. A step-size underflow (`ẏ = y²` blows up at `t = 1`), reported as the integration
 //!    reports it.
 
-use std::f64::consts::PI;
 use std::io::Write as _;
 
 use clap::Args;
-use eomgen::integrate::stability::{
-    GrowthTest, StabilityPolynomial, TestEquation, amplification, explicit_tableau_methods,
-    implicit_midpoint_stability, measured_limit, partitioned_oscillator_growth_limit,
-    partitioned_oscillator_spectral_radius, radau_iia5_stability,
+use eomgen::analysis::stability::{
+    AMPLIFICATION_STEPS, BISECTION_TOLERANCE, EnergyRow, ExplicitMethod, GROWTH_THRESHOLD,
+    Limits, STIFF_OUTPUT_TIMES, STIFF_REFERENCE_TOL, StabilityError, StabilityOptions,
+    StabilityStudy, StiffMode, StiffRow, UnderflowRun, stability_study,
 };
-use eomgen::{
-    BogackiShampine32, DormandPrince54, DormandPrince853, ExplicitEuler, ImplicitMidpoint,
-    IntegrationFailure, Integrator, IntegratorOptions, OdeFn, OutputTimes, RadauIIA5, RungeKutta4,
-    Solution, StormerVerlet, SymplecticEuler, Tableau,
-};
+use eomgen::integrate::stability::GrowthTest;
 use nalgebra::Complex;
-use serde::Serialize;
 use serde_json::json;
 
 use super::{CliError, find_model, plot};
@@ -58,196 +52,46 @@ pub struct StabilityArgs {
     pub plot: Option<String>,
 }
 
-/// Growth of `‖y‖` that counts as unstable in the bisection: far above the bounded transient
-/// of a stable non-normal step (symplectic Euler: `1/√(1 − hω/2)`, 100 at 10⁻⁴ below its
-/// limit).
-const GROWTH_THRESHOLD: f64 = 1e4;
-/// Relative width of the final bisection bracket.
-const BISECTION_TOLERANCE: f64 = 1e-6;
-/// `hω` at which the per-step amplification of the methods with an empty imaginary interval
-/// is measured.
-const EMPTY_INTERVAL_STEPS: [f64; 4] = [0.1, 0.5, 1.0, 2.0];
-/// Multiples of the imaginary limit at which a method too weakly unstable beyond it for the
-/// bisection's `N` (Dormand–Prince 5(4)) is shown by its amplification.
-const WEAK_INSTABILITY_FACTORS: [f64; 4] = [1.01, 1.2, 1.5, 2.0];
-/// `hω` at which the A-stable methods are run.
-const A_STABLE_STEPS: [f64; 3] = [10.0, 100.0, 1000.0];
-/// Steps of each amplification run (`N` in `(‖y_N‖/‖y₀‖)^(1/N)`): few enough that Radau
-/// IIA's amplitude (`≈ (3/hω)ᴺ`) stays above the `atol` of 1e-14 of its Newton iterations.
-const AMPLIFICATION_STEPS: usize = 3;
-/// Steps of the long run that shows the A-stable methods stable.
-const LONG_RUN_STEPS: usize = 1000;
-/// Steps per period in the energy study.
-const STEPS_PER_PERIOD: usize = 32;
-/// Number of output times of the stiff runs (uniform in `(0, t_end]`).
-const STIFF_OUTPUT_TIMES: usize = 100;
-/// Tolerance of the DOP853 reference of the stiff runs.
-const STIFF_REFERENCE_TOL: f64 = 1e-12;
-
-/// A stability interval, measured and in theory (part a).
-#[derive(Debug, Serialize)]
-struct LimitRow {
-    method: &'static str,
-    /// `"imaginary"` (`hω` on `ẍ = −ω²x`) or `"real"` (`hλ` on `ẋ = −λx`).
-    axis: &'static str,
-    theory: f64,
-    measured: Option<f64>,
-    relative_difference: Option<f64>,
-    /// The limit a run of `steps_used` steps can see: the first `h` where the per-step growth
-    /// exceeds the smallest detected one (theory, for this `N`).
-    theory_at_detection: f64,
-    relative_difference_at_detection: Option<f64>,
-    /// Per-step growth `|R| − 1` one percent above the theoretical limit.
-    growth_one_percent_above: f64,
-    /// Steps needed to see that growth exceed the threshold.
-    steps_needed_one_percent_above: usize,
-    steps_used: usize,
-}
-
-/// A measured per-step amplification against `|R(ihω)|` (part a).
-#[derive(Debug, Serialize)]
-struct AmplificationRow {
-    method: &'static str,
-    h_omega: f64,
-    steps: usize,
-    measured: f64,
-    theory: f64,
-    relative_difference: f64,
-    /// `‖y‖` after 1000 steps, from 1 (A-stable methods only).
-    norm_after_long_run: Option<f64>,
-}
-
-/// Where an integration stopped early: the error as reported, its time, and the time of the
-/// last sample recorded before it.
-#[derive(Debug, Serialize)]
-struct Failure {
-    error: String,
-    t: Option<f64>,
-    last_sample_t: Option<f64>,
-}
-
-impl Failure {
-    fn of(failure: &IntegrationFailure) -> Self {
-        Self {
-            error: failure.error.to_string(),
-            t: failure.error.t(),
-            last_sample_t: failure.partial.last().map(|(t, _)| t),
+/// A study that could not run, as the CLI reports it (naming the options to change).
+fn study_error(error: StabilityError) -> CliError {
+    match error {
+        StabilityError::InvalidSteps { .. } => CliError::usage("--steps must be in [100, 10⁷]"),
+        StabilityError::InvalidPeriods { .. } => {
+            CliError::usage("--periods must be in [1, 10⁶]")
         }
+        StabilityError::InvalidStiffness => {
+            CliError::usage("--stiffness takes ratios k/m in (0, 1e10], comma separated")
+        }
+        StabilityError::InvalidEndTime { .. } => CliError::usage("--t-end must be in (0, 100] s"),
+        StabilityError::InvalidTolerance { .. } => CliError::usage("--tol must be in [1e-13, 1)"),
+        other => CliError::failure(other.to_string()),
     }
 }
 
-/// The energy of one run over many periods (part b).
-#[derive(Debug, Serialize)]
-struct EnergyRow {
-    method: &'static str,
-    h: f64,
-    steps_per_period: usize,
-    /// Periods reached (fewer than asked if the run failed).
-    periods_reached: f64,
-    /// `E/E₀` at the last sample (`None` if it overflows a double).
-    final_energy_ratio: Option<f64>,
-    /// `log₁₀(E/E₀)` at the last sample.
-    log10_final_energy_ratio: f64,
-    /// `log₁₀(E/E₀)` the stability function predicts there: `2n log₁₀|R(ih)|` after `n`
-    /// steps (Runge–Kutta methods).
-    theory_log10_final_energy_ratio: Option<f64>,
-    /// Largest `|E/E₀ − 1|` over the samples (`None` if it overflows).
-    max_energy_error: Option<f64>,
-    /// The modified-energy bound on it (Störmer–Verlet: `(h²/4)/(1 − h²/4)`).
-    theory_max_energy_error: Option<f64>,
-    failure: Option<Failure>,
-    #[serde(skip)]
-    history: Vec<(f64, f64)>,
-}
-
-/// One method on the stiff spring at one `k/m` (part c).
-#[derive(Debug, Serialize)]
-struct StiffRow {
-    k_over_m: f64,
-    /// `"equilibrium"` (spring pre-stretched by the step force's static share: the stiff
-    /// mode is not excited) or `"rest"` (the model's initial state, spring at rest length).
-    start: &'static str,
-    method: &'static str,
-    steps: usize,
-    rejected: usize,
-    rhs_evals: usize,
-    jacobian_evals: usize,
-    lu_decompositions: usize,
-    /// Largest position error (m) at the output times against the reference.
-    position_error: Option<f64>,
-    /// Largest velocity error (m/s) at the output times against the reference.
-    velocity_error: Option<f64>,
-    failure: Option<Failure>,
-}
-
-/// The stiff mode at one `k/m` (part c).
-#[derive(Debug, Serialize)]
-struct StiffMode {
-    k_over_m: f64,
-    start: &'static str,
-    /// Its angular frequency `ω = √(k (m₁ + m₂)/(m₁ m₂))` (rad/s).
-    omega: f64,
-    /// Largest amplitude of a mass's oscillation about the slow motion (m): from rest with
-    /// the spring at rest length, the static stretch `F₀ m₁/(k (m₁ + m₂))` times
-    /// `max(m₁, m₂)/(m₁ + m₂)`; 0 from the equilibrium start.
-    position_amplitude: f64,
-    /// Its velocity amplitude `ω ·` that (m/s).
-    velocity_amplitude: f64,
-    reference_steps: usize,
-}
-
-/// The runs of part d.
-#[derive(Debug, Serialize)]
-struct UnderflowRun {
-    problem: &'static str,
-    method: &'static str,
-    t_end: f64,
-    tol: f64,
-    failure: Option<Failure>,
-}
-
-fn usage_checks(args: &StabilityArgs) -> Result<(), CliError> {
-    if !(100..=10_000_000).contains(&args.steps) {
-        return Err(CliError::usage("--steps must be in [100, 10⁷]"));
-    }
-    if !(1..=1_000_000).contains(&args.periods) {
-        return Err(CliError::usage("--periods must be in [1, 10⁶]"));
-    }
-    if args.stiffness.is_empty()
-        || args
-            .stiffness
-            .iter()
-            .any(|k| !(k.is_finite() && *k > 0.0 && *k <= 1e10))
-    {
-        return Err(CliError::usage(
-            "--stiffness takes ratios k/m in (0, 1e10], comma separated",
-        ));
-    }
-    if !(args.t_end.is_finite() && args.t_end > 0.0 && args.t_end <= 100.0) {
-        return Err(CliError::usage("--t-end must be in (0, 100] s"));
-    }
-    if !(args.tol.is_finite() && args.tol >= 1e-13 && args.tol < 1.0) {
-        return Err(CliError::usage("--tol must be in [1e-13, 1)"));
-    }
+/// Runs `eomgen study stability`.
+pub fn run(args: &StabilityArgs) -> Result<(), CliError> {
+    let options = StabilityOptions {
+        steps: args.steps,
+        periods: args.periods,
+        stiffness: args.stiffness.clone(),
+        t_end: args.t_end,
+        tol: args.tol,
+    };
+    options.validate().map_err(study_error)?;
     if let Some(prefix) = &args.plot
         && prefix.is_empty()
     {
         return Err(CliError::usage("--plot needs a file prefix"));
     }
-    Ok(())
-}
-
-/// Runs `eomgen study stability`.
-pub fn run(args: &StabilityArgs) -> Result<(), CliError> {
-    usage_checks(args)?;
-    let test = GrowthTest {
-        steps: args.steps,
-        threshold: GROWTH_THRESHOLD,
-    };
-    let mut limits = stability_limits(&test)?;
-    let energy = energy_runs(args.periods);
-    let (modes, stiff) = stiff_runs(args)?;
-    let underflow = underflow_run(args.tol);
+    let mut two_masses = find_model("two_masses")?;
+    let StabilityStudy {
+        test,
+        mut limits,
+        energy,
+        stiff_modes: modes,
+        stiff,
+        underflow,
+    } = stability_study(two_masses.as_mut(), &options).map_err(study_error)?;
 
     if let Some(prefix) = &args.plot {
         plot_limits(&chart_path(prefix, "limits"), &mut limits.explicit)?;
@@ -263,12 +107,7 @@ pub fn run(args: &StabilityArgs) -> Result<(), CliError> {
                 "bisection_tolerance": BISECTION_TOLERANCE,
                 "rows": limits.rows,
                 "amplification": limits.amplification,
-                "polynomials": limits.explicit.iter().map(|m| json!({
-                    "method": m.name,
-                    "coefficients": m.polynomial.coefficients(),
-                    "order": m.polynomial.order(),
-                    "implementation_difference": m.implementation_difference,
-                })).collect::<Vec<_>>(),
+                "polynomials": limits.polynomials,
             },
             "energy": {"periods": args.periods, "runs": energy},
             "stiff": {
@@ -327,447 +166,6 @@ pub(super) fn print_json(value: &serde_json::Value) -> Result<(), CliError> {
     let text = serde_json::to_string_pretty(value).map_err(|e| CliError::failure(e.to_string()))?;
     let _ = writeln!(std::io::stdout().lock(), "{text}");
     Ok(())
-}
-
-/// A stability function `R(z)`.
-type StabilityFunction = fn(Complex<f64>) -> Complex<f64>;
-
-/// An explicit method with its stability polynomial.
-struct ExplicitMethod {
-    name: &'static str,
-    method: Box<dyn Integrator>,
-    polynomial: StabilityPolynomial,
-    /// Largest difference between the coefficients from the tableau and those read off one
-    /// step of the implementation (`None` for DOP853, whose polynomial is the latter).
-    implementation_difference: Option<f64>,
-}
-
-/// The explicit methods, their polynomials from their tableaus (DOP853's from one step of it,
-/// its tableau being private), each checked against one step of its implementation.
-fn explicit_methods() -> Result<Vec<ExplicitMethod>, CliError> {
-    let failed =
-        |e: IntegrationFailure| CliError::failure(format!("a polynomial step failed: {e}"));
-    let mut methods = Vec::new();
-    for (tableau, mut method) in explicit_tableau_methods() {
-        let polynomial = StabilityPolynomial::of_tableau(&tableau);
-        let stepped = StabilityPolynomial::of_method(method.as_mut(), tableau.num_stages())
-            .map_err(failed)?;
-        let difference = polynomial
-            .coefficients()
-            .iter()
-            .zip(stepped.coefficients())
-            .map(|(a, b)| (a - b).abs())
-            .fold(0.0, f64::max);
-        methods.push(ExplicitMethod {
-            name: method.name(),
-            method,
-            polynomial,
-            implementation_difference: Some(difference),
-        });
-    }
-    let mut dop853: Box<dyn Integrator> = Box::new(DormandPrince853::new());
-    let polynomial = StabilityPolynomial::of_method(dop853.as_mut(), 12).map_err(failed)?;
-    methods.push(ExplicitMethod {
-        name: dop853.name(),
-        method: dop853,
-        polynomial,
-        implementation_difference: None,
-    });
-    Ok(methods)
-}
-
-/// Everything part a measures.
-struct Limits {
-    explicit: Vec<ExplicitMethod>,
-    rows: Vec<LimitRow>,
-    amplification: Vec<AmplificationRow>,
-}
-
-/// The theoretical limits of one method on one axis: strict (`|R| ≤ 1`), at the test's
-/// detection threshold, and the per-step growth one percent above the strict limit.
-struct Theory {
-    limit: f64,
-    at_detection: f64,
-    growth_one_percent_above: f64,
-}
-
-fn limit_row(
-    method: &mut dyn Integrator,
-    axis: &'static str,
-    theory: Theory,
-    test: &GrowthTest,
-) -> Result<LimitRow, CliError> {
-    let Theory {
-        limit: theory,
-        at_detection,
-        growth_one_percent_above: growth,
-    } = theory;
-    let equation = if axis == "real" {
-        TestEquation::Decay
-    } else {
-        TestEquation::Oscillator
-    };
-    let measured = measured_limit(method, equation, test, BISECTION_TOLERANCE).map_err(|e| {
-        CliError::failure(format!(
-            "{} failed on the test equation: {e}",
-            method.name()
-        ))
-    })?;
-    Ok(LimitRow {
-        method: method.name(),
-        axis,
-        theory,
-        measured,
-        relative_difference: measured.map(|m| (m - theory) / theory),
-        theory_at_detection: at_detection,
-        relative_difference_at_detection: measured.map(|m| (m - at_detection) / at_detection),
-        growth_one_percent_above: growth,
-        steps_needed_one_percent_above: test.steps_to_detect(growth),
-        steps_used: test.steps,
-    })
-}
-
-fn amplification_row(
-    method: &mut dyn Integrator,
-    h_omega: f64,
-    theory: f64,
-    long_run: bool,
-) -> Result<AmplificationRow, CliError> {
-    let name = method.name();
-    let failed =
-        |e: IntegrationFailure| CliError::failure(format!("{name} at hω = {h_omega}: {e}"));
-    let measured = amplification(
-        method,
-        TestEquation::Oscillator,
-        h_omega,
-        AMPLIFICATION_STEPS,
-    )
-    .map_err(failed)?;
-    let norm_after_long_run = if long_run {
-        Some(
-            TestEquation::Oscillator
-                .final_norm(method, h_omega, LONG_RUN_STEPS)
-                .map_err(failed)?,
-        )
-    } else {
-        None
-    };
-    Ok(AmplificationRow {
-        norm_after_long_run,
-        method: name,
-        h_omega,
-        steps: AMPLIFICATION_STEPS,
-        measured,
-        theory,
-        relative_difference: (measured - theory) / theory,
-    })
-}
-
-fn stability_limits(test: &GrowthTest) -> Result<Limits, CliError> {
-    let mut explicit = explicit_methods()?;
-    let mut rows = Vec::new();
-    let mut amplification = Vec::new();
-    let detected = test.smallest_detected_growth();
-    for m in &mut explicit {
-        let r = &m.polynomial;
-        let imaginary = r.imaginary_axis_limit();
-        if imaginary == 0.0 {
-            for h in EMPTY_INTERVAL_STEPS {
-                let theory = r.eval(Complex::new(0.0, h)).norm();
-                amplification.push(amplification_row(m.method.as_mut(), h, theory, false)?);
-            }
-        } else {
-            let growth = r.eval(Complex::new(0.0, 1.01 * imaginary)).norm() - 1.0;
-            let theory = Theory {
-                limit: imaginary,
-                at_detection: r.imaginary_axis_growth_limit(detected),
-                growth_one_percent_above: growth,
-            };
-            rows.push(limit_row(m.method.as_mut(), "imaginary", theory, test)?);
-            if test.steps_to_detect(growth) > test.steps {
-                // Too weakly unstable just beyond the limit for N steps to see: show the
-                // growth there directly.
-                for factor in WEAK_INSTABILITY_FACTORS {
-                    let h = factor * imaginary;
-                    let theory = r.eval(Complex::new(0.0, h)).norm();
-                    amplification.push(amplification_row(m.method.as_mut(), h, theory, false)?);
-                }
-            }
-        }
-        let real = r.real_axis_limit();
-        let theory = Theory {
-            limit: real,
-            at_detection: r.real_axis_growth_limit(detected),
-            growth_one_percent_above: r.eval_real(-1.01 * real).abs() - 1.0,
-        };
-        rows.push(limit_row(m.method.as_mut(), "real", theory, test)?);
-    }
-    let partitioned: [Box<dyn Integrator>; 2] = [
-        Box::new(SymplecticEuler::new()),
-        Box::new(StormerVerlet::new()),
-    ];
-    for mut method in partitioned {
-        let theory = Theory {
-            limit: 2.0,
-            at_detection: partitioned_oscillator_growth_limit(detected),
-            growth_one_percent_above: partitioned_oscillator_spectral_radius(2.02) - 1.0,
-        };
-        rows.push(limit_row(method.as_mut(), "imaginary", theory, test)?);
-    }
-    let implicit: [(Box<dyn Integrator>, StabilityFunction); 2] = [
-        // Its default Newton tolerance (1e-12 relative) is below the rounding of h·F at
-        // h = 1000 (about 1000 ε), where Newton would report non-convergence.
-        (
-            Box::new(ImplicitMidpoint::new().with_newton_tolerance(1e-10)),
-            implicit_midpoint_stability,
-        ),
-        (Box::new(RadauIIA5::new()), radau_iia5_stability),
-    ];
-    for (mut method, stability) in implicit {
-        for h in A_STABLE_STEPS {
-            let theory = stability(Complex::new(0.0, h)).norm();
-            amplification.push(amplification_row(method.as_mut(), h, theory, true)?);
-        }
-    }
-    Ok(Limits {
-        explicit,
-        rows,
-        amplification,
-    })
-}
-
-/// `E/E₀ = x² + ẋ²` of the oscillator `ẍ = −x` started at `(1, 0)`.
-fn energy_ratio(y: &[f64]) -> f64 {
-    y[0] * y[0] + y[1] * y[1]
-}
-
-fn energy_runs(periods: usize) -> Vec<EnergyRow> {
-    let period = 2.0 * PI;
-    let t_end = periods as f64 * period;
-    // Explicit Euler a hundred times finer too, since with h = T/32 it overflows.
-    let fine = 100 * STEPS_PER_PERIOD;
-    let runs: [(Box<dyn Integrator>, usize); 4] = [
-        (Box::new(ExplicitEuler::new()), STEPS_PER_PERIOD),
-        (Box::new(ExplicitEuler::new()), fine),
-        (Box::new(RungeKutta4::new()), STEPS_PER_PERIOD),
-        (Box::new(StormerVerlet::new()), STEPS_PER_PERIOD),
-    ];
-    let rk4 = StabilityPolynomial::of_tableau(&Tableau::rk4());
-    let euler = StabilityPolynomial::of_tableau(&Tableau::euler());
-    runs.into_iter()
-        .map(|(mut method, steps_per_period)| {
-            let h_run = period / steps_per_period as f64;
-            let options = IntegratorOptions::default()
-                .with_dt(h_run)
-                .with_max_steps(periods * steps_per_period + 10);
-            // Every step of the coarse runs (the energy of Störmer–Verlet oscillates within a
-            // period); once per period for the fine run (3.2 · 10⁷ steps).
-            let output = if steps_per_period == STEPS_PER_PERIOD {
-                OutputTimes::Steps
-            } else {
-                OutputTimes::At((0..=periods).map(|k| k as f64 * period).collect())
-            };
-            let mut oscillator = OdeFn::second_order(1, |_t: f64, y: &[f64], dy: &mut [f64]| {
-                dy[0] = y[1];
-                dy[1] = -y[0];
-            });
-            let (solution, failure) =
-                match method.integrate(&mut oscillator, 0.0, &[1.0, 0.0], t_end, &output, &options)
-                {
-                    Ok(s) => (s, None),
-                    Err(f) => {
-                        let failure = Failure::of(&f);
-                        (*f.partial, Some(failure))
-                    }
-                };
-            energy_row(method.name(), h_run, &solution, failure, &rk4, &euler)
-        })
-        .collect()
-}
-
-fn energy_row(
-    method: &'static str,
-    h: f64,
-    solution: &Solution,
-    failure: Option<Failure>,
-    rk4: &StabilityPolynomial,
-    euler: &StabilityPolynomial,
-) -> EnergyRow {
-    let period = 2.0 * PI;
-    let steps_per_period = (period / h).round() as usize;
-    let (t_last, y_last) = solution.last().unwrap_or((0.0, &[1.0, 0.0][..]));
-    let steps_done = (t_last / h).round();
-    let log_amplitude = |r: &StabilityPolynomial| r.eval(Complex::new(0.0, h)).norm().log10();
-    let theory_log10_final_energy_ratio = match method {
-        "euler" => Some(2.0 * steps_done * log_amplitude(euler)),
-        "rk4" => Some(2.0 * steps_done * log_amplitude(rk4)),
-        _ => None,
-    };
-    let theory_max_energy_error =
-        (method == "stormer-verlet").then(|| (h * h / 4.0) / (1.0 - h * h / 4.0));
-    let max_energy_error = solution
-        .iter()
-        .map(|(_, y)| (energy_ratio(y) - 1.0).abs())
-        .fold(0.0, f64::max);
-    let stride = if solution.len() > 1 && solution.t[1] < 0.99 * period {
-        steps_per_period
-    } else {
-        1
-    };
-    // E/E₀ above 1e200 is left out of the chart (its axis padding would overflow).
-    let history = solution
-        .iter()
-        .step_by(stride)
-        .map(|(t, y)| (t / period, energy_ratio(y)))
-        .filter(|(_, e)| *e <= 1e200)
-        .collect();
-    let final_energy_ratio = energy_ratio(y_last);
-    EnergyRow {
-        method,
-        h,
-        steps_per_period,
-        periods_reached: t_last / period,
-        final_energy_ratio: final_energy_ratio.is_finite().then_some(final_energy_ratio),
-        log10_final_energy_ratio: 2.0 * y_last[0].hypot(y_last[1]).log10(),
-        theory_log10_final_energy_ratio,
-        max_energy_error: max_energy_error.is_finite().then_some(max_energy_error),
-        theory_max_energy_error,
-        failure,
-        history,
-    }
-}
-
-/// The stiff two-mass spring at every `k/m`: the mode's figures and every method's run.
-fn stiff_runs(args: &StabilityArgs) -> Result<(Vec<StiffMode>, Vec<StiffRow>), CliError> {
-    let times: Vec<f64> = (1..=STIFF_OUTPUT_TIMES)
-        .map(|i| args.t_end * i as f64 / STIFF_OUTPUT_TIMES as f64)
-        .collect();
-    let output = OutputTimes::At(times);
-    let mut modes = Vec::new();
-    let mut rows = Vec::new();
-    for &ratio in &args.stiffness {
-        let mut model = find_model("two_masses")?;
-        let parameter = |name: &str| {
-            model
-                .parameter_names()
-                .iter()
-                .position(|p| *p == name)
-                .map(|i| model.parameter_values()[i])
-                .ok_or_else(|| CliError::failure(format!("two_masses has no parameter `{name}`")))
-        };
-        let (m1, m2, force) = (parameter("m1")?, parameter("m2")?, parameter("F0")?);
-        model
-            .set_parameter("k", ratio * m1)
-            .map_err(|e| CliError::failure(e.to_string()))?;
-        let k = ratio * m1;
-        let omega = (k * (m1 + m2) / (m1 * m2)).sqrt();
-        let static_stretch = force * m1 / (k * (m1 + m2));
-        let x2 = model
-            .coordinate_names()
-            .iter()
-            .position(|c| *c == "x2")
-            .ok_or_else(|| CliError::failure("two_masses has no coordinate `x2`"))?;
-        for start in ["equilibrium", "rest"] {
-            let mut y0 = model.initial_state();
-            let position_amplitude = if start == "equilibrium" {
-                y0[x2] += static_stretch;
-                0.0
-            } else {
-                static_stretch * m1.max(m2) / (m1 + m2)
-            };
-            let run = |method: &mut dyn Integrator,
-                       model: &mut dyn eomgen::ModelInfo,
-                       tol: f64|
-             -> Result<Solution, IntegrationFailure> {
-                let options = IntegratorOptions::default()
-                    .with_rtol(tol)
-                    .with_atol(tol)
-                    .with_max_steps(20_000_000);
-                method.integrate(model.as_ode_mut(), 0.0, &y0, args.t_end, &output, &options)
-            };
-            let reference = run(
-                &mut DormandPrince853::new(),
-                model.as_mut(),
-                STIFF_REFERENCE_TOL,
-            )
-            .map_err(|e| {
-                CliError::failure(format!(
-                    "the DOP853 reference at k/m = {ratio:e} from {start} failed: {e}"
-                ))
-            })?;
-            modes.push(StiffMode {
-                k_over_m: ratio,
-                start,
-                omega,
-                position_amplitude,
-                velocity_amplitude: omega * position_amplitude,
-                reference_steps: reference.stats.steps,
-            });
-            let methods: [Box<dyn Integrator>; 4] = [
-                Box::new(BogackiShampine32::new()),
-                Box::new(DormandPrince54::new()),
-                Box::new(DormandPrince853::new()),
-                Box::new(RadauIIA5::new()),
-            ];
-            for mut method in methods {
-                let (solution, failure) = match run(method.as_mut(), model.as_mut(), args.tol) {
-                    Ok(s) => (s, None),
-                    Err(f) => {
-                        let failure = Failure::of(&f);
-                        (*f.partial, Some(failure))
-                    }
-                };
-                let error = |offset: usize| {
-                    failure.is_none().then(|| {
-                        solution
-                            .iter()
-                            .zip(reference.iter())
-                            .flat_map(|((_, y), (_, r))| {
-                                (offset..offset + 2).map(move |i| (y[i] - r[i]).abs())
-                            })
-                            .fold(0.0, f64::max)
-                    })
-                };
-                rows.push(StiffRow {
-                    k_over_m: ratio,
-                    start,
-                    method: method.name(),
-                    steps: solution.stats.steps,
-                    rejected: solution.stats.rejected,
-                    rhs_evals: solution.stats.rhs_evals,
-                    jacobian_evals: solution.stats.jacobian_evals,
-                    lu_decompositions: solution.stats.lu_decompositions,
-                    position_error: error(0),
-                    velocity_error: error(2),
-                    failure,
-                });
-            }
-        }
-    }
-    Ok((modes, rows))
-}
-
-/// `ẏ = y²`, `y(0) = 1` (`y = 1/(1 − t)`, infinite at `t = 1`) asked for on `[0, 2]` with
-/// Dormand–Prince 5(4): the step size must shrink to nothing at the singularity.
-fn underflow_run(tol: f64) -> UnderflowRun {
-    let mut blow_up = OdeFn::new(1, |_t: f64, y: &[f64], dy: &mut [f64]| dy[0] = y[0] * y[0]);
-    let options = IntegratorOptions::default().with_rtol(tol).with_atol(tol);
-    let mut method = DormandPrince54::new();
-    let result = method.integrate(
-        &mut blow_up,
-        0.0,
-        &[1.0],
-        2.0,
-        &OutputTimes::Steps,
-        &options,
-    );
-    UnderflowRun {
-        problem: "y' = y², y(0) = 1 on [0, 2] (y = 1/(1 − t) blows up at t = 1)",
-        method: method.name(),
-        t_end: 2.0,
-        tol,
-        failure: result.err().as_ref().map(Failure::of),
-    }
 }
 
 fn optional(value: Option<f64>) -> String {
@@ -1018,14 +416,8 @@ fn plot_limits(path: &str, methods: &mut [ExplicitMethod]) -> Result<(), CliErro
         });
     }
     for m in methods.iter_mut() {
-        let points = (1..=16)
-            .filter_map(|i| {
-                let h = 0.25 * i as f64;
-                amplification(m.method.as_mut(), TestEquation::Oscillator, h, 10)
-                    .ok()
-                    .map(|a| (h, a))
-            })
-            .collect();
+        let steps: Vec<f64> = (1..=16).map(|i| 0.25 * f64::from(i)).collect();
+        let points = m.measured_amplifications(&steps);
         series.push(plot::Series {
             name: format!("{} measured", m.name),
             points,

@@ -1,20 +1,17 @@
 //! `eomgen study …`: numerical experiments that compare methods on a model.
 //!
-//! `constraint-methods` (issue 5, item 6; lectures 8–11, HW10's "which one is faster? more
-//! accurate?"): the constraint of a model handled as a stiff spring (method I, several `k`),
-//! as a DAE without and with Baumgarte stabilisation (II.1), and in minimal coordinates (II.3)
-//! where the model has a minimal-coordinate twin, side by side.
+//! `constraint-methods` (issue 5, item 6; lectures 8–11, HW10): the study is
+//! [`eomgen::analysis::constraint_methods`]; the minimal twin is the one the model file names
+//! (`minimal_twin:`). This module renders the table, the JSON and the chart.
 
 use std::io::Write as _;
 
 use clap::{Args, Subcommand};
-use eomgen::{
-    DormandPrince54, IntegrationFailure, Integrator, IntegratorOptions, ModelInfo, OutputTimes,
-    Solution, Stabilization,
-};
+use eomgen::analysis::{ConstraintMethods, ConstraintMethodsError, ConstraintMethodsOptions};
+use eomgen::studies::minimal_twin;
 use serde_json::json;
 
-use super::{CliError, find_model, plot};
+use super::{CliError, plot};
 
 /// The studies.
 #[derive(Debug, Subcommand)]
@@ -80,213 +77,36 @@ pub fn run(study: &Study) -> Result<(), CliError> {
     }
 }
 
-/// The bundled model with the same mechanism in minimal coordinates, and how to map its
-/// state to this model's points (by point name).
-fn minimal_twin(model: &str) -> Option<&'static str> {
-    match model {
-        "simple_pendulum_cartesian" => Some("simple_pendulum"),
-        _ => None,
-    }
-}
-
-/// One method's run.
-struct Row {
-    method: String,
-    /// Largest distance (m) of any point from its reference position at the output times.
-    position_error: f64,
-    /// Largest `|Φ|` at the output times (`None` in minimal coordinates: no constraint).
-    drift: Option<f64>,
-    rhs_evals: usize,
-    steps: usize,
-    wall_time_s: f64,
-    error_history: Vec<(f64, f64)>,
-    failure: Option<String>,
-}
-
-fn integrate(
-    model: &mut dyn ModelInfo,
-    t_end: f64,
-    times: &[f64],
-    tol: f64,
-) -> (Solution, Option<String>) {
-    let options = IntegratorOptions::default()
-        .with_rtol(tol)
-        .with_atol(tol)
-        .with_max_steps(2_000_000);
-    let y0 = model.initial_state();
-    match DormandPrince54::new().integrate(
-        model.as_ode_mut(),
-        0.0,
-        &y0,
-        t_end,
-        &OutputTimes::At(times.to_vec()),
-        &options,
-    ) {
-        Ok(s) => (s, None),
-        Err(IntegrationFailure { error, partial }) => (*partial, Some(error.to_string())),
-    }
-}
-
-/// Positions of the points named in `names`, in that order, at every sample.
-fn positions(model: &dyn ModelInfo, solution: &Solution, names: &[&str]) -> Vec<Vec<[f64; 3]>> {
-    let own = model.point_names();
-    solution
-        .iter()
-        .map(|(t, y)| {
-            let all = model.point_positions(t, y);
-            names
-                .iter()
-                .map(|n| {
-                    own.iter()
-                        .position(|p| p == n)
-                        .map_or([f64::NAN; 3], |i| all[i])
-                })
-                .collect()
-        })
-        .collect()
-}
-
-fn row(
-    method: String,
-    model: &mut dyn ModelInfo,
-    solution: &Solution,
-    failure: Option<String>,
-    reference: &[Vec<[f64; 3]>],
-    names: &[&str],
-    constrained: bool,
-) -> Row {
-    let here = positions(model, solution, names);
-    let mut error_history = Vec::new();
-    let mut position_error: f64 = 0.0;
-    for ((t, p), r) in solution.t.iter().zip(&here).zip(reference) {
-        let e = p
-            .iter()
-            .zip(r)
-            .map(|(a, b)| {
-                ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
-            })
-            .fold(0.0f64, f64::max);
-        position_error = position_error.max(e);
-        error_history.push((*t, e));
-    }
-    let drift = constrained.then(|| {
-        solution
-            .iter()
-            .map(|(t, y)| model.constraint_drift(t, y).0)
-            .fold(0.0f64, f64::max)
-    });
-    Row {
-        method,
-        position_error,
-        drift,
-        rhs_evals: solution.stats.rhs_evals,
-        steps: solution.stats.steps,
-        wall_time_s: solution.stats.wall_time_s,
-        error_history,
-        failure,
-    }
-}
-
+/// Runs `study constraint-methods`: [`eomgen::analysis::constraint_methods`] on the model
+/// and the minimal twin its file names, rendered as a table, JSON and a chart.
 fn constraint_methods(args: &ConstraintMethodsArgs) -> Result<(), CliError> {
-    let mut model = find_model(&args.model)?;
-    if model.holonomic_constraint_count() == 0 {
-        return Err(CliError::usage(format!(
-            "`{}` has no holonomic constraints to compare methods on; try simple_pendulum_cartesian or two_masses_rod",
-            model.name()
-        )));
-    }
-    let positive = |x: f64| x.is_finite() && x > 0.0;
-    if !positive(args.t_end) || !positive(args.tol) {
-        return Err(CliError::usage("--t-end and --tol must be positive"));
-    }
-    let times: Vec<f64> = (1..=200)
-        .map(|i| args.t_end * f64::from(i) / 200.0)
-        .collect();
-    let owned: Vec<String> = model.point_names().iter().map(|s| s.to_string()).collect();
-    let names: Vec<&str> = owned.iter().map(String::as_str).collect();
-
-    // Reference: the DAE with Baumgarte at rtol = atol = 1e-13, checked against the
-    // unstabilised DAE at the same tolerance (their agreement is printed).
-    let reference_tol = 1e-13;
-    model.set_stabilization(Stabilization::Baumgarte {
-        alpha: 10.0,
-        beta: 10.0,
-    });
-    let (reference_solution, failure) =
-        integrate(model.as_mut(), args.t_end, &times, reference_tol);
-    if let Some(f) = failure {
-        return Err(CliError::failure(format!(
-            "the reference solution failed: {f}"
-        )));
-    }
-    let reference = positions(model.as_ref(), &reference_solution, &names);
-    model.set_stabilization(Stabilization::None);
-    let (check, _) = integrate(model.as_mut(), args.t_end, &times, reference_tol);
-    let agreement = row(
-        String::new(),
-        model.as_mut(),
-        &check,
-        None,
-        &reference,
-        &names,
-        true,
+    let source = super::open_model(&args.model)?;
+    let twin = minimal_twin(&source).map_err(|e| CliError::failure(e.to_string()))?;
+    let options = ConstraintMethodsOptions {
+        t_end: args.t_end,
+        tol: args.tol,
+        stiffness: args.stiffness.clone(),
+    };
+    let study = eomgen::analysis::constraint_methods(
+        &mut || source.instantiate(),
+        twin.as_ref().map(|(name, twin)| (name.as_str(), twin.instantiate())),
+        &options,
     )
-    .position_error;
-
-    let mut rows = Vec::new();
-    for &k in &args.stiffness {
-        let mut m = find_model(&args.model)?;
-        m.set_stabilization(Stabilization::Penalty {
-            stiffness: k,
-            damping: 0.0,
-        });
-        let (s, f) = integrate(m.as_mut(), args.t_end, &times, args.tol);
-        rows.push(row(
-            format!("I: stiff spring k = {k:e}"),
-            m.as_mut(),
-            &s,
-            f,
-            &reference,
-            &names,
-            true,
-        ));
-    }
-    for (label, stab) in [
-        ("II.1: DAE, no stabilisation", Stabilization::None),
-        (
-            "II.1: DAE, Baumgarte α = β = 10/s",
-            Stabilization::Baumgarte {
-                alpha: 10.0,
-                beta: 10.0,
-            },
-        ),
-    ] {
-        let mut m = find_model(&args.model)?;
-        m.set_stabilization(stab);
-        let (s, f) = integrate(m.as_mut(), args.t_end, &times, args.tol);
-        rows.push(row(
-            label.to_string(),
-            m.as_mut(),
-            &s,
-            f,
-            &reference,
-            &names,
-            true,
-        ));
-    }
-    if let Some(twin) = minimal_twin(model.name()) {
-        let mut m = find_model(twin)?;
-        let (s, f) = integrate(m.as_mut(), args.t_end, &times, args.tol);
-        rows.push(row(
-            format!("II.3: minimal coordinates ({twin})"),
-            m.as_mut(),
-            &s,
-            f,
-            &reference,
-            &names,
-            false,
-        ));
-    }
+    .map_err(|e| match e {
+        ConstraintMethodsError::NoHolonomicConstraints { model } => CliError::usage(format!(
+            "`{model}` has no holonomic constraints to compare methods on; try simple_pendulum_cartesian or two_masses_rod"
+        )),
+        ConstraintMethodsError::InvalidOptions { .. } => {
+            CliError::usage("--t-end and --tol must be positive")
+        }
+        other => CliError::failure(other.to_string()),
+    })?;
+    let ConstraintMethods {
+        model,
+        reference_tol,
+        agreement,
+        rows,
+    } = study;
 
     if let Some(path) = &args.plot {
         let series: Vec<plot::Series> = rows
@@ -296,7 +116,7 @@ fn constraint_methods(args: &ConstraintMethodsArgs) -> Result<(), CliError> {
                 points: r.error_history.clone(),
             })
             .collect();
-        let title = format!("{}: constraint methods, position error", model.name());
+        let title = format!("{model}: constraint methods, position error");
         plot::lines(
             path,
             &plot::Chart {
@@ -313,7 +133,7 @@ fn constraint_methods(args: &ConstraintMethodsArgs) -> Result<(), CliError> {
     let mut stdout = std::io::stdout().lock();
     if args.json {
         let out = json!({
-            "model": model.name(),
+            "model": model,
             "t_end": args.t_end,
             "tol": args.tol,
             "reference": {"method": "dopri5, DAE with Baumgarte α = β = 10/s", "tol": reference_tol, "agreement_with_unstabilised_dae_m": agreement},
@@ -334,7 +154,7 @@ fn constraint_methods(args: &ConstraintMethodsArgs) -> Result<(), CliError> {
         let _ = writeln!(
             stdout,
             "model      {} over 0 ≤ t ≤ {} s, Dormand–Prince 5(4) at rtol = atol = {:e}",
-            model.name(),
+            model,
             args.t_end,
             args.tol
         );

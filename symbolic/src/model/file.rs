@@ -486,6 +486,10 @@ pub struct ModelFile {
     pub name: Located<String>,
     /// `description:` — one line.
     pub description: String,
+    /// `minimal_twin:` — the bundled model with the same mechanism in minimal coordinates
+    /// (`simple_pendulum` for `simple_pendulum_cartesian`), which `eomgen study
+    /// constraint-methods` runs beside the constrained forms; `None` if the file names none.
+    pub minimal_twin: Option<Located<String>>,
     /// `units: SI` — opts the file in to dimensional checks ([`super::unit_check`]): every
     /// parameter must then carry a unit, and every expression must be dimensionally
     /// consistent with its key. `None`: units are documentation only.

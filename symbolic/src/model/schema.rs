@@ -43,6 +43,7 @@ pub const TOP_LEVEL_KEYS: &[&str] = &[
     "events",
     "equilibria",
     "floquet",
+    "minimal_twin",
 ];
 
 /// Keys of the model format (DESIGN.md) that this version does not implement yet.
@@ -645,6 +646,11 @@ impl Ctx<'_> {
                 .unwrap_or_default(),
         };
 
+        self.section = "minimal_twin";
+        let minimal_twin = get(top, "minimal_twin")
+            .and_then(|n| self.name(n, "`minimal_twin`"))
+            .and_then(|twin| self.minimal_twin(twin, &name));
+
         self.section = "units";
         let units = get(top, "units").and_then(|n| {
             self.choice(n, "`units`", &[("SI", UnitSystem::Si)])
@@ -771,6 +777,7 @@ impl Ctx<'_> {
             path: path.to_string(),
             name,
             description,
+            minimal_twin,
             units,
             parameters,
             coordinates,
@@ -974,6 +981,37 @@ impl Ctx<'_> {
             });
         }
         out
+    }
+
+    /// `minimal_twin:` — the snake_case name of another model, the same mechanism in minimal
+    /// coordinates. Rule: it is a snake_case name (a bundled model's) and not the model's own.
+    fn minimal_twin(
+        &mut self,
+        twin: Located<String>,
+        name: &Located<String>,
+    ) -> Option<Located<String>> {
+        if !is_snake_case(&twin.value) {
+            let d = Diagnostic::new(
+                twin.location,
+                format!(
+                    "`minimal_twin` must be the snake_case name of a bundled model, found `{}`",
+                    twin.value
+                ),
+            )
+            .with_help("write `minimal_twin: simple_pendulum` (see `eomgen list`)");
+            self.error(d);
+            return None;
+        }
+        if twin.value == name.value {
+            let d = Diagnostic::new(
+                twin.location,
+                format!("`minimal_twin` names the model itself, `{}`", twin.value),
+            )
+            .with_help("name the model with the same mechanism in minimal coordinates, or leave the key out");
+            self.error(d);
+            return None;
+        }
+        Some(twin)
     }
 
     /// `equilibria:` — `name: { coordinate: value, … }`.

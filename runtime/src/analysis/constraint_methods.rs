@@ -1,0 +1,335 @@
+//! Constraint methods compared (issue 5, item 6; lectures 8–11, HW10's "which one is faster?
+//! more accurate?"): the holonomic constraints of a model handled as stiff springs (method I,
+//! several stiffnesses `k`), as a DAE without and with Baumgarte stabilisation (II.1), and in
+//! minimal coordinates (II.3) where the model has a minimal-coordinate twin, side by side.
+//!
+//! Every run is Dormand–Prince 5(4) at `rtol = atol = tol`, sampled at 200 equally spaced
+//! times. Its accuracy is the largest distance of any point from its position in a reference
+//! run (the DAE with Baumgarte at `rtol = atol = 1e-13`, whose agreement with the
+//! unstabilised DAE at that tolerance is reported), over the samples.
+//!
+//! References: J. Baumgarte, "Stabilization of constraints and integrals of motion in
+//! dynamical systems", *Computer Methods in Applied Mechanics and Engineering* 1 (1972) 1–16,
+//! doi:10.1016/0045-7825(72)90018-7; E. Hairer, G. Wanner, *Solving Ordinary Differential
+//! Equations II*, 2nd ed., Springer, 1996, §VII.2 (index reduction, stabilisation) and
+//! §VI.1 (stiff springs as singular perturbations of constraints).
+
+use serde::Serialize;
+
+use crate::constrained::Stabilization;
+use crate::integrate::{
+    DormandPrince54, IntegrationFailure, Integrator, IntegratorOptions, OutputTimes, Solution,
+};
+use crate::system::ModelInfo;
+
+/// Tolerance of the reference runs.
+pub const REFERENCE_TOL: f64 = 1e-13;
+/// Number of output times (uniform in `(0, t_end]`).
+pub const OUTPUT_TIMES: u32 = 200;
+/// Most steps of one run.
+pub const MAX_STEPS: usize = 2_000_000;
+
+/// Options of [`constraint_methods`].
+///
+/// # Solver limits
+/// Every run gives up after [`MAX_STEPS`] steps; a failed run is a row with its failure.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ConstraintMethodsOptions {
+    /// End time (s), positive (default: 10).
+    pub t_end: f64,
+    /// Relative and absolute tolerance of every run, positive (default: 1e-8).
+    pub tol: f64,
+    /// Spring stiffnesses of method I (N/m per unit of the constraint) (default: 1e2, 1e4,
+    /// 1e6).
+    pub stiffness: Vec<f64>,
+}
+
+impl Default for ConstraintMethodsOptions {
+    fn default() -> Self {
+        Self {
+            t_end: 10.0,
+            tol: 1e-8,
+            stiffness: vec![1e2, 1e4, 1e6],
+        }
+    }
+}
+
+/// Why the comparison could not run.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum ConstraintMethodsError {
+    /// The model has no holonomic constraint to handle.
+    #[error("`{model}` has no holonomic constraints to compare methods on")]
+    NoHolonomicConstraints {
+        /// The model's name.
+        model: String,
+    },
+    /// `t_end` or `tol` is not a positive number.
+    #[error("the end time and the tolerance must be positive, got {t_end} and {tol}")]
+    InvalidOptions {
+        /// The end time (s).
+        t_end: f64,
+        /// The tolerance.
+        tol: f64,
+    },
+    /// The reference run failed.
+    #[error("the reference solution failed: {message}")]
+    ReferenceFailed {
+        /// The integration's failure.
+        message: String,
+    },
+}
+
+/// One method's run.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ConstraintMethodRow {
+    /// The method, as the table names it (`I: stiff spring k = 1e4`).
+    pub method: String,
+    /// Largest distance (m) of any point from its reference position at the output times.
+    pub position_error: f64,
+    /// Largest `|Φ|` at the output times (`None` in minimal coordinates: no constraint).
+    pub drift: Option<f64>,
+    /// RHS evaluations.
+    pub rhs_evals: usize,
+    /// Accepted steps.
+    pub steps: usize,
+    /// Wall time (s).
+    pub wall_time_s: f64,
+    /// `(t, position error)` at every output time (for a chart).
+    pub error_history: Vec<(f64, f64)>,
+    /// Why the run stopped early, if it did.
+    pub failure: Option<String>,
+}
+
+/// The result of [`constraint_methods`].
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ConstraintMethods {
+    /// The model's name.
+    pub model: String,
+    /// The tolerance of the reference runs ([`REFERENCE_TOL`]).
+    pub reference_tol: f64,
+    /// Largest point distance (m) between the reference and the unstabilised DAE at the
+    /// reference tolerance.
+    pub agreement: f64,
+    /// Method I at every stiffness, II.1 without and with Baumgarte, and II.3 if there is a
+    /// twin, in that order.
+    pub rows: Vec<ConstraintMethodRow>,
+}
+
+fn integrate(
+    model: &mut dyn ModelInfo,
+    t_end: f64,
+    times: &[f64],
+    tol: f64,
+) -> (Solution, Option<String>) {
+    let options = IntegratorOptions::default()
+        .with_rtol(tol)
+        .with_atol(tol)
+        .with_max_steps(MAX_STEPS);
+    let y0 = model.initial_state();
+    match DormandPrince54::new().integrate(
+        model.as_ode_mut(),
+        0.0,
+        &y0,
+        t_end,
+        &OutputTimes::At(times.to_vec()),
+        &options,
+    ) {
+        Ok(s) => (s, None),
+        Err(IntegrationFailure { error, partial }) => (*partial, Some(error.to_string())),
+    }
+}
+
+/// Positions of the points named in `names`, in that order, at every sample (NaN for a
+/// point the model does not have).
+fn positions(model: &dyn ModelInfo, solution: &Solution, names: &[&str]) -> Vec<Vec<[f64; 3]>> {
+    let own = model.point_names();
+    solution
+        .iter()
+        .map(|(t, y)| {
+            let all = model.point_positions(t, y);
+            names
+                .iter()
+                .map(|n| {
+                    own.iter()
+                        .position(|p| p == n)
+                        .map_or([f64::NAN; 3], |i| all[i])
+                })
+                .collect()
+        })
+        .collect()
+}
+
+fn row(
+    method: String,
+    model: &mut dyn ModelInfo,
+    solution: &Solution,
+    failure: Option<String>,
+    reference: &[Vec<[f64; 3]>],
+    names: &[&str],
+    constrained: bool,
+) -> ConstraintMethodRow {
+    let here = positions(model, solution, names);
+    let mut error_history = Vec::new();
+    let mut position_error: f64 = 0.0;
+    for ((t, p), r) in solution.t.iter().zip(&here).zip(reference) {
+        let e = p
+            .iter()
+            .zip(r)
+            .map(|(a, b)| {
+                ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
+            })
+            .fold(0.0f64, f64::max);
+        position_error = position_error.max(e);
+        error_history.push((*t, e));
+    }
+    let drift = constrained.then(|| {
+        solution
+            .iter()
+            .map(|(t, y)| model.constraint_drift(t, y).0)
+            .fold(0.0f64, f64::max)
+    });
+    ConstraintMethodRow {
+        method,
+        position_error,
+        drift,
+        rhs_evals: solution.stats.rhs_evals,
+        steps: solution.stats.steps,
+        wall_time_s: solution.stats.wall_time_s,
+        error_history,
+        failure,
+    }
+}
+
+/// Compares the ways of handling the holonomic constraints of a model (see the module
+/// docs). `make` builds a fresh instance of the model (one per run); `twin` is its
+/// minimal-coordinate twin with its name (the model file's `minimal_twin:`), whose points
+/// of the same names are compared.
+///
+/// # Errors
+/// [`ConstraintMethodsError::NoHolonomicConstraints`],
+/// [`ConstraintMethodsError::InvalidOptions`], [`ConstraintMethodsError::ReferenceFailed`].
+///
+/// # Examples
+/// ```
+/// use eomgen::analysis::{ConstraintMethodsOptions, constraint_methods};
+///
+/// let entry = eomgen::models::find("simple_pendulum_cartesian").unwrap();
+/// let twin = (eomgen::models::find("simple_pendulum").unwrap().make)();
+/// let options = ConstraintMethodsOptions { t_end: 1.0, stiffness: vec![1e4], ..Default::default() };
+/// let study = constraint_methods(&mut || (entry.make)(), Some(("simple_pendulum", twin)), &options)?;
+/// assert_eq!(study.rows.len(), 4);
+/// // The DAE and the minimal coordinates are far more accurate than the spring.
+/// assert!(study.rows[1].position_error < 1e-6 && study.rows[3].position_error < 1e-6);
+/// assert!(study.rows[0].position_error > 1e-4);
+/// # Ok::<(), eomgen::analysis::ConstraintMethodsError>(())
+/// ```
+pub fn constraint_methods(
+    make: &mut dyn FnMut() -> Box<dyn ModelInfo>,
+    twin: Option<(&str, Box<dyn ModelInfo>)>,
+    options: &ConstraintMethodsOptions,
+) -> Result<ConstraintMethods, ConstraintMethodsError> {
+    let mut model = make();
+    if model.holonomic_constraint_count() == 0 {
+        return Err(ConstraintMethodsError::NoHolonomicConstraints {
+            model: model.name().to_string(),
+        });
+    }
+    let positive = |x: f64| x.is_finite() && x > 0.0;
+    if !positive(options.t_end) || !positive(options.tol) {
+        return Err(ConstraintMethodsError::InvalidOptions {
+            t_end: options.t_end,
+            tol: options.tol,
+        });
+    }
+    let (t_end, tol) = (options.t_end, options.tol);
+    let times: Vec<f64> = (1..=OUTPUT_TIMES)
+        .map(|i| t_end * f64::from(i) / f64::from(OUTPUT_TIMES))
+        .collect();
+    let owned: Vec<String> = model.point_names().iter().map(|s| s.to_string()).collect();
+    let names: Vec<&str> = owned.iter().map(String::as_str).collect();
+
+    // Reference: the DAE with Baumgarte at rtol = atol = 1e-13, checked against the
+    // unstabilised DAE at the same tolerance.
+    model.set_stabilization(Stabilization::Baumgarte {
+        alpha: 10.0,
+        beta: 10.0,
+    });
+    let (reference_solution, failure) = integrate(model.as_mut(), t_end, &times, REFERENCE_TOL);
+    if let Some(message) = failure {
+        return Err(ConstraintMethodsError::ReferenceFailed { message });
+    }
+    let reference = positions(model.as_ref(), &reference_solution, &names);
+    model.set_stabilization(Stabilization::None);
+    let (check, _) = integrate(model.as_mut(), t_end, &times, REFERENCE_TOL);
+    let agreement = row(
+        String::new(),
+        model.as_mut(),
+        &check,
+        None,
+        &reference,
+        &names,
+        true,
+    )
+    .position_error;
+
+    let mut rows = Vec::new();
+    for &k in &options.stiffness {
+        let mut m = make();
+        m.set_stabilization(Stabilization::Penalty {
+            stiffness: k,
+            damping: 0.0,
+        });
+        let (s, f) = integrate(m.as_mut(), t_end, &times, tol);
+        rows.push(row(
+            format!("I: stiff spring k = {k:e}"),
+            m.as_mut(),
+            &s,
+            f,
+            &reference,
+            &names,
+            true,
+        ));
+    }
+    for (label, stab) in [
+        ("II.1: DAE, no stabilisation", Stabilization::None),
+        (
+            "II.1: DAE, Baumgarte α = β = 10/s",
+            Stabilization::Baumgarte {
+                alpha: 10.0,
+                beta: 10.0,
+            },
+        ),
+    ] {
+        let mut m = make();
+        m.set_stabilization(stab);
+        let (s, f) = integrate(m.as_mut(), t_end, &times, tol);
+        rows.push(row(
+            label.to_string(),
+            m.as_mut(),
+            &s,
+            f,
+            &reference,
+            &names,
+            true,
+        ));
+    }
+    if let Some((twin, mut m)) = twin {
+        let (s, f) = integrate(m.as_mut(), t_end, &times, tol);
+        rows.push(row(
+            format!("II.3: minimal coordinates ({twin})"),
+            m.as_mut(),
+            &s,
+            f,
+            &reference,
+            &names,
+            false,
+        ));
+    }
+    Ok(ConstraintMethods {
+        model: model.name().to_string(),
+        reference_tol: REFERENCE_TOL,
+        agreement,
+        rows,
+    })
+}

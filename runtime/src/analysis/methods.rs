@@ -1,0 +1,228 @@
+//! The registry of integration methods: one [`Method`] per [`Integrator`], its
+//! command-line name, its name in the literature, and the integrator it builds.
+//!
+//! A front end selects a method by name (`"dp54".parse::<Method>()`), and every analysis
+//! that compares methods (work–precision, stability) iterates over [`Method::ALL`].
+//!
+//! References: E. Hairer, S. P. Nørsett, G. Wanner, *Solving Ordinary Differential Equations
+//! I*, 2nd ed., Springer, 1993 (the explicit Runge–Kutta methods and DOP853); E. Hairer,
+//! G. Wanner, *Solving Ordinary Differential Equations II*, 2nd ed., Springer, 1996 (Radau
+//! IIA 5); E. Hairer, C. Lubich, G. Wanner, *Geometric Numerical Integration*, 2nd ed.,
+//! Springer, 2006 (symplectic Euler, Störmer–Verlet, implicit midpoint).
+
+use std::fmt;
+use std::str::FromStr;
+
+use serde::Serialize;
+
+use crate::integrate::{
+    BogackiShampine32, DormandPrince54, DormandPrince853, ExplicitEuler, ExplicitMidpoint,
+    ImplicitMidpoint, Integrator, RadauIIA5, RungeKutta4, StormerVerlet, SymplecticEuler,
+};
+
+/// An integration method, by its command-line name.
+///
+/// Adaptive methods ([`Method::is_adaptive`]) control their step by `rtol`/`atol`; the
+/// others take a fixed step `dt`. Serialised (and displayed, and parsed) by its
+/// command-line name, [`Method::name`] (`"dp54"`).
+///
+/// # Examples
+/// ```
+/// use eomgen_runtime::analysis::Method;
+///
+/// let method: Method = "dp54".parse().unwrap();
+/// assert_eq!(method, Method::Dp54);
+/// assert!(method.is_adaptive());
+/// assert_eq!(method.display_name(), "Dormand–Prince 5(4)");
+/// assert_eq!(method.integrator().name(), "dopri5");
+/// let error = "rk5".parse::<Method>().unwrap_err();
+/// assert!(error.to_string().contains("euler, midpoint, rk4"));
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Method {
+    /// Explicit Euler, order 1, fixed step.
+    Euler,
+    /// Explicit midpoint, order 2, fixed step.
+    Midpoint,
+    /// Classical Runge–Kutta 4, fixed step.
+    Rk4,
+    /// Bogacki–Shampine 3(2) (ode23), adaptive, Hermite dense output.
+    Bs32,
+    /// Dormand–Prince 5(4), adaptive, dense output.
+    Dp54,
+    /// DOP853, Hairer's Dormand–Prince 8(5,3), adaptive, order-7 dense output.
+    Dop853,
+    /// Symplectic Euler, order 1, fixed step (symplectic for constant M and
+    /// velocity-independent forces).
+    SymplecticEuler,
+    /// Störmer–Verlet (leapfrog in q, q̇), order 2, fixed step (symplectic for constant M
+    /// and velocity-independent forces).
+    StormerVerlet,
+    /// Implicit midpoint, order 2, fixed step, Newton with the generated Jacobians
+    /// (symplectic for any M(q)).
+    ImplicitMidpoint,
+    /// Radau IIA order 5 (RADAU5), adaptive, L-stable, Newton with the generated Jacobians.
+    Radau5,
+}
+
+/// A method name that is none of [`Method::ALL`]'s.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("unknown integration method `{name}` (valid: {})", Method::names().join(", "))]
+pub struct UnknownMethod {
+    /// The name as given.
+    pub name: String,
+}
+
+impl Method {
+    /// Every method, in the order the CLI lists them.
+    pub const ALL: [Method; 10] = [
+        Method::Euler,
+        Method::Midpoint,
+        Method::Rk4,
+        Method::Bs32,
+        Method::Dp54,
+        Method::Dop853,
+        Method::SymplecticEuler,
+        Method::StormerVerlet,
+        Method::ImplicitMidpoint,
+        Method::Radau5,
+    ];
+
+    /// The command-line name (`"dp54"`, `"stormer-verlet"`), which [`FromStr`] parses.
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::Euler => "euler",
+            Method::Midpoint => "midpoint",
+            Method::Rk4 => "rk4",
+            Method::Bs32 => "bs32",
+            Method::Dp54 => "dp54",
+            Method::Dop853 => "dop853",
+            Method::SymplecticEuler => "symplectic-euler",
+            Method::StormerVerlet => "stormer-verlet",
+            Method::ImplicitMidpoint => "implicit-midpoint",
+            Method::Radau5 => "radau5",
+        }
+    }
+
+    /// The command-line names of [`Method::ALL`], in order.
+    pub fn names() -> Vec<&'static str> {
+        Self::ALL.iter().map(|m| m.name()).collect()
+    }
+
+    /// The literature's name of the method (`"Dormand–Prince 5(4)"`), as charts and tables
+    /// label it.
+    pub fn display_name(self) -> &'static str {
+        match self {
+            Method::Euler => "explicit Euler",
+            Method::Midpoint => "explicit midpoint",
+            Method::Rk4 => "RK4",
+            Method::Bs32 => "Bogacki–Shampine 3(2)",
+            Method::Dp54 => "Dormand–Prince 5(4)",
+            Method::Dop853 => "DOP853",
+            Method::SymplecticEuler => "symplectic Euler",
+            Method::StormerVerlet => "Störmer–Verlet",
+            Method::ImplicitMidpoint => "implicit midpoint",
+            Method::Radau5 => "Radau IIA 5",
+        }
+    }
+
+    /// A new integrator of this method, with its default settings.
+    pub fn integrator(self) -> Box<dyn Integrator> {
+        match self {
+            Method::Euler => Box::new(ExplicitEuler::new()),
+            Method::Midpoint => Box::new(ExplicitMidpoint::new()),
+            Method::Rk4 => Box::new(RungeKutta4::new()),
+            Method::Bs32 => Box::new(BogackiShampine32::new()),
+            Method::Dp54 => Box::new(DormandPrince54::new()),
+            Method::Dop853 => Box::new(DormandPrince853::new()),
+            Method::SymplecticEuler => Box::new(SymplecticEuler::new()),
+            Method::StormerVerlet => Box::new(StormerVerlet::new()),
+            Method::ImplicitMidpoint => Box::new(ImplicitMidpoint::new()),
+            Method::Radau5 => Box::new(RadauIIA5::new()),
+        }
+    }
+
+    /// Whether the method controls its step by `rtol`/`atol` (otherwise it takes the fixed
+    /// step `dt`).
+    pub fn is_adaptive(self) -> bool {
+        matches!(
+            self,
+            Method::Bs32 | Method::Dp54 | Method::Dop853 | Method::Radau5
+        )
+    }
+
+    /// Whether each step solves a nonlinear system by Newton's method with the model's
+    /// Jacobians (implicit midpoint, Radau IIA 5).
+    pub fn is_implicit(self) -> bool {
+        matches!(self, Method::ImplicitMidpoint | Method::Radau5)
+    }
+}
+
+impl fmt::Display for Method {
+    /// The command-line name, [`Method::name`].
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for Method {
+    type Err = UnknownMethod;
+
+    /// The method whose [`Method::name`] is `name` (exactly, case-sensitive).
+    ///
+    /// # Errors
+    /// [`UnknownMethod`], whose message lists the valid names.
+    fn from_str(name: &str) -> Result<Self, Self::Err> {
+        Self::ALL
+            .into_iter()
+            .find(|m| m.name() == name)
+            .ok_or_else(|| UnknownMethod {
+                name: name.to_string(),
+            })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_name_parses_back_to_its_method() {
+        for m in Method::ALL {
+            assert_eq!(m.name().parse::<Method>(), Ok(m));
+            assert_eq!(m.to_string(), m.name());
+            assert_eq!(
+                serde_json::to_value(m).unwrap(),
+                serde_json::Value::String(m.name().to_string())
+            );
+        }
+    }
+
+    #[test]
+    fn adaptive_methods_are_those_with_an_error_estimate() {
+        let adaptive: Vec<_> = Method::ALL.into_iter().filter(|m| m.is_adaptive()).collect();
+        assert_eq!(
+            adaptive,
+            [Method::Bs32, Method::Dp54, Method::Dop853, Method::Radau5]
+        );
+    }
+
+    #[test]
+    fn integrator_names_match_except_dopri5() {
+        for m in Method::ALL {
+            let expected = if m == Method::Dp54 { "dopri5" } else { m.name() };
+            assert_eq!(m.integrator().name(), expected);
+        }
+    }
+
+    #[test]
+    fn unknown_name_is_a_typed_error_listing_the_names() {
+        let e = "Dp54".parse::<Method>().unwrap_err();
+        assert_eq!(e.name, "Dp54");
+        assert_eq!(
+            e.to_string(),
+            "unknown integration method `Dp54` (valid: euler, midpoint, rk4, bs32, dp54, dop853, symplectic-euler, stormer-verlet, implicit-midpoint, radau5)"
+        );
+    }
+}

@@ -1,0 +1,30 @@
+//! Analyses on the size-erased model ([`ModelInfo`](crate::ModelInfo)) that the CLI, an
+//! embedding Rust program and the Python bindings share: the method registry, drift
+//! measures, simulation and the numerical studies.
+//!
+//! Every analysis is a function with a typed options struct, a `Serialize` report and a
+//! typed error, so that a front end only parses its input and renders the report.
+
+pub mod constraint_methods;
+pub mod drift;
+pub mod methods;
+pub mod roundoff;
+pub mod simulation;
+pub mod stability;
+pub mod work_precision;
+
+pub use constraint_methods::{
+    ConstraintMethodRow, ConstraintMethods, ConstraintMethodsError, ConstraintMethodsOptions,
+    constraint_methods,
+};
+pub use drift::{ConstraintDrift, EnergyDrift, constraint_drift, energy_drift};
+pub use methods::{Method, UnknownMethod};
+pub use roundoff::{EulerRoundoff, RoundoffError, RoundoffOptions, euler_roundoff};
+pub use simulation::{
+    AddedEvents, Simulation, SimulationError, SimulationOptions, simulate, simulate_with_events,
+};
+pub use stability::{StabilityError, StabilityOptions, StabilityStudy, stability_study};
+pub use work_precision::{
+    AtTarget, Measured, MethodRuns, RunFailure, Setting, SettingRun, WorkPrecision,
+    WorkPrecisionError, WorkPrecisionOptions, work_precision,
+};

@@ -1,0 +1,545 @@
+//! The checks of a model file (`eomgen report`'s pass/fail rows): the derivations agree, the
+//! energy and the constraints do not drift, and the reference values the file states in its
+//! `checks:` block (natural frequencies, damping ratios, an event's period, the state at a
+//! time, conserved quantities; see [`eomgen_symbolic::model::Checks`]) are met.
+//!
+//! A check passes when `|computed − expected| ≤ tolerance · max(1, |expected|)`; drifts and
+//! residuals are "computed" with expected 0 and their bound as tolerance. The simulations run
+//! through [`analysis::simulate`](crate::analysis::simulate) from the model's consistent
+//! initial state, without drift control; the modal values come from an operating point the
+//! caller computes (see [`ModesAt`]).
+
+use serde::Serialize;
+
+use crate::ModelSource;
+use crate::analysis::{Method, SimulationOptions, simulate};
+use crate::expressions::parameter_lookup;
+use eomgen_runtime::analysis::{constraint_drift, energy_drift};
+use eomgen_runtime::{Linearization, ModelInfo, OutputTimes, Solution, damped_modes};
+use eomgen_symbolic::mechanics::check::check_model;
+use eomgen_symbolic::model::parser::eval_expr;
+use eomgen_symbolic::model::{
+    DEFAULT_CONSTRAINT_DRIFT, DEFAULT_ENERGY_DRIFT, Diagnostic, Expr, ModalCheck, ModelFile,
+    RunSettings,
+};
+
+/// Relative tolerance of the derivation cross-checks, as `eomgen check`: the derivations
+/// differ only by rounding (~1e-14).
+pub const DERIVATION_TOLERANCE: f64 = 1e-8;
+/// Random states of the derivation cross-checks.
+pub const DERIVATION_STATES: usize = 100;
+/// Seed of the derivation cross-checks' random states.
+pub const DERIVATION_SEED: u64 = 0x5EED;
+/// Default end time of a check's simulation (s).
+pub const DEFAULT_T_END: f64 = 10.0;
+/// Default relative and absolute tolerance of a check's simulation.
+pub const DEFAULT_RTOL: f64 = 1e-12;
+/// Samples of a check's simulation (uniform in t, both ends included).
+pub const SAMPLES: usize = 1001;
+
+/// One row of a model's pass/fail table.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct CheckRow {
+    /// What was checked, with its unit or settings.
+    pub check: String,
+    /// The computed value; `None` when it could not be computed (see `note`).
+    pub computed: Option<f64>,
+    /// The expected value (NaN, serialised `null`, when it could not be evaluated).
+    pub expected: f64,
+    /// The tolerance: passes when `|computed − expected| ≤ tolerance · max(1, |expected|)`.
+    pub tolerance: f64,
+    /// Whether it passed.
+    pub passed: bool,
+    /// Why it could not be computed, if so.
+    pub note: Option<String>,
+}
+
+impl CheckRow {
+    /// Compares `computed` with `expected` (a failure to compute is a failed check, with
+    /// its reason as the note).
+    ///
+    /// # Examples
+    /// ```
+    /// use eomgen::checks::CheckRow;
+    ///
+    /// assert!(CheckRow::compare("ω (rad/s)", Ok(3.1622776), 10f64.sqrt(), 1e-7).passed);
+    /// assert!(!CheckRow::compare("ω (rad/s)", Ok(3.2), 10f64.sqrt(), 1e-7).passed);
+    /// assert!(!CheckRow::compare("ω", Err("no equilibrium".into()), 1.0, 1.0).passed);
+    /// ```
+    pub fn compare(
+        check: impl Into<String>,
+        computed: Result<f64, String>,
+        expected: f64,
+        tolerance: f64,
+    ) -> Self {
+        let (computed, note) = match computed {
+            Ok(v) => (Some(v), None),
+            Err(e) => (None, Some(e)),
+        };
+        let passed = computed.is_some_and(|c| {
+            c.is_finite() && (c - expected).abs() <= tolerance * expected.abs().max(1.0)
+        });
+        Self {
+            check: check.into(),
+            computed,
+            expected,
+            tolerance,
+            passed,
+            note,
+        }
+    }
+}
+
+/// How a check integrates: method, `rtol = atol`, end time (the file's `run:` settings).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct CheckRun {
+    /// The method (default: DOP853).
+    pub method: Method,
+    /// Relative and absolute tolerance (default: [`DEFAULT_RTOL`]).
+    pub rtol: f64,
+    /// End time (s) (default: [`DEFAULT_T_END`]).
+    pub t_end: f64,
+}
+
+impl CheckRun {
+    /// The run a check's `run:` settings ask for, the defaults filling in.
+    pub fn of(settings: &RunSettings) -> Self {
+        let method = settings
+            .method
+            .as_ref()
+            .and_then(|m| m.value.parse::<Method>().ok())
+            .unwrap_or(Method::Dop853);
+        Self {
+            method,
+            rtol: settings.rtol.unwrap_or(DEFAULT_RTOL),
+            t_end: settings.t_end.unwrap_or(DEFAULT_T_END),
+        }
+    }
+
+    /// `dop853, rtol 1e-12, 10 s`, as the rows name their settings.
+    pub fn describe(&self) -> String {
+        let method = self.method.name();
+        format!("{method}, rtol {:e}, {} s", self.rtol, fixed(self.t_end, 6))
+    }
+}
+
+impl Default for CheckRun {
+    fn default() -> Self {
+        Self::of(&RunSettings::default())
+    }
+}
+
+/// `v` with `decimals` decimals, trailing zeros dropped, `-0` as `0` (`fixed(10.0, 6)` is
+/// `10`, `fixed(0.25, 6)` is `0.25`), as the rows write times.
+pub fn fixed(v: f64, decimals: usize) -> String {
+    let s = format!("{v:.decimals$}");
+    let s = if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.')
+    } else {
+        &s
+    };
+    if s == "-0" {
+        "0".to_string()
+    } else {
+        s.to_string()
+    }
+}
+
+/// The simulations of one model that its checks (and a report's figures) share, each run
+/// once: a fresh instance of the model from its consistent initial state, sampled at
+/// [`SAMPLES`] uniform times, with the file's events located on the way.
+pub struct Simulations {
+    source: ModelSource,
+    done: Vec<(CheckRun, Result<Solution, String>)>,
+}
+
+impl Simulations {
+    /// No simulation of `source` yet.
+    pub fn new(source: ModelSource) -> Self {
+        Self {
+            source,
+            done: Vec::new(),
+        }
+    }
+
+    /// The solution of `run` (computed the first time it is asked for).
+    ///
+    /// # Errors
+    /// Why the simulation could not start or did not reach its end, as text.
+    pub fn get(&mut self, run: CheckRun) -> Result<&Solution, String> {
+        let k = match self.done.iter().position(|(d, _)| *d == run) {
+            Some(k) => k,
+            None => {
+                let solution = self.run(run, None);
+                self.done.push((run, solution));
+                self.done.len() - 1
+            }
+        };
+        self.done[k].1.as_ref().map_err(Clone::clone)
+    }
+
+    /// Runs `run` sampled at `times` (default: [`SAMPLES`] uniform times), not kept.
+    ///
+    /// # Errors
+    /// Why the simulation could not start or did not reach its end, as text.
+    pub fn run(&self, run: CheckRun, times: Option<Vec<f64>>) -> Result<Solution, String> {
+        let times = times.unwrap_or_else(|| {
+            (0..SAMPLES)
+                .map(|k| run.t_end * k as f64 / (SAMPLES - 1) as f64)
+                .collect()
+        });
+        let options = SimulationOptions {
+            method: run.method,
+            t_end: run.t_end,
+            rtol: run.rtol,
+            atol: run.rtol,
+            output: OutputTimes::At(times),
+            ..SimulationOptions::default()
+        };
+        let mut model = self.source.instantiate();
+        let simulation = simulate(model.as_mut(), &options).map_err(|e| e.to_string())?;
+        match simulation.failure {
+            None => Ok(simulation.solution),
+            Some(error) => Err(format!("the integration failed: {error}")),
+        }
+    }
+}
+
+/// The modal values at an operating point, as the caller found them (`eomgen modes --at`):
+/// the input of the `natural_frequencies:` and `damping_ratios:` checks.
+#[derive(Debug, Clone)]
+pub struct ModesAt {
+    /// The operating point's name (`hanging`) or guesses, as the rows name it.
+    pub label: String,
+    /// The undamped natural frequencies (rad/s, ascending).
+    pub natural_frequencies: Vec<f64>,
+    /// The exact linearisation there (for the damping ratios).
+    pub linearization: Linearization,
+}
+
+/// The rows of the derivation cross-checks (the checks of `eomgen check`: Lagrange against
+/// momentum balance, user balances and hand equations, and the power balance), and the notes
+/// of the comparison.
+///
+/// # Errors
+/// The model file's diagnostics, when it cannot be derived.
+pub fn derivation_checks(file: &ModelFile) -> Result<(Vec<CheckRow>, Vec<String>), Vec<Diagnostic>> {
+    let r = check_model(file, DERIVATION_STATES, DERIVATION_SEED)?;
+    let mut rows = Vec::new();
+    for c in &r.comparisons {
+        rows.push(CheckRow::compare(
+            format!(
+                "derivations agree: {} vs {} (max relative q̈ difference)",
+                c.a, c.b
+            ),
+            Ok(c.max_rel_residual),
+            0.0,
+            DERIVATION_TOLERANCE,
+        ));
+    }
+    if let Some(p) = &r.power_balance {
+        rows.push(CheckRow::compare(
+            "power balance dE/dt = Q·q̇ (max relative residual)",
+            Ok(p.max_rel_residual),
+            0.0,
+            DERIVATION_TOLERANCE,
+        ));
+    }
+    Ok((rows, r.notes))
+}
+
+/// Evaluates an expected value (an expression of the parameters).
+fn expected(e: &Expr, model: &dyn ModelInfo) -> Result<f64, String> {
+    eval_expr(e, &parameter_lookup(model)).map_err(|d| d.message)
+}
+
+/// Evaluates a function of the parameters (`parameters`), coordinates, rates and `t` at
+/// `(t, y)` of `model`.
+fn state_value(
+    e: &Expr,
+    model: &dyn ModelInfo,
+    parameters: &dyn Fn(&str) -> Option<f64>,
+    t: f64,
+    y: &[f64],
+) -> Result<f64, String> {
+    let coordinates = model.coordinate_names();
+    let n = coordinates.len();
+    eval_expr(e, &|name| {
+        if name == "t" {
+            return Some(t);
+        }
+        if let Some(v) = parameters(name) {
+            return Some(v);
+        }
+        if let Some(i) = coordinates.iter().position(|c| *c == name) {
+            return Some(y[i]);
+        }
+        let base = name.strip_suffix("_dot")?;
+        coordinates
+            .iter()
+            .position(|c| *c == base)
+            .map(|i| y[n + i])
+    })
+    .map_err(|d| d.message)
+}
+
+/// Rows comparing a list of computed modal values with a `natural_frequencies:` or
+/// `damping_ratios:` entry.
+fn modal_rows(
+    key: &str,
+    unit: &str,
+    check: &ModalCheck,
+    model: &dyn ModelInfo,
+    computed: Result<(String, Vec<f64>), String>,
+) -> Vec<CheckRow> {
+    let at = check.at.as_ref().map_or("", |a| a.value.as_str());
+    let (label, values) = match computed {
+        Ok(c) => c,
+        Err(e) => {
+            return vec![CheckRow::compare(
+                format!("{key} at {at}"),
+                Err(e),
+                f64::NAN,
+                check.tolerance,
+            )];
+        }
+    };
+    let mut rows = Vec::new();
+    for (k, e) in check.values.iter().enumerate() {
+        let what = format!("{key}[{}] at {label}{unit}", k + 1);
+        let value = values.get(k).copied().ok_or_else(|| {
+            format!(
+                "the model has {} value(s), the file states {}",
+                values.len(),
+                check.values.len()
+            )
+        });
+        match expected(e, model) {
+            Ok(x) => rows.push(CheckRow::compare(what, value, x, check.tolerance)),
+            Err(err) => rows.push(CheckRow::compare(what, Err(err), f64::NAN, check.tolerance)),
+        }
+    }
+    if values.len() > check.values.len() {
+        rows.push(CheckRow::compare(
+            format!("number of {key} at {label}"),
+            Ok(values.len() as f64),
+            check.values.len() as f64,
+            0.0,
+        ));
+    }
+    rows
+}
+
+/// A row whose expected value is an expression: evaluated against `model`'s parameters, or
+/// the failure to evaluate it.
+fn against_expected(
+    what: String,
+    computed: Result<f64, String>,
+    e: &Expr,
+    model: &dyn ModelInfo,
+    tolerance: f64,
+) -> CheckRow {
+    match expected(e, model) {
+        Ok(x) => CheckRow::compare(what, computed, x, tolerance),
+        Err(err) => CheckRow::compare(what, Err(err), f64::NAN, tolerance),
+    }
+}
+
+/// The rows of the checks that need a motion or an equilibrium of `model`, in this order:
+/// energy drift (conservative models, or where the file asks), constraint drift (constrained
+/// models), `natural_frequencies:`, `damping_ratios:`, `period:`, `final_state:` and
+/// `conserved:`.
+///
+/// `y0` is the model's consistent initial state; `simulations` runs (and keeps) the
+/// simulations of the model; `modes(at)` gives the modal values at the operating point `at`
+/// (an `equilibria:` name, `None` for the default) or why there are none.
+///
+/// # Examples
+/// ```
+/// use eomgen::checks::{Simulations, motion_checks};
+///
+/// let source = eomgen::ModelSource::open("simple_pendulum")?;
+/// let path = eomgen::models::find("simple_pendulum").unwrap().path;
+/// let text = std::fs::read_to_string(path).unwrap();
+/// let file = eomgen_symbolic::model::load(path, &text).unwrap();
+/// let mut model = source.instantiate();
+/// let y0 = model.consistent_initial_state().unwrap();
+/// let mut simulations = Simulations::new(source);
+/// let rows = motion_checks(&file, model.as_mut(), &y0, &mut simulations,
+///                          &mut |_| Err("not computed here".to_string()));
+/// let period = rows.iter().find(|r| r.check.starts_with("period")).unwrap();
+/// assert!(period.passed, "{period:?}");
+/// # Ok::<(), eomgen::OpenError>(())
+/// ```
+pub fn motion_checks(
+    file: &ModelFile,
+    model: &mut dyn ModelInfo,
+    y0: &[f64],
+    simulations: &mut Simulations,
+    modes: &mut dyn FnMut(Option<&str>) -> Result<ModesAt, String>,
+) -> Vec<CheckRow> {
+    let mut checks = Vec::new();
+    let default_run = CheckRun::default();
+
+    // Generic: energy conservation (conservative models, or where the file asks for it).
+    let energy = &file.checks.energy_drift;
+    if model.is_conservative() || energy.is_some() {
+        let (bound, run) = energy
+            .as_ref()
+            .map_or((DEFAULT_ENERGY_DRIFT, default_run), |d| {
+                (d.max, CheckRun::of(&d.run))
+            });
+        let computed = simulations.get(run).and_then(|s| {
+            energy_drift(model, y0, s)
+                .drift
+                .ok_or_else(|| "no samples".to_string())
+        });
+        checks.push(CheckRow::compare(
+            format!(
+                "energy drift max|E − E(0)|/max(T + |V|) ({})",
+                run.describe()
+            ),
+            computed,
+            0.0,
+            bound,
+        ));
+    }
+
+    // Generic: constraint drift (constrained models).
+    let constraint = &file.checks.constraint_drift;
+    if !model.constraint_names().is_empty() || constraint.is_some() {
+        let (bound, run) = constraint
+            .as_ref()
+            .map_or((DEFAULT_CONSTRAINT_DRIFT, default_run), |d| {
+                (d.max, CheckRun::of(&d.run))
+            });
+        let computed = simulations.get(run).map(|s| {
+            let (p, v) = constraint_drift(model, s).max_drift();
+            p.max(v)
+        });
+        checks.push(CheckRow::compare(
+            format!(
+                "constraint drift max(|Φ|, |Φ̇|), no stabilisation ({})",
+                run.describe()
+            ),
+            computed,
+            0.0,
+            bound,
+        ));
+    }
+
+    // Reference values stated in the file.
+    let at_of = |check: &ModalCheck| check.at.as_ref().map(|a| a.value.clone());
+    if let Some(check) = &file.checks.natural_frequencies {
+        let computed = modes(at_of(check).as_deref()).map(|m| (m.label, m.natural_frequencies));
+        checks.extend(modal_rows(
+            "natural_frequencies",
+            " (rad/s)",
+            check,
+            model,
+            computed,
+        ));
+    }
+    if let Some(check) = &file.checks.damping_ratios {
+        let computed = modes(at_of(check).as_deref()).and_then(|m| {
+            damped_modes(&m.linearization)
+                .map(|d| (m.label, d.iter().map(|mode| mode.1).collect()))
+                .map_err(|e| e.to_string())
+        });
+        checks.extend(modal_rows("damping_ratios", "", check, model, computed));
+    }
+    if let Some(check) = &file.checks.period {
+        let run = CheckRun::of(&check.run);
+        let event = check.event.value.as_str();
+        let computed = simulations.get(run).and_then(|s| {
+            let times: Vec<f64> = s
+                .events
+                .iter()
+                .filter(|e| e.name == event)
+                .map(|e| e.t)
+                .collect();
+            match times.as_slice() {
+                [.., a, b] => Ok(b - a),
+                _ => Err(format!(
+                    "event `{event}` occurred {} time(s) in {} s; a period needs two",
+                    times.len(),
+                    run.t_end
+                )),
+            }
+        });
+        let what = format!(
+            "period between the last two `{event}` events (s) ({})",
+            run.describe()
+        );
+        checks.push(against_expected(what, computed, &check.value, model, check.tolerance));
+    }
+    if let Some(check) = &file.checks.final_state {
+        match expected(&check.t, model) {
+            Ok(t) if t.is_finite() && t > 0.0 => {
+                let run = CheckRun {
+                    t_end: t,
+                    ..CheckRun::of(&check.run)
+                };
+                let state = simulations.run(run, Some(vec![t])).and_then(|s| {
+                    s.last()
+                        .filter(|(ts, _)| *ts == t)
+                        .map(|(_, y)| y.to_vec())
+                        .ok_or_else(|| format!("the integration stopped before t = {t}"))
+                });
+                let coordinates = model.coordinate_names();
+                let n = coordinates.len();
+                for (k, e) in &check.values {
+                    let index = coordinates.iter().position(|c| *c == k.value).or_else(|| {
+                        k.value
+                            .strip_suffix("_dot")
+                            .and_then(|b| coordinates.iter().position(|c| *c == b))
+                            .map(|i| n + i)
+                    });
+                    let computed = state.clone().and_then(|y| {
+                        index
+                            .map(|i| y[i])
+                            .ok_or_else(|| format!("`{}` is not a coordinate or rate", k.value))
+                    });
+                    let what = format!("{} at t = {} s ({})", k.value, fixed(t, 6), run.describe());
+                    checks.push(against_expected(what, computed, e, model, check.tolerance));
+                }
+            }
+            Ok(t) => checks.push(CheckRow::compare(
+                "final_state",
+                Err(format!("t = {t} is not a positive time")),
+                f64::NAN,
+                check.tolerance,
+            )),
+            Err(e) => checks.push(CheckRow::compare(
+                "final_state",
+                Err(e),
+                f64::NAN,
+                check.tolerance,
+            )),
+        }
+    }
+    let parameters = parameter_lookup(model);
+    for c in &file.checks.conserved {
+        let computed = simulations.get(default_run).and_then(|s| {
+            let mut q0 = None;
+            let mut worst: f64 = 0.0;
+            for (t, y) in s.iter() {
+                let q = state_value(&c.value, model, &parameters, t, y)?;
+                let q0 = *q0.get_or_insert(q);
+                worst = worst.max((q - q0).abs() / q0.abs().max(1.0));
+            }
+            Ok(worst)
+        });
+        checks.push(CheckRow::compare(
+            format!(
+                "conserved `{}`: max |Q − Q(0)|/max(1, |Q(0)|) ({})",
+                c.name.value,
+                default_run.describe()
+            ),
+            computed,
+            0.0,
+            c.tolerance,
+        ));
+    }
+    checks
+}

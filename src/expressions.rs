@@ -1,0 +1,517 @@
+//! Expressions given beside a model (the CLI's `--set`, `--init`, `--t-out`, `--stop-when`
+//! and `--event`), parsed by the model file's own expression parser and evaluated against a
+//! model: parameter assignments, initial values, and event functions added to a simulation.
+//!
+//! Syntax: the model file's expressions (numbers, `pi`, `+ - * / ^`, the functions of the
+//! model format); see `docs/model-format.md`.
+
+use eomgen_runtime::analysis::AddedEvents;
+use eomgen_runtime::{EventDirection, EventSpec, ModelInfo, RhsError, UnknownParameter};
+use eomgen_symbolic::model::parser::{closest, eval_expr, identifiers, parse_expr};
+use eomgen_symbolic::model::{BinOp, Expr, ExprKind, Location};
+
+/// An expression or assignment that could not be used. Each message starts with `what` (the
+/// option or context the text came from, e.g. `--set k`) and says what would be right.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum ExpressionError {
+    /// The text does not parse as an expression.
+    #[error("{what}: `{text}` is not an expression (column {column}): {message}")]
+    Syntax {
+        /// Where the text came from.
+        what: String,
+        /// The text.
+        text: String,
+        /// 1-based column of the mistake.
+        column: u32,
+        /// What is wrong.
+        message: String,
+    },
+    /// The expression names something unknown or cannot be evaluated.
+    #[error("{what}: {message} in `{text}`")]
+    Evaluation {
+        /// Where the text came from.
+        what: String,
+        /// The text.
+        text: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// The value is infinite or NaN.
+    #[error("{what}: `{text}` evaluates to {value}, not a finite number")]
+    NotFinite {
+        /// Where the text came from.
+        what: String,
+        /// The text.
+        text: String,
+        /// The value.
+        value: f64,
+    },
+    /// An assignment without `NAME=VALUE` form.
+    #[error("{option} takes NAME=VALUE, got `{text}` (for example `{option} theta1=pi/2`)")]
+    NotAnAssignment {
+        /// The option (`--set`).
+        option: String,
+        /// The text.
+        text: String,
+    },
+    /// A parameter the model does not have.
+    #[error(transparent)]
+    UnknownParameter(#[from] UnknownParameter),
+    /// An initial value for a name that is neither a coordinate nor a rate.
+    #[error(
+        "{option} {name}: `{model}` has no coordinate or rate `{name}` (coordinates: {coordinates}; rates: {rates})"
+    )]
+    UnknownCoordinate {
+        /// The option (`--init`).
+        option: String,
+        /// The name given.
+        name: String,
+        /// The model's name.
+        model: String,
+        /// The coordinates, comma separated.
+        coordinates: String,
+        /// The rates, comma separated.
+        rates: String,
+    },
+    /// An event's direction that is none of rising, falling, both.
+    #[error(
+        "{option} `{text}`: the direction after the comma must be rising, falling or both, found `{word}`"
+    )]
+    EventDirection {
+        /// The option (`--stop-when`).
+        option: String,
+        /// The whole argument.
+        text: String,
+        /// The word after the comma.
+        word: String,
+    },
+    /// An event function that does not parse.
+    #[error("{option} `{text}`: column {column}: {message}{}", help.as_ref().map(|h| format!(" ({h})")).unwrap_or_default())]
+    EventSyntax {
+        /// The option.
+        option: String,
+        /// The whole argument.
+        text: String,
+        /// 1-based column of the mistake.
+        column: u32,
+        /// What is wrong.
+        message: String,
+        /// What would be right, if known.
+        help: Option<String>,
+    },
+    /// A name in an event function that the model does not have.
+    #[error("{option} `{text}`: column {column}: unknown name `{name}` for model `{model}`; {hint}")]
+    EventUnknownName {
+        /// The option.
+        option: String,
+        /// The whole argument.
+        text: String,
+        /// 1-based column of the name.
+        column: u32,
+        /// The unknown name.
+        name: String,
+        /// The model's name.
+        model: String,
+        /// The closest known name, or every known name.
+        hint: String,
+    },
+}
+
+/// Evaluates `text` as an expression in which names are looked up with `lookup` (`pi` is
+/// known); `what` names where the text came from, for the error.
+///
+/// # Errors
+/// [`ExpressionError::Syntax`], [`ExpressionError::Evaluation`] (an unknown name) or
+/// [`ExpressionError::NotFinite`].
+///
+/// # Examples
+/// ```
+/// let v = eomgen::expressions::evaluate("2*pi/4", "--t-out", &|_| None).unwrap();
+/// assert_eq!(v, std::f64::consts::PI / 2.0);
+/// assert!(eomgen::expressions::evaluate("1/0", "--t-out", &|_| None).is_err());
+/// ```
+pub fn evaluate(
+    text: &str,
+    what: &str,
+    lookup: &dyn Fn(&str) -> Option<f64>,
+) -> Result<f64, ExpressionError> {
+    let start = Location { line: 1, column: 1 };
+    let expr = parse_expr(text, start).map_err(|d| ExpressionError::Syntax {
+        what: what.to_string(),
+        text: text.to_string(),
+        column: d.location.column,
+        message: d.message.clone(),
+    })?;
+    let v = eval_expr(&expr, lookup).map_err(|d| ExpressionError::Evaluation {
+        what: what.to_string(),
+        text: text.to_string(),
+        message: d.message.clone(),
+    })?;
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err(ExpressionError::NotFinite {
+            what: what.to_string(),
+            text: text.to_string(),
+            value: v,
+        })
+    }
+}
+
+/// Splits `NAME=VALUE` into its trimmed halves; `option` names the option for the error.
+///
+/// # Errors
+/// [`ExpressionError::NotAnAssignment`] when either half is empty or there is no `=`.
+pub fn split_assignment<'a>(
+    text: &'a str,
+    option: &str,
+) -> Result<(&'a str, &'a str), ExpressionError> {
+    text.split_once('=')
+        .map(|(n, v)| (n.trim(), v.trim()))
+        .filter(|(n, v)| !n.is_empty() && !v.is_empty())
+        .ok_or_else(|| ExpressionError::NotAnAssignment {
+            option: option.to_string(),
+            text: text.to_string(),
+        })
+}
+
+/// Looks up `model`'s current parameter values by name (for expressions beside a model).
+pub fn parameter_lookup(model: &dyn ModelInfo) -> impl Fn(&str) -> Option<f64> + '_ {
+    let names = model.parameter_names();
+    let values = model.parameter_values();
+    move |n: &str| names.iter().position(|p| *p == n).map(|i| values[i])
+}
+
+/// Applies `NAME=VALUE` parameter assignments in order (a value may use the parameters set
+/// before it), as `--set` does.
+///
+/// # Errors
+/// [`ExpressionError::NotAnAssignment`], an error of [`evaluate`], or
+/// [`ExpressionError::UnknownParameter`].
+///
+/// # Examples
+/// ```
+/// let mut model = (eomgen::models::find("simple_pendulum").unwrap().make)();
+/// eomgen::expressions::set_parameters(model.as_mut(), &["g=9.81", "l=g/pi^2"]).unwrap();
+/// let l = model.parameter_values()[1];
+/// assert_eq!(l, 9.81 / std::f64::consts::PI.powi(2));
+/// ```
+pub fn set_parameters(
+    model: &mut dyn ModelInfo,
+    assignments: &[impl AsRef<str>],
+) -> Result<(), ExpressionError> {
+    for s in assignments {
+        let (name, text) = split_assignment(s.as_ref(), "--set")?;
+        let value = evaluate(text, &format!("--set {name}"), &parameter_lookup(model))?;
+        model.set_parameter(name, value)?;
+    }
+    Ok(())
+}
+
+/// Applies `NAME=VALUE` initial values (`theta1=pi/2`, `theta1_dot=0`; values may use the
+/// parameters) to the state `y = [q; q̇]` of `model`, as `--init` does.
+///
+/// # Shapes
+/// `y` has `2n` entries, `n = model.num_dofs()`.
+///
+/// # Errors
+/// [`ExpressionError::NotAnAssignment`], an error of [`evaluate`], or
+/// [`ExpressionError::UnknownCoordinate`].
+///
+/// # Examples
+/// ```
+/// let model = (eomgen::models::find("simple_pendulum").unwrap().make)();
+/// let mut y = model.initial_state();
+/// eomgen::expressions::set_initial_values(model.as_ref(), &mut y, &["q=pi/6", "q_dot=1"]).unwrap();
+/// assert_eq!(y, [std::f64::consts::PI / 6.0, 1.0]);
+/// ```
+pub fn set_initial_values(
+    model: &dyn ModelInfo,
+    y: &mut [f64],
+    assignments: &[impl AsRef<str>],
+) -> Result<(), ExpressionError> {
+    let n = model.num_dofs();
+    let coordinates = model.coordinate_names();
+    for s in assignments {
+        let (name, text) = split_assignment(s.as_ref(), "--init")?;
+        let value = evaluate(text, &format!("--init {name}"), &parameter_lookup(model))?;
+        let index = coordinates
+            .iter()
+            .position(|c| *c == name)
+            .or_else(|| {
+                coordinates
+                    .iter()
+                    .position(|c| name.strip_suffix("_dot") == Some(c))
+                    .map(|i| n + i)
+            })
+            .ok_or_else(|| {
+                let rates: Vec<String> = coordinates.iter().map(|c| format!("{c}_dot")).collect();
+                ExpressionError::UnknownCoordinate {
+                    option: "--init".to_string(),
+                    name: name.to_string(),
+                    model: model.name().to_string(),
+                    coordinates: coordinates.join(", "),
+                    rates: rates.join(", "),
+                }
+            })?;
+        y[index] = value;
+    }
+    Ok(())
+}
+
+/// Where a name in an added event function takes its value from.
+#[derive(Debug, Clone, Copy)]
+enum Source {
+    /// A parameter (its value when the run starts).
+    Parameter(f64),
+    /// `y[i]`: a coordinate or a rate.
+    State(usize),
+    /// `q̈[i]`.
+    Acceleration(usize),
+    /// `λ[i]`.
+    Multiplier(usize),
+    /// `t`.
+    Time,
+}
+
+/// One added event function.
+#[derive(Debug)]
+struct ExpressionEvent {
+    spec: EventSpec,
+    function: Expr,
+    names: Vec<(String, Source)>,
+}
+
+/// Event functions written as expressions (issue 6, item 2; lecture 17, HW21, HW36): the
+/// CLI's `--stop-when` and `--event`, parsed once and evaluated on the states the integrator
+/// offers, beside the model file's own `events:`. Pass them to
+/// [`simulate_with_events`](eomgen_runtime::analysis::simulate_with_events).
+#[derive(Debug)]
+pub struct ExpressionEvents {
+    events: Vec<ExpressionEvent>,
+    needs_accelerations: bool,
+    needs_multipliers: bool,
+    /// Scratch: `ẏ` (for `q̈`).
+    dy: Vec<f64>,
+}
+
+impl ExpressionEvents {
+    /// Parses terminal (`stop_when`, named `stop_when_K`) and non-terminal (`event`, named
+    /// `event_K`, K counting from 1 over both lists) event functions for `model`. An
+    /// argument that names one of the model's own events makes it terminal (or leaves it as
+    /// is) instead of adding one — this changes `model`.
+    ///
+    /// Syntax: `EXPR`, `LHS = RHS` (the function is `LHS − RHS`), either followed by
+    /// `, rising`, `, falling` or `, both` (default). Names: parameters, coordinates, `t`,
+    /// rates `x_dot`, accelerations `x_ddot`, constraint forces `lambda_<constraint>`, `pi`.
+    ///
+    /// # Errors
+    /// [`ExpressionError::EventDirection`], [`ExpressionError::EventSyntax`] or
+    /// [`ExpressionError::EventUnknownName`], naming the argument, the column and what would
+    /// be right.
+    ///
+    /// # Examples
+    /// ```
+    /// use eomgen::analysis::{SimulationOptions, simulate_with_events};
+    /// use eomgen::expressions::ExpressionEvents;
+    ///
+    /// let mut model = (eomgen::models::find("simple_pendulum").unwrap().make)();
+    /// let mut events = ExpressionEvents::parse(model.as_mut(), &["q_dot = 0, falling"], &[] as &[&str])?;
+    /// let options = SimulationOptions { initial_state: Some(vec![0.5, 0.0]), ..Default::default() };
+    /// let run = simulate_with_events(model.as_mut(), &options, Some(&mut events)).unwrap();
+    /// let stop = &run.solution.events[run.solution.terminated_by_event.unwrap()];
+    /// assert_eq!(stop.name, "stop_when_1");
+    /// # Ok::<(), eomgen::expressions::ExpressionError>(())
+    /// ```
+    pub fn parse(
+        model: &mut dyn ModelInfo,
+        stop_when: &[impl AsRef<str>],
+        event: &[impl AsRef<str>],
+    ) -> Result<Self, ExpressionError> {
+        let mut events = Vec::new();
+        let args = stop_when
+            .iter()
+            .map(|a| (a.as_ref(), true, "--stop-when"))
+            .chain(event.iter().map(|a| (a.as_ref(), false, "--event")));
+        for (k, (text, terminal, option)) in args.enumerate() {
+            let trimmed = text.trim();
+            let own = model.event_specs().iter().any(|e| e.name == trimmed);
+            if own {
+                if terminal {
+                    model.set_event_terminal(trimmed, true);
+                }
+                continue;
+            }
+            events.push(parse_one(model, text, option, terminal, k)?);
+        }
+        let uses =
+            |pred: fn(&Source) -> bool| events.iter().any(|e| e.names.iter().any(|(_, s)| pred(s)));
+        let needs_multipliers = uses(|s| matches!(s, Source::Multiplier(_)));
+        let needs_accelerations = uses(|s| matches!(s, Source::Acceleration(_)));
+        Ok(Self {
+            events,
+            needs_accelerations,
+            needs_multipliers,
+            dy: vec![0.0; 2 * model.num_dofs()],
+        })
+    }
+
+    /// Whether there is nothing to add.
+    pub fn is_empty(&self) -> bool {
+        self.events.is_empty()
+    }
+}
+
+impl AddedEvents for ExpressionEvents {
+    /// The specs of the added events, in argument order (the terminal ones first).
+    fn specs(&self) -> Vec<EventSpec> {
+        self.events.iter().map(|e| e.spec.clone()).collect()
+    }
+
+    /// The added functions at `(t, y)` into `g`.
+    ///
+    /// # Errors
+    /// As the right-hand side, when `q̈` or `λ` is needed and cannot be solved for.
+    fn values(
+        &mut self,
+        model: &mut dyn ModelInfo,
+        t: f64,
+        y: &[f64],
+        g: &mut [f64],
+    ) -> Result<(), RhsError> {
+        if self.needs_accelerations {
+            model.rhs(t, y, &mut self.dy)?;
+        }
+        let lambda = if self.needs_multipliers {
+            model.constraint_forces(t, y)?
+        } else {
+            Vec::new()
+        };
+        let n = self.dy.len() / 2;
+        for (event, out) in self.events.iter().zip(g.iter_mut()) {
+            let lookup = |name: &str| {
+                let (_, source) = event.names.iter().find(|(n, _)| n == name)?;
+                Some(match *source {
+                    Source::Parameter(v) => v,
+                    Source::State(i) => y[i],
+                    Source::Acceleration(i) => self.dy[n + i],
+                    Source::Multiplier(i) => lambda.get(i).copied().unwrap_or(f64::NAN),
+                    Source::Time => t,
+                })
+            };
+            // Every name was resolved when parsing, so the only failure left is NaN.
+            *out = eval_expr(&event.function, &lookup).unwrap_or(f64::NAN);
+        }
+        Ok(())
+    }
+}
+
+/// Parses one `EXPR[, direction]` argument.
+fn parse_one(
+    model: &dyn ModelInfo,
+    text: &str,
+    option: &str,
+    terminal: bool,
+    k: usize,
+) -> Result<ExpressionEvent, ExpressionError> {
+    let (body, direction) = match text.rsplit_once(',') {
+        Some((body, word)) => {
+            let word = word.trim();
+            let direction = EventDirection::from_name(word).ok_or_else(|| {
+                ExpressionError::EventDirection {
+                    option: option.to_string(),
+                    text: text.to_string(),
+                    word: word.to_string(),
+                }
+            })?;
+            (body, direction)
+        }
+        None => (text, EventDirection::Both),
+    };
+    let at = Location { line: 1, column: 1 };
+    let parse = |part: &str, offset: usize| {
+        parse_expr(part, at.offset(offset)).map_err(|d| ExpressionError::EventSyntax {
+            option: option.to_string(),
+            text: text.to_string(),
+            column: d.location.column,
+            message: d.message.clone(),
+            help: d.help.clone(),
+        })
+    };
+    let function = match body.split_once('=') {
+        Some((lhs, rhs)) => {
+            let (l, r) = (parse(lhs, 0)?, parse(rhs, lhs.chars().count() + 1)?);
+            Expr {
+                location: l.location,
+                kind: ExprKind::Binary {
+                    op: BinOp::Sub,
+                    lhs: Box::new(l),
+                    rhs: Box::new(r),
+                },
+            }
+        }
+        None => parse(body, 0)?,
+    };
+    let names = resolve(model, &function, text, option)?;
+    let name = if terminal {
+        format!("stop_when_{}", k + 1)
+    } else {
+        format!("event_{}", k + 1)
+    };
+    Ok(ExpressionEvent {
+        spec: EventSpec::new(name, direction, terminal),
+        function,
+        names,
+    })
+}
+
+/// The source of every name in `function`, or an error with a suggestion.
+fn resolve(
+    model: &dyn ModelInfo,
+    function: &Expr,
+    text: &str,
+    option: &str,
+) -> Result<Vec<(String, Source)>, ExpressionError> {
+    let n = model.num_dofs();
+    let mut known: Vec<(String, Source)> = Vec::new();
+    for (name, value) in model.parameter_names().iter().zip(model.parameter_values()) {
+        known.push((name.to_string(), Source::Parameter(value)));
+    }
+    for (i, c) in model.coordinate_names().iter().enumerate() {
+        known.push((c.to_string(), Source::State(i)));
+        known.push((format!("{c}_dot"), Source::State(n + i)));
+        known.push((format!("{c}_ddot"), Source::Acceleration(i)));
+    }
+    for (i, c) in model.constraint_names().iter().enumerate() {
+        known.push((format!("lambda_{c}"), Source::Multiplier(i)));
+    }
+    known.push(("t".to_string(), Source::Time));
+    let mut ids = Vec::new();
+    identifiers(function, &mut ids);
+    let mut names = Vec::new();
+    for (id, at) in ids {
+        if id == "pi" || names.iter().any(|(n, _)| *n == id) {
+            continue;
+        }
+        match known.iter().find(|(n, _)| *n == id) {
+            Some(entry) => names.push(entry.clone()),
+            None => {
+                let candidates: Vec<&str> = known.iter().map(|(n, _)| n.as_str()).collect();
+                let hint = match closest(&id, &candidates) {
+                    Some(c) => format!("did you mean `{c}`?"),
+                    None => format!("names here are: {}, pi", candidates.join(", ")),
+                };
+                return Err(ExpressionError::EventUnknownName {
+                    option: option.to_string(),
+                    text: text.to_string(),
+                    column: at.column,
+                    name: id,
+                    model: model.name().to_string(),
+                    hint,
+                });
+            }
+        }
+    }
+    Ok(names)
+}

@@ -1,0 +1,3 @@
+eomgen::model!("minimal-twin-itself.yaml");
+
+fn main() {}
