@@ -223,7 +223,9 @@ pub struct ModesAt {
 ///
 /// # Errors
 /// The model file's diagnostics, when it cannot be derived.
-pub fn derivation_checks(file: &ModelFile) -> Result<(Vec<CheckRow>, Vec<String>), Vec<Diagnostic>> {
+pub fn derivation_checks(
+    file: &ModelFile,
+) -> Result<(Vec<CheckRow>, Vec<String>), Vec<Diagnostic>> {
     let r = check_model(file, DERIVATION_STATES, DERIVATION_SEED)?;
     let mut rows = Vec::new();
     for c in &r.comparisons {
@@ -471,7 +473,13 @@ pub fn motion_checks(
             "period between the last two `{event}` events (s) ({})",
             run.describe()
         );
-        checks.push(against_expected(what, computed, &check.value, model, check.tolerance));
+        checks.push(against_expected(
+            what,
+            computed,
+            &check.value,
+            model,
+            check.tolerance,
+        ));
     }
     if let Some(check) = &file.checks.final_state {
         match expected(&check.t, model) {

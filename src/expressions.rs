@@ -101,7 +101,9 @@ pub enum ExpressionError {
         help: Option<String>,
     },
     /// A name in an event function that the model does not have.
-    #[error("{option} `{text}`: column {column}: unknown name `{name}` for model `{model}`; {hint}")]
+    #[error(
+        "{option} `{text}`: column {column}: unknown name `{name}` for model `{model}`; {hint}"
+    )]
     EventUnknownName {
         /// The option.
         option: String,
@@ -418,13 +420,12 @@ fn parse_one(
     let (body, direction) = match text.rsplit_once(',') {
         Some((body, word)) => {
             let word = word.trim();
-            let direction = EventDirection::from_name(word).ok_or_else(|| {
-                ExpressionError::EventDirection {
+            let direction =
+                EventDirection::from_name(word).ok_or_else(|| ExpressionError::EventDirection {
                     option: option.to_string(),
                     text: text.to_string(),
                     word: word.to_string(),
-                }
-            })?;
+                })?;
             (body, direction)
         }
         None => (text, EventDirection::Both),

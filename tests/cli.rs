@@ -42,7 +42,7 @@ fn simulate_json_samples_exactly_at_requested_times() {
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(v["model"], "simple_pendulum");
     assert_eq!(v["coordinates"], serde_json::json!(["q"]));
-    assert_eq!(v["method"], "dopri5");
+    assert_eq!(v["method"], "dp54");
     let samples = v["samples"].as_array().unwrap();
     let times: Vec<f64> = samples.iter().map(|s| s["t"].as_f64().unwrap()).collect();
     assert_eq!(times, [0.5, 1.0, std::f64::consts::FRAC_PI_2]);

@@ -320,7 +320,10 @@ fn constraint_methods_compare_springs_dae_and_minimal() {
     )
     .unwrap();
     let minimal = study.rows.last().unwrap();
-    assert_eq!(minimal.method, "II.3: minimal coordinates (simple_pendulum)");
+    assert_eq!(
+        minimal.method,
+        "II.3: minimal coordinates (simple_pendulum)"
+    );
     assert!(minimal.drift.is_none());
     assert!(minimal.position_error < 1e-6, "{}", minimal.position_error);
 }

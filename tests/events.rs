@@ -160,8 +160,8 @@ fn stop_when_and_event_expressions() {
     let mut m = model("double_pendulum");
     let mut events =
         ExpressionEvents::parse(m.as_mut(), &["theta2 = 0, falling"], &["theta1_dot"]).unwrap();
-    let run = simulate_with_events(m.as_mut(), &SimulationOptions::default(), Some(&mut events))
-        .unwrap();
+    let run =
+        simulate_with_events(m.as_mut(), &SimulationOptions::default(), Some(&mut events)).unwrap();
     let s = &run.solution;
     let last = &s.events[s.terminated_by_event.expect("stopped")];
     assert_eq!(last.name, "stop_when_1");
@@ -169,14 +169,18 @@ fn stop_when_and_event_expressions() {
     assert!(last.y[1].abs() < 1e-12, "theta2 = {}", last.y[1]);
     assert!(last.y[3] < 0.0);
     assert_eq!(s.t.last(), Some(&last.t));
-    assert!(s.events.iter().all(|e| ["stop_when_1", "event_2"].contains(&e.name.as_str())));
+    assert!(
+        s.events
+            .iter()
+            .all(|e| ["stop_when_1", "event_2"].contains(&e.name.as_str()))
+    );
     // A model event made terminal by name: nothing is added. The return of the pendulum
     // released from the horizontal comes after a whole period, 4 K(1/√2) √(l/g).
     let mut m = model("simple_pendulum");
     let mut events = ExpressionEvents::parse(m.as_mut(), &["return"], &[] as &[&str]).unwrap();
     assert!(events.is_empty());
-    let run = simulate_with_events(m.as_mut(), &SimulationOptions::default(), Some(&mut events))
-        .unwrap();
+    let run =
+        simulate_with_events(m.as_mut(), &SimulationOptions::default(), Some(&mut events)).unwrap();
     let stop = &run.solution.events[run.solution.terminated_by_event.expect("stopped")];
     assert_eq!(stop.name, "return");
     let period = 4.0 * elliptic_k(1.0 / 2f64.sqrt()) * (1.0f64 / 10.0).sqrt();
@@ -186,13 +190,21 @@ fn stop_when_and_event_expressions() {
     let mut events =
         ExpressionEvents::parse(m.as_mut(), &["lambda_contact - 5, falling"], &[] as &[&str])
             .unwrap();
-    let run = simulate_with_events(m.as_mut(), &SimulationOptions::default(), Some(&mut events))
-        .unwrap();
+    let run =
+        simulate_with_events(m.as_mut(), &SimulationOptions::default(), Some(&mut events)).unwrap();
     assert_eq!(
-        run.solution.terminated_by_event.map(|k| run.solution.events[k].name.as_str()),
+        run.solution
+            .terminated_by_event
+            .map(|k| run.solution.events[k].name.as_str()),
         Some("stop_when_1")
     );
-    let last = run.constraints.lagrange_multipliers.last().unwrap().as_ref().unwrap();
+    let last = run
+        .constraints
+        .lagrange_multipliers
+        .last()
+        .unwrap()
+        .as_ref()
+        .unwrap();
     assert!((last[0] - 5.0).abs() < 1e-6, "lambda = {}", last[0]);
 }
 
@@ -214,7 +226,10 @@ fn stop_when_on_the_command_line() {
     let last = v["events"].as_array().unwrap().last().unwrap().clone();
     assert_eq!(last["name"], "stop_when_1");
     assert_eq!(last["direction"], "falling");
-    assert_eq!(v["samples"].as_array().unwrap().last().unwrap()["t"], last["t"]);
+    assert_eq!(
+        v["samples"].as_array().unwrap().last().unwrap()["t"],
+        last["t"]
+    );
     let out = eomgen(&["simulate", "simple_pendulum", "--stop-when", "return"]);
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(out.status.success());
@@ -225,15 +240,16 @@ fn stop_when_on_the_command_line() {
 #[test]
 fn bad_event_expressions_are_typed_errors() {
     let mut m = model("double_pendulum");
-    let error = ExpressionEvents::parse(m.as_mut(), &["x + theta2_dott"], &[] as &[&str]).unwrap_err();
+    let error =
+        ExpressionEvents::parse(m.as_mut(), &["x + theta2_dott"], &[] as &[&str]).unwrap_err();
     match error {
         ExpressionError::EventUnknownName { column, name, .. } => {
             assert_eq!((column, name.as_str()), (1, "x"));
         }
         other => panic!("{other:?}"),
     }
-    let error = ExpressionEvents::parse(m.as_mut(), &["theta2", "theta2, up"], &[] as &[&str])
-        .unwrap_err();
+    let error =
+        ExpressionEvents::parse(m.as_mut(), &["theta2", "theta2, up"], &[] as &[&str]).unwrap_err();
     assert!(matches!(error, ExpressionError::EventDirection { ref word, .. } if word == "up"));
 }
 

@@ -240,7 +240,11 @@ fn conservative_models_conserve_energy() {
         let times: Vec<f64> = (1..=100).map(|i| 0.1 * f64::from(i)).collect();
         let s = solve(m.as_mut(), &y0, 10.0, times, &tight());
         let drift = energy_drift(m.as_ref(), &y0, &s);
-        assert!(drift.scale > 0.0, "{}: motion has no energy scale", entry.name);
+        assert!(
+            drift.scale > 0.0,
+            "{}: motion has no energy scale",
+            entry.name
+        );
         let relative = drift.drift.expect("samples");
         assert!(
             relative <= 1e-10,

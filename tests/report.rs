@@ -507,7 +507,10 @@ fn checks_of_a_file_through_the_library() {
     let text = std::fs::read_to_string(path).unwrap();
     let file = eomgen_symbolic::model::load(path, &text).expect("loads");
     let (rows, _notes) = derivation_checks(&file).expect("derives");
-    assert!(!rows.is_empty() && rows.iter().all(|r| r.passed), "{rows:?}");
+    assert!(
+        !rows.is_empty() && rows.iter().all(|r| r.passed),
+        "{rows:?}"
+    );
     let source = eomgen::ModelSource::open(path).expect("compiles");
     let mut model = source.instantiate();
     let y0 = model.consistent_initial_state().unwrap();

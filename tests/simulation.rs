@@ -27,12 +27,16 @@ fn sampled_times_follow_the_small_angle_solution() {
     };
     let run = simulate(m.as_mut(), &options).unwrap();
     assert_eq!(run.method, Method::Dp54);
-    assert_eq!(run.integrator, "dopri5");
+    assert_eq!(run.integrator, "dp54");
     assert_eq!(run.solution.t, times);
     let omega = 10f64.sqrt();
     for (t, y) in run.solution.iter() {
         let exact = q0 * (omega * t).cos();
-        assert!((y[0] - hanging - exact).abs() < 1e-9, "t = {t}: {}", y[0] - hanging);
+        assert!(
+            (y[0] - hanging - exact).abs() < 1e-9,
+            "t = {t}: {}",
+            y[0] - hanging
+        );
     }
     assert_eq!(run.energy.energy.len(), 3);
     assert!(run.constraints.is_empty());
@@ -70,7 +74,11 @@ fn invalid_options_are_typed_errors() {
         ..SimulationOptions::default()
     };
     match simulate(m.as_mut(), &options).unwrap_err() {
-        SimulationError::InconsistentInitialState { constraint, residual, .. } => {
+        SimulationError::InconsistentInitialState {
+            constraint,
+            residual,
+            ..
+        } => {
             assert_eq!(constraint, "rod");
             assert!(residual > 1.0);
         }
@@ -115,10 +123,17 @@ fn projection_removes_the_constraint_drift() {
             stabilization,
             ..SimulationOptions::default()
         };
-        simulate(m.as_mut(), &options).unwrap().constraints.max_drift().0
+        simulate(m.as_mut(), &options)
+            .unwrap()
+            .constraints
+            .max_drift()
+            .0
     };
     let free = drift(Stabilization::None);
     let projected = drift(Stabilization::Projection);
     assert!(projected < 1e-9, "projected drift {projected}");
-    assert!(free > 100.0 * projected, "free {free}, projected {projected}");
+    assert!(
+        free > 100.0 * projected,
+        "free {free}, projected {projected}"
+    );
 }

@@ -85,7 +85,7 @@ fn explicit_stability_limits_match_theory_to_one_percent() {
                 ((measured - at_detection) / at_detection).abs() < 1e-4,
                 "{name} {equation:?}: measured {measured} vs theory(N) {at_detection}"
             );
-            if name == "dopri5" && equation == TestEquation::Oscillator {
+            if name == "dp54" && equation == TestEquation::Oscillator {
                 assert!(measured > theory);
                 let beyond = r.eval(Complex::new(0.0, 1.01 * theory)).norm() - 1.0;
                 assert!(TEST.steps_to_detect(beyond) > TEST.steps, "{beyond}");

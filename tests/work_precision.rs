@@ -81,11 +81,18 @@ fn reference_is_verified_and_adaptive_errors_fall_with_the_tolerance() {
             })
             .collect();
         assert_eq!(tols, [1e-4, 1e-7, 1e-10], "{method}: loosest first");
-        let measured: Vec<&Measured> = r.runs.iter().map(|run| run.outcome.as_ref().unwrap()).collect();
+        let measured: Vec<&Measured> = r
+            .runs
+            .iter()
+            .map(|run| run.outcome.as_ref().unwrap())
+            .collect();
         let e: Vec<f64> = measured.iter().map(|m| m.error).collect();
         assert!(e[2] * 100.0 <= e[0], "{method}: errors {e:?}");
         for (err, tol) in e.iter().zip(&tols) {
-            assert!(*err > 0.0 && *err < 100.0 * tol, "{method}: {err} at tol {tol}");
+            assert!(
+                *err > 0.0 && *err < 100.0 * tol,
+                "{method}: {err} at tol {tol}"
+            );
         }
         for m in measured {
             assert!(!study.unresolved(m), "{method}: {m:?}");
@@ -127,7 +134,11 @@ fn fixed_step_errors_fall_at_the_method_order() {
             .collect();
         assert_eq!(steps, [32, 64, 128, 256], "{method}");
         let expected = f64::from(1u32 << order);
-        let e: Vec<f64> = r.runs.iter().map(|run| run.outcome.as_ref().unwrap().error).collect();
+        let e: Vec<f64> = r
+            .runs
+            .iter()
+            .map(|run| run.outcome.as_ref().unwrap().error)
+            .collect();
         for pair in e.windows(2) {
             let ratio = pair[0] / pair[1];
             assert!(

@@ -317,7 +317,7 @@ fn every_integrator_solves_every_reference_problem() {
                 "rk4" => assert_eq!(stats.rhs_evals, 4 * stats.steps + 1, "{label}"),
                 // Per attempt (FSAL), plus F(t0) and the initial-step probe.
                 "bs32" => assert_eq!(stats.rhs_evals, 3 * attempts + 2, "{label}"),
-                "dopri5" => assert_eq!(stats.rhs_evals, 6 * attempts + 2, "{label}"),
+                "dp54" => assert_eq!(stats.rhs_evals, 6 * attempts + 2, "{label}"),
                 // Eleven per attempt, one at each accepted state, F(t0) and the probe.
                 "dop853" => assert_eq!(stats.rhs_evals, 11 * attempts + stats.steps + 2, "{label}"),
                 // At least one Newton evaluation per step (two, to confirm the residual) and
@@ -962,7 +962,7 @@ fn blow_up_stops_near_the_singularity() {
         };
         assert!((t - 1.0).abs() < window, "{label}");
         assert!(failure.partial.y.iter().all(|v| v.is_finite()), "{label}");
-        if method.name() == "dopri5" {
+        if method.name() == "dp54" {
             // The samples follow 1/(1 − t) to within the tolerance, up to y ~ 1e5 at least.
             let (t_last, y_last) = failure.partial.last().expect("samples");
             assert!(y_last[0] > 1e5, "{label}: reached y = {}", y_last[0]);

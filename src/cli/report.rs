@@ -24,9 +24,9 @@ use clap::Args;
 use rayon::prelude::*;
 use serde_json::json;
 
-pub(super) use eomgen::checks::CheckRow;
 use eomgen::ModelInfo;
 use eomgen::analysis::{constraint_drift, energy_drift};
+pub(super) use eomgen::checks::CheckRow;
 use eomgen::checks::{CheckRun, DERIVATION_TOLERANCE, ModesAt, Simulations, derivation_checks};
 use eomgen_symbolic::codegen::equations_mathml;
 use eomgen_symbolic::mechanics::{Formulation, Lagrange, SymbolicModel};

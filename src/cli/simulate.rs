@@ -25,9 +25,7 @@ fn method_help(method: Method) -> &'static str {
         Method::Rk4 => "Classical Runge–Kutta 4, fixed step `--dt`",
         Method::Bs32 => "Bogacki–Shampine 3(2) (ode23), adaptive, Hermite dense output",
         Method::Dp54 => "Dormand–Prince 5(4), adaptive, dense output (default)",
-        Method::Dop853 => {
-            "DOP853, Hairer's Dormand–Prince 8(5,3), adaptive, order-7 dense output"
-        }
+        Method::Dop853 => "DOP853, Hairer's Dormand–Prince 8(5,3), adaptive, order-7 dense output",
         Method::SymplecticEuler => {
             "Symplectic Euler, order 1, fixed step `--dt` (symplectic for constant M and velocity-independent forces)"
         }
@@ -188,7 +186,7 @@ pub(crate) struct Run {
     pub solution: Solution,
     /// Why the integration stopped early, if it did.
     pub failure: Option<IntegrationError>,
-    /// The integrator's name (`dopri5`).
+    /// The integrator's name (`dp54`).
     pub method_name: &'static str,
 }
 
@@ -383,8 +381,8 @@ fn simulation(
     set_parameters(model.as_mut(), &args.set)?;
     let mut y0 = model.initial_state();
     set_initial_values(model.as_ref(), &mut y0, &args.init).map_err(usage)?;
-    let mut added = ExpressionEvents::parse(model.as_mut(), &args.stop_when, &args.event)
-        .map_err(usage)?;
+    let mut added =
+        ExpressionEvents::parse(model.as_mut(), &args.stop_when, &args.event).map_err(usage)?;
     let options = args.simulation_options(output, y0);
     let added: Option<&mut dyn AddedEvents> = if added.is_empty() {
         None

@@ -15,9 +15,9 @@ use std::io::Write as _;
 
 use clap::Args;
 use eomgen::analysis::stability::{
-    AMPLIFICATION_STEPS, BISECTION_TOLERANCE, EnergyRow, ExplicitMethod, GROWTH_THRESHOLD,
-    Limits, STIFF_OUTPUT_TIMES, STIFF_REFERENCE_TOL, StabilityError, StabilityOptions,
-    StabilityStudy, StiffMode, StiffRow, UnderflowRun, stability_study,
+    AMPLIFICATION_STEPS, BISECTION_TOLERANCE, EnergyRow, ExplicitMethod, GROWTH_THRESHOLD, Limits,
+    STIFF_OUTPUT_TIMES, STIFF_REFERENCE_TOL, StabilityError, StabilityOptions, StabilityStudy,
+    StiffMode, StiffRow, UnderflowRun, stability_study,
 };
 use eomgen::integrate::stability::GrowthTest;
 use nalgebra::Complex;
@@ -56,9 +56,7 @@ pub struct StabilityArgs {
 fn study_error(error: StabilityError) -> CliError {
     match error {
         StabilityError::InvalidSteps { .. } => CliError::usage("--steps must be in [100, 10⁷]"),
-        StabilityError::InvalidPeriods { .. } => {
-            CliError::usage("--periods must be in [1, 10⁶]")
-        }
+        StabilityError::InvalidPeriods { .. } => CliError::usage("--periods must be in [1, 10⁶]"),
         StabilityError::InvalidStiffness => {
             CliError::usage("--stiffness takes ratios k/m in (0, 1e10], comma separated")
         }

@@ -136,7 +136,7 @@ fn constraint_methods(args: &ConstraintMethodsArgs) -> Result<(), CliError> {
             "model": model,
             "t_end": args.t_end,
             "tol": args.tol,
-            "reference": {"method": "dopri5, DAE with Baumgarte α = β = 10/s", "tol": reference_tol, "agreement_with_unstabilised_dae_m": agreement},
+            "reference": {"method": "dp54, DAE with Baumgarte α = β = 10/s", "tol": reference_tol, "agreement_with_unstabilised_dae_m": agreement},
             "methods": rows.iter().map(|r| json!({
                 "method": r.method,
                 "position_error_m": r.position_error,
@@ -154,9 +154,7 @@ fn constraint_methods(args: &ConstraintMethodsArgs) -> Result<(), CliError> {
         let _ = writeln!(
             stdout,
             "model      {} over 0 ≤ t ≤ {} s, Dormand–Prince 5(4) at rtol = atol = {:e}",
-            model,
-            args.t_end,
-            args.tol
+            model, args.t_end, args.tol
         );
         let _ = writeln!(
             stdout,

@@ -34,9 +34,9 @@ fn study_error(args: &WorkPrecisionArgs, error: WorkPrecisionError) -> CliError 
                 "--reference-tol must be in (0, 1e-6), far tighter than the tolerances studied, got {reference_tol}"
             ))
         }
-        WorkPrecisionError::InvalidBaseline { baseline_ms } => CliError::usage(format!(
-            "--baseline-ms must be positive, got {baseline_ms}"
-        )),
+        WorkPrecisionError::InvalidBaseline { baseline_ms } => {
+            CliError::usage(format!("--baseline-ms must be positive, got {baseline_ms}"))
+        }
         WorkPrecisionError::InvalidMinTime { .. } => CliError::usage(format!(
             "--min-time-ms must be ≥ 0, got {}",
             args.min_time_ms
@@ -127,9 +127,8 @@ fn parse_tols(text: &str) -> Result<Vec<f64>, CliError> {
     };
     let mut tols = if let Some((a, b)) = text.split_once("..") {
         let (a, b) = (number(a)?, number(b)?);
-        decades(a, b).ok_or_else(|| {
-            bad("the two ends of a range must be a whole number of decades apart")
-        })?
+        decades(a, b)
+            .ok_or_else(|| bad("the two ends of a range must be a whole number of decades apart"))?
     } else {
         text.split(',').map(number).collect::<Result<Vec<_>, _>>()?
     };

@@ -389,4 +389,3 @@ fn notes(rows: &[RoundoffRow], summaries: &[RoundoffSummary]) -> Vec<String> {
     }
     notes
 }
-

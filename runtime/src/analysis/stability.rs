@@ -445,8 +445,9 @@ pub struct ExplicitMethod {
 /// The explicit methods, their polynomials from their tableaus (DOP853's from one step of it,
 /// its tableau being private), each checked against one step of its implementation.
 fn explicit_methods() -> Result<Vec<ExplicitMethod>, StabilityError> {
-    let failed =
-        |e: IntegrationFailure| StabilityError::PolynomialStep { message: e.to_string() };
+    let failed = |e: IntegrationFailure| StabilityError::PolynomialStep {
+        message: e.to_string(),
+    };
     let mut methods = Vec::new();
     for (tableau, mut method) in explicit_tableau_methods() {
         let polynomial = StabilityPolynomial::of_tableau(&tableau);
@@ -834,12 +835,16 @@ fn stiff_runs(
                     .with_max_steps(20_000_000);
                 method.integrate(model.as_ode_mut(), 0.0, &y0, args.t_end, &output, &options)
             };
-            let reference = run(&mut DormandPrince853::new(), &mut *model, STIFF_REFERENCE_TOL)
-                .map_err(|e| StabilityError::Reference {
-                    k_over_m: ratio,
-                    start,
-                    message: e.to_string(),
-                })?;
+            let reference = run(
+                &mut DormandPrince853::new(),
+                &mut *model,
+                STIFF_REFERENCE_TOL,
+            )
+            .map_err(|e| StabilityError::Reference {
+                k_over_m: ratio,
+                start,
+                message: e.to_string(),
+            })?;
             modes.push(StiffMode {
                 k_over_m: ratio,
                 start,
@@ -914,4 +919,3 @@ fn underflow_run(tol: f64) -> UnderflowRun {
         failure: result.err().as_ref().map(Failure::of),
     }
 }
-

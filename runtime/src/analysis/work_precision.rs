@@ -763,6 +763,9 @@ mod tests {
     fn default_steps_span_by_order() {
         assert_eq!(default_steps(1).first(), Some(&1024));
         assert_eq!(default_steps(2).first(), Some(&256));
-        assert_eq!(default_steps(4), (6..=16).map(|k| 1 << k).collect::<Vec<_>>());
+        assert_eq!(
+            default_steps(4),
+            (6..=16).map(|k| 1 << k).collect::<Vec<_>>()
+        );
     }
 }

@@ -99,7 +99,7 @@ impl DormandPrince54 {
 
 impl Integrator for DormandPrince54 {
     fn name(&self) -> &'static str {
-        "dopri5"
+        "dp54"
     }
 
     fn order(&self) -> u32 {

@@ -101,7 +101,7 @@ use crate::ode::OdeSystem;
 ///
 /// Object safe: the CLI holds methods as `Box<dyn Integrator>`.
 pub trait Integrator {
-    /// Short name of the method (`"euler"`, `"midpoint"`, `"rk4"`, `"bs32"`, `"dopri5"`,
+    /// Short name of the method (`"euler"`, `"midpoint"`, `"rk4"`, `"bs32"`, `"dp54"`,
     /// `"dop853"`, `"symplectic-euler"`, `"stormer-verlet"`, `"implicit-midpoint"`,
     /// `"radau5"`).
     fn name(&self) -> &'static str;

@@ -302,7 +302,7 @@ impl Tableau {
     ///   2nd ed., Springer, 1993, §II.5–II.6, doi:10.1007/978-3-540-78862-1.
     pub fn dopri5() -> Self {
         Self {
-            name: "dopri5",
+            name: "dp54",
             order: 5,
             embedded_order: Some(4),
             c: &DOPRI5_C,
@@ -315,7 +315,7 @@ impl Tableau {
         }
     }
 
-    /// Short name of the method (`"euler"`, `"midpoint"`, `"rk4"`, `"bs32"`, `"dopri5"`).
+    /// Short name of the method (`"euler"`, `"midpoint"`, `"rk4"`, `"bs32"`, `"dp54"`), as a front end selects it.
     pub fn name(&self) -> &'static str {
         self.name
     }

@@ -538,6 +538,27 @@ fn arguments(n: usize) -> String {
 fn unknown_function(name: &str, loc: Location) -> Diagnostic {
     let known: Vec<&str> = FUNCTIONS.iter().map(|(f, _)| *f).collect();
     let d = Diagnostic::new(loc, format!("unknown function `{name}`"));
+    // Other names of the same functions, which spelling distance would not find.
+    let alias = match name {
+        "log" | "log10" | "log2" => Some("ln"),
+        "arcsin" => Some("asin"),
+        "arccos" => Some("acos"),
+        "arctan" => Some("atan"),
+        "sgn" | "signum" => Some("sign"),
+        "heaviside" => Some("step"),
+        _ => None,
+    };
+    if let Some(alias) = alias {
+        let note = if name == "log" {
+            " (the natural logarithm)"
+        } else {
+            ""
+        };
+        return d.with_help(format!(
+            "did you mean `{alias}`{note}? functions are: {}",
+            known.join(", ")
+        ));
+    }
     match closest(name, &known) {
         Some(c) => d.with_help(format!(
             "did you mean `{c}`? functions are: {}",
@@ -794,6 +815,25 @@ mod tests {
         assert!((v - (2.0 * std::f64::consts::PI - 2.0 + 9.0)).abs() < 1e-12);
         let e = parse_expr("b", Location::default()).unwrap();
         assert!(eval_expr(&e, &|_| None).is_err());
+    }
+
+    /// `log` is the natural logarithm's other name: the help says `ln`, not the nearest
+    /// spelling (`cos`).
+    #[test]
+    fn other_names_of_functions() {
+        let e = err("log(x)");
+        assert!(
+            e.help.as_deref().unwrap().starts_with("did you mean `ln`"),
+            "{e:?}"
+        );
+        let e = err("arctan(x)");
+        assert!(
+            e.help
+                .as_deref()
+                .unwrap()
+                .starts_with("did you mean `atan`"),
+            "{e:?}"
+        );
     }
 
     #[test]
