@@ -22,6 +22,7 @@ use plotters::prelude::*;
 use super::mode_plot::{self, Frame, Layout};
 use super::render::escape;
 use super::simulate::{IntegrationArgs, Run, failure_error, integrate};
+use super::output::outln;
 use super::{CliError, plot};
 
 /// The stylesheet, the error hooks (first script: they record script errors and
@@ -83,7 +84,7 @@ pub fn run(args: &AnimateArgs) -> Result<(), CliError> {
     };
     let html = animation.to_html();
     write(&args.output, &html)?;
-    println!(
+    outln!(
         "animation  {} ({} frames, {:.1} kB)",
         args.output,
         animation.clips[0].t.len(),
@@ -91,7 +92,7 @@ pub fn run(args: &AnimateArgs) -> Result<(), CliError> {
     );
     if let Some(path) = &args.gif {
         animation.write_gif(path, 0)?;
-        println!("gif        {path}");
+        outln!("gif        {path}");
     }
     match failure {
         None => Ok(()),

@@ -4,6 +4,7 @@ use clap::Args;
 use serde_json::json;
 
 use super::CliError;
+use super::output::outln;
 use eomgen_symbolic::mechanics::check::{CheckReport, check_model};
 
 /// Relative tolerance of every check: the derivations differ only by rounding (~1e-14).
@@ -34,7 +35,7 @@ pub fn run(args: &CheckArgs) -> Result<(), CliError> {
     let report = check_model(&file, args.states, 0x5EED)
         .map_err(|diagnostics| super::diagnostics_error(&display, &source, &diagnostics))?;
     if args.json {
-        println!(
+        outln!(
             "{}",
             serde_json::to_string_pretty(&to_json(&report, args.timing))
                 .map_err(|e| CliError::failure(e.to_string()))?
@@ -80,9 +81,9 @@ fn to_json(r: &CheckReport, timing: bool) -> serde_json::Value {
 
 fn print_report(r: &CheckReport) {
     let mark = |ok: bool| if ok { "ok  " } else { "FAIL" };
-    println!("model {}", r.model);
+    outln!("model {}", r.model);
     for c in &r.comparisons {
-        println!(
+        outln!(
             "{} {} vs {}: max relative difference of q'' {:.2e} over {} states; symbolically equal: {}",
             mark(c.max_rel_residual <= TOLERANCE),
             c.a,
@@ -97,14 +98,14 @@ fn print_report(r: &CheckReport) {
         );
     }
     if let Some(p) = &r.power_balance {
-        println!(
+        outln!(
             "{} power balance dE/dt = Q·q': max relative residual {:.2e}",
             mark(p.max_rel_residual <= TOLERANCE),
             p.max_rel_residual
         );
     }
     for d in &r.derivations {
-        println!(
+        outln!(
             "     {:<9} derived in {:.3} ms: {} operations, {} after CSE",
             d.name,
             d.time_s * 1e3,
@@ -113,6 +114,6 @@ fn print_report(r: &CheckReport) {
         );
     }
     for n in &r.notes {
-        println!("note {n}");
+        outln!("note {n}");
     }
 }

@@ -4,6 +4,7 @@
 use clap::{Args, ValueEnum};
 
 use super::CliError;
+use super::output::out;
 use eomgen_symbolic::codegen::{GenerateError, equations_latex, equations_text};
 use eomgen_symbolic::mechanics::{Formulation, Lagrange, MomentumBalance, SymbolicModel};
 use eomgen_symbolic::model::templates;
@@ -86,7 +87,7 @@ pub fn run(args: &EquationsArgs) -> Result<(), CliError> {
         })?;
         let code = syn::parse2::<syn::File>(tokens)
             .map_err(|e| CliError::failure(format!("the generated code does not parse: {e}")))?;
-        print!("{}", prettyplease::unparse(&code));
+        out!("{}", prettyplease::unparse(&code));
         return Ok(());
     }
     let mut model = SymbolicModel::from_file(&file).map_err(|d| render(&display, &source, &d))?;
@@ -103,9 +104,9 @@ pub fn run(args: &EquationsArgs) -> Result<(), CliError> {
         }
     };
     if args.latex {
-        print!("{}", equations_latex(&model, &eom));
+        out!("{}", equations_latex(&model, &eom));
     } else {
-        print!("{}", equations_text(&model, &eom));
+        out!("{}", equations_text(&model, &eom));
     }
     Ok(())
 }
@@ -114,6 +115,6 @@ pub fn run(args: &EquationsArgs) -> Result<(), CliError> {
 pub fn new(args: &NewArgs) -> Result<(), CliError> {
     let text =
         templates::generate(&args.template, args.n).map_err(|e| CliError::usage(e.to_string()))?;
-    print!("{text}");
+    out!("{text}");
     Ok(())
 }

@@ -148,7 +148,7 @@ pub fn run(args: &FloquetArgs) -> Result<(), CliError> {
             _ => None,
         },
     };
-    let mut stdout = std::io::stdout().lock();
+    let mut stdout = super::output::stdout();
     if args.json {
         let text = serde_json::to_string_pretty(&json_report(&report))
             .map_err(|e| CliError::failure(e.to_string()))?;

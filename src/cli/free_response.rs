@@ -300,7 +300,7 @@ pub fn run(args: &FreeResponseArgs) -> Result<(), CliError> {
         );
         panels(path, &title, &panel_list).map_err(CliError::failure)?;
     }
-    let mut stdout = std::io::stdout().lock();
+    let mut stdout = super::output::stdout();
     if args.json {
         let out = json!({
             "model": model.name(),

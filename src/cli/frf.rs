@@ -205,11 +205,11 @@ pub fn run(args: &FrfArgs) -> Result<(), CliError> {
         let text =
             serde_json::to_string_pretty(&json_report(args, model.as_ref(), &frf, simulated))
                 .map_err(|e| CliError::failure(e.to_string()))?;
-        let _ = writeln!(std::io::stdout().lock(), "{text}");
+        let _ = writeln!(super::output::stdout(), "{text}");
         return Ok(());
     }
     print_report(
-        &mut std::io::stdout().lock(),
+        &mut super::output::stdout(),
         args,
         model.as_ref(),
         &frf,

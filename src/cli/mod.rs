@@ -9,6 +9,7 @@ mod frf;
 mod modal_damping;
 mod mode_plot;
 mod modes;
+pub(crate) mod output;
 mod plot;
 mod render;
 mod report;
@@ -21,6 +22,8 @@ mod values;
 mod work_precision;
 
 use clap::{Parser, Subcommand};
+use output::outln;
+use std::io::Write as _;
 use std::process::ExitCode;
 
 /// eomgen: equations of motion derived at compile time from model files, simulated.
@@ -104,9 +107,22 @@ impl CliError {
     }
 }
 
-/// Runs the CLI on the process arguments.
+/// Runs the CLI on the process arguments. Exit status: 0 success, 1 a failed computation or
+/// a failed write (standard output or a file), 2 a usage error, 141 standard output closed by
+/// its reader ([`output`]).
 pub fn run() -> ExitCode {
-    let cli = Cli::parse();
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        // `--help`, `--version` (status 0) and usage errors (status 2), written by clap; a
+        // failed write of them is reported as any other.
+        Err(e) => {
+            let code = u8::try_from(e.exit_code()).unwrap_or(2);
+            return match e.print() {
+                Ok(()) => ExitCode::from(code),
+                Err(io) => output_failure(&io, None),
+            };
+        }
+    };
     let result = match cli.command {
         Command::List { json } => list(json),
         Command::Simulate(args) => simulate::run(&args),
@@ -119,20 +135,38 @@ pub fn run() -> ExitCode {
         Command::Report(args) => report::run(&args),
         Command::Study(study) => study::run(&study),
     };
-    match result {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(e) => {
-            // Every command that reports numbers takes `--json`; an error with a JSON form
-            // (a model file's diagnostics) is then printed as JSON on standard output too.
-            if let Some(json) = &e.json
-                && std::env::args().any(|a| a == "--json")
-            {
-                println!("{}", serde_json::to_string_pretty(json).unwrap_or_default());
-            }
-            eprintln!("error: {}", e.message);
+    if let Err(e) = &result
+        && let Some(json) = &e.json
+        && std::env::args().any(|a| a == "--json")
+    {
+        // Every command that reports numbers takes `--json`; an error with a JSON form
+        // (a model file's diagnostics) is then printed as JSON on standard output too.
+        outln!("{}", serde_json::to_string_pretty(json).unwrap_or_default());
+    }
+    // Standard output is complete (flushed) before any message on standard error.
+    let written = output::finish();
+    match (result, written) {
+        (Ok(()), Ok(())) => ExitCode::SUCCESS,
+        (Err(e), Ok(())) => {
+            let _ = writeln!(std::io::stderr(), "error: {}", e.message);
             ExitCode::from(e.code)
         }
+        (result, Err(io)) => output_failure(&io, result.err()),
     }
+}
+
+/// The end of a run whose standard output failed: the command's own error if it had one
+/// (and its status), then the write error (none for a closed pipe, [`output::message`]),
+/// with [`output::status`] when the command itself succeeded.
+fn output_failure(io: &std::io::Error, error: Option<CliError>) -> ExitCode {
+    let mut stderr = std::io::stderr();
+    if let Some(e) = &error {
+        let _ = writeln!(stderr, "error: {}", e.message);
+    }
+    if let Some(message) = output::message(io) {
+        let _ = writeln!(stderr, "error: {message}");
+    }
+    ExitCode::from(error.map_or_else(|| output::status(io), |e| e.code))
 }
 
 fn list(json: bool) -> Result<(), CliError> {
@@ -142,15 +176,15 @@ fn list(json: bool) -> Result<(), CliError> {
             .iter()
             .map(|m| serde_json::json!({"name": m.name(), "dof": m.num_dofs(), "description": m.description()}))
             .collect();
-        println!(
+        outln!(
             "{}",
             serde_json::to_string_pretty(&items).map_err(|e| CliError::failure(e.to_string()))?
         );
     } else {
         let width = models.iter().map(|m| m.name().len()).max().unwrap_or(4);
-        println!("{:width$}  dof  description", "name");
+        outln!("{:width$}  dof  description", "name");
         for m in &models {
-            println!(
+            outln!(
                 "{:width$}  {:>3}  {}",
                 m.name(),
                 m.num_dofs(),
@@ -190,7 +224,7 @@ fn open_model(name_or_path: &str) -> Result<eomgen::ModelSource, CliError> {
         && let Some(reason) = model.fallback_reason()
     {
         // Slower, but the same numbers: say so rather than run silently interpreted.
-        eprintln!("note: `{path}` runs on the interpreter: {reason}");
+        output::errln!("note: `{path}` runs on the interpreter: {reason}");
     }
     if source.is_file()
         && let Ok(mut files) = FILES.lock()

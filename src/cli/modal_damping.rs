@@ -120,7 +120,7 @@ pub fn run(args: &ModalDampingArgs) -> Result<(), CliError> {
         panels(path, &title, &panel_list).map_err(CliError::failure)?;
     }
 
-    let mut stdout = std::io::stdout().lock();
+    let mut stdout = super::output::stdout();
     if args.json {
         let text = serde_json::to_string_pretty(&json_report(model.as_ref(), &study))
             .map_err(|e| CliError::failure(e.to_string()))?;

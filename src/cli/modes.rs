@@ -120,7 +120,7 @@ pub fn run(args: &ModesArgs) -> Result<(), CliError> {
         let page = super::animate::modes(model.as_ref(), &equilibrium.q, modes, &shapes_q)?;
         super::render::write_file(path, page.to_html()).map_err(CliError::failure)?;
     }
-    let mut stdout = std::io::stdout().lock();
+    let mut stdout = super::output::stdout();
     if args.json {
         let mut point = point_json(label, &names, &equilibrium.q);
         point["newton_iterations"] = json!(equilibrium.iterations);

@@ -33,6 +33,7 @@ use eomgen_symbolic::mechanics::{Formulation, Lagrange, SymbolicModel};
 use eomgen_symbolic::model::ModelFile;
 
 use super::modes::{OperatingPoint, operating_point_of};
+use super::output::outln;
 use super::{CliError, plot};
 
 /// Options of `eomgen report`.
@@ -149,7 +150,7 @@ pub fn run(args: &ReportArgs) -> Result<(), CliError> {
         &super::report_html::page(&reports, args.timing),
     )?;
     if args.json {
-        println!("{text}");
+        outln!("{text}");
     }
     let total: usize = reports.iter().map(|r| r.checks.len()).sum();
     let failed: Vec<String> = reports
@@ -163,7 +164,7 @@ pub fn run(args: &ReportArgs) -> Result<(), CliError> {
         .collect();
     let index = args.out.join("index.html");
     if failed.is_empty() {
-        eprintln!(
+        super::output::errln!(
             "report: {} models, {total} checks, all passed: {}",
             reports.len(),
             index.display()

@@ -45,7 +45,7 @@ pub fn run(args: &EulerRoundoffArgs) -> Result<(), CliError> {
     if let Some(path) = &args.plot {
         plot_errors(path, &rows)?;
     }
-    let mut stdout = std::io::stdout().lock();
+    let mut stdout = super::output::stdout();
     if args.json {
         let out = json!({
             "problem": "x' = x, x(0) = 1 on [0, 1]; x(1) = e",

@@ -13,6 +13,7 @@ use eomgen::{IntegrationError, ModelInfo, OutputTimes, Solution};
 use serde_json::json;
 
 use super::values::{evaluate, set_parameters, usage};
+use super::output::outln;
 use super::{CliError, find_model, plot};
 use eomgen::Stabilization;
 
@@ -318,7 +319,7 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
         }
         let text =
             serde_json::to_string_pretty(&out).map_err(|e| CliError::failure(e.to_string()))?;
-        let mut stdout = std::io::stdout().lock();
+        let mut stdout = super::output::stdout();
         let _ = writeln!(stdout, "{text}");
     } else {
         print_summary(model.as_ref(), method_name, &args.run, &solution, &report);
@@ -519,19 +520,19 @@ fn print_summary(
     solution: &Solution,
     report: &EnergyDrift,
 ) {
-    println!(
+    outln!(
         "model      {} ({} dof): {}",
         model.name(),
         model.num_dofs(),
         model.description()
     );
-    println!("method     {method} ({})", args.step_control());
+    outln!("method     {method} ({})", args.step_control());
     if let Some((t, y)) = solution.last() {
         let n = model.num_dofs();
         let names = model.coordinate_names();
-        println!("final      t = {t}");
+        outln!("final      t = {t}");
         for (i, name) in names.iter().enumerate() {
-            println!(
+            outln!(
                 "           {name:>12} = {:>22.15e}   {:>16} = {:>22.15e}",
                 y[i],
                 format!("{name}_dot"),
@@ -540,14 +541,14 @@ fn print_summary(
         }
     }
     if let (e0, Some(e1)) = (report.initial_energy, report.energy.last()) {
-        println!("energy     E(0) = {e0:.12e} J, E(end) = {e1:.12e} J");
+        outln!("energy     E(0) = {e0:.12e} J, E(end) = {e1:.12e} J");
         if let Some(d) = report.drift {
             let note = if model.is_conservative() {
                 ""
             } else {
                 " (not conserved: the model has non-conservative loads or explicit time dependence)"
             };
-            println!("drift      max|E - E(0)| / max(T + |V|) = {d:.3e}{note}");
+            outln!("drift      max|E - E(0)| / max(T + |V|) = {d:.3e}{note}");
         }
     }
     let s = &solution.stats;
@@ -559,7 +560,7 @@ fn print_summary(
     } else {
         String::new()
     };
-    println!(
+    outln!(
         "work       {} steps ({} rejected), {} RHS evaluations{implicit}, {:.3} ms",
         s.steps,
         s.rejected,
@@ -619,14 +620,14 @@ fn print_events(model: &dyn ModelInfo, solution: &Solution) {
     }
     let n = model.num_dofs();
     let names = model.coordinate_names();
-    println!("events     {} located:", solution.events.len());
+    outln!("events     {} located:", solution.events.len());
     for e in &solution.events {
         let state: Vec<String> = names
             .iter()
             .enumerate()
             .map(|(i, c)| format!("{c} = {:.9e}, {c}_dot = {:.9e}", e.y[i], e.y[n + i]))
             .collect();
-        println!(
+        outln!(
             "           {:<16} {:<8} t = {:.15e}   {}",
             e.name,
             e.direction.name(),
@@ -651,7 +652,7 @@ fn print_events(model: &dyn ModelInfo, solution: &Solution) {
                 .windows(2)
                 .map(|w| format!("{:.12e}", w[1] - w[0]))
                 .collect();
-            println!(
+            outln!(
                 "intervals  between successive `{}`: {} s",
                 e.name,
                 intervals.join(", ")
@@ -660,7 +661,7 @@ fn print_events(model: &dyn ModelInfo, solution: &Solution) {
     }
     if let Some(k) = solution.terminated_by_event {
         let e = &solution.events[k];
-        println!("stopped    at t = {:.15e} by event `{}`", e.t, e.name);
+        outln!("stopped    at t = {:.15e} by event `{}`", e.t, e.name);
     }
 }
 
@@ -714,10 +715,10 @@ fn print_constraint_summary(constraints: &ConstraintDrift, stabilization: Stabil
             .zip(last)
             .map(|(n, l)| format!("{n} = {l:.9e}"))
             .collect();
-        println!("lambda     at the end: {}", forces.join(", "));
+        outln!("lambda     at the end: {}", forces.join(", "));
     }
     let (p, v) = constraints.max_drift();
-    println!(
+    outln!(
         "drift      constraints ({}): max |Φ| = {p:.3e}, max |Φ̇| = {v:.3e}",
         format!("{stabilization:?}").to_lowercase()
     );

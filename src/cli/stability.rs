@@ -125,7 +125,7 @@ pub fn run(args: &StabilityArgs) -> Result<(), CliError> {
         write_energy(&mut text, args.periods, &energy);
         write_stiff(&mut text, args, &modes, &stiff);
         write_underflow(&mut text, &underflow);
-        let _ = write!(std::io::stdout().lock(), "{text}");
+        let _ = write!(super::output::stdout(), "{text}");
     }
     Ok(())
 }
@@ -162,7 +162,7 @@ pub(super) fn log_y_chart(
 /// Prints `value` as pretty JSON on stdout.
 pub(super) fn print_json(value: &serde_json::Value) -> Result<(), CliError> {
     let text = serde_json::to_string_pretty(value).map_err(|e| CliError::failure(e.to_string()))?;
-    let _ = writeln!(std::io::stdout().lock(), "{text}");
+    let _ = writeln!(super::output::stdout(), "{text}");
     Ok(())
 }
 

@@ -130,7 +130,7 @@ fn constraint_methods(args: &ConstraintMethodsArgs) -> Result<(), CliError> {
         )
         .map_err(CliError::failure)?;
     }
-    let mut stdout = std::io::stdout().lock();
+    let mut stdout = super::output::stdout();
     if args.json {
         let out = json!({
             "model": model,

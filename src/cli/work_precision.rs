@@ -209,15 +209,15 @@ pub fn run(args: &WorkPrecisionArgs) -> Result<(), CliError> {
     let num_unresolved = study.report.num_unresolved();
     let agreement = study.report.agreement;
     if num_unresolved > 0 {
-        eprintln!(
+        super::output::errln!(
             "warning: {num_unresolved} run(s) have an error below 10 × the reference's agreement ({agreement:.2e}): the reference does not resolve them, their errors are upper bounds at best (marked `!` in the table, `\"resolved\": false` in JSON)"
         );
     }
     if let Some(prefix) = &args.plot {
         write_charts(prefix, study.model.name(), &study.report.results)?;
     }
-    let mut stdout = std::io::stdout().lock();
-    // A closed stdout (a pipe into `head`) is not an error of the study.
+    let mut stdout = super::output::stdout();
+    // A failed write (a pipe into `head` closed) is kept by `output` and sets the status.
     let _ = if args.json {
         serde_json::to_string_pretty(&study.to_json())
             .map_err(|e| CliError::failure(e.to_string()))
