@@ -46,7 +46,8 @@ impl<'a> Chart<'a> {
     }
 }
 
-/// Plots every coordinate against time, one line each, into `path` (`.svg` or `.png`).
+/// Plots every coordinate against time, one line each, into `path` (`.svg` or `.png`), with
+/// `note` (why the run is incomplete, if it is) drawn in red above the chart.
 ///
 /// # Errors
 /// An unknown extension, an empty solution, or a failure to write the file.
@@ -54,6 +55,7 @@ pub fn time_histories(
     path: &str,
     model: &dyn ModelInfo,
     solution: &Solution,
+    note: Option<&str>,
 ) -> Result<(), String> {
     let title = format!("{}: coordinates against time", model.name());
     per_coordinate(
@@ -63,11 +65,13 @@ pub fn time_histories(
         solution,
         |name| name.to_string(),
         |t, y, i, _| (t, y[i]),
+        note,
     )
 }
 
 /// Draws one line per coordinate `i` of `model` into `path`: its name `name(coordinate)`,
-/// its points `point(t, y, i, n)` at every sample `(t, y)` of `solution` (`n` coordinates).
+/// its points `point(t, y, i, n)` at every sample `(t, y)` of `solution` (`n` coordinates),
+/// with `note` drawn under the title ([`lines_noted`]).
 ///
 /// # Errors
 /// An empty solution, or the errors of [`lines`].
@@ -78,6 +82,7 @@ fn per_coordinate(
     solution: &Solution,
     name: impl Fn(&str) -> String,
     point: impl Fn(f64, &[f64], usize, usize) -> (f64, f64),
+    note: Option<&str>,
 ) -> Result<(), String> {
     if solution.is_empty() {
         return Err("nothing to plot: the solution has no samples".to_string());
@@ -92,7 +97,7 @@ fn per_coordinate(
             points: solution.iter().map(|(t, y)| point(t, y, i, n)).collect(),
         })
         .collect();
-    lines(path, chart, &series)
+    lines_noted(path, chart, &series, note)
 }
 
 /// Draws `series` as lines into `path` (`.svg` or `.png`), 960 × 600 px.
@@ -100,14 +105,33 @@ fn per_coordinate(
 /// # Errors
 /// An unknown extension, no finite point, or a failure to write the file.
 pub fn lines(path: &str, chart: &Chart<'_>, series: &[Series]) -> Result<(), String> {
+    lines_noted(path, chart, series, None)
+}
+
+/// [`lines`] with `note` (the reason a run is incomplete, say) drawn in red under the title.
+/// The file is written atomically ([`super::render::atomically`]): a failed or killed run
+/// leaves any previous file at `path` as it was.
+///
+/// # Errors
+/// As [`lines`].
+pub fn lines_noted(
+    path: &str,
+    chart: &Chart<'_>,
+    series: &[Series],
+    note: Option<&str>,
+) -> Result<(), String> {
     register_font()?;
     let size = (960, 600);
     if path.ends_with(".svg") {
-        let root = SVGBackend::new(path, size).into_drawing_area();
-        draw(root, chart, series)
+        super::render::atomically(path, |file| {
+            let root = SVGBackend::new(file, size).into_drawing_area();
+            draw(root, chart, series, note)
+        })
     } else if path.ends_with(".png") {
-        let root = BitMapBackend::new(path, size).into_drawing_area();
-        draw(root, chart, series)
+        super::render::atomically(path, |file| {
+            let root = BitMapBackend::new(file, size).into_drawing_area();
+            draw(root, chart, series, note)
+        })
     } else {
         Err(format!("`{path}`: a chart file must end in .svg or .png"))
     }
@@ -168,12 +192,26 @@ fn draw<DB: DrawingBackend>(
     root: DrawingArea<DB, plotters::coord::Shift>,
     chart: &Chart<'_>,
     series: &[Series],
+    note: Option<&str>,
 ) -> Result<(), String>
 where
     DB::ErrorType: 'static,
 {
     let err = |e: DrawingAreaErrorKind<DB::ErrorType>| format!("plotting failed: {e}");
     root.fill(&WHITE).map_err(err)?;
+    // The note goes above the chart, in its own band, so no line can hide it.
+    let root = match note {
+        Some(note) => {
+            root.draw(&Text::new(
+                note.to_string(),
+                (12, 6),
+                ("sans-serif", 16).into_font().color(&RED),
+            ))
+            .map_err(err)?;
+            root.margin(24, 0, 0, 0)
+        }
+        None => root,
+    };
     let (mut x_lo, mut x_hi, mut y_lo, mut y_hi) = (
         f64::INFINITY,
         f64::NEG_INFINITY,
@@ -248,7 +286,8 @@ where
 }
 
 /// Plots the phase portrait of every coordinate, `q̇ᵢ` against `qᵢ`, one line each, into
-/// `path` (`.svg` or `.png`) — lecture 17's picture of a trajectory in the state plane.
+/// `path` (`.svg` or `.png`) — lecture 17's picture of a trajectory in the state plane; `note`
+/// as in [`time_histories`].
 ///
 /// # Errors
 /// An unknown extension, an empty solution, or a failure to write the file.
@@ -256,6 +295,7 @@ pub fn phase_portrait(
     path: &str,
     model: &dyn ModelInfo,
     solution: &Solution,
+    note: Option<&str>,
 ) -> Result<(), String> {
     let title = format!("{}: phase portrait", model.name());
     per_coordinate(
@@ -265,6 +305,7 @@ pub fn phase_portrait(
         solution,
         |name| format!("{name}_dot vs {name}"),
         |_, y, i, n| (y[i], y[n + i]),
+        note,
     )
 }
 
@@ -273,6 +314,7 @@ pub fn phase_portrait(
 /// need not be a sample: with requested output times the first may come later), as
 /// [`eomgen::analysis::energy_drift`] computes them. Constant for a conservative
 /// model up to the integration error; for others it is the work of the non-conservative loads.
+/// `note` as in [`time_histories`].
 ///
 /// # Errors
 /// An unknown extension, no samples, or a failure to write the file.
@@ -282,6 +324,7 @@ pub fn energy_drift(
     t: &[f64],
     energy: &[f64],
     initial: f64,
+    note: Option<&str>,
 ) -> Result<(), String> {
     if t.is_empty() {
         return Err("nothing to plot: the solution has no samples".to_string());
@@ -295,17 +338,18 @@ pub fn energy_drift(
             .collect(),
     }];
     let title = format!("{name}: energy drift");
-    lines(
+    lines_noted(
         path,
         &Chart::linear(&title, "t (s)", "E − E(0) (J)"),
         &series,
+        note,
     )
 }
 
 /// Plots the constraint drift of a constrained model against time into `path` (`.svg` or
 /// `.png`), on a logarithmic axis: `max |Φᵢ|` and the largest velocity-level residual at each
 /// time (`drift[k] = (position, velocity)` at `t[k]`, as [`ModelInfo::constraint_drift`]
-/// gives them; exact zeros are left out of the log axis).
+/// gives them; exact zeros are left out of the log axis); `note` as in [`time_histories`].
 ///
 /// # Errors
 /// Unequal lengths, an unknown extension, no positive value, or a failure to write the file.
@@ -314,6 +358,7 @@ pub fn constraint_drift(
     model: &str,
     t: &[f64],
     drift: &[(f64, f64)],
+    note: Option<&str>,
 ) -> Result<(), String> {
     if t.len() != drift.len() {
         return Err(format!(
@@ -333,7 +378,7 @@ pub fn constraint_drift(
         },
     ];
     let title = format!("{model}: constraint drift");
-    lines(
+    lines_noted(
         path,
         &Chart {
             title: &title,
@@ -343,5 +388,6 @@ pub fn constraint_drift(
             log_y: true,
         },
         &series,
+        note,
     )
 }

@@ -141,8 +141,7 @@ pub fn run(args: &ReportArgs) -> Result<(), CliError> {
     let text = serde_json::to_string_pretty(&json).map_err(|e| CliError::failure(e.to_string()))?;
     let write = |name: &str, content: &str| {
         let path = args.out.join(name);
-        std::fs::write(&path, content)
-            .map_err(|e| CliError::failure(format!("cannot write `{}`: {e}", path.display())))
+        super::render::write_file(&path.to_string_lossy(), content).map_err(CliError::failure)
     };
     write("report.json", &format!("{text}\n"))?;
     write(
@@ -356,12 +355,12 @@ fn motion_checks(
             drawn.push((
                 "time.svg",
                 format!("Coordinates against time ({run})"),
-                plot::time_histories(&path("time.svg"), model, solution),
+                plot::time_histories(&path("time.svg"), model, solution, None),
             ));
             drawn.push((
                 "phase.svg",
                 "Phase portrait: each rate against its coordinate".to_string(),
-                plot::phase_portrait(&path("phase.svg"), model, solution),
+                plot::phase_portrait(&path("phase.svg"), model, solution, None),
             ));
             drawn.push(("energy.svg", "Energy drift E(t) − E(0)".to_string(), {
                 let energy = energy_drift(model, y0, solution);
@@ -371,6 +370,7 @@ fn motion_checks(
                     &solution.t,
                     &energy.energy,
                     energy.initial_energy,
+                    None,
                 )
             }));
             if !model.constraint_names().is_empty() {
@@ -378,7 +378,7 @@ fn motion_checks(
                 drawn.push((
                     "constraints.svg",
                     "Constraint drift max |Φ|, max |Φ̇|, no stabilisation".to_string(),
-                    plot::constraint_drift(&path("constraints.svg"), &name, &solution.t, &drift),
+                    plot::constraint_drift(&path("constraints.svg"), &name, &solution.t, &drift, None),
                 ));
             }
         }
@@ -477,10 +477,13 @@ fn animation(spec: &str, name: &str, model_dir: &Path, notes: &mut Vec<String>) 
                 notes.push(format!("animation: {}", e.message));
             }
             let file = "animation.html";
-            match std::fs::write(model_dir.join(file), animation.to_html()) {
+            match super::render::write_file(
+                &model_dir.join(file).to_string_lossy(),
+                animation.to_html(),
+            ) {
                 Ok(()) => Some(format!("{name}/{file}")),
                 Err(e) => {
-                    notes.push(format!("animation: cannot write `{file}`: {e}"));
+                    notes.push(format!("animation: {e}"));
                     None
                 }
             }

@@ -203,6 +203,13 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
         OutputTimes::At(times)
     };
     let (model, simulation) = simulation(&args.model, &args.run, output)?;
+    // A failure without a time is an invalid input (output times out of order, say) that
+    // stopped the run before its first step: a usage error, with no file written.
+    if let Some(e) = &simulation.failure
+        && e.t().is_none()
+    {
+        return Err(CliError::usage(e.to_string()).before_output());
+    }
     let Simulation {
         solution,
         energy: report,
@@ -217,22 +224,46 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
         .iter()
         .map(|s| s.to_string())
         .collect();
+    // The files of a failed integration say so: `# incomplete: <reason> at t = <t>` above a
+    // CSV's header, the same note on the charts (and `"error"` in the JSON below).
+    let incomplete = failure
+        .as_ref()
+        .map(|e| match e.t() {
+            // The reasons with a time say "at t = …" themselves.
+            Some(t) if !e.to_string().contains("t = ") => format!("incomplete: {e} at t = {t}"),
+            _ => format!("incomplete: {e}"),
+        });
     if let Some(path) = &args.csv {
-        write_csv(path, model.as_ref(), &solution, &report, &constraints)?;
+        write_csv(
+            path,
+            model.as_ref(),
+            &solution,
+            &report,
+            &constraints,
+            incomplete.as_deref(),
+        )?;
         if !solution.events.is_empty() {
             write_events_csv(&sibling(path, "events"), model.as_ref(), &solution)?;
         }
     }
     if let Some(path) = &args.plot {
-        plot::time_histories(path, model.as_ref(), &solution).map_err(CliError::failure)?;
+        plot::time_histories(path, model.as_ref(), &solution, incomplete.as_deref())
+            .map_err(CliError::failure)?;
         if !constraints.is_empty() {
             let drift_path = sibling(path, "drift");
-            plot::constraint_drift(&drift_path, model.name(), &solution.t, &constraints.drift)
-                .map_err(CliError::failure)?;
+            plot::constraint_drift(
+                &drift_path,
+                model.name(),
+                &solution.t,
+                &constraints.drift,
+                incomplete.as_deref(),
+            )
+            .map_err(CliError::failure)?;
         }
     }
     if let Some(path) = &args.plot_phase {
-        plot::phase_portrait(path, model.as_ref(), &solution).map_err(CliError::failure)?;
+        plot::phase_portrait(path, model.as_ref(), &solution, incomplete.as_deref())
+            .map_err(CliError::failure)?;
     }
     if let Some(path) = &args.plot_energy {
         plot::energy_drift(
@@ -241,6 +272,7 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
             &solution.t,
             &report.energy,
             report.initial_energy,
+            incomplete.as_deref(),
         )
         .map_err(CliError::failure)?;
     }
@@ -575,8 +607,10 @@ fn write_csv(
     solution: &Solution,
     report: &EnergyDrift,
     constraints: &ConstraintDrift,
+    incomplete: Option<&str>,
 ) -> Result<(), CliError> {
-    let mut out = String::from("t");
+    let mut out = incomplete.map_or_else(String::new, |note| format!("# {note}\n"));
+    out.push('t');
     for c in model.coordinate_names() {
         out.push(',');
         out.push_str(c);
@@ -609,7 +643,7 @@ fn write_csv(
         }
         out.push('\n');
     }
-    std::fs::write(path, out).map_err(|e| CliError::failure(format!("cannot write `{path}`: {e}")))
+    super::render::write_file(path, out).map_err(CliError::failure)
 }
 
 /// The located events: name, direction, time and state, and the intervals between
@@ -692,7 +726,7 @@ fn write_events_csv(
         }
         out.push('\n');
     }
-    std::fs::write(path, out).map_err(|e| CliError::failure(format!("cannot write `{path}`: {e}")))
+    super::render::write_file(path, out).map_err(CliError::failure)
 }
 
 /// `dir/name.svg` → `dir/name-{tag}.svg`.
