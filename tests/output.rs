@@ -323,3 +323,64 @@ fn the_charts_of_a_failed_integration_carry_a_visible_note() {
     let red_ok = red_in_band(&png);
     assert!(red_failed > 50 && red_ok == 0, "red pixels {red_failed}, {red_ok}");
 }
+
+/// Every size a user can type has an upper limit: a value over it is a usage error (exit 2)
+/// whose message names the limit.
+#[test]
+fn sizes_over_their_limit_are_usage_errors() {
+    // 100001 output times in two arguments (one argument may hold at most 128 KiB on Linux).
+    let times = vec!["1"; 50_001].join(",");
+    let cases: &[(&[&str], &str)] = &[
+        (&["check", "simple_pendulum", "--states", "0"], "1..=100000"),
+        (&["check", "simple_pendulum", "--states", "100001"], "1..=100000"),
+        (
+            &["frf", "forced_oscillator", "--input", "A", "--output", "x", "--points", "100001"],
+            "1..=100000",
+        ),
+        (
+            &["frf", "forced_oscillator", "--input", "A", "--output", "x", "--simulate", "1001"],
+            "1..=1000",
+        ),
+        (
+            &["study", "free-response", "three_masses", "--samples", "1000001"],
+            "2..=1000000",
+        ),
+        (
+            &["study", "modal-damping", "three_masses_damped", "--samples", "1000001"],
+            "2..=1000000",
+        ),
+        (
+            &["study", "work-precision", "simple_pendulum", "--samples", "100001"],
+            "1..=100000",
+        ),
+        (
+            &["study", "work-precision", "simple_pendulum", "--repeats", "1001"],
+            "1..=1000",
+        ),
+        (
+            &[
+                "study",
+                "floquet",
+                "mathieu_pendulum",
+                "--sweep",
+                "a=0..0.3:1001,w=10..100:1000",
+            ],
+            "at most 1000000",
+        ),
+        (&["study", "euler-roundoff", "--max-n", "11"], "at most 10"),
+        (&["study", "stability", "--steps", "100000000"], "10⁷"),
+        (&["new", "n-link-pendulum", "201"], "200"),
+        (
+            &["simulate", "simple_pendulum", "--t-out", &times, "--t-out", &times],
+            "at most 100000",
+        ),
+    ];
+    for (args, limit) in cases {
+        let out = run(args);
+        let text = stderr(&out);
+        let shown: Vec<&str> = args.iter().map(|a| &a[..a.len().min(40)]).collect();
+        assert_eq!(out.status.code(), Some(2), "eomgen {}: {text}", shown.join(" "));
+        assert!(text.contains(limit), "eomgen {}: {text}", shown.join(" "));
+        assert!(!text.contains("panicked"), "{text}");
+    }
+}

@@ -15,8 +15,8 @@ const TOLERANCE: f64 = 1e-8;
 pub struct CheckArgs {
     /// A bundled model's name, or the path of any model file (`path/to/x.yaml`).
     pub model: String,
-    /// Number of random states.
-    #[arg(long, default_value_t = 200)]
+    /// Number of random states (1 to 100000).
+    #[arg(long, default_value_t = 200, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..=100_000))]
     pub states: usize,
     /// Print the report as JSON (byte-identical across runs: derivation times are left out
     /// unless `--timing` is given).

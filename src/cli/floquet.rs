@@ -39,7 +39,8 @@ pub struct FloquetArgs {
     #[arg(long, default_value = "w")]
     pub period_parameter: String,
     /// Stability chart over two parameters, `X=LO..HI:N,Y=LO..HI:N` (N values each, ends
-    /// included; `a=0..0.3:61,w=10..100:61`): the x axis first.
+    /// included; `a=0..0.3:61,w=10..100:61`): the x axis first. N ≤ 10000 and at most 10⁶
+    /// points in all.
     #[arg(long, value_name = "X=LO..HI:N,Y=LO..HI:N")]
     pub sweep: Option<String>,
     /// Tolerance on |μ| = 1: stable means every |μ| ≤ 1 + tol (marginal when within tol of 1).
@@ -433,6 +434,9 @@ fn print_map(out: &mut impl std::io::Write, x: &Axis, y: &Axis, grid: &[Vec<Cell
 }
 
 /// `X=LO..HI:N,Y=LO..HI:N`.
+/// Most points of a `--sweep` grid (each is one Floquet analysis over a period).
+const MAX_SWEEP_POINTS: usize = 1_000_000;
+
 fn parse_sweep(spec: &str, model: &dyn ModelInfo) -> Result<(Axis, Axis), CliError> {
     let lookup = parameter_lookup(model);
     let mut axes = Vec::new();
@@ -463,6 +467,13 @@ fn parse_sweep(spec: &str, model: &dyn ModelInfo) -> Result<(Axis, Axis), CliErr
         axes.push(axis);
     }
     match <[Axis; 2]>::try_from(axes) {
+        Ok([x, y]) if x.values.len() * y.values.len() > MAX_SWEEP_POINTS => {
+            Err(CliError::usage(format!(
+                "--sweep: {} × {} points; the grid may have at most {MAX_SWEEP_POINTS}",
+                x.values.len(),
+                y.values.len()
+            )))
+        }
         Ok([x, y]) if x.name != y.name => Ok((x, y)),
         _ => Err(CliError::usage(
             "--sweep takes two different parameters, `X=LO..HI:N,Y=LO..HI:N` (for example `a=0..0.3:31,w=10..100:31`)",

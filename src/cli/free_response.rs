@@ -39,8 +39,8 @@ pub struct FreeResponseArgs {
     /// unstable mode grows by e⁵ if that is shorter, else 10 s.
     #[arg(long)]
     pub t_end: Option<f64>,
-    /// Number of output times, evenly spaced from 0 to the end time.
-    #[arg(long, default_value_t = 401)]
+    /// Number of output times, evenly spaced from 0 to the end time (2 to 1000000).
+    #[arg(long, default_value_t = 401, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(2..=1_000_000))]
     pub samples: usize,
     /// Relative and absolute tolerance of the DOP853 integration.
     #[arg(long, default_value_t = 1e-13)]

@@ -43,8 +43,8 @@ pub struct FrfArgs {
     /// decade below the lowest to a decade above the highest natural frequency).
     #[arg(long, value_name = "LO..HI")]
     pub freqs: Option<String>,
-    /// Frequencies of the sweep, spaced evenly in log ω.
-    #[arg(long, default_value_t = 400)]
+    /// Frequencies of the sweep, spaced evenly in log ω (1 to 100000).
+    #[arg(long, default_value_t = 400, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..=100_000))]
     pub points: usize,
     /// Also evaluate the response at this frequency (rad/s, an expression such as
     /// `sqrt(2*k/m)` or `w`); repeatable. With `--modal`, the modal breakdown is given here.
@@ -55,8 +55,8 @@ pub struct FrfArgs {
     #[arg(long)]
     pub modal: bool,
     /// Check K frequencies of the curve (log-spaced over the range) by simulating the full
-    /// model to steady state, in parallel.
-    #[arg(long, value_name = "K")]
+    /// model to steady state, in parallel (1 to 1000).
+    #[arg(long, value_name = "K", value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..=1000))]
     pub simulate: Option<usize>,
     /// The parameter holding the forcing frequency, set to each ω by `--simulate` (default:
     /// `w` if the model has it).

@@ -36,8 +36,8 @@ pub struct ModalDampingArgs {
     /// End time (s). Default: ten periods of the slowest oscillatory mode.
     #[arg(long)]
     pub t_end: Option<f64>,
-    /// Number of output times, evenly spaced from 0 to the end time.
-    #[arg(long, default_value_t = 801)]
+    /// Number of output times, evenly spaced from 0 to the end time (2 to 1000000).
+    #[arg(long, default_value_t = 801, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(2..=1_000_000))]
     pub samples: usize,
     /// Relative and absolute tolerance of the DOP853 check of the exact response.
     #[arg(long, default_value_t = 1e-12)]

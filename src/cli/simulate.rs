@@ -65,13 +65,17 @@ pub enum StabilizationArg {
     Projection,
 }
 
+/// Most output times `--t-out` may list.
+const MAX_OUTPUT_TIMES: usize = 100_000;
+
 /// Options of `eomgen simulate`.
 #[derive(Debug, Args)]
 pub struct SimulateArgs {
     /// A bundled model's name (see `eomgen list`) or the path of any model file.
     pub model: String,
     /// Output times, comma separated (expressions allowed), e.g. `--t-out 1,2,2.5`; samples
-    /// come from dense output at exactly these times. Default: every accepted step.
+    /// come from dense output at exactly these times (at most 100000). Default: every accepted
+    /// step.
     #[arg(long, value_delimiter = ',')]
     pub t_out: Vec<String>,
     /// What to integrate and how.
@@ -193,6 +197,12 @@ pub(crate) struct Run {
 
 /// Runs `simulate`.
 pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
+    if args.t_out.len() > MAX_OUTPUT_TIMES {
+        return Err(CliError::usage(format!(
+            "--t-out lists {} times; at most {MAX_OUTPUT_TIMES} are allowed",
+            args.t_out.len()
+        )));
+    }
     let mut times = Vec::with_capacity(args.t_out.len());
     for t in &args.t_out {
         times.push(evaluate(t, "--t-out", &|_| None)?);

@@ -74,8 +74,9 @@ pub struct WorkPrecisionArgs {
     /// End time T (s).
     #[arg(long, default_value_t = 10.0)]
     pub t_end: f64,
-    /// Number S of equally spaced output times `k T / S`, k = 1…S, at which errors are taken.
-    #[arg(long, default_value_t = 100)]
+    /// Number S of equally spaced output times `k T / S`, k = 1…S, at which errors are taken
+    /// (1 to 100000).
+    #[arg(long, default_value_t = 100, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..=100_000))]
     pub samples: usize,
     /// Error at which the work of every method is interpolated (same norm as the table).
     #[arg(long, default_value_t = 5e-4)]
@@ -87,8 +88,8 @@ pub struct WorkPrecisionArgs {
     /// Tolerance of the reference solution (DOP853, and Dormand–Prince 5(4) as its check).
     #[arg(long, default_value_t = 1e-14)]
     pub reference_tol: f64,
-    /// Fewest timed runs per setting; the reported time is their median.
-    #[arg(long, default_value_t = 3)]
+    /// Fewest timed runs per setting; the reported time is their median (1 to 1000).
+    #[arg(long, default_value_t = 3, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..=1000))]
     pub repeats: usize,
     /// Runs of one setting are repeated until their total wall time reaches this (ms), at
     /// most 1000 times.
