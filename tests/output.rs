@@ -371,6 +371,10 @@ fn sizes_over_their_limit_are_usage_errors() {
         (&["study", "stability", "--steps", "100000000"], "10⁷"),
         (&["new", "n-link-pendulum", "201"], "200"),
         (
+            &["animate", "simple_pendulum", "-o", "unwritten.html", "--fps", "100000"],
+            "more than 100000 frames",
+        ),
+        (
             &["simulate", "simple_pendulum", "--t-out", &times, "--t-out", &times],
             "at most 100000",
         ),
