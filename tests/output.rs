@@ -103,7 +103,7 @@ fn a_closed_pipe_ends_the_program_quietly_with_status_141() {
     let commands: &[&[&str]] = &[
         // About 1.5 MB of model file.
         &["new", "n-link-pendulum", "200"],
-        // Every accepted step as a JSON sample: about 10⁵ samples, several MB.
+        // Every accepted step as a JSON sample: 10⁵ samples, about 18 MB.
         &[
             "simulate",
             "simple_pendulum",
