@@ -46,7 +46,7 @@ pub struct FloquetArgs {
     #[arg(long, default_value_t = 1e-6)]
     pub stability_tolerance: f64,
     /// Relative and absolute tolerance of DOP853 on the state and the variational equations.
-    #[arg(long, default_value_t = 1e-12)]
+    #[arg(long, default_value_t = 1e-12, value_parser = super::values::relative_tolerance, allow_hyphen_values = true)]
     pub tol: f64,
     /// Print JSON.
     #[arg(long)]
