@@ -112,3 +112,31 @@ fn tolerances_below_round_off_are_refused_by_work_precision() {
     assert_eq!(out.status.code(), Some(2), "{err}");
     assert!(err.contains("f64 cannot deliver less"), "{err}");
 }
+
+/// `study floquet --period-parameter` must name an angular frequency: in a file that
+/// declares its units, a parameter in m (the Mathieu pendulum's amplitude `a`) or in Hz is a
+/// located usage error (the double pendulum's `g`, in m/s², too; that its equations do not
+/// depend on t is refused by the numerical check in the library, `tests/floquet.rs`). These
+/// used to report multipliers ("marginal") of a meaningless period.
+#[test]
+fn floquet_period_parameter_is_an_angular_frequency() {
+    let out = eomgen(&["study", "floquet", "mathieu_pendulum", "--period-parameter", "a"]);
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("mathieu_pendulum.yaml:") && err.contains("is in m, not a frequency"), "{err}");
+
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string("models/mathieu_pendulum.yaml").unwrap();
+    assert!(text.contains("w: 60.0    # rad/s,"));
+    let hertz = dir.path().join("mathieu_hz.yaml");
+    std::fs::write(&hertz, text.replace("w: 60.0    # rad/s,", "w: 60.0    # Hz,")).unwrap();
+    let out = eomgen(&["study", "floquet", hertz.to_str().unwrap()]);
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("is in Hz"), "{err}");
+
+    let out = eomgen(&["study", "floquet", "double_pendulum", "--period-parameter", "g"]);
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("`g` is in m/s^2, not a frequency"), "{err}");
+}

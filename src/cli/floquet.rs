@@ -71,6 +71,13 @@ fn analysis_text(model: &dyn ModelInfo, e: &FloquetStudyError) -> String {
 /// Runs `study floquet`.
 pub fn run(args: &FloquetArgs) -> Result<(), CliError> {
     let mut model = args.point.model(&args.model)?;
+    let source = super::open_model(&args.model)?;
+    eomgen::studies::check_period_parameter_unit(&source, &args.period_parameter).map_err(|e| {
+        match e {
+            eomgen::studies::PeriodUnitError::File(e) => CliError::failure(e.to_string()),
+            e => CliError::usage(e.to_string()),
+        }
+    })?;
     let options = FloquetStudyOptions {
         operating_point: args.point.options(model.as_ref())?,
         period_parameter: args.period_parameter.clone(),
@@ -106,7 +113,7 @@ pub fn run(args: &FloquetArgs) -> Result<(), CliError> {
         Some((x, y)) => Some(run_sweep(args, &guess, x, y, &options)?),
         None => None,
     };
-    let references = FloquetReferences::of(&super::open_model(&args.model)?, &label)
+    let references = FloquetReferences::of(&source, &label)
         .map_err(|e| CliError::failure(e.to_string()))?;
     let thresholds = references
         .as_ref()
