@@ -715,3 +715,43 @@ fn mathieu_pendulum_references_from_its_file() {
             .is_none()
     );
 }
+
+/// The period parameter is checked to be the forcing frequency: a model whose equations do
+/// not depend on `t` (the double pendulum, "period" g) is refused at the user's parameters;
+/// naming a parameter that is not the frequency (the Mathieu pendulum's `m`, or `a`) is
+/// refused because `M`, `F` are not `2π/m`-periodic, even where `m` happens to equal `w`
+/// (the check is repeated at a value 1/64 above); its `w`, whose forcing amplitude `a w²`
+/// depends on `w` too (so `F` is not a function of `w t` alone), passes. These runs used to
+/// report "marginal" or "unstable" multipliers of a wrong period.
+#[test]
+fn floquet_period_parameter_must_be_the_forcing_frequency() {
+    use eomgen::vibration::{FloquetStudyError, FloquetStudyOptions, floquet_at_equilibrium};
+    let named = |p: &str| FloquetStudyOptions {
+        period_parameter: p.to_string(),
+        ..FloquetStudyOptions::default()
+    };
+    let mut pendulum = model("double_pendulum");
+    let err = floquet_at_equilibrium(pendulum.as_mut(), &named("g")).unwrap_err();
+    assert!(matches!(err, FloquetStudyError::TimeIndependent { .. }), "{err}");
+    for (set, name) in [(None, "m"), (Some(60.0), "m"), (None, "a")] {
+        let mut m = model("mathieu_pendulum");
+        if let Some(v) = set {
+            m.set_parameter(name, v).unwrap();
+        }
+        let err = floquet_at_equilibrium(m.as_mut(), &named(name)).unwrap_err();
+        assert!(matches!(err, FloquetStudyError::NotPeriodic { .. }), "{name}: {err}");
+        assert_eq!(
+            parameter(m.as_ref(), name),
+            set.unwrap_or(if name == "m" { 1.0 } else { 0.1 }),
+            "the parameter is restored"
+        );
+    }
+    let mut m = model("mathieu_pendulum");
+    assert!(floquet_at_equilibrium(m.as_mut(), &named("w")).is_ok());
+    assert_eq!(parameter(m.as_ref(), "w"), 60.0);
+    // Without shaking the Mathieu pendulum does not depend on t: refused as a point, but a
+    // chart's a = 0 cell is analysed (checked in `floquet_study_point_and_cells`).
+    m.set_parameter("a", 0.0).unwrap();
+    let err = floquet_at_equilibrium(m.as_mut(), &named("w")).unwrap_err();
+    assert!(matches!(err, FloquetStudyError::TimeIndependent { .. }), "{err}");
+}

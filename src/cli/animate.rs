@@ -334,7 +334,7 @@ pub(crate) fn simulation(
                 short(solution.t[m - 1])
             ),
         };
-        failure_error(model.name(), &e, args.method, &kept)
+        failure_error(model.name(), &e, args, &kept)
     });
     if samples == 0 {
         return Ok((None, failure));

@@ -47,7 +47,7 @@ pub struct FloquetArgs {
     #[arg(long, default_value_t = 1e-6)]
     pub stability_tolerance: f64,
     /// Relative and absolute tolerance of DOP853 on the state and the variational equations.
-    #[arg(long, default_value_t = 1e-12)]
+    #[arg(long, default_value_t = 1e-12, value_parser = super::values::relative_tolerance, allow_hyphen_values = true)]
     pub tol: f64,
     /// Print JSON.
     #[arg(long)]
@@ -72,6 +72,13 @@ fn analysis_text(model: &dyn ModelInfo, e: &FloquetStudyError) -> String {
 /// Runs `study floquet`.
 pub fn run(args: &FloquetArgs) -> Result<(), CliError> {
     let mut model = args.point.model(&args.model)?;
+    let source = super::open_model(&args.model)?;
+    eomgen::studies::check_period_parameter_unit(&source, &args.period_parameter).map_err(|e| {
+        match e {
+            eomgen::studies::PeriodUnitError::File(e) => CliError::failure(e.to_string()),
+            e => CliError::usage(e.to_string()),
+        }
+    })?;
     let options = FloquetStudyOptions {
         operating_point: args.point.options(model.as_ref())?,
         period_parameter: args.period_parameter.clone(),
@@ -107,7 +114,7 @@ pub fn run(args: &FloquetArgs) -> Result<(), CliError> {
         Some((x, y)) => Some(run_sweep(args, &guess, x, y, &options)?),
         None => None,
     };
-    let references = FloquetReferences::of(&super::open_model(&args.model)?, &label)
+    let references = FloquetReferences::of(&source, &label)
         .map_err(|e| CliError::failure(e.to_string()))?;
     let thresholds = references
         .as_ref()

@@ -43,7 +43,7 @@ pub struct FreeResponseArgs {
     #[arg(long, default_value_t = 401, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(2..=1_000_000))]
     pub samples: usize,
     /// Relative and absolute tolerance of the DOP853 integration.
-    #[arg(long, default_value_t = 1e-13)]
+    #[arg(long, default_value_t = 1e-13, value_parser = super::values::relative_tolerance, allow_hyphen_values = true)]
     pub tol: f64,
     /// Print JSON instead of the table.
     #[arg(long)]

@@ -67,7 +67,7 @@ pub struct FrfArgs {
     #[arg(long, default_value_t = 1e-3)]
     pub amplitude: f64,
     /// Relative tolerance of the `--simulate` runs (DOP853).
-    #[arg(long, default_value_t = 1e-11)]
+    #[arg(long, default_value_t = 1e-11, value_parser = super::values::relative_tolerance, allow_hyphen_values = true)]
     pub rtol: f64,
     /// Print JSON.
     #[arg(long)]

@@ -114,10 +114,10 @@ pub struct IntegrationArgs {
     #[arg(long, value_parser = method_parser(), default_value_t = Method::Dp54)]
     pub method: Method,
     /// Relative tolerance (adaptive methods: bs32, dp54, dop853, radau5).
-    #[arg(long, default_value_t = 1e-8)]
+    #[arg(long, default_value_t = 1e-8, value_parser = super::values::relative_tolerance, allow_hyphen_values = true)]
     pub rtol: f64,
     /// Absolute tolerance (adaptive methods; implicit-midpoint's scale for components near 0).
-    #[arg(long, default_value_t = 1e-10)]
+    #[arg(long, default_value_t = 1e-10, value_parser = super::values::absolute_tolerance, allow_hyphen_values = true)]
     pub atol: f64,
     /// Step size: the fixed step of euler, midpoint, rk4, symplectic-euler, stormer-verlet and
     /// implicit-midpoint (default t_end/1000); the initial step of the adaptive methods
@@ -225,9 +225,13 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
         energy: report,
         constraints,
         failure,
+        warnings,
         integrator: method_name,
         ..
     } = simulation;
+    for warning in &warnings {
+        eprintln!("warning: {warning}");
+    }
     let n = model.num_dofs();
     let coordinates: Vec<String> = model
         .coordinate_names()
@@ -359,6 +363,18 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
         if let Some(e) = &failure {
             out["error"] = json!({"t": e.t(), "message": e.to_string()});
         }
+        if !warnings.is_empty() {
+            out["warnings"] = json!(
+                warnings
+                    .iter()
+                    .map(|w| {
+                        let mut warning = json!(w);
+                        warning["message"] = json!(w.to_string());
+                        warning
+                    })
+                    .collect::<Vec<_>>()
+            );
+        }
         let text =
             serde_json::to_string_pretty(&out).map_err(|e| CliError::failure(e.to_string()))?;
         let mut stdout = super::output::stdout();
@@ -373,7 +389,7 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
         Some(e) => Err(failure_error(
             model.name(),
             &e,
-            args.run.method,
+            &args.run,
             &format!(
                 "the {} samples computed before it were kept",
                 solution.len()
@@ -504,20 +520,44 @@ pub(crate) fn integrate(
 pub(crate) fn failure_error(
     model: &str,
     error: &IntegrationError,
-    method: Method,
+    args: &IntegrationArgs,
     kept: &str,
 ) -> CliError {
     CliError::failure(format!(
         "integration of `{model}` stopped: {error}; {kept}\nhelp: {}",
-        failure_hint(error, method)
+        failure_hint(error, args)
     ))
 }
 
-/// What to try after a failed integration (issue 8, item 3), by the reason and the method.
-fn failure_hint(error: &IntegrationError, method: Method) -> &'static str {
+/// An end time from which on `f64` resolves `t` only to steps of `16 ε t_end ≈ 3.6e-9 s` or
+/// coarser: a step-size underflow there comes from the end time, not from the model.
+const COARSE_TIME_END: f64 = 1e6;
+
+/// A relative tolerance this loose or looser no longer keeps the step inside the region
+/// where the error estimate is asymptotically right; an underflow there is the tolerance's.
+const LOOSE_RTOL: f64 = 1e-2;
+
+/// What to try after a failed integration (issue 8, item 3), by the reason, the method and
+/// the settings: a step-size underflow is blamed on the end time or the tolerance where
+/// those explain it, before stiffness or a singularity.
+fn failure_hint(error: &IntegrationError, args: &IntegrationArgs) -> String {
+    let method = args.method;
     let explicit = !method.is_implicit();
     let adaptive = method.is_adaptive();
-    match error {
+    let hint = match error {
+        IntegrationError::StepSizeTooSmall { .. } if args.t_end >= COARSE_TIME_END => {
+            return format!(
+                "the end time {:e} s is so large that f64 resolves t only to about {:.1e} s near it, coarser than the steps the motion needs; shorten --t-end (or rescale time in the model)",
+                args.t_end,
+                16.0 * f64::EPSILON * args.t_end
+            );
+        }
+        IntegrationError::StepSizeTooSmall { .. } if adaptive && args.rtol >= LOOSE_RTOL => {
+            return format!(
+                "--rtol {} is too loose for the error estimate to steer the step (it grows until the solution is lost, then collapses); use --rtol 1e-3 or tighter",
+                args.rtol
+            );
+        }
         IntegrationError::StepSizeTooSmall { .. } | IntegrationError::TooManySteps { .. }
             if explicit && adaptive =>
         {
@@ -552,7 +592,8 @@ fn failure_hint(error: &IntegrationError, method: Method) -> &'static str {
             "an event function is NaN there: check its expression (division by zero, sqrt of a negative)"
         }
         _ => "check the options against `eomgen simulate --help`",
-    }
+    };
+    hint.to_string()
 }
 
 fn print_summary(

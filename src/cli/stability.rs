@@ -35,13 +35,13 @@ pub struct StabilityArgs {
     #[arg(long, default_value_t = 10_000)]
     pub periods: usize,
     /// Stiffness ratios k/m (1/s²) of the stiff two-mass spring (part c), comma separated.
-    #[arg(long, value_delimiter = ',', default_values_t = [1e2, 1e4, 1e6, 1e8])]
+    #[arg(long, value_delimiter = ',', value_parser = super::values::positive, allow_hyphen_values = true, default_values_t = [1e2, 1e4, 1e6, 1e8])]
     pub stiffness: Vec<f64>,
     /// End time of the stiff runs (s).
     #[arg(long, default_value_t = 1.0)]
     pub t_end: f64,
     /// Relative and absolute tolerance of the stiff runs and of the underflow run.
-    #[arg(long, default_value_t = 1e-6)]
+    #[arg(long, default_value_t = 1e-6, value_parser = super::values::relative_tolerance, allow_hyphen_values = true)]
     pub tol: f64,
     /// Print JSON instead of the tables.
     #[arg(long)]

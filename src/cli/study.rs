@@ -51,10 +51,10 @@ pub struct ConstraintMethodsArgs {
     #[arg(long, default_value_t = 10.0)]
     pub t_end: f64,
     /// Relative and absolute tolerance of every run (Dormand–Prince 5(4)).
-    #[arg(long, default_value_t = 1e-8)]
+    #[arg(long, default_value_t = 1e-8, value_parser = super::values::relative_tolerance, allow_hyphen_values = true)]
     pub tol: f64,
     /// Spring stiffnesses of method I, comma separated.
-    #[arg(long, value_delimiter = ',', default_values_t = [1e2, 1e4, 1e6])]
+    #[arg(long, value_delimiter = ',', value_parser = super::values::positive, allow_hyphen_values = true, default_values_t = [1e2, 1e4, 1e6])]
     pub stiffness: Vec<f64>,
     /// Print JSON instead of the table.
     #[arg(long)]
@@ -99,6 +99,9 @@ fn constraint_methods(args: &ConstraintMethodsArgs) -> Result<(), CliError> {
         ConstraintMethodsError::InvalidOptions { .. } => {
             CliError::usage("--t-end and --tol must be positive")
         }
+        ConstraintMethodsError::InvalidStiffness { stiffness } => CliError::usage(format!(
+            "--stiffness: every stiffness must be a positive number, got {stiffness}"
+        )),
         other => CliError::failure(other.to_string()),
     })?;
     let ConstraintMethods {

@@ -33,3 +33,50 @@ pub fn split_assignment<'a>(arg: &'a str, option: &str) -> Result<(&'a str, &'a 
 pub fn set_parameters(model: &mut dyn ModelInfo, sets: &[String]) -> Result<(), CliError> {
     expressions::set_parameters(model, sets).map_err(usage)
 }
+
+/// Parses a relative tolerance (`--rtol`, `--tol`): a number in `(0, 1)`. A tolerance of 1
+/// or more asks for no correct digit; a negative one is written `--rtol -1` and reaches this
+/// parser (the arguments allow negative numbers) to get this message rather than clap's
+/// "unexpected argument". Refused values are usage errors (exit 2) in every command.
+pub fn relative_tolerance(text: &str) -> Result<f64, String> {
+    let value: f64 = text
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{text}` is not a number"))?;
+    if value.is_finite() && value > 0.0 && value < 1.0 {
+        Ok(value)
+    } else {
+        Err(format!(
+            "a relative tolerance must be a number in (0, 1), such as 1e-8; got {value}"
+        ))
+    }
+}
+
+/// Parses an absolute tolerance (`--atol`): a finite number `≥ 0` (0 leaves the relative
+/// tolerance alone in control).
+pub fn absolute_tolerance(text: &str) -> Result<f64, String> {
+    let value: f64 = text
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{text}` is not a number"))?;
+    if value.is_finite() && value >= 0.0 {
+        Ok(value)
+    } else {
+        Err(format!(
+            "an absolute tolerance must be a finite number >= 0, such as 1e-10; got {value}"
+        ))
+    }
+}
+
+/// Parses a positive finite number (a stiffness, a step): refused values are usage errors.
+pub fn positive(text: &str) -> Result<f64, String> {
+    let value: f64 = text
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{text}` is not a number"))?;
+    if value.is_finite() && value > 0.0 {
+        Ok(value)
+    } else {
+        Err(format!("must be a positive number, got {value}"))
+    }
+}

@@ -8,7 +8,8 @@ use std::io::Write;
 use clap::Args;
 use eomgen::ModelInfo;
 use eomgen::analysis::work_precision::{
-    AtTarget, DEFAULT_METHODS, MAX_REPEATS, Measured, MethodRuns, Setting, SettingRun,
+    AtTarget, DEFAULT_METHODS, MAX_REPEATS, Measured, MethodRuns, SMALLEST_TOLERANCE, Setting,
+    SettingRun,
     WorkPrecision, WorkPrecisionError, WorkPrecisionOptions, decades, work_precision,
 };
 use serde_json::json;
@@ -120,10 +121,12 @@ fn parse_tols(text: &str) -> Result<Vec<f64>, CliError> {
             .trim()
             .parse()
             .map_err(|_| bad(&format!("`{}` is not a number", s.trim())))?;
-        if v.is_finite() && v > 0.0 && v < 1.0 {
+        if v.is_finite() && v >= SMALLEST_TOLERANCE && v < 1.0 {
             Ok(v)
         } else {
-            Err(bad(&format!("{v} is not a tolerance in (0, 1)")))
+            Err(bad(&format!(
+                "{v} is not a tolerance in [{SMALLEST_TOLERANCE:e}, 1) (f64 cannot deliver less)"
+            )))
         }
     };
     let mut tols = if let Some((a, b)) = text.split_once("..") {
@@ -226,6 +229,12 @@ pub fn run(args: &WorkPrecisionArgs) -> Result<(), CliError> {
     } else {
         study.write_text(&mut stdout)
     };
+    if study.report.every_run_failed() {
+        return Err(CliError::failure(format!(
+            "every run of the study failed, so it measured nothing (the reasons are in the table); try tolerances between 1e-3 and 1e-13{}",
+            if args.steps.is_some() { " or more steps" } else { "" }
+        )));
+    }
     Ok(())
 }
 

@@ -72,6 +72,17 @@ pub enum ConstraintMethodsError {
         /// The tolerance.
         tol: f64,
     },
+    /// A stiffness of method I is not a positive number.
+    #[error("every stiffness must be positive, got {stiffness}")]
+    InvalidStiffness {
+        /// The offending stiffness.
+        stiffness: f64,
+    },
+    /// The model's initial state could not be made consistent with its constraints (every
+    /// run starts from the consistent state, so that the methods are compared on the same
+    /// motion).
+    #[error("the initial state cannot be made consistent with the constraints: {0}")]
+    InconsistentStart(crate::constrained::ProjectionError),
     /// The reference run failed.
     #[error("the reference solution failed: {message}")]
     ReferenceFailed {
@@ -118,6 +129,7 @@ pub struct ConstraintMethods {
 
 fn integrate(
     model: &mut dyn ModelInfo,
+    y0: &[f64],
     t_end: f64,
     times: &[f64],
     tol: f64,
@@ -126,11 +138,10 @@ fn integrate(
         .with_rtol(tol)
         .with_atol(tol)
         .with_max_steps(MAX_STEPS);
-    let y0 = model.initial_state();
     match DormandPrince54::new().integrate(
         model.as_ode_mut(),
         0.0,
-        &y0,
+        y0,
         t_end,
         &OutputTimes::At(times.to_vec()),
         &options,
@@ -206,9 +217,16 @@ fn row(
 /// minimal-coordinate twin with its name (the model file's `minimal_twin:`), whose points
 /// of the same names are compared.
 ///
+/// Every constrained run (and the reference) starts from the model's initial state made
+/// consistent with its constraints ([`ModelInfo::consistent_initial_state`]: the coordinates
+/// the file marks `{ guess: … }` solved by Newton), so that a file whose `initial:` only
+/// guesses the dependent coordinates is compared on the motion it describes; the minimal twin
+/// starts from its own initial state.
+///
 /// # Errors
 /// [`ConstraintMethodsError::NoHolonomicConstraints`],
-/// [`ConstraintMethodsError::InvalidOptions`], [`ConstraintMethodsError::ReferenceFailed`].
+/// [`ConstraintMethodsError::InvalidOptions`], [`ConstraintMethodsError::InvalidStiffness`],
+/// [`ConstraintMethodsError::InconsistentStart`], [`ConstraintMethodsError::ReferenceFailed`].
 ///
 /// # Examples
 /// ```
@@ -242,6 +260,12 @@ pub fn constraint_methods(
             tol: options.tol,
         });
     }
+    if let Some(&stiffness) = options.stiffness.iter().find(|&&k| !positive(k)) {
+        return Err(ConstraintMethodsError::InvalidStiffness { stiffness });
+    }
+    let y0 = model
+        .consistent_initial_state()
+        .map_err(ConstraintMethodsError::InconsistentStart)?;
     let (t_end, tol) = (options.t_end, options.tol);
     let times: Vec<f64> = (1..=OUTPUT_TIMES)
         .map(|i| t_end * f64::from(i) / f64::from(OUTPUT_TIMES))
@@ -255,13 +279,13 @@ pub fn constraint_methods(
         alpha: 10.0,
         beta: 10.0,
     });
-    let (reference_solution, failure) = integrate(model.as_mut(), t_end, &times, REFERENCE_TOL);
+    let (reference_solution, failure) = integrate(model.as_mut(), &y0, t_end, &times, REFERENCE_TOL);
     if let Some(message) = failure {
         return Err(ConstraintMethodsError::ReferenceFailed { message });
     }
     let reference = positions(model.as_ref(), &reference_solution, &names);
     model.set_stabilization(Stabilization::None);
-    let (check, _) = integrate(model.as_mut(), t_end, &times, REFERENCE_TOL);
+    let (check, _) = integrate(model.as_mut(), &y0, t_end, &times, REFERENCE_TOL);
     let agreement = row(
         String::new(),
         model.as_mut(),
@@ -280,7 +304,7 @@ pub fn constraint_methods(
             stiffness: k,
             damping: 0.0,
         });
-        let (s, f) = integrate(m.as_mut(), t_end, &times, tol);
+        let (s, f) = integrate(m.as_mut(), &y0, t_end, &times, tol);
         rows.push(row(
             format!("I: stiff spring k = {k:e}"),
             m.as_mut(),
@@ -303,7 +327,7 @@ pub fn constraint_methods(
     ] {
         let mut m = make();
         m.set_stabilization(stab);
-        let (s, f) = integrate(m.as_mut(), t_end, &times, tol);
+        let (s, f) = integrate(m.as_mut(), &y0, t_end, &times, tol);
         rows.push(row(
             label.to_string(),
             m.as_mut(),
@@ -315,7 +339,8 @@ pub fn constraint_methods(
         ));
     }
     if let Some((twin, mut m)) = twin {
-        let (s, f) = integrate(m.as_mut(), t_end, &times, tol);
+        let y0 = m.initial_state();
+        let (s, f) = integrate(m.as_mut(), &y0, t_end, &times, tol);
         rows.push(row(
             format!("II.3: minimal coordinates ({twin})"),
             m.as_mut(),

@@ -7,6 +7,7 @@
 
 pub mod constraint_methods;
 pub mod drift;
+pub mod fixed_step;
 pub mod methods;
 pub mod roundoff;
 pub mod simulation;
@@ -18,6 +19,7 @@ pub use constraint_methods::{
     constraint_methods,
 };
 pub use drift::{ConstraintDrift, EnergyDrift, constraint_drift, energy_drift};
+pub use fixed_step::{SimulationWarning, fixed_step_warnings};
 pub use methods::{Method, UnknownMethod};
 pub use roundoff::{EulerRoundoff, RoundoffError, RoundoffOptions, euler_roundoff};
 pub use simulation::{

@@ -5,6 +5,7 @@
 use serde::{Serialize, Serializer};
 
 use crate::analysis::drift::{ConstraintDrift, EnergyDrift, constraint_drift, energy_drift};
+use crate::analysis::fixed_step::{SimulationWarning, fixed_step_warnings};
 use crate::analysis::methods::Method;
 use crate::constrained::{ProjectionError, Stabilization};
 use crate::integrate::{
@@ -149,6 +150,10 @@ pub struct Simulation {
     pub energy: EnergyDrift,
     /// The constraint forces and drift at every sample (empty without constraints).
     pub constraints: ConstraintDrift,
+    /// Warnings about the settings found before the run: a fixed step longer than the span
+    /// or past the method's stability limit on the linearisation at the start
+    /// ([`fixed_step_warnings`]).
+    pub warnings: Vec<SimulationWarning>,
     /// Why the integration stopped before `t_end`, if it did (serialised as `{"t",
     /// "message"}`); `solution` then holds the samples computed before it.
     #[serde(serialize_with = "serialize_failure")]
@@ -267,6 +272,7 @@ pub fn simulate_with_events(
             t_end: options.t_end,
         });
     }
+    let warnings = fixed_step_warnings(model, options.method, &y0, options.dt, options.t_end);
     let integrator_options = options.integrator_options();
     let mut integrator = options.method.integrator();
     let result = match added {
@@ -310,6 +316,7 @@ pub fn simulate_with_events(
         solution,
         energy,
         constraints,
+        warnings,
         failure,
     })
 }

@@ -50,6 +50,13 @@ pub const MAX_STEPS: usize = 5_000_000;
 /// Most timed repetitions of one setting, whatever the minimum time asks.
 pub const MAX_REPEATS: usize = 1000;
 
+/// The smallest tolerance a run may ask for: about 5 units of round-off of `f64`
+/// (`ε = 2.2e-16`). Below it no step can meet the tolerance, and a run either collapses its
+/// step or creeps to the step limit (`--tols 1e-30..1e-40` failed every run after minutes).
+/// Hairer's DOP853 likewise refuses `rtol ≤ 10 · 1.1e-16` (Hairer, Nørsett, Wanner, *Solving
+/// Ordinary Differential Equations I*, 2nd ed., 1993, the code's documentation of `RTOL`).
+pub const SMALLEST_TOLERANCE: f64 = 1e-15;
+
 /// Options of [`work_precision`].
 ///
 /// # Solver limits
@@ -139,8 +146,8 @@ pub enum WorkPrecisionError {
         /// The minimum time (s).
         min_time_s: f64,
     },
-    /// A tolerance not in (0, 1).
-    #[error("{tol} is not a tolerance in (0, 1)")]
+    /// A tolerance not in `[SMALLEST_TOLERANCE, 1)`.
+    #[error("{tol} is not a tolerance in [1e-15, 1) (f64 cannot deliver less)")]
     InvalidTolerance {
         /// The tolerance.
         tol: f64,
@@ -217,7 +224,7 @@ impl WorkPrecisionOptions {
         if let Some(&tol) = self
             .tolerances
             .iter()
-            .find(|&&t| !(t.is_finite() && t > 0.0 && t < 1.0))
+            .find(|&&t| !(t.is_finite() && t >= SMALLEST_TOLERANCE && t < 1.0))
         {
             return Err(WorkPrecisionError::InvalidTolerance { tol });
         }
@@ -383,6 +390,16 @@ impl WorkPrecision {
     /// the reference as much as the method.
     pub fn unresolved(&self, m: &Measured) -> bool {
         m.error < 10.0 * self.agreement
+    }
+
+    /// Whether no run of any method succeeded (every setting failed): the study measured
+    /// nothing, which a front end reports as a failure (`eomgen study work-precision` exits
+    /// 1), whatever table it prints.
+    pub fn every_run_failed(&self) -> bool {
+        self.results
+            .iter()
+            .flat_map(|r| &r.runs)
+            .all(|r| r.outcome.is_err())
     }
 
     /// The number of runs whose error the reference does not resolve ([`Self::unresolved`]).
@@ -731,6 +748,49 @@ pub fn work_precision(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A study fails as a whole only when no run of any method measured anything.
+    #[test]
+    fn every_run_failed_only_when_no_run_measured() {
+        let failed = SettingRun {
+            setting: Setting::Tolerance(1e-6),
+            outcome: Err(RunFailure {
+                t: Some(0.5),
+                message: "step size underflow".into(),
+            }),
+        };
+        let measured = SettingRun {
+            setting: Setting::Tolerance(1e-4),
+            outcome: Ok(Measured {
+                error: 1e-4,
+                rhs_evals: 100,
+                steps: 10,
+                rejected: 0,
+                jacobian_evals: 0,
+                lu_decompositions: 0,
+                wall_time_s: 1e-5,
+                repeats: 1,
+                energy_drift: None,
+            }),
+        };
+        let study = |runs: Vec<Vec<SettingRun>>| WorkPrecision {
+            dim: 2,
+            agreement: 1e-13,
+            reference_steps: 1000,
+            min_repeats: 1,
+            min_time_s: 0.0,
+            results: runs
+                .into_iter()
+                .map(|runs| MethodRuns {
+                    method: Method::Dp54,
+                    runs,
+                    at_target: AtTarget::NotReached,
+                })
+                .collect(),
+        };
+        assert!(study(vec![vec![failed.clone()], vec![failed.clone(), failed.clone()]]).every_run_failed());
+        assert!(!study(vec![vec![failed.clone()], vec![failed, measured]]).every_run_failed());
+    }
 
     #[test]
     fn decades_are_exact_and_loosest_first() {

@@ -36,8 +36,10 @@ pub enum IntegrationError {
         /// The number of values given.
         found: usize,
     },
-    /// A tolerance is negative or not finite.
-    #[error("`{option}` is {value} for component {index}; tolerances must be finite and >= 0")]
+    /// A tolerance is negative or not finite, or a relative tolerance is 1 or more.
+    #[error(
+        "`{option}` is {value} for component {index}; tolerances must be finite and >= 0, and rtol < 1"
+    )]
     InvalidTolerance {
         /// Which option: `"rtol"` or `"atol"`.
         option: &'static str,

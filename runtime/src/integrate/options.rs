@@ -124,7 +124,8 @@ impl Default for IntegratorOptions {
 }
 
 impl IntegratorOptions {
-    /// Sets the relative tolerance (a scalar `f64` or one value per component).
+    /// Sets the relative tolerance (a scalar `f64` or one value per component), each in
+    /// `[0, 1)`.
     pub fn with_rtol(mut self, rtol: impl Into<Tolerance>) -> Self {
         self.rtol = rtol.into();
         self
@@ -211,7 +212,8 @@ pub(crate) fn check_initial_state(dim: usize, t0: f64, y0: &[f64]) -> Result<(),
     }
 }
 
-/// Rule: a tolerance has one value or `dim` values, each finite and non-negative; and for
+/// Rule: a tolerance has one value or `dim` values, each finite and non-negative, `rtol` below
+/// 1 (a relative tolerance of 1 asks for no correct digit); and for
 /// every component `rtol` and `atol` are not both zero, else the error scale of a component
 /// that passes through zero is zero and no step could be accepted.
 pub(crate) fn check_tolerances(
@@ -246,7 +248,11 @@ fn resolve_tolerance(
     if let Some((index, &value)) = values
         .iter()
         .enumerate()
-        .find(|(_, value)| !(value.is_finite() && **value >= 0.0))
+        .find(|(_, value)| {
+            // A relative tolerance of 1 or more asks for no correct digit: the error estimate
+            // then no longer steers the step (it grows until the solution is lost).
+            !(value.is_finite() && **value >= 0.0) || (option == "rtol" && **value >= 1.0)
+        })
     {
         return Err(IntegrationError::InvalidTolerance {
             option,
@@ -348,6 +354,12 @@ mod tests {
                 ..
             }
         ));
+        let loose = IntegratorOptions::default().with_rtol(1.0);
+        assert!(matches!(
+            check_tolerances(&loose, 2).unwrap_err(),
+            IntegrationError::InvalidTolerance { option: "rtol", .. }
+        ));
+        assert!(check_tolerances(&IntegratorOptions::default().with_rtol(0.99), 2).is_ok());
         let nan_scalar = IntegratorOptions::default().with_atol(f64::NAN);
         assert!(matches!(
             check_tolerances(&nan_scalar, 0).unwrap_err(),

@@ -2,7 +2,10 @@
 //! multipliers of a time-periodic model about an equilibrium that holds for every `t` of the
 //! period, and one cell of a stability chart over two parameters.
 //!
-//! The period is `T = 2π/w` with `w` the value of the period parameter; the operating point
+//! The period is `T = 2π/w` with `w` the value of the period parameter, which is checked
+//! numerically to be the forcing frequency: `M` and `F` depend on `t` and are `T`-periodic at a
+//! few states and times, both at `w` and at a value 1/64 above it (so a parameter that merely
+//! equals the frequency, or a model with no time dependence, is refused); the operating point
 //! is found by Newton at `t = 0` and checked to stay an equilibrium over the period
 //! ([`check_periodic_equilibrium`], 65 times); the monodromy matrix comes from the variational
 //! equations with the generated Jacobians ([`floquet_analysis`]). A chart repeats
@@ -70,6 +73,35 @@ pub enum FloquetStudyError {
         parameter: String,
         /// Its value (rad/s).
         frequency: f64,
+    },
+    /// The model's equations do not depend on `t`: there is no period to analyse (the
+    /// multipliers would be `e^{λT}` of the modes for any `T`).
+    #[error(
+        "`{model}` does not depend on t, so it has no forcing period; its stability is that of its modes (eomgen modes)"
+    )]
+    TimeIndependent {
+        /// The model.
+        model: String,
+    },
+    /// The model is not `T`-periodic with `T = 2π/w` for the named parameter `w` (at its
+    /// value, or at a value 1/64 above it: a parameter that only happens to equal the
+    /// frequency is not the frequency).
+    #[error(
+        "`{model}` is not periodic with T = 2π/{parameter} = {period} s at {parameter} = {frequency}: M or F differs by {difference:.3e} between t = {t} s and t + T; the period parameter must be the forcing frequency (rad/s)"
+    )]
+    NotPeriodic {
+        /// The model.
+        model: String,
+        /// The period parameter.
+        parameter: String,
+        /// The value tried (rad/s).
+        frequency: f64,
+        /// `T = 2π/frequency` (s).
+        period: f64,
+        /// The time of the largest difference (s).
+        t: f64,
+        /// The largest difference of `M` or `F`, relative to their size.
+        difference: f64,
     },
     /// Newton found no equilibrium at `t = 0`.
     #[error(transparent)]
@@ -151,19 +183,24 @@ fn check_options(
 /// # Errors
 /// [`FloquetStudyError::UnknownPeriodParameter`], [`FloquetStudyError::InvalidTolerance`],
 /// [`FloquetStudyError::OperatingPoint`], [`FloquetStudyError::InvalidFrequency`],
-/// [`FloquetStudyError::Equilibrium`], [`FloquetStudyError::Floquet`].
+/// [`FloquetStudyError::TimeIndependent`] and [`FloquetStudyError::NotPeriodic`] (the model
+/// is checked numerically to be `2π/w`-periodic in `t` for the period parameter `w`, see the
+/// module docs), [`FloquetStudyError::Equilibrium`], [`FloquetStudyError::Floquet`].
 ///
 /// # Examples
-/// The Mathieu pendulum upright without shaking (`a = 0`) is unstable with multipliers
-/// `e^{±√(g/l) T}`, `T = 2π/w`.
+/// A model whose equations do not depend on `t` has no forcing period, whatever parameter is
+/// named; the Mathieu pendulum's upright equilibrium is analysed (its shaking makes it
+/// stable at the file's values).
 /// ```
-/// use eomgen_runtime::vibration::{FloquetStudyOptions, floquet_at_equilibrium};
+/// use eomgen_runtime::vibration::{FloquetStudyError, FloquetStudyOptions, floquet_at_equilibrium};
+/// let mut pendulum = (eomgen::models::find("double_pendulum").unwrap().make)();
+/// let options = FloquetStudyOptions { period_parameter: "g".into(), ..Default::default() };
+/// let refused = floquet_at_equilibrium(pendulum.as_mut(), &options);
+/// assert!(matches!(refused, Err(FloquetStudyError::TimeIndependent { .. })));
+///
 /// let mut model = (eomgen::models::find("mathieu_pendulum").unwrap().make)();
-/// model.set_parameter("a", 0.0)?;
 /// let point = floquet_at_equilibrium(model.as_mut(), &FloquetStudyOptions::default())?;
-/// let period = 2.0 * std::f64::consts::PI / 60.0;
-/// let expected = (10f64.sqrt() * period).exp();
-/// assert!((point.floquet.spectral_radius - expected).abs() < 1e-8 * expected);
+/// assert!(point.floquet.spectral_radius <= 1.0 + 1e-6);
 /// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 ///
@@ -176,7 +213,17 @@ pub fn floquet_at_equilibrium(
 ) -> Result<FloquetPoint, FloquetStudyError> {
     check_options(model, options)?;
     let (name, guess) = options.operating_point.start.resolve(model)?;
-    analyse(model, name, &guess, options)
+    analyse(model, name, &guess, options, TimeDependence::Required)
+}
+
+/// Whether [`check_period_parameter`] refuses a model whose equations do not depend on `t`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum TimeDependence {
+    /// The analysis at the user's parameters: a model without time dependence is refused.
+    Required,
+    /// A cell of a chart: a parameter set without forcing (the Mathieu pendulum's `a = 0`
+    /// column) is the chart's limit, analysed as it is.
+    Allowed,
 }
 
 /// Equilibrium at `t = 0` from `guess`, the check that it stays one over the period, and the
@@ -186,6 +233,7 @@ fn analyse(
     name: String,
     guess: &[f64],
     options: &FloquetStudyOptions,
+    time_dependence: TimeDependence,
 ) -> Result<FloquetPoint, FloquetStudyError> {
     let parameter = &options.period_parameter;
     let index = model
@@ -205,6 +253,7 @@ fn analyse(
         });
     }
     let period = TAU / frequency;
+    check_period_parameter(model, index, guess, time_dependence)?;
     let equilibrium =
         find_equilibrium(model, guess, 0.0).map_err(FloquetStudyError::Equilibrium)?;
     let residual = check_periodic_equilibrium(model, &equilibrium.q, 0.0, period)?;
@@ -223,6 +272,93 @@ fn analyse(
         residual,
         floquet,
     })
+}
+
+/// Largest relative difference of `M` and `F` at the states `ys` between the times `t` and
+/// `t + shift`, with the time of the largest.
+fn largest_change(model: &dyn ModelInfo, ys: &[Vec<f64>], times: &[f64], shift: f64) -> (f64, f64) {
+    let mut worst = (0.0f64, times[0]);
+    for y in ys {
+        for &t in times {
+            let (m0, f0) = model.mass_matrix_and_forcing(t, y);
+            let (m1, f1) = model.mass_matrix_and_forcing(t + shift, y);
+            let scale = 1.0 + m0.amax().max(f0.amax());
+            let d = (m1 - m0).amax().max((f1 - f0).amax()) / scale;
+            let d = if d.is_nan() { f64::INFINITY } else { d };
+            if d > worst.0 {
+                worst = (d, t);
+            }
+        }
+    }
+    worst
+}
+
+/// Checks numerically that the parameter at `index` is the forcing frequency `w` of
+/// `model`: its equations `M(q, t)`, `F(q, q̇, t)` depend on `t` (where `time_dependence`
+/// requires it), and are `2π/w`-periodic at
+/// three states near `q` (the equilibrium guess, and it moved by up to 0.1 with rates up to
+/// 0.2) and seven times in the period, both at `w` and at `w (1 + 1/64)` (then restored).
+/// Tolerance: a relative difference of 1e-9, far above the round-off of evaluating at
+/// `t + T` (~1e-15 relative for the bundled models' `cos(w t)`) and far below the change a
+/// wrong period makes (of the order of the forcing amplitude).
+fn check_period_parameter(
+    model: &mut dyn ModelInfo,
+    index: usize,
+    q: &[f64],
+    time_dependence: TimeDependence,
+) -> Result<(), FloquetStudyError> {
+    const TOLERANCE: f64 = 1e-9;
+    let n = model.num_dofs();
+    let ys: Vec<Vec<f64>> = [(0.0, 0.0), (0.1, 0.2), (-0.07, -0.13)]
+        .iter()
+        .map(|&(dq, dv)| {
+            let mut y: Vec<f64> = q.iter().copied().chain(std::iter::repeat_n(0.0, n)).collect();
+            for i in 0..n {
+                let sign = if i % 2 == 0 { 1.0 } else { -0.6 };
+                y[i] += dq * sign;
+                y[n + i] = dv * sign;
+            }
+            y
+        })
+        .collect();
+    let name = model.parameter_names()[index].to_string();
+    let frequency = model.parameter_values()[index];
+    let period = TAU / frequency;
+    let times: Vec<f64> = (0..7).map(|k| 0.137 * period + f64::from(k) * period / 7.0).collect();
+    // Time dependence at all: F or M changes across two shifts that are irrational-looking
+    // fractions of the period (a quarter and a third would be whole periods of a forcing at
+    // 12 times the named "frequency").
+    let varies = largest_change(model, &ys, &times, 0.271_828 * period)
+        .0
+        .max(largest_change(model, &ys, &times, 0.414_214 * period).0);
+    if varies <= TOLERANCE && time_dependence == TimeDependence::Required {
+        return Err(FloquetStudyError::TimeIndependent {
+            model: model.name().to_string(),
+        });
+    }
+    let perturbed = frequency * (1.0 + 1.0 / 64.0);
+    for w in [frequency, perturbed] {
+        model
+            .set_parameter(&name, w)?;
+        let period = TAU / w;
+        let times: Vec<f64> = (0..7).map(|k| 0.137 * period + f64::from(k) * period / 7.0).collect();
+        let (difference, t) = largest_change(model, &ys, &times, period);
+        if difference > TOLERANCE {
+            model
+                .set_parameter(&name, frequency)?;
+            return Err(FloquetStudyError::NotPeriodic {
+                model: model.name().to_string(),
+                parameter: name,
+                frequency: w,
+                period,
+                t,
+                difference,
+            });
+        }
+    }
+    model
+        .set_parameter(&name, frequency)?;
+    Ok(())
 }
 
 /// One swept parameter of a stability chart.
@@ -275,7 +411,9 @@ pub struct FloquetCell {
 ///
 /// # Errors
 /// [`FloquetStudyError::Parameter`] for an unknown name, and those of
-/// [`floquet_at_equilibrium`].
+/// [`floquet_at_equilibrium`] except [`FloquetStudyError::TimeIndependent`]: a cell whose
+/// parameters switch the forcing off (the Mathieu pendulum's `a = 0`) is analysed, its
+/// multipliers those of the modes over the period `2π/w`.
 pub fn floquet_cell(
     model: &mut dyn ModelInfo,
     guess: &[f64],
@@ -285,7 +423,7 @@ pub fn floquet_cell(
     for (name, value) in values {
         model.set_parameter(name, *value)?;
     }
-    let point = analyse(model, String::new(), guess, options)?;
+    let point = analyse(model, String::new(), guess, options, TimeDependence::Allowed)?;
     Ok(FloquetCell {
         spectral_radius: point.floquet.spectral_radius,
         stability: point.floquet.stability,

@@ -232,20 +232,14 @@ pub fn check_model(
     let mut power_rel: f64 = 0.0;
     let mut quadratic = true;
     let symbols = model.arena.symbols().to_vec();
-    let defaults: FxHashMap<&str, f64> = model
-        .parameters
-        .iter()
-        .map(|p| (p.name.as_str(), p.default))
-        .collect();
+    let defaults = defaults_by_symbol(&model);
     let mut compared = 0;
     for _ in 0..states {
         let t = rng.uniform(0.0, 5.0);
         let mut bindings = vec![0.0; symbols.len()];
         for (i, s) in symbols.iter().enumerate() {
             bindings[i] = match s.kind {
-                SymbolKind::Parameter => {
-                    defaults.get(s.name.as_str()).copied().unwrap_or(0.0) * rng.uniform(0.9, 1.1)
-                }
+                SymbolKind::Parameter => defaults[i] * rng.uniform(0.9, 1.1),
                 SymbolKind::Coordinate(_) | SymbolKind::Velocity(_) => rng.uniform(-2.0, 2.0),
                 SymbolKind::Time => t,
                 _ => 0.0,
@@ -368,6 +362,16 @@ pub fn check_model(
     })
 }
 
+/// Each parameter's default at the index of its symbol (0 for every other symbol): looked up
+/// by index rather than by name, so that binding a state is linear in the number of symbols.
+fn defaults_by_symbol(model: &SymbolicModel) -> Vec<f64> {
+    let mut defaults = vec![0.0; model.arena.symbols().len()];
+    for p in &model.parameters {
+        defaults[p.symbol.index()] = p.default;
+    }
+    defaults
+}
+
 /// The value bound to the rate of coordinate `i`.
 fn bindings_rate(symbols: &[crate::expr::Symbol], bindings: &[f64], i: usize) -> f64 {
     symbols
@@ -424,11 +428,7 @@ fn integrable_nonholonomic(model: &mut SymbolicModel, seed: u64) -> Vec<String> 
             }
         }
         let mut evaluator = Evaluator::new(&model.arena, &terms);
-        let defaults: FxHashMap<&str, f64> = model
-            .parameters
-            .iter()
-            .map(|p| (p.name.as_str(), p.default))
-            .collect();
+        let defaults = defaults_by_symbol(model);
         let mut rng = Rng(seed ^ 0x5DEE_CE66);
         let mut integrable = true;
         for _ in 0..50 {
@@ -436,8 +436,9 @@ fn integrable_nonholonomic(model: &mut SymbolicModel, seed: u64) -> Vec<String> 
                 .arena
                 .symbols()
                 .iter()
-                .map(|s| match s.kind {
-                    SymbolKind::Parameter => defaults.get(s.name.as_str()).copied().unwrap_or(0.0),
+                .enumerate()
+                .map(|(i, s)| match s.kind {
+                    SymbolKind::Parameter => defaults[i],
                     _ => rng.uniform(-2.0, 2.0),
                 })
                 .collect();

@@ -87,18 +87,12 @@ pub fn mass_matrix_diagnostics(
 
     // Numerically: at random states, then at the initial state.
     let symbols = arena.symbols().to_vec();
-    let defaults: Vec<(usize, f64)> = symbols
+    // Each parameter's default at its symbol (not a search by name per symbol: a file of
+    // many parameters would be quadratic).
+    let defaults: Vec<(usize, f64)> = model
+        .parameters
         .iter()
-        .enumerate()
-        .filter(|(_, s)| s.kind == SymbolKind::Parameter)
-        .map(|(k, s)| {
-            let value = model
-                .parameters
-                .iter()
-                .find(|p| p.name == s.name)
-                .map_or(0.0, |p| p.default);
-            (k, value)
-        })
+        .map(|p| (p.symbol.index(), p.default))
         .collect();
     let mut evaluator = Evaluator::new(arena, &eom.mass_matrix);
     let mut bindings = vec![0.0; symbols.len()];

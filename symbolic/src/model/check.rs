@@ -136,7 +136,9 @@ impl<'f> Checker<'f> {
     // accelerations of coordinates).
     fn names(&mut self) {
         let file = self.file;
-        let mut seen: Vec<(&str, Location, &str)> = Vec::new();
+        // First place and kind of each name (a map: a file of many names stays linear).
+        let mut seen: std::collections::HashMap<&str, (Location, &str)> =
+            std::collections::HashMap::new();
         let named = file
             .parameters
             .iter()
@@ -170,7 +172,7 @@ impl<'f> Checker<'f> {
                     ),
                 );
             }
-            if let Some((_, first, first_kind)) = seen.iter().find(|(s, _, _)| *s == n) {
+            if let Some((first, first_kind)) = seen.get(n) {
                 self.error(
                     Diagnostic::new(
                         name.location,
@@ -179,7 +181,7 @@ impl<'f> Checker<'f> {
                     .with_help("parameters, coordinates, points and bodies share one namespace; rename one"),
                 );
             } else {
-                seen.push((n, name.location, kind));
+                seen.insert(n, (name.location, kind));
             }
         }
     }

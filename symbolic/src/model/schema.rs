@@ -5,12 +5,14 @@
 //! left out, and what was left out is recorded in [`Incomplete`] so that the cross-object
 //! checks ([`super::check`]) do not report its consequences a second time.
 
+use std::collections::HashMap;
+
 use super::ast::{BinOp, Expr, ExprKind};
 use super::diagnostic::{Diagnostic, Diagnostics};
 use super::file::*;
 use super::located::{Located, Location};
 use super::parser::{closest, eval_expr, identifiers, parse_expr_mapped};
-use super::yaml::{YamlKind, YamlNode, char_locations, trailing_comment};
+use super::yaml::{YamlKind, YamlNode, char_locations_in_lines, trailing_comment_of_line};
 
 type Entries = [(Located<String>, YamlNode)];
 
@@ -119,6 +121,7 @@ pub fn build(path: &str, source: &str, root: &YamlNode) -> Result<ModelFile, Vec
 pub fn build_partial(path: &str, source: &str, root: &YamlNode) -> Built {
     let mut cx = Ctx {
         source,
+        lines: source.lines().collect(),
         diagnostics: Diagnostics::new(),
         incomplete: Incomplete::default(),
         section: "",
@@ -132,13 +135,10 @@ pub fn build_partial(path: &str, source: &str, root: &YamlNode) -> Built {
     }
 }
 
-/// Where the text `comment` of the trailing comment of `line` starts (it ends the line).
-fn comment_location(source: &str, line: u32, comment: &str) -> Location {
-    let text = source
-        .lines()
-        .nth(line.saturating_sub(1) as usize)
-        .unwrap_or_default()
-        .trim_end();
+/// Where the text `comment` of the trailing comment of `line`, whose text is `text`, starts
+/// (it ends the line).
+fn comment_location(text: &str, line: u32, comment: &str) -> Location {
+    let text = text.trim_end();
     let byte = text.len().saturating_sub(comment.len());
     let column = text.get(..byte).map_or(0, |p| p.chars().count());
     Location {
@@ -273,13 +273,23 @@ fn cut_in_source(source: &str, end: Location) -> bool {
 
 struct Ctx<'s> {
     source: &'s str,
+    /// The lines of `source`, looked up by number (1-based) with [`Ctx::line`].
+    lines: Vec<&'s str>,
     diagnostics: Diagnostics,
     incomplete: Incomplete,
     /// The top-level key being read; every error marks it incomplete.
     section: &'static str,
 }
 
-impl Ctx<'_> {
+impl<'s> Ctx<'s> {
+    /// The text of line `line` (1-based) of the source, empty past its end.
+    fn line(&self, line: u32) -> &'s str {
+        line.checked_sub(1)
+            .and_then(|i| self.lines.get(i as usize))
+            .copied()
+            .unwrap_or_default()
+    }
+
     fn error(&mut self, d: Diagnostic) {
         self.diagnostics.push(d);
         if !self.section.is_empty() && !self.incomplete.has_section(self.section) {
@@ -455,7 +465,7 @@ impl Ctx<'_> {
     /// expression, with exact file locations.
     fn parse_part(&mut self, node: &YamlNode, text: &str, from: usize, to: usize) -> Option<Expr> {
         let start = node.location;
-        let locations = char_locations(self.source, start, text);
+        let locations = char_locations_in_lines(&self.lines, start, text);
         let locate = |i: usize| match &locations {
             Some(l) => l.get(from + i).or(l.last()).copied().unwrap_or(start),
             None => start.offset(from + i),
@@ -1471,7 +1481,7 @@ impl Ctx<'_> {
             }
             [_, second, ..] => {
                 let start = node.location;
-                let at = char_locations(self.source, start, &text)
+                let at = char_locations_in_lines(&self.lines, start, &text)
                     .and_then(|l| l.get(*second).copied())
                     .unwrap_or_else(|| start.offset(*second));
                 self.error(
@@ -1606,12 +1616,22 @@ impl Ctx<'_> {
         else {
             return Vec::new();
         };
+        // How many entries are written on each line (an entry counts once for each line its
+        // key and value are on): counted once, so that the whole section is linear in its
+        // number of parameters.
+        let mut per_line: HashMap<u32, usize> = HashMap::new();
+        for (k, v) in entries {
+            *per_line.entry(k.location.line).or_default() += 1;
+            if v.location.line != k.location.line {
+                *per_line.entry(v.location.line).or_default() += 1;
+            }
+        }
         let mut out = Vec::new();
         for (k, v) in entries {
             if !self.key_name(k, "parameter") {
                 continue;
             }
-            if let Some(p) = self.parameter(k, v, entries) {
+            if let Some(p) = self.parameter(k, v, &per_line) {
                 out.push(p);
             } else {
                 self.drop_name(&k.value);
@@ -1624,7 +1644,7 @@ impl Ctx<'_> {
         &mut self,
         k: &Located<String>,
         v: &YamlNode,
-        entries: &Entries,
+        per_line: &HashMap<u32, usize>,
     ) -> Option<Parameter> {
         // The map form `{ value: 1.0, unit: N/m }`.
         let mut unit_key = None;
@@ -1696,16 +1716,13 @@ impl Ctx<'_> {
         // The unit is the comment at the end of the value's line, if no other parameter
         // shares that line (`parameters: { m: 1, g: 9.81 }  # SI` names no unit).
         let line = v.location.line;
-        let shared = entries
-            .iter()
-            .filter(|(ok, ov)| ok.location.line == line || ov.location.line == line)
-            .count()
-            > 1;
+        let shared = per_line.get(&line).copied().unwrap_or(0) > 1;
         let unit = if unit_key.is_some() || shared {
             unit_key
         } else {
-            trailing_comment(self.source, line).map(|c| {
-                let at = comment_location(self.source, line, &c);
+            let text = self.line(line);
+            trailing_comment_of_line(text).map(|c| {
+                let at = comment_location(text, line, &c);
                 Located::new(c, at)
             })
         };
@@ -1764,7 +1781,7 @@ impl Ctx<'_> {
                 .count()
                 == 1;
             let comment = if alone {
-                trailing_comment(self.source, n.location.line)
+                trailing_comment_of_line(self.line(n.location.line))
             } else {
                 None
             };

@@ -500,6 +500,10 @@ impl<'a> Builder<'a> {
             Event::MappingStart(anchor, tag) => {
                 self.properties(anchor, tag.as_deref(), &span);
                 let mut entries: Vec<(Located<String>, YamlNode)> = Vec::new();
+                // The index of each key in `entries`, so that finding a duplicate is not a
+                // scan (a map of many keys would be quadratic).
+                let mut keys: std::collections::HashMap<String, usize> =
+                    std::collections::HashMap::new();
                 loop {
                     let (key_event, key_span) = match self.next() {
                         None | Some((Event::MappingEnd, _)) => break,
@@ -527,7 +531,8 @@ impl<'a> Builder<'a> {
                             continue;
                         }
                     };
-                    if let Some((first, _)) = entries.iter().find(|(k, _)| k.value == key_text) {
+                    if let Some(&index) = keys.get(key_text.as_str()) {
+                        let first: &Located<String> = &entries[index].0;
                         self.errors.push(
                             Diagnostic::new(key.location, format!("duplicate key `{key_text}`"))
                                 .with_help(format!(
@@ -537,6 +542,7 @@ impl<'a> Builder<'a> {
                         );
                         continue;
                     }
+                    keys.insert(key_text.clone(), entries.len());
                     entries.push((Located::new(key_text, key.location), value));
                 }
                 let node = YamlNode {
@@ -584,7 +590,13 @@ impl<'a> Builder<'a> {
 /// or `-`), so the apostrophe of `it's` does not. A line that ends inside an open quote has
 /// no comment.
 pub fn trailing_comment(source: &str, line: u32) -> Option<String> {
-    let text = source.lines().nth(line.checked_sub(1)? as usize)?;
+    trailing_comment_of_line(source.lines().nth(line.checked_sub(1)? as usize)?)
+}
+
+/// The text of the trailing `# comment` of the line `text`, trimmed, if any (the rules of
+/// [`trailing_comment`], for a caller that has the file's lines at hand: looking a line up
+/// by number is linear in the file, and a file of many parameters asks once per parameter).
+pub fn trailing_comment_of_line(text: &str) -> Option<String> {
     let chars: Vec<(usize, char)> = text.char_indices().collect();
     let mut previous: Option<char> = None;
     let mut k = 0;
@@ -630,7 +642,21 @@ pub fn trailing_comment(source: &str, line: u32) -> Option<String> {
 /// returns `None` when the text cannot be followed (escapes such as `\t`); the caller then
 /// counts columns from the first character.
 pub fn char_locations(source: &str, start: Location, text: &str) -> Option<Vec<Location>> {
-    let mut lines = source.lines().skip(start.line.checked_sub(1)? as usize);
+    char_locations_in_lines(&source.lines().collect::<Vec<_>>(), start, text)
+}
+
+/// [`char_locations`] over the source's `lines` (collected once by a caller that locates
+/// many scalars: skipping to a line of the source text is linear in the file, which made a
+/// file of many expressions quadratic).
+pub fn char_locations_in_lines(
+    lines: &[&str],
+    start: Location,
+    text: &str,
+) -> Option<Vec<Location>> {
+    let mut lines = lines
+        .iter()
+        .copied()
+        .skip(start.line.checked_sub(1)? as usize);
     let mut line_no = start.line;
     let first: Vec<char> = lines.next()?.chars().collect();
     let mut col = start.column.checked_sub(1)? as usize;

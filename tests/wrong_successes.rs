@@ -1,0 +1,142 @@
+//! Settings that used to give a wrong result with a success (exit 0) now give a usage error
+//! (exit 2), a warning, a failure (exit 1) or a hint that names the real cause. Each of these
+//! commands was run before the change and did what its test's comment says.
+
+mod common;
+use common::eomgen;
+
+fn stderr(out: &std::process::Output) -> String {
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
+/// Relative tolerances of 1 or more, and negative ones written after a space (which clap
+/// used to take for an unknown option), are usage errors in every command that takes one.
+#[test]
+fn tolerances_out_of_range_are_usage_errors_everywhere() {
+    let cases: [&[&str]; 9] = [
+        &["simulate", "simple_pendulum", "--rtol", "1"],
+        &["simulate", "simple_pendulum", "--rtol", "-1"],
+        &["simulate", "simple_pendulum", "--atol", "-1e-9"],
+        &["study", "constraint-methods", "simple_pendulum_cartesian", "--tol", "2"],
+        &["study", "free-response", "three_masses", "--tol", "1"],
+        &["study", "modal-damping", "three_masses", "--tol", "-0.5"],
+        &["study", "floquet", "mathieu_pendulum", "--tol", "1"],
+        &["study", "stability", "--tol", "1.5"],
+        &["frf", "forced_oscillator", "--input", "F0", "--rtol", "1"],
+    ];
+    for args in cases {
+        let out = eomgen(args);
+        let err = stderr(&out);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains("tolerance"), "{args:?}: {err}");
+        assert!(!err.contains("unexpected argument"), "{args:?}: {err}");
+    }
+}
+
+/// Non-positive stiffnesses were accepted by `constraint-methods` (a spring of stiffness −1
+/// pushes the constraint apart).
+#[test]
+fn non_positive_stiffnesses_are_usage_errors() {
+    for args in [
+        &["study", "constraint-methods", "simple_pendulum_cartesian", "--stiffness", "0,-1"][..],
+        &["study", "stability", "--stiffness", "1e4,-5"],
+    ] {
+        let out = eomgen(args);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {}", stderr(&out));
+        assert!(stderr(&out).contains("positive"), "{}", stderr(&out));
+    }
+}
+
+/// `simulate --method rk4 --dt 100` took the double pendulum's energy from 5 J to 3.4e33 J
+/// with exit 0 and no word: it now warns, on standard error and in the JSON, naming the
+/// stability limit; a step longer than the span warns too; a step well inside the limit
+/// gives no warning.
+#[test]
+fn a_fixed_step_past_the_stability_limit_warns() {
+    let out = eomgen(&[
+        "simulate",
+        "double_pendulum",
+        "--method",
+        "rk4",
+        "--dt",
+        "100",
+        "--t-end",
+        "1000",
+        "--json",
+    ]);
+    let err = stderr(&out);
+    assert!(err.contains("warning: the step 100 s is past the stability limit of RK4"), "{err}");
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON");
+    let warning = &json["warnings"][0];
+    assert_eq!(warning["kind"], "step_past_stability_limit");
+    let suggested = warning["suggested_dt"].as_f64().unwrap();
+    // The start's linearisation has modes of |λ| ~ 1/s: the limit is of the order of 1 s.
+    assert!(suggested > 0.01 && suggested < 10.0, "{suggested}");
+
+    let out = eomgen(&["simulate", "simple_pendulum", "--method", "euler", "--dt", "20", "--t-end", "10"]);
+    assert!(stderr(&out).contains("longer than the whole run"), "{}", stderr(&out));
+
+    let out = eomgen(&["simulate", "double_pendulum", "--method", "rk4", "--dt", "0.01"]);
+    assert_eq!(out.status.code(), Some(0));
+    assert!(!stderr(&out).contains("warning"), "{}", stderr(&out));
+}
+
+/// A step-size underflow caused by an end time of 1e12 s (where f64 resolves t only to
+/// ~3.6e-3 s) was blamed on stiffness; the hint now names the end time.
+#[test]
+fn an_underflow_from_a_huge_end_time_blames_the_end_time() {
+    let out = eomgen(&["simulate", "double_pendulum", "--t-end", "1e12", "--t-out", "1e12"]);
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(err.contains("shorten --t-end"), "{err}");
+    assert!(!err.contains("stiff"), "{err}");
+}
+
+/// A work–precision study with tolerances far below round-off failed every run (after
+/// minutes) and exited 0: such tolerances are now a usage error (a study whose every run
+/// fails exits 1: `WorkPrecision::every_run_failed`, tested in the library).
+#[test]
+fn tolerances_below_round_off_are_refused_by_work_precision() {
+    let out = eomgen(&[
+        "study",
+        "work-precision",
+        "simple_pendulum",
+        "--methods",
+        "dp54",
+        "--tols",
+        "1e-30..1e-31",
+        "--t-end",
+        "1",
+    ]);
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("f64 cannot deliver less"), "{err}");
+}
+
+/// `study floquet --period-parameter` must name an angular frequency: in a file that
+/// declares its units, a parameter in m (the Mathieu pendulum's amplitude `a`) or in Hz is a
+/// located usage error (the double pendulum's `g`, in m/s², too; that its equations do not
+/// depend on t is refused by the numerical check in the library, `tests/floquet.rs`). These
+/// used to report multipliers ("marginal") of a meaningless period.
+#[test]
+fn floquet_period_parameter_is_an_angular_frequency() {
+    let out = eomgen(&["study", "floquet", "mathieu_pendulum", "--period-parameter", "a"]);
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("mathieu_pendulum.yaml:") && err.contains("is in m, not a frequency"), "{err}");
+
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string("models/mathieu_pendulum.yaml").unwrap();
+    assert!(text.contains("w: 60.0    # rad/s,"));
+    let hertz = dir.path().join("mathieu_hz.yaml");
+    std::fs::write(&hertz, text.replace("w: 60.0    # rad/s,", "w: 60.0    # Hz,")).unwrap();
+    let out = eomgen(&["study", "floquet", hertz.to_str().unwrap()]);
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("is in Hz"), "{err}");
+
+    let out = eomgen(&["study", "floquet", "double_pendulum", "--period-parameter", "g"]);
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("`g` is in m/s^2, not a frequency"), "{err}");
+}
