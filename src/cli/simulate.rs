@@ -230,7 +230,7 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
         ..
     } = simulation;
     for warning in &warnings {
-        eprintln!("warning: {warning}");
+        super::output::errln!("warning: {warning}");
     }
     let n = model.num_dofs();
     let coordinates: Vec<String> = model
