@@ -140,3 +140,19 @@ fn floquet_period_parameter_is_an_angular_frequency() {
     assert_eq!(out.status.code(), Some(2), "{err}");
     assert!(err.contains("`g` is in m/s^2, not a frequency"), "{err}");
 }
+
+/// Any negative number after a space reaches the option's own check (clap took `-1` and
+/// `-0.1` for options: "unexpected argument '-1' found").
+#[test]
+fn negative_numbers_reach_the_options_checks() {
+    for (args, says) in [
+        (&["simulate", "simple_pendulum", "--t-end", "-1"][..], "--t-end must be a positive"),
+        (&["simulate", "simple_pendulum", "--method", "rk4", "--dt", "-0.1"], "`dt` is -0.1"),
+        (&["simulate", "simple_pendulum", "--atol", "-1e-9"], "absolute tolerance"),
+    ] {
+        let out = eomgen(args);
+        let err = stderr(&out);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains(says) && !err.contains("unexpected argument"), "{args:?}: {err}");
+    }
+}

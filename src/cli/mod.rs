@@ -107,11 +107,27 @@ impl CliError {
     }
 }
 
+/// `command` and all its subcommands with negative numbers allowed as values: `--t-end -1`
+/// then reaches the option's own check ("must be positive") instead of clap's "unexpected
+/// argument '-1'" (clap takes a value that starts with `-` for an option otherwise).
+fn allow_negative_numbers(command: clap::Command) -> clap::Command {
+    let names: Vec<String> = command
+        .get_subcommands()
+        .map(|s| s.get_name().to_string())
+        .collect();
+    names.iter().fold(command.allow_negative_numbers(true), |command, name| {
+        command.mut_subcommand(name, allow_negative_numbers)
+    })
+}
+
 /// Runs the CLI on the process arguments. Exit status: 0 success, 1 a failed computation or
 /// a failed write (standard output or a file), 2 a usage error, 141 standard output closed by
 /// its reader ([`output`]).
 pub fn run() -> ExitCode {
-    let cli = match Cli::try_parse() {
+    let parsed = allow_negative_numbers(<Cli as clap::CommandFactory>::command())
+        .try_get_matches()
+        .and_then(|matches| <Cli as clap::FromArgMatches>::from_arg_matches(&matches));
+    let cli = match parsed {
         Ok(cli) => cli,
         // `--help`, `--version` (status 0) and usage errors (status 2), written by clap; a
         // failed write of them is reported as any other.

@@ -34,49 +34,42 @@ pub fn set_parameters(model: &mut dyn ModelInfo, sets: &[String]) -> Result<(), 
     expressions::set_parameters(model, sets).map_err(usage)
 }
 
-/// Parses a relative tolerance (`--rtol`, `--tol`): a number in `(0, 1)`. A tolerance of 1
-/// or more asks for no correct digit; a negative one is written `--rtol -1` and reaches this
-/// parser (the arguments allow negative numbers) to get this message rather than clap's
-/// "unexpected argument". Refused values are usage errors (exit 2) in every command.
-pub fn relative_tolerance(text: &str) -> Result<f64, String> {
+/// Parses `text` as a number and accepts it if `valid`, else says what `expected` is.
+fn number(text: &str, valid: impl Fn(f64) -> bool, expected: &str) -> Result<f64, String> {
     let value: f64 = text
         .trim()
         .parse()
         .map_err(|_| format!("`{text}` is not a number"))?;
-    if value.is_finite() && value > 0.0 && value < 1.0 {
+    if valid(value) {
         Ok(value)
     } else {
-        Err(format!(
-            "a relative tolerance must be a number in (0, 1), such as 1e-8; got {value}"
-        ))
+        Err(format!("{expected}; got {value}"))
     }
+}
+
+/// Parses a relative tolerance (`--rtol`, `--tol`): a number in `(0, 1)`. A tolerance of 1
+/// or more asks for no correct digit; a negative one is written `--rtol -1` and reaches this
+/// parser (the arguments allow values that start with `-`) to get this message rather than
+/// clap's "unexpected argument". Refused values are usage errors (exit 2) in every command.
+pub fn relative_tolerance(text: &str) -> Result<f64, String> {
+    number(
+        text,
+        |v| v.is_finite() && v > 0.0 && v < 1.0,
+        "a relative tolerance must be a number in (0, 1), such as 1e-8",
+    )
 }
 
 /// Parses an absolute tolerance (`--atol`): a finite number `≥ 0` (0 leaves the relative
 /// tolerance alone in control).
 pub fn absolute_tolerance(text: &str) -> Result<f64, String> {
-    let value: f64 = text
-        .trim()
-        .parse()
-        .map_err(|_| format!("`{text}` is not a number"))?;
-    if value.is_finite() && value >= 0.0 {
-        Ok(value)
-    } else {
-        Err(format!(
-            "an absolute tolerance must be a finite number >= 0, such as 1e-10; got {value}"
-        ))
-    }
+    number(
+        text,
+        |v| v.is_finite() && v >= 0.0,
+        "an absolute tolerance must be a finite number >= 0, such as 1e-10",
+    )
 }
 
-/// Parses a positive finite number (a stiffness, a step): refused values are usage errors.
+/// Parses a positive finite number (a stiffness): refused values are usage errors.
 pub fn positive(text: &str) -> Result<f64, String> {
-    let value: f64 = text
-        .trim()
-        .parse()
-        .map_err(|_| format!("`{text}` is not a number"))?;
-    if value.is_finite() && value > 0.0 {
-        Ok(value)
-    } else {
-        Err(format!("must be a positive number, got {value}"))
-    }
+    number(text, |v| v.is_finite() && v > 0.0, "must be a positive number")
 }
