@@ -813,62 +813,46 @@ pub fn damped_modes(
     Ok(out)
 }
 
-/// The matrix exponential `e^A` by scaling and squaring with the degree-13 Padé approximant
-/// (Higham's `expm`), for the free response `y(t) = e^{At} y(0)` of the linearised system
-/// (lectures 30–32, HW32).
+/// The matrix exponential `e^A`, for the free response `y(t) = e^{At} y(0)` of the linearised
+/// system (lectures 30–32, HW32) and the monodromy of a constant-coefficient system.
 ///
-/// `A` is scaled by `2⁻ˢ` so that `‖A‖₁ 2⁻ˢ ≤ θ₁₃ = 5.37`, where the Padé approximant's
-/// backward error is below the unit roundoff, and the result squared `s` times.
+/// nalgebra's `Matrix::exp`: scaling and squaring with the Padé approximant of degree 3, 5,
+/// 7, 9 or 13, the cheapest whose backward error is below the unit roundoff for this `A`
+/// (Higham 2005's method, Algorithm 2.3, with the degree and scaling chosen from the norms of
+/// powers of `A` as in Al-Mohy and Higham 2009, Algorithm 6.1, which avoids overscaling).
+/// Against closed forms it was as accurate as a fixed degree-13 Padé on every case measured
+/// and 400 times more accurate on a stiff two-mass spring (relative error 1.2e-11 against
+/// 5.0e-9 at `‖At‖₁ = 2e8`), at 1.2–1.9 times its time (docs/performance.md, "Matrix
+/// exponential").
 ///
 /// # Shapes
-/// `a` is square, `n × n`; so is the result. A non-finite entry gives a non-finite result.
+/// `a` is square, `n × n`; so is the result. A non-finite entry gives an all-NaN result.
+/// Beyond `‖A‖₁ = 10³⁰` (where nalgebra's unscaled powers `A⁸`, `A¹⁰` would overflow)
+/// `e^A = (e^{A/2^k})^{2^k}` with the smallest `k` that brings the norm below it.
 ///
 /// # References
 /// N. J. Higham, "The scaling and squaring method for the matrix exponential revisited",
-/// SIAM J. Matrix Anal. Appl. 26 (2005) 1179–1193, Algorithm 2.3 (m = 13).
+/// SIAM J. Matrix Anal. Appl. 26 (2005) 1179–1193; A. H. Al-Mohy, N. J. Higham, "A new
+/// scaling and squaring algorithm for the matrix exponential", SIAM J. Matrix Anal. Appl. 31
+/// (2009) 970–989.
 pub fn matrix_exponential(a: &DMatrix<f64>) -> DMatrix<f64> {
-    const B: [f64; 14] = [
-        64_764_752_532_480_000.0,
-        32_382_376_266_240_000.0,
-        7_771_770_303_897_600.0,
-        1_187_353_796_428_800.0,
-        129_060_195_264_000.0,
-        10_559_470_521_600.0,
-        670_442_572_800.0,
-        33_522_128_640.0,
-        1_323_241_920.0,
-        40_840_800.0,
-        960_960.0,
-        16_380.0,
-        182.0,
-        1.0,
-    ];
-    const THETA_13: f64 = 5.371_920_351_148_152;
+    /// Largest `‖A‖₁` handed to nalgebra (its `A¹⁰` stays finite below ~10³⁰).
+    const LARGEST_NORM: f64 = 1e30;
     let n = a.nrows();
-    let norm = (0..n)
-        .map(|j| a.column(j).iter().map(|v| v.abs()).sum::<f64>())
-        .fold(0.0f64, f64::max);
-    let s = if norm > THETA_13 {
-        (norm / THETA_13).log2().ceil() as i32
+    if n == 0 {
+        return DMatrix::identity(0, 0);
+    }
+    if a.iter().any(|v| !v.is_finite()) {
+        return DMatrix::from_element(n, n, f64::NAN);
+    }
+    let norm = a.column_iter().map(|c| c.lp_norm(1)).fold(0.0, f64::max);
+    let k = if norm > LARGEST_NORM {
+        (norm / LARGEST_NORM).log2().ceil() as i32
     } else {
         0
     };
-    let a = a * 2f64.powi(-s);
-    let id = DMatrix::<f64>::identity(n, n);
-    let a2 = &a * &a;
-    let a4 = &a2 * &a2;
-    let a6 = &a4 * &a2;
-    let inner_u = &a6 * (&a6 * B[13] + &a4 * B[11] + &a2 * B[9]);
-    let u = &a * (inner_u + &a6 * B[7] + &a4 * B[5] + &a2 * B[3] + &id * B[1]);
-    let inner_v = &a6 * (&a6 * B[12] + &a4 * B[10] + &a2 * B[8]);
-    let v = inner_v + &a6 * B[6] + &a4 * B[4] + &a2 * B[2] + &id * B[0];
-    let p = &v + &u;
-    let q = &v - &u;
-    let mut r = match q.lu().solve(&p) {
-        Some(r) => r,
-        None => DMatrix::from_element(n, n, f64::NAN),
-    };
-    for _ in 0..s {
+    let mut r = (a * 2f64.powi(-k)).exp();
+    for _ in 0..k {
         r = &r * &r;
     }
     r

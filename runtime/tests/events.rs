@@ -1,11 +1,10 @@
 //! Event location (issue 6, item 2; lecture 17, HW21): zeros of g(t, y) found on each
 //! method's dense output, with direction and terminal events.
 
+use eomgen_runtime::analysis::Method;
 use eomgen_runtime::{
-    BogackiShampine32, DormandPrince54, DormandPrince853, EventDirection, EventSpec, ExplicitEuler,
-    ExplicitMidpoint, ImplicitMidpoint, IntegrationError, Integrator, IntegratorOptions, OdeFn,
-    OdeSystem, OutputTimes, RadauIIA5, RhsError, RungeKutta4, Solution, StormerVerlet,
-    SymplecticEuler, WithEvents,
+    DormandPrince853, EventDirection, EventSpec, ExplicitEuler, IntegrationError, Integrator,
+    IntegratorOptions, OdeFn, OdeSystem, OutputTimes, RhsError, RungeKutta4, Solution, WithEvents,
 };
 
 /// Complete elliptic integral of the first kind `K(k) = π / (2 AGM(1, √(1 − k²)))`
@@ -113,19 +112,21 @@ fn every_method_locates_the_returns() {
         .with_dt(h)
         .with_rtol(1e-10)
         .with_atol(1e-10);
-    let cases: Vec<(Box<dyn Integrator>, &IntegratorOptions, f64)> = vec![
-        (Box::new(ExplicitEuler::new()), &fixed, 0.1),
-        (Box::new(ExplicitMidpoint::new()), &fixed, 5e-4),
-        (Box::new(RungeKutta4::new()), &fixed, 3e-8),
-        (Box::new(SymplecticEuler::new()), &fixed, 1e-4),
-        (Box::new(StormerVerlet::new()), &fixed, 2e-4),
-        (Box::new(ImplicitMidpoint::new()), &fixed, 2e-4),
-        (Box::new(BogackiShampine32::new()), &adaptive, 2e-7),
-        (Box::new(DormandPrince54::new()), &adaptive, 5e-8),
-        (Box::new(DormandPrince853::new()), &adaptive, 2e-9),
-        (Box::new(RadauIIA5::new()), &adaptive, 1e-10),
-    ];
-    for (mut method, options, tolerance) in cases {
+    // Every method of the registry (the match is exhaustive: a new method needs its bound).
+    for method in Method::ALL {
+        let (options, tolerance) = match method {
+            Method::Euler => (&fixed, 0.1),
+            Method::Midpoint => (&fixed, 5e-4),
+            Method::Rk4 => (&fixed, 3e-8),
+            Method::SymplecticEuler => (&fixed, 1e-4),
+            Method::StormerVerlet => (&fixed, 2e-4),
+            Method::ImplicitMidpoint => (&fixed, 2e-4),
+            Method::Bs32 => (&adaptive, 2e-7),
+            Method::Dp54 => (&adaptive, 5e-8),
+            Method::Dop853 => (&adaptive, 2e-9),
+            Method::Radau5 => (&adaptive, 1e-10),
+        };
+        let mut method = method.integrator();
         let solution = returns(method.as_mut(), theta0, options);
         let name = method.name();
         assert_eq!(solution.events.len(), 5, "{name}");

@@ -9,211 +9,25 @@
 use std::f64::consts::PI;
 
 use eomgen_runtime::{
-    BogackiShampine32, DormandPrince54, DormandPrince853, ExplicitEuler, ExplicitMidpoint,
-    ImplicitMidpoint, IntegrationError, IntegrationFailure, Integrator, IntegratorOptions, OdeFn,
-    OdeSystem, OutputTimes, RadauIIA5, RhsError, RungeKutta4, Solution, StormerVerlet,
-    SymplecticEuler,
+    DormandPrince54, ExplicitEuler, ImplicitMidpoint, IntegrationError, IntegrationFailure,
+    Integrator, IntegratorOptions, OdeFn, OdeSystem, OutputTimes, RadauIIA5, RhsError, RungeKutta4,
+    Solution, StormerVerlet, SymplecticEuler,
 };
 
 // ---------------------------------------------------------------------------------------------
-// Problems with closed-form solutions
+// Problems with closed-form solutions (shared with `integrators.rs`)
 // ---------------------------------------------------------------------------------------------
 
-/// A right-hand side, Jacobian (column-major) or closed-form solution, written into the slice.
-type Function = fn(f64, &[f64], &mut [f64]);
+mod common;
+use common::problems::{
+    self, Problem, damped_oscillator, forced_decay, forced_oscillator, oscillator,
+};
+use eomgen_runtime::analysis::Method;
 
-/// `ẏ = F(t, y)` on `[t0, t_end]` with a closed-form solution and, where it helps, its exact
-/// Jacobian (so that the implicit methods are tested with both the exact Jacobian and the
-/// finite-difference fallback).
-#[derive(Clone, Copy)]
-struct Problem {
-    name: &'static str,
-    /// `Some(n)` for a second-order system `y = [q; q̇]`.
-    second_order: Option<usize>,
-    dim: usize,
-    t0: f64,
-    t_end: f64,
-    rhs: Function,
-    jacobian: Option<Function>,
-    exact: fn(f64, &mut [f64]),
-}
-
-/// A [`Problem`] as an [`OdeSystem`], with its exact Jacobian if it has one.
-struct System(Problem);
-
-impl OdeSystem for System {
-    fn dim(&self) -> usize {
-        self.0.dim
-    }
-
-    fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), RhsError> {
-        (self.0.rhs)(t, y, dy);
-        Ok(())
-    }
-
-    fn jacobian(&mut self, t: f64, y: &[f64], jac: &mut [f64]) -> Result<bool, RhsError> {
-        match self.0.jacobian {
-            Some(jacobian) => {
-                jacobian(t, y, jac);
-                Ok(true)
-            }
-            None => Ok(false),
-        }
-    }
-
-    fn second_order_dim(&self) -> Option<usize> {
-        self.0.second_order
-    }
-}
-
-impl Problem {
-    fn exact_at(&self, t: f64) -> Vec<f64> {
-        let mut y = vec![0.0; self.dim];
-        (self.exact)(t, &mut y);
-        y
-    }
-
-    fn solve_with(
-        &self,
-        method: &mut dyn Integrator,
-        output: &OutputTimes,
-        options: &IntegratorOptions,
-        t_end: f64,
-    ) -> Solution {
-        let y0 = self.exact_at(self.t0);
-        method
-            .integrate(&mut System(*self), self.t0, &y0, t_end, output, options)
-            .unwrap_or_else(|failure| panic!("{} on {}: {failure}", method.name(), self.name))
-    }
-
-    fn solve(
-        &self,
-        method: &mut dyn Integrator,
-        output: &OutputTimes,
-        options: &IntegratorOptions,
-    ) -> Solution {
-        self.solve_with(method, output, options, self.t_end)
-    }
-
-    /// Largest error over the samples, in the max norm.
-    fn max_error(&self, solution: &Solution) -> f64 {
-        solution
-            .iter()
-            .map(|(t, y)| {
-                let exact = self.exact_at(t);
-                y.iter()
-                    .zip(exact)
-                    .map(|(y, e)| (y - e).abs())
-                    .fold(0.0, f64::max)
-            })
-            .fold(0.0, f64::max)
-    }
-
-    /// `count` times strictly inside `(t0, t_end)` at irrational fractions of the interval,
-    /// so that none falls on a step.
-    fn interior_times(&self, count: usize) -> Vec<f64> {
-        let span = self.t_end - self.t0;
-        (0..count)
-            .map(|k| self.t0 + span * ((k as f64 + 2.0_f64.sqrt() / 3.0) / count as f64))
-            .collect()
-    }
-}
-
-/// Harmonic oscillator `ẍ = −4x`: `x = cos 2t`, `ẋ = −2 sin 2t`, on `[0, 10]`.
-fn oscillator() -> Problem {
-    Problem {
-        name: "oscillator",
-        second_order: Some(1),
-        dim: 2,
-        t0: 0.0,
-        t_end: 10.0,
-        rhs: |_t, y, dy| {
-            dy[0] = y[1];
-            dy[1] = -4.0 * y[0];
-        },
-        jacobian: Some(|_t, _y, jac| jac.copy_from_slice(&[0.0, -4.0, 1.0, 0.0])),
-        exact: |t, y| {
-            y[0] = (2.0 * t).cos();
-            y[1] = -2.0 * (2.0 * t).sin();
-        },
-    }
-}
-
-/// Forced oscillator `ẍ = −x + sin 2t`, `x(0) = 1`, `ẋ(0) = 0`:
-/// `x = cos t + (2/3) sin t − (1/3) sin 2t`. Second order and non-autonomous (checks the
-/// stage times of the partitioned methods).
-fn forced_oscillator() -> Problem {
-    Problem {
-        name: "forced oscillator",
-        second_order: Some(1),
-        dim: 2,
-        t0: 0.0,
-        t_end: 6.0,
-        rhs: |t, y, dy| {
-            dy[0] = y[1];
-            dy[1] = -y[0] + (2.0 * t).sin();
-        },
-        jacobian: None,
-        exact: |t, y| {
-            y[0] = t.cos() + 2.0 / 3.0 * t.sin() - (2.0 * t).sin() / 3.0;
-            y[1] = -t.sin() + 2.0 / 3.0 * t.cos() - 2.0 / 3.0 * (2.0 * t).cos();
-        },
-    }
-}
-
-/// `ζ` of the damped oscillator.
-const ZETA: f64 = 0.1;
-
-/// Damped oscillator `ẍ = −x − 2ζẋ` (a velocity-dependent force), `x(0) = 1`, `ẋ(0) = 0`:
-/// `x = e^(−ζt) (cos ωt + (ζ/ω) sin ωt)` with `ω = √(1 − ζ²)`.
-fn damped_oscillator() -> Problem {
-    Problem {
-        name: "damped oscillator",
-        second_order: Some(1),
-        dim: 2,
-        t0: 0.0,
-        t_end: 6.0,
-        rhs: |_t, y, dy| {
-            dy[0] = y[1];
-            dy[1] = -y[0] - 2.0 * ZETA * y[1];
-        },
-        jacobian: Some(|_t, _y, jac| jac.copy_from_slice(&[0.0, -1.0, 1.0, -2.0 * ZETA])),
-        exact: |t, y| {
-            let w = (1.0 - ZETA * ZETA).sqrt();
-            let decay = (-ZETA * t).exp();
-            y[0] = decay * ((w * t).cos() + ZETA / w * (w * t).sin());
-            y[1] = -decay * (1.0 + ZETA * ZETA / (w * w)) * w * (w * t).sin();
-        },
-    }
-}
-
-/// Forced decay `ẏ = −y + sin t`, `y(0) = 1`: `y = (sin t − cos t)/2 + 3/2 e^(−t)`.
-fn forced_decay() -> Problem {
-    Problem {
-        name: "forced decay",
-        second_order: None,
-        dim: 1,
-        t0: 0.0,
-        t_end: 5.0,
-        rhs: |t, y, dy| dy[0] = -y[0] + t.sin(),
-        jacobian: Some(|_t, _y, jac| jac[0] = -1.0),
-        exact: |t, y| y[0] = (t.sin() - t.cos()) / 2.0 + 1.5 * (-t).exp(),
-    }
-}
-
-/// Logistic growth `ẏ = y(1 − y)`, `y(1) = 0.1`: `y = 1/(1 + 9 e^(−(t − 1)))`. Nonlinear, so
-/// the Newton iterations do real work; no exact Jacobian (finite differences).
+/// The shared reference problems; the logistic equation on `[1, 6]` here, where the step
+/// counts of its convergence studies were chosen.
 fn logistic() -> Problem {
-    Problem {
-        name: "logistic",
-        second_order: None,
-        dim: 1,
-        t0: 1.0,
-        t_end: 6.0,
-        rhs: |_t, y, dy| dy[0] = y[0] * (1.0 - y[0]),
-        jacobian: None,
-        exact: |t, y| y[0] = 1.0 / (1.0 + 9.0 * (-(t - 1.0)).exp()),
-    }
+    problems::logistic().until(6.0)
 }
 
 /// Observed orders `log₂(eₖ/eₖ₊₁)` of errors for halved steps.
@@ -238,91 +52,68 @@ struct Study {
     problems: Vec<(Problem, [u32; 3])>,
 }
 
-/// Every method with step counts (halving the step) in its asymptotic range: the leading
-/// error term dominates (`ω dt` small enough) and the smallest error stays far above rounding
-/// (≳ 1e-12; the eighth-order DOP853 needs coarse steps for that).
+/// Every registered method ([`Method::ALL`]) with step counts (halving the step) in its
+/// asymptotic range: the leading error term dominates (`ω dt` small enough) and the smallest
+/// error stays far above rounding (≳ 1e-12; the eighth-order DOP853 needs coarse steps for
+/// that). The match is exhaustive: a new method needs its study.
 fn studies() -> Vec<Study> {
     let first_order = |p: Problem| {
-        let steps = if p.name == "oscillator" {
+        let steps = if p.name == oscillator().name {
             [4000, 8000, 16000]
         } else {
             [1000, 2000, 4000]
         };
         (p, steps)
     };
-    vec![
-        Study {
-            method: Box::new(ExplicitEuler::new()),
-            problems: vec![first_order(oscillator()), first_order(forced_decay())],
-        },
-        Study {
-            method: Box::new(ExplicitMidpoint::new()),
-            problems: vec![
-                (oscillator(), [400, 800, 1600]),
-                (forced_decay(), [100, 200, 400]),
-            ],
-        },
-        Study {
-            method: Box::new(RungeKutta4::new()),
-            problems: vec![
-                (oscillator(), [160, 320, 640]),
-                (forced_decay(), [20, 40, 80]),
-            ],
-        },
-        Study {
-            method: Box::new(BogackiShampine32::new()),
-            problems: vec![
-                (oscillator(), [200, 400, 800]),
-                (forced_decay(), [40, 80, 160]),
-            ],
-        },
-        Study {
-            method: Box::new(DormandPrince54::new()),
-            problems: vec![
-                (oscillator(), [160, 320, 640]),
-                (forced_decay(), [20, 40, 80]),
-            ],
-        },
-        Study {
-            method: Box::new(DormandPrince853::new()),
-            problems: vec![
-                (oscillator(), [32, 64, 128]),
-                (damped_oscillator(), [8, 16, 32]),
-            ],
-        },
-        Study {
-            method: Box::new(SymplecticEuler::new()),
-            problems: vec![
-                first_order(oscillator()),
-                first_order(forced_oscillator()),
-                first_order(damped_oscillator()),
-            ],
-        },
-        Study {
-            method: Box::new(StormerVerlet::new()),
-            problems: vec![
-                (oscillator(), [400, 800, 1600]),
-                (forced_oscillator(), [100, 200, 400]),
-                (damped_oscillator(), [100, 200, 400]),
-            ],
-        },
-        Study {
-            method: Box::new(ImplicitMidpoint::new()),
-            problems: vec![
-                (oscillator(), [400, 800, 1600]),
-                (forced_decay(), [100, 200, 400]),
-                (logistic(), [50, 100, 200]),
-            ],
-        },
-        Study {
-            method: Box::new(RadauIIA5::new()),
-            problems: vec![
-                (oscillator(), [80, 160, 320]),
-                (forced_decay(), [10, 20, 40]),
-                (logistic(), [10, 20, 40]),
-            ],
-        },
-    ]
+    Method::ALL
+        .into_iter()
+        .map(|method| Study {
+            method: method.integrator(),
+            problems: match method {
+                Method::Euler => vec![first_order(oscillator()), first_order(forced_decay())],
+                Method::Midpoint => vec![
+                    (oscillator(), [400, 800, 1600]),
+                    (forced_decay(), [100, 200, 400]),
+                ],
+                Method::Rk4 => vec![
+                    (oscillator(), [160, 320, 640]),
+                    (forced_decay(), [20, 40, 80]),
+                ],
+                Method::Bs32 => vec![
+                    (oscillator(), [200, 400, 800]),
+                    (forced_decay(), [40, 80, 160]),
+                ],
+                Method::Dp54 => vec![
+                    (oscillator(), [160, 320, 640]),
+                    (forced_decay(), [20, 40, 80]),
+                ],
+                Method::Dop853 => vec![
+                    (oscillator(), [32, 64, 128]),
+                    (damped_oscillator(), [8, 16, 32]),
+                ],
+                Method::SymplecticEuler => vec![
+                    first_order(oscillator()),
+                    first_order(forced_oscillator()),
+                    first_order(damped_oscillator()),
+                ],
+                Method::StormerVerlet => vec![
+                    (oscillator(), [400, 800, 1600]),
+                    (forced_oscillator(), [100, 200, 400]),
+                    (damped_oscillator(), [100, 200, 400]),
+                ],
+                Method::ImplicitMidpoint => vec![
+                    (oscillator(), [400, 800, 1600]),
+                    (forced_decay(), [100, 200, 400]),
+                    (logistic(), [50, 100, 200]),
+                ],
+                Method::Radau5 => vec![
+                    (oscillator(), [80, 160, 320]),
+                    (forced_decay(), [10, 20, 40]),
+                    (logistic(), [10, 20, 40]),
+                ],
+            },
+        })
+        .collect()
 }
 
 /// Error at `t_end` after `n` constant steps. The tolerances only stop the Newton iterations
@@ -376,14 +167,13 @@ fn every_method_converges_at_its_order() {
 // Adaptive methods: tolerance proportionality and dense output
 // ---------------------------------------------------------------------------------------------
 
-/// Every adaptive method, in its default configuration.
+/// Every adaptive method of the registry, in its default configuration.
 fn adaptive_methods() -> Vec<Box<dyn Integrator>> {
-    vec![
-        Box::new(BogackiShampine32::new()),
-        Box::new(DormandPrince54::new()),
-        Box::new(DormandPrince853::new()),
-        Box::new(RadauIIA5::new()),
-    ]
+    Method::ALL
+        .into_iter()
+        .filter(|m| m.is_adaptive())
+        .map(|m| m.integrator())
+        .collect()
 }
 
 /// The error of every adaptive method scales with the tolerance: over `rtol = atol` from 1e-4

@@ -11,7 +11,7 @@
 //! failures and how many still loaded is printed.
 //!
 //! Stable Rust has no coverage-guided fuzzer without extra tooling, so this is a seeded
-//! mutation fuzzer (xorshift, deterministic for a seed). `cargo test` runs 3,000 inputs;
+//! mutation fuzzer (Xoshiro256++ from `rand`, deterministic for a seed). `cargo test` runs 3,000 inputs;
 //! the full run of 10⁶ is
 //!
 //! ```text
@@ -24,6 +24,8 @@ use std::sync::Mutex;
 
 use eomgen_symbolic::codegen::{self, EmitOptions, GenerateError};
 use eomgen_symbolic::model::{Location, load, parser::parse_expr, units::parse_unit};
+use rand::rngs::Xoshiro256PlusPlus;
+use rand::{RngExt, SeedableRng};
 
 /// Tokens inserted by the mutator: YAML structure, expression syntax and names that occur
 /// in the models, so that edits reach past the YAML layer.
@@ -114,24 +116,9 @@ const TOKENS: &[&str] = &[
     "{ name: x, unit: ",
 ];
 
-/// xorshift64*, deterministic for a seed.
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        self.0.wrapping_mul(0x2545_f491_4f6c_dd1d)
-    }
-
-    fn below(&mut self, n: usize) -> usize {
-        if n == 0 {
-            0
-        } else {
-            (self.next() % n as u64) as usize
-        }
-    }
+/// Uniform in `0..n`; 0 when `n` is 0.
+fn below(rng: &mut Xoshiro256PlusPlus, n: usize) -> usize {
+    if n == 0 { 0 } else { rng.random_range(0..n) }
 }
 
 /// The nearest char boundary at or before `p`.
@@ -144,12 +131,12 @@ fn boundary(s: &str, mut p: usize) -> usize {
 }
 
 /// One random edit of `src`.
-fn mutate(src: &mut String, rng: &mut Rng) {
+fn mutate(src: &mut String, rng: &mut Xoshiro256PlusPlus) {
     let len = src.len();
-    let a = boundary(src, rng.below(len + 1));
-    let b = boundary(src, a + rng.below(40));
-    match rng.below(7) {
-        0 | 1 => src.insert_str(a, TOKENS[rng.below(TOKENS.len())]),
+    let a = boundary(src, below(rng, len + 1));
+    let b = boundary(src, a + below(rng, 40));
+    match below(rng, 7) {
+        0 | 1 => src.insert_str(a, TOKENS[below(rng, TOKENS.len())]),
         2 => src.replace_range(a..b, ""),
         3 => {
             let span = src[a..b].to_string();
@@ -158,12 +145,12 @@ fn mutate(src: &mut String, rng: &mut Rng) {
         4 => {
             // Swap two lines.
             let mut lines: Vec<&str> = src.split('\n').collect();
-            let (i, j) = (rng.below(lines.len()), rng.below(lines.len()));
+            let (i, j) = (below(rng, lines.len()), below(rng, lines.len()));
             lines.swap(i, j);
             *src = lines.join("\n");
         }
         5 => {
-            let c = char::from_u32(rng.below(0x250) as u32).unwrap_or('?');
+            let c = char::from_u32(below(rng, 0x250) as u32).unwrap_or('?');
             src.replace_range(a..boundary(src, a + 1).max(a), &c.to_string());
         }
         _ => src.truncate(b),
@@ -257,12 +244,12 @@ fn fuzz(cases: usize, seed: u64, target: fn(&str) -> bool) -> (usize, Vec<(Strin
     let _silenced = SILENCED.lock().unwrap_or_else(|e| e.into_inner());
     let previous = std::panic::take_hook();
     std::panic::set_hook(Box::new(|_| {}));
-    let mut rng = Rng(seed);
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
     let mut loaded = 0;
     let mut panics = Vec::new();
     for _ in 0..cases {
-        let mut src = corpus[rng.below(corpus.len())].1.clone();
-        for _ in 0..1 + rng.below(8) {
+        let mut src = corpus[below(&mut rng, corpus.len())].1.clone();
+        for _ in 0..1 + below(&mut rng, 8) {
             mutate(&mut src, &mut rng);
         }
         match run_one(&src, target) {

@@ -1,17 +1,11 @@
 //! Helpers shared by the end-to-end tests (each test file uses some of them).
 #![allow(dead_code)]
 
-/// Deterministic xorshift64 generator, so every run checks the same states.
-pub struct Rng(pub u64);
-
-impl Rng {
-    /// A uniform sample in `[lo, hi)`.
-    pub fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        lo + (hi - lo) * ((self.0 >> 11) as f64 / (1u64 << 53) as f64)
-    }
+/// The tests' random-number source, seeded so that every run checks the same states:
+/// Xoshiro256++ from `rand` (portable: the same draws on every platform), the generator of
+/// `eomgen check`'s random states too. Draw with `rand::RngExt::random_range(lo..hi)`.
+pub fn seeded_rng(seed: u64) -> rand::rngs::Xoshiro256PlusPlus {
+    rand::SeedableRng::seed_from_u64(seed)
 }
 
 /// Runs the `eomgen` binary built for the tests with `args`.

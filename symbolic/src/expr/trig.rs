@@ -196,14 +196,13 @@ mod tests {
                 a.node(*u)
             );
         }
-        let mut state = 0x2545_f491_4f6c_dd1d_u64;
+        let mut rng = <rand::rngs::Xoshiro256PlusPlus as rand::SeedableRng>::seed_from_u64(
+            0x2545_f491_4f6c_dd1d,
+        );
         for _ in 0..200 {
             let mut values = vec![0.0; a.symbols().len()];
             for v in values.iter_mut() {
-                state ^= state << 13;
-                state ^= state >> 7;
-                state ^= state << 17;
-                *v = (state >> 11) as f64 / (1u64 << 53) as f64 * 20.0 - 10.0;
+                *v = rand::RngExt::random_range(&mut rng, -10.0..10.0);
             }
             for (r, n) in roots.iter().zip(&new) {
                 let (x, y) = (a.eval(*r, &values), a.eval(*n, &values));

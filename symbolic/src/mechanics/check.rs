@@ -3,6 +3,8 @@
 
 use std::time::Instant;
 
+use rand::rngs::Xoshiro256PlusPlus;
+use rand::{RngExt, SeedableRng};
 use rustc_hash::FxHashMap;
 
 use super::BalanceInfo;
@@ -76,18 +78,6 @@ impl CheckReport {
                 .power_balance
                 .as_ref()
                 .is_none_or(|p| p.max_rel_residual <= tolerance)
-    }
-}
-
-/// xorshift64: reproducible random states.
-pub(crate) struct Rng(pub(crate) u64);
-impl Rng {
-    /// The next number, uniform in `[lo, hi)`.
-    pub(crate) fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        lo + (hi - lo) * ((self.0 >> 11) as f64 / (1u64 << 53) as f64)
     }
 }
 
@@ -227,7 +217,8 @@ pub fn check_model(
     // T at doubled rates, for the homogeneity test T(q, 2q̇) = 4 T(q, q̇).
     let mut kinetic_only = Evaluator::new(&model.arena, &[model.kinetic]);
 
-    let mut rng = Rng(seed);
+    // Xoshiro256++ (portable: the same states for a seed on every platform and release).
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
     let mut max_rel: Vec<f64> = vec![0.0; others.len()];
     let mut power_rel: f64 = 0.0;
     let mut quadratic = true;
@@ -235,12 +226,12 @@ pub fn check_model(
     let defaults = defaults_by_symbol(&model);
     let mut compared = 0;
     for _ in 0..states {
-        let t = rng.uniform(0.0, 5.0);
+        let t = rng.random_range(0.0..5.0);
         let mut bindings = vec![0.0; symbols.len()];
         for (i, s) in symbols.iter().enumerate() {
             bindings[i] = match s.kind {
-                SymbolKind::Parameter => defaults[i] * rng.uniform(0.9, 1.1),
-                SymbolKind::Coordinate(_) | SymbolKind::Velocity(_) => rng.uniform(-2.0, 2.0),
+                SymbolKind::Parameter => defaults[i] * rng.random_range(0.9..1.1),
+                SymbolKind::Coordinate(_) | SymbolKind::Velocity(_) => rng.random_range(-2.0..2.0),
                 SymbolKind::Time => t,
                 _ => 0.0,
             };
@@ -429,7 +420,7 @@ fn integrable_nonholonomic(model: &mut SymbolicModel, seed: u64) -> Vec<String> 
         }
         let mut evaluator = Evaluator::new(&model.arena, &terms);
         let defaults = defaults_by_symbol(model);
-        let mut rng = Rng(seed ^ 0x5DEE_CE66);
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed ^ 0x5DEE_CE66);
         let mut integrable = true;
         for _ in 0..50 {
             let bindings: Vec<f64> = model
@@ -439,7 +430,7 @@ fn integrable_nonholonomic(model: &mut SymbolicModel, seed: u64) -> Vec<String> 
                 .enumerate()
                 .map(|(i, s)| match s.kind {
                     SymbolKind::Parameter => defaults[i],
-                    _ => rng.uniform(-2.0, 2.0),
+                    _ => rng.random_range(-2.0..2.0),
                 })
                 .collect();
             let v = evaluator.eval(&bindings);

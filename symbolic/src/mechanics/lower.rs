@@ -270,8 +270,10 @@ impl<'f> Lowering<'f> {
         }
         // Rank of J at a few random configurations (parameters at their defaults).
         let mut evaluator = crate::expr::eval::Evaluator::new(&self.arena, &eqs.jacobian);
-        let mut rng = super::check::Rng(0x9E37_79B9_7F4A_7C15);
-        let mut uniform = move || rng.uniform(-2.0, 2.0);
+        let mut rng = <rand::rngs::Xoshiro256PlusPlus as rand::SeedableRng>::seed_from_u64(
+            0x9E37_79B9_7F4A_7C15,
+        );
+        let mut uniform = move || rand::RngExt::random_range(&mut rng, -2.0..2.0);
         let mut samples = Vec::new();
         for _ in 0..60 {
             if samples.len() == 6 {

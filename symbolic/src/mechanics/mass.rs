@@ -12,11 +12,13 @@
 //! Models with constraints are not checked here: their `M` may be singular while the
 //! constrained system `[M Jᵀ; J 0]` is not.
 
+use rand::rngs::Xoshiro256PlusPlus;
+use rand::{RngExt, SeedableRng};
+
 use crate::expr::SymbolKind;
 use crate::expr::eval::Evaluator;
 use crate::model::{Diagnostic, ModelFile};
 
-use super::check::Rng;
 use super::{EquationsOfMotion, SymbolicModel};
 
 /// Random states tried for "singular everywhere".
@@ -99,15 +101,15 @@ pub fn mass_matrix_diagnostics(
     for &(k, v) in &defaults {
         bindings[k] = v;
     }
-    let mut rng = Rng(0x6d61_7373);
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(0x6d61_7373);
     let mut regular = 0;
     for _ in 0..STATES {
         for (k, s) in symbols.iter().enumerate() {
             match s.kind {
                 SymbolKind::Coordinate(_) | SymbolKind::Velocity(_) => {
-                    bindings[k] = rng.uniform(-2.0, 2.0);
+                    bindings[k] = rng.random_range(-2.0..2.0);
                 }
-                SymbolKind::Time => bindings[k] = rng.uniform(0.0, 5.0),
+                SymbolKind::Time => bindings[k] = rng.random_range(0.0..5.0),
                 _ => {}
             }
         }

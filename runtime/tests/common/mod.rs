@@ -1,0 +1,3 @@
+//! Helpers shared by the integration tests of `eomgen-runtime`.
+
+pub mod problems;
