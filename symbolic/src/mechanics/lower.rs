@@ -2,6 +2,8 @@
 //! coordinates, rates and time; point positions; `T`, `V` and the generalized forces `Q`
 //! assembled from bodies, gravity, springs, dampers, forces and torques.
 
+use rustc_hash::FxHashMap;
+
 use super::constraints::{ConstraintEquations, linear_in_rates, redundant_rows};
 use crate::expr::{Constant, ExprArena, ExprId, Func, SymbolId, SymbolKind};
 use crate::model::Located;
@@ -125,8 +127,9 @@ pub struct SymbolicModel {
     pub initial_q: Vec<ExprId>,
     /// Initial `q̇(0)` per coordinate.
     pub initial_qdot: Vec<ExprId>,
-    /// Whether `T + V` is conserved: no dampers, forces, torques or generalized forces, and
-    /// no explicit time dependence in `T` or `V`.
+    /// Whether `T + V` is conserved: no dampers, forces, torques or generalized forces, no
+    /// explicit time dependence in `T` or `V`, `T` a quadratic form in the rates, and
+    /// workless constraints (no `t` in a holonomic `Φ`, `b = 0` in a non-holonomic one).
     pub conservative: bool,
     /// Spatial dimension of the points (2 or 3; 2 when there are none).
     pub dimension: usize,
@@ -318,6 +321,43 @@ impl<'f> Lowering<'f> {
             );
         }
         eqs
+    }
+
+    /// Whether `T` is a quadratic form in the rates (`T₀ = T(q, 0, t)` and
+    /// `T₁ = ∂T/∂q̇ (q, 0, t)` vanish): otherwise, as for a point carried by a prescribed
+    /// motion (`r cos ωt`), `T + V` is not conserved even without explicit `t` in `T` (the
+    /// Jacobi integral `T₂ − T₀ + V` is).
+    fn kinetic_is_quadratic_in_rates(&mut self, kinetic: ExprId) -> bool {
+        let symbols: Vec<[SymbolId; 3]> = self.arena.coordinates().to_vec();
+        let zero = self.arena.int(0);
+        let at_rest: FxHashMap<SymbolId, ExprId> = symbols.iter().map(|s| (s[1], zero)).collect();
+        let mut parts = vec![kinetic];
+        parts.extend(symbols.iter().map(|s| self.arena.diff(kinetic, s[1])));
+        parts.into_iter().all(|p| {
+            let p = self.arena.substitute(p, &at_rest);
+            if self.arena.is_zero(p) {
+                return true;
+            }
+            let p = self.arena.expand(p);
+            self.arena.is_zero(p)
+        })
+    }
+
+    /// Whether the constraint forces do no work on the motion: no holonomic `Φ` depends on
+    /// `t` (the power of the constraint forces is `λᵀ Φ_t`) and every non-holonomic
+    /// constraint has `b = 0` (power `−λᵀ b`). A rod spun at a prescribed rate drives its
+    /// bead, and `T + V` is then not conserved.
+    fn constraints_are_workless(&mut self, c: &ConstraintEquations) -> bool {
+        let time = self.arena.time_id();
+        let symbols: Vec<[SymbolId; 3]> = self.arena.coordinates().to_vec();
+        let zero = self.arena.int(0);
+        let at_rest: FxHashMap<SymbolId, ExprId> = symbols.iter().map(|s| (s[1], zero)).collect();
+        c.phi.iter().all(|&phi| !self.arena.depends_on(phi, time))
+            && c.velocity[c.holonomic..].iter().all(|&g| {
+                let b = self.arena.substitute(g, &at_rest);
+                let b = self.arena.expand(b);
+                self.arena.is_zero(b)
+            })
     }
 
     /// The expression `e` of the model file in the arena. Constants must come out exact or
@@ -862,7 +902,9 @@ impl<'f> Lowering<'f> {
             && file.forces.is_empty()
             && file.torques.is_empty()
             && generalized_forces.iter().all(|q| self.arena.is_zero(*q))
-            && !explicit_time;
+            && !explicit_time
+            && self.kinetic_is_quadratic_in_rates(kinetic)
+            && self.constraints_are_workless(&constraints);
 
         let draw_lines = file
             .draw
@@ -914,3 +956,4 @@ impl<'f> Lowering<'f> {
         })
     }
 }
+
