@@ -297,12 +297,45 @@ impl<'f> Lowering<'f> {
         }
         let all: Vec<&(Located<String>, crate::model::Expr)> =
             file.constraints.iter().chain(&file.nonholonomic).collect();
-        for (i, with) in redundant_rows(&samples, m, n) {
+        let dependent = redundant_rows(&samples, m, n);
+        let independent: Vec<usize> = (0..eqs.holonomic)
+            .filter(|i| dependent.iter().all(|(d, _)| d != i))
+            .collect();
+        for (i, with) in dependent {
             let (k, _) = all[i];
             let others: Vec<String> = with
                 .iter()
                 .map(|j| format!("`{}`", all[*j].0.value))
                 .collect();
+            // A holonomic constraint that repeats holonomic ones: redundant if it holds where
+            // they hold, contradictory if not.
+            if i < eqs.holonomic && with.iter().all(|j| *j < eqs.holonomic) {
+                if let Some(residual) = self.residual_where_others_hold(&eqs, parameters, &independent, i) {
+                    let scale = 1e-8;
+                    if residual.is_nan() || residual.abs() > scale {
+                        let message = if others.is_empty() {
+                            format!(
+                                "constraint `{}` can never hold: it does not depend on the coordinates, and it is {} (not 0)",
+                                k.value,
+                                short(residual)
+                            )
+                        } else {
+                            let hold = if others.len() == 1 { "holds" } else { "hold" };
+                            format!(
+                                "constraint `{}` contradicts {}: where {} {hold}, it is {} (not 0), so no configuration satisfies them all",
+                                k.value,
+                                others.join(", "),
+                                others.join(" and "),
+                                short(residual)
+                            )
+                        };
+                        self.errors.push(Diagnostic::new(k.location, message).with_help(
+                            "inconsistent constraints leave no motion to compute (with the parameters at their defaults); correct the value or remove the constraint",
+                        ));
+                        continue;
+                    }
+                }
+            }
             let message = if others.is_empty() {
                 format!(
                     "constraint `{}` constrains nothing: its Jacobian row is zero",
@@ -321,6 +354,65 @@ impl<'f> Lowering<'f> {
             );
         }
         eqs
+    }
+
+    /// The residual of the dependent holonomic constraint `dependent` where the
+    /// `independent` holonomic constraints hold (see
+    /// [`super::constraints::residual_where_others_hold`]), from up to six random
+    /// configurations at a random `t` (parameters at their defaults); `None` if Newton
+    /// converges from none of them.
+    fn residual_where_others_hold(
+        &mut self,
+        eqs: &ConstraintEquations,
+        parameters: &[ParameterInfo],
+        independent: &[usize],
+        dependent: usize,
+    ) -> Option<f64> {
+        let n = self.arena.coordinates().len();
+        let h = eqs.holonomic;
+        let roots: Vec<ExprId> = eqs.phi.iter().chain(&eqs.jacobian[..h * n]).copied().collect();
+        let mut evaluator = crate::expr::eval::Evaluator::new(&self.arena, &roots);
+        let mut rng = super::check::Rng(0xC0FF_EE15_5EED_1234);
+        let symbols = self.arena.symbols().to_vec();
+        let mut bindings: Vec<f64> = symbols
+            .iter()
+            .map(|s| match s.kind {
+                SymbolKind::Parameter => parameters
+                    .iter()
+                    .find(|p| p.name == s.name)
+                    .map_or(0.0, |p| p.default),
+                _ => rng.uniform(-2.0, 2.0),
+            })
+            .collect();
+        let slots: Vec<usize> = (0..n)
+            .map(|c| {
+                symbols
+                    .iter()
+                    .position(|s| s.kind == SymbolKind::Coordinate(c as u32))
+                    .unwrap_or(usize::MAX)
+            })
+            .collect();
+        for _ in 0..6 {
+            let q0: Vec<f64> = (0..n).map(|_| rng.uniform(-2.0, 2.0)).collect();
+            let mut eval = |q: &[f64]| {
+                for (slot, v) in slots.iter().zip(q) {
+                    if let Some(b) = bindings.get_mut(*slot) {
+                        *b = *v;
+                    }
+                }
+                let values = evaluator.eval(&bindings);
+                (values[..h].to_vec(), values[h..].to_vec())
+            };
+            if let Some(r) = super::constraints::residual_where_others_hold(
+                &mut eval,
+                &q0,
+                independent,
+                dependent,
+            ) {
+                return Some(r);
+            }
+        }
+        None
     }
 
     /// Whether `T` is a quadratic form in the rates (`T₀ = T(q, 0, t)` and
@@ -957,3 +1049,12 @@ impl<'f> Lowering<'f> {
     }
 }
 
+/// A residual in a diagnostic: 6 significant digits, as `1`, `-0.5` or `1.2e-7`.
+fn short(v: f64) -> String {
+    if v != 0.0 && (v.abs() < 1e-3 || v.abs() >= 1e6) {
+        format!("{v:.5e}")
+    } else {
+        let s = format!("{v:.6}");
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    }
+}
