@@ -248,7 +248,11 @@ pub fn derivation_checks(
         ));
     }
     if let Some(c) = &r.initial_constraints {
-        let kind = if c.velocity { "velocity residual" } else { "residual" };
+        let kind = if c.velocity {
+            "velocity residual"
+        } else {
+            "residual"
+        };
         rows.push(CheckRow::compare(
             format!(
                 "initial state satisfies the constraints (largest {kind}, of `{}`)",

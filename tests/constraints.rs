@@ -92,7 +92,10 @@ fn spinning_rod_bead_follows_cosh_and_its_constraint_force_is_coriolis() {
         let r = r0 * (w * t).cosh();
         let (x, yy) = (y[0], y[1]);
         let position_error = (x - r * (w * t).cos()).hypot(yy - r * (w * t).sin());
-        assert!(position_error <= 1e-9 * r, "t = {t}: |r − r_exact| = {position_error} m");
+        assert!(
+            position_error <= 1e-9 * r,
+            "t = {t}: |r − r_exact| = {position_error} m"
+        );
         let expected = 2.0 * mass * w * w * r0 * (w * t).sinh();
         let lambda = cart.constraint_forces(t, y).expect("solvable")[0];
         assert!(
@@ -101,7 +104,10 @@ fn spinning_rod_bead_follows_cosh_and_its_constraint_force_is_coriolis() {
         );
         let rp = p.state(i)[0];
         let twin = (x - rp * (w * t).cos()).hypot(yy - rp * (w * t).sin());
-        assert!(twin <= 1e-9 * r, "t = {t}: Cartesian and polar beads {twin} m apart");
+        assert!(
+            twin <= 1e-9 * r,
+            "t = {t}: Cartesian and polar beads {twin} m apart"
+        );
     }
 }
 

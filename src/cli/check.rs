@@ -109,7 +109,11 @@ fn print_report(r: &CheckReport) {
             "{} initial state satisfies the constraints: largest residual {:.2e} ({} of `{}`, tolerance {INITIAL_CONSTRAINT_TOLERANCE:e})",
             mark(c.passed()),
             c.residual,
-            if c.velocity { "velocity residual" } else { "residual" },
+            if c.velocity {
+                "velocity residual"
+            } else {
+                "residual"
+            },
             c.constraint
         );
         if !c.passed() {

@@ -136,7 +136,9 @@ fn initial_constraints(model: &SymbolicModel) -> Option<InitialConstraints> {
         .chain(&model.initial_qdot)
         .copied()
         .collect();
-    let start = Evaluator::new(&model.arena, &starts).eval(&parameters).to_vec();
+    let start = Evaluator::new(&model.arena, &starts)
+        .eval(&parameters)
+        .to_vec();
     let n = model.num_dofs();
     let bindings: Vec<f64> = symbols
         .iter()
@@ -148,7 +150,9 @@ fn initial_constraints(model: &SymbolicModel) -> Option<InitialConstraints> {
         })
         .collect();
     let roots: Vec<ExprId> = c.phi.iter().chain(&c.velocity).copied().collect();
-    let values = Evaluator::new(&model.arena, &roots).eval(&bindings).to_vec();
+    let values = Evaluator::new(&model.arena, &roots)
+        .eval(&bindings)
+        .to_vec();
     let mut worst: Option<InitialConstraints> = None;
     for (k, v) in values.iter().enumerate() {
         let (i, velocity) = if k < c.holonomic {

@@ -151,6 +151,10 @@ pub fn redundant_rows(samples: &[Vec<f64>], m: usize, n: usize) -> Vec<(usize, V
     found
 }
 
+/// `q ↦ (Φ, J)` of the holonomic constraints: `Φ` (one per constraint) and `J` (row-major,
+/// constraints × coordinates).
+pub type HolonomicValues<'a> = dyn FnMut(&[f64]) -> (Vec<f64>, Vec<f64>) + 'a;
+
 /// Whether a holonomic constraint whose Jacobian row depends on those of `independent`
 /// everywhere is consistent with them: Gauss–Newton (minimum-norm steps) puts `q` on
 /// `Φ_independent = 0` from `q0`, and there the dependent constraint's residual is returned
@@ -161,7 +165,7 @@ pub fn redundant_rows(samples: &[Vec<f64>], m: usize, n: usize) -> Vec<(usize, V
 /// `holonomic × n`) at `q`. `None` when Newton does not converge from `q0` in 50 steps or
 /// meets a non-finite value.
 pub fn residual_where_others_hold(
-    eval: &mut dyn FnMut(&[f64]) -> (Vec<f64>, Vec<f64>),
+    eval: &mut HolonomicValues<'_>,
     q0: &[f64],
     independent: &[usize],
     dependent: usize,

@@ -309,32 +309,32 @@ impl<'f> Lowering<'f> {
                 .collect();
             // A holonomic constraint that repeats holonomic ones: redundant if it holds where
             // they hold, contradictory if not.
-            if i < eqs.holonomic && with.iter().all(|j| *j < eqs.holonomic) {
-                if let Some(residual) = self.residual_where_others_hold(&eqs, parameters, &independent, i) {
-                    let scale = 1e-8;
-                    if residual.is_nan() || residual.abs() > scale {
-                        let message = if others.is_empty() {
-                            format!(
-                                "constraint `{}` can never hold: it does not depend on the coordinates, and it is {} (not 0)",
-                                k.value,
-                                short(residual)
-                            )
-                        } else {
-                            let hold = if others.len() == 1 { "holds" } else { "hold" };
-                            format!(
-                                "constraint `{}` contradicts {}: where {} {hold}, it is {} (not 0), so no configuration satisfies them all",
-                                k.value,
-                                others.join(", "),
-                                others.join(" and "),
-                                short(residual)
-                            )
-                        };
-                        self.errors.push(Diagnostic::new(k.location, message).with_help(
-                            "inconsistent constraints leave no motion to compute (with the parameters at their defaults); correct the value or remove the constraint",
-                        ));
-                        continue;
-                    }
-                }
+            if i < eqs.holonomic
+                && with.iter().all(|j| *j < eqs.holonomic)
+                && let Some(residual) =
+                    self.residual_where_others_hold(&eqs, parameters, &independent, i)
+                && (residual.is_nan() || residual.abs() > 1e-8)
+            {
+                let message = if others.is_empty() {
+                    format!(
+                        "constraint `{}` can never hold: it does not depend on the coordinates, and it is {} (not 0)",
+                        k.value,
+                        short(residual)
+                    )
+                } else {
+                    let hold = if others.len() == 1 { "holds" } else { "hold" };
+                    format!(
+                        "constraint `{}` contradicts {}: where {} {hold}, it is {} (not 0), so no configuration satisfies them all",
+                        k.value,
+                        others.join(", "),
+                        others.join(" and "),
+                        short(residual)
+                    )
+                };
+                self.errors.push(Diagnostic::new(k.location, message).with_help(
+                    "inconsistent constraints leave no motion to compute (with the parameters at their defaults); correct the value or remove the constraint",
+                ));
+                continue;
             }
             let message = if others.is_empty() {
                 format!(
@@ -370,7 +370,12 @@ impl<'f> Lowering<'f> {
     ) -> Option<f64> {
         let n = self.arena.coordinates().len();
         let h = eqs.holonomic;
-        let roots: Vec<ExprId> = eqs.phi.iter().chain(&eqs.jacobian[..h * n]).copied().collect();
+        let roots: Vec<ExprId> = eqs
+            .phi
+            .iter()
+            .chain(&eqs.jacobian[..h * n])
+            .copied()
+            .collect();
         let mut evaluator = crate::expr::eval::Evaluator::new(&self.arena, &roots);
         let mut rng = super::check::Rng(0xC0FF_EE15_5EED_1234);
         let symbols = self.arena.symbols().to_vec();
