@@ -247,6 +247,22 @@ pub fn derivation_checks(
             DERIVATION_TOLERANCE,
         ));
     }
+    if let Some(c) = &r.initial_constraints {
+        let kind = if c.velocity {
+            "velocity residual"
+        } else {
+            "residual"
+        };
+        rows.push(CheckRow::compare(
+            format!(
+                "initial state satisfies the constraints (largest {kind}, of `{}`)",
+                c.constraint
+            ),
+            Ok(c.residual),
+            0.0,
+            eomgen_symbolic::mechanics::check::INITIAL_CONSTRAINT_TOLERANCE,
+        ));
+    }
     Ok((rows, r.notes))
 }
 

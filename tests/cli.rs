@@ -367,6 +367,43 @@ fn simulate_reports_constraint_forces_and_rejects_inconsistent_starts() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// `check` tests the start too (issue 20): a copy of the Cartesian pendulum whose `initial:`
+/// puts the bob at x = 2 m on a rod of 1 m violates its constraint by exactly 1 m, which is a
+/// failing row naming the constraint and the residual (text and JSON) and exit 1; the bundled
+/// model's start passes the same row (residual 0, tolerance 1e-9 as at run time).
+#[test]
+fn check_fails_on_an_initial_state_that_violates_a_constraint() {
+    let source = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/models/simple_pendulum_cartesian.yaml"
+    ))
+    .unwrap();
+    let bad = source.replace("initial: { x: l, y: 0 }", "initial: { x: 2*l, y: 0 }");
+    assert_ne!(bad, source, "the initial state line changed");
+    let dir = std::env::temp_dir().join(format!("eomgen-initial-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("pendulum_off_rod.yaml");
+    std::fs::write(&path, bad).unwrap();
+    let out = eomgen(&["check", path.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(1));
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("FAIL initial state satisfies the constraints: largest residual 1.00e0 (residual of `rod`"),
+        "{text}"
+    );
+    let out = eomgen(&["check", path.to_str().unwrap(), "--json"]);
+    assert_eq!(out.status.code(), Some(1));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["passed"], false);
+    assert_eq!(v["initial_constraints"]["constraint"], "rod");
+    assert!((v["initial_constraints"]["residual"].as_f64().unwrap() - 1.0).abs() < 1e-12);
+    let out = eomgen(&["check", "simple_pendulum_cartesian", "--json"]);
+    assert!(out.status.success());
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["initial_constraints"]["passed"], true);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// `study constraint-methods` renders the study (its numbers are tested through the library
 /// in `tests/constraints.rs`): the minimal twin the file names gets its row, and a model
 /// without constraints is a usage error.

@@ -5,7 +5,7 @@ use serde_json::json;
 
 use super::CliError;
 use super::output::outln;
-use eomgen_symbolic::mechanics::check::{CheckReport, check_model};
+use eomgen_symbolic::mechanics::check::{CheckReport, INITIAL_CONSTRAINT_TOLERANCE, check_model};
 
 /// Relative tolerance of every check: the derivations differ only by rounding (~1e-14).
 const TOLERANCE: f64 = 1e-8;
@@ -74,6 +74,7 @@ fn to_json(r: &CheckReport, timing: bool) -> serde_json::Value {
         "passed": r.passed(TOLERANCE),
         "checks": r.comparisons.iter().map(|c| json!({"a": c.a, "b": c.b, "max_rel_residual": c.max_rel_residual, "symbolic_equal": c.symbolic_equal, "states": c.states})).collect::<Vec<_>>(),
         "power_balance": r.power_balance.as_ref().map(|p| json!({"max_rel_residual": p.max_rel_residual})),
+        "initial_constraints": r.initial_constraints.as_ref().map(|c| json!({"constraint": c.constraint, "residual": c.residual, "velocity": c.velocity, "tolerance": INITIAL_CONSTRAINT_TOLERANCE, "passed": c.passed()})),
         "derivation": derivation,
         "notes": r.notes,
     })
@@ -103,6 +104,24 @@ fn print_report(r: &CheckReport) {
             mark(p.max_rel_residual <= TOLERANCE),
             p.max_rel_residual
         );
+    }
+    if let Some(c) = &r.initial_constraints {
+        outln!(
+            "{} initial state satisfies the constraints: largest residual {:.2e} ({} of `{}`, tolerance {INITIAL_CONSTRAINT_TOLERANCE:e})",
+            mark(c.passed()),
+            c.residual,
+            if c.velocity {
+                "velocity residual"
+            } else {
+                "residual"
+            },
+            c.constraint
+        );
+        if !c.passed() {
+            outln!(
+                "     correct `initial:`, or mark the dependent coordinates as `{{ guess: … }}` to have them solved from the constraints"
+            );
+        }
     }
     for d in &r.derivations {
         outln!(

@@ -52,6 +52,30 @@ pub struct PowerBalance {
     pub max_rel_residual: f64,
 }
 
+/// Bound on the constraint residuals of the file's `initial:` state, as the runtime's
+/// (`make_consistent`): a start farther from `Φ = 0` or `Φ̇ = 0` is refused by `simulate`.
+pub const INITIAL_CONSTRAINT_TOLERANCE: f64 = 1e-9;
+
+/// The constraint residuals of the file's `initial:` state (t = 0, parameters at their
+/// defaults), when no coordinate is a `{ guess: … }` (else the runtime solves the start).
+#[derive(Debug, Clone, PartialEq)]
+pub struct InitialConstraints {
+    /// The constraint with the largest residual.
+    pub constraint: String,
+    /// Its residual: `|Φ|` (the constraint's unit) or, if larger, `|Φ̇|` (per s), or of the
+    /// non-holonomic `A q̇ + b`; NaN where it is undefined.
+    pub residual: f64,
+    /// Whether it is the velocity residual (`Φ̇` or `A q̇ + b`) rather than `Φ`.
+    pub velocity: bool,
+}
+
+impl InitialConstraints {
+    /// Whether the start satisfies every constraint to [`INITIAL_CONSTRAINT_TOLERANCE`].
+    pub fn passed(&self) -> bool {
+        self.residual <= INITIAL_CONSTRAINT_TOLERANCE
+    }
+}
+
 /// Everything `eomgen check` reports for one model.
 #[derive(Debug, Clone, PartialEq)]
 pub struct CheckReport {
@@ -66,6 +90,9 @@ pub struct CheckReport {
     pub derivations: Vec<DerivationStats>,
     /// Why a check was skipped.
     pub notes: Vec<String>,
+    /// The constraint residuals of `initial:`; `None` without constraints or when the start
+    /// has guesses to be solved.
+    pub initial_constraints: Option<InitialConstraints>,
 }
 
 impl CheckReport {
@@ -78,7 +105,66 @@ impl CheckReport {
                 .power_balance
                 .as_ref()
                 .is_none_or(|p| p.max_rel_residual <= tolerance)
+            && self
+                .initial_constraints
+                .as_ref()
+                .is_none_or(InitialConstraints::passed)
     }
+}
+
+/// The largest constraint residual of the file's `initial:` state (t = 0, parameters at
+/// their defaults); `None` without constraints or with `{ guess: … }` coordinates.
+fn initial_constraints(model: &SymbolicModel) -> Option<InitialConstraints> {
+    let c = &model.constraints;
+    if c.is_empty() || !model.initial_guesses.is_empty() {
+        return None;
+    }
+    let symbols = model.arena.symbols().to_vec();
+    // Parameters at their defaults, every other symbol 0.
+    let parameters = defaults_by_symbol(model);
+    let starts: Vec<ExprId> = model
+        .initial_q
+        .iter()
+        .chain(&model.initial_qdot)
+        .copied()
+        .collect();
+    let start = Evaluator::new(&model.arena, &starts)
+        .eval(&parameters)
+        .to_vec();
+    let n = model.num_dofs();
+    let bindings: Vec<f64> = symbols
+        .iter()
+        .zip(&parameters)
+        .map(|(s, p)| match s.kind {
+            SymbolKind::Coordinate(i) => start[i as usize],
+            SymbolKind::Velocity(i) => start[n + i as usize],
+            _ => *p,
+        })
+        .collect();
+    let roots: Vec<ExprId> = c.phi.iter().chain(&c.velocity).copied().collect();
+    let values = Evaluator::new(&model.arena, &roots)
+        .eval(&bindings)
+        .to_vec();
+    let mut worst: Option<InitialConstraints> = None;
+    for (k, v) in values.iter().enumerate() {
+        let (i, velocity) = if k < c.holonomic {
+            (k, false)
+        } else {
+            (k - c.holonomic, true)
+        };
+        let residual = if v.is_nan() { f64::NAN } else { v.abs() };
+        let larger = worst
+            .as_ref()
+            .is_none_or(|w| residual > w.residual || (residual.is_nan() && !w.residual.is_nan()));
+        if larger {
+            worst = Some(InitialConstraints {
+                constraint: c.names[i].clone(),
+                residual,
+                velocity,
+            });
+        }
+    }
+    worst
 }
 
 /// Solves `m x = f` (`m` is `n × n` row-major) by Gaussian elimination with partial pivoting;
@@ -344,12 +430,14 @@ pub fn check_model(
             max_rel_residual: power_rel,
         })
     };
+    let initial_constraints = initial_constraints(&model);
     Ok(CheckReport {
         model: model.name.clone(),
         comparisons,
         power_balance,
         derivations,
         notes,
+        initial_constraints,
     })
 }
 

@@ -151,6 +151,55 @@ pub fn redundant_rows(samples: &[Vec<f64>], m: usize, n: usize) -> Vec<(usize, V
     found
 }
 
+/// `q ↦ (Φ, J)` of the holonomic constraints: `Φ` (one per constraint) and `J` (row-major,
+/// constraints × coordinates).
+pub type HolonomicValues<'a> = dyn FnMut(&[f64]) -> (Vec<f64>, Vec<f64>) + 'a;
+
+/// Whether a holonomic constraint whose Jacobian row depends on those of `independent`
+/// everywhere is consistent with them: Gauss–Newton (minimum-norm steps) puts `q` on
+/// `Φ_independent = 0` from `q0`, and there the dependent constraint's residual is returned
+/// (zero when it is redundant, non-zero when it contradicts them: its gradient lies in the
+/// span of theirs, so it is constant along their solution set and no `q` satisfies all).
+///
+/// `eval(q)` gives `Φ` of every holonomic constraint and their Jacobian (row-major,
+/// `holonomic × n`) at `q`. `None` when Newton does not converge from `q0` in 50 steps or
+/// meets a non-finite value.
+pub fn residual_where_others_hold(
+    eval: &mut HolonomicValues<'_>,
+    q0: &[f64],
+    independent: &[usize],
+    dependent: usize,
+) -> Option<f64> {
+    let n = q0.len();
+    let mut q = q0.to_vec();
+    for _ in 0..50 {
+        let (phi, jac) = eval(&q);
+        let r: Vec<f64> = independent.iter().map(|&i| phi[i]).collect();
+        if !phi.iter().chain(&jac).all(|v| v.is_finite()) {
+            return None;
+        }
+        let scale = q.iter().fold(1.0f64, |m, x| m.max(x.abs()));
+        if r.iter().all(|v| v.abs() <= 1e-13 * scale) {
+            return Some(phi[dependent]);
+        }
+        let row = |i: usize| &jac[i * n..(i + 1) * n];
+        let k = independent.len();
+        let mut gram = vec![0.0; k * k];
+        for (a, &i) in independent.iter().enumerate() {
+            for (b, &j) in independent.iter().enumerate() {
+                gram[a * k + b] = row(i).iter().zip(row(j)).map(|(x, y)| x * y).sum();
+            }
+        }
+        let y = super::check::solve(gram, r)?;
+        for (a, &i) in independent.iter().enumerate() {
+            for (qc, jc) in q.iter_mut().zip(row(i)) {
+                *qc -= jc * y[a];
+            }
+        }
+    }
+    None
+}
+
 /// The earlier rows (`among`) with a non-negligible least-squares coefficient in `target`.
 fn involved<'a>(
     target: &[f64],
@@ -192,6 +241,22 @@ mod tests {
         // Rows: (1, 0), (0, 1), (2, 0) at two samples; (2, 0) = 2 (1, 0).
         let s = vec![vec![1.0, 0.0, 0.0, 1.0, 2.0, 0.0]; 2];
         assert_eq!(redundant_rows(&s, 3, 2), vec![(2, vec![0])]);
+    }
+
+    /// `x = 1` and `x = 2` (with `y` free): the rows are equal, and where the first holds
+    /// the second is −1, not 0; `2 x = 2` is redundant with `x = 1` (residual 0).
+    #[test]
+    fn a_contradicting_repetition_keeps_its_residual_and_a_redundant_one_vanishes() {
+        let mut eval = |q: &[f64]| {
+            (
+                vec![q[0] - 1.0, q[0] - 2.0, 2.0 * q[0] - 2.0],
+                vec![1.0, 0.0, 1.0, 0.0, 2.0, 0.0],
+            )
+        };
+        let r = residual_where_others_hold(&mut eval, &[0.3, -0.7], &[0], 1).unwrap();
+        assert!((r + 1.0).abs() < 1e-12, "{r}");
+        let r = residual_where_others_hold(&mut eval, &[0.3, -0.7], &[0], 2).unwrap();
+        assert!(r.abs() < 1e-12, "{r}");
     }
 
     #[test]

@@ -2,6 +2,8 @@
 //! coordinates, rates and time; point positions; `T`, `V` and the generalized forces `Q`
 //! assembled from bodies, gravity, springs, dampers, forces and torques.
 
+use rustc_hash::FxHashMap;
+
 use super::constraints::{ConstraintEquations, linear_in_rates, redundant_rows};
 use crate::expr::{Constant, ExprArena, ExprId, Func, SymbolId, SymbolKind};
 use crate::model::Located;
@@ -125,8 +127,9 @@ pub struct SymbolicModel {
     pub initial_q: Vec<ExprId>,
     /// Initial `q̇(0)` per coordinate.
     pub initial_qdot: Vec<ExprId>,
-    /// Whether `T + V` is conserved: no dampers, forces, torques or generalized forces, and
-    /// no explicit time dependence in `T` or `V`.
+    /// Whether `T + V` is conserved: no dampers, forces, torques or generalized forces, no
+    /// explicit time dependence in `T` or `V`, `T` a quadratic form in the rates, and
+    /// workless constraints (no `t` in a holonomic `Φ`, `b = 0` in a non-holonomic one).
     pub conservative: bool,
     /// Spatial dimension of the points (2 or 3; 2 when there are none).
     pub dimension: usize,
@@ -281,13 +284,13 @@ impl<'f> Lowering<'f> {
             }
             let mut bindings = vec![0.0; self.arena.symbols().len()];
             for (i, s) in self.arena.symbols().iter().enumerate() {
-                bindings[i] = match s.kind {
-                    SymbolKind::Parameter => parameters
-                        .iter()
-                        .find(|p| p.name == s.name)
-                        .map_or(0.0, |p| p.default),
-                    _ => uniform(),
-                };
+                if s.kind != SymbolKind::Parameter {
+                    bindings[i] = uniform();
+                }
+            }
+            // Parameters at their defaults, by symbol (not a search by name per symbol).
+            for p in parameters {
+                bindings[p.symbol.index()] = p.default;
             }
             let values = evaluator.eval(&bindings).to_vec();
             if values.iter().all(|v| v.is_finite()) {
@@ -296,12 +299,45 @@ impl<'f> Lowering<'f> {
         }
         let all: Vec<&(Located<String>, crate::model::Expr)> =
             file.constraints.iter().chain(&file.nonholonomic).collect();
-        for (i, with) in redundant_rows(&samples, m, n) {
+        let dependent = redundant_rows(&samples, m, n);
+        let independent: Vec<usize> = (0..eqs.holonomic)
+            .filter(|i| dependent.iter().all(|(d, _)| d != i))
+            .collect();
+        for (i, with) in dependent {
             let (k, _) = all[i];
             let others: Vec<String> = with
                 .iter()
                 .map(|j| format!("`{}`", all[*j].0.value))
                 .collect();
+            // A holonomic constraint that repeats holonomic ones: redundant if it holds where
+            // they hold, contradictory if not.
+            if i < eqs.holonomic
+                && with.iter().all(|j| *j < eqs.holonomic)
+                && let Some(residual) =
+                    self.residual_where_others_hold(&eqs, parameters, &independent, i)
+                && (residual.is_nan() || residual.abs() > 1e-8)
+            {
+                let message = if others.is_empty() {
+                    format!(
+                        "constraint `{}` can never hold: it does not depend on the coordinates, and it is {} (not 0)",
+                        k.value,
+                        short(residual)
+                    )
+                } else {
+                    let hold = if others.len() == 1 { "holds" } else { "hold" };
+                    format!(
+                        "constraint `{}` contradicts {}: where {} {hold}, it is {} (not 0), so no configuration satisfies them all",
+                        k.value,
+                        others.join(", "),
+                        others.join(" and "),
+                        short(residual)
+                    )
+                };
+                self.errors.push(Diagnostic::new(k.location, message).with_help(
+                    "inconsistent constraints leave no motion to compute (with the parameters at their defaults); correct the value or remove the constraint",
+                ));
+                continue;
+            }
             let message = if others.is_empty() {
                 format!(
                     "constraint `{}` constrains nothing: its Jacobian row is zero",
@@ -320,6 +356,109 @@ impl<'f> Lowering<'f> {
             );
         }
         eqs
+    }
+
+    /// The residual of the dependent holonomic constraint `dependent` where the
+    /// `independent` holonomic constraints hold (see
+    /// [`super::constraints::residual_where_others_hold`]), from up to six random
+    /// configurations at a random `t` (parameters at their defaults); `None` if Newton
+    /// converges from none of them.
+    fn residual_where_others_hold(
+        &mut self,
+        eqs: &ConstraintEquations,
+        parameters: &[ParameterInfo],
+        independent: &[usize],
+        dependent: usize,
+    ) -> Option<f64> {
+        let n = self.arena.coordinates().len();
+        let h = eqs.holonomic;
+        let roots: Vec<ExprId> = eqs
+            .phi
+            .iter()
+            .chain(&eqs.jacobian[..h * n])
+            .copied()
+            .collect();
+        let mut evaluator = crate::expr::eval::Evaluator::new(&self.arena, &roots);
+        let mut rng =
+            <rand::rngs::Xoshiro256PlusPlus as rand::SeedableRng>::seed_from_u64(0xC0FF_EE15_5EED_1234);
+        let mut uniform = move || rand::RngExt::random_range(&mut rng, -2.0..2.0);
+        let symbols = self.arena.symbols().to_vec();
+        let mut bindings: Vec<f64> = symbols
+            .iter()
+            .map(|s| match s.kind {
+                SymbolKind::Parameter => 0.0,
+                _ => uniform(),
+            })
+            .collect();
+        for p in parameters {
+            bindings[p.symbol.index()] = p.default;
+        }
+        let slots: Vec<usize> = (0..n)
+            .map(|c| {
+                symbols
+                    .iter()
+                    .position(|s| s.kind == SymbolKind::Coordinate(c as u32))
+                    .unwrap_or(usize::MAX)
+            })
+            .collect();
+        for _ in 0..6 {
+            let q0: Vec<f64> = (0..n).map(|_| uniform()).collect();
+            let mut eval = |q: &[f64]| {
+                for (slot, v) in slots.iter().zip(q) {
+                    if let Some(b) = bindings.get_mut(*slot) {
+                        *b = *v;
+                    }
+                }
+                let values = evaluator.eval(&bindings);
+                (values[..h].to_vec(), values[h..].to_vec())
+            };
+            if let Some(r) = super::constraints::residual_where_others_hold(
+                &mut eval,
+                &q0,
+                independent,
+                dependent,
+            ) {
+                return Some(r);
+            }
+        }
+        None
+    }
+
+    /// Whether `T` is a quadratic form in the rates (`T₀ = T(q, 0, t)` and
+    /// `T₁ = ∂T/∂q̇ (q, 0, t)` vanish): otherwise, as for a point carried by a prescribed
+    /// motion (`r cos ωt`), `T + V` is not conserved even without explicit `t` in `T` (the
+    /// Jacobi integral `T₂ − T₀ + V` is).
+    fn kinetic_is_quadratic_in_rates(&mut self, kinetic: ExprId) -> bool {
+        let symbols: Vec<[SymbolId; 3]> = self.arena.coordinates().to_vec();
+        let zero = self.arena.int(0);
+        let at_rest: FxHashMap<SymbolId, ExprId> = symbols.iter().map(|s| (s[1], zero)).collect();
+        let mut parts = vec![kinetic];
+        parts.extend(symbols.iter().map(|s| self.arena.diff(kinetic, s[1])));
+        parts.into_iter().all(|p| {
+            let p = self.arena.substitute(p, &at_rest);
+            if self.arena.is_zero(p) {
+                return true;
+            }
+            let p = self.arena.expand(p);
+            self.arena.is_zero(p)
+        })
+    }
+
+    /// Whether the constraint forces do no work on the motion: no holonomic `Φ` depends on
+    /// `t` (the power of the constraint forces is `λᵀ Φ_t`) and every non-holonomic
+    /// constraint has `b = 0` (power `−λᵀ b`). A rod spun at a prescribed rate drives its
+    /// bead, and `T + V` is then not conserved.
+    fn constraints_are_workless(&mut self, c: &ConstraintEquations) -> bool {
+        let time = self.arena.time_id();
+        let symbols: Vec<[SymbolId; 3]> = self.arena.coordinates().to_vec();
+        let zero = self.arena.int(0);
+        let at_rest: FxHashMap<SymbolId, ExprId> = symbols.iter().map(|s| (s[1], zero)).collect();
+        c.phi.iter().all(|&phi| !self.arena.depends_on(phi, time))
+            && c.velocity[c.holonomic..].iter().all(|&g| {
+                let b = self.arena.substitute(g, &at_rest);
+                let b = self.arena.expand(b);
+                self.arena.is_zero(b)
+            })
     }
 
     /// The expression `e` of the model file in the arena. Constants must come out exact or
@@ -864,7 +1003,9 @@ impl<'f> Lowering<'f> {
             && file.forces.is_empty()
             && file.torques.is_empty()
             && generalized_forces.iter().all(|q| self.arena.is_zero(*q))
-            && !explicit_time;
+            && !explicit_time
+            && self.kinetic_is_quadratic_in_rates(kinetic)
+            && self.constraints_are_workless(&constraints);
 
         let draw_lines = file
             .draw
@@ -914,5 +1055,15 @@ impl<'f> Lowering<'f> {
             events,
             equilibria,
         })
+    }
+}
+
+/// A residual in a diagnostic: 6 significant digits, as `1`, `-0.5` or `1.2e-7`.
+fn short(v: f64) -> String {
+    if v != 0.0 && (v.abs() < 1e-3 || v.abs() >= 1e6) {
+        format!("{v:.5e}")
+    } else {
+        let s = format!("{v:.6}");
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
     }
 }

@@ -1,0 +1,3 @@
+eomgen::model!("inconsistent-constraints.yaml");
+
+fn main() {}
