@@ -84,6 +84,53 @@ fn init_and_set_accept_expressions() {
     assert_eq!(v["parameters"]["g"], 10.0);
 }
 
+/// `--init` takes a comma list as `--at` does (a function's arguments stay together), in
+/// `simulate` and in the studies: the same run as the repeated option, to the bit.
+#[test]
+fn init_takes_a_comma_list() {
+    let run = |init: &[&str]| {
+        let mut args = vec!["simulate", "simple_pendulum", "--t-end", "0.5", "--json"];
+        for i in init {
+            args.extend(["--init", i]);
+        }
+        let out = eomgen(&args);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        v["samples"].clone()
+    };
+    let listed = run(&["q=atan2(1, 2),q_dot=0.25"]);
+    assert_eq!(listed[0]["q"][0].as_f64(), Some(0.5f64.atan()));
+    assert_eq!(listed[0]["qdot"][0].as_f64(), Some(0.25));
+    assert_eq!(listed, run(&["q=atan2(1, 2)", "q_dot=0.25"]));
+    let out = eomgen(&[
+        "study",
+        "free-response",
+        "three_masses",
+        "--init",
+        "x1=0.1,x3_dot=atan2(1, 1)",
+        "--t-end",
+        "0.1",
+        "--samples",
+        "3",
+        "--json",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["initial"]["q"], serde_json::json!([0.1, 0.0, 0.0]));
+    assert_eq!(
+        v["initial"]["qdot"],
+        serde_json::json!([0.0, 0.0, std::f64::consts::FRAC_PI_4])
+    );
+}
+
 #[test]
 fn usage_errors_are_clear_and_exit_2() {
     let out = eomgen(&["simulate", "double_pendulm"]);

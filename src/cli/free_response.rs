@@ -21,7 +21,7 @@ use serde_json::json;
 use super::CliError;
 use super::modes::{OperatingPointArgs, point_json};
 use super::plot::{self, Series};
-use super::values::{evaluate, parameter_lookup, split_assignment};
+use eomgen::expressions::set_initial_values;
 
 /// Options of `eomgen study free-response`.
 #[derive(Debug, Args)]
@@ -53,8 +53,8 @@ pub struct FreeResponseArgs {
     pub plot: Option<String>,
 }
 
-/// Parses `--init NAME=VALUE,…` into `(δq₀, δq̇₀)`, starting from zeros (`None` without
-/// `--init`: the study's default).
+/// Parses `--init NAME=VALUE,…` (repeatable, as `simulate --init`) into `(δq₀, δq̇₀)`,
+/// starting from zeros (`None` without `--init`: the study's default).
 pub(super) fn parse_init(
     model: &dyn ModelInfo,
     init: &[String],
@@ -62,30 +62,12 @@ pub(super) fn parse_init(
     if init.is_empty() {
         return Ok(None);
     }
+    // The deviation from rest, as `--init` sets a state: [δq₀; δq̇₀] from zeros.
     let n = model.num_dofs();
-    let coordinates = model.coordinate_names();
-    let lookup = parameter_lookup(model);
-    let (mut q0, mut v0) = (vec![0.0; n], vec![0.0; n]);
-    for part in init.iter().flat_map(|s| s.split(',')) {
-        let (name, text) = split_assignment(part, "--init")?;
-        let value = evaluate(text, &format!("--init {name}"), &lookup)?;
-        if let Some(i) = coordinates.iter().position(|c| *c == name) {
-            q0[i] = value;
-        } else if let Some(i) = coordinates
-            .iter()
-            .position(|c| name.strip_suffix("_dot") == Some(c))
-        {
-            v0[i] = value;
-        } else {
-            let rates: Vec<String> = coordinates.iter().map(|c| format!("{c}_dot")).collect();
-            return Err(CliError::usage(format!(
-                "--init {name}: `{}` has no coordinate or rate `{name}` (coordinates: {}; rates: {})",
-                model.name(),
-                coordinates.join(", "),
-                rates.join(", ")
-            )));
-        }
-    }
+    let mut y = vec![0.0; 2 * n];
+    set_initial_values(model, &mut y, init).map_err(super::values::usage)?;
+    let v0 = y.split_off(n);
+    let q0 = y;
     Ok(Some(InitialDeviation { q: q0, qdot: v0 }))
 }
 

@@ -123,9 +123,9 @@ pub struct IntegrationArgs {
     /// parameters); repeatable.
     #[arg(long = "set", value_name = "NAME=VALUE")]
     pub set: Vec<String>,
-    /// Set an initial coordinate or rate, `NAME=VALUE` (e.g. `theta1=pi/2`, `theta1_dot=0`);
-    /// repeatable.
-    #[arg(long = "init", value_name = "NAME=VALUE")]
+    /// Set initial coordinates or rates, `NAME=VALUE` or a comma list (e.g.
+    /// `theta1=pi/2,theta1_dot=0`); repeatable.
+    #[arg(long = "init", value_name = "NAME=VALUE,…")]
     pub init: Vec<String>,
     /// Drift control of a constrained model: `none` (show the drift), `baumgarte`
     /// (Φ̈ + 2α Φ̇ + β² Φ = 0, see --baumgarte) or `projection` (onto Φ = 0 and the velocity
