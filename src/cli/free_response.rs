@@ -21,6 +21,7 @@ use serde_json::json;
 use super::CliError;
 use super::modes::{OperatingPointArgs, point_json};
 use super::plot::{self, Series};
+use super::render::num;
 use eomgen::expressions::set_initial_values;
 
 /// Options of `eomgen study free-response`.
@@ -331,14 +332,15 @@ pub fn run(args: &FreeResponseArgs) -> Result<(), CliError> {
     if *ignored_damping > 0.0 {
         let _ = writeln!(
             stdout,
-            "note       the damping matrix (max |C| = {ignored_damping:.3e}) is left out here; see `eomgen study modal-damping`"
+            "note       the damping matrix (max |C| = {ignored_damping:.3e}) is left out here; see `eomgen study modal-damping`",
+            ignored_damping = num(ignored_damping)
         );
     }
     let fmt = |v: &[f64]| -> String {
         names
             .iter()
             .zip(v)
-            .map(|(c, x)| format!("{c} = {x:.6e}"))
+            .map(|(c, x)| format!("{c} = {x:.6e}", x = num(x)))
             .collect::<Vec<_>>()
             .join(", ")
     };
@@ -348,11 +350,14 @@ pub fn run(args: &FreeResponseArgs) -> Result<(), CliError> {
         let what = match modes.kinds[k] {
             ModeKind::Oscillatory => format!(
                 "ω = {:.10e} rad/s: a cos ωt + b sin ωt/ω",
-                modes.natural_frequencies[k]
+                num(modes.natural_frequencies[k])
             ),
             ModeKind::ZeroFrequency => "zero-frequency: a + b t".to_string(),
             ModeKind::Unstable { growth_rate } => {
-                format!("unstable, σ = {growth_rate:.10e} 1/s: a cosh σt + b sinh σt/σ")
+                format!(
+                    "unstable, σ = {growth_rate:.10e} 1/s: a cosh σt + b sinh σt/σ",
+                    growth_rate = num(growth_rate)
+                )
             }
         };
         let _ = writeln!(stdout, "mode {:<5} {what}", k + 1);
@@ -368,7 +373,9 @@ pub fn run(args: &FreeResponseArgs) -> Result<(), CliError> {
     }
     let _ = writeln!(
         stdout,
-        "largest |δq| = {q_scale:.6e}, |δq̇| = {v_scale:.6e}; max differences (absolute, relative):"
+        "largest |δq| = {q_scale:.6e}, |δq̇| = {v_scale:.6e}; max differences (absolute, relative):",
+        q_scale = num(q_scale),
+        v_scale = num(v_scale)
     );
     for d in differences {
         let _ = writeln!(
@@ -376,10 +383,10 @@ pub fn run(args: &FreeResponseArgs) -> Result<(), CliError> {
             "  {:<14} vs {:<14} δq {:>9.2e} ({:>8.1e})   δq̇ {:>9.2e} ({:>8.1e})",
             d.a.name(),
             d.b.name(),
-            d.displacement,
-            d.displacement_relative,
-            d.velocity,
-            d.velocity_relative
+            num(d.displacement),
+            num(d.displacement_relative),
+            num(d.velocity),
+            num(d.velocity_relative)
         );
     }
     Ok(())

@@ -19,6 +19,7 @@ use rayon::prelude::*;
 use serde_json::{Value, json};
 
 use super::modes::{OperatingPointArgs, point_json};
+use super::render::num;
 use super::values::{evaluate, parameter_lookup};
 use super::{CliError, plot};
 
@@ -322,10 +323,10 @@ fn print_report(
         .coordinate_names()
         .iter()
         .zip(&forced.equilibrium.q)
-        .map(|(c, v)| format!("{c} = {v:.6e}"))
+        .map(|(c, v)| format!("{c} = {v:.6e}", v = num(v)))
         .collect();
     let _ = writeln!(out, "equilibrium {label} (input = 0): {}", point.join(", "));
-    let column: Vec<String> = b.iter().map(|v| format!("{v:.6e}")).collect();
+    let column: Vec<String> = b.iter().map(|v| format!("{v:.6e}", v = num(v))).collect();
     let _ = writeln!(
         out,
         "B          [{}] (generalized force per unit {} at t = 0)",
@@ -334,20 +335,23 @@ fn print_report(
     );
     let _ = writeln!(out, "{:>4}  {:>16}  {:>12}", "mode", "ω (rad/s)", "ζ");
     for (k, w) in modes.natural_frequencies.iter().enumerate() {
-        let zeta = damping.damping_ratios[k].map_or("-".to_string(), |z| format!("{z:.6e}"));
-        let _ = writeln!(out, "{:>4}  {:>16.10e}  {:>12}", k + 1, w, zeta);
+        let zeta =
+            damping.damping_ratios[k].map_or("-".to_string(), |z| format!("{z:.6e}", z = num(z)));
+        let _ = writeln!(out, "{:>4}  {:>16.10e}  {:>12}", k + 1, num(w), zeta);
     }
     if damping.coupling > 1e-12 {
         let _ = writeln!(
             out,
             "note       ΨᵀCΨ is not diagonal (off-diagonal {:.2e} of the diagonal): the modal sum drops the coupling",
-            damping.coupling
+            num(damping.coupling)
         );
     }
     let _ = writeln!(
         out,
         "sweep      {} frequencies from {lo:.6e} to {hi:.6e} rad/s",
-        frf.frequencies.len()
+        frf.frequencies.len(),
+        lo = num(lo),
+        hi = num(hi)
     );
     for (o, s) in outputs.iter().zip(sweeps) {
         let o = &o.name;
@@ -360,15 +364,16 @@ fn print_report(
                     let _ = writeln!(
                         out,
                         "peak  {o:<4} ω = {:.10e} rad/s  |H| = {a:.10e}  phase {:.4}°",
-                        p.frequency,
-                        p.phase_deg.unwrap_or(f64::NAN)
+                        num(p.frequency),
+                        p.phase_deg.unwrap_or(f64::NAN),
+                        a = num(a)
                     );
                 }
                 PeakAmplitude::Unbounded => {
                     let _ = writeln!(
                         out,
                         "peak  {o:<4} ω = {:.10e} rad/s  |H| unbounded (undamped resonance)",
-                        p.frequency
+                        num(p.frequency)
                     );
                 }
             }
@@ -382,12 +387,13 @@ fn print_report(
                     .iter()
                     .map(|o| format!("{}: {}", o.name, polar(d[o.index])))
                     .collect();
-                let _ = writeln!(out, "H(ω = {w:.10e})  {}", cells.join(", "));
+                let _ = writeln!(out, "H(ω = {w:.10e})  {}", cells.join(", "), w = num(w));
             }
             None => {
                 let _ = writeln!(
                     out,
-                    "H(ω = {w:.10e})  unbounded (K − ω²M + iωC is singular: undamped resonance)"
+                    "H(ω = {w:.10e})  unbounded (K − ω²M + iωC is singular: undamped resonance)",
+                    w = num(w)
                 );
             }
         }
@@ -403,7 +409,8 @@ fn print_report(
             if let Some(diff) = e.modal_difference.filter(|d| d.is_finite()) {
                 let _ = writeln!(
                     out,
-                    "           modal sum vs direct solve: max difference {diff:.2e} of max |H|"
+                    "           modal sum vs direct solve: max difference {diff:.2e} of max |H|",
+                    diff = num(diff)
                 );
             }
         } else if args.modal {
@@ -417,7 +424,10 @@ fn print_report(
         let _ = writeln!(
             out,
             "simulate   {} = {:e}, {} = ω, DOP853 rtol {:e}, from rest at the equilibrium to steady state",
-            args.input, args.amplitude, plan.frequency_parameter, args.rtol
+            args.input,
+            num(args.amplitude),
+            plan.frequency_parameter,
+            num(args.rtol)
         );
         let _ = writeln!(
             out,
@@ -429,19 +439,19 @@ fn print_report(
                 let _ = writeln!(
                     out,
                     "{:>16.10e}  {:>5}  {:>10.1}  {:>36}  {:>36}  {:>9.2e}",
-                    p.frequency,
+                    num(p.frequency),
                     o.name,
                     p.settling_time,
                     polar(v.simulated),
                     polar(v.predicted),
-                    v.relative_error()
+                    num(v.relative_error())
                 );
             }
         }
         let _ = writeln!(
             out,
             "check      max relative error of the simulated steady state against H: {:.2e}",
-            max_simulation_error(points)
+            num(max_simulation_error(points))
         );
     }
     if let Some(path) = &args.plot {
@@ -450,7 +460,7 @@ fn print_report(
 }
 
 fn polar(z: Complex<f64>) -> String {
-    format!("{:.9e} ∠ {:>9.4}°", z.norm(), phase_degrees(z))
+    format!("{:.9e} ∠ {:>9.4}°", num(z.norm()), phase_degrees(z))
 }
 
 fn write_modal(
@@ -483,9 +493,9 @@ fn write_modal(
             out,
             "           {:>4}  {:>12.6e}  {:>10}  {:>12.5e}  {:>34}  {}",
             k + 1,
-            natural_frequencies[k],
-            damping_ratios[k].map_or("-".to_string(), |z| format!("{z:.4e}")),
-            r.modal_forces[k],
+            num(natural_frequencies[k]),
+            damping_ratios[k].map_or("-".to_string(), |z| format!("{z:.4e}", z = num(z))),
+            num(r.modal_forces[k]),
             polar(r.modal_coordinates[k]),
             cells.join("  ")
         );

@@ -11,6 +11,7 @@ use eomgen::{Equilibrium, Linearization, ModeKind, ModelInfo, NormalModes};
 use nalgebra::DMatrix;
 use serde_json::json;
 
+use super::render::num;
 use super::values::{evaluate, parameter_lookup, set_parameters, split_assignment};
 use super::{CliError, find_model};
 
@@ -156,19 +157,19 @@ pub fn run(args: &ModesArgs) -> Result<(), CliError> {
     let point: Vec<String> = names
         .iter()
         .zip(&equilibrium.q)
-        .map(|(c, v)| format!("{c} = {v:.12e}"))
+        .map(|(c, v)| format!("{c} = {v:.12e}", v = num(v)))
         .collect();
     let _ = writeln!(
         stdout,
         "equilibrium {label}: {} (Newton: {} iterations, max |F| = {:.1e})",
         point.join(", "),
         equilibrium.iterations,
-        equilibrium.residual
+        num(equilibrium.residual)
     );
     if !lin.lagrange_multipliers.is_empty() {
         let forces: Vec<String> = multipliers
             .iter()
-            .map(|(c, v)| format!("λ_{c} = {:.6e}", v.as_f64().unwrap_or(f64::NAN)))
+            .map(|(c, v)| format!("λ_{c} = {:.6e}", num(v.as_f64().unwrap_or(f64::NAN))))
             .collect();
         let _ = writeln!(
             stdout,
@@ -186,7 +187,7 @@ pub fn run(args: &ModesArgs) -> Result<(), CliError> {
         let _ = writeln!(
             stdout,
             "note       K is not symmetric (‖K − Kᵀ‖/‖K‖ = {:.2e}); its symmetric part is used",
-            modes.stiffness_asymmetry
+            num(modes.stiffness_asymmetry)
         );
     }
     let _ = writeln!(
@@ -204,29 +205,33 @@ pub fn run(args: &ModesArgs) -> Result<(), CliError> {
             ModeKind::Oscillatory => String::new(),
             ModeKind::ZeroFrequency => "  zero-frequency".to_string(),
             ModeKind::Unstable { growth_rate } => {
-                format!("  unstable, grows as e^({growth_rate:.6e} t)")
+                format!(
+                    "  unstable, grows as e^({growth_rate:.6e} t)",
+                    growth_rate = num(growth_rate)
+                )
             }
         };
         let shape: Vec<String> = shape
             .iter()
-            .map(|v| format!("{:>11.4e}", v + 0.0))
+            .map(|v| format!("{:>11.4e}", num(v + 0.0)))
             .collect();
         let zeta = damping_ratios
             .get(k)
-            .map_or("-".to_string(), |z| format!("{z:.4e}"));
+            .map_or("-".to_string(), |z| format!("{z:.4e}", z = num(z)));
         let _ = writeln!(
             stdout,
             "{:>4}  {:>16.10e}  {:>14.6e}  {:>10}  [{}]{note}",
             k + 1,
-            w,
-            w / std::f64::consts::TAU,
+            num(w),
+            num(w / std::f64::consts::TAU),
             zeta,
             shape.join(", ")
         );
     }
     let _ = writeln!(
         stdout,
-        "check      eigenvalues of M⁻¹K (lecture 22) vs the symmetric Cholesky route (lecture 24): max difference {route_difference:.1e} of max |ω²|"
+        "check      eigenvalues of M⁻¹K (lecture 22) vs the symmetric Cholesky route (lecture 24): max difference {route_difference:.1e} of max |ω²|",
+        route_difference = num(route_difference)
     );
     for path in &charts {
         let _ = writeln!(stdout, "chart      {path}");
@@ -244,7 +249,11 @@ pub(super) fn matrix_rows(m: &DMatrix<f64>) -> Vec<Vec<f64>> {
 
 fn print_matrix(out: &mut impl std::io::Write, name: &str, m: &DMatrix<f64>) {
     for i in 0..m.nrows() {
-        let row: Vec<String> = m.row(i).iter().map(|v| format!("{v:>13.6e}")).collect();
+        let row: Vec<String> = m
+            .row(i)
+            .iter()
+            .map(|v| format!("{v:>13.6e}", v = num(v)))
+            .collect();
         let label = if i == 0 {
             format!("{name} =")
         } else {

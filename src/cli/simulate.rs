@@ -12,6 +12,7 @@ use eomgen::expressions::{ExpressionEvents, set_initial_values};
 use eomgen::{IntegrationError, ModelInfo, OutputTimes, Solution};
 use serde_json::json;
 
+use super::render::num;
 use super::values::{evaluate, set_parameters, usage};
 use super::{CliError, find_model, plot};
 use eomgen::Stabilization;
@@ -168,10 +169,10 @@ impl IntegrationArgs {
     /// `fixed step dt = 1e-2 s` otherwise (`--dt`, default `t_end/1000`).
     pub(crate) fn step_control(&self) -> String {
         if self.method.is_adaptive() {
-            format!("rtol {:e}, atol {:e}", self.rtol, self.atol)
+            format!("rtol {:e}, atol {:e}", num(self.rtol), num(self.atol))
         } else {
             let dt = self.dt.unwrap_or(self.t_end / 1000.0);
-            format!("fixed step dt = {dt:e} s")
+            format!("fixed step dt = {dt:e} s", dt = num(dt))
         }
     }
 }
@@ -427,11 +428,13 @@ fn inconsistent_message(
 ) -> String {
     if has_guesses {
         format!(
-            "no consistent initial state for `{model}`: constraint `{constraint}` keeps a residual of {residual:.3e} after {iterations} Newton iteration(s) from the guesses; try other guesses"
+            "no consistent initial state for `{model}`: constraint `{constraint}` keeps a residual of {residual:.3e} after {iterations} Newton iteration(s) from the guesses; try other guesses",
+            residual = num(residual)
         )
     } else {
         format!(
-            "the initial state of `{model}` violates its constraints: `{constraint}` has a residual of {residual:.3e}; mark the dependent coordinates as `{{ guess: … }}` in `initial:` or fix the values"
+            "the initial state of `{model}` violates its constraints: `{constraint}` has a residual of {residual:.3e}; mark the dependent coordinates as `{{ guess: … }}` in `initial:` or fix the values",
+            residual = num(residual)
         )
     }
 }
@@ -533,21 +536,28 @@ fn print_summary(
         for (i, name) in names.iter().enumerate() {
             println!(
                 "           {name:>12} = {:>22.15e}   {:>16} = {:>22.15e}",
-                y[i],
+                num(y[i]),
                 format!("{name}_dot"),
-                y[n + i]
+                num(y[n + i])
             );
         }
     }
     if let (e0, Some(e1)) = (report.initial_energy, report.energy.last()) {
-        println!("energy     E(0) = {e0:.12e} J, E(end) = {e1:.12e} J");
+        println!(
+            "energy     E(0) = {e0:.12e} J, E(end) = {e1:.12e} J",
+            e0 = num(e0),
+            e1 = num(e1)
+        );
         if let Some(d) = report.drift {
             let note = if model.is_conservative() {
                 ""
             } else {
                 " (not conserved: the model has non-conservative loads or explicit time dependence)"
             };
-            println!("drift      max|E - E(0)| / max(T + |V|) = {d:.3e}{note}");
+            println!(
+                "drift      max|E - E(0)| / max(T + |V|) = {d:.3e}{note}",
+                d = num(d)
+            );
         }
     }
     let s = &solution.stats;
@@ -624,13 +634,19 @@ fn print_events(model: &dyn ModelInfo, solution: &Solution) {
         let state: Vec<String> = names
             .iter()
             .enumerate()
-            .map(|(i, c)| format!("{c} = {:.9e}, {c}_dot = {:.9e}", e.y[i], e.y[n + i]))
+            .map(|(i, c)| {
+                format!(
+                    "{c} = {:.9e}, {c}_dot = {:.9e}",
+                    num(e.y[i]),
+                    num(e.y[n + i])
+                )
+            })
             .collect();
         println!(
             "           {:<16} {:<8} t = {:.15e}   {}",
             e.name,
             e.direction.name(),
-            e.t,
+            num(e.t),
             state.join(", ")
         );
     }
@@ -649,7 +665,7 @@ fn print_events(model: &dyn ModelInfo, solution: &Solution) {
         if times.len() >= 2 {
             let intervals: Vec<String> = times
                 .windows(2)
-                .map(|w| format!("{:.12e}", w[1] - w[0]))
+                .map(|w| format!("{:.12e}", num(w[1] - w[0])))
                 .collect();
             println!(
                 "intervals  between successive `{}`: {} s",
@@ -660,7 +676,7 @@ fn print_events(model: &dyn ModelInfo, solution: &Solution) {
     }
     if let Some(k) = solution.terminated_by_event {
         let e = &solution.events[k];
-        println!("stopped    at t = {:.15e} by event `{}`", e.t, e.name);
+        println!("stopped    at t = {:.15e} by event `{}`", num(e.t), e.name);
     }
 }
 
@@ -684,7 +700,7 @@ fn write_events_csv(
             e.name,
             e.direction.name(),
             e.terminal,
-            e.t
+            num(e.t)
         ));
         for v in &e.y {
             out.push_str(&format!(",{v:e}"));
@@ -712,13 +728,15 @@ fn print_constraint_summary(constraints: &ConstraintDrift, stabilization: Stabil
             .constraint_names
             .iter()
             .zip(last)
-            .map(|(n, l)| format!("{n} = {l:.9e}"))
+            .map(|(n, l)| format!("{n} = {l:.9e}", l = num(l)))
             .collect();
         println!("lambda     at the end: {}", forces.join(", "));
     }
     let (p, v) = constraints.max_drift();
     println!(
         "drift      constraints ({}): max |Φ| = {p:.3e}, max |Φ̇| = {v:.3e}",
-        format!("{stabilization:?}").to_lowercase()
+        format!("{stabilization:?}").to_lowercase(),
+        p = num(p),
+        v = num(v)
     );
 }

@@ -23,6 +23,7 @@ use eomgen::integrate::stability::GrowthTest;
 use nalgebra::Complex;
 use serde_json::json;
 
+use super::render::num;
 use super::{CliError, find_model, plot};
 
 /// Options of `eomgen study stability`.
@@ -167,7 +168,7 @@ pub(super) fn print_json(value: &serde_json::Value) -> Result<(), CliError> {
 }
 
 fn optional(value: Option<f64>) -> String {
-    value.map_or_else(|| "-".to_string(), |v| format!("{v:.4e}"))
+    value.map_or_else(|| "-".to_string(), |v| format!("{v:.4e}", v = num(v)))
 }
 
 fn write_limits(out: &mut String, test: &GrowthTest, limits: &Limits) {
@@ -183,19 +184,23 @@ fn write_limits(out: &mut String, test: &GrowthTest, limits: &Limits) {
     let _ = writeln!(
         out,
         "   measured: bisection (to {BISECTION_TOLERANCE:e} relative) on runs of N = {} constant steps, unstable when ‖y‖ grows beyond {GROWTH_THRESHOLD:e}.",
-        test.steps
+        test.steps,
+        BISECTION_TOLERANCE = num(BISECTION_TOLERANCE),
+        GROWTH_THRESHOLD = num(GROWTH_THRESHOLD)
     );
     let _ = writeln!(
         out,
         "   N detects a per-step growth δ ≥ {:.2e}; one percent above a limit the growth is δ₁ and needs N₁ = ln {GROWTH_THRESHOLD:e}/ln(1 + δ₁) steps.",
-        test.smallest_detected_growth()
+        num(test.smallest_detected_growth()),
+        GROWTH_THRESHOLD = num(GROWTH_THRESHOLD)
     );
     let _ = writeln!(
         out,
         "   {:<18} {:<9} {:>10} {:>10} {:>10} {:>10} {:>10} {:>9} {:>8}",
         "method", "axis", "theory", "measured", "rel. diff", "theory(N)", "rel. diff", "δ₁", "N₁"
     );
-    let difference = |d: Option<f64>| d.map_or("-".to_string(), |d| format!("{d:+.2e}"));
+    let difference =
+        |d: Option<f64>| d.map_or("-".to_string(), |d| format!("{d:+.2e}", d = num(d)));
     for r in &limits.rows {
         let _ = writeln!(
             out,
@@ -207,7 +212,7 @@ fn write_limits(out: &mut String, test: &GrowthTest, limits: &Limits) {
             difference(r.relative_difference),
             r.theory_at_detection,
             difference(r.relative_difference_at_detection),
-            r.growth_one_percent_above,
+            num(r.growth_one_percent_above),
             r.steps_needed_one_percent_above,
             if r.steps_needed_one_percent_above > r.steps_used {
                 "  N₁ > N: 1% not resolvable"
@@ -219,7 +224,7 @@ fn write_limits(out: &mut String, test: &GrowthTest, limits: &Limits) {
     let _ = writeln!(
         out,
         "   theory(N): first h where the per-step growth exceeds the detected {:.2e}, the limit N steps can see.",
-        test.smallest_detected_growth()
+        num(test.smallest_detected_growth())
     );
     let _ = writeln!(
         out,
@@ -238,14 +243,19 @@ fn write_limits(out: &mut String, test: &GrowthTest, limits: &Limits) {
             r.h_omega,
             r.measured,
             r.theory,
-            r.relative_difference,
+            num(r.relative_difference),
             optional(r.norm_after_long_run)
         );
     }
     for m in &limits.explicit {
         let check = m.implementation_difference.map_or_else(
             || "read off one step of the implementation (tableau private)".to_string(),
-            |d| format!("tableau vs one step of the implementation: {d:.1e}"),
+            |d| {
+                format!(
+                    "tableau vs one step of the implementation: {d:.1e}",
+                    d = num(d)
+                )
+            },
         );
         let _ = writeln!(
             out,
@@ -284,12 +294,12 @@ fn write_energy(out: &mut String, periods: usize, rows: &[EnergyRow]) {
             format!("T/{}", r.steps_per_period),
             r.periods_reached,
             r.final_energy_ratio
-                .map_or("overflow".to_string(), |e| format!("{e:.6e}")),
+                .map_or("overflow".to_string(), |e| format!("{e:.6e}", e = num(e))),
             r.log10_final_energy_ratio,
             r.theory_log10_final_energy_ratio
                 .map_or("-".to_string(), |e| format!("{e:.6}")),
             r.max_energy_error
-                .map_or("overflow".to_string(), |e| format!("{e:.4e}")),
+                .map_or("overflow".to_string(), |e| format!("{e:.4e}", e = num(e))),
             optional(r.theory_max_energy_error)
         );
         if let Some(f) = &r.failure {
@@ -314,7 +324,9 @@ fn write_stiff(out: &mut String, args: &StabilityArgs, modes: &[StiffMode], rows
     let _ = writeln!(
         out,
         "c. Stiff two-mass spring (two_masses, k = (k/m)·m₁), 0 ≤ t ≤ {} s, rtol = atol = {:e}; errors at {STIFF_OUTPUT_TIMES} times against DOP853 at {STIFF_REFERENCE_TOL:e}",
-        args.t_end, args.tol
+        args.t_end,
+        num(args.tol),
+        STIFF_REFERENCE_TOL = num(STIFF_REFERENCE_TOL)
     );
     let _ = writeln!(
         out,
@@ -333,11 +345,11 @@ fn write_stiff(out: &mut String, args: &StabilityArgs, modes: &[StiffMode], rows
         let _ = writeln!(
             out,
             "   {:>8.0e} {:<12} {:>12.1} {:>14.2e} {:>14.2e} {:>11}",
-            m.k_over_m,
+            num(m.k_over_m),
             m.start,
             m.omega,
-            m.position_amplitude,
-            m.velocity_amplitude,
+            num(m.position_amplitude),
+            num(m.velocity_amplitude),
             m.reference_steps
         );
     }
@@ -359,7 +371,7 @@ fn write_stiff(out: &mut String, args: &StabilityArgs, modes: &[StiffMode], rows
         let _ = writeln!(
             out,
             "   {:>8.0e} {:<12} {:<8} {:>9} {:>8} {:>10} {:>6} {:>6} {:>12} {:>12}{}",
-            r.k_over_m,
+            num(r.k_over_m),
             r.start,
             r.method,
             r.steps,
@@ -382,7 +394,9 @@ fn write_underflow(out: &mut String, run: &UnderflowRun) {
     let _ = writeln!(
         out,
         "d. Step-size underflow: {}, {} at rtol = atol = {:e}",
-        run.problem, run.method, run.tol
+        run.problem,
+        run.method,
+        num(run.tol)
     );
     match &run.failure {
         Some(f) => {
