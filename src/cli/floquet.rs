@@ -314,13 +314,12 @@ fn run_sweep(
 ) -> Result<Vec<Vec<Cell>>, CliError> {
     let source = super::open_model(&args.model)?;
     let total = x.values.len() * y.values.len();
-    let bar = indicatif::ProgressBar::new(total as u64);
-    if let Ok(style) = indicatif::ProgressStyle::with_template(
+    let bar = super::render::progress_bar(
+        total,
         "{msg} [{bar:40}] {pos}/{len} analyses, {elapsed} (eta {eta})",
-    ) {
-        bar.set_style(style.progress_chars("=> "));
-    }
-    bar.set_message("floquet");
+        "floquet",
+        false,
+    );
     let flat: Vec<Cell> = (0..total)
         .into_par_iter()
         .map(|k| {

@@ -5,7 +5,7 @@
 //! [`eomgen::vibration::frequency_response_analysis`] and its simulated points; this module
 //! runs those in parallel and renders text, JSON and the chart.
 
-use std::io::{IsTerminal as _, Write as _};
+use std::io::Write as _;
 
 use clap::Args;
 use eomgen::vibration::{
@@ -527,19 +527,12 @@ fn simulate_points(
 ) -> Result<Vec<SimulatedPoint>, CliError> {
     let name = model.name();
     let k = plan.frequencies.len();
-    let progress = if args.json || !std::io::stderr().is_terminal() {
-        indicatif::ProgressBar::hidden()
-    } else {
-        let bar = indicatif::ProgressBar::new(k as u64);
-        bar.set_style(
-            indicatif::ProgressStyle::with_template(
-                "{msg} [{bar:30}] {pos}/{len} ({elapsed}, eta {eta})",
-            )
-            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
-        );
-        bar.set_message("steady-state simulations");
-        bar
-    };
+    let progress = super::render::progress_bar(
+        k,
+        "{msg} [{bar:30}] {pos}/{len} ({elapsed}, eta {eta})",
+        "steady-state simulations",
+        args.json,
+    );
     let results: Vec<Result<SimulatedPoint, CliError>> = plan
         .frequencies
         .par_iter()

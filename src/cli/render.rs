@@ -77,6 +77,29 @@ pub(super) fn write_file(path: &str, contents: impl AsRef<[u8]>) -> Result<(), S
     })
 }
 
+/// A progress bar on standard error, `len` steps drawn with the indicatif `template`
+/// (`{msg}` is `message`), or a hidden one when `quiet` (a `--json` run) or when standard
+/// error is not a terminal: scripts, pipes and tests see nothing.
+pub(super) fn progress_bar(
+    len: usize,
+    template: &str,
+    message: &'static str,
+    quiet: bool,
+) -> indicatif::ProgressBar {
+    use std::io::IsTerminal as _;
+    if quiet || !std::io::stderr().is_terminal() {
+        return indicatif::ProgressBar::hidden();
+    }
+    let bar = indicatif::ProgressBar::new(len as u64);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template(template)
+            .map(|style| style.progress_chars("=> "))
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    bar.set_message(message);
+    bar
+}
+
 /// The exponents printed in fixed notation by [`number`]: `10⁻³ ≤ |v| < 10⁵`, the range of
 /// the report's tables and the mode charts' legends.
 const FIXED_EXPONENTS: std::ops::RangeInclusive<i32> = -3..=4;

@@ -16,7 +16,6 @@
 //! `|computed − expected| ≤ tolerance · max(1, |expected|)`; drifts and residuals are
 //! "computed" with expected 0 and their bound as tolerance.
 
-use std::io::IsTerminal as _;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -113,19 +112,12 @@ pub fn run(args: &ReportArgs) -> Result<(), CliError> {
     let sources = sources(&args.models)?;
     std::fs::create_dir_all(&args.out)
         .map_err(|e| CliError::failure(format!("cannot create `{}`: {e}", args.out.display())))?;
-    let bar = if args.json || !std::io::stderr().is_terminal() {
-        indicatif::ProgressBar::hidden()
-    } else {
-        let bar = indicatif::ProgressBar::new(sources.len() as u64);
-        bar.set_style(
-            indicatif::ProgressStyle::with_template(
-                "{msg} [{bar:30}] {pos}/{len} models ({elapsed})",
-            )
-            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
-        );
-        bar.set_message("report");
-        bar
-    };
+    let bar = super::render::progress_bar(
+        sources.len(),
+        "{msg} [{bar:30}] {pos}/{len} models ({elapsed})",
+        "report",
+        args.json,
+    );
     let mut reports: Vec<ModelReport> = sources
         .par_iter()
         .map(|s| {

@@ -200,8 +200,19 @@ pub fn run(args: &WorkPrecisionArgs) -> Result<(), CliError> {
     options.tolerances = parse_tols(&args.tols)?;
     options.steps = args.steps.as_deref().map(parse_steps).transpose()?;
     let mut model = find_model(&args.model)?;
-    let report = work_precision(model.as_mut(), &options, &mut |_, _| {})
-        .map_err(|e| study_error(args, e))?;
+    // The runs take seconds to minutes: a bar on a terminal, nothing otherwise.
+    let bar = super::render::progress_bar(
+        0,
+        "{msg} [{bar:30}] {pos}/{len} runs ({elapsed}, eta {eta})",
+        "work-precision",
+        args.json,
+    );
+    let report = work_precision(model.as_mut(), &options, &mut |done, total| {
+        bar.set_length(total as u64);
+        bar.set_position(done as u64);
+    });
+    bar.finish_and_clear();
+    let report = report.map_err(|e| study_error(args, e))?;
     let study = Study {
         args,
         model: model.as_ref(),
