@@ -7,7 +7,7 @@ use clap::Args;
 use eomgen::vibration::{
     self, EquilibriumStart, ModalAnalysis, ModalOptions, OperatingPointError, OperatingPointOptions,
 };
-use eomgen::{Equilibrium, Linearization, ModeKind, ModelInfo, NormalModes};
+use eomgen::{ModeKind, ModelInfo};
 use nalgebra::DMatrix;
 use serde_json::json;
 
@@ -263,18 +263,6 @@ fn print_matrix(out: &mut impl std::io::Write, name: &str, m: &DMatrix<f64>) {
     }
 }
 
-/// The linearisation at the operating point `--at` and what to call it.
-pub(super) struct OperatingPoint {
-    /// The equilibrium's name, or the `--at` guesses as given.
-    pub label: String,
-    /// The equilibrium Newton found (with the constraint forces at rest).
-    pub equilibrium: Equilibrium,
-    /// The exact linearisation at the equilibrium Newton found.
-    pub lin: Linearization,
-    /// Its normal modes.
-    pub modes: NormalModes,
-}
-
 /// The model `model_name` with `--set` applied and its modal analysis at `--at`
 /// ([`eomgen::vibration::modal_analysis`]).
 ///
@@ -291,21 +279,6 @@ pub(super) fn analysis_of(
     let modal = vibration::modal_analysis(model.as_ref(), &options)
         .map_err(|e| point_failure(model.as_ref(), &e))?;
     Ok((model, modal))
-}
-
-/// Finds the equilibrium from `--at` (after `--set`), linearises there and computes the
-/// normal modes: the start of the modal studies and of the report's modal checks.
-pub(super) fn operating_point_of(
-    model_name: &str,
-    point: &OperatingPointArgs,
-) -> Result<OperatingPoint, CliError> {
-    let (_, modal) = analysis_of(model_name, point)?;
-    Ok(OperatingPoint {
-        label: modal.operating_point.name,
-        equilibrium: modal.operating_point.equilibrium,
-        lin: modal.linearization,
-        modes: modal.normal_modes,
-    })
 }
 
 /// The error of a failed equilibrium search, linearisation or modal analysis of `model`: the
