@@ -17,7 +17,7 @@ use clap::Args;
 use eomgen::analysis::stability::{
     AMPLIFICATION_STEPS, BISECTION_TOLERANCE, EnergyRow, ExplicitMethod, GROWTH_THRESHOLD, Limits,
     STIFF_OUTPUT_TIMES, STIFF_REFERENCE_TOL, StabilityError, StabilityOptions, StabilityStudy,
-    StiffMode, StiffRow, UnderflowRun, stability_study,
+    StiffMode, StiffRow, StiffSpring, UnderflowRun, stability_study,
 };
 use eomgen::integrate::stability::GrowthTest;
 use nalgebra::Complex;
@@ -25,6 +25,9 @@ use serde_json::json;
 
 use super::render::num;
 use super::{CliError, find_model, plot};
+
+/// The bundled model of part c: HW9's two-mass spring.
+const STIFF_MODEL: &str = "two_masses";
 
 /// Options of `eomgen study stability`.
 #[derive(Debug, Args)]
@@ -75,6 +78,14 @@ pub fn run(args: &StabilityArgs) -> Result<(), CliError> {
         stiffness: args.stiffness.clone(),
         t_end: args.t_end,
         tol: args.tol,
+        // HW9's two-mass spring file and its names.
+        stiff_spring: StiffSpring {
+            mass_1: "m1".to_string(),
+            mass_2: "m2".to_string(),
+            stiffness: "k".to_string(),
+            force: "F0".to_string(),
+            stretched: "x2".to_string(),
+        },
     };
     options.validate().map_err(study_error)?;
     if let Some(prefix) = &args.plot
@@ -82,7 +93,7 @@ pub fn run(args: &StabilityArgs) -> Result<(), CliError> {
     {
         return Err(CliError::usage("--plot needs a file prefix"));
     }
-    let mut two_masses = find_model("two_masses")?;
+    let mut two_masses = find_model(STIFF_MODEL)?;
     let StabilityStudy {
         test,
         mut limits,
@@ -110,7 +121,7 @@ pub fn run(args: &StabilityArgs) -> Result<(), CliError> {
             },
             "energy": {"periods": args.periods, "runs": energy},
             "stiff": {
-                "model": "two_masses",
+                "model": two_masses.name(),
                 "t_end": args.t_end,
                 "tol": args.tol,
                 "reference": {"method": "dop853", "tol": STIFF_REFERENCE_TOL},
@@ -323,7 +334,7 @@ fn write_stiff(out: &mut String, args: &StabilityArgs, modes: &[StiffMode], rows
     use std::fmt::Write as _;
     let _ = writeln!(
         out,
-        "c. Stiff two-mass spring (two_masses, k = (k/m)·m₁), 0 ≤ t ≤ {} s, rtol = atol = {:e}; errors at {STIFF_OUTPUT_TIMES} times against DOP853 at {STIFF_REFERENCE_TOL:e}",
+        "c. Stiff two-mass spring ({STIFF_MODEL}, k = (k/m)·m₁), 0 ≤ t ≤ {} s, rtol = atol = {:e}; errors at {STIFF_OUTPUT_TIMES} times against DOP853 at {STIFF_REFERENCE_TOL:e}",
         args.t_end,
         num(args.tol),
         STIFF_REFERENCE_TOL = num(STIFF_REFERENCE_TOL)

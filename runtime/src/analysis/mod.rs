@@ -23,7 +23,9 @@ pub use roundoff::{EulerRoundoff, RoundoffError, RoundoffOptions, euler_roundoff
 pub use simulation::{
     AddedEvents, Simulation, SimulationError, SimulationOptions, simulate, simulate_with_events,
 };
-pub use stability::{StabilityError, StabilityOptions, StabilityStudy, stability_study};
+pub use stability::{
+    StabilityError, StabilityOptions, StabilityStudy, StiffSpring, stability_study,
+};
 pub use work_precision::{
     AtTarget, Measured, MethodRuns, RunFailure, Setting, SettingRun, WorkPrecision,
     WorkPrecisionError, WorkPrecisionOptions, work_precision,
