@@ -7,8 +7,6 @@
 //! the pieces `study modal-damping` shares: `--init` parsing, the errors in the options' words
 //! and the stacked charts.
 
-use std::io::Write as _;
-
 use clap::Args;
 use eomgen::vibration::{
     self, FreeResponseMethod, FreeResponseOptions, FreeResponseStudy, InitialDeviation,
@@ -244,22 +242,9 @@ pub fn run(args: &FreeResponseArgs) -> Result<(), CliError> {
     };
     let study = vibration::free_response(model.as_ref(), &options)
         .map_err(|e| study_failure(model.as_ref(), &e))?;
-    let FreeResponseStudy {
-        operating_point: point,
-        normal_modes: modes,
-        ignored_damping,
-        initial,
-        t_end,
-        responses,
-        max_displacement: q_scale,
-        max_velocity: v_scale,
-        differences,
-        ..
-    } = &study;
-    let (label, (q0, v0)) = (&point.name, (&initial.q, &initial.qdot));
+    let (label, responses) = (&study.operating_point.name, &study.responses);
     let n = model.num_dofs();
     let names = model.coordinate_names();
-    let samples = responses[0].1.times.len();
     if let Some(path) = &args.plot {
         let panel_list: Vec<Panel> = (0..n)
             .map(|j| {
@@ -285,43 +270,91 @@ pub fn run(args: &FreeResponseArgs) -> Result<(), CliError> {
     }
     let mut stdout = std::io::stdout().lock();
     if args.json {
-        let out = json!({
-            "model": model.name(),
-            "coordinates": names,
-            "operating_point": point_json(label, &names, &study.linearization.q),
-            "ignored_damping": ignored_damping,
-            "modes": (0..n).map(|k| json!({
-                "kind": kind_json(&modes.kinds[k]),
-                "eigenvalue": modes.eigenvalues[k],
-                "natural_frequency": modes.natural_frequencies[k],
-                "growth_rate": match modes.kinds[k] { ModeKind::Unstable { growth_rate } => Some(growth_rate), _ => None },
-            })).collect::<Vec<_>>(),
-            "initial": {"q": q0, "qdot": v0},
-            "t_end": t_end,
-            "samples": samples,
-            "tol": study.tol,
-            "methods": FreeResponseMethod::ALL.iter().map(|m| json!({"name": m.name(), "description": m.description()})).collect::<Vec<_>>(),
-            "max_displacement": q_scale,
-            "max_velocity": v_scale,
-            "max_differences": differences.iter().map(|d| json!({
-                "a": d.a.name(),
-                "b": d.b.name(),
-                "displacement": d.displacement,
-                "velocity": d.velocity,
-                "displacement_relative": d.displacement_relative,
-                "velocity_relative": d.velocity_relative,
-            })).collect::<Vec<_>>(),
-            "final": responses.iter().map(|(method, r)| json!({
-                "method": method.name(),
-                "q": r.displacements.last(),
-                "qdot": r.velocities.last(),
-            })).collect::<Vec<_>>(),
-        });
-        let text =
-            serde_json::to_string_pretty(&out).map_err(|e| CliError::failure(e.to_string()))?;
-        let _ = writeln!(stdout, "{text}");
-        return Ok(());
+        print_json(&mut stdout, model.as_ref(), &study)
+    } else {
+        print_text(&mut stdout, model.as_ref(), &study);
+        Ok(())
     }
+}
+
+/// The JSON of `study free-response` (see docs/cli.md).
+fn print_json(
+    stdout: &mut impl std::io::Write,
+    model: &dyn ModelInfo,
+    study: &FreeResponseStudy,
+) -> Result<(), CliError> {
+    let FreeResponseStudy {
+        operating_point: point,
+        normal_modes: modes,
+        ignored_damping,
+        initial,
+        t_end,
+        responses,
+        max_displacement: q_scale,
+        max_velocity: v_scale,
+        differences,
+        ..
+    } = study;
+    let (label, (q0, v0)) = (&point.name, (&initial.q, &initial.qdot));
+    let n = model.num_dofs();
+    let names = model.coordinate_names();
+    let samples = responses[0].1.times.len();
+    let out = json!({
+        "model": model.name(),
+        "coordinates": names,
+        "operating_point": point_json(label, &names, &study.linearization.q),
+        "ignored_damping": ignored_damping,
+        "modes": (0..n).map(|k| json!({
+            "kind": kind_json(&modes.kinds[k]),
+            "eigenvalue": modes.eigenvalues[k],
+            "natural_frequency": modes.natural_frequencies[k],
+            "growth_rate": match modes.kinds[k] { ModeKind::Unstable { growth_rate } => Some(growth_rate), _ => None },
+        })).collect::<Vec<_>>(),
+        "initial": {"q": q0, "qdot": v0},
+        "t_end": t_end,
+        "samples": samples,
+        "tol": study.tol,
+        "methods": FreeResponseMethod::ALL.iter().map(|m| json!({"name": m.name(), "description": m.description()})).collect::<Vec<_>>(),
+        "max_displacement": q_scale,
+        "max_velocity": v_scale,
+        "max_differences": differences.iter().map(|d| json!({
+            "a": d.a.name(),
+            "b": d.b.name(),
+            "displacement": d.displacement,
+            "velocity": d.velocity,
+            "displacement_relative": d.displacement_relative,
+            "velocity_relative": d.velocity_relative,
+        })).collect::<Vec<_>>(),
+        "final": responses.iter().map(|(method, r)| json!({
+            "method": method.name(),
+            "q": r.displacements.last(),
+            "qdot": r.velocities.last(),
+        })).collect::<Vec<_>>(),
+    });
+    let text = serde_json::to_string_pretty(&out).map_err(|e| CliError::failure(e.to_string()))?;
+    let _ = writeln!(stdout, "{text}");
+    Ok(())
+}
+
+/// The text of `study free-response`: the set-up, the modes, the methods and their largest
+/// differences.
+fn print_text(stdout: &mut impl std::io::Write, model: &dyn ModelInfo, study: &FreeResponseStudy) {
+    let FreeResponseStudy {
+        operating_point: point,
+        normal_modes: modes,
+        ignored_damping,
+        initial,
+        t_end,
+        responses,
+        max_displacement: q_scale,
+        max_velocity: v_scale,
+        differences,
+        ..
+    } = study;
+    let (label, (q0, v0)) = (&point.name, (&initial.q, &initial.qdot));
+    let n = model.num_dofs();
+    let names = model.coordinate_names();
+    let samples = responses[0].1.times.len();
     let _ = writeln!(
         stdout,
         "model      {} ({} dof) at {label}: M δq̈ + K δq = 0, 0 ≤ t ≤ {t_end:.6} s, {} samples",
@@ -389,7 +422,6 @@ pub fn run(args: &FreeResponseArgs) -> Result<(), CliError> {
             num(d.velocity_relative)
         );
     }
-    Ok(())
 }
 
 /// The error of a failed response computation of `model`; a modal failure gets its hint

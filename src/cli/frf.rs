@@ -312,7 +312,6 @@ fn print_report(
         normal_modes: modes,
         modal_damping: damping,
         sweeps,
-        evaluations,
         ..
     } = frf;
     let label = &point.name;
@@ -353,6 +352,18 @@ fn print_report(
         lo = num(lo),
         hi = num(hi)
     );
+    write_peaks(out, outputs, sweeps);
+    write_evaluations(out, args, frf);
+    if let Some((points, plan)) = simulated {
+        write_simulated(out, args, outputs, points, plan);
+    }
+    if let Some(path) = &args.plot {
+        let _ = writeln!(out, "chart      {path}");
+    }
+}
+
+/// The resonance peaks of every output's sweep.
+fn write_peaks(out: &mut impl std::io::Write, outputs: &[FrfOutput], sweeps: &[FrequencySweep]) {
     for (o, s) in outputs.iter().zip(sweeps) {
         let o = &o.name;
         if s.peaks.is_empty() {
@@ -379,6 +390,17 @@ fn print_report(
             }
         }
     }
+}
+
+/// `H(ω)` at every `--frequency`, with the modal contributions of `--modal`.
+fn write_evaluations(out: &mut impl std::io::Write, args: &FrfArgs, frf: &FrfAnalysis) {
+    let FrfAnalysis {
+        outputs,
+        normal_modes: modes,
+        modal_damping: damping,
+        evaluations,
+        ..
+    } = frf;
     for e in evaluations {
         let w = e.frequency;
         match &e.response {
@@ -420,43 +442,48 @@ fn print_report(
             );
         }
     }
-    if let Some((points, plan)) = simulated {
-        let _ = writeln!(
-            out,
-            "simulate   {} = {:e}, {} = ω, DOP853 rtol {:e}, from rest at the equilibrium to steady state",
-            args.input,
-            num(args.amplitude),
-            plan.frequency_parameter,
-            num(args.rtol)
-        );
-        let _ = writeln!(
-            out,
-            "{:>16}  {:>5}  {:>10}  {:>36}  {:>36}  {:>9}",
-            "ω (rad/s)", "out", "t_settle", "simulated X/amplitude", "H(ω)", "rel. err"
-        );
-        for p in points {
-            for (o, v) in outputs.iter().zip(&p.values) {
-                let _ = writeln!(
-                    out,
-                    "{:>16.10e}  {:>5}  {:>10.1}  {:>36}  {:>36}  {:>9.2e}",
-                    num(p.frequency),
-                    o.name,
-                    p.settling_time,
-                    polar(v.simulated),
-                    polar(v.predicted),
-                    num(v.relative_error())
-                );
-            }
+}
+
+/// The points of `--simulate` against `H`.
+fn write_simulated(
+    out: &mut impl std::io::Write,
+    args: &FrfArgs,
+    outputs: &[FrfOutput],
+    points: &[SimulatedPoint],
+    plan: &FrfSimulationPlan,
+) {
+    let _ = writeln!(
+        out,
+        "simulate   {} = {:e}, {} = ω, DOP853 rtol {:e}, from rest at the equilibrium to steady state",
+        args.input,
+        num(args.amplitude),
+        plan.frequency_parameter,
+        num(args.rtol)
+    );
+    let _ = writeln!(
+        out,
+        "{:>16}  {:>5}  {:>10}  {:>36}  {:>36}  {:>9}",
+        "ω (rad/s)", "out", "t_settle", "simulated X/amplitude", "H(ω)", "rel. err"
+    );
+    for p in points {
+        for (o, v) in outputs.iter().zip(&p.values) {
+            let _ = writeln!(
+                out,
+                "{:>16.10e}  {:>5}  {:>10.1}  {:>36}  {:>36}  {:>9.2e}",
+                num(p.frequency),
+                o.name,
+                p.settling_time,
+                polar(v.simulated),
+                polar(v.predicted),
+                num(v.relative_error())
+            );
         }
-        let _ = writeln!(
-            out,
-            "check      max relative error of the simulated steady state against H: {:.2e}",
-            num(max_simulation_error(points))
-        );
     }
-    if let Some(path) = &args.plot {
-        let _ = writeln!(out, "chart      {path}");
-    }
+    let _ = writeln!(
+        out,
+        "check      max relative error of the simulated steady state against H: {:.2e}",
+        num(max_simulation_error(points))
+    );
 }
 
 fn polar(z: Complex<f64>) -> String {

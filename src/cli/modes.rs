@@ -1,8 +1,6 @@
 //! `eomgen modes MODEL`: equilibrium, exact linearisation `M δq̈ + C δq̇ + K δq = 0`, normal
 //! modes and damping (issue 7; lectures 22–26, 30).
 
-use std::io::Write as _;
-
 use clap::Args;
 use eomgen::vibration::{
     self, EquilibriumStart, ModalAnalysis, ModalOptions, OperatingPointError, OperatingPointOptions,
@@ -88,21 +86,8 @@ pub fn run(args: &ModesArgs) -> Result<(), CliError> {
     if args.plot.is_some() {
         super::mode_plot::check_drawable(model.as_ref())?;
     }
-    let ModalAnalysis {
-        operating_point: point,
-        linearization: lin,
-        normal_modes: modes,
-        mode_shapes: shapes,
-        minimal_coordinates: minimal,
-        damped_modes: damped,
-        damping_ratios,
-        m_inv_k_eigenvalues: route22,
-        m_inv_k_relative_difference: route_difference,
-    } = &modal;
-    let (label, equilibrium) = (&point.name, &point.equilibrium);
-    let n = model.num_dofs();
-    let names = model.coordinate_names();
-    let undamped = modal.is_undamped();
+    let (lin, modes) = (&modal.linearization, &modal.normal_modes);
+    let equilibrium = &modal.operating_point.equilibrium;
     // Mode shapes in the model's coordinates (δq = N z with constraints).
     let shapes_q = modal.mode_shape_matrix();
     let multipliers: serde_json::Map<String, serde_json::Value> = model
@@ -123,36 +108,102 @@ pub fn run(args: &ModesArgs) -> Result<(), CliError> {
     }
     let mut stdout = std::io::stdout().lock();
     if args.json {
-        let mut point = point_json(label, &names, &equilibrium.q);
-        point["newton_iterations"] = json!(equilibrium.iterations);
-        point["residual"] = json!(equilibrium.residual);
-        let out = json!({
-            "model": model.name(),
-            "coordinates": names,
-            "operating_point": point,
-            "natural_frequencies": modes.natural_frequencies,
-            "frequencies_hz": modes.natural_frequencies.iter().map(|w| w / std::f64::consts::TAU).collect::<Vec<_>>(),
-            "eigenvalues": modes.eigenvalues,
-            "kinds": modes.kinds,
-            "damping_ratios": damping_ratios,
-            "damped_modes": damped.iter().map(|d| json!({"re": d.eigenvalue.re, "im": d.eigenvalue.im, "damping_ratio": d.damping_ratio, "damped_frequency": d.damped_frequency})).collect::<Vec<_>>(),
-            "mode_shapes": shapes,
-            "minimal_coordinates": minimal,
-            "lagrange_multipliers": multipliers,
-            "mass_matrix": matrix_rows(&lin.mass_matrix),
-            "stiffness_matrix": matrix_rows(&lin.stiffness_matrix),
-            "damping_matrix": matrix_rows(&lin.damping_matrix),
-            "stiffness_asymmetry": modes.stiffness_asymmetry,
-            "m_inv_k_eigenvalues": route22,
-            "m_inv_k_relative_difference": route_difference,
-            "charts": charts,
-            "animation": args.animate,
-        });
-        let text =
-            serde_json::to_string_pretty(&out).map_err(|e| CliError::failure(e.to_string()))?;
-        let _ = writeln!(stdout, "{text}");
-        return Ok(());
+        print_json(
+            &mut stdout,
+            model.as_ref(),
+            &modal,
+            &multipliers,
+            &charts,
+            args,
+        )
+    } else {
+        print_text(
+            &mut stdout,
+            model.as_ref(),
+            &modal,
+            &multipliers,
+            &charts,
+            args,
+        );
+        Ok(())
     }
+}
+
+/// The JSON of `modes` (see docs/cli.md).
+fn print_json(
+    stdout: &mut impl std::io::Write,
+    model: &dyn ModelInfo,
+    modal: &ModalAnalysis,
+    multipliers: &serde_json::Map<String, serde_json::Value>,
+    charts: &[String],
+    args: &ModesArgs,
+) -> Result<(), CliError> {
+    let ModalAnalysis {
+        operating_point: point,
+        linearization: lin,
+        normal_modes: modes,
+        mode_shapes: shapes,
+        minimal_coordinates: minimal,
+        damped_modes: damped,
+        damping_ratios,
+        m_inv_k_eigenvalues: route22,
+        m_inv_k_relative_difference: route_difference,
+    } = modal;
+    let (label, equilibrium) = (&point.name, &point.equilibrium);
+    let names = model.coordinate_names();
+    let mut point = point_json(label, &names, &equilibrium.q);
+    point["newton_iterations"] = json!(equilibrium.iterations);
+    point["residual"] = json!(equilibrium.residual);
+    let out = json!({
+        "model": model.name(),
+        "coordinates": names,
+        "operating_point": point,
+        "natural_frequencies": modes.natural_frequencies,
+        "frequencies_hz": modes.natural_frequencies.iter().map(|w| w / std::f64::consts::TAU).collect::<Vec<_>>(),
+        "eigenvalues": modes.eigenvalues,
+        "kinds": modes.kinds,
+        "damping_ratios": damping_ratios,
+        "damped_modes": damped.iter().map(|d| json!({"re": d.eigenvalue.re, "im": d.eigenvalue.im, "damping_ratio": d.damping_ratio, "damped_frequency": d.damped_frequency})).collect::<Vec<_>>(),
+        "mode_shapes": shapes,
+        "minimal_coordinates": minimal,
+        "lagrange_multipliers": multipliers,
+        "mass_matrix": matrix_rows(&lin.mass_matrix),
+        "stiffness_matrix": matrix_rows(&lin.stiffness_matrix),
+        "damping_matrix": matrix_rows(&lin.damping_matrix),
+        "stiffness_asymmetry": modes.stiffness_asymmetry,
+        "m_inv_k_eigenvalues": route22,
+        "m_inv_k_relative_difference": route_difference,
+        "charts": charts,
+        "animation": args.animate,
+    });
+    let text = serde_json::to_string_pretty(&out).map_err(|e| CliError::failure(e.to_string()))?;
+    let _ = writeln!(stdout, "{text}");
+    Ok(())
+}
+
+/// The text of `modes`: the equilibrium, M, K, C, the modes, the check, the files written.
+fn print_text(
+    stdout: &mut impl std::io::Write,
+    model: &dyn ModelInfo,
+    modal: &ModalAnalysis,
+    multipliers: &serde_json::Map<String, serde_json::Value>,
+    charts: &[String],
+    args: &ModesArgs,
+) {
+    let ModalAnalysis {
+        operating_point: point,
+        linearization: lin,
+        normal_modes: modes,
+        mode_shapes: shapes,
+        minimal_coordinates: minimal,
+        damping_ratios,
+        m_inv_k_relative_difference: route_difference,
+        ..
+    } = modal;
+    let (label, equilibrium) = (&point.name, &point.equilibrium);
+    let names = model.coordinate_names();
+    let n = model.num_dofs();
+    let undamped = modal.is_undamped();
     let _ = writeln!(stdout, "model      {} ({} dof)", model.name(), n);
     let point: Vec<String> = names
         .iter()
@@ -178,10 +229,10 @@ pub fn run(args: &ModesArgs) -> Result<(), CliError> {
             minimal.join(", ")
         );
     }
-    print_matrix(&mut stdout, "M", &lin.mass_matrix);
-    print_matrix(&mut stdout, "K", &lin.stiffness_matrix);
+    print_matrix(stdout, "M", &lin.mass_matrix);
+    print_matrix(stdout, "K", &lin.stiffness_matrix);
     if !undamped {
-        print_matrix(&mut stdout, "C", &lin.damping_matrix);
+        print_matrix(stdout, "C", &lin.damping_matrix);
     }
     if modes.stiffness_asymmetry > 1e-12 {
         let _ = writeln!(
@@ -233,13 +284,12 @@ pub fn run(args: &ModesArgs) -> Result<(), CliError> {
         "check      eigenvalues of M⁻¹K (lecture 22) vs the symmetric Cholesky route (lecture 24): max difference {route_difference:.1e} of max |ω²|",
         route_difference = num(route_difference)
     );
-    for path in &charts {
+    for path in charts {
         let _ = writeln!(stdout, "chart      {path}");
     }
     if let Some(path) = &args.animate {
         let _ = writeln!(stdout, "animation  {path}");
     }
-    Ok(())
 }
 
 /// `m` as a list of rows, for JSON.
