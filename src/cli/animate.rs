@@ -15,6 +15,7 @@
 use std::fmt::Write as _;
 
 use clap::Args;
+use eomgen::analysis::energy_drift_at;
 use eomgen::{ModeKind, ModelInfo, NormalModes, OutputTimes};
 use nalgebra::DMatrix;
 use plotters::prelude::*;
@@ -344,9 +345,8 @@ pub(crate) fn simulation(
         .any(|(t, y)| model.point_positions(t, y).iter().any(|p| p[2] != 0.0));
     let mut t = Vec::with_capacity(samples / sub + 1);
     let mut frames = Vec::with_capacity(samples / sub + 1);
-    let mut energy = Vec::with_capacity(samples / sub + 1);
+    let mut frame_states = Vec::with_capacity(samples / sub + 1);
     let mut trail = vec![Vec::with_capacity(samples); scene.traces.len()];
-    let mut scale = model.kinetic_energy(0.0, &y0) + model.potential_energy(0.0, &y0).abs();
     for (j, (tk, y)) in solution.iter().take(samples).enumerate() {
         let frame = scene.project(&model.point_positions(tk, y));
         for (path, &p) in trail.iter_mut().zip(&scene.traces) {
@@ -357,22 +357,13 @@ pub(crate) fn simulation(
         }
         t.push(tk);
         frames.push(frame);
-        let (kinetic, potential) = (model.kinetic_energy(tk, y), model.potential_energy(tk, y));
-        energy.push(kinetic + potential);
-        scale = scale.max(kinetic + potential.abs());
+        frame_states.push((tk, y));
     }
-    let e0 = model.energy(0.0, &y0);
-    let drift: Vec<f64> = energy
-        .iter()
-        .map(|e| {
-            if scale > 0.0 {
-                (e - e0) / scale
-            } else {
-                e - e0
-            }
-        })
-        .collect();
-    let max_drift = drift.iter().fold(0.0f64, |m, d| m.max(d.abs()));
+    // The energy and its drift over the frames.
+    let energy_drift = energy_drift_at(model, &y0, frame_states.into_iter());
+    let drift = energy_drift.relative();
+    let max_drift = energy_drift.drift.unwrap_or(0.0);
+    let (e0, energy) = (energy_drift.initial_energy, energy_drift.energy);
     let method = format!("{method_name} ({})", args.step_control());
     let conserved = if model.is_conservative() {
         ""

@@ -17,7 +17,7 @@ pub use constraint_methods::{
     ConstraintMethodRow, ConstraintMethods, ConstraintMethodsError, ConstraintMethodsOptions,
     constraint_methods,
 };
-pub use drift::{ConstraintDrift, EnergyDrift, constraint_drift, energy_drift};
+pub use drift::{ConstraintDrift, EnergyDrift, constraint_drift, energy_drift, energy_drift_at};
 pub use methods::{Method, UnknownMethod};
 pub use roundoff::{EulerRoundoff, RoundoffError, RoundoffOptions, euler_roundoff};
 pub use simulation::{
