@@ -186,7 +186,8 @@ mod tests {
         assert_eq!(format!("[{:>10.3e}]", num(-2.5)), "[    -2.500]");
         assert_eq!(format!("[{:<9.1e}]", num(2.5e-7)), "[2.5e-7   ]");
         assert_eq!(format!("{:+.2e}", num(0.25)), "+0.250");
-        assert_eq!(format!("{:e}", num(&2.0)), "2");
+        let two = [2.0];
+        assert_eq!(format!("{:e}", num(two.first().unwrap())), "2");
         for v in [1.0, 3.7, -8.25, 0.0, 42.0, 0.001, 9999.0] {
             for p in 0..8 {
                 let s = number(v, Some(p));
