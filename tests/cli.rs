@@ -659,3 +659,41 @@ fn a_file_from_new_simulates_and_an_unknown_name_says_a_path_works() {
     assert!(stderr.contains("a path to a model file"), "{stderr}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `modes --plot PREFIX` prints its chart paths after the results (the last lines).
+#[test]
+fn modes_prints_its_chart_paths_after_the_results() {
+    let dir = std::env::temp_dir().join(format!("eomgen-modes-order-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let prefix = dir.join("shape");
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_eomgen"))
+        .args([
+            "modes",
+            "double_pendulum",
+            "--plot",
+            prefix.to_str().unwrap(),
+        ])
+        .output()
+        .expect("binary runs");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8_lossy(&out.stdout);
+    let lines: Vec<&str> = text.lines().collect();
+    let first_chart = lines
+        .iter()
+        .position(|l| l.starts_with("chart"))
+        .expect("charts");
+    assert!(
+        first_chart > 0 && lines[first_chart - 1].starts_with("check"),
+        "{text}"
+    );
+    assert!(
+        lines[first_chart..].iter().all(|l| l.starts_with("chart")),
+        "{text}"
+    );
+    assert_eq!(lines.len() - first_chart, 2, "one chart per mode: {text}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
