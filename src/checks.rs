@@ -13,8 +13,11 @@ use serde::Serialize;
 
 use crate::ModelSource;
 use crate::analysis::{Method, SimulationOptions, simulate};
-use crate::expressions::parameter_lookup;
-use eomgen_runtime::analysis::{constraint_drift, energy_drift};
+use crate::expressions::{evaluate, parameter_lookup, split_assignment};
+use eomgen_runtime::analysis::{EnergyDrift, constraint_drift, energy_drift};
+use eomgen_runtime::vibration::{
+    EquilibriumStart, ModalAnalysis, ModalOptions, OperatingPointOptions, modal_analysis,
+};
 use eomgen_runtime::{Linearization, ModelInfo, OutputTimes, Solution, damped_modes};
 use eomgen_symbolic::mechanics::check::check_model;
 use eomgen_symbolic::model::parser::eval_expr;
@@ -566,4 +569,199 @@ pub fn motion_checks(
         ));
     }
     checks
+}
+
+/// The default run of a model's checks, with what a report draws of it.
+#[derive(Debug, Clone)]
+pub struct DefaultRun {
+    /// Its settings ([`CheckRun::default`]).
+    pub run: CheckRun,
+    /// The solution, sampled at [`SAMPLES`] uniform times.
+    pub solution: Solution,
+    /// `E(t) = T + V` at every sample and `E(0)`.
+    pub energy: EnergyDrift,
+    /// `(max |Φ|, max |Φ̇|)` at every sample, for a constrained model (`None` without
+    /// constraints).
+    pub constraint_drift: Option<Vec<(f64, f64)>>,
+}
+
+/// Everything [`model_report`] found for one model: the rows of its pass/fail table and the
+/// data of its figures.
+#[derive(Debug, Clone)]
+pub struct ModelChecks {
+    /// The rows: the derivation cross-checks, then energy and constraint drift and the
+    /// file's `checks:` ([`derivation_checks`], [`motion_checks`]).
+    pub rows: Vec<CheckRow>,
+    /// The notes of the derivation cross-checks.
+    pub notes: Vec<String>,
+    /// The default run, or why it failed; `None` when the model has no consistent initial
+    /// state (a failed row says why).
+    pub default_run: Option<Result<DefaultRun, String>>,
+    /// The modal analysis at the equilibrium of the `natural_frequencies:` check (the first
+    /// named one without), or why it failed; `None` unless the model names equilibria and has
+    /// points to draw the mode shapes on.
+    pub mode_shapes: Option<Result<ModalAnalysis, String>>,
+    /// Wall time of the checks (s).
+    pub time_s: f64,
+}
+
+impl ModelChecks {
+    /// Whether every check passed.
+    pub fn passed(&self) -> bool {
+        self.rows.iter().all(|c| c.passed)
+    }
+}
+
+/// The diagnostics of a model file as one text: how many, then each with its source line
+/// (as the CLI prints them).
+pub fn diagnostics_text(path: &str, source: &str, diagnostics: &[Diagnostic]) -> String {
+    let text: Vec<String> = diagnostics.iter().map(|d| d.render(path, source)).collect();
+    format!(
+        "{} error(s) in the model file `{path}`\n{}",
+        diagnostics.len(),
+        text.join("\n")
+    )
+}
+
+/// The start of the equilibrium search that a check's `at:` names: a name of the file's
+/// `equilibria:`, or guesses `q1=VALUE,…` (expressions of the parameters; others 0);
+/// without `at:`, the first named equilibrium.
+fn check_start(model: &dyn ModelInfo, at: Option<&str>) -> Result<EquilibriumStart, String> {
+    let Some(at) = at else {
+        return Ok(EquilibriumStart::FirstNamed);
+    };
+    if !at.contains('=') || model.equilibrium_guesses().iter().any(|(n, _)| *n == at) {
+        return Ok(EquilibriumStart::Named(at.to_string()));
+    }
+    let lookup = parameter_lookup(model);
+    let mut q = vec![0.0; model.num_dofs()];
+    for part in at.split(',') {
+        let (name, text) = split_assignment(part, "at").map_err(|e| e.to_string())?;
+        let index = model
+            .coordinate_names()
+            .iter()
+            .position(|c| *c == name)
+            .ok_or_else(|| format!("at: `{name}` is not a coordinate of `{}`", model.name()))?;
+        q[index] = evaluate(text, &format!("at {name}"), &lookup).map_err(|e| e.to_string())?;
+    }
+    Ok(EquilibriumStart::Guess {
+        label: at.to_string(),
+        q,
+    })
+}
+
+/// Runs every check of one model (`eomgen report`'s section of it): the derivation
+/// cross-checks of the file at `path` (whose text is `text`, for the diagnostics), then, from
+/// the consistent initial state of `source`'s equations, the default run, energy and
+/// constraint drift and the reference values of the file's `checks:`; the operating points of
+/// the modal checks are found once each (Newton from the named equilibrium, at the
+/// parameters' defaults). The mode shapes' analysis is returned for models that name
+/// equilibria and have points.
+///
+/// Nothing fails: a check that cannot be computed is a failed row with its reason.
+///
+/// # Examples
+/// ```
+/// let path = concat!(env!("CARGO_MANIFEST_DIR"), "/models/simple_pendulum.yaml");
+/// let text = std::fs::read_to_string(path).unwrap();
+/// let file = eomgen_symbolic::model::load(path, &text).unwrap();
+/// let source = eomgen::ModelSource::open("simple_pendulum")?;
+/// let checks = eomgen::checks::model_report(path, &text, &file, &source);
+/// assert!(checks.passed(), "{:?}", checks.rows);
+/// let frequency = checks.rows.iter().find(|r| r.check.starts_with("natural_frequencies")).unwrap();
+/// assert!((frequency.computed.unwrap() - 10f64.sqrt()).abs() < 1e-12);
+/// # Ok::<(), eomgen::OpenError>(())
+/// ```
+pub fn model_report(path: &str, text: &str, file: &ModelFile, source: &ModelSource) -> ModelChecks {
+    let started = std::time::Instant::now();
+    let mut out = ModelChecks {
+        rows: Vec::new(),
+        notes: Vec::new(),
+        default_run: None,
+        mode_shapes: None,
+        time_s: 0.0,
+    };
+    match derivation_checks(file) {
+        Ok((rows, notes)) => {
+            out.rows.extend(rows);
+            out.notes.extend(notes);
+        }
+        Err(d) => out.rows.push(CheckRow::compare(
+            "derivations agree",
+            Err(diagnostics_text(path, text, &d)),
+            0.0,
+            DERIVATION_TOLERANCE,
+        )),
+    }
+    let mut model = source.instantiate();
+    let y0 = match model.consistent_initial_state() {
+        Ok(y0) => y0,
+        Err(e) => {
+            out.rows.push(CheckRow::compare(
+                "consistent initial state",
+                Err(format!(
+                    "constraint {} keeps a residual of {:.3e}",
+                    e.constraint, e.residual
+                )),
+                0.0,
+                0.0,
+            ));
+            out.time_s = started.elapsed().as_secs_f64();
+            return out;
+        }
+    };
+    let mut simulations = Simulations::new(source.clone());
+    let run = CheckRun::default();
+    out.default_run = Some(simulations.get(run).map(|solution| {
+        DefaultRun {
+            run,
+            solution: solution.clone(),
+            energy: energy_drift(model.as_ref(), &y0, solution),
+            constraint_drift: (!model.constraint_names().is_empty())
+                .then(|| constraint_drift(model.as_mut(), solution).drift),
+        }
+    }));
+    // The operating points, each found once (the modal checks and the mode shapes share them).
+    let mut points: Vec<(Option<String>, Result<ModalAnalysis, String>)> = Vec::new();
+    let mut analysis = |at: Option<&str>| -> Result<ModalAnalysis, String> {
+        if let Some((_, done)) = points.iter().find(|(a, _)| a.as_deref() == at) {
+            return done.clone();
+        }
+        // A fresh instance at the parameters' defaults.
+        let model = source.instantiate();
+        let result = check_start(model.as_ref(), at).and_then(|start| {
+            let options = ModalOptions {
+                operating_point: OperatingPointOptions {
+                    start,
+                    ..OperatingPointOptions::default()
+                },
+            };
+            modal_analysis(model.as_ref(), &options).map_err(|e| format!("`{}`: {e}", model.name()))
+        });
+        points.push((at.map(str::to_string), result.clone()));
+        result
+    };
+    out.rows.extend(motion_checks(
+        file,
+        model.as_mut(),
+        &y0,
+        &mut simulations,
+        &mut |at| {
+            analysis(at).map(|m| ModesAt {
+                label: m.operating_point.name.clone(),
+                natural_frequencies: m.normal_modes.natural_frequencies.clone(),
+                linearization: m.linearization.clone(),
+            })
+        },
+    ));
+    if !model.equilibrium_guesses().is_empty() && !model.point_names().is_empty() {
+        let at = file
+            .checks
+            .natural_frequencies
+            .as_ref()
+            .and_then(|check| check.at.as_ref().map(|a| a.value.clone()));
+        out.mode_shapes = Some(analysis(at.as_deref()));
+    }
+    out.time_s = started.elapsed().as_secs_f64();
+    out
 }

@@ -211,8 +211,40 @@ pub fn set_parameters(
     Ok(())
 }
 
+/// The items of a comma list of assignments, `q=0.1,q_dot=atan2(1, 2)` → `["q=0.1",
+/// "q_dot=atan2(1, 2)"]`: split at the commas outside parentheses (a function's arguments stay
+/// together), each item trimmed; empty items are dropped.
+///
+/// # Examples
+/// ```
+/// let items = eomgen::expressions::split_list("q=0.1, q_dot=atan2(1, 2)");
+/// assert_eq!(items, ["q=0.1", "q_dot=atan2(1, 2)"]);
+/// ```
+pub fn split_list(list: &str) -> Vec<&str> {
+    let mut items = Vec::new();
+    let (mut depth, mut start) = (0usize, 0);
+    for (i, c) in list.char_indices() {
+        match c {
+            '(' => depth += 1,
+            ')' => depth = depth.saturating_sub(1),
+            ',' if depth == 0 => {
+                items.push(&list[start..i]);
+                start = i + 1;
+            }
+            _ => {}
+        }
+    }
+    items.push(&list[start..]);
+    items
+        .into_iter()
+        .map(str::trim)
+        .filter(|s| !s.is_empty())
+        .collect()
+}
+
 /// Applies `NAME=VALUE` initial values (`theta1=pi/2`, `theta1_dot=0`; values may use the
-/// parameters) to the state `y = [q; q̇]` of `model`, as `--init` does.
+/// parameters) to the state `y = [q; q̇]` of `model`, as `--init` does. Each item may be a
+/// comma list, `q=0.1,q_dot=0` (split by [`split_list`]), as `--at` takes.
 ///
 /// # Shapes
 /// `y` has `2n` entries, `n = model.num_dofs()`.
@@ -227,6 +259,8 @@ pub fn set_parameters(
 /// let mut y = model.initial_state();
 /// eomgen::expressions::set_initial_values(model.as_ref(), &mut y, &["q=pi/6", "q_dot=1"]).unwrap();
 /// assert_eq!(y, [std::f64::consts::PI / 6.0, 1.0]);
+/// eomgen::expressions::set_initial_values(model.as_ref(), &mut y, &["q=atan2(1, 1),q_dot=0"]).unwrap();
+/// assert_eq!(y, [std::f64::consts::PI / 4.0, 0.0]);
 /// ```
 pub fn set_initial_values(
     model: &dyn ModelInfo,
@@ -235,8 +269,8 @@ pub fn set_initial_values(
 ) -> Result<(), ExpressionError> {
     let n = model.num_dofs();
     let coordinates = model.coordinate_names();
-    for s in assignments {
-        let (name, text) = split_assignment(s.as_ref(), "--init")?;
+    for s in assignments.iter().flat_map(|s| split_list(s.as_ref())) {
+        let (name, text) = split_assignment(s, "--init")?;
         let value = evaluate(text, &format!("--init {name}"), &parameter_lookup(model))?;
         let index = coordinates
             .iter()

@@ -84,6 +84,53 @@ fn init_and_set_accept_expressions() {
     assert_eq!(v["parameters"]["g"], 10.0);
 }
 
+/// `--init` takes a comma list as `--at` does (a function's arguments stay together), in
+/// `simulate` and in the studies: the same run as the repeated option, to the bit.
+#[test]
+fn init_takes_a_comma_list() {
+    let run = |init: &[&str]| {
+        let mut args = vec!["simulate", "simple_pendulum", "--t-end", "0.5", "--json"];
+        for i in init {
+            args.extend(["--init", i]);
+        }
+        let out = eomgen(&args);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        v["samples"].clone()
+    };
+    let listed = run(&["q=atan2(1, 2),q_dot=0.25"]);
+    assert_eq!(listed[0]["q"][0].as_f64(), Some(0.5f64.atan()));
+    assert_eq!(listed[0]["qdot"][0].as_f64(), Some(0.25));
+    assert_eq!(listed, run(&["q=atan2(1, 2)", "q_dot=0.25"]));
+    let out = eomgen(&[
+        "study",
+        "free-response",
+        "three_masses",
+        "--init",
+        "x1=0.1,x3_dot=atan2(1, 1)",
+        "--t-end",
+        "0.1",
+        "--samples",
+        "3",
+        "--json",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["initial"]["q"], serde_json::json!([0.1, 0.0, 0.0]));
+    assert_eq!(
+        v["initial"]["qdot"],
+        serde_json::json!([0.0, 0.0, std::f64::consts::FRAC_PI_4])
+    );
+}
+
 #[test]
 fn usage_errors_are_clear_and_exit_2() {
     let out = eomgen(&["simulate", "double_pendulm"]);
@@ -647,5 +694,43 @@ fn a_file_from_new_simulates_and_an_unknown_name_says_a_path_works() {
         "{stderr}"
     );
     assert!(stderr.contains("a path to a model file"), "{stderr}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// `modes --plot PREFIX` prints its chart paths after the results (the last lines).
+#[test]
+fn modes_prints_its_chart_paths_after_the_results() {
+    let dir = std::env::temp_dir().join(format!("eomgen-modes-order-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let prefix = dir.join("shape");
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_eomgen"))
+        .args([
+            "modes",
+            "double_pendulum",
+            "--plot",
+            prefix.to_str().unwrap(),
+        ])
+        .output()
+        .expect("binary runs");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8_lossy(&out.stdout);
+    let lines: Vec<&str> = text.lines().collect();
+    let first_chart = lines
+        .iter()
+        .position(|l| l.starts_with("chart"))
+        .expect("charts");
+    assert!(
+        first_chart > 0 && lines[first_chart - 1].starts_with("check"),
+        "{text}"
+    );
+    assert!(
+        lines[first_chart..].iter().all(|l| l.starts_with("chart")),
+        "{text}"
+    );
+    assert_eq!(lines.len() - first_chart, 2, "one chart per mode: {text}");
     let _ = std::fs::remove_dir_all(&dir);
 }

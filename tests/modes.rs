@@ -359,7 +359,7 @@ fn modes_cli_json_contract_and_errors() {
         "theta1=-1.4,theta2=-1.7",
     ]);
     assert!(out.status.success());
-    assert!(String::from_utf8_lossy(&out.stdout).contains("theta1 = -1.570796326795e0"));
+    assert!(String::from_utf8_lossy(&out.stdout).contains("theta1 = -1.570796326795,"));
     // A constrained model: shapes in all n coordinates, one per minimal coordinate.
     let out = eomgen(&["modes", "simple_pendulum_cartesian", "--json"]);
     assert!(out.status.success());

@@ -437,6 +437,60 @@ fn full_report_passes_on_every_model() {
     );
     assert_eq!(report["summary"]["failed"], 0);
     let _ = std::fs::remove_dir_all(&dir);
+    every_golden_row_is_present_and_passes(&report);
+}
+
+/// The report's rows stay as they are: every `(model, check)` of
+/// `tests/fixtures/report_checks.txt` (one `model<TAB>check` a line, sorted) is in the report
+/// and passes. A new bundled model or check may add rows: they are printed so that they can be
+/// added to the file (`EOMGEN_UPDATE_SCHEMAS=1` rewrites it from the report).
+fn every_golden_row_is_present_and_passes(report: &serde_json::Value) {
+    let mut rows: Vec<(String, bool)> = Vec::new();
+    for model in report["models"].as_array().expect("models") {
+        let name = model["name"].as_str().expect("name");
+        for c in model["checks"].as_array().expect("checks") {
+            let check = c["check"].as_str().expect("check");
+            rows.push((format!("{name}\t{check}"), c["passed"] == true));
+        }
+    }
+    rows.sort();
+    let file = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/fixtures/report_checks.txt"
+    );
+    if std::env::var_os("EOMGEN_UPDATE_SCHEMAS").is_some() {
+        let text: String = rows.iter().map(|(r, _)| format!("{r}\n")).collect();
+        std::fs::write(file, text).unwrap();
+        return;
+    }
+    let golden = std::fs::read_to_string(file).expect("golden rows");
+    let golden: Vec<&str> = golden.lines().filter(|l| !l.is_empty()).collect();
+    let missing: Vec<&&str> = golden
+        .iter()
+        .filter(|g| !rows.iter().any(|(r, passed)| r == **g && *passed))
+        .collect();
+    let added: Vec<&String> = rows
+        .iter()
+        .map(|(r, _)| r)
+        .filter(|r| !golden.contains(&r.as_str()))
+        .collect();
+    if !added.is_empty() {
+        println!(
+            "rows not in report_checks.txt (add them if intended):\n{}",
+            added
+                .iter()
+                .map(|r| r.as_str())
+                .collect::<Vec<_>>()
+                .join("\n")
+        );
+    }
+    assert!(
+        missing.is_empty(),
+        "{} of {} golden rows missing or failing:\n{}",
+        missing.len(),
+        golden.len(),
+        missing.iter().map(|r| **r).collect::<Vec<_>>().join("\n")
+    );
 }
 
 /// `report --models FILE` runs the file's own equations, compiled at run time, even when the

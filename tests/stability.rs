@@ -387,3 +387,39 @@ fn stability_study_runs_and_writes_its_charts() {
     assert_eq!(bad.status.code(), Some(2));
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// The stiff model's names come from the options (the library names no model): a name the
+/// model lacks is an error naming the model, the name and its role.
+#[test]
+fn the_stiff_spring_names_come_from_the_options() {
+    use eomgen::analysis::{StabilityError, StabilityOptions, StiffSpring, stability_study};
+    let mut pendulum = (eomgen::models::find("simple_pendulum").unwrap().make)();
+    let options = StabilityOptions {
+        steps: 200,
+        periods: 2,
+        stiffness: vec![1e2],
+        ..StabilityOptions::default()
+    };
+    let error = stability_study(pendulum.as_mut(), &options)
+        .err()
+        .expect("the pendulum has no m1");
+    assert!(
+        matches!(&error, StabilityError::MissingParameter { model, name, .. } if model == "simple_pendulum" && name == "m1"),
+        "{error}"
+    );
+    let mut two_masses = (eomgen::models::find("two_masses").unwrap().make)();
+    let options = StabilityOptions {
+        stiff_spring: StiffSpring {
+            stretched: "x3".to_string(),
+            ..StiffSpring::default()
+        },
+        ..options
+    };
+    let error = stability_study(two_masses.as_mut(), &options)
+        .err()
+        .expect("no x3");
+    assert_eq!(
+        error.to_string(),
+        "the stiff model `two_masses` has no coordinate `x3` (its stretched coordinate)"
+    );
+}

@@ -15,6 +15,7 @@
 use std::fmt::Write as _;
 
 use clap::Args;
+use eomgen::analysis::energy_drift_at;
 use eomgen::{ModeKind, ModelInfo, NormalModes, OutputTimes};
 use nalgebra::DMatrix;
 use plotters::prelude::*;
@@ -345,9 +346,8 @@ pub(crate) fn simulation(
         .any(|(t, y)| model.point_positions(t, y).iter().any(|p| p[2] != 0.0));
     let mut t = Vec::with_capacity(samples / sub + 1);
     let mut frames = Vec::with_capacity(samples / sub + 1);
-    let mut energy = Vec::with_capacity(samples / sub + 1);
+    let mut frame_states = Vec::with_capacity(samples / sub + 1);
     let mut trail = vec![Vec::with_capacity(samples); scene.traces.len()];
-    let mut scale = model.kinetic_energy(0.0, &y0) + model.potential_energy(0.0, &y0).abs();
     for (j, (tk, y)) in solution.iter().take(samples).enumerate() {
         let frame = scene.project(&model.point_positions(tk, y));
         for (path, &p) in trail.iter_mut().zip(&scene.traces) {
@@ -358,22 +358,13 @@ pub(crate) fn simulation(
         }
         t.push(tk);
         frames.push(frame);
-        let (kinetic, potential) = (model.kinetic_energy(tk, y), model.potential_energy(tk, y));
-        energy.push(kinetic + potential);
-        scale = scale.max(kinetic + potential.abs());
+        frame_states.push((tk, y));
     }
-    let e0 = model.energy(0.0, &y0);
-    let drift: Vec<f64> = energy
-        .iter()
-        .map(|e| {
-            if scale > 0.0 {
-                (e - e0) / scale
-            } else {
-                e - e0
-            }
-        })
-        .collect();
-    let max_drift = drift.iter().fold(0.0f64, |m, d| m.max(d.abs()));
+    // The energy and its drift over the frames.
+    let energy_drift = energy_drift_at(model, &y0, frame_states.into_iter());
+    let drift = energy_drift.relative();
+    let max_drift = energy_drift.drift.unwrap_or(0.0);
+    let (e0, energy) = (energy_drift.initial_energy, energy_drift.energy);
     let method = format!("{method_name} ({})", args.step_control());
     let conserved = if model.is_conservative() {
         ""
@@ -594,6 +585,82 @@ impl Animation {
         let view_decimals = (5 - magnitude).clamp(0, 17) as usize;
         let p = |v: f64| fixed(v, decimals);
         let v = |v: f64| fixed(v, view_decimals);
+        let data = self.data_json(&p);
+
+        let step = grid_step(span);
+        let svg = self.scene_svg((x0, x1, y0, y1), &p, &v);
+
+        let choice = if self.clips.len() > 1 || self.clips[0].period.is_some() {
+            let options: Vec<String> = self
+                .clips
+                .iter()
+                .enumerate()
+                .map(|(i, c)| format!("<option value=\"{i}\">{}</option>", escape(&c.label)))
+                .collect();
+            format!(
+                "<select id=\"clip\" aria-label=\"mode\">{}</select>",
+                options.join("")
+            )
+        } else {
+            String::new()
+        };
+        let speeds = [0.25, 0.5, 1.0, 2.0, 4.0]
+            .iter()
+            .map(|s| {
+                let selected = if *s == 1.0 { " selected" } else { "" };
+                format!("<option value=\"{s}\"{selected}>{s}×</option>")
+            })
+            .collect::<Vec<_>>()
+            .join("");
+        let last_frame = self.clips[0].t.len() - 1;
+        let view = if scene.three_d {
+            "isometric view: across (x − y) cos 30°, up z + (x + y) sin 30°; "
+        } else {
+            ""
+        };
+        format!(
+            r#"<!DOCTYPE html>
+<html lang="en">
+<head>
+<meta charset="utf-8">
+<meta name="viewport" content="width=device-width, initial-scale=1">
+<title>{title}</title>
+<script>
+{HOOKS}</script>
+<style>
+{STYLE}</style>
+</head>
+<body>
+<h1>{title}</h1>
+<p id="info">{info}</p>
+{svg}
+<div class="controls">
+{choice}
+<button id="play" type="button" title="play or pause (space)">Pause</button>
+<label>speed <select id="speed">{speeds}</select></label>
+<input id="scrub" type="range" min="0" max="{last_frame}" step="1" value="0" aria-label="frame">
+</div>
+<div class="readout"><span id="time" data-t="0">t = 0 s</span><span id="energy"></span><span id="drift"></span><span id="frame" data-frame="0">frame 1 / {frames}</span><span class="hint">{view}grid {grid} m · space: play/pause · ←/→: step</span></div>
+<pre id="errors"></pre>
+<script>
+const DATA = {data};
+</script>
+<script>
+{PLAYER}</script>
+</body>
+</html>
+"#,
+            title = escape(&scene.title),
+            info = escape(&self.clips[0].info),
+            frames = last_frame + 1,
+            grid = short(step),
+        )
+    }
+
+    /// The data of the player, a JS object literal: the scene (names, lines, dots, traces,
+    /// centres) and every clip's times and frames; positions through `p`.
+    fn data_json(&self, p: &dyn Fn(f64) -> String) -> String {
+        let scene = &self.scene;
         let mut data = String::new();
         let names: Vec<String> = scene.names.iter().map(|n| json_string(n)).collect();
         let pairs = |list: &[usize]| {
@@ -678,7 +745,19 @@ impl Animation {
             data.push('}');
         }
         data.push_str("]}");
+        data
+    }
 
+    /// The picture: the grid over the box `(x0, x1, y0, y1)` and the mechanism at the first
+    /// frame, positions through `p`, view-box sizes through `v`.
+    fn scene_svg(
+        &self,
+        (x0, x1, y0, y1): (f64, f64, f64, f64),
+        p: &dyn Fn(f64) -> String,
+        v: &dyn Fn(f64) -> String,
+    ) -> String {
+        let scene = &self.scene;
+        let span = (x1 - x0).max(y1 - y0);
         // The picture: y up (a flipped group), the view box of the whole run.
         let mut svg = String::new();
         let _ = write!(
@@ -759,72 +838,7 @@ impl Animation {
             );
         }
         svg.push_str("\n</g>\n</svg>");
-
-        let choice = if self.clips.len() > 1 || self.clips[0].period.is_some() {
-            let options: Vec<String> = self
-                .clips
-                .iter()
-                .enumerate()
-                .map(|(i, c)| format!("<option value=\"{i}\">{}</option>", escape(&c.label)))
-                .collect();
-            format!(
-                "<select id=\"clip\" aria-label=\"mode\">{}</select>",
-                options.join("")
-            )
-        } else {
-            String::new()
-        };
-        let speeds = [0.25, 0.5, 1.0, 2.0, 4.0]
-            .iter()
-            .map(|s| {
-                let selected = if *s == 1.0 { " selected" } else { "" };
-                format!("<option value=\"{s}\"{selected}>{s}×</option>")
-            })
-            .collect::<Vec<_>>()
-            .join("");
-        let last_frame = self.clips[0].t.len() - 1;
-        let view = if scene.three_d {
-            "isometric view: across (x − y) cos 30°, up z + (x + y) sin 30°; "
-        } else {
-            ""
-        };
-        format!(
-            r#"<!DOCTYPE html>
-<html lang="en">
-<head>
-<meta charset="utf-8">
-<meta name="viewport" content="width=device-width, initial-scale=1">
-<title>{title}</title>
-<script>
-{HOOKS}</script>
-<style>
-{STYLE}</style>
-</head>
-<body>
-<h1>{title}</h1>
-<p id="info">{info}</p>
-{svg}
-<div class="controls">
-{choice}
-<button id="play" type="button" title="play or pause (space)">Pause</button>
-<label>speed <select id="speed">{speeds}</select></label>
-<input id="scrub" type="range" min="0" max="{last_frame}" step="1" value="0" aria-label="frame">
-</div>
-<div class="readout"><span id="time" data-t="0">t = 0 s</span><span id="energy"></span><span id="drift"></span><span id="frame" data-frame="0">frame 1 / {frames}</span><span class="hint">{view}grid {grid} m · space: play/pause · ←/→: step</span></div>
-<pre id="errors"></pre>
-<script>
-const DATA = {data};
-</script>
-<script>
-{PLAYER}</script>
-</body>
-</html>
-"#,
-            title = escape(&scene.title),
-            info = escape(&self.clips[0].info),
-            frames = last_frame + 1,
-            grid = short(step),
-        )
+        svg
     }
 
     /// Writes clip `clip` as an animated GIF: the same picture (equal scales, the whole run's

@@ -5,6 +5,7 @@ use serde_json::json;
 
 use super::CliError;
 use super::output::outln;
+use super::render::num;
 use eomgen_symbolic::mechanics::check::{CheckReport, INITIAL_CONSTRAINT_TOLERANCE, check_model};
 
 /// Relative tolerance of every check: the derivations differ only by rounding (~1e-14).
@@ -48,7 +49,8 @@ pub fn run(args: &CheckArgs) -> Result<(), CliError> {
     } else {
         Err(CliError::failure(format!(
             "`{}` failed a check (tolerance {TOLERANCE:e})",
-            report.model
+            report.model,
+            TOLERANCE = num(TOLERANCE)
         )))
     }
 }
@@ -89,7 +91,7 @@ fn print_report(r: &CheckReport) {
             mark(c.max_rel_residual <= TOLERANCE),
             c.a,
             c.b,
-            c.max_rel_residual,
+            num(c.max_rel_residual),
             c.states,
             match c.symbolic_equal {
                 Some(true) => "yes",
@@ -102,7 +104,7 @@ fn print_report(r: &CheckReport) {
         outln!(
             "{} power balance dE/dt = Q·q': max relative residual {:.2e}",
             mark(p.max_rel_residual <= TOLERANCE),
-            p.max_rel_residual
+            num(p.max_rel_residual)
         );
     }
     if let Some(c) = &r.initial_constraints {

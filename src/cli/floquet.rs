@@ -25,6 +25,7 @@ use serde_json::{Value, json};
 use super::CliError;
 use super::modes::{OperatingPointArgs, point_json};
 use super::plot::{register_font, tick};
+use super::render::num;
 use super::values::{evaluate, parameter_lookup, set_parameters, split_assignment};
 
 /// Options of `eomgen study floquet`.
@@ -232,7 +233,7 @@ fn print_report(stdout: &mut impl std::io::Write, report: &Report<'_>) {
     let q: Vec<String> = names
         .iter()
         .zip(&point.q)
-        .map(|(c, v)| format!("{c} = {v:.12e}"))
+        .map(|(c, v)| format!("{c} = {v:.12e}", v = num(v)))
         .collect();
     let _ = writeln!(
         stdout,
@@ -244,16 +245,16 @@ fn print_report(stdout: &mut impl std::io::Write, report: &Report<'_>) {
         stdout,
         "equilibrium  {label}: {} (for all t: max |F(q, 0, t)| = {:.1e})",
         q.join(", "),
-        point.residual
+        num(point.residual)
     );
     let _ = writeln!(
         stdout,
         "period       T = 2π/{} = {:.12e} s ({} = {} rad/s); DOP853 at tol {:e}: {} steps, {} RHS evaluations",
         args.period_parameter,
-        f.period,
+        num(f.period),
         args.period_parameter,
         point.frequency,
-        args.tol,
+        num(args.tol),
         f.stats.steps,
         f.stats.rhs_evals
     );
@@ -267,20 +268,20 @@ fn print_report(stdout: &mut impl std::io::Write, report: &Report<'_>) {
             stdout,
             "{:>3}  {:>22.14e}  {:>22.14e}  {:>16.10e}  {:>16.8e}  {:>16.8e}",
             k + 1,
-            m.re,
-            m.im,
-            m.norm(),
-            e.re,
-            e.im
+            num(m.re),
+            num(m.im),
+            num(m.norm()),
+            num(e.re),
+            num(e.im)
         );
     }
     let _ = writeln!(
         stdout,
         "result       spectral radius ρ = {:.12e}, det Φ(T) = {:.12e}: {} (tolerance {:e} on |μ| = 1)",
-        f.spectral_radius,
-        f.determinant,
+        num(f.spectral_radius),
+        num(f.determinant),
         f.stability.as_str().replace('_', " "),
-        args.stability_tolerance
+        num(args.stability_tolerance)
     );
     for t in thresholds {
         let _ = writeln!(
@@ -288,9 +289,9 @@ fn print_report(stdout: &mut impl std::io::Write, report: &Report<'_>) {
             "{:<12} {} = {:.6e} against {} = {:.6e}: {} predicts {label} {} ({})",
             t.name,
             t.label,
-            t.value,
+            num(t.value),
             t.critical_label,
-            t.critical,
+            num(t.critical),
             t.by,
             if t.predicts_stable {
                 "stable"
@@ -321,13 +322,12 @@ fn run_sweep(
 ) -> Result<Vec<Vec<Cell>>, CliError> {
     let source = super::open_model(&args.model)?;
     let total = x.values.len() * y.values.len();
-    let bar = indicatif::ProgressBar::new(total as u64);
-    if let Ok(style) = indicatif::ProgressStyle::with_template(
+    let bar = super::render::progress_bar(
+        total,
         "{msg} [{bar:40}] {pos}/{len} analyses, {elapsed} (eta {eta})",
-    ) {
-        bar.set_style(style.progress_chars("=> "));
-    }
-    bar.set_message("floquet");
+        "floquet",
+        false,
+    );
     let flat: Vec<Cell> = (0..total)
         .into_par_iter()
         .map(|k| {
@@ -428,15 +428,15 @@ fn print_map(out: &mut impl std::io::Write, x: &Axis, y: &Axis, grid: &[Vec<Cell
                 Err(_) => '?',
             })
             .collect();
-        let _ = writeln!(out, "{:>12.4e} {row}", y.values[j]);
+        let _ = writeln!(out, "{:>12.4e} {row}", num(y.values[j]));
     }
     let _ = writeln!(
         out,
         "{:>12} {} = {:.4e} … {:.4e}",
         "",
         x.name,
-        x.values.first().copied().unwrap_or(f64::NAN),
-        x.values.last().copied().unwrap_or(f64::NAN)
+        num(x.values.first().copied().unwrap_or(f64::NAN)),
+        num(x.values.last().copied().unwrap_or(f64::NAN))
     );
 }
 

@@ -7,8 +7,6 @@
 //! the pieces `study modal-damping` shares: `--init` parsing, the errors in the options' words
 //! and the stacked charts.
 
-use std::io::Write as _;
-
 use clap::Args;
 use eomgen::vibration::{
     self, FreeResponseMethod, FreeResponseOptions, FreeResponseStudy, InitialDeviation,
@@ -21,7 +19,8 @@ use serde_json::json;
 use super::CliError;
 use super::modes::{OperatingPointArgs, point_json};
 use super::plot::{self, Series};
-use super::values::{evaluate, parameter_lookup, split_assignment};
+use super::render::num;
+use eomgen::expressions::set_initial_values;
 
 /// Options of `eomgen study free-response`.
 #[derive(Debug, Args)]
@@ -53,8 +52,8 @@ pub struct FreeResponseArgs {
     pub plot: Option<String>,
 }
 
-/// Parses `--init NAME=VALUE,…` into `(δq₀, δq̇₀)`, starting from zeros (`None` without
-/// `--init`: the study's default).
+/// Parses `--init NAME=VALUE,…` (repeatable, as `simulate --init`) into `(δq₀, δq̇₀)`,
+/// starting from zeros (`None` without `--init`: the study's default).
 pub(super) fn parse_init(
     model: &dyn ModelInfo,
     init: &[String],
@@ -62,30 +61,12 @@ pub(super) fn parse_init(
     if init.is_empty() {
         return Ok(None);
     }
+    // The deviation from rest, as `--init` sets a state: [δq₀; δq̇₀] from zeros.
     let n = model.num_dofs();
-    let coordinates = model.coordinate_names();
-    let lookup = parameter_lookup(model);
-    let (mut q0, mut v0) = (vec![0.0; n], vec![0.0; n]);
-    for part in init.iter().flat_map(|s| s.split(',')) {
-        let (name, text) = split_assignment(part, "--init")?;
-        let value = evaluate(text, &format!("--init {name}"), &lookup)?;
-        if let Some(i) = coordinates.iter().position(|c| *c == name) {
-            q0[i] = value;
-        } else if let Some(i) = coordinates
-            .iter()
-            .position(|c| name.strip_suffix("_dot") == Some(c))
-        {
-            v0[i] = value;
-        } else {
-            let rates: Vec<String> = coordinates.iter().map(|c| format!("{c}_dot")).collect();
-            return Err(CliError::usage(format!(
-                "--init {name}: `{}` has no coordinate or rate `{name}` (coordinates: {}; rates: {})",
-                model.name(),
-                coordinates.join(", "),
-                rates.join(", ")
-            )));
-        }
-    }
+    let mut y = vec![0.0; 2 * n];
+    set_initial_values(model, &mut y, init).map_err(super::values::usage)?;
+    let v0 = y.split_off(n);
+    let q0 = y;
     Ok(Some(InitialDeviation { q: q0, qdot: v0 }))
 }
 
@@ -261,22 +242,9 @@ pub fn run(args: &FreeResponseArgs) -> Result<(), CliError> {
     };
     let study = vibration::free_response(model.as_ref(), &options)
         .map_err(|e| study_failure(model.as_ref(), &e))?;
-    let FreeResponseStudy {
-        operating_point: point,
-        normal_modes: modes,
-        ignored_damping,
-        initial,
-        t_end,
-        responses,
-        max_displacement: q_scale,
-        max_velocity: v_scale,
-        differences,
-        ..
-    } = &study;
-    let (label, (q0, v0)) = (&point.name, (&initial.q, &initial.qdot));
+    let (label, responses) = (&study.operating_point.name, &study.responses);
     let n = model.num_dofs();
     let names = model.coordinate_names();
-    let samples = responses[0].1.times.len();
     if let Some(path) = &args.plot {
         let panel_list: Vec<Panel> = (0..n)
             .map(|j| {
@@ -302,43 +270,91 @@ pub fn run(args: &FreeResponseArgs) -> Result<(), CliError> {
     }
     let mut stdout = super::output::stdout();
     if args.json {
-        let out = json!({
-            "model": model.name(),
-            "coordinates": names,
-            "operating_point": point_json(label, &names, &study.linearization.q),
-            "ignored_damping": ignored_damping,
-            "modes": (0..n).map(|k| json!({
-                "kind": kind_json(&modes.kinds[k]),
-                "eigenvalue": modes.eigenvalues[k],
-                "natural_frequency": modes.natural_frequencies[k],
-                "growth_rate": match modes.kinds[k] { ModeKind::Unstable { growth_rate } => Some(growth_rate), _ => None },
-            })).collect::<Vec<_>>(),
-            "initial": {"q": q0, "qdot": v0},
-            "t_end": t_end,
-            "samples": samples,
-            "tol": study.tol,
-            "methods": FreeResponseMethod::ALL.iter().map(|m| json!({"name": m.name(), "description": m.description()})).collect::<Vec<_>>(),
-            "max_displacement": q_scale,
-            "max_velocity": v_scale,
-            "max_differences": differences.iter().map(|d| json!({
-                "a": d.a.name(),
-                "b": d.b.name(),
-                "displacement": d.displacement,
-                "velocity": d.velocity,
-                "displacement_relative": d.displacement_relative,
-                "velocity_relative": d.velocity_relative,
-            })).collect::<Vec<_>>(),
-            "final": responses.iter().map(|(method, r)| json!({
-                "method": method.name(),
-                "q": r.displacements.last(),
-                "qdot": r.velocities.last(),
-            })).collect::<Vec<_>>(),
-        });
-        let text =
-            serde_json::to_string_pretty(&out).map_err(|e| CliError::failure(e.to_string()))?;
-        let _ = writeln!(stdout, "{text}");
-        return Ok(());
+        print_json(&mut stdout, model.as_ref(), &study)
+    } else {
+        print_text(&mut stdout, model.as_ref(), &study);
+        Ok(())
     }
+}
+
+/// The JSON of `study free-response` (see docs/cli.md).
+fn print_json(
+    stdout: &mut impl std::io::Write,
+    model: &dyn ModelInfo,
+    study: &FreeResponseStudy,
+) -> Result<(), CliError> {
+    let FreeResponseStudy {
+        operating_point: point,
+        normal_modes: modes,
+        ignored_damping,
+        initial,
+        t_end,
+        responses,
+        max_displacement: q_scale,
+        max_velocity: v_scale,
+        differences,
+        ..
+    } = study;
+    let (label, (q0, v0)) = (&point.name, (&initial.q, &initial.qdot));
+    let n = model.num_dofs();
+    let names = model.coordinate_names();
+    let samples = responses[0].1.times.len();
+    let out = json!({
+        "model": model.name(),
+        "coordinates": names,
+        "operating_point": point_json(label, &names, &study.linearization.q),
+        "ignored_damping": ignored_damping,
+        "modes": (0..n).map(|k| json!({
+            "kind": kind_json(&modes.kinds[k]),
+            "eigenvalue": modes.eigenvalues[k],
+            "natural_frequency": modes.natural_frequencies[k],
+            "growth_rate": match modes.kinds[k] { ModeKind::Unstable { growth_rate } => Some(growth_rate), _ => None },
+        })).collect::<Vec<_>>(),
+        "initial": {"q": q0, "qdot": v0},
+        "t_end": t_end,
+        "samples": samples,
+        "tol": study.tol,
+        "methods": FreeResponseMethod::ALL.iter().map(|m| json!({"name": m.name(), "description": m.description()})).collect::<Vec<_>>(),
+        "max_displacement": q_scale,
+        "max_velocity": v_scale,
+        "max_differences": differences.iter().map(|d| json!({
+            "a": d.a.name(),
+            "b": d.b.name(),
+            "displacement": d.displacement,
+            "velocity": d.velocity,
+            "displacement_relative": d.displacement_relative,
+            "velocity_relative": d.velocity_relative,
+        })).collect::<Vec<_>>(),
+        "final": responses.iter().map(|(method, r)| json!({
+            "method": method.name(),
+            "q": r.displacements.last(),
+            "qdot": r.velocities.last(),
+        })).collect::<Vec<_>>(),
+    });
+    let text = serde_json::to_string_pretty(&out).map_err(|e| CliError::failure(e.to_string()))?;
+    let _ = writeln!(stdout, "{text}");
+    Ok(())
+}
+
+/// The text of `study free-response`: the set-up, the modes, the methods and their largest
+/// differences.
+fn print_text(stdout: &mut impl std::io::Write, model: &dyn ModelInfo, study: &FreeResponseStudy) {
+    let FreeResponseStudy {
+        operating_point: point,
+        normal_modes: modes,
+        ignored_damping,
+        initial,
+        t_end,
+        responses,
+        max_displacement: q_scale,
+        max_velocity: v_scale,
+        differences,
+        ..
+    } = study;
+    let (label, (q0, v0)) = (&point.name, (&initial.q, &initial.qdot));
+    let n = model.num_dofs();
+    let names = model.coordinate_names();
+    let samples = responses[0].1.times.len();
     let _ = writeln!(
         stdout,
         "model      {} ({} dof) at {label}: M δq̈ + K δq = 0, 0 ≤ t ≤ {t_end:.6} s, {} samples",
@@ -349,14 +365,15 @@ pub fn run(args: &FreeResponseArgs) -> Result<(), CliError> {
     if *ignored_damping > 0.0 {
         let _ = writeln!(
             stdout,
-            "note       the damping matrix (max |C| = {ignored_damping:.3e}) is left out here; see `eomgen study modal-damping`"
+            "note       the damping matrix (max |C| = {ignored_damping:.3e}) is left out here; see `eomgen study modal-damping`",
+            ignored_damping = num(ignored_damping)
         );
     }
     let fmt = |v: &[f64]| -> String {
         names
             .iter()
             .zip(v)
-            .map(|(c, x)| format!("{c} = {x:.6e}"))
+            .map(|(c, x)| format!("{c} = {x:.6e}", x = num(x)))
             .collect::<Vec<_>>()
             .join(", ")
     };
@@ -366,11 +383,14 @@ pub fn run(args: &FreeResponseArgs) -> Result<(), CliError> {
         let what = match modes.kinds[k] {
             ModeKind::Oscillatory => format!(
                 "ω = {:.10e} rad/s: a cos ωt + b sin ωt/ω",
-                modes.natural_frequencies[k]
+                num(modes.natural_frequencies[k])
             ),
             ModeKind::ZeroFrequency => "zero-frequency: a + b t".to_string(),
             ModeKind::Unstable { growth_rate } => {
-                format!("unstable, σ = {growth_rate:.10e} 1/s: a cosh σt + b sinh σt/σ")
+                format!(
+                    "unstable, σ = {growth_rate:.10e} 1/s: a cosh σt + b sinh σt/σ",
+                    growth_rate = num(growth_rate)
+                )
             }
         };
         let _ = writeln!(stdout, "mode {:<5} {what}", k + 1);
@@ -386,7 +406,9 @@ pub fn run(args: &FreeResponseArgs) -> Result<(), CliError> {
     }
     let _ = writeln!(
         stdout,
-        "largest |δq| = {q_scale:.6e}, |δq̇| = {v_scale:.6e}; max differences (absolute, relative):"
+        "largest |δq| = {q_scale:.6e}, |δq̇| = {v_scale:.6e}; max differences (absolute, relative):",
+        q_scale = num(q_scale),
+        v_scale = num(v_scale)
     );
     for d in differences {
         let _ = writeln!(
@@ -394,13 +416,12 @@ pub fn run(args: &FreeResponseArgs) -> Result<(), CliError> {
             "  {:<14} vs {:<14} δq {:>9.2e} ({:>8.1e})   δq̇ {:>9.2e} ({:>8.1e})",
             d.a.name(),
             d.b.name(),
-            d.displacement,
-            d.displacement_relative,
-            d.velocity,
-            d.velocity_relative
+            num(d.displacement),
+            num(d.displacement_relative),
+            num(d.velocity),
+            num(d.velocity_relative)
         );
     }
-    Ok(())
 }
 
 /// The error of a failed response computation of `model`; a modal failure gets its hint

@@ -5,7 +5,7 @@
 //! [`eomgen::vibration::frequency_response_analysis`] and its simulated points; this module
 //! runs those in parallel and renders text, JSON and the chart.
 
-use std::io::{IsTerminal as _, Write as _};
+use std::io::Write as _;
 
 use clap::Args;
 use eomgen::vibration::{
@@ -19,6 +19,7 @@ use rayon::prelude::*;
 use serde_json::{Value, json};
 
 use super::modes::{OperatingPointArgs, point_json};
+use super::render::num;
 use super::values::{evaluate, parameter_lookup};
 use super::{CliError, plot};
 
@@ -311,7 +312,6 @@ fn print_report(
         normal_modes: modes,
         modal_damping: damping,
         sweeps,
-        evaluations,
         ..
     } = frf;
     let label = &point.name;
@@ -322,10 +322,10 @@ fn print_report(
         .coordinate_names()
         .iter()
         .zip(&forced.equilibrium.q)
-        .map(|(c, v)| format!("{c} = {v:.6e}"))
+        .map(|(c, v)| format!("{c} = {v:.6e}", v = num(v)))
         .collect();
     let _ = writeln!(out, "equilibrium {label} (input = 0): {}", point.join(", "));
-    let column: Vec<String> = b.iter().map(|v| format!("{v:.6e}")).collect();
+    let column: Vec<String> = b.iter().map(|v| format!("{v:.6e}", v = num(v))).collect();
     let _ = writeln!(
         out,
         "B          [{}] (generalized force per unit {} at t = 0)",
@@ -334,21 +334,36 @@ fn print_report(
     );
     let _ = writeln!(out, "{:>4}  {:>16}  {:>12}", "mode", "ω (rad/s)", "ζ");
     for (k, w) in modes.natural_frequencies.iter().enumerate() {
-        let zeta = damping.damping_ratios[k].map_or("-".to_string(), |z| format!("{z:.6e}"));
-        let _ = writeln!(out, "{:>4}  {:>16.10e}  {:>12}", k + 1, w, zeta);
+        let zeta =
+            damping.damping_ratios[k].map_or("-".to_string(), |z| format!("{z:.6e}", z = num(z)));
+        let _ = writeln!(out, "{:>4}  {:>16.10e}  {:>12}", k + 1, num(w), zeta);
     }
     if damping.coupling > 1e-12 {
         let _ = writeln!(
             out,
             "note       ΨᵀCΨ is not diagonal (off-diagonal {:.2e} of the diagonal): the modal sum drops the coupling",
-            damping.coupling
+            num(damping.coupling)
         );
     }
     let _ = writeln!(
         out,
         "sweep      {} frequencies from {lo:.6e} to {hi:.6e} rad/s",
-        frf.frequencies.len()
+        frf.frequencies.len(),
+        lo = num(lo),
+        hi = num(hi)
     );
+    write_peaks(out, outputs, sweeps);
+    write_evaluations(out, args, frf);
+    if let Some((points, plan)) = simulated {
+        write_simulated(out, args, outputs, points, plan);
+    }
+    if let Some(path) = &args.plot {
+        let _ = writeln!(out, "chart      {path}");
+    }
+}
+
+/// The resonance peaks of every output's sweep.
+fn write_peaks(out: &mut impl std::io::Write, outputs: &[FrfOutput], sweeps: &[FrequencySweep]) {
     for (o, s) in outputs.iter().zip(sweeps) {
         let o = &o.name;
         if s.peaks.is_empty() {
@@ -360,20 +375,32 @@ fn print_report(
                     let _ = writeln!(
                         out,
                         "peak  {o:<4} ω = {:.10e} rad/s  |H| = {a:.10e}  phase {:.4}°",
-                        p.frequency,
-                        p.phase_deg.unwrap_or(f64::NAN)
+                        num(p.frequency),
+                        p.phase_deg.unwrap_or(f64::NAN),
+                        a = num(a)
                     );
                 }
                 PeakAmplitude::Unbounded => {
                     let _ = writeln!(
                         out,
                         "peak  {o:<4} ω = {:.10e} rad/s  |H| unbounded (undamped resonance)",
-                        p.frequency
+                        num(p.frequency)
                     );
                 }
             }
         }
     }
+}
+
+/// `H(ω)` at every `--frequency`, with the modal contributions of `--modal`.
+fn write_evaluations(out: &mut impl std::io::Write, args: &FrfArgs, frf: &FrfAnalysis) {
+    let FrfAnalysis {
+        outputs,
+        normal_modes: modes,
+        modal_damping: damping,
+        evaluations,
+        ..
+    } = frf;
     for e in evaluations {
         let w = e.frequency;
         match &e.response {
@@ -382,12 +409,13 @@ fn print_report(
                     .iter()
                     .map(|o| format!("{}: {}", o.name, polar(d[o.index])))
                     .collect();
-                let _ = writeln!(out, "H(ω = {w:.10e})  {}", cells.join(", "));
+                let _ = writeln!(out, "H(ω = {w:.10e})  {}", cells.join(", "), w = num(w));
             }
             None => {
                 let _ = writeln!(
                     out,
-                    "H(ω = {w:.10e})  unbounded (K − ω²M + iωC is singular: undamped resonance)"
+                    "H(ω = {w:.10e})  unbounded (K − ω²M + iωC is singular: undamped resonance)",
+                    w = num(w)
                 );
             }
         }
@@ -403,7 +431,8 @@ fn print_report(
             if let Some(diff) = e.modal_difference.filter(|d| d.is_finite()) {
                 let _ = writeln!(
                     out,
-                    "           modal sum vs direct solve: max difference {diff:.2e} of max |H|"
+                    "           modal sum vs direct solve: max difference {diff:.2e} of max |H|",
+                    diff = num(diff)
                 );
             }
         } else if args.modal {
@@ -413,44 +442,52 @@ fn print_report(
             );
         }
     }
-    if let Some((points, plan)) = simulated {
-        let _ = writeln!(
-            out,
-            "simulate   {} = {:e}, {} = ω, DOP853 rtol {:e}, from rest at the equilibrium to steady state",
-            args.input, args.amplitude, plan.frequency_parameter, args.rtol
-        );
-        let _ = writeln!(
-            out,
-            "{:>16}  {:>5}  {:>10}  {:>36}  {:>36}  {:>9}",
-            "ω (rad/s)", "out", "t_settle", "simulated X/amplitude", "H(ω)", "rel. err"
-        );
-        for p in points {
-            for (o, v) in outputs.iter().zip(&p.values) {
-                let _ = writeln!(
-                    out,
-                    "{:>16.10e}  {:>5}  {:>10.1}  {:>36}  {:>36}  {:>9.2e}",
-                    p.frequency,
-                    o.name,
-                    p.settling_time,
-                    polar(v.simulated),
-                    polar(v.predicted),
-                    v.relative_error()
-                );
-            }
+}
+
+/// The points of `--simulate` against `H`.
+fn write_simulated(
+    out: &mut impl std::io::Write,
+    args: &FrfArgs,
+    outputs: &[FrfOutput],
+    points: &[SimulatedPoint],
+    plan: &FrfSimulationPlan,
+) {
+    let _ = writeln!(
+        out,
+        "simulate   {} = {:e}, {} = ω, DOP853 rtol {:e}, from rest at the equilibrium to steady state",
+        args.input,
+        num(args.amplitude),
+        plan.frequency_parameter,
+        num(args.rtol)
+    );
+    let _ = writeln!(
+        out,
+        "{:>16}  {:>5}  {:>10}  {:>36}  {:>36}  {:>9}",
+        "ω (rad/s)", "out", "t_settle", "simulated X/amplitude", "H(ω)", "rel. err"
+    );
+    for p in points {
+        for (o, v) in outputs.iter().zip(&p.values) {
+            let _ = writeln!(
+                out,
+                "{:>16.10e}  {:>5}  {:>10.1}  {:>36}  {:>36}  {:>9.2e}",
+                num(p.frequency),
+                o.name,
+                p.settling_time,
+                polar(v.simulated),
+                polar(v.predicted),
+                num(v.relative_error())
+            );
         }
-        let _ = writeln!(
-            out,
-            "check      max relative error of the simulated steady state against H: {:.2e}",
-            max_simulation_error(points)
-        );
     }
-    if let Some(path) = &args.plot {
-        let _ = writeln!(out, "chart      {path}");
-    }
+    let _ = writeln!(
+        out,
+        "check      max relative error of the simulated steady state against H: {:.2e}",
+        num(max_simulation_error(points))
+    );
 }
 
 fn polar(z: Complex<f64>) -> String {
-    format!("{:.9e} ∠ {:>9.4}°", z.norm(), phase_degrees(z))
+    format!("{:.9e} ∠ {:>9.4}°", num(z.norm()), phase_degrees(z))
 }
 
 fn write_modal(
@@ -483,9 +520,9 @@ fn write_modal(
             out,
             "           {:>4}  {:>12.6e}  {:>10}  {:>12.5e}  {:>34}  {}",
             k + 1,
-            natural_frequencies[k],
-            damping_ratios[k].map_or("-".to_string(), |z| format!("{z:.4e}")),
-            r.modal_forces[k],
+            num(natural_frequencies[k]),
+            damping_ratios[k].map_or("-".to_string(), |z| format!("{z:.4e}", z = num(z))),
+            num(r.modal_forces[k]),
             polar(r.modal_coordinates[k]),
             cells.join("  ")
         );
@@ -517,19 +554,12 @@ fn simulate_points(
 ) -> Result<Vec<SimulatedPoint>, CliError> {
     let name = model.name();
     let k = plan.frequencies.len();
-    let progress = if args.json || !std::io::stderr().is_terminal() {
-        indicatif::ProgressBar::hidden()
-    } else {
-        let bar = indicatif::ProgressBar::new(k as u64);
-        bar.set_style(
-            indicatif::ProgressStyle::with_template(
-                "{msg} [{bar:30}] {pos}/{len} ({elapsed}, eta {eta})",
-            )
-            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
-        );
-        bar.set_message("steady-state simulations");
-        bar
-    };
+    let progress = super::render::progress_bar(
+        k,
+        "{msg} [{bar:30}] {pos}/{len} ({elapsed}, eta {eta})",
+        "steady-state simulations",
+        args.json,
+    );
     let results: Vec<Result<SimulatedPoint, CliError>> = plan
         .frequencies
         .par_iter()

@@ -15,6 +15,7 @@ use super::CliError;
 use super::free_response::{Panel, kind_json, panels, parse_init, study_failure};
 use super::modes::{OperatingPointArgs, matrix_rows, point_json};
 use super::plot::Series;
+use super::render::num;
 
 /// Options of `eomgen study modal-damping`.
 #[derive(Debug, Args)]
@@ -202,7 +203,7 @@ fn print_report(
     let _ = writeln!(
         stdout,
         "Ĉ = ΨᵀCΨ  off-diagonal coupling max|Ĉᵢⱼ|/max|Ĉₖₖ| = {:.4e}{}",
-        approx.coupling,
+        num(approx.coupling),
         if approx.coupling == 0.0 {
             " (diagonal: the modal approximation is exact)"
         } else {
@@ -214,7 +215,7 @@ fn print_report(
             .modal_damping_matrix
             .row(i)
             .iter()
-            .map(|v| format!("{:>12.5e}", v + 0.0)) // −0 prints as 0
+            .map(|v| format!("{:>12.5e}", num(v + 0.0))) // −0 prints as 0
             .collect();
         let _ = writeln!(stdout, "           [{}]", row.join(", "));
     }
@@ -226,7 +227,8 @@ fn print_report(
             let _ = writeln!(
                 stdout,
                 "Rayleigh   C = αM + βK fitted to the exact ζ of modes {a} and {b}: α = {:.6e} 1/s, β = {:.6e} s",
-                fit.alpha, fit.beta
+                num(fit.alpha),
+                num(fit.beta)
             );
         }
         None => {
@@ -237,7 +239,7 @@ fn print_report(
         }
     }
     let opt = |v: Option<f64>, width: usize| match v {
-        Some(x) => format!("{:>width$.6e}", x + 0.0),
+        Some(x) => format!("{:>width$.6e}", num(x + 0.0)),
         None => format!("{:>width$}", "-"),
     };
     let _ = writeln!(
@@ -257,7 +259,7 @@ fn print_report(
             stdout,
             "{:>4} {:>13.6e} | {} {} | {} {} | {} {}",
             m.mode,
-            m.natural_frequency,
+            num(m.natural_frequency),
             opt(m.exact.map(|d| d.damping_ratio), 13),
             opt(m.exact.map(|d| d.damped_frequency), 13),
             opt(m.diagonal.map(|d| d.damping_ratio), 13),
@@ -280,10 +282,10 @@ fn print_report(
             stdout,
             "  {:<36} {:>12.2e} {:>14.2e} {:>12}",
             c.name,
-            c.integration_vs_exact,
-            c.diagonal_vs_exact,
+            num(c.integration_vs_exact),
+            num(c.diagonal_vs_exact),
             c.rayleigh_vs_exact
-                .map_or("-".to_string(), |r| format!("{r:.2e}"))
+                .map_or("-".to_string(), |r| format!("{r:.2e}", r = num(r)))
         );
     }
 }

@@ -1,16 +1,15 @@
 //! `eomgen modes MODEL`: equilibrium, exact linearisation `M δq̈ + C δq̇ + K δq = 0`, normal
 //! modes and damping (issue 7; lectures 22–26, 30).
 
-use std::io::Write as _;
-
 use clap::Args;
 use eomgen::vibration::{
     self, EquilibriumStart, ModalAnalysis, ModalOptions, OperatingPointError, OperatingPointOptions,
 };
-use eomgen::{Equilibrium, Linearization, ModeKind, ModelInfo, NormalModes};
+use eomgen::{ModeKind, ModelInfo};
 use nalgebra::DMatrix;
 use serde_json::json;
 
+use super::render::num;
 use super::values::{evaluate, parameter_lookup, set_parameters, split_assignment};
 use super::{CliError, find_model};
 
@@ -87,21 +86,8 @@ pub fn run(args: &ModesArgs) -> Result<(), CliError> {
     if args.plot.is_some() {
         super::mode_plot::check_drawable(model.as_ref())?;
     }
-    let ModalAnalysis {
-        operating_point: point,
-        linearization: lin,
-        normal_modes: modes,
-        mode_shapes: shapes,
-        minimal_coordinates: minimal,
-        damped_modes: damped,
-        damping_ratios,
-        m_inv_k_eigenvalues: route22,
-        m_inv_k_relative_difference: route_difference,
-    } = &modal;
-    let (label, equilibrium) = (&point.name, &point.equilibrium);
-    let n = model.num_dofs();
-    let names = model.coordinate_names();
-    let undamped = modal.is_undamped();
+    let (lin, modes) = (&modal.linearization, &modal.normal_modes);
+    let equilibrium = &modal.operating_point.equilibrium;
     // Mode shapes in the model's coordinates (δq = N z with constraints).
     let shapes_q = modal.mode_shape_matrix();
     let multipliers: serde_json::Map<String, serde_json::Value> = model
@@ -122,53 +108,119 @@ pub fn run(args: &ModesArgs) -> Result<(), CliError> {
     }
     let mut stdout = super::output::stdout();
     if args.json {
-        let mut point = point_json(label, &names, &equilibrium.q);
-        point["newton_iterations"] = json!(equilibrium.iterations);
-        point["residual"] = json!(equilibrium.residual);
-        let out = json!({
-            "model": model.name(),
-            "coordinates": names,
-            "operating_point": point,
-            "natural_frequencies": modes.natural_frequencies,
-            "frequencies_hz": modes.natural_frequencies.iter().map(|w| w / std::f64::consts::TAU).collect::<Vec<_>>(),
-            "eigenvalues": modes.eigenvalues,
-            "kinds": modes.kinds,
-            "damping_ratios": damping_ratios,
-            "damped_modes": damped.iter().map(|d| json!({"re": d.eigenvalue.re, "im": d.eigenvalue.im, "damping_ratio": d.damping_ratio, "damped_frequency": d.damped_frequency})).collect::<Vec<_>>(),
-            "mode_shapes": shapes,
-            "minimal_coordinates": minimal,
-            "lagrange_multipliers": multipliers,
-            "mass_matrix": matrix_rows(&lin.mass_matrix),
-            "stiffness_matrix": matrix_rows(&lin.stiffness_matrix),
-            "damping_matrix": matrix_rows(&lin.damping_matrix),
-            "stiffness_asymmetry": modes.stiffness_asymmetry,
-            "m_inv_k_eigenvalues": route22,
-            "m_inv_k_relative_difference": route_difference,
-            "charts": charts,
-            "animation": args.animate,
-        });
-        let text =
-            serde_json::to_string_pretty(&out).map_err(|e| CliError::failure(e.to_string()))?;
-        let _ = writeln!(stdout, "{text}");
-        return Ok(());
+        print_json(
+            &mut stdout,
+            model.as_ref(),
+            &modal,
+            &multipliers,
+            &charts,
+            args,
+        )
+    } else {
+        print_text(
+            &mut stdout,
+            model.as_ref(),
+            &modal,
+            &multipliers,
+            &charts,
+            args,
+        );
+        Ok(())
     }
+}
+
+/// The JSON of `modes` (see docs/cli.md).
+fn print_json(
+    stdout: &mut impl std::io::Write,
+    model: &dyn ModelInfo,
+    modal: &ModalAnalysis,
+    multipliers: &serde_json::Map<String, serde_json::Value>,
+    charts: &[String],
+    args: &ModesArgs,
+) -> Result<(), CliError> {
+    let ModalAnalysis {
+        operating_point: point,
+        linearization: lin,
+        normal_modes: modes,
+        mode_shapes: shapes,
+        minimal_coordinates: minimal,
+        damped_modes: damped,
+        damping_ratios,
+        m_inv_k_eigenvalues: route22,
+        m_inv_k_relative_difference: route_difference,
+    } = modal;
+    let (label, equilibrium) = (&point.name, &point.equilibrium);
+    let names = model.coordinate_names();
+    let mut point = point_json(label, &names, &equilibrium.q);
+    point["newton_iterations"] = json!(equilibrium.iterations);
+    point["residual"] = json!(equilibrium.residual);
+    let out = json!({
+        "model": model.name(),
+        "coordinates": names,
+        "operating_point": point,
+        "natural_frequencies": modes.natural_frequencies,
+        "frequencies_hz": modes.natural_frequencies.iter().map(|w| w / std::f64::consts::TAU).collect::<Vec<_>>(),
+        "eigenvalues": modes.eigenvalues,
+        "kinds": modes.kinds,
+        "damping_ratios": damping_ratios,
+        "damped_modes": damped.iter().map(|d| json!({"re": d.eigenvalue.re, "im": d.eigenvalue.im, "damping_ratio": d.damping_ratio, "damped_frequency": d.damped_frequency})).collect::<Vec<_>>(),
+        "mode_shapes": shapes,
+        "minimal_coordinates": minimal,
+        "lagrange_multipliers": multipliers,
+        "mass_matrix": matrix_rows(&lin.mass_matrix),
+        "stiffness_matrix": matrix_rows(&lin.stiffness_matrix),
+        "damping_matrix": matrix_rows(&lin.damping_matrix),
+        "stiffness_asymmetry": modes.stiffness_asymmetry,
+        "m_inv_k_eigenvalues": route22,
+        "m_inv_k_relative_difference": route_difference,
+        "charts": charts,
+        "animation": args.animate,
+    });
+    let text = serde_json::to_string_pretty(&out).map_err(|e| CliError::failure(e.to_string()))?;
+    let _ = writeln!(stdout, "{text}");
+    Ok(())
+}
+
+/// The text of `modes`: the equilibrium, M, K, C, the modes, the check, the files written.
+fn print_text(
+    stdout: &mut impl std::io::Write,
+    model: &dyn ModelInfo,
+    modal: &ModalAnalysis,
+    multipliers: &serde_json::Map<String, serde_json::Value>,
+    charts: &[String],
+    args: &ModesArgs,
+) {
+    let ModalAnalysis {
+        operating_point: point,
+        linearization: lin,
+        normal_modes: modes,
+        mode_shapes: shapes,
+        minimal_coordinates: minimal,
+        damping_ratios,
+        m_inv_k_relative_difference: route_difference,
+        ..
+    } = modal;
+    let (label, equilibrium) = (&point.name, &point.equilibrium);
+    let names = model.coordinate_names();
+    let n = model.num_dofs();
+    let undamped = modal.is_undamped();
     let _ = writeln!(stdout, "model      {} ({} dof)", model.name(), n);
     let point: Vec<String> = names
         .iter()
         .zip(&equilibrium.q)
-        .map(|(c, v)| format!("{c} = {v:.12e}"))
+        .map(|(c, v)| format!("{c} = {v:.12e}", v = num(v)))
         .collect();
     let _ = writeln!(
         stdout,
         "equilibrium {label}: {} (Newton: {} iterations, max |F| = {:.1e})",
         point.join(", "),
         equilibrium.iterations,
-        equilibrium.residual
+        num(equilibrium.residual)
     );
     if !lin.lagrange_multipliers.is_empty() {
         let forces: Vec<String> = multipliers
             .iter()
-            .map(|(c, v)| format!("λ_{c} = {:.6e}", v.as_f64().unwrap_or(f64::NAN)))
+            .map(|(c, v)| format!("λ_{c} = {:.6e}", num(v.as_f64().unwrap_or(f64::NAN))))
             .collect();
         let _ = writeln!(
             stdout,
@@ -177,16 +229,16 @@ pub fn run(args: &ModesArgs) -> Result<(), CliError> {
             minimal.join(", ")
         );
     }
-    print_matrix(&mut stdout, "M", &lin.mass_matrix);
-    print_matrix(&mut stdout, "K", &lin.stiffness_matrix);
+    print_matrix(stdout, "M", &lin.mass_matrix);
+    print_matrix(stdout, "K", &lin.stiffness_matrix);
     if !undamped {
-        print_matrix(&mut stdout, "C", &lin.damping_matrix);
+        print_matrix(stdout, "C", &lin.damping_matrix);
     }
     if modes.stiffness_asymmetry > 1e-12 {
         let _ = writeln!(
             stdout,
             "note       K is not symmetric (‖K − Kᵀ‖/‖K‖ = {:.2e}); its symmetric part is used",
-            modes.stiffness_asymmetry
+            num(modes.stiffness_asymmetry)
         );
     }
     let _ = writeln!(
@@ -204,37 +256,40 @@ pub fn run(args: &ModesArgs) -> Result<(), CliError> {
             ModeKind::Oscillatory => String::new(),
             ModeKind::ZeroFrequency => "  zero-frequency".to_string(),
             ModeKind::Unstable { growth_rate } => {
-                format!("  unstable, grows as e^({growth_rate:.6e} t)")
+                format!(
+                    "  unstable, grows as e^({growth_rate:.6e} t)",
+                    growth_rate = num(growth_rate)
+                )
             }
         };
         let shape: Vec<String> = shape
             .iter()
-            .map(|v| format!("{:>11.4e}", v + 0.0))
+            .map(|v| format!("{:>11.4e}", num(v + 0.0)))
             .collect();
         let zeta = damping_ratios
             .get(k)
-            .map_or("-".to_string(), |z| format!("{z:.4e}"));
+            .map_or("-".to_string(), |z| format!("{z:.4e}", z = num(z)));
         let _ = writeln!(
             stdout,
             "{:>4}  {:>16.10e}  {:>14.6e}  {:>10}  [{}]{note}",
             k + 1,
-            w,
-            w / std::f64::consts::TAU,
+            num(w),
+            num(w / std::f64::consts::TAU),
             zeta,
             shape.join(", ")
         );
     }
     let _ = writeln!(
         stdout,
-        "check      eigenvalues of M⁻¹K (lecture 22) vs the symmetric Cholesky route (lecture 24): max difference {route_difference:.1e} of max |ω²|"
+        "check      eigenvalues of M⁻¹K (lecture 22) vs the symmetric Cholesky route (lecture 24): max difference {route_difference:.1e} of max |ω²|",
+        route_difference = num(route_difference)
     );
-    for path in &charts {
+    for path in charts {
         let _ = writeln!(stdout, "chart      {path}");
     }
     if let Some(path) = &args.animate {
         let _ = writeln!(stdout, "animation  {path}");
     }
-    Ok(())
 }
 
 /// `m` as a list of rows, for JSON.
@@ -244,7 +299,11 @@ pub(super) fn matrix_rows(m: &DMatrix<f64>) -> Vec<Vec<f64>> {
 
 fn print_matrix(out: &mut impl std::io::Write, name: &str, m: &DMatrix<f64>) {
     for i in 0..m.nrows() {
-        let row: Vec<String> = m.row(i).iter().map(|v| format!("{v:>13.6e}")).collect();
+        let row: Vec<String> = m
+            .row(i)
+            .iter()
+            .map(|v| format!("{v:>13.6e}", v = num(v)))
+            .collect();
         let label = if i == 0 {
             format!("{name} =")
         } else {
@@ -252,18 +311,6 @@ fn print_matrix(out: &mut impl std::io::Write, name: &str, m: &DMatrix<f64>) {
         };
         let _ = writeln!(out, "{label:<10} [{}]", row.join(", "));
     }
-}
-
-/// The linearisation at the operating point `--at` and what to call it.
-pub(super) struct OperatingPoint {
-    /// The equilibrium's name, or the `--at` guesses as given.
-    pub label: String,
-    /// The equilibrium Newton found (with the constraint forces at rest).
-    pub equilibrium: Equilibrium,
-    /// The exact linearisation at the equilibrium Newton found.
-    pub lin: Linearization,
-    /// Its normal modes.
-    pub modes: NormalModes,
 }
 
 /// The model `model_name` with `--set` applied and its modal analysis at `--at`
@@ -282,21 +329,6 @@ pub(super) fn analysis_of(
     let modal = vibration::modal_analysis(model.as_ref(), &options)
         .map_err(|e| point_failure(model.as_ref(), &e))?;
     Ok((model, modal))
-}
-
-/// Finds the equilibrium from `--at` (after `--set`), linearises there and computes the
-/// normal modes: the start of the modal studies and of the report's modal checks.
-pub(super) fn operating_point_of(
-    model_name: &str,
-    point: &OperatingPointArgs,
-) -> Result<OperatingPoint, CliError> {
-    let (_, modal) = analysis_of(model_name, point)?;
-    Ok(OperatingPoint {
-        label: modal.operating_point.name,
-        equilibrium: modal.operating_point.equilibrium,
-        lin: modal.linearization,
-        modes: modal.normal_modes,
-    })
 }
 
 /// The error of a failed equilibrium search, linearisation or modal analysis of `model`: the

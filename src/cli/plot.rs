@@ -266,6 +266,7 @@ where
                     });
             }
             ctx.configure_series_labels()
+                .position(legend_position(chart, series, (x0, x1), (y0, y1)))
                 .background_style(WHITE.mix(0.8))
                 .border_style(BLACK)
                 .label_font(("sans-serif", 14))
@@ -283,6 +284,88 @@ where
     }
     root.present().map_err(err)?;
     Ok(())
+}
+
+/// Where the legend hides the fewest points of the curves: plotters' default, the middle of
+/// the right side, unless another corner or side is emptier (a phase portrait's closed
+/// curves pass through the middle right). The legend's box is estimated from its labels
+/// (14 px text, 20 px per line) on the plotting area of a 960 × 600 px chart, and the curves
+/// are sampled along each segment so that a line crossing the box counts too.
+fn legend_position(
+    chart: &Chart<'_>,
+    series: &[Series],
+    (x0, x1): (f64, f64),
+    (y0, y1): (f64, f64),
+) -> SeriesLabelPosition {
+    // The plotting area (px) and the legend's box as fractions of it.
+    let (width, height) = (840.0, 490.0);
+    let longest = series
+        .iter()
+        .map(|s| s.name.chars().count())
+        .max()
+        .unwrap_or(0);
+    let box_w = ((longest as f64 * 8.0 + 50.0) / width).min(1.0);
+    let box_h = ((series.len() as f64 * 20.0 + 20.0) / height).min(1.0);
+    let fraction = |v: f64, lo: f64, hi: f64, log: bool| {
+        if log {
+            (v.ln() - lo.ln()) / (hi.ln() - lo.ln())
+        } else {
+            (v - lo) / (hi - lo)
+        }
+    };
+    let mut points: Vec<(f64, f64)> = Vec::new();
+    for s in series {
+        let drawn: Vec<(f64, f64)> = usable(chart, s)
+            .map(|(x, y)| {
+                (
+                    fraction(x, x0, x1, chart.log_x),
+                    fraction(y, y0, y1, chart.log_y),
+                )
+            })
+            .collect();
+        for pair in drawn.windows(2) {
+            let ((ax, ay), (bx, by)) = (pair[0], pair[1]);
+            points.extend((0..8).map(|k| {
+                let f = f64::from(k) / 8.0;
+                (ax + f * (bx - ax), ay + f * (by - ay))
+            }));
+        }
+        points.extend(drawn.last());
+    }
+    // Candidates in order of preference (ties keep the earlier), with the box's lower-left
+    // corner in fractions of the plotting area (y up).
+    let candidates = [
+        (
+            SeriesLabelPosition::MiddleRight,
+            (1.0 - box_w, 0.5 - box_h / 2.0),
+        ),
+        (SeriesLabelPosition::UpperRight, (1.0 - box_w, 1.0 - box_h)),
+        (SeriesLabelPosition::UpperLeft, (0.0, 1.0 - box_h)),
+        (SeriesLabelPosition::LowerRight, (1.0 - box_w, 0.0)),
+        (SeriesLabelPosition::LowerLeft, (0.0, 0.0)),
+        (
+            SeriesLabelPosition::UpperMiddle,
+            (0.5 - box_w / 2.0, 1.0 - box_h),
+        ),
+        (SeriesLabelPosition::LowerMiddle, (0.5 - box_w / 2.0, 0.0)),
+        (SeriesLabelPosition::MiddleLeft, (0.0, 0.5 - box_h / 2.0)),
+    ];
+    let hidden = |(left, bottom): (f64, f64)| {
+        points
+            .iter()
+            .filter(|(x, y)| {
+                (left..=left + box_w).contains(x) && (bottom..=bottom + box_h).contains(y)
+            })
+            .count()
+    };
+    let mut best = (SeriesLabelPosition::MiddleRight, usize::MAX);
+    for (position, corner) in candidates {
+        let count = hidden(corner);
+        if count < best.1 {
+            best = (position, count);
+        }
+    }
+    best.0
 }
 
 /// Plots the phase portrait of every coordinate, `q̇ᵢ` against `qᵢ`, one line each, into
@@ -390,4 +473,38 @@ pub fn constraint_drift(
         &series,
         note,
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A phase portrait's closed curve through the middle of the right side moves the legend
+    /// to an empty corner; a curve that leaves the middle right empty keeps plotters' default.
+    #[test]
+    fn the_legend_goes_where_it_hides_nothing() {
+        let chart = Chart::linear("t", "x", "y");
+        let ellipse = |phase: f64| Series {
+            name: "q_dot vs q".to_string(),
+            points: (0..=200)
+                .map(|k| {
+                    let a = phase + std::f64::consts::TAU * f64::from(k) / 200.0;
+                    (a.cos(), 0.5 * a.sin())
+                })
+                .collect(),
+        };
+        let series = [ellipse(0.0)];
+        let (x, y) = ((-1.1, 1.1), (-0.55, 0.55));
+        let position = legend_position(&chart, &series, x, y);
+        assert!(
+            !matches!(position, SeriesLabelPosition::MiddleRight),
+            "the ellipse crosses the middle right"
+        );
+        let rising = [Series {
+            name: "x".to_string(),
+            points: vec![(0.0, 0.0), (0.5, 1.0)],
+        }];
+        let position = legend_position(&chart, &rising, (0.0, 1.0), (0.0, 1.0));
+        assert!(matches!(position, SeriesLabelPosition::MiddleRight));
+    }
 }

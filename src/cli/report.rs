@@ -16,7 +16,6 @@
 //! `|computed − expected| ≤ tolerance · max(1, |expected|)`; drifts and residuals are
 //! "computed" with expected 0 and their bound as tolerance.
 
-use std::io::IsTerminal as _;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -25,15 +24,14 @@ use rayon::prelude::*;
 use serde_json::json;
 
 use eomgen::ModelInfo;
-use eomgen::analysis::{constraint_drift, energy_drift};
-pub(super) use eomgen::checks::CheckRow;
-use eomgen::checks::{CheckRun, DERIVATION_TOLERANCE, ModesAt, Simulations, derivation_checks};
+use eomgen::checks::{DefaultRun, model_report};
+use eomgen::vibration::ModalAnalysis;
 use eomgen_symbolic::codegen::equations_mathml;
 use eomgen_symbolic::mechanics::{Formulation, Lagrange, SymbolicModel};
 use eomgen_symbolic::model::ModelFile;
 
-use super::modes::{OperatingPoint, operating_point_of};
 use super::output::outln;
+use super::report_html::{Figure, ModelReport};
 use super::{CliError, plot};
 
 /// Options of `eomgen report`.
@@ -57,49 +55,6 @@ pub struct ReportArgs {
     pub timing: bool,
 }
 
-/// A figure of a model's section: the file (relative to the report's directory) and what
-/// it shows.
-#[derive(Debug, Clone)]
-pub(super) struct Figure {
-    /// Relative path, `model/kind.svg`.
-    pub file: String,
-    /// Caption.
-    pub caption: String,
-}
-
-/// Everything the report shows for one model.
-#[derive(Debug, Clone)]
-pub(super) struct ModelReport {
-    /// The model's name.
-    pub name: String,
-    /// `description:`.
-    pub description: String,
-    /// The comment block at the top of the model file (its source and reference values).
-    pub header: String,
-    /// Degrees of freedom.
-    pub dof: usize,
-    /// The equations of motion, one `<math>` element per line.
-    pub equations: Vec<String>,
-    /// Charts.
-    pub figures: Vec<Figure>,
-    /// The model's animation (a self-contained HTML file relative to the report's
-    /// directory), embedded when present.
-    pub animation: Option<String>,
-    /// The pass/fail table.
-    pub checks: Vec<CheckRow>,
-    /// What could not be drawn or was skipped, and why.
-    pub notes: Vec<String>,
-    /// Wall time (s).
-    pub time_s: f64,
-}
-
-impl ModelReport {
-    /// Whether every check passed.
-    pub fn passed(&self) -> bool {
-        self.checks.iter().all(|c| c.passed)
-    }
-}
-
 /// A model to report on: its file and its compiled equations (bundled, or the file's own
 /// compiled at run time).
 struct Source {
@@ -114,19 +69,12 @@ pub fn run(args: &ReportArgs) -> Result<(), CliError> {
     let sources = sources(&args.models)?;
     std::fs::create_dir_all(&args.out)
         .map_err(|e| CliError::failure(format!("cannot create `{}`: {e}", args.out.display())))?;
-    let bar = if args.json || !std::io::stderr().is_terminal() {
-        indicatif::ProgressBar::hidden()
-    } else {
-        let bar = indicatif::ProgressBar::new(sources.len() as u64);
-        bar.set_style(
-            indicatif::ProgressStyle::with_template(
-                "{msg} [{bar:30}] {pos}/{len} models ({elapsed})",
-            )
-            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
-        );
-        bar.set_message("report");
-        bar
-    };
+    let bar = super::render::progress_bar(
+        sources.len(),
+        "{msg} [{bar:30}] {pos}/{len} models ({elapsed})",
+        "report",
+        args.json,
+    );
     let mut reports: Vec<ModelReport> = sources
         .par_iter()
         .map(|s| {
@@ -226,36 +174,12 @@ fn header_comment(source: &str) -> String {
         .join("\n")
 }
 
-/// Results computed once per key (a model's simulations, its operating points), failures
-/// included.
-struct Memo<K, V> {
-    done: Vec<(K, Result<V, String>)>,
-}
-
-impl<K: PartialEq, V> Memo<K, V> {
-    fn new() -> Self {
-        Self { done: Vec::new() }
-    }
-
-    /// The result for `key`, computed by `compute` the first time.
-    fn get(&mut self, key: K, compute: impl FnOnce(&K) -> Result<V, String>) -> Result<&V, String> {
-        let k = match self.done.iter().position(|(d, _)| *d == key) {
-            Some(k) => k,
-            None => {
-                let value = compute(&key);
-                self.done.push((key, value));
-                self.done.len() - 1
-            }
-        };
-        self.done[k].1.as_ref().map_err(Clone::clone)
-    }
-}
-
-/// Runs every check of one model and draws its figures into `dir/<name>/`.
+/// Runs every check of one model ([`eomgen::checks::model_report`]) and draws its figures
+/// into `dir/<name>/`.
 fn report_model(source: &Source, dir: &Path) -> ModelReport {
     let started = Instant::now();
     let file = &source.file;
-    let mut model = source.model.instantiate();
+    let model = source.model.instantiate();
     let mut report = ModelReport {
         name: model.name().to_string(),
         description: model.description().to_string(),
@@ -280,180 +204,130 @@ fn report_model(source: &Source, dir: &Path) -> ModelReport {
             .push(super::equations::render(&source.display, &source.text, &d).message),
     }
 
-    // Generic: the derivations agree (the checks of `eomgen check`).
-    match derivation_checks(file) {
-        Ok((rows, notes)) => {
-            report.checks.extend(rows);
-            report.notes.extend(notes);
+    let checks = model_report(&source.display, &source.text, file, &source.model);
+    report.checks = checks.rows;
+    report.notes.extend(checks.notes);
+    if let Some(run) = &checks.default_run {
+        let model_dir = dir.join(&report.name);
+        if let Err(e) = std::fs::create_dir_all(&model_dir) {
+            report
+                .notes
+                .push(format!("cannot create `{}`: {e}", model_dir.display()));
         }
-        Err(d) => report.checks.push(CheckRow::compare(
-            "derivations agree",
-            Err(super::equations::render(&source.display, &source.text, &d).message),
-            0.0,
-            DERIVATION_TOLERANCE,
-        )),
-    }
-
-    match model.consistent_initial_state() {
-        Ok(y0) => motion_checks(source, model.as_mut(), &y0, dir, &mut report),
-        Err(e) => report.checks.push(CheckRow::compare(
-            "consistent initial state",
-            Err(format!(
-                "constraint {} keeps a residual of {:.3e}",
-                e.constraint, e.residual
-            )),
-            0.0,
-            0.0,
-        )),
+        draw_default_run(model.as_ref(), run, &model_dir, &mut report);
+        if let Some(shapes) = &checks.mode_shapes {
+            draw_mode_shapes(model.as_ref(), shapes, &model_dir, &mut report);
+        }
+        let spec = source.model.argument().to_string();
+        report.animation = animation(&spec, &report.name, &model_dir, &mut report.notes);
     }
     report.time_s = started.elapsed().as_secs_f64();
     report
 }
 
-/// The checks and figures that need a motion or an equilibrium of `model` (from the
-/// consistent initial state `y0`), added to `report`: the figures of the default run, the
-/// rows of [`eomgen::checks::motion_checks`], the mode shapes; the figures and the animation
-/// go into `dir/<name>/`.
-fn motion_checks(
-    source: &Source,
-    model: &mut dyn ModelInfo,
-    y0: &[f64],
-    dir: &Path,
+/// The figures of the default run (`Err`: why there are none): time histories, phase
+/// portrait, energy drift and, for a constrained model, constraint drift.
+fn draw_default_run(
+    model: &dyn ModelInfo,
+    run: &Result<DefaultRun, String>,
+    model_dir: &Path,
     report: &mut ModelReport,
 ) {
-    let file = &source.file;
     let name = report.name.clone();
-    // How the CLI names this model again: a bundled name, or the file's path.
-    let spec = source.model.argument().to_string();
-    let ModelReport {
-        checks,
-        figures,
-        notes,
-        ..
-    } = report;
-    let mut simulations = Simulations::new(source.model.clone());
-    let mut operating_points: Memo<Option<String>, OperatingPoint> = Memo::new();
-    let operating_point = |at: &Option<String>| {
-        let point = super::modes::OperatingPointArgs {
-            at: at.clone(),
-            set: Vec::new(),
-        };
-        operating_point_of(&spec, &point).map_err(|e| e.message)
-    };
-    let default_run = CheckRun::default();
-
-    // Figures of the default run.
-    let model_dir = dir.join(&name);
-    if let Err(e) = std::fs::create_dir_all(&model_dir) {
-        notes.push(format!("cannot create `{}`: {e}", model_dir.display()));
-    }
-    let mut drawn: Vec<(&str, String, Result<(), String>)> = Vec::new();
-    let path = |file: &str| model_dir.join(file).to_string_lossy().to_string();
-    match simulations.get(default_run) {
-        Ok(solution) => {
-            let run = default_run.describe();
-            drawn.push((
-                "time.svg",
-                format!("Coordinates against time ({run})"),
-                plot::time_histories(&path("time.svg"), model, solution, None),
-            ));
-            drawn.push((
-                "phase.svg",
-                "Phase portrait: each rate against its coordinate".to_string(),
-                plot::phase_portrait(&path("phase.svg"), model, solution, None),
-            ));
-            drawn.push(("energy.svg", "Energy drift E(t) − E(0)".to_string(), {
-                let energy = energy_drift(model, y0, solution);
-                plot::energy_drift(
-                    &path("energy.svg"),
-                    model.name(),
-                    &solution.t,
-                    &energy.energy,
-                    energy.initial_energy,
-                    None,
-                )
-            }));
-            if !model.constraint_names().is_empty() {
-                let drift = constraint_drift(model, solution).drift;
-                drawn.push((
-                    "constraints.svg",
-                    "Constraint drift max |Φ|, max |Φ̇|, no stabilisation".to_string(),
-                    plot::constraint_drift(&path("constraints.svg"), &name, &solution.t, &drift, None),
-                ));
-            }
+    let run = match run {
+        Ok(run) => run,
+        Err(e) => {
+            report.notes.push(format!("no figures: {e}"));
+            return;
         }
-        Err(e) => notes.push(format!("no figures: {e}")),
+    };
+    let path = |file: &str| model_dir.join(file).to_string_lossy().to_string();
+    let solution = &run.solution;
+    let mut drawn: Vec<(&str, String, Result<(), String>)> = vec![
+        (
+            "time.svg",
+            format!("Coordinates against time ({})", run.run.describe()),
+            plot::time_histories(&path("time.svg"), model, solution, None),
+        ),
+        (
+            "phase.svg",
+            "Phase portrait: each rate against its coordinate".to_string(),
+            plot::phase_portrait(&path("phase.svg"), model, solution, None),
+        ),
+        (
+            "energy.svg",
+            "Energy drift E(t) − E(0)".to_string(),
+            plot::energy_drift(
+                &path("energy.svg"),
+                model.name(),
+                &solution.t,
+                &run.energy.energy,
+                run.energy.initial_energy,
+                None,
+            ),
+        ),
+    ];
+    if let Some(drift) = &run.constraint_drift {
+        drawn.push((
+            "constraints.svg",
+            "Constraint drift max |Φ|, max |Φ̇|, no stabilisation".to_string(),
+            plot::constraint_drift(&path("constraints.svg"), &name, &solution.t, drift, None),
+        ));
     }
     for (file, caption, result) in drawn {
         match result {
-            Ok(()) => figures.push(Figure {
+            Ok(()) => report.figures.push(Figure {
                 file: format!("{name}/{file}"),
                 caption,
             }),
-            Err(e) => notes.push(format!("{file}: {e}")),
+            Err(e) => report.notes.push(format!("{file}: {e}")),
         }
     }
+}
 
-    checks.extend(eomgen::checks::motion_checks(
-        file,
+/// The mode shapes on the mechanism at the frequency check's equilibrium (`Err`: why the
+/// analysis failed), `NAME/shape-mode<k>.svg`.
+fn draw_mode_shapes(
+    model: &dyn ModelInfo,
+    shapes: &Result<ModalAnalysis, String>,
+    model_dir: &Path,
+    report: &mut ModelReport,
+) {
+    let name = report.name.clone();
+    let modal = match shapes {
+        Ok(modal) => modal,
+        Err(e) => {
+            report.notes.push(format!("mode shapes: {e}"));
+            return;
+        }
+    };
+    let modes = &modal.normal_modes;
+    let prefix = model_dir.join("shape.svg");
+    match super::mode_plot::mode_charts(
+        &prefix.to_string_lossy(),
         model,
-        y0,
-        &mut simulations,
-        &mut |at| {
-            operating_points
-                .get(at.map(str::to_string), operating_point)
-                .map(|op| ModesAt {
-                    label: op.label.clone(),
-                    natural_frequencies: op.modes.natural_frequencies.clone(),
-                    linearization: op.lin.clone(),
-                })
-        },
-    ));
-
-    // Mode shapes where `eomgen modes` applies: named equilibria and points to draw on (at
-    // the equilibrium of the frequency check).
-    if !model.equilibrium_guesses().is_empty() && !model.point_names().is_empty() {
-        let at = file
-            .checks
-            .natural_frequencies
-            .as_ref()
-            .and_then(|check| check.at.as_ref().map(|a| a.value.clone()));
-        match operating_points.get(at, operating_point) {
-            Ok(op) => {
-                let shapes = op.lin.to_coordinates(&op.modes.mode_shapes);
-                let prefix = model_dir.join("shape.svg");
-                match super::mode_plot::mode_charts(
-                    &prefix.to_string_lossy(),
-                    model,
-                    &op.equilibrium.q,
-                    &op.modes,
-                    &shapes,
-                ) {
-                    Ok(paths) => {
-                        for (k, (path, omega)) in
-                            paths.iter().zip(&op.modes.natural_frequencies).enumerate()
-                        {
-                            let file_name = Path::new(path)
-                                .file_name()
-                                .map(|f| f.to_string_lossy().to_string())
-                                .unwrap_or_default();
-                            figures.push(Figure {
-                                file: format!("{name}/{file_name}"),
-                                caption: format!(
-                                    "Mode {} at {}: ω = {omega:.6} rad/s",
-                                    k + 1,
-                                    op.label
-                                ),
-                            });
-                        }
-                    }
-                    Err(e) => notes.push(format!("mode shapes: {}", e.message)),
-                }
+        &modal.operating_point.equilibrium.q,
+        modes,
+        &modal.mode_shape_matrix(),
+    ) {
+        Ok(paths) => {
+            for (k, (path, omega)) in paths.iter().zip(&modes.natural_frequencies).enumerate() {
+                let file_name = Path::new(path)
+                    .file_name()
+                    .map(|f| f.to_string_lossy().to_string())
+                    .unwrap_or_default();
+                report.figures.push(Figure {
+                    file: format!("{name}/{file_name}"),
+                    caption: format!(
+                        "Mode {} at {}: ω = {omega:.6} rad/s",
+                        k + 1,
+                        modal.operating_point.name
+                    ),
+                });
             }
-            Err(e) => notes.push(format!("mode shapes: {e}")),
         }
+        Err(e) => report.notes.push(format!("mode shapes: {}", e.message)),
     }
-    report.animation = animation(&spec, &name, &model_dir, &mut report.notes);
 }
 
 /// Writes the model's animation, `NAME/animation.html` (`eomgen animate NAME` with the

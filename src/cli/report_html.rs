@@ -6,7 +6,50 @@
 use std::fmt::Write as _;
 
 use super::render::escape;
-use super::report::{CheckRow, ModelReport};
+use eomgen::checks::CheckRow;
+
+/// A figure of a model's section: the file (relative to the report's directory) and what
+/// it shows.
+#[derive(Debug, Clone)]
+pub(super) struct Figure {
+    /// Relative path, `model/kind.svg`.
+    pub file: String,
+    /// Caption.
+    pub caption: String,
+}
+
+/// Everything the report shows for one model.
+#[derive(Debug, Clone)]
+pub(super) struct ModelReport {
+    /// The model's name.
+    pub name: String,
+    /// `description:`.
+    pub description: String,
+    /// The comment block at the top of the model file (its source and reference values).
+    pub header: String,
+    /// Degrees of freedom.
+    pub dof: usize,
+    /// The equations of motion, one `<math>` element per line.
+    pub equations: Vec<String>,
+    /// Charts.
+    pub figures: Vec<Figure>,
+    /// The model's animation (a self-contained HTML file relative to the report's
+    /// directory), embedded when present.
+    pub animation: Option<String>,
+    /// The pass/fail table.
+    pub checks: Vec<CheckRow>,
+    /// What could not be drawn or was skipped, and why.
+    pub notes: Vec<String>,
+    /// Wall time (s).
+    pub time_s: f64,
+}
+
+impl ModelReport {
+    /// Whether every check passed.
+    pub fn passed(&self) -> bool {
+        self.checks.iter().all(|c| c.passed)
+    }
+}
 
 const STYLE: &str = r#"
 :root { --pass: #1a7f37; --fail: #cf222e; --line: #d0d7de; --muted: #57606a; }

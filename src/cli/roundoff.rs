@@ -11,6 +11,7 @@ use eomgen::analysis::roundoff::{
 };
 use serde_json::json;
 
+use super::render::num;
 use super::stability::{log_y_chart, print_json};
 use super::{CliError, plot};
 
@@ -60,7 +61,7 @@ pub fn run(args: &EulerRoundoffArgs) -> Result<(), CliError> {
         let _ = writeln!(
             stdout,
             "x' = x, x(0) = 1 on [0, 1], h = 10⁻ⁿ: error x(1) − e = truncation (exact-arithmetic Φ(h)ᴺ − e) + roundoff (x(1) − Φ(h)ᴺ); ε = {:e}",
-            f64::EPSILON
+            num(f64::EPSILON)
         );
         let _ = writeln!(
             stdout,
@@ -87,18 +88,18 @@ pub fn run(args: &EulerRoundoffArgs) -> Result<(), CliError> {
                 "{:>3} {:>11} | {:>10.2e} {:>10.2e} {:>10.2e} {:>10.2e} | {:>10.2e} {:>10.2e} | {:>10.2e} {:>10.2e} | {:>10.2e} {:>10.2e} | {:>10.2e} {:>10.2e}",
                 r.n,
                 r.steps,
-                euler.error,
-                euler.truncation,
-                -E * r.h / 2.0,
-                euler.roundoff,
-                midpoint.error,
-                midpoint.roundoff,
-                rk4.error,
-                rk4.roundoff,
-                r.epsilon_sqrt_steps,
-                r.epsilon_steps,
-                r.single_precision_euler.error,
-                r.single_precision_euler.epsilon_sqrt_steps
+                num(euler.error),
+                num(euler.truncation),
+                num(-E * r.h / 2.0),
+                num(euler.roundoff),
+                num(midpoint.error),
+                num(midpoint.roundoff),
+                num(rk4.error),
+                num(rk4.roundoff),
+                num(r.epsilon_sqrt_steps),
+                num(r.epsilon_steps),
+                num(r.single_precision_euler.error),
+                num(r.single_precision_euler.epsilon_sqrt_steps)
             );
         }
         for s in &summaries {
@@ -107,7 +108,7 @@ pub fn run(args: &EulerRoundoffArgs) -> Result<(), CliError> {
                 "{:<9} optimal n = {} (|error| {:.2e}); roundoff grows as N^{}",
                 s.method,
                 s.optimal_n,
-                s.smallest_error,
+                num(s.smallest_error),
                 s.roundoff_exponent
                     .map_or("? (too few n above the floor)".to_string(), |a| format!(
                         "{a:.2}"

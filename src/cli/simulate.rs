@@ -12,6 +12,7 @@ use eomgen::expressions::{ExpressionEvents, set_initial_values};
 use eomgen::{IntegrationError, ModelInfo, OutputTimes, Solution};
 use serde_json::json;
 
+use super::render::num;
 use super::values::{evaluate, set_parameters, usage};
 use super::output::outln;
 use super::{CliError, find_model, plot};
@@ -128,9 +129,9 @@ pub struct IntegrationArgs {
     /// parameters); repeatable.
     #[arg(long = "set", value_name = "NAME=VALUE")]
     pub set: Vec<String>,
-    /// Set an initial coordinate or rate, `NAME=VALUE` (e.g. `theta1=pi/2`, `theta1_dot=0`);
-    /// repeatable.
-    #[arg(long = "init", value_name = "NAME=VALUE")]
+    /// Set initial coordinates or rates, `NAME=VALUE` or a comma list (e.g.
+    /// `theta1=pi/2,theta1_dot=0`); repeatable.
+    #[arg(long = "init", value_name = "NAME=VALUE,…")]
     pub init: Vec<String>,
     /// Drift control of a constrained model: `none` (show the drift), `baumgarte`
     /// (Φ̈ + 2α Φ̇ + β² Φ = 0, see --baumgarte) or `projection` (onto Φ = 0 and the velocity
@@ -173,10 +174,10 @@ impl IntegrationArgs {
     /// `fixed step dt = 1e-2 s` otherwise (`--dt`, default `t_end/1000`).
     pub(crate) fn step_control(&self) -> String {
         if self.method.is_adaptive() {
-            format!("rtol {:e}, atol {:e}", self.rtol, self.atol)
+            format!("rtol {:e}, atol {:e}", num(self.rtol), num(self.atol))
         } else {
             let dt = self.dt.unwrap_or(self.t_end / 1000.0);
-            format!("fixed step dt = {dt:e} s")
+            format!("fixed step dt = {dt:e} s", dt = num(dt))
         }
     }
 }
@@ -486,11 +487,13 @@ fn inconsistent_message(
 ) -> String {
     if has_guesses {
         format!(
-            "no consistent initial state for `{model}`: constraint `{constraint}` keeps a residual of {residual:.3e} after {iterations} Newton iteration(s) from the guesses; try other guesses"
+            "no consistent initial state for `{model}`: constraint `{constraint}` keeps a residual of {residual:.3e} after {iterations} Newton iteration(s) from the guesses; try other guesses",
+            residual = num(residual)
         )
     } else {
         format!(
-            "the initial state of `{model}` violates its constraints: `{constraint}` has a residual of {residual:.3e}; mark the dependent coordinates as `{{ guess: … }}` in `initial:` or fix the values"
+            "the initial state of `{model}` violates its constraints: `{constraint}` has a residual of {residual:.3e}; mark the dependent coordinates as `{{ guess: … }}` in `initial:` or fix the values",
+            residual = num(residual)
         )
     }
 }
@@ -617,21 +620,28 @@ fn print_summary(
         for (i, name) in names.iter().enumerate() {
             outln!(
                 "           {name:>12} = {:>22.15e}   {:>16} = {:>22.15e}",
-                y[i],
+                num(y[i]),
                 format!("{name}_dot"),
-                y[n + i]
+                num(y[n + i])
             );
         }
     }
     if let (e0, Some(e1)) = (report.initial_energy, report.energy.last()) {
-        outln!("energy     E(0) = {e0:.12e} J, E(end) = {e1:.12e} J");
+        outln!(
+            "energy     E(0) = {e0:.12e} J, E(end) = {e1:.12e} J",
+            e0 = num(e0),
+            e1 = num(e1)
+        );
         if let Some(d) = report.drift {
             let note = if model.is_conservative() {
                 ""
             } else {
                 " (not conserved: the model has non-conservative loads or explicit time dependence)"
             };
-            outln!("drift      max|E - E(0)| / max(T + |V|) = {d:.3e}{note}");
+            outln!(
+                "drift      max|E - E(0)| / max(T + |V|) = {d:.3e}{note}",
+                d = num(d)
+            );
         }
     }
     let s = &solution.stats;
@@ -710,13 +720,19 @@ fn print_events(model: &dyn ModelInfo, solution: &Solution) {
         let state: Vec<String> = names
             .iter()
             .enumerate()
-            .map(|(i, c)| format!("{c} = {:.9e}, {c}_dot = {:.9e}", e.y[i], e.y[n + i]))
+            .map(|(i, c)| {
+                format!(
+                    "{c} = {:.9e}, {c}_dot = {:.9e}",
+                    num(e.y[i]),
+                    num(e.y[n + i])
+                )
+            })
             .collect();
         outln!(
             "           {:<16} {:<8} t = {:.15e}   {}",
             e.name,
             e.direction.name(),
-            e.t,
+            num(e.t),
             state.join(", ")
         );
     }
@@ -735,7 +751,7 @@ fn print_events(model: &dyn ModelInfo, solution: &Solution) {
         if times.len() >= 2 {
             let intervals: Vec<String> = times
                 .windows(2)
-                .map(|w| format!("{:.12e}", w[1] - w[0]))
+                .map(|w| format!("{:.12e}", num(w[1] - w[0])))
                 .collect();
             outln!(
                 "intervals  between successive `{}`: {} s",
@@ -746,7 +762,7 @@ fn print_events(model: &dyn ModelInfo, solution: &Solution) {
     }
     if let Some(k) = solution.terminated_by_event {
         let e = &solution.events[k];
-        outln!("stopped    at t = {:.15e} by event `{}`", e.t, e.name);
+        outln!("stopped    at t = {:.15e} by event `{}`", num(e.t), e.name);
     }
 }
 
@@ -770,7 +786,7 @@ fn write_events_csv(
             e.name,
             e.direction.name(),
             e.terminal,
-            e.t
+            num(e.t)
         ));
         for v in &e.y {
             out.push_str(&format!(",{v:e}"));
@@ -798,13 +814,15 @@ fn print_constraint_summary(constraints: &ConstraintDrift, stabilization: Stabil
             .constraint_names
             .iter()
             .zip(last)
-            .map(|(n, l)| format!("{n} = {l:.9e}"))
+            .map(|(n, l)| format!("{n} = {l:.9e}", l = num(l)))
             .collect();
         outln!("lambda     at the end: {}", forces.join(", "));
     }
     let (p, v) = constraints.max_drift();
     outln!(
         "drift      constraints ({}): max |Φ| = {p:.3e}, max |Φ̇| = {v:.3e}",
-        format!("{stabilization:?}").to_lowercase()
+        format!("{stabilization:?}").to_lowercase(),
+        p = num(p),
+        v = num(v)
     );
 }

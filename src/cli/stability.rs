@@ -17,13 +17,17 @@ use clap::Args;
 use eomgen::analysis::stability::{
     AMPLIFICATION_STEPS, BISECTION_TOLERANCE, EnergyRow, ExplicitMethod, GROWTH_THRESHOLD, Limits,
     STIFF_OUTPUT_TIMES, STIFF_REFERENCE_TOL, StabilityError, StabilityOptions, StabilityStudy,
-    StiffMode, StiffRow, UnderflowRun, stability_study,
+    StiffMode, StiffRow, StiffSpring, UnderflowRun, stability_study,
 };
 use eomgen::integrate::stability::GrowthTest;
 use nalgebra::Complex;
 use serde_json::json;
 
+use super::render::num;
 use super::{CliError, find_model, plot};
+
+/// The bundled model of part c: HW9's two-mass spring.
+const STIFF_MODEL: &str = "two_masses";
 
 /// Options of `eomgen study stability`.
 #[derive(Debug, Args)]
@@ -74,6 +78,14 @@ pub fn run(args: &StabilityArgs) -> Result<(), CliError> {
         stiffness: args.stiffness.clone(),
         t_end: args.t_end,
         tol: args.tol,
+        // HW9's two-mass spring file and its names.
+        stiff_spring: StiffSpring {
+            mass_1: "m1".to_string(),
+            mass_2: "m2".to_string(),
+            stiffness: "k".to_string(),
+            force: "F0".to_string(),
+            stretched: "x2".to_string(),
+        },
     };
     options.validate().map_err(study_error)?;
     if let Some(prefix) = &args.plot
@@ -81,7 +93,7 @@ pub fn run(args: &StabilityArgs) -> Result<(), CliError> {
     {
         return Err(CliError::usage("--plot needs a file prefix"));
     }
-    let mut two_masses = find_model("two_masses")?;
+    let mut two_masses = find_model(STIFF_MODEL)?;
     let StabilityStudy {
         test,
         mut limits,
@@ -109,7 +121,7 @@ pub fn run(args: &StabilityArgs) -> Result<(), CliError> {
             },
             "energy": {"periods": args.periods, "runs": energy},
             "stiff": {
-                "model": "two_masses",
+                "model": two_masses.name(),
                 "t_end": args.t_end,
                 "tol": args.tol,
                 "reference": {"method": "dop853", "tol": STIFF_REFERENCE_TOL},
@@ -167,7 +179,7 @@ pub(super) fn print_json(value: &serde_json::Value) -> Result<(), CliError> {
 }
 
 fn optional(value: Option<f64>) -> String {
-    value.map_or_else(|| "-".to_string(), |v| format!("{v:.4e}"))
+    value.map_or_else(|| "-".to_string(), |v| format!("{v:.4e}", v = num(v)))
 }
 
 fn write_limits(out: &mut String, test: &GrowthTest, limits: &Limits) {
@@ -183,19 +195,23 @@ fn write_limits(out: &mut String, test: &GrowthTest, limits: &Limits) {
     let _ = writeln!(
         out,
         "   measured: bisection (to {BISECTION_TOLERANCE:e} relative) on runs of N = {} constant steps, unstable when ‖y‖ grows beyond {GROWTH_THRESHOLD:e}.",
-        test.steps
+        test.steps,
+        BISECTION_TOLERANCE = num(BISECTION_TOLERANCE),
+        GROWTH_THRESHOLD = num(GROWTH_THRESHOLD)
     );
     let _ = writeln!(
         out,
         "   N detects a per-step growth δ ≥ {:.2e}; one percent above a limit the growth is δ₁ and needs N₁ = ln {GROWTH_THRESHOLD:e}/ln(1 + δ₁) steps.",
-        test.smallest_detected_growth()
+        num(test.smallest_detected_growth()),
+        GROWTH_THRESHOLD = num(GROWTH_THRESHOLD)
     );
     let _ = writeln!(
         out,
         "   {:<18} {:<9} {:>10} {:>10} {:>10} {:>10} {:>10} {:>9} {:>8}",
         "method", "axis", "theory", "measured", "rel. diff", "theory(N)", "rel. diff", "δ₁", "N₁"
     );
-    let difference = |d: Option<f64>| d.map_or("-".to_string(), |d| format!("{d:+.2e}"));
+    let difference =
+        |d: Option<f64>| d.map_or("-".to_string(), |d| format!("{d:+.2e}", d = num(d)));
     for r in &limits.rows {
         let _ = writeln!(
             out,
@@ -207,7 +223,7 @@ fn write_limits(out: &mut String, test: &GrowthTest, limits: &Limits) {
             difference(r.relative_difference),
             r.theory_at_detection,
             difference(r.relative_difference_at_detection),
-            r.growth_one_percent_above,
+            num(r.growth_one_percent_above),
             r.steps_needed_one_percent_above,
             if r.steps_needed_one_percent_above > r.steps_used {
                 "  N₁ > N: 1% not resolvable"
@@ -219,7 +235,7 @@ fn write_limits(out: &mut String, test: &GrowthTest, limits: &Limits) {
     let _ = writeln!(
         out,
         "   theory(N): first h where the per-step growth exceeds the detected {:.2e}, the limit N steps can see.",
-        test.smallest_detected_growth()
+        num(test.smallest_detected_growth())
     );
     let _ = writeln!(
         out,
@@ -238,14 +254,19 @@ fn write_limits(out: &mut String, test: &GrowthTest, limits: &Limits) {
             r.h_omega,
             r.measured,
             r.theory,
-            r.relative_difference,
+            num(r.relative_difference),
             optional(r.norm_after_long_run)
         );
     }
     for m in &limits.explicit {
         let check = m.implementation_difference.map_or_else(
             || "read off one step of the implementation (tableau private)".to_string(),
-            |d| format!("tableau vs one step of the implementation: {d:.1e}"),
+            |d| {
+                format!(
+                    "tableau vs one step of the implementation: {d:.1e}",
+                    d = num(d)
+                )
+            },
         );
         let _ = writeln!(
             out,
@@ -284,12 +305,12 @@ fn write_energy(out: &mut String, periods: usize, rows: &[EnergyRow]) {
             format!("T/{}", r.steps_per_period),
             r.periods_reached,
             r.final_energy_ratio
-                .map_or("overflow".to_string(), |e| format!("{e:.6e}")),
+                .map_or("overflow".to_string(), |e| format!("{e:.6e}", e = num(e))),
             r.log10_final_energy_ratio,
             r.theory_log10_final_energy_ratio
                 .map_or("-".to_string(), |e| format!("{e:.6}")),
             r.max_energy_error
-                .map_or("overflow".to_string(), |e| format!("{e:.4e}")),
+                .map_or("overflow".to_string(), |e| format!("{e:.4e}", e = num(e))),
             optional(r.theory_max_energy_error)
         );
         if let Some(f) = &r.failure {
@@ -313,8 +334,10 @@ fn write_stiff(out: &mut String, args: &StabilityArgs, modes: &[StiffMode], rows
     use std::fmt::Write as _;
     let _ = writeln!(
         out,
-        "c. Stiff two-mass spring (two_masses, k = (k/m)·m₁), 0 ≤ t ≤ {} s, rtol = atol = {:e}; errors at {STIFF_OUTPUT_TIMES} times against DOP853 at {STIFF_REFERENCE_TOL:e}",
-        args.t_end, args.tol
+        "c. Stiff two-mass spring ({STIFF_MODEL}, k = (k/m)·m₁), 0 ≤ t ≤ {} s, rtol = atol = {:e}; errors at {STIFF_OUTPUT_TIMES} times against DOP853 at {STIFF_REFERENCE_TOL:e}",
+        args.t_end,
+        num(args.tol),
+        STIFF_REFERENCE_TOL = num(STIFF_REFERENCE_TOL)
     );
     let _ = writeln!(
         out,
@@ -333,11 +356,11 @@ fn write_stiff(out: &mut String, args: &StabilityArgs, modes: &[StiffMode], rows
         let _ = writeln!(
             out,
             "   {:>8.0e} {:<12} {:>12.1} {:>14.2e} {:>14.2e} {:>11}",
-            m.k_over_m,
+            num(m.k_over_m),
             m.start,
             m.omega,
-            m.position_amplitude,
-            m.velocity_amplitude,
+            num(m.position_amplitude),
+            num(m.velocity_amplitude),
             m.reference_steps
         );
     }
@@ -359,7 +382,7 @@ fn write_stiff(out: &mut String, args: &StabilityArgs, modes: &[StiffMode], rows
         let _ = writeln!(
             out,
             "   {:>8.0e} {:<12} {:<8} {:>9} {:>8} {:>10} {:>6} {:>6} {:>12} {:>12}{}",
-            r.k_over_m,
+            num(r.k_over_m),
             r.start,
             r.method,
             r.steps,
@@ -382,7 +405,9 @@ fn write_underflow(out: &mut String, run: &UnderflowRun) {
     let _ = writeln!(
         out,
         "d. Step-size underflow: {}, {} at rtol = atol = {:e}",
-        run.problem, run.method, run.tol
+        run.problem,
+        run.method,
+        num(run.tol)
     );
     match &run.failure {
         Some(f) => {

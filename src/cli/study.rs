@@ -11,6 +11,7 @@ use eomgen::analysis::{ConstraintMethods, ConstraintMethodsError, ConstraintMeth
 use eomgen::studies::minimal_twin;
 use serde_json::json;
 
+use super::render::num;
 use super::{CliError, plot};
 
 /// The studies.
@@ -157,11 +158,15 @@ fn constraint_methods(args: &ConstraintMethodsArgs) -> Result<(), CliError> {
         let _ = writeln!(
             stdout,
             "model      {} over 0 ≤ t ≤ {} s, Dormand–Prince 5(4) at rtol = atol = {:e}",
-            model, args.t_end, args.tol
+            model,
+            args.t_end,
+            num(args.tol)
         );
         let _ = writeln!(
             stdout,
-            "reference  DAE with Baumgarte at tol {reference_tol:e}; the unstabilised DAE at that tolerance agrees to {agreement:.2e} m"
+            "reference  DAE with Baumgarte at tol {reference_tol:e}; the unstabilised DAE at that tolerance agrees to {agreement:.2e} m",
+            reference_tol = num(reference_tol),
+            agreement = num(agreement)
         );
         let _ = writeln!(
             stdout,
@@ -169,12 +174,14 @@ fn constraint_methods(args: &ConstraintMethodsArgs) -> Result<(), CliError> {
             "method", "pos. err (m)", "max |Φ|", "RHS evals", "steps", "time (ms)"
         );
         for r in &rows {
-            let drift = r.drift.map_or("-".to_string(), |d| format!("{d:.2e}"));
+            let drift = r
+                .drift
+                .map_or("-".to_string(), |d| format!("{d:.2e}", d = num(d)));
             let _ = writeln!(
                 stdout,
                 "{:<44} {:>12.2e} {:>12} {:>10} {:>8} {:>10.3}{}",
                 r.method,
-                r.position_error,
+                num(r.position_error),
                 drift,
                 r.rhs_evals,
                 r.steps,

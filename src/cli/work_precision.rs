@@ -14,6 +14,7 @@ use eomgen::analysis::work_precision::{
 };
 use serde_json::json;
 
+use super::render::num;
 use super::simulate::Method;
 use super::{CliError, find_model, plot};
 
@@ -203,8 +204,19 @@ pub fn run(args: &WorkPrecisionArgs) -> Result<(), CliError> {
     options.tolerances = parse_tols(&args.tols)?;
     options.steps = args.steps.as_deref().map(parse_steps).transpose()?;
     let mut model = find_model(&args.model)?;
-    let report = work_precision(model.as_mut(), &options, &mut |_, _| {})
-        .map_err(|e| study_error(args, e))?;
+    // The runs take seconds to minutes: a bar on a terminal, nothing otherwise.
+    let bar = super::render::progress_bar(
+        0,
+        "{msg} [{bar:30}] {pos}/{len} runs ({elapsed}, eta {eta})",
+        "work-precision",
+        args.json,
+    );
+    let report = work_precision(model.as_mut(), &options, &mut |done, total| {
+        bar.set_length(total as u64);
+        bar.set_position(done as u64);
+    });
+    bar.finish_and_clear();
+    let report = report.map_err(|e| study_error(args, e))?;
     let study = Study {
         args,
         model: model.as_ref(),
@@ -214,7 +226,8 @@ pub fn run(args: &WorkPrecisionArgs) -> Result<(), CliError> {
     let agreement = study.report.agreement;
     if num_unresolved > 0 {
         super::output::errln!(
-            "warning: {num_unresolved} run(s) have an error below 10 × the reference's agreement ({agreement:.2e}): the reference does not resolve them, their errors are upper bounds at best (marked `!` in the table, `\"resolved\": false` in JSON)"
+            "warning: {num_unresolved} run(s) have an error below 10 × the reference's agreement ({agreement:.2e}): the reference does not resolve them, their errors are upper bounds at best (marked `!` in the table, `\"resolved\": false` in JSON)",
+            agreement = num(agreement)
         );
     }
     if let Some(prefix) = &args.plot {
@@ -372,7 +385,9 @@ impl Study<'_> {
         writeln!(
             out,
             "reference  DOP853 at rtol = atol = {:e} ({} steps); Dormand–Prince 5(4) at the same tolerance agrees to {:.2e}",
-            args.reference_tol, self.report.reference_steps, self.report.agreement
+            num(args.reference_tol),
+            self.report.reference_steps,
+            num(self.report.agreement)
         )?;
         writeln!(
             out,
@@ -401,13 +416,13 @@ impl Study<'_> {
                     Ok(m) => writeln!(
                         out,
                         "{name:<22} {setting:>13} {:>9.2e}{} {:>11} {:>9} {:>11.3} {:>12}",
-                        m.error,
+                        num(m.error),
                         if self.unresolved(m) { "!" } else { " " },
                         m.rhs_evals,
                         m.steps,
                         m.wall_time_s * 1e3,
                         m.energy_drift
-                            .map_or("-".to_string(), |d| format!("{d:.2e}"))
+                            .map_or("-".to_string(), |d| format!("{d:.2e}", d = num(d)))
                     )?,
                     Err(f) => writeln!(out, "{name:<22} {setting:>13}   failed: {}", f.message)?,
                 }
@@ -416,7 +431,7 @@ impl Study<'_> {
         writeln!(
             out,
             "\nwork to reach an error of {:e} (log–log interpolation between the bracketing settings)",
-            args.target_error
+            num(args.target_error)
         )?;
         let baseline_header = args.baseline_ms.map_or(String::new(), |b| {
             format!(" {:>16}", format!("{b} ms / time"))

@@ -30,6 +30,23 @@ pub struct EnergyDrift {
     pub drift: Option<f64>,
 }
 
+impl EnergyDrift {
+    /// `(E − E(0)) / scale` at every sample (the absolute deviation when the scale is 0),
+    /// signed.
+    pub fn relative(&self) -> Vec<f64> {
+        self.energy
+            .iter()
+            .map(|e| {
+                if self.scale > 0.0 {
+                    (e - self.initial_energy) / self.scale
+                } else {
+                    e - self.initial_energy
+                }
+            })
+            .collect()
+    }
+}
+
 /// The energy drift of `solution` from the initial state `y0`:
 ///
 /// ```text
@@ -59,10 +76,31 @@ pub struct EnergyDrift {
 /// # Ok::<(), eomgen::IntegrationFailure>(())
 /// ```
 pub fn energy_drift(model: &dyn ModelInfo, y0: &[f64], solution: &Solution) -> EnergyDrift {
-    let mut energy = Vec::with_capacity(solution.len());
+    energy_drift_at(model, y0, solution.iter())
+}
+
+/// [`energy_drift`] over the states `samples` (`(t, y)` pairs, `y = [q; q̇]` of `2n`
+/// entries), for samples that are not a whole [`Solution`] (an animation's frames).
+///
+/// # Examples
+/// ```
+/// use eomgen::analysis::energy_drift_at;
+///
+/// let model = (eomgen::models::find("simple_pendulum").unwrap().make)();
+/// let y0 = model.initial_state();
+/// let drift = energy_drift_at(model.as_ref(), &y0, [(0.0, y0.as_slice())].into_iter());
+/// assert_eq!(drift.drift, Some(0.0));
+/// assert_eq!(drift.relative(), [0.0]);
+/// ```
+pub fn energy_drift_at<'a>(
+    model: &dyn ModelInfo,
+    y0: &[f64],
+    samples: impl Iterator<Item = (f64, &'a [f64])>,
+) -> EnergyDrift {
+    let mut energy = Vec::with_capacity(samples.size_hint().0);
     let initial_energy = model.energy(0.0, y0);
     let mut scale: f64 = model.kinetic_energy(0.0, y0) + model.potential_energy(0.0, y0).abs();
-    for (t, y) in solution.iter() {
+    for (t, y) in samples {
         let (tk, v) = (model.kinetic_energy(t, y), model.potential_energy(t, y));
         energy.push(tk + v);
         scale = scale.max(tk + v.abs());

@@ -18,14 +18,16 @@ pub use constraint_methods::{
     ConstraintMethodRow, ConstraintMethods, ConstraintMethodsError, ConstraintMethodsOptions,
     constraint_methods,
 };
-pub use drift::{ConstraintDrift, EnergyDrift, constraint_drift, energy_drift};
+pub use drift::{ConstraintDrift, EnergyDrift, constraint_drift, energy_drift, energy_drift_at};
 pub use fixed_step::{SimulationWarning, fixed_step_warnings};
 pub use methods::{Method, UnknownMethod};
 pub use roundoff::{EulerRoundoff, RoundoffError, RoundoffOptions, euler_roundoff};
 pub use simulation::{
     AddedEvents, Simulation, SimulationError, SimulationOptions, simulate, simulate_with_events,
 };
-pub use stability::{StabilityError, StabilityOptions, StabilityStudy, stability_study};
+pub use stability::{
+    StabilityError, StabilityOptions, StabilityStudy, StiffSpring, stability_study,
+};
 pub use work_precision::{
     AtTarget, Measured, MethodRuns, RunFailure, Setting, SettingRun, WorkPrecision,
     WorkPrecisionError, WorkPrecisionOptions, work_precision,

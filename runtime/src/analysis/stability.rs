@@ -51,6 +51,40 @@ pub struct StabilityOptions {
     /// Relative and absolute tolerance of the stiff runs and of the underflow run, in
     /// `[1e-13, 1)` (default: 1e-6).
     pub tol: f64,
+    /// The names of the stiff model's masses, spring, force and stretched coordinate (part
+    /// c; default: those of HW9's two-mass spring file).
+    pub stiff_spring: StiffSpring,
+}
+
+/// The names in the stiff model of part c: two masses `m₁`, `m₂` (kg) joined by a spring of
+/// stiffness `k` (N/m) under a constant force `F₀` (N), whose static stretch
+/// `F₀ m₁/(k (m₁ + m₂))` is added to the stretched coordinate in the run from equilibrium;
+/// the stiff mode's frequency is `√(k (m₁ + m₂)/(m₁ m₂))`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StiffSpring {
+    /// The first mass's parameter (default `m1`).
+    pub mass_1: String,
+    /// The second mass's parameter (default `m2`).
+    pub mass_2: String,
+    /// The spring's stiffness parameter, set to `k/m · m₁` (default `k`).
+    pub stiffness: String,
+    /// The constant force's parameter (default `F0`).
+    pub force: String,
+    /// The coordinate displaced by the static stretch in the run from equilibrium (default
+    /// `x2`).
+    pub stretched: String,
+}
+
+impl Default for StiffSpring {
+    fn default() -> Self {
+        Self {
+            mass_1: "m1".to_string(),
+            mass_2: "m2".to_string(),
+            stiffness: "k".to_string(),
+            force: "F0".to_string(),
+            stretched: "x2".to_string(),
+        }
+    }
 }
 
 impl Default for StabilityOptions {
@@ -61,6 +95,7 @@ impl Default for StabilityOptions {
             stiffness: vec![1e2, 1e4, 1e6, 1e8],
             t_end: 1.0,
             tol: 1e-6,
+            stiff_spring: StiffSpring::default(),
         }
     }
 }
@@ -120,15 +155,24 @@ pub enum StabilityError {
         /// The integration's failure.
         message: String,
     },
-    /// The stiff model lacks a parameter the study sets or reads (`m1`, `m2`, `F0`, `k`).
-    #[error("two_masses has no parameter `{name}`")]
+    /// The stiff model lacks a parameter of [`StiffSpring`].
+    #[error("the stiff model `{model}` has no parameter `{name}` (its {role})")]
     MissingParameter {
+        /// The model's name.
+        model: String,
         /// The parameter.
-        name: &'static str,
+        name: String,
+        /// What it was to be (`first mass`, `spring stiffness`, …).
+        role: &'static str,
     },
-    /// The stiff model lacks the coordinate `x2`.
-    #[error("two_masses has no coordinate `x2`")]
-    MissingCoordinate,
+    /// The stiff model lacks the coordinate [`StiffSpring::stretched`].
+    #[error("the stiff model `{model}` has no coordinate `{name}` (its stretched coordinate)")]
+    MissingCoordinate {
+        /// The model's name.
+        model: String,
+        /// The coordinate.
+        name: String,
+    },
     /// Setting `k` failed.
     #[error(transparent)]
     UnknownParameter(#[from] UnknownParameter),
@@ -196,16 +240,16 @@ pub struct StabilityStudy {
     pub underflow: UnderflowRun,
 }
 
-/// Runs the stability study (see the module docs); `two_masses` is HW9's two-mass spring
-/// (parameters `m1`, `m2`, `k`, `F0`, coordinates `x1`, `x2`) whose `k` is set to each
-/// `k/m · m1` of part c.
+/// Runs the stability study (see the module docs); `stiff_model` is a two-mass spring (HW9's)
+/// with the names of [`StabilityOptions::stiff_spring`], whose stiffness is set to each
+/// `k/m · m₁` of part c.
 ///
 /// # Errors
 /// The errors of [`StabilityOptions::validate`]; [`StabilityError::PolynomialStep`],
 /// [`StabilityError::TestEquation`] and [`StabilityError::Amplification`] when a method fails
 /// on the test equations; [`StabilityError::MissingParameter`],
 /// [`StabilityError::MissingCoordinate`] or [`StabilityError::UnknownParameter`] for a
-/// `two_masses` without the names above; [`StabilityError::Reference`] when a stiff
+/// stiff model without those names; [`StabilityError::Reference`] when a stiff
 /// reference fails.
 ///
 /// # Examples
@@ -220,7 +264,7 @@ pub struct StabilityStudy {
 /// # Ok::<(), eomgen::analysis::StabilityError>(())
 /// ```
 pub fn stability_study(
-    two_masses: &mut dyn ModelInfo,
+    stiff_model: &mut dyn ModelInfo,
     options: &StabilityOptions,
 ) -> Result<StabilityStudy, StabilityError> {
     options.validate()?;
@@ -230,7 +274,7 @@ pub fn stability_study(
     };
     let limits = stability_limits(&test)?;
     let energy = energy_runs(options.periods);
-    let (stiff_modes, stiff) = stiff_runs(two_masses, options)?;
+    let (stiff_modes, stiff) = stiff_runs(stiff_model, options)?;
     let underflow = underflow_run(options.tol);
     Ok(StabilityStudy {
         test,
@@ -799,24 +843,35 @@ fn stiff_runs(
     let mut modes = Vec::new();
     let mut rows = Vec::new();
     for &ratio in &args.stiffness {
-        let parameter = |name: &'static str| {
+        let names = &args.stiff_spring;
+        let parameter = |name: &str, role: &'static str| {
             model
                 .parameter_names()
                 .iter()
                 .position(|p| *p == name)
                 .map(|i| model.parameter_values()[i])
-                .ok_or(StabilityError::MissingParameter { name })
+                .ok_or_else(|| StabilityError::MissingParameter {
+                    model: model.name().to_string(),
+                    name: name.to_string(),
+                    role,
+                })
         };
-        let (m1, m2, force) = (parameter("m1")?, parameter("m2")?, parameter("F0")?);
-        model.set_parameter("k", ratio * m1)?;
+        let m1 = parameter(&names.mass_1, "first mass")?;
+        let m2 = parameter(&names.mass_2, "second mass")?;
+        let force = parameter(&names.force, "force")?;
+        parameter(&names.stiffness, "spring stiffness")?;
+        model.set_parameter(&names.stiffness, ratio * m1)?;
         let k = ratio * m1;
         let omega = (k * (m1 + m2) / (m1 * m2)).sqrt();
         let static_stretch = force * m1 / (k * (m1 + m2));
         let x2 = model
             .coordinate_names()
             .iter()
-            .position(|c| *c == "x2")
-            .ok_or(StabilityError::MissingCoordinate)?;
+            .position(|c| *c == names.stretched)
+            .ok_or_else(|| StabilityError::MissingCoordinate {
+                model: model.name().to_string(),
+                name: names.stretched.clone(),
+            })?;
         for start in ["equilibrium", "rest"] {
             let mut y0 = model.initial_state();
             let position_amplitude = if start == "equilibrium" {
