@@ -9,7 +9,8 @@ use nalgebra::SVector;
 
 use crate::dynamic::DynMechanicalSystem;
 use crate::ode::RhsError;
-use crate::system::{MechanicalSystem, solve_spd_in_place};
+use crate::linalg::solve_spd_in_place;
+use crate::system::MechanicalSystem;
 
 /// The functions of a constrained mechanical system the workspace evaluates, on slices
 /// (shapes as [`DynMechanicalSystem`]: `M` column-major, `J` row-major).

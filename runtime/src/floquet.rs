@@ -37,7 +37,7 @@ use crate::integrate::{
     OutputTimes, Stats,
 };
 use crate::ode::{OdeSystem, RhsError};
-use crate::system::ModelInfo;
+use crate::model_info::ModelInfo;
 
 /// Why a Floquet analysis failed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

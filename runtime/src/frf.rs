@@ -58,7 +58,8 @@ use crate::modal::{
     linearize,
 };
 use crate::response::modal_damping;
-use crate::system::{ModelInfo, UnknownParameter};
+use crate::model_info::ModelInfo;
+use crate::system::UnknownParameter;
 
 /// Why an input matrix, a frequency response or a steady-state simulation failed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

@@ -8,11 +8,14 @@
 pub mod analysis;
 pub mod constrained;
 pub mod dynamic;
+pub mod first_order;
 pub mod floquet;
 pub mod frf;
 pub mod functions;
 pub mod integrate;
+pub mod linalg;
 pub mod modal;
+pub mod model_info;
 pub mod ode;
 pub mod response;
 pub mod system;
@@ -22,7 +25,8 @@ pub use analysis::{Method, UnknownMethod};
 pub use constrained::{
     ConstraintFunctions, ConstraintWorkspace, ProjectionError, Stabilization, StaticSystem,
 };
-pub use dynamic::{DynFirstOrder, DynMechanicalSystem};
+pub use dynamic::DynMechanicalSystem;
+pub use first_order::{DynFirstOrder, FirstOrder};
 pub use floquet::{
     FloquetAnalysis, FloquetError, FloquetOptions, FloquetStability, check_periodic_equilibrium,
     floquet_analysis, floquet_multipliers, monodromy_matrix,
@@ -53,7 +57,6 @@ pub use response::{
     response_with_modal_damping, state_response_by_eigenvectors, state_response_by_exponential,
     state_response_by_integration,
 };
-pub use system::{
-    BodyCentre, ConstraintValues, FirstOrder, MechanicalSystem, ModelInfo, UnknownParameter,
-    solve_spd, solve_spd_in_place,
-};
+pub use linalg::{solve_spd, solve_spd_in_place};
+pub use model_info::{ConstraintValues, ModelInfo};
+pub use system::{BodyCentre, MechanicalSystem, UnknownParameter};

@@ -11,7 +11,7 @@ use crate::integrate::{
     EventSpec, IntegrationError, IntegrationFailure, IntegratorOptions, OutputTimes, Solution,
 };
 use crate::ode::{RhsError, WithEvents};
-use crate::system::ModelInfo;
+use crate::model_info::ModelInfo;
 
 /// Options of [`simulate`]: method, end time, step control, output times, drift control and
 /// initial state.

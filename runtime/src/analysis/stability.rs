@@ -33,7 +33,7 @@ use crate::integrate::{
     Solution, StormerVerlet, SymplecticEuler, Tableau,
 };
 use crate::ode::OdeFn;
-use crate::system::ModelInfo;
+use crate::model_info::ModelInfo;
 
 /// Options of [`stability_study`].
 #[derive(Debug, Clone, PartialEq)]

@@ -14,7 +14,7 @@ use crate::response::{
     FreeResponse, ResponseError, response_by_exponential, response_by_integration,
     response_by_m_inv_k_modes, response_by_normal_modes,
 };
-use crate::system::ModelInfo;
+use crate::model_info::ModelInfo;
 
 /// Why a free-response or modal-damping study failed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

@@ -19,7 +19,7 @@ use crate::frf::{
 };
 use crate::modal::{NormalModes, normal_modes};
 use crate::response::{ModalDamping, modal_damping};
-use crate::system::ModelInfo;
+use crate::model_info::ModelInfo;
 
 /// Why a frequency-response analysis failed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

@@ -16,7 +16,7 @@ use crate::response::{
     DampedMode, FreeResponse, ModalDamping, RayleighDamping, exact_damped_modes, modal_damping,
     response_by_exponential, response_by_integration, response_with_modal_damping,
 };
-use crate::system::ModelInfo;
+use crate::model_info::ModelInfo;
 
 /// Options of [`modal_damping_study`].
 #[derive(Debug, Clone, PartialEq, Serialize)]
