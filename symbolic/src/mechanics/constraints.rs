@@ -171,7 +171,7 @@ fn involved<'a>(
         }
         rhs[a] = (0..n).map(|c| row(i)[c] * target[c]).sum();
     }
-    let Some(c) = super::check::solve(gram, rhs) else {
+    let Some(c) = super::numeric::solve(gram, rhs) else {
         return among.to_vec();
     };
     let scale = c.iter().fold(0.0f64, |m, x| m.max(x.abs()));

@@ -270,7 +270,7 @@ impl<'f> Lowering<'f> {
         }
         // Rank of J at a few random configurations (parameters at their defaults).
         let mut evaluator = crate::expr::eval::Evaluator::new(&self.arena, &eqs.jacobian);
-        let mut rng = super::check::Rng(0x9E37_79B9_7F4A_7C15);
+        let mut rng = super::numeric::Rng(0x9E37_79B9_7F4A_7C15);
         let mut uniform = move || rng.uniform(-2.0, 2.0);
         let mut samples = Vec::new();
         for _ in 0..60 {

@@ -16,7 +16,7 @@ use crate::expr::SymbolKind;
 use crate::expr::eval::Evaluator;
 use crate::model::{Diagnostic, ModelFile};
 
-use super::check::Rng;
+use super::numeric::Rng;
 use super::{EquationsOfMotion, SymbolicModel};
 
 /// Random states tried for "singular everywhere".
