@@ -2,12 +2,15 @@
 //!
 //! [`DynMechanicalSystem`] is [`MechanicalSystem`](crate::MechanicalSystem) with slices in
 //! place of nalgebra's static vectors and matrices: what a model compiled at run time (from any
-//! model file, with no rebuild) implements. Its first-order form is
+//! model file, with no rebuild) implements, and what every [`MechanicalSystem<N>`] is through
+//! the adapter [`StaticSystem`]. Its first-order form is
 //! [`DynFirstOrder`](crate::DynFirstOrder), which implements [`ModelInfo`](crate::ModelInfo),
 //! so every analysis that takes a `Box<dyn ModelInfo>` takes such a model unchanged.
 
+use nalgebra::SVector;
+
 use crate::ode::EventSpec;
-use crate::system::{BodyCentre, UnknownParameter};
+use crate::system::{BodyCentre, MechanicalSystem, UnknownParameter};
 
 /// Equations of motion `M(q, t) q̈ = F(q, q̇, t)` of a mechanism with `n` degrees of freedom,
 /// `n` known at run time.
@@ -121,4 +124,373 @@ pub trait DynMechanicalSystem {
         lambda: &[f64],
         out: &mut [f64],
     );
+}
+
+/// A [`MechanicalSystem<N>`] seen as a [`DynMechanicalSystem`]: the one place where the
+/// compile-time-sized interface is mapped to the slices of the run-time one (static vectors
+/// and matrices copied from and to the slices, names and lists collected into `Vec`s).
+///
+/// With it, what is written once over [`DynMechanicalSystem`] serves the models compiled by
+/// `eomgen::model!` too: the constrained solve, drift and projection of
+/// [`ConstraintWorkspace`](crate::ConstraintWorkspace), and the size-erased
+/// [`ModelInfo`](crate::ModelInfo) of [`FirstOrder`](crate::FirstOrder). (A blanket
+/// `impl<S: MechanicalSystem<N>, const N: usize> DynMechanicalSystem for S` is not possible:
+/// `N` would not be constrained by the implementing type.) The compiled models' hot path,
+/// `FirstOrder::rhs` and its Jacobian, does not go through here.
+///
+/// `repr(transparent)`, so that [`Self::from_ref`] and [`Self::from_mut`] view a borrowed `S`
+/// in place: a wrapper lends the names it returns with the borrow of the system itself.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[repr(transparent)]
+pub struct StaticSystem<S, const N: usize>(pub S);
+
+impl<S, const N: usize> StaticSystem<S, N> {
+    /// `system` seen through the adapter, borrowed in place.
+    pub fn from_ref(system: &S) -> &Self {
+        // SAFETY: `StaticSystem<S, N>` is `repr(transparent)` over its only field, an `S`, so
+        // the two have the same layout and alignment; the lifetime is kept.
+        unsafe { &*(system as *const S).cast::<Self>() }
+    }
+
+    /// `system` seen through the adapter, mutably borrowed in place.
+    pub fn from_mut(system: &mut S) -> &mut Self {
+        // SAFETY: as in `from_ref`; the unique borrow of `system` becomes the unique borrow of
+        // the wrapper.
+        unsafe { &mut *(system as *mut S).cast::<Self>() }
+    }
+}
+
+fn vector<const N: usize>(x: &[f64]) -> SVector<f64, N> {
+    SVector::<f64, N>::from_column_slice(&x[..N])
+}
+
+impl<S: MechanicalSystem<N>, const N: usize> DynMechanicalSystem for StaticSystem<S, N> {
+    fn name(&self) -> &str {
+        self.0.name()
+    }
+    fn description(&self) -> &str {
+        self.0.description()
+    }
+    fn num_dofs(&self) -> usize {
+        N
+    }
+    fn coordinate_names(&self) -> Vec<&str> {
+        self.0.coordinate_names().to_vec()
+    }
+    fn parameter_names(&self) -> Vec<&str> {
+        self.0.parameter_names().to_vec()
+    }
+    fn parameter_values(&self) -> Vec<f64> {
+        self.0.parameter_values()
+    }
+    fn set_parameter(&mut self, name: &str, value: f64) -> Result<(), UnknownParameter> {
+        self.0.set_parameter(name, value)
+    }
+    fn initial_state(&self, q: &mut [f64], qdot: &mut [f64]) {
+        let (q0, qdot0) = self.0.initial_state();
+        q[..N].copy_from_slice(q0.as_slice());
+        qdot[..N].copy_from_slice(qdot0.as_slice());
+    }
+    fn mass_matrix_and_forcing(
+        &self,
+        q: &[f64],
+        qdot: &[f64],
+        t: f64,
+        mass: &mut [f64],
+        forcing: &mut [f64],
+    ) {
+        let (m, f) = self
+            .0
+            .mass_matrix_and_forcing(&vector::<N>(q), &vector::<N>(qdot), t);
+        mass[..N * N].copy_from_slice(m.as_slice());
+        forcing[..N].copy_from_slice(f.as_slice());
+    }
+    fn forcing_jacobian_q(&self, q: &[f64], qdot: &[f64], t: f64, out: &mut [f64]) {
+        let j = self
+            .0
+            .forcing_jacobian_q(&vector::<N>(q), &vector::<N>(qdot), t);
+        out[..N * N].copy_from_slice(j.as_slice());
+    }
+    fn forcing_jacobian_qdot(&self, q: &[f64], qdot: &[f64], t: f64, out: &mut [f64]) {
+        let j = self
+            .0
+            .forcing_jacobian_qdot(&vector::<N>(q), &vector::<N>(qdot), t);
+        out[..N * N].copy_from_slice(j.as_slice());
+    }
+    fn mass_matrix_product_jacobian(&self, q: &[f64], t: f64, a: &[f64], out: &mut [f64]) {
+        let j = self
+            .0
+            .mass_matrix_product_jacobian(&vector::<N>(q), t, &vector::<N>(a));
+        out[..N * N].copy_from_slice(j.as_slice());
+    }
+    fn kinetic_energy(&self, q: &[f64], qdot: &[f64], t: f64) -> f64 {
+        self.0
+            .kinetic_energy(&vector::<N>(q), &vector::<N>(qdot), t)
+    }
+    fn potential_energy(&self, q: &[f64], t: f64) -> f64 {
+        self.0.potential_energy(&vector::<N>(q), t)
+    }
+    fn is_conservative(&self) -> bool {
+        self.0.is_conservative()
+    }
+    fn point_names(&self) -> Vec<&str> {
+        self.0.point_names().to_vec()
+    }
+    fn point_positions(&self, q: &[f64], t: f64, out: &mut [[f64; 3]]) {
+        self.0.point_positions(&vector::<N>(q), t, out);
+    }
+    fn draw_lines(&self) -> Vec<[&str; 2]> {
+        self.0.draw_lines().to_vec()
+    }
+    fn trace_points(&self) -> Vec<&str> {
+        self.0.trace_points().to_vec()
+    }
+    fn body_centres(&self) -> Vec<BodyCentre<'_>> {
+        self.0.body_centres().to_vec()
+    }
+    fn equations_text(&self) -> &str {
+        self.0.equations_text()
+    }
+    fn equations_latex(&self) -> &str {
+        self.0.equations_latex()
+    }
+    fn constraint_names(&self) -> Vec<&str> {
+        self.0.constraint_names().to_vec()
+    }
+    fn holonomic_constraint_count(&self) -> usize {
+        self.0.holonomic_constraint_count()
+    }
+    fn constraint_residuals(&self, q: &[f64], t: f64, out: &mut [f64]) {
+        self.0.constraint_residuals(&vector::<N>(q), t, out);
+    }
+    fn constraint_jacobian(&self, q: &[f64], t: f64, out: &mut [f64]) {
+        self.0.constraint_jacobian(&vector::<N>(q), t, out);
+    }
+    fn constraint_velocity_residuals(&self, q: &[f64], qdot: &[f64], t: f64, out: &mut [f64]) {
+        self.0
+            .constraint_velocity_residuals(&vector::<N>(q), &vector::<N>(qdot), t, out);
+    }
+    fn constraint_gamma(&self, q: &[f64], qdot: &[f64], t: f64, out: &mut [f64]) {
+        self.0
+            .constraint_gamma(&vector::<N>(q), &vector::<N>(qdot), t, out);
+    }
+    fn initial_guesses(&self) -> &[usize] {
+        self.0.initial_guesses()
+    }
+    fn equilibrium_names(&self) -> Vec<&str> {
+        self.0.equilibrium_names().to_vec()
+    }
+    fn equilibrium_guesses(&self, out: &mut [f64]) {
+        self.0.equilibrium_guesses(out);
+    }
+    fn event_specs(&self) -> Vec<EventSpec> {
+        self.0.event_specs().to_vec()
+    }
+    fn events_need_accelerations(&self) -> bool {
+        self.0.events_need_accelerations()
+    }
+    fn event_values(
+        &self,
+        q: &[f64],
+        qdot: &[f64],
+        t: f64,
+        qddot: &[f64],
+        lambda: &[f64],
+        out: &mut [f64],
+    ) {
+        self.0.event_values(
+            &vector::<N>(q),
+            &vector::<N>(qdot),
+            t,
+            &vector::<N>(qddot),
+            lambda,
+            out,
+        );
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use nalgebra::{Matrix2, Vector2};
+
+    use super::*;
+    use crate::{DynFirstOrder, FirstOrder, ModelInfo, OdeSystem};
+
+    /// A two-degree-of-freedom system whose every matrix has distinct entries (a transposed
+    /// or misplaced copy shows), with points, an equilibrium guess and parameters.
+    #[derive(Debug, Clone)]
+    struct Skewed {
+        k: f64,
+    }
+
+    impl MechanicalSystem<2> for Skewed {
+        fn name(&self) -> &'static str {
+            "skewed"
+        }
+        fn description(&self) -> &'static str {
+            "a test system"
+        }
+        fn coordinate_names(&self) -> [&'static str; 2] {
+            ["x", "y"]
+        }
+        fn parameter_names(&self) -> &'static [&'static str] {
+            &["k"]
+        }
+        fn parameter_values(&self) -> Vec<f64> {
+            vec![self.k]
+        }
+        fn set_parameter(&mut self, name: &str, value: f64) -> Result<(), UnknownParameter> {
+            match name {
+                "k" => {
+                    self.k = value;
+                    Ok(())
+                }
+                _ => Err(UnknownParameter {
+                    model: "skewed".into(),
+                    name: name.into(),
+                    known: "k".into(),
+                }),
+            }
+        }
+        fn initial_state(&self) -> (SVector<f64, 2>, SVector<f64, 2>) {
+            (Vector2::new(0.3, -0.2), Vector2::new(0.1, 0.7))
+        }
+        fn mass_matrix(&self, q: &SVector<f64, 2>, _t: f64) -> nalgebra::SMatrix<f64, 2, 2> {
+            let c = 0.4 * q[1].cos();
+            Matrix2::new(2.0 + q[0] * q[0], c, c, 1.5)
+        }
+        fn forcing(&self, q: &SVector<f64, 2>, qdot: &SVector<f64, 2>, t: f64) -> SVector<f64, 2> {
+            Vector2::new(
+                -self.k * q[0] + 0.3 * qdot[1] * q[1] + t.sin(),
+                -2.0 * self.k * q[1] - 0.7 * qdot[0] * q[0],
+            )
+        }
+        fn mass_matrix_and_forcing(
+            &self,
+            q: &SVector<f64, 2>,
+            qdot: &SVector<f64, 2>,
+            t: f64,
+        ) -> (nalgebra::SMatrix<f64, 2, 2>, SVector<f64, 2>) {
+            (self.mass_matrix(q, t), self.forcing(q, qdot, t))
+        }
+        fn forcing_jacobian_q(
+            &self,
+            _q: &SVector<f64, 2>,
+            qdot: &SVector<f64, 2>,
+            _t: f64,
+        ) -> nalgebra::SMatrix<f64, 2, 2> {
+            Matrix2::new(-self.k, 0.3 * qdot[1], -0.7 * qdot[0], -2.0 * self.k)
+        }
+        fn forcing_jacobian_qdot(
+            &self,
+            q: &SVector<f64, 2>,
+            _qdot: &SVector<f64, 2>,
+            _t: f64,
+        ) -> nalgebra::SMatrix<f64, 2, 2> {
+            Matrix2::new(0.0, 0.3 * q[1], -0.7 * q[0], 0.0)
+        }
+        fn mass_matrix_product_jacobian(
+            &self,
+            q: &SVector<f64, 2>,
+            _t: f64,
+            a: &SVector<f64, 2>,
+        ) -> nalgebra::SMatrix<f64, 2, 2> {
+            let dc = -0.4 * q[1].sin();
+            Matrix2::new(2.0 * q[0] * a[0], dc * a[1], 0.0, dc * a[0])
+        }
+        fn kinetic_energy(&self, q: &SVector<f64, 2>, qdot: &SVector<f64, 2>, t: f64) -> f64 {
+            0.5 * qdot.dot(&(self.mass_matrix(q, t) * qdot))
+        }
+        fn potential_energy(&self, q: &SVector<f64, 2>, _t: f64) -> f64 {
+            0.5 * self.k * (q[0] * q[0] + 2.0 * q[1] * q[1])
+        }
+        fn is_conservative(&self) -> bool {
+            false
+        }
+        fn point_names(&self) -> &'static [&'static str] {
+            &["p", "r"]
+        }
+        fn point_positions(&self, q: &SVector<f64, 2>, _t: f64, out: &mut [[f64; 3]]) {
+            out[0] = [q[0], 0.0, 0.0];
+            out[1] = [q[0], q[1], 1.0];
+        }
+        fn equations_text(&self) -> &'static str {
+            "text"
+        }
+        fn equations_latex(&self) -> &'static str {
+            "latex"
+        }
+        fn equilibrium_names(&self) -> &'static [&'static str] {
+            &["rest", "off"]
+        }
+        fn equilibrium_guesses(&self, out: &mut [f64]) {
+            out.copy_from_slice(&[0.0, 0.0, 0.5, -0.5]);
+        }
+    }
+
+    /// The adapter against the compiled system itself: `FirstOrder` (its own right-hand side,
+    /// its `ModelInfo` through `StaticSystem`) and `DynFirstOrder` of the adapter (the
+    /// run-time path throughout) agree to the bit with each other and with the
+    /// `MechanicalSystem` methods, entry by entry; the matrices have distinct entries, so a
+    /// transposed or misplaced copy fails.
+    #[test]
+    fn static_system_is_the_compiled_system_on_slices() {
+        let system = Skewed { k: 3.0 };
+        let mut compiled = FirstOrder::new(system.clone());
+        let mut runtime = DynFirstOrder::new(StaticSystem::<_, 2>(system.clone()));
+        let y = [0.3, -0.2, 0.1, 0.7];
+        let t = 0.25;
+        let (q, qdot) = (Vector2::new(y[0], y[1]), Vector2::new(y[2], y[3]));
+        for model in [&mut compiled as &mut dyn ModelInfo, &mut runtime] {
+            assert_eq!(model.num_dofs(), 2);
+            assert_eq!(model.coordinate_names(), ["x", "y"]);
+            assert_eq!(model.initial_state(), y);
+            let (m, f) = model.mass_matrix_and_forcing(t, &y);
+            let (m0, f0) = system.mass_matrix_and_forcing(&q, &qdot, t);
+            assert_eq!(m.as_slice(), m0.as_slice());
+            assert_eq!(f.as_slice(), f0.as_slice());
+            let (jq, jv) = model.forcing_jacobians(t, &y);
+            assert_eq!(jq[(0, 1)], 0.3 * y[3]);
+            assert_eq!(
+                jq.as_slice(),
+                system.forcing_jacobian_q(&q, &qdot, t).as_slice()
+            );
+            assert_eq!(
+                jv.as_slice(),
+                system.forcing_jacobian_qdot(&q, &qdot, t).as_slice()
+            );
+            let a = [0.9, -1.1];
+            let pj = model.mass_matrix_product_jacobian(t, &y, &a);
+            let pj0 = system.mass_matrix_product_jacobian(&q, t, &Vector2::new(a[0], a[1]));
+            assert_eq!(pj.as_slice(), pj0.as_slice());
+            assert_eq!(
+                model.kinetic_energy(t, &y),
+                system.kinetic_energy(&q, &qdot, t)
+            );
+            assert_eq!(
+                model.potential_energy(t, &y),
+                system.potential_energy(&q, t)
+            );
+            assert_eq!(
+                model.point_positions(t, &y),
+                [[0.3, 0.0, 0.0], [0.3, -0.2, 1.0]]
+            );
+            assert_eq!(
+                model.equilibrium_guesses(),
+                [("rest", vec![0.0, 0.0]), ("off", vec![0.5, -0.5])]
+            );
+            assert!(model.set_parameter("k", 4.0).is_ok());
+            assert_eq!(model.parameter_values(), [4.0]);
+            assert!(model.set_parameter("c", 1.0).is_err());
+            model.set_parameter("k", 3.0).unwrap();
+        }
+        let (mut dc, mut dr) = ([0.0; 4], [0.0; 4]);
+        compiled.rhs(t, &y, &mut dc).unwrap();
+        runtime.rhs(t, &y, &mut dr).unwrap();
+        assert_eq!(dc, dr);
+        let (mut jc, mut jr) = ([0.0; 16], [0.0; 16]);
+        assert!(compiled.jacobian(t, &y, &mut jc).unwrap());
+        assert!(runtime.jacobian(t, &y, &mut jr).unwrap());
+        assert_eq!(jc, jr);
+    }
 }

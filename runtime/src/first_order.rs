@@ -5,12 +5,12 @@
 
 use nalgebra::{DMatrix, DVector, SMatrix, SVector};
 
-use crate::constrained::{ConstraintWorkspace, ProjectionError, Stabilization, StaticSystem};
-use crate::dynamic::DynMechanicalSystem;
+use crate::constrained::{ConstraintWorkspace, Stabilization};
+use crate::dynamic::{DynMechanicalSystem, StaticSystem};
 use crate::linalg::{solve_spd, solve_spd_in_place};
-use crate::model_info::{ConstraintValues, ModelInfo};
+use crate::model_info::{FirstOrderForm, FirstOrderParts};
 use crate::ode::{EventSpec, OdeSystem, RhsError};
-use crate::system::{BodyCentre, MechanicalSystem, UnknownParameter};
+use crate::system::MechanicalSystem;
 
 /// The first-order form `y = [q; q̇]`, `ẏ = [q̇; M⁻¹F]` of a [`MechanicalSystem`].
 ///
@@ -23,6 +23,11 @@ use crate::system::{BodyCentre, MechanicalSystem, UnknownParameter};
 /// multipliers `λ` come from the index-1 system `[M Jᵀ; J 0][q̈; λ] = [F; γ]` instead, solved by
 /// LU with partial pivoting on buffers allocated in [`FirstOrder::new`]; the drift control is
 /// [`FirstOrder::stabilization`].
+///
+/// Its [`OdeSystem`] (right-hand side, Jacobian, events) is its own, on stack vectors and
+/// matrices of size `N`; its size-erased [`ModelInfo`](crate::ModelInfo) is the one written
+/// for every [`FirstOrderForm`], reaching the system through
+/// [`StaticSystem`](crate::StaticSystem).
 #[derive(Debug, Clone)]
 pub struct FirstOrder<S, const N: usize> {
     /// The wrapped system.
@@ -32,7 +37,7 @@ pub struct FirstOrder<S, const N: usize> {
     /// Buffers and the last multipliers `λ` of a constrained system.
     pub constraints: ConstraintWorkspace,
     /// The model's events ([`MechanicalSystem::event_specs`]), whose `terminal` flags may be
-    /// changed ([`ModelInfo::set_event_terminal`]).
+    /// changed ([`ModelInfo::set_event_terminal`](crate::ModelInfo::set_event_terminal)).
     pub events: Vec<EventSpec>,
 }
 
@@ -153,7 +158,7 @@ impl<S: MechanicalSystem<N>, const N: usize> OdeSystem for FirstOrder<S, N> {
         let (q, qdot) = y.split_at_mut(N);
         self.constraints
             .project(
-                &StaticSystem(&self.system),
+                StaticSystem::from_ref(&self.system),
                 q,
                 &mut qdot[..N],
                 t,
@@ -227,165 +232,17 @@ impl<S: MechanicalSystem<N>, const N: usize> OdeSystem for FirstOrder<S, N> {
     }
 }
 
-impl<S: MechanicalSystem<N>, const N: usize> ModelInfo for FirstOrder<S, N> {
-    fn name(&self) -> &str {
-        self.system.name()
+impl<S: MechanicalSystem<N>, const N: usize> FirstOrderForm for FirstOrder<S, N> {
+    type System = StaticSystem<S, N>;
+    fn dyn_system(&self) -> &StaticSystem<S, N> {
+        StaticSystem::from_ref(&self.system)
     }
-    fn description(&self) -> &str {
-        self.system.description()
-    }
-    fn num_dofs(&self) -> usize {
-        N
-    }
-    fn coordinate_names(&self) -> Vec<&str> {
-        self.system.coordinate_names().to_vec()
-    }
-    fn parameter_names(&self) -> Vec<&str> {
-        self.system.parameter_names().to_vec()
-    }
-    fn parameter_values(&self) -> Vec<f64> {
-        self.system.parameter_values()
-    }
-    fn set_parameter(&mut self, name: &str, value: f64) -> Result<(), UnknownParameter> {
-        self.system.set_parameter(name, value)
-    }
-    fn initial_state(&self) -> Vec<f64> {
-        let (q, qdot) = self.system.initial_state();
-        q.iter().chain(qdot.iter()).copied().collect()
-    }
-    fn kinetic_energy(&self, t: f64, y: &[f64]) -> f64 {
-        let (q, qdot) = split::<N>(y);
-        self.system.kinetic_energy(&q, &qdot, t)
-    }
-    fn potential_energy(&self, t: f64, y: &[f64]) -> f64 {
-        let (q, _) = split::<N>(y);
-        self.system.potential_energy(&q, t)
-    }
-    fn is_conservative(&self) -> bool {
-        self.system.is_conservative()
-    }
-    fn point_names(&self) -> Vec<&str> {
-        self.system.point_names().to_vec()
-    }
-    fn point_positions(&self, t: f64, y: &[f64]) -> Vec<[f64; 3]> {
-        let (q, _) = split::<N>(y);
-        let mut out = vec![[0.0; 3]; self.system.point_names().len()];
-        self.system.point_positions(&q, t, &mut out);
-        out
-    }
-    fn draw_lines(&self) -> Vec<[&str; 2]> {
-        self.system.draw_lines().to_vec()
-    }
-    fn trace_points(&self) -> Vec<&str> {
-        self.system.trace_points().to_vec()
-    }
-    fn body_centres(&self) -> Vec<BodyCentre<'_>> {
-        self.system.body_centres().to_vec()
-    }
-    fn equations_text(&self) -> &str {
-        self.system.equations_text()
-    }
-    fn equations_latex(&self) -> &str {
-        self.system.equations_latex()
-    }
-    fn as_ode_mut(&mut self) -> &mut dyn OdeSystem {
-        self
-    }
-    fn mass_matrix_and_forcing(&self, t: f64, y: &[f64]) -> (DMatrix<f64>, DVector<f64>) {
-        let (q, qdot) = split::<N>(y);
-        let (m, f) = self.system.mass_matrix_and_forcing(&q, &qdot, t);
-        (
-            DMatrix::from_column_slice(N, N, m.as_slice()),
-            DVector::from_column_slice(f.as_slice()),
-        )
-    }
-    fn forcing_jacobians(&self, t: f64, y: &[f64]) -> (DMatrix<f64>, DMatrix<f64>) {
-        let (q, qdot) = split::<N>(y);
-        let jq = self.system.forcing_jacobian_q(&q, &qdot, t);
-        let jqd = self.system.forcing_jacobian_qdot(&q, &qdot, t);
-        (
-            DMatrix::from_column_slice(N, N, jq.as_slice()),
-            DMatrix::from_column_slice(N, N, jqd.as_slice()),
-        )
-    }
-    fn mass_matrix_product_jacobian(&self, t: f64, y: &[f64], a: &[f64]) -> DMatrix<f64> {
-        let (q, _) = split::<N>(y);
-        let a = SVector::<f64, N>::from_column_slice(&a[..N]);
-        let j = self.system.mass_matrix_product_jacobian(&q, t, &a);
-        DMatrix::from_column_slice(N, N, j.as_slice())
-    }
-    fn constraint_names(&self) -> Vec<&str> {
-        self.system.constraint_names().to_vec()
-    }
-    fn holonomic_constraint_count(&self) -> usize {
-        self.system.holonomic_constraint_count()
-    }
-    fn set_stabilization(&mut self, stabilization: Stabilization) {
-        self.stabilization = stabilization;
-    }
-    fn constraint_forces(&mut self, t: f64, y: &[f64]) -> Result<Vec<f64>, RhsError> {
-        if self.constraints.is_empty() {
-            return Ok(Vec::new());
-        }
-        let (q, qdot) = split::<N>(y);
-        self.constraints
-            .accelerations(&self.system, &q, &qdot, t, self.stabilization)?;
-        Ok(self.constraints.multipliers.clone())
-    }
-    fn constraint_drift(&mut self, t: f64, y: &[f64]) -> (f64, f64) {
-        self.constraints
-            .drift(&StaticSystem(&self.system), &y[..N], &y[N..2 * N], t)
-    }
-    fn project(&mut self, t: f64, y: &mut [f64], free: &[usize]) -> Result<usize, ProjectionError> {
-        // On a copy, so that a projection that fails leaves `y` as it was.
-        let mut projected = y[..2 * N].to_vec();
-        let (q, qdot) = projected.split_at_mut(N);
-        let iterations =
-            self.constraints
-                .project(&StaticSystem(&self.system), q, qdot, t, free, 1e-12)?;
-        y[..2 * N].copy_from_slice(&projected);
-        Ok(iterations)
-    }
-    fn initial_guesses(&self) -> &[usize] {
-        self.system.initial_guesses()
-    }
-    fn equilibrium_guesses(&self) -> Vec<(&str, Vec<f64>)> {
-        let names = self.system.equilibrium_names();
-        let mut values = vec![0.0; N * names.len()];
-        self.system.equilibrium_guesses(&mut values);
-        names
-            .iter()
-            .zip(values.chunks(N.max(1)))
-            .map(|(name, q)| (*name, q.to_vec()))
-            .collect()
-    }
-    fn set_event_terminal(&mut self, name: &str, terminal: bool) -> bool {
-        match self.events.iter_mut().find(|e| e.name == name) {
-            Some(e) => {
-                e.terminal = terminal;
-                true
-            }
-            None => false,
-        }
-    }
-    fn constraint_equations(&self, t: f64, y: &[f64]) -> ConstraintValues {
-        let (q, qdot) = split::<N>(y);
-        let m = self.system.constraint_names().len();
-        let h = self.system.holonomic_constraint_count();
-        let mut phi = vec![0.0; h];
-        let mut jacobian = vec![0.0; m * N];
-        let mut velocity = vec![0.0; m];
-        let mut gamma = vec![0.0; m];
-        self.system.constraint_residuals(&q, t, &mut phi);
-        self.system.constraint_jacobian(&q, t, &mut jacobian);
-        self.system
-            .constraint_velocity_residuals(&q, &qdot, t, &mut velocity);
-        self.system.constraint_gamma(&q, &qdot, t, &mut gamma);
-        ConstraintValues {
-            phi: DVector::from_vec(phi),
-            jacobian: DMatrix::from_row_slice(m, N, &jacobian),
-            velocity: DVector::from_vec(velocity),
-            gamma: DVector::from_vec(gamma),
+    fn parts_mut(&mut self) -> FirstOrderParts<'_, StaticSystem<S, N>> {
+        FirstOrderParts {
+            system: StaticSystem::from_mut(&mut self.system),
+            stabilization: &mut self.stabilization,
+            constraints: &mut self.constraints,
+            events: &mut self.events,
         }
     }
 }
@@ -409,7 +266,7 @@ pub struct DynFirstOrder<S> {
     /// Buffers and the last multipliers `λ` of a constrained system.
     pub constraints: ConstraintWorkspace,
     /// The model's events, whose `terminal` flags may be changed
-    /// ([`ModelInfo::set_event_terminal`]).
+    /// ([`ModelInfo::set_event_terminal`](crate::ModelInfo::set_event_terminal)).
     pub events: Vec<EventSpec>,
     n: usize,
     mass: Vec<f64>,
@@ -645,184 +502,17 @@ impl<S: DynMechanicalSystem> OdeSystem for DynFirstOrder<S> {
     }
 }
 
-impl<S: DynMechanicalSystem> ModelInfo for DynFirstOrder<S> {
-    fn name(&self) -> &str {
-        self.system.name()
+impl<S: DynMechanicalSystem> FirstOrderForm for DynFirstOrder<S> {
+    type System = S;
+    fn dyn_system(&self) -> &S {
+        &self.system
     }
-    fn description(&self) -> &str {
-        self.system.description()
-    }
-    fn num_dofs(&self) -> usize {
-        self.n
-    }
-    fn coordinate_names(&self) -> Vec<&str> {
-        self.system.coordinate_names()
-    }
-    fn parameter_names(&self) -> Vec<&str> {
-        self.system.parameter_names()
-    }
-    fn parameter_values(&self) -> Vec<f64> {
-        self.system.parameter_values()
-    }
-    fn set_parameter(&mut self, name: &str, value: f64) -> Result<(), UnknownParameter> {
-        self.system.set_parameter(name, value)
-    }
-    fn initial_state(&self) -> Vec<f64> {
-        let n = self.n;
-        let mut y = vec![0.0; 2 * n];
-        let (q, qdot) = y.split_at_mut(n);
-        self.system.initial_state(q, qdot);
-        y
-    }
-    fn kinetic_energy(&self, t: f64, y: &[f64]) -> f64 {
-        self.system
-            .kinetic_energy(&y[..self.n], &y[self.n..2 * self.n], t)
-    }
-    fn potential_energy(&self, t: f64, y: &[f64]) -> f64 {
-        self.system.potential_energy(&y[..self.n], t)
-    }
-    fn is_conservative(&self) -> bool {
-        self.system.is_conservative()
-    }
-    fn point_names(&self) -> Vec<&str> {
-        self.system.point_names()
-    }
-    fn point_positions(&self, t: f64, y: &[f64]) -> Vec<[f64; 3]> {
-        let mut out = vec![[0.0; 3]; self.system.point_names().len()];
-        self.system.point_positions(&y[..self.n], t, &mut out);
-        out
-    }
-    fn draw_lines(&self) -> Vec<[&str; 2]> {
-        self.system.draw_lines()
-    }
-    fn trace_points(&self) -> Vec<&str> {
-        self.system.trace_points()
-    }
-    fn body_centres(&self) -> Vec<BodyCentre<'_>> {
-        self.system.body_centres()
-    }
-    fn equations_text(&self) -> &str {
-        self.system.equations_text()
-    }
-    fn equations_latex(&self) -> &str {
-        self.system.equations_latex()
-    }
-    fn as_ode_mut(&mut self) -> &mut dyn OdeSystem {
-        self
-    }
-    fn mass_matrix_and_forcing(&self, t: f64, y: &[f64]) -> (DMatrix<f64>, DVector<f64>) {
-        let n = self.n;
-        let (mut mass, mut forcing) = (DMatrix::zeros(n, n), DVector::zeros(n));
-        self.system.mass_matrix_and_forcing(
-            &y[..n],
-            &y[n..2 * n],
-            t,
-            mass.as_mut_slice(),
-            forcing.as_mut_slice(),
-        );
-        (mass, forcing)
-    }
-    fn forcing_jacobians(&self, t: f64, y: &[f64]) -> (DMatrix<f64>, DMatrix<f64>) {
-        let n = self.n;
-        let (mut jq, mut jqd) = (DMatrix::zeros(n, n), DMatrix::zeros(n, n));
-        self.system
-            .forcing_jacobian_q(&y[..n], &y[n..2 * n], t, jq.as_mut_slice());
-        self.system
-            .forcing_jacobian_qdot(&y[..n], &y[n..2 * n], t, jqd.as_mut_slice());
-        (jq, jqd)
-    }
-    fn mass_matrix_product_jacobian(&self, t: f64, y: &[f64], a: &[f64]) -> DMatrix<f64> {
-        let n = self.n;
-        let mut out = DMatrix::zeros(n, n);
-        self.system
-            .mass_matrix_product_jacobian(&y[..n], t, &a[..n], out.as_mut_slice());
-        out
-    }
-    fn constraint_names(&self) -> Vec<&str> {
-        self.system.constraint_names()
-    }
-    fn holonomic_constraint_count(&self) -> usize {
-        self.system.holonomic_constraint_count()
-    }
-    fn set_stabilization(&mut self, stabilization: Stabilization) {
-        self.stabilization = stabilization;
-    }
-    fn constraint_forces(&mut self, t: f64, y: &[f64]) -> Result<Vec<f64>, RhsError> {
-        if self.constraints.is_empty() {
-            return Ok(Vec::new());
-        }
-        let n = self.n;
-        let mut qddot = vec![0.0; n];
-        self.constraints.accelerations_into(
-            &self.system,
-            &y[..n],
-            &y[n..2 * n],
-            t,
-            self.stabilization,
-            &mut qddot,
-        )?;
-        Ok(self.constraints.multipliers.clone())
-    }
-    fn constraint_drift(&mut self, t: f64, y: &[f64]) -> (f64, f64) {
-        let n = self.n;
-        self.constraints
-            .drift(&self.system, &y[..n], &y[n..2 * n], t)
-    }
-    fn project(&mut self, t: f64, y: &mut [f64], free: &[usize]) -> Result<usize, ProjectionError> {
-        // On a copy, so that a projection that fails leaves `y` as it was.
-        let n = self.n;
-        let mut projected = y[..2 * n].to_vec();
-        let (q, qdot) = projected.split_at_mut(n);
-        let iterations = self
-            .constraints
-            .project(&self.system, q, qdot, t, free, 1e-12)?;
-        y[..2 * n].copy_from_slice(&projected);
-        Ok(iterations)
-    }
-    fn initial_guesses(&self) -> &[usize] {
-        self.system.initial_guesses()
-    }
-    fn equilibrium_guesses(&self) -> Vec<(&str, Vec<f64>)> {
-        let n = self.n;
-        let names = self.system.equilibrium_names();
-        let mut values = vec![0.0; n * names.len()];
-        self.system.equilibrium_guesses(&mut values);
-        names
-            .into_iter()
-            .zip(values.chunks(n.max(1)))
-            .map(|(name, q)| (name, q.to_vec()))
-            .collect()
-    }
-    fn set_event_terminal(&mut self, name: &str, terminal: bool) -> bool {
-        match self.events.iter_mut().find(|e| e.name == name) {
-            Some(e) => {
-                e.terminal = terminal;
-                true
-            }
-            None => false,
-        }
-    }
-    fn constraint_equations(&self, t: f64, y: &[f64]) -> ConstraintValues {
-        let n = self.n;
-        let (q, qdot) = (&y[..n], &y[n..2 * n]);
-        let m = self.system.constraint_names().len();
-        let h = self.system.holonomic_constraint_count();
-        let mut phi = vec![0.0; h];
-        let mut jacobian = vec![0.0; m * n];
-        let mut velocity = vec![0.0; m];
-        let mut gamma = vec![0.0; m];
-        if m > 0 {
-            self.system.constraint_residuals(q, t, &mut phi);
-            self.system.constraint_jacobian(q, t, &mut jacobian);
-            self.system
-                .constraint_velocity_residuals(q, qdot, t, &mut velocity);
-            self.system.constraint_gamma(q, qdot, t, &mut gamma);
-        }
-        ConstraintValues {
-            phi: DVector::from_vec(phi),
-            jacobian: DMatrix::from_row_slice(m, n, &jacobian),
-            velocity: DVector::from_vec(velocity),
-            gamma: DVector::from_vec(gamma),
+    fn parts_mut(&mut self) -> FirstOrderParts<'_, S> {
+        FirstOrderParts {
+            system: &mut self.system,
+            stabilization: &mut self.stabilization,
+            constraints: &mut self.constraints,
+            events: &mut self.events,
         }
     }
 }

@@ -57,8 +57,8 @@ use crate::modal::{
     Equilibrium, Linearization, ModalError, ModeKind, NormalModes, damped_modes, find_equilibrium,
     linearize,
 };
-use crate::response::modal_damping;
 use crate::model_info::ModelInfo;
+use crate::response::modal_damping;
 use crate::system::UnknownParameter;
 
 /// Why an input matrix, a frequency response or a steady-state simulation failed.

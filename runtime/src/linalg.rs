@@ -239,4 +239,3 @@ mod tests {
         assert_eq!(solve_spd(&nan, &f), None);
     }
 }
-

@@ -6,8 +6,8 @@ use std::time::Instant;
 use rustc_hash::FxHashMap;
 
 use super::BalanceInfo;
-pub use super::numeric::solve;
 use super::numeric::Rng;
+pub use super::numeric::solve;
 use super::{
     EquationsOfMotion, Formulation, HandEquations, Lagrange, MomentumBalance, SymbolicModel,
     UserBalances,
