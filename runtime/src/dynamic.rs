@@ -1,6 +1,6 @@
 //! Equations of motion whose size is known only at run time.
 //!
-//! [`DynMechanicalSystem`] is [`MechanicalSystem`](crate::MechanicalSystem) with slices in
+//! [`DynMechanicalSystem`] is [`MechanicalSystem`] with slices in
 //! place of nalgebra's static vectors and matrices: what a model compiled at run time (from any
 //! model file, with no rebuild) implements, and what every [`MechanicalSystem<N>`] is through
 //! the adapter [`StaticSystem`]. Its first-order form is
@@ -16,7 +16,7 @@ use crate::system::{BodyCentre, MechanicalSystem, UnknownParameter};
 /// `n` known at run time.
 ///
 /// Every method means what the method of the same name of
-/// [`MechanicalSystem`](crate::MechanicalSystem) means; values are written into caller-owned
+/// [`MechanicalSystem`] means; values are written into caller-owned
 /// slices so that an evaluation allocates nothing.
 ///
 /// # Shapes
@@ -96,7 +96,7 @@ pub trait DynMechanicalSystem {
     /// [`Self::holonomic_constraint_count`]).
     fn constraint_residuals(&self, q: &[f64], t: f64, out: &mut [f64]);
     /// The constraint Jacobian `J` (`m × n`, **row-major**, as
-    /// [`MechanicalSystem::constraint_jacobian`](crate::MechanicalSystem::constraint_jacobian))
+    /// [`MechanicalSystem::constraint_jacobian`])
     /// into `out`.
     fn constraint_jacobian(&self, q: &[f64], t: f64, out: &mut [f64]);
     /// Velocity-level residuals (length `m`) into `out`.

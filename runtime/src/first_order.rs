@@ -27,7 +27,7 @@ use crate::system::MechanicalSystem;
 /// Its [`OdeSystem`] (right-hand side, Jacobian, events) is its own, on stack vectors and
 /// matrices of size `N`; its size-erased [`ModelInfo`](crate::ModelInfo) is the one written
 /// for every [`FirstOrderForm`], reaching the system through
-/// [`StaticSystem`](crate::StaticSystem).
+/// [`StaticSystem`].
 #[derive(Debug, Clone)]
 pub struct FirstOrder<S, const N: usize> {
     /// The wrapped system.
@@ -248,7 +248,7 @@ impl<S: MechanicalSystem<N>, const N: usize> FirstOrderForm for FirstOrder<S, N>
 }
 
 /// The first-order form `y = [q; q̇]`, `ẏ = [q̇; q̈]` of a [`DynMechanicalSystem`]: what
-/// [`FirstOrder`](crate::FirstOrder) is for a [`MechanicalSystem<N>`](crate::MechanicalSystem),
+/// [`FirstOrder`] is for a [`MechanicalSystem<N>`],
 /// with the same solves in the same operation order, so that the same equations give the
 /// same bits either way.
 ///
@@ -448,7 +448,7 @@ impl<S: DynMechanicalSystem> OdeSystem for DynFirstOrder<S> {
     }
 
     /// The exact Jacobian of `ẏ = [q̇; q̈]`, as
-    /// [`FirstOrder`](crate::FirstOrder)'s; `Ok(false)` for a constrained system.
+    /// [`FirstOrder`]'s; `Ok(false)` for a constrained system.
     fn jacobian(&mut self, t: f64, y: &[f64], jac: &mut [f64]) -> Result<bool, RhsError> {
         if !self.constraints.is_empty() {
             return Ok(false);

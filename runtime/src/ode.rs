@@ -335,8 +335,8 @@ impl EventDirection {
 /// An event function's name, the crossings that count and whether it stops the integration.
 ///
 /// The function itself is component `i` of
-/// [`OdeSystem::event_values`](crate::OdeSystem::event_values) for the `i`-th spec of
-/// [`OdeSystem::event_specs`](crate::OdeSystem::event_specs).
+/// [`OdeSystem::event_values`] for the `i`-th spec of
+/// [`OdeSystem::event_specs`].
 #[derive(Debug, Clone, PartialEq, Eq, Serialize)]
 pub struct EventSpec {
     /// Name, as in the model file's `events:` or given on the command line.

@@ -206,7 +206,7 @@ pub trait MechanicalSystem<const N: usize> {
     }
 
     /// Whether an event function uses the accelerations `q̈` or the constraint forces `λ`
-    /// (then [`FirstOrder`] solves for them before calling [`Self::event_values`]).
+    /// (then [`FirstOrder`](crate::FirstOrder) solves for them before calling [`Self::event_values`]).
     fn events_need_accelerations(&self) -> bool {
         false
     }
