@@ -7,14 +7,15 @@
 
 use nalgebra::SVector;
 
-use crate::dynamic::DynMechanicalSystem;
+use crate::dynamic::{DynMechanicalSystem, StaticSystem};
+use crate::linalg::solve_spd_in_place;
 use crate::ode::RhsError;
-use crate::system::{MechanicalSystem, solve_spd_in_place};
+use crate::system::MechanicalSystem;
 
 /// The functions of a constrained mechanical system the workspace evaluates, on slices
 /// (shapes as [`DynMechanicalSystem`]: `M` column-major, `J` row-major).
 ///
-/// Implemented by every [`DynMechanicalSystem`] and, through the adapter
+/// Implemented by every [`DynMechanicalSystem`], and so, through the adapter
 /// [`StaticSystem`], by every [`MechanicalSystem<N>`], so that the constrained solve, the
 /// drift and the projection are written once for the models compiled by `eomgen::model!` and
 /// those compiled at run time.
@@ -61,46 +62,6 @@ impl<S: DynMechanicalSystem + ?Sized> ConstraintFunctions for S {
     fn constraint_gamma(&self, q: &[f64], qdot: &[f64], t: f64, out: &mut [f64]) {
         DynMechanicalSystem::constraint_gamma(self, q, qdot, t, out);
     }
-}
-
-/// A [`MechanicalSystem<N>`] seen through [`ConstraintFunctions`] (static vectors and
-/// matrices copied from and to the slices).
-#[derive(Debug, Clone, Copy)]
-pub struct StaticSystem<'a, S, const N: usize>(pub &'a S);
-
-impl<S: MechanicalSystem<N>, const N: usize> ConstraintFunctions for StaticSystem<'_, S, N> {
-    fn mass_matrix_and_forcing(
-        &self,
-        q: &[f64],
-        qdot: &[f64],
-        t: f64,
-        mass: &mut [f64],
-        forcing: &mut [f64],
-    ) {
-        let (m, f) = self
-            .0
-            .mass_matrix_and_forcing(&vector::<N>(q), &vector::<N>(qdot), t);
-        mass[..N * N].copy_from_slice(m.as_slice());
-        forcing[..N].copy_from_slice(f.as_slice());
-    }
-    fn constraint_residuals(&self, q: &[f64], t: f64, out: &mut [f64]) {
-        self.0.constraint_residuals(&vector::<N>(q), t, out);
-    }
-    fn constraint_jacobian(&self, q: &[f64], t: f64, out: &mut [f64]) {
-        self.0.constraint_jacobian(&vector::<N>(q), t, out);
-    }
-    fn constraint_velocity_residuals(&self, q: &[f64], qdot: &[f64], t: f64, out: &mut [f64]) {
-        self.0
-            .constraint_velocity_residuals(&vector::<N>(q), &vector::<N>(qdot), t, out);
-    }
-    fn constraint_gamma(&self, q: &[f64], qdot: &[f64], t: f64, out: &mut [f64]) {
-        self.0
-            .constraint_gamma(&vector::<N>(q), &vector::<N>(qdot), t, out);
-    }
-}
-
-fn vector<const N: usize>(x: &[f64]) -> SVector<f64, N> {
-    SVector::<f64, N>::from_column_slice(&x[..N])
 }
 
 /// How constraint drift is controlled during an integration (selectable per run).
@@ -217,7 +178,7 @@ impl ConstraintWorkspace {
     ) -> Result<SVector<f64, N>, RhsError> {
         let mut qddot = SVector::<f64, N>::zeros();
         self.accelerations_into(
-            &StaticSystem(system),
+            StaticSystem::from_ref(system),
             q.as_slice(),
             qdot.as_slice(),
             t,

@@ -1,25 +1,22 @@
 //! Equations of motion whose size is known only at run time.
 //!
-//! [`DynMechanicalSystem`] is [`MechanicalSystem`](crate::MechanicalSystem) with slices in
+//! [`DynMechanicalSystem`] is [`MechanicalSystem`] with slices in
 //! place of nalgebra's static vectors and matrices: what a model compiled at run time (from any
-//! model file, with no rebuild) implements. [`DynFirstOrder`] is its first-order form and
-//! implements [`ModelInfo`], so every analysis that takes a
-//! `Box<dyn ModelInfo>` takes such a model unchanged.
+//! model file, with no rebuild) implements, and what every [`MechanicalSystem<N>`] is through
+//! the adapter [`StaticSystem`]. Its first-order form is
+//! [`DynFirstOrder`](crate::DynFirstOrder), which implements [`ModelInfo`](crate::ModelInfo),
+//! so every analysis that takes a `Box<dyn ModelInfo>` takes such a model unchanged.
 
-use nalgebra::{DMatrix, DVector, SMatrix, SVector};
+use nalgebra::SVector;
 
-use crate::constrained::{ConstraintWorkspace, ProjectionError, Stabilization};
-use crate::integrate::EventSpec;
-use crate::ode::{OdeSystem, RhsError};
-use crate::system::{
-    BodyCentre, ConstraintValues, ModelInfo, UnknownParameter, solve_spd, solve_spd_in_place,
-};
+use crate::ode::EventSpec;
+use crate::system::{BodyCentre, MechanicalSystem, UnknownParameter};
 
 /// Equations of motion `M(q, t) q̈ = F(q, q̇, t)` of a mechanism with `n` degrees of freedom,
 /// `n` known at run time.
 ///
 /// Every method means what the method of the same name of
-/// [`MechanicalSystem`](crate::MechanicalSystem) means; values are written into caller-owned
+/// [`MechanicalSystem`] means; values are written into caller-owned
 /// slices so that an evaluation allocates nothing.
 ///
 /// # Shapes
@@ -99,7 +96,7 @@ pub trait DynMechanicalSystem {
     /// [`Self::holonomic_constraint_count`]).
     fn constraint_residuals(&self, q: &[f64], t: f64, out: &mut [f64]);
     /// The constraint Jacobian `J` (`m × n`, **row-major**, as
-    /// [`MechanicalSystem::constraint_jacobian`](crate::MechanicalSystem::constraint_jacobian))
+    /// [`MechanicalSystem::constraint_jacobian`])
     /// into `out`.
     fn constraint_jacobian(&self, q: &[f64], t: f64, out: &mut [f64]);
     /// Velocity-level residuals (length `m`) into `out`.
@@ -129,439 +126,371 @@ pub trait DynMechanicalSystem {
     );
 }
 
-/// The first-order form `y = [q; q̇]`, `ẏ = [q̇; q̈]` of a [`DynMechanicalSystem`]: what
-/// [`FirstOrder`](crate::FirstOrder) is for a [`MechanicalSystem<N>`](crate::MechanicalSystem),
-/// with the same solves in the same operation order, so that the same equations give the
-/// same bits either way.
+/// A [`MechanicalSystem<N>`] seen as a [`DynMechanicalSystem`]: the one place where the
+/// compile-time-sized interface is mapped to the slices of the run-time one (static vectors
+/// and matrices copied from and to the slices, names and lists collected into `Vec`s).
 ///
-/// `M q̈ = F` is solved by [`solve_spd_in_place`] (closed forms for one and two degrees of
-/// freedom, else `L D Lᵀ`); with constraints, `q̈` and `λ` come from `[M Jᵀ; J 0][q̈; λ] = [F; γ]`
-/// ([`ConstraintWorkspace`]), with the drift control [`DynFirstOrder::stabilization`]. Every
-/// buffer is allocated in [`DynFirstOrder::new`]: an evaluation of the right-hand side
-/// allocates nothing.
-#[derive(Debug, Clone)]
-pub struct DynFirstOrder<S> {
-    /// The wrapped system.
-    pub system: S,
-    /// Drift control of a constrained system (ignored without constraints).
-    pub stabilization: Stabilization,
-    /// Buffers and the last multipliers `λ` of a constrained system.
-    pub constraints: ConstraintWorkspace,
-    /// The model's events, whose `terminal` flags may be changed
-    /// ([`ModelInfo::set_event_terminal`]).
-    pub events: Vec<EventSpec>,
-    n: usize,
-    mass: Vec<f64>,
-    forcing: Vec<f64>,
-    spd: Vec<f64>,
-    zeros: Vec<f64>,
-}
+/// With it, what is written once over [`DynMechanicalSystem`] serves the models compiled by
+/// `eomgen::model!` too: the constrained solve, drift and projection of
+/// [`ConstraintWorkspace`](crate::ConstraintWorkspace), and the size-erased
+/// [`ModelInfo`](crate::ModelInfo) of [`FirstOrder`](crate::FirstOrder). (A blanket
+/// `impl<S: MechanicalSystem<N>, const N: usize> DynMechanicalSystem for S` is not possible:
+/// `N` would not be constrained by the implementing type.) The compiled models' hot path,
+/// `FirstOrder::rhs` and its Jacobian, does not go through here.
+///
+/// `repr(transparent)`, so that [`Self::from_ref`] and [`Self::from_mut`] view a borrowed `S`
+/// in place: a wrapper lends the names it returns with the borrow of the system itself.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[repr(transparent)]
+pub struct StaticSystem<S, const N: usize>(pub S);
 
-impl<S: DynMechanicalSystem> DynFirstOrder<S> {
-    /// Wraps `system`.
-    pub fn new(system: S) -> Self {
-        let n = system.num_dofs();
-        let m = system.constraint_names().len();
-        let holonomic = system.holonomic_constraint_count();
-        let events = system.event_specs();
-        Self {
-            system,
-            stabilization: Stabilization::None,
-            constraints: ConstraintWorkspace::new(n, m, holonomic),
-            events,
-            n,
-            mass: vec![0.0; n * n],
-            forcing: vec![0.0; n],
-            spd: vec![0.0; n * n + 2 * n],
-            zeros: vec![0.0; n],
-        }
+impl<S, const N: usize> StaticSystem<S, N> {
+    /// `system` seen through the adapter, borrowed in place.
+    pub fn from_ref(system: &S) -> &Self {
+        // SAFETY: `StaticSystem<S, N>` is `repr(transparent)` over its only field, an `S`, so
+        // the two have the same layout and alignment; the lifetime is kept.
+        unsafe { &*(system as *const S).cast::<Self>() }
     }
 
-    /// Generalized accelerations `q̈` at `(q, q̇, t)` into `qddot` (length `n`): `M⁻¹F`, or the
-    /// constrained solve.
-    ///
-    /// # Errors
-    /// [`RhsError::SingularMassMatrix`] if `M` is not positive definite,
-    /// [`RhsError::SingularConstraintMatrix`] for a singular KKT matrix, and
-    /// [`RhsError::NonFinite`] if `q̈` has a NaN or infinite component (index counted in
-    /// `y`, so `n + i`).
-    pub fn generalized_accelerations(
-        &mut self,
-        q: &[f64],
-        qdot: &[f64],
-        t: f64,
-        qddot: &mut [f64],
-    ) -> Result<(), RhsError> {
-        let n = self.n;
-        if self.constraints.is_empty() {
-            self.system
-                .mass_matrix_and_forcing(q, qdot, t, &mut self.mass, &mut self.forcing);
-            solve_spd_in_place(n, &self.mass, &mut self.forcing, &mut self.spd)
-                .ok_or(RhsError::SingularMassMatrix)?;
-            qddot[..n].copy_from_slice(&self.forcing);
-        } else {
-            self.constraints.accelerations_into(
-                &self.system,
-                q,
-                qdot,
-                t,
-                self.stabilization,
-                qddot,
-            )?;
-        }
-        match qddot[..n].iter().position(|v| !v.is_finite()) {
-            Some(i) => Err(RhsError::NonFinite { index: n + i }),
-            None => Ok(()),
-        }
-    }
-
-    /// The Jacobians `(∂q̈/∂q, ∂q̈/∂q̇)` (each `n × n`) of `q̈ = M⁻¹F` at `(q, q̇, t)`, as
-    /// [`FirstOrder::acceleration_jacobians`](crate::FirstOrder::acceleration_jacobians)
-    /// computes them: `M⁻¹ (∂F/∂q − ∂(M a)/∂q |_(a = q̈))` and `M⁻¹ ∂F/∂q̇`, with one Cholesky
-    /// factorisation.
-    ///
-    /// # Errors
-    /// [`RhsError::SingularMassMatrix`] if `M` is not positive definite; [`RhsError::NonFinite`]
-    /// if `q̈` or an entry of the Jacobians is not finite (index `n + i` for row `i`).
-    pub fn acceleration_jacobians(
-        &mut self,
-        q: &[f64],
-        qdot: &[f64],
-        t: f64,
-    ) -> Result<(DMatrix<f64>, DMatrix<f64>), RhsError> {
-        let n = self.n;
-        self.system
-            .mass_matrix_and_forcing(q, qdot, t, &mut self.mass, &mut self.forcing);
-        let mass = DMatrix::from_column_slice(n, n, &self.mass);
-        let chol = nalgebra::Cholesky::new(mass).ok_or(RhsError::SingularMassMatrix)?;
-        let qdd = chol.solve(&DVector::from_column_slice(&self.forcing));
-        let mut d_forcing_q = DMatrix::zeros(n, n);
-        self.system
-            .forcing_jacobian_q(q, qdot, t, d_forcing_q.as_mut_slice());
-        let mut product = DMatrix::zeros(n, n);
-        self.system
-            .mass_matrix_product_jacobian(q, t, qdd.as_slice(), product.as_mut_slice());
-        let d_qdd_q = chol.solve(&(d_forcing_q - product));
-        let mut d_forcing_qdot = DMatrix::zeros(n, n);
-        self.system
-            .forcing_jacobian_qdot(q, qdot, t, d_forcing_qdot.as_mut_slice());
-        let d_qdd_qdot = chol.solve(&d_forcing_qdot);
-        if let Some(i) = qdd.iter().position(|v| !v.is_finite()) {
-            return Err(RhsError::NonFinite { index: n + i });
-        }
-        for matrix in [&d_qdd_q, &d_qdd_qdot] {
-            let bad = matrix
-                .row_iter()
-                .position(|row| row.iter().any(|v| !v.is_finite()));
-            if let Some(i) = bad {
-                return Err(RhsError::NonFinite { index: n + i });
-            }
-        }
-        Ok((d_qdd_q, d_qdd_qdot))
+    /// `system` seen through the adapter, mutably borrowed in place.
+    pub fn from_mut(system: &mut S) -> &mut Self {
+        // SAFETY: as in `from_ref`; the unique borrow of `system` becomes the unique borrow of
+        // the wrapper.
+        unsafe { &mut *(system as *mut S).cast::<Self>() }
     }
 }
 
-impl<S: DynMechanicalSystem> DynFirstOrder<S> {
-    /// The right-hand side of an unconstrained system of `N = n` degrees of freedom, as
-    /// `FirstOrder::rhs` computes it.
-    fn unconstrained_rhs<const N: usize>(
-        &mut self,
-        t: f64,
-        y: &[f64],
-        dy: &mut [f64],
-    ) -> Result<(), RhsError> {
-        let mut mass = SMatrix::<f64, N, N>::zeros();
-        let mut forcing = SVector::<f64, N>::zeros();
-        self.system.mass_matrix_and_forcing(
-            &y[..N],
-            &y[N..2 * N],
-            t,
-            mass.as_mut_slice(),
-            forcing.as_mut_slice(),
-        );
-        let qdd = solve_spd(&mass, &forcing).ok_or(RhsError::SingularMassMatrix)?;
-        if let Some(i) = qdd.iter().position(|v| !v.is_finite()) {
-            return Err(RhsError::NonFinite { index: N + i });
-        }
-        dy[..N].copy_from_slice(&y[N..2 * N]);
-        dy[N..2 * N].copy_from_slice(qdd.as_slice());
-        Ok(())
-    }
+fn vector<const N: usize>(x: &[f64]) -> SVector<f64, N> {
+    SVector::<f64, N>::from_column_slice(&x[..N])
 }
 
-impl<S: DynMechanicalSystem> OdeSystem for DynFirstOrder<S> {
-    fn dim(&self) -> usize {
-        2 * self.n
-    }
-
-    fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), RhsError> {
-        if self.constraints.is_empty() {
-            // The sizes of most mechanisms, with the matrices on the stack and the solve of
-            // `FirstOrder` (the same operations as `solve_spd_in_place`): on the double
-            // pendulum this path is ~6 ns shorter than the general one (`benches/runtime_model.rs`).
-            match self.n {
-                1 => return self.unconstrained_rhs::<1>(t, y, dy),
-                2 => return self.unconstrained_rhs::<2>(t, y, dy),
-                3 => return self.unconstrained_rhs::<3>(t, y, dy),
-                4 => return self.unconstrained_rhs::<4>(t, y, dy),
-                _ => {}
-            }
-        }
-        let n = self.n;
-        let (q, qdot) = (&y[..n], &y[n..2 * n]);
-        let (velocity, acceleration) = dy.split_at_mut(n);
-        self.generalized_accelerations(q, qdot, t, acceleration)?;
-        velocity.copy_from_slice(qdot);
-        Ok(())
-    }
-
-    fn after_step(&mut self, t: f64, y: &mut [f64]) -> Result<bool, RhsError> {
-        if self.constraints.is_empty() || self.stabilization != Stabilization::Projection {
-            return Ok(false);
-        }
-        let n = self.n;
-        let (q, qdot) = y.split_at_mut(n);
-        self.constraints
-            .project(&self.system, q, &mut qdot[..n], t, &[], 1e-12)
-            .map_err(|e| RhsError::ProjectionFailed {
-                residual: e.residual,
-            })?;
-        Ok(true)
-    }
-
-    /// The exact Jacobian of `ẏ = [q̇; q̈]`, as
-    /// [`FirstOrder`](crate::FirstOrder)'s; `Ok(false)` for a constrained system.
-    fn jacobian(&mut self, t: f64, y: &[f64], jac: &mut [f64]) -> Result<bool, RhsError> {
-        if !self.constraints.is_empty() {
-            return Ok(false);
-        }
-        let n = self.n;
-        let (d_q, d_qdot) = self.acceleration_jacobians(&y[..n], &y[n..2 * n], t)?;
-        let dim = 2 * n;
-        jac[..dim * dim].fill(0.0);
-        for j in 0..n {
-            // Column n + j of the upper block row: ∂q̇ᵢ/∂q̇ⱼ = δᵢⱼ.
-            jac[j + (n + j) * dim] = 1.0;
-            for i in 0..n {
-                jac[n + i + j * dim] = d_q[(i, j)];
-                jac[n + i + (n + j) * dim] = d_qdot[(i, j)];
-            }
-        }
-        Ok(true)
-    }
-
-    fn second_order_dim(&self) -> Option<usize> {
-        Some(self.n)
-    }
-
-    fn event_specs(&self) -> &[EventSpec] {
-        &self.events
-    }
-
-    fn event_values(&mut self, t: f64, y: &[f64], g: &mut [f64]) -> Result<(), RhsError> {
-        if self.events.is_empty() {
-            return Ok(());
-        }
-        let n = self.n;
-        let (q, qdot) = (&y[..n], &y[n..2 * n]);
-        if !self.system.events_need_accelerations() {
-            self.system.event_values(q, qdot, t, &self.zeros, &[], g);
-            return Ok(());
-        }
-        let mut qddot = std::mem::take(&mut self.zeros);
-        let result = self.generalized_accelerations(q, qdot, t, &mut qddot);
-        if result.is_ok() {
-            let lambda: &[f64] = if self.constraints.is_empty() {
-                &[]
-            } else {
-                &self.constraints.multipliers
-            };
-            self.system.event_values(q, qdot, t, &qddot, lambda, g);
-        }
-        qddot.fill(0.0);
-        self.zeros = qddot;
-        result
-    }
-}
-
-impl<S: DynMechanicalSystem> ModelInfo for DynFirstOrder<S> {
+impl<S: MechanicalSystem<N>, const N: usize> DynMechanicalSystem for StaticSystem<S, N> {
     fn name(&self) -> &str {
-        self.system.name()
+        self.0.name()
     }
     fn description(&self) -> &str {
-        self.system.description()
+        self.0.description()
     }
     fn num_dofs(&self) -> usize {
-        self.n
+        N
     }
     fn coordinate_names(&self) -> Vec<&str> {
-        self.system.coordinate_names()
+        self.0.coordinate_names().to_vec()
     }
     fn parameter_names(&self) -> Vec<&str> {
-        self.system.parameter_names()
+        self.0.parameter_names().to_vec()
     }
     fn parameter_values(&self) -> Vec<f64> {
-        self.system.parameter_values()
+        self.0.parameter_values()
     }
     fn set_parameter(&mut self, name: &str, value: f64) -> Result<(), UnknownParameter> {
-        self.system.set_parameter(name, value)
+        self.0.set_parameter(name, value)
     }
-    fn initial_state(&self) -> Vec<f64> {
-        let n = self.n;
-        let mut y = vec![0.0; 2 * n];
-        let (q, qdot) = y.split_at_mut(n);
-        self.system.initial_state(q, qdot);
-        y
+    fn initial_state(&self, q: &mut [f64], qdot: &mut [f64]) {
+        let (q0, qdot0) = self.0.initial_state();
+        q[..N].copy_from_slice(q0.as_slice());
+        qdot[..N].copy_from_slice(qdot0.as_slice());
     }
-    fn kinetic_energy(&self, t: f64, y: &[f64]) -> f64 {
-        self.system
-            .kinetic_energy(&y[..self.n], &y[self.n..2 * self.n], t)
+    fn mass_matrix_and_forcing(
+        &self,
+        q: &[f64],
+        qdot: &[f64],
+        t: f64,
+        mass: &mut [f64],
+        forcing: &mut [f64],
+    ) {
+        let (m, f) = self
+            .0
+            .mass_matrix_and_forcing(&vector::<N>(q), &vector::<N>(qdot), t);
+        mass[..N * N].copy_from_slice(m.as_slice());
+        forcing[..N].copy_from_slice(f.as_slice());
     }
-    fn potential_energy(&self, t: f64, y: &[f64]) -> f64 {
-        self.system.potential_energy(&y[..self.n], t)
+    fn forcing_jacobian_q(&self, q: &[f64], qdot: &[f64], t: f64, out: &mut [f64]) {
+        let j = self
+            .0
+            .forcing_jacobian_q(&vector::<N>(q), &vector::<N>(qdot), t);
+        out[..N * N].copy_from_slice(j.as_slice());
+    }
+    fn forcing_jacobian_qdot(&self, q: &[f64], qdot: &[f64], t: f64, out: &mut [f64]) {
+        let j = self
+            .0
+            .forcing_jacobian_qdot(&vector::<N>(q), &vector::<N>(qdot), t);
+        out[..N * N].copy_from_slice(j.as_slice());
+    }
+    fn mass_matrix_product_jacobian(&self, q: &[f64], t: f64, a: &[f64], out: &mut [f64]) {
+        let j = self
+            .0
+            .mass_matrix_product_jacobian(&vector::<N>(q), t, &vector::<N>(a));
+        out[..N * N].copy_from_slice(j.as_slice());
+    }
+    fn kinetic_energy(&self, q: &[f64], qdot: &[f64], t: f64) -> f64 {
+        self.0
+            .kinetic_energy(&vector::<N>(q), &vector::<N>(qdot), t)
+    }
+    fn potential_energy(&self, q: &[f64], t: f64) -> f64 {
+        self.0.potential_energy(&vector::<N>(q), t)
     }
     fn is_conservative(&self) -> bool {
-        self.system.is_conservative()
+        self.0.is_conservative()
     }
     fn point_names(&self) -> Vec<&str> {
-        self.system.point_names()
+        self.0.point_names().to_vec()
     }
-    fn point_positions(&self, t: f64, y: &[f64]) -> Vec<[f64; 3]> {
-        let mut out = vec![[0.0; 3]; self.system.point_names().len()];
-        self.system.point_positions(&y[..self.n], t, &mut out);
-        out
+    fn point_positions(&self, q: &[f64], t: f64, out: &mut [[f64; 3]]) {
+        self.0.point_positions(&vector::<N>(q), t, out);
     }
     fn draw_lines(&self) -> Vec<[&str; 2]> {
-        self.system.draw_lines()
+        self.0.draw_lines().to_vec()
     }
     fn trace_points(&self) -> Vec<&str> {
-        self.system.trace_points()
+        self.0.trace_points().to_vec()
     }
     fn body_centres(&self) -> Vec<BodyCentre<'_>> {
-        self.system.body_centres()
+        self.0.body_centres().to_vec()
     }
     fn equations_text(&self) -> &str {
-        self.system.equations_text()
+        self.0.equations_text()
     }
     fn equations_latex(&self) -> &str {
-        self.system.equations_latex()
-    }
-    fn as_ode_mut(&mut self) -> &mut dyn OdeSystem {
-        self
-    }
-    fn mass_matrix_and_forcing(&self, t: f64, y: &[f64]) -> (DMatrix<f64>, DVector<f64>) {
-        let n = self.n;
-        let (mut mass, mut forcing) = (DMatrix::zeros(n, n), DVector::zeros(n));
-        self.system.mass_matrix_and_forcing(
-            &y[..n],
-            &y[n..2 * n],
-            t,
-            mass.as_mut_slice(),
-            forcing.as_mut_slice(),
-        );
-        (mass, forcing)
-    }
-    fn forcing_jacobians(&self, t: f64, y: &[f64]) -> (DMatrix<f64>, DMatrix<f64>) {
-        let n = self.n;
-        let (mut jq, mut jqd) = (DMatrix::zeros(n, n), DMatrix::zeros(n, n));
-        self.system
-            .forcing_jacobian_q(&y[..n], &y[n..2 * n], t, jq.as_mut_slice());
-        self.system
-            .forcing_jacobian_qdot(&y[..n], &y[n..2 * n], t, jqd.as_mut_slice());
-        (jq, jqd)
-    }
-    fn mass_matrix_product_jacobian(&self, t: f64, y: &[f64], a: &[f64]) -> DMatrix<f64> {
-        let n = self.n;
-        let mut out = DMatrix::zeros(n, n);
-        self.system
-            .mass_matrix_product_jacobian(&y[..n], t, &a[..n], out.as_mut_slice());
-        out
+        self.0.equations_latex()
     }
     fn constraint_names(&self) -> Vec<&str> {
-        self.system.constraint_names()
+        self.0.constraint_names().to_vec()
     }
     fn holonomic_constraint_count(&self) -> usize {
-        self.system.holonomic_constraint_count()
+        self.0.holonomic_constraint_count()
     }
-    fn set_stabilization(&mut self, stabilization: Stabilization) {
-        self.stabilization = stabilization;
+    fn constraint_residuals(&self, q: &[f64], t: f64, out: &mut [f64]) {
+        self.0.constraint_residuals(&vector::<N>(q), t, out);
     }
-    fn constraint_forces(&mut self, t: f64, y: &[f64]) -> Result<Vec<f64>, RhsError> {
-        if self.constraints.is_empty() {
-            return Ok(Vec::new());
-        }
-        let n = self.n;
-        let mut qddot = vec![0.0; n];
-        self.constraints.accelerations_into(
-            &self.system,
-            &y[..n],
-            &y[n..2 * n],
-            t,
-            self.stabilization,
-            &mut qddot,
-        )?;
-        Ok(self.constraints.multipliers.clone())
+    fn constraint_jacobian(&self, q: &[f64], t: f64, out: &mut [f64]) {
+        self.0.constraint_jacobian(&vector::<N>(q), t, out);
     }
-    fn constraint_drift(&mut self, t: f64, y: &[f64]) -> (f64, f64) {
-        let n = self.n;
-        self.constraints
-            .drift(&self.system, &y[..n], &y[n..2 * n], t)
+    fn constraint_velocity_residuals(&self, q: &[f64], qdot: &[f64], t: f64, out: &mut [f64]) {
+        self.0
+            .constraint_velocity_residuals(&vector::<N>(q), &vector::<N>(qdot), t, out);
     }
-    fn project(&mut self, t: f64, y: &mut [f64], free: &[usize]) -> Result<usize, ProjectionError> {
-        // On a copy, so that a projection that fails leaves `y` as it was.
-        let n = self.n;
-        let mut projected = y[..2 * n].to_vec();
-        let (q, qdot) = projected.split_at_mut(n);
-        let iterations = self
-            .constraints
-            .project(&self.system, q, qdot, t, free, 1e-12)?;
-        y[..2 * n].copy_from_slice(&projected);
-        Ok(iterations)
+    fn constraint_gamma(&self, q: &[f64], qdot: &[f64], t: f64, out: &mut [f64]) {
+        self.0
+            .constraint_gamma(&vector::<N>(q), &vector::<N>(qdot), t, out);
     }
     fn initial_guesses(&self) -> &[usize] {
-        self.system.initial_guesses()
+        self.0.initial_guesses()
     }
-    fn equilibrium_guesses(&self) -> Vec<(&str, Vec<f64>)> {
-        let n = self.n;
-        let names = self.system.equilibrium_names();
-        let mut values = vec![0.0; n * names.len()];
-        self.system.equilibrium_guesses(&mut values);
-        names
-            .into_iter()
-            .zip(values.chunks(n.max(1)))
-            .map(|(name, q)| (name, q.to_vec()))
-            .collect()
+    fn equilibrium_names(&self) -> Vec<&str> {
+        self.0.equilibrium_names().to_vec()
     }
-    fn set_event_terminal(&mut self, name: &str, terminal: bool) -> bool {
-        match self.events.iter_mut().find(|e| e.name == name) {
-            Some(e) => {
-                e.terminal = terminal;
-                true
+    fn equilibrium_guesses(&self, out: &mut [f64]) {
+        self.0.equilibrium_guesses(out);
+    }
+    fn event_specs(&self) -> Vec<EventSpec> {
+        self.0.event_specs().to_vec()
+    }
+    fn events_need_accelerations(&self) -> bool {
+        self.0.events_need_accelerations()
+    }
+    fn event_values(
+        &self,
+        q: &[f64],
+        qdot: &[f64],
+        t: f64,
+        qddot: &[f64],
+        lambda: &[f64],
+        out: &mut [f64],
+    ) {
+        self.0.event_values(
+            &vector::<N>(q),
+            &vector::<N>(qdot),
+            t,
+            &vector::<N>(qddot),
+            lambda,
+            out,
+        );
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use nalgebra::{Matrix2, Vector2};
+
+    use super::*;
+    use crate::{DynFirstOrder, FirstOrder, ModelInfo, OdeSystem};
+
+    /// A two-degree-of-freedom system whose every matrix has distinct entries (a transposed
+    /// or misplaced copy shows), with points, an equilibrium guess and parameters.
+    #[derive(Debug, Clone)]
+    struct Skewed {
+        k: f64,
+    }
+
+    impl MechanicalSystem<2> for Skewed {
+        fn name(&self) -> &'static str {
+            "skewed"
+        }
+        fn description(&self) -> &'static str {
+            "a test system"
+        }
+        fn coordinate_names(&self) -> [&'static str; 2] {
+            ["x", "y"]
+        }
+        fn parameter_names(&self) -> &'static [&'static str] {
+            &["k"]
+        }
+        fn parameter_values(&self) -> Vec<f64> {
+            vec![self.k]
+        }
+        fn set_parameter(&mut self, name: &str, value: f64) -> Result<(), UnknownParameter> {
+            match name {
+                "k" => {
+                    self.k = value;
+                    Ok(())
+                }
+                _ => Err(UnknownParameter {
+                    model: "skewed".into(),
+                    name: name.into(),
+                    known: "k".into(),
+                }),
             }
-            None => false,
+        }
+        fn initial_state(&self) -> (SVector<f64, 2>, SVector<f64, 2>) {
+            (Vector2::new(0.3, -0.2), Vector2::new(0.1, 0.7))
+        }
+        fn mass_matrix(&self, q: &SVector<f64, 2>, _t: f64) -> nalgebra::SMatrix<f64, 2, 2> {
+            let c = 0.4 * q[1].cos();
+            Matrix2::new(2.0 + q[0] * q[0], c, c, 1.5)
+        }
+        fn forcing(&self, q: &SVector<f64, 2>, qdot: &SVector<f64, 2>, t: f64) -> SVector<f64, 2> {
+            Vector2::new(
+                -self.k * q[0] + 0.3 * qdot[1] * q[1] + t.sin(),
+                -2.0 * self.k * q[1] - 0.7 * qdot[0] * q[0],
+            )
+        }
+        fn mass_matrix_and_forcing(
+            &self,
+            q: &SVector<f64, 2>,
+            qdot: &SVector<f64, 2>,
+            t: f64,
+        ) -> (nalgebra::SMatrix<f64, 2, 2>, SVector<f64, 2>) {
+            (self.mass_matrix(q, t), self.forcing(q, qdot, t))
+        }
+        fn forcing_jacobian_q(
+            &self,
+            _q: &SVector<f64, 2>,
+            qdot: &SVector<f64, 2>,
+            _t: f64,
+        ) -> nalgebra::SMatrix<f64, 2, 2> {
+            Matrix2::new(-self.k, 0.3 * qdot[1], -0.7 * qdot[0], -2.0 * self.k)
+        }
+        fn forcing_jacobian_qdot(
+            &self,
+            q: &SVector<f64, 2>,
+            _qdot: &SVector<f64, 2>,
+            _t: f64,
+        ) -> nalgebra::SMatrix<f64, 2, 2> {
+            Matrix2::new(0.0, 0.3 * q[1], -0.7 * q[0], 0.0)
+        }
+        fn mass_matrix_product_jacobian(
+            &self,
+            q: &SVector<f64, 2>,
+            _t: f64,
+            a: &SVector<f64, 2>,
+        ) -> nalgebra::SMatrix<f64, 2, 2> {
+            let dc = -0.4 * q[1].sin();
+            Matrix2::new(2.0 * q[0] * a[0], dc * a[1], 0.0, dc * a[0])
+        }
+        fn kinetic_energy(&self, q: &SVector<f64, 2>, qdot: &SVector<f64, 2>, t: f64) -> f64 {
+            0.5 * qdot.dot(&(self.mass_matrix(q, t) * qdot))
+        }
+        fn potential_energy(&self, q: &SVector<f64, 2>, _t: f64) -> f64 {
+            0.5 * self.k * (q[0] * q[0] + 2.0 * q[1] * q[1])
+        }
+        fn is_conservative(&self) -> bool {
+            false
+        }
+        fn point_names(&self) -> &'static [&'static str] {
+            &["p", "r"]
+        }
+        fn point_positions(&self, q: &SVector<f64, 2>, _t: f64, out: &mut [[f64; 3]]) {
+            out[0] = [q[0], 0.0, 0.0];
+            out[1] = [q[0], q[1], 1.0];
+        }
+        fn equations_text(&self) -> &'static str {
+            "text"
+        }
+        fn equations_latex(&self) -> &'static str {
+            "latex"
+        }
+        fn equilibrium_names(&self) -> &'static [&'static str] {
+            &["rest", "off"]
+        }
+        fn equilibrium_guesses(&self, out: &mut [f64]) {
+            out.copy_from_slice(&[0.0, 0.0, 0.5, -0.5]);
         }
     }
-    fn constraint_equations(&self, t: f64, y: &[f64]) -> ConstraintValues {
-        let n = self.n;
-        let (q, qdot) = (&y[..n], &y[n..2 * n]);
-        let m = self.system.constraint_names().len();
-        let h = self.system.holonomic_constraint_count();
-        let mut phi = vec![0.0; h];
-        let mut jacobian = vec![0.0; m * n];
-        let mut velocity = vec![0.0; m];
-        let mut gamma = vec![0.0; m];
-        if m > 0 {
-            self.system.constraint_residuals(q, t, &mut phi);
-            self.system.constraint_jacobian(q, t, &mut jacobian);
-            self.system
-                .constraint_velocity_residuals(q, qdot, t, &mut velocity);
-            self.system.constraint_gamma(q, qdot, t, &mut gamma);
+
+    /// The adapter against the compiled system itself: `FirstOrder` (its own right-hand side,
+    /// its `ModelInfo` through `StaticSystem`) and `DynFirstOrder` of the adapter (the
+    /// run-time path throughout) agree to the bit with each other and with the
+    /// `MechanicalSystem` methods, entry by entry; the matrices have distinct entries, so a
+    /// transposed or misplaced copy fails.
+    #[test]
+    fn static_system_is_the_compiled_system_on_slices() {
+        let system = Skewed { k: 3.0 };
+        let mut compiled = FirstOrder::new(system.clone());
+        let mut runtime = DynFirstOrder::new(StaticSystem::<_, 2>(system.clone()));
+        let y = [0.3, -0.2, 0.1, 0.7];
+        let t = 0.25;
+        let (q, qdot) = (Vector2::new(y[0], y[1]), Vector2::new(y[2], y[3]));
+        for model in [&mut compiled as &mut dyn ModelInfo, &mut runtime] {
+            assert_eq!(model.num_dofs(), 2);
+            assert_eq!(model.coordinate_names(), ["x", "y"]);
+            assert_eq!(model.initial_state(), y);
+            let (m, f) = model.mass_matrix_and_forcing(t, &y);
+            let (m0, f0) = system.mass_matrix_and_forcing(&q, &qdot, t);
+            assert_eq!(m.as_slice(), m0.as_slice());
+            assert_eq!(f.as_slice(), f0.as_slice());
+            let (jq, jv) = model.forcing_jacobians(t, &y);
+            assert_eq!(jq[(0, 1)], 0.3 * y[3]);
+            assert_eq!(
+                jq.as_slice(),
+                system.forcing_jacobian_q(&q, &qdot, t).as_slice()
+            );
+            assert_eq!(
+                jv.as_slice(),
+                system.forcing_jacobian_qdot(&q, &qdot, t).as_slice()
+            );
+            let a = [0.9, -1.1];
+            let pj = model.mass_matrix_product_jacobian(t, &y, &a);
+            let pj0 = system.mass_matrix_product_jacobian(&q, t, &Vector2::new(a[0], a[1]));
+            assert_eq!(pj.as_slice(), pj0.as_slice());
+            assert_eq!(
+                model.kinetic_energy(t, &y),
+                system.kinetic_energy(&q, &qdot, t)
+            );
+            assert_eq!(
+                model.potential_energy(t, &y),
+                system.potential_energy(&q, t)
+            );
+            assert_eq!(
+                model.point_positions(t, &y),
+                [[0.3, 0.0, 0.0], [0.3, -0.2, 1.0]]
+            );
+            assert_eq!(
+                model.equilibrium_guesses(),
+                [("rest", vec![0.0, 0.0]), ("off", vec![0.5, -0.5])]
+            );
+            assert!(model.set_parameter("k", 4.0).is_ok());
+            assert_eq!(model.parameter_values(), [4.0]);
+            assert!(model.set_parameter("c", 1.0).is_err());
+            model.set_parameter("k", 3.0).unwrap();
         }
-        ConstraintValues {
-            phi: DVector::from_vec(phi),
-            jacobian: DMatrix::from_row_slice(m, n, &jacobian),
-            velocity: DVector::from_vec(velocity),
-            gamma: DVector::from_vec(gamma),
-        }
+        let (mut dc, mut dr) = ([0.0; 4], [0.0; 4]);
+        compiled.rhs(t, &y, &mut dc).unwrap();
+        runtime.rhs(t, &y, &mut dr).unwrap();
+        assert_eq!(dc, dr);
+        let (mut jc, mut jr) = ([0.0; 16], [0.0; 16]);
+        assert!(compiled.jacobian(t, &y, &mut jc).unwrap());
+        assert!(runtime.jacobian(t, &y, &mut jr).unwrap());
+        assert_eq!(jc, jr);
     }
 }

@@ -36,8 +36,8 @@ use crate::integrate::{
     DormandPrince853, IntegrationError, IntegrationFailure, Integrator, IntegratorOptions,
     OutputTimes, Stats,
 };
+use crate::model_info::ModelInfo;
 use crate::ode::{OdeSystem, RhsError};
-use crate::system::ModelInfo;
 
 /// Why a Floquet analysis failed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

@@ -57,8 +57,9 @@ use crate::modal::{
     Equilibrium, Linearization, ModalError, ModeKind, NormalModes, damped_modes, find_equilibrium,
     linearize,
 };
+use crate::model_info::ModelInfo;
 use crate::response::modal_damping;
-use crate::system::{ModelInfo, UnknownParameter};
+use crate::system::UnknownParameter;
 
 /// Why an input matrix, a frequency response or a steady-state simulation failed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

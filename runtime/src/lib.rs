@@ -8,21 +8,23 @@
 pub mod analysis;
 pub mod constrained;
 pub mod dynamic;
+pub mod first_order;
 pub mod floquet;
 pub mod frf;
 pub mod functions;
 pub mod integrate;
+pub mod linalg;
 pub mod modal;
+pub mod model_info;
 pub mod ode;
 pub mod response;
 pub mod system;
 pub mod vibration;
 
 pub use analysis::{Method, UnknownMethod};
-pub use constrained::{
-    ConstraintFunctions, ConstraintWorkspace, ProjectionError, Stabilization, StaticSystem,
-};
-pub use dynamic::{DynFirstOrder, DynMechanicalSystem};
+pub use constrained::{ConstraintFunctions, ConstraintWorkspace, ProjectionError, Stabilization};
+pub use dynamic::{DynMechanicalSystem, StaticSystem};
+pub use first_order::{DynFirstOrder, FirstOrder};
 pub use floquet::{
     FloquetAnalysis, FloquetError, FloquetOptions, FloquetStability, check_periodic_equilibrium,
     floquet_analysis, floquet_multipliers, monodromy_matrix,
@@ -40,11 +42,13 @@ pub use integrate::{
     RungeKutta4, Solution, Stats, StepOutcome, StepSizeController, StormerVerlet, SymplecticEuler,
     Tableau, Tolerance,
 };
+pub use linalg::{solve_spd, solve_spd_in_place};
 pub use modal::{
     Equilibrium, Linearization, ModalError, ModeKind, NewtonStop, NormalModes, constraint_hessians,
     damped_modes, eigenvalues_of_m_inv_k, find_equilibrium, linearize, matrix_exponential,
     normal_modes,
 };
+pub use model_info::{ConstraintValues, FirstOrderForm, FirstOrderParts, ModelInfo};
 pub use ode::{OdeFn, OdeSystem, RhsError, WithEvents};
 pub use response::{
     DampedMode, FreeResponse, LinearOde, MInvKModes, ModalDamping, RayleighDamping, ResponseError,
@@ -53,7 +57,4 @@ pub use response::{
     response_with_modal_damping, state_response_by_eigenvectors, state_response_by_exponential,
     state_response_by_integration,
 };
-pub use system::{
-    BodyCentre, ConstraintValues, FirstOrder, MechanicalSystem, ModelInfo, UnknownParameter,
-    solve_spd, solve_spd_in_place,
-};
+pub use system::{BodyCentre, MechanicalSystem, UnknownParameter};

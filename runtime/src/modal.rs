@@ -24,7 +24,7 @@
 
 use nalgebra::{DMatrix, DVector, SymmetricEigen};
 
-use crate::system::ModelInfo;
+use crate::model_info::ModelInfo;
 
 /// Why an equilibrium, a linearisation or a modal analysis failed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

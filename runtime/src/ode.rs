@@ -1,6 +1,10 @@
-//! First-order ordinary differential equations `ẏ = F(t, y)`, the form every integrator takes.
+//! First-order ordinary differential equations `ẏ = F(t, y)`, the form every integrator takes,
+//! and the event functions an integration locates on them ([`EventSpec`], [`EventDirection`],
+//! [`Event`]; the root finding is in [`crate::integrate`]).
 
-use crate::integrate::EventSpec;
+use std::borrow::Cow;
+
+use serde::Serialize;
 
 /// Why a right-hand side could not be evaluated at a state.
 ///
@@ -278,5 +282,119 @@ where
         let (own, added) = g.split_at_mut(self.own.min(g.len()));
         self.system.event_values(t, y, own)?;
         (self.g)(self.system, t, y, added)
+    }
+}
+
+/// Which zero crossings of an event function count.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum EventDirection {
+    /// `g` goes from negative to non-negative ("reaches zero from below").
+    Rising,
+    /// `g` goes from positive to non-positive ("reaches zero from above": HW21's velocity
+    /// reaching zero at a peak).
+    Falling,
+    /// Either (the default).
+    #[default]
+    Both,
+}
+
+impl EventDirection {
+    /// Parses `rising`, `falling` or `both`.
+    pub fn from_name(name: &str) -> Option<Self> {
+        match name {
+            "rising" => Some(Self::Rising),
+            "falling" => Some(Self::Falling),
+            "both" => Some(Self::Both),
+            _ => None,
+        }
+    }
+
+    /// `rising`, `falling` or `both`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Rising => "rising",
+            Self::Falling => "falling",
+            Self::Both => "both",
+        }
+    }
+
+    /// Whether `g` going from `before` to `after` over a step is a crossing this direction
+    /// counts: a sign change from a nonzero `before` to an `after` of the other sign or zero.
+    pub fn crosses(self, before: f64, after: f64) -> bool {
+        let rising = before < 0.0 && after >= 0.0;
+        let falling = before > 0.0 && after <= 0.0;
+        match self {
+            Self::Rising => rising,
+            Self::Falling => falling,
+            Self::Both => rising || falling,
+        }
+    }
+}
+
+/// An event function's name, the crossings that count and whether it stops the integration.
+///
+/// The function itself is component `i` of
+/// [`OdeSystem::event_values`] for the `i`-th spec of
+/// [`OdeSystem::event_specs`].
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+pub struct EventSpec {
+    /// Name, as in the model file's `events:` or given on the command line.
+    pub name: Cow<'static, str>,
+    /// Which crossings count.
+    pub direction: EventDirection,
+    /// Whether the first counted crossing ends the integration (`--stop-when`).
+    pub terminal: bool,
+}
+
+impl EventSpec {
+    /// A spec named `name`.
+    pub fn new(
+        name: impl Into<Cow<'static, str>>,
+        direction: EventDirection,
+        terminal: bool,
+    ) -> Self {
+        Self {
+            name: name.into(),
+            direction,
+            terminal,
+        }
+    }
+}
+
+/// A located zero of an event function.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Event {
+    /// Index of the event function (into the system's [`EventSpec`]s).
+    pub index: usize,
+    /// Its name.
+    pub name: String,
+    /// Time of the zero (units of `t`).
+    pub t: f64,
+    /// State at `t` from the dense output (`dim` entries).
+    pub y: Vec<f64>,
+    /// The crossing's direction: [`EventDirection::Rising`] or [`EventDirection::Falling`].
+    pub direction: EventDirection,
+    /// Whether it ended the integration.
+    pub terminal: bool,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn directions_count_the_right_crossings() {
+        use EventDirection::*;
+        assert!(Rising.crosses(-1.0, 1.0) && Rising.crosses(-1.0, 0.0));
+        assert!(!Rising.crosses(1.0, -1.0) && !Rising.crosses(0.0, 1.0));
+        assert!(Falling.crosses(1.0, -1.0) && Falling.crosses(2.0, 0.0));
+        assert!(!Falling.crosses(-1.0, 1.0) && !Falling.crosses(0.0, -1.0));
+        assert!(Both.crosses(1.0, -1.0) && Both.crosses(-1.0, 1.0));
+        assert!(!Both.crosses(1.0, 2.0) && !Both.crosses(f64::NAN, 1.0));
+        for d in [Rising, Falling, Both] {
+            assert_eq!(EventDirection::from_name(d.name()), Some(d));
+        }
+        assert_eq!(EventDirection::from_name("up"), None);
     }
 }

@@ -20,7 +20,7 @@ use crate::constrained::Stabilization;
 use crate::integrate::{
     DormandPrince54, IntegrationFailure, Integrator, IntegratorOptions, OutputTimes, Solution,
 };
-use crate::system::ModelInfo;
+use crate::model_info::ModelInfo;
 
 /// Tolerance of the reference runs.
 pub const REFERENCE_TOL: f64 = 1e-13;

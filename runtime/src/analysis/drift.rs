@@ -14,7 +14,7 @@
 use serde::Serialize;
 
 use crate::integrate::Solution;
-use crate::system::ModelInfo;
+use crate::model_info::ModelInfo;
 
 /// The energy at every sample and its relative drift (see [`energy_drift`]).
 #[derive(Debug, Clone, PartialEq, Serialize)]

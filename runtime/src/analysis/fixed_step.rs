@@ -28,7 +28,7 @@ use crate::integrate::Tableau;
 use crate::integrate::stability::{
     StabilityPolynomial, implicit_midpoint_stability, partitioned_oscillator_spectral_radius,
 };
-use crate::system::ModelInfo;
+use crate::model_info::ModelInfo;
 
 /// The growth of a mode that should not grow, over the whole run, beyond which a fixed step
 /// is warned about (a factor of 10: an error that the exact solution does not have, larger

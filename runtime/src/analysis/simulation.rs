@@ -11,8 +11,8 @@ use crate::constrained::{ProjectionError, Stabilization};
 use crate::integrate::{
     EventSpec, IntegrationError, IntegrationFailure, IntegratorOptions, OutputTimes, Solution,
 };
+use crate::model_info::ModelInfo;
 use crate::ode::{RhsError, WithEvents};
-use crate::system::ModelInfo;
 
 /// Options of [`simulate`]: method, end time, step control, output times, drift control and
 /// initial state.

@@ -32,8 +32,8 @@ use crate::integrate::{
     IntegrationFailure, Integrator, IntegratorOptions, OutputTimes, RadauIIA5, RungeKutta4,
     Solution, StormerVerlet, SymplecticEuler, Tableau,
 };
+use crate::model_info::ModelInfo;
 use crate::ode::OdeFn;
-use crate::system::ModelInfo;
 
 /// Options of [`stability_study`].
 #[derive(Debug, Clone, PartialEq)]

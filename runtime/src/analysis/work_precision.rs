@@ -30,7 +30,7 @@ use crate::analysis::drift::energy_drift;
 use crate::analysis::methods::Method;
 use crate::analysis::simulation::SimulationError;
 use crate::integrate::{IntegrationFailure, Integrator, IntegratorOptions, OutputTimes, Solution};
-use crate::system::ModelInfo;
+use crate::model_info::ModelInfo;
 
 /// The methods compared by default: every adaptive method, and the fixed-step RK4 and
 /// Störmer–Verlet.

@@ -85,7 +85,6 @@ pub use dop853::DormandPrince853;
 pub use dopri5::DormandPrince54;
 pub use error::{IntegrationError, IntegrationFailure};
 pub use euler::ExplicitEuler;
-pub use events::{Event, EventDirection, EventSpec};
 pub use implicit_midpoint::ImplicitMidpoint;
 pub use midpoint::ExplicitMidpoint;
 pub use options::{IntegratorOptions, OutputTimes, Tolerance};
@@ -94,6 +93,10 @@ pub use rk4::RungeKutta4;
 pub use solution::{Solution, Stats};
 pub use symplectic::{StormerVerlet, SymplecticEuler};
 pub use tableau::Tableau;
+
+// The event types belong to the ODE interface (`OdeSystem::event_specs`); the root finding is
+// `events`.
+pub use crate::ode::{Event, EventDirection, EventSpec};
 
 use crate::ode::OdeSystem;
 

@@ -2,7 +2,7 @@
 
 use serde::Serialize;
 
-use super::events::Event;
+use crate::ode::Event;
 
 /// The work an integration did.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]

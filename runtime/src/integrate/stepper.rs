@@ -7,11 +7,10 @@
 
 use nalgebra::DMatrix;
 
-use crate::ode::{OdeSystem, RhsError};
+use crate::ode::{EventSpec, OdeSystem, RhsError};
 
 use super::dense_output::{DenseOutput, hermite};
 use super::error::IntegrationError;
-use super::events::EventSpec;
 use super::options::ErrorWeights;
 
 /// Why a step attempt produced no usable candidate.

@@ -22,7 +22,8 @@ use crate::floquet::{
     floquet_analysis,
 };
 use crate::modal::{ModalError, find_equilibrium};
-use crate::system::{ModelInfo, UnknownParameter};
+use crate::model_info::ModelInfo;
+use crate::system::UnknownParameter;
 
 /// Why a Floquet analysis (or one cell of a chart) failed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

@@ -18,8 +18,8 @@ use crate::frf::{
     log_frequencies, modal_frequency_response, output_index, settling_time, simulate_steady_state,
 };
 use crate::modal::{NormalModes, normal_modes};
+use crate::model_info::ModelInfo;
 use crate::response::{ModalDamping, modal_damping};
-use crate::system::ModelInfo;
 
 /// Why a frequency-response analysis failed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

@@ -12,11 +12,11 @@ use super::free_response::{
 };
 use super::operating_point::{OperatingPoint, OperatingPointOptions};
 use crate::modal::{Linearization, ModeKind, NormalModes};
+use crate::model_info::ModelInfo;
 use crate::response::{
     DampedMode, FreeResponse, ModalDamping, RayleighDamping, exact_damped_modes, modal_damping,
     response_by_exponential, response_by_integration, response_with_modal_damping,
 };
-use crate::system::ModelInfo;
 
 /// Options of [`modal_damping_study`].
 #[derive(Debug, Clone, PartialEq, Serialize)]

@@ -11,7 +11,7 @@ use super::operating_point::{
 use crate::modal::{
     Linearization, NormalModes, damped_modes, eigenvalues_of_m_inv_k, linearize, normal_modes,
 };
-use crate::system::ModelInfo;
+use crate::model_info::ModelInfo;
 
 /// Options of [`modal_analysis`].
 #[derive(Debug, Clone, PartialEq, Default, Serialize)]

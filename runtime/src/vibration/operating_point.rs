@@ -5,7 +5,7 @@
 use serde::Serialize;
 
 use crate::modal::{Equilibrium, ModalError, find_equilibrium};
-use crate::system::ModelInfo;
+use crate::model_info::ModelInfo;
 
 /// Where Newton's search for the equilibrium starts.
 #[derive(Debug, Clone, PartialEq, Default, Serialize)]

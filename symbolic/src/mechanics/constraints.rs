@@ -190,7 +190,7 @@ pub fn residual_where_others_hold(
                 gram[a * k + b] = row(i).iter().zip(row(j)).map(|(x, y)| x * y).sum();
             }
         }
-        let y = super::check::solve(gram, r)?;
+        let y = super::numeric::solve(gram, r)?;
         for (a, &i) in independent.iter().enumerate() {
             for (qc, jc) in q.iter_mut().zip(row(i)) {
                 *qc -= jc * y[a];
@@ -220,7 +220,7 @@ fn involved<'a>(
         }
         rhs[a] = (0..n).map(|c| row(i)[c] * target[c]).sum();
     }
-    let Some(c) = super::check::solve(gram, rhs) else {
+    let Some(c) = super::numeric::solve(gram, rhs) else {
         return among.to_vec();
     };
     let scale = c.iter().fold(0.0f64, |m, x| m.max(x.abs()));

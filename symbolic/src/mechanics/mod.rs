@@ -12,6 +12,7 @@ mod lagrange;
 mod lower;
 mod mass;
 mod momentum;
+mod numeric;
 
 pub use balances::{HandEquations, UserBalances};
 pub use constraints::{ConstraintEquations, linear_in_rates, redundant_rows};

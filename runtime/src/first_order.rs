@@ -1,0 +1,518 @@
+//! The first-order forms `y = [q; q̇]`, `ẏ = [q̇; q̈]` that integrators take: [`FirstOrder`] of a
+//! [`MechanicalSystem<N>`] compiled by `eomgen::model!` (stack vectors and matrices, size
+//! known at compile time) and [`DynFirstOrder`] of a [`DynMechanicalSystem`] compiled at run
+//! time, with the same solves in the same operation order.
+
+use nalgebra::{DMatrix, DVector, SMatrix, SVector};
+
+use crate::constrained::{ConstraintWorkspace, Stabilization};
+use crate::dynamic::{DynMechanicalSystem, StaticSystem};
+use crate::linalg::{solve_spd, solve_spd_in_place};
+use crate::model_info::{FirstOrderForm, FirstOrderParts};
+use crate::ode::{EventSpec, OdeSystem, RhsError};
+use crate::system::MechanicalSystem;
+
+/// The first-order form `y = [q; q̇]`, `ẏ = [q̇; M⁻¹F]` of a [`MechanicalSystem`].
+///
+/// `M q̈ = F` is solved at every evaluation by [`solve_spd`] (in closed form for one or two
+/// degrees of freedom, else an `L D Lᵀ` factorisation); a mass matrix that is not
+/// positive definite is [`RhsError::SingularMassMatrix`], a non-finite `q̈` is
+/// [`RhsError::NonFinite`]. No heap allocation.
+///
+/// With constraints ([`MechanicalSystem::constraint_names`] not empty), `q̈` and the
+/// multipliers `λ` come from the index-1 system `[M Jᵀ; J 0][q̈; λ] = [F; γ]` instead, solved by
+/// LU with partial pivoting on buffers allocated in [`FirstOrder::new`]; the drift control is
+/// [`FirstOrder::stabilization`].
+///
+/// Its [`OdeSystem`] (right-hand side, Jacobian, events) is its own, on stack vectors and
+/// matrices of size `N`; its size-erased [`ModelInfo`](crate::ModelInfo) is the one written
+/// for every [`FirstOrderForm`], reaching the system through
+/// [`StaticSystem`].
+#[derive(Debug, Clone)]
+pub struct FirstOrder<S, const N: usize> {
+    /// The wrapped system.
+    pub system: S,
+    /// Drift control of a constrained system (ignored without constraints).
+    pub stabilization: Stabilization,
+    /// Buffers and the last multipliers `λ` of a constrained system.
+    pub constraints: ConstraintWorkspace,
+    /// The model's events ([`MechanicalSystem::event_specs`]), whose `terminal` flags may be
+    /// changed ([`ModelInfo::set_event_terminal`](crate::ModelInfo::set_event_terminal)).
+    pub events: Vec<EventSpec>,
+}
+
+impl<S: MechanicalSystem<N>, const N: usize> FirstOrder<S, N> {
+    /// Wraps `system`.
+    pub fn new(system: S) -> Self {
+        let m = system.constraint_names().len();
+        let holonomic = system.holonomic_constraint_count();
+        let events = system.event_specs().to_vec();
+        Self {
+            system,
+            stabilization: Stabilization::None,
+            constraints: ConstraintWorkspace::new(N, m, holonomic),
+            events,
+        }
+    }
+
+    /// Generalized accelerations `q̈ = M⁻¹F` at `(q, q̇, t)`.
+    ///
+    /// # Errors
+    /// [`RhsError::SingularMassMatrix`] if `M` is not positive definite, [`RhsError::NonFinite`]
+    /// if `q̈` has a NaN or infinite component (index counted in `y`, so `N + i`).
+    pub fn generalized_accelerations(
+        &self,
+        q: &SVector<f64, N>,
+        qdot: &SVector<f64, N>,
+        t: f64,
+    ) -> Result<SVector<f64, N>, RhsError> {
+        let (m, f) = self.system.mass_matrix_and_forcing(q, qdot, t);
+        let qdd = solve_spd(&m, &f).ok_or(RhsError::SingularMassMatrix)?;
+        if let Some(i) = qdd.iter().position(|v| !v.is_finite()) {
+            return Err(RhsError::NonFinite { index: N + i });
+        }
+        Ok(qdd)
+    }
+
+    /// The Jacobians `(∂q̈/∂q, ∂q̈/∂q̇)` of `q̈ = M⁻¹F` at `(q, q̇, t)`, from the generated exact
+    /// derivatives.
+    ///
+    /// Differentiating `M(q, t) q̈ = F(q, q̇, t)` at fixed `t`:
+    ///
+    /// ```text
+    /// ∂q̈/∂q = M⁻¹ (∂F/∂q − ∂(M a)/∂q |_(a = q̈)),     ∂q̈/∂q̇ = M⁻¹ ∂F/∂q̇
+    /// ```
+    ///
+    /// where `∂(M a)/∂q` is [`MechanicalSystem::mass_matrix_product_jacobian`] (the derivative of
+    /// `M(q) a` with `a` held fixed). One Cholesky factorisation serves `q̈` and both solves;
+    /// no heap allocation.
+    ///
+    /// # Shapes
+    /// Both matrices are `N × N`; entry `(i, j)` of the first is `∂q̈ᵢ/∂qⱼ`.
+    ///
+    /// # Errors
+    /// [`RhsError::SingularMassMatrix`] if `M` is not positive definite; [`RhsError::NonFinite`]
+    /// if `q̈` or an entry of the Jacobians is not finite (index `N + i` for row `i`).
+    pub fn acceleration_jacobians(
+        &self,
+        q: &SVector<f64, N>,
+        qdot: &SVector<f64, N>,
+        t: f64,
+    ) -> Result<(SMatrix<f64, N, N>, SMatrix<f64, N, N>), RhsError> {
+        let (m, f) = self.system.mass_matrix_and_forcing(q, qdot, t);
+        let chol = nalgebra::Cholesky::new(m).ok_or(RhsError::SingularMassMatrix)?;
+        let qdd = chol.solve(&f);
+        let d_forcing_q = self.system.forcing_jacobian_q(q, qdot, t)
+            - self.system.mass_matrix_product_jacobian(q, t, &qdd);
+        let d_qdd_q = chol.solve(&d_forcing_q);
+        let d_qdd_qdot = chol.solve(&self.system.forcing_jacobian_qdot(q, qdot, t));
+        if let Some(i) = qdd.iter().position(|v| !v.is_finite()) {
+            return Err(RhsError::NonFinite { index: N + i });
+        }
+        for matrix in [&d_qdd_q, &d_qdd_qdot] {
+            let bad = matrix
+                .row_iter()
+                .position(|row| row.iter().any(|v| !v.is_finite()));
+            if let Some(i) = bad {
+                return Err(RhsError::NonFinite { index: N + i });
+            }
+        }
+        Ok((d_qdd_q, d_qdd_qdot))
+    }
+}
+
+fn split<const N: usize>(y: &[f64]) -> (SVector<f64, N>, SVector<f64, N>) {
+    (
+        SVector::<f64, N>::from_column_slice(&y[..N]),
+        SVector::<f64, N>::from_column_slice(&y[N..2 * N]),
+    )
+}
+
+impl<S: MechanicalSystem<N>, const N: usize> OdeSystem for FirstOrder<S, N> {
+    fn dim(&self) -> usize {
+        2 * N
+    }
+
+    fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), RhsError> {
+        let (q, qdot) = split::<N>(y);
+        let qdd = if self.constraints.is_empty() {
+            self.generalized_accelerations(&q, &qdot, t)?
+        } else {
+            let qdd =
+                self.constraints
+                    .accelerations(&self.system, &q, &qdot, t, self.stabilization)?;
+            if let Some(i) = qdd.iter().position(|v| !v.is_finite()) {
+                return Err(RhsError::NonFinite { index: N + i });
+            }
+            qdd
+        };
+        dy[..N].copy_from_slice(qdot.as_slice());
+        dy[N..2 * N].copy_from_slice(qdd.as_slice());
+        Ok(())
+    }
+
+    fn after_step(&mut self, t: f64, y: &mut [f64]) -> Result<bool, RhsError> {
+        if self.constraints.is_empty() || self.stabilization != Stabilization::Projection {
+            return Ok(false);
+        }
+        let (q, qdot) = y.split_at_mut(N);
+        self.constraints
+            .project(
+                StaticSystem::from_ref(&self.system),
+                q,
+                &mut qdot[..N],
+                t,
+                &[],
+                1e-12,
+            )
+            .map_err(|e| RhsError::ProjectionFailed {
+                residual: e.residual,
+            })?;
+        Ok(true)
+    }
+
+    /// The exact Jacobian of `ẏ = [q̇; q̈]`, from [`FirstOrder::acceleration_jacobians`]:
+    ///
+    /// ```text
+    /// ∂F/∂y = [ 0        I       ]
+    ///         [ ∂q̈/∂q    ∂q̈/∂q̇   ]
+    /// ```
+    ///
+    /// A constrained system returns `Ok(false)`: its `q̈` comes from the KKT system, whose
+    /// derivative needs `∂J/∂q` and `∂γ/∂(q, q̇)`, which are not generated; the implicit
+    /// methods then difference `F`.
+    fn jacobian(&mut self, t: f64, y: &[f64], jac: &mut [f64]) -> Result<bool, RhsError> {
+        if !self.constraints.is_empty() {
+            return Ok(false);
+        }
+        let (q, qdot) = split::<N>(y);
+        let (d_q, d_qdot) = self.acceleration_jacobians(&q, &qdot, t)?;
+        let dim = 2 * N;
+        jac[..dim * dim].fill(0.0);
+        for j in 0..N {
+            // Column N + j of the upper block row: ∂q̇ᵢ/∂q̇ⱼ = δᵢⱼ.
+            jac[j + (N + j) * dim] = 1.0;
+            for i in 0..N {
+                jac[N + i + j * dim] = d_q[(i, j)];
+                jac[N + i + (N + j) * dim] = d_qdot[(i, j)];
+            }
+        }
+        Ok(true)
+    }
+
+    fn second_order_dim(&self) -> Option<usize> {
+        Some(N)
+    }
+
+    fn event_specs(&self) -> &[EventSpec] {
+        &self.events
+    }
+
+    fn event_values(&mut self, t: f64, y: &[f64], g: &mut [f64]) -> Result<(), RhsError> {
+        if self.events.is_empty() {
+            return Ok(());
+        }
+        let (q, qdot) = split::<N>(y);
+        if !self.system.events_need_accelerations() {
+            let zero = SVector::<f64, N>::zeros();
+            self.system.event_values(&q, &qdot, t, &zero, &[], g);
+            return Ok(());
+        }
+        if self.constraints.is_empty() {
+            let qdd = self.generalized_accelerations(&q, &qdot, t)?;
+            self.system.event_values(&q, &qdot, t, &qdd, &[], g);
+        } else {
+            let qdd =
+                self.constraints
+                    .accelerations(&self.system, &q, &qdot, t, self.stabilization)?;
+            self.system
+                .event_values(&q, &qdot, t, &qdd, &self.constraints.multipliers, g);
+        }
+        Ok(())
+    }
+}
+
+impl<S: MechanicalSystem<N>, const N: usize> FirstOrderForm for FirstOrder<S, N> {
+    type System = StaticSystem<S, N>;
+    fn dyn_system(&self) -> &StaticSystem<S, N> {
+        StaticSystem::from_ref(&self.system)
+    }
+    fn parts_mut(&mut self) -> FirstOrderParts<'_, StaticSystem<S, N>> {
+        FirstOrderParts {
+            system: StaticSystem::from_mut(&mut self.system),
+            stabilization: &mut self.stabilization,
+            constraints: &mut self.constraints,
+            events: &mut self.events,
+        }
+    }
+}
+
+/// The first-order form `y = [q; q̇]`, `ẏ = [q̇; q̈]` of a [`DynMechanicalSystem`]: what
+/// [`FirstOrder`] is for a [`MechanicalSystem<N>`],
+/// with the same solves in the same operation order, so that the same equations give the
+/// same bits either way.
+///
+/// `M q̈ = F` is solved by [`solve_spd_in_place`] (closed forms for one and two degrees of
+/// freedom, else `L D Lᵀ`); with constraints, `q̈` and `λ` come from `[M Jᵀ; J 0][q̈; λ] = [F; γ]`
+/// ([`ConstraintWorkspace`]), with the drift control [`DynFirstOrder::stabilization`]. Every
+/// buffer is allocated in [`DynFirstOrder::new`]: an evaluation of the right-hand side
+/// allocates nothing.
+#[derive(Debug, Clone)]
+pub struct DynFirstOrder<S> {
+    /// The wrapped system.
+    pub system: S,
+    /// Drift control of a constrained system (ignored without constraints).
+    pub stabilization: Stabilization,
+    /// Buffers and the last multipliers `λ` of a constrained system.
+    pub constraints: ConstraintWorkspace,
+    /// The model's events, whose `terminal` flags may be changed
+    /// ([`ModelInfo::set_event_terminal`](crate::ModelInfo::set_event_terminal)).
+    pub events: Vec<EventSpec>,
+    n: usize,
+    mass: Vec<f64>,
+    forcing: Vec<f64>,
+    spd: Vec<f64>,
+    zeros: Vec<f64>,
+}
+
+impl<S: DynMechanicalSystem> DynFirstOrder<S> {
+    /// Wraps `system`.
+    pub fn new(system: S) -> Self {
+        let n = system.num_dofs();
+        let m = system.constraint_names().len();
+        let holonomic = system.holonomic_constraint_count();
+        let events = system.event_specs();
+        Self {
+            system,
+            stabilization: Stabilization::None,
+            constraints: ConstraintWorkspace::new(n, m, holonomic),
+            events,
+            n,
+            mass: vec![0.0; n * n],
+            forcing: vec![0.0; n],
+            spd: vec![0.0; n * n + 2 * n],
+            zeros: vec![0.0; n],
+        }
+    }
+
+    /// Generalized accelerations `q̈` at `(q, q̇, t)` into `qddot` (length `n`): `M⁻¹F`, or the
+    /// constrained solve.
+    ///
+    /// # Errors
+    /// [`RhsError::SingularMassMatrix`] if `M` is not positive definite,
+    /// [`RhsError::SingularConstraintMatrix`] for a singular KKT matrix, and
+    /// [`RhsError::NonFinite`] if `q̈` has a NaN or infinite component (index counted in
+    /// `y`, so `n + i`).
+    pub fn generalized_accelerations(
+        &mut self,
+        q: &[f64],
+        qdot: &[f64],
+        t: f64,
+        qddot: &mut [f64],
+    ) -> Result<(), RhsError> {
+        let n = self.n;
+        if self.constraints.is_empty() {
+            self.system
+                .mass_matrix_and_forcing(q, qdot, t, &mut self.mass, &mut self.forcing);
+            solve_spd_in_place(n, &self.mass, &mut self.forcing, &mut self.spd)
+                .ok_or(RhsError::SingularMassMatrix)?;
+            qddot[..n].copy_from_slice(&self.forcing);
+        } else {
+            self.constraints.accelerations_into(
+                &self.system,
+                q,
+                qdot,
+                t,
+                self.stabilization,
+                qddot,
+            )?;
+        }
+        match qddot[..n].iter().position(|v| !v.is_finite()) {
+            Some(i) => Err(RhsError::NonFinite { index: n + i }),
+            None => Ok(()),
+        }
+    }
+
+    /// The Jacobians `(∂q̈/∂q, ∂q̈/∂q̇)` (each `n × n`) of `q̈ = M⁻¹F` at `(q, q̇, t)`, as
+    /// [`FirstOrder::acceleration_jacobians`](crate::FirstOrder::acceleration_jacobians)
+    /// computes them: `M⁻¹ (∂F/∂q − ∂(M a)/∂q |_(a = q̈))` and `M⁻¹ ∂F/∂q̇`, with one Cholesky
+    /// factorisation.
+    ///
+    /// # Errors
+    /// [`RhsError::SingularMassMatrix`] if `M` is not positive definite; [`RhsError::NonFinite`]
+    /// if `q̈` or an entry of the Jacobians is not finite (index `n + i` for row `i`).
+    pub fn acceleration_jacobians(
+        &mut self,
+        q: &[f64],
+        qdot: &[f64],
+        t: f64,
+    ) -> Result<(DMatrix<f64>, DMatrix<f64>), RhsError> {
+        let n = self.n;
+        self.system
+            .mass_matrix_and_forcing(q, qdot, t, &mut self.mass, &mut self.forcing);
+        let mass = DMatrix::from_column_slice(n, n, &self.mass);
+        let chol = nalgebra::Cholesky::new(mass).ok_or(RhsError::SingularMassMatrix)?;
+        let qdd = chol.solve(&DVector::from_column_slice(&self.forcing));
+        let mut d_forcing_q = DMatrix::zeros(n, n);
+        self.system
+            .forcing_jacobian_q(q, qdot, t, d_forcing_q.as_mut_slice());
+        let mut product = DMatrix::zeros(n, n);
+        self.system
+            .mass_matrix_product_jacobian(q, t, qdd.as_slice(), product.as_mut_slice());
+        let d_qdd_q = chol.solve(&(d_forcing_q - product));
+        let mut d_forcing_qdot = DMatrix::zeros(n, n);
+        self.system
+            .forcing_jacobian_qdot(q, qdot, t, d_forcing_qdot.as_mut_slice());
+        let d_qdd_qdot = chol.solve(&d_forcing_qdot);
+        if let Some(i) = qdd.iter().position(|v| !v.is_finite()) {
+            return Err(RhsError::NonFinite { index: n + i });
+        }
+        for matrix in [&d_qdd_q, &d_qdd_qdot] {
+            let bad = matrix
+                .row_iter()
+                .position(|row| row.iter().any(|v| !v.is_finite()));
+            if let Some(i) = bad {
+                return Err(RhsError::NonFinite { index: n + i });
+            }
+        }
+        Ok((d_qdd_q, d_qdd_qdot))
+    }
+}
+
+impl<S: DynMechanicalSystem> DynFirstOrder<S> {
+    /// The right-hand side of an unconstrained system of `N = n` degrees of freedom, as
+    /// `FirstOrder::rhs` computes it.
+    fn unconstrained_rhs<const N: usize>(
+        &mut self,
+        t: f64,
+        y: &[f64],
+        dy: &mut [f64],
+    ) -> Result<(), RhsError> {
+        let mut mass = SMatrix::<f64, N, N>::zeros();
+        let mut forcing = SVector::<f64, N>::zeros();
+        self.system.mass_matrix_and_forcing(
+            &y[..N],
+            &y[N..2 * N],
+            t,
+            mass.as_mut_slice(),
+            forcing.as_mut_slice(),
+        );
+        let qdd = solve_spd(&mass, &forcing).ok_or(RhsError::SingularMassMatrix)?;
+        if let Some(i) = qdd.iter().position(|v| !v.is_finite()) {
+            return Err(RhsError::NonFinite { index: N + i });
+        }
+        dy[..N].copy_from_slice(&y[N..2 * N]);
+        dy[N..2 * N].copy_from_slice(qdd.as_slice());
+        Ok(())
+    }
+}
+
+impl<S: DynMechanicalSystem> OdeSystem for DynFirstOrder<S> {
+    fn dim(&self) -> usize {
+        2 * self.n
+    }
+
+    fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), RhsError> {
+        if self.constraints.is_empty() {
+            // The sizes of most mechanisms, with the matrices on the stack and the solve of
+            // `FirstOrder` (the same operations as `solve_spd_in_place`): on the double
+            // pendulum this path is ~6 ns shorter than the general one (`benches/runtime_model.rs`).
+            match self.n {
+                1 => return self.unconstrained_rhs::<1>(t, y, dy),
+                2 => return self.unconstrained_rhs::<2>(t, y, dy),
+                3 => return self.unconstrained_rhs::<3>(t, y, dy),
+                4 => return self.unconstrained_rhs::<4>(t, y, dy),
+                _ => {}
+            }
+        }
+        let n = self.n;
+        let (q, qdot) = (&y[..n], &y[n..2 * n]);
+        let (velocity, acceleration) = dy.split_at_mut(n);
+        self.generalized_accelerations(q, qdot, t, acceleration)?;
+        velocity.copy_from_slice(qdot);
+        Ok(())
+    }
+
+    fn after_step(&mut self, t: f64, y: &mut [f64]) -> Result<bool, RhsError> {
+        if self.constraints.is_empty() || self.stabilization != Stabilization::Projection {
+            return Ok(false);
+        }
+        let n = self.n;
+        let (q, qdot) = y.split_at_mut(n);
+        self.constraints
+            .project(&self.system, q, &mut qdot[..n], t, &[], 1e-12)
+            .map_err(|e| RhsError::ProjectionFailed {
+                residual: e.residual,
+            })?;
+        Ok(true)
+    }
+
+    /// The exact Jacobian of `ẏ = [q̇; q̈]`, as
+    /// [`FirstOrder`]'s; `Ok(false)` for a constrained system.
+    fn jacobian(&mut self, t: f64, y: &[f64], jac: &mut [f64]) -> Result<bool, RhsError> {
+        if !self.constraints.is_empty() {
+            return Ok(false);
+        }
+        let n = self.n;
+        let (d_q, d_qdot) = self.acceleration_jacobians(&y[..n], &y[n..2 * n], t)?;
+        let dim = 2 * n;
+        jac[..dim * dim].fill(0.0);
+        for j in 0..n {
+            // Column n + j of the upper block row: ∂q̇ᵢ/∂q̇ⱼ = δᵢⱼ.
+            jac[j + (n + j) * dim] = 1.0;
+            for i in 0..n {
+                jac[n + i + j * dim] = d_q[(i, j)];
+                jac[n + i + (n + j) * dim] = d_qdot[(i, j)];
+            }
+        }
+        Ok(true)
+    }
+
+    fn second_order_dim(&self) -> Option<usize> {
+        Some(self.n)
+    }
+
+    fn event_specs(&self) -> &[EventSpec] {
+        &self.events
+    }
+
+    fn event_values(&mut self, t: f64, y: &[f64], g: &mut [f64]) -> Result<(), RhsError> {
+        if self.events.is_empty() {
+            return Ok(());
+        }
+        let n = self.n;
+        let (q, qdot) = (&y[..n], &y[n..2 * n]);
+        if !self.system.events_need_accelerations() {
+            self.system.event_values(q, qdot, t, &self.zeros, &[], g);
+            return Ok(());
+        }
+        let mut qddot = std::mem::take(&mut self.zeros);
+        let result = self.generalized_accelerations(q, qdot, t, &mut qddot);
+        if result.is_ok() {
+            let lambda: &[f64] = if self.constraints.is_empty() {
+                &[]
+            } else {
+                &self.constraints.multipliers
+            };
+            self.system.event_values(q, qdot, t, &qddot, lambda, g);
+        }
+        qddot.fill(0.0);
+        self.zeros = qddot;
+        result
+    }
+}
+
+impl<S: DynMechanicalSystem> FirstOrderForm for DynFirstOrder<S> {
+    type System = S;
+    fn dyn_system(&self) -> &S {
+        &self.system
+    }
+    fn parts_mut(&mut self) -> FirstOrderParts<'_, S> {
+        FirstOrderParts {
+            system: &mut self.system,
+            stabilization: &mut self.stabilization,
+            constraints: &mut self.constraints,
+            events: &mut self.events,
+        }
+    }
+}

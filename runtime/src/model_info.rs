@@ -1,0 +1,387 @@
+//! The size-erased model, as the CLI and every analysis hold it: [`ModelInfo`], and the
+//! constraint functions at one state it returns ([`ConstraintValues`]).
+//!
+//! [`ModelInfo`] is implemented once, for every [`FirstOrderForm`]: a first-order form that
+//! lends its system as a [`DynMechanicalSystem`] with its constraint workspace, drift control
+//! and events. [`FirstOrder`](crate::FirstOrder) is one (its compiled system through the
+//! adapter [`StaticSystem`](crate::StaticSystem)), [`DynFirstOrder`](crate::DynFirstOrder)
+//! the other.
+
+use nalgebra::{DMatrix, DVector};
+
+use crate::constrained::{ConstraintWorkspace, ProjectionError, Stabilization};
+use crate::dynamic::DynMechanicalSystem;
+use crate::ode::{EventSpec, OdeSystem, RhsError};
+use crate::system::{BodyCentre, UnknownParameter};
+
+/// A model with its size erased, as the CLI holds it: `Box<dyn ModelInfo>`.
+///
+/// Implemented once, for every [`FirstOrderForm`]: [`FirstOrder`](crate::FirstOrder) for every
+/// model compiled by `eomgen::model!` and [`DynFirstOrder`](crate::DynFirstOrder) for a model
+/// compiled at run time; names are borrowed from the model (which owns them in the second
+/// case).
+///
+/// Vectors here are runtime-sized; `y = [q; q̇]` has length `2 num_dofs()`.
+pub trait ModelInfo: OdeSystem {
+    /// The model's name.
+    fn name(&self) -> &str;
+    /// One-line description.
+    fn description(&self) -> &str;
+    /// Number of degrees of freedom `n`.
+    fn num_dofs(&self) -> usize;
+    /// Names of the generalized coordinates (length `n`).
+    fn coordinate_names(&self) -> Vec<&str>;
+    /// Parameter names, in file order.
+    fn parameter_names(&self) -> Vec<&str>;
+    /// Current parameter values.
+    fn parameter_values(&self) -> Vec<f64>;
+    /// Sets a parameter by name.
+    ///
+    /// # Errors
+    /// [`UnknownParameter`] if there is no parameter `name`.
+    fn set_parameter(&mut self, name: &str, value: f64) -> Result<(), UnknownParameter>;
+    /// Initial state `y(0) = [q(0); q̇(0)]` (length `2n`).
+    fn initial_state(&self) -> Vec<f64>;
+    /// Kinetic energy `T` at `(t, y)` (J).
+    fn kinetic_energy(&self, t: f64, y: &[f64]) -> f64;
+    /// Potential energy `V` at `(t, y)` (J).
+    fn potential_energy(&self, t: f64, y: &[f64]) -> f64;
+    /// Total mechanical energy `T + V` (J).
+    fn energy(&self, t: f64, y: &[f64]) -> f64 {
+        self.kinetic_energy(t, y) + self.potential_energy(t, y)
+    }
+    /// Whether `T + V` is a constant of the motion.
+    fn is_conservative(&self) -> bool;
+    /// Names of the model's points.
+    fn point_names(&self) -> Vec<&str>;
+    /// Positions of the points at `(t, y)`, `[x, y, z]` each (m).
+    fn point_positions(&self, t: f64, y: &[f64]) -> Vec<[f64; 3]>;
+    /// The `draw: lines` segments as pairs of point names ([`draw_lines`](crate::MechanicalSystem::draw_lines)).
+    fn draw_lines(&self) -> Vec<[&str; 2]>;
+    /// The `draw: trace` point names ([`trace_points`](crate::MechanicalSystem::trace_points)).
+    fn trace_points(&self) -> Vec<&str>;
+    /// The bodies' centres of mass ([`body_centres`](crate::MechanicalSystem::body_centres)).
+    fn body_centres(&self) -> Vec<BodyCentre<'_>>;
+    /// The derived equations as text.
+    fn equations_text(&self) -> &str;
+    /// The derived equations as LaTeX.
+    fn equations_latex(&self) -> &str;
+    /// Upcast to the first-order system for an integrator.
+    fn as_ode_mut(&mut self) -> &mut dyn OdeSystem;
+    /// `M` (`n × n`) and `F` (`n`) at `(t, y)`.
+    fn mass_matrix_and_forcing(&self, t: f64, y: &[f64]) -> (DMatrix<f64>, DVector<f64>);
+    /// The exact Jacobians `(∂F/∂q, ∂F/∂q̇)`, each `n × n`, at `(t, y)`.
+    fn forcing_jacobians(&self, t: f64, y: &[f64]) -> (DMatrix<f64>, DMatrix<f64>);
+    /// The exact `∂(M a)/∂q` (`n × n`) at `(t, q)` for the vector `a` (length `n`).
+    fn mass_matrix_product_jacobian(&self, t: f64, y: &[f64], a: &[f64]) -> DMatrix<f64>;
+    /// Names of the constraints (holonomic first); empty for an unconstrained model.
+    fn constraint_names(&self) -> Vec<&str>;
+    /// How many constraints are holonomic.
+    fn holonomic_constraint_count(&self) -> usize;
+    /// Selects the drift control of a constrained model.
+    fn set_stabilization(&mut self, stabilization: Stabilization);
+    /// The constraint forces `λ` (length `m`; see [`constraint_names`](crate::MechanicalSystem::constraint_names) for
+    /// their meaning and sign) and `q̈` at `(t, y)`.
+    ///
+    /// # Errors
+    /// As the right-hand side.
+    fn constraint_forces(&mut self, t: f64, y: &[f64]) -> Result<Vec<f64>, RhsError>;
+    /// Largest `|Φᵢ|` and largest velocity-level residual at `(t, y)`; `(0, 0)` without
+    /// constraints.
+    fn constraint_drift(&mut self, t: f64, y: &[f64]) -> (f64, f64);
+    /// Projects `y = [q; q̇]` onto the constraint manifold at `t`, moving only the coordinates
+    /// `free` (all when empty); see [`ConstraintWorkspace::project`].
+    ///
+    /// # Errors
+    /// [`ProjectionError`] when Newton does not converge.
+    fn project(&mut self, t: f64, y: &mut [f64], free: &[usize]) -> Result<usize, ProjectionError>;
+    /// Indices of the coordinates whose initial values are guesses.
+    fn initial_guesses(&self) -> &[usize];
+    /// The model's named equilibrium guesses `(name, q)` ([`equilibrium_names`](crate::MechanicalSystem::equilibrium_names)).
+    fn equilibrium_guesses(&self) -> Vec<(&str, Vec<f64>)>;
+    /// Makes the model event `name` terminal or not (`eomgen simulate --stop-when NAME`);
+    /// returns `false` if the model has no event `name`.
+    fn set_event_terminal(&mut self, name: &str, terminal: bool) -> bool;
+    /// `Φ` (length `m_h`), `J` (`m × n`), the velocity residuals and `γ` (length `m`) at
+    /// `(t, y)`; see [`constraint_jacobian`](crate::MechanicalSystem::constraint_jacobian) and siblings.
+    fn constraint_equations(&self, t: f64, y: &[f64]) -> ConstraintValues;
+    /// Makes `y = [q; q̇]` (at `t = 0`) consistent with the constraints (issue 5, item 3): the
+    /// coordinates marked `{ guess: … }` and their rates are solved by Newton from
+    /// `Φ(q, 0) = 0` and the velocity constraints, the others held. Without guesses, `y` must
+    /// already satisfy the constraints to 1e-9. Nothing to do without constraints.
+    ///
+    /// # Errors
+    /// [`ProjectionError`] naming the constraint with the largest residual: Newton did not
+    /// converge, or (without guesses, `iterations` = 0) the given state violates it.
+    fn make_consistent(&mut self, y: &mut [f64]) -> Result<(), ProjectionError> {
+        if self.constraint_names().is_empty() {
+            return Ok(());
+        }
+        let guesses = self.initial_guesses().to_vec();
+        if !guesses.is_empty() {
+            return self.project(0.0, y, &guesses).map(|_| ());
+        }
+        let c = self.constraint_equations(0.0, y);
+        let worst = c
+            .phi
+            .iter()
+            .map(|v| v.abs())
+            .enumerate()
+            .chain(c.velocity.iter().map(|v| v.abs()).enumerate())
+            .fold((0, 0.0f64), |best, x| if x.1 > best.1 { x } else { best });
+        if worst.1 > 1e-9 || worst.1.is_nan() {
+            return Err(ProjectionError {
+                constraint: worst.0,
+                residual: worst.1,
+                iterations: 0,
+            });
+        }
+        Ok(())
+    }
+    /// [`Self::initial_state`] made consistent by [`Self::make_consistent`].
+    ///
+    /// # Errors
+    /// As [`Self::make_consistent`].
+    fn consistent_initial_state(&mut self) -> Result<Vec<f64>, ProjectionError> {
+        let mut y = self.initial_state();
+        self.make_consistent(&mut y)?;
+        Ok(y)
+    }
+}
+
+/// The constraint functions of a model at one state ([`ModelInfo::constraint_equations`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ConstraintValues {
+    /// `Φ(q, t)` of the holonomic constraints (length `m_h`).
+    pub phi: DVector<f64>,
+    /// `J`, `m × n`: `∂Φ/∂q` rows, then the non-holonomic `A` rows.
+    pub jacobian: DMatrix<f64>,
+    /// Velocity residuals `J q̇ + Φ_t` and `A q̇ + b` (length `m`).
+    pub velocity: DVector<f64>,
+    /// `γ` of `J q̈ = γ` (length `m`).
+    pub gamma: DVector<f64>,
+}
+
+/// A first-order form `y = [q; q̇]` of a mechanical system, as [`ModelInfo`] is written over
+/// it: the system seen as a [`DynMechanicalSystem`], and the state a model carries besides its
+/// equations (constraint workspace, drift control, events).
+///
+/// # Why
+/// [`FirstOrder<S, N>`](crate::FirstOrder) (compiled, `S: MechanicalSystem<N>`) and
+/// [`DynFirstOrder`](crate::DynFirstOrder) (compiled at run time) are the same model behind
+/// two interfaces. Their right-hand sides stay their own (the compiled one on stack vectors
+/// and matrices of size `N`, the hot path of every integration), but everything else the
+/// size-erased [`ModelInfo`] offers (metadata, energies, points, constraint functions and
+/// forces, projection, equilibrium guesses, events) is the same computation, written once in
+/// the blanket `impl<F: FirstOrderForm> ModelInfo for F` over [`DynMechanicalSystem`]. A
+/// compiled system takes part through the adapter [`StaticSystem`](crate::StaticSystem),
+/// which copies its static vectors to and from slices (those calls are not on the hot path).
+pub trait FirstOrderForm: OdeSystem {
+    /// The system, seen through the run-time interface.
+    type System: DynMechanicalSystem + ?Sized;
+    /// The system.
+    fn dyn_system(&self) -> &Self::System;
+    /// The system and the state beside it, mutably and at once.
+    fn parts_mut(&mut self) -> FirstOrderParts<'_, Self::System>;
+}
+
+/// What a [`FirstOrderForm`] lends mutably ([`FirstOrderForm::parts_mut`]).
+#[derive(Debug)]
+pub struct FirstOrderParts<'a, S: ?Sized> {
+    /// The system.
+    pub system: &'a mut S,
+    /// Drift control of a constrained system.
+    pub stabilization: &'a mut Stabilization,
+    /// Buffers and the last multipliers `λ` of a constrained system.
+    pub constraints: &'a mut ConstraintWorkspace,
+    /// The model's events.
+    pub events: &'a mut Vec<EventSpec>,
+}
+
+impl<F: FirstOrderForm> ModelInfo for F {
+    fn name(&self) -> &str {
+        self.dyn_system().name()
+    }
+    fn description(&self) -> &str {
+        self.dyn_system().description()
+    }
+    fn num_dofs(&self) -> usize {
+        self.dyn_system().num_dofs()
+    }
+    fn coordinate_names(&self) -> Vec<&str> {
+        self.dyn_system().coordinate_names()
+    }
+    fn parameter_names(&self) -> Vec<&str> {
+        self.dyn_system().parameter_names()
+    }
+    fn parameter_values(&self) -> Vec<f64> {
+        self.dyn_system().parameter_values()
+    }
+    fn set_parameter(&mut self, name: &str, value: f64) -> Result<(), UnknownParameter> {
+        self.parts_mut().system.set_parameter(name, value)
+    }
+    fn initial_state(&self) -> Vec<f64> {
+        let n = self.num_dofs();
+        let mut y = vec![0.0; 2 * n];
+        let (q, qdot) = y.split_at_mut(n);
+        self.dyn_system().initial_state(q, qdot);
+        y
+    }
+    fn kinetic_energy(&self, t: f64, y: &[f64]) -> f64 {
+        let n = self.num_dofs();
+        self.dyn_system().kinetic_energy(&y[..n], &y[n..2 * n], t)
+    }
+    fn potential_energy(&self, t: f64, y: &[f64]) -> f64 {
+        let n = self.num_dofs();
+        self.dyn_system().potential_energy(&y[..n], t)
+    }
+    fn is_conservative(&self) -> bool {
+        self.dyn_system().is_conservative()
+    }
+    fn point_names(&self) -> Vec<&str> {
+        self.dyn_system().point_names()
+    }
+    fn point_positions(&self, t: f64, y: &[f64]) -> Vec<[f64; 3]> {
+        let system = self.dyn_system();
+        let mut out = vec![[0.0; 3]; system.point_names().len()];
+        system.point_positions(&y[..system.num_dofs()], t, &mut out);
+        out
+    }
+    fn draw_lines(&self) -> Vec<[&str; 2]> {
+        self.dyn_system().draw_lines()
+    }
+    fn trace_points(&self) -> Vec<&str> {
+        self.dyn_system().trace_points()
+    }
+    fn body_centres(&self) -> Vec<BodyCentre<'_>> {
+        self.dyn_system().body_centres()
+    }
+    fn equations_text(&self) -> &str {
+        self.dyn_system().equations_text()
+    }
+    fn equations_latex(&self) -> &str {
+        self.dyn_system().equations_latex()
+    }
+    fn as_ode_mut(&mut self) -> &mut dyn OdeSystem {
+        self
+    }
+    fn mass_matrix_and_forcing(&self, t: f64, y: &[f64]) -> (DMatrix<f64>, DVector<f64>) {
+        let n = self.num_dofs();
+        let (mut mass, mut forcing) = (DMatrix::zeros(n, n), DVector::zeros(n));
+        self.dyn_system().mass_matrix_and_forcing(
+            &y[..n],
+            &y[n..2 * n],
+            t,
+            mass.as_mut_slice(),
+            forcing.as_mut_slice(),
+        );
+        (mass, forcing)
+    }
+    fn forcing_jacobians(&self, t: f64, y: &[f64]) -> (DMatrix<f64>, DMatrix<f64>) {
+        let n = self.num_dofs();
+        let (mut jq, mut jqd) = (DMatrix::zeros(n, n), DMatrix::zeros(n, n));
+        let system = self.dyn_system();
+        system.forcing_jacobian_q(&y[..n], &y[n..2 * n], t, jq.as_mut_slice());
+        system.forcing_jacobian_qdot(&y[..n], &y[n..2 * n], t, jqd.as_mut_slice());
+        (jq, jqd)
+    }
+    fn mass_matrix_product_jacobian(&self, t: f64, y: &[f64], a: &[f64]) -> DMatrix<f64> {
+        let n = self.num_dofs();
+        let mut out = DMatrix::zeros(n, n);
+        self.dyn_system()
+            .mass_matrix_product_jacobian(&y[..n], t, &a[..n], out.as_mut_slice());
+        out
+    }
+    fn constraint_names(&self) -> Vec<&str> {
+        self.dyn_system().constraint_names()
+    }
+    fn holonomic_constraint_count(&self) -> usize {
+        self.dyn_system().holonomic_constraint_count()
+    }
+    fn set_stabilization(&mut self, stabilization: Stabilization) {
+        *self.parts_mut().stabilization = stabilization;
+    }
+    fn constraint_forces(&mut self, t: f64, y: &[f64]) -> Result<Vec<f64>, RhsError> {
+        let parts = self.parts_mut();
+        if parts.constraints.is_empty() {
+            return Ok(Vec::new());
+        }
+        let n = parts.system.num_dofs();
+        let mut qddot = vec![0.0; n];
+        parts.constraints.accelerations_into(
+            &*parts.system,
+            &y[..n],
+            &y[n..2 * n],
+            t,
+            *parts.stabilization,
+            &mut qddot,
+        )?;
+        Ok(parts.constraints.multipliers.clone())
+    }
+    fn constraint_drift(&mut self, t: f64, y: &[f64]) -> (f64, f64) {
+        let parts = self.parts_mut();
+        let n = parts.system.num_dofs();
+        parts
+            .constraints
+            .drift(&*parts.system, &y[..n], &y[n..2 * n], t)
+    }
+    fn project(&mut self, t: f64, y: &mut [f64], free: &[usize]) -> Result<usize, ProjectionError> {
+        let parts = self.parts_mut();
+        let n = parts.system.num_dofs();
+        // On a copy, so that a projection that fails leaves `y` as it was.
+        let mut projected = y[..2 * n].to_vec();
+        let (q, qdot) = projected.split_at_mut(n);
+        let iterations = parts
+            .constraints
+            .project(&*parts.system, q, qdot, t, free, 1e-12)?;
+        y[..2 * n].copy_from_slice(&projected);
+        Ok(iterations)
+    }
+    fn initial_guesses(&self) -> &[usize] {
+        self.dyn_system().initial_guesses()
+    }
+    fn equilibrium_guesses(&self) -> Vec<(&str, Vec<f64>)> {
+        let system = self.dyn_system();
+        let n = system.num_dofs();
+        let names = system.equilibrium_names();
+        let mut values = vec![0.0; n * names.len()];
+        system.equilibrium_guesses(&mut values);
+        names
+            .into_iter()
+            .zip(values.chunks(n.max(1)))
+            .map(|(name, q)| (name, q.to_vec()))
+            .collect()
+    }
+    fn set_event_terminal(&mut self, name: &str, terminal: bool) -> bool {
+        match self.parts_mut().events.iter_mut().find(|e| e.name == name) {
+            Some(e) => {
+                e.terminal = terminal;
+                true
+            }
+            None => false,
+        }
+    }
+    fn constraint_equations(&self, t: f64, y: &[f64]) -> ConstraintValues {
+        let system = self.dyn_system();
+        let n = system.num_dofs();
+        let (q, qdot) = (&y[..n], &y[n..2 * n]);
+        let m = system.constraint_names().len();
+        let h = system.holonomic_constraint_count();
+        let mut phi = vec![0.0; h];
+        let mut jacobian = vec![0.0; m * n];
+        let mut velocity = vec![0.0; m];
+        let mut gamma = vec![0.0; m];
+        if m > 0 {
+            system.constraint_residuals(q, t, &mut phi);
+            system.constraint_jacobian(q, t, &mut jacobian);
+            system.constraint_velocity_residuals(q, qdot, t, &mut velocity);
+            system.constraint_gamma(q, qdot, t, &mut gamma);
+        }
+        ConstraintValues {
+            phi: DVector::from_vec(phi),
+            jacobian: DMatrix::from_row_slice(m, n, &jacobian),
+            velocity: DVector::from_vec(velocity),
+            gamma: DVector::from_vec(gamma),
+        }
+    }
+}
