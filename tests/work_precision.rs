@@ -359,7 +359,7 @@ fn bad_options_are_usage_errors() {
     for (args, expected) in [
         (&["--tols", "1e-3..abc"][..], "--tols"),
         (&["--tols", "1e-3..3e-5"][..], "whole number of decades"),
-        (&["--tols", "0"][..], "(0, 1)"),
+        (&["--tols", "0"][..], "[1e-15, 1)"),
         (&["--tols", "1e-3;1e-4"][..], "--tols"),
         (&["--steps", "0..64"][..], "--steps"),
         (&["--steps", "1.5"][..], "--steps"),

@@ -79,6 +79,15 @@ fn a_fixed_step_past_the_stability_limit_warns() {
     let out = eomgen(&["simulate", "double_pendulum", "--method", "rk4", "--dt", "0.01"]);
     assert_eq!(out.status.code(), Some(0));
     assert!(!stderr(&out).contains("warning"), "{}", stderr(&out));
+
+    // The pendulum released from the horizontal: A = 0 at the start, so the linearisation
+    // sees nothing, but the energy (0 J) goes to 3.6e6 J: the conservation law warns.
+    let out = eomgen(&["simulate", "simple_pendulum", "--method", "rk4", "--dt", "100", "--t-end", "1000"]);
+    let err = stderr(&out);
+    assert!(err.contains("warning: the energy of this conservative model drifted by"), "{err}");
+    // A model with damping is not conservative: no energy warning however it drifts.
+    let out = eomgen(&["simulate", "three_masses_damped", "--t-end", "5"]);
+    assert!(!stderr(&out).contains("energy of this conservative"), "{}", stderr(&out));
 }
 
 /// A step-size underflow caused by an end time of 1e12 s (where f64 resolves t only to

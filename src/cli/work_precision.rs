@@ -122,7 +122,7 @@ fn parse_tols(text: &str) -> Result<Vec<f64>, CliError> {
             .trim()
             .parse()
             .map_err(|_| bad(&format!("`{}` is not a number", s.trim())))?;
-        if v.is_finite() && v >= SMALLEST_TOLERANCE && v < 1.0 {
+        if v.is_finite() && (SMALLEST_TOLERANCE..1.0).contains(&v) {
             Ok(v)
         } else {
             Err(bad(&format!(

@@ -19,7 +19,7 @@ pub use constraint_methods::{
     constraint_methods,
 };
 pub use drift::{ConstraintDrift, EnergyDrift, constraint_drift, energy_drift, energy_drift_at};
-pub use fixed_step::{SimulationWarning, fixed_step_warnings};
+pub use fixed_step::{ENERGY_DRIFT_LIMIT, SimulationWarning, fixed_step_warnings};
 pub use methods::{Method, UnknownMethod};
 pub use roundoff::{EulerRoundoff, RoundoffError, RoundoffOptions, euler_roundoff};
 pub use simulation::{

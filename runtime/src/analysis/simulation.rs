@@ -5,7 +5,7 @@
 use serde::{Serialize, Serializer};
 
 use crate::analysis::drift::{ConstraintDrift, EnergyDrift, constraint_drift, energy_drift};
-use crate::analysis::fixed_step::{SimulationWarning, fixed_step_warnings};
+use crate::analysis::fixed_step::{ENERGY_DRIFT_LIMIT, SimulationWarning, fixed_step_warnings};
 use crate::analysis::methods::Method;
 use crate::constrained::{ProjectionError, Stabilization};
 use crate::integrate::{
@@ -150,9 +150,10 @@ pub struct Simulation {
     pub energy: EnergyDrift,
     /// The constraint forces and drift at every sample (empty without constraints).
     pub constraints: ConstraintDrift,
-    /// Warnings about the settings found before the run: a fixed step longer than the span
-    /// or past the method's stability limit on the linearisation at the start
-    /// ([`fixed_step_warnings`]).
+    /// Warnings about the settings found before the run (a fixed step longer than the span
+    /// or past the method's stability limit on the linearisation at the start:
+    /// [`fixed_step_warnings`]) and after it (a conservative model whose energy drifted by
+    /// more than [`ENERGY_DRIFT_LIMIT`]: [`SimulationWarning::EnergyNotConserved`]).
     pub warnings: Vec<SimulationWarning>,
     /// Why the integration stopped before `t_end`, if it did (serialised as `{"t",
     /// "message"}`); `solution` then holds the samples computed before it.
@@ -309,6 +310,17 @@ pub fn simulate_with_events(
     };
     let energy = energy_drift(model, &y0, &solution);
     let constraints = constraint_drift(model, &solution);
+    let mut warnings = warnings;
+    if model.is_conservative()
+        && let Some(drift) = energy.drift
+        && drift > ENERGY_DRIFT_LIMIT
+    {
+        warnings.push(SimulationWarning::EnergyNotConserved {
+            drift,
+            initial_energy: energy.initial_energy,
+            final_energy: energy.energy.last().copied().unwrap_or(energy.initial_energy),
+        });
+    }
     Ok(Simulation {
         method: options.method,
         integrator: integrator.name(),

@@ -224,7 +224,7 @@ impl WorkPrecisionOptions {
         if let Some(&tol) = self
             .tolerances
             .iter()
-            .find(|&&t| !(t.is_finite() && t >= SMALLEST_TOLERANCE && t < 1.0))
+            .find(|&&t| !(t.is_finite() && (SMALLEST_TOLERANCE..1.0).contains(&t)))
         {
             return Err(WorkPrecisionError::InvalidTolerance { tol });
         }
