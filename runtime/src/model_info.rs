@@ -128,7 +128,14 @@ pub trait ModelInfo: OdeSystem {
             .map(|v| v.abs())
             .enumerate()
             .chain(c.velocity.iter().map(|v| v.abs()).enumerate())
-            .fold((0, 0.0f64), |best, x| if x.1 > best.1 { x } else { best });
+            // A NaN residual is the worst (it must not pass as consistent).
+            .fold((0, 0.0f64), |best, x| {
+                if x.1.is_nan() || (x.1 > best.1 && !best.1.is_nan()) {
+                    x
+                } else {
+                    best
+                }
+            });
         if worst.1 > 1e-9 || worst.1.is_nan() {
             return Err(ProjectionError {
                 constraint: worst.0,

@@ -111,7 +111,7 @@ fn print_report(r: &CheckReport) {
         outln!(
             "{} initial state satisfies the constraints: largest residual {:.2e} ({} of `{}`, tolerance {INITIAL_CONSTRAINT_TOLERANCE:e})",
             mark(c.passed()),
-            c.residual,
+            num(c.residual),
             if c.velocity {
                 "velocity residual"
             } else {

@@ -129,12 +129,14 @@ pub fn run() -> ExitCode {
         .and_then(|matches| <Cli as clap::FromArgMatches>::from_arg_matches(&matches));
     let cli = match parsed {
         Ok(cli) => cli,
-        // `--help`, `--version` (status 0) and usage errors (status 2), written by clap; a
-        // failed write of them is reported as any other.
+        // `--help`, `--version` (status 0, on standard output: a failed write of them is
+        // reported as any other) and usage errors (status 2, on standard error: a message
+        // that cannot be written there is dropped, the status still tells).
         Err(e) => {
             let code = u8::try_from(e.exit_code()).unwrap_or(2);
             return match e.print() {
                 Ok(()) => ExitCode::from(code),
+                Err(_) if e.use_stderr() => ExitCode::from(code),
                 Err(io) => output_failure(&io, None),
             };
         }

@@ -115,7 +115,7 @@ pub struct IntegrationArgs {
     #[arg(long, value_parser = method_parser(), default_value_t = Method::Dp54)]
     pub method: Method,
     /// Relative tolerance (adaptive methods: bs32, dp54, dop853, radau5).
-    #[arg(long, default_value_t = 1e-8, value_parser = super::values::relative_tolerance, allow_hyphen_values = true)]
+    #[arg(long, default_value_t = 1e-8, value_parser = super::values::simulation_relative_tolerance, allow_hyphen_values = true)]
     pub rtol: f64,
     /// Absolute tolerance (adaptive methods; implicit-midpoint's scale for components near 0).
     #[arg(long, default_value_t = 1e-10, value_parser = super::values::absolute_tolerance, allow_hyphen_values = true)]

@@ -59,6 +59,16 @@ pub fn relative_tolerance(text: &str) -> Result<f64, String> {
     )
 }
 
+/// Parses the relative tolerance of `simulate --rtol`: a number in `[0, 1)` (0 leaves the
+/// absolute tolerance alone in control, which then must be positive: the integrator says so).
+pub fn simulation_relative_tolerance(text: &str) -> Result<f64, String> {
+    number(
+        text,
+        |v| v.is_finite() && (0.0..1.0).contains(&v),
+        "a relative tolerance must be a number in [0, 1), such as 1e-8",
+    )
+}
+
 /// Parses an absolute tolerance (`--atol`): a finite number `≥ 0` (0 leaves the relative
 /// tolerance alone in control).
 pub fn absolute_tolerance(text: &str) -> Result<f64, String> {

@@ -396,10 +396,8 @@ impl WorkPrecision {
     /// nothing, which a front end reports as a failure (`eomgen study work-precision` exits
     /// 1), whatever table it prints.
     pub fn every_run_failed(&self) -> bool {
-        self.results
-            .iter()
-            .flat_map(|r| &r.runs)
-            .all(|r| r.outcome.is_err())
+        let mut runs = self.results.iter().flat_map(|r| &r.runs).peekable();
+        runs.peek().is_some() && runs.all(|r| r.outcome.is_err())
     }
 
     /// The number of runs whose error the reference does not resolve ([`Self::unresolved`]).

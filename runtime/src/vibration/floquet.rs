@@ -276,22 +276,24 @@ fn analyse(
 }
 
 /// Largest relative difference of `M` and `F` at the states `ys` between the times `t` and
-/// `t + shift`, with the time of the largest.
+/// `t + shift`, with the time of the largest: the largest absolute difference of any entry
+/// over the largest magnitude of any entry of `M` and `F` over all the states and times (a
+/// purely relative measure, so that a model in small units is judged as one in large units).
 fn largest_change(model: &dyn ModelInfo, ys: &[Vec<f64>], times: &[f64], shift: f64) -> (f64, f64) {
-    let mut worst = (0.0f64, times[0]);
+    let (mut worst, mut at, mut scale) = (0.0f64, times[0], 0.0f64);
     for y in ys {
         for &t in times {
             let (m0, f0) = model.mass_matrix_and_forcing(t, y);
             let (m1, f1) = model.mass_matrix_and_forcing(t + shift, y);
-            let scale = 1.0 + m0.amax().max(f0.amax());
-            let d = (m1 - m0).amax().max((f1 - f0).amax()) / scale;
+            scale = scale.max(m0.amax()).max(f0.amax()).max(m1.amax()).max(f1.amax());
+            let d = (m1 - m0).amax().max((f1 - f0).amax());
             let d = if d.is_nan() { f64::INFINITY } else { d };
-            if d > worst.0 {
-                worst = (d, t);
+            if d > worst {
+                (worst, at) = (d, t);
             }
         }
     }
-    worst
+    (worst / scale.max(f64::MIN_POSITIVE), at)
 }
 
 /// Checks numerically that the parameter at `index` is the forcing frequency `w` of
