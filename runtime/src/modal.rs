@@ -827,8 +827,13 @@ pub fn damped_modes(
 ///
 /// # Shapes
 /// `a` is square, `n × n`; so is the result. A non-finite entry gives an all-NaN result.
-/// Beyond `‖A‖₁ = 10³⁰` (where nalgebra's unscaled powers `A⁸`, `A¹⁰` would overflow)
-/// `e^A = (e^{A/2^k})^{2^k}` with the smallest `k` that brings the norm below it.
+/// Beyond `‖A‖₁ = 10¹¹`, `e^A = (e^{A/2^k})^{2^k}` with the smallest `k` that brings the norm
+/// below it: nalgebra's own choice of scaling uses `‖|A|²⁷‖₁ ≤ ‖A‖₁²⁷`, which overflows above
+/// ~2.6·10¹¹, and an infinite value made its squaring loop run (practically) forever for a
+/// matrix whose `|A|` grows where `A` does not (a nilpotent `A` with cancelling entries). Such
+/// a defective matrix of norm ~10¹² is beyond scaling and squaring in `f64` (a perturbation ε
+/// of `e^{A/2^k}` splits its double eigenvalue by √ε, which `2^k` squarings blow up): the
+/// result is finite but not accurate.
 ///
 /// # References
 /// N. J. Higham, "The scaling and squaring method for the matrix exponential revisited",
@@ -836,8 +841,8 @@ pub fn damped_modes(
 /// scaling and squaring algorithm for the matrix exponential", SIAM J. Matrix Anal. Appl. 31
 /// (2009) 970–989.
 pub fn matrix_exponential(a: &DMatrix<f64>) -> DMatrix<f64> {
-    /// Largest `‖A‖₁` handed to nalgebra (its `A¹⁰` stays finite below ~10³⁰).
-    const LARGEST_NORM: f64 = 1e30;
+    /// Largest `‖A‖₁` handed to nalgebra: `‖A‖₁²⁷` stays finite below ~2.6·10¹¹.
+    const LARGEST_NORM: f64 = 1e11;
     let n = a.nrows();
     if n == 0 {
         return DMatrix::identity(0, 0);
