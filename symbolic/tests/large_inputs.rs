@@ -127,3 +127,89 @@ fn a_hundred_thousand_parameters_load_in_linear_time() {
     let report = check_model(&file, 20, 1).expect("checks");
     assert!(report.passed(1e-9), "{:?}", report.notes);
 }
+
+/// An expression tree drawn at random: `ops` binary operations (`+ - * /`, and `^2` at
+/// leaves) over `x`, `k` and small numbers, each operand a chain (left-deep, as written
+/// without parentheses) or a parenthesised subtree, so that heights range from `log₂ ops` to
+/// `ops`.
+fn random_expression(rng: &mut impl rand::Rng, ops: usize) -> String {
+    use rand::RngExt;
+    fn leaf(rng: &mut impl rand::Rng) -> String {
+        match rng.random_range(0..4) {
+            0 => "x".to_string(),
+            1 => "k".to_string(),
+            2 => "x^2".to_string(),
+            _ => format!("{}", rng.random_range(1..10)),
+        }
+    }
+    fn build(rng: &mut impl rand::Rng, ops: usize, out: &mut String) {
+        if ops == 0 {
+            out.push_str(&leaf(rng));
+            return;
+        }
+        let operator = ["+", "-", "*", "+"][rng.random_range(0..4)];
+        if rng.random_bool(0.5) {
+            // A chain: `ops` operations written one after the other.
+            out.push_str(&leaf(rng));
+            for _ in 0..ops {
+                out.push_str(&format!(" {operator} {}", leaf(rng)));
+            }
+        } else {
+            // A balanced split in parentheses.
+            let left = (ops - 1) / 2;
+            out.push('(');
+            build(rng, left, out);
+            out.push_str(&format!(") {operator} ("));
+            build(rng, ops - 1 - left, out);
+            out.push(')');
+        }
+    }
+    let mut out = String::new();
+    build(rng, ops, &mut out);
+    out
+}
+
+proptest::proptest! {
+    #![proptest_config(proptest::prelude::ProptestConfig { cases: 24, .. Default::default() })]
+
+    /// Random expressions of 1 to 10⁶ operations as a potential, on a 2 MiB stack: the file
+    /// loads, or every diagnostic is located on the potential's line with a message; a file
+    /// that loads with under 10⁴ operations also derives, cross-checked (the derivations of
+    /// larger ones are left to the chain test above, for time).
+    #[test]
+    fn random_expressions_load_or_are_a_located_error(
+        seed in proptest::prelude::any::<u64>(),
+        log_ops in 0.0f64..6.0,
+    ) {
+        let ops = 10f64.powf(log_ops) as usize;
+        let verdict = on_small_stack(move || {
+            let mut rng = <rand::rngs::Xoshiro256PlusPlus as rand::SeedableRng>::seed_from_u64(seed);
+            let expression = random_expression(&mut rng, ops);
+            let source = format!(
+                "name: random\ncoordinates: [x]\nparameters: {{ k: 2.0 }}\nkinetic: x_dot^2/2\npotential: {expression}\n"
+            );
+            match load("random.yaml", &source) {
+                Ok(file) => {
+                    if ops < 10_000 {
+                        // A potential whose x-derivative is singular somewhere is a model
+                        // error, not a crash: either way the call returns.
+                        let _ = check_model(&file, 2, 1);
+                    }
+                    Ok(())
+                }
+                Err(diagnostics) => {
+                    for d in &diagnostics {
+                        if d.location.line != 5 || d.message.is_empty() {
+                            return Err(format!("{d:?}"));
+                        }
+                    }
+                    if diagnostics.is_empty() {
+                        return Err("an error without a diagnostic".to_string());
+                    }
+                    Ok(())
+                }
+            }
+        });
+        proptest::prop_assert!(verdict.is_ok(), "{:?}", verdict);
+    }
+}
