@@ -70,7 +70,11 @@ fn cases() -> Vec<(&'static str, DMatrix<f64>, DMatrix<f64>)> {
     for (w, t) in [(1.0f64, 1.0f64), (2.0, 50.0)] {
         let a = DMatrix::from_row_slice(2, 2, &[0.0, w * t, -w * t, 0.0]);
         let (s, c) = (w * t).sin_cos();
-        let name = if t == 1.0 { "rotation, wt = 1" } else { "rotation, wt = 100" };
+        let name = if t == 1.0 {
+            "rotation, wt = 1"
+        } else {
+            "rotation, wt = 100"
+        };
         out.push((name, a, DMatrix::from_row_slice(2, 2, &[c, s, -s, c])));
     }
     // Damped oscillator x'' + 2ζω x' + ω² x = 0, A = [[0, 1], [-ω², -2ζω]]:
@@ -178,7 +182,10 @@ fn accuracy() {
         "relative error ‖X − e^(At)‖_F / ‖e^(At)‖_F (ε = {:.2e})",
         f64::EPSILON
     );
-    println!("{:<44} {:>10} {:>12} {:>12}", "case", "‖At‖₁", "Padé 13", "nalgebra");
+    println!(
+        "{:<44} {:>10} {:>12} {:>12}",
+        "case", "‖At‖₁", "Padé 13", "nalgebra"
+    );
     for (name, a, exact) in cases() {
         let norm = a.column_iter().map(|c| c.lp_norm(1)).fold(0.0f64, f64::max);
         let err = |x: DMatrix<f64>| (x - &exact).norm() / exact.norm();

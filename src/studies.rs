@@ -83,7 +83,10 @@ pub enum PeriodUnitError {
 /// let err = check_period_parameter_unit(&mathieu, "a").unwrap_err();
 /// assert!(err.to_string().contains("is in m, not a frequency"), "{err}");
 /// ```
-pub fn check_period_parameter_unit(source: &ModelSource, name: &str) -> Result<(), PeriodUnitError> {
+pub fn check_period_parameter_unit(
+    source: &ModelSource,
+    name: &str,
+) -> Result<(), PeriodUnitError> {
     let (path, file) = load_file(source)?;
     if !matches!(file.units.as_ref().map(|u| &u.value), Some(UnitSystem::Si)) {
         return Ok(());

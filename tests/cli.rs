@@ -435,7 +435,9 @@ fn check_fails_on_an_initial_state_that_violates_a_constraint() {
     assert_eq!(out.status.code(), Some(1));
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(
-        text.contains("FAIL initial state satisfies the constraints: largest residual 1.00 (residual of `rod`"),
+        text.contains(
+            "FAIL initial state satisfies the constraints: largest residual 1.00 (residual of `rod`"
+        ),
         "{text}"
     );
     let out = eomgen(&["check", path.to_str().unwrap(), "--json"]);

@@ -53,8 +53,18 @@ const CASES: &[Case] = &[
     Case {
         args: &["simulate", "simple_pendulum", "--t-end", "1"],
         options: &[
-            "--t-end", "--t-out", "--method", "--rtol", "--atol", "--dt", "--set", "--init",
-            "--stabilization", "--baumgarte", "--stop-when", "--event",
+            "--t-end",
+            "--t-out",
+            "--method",
+            "--rtol",
+            "--atol",
+            "--dt",
+            "--set",
+            "--init",
+            "--stabilization",
+            "--baumgarte",
+            "--stop-when",
+            "--event",
         ],
     },
     Case {
@@ -76,8 +86,16 @@ const CASES: &[Case] = &[
     Case {
         args: &["frf", "forced_oscillator", "--input", "F0"],
         options: &[
-            "--input", "--output", "--at", "--set", "--freqs", "--points", "--frequency",
-            "--simulate", "--amplitude", "--rtol",
+            "--input",
+            "--output",
+            "--at",
+            "--set",
+            "--freqs",
+            "--points",
+            "--frequency",
+            "--simulate",
+            "--amplitude",
+            "--rtol",
         ],
     },
     Case {
@@ -86,20 +104,45 @@ const CASES: &[Case] = &[
     },
     Case {
         args: &["study", "modal-damping", "three_masses", "--t-end", "1"],
-        options: &["--rayleigh-modes", "--init", "--t-end", "--samples", "--tol"],
+        options: &[
+            "--rayleigh-modes",
+            "--init",
+            "--t-end",
+            "--samples",
+            "--tol",
+        ],
     },
     Case {
         args: &["study", "floquet", "mathieu_pendulum"],
         options: &[
-            "--at", "--period-parameter", "--set", "--sweep", "--tol", "--stability-tolerance",
+            "--at",
+            "--period-parameter",
+            "--set",
+            "--sweep",
+            "--tol",
+            "--stability-tolerance",
         ],
     },
     Case {
         args: &[
-            "study", "work-precision", "simple_pendulum", "--methods", "dp54", "--tols",
-            "1e-3..1e-4", "--t-end", "1",
+            "study",
+            "work-precision",
+            "simple_pendulum",
+            "--methods",
+            "dp54",
+            "--tols",
+            "1e-3..1e-4",
+            "--t-end",
+            "1",
         ],
-        options: &["--methods", "--tols", "--steps", "--t-end", "--target-error", "--baseline-ms"],
+        options: &[
+            "--methods",
+            "--tols",
+            "--steps",
+            "--t-end",
+            "--target-error",
+            "--baseline-ms",
+        ],
     },
     Case {
         args: &["study", "stability", "--steps", "100", "--periods", "10"],
@@ -110,7 +153,13 @@ const CASES: &[Case] = &[
         options: &["--max-n"],
     },
     Case {
-        args: &["study", "constraint-methods", "simple_pendulum_cartesian", "--t-end", "0.5"],
+        args: &[
+            "study",
+            "constraint-methods",
+            "simple_pendulum_cartesian",
+            "--t-end",
+            "0.5",
+        ],
         options: &["--t-end", "--tol", "--stiffness"],
     },
 ];

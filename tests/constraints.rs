@@ -386,7 +386,10 @@ fn constraint_methods_start_from_the_consistent_state() {
         let y = m.initial_state();
         m.constraint_drift(0.0, &y).0
     };
-    assert!(guessed > 1e-2, "the file's guesses are off the loop: {guessed}");
+    assert!(
+        guessed > 1e-2,
+        "the file's guesses are off the loop: {guessed}"
+    );
     let options = ConstraintMethodsOptions {
         t_end: 1.0,
         stiffness: vec![1e4],
@@ -397,7 +400,12 @@ fn constraint_methods_start_from_the_consistent_state() {
     for row in study.rows.iter().filter(|r| r.method.starts_with("II.1")) {
         let drift = row.drift.unwrap();
         assert!(drift < 1e-6, "{}: |Φ| = {drift}", row.method);
-        assert!(row.position_error < 1e-5, "{}: {}", row.method, row.position_error);
+        assert!(
+            row.position_error < 1e-5,
+            "{}: {}",
+            row.method,
+            row.position_error
+        );
     }
     for bad in [0.0, -1.0, f64::NAN] {
         let options = ConstraintMethodsOptions {
@@ -405,6 +413,9 @@ fn constraint_methods_start_from_the_consistent_state() {
             ..options.clone()
         };
         let err = constraint_methods(&mut || four_bar.instantiate(), None, &options).unwrap_err();
-        assert!(matches!(err, ConstraintMethodsError::InvalidStiffness { .. }), "{err}");
+        assert!(
+            matches!(err, ConstraintMethodsError::InvalidStiffness { .. }),
+            "{err}"
+        );
     }
 }

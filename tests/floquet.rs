@@ -732,14 +732,20 @@ fn floquet_period_parameter_must_be_the_forcing_frequency() {
     };
     let mut pendulum = model("double_pendulum");
     let err = floquet_at_equilibrium(pendulum.as_mut(), &named("g")).unwrap_err();
-    assert!(matches!(err, FloquetStudyError::TimeIndependent { .. }), "{err}");
+    assert!(
+        matches!(err, FloquetStudyError::TimeIndependent { .. }),
+        "{err}"
+    );
     for (set, name) in [(None, "m"), (Some(60.0), "m"), (None, "a")] {
         let mut m = model("mathieu_pendulum");
         if let Some(v) = set {
             m.set_parameter(name, v).unwrap();
         }
         let err = floquet_at_equilibrium(m.as_mut(), &named(name)).unwrap_err();
-        assert!(matches!(err, FloquetStudyError::NotPeriodic { .. }), "{name}: {err}");
+        assert!(
+            matches!(err, FloquetStudyError::NotPeriodic { .. }),
+            "{name}: {err}"
+        );
         assert_eq!(
             parameter(m.as_ref(), name),
             set.unwrap_or(if name == "m" { 1.0 } else { 0.1 }),
@@ -753,5 +759,8 @@ fn floquet_period_parameter_must_be_the_forcing_frequency() {
     // chart's a = 0 cell is analysed (checked in `floquet_study_point_and_cells`).
     m.set_parameter("a", 0.0).unwrap();
     let err = floquet_at_equilibrium(m.as_mut(), &named("w")).unwrap_err();
-    assert!(matches!(err, FloquetStudyError::TimeIndependent { .. }), "{err}");
+    assert!(
+        matches!(err, FloquetStudyError::TimeIndependent { .. }),
+        "{err}"
+    );
 }

@@ -71,7 +71,11 @@ fn a_full_device_is_an_error_never_a_panic_or_a_success() {
             "eomgen {}: {text}",
             args.join(" ")
         );
-        assert!(!text.contains("panicked"), "eomgen {}: {text}", args.join(" "));
+        assert!(
+            !text.contains("panicked"),
+            "eomgen {}: {text}",
+            args.join(" ")
+        );
     }
 }
 
@@ -93,7 +97,11 @@ fn read_one_line_then_close(args: &[&str]) -> Output {
     let mut reader = BufReader::new(stdout);
     let mut line = String::new();
     reader.read_line(&mut line).expect("one line");
-    assert!(!line.is_empty(), "eomgen {} printed nothing", args.join(" "));
+    assert!(
+        !line.is_empty(),
+        "eomgen {} printed nothing",
+        args.join(" ")
+    );
     drop(reader);
     child.wait_with_output().expect("process ends")
 }
@@ -125,7 +133,11 @@ fn a_closed_pipe_ends_the_program_quietly_with_status_141() {
             "eomgen {}: {text}",
             args.join(" ")
         );
-        assert!(text.is_empty(), "eomgen {}: quiet, got {text}", args.join(" "));
+        assert!(
+            text.is_empty(),
+            "eomgen {}: quiet, got {text}",
+            args.join(" ")
+        );
     }
 }
 
@@ -136,11 +148,25 @@ fn a_failed_run_leaves_the_previous_csv_intact() {
     let dir = tempfile::tempdir().unwrap();
     let csv = dir.path().join("f.csv");
     let csv = csv.to_str().unwrap();
-    let good = run(&["simulate", "simple_pendulum", "--t-out", "1,2,3", "--csv", csv]);
+    let good = run(&[
+        "simulate",
+        "simple_pendulum",
+        "--t-out",
+        "1,2,3",
+        "--csv",
+        csv,
+    ]);
     assert!(good.status.success(), "{}", stderr(&good));
     let before = std::fs::read(csv).unwrap();
     assert_eq!(before.iter().filter(|b| **b == b'\n').count(), 4);
-    let bad = run(&["simulate", "simple_pendulum", "--t-out", "3,1,2", "--csv", csv]);
+    let bad = run(&[
+        "simulate",
+        "simple_pendulum",
+        "--t-out",
+        "3,1,2",
+        "--csv",
+        csv,
+    ]);
     assert_eq!(bad.status.code(), Some(2), "{}", stderr(&bad));
     assert_eq!(std::fs::read(csv).unwrap(), before);
 }
@@ -177,7 +203,13 @@ fn a_killed_run_leaves_the_old_file_or_the_complete_new_one() {
         others > 0 || len != old.len() as u64
     };
     let (mut kept_old, mut mid_write) = (0, 0);
-    for kill in ["at once", "when writing", "when writing", "when writing", "never"] {
+    for kill in [
+        "at once",
+        "when writing",
+        "when writing",
+        "when writing",
+        "never",
+    ] {
         for entry in std::fs::read_dir(dir.path()).unwrap() {
             std::fs::remove_file(entry.unwrap().path()).unwrap();
         }
@@ -242,7 +274,10 @@ fn the_csv_of_a_failed_integration_says_so_on_its_first_line() {
         .rsplit_once("at t = ")
         .map(|(_, t)| t.trim_end_matches(')').parse().unwrap())
         .unwrap_or_else(|| panic!("no time in {first}"));
-    assert!(t > 1.0 && t < 2.45, "the blow-up lies in (1, 2.45) s, got {t}");
+    assert!(
+        t > 1.0 && t < 2.45,
+        "the blow-up lies in (1, 2.45) s, got {t}"
+    );
     assert_eq!(lines.next(), Some("t,x,x_dot,energy"));
     // The samples before the failure follow, the last one before the reported time.
     let last: f64 = text
@@ -321,7 +356,10 @@ fn the_charts_of_a_failed_integration_carry_a_visible_note() {
     let ok = run(&["simulate", BLOW_UP, "--t-end", "0.5", "--plot", &png]);
     assert!(ok.status.success(), "{}", stderr(&ok));
     let red_ok = red_in_band(&png);
-    assert!(red_failed > 50 && red_ok == 0, "red pixels {red_failed}, {red_ok}");
+    assert!(
+        red_failed > 50 && red_ok == 0,
+        "red pixels {red_failed}, {red_ok}"
+    );
 }
 
 /// Every size a user can type has an upper limit: a value over it is a usage error (exit 2)
@@ -332,29 +370,74 @@ fn sizes_over_their_limit_are_usage_errors() {
     let times = vec!["1"; 50_001].join(",");
     let cases: &[(&[&str], &str)] = &[
         (&["check", "simple_pendulum", "--states", "0"], "1..=100000"),
-        (&["check", "simple_pendulum", "--states", "100001"], "1..=100000"),
         (
-            &["frf", "forced_oscillator", "--input", "A", "--output", "x", "--points", "100001"],
+            &["check", "simple_pendulum", "--states", "100001"],
             "1..=100000",
         ),
         (
-            &["frf", "forced_oscillator", "--input", "A", "--output", "x", "--simulate", "1001"],
+            &[
+                "frf",
+                "forced_oscillator",
+                "--input",
+                "A",
+                "--output",
+                "x",
+                "--points",
+                "100001",
+            ],
+            "1..=100000",
+        ),
+        (
+            &[
+                "frf",
+                "forced_oscillator",
+                "--input",
+                "A",
+                "--output",
+                "x",
+                "--simulate",
+                "1001",
+            ],
             "1..=1000",
         ),
         (
-            &["study", "free-response", "three_masses", "--samples", "1000001"],
+            &[
+                "study",
+                "free-response",
+                "three_masses",
+                "--samples",
+                "1000001",
+            ],
             "2..=1000000",
         ),
         (
-            &["study", "modal-damping", "three_masses_damped", "--samples", "1000001"],
+            &[
+                "study",
+                "modal-damping",
+                "three_masses_damped",
+                "--samples",
+                "1000001",
+            ],
             "2..=1000000",
         ),
         (
-            &["study", "work-precision", "simple_pendulum", "--samples", "100001"],
+            &[
+                "study",
+                "work-precision",
+                "simple_pendulum",
+                "--samples",
+                "100001",
+            ],
             "1..=100000",
         ),
         (
-            &["study", "work-precision", "simple_pendulum", "--repeats", "1001"],
+            &[
+                "study",
+                "work-precision",
+                "simple_pendulum",
+                "--repeats",
+                "1001",
+            ],
             "1..=1000",
         ),
         (
@@ -371,11 +454,25 @@ fn sizes_over_their_limit_are_usage_errors() {
         (&["study", "stability", "--steps", "100000000"], "10⁷"),
         (&["new", "n-link-pendulum", "201"], "200"),
         (
-            &["animate", "simple_pendulum", "-o", "unwritten.html", "--fps", "100000"],
+            &[
+                "animate",
+                "simple_pendulum",
+                "-o",
+                "unwritten.html",
+                "--fps",
+                "100000",
+            ],
             "more than 100000 frames",
         ),
         (
-            &["simulate", "simple_pendulum", "--t-out", &times, "--t-out", &times],
+            &[
+                "simulate",
+                "simple_pendulum",
+                "--t-out",
+                &times,
+                "--t-out",
+                &times,
+            ],
             "at most 100000",
         ),
     ];
@@ -383,7 +480,12 @@ fn sizes_over_their_limit_are_usage_errors() {
         let out = run(args);
         let text = stderr(&out);
         let shown: Vec<&str> = args.iter().map(|a| &a[..a.len().min(40)]).collect();
-        assert_eq!(out.status.code(), Some(2), "eomgen {}: {text}", shown.join(" "));
+        assert_eq!(
+            out.status.code(),
+            Some(2),
+            "eomgen {}: {text}",
+            shown.join(" ")
+        );
         assert!(text.contains(limit), "eomgen {}: {text}", shown.join(" "));
         assert!(!text.contains("panicked"), "{text}");
     }

@@ -17,7 +17,13 @@ fn tolerances_out_of_range_are_usage_errors_everywhere() {
         &["simulate", "simple_pendulum", "--rtol", "1"],
         &["simulate", "simple_pendulum", "--rtol", "-1"],
         &["simulate", "simple_pendulum", "--atol", "-1e-9"],
-        &["study", "constraint-methods", "simple_pendulum_cartesian", "--tol", "2"],
+        &[
+            "study",
+            "constraint-methods",
+            "simple_pendulum_cartesian",
+            "--tol",
+            "2",
+        ],
         &["study", "free-response", "three_masses", "--tol", "1"],
         &["study", "modal-damping", "three_masses", "--tol", "-0.5"],
         &["study", "floquet", "mathieu_pendulum", "--tol", "1"],
@@ -38,7 +44,13 @@ fn tolerances_out_of_range_are_usage_errors_everywhere() {
 #[test]
 fn non_positive_stiffnesses_are_usage_errors() {
     for args in [
-        &["study", "constraint-methods", "simple_pendulum_cartesian", "--stiffness", "0,-1"][..],
+        &[
+            "study",
+            "constraint-methods",
+            "simple_pendulum_cartesian",
+            "--stiffness",
+            "0,-1",
+        ][..],
         &["study", "stability", "--stiffness", "1e4,-5"],
     ] {
         let out = eomgen(args);
@@ -65,7 +77,10 @@ fn a_fixed_step_past_the_stability_limit_warns() {
         "--json",
     ]);
     let err = stderr(&out);
-    assert!(err.contains("warning: the step 100 s is past the stability limit of RK4"), "{err}");
+    assert!(
+        err.contains("warning: the step 100 s is past the stability limit of RK4"),
+        "{err}"
+    );
     let json: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON");
     let warning = &json["warnings"][0];
     assert_eq!(warning["kind"], "step_past_stability_limit");
@@ -73,28 +88,71 @@ fn a_fixed_step_past_the_stability_limit_warns() {
     // The start's linearisation has modes of |λ| ~ 1/s: the limit is of the order of 1 s.
     assert!(suggested > 0.01 && suggested < 10.0, "{suggested}");
 
-    let out = eomgen(&["simulate", "simple_pendulum", "--method", "euler", "--dt", "20", "--t-end", "10"]);
-    assert!(stderr(&out).contains("longer than the whole run"), "{}", stderr(&out));
+    let out = eomgen(&[
+        "simulate",
+        "simple_pendulum",
+        "--method",
+        "euler",
+        "--dt",
+        "20",
+        "--t-end",
+        "10",
+    ]);
+    assert!(
+        stderr(&out).contains("longer than the whole run"),
+        "{}",
+        stderr(&out)
+    );
 
-    let out = eomgen(&["simulate", "double_pendulum", "--method", "rk4", "--dt", "0.01"]);
+    let out = eomgen(&[
+        "simulate",
+        "double_pendulum",
+        "--method",
+        "rk4",
+        "--dt",
+        "0.01",
+    ]);
     assert_eq!(out.status.code(), Some(0));
     assert!(!stderr(&out).contains("warning"), "{}", stderr(&out));
 
     // The pendulum released from the horizontal: A = 0 at the start, so the linearisation
     // sees nothing, but the energy (0 J) goes to 3.6e6 J: the conservation law warns.
-    let out = eomgen(&["simulate", "simple_pendulum", "--method", "rk4", "--dt", "100", "--t-end", "1000"]);
+    let out = eomgen(&[
+        "simulate",
+        "simple_pendulum",
+        "--method",
+        "rk4",
+        "--dt",
+        "100",
+        "--t-end",
+        "1000",
+    ]);
     let err = stderr(&out);
-    assert!(err.contains("warning: the energy of this conservative model drifted by"), "{err}");
+    assert!(
+        err.contains("warning: the energy of this conservative model drifted by"),
+        "{err}"
+    );
     // A model with damping is not conservative: no energy warning however it drifts.
     let out = eomgen(&["simulate", "three_masses_damped", "--t-end", "5"]);
-    assert!(!stderr(&out).contains("energy of this conservative"), "{}", stderr(&out));
+    assert!(
+        !stderr(&out).contains("energy of this conservative"),
+        "{}",
+        stderr(&out)
+    );
 }
 
 /// A step-size underflow caused by an end time of 1e12 s (where f64 resolves t only to
 /// ~3.6e-3 s) was blamed on stiffness; the hint now names the end time.
 #[test]
 fn an_underflow_from_a_huge_end_time_blames_the_end_time() {
-    let out = eomgen(&["simulate", "double_pendulum", "--t-end", "1e12", "--t-out", "1e12"]);
+    let out = eomgen(&[
+        "simulate",
+        "double_pendulum",
+        "--t-end",
+        "1e12",
+        "--t-out",
+        "1e12",
+    ]);
     let err = stderr(&out);
     assert_eq!(out.status.code(), Some(1), "{err}");
     assert!(err.contains("shorten --t-end"), "{err}");
@@ -129,22 +187,41 @@ fn tolerances_below_round_off_are_refused_by_work_precision() {
 /// used to report multipliers ("marginal") of a meaningless period.
 #[test]
 fn floquet_period_parameter_is_an_angular_frequency() {
-    let out = eomgen(&["study", "floquet", "mathieu_pendulum", "--period-parameter", "a"]);
+    let out = eomgen(&[
+        "study",
+        "floquet",
+        "mathieu_pendulum",
+        "--period-parameter",
+        "a",
+    ]);
     let err = stderr(&out);
     assert_eq!(out.status.code(), Some(2), "{err}");
-    assert!(err.contains("mathieu_pendulum.yaml:") && err.contains("is in m, not a frequency"), "{err}");
+    assert!(
+        err.contains("mathieu_pendulum.yaml:") && err.contains("is in m, not a frequency"),
+        "{err}"
+    );
 
     let dir = tempfile::tempdir().unwrap();
     let text = std::fs::read_to_string("models/mathieu_pendulum.yaml").unwrap();
     assert!(text.contains("w: 60.0    # rad/s,"));
     let hertz = dir.path().join("mathieu_hz.yaml");
-    std::fs::write(&hertz, text.replace("w: 60.0    # rad/s,", "w: 60.0    # Hz,")).unwrap();
+    std::fs::write(
+        &hertz,
+        text.replace("w: 60.0    # rad/s,", "w: 60.0    # Hz,"),
+    )
+    .unwrap();
     let out = eomgen(&["study", "floquet", hertz.to_str().unwrap()]);
     let err = stderr(&out);
     assert_eq!(out.status.code(), Some(2), "{err}");
     assert!(err.contains("is in Hz"), "{err}");
 
-    let out = eomgen(&["study", "floquet", "double_pendulum", "--period-parameter", "g"]);
+    let out = eomgen(&[
+        "study",
+        "floquet",
+        "double_pendulum",
+        "--period-parameter",
+        "g",
+    ]);
     let err = stderr(&out);
     assert_eq!(out.status.code(), Some(2), "{err}");
     assert!(err.contains("`g` is in m/s^2, not a frequency"), "{err}");
@@ -155,13 +232,32 @@ fn floquet_period_parameter_is_an_angular_frequency() {
 #[test]
 fn negative_numbers_reach_the_options_checks() {
     for (args, says) in [
-        (&["simulate", "simple_pendulum", "--t-end", "-1"][..], "--t-end must be a positive"),
-        (&["simulate", "simple_pendulum", "--method", "rk4", "--dt", "-0.1"], "`dt` is -0.1"),
-        (&["simulate", "simple_pendulum", "--atol", "-1e-9"], "absolute tolerance"),
+        (
+            &["simulate", "simple_pendulum", "--t-end", "-1"][..],
+            "--t-end must be a positive",
+        ),
+        (
+            &[
+                "simulate",
+                "simple_pendulum",
+                "--method",
+                "rk4",
+                "--dt",
+                "-0.1",
+            ],
+            "`dt` is -0.1",
+        ),
+        (
+            &["simulate", "simple_pendulum", "--atol", "-1e-9"],
+            "absolute tolerance",
+        ),
     ] {
         let out = eomgen(args);
         let err = stderr(&out);
         assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
-        assert!(err.contains(says) && !err.contains("unexpected argument"), "{args:?}: {err}");
+        assert!(
+            err.contains(says) && !err.contains("unexpected argument"),
+            "{args:?}: {err}"
+        );
     }
 }

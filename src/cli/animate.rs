@@ -21,9 +21,9 @@ use nalgebra::DMatrix;
 use plotters::prelude::*;
 
 use super::mode_plot::{self, Frame, Layout};
+use super::output::outln;
 use super::render::escape;
 use super::simulate::{IntegrationArgs, Run, failure_error, integrate};
-use super::output::outln;
 use super::{CliError, plot};
 
 /// The stylesheet, the error hooks (first script: they record script errors and

@@ -115,9 +115,11 @@ fn allow_negative_numbers(command: clap::Command) -> clap::Command {
         .get_subcommands()
         .map(|s| s.get_name().to_string())
         .collect();
-    names.iter().fold(command.allow_negative_numbers(true), |command, name| {
-        command.mut_subcommand(name, allow_negative_numbers)
-    })
+    names
+        .iter()
+        .fold(command.allow_negative_numbers(true), |command, name| {
+            command.mut_subcommand(name, allow_negative_numbers)
+        })
 }
 
 /// Runs the CLI on the process arguments. Exit status: 0 success, 1 a failed computation or

@@ -12,9 +12,9 @@ use eomgen::expressions::{ExpressionEvents, set_initial_values};
 use eomgen::{IntegrationError, ModelInfo, OutputTimes, Solution};
 use serde_json::json;
 
+use super::output::outln;
 use super::render::num;
 use super::values::{evaluate, set_parameters, usage};
-use super::output::outln;
 use super::{CliError, find_model, plot};
 use eomgen::Stabilization;
 
@@ -241,13 +241,11 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
         .collect();
     // The files of a failed integration say so: `# incomplete: <reason> at t = <t>` above a
     // CSV's header, the same note on the charts (and `"error"` in the JSON below).
-    let incomplete = failure
-        .as_ref()
-        .map(|e| match e.t() {
-            // The reasons with a time say "at t = …" themselves.
-            Some(t) if !e.to_string().contains("t = ") => format!("incomplete: {e} at t = {t}"),
-            _ => format!("incomplete: {e}"),
-        });
+    let incomplete = failure.as_ref().map(|e| match e.t() {
+        // The reasons with a time say "at t = …" themselves.
+        Some(t) if !e.to_string().contains("t = ") => format!("incomplete: {e} at t = {t}"),
+        _ => format!("incomplete: {e}"),
+    });
     if let Some(path) = &args.csv {
         write_csv(
             path,

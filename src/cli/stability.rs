@@ -64,7 +64,9 @@ fn study_error(error: StabilityError) -> CliError {
         StabilityError::InvalidStiffness => {
             CliError::usage("--stiffness takes ratios k/m in (0, 1e10], comma separated")
         }
-        StabilityError::InvalidEndTime { .. } => CliError::usage("--t-end must be in [1e-6, 100] s"),
+        StabilityError::InvalidEndTime { .. } => {
+            CliError::usage("--t-end must be in [1e-6, 100] s")
+        }
         StabilityError::InvalidTolerance { .. } => CliError::usage("--tol must be in [1e-13, 1)"),
         other => CliError::failure(other.to_string()),
     }

@@ -81,5 +81,9 @@ pub fn absolute_tolerance(text: &str) -> Result<f64, String> {
 
 /// Parses a positive finite number (a stiffness): refused values are usage errors.
 pub fn positive(text: &str) -> Result<f64, String> {
-    number(text, |v| v.is_finite() && v > 0.0, "must be a positive number")
+    number(
+        text,
+        |v| v.is_finite() && v > 0.0,
+        "must be a positive number",
+    )
 }

@@ -9,8 +9,7 @@ use clap::Args;
 use eomgen::ModelInfo;
 use eomgen::analysis::work_precision::{
     AtTarget, DEFAULT_METHODS, MAX_REPEATS, Measured, MethodRuns, SMALLEST_TOLERANCE, Setting,
-    SettingRun,
-    WorkPrecision, WorkPrecisionError, WorkPrecisionOptions, decades, work_precision,
+    SettingRun, WorkPrecision, WorkPrecisionError, WorkPrecisionOptions, decades, work_precision,
 };
 use serde_json::json;
 
@@ -245,7 +244,11 @@ pub fn run(args: &WorkPrecisionArgs) -> Result<(), CliError> {
     if study.report.every_run_failed() {
         return Err(CliError::failure(format!(
             "every run of the study failed, so it measured nothing (the reasons are in the table); try tolerances between 1e-3 and 1e-13{}",
-            if args.steps.is_some() { " or more steps" } else { "" }
+            if args.steps.is_some() {
+                " or more steps"
+            } else {
+                ""
+            }
         )));
     }
     Ok(())

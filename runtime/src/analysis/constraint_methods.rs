@@ -279,7 +279,8 @@ pub fn constraint_methods(
         alpha: 10.0,
         beta: 10.0,
     });
-    let (reference_solution, failure) = integrate(model.as_mut(), &y0, t_end, &times, REFERENCE_TOL);
+    let (reference_solution, failure) =
+        integrate(model.as_mut(), &y0, t_end, &times, REFERENCE_TOL);
     if let Some(message) = failure {
         return Err(ConstraintMethodsError::ReferenceFailed { message });
     }

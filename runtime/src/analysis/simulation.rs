@@ -318,7 +318,11 @@ pub fn simulate_with_events(
         warnings.push(SimulationWarning::EnergyNotConserved {
             drift,
             initial_energy: energy.initial_energy,
-            final_energy: energy.energy.last().copied().unwrap_or(energy.initial_energy),
+            final_energy: energy
+                .energy
+                .last()
+                .copied()
+                .unwrap_or(energy.initial_energy),
         });
     }
     Ok(Simulation {

@@ -786,7 +786,13 @@ mod tests {
                 })
                 .collect(),
         };
-        assert!(study(vec![vec![failed.clone()], vec![failed.clone(), failed.clone()]]).every_run_failed());
+        assert!(
+            study(vec![
+                vec![failed.clone()],
+                vec![failed.clone(), failed.clone()]
+            ])
+            .every_run_failed()
+        );
         assert!(!study(vec![vec![failed.clone()], vec![failed, measured]]).every_run_failed());
     }
 

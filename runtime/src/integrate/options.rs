@@ -245,15 +245,11 @@ fn resolve_tolerance(
             });
         }
     };
-    if let Some((index, &value)) = values
-        .iter()
-        .enumerate()
-        .find(|(_, value)| {
-            // A relative tolerance of 1 or more asks for no correct digit: the error estimate
-            // then no longer steers the step (it grows until the solution is lost).
-            !(value.is_finite() && **value >= 0.0) || (option == "rtol" && **value >= 1.0)
-        })
-    {
+    if let Some((index, &value)) = values.iter().enumerate().find(|(_, value)| {
+        // A relative tolerance of 1 or more asks for no correct digit: the error estimate
+        // then no longer steers the step (it grows until the solution is lost).
+        !(value.is_finite() && **value >= 0.0) || (option == "rtol" && **value >= 1.0)
+    }) {
         return Err(IntegrationError::InvalidTolerance {
             option,
             index,

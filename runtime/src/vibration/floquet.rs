@@ -285,7 +285,11 @@ fn largest_change(model: &dyn ModelInfo, ys: &[Vec<f64>], times: &[f64], shift: 
         for &t in times {
             let (m0, f0) = model.mass_matrix_and_forcing(t, y);
             let (m1, f1) = model.mass_matrix_and_forcing(t + shift, y);
-            scale = scale.max(m0.amax()).max(f0.amax()).max(m1.amax()).max(f1.amax());
+            scale = scale
+                .max(m0.amax())
+                .max(f0.amax())
+                .max(m1.amax())
+                .max(f1.amax());
             let d = (m1 - m0).amax().max((f1 - f0).amax());
             let d = if d.is_nan() { f64::INFINITY } else { d };
             if d > worst {
@@ -315,7 +319,11 @@ fn check_period_parameter(
     let ys: Vec<Vec<f64>> = [(0.0, 0.0), (0.1, 0.2), (-0.07, -0.13)]
         .iter()
         .map(|&(dq, dv)| {
-            let mut y: Vec<f64> = q.iter().copied().chain(std::iter::repeat_n(0.0, n)).collect();
+            let mut y: Vec<f64> = q
+                .iter()
+                .copied()
+                .chain(std::iter::repeat_n(0.0, n))
+                .collect();
             for i in 0..n {
                 let sign = if i % 2 == 0 { 1.0 } else { -0.6 };
                 y[i] += dq * sign;
@@ -327,7 +335,9 @@ fn check_period_parameter(
     let name = model.parameter_names()[index].to_string();
     let frequency = model.parameter_values()[index];
     let period = TAU / frequency;
-    let times: Vec<f64> = (0..7).map(|k| 0.137 * period + f64::from(k) * period / 7.0).collect();
+    let times: Vec<f64> = (0..7)
+        .map(|k| 0.137 * period + f64::from(k) * period / 7.0)
+        .collect();
     // Time dependence at all: F or M changes across two shifts that are irrational-looking
     // fractions of the period (a quarter and a third would be whole periods of a forcing at
     // 12 times the named "frequency").
@@ -341,14 +351,14 @@ fn check_period_parameter(
     }
     let perturbed = frequency * (1.0 + 1.0 / 64.0);
     for w in [frequency, perturbed] {
-        model
-            .set_parameter(&name, w)?;
+        model.set_parameter(&name, w)?;
         let period = TAU / w;
-        let times: Vec<f64> = (0..7).map(|k| 0.137 * period + f64::from(k) * period / 7.0).collect();
+        let times: Vec<f64> = (0..7)
+            .map(|k| 0.137 * period + f64::from(k) * period / 7.0)
+            .collect();
         let (difference, t) = largest_change(model, &ys, &times, period);
         if difference > TOLERANCE {
-            model
-                .set_parameter(&name, frequency)?;
+            model.set_parameter(&name, frequency)?;
             return Err(FloquetStudyError::NotPeriodic {
                 model: model.name().to_string(),
                 parameter: name,
@@ -359,8 +369,7 @@ fn check_period_parameter(
             });
         }
     }
-    model
-        .set_parameter(&name, frequency)?;
+    model.set_parameter(&name, frequency)?;
     Ok(())
 }
 
@@ -426,7 +435,13 @@ pub fn floquet_cell(
     for (name, value) in values {
         model.set_parameter(name, *value)?;
     }
-    let point = analyse(model, String::new(), guess, options, TimeDependence::Allowed)?;
+    let point = analyse(
+        model,
+        String::new(),
+        guess,
+        options,
+        TimeDependence::Allowed,
+    )?;
     Ok(FloquetCell {
         spectral_radius: point.floquet.spectral_radius,
         stability: point.floquet.stability,

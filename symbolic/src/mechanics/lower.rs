@@ -379,8 +379,9 @@ impl<'f> Lowering<'f> {
             .copied()
             .collect();
         let mut evaluator = crate::expr::eval::Evaluator::new(&self.arena, &roots);
-        let mut rng =
-            <rand::rngs::Xoshiro256PlusPlus as rand::SeedableRng>::seed_from_u64(0xC0FF_EE15_5EED_1234);
+        let mut rng = <rand::rngs::Xoshiro256PlusPlus as rand::SeedableRng>::seed_from_u64(
+            0xC0FF_EE15_5EED_1234,
+        );
         let mut uniform = move || rand::RngExt::random_range(&mut rng, -2.0..2.0);
         let symbols = self.arena.symbols().to_vec();
         let mut bindings: Vec<f64> = symbols
