@@ -149,3 +149,30 @@ fn a_broken_parameter_is_not_an_unknown_name_later() {
     assert!(messages[0].contains("parameter `m` has no default value"));
     assert!(messages[1].contains("parameter defaults must be constant"));
 }
+
+/// A constraint that repeats another is redundant or contradicts it by its residual where
+/// the other holds, measured against the size of its terms: at lengths of 3.3e8 (a rounding
+/// residual of ~1e-7) `2*x - 2*l` is still redundant with `x - l`, and `x - l*(1 + 1e-6)`,
+/// 330 away, still contradicts it (offsets below 1e-8 of the terms are taken for rounding).
+#[test]
+fn redundant_or_contradictory_at_any_length_scale() {
+    use eomgen_symbolic::mechanics::SymbolicModel;
+    let lower = |second: &str| -> String {
+        let src = format!(
+            "name: x\nparameters: {{ m: 1.0, l: 3.3e8 }}\ncoordinates: [x, y]\npoints: {{ P: [x, y] }}\nbodies: {{ bob: {{ mass: m, at: P }} }}\nconstraints:\n  at_l: x - l\n  again: {second}\n"
+        );
+        let file = load("x.yaml", &src).expect("loads");
+        let errors = SymbolicModel::from_file(&file).expect_err("refused");
+        assert_eq!(errors.len(), 1, "{}", show(&errors));
+        errors[0].message.clone()
+    };
+    for (second, verdict) in [
+        ("2*x - 2*l", "is redundant with `at_l`"),
+        ("x/3 - l/3", "is redundant with `at_l`"),
+        ("x - l*(1 + 1e-6)", "contradicts `at_l`"),
+        ("x - 2*l", "contradicts `at_l`"),
+    ] {
+        let message = lower(second);
+        assert!(message.contains(verdict), "{second}: {message}");
+    }
+}

@@ -155,11 +155,39 @@ pub fn redundant_rows(samples: &[Vec<f64>], m: usize, n: usize) -> Vec<(usize, V
 /// constraints × coordinates).
 pub type HolonomicValues<'a> = dyn FnMut(&[f64]) -> (Vec<f64>, Vec<f64>) + 'a;
 
+/// The residual of a dependent holonomic constraint where the others hold, with the scale it
+/// is measured against.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DependentResidual {
+    /// `Φ_dependent` at the point found on the others' solution set (the constraint's units).
+    pub residual: f64,
+    /// The magnitude of the constraint's terms there, `max(1, ‖J_dependent‖∞ ‖q‖∞)`: a
+    /// rounding-level residual is a small multiple of `1e-16` of it.
+    pub scale: f64,
+}
+
+impl DependentResidual {
+    /// Whether the constraint contradicts the others: its residual is NaN or above `1e-8` of
+    /// its scale (rounding gives ~1e-16 of it; a redundant constraint written in metres for a
+    /// mechanism of 1e7 m is still redundant). At scales below 1 the bound is absolute, 1e-8
+    /// in the model's units.
+    pub fn contradicts(&self) -> bool {
+        self.residual.is_nan() || self.residual.abs() > 1e-8 * self.scale
+    }
+}
+
+/// The largest magnitude in `v` (0 for an empty slice).
+fn max_abs(v: &[f64]) -> f64 {
+    v.iter().fold(0.0f64, |m, x| m.max(x.abs()))
+}
+
 /// Whether a holonomic constraint whose Jacobian row depends on those of `independent`
 /// everywhere is consistent with them: Gauss–Newton (minimum-norm steps) puts `q` on
 /// `Φ_independent = 0` from `q0`, and there the dependent constraint's residual is returned
 /// (zero when it is redundant, non-zero when it contradicts them: its gradient lies in the
 /// span of theirs, so it is constant along their solution set and no `q` satisfies all).
+/// Newton stops when every `|Φᵢ|` is below `1e-13 max(1, ‖Jᵢ‖∞ ‖q‖∞)`, relative to the size
+/// of the constraint's terms so that a mechanism of any size converges.
 ///
 /// `eval(q)` gives `Φ` of every holonomic constraint and their Jacobian (row-major,
 /// `holonomic × n`) at `q`. `None` when Newton does not converge from `q0` in 50 steps or
@@ -169,7 +197,7 @@ pub fn residual_where_others_hold(
     q0: &[f64],
     independent: &[usize],
     dependent: usize,
-) -> Option<f64> {
+) -> Option<DependentResidual> {
     let n = q0.len();
     let mut q = q0.to_vec();
     for _ in 0..50 {
@@ -178,11 +206,18 @@ pub fn residual_where_others_hold(
         if !phi.iter().chain(&jac).all(|v| v.is_finite()) {
             return None;
         }
-        let scale = q.iter().fold(1.0f64, |m, x| m.max(x.abs()));
-        if r.iter().all(|v| v.abs() <= 1e-13 * scale) {
-            return Some(phi[dependent]);
-        }
         let row = |i: usize| &jac[i * n..(i + 1) * n];
+        let size = max_abs(&q).max(1.0);
+        let scale = |i: usize| (max_abs(row(i)) * size).max(1.0);
+        if r.iter()
+            .zip(independent)
+            .all(|(v, &i)| v.abs() <= 1e-13 * scale(i))
+        {
+            return Some(DependentResidual {
+                residual: phi[dependent],
+                scale: scale(dependent),
+            });
+        }
         let k = independent.len();
         let mut gram = vec![0.0; k * k];
         for (a, &i) in independent.iter().enumerate() {
@@ -223,7 +258,7 @@ fn involved<'a>(
     let Some(c) = super::numeric::solve(gram, rhs) else {
         return among.to_vec();
     };
-    let scale = c.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    let scale = max_abs(&c);
     among
         .iter()
         .zip(&c)
@@ -254,9 +289,211 @@ mod tests {
             )
         };
         let r = residual_where_others_hold(&mut eval, &[0.3, -0.7], &[0], 1).unwrap();
-        assert!((r + 1.0).abs() < 1e-12, "{r}");
+        assert!((r.residual + 1.0).abs() < 1e-12 && r.contradicts(), "{r:?}");
         let r = residual_where_others_hold(&mut eval, &[0.3, -0.7], &[0], 2).unwrap();
-        assert!(r.abs() < 1e-12, "{r}");
+        assert!(r.residual.abs() < 1e-12 && !r.contradicts(), "{r:?}");
+    }
+
+    use crate::expr::eval::Evaluator;
+    use crate::expr::{ExprArena, SymbolKind};
+
+    /// An arena with coordinates `x`, `y`, `θ` (and their rates and accelerations), time
+    /// and a parameter `w`; returns the arena, the `(q, q̇, q̈)` symbols and the expressions
+    /// `[x, y, θ, ẋ, ẏ, t, w]`.
+    fn planar() -> (ExprArena, Vec<[SymbolId; 3]>, [ExprId; 7]) {
+        let mut arena = ExprArena::new();
+        let [x, y, th] = ["x", "y", "theta"].map(|name| arena.coordinate(name));
+        let t = arena.time();
+        let w = arena.symbol("w", SymbolKind::Parameter);
+        let symbols = arena.coordinates().to_vec();
+        (arena, symbols, [x[0], y[0], th[0], x[1], y[1], t, w])
+    }
+
+    /// Values of `roots` with `q = (x, y, θ)`, `q̇`, `q̈ = 0`, `t` and `w` bound.
+    fn values(arena: &ExprArena, roots: &[ExprId], state: [f64; 6], t: f64, w: f64) -> Vec<f64> {
+        let bindings: Vec<f64> = arena
+            .symbols()
+            .iter()
+            .map(|s| match s.kind {
+                SymbolKind::Coordinate(i) => state[i as usize],
+                SymbolKind::Velocity(i) => state[3 + i as usize],
+                SymbolKind::Time => t,
+                SymbolKind::Parameter => w,
+                _ => 0.0,
+            })
+            .collect();
+        Evaluator::new(arena, roots).eval(&bindings).to_vec()
+    }
+
+    /// The bead on a rod spun at the rate ω, `Φ = x sin ωt − y cos ωt`, and a knife edge,
+    /// `g = ẋ sin θ − ẏ cos θ`: `J`, the velocity residuals and `γ` against their closed forms
+    /// (`γ = −Φ̈|q̈=0 = −2ω(ẋ cos ωt + ẏ sin ωt) + ω² (x sin ωt − y cos ωt)` and
+    /// `γ = −θ̇ (ẋ cos θ + ẏ sin θ)`), to rounding (1e-14 relative).
+    #[test]
+    fn a_rheonomic_and_a_nonholonomic_constraint_against_their_closed_forms() {
+        let (mut a, symbols, [x, y, th, xd, yd, t, w]) = planar();
+        let wt = a.times(w, t);
+        let (s, c) = (a.sin(wt), a.cos(wt));
+        let xs = a.times(x, s);
+        let yc = a.times(y, c);
+        let phi = a.minus(xs, yc);
+        let (st, ct) = (a.sin(th), a.cos(th));
+        let xst = a.times(xd, st);
+        let yct = a.times(yd, ct);
+        let g = a.minus(xst, yct);
+        let eqs = ConstraintEquations::derive(
+            &mut a,
+            &symbols,
+            &[("rod".into(), phi)],
+            &[("knife".into(), g)],
+        );
+        assert_eq!((eqs.len(), eqs.holonomic, eqs.is_empty()), (2, 1, false));
+        assert_eq!(eqs.names, ["rod", "knife"]);
+        let roots: Vec<ExprId> = eqs
+            .jacobian
+            .iter()
+            .chain(&eqs.velocity)
+            .chain(&eqs.gamma)
+            .chain(&eqs.phi)
+            .copied()
+            .collect();
+        let state = [0.7, -0.4, 1.1, 0.3, -1.3, 0.9];
+        let (tv, wv) = (0.8, 2.5);
+        let v = values(&a, &roots, state, tv, wv);
+        let [xv, yv, thv, xdv, ydv, thdv] = state;
+        let (sv, cv) = ((wv * tv).sin(), (wv * tv).cos());
+        let expected = [
+            sv,
+            -cv,
+            0.0,
+            thv.sin(),
+            -thv.cos(),
+            0.0,
+            xdv * sv + xv * wv * cv - ydv * cv + yv * wv * sv,
+            xdv * thv.sin() - ydv * thv.cos(),
+            -2.0 * wv * (xdv * cv + ydv * sv) + wv * wv * (xv * sv - yv * cv),
+            -thdv * (xdv * thv.cos() + ydv * thv.sin()),
+            xv * sv - yv * cv,
+        ];
+        for (k, (got, want)) in v.iter().zip(expected).enumerate() {
+            assert!(
+                (got - want).abs() <= 1e-14 * want.abs().max(1.0),
+                "{k}: {got} vs {want}"
+            );
+        }
+        assert!(ConstraintEquations::default().is_empty());
+    }
+
+    #[test]
+    fn rates_enter_a_velocity_constraint_linearly_or_not() {
+        let (mut a, symbols, [x, _, th, xd, yd, _, _]) = planar();
+        let st = a.sin(th);
+        let linear = a.times(xd, st);
+        let linear = a.plus(linear, x);
+        assert!(linear_in_rates(&mut a, linear, &symbols));
+        let product = a.times(xd, yd);
+        assert!(!linear_in_rates(&mut a, product, &symbols));
+        let two = a.int(2);
+        let square = a.pow(xd, two);
+        assert!(!linear_in_rates(&mut a, square, &symbols));
+    }
+
+    /// Rows of unequal norms: the third is 2 r₀ + r₁, found by Gram–Schmidt with normalised
+    /// basis vectors; the fourth, zero, constrains nothing (combines none); the fifth is
+    /// independent.
+    #[test]
+    fn a_combination_of_rows_of_unequal_norms_is_found_with_its_rows() {
+        let s = vec![
+            3.0, 4.0, 0.0, //
+            0.0, 0.0, 2.0, //
+            6.0, 8.0, 2.0, //
+            0.0, 0.0, 0.0, //
+            0.0, 1.0, 0.0,
+        ];
+        assert_eq!(
+            redundant_rows(&[s.clone(), s], 5, 3),
+            vec![(2, vec![0, 1]), (3, vec![])]
+        );
+    }
+
+    /// Dependence is relative to the row's norm: at 1e5 a difference of 1e-6 (1e-11
+    /// relative) is rounding, and at 1 a difference of 1e-6 is a different row.
+    #[test]
+    fn dependence_is_relative_to_the_norm_of_the_row() {
+        let big = vec![1e5, 0.0, 2e5, 1e-6];
+        assert_eq!(redundant_rows(&[big], 2, 2), vec![(1, vec![0])]);
+        let small = vec![1.0, 0.0, 2.0, 1e-6];
+        assert!(redundant_rows(&[small], 2, 2).is_empty());
+    }
+
+    /// The constraints a dependent row combines are named from the first sample.
+    #[test]
+    fn the_combination_is_named_from_the_first_sample() {
+        let first = vec![1.0, 0.0, 0.0, 1.0, 1.0, 0.0];
+        let second = vec![1.0, 0.0, 0.0, 1.0, 0.0, 1.0];
+        assert_eq!(redundant_rows(&[first, second], 3, 2), vec![(2, vec![0])]);
+    }
+
+    /// The circle `x² + y² = 1` is reached by several Gauss–Newton steps from (0.3, −0.7);
+    /// there `2 (x² + y²) − 2` vanishes (redundant) and `x² + y² − 4` is −3 (contradicts).
+    /// Scaled by 1e7 (a mechanism of 1e7 m, or a constraint in other units) the answers stay.
+    #[test]
+    fn a_curved_dependent_constraint_is_tested_on_the_others_at_any_scale() {
+        for scale in [1.0, 1e7] {
+            let mut eval = |q: &[f64]| {
+                let (x, y) = (q[0] / scale, q[1] / scale);
+                let r2 = x * x + y * y;
+                (
+                    vec![
+                        scale * (r2 - 1.0),
+                        scale * (2.0 * r2 - 2.0),
+                        scale * (r2 - 4.0),
+                    ],
+                    vec![2.0 * x, 2.0 * y, 4.0 * x, 4.0 * y, 2.0 * x, 2.0 * y],
+                )
+            };
+            let q0 = [0.3 * scale, -0.7 * scale];
+            let r = residual_where_others_hold(&mut eval, &q0, &[0], 1).unwrap();
+            assert!(!r.contradicts(), "{scale}: {r:?}");
+            let r = residual_where_others_hold(&mut eval, &q0, &[0], 2).unwrap();
+            assert!(r.contradicts(), "{scale}: {r:?}");
+            assert!((r.residual / scale + 3.0).abs() < 1e-9, "{scale}: {r:?}");
+        }
+    }
+
+    /// Two lines `x + y = 1` and `x − y = 0` meet at (½, ½), which a step with the 2 × 2 Gram
+    /// matrix reaches; a third line through that point is redundant there, one that misses it
+    /// by 1e-3 contradicts (and is −1e-3 there).
+    #[test]
+    fn two_independent_constraints_are_solved_together() {
+        let mut eval = |q: &[f64]| {
+            (
+                vec![
+                    q[0] + q[1] - 1.0,
+                    q[0] - q[1],
+                    3.0 * q[0] - q[1] - 1.0,
+                    3.0 * q[0] - q[1] - 1.001,
+                ],
+                vec![1.0, 1.0, 1.0, -1.0, 3.0, -1.0, 3.0, -1.0],
+            )
+        };
+        let r = residual_where_others_hold(&mut eval, &[1.7, -0.2], &[0, 1], 2).unwrap();
+        assert!(r.residual.abs() < 1e-13 && !r.contradicts(), "{r:?}");
+        let r = residual_where_others_hold(&mut eval, &[1.7, -0.2], &[0, 1], 3).unwrap();
+        assert!(
+            (r.residual + 1e-3).abs() < 1e-12 && r.contradicts(),
+            "{r:?}"
+        );
+    }
+
+    /// Newton that meets a NaN, or does not converge, gives no answer rather than a wrong one.
+    #[test]
+    fn no_residual_without_a_converged_point() {
+        let mut nan = |_: &[f64]| (vec![f64::NAN, 0.0], vec![1.0, 0.0]);
+        assert!(residual_where_others_hold(&mut nan, &[0.0], &[0], 1).is_none());
+        // x² + 1 = 0 has no real root: Gauss–Newton wanders and stops after 50 steps.
+        let mut none = |q: &[f64]| (vec![q[0] * q[0] + 1.0, 0.0], vec![2.0 * q[0], 0.0]);
+        assert!(residual_where_others_hold(&mut none, &[0.5], &[0], 1).is_none());
     }
 
     #[test]

@@ -313,10 +313,11 @@ impl<'f> Lowering<'f> {
             // they hold, contradictory if not.
             if i < eqs.holonomic
                 && with.iter().all(|j| *j < eqs.holonomic)
-                && let Some(residual) =
+                && let Some(found) =
                     self.residual_where_others_hold(&eqs, parameters, &independent, i)
-                && (residual.is_nan() || residual.abs() > 1e-8)
+                && found.contradicts()
             {
+                let residual = found.residual;
                 let message = if others.is_empty() {
                     format!(
                         "constraint `{}` can never hold: it does not depend on the coordinates, and it is {} (not 0)",
@@ -369,7 +370,7 @@ impl<'f> Lowering<'f> {
         parameters: &[ParameterInfo],
         independent: &[usize],
         dependent: usize,
-    ) -> Option<f64> {
+    ) -> Option<super::constraints::DependentResidual> {
         let n = self.arena.coordinates().len();
         let h = eqs.holonomic;
         let roots: Vec<ExprId> = eqs

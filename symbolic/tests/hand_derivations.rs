@@ -1,0 +1,144 @@
+//! The derivations a model file writes by hand — its `balances:` and its
+//! `checks: equations_of_motion` — go through `check_model` and are compared with Lagrange:
+//! every bundled set agrees, a set that is not there is not compared, and each term the
+//! balances take (gravity, a torque on a body, `form: h_dot`) is needed for the agreement.
+
+use eomgen_symbolic::mechanics::check::{CheckReport, check_model};
+
+fn check(source: &str) -> CheckReport {
+    let file = eomgen_symbolic::model::load("m.yaml", source).expect("loads");
+    check_model(&file, 20, 7).expect("checks")
+}
+
+/// The largest relative residual of the comparison of Lagrange with the derivation `name`.
+fn residual(report: &CheckReport, name: &str) -> Option<f64> {
+    report
+        .comparisons
+        .iter()
+        .find(|c| c.b == name)
+        .map(|c| c.max_rel_residual)
+}
+
+/// Every bundled model with `balances:` is compared with them, and with its hand equations
+/// if it has them, and both agree with Lagrange to 1e-9 relative (both are exact
+/// rearrangements of the same q̈: rounding only, ~1e-14); a model without them is not compared
+/// with them.
+#[test]
+fn every_bundled_balance_set_and_hand_equation_set_agrees_with_lagrange() {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../models");
+    let mut entries: Vec<_> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    entries.sort();
+    let (mut balances, mut by_hand) = (0, 0);
+    for path in entries {
+        let source = std::fs::read_to_string(&path).unwrap();
+        let report = check(&source);
+        let has_balances = source.contains("\nbalances:");
+        let has_hand = source.contains("equations_of_motion:");
+        for (name, has, count) in [
+            ("balances", has_balances, &mut balances),
+            ("by_hand", has_hand, &mut by_hand),
+        ] {
+            match residual(&report, name) {
+                Some(r) => {
+                    assert!(
+                        has,
+                        "{}: compared with {name} it does not have",
+                        path.display()
+                    );
+                    assert!(r < 1e-9, "{}: {name} residual {r}", path.display());
+                    *count += 1;
+                }
+                None => assert!(!has, "{}: {name} not compared", path.display()),
+            }
+        }
+        assert!(
+            report.notes.iter().all(|n| !n.contains("disagree")),
+            "{}: {:?}",
+            path.display(),
+            report.notes
+        );
+    }
+    assert!(balances >= 3 && by_hand >= 12, "{balances} {by_hand}");
+}
+
+/// A compound pendulum (a bar of mass m and length L hinged at its end O) driven by a torque
+/// τ: AMB about O, `I_O θ̈ = −m g (L/2) cos θ + τ` with θ from +x, is right only with both the
+/// gravity moment and the torque; `lmb` along the bar's normal through the centre of mass is a
+/// second balance that keeps the reaction (so it may not be chosen alone).
+const DRIVEN_BAR: &str = "
+name: driven_bar
+parameters: { m: 2.0, L: 1.5, g: 9.81, tau0: 3.0 }
+coordinates: [theta]
+points:
+  O: [0, 0]
+  G: [L/2*cos(theta), L/2*sin(theta)]
+bodies:
+  bar: { mass: m, inertia: m*L^2/12, com: G, angle: theta }
+gravity: [0, -g]
+torques: { motor: { body: bar, value: tau0*cos(2*t) } }
+balances:
+  - { amb: { about: O, bodies: [bar] FORM } }
+initial: { theta: 0.3 }
+";
+
+#[test]
+fn a_balance_about_the_hinge_takes_the_gravity_moment_and_the_torque() {
+    let report = check(&DRIVEN_BAR.replace(" FORM", ""));
+    let r = residual(&report, "balances").expect("compared");
+    assert!(r < 1e-9, "{r}");
+}
+
+/// `form: h_dot` about the fixed hinge is right (dH_O/dt = Σ M_O there); about the moving
+/// elbow of the double pendulum it misses v_E × m v_G, which the check reports.
+#[test]
+fn h_dot_is_right_about_a_fixed_point_and_reported_about_a_moving_one() {
+    let report = check(&DRIVEN_BAR.replace(" FORM", ", form: h_dot"));
+    let r = residual(&report, "balances").expect("compared");
+    assert!(r < 1e-9, "{r}");
+
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../models");
+    let source = std::fs::read_to_string(format!("{dir}/double_pendulum.yaml")).unwrap();
+    let moving = source.replace(
+        "{ amb: { about: E, bodies: [fore] } }",
+        "{ amb: { about: E, bodies: [fore], form: h_dot } }",
+    );
+    assert_ne!(moving, source);
+    let report = check(&moving);
+    let r = residual(&report, "balances").expect("compared");
+    assert!(r > 1e-3, "{r}");
+    assert!(
+        report.notes.iter().any(|n| n.contains("h_dot")),
+        "{:?}",
+        report.notes
+    );
+    // The same balance in the default form, r × m a, is right about the moving elbow.
+    let report = check(&source);
+    assert!(residual(&report, "balances").unwrap() < 1e-9);
+}
+
+/// A hand equation with a wrong sign is reported as a disagreement, one with a wrong factor
+/// too; the right one agrees.
+#[test]
+fn a_wrong_hand_equation_is_reported() {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../models");
+    let source = std::fs::read_to_string(format!("{dir}/simple_pendulum.yaml")).unwrap();
+    let right = "m*l^2*q_ddot = -m*g*l*cos(q)";
+    assert!(source.contains(right));
+    assert!(residual(&check(&source), "by_hand").unwrap() < 1e-9);
+    for wrong in [
+        "m*l^2*q_ddot = m*g*l*cos(q)",
+        "m*l^2*q_ddot = -m*g*l*cos(q)/2",
+    ] {
+        let report = check(&source.replace(right, wrong));
+        let r = residual(&report, "by_hand").unwrap();
+        assert!(r > 1e-3, "{wrong}: {r}");
+        assert!(
+            report.notes.iter().any(|n| n.contains("by hand disagree")),
+            "{:?}",
+            report.notes
+        );
+    }
+}
