@@ -252,3 +252,109 @@ fn preferred_formulation_needs_no_derivation() {
         );
     }
 }
+
+/// The exact Jacobians of the equations of motion (`∂F/∂q`, `∂F/∂q̇`, `∂(M a)/∂q`) against
+/// central differences of `F` and `M a` (step 1e-5: truncation ~1e-10, rounding ~1e-11 of
+/// the entries' scale; tolerance 1e-7 of the largest entry) on every bundled model of two or
+/// more coordinates, by both formulations where both apply, at random states and a random `a`.
+#[test]
+fn jacobians_match_central_differences_of_the_equations() {
+    use eomgen_symbolic::mechanics::Jacobians;
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../models");
+    let mut entries: Vec<_> = std::fs::read_dir(dir)
+        .unwrap()
+        .filter_map(Result::ok)
+        .map(|e| e.path())
+        .collect();
+    entries.sort();
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(5);
+    let mut checked = 0;
+    for path in entries {
+        let source = std::fs::read_to_string(&path).unwrap();
+        for formulation in [&Lagrange as &dyn Formulation, &MomentumBalance] {
+            let (mut model, eom) = derive(&source, formulation);
+            let n = eom.num_dofs;
+            if n < 2 || (formulation.name() == "momentum" && !MomentumBalance::applies_to(&model)) {
+                continue;
+            }
+            let jac = Jacobians::of(&mut model, &eom);
+            let mut roots: Vec<_> = eom.mass_matrix.clone();
+            roots.extend(&eom.forcing);
+            roots.extend(&jac.forcing_q);
+            roots.extend(&jac.forcing_qdot);
+            roots.extend(&jac.mass_product_q);
+            let mut evaluator = Evaluator::new(&model.arena, &roots);
+            let symbols = model.arena.symbols().to_vec();
+            let parameters = model.parameters.clone();
+            let q: Vec<f64> = (0..n).map(|_| rng.random_range(-1.5..1.5)).collect();
+            let qd: Vec<f64> = (0..n).map(|_| rng.random_range(-1.5..1.5)).collect();
+            let a: Vec<f64> = (0..n).map(|_| rng.random_range(-1.5..1.5)).collect();
+            let t = rng.random_range(0.0..2.0);
+            let mut eval = |q: &[f64], qd: &[f64]| -> Vec<f64> {
+                let bindings: Vec<f64> = symbols
+                    .iter()
+                    .map(|s| match s.kind {
+                        SymbolKind::Parameter => parameters
+                            .iter()
+                            .find(|p| p.name == s.name)
+                            .map_or(0.0, |p| p.default),
+                        SymbolKind::Coordinate(i) => q[i as usize],
+                        SymbolKind::Velocity(i) => qd[i as usize],
+                        SymbolKind::Acceleration(i) => a[i as usize],
+                        SymbolKind::Time => t,
+                        _ => 0.0,
+                    })
+                    .collect();
+                evaluator.eval(&bindings).to_vec()
+            };
+            let at = eval(&q, &qd);
+            if !at.iter().all(|v| v.is_finite()) {
+                continue;
+            }
+            // F and M a at a perturbed state.
+            let mut f_and_ma = |q: &[f64], qd: &[f64]| -> Vec<f64> {
+                let v = eval(q, qd);
+                let mut out = v[n * n..n * n + n].to_vec();
+                out.extend((0..n).map(|i| (0..n).map(|j| v[i * n + j] * a[j]).sum::<f64>()));
+                out
+            };
+            let h = 1e-5;
+            let mut numeric = vec![0.0; 3 * n * n];
+            for k in 0..n {
+                for rates in [false, true] {
+                    let (mut plus, mut minus) = ((q.clone(), qd.clone()), (q.clone(), qd.clone()));
+                    if rates {
+                        plus.1[k] += h;
+                        minus.1[k] -= h;
+                    } else {
+                        plus.0[k] += h;
+                        minus.0[k] -= h;
+                    }
+                    let (p, m) = (f_and_ma(&plus.0, &plus.1), f_and_ma(&minus.0, &minus.1));
+                    for i in 0..n {
+                        let df = (p[i] - m[i]) / (2.0 * h);
+                        let dma = (p[n + i] - m[n + i]) / (2.0 * h);
+                        if rates {
+                            numeric[n * n + i * n + k] = df;
+                        } else {
+                            numeric[i * n + k] = df;
+                            numeric[2 * n * n + i * n + k] = dma;
+                        }
+                    }
+                }
+            }
+            let exact = &at[n * n + n..];
+            let scale = exact.iter().fold(1.0f64, |m, v| m.max(v.abs()));
+            for (idx, (x, y)) in exact.iter().zip(&numeric).enumerate() {
+                assert!(
+                    (x - y).abs() <= 1e-7 * scale,
+                    "{} ({}): entry {idx} of [F_q, F_qdot, (M a)_q]: exact {x}, differences {y}",
+                    path.display(),
+                    formulation.name()
+                );
+            }
+            checked += 1;
+        }
+    }
+    assert!(checked >= 20, "{checked}");
+}

@@ -142,3 +142,26 @@ fn a_wrong_hand_equation_is_reported() {
         );
     }
 }
+
+/// The file's `initial:` against its constraints: the Cartesian pendulum starts on its circle
+/// (passes); moved 1 cm off it, or 1e-10 off (inside the 1e-9 bound), it fails and passes.
+#[test]
+fn the_initial_state_is_checked_against_the_constraints() {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../models");
+    let source = std::fs::read_to_string(format!("{dir}/simple_pendulum_cartesian.yaml")).unwrap();
+    let start = "initial: { x: l, y: 0 }";
+    assert!(source.contains(start));
+    for (initial, residual, passed) in [
+        (start, 0.0, true),
+        ("initial: { x: 1.01*l, y: 0 }", 0.01, false),
+        ("initial: { x: (1 + 1e-10)*l, y: 0 }", 1e-10, true),
+    ] {
+        let report = check(&source.replace(start, initial));
+        let found = report.initial_constraints.as_ref().expect("checked");
+        assert!(
+            (found.residual - residual).abs() <= 1e-12 && found.passed() == passed,
+            "{initial}: {found:?}"
+        );
+        assert_eq!(report.passed(1e-8), passed, "{initial}");
+    }
+}

@@ -150,3 +150,36 @@ pub(crate) fn cheaper_of_raw_and_expanded(
         (mass_matrix, forcing)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::expr::ExprArena;
+    use crate::expr::cse::operation_count;
+
+    /// `(x + 1)² − x² − 2x` multiplies out to 1, so the expanded form is kept; of `(x + 1)⁵`
+    /// and its expansion the cheaper is kept. (On a tie the raw form is kept; keeping the
+    /// expanded one would be as good: that choice is not tested.)
+    #[test]
+    fn the_cheaper_of_the_raw_and_the_expanded_form_is_kept() {
+        let mut a = ExprArena::new();
+        let [x, _, _] = a.coordinate("x");
+        let one = a.int(1);
+        let (two, five) = (a.int(2), a.int(5));
+        let x1 = a.plus(x, one);
+        let square = a.pow(x1, two);
+        let x2 = a.pow(x, two);
+        let two_x = a.times(two, x);
+        let (nx2, n2x) = (a.neg(x2), a.neg(two_x));
+        let cancelling = a.sum(&[square, nx2, n2x]);
+        let fifth = a.pow(x1, five);
+        let (m, f) = cheaper_of_raw_and_expanded(&mut a, vec![cancelling], vec![x]);
+        let d = a.minus(m[0], one);
+        assert!(a.is_zero(d) && f == [x], "{m:?}");
+        // Whichever it keeps costs no more than the other form.
+        let expanded = a.expand(fifth);
+        let (m, _) = cheaper_of_raw_and_expanded(&mut a, vec![fifth], vec![x]);
+        let kept = operation_count(&a, &m);
+        assert!(kept <= operation_count(&a, &[fifth]) && kept <= operation_count(&a, &[expanded]));
+    }
+}
