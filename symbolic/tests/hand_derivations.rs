@@ -144,7 +144,8 @@ fn a_wrong_hand_equation_is_reported() {
 }
 
 /// The file's `initial:` against its constraints: the Cartesian pendulum starts on its circle
-/// (passes); moved 1 cm off it, or 1e-10 off (inside the 1e-9 bound), it fails and passes.
+/// (passes); moved 1 cm off it, or 1e-10 off (inside the 1e-9 bound), it fails and passes;
+/// a rate across the circle fails the velocity constraint.
 #[test]
 fn the_initial_state_is_checked_against_the_constraints() {
     let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../models");
@@ -153,6 +154,17 @@ fn the_initial_state_is_checked_against_the_constraints() {
     assert!(source.contains(start));
     for (initial, residual, passed) in [
         (start, 0.0, true),
+        // On the circle, moving along it (|v| = 1 m/s, tangent) and across it.
+        (
+            "initial: { x: 0.6*l, y: -0.8*l, x_dot: 0.8, y_dot: 0.6 }",
+            0.0,
+            true,
+        ),
+        (
+            "initial: { x: 0.6*l, y: -0.8*l, x_dot: 0.6, y_dot: -0.8 }",
+            1.0,
+            false,
+        ),
         ("initial: { x: 1.01*l, y: 0 }", 0.01, false),
         ("initial: { x: (1 + 1e-10)*l, y: 0 }", 1e-10, true),
     ] {
@@ -163,5 +175,32 @@ fn the_initial_state_is_checked_against_the_constraints() {
             "{initial}: {found:?}"
         );
         assert_eq!(report.passed(1e-8), passed, "{initial}");
+    }
+}
+
+/// A block on an incline at angle α (s down the slope): linear momentum balance along the
+/// slope, `m s̈ = m g sin α`, is right only with the weight's component along it.
+#[test]
+fn a_linear_momentum_balance_takes_the_weight_along_its_direction() {
+    let source = "
+name: incline
+parameters: { m: 2.0, g: 9.81, alpha: 0.4 }
+coordinates: [s]
+points:
+  P: [s*cos(alpha), -s*sin(alpha)]
+bodies:
+  block: { mass: m, at: P }
+gravity: [0, -g]
+balances:
+  - { lmb: { along: [cos(alpha), -sin(alpha)], bodies: [block] } }
+checks:
+  equations_of_motion:
+    - m*s_ddot = m*g*sin(alpha)
+initial: { s: 0 }
+";
+    let report = check(source);
+    for name in ["balances", "by_hand"] {
+        let r = residual(&report, name).expect("compared");
+        assert!(r < 1e-9, "{name}: {r}");
     }
 }

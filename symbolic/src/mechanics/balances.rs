@@ -33,9 +33,10 @@ use crate::model::AmbForm;
 pub struct UserBalances;
 
 impl UserBalances {
-    /// Whether the model gives one balance per coordinate.
+    /// Whether the model has balances. [`crate::model::load`] refuses a file whose count of
+    /// balances differs from its count of coordinates, so they are then one per coordinate.
     pub fn applies_to(model: &SymbolicModel) -> bool {
-        !model.balances.is_empty() && model.balances.len() == model.num_dofs()
+        !model.balances.is_empty()
     }
 }
 
@@ -149,9 +150,10 @@ impl Formulation for UserBalances {
 pub struct HandEquations;
 
 impl HandEquations {
-    /// Whether the model gives one equation per coordinate.
+    /// Whether the model states its equations of motion. [`crate::model::load`] refuses a
+    /// file whose count of equations differs from its count of coordinates.
     pub fn applies_to(model: &SymbolicModel) -> bool {
-        !model.hand_equations.is_empty() && model.hand_equations.len() == model.num_dofs()
+        !model.hand_equations.is_empty()
     }
 }
 
