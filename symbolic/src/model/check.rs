@@ -4,6 +4,8 @@
 //! The rules run on what the schema pass built. Entries it left out (already reported) are
 //! listed in [`Incomplete`] and treated as present, so that one mistake gives one message.
 
+use rustc_hash::FxHashSet;
+
 use super::ast::{Expr, FUNCTIONS};
 use super::diagnostic::{Diagnostic, Diagnostics};
 use super::file::{BalanceKind, BodyKind, ModelFile, Parameter};
@@ -90,6 +92,19 @@ struct Checker<'f> {
     multipliers: Vec<String>,
     points: Vec<&'f str>,
     bodies: Vec<&'f str>,
+    /// The names above as sets, for lookups in time independent of their number (the lists
+    /// keep the file's order for suggestions and help).
+    sets: NameSets,
+}
+
+/// Parameter, coordinate, rate, acceleration and multiplier names, hashed.
+#[derive(Default)]
+struct NameSets {
+    params: FxHashSet<String>,
+    coords: FxHashSet<String>,
+    rates: FxHashSet<String>,
+    accelerations: FxHashSet<String>,
+    multipliers: FxHashSet<String>,
 }
 
 impl<'f> Checker<'f> {
@@ -99,7 +114,7 @@ impl<'f> Checker<'f> {
             .iter()
             .map(|c| c.name.value.as_str())
             .collect();
-        Self {
+        let mut checker = Self {
             file,
             incomplete,
             diagnostics: Diagnostics::new(),
@@ -119,7 +134,18 @@ impl<'f> Checker<'f> {
             coords,
             points: file.points.iter().map(|p| p.name.value.as_str()).collect(),
             bodies: file.bodies.iter().map(|b| b.name.value.as_str()).collect(),
-        }
+            sets: NameSets::default(),
+        };
+        let owned = |v: &[&str]| v.iter().map(|s| s.to_string()).collect();
+        let sets = NameSets {
+            params: owned(&checker.params),
+            coords: owned(&checker.coords),
+            rates: checker.rates.iter().cloned().collect(),
+            accelerations: checker.accelerations.iter().cloned().collect(),
+            multipliers: checker.multipliers.iter().cloned().collect(),
+        };
+        checker.sets = sets;
+        checker
     }
 
     fn error(&mut self, d: Diagnostic) {
@@ -347,13 +373,12 @@ impl<'f> Checker<'f> {
         identifiers(e, &mut ids);
         for (n, at) in ids {
             let n = n.as_str();
-            let is_param = n == "pi" || self.params.contains(&n);
-            let is_coord = self.coords.contains(&n);
-            let is_rate = self.rates.iter().any(|r| r == n);
+            let is_param = n == "pi" || self.sets.params.contains(n);
+            let is_coord = self.sets.coords.contains(n);
+            let is_rate = self.sets.rates.contains(n);
             let is_acceleration =
-                depends >= Depends::Acceleration && self.accelerations.iter().any(|r| r == n);
-            let is_multiplier =
-                depends >= Depends::Event && self.multipliers.iter().any(|r| r == n);
+                depends >= Depends::Acceleration && self.sets.accelerations.contains(n);
+            let is_multiplier = depends >= Depends::Event && self.sets.multipliers.contains(n);
             let needs = if is_param {
                 Depends::Constant
             } else if is_coord || n == "t" {
@@ -415,9 +440,9 @@ impl<'f> Checker<'f> {
         let stem = n
             .strip_suffix("_ddot")
             .or_else(|| n.strip_suffix("_dot"))
-            .filter(|s| !self.coords.contains(s));
+            .filter(|s| !self.sets.coords.contains(*s));
         if let Some(stem) = stem {
-            let kind = if self.params.contains(&stem) {
+            let kind = if self.sets.params.contains(stem) {
                 Some("a parameter, which is constant")
             } else if stem == "t" {
                 Some("the time")
@@ -630,7 +655,7 @@ impl<'f> Checker<'f> {
         let coordinates_lost = self.section_lost("coordinates", self.coords.is_empty());
         for (k, _) in &file.generalized_forces {
             let n = k.value.as_str();
-            if self.coords.contains(&n) || self.incomplete.has_name(n) || coordinates_lost {
+            if self.sets.coords.contains(n) || self.incomplete.has_name(n) || coordinates_lost {
                 continue;
             }
             let d = Diagnostic::new(
@@ -646,7 +671,7 @@ impl<'f> Checker<'f> {
         for q in &file.equilibria {
             for (k, _) in &q.values {
                 let n = k.value.as_str();
-                if self.coords.contains(&n) || self.incomplete.has_name(n) || coordinates_lost {
+                if self.sets.coords.contains(n) || self.incomplete.has_name(n) || coordinates_lost {
                     continue;
                 }
                 let d = Diagnostic::new(
@@ -668,8 +693,8 @@ impl<'f> Checker<'f> {
         for (k, _) in &file.initial {
             let n = k.value.as_str();
             let base = n.strip_suffix("_dot").unwrap_or(n);
-            if self.coords.contains(&n)
-                || self.rates.iter().any(|r| r == n)
+            if self.sets.coords.contains(n)
+                || self.sets.rates.contains(n)
                 || self.incomplete.has_name(base)
                 || coordinates_lost
             {
@@ -729,7 +754,7 @@ impl<'f> Checker<'f> {
             );
         }
         for g in &file.initial_guesses {
-            if !self.coords.contains(&g.value.as_str()) {
+            if !self.sets.coords.contains(g.value.as_str()) {
                 self.error(
                     Diagnostic::new(
                         g.location,
@@ -867,7 +892,7 @@ impl<'f> Checker<'f> {
     /// Reports `name` unless it is a parameter; `what` says where it was written.
     fn parameter_name(&mut self, name: &Located<String>, what: &str) {
         let n = name.value.as_str();
-        if self.params.contains(&n) || self.incomplete.has_name(n) {
+        if self.sets.params.contains(n) || self.incomplete.has_name(n) {
             return;
         }
         let d = Diagnostic::new(name.location, format!("{what}: `{n}` is not a parameter"));
@@ -973,8 +998,8 @@ impl<'f> Checker<'f> {
                     &format!("the value of `{}` in `final_state`", k.value),
                 );
                 let n = k.value.as_str();
-                if self.coords.contains(&n)
-                    || self.rates.iter().any(|r| r == n)
+                if self.sets.coords.contains(n)
+                    || self.sets.rates.contains(n)
                     || self.incomplete.has_section("coordinates")
                 {
                     continue;
@@ -1101,8 +1126,8 @@ impl<'f> Checker<'f> {
                         let mut ids = Vec::new();
                         identifiers(e, &mut ids);
                         for (name, location) in ids {
-                            let ok = self.params.contains(&name.as_str())
-                                || self.coords.contains(&name.as_str())
+                            let ok = self.sets.params.contains(name.as_str())
+                                || self.sets.coords.contains(name.as_str())
                                 || name == "t"
                                 || name == "pi";
                             if !ok {

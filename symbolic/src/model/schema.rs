@@ -1748,6 +1748,12 @@ impl<'s> Ctx<'s> {
                 return Vec::new();
             }
         };
+        // How many coordinates start on each line, counted once (not per coordinate, which
+        // was quadratic in a long one-line list).
+        let mut per_line: HashMap<u32, usize> = HashMap::new();
+        for item in items {
+            *per_line.entry(item.location.line).or_default() += 1;
+        }
         let mut out = Vec::new();
         for item in items {
             // The map form `{ name: x, unit: m }`.
@@ -1775,11 +1781,7 @@ impl<'s> Ctx<'s> {
                 continue;
             };
             // A trailing comment describes the coordinate only if it is alone on its line.
-            let alone = items
-                .iter()
-                .filter(|o| o.location.line == item.location.line)
-                .count()
-                == 1;
+            let alone = per_line[&item.location.line] == 1;
             let comment = if alone {
                 trailing_comment_of_line(self.line(n.location.line))
             } else {
