@@ -204,3 +204,17 @@ initial: { s: 0 }
         assert!(r < 1e-9, "{name}: {r}");
     }
 }
+
+/// States are drawn over time too: a forcing term written as `B*sin(2*w*t)` instead of
+/// `B*sin(w*t)` agrees at t = 0 only, and is reported.
+#[test]
+fn a_hand_equation_wrong_only_away_from_t_0_is_reported() {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../models");
+    let source = std::fs::read_to_string(format!("{dir}/forced_oscillator.yaml")).unwrap();
+    let right = "A*cos(w*t) + B*sin(w*t)";
+    assert!(source.contains(right));
+    assert!(residual(&check(&source), "by_hand").unwrap() < 1e-9);
+    let wrong = source.replace(right, "A*cos(w*t) + B*sin(2*w*t)");
+    let r = residual(&check(&wrong), "by_hand").unwrap();
+    assert!(r > 1e-3, "{r}");
+}

@@ -188,7 +188,7 @@ fn timed(model: &mut SymbolicModel, f: &dyn Formulation) -> (EquationsOfMotion, 
 }
 
 /// Derives `file` by every applicable formulation and cross-checks them at `states` random
-/// states (q, q̇ in [−2, 2], t in [0, 5], parameters within ±10 % of their defaults).
+/// states (q, q̇ in [−2, 2], t in [0, 5], parameters within ±10 % of their defaults, or in [0.1, 0.5] where the default is 0).
 ///
 /// # Errors
 /// The diagnostics of a model that does not lower.
@@ -248,103 +248,15 @@ pub fn check_model(
         })
         .collect();
 
-    // Power balance: d(T + V)/dt along the motion against Σ Qᵢ q̇ᵢ.
-    let energy = model.arena.plus(model.kinetic, model.potential);
-    let de_dt = model.arena.time_derivative(energy);
-    let rates: Vec<ExprId> = (0..n).map(|i| model.coordinates[i][1]).collect();
-    let power_terms: Vec<ExprId> = (0..n)
-        .map(|i| model.arena.times(model.generalized_forces[i], rates[i]))
-        .collect();
-    let power = model.arena.sum(&power_terms);
     let ts = model.time_symbol();
     let explicit_time =
         model.arena.depends_on(model.kinetic, ts) || model.arena.depends_on(model.potential, ts);
-
-    let mut roots: Vec<ExprId> = lagrange
-        .mass_matrix
-        .iter()
-        .chain(&lagrange.forcing)
-        .copied()
-        .collect();
-    let lagrange_len = roots.len();
-    for (_, b) in &others {
-        roots.extend(b.mass_matrix.iter().chain(&b.forcing));
-    }
-    roots.extend([de_dt, power, model.kinetic]);
-    let mut evaluator = Evaluator::new(&model.arena, &roots);
-    // T at doubled rates, for the homogeneity test T(q, 2q̇) = 4 T(q, q̇).
-    let mut kinetic_only = Evaluator::new(&model.arena, &[model.kinetic]);
-
-    // Xoshiro256++ (portable: the same states for a seed on every platform and release).
-    let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
-    let mut max_rel: Vec<f64> = vec![0.0; others.len()];
-    let mut power_rel: f64 = 0.0;
-    let mut quadratic = true;
-    let symbols = model.arena.symbols().to_vec();
-    let defaults = defaults_by_symbol(&model);
-    let mut compared = 0;
-    for _ in 0..states {
-        let t = rng.random_range(0.0..5.0);
-        let mut bindings = vec![0.0; symbols.len()];
-        for (i, s) in symbols.iter().enumerate() {
-            bindings[i] = match s.kind {
-                SymbolKind::Parameter => defaults[i] * rng.random_range(0.9..1.1),
-                SymbolKind::Coordinate(_) | SymbolKind::Velocity(_) => rng.random_range(-2.0..2.0),
-                SymbolKind::Time => t,
-                _ => 0.0,
-            };
-        }
-        let v = evaluator.eval(&bindings);
-        let nn = n * n;
-        let Some(qdd) = solve(v[..nn].to_vec(), v[nn..nn + n].to_vec()) else {
-            continue;
-        };
-        if !qdd.iter().all(|x| x.is_finite()) {
-            continue;
-        }
-        compared += 1;
-        for (k, worst) in max_rel.iter_mut().enumerate() {
-            let base = lagrange_len + k * (nn + n);
-            match solve(
-                v[base..base + nn].to_vec(),
-                v[base + nn..base + nn + n].to_vec(),
-            ) {
-                Some(other) => {
-                    let scale = qdd.iter().chain(&other).fold(1.0f64, |m, x| m.max(x.abs()));
-                    for (a, b) in qdd.iter().zip(&other) {
-                        *worst = worst.max((a - b).abs() / scale);
-                    }
-                }
-                None => *worst = f64::INFINITY,
-            }
-        }
-        // T homogeneous of degree 2 in q̇?
-        let t1 = v[v.len() - 1];
-        let mut doubled = bindings.clone();
-        for (i, s) in symbols.iter().enumerate() {
-            if let SymbolKind::Velocity(_) = s.kind {
-                doubled[i] *= 2.0;
-            }
-        }
-        let t2 = kinetic_only.eval(&doubled)[0];
-        if (t2 - 4.0 * t1).abs() > 1e-9 * (1.0 + t1.abs()) {
-            quadratic = false;
-        }
-        // dE/dt with the solved accelerations.
-        let mut with_acc = bindings.clone();
-        for (i, s) in symbols.iter().enumerate() {
-            if let SymbolKind::Acceleration(j) = s.kind {
-                with_acc[i] = qdd[j as usize];
-            }
-        }
-        let w = evaluator.eval(&with_acc);
-        let (de, p) = (w[w.len() - 3], w[w.len() - 2]);
-        let fq: f64 = (0..n)
-            .map(|i| (v[nn + i] * bindings_rate(&symbols, &bindings, i)).abs())
-            .sum();
-        let scale = de.abs().max(p.abs()).max(fq).max(f64::MIN_POSITIVE);
-        power_rel = power_rel.max((de - p).abs() / scale);
-    }
+    let Sampled {
+        max_rel,
+        power_rel,
+        quadratic,
+        compared,
+    } = sample_states(&mut model, &lagrange, &others, states, seed);
     if compared == 0 {
         notes.push("no random state had a solvable mass matrix".to_string());
     }
@@ -411,6 +323,138 @@ pub fn check_model(
         notes,
         initial_constraints,
     })
+}
+
+/// What [`check_model`] measures at random states: q̈ of each other derivation against
+/// Lagrange's, the power balance, and whether `T` is homogeneous of degree 2 in the rates.
+#[derive(Debug, Clone, PartialEq)]
+struct Sampled {
+    /// Per other derivation, the largest `|q̈_L − q̈_other|` relative to the largest `|q̈|`
+    /// (infinite where its `M′` is singular).
+    max_rel: Vec<f64>,
+    /// The largest `|dE/dt − Σ Qᵢ q̇ᵢ|` along Lagrange's q̈, relative to the largest of
+    /// `|dE/dt|`, `|Σ Qᵢ q̇ᵢ|` and `Σ |Fᵢ q̇ᵢ|`.
+    power_rel: f64,
+    /// `T(q, 2q̇) = 4 T(q, q̇)` at every state (to 1e-9 relative).
+    quadratic: bool,
+    /// States where Lagrange's `M` was regular (those compared).
+    compared: usize,
+}
+
+/// Samples `states` random states (q, q̇ in [−2, 2], t in [0, 5], parameters within ±10 % of
+/// their defaults or, where the default is 0, in [0.1, 0.5]; from `seed`) and compares
+/// `others` with `lagrange` there.
+fn sample_states(
+    model: &mut SymbolicModel,
+    lagrange: &EquationsOfMotion,
+    others: &[(&'static str, EquationsOfMotion)],
+    states: usize,
+    seed: u64,
+) -> Sampled {
+    let n = model.num_dofs();
+    // Power balance: d(T + V)/dt along the motion against Σ Qᵢ q̇ᵢ.
+    let energy = model.arena.plus(model.kinetic, model.potential);
+    let de_dt = model.arena.time_derivative(energy);
+    let rates: Vec<ExprId> = (0..n).map(|i| model.coordinates[i][1]).collect();
+    let power_terms: Vec<ExprId> = (0..n)
+        .map(|i| model.arena.times(model.generalized_forces[i], rates[i]))
+        .collect();
+    let power = model.arena.sum(&power_terms);
+
+    let mut roots: Vec<ExprId> = lagrange
+        .mass_matrix
+        .iter()
+        .chain(&lagrange.forcing)
+        .copied()
+        .collect();
+    let lagrange_len = roots.len();
+    for (_, b) in others {
+        roots.extend(b.mass_matrix.iter().chain(&b.forcing));
+    }
+    roots.extend([de_dt, power, model.kinetic]);
+    let mut evaluator = Evaluator::new(&model.arena, &roots);
+    // T at doubled rates, for the homogeneity test T(q, 2q̇) = 4 T(q, q̇).
+    let mut kinetic_only = Evaluator::new(&model.arena, &[model.kinetic]);
+
+    // Xoshiro256++ (portable: the same states for a seed on every platform and release).
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
+    let mut max_rel: Vec<f64> = vec![0.0; others.len()];
+    let mut power_rel: f64 = 0.0;
+    let mut quadratic = true;
+    let symbols = model.arena.symbols().to_vec();
+    let defaults = defaults_by_symbol(model);
+    let mut compared = 0;
+    for _ in 0..states {
+        let t = rng.random_range(0.0..5.0);
+        let mut bindings = vec![0.0; symbols.len()];
+        for (i, s) in symbols.iter().enumerate() {
+            bindings[i] = match s.kind {
+                // A parameter whose default is 0 (a forcing amplitude or damping switched
+                // off) would hide every term it multiplies: it takes a value in [0.1, 0.5].
+                SymbolKind::Parameter if defaults[i] == 0.0 => rng.random_range(0.1..0.5),
+                SymbolKind::Parameter => defaults[i] * rng.random_range(0.9..1.1),
+                SymbolKind::Coordinate(_) | SymbolKind::Velocity(_) => rng.random_range(-2.0..2.0),
+                SymbolKind::Time => t,
+                _ => 0.0,
+            };
+        }
+        let v = evaluator.eval(&bindings);
+        let nn = n * n;
+        let Some(qdd) = solve(v[..nn].to_vec(), v[nn..nn + n].to_vec()) else {
+            continue;
+        };
+        if !qdd.iter().all(|x| x.is_finite()) {
+            continue;
+        }
+        compared += 1;
+        for (k, worst) in max_rel.iter_mut().enumerate() {
+            let base = lagrange_len + k * (nn + n);
+            match solve(
+                v[base..base + nn].to_vec(),
+                v[base + nn..base + nn + n].to_vec(),
+            ) {
+                Some(other) => {
+                    let scale = qdd.iter().chain(&other).fold(1.0f64, |m, x| m.max(x.abs()));
+                    for (a, b) in qdd.iter().zip(&other) {
+                        *worst = worst.max((a - b).abs() / scale);
+                    }
+                }
+                None => *worst = f64::INFINITY,
+            }
+        }
+        // T homogeneous of degree 2 in q̇?
+        let t1 = v[v.len() - 1];
+        let mut doubled = bindings.clone();
+        for (i, s) in symbols.iter().enumerate() {
+            if let SymbolKind::Velocity(_) = s.kind {
+                doubled[i] *= 2.0;
+            }
+        }
+        let t2 = kinetic_only.eval(&doubled)[0];
+        if (t2 - 4.0 * t1).abs() > 1e-9 * (1.0 + t1.abs()) {
+            quadratic = false;
+        }
+        // dE/dt with the solved accelerations.
+        let mut with_acc = bindings.clone();
+        for (i, s) in symbols.iter().enumerate() {
+            if let SymbolKind::Acceleration(j) = s.kind {
+                with_acc[i] = qdd[j as usize];
+            }
+        }
+        let w = evaluator.eval(&with_acc);
+        let (de, p) = (w[w.len() - 3], w[w.len() - 2]);
+        let fq: f64 = (0..n)
+            .map(|i| (v[nn + i] * bindings_rate(&symbols, &bindings, i)).abs())
+            .sum();
+        let scale = de.abs().max(p.abs()).max(fq).max(f64::MIN_POSITIVE);
+        power_rel = power_rel.max((de - p).abs() / scale);
+    }
+    Sampled {
+        max_rel,
+        power_rel,
+        quadratic,
+        compared,
+    }
 }
 
 /// Each parameter's default at the index of its symbol (0 for every other symbol): looked up
@@ -507,4 +551,91 @@ fn integrable_nonholonomic(model: &mut SymbolicModel, seed: u64) -> Vec<String> 
         }
     }
     found
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn model(name: &str) -> SymbolicModel {
+        let path = format!("{}/../models/{name}.yaml", env!("CARGO_MANIFEST_DIR"));
+        let source = std::fs::read_to_string(path).unwrap();
+        let file = crate::model::load("m.yaml", &source).unwrap();
+        SymbolicModel::from_file(&file).unwrap()
+    }
+
+    /// The comparison is the oracle of every derivation, so it must see a wrong one: on the
+    /// double pendulum, Lagrange's equations agree with momentum balance and the power
+    /// balance holds to rounding (below 1e-12), and with `F₁` scaled by 1.01 (a 1 % error in
+    /// one term, as a dropped or wrong term would give) both fail by more than 1e-5, well
+    /// above `check`'s 1e-8.
+    #[test]
+    fn the_sampled_comparison_sees_a_one_percent_error_in_one_equation() {
+        let mut m = model("double_pendulum");
+        let lagrange = Lagrange.derive(&mut m);
+        let momentum = MomentumBalance.derive(&mut m);
+        let others = vec![("momentum", momentum)];
+        let right = sample_states(&mut m, &lagrange, &others, 30, 3);
+        assert_eq!(right.compared, 30);
+        assert!(right.quadratic);
+        assert!(
+            right.max_rel[0] < 1e-12 && right.power_rel < 1e-12,
+            "{right:?}"
+        );
+
+        let mut wrong = lagrange.clone();
+        let factor = m.arena.float(1.01);
+        wrong.forcing[1] = m.arena.times(factor, wrong.forcing[1]);
+        let found = sample_states(&mut m, &wrong, &others, 30, 3);
+        assert!(
+            found.max_rel[0] > 1e-5 && found.power_rel > 1e-5,
+            "{found:?}"
+        );
+        // The other way round: a wrong other derivation, the right Lagrange.
+        let mut bad_other = others.clone();
+        bad_other[0].1.forcing[0] = m.arena.times(factor, bad_other[0].1.forcing[0]);
+        let found = sample_states(&mut m, &lagrange, &bad_other, 30, 3);
+        assert!(
+            found.max_rel[0] > 1e-5 && found.power_rel < 1e-12,
+            "{found:?}"
+        );
+    }
+
+    /// A singular `M′` of the other derivation is an infinite residual, not a skipped state;
+    /// a singular Lagrange `M` skips the state.
+    #[test]
+    fn a_singular_mass_matrix_is_infinite_or_skipped() {
+        let mut m = model("double_pendulum");
+        let lagrange = Lagrange.derive(&mut m);
+        let mut singular = lagrange.clone();
+        singular.mass_matrix = vec![m.arena.int(0); 4];
+        let found = sample_states(&mut m, &lagrange, &[("x", singular.clone())], 5, 1);
+        assert!(
+            found.max_rel[0].is_infinite() && found.compared == 5,
+            "{found:?}"
+        );
+        let found = sample_states(&mut m, &singular, &[("x", lagrange)], 5, 1);
+        assert_eq!(found.compared, 0);
+    }
+
+    /// `T` with a term linear in the rate (a point carried by a prescribed motion has one) is
+    /// not a quadratic form: the power balance is then skipped, with a note.
+    #[test]
+    fn a_kinetic_energy_linear_in_the_rates_skips_the_power_balance() {
+        let source = "name: lin\nparameters: { m: 1.0, c: 0.5, k: 2.0 }\ncoordinates: [x]\nkinetic: m*x_dot^2/2 + c*x*x_dot + c^2\npotential: k*x^2/2\ninitial: { x: 1 }\n";
+        let file = crate::model::load("m.yaml", source).unwrap();
+        let report = check_model(&file, 10, 1).unwrap();
+        assert!(report.power_balance.is_none(), "{report:?}");
+        assert!(
+            report
+                .notes
+                .iter()
+                .any(|n| n.contains("not a quadratic form"))
+        );
+        let quadratic = source.replace(" + c*x*x_dot + c^2", "");
+        let file = crate::model::load("m.yaml", &quadratic).unwrap();
+        let report = check_model(&file, 10, 1).unwrap();
+        let p = report.power_balance.expect("checked");
+        assert!(p.max_rel_residual < 1e-12, "{p:?}");
+    }
 }
