@@ -638,4 +638,34 @@ mod tests {
         let p = report.power_balance.expect("checked");
         assert!(p.max_rel_residual < 1e-12, "{p:?}");
     }
+
+    /// A sleigh's velocity constraints written in several forms: the knife edge
+    /// `−sin θ ẋ + cos θ ẏ` is not integrable (Frobenius fails); `ẏ − 2ẋ` (y = 2x),
+    /// `ẏ − 2 x ẋ − cos t` (y = x² + sin t) and `cos θ θ̇ + ẋ` (x + sin θ = const) are;
+    /// `c (−sin θ ẋ + cos θ ẏ) + ẋ` is at the file's `c = 0` (x = const) and not at c = 1.
+    #[test]
+    fn integrable_velocity_constraints_are_told_from_a_knife_edge() {
+        let path = format!("{}/../models/chaplygin_sleigh.yaml", env!("CARGO_MANIFEST_DIR"));
+        let source = std::fs::read_to_string(path).unwrap();
+        let knife = "no_side_slip: -sin(theta)*x_dot + cos(theta)*y_dot";
+        assert!(source.contains(knife));
+        for (constraint, c, integrable) in [
+            (knife, "0", false),
+            ("line: y_dot - 2*x_dot", "0", true),
+            ("parabola: y_dot - 2*x*x_dot - cos(t)", "0", true),
+            ("hidden: cos(theta)*theta_dot + x_dot", "0", true),
+            ("switched: c*(-sin(theta)*x_dot + cos(theta)*y_dot) + x_dot", "0", true),
+            ("switched: c*(-sin(theta)*x_dot + cos(theta)*y_dot) + x_dot", "1", false),
+        ] {
+            // Without `units: SI`, so that the constraints need not be in m/s.
+            let text = source
+                .replace("units: SI\n", "")
+                .replace(knife, constraint)
+                .replace("  m: 1.0     # kg", &format!("  m: 1.0     # kg\n  c: {c}"));
+            let file = crate::model::load("m.yaml", &text).unwrap();
+            let mut m = SymbolicModel::from_file(&file).unwrap();
+            let found = integrable_nonholonomic(&mut m, 7);
+            assert_eq!(found.len(), usize::from(integrable), "{constraint} (c = {c}): {found:?}");
+        }
+    }
 }
