@@ -218,3 +218,35 @@ fn a_hand_equation_wrong_only_away_from_t_0_is_reported() {
     let r = residual(&check(&wrong), "by_hand").unwrap();
     assert!(r > 1e-3, "{r}");
 }
+
+/// The initial-state check names the constraint with the largest residual, position or
+/// velocity, and prefers a NaN (a start outside a constraint's domain) to any number.
+#[test]
+fn the_initial_check_names_the_worst_constraint() {
+    let model = |a: &str, initial: &str| {
+        format!(
+            "name: three\nparameters: {{ m: 1.0 }}\ncoordinates: [x, y, z]\npoints: {{ P: [x, y], Q: [z, 0] }}\nbodies: {{ p: {{ mass: m, at: P }}, q: {{ mass: m, at: Q }} }}\nconstraints:\n  a: {a}\n  b: y - 2\nnonholonomic:\n  n: z_dot - x_dot\ninitial: {{ {initial} }}\n"
+        )
+    };
+    for (a, initial, name, residual, velocity) in [
+        ("x - 1", "x: 1, y: 2.5, z: 0", "b", 0.5, false),
+        ("x - 1", "x: 1.2, y: 2.5, z: 0", "b", 0.5, false),
+        ("x - 1", "x: 1.5, y: 2.2, z: 0", "a", 0.5, false),
+        ("x - 1", "x: 1, y: 2, z: 0, z_dot: 0.3", "n", 0.3, true),
+        ("x - 1", "x: 1, y: 2, z: 0, y_dot: 0.7", "b", 0.7, true),
+        ("sqrt(x) - 1", "x: -1, y: 2.5, z: 0", "a", f64::NAN, false),
+        ("y - 2 + sqrt(x)", "x: 4, y: 1, z: 0", "a", 1.0, false),
+    ] {
+        let report = check(&model(a, initial));
+        let found = report.initial_constraints.expect("checked");
+        let same = if residual.is_nan() {
+            found.residual.is_nan()
+        } else {
+            (found.residual - residual).abs() < 1e-12
+        };
+        assert!(
+            found.constraint == name && same && found.velocity == velocity,
+            "{initial}: {found:?}"
+        );
+    }
+}
