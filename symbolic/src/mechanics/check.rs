@@ -383,6 +383,10 @@ fn sample_states(
     let mut quadratic = true;
     let symbols = model.arena.symbols().to_vec();
     let defaults = defaults_by_symbol(model);
+    // Where each coordinate's rate is bound.
+    let rate_slots: Vec<usize> = (0..n)
+        .map(|i| model.coordinate_symbols(i)[1].index())
+        .collect();
     let mut compared = 0;
     for _ in 0..states {
         let t = rng.random_range(0.0..5.0);
@@ -444,7 +448,7 @@ fn sample_states(
         let w = evaluator.eval(&with_acc);
         let (de, p) = (w[w.len() - 3], w[w.len() - 2]);
         let fq: f64 = (0..n)
-            .map(|i| (v[nn + i] * bindings_rate(&symbols, &bindings, i)).abs())
+            .map(|i| (v[nn + i] * bindings[rate_slots[i]]).abs())
             .sum();
         let scale = de.abs().max(p.abs()).max(fq).max(f64::MIN_POSITIVE);
         power_rel = power_rel.max((de - p).abs() / scale);
@@ -465,14 +469,6 @@ fn defaults_by_symbol(model: &SymbolicModel) -> Vec<f64> {
         defaults[p.symbol.index()] = p.default;
     }
     defaults
-}
-
-/// The value bound to the rate of coordinate `i`.
-fn bindings_rate(symbols: &[crate::expr::Symbol], bindings: &[f64], i: usize) -> f64 {
-    symbols
-        .iter()
-        .position(|s| s.kind == SymbolKind::Velocity(i as u32))
-        .map_or(0.0, |k| bindings[k])
 }
 
 /// Names of the non-holonomic constraints that are integrable, by Frobenius' condition on the
