@@ -486,6 +486,21 @@ mod tests {
         );
     }
 
+    /// The scale is the size of the constraint's terms, |J| |q|: written in other units,
+    /// `1e-6 (x − 1e6)` has terms of size 1, and `1e-6 (x − 1e6 − 0.5)`, 0.5 m away, contradicts
+    /// it (a scale of |J| + |q| = 1e6 would take its residual, 5e-7, for rounding).
+    #[test]
+    fn the_scale_is_the_size_of_the_terms() {
+        let mut eval = |q: &[f64]| {
+            (
+                vec![1e-6 * (q[0] - 1e6), 1e-6 * (q[0] - 1e6 - 0.5)],
+                vec![1e-6, 1e-6],
+            )
+        };
+        let r = residual_where_others_hold(&mut eval, &[3.0], &[0], 1).unwrap();
+        assert!((r.scale - 1.0).abs() < 1e-9 && r.contradicts(), "{r:?}");
+    }
+
     /// Newton that meets a NaN, or does not converge, gives no answer rather than a wrong one.
     #[test]
     fn no_residual_without_a_converged_point() {
