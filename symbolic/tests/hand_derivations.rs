@@ -250,3 +250,39 @@ fn the_initial_check_names_the_worst_constraint() {
         );
     }
 }
+
+/// An event that uses an acceleration or a constraint force needs them solved first; one in
+/// the state alone does not.
+#[test]
+fn events_on_accelerations_or_constraint_forces_are_told_apart() {
+    use eomgen_symbolic::mechanics::SymbolicModel;
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../models");
+    let source = std::fs::read_to_string(format!("{dir}/simple_pendulum_cartesian.yaml")).unwrap();
+    assert!(source.contains("\n  rod: "));
+    for (event, needs) in [
+        ("x", false),
+        ("x_dot - y", false),
+        ("x_ddot", true),
+        ("lambda_rod", true),
+    ] {
+        let text = format!("{}\nevents:\n  e: {{ when: {event} }}\n", source.trim_end())
+            .replace("units: SI\n", "");
+        let file = eomgen_symbolic::model::load("m.yaml", &text).expect("loads");
+        let model = SymbolicModel::from_file(&file).unwrap();
+        assert_eq!(model.events_need_accelerations(), needs, "{event}");
+    }
+}
+
+/// A velocity constraint that is not linear in the rates is one error, not also "redundant"
+/// (its row `∂g/∂q̇ = (2ẋ, 0)` is parallel to the holonomic one's).
+#[test]
+fn a_nonlinear_velocity_constraint_is_one_error() {
+    let src = "name: x\nparameters: { m: 1.0 }\ncoordinates: [x, y]\npoints: { P: [x, y] }\nbodies: { b: { mass: m, at: P } }\nconstraints:\n  a: x - 1\nnonholonomic:\n  n: x_dot*x_dot\n";
+    let file = eomgen_symbolic::model::load("m.yaml", src).expect("loads");
+    let errors = eomgen_symbolic::mechanics::SymbolicModel::from_file(&file).expect_err("refused");
+    assert_eq!(errors.len(), 1, "{errors:?}");
+    assert!(
+        errors[0].message.contains("not linear in the rates"),
+        "{errors:?}"
+    );
+}

@@ -641,7 +641,10 @@ mod tests {
     /// `c (−sin θ ẋ + cos θ ẏ) + ẋ` is at the file's `c = 0` (x = const) and not at c = 1.
     #[test]
     fn integrable_velocity_constraints_are_told_from_a_knife_edge() {
-        let path = format!("{}/../models/chaplygin_sleigh.yaml", env!("CARGO_MANIFEST_DIR"));
+        let path = format!(
+            "{}/../models/chaplygin_sleigh.yaml",
+            env!("CARGO_MANIFEST_DIR")
+        );
         let source = std::fs::read_to_string(path).unwrap();
         let knife = "no_side_slip: -sin(theta)*x_dot + cos(theta)*y_dot";
         assert!(source.contains(knife));
@@ -650,8 +653,16 @@ mod tests {
             ("line: y_dot - 2*x_dot", "0", true),
             ("parabola: y_dot - 2*x*x_dot - cos(t)", "0", true),
             ("hidden: cos(theta)*theta_dot + x_dot", "0", true),
-            ("switched: c*(-sin(theta)*x_dot + cos(theta)*y_dot) + x_dot", "0", true),
-            ("switched: c*(-sin(theta)*x_dot + cos(theta)*y_dot) + x_dot", "1", false),
+            (
+                "switched: c*(-sin(theta)*x_dot + cos(theta)*y_dot) + x_dot",
+                "0",
+                true,
+            ),
+            (
+                "switched: c*(-sin(theta)*x_dot + cos(theta)*y_dot) + x_dot",
+                "1",
+                false,
+            ),
         ] {
             // Without `units: SI`, so that the constraints need not be in m/s.
             let text = source
@@ -661,7 +672,11 @@ mod tests {
             let file = crate::model::load("m.yaml", &text).unwrap();
             let mut m = SymbolicModel::from_file(&file).unwrap();
             let found = integrable_nonholonomic(&mut m, 7);
-            assert_eq!(found.len(), usize::from(integrable), "{constraint} (c = {c}): {found:?}");
+            assert_eq!(
+                found.len(),
+                usize::from(integrable),
+                "{constraint} (c = {c}): {found:?}"
+            );
         }
     }
 }

@@ -416,6 +416,16 @@ mod tests {
         );
     }
 
+    /// The constraints named in a combination are those whose coefficient is above 1e-8 of
+    /// the largest: in `1e3 r₀ + 1e-6 r₁` (1e-9 relative) only `r₀`.
+    #[test]
+    fn a_negligible_coefficient_does_not_name_its_row() {
+        let s = vec![1.0, 0.0, 0.0, 1.0, 1e3, 1e-6];
+        assert_eq!(redundant_rows(&[s], 3, 2), vec![(2, vec![0])]);
+        let s = vec![1.0, 0.0, 0.0, 1.0, 1e3, 1e-3];
+        assert_eq!(redundant_rows(&[s], 3, 2), vec![(2, vec![0, 1])]);
+    }
+
     /// Dependence is relative to the row's norm: at 1e5 a difference of 1e-6 (1e-11
     /// relative) is rounding, and at 1 a difference of 1e-6 is a different row.
     #[test]

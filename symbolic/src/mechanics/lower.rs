@@ -268,7 +268,9 @@ impl<'f> Lowering<'f> {
         }
         let eqs = ConstraintEquations::derive(&mut self.arena, &symbols, &holonomic, &nonholonomic);
         let (m, n) = (eqs.len(), symbols.len());
-        if m > n || !self.errors.is_empty() {
+        // (More constraints than coordinates is the loader's error; after an error here the
+        // rank test would only repeat it.)
+        if !self.errors.is_empty() {
             return eqs;
         }
         // Rank of J at a few random configurations (parameters at their defaults).
