@@ -358,3 +358,37 @@ fn jacobians_match_central_differences_of_the_equations() {
     }
     assert!(checked >= 20, "{checked}");
 }
+
+/// Which models conserve `T + V`: none of dampers, forces, torques or generalized forces, no
+/// explicit `t` in `T` or `V`, `T` quadratic in the rates and workless constraints. The
+/// Cartesian pendulum (a scleronomic constraint) and the Chaplygin sleigh (`b = 0`) are; the
+/// bead on the spun rod (`Φ` depends on t), a knife edge on a belt moving at `v` (`b ≠ 0`),
+/// and `T` with a term linear in the rate (`T + V` is then not the Jacobi integral) are not.
+#[test]
+fn conservative_models_are_recognised() {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../models");
+    let read = |name: &str| std::fs::read_to_string(format!("{dir}/{name}.yaml")).unwrap();
+    let conservative = |source: &str| {
+        let file = eomgen_symbolic::model::load("m.yaml", source).expect("loads");
+        SymbolicModel::from_file(&file).unwrap().conservative
+    };
+    for (name, expected) in [
+        ("simple_pendulum", true),
+        ("simple_pendulum_cartesian", true),
+        ("chaplygin_sleigh", true),
+        ("double_pendulum", true),
+        ("bead_spinning_rod", false),
+        ("forced_oscillator", false),
+        ("three_masses_damped", false),
+    ] {
+        assert_eq!(conservative(&read(name)), expected, "{name}");
+    }
+    let sleigh = read("chaplygin_sleigh").replace("units: SI\n", "");
+    let knife = "-sin(theta)*x_dot + cos(theta)*y_dot";
+    assert!(sleigh.contains(knife));
+    let belt = sleigh.replace(knife, &format!("{knife} - v0"));
+    assert!(!conservative(&belt));
+    let linear = "name: lin\nparameters: { m: 1.0, c: 0.5, k: 2.0 }\ncoordinates: [x]\nkinetic: m*x_dot^2/2 + c*x*x_dot\npotential: k*x^2/2\n";
+    assert!(!conservative(linear));
+    assert!(conservative(&linear.replace(" + c*x*x_dot", "")));
+}

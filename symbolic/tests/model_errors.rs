@@ -176,3 +176,48 @@ fn redundant_or_contradictory_at_any_length_scale() {
         assert!(message.contains(verdict), "{second}: {message}");
     }
 }
+
+/// The other cases of a dependent constraint: a velocity constraint implied by a holonomic
+/// one is redundant (x = 1 gives ẋ = 0); one that contradicts two others names both ("hold");
+/// a constraint on no coordinate can never hold unless it is 0.
+#[test]
+fn dependent_constraints_of_every_kind_are_named() {
+    use eomgen_symbolic::mechanics::SymbolicModel;
+    let lower = |coordinates: &str, constraints: &str| -> Vec<String> {
+        let src = format!(
+            "name: x\nparameters: {{ m: 1.0, l: 1.0 }}\ncoordinates: [{coordinates}]\npoints: {{ P: [x, 0] }}\nbodies: {{ bob: {{ mass: m, at: P }} }}\n{constraints}"
+        );
+        let file = load("x.yaml", &src).expect("loads");
+        match SymbolicModel::from_file(&file) {
+            Ok(_) => Vec::new(),
+            Err(errors) => errors.into_iter().map(|d| d.message).collect(),
+        }
+    };
+    let found = lower(
+        "x, y",
+        "constraints:\n  a: x - l\nnonholonomic:\n  n: x_dot\n",
+    );
+    assert!(
+        found.len() == 1 && found[0].contains("`n` is redundant with `a`"),
+        "{found:?}"
+    );
+    let found = lower(
+        "x, y, z",
+        "constraints:\n  a: x - l\n  b: y - l\n  c: x + y - 3*l\n",
+    );
+    assert!(
+        found.len() == 1
+            && found[0].contains("`c` contradicts `a`, `b`: where `a` and `b` hold, it is -1"),
+        "{found:?}"
+    );
+    let found = lower("x", "constraints:\n  c: l - 2\n");
+    assert!(
+        found.len() == 1 && found[0].contains("`c` can never hold") && found[0].contains("-1"),
+        "{found:?}"
+    );
+    let found = lower("x", "constraints:\n  c: l - 1\n");
+    assert!(
+        found.len() == 1 && found[0].contains("`c` constrains nothing"),
+        "{found:?}"
+    );
+}

@@ -313,8 +313,8 @@ impl<'f> Lowering<'f> {
                 .collect();
             // A holonomic constraint that repeats holonomic ones: redundant if it holds where
             // they hold, contradictory if not.
+            // (The constraints it combines come before it, so they are holonomic too.)
             if i < eqs.holonomic
-                && with.iter().all(|j| *j < eqs.holonomic)
                 && let Some(found) =
                     self.residual_where_others_hold(&eqs, parameters, &independent, i)
                 && found.contradicts()
@@ -387,13 +387,8 @@ impl<'f> Lowering<'f> {
         );
         let mut uniform = move || rand::RngExt::random_range(&mut rng, -2.0..2.0);
         let symbols = self.arena.symbols().to_vec();
-        let mut bindings: Vec<f64> = symbols
-            .iter()
-            .map(|s| match s.kind {
-                SymbolKind::Parameter => 0.0,
-                _ => uniform(),
-            })
-            .collect();
+        // Random values for t (and the rates, unused), the parameters' defaults.
+        let mut bindings: Vec<f64> = symbols.iter().map(|_| uniform()).collect();
         for p in parameters {
             bindings[p.symbol.index()] = p.default;
         }
@@ -486,8 +481,8 @@ impl<'f> Lowering<'f> {
                 self.arena.constant(c)
             }
             ExprKind::Ident(name) => match name.as_str() {
+                // `t` is the first symbol declared (in `run`), so it is found like the others.
                 "pi" => self.arena.pi(),
-                "t" => self.arena.time(),
                 _ => match self.arena.symbol_id(name) {
                     Some(s)
                         if self.allow_accelerations
