@@ -221,3 +221,67 @@ fn dependent_constraints_of_every_kind_are_named() {
         "{found:?}"
     );
 }
+
+/// Operations on numbers whose value is undefined or overflows are located errors with a
+/// help that names the rule; their defined neighbours are not errors.
+#[test]
+fn undefined_constant_operations_are_located_errors() {
+    use eomgen_symbolic::mechanics::SymbolicModel;
+    let errors = |expr: &str| -> Vec<Diagnostic> {
+        let src = format!(
+            "name: x\nparameters: {{ k: 1.0 }}\ncoordinates: [x]\nkinetic: x_dot^2/2\npotential: k*x^2/2 + x*{expr}\n"
+        );
+        match load("x.yaml", &src) {
+            Err(errors) => errors,
+            Ok(file) => SymbolicModel::from_file(&file).err().unwrap_or_default(),
+        }
+    };
+    for (expr, message, help) in [
+        ("1/0", "division by zero", "the divisor is 0"),
+        ("0^0", "`0^0` is undefined", "non-positive exponent"),
+        ("0^(-1)", "`0^-1` is undefined", "non-positive exponent"),
+        ("(-8)^(1/3)", "is not a real number", "only integer powers"),
+        ("10^400", "overflows", "exponent"),
+        (
+            "ln(-1)",
+            "`ln(-1)` is not a finite real number",
+            "positive argument",
+        ),
+        (
+            "sqrt(-1)",
+            "`sqrt(-1)` is not a finite real number",
+            "non-negative argument",
+        ),
+        (
+            "asin(2)",
+            "`asin(2)` is not a finite real number",
+            "[-1, 1]",
+        ),
+        (
+            "acos(-2)",
+            "`acos(-2)` is not a finite real number",
+            "[-1, 1]",
+        ),
+        ("tan(pi/2)", "", ""),
+    ] {
+        let found = errors(expr);
+        if message.is_empty() {
+            // tan(π/2) in f64 is 1.6e16: finite, not an error.
+            assert!(found.is_empty(), "{expr}: {found:?}");
+            continue;
+        }
+        assert!(
+            found.len() == 1
+                && found[0].message.contains(message)
+                && found[0].help.as_deref().is_some_and(|h| h.contains(help))
+                && found[0].location.line == 5,
+            "{expr}: {found:?}"
+        );
+    }
+    for defined in [
+        "(-8)^2", "0^2", "0^0.5", "2^(-1)", "2^0.5", "2^3", "1/2", "ln(2)", "sqrt(0)",
+    ] {
+        let found = errors(defined);
+        assert!(found.is_empty(), "{defined}: {found:?}");
+    }
+}
