@@ -391,4 +391,23 @@ fn conservative_models_are_recognised() {
     let linear = "name: lin\nparameters: { m: 1.0, c: 0.5, k: 2.0 }\ncoordinates: [x]\nkinetic: m*x_dot^2/2 + c*x*x_dot\npotential: k*x^2/2\n";
     assert!(!conservative(linear));
     assert!(conservative(&linear.replace(" + c*x*x_dot", "")));
+    // Each reason alone: t in V only, t in T only, a force, a torque, a damper.
+    let spring = linear.replace(" + c*x*x_dot", "");
+    assert!(!conservative(
+        &spring.replace("k*x^2/2", "k*x^2/2*(1 + c*cos(t))")
+    ));
+    assert!(!conservative(
+        &spring.replace("m*x_dot^2/2", "m*(1 + c*cos(t))*x_dot^2/2")
+    ));
+    let bar = "name: bar\nparameters: { m: 2.0, L: 1.5, g: 9.81, c: 0.5 }\ncoordinates: [x, theta]\npoints:\n  O: [0, 0]\n  G: [x + L/2*cos(theta), L/2*sin(theta)]\nbodies:\n  bar: { mass: m, inertia: m*L^2/12, com: G, angle: theta }\ngravity: [0, -g]\nsprings: { s: { between: [O, G], stiffness: c } }\n";
+    assert!(conservative(bar));
+    assert!(!conservative(&format!(
+        "{bar}forces: {{ push: {{ at: G, vector: [c, 0] }} }}\n"
+    )));
+    assert!(!conservative(&format!(
+        "{bar}torques: {{ motor: {{ body: bar, value: c }} }}\n"
+    )));
+    assert!(!conservative(&format!(
+        "{bar}dampers: {{ d: {{ between: [O, G], coefficient: c }} }}\n"
+    )));
 }

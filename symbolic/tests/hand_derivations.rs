@@ -287,3 +287,24 @@ fn a_nonlinear_velocity_constraint_is_one_error() {
         "{errors:?}"
     );
 }
+
+/// A torque on the second body (the forearm of the double pendulum) enters the balances
+/// that take that body, and only those: both balances still agree with Lagrange.
+#[test]
+fn a_torque_on_the_second_body_enters_its_balances() {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../models");
+    let source = std::fs::read_to_string(format!("{dir}/double_pendulum.yaml")).unwrap();
+    let driven = source
+        .replace(
+            "  g: 10.0    # m/s^2\n",
+            "  g: 10.0    # m/s^2\n  tau0: 3.0  # N*m\n",
+        )
+        .replace(
+            "gravity: [0, -g]\n",
+            "gravity: [0, -g]\ntorques: { motor: { body: fore, value: tau0*cos(sqrt(g/l1)*t) } }\n",
+        );
+    assert!(driven.contains("tau0: 3.0") && driven.contains("torques:"));
+    let report = check(&driven);
+    let r = residual(&report, "balances").expect("compared");
+    assert!(r < 1e-9, "{r}: {:?}", report.notes);
+}

@@ -1066,3 +1066,44 @@ fn short(v: f64) -> String {
         s.trim_end_matches('0').trim_end_matches('.').to_string()
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn residuals_print_with_six_significant_digits() {
+        for (v, s) in [
+            (0.0, "0"),
+            (1.0, "1"),
+            (-0.5, "-0.5"),
+            (0.001, "0.001"),
+            (0.000_999_9, "9.99900e-4"),
+            (1.2e-7, "1.20000e-7"),
+            (999_999.0, "999999"),
+            (1e6, "1.00000e6"),
+            (-2.5e6, "-2.50000e6"),
+            (1.0 / 3.0, "0.333333"),
+        ] {
+            assert_eq!(short(v), s, "{v}");
+        }
+    }
+
+    /// `equilibria:` and `{ guess: … }` map to their coordinates by name, in any order.
+    #[test]
+    fn equilibria_and_guesses_go_to_their_coordinates() {
+        let src = "name: x\nparameters: { m: 1.0 }\ncoordinates: [a, b, c]\npoints: { P: [a, b], Q: [c, 0] }\nbodies: { p: { mass: m, at: P }, q: { mass: m, at: Q } }\nconstraints:\n  k: a + b + c - 6\ninitial: { a: 1, c: { guess: 3 }, b: { guess: 2 } }\nequilibria:\n  e: { c: 3, a: 1 }\n";
+        let file = crate::model::load("m.yaml", src).expect("loads");
+        let model = SymbolicModel::from_file(&file).unwrap();
+        assert_eq!(model.initial_guesses, [2, 1]);
+        let (name, guess) = &model.equilibria[0];
+        let values: Vec<Option<f64>> = guess
+            .iter()
+            .map(|e| model.arena.as_constant(*e).map(Constant::to_f64))
+            .collect();
+        assert_eq!(
+            (name.as_str(), values),
+            ("e", vec![Some(1.0), Some(0.0), Some(3.0)])
+        );
+    }
+}

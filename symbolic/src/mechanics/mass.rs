@@ -184,3 +184,65 @@ pub fn mass_matrix_diagnostics(
     }
     out
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Leading principal minors of a 3 × 3 matrix (Sylvester's criterion), computed by their
+    /// determinant formulas: an independent test of positive definiteness.
+    fn minors(m: &[f64]) -> [f64; 3] {
+        let d2 = m[0] * m[4] - m[1] * m[3];
+        let d3 = m[0] * (m[4] * m[8] - m[5] * m[7]) - m[1] * (m[3] * m[8] - m[5] * m[6])
+            + m[2] * (m[3] * m[7] - m[4] * m[6]);
+        [m[0], d2, d3]
+    }
+
+    /// Against Sylvester's criterion on 2,000 random symmetric 3 × 3 matrices (entries in
+    /// [−1, 1], diagonal shifted by [0, 2]), leaving out those within 1e-6 of the boundary.
+    #[test]
+    fn positive_definiteness_agrees_with_sylvester() {
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(9);
+        let (mut yes, mut no) = (0, 0);
+        for _ in 0..2000 {
+            let mut m = [0.0; 9];
+            for i in 0..3 {
+                for j in i..3 {
+                    let v = rng.random_range(-1.0..1.0);
+                    m[i * 3 + j] = v;
+                    m[j * 3 + i] = v;
+                }
+                m[i * 3 + i] += rng.random_range(0.0..2.0);
+            }
+            let d = minors(&m);
+            if d.iter().any(|x| x.abs() < 1e-6) {
+                continue;
+            }
+            let expected = d.iter().all(|x| *x > 0.0);
+            assert_eq!(positive_definite(&m, 3), expected, "{m:?}: minors {d:?}");
+            if expected {
+                yes += 1;
+            } else {
+                no += 1;
+            }
+        }
+        assert!(yes > 200 && no > 200, "{yes} {no}");
+    }
+
+    /// The bound is relative to the largest diagonal entry: a pivot of 1e-13 of it is
+    /// singular, one of 1e-11 is not, at any overall scale; zero, NaN or infinite
+    /// matrices are not positive definite.
+    #[test]
+    fn the_pivot_bound_is_relative() {
+        for scale in [1e-20, 1.0, 1e20] {
+            let diag = |a: f64, b: f64| [a * scale, 0.0, 0.0, b * scale];
+            assert!(positive_definite(&diag(1.0, 1e-11), 2), "{scale}");
+            assert!(!positive_definite(&diag(1.0, 1e-13), 2), "{scale}");
+            assert!(!positive_definite(&diag(1e-13, 1.0), 2), "{scale}");
+        }
+        assert!(!positive_definite(&[0.0; 4], 2));
+        assert!(!positive_definite(&[1.0, 0.0, 0.0, f64::NAN], 2));
+        assert!(!positive_definite(&[f64::INFINITY, 0.0, 0.0, 1.0], 2));
+        assert!(positive_definite(&[2.0], 1));
+    }
+}
