@@ -285,3 +285,53 @@ fn undefined_constant_operations_are_located_errors() {
         assert!(found.is_empty(), "{defined}: {found:?}");
     }
 }
+
+/// A singular mass matrix is refused with its reason; a model whose `M` is singular only
+/// where it never starts, or only off its constraints, is not.
+#[test]
+fn singular_mass_matrices_are_refused_with_their_reason() {
+    use eomgen_symbolic::mechanics::check::check_model;
+    let check = |body: &str| -> Vec<String> {
+        let src = format!("name: x\nparameters: {{ m: 1.0, k: 1.0 }}\n{body}");
+        let file = load("x.yaml", &src).expect("loads");
+        match check_model(&file, 5, 1) {
+            Ok(_) => Vec::new(),
+            Err(errors) => errors.into_iter().map(|d| d.message).collect(),
+        }
+    };
+    let one = |found: Vec<String>, fragment: &str| {
+        assert!(
+            found.len() == 1 && found[0].contains(fragment),
+            "{fragment}: {found:?}"
+        );
+    };
+    one(
+        check("coordinates: [x, y]\nkinetic: m*x_dot^2/2\npotential: k*(x^2 + y^2)/2\n"),
+        "coordinate `y` has no inertia",
+    );
+    one(
+        check("coordinates: [x, y]\nkinetic: m*(x_dot + y_dot)^2/2\npotential: k*(x^2 + y^2)/2\n"),
+        "singular at every state tried",
+    );
+    one(
+        check(
+            "coordinates: [q]\nkinetic: m*cos(q)^2*q_dot^2/2\npotential: k*q^2/2\ninitial: { q: pi/2 }\n",
+        ),
+        "singular or not finite at the initial state (q = 1.57",
+    );
+    // Singular only at q = 0, which the random states and the start (q = 1) avoid.
+    assert_eq!(
+        check(
+            "coordinates: [q]\nkinetic: m*q^2*q_dot^2/2\npotential: k*q^2/2\ninitial: { q: 1 }\n"
+        ),
+        Vec::<String>::new()
+    );
+    // With x = y enforced, only x + y moves, which has inertia: the constrained system is
+    // regular, and M alone is not tested.
+    assert_eq!(
+        check(
+            "coordinates: [x, y]\npoints: { P: [x + y, 0] }\nbodies: { b: { mass: m, at: P } }\nconstraints:\n  same: x - y\n"
+        ),
+        Vec::<String>::new()
+    );
+}

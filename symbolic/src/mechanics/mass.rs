@@ -24,10 +24,17 @@ use super::{EquationsOfMotion, SymbolicModel};
 /// Random states tried for "singular everywhere".
 const STATES: usize = 16;
 
+/// The largest diagonal entry of `m` in magnitude (`n × n`, row-major).
+fn largest_diagonal(m: &[f64], n: usize) -> f64 {
+    (0..n).map(|i| m[i * n + i].abs()).fold(0.0f64, f64::max)
+}
+
 /// Whether the symmetric `m` (`n × n`, row-major) is positive definite: every pivot of its
-/// `L D Lᵀ` factorisation above `1e-12` of the largest diagonal entry.
-fn positive_definite(m: &[f64], n: usize) -> bool {
-    let scale = (0..n).map(|i| m[i * n + i].abs()).fold(0.0f64, f64::max);
+/// `L D Lᵀ` factorisation above `1e-12` of `reference`, or of its largest diagonal entry if
+/// that is larger. A reference measured elsewhere (the size of `M` at other states) finds a
+/// matrix that is small as a whole, as a 1 × 1 `M` near a singular configuration.
+fn positive_definite(m: &[f64], n: usize, reference: f64) -> bool {
+    let scale = largest_diagonal(m, n).max(reference);
     if !(scale > 0.0 && scale.is_finite()) {
         return false;
     }
@@ -103,6 +110,7 @@ pub fn mass_matrix_diagnostics(
     }
     let mut rng = Xoshiro256PlusPlus::seed_from_u64(0x6d61_7373);
     let mut regular = 0;
+    let mut sizes = Vec::with_capacity(STATES);
     for _ in 0..STATES {
         for (k, s) in symbols.iter().enumerate() {
             match s.kind {
@@ -113,10 +121,15 @@ pub fn mass_matrix_diagnostics(
                 _ => {}
             }
         }
-        if positive_definite(&evaluator.eval(&bindings), n) {
+        let m = evaluator.eval(&bindings);
+        if positive_definite(&m, n, 0.0) {
             regular += 1;
+            sizes.push(largest_diagonal(&m, n));
         }
     }
+    // The typical size of M where it is regular: the reference at the initial state.
+    sizes.sort_by(f64::total_cmp);
+    let typical = sizes.get(sizes.len() / 2).copied().unwrap_or(0.0);
     let first = file.coordinates.first().map(|c| c.name.location);
     if regular == 0 {
         if let Some(location) = first {
@@ -155,7 +168,7 @@ pub fn mass_matrix_diagnostics(
         let [q, _, _] = model.coordinate_symbols(i);
         bindings[q.index()] = v;
     }
-    if !positive_definite(&evaluator.eval(&bindings), n) {
+    if !positive_definite(&evaluator.eval(&bindings), n, typical) {
         let location = file
             .initial
             .first()
@@ -219,7 +232,11 @@ mod tests {
                 continue;
             }
             let expected = d.iter().all(|x| *x > 0.0);
-            assert_eq!(positive_definite(&m, 3), expected, "{m:?}: minors {d:?}");
+            assert_eq!(
+                positive_definite(&m, 3, 0.0),
+                expected,
+                "{m:?}: minors {d:?}"
+            );
             if expected {
                 yes += 1;
             } else {
@@ -236,13 +253,16 @@ mod tests {
     fn the_pivot_bound_is_relative() {
         for scale in [1e-20, 1.0, 1e20] {
             let diag = |a: f64, b: f64| [a * scale, 0.0, 0.0, b * scale];
-            assert!(positive_definite(&diag(1.0, 1e-11), 2), "{scale}");
-            assert!(!positive_definite(&diag(1.0, 1e-13), 2), "{scale}");
-            assert!(!positive_definite(&diag(1e-13, 1.0), 2), "{scale}");
+            assert!(positive_definite(&diag(1.0, 1e-11), 2, 0.0), "{scale}");
+            assert!(!positive_definite(&diag(1.0, 1e-13), 2, 0.0), "{scale}");
+            assert!(!positive_definite(&diag(1e-13, 1.0), 2, 0.0), "{scale}");
         }
-        assert!(!positive_definite(&[0.0; 4], 2));
-        assert!(!positive_definite(&[1.0, 0.0, 0.0, f64::NAN], 2));
-        assert!(!positive_definite(&[f64::INFINITY, 0.0, 0.0, 1.0], 2));
-        assert!(positive_definite(&[2.0], 1));
+        assert!(!positive_definite(&[0.0; 4], 2, 0.0));
+        assert!(!positive_definite(&[1.0, 0.0, 0.0, f64::NAN], 2, 0.0));
+        assert!(!positive_definite(&[f64::INFINITY, 0.0, 0.0, 1.0], 2, 0.0));
+        assert!(positive_definite(&[2.0], 1, 0.0));
+        // Against a reference: 1e-13 of it is singular, 1e-11 is not.
+        assert!(!positive_definite(&[1e-13], 1, 1.0));
+        assert!(positive_definite(&[1e-11], 1, 1.0));
     }
 }
