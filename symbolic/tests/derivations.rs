@@ -411,3 +411,29 @@ fn conservative_models_are_recognised() {
         "{bar}dampers: {{ d: {{ between: [O, G], coefficient: c }} }}\n"
     )));
 }
+
+/// Momentum balance reuses the summed `Σ m a` of a smaller set of bodies only when that set
+/// is inside the one it needs: a double pendulum hung from a fixed point and a cart on a
+/// spring, running on a parabola (so that its velocity-product acceleration is not zero). The sets are summed smallest first, {b}, {cart}, then {a, b}, which must be built
+/// from {b}, not from {cart}, the last set of one body.
+#[test]
+fn momentum_balance_reuses_only_subsets_of_bodies() {
+    let source = "
+name: cart_and_pendulum
+parameters: { m: 1.0, M: 2.0, l: 1.0, g: 9.81, k: 3.0 }
+coordinates: [th1, th2, x]
+points:
+  O: [0, 0]
+  C: [x, x^2/2]
+  A: [l*sin(th1), -l*cos(th1)]
+  B: [l*sin(th1) + l*sin(th2), -l*cos(th1) - l*cos(th2)]
+bodies:
+  cart: { mass: M, at: C }
+  a: { mass: m, at: A }
+  b: { mass: m, at: B }
+springs: { s: { between: [O, C], stiffness: k } }
+gravity: [0, -g]
+";
+    let d = max_relative_difference(source, source, 17);
+    assert!(d < 1e-10, "{d}");
+}

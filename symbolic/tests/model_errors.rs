@@ -319,6 +319,13 @@ fn singular_mass_matrices_are_refused_with_their_reason() {
         ),
         "singular or not finite at the initial state (q = 1.57",
     );
+    // Singular at t = 0 only (the start), regular at the random times in [0, 5].
+    one(
+        check(
+            "coordinates: [q]\nkinetic: m*t^2*q_dot^2/2\npotential: k*q^2/2\ninitial: { q: 1 }\n",
+        ),
+        "singular or not finite at the initial state",
+    );
     // Singular only at q = 0, which the random states and the start (q = 1) avoid.
     assert_eq!(
         check(
