@@ -437,3 +437,21 @@ gravity: [0, -g]
     let d = max_relative_difference(source, source, 17);
     assert!(d < 1e-10, "{d}");
 }
+
+/// A torque on the forearm of the double pendulum: momentum balance projects it on the
+/// partial angular velocities as Lagrange takes its virtual work.
+#[test]
+fn momentum_balance_takes_a_torque_like_lagrange() {
+    let source = include_str!("../../models/double_pendulum.yaml")
+        .replace(
+            "  g: 10.0    # m/s^2\n",
+            "  g: 10.0    # m/s^2\n  tau0: 3.0  # N*m\n",
+        )
+        .replace(
+            "gravity: [0, -g]\n",
+            "gravity: [0, -g]\ntorques: { motor: { body: fore, value: tau0*cos(sqrt(g/l1)*t) } }\n",
+        );
+    assert!(source.contains("torques:"));
+    let d = max_relative_difference(&source, &source, 19);
+    assert!(d < 1e-10, "{d}");
+}

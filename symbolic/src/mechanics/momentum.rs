@@ -521,3 +521,35 @@ pub(crate) fn linear_in_accelerations(
         forcing,
     }
 }
+
+#[cfg(test)]
+mod choice_tests {
+    use super::*;
+    use crate::expr::cse::operation_count;
+
+    /// `(x + 1)² − x² − 2x` collects to 1 and is kept collected; `(x + 1)⁶` is kept as
+    /// given, its expansion costing more. Either way the kept form costs no more than the
+    /// other. (On a tie the collected form is kept; the raw one would be as good.)
+    #[test]
+    fn the_cheaper_of_the_raw_and_the_collected_form_is_kept() {
+        let mut a = ExprArena::new();
+        let [x, _, _] = a.coordinate("x");
+        let (one, two, six) = (a.int(1), a.int(2), a.int(6));
+        let x1 = a.plus(x, one);
+        let square = a.pow(x1, two);
+        let x2 = a.pow(x, two);
+        let two_x = a.times(two, x);
+        let (nx2, n2x) = (a.neg(x2), a.neg(two_x));
+        let cancelling = a.sum(&[square, nx2, n2x]);
+        let (m, _) = cheaper_of_raw_and_collected(&mut a, vec![cancelling], vec![x]);
+        let d = a.minus(m[0], one);
+        assert!(a.is_zero(d), "{m:?}");
+        let sixth = a.pow(x1, six);
+        let expanded = a.expand_time_varying(sixth);
+        let collected = a.collect_time_varying(expanded);
+        let (m, _) = cheaper_of_raw_and_collected(&mut a, vec![sixth], vec![x]);
+        let kept = operation_count(&a, &m);
+        assert!(kept <= operation_count(&a, &[sixth]));
+        assert!(kept <= operation_count(&a, &[collected]));
+    }
+}
