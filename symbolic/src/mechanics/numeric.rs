@@ -29,3 +29,40 @@ pub fn solve(mut m: Vec<f64>, mut f: Vec<f64>) -> Option<Vec<f64>> {
     }
     Some(x)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A 4 × 4 system that needs row exchanges (a zero at the first pivot), against its
+    /// known solution (residual of rounding, 1e-14).
+    #[test]
+    fn a_system_needing_pivoting_is_solved() {
+        let m = vec![
+            0.0, 2.0, 1.0, -1.0, //
+            3.0, 1.0, 0.0, 2.0, //
+            1.0, -1.0, 4.0, 0.5, //
+            2.0, 0.0, -2.0, 5.0,
+        ];
+        let x = [1.0, -2.0, 0.5, 3.0];
+        let f: Vec<f64> = (0..4)
+            .map(|r| (0..4).map(|k| m[r * 4 + k] * x[k]).sum())
+            .collect();
+        let got = solve(m, f).unwrap();
+        for (a, b) in got.iter().zip(x) {
+            assert!((a - b).abs() < 1e-14, "{got:?}");
+        }
+    }
+
+    /// A singular matrix (at the first or a later pivot), a zero one or one with a NaN has
+    /// no solution.
+    #[test]
+    fn singular_or_non_finite_matrices_have_no_solution() {
+        assert!(solve(vec![1.0, 2.0, 2.0, 4.0], vec![1.0, 1.0]).is_none());
+        assert!(solve(vec![0.0; 4], vec![1.0, 1.0]).is_none());
+        let singular_last = vec![1.0, 0.0, 0.0, 0.0, 1.0, 1.0, 0.0, 1.0, 1.0];
+        assert!(solve(singular_last, vec![1.0; 3]).is_none());
+        assert!(solve(vec![f64::NAN, 0.0, 0.0, 1.0], vec![1.0, 1.0]).is_none());
+        assert!(solve(vec![1.0, 0.0, 0.0, f64::INFINITY], vec![1.0, 1.0]).is_none());
+    }
+}
