@@ -54,6 +54,7 @@ fn every_bundled_balance_set_and_hand_equation_set_agrees_with_lagrange() {
                 None => assert!(!has, "{}: {name} not compared", path.display()),
             }
         }
+        assert!(report.passed(1e-9), "{}: {report:?}", path.display());
         assert!(
             report.notes.iter().all(|n| !n.contains("disagree")),
             "{}: {:?}",

@@ -579,6 +579,34 @@ mod tests {
             "{right:?}"
         );
 
+        // Relative to the size of q̈: with g = 1e6, q̈ ~ 1e6, and the differences of rounding
+        // (~1e-10 absolute) between equations and their multiple are still ~1e-16 relative.
+        let path = format!(
+            "{}/../models/double_pendulum.yaml",
+            env!("CARGO_MANIFEST_DIR")
+        );
+        let heavy = std::fs::read_to_string(path)
+            .unwrap()
+            .replace("  g: 10.0 ", "  g: 1e6  ");
+        let file = crate::model::load("m.yaml", &heavy).unwrap();
+        let mut h = SymbolicModel::from_file(&file).unwrap();
+        let hl = Lagrange.derive(&mut h);
+        // The same equations times 7.1: equal q̈ up to rounding.
+        let factor = h.arena.float(7.1);
+        let mut scaled = hl.clone();
+        for e in scaled
+            .mass_matrix
+            .iter_mut()
+            .chain(scaled.forcing.iter_mut())
+        {
+            *e = h.arena.times(factor, *e);
+        }
+        let found = sample_states(&mut h, &hl, &[("scaled", scaled)], 30, 3);
+        assert!(
+            found.max_rel[0] < 1e-12 && found.power_rel < 1e-12,
+            "{found:?}"
+        );
+
         let mut wrong = lagrange.clone();
         let factor = m.arena.float(1.01);
         wrong.forcing[1] = m.arena.times(factor, wrong.forcing[1]);
@@ -612,6 +640,48 @@ mod tests {
         );
         let found = sample_states(&mut m, &singular, &[("x", lagrange)], 5, 1);
         assert_eq!(found.compared, 0);
+    }
+
+    /// Parameters are drawn within ±10 % of their defaults: `M = sqrt(m − 0.6) sqrt(1.2 − m)`
+    /// is real for m = 1 ± 10 % (not for m + 1, nor for the [0.1, 0.5] of a zero default), so
+    /// every state is compared and no note says otherwise; time in `V` alone skips the power
+    /// balance, with its note.
+    #[test]
+    fn parameters_near_their_defaults_and_explicit_time() {
+        let base = "name: p\nparameters: { m: 1.0, k: 2.0 }\ncoordinates: [x]\nkinetic: sqrt(m - 0.6)*sqrt(1.2 - m)*x_dot^2/2\npotential: k*x^2/2\ninitial: { x: 1 }\n";
+        let file = crate::model::load("m.yaml", base).unwrap();
+        let report = check_model(&file, 20, 1).unwrap();
+        assert!(
+            report.notes.iter().all(|n| !n.contains("no random state")),
+            "{:?}",
+            report.notes
+        );
+        assert!(report.power_balance.unwrap().max_rel_residual < 1e-12);
+        let timed = base.replace("potential: k*x^2/2", "potential: k*x^2/2*(2 + cos(t))");
+        let file = crate::model::load("m.yaml", &timed).unwrap();
+        let report = check_model(&file, 20, 1).unwrap();
+        assert!(report.power_balance.is_none());
+        assert!(
+            report
+                .notes
+                .iter()
+                .any(|n| n == "power balance skipped: T or V depends explicitly on t"),
+            "{:?}",
+            report.notes
+        );
+        // M = 0 wherever it is sampled (only x + y moves, and x = y holds): nothing to
+        // compare, and the note says so.
+        let stuck = "name: s\nparameters: { m: 1.0 }\ncoordinates: [x, y]\npoints: { P: [x + y, 0] }\nbodies: { b: { mass: m, at: P } }\nconstraints:\n  same: x - y\n";
+        let file = crate::model::load("m.yaml", stuck).unwrap();
+        let report = check_model(&file, 5, 1).unwrap();
+        assert!(
+            report
+                .notes
+                .iter()
+                .any(|n| n.contains("no random state had a solvable mass matrix")),
+            "{:?}",
+            report.notes
+        );
     }
 
     /// `T` with a term linear in the rate (a point carried by a prescribed motion has one) is
