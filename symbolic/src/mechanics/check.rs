@@ -705,6 +705,25 @@ mod tests {
         assert!(p.max_rel_residual < 1e-12, "{p:?}");
     }
 
+    /// The constraint tested is the right row when holonomic ones come first (a knife edge
+    /// after `y = 2x`), and with two coordinates (three variables with t) the test is made:
+    /// `ẋ − t ẏ` is not integrable (ω ∧ dω = dx ∧ dy ∧ dt).
+    #[test]
+    fn integrability_after_holonomic_constraints_and_in_two_coordinates() {
+        let sleigh = "name: s\nparameters: { m: 1.0, I: 0.1, d: 0.5 }\ncoordinates: [x, y, theta]\npoints:\n  P: [x, y]\n  G: [x + d*cos(theta), y + d*sin(theta)]\nbodies:\n  s: { mass: m, inertia: I, com: G, angle: theta }\nconstraints:\n  line: y - 2*x\nnonholonomic:\n  knife: -sin(theta)*x_dot + cos(theta)*y_dot\n";
+        let file = crate::model::load("m.yaml", sleigh).unwrap();
+        let mut m = SymbolicModel::from_file(&file).unwrap();
+        assert!(integrable_nonholonomic(&mut m, 7).is_empty());
+        let plane = "name: p\nparameters: { m: 1.0 }\ncoordinates: [x, y]\npoints: { P: [x, y] }\nbodies: { b: { mass: m, at: P } }\nnonholonomic:\n  n: x_dot - t*y_dot\n";
+        let file = crate::model::load("m.yaml", plane).unwrap();
+        let mut m = SymbolicModel::from_file(&file).unwrap();
+        assert!(integrable_nonholonomic(&mut m, 7).is_empty());
+        let exact = plane.replace("x_dot - t*y_dot", "x_dot - 2*y_dot");
+        let file = crate::model::load("m.yaml", &exact).unwrap();
+        let mut m = SymbolicModel::from_file(&file).unwrap();
+        assert_eq!(integrable_nonholonomic(&mut m, 7), ["n"]);
+    }
+
     /// A sleigh's velocity constraints written in several forms: the knife edge
     /// `−sin θ ẋ + cos θ ẏ` is not integrable (Frobenius fails); `ẏ − 2ẋ` (y = 2x),
     /// `ẏ − 2 x ẋ − cos t` (y = x² + sin t) and `cos θ θ̇ + ẋ` (x + sin θ = const) are;
@@ -732,6 +751,18 @@ mod tests {
                 "switched: c*(-sin(theta)*x_dot + cos(theta)*y_dot) + x_dot",
                 "1",
                 false,
+            ),
+            // The differential of x y sin θ + t x (exact), and the same times 1 + x²
+            // (integrable with an integrating factor): every ∂aᵢ/∂xⱼ is used, none is 0.
+            (
+                "exact: (y*sin(theta) + t)*x_dot + x*sin(theta)*y_dot + x*y*cos(theta)*theta_dot + x",
+                "0",
+                true,
+            ),
+            (
+                "factor: (1 + x^2)*((y*sin(theta) + t)*x_dot + x*sin(theta)*y_dot + x*y*cos(theta)*theta_dot + x)",
+                "0",
+                true,
             ),
         ] {
             // Without `units: SI`, so that the constraints need not be in m/s.
