@@ -722,6 +722,12 @@ mod tests {
         let file = crate::model::load("m.yaml", &exact).unwrap();
         let mut m = SymbolicModel::from_file(&file).unwrap();
         assert_eq!(integrable_nonholonomic(&mut m, 7), ["n"]);
+        // ω = dx + x dy + (y − 3) dz: ω ∧ dω = (y − 2) dx ∧ dy ∧ dz, whose terms 1 and y − 3
+        // partly cancel at every state: the bound is relative to the largest term.
+        let three = "name: t\nparameters: { m: 1.0 }\ncoordinates: [x, y, z]\npoints: { P: [x, y], Q: [z, 0] }\nbodies: { b: { mass: m, at: P }, c: { mass: m, at: Q } }\nnonholonomic:\n  n: x_dot + x*y_dot + (y - 3)*z_dot\n";
+        let file = crate::model::load("m.yaml", three).unwrap();
+        let mut m = SymbolicModel::from_file(&file).unwrap();
+        assert!(integrable_nonholonomic(&mut m, 7).is_empty());
     }
 
     /// A sleigh's velocity constraints written in several forms: the knife edge
