@@ -389,6 +389,46 @@ mod tests {
     /// The predictive controller follows RADAU5: h/10 after a first rejected step, the
     /// classical proposal before any history, the smaller predictive one after, and holds the
     /// step for proposals in [1, 1.2].
+    /// When the error grows, Gustafsson's predictive factor
+    /// `0.9 (h/h_prev) (err_prev/err)^(1/4) err^(−1/4)` is below the classical one and is
+    /// taken: after a step of 2 with error 0.01, a step of 1 with error 0.5 proposes
+    /// 0.9 · 0.5 · 0.02^(1/4) · 0.5^(−1/4) = 0.2012 (the classical factor is 1.07).
+    #[test]
+    fn the_predictive_factor_is_taken_when_the_error_grows() {
+        let mut controller = PredictiveController::radau5();
+        accepted(controller.decide(2.0, 0.01));
+        let next = accepted(controller.decide(1.0, 0.5));
+        let predictive = 0.9 * 0.5 * (0.01_f64 / 0.5).powf(0.25) * 0.5_f64.powf(-0.25);
+        assert!(predictive < 0.9 * 0.5_f64.powf(-0.25));
+        assert!((next - predictive).abs() < 1e-15, "{next} vs {predictive}");
+    }
+
+    /// Each adaptive method keeps the controller it is given.
+    #[test]
+    fn the_methods_keep_the_controller_they_are_given() {
+        use crate::integrate::{BogackiShampine32, DormandPrince54, DormandPrince853, RadauIIA5};
+        let pi = PiController::dopri5()
+            .with_safety(0.8)
+            .with_factor_bounds(0.3, 4.0);
+        assert_eq!(*DormandPrince54::new().with_controller(pi).controller(), pi);
+        assert_eq!(
+            *BogackiShampine32::new().with_controller(pi).controller(),
+            pi
+        );
+        assert_eq!(
+            *DormandPrince853::new().with_controller(pi).controller(),
+            pi
+        );
+        let predictive = PredictiveController {
+            safety: 0.8,
+            ..PredictiveController::radau5()
+        };
+        assert_eq!(
+            *RadauIIA5::new().with_controller(predictive).controller(),
+            predictive
+        );
+    }
+
     #[test]
     fn predictive_controller_follows_radau5() {
         let mut controller = PredictiveController::radau5();
