@@ -759,7 +759,8 @@ mod tests {
                 false,
             ),
             // The differential of x y sin θ + t x (exact), and the same times 1 + x²
-            // (integrable with an integrating factor): every ∂aᵢ/∂xⱼ is used, none is 0.
+            // (integrable with an integrating factor): every ∂aᵢ/∂xⱼ is used, none is 0; times
+            // 1e3 the terms are 1e6 times larger, and so is the rounding the bound allows.
             (
                 "exact: (y*sin(theta) + t)*x_dot + x*sin(theta)*y_dot + x*y*cos(theta)*theta_dot + x",
                 "0",
@@ -767,6 +768,11 @@ mod tests {
             ),
             (
                 "factor: (1 + x^2)*((y*sin(theta) + t)*x_dot + x*sin(theta)*y_dot + x*y*cos(theta)*theta_dot + x)",
+                "0",
+                true,
+            ),
+            (
+                "large: 1e3*(1 + x^2)*((y*sin(theta) + t)*x_dot + x*sin(theta)*y_dot + x*y*cos(theta)*theta_dot + x)",
                 "0",
                 true,
             ),
