@@ -484,6 +484,37 @@ mod tests {
         }
     }
 
+    /// `combine`'s copies for 2, 4, 6 and 8 components equal `y + h Σ wⱼ kⱼ` formed by the
+    /// general sum, to the bit; `write_update` also covers odd dimensions (its last component
+    /// alone), which no stage uses today.
+    #[test]
+    fn the_fixed_dimension_updates_equal_the_general_one_to_the_bit() {
+        let weights = [0.1, 0.0, -2.5, 1.0 / 3.0, 0.0, 7.25, 1e-3];
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        for dim in [2, 4, 6, 8] {
+            let y: Vec<f64> = (0..dim).map(|i| 1.0 - i as f64 / 9.0).collect();
+            let first: Vec<f64> = (0..dim).map(|i| 0.3 + i as f64 / 7.0).collect();
+            let k: Vec<f64> = (0..6 * dim)
+                .map(|i| ((i * 37 % 11) as f64 - 5.0) / 3.0)
+                .collect();
+            let mut fixed = vec![f64::NAN; dim];
+            combine(&mut fixed, &y, 0.125, &weights, &first, &k);
+            let mut general = vec![f64::NAN; dim];
+            weighted_sum_any(&mut general, &weights, &first, &k, dim);
+            for (o, &yi) in general.iter_mut().zip(&y) {
+                *o = yi + 0.125 * *o;
+            }
+            assert_eq!(bits(&fixed), bits(&general), "dim {dim}");
+        }
+        let (y, sum) = ([1.0, 2.0, 3.0], [0.5, -1.0, 4.0]);
+        let mut out = [f64::NAN; 3];
+        write_update::<3>(&mut out, &y, 0.25, &sum);
+        assert_eq!(out, [1.125, 1.75, 4.0]);
+        let mut one = [f64::NAN];
+        write_update::<1>(&mut one, &[2.0], 0.5, &[3.0]);
+        assert_eq!(one, [3.5]);
+    }
+
     /// The DP5(4) stages compiled for 2, 4, 6 and 8 components give the same steps as the
     /// general stages, to the bit, over several error-controlled attempts of a nonlinear
     /// system.
