@@ -210,6 +210,16 @@ fn dependent_constraints_of_every_kind_are_named() {
             && found[0].contains("`c` contradicts `a`, `b`: where `a` and `b` hold, it is -1"),
         "{found:?}"
     );
+    // A long coordinate does not scale another's constraint: with x at 3.3e8, θ = 0.5 and
+    // 2θ = 1.001 still contradict (by 1e-3 rad).
+    let found = lower(
+        "x, theta, z",
+        "constraints:\n  far: x - 3.3e8\n  b: theta - 0.5\n  c: 2*theta - 1.001\n",
+    );
+    assert!(
+        found.len() == 1 && found[0].contains("`c` contradicts `b`"),
+        "{found:?}"
+    );
     let found = lower("x", "constraints:\n  c: l - 2\n");
     assert!(
         found.len() == 1 && found[0].contains("`c` can never hold") && found[0].contains("-1"),

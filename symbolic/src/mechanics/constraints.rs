@@ -161,18 +161,19 @@ pub type HolonomicValues<'a> = dyn FnMut(&[f64]) -> (Vec<f64>, Vec<f64>) + 'a;
 pub struct DependentResidual {
     /// `Φ_dependent` at the point found on the others' solution set (the constraint's units).
     pub residual: f64,
-    /// The magnitude of the constraint's terms there, `max(1, ‖J_dependent‖∞ ‖q‖∞)`: a
-    /// rounding-level residual is a small multiple of `1e-16` of it.
+    /// The size of the constraint's terms there, `max(1, Σⱼ |J_dependent,j qⱼ|)` (over the
+    /// coordinates it uses only): a redundant constraint's residual is rounding and Newton's
+    /// stopping error, far below `1e-8` of it.
     pub scale: f64,
 }
 
 impl DependentResidual {
-    /// Whether the constraint contradicts the others: its residual is NaN or above `1e-8` of
-    /// its scale (rounding gives ~1e-16 of it; a redundant constraint written in metres for a
+    /// Whether the constraint contradicts the others: its residual is above `1e-8` of its
+    /// scale (Newton stops at 1e-13 of the others' scales; a redundant constraint of a
     /// mechanism of 1e7 m is still redundant). At scales below 1 the bound is absolute, 1e-8
-    /// in the model's units.
+    /// in the model's units: a contradiction smaller than that is taken for redundancy.
     pub fn contradicts(&self) -> bool {
-        self.residual.is_nan() || self.residual.abs() > 1e-8 * self.scale
+        self.residual.abs() > 1e-8 * self.scale
     }
 }
 
@@ -186,7 +187,7 @@ fn max_abs(v: &[f64]) -> f64 {
 /// `Φ_independent = 0` from `q0`, and there the dependent constraint's residual is returned
 /// (zero when it is redundant, non-zero when it contradicts them: its gradient lies in the
 /// span of theirs, so it is constant along their solution set and no `q` satisfies all).
-/// Newton stops when every `|Φᵢ|` is below `1e-13 max(1, ‖Jᵢ‖∞ ‖q‖∞)`, relative to the size
+/// Newton stops when every `|Φᵢ|` is below `1e-13 max(1, Σⱼ |Jᵢⱼ qⱼ|)`, relative to the size
 /// of the constraint's terms so that a mechanism of any size converges.
 ///
 /// `eval(q)` gives `Φ` of every holonomic constraint and their Jacobian (row-major,
@@ -207,8 +208,15 @@ pub fn residual_where_others_hold(
             return None;
         }
         let row = |i: usize| &jac[i * n..(i + 1) * n];
-        let size = max_abs(&q).max(1.0);
-        let scale = |i: usize| (max_abs(row(i)) * size).max(1.0);
+        // The size of constraint i's terms: Σⱼ |Jᵢⱼ qⱼ|, over the coordinates it uses.
+        let scale = |i: usize| {
+            row(i)
+                .iter()
+                .zip(&q)
+                .map(|(j, x)| (j * x).abs())
+                .sum::<f64>()
+                .max(1.0)
+        };
         if r.iter()
             .zip(independent)
             .all(|(v, &i)| v.abs() <= 1e-13 * scale(i))
@@ -496,7 +504,7 @@ mod tests {
         );
     }
 
-    /// The scale is the size of the constraint's terms, |J| |q|: written in other units,
+    /// The scale is the size of the constraint's terms, Σ |Jⱼ qⱼ|: written in other units,
     /// `1e-6 (x − 1e6)` has terms of size 1, and `1e-6 (x − 1e6 − 0.5)`, 0.5 m away, contradicts
     /// it (a scale of |J| + |q| = 1e6 would take its residual, 5e-7, for rounding).
     #[test]
