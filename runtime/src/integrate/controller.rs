@@ -272,7 +272,8 @@ impl StepSizeController for PredictiveController {
         let clamp = |factor: f64| factor.max(self.min_factor).min(self.max_factor);
         // `∞^(−exponent) = 0` and NaN: `f64::max` returns `min_factor`.
         let classical = clamp(self.safety * error_norm.powf(-self.exponent));
-        if error_norm.is_nan() || error_norm > 1.0 {
+        // RADAU5 accepts only `err < 1` (DOPRI5, and the PI controller, also accept 1).
+        if error_norm.is_nan() || error_norm >= 1.0 {
             self.rejected_last = true;
             let factor = if self.last_accepted.is_none() {
                 0.1
@@ -386,9 +387,6 @@ mod tests {
         assert_eq!((dop853.min_factor, dop853.max_factor), (0.333, 6.0));
     }
 
-    /// The predictive controller follows RADAU5: h/10 after a first rejected step, the
-    /// classical proposal before any history, the smaller predictive one after, and holds the
-    /// step for proposals in [1, 1.2].
     /// When the error grows, Gustafsson's predictive factor
     /// `0.9 (h/h_prev) (err_prev/err)^(1/4) err^(−1/4)` is below the classical one and is
     /// taken: after a step of 2 with error 0.01, a step of 1 with error 0.5 proposes
@@ -401,6 +399,19 @@ mod tests {
         let predictive = 0.9 * 0.5 * (0.01_f64 / 0.5).powf(0.25) * 0.5_f64.powf(-0.25);
         assert!(predictive < 0.9 * 0.5_f64.powf(-0.25));
         assert!((next - predictive).abs() < 1e-15, "{next} vs {predictive}");
+    }
+
+    /// An error norm of exactly 1: the PI controller accepts it (as DOPRI5 does, `err ≤ 1`),
+    /// the predictive one rejects it (as RADAU5 does, accepting only `err < 1`).
+    #[test]
+    fn an_error_of_exactly_one_is_accepted_by_pi_and_rejected_by_radau5() {
+        let mut pi = PiController::dopri5();
+        assert!(matches!(pi.decide(1.0, 1.0), StepOutcome::Accepted { .. }));
+        let mut predictive = PredictiveController::radau5();
+        assert!(matches!(
+            predictive.decide(1.0, 1.0),
+            StepOutcome::Rejected { .. }
+        ));
     }
 
     /// Each adaptive method keeps the controller it is given.
@@ -429,6 +440,9 @@ mod tests {
         );
     }
 
+    /// The predictive controller follows RADAU5: h/10 after a first rejected step, the
+    /// classical proposal before any history, the smaller predictive one after, and holds the
+    /// step for proposals in [1, 1.2].
     #[test]
     fn predictive_controller_follows_radau5() {
         let mut controller = PredictiveController::radau5();

@@ -329,8 +329,8 @@ pub fn check_model(
 /// Lagrange's, the power balance, and whether `T` is homogeneous of degree 2 in the rates.
 #[derive(Debug, Clone, PartialEq)]
 struct Sampled {
-    /// Per other derivation, the largest `|q̈_L − q̈_other|` relative to the largest `|q̈|`
-    /// (infinite where its `M′` is singular).
+    /// Per other derivation, the largest `|q̈_L − q̈_other|` relative to the largest `|q̈|` of
+    /// the state, or to 1 if that is smaller (infinite where its `M′` is singular).
     max_rel: Vec<f64>,
     /// The largest `|dE/dt − Σ Qᵢ q̇ᵢ|` along Lagrange's q̈, relative to the largest of
     /// `|dE/dt|`, `|Σ Qᵢ q̇ᵢ|` and `Σ |Fᵢ q̇ᵢ|`.
@@ -562,7 +562,7 @@ mod tests {
 
     /// The comparison is the oracle of every derivation, so it must see a wrong one: on the
     /// double pendulum, Lagrange's equations agree with momentum balance and the power
-    /// balance holds to rounding (below 1e-12), and with `F₁` scaled by 1.01 (a 1 % error in
+    /// balance holds to rounding (below 1e-12), and with `F₂` scaled by 1.01 (a 1 % error in
     /// one term, as a dropped or wrong term would give) both fail by more than 1e-5, well
     /// above `check`'s 1e-8.
     #[test]
@@ -585,9 +585,9 @@ mod tests {
             "{}/../models/double_pendulum.yaml",
             env!("CARGO_MANIFEST_DIR")
         );
-        let heavy = std::fs::read_to_string(path)
-            .unwrap()
-            .replace("  g: 10.0 ", "  g: 1e6  ");
+        let source = std::fs::read_to_string(path).unwrap();
+        let heavy = source.replace("  g: 10.0 ", "  g: 1e6  ");
+        assert_ne!(heavy, source);
         let file = crate::model::load("m.yaml", &heavy).unwrap();
         let mut h = SymbolicModel::from_file(&file).unwrap();
         let hl = Lagrange.derive(&mut h);
@@ -669,8 +669,8 @@ mod tests {
             "{:?}",
             report.notes
         );
-        // M = 0 wherever it is sampled (only x + y moves, and x = y holds): nothing to
-        // compare, and the note says so.
+        // M = m [[1, 1], [1, 1]] is singular at every state (only x + y carries inertia; the
+        // comparison ignores the constraint): nothing to compare, and the note says so.
         let stuck = "name: s\nparameters: { m: 1.0 }\ncoordinates: [x, y]\npoints: { P: [x + y, 0] }\nbodies: { b: { mass: m, at: P } }\nconstraints:\n  same: x - y\n";
         let file = crate::model::load("m.yaml", stuck).unwrap();
         let report = check_model(&file, 5, 1).unwrap();
@@ -706,7 +706,9 @@ mod tests {
     }
 
     /// The constraint tested is the right row when holonomic ones come first (a knife edge
-    /// after `y = 2x`), and with two coordinates (three variables with t) the test is made:
+    /// after `y = 2x`; the test is made in the full space of (q, t), where the knife edge is
+    /// not integrable, although on `y = 2x` it would be), and with two coordinates (three
+    /// variables with t) the test is made:
     /// `ẋ − t ẏ` is not integrable (ω ∧ dω = dx ∧ dy ∧ dt).
     #[test]
     fn integrability_after_holonomic_constraints_and_in_two_coordinates() {
