@@ -34,10 +34,8 @@ fn largest_diagonal(m: &[f64], n: usize) -> f64 {
 /// that is larger. A reference measured elsewhere (the size of `M` at other states) finds a
 /// matrix that is small as a whole, as a 1 × 1 `M` near a singular configuration.
 fn positive_definite(m: &[f64], n: usize, reference: f64) -> bool {
+    // A zero, infinite or NaN scale fails every pivot below (`dj <= 0`, `dj <= ∞`, NaN).
     let scale = largest_diagonal(m, n).max(reference);
-    if !(scale > 0.0 && scale.is_finite()) {
-        return false;
-    }
     let mut l = vec![0.0f64; n * n];
     let mut d = vec![0.0f64; n];
     for j in 0..n {
