@@ -336,6 +336,20 @@ fn singular_mass_matrices_are_refused_with_their_reason() {
         ),
         "singular or not finite at the initial state",
     );
+    // A coordinate in no energy and no load.
+    one(
+        check("coordinates: [x, y]\nkinetic: m*x_dot^2/2\npotential: k*x^2/2\n"),
+        "coordinate `y` appears in no energy and no load",
+    );
+    // M = m e^(4q) spans up to e^-8 … e^8 over the random states; at q = -8 it is 1.3e-14,
+    // below 1e-12 of its median size there, though not of its smallest (~1e-3): the
+    // reference is the median.
+    one(
+        check(
+            "coordinates: [q]\nkinetic: m*exp(4*q)*q_dot^2/2\npotential: k*q^2/2\ninitial: { q: -8 }\n",
+        ),
+        "singular or not finite at the initial state",
+    );
     // Singular only at q = 0, which the random states and the start (q = 1) avoid.
     assert_eq!(
         check(
