@@ -336,6 +336,13 @@ fn singular_mass_matrices_are_refused_with_their_reason() {
         ),
         "singular or not finite at the initial state",
     );
+    // A coordinate with a load but no energy has no inertia (it is not unused).
+    one(
+        check(
+            "coordinates: [x, y]\nkinetic: m*x_dot^2/2\npotential: k*x^2/2\ngeneralized_forces: { y: -k*y }\n",
+        ),
+        "coordinate `y` has no inertia",
+    );
     // A coordinate in no energy and no load.
     one(
         check("coordinates: [x, y]\nkinetic: m*x_dot^2/2\npotential: k*x^2/2\n"),
