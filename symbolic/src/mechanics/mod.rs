@@ -160,18 +160,25 @@ mod tests {
     /// `(x + 1)² − x² − 2x` multiplies out to 1, so the expanded form is kept; of `(x + 1)⁵`
     /// and its expansion the cheaper is kept. (On a tie the raw form is kept; keeping the
     /// expanded one would be as good: that choice is not tested.)
-    #[test]
-    fn the_cheaper_of_the_raw_and_the_expanded_form_is_kept() {
+    /// An arena with the coordinate `x`; returns it with `x`, `x + 1` and
+    /// `(x + 1)² − x² − 2x` (which multiplies out to 1), for the tests of the form choices.
+    pub(in crate::mechanics) fn cancelling_square() -> (ExprArena, ExprId, ExprId, ExprId) {
         let mut a = ExprArena::new();
         let [x, _, _] = a.coordinate("x");
-        let one = a.int(1);
-        let (two, five) = (a.int(2), a.int(5));
+        let (one, two) = (a.int(1), a.int(2));
         let x1 = a.plus(x, one);
         let square = a.pow(x1, two);
         let x2 = a.pow(x, two);
         let two_x = a.times(two, x);
         let (nx2, n2x) = (a.neg(x2), a.neg(two_x));
         let cancelling = a.sum(&[square, nx2, n2x]);
+        (a, x, x1, cancelling)
+    }
+
+    #[test]
+    fn the_cheaper_of_the_raw_and_the_expanded_form_is_kept() {
+        let (mut a, x, x1, cancelling) = cancelling_square();
+        let (one, five) = (a.int(1), a.int(5));
         let fifth = a.pow(x1, five);
         let (m, f) = cheaper_of_raw_and_expanded(&mut a, vec![cancelling], vec![x]);
         let d = a.minus(m[0], one);

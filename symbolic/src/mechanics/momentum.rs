@@ -532,15 +532,8 @@ mod choice_tests {
     /// other. (On a tie the collected form is kept; the raw one would be as good.)
     #[test]
     fn the_cheaper_of_the_raw_and_the_collected_form_is_kept() {
-        let mut a = ExprArena::new();
-        let [x, _, _] = a.coordinate("x");
-        let (one, two, six) = (a.int(1), a.int(2), a.int(6));
-        let x1 = a.plus(x, one);
-        let square = a.pow(x1, two);
-        let x2 = a.pow(x, two);
-        let two_x = a.times(two, x);
-        let (nx2, n2x) = (a.neg(x2), a.neg(two_x));
-        let cancelling = a.sum(&[square, nx2, n2x]);
+        let (mut a, x, x1, cancelling) = super::super::tests::cancelling_square();
+        let (one, six) = (a.int(1), a.int(6));
         let (m, _) = cheaper_of_raw_and_collected(&mut a, vec![cancelling], vec![x]);
         let d = a.minus(m[0], one);
         assert!(a.is_zero(d), "{m:?}");
