@@ -1,6 +1,8 @@
 //! Lagrange ≡ momentum balance: two independent derivations of every kinematic-form model give
 //! the same generalized accelerations q̈ at random states.
 
+mod common;
+
 use eomgen_symbolic::expr::SymbolKind;
 use eomgen_symbolic::expr::eval::Evaluator;
 use eomgen_symbolic::mechanics::check::solve;
@@ -442,16 +444,7 @@ gravity: [0, -g]
 /// partial angular velocities as Lagrange takes its virtual work.
 #[test]
 fn momentum_balance_takes_a_torque_like_lagrange() {
-    let source = include_str!("../../models/double_pendulum.yaml")
-        .replace(
-            "  g: 10.0    # m/s^2\n",
-            "  g: 10.0    # m/s^2\n  tau0: 3.0  # N*m\n",
-        )
-        .replace(
-            "gravity: [0, -g]\n",
-            "gravity: [0, -g]\ntorques: { motor: { body: fore, value: tau0*cos(sqrt(g/l1)*t) } }\n",
-        );
-    assert!(source.contains("torques:"));
+    let source = common::double_pendulum_with_forearm_torque();
     let d = max_relative_difference(&source, &source, 19);
     assert!(d < 1e-10, "{d}");
 }

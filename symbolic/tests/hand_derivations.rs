@@ -3,6 +3,8 @@
 //! every bundled set agrees, a set that is not there is not compared, and each term the
 //! balances take (gravity, a torque on a body, `form: h_dot`) is needed for the agreement.
 
+mod common;
+
 use eomgen_symbolic::mechanics::check::{CheckReport, check_model};
 
 fn check(source: &str) -> CheckReport {
@@ -293,18 +295,7 @@ fn a_nonlinear_velocity_constraint_is_one_error() {
 /// that take that body, and only those: both balances still agree with Lagrange.
 #[test]
 fn a_torque_on_the_second_body_enters_its_balances() {
-    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../models");
-    let source = std::fs::read_to_string(format!("{dir}/double_pendulum.yaml")).unwrap();
-    let driven = source
-        .replace(
-            "  g: 10.0    # m/s^2\n",
-            "  g: 10.0    # m/s^2\n  tau0: 3.0  # N*m\n",
-        )
-        .replace(
-            "gravity: [0, -g]\n",
-            "gravity: [0, -g]\ntorques: { motor: { body: fore, value: tau0*cos(sqrt(g/l1)*t) } }\n",
-        );
-    assert!(driven.contains("tau0: 3.0") && driven.contains("torques:"));
+    let driven = common::double_pendulum_with_forearm_torque();
     let report = check(&driven);
     let r = residual(&report, "balances").expect("compared");
     assert!(r < 1e-9, "{r}: {:?}", report.notes);
