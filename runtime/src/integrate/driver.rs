@@ -599,6 +599,209 @@ fn correct_state<S: Stepper>(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::integrate::controller::{PiController, StepOutcome, StepSizeController};
+    use crate::integrate::explicit_rk::ExplicitRk;
+    use crate::integrate::tableau::Tableau;
+    use crate::integrate::{DormandPrince54, Integrator, RungeKutta4};
+    use crate::ode::{OdeFn, RhsError};
+
+    /// DOPRI5's stepper over `[t0, t_end]` with the given controller, every step recorded.
+    fn dopri5_run(
+        system: &mut dyn OdeSystem,
+        (t0, t_end): (f64, f64),
+        options: &IntegratorOptions,
+        controller: &mut dyn StepSizeController,
+    ) -> Result<Solution, IntegrationFailure> {
+        let y0 = vec![1.0; system.dim()];
+        let problem = Problem {
+            t0,
+            y0: &y0,
+            t_end,
+            output: &OutputTimes::Steps,
+            options,
+        };
+        let control = Control::Adaptive {
+            controller,
+            error_order: 4,
+        };
+        run(&problem, system, control, |shape| {
+            Ok(ExplicitRk::new(Tableau::dopri5(), shape.dim))
+        })
+    }
+
+    /// Breaks the controller's contract: accepts every step, then proposes 0.1.
+    struct AcceptsEverything;
+
+    impl StepSizeController for AcceptsEverything {
+        fn reset(&mut self) {}
+        fn decide(&mut self, _dt: f64, _error_norm: f64) -> StepOutcome {
+            StepOutcome::Accepted { dt_next: 0.1 }
+        }
+    }
+
+    /// An attempt with a NaN stage is rejected even by a controller that accepts every error
+    /// (`∞` included), and retried at a fifth of its size: the steps of 0.1 run to 0.2, the
+    /// attempt to 0.3 meets a one-off NaN at t = 0.28 (DOPRI5's third stage), the retry ends
+    /// at 0.22, and the run goes on to t = 1 with a finite state, one rejection counted.
+    #[test]
+    fn a_controller_accepting_a_failed_attempt_is_overruled() {
+        let mut fired = false;
+        let mut system = OdeFn::new(1, move |t: f64, y: &[f64], dy: &mut [f64]| {
+            dy[0] = -y[0];
+            if t > 0.25 && !fired {
+                fired = true;
+                dy[0] = f64::NAN;
+            }
+        });
+        let options = IntegratorOptions::default().with_dt(0.1);
+        let solution =
+            dopri5_run(&mut system, (0.0, 1.0), &options, &mut AcceptsEverything).unwrap();
+        assert_eq!(solution.stats.rejected, 1);
+        let t2 = solution.t[2];
+        let failed = (t2 + 0.1) - t2;
+        assert_eq!(solution.t[3], t2 + 0.2 * failed, "{:?}", solution.t);
+        assert_eq!(solution.t[4], solution.t[3] + 0.1, "{:?}", solution.t);
+        assert_eq!(*solution.t.last().unwrap(), 1.0);
+        assert!(solution.y.iter().all(|y| y.is_finite()));
+    }
+
+    /// A system that evaluates normally until `t > 0.25`, then reports a singular mass
+    /// matrix, counting those reports.
+    struct SingularAfter {
+        reports: usize,
+    }
+
+    impl OdeSystem for SingularAfter {
+        fn dim(&self) -> usize {
+            1
+        }
+        fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), RhsError> {
+            if t > 0.25 {
+                self.reports += 1;
+                return Err(RhsError::SingularMassMatrix);
+            }
+            dy[0] = -y[0];
+            Ok(())
+        }
+    }
+
+    /// A failure that a smaller step cannot cure (a singular mass matrix) ends the run at
+    /// the first evaluation that reports it, with no retry, and at that evaluation's time.
+    #[test]
+    fn a_failure_no_smaller_step_cures_ends_the_run_at_once() {
+        let mut system = SingularAfter { reports: 0 };
+        let options = IntegratorOptions::default();
+        let failure = dopri5_run(
+            &mut system,
+            (0.0, 1.0),
+            &options,
+            &mut PiController::dopri5(),
+        )
+        .unwrap_err();
+        assert_eq!(system.reports, 1);
+        match failure.error {
+            IntegrationError::SingularMassMatrix { t } => assert!(t > 0.25 && t < 1.0, "{t}"),
+            other => panic!("{other:?}"),
+        }
+    }
+
+    /// Adaptive and fixed steps over an interval that starts at a negative time (the span,
+    /// not `t_end + t0`, bounds the steps): `ẏ = −y` from t = −1 to 1 ends at `e⁻²`.
+    #[test]
+    fn an_interval_may_start_before_zero() {
+        let exact = (-2.0f64).exp();
+        let options = IntegratorOptions::default()
+            .with_rtol(1e-9)
+            .with_atol(1e-12);
+        let fixed = options.clone().with_fixed_step(true).with_dt(0.01);
+        for (method, options, bound) in [
+            (
+                &mut DormandPrince54::new() as &mut dyn Integrator,
+                &options,
+                1e-8,
+            ),
+            (&mut RungeKutta4::new(), &fixed, 1e-9),
+        ] {
+            let mut system = OdeFn::new(1, |_t: f64, y: &[f64], dy: &mut [f64]| dy[0] = -y[0]);
+            let solution = method
+                .integrate(&mut system, -1.0, &[1.0], 1.0, &OutputTimes::Steps, options)
+                .unwrap();
+            let last = solution.y[solution.y.len() - 1];
+            assert!((last - exact).abs() < bound, "{}: {last}", method.name());
+        }
+    }
+
+    /// A fixed step of 20 rounding units of `t_end` (above the smallest step, 16 units of
+    /// `max(|t|, span)`) is taken: the run stops at its step budget, not for a step too small.
+    #[test]
+    fn a_fixed_step_just_above_the_smallest_is_taken() {
+        let mut system = OdeFn::new(1, |_t: f64, y: &[f64], dy: &mut [f64]| dy[0] = -y[0]);
+        let options = IntegratorOptions::default()
+            .with_fixed_step(true)
+            .with_dt(40.0 * f64::EPSILON)
+            .with_max_steps(5);
+        let failure = RungeKutta4::new()
+            .integrate(&mut system, 1.0, &[1.0], 2.0, &OutputTimes::Steps, &options)
+            .unwrap_err();
+        assert!(
+            matches!(
+                failure.error,
+                IntegrationError::TooManySteps { max_steps: 5, .. }
+            ),
+            "{:?}",
+            failure.error
+        );
+    }
+
+    /// A fixed step that would end 3 rounding units (of `t_end` = 4) short of `t_end` ends
+    /// at `t_end`: one step, no sliver step after it. The step is 2⁻²⁰ long, so the
+    /// allowance is the 8 rounding units of `t_end`, not `10⁻⁹ dt` (one unit).
+    #[test]
+    fn a_step_a_few_rounding_units_short_of_the_end_ends_there() {
+        let t_end = 4.0;
+        let unit = 4.0 * f64::EPSILON;
+        let t0 = t_end - (-20.0f64).exp2();
+        // Exact (Sterbenz): both ends lie within a factor 2 of each other.
+        let dt = (t_end - 3.0 * unit) - t0;
+        let mut system = OdeFn::new(1, |_t: f64, y: &[f64], dy: &mut [f64]| dy[0] = -y[0]);
+        let options = IntegratorOptions::default()
+            .with_fixed_step(true)
+            .with_dt(dt);
+        let solution = RungeKutta4::new()
+            .integrate(
+                &mut system,
+                t0,
+                &[1.0],
+                t_end,
+                &OutputTimes::Steps,
+                &options,
+            )
+            .unwrap();
+        assert_eq!(solution.t, [t0, t_end]);
+    }
+
+    /// A fixed step so much larger than the interval that `span / dt` underflows to 0 still
+    /// takes the one step the interval needs.
+    #[test]
+    fn a_fixed_step_far_larger_than_the_interval_takes_one_step() {
+        let mut system = OdeFn::new(1, |_t: f64, _y: &[f64], dy: &mut [f64]| dy[0] = 1.0);
+        let options = IntegratorOptions::default()
+            .with_fixed_step(true)
+            .with_dt(1e300);
+        let solution = RungeKutta4::new()
+            .integrate(
+                &mut system,
+                0.0,
+                &[0.0],
+                1e-30,
+                &OutputTimes::Steps,
+                &options,
+            )
+            .unwrap();
+        assert_eq!(solution.t, [0.0, 1e-30]);
+        // y' = 1: one RK4 step is exact up to the rounding of its weights' sum.
+        assert!((solution.y[1] / 1e-30 - 1.0).abs() < 1e-15);
+    }
 
     #[test]
     fn min_step_scales_with_t_and_span() {
