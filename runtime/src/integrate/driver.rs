@@ -803,6 +803,57 @@ mod tests {
         assert!((solution.y[1] / 1e-30 - 1.0).abs() < 1e-15);
     }
 
+    /// [`initial_step`] for a DOPRI5 stepper (estimator order 4) started at `(t0, y0)`.
+    fn first_step(
+        f: impl FnMut(f64, &[f64], &mut [f64]),
+        (t0, y0): (f64, &[f64]),
+        (rtol, atol): (f64, f64),
+        dt_max: f64,
+    ) -> f64 {
+        let mut system = OdeFn::new(y0.len(), f);
+        let mut rhs = CheckedRhs::new(&mut system);
+        let mut stepper = ExplicitRk::new(Tableau::dopri5(), y0.len());
+        stepper.reset(&mut rhs, t0, y0).unwrap();
+        let weights = ErrorWeights::uniform(y0.len(), rtol, atol);
+        initial_step(&mut rhs, &stepper, &weights, 4, dt_max, 10.0)
+    }
+
+    /// Hairer's starting step, worked by hand on problems where every quantity has a closed
+    /// form (scale `s = atol + rtol |y₀|`, estimator order q = 4, so `h₁ = (0.01/d)^(1/5)`).
+    /// Each case takes another branch: both norms large; `‖y₀‖` small; `‖F‖` small; `F = 0`
+    /// (the `1e-3 h₀` floor); a time-dependent `F` (the probe's time); `dt_max`.
+    #[test]
+    fn the_initial_step_is_hairers_starting_step() {
+        let close = |a: f64, b: f64| (a - b).abs() <= 1e-12 * b.abs();
+        // ẏ = −y², y₀ = 1: d₀ = d₁ = 1/s, h₀ = 0.01, the probe y₁ = 0.99 gives
+        // d₂ = ((1 − 0.99²)/s) / h₀ = 1.99/s, so h = min(100 h₀, (0.01 s/1.99)^(1/5)).
+        let quadratic = |_t: f64, y: &[f64], dy: &mut [f64]| dy[0] = -y[0] * y[0];
+        let s: f64 = 2e-6;
+        let h = first_step(quadratic, (0.0, &[1.0]), (1e-6, 1e-6), 10.0);
+        assert!(close(h, (0.01 * s / 1.99).powf(0.2)), "{h}");
+        assert_eq!(
+            first_step(quadratic, (0.0, &[1.0]), (1e-6, 1e-6), 0.01),
+            0.01
+        );
+        // ẏ = −2y, y₀ = 1e-12 with atol = 1e-6: d₀ ≈ 1e-6 < 1e-5, so h₀ = 1e-6; d₂ ≈ 4e-6
+        // gives h₁ ≈ 4.8, and h = 100 h₀.
+        let decay = |_t: f64, y: &[f64], dy: &mut [f64]| dy[0] = -2.0 * y[0];
+        let h = first_step(decay, (0.0, &[1e-12]), (1e-6, 1e-6), 10.0);
+        assert!(close(h, 1e-4), "{h}");
+        // ẏ = 1e-12 y: d₁ = 5e-7 < 1e-5, so h₀ = 1e-6 and h = 100 h₀ again.
+        let slow = |_t: f64, y: &[f64], dy: &mut [f64]| dy[0] = 1e-12 * y[0];
+        let h = first_step(slow, (0.0, &[1.0]), (1e-6, 1e-6), 10.0);
+        assert!(close(h, 1e-4), "{h}");
+        // ẏ = 0: d₁ = d₂ = 0, h₀ = 1e-6 and h₁ = max(1e-6, 1e-3 h₀) = 1e-6.
+        let still = |_t: f64, _y: &[f64], dy: &mut [f64]| dy[0] = 0.0;
+        assert_eq!(first_step(still, (0.0, &[1.0]), (1e-6, 1e-6), 10.0), 1e-6);
+        // ẏ = t² from t₀ = 1, y₀ = 1: d₀ = d₁ = 1/s, h₀ = 0.01, and the probe at t = 1.01
+        // gives d₂ = (1.01² − 1) / (s h₀) = 2.01/s.
+        let clock = |t: f64, _y: &[f64], dy: &mut [f64]| dy[0] = t * t;
+        let h = first_step(clock, (1.0, &[1.0]), (1e-6, 1e-6), 10.0);
+        assert!(close(h, (0.01 * s / 2.01).powf(0.2)), "{h}");
+    }
+
     #[test]
     fn min_step_scales_with_t_and_span() {
         assert_eq!(min_step(0.0, 1.0), 16.0 * f64::EPSILON);
