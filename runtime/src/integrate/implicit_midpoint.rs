@@ -409,6 +409,7 @@ impl Integrator for ImplicitMidpoint {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::integrate::{IntegrationError, Integrator, IntegratorOptions, OutputTimes};
     use crate::ode::OdeFn;
 
     /// On ẏ = λy one step is the (1,1) Padé approximant (1 + hλ/2)/(1 − hλ/2) of e^(hλ); the
@@ -432,5 +433,83 @@ mod tests {
         stepper.attempt(&mut rhs, 2.0 * h, &weights, false).unwrap();
         assert_eq!(rhs.jacobian_evals(), 1);
         assert_eq!(rhs.lu_decompositions(), 1);
+    }
+
+    /// `ẏ = λy` with its exact Jacobian.
+    struct LinearDecay(f64);
+
+    impl OdeSystem for LinearDecay {
+        fn dim(&self) -> usize {
+            1
+        }
+        fn rhs(&mut self, _t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), crate::ode::RhsError> {
+            dy[0] = self.0 * y[0];
+            Ok(())
+        }
+        fn jacobian(
+            &mut self,
+            _t: f64,
+            _y: &[f64],
+            jac: &mut [f64],
+        ) -> Result<bool, crate::ode::RhsError> {
+            jac[0] = self.0;
+            Ok(true)
+        }
+    }
+
+    /// On a linear system with its exact Jacobian one Newton correction solves the step
+    /// exactly, so each step costs three evaluations of `F` (the correction's, the check's and
+    /// `F` at the new state, which the dense output and the next guess use; plus `F(t₀)`),
+    /// and the iteration matrix `I − (h/2) J` is factored once per step size: steps of 0.1
+    /// over [0, 1.05] are ten of 0.1 and a last of 0.05, two factorisations. The derivative
+    /// kept at the step's end is `F` there.
+    #[test]
+    fn a_linear_step_takes_one_correction_and_one_factorisation_per_step_size() {
+        let lambda = -3.0;
+        let mut system = LinearDecay(lambda);
+        let options = IntegratorOptions::default()
+            .with_fixed_step(true)
+            .with_dt(0.1);
+        let solution = ImplicitMidpoint::new()
+            .integrate(
+                &mut system,
+                0.0,
+                &[1.0],
+                1.05,
+                &OutputTimes::Steps,
+                &options,
+            )
+            .unwrap();
+        assert_eq!(solution.stats.steps, 11);
+        assert_eq!(solution.stats.rhs_evals, 1 + 3 * 11);
+        assert_eq!(solution.stats.jacobian_evals, 1);
+        assert_eq!(solution.stats.lu_decompositions, 2);
+
+        let mut rhs = CheckedRhs::new(&mut system);
+        let mut stepper = MidpointStepper::new(1, NEWTON_TOLERANCE, MAX_NEWTON_ITERATIONS);
+        stepper.reset(&mut rhs, 0.0, &[1.0]).unwrap();
+        let weights = ErrorWeights::uniform(1, 1e-6, 1e-9);
+        stepper.attempt(&mut rhs, 0.1, &weights, false).unwrap();
+        stepper.accept(&mut rhs).unwrap();
+        assert_eq!(stepper.derivative(), [lambda * stepper.y()[0]]);
+        assert_eq!(rhs.jacobian_evals(), 1);
+    }
+
+    /// `I − (h/2) J` singular with a Jacobian evaluated at the step's start (`ẏ = 4y`,
+    /// `h = 0.5`) is reported as such, at the step's start: a fresh Jacobian cannot help.
+    #[test]
+    fn a_singular_iteration_matrix_with_a_current_jacobian_is_reported() {
+        let mut system = OdeFn::new(1, |_t: f64, y: &[f64], dy: &mut [f64]| dy[0] = 4.0 * y[0]);
+        let options = IntegratorOptions::default()
+            .with_fixed_step(true)
+            .with_dt(0.5);
+        let failure = ImplicitMidpoint::new()
+            .integrate(&mut system, 0.0, &[1.0], 1.0, &OutputTimes::Steps, &options)
+            .unwrap_err();
+        assert!(
+            matches!(failure.error, IntegrationError::SingularIterationMatrix { t } if t == 0.0),
+            "{:?}",
+            failure.error
+        );
     }
 }
