@@ -495,6 +495,86 @@ mod tests {
         assert_eq!(rhs.jacobian_evals(), 1);
     }
 
+    /// A Jacobian kept from an earlier step that fails the iteration is replaced before the
+    /// step is given up: `ẏ = −a(t) y` with `a` switching from 0 to 100 at t = 0.2, steps of
+    /// 0.25. The second step starts with the first step's `J = 0`, with which the simplified
+    /// Newton iteration multiplies its error by `h a / 2 = 12.5`; the fresh `J = −100` solves
+    /// the linear stage equation, and the step ends at the rule's value.
+    #[test]
+    fn a_stale_jacobian_that_fails_is_replaced() {
+        struct Switched;
+        impl OdeSystem for Switched {
+            fn dim(&self) -> usize {
+                1
+            }
+            fn rhs(
+                &mut self,
+                t: f64,
+                y: &[f64],
+                dy: &mut [f64],
+            ) -> Result<(), crate::ode::RhsError> {
+                dy[0] = if t < 0.2 { 0.0 } else { -100.0 * y[0] };
+                Ok(())
+            }
+            fn jacobian(
+                &mut self,
+                t: f64,
+                _y: &[f64],
+                jac: &mut [f64],
+            ) -> Result<bool, crate::ode::RhsError> {
+                jac[0] = if t < 0.2 { 0.0 } else { -100.0 };
+                Ok(true)
+            }
+        }
+        let options = IntegratorOptions::default()
+            .with_fixed_step(true)
+            .with_dt(0.25);
+        let solution = ImplicitMidpoint::new()
+            .integrate(
+                &mut Switched,
+                0.0,
+                &[1.0],
+                0.5,
+                &OutputTimes::Steps,
+                &options,
+            )
+            .unwrap();
+        let rule = (1.0 - 0.25 * 100.0 / 2.0) / (1.0 + 0.25 * 100.0 / 2.0);
+        assert!((solution.y[2] - rule).abs() < 1e-12, "{}", solution.y[2]);
+        assert_eq!(solution.stats.jacobian_evals, 2);
+    }
+
+    /// The Newton options are the ones given: one iteration cannot solve a nonlinear stage
+    /// equation (`ẏ = −y²`), and a loose tolerance stops the iteration sooner than the
+    /// default one.
+    #[test]
+    fn newton_options_are_kept() {
+        let mut system = OdeFn::new(1, |_t: f64, y: &[f64], dy: &mut [f64]| dy[0] = -y[0] * y[0]);
+        let options = IntegratorOptions::default()
+            .with_fixed_step(true)
+            .with_dt(0.1);
+        let mut run = |method: ImplicitMidpoint| {
+            method
+                .clone()
+                .integrate(&mut system, 0.0, &[1.0], 1.0, &OutputTimes::Steps, &options)
+        };
+        let failure = run(ImplicitMidpoint::new().with_max_newton_iterations(1)).unwrap_err();
+        assert!(
+            matches!(
+                failure.error,
+                IntegrationError::NewtonDidNotConverge { iterations: 1, .. }
+            ),
+            "{:?}",
+            failure.error
+        );
+        let tight = run(ImplicitMidpoint::new()).unwrap().stats.rhs_evals;
+        let loose = run(ImplicitMidpoint::new().with_newton_tolerance(1e-3))
+            .unwrap()
+            .stats
+            .rhs_evals;
+        assert!(loose < tight, "{loose} vs {tight}");
+    }
+
     /// `I − (h/2) J` singular with a Jacobian evaluated at the step's start (`ẏ = 4y`,
     /// `h = 0.5`) is reported as such, at the step's start: a fresh Jacobian cannot help.
     #[test]
