@@ -168,6 +168,29 @@ mod tests {
         }
     }
 
+    /// Partial pivoting: a zero leading entry is no obstacle (a permutation), and a tiny one
+    /// is not used as the pivot, which without pivoting multiplies the rounding of the
+    /// second row by 1e20 (`[[1e-20, 1], [1, 1]] x = [1, 2]`, `x ≈ [1, 1]`: without the
+    /// row exchange `x₁` comes out 0).
+    #[test]
+    fn rows_are_exchanged_for_the_largest_pivot() {
+        let cases = [
+            ([0.0, 1.0, 1.0, 0.0], [2.0, 3.0], [3.0, 2.0]),
+            ([1e-20, 1.0, 1.0, 1.0], [1.0, 2.0], [1.0, 1.0]),
+        ];
+        for (values, b, expected) in cases {
+            let mut lu = LuFactors::<f64>::new(2);
+            lu.matrix_mut()
+                .copy_from(&DMatrix::from_row_slice(2, 2, &values));
+            lu.factor().unwrap();
+            let mut x = b.to_vec();
+            lu.solve_in_place(&mut x);
+            for (x, e) in x.iter().zip(expected) {
+                assert!((x - e).abs() < 1e-15, "{values:?}: {x} vs {e}");
+            }
+        }
+    }
+
     #[test]
     fn singular_matrices_are_reported() {
         let mut lu = LuFactors::<f64>::new(2);
