@@ -748,7 +748,7 @@ mod tests {
     use super::*;
     use crate::integrate::tableau::tests::assert_tree_order;
     use crate::ode::OdeFn;
-    use nalgebra::Matrix3;
+    use nalgebra::{Matrix3, Vector3};
 
     /// The Butcher matrix of Radau IIA order 5, from its closed form.
     fn radau_a() -> Matrix3<f64> {
@@ -764,6 +764,124 @@ mod tests {
             (16.0 + s) / 36.0,
             1.0 / 9.0,
         )
+    }
+
+    /// `ẏ = λy` with its exact Jacobian (so that one Newton correction solves the linear
+    /// stage equations to rounding).
+    struct Linear(f64);
+
+    impl OdeSystem for Linear {
+        fn dim(&self) -> usize {
+            1
+        }
+        fn rhs(&mut self, _t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), crate::ode::RhsError> {
+            dy[0] = self.0 * y[0];
+            Ok(())
+        }
+        fn jacobian(
+            &mut self,
+            _t: f64,
+            _y: &[f64],
+            jac: &mut [f64],
+        ) -> Result<bool, crate::ode::RhsError> {
+            jac[0] = self.0;
+            Ok(true)
+        }
+    }
+
+    /// RADAU5's error estimate on `ẏ = λy` from its definition (Hairer–Wanner II, IV.8
+    /// (8.19)–(8.20)), with the stage increments solved directly from
+    /// `(I − hλA) Z = hλ A𝟙 y₀`: `e₀ = (γ/h − λ)⁻¹ (λ y₀ + Σ dₛ Zₛ / h)` and, refined,
+    /// `e₁ = (γ/h − λ)⁻¹ (λ (y₀ + e₀) + Σ dₛ Zₛ / h)`, each over the scale
+    /// `atol + rtol |y₀|` (and at least 1e-10). The estimate is refined only when it is at
+    /// least 1 on the first step or after a rejection.
+    #[test]
+    fn the_error_estimate_is_radau5s() {
+        let (lambda, y0) = (-50.0, 1.0);
+        let k = RadauConstants::new();
+        let estimates = |h: f64, y: f64, tol: f64| -> (f64, f64) {
+            let a = radau_a();
+            let z = (Matrix3::identity() - a * (h * lambda))
+                .lu()
+                .solve(&(a * Vector3::repeat(h * lambda * y)))
+                .unwrap();
+            let dz = (k.dd[0] * z[0] + k.dd[1] * z[1] + k.dd[2] * z[2]) / h;
+            let inverse = 1.0 / (k.gamma / h - lambda);
+            let e0 = inverse * (lambda * y + dz);
+            let e1 = inverse * (lambda * (y + e0) + dz);
+            let scale = tol + tol * y.abs();
+            ((e0 / scale).abs().max(1e-10), (e1 / scale).abs().max(1e-10))
+        };
+        // The same quantities, computed another way: 1e-9 relative leaves room for the
+        // rounding of the Newton iteration and of the two solves (observed 1e-13).
+        let close = |squared: f64, e: f64| (squared.sqrt() - e).abs() <= 1e-9 * e;
+        let mut system = Linear(lambda);
+        let mut rhs = CheckedRhs::new(&mut system);
+        let tight = ErrorWeights::uniform(1, 1e-8, 1e-8);
+        let mut stepper = RadauStepper::new(1, MAX_NEWTON_ITERATIONS);
+        stepper.reset(&mut rhs, 0.0, &[y0]).unwrap();
+        // The first step: e₀ ≥ 1 is refined.
+        let (e0, e1) = estimates(0.1, y0, 1e-8);
+        assert!(e0 >= 1.0 && (e1 - e0).abs() > 1e-3 * e0, "{e0} {e1}");
+        let squared = stepper
+            .attempt(&mut rhs, 0.1, &tight, true)
+            .unwrap()
+            .unwrap();
+        assert!(close(squared, e1));
+        // Rejected and retried: refined again.
+        let (_, e1) = estimates(0.05, y0, 1e-8);
+        let squared = stepper
+            .attempt(&mut rhs, 0.05, &tight, true)
+            .unwrap()
+            .unwrap();
+        assert!(close(squared, e1));
+        // After an accepted step, e₀ ≥ 1 is kept.
+        stepper.accept(&mut rhs).unwrap();
+        let y1 = stepper.y()[0];
+        let (e0, _) = estimates(0.1, y1, 1e-8);
+        assert!(e0 >= 1.0);
+        let squared = stepper
+            .attempt(&mut rhs, 0.15, &tight, true)
+            .unwrap()
+            .unwrap();
+        assert!(close(squared, e0));
+        // The first step with e₀ < 1: kept.
+        let loose = ErrorWeights::uniform(1, 1e-3, 1e-3);
+        let (e0, _) = estimates(0.01, y0, 1e-3);
+        assert!(e0 < 1.0 && e0 > 1e-10, "{e0}");
+        stepper.reset(&mut rhs, 0.0, &[y0]).unwrap();
+        let squared = stepper
+            .attempt(&mut rhs, 0.01, &loose, true)
+            .unwrap()
+            .unwrap();
+        assert!(close(squared, e0));
+    }
+
+    /// The Newton iteration limit given is kept: with fixed steps (which cannot shrink) two
+    /// iterations (the least allowed) cannot solve the nonlinear stage equations of
+    /// `ẏ = −y²` with h = 0.5, while the default limit does.
+    #[test]
+    fn the_newton_limit_is_kept() {
+        use crate::integrate::{IntegrationError, Integrator, IntegratorOptions, OutputTimes};
+        let mut system = OdeFn::new(1, |_t: f64, y: &[f64], dy: &mut [f64]| dy[0] = -y[0] * y[0]);
+        let options = IntegratorOptions::default()
+            .with_fixed_step(true)
+            .with_dt(0.5);
+        let mut run = |method: RadauIIA5| {
+            method
+                .clone()
+                .integrate(&mut system, 0.0, &[1.0], 1.0, &OutputTimes::Steps, &options)
+        };
+        let failure = run(RadauIIA5::new().with_max_newton_iterations(2)).unwrap_err();
+        assert!(
+            matches!(
+                failure.error,
+                IntegrationError::NewtonDidNotConverge { iterations: 2, .. }
+            ),
+            "{:?}",
+            failure.error
+        );
+        assert!(run(RadauIIA5::new()).is_ok());
     }
 
     /// Row sums are the nodes, `Σ b = 1`, the simplifying assumption C(3)

@@ -175,5 +175,8 @@ mod tests {
         assert_eq!(solution.len(), 2);
         assert_eq!(solution.state(1), &[] as &[f64]);
         assert_eq!(solution.iter().count(), 2);
+        // The empty row past the end is not a sample.
+        assert_eq!(solution.try_state(1), Some(&[] as &[f64]));
+        assert_eq!(solution.try_state(2), None);
     }
 }
