@@ -511,6 +511,108 @@ pub fn measured_limit(
 mod tests {
     use super::*;
 
+    /// The stability polynomials read off one step of each explicit method equal the known
+    /// ones (Hairer–Wanner II, §IV.2): `Σₖ≤ₚ zᵏ/k!` for Euler, the midpoint rule and RK4;
+    /// BS3's of degree 3 (its fourth stage has no weight); DP5(4)'s with `r₆ = 1/600`; and
+    /// DOP853's `1/k!` up to `k = 8` (to 1e-14: its coefficients, up to 44 in size, leave
+    /// rounding of a few 1e-16 in each sum; the exact ones to 1e-15). Each equals the tableau's `bᵀAᵏ⁻¹𝟙` where the tableau is
+    /// public, and `order()` counts the leading `1/k!`.
+    #[test]
+    fn polynomials_of_the_methods_are_the_known_ones() {
+        let taylor = |p: usize| -> Vec<f64> {
+            (0..=p)
+                .map(|k| 1.0 / (1..=k).map(|i| i as f64).product::<f64>())
+                .collect()
+        };
+        let mut dopri5 = taylor(5);
+        dopri5.extend([1.0 / 600.0, 0.0]);
+        let mut bs3 = taylor(3);
+        bs3.push(0.0);
+        let cases: [(&mut dyn Integrator, usize, Option<Tableau>, Vec<f64>, usize); 5] = [
+            (
+                &mut ExplicitEuler::new(),
+                1,
+                Some(Tableau::euler()),
+                taylor(1),
+                1,
+            ),
+            (
+                &mut ExplicitMidpoint::new(),
+                2,
+                Some(Tableau::midpoint()),
+                taylor(2),
+                2,
+            ),
+            (
+                &mut RungeKutta4::new(),
+                4,
+                Some(Tableau::rk4()),
+                taylor(4),
+                4,
+            ),
+            (
+                &mut BogackiShampine32::new(),
+                4,
+                Some(Tableau::bs32()),
+                bs3,
+                3,
+            ),
+            (
+                &mut DormandPrince54::new(),
+                7,
+                Some(Tableau::dopri5()),
+                dopri5,
+                5,
+            ),
+        ];
+        for (method, stages, tableau, expected, order) in cases {
+            let name = method.name();
+            let read = StabilityPolynomial::of_method(method, stages).unwrap();
+            assert_eq!(read.coefficients().len(), expected.len(), "{name}");
+            for (r, e) in read.coefficients().iter().zip(&expected) {
+                assert!((r - e).abs() < 1e-15, "{name}: {:?}", read.coefficients());
+            }
+            assert_eq!(read.order(), order, "{name}");
+            let from_tableau = StabilityPolynomial::of_tableau(&tableau.unwrap());
+            for (r, e) in from_tableau.coefficients().iter().zip(&expected) {
+                assert!(
+                    (r - e).abs() < 1e-15,
+                    "{name}: {:?}",
+                    from_tableau.coefficients()
+                );
+            }
+        }
+        let dop853 =
+            StabilityPolynomial::of_method(&mut crate::integrate::DormandPrince853::new(), 12)
+                .unwrap();
+        for (r, e) in dop853.coefficients().iter().zip(taylor(8)) {
+            assert!((r - e).abs() < 1e-14, "dop853: {:?}", dop853.coefficients());
+        }
+        assert_eq!(dop853.order(), 8);
+    }
+
+    /// Horner's evaluation equals the sum `Σ rₖ zᵏ`, at a complex and at a real point.
+    #[test]
+    fn evaluation_is_the_sum_of_the_terms() {
+        let p = StabilityPolynomial::from_coefficients(vec![1.0, -2.0, 0.5, 3.0]);
+        let z = Complex::new(0.3, -0.7);
+        let sum: Complex<f64> = p
+            .coefficients()
+            .iter()
+            .enumerate()
+            .map(|(k, &r)| z.powi(k as i32) * r)
+            .sum();
+        assert!((p.eval(z) - sum).norm() < 1e-15);
+        let x: f64 = -0.7;
+        let sum: f64 = p
+            .coefficients()
+            .iter()
+            .enumerate()
+            .map(|(k, &r)| r * x.powi(k as i32))
+            .sum();
+        assert!((p.eval_real(x) - sum).abs() < 1e-15);
+    }
+
     /// `|R(iy)|²` from the excess polynomial agrees with direct evaluation of `R`.
     #[test]
     fn excess_is_the_squared_modulus_minus_one() {
