@@ -194,9 +194,10 @@ impl StabilityPolynomial {
                 }
             }
         }
+        // r₀² − 1: exactly 0 for r₀ = 1, so only the terms in y¹ … yᵖ need clearing.
         e[0] -= 1.0;
         let p = self.order();
-        for coefficient in e.iter_mut().take(p + 1) {
+        for coefficient in e.iter_mut().take(p + 1).skip(1) {
             *coefficient = 0.0;
         }
         e
@@ -589,6 +590,23 @@ mod tests {
             assert!((r - e).abs() < 1e-14, "dop853: {:?}", dop853.coefficients());
         }
         assert_eq!(dop853.order(), 8);
+    }
+
+    /// RK4's limits: on the imaginary axis `|R(iy)|² = 1 − y⁶/72 + y⁸/576`, so `2√2`
+    /// (the rounding noise of +7e-18 left in its `y⁴` coefficient would make it 0, which is
+    /// why the coefficients up to `yᵖ` are cleared); on the real axis the root of
+    /// `R(−x) = 1`, `x(−1 + x/2 − x²/6 + x³/24) = 0`, found by plain bisection of the cubic:
+    /// 2.7852935634052813. Bogacki–Shampine's real limit, the root of `R(−x) = −1`
+    /// (2.5127453266183286). And `E(y)` of an inconsistent `R = 2 + z` keeps `r₀² − 1 = 3`.
+    #[test]
+    fn limits_of_rk4_and_bs3() {
+        let rk4 = StabilityPolynomial::of_tableau(&Tableau::rk4());
+        assert!((rk4.imaginary_axis_limit() - 8f64.sqrt()).abs() < 1e-12);
+        assert!((rk4.real_axis_limit() - 2.785_293_563_405_281_3).abs() < 1e-12);
+        let bs3 = StabilityPolynomial::of_tableau(&Tableau::bs32());
+        assert!((bs3.real_axis_limit() - 2.512_745_326_618_328_6).abs() < 1e-12);
+        let excess = StabilityPolynomial::from_coefficients(vec![2.0, 1.0]).imaginary_axis_excess();
+        assert_eq!(excess, [3.0, 0.0, 1.0]);
     }
 
     /// Horner's evaluation equals the sum `Σ rₖ zᵏ`, at a complex and at a real point.
