@@ -609,6 +609,36 @@ mod tests {
         assert_eq!(excess, [3.0, 0.0, 1.0]);
     }
 
+    /// Growth limits in closed form: explicit Euler `|1 + iy|² = 1 + y²` and the midpoint
+    /// rule `|R(iy)|² = 1 + y⁴/4` exceed `(1 + g)²` from `y = √(g(2 + g))` and
+    /// `y = (4g(2 + g))^(1/4)`; Euler's `|1 − x|` exceeds `1 + g` from `x = 2 + g`.
+    #[test]
+    fn growth_limits_of_closed_forms() {
+        let euler = StabilityPolynomial::of_tableau(&Tableau::euler());
+        let midpoint = StabilityPolynomial::of_tableau(&Tableau::midpoint());
+        // g = 14 puts the midpoint rule's crossing at 5.47, inside its scanned [0, 2(d + 1)].
+        for g in [0.01_f64, 0.1, 0.5, 14.0] {
+            let level = g * (2.0 + g);
+            let close = |a: f64, b: f64| (a - b).abs() < 1e-12 * b;
+            // Beyond the scanned [0, 2(d + 1)] = [0, 4] (g = 14: 15.0), the bound.
+            let euler_limit = if g < 4.0 { level.sqrt() } else { 4.0 };
+            assert!(
+                close(euler.imaginary_axis_growth_limit(g), euler_limit),
+                "{g}"
+            );
+            assert!(
+                close(
+                    midpoint.imaginary_axis_growth_limit(g),
+                    (4.0 * level).powf(0.25)
+                ),
+                "{g}"
+            );
+            // Its real crossing, 2 + g, is scanned for on [0, 2d² + 1] = [0, 3].
+            let real_limit = (2.0 + g).min(3.0);
+            assert!(close(euler.real_axis_growth_limit(g), real_limit), "{g}");
+        }
+    }
+
     /// Horner's evaluation equals the sum `Σ rₖ zᵏ`, at a complex and at a real point.
     #[test]
     fn evaluation_is_the_sum_of_the_terms() {
