@@ -639,6 +639,15 @@ mod tests {
         }
     }
 
+    /// The scan finds the first of several crossings (`sin 10x = 1/2` at `π/60`, then
+    /// again every `2π/10`), refined to rounding; none gives the bound.
+    #[test]
+    fn the_first_crossing_is_found() {
+        let x = first_crossing(|x| (10.0 * x).sin() - 0.5, 3.0);
+        assert!((x - std::f64::consts::PI / 60.0).abs() < 1e-15, "{x}");
+        assert_eq!(first_crossing(|x| -1.0 - x, 2.0), 2.0);
+    }
+
     /// Horner's evaluation equals the sum `Σ rₖ zᵏ`, at a complex and at a real point.
     #[test]
     fn evaluation_is_the_sum_of_the_terms() {
