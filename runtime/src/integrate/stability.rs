@@ -516,8 +516,9 @@ mod tests {
     /// ones (Hairer–Wanner II, §IV.2): `Σₖ≤ₚ zᵏ/k!` for Euler, the midpoint rule and RK4;
     /// BS3's of degree 3 (its fourth stage has no weight); DP5(4)'s with `r₆ = 1/600`; and
     /// DOP853's `1/k!` up to `k = 8` (to 1e-14: its coefficients, up to 44 in size, leave
-    /// rounding of a few 1e-16 in each sum; the exact ones to 1e-15). Each equals the tableau's `bᵀAᵏ⁻¹𝟙` where the tableau is
-    /// public, and `order()` counts the leading `1/k!`.
+    /// rounding of a few 1e-16 in each sum; the exact ones to 1e-15). Each equals the
+    /// tableau's `bᵀAᵏ⁻¹𝟙` where the tableau is public, and `order()` counts the leading
+    /// `1/k!`.
     #[test]
     fn polynomials_of_the_methods_are_the_known_ones() {
         let taylor = |p: usize| -> Vec<f64> {
@@ -646,6 +647,109 @@ mod tests {
         let x = first_crossing(|x| (10.0 * x).sin() - 0.5, 3.0);
         assert!((x - std::f64::consts::PI / 60.0).abs() < 1e-15, "{x}");
         assert_eq!(first_crossing(|x| -1.0 - x, 2.0), 2.0);
+    }
+
+    /// The implicit methods' stability functions are their steps: one step of size 1 of
+    /// implicit midpoint and of RADAU5 on `ẏ = zy` multiplies `y` by `R(z)` (to 1e-9, the
+    /// Newton iterations' tolerance), for mild and stiff real `z`; at complex `z` they equal
+    /// the Padé forms written over a common denominator, `(2 + z)/(2 − z)` and
+    /// `(60 + 24z + 3z²)/(60 − 36z + 9z² − z³)`.
+    #[test]
+    fn implicit_stability_functions_are_one_step_of_the_methods() {
+        use crate::integrate::{ImplicitMidpoint, RadauIIA5};
+        for z in [-0.5, -3.0, -40.0] {
+            let options = IntegratorOptions::default()
+                .with_fixed_step(true)
+                .with_dt(1.0)
+                .with_rtol(1e-12)
+                .with_atol(1e-14);
+            let mut step = |method: &mut dyn Integrator| {
+                let mut system = OdeFn::new(1, move |_t: f64, y: &[f64], dy: &mut [f64]| {
+                    dy[0] = z * y[0]
+                });
+                method
+                    .integrate(&mut system, 0.0, &[1.0], 1.0, &OutputTimes::Steps, &options)
+                    .unwrap()
+                    .y[1]
+            };
+            let midpoint = step(&mut ImplicitMidpoint::new());
+            let expected = implicit_midpoint_stability(Complex::new(z, 0.0)).re;
+            assert!(
+                (midpoint - expected).abs() < 1e-9 * expected.abs(),
+                "{z}: {midpoint} vs {expected}"
+            );
+            let radau = step(&mut RadauIIA5::new());
+            let expected = radau_iia5_stability(Complex::new(z, 0.0)).re;
+            assert!(
+                (radau - expected).abs() < 1e-9 * expected.abs().max(1e-3),
+                "{z}: {radau} vs {expected}"
+            );
+        }
+        for z in [
+            Complex::new(0.3, 2.0),
+            Complex::new(-5.0, -1.0),
+            Complex::new(0.0, 50.0),
+        ] {
+            let midpoint = (2.0 + z) / (2.0 - z);
+            assert!((implicit_midpoint_stability(z) - midpoint).norm() < 1e-14 * midpoint.norm());
+            let radau =
+                (60.0 + 24.0 * z + 3.0 * z * z) / (60.0 - 36.0 * z + 9.0 * z * z - z * z * z);
+            assert!(
+                (radau_iia5_stability(z) - radau).norm() < 1e-14 * radau.norm(),
+                "{z}"
+            );
+        }
+    }
+
+    /// The measurements against the theory: the per-step amplification of RK4 is `|R(ih)|`
+    /// on the oscillator and `|R(−h)|` on the decay (to rounding over 20 steps); explicit
+    /// Euler's norm on the oscillator after 10 steps of 0.1 is `(1 + h²)^(10/2)`; a growth
+    /// test of 100 steps and threshold 10 detects `δ ≥ 10^(1/100) − 1` and needs
+    /// `⌈ln 10 / ln 1.05⌉ = 48` steps for `δ = 0.05`; and the measured limit of RK4 on the
+    /// oscillator lies just above `2√2`, by the `Δh` at which `|R(ih)| − 1` reaches the
+    /// smallest detected growth.
+    #[test]
+    fn measurements_match_the_theory() {
+        let rk4 = StabilityPolynomial::of_tableau(&Tableau::rk4());
+        for h in [0.5, 2.0, 3.0] {
+            let oscillator =
+                amplification(&mut RungeKutta4::new(), TestEquation::Oscillator, h, 20).unwrap();
+            let expected = rk4.eval(Complex::new(0.0, h)).norm();
+            assert!(
+                (oscillator - expected).abs() < 1e-13,
+                "{h}: {oscillator} vs {expected}"
+            );
+            let decay = amplification(&mut RungeKutta4::new(), TestEquation::Decay, h, 20).unwrap();
+            let expected = rk4.eval_real(-h).abs();
+            assert!(
+                (decay - expected).abs() < 1e-13,
+                "{h}: {decay} vs {expected}"
+            );
+        }
+        let euler = TestEquation::Oscillator
+            .final_norm(&mut ExplicitEuler::new(), 0.1, 10)
+            .unwrap();
+        assert!((euler - 1.01f64.powi(5)).abs() < 1e-14, "{euler}");
+        let test = GrowthTest {
+            steps: 100,
+            threshold: 10.0,
+        };
+        assert!((test.smallest_detected_growth() - (10f64.powf(0.01) - 1.0)).abs() < 1e-15);
+        assert_eq!(test.steps_to_detect(0.05), 48);
+        assert_eq!(test.steps_to_detect(0.0), usize::MAX);
+        let measured = measured_limit(
+            &mut RungeKutta4::new(),
+            TestEquation::Oscillator,
+            &test,
+            1e-6,
+        )
+        .unwrap()
+        .unwrap();
+        let detected = rk4.imaginary_axis_growth_limit(test.smallest_detected_growth());
+        assert!(
+            measured > 8f64.sqrt() && (measured - detected).abs() < 1e-4,
+            "{measured} vs {detected}"
+        );
     }
 
     /// Horner's evaluation equals the sum `Σ rₖ zᵏ`, at a complex and at a real point.
