@@ -707,7 +707,7 @@ mod tests {
     /// test of 100 steps and threshold 10 detects `δ ≥ 10^(1/100) − 1` and needs
     /// `⌈ln 10 / ln 1.05⌉ = 48` steps for `δ = 0.05`; and the measured limit of RK4 on the
     /// oscillator lies just above `2√2`, by the `Δh` at which `|R(ih)| − 1` reaches the
-    /// smallest detected growth.
+    /// smallest detected growth, while RADAU5 (A-stable) has none on the decay.
     #[test]
     fn measurements_match_the_theory() {
         let rk4 = StabilityPolynomial::of_tableau(&Tableau::rk4());
@@ -750,6 +750,14 @@ mod tests {
             measured > 8f64.sqrt() && (measured - detected).abs() < 1e-4,
             "{measured} vs {detected}"
         );
+        // An A-stable method is stable at every h tried, up to 1000.
+        let radau = measured_limit(
+            &mut crate::integrate::RadauIIA5::new(),
+            TestEquation::Decay,
+            &test,
+            1e-6,
+        );
+        assert_eq!(radau.unwrap(), None);
     }
 
     /// Horner's evaluation equals the sum `Σ rₖ zᵏ`, at a complex and at a real point.
