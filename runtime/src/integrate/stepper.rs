@@ -626,6 +626,47 @@ mod tests {
         ));
     }
 
+    /// The difference step scales with `|y|` (`√(ε max(|y|, 1e-5))`): at `y = 10⁶` the
+    /// derivative of `y³`, 3e12, comes out to 1e-5 relative (the rounding of `F ≈ 1e18`
+    /// divided by a step of 1.5e-5), where a step not scaled up with `y` would drown it.
+    #[test]
+    fn the_difference_step_scales_with_the_state() {
+        let mut cube = OdeFn::new(1, |_t: f64, y: &[f64], dy: &mut [f64]| dy[0] = y[0].powi(3));
+        let mut rhs = CheckedRhs::new(&mut cube);
+        let y = [1e6];
+        let f = [1e18];
+        let mut jac = DMatrix::zeros(1, 1);
+        rhs.jacobian(0.0, &y, &f, &mut jac, &mut [0.0], &mut [0.0])
+            .unwrap();
+        assert!((jac[(0, 0)] / 3e12 - 1.0).abs() < 1e-5, "{}", jac[(0, 0)]);
+    }
+
+    /// The cubic Hermite interpolant over a step that does not start at 0 reproduces a
+    /// quadratic: implicit midpoint on `ẏ = 2t` (exact at the steps, the midpoint rule being
+    /// exact for a linear integrand) from t = 1 with steps of 0.5, sampled between steps.
+    #[test]
+    fn hermite_output_reproduces_a_quadratic_on_later_steps() {
+        use crate::integrate::{ImplicitMidpoint, Integrator, IntegratorOptions, OutputTimes};
+        let mut system = OdeFn::new(1, |t: f64, _y: &[f64], dy: &mut [f64]| dy[0] = 2.0 * t);
+        let options = IntegratorOptions::default()
+            .with_fixed_step(true)
+            .with_dt(0.5);
+        let times = vec![1.25, 1.8, 2.6, 2.9];
+        let solution = ImplicitMidpoint::new()
+            .integrate(
+                &mut system,
+                1.0,
+                &[1.0],
+                3.0,
+                &OutputTimes::At(times.clone()),
+                &options,
+            )
+            .unwrap();
+        for (t, y) in times.iter().zip(&solution.y) {
+            assert!((y - t * t).abs() < 1e-13, "t = {t}: {y}");
+        }
+    }
+
     #[test]
     fn newton_failures_are_recoverable_with_their_factor() {
         let newton = StepFailure::Newton {
