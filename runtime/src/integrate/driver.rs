@@ -825,12 +825,12 @@ mod tests {
     #[test]
     fn the_initial_step_is_hairers_starting_step() {
         let close = |a: f64, b: f64| (a - b).abs() <= 1e-12 * b.abs();
-        // ẏ = −y², y₀ = 1: d₀ = d₁ = 1/s, h₀ = 0.01, the probe y₁ = 0.99 gives
-        // d₂ = ((1 − 0.99²)/s) / h₀ = 1.99/s, so h = min(100 h₀, (0.01 s/1.99)^(1/5)).
-        let quadratic = |_t: f64, y: &[f64], dy: &mut [f64]| dy[0] = -y[0] * y[0];
+        // ẏ = −2y², y₀ = 1: d₀ = 1/s, d₁ = 2/s, h₀ = 0.005, the probe y₁ = 0.99 gives
+        // d₂ = ((2 − 2 · 0.99²)/s) / h₀ = 7.96/s, so h = min(100 h₀, (0.01 s/7.96)^(1/5)).
+        let quadratic = |_t: f64, y: &[f64], dy: &mut [f64]| dy[0] = -2.0 * y[0] * y[0];
         let s: f64 = 2e-6;
         let h = first_step(quadratic, (0.0, &[1.0]), (1e-6, 1e-6), 10.0);
-        assert!(close(h, (0.01 * s / 1.99).powf(0.2)), "{h}");
+        assert!(close(h, (0.01 * s / 7.96).powf(0.2)), "{h}");
         assert_eq!(
             first_step(quadratic, (0.0, &[1.0]), (1e-6, 1e-6), 0.01),
             0.01
@@ -839,6 +839,11 @@ mod tests {
         // gives h₁ ≈ 4.8, and h = 100 h₀.
         let decay = |_t: f64, y: &[f64], dy: &mut [f64]| dy[0] = -2.0 * y[0];
         let h = first_step(decay, (0.0, &[1e-12]), (1e-6, 1e-6), 10.0);
+        assert!(close(h, 1e-4), "{h}");
+        // ẏ = 1, y₀ = 1e-12: d₀ ≈ 1e-6 < 1e-5 while d₁ = 1e6, so h₀ = 1e-6 (not
+        // 0.01 d₀/d₁ = 1e-14); d₂ = 0 and h₁ = (1e-8)^(1/5), so h = 100 h₀.
+        let constant = |_t: f64, _y: &[f64], dy: &mut [f64]| dy[0] = 1.0;
+        let h = first_step(constant, (0.0, &[1e-12]), (1e-6, 1e-6), 10.0);
         assert!(close(h, 1e-4), "{h}");
         // ẏ = 1e-12 y: d₁ = 5e-7 < 1e-5, so h₀ = 1e-6 and h = 100 h₀ again.
         let slow = |_t: f64, y: &[f64], dy: &mut [f64]| dy[0] = 1e-12 * y[0];
