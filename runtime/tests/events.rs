@@ -256,6 +256,41 @@ fn zeros_are_located_in_few_evaluations() {
     }
 }
 
+/// An event at the same instant as a terminal one is recorded with it (a later one is not):
+/// `y − 0.5` (terminal) and `2y − 1` cross together, `y − 0.7` after.
+#[test]
+fn events_at_the_terminal_instant_are_recorded() {
+    let mut clock = OdeFn::new(1, |_t: f64, _y: &[f64], dy: &mut [f64]| dy[0] = 1.0);
+    let specs = vec![
+        EventSpec::new("stop", EventDirection::Rising, true),
+        EventSpec::new("same", EventDirection::Rising, false),
+        EventSpec::new("later", EventDirection::Rising, false),
+    ];
+    let mut system = WithEvents::new(
+        &mut clock,
+        specs,
+        |_: &mut _, _t, y: &[f64], g: &mut [f64]| {
+            g[0] = y[0] - 0.5;
+            g[1] = 2.0 * y[0] - 1.0;
+            g[2] = y[0] - 0.7;
+            Ok(())
+        },
+    );
+    let options = IntegratorOptions::default().with_dt(1.0);
+    let solution = ExplicitEuler::new()
+        .integrate(&mut system, 0.0, &[0.0], 1.0, &OutputTimes::Steps, &options)
+        .unwrap();
+    let found: Vec<(&str, f64)> = solution
+        .events
+        .iter()
+        .map(|e| (e.name.as_str(), e.t))
+        .collect();
+    assert_eq!(found.len(), 2, "{found:?}");
+    assert_eq!((found[0].0, found[1].0), ("stop", "same"));
+    assert_eq!(found[0].1, found[1].1);
+    assert_eq!(solution.terminated_by_event, Some(0));
+}
+
 /// Several zeros in one step come out in time order, whatever the order of the functions.
 #[test]
 fn zeros_within_one_step_are_ordered() {
