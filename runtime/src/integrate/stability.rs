@@ -597,8 +597,9 @@ mod tests {
     /// (the rounding noise of +7e-18 left in its `y⁴` coefficient would make it 0, which is
     /// why the coefficients up to `yᵖ` are cleared); on the real axis the root of
     /// `R(−x) = 1`, `x(−1 + x/2 − x²/6 + x³/24) = 0`, found by plain bisection of the cubic:
-    /// 2.7852935634052813. Bogacki–Shampine's real limit, the root of `R(−x) = −1`
-    /// (2.5127453266183286). And `E(y)` of an inconsistent `R = 2 + z` keeps `r₀² − 1 = 3`.
+    /// 2.7852935634052813. Bogacki–Shampine's and DP5(4)'s real limits, where `R(−x)`
+    /// reaches −1 and +1 (2.5127453266183286 and 3.306567892634946, by scan and bisection of
+    /// the polynomials in plain code). And `E(y)` of an inconsistent `R = 2 + z` keeps `r₀² − 1 = 3`.
     #[test]
     fn limits_of_rk4_and_bs3() {
         let rk4 = StabilityPolynomial::of_tableau(&Tableau::rk4());
@@ -606,6 +607,9 @@ mod tests {
         assert!((rk4.real_axis_limit() - 2.785_293_563_405_281_3).abs() < 1e-12);
         let bs3 = StabilityPolynomial::of_tableau(&Tableau::bs32());
         assert!((bs3.real_axis_limit() - 2.512_745_326_618_328_6).abs() < 1e-12);
+        // DP5(4)'s lies beyond 3 (the scan covers [0, 2 · 6² + 1] for its degree 6).
+        let dopri5 = StabilityPolynomial::of_tableau(&Tableau::dopri5());
+        assert!((dopri5.real_axis_limit() - 3.306_567_892_634_946).abs() < 1e-12);
         let excess = StabilityPolynomial::from_coefficients(vec![2.0, 1.0]).imaginary_axis_excess();
         assert_eq!(excess, [3.0, 0.0, 1.0]);
     }
