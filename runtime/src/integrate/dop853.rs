@@ -964,8 +964,8 @@ mod tests {
     /// `y + h Σ bᵢ kᵢ`, `e₅ = Σ ERᵢ kᵢ`, `e₃ = Σ bᵢ kᵢ − Σ BHHⱼ kⱼ`, scales
     /// `sk = atol + rtol · max(|y|, |y₁|)`, `E₅² = Σ (e₅/sk)²`, `E₃² = Σ (e₃/sk)²` and
     /// `err = |h| E₅² / √(n (E₅² + 0.01 E₃²))`.
-    fn plain_step(
-        f: &mut dyn FnMut(f64, &[f64], &mut [f64]),
+    fn plain_step<F: FnMut(f64, &[f64], &mut [f64])>(
+        f: &mut F,
         t: f64,
         y: &[f64],
         h: f64,
