@@ -194,8 +194,8 @@ fn terminal_events_stop_the_integration() {
     }
 }
 
-/// Zeros located by Brent's method: each root to a few rounding units, and the evaluations
-/// of `g` it takes.
+/// Zeros located by Brent's method: each root to 4ε (absolute), and the evaluations of `g`
+/// it takes.
 ///
 /// `g(y)` over one Euler step of `y' = 1` on [0, 1], whose linear dense output is `y = t`
 /// exactly, for simple roots of smooth functions, a steep one, a jump and a square-root

@@ -591,8 +591,10 @@ impl Stepper for Dop853Stepper {
         // logarithm).
         // (h E₅²)² / (n D) without forming (h E₅²)², which could overflow first. Every stage
         // with a weight in either estimate has one in the candidate, which is finite, so a
-        // non-finite result comes from an error where the scale is zero, or from overflow:
-        // the controller rejects it and shrinks the step.
+        // non-finite result comes from an error where the scale is zero, or from E₅²
+        // overflowing: the controller rejects it and shrinks the step. (E₃² overflowing
+        // alone, which needs atol ≲ 1e-150 with rtol = 0, makes D infinite and the estimate
+        // 0, as in dop853.f.)
         Ok(Some(h * h * fifth * (fifth / (n as f64 * denominator))))
     }
 
@@ -1008,7 +1010,8 @@ mod tests {
     /// growing part of them as `h` shrinks (observed 1e-7 to 8e-6 here); every change to the
     /// formula moves it by a factor. The observed order `log₂` of successive ratios within
     /// 0.5 of 8 (observed 7.69–8.06 from h = 0.1 to 0.025, the next terms of the expansion
-    /// still showing), while dropping `h²`, `E₃` or `n` from the formula moves it to 6 or 11.
+    /// still showing), while dropping `h` or `E₃` from the formula, or its division, moves
+    /// it to 7, 6 or 11.
     #[test]
     fn the_error_estimate_is_dop853s_and_of_order_8() {
         for dim in [2, 3] {

@@ -820,8 +820,9 @@ mod tests {
 
     /// Hairer's starting step, worked by hand on problems where every quantity has a closed
     /// form (scale `s = atol + rtol |y₀|`, estimator order q = 4, so `h₁ = (0.01/d)^(1/5)`).
-    /// Each case takes another branch: both norms large; `‖y₀‖` small; `‖F‖` small; `F = 0`
-    /// (the `1e-3 h₀` floor); a time-dependent `F` (the probe's time); `dt_max`.
+    /// Each case takes another branch: both norms large; `‖y₀‖` small; `‖F‖` small; `‖F‖`
+    /// infinite with a failing probe; `F = 0` (the 1e-6 floor of `h₁`); a time-dependent `F`
+    /// (the probe's time); `dt_max`.
     #[test]
     fn the_initial_step_is_hairers_starting_step() {
         let close = |a: f64, b: f64| (a - b).abs() <= 1e-12 * b.abs();
@@ -849,6 +850,16 @@ mod tests {
         let slow = |_t: f64, y: &[f64], dy: &mut [f64]| dy[0] = 1e-12 * y[0];
         let h = first_step(slow, (0.0, &[1.0]), (1e-6, 1e-6), 10.0);
         assert!(close(h, 1e-4), "{h}");
+        // A component at 0 with atol = 0 and F ≠ 0: zero scale, d₁ = ∞, so 0.01 d₀/d₁ = 0
+        // is replaced by h₀ = 1e-6; a probe that fails (F is NaN after t₀) returns h₀.
+        let stuck = |t: f64, _y: &[f64], dy: &mut [f64]| {
+            dy[0] = 1.0;
+            dy[1] = if t > 0.0 { f64::NAN } else { 1.0 };
+        };
+        assert_eq!(
+            first_step(stuck, (0.0, &[1.0, 0.0]), (1e-6, 0.0), 10.0),
+            1e-6
+        );
         // ẏ = 0: d₁ = d₂ = 0, h₀ = 1e-6 and h₁ = max(1e-6, 1e-3 h₀) = 1e-6.
         let still = |_t: f64, _y: &[f64], dy: &mut [f64]| dy[0] = 0.0;
         assert_eq!(first_step(still, (0.0, &[1.0]), (1e-6, 1e-6), 10.0), 1e-6);

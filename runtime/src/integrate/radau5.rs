@@ -828,7 +828,7 @@ mod tests {
             .unwrap()
             .unwrap();
         assert!(close(squared, e1));
-        // Rejected and retried: refined again.
+        // Rejected and retried before any acceptance: refined again.
         let (_, e1) = estimates(0.05, y0, 1e-8);
         let squared = stepper
             .attempt(&mut rhs, 0.05, &tight, true)
@@ -845,6 +845,14 @@ mod tests {
             .unwrap()
             .unwrap();
         assert!(close(squared, e0));
+        // That attempt rejected and retried, after an accepted step: refined.
+        let (e0, e1) = estimates(0.08, y1, 1e-8);
+        assert!(e0 >= 1.0);
+        let squared = stepper
+            .attempt(&mut rhs, 0.05 + 0.08, &tight, true)
+            .unwrap()
+            .unwrap();
+        assert!(close(squared, e1));
         // The first step with e₀ < 1: kept.
         let loose = ErrorWeights::uniform(1, 1e-3, 1e-3);
         let (e0, _) = estimates(0.01, y0, 1e-3);
