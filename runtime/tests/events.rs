@@ -234,12 +234,17 @@ fn zeros_are_located_in_few_evaluations() {
     for (name, g, root, most) in cases {
         let mut clock = OdeFn::new(1, |_t: f64, _y: &[f64], dy: &mut [f64]| dy[0] = 1.0);
         let evaluations = std::cell::Cell::new(0);
+        let outside = std::cell::Cell::new(0);
         let specs = vec![EventSpec::new("zero", EventDirection::Rising, false)];
         let mut system = WithEvents::new(
             &mut clock,
             specs,
-            |_: &mut _, _t, y: &[f64], values: &mut [f64]| {
+            |_: &mut _, t: f64, y: &[f64], values: &mut [f64]| {
                 evaluations.set(evaluations.get() + 1);
+                // Every trial point of the search lies in the step (the bracket).
+                if !(0.0..=1.0).contains(&t) {
+                    outside.set(outside.get() + 1);
+                }
                 values[0] = g(y[0]);
                 Ok(())
             },
@@ -250,9 +255,66 @@ fn zeros_are_located_in_few_evaluations() {
             .unwrap();
         let t = solution.events[0].t;
         assert!((t - root).abs() < 4.0 * f64::EPSILON, "{name}: {t}");
+        assert_eq!(outside.get(), 0, "{name}: trial points outside the step");
         // At the start and at the step's end, then the search.
         let search = evaluations.get() - 2;
         assert!(search <= most, "{name}: {search} evaluations");
+    }
+}
+
+/// Brent's search keeps every trial point inside the step and finds the root, on 3,000
+/// functions with one simple root `r ∈ [0.02, 0.98]` in one Euler step of `y' = 1` (so
+/// `y = t`), drawn from four families by a fixed linear congruential sequence: `eᵏᵗ − eᵏʳ`
+/// (steep and convex), `(t − r)(0.01 + a (t − s)²)` (nearly flat beside the root),
+/// `atan(k (t − r)) + 0.3 a (t − r)³`, and `sign(t − r) |t − r|^p` with `p ∈ [0.1, 3.1]`
+/// (infinite or zero slope at the root). The root to 1e-9: the search ends on a bracket a
+/// few rounding units wide around the sign change, or where `g` rounds to 0 (within about
+/// 1e-15 of `r` for these families), so 1e-9 only leaves margin; a trial point outside the
+/// step, or a root elsewhere, is what a broken safeguard produces.
+#[test]
+fn brent_keeps_its_trial_points_in_the_step() {
+    let mut state: u64 = 12345;
+    let mut uniform = move || {
+        state = state
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    for case in 0..3000 {
+        let r = 0.02 + 0.96 * uniform();
+        let k = 1.0 + 60.0 * uniform();
+        let (a, s) = (50.0 * uniform(), uniform());
+        let family = case % 4;
+        let g = move |t: f64| match family {
+            0 => (k * t).exp() - (k * r).exp(),
+            1 => (t - r) * (0.01 + a * (t - s).powi(2)),
+            2 => (k * (t - r)).atan() + 0.3 * a * (t - r).powi(3),
+            _ => (t - r).signum() * (t - r).abs().powf(0.1 + 3.0 * s),
+        };
+        let mut clock = OdeFn::new(1, |_t: f64, _y: &[f64], dy: &mut [f64]| dy[0] = 1.0);
+        let outside = std::cell::Cell::new(0);
+        let specs = vec![EventSpec::new("zero", EventDirection::Rising, false)];
+        let mut system = WithEvents::new(
+            &mut clock,
+            specs,
+            |_: &mut _, t: f64, y: &[f64], values: &mut [f64]| {
+                if !(0.0..=1.0).contains(&t) {
+                    outside.set(outside.get() + 1);
+                }
+                values[0] = g(y[0]);
+                Ok(())
+            },
+        );
+        let options = IntegratorOptions::default().with_dt(1.0);
+        let solution = ExplicitEuler::new()
+            .integrate(&mut system, 0.0, &[0.0], 1.0, &OutputTimes::Steps, &options)
+            .unwrap();
+        let t = solution.events[0].t;
+        assert!(
+            (t - r).abs() < 1e-9,
+            "case {case} (family {family}): {t} vs {r}"
+        );
+        assert_eq!(outside.get(), 0, "case {case} (family {family})");
     }
 }
 
