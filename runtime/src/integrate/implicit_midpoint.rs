@@ -484,6 +484,23 @@ mod tests {
         assert_eq!(solution.stats.rhs_evals, 1 + 3 * 11);
         assert_eq!(solution.stats.jacobian_evals, 1);
         assert_eq!(solution.stats.lu_decompositions, 2);
+        // The same at steps of 1e-6 (ten of them and a last of 5e-7): the test of "the same
+        // step" is relative to `h`, so a halved small step is still a new factorisation.
+        let small = IntegratorOptions::default()
+            .with_fixed_step(true)
+            .with_dt(1e-6);
+        let solution = ImplicitMidpoint::new()
+            .integrate(
+                &mut system,
+                0.0,
+                &[1.0],
+                1.05e-5,
+                &OutputTimes::Steps,
+                &small,
+            )
+            .unwrap();
+        assert_eq!(solution.stats.steps, 11);
+        assert_eq!(solution.stats.lu_decompositions, 2);
 
         let mut rhs = CheckedRhs::new(&mut system);
         let mut stepper = MidpointStepper::new(1, NEWTON_TOLERANCE, MAX_NEWTON_ITERATIONS);

@@ -865,6 +865,29 @@ mod tests {
         assert!(close(squared, e0));
     }
 
+    /// One factorisation per step size, at small steps too: fixed steps of 1e-6 over
+    /// [0, 1.5e-6] are one of 1e-6 and one of 5e-7, two factorisations (the test of "the same
+    /// step" is relative to `h`).
+    #[test]
+    fn a_new_small_step_is_factored_anew() {
+        use crate::integrate::{Integrator, IntegratorOptions, OutputTimes};
+        let options = IntegratorOptions::default()
+            .with_fixed_step(true)
+            .with_dt(1e-6);
+        let solution = RadauIIA5::new()
+            .integrate(
+                &mut Linear(-50.0),
+                0.0,
+                &[1.0],
+                1.5e-6,
+                &OutputTimes::Steps,
+                &options,
+            )
+            .unwrap();
+        assert_eq!(solution.stats.steps, 2);
+        assert_eq!(solution.stats.lu_decompositions, 2);
+    }
+
     /// The Newton iteration limit given is kept: with fixed steps (which cannot shrink) two
     /// iterations (the least allowed) cannot solve the nonlinear stage equations of
     /// `ẏ = −y²` with h = 0.5, while the default limit does.
