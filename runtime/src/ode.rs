@@ -380,8 +380,26 @@ pub struct Event {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
+
+    /// `ẏ = λy` with its exact Jacobian, for tests of the implicit methods (one Newton
+    /// correction then solves a linear stage equation to rounding).
+    pub(crate) struct Linear(pub(crate) f64);
+
+    impl OdeSystem for Linear {
+        fn dim(&self) -> usize {
+            1
+        }
+        fn rhs(&mut self, _t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), RhsError> {
+            dy[0] = self.0 * y[0];
+            Ok(())
+        }
+        fn jacobian(&mut self, _t: f64, _y: &[f64], jac: &mut [f64]) -> Result<bool, RhsError> {
+            jac[0] = self.0;
+            Ok(true)
+        }
+    }
 
     #[test]
     fn directions_count_the_right_crossings() {

@@ -411,6 +411,7 @@ mod tests {
     use super::*;
     use crate::integrate::{IntegrationError, Integrator, IntegratorOptions, OutputTimes};
     use crate::ode::OdeFn;
+    use crate::ode::tests::Linear;
 
     /// On ẏ = λy one step is the (1,1) Padé approximant (1 + hλ/2)/(1 − hλ/2) of e^(hλ); the
     /// differenced Jacobian is exact to about 1e-8 here, so Newton converges in a few
@@ -435,28 +436,6 @@ mod tests {
         assert_eq!(rhs.lu_decompositions(), 1);
     }
 
-    /// `ẏ = λy` with its exact Jacobian.
-    struct LinearDecay(f64);
-
-    impl OdeSystem for LinearDecay {
-        fn dim(&self) -> usize {
-            1
-        }
-        fn rhs(&mut self, _t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), crate::ode::RhsError> {
-            dy[0] = self.0 * y[0];
-            Ok(())
-        }
-        fn jacobian(
-            &mut self,
-            _t: f64,
-            _y: &[f64],
-            jac: &mut [f64],
-        ) -> Result<bool, crate::ode::RhsError> {
-            jac[0] = self.0;
-            Ok(true)
-        }
-    }
-
     /// On a linear system with its exact Jacobian one Newton correction solves the step
     /// exactly, so each step costs three evaluations of `F` (the correction's, the check's and
     /// `F` at the new state, which the dense output and the next guess use; plus `F(t₀)`),
@@ -466,7 +445,7 @@ mod tests {
     #[test]
     fn a_linear_step_takes_one_correction_and_one_factorisation_per_step_size() {
         let lambda = -3.0;
-        let mut system = LinearDecay(lambda);
+        let mut system = Linear(lambda);
         let options = IntegratorOptions::default()
             .with_fixed_step(true)
             .with_dt(0.1);

@@ -748,6 +748,7 @@ mod tests {
     use super::*;
     use crate::integrate::tableau::tests::assert_tree_order;
     use crate::ode::OdeFn;
+    use crate::ode::tests::Linear;
     use nalgebra::{Matrix3, Vector3};
 
     /// The Butcher matrix of Radau IIA order 5, from its closed form.
@@ -764,29 +765,6 @@ mod tests {
             (16.0 + s) / 36.0,
             1.0 / 9.0,
         )
-    }
-
-    /// `ẏ = λy` with its exact Jacobian (so that one Newton correction solves the linear
-    /// stage equations to rounding).
-    struct Linear(f64);
-
-    impl OdeSystem for Linear {
-        fn dim(&self) -> usize {
-            1
-        }
-        fn rhs(&mut self, _t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), crate::ode::RhsError> {
-            dy[0] = self.0 * y[0];
-            Ok(())
-        }
-        fn jacobian(
-            &mut self,
-            _t: f64,
-            _y: &[f64],
-            jac: &mut [f64],
-        ) -> Result<bool, crate::ode::RhsError> {
-            jac[0] = self.0;
-            Ok(true)
-        }
     }
 
     /// RADAU5's error estimate on `ẏ = λy` from its definition (Hairer–Wanner II, IV.8
