@@ -194,6 +194,43 @@ fn terminal_events_stop_the_integration() {
     }
 }
 
+/// One explicit Euler step of the clock `y' = 1` over [0, 1] (so `y = t` exactly, its
+/// dense output linear) with the events `specs` whose values `g(t, y)` computes.
+fn one_step_of_the_clock(
+    specs: Vec<EventSpec>,
+    g: impl FnMut(f64, &[f64], &mut [f64]),
+) -> Solution {
+    let mut g = g;
+    let mut clock = OdeFn::new(1, |_t: f64, _y: &[f64], dy: &mut [f64]| dy[0] = 1.0);
+    let mut system = WithEvents::new(
+        &mut clock,
+        specs,
+        |_: &mut _, t: f64, y: &[f64], values: &mut [f64]| {
+            g(t, y, values);
+            Ok(())
+        },
+    );
+    let options = IntegratorOptions::default().with_dt(1.0);
+    ExplicitEuler::new()
+        .integrate(&mut system, 0.0, &[0.0], 1.0, &OutputTimes::Steps, &options)
+        .unwrap()
+}
+
+/// The located zero of `g(y)` over [`one_step_of_the_clock`], the number of evaluations of
+/// `g` after the two at the step's ends, and how many of them fell outside the step.
+fn located_zero(g: impl Fn(f64) -> f64) -> (f64, usize, usize) {
+    let (mut evaluations, mut outside) = (0, 0);
+    let specs = vec![EventSpec::new("zero", EventDirection::Rising, false)];
+    let solution = one_step_of_the_clock(specs, |t, y, values| {
+        evaluations += 1;
+        if !(0.0..=1.0).contains(&t) {
+            outside += 1;
+        }
+        values[0] = g(y[0]);
+    });
+    (solution.events[0].t, evaluations - 2, outside)
+}
+
 /// Zeros located by Brent's method: each root to 4ε (absolute), and the evaluations of `g`
 /// it takes.
 ///
@@ -232,32 +269,9 @@ fn zeros_are_located_in_few_evaluations() {
         ),
     ];
     for (name, g, root, most) in cases {
-        let mut clock = OdeFn::new(1, |_t: f64, _y: &[f64], dy: &mut [f64]| dy[0] = 1.0);
-        let evaluations = std::cell::Cell::new(0);
-        let outside = std::cell::Cell::new(0);
-        let specs = vec![EventSpec::new("zero", EventDirection::Rising, false)];
-        let mut system = WithEvents::new(
-            &mut clock,
-            specs,
-            |_: &mut _, t: f64, y: &[f64], values: &mut [f64]| {
-                evaluations.set(evaluations.get() + 1);
-                // Every trial point of the search lies in the step (the bracket).
-                if !(0.0..=1.0).contains(&t) {
-                    outside.set(outside.get() + 1);
-                }
-                values[0] = g(y[0]);
-                Ok(())
-            },
-        );
-        let options = IntegratorOptions::default().with_dt(1.0);
-        let solution = ExplicitEuler::new()
-            .integrate(&mut system, 0.0, &[0.0], 1.0, &OutputTimes::Steps, &options)
-            .unwrap();
-        let t = solution.events[0].t;
+        let (t, search, outside) = located_zero(g);
         assert!((t - root).abs() < 4.0 * f64::EPSILON, "{name}: {t}");
-        assert_eq!(outside.get(), 0, "{name}: trial points outside the step");
-        // At the start and at the step's end, then the search.
-        let search = evaluations.get() - 2;
+        assert_eq!(outside, 0, "{name}: trial points outside the step");
         assert!(search <= most, "{name}: {search} evaluations");
     }
 }
@@ -291,30 +305,12 @@ fn brent_keeps_its_trial_points_in_the_step() {
             2 => (k * (t - r)).atan() + 0.3 * a * (t - r).powi(3),
             _ => (t - r).signum() * (t - r).abs().powf(0.1 + 3.0 * s),
         };
-        let mut clock = OdeFn::new(1, |_t: f64, _y: &[f64], dy: &mut [f64]| dy[0] = 1.0);
-        let outside = std::cell::Cell::new(0);
-        let specs = vec![EventSpec::new("zero", EventDirection::Rising, false)];
-        let mut system = WithEvents::new(
-            &mut clock,
-            specs,
-            |_: &mut _, t: f64, y: &[f64], values: &mut [f64]| {
-                if !(0.0..=1.0).contains(&t) {
-                    outside.set(outside.get() + 1);
-                }
-                values[0] = g(y[0]);
-                Ok(())
-            },
-        );
-        let options = IntegratorOptions::default().with_dt(1.0);
-        let solution = ExplicitEuler::new()
-            .integrate(&mut system, 0.0, &[0.0], 1.0, &OutputTimes::Steps, &options)
-            .unwrap();
-        let t = solution.events[0].t;
+        let (t, _, outside) = located_zero(g);
         assert!(
             (t - r).abs() < 1e-9,
             "case {case} (family {family}): {t} vs {r}"
         );
-        assert_eq!(outside.get(), 0, "case {case} (family {family})");
+        assert_eq!(outside, 0, "case {case} (family {family})");
     }
 }
 
@@ -322,26 +318,16 @@ fn brent_keeps_its_trial_points_in_the_step() {
 /// `y − 0.5` (terminal) and `2y − 1` cross together, `y − 0.7` after.
 #[test]
 fn events_at_the_terminal_instant_are_recorded() {
-    let mut clock = OdeFn::new(1, |_t: f64, _y: &[f64], dy: &mut [f64]| dy[0] = 1.0);
     let specs = vec![
         EventSpec::new("stop", EventDirection::Rising, true),
         EventSpec::new("same", EventDirection::Rising, false),
         EventSpec::new("later", EventDirection::Rising, false),
     ];
-    let mut system = WithEvents::new(
-        &mut clock,
-        specs,
-        |_: &mut _, _t, y: &[f64], g: &mut [f64]| {
-            g[0] = y[0] - 0.5;
-            g[1] = 2.0 * y[0] - 1.0;
-            g[2] = y[0] - 0.7;
-            Ok(())
-        },
-    );
-    let options = IntegratorOptions::default().with_dt(1.0);
-    let solution = ExplicitEuler::new()
-        .integrate(&mut system, 0.0, &[0.0], 1.0, &OutputTimes::Steps, &options)
-        .unwrap();
+    let solution = one_step_of_the_clock(specs, |_t, y, g| {
+        g[0] = y[0] - 0.5;
+        g[1] = 2.0 * y[0] - 1.0;
+        g[2] = y[0] - 0.7;
+    });
     let found: Vec<(&str, f64)> = solution
         .events
         .iter()
@@ -356,24 +342,14 @@ fn events_at_the_terminal_instant_are_recorded() {
 /// Several zeros in one step come out in time order, whatever the order of the functions.
 #[test]
 fn zeros_within_one_step_are_ordered() {
-    let mut clock = OdeFn::new(1, |_t: f64, _y: &[f64], dy: &mut [f64]| dy[0] = 1.0);
     let specs = vec![
         EventSpec::new("late", EventDirection::Rising, false),
         EventSpec::new("early", EventDirection::Rising, false),
     ];
-    let mut system = WithEvents::new(
-        &mut clock,
-        specs,
-        |_: &mut _, _t, y: &[f64], g: &mut [f64]| {
-            g[0] = y[0] - 0.7;
-            g[1] = y[0] - 0.2;
-            Ok(())
-        },
-    );
-    let options = IntegratorOptions::default().with_dt(1.0);
-    let solution = ExplicitEuler::new()
-        .integrate(&mut system, 0.0, &[0.0], 1.0, &OutputTimes::Steps, &options)
-        .unwrap();
+    let solution = one_step_of_the_clock(specs, |_t, y, g| {
+        g[0] = y[0] - 0.7;
+        g[1] = y[0] - 0.2;
+    });
     let found: Vec<(&str, f64)> = solution
         .events
         .iter()
