@@ -38,9 +38,9 @@ pub use frf::{
 pub use integrate::{
     BogackiShampine32, DormandPrince54, DormandPrince853, Event, EventDirection, EventSpec,
     ExplicitEuler, ExplicitMidpoint, ImplicitMidpoint, IntegrationError, IntegrationFailure,
-    Integrator, IntegratorOptions, OutputTimes, PiController, PredictiveController, RadauIIA5,
-    RungeKutta4, Solution, Stats, StepOutcome, StepSizeController, StormerVerlet, SymplecticEuler,
-    Tableau, Tolerance,
+    Integrator, IntegratorOptions, NewtonWork, OutputTimes, PiController, PredictiveController,
+    RadauIIA5, RungeKutta4, Solution, Stats, StepOutcome, StepSizeController, StormerVerlet,
+    SymplecticEuler, Tableau, Tolerance,
 };
 pub use linalg::{solve_spd, solve_spd_in_place};
 pub use modal::{

@@ -45,6 +45,37 @@ pub trait StepSizeController {
     fn decide_squared(&mut self, dt: f64, error_norm_squared: f64) -> StepOutcome {
         self.decide(dt, error_norm_squared.sqrt())
     }
+
+    /// [`decide_squared`](Self::decide_squared) for a step of an implicit method whose
+    /// Newton iteration did `newton`'s work; the integrators call this one for such methods.
+    ///
+    /// The default ignores `newton`. [`PredictiveController`] uses it as RADAU5 does: it
+    /// lowers its safety factor after many iterations and holds the step size only when the
+    /// factorised matrices can be kept.
+    fn decide_after_newton(
+        &mut self,
+        dt: f64,
+        error_norm_squared: f64,
+        newton: NewtonWork,
+    ) -> StepOutcome {
+        let _ = newton;
+        self.decide_squared(dt, error_norm_squared)
+    }
+}
+
+/// What the Newton iteration of an implicit method did on an attempted step, for
+/// [`StepSizeController::decide_after_newton`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub struct NewtonWork {
+    /// Newton iterations of the attempt (`≥ 1`).
+    pub iterations: usize,
+    /// The method's limit on them (RADAU5's `NIT`; [`RadauIIA5`](super::RadauIIA5): 7 by
+    /// default).
+    pub max_iterations: usize,
+    /// Whether a next step of the same size would reuse the factorised iteration matrices:
+    /// the iteration contracted fast enough (RADAU5: `θ ≤ 0.001`) for the method to keep its
+    /// Jacobian.
+    pub matrices_reusable: bool,
 }
 
 /// Smallest error remembered for the next step, so that a step with zero error does not
@@ -209,9 +240,12 @@ impl StepSizeController for PiController {
 /// proposal within `[1, hold_max]` times `h` keeps `h` unchanged, so that an implicit method
 /// can keep its factorised iteration matrix (RADAU5's `QUOT1 = 1`, `QUOT2 = 1.2`).
 ///
-/// RADAU5 also lowers the safety factor when the Newton iteration needed many iterations;
-/// this controller sees only the error norm and does not, relying on the method's own step
-/// reduction when Newton converges slowly.
+/// Through [`decide_after_newton`](StepSizeController::decide_after_newton) it also does
+/// what RADAU5 does with the Newton work of the step: after `k` of at most `k_max` iterations
+/// the classical proposal uses the safety factor
+/// `min(safety, safety (1 + 2 k_max)/(k + 2 k_max))`, and a step is held only when the method
+/// keeps its factorised matrices. The arithmetic is RADAU5's (quotients `h/h_new`), so that
+/// [`RadauIIA5`](super::RadauIIA5) repeats `radau5.f`'s steps.
 ///
 /// # References
 /// - K. Gustafsson, "Control-theoretic techniques for stepsize selection in implicit
@@ -262,6 +296,57 @@ impl Default for PredictiveController {
     }
 }
 
+impl PredictiveController {
+    /// The decision, with RADAU5's arithmetic: in quotients `h/h_new`, clamped to
+    /// `[1/max_factor, 1/min_factor]` (`FACR`, `FACL`), so that a run repeats `radau5.f`'s
+    /// steps to the bit where the estimates agree.
+    fn decide_with(&mut self, dt: f64, error_norm: f64, newton: Option<NewtonWork>) -> StepOutcome {
+        let (quot_min, quot_max) = (1.0 / self.max_factor, 1.0 / self.min_factor);
+        // A NaN quotient (NaN error) becomes `quot_max`: `f64::min` returns the other operand.
+        let clamp = |quot: f64| quot.min(quot_max).max(quot_min);
+        // RADAU5's `FAC = min(SAFE, CFAC/(NEWT + 2 NIT))` with `CFAC = SAFE (1 + 2 NIT)`:
+        // the step grows less after a Newton iteration that needed many iterations.
+        let safety = newton.map_or(self.safety, |work| {
+            let limit = 2.0 * work.max_iterations as f64;
+            let damped = self.safety * (1.0 + limit) / (work.iterations as f64 + limit);
+            self.safety.min(damped)
+        });
+        // RADAU5 accepts only `err < 1` (DOPRI5, and the PI controller, also accept 1).
+        if error_norm.is_nan() || error_norm >= 1.0 {
+            self.rejected_last = true;
+            let dt_retry = if self.last_accepted.is_none() {
+                dt * 0.1
+            } else {
+                // `∞^exponent = ∞`: the largest quotient, `1/min_factor`.
+                dt / clamp(error_norm.powf(self.exponent) / safety)
+            };
+            return StepOutcome::Rejected { dt_retry };
+        }
+        let error = error_norm.max(1e-10);
+        let mut quot = clamp(error.powf(self.exponent) / safety);
+        if let Some((dt_previous, error_previous)) = self.last_accepted {
+            // Gustafsson's `FACGUS = (h_prev/h) (err²/err_prev)^exponent / SAFE`, with the
+            // undamped safety factor as in RADAU5.
+            let predictive = (dt_previous / dt)
+                * (error * error / error_previous).powf(self.exponent)
+                / self.safety;
+            quot = quot.max(clamp(predictive));
+        }
+        let mut dt_next = dt / quot;
+        if self.rejected_last {
+            dt_next = dt_next.min(dt);
+        }
+        // Holding the step pays only if the method can keep its factorised matrices.
+        let hold = newton.is_none_or(|work| work.matrices_reusable);
+        if hold && (1.0..=self.hold_max).contains(&(dt_next / dt)) {
+            dt_next = dt;
+        }
+        self.last_accepted = Some((dt, error.max(1e-2)));
+        self.rejected_last = false;
+        StepOutcome::Accepted { dt_next }
+    }
+}
+
 impl StepSizeController for PredictiveController {
     fn reset(&mut self) {
         self.last_accepted = None;
@@ -269,43 +354,16 @@ impl StepSizeController for PredictiveController {
     }
 
     fn decide(&mut self, dt: f64, error_norm: f64) -> StepOutcome {
-        let clamp = |factor: f64| factor.max(self.min_factor).min(self.max_factor);
-        // `∞^(−exponent) = 0` and NaN: `f64::max` returns `min_factor`.
-        let classical = clamp(self.safety * error_norm.powf(-self.exponent));
-        // RADAU5 accepts only `err < 1` (DOPRI5, and the PI controller, also accept 1).
-        if error_norm.is_nan() || error_norm >= 1.0 {
-            self.rejected_last = true;
-            let factor = if self.last_accepted.is_none() {
-                0.1
-            } else {
-                classical
-            };
-            return StepOutcome::Rejected {
-                dt_retry: dt * factor,
-            };
-        }
-        let error = error_norm.max(1e-10);
-        let mut factor = clamp(self.safety * error.powf(-self.exponent));
-        if let Some((dt_previous, error_previous)) = self.last_accepted {
-            let predictive = clamp(
-                self.safety
-                    * (dt / dt_previous)
-                    * (error_previous / error).powf(self.exponent)
-                    * error.powf(-self.exponent),
-            );
-            factor = factor.min(predictive);
-        }
-        if self.rejected_last {
-            factor = factor.min(1.0);
-        }
-        if (1.0..=self.hold_max).contains(&factor) {
-            factor = 1.0;
-        }
-        self.last_accepted = Some((dt, error.max(1e-2)));
-        self.rejected_last = false;
-        StepOutcome::Accepted {
-            dt_next: dt * factor,
-        }
+        self.decide_with(dt, error_norm, None)
+    }
+
+    fn decide_after_newton(
+        &mut self,
+        dt: f64,
+        error_norm_squared: f64,
+        newton: NewtonWork,
+    ) -> StepOutcome {
+        self.decide_with(dt, error_norm_squared.sqrt(), Some(newton))
     }
 }
 
@@ -473,6 +531,57 @@ mod tests {
         assert_eq!(rejected(controller.decide(1.0, f64::NAN)), 0.2);
         controller.reset();
         assert_eq!(rejected(controller.decide(1.0, 3.0)), 0.1);
+    }
+
+    /// With the Newton work of the step, the predictive controller lowers its safety factor
+    /// as RADAU5 does, to `min(0.9, 0.9 (1 + 2·7)/(k + 2·7))` after `k` of at most 7
+    /// iterations (0.9 for `k = 1`, 0.675 for `k = 6`), and holds the step only when the
+    /// method can keep its matrices; without it, it decides as before. Other controllers
+    /// ignore the Newton work.
+    #[test]
+    fn the_newton_work_lowers_the_safety_factor_and_gates_the_hold() {
+        let work = |iterations, matrices_reusable| NewtonWork {
+            iterations,
+            max_iterations: 7,
+            matrices_reusable,
+        };
+        let error: f64 = 0.01;
+        for (iterations, safety) in [(1, 0.9), (2, 0.9 * 15.0 / 16.0), (6, 0.9 * 15.0 / 20.0)] {
+            let mut controller = PredictiveController::radau5();
+            let next = accepted(controller.decide_after_newton(
+                1.0,
+                error * error,
+                work(iterations, false),
+            ));
+            let expected = safety / error.powf(0.25);
+            assert!(
+                (next - expected).abs() < 1e-15,
+                "{iterations}: {next} vs {expected}"
+            );
+        }
+        // A proposal of 1.1 h: held only if the matrices can be kept.
+        let error = (0.9_f64 / 1.1).powi(4);
+        let mut controller = PredictiveController::radau5();
+        assert_eq!(
+            accepted(controller.decide_after_newton(2.0, error * error, work(1, true))),
+            2.0
+        );
+        let mut controller = PredictiveController::radau5();
+        let next = accepted(controller.decide_after_newton(2.0, error * error, work(1, false)));
+        assert!((next - 2.2).abs() < 1e-14, "{next}");
+        let mut controller = PredictiveController::radau5();
+        assert_eq!(accepted(controller.decide(2.0, error)), 2.0);
+        // A rejection (error 4) after six iterations: the retry uses the lowered factor too.
+        let mut controller = PredictiveController::radau5();
+        accepted(controller.decide(1.0, 0.5));
+        let retry = rejected(controller.decide_after_newton(1.0, 16.0, work(6, false)));
+        assert!((retry - 0.675 / 2.0_f64.sqrt()).abs() < 1e-15, "{retry}");
+        let mut pi = PiController::dopri5();
+        let mut same = PiController::dopri5();
+        assert_eq!(
+            pi.decide_after_newton(1.0, 0.25, work(6, false)),
+            same.decide_squared(1.0, 0.25)
+        );
     }
 
     /// The integrators hand the controllers the square of the error norm. Fed the squares of

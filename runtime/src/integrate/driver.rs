@@ -296,7 +296,11 @@ fn adaptive_steps<S: Stepper>(
             }
             Err(failure) => return Err(failure.into_error()),
         };
-        match controller.decide_squared(t_new - t, error_squared) {
+        let outcome = match stepper.newton_work() {
+            Some(work) if usable => controller.decide_after_newton(t_new - t, error_squared, work),
+            _ => controller.decide_squared(t_new - t, error_squared),
+        };
+        match outcome {
             // `usable` guards against a controller that would accept an infinite error.
             StepOutcome::Accepted { dt_next } if usable => {
                 stepper.accept(rhs).map_err(StepFailure::into_error)?;

@@ -588,4 +588,185 @@ mod tests {
             failure.error
         );
     }
+
+    /// `ẏ = λy` whose `jacobian` returns `μ` instead of `λ`. The simplified Newton iteration
+    /// is then a linear fixed-point iteration: each correction `Δ = r/(1 − hμ/2)` multiplies
+    /// the residual `r = hλ(y + z/2) − z` by exactly `ρ = h(λ − μ)/(2 − hμ)`, so the number of
+    /// iterations a step takes can be worked out by hand.
+    struct WrongJacobian {
+        lambda: f64,
+        mu: f64,
+    }
+
+    impl WrongJacobian {
+        /// The system whose iteration contracts by `rho` at step `h`:
+        /// `μ = (hλ − 2ρ)/(h(1 − ρ))`.
+        fn contracting(lambda: f64, h: f64, rho: f64) -> Self {
+            let mu = (h * lambda - 2.0 * rho) / (h * (1.0 - rho));
+            Self { lambda, mu }
+        }
+
+        /// `steps` fixed steps of `h` from `y0` with the default Newton options.
+        fn run(&mut self, y0: f64, h: f64, steps: usize) -> Result<Solution, IntegrationError> {
+            let options = IntegratorOptions::default()
+                .with_fixed_step(true)
+                .with_dt(h);
+            ImplicitMidpoint::new()
+                .integrate(
+                    self,
+                    0.0,
+                    &[y0],
+                    steps as f64 * h,
+                    &OutputTimes::Steps,
+                    &options,
+                )
+                .map_err(|failure| failure.error)
+        }
+    }
+
+    impl OdeSystem for WrongJacobian {
+        fn dim(&self) -> usize {
+            1
+        }
+        fn rhs(&mut self, _t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), crate::ode::RhsError> {
+            dy[0] = self.lambda * y[0];
+            Ok(())
+        }
+        fn jacobian(
+            &mut self,
+            _t: f64,
+            _y: &[f64],
+            jac: &mut [f64],
+        ) -> Result<bool, crate::ode::RhsError> {
+            jac[0] = self.mu;
+            Ok(true)
+        }
+    }
+
+    /// The iteration starts from `z = h F(t, y)` and stops at the first iterate whose residual
+    /// relative to the state is within the tolerance, whatever the state's scale.
+    ///
+    /// `ẏ = −y`, `h = 0.01`, contraction `ρ = 10⁻⁵`: from `z = h F` the first residual is
+    /// `h²λ² |y|/2`, relative `5·10⁻⁵` (`|y₁| < |y|`), then `5·10⁻¹⁰` and `5·10⁻¹⁵ ≤ 10⁻¹²`: three
+    /// evaluations of `F` per step, plus one at its end. Three iterations are not slow, so the
+    /// one Jacobian serves all ten steps. The same from `y₀ = 10⁻³`, 1 and 10³: the residual is
+    /// relative. (From `z = 0` the first residual would be `h|λ| = 10⁻²` and the step would
+    /// need four iterations.)
+    #[test]
+    fn newton_stops_at_the_first_iterate_within_the_tolerance_at_every_scale() {
+        let (h, steps) = (0.01, 10);
+        for y0 in [1e-3, 1.0, 1e3] {
+            let solution = WrongJacobian::contracting(-1.0, h, 1e-5)
+                .run(y0, h, steps)
+                .unwrap();
+            assert_eq!(solution.stats.steps, steps, "y0 = {y0}");
+            assert_eq!(solution.stats.rhs_evals, 1 + steps * (3 + 1), "y0 = {y0}");
+            assert_eq!(solution.stats.jacobian_evals, 1, "y0 = {y0}");
+            let rule = ((1.0 - h / 2.0) / (1.0 + h / 2.0)).powi(steps as i32);
+            let (_, y) = solution.last().unwrap();
+            assert!((y[0] / y0 - rule).abs() < 1e-13, "y0 = {y0}: {}", y[0]);
+        }
+    }
+
+    /// A step that needs more than three iterations fetches a fresh Jacobian for the next one:
+    /// with `ρ = 10⁻³` the residuals are `5·10⁻⁵ ρ^(k−1)`, within `10⁻¹²` at `k = 4`, so each of
+    /// the five steps takes four iterations and each after the first a new Jacobian (here the
+    /// same wrong one).
+    #[test]
+    fn a_slow_iteration_fetches_a_fresh_jacobian_for_the_next_step() {
+        let (h, steps) = (0.01, 5);
+        let solution = WrongJacobian::contracting(-1.0, h, 1e-3)
+            .run(1.0, h, steps)
+            .unwrap();
+        assert_eq!(solution.stats.rhs_evals, 1 + steps * (4 + 1));
+        assert_eq!(solution.stats.jacobian_evals, steps);
+    }
+
+    /// The residual is measured against `max(|y|, |y + z|)`, the larger of the state and the
+    /// current iterate of the new state: `ẏ = y`, `h = 1` (`y₁ = 3y`, `z → 2y`), `y₀ = 1`,
+    /// contraction `ρ = 2.2·10⁻⁶`. The residuals are `0.5 ρ^(k−1)` against a scale of 3 (from
+    /// the second iterate on): at `k = 3`, `0.5 ρ²/3 = 8.1·10⁻¹³ ≤ 10⁻¹²`, so the step takes
+    /// three iterations. Against `|y|` alone, or `|y − z|`, or `|y z|` (scales 1, 1 and 2) it
+    /// would take four.
+    #[test]
+    fn the_residual_is_relative_to_the_larger_of_the_state_and_its_new_value() {
+        let solution = WrongJacobian::contracting(1.0, 1.0, 2.2e-6)
+            .run(1.0, 1.0, 1)
+            .unwrap();
+        assert_eq!(solution.stats.rhs_evals, 1 + 3 + 1);
+        let (_, y) = solution.last().unwrap();
+        assert!((y[0] - 3.0).abs() < 1e-11, "{}", y[0]);
+    }
+
+    /// An iteration that stops contracting fails at its second stall in a row: with
+    /// `ρ = 0.995` each residual is at least 0.99 times the one before, so iterations 2 and 3
+    /// stall and the step fails after three iterations (with fixed steps, at once).
+    #[test]
+    fn an_iteration_that_stalls_twice_fails() {
+        let h = 0.01;
+        let error = WrongJacobian::contracting(-1.0, h, 0.995)
+            .run(1.0, h, 1)
+            .unwrap_err();
+        assert!(
+            matches!(
+                error,
+                IntegrationError::NewtonDidNotConverge {
+                    t: 0.0,
+                    iterations: 3,
+                    ..
+                }
+            ),
+            "{error:?}"
+        );
+    }
+
+    /// A Jacobian kept from an earlier step whose iteration matrix is singular at a new step
+    /// size is replaced rather than reported: `ẏ = a(t) y` with `a = 4` before `t = 2` and 1
+    /// after, steps of 1 to `t = 2.5`. The last step, of 0.5, would factor `1 − 0.25 · 4 = 0`
+    /// with the kept `J = 4`; the fresh `J = 1` gives 0.75, and the run ends at the rule's
+    /// value `(−3)² · 5/3 = 15`.
+    #[test]
+    fn a_stale_jacobian_singular_at_a_new_step_size_is_replaced() {
+        struct Switched;
+        impl OdeSystem for Switched {
+            fn dim(&self) -> usize {
+                1
+            }
+            fn rhs(
+                &mut self,
+                t: f64,
+                y: &[f64],
+                dy: &mut [f64],
+            ) -> Result<(), crate::ode::RhsError> {
+                dy[0] = if t < 2.0 { 4.0 } else { 1.0 } * y[0];
+                Ok(())
+            }
+            fn jacobian(
+                &mut self,
+                t: f64,
+                _y: &[f64],
+                jac: &mut [f64],
+            ) -> Result<bool, crate::ode::RhsError> {
+                jac[0] = if t < 2.0 { 4.0 } else { 1.0 };
+                Ok(true)
+            }
+        }
+        let options = IntegratorOptions::default()
+            .with_fixed_step(true)
+            .with_dt(1.0);
+        let solution = ImplicitMidpoint::new()
+            .integrate(
+                &mut Switched,
+                0.0,
+                &[1.0],
+                2.5,
+                &OutputTimes::Steps,
+                &options,
+            )
+            .unwrap();
+        let (t, y) = solution.last().unwrap();
+        assert_eq!(t, 2.5);
+        assert!((y[0] - 15.0).abs() < 1e-12, "{}", y[0]);
+        assert_eq!(solution.stats.jacobian_evals, 2);
+    }
 }

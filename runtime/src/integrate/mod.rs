@@ -80,7 +80,9 @@ mod symplectic;
 mod tableau;
 
 pub use bs32::BogackiShampine32;
-pub use controller::{PiController, PredictiveController, StepOutcome, StepSizeController};
+pub use controller::{
+    NewtonWork, PiController, PredictiveController, StepOutcome, StepSizeController,
+};
 pub use dop853::DormandPrince853;
 pub use dopri5::DormandPrince54;
 pub use error::{IntegrationError, IntegrationFailure};

@@ -13,7 +13,7 @@ use nalgebra::{Complex, DMatrix};
 use crate::ode::OdeSystem;
 
 use super::Integrator;
-use super::controller::PredictiveController;
+use super::controller::{NewtonWork, PredictiveController};
 use super::dense_output::DenseOutput;
 use super::driver::{self, Control, Problem};
 use super::error::IntegrationFailure;
@@ -29,6 +29,10 @@ const MAX_NEWTON_ITERATIONS: usize = 7;
 /// The Jacobian is kept for the next step when the Newton contraction of the accepted step was
 /// at most this (RADAU5's `THET`).
 const JACOBIAN_REUSE_THETA: f64 = 0.001;
+/// RADAU5's rounding unit `UROUND` (its default, `1e-16`; `f64::EPSILON / 2 ≈ 1.1e-16`), in
+/// the Newton tolerance and as the floor of the contraction estimates, kept as `radau5.f`
+/// has it so that runs repeat its steps.
+const UROUND: f64 = 1e-16;
 
 /// The method's constants, computed once per integration from their closed forms (nodes,
 /// error-estimate weights, eigenvalues of `A⁻¹`), and the eigenvector matrix `T` of `A⁻¹` and
@@ -160,6 +164,8 @@ pub(crate) struct RadauStepper {
     theta: f64,
     /// `θ/(1 − θ)` of the last attempt, the first iteration's convergence factor.
     faccon: f64,
+    /// Newton iterations of the last attempt.
+    iterations: usize,
     accepted_any: bool,
     attempted_since_accept: bool,
 }
@@ -197,6 +203,7 @@ impl RadauStepper {
             lu_h: f64::NAN,
             theta: JACOBIAN_REUSE_THETA,
             faccon: 1.0,
+            iterations: 0,
             accepted_any: false,
             attempted_since_accept: false,
         }
@@ -305,7 +312,7 @@ impl RadauStepper {
         let nit = self.max_iterations;
         let (fac1, alphn, betan) = (self.k.gamma / h, self.k.alpha / h, self.k.beta / h);
         let nodes = [self.k.c1, self.k.c2, 1.0];
-        self.faccon = self.faccon.max(f64::EPSILON).powf(0.8);
+        self.faccon = self.faccon.max(UROUND).powf(0.8);
         self.theta = JACOBIAN_REUSE_THETA;
         let (mut dyno, mut dyno_old, mut thq_old) = (0.0, 0.0, 0.0);
         let mut iterations = 0;
@@ -342,8 +349,8 @@ impl RadauStepper {
             }
             iterations += 1;
             let mut sum = 0.0;
-            for s in 0..3 {
-                for i in 0..n {
+            for i in 0..n {
+                for s in 0..3 {
                     let d = self.fz[s][i];
                     if d != 0.0 {
                         sum += (d / self.scale[i]).powi(2);
@@ -397,7 +404,7 @@ impl RadauStepper {
                     });
                 }
             }
-            dyno_old = dyno.max(f64::EPSILON);
+            dyno_old = dyno.max(UROUND);
             for i in 0..n {
                 let mut wi = [0.0; 3];
                 for (s, w) in wi.iter_mut().enumerate() {
@@ -425,10 +432,9 @@ impl RadauStepper {
         refine: bool,
     ) -> Result<f64, StepFailure> {
         let n = self.n;
-        let dd = self.k.dd;
+        let [hee1, hee2, hee3] = self.k.dd.map(|d| d / h);
         for i in 0..n {
-            self.stage[i] =
-                (dd[0] * self.z[0][i] + dd[1] * self.z[1][i] + dd[2] * self.z[2][i]) / h;
+            self.stage[i] = hee1 * self.z[0][i] + hee2 * self.z[1][i] + hee3 * self.z[2][i];
             self.err[i] = self.stage[i] + self.f[i];
         }
         self.real.solve_in_place(&mut self.err);
@@ -501,6 +507,7 @@ impl Stepper for RadauStepper {
         self.lu_h = f64::NAN;
         self.theta = JACOBIAN_REUSE_THETA;
         self.faccon = 1.0;
+        self.iterations = 0;
         self.accepted_any = false;
         self.attempted_since_accept = false;
         Ok(())
@@ -530,21 +537,18 @@ impl Stepper for RadauStepper {
             .fold(f64::INFINITY, f64::min)
             .max(1e3 * f64::EPSILON);
         let rtol = if rtol.is_finite() { rtol } else { 1e-6 };
-        let newton_tolerance = (10.0 * f64::EPSILON / rtol).max(0.03_f64.min(rtol.sqrt()));
+        let newton_tolerance = (10.0 * UROUND / rtol).max(0.03_f64.min(rtol.sqrt()));
 
+        // After a rejection or a failure, a Jacobian from an earlier step is recomputed.
+        if rejected {
+            self.reuse_jacobian = false;
+        }
         if !self.jac_valid || (!self.jac_current && !self.reuse_jacobian) {
             self.update_jacobian(rhs)?;
         }
-        let result = self.factor(rhs, h).and_then(|()| {
-            self.starting_values(h);
-            self.newton(rhs, h, newton_tolerance, estimate_error)
-        });
-        if let Err(failure) = result {
-            // After a failure the Jacobian is recomputed unless it is already current.
-            self.reuse_jacobian = false;
-            self.faccon = 1.0;
-            return Err(failure);
-        }
+        self.factor(rhs, h)?;
+        self.starting_values(h);
+        self.iterations = self.newton(rhs, h, newton_tolerance, estimate_error)?;
         for i in 0..n {
             self.y_new[i] = self.y[i] + self.z[2][i];
         }
@@ -558,6 +562,14 @@ impl Stepper for RadauStepper {
         // Squared, as the driver expects (`√(e²) = e` exactly for the controller).
         self.error_estimate(rhs, h, refine)
             .map(|error| Some(error * error))
+    }
+
+    fn newton_work(&self) -> Option<NewtonWork> {
+        Some(NewtonWork {
+            iterations: self.iterations,
+            max_iterations: self.max_iterations,
+            matrices_reusable: self.theta <= JACOBIAN_REUSE_THETA,
+        })
     }
 
     fn accept(&mut self, rhs: &mut CheckedRhs<'_>) -> Result<(), StepFailure> {
@@ -609,18 +621,24 @@ impl Stepper for RadauStepper {
 /// `(γ/h I − J)` and one complex one `((α + iβ)/h I − J)` (LU with partial pivoting, computed
 /// only when `J` or `h` changes). The iteration starts from the extrapolated collocation
 /// polynomial of the previous step and stops when the estimated remaining error
-/// `θ/(1 − θ) ‖Δw‖` is below `max(10 ε/rtol, min(0.03, √rtol))` (weighted RMS norm with scales
-/// `atolᵢ + rtolᵢ |yᵢ|`). It fails when it diverges (`θ ≥ 0.99`), uses up its iterations
-/// (default 7), or is predicted too slow; the step is then retried smaller (halved, or by
-/// RADAU5's predicted factor), with a fresh Jacobian if the old one was from an earlier step.
-/// The Jacobian is kept for the next step when the iteration contracted by `θ ≤ 0.001`.
+/// `θ/(1 − θ) ‖Δw‖` is below `max(10 u/rtol, min(0.03, √rtol))` (`u = 10⁻¹⁶`, weighted RMS
+/// norm with scales `atolᵢ + rtolᵢ |yᵢ|`). It fails when it diverges (`θ ≥ 0.99`), uses up its
+/// iterations (default 7), or is predicted too slow; the step is then retried smaller (halved,
+/// or by RADAU5's predicted factor). The Jacobian is kept for the next step when the iteration
+/// contracted by `θ ≤ 0.001`; after a rejected or failed attempt a Jacobian from an earlier
+/// step is recomputed.
 ///
 /// The error estimate is RADAU5's embedded third-order one, `(γ/h I − J)⁻¹(F(t, y) + Σ dₛ zₛ/h)`,
-/// refined by one evaluation of `F` after a rejection; steps are accepted when its weighted
-/// RMS norm (scales `atolᵢ + rtolᵢ |yᵢ|` at the step's start) is at most 1, and the
-/// [`PredictiveController`] proposes the next one. Unlike `radau5.f`, the tolerances are used
-/// as given (RADAU5 replaces `rtol` by `0.1 rtol^(2/3)` internally), so that `rtol` means the
-/// same for every method: the local error per step. Dense output ([`OutputTimes::At`]) is the
+/// refined by one evaluation of `F` on the first step and after a rejection; steps are
+/// accepted when its weighted RMS norm (scales `atolᵢ + rtolᵢ |yᵢ|` at the step's start) is
+/// below 1, and the [`PredictiveController`] proposes the next one from the error and the
+/// Newton work ([`NewtonWork`]). Unlike `radau5.f`, the tolerances are used as given (RADAU5
+/// replaces `rtol` by `rtol' = 0.1 rtol^(2/3)` and `atol` by `rtol' atol/rtol` internally), so
+/// that `rtol` means the same for every method: the local error per step. Given those
+/// internal tolerances and an exact Jacobian, the method takes `radau5.f`'s steps: the same
+/// accepted and rejected attempts, Newton iterations, Jacobians and factorisations (tested
+/// on van der Pol's and Robertson's problems, `runtime/tests/radau5_reference.rs`), with one
+/// more evaluation of `F`, at the final state. Dense output ([`OutputTimes::At`]) is the
 /// collocation polynomial of each step (degree 3, continuous extension of order 3). With
 /// [`IntegratorOptions::fixed_step`] the method takes constant steps `dt` without error
 /// control; Newton then iterates until it converges, diverges or uses up its iterations, and a

@@ -9,6 +9,7 @@ use nalgebra::DMatrix;
 
 use crate::ode::{EventSpec, OdeSystem, RhsError};
 
+use super::controller::NewtonWork;
 use super::dense_output::{DenseOutput, hermite};
 use super::error::IntegrationError;
 use super::options::ErrorWeights;
@@ -435,6 +436,12 @@ pub(crate) trait Stepper: DenseOutput {
         weights: &ErrorWeights,
         estimate_error: bool,
     ) -> Result<Option<f64>, StepFailure>;
+
+    /// The Newton work of the last successful attempt, for methods that iterate (the
+    /// controller adapts the step size to it); `None` (the default) for the others.
+    fn newton_work(&self) -> Option<NewtonWork> {
+        None
+    }
 
     /// Makes the last candidate the current state, with `F` there (reused from the last stage
     /// or evaluated), and the dense output over that step.
