@@ -216,19 +216,24 @@ fn one_step_of_the_clock(
         .unwrap()
 }
 
+/// The located zero of `g(y)` over [`one_step_of_the_clock`] and the times at which the
+/// search evaluated `g`, after the two evaluations at the step's ends.
+fn zero_search(g: impl Fn(f64) -> f64) -> (f64, Vec<f64>) {
+    let mut times = Vec::new();
+    let specs = vec![EventSpec::new("zero", EventDirection::Rising, false)];
+    let solution = one_step_of_the_clock(specs, |t, y, values| {
+        times.push(t);
+        values[0] = g(y[0]);
+    });
+    (solution.events[0].t, times.split_off(2))
+}
+
 /// The located zero of `g(y)` over [`one_step_of_the_clock`], the number of evaluations of
 /// `g` after the two at the step's ends, and how many of them fell outside the step.
 fn located_zero(g: impl Fn(f64) -> f64) -> (f64, usize, usize) {
-    let (mut evaluations, mut outside) = (0, 0);
-    let specs = vec![EventSpec::new("zero", EventDirection::Rising, false)];
-    let solution = one_step_of_the_clock(specs, |t, y, values| {
-        evaluations += 1;
-        if !(0.0..=1.0).contains(&t) {
-            outside += 1;
-        }
-        values[0] = g(y[0]);
-    });
-    (solution.events[0].t, evaluations - 2, outside)
+    let (t, times) = zero_search(g);
+    let outside = times.iter().filter(|t| !(0.0..=1.0).contains(*t)).count();
+    (t, times.len(), outside)
 }
 
 /// Zeros located by Brent's method: each root to 4ε (absolute), and the evaluations of `g`
@@ -312,6 +317,92 @@ fn brent_keeps_its_trial_points_in_the_step() {
         );
         assert_eq!(outside, 0, "case {case} (family {family})");
     }
+}
+
+/// Test function `k` of `tools/brent_reference/problems.f90`, with the same operations in
+/// the same order: nine chosen ones (smooth, convex, flat beside the root, a jump, square-root
+/// and ninth-order zeros, a root at `10⁻³¹⁰` below the absolute tolerance, a pole beside the
+/// root, `t²⁰`), then 400 from four families with parameters `frac(k c)` for three
+/// irrational `c`: `(t − r)(0.01 + a (t − s)²)`, `sign(t − r) √|t − r| (1 + a t)`,
+/// `(t − r)³ + 10⁻³ a (t − r)` and `(t − r)/(0.01 + (t − s)²)`.
+fn brent_case(k: usize) -> impl Fn(f64) -> f64 {
+    let frac = |c: f64| (k as f64 * c).fract();
+    let r = 0.02 + 0.96 * frac(0.6180339887498949);
+    let a = 50.0 * frac(0.7548776662466927);
+    let s = frac(0.5698402909980532);
+    move |t: f64| match k {
+        1 => t * t * t - 0.1,
+        2 => t * t - 1e-4,
+        3 => {
+            let x = t - 0.31;
+            (t - 0.3) * (1.0 + 1e6 * (x * x))
+        }
+        4 => {
+            if t < 0.3 {
+                -1.0
+            } else {
+                1.0 + t
+            }
+        }
+        5 => {
+            let x = t - 0.3;
+            x.abs().sqrt().copysign(x)
+        }
+        6 => {
+            let x = t - 0.3;
+            x * x * x * x * x * x * x * x * x
+        }
+        7 => t - 1e-310,
+        8 => 50.0 - 1.0 / (t + 0.01),
+        9 => {
+            let t2 = t * t;
+            let t4 = t2 * t2;
+            let t16 = (t4 * t4) * (t4 * t4);
+            t16 * t4 - 0.5
+        }
+        _ => {
+            let x = t - r;
+            match k % 4 {
+                0 => x * (0.01 + a * ((t - s) * (t - s))),
+                1 => x.abs().sqrt().copysign(x) * (1.0 + a * t),
+                2 => x * x * x + (1e-3 * a) * x,
+                _ => x / (0.01 + (t - s) * (t - s)),
+            }
+        }
+    }
+}
+
+/// The event search is Brent's procedure `zero` (Brent 1973, §4.6) with `macheps = ε` and
+/// `t = f64::MIN_POSITIVE`: on 409 functions it evaluates `g` at the same times, to the bit,
+/// as `zero` itself, compiled from J. Burkardt's Fortran transcription
+/// (`tools/brent_reference`, whose output is `tests/data/brent_zero.txt`: per function the
+/// number of evaluations after the two at the step's ends, the sum of their times in order
+/// and the last time). Every choice between interpolation and bisection shows in these
+/// sequences: the step before last `e` that gates interpolation, its reset when the bracket
+/// changes sides, which end is the best point, the acceptance test of an interpolated point
+/// and the absolute part of the tolerance. The test functions use `+ − × /` and `√` only, so
+/// both codes compute the same values.
+#[test]
+fn brent_takes_the_steps_of_brents_zero() {
+    let reference = include_str!("data/brent_zero.txt");
+    let mut cases = 0;
+    for line in reference.lines() {
+        let fields: Vec<&str> = line.split_whitespace().collect();
+        let k: usize = fields[0].parse().unwrap();
+        let count: usize = fields[1].parse().unwrap();
+        let (sum, last): (f64, f64) = (fields[2].parse().unwrap(), fields[3].parse().unwrap());
+        let (_, times) = zero_search(brent_case(k));
+        let ours_sum = times.iter().fold(0.0, |total, t| total + t);
+        let ours_last = times.last().copied().unwrap_or(0.0);
+        assert_eq!(
+            (times.len(), ours_sum.to_bits(), ours_last.to_bits()),
+            (count, sum.to_bits(), last.to_bits()),
+            "function {k}: {} evaluations, sum {ours_sum:e}, last {ours_last:e}; zero: {count}, {sum:e}, {last:e}",
+            times.len()
+        );
+        cases += 1;
+    }
+    assert_eq!(cases, 409);
 }
 
 /// An event at the same instant as a terminal one is recorded with it (a later one is not):

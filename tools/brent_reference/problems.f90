@@ -1,0 +1,101 @@
+! Reference runs of Brent's procedure `zero` for eomgen's event-location test
+! (runtime/tests/events.rs, `brent_takes_the_steps_of_brents_zero`).
+!
+! For each test function g on [0, 1] (g(0) < 0 < g(1)) it calls
+! zero(0, 1, machep = epsilon(1d0), t = tiny(1d0), g) and prints, for the
+! evaluations after the two at the ends, their number, the sum of the points
+! in the order evaluated, and the last point. Build and run with run.sh.
+module cases
+  implicit none
+  integer, parameter :: dp = kind(1.0d0)
+  integer :: which
+  real(dp) :: r, a, s
+  integer :: evaluations
+  real(dp) :: total, last
+contains
+  ! The same arithmetic, operation by operation, as `brent_case` in the test.
+  real(dp) function g(t)
+    real(dp), intent(in) :: t
+    real(dp) :: x, t2, t4, t16
+    select case (which)
+    case (1)
+      g = t * t * t - 0.1d0
+    case (2)
+      g = t * t - 1.0d-4
+    case (3)
+      x = t - 0.31d0
+      g = (t - 0.3d0) * (1.0d0 + 1.0d6 * (x * x))
+    case (4)
+      if (t < 0.3d0) then
+        g = -1.0d0
+      else
+        g = 1.0d0 + t
+      end if
+    case (5)
+      x = t - 0.3d0
+      g = sign(sqrt(abs(x)), x)
+    case (6)
+      x = t - 0.3d0
+      g = x * x * x * x * x * x * x * x * x
+    case (7)
+      g = t - 1.0d-310
+    case (8)
+      g = 50.0d0 - 1.0d0 / (t + 0.01d0)
+    case (9)
+      t2 = t * t
+      t4 = t2 * t2
+      t16 = (t4 * t4) * (t4 * t4)
+      g = t16 * t4 - 0.5d0
+    case default
+      x = t - r
+      select case (mod(which, 4))
+      case (0)
+        g = x * (0.01d0 + a * ((t - s) * (t - s)))
+      case (1)
+        g = sign(sqrt(abs(x)), x) * (1.0d0 + a * t)
+      case (2)
+        g = x * x * x + (1.0d-3 * a) * x
+      case default
+        g = x / (0.01d0 + (t - s) * (t - s))
+      end select
+    end select
+  end function g
+
+  real(dp) function counted(t)
+    real(dp), intent(in) :: t
+    evaluations = evaluations + 1
+    if (evaluations > 2) then
+      total = total + t
+      last = t
+    end if
+    counted = g(t)
+  end function counted
+
+  ! frac(k c), as `f64::fract` computes it.
+  real(dp) function frac(k, c)
+    integer, intent(in) :: k
+    real(dp), intent(in) :: c
+    real(dp) :: x
+    x = dble(k) * c
+    frac = x - aint(x)
+  end function frac
+end module cases
+
+program problems
+  use cases
+  implicit none
+  real(dp), external :: zero
+  real(dp) :: root
+  integer :: k
+  do k = 1, 409
+    which = k
+    r = 0.02d0 + 0.96d0 * frac(k, 0.6180339887498949d0)
+    a = 50.0d0 * frac(k, 0.7548776662466927d0)
+    s = frac(k, 0.5698402909980532d0)
+    evaluations = 0
+    total = 0.0d0
+    last = 0.0d0
+    root = zero(0.0d0, 1.0d0, epsilon(1.0d0), tiny(1.0d0), counted)
+    write (*, '(I4, I5, 2ES27.17E3)') k, evaluations - 2, total, last
+  end do
+end program problems
