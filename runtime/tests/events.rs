@@ -200,6 +200,16 @@ fn one_step_of_the_clock(
     specs: Vec<EventSpec>,
     g: impl FnMut(f64, &[f64], &mut [f64]),
 ) -> Solution {
+    one_step_of_the_clock_from(0.0, specs, g)
+}
+
+/// [`one_step_of_the_clock`] over `[start, start + 1]`, from `y = start` (for `start` in
+/// `[0, 1]` still `y = t` exactly: `start + (t − start)` rounds to `t`).
+fn one_step_of_the_clock_from(
+    start: f64,
+    specs: Vec<EventSpec>,
+    g: impl FnMut(f64, &[f64], &mut [f64]),
+) -> Solution {
     let mut g = g;
     let mut clock = OdeFn::new(1, |_t: f64, _y: &[f64], dy: &mut [f64]| dy[0] = 1.0);
     let mut system = WithEvents::new(
@@ -212,18 +222,25 @@ fn one_step_of_the_clock(
     );
     let options = IntegratorOptions::default().with_dt(1.0);
     ExplicitEuler::new()
-        .integrate(&mut system, 0.0, &[0.0], 1.0, &OutputTimes::Steps, &options)
+        .integrate(
+            &mut system,
+            start,
+            &[start],
+            start + 1.0,
+            &OutputTimes::Steps,
+            &options,
+        )
         .unwrap()
 }
 
-/// The located zero of `g(y)` over [`one_step_of_the_clock`] and the times at which the
-/// search evaluated `g`, after the two evaluations at the step's ends.
-fn zero_search(g: impl Fn(f64) -> f64) -> (f64, Vec<f64>) {
+/// The located zero of `g(y − start)` over [`one_step_of_the_clock_from`] `start` and the
+/// times at which the search evaluated `g`, after the two evaluations at the step's ends.
+fn zero_search_from(start: f64, g: impl Fn(f64) -> f64) -> (f64, Vec<f64>) {
     let mut times = Vec::new();
     let specs = vec![EventSpec::new("zero", EventDirection::Rising, false)];
-    let solution = one_step_of_the_clock(specs, |t, y, values| {
+    let solution = one_step_of_the_clock_from(start, specs, |t, y, values| {
         times.push(t);
-        values[0] = g(y[0]);
+        values[0] = g(y[0] - start);
     });
     (solution.events[0].t, times.split_off(2))
 }
@@ -231,7 +248,7 @@ fn zero_search(g: impl Fn(f64) -> f64) -> (f64, Vec<f64>) {
 /// The located zero of `g(y)` over [`one_step_of_the_clock`], the number of evaluations of
 /// `g` after the two at the step's ends, and how many of them fell outside the step.
 fn located_zero(g: impl Fn(f64) -> f64) -> (f64, usize, usize) {
-    let (t, times) = zero_search(g);
+    let (t, times) = zero_search_from(0.0, g);
     let outside = times.iter().filter(|t| !(0.0..=1.0).contains(*t)).count();
     (t, times.len(), outside)
 }
@@ -373,11 +390,13 @@ fn brent_case(k: usize) -> impl Fn(f64) -> f64 {
 }
 
 /// The event search is Brent's procedure `zero` (Brent 1973, §4.6) with `macheps = ε` and
-/// `t = f64::MIN_POSITIVE`: on 409 functions it evaluates `g` at the same times, to the bit,
-/// as `zero` itself, compiled from J. Burkardt's Fortran transcription
-/// (`tools/brent_reference`, whose output is `tests/data/brent_zero.txt`: per function the
-/// number of evaluations after the two at the step's ends, the sum of their times in order
-/// and the last time). Every choice between interpolation and bisection shows in these
+/// `t = f64::MIN_POSITIVE`: on 409 functions `g(t − t₀)`, over steps `[t₀, t₀ + 1]` from
+/// `t₀ = 0` and from `t₀ = 1` (where the step's end `b + a` differs from its length
+/// `b − a`, and the tolerance `2ε|t|` from its absolute part), it evaluates `g` at the same
+/// times, to the bit, as `zero` itself, compiled from J. Burkardt's Fortran transcription
+/// (`tools/brent_reference`, whose output is `tests/data/brent_zero.txt`: per function and
+/// step the number of evaluations after the two at the step's ends, the sum of their times
+/// in order and the last time). Every choice between interpolation and bisection shows in these
 /// sequences: the step before last `e` that gates interpolation, its reset when the bracket
 /// changes sides, which end is the best point, the acceptance test of an interpolated point
 /// and the absolute part of the tolerance. The test functions use `+ − × /` and `√` only, so
@@ -389,20 +408,21 @@ fn brent_takes_the_steps_of_brents_zero() {
     for line in reference.lines() {
         let fields: Vec<&str> = line.split_whitespace().collect();
         let k: usize = fields[0].parse().unwrap();
-        let count: usize = fields[1].parse().unwrap();
-        let (sum, last): (f64, f64) = (fields[2].parse().unwrap(), fields[3].parse().unwrap());
-        let (_, times) = zero_search(brent_case(k));
+        let start: f64 = fields[1].parse().unwrap();
+        let count: usize = fields[2].parse().unwrap();
+        let (sum, last): (f64, f64) = (fields[3].parse().unwrap(), fields[4].parse().unwrap());
+        let (_, times) = zero_search_from(start, brent_case(k));
         let ours_sum = times.iter().fold(0.0, |total, t| total + t);
         let ours_last = times.last().copied().unwrap_or(0.0);
         assert_eq!(
             (times.len(), ours_sum.to_bits(), ours_last.to_bits()),
             (count, sum.to_bits(), last.to_bits()),
-            "function {k}: {} evaluations, sum {ours_sum:e}, last {ours_last:e}; zero: {count}, {sum:e}, {last:e}",
+            "function {k} from {start}: {} evaluations, sum {ours_sum:e}, last {ours_last:e}; zero: {count}, {sum:e}, {last:e}",
             times.len()
         );
         cases += 1;
     }
-    assert_eq!(cases, 409);
+    assert_eq!(cases, 2 * 409);
 }
 
 /// An event at the same instant as a terminal one is recorded with it (a later one is not):

@@ -1,15 +1,17 @@
 ! Reference runs of Brent's procedure `zero` for eomgen's event-location test
 ! (runtime/tests/events.rs, `brent_takes_the_steps_of_brents_zero`).
 !
-! For each test function g on [0, 1] (g(0) < 0 < g(1)) it calls
-! zero(0, 1, machep = epsilon(1d0), t = tiny(1d0), g) and prints, for the
-! evaluations after the two at the ends, their number, the sum of the points
-! in the order evaluated, and the last point. Build and run with run.sh.
+! For each test function g on [0, 1] (g(0) < 0 < g(1)) and each start
+! t0 = 0 and t0 = 1 it calls zero(t0, t0 + 1, machep = epsilon(1d0),
+! t = tiny(1d0), t -> g(t - t0)) and prints t0 and, for the evaluations after
+! the two at the ends, their number, the sum of the points in the order
+! evaluated, and the last point. For t in [1, 2], t - 1 is exact. Build and
+! run with run.sh.
 module cases
   implicit none
   integer, parameter :: dp = kind(1.0d0)
   integer :: which
-  real(dp) :: r, a, s
+  real(dp) :: r, a, s, start
   integer :: evaluations
   real(dp) :: total, last
 contains
@@ -68,7 +70,7 @@ contains
       total = total + t
       last = t
     end if
-    counted = g(t)
+    counted = g(t - start)
   end function counted
 
   ! frac(k c), as `f64::fract` computes it.
@@ -86,7 +88,9 @@ program problems
   implicit none
   real(dp), external :: zero
   real(dp) :: root
-  integer :: k
+  integer :: k, j
+  do j = 0, 1
+  start = dble(j)
   do k = 1, 409
     which = k
     r = 0.02d0 + 0.96d0 * frac(k, 0.6180339887498949d0)
@@ -95,7 +99,8 @@ program problems
     evaluations = 0
     total = 0.0d0
     last = 0.0d0
-    root = zero(0.0d0, 1.0d0, epsilon(1.0d0), tiny(1.0d0), counted)
-    write (*, '(I4, I5, 2ES27.17E3)') k, evaluations - 2, total, last
+    root = zero(start, start + 1.0d0, epsilon(1.0d0), tiny(1.0d0), counted)
+    write (*, '(I4, F4.1, I5, 2ES27.17E3)') k, start, evaluations - 2, total, last
+  end do
   end do
 end program problems

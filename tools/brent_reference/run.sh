@@ -1,7 +1,8 @@
 #!/bin/sh
 # Reference figures for runtime/tests/data/brent_zero.txt: builds Brent's procedure `zero`
-# with the 409 test functions of problems.f90 and prints, per function, the number of
-# evaluations after the two at the ends, their sum and the last point.
+# with the 409 test functions of problems.f90 and prints, per function and step (from 0
+# and from 1), the number of evaluations after the two at the ends, their sum and the last
+# point.
 #
 # Usage: tools/brent_reference/run.sh ZERO.f90 > runtime/tests/data/brent_zero.txt
 #   ZERO.f90 holds `function zero(a, b, machep, t, f)`, Brent's ALGOL procedure `zero`
