@@ -47,7 +47,9 @@ pub trait StepSizeController {
     }
 
     /// [`decide_squared`](Self::decide_squared) for a step of an implicit method whose
-    /// Newton iteration did `newton`'s work; the integrators call this one for such methods.
+    /// Newton iteration converged after `newton`'s work; the integrators call this one for
+    /// such methods. An attempt whose iteration failed comes through
+    /// [`decide_squared`](Self::decide_squared) as an infinite error.
     ///
     /// The default ignores `newton`. [`PredictiveController`] uses it as RADAU5 does: it
     /// lowers its safety factor after many iterations and holds the step size only when the

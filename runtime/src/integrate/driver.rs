@@ -669,6 +669,73 @@ mod tests {
         assert!(solution.y.iter().all(|y| y.is_finite()));
     }
 
+    /// A controller that decides as RADAU5's does and records how it was asked.
+    #[derive(Default)]
+    struct Recorder {
+        inner: crate::integrate::PredictiveController,
+        /// Errors handed over without Newton work.
+        plain: Vec<f64>,
+        /// Errors handed over with Newton work.
+        with_newton: Vec<f64>,
+    }
+
+    impl StepSizeController for Recorder {
+        fn reset(&mut self) {
+            self.inner.reset();
+        }
+        fn decide(&mut self, dt: f64, error_norm: f64) -> StepOutcome {
+            self.plain.push(error_norm);
+            self.inner.decide(dt, error_norm)
+        }
+        fn decide_after_newton(
+            &mut self,
+            dt: f64,
+            error_norm_squared: f64,
+            newton: crate::integrate::NewtonWork,
+        ) -> StepOutcome {
+            self.with_newton.push(error_norm_squared.sqrt());
+            self.inner
+                .decide_after_newton(dt, error_norm_squared, newton)
+        }
+    }
+
+    /// The controller hears the Newton work only of attempts whose iteration converged: an
+    /// attempt whose iteration failed (30 of 171 on van der Pol's equation with `ε = 10⁻⁶` at
+    /// a loose tolerance) comes as an infinite error without it, since its work is not that
+    /// of a step.
+    #[test]
+    fn newton_work_is_reported_only_for_converged_attempts() {
+        let mut system = OdeFn::new(2, |_t: f64, y: &[f64], dy: &mut [f64]| {
+            dy[0] = y[1];
+            dy[1] = ((1.0 - y[0] * y[0]) * y[1] - y[0]) / 1e-6;
+        });
+        let options = IntegratorOptions::default()
+            .with_rtol(1e-3)
+            .with_atol(1e-3)
+            .with_dt(1e-6);
+        let problem = Problem {
+            t0: 0.0,
+            y0: &[2.0, -0.66],
+            t_end: 2.0,
+            output: &OutputTimes::Steps,
+            options: &options,
+        };
+        let mut recorder = Recorder::default();
+        let control = Control::Adaptive {
+            controller: &mut recorder,
+            error_order: 3,
+        };
+        let solution = run(&problem, &mut system, control, |shape| {
+            Ok(crate::integrate::radau5::RadauStepper::new(shape.dim, 7))
+        })
+        .unwrap();
+        let attempts = solution.stats.steps + solution.stats.rejected;
+        assert_eq!(recorder.plain.len() + recorder.with_newton.len(), attempts);
+        assert!(recorder.with_newton.iter().all(|e| e.is_finite()));
+        assert!(!recorder.plain.is_empty(), "no failed iteration");
+        assert!(recorder.plain.iter().all(|e| e.is_infinite()));
+    }
+
     /// A system that evaluates normally until `t > 0.25`, then reports a singular mass
     /// matrix, counting those reports.
     struct SingularAfter {
