@@ -700,7 +700,7 @@ mod tests {
     }
 
     /// The controller hears the Newton work only of attempts whose iteration converged: an
-    /// attempt whose iteration failed (30 of 171 on van der Pol's equation with `ε = 10⁻⁶` at
+    /// attempt whose iteration failed (31 of 214 on van der Pol's equation with `ε = 10⁻⁶` at
     /// a loose tolerance) comes as an infinite error without it, since its work is not that
     /// of a step.
     #[test]
