@@ -337,9 +337,10 @@ fn brent_keeps_its_trial_points_in_the_step() {
 }
 
 /// Test function `k` of `tools/brent_reference/problems.f90`, with the same operations in
-/// the same order: nine chosen ones (smooth, convex, flat beside the root, a jump, square-root
+/// the same order: ten chosen ones (smooth, convex, flat beside the root, a jump, square-root
 /// and ninth-order zeros, a root at `10⁻³¹⁰` below the absolute tolerance, a pole beside the
-/// root, `t²⁰`), then 400 from four families with parameters `frac(k c)` for three
+/// root, `t²⁰`, and one built so that an interpolated point falls within rounding of the
+/// acceptance test's bound), then 400 from four families with parameters `frac(k c)` for three
 /// irrational `c`: `(t − r)(0.01 + a (t − s)²)`, `sign(t − r) √|t − r| (1 + a t)`,
 /// `(t − r)³ + 10⁻³ a (t − r)` and `(t − r)/(0.01 + (t − s)²)`.
 fn brent_case(k: usize) -> impl Fn(f64) -> f64 {
@@ -377,6 +378,16 @@ fn brent_case(k: usize) -> impl Fn(f64) -> f64 {
             let t16 = (t4 * t4) * (t4 * t4);
             t16 * t4 - 0.5
         }
+        // Its value at 0.6, the secant point from (0, −1.5) and (1, 1), puts the next
+        // (inverse quadratic) point 0.45 from 0.6, a few rounding units short of three
+        // quarters of the bracket [0, 0.6]: rejected by the test `2p < 3mq − |tol q|`,
+        // accepted without the `− |tol q|`.
+        10 => match t {
+            0.0 => -1.5,
+            1.0 => 1.0,
+            0.6 => 0.6131299792238182,
+            _ => t - 0.1,
+        },
         _ => {
             let x = t - r;
             match k % 4 {
@@ -390,7 +401,7 @@ fn brent_case(k: usize) -> impl Fn(f64) -> f64 {
 }
 
 /// The event search is Brent's procedure `zero` (Brent 1973, §4.6) with `macheps = ε` and
-/// `t = f64::MIN_POSITIVE`: on 409 functions `g(t − t₀)`, over steps `[t₀, t₀ + 1]` from
+/// `t = f64::MIN_POSITIVE`: on 410 functions `g(t − t₀)`, over steps `[t₀, t₀ + 1]` from
 /// `t₀ = 0` and from `t₀ = 1` (where the step's end `b + a` differs from its length
 /// `b − a`, and the tolerance `2ε|t|` from its absolute part), it evaluates `g` at the same
 /// times, to the bit, as `zero` itself, compiled from J. Burkardt's Fortran transcription
@@ -422,7 +433,7 @@ fn brent_takes_the_steps_of_brents_zero() {
         );
         cases += 1;
     }
-    assert_eq!(cases, 2 * 409);
+    assert_eq!(cases, 2 * 410);
 }
 
 /// An event at the same instant as a terminal one is recorded with it (a later one is not):

@@ -48,6 +48,20 @@ contains
       t4 = t2 * t2
       t16 = (t4 * t4) * (t4 * t4)
       g = t16 * t4 - 0.5d0
+    case (10)
+      ! Its value at 0.6, the secant point from (0, -1.5) and (1, 1), puts the
+      ! next (inverse quadratic) point 0.45 from 0.6, a few rounding units
+      ! short of three quarters of the bracket [0, 0.6]: rejected by the test
+      ! 2p < 3mq - |tol q|, accepted without the - |tol q|.
+      if (t == 0.0d0) then
+        g = -1.5d0
+      else if (t == 1.0d0) then
+        g = 1.0d0
+      else if (t == 0.6d0) then
+        g = 0.6131299792238182d0
+      else
+        g = t - 0.1d0
+      end if
     case default
       x = t - r
       select case (mod(which, 4))
@@ -91,7 +105,7 @@ program problems
   integer :: k, j
   do j = 0, 1
   start = dble(j)
-  do k = 1, 409
+  do k = 1, 410
     which = k
     r = 0.02d0 + 0.96d0 * frac(k, 0.6180339887498949d0)
     a = 50.0d0 * frac(k, 0.7548776662466927d0)

@@ -1,6 +1,6 @@
 #!/bin/sh
 # Reference figures for runtime/tests/data/brent_zero.txt: builds Brent's procedure `zero`
-# with the 409 test functions of problems.f90 and prints, per function and step (from 0
+# with the 410 test functions of problems.f90 and prints, per function and step (from 0
 # and from 1), the number of evaluations after the two at the ends, their sum and the last
 # point.
 #
