@@ -378,10 +378,11 @@ fn brent_case(k: usize) -> impl Fn(f64) -> f64 {
             let t16 = (t4 * t4) * (t4 * t4);
             t16 * t4 - 0.5
         }
-        // Its value at 0.6, the secant point from (0, −1.5) and (1, 1), puts the next
-        // (inverse quadratic) point 0.45 from 0.6, a few rounding units short of three
-        // quarters of the bracket [0, 0.6]: rejected by the test `2p < 3mq − |tol q|`,
-        // accepted without the `− |tol q|`.
+        // Over the step from 0, its value at 0.6, the secant point from (0, −1.5) and (1, 1),
+        // puts the next (inverse quadratic) point 0.45 from 0.6, a few rounding units short
+        // of three quarters of the bracket [0, 0.6]: rejected by the test
+        // `2p < 3mq − |tol q|`, accepted without the `− |tol q|`. (From 1 the secant point is
+        // 1.6, and 1.6 − 1 is not 0.6: there it is `t − 0.1`.)
         10 => match t {
             0.0 => -1.5,
             1.0 => 1.0,
@@ -403,11 +404,12 @@ fn brent_case(k: usize) -> impl Fn(f64) -> f64 {
 /// The event search is Brent's procedure `zero` (Brent 1973, §4.6) with `macheps = ε` and
 /// `t = f64::MIN_POSITIVE`: on 410 functions `g(t − t₀)`, over steps `[t₀, t₀ + 1]` from
 /// `t₀ = 0` and from `t₀ = 1` (where the step's end `b + a` differs from its length
-/// `b − a`, and the tolerance `2ε|t|` from its absolute part), it evaluates `g` at the same
-/// times, to the bit, as `zero` itself, compiled from J. Burkardt's Fortran transcription
-/// (`tools/brent_reference`, whose output is `tests/data/brent_zero.txt`: per function and
-/// step the number of evaluations after the two at the step's ends, the sum of their times
-/// in order and the last time). Every choice between interpolation and bisection shows in these
+/// `b − a`, and the tolerance `2ε|t|` from its absolute part), its evaluations of `g` have
+/// the same fingerprint, to the bit, as those of `zero` itself, compiled from J. Burkardt's
+/// Fortran transcription (`tools/brent_reference`, whose output is
+/// `tests/data/brent_zero.txt`): per function and step the number of evaluations after the
+/// two at the step's ends, the sum of their times in order and the last time. A different
+/// sequence of times would have to agree in all three to pass. Every choice between interpolation and bisection shows in these
 /// sequences: the step before last `e` that gates interpolation, its reset when the bracket
 /// changes sides, which end is the best point, the acceptance test of an interpolated point
 /// and the absolute part of the tolerance. The test functions use `+ − × /` and `√` only, so

@@ -3,8 +3,8 @@
 //! Given `radau5.f`'s internal tolerances (it replaces `rtol` by `rtol' = 0.1 rtol^(2/3)` and
 //! `atol` by `rtol' · atol/rtol`) and the same exact Jacobian, `RadauIIA5` makes the decisions
 //! `radau5.f` makes: the same accepted steps, the same rejected attempts (error too large,
-//! Newton too slow or diverging), the same Newton iterations, Jacobians and LU
-//! factorisations. Every heuristic of the method shows in these counts: the starting values
+//! Newton too slow or diverging), the same evaluations of `F` (three per Newton iteration),
+//! Jacobians and LU factorisations. Every heuristic of the method shows in these counts: the starting values
 //! of the Newton iteration, its convergence-rate prediction and early exit, the reuse of the
 //! Jacobian and of the factorised matrices, the Newton-dependent safety factor and
 //! Gustafsson's predictive controller. A change to any of them changes some count on these

@@ -11,6 +11,7 @@
 # Built without optimisation, so that every expression is evaluated as written.
 set -eu
 zero=${1:?usage: run.sh ZERO.f90}
+zero=$(cd "$(dirname "$zero")" && pwd)/$(basename "$zero")
 build=$(mktemp -d)
 trap 'rm -rf "$build"' EXIT
 here=$(cd "$(dirname "$0")" && pwd)

@@ -20,9 +20,10 @@ pub enum StepOutcome {
 /// A rule that accepts or rejects a step from its error estimate and proposes the next step
 /// size.
 ///
-/// The integrator calls [`reset`](Self::reset) before an integration and
-/// [`decide_squared`](Self::decide_squared) (whose default calls [`decide`](Self::decide))
-/// after every attempted step.
+/// The integrator calls [`reset`](Self::reset) before an integration and, after every
+/// attempted step, [`decide_after_newton`](Self::decide_after_newton) for a step of an
+/// implicit method whose Newton iteration converged, else
+/// [`decide_squared`](Self::decide_squared) (whose default calls [`decide`](Self::decide)).
 pub trait StepSizeController {
     /// Forgets the history of earlier steps.
     fn reset(&mut self);
@@ -36,7 +37,8 @@ pub trait StepSizeController {
 
     /// [`decide`](Self::decide) given the *square* of the error norm, `error_norm²` (what
     /// the integrators hand over: for an RMS norm the mean of the squared weighted errors,
-    /// whose square root is then left to the controller). The integrators call this one.
+    /// whose square root is then left to the controller). The integrators call this one, or
+    /// [`decide_after_newton`](Self::decide_after_newton) (whose default calls this one).
     ///
     /// The default takes the square root and calls [`decide`](Self::decide). A controller
     /// that works with `ln(error_norm)` takes `ln(error_norm²)/2` instead: the step size is
@@ -68,6 +70,7 @@ pub trait StepSizeController {
 /// What the Newton iteration of an implicit method did on an attempted step, for
 /// [`StepSizeController::decide_after_newton`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[non_exhaustive]
 pub struct NewtonWork {
     /// Newton iterations of the attempt (`≥ 1`).
     pub iterations: usize,
@@ -78,6 +81,19 @@ pub struct NewtonWork {
     /// the iteration contracted fast enough (RADAU5: `θ ≤ 0.001`) for the method to keep its
     /// Jacobian.
     pub matrices_reusable: bool,
+}
+
+impl NewtonWork {
+    /// The work of an attempt that converged after `iterations` of at most `max_iterations`
+    /// Newton iterations, `matrices_reusable` if a next step of the same size would keep the
+    /// factorised iteration matrices.
+    pub fn new(iterations: usize, max_iterations: usize, matrices_reusable: bool) -> Self {
+        Self {
+            iterations,
+            max_iterations,
+            matrices_reusable,
+        }
+    }
 }
 
 /// Smallest error remembered for the next step, so that a step with zero error does not

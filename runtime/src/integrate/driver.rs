@@ -700,9 +700,9 @@ mod tests {
     }
 
     /// The controller hears the Newton work only of attempts whose iteration converged: an
-    /// attempt whose iteration failed (31 of 214 on van der Pol's equation with `ε = 10⁻⁶` at
-    /// a loose tolerance) comes as an infinite error without it, since its work is not that
-    /// of a step.
+    /// attempt whose iteration failed (some tens on van der Pol's equation with `ε = 10⁻⁶`
+    /// at a loose tolerance) comes as an infinite error without it, since its work is not
+    /// that of a step.
     #[test]
     fn newton_work_is_reported_only_for_converged_attempts() {
         let mut system = OdeFn::new(2, |_t: f64, y: &[f64], dy: &mut [f64]| {

@@ -528,8 +528,9 @@ impl Stepper for RadauStepper {
         for i in 0..n {
             self.scale[i] = weights.scale(i, self.y[i].abs());
         }
-        // RADAU5's Newton tolerance max(10 ε / rtol, min(0.03, √rtol)), with the smallest
-        // relative tolerance (at least 1000 ε, so that a pure atol still iterates).
+        // RADAU5's Newton tolerance max(10 u / rtol, min(0.03, √rtol)) with its rounding unit
+        // u = UROUND, with the smallest relative tolerance (at least 1000 ε, so that a pure
+        // atol still iterates).
         let rtol = weights
             .rtol
             .iter()
@@ -635,10 +636,15 @@ impl Stepper for RadauStepper {
 /// Newton work ([`NewtonWork`]). Unlike `radau5.f`, the tolerances are used as given (RADAU5
 /// replaces `rtol` by `rtol' = 0.1 rtol^(2/3)` and `atol` by `rtol' atol/rtol` internally), so
 /// that `rtol` means the same for every method: the local error per step. Given those
-/// internal tolerances and an exact Jacobian, the method takes `radau5.f`'s steps: the same
-/// accepted and rejected attempts, Newton iterations, Jacobians and factorisations (tested
-/// on van der Pol's and Robertson's problems, `runtime/tests/radau5_reference.rs`), with one
-/// more evaluation of `F`, at the final state. Dense output ([`OutputTimes::At`]) is the
+/// internal tolerances, an exact Jacobian and the same starting step
+/// ([`IntegratorOptions::with_dt`]), the method takes `radau5.f`'s steps: the same accepted
+/// and rejected attempts, evaluations of `F` (one more, at the final state), Jacobians and
+/// factorisations (tested on van der Pol's and Robertson's problems,
+/// `runtime/tests/radau5_reference.rs`). Two things can still part them: a maximum step
+/// (`dt_max` caps the proposal after the test for holding the step, radau5.f's `HMAX`
+/// before it), and the end of the interval, where the driver stretches a step by up to 1 %
+/// onto `t_end` (as DOPRI5 does) while radau5.f takes a step only as far as `t_end`
+/// reaches. Dense output ([`OutputTimes::At`]) is the
 /// collocation polynomial of each step (degree 3, continuous extension of order 3). With
 /// [`IntegratorOptions::fixed_step`] the method takes constant steps `dt` without error
 /// control; Newton then iterates until it converges, diverges or uses up its iterations, and a
