@@ -491,50 +491,68 @@ mod tests {
         assert_eq!(rhs.jacobian_evals(), 1);
     }
 
+    /// Implicit midpoint with the default Newton options, fixed steps of `dt` from `y0` at
+    /// `t = 0` to `t_end`.
+    fn fixed_steps(
+        system: &mut dyn OdeSystem,
+        y0: f64,
+        dt: f64,
+        t_end: f64,
+    ) -> Result<Solution, IntegrationError> {
+        let options = IntegratorOptions::default()
+            .with_fixed_step(true)
+            .with_dt(dt);
+        ImplicitMidpoint::new()
+            .integrate(system, 0.0, &[y0], t_end, &OutputTimes::Steps, &options)
+            .map_err(|failure| failure.error)
+    }
+
+    /// `ẏ = a(t) y` with `a = before` for `t < at` and `after` from `at` on, with its exact
+    /// Jacobian.
+    struct Switched {
+        at: f64,
+        before: f64,
+        after: f64,
+    }
+
+    impl Switched {
+        fn a(&self, t: f64) -> f64 {
+            if t < self.at { self.before } else { self.after }
+        }
+    }
+
+    impl OdeSystem for Switched {
+        fn dim(&self) -> usize {
+            1
+        }
+        fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), crate::ode::RhsError> {
+            dy[0] = self.a(t) * y[0];
+            Ok(())
+        }
+        fn jacobian(
+            &mut self,
+            t: f64,
+            _y: &[f64],
+            jac: &mut [f64],
+        ) -> Result<bool, crate::ode::RhsError> {
+            jac[0] = self.a(t);
+            Ok(true)
+        }
+    }
+
     /// A Jacobian kept from an earlier step that fails the iteration is replaced before the
-    /// step is given up: `ẏ = −a(t) y` with `a` switching from 0 to 100 at t = 0.2, steps of
+    /// step is given up: `ẏ = a(t) y` with `a` switching from 0 to −100 at t = 0.2, steps of
     /// 0.25. The second step starts with the first step's `J = 0`, with which the simplified
     /// Newton iteration multiplies its error by `h a / 2 = 12.5`; the fresh `J = −100` solves
     /// the linear stage equation, and the step ends at the rule's value.
     #[test]
     fn a_stale_jacobian_that_fails_is_replaced() {
-        struct Switched;
-        impl OdeSystem for Switched {
-            fn dim(&self) -> usize {
-                1
-            }
-            fn rhs(
-                &mut self,
-                t: f64,
-                y: &[f64],
-                dy: &mut [f64],
-            ) -> Result<(), crate::ode::RhsError> {
-                dy[0] = if t < 0.2 { 0.0 } else { -100.0 * y[0] };
-                Ok(())
-            }
-            fn jacobian(
-                &mut self,
-                t: f64,
-                _y: &[f64],
-                jac: &mut [f64],
-            ) -> Result<bool, crate::ode::RhsError> {
-                jac[0] = if t < 0.2 { 0.0 } else { -100.0 };
-                Ok(true)
-            }
-        }
-        let options = IntegratorOptions::default()
-            .with_fixed_step(true)
-            .with_dt(0.25);
-        let solution = ImplicitMidpoint::new()
-            .integrate(
-                &mut Switched,
-                0.0,
-                &[1.0],
-                0.5,
-                &OutputTimes::Steps,
-                &options,
-            )
-            .unwrap();
+        let mut switched = Switched {
+            at: 0.2,
+            before: 0.0,
+            after: -100.0,
+        };
+        let solution = fixed_steps(&mut switched, 1.0, 0.25, 0.5).unwrap();
         let rule = (1.0 - 0.25 * 100.0 / 2.0) / (1.0 + 0.25 * 100.0 / 2.0);
         assert!((solution.y[2] - rule).abs() < 1e-12, "{}", solution.y[2]);
         assert_eq!(solution.stats.jacobian_evals, 2);
@@ -608,19 +626,7 @@ mod tests {
 
         /// `steps` fixed steps of `h` from `y0` with the default Newton options.
         fn run(&mut self, y0: f64, h: f64, steps: usize) -> Result<Solution, IntegrationError> {
-            let options = IntegratorOptions::default()
-                .with_fixed_step(true)
-                .with_dt(h);
-            ImplicitMidpoint::new()
-                .integrate(
-                    self,
-                    0.0,
-                    &[y0],
-                    steps as f64 * h,
-                    &OutputTimes::Steps,
-                    &options,
-                )
-                .map_err(|failure| failure.error)
+            fixed_steps(self, y0, h, steps as f64 * h)
         }
     }
 
@@ -729,43 +735,12 @@ mod tests {
     /// value `(−3)² · 5/3 = 15`.
     #[test]
     fn a_stale_jacobian_singular_at_a_new_step_size_is_replaced() {
-        struct Switched;
-        impl OdeSystem for Switched {
-            fn dim(&self) -> usize {
-                1
-            }
-            fn rhs(
-                &mut self,
-                t: f64,
-                y: &[f64],
-                dy: &mut [f64],
-            ) -> Result<(), crate::ode::RhsError> {
-                dy[0] = if t < 2.0 { 4.0 } else { 1.0 } * y[0];
-                Ok(())
-            }
-            fn jacobian(
-                &mut self,
-                t: f64,
-                _y: &[f64],
-                jac: &mut [f64],
-            ) -> Result<bool, crate::ode::RhsError> {
-                jac[0] = if t < 2.0 { 4.0 } else { 1.0 };
-                Ok(true)
-            }
-        }
-        let options = IntegratorOptions::default()
-            .with_fixed_step(true)
-            .with_dt(1.0);
-        let solution = ImplicitMidpoint::new()
-            .integrate(
-                &mut Switched,
-                0.0,
-                &[1.0],
-                2.5,
-                &OutputTimes::Steps,
-                &options,
-            )
-            .unwrap();
+        let mut switched = Switched {
+            at: 2.0,
+            before: 4.0,
+            after: 1.0,
+        };
+        let solution = fixed_steps(&mut switched, 1.0, 1.0, 2.5).unwrap();
         let (t, y) = solution.last().unwrap();
         assert_eq!(t, 2.5);
         assert!((y[0] - 15.0).abs() < 1e-12, "{}", y[0]);

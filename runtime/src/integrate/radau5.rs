@@ -566,11 +566,11 @@ impl Stepper for RadauStepper {
     }
 
     fn newton_work(&self) -> Option<NewtonWork> {
-        Some(NewtonWork {
-            iterations: self.iterations,
-            max_iterations: self.max_iterations,
-            matrices_reusable: self.theta <= JACOBIAN_REUSE_THETA,
-        })
+        Some(NewtonWork::new(
+            self.iterations,
+            self.max_iterations,
+            self.theta <= JACOBIAN_REUSE_THETA,
+        ))
     }
 
     fn accept(&mut self, rhs: &mut CheckedRhs<'_>) -> Result<(), StepFailure> {
