@@ -51,7 +51,13 @@ fn main() {
         );
         let _ = writeln!(
             registry,
-            "    ModelEntry {{ name: {name:?}, path: {path:?}, make: || ::std::boxed::Box::new(crate::FirstOrder::new({module}::{ty}::default())) }},",
+            "    ModelEntry {{ name: {name:?}, file: {file:?}, source: include_str!({path:?}), make: || ::std::boxed::Box::new(crate::FirstOrder::new({module}::{ty}::default())) }},",
+            file = format!(
+                "models/{}",
+                f.file_name()
+                    .and_then(|s| s.to_str())
+                    .unwrap_or("model.yaml")
+            ),
             path = f.display().to_string(),
         );
     }

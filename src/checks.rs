@@ -380,9 +380,8 @@ fn against_expected(
 /// use eomgen::checks::{Simulations, motion_checks};
 ///
 /// let source = eomgen::ModelSource::open("simple_pendulum")?;
-/// let path = eomgen::models::find("simple_pendulum").unwrap().path;
-/// let text = std::fs::read_to_string(path).unwrap();
-/// let file = eomgen_symbolic::model::load(path, &text).unwrap();
+/// let entry = eomgen::models::find("simple_pendulum").unwrap();
+/// let file = eomgen_symbolic::model::load(entry.file, entry.source).unwrap();
 /// let mut model = source.instantiate();
 /// let y0 = model.consistent_initial_state().unwrap();
 /// let mut simulations = Simulations::new(source);

@@ -105,19 +105,19 @@ impl FloquetReferences {
     /// ```
     pub fn of(source: &ModelSource, equilibrium: &str) -> Result<Option<Self>, ReferenceError> {
         let path = source.path();
-        let text = std::fs::read_to_string(path).map_err(|e| ReferenceError::Read {
+        let bytes = source.bytes().map_err(|e| ReferenceError::Read {
             path: path.to_string(),
             source: e,
         })?;
-        let file = eomgen_symbolic::model::load(path, &text).map_err(|diagnostics| {
-            ReferenceError::Model {
-                path: path.to_string(),
-                messages: diagnostics
-                    .iter()
-                    .map(|d| format!("{}:{}: {}", d.location.line, d.location.column, d.message))
-                    .collect(),
-            }
-        })?;
+        let mistakes = |diagnostics: &[eomgen_symbolic::model::Diagnostic]| ReferenceError::Model {
+            path: path.to_string(),
+            messages: diagnostics
+                .iter()
+                .map(|d| format!("{}:{}: {}", d.location.line, d.location.column, d.message))
+                .collect(),
+        };
+        let text = eomgen_symbolic::model::decode(&bytes).map_err(|d| mistakes(&[d]))?;
+        let file = eomgen_symbolic::model::load(path, text).map_err(|d| mistakes(&d))?;
         Ok(file
             .floquet
             .into_iter()

@@ -67,14 +67,17 @@ pub struct RustPageDoctests;
 
 /// Every model in `models/`, compiled in: one module and struct per file, and [`models::ALL`].
 pub mod models {
-    /// A bundled model: its name, its file, and a constructor of its first-order form with
+    /// A bundled model: its name, its file's text (compiled into the binary, so an installed
+    /// or moved program needs no source tree), and a constructor of its first-order form with
     /// the file's default parameters.
     #[derive(Debug, Clone, Copy)]
     pub struct ModelEntry {
         /// The model's `name`.
         pub name: &'static str,
-        /// Absolute path of its YAML file at build time.
-        pub path: &'static str,
+        /// The file as it is shown in messages and diagnostics: `models/<file name>`.
+        pub file: &'static str,
+        /// The text of the model file, as it was compiled.
+        pub source: &'static str,
         /// Builds the model with its default parameters.
         pub make: fn() -> Box<dyn crate::ModelInfo>,
     }

@@ -86,11 +86,24 @@ impl ModelSource {
         }
     }
 
-    /// The model file: a bundled model's file at build time, or the path given.
+    /// The model file as messages name it: `models/<file>` for a bundled model, or the path
+    /// given.
     pub fn path(&self) -> &str {
         match self {
-            ModelSource::Bundled(entry) => entry.path,
+            ModelSource::Bundled(entry) => entry.file,
             ModelSource::File { path, .. } => path,
+        }
+    }
+
+    /// The bytes of the model file: a bundled model's text as compiled into the program (no
+    /// file is read, so an installed program needs no source tree), or the file read again.
+    ///
+    /// # Errors
+    /// The operating system's error when the file cannot be read.
+    pub fn bytes(&self) -> std::io::Result<std::borrow::Cow<'static, [u8]>> {
+        match self {
+            ModelSource::Bundled(entry) => Ok(std::borrow::Cow::Borrowed(entry.source.as_bytes())),
+            ModelSource::File { path, .. } => read_file(path).map(std::borrow::Cow::Owned),
         }
     }
 
@@ -116,6 +129,33 @@ pub enum Resolved {
     Bundled(&'static ModelEntry),
     /// A model file, by the path given.
     File(String),
+}
+
+impl Resolved {
+    /// The model file as messages name it: `models/<file>` for a bundled model, or the path
+    /// given.
+    pub fn path(&self) -> &str {
+        match self {
+            Resolved::Bundled(entry) => entry.file,
+            Resolved::File(path) => path,
+        }
+    }
+
+    /// The bytes of the model file, as [`ModelSource::bytes`].
+    ///
+    /// # Errors
+    /// The operating system's error when the file cannot be read.
+    pub fn bytes(&self) -> std::io::Result<std::borrow::Cow<'static, [u8]>> {
+        match self {
+            Resolved::Bundled(entry) => Ok(std::borrow::Cow::Borrowed(entry.source.as_bytes())),
+            Resolved::File(path) => read_file(path).map(std::borrow::Cow::Owned),
+        }
+    }
+}
+
+/// Reads a model file named on a command line.
+fn read_file(path: &str) -> std::io::Result<Vec<u8>> {
+    std::fs::read(path)
 }
 
 /// Resolves `name_or_path` as [`ModelSource::open`] does, without loading anything: a path

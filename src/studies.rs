@@ -10,15 +10,14 @@ use crate::{ModelSource, OpenError};
 
 /// The model file behind `source`, loaded (with its path).
 fn load_file(source: &ModelSource) -> Result<(String, ModelFile), TwinError> {
-    let path = match source {
-        ModelSource::Bundled(entry) => entry.path,
-        ModelSource::File { path, .. } => path.as_str(),
-    };
-    let text = std::fs::read_to_string(path).map_err(|e| TwinError::Read {
+    let path = source.path();
+    let read = |message: String| TwinError::Read {
         path: path.to_string(),
-        message: e.to_string(),
-    })?;
-    let file = eomgen_symbolic::model::load(path, &text).map_err(|d| TwinError::Diagnostics {
+        message,
+    };
+    let bytes = source.bytes().map_err(|e| read(e.to_string()))?;
+    let text = eomgen_symbolic::model::decode(&bytes).map_err(|d| read(d.message))?;
+    let file = eomgen_symbolic::model::load(path, text).map_err(|d| TwinError::Diagnostics {
         path: path.to_string(),
         count: d.len(),
     })?;

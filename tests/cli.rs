@@ -259,7 +259,7 @@ fn check_passes_on_every_model_and_accepts_paths() {
     }
     let out = eomgen(&[
         "check",
-        eomgen::models::find("double_pendulum").unwrap().path,
+        concat!(env!("CARGO_MANIFEST_DIR"), "/models/double_pendulum.yaml"),
         "--json",
     ]);
     assert!(out.status.success());
@@ -735,4 +735,140 @@ fn modes_prints_its_chart_paths_after_the_results() {
     );
     assert_eq!(lines.len() - first_chart, 2, "one chart per mode: {text}");
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// An installed program (`cargo install`, a copied binary, a moved checkout) needs no source
+/// tree (issue 28, item 3): the bundled models' files are compiled into the binary, so every
+/// command that reads a bundled model's file — `check`, `equations`, `report`, `study floquet`,
+/// `study constraint-methods` — works from a copy of the binary run in an empty directory.
+/// (Before, `build.rs` recorded each file's absolute path and these commands read it: "cannot
+/// read models/double_pendulum.yaml" once the checkout had moved.) The registry holds no path
+/// any more (`ModelEntry` has the file's text and its display name only), so nothing can read
+/// the build-time tree; this run also catches a read relative to the working directory.
+#[test]
+fn issue_28_bundled_models_run_without_the_source_tree() {
+    let dir = tempfile::tempdir().unwrap();
+    let binary = dir.path().join("eomgen");
+    std::fs::copy(env!("CARGO_BIN_EXE_eomgen"), &binary).unwrap();
+    let runs: [&[&str]; 6] = [
+        &["check", "double_pendulum"],
+        &["equations", "simple_pendulum_cartesian", "--latex"],
+        &["equations", "double_pendulum", "--rust"],
+        &["report", "--models", "simple_pendulum", "--out", "report"],
+        &["study", "floquet", "mathieu_pendulum", "--tol", "1e-6"],
+        &[
+            "study",
+            "constraint-methods",
+            "simple_pendulum_cartesian",
+            "--t-end",
+            "0.5",
+        ],
+    ];
+    for args in runs {
+        let out = std::process::Command::new(&binary)
+            .args(args)
+            .current_dir(dir.path())
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success(), "{args:?}: {err}");
+        assert!(!err.contains("cannot read"), "{args:?}: {err}");
+    }
+    assert!(dir.path().join("report/index.html").is_file());
+}
+
+/// `equations` of a constrained model prints the equations the runtime solves (issue 28,
+/// item 8: it printed `M q'' = F`, a free-falling particle, for the Cartesian pendulum):
+/// `M q̈ + Jᵀλ = F` and `J q̈ = γ` with the constraint `Φ = 0`. Each printed expression is
+/// parsed back and evaluated at random states against the closed forms of the pendulum on a
+/// rod, `Φ = r − l` with `r = √(x² + y²)`: `J = (x, y)/r` and
+/// `γ = −(ẋ² + ẏ²)/r + (x ẋ + y ẏ)²/r³` (to 1e-12 relative: a few roundings). The sign of
+/// `λ` is the one `simulate` reports: hanging at rest, `Jᵀλ = F` gives `λ = m g`, the tension
+/// `simulate --json` prints as the constraint force.
+#[test]
+fn issue_28_equations_of_a_constrained_model_show_the_constraint_forces() {
+    use eomgen_symbolic::model::parser::{eval_expr, parse_expr};
+    let out = eomgen(&["equations", "simple_pendulum_cartesian"]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success());
+    assert!(
+        text.contains("M q'' + J^T lambda = F and J q'' = gamma"),
+        "{text}"
+    );
+    assert!(
+        text.contains("rod: sqrt(x^2 + y^2) - l = 0 (holonomic"),
+        "{text}"
+    );
+    let latex = stdout(eomgen_ok(&[
+        "equations",
+        "simple_pendulum_cartesian",
+        "--latex",
+    ]));
+    assert!(latex.contains("\\lambda_{\\mathrm{rod}}"), "{latex}");
+    let nonholonomic = stdout(eomgen_ok(&["equations", "chaplygin_sleigh"]));
+    assert!(
+        nonholonomic.contains("(non-holonomic: A q' + b = 0)"),
+        "{nonholonomic}"
+    );
+
+    let json = stdout(eomgen_ok(&[
+        "equations",
+        "simple_pendulum_cartesian",
+        "--json",
+    ]));
+    let v: serde_json::Value = serde_json::from_str(&json).unwrap();
+    let e = &v["equations"];
+    let rod = &e["constraints"][0];
+    assert_eq!(rod["name"], "rod");
+    assert_eq!(rod["kind"], "holonomic");
+    let (m, l, g) = (1.0, 1.0, 10.0);
+    let mut rng = common::seeded_rng(28);
+    for _ in 0..20 {
+        use rand::RngExt as _;
+        let [x, y, xd, yd]: [f64; 4] = std::array::from_fn(|_| rng.random_range(-2.0..2.0));
+        let value = |text: &serde_json::Value| {
+            let expr = parse_expr(text.as_str().unwrap(), Default::default()).unwrap();
+            eval_expr(&expr, &|name| match name {
+                "x" => Some(x),
+                "y" => Some(y),
+                "x_dot" => Some(xd),
+                "y_dot" => Some(yd),
+                "m" => Some(m),
+                "l" => Some(l),
+                "g" => Some(g),
+                _ => None,
+            })
+            .unwrap()
+        };
+        let r = x.hypot(y);
+        let close = |a: f64, b: f64| (a - b).abs() <= 1e-12 * b.abs().max(1.0);
+        assert!(close(value(&rod["equation"]), r - l));
+        assert!(close(value(&rod["jacobian"][0]), x / r));
+        assert!(close(value(&rod["jacobian"][1]), y / r));
+        let gamma = -(xd * xd + yd * yd) / r + (x * xd + y * yd).powi(2) / r.powi(3);
+        assert!(
+            close(value(&rod["gamma"]), gamma),
+            "{} {gamma}",
+            value(&rod["gamma"])
+        );
+        assert!(close(value(&e["forcing"][1]), -m * g));
+        assert!(close(value(&e["mass_matrix"][0][0]), m));
+    }
+    // Hanging at rest: q̈ = 0, so Jᵀλ = F with J = (0, −1) gives λ = m g, as simulated.
+    let run = stdout(eomgen_ok(&[
+        "simulate",
+        "simple_pendulum_cartesian",
+        "--init",
+        "x=0,y=-l",
+        "--t-end",
+        "0.01",
+        "--json",
+    ]));
+    let run: serde_json::Value = serde_json::from_str(&run).unwrap();
+    let lambda = run["samples"][0]["constraint_forces"][0].as_f64().unwrap();
+    assert!((lambda - m * g).abs() < 1e-12, "{lambda}");
+}
+
+fn stdout(out: std::process::Output) -> String {
+    String::from_utf8(out.stdout).unwrap()
 }

@@ -125,6 +125,10 @@ fn json_output_keeps_its_schema() {
                 "--json",
             ],
         ),
+        (
+            "equations_constrained",
+            vec!["equations", "simple_pendulum_cartesian", "--json"],
+        ),
         ("modes", vec!["modes", "three_masses_damped", "--json"]),
         (
             "modes_constrained",

@@ -45,8 +45,8 @@ fn outside_domain(model: &dyn eomgen::ModelInfo, t: f64, y: &[f64]) -> bool {
 fn generated_code_equals_engine_evaluation() {
     let mut rng = seeded_rng(0x9E37_79B9_7F4A_7C15);
     for entry in ALL {
-        let source = std::fs::read_to_string(entry.path).expect("model file readable");
-        let file = eomgen_symbolic::model::load(entry.path, &source).expect("bundled model loads");
+        let file =
+            eomgen_symbolic::model::load(entry.file, entry.source).expect("bundled model loads");
         let mut model = SymbolicModel::from_file(&file).expect("bundled model lowers");
         let eom = Lagrange.derive(&mut model);
         let jac = Jacobians::of(&mut model, &eom);
@@ -250,8 +250,7 @@ fn every_model_simulates_from_its_initial_state() {
 fn point_positions_equal_engine_evaluation() {
     let mut rng = seeded_rng(2024);
     for entry in ALL {
-        let source = std::fs::read_to_string(entry.path).expect("model file readable");
-        let file = eomgen_symbolic::model::load(entry.path, &source).expect("loads");
+        let file = eomgen_symbolic::model::load(entry.file, entry.source).expect("loads");
         let model = SymbolicModel::from_file(&file).expect("lowers");
         let generated = (entry.make)();
         assert_eq!(

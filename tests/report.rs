@@ -322,8 +322,7 @@ fn compact(n: &Node) -> String {
 #[test]
 fn mathml_of_the_simple_pendulum_equation() {
     let entry = eomgen::models::find("simple_pendulum").expect("bundled");
-    let source = std::fs::read_to_string(entry.path).unwrap();
-    let file = eomgen_symbolic::model::load(entry.path, &source).expect("loads");
+    let file = eomgen_symbolic::model::load(entry.file, entry.source).expect("loads");
     let mut model = SymbolicModel::from_file(&file).expect("lowers");
     let eom = Lagrange.derive(&mut model);
     let lines = equations_mathml(&mut model, &eom);

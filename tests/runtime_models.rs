@@ -154,6 +154,12 @@ fn compare(name: &str, compiled: &mut dyn ModelInfo, runtime: &mut dyn ModelInfo
     }
 }
 
+/// The file of a bundled model in this source tree (the program itself reads the text it
+/// compiled in, `entry.source`).
+fn bundled_file(entry: &eomgen::models::ModelEntry) -> String {
+    format!("{}/{}", env!("CARGO_MANIFEST_DIR"), entry.file)
+}
+
 fn runtime_model(path: &str, backend: Option<Backend>) -> Box<dyn ModelInfo> {
     let options = LoadOptions {
         backend,
@@ -175,7 +181,7 @@ fn runtime_model(path: &str, backend: Option<Backend>) -> Box<dyn ModelInfo> {
 fn every_bundled_model_compiled_at_run_time_equals_the_macro_compiled_one() {
     for entry in eomgen::models::ALL {
         let mut compiled = (entry.make)();
-        let mut runtime = runtime_model(entry.path, None);
+        let mut runtime = runtime_model(&bundled_file(entry), None);
         compare(entry.name, compiled.as_mut(), runtime.as_mut(), 50);
     }
 }
@@ -184,7 +190,7 @@ fn every_bundled_model_compiled_at_run_time_equals_the_macro_compiled_one() {
 fn the_interpreter_equals_the_macro_compiled_model_too() {
     for entry in eomgen::models::ALL {
         let mut compiled = (entry.make)();
-        let mut runtime = runtime_model(entry.path, Some(Backend::Interpreter));
+        let mut runtime = runtime_model(&bundled_file(entry), Some(Backend::Interpreter));
         compare(entry.name, compiled.as_mut(), runtime.as_mut(), 10);
     }
 }
@@ -197,7 +203,7 @@ fn parameters_set_by_name_agree() {
     let mut random = seeded_rng(42);
     for entry in eomgen::models::ALL {
         let mut compiled = (entry.make)();
-        let mut runtime = runtime_model(entry.path, None);
+        let mut runtime = runtime_model(&bundled_file(entry), None);
         let names: Vec<String> = compiled
             .parameter_names()
             .iter()

@@ -5,7 +5,8 @@ use clap::{Args, ValueEnum};
 
 use super::CliError;
 use super::output::out;
-use eomgen_symbolic::codegen::{GenerateError, equations_latex, equations_text};
+use eomgen_symbolic::codegen::{EquationsListing, GenerateError, equations_latex, equations_text};
+use eomgen_symbolic::expr::print::Syntax;
 use eomgen_symbolic::mechanics::{Formulation, Lagrange, MomentumBalance, SymbolicModel};
 use eomgen_symbolic::model::templates;
 
@@ -29,6 +30,10 @@ pub struct EquationsArgs {
     /// Print LaTeX (amsmath) instead of text.
     #[arg(long, conflicts_with = "rust")]
     pub latex: bool,
+    /// Print JSON: `{"model", "method", "equations", "latex"}`, the equations (T, V, Q, M, F
+    /// and each constraint's equation, Jacobian row and γ) as text and as LaTeX.
+    #[arg(long, conflicts_with_all = ["rust", "latex"])]
+    pub json: bool,
     /// Print the Rust that `eomgen::model!` generates for the file (formatted; the same
     /// pipeline as the macro, with the file tracked by its path as shown).
     #[arg(long, conflicts_with = "method")]
@@ -46,14 +51,10 @@ pub struct NewArgs {
 
 /// Reads a bundled model by name or any file by path: `(display path, source)`.
 pub fn read_model(model: &str) -> Result<(String, String), CliError> {
-    let (display, path) = match eomgen::resolve(model).map_err(super::open_error)? {
-        eomgen::Resolved::File(path) => (path.clone(), path),
-        eomgen::Resolved::Bundled(entry) => (
-            format!("models/{}.yaml", entry.name),
-            entry.path.to_string(),
-        ),
-    };
-    let bytes = std::fs::read(&path)
+    let resolved = eomgen::resolve(model).map_err(super::open_error)?;
+    let display = resolved.path().to_string();
+    let bytes = resolved
+        .bytes()
         .map_err(|e| CliError::usage(format!("cannot read `{display}`: {e}")).before_output())?;
     let source = eomgen_symbolic::model::decode(&bytes)
         .map_err(|d| super::diagnostics_error(&display, &String::from_utf8_lossy(&bytes), &[d]))?
@@ -68,6 +69,19 @@ pub fn render(
     diagnostics: &[eomgen_symbolic::model::Diagnostic],
 ) -> CliError {
     super::diagnostics_error(display, source, diagnostics)
+}
+
+/// What `eomgen equations --json` prints.
+#[derive(serde::Serialize)]
+struct EquationsReport<'a> {
+    /// The model's name.
+    model: &'a str,
+    /// `lagrange` or `momentum`.
+    method: &'static str,
+    /// The equations in the model file's syntax.
+    equations: EquationsListing,
+    /// The same in LaTeX.
+    latex: EquationsListing,
 }
 
 /// Runs `equations`.
@@ -103,7 +117,20 @@ pub fn run(args: &EquationsArgs) -> Result<(), CliError> {
             MomentumBalance.derive(&mut model)
         }
     };
-    if args.latex {
+    if args.json {
+        let report = EquationsReport {
+            model: &model.name,
+            method: match args.method {
+                Method::Lagrange => "lagrange",
+                Method::Momentum => "momentum",
+            },
+            equations: EquationsListing::of(&model, &eom, Syntax::Text),
+            latex: EquationsListing::of(&model, &eom, Syntax::Latex),
+        };
+        let text = serde_json::to_string_pretty(&report)
+            .map_err(|e| CliError::failure(format!("cannot encode the equations: {e}")))?;
+        out!("{text}\n");
+    } else if args.latex {
         out!("{}", equations_latex(&model, &eom));
     } else {
         out!("{}", equations_text(&model, &eom));

@@ -50,7 +50,8 @@ enum Command {
     /// Derive a model (bundled, or any YAML file) by Lagrange and by momentum balance at run
     /// time and cross-check them and the power balance; exit 1 if a check fails.
     Check(check::CheckArgs),
-    /// Print a model's equations of motion M q'' = F (text or LaTeX), derived at run time.
+    /// Print a model's equations of motion M q'' = F (+ J^T lambda and J q'' = gamma with
+    /// constraints) as text, LaTeX or JSON, derived at run time.
     Equations(equations::EquationsArgs),
     /// Equilibrium, exact linearisation (M, C, K), natural frequencies, mode shapes and
     /// damping ratios at an operating point (`--at hanging`).

@@ -6,8 +6,14 @@
 //! and builds its nalgebra static matrix from a stack array. Output is deterministic: it
 //! depends only on the model file.
 
+mod listing;
 pub mod program;
 pub mod tape;
+
+pub use listing::{
+    ConstraintKind, ConstraintListing, EquationsListing, GeneralizedForce, equations_latex,
+    equations_text,
+};
 
 use std::fmt::Write as _;
 
@@ -636,58 +642,6 @@ pub fn emit(
         .parse()
         .map_err(|e| format!("generated code does not tokenize ({e}):\n{src}"))?;
     Ok((tokens, stats))
-}
-
-/// The equations as text: `T`, `V`, `Q`, then `M` and `F` entry by entry.
-pub fn equations_text(model: &SymbolicModel, eom: &EquationsOfMotion) -> String {
-    let p = Printer::new(&model.arena, Syntax::Text);
-    let n = eom.num_dofs;
-    let mut s = String::new();
-    let _ = writeln!(s, "q = [{}]", model.coordinate_names.join(", "));
-    let _ = writeln!(s, "T = {}", p.print(model.kinetic));
-    let _ = writeln!(s, "V = {}", p.print(model.potential));
-    for (i, q) in model.generalized_forces.iter().enumerate() {
-        if !model.arena.is_zero(*q) {
-            let _ = writeln!(s, "Q[{}] = {}", model.coordinate_names[i], p.print(*q));
-        }
-    }
-    let _ = writeln!(s, "M q'' = F with");
-    for i in 0..n {
-        for j in i..n {
-            let _ = writeln!(s, "  M[{i},{j}] = {}", p.print(eom.mass(i, j)));
-        }
-    }
-    for i in 0..n {
-        let _ = writeln!(s, "  F[{i}] = {}", p.print(eom.forcing[i]));
-    }
-    s
-}
-
-/// The equations as LaTeX (`amsmath`): `T`, `V` and `M(q) q̈ = F`.
-pub fn equations_latex(model: &SymbolicModel, eom: &EquationsOfMotion) -> String {
-    let p = Printer::new(&model.arena, Syntax::Latex);
-    let n = eom.num_dofs;
-    let mut s = String::new();
-    let _ = writeln!(s, "T = {}", p.print(model.kinetic));
-    let _ = writeln!(s, "\\\\\nV = {}", p.print(model.potential));
-    let rows: Vec<String> = (0..n)
-        .map(|i| {
-            (0..n)
-                .map(|j| p.print(eom.mass(i, j)))
-                .collect::<Vec<_>>()
-                .join(" & ")
-        })
-        .collect();
-    let acc: Vec<String> = (0..n).map(|i| p.print(model.coordinates[i][2])).collect();
-    let forcing: Vec<String> = eom.forcing.iter().map(|f| p.print(*f)).collect();
-    let _ = writeln!(
-        s,
-        "\\\\\n\\begin{{bmatrix}} {} \\end{{bmatrix}} \\begin{{bmatrix}} {} \\end{{bmatrix}} = \\begin{{bmatrix}} {} \\end{{bmatrix}}",
-        rows.join(" \\\\ "),
-        acc.join(" \\\\ "),
-        forcing.join(" \\\\ ")
-    );
-    s
 }
 
 /// The equations as MathML, one `<math display="block">` element per line: `T = …`,

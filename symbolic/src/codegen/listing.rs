@@ -1,0 +1,246 @@
+//! The equations of motion as a reader sees them: `eomgen equations` (text, LaTeX, JSON) and
+//! the `equations_text`/`equations_latex` of every generated model.
+//!
+//! A constrained model's equations are the ones the runtime solves,
+//!
+//! ```text
+//! M(q, t) q̈ + Jᵀ(q, t) λ = F(q, q̇, t),     J q̈ = γ(q, q̇, t),
+//! ```
+//!
+//! with `λ` the Lagrange multipliers (the constraint forces, in the sign of the runtime's
+//! `lagrange_multipliers`), each holonomic constraint `Φ(q, t) = 0` with its row `J = ∂Φ/∂q`
+//! and each non-holonomic one `A(q, t) q̇ + b = 0` with its row `J = A` (DESIGN.md,
+//! "Derivations"; lectures 8–10 of the course, method II.1).
+
+use std::fmt::Write as _;
+
+use crate::expr::print::{Printer, Syntax};
+use crate::mechanics::{EquationsOfMotion, SymbolicModel};
+
+/// Whether a constraint restricts positions or only velocities.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ConstraintKind {
+    /// `Φ(q, t) = 0`.
+    Holonomic,
+    /// `A(q, t) q̇ + b(q, t) = 0`, linear in the rates.
+    Nonholonomic,
+}
+
+/// One constraint as printed: its equation, its row of the constraint Jacobian and its `γ`.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct ConstraintListing {
+    /// The constraint's name in the file.
+    pub name: String,
+    /// Holonomic or non-holonomic.
+    pub kind: ConstraintKind,
+    /// The expression that is zero: `Φ(q, t)`, or `A q̇ + b`.
+    pub equation: String,
+    /// Its row of the constraint Jacobian `J` (length `n`): `∂Φ/∂qⱼ`, or `Aⱼ`.
+    pub jacobian: Vec<String>,
+    /// `γ` of `J q̈ = γ` (the constraint differentiated once more in time, minus its
+    /// acceleration terms).
+    pub gamma: String,
+}
+
+/// A generalized force that is not zero.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct GeneralizedForce {
+    /// The coordinate it acts on.
+    pub coordinate: String,
+    /// `Q` for that coordinate (N or N·m).
+    pub expression: String,
+}
+
+/// The equations of motion of a model printed in one syntax ([`Syntax::Text`] parses back
+/// with the model parser; [`Syntax::Latex`] for documents).
+///
+/// # Shapes
+/// `n` coordinates and `m` constraints: `mass_matrix` is `n × n` (rows), `forcing` has `n`
+/// entries, `constraints` `m` (holonomic first).
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct EquationsListing {
+    /// The generalized coordinates `q`, in order.
+    pub coordinates: Vec<String>,
+    /// The kinetic energy `T` (J).
+    pub kinetic_energy: String,
+    /// The potential energy `V` (J).
+    pub potential_energy: String,
+    /// The generalized forces that are not zero.
+    pub generalized_forces: Vec<GeneralizedForce>,
+    /// `M(q, t)`, by rows.
+    pub mass_matrix: Vec<Vec<String>>,
+    /// `F(q, q̇, t)`.
+    pub forcing: Vec<String>,
+    /// The constraints, holonomic then non-holonomic; empty for an unconstrained model, whose
+    /// equations are `M q̈ = F`.
+    pub constraints: Vec<ConstraintListing>,
+}
+
+impl EquationsListing {
+    /// Prints the equations `eom` of `model` in `syntax`.
+    pub fn of(model: &SymbolicModel, eom: &EquationsOfMotion, syntax: Syntax) -> Self {
+        let p = Printer::new(&model.arena, syntax);
+        let n = eom.num_dofs;
+        let c = &model.constraints;
+        let constraints = (0..c.len())
+            .map(|k| {
+                let holonomic = k < c.holonomic;
+                ConstraintListing {
+                    name: c.names[k].clone(),
+                    kind: if holonomic {
+                        ConstraintKind::Holonomic
+                    } else {
+                        ConstraintKind::Nonholonomic
+                    },
+                    equation: p.print(if holonomic { c.phi[k] } else { c.velocity[k] }),
+                    jacobian: (0..n).map(|j| p.print(c.jacobian[k * n + j])).collect(),
+                    gamma: p.print(c.gamma[k]),
+                }
+            })
+            .collect();
+        Self {
+            coordinates: model.coordinate_names.clone(),
+            kinetic_energy: p.print(model.kinetic),
+            potential_energy: p.print(model.potential),
+            generalized_forces: model
+                .generalized_forces
+                .iter()
+                .enumerate()
+                .filter(|(_, q)| !model.arena.is_zero(**q))
+                .map(|(i, q)| GeneralizedForce {
+                    coordinate: model.coordinate_names[i].clone(),
+                    expression: p.print(*q),
+                })
+                .collect(),
+            mass_matrix: (0..n)
+                .map(|i| (0..n).map(|j| p.print(eom.mass(i, j))).collect())
+                .collect(),
+            forcing: eom.forcing.iter().map(|f| p.print(*f)).collect(),
+            constraints,
+        }
+    }
+}
+
+/// The equations as text: `q`, `T`, `V`, `Q`, then `M` (upper triangle) and `F` entry by
+/// entry; for a constrained model `M q'' + J^T lambda = F` and `J q'' = gamma` with the
+/// non-zero entries of `J`, each `γ`, and each constraint's equation.
+pub fn equations_text(model: &SymbolicModel, eom: &EquationsOfMotion) -> String {
+    let e = EquationsListing::of(model, eom, Syntax::Text);
+    let n = e.coordinates.len();
+    let mut s = String::new();
+    let _ = writeln!(s, "q = [{}]", e.coordinates.join(", "));
+    let _ = writeln!(s, "T = {}", e.kinetic_energy);
+    let _ = writeln!(s, "V = {}", e.potential_energy);
+    for q in &e.generalized_forces {
+        let _ = writeln!(s, "Q[{}] = {}", q.coordinate, q.expression);
+    }
+    if e.constraints.is_empty() {
+        let _ = writeln!(s, "M q'' = F with");
+    } else {
+        let names: Vec<&str> = e.constraints.iter().map(|c| c.name.as_str()).collect();
+        let _ = writeln!(
+            s,
+            "M q'' + J^T lambda = F and J q'' = gamma, lambda = [{}] (the constraint forces), with",
+            names.join(", ")
+        );
+    }
+    for (i, row) in e.mass_matrix.iter().enumerate() {
+        for (j, m) in row.iter().enumerate().skip(i) {
+            let _ = writeln!(s, "  M[{i},{j}] = {m}");
+        }
+    }
+    for (i, f) in e.forcing.iter().enumerate() {
+        let _ = writeln!(s, "  F[{i}] = {f}");
+    }
+    for c in &e.constraints {
+        for (j, entry) in c.jacobian.iter().enumerate() {
+            if entry != "0" {
+                let _ = writeln!(s, "  J[{},{}] = {entry}", c.name, e.coordinates[j]);
+            }
+        }
+        let _ = writeln!(s, "  gamma[{}] = {}", c.name, c.gamma);
+    }
+    if !e.constraints.is_empty() {
+        let _ = writeln!(s, "where");
+        for c in &e.constraints {
+            let what = match c.kind {
+                ConstraintKind::Holonomic => "holonomic: Phi(q, t) = 0",
+                ConstraintKind::Nonholonomic => "non-holonomic: A q' + b = 0",
+            };
+            let _ = writeln!(s, "  {}: {} = 0 ({what})", c.name, c.equation);
+        }
+    }
+    debug_assert!(e.mass_matrix.len() == n);
+    s
+}
+
+/// The equations as LaTeX (`amsmath`): `T`, `V` and `M(q) q̈ = F`; for a constrained model
+/// `M q̈ + Jᵀλ = F`, `J q̈ = γ` and each constraint's equation `= 0`.
+pub fn equations_latex(model: &SymbolicModel, eom: &EquationsOfMotion) -> String {
+    let e = EquationsListing::of(model, eom, Syntax::Latex);
+    let p = Printer::new(&model.arena, Syntax::Latex);
+    let n = e.coordinates.len();
+    let bmatrix = |rows: &[String]| {
+        format!(
+            "\\begin{{bmatrix}} {} \\end{{bmatrix}}",
+            rows.join(" \\\\ ")
+        )
+    };
+    let mut s = String::new();
+    let _ = writeln!(s, "T = {}", e.kinetic_energy);
+    let _ = writeln!(s, "\\\\\nV = {}", e.potential_energy);
+    let rows: Vec<String> = e.mass_matrix.iter().map(|row| row.join(" & ")).collect();
+    let acc: Vec<String> = (0..n).map(|i| p.print(model.coordinates[i][2])).collect();
+    if e.constraints.is_empty() {
+        let _ = writeln!(
+            s,
+            "\\\\\n{} {} = {}",
+            bmatrix(&rows),
+            bmatrix(&acc),
+            bmatrix(&e.forcing)
+        );
+        return s;
+    }
+    // Jᵀ is n × m: row i holds the i-th entry of every constraint's row of J.
+    let transposed: Vec<String> = (0..n)
+        .map(|i| {
+            e.constraints
+                .iter()
+                .map(|c| c.jacobian[i].as_str())
+                .collect::<Vec<_>>()
+                .join(" & ")
+        })
+        .collect();
+    let multipliers: Vec<String> = e
+        .constraints
+        .iter()
+        .map(|c| format!("\\lambda_{{\\mathrm{{{}}}}}", c.name.replace('_', "\\_")))
+        .collect();
+    let jacobian: Vec<String> = e
+        .constraints
+        .iter()
+        .map(|c| c.jacobian.join(" & "))
+        .collect();
+    let gamma: Vec<String> = e.constraints.iter().map(|c| c.gamma.clone()).collect();
+    let _ = writeln!(
+        s,
+        "\\\\\n{} {} + {} {} = {}",
+        bmatrix(&rows),
+        bmatrix(&acc),
+        bmatrix(&transposed),
+        bmatrix(&multipliers),
+        bmatrix(&e.forcing)
+    );
+    let _ = writeln!(
+        s,
+        "\\\\\n{} {} = {}",
+        bmatrix(&jacobian),
+        bmatrix(&acc),
+        bmatrix(&gamma)
+    );
+    for c in &e.constraints {
+        let _ = writeln!(s, "\\\\\n{} = 0", c.equation);
+    }
+    s
+}
