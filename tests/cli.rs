@@ -872,3 +872,85 @@ fn issue_28_equations_of_a_constrained_model_show_the_constraint_forces() {
 fn stdout(out: std::process::Output) -> String {
     String::from_utf8(out.stdout).unwrap()
 }
+
+/// After a failed integration the help names what the model shows where it stopped, before
+/// any guess about the method (issue 28, item 7): "the model may be stiff; try radau5" was
+/// given for a mass matrix singular because of a parameter (`l1 = 0`, then described as
+/// "the coordinates are singular"), for a negative mass (also to a run already using radau5)
+/// and for a solution that runs into a singularity; a fixed-step run out of steps was told to
+/// loosen `--rtol`; radau5 with `--atol 0` reported "Newton … residual norm inf".
+#[test]
+fn issue_28_failure_hints_name_the_model_cause() {
+    let help = |args: &[&str]| {
+        let out = eomgen(args);
+        assert_eq!(out.status.code(), Some(1), "{args:?}");
+        let err = String::from_utf8_lossy(&out.stderr).into_owned();
+        err.lines()
+            .find_map(|l| l.strip_prefix("help: "))
+            .unwrap_or_else(|| panic!("{args:?}: no help in {err}"))
+            .to_string()
+    };
+    // l1 = 0: M = [[m1/3 + m2, 0], [0, m2 l2²/3]] loses its first row everywhere.
+    let h = help(&["simulate", "double_pendulum", "--set", "l1=0"]);
+    assert!(
+        h.contains("every configuration") && h.contains("l1 = 0"),
+        "{h}"
+    );
+    assert!(
+        !h.contains("coordinates are singular") && !h.contains("stiff"),
+        "{h}"
+    );
+    // m1 = −1: det M = m2²/9 − m2² cos²(θ1 − θ2)/4 + m1 m2/9 vanishes when cos² = 8/9.
+    for method in ["dp54", "radau5"] {
+        let h = help(&[
+            "simulate",
+            "double_pendulum",
+            "--set",
+            "m1=-1",
+            "--method",
+            method,
+        ]);
+        assert!(
+            h.contains("negative mass") && h.contains("m1 = -1"),
+            "{method}: {h}"
+        );
+        assert!(!h.contains("try --method radau5"), "{method}: {h}");
+    }
+    let well = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/log_well.yaml");
+    for method in ["dp54", "radau5"] {
+        let h = help(&["simulate", well, "--method", method]);
+        assert!(h.starts_with("not stiffness"), "{method}: {h}");
+        assert!(!h.contains("try --method radau5"), "{method}: {h}");
+    }
+    // 10⁷ fixed steps wanted, 10⁶ allowed: the step is the setting to change, not --rtol.
+    let h = help(&[
+        "simulate",
+        "simple_pendulum",
+        "--method",
+        "rk4",
+        "--dt",
+        "1e-7",
+        "--t-end",
+        "1",
+        "--t-out",
+        "1",
+    ]);
+    assert!(h.contains("larger --dt") && !h.contains("rtol"), "{h}");
+    for method in ["radau5", "implicit-midpoint"] {
+        let out = eomgen(&[
+            "simulate",
+            "double_pendulum",
+            "--method",
+            method,
+            "--atol",
+            "0",
+        ]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{method}: {err}");
+        assert!(
+            err.contains("absolute tolerance above 0"),
+            "{method}: {err}"
+        );
+        assert!(!err.contains("inf"), "{method}: {err}");
+    }
+}

@@ -318,6 +318,7 @@ pub(crate) fn simulation(
         y0,
         solution,
         failure,
+        cause,
         method_name,
     } = integrate(model_name, args, OutputTimes::At(times))?;
     let model = model.as_ref();
@@ -335,7 +336,7 @@ pub(crate) fn simulation(
                 short(solution.t[m - 1])
             ),
         };
-        failure_error(model.name(), &e, args, &kept)
+        failure_error(model.name(), &e, cause.as_ref(), args, &kept)
     });
     if samples == 0 {
         return Ok((None, failure));

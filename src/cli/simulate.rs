@@ -5,8 +5,8 @@ use std::io::Write as _;
 use clap::{Args, ValueEnum};
 pub(crate) use eomgen::Method;
 use eomgen::analysis::{
-    AddedEvents, ConstraintDrift, EnergyDrift, Simulation, SimulationError, SimulationOptions,
-    simulate_with_events,
+    AddedEvents, ConstraintDrift, EnergyDrift, FailureCause, Simulation, SimulationError,
+    SimulationOptions, simulate_with_events,
 };
 use eomgen::expressions::{ExpressionEvents, set_initial_values};
 use eomgen::{IntegrationError, ModelInfo, OutputTimes, Solution};
@@ -192,6 +192,8 @@ pub(crate) struct Run {
     pub solution: Solution,
     /// Why the integration stopped early, if it did.
     pub failure: Option<IntegrationError>,
+    /// What the model shows where it stopped, if anything.
+    pub cause: Option<FailureCause>,
     /// The integrator's name (`dp54`).
     pub method_name: &'static str,
 }
@@ -226,6 +228,7 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
         energy: report,
         constraints,
         failure,
+        cause,
         warnings,
         integrator: method_name,
         ..
@@ -388,6 +391,7 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
         Some(e) => Err(failure_error(
             model.name(),
             &e,
+            cause.as_ref(),
             &args.run,
             &format!(
                 "the {} samples computed before it were kept",
@@ -512,6 +516,7 @@ pub(crate) fn integrate(
         y0: simulation.initial_state,
         solution: simulation.solution,
         failure: simulation.failure,
+        cause: simulation.cause,
         method_name: simulation.integrator,
     })
 }
@@ -521,12 +526,13 @@ pub(crate) fn integrate(
 pub(crate) fn failure_error(
     model: &str,
     error: &IntegrationError,
+    cause: Option<&FailureCause>,
     args: &IntegrationArgs,
     kept: &str,
 ) -> CliError {
     CliError::failure(format!(
         "integration of `{model}` stopped: {error}; {kept}\nhelp: {}",
-        failure_hint(error, args)
+        failure_hint(error, cause, args)
     ))
 }
 
@@ -541,10 +547,28 @@ const LOOSE_RTOL: f64 = 1e-2;
 /// What to try after a failed integration (issue 8, item 3), by the reason, the method and
 /// the settings: a step-size underflow is blamed on the end time or the tolerance where
 /// those explain it, before stiffness or a singularity.
-fn failure_hint(error: &IntegrationError, args: &IntegrationArgs) -> String {
+fn failure_hint(
+    error: &IntegrationError,
+    cause: Option<&FailureCause>,
+    args: &IntegrationArgs,
+) -> String {
     let method = args.method;
     let explicit = !method.is_implicit();
     let adaptive = method.is_adaptive();
+    // What the model shows where the run stopped comes before any guess about the method.
+    if let Some(cause) = cause {
+        let what_to_do = match cause {
+            FailureCause::MassMatrixDegenerateEverywhere { .. } => {
+                "check the parameters (--set) and that every coordinate moves some mass"
+            }
+            FailureCause::NegativeParameters { .. } => "masses and inertias must be positive",
+            FailureCause::SingularCoordinates { .. } => {
+                "choose coordinates that stay regular there, or add the motion as a constraint"
+            }
+            _ => "check the model's expressions and the initial state near that t",
+        };
+        return format!("{cause}; {what_to_do}");
+    }
     let hint = match error {
         IntegrationError::StepSizeTooSmall { .. } if args.t_end >= COARSE_TIME_END => {
             return format!(
@@ -567,8 +591,14 @@ fn failure_hint(error: &IntegrationError, args: &IntegrationArgs) -> String {
         IntegrationError::StepSizeTooSmall { .. } => {
             "the solution may have a singularity there (it blows up or loses smoothness); check the model and the initial state near that t"
         }
-        IntegrationError::TooManySteps { .. } => {
+        IntegrationError::TooManySteps { .. } if !adaptive => {
+            "a fixed-step run takes t_end/dt steps, more than allowed here: use a larger --dt or shorten --t-end"
+        }
+        IntegrationError::TooManySteps { .. } if explicit => {
             "the run needs more steps than allowed: loosen --rtol/--atol, shorten --t-end, or use --method radau5 if the model is stiff"
+        }
+        IntegrationError::TooManySteps { .. } => {
+            "the run needs more steps than allowed: loosen --rtol/--atol or shorten --t-end"
         }
         IntegrationError::NonFiniteState { .. } | IntegrationError::RhsNonFinite { .. }
             if !adaptive =>

@@ -7,6 +7,7 @@
 
 pub mod constraint_methods;
 pub mod drift;
+pub mod failure;
 pub mod fixed_step;
 pub mod methods;
 pub mod roundoff;
@@ -19,6 +20,7 @@ pub use constraint_methods::{
     constraint_methods,
 };
 pub use drift::{ConstraintDrift, EnergyDrift, constraint_drift, energy_drift, energy_drift_at};
+pub use failure::{FailureCause, failure_cause};
 pub use fixed_step::{ENERGY_DRIFT_LIMIT, SimulationWarning, fixed_step_warnings};
 pub use methods::{Method, UnknownMethod};
 pub use roundoff::{EulerRoundoff, RoundoffError, RoundoffOptions, euler_roundoff};

@@ -5,6 +5,7 @@
 use serde::{Serialize, Serializer};
 
 use crate::analysis::drift::{ConstraintDrift, EnergyDrift, constraint_drift, energy_drift};
+use crate::analysis::failure::{FailureCause, failure_cause};
 use crate::analysis::fixed_step::{ENERGY_DRIFT_LIMIT, SimulationWarning, fixed_step_warnings};
 use crate::analysis::methods::Method;
 use crate::constrained::{ProjectionError, Stabilization};
@@ -159,6 +160,10 @@ pub struct Simulation {
     /// "message"}`); `solution` then holds the samples computed before it.
     #[serde(serialize_with = "serialize_failure")]
     pub failure: Option<IntegrationError>,
+    /// What the model shows where the integration stopped ([`failure_cause`]): a mass matrix
+    /// that is not positive definite, or a forcing that leaves a function's domain; `None`
+    /// without a failure, or when the model shows nothing wrong there.
+    pub cause: Option<FailureCause>,
 }
 
 fn serialize_failure<S: Serializer>(
@@ -308,6 +313,15 @@ pub fn simulate_with_events(
         Ok(s) => (s, None),
         Err(IntegrationFailure { error, partial }) => (*partial, Some(error)),
     };
+    let cause = failure.as_ref().and_then(|e| {
+        let t = e.t()?;
+        let y = match solution.last() {
+            Some((last, y)) if last == t => y.to_vec(),
+            _ if solution.is_empty() => y0.clone(),
+            _ => return None,
+        };
+        failure_cause(model, e, t, &y, &y0)
+    });
     let energy = energy_drift(model, &y0, &solution);
     let constraints = constraint_drift(model, &solution);
     let mut warnings = warnings;
@@ -334,6 +348,7 @@ pub fn simulate_with_events(
         constraints,
         warnings,
         failure,
+        cause,
     })
 }
 

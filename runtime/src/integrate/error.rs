@@ -54,6 +54,19 @@ pub enum IntegrationError {
         /// The component.
         index: usize,
     },
+    /// A method that solves its stages by Newton's iteration was given `atol = 0` for a
+    /// component: it measures each correction in the weights `atol + rtol |y|` of the step's
+    /// start, which are 0 for a component at 0 (a body at rest), so no iteration could
+    /// converge. Hairer and Wanner's radau5.f refuses `ATOL ≤ 0` for the same reason.
+    #[error(
+        "{method} needs an absolute tolerance above 0 (`atol` is 0 for component {index}): its Newton iteration measures corrections relative to atol + rtol·|y|, which is 0 for a component at 0"
+    )]
+    AbsoluteToleranceRequired {
+        /// The method's name.
+        method: &'static str,
+        /// The first component whose `atol` is 0.
+        index: usize,
+    },
     /// `dt` or `dt_max` is zero, negative or not finite.
     #[error("`{option}` is {value}; step sizes must be finite and positive")]
     InvalidStepSize {
@@ -213,6 +226,7 @@ impl IntegrationError {
             | IntegrationError::ToleranceLengthMismatch { .. }
             | IntegrationError::InvalidTolerance { .. }
             | IntegrationError::ZeroTolerance { .. }
+            | IntegrationError::AbsoluteToleranceRequired { .. }
             | IntegrationError::InvalidStepSize { .. }
             | IntegrationError::OutputTimesNotSorted { .. }
             | IntegrationError::OutputTimeOutOfRange { .. }

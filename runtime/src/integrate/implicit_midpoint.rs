@@ -12,7 +12,7 @@ use super::dense_output::DenseOutput;
 use super::driver::{self, Control, Problem};
 use super::error::IntegrationFailure;
 use super::linear::{LuFactors, SAME_STEP};
-use super::options::{ErrorWeights, IntegratorOptions, OutputTimes};
+use super::options::{ErrorWeights, IntegratorOptions, OutputTimes, check_absolute_tolerance};
 use super::solution::Solution;
 use super::stepper::{CheckedRhs, StepEnds, StepFailure, Stepper};
 
@@ -401,6 +401,7 @@ impl Integrator for ImplicitMidpoint {
         };
         let (tolerance, iterations) = (self.newton_tolerance, self.max_newton_iterations.max(1));
         driver::run(&problem, system, Control::Fixed, |shape| {
+            check_absolute_tolerance(options, shape.dim, "implicit midpoint")?;
             Ok(MidpointStepper::new(shape.dim, tolerance, iterations))
         })
     }

@@ -228,6 +228,20 @@ pub(crate) fn check_tolerances(
     Ok(ErrorWeights { rtol, atol })
 }
 
+/// Rule: a method that iterates Newton's method to a tolerance measured in the error weights
+/// has `atol > 0` for every component (radau5.f's rule), since a component at 0 has weight 0.
+pub(crate) fn check_absolute_tolerance(
+    options: &IntegratorOptions,
+    dim: usize,
+    method: &'static str,
+) -> Result<(), IntegrationError> {
+    let atol = resolve_tolerance(&options.atol, "atol", dim)?;
+    match atol.iter().position(|&a| a == 0.0) {
+        Some(index) => Err(IntegrationError::AbsoluteToleranceRequired { method, index }),
+        None => Ok(()),
+    }
+}
+
 /// One value per component of a tolerance named `option`, each checked.
 fn resolve_tolerance(
     tolerance: &Tolerance,

@@ -18,7 +18,7 @@ use super::dense_output::DenseOutput;
 use super::driver::{self, Control, Problem};
 use super::error::IntegrationFailure;
 use super::linear::{LuFactors, SAME_STEP};
-use super::options::{ErrorWeights, IntegratorOptions, OutputTimes};
+use super::options::{ErrorWeights, IntegratorOptions, OutputTimes, check_absolute_tolerance};
 use super::solution::Solution;
 use super::stepper::{CheckedRhs, StepFailure, Stepper};
 
@@ -762,6 +762,7 @@ impl Integrator for RadauIIA5 {
         };
         let iterations = self.max_newton_iterations.max(2);
         driver::run(&problem, system, control, |shape| {
+            check_absolute_tolerance(options, shape.dim, "Radau IIA (radau5)")?;
             Ok(RadauStepper::new(shape.dim, iterations))
         })
     }
