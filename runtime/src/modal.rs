@@ -48,7 +48,7 @@ pub enum ModalError {
     /// forces fade with distance (an inverse-square attraction), and the next Newton step
     /// from the last iterate is not small against it, so no root is near.
     #[error(
-        "no equilibrium found: from the guess {guess:?} Newton walked away to q = {q:?}, where |F| = {residual:e} is small only because the forces fade with distance (the next Newton step would move q by {step:e} more)"
+        "no equilibrium found: from the guess {guess:?} Newton walked away to q = {q:?}, where |F| = {residual:.3e} is small only because the forces fade with distance (the next Newton step would move q by {step:.3e} more)"
     )]
     EquilibriumAtInfinity {
         /// The starting guess.
@@ -495,25 +495,19 @@ const TIME_OFFSETS: [f64; 6] = [0.073_1, 0.271_828, 1.414_214, 5.302_9, 19.739, 
 /// (~1e-14) and far below any physical modulation.
 const TIME_TOLERANCE: f64 = 1e-9;
 
-/// The largest change of `part(t)` from `part(t₀)` over `t₀ + TIME_OFFSETS`, relative to the
-/// largest entry of every sample (and of `floor`), with the time where it occurred; a NaN
-/// counts as an infinite change.
-fn relative_change(
-    t0: f64,
-    floor: f64,
-    part: impl Fn(f64) -> DVector<f64>,
-) -> (f64, f64) {
-    let at_t0 = part(t0);
-    let mut scale = at_t0.amax().max(floor);
-    let (mut change, mut at) = (0.0f64, t0);
-    for offset in TIME_OFFSETS {
-        let t = t0 + offset;
-        let value = part(t);
+/// The largest change of a part of the equations from its value at `t₀` (`samples[0]`) over
+/// the later samples, relative to the largest entry of every sample (and of `floor`), with
+/// the index of the sample where it occurred; a NaN counts as an infinite change.
+fn relative_change(samples: &[DVector<f64>], floor: f64) -> (f64, usize) {
+    let at_t0 = &samples[0];
+    let mut scale = floor;
+    let (mut change, mut at) = (0.0f64, 0);
+    for (k, value) in samples.iter().enumerate() {
         scale = scale.max(value.amax());
-        let d = (&value - &at_t0).amax();
+        let d = (value - at_t0).amax();
         let d = if d.is_nan() { f64::INFINITY } else { d };
         if d > change {
-            (change, at) = (d, t);
+            (change, at) = (d, k);
         }
     }
     if change == 0.0 {
@@ -553,66 +547,82 @@ pub fn time_dependence(
         .copied()
         .chain(std::iter::repeat_n(0.0, n))
         .collect();
-    let refuse = |part: TimeDependentPart, (relative_change, t): (f64, f64)| {
+    let times: Vec<f64> = std::iter::once(t0)
+        .chain(TIME_OFFSETS.iter().map(|offset| t0 + offset))
+        .collect();
+    let refuse = |part: TimeDependentPart, (relative_change, k): (f64, usize)| {
         if relative_change > TIME_TOLERANCE {
             Err(ModalError::TimeDependent {
                 part,
                 t0,
-                t,
+                t: times[k],
                 relative_change,
             })
         } else {
             Ok(())
         }
     };
-    let names = model.constraint_names();
-    for (i, name) in names.iter().take(m).enumerate() {
-        let change = relative_change(t0, 0.0, |t| {
-            let c = model.constraint_equations(t, &y);
-            let row = c.jacobian.row(i);
-            DVector::from_iterator(
-                n + 3,
-                [c.phi[i], c.velocity[i], c.gamma[i]]
-                    .into_iter()
-                    .chain(row.iter().copied()),
-            )
-        });
-        refuse(
-            TimeDependentPart::Constraint {
-                name: name.to_string(),
-            },
-            change,
-        )?;
+    if m > 0 {
+        let constraints: Vec<_> = times
+            .iter()
+            .map(|&t| model.constraint_equations(t, &y))
+            .collect();
+        for (i, name) in model.constraint_names().iter().take(m).enumerate() {
+            let samples: Vec<DVector<f64>> = constraints
+                .iter()
+                .map(|c| {
+                    let head = [c.phi[i], c.velocity[i], c.gamma[i]];
+                    DVector::from_iterator(
+                        n + 3,
+                        head.into_iter().chain(c.jacobian.row(i).iter().copied()),
+                    )
+                })
+                .collect();
+            refuse(
+                TimeDependentPart::Constraint {
+                    name: name.to_string(),
+                },
+                relative_change(&samples, 0.0),
+            )?;
+        }
     }
     let flat = |a: &DMatrix<f64>| DVector::from_column_slice(a.as_slice());
-    let mass = |t: f64| flat(&model.mass_matrix_and_forcing(t, &y).0);
-    refuse(TimeDependentPart::MassMatrix, relative_change(t0, 0.0, mass))?;
-    let damping = |t: f64| flat(&model.forcing_jacobians(t, &y).1);
+    let (mut mass, mut forcing, mut damping, mut stiffness) =
+        (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    for &t in &times {
+        let (m_t, f_t) = model.mass_matrix_and_forcing(t, &y);
+        let (jq, jqd) = model.forcing_jacobians(t, &y);
+        mass.push(flat(&m_t));
+        forcing.push(f_t);
+        damping.push(flat(&jqd));
+        stiffness.push(flat(&jq));
+    }
+    refuse(
+        TimeDependentPart::MassMatrix,
+        relative_change(&mass, 0.0),
+    )?;
     refuse(
         TimeDependentPart::DampingMatrix,
-        relative_change(t0, 0.0, damping),
+        relative_change(&damping, 0.0),
     )?;
-    let stiffness = |t: f64| flat(&model.forcing_jacobians(t, &y).0);
     refuse(
         TimeDependentPart::StiffnessMatrix,
-        relative_change(t0, 0.0, stiffness),
+        relative_change(&stiffness, 0.0),
     )?;
     // The load: its rounding is that of its terms, of the order of the stiffness times the
     // displacement, so that scale is the floor of the comparison.
     let size = q.iter().fold(1.0f64, |a, v| a.max(v.abs()));
-    let floor = model.forcing_jacobians(t0, &y).0.amax() * size;
-    let forcing = |t: f64| model.mass_matrix_and_forcing(t, &y).1;
-    let (change, t) = relative_change(t0, floor, forcing);
+    let (change, k) = relative_change(&forcing, stiffness[0].amax() * size);
     if change <= TIME_TOLERANCE {
         return Ok(None);
     }
-    let difference = model.mass_matrix_and_forcing(t, &y).1 - model.mass_matrix_and_forcing(t0, &y).1;
+    let difference = &forcing[k] - &forcing[0];
     let i = difference.iamax();
     Ok(Some(TimeDependentForcing {
         t0,
         coordinate: model.coordinate_names()[i].to_string(),
         largest_change: difference[i].abs(),
-        t,
+        t: times[k],
     }))
 }
 
