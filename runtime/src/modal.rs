@@ -323,7 +323,7 @@ pub fn find_equilibrium(
     // the rounding of q; there it is a fraction of q itself.
     let step = newton_step(&jacobian_of(&x), &residual_of(&x)).amax();
     let size = x.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-    if !(step <= RECEDING_STEP * (1.0 + size)) {
+    if step.is_nan() || step > RECEDING_STEP * (1.0 + size) {
         return Err(ModalError::EquilibriumAtInfinity {
             guess: guess.to_vec(),
             q: x[..n].to_vec(),
@@ -366,8 +366,8 @@ fn newton_step(jac: &DMatrix<f64>, f: &DVector<f64>) -> DVector<f64> {
 #[allow(clippy::type_complexity)]
 fn newton(
     x0: &[f64],
-    residual_of: impl Fn(&[f64]) -> DVector<f64>,
-    jacobian_of: impl Fn(&[f64]) -> DMatrix<f64>,
+    residual_of: &impl Fn(&[f64]) -> DVector<f64>,
+    jacobian_of: &impl Fn(&[f64]) -> DMatrix<f64>,
 ) -> Result<(Vec<f64>, usize, f64), (usize, f64, NewtonStop)> {
     let norm = |f: &DVector<f64>| {
         let r = f.amax();
@@ -488,7 +488,7 @@ pub struct TimeDependentForcing {
 /// Offsets (s) from `t₀` at which [`time_dependence`] samples the equations: spread over
 /// three decades and irrational-looking, so that no forcing is periodic in all of them and
 /// slow and fast ones both change between samples.
-const TIME_OFFSETS: [f64; 6] = [0.073_1, 0.271_828, 1.414_214, 5.302_9, 19.739, 71.313];
+const TIME_OFFSETS: [f64; 6] = [0.073_1, 0.271_828, 1.523_7, 5.302_9, 19.739, 71.313];
 
 /// A change of a part of the equations relative to its largest entry over the samples above
 /// which it depends on `t`: far above the rounding of evaluating `cos(w t)` at `t ≤ 72 s`
