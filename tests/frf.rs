@@ -617,11 +617,20 @@ fn issue_28_frequency_response_beyond_overflow_of_omega_squared() {
     for w in [1e100, 1e150, 1e155] {
         let exact = -1.0 / (1e-10 * w) / w;
         let h = frequency_response(&f.linearization, &f.input_matrix, w).unwrap()[(0, 0)];
-        assert!((h.re - exact).abs() < 1e-14 * exact.abs(), "{w:e}: {h} vs {exact:e}");
+        assert!(
+            (h.re - exact).abs() < 1e-14 * exact.abs(),
+            "{w:e}: {h} vs {exact:e}"
+        );
         // Im H = −cω/|Z|² ≈ −c/(m²ω³): a lag of c/(mω) ≤ 1e-90 rad.
-        assert!(h.im <= 0.0 && h.im.abs() / exact.abs() < 1e-80, "{w:e}: {h}");
+        assert!(
+            h.im <= 0.0 && h.im.abs() / exact.abs() < 1e-80,
+            "{w:e}: {h}"
+        );
         let modal = modal_frequency_response(&f.linearization, &modes, &b, w).unwrap();
-        assert!((modal.response[0].re - exact).abs() < 1e-14 * exact.abs(), "{w:e}");
+        assert!(
+            (modal.response[0].re - exact).abs() < 1e-14 * exact.abs(),
+            "{w:e}"
+        );
     }
     m.set_parameter("m", 1.0).unwrap();
     let f = forced(m.as_mut(), "A");
@@ -643,5 +652,8 @@ fn issue_28_frequency_response_beyond_overflow_of_omega_squared() {
     ]);
     assert_eq!(out.status.code(), Some(2));
     let err = String::from_utf8_lossy(&out.stderr);
-    assert!(err.contains("range of floating point") && !err.contains("singular"), "{err}");
+    assert!(
+        err.contains("range of floating point") && !err.contains("singular"),
+        "{err}"
+    );
 }

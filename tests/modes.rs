@@ -708,7 +708,10 @@ fn issue_28_parametric_excitation_is_refused() {
     let out = eomgen(&["modes", "mathieu_pendulum", "--set", "a=0.01"]);
     assert_eq!(out.status.code(), Some(1));
     let err = String::from_utf8_lossy(&out.stderr);
-    assert!(err.contains("depend on t") && err.contains("study floquet"), "{err}");
+    assert!(
+        err.contains("depend on t") && err.contains("study floquet"),
+        "{err}"
+    );
 }
 
 /// Issue 28, item 2: `modes bead_spinning_rod` reported a zero frequency for a bead whose
@@ -770,13 +773,15 @@ fn issue_28_time_dependent_load_is_set_aside() {
     }
     let forced = model("three_masses_forced");
     let modal = modal_analysis(forced.as_ref(), &ModalOptions::default()).unwrap();
-    assert_eq!(modal.time_dependent_forcing.as_ref().unwrap().coordinate, "x1");
-    for (w, w2) in modal
-        .normal_modes
-        .natural_frequencies
-        .iter()
-        .zip([2.0 - 2f64.sqrt(), 2.0, 2.0 + 2f64.sqrt()])
-    {
+    assert_eq!(
+        modal.time_dependent_forcing.as_ref().unwrap().coordinate,
+        "x1"
+    );
+    for (w, w2) in modal.normal_modes.natural_frequencies.iter().zip([
+        2.0 - 2f64.sqrt(),
+        2.0,
+        2.0 + 2f64.sqrt(),
+    ]) {
         assert!((w - w2.sqrt()).abs() < 1e-12);
     }
     // A model without t has nothing set aside.

@@ -721,7 +721,10 @@ fn issue_28_isotropic_oscillator_is_not_defective() {
     }
     assert!(worst < 1e-10, "{worst:e}");
     // The study (`eomgen study free-response`) on the model file itself.
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/isotropic_oscillator.yaml");
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/fixtures/isotropic_oscillator.yaml"
+    );
     let out = eomgen_ok(&["study", "free-response", path, "--json"]);
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(v["methods"].as_array().unwrap().len(), 4);

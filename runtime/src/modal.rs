@@ -597,10 +597,7 @@ pub fn time_dependence(
         damping.push(flat(&jqd));
         stiffness.push(flat(&jq));
     }
-    refuse(
-        TimeDependentPart::MassMatrix,
-        relative_change(&mass, 0.0),
-    )?;
+    refuse(TimeDependentPart::MassMatrix, relative_change(&mass, 0.0))?;
     refuse(
         TimeDependentPart::DampingMatrix,
         relative_change(&damping, 0.0),
