@@ -600,3 +600,60 @@ fn a_coordinate_input_is_a_unit_generalized_force() {
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("needs a load parameter"));
 }
+
+/// Issue 28: `frf --frequency 1e155` on a damped model reported an undamped resonance,
+/// because ω² overflowed and `K − ω²M + iωC` became infinite. Solved as `(Z/ω²) X = B`,
+/// `H = X/ω²`: a light mass (m = 1e-10 kg, c = 1, k = 1) has `H(1e155) = −1/(mω²)
+/// (1 + O(c/(mω)))` = −1e-300 exactly to rounding (1e-14), directly and mode by mode; where
+/// |H| itself leaves the normal range (m = 1: 1e-310) the frequency is refused with a typed
+/// error, not rounded to 0 or called singular, and `eomgen frf` exits 2.
+#[test]
+fn issue_28_frequency_response_beyond_overflow_of_omega_squared() {
+    let mut m = model("forced_oscillator");
+    m.set_parameter("m", 1e-10).unwrap();
+    let f = forced(m.as_mut(), "A");
+    let modes = normal_modes(&f.linearization).unwrap();
+    let b = f.input_matrix.column(0).into_owned();
+    for w in [1e100, 1e150, 1e155] {
+        let exact = -1.0 / (1e-10 * w) / w;
+        let h = frequency_response(&f.linearization, &f.input_matrix, w).unwrap()[(0, 0)];
+        assert!(
+            (h.re - exact).abs() < 1e-14 * exact.abs(),
+            "{w:e}: {h} vs {exact:e}"
+        );
+        // Im H = −cω/|Z|² ≈ −c/(m²ω³): a lag of c/(mω) ≤ 1e-90 rad.
+        assert!(
+            h.im <= 0.0 && h.im.abs() / exact.abs() < 1e-80,
+            "{w:e}: {h}"
+        );
+        let modal = modal_frequency_response(&f.linearization, &modes, &b, w).unwrap();
+        assert!(
+            (modal.response[0].re - exact).abs() < 1e-14 * exact.abs(),
+            "{w:e}"
+        );
+    }
+    m.set_parameter("m", 1.0).unwrap();
+    let f = forced(m.as_mut(), "A");
+    let err = frequency_response(&f.linearization, &f.input_matrix, 1e155).unwrap_err();
+    let FrfError::ResponseOutOfRange {
+        log10_magnitude, ..
+    } = err
+    else {
+        panic!("{err}")
+    };
+    assert!((log10_magnitude + 310.0).abs() < 1e-9);
+    let out = eomgen(&[
+        "frf",
+        "forced_oscillator",
+        "--input",
+        "A",
+        "--frequency",
+        "1e155",
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("range of floating point") && !err.contains("singular"),
+        "{err}"
+    );
+}

@@ -669,3 +669,180 @@ fn four_bar_mode_matches_an_energy_method() {
     assert_eq!(lin.independent_coordinates, vec![0]);
     assert!((lin.mass_matrix[(0, 0)] - m_eff).abs() < 1e-12 * m_eff);
 }
+
+eomgen::model!("fixtures/kepler_orbit.yaml");
+eomgen::model!("fixtures/euler_top.yaml");
+
+/// The path of a test fixture, for the CLI.
+fn fixture(name: &str) -> String {
+    format!("{}/tests/fixtures/{name}", env!("CARGO_MANIFEST_DIR"))
+}
+
+/// Issue 28, item 2: `modes mathieu_pendulum --set a=0.01` froze t = 0 and reported an
+/// oscillation at 5.10 rad/s where Floquet finds ρ = 1.39. The stiffness
+/// `m l (g − a w² cos wt)` changes with t: refused, naming it. Without the shaking (a = 0)
+/// nothing depends on t and upright grows as `e^{√(g/l) t}` (√10, to 1e-12).
+#[test]
+fn issue_28_parametric_excitation_is_refused() {
+    use eomgen::vibration::{ModalOptions, OperatingPointError, modal_analysis};
+    let mut m = model("mathieu_pendulum");
+    m.set_parameter("a", 0.01).unwrap();
+    let err = modal_analysis(m.as_ref(), &ModalOptions::default()).unwrap_err();
+    assert!(
+        matches!(
+            err,
+            OperatingPointError::Modal(ModalError::TimeDependent {
+                part: eomgen::TimeDependentPart::StiffnessMatrix,
+                ..
+            })
+        ),
+        "{err}"
+    );
+    m.set_parameter("a", 0.0).unwrap();
+    let modal = modal_analysis(m.as_ref(), &ModalOptions::default()).unwrap();
+    assert!(modal.time_dependent_forcing.is_none());
+    let ModeKind::Unstable { growth_rate } = modal.normal_modes.kinds[0] else {
+        panic!("{:?}", modal.normal_modes.kinds)
+    };
+    assert!((growth_rate - 10f64.sqrt()).abs() < 1e-12);
+    let out = eomgen(&["modes", "mathieu_pendulum", "--set", "a=0.01"]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("depend on t") && err.contains("study floquet"),
+        "{err}"
+    );
+}
+
+/// Issue 28, item 2: `modes bead_spinning_rod` reported a zero frequency for a bead whose
+/// distance grows as `cosh ωt`. Its rod is the rheonomic constraint `x sin wt − y cos wt`:
+/// frozen at t = 0 it is a fixed frictionless rod (no stiffness), which drops the
+/// centrifugal effect of the rotation. Refused, naming the constraint; the same bead in its
+/// distance along the rod (`bead_spinning_rod_polar`, `r̈ = w² r`, no t in the equations)
+/// has the unstable mode with growth rate `w` (to 1e-12).
+#[test]
+fn issue_28_rheonomic_constraint_is_refused() {
+    use eomgen::vibration::{ModalOptions, OperatingPointError, modal_analysis};
+    let m = model("bead_spinning_rod");
+    let err = modal_analysis(m.as_ref(), &ModalOptions::default()).unwrap_err();
+    let OperatingPointError::Modal(ModalError::TimeDependent {
+        part: eomgen::TimeDependentPart::Constraint { name },
+        ..
+    }) = &err
+    else {
+        panic!("{err}")
+    };
+    assert_eq!(name, "rod");
+    let mut polar = model("bead_spinning_rod_polar");
+    for w in [1.0, 2.5] {
+        polar.set_parameter("w", w).unwrap();
+        let modal = modal_analysis(polar.as_ref(), &ModalOptions::default()).unwrap();
+        assert!(modal.time_dependent_forcing.is_none());
+        let ModeKind::Unstable { growth_rate } = modal.normal_modes.kinds[0] else {
+            panic!("{:?}", modal.normal_modes.kinds)
+        };
+        assert!((growth_rate - w).abs() < 1e-12 * w, "{growth_rate} vs {w}");
+    }
+    let out = eomgen(&["modes", "bead_spinning_rod"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("constraint `rod`"));
+}
+
+/// Issue 28, item 2: a load `A cos wt + B sin wt` enters neither M, C nor K, so the modes of
+/// the unforced equations stand (`forced_oscillator`: ω = √(k/m), ζ = c/(2√(km)), to 1e-12;
+/// HW37's three masses: ω² = (2 ∓ √2) k/m, 2k/m) and the load is reported as set aside:
+/// its change `A (cos wt − 1) + B sin wt` is at most `|A| + √(A² + B²)`, and the equilibrium
+/// balances its t = 0 value, `x* = A/k`.
+#[test]
+fn issue_28_time_dependent_load_is_set_aside() {
+    use eomgen::vibration::{ModalOptions, modal_analysis};
+    let mut m = model("forced_oscillator");
+    for (mass, c, k, a, b) in [(1.0, 1.0, 1.0, 1.0, 0.0), (2.0, 0.3, 7.0, 0.5, 2.0)] {
+        for (name, value) in [("m", mass), ("c", c), ("k", k), ("A", a), ("B", b)] {
+            m.set_parameter(name, value).unwrap();
+        }
+        let modal = modal_analysis(m.as_ref(), &ModalOptions::default()).unwrap();
+        let forcing = modal.time_dependent_forcing.as_ref().expect("a load in t");
+        assert_eq!(forcing.coordinate, "x");
+        assert!(forcing.largest_change > 0.1 && forcing.largest_change <= a + a.hypot(b) + 1e-12);
+        assert!((modal.operating_point.q()[0] - a / k).abs() < 1e-12);
+        let w = modal.normal_modes.natural_frequencies[0];
+        assert!((w - (k / mass).sqrt()).abs() < 1e-12 * w);
+        let zeta = c / (2.0 * (k * mass).sqrt());
+        assert!((modal.damping_ratios[0] - zeta).abs() < 1e-12);
+    }
+    let forced = model("three_masses_forced");
+    let modal = modal_analysis(forced.as_ref(), &ModalOptions::default()).unwrap();
+    assert_eq!(
+        modal.time_dependent_forcing.as_ref().unwrap().coordinate,
+        "x1"
+    );
+    for (w, w2) in modal.normal_modes.natural_frequencies.iter().zip([
+        2.0 - 2f64.sqrt(),
+        2.0,
+        2.0 + 2f64.sqrt(),
+    ]) {
+        assert!((w - w2.sqrt()).abs() < 1e-12);
+    }
+    // A model without t has nothing set aside.
+    let plain = model("three_masses");
+    let modal = modal_analysis(plain.as_ref(), &ModalOptions::default()).unwrap();
+    assert!(modal.time_dependent_forcing.is_none());
+    let out = eomgen_ok(&["modes", "forced_oscillator", "--json"]);
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["time_dependent_forcing"]["coordinate"], "x");
+    let out = eomgen_ok(&["modes", "forced_oscillator"]);
+    assert!(String::from_utf8_lossy(&out.stdout).contains("set aside"));
+}
+
+/// Issue 28, item 8: Kepler's problem at rest (`tests/fixtures/kepler_orbit.yaml`,
+/// `F_r = −μm/r²`) has no equilibrium; from r = 1 Newton's steps are `r/2` outwards and |F|
+/// fell below the absolute tolerance at r = 9.7e5 m, which `modes --at r=1` reported as an
+/// equilibrium. Refused as walking away; a spring (a true root) still converges.
+#[test]
+fn issue_28_equilibrium_at_infinity_is_refused() {
+    let kepler: Box<dyn ModelInfo> = Box::new(eomgen::FirstOrder::new(KeplerOrbit::default()));
+    let err = find_equilibrium(kepler.as_ref(), &[1.0, 0.0], 0.0).unwrap_err();
+    let ModalError::EquilibriumAtInfinity { q, step, .. } = &err else {
+        panic!("{err}")
+    };
+    assert!(q[0] > 1e3 && *step > 0.1 * q[0], "{err}");
+    let out = eomgen(&["modes", &fixture("kepler_orbit.yaml"), "--at", "r=1"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("walked away"));
+    let e = find_equilibrium(model("three_masses").as_ref(), &[0.3, -0.2, 0.1], 0.0).unwrap();
+    assert!(e.q.iter().all(|v| v.abs() < 1e-12));
+}
+
+/// Issue 28, item 8: a top in Euler angles at θ = 0 or π (`tests/fixtures/euler_top.yaml`),
+/// where precession and spin turn the body about the same axis: `det M = I1² I3 sin²θ`
+/// vanishes (to rounding at θ = π, where `sin π = 1.2e-16` left a pivot of 1e-33 and mode
+/// shapes of 7.6e8). Refused, naming φ and ψ; at θ = 0.5 M is accepted and its determinant
+/// is the closed form (1e-12); at θ = 1e-6 the unit-diagonal M has smallest eigenvalue
+/// `≈ I1 θ²/(2 I3) = 1.5e-12`, below the 1e-10 bound, and at θ = 1e-3 (1.5e-6) above it.
+#[test]
+fn issue_28_singular_mass_matrix_names_the_coordinates() {
+    let top: Box<dyn ModelInfo> = Box::new(eomgen::FirstOrder::new(EulerTop::default()));
+    for at in ["upright", "hanging"] {
+        let q = guess(top.as_ref(), at);
+        let err = linearize(top.as_ref(), &q, &[0.0; 3], 0.0).unwrap_err();
+        let ModalError::DegenerateCoordinates { coordinates, .. } = &err else {
+            panic!("{at}: {err}")
+        };
+        assert_eq!(coordinates, &["phi", "psi"], "{at}");
+    }
+    assert!(matches!(
+        linearize(top.as_ref(), &[0.0, 1e-6, 0.0], &[0.0; 3], 0.0),
+        Err(ModalError::DegenerateCoordinates { .. })
+    ));
+    linearize(top.as_ref(), &[0.0, 1e-3, 0.0], &[0.0; 3], 0.0).unwrap();
+    let theta: f64 = 0.5;
+    let lin = linearize(top.as_ref(), &[0.0, theta, 0.0], &[0.0; 3], 0.0).unwrap();
+    let (i1, i3) = (0.3, 0.1);
+    let det = i1 * i1 * i3 * theta.sin().powi(2);
+    assert!((lin.mass_matrix.determinant() - det).abs() < 1e-12 * det);
+    let out = eomgen(&["modes", &fixture("euler_top.yaml"), "--at", "hanging"]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("phi, psi") && !err.contains("e8"), "{err}");
+}

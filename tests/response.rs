@@ -680,3 +680,52 @@ fn modal_damping_cli() {
     assert_eq!(out.status.code(), Some(2));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Issue 28: the isotropic 3-D oscillator (`tests/fixtures/isotropic_oscillator.yaml`,
+/// `M = 2I`, `K = 50I`) has ω = 5 rad/s three times and a full set of eigenvectors (every
+/// direction is a mode): not defective, though `M⁻¹K − 25I` is rounding in every direction.
+/// Every route matches the closed form `x(t) = x₀ cos 5t + v₀ sin 5t/5` to 1e-10 (the
+/// routes' own tolerance); with `C = I` the eigenvectors of `A` (`s = −1/4 ± i√(25 − 1/16)`,
+/// three times each) give `x = e^{−t/4}(x₀ cos ω_d t + (v₀ + x₀/4) sin ω_d t/ω_d)` to 1e-10.
+#[test]
+fn issue_28_isotropic_oscillator_is_not_defective() {
+    let i3 = nalgebra::DMatrix::<f64>::identity(3, 3);
+    let undamped = Linearization::from_matrices(&i3 * 2.0, &i3 * 50.0, &i3 * 0.0);
+    let (q0, v0) = ([0.1, 0.05, -0.02], [0.3, -0.2, 0.0]);
+    let times = grid(4.0, 81);
+    for response in four_ways(&undamped, &q0, &v0, &times) {
+        let error = against(&response, |t| {
+            let (s, c) = (5.0 * t).sin_cos();
+            (
+                (0..3).map(|i| q0[i] * c + v0[i] * s / 5.0).collect(),
+                (0..3).map(|i| -5.0 * q0[i] * s + v0[i] * c).collect(),
+            )
+        });
+        assert!(error < 1e-10, "{error:e}");
+    }
+    let damped = Linearization::from_matrices(&i3 * 2.0, &i3 * 50.0, i3.clone());
+    let y0: Vec<f64> = q0.iter().chain(&v0).copied().collect();
+    let states =
+        state_response_by_eigenvectors(&damped.state_matrix().unwrap(), &y0, &times).unwrap();
+    let (h, wd) = (0.25, (25.0f64 - 0.0625).sqrt());
+    let mut worst = 0.0f64;
+    for (y, &t) in states.iter().zip(&times) {
+        let (s, c) = (wd * t).sin_cos();
+        let e = (-h * t).exp();
+        for i in 0..3 {
+            let b = (v0[i] + h * q0[i]) / wd;
+            let x = e * (q0[i] * c + b * s);
+            let v = e * (-h * (q0[i] * c + b * s) + wd * (-q0[i] * s + b * c));
+            worst = worst.max((y[i] - x).abs()).max((y[3 + i] - v).abs());
+        }
+    }
+    assert!(worst < 1e-10, "{worst:e}");
+    // The study (`eomgen study free-response`) on the model file itself.
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/fixtures/isotropic_oscillator.yaml"
+    );
+    let out = eomgen_ok(&["study", "free-response", path, "--json"]);
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["methods"].as_array().unwrap().len(), 4);
+}

@@ -55,7 +55,7 @@ use crate::integrate::{
 };
 use crate::modal::{
     Equilibrium, Linearization, ModalError, ModeKind, NormalModes, damped_modes, find_equilibrium,
-    linearize,
+    linearize, time_dependence,
 };
 use crate::model_info::ModelInfo;
 use crate::response::modal_damping;
@@ -137,6 +137,22 @@ pub enum FrfError {
     Singular {
         /// The frequency (rad/s).
         frequency: f64,
+    },
+    /// An entry of `H(ω)` is beyond the range of `f64` normal numbers (`2.2e-308` to
+    /// `1.8e308`): far above the natural frequencies `|H| ≈ 1/(ω² m)` falls below it
+    /// (`ω ≳ 1e154` for a unit mass).
+    #[error(
+        "the frequency response at ω = {frequency:e} rad/s is beyond the range of floating point: |H| of entry ({row}, {column}) is about 1e{log10_magnitude:.0} (normal f64 numbers lie between 2.2e-308 and 1.8e308)"
+    )]
+    ResponseOutOfRange {
+        /// The frequency (rad/s).
+        frequency: f64,
+        /// The coordinate (row of `H`, from 0).
+        row: usize,
+        /// The input (column of `H`, from 0).
+        column: usize,
+        /// `log₁₀ |Hᵢⱼ|`, computed from the scaled solution.
+        log10_magnitude: f64,
     },
     /// The input matrix has the wrong number of rows.
     #[error("the input matrix has {found} rows, the model {expected} coordinates")]
@@ -239,7 +255,8 @@ const LINEARITY_TOLERANCE: f64 = 1e-10;
 ///
 /// # Errors
 /// [`FrfError::UnknownParameter`] for an input the model does not have;
-/// [`FrfError::Modal`] if the equilibrium or the linearisation fails;
+/// [`FrfError::Modal`] if the equilibrium or the linearisation fails, or with
+/// [`ModalError::TimeDependent`] when `M`, `C`, `K` or a constraint change with `t` (inputs at 0);
 /// [`FrfError::NonlinearInput`], [`FrfError::InputNotInForcing`],
 /// [`FrfError::InputChangesMassMatrix`] for a parameter that is not a load amplitude.
 ///
@@ -292,6 +309,9 @@ fn linearize_with_inputs_inner(
     let equilibrium = find_equilibrium(&*model, guess, 0.0)?;
     let zeros = vec![0.0; n];
     let linearization = linearize(&*model, &equilibrium.q, &zeros, 0.0)?;
+    // Coefficients that change with t (a shaken pivot) have no frequency response; a load
+    // left in F that is not an input is the same at every frequency and stays out of H.
+    time_dependence(&*model, &equilibrium.q, 0.0)?;
     let y: Vec<f64> = equilibrium.q.iter().chain(&zeros).copied().collect();
     let mut input_matrix = DMatrix::zeros(n, inputs.len());
     for (j, input) in inputs.iter().enumerate() {
@@ -358,14 +378,48 @@ pub fn output_index(model: &dyn ModelInfo, output: &str) -> Result<usize, FrfErr
         })
 }
 
-/// The dynamic stiffness `Z(ω) = K − ω²M + iωC` (`n × n`, complex).
+/// The dynamic stiffness `Z(ω) = K − ω²M + iωC` (`n × n`, complex). Beyond `ω ≈ 1.3e154`
+/// rad/s `ω²` overflows; [`frequency_response`] solves with `Z(ω)/ω²` instead.
 pub fn dynamic_stiffness(lin: &Linearization, frequency: f64) -> DMatrix<Complex<f64>> {
-    let w = frequency;
+    scaled_dynamic_stiffness(lin, frequency, 1.0)
+}
+
+/// `Z(ω)/s² = K/s² − (ω/s)²M + i(ω/s)C/s`, each term formed without overflow for `s ≥ 1`.
+fn scaled_dynamic_stiffness(lin: &Linearization, frequency: f64, s: f64) -> DMatrix<Complex<f64>> {
+    let w = frequency / s;
     DMatrix::from_fn(lin.mass_matrix.nrows(), lin.mass_matrix.ncols(), |i, j| {
         Complex::new(
-            lin.stiffness_matrix[(i, j)] - w * w * lin.mass_matrix[(i, j)],
-            w * lin.damping_matrix[(i, j)],
+            lin.stiffness_matrix[(i, j)] / s / s - w * w * lin.mass_matrix[(i, j)],
+            w * lin.damping_matrix[(i, j)] / s,
         )
+    })
+}
+
+/// The factor `s` by which [`frequency_response`] and [`modal_frequency_response`] scale
+/// `ω`: `max(ω, 1)`, so that `ω/s ≤ 1` and `ω²` is never formed above 1 rad/s.
+fn frequency_scale(frequency: f64) -> f64 {
+    frequency.max(1.0)
+}
+
+/// `x/s²` (the response from the solution `x` of the scaled system), or
+/// [`FrfError::ResponseOutOfRange`] when a non-zero `x` gives a result that is not a finite
+/// normal `f64` (an exact zero, an output the input does not reach, stays zero).
+fn descale(
+    x: Complex<f64>,
+    s: f64,
+    frequency: f64,
+    (row, column): (usize, usize),
+) -> Result<Complex<f64>, FrfError> {
+    let h = x / s / s;
+    let size = h.norm();
+    if x.norm() == 0.0 || (size.is_finite() && size >= f64::MIN_POSITIVE) {
+        return Ok(h);
+    }
+    Err(FrfError::ResponseOutOfRange {
+        frequency,
+        row,
+        column,
+        log10_magnitude: x.norm().log10() - 2.0 * s.log10(),
     })
 }
 
@@ -378,6 +432,11 @@ const SINGULAR_PIVOT: f64 = 1e-13;
 /// The frequency response `H(ω) = (K − ω²M + iωC)⁻¹ B` at one frequency, by complex LU with
 /// partial pivoting.
 ///
+/// Above 1 rad/s the system is solved as `(Z(ω)/ω²) X = B`, `H = X/ω²`: `ω²` overflows beyond
+/// `ω ≈ 1.3e154` (an infinite `ω²M` made every damped model look undamped there), and the
+/// scaled matrix keeps the dominant `M` at its own size. Where the result itself leaves the
+/// range of `f64` (`|H| ≈ 1/(ω² m)` below `2.2e-308`) it is refused, not rounded to zero.
+///
 /// # Shapes
 /// `input_matrix` is `n × r`; the result is `n × r` (complex): entry `(i, j)` is the complex
 /// amplitude of coordinate `i` per unit amplitude of input `j` (m or rad per unit input).
@@ -388,7 +447,8 @@ const SINGULAR_PIVOT: f64 = 1e-13;
 /// # Errors
 /// [`FrfError::InvalidFrequency`]; [`FrfError::DimensionMismatch`];
 /// [`FrfError::Singular`] at an undamped resonance (or `ω = 0` with a rigid-body mode): when
-/// a pivot of the LU factors is below `1e-13` of the largest entry of `K − ω²M + iωC`.
+/// a pivot of the LU factors is below `1e-13` of the largest entry of `K − ω²M + iωC`;
+/// [`FrfError::ResponseOutOfRange`] when a non-zero entry of `H` is not a finite normal `f64`.
 ///
 /// # References
 /// Lecture 21 (one degree of freedom), HW37 (three masses).
@@ -399,7 +459,8 @@ pub fn frequency_response(
 ) -> Result<DMatrix<Complex<f64>>, FrfError> {
     check_forcing(lin, input_matrix.nrows(), frequency)?;
     let b = input_matrix.map(|v| Complex::new(v, 0.0));
-    let z = dynamic_stiffness(lin, frequency);
+    let s = frequency_scale(frequency);
+    let z = scaled_dynamic_stiffness(lin, frequency, s);
     let scale = z.iter().map(|v| v.norm()).fold(0.0f64, f64::max);
     let lu = z.lu();
     let smallest_pivot = lu
@@ -411,12 +472,17 @@ pub fn frequency_response(
     if smallest_pivot.is_nan() || smallest_pivot <= SINGULAR_PIVOT * scale {
         return Err(FrfError::Singular { frequency });
     }
-    let h = lu.solve(&b).ok_or(FrfError::Singular { frequency })?;
-    if h.iter().all(|v| v.re.is_finite() && v.im.is_finite()) {
-        Ok(h)
-    } else {
-        Err(FrfError::Singular { frequency })
+    let x = lu.solve(&b).ok_or(FrfError::Singular { frequency })?;
+    if !x.iter().all(|v| v.re.is_finite() && v.im.is_finite()) {
+        return Err(FrfError::Singular { frequency });
     }
+    let mut h = DMatrix::zeros(x.nrows(), x.ncols());
+    for i in 0..x.nrows() {
+        for j in 0..x.ncols() {
+            h[(i, j)] = descale(x[(i, j)], s, frequency, (i, j))?;
+        }
+    }
+    Ok(h)
 }
 
 /// The height of a resonance peak.
@@ -762,7 +828,9 @@ pub struct ModalResponse {
 /// # Errors
 /// [`FrfError::InvalidFrequency`]; [`FrfError::DimensionMismatch`];
 /// [`FrfError::Singular`] when a mode's denominator is below `1e-13 max(|ω_k²|, ω²)` (an
-/// undamped resonance to rounding).
+/// undamped resonance to rounding); [`FrfError::ResponseOutOfRange`] when a non-zero
+/// contribution is not a finite normal `f64` (the denominators are scaled by `ω²` above
+/// 1 rad/s, as in [`frequency_response`]).
 ///
 /// # References
 /// HW37 (c): modal forcing of the three-mass system; HW34 (modal damping).
@@ -777,24 +845,28 @@ pub fn modal_frequency_response(
     let damping = modal_damping(lin, modes);
     let psi = &modes.mode_shapes;
     let k = psi.ncols();
-    let w = frequency;
+    // Scaled by s² as in `frequency_response`: the denominator divided by s².
+    let s = frequency_scale(frequency);
+    let w = frequency / s;
     let mut modal_forces = Vec::with_capacity(k);
     let mut modal_coordinates = Vec::with_capacity(k);
     let mut contributions = DMatrix::zeros(n, k);
     for mode in 0..k {
         let shape = psi.column(mode);
         let force = shape.dot(b);
+        let stiffness = modes.eigenvalues[mode] / s / s;
         let denominator = Complex::new(
-            modes.eigenvalues[mode] - w * w,
-            w * damping.modal_damping_matrix[(mode, mode)],
+            stiffness - w * w,
+            w * damping.modal_damping_matrix[(mode, mode)] / s,
         );
-        let floor = SINGULAR_PIVOT * modes.eigenvalues[mode].abs().max(w * w);
+        let floor = SINGULAR_PIVOT * stiffness.abs().max(w * w);
         if denominator.norm().is_nan() || denominator.norm() <= floor {
             return Err(FrfError::Singular { frequency });
         }
-        let eta = Complex::new(force, 0.0) / denominator;
+        let eta_scaled = Complex::new(force, 0.0) / denominator;
+        let eta = eta_scaled / s / s;
         for i in 0..n {
-            contributions[(i, mode)] = eta * shape[i];
+            contributions[(i, mode)] = descale(eta_scaled * shape[i], s, frequency, (i, 0))?;
         }
         modal_forces.push(force);
         modal_coordinates.push(eta);

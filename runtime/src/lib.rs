@@ -44,9 +44,10 @@ pub use integrate::{
 };
 pub use linalg::{solve_spd, solve_spd_in_place};
 pub use modal::{
-    Equilibrium, Linearization, ModalError, ModeKind, NewtonStop, NormalModes, constraint_hessians,
-    damped_modes, eigenvalues_of_m_inv_k, find_equilibrium, linearize, matrix_exponential,
-    normal_modes,
+    Equilibrium, Linearization, MASS_MATRIX_SINGULARITY, ModalError, ModeKind, NewtonStop,
+    NormalModes, TimeDependentForcing, TimeDependentPart, constraint_hessians, damped_modes,
+    eigenvalues_of_m_inv_k, find_equilibrium, linearize, matrix_exponential, normal_modes,
+    time_dependence,
 };
 pub use model_info::{ConstraintValues, FirstOrderForm, FirstOrderParts, ModelInfo};
 pub use ode::{OdeFn, OdeSystem, RhsError, WithEvents};

@@ -44,11 +44,63 @@ pub enum ModalError {
         /// The starting guess.
         guess: Vec<f64>,
     },
+    /// Newton's residual fell below its tolerance only because the iterates ran away: the
+    /// forces fade with distance (an inverse-square attraction), and the next Newton step
+    /// from the last iterate is not small against it, so no root is near.
+    #[error(
+        "no equilibrium found: from the guess {guess:?} Newton walked away to q = {q:?}, where |F| = {residual:.3e} is small only because the forces fade with distance (the next Newton step would move q by {step:.3e} more)"
+    )]
+    EquilibriumAtInfinity {
+        /// The starting guess.
+        guess: Vec<f64>,
+        /// The last iterate (length `n`).
+        q: Vec<f64>,
+        /// Largest `|Fᵢ|` there (units of the generalized forces).
+        residual: f64,
+        /// Largest entry of the Newton step from there (units of `q`; and of `λ` with
+        /// constraints).
+        step: f64,
+    },
     /// The mass matrix at the operating point is not positive definite.
     #[error("the mass matrix is not positive definite at q = {q:?}")]
     SingularMassMatrix {
         /// The operating point.
         q: Vec<f64>,
+    },
+    /// The mass matrix at the operating point is singular to working precision: some
+    /// coordinates have no inertia there, or move the mechanism the same way (Euler angles
+    /// at `θ = 0`, where the precession and spin angles turn the body about the same axis).
+    #[error(
+        "the mass matrix is singular at q = {q:?} in the coordinates {}: smallest eigenvalue {smallest_eigenvalue:.1e} of its unit-diagonal form (below {MASS_MATRIX_SINGULARITY:e}: these coordinates have no inertia or move the mechanism the same way here)",
+        coordinates.join(", ")
+    )]
+    DegenerateCoordinates {
+        /// The coordinates (minimal coordinates with constraints) of the near-null
+        /// direction: those whose entry in it is at least a tenth of the largest.
+        coordinates: Vec<String>,
+        /// The operating point.
+        q: Vec<f64>,
+        /// The smallest eigenvalue of `D^{-1/2} M D^{-1/2}`, `D = diag M` (dimensionless; 1
+        /// for a diagonal `M`, 0 for a singular one, negative for an indefinite one).
+        smallest_eigenvalue: f64,
+    },
+    /// The equations linearised about the operating point change with time: the mass,
+    /// damping or stiffness coefficients, or a constraint, depend on `t` (parametric
+    /// excitation, a rheonomic constraint, a moving frame written with `t`). Modes of the
+    /// equations frozen at one `t` describe no motion; a periodic dependence is analysed by
+    /// its Floquet multipliers instead.
+    #[error(
+        "the linearised equations depend on t: {part} at the operating point changes by {relative_change:.1e} (relative) between t = {t0} s and t = {t} s, so modes of the equations frozen at t = {t0} s describe no motion (a parametrically excited system or a moving constraint); for a periodic dependence its stability is given by Floquet multipliers"
+    )]
+    TimeDependent {
+        /// What depends on `t`.
+        part: TimeDependentPart,
+        /// The time of the operating point (s).
+        t0: f64,
+        /// The sampled time where the change was largest (s).
+        t: f64,
+        /// The largest change relative to the part's largest entry over the samples.
+        relative_change: f64,
     },
     /// A value is not finite at the operating point.
     #[error("the linearisation is not finite at q = {q:?}")]
@@ -93,6 +145,43 @@ pub enum ModalError {
         found: usize,
     },
 }
+
+/// A part of the linearised equations found to depend on `t` ([`ModalError::TimeDependent`]).
+#[derive(Debug, Clone, PartialEq, Eq, serde::Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+#[non_exhaustive]
+pub enum TimeDependentPart {
+    /// The holonomic constraint of this name: `Φ`, its Jacobian `J` or its `γ` (a rheonomic
+    /// constraint).
+    Constraint {
+        /// The constraint's name.
+        name: String,
+    },
+    /// The mass matrix `M(q*, t)`.
+    MassMatrix,
+    /// The damping coefficients `−∂F/∂q̇ (q*, 0, t)`.
+    DampingMatrix,
+    /// The stiffness coefficients `−∂F/∂q (q*, 0, t)` (parametric excitation).
+    StiffnessMatrix,
+}
+
+impl std::fmt::Display for TimeDependentPart {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::Constraint { name } => write!(f, "the constraint `{name}` (Φ, J or γ)"),
+            Self::MassMatrix => f.write_str("the mass matrix M"),
+            Self::DampingMatrix => f.write_str("the damping matrix C = −∂F/∂q̇"),
+            Self::StiffnessMatrix => f.write_str("the stiffness −∂F/∂q"),
+        }
+    }
+}
+
+/// Below this smallest eigenvalue of the unit-diagonal mass matrix `D^{-1/2} M D^{-1/2}` the
+/// mass matrix is refused as singular ([`ModalError::DegenerateCoordinates`]): solving with
+/// it loses `log₁₀(1/λ_min)` digits, ten of sixteen here. Scaling by the diagonal makes the
+/// test independent of units and of the sizes of the bodies (a 1000 kg cart and a 1 g bob
+/// give a ratio near 1 if their coordinates are independent).
+pub const MASS_MATRIX_SINGULARITY: f64 = 1e-10;
 
 /// Why Newton's method on the equilibrium equations stopped short of a root.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
@@ -146,12 +235,16 @@ pub struct Equilibrium {
 /// position, a rigid-body rotation) stay at their guess; steps are halved while the residual
 /// does not decrease (at most 30 halvings). Converged when the largest residual is at most
 /// `1e-12 (1 + r₀)`, with `r₀` the largest at the guess, or when the step is below
-/// `1e-14 (1 + |x|)` with the residual small (`≤ 1e-8 (1 + r₀)`).
+/// `1e-14 (1 + |x|)` with the residual small (`≤ 1e-8 (1 + r₀)`). A small residual is
+/// accepted only where the next Newton step is below `1e-6 (1 + max |xᵢ|)`: forces that fade
+/// with distance (a central `−μm/r²`) fall below any residual tolerance as the iterates run
+/// off to infinity, each step a fixed fraction of the distance.
 ///
 /// # Errors
 /// [`ModalError::EquilibriumNotFound`] after 100 iterations, when no halving decreases the
 /// residual, or when the Jacobian is zero (the forces do not depend on `q`: no equilibrium
-/// unless they vanish) or not finite; [`ModalError::NonHolonomic`] for a model with non-holonomic constraints;
+/// unless they vanish) or not finite; [`ModalError::EquilibriumAtInfinity`] when the residual
+/// is small only because the iterates ran away; [`ModalError::NonHolonomic`] for a model with non-holonomic constraints;
 /// [`ModalError::DimensionMismatch`].
 pub fn find_equilibrium(
     model: &dyn ModelInfo,
@@ -216,7 +309,7 @@ pub fn find_equilibrium(
         x0.extend(lambda.iter());
     }
     let (x, iterations, residual) =
-        newton(&x0, residual_of, jacobian_of).map_err(|(iterations, residual, reason)| {
+        newton(&x0, &residual_of, &jacobian_of).map_err(|(iterations, residual, reason)| {
             ModalError::EquilibriumNotFound {
                 iterations,
                 reason,
@@ -224,6 +317,20 @@ pub fn find_equilibrium(
                 guess: guess.to_vec(),
             }
         })?;
+    // A small residual is a root only if the root is near: where the forces fade with
+    // distance (`−μm/r²`), |F| falls below any tolerance as Newton walks off to infinity,
+    // each step a fixed fraction of the distance. At a root the next step is of the order of
+    // the rounding of q; there it is a fraction of q itself.
+    let step = newton_step(&jacobian_of(&x), &residual_of(&x)).amax();
+    let size = x.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+    if step.is_nan() || step > RECEDING_STEP * (1.0 + size) {
+        return Err(ModalError::EquilibriumAtInfinity {
+            guess: guess.to_vec(),
+            q: x[..n].to_vec(),
+            residual,
+            step,
+        });
+    }
     Ok(Equilibrium {
         q: x[..n].to_vec(),
         lagrange_multipliers: x[n..].to_vec(),
@@ -232,13 +339,35 @@ pub fn find_equilibrium(
     })
 }
 
+/// The largest Newton step from a converged iterate, relative to `1 + max |xᵢ|`, that
+/// [`find_equilibrium`] accepts: beyond it the residual is small only because the iterates
+/// ran away ([`ModalError::EquilibriumAtInfinity`]). At a simple root the step is of the
+/// order of the residual's rounding divided by the stiffness (`≲ 1e-12` relative); walking
+/// off to infinity under an inverse-square force, it is half the distance.
+const RECEDING_STEP: f64 = 1e-6;
+
+/// The minimum-norm Newton step `−J⁺F` (singular values below `1e-12 σ_max` dropped); zero
+/// when `J` is zero, not finite or the solve fails.
+fn newton_step(jac: &DMatrix<f64>, f: &DVector<f64>) -> DVector<f64> {
+    if !jac.iter().all(|v| v.is_finite()) {
+        return DVector::zeros(f.len());
+    }
+    let svd = jac.clone().svd(true, true);
+    let largest = svd.singular_values.max();
+    if largest == 0.0 {
+        return DVector::zeros(f.len());
+    }
+    svd.solve(&(-f), 1e-12 * largest)
+        .unwrap_or_else(|_| DVector::zeros(f.len()))
+}
+
 /// Damped Newton with minimum-norm SVD steps (see [`find_equilibrium`]): returns the root,
 /// the iterations and the largest residual, or `(iterations, residual, why)` on failure.
 #[allow(clippy::type_complexity)]
 fn newton(
     x0: &[f64],
-    residual_of: impl Fn(&[f64]) -> DVector<f64>,
-    jacobian_of: impl Fn(&[f64]) -> DMatrix<f64>,
+    residual_of: &impl Fn(&[f64]) -> DVector<f64>,
+    jacobian_of: &impl Fn(&[f64]) -> DMatrix<f64>,
 ) -> Result<(Vec<f64>, usize, f64), (usize, f64, NewtonStop)> {
     let norm = |f: &DVector<f64>| {
         let r = f.amax();
@@ -256,15 +385,10 @@ fn newton(
         if !jac.iter().all(|v| v.is_finite()) {
             return Err((iteration, r, NewtonStop::NonFiniteJacobian));
         }
-        let svd = jac.svd(true, true);
-        let largest = svd.singular_values.max();
-        if largest == 0.0 {
+        if jac.amax() == 0.0 {
             return Err((iteration, r, NewtonStop::ZeroJacobian));
         }
-        // Fails only for a negative tolerance or without U and V, neither of which occurs.
-        let Ok(step) = svd.solve(&(-&f), 1e-12 * largest) else {
-            return Err((iteration, r, NewtonStop::NoDecrease));
-        };
+        let step = newton_step(&jac, &f);
         let mut lambda = 1.0;
         let mut accepted = false;
         for _ in 0..30 {
@@ -343,6 +467,204 @@ pub fn constraint_hessians(model: &dyn ModelInfo, q: &[f64], t: f64) -> Vec<DMat
         }
     }
     out
+}
+
+/// A load that depends on `t` at the operating point and enters neither `M`, `C` nor `K`:
+/// the linearisation is `M δq̈ + C δq̇ + K δq = F(q*, 0, t) − F(q*, 0, t₀)`, and the modes are
+/// those of its left side, the unforced equations ([`time_dependence`]).
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct TimeDependentForcing {
+    /// The time `t₀` (s) at which the load is frozen in the equilibrium `F(q*, 0, t₀) = 0`.
+    pub t0: f64,
+    /// The coordinate whose generalized force changes most.
+    pub coordinate: String,
+    /// `max |Fᵢ(q*, 0, t) − Fᵢ(q*, 0, t₀)|` over the sampled times (units of that
+    /// generalized force): the size of the input set aside.
+    pub largest_change: f64,
+    /// The sampled time (s) where it was largest.
+    pub t: f64,
+}
+
+/// Offsets (s) from `t₀` at which [`time_dependence`] samples the equations: spread over
+/// three decades and irrational-looking, so that no forcing is periodic in all of them and
+/// slow and fast ones both change between samples.
+const TIME_OFFSETS: [f64; 6] = [0.073_1, 0.271_828, 1.523_7, 5.302_9, 19.739, 71.313];
+
+/// A change of a part of the equations relative to its largest entry over the samples above
+/// which it depends on `t`: far above the rounding of evaluating `cos(w t)` at `t ≤ 72 s`
+/// (~1e-14) and far below any physical modulation.
+const TIME_TOLERANCE: f64 = 1e-9;
+
+/// The largest change of a part of the equations from its value at `t₀` (`samples[0]`) over
+/// the later samples, relative to the largest entry of every sample (and of `floor`), with
+/// the index of the sample where it occurred; a NaN counts as an infinite change.
+fn relative_change(samples: &[DVector<f64>], floor: f64) -> (f64, usize) {
+    let at_t0 = &samples[0];
+    let mut scale = floor;
+    let (mut change, mut at) = (0.0f64, 0);
+    for (k, value) in samples.iter().enumerate() {
+        scale = scale.max(value.amax());
+        let d = (value - at_t0).amax();
+        let d = if d.is_nan() { f64::INFINITY } else { d };
+        if d > change {
+            (change, at) = (d, k);
+        }
+    }
+    if change == 0.0 {
+        (0.0, at)
+    } else {
+        (change / scale, at)
+    }
+}
+
+/// The explicit time dependence of `model`'s equations at rest at `q` (the operating point,
+/// length `n`), from `t₀` (s): evaluated at six later times, each holonomic constraint
+/// (`Φ`, `J`, `Φ_t`, `γ`), then `M(q, t)`, `∂F/∂q̇ (q, 0, t)` and `∂F/∂q (q, 0, t)` must not
+/// change (relative change at most `1e-9`). A change of `F(q, 0, t)` alone is a load that
+/// enters neither `M`, `C` nor `K` — the linear oscillator driven by `F₀ cos ωt` — and is
+/// returned: the modes are those of the unforced equations, with the load frozen at `t₀` in
+/// the equilibrium. `Ok(None)` when nothing changes.
+///
+/// Why numerically: the model is a compiled function of `(t, y)`; sampling its values is
+/// what the Floquet study does to check a period, and it sees every route by which `t`
+/// enters (a point moved with `t`, a constraint, a load).
+///
+/// # Errors
+/// [`ModalError::TimeDependent`] naming the first part found to change, in the order above
+/// (a rheonomic constraint such as a rod spun at a constant rate written with `t`, a
+/// parametrically excited stiffness such as a pendulum on a shaken pivot);
+/// [`ModalError::DimensionMismatch`] and [`ModalError::NonHolonomic`].
+pub fn time_dependence(
+    model: &dyn ModelInfo,
+    q: &[f64],
+    t0: f64,
+) -> Result<Option<TimeDependentForcing>, ModalError> {
+    check_point(model, q)?;
+    let n = q.len();
+    let m = model.holonomic_constraint_count();
+    let y: Vec<f64> = q
+        .iter()
+        .copied()
+        .chain(std::iter::repeat_n(0.0, n))
+        .collect();
+    let times: Vec<f64> = std::iter::once(t0)
+        .chain(TIME_OFFSETS.iter().map(|offset| t0 + offset))
+        .collect();
+    let refuse = |part: TimeDependentPart, (relative_change, k): (f64, usize)| {
+        if relative_change > TIME_TOLERANCE {
+            Err(ModalError::TimeDependent {
+                part,
+                t0,
+                t: times[k],
+                relative_change,
+            })
+        } else {
+            Ok(())
+        }
+    };
+    if m > 0 {
+        let constraints: Vec<_> = times
+            .iter()
+            .map(|&t| model.constraint_equations(t, &y))
+            .collect();
+        for (i, name) in model.constraint_names().iter().take(m).enumerate() {
+            let samples: Vec<DVector<f64>> = constraints
+                .iter()
+                .map(|c| {
+                    let head = [c.phi[i], c.velocity[i], c.gamma[i]];
+                    DVector::from_iterator(
+                        n + 3,
+                        head.into_iter().chain(c.jacobian.row(i).iter().copied()),
+                    )
+                })
+                .collect();
+            refuse(
+                TimeDependentPart::Constraint {
+                    name: name.to_string(),
+                },
+                relative_change(&samples, 0.0),
+            )?;
+        }
+    }
+    let flat = |a: &DMatrix<f64>| DVector::from_column_slice(a.as_slice());
+    let (mut mass, mut forcing, mut damping, mut stiffness) =
+        (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    for &t in &times {
+        let (m_t, f_t) = model.mass_matrix_and_forcing(t, &y);
+        let (jq, jqd) = model.forcing_jacobians(t, &y);
+        mass.push(flat(&m_t));
+        forcing.push(f_t);
+        damping.push(flat(&jqd));
+        stiffness.push(flat(&jq));
+    }
+    refuse(TimeDependentPart::MassMatrix, relative_change(&mass, 0.0))?;
+    refuse(
+        TimeDependentPart::DampingMatrix,
+        relative_change(&damping, 0.0),
+    )?;
+    refuse(
+        TimeDependentPart::StiffnessMatrix,
+        relative_change(&stiffness, 0.0),
+    )?;
+    // The load: its rounding is that of its terms, of the order of the stiffness times the
+    // displacement, so that scale is the floor of the comparison.
+    let size = q.iter().fold(1.0f64, |a, v| a.max(v.abs()));
+    let (change, k) = relative_change(&forcing, stiffness[0].amax() * size);
+    if change <= TIME_TOLERANCE {
+        return Ok(None);
+    }
+    let difference = &forcing[k] - &forcing[0];
+    let i = difference.iamax();
+    Ok(Some(TimeDependentForcing {
+        t0,
+        coordinate: model.coordinate_names()[i].to_string(),
+        largest_change: difference[i].abs(),
+        t: times[k],
+    }))
+}
+
+/// Refuses a mass matrix (`r × r`, in the coordinates `names`) that is singular to working
+/// precision at `q`: a non-positive diagonal entry, or a smallest eigenvalue of the
+/// unit-diagonal form below [`MASS_MATRIX_SINGULARITY`] ([`ModalError::DegenerateCoordinates`],
+/// naming the coordinates of the near-null direction; a negative diagonal entry is
+/// [`ModalError::SingularMassMatrix`]). A non-finite `M` passes here and is refused by the
+/// caller's finiteness check.
+fn check_mass_matrix(mass: &DMatrix<f64>, names: &[&str], q: &[f64]) -> Result<(), ModalError> {
+    let r = mass.nrows();
+    if r == 0 || !mass.iter().all(|v| v.is_finite()) {
+        return Ok(());
+    }
+    let degenerate = |coordinates: Vec<String>, smallest_eigenvalue: f64| {
+        Err(ModalError::DegenerateCoordinates {
+            coordinates,
+            q: q.to_vec(),
+            smallest_eigenvalue,
+        })
+    };
+    let diagonal: Vec<f64> = mass.diagonal().iter().copied().collect();
+    if diagonal.iter().any(|d| *d < 0.0) {
+        return Err(ModalError::SingularMassMatrix { q: q.to_vec() });
+    }
+    if let Some(i) = diagonal.iter().position(|d| *d == 0.0) {
+        return degenerate(vec![names[i].to_string()], 0.0);
+    }
+    let root: Vec<f64> = diagonal.iter().map(|d| d.sqrt()).collect();
+    let scaled = DMatrix::from_fn(r, r, |i, j| {
+        0.5 * (mass[(i, j)] + mass[(j, i)]) / (root[i] * root[j])
+    });
+    let eigen = SymmetricEigen::new(scaled);
+    let k = eigen.eigenvalues.imin();
+    let smallest = eigen.eigenvalues[k];
+    if smallest >= MASS_MATRIX_SINGULARITY {
+        return Ok(());
+    }
+    let v = eigen.eigenvectors.column(k);
+    let largest = v.amax();
+    let coordinates = (0..r)
+        .filter(|&i| v[i].abs() >= 0.1 * largest)
+        .map(|i| names[i].to_string())
+        .collect();
+    degenerate(coordinates, smallest)
 }
 
 fn check_point(model: &dyn ModelInfo, q: &[f64]) -> Result<(), ModalError> {
@@ -497,6 +819,9 @@ fn asymmetry(k: &DMatrix<f64>) -> f64 {
 /// [`ModalError::NonHolonomic`], [`ModalError::DimensionMismatch`],
 /// [`ModalError::ConstrainedMotion`] (constrained and `q̇ ≠ 0`),
 /// [`ModalError::OffConstraints`] (`|Φ| > 1e-8`), [`ModalError::SingularMassMatrix`],
+/// [`ModalError::DegenerateCoordinates`] (a mass matrix singular to working precision: the
+/// smallest eigenvalue of `D^{-1/2} M D^{-1/2}`, `D = diag M`, below
+/// [`MASS_MATRIX_SINGULARITY`], in the minimal coordinates with constraints),
 /// [`ModalError::NonFinite`].
 pub fn linearize(
     model: &dyn ModelInfo,
@@ -517,7 +842,9 @@ pub fn linearize(
     let (mass, f) = model.mass_matrix_and_forcing(t, &y);
     let (jq, jqd) = model.forcing_jacobians(t, &y);
     let finite = |a: &DMatrix<f64>| a.iter().all(|v| v.is_finite());
+    let names = model.coordinate_names();
     if m == 0 {
+        check_mass_matrix(&mass, &names, q)?;
         let chol = mass
             .clone()
             .cholesky()
@@ -585,6 +912,8 @@ pub fn linearize(
     let (basis, independent) = null_space_by_partitioning(&j);
     let nt = basis.transpose();
     let mass_matrix = &nt * &mass * &basis;
+    let minimal: Vec<&str> = independent.iter().map(|&i| names[i]).collect();
+    check_mass_matrix(&mass_matrix, &minimal, q)?;
     let stiffness_matrix = &nt * &k_full * &basis;
     let damping_matrix = &nt * (-jqd) * &basis;
     if !(finite(&mass_matrix) && finite(&stiffness_matrix) && finite(&damping_matrix)) {

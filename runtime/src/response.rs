@@ -407,20 +407,33 @@ fn clusters<T: Copy>(values: &[T], distance: impl Fn(T, T) -> f64, tol: f64) -> 
 /// through them would lose more than six digits (error ≈ ε/ratio).
 const MIN_SINGULAR_RATIO: f64 = 1e-6;
 
+/// A singular value of `B − λI` at most this fraction of `max |Bᵢⱼ|` is rounding: the entries
+/// of `B` and the computed `λ` carry errors of a few `ε max |Bᵢⱼ|`.
+const ROUNDING_SINGULAR_VALUE: f64 = 1e-12;
+
 /// The rows of `Vᵀ` (right singular vectors of `B − λI`) for the `count` smallest singular
 /// values, where `count` is the multiplicity of the eigenvalue `λ`. Each is an eigenvector only
-/// if its singular value is negligible (`≤ 1e-6 σ_max`); otherwise the eigenvalue's
-/// eigenspace is smaller than its multiplicity (a Jordan block): [`ResponseError::Defective`].
+/// if its singular value is negligible: `≤ 1e-6 σ_max(B − λI)`, or rounding
+/// (`≤ 1e-12 max |Bᵢⱼ|`, given as `matrix_scale`); otherwise the eigenvalue's eigenspace is
+/// smaller than its multiplicity (a Jordan block): [`ResponseError::Defective`].
+///
+/// The second bound is for `B = λI` (an isotropic oscillator, `M = 2I`, `K = 50I`): `B − λI`
+/// is then rounding in every direction, its largest singular value too, and the first bound
+/// alone compared rounding with rounding and called the eigenvalue defective with a ratio
+/// near 1. It never loosens the test where `B − λI` has a part of the size of `B`, which is
+/// where a Jordan block shows.
 fn null_vectors(
     singular_values: &DVector<f64>,
     count: usize,
+    matrix_scale: f64,
     matrix: &'static str,
 ) -> Result<Vec<usize>, ResponseError> {
     let max = singular_values.max();
+    let negligible = (1e-6 * max).max(ROUNDING_SINGULAR_VALUE * matrix_scale);
     let mut order: Vec<usize> = (0..singular_values.len()).collect();
     order.sort_by(|&i, &j| singular_values[i].total_cmp(&singular_values[j]));
     order.truncate(count);
-    if let Some(&k) = order.iter().find(|&&k| singular_values[k] > 1e-6 * max) {
+    if let Some(&k) = order.iter().find(|&&k| singular_values[k] > negligible) {
         return Err(ResponseError::Defective {
             matrix,
             ratio: singular_values[k] / max,
@@ -488,7 +501,7 @@ pub fn state_response_by_eigenvectors(
                 ratio: 0.0,
             });
         };
-        for k in null_vectors(&svd.singular_values, cluster.len(), "A")? {
+        for k in null_vectors(&svd.singular_values, cluster.len(), a.amax(), "A")? {
             let col = values.len();
             for i in 0..m {
                 vectors[(i, col)] = v_t[(k, i)].conj();
@@ -633,7 +646,7 @@ pub fn modes_of_m_inv_k(lin: &Linearization) -> Result<MInvKModes, ResponseError
         } else {
             (mean, ModeKind::Oscillatory)
         };
-        for k in null_vectors(&svd.singular_values, cluster.len(), "M⁻¹K")? {
+        for k in null_vectors(&svd.singular_values, cluster.len(), b.amax(), "M⁻¹K")? {
             let col = eigenvalues.len();
             let mut u: DVector<f64> = v_t.row(k).transpose();
             let imax = u.iamax();

@@ -130,6 +130,9 @@ fn failure(model: &dyn ModelInfo, e: FrfAnalysisError) -> CliError {
             CliError::usage(format!("--simulate: `{name}`: {e}; add damping with --set"))
         }
         FrfAnalysisError::Frf(FrfError::Modal(m)) => super::modes::modal_failure(model, &m),
+        FrfAnalysisError::Frf(e @ FrfError::ResponseOutOfRange { .. }) => CliError::usage(format!(
+            "--frequency/--freqs: {e}; choose frequencies where the response is representable"
+        )),
         e => CliError::failure(format!("`{name}`: {e}")),
     }
 }

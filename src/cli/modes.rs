@@ -148,6 +148,7 @@ fn print_json(
         damping_ratios,
         m_inv_k_eigenvalues: route22,
         m_inv_k_relative_difference: route_difference,
+        time_dependent_forcing: forcing,
     } = modal;
     let (label, equilibrium) = (&point.name, &point.equilibrium);
     let names = model.coordinate_names();
@@ -173,6 +174,7 @@ fn print_json(
         "stiffness_asymmetry": modes.stiffness_asymmetry,
         "m_inv_k_eigenvalues": route22,
         "m_inv_k_relative_difference": route_difference,
+        "time_dependent_forcing": forcing,
         "charts": charts,
         "animation": args.animate,
     });
@@ -198,6 +200,7 @@ fn print_text(
         minimal_coordinates: minimal,
         damping_ratios,
         m_inv_k_relative_difference: route_difference,
+        time_dependent_forcing: forcing,
         ..
     } = modal;
     let (label, equilibrium) = (&point.name, &point.equilibrium);
@@ -217,6 +220,16 @@ fn print_text(
         equilibrium.iterations,
         num(equilibrium.residual)
     );
+    if let Some(forcing) = forcing {
+        let _ = writeln!(
+            stdout,
+            "note       F depends on t through a load that enters neither M, C nor K: F(q*, 0, t) − F(q*, 0, t₀) reaches {change:.3e} on {coordinate} (t = {t:.6e} s, t₀ = {t0} s); it is set aside as an input (the equilibrium balances its value at t₀), and the modes below are those of the unforced equations",
+            change = num(forcing.largest_change),
+            coordinate = forcing.coordinate,
+            t = num(forcing.t),
+            t0 = forcing.t0,
+        );
+    }
     if !lin.lagrange_multipliers.is_empty() {
         let forces: Vec<String> = multipliers
             .iter()
@@ -371,6 +384,21 @@ pub(super) fn modal_hint(model: &dyn ModelInfo, e: &eomgen::ModalError) -> Strin
         ),
         ModalError::EquilibriumNotFound { .. } => format!(
             "start Newton nearer an equilibrium: {start}; a model whose loads cannot be balanced (a driven or falling body) has none"
+        ),
+        ModalError::EquilibriumAtInfinity { .. } => format!(
+            "the forces fade with distance without balancing (an attraction with nothing to oppose it: an orbit has no equilibrium at rest); start Newton nearer an equilibrium if there is one: {start}"
+        ),
+        ModalError::DegenerateCoordinates { .. } => format!(
+            "the coordinates are singular at this configuration (Euler angles at θ = 0, an angle of a point at its pivot): choose an operating point away from it, {start}, or other coordinates"
+        ),
+        ModalError::TimeDependent {
+            part: eomgen::TimeDependentPart::Constraint { .. },
+            ..
+        } => format!(
+            "a constraint that moves with t (a rod spun at a given rate) has no modes at rest; write the model in coordinates that move with it (the distance along a spun rod), where the equations no longer contain t, or simulate it (`eomgen simulate {name}`)"
+        ),
+        ModalError::TimeDependent { .. } => format!(
+            "for a periodic dependence, its stability about this operating point is given by `eomgen study floquet {name}` (Floquet multipliers over one period); `eomgen simulate {name}` follows the motion"
         ),
         ModalError::SingularMassMatrix { .. } => format!(
             "a coordinate has no inertia at this configuration (the mass matrix loses rank there, e.g. an angle of a point at its pivot): choose another operating point, {start}"

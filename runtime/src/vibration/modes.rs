@@ -9,7 +9,8 @@ use super::operating_point::{
     OperatingPoint, OperatingPointError, OperatingPointOptions, operating_point,
 };
 use crate::modal::{
-    Linearization, NormalModes, damped_modes, eigenvalues_of_m_inv_k, linearize, normal_modes,
+    Linearization, NormalModes, TimeDependentForcing, damped_modes, eigenvalues_of_m_inv_k,
+    linearize, normal_modes, time_dependence,
 };
 use crate::model_info::ModelInfo;
 
@@ -61,6 +62,11 @@ pub struct ModalAnalysis {
     /// The largest difference between them and `normal_modes.eigenvalues` (lecture 24's
     /// symmetric route), relative to the largest `|ω²|`.
     pub m_inv_k_relative_difference: f64,
+    /// A load that depends on `t` and enters neither `M`, `C` nor `K` (`F₀ cos ωt` on a
+    /// linear oscillator): set aside as an input, frozen at the operating point's `t` in the
+    /// equilibrium; the modes are those of the unforced equations. `None` when the equations
+    /// at the operating point do not depend on `t`.
+    pub time_dependent_forcing: Option<TimeDependentForcing>,
 }
 
 impl ModalAnalysis {
@@ -81,10 +87,18 @@ impl ModalAnalysis {
 /// modes, the damped eigenvalues and lecture 22's `M⁻¹K` check: `eomgen modes` and the start
 /// of the modal studies.
 ///
+/// Explicit time dependence is checked at the equilibrium ([`time_dependence`]): a load that
+/// changes with `t` but enters neither `M`, `C` nor `K` is set aside (reported in
+/// [`ModalAnalysis::time_dependent_forcing`]); coefficients or constraints that change with
+/// `t` are refused, since modes of equations frozen at one instant describe no motion.
+///
 /// # Errors
 /// [`OperatingPointError::UnknownEquilibrium`]; [`OperatingPointError::Modal`] when the
 /// equilibrium search, the linearisation (constraints violated, singular or non-finite
-/// matrices) or the eigenproblems fail.
+/// matrices, [`ModalError::DegenerateCoordinates`](crate::ModalError::DegenerateCoordinates))
+/// or the eigenproblems fail, or with
+/// [`ModalError::TimeDependent`](crate::ModalError::TimeDependent) for time-dependent
+/// coefficients or constraints.
 ///
 /// # Examples
 /// Three equal masses between four equal springs (`three_masses`, HW28): `ω² = (2 − √2) k/m`,
@@ -110,6 +124,7 @@ pub fn modal_analysis(
     options: &ModalOptions,
 ) -> Result<ModalAnalysis, OperatingPointError> {
     let point = operating_point(model, &options.operating_point)?;
+    let time_dependent_forcing = time_dependence(model, point.q(), point.t)?;
     let n = model.num_dofs();
     let linearization = linearize(model, point.q(), &vec![0.0; n], point.t)?;
     let modes = normal_modes(&linearization)?;
@@ -157,5 +172,6 @@ pub fn modal_analysis(
         damping_ratios,
         m_inv_k_eigenvalues,
         m_inv_k_relative_difference,
+        time_dependent_forcing,
     })
 }
