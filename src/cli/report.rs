@@ -89,7 +89,7 @@ pub fn run(args: &ReportArgs) -> Result<(), CliError> {
     let text = serde_json::to_string_pretty(&json).map_err(|e| CliError::failure(e.to_string()))?;
     let write = |name: &str, content: &str| {
         let path = args.out.join(name);
-        super::render::write_file(&path.to_string_lossy(), content).map_err(CliError::failure)
+        super::files::write(&path.to_string_lossy(), content.as_bytes()).map_err(CliError::from)
     };
     write("report.json", &format!("{text}\n"))?;
     write(
@@ -351,9 +351,9 @@ fn animation(spec: &str, name: &str, model_dir: &Path, notes: &mut Vec<String>) 
                 notes.push(format!("animation: {}", e.message));
             }
             let file = "animation.html";
-            match super::render::write_file(
+            match super::files::write(
                 &model_dir.join(file).to_string_lossy(),
-                animation.to_html(),
+                animation.to_html().as_bytes(),
             ) {
                 Ok(()) => Some(format!("{name}/{file}")),
                 Err(e) => {
