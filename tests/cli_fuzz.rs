@@ -41,6 +41,14 @@ const VALUES: &[&str] = &[
     "x=",
     "=1",
     "\u{1}",
+    // Issue 28: subnormal and absurd values, ranges that start with `-` (clap took them
+    // for options), and paths that are not regular files.
+    "1e-320",
+    "-1..10",
+    "1e-320..10",
+    "-inf..1",
+    ".",
+    "/dev/null",
 ];
 
 /// A valid command and the options of it that take a value.
@@ -65,7 +73,14 @@ const CASES: &[Case] = &[
             "--baumgarte",
             "--stop-when",
             "--event",
+            "--csv",
+            "--plot",
+            "--plot-phase",
         ],
+    },
+    Case {
+        args: &["animate", "simple_pendulum", "-o", "a.html", "--t-end", "1"],
+        options: &["--t-end", "--dt", "--fps", "--rtol", "-o", "--gif"],
     },
     Case {
         args: &["simulate", "simple_pendulum_cartesian", "--t-end", "1"],
@@ -142,6 +157,8 @@ const CASES: &[Case] = &[
             "--t-end",
             "--target-error",
             "--baseline-ms",
+            "--min-time-ms",
+            "--plot",
         ],
     },
     Case {
