@@ -541,7 +541,10 @@ fn issue_28_dev_null_stays_a_character_device() {
 
 /// Makes a FIFO at `path` (with the system's `mkfifo`).
 fn mkfifo(path: &std::path::Path) {
-    let made = Command::new("mkfifo").arg(path).status().expect("mkfifo runs");
+    let made = Command::new("mkfifo")
+        .arg(path)
+        .status()
+        .expect("mkfifo runs");
     assert!(made.success());
 }
 
@@ -552,7 +555,10 @@ fn mkfifo(path: &std::path::Path) {
 fn issue_28_a_fifo_is_written_in_place() {
     use std::os::unix::fs::FileTypeExt as _;
     let dir = tempfile::tempdir().unwrap();
-    for (option, name, starts) in [("--csv", "pipe.csv", "t,q,q_dot,energy"), ("--plot", "pipe.svg", "<svg")] {
+    for (option, name, starts) in [
+        ("--csv", "pipe.csv", "t,q,q_dot,energy"),
+        ("--plot", "pipe.svg", "<svg"),
+    ] {
         let fifo = dir.path().join(name);
         mkfifo(&fifo);
         let reader = {
@@ -574,7 +580,11 @@ fn issue_28_a_fifo_is_written_in_place() {
         let kind = std::fs::symlink_metadata(&fifo).unwrap().file_type();
         assert!(kind.is_fifo(), "{name} is now {kind:?}");
         let text = reader.join().unwrap();
-        assert!(text.starts_with(starts), "{option}: {}", &text[..text.len().min(80)]);
+        assert!(
+            text.starts_with(starts),
+            "{option}: {}",
+            &text[..text.len().min(80)]
+        );
         if option == "--csv" {
             assert_eq!(text.lines().count(), 3, "{text}");
         } else {
@@ -630,13 +640,25 @@ fn issue_28_a_symbolic_link_is_followed_and_kept() {
 fn issue_28_an_existing_file_keeps_its_mode() {
     use std::os::unix::fs::PermissionsExt as _;
     let dir = tempfile::tempdir().unwrap();
-    let mode = |path: &std::path::Path| std::fs::metadata(path).unwrap().permissions().mode() & 0o7777;
+    let mode =
+        |path: &std::path::Path| std::fs::metadata(path).unwrap().permissions().mode() & 0o7777;
     for (name, kept) in [("a.csv", 0o600), ("b.svg", 0o640), ("c.csv", 0o444)] {
         let path = dir.path().join(name);
         std::fs::write(&path, "old\n").unwrap();
         std::fs::set_permissions(&path, std::fs::Permissions::from_mode(kept)).unwrap();
-        let option = if name.ends_with(".svg") { "--plot" } else { "--csv" };
-        let out = run(&["simulate", "simple_pendulum", "--t-out", "1", option, path.to_str().unwrap()]);
+        let option = if name.ends_with(".svg") {
+            "--plot"
+        } else {
+            "--csv"
+        };
+        let out = run(&[
+            "simulate",
+            "simple_pendulum",
+            "--t-out",
+            "1",
+            option,
+            path.to_str().unwrap(),
+        ]);
         assert!(out.status.success(), "{}", stderr(&out));
         assert_ne!(std::fs::read(&path).unwrap(), b"old\n");
         assert_eq!(mode(&path), kept, "{name}");
@@ -644,7 +666,14 @@ fn issue_28_an_existing_file_keeps_its_mode() {
     let reference = dir.path().join("reference");
     std::fs::File::create(&reference).unwrap();
     let new = dir.path().join("new.csv");
-    let out = run(&["simulate", "simple_pendulum", "--t-out", "1", "--csv", new.to_str().unwrap()]);
+    let out = run(&[
+        "simulate",
+        "simple_pendulum",
+        "--t-out",
+        "1",
+        "--csv",
+        new.to_str().unwrap(),
+    ]);
     assert!(out.status.success(), "{}", stderr(&out));
     assert_eq!(mode(&new), mode(&reference));
 }
@@ -654,7 +683,14 @@ fn issue_28_an_existing_file_keeps_its_mode() {
 /// would have replaced, losing the summary).
 #[test]
 fn issue_28_dev_stdout_is_standard_output() {
-    let args = ["simulate", "simple_pendulum", "--t-out", "1,2", "--csv", "/dev/stdout"];
+    let args = [
+        "simulate",
+        "simple_pendulum",
+        "--t-out",
+        "1,2",
+        "--csv",
+        "/dev/stdout",
+    ];
     let out = run(&args);
     assert!(out.status.success(), "{}", stderr(&out));
     let text = String::from_utf8(out.stdout).unwrap();
@@ -685,41 +721,113 @@ fn issue_28_outputs_are_checked_before_any_work() {
     let dir = tempfile::tempdir().unwrap();
     let cases: &[(&[&str], &str)] = &[
         (
-            &["simulate", "simple_pendulum", "--csv", "a.csv", "--plot", "a.pdf"],
+            &[
+                "simulate",
+                "simple_pendulum",
+                "--csv",
+                "a.csv",
+                "--plot",
+                "a.pdf",
+            ],
             "--plot `a.pdf`: a chart file must end in .svg or .png",
         ),
         (
-            &["simulate", "simple_pendulum", "--csv", "a.csv", "--plot", "q.svg", "--plot-phase", "./q.svg"],
+            &[
+                "simulate",
+                "simple_pendulum",
+                "--csv",
+                "a.csv",
+                "--plot",
+                "q.svg",
+                "--plot-phase",
+                "./q.svg",
+            ],
             "--plot and --plot-phase both write `./q.svg`",
         ),
         (
-            &["simulate", "simple_pendulum", "--csv", "a.csv", "--plot", "q.svg", "--plot-energy", "q.svg"],
+            &[
+                "simulate",
+                "simple_pendulum",
+                "--csv",
+                "a.csv",
+                "--plot",
+                "q.svg",
+                "--plot-energy",
+                "q.svg",
+            ],
             "both write `q.svg`",
         ),
         (
             // A companion: `--plot q.svg` owns `q-drift.svg`.
-            &["simulate", "simple_pendulum_cartesian", "--csv", "a.csv", "--plot", "q.svg", "--plot-phase", "q-drift.svg"],
+            &[
+                "simulate",
+                "simple_pendulum_cartesian",
+                "--csv",
+                "a.csv",
+                "--plot",
+                "q.svg",
+                "--plot-phase",
+                "q-drift.svg",
+            ],
             "--plot (its constraint drift chart) and --plot-phase both write `q-drift.svg`",
         ),
         (
-            &["simulate", "simple_pendulum", "--csv", "a.csv", "--plot-phase", "missing/p.svg"],
+            &[
+                "simulate",
+                "simple_pendulum",
+                "--csv",
+                "a.csv",
+                "--plot-phase",
+                "missing/p.svg",
+            ],
             "the directory `missing` does not exist",
         ),
         (
-            &["simulate", "simple_pendulum", "--csv", "a.csv", "--plot", "."],
+            &[
+                "simulate",
+                "simple_pendulum",
+                "--csv",
+                "a.csv",
+                "--plot",
+                ".",
+            ],
             "a chart file must end in .svg or .png",
         ),
-        (&["simulate", "simple_pendulum", "--csv", "."], "is a directory"),
         (
-            &["animate", "simple_pendulum", "-o", "a.html", "--gif", "./a.html"],
+            &["simulate", "simple_pendulum", "--csv", "."],
+            "is a directory",
+        ),
+        (
+            &[
+                "animate",
+                "simple_pendulum",
+                "-o",
+                "a.html",
+                "--gif",
+                "./a.html",
+            ],
             "--output and --gif both write `./a.html`",
         ),
         (
-            &["frf", "forced_oscillator", "--input", "F0", "--plot", "bode.txt"],
+            &[
+                "frf",
+                "forced_oscillator",
+                "--input",
+                "F0",
+                "--plot",
+                "bode.txt",
+            ],
             "a chart file must end in .svg or .png",
         ),
         (
-            &["modes", "double_pendulum", "--plot", "dp", "--animate", "dp-mode2.svg"],
+            &[
+                "modes",
+                "double_pendulum",
+                "--plot",
+                "dp",
+                "--animate",
+                "dp-mode2.svg",
+            ],
             "both write `dp-mode2.svg`",
         ),
         (
@@ -752,26 +860,75 @@ fn issue_28_stale_companions_are_removed() {
     let drift = dir.path().join("d-drift.svg");
     let with = run_in(
         dir.path(),
-        &["simulate", "simple_pendulum", "--init", "q=1", "--event", "q = 0", "--t-end", "3", "--csv", "e.csv"],
+        &[
+            "simulate",
+            "simple_pendulum",
+            "--init",
+            "q=1",
+            "--event",
+            "q = 0",
+            "--t-end",
+            "3",
+            "--csv",
+            "e.csv",
+        ],
     );
     assert!(with.status.success(), "{}", stderr(&with));
-    assert!(std::fs::read_to_string(&events).unwrap().starts_with("event,direction"));
+    assert!(
+        std::fs::read_to_string(&events)
+            .unwrap()
+            .starts_with("event,direction")
+    );
     let constrained = run_in(
         dir.path(),
-        &["simulate", "simple_pendulum_cartesian", "--t-end", "1", "--plot", "d.svg"],
+        &[
+            "simulate",
+            "simple_pendulum_cartesian",
+            "--t-end",
+            "1",
+            "--plot",
+            "d.svg",
+        ],
     );
     assert!(constrained.status.success(), "{}", stderr(&constrained));
     assert!(drift.exists());
 
-    let without = run_in(dir.path(), &["simulate", "simple_pendulum", "--t-end", "1", "--csv", "e.csv", "--plot", "d.svg"]);
+    let without = run_in(
+        dir.path(),
+        &[
+            "simulate",
+            "simple_pendulum",
+            "--t-end",
+            "1",
+            "--csv",
+            "e.csv",
+            "--plot",
+            "d.svg",
+        ],
+    );
     assert!(without.status.success(), "{}", stderr(&without));
     assert!(!events.exists(), "a stale events file stayed");
     assert!(!drift.exists(), "a stale drift chart stayed");
 
     std::os::unix::fs::symlink("elsewhere.csv", &events).unwrap();
-    let again = run_in(dir.path(), &["simulate", "simple_pendulum", "--t-end", "1", "--csv", "e.csv"]);
+    let again = run_in(
+        dir.path(),
+        &[
+            "simulate",
+            "simple_pendulum",
+            "--t-end",
+            "1",
+            "--csv",
+            "e.csv",
+        ],
+    );
     assert!(again.status.success(), "{}", stderr(&again));
-    assert!(std::fs::symlink_metadata(&events).unwrap().file_type().is_symlink());
+    assert!(
+        std::fs::symlink_metadata(&events)
+            .unwrap()
+            .file_type()
+            .is_symlink()
+    );
 }
 
 /// A chart written to a full disk said `plotting failed: ImageError(IoError(Custom {…}))`
@@ -788,10 +945,41 @@ fn issue_28_a_failed_chart_write_names_the_file_and_the_reason() {
     let (png, svg, csv) = (full("q.png"), full("p.svg"), full("f.csv"));
     let mode = full("dp-mode1.svg");
     let cases: Vec<(Vec<&str>, &str)> = vec![
-        (vec!["simulate", "simple_pendulum", "--t-end", "1", "--plot", &png], &png),
-        (vec!["simulate", "simple_pendulum", "--t-end", "1", "--plot-phase", &svg], &svg),
-        (vec!["simulate", "simple_pendulum", "--t-end", "1", "--csv", &csv], &csv),
-        (vec!["modes", "double_pendulum", "--plot", &mode[..mode.len() - "-mode1.svg".len()]], &mode),
+        (
+            vec![
+                "simulate",
+                "simple_pendulum",
+                "--t-end",
+                "1",
+                "--plot",
+                &png,
+            ],
+            &png,
+        ),
+        (
+            vec![
+                "simulate",
+                "simple_pendulum",
+                "--t-end",
+                "1",
+                "--plot-phase",
+                &svg,
+            ],
+            &svg,
+        ),
+        (
+            vec!["simulate", "simple_pendulum", "--t-end", "1", "--csv", &csv],
+            &csv,
+        ),
+        (
+            vec![
+                "modes",
+                "double_pendulum",
+                "--plot",
+                &mode[..mode.len() - "-mode1.svg".len()],
+            ],
+            &mode,
+        ),
     ];
     for (args, path) in cases {
         let out = run(&args);
@@ -802,9 +990,17 @@ fn issue_28_a_failed_chart_write_names_the_file_and_the_reason() {
             "{args:?}: {text}"
         );
         assert_eq!(text.matches(path).count(), 1, "{text}");
-        assert!(!text.contains("ImageError") && !text.contains("Custom"), "{text}");
+        assert!(
+            !text.contains("ImageError") && !text.contains("Custom"),
+            "{text}"
+        );
         // The link is still a link to the device.
-        assert!(std::fs::symlink_metadata(path).unwrap().file_type().is_symlink());
+        assert!(
+            std::fs::symlink_metadata(path)
+                .unwrap()
+                .file_type()
+                .is_symlink()
+        );
     }
 }
 
@@ -818,7 +1014,10 @@ fn issue_28_diagnostics_json_on_a_full_device_is_status_1() {
     let out = to_full_device(&["check", "--json", bad.to_str().unwrap()]);
     let text = stderr(&out);
     assert_eq!(out.status.code(), Some(1), "{text}");
-    assert!(text.contains("cannot write standard output: No space left on device"), "{text}");
+    assert!(
+        text.contains("cannot write standard output: No space left on device"),
+        "{text}"
+    );
     // Written where it can be, the same error is a usage error (2).
     let out = run(&["check", "--json", bad.to_str().unwrap()]);
     assert_eq!(out.status.code(), Some(2));

@@ -17,7 +17,14 @@ fn tolerances_out_of_range_are_usage_errors_everywhere() {
         &["simulate", "simple_pendulum", "--rtol", "1"],
         // Issue 28: the documented range is (0, 1), and 0 was accepted.
         &["simulate", "simple_pendulum", "--rtol", "0"],
-        &["animate", "simple_pendulum", "-o", "unwritten.html", "--rtol", "0"],
+        &[
+            "animate",
+            "simple_pendulum",
+            "-o",
+            "unwritten.html",
+            "--rtol",
+            "0",
+        ],
         &["simulate", "simple_pendulum", "--rtol", "-1"],
         &["simulate", "simple_pendulum", "--atol", "-1e-9"],
         &[
@@ -272,37 +279,104 @@ fn negative_numbers_reach_the_options_checks() {
 fn issue_28_out_of_range_options_are_usage_errors() {
     let cases: &[(&[&str], &str)] = &[
         (
-            &["frf", "forced_oscillator", "--input", "F0", "--freqs", "1e-320..10"],
+            &[
+                "frf",
+                "forced_oscillator",
+                "--input",
+                "F0",
+                "--freqs",
+                "1e-320..10",
+            ],
             "--freqs LO `1e-320`: a frequency must be in [1e-12, 1e12] rad/s",
         ),
         (
-            &["frf", "forced_oscillator", "--input", "F0", "--frequency", "1e155"],
+            &[
+                "frf",
+                "forced_oscillator",
+                "--input",
+                "F0",
+                "--frequency",
+                "1e155",
+            ],
             "[1e-12, 1e12] rad/s or 0",
         ),
         (
-            &["study", "constraint-methods", "two_masses_rod", "--t-end", "1e308"],
+            &[
+                "study",
+                "constraint-methods",
+                "two_masses_rod",
+                "--t-end",
+                "1e308",
+            ],
             "[1e-6, 1e6]",
         ),
         (
-            &["study", "work-precision", "double_pendulum", "--t-end", "1e-320"],
+            &[
+                "study",
+                "work-precision",
+                "double_pendulum",
+                "--t-end",
+                "1e-320",
+            ],
             "[1e-6, 1e6]",
         ),
-        (&["study", "free-response", "three_masses", "--t-end", "1e308"], "[1e-6, 1e6]"),
-        (&["study", "modal-damping", "three_masses", "--t-end", "1e308"], "[1e-6, 1e6]"),
-        (&["study", "stability", "--stiffness", "1e-320"], "[1e-6, 1e10]"),
         (
-            &["study", "constraint-methods", "simple_pendulum_cartesian", "--stiffness", "1e-320"],
+            &["study", "free-response", "three_masses", "--t-end", "1e308"],
+            "[1e-6, 1e6]",
+        ),
+        (
+            &["study", "modal-damping", "three_masses", "--t-end", "1e308"],
+            "[1e-6, 1e6]",
+        ),
+        (
+            &["study", "stability", "--stiffness", "1e-320"],
             "[1e-6, 1e10]",
         ),
         (
-            &["simulate", "simple_pendulum", "--method", "rk4", "--dt", "0"],
+            &[
+                "study",
+                "constraint-methods",
+                "simple_pendulum_cartesian",
+                "--stiffness",
+                "1e-320",
+            ],
+            "[1e-6, 1e10]",
+        ),
+        (
+            &[
+                "simulate",
+                "simple_pendulum",
+                "--method",
+                "rk4",
+                "--dt",
+                "0",
+            ],
             "`dt` is 0",
         ),
         (
-            &["animate", "simple_pendulum", "-o", "unwritten.html", "--method", "rk4", "--dt", "0"],
+            &[
+                "animate",
+                "simple_pendulum",
+                "-o",
+                "unwritten.html",
+                "--method",
+                "rk4",
+                "--dt",
+                "0",
+            ],
             "`dt` is 0",
         ),
-        (&["animate", "simple_pendulum", "-o", "unwritten.html", "--dt", "0"], "`dt` is 0"),
+        (
+            &[
+                "animate",
+                "simple_pendulum",
+                "-o",
+                "unwritten.html",
+                "--dt",
+                "0",
+            ],
+            "`dt` is 0",
+        ),
     ];
     for (args, says) in cases {
         let out = eomgen(args);
@@ -319,18 +393,44 @@ fn issue_28_out_of_range_options_are_usage_errors() {
 #[test]
 fn issue_28_values_starting_with_a_minus_reach_the_checks_and_numbers_print_short() {
     let cases: &[(&[&str], &str)] = &[
-        (&["simulate", "simple_pendulum", "--t-end", "-inf"], "--t-end must be a positive number of seconds, got -inf"),
         (
-            &["frf", "forced_oscillator", "--input", "F0", "--freqs", "-1..10"],
+            &["simulate", "simple_pendulum", "--t-end", "-inf"],
+            "--t-end must be a positive number of seconds, got -inf",
+        ),
+        (
+            &[
+                "frf",
+                "forced_oscillator",
+                "--input",
+                "F0",
+                "--freqs",
+                "-1..10",
+            ],
             "--freqs LO `-1`",
         ),
-        (&["study", "stability", "--stiffness", "-inf"], "a stiffness must be"),
         (
-            &["animate", "simple_pendulum", "-o", "unwritten.html", "--t-end", "1e308"],
+            &["study", "stability", "--stiffness", "-inf"],
+            "a stiffness must be",
+        ),
+        (
+            &[
+                "animate",
+                "simple_pendulum",
+                "-o",
+                "unwritten.html",
+                "--t-end",
+                "1e308",
+            ],
             "--t-end 1e308 at --fps 30 gives more than 100000 frames",
         ),
         (
-            &["study", "work-precision", "simple_pendulum", "--target-error", "-1e308"],
+            &[
+                "study",
+                "work-precision",
+                "simple_pendulum",
+                "--target-error",
+                "-1e308",
+            ],
             "got -1e308",
         ),
     ];
@@ -345,5 +445,9 @@ fn issue_28_values_starting_with_a_minus_reach_the_checks_and_numbers_print_shor
     // An option after an option that takes a value is still an option: the value is missing.
     let out = eomgen(&["simulate", "simple_pendulum", "--csv", "--json"]);
     assert_eq!(out.status.code(), Some(2));
-    assert!(stderr(&out).contains("a value is required for '--csv <FILE>'"), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("a value is required for '--csv <FILE>'"),
+        "{}",
+        stderr(&out)
+    );
 }

@@ -262,7 +262,9 @@ pub(super) fn write(path: &str, bytes: &[u8]) -> Result<(), FileError> {
                 .truncate(truncate)
                 .open(target)
                 .map_err(fail)?;
-            file.write_all(bytes).and_then(|()| file.flush()).map_err(fail)
+            file.write_all(bytes)
+                .and_then(|()| file.flush())
+                .map_err(fail)
         }
         Target::Regular {
             path: target,
@@ -293,7 +295,9 @@ fn replace(target: &Path, existing: Option<&Metadata>, bytes: &[u8]) -> io::Resu
                 Some(existing.gid()),
             );
         }
-        temporary.as_file().set_permissions(existing.permissions())?;
+        temporary
+            .as_file()
+            .set_permissions(existing.permissions())?;
     }
     temporary.write_all(bytes)?;
     temporary.persist(target).map_err(|e| e.error)?;

@@ -22,8 +22,8 @@ use plotters::prelude::*;
 use rayon::prelude::*;
 use serde_json::{Value, json};
 
-use super::files::Outputs;
 use super::CliError;
+use super::files::Outputs;
 use super::modes::{OperatingPointArgs, point_json};
 use super::plot::{register_font, tick};
 use super::render::num;
@@ -73,7 +73,9 @@ fn analysis_text(model: &dyn ModelInfo, e: &FloquetStudyError) -> String {
 
 /// Runs `study floquet`.
 pub fn run(args: &FloquetArgs) -> Result<(), CliError> {
-    Outputs::new().chart("--plot", args.plot.as_deref()).check()?;
+    Outputs::new()
+        .chart("--plot", args.plot.as_deref())
+        .check()?;
     let mut model = args.point.model(&args.model)?;
     let source = super::open_model(&args.model)?;
     // A file that cannot be read here (a bundled model's file moved away from an installed

@@ -16,8 +16,8 @@ use eomgen::{ModeKind, ModelInfo};
 use plotters::prelude::*;
 use serde_json::json;
 
-use super::files::Outputs;
 use super::CliError;
+use super::files::Outputs;
 use super::modes::{OperatingPointArgs, point_json};
 use super::plot::{self, Series};
 use super::render::num;
@@ -80,12 +80,10 @@ pub(super) fn study_failure(model: &dyn ModelInfo, e: &ResponseStudyError) -> Cl
             "`{name}` has constraints; this study takes unconstrained models (`eomgen modes {name}` gives its modes in minimal coordinates)"
         )),
         ResponseStudyError::InvalidTolerance { .. } => CliError::usage("--tol must be positive"),
-        ResponseStudyError::InvalidEndTime { t_end } => {
-            CliError::usage(format!(
-                "--t-end must be positive and finite, got {:e}",
-                super::render::num(t_end)
-            ))
-        }
+        ResponseStudyError::InvalidEndTime { t_end } => CliError::usage(format!(
+            "--t-end must be positive and finite, got {:e}",
+            super::render::num(t_end)
+        )),
         ResponseStudyError::TooFewSamples { .. } => CliError::usage("--samples must be at least 2"),
         ResponseStudyError::NoSuchMode { .. } | ResponseStudyError::NotUnderdamped { .. } => {
             CliError::usage(format!("--rayleigh-modes: {e}"))
@@ -218,7 +216,9 @@ where
 
 /// Runs `study free-response`.
 pub fn run(args: &FreeResponseArgs) -> Result<(), CliError> {
-    Outputs::new().chart("--plot", args.plot.as_deref()).check()?;
+    Outputs::new()
+        .chart("--plot", args.plot.as_deref())
+        .check()?;
     let model = args.point.model(&args.model)?;
     let options = FreeResponseOptions {
         operating_point: args.point.options(model.as_ref())?,

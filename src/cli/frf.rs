@@ -153,7 +153,9 @@ fn frequency(option: &str, text: &str, w: f64, zero: bool) -> Result<f64, CliErr
 
 /// Runs `frf`.
 pub fn run(args: &FrfArgs) -> Result<(), CliError> {
-    Outputs::new().chart("--plot", args.plot.as_deref()).check()?;
+    Outputs::new()
+        .chart("--plot", args.plot.as_deref())
+        .check()?;
     let mut model = args.point.model(&args.model)?;
     let lookup = parameter_lookup(model.as_ref());
     let frequency_range = match &args.freqs {

@@ -1,9 +1,9 @@
 //! Command-line interface (clap): parsing, dispatch, and the rendering of errors.
 
 mod animate;
-mod files;
 mod check;
 mod equations;
+mod files;
 mod floquet;
 mod free_response;
 mod frf;
@@ -129,7 +129,10 @@ fn allow_negative_numbers(command: clap::Command) -> clap::Command {
 /// plain negative numbers pass its `allow_negative_numbers`. The value then reaches the
 /// option's own check. An option of the command after another (`--csv --json`) stays an
 /// option, so a missing value is still reported as missing.
-fn join_hyphen_values(command: &clap::Command, args: Vec<std::ffi::OsString>) -> Vec<std::ffi::OsString> {
+fn join_hyphen_values(
+    command: &clap::Command,
+    args: Vec<std::ffi::OsString>,
+) -> Vec<std::ffi::OsString> {
     let mut current = command;
     let mut out = Vec::with_capacity(args.len());
     let mut rest = args.into_iter();

@@ -11,8 +11,8 @@ use eomgen::ModelInfo;
 use eomgen::vibration::{ModalDampingOptions, ModalDampingStudy, RayleighFit};
 use serde_json::json;
 
-use super::files::Outputs;
 use super::CliError;
+use super::files::Outputs;
 use super::free_response::{Panel, kind_json, panels, parse_init, study_failure};
 use super::modes::{OperatingPointArgs, matrix_rows, point_json};
 use super::plot::Series;
@@ -55,7 +55,9 @@ pub struct ModalDampingArgs {
 
 /// Runs `study modal-damping`.
 pub fn run(args: &ModalDampingArgs) -> Result<(), CliError> {
-    Outputs::new().chart("--plot", args.plot.as_deref()).check()?;
+    Outputs::new()
+        .chart("--plot", args.plot.as_deref())
+        .check()?;
     let model = args.point.model(&args.model)?;
     let rayleigh_modes = match &args.rayleigh_modes {
         Some(list) => match list.as_slice() {

@@ -18,9 +18,8 @@ macro_rules! write_chart {
             Ok($crate::cli::plot::ChartFormat::Svg) => {
                 let mut text = String::new();
                 let drawn = {
-                    let $root =
-                        ::plotters::prelude::SVGBackend::with_string(&mut text, size)
-                            .into_drawing_area();
+                    let $root = ::plotters::prelude::SVGBackend::with_string(&mut text, size)
+                        .into_drawing_area();
                     $draw
                 };
                 drawn
@@ -30,9 +29,8 @@ macro_rules! write_chart {
             Ok($crate::cli::plot::ChartFormat::Png) => {
                 let mut pixels = vec![0u8; size.0 as usize * size.1 as usize * 3];
                 let drawn = {
-                    let $root =
-                        ::plotters::prelude::BitMapBackend::with_buffer(&mut pixels, size)
-                            .into_drawing_area();
+                    let $root = ::plotters::prelude::BitMapBackend::with_buffer(&mut pixels, size)
+                        .into_drawing_area();
                     $draw
                 };
                 drawn
@@ -191,7 +189,6 @@ impl ChartFormat {
     }
 }
 
-
 /// Writes a drawn chart's bytes to `path` ([`super::files::write`]).
 ///
 /// # Errors
@@ -205,7 +202,11 @@ pub(super) fn save(path: &str, bytes: &[u8]) -> Result<(), String> {
 ///
 /// # Errors
 /// A failed encoding, or the write error.
-pub(super) fn save_png(path: &str, pixels: &[u8], (width, height): (u32, u32)) -> Result<(), String> {
+pub(super) fn save_png(
+    path: &str,
+    pixels: &[u8],
+    (width, height): (u32, u32),
+) -> Result<(), String> {
     use image::ImageEncoder as _;
     let mut bytes = Vec::new();
     image::codecs::png::PngEncoder::new(&mut bytes)

@@ -33,7 +33,9 @@ pub struct EulerRoundoffArgs {
 
 /// Runs `eomgen study euler-roundoff`.
 pub fn run(args: &EulerRoundoffArgs) -> Result<(), CliError> {
-    Outputs::new().chart("--plot", args.plot.as_deref()).check()?;
+    Outputs::new()
+        .chart("--plot", args.plot.as_deref())
+        .check()?;
     let EulerRoundoff {
         rows,
         summary: summaries,

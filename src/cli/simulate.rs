@@ -214,7 +214,10 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
         .file("--csv", args.csv.as_deref())
         .file("--csv (its events file)", events_csv.as_deref())
         .chart("--plot", args.plot.as_deref())
-        .chart("--plot (its constraint drift chart)", drift_chart.as_deref())
+        .chart(
+            "--plot (its constraint drift chart)",
+            drift_chart.as_deref(),
+        )
         .chart("--plot-phase", args.plot_phase.as_deref())
         .chart("--plot-energy", args.plot_energy.as_deref())
         .check()?;

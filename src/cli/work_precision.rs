@@ -38,12 +38,10 @@ fn study_error(args: &WorkPrecisionArgs, error: WorkPrecisionError) -> CliError 
                 num(reference_tol)
             ))
         }
-        WorkPrecisionError::InvalidBaseline { baseline_ms } => {
-            CliError::usage(format!(
-                "--baseline-ms must be positive, got {:e}",
-                num(baseline_ms)
-            ))
-        }
+        WorkPrecisionError::InvalidBaseline { baseline_ms } => CliError::usage(format!(
+            "--baseline-ms must be positive, got {:e}",
+            num(baseline_ms)
+        )),
         WorkPrecisionError::InvalidMinTime { .. } => CliError::usage(format!(
             "--min-time-ms must be in [0, 10000], got {:e}",
             num(args.min_time_ms)
