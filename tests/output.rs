@@ -798,6 +798,10 @@ fn issue_28_outputs_are_checked_before_any_work() {
             "is a directory",
         ),
         (
+            &["simulate", "simple_pendulum", "--csv", ""],
+            "--csv `` names no file",
+        ),
+        (
             &[
                 "animate",
                 "simple_pendulum",
@@ -847,6 +851,23 @@ fn issue_28_outputs_are_checked_before_any_work() {
         let written: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();
         assert!(written.is_empty(), "{args:?} wrote {written:?}");
     }
+    // `report -o` names a directory (created if needed), not a file.
+    let file = dir.path().join("not-a-directory");
+    std::fs::write(&file, "x").unwrap();
+    let out = run(&[
+        "report",
+        "--models",
+        "simple_pendulum",
+        "-o",
+        file.to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("is not a directory"),
+        "{}",
+        stderr(&out)
+    );
+    assert_eq!(std::fs::read_to_string(&file).unwrap(), "x");
 }
 
 /// A previous run's `FILE-events.csv` and `FILE-drift.svg` stayed beside the new outputs of

@@ -44,6 +44,14 @@ pub(super) enum FileError {
         /// The path as given.
         path: String,
     },
+    /// The path names no file (empty, or ending in `..`).
+    #[error("{option} `{path}` names no file; give a file name")]
+    NoFileName {
+        /// The option that names the file.
+        option: String,
+        /// The path as given.
+        path: String,
+    },
     /// The file's directory does not exist (or is not a directory).
     #[error("{option} `{path}`: the directory `{directory}` does not exist")]
     NoDirectory {
@@ -447,6 +455,12 @@ fn check_one(planned: &Planned) -> Result<Identity, FileError> {
             path: target,
             existing,
         } => {
+            let Some(name) = target.file_name() else {
+                return Err(FileError::NoFileName {
+                    option: option.clone(),
+                    path: path.clone(),
+                });
+            };
             let directory = directory_of(&target);
             if !directory.is_dir() {
                 return Err(FileError::NoDirectory {
@@ -464,7 +478,7 @@ fn check_one(planned: &Planned) -> Result<Identity, FileError> {
                 Some((device, inode)) => Identity::Inode(device, inode),
                 None => {
                     let absolute = fs::canonicalize(directory).map_err(unusable)?;
-                    Identity::Name(absolute.join(target.file_name().unwrap_or_default()))
+                    Identity::Name(absolute.join(name))
                 }
             })
         }

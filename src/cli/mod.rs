@@ -144,6 +144,12 @@ fn join_hyphen_values(
             out.push(arg);
             continue;
         };
+        if text == "--" {
+            // Everything after `--` is a positional value already.
+            out.push(arg);
+            out.extend(rest);
+            break;
+        }
         if let Some(sub) = current.find_subcommand(&text) {
             current = sub;
             out.push(arg);

@@ -66,6 +66,13 @@ struct Source {
 
 /// Runs `report`.
 pub fn run(args: &ReportArgs) -> Result<(), CliError> {
+    // The directory is created if needed; a file of that name is refused before any work.
+    if args.out.exists() && !args.out.is_dir() {
+        return Err(CliError::usage(format!(
+            "--out `{}` is not a directory; give a directory for index.html, report.json and the figures",
+            args.out.display()
+        )));
+    }
     let sources = sources(&args.models)?;
     std::fs::create_dir_all(&args.out)
         .map_err(|e| CliError::failure(format!("cannot create `{}`: {e}", args.out.display())))?;
