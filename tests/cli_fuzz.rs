@@ -99,7 +99,7 @@ const CASES: &[Case] = &[
         options: &["--at", "--set"],
     },
     Case {
-        args: &["frf", "forced_oscillator", "--input", "F0"],
+        args: &["frf", "forced_oscillator", "--input", "A"],
         options: &[
             "--input",
             "--output",

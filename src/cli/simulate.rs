@@ -861,3 +861,19 @@ fn print_constraint_summary(constraints: &ConstraintDrift, stabilization: Stabil
         v = num(v)
     );
 }
+
+#[cfg(test)]
+mod tests {
+    use super::sibling;
+
+    /// Only the file name's extension counts (a dot in a directory name used to put the tag
+    /// inside the directory's name), and a leading dot starts no extension.
+    #[test]
+    fn siblings_keep_the_extension_of_the_file_name() {
+        assert_eq!(sibling("out/run.csv", "events"), "out/run-events.csv");
+        assert_eq!(sibling("out.d/run", "events"), "out.d/run-events");
+        assert_eq!(sibling("run", "drift"), "run-drift");
+        assert_eq!(sibling("dir/.hidden", "drift"), "dir/.hidden-drift");
+        assert_eq!(sibling("a.b/c.tar.svg", "drift"), "a.b/c.tar-drift.svg");
+    }
+}
