@@ -124,7 +124,7 @@ fn allow_negative_numbers(command: clap::Command) -> clap::Command {
 }
 
 /// `args` with `--option VALUE` written `--option=VALUE` where `VALUE` starts with `-` but is
-/// no option of the command (`--t-end -inf`, `--freqs -1..10`, `--set k=-2`): clap takes
+/// no option of the command (`--t-end -inf`, `--freqs -1..10`, `--at -pi/2`): clap takes
 /// such a value for an unknown option otherwise ("unexpected argument '-inf'"), and only
 /// plain negative numbers pass its `allow_negative_numbers`. The value then reaches the
 /// option's own check. An option of the command after another (`--csv --json`) stays an
@@ -165,7 +165,7 @@ fn join_hyphen_values(
         } else if let Some(short) = text.strip_prefix('-').filter(|s| s.chars().count() == 1) {
             current
                 .get_arguments()
-                .find(|a| Some(a.get_short()) == Some(short.chars().next()) && takes_one_value(a))
+                .find(|a| a.get_short() == short.chars().next() && takes_one_value(a))
         } else {
             None
         };
