@@ -879,71 +879,39 @@ fn issue_28_stale_companions_are_removed() {
     let dir = tempfile::tempdir().unwrap();
     let events = dir.path().join("e-events.csv");
     let drift = dir.path().join("d-drift.svg");
-    let with = run_in(
-        dir.path(),
+    let succeeds = |args: &[&str]| {
+        let out = run_in(dir.path(), args);
+        assert!(out.status.success(), "{args:?}: {}", stderr(&out));
+    };
+    let pendulum = ["simulate", "simple_pendulum", "--t-end", "1"];
+    succeeds(
         &[
-            "simulate",
-            "simple_pendulum",
-            "--init",
-            "q=1",
-            "--event",
-            "q = 0",
-            "--t-end",
-            "3",
-            "--csv",
-            "e.csv",
-        ],
+            &pendulum[..],
+            &["--init", "q=1", "--event", "q = 0", "--csv", "e.csv"],
+        ]
+        .concat(),
     );
-    assert!(with.status.success(), "{}", stderr(&with));
     assert!(
         std::fs::read_to_string(&events)
             .unwrap()
             .starts_with("event,direction")
     );
-    let constrained = run_in(
-        dir.path(),
-        &[
-            "simulate",
-            "simple_pendulum_cartesian",
-            "--t-end",
-            "1",
-            "--plot",
-            "d.svg",
-        ],
-    );
-    assert!(constrained.status.success(), "{}", stderr(&constrained));
+    succeeds(&[
+        "simulate",
+        "simple_pendulum_cartesian",
+        "--t-end",
+        "1",
+        "--plot",
+        "d.svg",
+    ]);
     assert!(drift.exists());
 
-    let without = run_in(
-        dir.path(),
-        &[
-            "simulate",
-            "simple_pendulum",
-            "--t-end",
-            "1",
-            "--csv",
-            "e.csv",
-            "--plot",
-            "d.svg",
-        ],
-    );
-    assert!(without.status.success(), "{}", stderr(&without));
+    succeeds(&[&pendulum[..], &["--csv", "e.csv", "--plot", "d.svg"]].concat());
     assert!(!events.exists(), "a stale events file stayed");
     assert!(!drift.exists(), "a stale drift chart stayed");
 
     std::os::unix::fs::symlink("elsewhere.csv", &events).unwrap();
-    let again = run_in(
-        dir.path(),
-        &[
-            "simulate",
-            "simple_pendulum",
-            "--t-end",
-            "1",
-            "--csv",
-            "e.csv",
-        ],
-    );
-    assert!(again.status.success(), "{}", stderr(&again));
+    succeeds(&[&pendulum[..], &["--csv", "e.csv"]].concat());
     assert!(
         std::fs::symlink_metadata(&events)
             .unwrap()
