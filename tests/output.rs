@@ -635,7 +635,8 @@ fn issue_28_a_symbolic_link_is_followed_and_kept() {
 /// A 0600 file came back 0644 (the temporary file's mode). An existing file now keeps its
 /// permissions exactly (0600, 0640, 0444 — the umask does not apply to them), and a new file
 /// gets the mode any new file gets (0666 less the umask, as `File::create` makes it here:
-/// the child inherits the test's umask).
+/// the child inherits the test's umask). The owner and group are kept too where the process
+/// may set them.
 #[test]
 fn issue_28_an_existing_file_keeps_its_mode() {
     use std::os::unix::fs::PermissionsExt as _;
@@ -676,6 +677,26 @@ fn issue_28_an_existing_file_keeps_its_mode() {
     ]);
     assert!(out.status.success(), "{}", stderr(&out));
     assert_eq!(mode(&new), mode(&reference));
+
+    // The owner and group are kept where the writer may set them: run as root (the only
+    // user that may give a file away, and so the only one that can set this case up).
+    use std::os::unix::fs::MetadataExt as _;
+    let owned = dir.path().join("owned.csv");
+    std::fs::write(&owned, "old\n").unwrap();
+    if std::os::unix::fs::chown(&owned, Some(4321), Some(4321)).is_ok() {
+        let out = run(&[
+            "simulate",
+            "simple_pendulum",
+            "--t-out",
+            "1",
+            "--csv",
+            owned.to_str().unwrap(),
+        ]);
+        assert!(out.status.success(), "{}", stderr(&out));
+        let metadata = std::fs::metadata(&owned).unwrap();
+        assert_eq!((metadata.uid(), metadata.gid()), (4321, 4321));
+        assert_ne!(std::fs::read(&owned).unwrap(), b"old\n");
+    }
 }
 
 /// `--csv /dev/stdout` writes the CSV into standard output, in order with the summary, both
