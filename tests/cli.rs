@@ -635,10 +635,15 @@ fn files_are_replaced_whole() {
         "-o",
         missing.to_str().unwrap(),
     ]);
-    assert_eq!(out.status.code(), Some(1));
+    // A missing directory is found before the simulation (issue 28): a usage error.
+    assert_eq!(out.status.code(), Some(2));
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(
-        stderr.contains(&format!("cannot write `{}`", missing.display())),
+        stderr.contains(&format!(
+            "--output `{}`: the directory `{}` does not exist",
+            missing.display(),
+            dir.path().join("no_such_dir").display()
+        )),
         "{stderr}"
     );
     assert!(!stderr.contains(".eomgen-"), "{stderr}");

@@ -451,6 +451,16 @@ fn sizes_over_their_limit_are_usage_errors() {
             "at most 1000000",
         ),
         (&["study", "euler-roundoff", "--max-n", "11"], "at most 10"),
+        (
+            &[
+                "study",
+                "work-precision",
+                "simple_pendulum",
+                "--min-time-ms",
+                "10001",
+            ],
+            "[0, 10000]",
+        ),
         (&["study", "stability", "--steps", "100000000"], "10⁷"),
         (&["new", "n-link-pendulum", "201"], "200"),
         (
@@ -489,4 +499,537 @@ fn sizes_over_their_limit_are_usage_errors() {
         assert!(text.contains(limit), "eomgen {}: {text}", shown.join(" "));
         assert!(!text.contains("panicked"), "{text}");
     }
+}
+
+// Issue 28, item 1: an output path that is not a regular file is never replaced by one.
+
+/// Runs `eomgen args` in `dir` (so that relative output paths land there).
+fn run_in(dir: &std::path::Path, args: &[&str]) -> Output {
+    binary()
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .expect("binary runs")
+}
+
+/// The files of `dir` whose names start with `.eomgen-`: temporary files left behind.
+fn temporaries(dir: &std::path::Path) -> Vec<String> {
+    std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|name| name.starts_with(".eomgen-"))
+        .collect()
+}
+
+/// `--csv /dev/null` used to rename a temporary file over the device (as root, the system's
+/// /dev/null became a CSV file). It is now written in place and stays a character device.
+#[test]
+fn issue_28_dev_null_stays_a_character_device() {
+    use std::os::unix::fs::FileTypeExt as _;
+    let out = run(&[
+        "simulate",
+        "simple_pendulum",
+        "--t-end",
+        "1",
+        "--csv",
+        "/dev/null",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let kind = std::fs::metadata("/dev/null").unwrap().file_type();
+    assert!(kind.is_char_device(), "/dev/null is now {kind:?}");
+}
+
+/// Makes a FIFO at `path` (with the system's `mkfifo`).
+fn mkfifo(path: &std::path::Path) {
+    let made = Command::new("mkfifo")
+        .arg(path)
+        .status()
+        .expect("mkfifo runs");
+    assert!(made.success());
+}
+
+/// A FIFO given as `--csv` or `--plot` receives the bytes (a reader on the other end sees the
+/// whole CSV, or the whole SVG) and is still a FIFO afterwards: it used to be replaced by a
+/// regular file, and its reader waited forever.
+#[test]
+fn issue_28_a_fifo_is_written_in_place() {
+    use std::os::unix::fs::FileTypeExt as _;
+    let dir = tempfile::tempdir().unwrap();
+    for (option, name, starts) in [
+        ("--csv", "pipe.csv", "t,q,q_dot,energy"),
+        ("--plot", "pipe.svg", "<svg"),
+    ] {
+        let fifo = dir.path().join(name);
+        mkfifo(&fifo);
+        let reader = {
+            let fifo = fifo.clone();
+            std::thread::spawn(move || std::fs::read_to_string(fifo).unwrap())
+        };
+        let out = run(&[
+            "simulate",
+            "simple_pendulum",
+            "--init",
+            "q=1",
+            "--t-out",
+            "0.5,1",
+            option,
+            fifo.to_str().unwrap(),
+        ]);
+        assert!(out.status.success(), "{option}: {}", stderr(&out));
+        // Checked before the reader is joined: a FIFO replaced by a file leaves it waiting.
+        let kind = std::fs::symlink_metadata(&fifo).unwrap().file_type();
+        assert!(kind.is_fifo(), "{name} is now {kind:?}");
+        let text = reader.join().unwrap();
+        assert!(
+            text.starts_with(starts),
+            "{option}: {}",
+            &text[..text.len().min(80)]
+        );
+        if option == "--csv" {
+            assert_eq!(text.lines().count(), 3, "{text}");
+        } else {
+            assert!(text.trim_end().ends_with("</svg>"));
+        }
+    }
+    assert!(temporaries(dir.path()).is_empty());
+}
+
+/// `--csv link.csv` used to replace the symbolic link by a regular file and leave its target
+/// stale. The link now stays a link, and its target (in another directory) is the new file,
+/// written through a temporary file in the target's directory.
+#[test]
+fn issue_28_a_symbolic_link_is_followed_and_kept() {
+    let dir = tempfile::tempdir().unwrap();
+    let data = dir.path().join("data");
+    std::fs::create_dir(&data).unwrap();
+    let target = data.join("target.csv");
+    std::fs::write(&target, "old\n").unwrap();
+    let link = dir.path().join("link.csv");
+    std::os::unix::fs::symlink("data/target.csv", &link).unwrap();
+    // A chain of two links, and a link to a file that does not exist yet.
+    let chain = dir.path().join("chain.csv");
+    std::os::unix::fs::symlink("link.csv", &chain).unwrap();
+    let dangling = dir.path().join("new.csv");
+    std::os::unix::fs::symlink("data/created.csv", &dangling).unwrap();
+    for path in [&link, &chain, &dangling] {
+        let out = run(&[
+            "simulate",
+            "simple_pendulum",
+            "--t-out",
+            "1,2",
+            "--csv",
+            path.to_str().unwrap(),
+        ]);
+        assert!(out.status.success(), "{}", stderr(&out));
+        let kind = std::fs::symlink_metadata(path).unwrap().file_type();
+        assert!(kind.is_symlink(), "{} is now {kind:?}", path.display());
+    }
+    for file in [&target, &data.join("created.csv")] {
+        let text = std::fs::read_to_string(file).unwrap();
+        assert!(text.starts_with("t,q,q_dot,energy\n"), "{text}");
+        assert_eq!(text.lines().count(), 3);
+    }
+    assert!(temporaries(dir.path()).is_empty() && temporaries(&data).is_empty());
+}
+
+/// A 0600 file came back 0644 (the temporary file's mode). An existing file now keeps its
+/// permissions exactly (0600, 0640, 0444 — the umask does not apply to them), and a new file
+/// gets the mode any new file gets (0666 less the umask, as `File::create` makes it here:
+/// the child inherits the test's umask). The owner and group are kept too where the process
+/// may set them.
+#[test]
+fn issue_28_an_existing_file_keeps_its_mode() {
+    use std::os::unix::fs::PermissionsExt as _;
+    let dir = tempfile::tempdir().unwrap();
+    let mode =
+        |path: &std::path::Path| std::fs::metadata(path).unwrap().permissions().mode() & 0o7777;
+    for (name, kept) in [("a.csv", 0o600), ("b.svg", 0o640), ("c.csv", 0o444)] {
+        let path = dir.path().join(name);
+        std::fs::write(&path, "old\n").unwrap();
+        std::fs::set_permissions(&path, std::fs::Permissions::from_mode(kept)).unwrap();
+        let option = if name.ends_with(".svg") {
+            "--plot"
+        } else {
+            "--csv"
+        };
+        let out = run(&[
+            "simulate",
+            "simple_pendulum",
+            "--t-out",
+            "1",
+            option,
+            path.to_str().unwrap(),
+        ]);
+        assert!(out.status.success(), "{}", stderr(&out));
+        assert_ne!(std::fs::read(&path).unwrap(), b"old\n");
+        assert_eq!(mode(&path), kept, "{name}");
+    }
+    let reference = dir.path().join("reference");
+    std::fs::File::create(&reference).unwrap();
+    let new = dir.path().join("new.csv");
+    let out = run(&[
+        "simulate",
+        "simple_pendulum",
+        "--t-out",
+        "1",
+        "--csv",
+        new.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert_eq!(mode(&new), mode(&reference));
+
+    // The owner and group are kept where the writer may set them: run as root (the only
+    // user that may give a file away, and so the only one that can set this case up).
+    use std::os::unix::fs::MetadataExt as _;
+    let owned = dir.path().join("owned.csv");
+    std::fs::write(&owned, "old\n").unwrap();
+    if std::os::unix::fs::chown(&owned, Some(4321), Some(4321)).is_ok() {
+        let out = run(&[
+            "simulate",
+            "simple_pendulum",
+            "--t-out",
+            "1",
+            "--csv",
+            owned.to_str().unwrap(),
+        ]);
+        assert!(out.status.success(), "{}", stderr(&out));
+        let metadata = std::fs::metadata(&owned).unwrap();
+        assert_eq!((metadata.uid(), metadata.gid()), (4321, 4321));
+        assert_ne!(std::fs::read(&owned).unwrap(), b"old\n");
+    }
+}
+
+/// `--csv /dev/stdout` writes the CSV into standard output, in order with the summary, both
+/// into a pipe and into a regular file that standard output is redirected to (which a rename
+/// would have replaced, losing the summary).
+#[test]
+fn issue_28_dev_stdout_is_standard_output() {
+    let args = [
+        "simulate",
+        "simple_pendulum",
+        "--t-out",
+        "1,2",
+        "--csv",
+        "/dev/stdout",
+    ];
+    let out = run(&args);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(text.starts_with("t,q,q_dot,energy\n"), "{text}");
+    assert!(text.contains("\nmodel      simple_pendulum"), "{text}");
+
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("out.txt");
+    let out = binary()
+        .args(args)
+        .stdout(std::fs::File::create(&file).unwrap())
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = std::fs::read_to_string(&file).unwrap();
+    assert!(text.starts_with("t,q,q_dot,energy\n"), "{text}");
+    assert!(text.contains("\nmodel      simple_pendulum"), "{text}");
+    assert!(temporaries(dir.path()).is_empty());
+}
+
+// Issue 28, items 6 and 7: outputs checked before any work, companions, statuses, messages.
+
+/// A chart's bad extension was found after integrating, with the CSV already written; the
+/// same path given to two outputs kept one of them; a missing directory was found at the
+/// end. Each is now a usage error before any work, and no file is written.
+#[test]
+fn issue_28_outputs_are_checked_before_any_work() {
+    let dir = tempfile::tempdir().unwrap();
+    let cases: &[(&[&str], &str)] = &[
+        (
+            &[
+                "simulate",
+                "simple_pendulum",
+                "--csv",
+                "a.csv",
+                "--plot",
+                "a.pdf",
+            ],
+            "--plot `a.pdf`: a chart file must end in .svg or .png",
+        ),
+        (
+            &[
+                "simulate",
+                "simple_pendulum",
+                "--csv",
+                "a.csv",
+                "--plot",
+                "q.svg",
+                "--plot-phase",
+                "./q.svg",
+            ],
+            "--plot and --plot-phase both write `./q.svg`",
+        ),
+        (
+            &[
+                "simulate",
+                "simple_pendulum",
+                "--csv",
+                "a.csv",
+                "--plot",
+                "q.svg",
+                "--plot-energy",
+                "q.svg",
+            ],
+            "both write `q.svg`",
+        ),
+        (
+            // A companion: `--plot q.svg` owns `q-drift.svg`.
+            &[
+                "simulate",
+                "simple_pendulum_cartesian",
+                "--csv",
+                "a.csv",
+                "--plot",
+                "q.svg",
+                "--plot-phase",
+                "q-drift.svg",
+            ],
+            "--plot (its constraint drift chart) and --plot-phase both write `q-drift.svg`",
+        ),
+        (
+            &[
+                "simulate",
+                "simple_pendulum",
+                "--csv",
+                "a.csv",
+                "--plot-phase",
+                "missing/p.svg",
+            ],
+            "the directory `missing` does not exist",
+        ),
+        (
+            &[
+                "simulate",
+                "simple_pendulum",
+                "--csv",
+                "a.csv",
+                "--plot",
+                ".",
+            ],
+            "a chart file must end in .svg or .png",
+        ),
+        (
+            &["simulate", "simple_pendulum", "--csv", "."],
+            "is a directory",
+        ),
+        (
+            &["simulate", "simple_pendulum", "--csv", ""],
+            "--csv `` names no file",
+        ),
+        (
+            &[
+                "animate",
+                "simple_pendulum",
+                "-o",
+                "a.html",
+                "--gif",
+                "./a.html",
+            ],
+            "--output and --gif both write `./a.html`",
+        ),
+        (
+            &[
+                "frf",
+                "forced_oscillator",
+                "--input",
+                "F0",
+                "--plot",
+                "bode.txt",
+            ],
+            "a chart file must end in .svg or .png",
+        ),
+        (
+            &[
+                "modes",
+                "double_pendulum",
+                "--plot",
+                "dp",
+                "--animate",
+                "dp-mode2.svg",
+            ],
+            "both write `dp-mode2.svg`",
+        ),
+        (
+            &["study", "free-response", "three_masses", "--plot", "r.eps"],
+            "a chart file must end in .svg or .png",
+        ),
+        (
+            &["study", "euler-roundoff", "--plot", "missing/e.svg"],
+            "does not exist",
+        ),
+    ];
+    for (args, says) in cases {
+        let out = run_in(dir.path(), args);
+        let text = stderr(&out);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {text}");
+        assert!(text.contains(says), "{args:?}: {text}");
+        let written: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();
+        assert!(written.is_empty(), "{args:?} wrote {written:?}");
+    }
+    // `report -o` names a directory (created if needed), not a file.
+    let file = dir.path().join("not-a-directory");
+    std::fs::write(&file, "x").unwrap();
+    let out = run(&[
+        "report",
+        "--models",
+        "simple_pendulum",
+        "-o",
+        file.to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("is not a directory"),
+        "{}",
+        stderr(&out)
+    );
+    assert_eq!(std::fs::read_to_string(&file).unwrap(), "x");
+}
+
+/// A previous run's `FILE-events.csv` and `FILE-drift.svg` stayed beside the new outputs of
+/// a run that wrote none. A run now writes each companion it has something for and removes a
+/// regular file of that name otherwise; a companion that is not a regular file (a link, a
+/// FIFO) is left alone.
+#[test]
+fn issue_28_stale_companions_are_removed() {
+    let dir = tempfile::tempdir().unwrap();
+    let events = dir.path().join("e-events.csv");
+    let drift = dir.path().join("d-drift.svg");
+    let succeeds = |args: &[&str]| {
+        let out = run_in(dir.path(), args);
+        assert!(out.status.success(), "{args:?}: {}", stderr(&out));
+    };
+    let pendulum = ["simulate", "simple_pendulum", "--t-end", "1"];
+    succeeds(
+        &[
+            &pendulum[..],
+            &["--init", "q=1", "--event", "q = 0", "--csv", "e.csv"],
+        ]
+        .concat(),
+    );
+    assert!(
+        std::fs::read_to_string(&events)
+            .unwrap()
+            .starts_with("event,direction")
+    );
+    succeeds(&[
+        "simulate",
+        "simple_pendulum_cartesian",
+        "--t-end",
+        "1",
+        "--plot",
+        "d.svg",
+    ]);
+    assert!(drift.exists());
+
+    succeeds(&[&pendulum[..], &["--csv", "e.csv", "--plot", "d.svg"]].concat());
+    assert!(!events.exists(), "a stale events file stayed");
+    assert!(!drift.exists(), "a stale drift chart stayed");
+
+    std::os::unix::fs::symlink("elsewhere.csv", &events).unwrap();
+    succeeds(&[&pendulum[..], &["--csv", "e.csv"]].concat());
+    assert!(
+        std::fs::symlink_metadata(&events)
+            .unwrap()
+            .file_type()
+            .is_symlink()
+    );
+}
+
+/// A chart written to a full disk said `plotting failed: ImageError(IoError(Custom {…}))`
+/// without the file's name, and the `modes --plot` error repeated the path. Each write
+/// error now names the file once, with the operating system's reason, and exits 1.
+#[test]
+fn issue_28_a_failed_chart_write_names_the_file_and_the_reason() {
+    let dir = tempfile::tempdir().unwrap();
+    let full = |name: &str| {
+        let path = dir.path().join(name);
+        std::os::unix::fs::symlink("/dev/full", &path).unwrap();
+        path.to_str().unwrap().to_string()
+    };
+    let (png, svg, csv) = (full("q.png"), full("p.svg"), full("f.csv"));
+    let mode = full("dp-mode1.svg");
+    let cases: Vec<(Vec<&str>, &str)> = vec![
+        (
+            vec![
+                "simulate",
+                "simple_pendulum",
+                "--t-end",
+                "1",
+                "--plot",
+                &png,
+            ],
+            &png,
+        ),
+        (
+            vec![
+                "simulate",
+                "simple_pendulum",
+                "--t-end",
+                "1",
+                "--plot-phase",
+                &svg,
+            ],
+            &svg,
+        ),
+        (
+            vec!["simulate", "simple_pendulum", "--t-end", "1", "--csv", &csv],
+            &csv,
+        ),
+        (
+            vec![
+                "modes",
+                "double_pendulum",
+                "--plot",
+                &mode[..mode.len() - "-mode1.svg".len()],
+            ],
+            &mode,
+        ),
+    ];
+    for (args, path) in cases {
+        let out = run(&args);
+        let text = stderr(&out);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {text}");
+        assert!(
+            text.contains(&format!("cannot write `{path}`: No space left on device")),
+            "{args:?}: {text}"
+        );
+        assert_eq!(text.matches(path).count(), 1, "{text}");
+        assert!(
+            !text.contains("ImageError") && !text.contains("Custom"),
+            "{text}"
+        );
+        // The link is still a link to the device.
+        assert!(
+            std::fs::symlink_metadata(path)
+                .unwrap()
+                .file_type()
+                .is_symlink()
+        );
+    }
+}
+
+/// A model file's diagnostics as JSON (`check --json bad.yaml`) on a full device exited 2;
+/// a failed write is status 1, as docs/reliability.md says.
+#[test]
+fn issue_28_diagnostics_json_on_a_full_device_is_status_1() {
+    let dir = tempfile::tempdir().unwrap();
+    let bad = dir.path().join("bad.yaml");
+    std::fs::write(&bad, "name: bad\nbogus: 1\n").unwrap();
+    let out = to_full_device(&["check", "--json", bad.to_str().unwrap()]);
+    let text = stderr(&out);
+    assert_eq!(out.status.code(), Some(1), "{text}");
+    assert!(
+        text.contains("cannot write standard output: No space left on device"),
+        "{text}"
+    );
+    // Written where it can be, the same error is a usage error (2).
+    let out = run(&["check", "--json", bad.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(serde_json::from_slice::<serde_json::Value>(&out.stdout).is_ok());
 }

@@ -13,8 +13,18 @@ fn stderr(out: &std::process::Output) -> String {
 /// used to take for an unknown option), are usage errors in every command that takes one.
 #[test]
 fn tolerances_out_of_range_are_usage_errors_everywhere() {
-    let cases: [&[&str]; 9] = [
+    let cases: [&[&str]; 11] = [
         &["simulate", "simple_pendulum", "--rtol", "1"],
+        // Issue 28: the documented range is (0, 1), and 0 was accepted.
+        &["simulate", "simple_pendulum", "--rtol", "0"],
+        &[
+            "animate",
+            "simple_pendulum",
+            "-o",
+            "unwritten.html",
+            "--rtol",
+            "0",
+        ],
         &["simulate", "simple_pendulum", "--rtol", "-1"],
         &["simulate", "simple_pendulum", "--atol", "-1e-9"],
         &[
@@ -260,4 +270,184 @@ fn negative_numbers_reach_the_options_checks() {
             "{args:?}: {err}"
         );
     }
+}
+
+/// Issue 28, item 6: out-of-range options were computation failures (exit 1) or ran: each
+/// is now a usage error (exit 2) found when the options are read, with the option's range.
+/// `animate --dt 0` exited 1 where `simulate --dt 0` exited 2.
+#[test]
+fn issue_28_out_of_range_options_are_usage_errors() {
+    let cases: &[(&[&str], &str)] = &[
+        (
+            &[
+                "frf",
+                "forced_oscillator",
+                "--input",
+                "A",
+                "--freqs",
+                "1e-320..10",
+            ],
+            "--freqs LO `1e-320`: a frequency must be in [1e-12, 1e12] rad/s",
+        ),
+        (
+            &[
+                "frf",
+                "forced_oscillator",
+                "--input",
+                "A",
+                "--frequency",
+                "1e155",
+            ],
+            "[1e-12, 1e12] rad/s or 0",
+        ),
+        (
+            &[
+                "study",
+                "constraint-methods",
+                "two_masses_rod",
+                "--t-end",
+                "1e308",
+            ],
+            "[1e-6, 1e6]",
+        ),
+        (
+            &[
+                "study",
+                "work-precision",
+                "double_pendulum",
+                "--t-end",
+                "1e-320",
+            ],
+            "[1e-6, 1e6]",
+        ),
+        (
+            &["study", "free-response", "three_masses", "--t-end", "1e308"],
+            "[1e-6, 1e6]",
+        ),
+        (
+            &["study", "modal-damping", "three_masses", "--t-end", "1e308"],
+            "[1e-6, 1e6]",
+        ),
+        (
+            &["study", "stability", "--stiffness", "1e-320"],
+            "[1e-6, 1e10]",
+        ),
+        (
+            &[
+                "study",
+                "constraint-methods",
+                "simple_pendulum_cartesian",
+                "--stiffness",
+                "1e-320",
+            ],
+            "[1e-6, 1e10]",
+        ),
+        (
+            &[
+                "simulate",
+                "simple_pendulum",
+                "--method",
+                "rk4",
+                "--dt",
+                "0",
+            ],
+            "`dt` is 0",
+        ),
+        (
+            &[
+                "animate",
+                "simple_pendulum",
+                "-o",
+                "unwritten.html",
+                "--method",
+                "rk4",
+                "--dt",
+                "0",
+            ],
+            "`dt` is 0",
+        ),
+        (
+            &[
+                "animate",
+                "simple_pendulum",
+                "-o",
+                "unwritten.html",
+                "--dt",
+                "0",
+            ],
+            "`dt` is 0",
+        ),
+    ];
+    for (args, says) in cases {
+        let out = eomgen(args);
+        let err = stderr(&out);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains(says), "{args:?}: {err}");
+    }
+    assert!(!std::path::Path::new("unwritten.html").exists());
+}
+
+/// Issue 28, item 7: `-inf` and ranges such as `-1..10` were taken for options by clap
+/// ("unexpected argument"); they now reach the option's own check. A huge value is quoted
+/// as typed or in exponent form, never as its 309 digits.
+#[test]
+fn issue_28_values_starting_with_a_minus_reach_the_checks_and_numbers_print_short() {
+    let cases: &[(&[&str], &str)] = &[
+        (
+            &["simulate", "simple_pendulum", "--t-end", "-inf"],
+            "--t-end must be a positive number of seconds, got -inf",
+        ),
+        (
+            &[
+                "frf",
+                "forced_oscillator",
+                "--input",
+                "A",
+                "--freqs",
+                "-1..10",
+            ],
+            "--freqs LO `-1`",
+        ),
+        (
+            &["study", "stability", "--stiffness", "-inf"],
+            "a stiffness must be",
+        ),
+        (
+            &[
+                "animate",
+                "simple_pendulum",
+                "-o",
+                "unwritten.html",
+                "--t-end",
+                "1e308",
+            ],
+            "--t-end 1e308 at --fps 30 gives more than 100000 frames",
+        ),
+        (
+            &[
+                "study",
+                "work-precision",
+                "simple_pendulum",
+                "--target-error",
+                "-1e308",
+            ],
+            "got -1e308",
+        ),
+    ];
+    for (args, says) in cases {
+        let out = eomgen(args);
+        let err = stderr(&out);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains(says), "{args:?}: {err}");
+        assert!(!err.contains("unexpected argument"), "{args:?}: {err}");
+        assert!(!err.contains("000000000000"), "{args:?}: {err}");
+    }
+    // An option after an option that takes a value is still an option: the value is missing.
+    let out = eomgen(&["simulate", "simple_pendulum", "--csv", "--json"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        stderr(&out).contains("a value is required for '--csv <FILE>'"),
+        "{}",
+        stderr(&out)
+    );
 }

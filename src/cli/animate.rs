@@ -79,6 +79,10 @@ pub struct AnimateArgs {
 
 /// Runs `animate`.
 pub fn run(args: &AnimateArgs) -> Result<(), CliError> {
+    super::files::Outputs::new()
+        .file("--output", Some(&args.output))
+        .file("--gif", args.gif.as_deref())
+        .check()?;
     let (animation, failure) = simulation(&args.model, &args.run, args.fps, &args.trace)?;
     let Some(animation) = animation else {
         return Err(failure.unwrap_or_else(|| CliError::failure("no frame was computed")));
@@ -102,7 +106,7 @@ pub fn run(args: &AnimateArgs) -> Result<(), CliError> {
 }
 
 fn write(path: &str, text: &str) -> Result<(), CliError> {
-    super::render::write_file(path, text).map_err(CliError::failure)
+    Ok(super::files::write(path, text.as_bytes())?)
 }
 
 /// What every frame draws: the points used, the segments between them, the points marked
@@ -289,15 +293,17 @@ pub(crate) fn simulation(
 ) -> Result<(Option<Animation>, Option<CliError>), CliError> {
     if !(fps.is_finite() && fps > 0.0) {
         return Err(CliError::usage(format!(
-            "--fps must be a positive number of frames per second, got {fps}"
+            "--fps must be a positive number of frames per second, got {:e}",
+            super::render::num(fps)
         )));
     }
     // (A `--t-end` that is not positive is `integrate`'s usage error.)
     let frames = (args.t_end * fps * (1.0 + 1e-12)).floor().max(0.0);
     if frames >= MAX_FRAMES as f64 {
         return Err(CliError::usage(format!(
-            "--t-end {} at --fps {fps} gives more than {MAX_FRAMES} frames; lower --fps",
-            args.t_end
+            "--t-end {:e} at --fps {:e} gives more than {MAX_FRAMES} frames; lower --fps",
+            super::render::num(args.t_end),
+            super::render::num(fps)
         )));
     }
     // Check the model's drawing before integrating.
@@ -964,7 +970,7 @@ const DATA = {data};
             k += step;
         }
         let bytes = encoder.into_inner().map_err(|e| fail(e.to_string()))?;
-        super::render::write_file(path, bytes).map_err(CliError::failure)
+        Ok(super::files::write(path, &bytes)?)
     }
 }
 

@@ -23,6 +23,7 @@ use rayon::prelude::*;
 use serde_json::{Value, json};
 
 use super::CliError;
+use super::files::Outputs;
 use super::modes::{OperatingPointArgs, point_json};
 use super::plot::{register_font, tick};
 use super::render::num;
@@ -72,6 +73,9 @@ fn analysis_text(model: &dyn ModelInfo, e: &FloquetStudyError) -> String {
 
 /// Runs `study floquet`.
 pub fn run(args: &FloquetArgs) -> Result<(), CliError> {
+    Outputs::new()
+        .chart("--plot", args.plot.as_deref())
+        .check()?;
     let mut model = args.point.model(&args.model)?;
     let source = super::open_model(&args.model)?;
     // A file that cannot be read here (a bundled model's file moved away from an installed
@@ -501,19 +505,9 @@ fn stability_chart(
 ) -> Result<(), String> {
     register_font()?;
     let size = (960, 720);
-    if path.ends_with(".svg") {
-        super::render::atomically(path, |file| {
-            let root = SVGBackend::new(file, size).into_drawing_area();
-            draw_stability(root, title, axes, labels, grid, references)
-        })
-    } else if path.ends_with(".png") {
-        super::render::atomically(path, |file| {
-            let root = BitMapBackend::new(file, size).into_drawing_area();
-            draw_stability(root, title, axes, labels, grid, references)
-        })
-    } else {
-        Err(format!("`{path}`: a chart file must end in .svg or .png"))
-    }
+    super::plot::write_chart!(path, size, |root| draw_stability(
+        root, title, axes, labels, grid, references
+    ))
 }
 
 /// An axis label with the unit where it is known: the period parameter is a frequency in
@@ -694,25 +688,7 @@ where
 fn multiplier_chart(path: &str, title: &str, floquet: &FloquetAnalysis) -> Result<(), String> {
     register_font()?;
     let size = (720, 720);
-    if path.ends_with(".svg") {
-        super::render::atomically(path, |file| {
-            draw_multipliers(
-                SVGBackend::new(file, size).into_drawing_area(),
-                title,
-                floquet,
-            )
-        })
-    } else if path.ends_with(".png") {
-        super::render::atomically(path, |file| {
-            draw_multipliers(
-                BitMapBackend::new(file, size).into_drawing_area(),
-                title,
-                floquet,
-            )
-        })
-    } else {
-        Err(format!("`{path}`: a chart file must end in .svg or .png"))
-    }
+    super::plot::write_chart!(path, size, |root| draw_multipliers(root, title, floquet))
 }
 
 fn draw_multipliers<DB: DrawingBackend>(

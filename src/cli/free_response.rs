@@ -17,6 +17,7 @@ use plotters::prelude::*;
 use serde_json::json;
 
 use super::CliError;
+use super::files::Outputs;
 use super::modes::{OperatingPointArgs, point_json};
 use super::plot::{self, Series};
 use super::render::num;
@@ -35,8 +36,8 @@ pub struct FreeResponseArgs {
     #[arg(long, value_name = "NAME=VALUE,…")]
     pub init: Vec<String>,
     /// End time (s). Default: four periods of the slowest oscillatory mode, or the time an
-    /// unstable mode grows by e⁵ if that is shorter, else 10 s.
-    #[arg(long)]
+    /// unstable mode grows by e⁵ if that is shorter, else 10 s; in [1e-6, 1e6].
+    #[arg(long, value_parser = super::values::study_end_time, allow_hyphen_values = true)]
     pub t_end: Option<f64>,
     /// Number of output times, evenly spaced from 0 to the end time (2 to 1000000).
     #[arg(long, default_value_t = 401, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(2..=1_000_000))]
@@ -79,9 +80,10 @@ pub(super) fn study_failure(model: &dyn ModelInfo, e: &ResponseStudyError) -> Cl
             "`{name}` has constraints; this study takes unconstrained models (`eomgen modes {name}` gives its modes in minimal coordinates)"
         )),
         ResponseStudyError::InvalidTolerance { .. } => CliError::usage("--tol must be positive"),
-        ResponseStudyError::InvalidEndTime { t_end } => {
-            CliError::usage(format!("--t-end must be positive and finite, got {t_end}"))
-        }
+        ResponseStudyError::InvalidEndTime { t_end } => CliError::usage(format!(
+            "--t-end must be positive and finite, got {:e}",
+            super::render::num(t_end)
+        )),
         ResponseStudyError::TooFewSamples { .. } => CliError::usage("--samples must be at least 2"),
         ResponseStudyError::NoSuchMode { .. } | ResponseStudyError::NotUnderdamped { .. } => {
             CliError::usage(format!("--rayleigh-modes: {e}"))
@@ -124,25 +126,7 @@ pub(super) struct Panel {
 pub(super) fn panels(path: &str, title: &str, panels: &[Panel]) -> Result<(), String> {
     plot::register_font()?;
     let size = (960, 60 + 260 * panels.len().max(1) as u32);
-    if path.ends_with(".svg") {
-        super::render::atomically(path, |file| {
-            draw_panels(
-                SVGBackend::new(file, size).into_drawing_area(),
-                title,
-                panels,
-            )
-        })
-    } else if path.ends_with(".png") {
-        super::render::atomically(path, |file| {
-            draw_panels(
-                BitMapBackend::new(file, size).into_drawing_area(),
-                title,
-                panels,
-            )
-        })
-    } else {
-        Err(format!("`{path}`: a chart file must end in .svg or .png"))
-    }
+    plot::write_chart!(path, size, |root| draw_panels(root, title, panels))
 }
 
 fn draw_panels<DB: DrawingBackend>(
@@ -232,6 +216,9 @@ where
 
 /// Runs `study free-response`.
 pub fn run(args: &FreeResponseArgs) -> Result<(), CliError> {
+    Outputs::new()
+        .chart("--plot", args.plot.as_deref())
+        .check()?;
     let model = args.point.model(&args.model)?;
     let options = FreeResponseOptions {
         operating_point: args.point.options(model.as_ref())?,

@@ -18,6 +18,7 @@ use plotters::prelude::*;
 use rayon::prelude::*;
 use serde_json::{Value, json};
 
+use super::files::Outputs;
 use super::modes::{OperatingPointArgs, point_json};
 use super::render::num;
 use super::values::{evaluate, parameter_lookup};
@@ -137,8 +138,27 @@ fn failure(model: &dyn ModelInfo, e: FrfAnalysisError) -> CliError {
     }
 }
 
+/// `w` (rad/s), the value of `option` typed as `text`, if it is in
+/// [`super::values::FREQUENCY`] (or 0, the static response, when `zero` is allowed).
+///
+/// # Errors
+/// A usage error that quotes `text` and gives the range.
+fn frequency(option: &str, text: &str, w: f64, zero: bool) -> Result<f64, CliError> {
+    if super::values::FREQUENCY.contains(&w) || (zero && w == 0.0) {
+        Ok(w)
+    } else {
+        Err(CliError::usage(format!(
+            "{option} `{text}`: a frequency must be in [1e-12, 1e12] rad/s{}",
+            if zero { " or 0" } else { "" }
+        )))
+    }
+}
+
 /// Runs `frf`.
 pub fn run(args: &FrfArgs) -> Result<(), CliError> {
+    Outputs::new()
+        .chart("--plot", args.plot.as_deref())
+        .check()?;
     let mut model = args.point.model(&args.model)?;
     let lookup = parameter_lookup(model.as_ref());
     let frequency_range = match &args.freqs {
@@ -148,9 +168,11 @@ pub fn run(args: &FrfArgs) -> Result<(), CliError> {
                     "--freqs takes LO..HI in rad/s, got `{text}` (for example `--freqs 0.1..10`)"
                 ))
             })?;
+            let lo = evaluate(a.trim(), "--freqs LO", &lookup)?;
+            let hi = evaluate(b.trim(), "--freqs HI", &lookup)?;
             Some((
-                evaluate(a.trim(), "--freqs LO", &lookup)?,
-                evaluate(b.trim(), "--freqs HI", &lookup)?,
+                frequency("--freqs LO", a.trim(), lo, false)?,
+                frequency("--freqs HI", b.trim(), hi, false)?,
             ))
         }
         None => None,
@@ -158,12 +180,7 @@ pub fn run(args: &FrfArgs) -> Result<(), CliError> {
     let mut frequencies = Vec::new();
     for text in &args.frequencies {
         let w = evaluate(text, &format!("--frequency {text}"), &lookup)?;
-        if w < 0.0 {
-            return Err(CliError::usage(format!(
-                "--frequency {text}: {w} rad/s is negative"
-            )));
-        }
-        frequencies.push(w);
+        frequencies.push(frequency("--frequency", text, w, true)?);
     }
     drop(lookup);
     let simulation = args.simulate.map(|count| FrfSimulationOptions {
@@ -590,19 +607,9 @@ fn bode_chart(
 ) -> Result<(), String> {
     plot::register_font()?;
     let size = (960, 720);
-    if path.ends_with(".svg") {
-        super::render::atomically(path, |file| {
-            let root = SVGBackend::new(file, size).into_drawing_area();
-            draw_bode(root, title, outputs, sweeps, simulated)
-        })
-    } else if path.ends_with(".png") {
-        super::render::atomically(path, |file| {
-            let root = BitMapBackend::new(file, size).into_drawing_area();
-            draw_bode(root, title, outputs, sweeps, simulated)
-        })
-    } else {
-        Err(format!("`{path}`: a chart file must end in .svg or .png"))
-    }
+    plot::write_chart!(path, size, |root| draw_bode(
+        root, title, outputs, sweeps, simulated
+    ))
 }
 
 /// Contiguous runs of finite points (a `None` breaks the line).

@@ -3,6 +3,7 @@
 mod animate;
 mod check;
 mod equations;
+mod files;
 mod floquet;
 mod free_response;
 mod frf;
@@ -123,12 +124,102 @@ fn allow_negative_numbers(command: clap::Command) -> clap::Command {
         })
 }
 
+/// `args` with `--option VALUE` written `--option=VALUE` where `VALUE` starts with `-` but is
+/// no option of the command (`--t-end -inf`, `--freqs -1..10`, `--at -pi/2`): clap takes
+/// such a value for an unknown option otherwise ("unexpected argument '-inf'"), and only
+/// plain negative numbers pass its `allow_negative_numbers`. The value then reaches the
+/// option's own check. An option of the command after another (`--csv --json`) stays an
+/// option, so a missing value is still reported as missing.
+fn join_hyphen_values(
+    command: &clap::Command,
+    args: Vec<std::ffi::OsString>,
+) -> Vec<std::ffi::OsString> {
+    let mut current = command;
+    let mut out = Vec::with_capacity(args.len());
+    let mut rest = args.into_iter();
+    if let Some(program) = rest.next() {
+        out.push(program);
+    }
+    while let Some(arg) = rest.next() {
+        let Some(text) = arg.to_str().map(str::to_string) else {
+            out.push(arg);
+            continue;
+        };
+        if text == "--" {
+            // Everything after `--` is a positional value already.
+            out.push(arg);
+            out.extend(rest);
+            break;
+        }
+        if let Some(sub) = current.find_subcommand(&text) {
+            current = sub;
+            out.push(arg);
+            continue;
+        }
+        let takes_one_value = |a: &clap::Arg| {
+            a.get_action().takes_values() && a.get_num_args().is_none_or(|n| n.max_values() == 1)
+        };
+        let option = if let Some(long) = text.strip_prefix("--") {
+            current
+                .get_arguments()
+                .find(|a| a.get_long() == Some(long) && takes_one_value(a))
+        } else if let Some(short) = text.strip_prefix('-').filter(|s| s.chars().count() == 1) {
+            current
+                .get_arguments()
+                .find(|a| a.get_short() == short.chars().next() && takes_one_value(a))
+        } else {
+            None
+        };
+        let Some(option) = option else {
+            out.push(arg);
+            continue;
+        };
+        let Some(value) = rest.next() else {
+            out.push(arg);
+            break;
+        };
+        match value.to_str() {
+            Some(v) if v.starts_with('-') && v != "-" && !is_option_of(current, v) => {
+                let name = option.get_long().map_or_else(
+                    || format!("-{}", option.get_short().unwrap_or_default()),
+                    |long| format!("--{long}"),
+                );
+                out.push(format!("{name}={v}").into());
+            }
+            _ => {
+                out.push(arg);
+                out.push(value);
+            }
+        }
+    }
+    out
+}
+
+/// Whether `text` (which starts with `-`) is an option of `command`: `--name`, `--name=…`,
+/// `-x…` for one of its short names, `--help`, `-h`, `--version`, `-V`, or `--`.
+fn is_option_of(command: &clap::Command, text: &str) -> bool {
+    if let Some(long) = text.strip_prefix("--") {
+        let name = long.split_once('=').map_or(long, |(name, _)| name);
+        name.is_empty()
+            || matches!(name, "help" | "version")
+            || command.get_arguments().any(|a| a.get_long() == Some(name))
+    } else {
+        let short = text[1..].chars().next();
+        matches!(short, Some('h' | 'V'))
+            || command
+                .get_arguments()
+                .any(|a| a.get_short().is_some() && a.get_short() == short)
+    }
+}
+
 /// Runs the CLI on the process arguments. Exit status: 0 success, 1 a failed computation or
 /// a failed write (standard output or a file), 2 a usage error, 141 standard output closed by
 /// its reader ([`output`]).
 pub fn run() -> ExitCode {
-    let parsed = allow_negative_numbers(<Cli as clap::CommandFactory>::command())
-        .try_get_matches()
+    let command = allow_negative_numbers(<Cli as clap::CommandFactory>::command());
+    let args = join_hyphen_values(&command, std::env::args_os().collect());
+    let parsed = command
+        .try_get_matches_from(args)
         .and_then(|matches| <Cli as clap::FromArgMatches>::from_arg_matches(&matches));
     let cli = match parsed {
         Ok(cli) => cli,
@@ -176,9 +267,11 @@ pub fn run() -> ExitCode {
     }
 }
 
-/// The end of a run whose standard output failed: the command's own error if it had one
-/// (and its status), then the write error (none for a closed pipe, [`output::message`]),
-/// with [`output::status`] when the command itself succeeded.
+/// The end of a run whose standard output failed: the command's own error if it had one,
+/// then the write error (none for a closed pipe, [`output::message`]). The status is the
+/// command's when it failed (1); otherwise, and after a usage error whose JSON
+/// (`check --json bad.yaml > /dev/full`) was not delivered, the failed write's
+/// ([`output::status`]: 1, or 141 for a closed pipe).
 fn output_failure(io: &std::io::Error, error: Option<CliError>) -> ExitCode {
     let mut stderr = std::io::stderr();
     if let Some(e) = &error {
@@ -187,7 +280,10 @@ fn output_failure(io: &std::io::Error, error: Option<CliError>) -> ExitCode {
     if let Some(message) = output::message(io) {
         let _ = writeln!(stderr, "error: {message}");
     }
-    ExitCode::from(error.map_or_else(|| output::status(io), |e| e.code))
+    ExitCode::from(match error {
+        Some(e) if e.code != 2 => e.code,
+        _ => output::status(io),
+    })
 }
 
 fn list(json: bool) -> Result<(), CliError> {

@@ -12,6 +12,7 @@ use eomgen::vibration::{ModalDampingOptions, ModalDampingStudy, RayleighFit};
 use serde_json::json;
 
 use super::CliError;
+use super::files::Outputs;
 use super::free_response::{Panel, kind_json, panels, parse_init, study_failure};
 use super::modes::{OperatingPointArgs, matrix_rows, point_json};
 use super::plot::Series;
@@ -35,7 +36,7 @@ pub struct ModalDampingArgs {
     #[arg(long, value_name = "NAME=VALUE,…")]
     pub init: Vec<String>,
     /// End time (s). Default: ten periods of the slowest oscillatory mode.
-    #[arg(long)]
+    #[arg(long, value_parser = super::values::study_end_time, allow_hyphen_values = true)]
     pub t_end: Option<f64>,
     /// Number of output times, evenly spaced from 0 to the end time (2 to 1000000).
     #[arg(long, default_value_t = 801, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(2..=1_000_000))]
@@ -54,6 +55,9 @@ pub struct ModalDampingArgs {
 
 /// Runs `study modal-damping`.
 pub fn run(args: &ModalDampingArgs) -> Result<(), CliError> {
+    Outputs::new()
+        .chart("--plot", args.plot.as_deref())
+        .check()?;
     let model = args.point.model(&args.model)?;
     let rayleigh_modes = match &args.rayleigh_modes {
         Some(list) => match list.as_slice() {

@@ -230,22 +230,9 @@ pub fn mode_charts(
             equilibrium: rest.clone(),
             displaced,
         };
-        let result = super::render::atomically(&path, |file| {
-            if path.ends_with(".png") {
-                draw(
-                    BitMapBackend::new(file, SIZE).into_drawing_area(),
-                    &layout,
-                    &drawing,
-                )
-            } else {
-                draw(
-                    SVGBackend::new(file, SIZE).into_drawing_area(),
-                    &layout,
-                    &drawing,
-                )
-            }
-        });
-        result.map_err(|e| CliError::failure(format!("`{path}`: {e}")))?;
+        // The messages name the file (a write error names it itself).
+        super::plot::write_chart!(&path, SIZE, |root| draw(root, &layout, &drawing))
+            .map_err(CliError::failure)?;
         paths.push(path);
     }
     Ok(paths)

@@ -82,6 +82,22 @@ impl OperatingPointArgs {
 
 /// Runs `modes`.
 pub fn run(args: &ModesArgs) -> Result<(), CliError> {
+    // The charts `PREFIX-mode<k>` (at most one per degree of freedom) and the page, checked
+    // before the analysis.
+    let num_dofs = args.point.model(&args.model)?.num_dofs();
+    let charts: Vec<String> = match &args.plot {
+        Some(prefix) => (1..=num_dofs)
+            .map(|k| super::mode_plot::chart_path(prefix, k))
+            .collect(),
+        None => Vec::new(),
+    };
+    charts
+        .iter()
+        .fold(super::files::Outputs::new(), |outputs, path| {
+            outputs.chart("--plot", Some(path))
+        })
+        .file("--animate", args.animate.as_deref())
+        .check()?;
     let (model, modal) = analysis_of(&args.model, &args.point)?;
     if args.plot.is_some() {
         super::mode_plot::check_drawable(model.as_ref())?;
@@ -104,7 +120,7 @@ pub fn run(args: &ModesArgs) -> Result<(), CliError> {
     };
     if let Some(path) = &args.animate {
         let page = super::animate::modes(model.as_ref(), &equilibrium.q, modes, &shapes_q)?;
-        super::render::write_file(path, page.to_html()).map_err(CliError::failure)?;
+        super::files::write(path, page.to_html().as_bytes())?;
     }
     let mut stdout = super::output::stdout();
     if args.json {

@@ -3,6 +3,45 @@
 use eomgen::{ModelInfo, Solution};
 use plotters::prelude::*;
 
+/// Draws a chart of `$size` pixels in memory, in the format `$path`'s extension names, with
+/// `$draw` (an expression of the drawing area `$root` that returns `Result<(), String>`), and
+/// writes the file with [`super::files::write`]; a drawing error is prefixed with the path. Drawing in memory keeps the file system out
+/// of plotters: one writer handles regular files, links, devices and FIFOs, and names the
+/// file and the operating system's reason when a write fails.
+macro_rules! write_chart {
+    ($path:expr, $size:expr, |$root:ident| $draw:expr) => {{
+        use ::plotters::prelude::IntoDrawingArea as _;
+        let path: &str = $path;
+        let size: (u32, u32) = $size;
+        match $crate::cli::plot::ChartFormat::of(path) {
+            Err(e) => Err(e),
+            Ok($crate::cli::plot::ChartFormat::Svg) => {
+                let mut text = String::new();
+                let drawn = {
+                    let $root = ::plotters::prelude::SVGBackend::with_string(&mut text, size)
+                        .into_drawing_area();
+                    $draw
+                };
+                drawn
+                    .map_err(|e| format!("`{path}`: {e}"))
+                    .and_then(|()| $crate::cli::plot::save(path, text.as_bytes()))
+            }
+            Ok($crate::cli::plot::ChartFormat::Png) => {
+                let mut pixels = vec![0u8; size.0 as usize * size.1 as usize * 3];
+                let drawn = {
+                    let $root = ::plotters::prelude::BitMapBackend::with_buffer(&mut pixels, size)
+                        .into_drawing_area();
+                    $draw
+                };
+                drawn
+                    .map_err(|e| format!("`{path}`: {e}"))
+                    .and_then(|()| $crate::cli::plot::save_png(path, &pixels, size))
+            }
+        }
+    }};
+}
+pub(crate) use write_chart;
+
 static FONT: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
 
 /// Registers the bundled DejaVu Sans as plotters' `sans-serif`.
@@ -109,8 +148,8 @@ pub fn lines(path: &str, chart: &Chart<'_>, series: &[Series]) -> Result<(), Str
 }
 
 /// [`lines`] with `note` (the reason a run is incomplete, say) drawn in red under the title.
-/// The file is written atomically ([`super::render::atomically`]): a failed or killed run
-/// leaves any previous file at `path` as it was.
+/// The file is written by [`super::files::write`]: atomically for a regular file, in place
+/// for a device or FIFO.
 ///
 /// # Errors
 /// As [`lines`].
@@ -121,20 +160,59 @@ pub fn lines_noted(
     note: Option<&str>,
 ) -> Result<(), String> {
     register_font()?;
-    let size = (960, 600);
-    if path.ends_with(".svg") {
-        super::render::atomically(path, |file| {
-            let root = SVGBackend::new(file, size).into_drawing_area();
-            draw(root, chart, series, note)
-        })
-    } else if path.ends_with(".png") {
-        super::render::atomically(path, |file| {
-            let root = BitMapBackend::new(file, size).into_drawing_area();
-            draw(root, chart, series, note)
-        })
-    } else {
-        Err(format!("`{path}`: a chart file must end in .svg or .png"))
+    write_chart!(path, (960, 600), |root| draw(root, chart, series, note))
+}
+
+/// The format of a chart file, named by its extension.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum ChartFormat {
+    /// `.svg`.
+    Svg,
+    /// `.png`.
+    Png,
+}
+
+impl ChartFormat {
+    /// The format `path`'s extension names.
+    ///
+    /// # Errors
+    /// A message naming `path` when it ends in neither `.svg` nor `.png` (the commands find
+    /// this before any work, [`super::files::Outputs::check`]).
+    pub(super) fn of(path: &str) -> Result<Self, String> {
+        if path.ends_with(".svg") {
+            Ok(Self::Svg)
+        } else if path.ends_with(".png") {
+            Ok(Self::Png)
+        } else {
+            Err(format!("`{path}`: a chart file must end in .svg or .png"))
+        }
     }
+}
+
+/// Writes a drawn chart's bytes to `path` ([`super::files::write`]).
+///
+/// # Errors
+/// The write error, naming the file and the operating system's reason.
+pub(super) fn save(path: &str, bytes: &[u8]) -> Result<(), String> {
+    super::files::write(path, bytes).map_err(|e| e.to_string())
+}
+
+/// Encodes `pixels` (RGB, 8 bits a channel, rows of `size.0`) as PNG, as plotters' own
+/// bitmap files are encoded, and writes it to `path` ([`save`]).
+///
+/// # Errors
+/// A failed encoding, or the write error.
+pub(super) fn save_png(
+    path: &str,
+    pixels: &[u8],
+    (width, height): (u32, u32),
+) -> Result<(), String> {
+    use image::ImageEncoder as _;
+    let mut bytes = Vec::new();
+    image::codecs::png::PngEncoder::new(&mut bytes)
+        .write_image(pixels, width, height, image::ColorType::Rgb8)
+        .map_err(|e| format!("`{path}`: cannot encode the PNG: {e}"))?;
+    save(path, &bytes)
 }
 
 /// The points of `s` that can be drawn on the chart's axes.

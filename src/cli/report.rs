@@ -66,6 +66,13 @@ struct Source {
 
 /// Runs `report`.
 pub fn run(args: &ReportArgs) -> Result<(), CliError> {
+    // The directory is created if needed; a file of that name is refused before any work.
+    if args.out.exists() && !args.out.is_dir() {
+        return Err(CliError::usage(format!(
+            "--out `{}` is not a directory; give a directory for index.html, report.json and the figures",
+            args.out.display()
+        )));
+    }
     let sources = sources(&args.models)?;
     std::fs::create_dir_all(&args.out)
         .map_err(|e| CliError::failure(format!("cannot create `{}`: {e}", args.out.display())))?;
@@ -89,7 +96,7 @@ pub fn run(args: &ReportArgs) -> Result<(), CliError> {
     let text = serde_json::to_string_pretty(&json).map_err(|e| CliError::failure(e.to_string()))?;
     let write = |name: &str, content: &str| {
         let path = args.out.join(name);
-        super::render::write_file(&path.to_string_lossy(), content).map_err(CliError::failure)
+        super::files::write(&path.to_string_lossy(), content.as_bytes()).map_err(CliError::from)
     };
     write("report.json", &format!("{text}\n"))?;
     write(
@@ -351,9 +358,9 @@ fn animation(spec: &str, name: &str, model_dir: &Path, notes: &mut Vec<String>) 
                 notes.push(format!("animation: {}", e.message));
             }
             let file = "animation.html";
-            match super::render::write_file(
+            match super::files::write(
                 &model_dir.join(file).to_string_lossy(),
-                animation.to_html(),
+                animation.to_html().as_bytes(),
             ) {
                 Ok(()) => Some(format!("{name}/{file}")),
                 Err(e) => {

@@ -11,6 +11,7 @@ use eomgen::analysis::roundoff::{
 };
 use serde_json::json;
 
+use super::files::Outputs;
 use super::render::num;
 use super::stability::{log_y_chart, print_json};
 use super::{CliError, plot};
@@ -32,6 +33,9 @@ pub struct EulerRoundoffArgs {
 
 /// Runs `eomgen study euler-roundoff`.
 pub fn run(args: &EulerRoundoffArgs) -> Result<(), CliError> {
+    Outputs::new()
+        .chart("--plot", args.plot.as_deref())
+        .check()?;
     let EulerRoundoff {
         rows,
         summary: summaries,

@@ -12,6 +12,7 @@ use eomgen::expressions::{ExpressionEvents, set_initial_values};
 use eomgen::{IntegrationError, ModelInfo, OutputTimes, Solution};
 use serde_json::json;
 
+use super::files::{self, Outputs};
 use super::output::outln;
 use super::render::num;
 use super::values::{evaluate, set_parameters, usage};
@@ -115,7 +116,7 @@ pub struct IntegrationArgs {
     #[arg(long, value_parser = method_parser(), default_value_t = Method::Dp54)]
     pub method: Method,
     /// Relative tolerance (adaptive methods: bs32, dp54, dop853, radau5).
-    #[arg(long, default_value_t = 1e-8, value_parser = super::values::simulation_relative_tolerance, allow_hyphen_values = true)]
+    #[arg(long, default_value_t = 1e-8, value_parser = super::values::relative_tolerance, allow_hyphen_values = true)]
     pub rtol: f64,
     /// Absolute tolerance (adaptive methods; implicit-midpoint's scale for components near 0).
     #[arg(long, default_value_t = 1e-10, value_parser = super::values::absolute_tolerance, allow_hyphen_values = true)]
@@ -200,6 +201,28 @@ pub(crate) struct Run {
 
 /// Runs `simulate`.
 pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
+    // Every file this run may write or remove, checked before any work: `--csv FILE` owns
+    // `FILE-events.csv` and `--plot FILE` owns `FILE-drift.EXT` (written when the run has
+    // events or constraints, else removed when an earlier run left one). An output written
+    // in place (`/dev/stdout`, a FIFO) has no directory beside it, so no companion.
+    let companion = |path: &Option<String>, tag: &str| {
+        path.as_deref()
+            .filter(|path| !files::writes_in_place(path))
+            .map(|path| sibling(path, tag))
+    };
+    let events_csv = companion(&args.csv, "events");
+    let drift_chart = companion(&args.plot, "drift");
+    Outputs::new()
+        .file("--csv", args.csv.as_deref())
+        .file("--csv (its events file)", events_csv.as_deref())
+        .chart("--plot", args.plot.as_deref())
+        .chart(
+            "--plot (its constraint drift chart)",
+            drift_chart.as_deref(),
+        )
+        .chart("--plot-phase", args.plot_phase.as_deref())
+        .chart("--plot-energy", args.plot_energy.as_deref())
+        .check()?;
     if args.t_out.len() > MAX_OUTPUT_TIMES {
         return Err(CliError::usage(format!(
             "--t-out lists {} times; at most {MAX_OUTPUT_TIMES} are allowed",
@@ -216,13 +239,6 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
         OutputTimes::At(times)
     };
     let (model, simulation) = simulation(&args.model, &args.run, output)?;
-    // A failure without a time is an invalid input (output times out of order, say) that
-    // stopped the run before its first step: a usage error, with no file written.
-    if let Some(e) = &simulation.failure
-        && e.t().is_none()
-    {
-        return Err(CliError::usage(e.to_string()).before_output());
-    }
     let Simulation {
         solution,
         energy: report,
@@ -258,17 +274,24 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
             &constraints,
             incomplete.as_deref(),
         )?;
-        if !solution.events.is_empty() {
-            write_events_csv(&sibling(path, "events"), model.as_ref(), &solution)?;
+    }
+    if let Some(events) = &events_csv {
+        if solution.events.is_empty() {
+            files::remove_stale(events)?;
+        } else {
+            write_events_csv(events, model.as_ref(), &solution)?;
         }
     }
     if let Some(path) = &args.plot {
         plot::time_histories(path, model.as_ref(), &solution, incomplete.as_deref())
             .map_err(CliError::failure)?;
-        if !constraints.is_empty() {
-            let drift_path = sibling(path, "drift");
+    }
+    if let Some(drift_path) = &drift_chart {
+        if constraints.is_empty() {
+            files::remove_stale(drift_path)?;
+        } else {
             plot::constraint_drift(
-                &drift_path,
+                drift_path,
                 model.name(),
                 &solution.t,
                 &constraints.drift,
@@ -453,6 +476,14 @@ fn simulation(
     };
     let simulation =
         simulate_with_events(model.as_mut(), &options, added).map_err(simulation_error)?;
+    // A failure without a time is an invalid input (output times out of order, a step of 0)
+    // that stopped the run before its first step: a usage error, with no file written, in
+    // `simulate`, `animate` and `report` alike.
+    if let Some(e) = &simulation.failure
+        && e.t().is_none()
+    {
+        return Err(CliError::usage(e.to_string()).before_output());
+    }
     Ok((model, simulation))
 }
 
@@ -460,7 +491,8 @@ fn simulation(
 pub(crate) fn simulation_error(error: SimulationError) -> CliError {
     match error {
         SimulationError::InvalidEndTime { t_end } => CliError::usage(format!(
-            "--t-end must be a positive number of seconds, got {t_end}"
+            "--t-end must be a positive number of seconds, got {:e}",
+            num(t_end)
         )),
         SimulationError::InconsistentInitialState {
             model,
@@ -732,7 +764,7 @@ fn write_csv(
         }
         out.push('\n');
     }
-    super::render::write_file(path, out).map_err(CliError::failure)
+    Ok(super::files::write(path, out.as_bytes())?)
 }
 
 /// The located events: name, direction, time and state, and the intervals between
@@ -821,14 +853,19 @@ fn write_events_csv(
         }
         out.push('\n');
     }
-    super::render::write_file(path, out).map_err(CliError::failure)
+    Ok(super::files::write(path, out.as_bytes())?)
 }
 
-/// `dir/name.svg` → `dir/name-{tag}.svg`.
+/// `dir/name.svg` → `dir/name-{tag}.svg`, `dir.d/name` → `dir.d/name-{tag}` (only the
+/// file name's extension counts; a leading dot starts no extension).
 fn sibling(path: &str, tag: &str) -> String {
-    match path.rsplit_once('.') {
-        Some((stem, ext)) => format!("{stem}-{tag}.{ext}"),
-        None => format!("{path}-{tag}"),
+    let name = path.rfind('/').map_or(0, |i| i + 1);
+    match path[name..].rfind('.') {
+        Some(dot) if dot > 0 => {
+            let (stem, ext) = path.split_at(name + dot);
+            format!("{stem}-{tag}{ext}")
+        }
+        _ => format!("{path}-{tag}"),
     }
 }
 
@@ -853,4 +890,20 @@ fn print_constraint_summary(constraints: &ConstraintDrift, stabilization: Stabil
         p = num(p),
         v = num(v)
     );
+}
+
+#[cfg(test)]
+mod tests {
+    use super::sibling;
+
+    /// Only the file name's extension counts (a dot in a directory name used to put the tag
+    /// inside the directory's name), and a leading dot starts no extension.
+    #[test]
+    fn siblings_keep_the_extension_of_the_file_name() {
+        assert_eq!(sibling("out/run.csv", "events"), "out/run-events.csv");
+        assert_eq!(sibling("out.d/run", "events"), "out.d/run-events");
+        assert_eq!(sibling("run", "drift"), "run-drift");
+        assert_eq!(sibling("dir/.hidden", "drift"), "dir/.hidden-drift");
+        assert_eq!(sibling("a.b/c.tar.svg", "drift"), "a.b/c.tar-drift.svg");
+    }
 }

@@ -23,6 +23,7 @@ use eomgen::integrate::stability::GrowthTest;
 use nalgebra::Complex;
 use serde_json::json;
 
+use super::files::Outputs;
 use super::render::num;
 use super::{CliError, find_model, plot};
 
@@ -39,7 +40,7 @@ pub struct StabilityArgs {
     #[arg(long, default_value_t = 10_000)]
     pub periods: usize,
     /// Stiffness ratios k/m (1/s²) of the stiff two-mass spring (part c), comma separated.
-    #[arg(long, value_delimiter = ',', value_parser = super::values::positive, allow_hyphen_values = true, default_values_t = [1e2, 1e4, 1e6, 1e8])]
+    #[arg(long, value_delimiter = ',', value_parser = super::values::stiffness, allow_hyphen_values = true, default_values_t = [1e2, 1e4, 1e6, 1e8])]
     pub stiffness: Vec<f64>,
     /// End time of the stiff runs (s).
     #[arg(long, default_value_t = 1.0)]
@@ -95,6 +96,17 @@ pub fn run(args: &StabilityArgs) -> Result<(), CliError> {
     {
         return Err(CliError::usage("--plot needs a file prefix"));
     }
+    let charts = args
+        .plot
+        .as_deref()
+        .map(|prefix| CHARTS.map(|name| chart_path(prefix, name)));
+    charts
+        .iter()
+        .flatten()
+        .fold(Outputs::new(), |outputs, path| {
+            outputs.chart("--plot", Some(path))
+        })
+        .check()?;
     let mut two_masses = find_model(STIFF_MODEL)?;
     let StabilityStudy {
         test,
@@ -105,10 +117,10 @@ pub fn run(args: &StabilityArgs) -> Result<(), CliError> {
         underflow,
     } = stability_study(two_masses.as_mut(), &options).map_err(study_error)?;
 
-    if let Some(prefix) = &args.plot {
-        plot_limits(&chart_path(prefix, "limits"), &mut limits.explicit)?;
-        plot_energy(&chart_path(prefix, "energy"), &energy)?;
-        plot_stiff(&chart_path(prefix, "stiff"), &stiff)?;
+    if let Some([limits_path, energy_path, stiff_path]) = &charts {
+        plot_limits(limits_path, &mut limits.explicit)?;
+        plot_energy(energy_path, &energy)?;
+        plot_stiff(stiff_path, &stiff)?;
     }
     if args.json {
         let out = json!({
@@ -145,6 +157,9 @@ pub fn run(args: &StabilityArgs) -> Result<(), CliError> {
 }
 
 /// `PREFIX-name.svg`, or `.png` when the prefix ends in `.png` (a `.svg` ending is dropped).
+/// The charts of `--plot PREFIX`: `PREFIX-limits`, `PREFIX-energy`, `PREFIX-stiff`.
+const CHARTS: [&str; 3] = ["limits", "energy", "stiff"];
+
 fn chart_path(prefix: &str, name: &str) -> String {
     if let Some(stem) = prefix.strip_suffix(".png") {
         format!("{stem}-{name}.png")

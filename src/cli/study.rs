@@ -48,14 +48,14 @@ pub struct ConstraintMethodsArgs {
     /// A model with holonomic constraints (`simple_pendulum_cartesian`, `two_masses_rod`, …):
     /// a bundled name or the path of any model file.
     pub model: String,
-    /// End time (s).
-    #[arg(long, default_value_t = 10.0)]
+    /// End time (s), in [1e-6, 1e6].
+    #[arg(long, default_value_t = 10.0, value_parser = super::values::study_end_time, allow_hyphen_values = true)]
     pub t_end: f64,
     /// Relative and absolute tolerance of every run (Dormand–Prince 5(4)).
     #[arg(long, default_value_t = 1e-8, value_parser = super::values::relative_tolerance, allow_hyphen_values = true)]
     pub tol: f64,
     /// Spring stiffnesses of method I, comma separated.
-    #[arg(long, value_delimiter = ',', value_parser = super::values::positive, allow_hyphen_values = true, default_values_t = [1e2, 1e4, 1e6])]
+    #[arg(long, value_delimiter = ',', value_parser = super::values::stiffness, allow_hyphen_values = true, default_values_t = [1e2, 1e4, 1e6])]
     pub stiffness: Vec<f64>,
     /// Print JSON instead of the table.
     #[arg(long)]
@@ -81,6 +81,9 @@ pub fn run(study: &Study) -> Result<(), CliError> {
 /// Runs `study constraint-methods`: [`eomgen::analysis::constraint_methods`] on the model
 /// and the minimal twin its file names, rendered as a table, JSON and a chart.
 fn constraint_methods(args: &ConstraintMethodsArgs) -> Result<(), CliError> {
+    super::files::Outputs::new()
+        .chart("--plot", args.plot.as_deref())
+        .check()?;
     let source = super::open_model(&args.model)?;
     let twin = minimal_twin(&source).map_err(|e| CliError::failure(e.to_string()))?;
     let options = ConstraintMethodsOptions {
@@ -101,7 +104,8 @@ fn constraint_methods(args: &ConstraintMethodsArgs) -> Result<(), CliError> {
             CliError::usage("--t-end and --tol must be positive")
         }
         ConstraintMethodsError::InvalidStiffness { stiffness } => CliError::usage(format!(
-            "--stiffness: every stiffness must be a positive number, got {stiffness}"
+            "--stiffness: every stiffness must be a positive number, got {:e}",
+            num(stiffness)
         )),
         other => CliError::failure(other.to_string()),
     })?;

@@ -24,23 +24,27 @@ type Work = fn(&Measured) -> f64;
 fn study_error(args: &WorkPrecisionArgs, error: WorkPrecisionError) -> CliError {
     match error {
         WorkPrecisionError::InvalidEndTime { t_end } => CliError::usage(format!(
-            "--t-end must be a positive number of seconds, got {t_end}"
+            "--t-end must be a positive number of seconds, got {:e}",
+            num(t_end)
         )),
         WorkPrecisionError::NoSamples => CliError::usage("--samples must be at least 1"),
         WorkPrecisionError::InvalidTargetError { target_error } => CliError::usage(format!(
-            "--target-error must be positive, got {target_error}"
+            "--target-error must be positive, got {:e}",
+            num(target_error)
         )),
         WorkPrecisionError::InvalidReferenceTolerance { reference_tol } => {
             CliError::usage(format!(
-                "--reference-tol must be in (0, 1e-6), far tighter than the tolerances studied, got {reference_tol}"
+                "--reference-tol must be in (0, 1e-6), far tighter than the tolerances studied, got {:e}",
+                num(reference_tol)
             ))
         }
-        WorkPrecisionError::InvalidBaseline { baseline_ms } => {
-            CliError::usage(format!("--baseline-ms must be positive, got {baseline_ms}"))
-        }
+        WorkPrecisionError::InvalidBaseline { baseline_ms } => CliError::usage(format!(
+            "--baseline-ms must be positive, got {:e}",
+            num(baseline_ms)
+        )),
         WorkPrecisionError::InvalidMinTime { .. } => CliError::usage(format!(
-            "--min-time-ms must be ≥ 0, got {}",
-            args.min_time_ms
+            "--min-time-ms must be in [0, 10000], got {:e}",
+            num(args.min_time_ms)
         )),
         WorkPrecisionError::InitialState(e) => super::simulate::simulation_error(e),
         e @ WorkPrecisionError::ReferenceFailed { .. } => CliError::failure(format!(
@@ -72,8 +76,8 @@ pub struct WorkPrecisionArgs {
     /// `256..4194304` for p = 2, `1024..4194304` for p = 1.
     #[arg(long)]
     pub steps: Option<String>,
-    /// End time T (s).
-    #[arg(long, default_value_t = 10.0)]
+    /// End time T (s), in [1e-6, 1e6].
+    #[arg(long, default_value_t = 10.0, value_parser = super::values::study_end_time, allow_hyphen_values = true)]
     pub t_end: f64,
     /// Number S of equally spaced output times `k T / S`, k = 1…S, at which errors are taken
     /// (1 to 100000).
@@ -92,9 +96,9 @@ pub struct WorkPrecisionArgs {
     /// Fewest timed runs per setting; the reported time is their median (1 to 1000).
     #[arg(long, default_value_t = 3, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..=1000))]
     pub repeats: usize,
-    /// Runs of one setting are repeated until their total wall time reaches this (ms), at
-    /// most 1000 times.
-    #[arg(long, default_value_t = 20.0)]
+    /// Runs of one setting are repeated until their total wall time reaches this (ms, 0 to
+    /// 10000), at most 1000 times.
+    #[arg(long, default_value_t = 20.0, value_parser = super::values::min_time_ms, allow_hyphen_values = true)]
     pub min_time_ms: f64,
     /// Print JSON instead of the tables.
     #[arg(long)]
@@ -200,6 +204,15 @@ pub fn run(args: &WorkPrecisionArgs) -> Result<(), CliError> {
         min_time_s: args.min_time_ms * 1e-3,
     };
     options.validate().map_err(|e| study_error(args, e))?;
+    if let Some(prefix) = &args.plot {
+        ["evals", "time"]
+            .iter()
+            .flat_map(|tag| ["svg", "png"].map(|ext| chart_path(prefix, tag, ext)))
+            .fold(super::files::Outputs::new(), |outputs, path| {
+                outputs.chart("--plot", Some(&path))
+            })
+            .check()?;
+    }
     options.tolerances = parse_tols(&args.tols)?;
     options.steps = args.steps.as_deref().map(parse_steps).transpose()?;
     let mut model = find_model(&args.model)?;
@@ -468,6 +481,11 @@ impl Study<'_> {
     }
 }
 
+/// The chart `PREFIX-{tag}.{ext}` of `--plot PREFIX`.
+fn chart_path(prefix: &str, tag: &str, ext: &str) -> String {
+    format!("{prefix}-{tag}.{ext}")
+}
+
 /// Writes `PREFIX-evals.{svg,png}` and `PREFIX-time.{svg,png}`: the error of every
 /// successful run against its RHS evaluations and its median wall time, log–log.
 fn write_charts(prefix: &str, model: &str, results: &[MethodRuns]) -> Result<(), CliError> {
@@ -493,7 +511,7 @@ fn write_charts(prefix: &str, model: &str, results: &[MethodRuns]) -> Result<(),
         let data = series(work);
         let title = format!("{model}: work–precision ({x_desc})");
         for ext in ["svg", "png"] {
-            let path = format!("{prefix}-{tag}.{ext}");
+            let path = chart_path(prefix, tag, ext);
             plot::lines(
                 &path,
                 &plot::Chart {

@@ -1,0 +1,498 @@
+//! Output files: the one writer of every file the command line writes ([`write`]), and the
+//! check of a command's outputs before it does any work ([`Outputs::check`]).
+//!
+//! What a path names decides how it is written (docs/reliability.md, "Atomic outputs"):
+//!
+//! - a **regular file**, or a name that does not exist yet: the bytes go to a temporary file
+//!   `.eomgen-…` in the same directory, renamed onto the name when complete, so a failed or
+//!   killed run leaves the previous file whole. An existing file keeps its permissions (and
+//!   its owner and group where the process may set them); a new one gets the ordinary mode
+//!   of a new file (0666 less the umask);
+//! - a **symbolic link** is followed to its final target (which need not exist yet), and that
+//!   target is replaced as above, in its own directory: the link stays a link and its target
+//!   is the new file;
+//! - the program's own **standard output or error** (`/dev/stdout`, `/dev/fd/1`, or any name
+//!   of the same open file) is written through the stream, in order with what the command
+//!   prints, and standard output's errors are reported as standard output's
+//!   ([`super::output`]);
+//! - anything else that is not a regular file (`/dev/null`, a FIFO, a terminal, a file
+//!   reached through `/proc/…/fd/N`) is opened for writing and the bytes are streamed into it:
+//!   never renamed over, never removed.
+
+use std::fs::{self, Metadata, OpenOptions};
+use std::io::{self, Write as _};
+use std::path::{Path, PathBuf};
+
+use super::CliError;
+
+/// An output that cannot be written, or two outputs that would write one file.
+#[derive(Debug, thiserror::Error)]
+pub(super) enum FileError {
+    /// A chart's format is chosen by its extension, and this one names none.
+    #[error("{option} `{path}`: a chart file must end in .svg or .png")]
+    ChartExtension {
+        /// The option that names the file (`--plot`).
+        option: String,
+        /// The path as given.
+        path: String,
+    },
+    /// The path names a directory.
+    #[error("{option} `{path}` is a directory; give a file name")]
+    Directory {
+        /// The option that names the file.
+        option: String,
+        /// The path as given.
+        path: String,
+    },
+    /// The path names no file (empty, or ending in `..`).
+    #[error("{option} `{path}` names no file; give a file name")]
+    NoFileName {
+        /// The option that names the file.
+        option: String,
+        /// The path as given.
+        path: String,
+    },
+    /// The file's directory does not exist (or is not a directory).
+    #[error("{option} `{path}`: the directory `{directory}` does not exist")]
+    NoDirectory {
+        /// The option that names the file.
+        option: String,
+        /// The path as given.
+        path: String,
+        /// The directory the file would be created in (after any symbolic links).
+        directory: String,
+    },
+    /// The path cannot be used: its directory is not writable, a link loops, a component
+    /// cannot be searched.
+    #[error("{option} `{path}` cannot be written: {reason}")]
+    Unusable {
+        /// The option that names the file.
+        option: String,
+        /// The path as given.
+        path: String,
+        /// The operating system's reason.
+        reason: String,
+    },
+    /// Two outputs of one run name the same file: one of them would be lost.
+    #[error("{first} and {second} both write `{path}`; give each output its own file")]
+    SamePath {
+        /// The option named first.
+        first: String,
+        /// The option named second.
+        second: String,
+        /// The path as the second option gives it.
+        path: String,
+    },
+    /// Writing the file failed.
+    #[error("cannot write `{path}`: {reason}")]
+    Write {
+        /// The path as given.
+        path: String,
+        /// The operating system's reason.
+        reason: String,
+    },
+    /// A stale companion file could not be removed.
+    #[error("cannot remove `{path}`, left by an earlier run: {reason}")]
+    Remove {
+        /// The companion's path.
+        path: String,
+        /// The operating system's reason.
+        reason: String,
+    },
+}
+
+impl From<FileError> for CliError {
+    /// A refused output is a usage error (exit 2), found before any work; a failed write or
+    /// removal is a failure (exit 1).
+    fn from(e: FileError) -> Self {
+        match e {
+            FileError::Write { .. } | FileError::Remove { .. } => CliError::failure(e.to_string()),
+            _ => CliError::usage(e.to_string()),
+        }
+    }
+}
+
+/// The most symbolic links followed from one path (Linux's limit, `ELOOP` beyond).
+const MAX_LINKS: usize = 40;
+
+/// One of the program's standard streams.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Stream {
+    Output,
+    Error,
+}
+
+/// How a path is written ([`resolve`]).
+#[derive(Debug)]
+enum Target {
+    /// The program's standard output or error: written through the stream.
+    Standard(Stream),
+    /// Not a regular file, or a file reached through `/proc/…/fd/N`: opened and written in
+    /// place (truncated when it is a regular file, as a shell's `>` does).
+    InPlace { path: PathBuf, truncate: bool },
+    /// A regular file at the end of any symbolic links, replaced by rename; `existing` is
+    /// the file there now, if any.
+    Regular {
+        path: PathBuf,
+        existing: Option<Metadata>,
+    },
+    /// A directory: refused.
+    Directory,
+}
+
+/// What `path` names, following symbolic links ([`Target`]).
+fn resolve(path: &str) -> io::Result<Target> {
+    match fs::metadata(path) {
+        Ok(m) if m.is_dir() => return Ok(Target::Directory),
+        Ok(m) => {
+            if let Some(stream) = standard_stream(&m) {
+                return Ok(Target::Standard(stream));
+            }
+            if !m.is_file() {
+                return Ok(Target::InPlace {
+                    path: PathBuf::from(path),
+                    truncate: false,
+                });
+            }
+        }
+        Err(e) if e.kind() == io::ErrorKind::NotFound => {}
+        Err(e) => return Err(e),
+    }
+    // A regular file or a new name: follow the links one by one to the name to replace.
+    let mut current = PathBuf::from(path);
+    for _ in 0..MAX_LINKS {
+        let metadata = match fs::symlink_metadata(&current) {
+            Ok(m) => m,
+            Err(e) if e.kind() == io::ErrorKind::NotFound => {
+                return Ok(Target::Regular {
+                    path: current,
+                    existing: None,
+                });
+            }
+            Err(e) => return Err(e),
+        };
+        if !metadata.file_type().is_symlink() {
+            return Ok(Target::Regular {
+                path: current,
+                existing: Some(metadata),
+            });
+        }
+        // `/proc/…/fd/N` (and `/dev/fd/N` through it) names an open file, not a place in
+        // a directory: its "target" may be `pipe:[…]` or a deleted file.
+        if current.starts_with("/proc") || current.starts_with("/dev/fd") {
+            return Ok(Target::InPlace {
+                path: PathBuf::from(path),
+                truncate: true,
+            });
+        }
+        let link = fs::read_link(&current)?;
+        current = match current.parent() {
+            Some(dir) => dir.join(link),
+            None => link,
+        };
+    }
+    Err(io::Error::other("too many levels of symbolic links"))
+}
+
+/// The standard stream that is the same open file as `metadata`'s, if any.
+#[cfg(unix)]
+fn standard_stream(metadata: &Metadata) -> Option<Stream> {
+    use std::os::fd::AsFd as _;
+    use std::os::unix::fs::MetadataExt as _;
+    let same = |fd: std::os::fd::BorrowedFd<'_>| {
+        fd.try_clone_to_owned()
+            .ok()
+            .and_then(|fd| fs::File::from(fd).metadata().ok())
+            .is_some_and(|s| s.dev() == metadata.dev() && s.ino() == metadata.ino())
+    };
+    if same(io::stdout().as_fd()) {
+        Some(Stream::Output)
+    } else if same(io::stderr().as_fd()) {
+        Some(Stream::Error)
+    } else {
+        None
+    }
+}
+
+#[cfg(not(unix))]
+fn standard_stream(_: &Metadata) -> Option<Stream> {
+    None
+}
+
+/// The directory a file at `path` is created in (`.` for a bare name).
+fn directory_of(path: &Path) -> &Path {
+    match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    }
+}
+
+/// The operating system's message of `e` without the temporary file's path that the
+/// temporary-file errors append (`… at path "dir/.eomgen-…"`): the user named another path.
+fn os_error(e: &io::Error) -> String {
+    let text = e.to_string();
+    match text.split_once(" at path ") {
+        Some((message, _)) => message.to_string(),
+        None => text,
+    }
+}
+
+/// Writes `bytes` to `path` as its kind asks (see the module's documentation): a regular file
+/// (or the final target of a symbolic link) is replaced atomically keeping its mode, a
+/// device or FIFO is written in place, the program's standard output or error through the
+/// stream.
+///
+/// # Errors
+/// [`FileError::Write`] naming `path` with the operating system's reason, or
+/// [`FileError::Directory`] for a directory. A write to standard output that fails is kept by
+/// [`super::output`] (status 1, or 141 for a closed pipe) and is not an error here.
+pub(super) fn write(path: &str, bytes: &[u8]) -> Result<(), FileError> {
+    let fail = |e: io::Error| FileError::Write {
+        path: path.to_string(),
+        reason: os_error(&e),
+    };
+    match resolve(path).map_err(fail)? {
+        Target::Directory => Err(FileError::Directory {
+            option: "output".to_string(),
+            path: path.to_string(),
+        }),
+        Target::Standard(Stream::Output) => {
+            let _ = super::output::stdout().write_all(bytes);
+            Ok(())
+        }
+        Target::Standard(Stream::Error) => io::stderr().write_all(bytes).map_err(fail),
+        Target::InPlace {
+            path: target,
+            truncate,
+        } => {
+            let mut file = OpenOptions::new()
+                .write(true)
+                .truncate(truncate)
+                .open(target)
+                .map_err(fail)?;
+            file.write_all(bytes)
+                .and_then(|()| file.flush())
+                .map_err(fail)
+        }
+        Target::Regular {
+            path: target,
+            existing,
+        } => replace(&target, existing.as_ref(), bytes).map_err(fail),
+    }
+}
+
+/// Writes `bytes` to a temporary file in `target`'s directory, with the owner, group and
+/// permissions of `existing` (or a new file's mode), and renames it onto `target`.
+fn replace(target: &Path, existing: Option<&Metadata>, bytes: &[u8]) -> io::Result<()> {
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(".eomgen-");
+    // The mode of an ordinary new file (the umask applies), not a temporary file's 0600.
+    #[cfg(unix)]
+    builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666));
+    let mut temporary = builder.tempfile_in(directory_of(target))?;
+    if let Some(existing) = existing {
+        // Owner first: changing it may clear set-id bits that the mode then restores. A
+        // process may not give a file away (only root may), so a refusal leaves the owner
+        // the writer; the mode is set exactly (fchmod is not masked by the umask).
+        #[cfg(unix)]
+        {
+            use std::os::unix::fs::MetadataExt as _;
+            let _ = std::os::unix::fs::fchown(
+                temporary.as_file(),
+                Some(existing.uid()),
+                Some(existing.gid()),
+            );
+        }
+        temporary
+            .as_file()
+            .set_permissions(existing.permissions())?;
+    }
+    temporary.write_all(bytes)?;
+    temporary.persist(target).map_err(|e| e.error)?;
+    Ok(())
+}
+
+/// Whether `path` is written in place (a device, FIFO or standard stream, see [`write`])
+/// rather than replaced as a regular file.
+pub(super) fn writes_in_place(path: &str) -> bool {
+    matches!(
+        resolve(path),
+        Ok(Target::Standard(_) | Target::InPlace { .. })
+    )
+}
+
+/// Removes `path`, a companion file that an earlier run wrote beside an output and that this
+/// run does not write (`FILE-events.csv` of a run without events), so that the files beside
+/// an output always come from the same run. Only a regular file is removed: a symbolic link,
+/// a device or a FIFO of that name is left alone, and so is a missing file.
+///
+/// # Errors
+/// [`FileError::Remove`] when a regular file is there and cannot be removed.
+pub(super) fn remove_stale(path: &str) -> Result<(), FileError> {
+    match fs::symlink_metadata(path) {
+        Ok(m) if m.is_file() => fs::remove_file(path).map_err(|e| FileError::Remove {
+            path: path.to_string(),
+            reason: os_error(&e),
+        }),
+        _ => Ok(()),
+    }
+}
+
+/// What an output option writes, which decides what its path must look like.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum Format {
+    /// A chart: `.svg` or `.png`, chosen by the extension.
+    Chart,
+    /// A file of one fixed format (CSV, HTML, GIF, JSON): any name.
+    Fixed,
+}
+
+/// One planned output: the option that names it, its path and format.
+#[derive(Debug, Clone)]
+struct Planned {
+    option: String,
+    path: String,
+    format: Format,
+}
+
+/// Which file a planned output is, to find two outputs that write one file.
+#[derive(Debug, PartialEq, Eq)]
+enum Identity {
+    /// An existing file (device and inode, after symbolic links).
+    Inode(u64, u64),
+    /// A new file: its directory, made absolute, and its name.
+    Name(PathBuf),
+    /// A device, FIFO or standard stream: written in place, so two outputs there are both
+    /// delivered, one after the other (`--csv /dev/null --plot-phase /dev/null`).
+    Stream,
+}
+
+/// A command's outputs, checked together before it does any work ([`Outputs::check`]).
+#[derive(Debug, Default)]
+pub(super) struct Outputs(Vec<Planned>);
+
+impl Outputs {
+    /// No output yet.
+    pub(super) fn new() -> Self {
+        Self::default()
+    }
+
+    /// Adds the output `path` of `option` (nothing when `None`), in `format`.
+    #[must_use]
+    pub(super) fn add(mut self, option: &str, path: Option<&str>, format: Format) -> Self {
+        if let Some(path) = path {
+            self.0.push(Planned {
+                option: option.to_string(),
+                path: path.to_string(),
+                format,
+            });
+        }
+        self
+    }
+
+    /// Adds a chart (`.svg` or `.png`) of `option`.
+    #[must_use]
+    pub(super) fn chart(self, option: &str, path: Option<&str>) -> Self {
+        self.add(option, path, Format::Chart)
+    }
+
+    /// Adds a file of fixed format of `option`.
+    #[must_use]
+    pub(super) fn file(self, option: &str, path: Option<&str>) -> Self {
+        self.add(option, path, Format::Fixed)
+    }
+
+    /// Checks every output before the command computes anything: a chart's extension, a
+    /// path that is a directory, a directory that does not exist or cannot be written (a
+    /// temporary file is created there and removed), and two outputs of one file.
+    ///
+    /// # Errors
+    /// The first refused output ([`FileError`], a usage error).
+    pub(super) fn check(&self) -> Result<(), FileError> {
+        let mut seen: Vec<(Identity, &str)> = Vec::with_capacity(self.0.len());
+        for planned in &self.0 {
+            let identity = check_one(planned)?;
+            if identity != Identity::Stream
+                && let Some((_, first)) = seen.iter().find(|(i, _)| *i == identity)
+            {
+                return Err(FileError::SamePath {
+                    first: first.to_string(),
+                    second: planned.option.clone(),
+                    path: planned.path.clone(),
+                });
+            }
+            seen.push((identity, &planned.option));
+        }
+        Ok(())
+    }
+}
+
+/// Checks one planned output and says which file it is.
+fn check_one(planned: &Planned) -> Result<Identity, FileError> {
+    let Planned {
+        option,
+        path,
+        format,
+    } = planned;
+    let unusable = |e: io::Error| FileError::Unusable {
+        option: option.clone(),
+        path: path.clone(),
+        reason: os_error(&e),
+    };
+    if *format == Format::Chart && !(path.ends_with(".svg") || path.ends_with(".png")) {
+        return Err(FileError::ChartExtension {
+            option: option.clone(),
+            path: path.clone(),
+        });
+    }
+    match resolve(path).map_err(unusable)? {
+        Target::Directory => Err(FileError::Directory {
+            option: option.clone(),
+            path: path.clone(),
+        }),
+        Target::Standard(_) | Target::InPlace { .. } => Ok(Identity::Stream),
+        Target::Regular {
+            path: target,
+            existing,
+        } => {
+            let Some(name) = target.file_name() else {
+                return Err(FileError::NoFileName {
+                    option: option.clone(),
+                    path: path.clone(),
+                });
+            };
+            let directory = directory_of(&target);
+            if !directory.is_dir() {
+                return Err(FileError::NoDirectory {
+                    option: option.clone(),
+                    path: path.clone(),
+                    directory: directory.display().to_string(),
+                });
+            }
+            // Where the file will be renamed into place: it must take a new file.
+            tempfile::Builder::new()
+                .prefix(".eomgen-")
+                .tempfile_in(directory)
+                .map_err(unusable)?;
+            Ok(match existing.as_ref().and_then(inode) {
+                Some((device, inode)) => Identity::Inode(device, inode),
+                None => {
+                    let absolute = fs::canonicalize(directory).map_err(unusable)?;
+                    Identity::Name(absolute.join(name))
+                }
+            })
+        }
+    }
+}
+
+/// The device and inode of a file.
+#[cfg(unix)]
+fn inode(metadata: &Metadata) -> Option<(u64, u64)> {
+    use std::os::unix::fs::MetadataExt as _;
+    Some((metadata.dev(), metadata.ino()))
+}
+
+#[cfg(not(unix))]
+fn inode(_: &Metadata) -> Option<(u64, u64)> {
+    None
+}
