@@ -24,7 +24,8 @@ use rayon::prelude::*;
 use serde_json::json;
 
 use eomgen::ModelInfo;
-use eomgen::checks::{DefaultRun, model_report};
+use eomgen::analysis::StudyRuns;
+use eomgen::checks::{DefaultRun, ReportRows, model_report};
 use eomgen::vibration::ModalAnalysis;
 use eomgen_symbolic::codegen::equations_mathml;
 use eomgen_symbolic::mechanics::{Formulation, Lagrange, SymbolicModel};
@@ -100,16 +101,25 @@ pub fn run(args: &ReportArgs) -> Result<(), CliError> {
         outln!("{text}");
     }
     let total: usize = reports.iter().map(|r| r.checks.len()).sum();
+    // Each failed check with its reason (not computed, or computed against expected).
     let failed: Vec<String> = reports
         .iter()
         .flat_map(|r| {
-            r.checks
-                .iter()
-                .filter(|c| !c.passed)
-                .map(move |c| format!("{}: {}", r.name, c.check))
+            r.checks.iter().filter_map(move |c| {
+                c.failure_reason()
+                    .map(|reason| format!("{}: {}: {reason}", r.name, c.check))
+            })
         })
         .collect();
     let index = args.out.join("index.html");
+    ReportRows(
+        reports
+            .iter()
+            .map(|r| (r.name.as_str(), r.checks.as_slice()))
+            .collect(),
+    )
+    .check_measured()
+    .map_err(|e| CliError::failure(format!("{e} ({})", index.display())))?;
     if failed.is_empty() {
         super::output::errln!(
             "report: {} models, {total} checks, all passed: {}",

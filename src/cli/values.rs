@@ -79,6 +79,16 @@ pub fn absolute_tolerance(text: &str) -> Result<f64, String> {
     )
 }
 
+/// Parses a gain of Baumgarte's stabilisation (`--baumgarte ALPHA,BETA`, 1/s): a finite
+/// number `≥ 0` (a negative α makes the constraint drift grow instead of decay).
+pub fn baumgarte_gain(text: &str) -> Result<f64, String> {
+    number(
+        text,
+        |v| v.is_finite() && v >= 0.0,
+        "a Baumgarte gain must be a finite number >= 0 (1/s), such as 10",
+    )
+}
+
 /// Parses a positive finite number (a stiffness): refused values are usage errors.
 pub fn positive(text: &str) -> Result<f64, String> {
     number(
