@@ -14,9 +14,7 @@ use serde::Serialize;
 use crate::ModelSource;
 use crate::analysis::{Method, SimulationOptions, simulate};
 use crate::expressions::{evaluate, parameter_lookup, split_assignment};
-use eomgen_runtime::analysis::{
-    EnergyDrift, RunTally, StudyRuns, constraint_drift, energy_drift,
-};
+use eomgen_runtime::analysis::{EnergyDrift, RunTally, StudyRuns, constraint_drift, energy_drift};
 use eomgen_runtime::vibration::{
     EquilibriumStart, ModalAnalysis, ModalOptions, OperatingPointOptions, modal_analysis,
 };

@@ -29,8 +29,7 @@ pub use dynamic::{DynMechanicalSystem, StaticSystem};
 pub use first_order::{DynFirstOrder, FirstOrder};
 pub use floquet::{
     FloquetAnalysis, FloquetError, FloquetOptions, FloquetStability, LARGEST_STABILITY_TOLERANCE,
-    check_periodic_equilibrium,
-    floquet_analysis, floquet_multipliers, monodromy_matrix,
+    check_periodic_equilibrium, floquet_analysis, floquet_multipliers, monodromy_matrix,
 };
 pub use frf::{
     ForcedLinearization, FrequencySweep, FrfError, HarmonicForcing, ModalResponse, PeakAmplitude,

@@ -13,14 +13,14 @@ use std::f64::consts::TAU;
 use std::io::Write as _;
 
 use clap::Args;
+use eomgen::analysis::StudyRuns;
 use eomgen::vibration::{
     self, FloquetCell, FloquetChart, FloquetPoint, FloquetStudyError, FloquetStudyOptions,
     SweepAxis,
 };
-use eomgen::analysis::StudyRuns;
 use eomgen::{
-    ChartAxis, FloquetAnalysis, FloquetError, FloquetOptions, FloquetReferences, FloquetStability, ModelInfo,
-    ThresholdPrediction,
+    ChartAxis, FloquetAnalysis, FloquetError, FloquetOptions, FloquetReferences, FloquetStability,
+    ModelInfo, ThresholdPrediction,
 };
 use plotters::prelude::*;
 use rayon::prelude::*;
@@ -386,7 +386,10 @@ fn sweep_json(x: &Axis, y: &Axis, grid: &[Vec<Cell>]) -> Value {
         .iter()
         .map(|col| {
             col.iter()
-                .map(|c| c.as_ref().map_or(Value::Null, |c| json!(c.stability.as_str())))
+                .map(|c| {
+                    c.as_ref()
+                        .map_or(Value::Null, |c| json!(c.stability.as_str()))
+                })
                 .collect()
         })
         .collect();
@@ -666,9 +669,7 @@ where
     )?;
     cells(
         &|c| match c {
-            Ok(c) if c.stability == FloquetStability::Unstable => {
-                Some(unstable(c.spectral_radius))
-            }
+            Ok(c) if c.stability == FloquetStability::Unstable => Some(unstable(c.spectral_radius)),
             _ => None,
         },
         &format!("unstable, yellow→red with log₁₀ ρ up to {log_max:.2}"),

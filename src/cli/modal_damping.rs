@@ -7,8 +7,8 @@
 use std::io::Write as _;
 
 use clap::Args;
-use eomgen::analysis::StudyRuns;
 use eomgen::ModelInfo;
+use eomgen::analysis::StudyRuns;
 use eomgen::vibration::{ModalDampingOptions, ModalDampingStudy, RayleighFit};
 use serde_json::json;
 

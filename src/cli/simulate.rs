@@ -138,8 +138,8 @@ pub struct IntegrationArgs {
     /// constraints after every step). Ignored without constraints.
     #[arg(long, value_enum, default_value_t = StabilizationArg::None)]
     pub stabilization: StabilizationArg,
-    /// Baumgarte's α and β (1/s, finite and ≥ 0), `ALPHA,BETA` or `ALPHA BETA`.
-    #[arg(long, value_name = "ALPHA,BETA", value_delimiter = ',', num_args = 1..=2, value_parser = super::values::baumgarte_gain, allow_hyphen_values = true, default_values_t = [10.0, 10.0])]
+    /// Baumgarte's α and β (1/s, finite and ≥ 0), `ALPHA,BETA`.
+    #[arg(long, value_name = "ALPHA,BETA", value_delimiter = ',', value_parser = super::values::baumgarte_gain, allow_hyphen_values = true, default_values_t = [10.0, 10.0])]
     pub baumgarte: Vec<f64>,
     /// Stop at the first zero of a function: a model event's name (`--stop-when lift_off`)
     /// or `EXPR` / `LHS = RHS`, optionally followed by `, rising`, `, falling` or `, both`

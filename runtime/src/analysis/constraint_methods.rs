@@ -138,11 +138,7 @@ impl StudyRuns for ConstraintMethods {
     fn tally(&self) -> RunTally {
         let mut tally = RunTally::default();
         for row in &self.rows {
-            tally.add(
-                row.failure
-                    .as_ref()
-                    .map(|f| format!("{}: {f}", row.method)),
-            );
+            tally.add(row.failure.as_ref().map(|f| format!("{}: {f}", row.method)));
         }
         tally
     }

@@ -43,7 +43,9 @@ impl RunTally {
 
 /// A study that measured nothing: every one of its runs failed (or it had none).
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("{study}: every run failed ({failed} of {failed}), so nothing was measured; the first failed: {first_failure}")]
+#[error(
+    "{study}: every run failed ({failed} of {failed}), so nothing was measured; the first failed: {first_failure}"
+)]
 pub struct NothingMeasured {
     /// The study (`work-precision`).
     pub study: &'static str,

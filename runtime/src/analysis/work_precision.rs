@@ -174,15 +174,18 @@ pub enum WorkPrecisionError {
         /// Why it failed.
         message: String,
     },
-    /// The reference stays at the initial state to the last bit over `[0, t_end]`: the
-    /// motion is below rounding (an end time of `1e-320` s), so there is no error to
-    /// measure and every run would report 0.
+    /// The reference moves less than its own tolerance over `[0, t_end]`: every component
+    /// stays within `tol (1 + |y₀ᵢ|)` of its start (an end time of `1e-320` s, or a state at
+    /// rest at an equilibrium), so the reference cannot resolve any run's error, and every
+    /// run would report about 0.
     #[error(
-        "the reference solution does not move from the initial state over 0 ≤ t ≤ {t_end} s (every component equal to the last bit): there is no motion whose error could be measured; choose a longer --t-end or a state that moves"
+        "the reference solution moves less than its tolerance {reference_tol:e} over 0 ≤ t ≤ {t_end:e} s (every component within tol·(1 + |y₀|) of its start): there is no motion whose error could be measured; choose a longer --t-end or a state that moves"
     )]
     NoMotion {
         /// The end time (s).
         t_end: f64,
+        /// The reference tolerance.
+        reference_tol: f64,
     },
     /// The reference and its check disagree by more than a hundredth of the target error.
     #[error(
@@ -633,8 +636,8 @@ impl Problem<'_> {
 /// [`WorkPrecisionError::InitialState`] when the initial state cannot be made consistent;
 /// [`WorkPrecisionError::ReferenceFailed`] and [`WorkPrecisionError::ReferenceNotVerified`]
 /// when the reference cannot be computed or its check does not agree with it to a hundredth
-/// of the target error; [`WorkPrecisionError::NoMotion`] when the reference does not move
-/// from the initial state. A method that fails at a setting is reported in its row; a study
+/// of the target error; [`WorkPrecisionError::NoMotion`] when the reference moves less than
+/// its tolerance. A method that fails at a setting is reported in its row; a study
 /// whose every run failed measured nothing ([`StudyRuns::check_measured`]).
 ///
 /// # Examples
@@ -708,12 +711,18 @@ pub fn work_precision(
     };
     let reference = solve(Method::Dop853, "the reference solution")?;
     let check = solve(Method::Dp54, "the check of the reference")?;
-    if reference
-        .iter()
-        .all(|(_, y)| y.iter().zip(&problem.y0).all(|(a, b)| a == b))
-    {
+    // The reference's own error is up to its tolerance per component (`atol + rtol |y|`):
+    // a motion within it leaves no error to resolve.
+    let tol = options.reference_tol;
+    let moves = reference.iter().any(|(_, y)| {
+        y.iter()
+            .zip(&problem.y0)
+            .any(|(a, b)| (a - b).abs() > tol * (1.0 + b.abs()))
+    });
+    if !moves {
         return Err(WorkPrecisionError::NoMotion {
             t_end: options.t_end,
+            reference_tol: tol,
         });
     }
     let agreement = state_error(&check, &reference);

@@ -17,11 +17,11 @@ use std::f64::consts::TAU;
 use serde::Serialize;
 
 use super::operating_point::{OperatingPointError, OperatingPointOptions};
+use crate::analysis::outcome::{RunTally, StudyRuns};
 use crate::floquet::{
     FloquetAnalysis, FloquetError, FloquetOptions, FloquetStability, check_periodic_equilibrium,
     floquet_analysis,
 };
-use crate::analysis::outcome::{RunTally, StudyRuns};
 use crate::modal::{ModalError, find_equilibrium};
 use crate::model_info::ModelInfo;
 use crate::system::UnknownParameter;
@@ -42,7 +42,9 @@ pub enum FloquetStudyError {
     },
     /// DOP853's tolerances are not finite and positive. (A tolerance on `|μ| = 1` out of its
     /// range is [`FloquetError::InvalidStabilityTolerance`], in [`FloquetStudyError::Floquet`].)
-    #[error("the integration's tolerances must be finite and positive, got rtol = {rtol}, atol = {atol}")]
+    #[error(
+        "the integration's tolerances must be finite and positive, got rtol = {rtol}, atol = {atol}"
+    )]
     InvalidTolerance {
         /// DOP853's relative tolerance.
         rtol: f64,

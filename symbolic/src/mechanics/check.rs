@@ -166,9 +166,10 @@ impl CheckReport {
     /// state was compared ([`SampledStates::nothing_compared`]).
     pub fn passed(&self, tolerance: f64) -> bool {
         self.states.compared > 0
-            && self.comparisons
-            .iter()
-            .all(|c| c.max_rel_residual <= tolerance)
+            && self
+                .comparisons
+                .iter()
+                .all(|c| c.max_rel_residual <= tolerance)
             && self
                 .power_balance
                 .as_ref()
