@@ -274,12 +274,22 @@ pub fn derivation_checks(
     let sampled = |value: f64| nothing_compared.clone().map_or(Ok(value), Err);
     let mut rows = Vec::new();
     for c in &r.comparisons {
+        let computed = sampled(c.max_rel_residual).and_then(|v| {
+            if v.is_nan() {
+                Err(format!(
+                    "{} is not finite at some of the states where {} is",
+                    c.b, c.a
+                ))
+            } else {
+                Ok(v)
+            }
+        });
         rows.push(CheckRow::compare(
             format!(
                 "derivations agree: {} vs {} (max relative q̈ difference)",
                 c.a, c.b
             ),
-            sampled(c.max_rel_residual),
+            computed,
             0.0,
             DERIVATION_TOLERANCE,
         ));

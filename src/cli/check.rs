@@ -106,12 +106,17 @@ fn print_report(r: &CheckReport) {
     }
     let sampled = r.states.compared > 0;
     for c in r.comparisons.iter().filter(|_| sampled) {
+        // NaN: `b` was not finite at a state where `a` was (the note says more).
+        let residual = if c.max_rel_residual.is_nan() {
+            "not finite".to_string()
+        } else {
+            format!("{:.2e}", num(c.max_rel_residual))
+        };
         outln!(
-            "{} {} vs {}: max relative difference of q'' {:.2e} over {} states; symbolically equal: {}",
+            "{} {} vs {}: max relative difference of q'' {residual} over {} states; symbolically equal: {}",
             mark(c.max_rel_residual <= TOLERANCE),
             c.a,
             c.b,
-            num(c.max_rel_residual),
             c.states,
             match c.symbolic_equal {
                 Some(true) => "yes",

@@ -37,7 +37,8 @@ pub struct Comparison {
     pub a: &'static str,
     /// Second formulation.
     pub b: &'static str,
-    /// Largest `|q̈_a − q̈_b| / max(1, |q̈|)` over the random states.
+    /// Largest `|q̈_a − q̈_b| / max(1, |q̈|)` over the random states: infinite where `b`'s
+    /// `M′` is singular, NaN where `b` is not finite at a state where `a` is (a failure).
     pub max_rel_residual: f64,
     /// Whether `M_a − M_b` and `F_a − F_b` simplify to zero after expansion; `None` where
     /// the rows are not expected to match (user balances are combinations of the equations).
@@ -353,8 +354,15 @@ pub fn check_model(
     });
     for c in &comparisons {
         if c.max_rel_residual.is_nan() || c.max_rel_residual > 1e-8 {
-            let singular = !c.max_rel_residual.is_finite();
-            if c.b == UserBalances.name() {
+            let singular = c.max_rel_residual.is_infinite();
+            if c.max_rel_residual.is_nan() {
+                let which = if c.b == UserBalances.name() {
+                    "the balances"
+                } else {
+                    "the equations of motion written by hand"
+                };
+                notes.push(format!("{which} are not finite at some of the states where Lagrange's are (a function outside its domain, such as sqrt or asin, or an overflow)"));
+            } else if c.b == UserBalances.name() {
                 notes.push(if singular {
                     "the balances are not independent: their M′ is singular".to_string()
                 } else if moving_h_dot {
@@ -399,7 +407,8 @@ pub fn check_model(
 #[derive(Debug, Clone, PartialEq)]
 struct Sampled {
     /// Per other derivation, the largest `|q̈_L − q̈_other|` relative to the largest `|q̈|` of
-    /// the state, or to 1 if that is smaller (infinite where its `M′` is singular).
+    /// the state, or to 1 if that is smaller (infinite where its `M′` is singular, NaN where
+    /// its `M′` or `F′` is not finite at a compared state).
     max_rel: Vec<f64>,
     /// The largest `|dE/dt − Σ Qᵢ q̇ᵢ|` along Lagrange's q̈, relative to the largest of
     /// `|dE/dt|`, `|Σ Qᵢ q̇ᵢ|` and `Σ |Fᵢ q̇ᵢ|`.
@@ -490,13 +499,16 @@ fn sample_states(
         sampled.compared += 1;
         for (k, worst) in max_rel.iter_mut().enumerate() {
             let base = lagrange_len + k * (nn + n);
+            // The other derivation not finite where Lagrange's is (a function outside its
+            // domain) is a disagreement, not a state to skip: NaN, kept (`max` would drop it).
+            if worst.is_nan() || !v[base..base + nn + n].iter().all(|x| x.is_finite()) {
+                *worst = f64::NAN;
+                continue;
+            }
             match solve(
                 v[base..base + nn].to_vec(),
                 v[base + nn..base + nn + n].to_vec(),
             ) {
-                // A non-finite q̈ of the other derivation where Lagrange's is finite (its `F′`
-                // outside a function's domain) is a disagreement, not a state to skip: `max`
-                // would drop the NaN.
                 Some(other) if other.iter().any(|x| !x.is_finite()) => *worst = f64::INFINITY,
                 Some(other) => {
                     let scale = qdd.iter().chain(&other).fold(1.0f64, |m, x| m.max(x.abs()));
