@@ -782,8 +782,15 @@ fn issue_28_stability_tolerance_has_a_meaningful_range() {
         },
         ..Default::default()
     };
-    for (st, tol) in [(1e9, 1e-12), (0.0, 1e-12), (1e-7, 1e-12), (0.2, 1e-12), (1e-4, 1e-6)] {
-        let refused = eomgen::vibration::floquet_at_equilibrium(pendulum.as_mut(), &options(st, tol));
+    for (st, tol) in [
+        (1e9, 1e-12),
+        (0.0, 1e-12),
+        (1e-7, 1e-12),
+        (0.2, 1e-12),
+        (1e-4, 1e-6),
+    ] {
+        let refused =
+            eomgen::vibration::floquet_at_equilibrium(pendulum.as_mut(), &options(st, tol));
         assert!(
             matches!(
                 refused,
@@ -801,11 +808,19 @@ fn issue_28_stability_tolerance_has_a_meaningful_range() {
         assert_eq!(point.floquet.stability, FloquetStability::Marginal, "{st}");
     }
     for st in ["1e9", "0", "1e-7", "0.5"] {
-        let out = eomgen(&["study", "floquet", "mathieu_pendulum", "--stability-tolerance", st]);
+        let out = eomgen(&[
+            "study",
+            "floquet",
+            "mathieu_pendulum",
+            "--stability-tolerance",
+            st,
+        ]);
         let err = String::from_utf8_lossy(&out.stderr);
         assert_eq!(out.status.code(), Some(2), "{st}: {err}");
         assert!(
-            err.contains("--stability-tolerance: the stability tolerance must be in [1.000e-6, 0.1]"),
+            err.contains(
+                "--stability-tolerance: the stability tolerance must be in [1.000e-6, 0.1]"
+            ),
             "{st}: {err}"
         );
     }

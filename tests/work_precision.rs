@@ -480,7 +480,16 @@ fn issue_28_a_study_that_measured_nothing_is_a_failure() {
     assert_eq!(out.status.code(), Some(1));
     let v: Value = serde_json::from_slice(&out.stdout).expect("JSON");
     for m in v["methods"].as_array().unwrap() {
-        assert!(m["position_error_m"].is_null() && m["max_constraint_drift"].is_null(), "{m}");
-        assert!(m["error"].as_str().unwrap().contains("smallest usable step"), "{m}");
+        assert!(
+            m["position_error_m"].is_null() && m["max_constraint_drift"].is_null(),
+            "{m}"
+        );
+        assert!(
+            m["error"]
+                .as_str()
+                .unwrap()
+                .contains("smallest usable step"),
+            "{m}"
+        );
     }
 }

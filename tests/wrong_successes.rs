@@ -273,7 +273,10 @@ fn negative_numbers_reach_the_options_checks() {
 fn issue_28_a_check_over_no_state_is_never_a_pass() {
     let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/wrong");
     for (file, why) in [
-        ("sqrt_outside_domain.yaml", "200 had a non-finite Lagrange M or F"),
+        (
+            "sqrt_outside_domain.yaml",
+            "200 had a non-finite Lagrange M or F",
+        ),
         ("massless_coordinate.yaml", "200 had a singular Lagrange M"),
     ] {
         let path = format!("{dir}/{file}");
@@ -298,7 +301,13 @@ fn issue_28_a_check_over_no_state_is_never_a_pass() {
 
     let out_dir = std::env::temp_dir().join(format!("eomgen-no-state-{}", std::process::id()));
     let models = format!("{dir}/sqrt_outside_domain.yaml,{dir}/massless_coordinate.yaml");
-    let out = eomgen(&["report", "--models", &models, "-o", out_dir.to_str().unwrap()]);
+    let out = eomgen(&[
+        "report",
+        "--models",
+        &models,
+        "-o",
+        out_dir.to_str().unwrap(),
+    ]);
     let err = stderr(&out);
     assert_eq!(out.status.code(), Some(1), "{err}");
     for model in ["sqrt_outside_domain", "massless_coordinate"] {
@@ -332,7 +341,9 @@ fn issue_28_baumgarte_gains_are_finite_and_non_negative() {
             "1",
         ])
     };
-    for gains in ["-10,-10", "-10,10", "10,-1", "nan,nan", "inf,1", "10", "1,2,3"] {
+    for gains in [
+        "-10,-10", "-10,10", "10,-1", "nan,nan", "inf,1", "10", "1,2,3",
+    ] {
         let out = run(gains);
         let err = stderr(&out);
         assert_eq!(out.status.code(), Some(2), "{gains}: {err}");

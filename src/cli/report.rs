@@ -112,15 +112,18 @@ pub fn run(args: &ReportArgs) -> Result<(), CliError> {
         })
         .collect();
     let index = args.out.join("index.html");
-    ReportRows(
+    // A report none of whose checks could be computed measured nothing: said first, above
+    // the failed checks with their reasons.
+    let nothing = ReportRows(
         reports
             .iter()
             .map(|r| (r.name.as_str(), r.checks.as_slice()))
             .collect(),
     )
     .check_measured()
-    .map_err(|e| CliError::failure(format!("{e} ({})", index.display())))?;
-    if failed.is_empty() {
+    .err()
+    .map_or(String::new(), |e| format!("{e}\n"));
+    if failed.is_empty() && nothing.is_empty() {
         super::output::errln!(
             "report: {} models, {total} checks, all passed: {}",
             reports.len(),
@@ -129,7 +132,7 @@ pub fn run(args: &ReportArgs) -> Result<(), CliError> {
         Ok(())
     } else {
         Err(CliError::failure(format!(
-            "{} of {total} checks failed ({}):\n  {}",
+            "{nothing}{} of {total} checks failed ({}):\n  {}",
             failed.len(),
             index.display(),
             failed.join("\n  ")

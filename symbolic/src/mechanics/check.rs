@@ -258,6 +258,8 @@ fn timed(model: &mut SymbolicModel, f: &dyn Formulation) -> (EquationsOfMotion, 
 
 /// Derives `file` by every applicable formulation and cross-checks them at `states` random
 /// states (q, q̇ in [−2, 2], t in [0, 5], parameters within ±10 % of their defaults, or in [0.1, 0.5] where the default is 0).
+/// A state is compared where Lagrange's `M` and `F` are finite and `M` is regular
+/// ([`CheckReport::states`]); a report that compared no state does not pass.
 ///
 /// # Errors
 /// The diagnostics of a model that does not lower.
