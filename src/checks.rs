@@ -14,7 +14,7 @@ use serde::Serialize;
 use crate::ModelSource;
 use crate::analysis::{Method, SimulationOptions, simulate};
 use crate::expressions::{evaluate, parameter_lookup, split_assignment};
-use eomgen_runtime::analysis::{EnergyDrift, constraint_drift, energy_drift};
+use eomgen_runtime::analysis::{EnergyDrift, RunTally, StudyRuns, constraint_drift, energy_drift};
 use eomgen_runtime::vibration::{
     EquilibriumStart, ModalAnalysis, ModalOptions, OperatingPointOptions, modal_analysis,
 };
@@ -39,6 +39,9 @@ pub const DEFAULT_T_END: f64 = 10.0;
 pub const DEFAULT_RTOL: f64 = 1e-12;
 /// Samples of a check's simulation (uniform in t, both ends included).
 pub const SAMPLES: usize = 1001;
+/// Expected periods a `period:` check integrates at least, when its file gives no `t_end:`
+/// (two zeros one period apart fit whatever the phase of the first, with a period to spare).
+pub const PERIODS_PER_RUN: f64 = 3.0;
 
 /// One row of a model's pass/fail table.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -58,6 +61,42 @@ pub struct CheckRow {
 }
 
 impl CheckRow {
+    /// Why the check failed, in words (`None` when it passed): the reason it could not be
+    /// computed, or the computed value against the expected one and the tolerance.
+    ///
+    /// # Examples
+    /// ```
+    /// use eomgen::checks::CheckRow;
+    ///
+    /// let row = CheckRow::compare("ω (rad/s)", Ok(3.2), 3.1, 1e-7);
+    /// assert_eq!(
+    ///     row.failure_reason().unwrap(),
+    ///     "computed 3.2, expected 3.1, |difference| 1.000e-1 > tolerance 1e-7 × max(1, |expected|)"
+    /// );
+    /// assert_eq!(CheckRow::compare("ω", Ok(3.1), 3.1, 1e-7).failure_reason(), None);
+    /// let row = CheckRow::compare("ω", Err("no equilibrium".into()), 1.0, 1.0);
+    /// assert_eq!(row.failure_reason().unwrap(), "not computed: no equilibrium");
+    /// ```
+    pub fn failure_reason(&self) -> Option<String> {
+        if self.passed {
+            return None;
+        }
+        Some(match (self.computed, &self.note) {
+            (_, Some(note)) => format!("not computed: {note}"),
+            (Some(c), None) if !c.is_finite() => format!("computed {c}, not a finite number"),
+            (Some(c), None) if self.expected.is_nan() => {
+                format!("computed {c}, but the expected value is undefined")
+            }
+            (Some(c), None) => format!(
+                "computed {c}, expected {}, |difference| {:.3e} > tolerance {:e} × max(1, |expected|)",
+                self.expected,
+                (c - self.expected).abs(),
+                self.tolerance
+            ),
+            (None, None) => "not computed".to_string(),
+        })
+    }
+
     /// Compares `computed` with `expected` (a failure to compute is a failed check, with
     /// its reason as the note).
     ///
@@ -230,14 +269,27 @@ pub fn derivation_checks(
     file: &ModelFile,
 ) -> Result<(Vec<CheckRow>, Vec<String>), Vec<Diagnostic>> {
     let r = check_model(file, DERIVATION_STATES, DERIVATION_SEED)?;
+    // A comparison over no state is never a pass: each of its rows fails with the reason.
+    let nothing_compared = r.states.nothing_compared();
+    let sampled = |value: f64| nothing_compared.clone().map_or(Ok(value), Err);
     let mut rows = Vec::new();
     for c in &r.comparisons {
+        let computed = sampled(c.max_rel_residual).and_then(|v| {
+            if v.is_nan() {
+                Err(format!(
+                    "{} is not finite at some of the states where {} is",
+                    c.b, c.a
+                ))
+            } else {
+                Ok(v)
+            }
+        });
         rows.push(CheckRow::compare(
             format!(
                 "derivations agree: {} vs {} (max relative q̈ difference)",
                 c.a, c.b
             ),
-            Ok(c.max_rel_residual),
+            computed,
             0.0,
             DERIVATION_TOLERANCE,
         ));
@@ -245,7 +297,17 @@ pub fn derivation_checks(
     if let Some(p) = &r.power_balance {
         rows.push(CheckRow::compare(
             "power balance dE/dt = Q·q̇ (max relative residual)",
-            Ok(p.max_rel_residual),
+            sampled(p.max_rel_residual),
+            0.0,
+            DERIVATION_TOLERANCE,
+        ));
+    }
+    if rows.is_empty()
+        && let Some(reason) = &nothing_compared
+    {
+        rows.push(CheckRow::compare(
+            "Lagrange's equations evaluated at random states",
+            Err(reason.clone()),
             0.0,
             DERIVATION_TOLERANCE,
         ));
@@ -469,7 +531,16 @@ pub fn motion_checks(
         checks.extend(modal_rows("damping_ratios", "", check, model, computed));
     }
     if let Some(check) = &file.checks.period {
-        let run = CheckRun::of(&check.run);
+        let mut run = CheckRun::of(&check.run);
+        // Without `t_end:`, long enough for two zeros a period apart whatever the phase of
+        // the first: at least PERIODS_PER_RUN expected periods.
+        if check.run.t_end.is_none()
+            && let Ok(period) = expected(&check.value, model)
+            && period.is_finite()
+            && period > 0.0
+        {
+            run.t_end = run.t_end.max(PERIODS_PER_RUN * period);
+        }
         let event = check.event.value.as_str();
         let computed = simulations.get(run).and_then(|s| {
             let times: Vec<f64> = s
@@ -608,6 +679,34 @@ impl ModelChecks {
     /// Whether every check passed.
     pub fn passed(&self) -> bool {
         self.rows.iter().all(|c| c.passed)
+    }
+}
+
+/// The checks of the models of one report (`eomgen report`), each model's name with its
+/// rows: a report none of whose checks could be computed measured nothing.
+pub struct ReportRows<'a>(pub Vec<(&'a str, &'a [CheckRow])>);
+
+/// Every row is a run: computed (whether it passed or not), or not computed with its reason.
+impl StudyRuns for ReportRows<'_> {
+    fn study(&self) -> &'static str {
+        "report"
+    }
+
+    fn tally(&self) -> RunTally {
+        let mut tally = RunTally::default();
+        for (model, rows) in &self.0 {
+            for row in *rows {
+                match row.computed {
+                    Some(_) => tally.measured(),
+                    None => tally.failed(format!(
+                        "{model}: {}: {}",
+                        row.check,
+                        row.note.as_deref().unwrap_or("not computed")
+                    )),
+                }
+            }
+        }
+        tally
     }
 }
 

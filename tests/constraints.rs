@@ -419,3 +419,80 @@ fn constraint_methods_start_from_the_consistent_state() {
         );
     }
 }
+
+/// Issue 28: Baumgarte's gains are checked where the run starts, in the library: a negative
+/// `α` (the residual of the Cartesian pendulum reached 8.4e34 over 10 s with α = β = −10) and
+/// a NaN are refused with a typed error before any integration; zero gains (no
+/// stabilisation) and the defaults pass.
+#[test]
+fn issue_28_baumgarte_gains_are_checked_by_simulate() {
+    use eomgen::StabilizationError;
+    use eomgen::analysis::{SimulationError, SimulationOptions, simulate};
+    for (alpha, beta) in [(-10.0, -10.0), (-1.0, 10.0), (10.0, -1.0), (f64::NAN, 1.0)] {
+        let mut m = model("simple_pendulum_cartesian");
+        let options = SimulationOptions {
+            t_end: 1.0,
+            stabilization: Stabilization::Baumgarte { alpha, beta },
+            ..SimulationOptions::default()
+        };
+        match simulate(m.as_mut(), &options) {
+            Err(SimulationError::InvalidStabilization(
+                StabilizationError::InvalidBaumgarteGains { .. },
+            )) => {}
+            other => panic!("α = {alpha}, β = {beta}: {other:?}"),
+        }
+    }
+    for (alpha, beta) in [(0.0, 0.0), (10.0, 10.0)] {
+        let mut m = model("simple_pendulum_cartesian");
+        let options = SimulationOptions {
+            t_end: 1.0,
+            stabilization: Stabilization::Baumgarte { alpha, beta },
+            ..SimulationOptions::default()
+        };
+        let run = simulate(m.as_mut(), &options).expect("runs");
+        assert!(run.failure.is_none());
+        let (position, _) = run.constraints.max_drift();
+        assert!(position < 1e-6, "α = {alpha}: {position}");
+    }
+    assert!(
+        Stabilization::Penalty {
+            stiffness: -1.0,
+            damping: 0.0
+        }
+        .validate()
+        .is_err()
+    );
+}
+
+/// Issue 28: `study constraint-methods two_masses_rod --tol 1e-320` failed every run (the
+/// step underflows at t = 0) and exited 0 with errors of 0.00: the study now says it measured
+/// nothing (`StudyRuns::check_measured`), the first failure as its reason; one run that
+/// measured something is enough.
+#[test]
+fn issue_28_constraint_methods_that_measured_nothing_fail() {
+    use eomgen::analysis::{ConstraintMethodsOptions, StudyRuns, constraint_methods};
+    let entry = models::find("two_masses_rod").expect("bundled");
+    let options = ConstraintMethodsOptions {
+        t_end: 1.0,
+        tol: 1e-320,
+        ..ConstraintMethodsOptions::default()
+    };
+    let study = constraint_methods(&mut || (entry.make)(), None, &options).expect("runs");
+    assert_eq!(study.rows.len(), 5);
+    assert!(study.rows.iter().all(|r| r.failure.is_some()), "{study:?}");
+    let nothing = study.check_measured().expect_err("measured nothing");
+    assert_eq!(nothing.failed, 5);
+    assert!(
+        nothing
+            .first_failure
+            .starts_with("I: stiff spring k = 1e2: the step size"),
+        "{nothing}"
+    );
+    let options = ConstraintMethodsOptions {
+        t_end: 1.0,
+        stiffness: vec![1e2],
+        ..ConstraintMethodsOptions::default()
+    };
+    let study = constraint_methods(&mut || (entry.make)(), None, &options).expect("runs");
+    assert!(study.check_measured().is_ok());
+}

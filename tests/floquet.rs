@@ -764,3 +764,116 @@ fn floquet_period_parameter_must_be_the_forcing_frequency() {
         "{err}"
     );
 }
+
+/// Issue 28: the tolerance on `|μ| = 1` had no range: `--stability-tolerance 1e9` called
+/// ρ = 1.64 "marginal", and 0 called a conservative system (multipliers on the unit circle
+/// only to the integration error) "asymptotically stable". It must lie in
+/// `[√max(rtol, atol), 0.1]` (`FloquetOptions::validate`): in the library a typed error, in
+/// the CLI a usage error (status 2); the ends of the range are accepted.
+#[test]
+fn issue_28_stability_tolerance_has_a_meaningful_range() {
+    let mut pendulum = model("mathieu_pendulum");
+    let options = |stability_tolerance: f64, tol: f64| eomgen::vibration::FloquetStudyOptions {
+        floquet: FloquetOptions {
+            rtol: tol,
+            atol: tol,
+            stability_tolerance,
+            ..FloquetOptions::default()
+        },
+        ..Default::default()
+    };
+    for (st, tol) in [
+        (1e9, 1e-12),
+        (0.0, 1e-12),
+        (1e-7, 1e-12),
+        (0.2, 1e-12),
+        (1e-4, 1e-6),
+    ] {
+        let refused =
+            eomgen::vibration::floquet_at_equilibrium(pendulum.as_mut(), &options(st, tol));
+        assert!(
+            matches!(
+                refused,
+                Err(eomgen::vibration::FloquetStudyError::Floquet(
+                    FloquetError::InvalidStabilityTolerance { .. }
+                ))
+            ),
+            "{st} at tol {tol}: {refused:?}"
+        );
+    }
+    for (st, tol) in [(1e-6, 1e-12), (0.1, 1e-12), (1e-3, 1e-6)] {
+        let point = eomgen::vibration::floquet_at_equilibrium(pendulum.as_mut(), &options(st, tol))
+            .unwrap_or_else(|e| panic!("{st} at tol {tol}: {e}"));
+        // Upright and shaken at the file's a, w: stable, on the unit circle.
+        assert_eq!(point.floquet.stability, FloquetStability::Marginal, "{st}");
+    }
+    for st in ["1e9", "0", "1e-7", "0.5"] {
+        let out = eomgen(&[
+            "study",
+            "floquet",
+            "mathieu_pendulum",
+            "--stability-tolerance",
+            st,
+        ]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{st}: {err}");
+        assert!(
+            err.contains(
+                "--stability-tolerance: the stability tolerance must be in [1.000e-6, 0.1]"
+            ),
+            "{st}: {err}"
+        );
+    }
+}
+
+/// Issue 28: a `--sweep` was refused when the model did not depend on t at the parameters'
+/// own values (the Mathieu pendulum with `a = 0`), although the swept values do. The time
+/// dependence is now checked at the swept values (the grid's corners, side middles and
+/// centre): the chart is drawn, the point at the own values analysed as a cell and marked as
+/// independent of t; a sweep none of whose values makes the model depend on t is still
+/// refused. A chart every cell of which failed measured nothing.
+#[test]
+fn issue_28_floquet_sweep_checks_time_dependence_at_the_swept_values() {
+    let out = eomgen_ok(&[
+        "study",
+        "floquet",
+        "mathieu_pendulum",
+        "--set",
+        "a=0",
+        "--sweep",
+        "a=0..0.3:4,w=40..60:3",
+        "--json",
+    ]);
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["time_dependent"], false, "{v}");
+    // Unshaken upright: unstable (ρ = e^{√(g/l) T}); shaken at a = 0.3, w ≥ 40: stable.
+    assert_eq!(v["stability"], "unstable");
+    let sweep = &v["sweep"];
+    assert_eq!(sweep["failures"].as_array().unwrap().len(), 0, "{sweep}");
+    assert_eq!(sweep["stability"][3][2], "marginal", "{sweep}");
+    assert_eq!(sweep["stability"][0][0], "unstable", "{sweep}");
+
+    let out = eomgen(&[
+        "study",
+        "floquet",
+        "mathieu_pendulum",
+        "--set",
+        "a=0",
+        "--sweep",
+        "g=9..10:2,w=40..60:3",
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(err.contains("does not depend on t"), "{err}");
+
+    use eomgen::analysis::StudyRuns;
+    use eomgen::vibration::{FloquetChart, SweepAxis};
+    let chart = FloquetChart {
+        x: SweepAxis::linear("a", 0.0, 0.1, 2).unwrap(),
+        y: SweepAxis::linear("w", 40.0, 40.0, 1).unwrap(),
+        cells: vec![vec![Err("no equilibrium".to_string())]; 2],
+    };
+    let nothing = chart.check_measured().expect_err("measured nothing");
+    assert_eq!(nothing.failed, 2);
+    assert_eq!(nothing.first_failure, "a = 0, w = 40: no equilibrium");
+}

@@ -592,3 +592,52 @@ fn checks_of_a_file_through_the_library() {
     assert!(energy.passed && energy.computed.unwrap() < 1e-9);
     assert_eq!(rows.iter().filter(|r| !r.passed).count(), 2);
 }
+
+/// Issue 28: `report` printed only the names of the failed checks on the terminal (the
+/// reasons were in report.json only). Each failed check is now printed with its reason: the
+/// computed value against the expected one and the tolerance, or why it was not computed.
+#[test]
+fn issue_28_failed_checks_are_printed_with_their_reasons() {
+    let dir = out_dir("reasons");
+    let fixture = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/fixtures/report_wrong_values.yaml"
+    );
+    let out = eomgen(&["report", "--models", fixture, "-o", dir.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(1));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains(
+            "compound_pendulum: natural_frequencies[1] at hanging (rad/s): computed 3.87298334620741"
+        ) && stderr.contains(
+            ", expected 4, |difference| 1.270e-1 > tolerance 1e-9 × max(1, |expected|)"
+        ),
+        "{stderr}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Issue 28: a `checks: period` longer than 10 s failed ("occurred 0 time(s) in 10 s")
+/// unless the file gave an undocumented `t_end:`. Without `t_end:` the check now integrates
+/// three expected periods: the 100 m pendulum of `tests/fixtures/long_period_pendulum.yaml`,
+/// period 4 √(l/g) K(1/√2) = 23.452395… s, is measured over 70.357 s to the check's 1e-9.
+#[test]
+fn issue_28_a_long_period_is_integrated_long_enough() {
+    let dir = out_dir("long-period");
+    let fixture = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/fixtures/long_period_pendulum.yaml"
+    );
+    report_ok(Some(fixture), &dir);
+    let report = read_json(&dir);
+    let rows = checks(&report, "long_period_pendulum");
+    let period = row(rows, "period between the last two `return` events", "row");
+    assert_eq!(period["passed"], true, "{period}");
+    assert!(
+        period["check"].as_str().unwrap().contains("70.357187 s"),
+        "{period}"
+    );
+    let expected = 4.0 * 10f64.sqrt() * 1.8540746773013719;
+    assert!((period["computed"].as_f64().unwrap() - expected).abs() < 1e-9 * expected);
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -377,3 +377,103 @@ fn bad_options_are_usage_errors() {
         assert!(out.stdout.is_empty(), "{args:?}");
     }
 }
+
+/// Issue 28: `study work-precision double_pendulum --t-end 1e-320` exited 0 with a table of
+/// 0.00 errors: the reference moved less than its own tolerance, so no error could be
+/// measured. The library refuses it (`WorkPrecisionError::NoMotion`); the command refuses
+/// end times outside [1e-6, 1e6] s when it reads its options (`tests/wrong_successes.rs`).
+/// A study every run of which failed exits 1 with the first failure, and
+/// `study constraint-methods --tol 1e-320` (every run underflows at t = 0) prints `failed`
+/// in its error columns, never 0.00, and exits 1.
+#[test]
+fn issue_28_a_study_that_measured_nothing_is_a_failure() {
+    use eomgen::analysis::WorkPrecisionError;
+    let mut model = (eomgen::models::find("double_pendulum").unwrap().make)();
+    let options = WorkPrecisionOptions {
+        methods: vec![Method::Dp54],
+        tolerances: vec![1e-3],
+        t_end: 1e-320,
+        repeats: 1,
+        min_time_s: 0.0,
+        ..WorkPrecisionOptions::default()
+    };
+    let refused = work_precision(model.as_mut(), &options, &mut |_, _| {});
+    assert!(
+        matches!(refused, Err(WorkPrecisionError::NoMotion { .. })),
+        "{refused:?}"
+    );
+    // Every setting failing: RK4 in two steps of 5 s over 10 s of the double pendulum
+    // overflows.
+    let out = eomgen(&[
+        "study",
+        "work-precision",
+        "double_pendulum",
+        "--methods",
+        "rk4",
+        "--steps",
+        "2",
+        "--t-end",
+        "10",
+        "--repeats",
+        "1",
+        "--min-time-ms",
+        "0",
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(out.status.code(), Some(1), "{text}{err}");
+    assert!(
+        err.contains("work-precision: every run failed (1 of 1)")
+            && err.contains("the first failed: RK4 at h 5.000e0: component 2 of the right-hand side is not finite"),
+        "{err}"
+    );
+
+    let args = [
+        "study",
+        "constraint-methods",
+        "two_masses_rod",
+        "--tol",
+        "1e-320",
+        "--t-end",
+        "1",
+    ];
+    // The table has wall times, which differ between the bundled model and its file: run
+    // once, directly.
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_eomgen"))
+        .args(args)
+        .output()
+        .expect("runs");
+    let err = String::from_utf8_lossy(&out.stderr);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(out.status.code(), Some(1), "{text}{err}");
+    assert!(
+        err.contains("constraint-methods: every run failed (5 of 5)"),
+        "{err}"
+    );
+    let rows: Vec<&str> = text.lines().filter(|l| l.starts_with("I")).collect();
+    assert_eq!(rows.len(), 5, "{text}");
+    for line in rows {
+        let columns: Vec<&str> = line.split_whitespace().collect();
+        assert!(
+            columns.windows(2).any(|w| w == ["failed", "failed"]),
+            "{line}"
+        );
+        assert!(!line.contains("0.00 "), "{line}");
+    }
+    let out = eomgen(&[&args[..], &["--json"]].concat());
+    assert_eq!(out.status.code(), Some(1));
+    let v: Value = serde_json::from_slice(&out.stdout).expect("JSON");
+    for m in v["methods"].as_array().unwrap() {
+        assert!(
+            m["position_error_m"].is_null() && m["max_constraint_drift"].is_null(),
+            "{m}"
+        );
+        assert!(
+            m["error"]
+                .as_str()
+                .unwrap()
+                .contains("smallest usable step"),
+            "{m}"
+        );
+    }
+}

@@ -450,4 +450,95 @@ fn issue_28_values_starting_with_a_minus_reach_the_checks_and_numbers_print_shor
         "{}",
         stderr(&out)
     );
+/// Issue 28: `check` passed "over 0 states" (`"passed": true`) when no random state could be
+/// compared — a grossly wrong hand equation of a model whose potential is outside `sqrt`'s
+/// domain at every state drawn (`tests/wrong/sqrt_outside_domain.yaml`), and a constrained
+/// model with a coordinate of no inertia that cannot be simulated
+/// (`tests/wrong/massless_coordinate.yaml`); `report` counted both as passed. A check over no
+/// state now fails, in both commands, with the number of states drawn and why each was
+/// skipped, and prints no residual for it.
+#[test]
+fn issue_28_a_check_over_no_state_is_never_a_pass() {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/wrong");
+    for (file, why) in [
+        (
+            "sqrt_outside_domain.yaml",
+            "200 had a non-finite Lagrange M or F",
+        ),
+        ("massless_coordinate.yaml", "200 had a singular Lagrange M"),
+    ] {
+        let path = format!("{dir}/{file}");
+        let out = eomgen(&["check", &path]);
+        let err = stderr(&out);
+        assert_eq!(out.status.code(), Some(1), "{file}: {err}");
+        assert!(
+            err.contains("no state compared: of 200 random states") && err.contains(why),
+            "{file}: {err}"
+        );
+        let text = String::from_utf8_lossy(&out.stdout);
+        assert!(!text.contains("over 0 states"), "{file}: {text}");
+        let out = eomgen(&["check", &path, "--json"]);
+        assert_eq!(out.status.code(), Some(1), "{file}");
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        assert_eq!(v["passed"], false, "{v}");
+        assert_eq!(v["states"]["compared"], 0, "{v}");
+        assert_eq!(v["states"]["drawn"], 200, "{v}");
+        assert!(v["failure"].as_str().unwrap().contains(why), "{v}");
+        assert!(v["checks"][0]["max_rel_residual"].is_null(), "{v}");
+    }
+
+    let out_dir = std::env::temp_dir().join(format!("eomgen-no-state-{}", std::process::id()));
+    let models = format!("{dir}/sqrt_outside_domain.yaml,{dir}/massless_coordinate.yaml");
+    let out = eomgen(&[
+        "report",
+        "--models",
+        &models,
+        "-o",
+        out_dir.to_str().unwrap(),
+    ]);
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    for model in ["sqrt_outside_domain", "massless_coordinate"] {
+        assert!(
+            err.contains(&format!(
+                "{model}: derivations agree: lagrange vs momentum (max relative q̈ difference): not computed: no state compared"
+            )) || err.contains(&format!(
+                "{model}: derivations agree: lagrange vs by_hand (max relative q̈ difference): not computed: no state compared"
+            )),
+            "{model}: {err}"
+        );
+    }
+    let _ = std::fs::remove_dir_all(&out_dir);
+}
+
+/// Issue 28: negative Baumgarte gains were accepted (`--baumgarte -10 -10` took the pendulum's
+/// constraint residual to 8.4e34 with exit 0), `nan` was a failed computation rather than a
+/// usage error, and the documented `--baumgarte 10,10` was refused. Gains must be finite and
+/// ≥ 0 (status 2), and `ALPHA,BETA` is the syntax.
+#[test]
+fn issue_28_baumgarte_gains_are_finite_and_non_negative() {
+    let run = |gains: &str| {
+        eomgen(&[
+            "simulate",
+            "simple_pendulum_cartesian",
+            "--stabilization",
+            "baumgarte",
+            "--baumgarte",
+            gains,
+            "--t-end",
+            "1",
+        ])
+    };
+    for gains in [
+        "-10,-10", "-10,10", "10,-1", "nan,nan", "inf,1", "10", "1,2,3",
+    ] {
+        let out = run(gains);
+        let err = stderr(&out);
+        assert_eq!(out.status.code(), Some(2), "{gains}: {err}");
+        assert!(err.contains("--baumgarte"), "{gains}: {err}");
+    }
+    for gains in ["10,10", "0,0", "2.5,40"] {
+        let out = run(gains);
+        assert_eq!(out.status.code(), Some(0), "{gains}: {}", stderr(&out));
+    }
 }

@@ -75,11 +75,13 @@ pub enum Stabilization {
     None,
     /// Baumgarte's stabilisation (Baumgarte 1972, *Comput. Methods Appl. Mech. Eng.* 1):
     /// `Φ̈ + 2α Φ̇ + β² Φ = 0` replaces `Φ̈ = 0`, so the acceleration-level row becomes
-    /// `J q̈ = γ − 2α Φ̇ − β² Φ` (non-holonomic rows: `γ − 2α (A q̇ + b)`). `α`, `β` in 1/s.
+    /// `J q̈ = γ − 2α Φ̇ − β² Φ` (non-holonomic rows: `γ − 2α (A q̇ + b)`). `α`, `β` in 1/s,
+    /// finite and ≥ 0 ([`Stabilization::validate`]): the drift then decays as the motion of
+    /// a damped oscillator of natural frequency `β` and damping ratio `α/β`.
     Baumgarte {
-        /// Damping of the drift (1/s).
+        /// Damping of the drift (1/s), finite and ≥ 0.
         alpha: f64,
-        /// Stiffness of the drift (1/s).
+        /// Stiffness of the drift (1/s), finite and ≥ 0.
         beta: f64,
     },
     /// Projection after every accepted step (Hairer, Lubich & Wanner, *Geometric Numerical
@@ -100,6 +102,67 @@ pub enum Stabilization {
         /// Damping `c` on `Φ̇` (N·s/m for a length constraint).
         damping: f64,
     },
+}
+
+/// Why a [`Stabilization`] cannot be used.
+#[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum StabilizationError {
+    /// Baumgarte's `α` or `β` is negative or not finite. With `Φ̈ + 2α Φ̇ + β² Φ = 0` a
+    /// negative `α` makes the drift grow as `e^{−αt}` (a residual of 8.4e34 over a short
+    /// run), and a non-finite gain makes `γ̃` NaN; `β` enters squared, and is taken ≥ 0 as
+    /// Baumgarte writes it.
+    #[error(
+        "Baumgarte's gains must be finite and ≥ 0 (1/s; Φ̈ + 2α Φ̇ + β² Φ = 0, where a negative α makes the drift grow), got α = {alpha}, β = {beta}"
+    )]
+    InvalidBaumgarteGains {
+        /// The damping gain `α` given (1/s).
+        alpha: f64,
+        /// The stiffness gain `β` given (1/s).
+        beta: f64,
+    },
+    /// The penalty's stiffness is not finite and positive, or its damping not finite and
+    /// ≥ 0 (a negative spring pushes the constraint apart).
+    #[error(
+        "the constraint springs need a finite positive stiffness and a finite damping ≥ 0, got k = {stiffness}, c = {damping}"
+    )]
+    InvalidPenalty {
+        /// The stiffness `k` given.
+        stiffness: f64,
+        /// The damping `c` given.
+        damping: f64,
+    },
+}
+
+impl Stabilization {
+    /// Checks the gains: Baumgarte's `α`, `β` finite and ≥ 0; the penalty's stiffness finite
+    /// and positive, its damping finite and ≥ 0.
+    ///
+    /// # Errors
+    /// [`StabilizationError::InvalidBaumgarteGains`], [`StabilizationError::InvalidPenalty`].
+    ///
+    /// # Examples
+    /// ```
+    /// use eomgen_runtime::Stabilization;
+    /// assert!(Stabilization::Baumgarte { alpha: 10.0, beta: 10.0 }.validate().is_ok());
+    /// assert!(Stabilization::Baumgarte { alpha: 0.0, beta: 0.0 }.validate().is_ok());
+    /// assert!(Stabilization::Baumgarte { alpha: -10.0, beta: 10.0 }.validate().is_err());
+    /// assert!(Stabilization::Baumgarte { alpha: f64::NAN, beta: 1.0 }.validate().is_err());
+    /// ```
+    pub fn validate(self) -> Result<(), StabilizationError> {
+        let gain = |x: f64| x.is_finite() && x >= 0.0;
+        match self {
+            Stabilization::Baumgarte { alpha, beta } if !(gain(alpha) && gain(beta)) => {
+                Err(StabilizationError::InvalidBaumgarteGains { alpha, beta })
+            }
+            Stabilization::Penalty { stiffness, damping }
+                if !(gain(stiffness) && stiffness > 0.0 && gain(damping)) =>
+            {
+                Err(StabilizationError::InvalidPenalty { stiffness, damping })
+            }
+            _ => Ok(()),
+        }
+    }
 }
 
 /// Scratch space of the constrained solve, sized for `n` coordinates and `m` constraints.

@@ -80,6 +80,21 @@ pub enum FloquetError {
         /// Its column.
         column: usize,
     },
+    /// The tolerance on `|μ| = 1` is outside
+    /// `[FloquetOptions::smallest_stability_tolerance(), LARGEST_STABILITY_TOLERANCE]`.
+    #[error(
+        "the stability tolerance must be in [{smallest:.3e}, {largest}], got {stability_tolerance}: below √tol = {smallest:.3e} the integration error (at tol = {tol:e}) decides between stable, marginal and unstable (an undamped system's multipliers lie on the unit circle only to that error), and above {largest} a growth of more than 10 % per period would be called marginal"
+    )]
+    InvalidStabilityTolerance {
+        /// The tolerance given.
+        stability_tolerance: f64,
+        /// The larger of the integration's `rtol` and `atol`.
+        tol: f64,
+        /// The smallest tolerance allowed, `√tol`.
+        smallest: f64,
+        /// The largest allowed, [`LARGEST_STABILITY_TOLERANCE`].
+        largest: f64,
+    },
     /// The eigenvalues of the monodromy matrix did not converge (Schur iteration limit).
     #[error("the eigenvalues of the monodromy matrix did not converge")]
     EigenvaluesDidNotConverge,
@@ -170,10 +185,60 @@ pub struct FloquetOptions {
     pub atol: f64,
     /// Most step attempts over one period (default: 1 000 000).
     pub max_steps: usize,
-    /// Tolerance `tol` on `|μ| = 1` in [`FloquetStability::of`] (default: 1e-6; the
+    /// Tolerance `tol` on `|μ| = 1` in [`FloquetStability::of`], in
+    /// `[√max(rtol, atol), 0.1]` ([`FloquetOptions::validate`]) (default: 1e-6; the
     /// multipliers of a matrix integrated to 1e-12 are accurate to about 1e-10 away from a
     /// stability boundary, and to about `√1e-12 = 1e-6` at a double multiplier on it).
     pub stability_tolerance: f64,
+}
+
+/// The largest tolerance on `|μ| = 1`: a spectral radius of 1.1, a growth of 10 % per
+/// period, is instability, not a margin of the computation.
+pub const LARGEST_STABILITY_TOLERANCE: f64 = 0.1;
+
+impl FloquetOptions {
+    /// The smallest tolerance on `|μ| = 1` the integration supports: `√max(rtol, atol)`.
+    ///
+    /// The multipliers of an undamped (Hamiltonian) system lie on the unit circle, as pairs
+    /// `μ, 1/μ`, only up to the integration's error. Away from a stability boundary that
+    /// error in `|μ|` is about the tolerance; at a boundary the two multipliers of a pair
+    /// meet in a double multiplier, whose computed value moves by the square root of the
+    /// perturbation of the matrix (a 2 × 2 Jordan block perturbed by `δ` has eigenvalues
+    /// `±√δ` apart). A tolerance below `√tol` would let the integration error decide whether
+    /// a conservative system is called asymptotically stable, marginal or unstable.
+    pub fn smallest_stability_tolerance(&self) -> f64 {
+        self.rtol.max(self.atol).sqrt()
+    }
+
+    /// Checks that the tolerance on `|μ| = 1` is in
+    /// `[self.smallest_stability_tolerance(), LARGEST_STABILITY_TOLERANCE]`.
+    ///
+    /// # Errors
+    /// [`FloquetError::InvalidStabilityTolerance`].
+    ///
+    /// # Examples
+    /// ```
+    /// use eomgen_runtime::FloquetOptions;
+    /// assert!(FloquetOptions::default().validate().is_ok()); // 1e-6 = √1e-12
+    /// for bad in [0.0, 1e-9, 1e9, f64::NAN] {
+    ///     let options = FloquetOptions { stability_tolerance: bad, ..FloquetOptions::default() };
+    ///     assert!(options.validate().is_err(), "{bad}");
+    /// }
+    /// ```
+    pub fn validate(&self) -> Result<(), FloquetError> {
+        let smallest = self.smallest_stability_tolerance();
+        let tol = self.stability_tolerance;
+        if (smallest..=LARGEST_STABILITY_TOLERANCE).contains(&tol) {
+            Ok(())
+        } else {
+            Err(FloquetError::InvalidStabilityTolerance {
+                stability_tolerance: tol,
+                tol: self.rtol.max(self.atol),
+                smallest,
+                largest: LARGEST_STABILITY_TOLERANCE,
+            })
+        }
+    }
 }
 
 impl Default for FloquetOptions {
@@ -283,6 +348,7 @@ impl OdeSystem for Variational<'_> {
 /// and exponents.
 ///
 /// # Errors
+/// [`FloquetError::InvalidStabilityTolerance`] ([`FloquetOptions::validate`]),
 /// [`FloquetError::InvalidPeriod`], [`FloquetError::DimensionMismatch`],
 /// [`FloquetError::JacobianUnavailable`], [`FloquetError::IntegrationFailed`] (with the time
 /// it stopped), [`FloquetError::NonFinite`], [`FloquetError::EigenvaluesDidNotConverge`].
@@ -318,6 +384,7 @@ pub fn floquet_analysis(
     period: f64,
     options: &FloquetOptions,
 ) -> Result<FloquetAnalysis, FloquetError> {
+    options.validate()?;
     let (monodromy_matrix, y_end, stats) = monodromy_matrix(system, y0, t0, period, options)?;
     let closure_error = y_end
         .iter()

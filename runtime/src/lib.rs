@@ -22,12 +22,14 @@ pub mod system;
 pub mod vibration;
 
 pub use analysis::{Method, UnknownMethod};
-pub use constrained::{ConstraintFunctions, ConstraintWorkspace, ProjectionError, Stabilization};
+pub use constrained::{
+    ConstraintFunctions, ConstraintWorkspace, ProjectionError, Stabilization, StabilizationError,
+};
 pub use dynamic::{DynMechanicalSystem, StaticSystem};
 pub use first_order::{DynFirstOrder, FirstOrder};
 pub use floquet::{
-    FloquetAnalysis, FloquetError, FloquetOptions, FloquetStability, check_periodic_equilibrium,
-    floquet_analysis, floquet_multipliers, monodromy_matrix,
+    FloquetAnalysis, FloquetError, FloquetOptions, FloquetStability, LARGEST_STABILITY_TOLERANCE,
+    check_periodic_equilibrium, floquet_analysis, floquet_multipliers, monodromy_matrix,
 };
 pub use frf::{
     ForcedLinearization, FrequencySweep, FrfError, HarmonicForcing, ModalResponse, PeakAmplitude,

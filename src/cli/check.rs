@@ -46,6 +46,11 @@ pub fn run(args: &CheckArgs) -> Result<(), CliError> {
     }
     if report.passed(TOLERANCE) {
         Ok(())
+    } else if let Some(reason) = report.states.nothing_compared() {
+        Err(CliError::failure(format!(
+            "`{}` failed: {reason}",
+            report.model
+        )))
     } else {
         Err(CliError::failure(format!(
             "`{}` failed a check (tolerance {TOLERANCE:e})",
@@ -70,13 +75,17 @@ fn to_json(r: &CheckReport, timing: bool) -> serde_json::Value {
             )
         })
         .collect();
+    let sampled = r.states.compared > 0;
     json!({
         "model": r.model,
         "tolerance": TOLERANCE,
+        "failure": r.states.nothing_compared(),
         "passed": r.passed(TOLERANCE),
-        "checks": r.comparisons.iter().map(|c| json!({"a": c.a, "b": c.b, "max_rel_residual": c.max_rel_residual, "symbolic_equal": c.symbolic_equal, "states": c.states})).collect::<Vec<_>>(),
-        "power_balance": r.power_balance.as_ref().map(|p| json!({"max_rel_residual": p.max_rel_residual})),
+        // A residual over no state is null, not 0.
+        "checks": r.comparisons.iter().map(|c| json!({"a": c.a, "b": c.b, "max_rel_residual": sampled.then_some(c.max_rel_residual), "symbolic_equal": c.symbolic_equal, "states": c.states})).collect::<Vec<_>>(),
+        "power_balance": r.power_balance.as_ref().map(|p| json!({"max_rel_residual": sampled.then_some(p.max_rel_residual)})),
         "initial_constraints": r.initial_constraints.as_ref().map(|c| json!({"constraint": c.constraint, "residual": c.residual, "velocity": c.velocity, "tolerance": INITIAL_CONSTRAINT_TOLERANCE, "passed": c.passed()})),
+        "states": {"drawn": r.states.drawn, "compared": r.states.compared, "not_finite": r.states.not_finite, "singular": r.states.singular},
         "derivation": derivation,
         "notes": r.notes,
     })
@@ -85,13 +94,29 @@ fn to_json(r: &CheckReport, timing: bool) -> serde_json::Value {
 fn print_report(r: &CheckReport) {
     let mark = |ok: bool| if ok { "ok  " } else { "FAIL" };
     outln!("model {}", r.model);
-    for c in &r.comparisons {
+    if let Some(reason) = r.states.nothing_compared() {
+        // A residual over no state measured nothing: no 0.00 for it.
+        outln!("FAIL {reason}");
+        for c in &r.comparisons {
+            outln!("FAIL {} vs {}: not compared", c.a, c.b);
+        }
+        if r.power_balance.is_some() {
+            outln!("FAIL power balance dE/dt = Q·q': not compared");
+        }
+    }
+    let sampled = r.states.compared > 0;
+    for c in r.comparisons.iter().filter(|_| sampled) {
+        // NaN: `b` was not finite at a state where `a` was (the note says more).
+        let residual = if c.max_rel_residual.is_nan() {
+            "not finite".to_string()
+        } else {
+            format!("{:.2e}", num(c.max_rel_residual))
+        };
         outln!(
-            "{} {} vs {}: max relative difference of q'' {:.2e} over {} states; symbolically equal: {}",
+            "{} {} vs {}: max relative difference of q'' {residual} over {} states; symbolically equal: {}",
             mark(c.max_rel_residual <= TOLERANCE),
             c.a,
             c.b,
-            num(c.max_rel_residual),
             c.states,
             match c.symbolic_equal {
                 Some(true) => "yes",
@@ -100,7 +125,7 @@ fn print_report(r: &CheckReport) {
             }
         );
     }
-    if let Some(p) = &r.power_balance {
+    if let Some(p) = r.power_balance.as_ref().filter(|_| sampled) {
         outln!(
             "{} power balance dE/dt = Q·q': max relative residual {:.2e}",
             mark(p.max_rel_residual <= TOLERANCE),

@@ -13,10 +13,14 @@ use std::f64::consts::TAU;
 use std::io::Write as _;
 
 use clap::Args;
-use eomgen::vibration::{self, FloquetPoint, FloquetStudyError, FloquetStudyOptions, SweepAxis};
+use eomgen::analysis::StudyRuns;
+use eomgen::vibration::{
+    self, FloquetCell, FloquetChart, FloquetPoint, FloquetStudyError, FloquetStudyOptions,
+    SweepAxis,
+};
 use eomgen::{
-    ChartAxis, FloquetAnalysis, FloquetOptions, FloquetReferences, FloquetStability, ModelInfo,
-    ThresholdPrediction,
+    ChartAxis, FloquetAnalysis, FloquetError, FloquetOptions, FloquetReferences, FloquetStability,
+    ModelInfo, ThresholdPrediction,
 };
 use plotters::prelude::*;
 use rayon::prelude::*;
@@ -100,22 +104,29 @@ pub fn run(args: &FloquetArgs) -> Result<(), CliError> {
         .as_deref()
         .map(|s| parse_sweep(s, model.as_ref()))
         .transpose()?;
-    let point =
-        vibration::floquet_at_equilibrium(model.as_mut(), &options).map_err(|e| match e {
-            FloquetStudyError::UnknownPeriodParameter { ref name, .. } => CliError::usage(format!(
-                "--period-parameter {name}: {e}; name the forcing frequency w (rad/s), T = 2π/w"
-            )),
-            FloquetStudyError::InvalidTolerance { .. } => {
-                CliError::usage("--tol must be positive and --stability-tolerance finite and >= 0")
-            }
-            FloquetStudyError::OperatingPoint(e) => super::modes::point_failure(model.as_ref(), &e),
-            e => CliError::failure(format!(
-                "`{}` at {label}: {}",
-                model.name(),
-                analysis_text(model.as_ref(), &e)
-            )),
-        })?;
-    let sweep = match &axes {
+    // With a sweep, the model must depend on t at swept values, not necessarily at its own.
+    let point = match &axes {
+        Some((x, y)) => {
+            vibration::floquet_at_equilibrium_for_sweep(model.as_mut(), &options, [x, y])
+        }
+        None => vibration::floquet_at_equilibrium(model.as_mut(), &options),
+    }
+    .map_err(|e| match e {
+        FloquetStudyError::UnknownPeriodParameter { ref name, .. } => CliError::usage(format!(
+            "--period-parameter {name}: {e}; name the forcing frequency w (rad/s), T = 2π/w"
+        )),
+        FloquetStudyError::InvalidTolerance { .. } => CliError::usage(format!("--tol: {e}")),
+        FloquetStudyError::Floquet(e @ FloquetError::InvalidStabilityTolerance { .. }) => {
+            CliError::usage(format!("--stability-tolerance: {e}"))
+        }
+        FloquetStudyError::OperatingPoint(e) => super::modes::point_failure(model.as_ref(), &e),
+        e => CliError::failure(format!(
+            "`{}` at {label}: {}",
+            model.name(),
+            analysis_text(model.as_ref(), &e)
+        )),
+    })?;
+    let sweep = match axes {
         Some((x, y)) => Some(run_sweep(args, &guess, x, y, &options)?),
         None => None,
     };
@@ -127,8 +138,8 @@ pub fn run(args: &FloquetArgs) -> Result<(), CliError> {
         .unwrap_or_default();
 
     if let Some(path) = &args.plot {
-        match (&axes, &sweep) {
-            (Some((x, y)), Some(grid)) => {
+        match &sweep {
+            Some(FloquetChart { x, y, cells: grid }) => {
                 let title = format!(
                     "{} at {label}: Floquet stability over {} and {}",
                     model.name(),
@@ -156,20 +167,23 @@ pub fn run(args: &FloquetArgs) -> Result<(), CliError> {
         label: &label,
         point: &point,
         thresholds: &thresholds,
-        sweep: match (&axes, &sweep) {
-            (Some((x, y)), Some(grid)) => Some((x, y, grid.as_slice())),
-            _ => None,
-        },
+        sweep: sweep.as_ref(),
     };
     let mut stdout = super::output::stdout();
     if args.json {
         let text = serde_json::to_string_pretty(&json_report(&report))
             .map_err(|e| CliError::failure(e.to_string()))?;
         let _ = writeln!(stdout, "{text}");
-        return Ok(());
+    } else {
+        print_report(&mut stdout, &report);
     }
-    print_report(&mut stdout, &report);
-    Ok(())
+    // A chart every cell of which failed measured nothing.
+    match &sweep {
+        Some(chart) => chart
+            .check_measured()
+            .map_err(|e| CliError::failure(e.to_string())),
+        None => Ok(()),
+    }
 }
 
 /// What `study floquet` prints.
@@ -179,7 +193,7 @@ struct Report<'a> {
     label: &'a str,
     point: &'a FloquetPoint,
     thresholds: &'a [ThresholdPrediction],
-    sweep: Option<(&'a Axis, &'a Axis, &'a [Vec<Cell>])>,
+    sweep: Option<&'a FloquetChart>,
 }
 
 /// The JSON of `report`.
@@ -216,8 +230,9 @@ fn json_report(report: &Report<'_>) -> Value {
         prediction.insert(format!("predicts_stable_{label}"), json!(t.predicts_stable));
         out[t.name.as_str()] = Value::Object(prediction);
     }
-    if let Some((x, y, grid)) = report.sweep {
-        out["sweep"] = sweep_json(x, y, grid);
+    out["time_dependent"] = json!(point.time_dependent);
+    if let Some(chart) = report.sweep {
+        out["sweep"] = sweep_json(&chart.x, &chart.y, &chart.cells);
     }
     out
 }
@@ -305,13 +320,20 @@ fn print_report(stdout: &mut impl std::io::Write, report: &Report<'_>) {
             t.note
         );
     }
-    if let Some((x, y, grid)) = sweep {
-        print_map(stdout, x, y, grid);
+    if !point.time_dependent {
+        let _ = writeln!(
+            stdout,
+            "note         at these parameters the equations do not depend on t: the multipliers are those of the modes over T = 2π/{}; the chart's swept values do depend on t",
+            args.period_parameter
+        );
+    }
+    if let Some(chart) = sweep {
+        print_map(stdout, &chart.x, &chart.y, &chart.cells);
     }
 }
 
-/// One grid cell's outcome: `(spectral radius, stability)` or the failure.
-type Cell = Result<(f64, FloquetStability), String>;
+/// One grid cell's outcome: the cell or the failure.
+type Cell = Result<FloquetCell, String>;
 
 /// One swept parameter.
 type Axis = SweepAxis;
@@ -320,10 +342,10 @@ type Axis = SweepAxis;
 fn run_sweep(
     args: &FloquetArgs,
     guess: &[f64],
-    x: &Axis,
-    y: &Axis,
+    x: Axis,
+    y: Axis,
     options: &FloquetStudyOptions,
-) -> Result<Vec<Vec<Cell>>, CliError> {
+) -> Result<FloquetChart, CliError> {
     let source = super::open_model(&args.model)?;
     let total = x.values.len() * y.values.len();
     let bar = super::render::progress_bar(
@@ -344,7 +366,6 @@ fn run_sweep(
                     (y.name.as_str(), y.values[j]),
                 ];
                 vibration::floquet_cell(model.as_mut(), guess, &values, options)
-                    .map(|c| (c.spectral_radius, c.stability))
                     .map_err(|e| analysis_text(model.as_ref(), &e))
             })();
             bar.inc(1);
@@ -352,7 +373,8 @@ fn run_sweep(
         })
         .collect();
     bar.finish_and_clear();
-    Ok(flat.chunks(y.values.len()).map(<[Cell]>::to_vec).collect())
+    let cells = flat.chunks(y.values.len()).map(<[Cell]>::to_vec).collect();
+    Ok(FloquetChart { x, y, cells })
 }
 
 fn sweep_json(x: &Axis, y: &Axis, grid: &[Vec<Cell>]) -> Value {
@@ -360,7 +382,7 @@ fn sweep_json(x: &Axis, y: &Axis, grid: &[Vec<Cell>]) -> Value {
         .iter()
         .map(|col| {
             col.iter()
-                .map(|c| c.as_ref().map_or(Value::Null, |(r, _)| json!(r)))
+                .map(|c| c.as_ref().map_or(Value::Null, |c| json!(c.spectral_radius)))
                 .collect()
         })
         .collect();
@@ -368,7 +390,10 @@ fn sweep_json(x: &Axis, y: &Axis, grid: &[Vec<Cell>]) -> Value {
         .iter()
         .map(|col| {
             col.iter()
-                .map(|c| c.as_ref().map_or(Value::Null, |(_, s)| json!(s.as_str())))
+                .map(|c| {
+                    c.as_ref()
+                        .map_or(Value::Null, |c| json!(c.stability.as_str()))
+                })
                 .collect()
         })
         .collect();
@@ -385,7 +410,7 @@ fn sweep_json(x: &Axis, y: &Axis, grid: &[Vec<Cell>]) -> Value {
     let stable = grid
         .iter()
         .flatten()
-        .filter(|c| matches!(c, Ok((_, s)) if s.is_stable()))
+        .filter(|c| matches!(c, Ok(c) if c.stability.is_stable()))
         .count();
     json!({
         "x": {"name": x.name, "values": x.values},
@@ -406,7 +431,7 @@ fn print_map(out: &mut impl std::io::Write, x: &Axis, y: &Axis, grid: &[Vec<Cell
     let stable = grid
         .iter()
         .flatten()
-        .filter(|c| matches!(c, Ok((_, s)) if s.is_stable()))
+        .filter(|c| matches!(c, Ok(c) if c.stability.is_stable()))
         .count();
     let failed = grid.iter().flatten().filter(|c| c.is_err()).count();
     let (columns, rows) = (x.values.len(), y.values.len());
@@ -427,7 +452,7 @@ fn print_map(out: &mut impl std::io::Write, x: &Axis, y: &Axis, grid: &[Vec<Cell
         let row: String = grid
             .iter()
             .map(|col| match &col[j] {
-                Ok((_, s)) if s.is_stable() => '·',
+                Ok(c) if c.stability.is_stable() => '·',
                 Ok(_) => '#',
                 Err(_) => '?',
             })
@@ -580,7 +605,7 @@ where
         .iter()
         .flatten()
         .filter_map(|c| c.as_ref().ok())
-        .map(|(r, _)| r.log10())
+        .map(|c| c.spectral_radius.log10())
         .filter(|v| v.is_finite())
         .fold(0.0f64, f64::max)
         .max(1e-3);
@@ -621,18 +646,24 @@ where
         Ok::<(), String>(())
     };
     cells(
-        &|c| matches!(c, Ok((_, FloquetStability::AsymptoticallyStable))).then_some(stable_color),
+        &|c| {
+            matches!(c, Ok(c) if c.stability == FloquetStability::AsymptoticallyStable)
+                .then_some(stable_color)
+        },
         "asymptotically stable (ρ < 1)",
         stable_color,
     )?;
     cells(
-        &|c| matches!(c, Ok((_, FloquetStability::Marginal))).then_some(marginal_color),
+        &|c| {
+            matches!(c, Ok(c) if c.stability == FloquetStability::Marginal)
+                .then_some(marginal_color)
+        },
         "marginal (|μ| = 1 within tol): stable",
         marginal_color,
     )?;
     cells(
         &|c| match c {
-            Ok((rho, FloquetStability::Unstable)) => Some(unstable(*rho)),
+            Ok(c) if c.stability == FloquetStability::Unstable => Some(unstable(c.spectral_radius)),
             _ => None,
         },
         &format!("unstable, yellow→red with log₁₀ ρ up to {log_max:.2}"),

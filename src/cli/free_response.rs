@@ -8,6 +8,7 @@
 //! and the stacked charts.
 
 use clap::Args;
+use eomgen::analysis::StudyRuns;
 use eomgen::vibration::{
     self, FreeResponseMethod, FreeResponseOptions, FreeResponseStudy, InitialDeviation,
     ResponseStudyError,
@@ -229,6 +230,9 @@ pub fn run(args: &FreeResponseArgs) -> Result<(), CliError> {
     };
     let study = vibration::free_response(model.as_ref(), &options)
         .map_err(|e| study_failure(model.as_ref(), &e))?;
+    study
+        .check_measured()
+        .map_err(|e| CliError::failure(e.to_string()))?;
     let (label, responses) = (&study.operating_point.name, &study.responses);
     let n = model.num_dofs();
     let names = model.coordinate_names();

@@ -8,6 +8,7 @@ use std::io::Write as _;
 
 use clap::Args;
 use eomgen::ModelInfo;
+use eomgen::analysis::StudyRuns;
 use eomgen::vibration::{ModalDampingOptions, ModalDampingStudy, RayleighFit};
 use serde_json::json;
 
@@ -81,6 +82,9 @@ pub fn run(args: &ModalDampingArgs) -> Result<(), CliError> {
     };
     let study = eomgen::vibration::modal_damping_study(model.as_ref(), &options)
         .map_err(|e| study_failure(model.as_ref(), &e))?;
+    study
+        .check_measured()
+        .map_err(|e| CliError::failure(e.to_string()))?;
     let ModalDampingStudy {
         operating_point: point,
         rayleigh,

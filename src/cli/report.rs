@@ -24,7 +24,8 @@ use rayon::prelude::*;
 use serde_json::json;
 
 use eomgen::ModelInfo;
-use eomgen::checks::{DefaultRun, model_report};
+use eomgen::analysis::StudyRuns;
+use eomgen::checks::{DefaultRun, ReportRows, model_report};
 use eomgen::vibration::ModalAnalysis;
 use eomgen_symbolic::codegen::equations_mathml;
 use eomgen_symbolic::mechanics::{Formulation, Lagrange, SymbolicModel};
@@ -107,17 +108,29 @@ pub fn run(args: &ReportArgs) -> Result<(), CliError> {
         outln!("{text}");
     }
     let total: usize = reports.iter().map(|r| r.checks.len()).sum();
+    // Each failed check with its reason (not computed, or computed against expected).
     let failed: Vec<String> = reports
         .iter()
         .flat_map(|r| {
-            r.checks
-                .iter()
-                .filter(|c| !c.passed)
-                .map(move |c| format!("{}: {}", r.name, c.check))
+            r.checks.iter().filter_map(move |c| {
+                c.failure_reason()
+                    .map(|reason| format!("{}: {}: {reason}", r.name, c.check))
+            })
         })
         .collect();
     let index = args.out.join("index.html");
-    if failed.is_empty() {
+    // A report none of whose checks could be computed measured nothing: said first, above
+    // the failed checks with their reasons.
+    let nothing = ReportRows(
+        reports
+            .iter()
+            .map(|r| (r.name.as_str(), r.checks.as_slice()))
+            .collect(),
+    )
+    .check_measured()
+    .err()
+    .map_or(String::new(), |e| format!("{e}\n"));
+    if failed.is_empty() && nothing.is_empty() {
         super::output::errln!(
             "report: {} models, {total} checks, all passed: {}",
             reports.len(),
@@ -126,7 +139,7 @@ pub fn run(args: &ReportArgs) -> Result<(), CliError> {
         Ok(())
     } else {
         Err(CliError::failure(format!(
-            "{} of {total} checks failed ({}):\n  {}",
+            "{nothing}{} of {total} checks failed ({}):\n  {}",
             failed.len(),
             index.display(),
             failed.join("\n  ")

@@ -6,6 +6,7 @@ use std::f64::consts::E;
 use std::io::Write as _;
 
 use clap::Args;
+use eomgen::analysis::StudyRuns;
 use eomgen::analysis::roundoff::{
     EulerRoundoff, RoundoffError, RoundoffOptions, RoundoffRow, euler_roundoff,
 };
@@ -36,16 +37,20 @@ pub fn run(args: &EulerRoundoffArgs) -> Result<(), CliError> {
     Outputs::new()
         .chart("--plot", args.plot.as_deref())
         .check()?;
-    let EulerRoundoff {
-        rows,
-        summary: summaries,
-        notes,
-    } = euler_roundoff(&RoundoffOptions { max_n: args.max_n }).map_err(|e| match e {
+    let study = euler_roundoff(&RoundoffOptions { max_n: args.max_n }).map_err(|e| match e {
         RoundoffError::MaxNTooLarge { largest, .. } => CliError::usage(format!(
             "--max-n must be at most {largest} (10ⁿ steps per method)"
         )),
         other => CliError::failure(other.to_string()),
     })?;
+    study
+        .check_measured()
+        .map_err(|e| CliError::failure(e.to_string()))?;
+    let EulerRoundoff {
+        rows,
+        summary: summaries,
+        notes,
+    } = study;
 
     if let Some(path) = &args.plot {
         plot_errors(path, &rows)?;

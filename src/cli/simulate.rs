@@ -139,8 +139,8 @@ pub struct IntegrationArgs {
     /// constraints after every step). Ignored without constraints.
     #[arg(long, value_enum, default_value_t = StabilizationArg::None)]
     pub stabilization: StabilizationArg,
-    /// Baumgarte's α and β (1/s), `ALPHA,BETA`.
-    #[arg(long, value_delimiter = ',', num_args = 2, default_values_t = [10.0, 10.0])]
+    /// Baumgarte's α and β (1/s, finite and ≥ 0), `ALPHA,BETA`.
+    #[arg(long, value_name = "ALPHA,BETA", value_delimiter = ',', value_parser = super::values::baumgarte_gain, allow_hyphen_values = true, default_values_t = [10.0, 10.0])]
     pub baumgarte: Vec<f64>,
     /// Stop at the first zero of a function: a model event's name (`--stop-when lift_off`)
     /// or `EXPR` / `LHS = RHS`, optionally followed by `, rising`, `, falling` or `, both`
@@ -427,8 +427,21 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
 impl IntegrationArgs {
     /// The library's options of these arguments, sampled at `output`, from the initial state
     /// `y0`.
-    fn simulation_options(&self, output: OutputTimes, y0: Vec<f64>) -> SimulationOptions {
-        SimulationOptions {
+    ///
+    /// # Errors
+    /// A usage error when `--baumgarte` does not give exactly two gains.
+    fn simulation_options(
+        &self,
+        output: OutputTimes,
+        y0: Vec<f64>,
+    ) -> Result<SimulationOptions, CliError> {
+        let &[alpha, beta] = self.baumgarte.as_slice() else {
+            return Err(CliError::usage(format!(
+                "--baumgarte takes two gains ALPHA,BETA (1/s), got {}",
+                self.baumgarte.len()
+            )));
+        };
+        Ok(SimulationOptions {
             method: self.method,
             t_end: self.t_end,
             rtol: self.rtol,
@@ -437,14 +450,11 @@ impl IntegrationArgs {
             output,
             stabilization: match self.stabilization {
                 StabilizationArg::None => Stabilization::None,
-                StabilizationArg::Baumgarte => Stabilization::Baumgarte {
-                    alpha: self.baumgarte[0],
-                    beta: self.baumgarte[1],
-                },
+                StabilizationArg::Baumgarte => Stabilization::Baumgarte { alpha, beta },
                 StabilizationArg::Projection => Stabilization::Projection,
             },
             initial_state: Some(y0),
-        }
+        })
     }
 }
 
@@ -468,7 +478,7 @@ fn simulation(
     set_initial_values(model.as_ref(), &mut y0, &args.init).map_err(usage)?;
     let mut added =
         ExpressionEvents::parse(model.as_mut(), &args.stop_when, &args.event).map_err(usage)?;
-    let options = args.simulation_options(output, y0);
+    let options = args.simulation_options(output, y0)?;
     let added: Option<&mut dyn AddedEvents> = if added.is_empty() {
         None
     } else {
@@ -507,6 +517,7 @@ pub(crate) fn simulation_error(error: SimulationError) -> CliError {
             iterations,
             has_guesses,
         )),
+        SimulationError::InvalidStabilization(e) => CliError::usage(format!("--baumgarte: {e}")),
         other => CliError::usage(other.to_string()),
     }
 }

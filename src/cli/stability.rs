@@ -14,6 +14,7 @@
 use std::io::Write as _;
 
 use clap::Args;
+use eomgen::analysis::StudyRuns;
 use eomgen::analysis::stability::{
     AMPLIFICATION_STEPS, BISECTION_TOLERANCE, EnergyRow, ExplicitMethod, GROWTH_THRESHOLD, Limits,
     STIFF_OUTPUT_TIMES, STIFF_REFERENCE_TOL, StabilityError, StabilityOptions, StabilityStudy,
@@ -108,6 +109,9 @@ pub fn run(args: &StabilityArgs) -> Result<(), CliError> {
         })
         .check()?;
     let mut two_masses = find_model(STIFF_MODEL)?;
+    let study = stability_study(two_masses.as_mut(), &options).map_err(study_error)?;
+    // Printed in any case; a study that measured nothing then exits 1.
+    let measured = study.check_measured();
     let StabilityStudy {
         test,
         mut limits,
@@ -115,7 +119,7 @@ pub fn run(args: &StabilityArgs) -> Result<(), CliError> {
         stiff_modes: modes,
         stiff,
         underflow,
-    } = stability_study(two_masses.as_mut(), &options).map_err(study_error)?;
+    } = study;
 
     if let Some([limits_path, energy_path, stiff_path]) = &charts {
         plot_limits(limits_path, &mut limits.explicit)?;
@@ -153,7 +157,7 @@ pub fn run(args: &StabilityArgs) -> Result<(), CliError> {
         write_underflow(&mut text, &underflow);
         let _ = write!(super::output::stdout(), "{text}");
     }
-    Ok(())
+    measured.map_err(|e| CliError::failure(e.to_string()))
 }
 
 /// `PREFIX-name.svg`, or `.png` when the prefix ends in `.png` (a `.svg` ending is dropped).

@@ -7,7 +7,9 @@
 use std::io::Write as _;
 
 use clap::{Args, Subcommand};
-use eomgen::analysis::{ConstraintMethods, ConstraintMethodsError, ConstraintMethodsOptions};
+use eomgen::analysis::{
+    ConstraintMethods, ConstraintMethodsError, ConstraintMethodsOptions, StudyRuns,
+};
 use eomgen::studies::minimal_twin;
 use serde_json::json;
 
@@ -114,7 +116,8 @@ fn constraint_methods(args: &ConstraintMethodsArgs) -> Result<(), CliError> {
         reference_tol,
         agreement,
         rows,
-    } = study;
+    } = &study;
+    let (reference_tol, agreement) = (*reference_tol, *agreement);
 
     if let Some(path) = &args.plot {
         let series: Vec<plot::Series> = rows
@@ -145,10 +148,11 @@ fn constraint_methods(args: &ConstraintMethodsArgs) -> Result<(), CliError> {
             "t_end": args.t_end,
             "tol": args.tol,
             "reference": {"method": "dp54, DAE with Baumgarte α = β = 10/s", "tol": reference_tol, "agreement_with_unstabilised_dae_m": agreement},
+            // A failed run measured nothing: its error and drift are null, not 0.
             "methods": rows.iter().map(|r| json!({
                 "method": r.method,
-                "position_error_m": r.position_error,
-                "max_constraint_drift": r.drift,
+                "position_error_m": r.failure.is_none().then_some(r.position_error),
+                "max_constraint_drift": r.drift.filter(|_| r.failure.is_none()),
                 "rhs_evals": r.rhs_evals,
                 "steps": r.steps,
                 "wall_time_s": r.wall_time_s,
@@ -177,15 +181,23 @@ fn constraint_methods(args: &ConstraintMethodsArgs) -> Result<(), CliError> {
             "{:<44} {:>12} {:>12} {:>10} {:>8} {:>10}",
             "method", "pos. err (m)", "max |Φ|", "RHS evals", "steps", "time (ms)"
         );
-        for r in &rows {
-            let drift = r
-                .drift
-                .map_or("-".to_string(), |d| format!("{d:.2e}", d = num(d)));
+        for r in rows {
+            // A failed run measured nothing: `failed` in its error and drift columns, never
+            // the 0.00 of an empty run.
+            let (error, drift) = if r.failure.is_some() {
+                ("failed".to_string(), "failed".to_string())
+            } else {
+                (
+                    format!("{:.2e}", num(r.position_error)),
+                    r.drift
+                        .map_or("-".to_string(), |d| format!("{d:.2e}", d = num(d))),
+                )
+            };
             let _ = writeln!(
                 stdout,
-                "{:<44} {:>12.2e} {:>12} {:>10} {:>8} {:>10.3}{}",
+                "{:<44} {:>12} {:>12} {:>10} {:>8} {:>10.3}{}",
                 r.method,
-                num(r.position_error),
+                error,
                 drift,
                 r.rhs_evals,
                 r.steps,
@@ -196,5 +208,7 @@ fn constraint_methods(args: &ConstraintMethodsArgs) -> Result<(), CliError> {
             );
         }
     }
-    Ok(())
+    study
+        .check_measured()
+        .map_err(|e| CliError::failure(e.to_string()))
 }

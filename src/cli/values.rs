@@ -70,6 +70,16 @@ pub fn absolute_tolerance(text: &str) -> Result<f64, String> {
     )
 }
 
+/// Parses a gain of Baumgarte's stabilisation (`--baumgarte ALPHA,BETA`, 1/s): a finite
+/// number `≥ 0` (a negative α makes the constraint drift grow instead of decay).
+pub fn baumgarte_gain(text: &str) -> Result<f64, String> {
+    number(
+        text,
+        |v| v.is_finite() && v >= 0.0,
+        "a Baumgarte gain must be a finite number >= 0 (1/s), such as 10",
+    )
+}
+
 /// The stiffnesses `--stiffness` takes (N/m, or k/m in 1/s² for `study stability`): below
 /// 1e-6 a spring no longer holds anything on the studies' scales (masses and lengths of
 /// order 1), and above 1e10 its period (~6e-5 s for 1 kg) asks an explicit method for more

@@ -7,6 +7,7 @@ use std::io::Write;
 
 use clap::Args;
 use eomgen::ModelInfo;
+use eomgen::analysis::StudyRuns;
 use eomgen::analysis::work_precision::{
     AtTarget, DEFAULT_METHODS, MAX_REPEATS, Measured, MethodRuns, SMALLEST_TOLERANCE, Setting,
     SettingRun, WorkPrecision, WorkPrecisionError, WorkPrecisionOptions, decades, work_precision,
@@ -53,6 +54,7 @@ fn study_error(args: &WorkPrecisionArgs, error: WorkPrecisionError) -> CliError 
         e @ WorkPrecisionError::ReferenceNotVerified { .. } => CliError::failure(format!(
             "{e}; try a shorter --t-end, a larger --target-error or another --reference-tol"
         )),
+        e @ WorkPrecisionError::NoMotion { .. } => CliError::failure(e.to_string()),
         other => CliError::usage(other.to_string()),
     }
 }
@@ -254,17 +256,16 @@ pub fn run(args: &WorkPrecisionArgs) -> Result<(), CliError> {
     } else {
         study.write_text(&mut stdout)
     };
-    if study.report.every_run_failed() {
-        return Err(CliError::failure(format!(
-            "every run of the study failed, so it measured nothing (the reasons are in the table); try tolerances between 1e-3 and 1e-13{}",
+    study.report.check_measured().map_err(|e| {
+        CliError::failure(format!(
+            "{e}; try tolerances between 1e-3 and 1e-13{}",
             if args.steps.is_some() {
                 " or more steps"
             } else {
                 ""
             }
-        )));
-    }
-    Ok(())
+        ))
+    })
 }
 
 /// Everything the study measured, for the table and the JSON.

@@ -300,3 +300,47 @@ fn a_torque_on_the_second_body_enters_its_balances() {
     let r = residual(&report, "balances").expect("compared");
     assert!(r < 1e-9, "{r}: {:?}", report.notes);
 }
+
+/// Issue 28: a grossly wrong hand equation passed "over 0 states" when Lagrange's `F` was
+/// outside `sqrt`'s domain at every random state (`tests/wrong/sqrt_outside_domain.yaml`):
+/// a check over no state is never a pass, and it says how many states were drawn and why
+/// they were skipped. And a hand equation that is not finite where Lagrange's is (`asin` of
+/// a number below −1) was compared as agreeing, `max` dropping its NaN: it is now a failure
+/// with its own note.
+#[test]
+fn issue_28_no_state_compared_and_a_non_finite_hand_equation_fail() {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../tests/wrong/sqrt_outside_domain.yaml"
+    );
+    let report = check(&std::fs::read_to_string(path).unwrap());
+    assert_eq!(report.states.drawn, 20);
+    assert_eq!((report.states.compared, report.states.not_finite), (0, 20));
+    assert!(!report.passed(1e-8), "{report:?}");
+    let reason = report.states.nothing_compared().expect("a reason");
+    assert!(
+        reason.starts_with("no state compared: of 20 random states")
+            && reason.contains("20 had a non-finite Lagrange M or F"),
+        "{reason}"
+    );
+
+    // cos(asin(u))² + u² = 1 where |u| ≤ 1, NaN elsewhere: x/10 − 3 is below −2.8 at every
+    // state drawn (|x| ≤ 2), so the hand equation is NaN where Lagrange's is finite.
+    let undefined = "name: u\nparameters: { m: 1.0, k: 10.0 }\ncoordinates: [x]\nkinetic: m*x_dot^2/2\npotential: k*x^2/2\nchecks:\n  equations_of_motion:\n    - m*x_ddot = -k*x*(cos(asin(x/10 - 3))^2 + (x/10 - 3)^2)\ninitial: { x: 1 }\n";
+    let report = check(undefined);
+    assert_eq!(report.states.compared, 20);
+    assert!(residual(&report, "by_hand").unwrap().is_nan());
+    assert!(!report.passed(1e-8));
+    assert!(
+        report
+            .notes
+            .iter()
+            .any(|n| n.starts_with("the equations of motion written by hand are not finite")),
+        "{:?}",
+        report.notes
+    );
+    // Where the hand equation is defined (x/10 − 3 in [−1, 1], here u = x/10 with |u| ≤ 0.2)
+    // it is Lagrange's, and the check passes.
+    let defined = undefined.replace("x/10 - 3", "x/10");
+    assert!(check(&defined).passed(1e-8));
+}

@@ -16,6 +16,7 @@
 
 use serde::Serialize;
 
+use crate::analysis::outcome::{RunTally, StudyRuns};
 use crate::constrained::Stabilization;
 use crate::integrate::{
     DormandPrince54, IntegrationFailure, Integrator, IntegratorOptions, OutputTimes, Solution,
@@ -127,6 +128,22 @@ pub struct ConstraintMethods {
     pub rows: Vec<ConstraintMethodRow>,
 }
 
+/// Every method's run is a run of the study; the reference is not (it fails the study as a
+/// whole, [`ConstraintMethodsError::ReferenceFailed`]).
+impl StudyRuns for ConstraintMethods {
+    fn study(&self) -> &'static str {
+        "constraint-methods"
+    }
+
+    fn tally(&self) -> RunTally {
+        let mut tally = RunTally::default();
+        for row in &self.rows {
+            tally.add(row.failure.as_ref().map(|f| format!("{}: {f}", row.method)));
+        }
+        tally
+    }
+}
+
 fn integrate(
     model: &mut dyn ModelInfo,
     y0: &[f64],
@@ -227,6 +244,8 @@ fn row(
 /// [`ConstraintMethodsError::NoHolonomicConstraints`],
 /// [`ConstraintMethodsError::InvalidOptions`], [`ConstraintMethodsError::InvalidStiffness`],
 /// [`ConstraintMethodsError::InconsistentStart`], [`ConstraintMethodsError::ReferenceFailed`].
+/// A method whose run fails is a row with its failure; a study whose every run failed
+/// measured nothing ([`StudyRuns::check_measured`]).
 ///
 /// # Examples
 /// ```

@@ -3,13 +3,16 @@
 //! measures, simulation and the numerical studies.
 //!
 //! Every analysis is a function with a typed options struct, a `Serialize` report and a
-//! typed error, so that a front end only parses its input and renders the report.
+//! typed error, so that a front end only parses its input and renders the report. Every
+//! study's report implements [`StudyRuns`]: a study whose every run failed measured nothing,
+//! and [`StudyRuns::check_measured`] says so with the first failure's reason.
 
 pub mod constraint_methods;
 pub mod drift;
 pub mod failure;
 pub mod fixed_step;
 pub mod methods;
+pub mod outcome;
 pub mod roundoff;
 pub mod simulation;
 pub mod stability;
@@ -23,6 +26,7 @@ pub use drift::{ConstraintDrift, EnergyDrift, constraint_drift, energy_drift, en
 pub use failure::{FailureCause, failure_cause};
 pub use fixed_step::{ENERGY_DRIFT_LIMIT, SimulationWarning, fixed_step_warnings};
 pub use methods::{Method, UnknownMethod};
+pub use outcome::{NothingMeasured, RunTally, StudyRuns};
 pub use roundoff::{EulerRoundoff, RoundoffError, RoundoffOptions, euler_roundoff};
 pub use simulation::{
     AddedEvents, Simulation, SimulationError, SimulationOptions, simulate, simulate_with_events,

@@ -27,6 +27,7 @@ use std::f64::consts::E;
 
 use serde::Serialize;
 
+use crate::analysis::outcome::{RunTally, StudyRuns};
 use crate::integrate::stability::StabilityPolynomial;
 use crate::integrate::{
     ExplicitEuler, ExplicitMidpoint, Integrator, IntegratorOptions, OutputTimes, RungeKutta4,
@@ -81,6 +82,21 @@ pub struct EulerRoundoff {
     pub summary: Vec<RoundoffSummary>,
     /// What the figures show, in words that follow the figures.
     pub notes: Vec<String>,
+}
+
+/// Each method at each `h` is a run; a failed one fails the study as a whole
+/// ([`RoundoffError::Integration`]), so every run of a report measured something.
+impl StudyRuns for EulerRoundoff {
+    fn study(&self) -> &'static str {
+        "euler-roundoff"
+    }
+
+    fn tally(&self) -> RunTally {
+        RunTally {
+            measured: self.rows.iter().map(|r| r.runs.len()).sum(),
+            ..RunTally::default()
+        }
+    }
 }
 
 /// Runs HW1's round-off study (see the module docs): explicit Euler, explicit midpoint and

@@ -8,7 +8,7 @@ use crate::analysis::drift::{ConstraintDrift, EnergyDrift, constraint_drift, ene
 use crate::analysis::failure::{FailureCause, failure_cause};
 use crate::analysis::fixed_step::{ENERGY_DRIFT_LIMIT, SimulationWarning, fixed_step_warnings};
 use crate::analysis::methods::Method;
-use crate::constrained::{ProjectionError, Stabilization};
+use crate::constrained::{ProjectionError, Stabilization, StabilizationError};
 use crate::integrate::{
     EventSpec, IntegrationError, IntegrationFailure, IntegratorOptions, OutputTimes, Solution,
 };
@@ -132,6 +132,9 @@ pub enum SimulationError {
         /// them; otherwise the state had to satisfy the constraints as given).
         has_guesses: bool,
     },
+    /// The drift control's gains cannot be used (a negative Baumgarte gain).
+    #[error(transparent)]
+    InvalidStabilization(#[from] StabilizationError),
 }
 
 /// The result of [`simulate`]: the samples, the drift measures and the events, and the
@@ -222,10 +225,11 @@ pub fn simulate(
 /// `options.initial_state`, when given, has `2n` entries (`n = model.num_dofs()`).
 ///
 /// # Errors
-/// [`SimulationError::DimensionMismatch`] for an initial state of the wrong length,
-/// [`SimulationError::InconsistentInitialState`] when the constraints cannot be satisfied,
-/// [`SimulationError::InvalidEndTime`] for a `t_end` that is not a positive number (checked
-/// in this order).
+/// [`SimulationError::InvalidStabilization`] for unusable drift-control gains
+/// ([`Stabilization::validate`]), [`SimulationError::DimensionMismatch`] for an initial state
+/// of the wrong length, [`SimulationError::InconsistentInitialState`] when the constraints
+/// cannot be satisfied, [`SimulationError::InvalidEndTime`] for a `t_end` that is not a
+/// positive number (checked in this order).
 ///
 /// # Examples
 /// A pendulum released from the horizontal, stopped when it swings back (`q̇ = 0`, falling,
@@ -258,6 +262,7 @@ pub fn simulate_with_events(
     options: &SimulationOptions,
     added: Option<&mut dyn AddedEvents>,
 ) -> Result<Simulation, SimulationError> {
+    options.stabilization.validate()?;
     let mut y0 = match &options.initial_state {
         Some(y0) => y0.clone(),
         None => model.initial_state(),

@@ -28,6 +28,7 @@ use serde::Serialize;
 
 use crate::analysis::drift::energy_drift;
 use crate::analysis::methods::Method;
+use crate::analysis::outcome::{RunTally, StudyRuns};
 use crate::analysis::simulation::SimulationError;
 use crate::integrate::{IntegrationFailure, Integrator, IntegratorOptions, OutputTimes, Solution};
 use crate::model_info::ModelInfo;
@@ -172,6 +173,19 @@ pub enum WorkPrecisionError {
         rtol: f64,
         /// Why it failed.
         message: String,
+    },
+    /// The reference moves less than its own tolerance over `[0, t_end]`: every component
+    /// stays within `tol (1 + |y₀ᵢ|)` of its start (an end time of `1e-320` s, or a state at
+    /// rest at an equilibrium), so the reference cannot resolve any run's error, and every
+    /// run would report about 0.
+    #[error(
+        "the reference solution moves less than its tolerance {reference_tol:e} over 0 ≤ t ≤ {t_end:e} s (every component within tol·(1 + |y₀|) of its start): there is no motion whose error could be measured; choose a longer --t-end or a state that moves"
+    )]
+    NoMotion {
+        /// The end time (s).
+        t_end: f64,
+        /// The reference tolerance.
+        reference_tol: f64,
     },
     /// The reference and its check disagree by more than a hundredth of the target error.
     #[error(
@@ -392,14 +406,6 @@ impl WorkPrecision {
         m.error < 10.0 * self.agreement
     }
 
-    /// Whether no run of any method succeeded (every setting failed): the study measured
-    /// nothing, which a front end reports as a failure (`eomgen study work-precision` exits
-    /// 1), whatever table it prints.
-    pub fn every_run_failed(&self) -> bool {
-        let mut runs = self.results.iter().flat_map(|r| &r.runs).peekable();
-        runs.peek().is_some() && runs.all(|r| r.outcome.is_err())
-    }
-
     /// The number of runs whose error the reference does not resolve ([`Self::unresolved`]).
     pub fn num_unresolved(&self) -> usize {
         self.results
@@ -407,6 +413,32 @@ impl WorkPrecision {
             .flat_map(|r| &r.runs)
             .filter(|r| r.outcome.as_ref().is_ok_and(|m| self.unresolved(m)))
             .count()
+    }
+}
+
+/// Every setting of every method is a run; one that failed is counted with its message.
+impl StudyRuns for WorkPrecision {
+    fn study(&self) -> &'static str {
+        "work-precision"
+    }
+
+    fn tally(&self) -> RunTally {
+        let mut tally = RunTally::default();
+        for (method, run) in self
+            .results
+            .iter()
+            .flat_map(|r| r.runs.iter().map(move |run| (r.method, run)))
+        {
+            tally.add(run.outcome.as_ref().err().map(|f| {
+                format!(
+                    "{} at {}: {}",
+                    method.display_name(),
+                    run.setting.label(),
+                    f.message
+                )
+            }));
+        }
+        tally
     }
 }
 
@@ -604,7 +636,9 @@ impl Problem<'_> {
 /// [`WorkPrecisionError::InitialState`] when the initial state cannot be made consistent;
 /// [`WorkPrecisionError::ReferenceFailed`] and [`WorkPrecisionError::ReferenceNotVerified`]
 /// when the reference cannot be computed or its check does not agree with it to a hundredth
-/// of the target error. A method that fails at a setting is reported in its row.
+/// of the target error; [`WorkPrecisionError::NoMotion`] when the reference moves less than
+/// its tolerance. A method that fails at a setting is reported in its row; a study
+/// whose every run failed measured nothing ([`StudyRuns::check_measured`]).
 ///
 /// # Examples
 /// RK4 at 64…256 steps over 2 s of the pendulum: the error falls about 16× per halving of
@@ -677,6 +711,20 @@ pub fn work_precision(
     };
     let reference = solve(Method::Dop853, "the reference solution")?;
     let check = solve(Method::Dp54, "the check of the reference")?;
+    // The reference's own error is up to its tolerance per component (`atol + rtol |y|`):
+    // a motion within it leaves no error to resolve.
+    let tol = options.reference_tol;
+    let moves = reference.iter().any(|(_, y)| {
+        y.iter()
+            .zip(&problem.y0)
+            .any(|(a, b)| (a - b).abs() > tol * (1.0 + b.abs()))
+    });
+    if !moves {
+        return Err(WorkPrecisionError::NoMotion {
+            t_end: options.t_end,
+            reference_tol: tol,
+        });
+    }
     let agreement = state_error(&check, &reference);
     if agreement.is_nan() || agreement > options.target_error / 100.0 {
         return Err(WorkPrecisionError::ReferenceNotVerified {
@@ -786,14 +834,23 @@ mod tests {
                 })
                 .collect(),
         };
-        assert!(
-            study(vec![
-                vec![failed.clone()],
-                vec![failed.clone(), failed.clone()]
-            ])
-            .every_run_failed()
+        let nothing = study(vec![
+            vec![failed.clone()],
+            vec![failed.clone(), failed.clone()],
+        ])
+        .check_measured()
+        .unwrap_err();
+        assert_eq!(nothing.failed, 3);
+        assert_eq!(
+            nothing.first_failure,
+            "Dormand–Prince 5(4) at tol 1e-6: step size underflow"
         );
-        assert!(!study(vec![vec![failed.clone()], vec![failed, measured]]).every_run_failed());
+        assert!(
+            study(vec![vec![failed.clone()], vec![failed, measured]])
+                .check_measured()
+                .is_ok()
+        );
+        assert!(study(vec![]).check_measured().is_err());
     }
 
     #[test]

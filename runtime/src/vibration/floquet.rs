@@ -17,6 +17,7 @@ use std::f64::consts::TAU;
 use serde::Serialize;
 
 use super::operating_point::{OperatingPointError, OperatingPointOptions};
+use crate::analysis::outcome::{RunTally, StudyRuns};
 use crate::floquet::{
     FloquetAnalysis, FloquetError, FloquetOptions, FloquetStability, check_periodic_equilibrium,
     floquet_analysis,
@@ -39,15 +40,16 @@ pub enum FloquetStudyError {
         /// Its parameters, comma separated.
         parameters: String,
     },
-    /// A tolerance is out of range.
+    /// DOP853's tolerances are not finite and positive. (A tolerance on `|μ| = 1` out of its
+    /// range is [`FloquetError::InvalidStabilityTolerance`], in [`FloquetStudyError::Floquet`].)
     #[error(
-        "the tolerance must be positive ({rtol}) and the stability tolerance finite and ≥ 0 ({stability_tolerance})"
+        "the integration's tolerances must be finite and positive, got rtol = {rtol}, atol = {atol}"
     )]
     InvalidTolerance {
-        /// DOP853's tolerance.
+        /// DOP853's relative tolerance.
         rtol: f64,
-        /// The tolerance on `|μ| = 1`.
-        stability_tolerance: f64,
+        /// DOP853's absolute tolerance.
+        atol: f64,
     },
     /// A swept axis is malformed.
     #[error("need 1 ≤ N ≤ 10000 values and LO < HI, got {lo}..{hi}:{count}")]
@@ -144,6 +146,10 @@ pub struct FloquetPoint {
     pub frequency: f64,
     /// `max |F(q*, 0, t)|` over the period (units of the generalized forces).
     pub residual: f64,
+    /// Whether the equations depend on `t` at these parameters. Only the point that heads a
+    /// chart ([`floquet_at_equilibrium_for_sweep`]) and a chart's cells may be independent
+    /// of `t`; their multipliers are then those of the modes over `2π/w`.
+    pub time_dependent: bool,
     /// The monodromy matrix, multipliers, exponents, spectral radius and stability.
     pub floquet: FloquetAnalysis,
 }
@@ -161,19 +167,11 @@ fn check_options(
             parameters: model.parameter_names().join(", "),
         });
     }
-    let FloquetOptions {
-        rtol,
-        atol,
-        stability_tolerance,
-        ..
-    } = options.floquet;
-    let valid_tol = rtol.is_finite() && rtol > 0.0 && atol.is_finite() && atol > 0.0;
-    if !(valid_tol && stability_tolerance.is_finite() && stability_tolerance >= 0.0) {
-        return Err(FloquetStudyError::InvalidTolerance {
-            rtol,
-            stability_tolerance,
-        });
+    let FloquetOptions { rtol, atol, .. } = options.floquet;
+    if !(rtol.is_finite() && rtol > 0.0 && atol.is_finite() && atol > 0.0) {
+        return Err(FloquetStudyError::InvalidTolerance { rtol, atol });
     }
+    options.floquet.validate()?;
     Ok(())
 }
 
@@ -254,7 +252,7 @@ fn analyse(
         });
     }
     let period = TAU / frequency;
-    check_period_parameter(model, index, guess, time_dependence)?;
+    let time_dependent = check_period_parameter(model, index, guess, time_dependence)?;
     let equilibrium =
         find_equilibrium(model, guess, 0.0).map_err(FloquetStudyError::Equilibrium)?;
     let residual = check_periodic_equilibrium(model, &equilibrium.q, 0.0, period)?;
@@ -271,6 +269,7 @@ fn analyse(
         q: equilibrium.q,
         frequency,
         residual,
+        time_dependent,
         floquet,
     })
 }
@@ -300,23 +299,16 @@ fn largest_change(model: &dyn ModelInfo, ys: &[Vec<f64>], times: &[f64], shift: 
     (worst / scale.max(f64::MIN_POSITIVE), at)
 }
 
-/// Checks numerically that the parameter at `index` is the forcing frequency `w` of
-/// `model`: its equations `M(q, t)`, `F(q, q̇, t)` depend on `t` (where `time_dependence`
-/// requires it), and are `2π/w`-periodic at
-/// three states near `q` (the equilibrium guess, and it moved by up to 0.1 with rates up to
-/// 0.2) and seven times in the period, both at `w` and at `w (1 + 1/64)` (then restored).
-/// Tolerance: a relative difference of 1e-9, far above the round-off of evaluating at
-/// `t + T` (~1e-15 relative for the bundled models' `cos(w t)`) and far below the change a
-/// wrong period makes (of the order of the forcing amplitude).
-fn check_period_parameter(
-    model: &mut dyn ModelInfo,
-    index: usize,
-    q: &[f64],
-    time_dependence: TimeDependence,
-) -> Result<(), FloquetStudyError> {
-    const TOLERANCE: f64 = 1e-9;
+/// The relative change of `M` or `F` the period checks accept as none: far above the
+/// round-off of evaluating at `t + T` (~1e-15 relative for the bundled models' `cos(w t)`)
+/// and far below the change a wrong period makes (of the order of the forcing amplitude).
+const PERIOD_TOLERANCE: f64 = 1e-9;
+
+/// Three states near `q` (the equilibrium guess, and it moved by up to 0.1 with rates up to
+/// 0.2) at which the period checks evaluate `M` and `F`.
+fn probe_states(model: &dyn ModelInfo, q: &[f64]) -> Vec<Vec<f64>> {
     let n = model.num_dofs();
-    let ys: Vec<Vec<f64>> = [(0.0, 0.0), (0.1, 0.2), (-0.07, -0.13)]
+    [(0.0, 0.0), (0.1, 0.2), (-0.07, -0.13)]
         .iter()
         .map(|&(dq, dv)| {
             let mut y: Vec<f64> = q
@@ -331,20 +323,40 @@ fn check_period_parameter(
             }
             y
         })
-        .collect();
-    let name = model.parameter_names()[index].to_string();
-    let frequency = model.parameter_values()[index];
+        .collect()
+}
+
+/// Whether `M` or `F` changes with `t` at the states `ys`, for the forcing frequency
+/// `frequency`: across two shifts that are irrational-looking fractions of the period `2π/w`
+/// (a quarter and a third would be whole periods of a forcing at 12 times the named
+/// "frequency"), from seven times in a period.
+fn depends_on_time(model: &dyn ModelInfo, ys: &[Vec<f64>], frequency: f64) -> bool {
     let period = TAU / frequency;
     let times: Vec<f64> = (0..7)
         .map(|k| 0.137 * period + f64::from(k) * period / 7.0)
         .collect();
-    // Time dependence at all: F or M changes across two shifts that are irrational-looking
-    // fractions of the period (a quarter and a third would be whole periods of a forcing at
-    // 12 times the named "frequency").
-    let varies = largest_change(model, &ys, &times, 0.271_828 * period)
+    let varies = largest_change(model, ys, &times, 0.271_828 * period)
         .0
-        .max(largest_change(model, &ys, &times, 0.414_214 * period).0);
-    if varies <= TOLERANCE && time_dependence == TimeDependence::Required {
+        .max(largest_change(model, ys, &times, 0.414_214 * period).0);
+    varies > PERIOD_TOLERANCE
+}
+
+/// Checks numerically that the parameter at `index` is the forcing frequency `w` of
+/// `model`: its equations `M(q, t)`, `F(q, q̇, t)` depend on `t` (where `time_dependence`
+/// requires it), and are `2π/w`-periodic at three states near `q` ([`probe_states`]) and
+/// seven times in the period, both at `w` and at `w (1 + 1/64)` (then restored), to a
+/// relative difference of [`PERIOD_TOLERANCE`]. Returns whether they depend on `t`.
+fn check_period_parameter(
+    model: &mut dyn ModelInfo,
+    index: usize,
+    q: &[f64],
+    time_dependence: TimeDependence,
+) -> Result<bool, FloquetStudyError> {
+    let ys = probe_states(model, q);
+    let name = model.parameter_names()[index].to_string();
+    let frequency = model.parameter_values()[index];
+    let time_dependent = depends_on_time(model, &ys, frequency);
+    if !time_dependent && time_dependence == TimeDependence::Required {
         return Err(FloquetStudyError::TimeIndependent {
             model: model.name().to_string(),
         });
@@ -357,7 +369,7 @@ fn check_period_parameter(
             .map(|k| 0.137 * period + f64::from(k) * period / 7.0)
             .collect();
         let (difference, t) = largest_change(model, &ys, &times, period);
-        if difference > TOLERANCE {
+        if difference > PERIOD_TOLERANCE {
             model.set_parameter(&name, frequency)?;
             return Err(FloquetStudyError::NotPeriodic {
                 model: model.name().to_string(),
@@ -370,7 +382,7 @@ fn check_period_parameter(
         }
     }
     model.set_parameter(&name, frequency)?;
-    Ok(())
+    Ok(time_dependent)
 }
 
 /// One swept parameter of a stability chart.
@@ -446,4 +458,129 @@ pub fn floquet_cell(
         spectral_radius: point.floquet.spectral_radius,
         stability: point.floquet.stability,
     })
+}
+
+/// The Floquet analysis at the model's own parameters that heads a stability chart over
+/// `axes`: as [`floquet_at_equilibrium`], except that the model need not depend on `t` at
+/// its own parameters when it does at swept values (the Mathieu pendulum at `a = 0`, swept
+/// over `a = 0..0.6`). The time dependence is checked at the corners and the centre of the
+/// grid and the middles of its sides (3 × 3 points, the other parameters as set); the point
+/// itself is then analysed as a cell is, and says whether it depends on `t`
+/// ([`FloquetPoint::time_dependent`]). `model` keeps its own parameter values.
+///
+/// # Errors
+/// Those of [`floquet_at_equilibrium`], [`FloquetStudyError::TimeIndependent`] only when the
+/// model depends on `t` at none of the 3 × 3 points, and [`FloquetStudyError::Parameter`]
+/// for an axis that is not a parameter of the model.
+///
+/// # Examples
+/// The Mathieu pendulum without shaking (`a = 0`) has no period, but a chart over `a` has:
+/// ```
+/// use eomgen_runtime::vibration::{
+///     FloquetStudyError, FloquetStudyOptions, SweepAxis, floquet_at_equilibrium,
+///     floquet_at_equilibrium_for_sweep,
+/// };
+/// let mut model = (eomgen::models::find("mathieu_pendulum").unwrap().make)();
+/// model.set_parameter("a", 0.0)?;
+/// let options = FloquetStudyOptions::default();
+/// assert!(matches!(
+///     floquet_at_equilibrium(model.as_mut(), &options),
+///     Err(FloquetStudyError::TimeIndependent { .. })
+/// ));
+/// let a = SweepAxis::linear("a", 0.0, 0.3, 31)?;
+/// let w = SweepAxis::linear("w", 10.0, 100.0, 31)?;
+/// let point = floquet_at_equilibrium_for_sweep(model.as_mut(), &options, [&a, &w])?;
+/// assert!(!point.time_dependent);
+/// let flat = SweepAxis::linear("a", 0.0, 0.0, 1)?;
+/// assert!(matches!(
+///     floquet_at_equilibrium_for_sweep(model.as_mut(), &options, [&flat, &w]),
+///     Err(FloquetStudyError::TimeIndependent { .. })
+/// ));
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+pub fn floquet_at_equilibrium_for_sweep(
+    model: &mut dyn ModelInfo,
+    options: &FloquetStudyOptions,
+    axes: [&SweepAxis; 2],
+) -> Result<FloquetPoint, FloquetStudyError> {
+    check_options(model, options)?;
+    let (name, guess) = options.operating_point.start.resolve(model)?;
+    let ys = probe_states(model, &guess);
+    let names: Vec<String> = model
+        .parameter_names()
+        .iter()
+        .map(|n| n.to_string())
+        .collect();
+    let index = |p: &str| names.iter().position(|n| n == p);
+    let period_index = index(&options.period_parameter);
+    let own: Vec<(String, f64)> = axes
+        .iter()
+        .map(|a| {
+            let i = index(&a.name).ok_or_else(|| UnknownParameter {
+                model: model.name().to_string(),
+                name: a.name.clone(),
+                known: names.join(", "),
+            })?;
+            Ok((a.name.clone(), model.parameter_values()[i]))
+        })
+        .collect::<Result<_, FloquetStudyError>>()?;
+    let three = |a: &SweepAxis| -> Vec<f64> {
+        let v = &a.values;
+        vec![v[0], v[v.len() / 2], v[v.len() - 1]]
+    };
+    let mut found = false;
+    'grid: for x in three(axes[0]) {
+        for y in three(axes[1]) {
+            model.set_parameter(&axes[0].name, x)?;
+            model.set_parameter(&axes[1].name, y)?;
+            let frequency = period_index.map_or(f64::NAN, |i| model.parameter_values()[i]);
+            if frequency.is_finite() && frequency > 0.0 && depends_on_time(model, &ys, frequency) {
+                found = true;
+                break 'grid;
+            }
+        }
+    }
+    for (name, value) in &own {
+        model.set_parameter(name, *value)?;
+    }
+    let time_dependence = if found {
+        TimeDependence::Allowed
+    } else {
+        TimeDependence::Required
+    };
+    analyse(model, name, &guess, options, time_dependence)
+}
+
+/// A stability chart: the Floquet analysis ([`floquet_cell`]) at every point of a grid over
+/// two parameters, or why it failed there.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FloquetChart {
+    /// The x axis.
+    pub x: SweepAxis,
+    /// The y axis.
+    pub y: SweepAxis,
+    /// `cells[i][j]` at `(x.values[i], y.values[j])`: the cell, or the failure's text.
+    pub cells: Vec<Vec<Result<FloquetCell, String>>>,
+}
+
+/// Every cell is a run; a failed one is counted with its parameters and reason.
+impl StudyRuns for FloquetChart {
+    fn study(&self) -> &'static str {
+        "floquet --sweep"
+    }
+
+    fn tally(&self) -> RunTally {
+        let mut tally = RunTally::default();
+        for (i, column) in self.cells.iter().enumerate() {
+            for (j, cell) in column.iter().enumerate() {
+                tally.add(cell.as_ref().err().map(|e| {
+                    format!(
+                        "{} = {}, {} = {}: {e}",
+                        self.x.name, self.x.values[i], self.y.name, self.y.values[j]
+                    )
+                }));
+            }
+        }
+        tally
+    }
 }

@@ -9,6 +9,7 @@ use serde::Serialize;
 
 use super::modes::{ModalAnalysis, ModalOptions, modal_analysis};
 use super::operating_point::{OperatingPoint, OperatingPointError, OperatingPointOptions};
+use crate::analysis::outcome::{RunTally, StudyRuns};
 use crate::modal::{Linearization, ModeKind, NormalModes};
 use crate::model_info::ModelInfo;
 use crate::response::{
@@ -271,6 +272,21 @@ pub struct FreeResponseStudy {
     pub max_velocity: f64,
     /// Every pair of methods, in the order `(1, 2), (1, 3), …, (3, 4)`.
     pub differences: Vec<ResponseDifference>,
+}
+
+/// Each of the four responses is a run; a failed one fails the study as a whole
+/// ([`ResponseStudyError::Response`]).
+impl StudyRuns for FreeResponseStudy {
+    fn study(&self) -> &'static str {
+        "free-response"
+    }
+
+    fn tally(&self) -> RunTally {
+        RunTally {
+            measured: self.responses.len(),
+            ..RunTally::default()
+        }
+    }
 }
 
 /// The free response of the undamped linearisation `M δq̈ + K δq = 0` at an operating point,

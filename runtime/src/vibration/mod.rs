@@ -30,8 +30,8 @@ pub mod operating_point;
 pub(crate) mod serde_matrix;
 
 pub use floquet::{
-    FloquetCell, FloquetPoint, FloquetStudyError, FloquetStudyOptions, SweepAxis,
-    floquet_at_equilibrium, floquet_cell,
+    FloquetCell, FloquetChart, FloquetPoint, FloquetStudyError, FloquetStudyOptions, SweepAxis,
+    floquet_at_equilibrium, floquet_at_equilibrium_for_sweep, floquet_cell,
 };
 pub use free_response::{
     FreeResponseMethod, FreeResponseOptions, FreeResponseStudy, InitialDeviation,

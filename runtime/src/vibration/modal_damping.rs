@@ -11,6 +11,7 @@ use super::free_response::{
     unconstrained_modal_analysis, uniform_times,
 };
 use super::operating_point::{OperatingPoint, OperatingPointOptions};
+use crate::analysis::outcome::{RunTally, StudyRuns};
 use crate::modal::{Linearization, ModeKind, NormalModes};
 use crate::model_info::ModelInfo;
 use crate::response::{
@@ -137,6 +138,21 @@ pub struct ModalDampingStudy {
     pub tol: f64,
     /// The releases.
     pub releases: Vec<Release>,
+}
+
+/// Each release is a run; a failed response fails the study as a whole
+/// ([`ResponseStudyError::Response`]).
+impl StudyRuns for ModalDampingStudy {
+    fn study(&self) -> &'static str {
+        "modal-damping"
+    }
+
+    fn tally(&self) -> RunTally {
+        RunTally {
+            measured: self.releases.len(),
+            ..RunTally::default()
+        }
+    }
 }
 
 /// `ω √(1 − ζ²)` (`None` when `|ζ| ≥ 1`).

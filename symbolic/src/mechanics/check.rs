@@ -37,7 +37,8 @@ pub struct Comparison {
     pub a: &'static str,
     /// Second formulation.
     pub b: &'static str,
-    /// Largest `|q̈_a − q̈_b| / max(1, |q̈|)` over the random states.
+    /// Largest `|q̈_a − q̈_b| / max(1, |q̈|)` over the random states: infinite where `b`'s
+    /// `M′` is singular, NaN where `b` is not finite at a state where `a` is (a failure).
     pub max_rel_residual: f64,
     /// Whether `M_a − M_b` and `F_a − F_b` simplify to zero after expansion; `None` where
     /// the rows are not expected to match (user balances are combinations of the equations).
@@ -94,14 +95,82 @@ pub struct CheckReport {
     /// The constraint residuals of `initial:`; `None` without constraints or when the start
     /// has guesses to be solved.
     pub initial_constraints: Option<InitialConstraints>,
+    /// How many of the random states were compared, and why the others were skipped.
+    pub states: SampledStates,
+}
+
+/// How many random states [`check_model`] compared, and why it skipped the others: a state
+/// is compared only where Lagrange's `M` and `F` are finite and `M` is regular.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct SampledStates {
+    /// States drawn.
+    pub drawn: usize,
+    /// States compared.
+    pub compared: usize,
+    /// States skipped because Lagrange's `M` or `F` was not finite there (a function outside
+    /// its domain, such as `sqrt` or `ln` of a negative number, or an overflow).
+    pub not_finite: usize,
+    /// States skipped because Lagrange's `M` was singular there (or `q̈` overflowed).
+    pub singular: usize,
+}
+
+impl SampledStates {
+    /// Why nothing was compared, when no state was (`None` when some state was): a check
+    /// over no state is never a pass.
+    pub fn nothing_compared(&self) -> Option<String> {
+        (self.compared == 0).then(|| {
+            format!(
+                "no state compared: of {} random states (q, q̇ in [−2, 2], t in [0, 5]), {}",
+                self.drawn,
+                self.skipped()
+            )
+        })
+    }
+
+    /// Why states were skipped, when some were (`None` when every state was compared):
+    /// `3 had a non-finite M or F (…), 2 a singular M`.
+    pub fn skipped_note(&self) -> Option<String> {
+        (self.compared > 0 && self.compared < self.drawn).then(|| {
+            format!(
+                "compared {} of {} random states: {}",
+                self.compared,
+                self.drawn,
+                self.skipped()
+            )
+        })
+    }
+
+    fn skipped(&self) -> String {
+        let mut parts = Vec::new();
+        if self.not_finite > 0 {
+            parts.push(format!(
+                "{} had a non-finite Lagrange M or F (a function outside its domain, such as sqrt or ln of a negative number, or an overflow)",
+                self.not_finite
+            ));
+        }
+        if self.singular > 0 {
+            parts.push(format!(
+                "{} had a singular Lagrange M (the comparison solves M q̈ = F without the constraints)",
+                self.singular
+            ));
+        }
+        if parts.is_empty() {
+            "none was drawn".to_string()
+        } else {
+            parts.join(", ")
+        }
+    }
 }
 
 impl CheckReport {
-    /// Whether every check passed at relative tolerance `tolerance`.
+    /// Whether every check passed at relative tolerance `tolerance`; never when no random
+    /// state was compared ([`SampledStates::nothing_compared`]).
     pub fn passed(&self, tolerance: f64) -> bool {
-        self.comparisons
-            .iter()
-            .all(|c| c.max_rel_residual <= tolerance)
+        self.states.compared > 0
+            && self
+                .comparisons
+                .iter()
+                .all(|c| c.max_rel_residual <= tolerance)
             && self
                 .power_balance
                 .as_ref()
@@ -189,6 +258,8 @@ fn timed(model: &mut SymbolicModel, f: &dyn Formulation) -> (EquationsOfMotion, 
 
 /// Derives `file` by every applicable formulation and cross-checks them at `states` random
 /// states (q, q̇ in [−2, 2], t in [0, 5], parameters within ±10 % of their defaults, or in [0.1, 0.5] where the default is 0).
+/// A state is compared where Lagrange's `M` and `F` are finite and `M` is regular
+/// ([`CheckReport::states`]); a report that compared no state does not pass.
 ///
 /// # Errors
 /// The diagnostics of a model that does not lower.
@@ -255,11 +326,11 @@ pub fn check_model(
         max_rel,
         power_rel,
         quadratic,
-        compared,
+        states: sampled,
     } = sample_states(&mut model, &lagrange, &others, states, seed);
-    if compared == 0 {
-        notes.push("no random state had a solvable mass matrix".to_string());
-    }
+    let compared = sampled.compared;
+    // (When nothing was compared, the report fails with `nothing_compared()` as its reason.)
+    notes.extend(sampled.skipped_note());
     let comparisons: Vec<Comparison> = others
         .iter()
         .zip(&max_rel)
@@ -285,8 +356,15 @@ pub fn check_model(
     });
     for c in &comparisons {
         if c.max_rel_residual.is_nan() || c.max_rel_residual > 1e-8 {
-            let singular = !c.max_rel_residual.is_finite();
-            if c.b == UserBalances.name() {
+            let singular = c.max_rel_residual.is_infinite();
+            if c.max_rel_residual.is_nan() {
+                let which = if c.b == UserBalances.name() {
+                    "the balances"
+                } else {
+                    "the equations of motion written by hand"
+                };
+                notes.push(format!("{which} are not finite at some of the states where Lagrange's are (a function outside its domain, such as sqrt or asin, or an overflow)"));
+            } else if c.b == UserBalances.name() {
                 notes.push(if singular {
                     "the balances are not independent: their M′ is singular".to_string()
                 } else if moving_h_dot {
@@ -322,6 +400,7 @@ pub fn check_model(
         derivations,
         notes,
         initial_constraints,
+        states: sampled,
     })
 }
 
@@ -330,15 +409,17 @@ pub fn check_model(
 #[derive(Debug, Clone, PartialEq)]
 struct Sampled {
     /// Per other derivation, the largest `|q̈_L − q̈_other|` relative to the largest `|q̈|` of
-    /// the state, or to 1 if that is smaller (infinite where its `M′` is singular).
+    /// the state, or to 1 if that is smaller (infinite where its `M′` is singular, NaN where
+    /// its `M′` or `F′` is not finite at a compared state).
     max_rel: Vec<f64>,
     /// The largest `|dE/dt − Σ Qᵢ q̇ᵢ|` along Lagrange's q̈, relative to the largest of
     /// `|dE/dt|`, `|Σ Qᵢ q̇ᵢ|` and `Σ |Fᵢ q̇ᵢ|`.
     power_rel: f64,
     /// `T(q, 2q̇) = 4 T(q, q̇)` at every state (to 1e-9 relative).
     quadratic: bool,
-    /// States where Lagrange's `M` was regular (those compared).
-    compared: usize,
+    /// The states compared (where Lagrange's `M` and `F` were finite and `M` regular) and
+    /// why the others were skipped.
+    states: SampledStates,
 }
 
 /// Samples `states` random states (q, q̇ in [−2, 2], t in [0, 5], parameters within ±10 % of
@@ -387,7 +468,10 @@ fn sample_states(
     let rate_slots: Vec<usize> = (0..n)
         .map(|i| model.coordinate_symbols(i)[1].index())
         .collect();
-    let mut compared = 0;
+    let mut sampled = SampledStates {
+        drawn: states,
+        ..SampledStates::default()
+    };
     for _ in 0..states {
         let t = rng.random_range(0.0..5.0);
         let mut bindings = vec![0.0; symbols.len()];
@@ -404,19 +488,30 @@ fn sample_states(
         }
         let v = evaluator.eval(&bindings);
         let nn = n * n;
-        let Some(qdd) = solve(v[..nn].to_vec(), v[nn..nn + n].to_vec()) else {
-            continue;
-        };
-        if !qdd.iter().all(|x| x.is_finite()) {
+        if !v[..nn + n].iter().all(|x| x.is_finite()) {
+            sampled.not_finite += 1;
             continue;
         }
-        compared += 1;
+        let Some(qdd) = solve(v[..nn].to_vec(), v[nn..nn + n].to_vec())
+            .filter(|qdd| qdd.iter().all(|x| x.is_finite()))
+        else {
+            sampled.singular += 1;
+            continue;
+        };
+        sampled.compared += 1;
         for (k, worst) in max_rel.iter_mut().enumerate() {
             let base = lagrange_len + k * (nn + n);
+            // The other derivation not finite where Lagrange's is (a function outside its
+            // domain) is a disagreement, not a state to skip: NaN, kept (`max` would drop it).
+            if worst.is_nan() || !v[base..base + nn + n].iter().all(|x| x.is_finite()) {
+                *worst = f64::NAN;
+                continue;
+            }
             match solve(
                 v[base..base + nn].to_vec(),
                 v[base + nn..base + nn + n].to_vec(),
             ) {
+                Some(other) if other.iter().any(|x| !x.is_finite()) => *worst = f64::INFINITY,
                 Some(other) => {
                     let scale = qdd.iter().chain(&other).fold(1.0f64, |m, x| m.max(x.abs()));
                     for (a, b) in qdd.iter().zip(&other) {
@@ -457,7 +552,7 @@ fn sample_states(
         max_rel,
         power_rel,
         quadratic,
-        compared,
+        states: sampled,
     }
 }
 
@@ -572,7 +667,7 @@ mod tests {
         let momentum = MomentumBalance.derive(&mut m);
         let others = vec![("momentum", momentum)];
         let right = sample_states(&mut m, &lagrange, &others, 30, 3);
-        assert_eq!(right.compared, 30);
+        assert_eq!(right.states.compared, 30);
         assert!(right.quadratic);
         assert!(
             right.max_rel[0] < 1e-12 && right.power_rel < 1e-12,
@@ -635,11 +730,11 @@ mod tests {
         singular.mass_matrix = vec![m.arena.int(0); 4];
         let found = sample_states(&mut m, &lagrange, &[("x", singular.clone())], 5, 1);
         assert!(
-            found.max_rel[0].is_infinite() && found.compared == 5,
+            found.max_rel[0].is_infinite() && found.states.compared == 5,
             "{found:?}"
         );
         let found = sample_states(&mut m, &singular, &[("x", lagrange)], 5, 1);
-        assert_eq!(found.compared, 0);
+        assert_eq!((found.states.compared, found.states.singular), (0, 5));
     }
 
     /// Parameters are drawn within ±10 % of their defaults: `M = sqrt(m − 0.6) sqrt(1.2 − m)`
@@ -652,7 +747,7 @@ mod tests {
         let file = crate::model::load("m.yaml", base).unwrap();
         let report = check_model(&file, 20, 1).unwrap();
         assert!(
-            report.notes.iter().all(|n| !n.contains("no random state")),
+            report.states.compared == 20 && report.notes.iter().all(|n| !n.contains("states")),
             "{:?}",
             report.notes
         );
@@ -670,18 +765,18 @@ mod tests {
             report.notes
         );
         // M = m [[1, 1], [1, 1]] is singular at every state (only x + y carries inertia; the
-        // comparison ignores the constraint): nothing to compare, and the note says so.
+        // comparison ignores the constraint): nothing to compare, the note says so and the
+        // check fails.
         let stuck = "name: s\nparameters: { m: 1.0 }\ncoordinates: [x, y]\npoints: { P: [x + y, 0] }\nbodies: { b: { mass: m, at: P } }\nconstraints:\n  same: x - y\n";
         let file = crate::model::load("m.yaml", stuck).unwrap();
         let report = check_model(&file, 5, 1).unwrap();
+        let reason = report.states.nothing_compared().expect("nothing compared");
         assert!(
-            report
-                .notes
-                .iter()
-                .any(|n| n.contains("no random state had a solvable mass matrix")),
-            "{:?}",
-            report.notes
+            reason.starts_with("no state compared: of 5 random states")
+                && reason.contains("5 had a singular Lagrange M"),
+            "{reason}"
         );
+        assert!(!report.passed(1e-8), "{report:?}");
     }
 
     /// `T` with a term linear in the rate (a point carried by a prescribed motion has one) is
