@@ -93,7 +93,7 @@ pub fn run(args: &ModesArgs) -> Result<(), CliError> {
     };
     charts
         .iter()
-        .fold(super::files::Outputs::new(), |outputs, path| {
+        .fold(super::files::Outputs::new().input(&args.model), |outputs, path| {
             outputs.chart("--plot", Some(path))
         })
         .file("--animate", args.animate.as_deref())
