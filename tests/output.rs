@@ -2,6 +2,9 @@
 //! 20): standard output to a full device or a closed pipe, files replaced atomically (a failed
 //! or killed run leaves the previous file whole), files of a failed integration marked as
 //! incomplete, and the documented upper limit of every size a user can type.
+//!
+//! Unix only: the tests use `/dev/full`, FIFOs, descriptors, modes and owners.
+#![cfg(unix)]
 
 use std::io::{BufRead as _, BufReader};
 use std::process::{Command, Output, Stdio};
@@ -696,6 +699,8 @@ fn issue_28_an_existing_file_keeps_its_mode() {
         let metadata = std::fs::metadata(&owned).unwrap();
         assert_eq!((metadata.uid(), metadata.gid()), (4321, 4321));
         assert_ne!(std::fs::read(&owned).unwrap(), b"old\n");
+    } else {
+        eprintln!("skipped: the owner-kept case needs root (only root may give a file away)");
     }
 }
 
@@ -1258,4 +1263,80 @@ fn issue_28_a_planted_link_in_a_sticky_directory_is_not_followed() {
             .unwrap()
             .starts_with("t,q,q_dot,energy\n")
     );
+}
+
+/// With `mkdir -p R/index.html`, `report -o R` wrote report.json and the model's folder, then
+/// exited 2 naming an option "output". The report's files are now checked before any work
+/// like every command's outputs (status 2, nothing written); so is a file where a model's
+/// folder goes.
+#[test]
+fn issue_28_report_outputs_are_checked_before_any_work() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("R");
+    std::fs::create_dir_all(out.join("index.html")).unwrap();
+    let report = || {
+        run(&[
+            "report",
+            "--models",
+            "simple_pendulum",
+            "-o",
+            out.to_str().unwrap(),
+        ])
+    };
+    let result = report();
+    let text = stderr(&result);
+    assert_eq!(result.status.code(), Some(2), "{text}");
+    assert!(
+        text.contains("--out (its index.html)") && text.contains("is a directory"),
+        "{text}"
+    );
+    let written: Vec<_> = std::fs::read_dir(&out)
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(written, ["index.html"], "written before the refusal");
+
+    std::fs::remove_dir(out.join("index.html")).unwrap();
+    std::fs::write(out.join("simple_pendulum"), "mine\n").unwrap();
+    let result = report();
+    let text = stderr(&result);
+    assert_eq!(result.status.code(), Some(2), "{text}");
+    assert!(text.contains("is not a directory"), "{text}");
+    assert!(!out.join("report.json").exists());
+}
+
+/// `--csv new/` (a directory's name) wrote a file `new`; `--csv -` wrote a file named `-`
+/// and a companion `--events.csv`. A file output ending in `/` is refused before any work,
+/// and `-` is standard output.
+#[test]
+fn issue_28_a_trailing_slash_is_refused_and_dash_is_standard_output() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = run_in(
+        dir.path(),
+        &["simulate", "simple_pendulum", "--t-out", "1", "--csv", "new/"],
+    );
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(stderr(&out).contains("--csv `new/` names no file"), "{}", stderr(&out));
+
+    let out = run_in(
+        dir.path(),
+        &[
+            "simulate",
+            "simple_pendulum",
+            "--t-out",
+            "1",
+            "--init",
+            "q=1",
+            "--event",
+            "q = 0",
+            "--csv",
+            "-",
+        ],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.starts_with("t,q,q_dot,energy\n"), "{text}");
+    assert!(text.contains("\nmodel      simple_pendulum"), "{text}");
+    let written: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();
+    assert!(written.is_empty(), "wrote {written:?}");
 }

@@ -12,8 +12,8 @@
 //!   target is replaced as above, in its own directory: the link stays a link and its target
 //!   is the new file. A link that the kernel's `fs.protected_symlinks` rule would not follow
 //!   (another user's, in a sticky world-writable directory) is refused ([`may_follow`]);
-//! - the program's own **standard output or error** (`/dev/stdout`, `/dev/fd/1`, or any name
-//!   of the same open file) is written through the stream, in order with what the command
+//! - the program's own **standard output or error** (`-`, `/dev/stdout`, `/dev/fd/1`, or any
+//!   name of the same open file) is written through the stream, in order with what the command
 //!   prints, and standard output's errors are reported as standard output's
 //!   ([`super::output`]);
 //! - another of the program's **open descriptors**, named exactly `/dev/fd/N` or
@@ -48,7 +48,7 @@ pub(super) enum FileError {
         /// The path as given.
         path: String,
     },
-    /// The path names no file (empty, or ending in `..`).
+    /// The path names no file (empty, ending in `/` or in `..`).
     #[error("{option} `{path}` names no file; give a file name")]
     NoFileName {
         /// The option that names the file.
@@ -195,6 +195,11 @@ fn fd_path(path: &str) -> Option<FdPath> {
 
 /// What `path` names, following symbolic links ([`Target`]).
 fn resolve(path: &str) -> io::Result<Target> {
+    // `-` is standard output, as for most programs (it used to be a file named `-`, with a
+    // companion `--events.csv`).
+    if path == "-" {
+        return Ok(Target::Standard(Stream::Output));
+    }
     let descriptor = fd_path(path);
     match fs::metadata(path) {
         Ok(m) if m.is_dir() => return Ok(Target::Directory),
@@ -334,8 +339,8 @@ fn os_error(e: &io::Error) -> String {
 /// stream.
 ///
 /// # Errors
-/// [`FileError::Write`] naming `path` with the operating system's reason, or
-/// [`FileError::Directory`] for a directory. A write to standard output that fails is kept by
+/// [`FileError::Write`] naming `path` with the operating system's reason (or that a
+/// directory is in the way). A write to standard output that fails is kept by
 /// [`super::output`] (status 1, or 141 for a closed pipe) and is not an error here.
 pub(super) fn write(path: &str, bytes: &[u8]) -> Result<(), FileError> {
     let fail = |e: io::Error| FileError::Write {
@@ -343,9 +348,11 @@ pub(super) fn write(path: &str, bytes: &[u8]) -> Result<(), FileError> {
         reason: os_error(&e),
     };
     match resolve(path).map_err(fail)? {
-        Target::Directory => Err(FileError::Directory {
-            option: "output".to_string(),
+        // Found when the file is written, after the work: a failed write, not a usage error
+        // (the check before the work refuses it as one).
+        Target::Directory => Err(FileError::Write {
             path: path.to_string(),
+            reason: "a directory is in the way".to_string(),
         }),
         Target::Standard(Stream::Output) => {
             let _ = super::output::stdout().write_all(bytes);
@@ -599,6 +606,13 @@ fn check_one(planned: &Planned) -> Result<Identity, FileError> {
         path: path.clone(),
         reason: os_error(&e),
     };
+    // `out/` names a directory: a file output would otherwise create the file `out`.
+    if path.ends_with('/') {
+        return Err(FileError::NoFileName {
+            option: option.clone(),
+            path: path.clone(),
+        });
+    }
     if *format == Format::Chart && !(path.ends_with(".svg") || path.ends_with(".png")) {
         return Err(FileError::ChartExtension {
             option: option.clone(),
@@ -667,4 +681,49 @@ fn inode(metadata: &Metadata) -> Option<(u64, u64)> {
 #[cfg(not(unix))]
 fn inode(_: &Metadata) -> Option<(u64, u64)> {
     None
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A directory found in the way when the file is written (after the check before the
+    /// work) is a failed write naming the file, status 1, not a usage error.
+    #[test]
+    fn a_directory_in_the_way_at_write_time_is_a_failed_write() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("index.html");
+        std::fs::create_dir(&path).unwrap();
+        let path = path.to_string_lossy().into_owned();
+        let error = write(&path, b"x").unwrap_err();
+        assert!(
+            matches!(&error, FileError::Write { path: p, .. } if *p == path),
+            "{error:?}"
+        );
+        assert_eq!(CliError::from(error).code, 1);
+    }
+
+    /// Exactly `/dev/fd/N` and `/proc/<pid>/fd/N` name descriptors; other paths under
+    /// `/proc` are ordinary.
+    #[test]
+    fn only_descriptor_paths_are_descriptors() {
+        let own = format!("/proc/{}/fd/4", std::process::id());
+        for (path, kind) in [
+            ("/dev/fd/3", Some(FdPath::Own(3))),
+            ("/proc/self/fd/12", Some(FdPath::Own(12))),
+            ("/proc/thread-self/fd/0", Some(FdPath::Own(0))),
+            (own.as_str(), Some(FdPath::Own(4))),
+            ("/proc/1/fd/3", Some(FdPath::Other)),
+            ("/proc/self/cwd/out.csv", None),
+            ("/proc/self/root/tmp/x.csv", None),
+            ("/proc/self/fd/3/", None),
+            ("/proc/self/fd/../fd/3", None),
+            ("/dev/fd/", None),
+            ("/dev/fd/-1", None),
+            ("/dev/fd/3x", None),
+            ("/dev/fd/99999999999", None),
+        ] {
+            assert_eq!(fd_path(path), kind, "{path}");
+        }
+    }
 }
