@@ -932,7 +932,7 @@ fn print_constraint_summary(constraints: &ConstraintDrift, stabilization: Stabil
 
 #[cfg(test)]
 mod tests {
-    use super::sibling;
+    use super::{is_events_csv, sibling};
 
     /// Only the file name's extension counts (a dot in a directory name used to put the tag
     /// inside the directory's name), and a leading dot starts no extension.
