@@ -1056,9 +1056,30 @@ fn issue_28_an_output_naming_the_model_file_is_refused() {
     std::os::unix::fs::symlink("pend.yaml", dir.path().join("link.csv")).unwrap();
     std::fs::hard_link(dir.path().join("pend.yaml"), dir.path().join("hard.csv")).unwrap();
     let cases: &[&[&str]] = &[
-        &["simulate", "pend.yaml", "--t-end", "1", "--csv", "pend.yaml"],
-        &["simulate", "pend.yaml", "--t-end", "1", "--csv", "./pend.yaml"],
-        &["simulate", "./pend.yaml", "--t-end", "1", "--csv", "link.csv"],
+        &[
+            "simulate",
+            "pend.yaml",
+            "--t-end",
+            "1",
+            "--csv",
+            "pend.yaml",
+        ],
+        &[
+            "simulate",
+            "pend.yaml",
+            "--t-end",
+            "1",
+            "--csv",
+            "./pend.yaml",
+        ],
+        &[
+            "simulate",
+            "./pend.yaml",
+            "--t-end",
+            "1",
+            "--csv",
+            "link.csv",
+        ],
         &["simulate", "pend.yaml", "--t-end", "1", "--csv", "hard.csv"],
         &["animate", "pend.yaml", "--t-end", "1", "-o", "pend.yaml"],
         &["modes", "pend.yaml", "--animate", "pend.yaml"],
@@ -1181,12 +1202,18 @@ fn issue_28_an_open_descriptor_is_written_through_not_reopened() {
         );
         assert!(out.status.success(), "{path}: {}", stderr(&out));
         let text = std::fs::read_to_string(&log).unwrap();
-        assert!(text.starts_with("keep\nt,q,q_dot,energy\n"), "{path}: {text}");
+        assert!(
+            text.starts_with("keep\nt,q,q_dot,energy\n"),
+            "{path}: {text}"
+        );
         assert_eq!(text.matches("keep").count(), 1, "{path}: {text}");
         assert!(temporaries(dir.path()).is_empty(), "{k}");
     }
     // Not open: nothing to write to.
-    let out = run_in(dir.path(), &[&pendulum[..], &["--csv", "/dev/fd/9"]].concat());
+    let out = run_in(
+        dir.path(),
+        &[&pendulum[..], &["--csv", "/dev/fd/9"]].concat(),
+    );
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
     assert!(
         stderr(&out).contains("no such open file descriptor"),
@@ -1313,10 +1340,21 @@ fn issue_28_a_trailing_slash_is_refused_and_dash_is_standard_output() {
     let dir = tempfile::tempdir().unwrap();
     let out = run_in(
         dir.path(),
-        &["simulate", "simple_pendulum", "--t-out", "1", "--csv", "new/"],
+        &[
+            "simulate",
+            "simple_pendulum",
+            "--t-out",
+            "1",
+            "--csv",
+            "new/",
+        ],
     );
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
-    assert!(stderr(&out).contains("--csv `new/` names no file"), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("--csv `new/` names no file"),
+        "{}",
+        stderr(&out)
+    );
 
     let out = run_in(
         dir.path(),

@@ -463,7 +463,10 @@ pub(super) enum Stale {
 ///
 /// # Errors
 /// [`FileError::Remove`] when a file of ours is there and cannot be removed.
-pub(super) fn remove_stale(path: &str, is_ours: impl Fn(&[u8]) -> bool) -> Result<Stale, FileError> {
+pub(super) fn remove_stale(
+    path: &str,
+    is_ours: impl Fn(&[u8]) -> bool,
+) -> Result<Stale, FileError> {
     match fs::symlink_metadata(path) {
         Ok(m) if m.is_file() => {
             if !fs::read(path).is_ok_and(|bytes| is_ours(&bytes)) {

@@ -857,7 +857,7 @@ fn is_events_csv(bytes: &[u8]) -> bool {
     };
     let columns: Vec<&str> = columns.split(',').collect();
     let (coordinates, rates) = columns.split_at(columns.len() / 2);
-    columns.len() % 2 == 0
+    columns.len().is_multiple_of(2)
         && coordinates
             .iter()
             .zip(rates)
