@@ -2,6 +2,9 @@
 //! 20): standard output to a full device or a closed pipe, files replaced atomically (a failed
 //! or killed run leaves the previous file whole), files of a failed integration marked as
 //! incomplete, and the documented upper limit of every size a user can type.
+//!
+//! Unix only: the tests use `/dev/full`, FIFOs, descriptors, modes and owners.
+#![cfg(unix)]
 
 use std::io::{BufRead as _, BufReader};
 use std::process::{Command, Output, Stdio};
@@ -696,6 +699,8 @@ fn issue_28_an_existing_file_keeps_its_mode() {
         let metadata = std::fs::metadata(&owned).unwrap();
         assert_eq!((metadata.uid(), metadata.gid()), (4321, 4321));
         assert_ne!(std::fs::read(&owned).unwrap(), b"old\n");
+    } else {
+        eprintln!("skipped: the owner-kept case needs root (only root may give a file away)");
     }
 }
 
@@ -1032,4 +1037,344 @@ fn issue_28_diagnostics_json_on_a_full_device_is_status_1() {
     let out = run(&["check", "--json", bad.to_str().unwrap()]);
     assert_eq!(out.status.code(), Some(2));
     assert!(serde_json::from_slice::<serde_json::Value>(&out.stdout).is_ok());
+}
+
+// Issue 28, review of the output writer: inputs, companions, descriptors, links, arguments.
+
+/// `simulate pend.yaml --csv pend.yaml` replaced the model file with the CSV and exited 0.
+/// An output that is the model file the command reads — by the same name, another spelling,
+/// a symbolic link or a hard link to it — is now a usage error before any work, and the
+/// model file is left as it was.
+#[test]
+fn issue_28_an_output_naming_the_model_file_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("models/simple_pendulum.yaml"),
+    )
+    .unwrap();
+    std::fs::write(dir.path().join("pend.yaml"), &model).unwrap();
+    std::os::unix::fs::symlink("pend.yaml", dir.path().join("link.csv")).unwrap();
+    std::fs::hard_link(dir.path().join("pend.yaml"), dir.path().join("hard.csv")).unwrap();
+    let cases: &[&[&str]] = &[
+        &[
+            "simulate",
+            "pend.yaml",
+            "--t-end",
+            "1",
+            "--csv",
+            "pend.yaml",
+        ],
+        &[
+            "simulate",
+            "pend.yaml",
+            "--t-end",
+            "1",
+            "--csv",
+            "./pend.yaml",
+        ],
+        &[
+            "simulate",
+            "./pend.yaml",
+            "--t-end",
+            "1",
+            "--csv",
+            "link.csv",
+        ],
+        &["simulate", "pend.yaml", "--t-end", "1", "--csv", "hard.csv"],
+        &["animate", "pend.yaml", "--t-end", "1", "-o", "pend.yaml"],
+        &["modes", "pend.yaml", "--animate", "pend.yaml"],
+    ];
+    for args in cases {
+        let out = run_in(dir.path(), args);
+        let text = stderr(&out);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {text}");
+        assert!(
+            text.contains("is the model file") && text.contains("pend.yaml"),
+            "{args:?}: {text}"
+        );
+        assert_eq!(
+            std::fs::read_to_string(dir.path().join("pend.yaml")).unwrap(),
+            model,
+            "{args:?} changed the model file"
+        );
+    }
+}
+
+/// With `echo mine > run-events.csv`, `simulate … --csv run.csv` deleted the user's file as
+/// a stale companion. A companion is removed only when eomgen wrote it (the events CSV's
+/// header, the drift chart's title or PNG marker); another file of that name is kept, with a
+/// warning that it is stale.
+#[test]
+fn issue_28_a_stale_companion_is_removed_only_when_eomgen_wrote_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let pendulum = ["simulate", "simple_pendulum", "--t-end", "1"];
+    for name in ["run-events.csv", "p-drift.svg", "p-drift.png"] {
+        std::fs::write(dir.path().join(name), "mine\n").unwrap();
+    }
+    for plot in ["p.svg", "p.png"] {
+        let out = run_in(
+            dir.path(),
+            &[&pendulum[..], &["--csv", "run.csv", "--plot", plot]].concat(),
+        );
+        let text = stderr(&out);
+        assert!(out.status.success(), "{text}");
+        assert!(
+            text.contains("warning: `run-events.csv` is not from this run"),
+            "{text}"
+        );
+        let drift = plot.replace('.', "-drift.");
+        assert!(text.contains(&format!("warning: `{drift}`")), "{text}");
+    }
+    for name in ["run-events.csv", "p-drift.svg", "p-drift.png"] {
+        assert_eq!(
+            std::fs::read_to_string(dir.path().join(name)).unwrap(),
+            "mine\n",
+            "{name}"
+        );
+    }
+    // The same names written by eomgen are removed by a run that has nothing for them.
+    for name in ["run-events.csv", "p-drift.svg", "p-drift.png"] {
+        std::fs::remove_file(dir.path().join(name)).unwrap();
+    }
+    let succeeds = |args: &[&str]| {
+        let out = run_in(dir.path(), args);
+        assert!(out.status.success(), "{args:?}: {}", stderr(&out));
+        stderr(&out)
+    };
+    succeeds(
+        &[
+            &pendulum[..],
+            &["--init", "q=1", "--event", "q = 0", "--csv", "run.csv"],
+        ]
+        .concat(),
+    );
+    for plot in ["p.svg", "p.png"] {
+        succeeds(&[
+            "simulate",
+            "simple_pendulum_cartesian",
+            "--t-end",
+            "1",
+            "--plot",
+            plot,
+        ]);
+    }
+    for name in ["run-events.csv", "p-drift.svg", "p-drift.png"] {
+        assert!(dir.path().join(name).exists(), "{name}");
+    }
+    let text = succeeds(&[&pendulum[..], &["--csv", "run.csv", "--plot", "p.svg"]].concat());
+    let text = text + &succeeds(&[&pendulum[..], &["--plot", "p.png"]].concat());
+    assert!(!text.contains("warning"), "{text}");
+    for name in ["run-events.csv", "p-drift.svg", "p-drift.png"] {
+        assert!(!dir.path().join(name).exists(), "{name} stayed");
+    }
+}
+
+/// Runs `eomgen args` in `dir` through `sh -c`, with `redirection` (`3>>log.csv`) applied to
+/// it: how a user hands the program a descriptor.
+fn run_redirected(dir: &std::path::Path, redirection: &str, args: &[&str]) -> Output {
+    Command::new("sh")
+        .arg("-c")
+        .arg(format!("\"$@\" {redirection}"))
+        .arg("sh")
+        .arg(env!("CARGO_BIN_EXE_eomgen"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .expect("sh runs")
+}
+
+/// `--csv /dev/fd/3 3>>log.csv` reopened the descriptor's file with O_TRUNC and destroyed
+/// the log. A descriptor of the program is now written through a duplicate of it (appended
+/// to, as its redirection says, and never truncated); a descriptor that is not open is a
+/// usage error; `/proc/self/cwd/…` is an ordinary path (replaced by rename, like any file).
+#[test]
+fn issue_28_an_open_descriptor_is_written_through_not_reopened() {
+    use std::os::unix::fs::MetadataExt as _;
+    let dir = tempfile::tempdir().unwrap();
+    let log = dir.path().join("log.csv");
+    let pendulum = ["simulate", "simple_pendulum", "--t-out", "1"];
+    for (k, path) in ["/dev/fd/3", "/proc/self/fd/3"].into_iter().enumerate() {
+        std::fs::write(&log, "keep\n").unwrap();
+        let out = run_redirected(
+            dir.path(),
+            "3>>log.csv",
+            &[&pendulum[..], &["--csv", path]].concat(),
+        );
+        assert!(out.status.success(), "{path}: {}", stderr(&out));
+        let text = std::fs::read_to_string(&log).unwrap();
+        assert!(
+            text.starts_with("keep\nt,q,q_dot,energy\n"),
+            "{path}: {text}"
+        );
+        assert_eq!(text.matches("keep").count(), 1, "{path}: {text}");
+        assert!(temporaries(dir.path()).is_empty(), "{k}");
+    }
+    // Not open: nothing to write to.
+    let out = run_in(
+        dir.path(),
+        &[&pendulum[..], &["--csv", "/dev/fd/9"]].concat(),
+    );
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("no such open file descriptor"),
+        "{}",
+        stderr(&out)
+    );
+    // Any other path under /proc is a path like any other.
+    let file = dir.path().join("cwd.csv");
+    std::fs::write(&file, "old\n").unwrap();
+    let before = std::fs::metadata(&file).unwrap().ino();
+    let out = run_in(
+        dir.path(),
+        &[&pendulum[..], &["--csv", "/proc/self/cwd/cwd.csv"]].concat(),
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(
+        std::fs::read_to_string(&file)
+            .unwrap()
+            .starts_with("t,q,q_dot,energy\n")
+    );
+    assert_ne!(
+        std::fs::metadata(&file).unwrap().ino(),
+        before,
+        "replaced by rename, as an ordinary file"
+    );
+}
+
+/// As root, a link that another user planted in a sticky world-writable directory was
+/// followed and its target replaced, which the kernel's fs.protected_symlinks forbids. Such
+/// a link is now refused before any work (the target is untouched); a link of the caller in
+/// the same directory is followed. Only root can give a link to another user, so the test
+/// says it was skipped otherwise.
+#[test]
+fn issue_28_a_planted_link_in_a_sticky_directory_is_not_followed() {
+    use std::os::unix::fs::PermissionsExt as _;
+    let dir = tempfile::tempdir().unwrap();
+    let sticky = dir.path().join("shared");
+    std::fs::create_dir(&sticky).unwrap();
+    std::fs::set_permissions(&sticky, std::fs::Permissions::from_mode(0o1777)).unwrap();
+    let victim = dir.path().join("victim.csv");
+    std::fs::write(&victim, "precious\n").unwrap();
+    let planted = sticky.join("planted.csv");
+    std::os::unix::fs::symlink(&victim, &planted).unwrap();
+    if std::os::unix::fs::lchown(&planted, Some(4321), Some(4321)).is_err() {
+        eprintln!("skipped: only root can give a link to another user");
+        return;
+    }
+    let out = run(&[
+        "simulate",
+        "simple_pendulum",
+        "--t-out",
+        "1",
+        "--csv",
+        planted.to_str().unwrap(),
+    ]);
+    let text = stderr(&out);
+    assert_eq!(out.status.code(), Some(2), "{text}");
+    assert!(text.contains("fs.protected_symlinks"), "{text}");
+    assert_eq!(std::fs::read_to_string(&victim).unwrap(), "precious\n");
+
+    let own = sticky.join("own.csv");
+    std::os::unix::fs::symlink(&victim, &own).unwrap();
+    let out = run(&[
+        "simulate",
+        "simple_pendulum",
+        "--t-out",
+        "1",
+        "--csv",
+        own.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(
+        std::fs::read_to_string(&victim)
+            .unwrap()
+            .starts_with("t,q,q_dot,energy\n")
+    );
+}
+
+/// With `mkdir -p R/index.html`, `report -o R` wrote report.json and the model's folder, then
+/// exited 2 naming an option "output". The report's files are now checked before any work
+/// like every command's outputs (status 2, nothing written); so is a file where a model's
+/// folder goes.
+#[test]
+fn issue_28_report_outputs_are_checked_before_any_work() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("R");
+    std::fs::create_dir_all(out.join("index.html")).unwrap();
+    let report = || {
+        run(&[
+            "report",
+            "--models",
+            "simple_pendulum",
+            "-o",
+            out.to_str().unwrap(),
+        ])
+    };
+    let result = report();
+    let text = stderr(&result);
+    assert_eq!(result.status.code(), Some(2), "{text}");
+    assert!(
+        text.contains("--out (its index.html)") && text.contains("is a directory"),
+        "{text}"
+    );
+    let written: Vec<_> = std::fs::read_dir(&out)
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(written, ["index.html"], "written before the refusal");
+
+    std::fs::remove_dir(out.join("index.html")).unwrap();
+    std::fs::write(out.join("simple_pendulum"), "mine\n").unwrap();
+    let result = report();
+    let text = stderr(&result);
+    assert_eq!(result.status.code(), Some(2), "{text}");
+    assert!(text.contains("is not a directory"), "{text}");
+    assert!(!out.join("report.json").exists());
+}
+
+/// `--csv new/` (a directory's name) wrote a file `new`; `--csv -` wrote a file named `-`
+/// and a companion `--events.csv`. A file output ending in `/` is refused before any work,
+/// and `-` is standard output.
+#[test]
+fn issue_28_a_trailing_slash_is_refused_and_dash_is_standard_output() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = run_in(
+        dir.path(),
+        &[
+            "simulate",
+            "simple_pendulum",
+            "--t-out",
+            "1",
+            "--csv",
+            "new/",
+        ],
+    );
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("--csv `new/` names no file"),
+        "{}",
+        stderr(&out)
+    );
+
+    let out = run_in(
+        dir.path(),
+        &[
+            "simulate",
+            "simple_pendulum",
+            "--t-out",
+            "1",
+            "--init",
+            "q=1",
+            "--event",
+            "q = 0",
+            "--csv",
+            "-",
+        ],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.starts_with("t,q,q_dot,energy\n"), "{text}");
+    assert!(text.contains("\nmodel      simple_pendulum"), "{text}");
+    let written: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();
+    assert!(written.is_empty(), "wrote {written:?}");
 }

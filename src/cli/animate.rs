@@ -80,6 +80,7 @@ pub struct AnimateArgs {
 /// Runs `animate`.
 pub fn run(args: &AnimateArgs) -> Result<(), CliError> {
     super::files::Outputs::new()
+        .input(&args.model)
         .file("--output", Some(&args.output))
         .file("--gif", args.gif.as_deref())
         .check()?;

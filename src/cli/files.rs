@@ -10,14 +10,18 @@
 //!   of a new file (0666 less the umask);
 //! - a **symbolic link** is followed to its final target (which need not exist yet), and that
 //!   target is replaced as above, in its own directory: the link stays a link and its target
-//!   is the new file;
-//! - the program's own **standard output or error** (`/dev/stdout`, `/dev/fd/1`, or any name
-//!   of the same open file) is written through the stream, in order with what the command
+//!   is the new file. A link that the kernel's `fs.protected_symlinks` rule would not follow
+//!   (another user's, in a sticky world-writable directory) is refused ([`may_follow`]);
+//! - the program's own **standard output or error** (`-`, `/dev/stdout`, `/dev/fd/1`, or any
+//!   name of the same open file) is written through the stream, in order with what the command
 //!   prints, and standard output's errors are reported as standard output's
 //!   ([`super::output`]);
-//! - anything else that is not a regular file (`/dev/null`, a FIFO, a terminal, a file
-//!   reached through `/proc/…/fd/N`) is opened for writing and the bytes are streamed into it:
-//!   never renamed over, never removed.
+//! - another of the program's **open descriptors**, named exactly `/dev/fd/N` or
+//!   `/proc/self/fd/N`, is written through a duplicate of it, never reopened or truncated
+//!   (`3>>log.csv` appends); another process's `/proc/<pid>/fd/N` is opened and appended to;
+//! - anything else that is not a regular file (`/dev/null`, a FIFO, a terminal) is opened
+//!   for writing and the bytes are streamed into it: never truncated, renamed over or
+//!   removed.
 
 use std::fs::{self, Metadata, OpenOptions};
 use std::io::{self, Write as _};
@@ -44,7 +48,7 @@ pub(super) enum FileError {
         /// The path as given.
         path: String,
     },
-    /// The path names no file (empty, or ending in `..`).
+    /// The path names no file (empty, ending in `/` or in `..`).
     #[error("{option} `{path}` names no file; give a file name")]
     NoFileName {
         /// The option that names the file.
@@ -82,6 +86,19 @@ pub(super) enum FileError {
         second: String,
         /// The path as the second option gives it.
         path: String,
+    },
+    /// An output names a file the command reads (its model file, under any name: a link
+    /// to it, a hard link, another spelling of its path): writing it would destroy the input.
+    #[error(
+        "{option} `{path}` is the model file `{input}` that this command reads; give the output another name"
+    )]
+    InputFile {
+        /// The option that names the output.
+        option: String,
+        /// The output's path as given.
+        path: String,
+        /// The input's path as given.
+        input: String,
     },
     /// Writing the file failed.
     #[error("cannot write `{path}`: {reason}")]
@@ -127,33 +144,89 @@ enum Stream {
 enum Target {
     /// The program's standard output or error: written through the stream.
     Standard(Stream),
-    /// Not a regular file, or a file reached through `/proc/…/fd/N`: opened and written in
-    /// place (truncated when it is a regular file, as a shell's `>` does).
-    InPlace { path: PathBuf, truncate: bool },
+    /// Not a regular file, or another process's descriptor (`/proc/<pid>/fd/N`): opened and
+    /// written in place, never truncated (appended to when `append`).
+    InPlace { path: PathBuf, append: bool },
     /// A regular file at the end of any symbolic links, replaced by rename; `existing` is
     /// the file there now, if any.
     Regular {
         path: PathBuf,
         existing: Option<Metadata>,
     },
+    /// One of the program's own open descriptors (`/dev/fd/N`, `/proc/self/fd/N`): written
+    /// through a duplicate of it, at its offset and with its flags (`3>>log` appends), never
+    /// reopened or truncated.
+    Descriptor(i32),
     /// A directory: refused.
     Directory,
 }
 
+/// What a path of the form `/dev/fd/N` or `/proc/<pid>/fd/N` names.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum FdPath {
+    /// Descriptor `N` of this process (`/dev/fd/N`, `/proc/self/fd/N`,
+    /// `/proc/thread-self/fd/N`, or `/proc/<our pid>/fd/N`).
+    Own(i32),
+    /// A descriptor of another process: opened through its link, appended to.
+    Other,
+}
+
+/// Whether `path` is exactly `/dev/fd/N` or `/proc/<pid>/fd/N` (no other path under `/proc`,
+/// such as `/proc/self/cwd/…` or `/proc/self/root/…`, which are ordinary paths).
+fn fd_path(path: &str) -> Option<FdPath> {
+    let number = |text: &str| {
+        (!text.is_empty() && text.bytes().all(|b| b.is_ascii_digit()))
+            .then(|| text.parse::<i32>().ok())
+            .flatten()
+    };
+    if let Some(n) = path.strip_prefix("/dev/fd/") {
+        return number(n).map(FdPath::Own);
+    }
+    let (process, n) = path.strip_prefix("/proc/")?.split_once("/fd/")?;
+    let n = number(n)?;
+    let own = matches!(process, "self" | "thread-self")
+        || number(process).is_some_and(|pid| u32::try_from(pid) == Ok(std::process::id()));
+    if own {
+        Some(FdPath::Own(n))
+    } else {
+        number(process).map(|_| FdPath::Other)
+    }
+}
+
 /// What `path` names, following symbolic links ([`Target`]).
 fn resolve(path: &str) -> io::Result<Target> {
+    // `-` is standard output, as for most programs (it used to be a file named `-`, with a
+    // companion `--events.csv`).
+    if path == "-" {
+        return Ok(Target::Standard(Stream::Output));
+    }
+    let descriptor = fd_path(path);
     match fs::metadata(path) {
         Ok(m) if m.is_dir() => return Ok(Target::Directory),
         Ok(m) => {
             if let Some(stream) = standard_stream(&m) {
                 return Ok(Target::Standard(stream));
             }
+            match descriptor {
+                Some(FdPath::Own(n)) => return Ok(Target::Descriptor(n)),
+                Some(FdPath::Other) => {
+                    return Ok(Target::InPlace {
+                        path: PathBuf::from(path),
+                        append: true,
+                    });
+                }
+                None => {}
+            }
             if !m.is_file() {
                 return Ok(Target::InPlace {
                     path: PathBuf::from(path),
-                    truncate: false,
+                    append: false,
                 });
             }
+        }
+        // A descriptor that is not open names nothing to write to (and no place to create).
+        Err(_) if descriptor.is_some() => {
+            return Err(io::Error::other("no such open file descriptor"));
         }
         Err(e) if e.kind() == io::ErrorKind::NotFound => {}
         Err(e) => return Err(e),
@@ -177,13 +250,15 @@ fn resolve(path: &str) -> io::Result<Target> {
                 existing: Some(metadata),
             });
         }
-        // `/proc/…/fd/N` (and `/dev/fd/N` through it) names an open file, not a place in
-        // a directory: its "target" may be `pipe:[…]` or a deleted file.
-        if current.starts_with("/proc") || current.starts_with("/dev/fd") {
-            return Ok(Target::InPlace {
-                path: PathBuf::from(path),
-                truncate: true,
-            });
+        if !may_follow(&current, &metadata)? {
+            return Err(io::Error::new(
+                io::ErrorKind::PermissionDenied,
+                format!(
+                    "the symbolic link `{}` is owned by another user in a sticky world-writable \
+                     directory, and is not followed (the rule of fs.protected_symlinks)",
+                    current.display()
+                ),
+            ));
         }
         let link = fs::read_link(&current)?;
         current = match current.parent() {
@@ -192,6 +267,27 @@ fn resolve(path: &str) -> io::Result<Target> {
         };
     }
     Err(io::Error::other("too many levels of symbolic links"))
+}
+
+/// Whether the writer may follow the symbolic `link` (whose own metadata is `metadata`): the
+/// kernel's rule of `fs.protected_symlinks`, applied here because the writer follows links
+/// itself (to replace the final target) where the kernel's check would not run. A link in a
+/// sticky world-writable directory (`/tmp`) is followed only when its owner is the caller
+/// (effective user) or the directory's owner: otherwise another user may have planted it to
+/// make the writer — root, say — replace a file it points to.
+#[cfg(unix)]
+fn may_follow(link: &Path, metadata: &Metadata) -> io::Result<bool> {
+    use std::os::unix::fs::MetadataExt as _;
+    let directory = fs::metadata(directory_of(link))?;
+    let sticky_world_writable = directory.mode() & 0o1002 == 0o1002;
+    // SAFETY: `geteuid` has no preconditions and cannot fail (POSIX).
+    let caller = unsafe { libc::geteuid() };
+    Ok(!sticky_world_writable || metadata.uid() == caller || metadata.uid() == directory.uid())
+}
+
+#[cfg(not(unix))]
+fn may_follow(_: &Path, _: &Metadata) -> io::Result<bool> {
+    Ok(true)
 }
 
 /// The standard stream that is the same open file as `metadata`'s, if any.
@@ -243,8 +339,8 @@ fn os_error(e: &io::Error) -> String {
 /// stream.
 ///
 /// # Errors
-/// [`FileError::Write`] naming `path` with the operating system's reason, or
-/// [`FileError::Directory`] for a directory. A write to standard output that fails is kept by
+/// [`FileError::Write`] naming `path` with the operating system's reason (or that a
+/// directory is in the way). A write to standard output that fails is kept by
 /// [`super::output`] (status 1, or 141 for a closed pipe) and is not an error here.
 pub(super) fn write(path: &str, bytes: &[u8]) -> Result<(), FileError> {
     let fail = |e: io::Error| FileError::Write {
@@ -252,9 +348,11 @@ pub(super) fn write(path: &str, bytes: &[u8]) -> Result<(), FileError> {
         reason: os_error(&e),
     };
     match resolve(path).map_err(fail)? {
-        Target::Directory => Err(FileError::Directory {
-            option: "output".to_string(),
+        // Found when the file is written, after the work: a failed write, not a usage error
+        // (the check before the work refuses it as one).
+        Target::Directory => Err(FileError::Write {
             path: path.to_string(),
+            reason: "a directory is in the way".to_string(),
         }),
         Target::Standard(Stream::Output) => {
             let _ = super::output::stdout().write_all(bytes);
@@ -263,22 +361,45 @@ pub(super) fn write(path: &str, bytes: &[u8]) -> Result<(), FileError> {
         Target::Standard(Stream::Error) => io::stderr().write_all(bytes).map_err(fail),
         Target::InPlace {
             path: target,
-            truncate,
+            append,
         } => {
-            let mut file = OpenOptions::new()
+            let file = OpenOptions::new()
                 .write(true)
-                .truncate(truncate)
+                .append(append)
                 .open(target)
                 .map_err(fail)?;
-            file.write_all(bytes)
-                .and_then(|()| file.flush())
-                .map_err(fail)
+            write_all(file, bytes).map_err(fail)
         }
+        Target::Descriptor(n) => write_all(duplicate(n).map_err(fail)?, bytes).map_err(fail),
         Target::Regular {
             path: target,
             existing,
         } => replace(&target, existing.as_ref(), bytes).map_err(fail),
     }
+}
+
+/// Writes all of `bytes` into `file` and flushes it.
+fn write_all(mut file: fs::File, bytes: &[u8]) -> io::Result<()> {
+    file.write_all(bytes)?;
+    file.flush()
+}
+
+/// A duplicate of this process's open descriptor `n` (`dup`): the same open file, offset and
+/// flags, so the bytes go where the shell's redirection (`3>>log.csv`) points, appended or at
+/// the offset, with nothing reopened or truncated.
+#[cfg(unix)]
+fn duplicate(n: i32) -> io::Result<fs::File> {
+    use std::os::fd::BorrowedFd;
+    // SAFETY: `resolve` found `n` open (its metadata was read through `/dev/fd/N` just
+    // before), and the borrow lasts only for the `dup` below, which fails with EBADF rather
+    // than misbehaves if it was closed since.
+    let fd = unsafe { BorrowedFd::borrow_raw(n) };
+    Ok(fs::File::from(fd.try_clone_to_owned()?))
+}
+
+#[cfg(not(unix))]
+fn duplicate(_: i32) -> io::Result<fs::File> {
+    Err(io::Error::from(io::ErrorKind::Unsupported))
 }
 
 /// Writes `bytes` to a temporary file in `target`'s directory, with the owner, group and
@@ -317,24 +438,47 @@ fn replace(target: &Path, existing: Option<&Metadata>, bytes: &[u8]) -> io::Resu
 pub(super) fn writes_in_place(path: &str) -> bool {
     matches!(
         resolve(path),
-        Ok(Target::Standard(_) | Target::InPlace { .. })
+        Ok(Target::Standard(_) | Target::InPlace { .. } | Target::Descriptor(_))
     )
+}
+
+/// What [`remove_stale`] did with a companion file of an earlier run.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum Stale {
+    /// No regular file of that name: nothing to do.
+    Absent,
+    /// A file that eomgen wrote, removed.
+    Removed,
+    /// A regular file that eomgen did not write (or cannot be read to tell): kept, and stale
+    /// beside this run's outputs; the caller warns.
+    Kept,
 }
 
 /// Removes `path`, a companion file that an earlier run wrote beside an output and that this
 /// run does not write (`FILE-events.csv` of a run without events), so that the files beside
-/// an output always come from the same run. Only a regular file is removed: a symbolic link,
-/// a device or a FIFO of that name is left alone, and so is a missing file.
+/// an output always come from the same run. Only a regular file that `is_ours` recognises
+/// from its bytes (the header or the marker eomgen writes in it) is removed: a file of that
+/// name that eomgen did not write is the user's and is kept ([`Stale::Kept`]); a symbolic
+/// link, a device or a FIFO of that name is left alone, and so is a missing file.
 ///
 /// # Errors
-/// [`FileError::Remove`] when a regular file is there and cannot be removed.
-pub(super) fn remove_stale(path: &str) -> Result<(), FileError> {
+/// [`FileError::Remove`] when a file of ours is there and cannot be removed.
+pub(super) fn remove_stale(
+    path: &str,
+    is_ours: impl Fn(&[u8]) -> bool,
+) -> Result<Stale, FileError> {
     match fs::symlink_metadata(path) {
-        Ok(m) if m.is_file() => fs::remove_file(path).map_err(|e| FileError::Remove {
-            path: path.to_string(),
-            reason: os_error(&e),
-        }),
-        _ => Ok(()),
+        Ok(m) if m.is_file() => {
+            if !fs::read(path).is_ok_and(|bytes| is_ours(&bytes)) {
+                return Ok(Stale::Kept);
+            }
+            fs::remove_file(path).map_err(|e| FileError::Remove {
+                path: path.to_string(),
+                reason: os_error(&e),
+            })?;
+            Ok(Stale::Removed)
+        }
+        _ => Ok(Stale::Absent),
     }
 }
 
@@ -367,9 +511,13 @@ enum Identity {
     Stream,
 }
 
-/// A command's outputs, checked together before it does any work ([`Outputs::check`]).
+/// A command's outputs, checked together before it does any work ([`Outputs::check`]), and
+/// the files it reads, which no output may overwrite.
 #[derive(Debug, Default)]
-pub(super) struct Outputs(Vec<Planned>);
+pub(super) struct Outputs {
+    outputs: Vec<Planned>,
+    inputs: Vec<String>,
+}
 
 impl Outputs {
     /// No output yet.
@@ -381,12 +529,21 @@ impl Outputs {
     #[must_use]
     pub(super) fn add(mut self, option: &str, path: Option<&str>, format: Format) -> Self {
         if let Some(path) = path {
-            self.0.push(Planned {
+            self.outputs.push(Planned {
                 option: option.to_string(),
                 path: path.to_string(),
                 format,
             });
         }
+        self
+    }
+
+    /// Adds a file the command reads: `name_or_path` is a model's name or its file's path. A
+    /// name that is no file (a bundled model) adds nothing to check; a path that cannot be
+    /// read is left to the command's own error.
+    #[must_use]
+    pub(super) fn input(mut self, name_or_path: &str) -> Self {
+        self.inputs.push(name_or_path.to_string());
         self
     }
 
@@ -404,14 +561,27 @@ impl Outputs {
 
     /// Checks every output before the command computes anything: a chart's extension, a
     /// path that is a directory, a directory that does not exist or cannot be written (a
-    /// temporary file is created there and removed), and two outputs of one file.
+    /// temporary file is created there and removed), two outputs of one file, and an output
+    /// that is one of the files the command reads (the same device and inode, after links).
     ///
     /// # Errors
     /// The first refused output ([`FileError`], a usage error).
     pub(super) fn check(&self) -> Result<(), FileError> {
-        let mut seen: Vec<(Identity, &str)> = Vec::with_capacity(self.0.len());
-        for planned in &self.0 {
+        let inputs: Vec<(Identity, &str)> = self
+            .inputs
+            .iter()
+            .filter_map(|path| Some((input_identity(path)?, path.as_str())))
+            .collect();
+        let mut seen: Vec<(Identity, &str)> = Vec::with_capacity(self.outputs.len());
+        for planned in &self.outputs {
             let identity = check_one(planned)?;
+            if let Some((_, input)) = inputs.iter().find(|(i, _)| *i == identity) {
+                return Err(FileError::InputFile {
+                    option: planned.option.clone(),
+                    path: planned.path.clone(),
+                    input: input.to_string(),
+                });
+            }
             if identity != Identity::Stream
                 && let Some((_, first)) = seen.iter().find(|(i, _)| *i == identity)
             {
@@ -439,6 +609,13 @@ fn check_one(planned: &Planned) -> Result<Identity, FileError> {
         path: path.clone(),
         reason: os_error(&e),
     };
+    // `out/` names a directory: a file output would otherwise create the file `out`.
+    if path.ends_with('/') {
+        return Err(FileError::NoFileName {
+            option: option.clone(),
+            path: path.clone(),
+        });
+    }
     if *format == Format::Chart && !(path.ends_with(".svg") || path.ends_with(".png")) {
         return Err(FileError::ChartExtension {
             option: option.clone(),
@@ -450,7 +627,9 @@ fn check_one(planned: &Planned) -> Result<Identity, FileError> {
             option: option.clone(),
             path: path.clone(),
         }),
-        Target::Standard(_) | Target::InPlace { .. } => Ok(Identity::Stream),
+        Target::Standard(_) | Target::InPlace { .. } | Target::Descriptor(_) => {
+            Ok(Identity::Stream)
+        }
         Target::Regular {
             path: target,
             existing,
@@ -485,6 +664,16 @@ fn check_one(planned: &Planned) -> Result<Identity, FileError> {
     }
 }
 
+/// Which file the input `path` is: an existing regular file (after symbolic links), by device
+/// and inode, or by canonical name where there are no inodes; `None` for anything else.
+fn input_identity(path: &str) -> Option<Identity> {
+    let metadata = fs::metadata(path).ok().filter(Metadata::is_file)?;
+    match inode(&metadata) {
+        Some((device, inode)) => Some(Identity::Inode(device, inode)),
+        None => fs::canonicalize(path).ok().map(Identity::Name),
+    }
+}
+
 /// The device and inode of a file.
 #[cfg(unix)]
 fn inode(metadata: &Metadata) -> Option<(u64, u64)> {
@@ -495,4 +684,49 @@ fn inode(metadata: &Metadata) -> Option<(u64, u64)> {
 #[cfg(not(unix))]
 fn inode(_: &Metadata) -> Option<(u64, u64)> {
     None
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A directory found in the way when the file is written (after the check before the
+    /// work) is a failed write naming the file, status 1, not a usage error.
+    #[test]
+    fn a_directory_in_the_way_at_write_time_is_a_failed_write() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("index.html");
+        std::fs::create_dir(&path).unwrap();
+        let path = path.to_string_lossy().into_owned();
+        let error = write(&path, b"x").unwrap_err();
+        assert!(
+            matches!(&error, FileError::Write { path: p, .. } if *p == path),
+            "{error:?}"
+        );
+        assert_eq!(CliError::from(error).code, 1);
+    }
+
+    /// Exactly `/dev/fd/N` and `/proc/<pid>/fd/N` name descriptors; other paths under
+    /// `/proc` are ordinary.
+    #[test]
+    fn only_descriptor_paths_are_descriptors() {
+        let own = format!("/proc/{}/fd/4", std::process::id());
+        for (path, kind) in [
+            ("/dev/fd/3", Some(FdPath::Own(3))),
+            ("/proc/self/fd/12", Some(FdPath::Own(12))),
+            ("/proc/thread-self/fd/0", Some(FdPath::Own(0))),
+            (own.as_str(), Some(FdPath::Own(4))),
+            ("/proc/1/fd/3", Some(FdPath::Other)),
+            ("/proc/self/cwd/out.csv", None),
+            ("/proc/self/root/tmp/x.csv", None),
+            ("/proc/self/fd/3/", None),
+            ("/proc/self/fd/../fd/3", None),
+            ("/dev/fd/", None),
+            ("/dev/fd/-1", None),
+            ("/dev/fd/3x", None),
+            ("/dev/fd/99999999999", None),
+        ] {
+            assert_eq!(fd_path(path), kind, "{path}");
+        }
+    }
 }

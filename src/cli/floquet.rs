@@ -78,6 +78,7 @@ fn analysis_text(model: &dyn ModelInfo, e: &FloquetStudyError) -> String {
 /// Runs `study floquet`.
 pub fn run(args: &FloquetArgs) -> Result<(), CliError> {
     Outputs::new()
+        .input(&args.model)
         .chart("--plot", args.plot.as_deref())
         .check()?;
     let mut model = args.point.model(&args.model)?;

@@ -218,6 +218,7 @@ where
 /// Runs `study free-response`.
 pub fn run(args: &FreeResponseArgs) -> Result<(), CliError> {
     Outputs::new()
+        .input(&args.model)
         .chart("--plot", args.plot.as_deref())
         .check()?;
     let model = args.point.model(&args.model)?;

@@ -157,6 +157,7 @@ fn frequency(option: &str, text: &str, w: f64, zero: bool) -> Result<f64, CliErr
 /// Runs `frf`.
 pub fn run(args: &FrfArgs) -> Result<(), CliError> {
     Outputs::new()
+        .input(&args.model)
         .chart("--plot", args.plot.as_deref())
         .check()?;
     let mut model = args.point.model(&args.model)?;

@@ -129,7 +129,9 @@ fn allow_negative_numbers(command: clap::Command) -> clap::Command {
 /// such a value for an unknown option otherwise ("unexpected argument '-inf'"), and only
 /// plain negative numbers pass its `allow_negative_numbers`. The value then reaches the
 /// option's own check. An option of the command after another (`--csv --json`) stays an
-/// option, so a missing value is still reported as missing.
+/// option, so a missing value is still reported as missing, and so does any word that
+/// starts with `--` (`--csv --plot-phse`): no value starts with `--`, and a mistyped option
+/// must be reported, not taken for a file name.
 fn join_hyphen_values(
     command: &clap::Command,
     args: Vec<std::ffi::OsString>,
@@ -179,7 +181,12 @@ fn join_hyphen_values(
             break;
         };
         match value.to_str() {
-            Some(v) if v.starts_with('-') && v != "-" && !is_option_of(current, v) => {
+            Some(v)
+                if v.starts_with('-')
+                    && !v.starts_with("--")
+                    && v != "-"
+                    && !is_option_of(current, v) =>
+            {
                 let name = option.get_long().map_or_else(
                     || format!("-{}", option.get_short().unwrap_or_default()),
                     |long| format!("--{long}"),
@@ -196,7 +203,9 @@ fn join_hyphen_values(
 }
 
 /// Whether `text` (which starts with `-`) is an option of `command`: `--name`, `--name=…`,
-/// `-x…` for one of its short names, `--help`, `-h`, `--version`, `-V`, or `--`.
+/// exactly `-x` for one of its short names, `--help`, `-h`, `--version`, `-V`, or `--`. A
+/// longer word with one dash is a value, even when it starts with a short name's letter: an
+/// expression such as `-height + q` or `-omega` (`--stop-when`), not `-h` and `eight + q`.
 fn is_option_of(command: &clap::Command, text: &str) -> bool {
     if let Some(long) = text.strip_prefix("--") {
         let name = long.split_once('=').map_or(long, |(name, _)| name);
@@ -204,7 +213,11 @@ fn is_option_of(command: &clap::Command, text: &str) -> bool {
             || matches!(name, "help" | "version")
             || command.get_arguments().any(|a| a.get_long() == Some(name))
     } else {
-        let short = text[1..].chars().next();
+        let mut rest = text[1..].chars();
+        let short = rest.next();
+        if rest.next().is_some() {
+            return false;
+        }
         matches!(short, Some('h' | 'V'))
             || command
                 .get_arguments()

@@ -57,6 +57,7 @@ pub struct ModalDampingArgs {
 /// Runs `study modal-damping`.
 pub fn run(args: &ModalDampingArgs) -> Result<(), CliError> {
     Outputs::new()
+        .input(&args.model)
         .chart("--plot", args.plot.as_deref())
         .check()?;
     let model = args.point.model(&args.model)?;

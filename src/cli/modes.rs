@@ -93,9 +93,10 @@ pub fn run(args: &ModesArgs) -> Result<(), CliError> {
     };
     charts
         .iter()
-        .fold(super::files::Outputs::new(), |outputs, path| {
-            outputs.chart("--plot", Some(path))
-        })
+        .fold(
+            super::files::Outputs::new().input(&args.model),
+            |outputs, path| outputs.chart("--plot", Some(path)),
+        )
         .file("--animate", args.animate.as_deref())
         .check()?;
     let (model, modal) = analysis_of(&args.model, &args.point)?;

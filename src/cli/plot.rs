@@ -24,7 +24,7 @@ macro_rules! write_chart {
                 };
                 drawn
                     .map_err(|e| format!("`{path}`: {e}"))
-                    .and_then(|()| $crate::cli::plot::save(path, text.as_bytes()))
+                    .and_then(|()| $crate::cli::plot::save_svg(path, &text))
             }
             Ok($crate::cli::plot::ChartFormat::Png) => {
                 let mut pixels = vec![0u8; size.0 as usize * size.1 as usize * 3];
@@ -197,8 +197,26 @@ pub(super) fn save(path: &str, bytes: &[u8]) -> Result<(), String> {
     super::files::write(path, bytes).map_err(|e| e.to_string())
 }
 
+/// The comment that marks an SVG as written by eomgen, right after its opening `<svg …>`
+/// tag: how a later run recognises a stale chart of its own ([`is_own_drift_chart`]).
+const SVG_SOFTWARE: &str = "<!-- Software: eomgen -->";
+
+/// Writes a drawn SVG to `path` ([`save`]) with the [`SVG_SOFTWARE`] comment after its
+/// opening tag.
+///
+/// # Errors
+/// The write error, naming the file and the operating system's reason.
+pub(super) fn save_svg(path: &str, svg: &str) -> Result<(), String> {
+    let marked = match svg.split_once('\n') {
+        Some((open, rest)) => format!("{open}\n{SVG_SOFTWARE}\n{rest}"),
+        None => svg.to_string(),
+    };
+    save(path, marked.as_bytes())
+}
+
 /// Encodes `pixels` (RGB, 8 bits a channel, rows of `size.0`) as PNG, as plotters' own
-/// bitmap files are encoded, and writes it to `path` ([`save`]).
+/// bitmap files are encoded, with the text chunk `Software: eomgen` ([`PNG_SOFTWARE`]), and
+/// writes it to `path` ([`save`]).
 ///
 /// # Errors
 /// A failed encoding, or the write error.
@@ -212,7 +230,71 @@ pub(super) fn save_png(
     image::codecs::png::PngEncoder::new(&mut bytes)
         .write_image(pixels, width, height, image::ColorType::Rgb8)
         .map_err(|e| format!("`{path}`: cannot encode the PNG: {e}"))?;
-    save(path, &bytes)
+    save(path, &with_software_chunk(bytes))
+}
+
+/// The `tEXt` chunk that marks a PNG as written by eomgen (keyword `Software`, PNG
+/// specification §11.3.4.2): how a later run recognises a stale chart of its own
+/// ([`is_own_png`]) before removing it.
+const PNG_SOFTWARE: &[u8] = b"Software\0eomgen";
+
+/// The 8-byte PNG signature and the 25-byte `IHDR` chunk that every PNG starts with: the
+/// `tEXt` chunk goes right after them.
+const PNG_HEADER_LEN: usize = 8 + 25;
+
+/// `png` (as the encoder wrote it) with the [`PNG_SOFTWARE`] chunk after its header.
+fn with_software_chunk(png: Vec<u8>) -> Vec<u8> {
+    if png.len() < PNG_HEADER_LEN {
+        return png;
+    }
+    let mut chunk = Vec::with_capacity(12 + PNG_SOFTWARE.len());
+    let length = u32::try_from(PNG_SOFTWARE.len()).unwrap_or(u32::MAX);
+    chunk.extend_from_slice(&length.to_be_bytes());
+    chunk.extend_from_slice(b"tEXt");
+    chunk.extend_from_slice(PNG_SOFTWARE);
+    let crc = crc32(&chunk[4..]);
+    chunk.extend_from_slice(&crc.to_be_bytes());
+    let mut out = png;
+    out.splice(PNG_HEADER_LEN..PNG_HEADER_LEN, chunk);
+    out
+}
+
+/// Whether `bytes` is a PNG that eomgen wrote: its first chunk after the header is the
+/// [`PNG_SOFTWARE`] text chunk.
+pub(super) fn is_own_png(bytes: &[u8]) -> bool {
+    let start = PNG_HEADER_LEN + 8;
+    bytes.starts_with(b"\x89PNG\r\n\x1a\n")
+        && bytes.get(PNG_HEADER_LEN + 4..start) == Some(b"tEXt".as_slice())
+        && bytes.get(start..start + PNG_SOFTWARE.len()) == Some(PNG_SOFTWARE)
+}
+
+/// The CRC-32 of a PNG chunk's type and data (ISO 3309, reflected polynomial 0xEDB88320,
+/// as the PNG specification's Annex D computes it), bit by bit: a chunk of 20 bytes.
+fn crc32(bytes: &[u8]) -> u32 {
+    let mut crc = u32::MAX;
+    for &byte in bytes {
+        crc ^= u32::from(byte);
+        for _ in 0..8 {
+            crc = if crc & 1 == 1 {
+                (crc >> 1) ^ 0xEDB8_8320
+            } else {
+                crc >> 1
+            };
+        }
+    }
+    !crc
+}
+
+/// Every constraint drift chart's title ([`constraint_drift`]) ends with this.
+const DRIFT_TITLE: &str = ": constraint drift";
+
+/// Whether `bytes` is a constraint drift chart that eomgen wrote: an SVG with eomgen's
+/// comment ([`SVG_SOFTWARE`]) and the drift chart's title, or a PNG with eomgen's text chunk
+/// ([`is_own_png`]).
+pub(super) fn is_own_drift_chart(bytes: &[u8]) -> bool {
+    let contains = |needle: &str| bytes.windows(needle.len()).any(|w| w == needle.as_bytes());
+    is_own_png(bytes)
+        || (bytes.starts_with(b"<svg") && contains(SVG_SOFTWARE) && contains(DRIFT_TITLE))
 }
 
 /// The points of `s` that can be drawn on the chart's axes.
@@ -538,7 +620,7 @@ pub fn constraint_drift(
             points: t.iter().zip(drift).map(|(t, d)| (*t, d.1)).collect(),
         },
     ];
-    let title = format!("{model}: constraint drift");
+    let title = format!("{model}{DRIFT_TITLE}");
     lines_noted(
         path,
         &Chart {
@@ -556,6 +638,24 @@ pub fn constraint_drift(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The CRC of the PNG specification's check value, and a marked PNG recognised as ours.
+    #[test]
+    fn a_png_carries_the_software_chunk() {
+        assert_eq!(crc32(b"123456789"), 0xCBF4_3926);
+        // IEND's CRC, as every PNG ends with it.
+        assert_eq!(crc32(b"IEND"), 0xAE42_6082);
+        use image::ImageEncoder as _;
+        let mut bytes = Vec::new();
+        image::codecs::png::PngEncoder::new(&mut bytes)
+            .write_image(&[0u8; 12], 2, 2, image::ColorType::Rgb8)
+            .unwrap();
+        assert!(!is_own_png(&bytes));
+        let marked = with_software_chunk(bytes);
+        assert!(is_own_png(&marked));
+        let decoded = image::load_from_memory(&marked).unwrap();
+        assert_eq!((decoded.width(), decoded.height()), (2, 2));
+    }
 
     /// A phase portrait's closed curve through the middle of the right side moves the legend
     /// to an empty corner; a curve that leaves the middle right empty keeps plotters' default.

@@ -75,6 +75,7 @@ pub fn run(args: &ReportArgs) -> Result<(), CliError> {
         )));
     }
     let sources = sources(&args.models)?;
+    check_outputs(args, &sources)?;
     std::fs::create_dir_all(&args.out)
         .map_err(|e| CliError::failure(format!("cannot create `{}`: {e}", args.out.display())))?;
     let bar = super::render::progress_bar(
@@ -145,6 +146,41 @@ pub fn run(args: &ReportArgs) -> Result<(), CliError> {
             failed.join("\n  ")
         )))
     }
+}
+
+/// Checks the report's files before any work, as every command checks its outputs
+/// ([`super::files::Outputs::check`]): `DIR/report.json` and `DIR/index.html` (not
+/// directories, not a model file read), and each model's folder `DIR/<name>` (a directory or
+/// nothing yet). A directory that does not exist yet is created empty, so nothing in it can
+/// be in the way.
+///
+/// # Errors
+/// A usage error naming the first file in the way.
+fn check_outputs(args: &ReportArgs, sources: &[Source]) -> Result<(), CliError> {
+    if !args.out.is_dir() {
+        return Ok(());
+    }
+    let path = |name: &str| args.out.join(name).to_string_lossy().into_owned();
+    let (json, index) = (path("report.json"), path("index.html"));
+    args.models
+        .iter()
+        .fold(super::files::Outputs::new(), |outputs, model| {
+            outputs.input(model)
+        })
+        .file("--out (its report.json)", Some(&json))
+        .file("--out (its index.html)", Some(&index))
+        .check()?;
+    for source in sources {
+        let folder = args.out.join(source.model.name());
+        if folder.exists() && !folder.is_dir() {
+            return Err(CliError::usage(format!(
+                "--out: `{}`, the folder of `{}`'s figures, is not a directory",
+                folder.display(),
+                source.model.name()
+            )));
+        }
+    }
+    Ok(())
 }
 
 /// The models named by `--models` (every bundled model when empty), loaded.

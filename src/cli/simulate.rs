@@ -213,6 +213,7 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
     let events_csv = companion(&args.csv, "events");
     let drift_chart = companion(&args.plot, "drift");
     Outputs::new()
+        .input(&args.model)
         .file("--csv", args.csv.as_deref())
         .file("--csv (its events file)", events_csv.as_deref())
         .chart("--plot", args.plot.as_deref())
@@ -275,9 +276,18 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
             incomplete.as_deref(),
         )?;
     }
+    // A companion this run has nothing for is removed when an earlier run of eomgen wrote
+    // it; a file of that name that eomgen did not write is kept, with a warning.
+    let keep_stale = |path: &str, stale: files::Stale| {
+        if stale == files::Stale::Kept {
+            super::output::errln!(
+                "warning: `{path}` is not from this run and was not written by eomgen; it was kept"
+            );
+        }
+    };
     if let Some(events) = &events_csv {
         if solution.events.is_empty() {
-            files::remove_stale(events)?;
+            keep_stale(events, files::remove_stale(events, is_events_csv)?);
         } else {
             write_events_csv(events, model.as_ref(), &solution)?;
         }
@@ -288,7 +298,10 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
     }
     if let Some(drift_path) = &drift_chart {
         if constraints.is_empty() {
-            files::remove_stale(drift_path)?;
+            keep_stale(
+                drift_path,
+                files::remove_stale(drift_path, plot::is_own_drift_chart)?,
+            );
         } else {
             plot::constraint_drift(
                 drift_path,
@@ -837,13 +850,38 @@ fn print_events(model: &dyn ModelInfo, solution: &Solution) {
     }
 }
 
+/// The first columns of an events CSV's header ([`write_events_csv`]).
+const EVENTS_HEADER: &str = "event,direction,terminal,t";
+
+/// Whether `bytes` is an events CSV that eomgen wrote, for any model: its first line is the
+/// exact header [`write_events_csv`] writes, [`EVENTS_HEADER`] then the coordinates `c₁…cₙ`
+/// and their rates `c₁_dot…cₙ_dot`.
+fn is_events_csv(bytes: &[u8]) -> bool {
+    let Some(line) = bytes.split(|&b| b == b'\n').next() else {
+        return false;
+    };
+    let Some(columns) = std::str::from_utf8(line)
+        .ok()
+        .and_then(|line| line.strip_prefix(EVENTS_HEADER)?.strip_prefix(','))
+    else {
+        return false;
+    };
+    let columns: Vec<&str> = columns.split(',').collect();
+    let (coordinates, rates) = columns.split_at(columns.len() / 2);
+    columns.len().is_multiple_of(2)
+        && coordinates
+            .iter()
+            .zip(rates)
+            .all(|(c, r)| !c.is_empty() && r.strip_suffix("_dot") == Some(c))
+}
+
 /// The located events as CSV: name, direction, t, coordinates, rates.
 fn write_events_csv(
     path: &str,
     model: &dyn ModelInfo,
     solution: &Solution,
 ) -> Result<(), CliError> {
-    let mut out = String::from("event,direction,terminal,t");
+    let mut out = String::from(EVENTS_HEADER);
     for c in model.coordinate_names() {
         out.push_str(&format!(",{c}"));
     }
@@ -905,7 +943,7 @@ fn print_constraint_summary(constraints: &ConstraintDrift, stabilization: Stabil
 
 #[cfg(test)]
 mod tests {
-    use super::sibling;
+    use super::{is_events_csv, sibling};
 
     /// Only the file name's extension counts (a dot in a directory name used to put the tag
     /// inside the directory's name), and a leading dot starts no extension.
@@ -916,5 +954,29 @@ mod tests {
         assert_eq!(sibling("run", "drift"), "run-drift");
         assert_eq!(sibling("dir/.hidden", "drift"), "dir/.hidden-drift");
         assert_eq!(sibling("a.b/c.tar.svg", "drift"), "a.b/c.tar-drift.svg");
+    }
+
+    /// An events CSV is recognised by the exact header eomgen writes, for any model; a file
+    /// whose first line differs in any way is not ours.
+    #[test]
+    fn an_events_csv_is_recognised_by_its_header() {
+        for ours in [
+            "event,direction,terminal,t,q,q_dot\n",
+            "event,direction,terminal,t,x,theta,x_dot,theta_dot\nhit,rising,true,1e0,0,0,0,0\n",
+        ] {
+            assert!(is_events_csv(ours.as_bytes()), "{ours}");
+        }
+        for theirs in [
+            "mine\n",
+            "",
+            "event,direction,terminal,t\n",
+            "event,direction,terminal,t,q\n",
+            "event,direction,terminal,t,q,p_dot\n",
+            "event,direction,terminal,time,q,q_dot\n",
+            "event,direction,terminal,t,q,q_dot,extra\n",
+            "# event,direction,terminal,t,q,q_dot\n",
+        ] {
+            assert!(!is_events_csv(theirs.as_bytes()), "{theirs}");
+        }
     }
 }

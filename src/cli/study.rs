@@ -84,6 +84,7 @@ pub fn run(study: &Study) -> Result<(), CliError> {
 /// and the minimal twin its file names, rendered as a table, JSON and a chart.
 fn constraint_methods(args: &ConstraintMethodsArgs) -> Result<(), CliError> {
     super::files::Outputs::new()
+        .input(&args.model)
         .chart("--plot", args.plot.as_deref())
         .check()?;
     let source = super::open_model(&args.model)?;

@@ -210,9 +210,10 @@ pub fn run(args: &WorkPrecisionArgs) -> Result<(), CliError> {
         ["evals", "time"]
             .iter()
             .flat_map(|tag| ["svg", "png"].map(|ext| chart_path(prefix, tag, ext)))
-            .fold(super::files::Outputs::new(), |outputs, path| {
-                outputs.chart("--plot", Some(&path))
-            })
+            .fold(
+                super::files::Outputs::new().input(&args.model),
+                |outputs, path| outputs.chart("--plot", Some(&path)),
+            )
             .check()?;
     }
     options.tolerances = parse_tols(&args.tols)?;
