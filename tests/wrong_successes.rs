@@ -456,6 +456,8 @@ fn issue_28_values_starting_with_a_minus_reach_the_checks_and_numbers_print_shor
         "{}",
         stderr(&out)
     );
+}
+
 /// Issue 28: `check` passed "over 0 states" (`"passed": true`) when no random state could be
 /// compared — a grossly wrong hand equation of a model whose potential is outside `sqrt`'s
 /// domain at every state drawn (`tests/wrong/sqrt_outside_domain.yaml`), and a constrained
