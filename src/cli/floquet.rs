@@ -49,9 +49,11 @@ pub struct FloquetArgs {
     /// points in all.
     #[arg(long, value_name = "X=LO..HI:N,Y=LO..HI:N")]
     pub sweep: Option<String>,
-    /// Tolerance on |μ| = 1: stable means every |μ| ≤ 1 + tol (marginal when within tol of 1).
-    #[arg(long, default_value_t = 1e-6)]
-    pub stability_tolerance: f64,
+    /// Tolerance on |μ| = 1: stable means every |μ| ≤ 1 + tol (marginal when within tol of 1),
+    /// in [√tol, 0.1] (default: the larger of 1e-6 and √tol, the smallest the integration
+    /// supports).
+    #[arg(long)]
+    pub stability_tolerance: Option<f64>,
     /// Relative and absolute tolerance of DOP853 on the state and the variational equations.
     #[arg(long, default_value_t = 1e-12, value_parser = super::values::relative_tolerance, allow_hyphen_values = true)]
     pub tol: f64,
@@ -75,6 +77,18 @@ fn analysis_text(model: &dyn ModelInfo, e: &FloquetStudyError) -> String {
     }
 }
 
+impl FloquetArgs {
+    /// The tolerance on |μ| = 1: as given, else the default 1e-6 raised to `√tol` when the
+    /// integration is looser than 1e-12 (what `FloquetOptions::validate` accepts).
+    fn stability_tolerance(&self) -> f64 {
+        self.stability_tolerance.unwrap_or_else(|| {
+            FloquetOptions::default()
+                .stability_tolerance
+                .max(self.tol.sqrt())
+        })
+    }
+}
+
 /// Runs `study floquet`.
 pub fn run(args: &FloquetArgs) -> Result<(), CliError> {
     Outputs::new()
@@ -95,7 +109,7 @@ pub fn run(args: &FloquetArgs) -> Result<(), CliError> {
         floquet: FloquetOptions {
             rtol: args.tol,
             atol: args.tol,
-            stability_tolerance: args.stability_tolerance,
+            stability_tolerance: args.stability_tolerance(),
             ..FloquetOptions::default()
         },
     };
@@ -220,7 +234,7 @@ fn json_report(report: &Report<'_>) -> Value {
         "determinant": f.determinant,
         "stability": f.stability.as_str(),
         "stable": f.stability.is_stable(),
-        "stability_tolerance": args.stability_tolerance,
+        "stability_tolerance": args.stability_tolerance(),
         "closure_error": f.closure_error,
         "integration": {"method": "dop853", "tol": args.tol, "steps": f.stats.steps, "rhs_evals": f.stats.rhs_evals},
     });
@@ -301,7 +315,7 @@ fn print_report(stdout: &mut impl std::io::Write, report: &Report<'_>) {
         num(f.spectral_radius),
         num(f.determinant),
         f.stability.as_str().replace('_', " "),
-        num(args.stability_tolerance)
+        num(args.stability_tolerance())
     );
     for t in thresholds {
         let _ = writeln!(

@@ -225,12 +225,24 @@ pub(super) fn save_png(
     pixels: &[u8],
     (width, height): (u32, u32),
 ) -> Result<(), String> {
-    use image::ImageEncoder as _;
-    let mut bytes = Vec::new();
-    image::codecs::png::PngEncoder::new(&mut bytes)
-        .write_image(pixels, width, height, image::ColorType::Rgb8)
+    let bytes = encode_png(pixels, (width, height))
         .map_err(|e| format!("`{path}`: cannot encode the PNG: {e}"))?;
-    save(path, &with_software_chunk(bytes))
+    save(path, &bytes)
+}
+
+/// `pixels` (RGB, 8 bits per channel, by rows) as a PNG that carries the [`PNG_SOFTWARE`]
+/// text chunk right after its header, written by the `png` crate.
+fn encode_png(pixels: &[u8], (width, height): (u32, u32)) -> Result<Vec<u8>, png::EncodingError> {
+    let mut bytes = Vec::new();
+    let mut encoder = png::Encoder::new(&mut bytes, width, height);
+    encoder.set_color(png::ColorType::Rgb);
+    encoder.set_depth(png::BitDepth::Eight);
+    let (keyword, text) = PNG_SOFTWARE_TEXT;
+    encoder.add_text_chunk(keyword.to_string(), text.to_string())?;
+    let mut writer = encoder.write_header()?;
+    writer.write_image_data(pixels)?;
+    writer.finish()?;
+    Ok(bytes)
 }
 
 /// The `tEXt` chunk that marks a PNG as written by eomgen (keyword `Software`, PNG
@@ -238,26 +250,12 @@ pub(super) fn save_png(
 /// ([`is_own_png`]) before removing it.
 const PNG_SOFTWARE: &[u8] = b"Software\0eomgen";
 
+/// [`PNG_SOFTWARE`]'s keyword and text.
+const PNG_SOFTWARE_TEXT: (&str, &str) = ("Software", "eomgen");
+
 /// The 8-byte PNG signature and the 25-byte `IHDR` chunk that every PNG starts with: the
 /// `tEXt` chunk goes right after them.
 const PNG_HEADER_LEN: usize = 8 + 25;
-
-/// `png` (as the encoder wrote it) with the [`PNG_SOFTWARE`] chunk after its header.
-fn with_software_chunk(png: Vec<u8>) -> Vec<u8> {
-    if png.len() < PNG_HEADER_LEN {
-        return png;
-    }
-    let mut chunk = Vec::with_capacity(12 + PNG_SOFTWARE.len());
-    let length = u32::try_from(PNG_SOFTWARE.len()).unwrap_or(u32::MAX);
-    chunk.extend_from_slice(&length.to_be_bytes());
-    chunk.extend_from_slice(b"tEXt");
-    chunk.extend_from_slice(PNG_SOFTWARE);
-    let crc = crc32(&chunk[4..]);
-    chunk.extend_from_slice(&crc.to_be_bytes());
-    let mut out = png;
-    out.splice(PNG_HEADER_LEN..PNG_HEADER_LEN, chunk);
-    out
-}
 
 /// Whether `bytes` is a PNG that eomgen wrote: its first chunk after the header is the
 /// [`PNG_SOFTWARE`] text chunk.
@@ -266,23 +264,6 @@ pub(super) fn is_own_png(bytes: &[u8]) -> bool {
     bytes.starts_with(b"\x89PNG\r\n\x1a\n")
         && bytes.get(PNG_HEADER_LEN + 4..start) == Some(b"tEXt".as_slice())
         && bytes.get(start..start + PNG_SOFTWARE.len()) == Some(PNG_SOFTWARE)
-}
-
-/// The CRC-32 of a PNG chunk's type and data (ISO 3309, reflected polynomial 0xEDB88320,
-/// as the PNG specification's Annex D computes it), bit by bit: a chunk of 20 bytes.
-fn crc32(bytes: &[u8]) -> u32 {
-    let mut crc = u32::MAX;
-    for &byte in bytes {
-        crc ^= u32::from(byte);
-        for _ in 0..8 {
-            crc = if crc & 1 == 1 {
-                (crc >> 1) ^ 0xEDB8_8320
-            } else {
-                crc >> 1
-            };
-        }
-    }
-    !crc
 }
 
 /// Every constraint drift chart's title ([`constraint_drift`]) ends with this.
@@ -639,22 +620,26 @@ pub fn constraint_drift(
 mod tests {
     use super::*;
 
-    /// The CRC of the PNG specification's check value, and a marked PNG recognised as ours.
+    /// A PNG written here carries the software chunk where [`is_own_png`] looks for it and
+    /// decodes to the pixels given; a PNG without it is not ours.
     #[test]
     fn a_png_carries_the_software_chunk() {
-        assert_eq!(crc32(b"123456789"), 0xCBF4_3926);
-        // IEND's CRC, as every PNG ends with it.
-        assert_eq!(crc32(b"IEND"), 0xAE42_6082);
-        use image::ImageEncoder as _;
-        let mut bytes = Vec::new();
-        image::codecs::png::PngEncoder::new(&mut bytes)
-            .write_image(&[0u8; 12], 2, 2, image::ColorType::Rgb8)
-            .unwrap();
-        assert!(!is_own_png(&bytes));
-        let marked = with_software_chunk(bytes);
+        let pixels: Vec<u8> = (0..12).collect();
+        let marked = encode_png(&pixels, (2, 2)).unwrap();
         assert!(is_own_png(&marked));
-        let decoded = image::load_from_memory(&marked).unwrap();
-        assert_eq!((decoded.width(), decoded.height()), (2, 2));
+        let decoder = png::Decoder::new(std::io::Cursor::new(&marked));
+        let mut reader = decoder.read_info().unwrap();
+        let mut decoded = vec![0; reader.output_buffer_size()];
+        reader.next_frame(&mut decoded).unwrap();
+        assert_eq!(decoded, pixels);
+        let text = &reader.info().uncompressed_latin1_text;
+        assert_eq!(
+            (text[0].keyword.as_str(), text[0].text.as_str()),
+            PNG_SOFTWARE_TEXT
+        );
+        let mut plain = marked.clone();
+        plain[PNG_HEADER_LEN + 4..PNG_HEADER_LEN + 8].copy_from_slice(b"zTXt");
+        assert!(!is_own_png(&plain));
     }
 
     /// A phase portrait's closed curve through the middle of the right side moves the legend
