@@ -1503,10 +1503,12 @@ impl<'s> Ctx<'s> {
         )?;
         Some(match rhs {
             None => lhs,
+            // The `=` is not kept: the difference is located at its right side.
             Some(rhs) => Expr {
                 location: lhs.location,
                 kind: ExprKind::Binary {
                     op: BinOp::Sub,
+                    op_location: rhs.location,
                     lhs: Box::new(lhs),
                     rhs: Box::new(rhs),
                 },

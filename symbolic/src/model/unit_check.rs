@@ -255,7 +255,7 @@ fn write_expr(e: &Expr, outer: u8) -> String {
             ),
             4,
         ),
-        ExprKind::Binary { op, lhs, rhs } => match op {
+        ExprKind::Binary { op, lhs, rhs, .. } => match op {
             BinOp::Add | BinOp::Sub => {
                 let sign = if *op == BinOp::Add { " + " } else { " - " };
                 (
@@ -288,7 +288,7 @@ fn numeric_exponent(e: &Expr) -> Option<Rational> {
     match &e.kind {
         ExprKind::Number { text, .. } => Rational::from_decimal(text),
         ExprKind::Neg(a) => numeric_exponent(a)?.checked_neg(),
-        ExprKind::Binary { op, lhs, rhs } => {
+        ExprKind::Binary { op, lhs, rhs, .. } => {
             let (a, b) = (numeric_exponent(lhs)?, numeric_exponent(rhs)?);
             match op {
                 BinOp::Add => a.checked_add(b),
@@ -309,6 +309,7 @@ fn terms<'e>(e: &'e Expr, out: &mut Vec<&'e Expr>) {
             op: BinOp::Add | BinOp::Sub,
             lhs,
             rhs,
+            ..
         } => {
             terms(lhs, out);
             terms(rhs, out);
@@ -541,6 +542,7 @@ impl<'f> Checker<'f> {
                 op: op @ (BinOp::Mul | BinOp::Div),
                 lhs,
                 rhs,
+                ..
             } => {
                 let a = self.dim(lhs, what);
                 let b = self.dim(rhs, what);
