@@ -295,8 +295,21 @@ fn undefined_constant_operations_are_located_errors() {
         );
     }
     for defined in [
-        "(-8)^2", "0^2", "0^0.5", "2^(-1)", "2^0.5", "2^3", "1/2", "ln(2)", "sqrt(0)",
-        "(1e-150*1e-150)", "exp(-700)", "(1e-300 - 1e-300)", "0e-400", "step(-1)", "ln(1)",
+        "(-8)^2",
+        "0^2",
+        "0^0.5",
+        "2^(-1)",
+        "2^0.5",
+        "2^3",
+        "1/2",
+        "ln(2)",
+        "sqrt(0)",
+        "(1e-150*1e-150)",
+        "exp(-700)",
+        "(1e-300 - 1e-300)",
+        "0e-400",
+        "step(-1)",
+        "ln(1)",
     ] {
         let found = errors(defined);
         assert!(found.is_empty(), "{defined}: {found:?}");
@@ -317,7 +330,9 @@ fn issue_28_underflow_of_constants_is_a_located_error() {
     // 1/2 · 1e-300 = 5e-301 is normal; times 1e-300 it underflows, at the second `*1e-300`.
     assert_eq!(errors[0].location.to_string(), "5:26", "{}", show(&errors));
     assert!(
-        errors[0].message.contains("the numbers in this product underflow")
+        errors[0]
+            .message
+            .contains("the numbers in this product underflow")
             && errors[0].message.contains("2.2e-308"),
         "{}",
         show(&errors)

@@ -18,7 +18,9 @@ pub enum FoldError {
     /// normal double: it came out 0 (`1e-300*1e-300`) or subnormal, with fewer than the 53
     /// significant bits of every other number, so that a term would vanish or lose its
     /// precision without a word.
-    #[error("the result is below 2.2e-308, the smallest normal double, and would be rounded to 0 or lose its precision")]
+    #[error(
+        "the result is below 2.2e-308, the smallest normal double, and would be rounded to 0 or lose its precision"
+    )]
     Underflow,
     /// The result is not a real number (NaN): `0/0`, `ln(-1)`.
     #[error("the result is not a real number")]
@@ -335,11 +337,20 @@ mod tests {
         // Exact zeros and normal results are kept.
         assert_eq!(tiny.checked_add(tiny.negated()), Ok(Constant::ZERO));
         assert_eq!(tiny.checked_mul(Constant::ZERO), Ok(Constant::ZERO));
-        assert_eq!(Constant::ZERO.pow(Constant::int(3)), Ok(Some(Constant::ZERO)));
+        assert_eq!(
+            Constant::ZERO.pow(Constant::int(3)),
+            Ok(Some(Constant::ZERO))
+        );
         let near = Constant::parse_decimal("1e-150").unwrap();
-        assert!(near.checked_mul(near).is_ok_and(|c| c.to_f64() == 1e-150 * 1e-150));
+        assert!(
+            near.checked_mul(near)
+                .is_ok_and(|c| c.to_f64() == 1e-150 * 1e-150)
+        );
         assert_eq!(fold(f64::MIN_POSITIVE, false), Ok(f64::MIN_POSITIVE));
-        assert_eq!(fold(f64::MIN_POSITIVE / 2.0, true), Err(FoldError::Underflow));
+        assert_eq!(
+            fold(f64::MIN_POSITIVE / 2.0, true),
+            Err(FoldError::Underflow)
+        );
         assert_eq!(fold(f64::NAN, true), Err(FoldError::Undefined));
     }
 

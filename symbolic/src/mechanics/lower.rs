@@ -6,8 +6,8 @@ use rustc_hash::FxHashMap;
 
 use super::constraints::{ConstraintEquations, linear_in_rates, redundant_rows};
 use crate::expr::{Constant, ExprArena, ExprId, Func, SymbolId, SymbolKind};
-use crate::model::{Located, Location};
 use crate::model::{BinOp, BodyKind, Diagnostic, Expr, ExprKind, ModelFile};
+use crate::model::{Located, Location};
 
 /// A parameter of a lowered model.
 #[derive(Debug, Clone, PartialEq)]
@@ -530,8 +530,11 @@ impl<'f> Lowering<'f> {
                 if let Some(error) = self.arena.take_fold_error()
                     && !undefined
                 {
-                    self.errors
-                        .push(crate::model::parser::fold_diagnostic(*op_location, *op, error));
+                    self.errors.push(crate::model::parser::fold_diagnostic(
+                        *op_location,
+                        *op,
+                        error,
+                    ));
                 }
                 result
             }

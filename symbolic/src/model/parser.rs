@@ -16,9 +16,9 @@
 //! expected there.
 
 use super::ast::{BinOp, Expr, ExprKind, FUNCTIONS};
-use crate::expr::{Func, FoldError, fold};
 use super::diagnostic::Diagnostic;
 use super::located::Location;
+use crate::expr::{FoldError, Func, fold};
 
 /// Parses one expression whose first character is at `start`; the expression is on one
 /// line, so character `i` of `text` is at column `start.column + i`.

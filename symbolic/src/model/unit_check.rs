@@ -342,7 +342,7 @@ impl<'f> Checker<'f> {
                     Err(e) => {
                         let mut d = Diagnostic::new(
                             u.location.offset(e.offset),
-                            format!("{} in the unit of parameter `{}`", e.message, p.name.value),
+                            e.message_for(&format!("parameter `{}`", p.name.value)),
                         )
                         .with_help(e.help);
                         if u.value.contains(' ') && !u.value.contains(',') {
@@ -366,10 +366,7 @@ impl<'f> Checker<'f> {
                         diagnostics.push(
                             Diagnostic::new(
                                 u.location.offset(e.offset),
-                                format!(
-                                    "{} in the unit of coordinate `{}`",
-                                    e.message, c.name.value
-                                ),
+                                e.message_for(&format!("coordinate `{}`", c.name.value)),
                             )
                             .with_help(e.help),
                         );
@@ -1241,6 +1238,16 @@ mod tests {
             [
                 "5:15: unknown unit `mm` in the unit of parameter `k`",
                 "8:22: unknown unit `furlong` in the unit of coordinate `y`",
+            ]
+        );
+        // Issue 28: "in the unit in the unit of parameter" is said once.
+        let src = "name: a\nunits: SI\nparameters:\n  m: { value: 1.0, unit: kg }\n  k: { value: 1.0, unit: N/m) }\n  c: { value: 1.0, unit: (N*s/m }\n  d: { value: 1.0, unit: N%m }\ncoordinates:\n  - { name: x, unit: m }\nkinetic: m*x_dot^2/2\n";
+        assert_eq!(
+            errors(src),
+            [
+                "5:29: unexpected `)` in the unit of parameter `k`: it closes no `(`",
+                "6:32: unclosed `(` in the unit of parameter `c`",
+                "7:27: unexpected `%` in the unit of parameter `d`",
             ]
         );
     }
