@@ -7,7 +7,7 @@ use super::CliError;
 use super::output::out;
 use eomgen_symbolic::codegen::{GenerateError, equations_latex, equations_text};
 use eomgen_symbolic::mechanics::{Formulation, Lagrange, MomentumBalance, SymbolicModel};
-use eomgen_symbolic::model::templates;
+use eomgen_symbolic::model::{ReadError, templates};
 
 /// Which derivation to print.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -53,11 +53,14 @@ pub fn read_model(model: &str) -> Result<(String, String), CliError> {
             entry.path.to_string(),
         ),
     };
-    let bytes = std::fs::read(&path)
-        .map_err(|e| CliError::usage(format!("cannot read `{display}`: {e}")).before_output())?;
-    let source = eomgen_symbolic::model::decode(&bytes)
-        .map_err(|d| super::diagnostics_error(&display, &String::from_utf8_lossy(&bytes), &[d]))?
-        .to_string();
+    let source = eomgen_symbolic::model::read_model_file(std::path::Path::new(&path)).map_err(
+        |e| match e {
+            ReadError::NotText { diagnostic, text } => {
+                super::diagnostics_error(&display, &text, &[diagnostic])
+            }
+            e => CliError::usage(format!("cannot read `{display}`: {e}")).before_output(),
+        },
+    )?;
     Ok((display, source))
 }
 

@@ -422,3 +422,32 @@ fn singular_mass_matrices_are_refused_with_their_reason() {
         Vec::<String>::new()
     );
 }
+
+/// Issue 28: a redundant constraint was reported only after an unrelated error was fixed.
+/// Mistakes the derivation finds (here a constant that overflows and an equation written by
+/// hand that is not linear in the accelerations) no longer stop the constraint checks: every
+/// diagnostic at once. (With a unit mistake, the loader reports them together:
+/// `fixtures/broken/redundant-constraint-with-a-unit-error.yaml`.)
+#[test]
+fn issue_28_a_redundant_constraint_is_reported_with_other_mistakes() {
+    use eomgen_symbolic::mechanics::SymbolicModel;
+    let src = "name: rails\nparameters: { m: 1.0, l: 1.0 }\ncoordinates: [x, y]\npoints: { P: [x, y] }\nbodies: { bead: { mass: m, at: P } }\npotential: m*y*1e300*1e300\nconstraints:\n  rail: x - l\n  again: 2*x - 2*l\nchecks:\n  equations_of_motion:\n    - m*y_ddot^2 = 0\n    - m*x_ddot = 0\n";
+    let file = load("rails.yaml", src).expect("loads");
+    let errors = SymbolicModel::from_file(&file).expect_err("refused");
+    let at: Vec<String> = errors.iter().map(|d| d.location.to_string()).collect();
+    assert_eq!(errors.len(), 3, "{}", show(&errors));
+    assert!(errors[0].message.contains("overflow"), "{}", show(&errors));
+    assert!(
+        errors
+            .iter()
+            .any(|d| d.message.contains("not linear in the accelerations")),
+        "{}",
+        show(&errors)
+    );
+    assert!(
+        errors.iter().any(|d| d.location.to_string() == "9:3"
+            && d.message.contains("`again` is redundant with `rail`")),
+        "{at:?}: {}",
+        show(&errors)
+    );
+}

@@ -244,6 +244,7 @@ impl<'f> Lowering<'f> {
         file: &ModelFile,
         parameters: &[ParameterInfo],
     ) -> ConstraintEquations {
+        let before = self.errors.len();
         let holonomic: Vec<(String, ExprId)> = file
             .constraints
             .iter()
@@ -268,9 +269,10 @@ impl<'f> Lowering<'f> {
         }
         let eqs = ConstraintEquations::derive(&mut self.arena, &symbols, &holonomic, &nonholonomic);
         let (m, n) = (eqs.len(), symbols.len());
-        // (More constraints than coordinates is the loader's error; after an error here the
-        // rank test would only repeat it.)
-        if !self.errors.is_empty() {
+        // (More constraints than coordinates is the loader's error; after an error in the
+        // constraints themselves the rank test would only repeat it. An error elsewhere does
+        // not stop it: every diagnostic at once.)
+        if self.errors.len() > before {
             return eqs;
         }
         // Rank of J at a few random configurations (parameters at their defaults).

@@ -27,6 +27,22 @@ pub fn check(file: &ModelFile) -> Result<(), Vec<Diagnostic>> {
 /// # Errors
 /// Every violation, sorted by location.
 pub fn check_partial(file: &ModelFile, incomplete: &Incomplete) -> Result<(), Vec<Diagnostic>> {
+    let (mut list, units) = check_parts(file, incomplete);
+    list.extend(units);
+    if list.is_empty() {
+        return Ok(());
+    }
+    list.sort_by_key(|d| d.location);
+    Err(list)
+}
+
+/// [`check_partial`]'s diagnostics in two lists: the rules' and the units' (a unit mistake
+/// at the place of a rule's mistake left out). A file whose only mistakes are units is sound
+/// to derive ([`super::load`] then reports what the derivation finds too).
+pub(crate) fn check_parts(
+    file: &ModelFile,
+    incomplete: &Incomplete,
+) -> (Vec<Diagnostic>, Vec<Diagnostic>) {
     let mut checker = Checker::new(file, incomplete);
     checker.names();
     checker.presence();
@@ -42,14 +58,13 @@ pub fn check_partial(file: &ModelFile, incomplete: &Incomplete) -> Result<(), Ve
     let units = super::unit_check::check(file);
     // A unit mistake at the place of another mistake is its consequence (`initial: { theta:
     // x }` is not constant, and so not in rad either): one message per mistake.
-    let mut list = checker.diagnostics.finish().err().unwrap_or_default();
+    let list = checker.diagnostics.finish().err().unwrap_or_default();
     let taken: Vec<Location> = list.iter().map(|d| d.location).collect();
-    list.extend(units.into_iter().filter(|d| !taken.contains(&d.location)));
-    if list.is_empty() {
-        return Ok(());
-    }
-    list.sort_by_key(|d| d.location);
-    Err(list)
+    let units = units
+        .into_iter()
+        .filter(|d| !taken.contains(&d.location))
+        .collect();
+    (list, units)
 }
 
 /// The value of a constant expression at the parameters' defaults (`None` if it uses
