@@ -570,6 +570,9 @@ fn failure_hint(error: &IntegrationError, args: &IntegrationArgs) -> String {
         IntegrationError::TooManySteps { .. } => {
             "the run needs more steps than allowed: loosen --rtol/--atol, shorten --t-end, or use --method radau5 if the model is stiff"
         }
+        IntegrationError::JacobianNonFinite { .. } => {
+            "the Jacobian of the right-hand side is not finite there, even by differences, though the right-hand side is: a term of the model grows without bound in its derivative; smooth the model there, or use an explicit method (--method dopri5)"
+        }
         IntegrationError::NonFiniteState { .. } | IntegrationError::RhsNonFinite { .. }
             if !adaptive =>
         {
