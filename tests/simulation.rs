@@ -161,8 +161,7 @@ fn issue_28_quadratic_drag_from_rest_runs_on_the_implicit_methods() {
             initial_state: Some(vec![0.0, 0.0, 0.0, 0.0]),
             ..SimulationOptions::default()
         };
-        let run = simulate(model.as_mut(), &options)
-            .unwrap_or_else(|e| panic!("{method:?}: {e}"));
+        let run = simulate(model.as_mut(), &options).unwrap_or_else(|e| panic!("{method:?}: {e}"));
         for (t, y) in run.solution.iter() {
             let exact = -terminal * (g * t / terminal).tanh();
             assert!(

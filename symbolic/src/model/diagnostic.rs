@@ -76,7 +76,7 @@ pub const SNIPPET_WIDTH: usize = 100;
 
 /// Characters of a message or help shown: a longer one keeps its start and end around a `…`
 /// (a message quotes the file, and a name or key can be as long as a line).
-pub const MESSAGE_WIDTH: usize = 400;
+pub const MESSAGE_WIDTH: usize = 1_000;
 
 /// Whether `c` would act on a terminal rather than show: the C0 and C1 controls but tab,
 /// and the bidirectional embeddings, overrides and isolates (which reorder what follows).
