@@ -249,21 +249,21 @@ impl Constant {
     pub fn pow(self, other: Self) -> Result<Option<Self>, FoldError> {
         let base = self.to_f64();
         if let Some(n) = other.as_integer() {
-            if let Constant::Rational { num, den } = self {
-                if n.unsigned_abs() <= 64 {
-                    let e = n.unsigned_abs() as u32;
-                    let exact = (|| {
-                        let p = num.checked_pow(e)?;
-                        let q = den.checked_pow(e)?;
-                        if n >= 0 {
-                            Constant::rational(p, q)
-                        } else {
-                            Constant::rational(q, p)
-                        }
-                    })();
-                    if exact.is_some() {
-                        return Ok(exact);
+            if let Constant::Rational { num, den } = self
+                && n.unsigned_abs() <= 64
+            {
+                let e = n.unsigned_abs() as u32;
+                let exact = (|| {
+                    let p = num.checked_pow(e)?;
+                    let q = den.checked_pow(e)?;
+                    if n >= 0 {
+                        Constant::rational(p, q)
+                    } else {
+                        Constant::rational(q, p)
                     }
+                })();
+                if exact.is_some() {
+                    return Ok(exact);
                 }
             }
             if base == 0.0 && n < 0 {
