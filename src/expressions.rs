@@ -481,6 +481,7 @@ fn parse_one(
                 location: l.location,
                 kind: ExprKind::Binary {
                     op: BinOp::Sub,
+                    op_location: r.location,
                     lhs: Box::new(l),
                     rhs: Box::new(r),
                 },

@@ -153,9 +153,18 @@ impl Resolved {
     }
 }
 
-/// Reads a model file named on a command line.
+/// Reads a model file named on a command line, through the loader's size limit
+/// ([`eomgen_symbolic::model::read_model_file`]: a device or FIFO is bounded too).
 fn read_file(path: &str) -> std::io::Result<Vec<u8>> {
-    std::fs::read(path)
+    use eomgen_symbolic::model::ReadError;
+    match eomgen_symbolic::model::read_model_file(std::path::Path::new(path)) {
+        Ok(text) => Ok(text.into_bytes()),
+        Err(ReadError::Io(e)) => Err(e),
+        Err(e) => Err(std::io::Error::new(
+            std::io::ErrorKind::InvalidData,
+            e.to_string(),
+        )),
+    }
 }
 
 /// Resolves `name_or_path` as [`ModelSource::open`] does, without loading anything: a path

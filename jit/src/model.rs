@@ -10,7 +10,7 @@ use eomgen_runtime::{
 use eomgen_symbolic::codegen::GenerateError;
 use eomgen_symbolic::codegen::program::{Derivation, FunctionTape, ModelProgram};
 use eomgen_symbolic::codegen::tape::{Input, Instruction};
-use eomgen_symbolic::model::{Crossing, Diagnostic};
+use eomgen_symbolic::model::{Crossing, Diagnostic, ReadError, read_model_file};
 
 use crate::native::{CompileError, NativeCode, NativeFn};
 use crate::{Backend, Inputs, interpret, native};
@@ -19,13 +19,15 @@ use crate::{Backend, Inputs, interpret, native};
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum LoadError {
-    /// The file could not be read.
+    /// The file could not be read: the operating system's error, or a file larger than
+    /// [`eomgen_symbolic::model::MAX_FILE_BYTES`].
     #[error("cannot read `{path}`: {source}")]
     Read {
         /// The path as given.
         path: String,
-        /// The operating system's error.
-        source: std::io::Error,
+        /// Why ([`ReadError::Io`] or [`ReadError::TooLarge`]; a file that is not UTF-8 is
+        /// [`LoadError::Diagnostics`]).
+        source: ReadError,
     },
     /// The file has mistakes: the located diagnostics `eomgen::model!` reports for it (YAML,
     /// schema, cross-object rules, units, and after the derivation a singular mass matrix).
@@ -375,7 +377,8 @@ impl JitModel {
     /// interpreter where the host has no code generator).
     ///
     /// # Errors
-    /// [`LoadError::Read`] if the file cannot be read; [`LoadError::Diagnostics`] with every
+    /// [`LoadError::Read`] if the file cannot be read or is larger than
+    /// [`eomgen_symbolic::model::MAX_FILE_BYTES`]; [`LoadError::Diagnostics`] with every
     /// located mistake of the file, as `eomgen::model!` reports them; [`LoadError::Compile`]
     /// naming the function that could not be compiled.
     pub fn load(path: impl AsRef<std::path::Path>) -> Result<JitModel, LoadError> {
@@ -392,17 +395,18 @@ impl JitModel {
     ) -> Result<JitModel, LoadError> {
         let path = path.as_ref();
         let display = path.display().to_string();
-        let bytes = std::fs::read(path).map_err(|source| LoadError::Read {
-            path: display.clone(),
-            source,
-        })?;
-        let source =
-            eomgen_symbolic::model::decode(&bytes).map_err(|d| LoadError::Diagnostics {
+        let source = read_model_file(path).map_err(|e| match e {
+            ReadError::NotText { diagnostic, text } => LoadError::Diagnostics {
                 path: display.clone(),
-                text: String::from_utf8_lossy(&bytes).into_owned(),
-                diagnostics: vec![d],
-            })?;
-        Self::from_source_with(&display, source, options)
+                text,
+                diagnostics: vec![diagnostic],
+            },
+            source => LoadError::Read {
+                path: display.clone(),
+                source,
+            },
+        })?;
+        Self::from_source_with(&display, &source, options)
     }
 
     /// Builds the model of a file's text; `path` names the file in diagnostics.

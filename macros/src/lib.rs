@@ -13,6 +13,7 @@ use proc_macro2::Span;
 use syn::LitStr;
 
 use eomgen_symbolic::codegen::{self, EmitOptions, GenerateError};
+use eomgen_symbolic::model::ReadError;
 
 /// Generates the equations of motion of a model file at compile time.
 ///
@@ -129,23 +130,18 @@ fn expand(input: proc_macro2::TokenStream) -> Result<proc_macro2::TokenStream, F
                 .map(|r| r.display().to_string())
         })
         .unwrap_or_else(|| literal_path.clone());
-    let bytes = std::fs::read(&path).map_err(|e| {
-        syn::Error::new(
+    let source = eomgen_symbolic::model::read_model_file(&path).map_err(|e| match e {
+        ReadError::NotText { diagnostic, text } => {
+            syn::Error::new(literal.span(), diagnostic.render(&written, &text))
+        }
+        e => syn::Error::new(
             literal.span(),
             format!(
                 "cannot read model file `{written}` (looked at `{}`): {e}",
                 path.display()
             ),
-        )
+        ),
     })?;
-    let source = eomgen_symbolic::model::decode(&bytes)
-        .map_err(|d| {
-            syn::Error::new(
-                literal.span(),
-                d.render(&written, &String::from_utf8_lossy(&bytes)),
-            )
-        })?
-        .to_string();
     let errors = |diagnostics: Vec<eomgen_symbolic::model::Diagnostic>| {
         let mut all: Option<syn::Error> = None;
         for d in diagnostics {

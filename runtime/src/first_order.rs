@@ -114,7 +114,7 @@ impl<S: MechanicalSystem<N>, const N: usize> FirstOrder<S, N> {
                 .row_iter()
                 .position(|row| row.iter().any(|v| !v.is_finite()));
             if let Some(i) = bad {
-                return Err(RhsError::NonFinite { index: N + i });
+                return Err(RhsError::JacobianNonFinite { row: N + i });
             }
         }
         Ok((d_qdd_q, d_qdd_qdot))
@@ -372,7 +372,7 @@ impl<S: DynMechanicalSystem> DynFirstOrder<S> {
                 .row_iter()
                 .position(|row| row.iter().any(|v| !v.is_finite()));
             if let Some(i) = bad {
-                return Err(RhsError::NonFinite { index: n + i });
+                return Err(RhsError::JacobianNonFinite { row: n + i });
             }
         }
         Ok((d_qdd_q, d_qdd_qdot))

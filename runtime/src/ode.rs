@@ -36,12 +36,19 @@ pub enum RhsError {
         /// Index of the event function.
         index: usize,
     },
-    /// The right-hand side (or its Jacobian) produced NaN or ±∞ in component `index`.
+    /// The right-hand side produced NaN or ±∞ in component `index`.
     #[error("the right-hand side is not finite in component {index}")]
     NonFinite {
-        /// Index into the state vector of the first non-finite component (for a Jacobian, the
-        /// row: the component of `F` whose derivative is not finite).
+        /// Index into the state vector of the first non-finite component.
         index: usize,
+    },
+    /// The Jacobian `∂F/∂y` has NaN or ±∞ in row `row`, where `F` itself is finite (an
+    /// implicit method then differences `F` instead, see
+    /// [`OdeSystem::jacobian`]).
+    #[error("the Jacobian of the right-hand side is not finite in row {row}")]
+    JacobianNonFinite {
+        /// The first row (the component of `F`) whose derivative is not finite.
+        row: usize,
     },
 }
 

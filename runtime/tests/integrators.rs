@@ -755,6 +755,7 @@ fn blow_up_stops_near_the_singularity() {
             IntegrationError::StepSizeTooSmall { t, .. }
             | IntegrationError::NonFiniteState { t, .. }
             | IntegrationError::RhsNonFinite { t, .. }
+            | IntegrationError::JacobianNonFinite { t, .. }
             | IntegrationError::NewtonDidNotConverge { t, .. } => t,
             _ => panic!("{label}: wrong error"),
         };

@@ -8,7 +8,7 @@ use super::output::out;
 use eomgen_symbolic::codegen::{EquationsListing, GenerateError, equations_latex, equations_text};
 use eomgen_symbolic::expr::print::Syntax;
 use eomgen_symbolic::mechanics::{Formulation, Lagrange, MomentumBalance, SymbolicModel};
-use eomgen_symbolic::model::templates;
+use eomgen_symbolic::model::{ReadError, templates};
 
 /// Which derivation to print.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -53,12 +53,19 @@ pub struct NewArgs {
 pub fn read_model(model: &str) -> Result<(String, String), CliError> {
     let resolved = eomgen::resolve(model).map_err(super::open_error)?;
     let display = resolved.path().to_string();
-    let bytes = resolved
-        .bytes()
-        .map_err(|e| CliError::usage(format!("cannot read `{display}`: {e}")).before_output())?;
-    let source = eomgen_symbolic::model::decode(&bytes)
-        .map_err(|d| super::diagnostics_error(&display, &String::from_utf8_lossy(&bytes), &[d]))?
-        .to_string();
+    let source = match &resolved {
+        // Compiled into the binary: no file is read.
+        eomgen::Resolved::Bundled(entry) => entry.source.to_string(),
+        eomgen::Resolved::File(path) => eomgen_symbolic::model::read_model_file(
+            std::path::Path::new(path),
+        )
+        .map_err(|e| match e {
+            ReadError::NotText { diagnostic, text } => {
+                super::diagnostics_error(&display, &text, &[diagnostic])
+            }
+            e => CliError::usage(format!("cannot read `{display}`: {e}")).before_output(),
+        })?,
+    };
     Ok((display, source))
 }
 

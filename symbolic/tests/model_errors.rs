@@ -251,7 +251,13 @@ fn undefined_constant_operations_are_located_errors() {
         ("0^0", "`0^0` is undefined", "non-positive exponent"),
         ("0^(-1)", "`0^-1` is undefined", "non-positive exponent"),
         ("(-8)^(1/3)", "is not a real number", "only integer powers"),
-        ("10^400", "overflows", "exponent"),
+        ("10^400", "power overflow", "exponent"),
+        ("1e300*1e300", "product overflow", "exponent"),
+        ("10^(-400)", "power underflow", "exponent"),
+        ("(1e-200*1e-200)", "product underflow", "exponent"),
+        ("(1e-300/1e10)", "product underflow", "exponent"),
+        ("exp(-1000)", "`exp(-1000)` underflows", "argument"),
+        ("1e-400", "the number `1e-400` is too small", "write 0"),
         (
             "ln(-1)",
             "`ln(-1)` is not a finite real number",
@@ -289,11 +295,54 @@ fn undefined_constant_operations_are_located_errors() {
         );
     }
     for defined in [
-        "(-8)^2", "0^2", "0^0.5", "2^(-1)", "2^0.5", "2^3", "1/2", "ln(2)", "sqrt(0)",
+        "(-8)^2",
+        "0^2",
+        "0^0.5",
+        "2^(-1)",
+        "2^0.5",
+        "2^3",
+        "1/2",
+        "ln(2)",
+        "sqrt(0)",
+        "(1e-150*1e-150)",
+        "exp(-700)",
+        "(1e-300 - 1e-300)",
+        "0e-400",
+        "step(-1)",
+        "ln(1)",
     ] {
         let found = errors(defined);
         assert!(found.is_empty(), "{defined}: {found:?}");
     }
+}
+
+/// Issue 28: `k*x^2/2*1e-300*1e-300*1e300*1e300` folded `1e-300*1e-300` to 0, so that
+/// `V = 0` and `F = 0` and every command went on. An operation on non-zero numbers whose
+/// result underflows (to 0, or to a subnormal number with fewer significant bits) is a
+/// located error at its operator, as overflow is; in a parameter's default too.
+#[test]
+fn issue_28_underflow_of_constants_is_a_located_error() {
+    use eomgen_symbolic::mechanics::SymbolicModel;
+    let src = "name: x\nparameters: { k: 1.0 }\ncoordinates: [x]\nkinetic: x_dot^2/2\npotential: k*x^2/2*1e-300*1e-300*1e300*1e300\n";
+    let file = load("x.yaml", src).expect("loads");
+    let errors = SymbolicModel::from_file(&file).expect_err("refused");
+    assert_eq!(errors.len(), 1, "{}", show(&errors));
+    // 1/2 · 1e-300 = 5e-301 is normal; times 1e-300 it underflows, at the second `*1e-300`.
+    assert_eq!(errors[0].location.to_string(), "5:26", "{}", show(&errors));
+    assert!(
+        errors[0]
+            .message
+            .contains("the numbers in this product underflow")
+            && errors[0].message.contains("2.2e-308"),
+        "{}",
+        show(&errors)
+    );
+    // A default: refused at load, at its operator.
+    let src = "name: x\nparameters: { k: 1e-200*1e-200 }\ncoordinates: [x]\nkinetic: x_dot^2/2\npotential: k*x^2/2\n";
+    let errors = load("x.yaml", src).expect_err("refused");
+    assert_eq!(errors.len(), 1, "{}", show(&errors));
+    assert_eq!(errors[0].location.to_string(), "2:24", "{}", show(&errors));
+    assert!(errors[0].message.contains("underflow"), "{}", show(&errors));
 }
 
 /// A singular mass matrix is refused with its reason; a model whose `M` is singular only
@@ -371,5 +420,34 @@ fn singular_mass_matrices_are_refused_with_their_reason() {
             "coordinates: [x, y]\npoints: { P: [x + y, 0] }\nbodies: { b: { mass: m, at: P } }\nconstraints:\n  same: x - y\n"
         ),
         Vec::<String>::new()
+    );
+}
+
+/// Issue 28: a redundant constraint was reported only after an unrelated error was fixed.
+/// Mistakes the derivation finds (here a constant that overflows and an equation written by
+/// hand that is not linear in the accelerations) no longer stop the constraint checks: every
+/// diagnostic at once. (With a unit mistake, the loader reports them together:
+/// `fixtures/broken/redundant-constraint-with-a-unit-error.yaml`.)
+#[test]
+fn issue_28_a_redundant_constraint_is_reported_with_other_mistakes() {
+    use eomgen_symbolic::mechanics::SymbolicModel;
+    let src = "name: rails\nparameters: { m: 1.0, l: 1.0 }\ncoordinates: [x, y]\npoints: { P: [x, y] }\nbodies: { bead: { mass: m, at: P } }\npotential: m*y*1e300*1e300\nconstraints:\n  rail: x - l\n  again: 2*x - 2*l\nchecks:\n  equations_of_motion:\n    - m*y_ddot^2 = 0\n    - m*x_ddot = 0\n";
+    let file = load("rails.yaml", src).expect("loads");
+    let errors = SymbolicModel::from_file(&file).expect_err("refused");
+    let at: Vec<String> = errors.iter().map(|d| d.location.to_string()).collect();
+    assert_eq!(errors.len(), 3, "{}", show(&errors));
+    assert!(errors[0].message.contains("overflow"), "{}", show(&errors));
+    assert!(
+        errors
+            .iter()
+            .any(|d| d.message.contains("not linear in the accelerations")),
+        "{}",
+        show(&errors)
+    );
+    assert!(
+        errors.iter().any(|d| d.location.to_string() == "9:3"
+            && d.message.contains("`again` is redundant with `rail`")),
+        "{at:?}: {}",
+        show(&errors)
     );
 }

@@ -10,7 +10,7 @@ fn show(e: &Expr) -> String {
         ExprKind::Number { text, .. } => text.clone(),
         ExprKind::Ident(n) => n.clone(),
         ExprKind::Neg(a) => format!("(-{})", show(a)),
-        ExprKind::Binary { op, lhs, rhs } => {
+        ExprKind::Binary { op, lhs, rhs, .. } => {
             let op = match op {
                 BinOp::Add => "+",
                 BinOp::Sub => "-",

@@ -117,3 +117,67 @@ fn every_declared_unit_is_binding() {
         unnoticed.join("\n")
     );
 }
+
+/// Issue 28: one wrong unit gave one error per use of its parameter (six), the first at a
+/// use, none at the declaration. A declared unit that the uses of its name contradict is
+/// reported once, at the declaration, with the unit the uses need; a mistake elsewhere is
+/// still reported on its own.
+#[test]
+fn issue_28_one_wrong_unit_is_one_error_at_its_declaration() {
+    let src = "\
+name: falling
+units: SI
+parameters:
+  m: 1.0     # kg
+  g: 9.81    # m/s
+  h: 2.0     # m
+coordinates:
+  - y        # m
+points: { P: [0, y] }
+bodies: { ball: { mass: m, at: P } }
+gravity: [0, -g]
+initial: { y: h }
+events:
+  floor: y
+checks:
+  equations_of_motion:
+    - m*y_ddot = -m*g
+  conserved: { energy: m*y_dot^2/2 + m*g*y }
+";
+    let errors = load("falling.yaml", src).expect_err("refused");
+    let shown: Vec<String> = errors
+        .iter()
+        .map(|d| format!("{}: {}", d.location, d.message))
+        .collect();
+    assert_eq!(errors.len(), 1, "{shown:#?}");
+    assert_eq!(errors[0].location.to_string(), "5:16", "{shown:#?}");
+    assert!(
+        errors[0]
+            .message
+            .starts_with("parameter `g` is declared in m/s, but its uses need m/s^2"),
+        "{shown:#?}"
+    );
+    assert!(
+        errors[0]
+            .help
+            .as_deref()
+            .is_some_and(|h| h.contains("declare `g` in m/s^2")),
+        "{:?}",
+        errors[0].help
+    );
+
+    // With a second, unrelated mistake (a mass in N), both are reported, each once.
+    let two = src.replace("m: 1.0     # kg", "m: 1.0     # N");
+    let errors = load("falling.yaml", &two).expect_err("refused");
+    let shown: Vec<String> = errors
+        .iter()
+        .map(|d| format!("{}: {}", d.location, d.message))
+        .collect();
+    assert!(
+        shown
+            .iter()
+            .any(|s| s.starts_with("5:16: parameter `g` is declared in m/s")),
+        "{shown:#?}"
+    );
+    assert!(shown.len() <= 3, "{shown:#?}");
+}

@@ -144,6 +144,15 @@ pub enum IntegrationError {
         /// Index of the first non-finite component.
         index: usize,
     },
+    /// The Jacobian `∂F/∂y` an implicit method needs is NaN or infinite in row `row`, even
+    /// by differences of `F` ([`RhsError::JacobianNonFinite`](crate::RhsError::JacobianNonFinite)).
+    #[error("row {row} of the Jacobian of the right-hand side is not finite at t = {t}")]
+    JacobianNonFinite {
+        /// Time at which the Jacobian was evaluated (the start of the failed step).
+        t: f64,
+        /// The first row whose derivative is not finite.
+        row: usize,
+    },
     /// The mass matrix is not positive definite
     /// ([`RhsError::SingularMassMatrix`](crate::RhsError::SingularMassMatrix)).
     #[error("the mass matrix is not positive definite at t = {t}")]
@@ -215,6 +224,7 @@ impl IntegrationError {
             | IntegrationError::TooManySteps { t, .. }
             | IntegrationError::NonFiniteState { t, .. }
             | IntegrationError::RhsNonFinite { t, .. }
+            | IntegrationError::JacobianNonFinite { t, .. }
             | IntegrationError::SingularMassMatrix { t }
             | IntegrationError::SingularConstraintMatrix { t }
             | IntegrationError::ProjectionFailed { t, .. }

@@ -460,7 +460,9 @@ impl GrowthTest {
             Ok(norm) => Ok(norm <= self.threshold),
             Err(IntegrationFailure {
                 error:
-                    IntegrationError::NonFiniteState { .. } | IntegrationError::RhsNonFinite { .. },
+                    IntegrationError::NonFiniteState { .. }
+                    | IntegrationError::RhsNonFinite { .. }
+                    | IntegrationError::JacobianNonFinite { .. },
                 ..
             }) => Ok(false),
             Err(failure) => Err(failure),

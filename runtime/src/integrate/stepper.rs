@@ -51,7 +51,7 @@ impl StepFailure {
                 ..
             } => false,
             StepFailure::Rhs {
-                error: RhsError::NonFinite { .. },
+                error: RhsError::NonFinite { .. } | RhsError::JacobianNonFinite { .. },
                 ..
             }
             | StepFailure::NonFiniteState { .. }
@@ -89,6 +89,10 @@ impl StepFailure {
                 t,
                 error: RhsError::NonFinite { index },
             } => IntegrationError::RhsNonFinite { t, index },
+            StepFailure::Rhs {
+                t,
+                error: RhsError::JacobianNonFinite { row },
+            } => IntegrationError::JacobianNonFinite { t, row },
             StepFailure::Rhs {
                 t,
                 error: RhsError::EventNotFinite { index },
@@ -346,8 +350,14 @@ impl<'a> CheckedRhs<'a> {
     ///
     /// `work_y` and `work_f` are `dim`-entry scratch buffers.
     ///
+    /// The system's exact Jacobian is replaced by those differences where it is not finite
+    /// and `F` is: a derivative can have a removable singularity that `F` has not (quadratic
+    /// drag `|v| v`, with `|v| = √(vₓ² + v_y²)`, has `vₓ²/|v|`, 0/0 at rest, where the
+    /// derivative is 0), and the Jacobian only steers Newton's iteration.
+    ///
     /// # Errors
-    /// [`StepFailure::Rhs`] at `t` if the system fails or an entry is not finite (index: the
+    /// [`StepFailure::Rhs`] at `t` if the system fails, or with
+    /// [`RhsError::JacobianNonFinite`] if an entry of the differences is not finite (the
     /// row).
     pub(crate) fn jacobian(
         &mut self,
@@ -360,10 +370,11 @@ impl<'a> CheckedRhs<'a> {
     ) -> Result<(), StepFailure> {
         self.jacobian_evals += 1;
         let n = y.len();
-        let exact = self
-            .system
-            .jacobian(t, y, jac.as_mut_slice())
-            .map_err(|error| StepFailure::Rhs { t, error })?;
+        let exact = match self.system.jacobian(t, y, jac.as_mut_slice()) {
+            Ok(exact) => exact,
+            Err(RhsError::JacobianNonFinite { .. }) => false,
+            Err(error) => return Err(StepFailure::Rhs { t, error }),
+        };
         if !exact {
             work_y.copy_from_slice(y);
             for j in 0..n {
@@ -378,9 +389,9 @@ impl<'a> CheckedRhs<'a> {
         }
         let bad = (0..n).find(|&i| (0..n).any(|j| !jac[(i, j)].is_finite()));
         match bad {
-            Some(index) => Err(StepFailure::Rhs {
+            Some(row) => Err(StepFailure::Rhs {
                 t,
-                error: RhsError::NonFinite { index },
+                error: RhsError::JacobianNonFinite { row },
             }),
             None => Ok(()),
         }

@@ -23,6 +23,7 @@ use crate::expr::cse::{self, CsePlan, Temporary};
 use crate::expr::print::{Printer, Syntax};
 use crate::expr::{ExprArena, ExprId, SymbolId, SymbolKind, trig};
 use crate::mechanics::{EquationsOfMotion, Jacobians, SymbolicModel};
+use crate::model::schema::RUST_KEYWORDS;
 
 /// Why [`generate`] produced no code.
 #[derive(Debug, Clone)]
@@ -91,36 +92,18 @@ pub struct EmitStats {
     pub ops_after_cse: u64,
 }
 
-const RUST_KEYWORDS: &[&str] = &[
-    "as", "async", "await", "break", "const", "continue", "crate", "dyn", "else", "enum", "extern",
-    "false", "fn", "for", "gen", "if", "impl", "in", "let", "loop", "match", "mod", "move", "mut",
-    "pub", "ref", "return", "self", "Self", "static", "struct", "super", "trait", "true", "type",
-    "unsafe", "use", "where", "while", "abstract", "become", "box", "do", "final", "macro",
-    "override", "priv", "typeof", "unsized", "virtual", "yield", "try",
-];
+pub use crate::model::schema::struct_name;
 
-/// A symbol's local variable name in generated code (`r#`-free: keywords get a `_` suffix).
+/// A symbol's local variable name in generated code: its own name, a keyword as a raw
+/// identifier (`r#type`, so that it cannot meet another name, as a suffix `type_` could), and
+/// a name of the generator's own (`__q`) with a `_` suffix. The loader refuses the keywords
+/// that are not raw identifiers ([`crate::model::schema::UNRAW_KEYWORDS`]).
 pub fn local_name(name: &str) -> String {
-    if RUST_KEYWORDS.contains(&name) || name.starts_with("__") {
+    if name.starts_with("__") {
         format!("{name}_")
     } else {
-        name.to_string()
+        field_name(name)
     }
-}
-
-/// `double_pendulum` → `DoublePendulum`.
-pub fn struct_name(model_name: &str) -> String {
-    model_name
-        .split('_')
-        .filter(|p| !p.is_empty())
-        .map(|p| {
-            let mut c = p.chars();
-            match c.next() {
-                Some(f) => f.to_ascii_uppercase().to_string() + c.as_str(),
-                None => String::new(),
-            }
-        })
-        .collect()
 }
 
 /// Source of one function body: symbol bindings, temporaries, and the returned values
@@ -187,6 +170,7 @@ fn body(arena: &mut ExprArena, roots: &[ExprId], helpers: &str) -> (Body, CsePla
     (Body { code, values }, plan)
 }
 
+/// A parameter's field: its name, a keyword as a raw identifier (`r#type`).
 fn field_name(name: &str) -> String {
     if RUST_KEYWORDS.contains(&name) {
         format!("r#{name}")

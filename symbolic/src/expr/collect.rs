@@ -209,7 +209,7 @@ impl ExprArena {
         let mut scaled = Vec::with_capacity(terms.len());
         for t in terms {
             let (ct, rest) = self.split_coefficient(t);
-            let Some(product) = ct.checked_mul(c) else {
+            let Ok(product) = ct.checked_mul(c) else {
                 return coefficient;
             };
             before += usize::from(!is_unit(ct));

@@ -4,6 +4,50 @@
 //! canonical forms and symbolic equality reliable. Overflow falls back to `f64`. The `f64`
 //! is stored as its bit pattern (with `-0.0` normalised to `0.0`) so that constants are
 //! `Eq + Hash` and can be hash-consed; NaN is never stored.
+//!
+//! Every `f64` computed from constants passes [`fold`], the one rule for what a folded
+//! number may be: finite, and not lost to underflow (see [`FoldError`]).
+
+/// Why an operation on numbers has no value that a constant may hold.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+pub enum FoldError {
+    /// The result is beyond ±1.8e308 (`f64::MAX`): `1e308*10`, `10^400`.
+    #[error("the result is beyond ±1.8e308, the largest a double holds")]
+    Overflow,
+    /// The result of non-zero numbers is below 2.2e-308 (`f64::MIN_POSITIVE`), the smallest
+    /// normal double: it came out 0 (`1e-300*1e-300`) or subnormal, with fewer than the 53
+    /// significant bits of every other number, so that a term would vanish or lose its
+    /// precision without a word.
+    #[error(
+        "the result is below 2.2e-308, the smallest normal double, and would be rounded to 0 or lose its precision"
+    )]
+    Underflow,
+    /// The result is not a real number (NaN): `0/0`, `ln(-1)`.
+    #[error("the result is not a real number")]
+    Undefined,
+}
+
+/// The one rule for a number computed from constants: `value` is kept if it is finite and,
+/// unless it is an exact 0 (`exact_zero`: `1 - 1`, `ln(1)`), normal.
+///
+/// Sums pass `exact_zero = true` when their value is 0 (a sum that cancels is exact in
+/// binary floating point); products, powers and functions of non-zero numbers pass `false`,
+/// since their exact value is not 0.
+///
+/// # Errors
+/// [`FoldError::Undefined`] for NaN, [`FoldError::Overflow`] for ±∞,
+/// [`FoldError::Underflow`] for a subnormal value, or 0 that is not exact.
+pub fn fold(value: f64, exact_zero: bool) -> Result<f64, FoldError> {
+    if value.is_nan() {
+        Err(FoldError::Undefined)
+    } else if value.is_infinite() {
+        Err(FoldError::Overflow)
+    } else if value == 0.0 && !exact_zero || value != 0.0 && !value.is_normal() {
+        Err(FoldError::Underflow)
+    } else {
+        Ok(value)
+    }
+}
 
 /// A constant in an expression.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -132,8 +176,20 @@ impl Constant {
         }
     }
 
+    /// [`fold`] of `value` as a constant.
+    ///
+    /// # Errors
+    /// As [`fold`].
+    pub fn folded(value: f64, exact_zero: bool) -> Result<Self, FoldError> {
+        // `fold` lets through only finite values, which `float` keeps.
+        fold(value, exact_zero).map(|v| Constant::float(v).unwrap_or(Constant::ZERO))
+    }
+
     /// `self + other`, exact for rationals (falls back to `f64` on overflow).
-    pub fn checked_add(self, other: Self) -> Option<Self> {
+    ///
+    /// # Errors
+    /// As [`fold`]: a sum of floats beyond `f64` or below its normal range.
+    pub fn checked_add(self, other: Self) -> Result<Self, FoldError> {
         if let (Constant::Rational { num: a, den: b }, Constant::Rational { num: c, den: d }) =
             (self, other)
         {
@@ -142,15 +198,20 @@ impl Constant {
                 let num = a.checked_mul(d / g)?.checked_add(c.checked_mul(b / g)?)?;
                 Constant::rational(num, b.checked_mul(d / g)?)
             })();
-            if exact.is_some() {
-                return exact;
+            if let Some(exact) = exact {
+                return Ok(exact);
             }
         }
-        Constant::float(self.to_f64() + other.to_f64())
+        let (a, b) = (self.to_f64(), other.to_f64());
+        Constant::folded(a + b, a == -b)
     }
 
     /// `self · other`, exact for rationals (falls back to `f64` on overflow).
-    pub fn checked_mul(self, other: Self) -> Option<Self> {
+    ///
+    /// # Errors
+    /// As [`fold`]: a product beyond `f64`, or of non-zero numbers below its normal range
+    /// (`1e-300 · 1e-300`).
+    pub fn checked_mul(self, other: Self) -> Result<Self, FoldError> {
         if let (Constant::Rational { num: a, den: b }, Constant::Rational { num: c, den: d }) =
             (self, other)
         {
@@ -159,11 +220,12 @@ impl Constant {
                 let g2 = gcd(c, b).max(1);
                 Constant::rational((a / g1).checked_mul(c / g2)?, (b / g2).checked_mul(d / g1)?)
             })();
-            if exact.is_some() {
-                return exact;
+            if let Some(exact) = exact {
+                return Ok(exact);
             }
         }
-        Constant::float(self.to_f64() * other.to_f64())
+        let (a, b) = (self.to_f64(), other.to_f64());
+        Constant::folded(a * b, a == 0.0 || b == 0.0)
     }
 
     /// `-self`.
@@ -178,37 +240,45 @@ impl Constant {
     }
 
     /// `self ^ other`: exact for a rational to an integer power, else `f64` when the result
-    /// is finite and real; `None` when it is not (`0^-1`, `(-2)^(1/2)`) or would not be exact
-    /// enough to be worth folding (irrational results of rationals are kept symbolic).
-    pub fn pow(self, other: Self) -> Option<Self> {
+    /// is finite, real and normal; `Ok(None)` when it would not be exact enough to be worth
+    /// folding (irrational results of rationals are kept symbolic).
+    ///
+    /// # Errors
+    /// [`FoldError::Undefined`] for `0^-1` and `(-2)^(1/2)`; else as [`fold`]: `10^400`
+    /// overflows, `10^-400` underflows.
+    pub fn pow(self, other: Self) -> Result<Option<Self>, FoldError> {
         let base = self.to_f64();
         if let Some(n) = other.as_integer() {
-            if let Constant::Rational { num, den } = self {
-                if n.unsigned_abs() <= 64 {
-                    let e = n.unsigned_abs() as u32;
-                    let exact = (|| {
-                        let p = num.checked_pow(e)?;
-                        let q = den.checked_pow(e)?;
-                        if n >= 0 {
-                            Constant::rational(p, q)
-                        } else {
-                            Constant::rational(q, p)
-                        }
-                    })();
-                    if exact.is_some() {
-                        return exact;
+            if let Constant::Rational { num, den } = self
+                && n.unsigned_abs() <= 64
+            {
+                let e = n.unsigned_abs() as u32;
+                let exact = (|| {
+                    let p = num.checked_pow(e)?;
+                    let q = den.checked_pow(e)?;
+                    if n >= 0 {
+                        Constant::rational(p, q)
+                    } else {
+                        Constant::rational(q, p)
                     }
-                }
-                if base == 0.0 && n < 0 {
-                    return None;
+                })();
+                if exact.is_some() {
+                    return Ok(exact);
                 }
             }
-            return Constant::float(base.powi(n.clamp(i32::MIN as i64, i32::MAX as i64) as i32));
+            if base == 0.0 && n < 0 {
+                return Err(FoldError::Undefined);
+            }
+            let value = base.powi(n.clamp(i32::MIN as i64, i32::MAX as i64) as i32);
+            return Constant::folded(value, base == 0.0).map(Some);
         }
         // Non-integer exponent: fold only floats, where exactness is already gone.
         match self {
-            Constant::Float(_) if base > 0.0 => Constant::float(base.powf(other.to_f64())),
-            _ => None,
+            Constant::Float(_) if base > 0.0 => {
+                Constant::folded(base.powf(other.to_f64()), false).map(Some)
+            }
+            _ if base < 0.0 => Err(FoldError::Undefined),
+            _ => Ok(None),
         }
     }
 }
@@ -238,17 +308,60 @@ mod tests {
     #[test]
     fn rational_arithmetic_is_exact() {
         let third = Constant::rational(1, 3).unwrap();
-        assert_eq!(third.checked_mul(Constant::int(3)), Some(Constant::ONE));
+        assert_eq!(third.checked_mul(Constant::int(3)), Ok(Constant::ONE));
         let half = Constant::rational(1, 2).unwrap();
-        assert_eq!(half.checked_add(half), Some(Constant::ONE));
-        assert_eq!(half.pow(Constant::int(-2)), Some(Constant::int(4)));
-        assert_eq!(Constant::ZERO.pow(Constant::int(-1)), None);
+        assert_eq!(half.checked_add(half), Ok(Constant::ONE));
+        assert_eq!(half.pow(Constant::int(-2)), Ok(Some(Constant::int(4))));
+        assert_eq!(
+            Constant::ZERO.pow(Constant::int(-1)),
+            Err(FoldError::Undefined)
+        );
+    }
+
+    /// Issue 28: `1e-300 · 1e-300` was folded to 0, and a term of the potential vanished.
+    #[test]
+    fn underflow_of_non_zero_numbers_is_refused() {
+        let tiny = Constant::parse_decimal("1e-300").unwrap();
+        assert_eq!(tiny.checked_mul(tiny), Err(FoldError::Underflow));
+        // Subnormal: 1e-300 · 1e-10 = 1e-310 has only ~44 significant bits.
+        let small = Constant::parse_decimal("1e-10").unwrap();
+        assert_eq!(tiny.checked_mul(small), Err(FoldError::Underflow));
+        assert_eq!(
+            Constant::int(10).pow(Constant::int(-400)),
+            Err(FoldError::Underflow)
+        );
+        assert_eq!(
+            Constant::int(10).pow(Constant::int(400)),
+            Err(FoldError::Overflow)
+        );
+        // Exact zeros and normal results are kept.
+        assert_eq!(tiny.checked_add(tiny.negated()), Ok(Constant::ZERO));
+        assert_eq!(tiny.checked_mul(Constant::ZERO), Ok(Constant::ZERO));
+        assert_eq!(
+            Constant::ZERO.pow(Constant::int(3)),
+            Ok(Some(Constant::ZERO))
+        );
+        let near = Constant::parse_decimal("1e-150").unwrap();
+        assert!(
+            near.checked_mul(near)
+                .is_ok_and(|c| c.to_f64() == 1e-150 * 1e-150)
+        );
+        assert_eq!(fold(f64::MIN_POSITIVE, false), Ok(f64::MIN_POSITIVE));
+        assert_eq!(
+            fold(f64::MIN_POSITIVE / 2.0, true),
+            Err(FoldError::Underflow)
+        );
+        assert_eq!(fold(f64::NAN, true), Err(FoldError::Undefined));
     }
 
     #[test]
     fn overflow_falls_back_to_float() {
         let big = Constant::int(i64::MAX / 2);
         let r = big.checked_mul(Constant::int(4)).unwrap();
+        assert_eq!(
+            Constant::Float(1e300f64.to_bits()).checked_mul(Constant::Float(1e300f64.to_bits())),
+            Err(FoldError::Overflow)
+        );
         assert!(matches!(r, Constant::Float(_)));
         assert_eq!(r.to_f64(), (i64::MAX / 2) as f64 * 4.0);
     }

@@ -37,7 +37,7 @@ mod expand;
 pub mod print;
 pub mod trig;
 
-pub use constant::Constant;
+pub use constant::{Constant, FoldError, fold};
 
 use rustc_hash::FxHashMap;
 
@@ -171,6 +171,19 @@ impl Func {
                 }
             }
         }
+    }
+
+    /// `f(x)` of a number `x` by the one rule of folding ([`fold`]): an exact 0 is where the
+    /// function vanishes (at 0; `ln` and `acos` at 1; `abs`, `sign`, `step`, which are exact,
+    /// anywhere), so `exp(-1000)`, 0 in `f64`, is an underflow.
+    ///
+    /// # Errors
+    /// As [`fold`]: `ln(-1)` is undefined, `cosh(1000)` overflows, `exp(-1000)` underflows.
+    pub fn fold(self, x: f64) -> Result<f64, FoldError> {
+        let exact_zero = x == 0.0
+            || matches!(self, Func::Abs | Func::Sign | Func::Step)
+            || x == 1.0 && matches!(self, Func::Ln | Func::Acos);
+        fold(self.apply(x), exact_zero)
     }
 
     /// `f(-x) = -f(x)`.
@@ -337,10 +350,11 @@ pub struct ExprArena {
     /// and every negation asks for one, and a hash-cons lookup per request was a tenth of a
     /// long chain's Lagrange derivation.
     small_ints: [Option<ExprId>; 4],
-    /// Set when folding constants gave a value beyond `f64` (a product or sum of constants
-    /// over ±1.8e308), which cannot be a node: the fold is then incomplete, and lowering a
-    /// model file turns this into a located error ([`Self::take_constant_overflow`]).
-    constant_overflow: std::cell::Cell<bool>,
+    /// The first fold of constants since the last [`Self::take_fold_error`] whose value
+    /// cannot be a node (a product or sum of constants beyond ±1.8e308, a product of non-zero
+    /// ones that underflows to 0, a power that is not real): the fold is then incomplete, and
+    /// lowering a model file turns this into a located error.
+    fold_error: std::cell::Cell<Option<FoldError>>,
 }
 
 impl ExprArena {
@@ -359,10 +373,18 @@ impl ExprArena {
         self.nodes.is_empty()
     }
 
-    /// Whether folding constants overflowed `f64` since the last call (and clears it). The
-    /// expression built then is not the one asked for: its caller reports an error.
-    pub fn take_constant_overflow(&mut self) -> bool {
-        self.constant_overflow.replace(false)
+    /// Why folding constants failed since the last call, if it did (and clears it): a
+    /// value beyond `f64` or lost to underflow ([`FoldError`]). The expression built then is
+    /// not the one asked for: its caller reports an error.
+    pub fn take_fold_error(&mut self) -> Option<FoldError> {
+        self.fold_error.take()
+    }
+
+    /// Records the first failed fold since the last [`Self::take_fold_error`].
+    fn fold_failed(&self, e: FoldError) {
+        if self.fold_error.get().is_none() {
+            self.fold_error.set(Some(e));
+        }
     }
 
     /// The node behind `id`.
@@ -615,9 +637,9 @@ impl ExprArena {
         for term in flat {
             match self.split_coefficient(term) {
                 (c, None) => match constant.checked_add(c) {
-                    Some(s) => constant = s,
-                    None => {
-                        self.constant_overflow.set(true);
+                    Ok(s) => constant = s,
+                    Err(e) => {
+                        self.fold_failed(e);
                         float_fallback.push(term);
                     }
                 },
@@ -632,12 +654,12 @@ impl ExprArena {
             if kept > 0 && merged[kept - 1].0 == rest {
                 let (_, total, o) = &mut merged[kept - 1];
                 match total.checked_add(c) {
-                    Some(s) => {
+                    Ok(s) => {
                         *total = s;
                         *o = None;
                     }
-                    None => {
-                        self.constant_overflow.set(true);
+                    Err(e) => {
+                        self.fold_failed(e);
                         float_fallback.extend(original);
                     }
                 }
@@ -784,8 +806,8 @@ impl ExprArena {
             zero_term(collected, partner);
             match others.len() {
                 0 => {
-                    *constant = constant.checked_add(c).unwrap_or_else(|| {
-                        self.constant_overflow.set(true);
+                    *constant = constant.checked_add(c).unwrap_or_else(|e| {
+                        self.fold_failed(e);
                         *constant
                     });
                 }
@@ -956,7 +978,7 @@ impl ExprArena {
                 let Some(partner) = self.lookup(NodeRef::Mul(&partner_factors)) else {
                     continue;
                 };
-                let Some(expected) = c.checked_mul(sign) else {
+                let Ok(expected) = c.checked_mul(sign) else {
                     continue;
                 };
                 if collected.get(&partner) == Some(&expected) {
@@ -1017,9 +1039,9 @@ impl ExprArena {
                         return self.int(0);
                     }
                     match coefficient.checked_mul(c) {
-                        Some(v) => coefficient = v,
-                        None => {
-                            self.constant_overflow.set(true);
+                        Ok(v) => coefficient = v,
+                        Err(e) => {
+                            self.fold_failed(e);
                             results.push(p);
                         }
                     }
@@ -1059,7 +1081,8 @@ impl ExprArena {
 
     /// The factors of `Π factors` as `(base, exponent, factor)` in `powers` (nested products
     /// flattened), and the product of their numbers; `None` if that is zero. A product of
-    /// numbers beyond `f64` sets the overflow flag and leaves out the factor that overflowed.
+    /// numbers beyond `f64` or lost to underflow records the failed fold and leaves out the
+    /// factor that made it fail.
     fn gather_factors(
         &self,
         factors: &[ExprId],
@@ -1081,10 +1104,11 @@ impl ExprArena {
         (!coefficient.is_zero()).then_some(coefficient)
     }
 
-    /// `a · b` of two numbers, or `a` with the overflow flag set when it is beyond `f64`.
+    /// `a · b` of two numbers, or `a` with the fold recorded as failed when `a · b` is beyond
+    /// `f64` or underflows.
     fn folded_product(&self, a: Constant, b: Constant) -> Constant {
-        a.checked_mul(b).unwrap_or_else(|| {
-            self.constant_overflow.set(true);
+        a.checked_mul(b).unwrap_or_else(|e| {
+            self.fold_failed(e);
             a
         })
     }
@@ -1139,10 +1163,13 @@ impl ExprArena {
             if b.is_one() {
                 return self.int(1);
             }
-            if let Some(e) = e
-                && let Some(v) = b.pow(e)
-            {
-                return self.constant(v);
+            if let Some(e) = e {
+                match b.pow(e) {
+                    Ok(Some(v)) => return self.constant(v),
+                    Ok(None) => {}
+                    // Kept as a power; the caller reports the fold.
+                    Err(error) => self.fold_failed(error),
+                }
             }
             if b.is_zero() && e.is_some_and(|e| !e.is_negative()) {
                 return self.int(0);

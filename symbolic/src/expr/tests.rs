@@ -623,3 +623,35 @@ fn operation_counts() {
     // shared: s once → 4
     assert_eq!(plan(&a, &[r], "t").operation_count(), 4);
 }
+
+/// Issue 28: quadratic drag `|v| v` from rest failed the implicit methods on a Jacobian that
+/// was not finite. The derivatives of `abs`, `sign` and `step` are finite everywhere:
+/// `d|x|/dx = sign(x)` with `sign(0) = 0`, and `sign' = step' = 0` (0 at the kink too).
+#[test]
+fn derivatives_at_kinks_are_finite() {
+    let (mut a, x, y, sx, _) = arena_xy();
+    let abs = a.func(Func::Abs, x);
+    let drag = a.times(abs, x);
+    let sign = a.func(Func::Sign, x);
+    let step = a.func(Func::Step, x);
+    let shifted = a.minus(x, y);
+    let step_shifted = a.func(Func::Step, shifted);
+    let abs_shifted = a.func(Func::Abs, shifted);
+    let cases = [drag, abs, sign, step, step_shifted, abs_shifted];
+    let derivatives: Vec<ExprId> = cases.iter().map(|&e| a.diff(e, sx)).collect();
+    for (x0, y0) in [(0.0, 0.0), (0.0, 1.0), (1.0, 1.0), (-0.5, 2.0), (2.0, -1.0)] {
+        let values: Vec<f64> = derivatives.iter().map(|&d| a.eval(d, &[x0, y0])).collect();
+        // d(|x| x)/dx = 2|x|; d|x|/dx = sign(x); sign' = step' = 0.
+        let expected = [
+            2.0 * x0.abs(),
+            Func::Sign.apply(x0),
+            0.0,
+            0.0,
+            0.0,
+            Func::Sign.apply(x0 - y0),
+        ];
+        assert_eq!(values, expected, "at x = {x0}, y = {y0}");
+    }
+    assert_eq!(Func::Sign.apply(0.0), 0.0);
+    assert_eq!(Func::Sign.apply(-0.0), 0.0);
+}

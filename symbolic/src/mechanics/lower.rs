@@ -6,8 +6,8 @@ use rustc_hash::FxHashMap;
 
 use super::constraints::{ConstraintEquations, linear_in_rates, redundant_rows};
 use crate::expr::{Constant, ExprArena, ExprId, Func, SymbolId, SymbolKind};
-use crate::model::Located;
 use crate::model::{BinOp, BodyKind, Diagnostic, Expr, ExprKind, ModelFile};
+use crate::model::{Located, Location};
 
 /// A parameter of a lowered model.
 #[derive(Debug, Clone, PartialEq)]
@@ -244,6 +244,7 @@ impl<'f> Lowering<'f> {
         file: &ModelFile,
         parameters: &[ParameterInfo],
     ) -> ConstraintEquations {
+        let before = self.errors.len();
         let holonomic: Vec<(String, ExprId)> = file
             .constraints
             .iter()
@@ -268,9 +269,10 @@ impl<'f> Lowering<'f> {
         }
         let eqs = ConstraintEquations::derive(&mut self.arena, &symbols, &holonomic, &nonholonomic);
         let (m, n) = (eqs.len(), symbols.len());
-        // (More constraints than coordinates is the loader's error; after an error here the
-        // rank test would only repeat it.)
-        if !self.errors.is_empty() {
+        // (More constraints than coordinates is the loader's error; after an error in the
+        // constraints themselves the rank test would only repeat it. An error elsewhere does
+        // not stop it: every diagnostic at once.)
+        if self.errors.len() > before {
             return eqs;
         }
         // Rank of J at a few random configurations (parameters at their defaults).
@@ -462,12 +464,13 @@ impl<'f> Lowering<'f> {
 
     /// The expression `e` of the model file in the arena. Constants must come out exact or
     /// not at all: an operation on constants that is undefined (division by zero, `0^0`, the
-    /// logarithm of a non-positive number, a root of a negative one) or that overflows `f64`
-    /// is a located error (see [`Self::check_constants`]), never a silent 0, NaN or ∞ in the
-    /// equations.
+    /// logarithm of a non-positive number, a root of a negative one), that overflows `f64`
+    /// or that underflows from non-zero numbers (`1e-300*1e-300`, `exp(-1000)`) is a located
+    /// error at its operator (see [`Self::check_constants`] and [`crate::expr::fold`]), never
+    /// a silent 0, NaN or ∞ in the equations.
     fn expr(&mut self, e: &Expr) -> ExprId {
-        // The flag may be left from an expression built outside a model file's.
-        self.arena.take_constant_overflow();
+        // The record may be left from an expression built outside a model file's.
+        self.arena.take_fold_error();
         self.lower(e)
     }
 
@@ -506,9 +509,19 @@ impl<'f> Lowering<'f> {
                 let a = self.lower(a);
                 self.arena.neg(a)
             }
-            ExprKind::Binary { op, lhs, rhs } => {
+            ExprKind::Binary {
+                op,
+                lhs,
+                rhs,
+                op_location,
+            } => {
+                let before = self.errors.len();
                 let (a, b) = (self.lower(lhs), self.lower(rhs));
-                self.check_constants(e, *op, a, b);
+                // Folds of the operands were reported there, and what follows from a mistake
+                // in an operand (`10^400/10^399` is then `10^400 · 10^-399`) is not another.
+                self.arena.take_fold_error();
+                let reported = self.errors.len() > before;
+                let undefined = reported || self.check_constants(*op_location, *op, a, b);
                 let result = match op {
                     BinOp::Add => self.arena.plus(a, b),
                     BinOp::Sub => self.arena.minus(a, b),
@@ -516,21 +529,14 @@ impl<'f> Lowering<'f> {
                     BinOp::Div => self.arena.divide(a, b),
                     BinOp::Pow => self.arena.pow(a, b),
                 };
-                if self.arena.take_constant_overflow() {
-                    self.errors.push(
-                        Diagnostic::new(
-                            e.location,
-                            format!(
-                                "the numbers in this {} overflow: their value is beyond ±1.8e308, the largest a double holds",
-                                match op {
-                                    BinOp::Add | BinOp::Sub => "sum",
-                                    BinOp::Mul | BinOp::Div => "product",
-                                    BinOp::Pow => "power",
-                                }
-                            ),
-                        )
-                        .with_help("check the exponents of the numbers; rescale the units if the values are real"),
-                    );
+                if let Some(error) = self.arena.take_fold_error()
+                    && !undefined
+                {
+                    self.errors.push(crate::model::parser::fold_diagnostic(
+                        *op_location,
+                        *op,
+                        error,
+                    ));
                 }
                 result
             }
@@ -538,23 +544,11 @@ impl<'f> Lowering<'f> {
                 let args: Vec<ExprId> = args.iter().map(|a| self.lower(a)).collect();
                 if let [a] = args.as_slice()
                     && let Some(x) = self.arena.as_constant(*a).map(Constant::to_f64)
+                    && let Some(Err(error)) = crate::model::parser::fold_call(func, x)
                 {
-                    let value = match func.as_str() {
-                        "sqrt" => Some(x.sqrt()),
-                        name => Func::from_name(name).map(|f| f.apply(x)),
-                    };
-                    if value.is_some_and(|v| !v.is_finite()) {
-                        self.undefined(
-                            e,
-                            &format!("`{func}({x})` is not a finite real number"),
-                            match func.as_str() {
-                                "ln" => "the logarithm takes a positive argument",
-                                "sqrt" => "the square root takes a non-negative argument",
-                                "asin" | "acos" => "the argument must lie in [-1, 1]",
-                                _ => "check the argument",
-                            },
-                        );
-                    }
+                    self.errors.push(crate::model::parser::call_fold_diagnostic(
+                        e.location, func, x, error,
+                    ));
                 }
                 match (func.as_str(), args.as_slice()) {
                     ("sqrt", [a]) => self.arena.sqrt(*a),
@@ -569,49 +563,41 @@ impl<'f> Lowering<'f> {
         }
     }
 
-    /// Reports `a op b` (the node `e`) when its value is undefined for the numbers it is
-    /// given: `a / 0`, `0 ^ b` with `b ≤ 0`, a negative number to a non-integer power, or a
-    /// power of numbers that overflows.
-    fn check_constants(&mut self, e: &Expr, op: BinOp, a: ExprId, b: ExprId) {
+    /// Reports `a op b` (its operator at `at`) when its value is undefined for the numbers it
+    /// is given: `a / 0`, `0 ^ b` with `b ≤ 0`, a negative number to a non-integer power;
+    /// whether it did. (Overflow and underflow are the arena's fold errors.)
+    fn check_constants(&mut self, at: Location, op: BinOp, a: ExprId, b: ExprId) -> bool {
         let (x, y) = (
             self.arena.as_constant(a).map(Constant::to_f64),
             self.arena.as_constant(b).map(Constant::to_f64),
         );
         match (op, x, y) {
             (BinOp::Div, _, Some(0.0)) => {
-                self.undefined(e, "division by zero", "the divisor is 0 here");
+                self.undefined(at, "division by zero", "the divisor is 0 here");
             }
             (BinOp::Pow, Some(x), Some(y)) if x == 0.0 && y <= 0.0 => {
                 self.undefined(
-                    e,
+                    at,
                     &format!("`0^{y}` is undefined"),
                     "zero has no power of a non-positive exponent",
                 );
             }
             (BinOp::Pow, Some(x), Some(y)) if x < 0.0 && y.fract() != 0.0 => {
                 self.undefined(
-                    e,
+                    at,
                     &format!("`({x})^{y}` is not a real number"),
                     "a negative number has only integer powers",
                 );
             }
-            (BinOp::Pow, Some(x), Some(y)) if !x.powf(y).is_finite() => {
-                self.errors.push(
-                    Diagnostic::new(
-                        e.location,
-                        format!("`{x}^{y}` overflows: its value is beyond ±1.8e308, the largest a double holds"),
-                    )
-                    .with_help("check the exponent; rescale the units if the values are real"),
-                );
-            }
-            _ => {}
+            _ => return false,
         }
+        true
     }
 
     /// A located error: an operation on numbers whose result is undefined.
-    fn undefined(&mut self, e: &Expr, what: &str, help: &str) {
+    fn undefined(&mut self, at: Location, what: &str, help: &str) {
         self.errors
-            .push(Diagnostic::new(e.location, what.to_string()).with_help(help.to_string()));
+            .push(Diagnostic::new(at, what.to_string()).with_help(help.to_string()));
     }
 
     fn unknown_function(&mut self, e: &Expr, name: &str) -> ExprId {

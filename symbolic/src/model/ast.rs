@@ -73,6 +73,8 @@ pub enum ExprKind {
         lhs: Box<Expr>,
         /// Right operand.
         rhs: Box<Expr>,
+        /// Where the operator is (the `*` of `a * b`): errors of the operation point here.
+        op_location: Location,
     },
     /// `f(a, …)` with `f` one of [`FUNCTIONS`] and the right number of arguments.
     Call {

@@ -11,7 +11,7 @@ use super::diagnostic::{Diagnostic, Diagnostics};
 use super::file::{BalanceKind, BodyKind, ModelFile, Parameter};
 use super::located::{Located, Location};
 use super::parser::{closest, eval_expr, identifiers};
-use super::schema::Incomplete;
+use super::schema::{self, Incomplete, UNRAW_KEYWORDS};
 
 /// Runs every rule on `file`.
 ///
@@ -27,6 +27,22 @@ pub fn check(file: &ModelFile) -> Result<(), Vec<Diagnostic>> {
 /// # Errors
 /// Every violation, sorted by location.
 pub fn check_partial(file: &ModelFile, incomplete: &Incomplete) -> Result<(), Vec<Diagnostic>> {
+    let (mut list, units) = check_parts(file, incomplete);
+    list.extend(units);
+    if list.is_empty() {
+        return Ok(());
+    }
+    list.sort_by_key(|d| d.location);
+    Err(list)
+}
+
+/// [`check_partial`]'s diagnostics in two lists: the rules' and the units' (a unit mistake
+/// at the place of a rule's mistake left out). A file whose only mistakes are units is sound
+/// to derive ([`super::load`] then reports what the derivation finds too).
+pub(crate) fn check_parts(
+    file: &ModelFile,
+    incomplete: &Incomplete,
+) -> (Vec<Diagnostic>, Vec<Diagnostic>) {
     let mut checker = Checker::new(file, incomplete);
     checker.names();
     checker.presence();
@@ -42,14 +58,13 @@ pub fn check_partial(file: &ModelFile, incomplete: &Incomplete) -> Result<(), Ve
     let units = super::unit_check::check(file);
     // A unit mistake at the place of another mistake is its consequence (`initial: { theta:
     // x }` is not constant, and so not in rad either): one message per mistake.
-    let mut list = checker.diagnostics.finish().err().unwrap_or_default();
+    let list = checker.diagnostics.finish().err().unwrap_or_default();
     let taken: Vec<Location> = list.iter().map(|d| d.location).collect();
-    list.extend(units.into_iter().filter(|d| !taken.contains(&d.location)));
-    if list.is_empty() {
-        return Ok(());
-    }
-    list.sort_by_key(|d| d.location);
-    Err(list)
+    let units = units
+        .into_iter()
+        .filter(|d| !taken.contains(&d.location))
+        .collect();
+    (list, units)
 }
 
 /// The value of a constant expression at the parameters' defaults (`None` if it uses
@@ -159,9 +174,25 @@ impl<'f> Checker<'f> {
 
     // Rule: parameters, coordinates, points and bodies have distinct names, none of which is
     // `t`, `pi` or a function name, or ends in `_dot` / `_ddot` (those spell rates and
-    // accelerations of coordinates).
+    // accelerations of coordinates). Parameters and coordinates are Rust names in generated
+    // code (fields and locals, a keyword as `r#type`), so none is one of the keywords that
+    // cannot be raw (`self`, `Self`, `super`, `crate`); nor is the model's struct `Self`.
+    // (Points and bodies are only strings there: any name will do.)
     fn names(&mut self) {
         let file = self.file;
+        let model = &file.name;
+        if schema::struct_name(&model.value) == "Self" {
+            self.error(
+                Diagnostic::new(
+                    model.location,
+                    format!(
+                        "model name `{}` is reserved: its struct would be `Self`, a Rust keyword",
+                        model.value
+                    ),
+                )
+                .with_help("choose another name, such as `self_model`"),
+            );
+        }
         // First place and kind of each name (a map: a file of many names stays linear).
         let mut seen: std::collections::HashMap<&str, (Location, &str)> =
             std::collections::HashMap::new();
@@ -186,6 +217,19 @@ impl<'f> Checker<'f> {
                         format!("{kind} name `{n}` is reserved: {why}"),
                     )
                     .with_help("choose another name"),
+                );
+            } else if matches!(kind, "parameter" | "coordinate") && UNRAW_KEYWORDS.contains(&n) {
+                self.error(
+                    Diagnostic::new(
+                        name.location,
+                        format!(
+                            "{kind} name `{n}` is reserved: `{n}` is a Rust keyword, which generated code cannot use as a name (not even as `r#{n}`)"
+                        ),
+                    )
+                    .with_help(format!(
+                        "choose another name, such as `{}_`; other keywords (`type`, `box`) are fine",
+                        n.to_lowercase()
+                    )),
                 );
             } else if n.ends_with("_dot") || n.ends_with("_ddot") {
                 self.error(
@@ -1241,6 +1285,22 @@ mod tests {
                 "2:27: parameter name `sin` is reserved: `sin` is a function",
                 "2:35: parameter name `x_dot` ends in `_dot` or `_ddot`, which spell rates",
                 "3:15: duplicate name `q`: already a parameter at 2:21",
+            ]
+        );
+    }
+
+    /// Issue 28: the keywords that are not raw identifiers cannot name a parameter, a
+    /// coordinate or (as `Self`) the model; any other keyword can, and any name a point.
+    #[test]
+    fn keywords_that_generated_code_cannot_spell_are_reserved() {
+        let src = "name: self\nparameters: { super: 1, type: 2 }\ncoordinates: [crate, Self]\npoints: { self: [crate, Self] }\nkinetic: crate_dot^2 + Self_dot^2\n";
+        assert_eq!(
+            errors(src),
+            [
+                "1:7: model name `self` is reserved: its struct would be `Self`, a Rust keyword",
+                "2:15: parameter name `super` is reserved: `super` is a Rust keyword, which generated code cannot use as a name (not even as `r#super`)",
+                "3:15: coordinate name `crate` is reserved: `crate` is a Rust keyword, which generated code cannot use as a name (not even as `r#crate`)",
+                "3:22: coordinate name `Self` is reserved: `Self` is a Rust keyword, which generated code cannot use as a name (not even as `r#Self`)",
             ]
         );
     }

@@ -33,12 +33,23 @@ impl Diagnostic {
         self
     }
 
-    /// The one-line form `path:line:col: message`.
+    /// The one-line form `path:line:col: message`, for a terminal: control characters
+    /// escaped and long quotes shortened ([`printable`]).
     pub fn headline(&self, path: &str) -> String {
-        format!("{path}:{}: {}", self.location, self.message)
+        format!(
+            "{}:{}: {}",
+            printable(path),
+            self.location,
+            printable(&self.message)
+        )
     }
 
     /// The full form: headline, source line with a caret under the column, and help.
+    ///
+    /// What reaches the terminal is printable: a control character of the file (ESC, BEL,
+    /// a bidirectional override) is shown escaped (`\u{1b}`), never sent as is, and a line
+    /// longer than [`SNIPPET_WIDTH`] characters is shown as a window around the column, cut
+    /// with `…`.
     pub fn render(&self, path: &str, source: &str) -> String {
         let mut out = self.headline(path);
         if let Some(line) = source
@@ -47,20 +58,93 @@ impl Diagnostic {
         {
             let number = self.location.line.to_string();
             let pad = " ".repeat(number.len());
-            let caret_pad: String = line
-                .chars()
-                .take(self.location.column.saturating_sub(1) as usize)
-                .map(|c| if c == '\t' { '\t' } else { ' ' })
-                .collect();
+            let (shown, caret_pad) = snippet(line, self.location.column);
             out.push_str(&format!(
-                "\n{pad} |\n{number} | {line}\n{pad} | {caret_pad}^"
+                "\n{pad} |\n{number} | {shown}\n{pad} | {caret_pad}^"
             ));
         }
         if let Some(help) = &self.help {
-            out.push_str(&format!("\n= help: {help}"));
+            out.push_str(&format!("\n= help: {}", printable(help)));
         }
         out
     }
+}
+
+/// Characters of a source line shown in a diagnostic: a longer line is cut to a window of
+/// this many around the column.
+pub const SNIPPET_WIDTH: usize = 100;
+
+/// Characters of a message or help shown: a longer one keeps its start and end around a `…`
+/// (a message quotes the file, and a name or key can be as long as a line).
+pub const MESSAGE_WIDTH: usize = 1_000;
+
+/// Whether `c` would act on a terminal rather than show: the C0 and C1 controls but tab,
+/// and the bidirectional embeddings, overrides and isolates (which reorder what follows).
+fn acts_on_terminal(c: char) -> bool {
+    (c.is_control() && c != '\t') || matches!(c, '\u{202a}'..='\u{202e}' | '\u{2066}'..='\u{2069}')
+}
+
+/// How `c` is shown: itself, or escaped as `\u{1b}`.
+fn shown(c: char) -> String {
+    if acts_on_terminal(c) {
+        format!("\\u{{{:x}}}", c as u32)
+    } else {
+        c.to_string()
+    }
+}
+
+/// `text` for a terminal: control characters escaped (`\u{7}`), and when longer than
+/// [`MESSAGE_WIDTH`] characters, its start and end around a `…`.
+pub fn printable(text: &str) -> String {
+    let count = text.chars().count();
+    if count <= MESSAGE_WIDTH && !text.chars().any(acts_on_terminal) {
+        return text.to_string();
+    }
+    let half = MESSAGE_WIDTH / 2;
+    let mut out = String::new();
+    for (i, c) in text.chars().enumerate() {
+        if count > MESSAGE_WIDTH && i == half {
+            out.push('…');
+        }
+        if count <= MESSAGE_WIDTH || i < half || i >= count - half {
+            out.push_str(&shown(c));
+        }
+    }
+    out
+}
+
+/// The part of `line` shown under a diagnostic at `column` (1-based), and the padding that
+/// puts a caret under that column: at most [`SNIPPET_WIDTH`] characters around it, cut with
+/// `…`, control characters escaped.
+fn snippet(line: &str, column: u32) -> (String, String) {
+    let chars: Vec<char> = line.chars().collect();
+    let at = (column.saturating_sub(1) as usize).min(chars.len());
+    let (start, end) = if chars.len() <= SNIPPET_WIDTH {
+        (0, chars.len())
+    } else {
+        let start = at
+            .saturating_sub(SNIPPET_WIDTH / 2)
+            .min(chars.len() - SNIPPET_WIDTH);
+        (start, start + SNIPPET_WIDTH)
+    };
+    let mut text = String::new();
+    let mut pad = String::new();
+    if start > 0 {
+        text.push('…');
+        pad.push(' ');
+    }
+    for (i, &c) in chars[start..end].iter().enumerate() {
+        let s = shown(c);
+        if start + i < at {
+            // A tab stays a tab, so that the caret lines up as the line does.
+            pad.extend(s.chars().map(|x| if x == '\t' { '\t' } else { ' ' }));
+        }
+        text.push_str(&s);
+    }
+    if end < chars.len() {
+        text.push('…');
+    }
+    (text, pad)
 }
 
 /// Collects every diagnostic of a file so that all are reported at once.
@@ -117,5 +201,60 @@ impl Drop for Diagnostics {
             self.checked || self.list.is_empty() || std::thread::panicking(),
             "Diagnostics dropped without finish()"
         );
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Issue 28: ESC and BEL of a model file reached the terminal; a 500 kB line was
+    /// printed whole.
+    #[test]
+    fn what_reaches_the_terminal_is_printable_and_short() {
+        let at = Location { line: 1, column: 8 };
+        let d = Diagnostic::new(at, "unknown key `a\u{1b}[2Jb`").with_help("bell \u{7}");
+        let text = d.render("m\u{1b}.yaml", "bogus: a\u{1b}[2Jb\u{202e}x\n");
+        assert!(
+            !text.lines().any(|l| l.chars().any(acts_on_terminal)),
+            "{text:?}"
+        );
+        assert_eq!(
+            text,
+            "m\\u{1b}.yaml:1:8: unknown key `a\\u{1b}[2Jb`\n  |\n1 | bogus: a\\u{1b}[2Jb\\u{202e}x\n  |        ^\n= help: bell \\u{7}"
+        );
+        // An escaped character before the column moves the caret by its escaped width.
+        let d = Diagnostic::new(Location { line: 1, column: 3 }, "here");
+        assert_eq!(
+            d.render("m", "\u{7}xy"),
+            "m:1:3: here\n  |\n1 | \\u{7}xy\n  |       ^"
+        );
+
+        let long = format!("{}X{}", "a".repeat(250_000), "b".repeat(250_000));
+        let d = Diagnostic::new(
+            Location {
+                line: 1,
+                column: 250_001,
+            },
+            format!("unknown name `{long}`"),
+        );
+        let text = d.render("m", &long);
+        assert!(
+            text.len() < 2 * (SNIPPET_WIDTH + MESSAGE_WIDTH) + 100,
+            "{}",
+            text.len()
+        );
+        let lines: Vec<&str> = text.lines().collect();
+        // The window keeps the column, with the caret under the `X`.
+        let caret = lines[3].find('^').unwrap();
+        assert_eq!(
+            lines[2].chars().nth(caret),
+            Some('X'),
+            "{}\n{}",
+            lines[2],
+            lines[3]
+        );
+        assert!(lines[2].contains("…aaa") && lines[2].ends_with("bbb…"));
+        assert!(lines[0].contains("aaa…bbb"), "{}", lines[0]);
     }
 }

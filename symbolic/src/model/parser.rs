@@ -18,6 +18,7 @@
 use super::ast::{BinOp, Expr, ExprKind, FUNCTIONS};
 use super::diagnostic::Diagnostic;
 use super::located::Location;
+use crate::expr::{FoldError, Func, fold};
 
 /// Parses one expression whose first character is at `start`; the expression is on one
 /// line, so character `i` of `text` is at column `start.column + i`.
@@ -141,7 +142,20 @@ fn lex(text: &str, locate: &dyn Fn(usize) -> Location) -> Result<Vec<(Tok, usize
                 }
             }
             let lit: String = chars[s..i].iter().collect();
+            // A literal with a non-zero digit that reads as 0 or subnormal (`1e-400`) is
+            // refused by the rule of folding, as a product that underflows is.
+            let zero = lit
+                .split(['e', 'E'])
+                .next()
+                .is_some_and(|m| m.chars().all(|c| matches!(c, '0' | '.')));
             match lit.parse::<f64>() {
+                Ok(v) if v.is_finite() && fold(v, zero).is_err() => {
+                    return Err(Diagnostic::new(
+                        locate(s),
+                        format!("the number `{lit}` is too small: {}", FoldError::Underflow),
+                    )
+                    .with_help("write 0 if 0 is meant; rescale the units if the value is real"));
+                }
                 Ok(v) if v.is_finite() => toks.push((Tok::Num(v, lit), s)),
                 Ok(_) => {
                     return Err(Diagnostic::new(
@@ -239,6 +253,7 @@ fn binary(op: BinOp, (lhs, lh): (Expr, usize), (rhs, rh): (Expr, usize), at: Loc
                 op,
                 lhs: Box::new(lhs),
                 rhs: Box::new(rhs),
+                op_location: at,
             },
             location,
         },
@@ -599,13 +614,80 @@ pub fn edit_distance(a: &str, b: &str) -> usize {
     prev[b.len()]
 }
 
+/// The located error of an operation on numbers that the rule of folding refuses
+/// ([`crate::expr::fold`]): "the numbers in this product underflow: …" at the operator.
+pub fn fold_diagnostic(at: Location, op: BinOp, error: FoldError) -> Diagnostic {
+    let kind = match op {
+        BinOp::Add | BinOp::Sub => "sum",
+        BinOp::Mul | BinOp::Div => "product",
+        BinOp::Pow => "power",
+    };
+    let verb = match error {
+        FoldError::Overflow => "overflow",
+        FoldError::Underflow => "underflow",
+        FoldError::Undefined => "have no value",
+    };
+    Diagnostic::new(at, format!("the numbers in this {kind} {verb}: {error}"))
+        .with_help("check the exponents of the numbers; rescale the units if the values are real")
+}
+
+/// The located error of a function of a number that the rule of folding refuses
+/// ([`Func::fold`]): `exp(-1000)` underflows.
+pub fn call_fold_diagnostic(at: Location, func: &str, x: f64, error: FoldError) -> Diagnostic {
+    let (what, help) = match (error, func) {
+        (FoldError::Underflow, _) => (
+            format!("`{func}({x})` underflows: {error}"),
+            "check the argument; rescale the units if the values are real",
+        ),
+        (_, "ln") => (
+            format!("`{func}({x})` is not a finite real number"),
+            "the logarithm takes a positive argument",
+        ),
+        (_, "sqrt") => (
+            format!("`{func}({x})` is not a finite real number"),
+            "the square root takes a non-negative argument",
+        ),
+        (_, "asin" | "acos") => (
+            format!("`{func}({x})` is not a finite real number"),
+            "the argument must lie in [-1, 1]",
+        ),
+        _ => (
+            format!("`{func}({x})` is not a finite real number"),
+            "check the argument",
+        ),
+    };
+    Diagnostic::new(at, what).with_help(help)
+}
+
+/// `func(x)` (`sqrt` included, which is not a [`Func`]); `None` for a name that is no
+/// function of one argument.
+fn apply_call(func: &str, x: f64) -> Option<f64> {
+    match func {
+        "sqrt" => Some(x.sqrt()),
+        name => Func::from_name(name).map(|f| f.apply(x)),
+    }
+}
+
+/// `func(x)` of a number by the rule of folding (`sqrt` included, which is not a
+/// [`Func`]); `None` for a name that is no function of one argument.
+pub fn fold_call(func: &str, x: f64) -> Option<Result<f64, FoldError>> {
+    match func {
+        "sqrt" => Some(fold(x.sqrt(), x == 0.0)),
+        name => Func::from_name(name).map(|f| f.fold(x)),
+    }
+}
+
 /// Evaluates an expression with names resolved by `lookup` (`pi` is built in).
 ///
 /// Functions and powers are evaluated exactly as the expression DAG evaluates them
-/// (`crate::expr`), so that a value checked here is the value used later.
+/// (`crate::expr`), so that a value checked here is the value used later. A result of
+/// non-zero numbers that underflows (`1e-300*1e-300`, `exp(-1000)`) is an error, as the rule
+/// of folding has it ([`crate::expr::fold`]); an overflow or an undefined operation gives ∞
+/// or NaN, for the caller to report with its context.
 ///
 /// # Errors
-/// A diagnostic at the first name `lookup` does not know (message `unknown name `x``).
+/// A diagnostic at the first name `lookup` does not know (message `unknown name `x``), or at
+/// the first operation that underflows.
 pub fn eval_expr(e: &Expr, lookup: &dyn Fn(&str) -> Option<f64>) -> Result<f64, Diagnostic> {
     Ok(match &e.kind {
         ExprKind::Number { value, .. } => *value,
@@ -614,15 +696,24 @@ pub fn eval_expr(e: &Expr, lookup: &dyn Fn(&str) -> Option<f64>) -> Result<f64, 
             lookup(n).ok_or_else(|| Diagnostic::new(e.location, format!("unknown name `{n}`")))?
         }
         ExprKind::Neg(a) => -eval_expr(a, lookup)?,
-        ExprKind::Binary { op, lhs, rhs } => {
+        ExprKind::Binary {
+            op,
+            lhs,
+            rhs,
+            op_location,
+        } => {
             let (a, b) = (eval_expr(lhs, lookup)?, eval_expr(rhs, lookup)?);
-            match op {
-                BinOp::Add => a + b,
-                BinOp::Sub => a - b,
-                BinOp::Mul => a * b,
-                BinOp::Div => a / b,
-                BinOp::Pow => crate::expr::eval::pow(a, b),
+            let (value, exact_zero) = match op {
+                BinOp::Add => (a + b, a == -b),
+                BinOp::Sub => (a - b, a == b),
+                BinOp::Mul => (a * b, a == 0.0 || b == 0.0),
+                BinOp::Div => (a / b, a == 0.0),
+                BinOp::Pow => (crate::expr::eval::pow(a, b), a == 0.0),
+            };
+            if let Err(error @ FoldError::Underflow) = fold(value, exact_zero) {
+                return Err(fold_diagnostic(*op_location, *op, error));
             }
+            value
         }
         ExprKind::Call { func, args } => {
             let v: Vec<f64> = args
@@ -630,11 +721,13 @@ pub fn eval_expr(e: &Expr, lookup: &dyn Fn(&str) -> Option<f64>) -> Result<f64, 
                 .map(|a| eval_expr(a, lookup))
                 .collect::<Result<_, _>>()?;
             match (func.as_str(), v.as_slice()) {
-                ("sqrt", [x]) => x.sqrt(),
                 ("atan2", [y, x]) => y.atan2(*x),
-                (name, [x]) => match crate::expr::Func::from_name(name) {
-                    Some(f) => f.apply(*x),
-                    None => {
+                (name, [x]) => match (apply_call(name, *x), fold_call(name, *x)) {
+                    (_, Some(Err(error @ FoldError::Underflow))) => {
+                        return Err(call_fold_diagnostic(e.location, name, *x, error));
+                    }
+                    (Some(value), _) => value,
+                    (None, _) => {
                         return Err(Diagnostic::new(
                             e.location,
                             format!("unknown function `{name}`"),
@@ -675,7 +768,7 @@ mod tests {
             ExprKind::Number { text, .. } => text.clone(),
             ExprKind::Ident(n) => n.clone(),
             ExprKind::Neg(a) => format!("(-{})", show(a)),
-            ExprKind::Binary { op, lhs, rhs } => {
+            ExprKind::Binary { op, lhs, rhs, .. } => {
                 format!("({} {} {})", show(lhs), symbol(*op), show(rhs))
             }
             ExprKind::Call { func, args } => format!(

@@ -154,6 +154,36 @@ pub fn is_identifier(s: &str) -> bool {
         && c.all(|x| x.is_ascii_alphanumeric() || x == '_')
 }
 
+/// Rust's keywords, strict and reserved, of every edition up to 2024 (`gen`): generated code
+/// spells a parameter or coordinate named so as a raw identifier (`r#type`).
+pub const RUST_KEYWORDS: &[&str] = &[
+    "as", "async", "await", "break", "const", "continue", "crate", "dyn", "else", "enum", "extern",
+    "false", "fn", "for", "gen", "if", "impl", "in", "let", "loop", "match", "mod", "move", "mut",
+    "pub", "ref", "return", "self", "Self", "static", "struct", "super", "trait", "true", "type",
+    "unsafe", "use", "where", "while", "abstract", "become", "box", "do", "final", "macro",
+    "override", "priv", "typeof", "unsized", "virtual", "yield", "try",
+];
+
+/// The keywords that are not raw identifiers either (`r#self` is not Rust): no parameter or
+/// coordinate can be named so, and no model whose struct ([`struct_name`]) would be `Self`.
+pub const UNRAW_KEYWORDS: &[&str] = &["self", "Self", "super", "crate"];
+
+/// The generated struct's name, the UpperCamelCase of the model's: `double_pendulum` →
+/// `DoublePendulum`.
+pub fn struct_name(model_name: &str) -> String {
+    model_name
+        .split('_')
+        .filter(|p| !p.is_empty())
+        .map(|p| {
+            let mut c = p.chars();
+            match c.next() {
+                Some(f) => f.to_ascii_uppercase().to_string() + c.as_str(),
+                None => String::new(),
+            }
+        })
+        .collect()
+}
+
 /// Whether `s` is a snake_case identifier: a lowercase letter, then lowercase letters,
 /// digits and `_`.
 pub fn is_snake_case(s: &str) -> bool {
@@ -1503,10 +1533,12 @@ impl<'s> Ctx<'s> {
         )?;
         Some(match rhs {
             None => lhs,
+            // The `=` is not kept: the difference is located at its right side.
             Some(rhs) => Expr {
                 location: lhs.location,
                 kind: ExprKind::Binary {
                     op: BinOp::Sub,
+                    op_location: rhs.location,
                     lhs: Box::new(lhs),
                     rhs: Box::new(rhs),
                 },

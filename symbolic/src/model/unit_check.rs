@@ -45,15 +45,142 @@ pub fn check(file: &ModelFile) -> Vec<Diagnostic> {
     if file.units.is_none() {
         return Vec::new();
     }
-    let mut cx = Checker::new(file);
-    // Pass 1: requirements in the unknowns; solve them.
-    cx.walk();
-    cx.solve();
-    // Pass 2: every unknown solved or left free; report.
-    cx.mode = Mode::Report;
-    cx.walk();
-    cx.undeclared();
-    cx.diagnostics
+    let cx = Checker::run(file, None);
+    if cx.diagnostics.len() < 2 {
+        return cx.diagnostics;
+    }
+    root_cause(file, cx)
+}
+
+/// A declared unit (a parameter's, or a coordinate's) that its uses contradict is one
+/// mistake, not one per use: `g: 9.81  # m/s` used in `gravity`, the potential and a hand
+/// equation gave three errors, the first at `gravity`, none at the declaration.
+///
+/// Rule: a name declared in unit `U` and found in two or more of the failing expressions is
+/// checked again as if undeclared; if its uses then imply a unit `V ≠ U` and at least two
+/// errors go away, those errors are replaced by one at the declaration ("declared in m/s,
+/// but its uses need m/s^2"). The name that leaves the fewest errors wins; only the eight
+/// names found in the most failing expressions are tried, so a file of many parameters
+/// stays linear.
+fn root_cause<'f>(file: &'f ModelFile, first: Checker<'f>) -> Vec<Diagnostic> {
+    let mut counts: HashMap<&str, usize> = HashMap::new();
+    for names in &first.failing_names {
+        let mut names: Vec<&str> = names.iter().map(String::as_str).collect();
+        names.sort_unstable();
+        names.dedup();
+        for n in names {
+            *counts.entry(n).or_default() += 1;
+        }
+    }
+    let declared = |n: &str| -> Option<(Target, Dimension)> {
+        if let Some(i) = file.parameters.iter().position(|p| p.name.value == n) {
+            match first.parameters.get(i) {
+                Some(Unit::Known(d)) => Some((Target::Parameter(i), *d)),
+                _ => None,
+            }
+        } else {
+            let i = first.coordinate(n)?;
+            match first.coordinates.get(i) {
+                Some(Unit::Known(d)) => Some((Target::Coordinate(i), *d)),
+                _ => None,
+            }
+        }
+    };
+    let mut candidates: Vec<(&str, usize)> = counts
+        .into_iter()
+        .filter(|(n, count)| *count >= 2 && declared(n).is_some())
+        .collect();
+    // Most failing expressions first, then by name (a deterministic order).
+    candidates.sort_by(|a, b| b.1.cmp(&a.1).then(a.0.cmp(b.0)));
+    candidates.truncate(8);
+    let total = first.diagnostics.len();
+    let mut best: Option<(Vec<Diagnostic>, Diagnostic)> = None;
+    for (name, _) in candidates {
+        let Some((target, unit)) = declared(name) else {
+            continue;
+        };
+        let again = Checker::run(file, Some(target));
+        let Some(needed) = again.solution_of(target) else {
+            continue;
+        };
+        if needed.unit == unit {
+            continue;
+        }
+        let at = target.location(file);
+        // "parameter `g` has no unit" is this run's own doing.
+        let rest: Vec<Diagnostic> = again
+            .diagnostics
+            .into_iter()
+            .filter(|d| d.location != at)
+            .collect();
+        let removed = total.saturating_sub(rest.len());
+        if removed < 2 || best.as_ref().is_some_and(|(b, _)| b.len() <= rest.len()) {
+            continue;
+        }
+        let (kind, spelling) = match target {
+            Target::Parameter(i) => (
+                "parameter",
+                file.parameters
+                    .get(i)
+                    .and_then(|p| p.unit.as_ref())
+                    .map(|u| unit_part(&u.value).trim().to_string()),
+            ),
+            Target::Coordinate(_) => ("coordinate", None),
+        };
+        let declared_text = spelling.unwrap_or_else(|| show(unit));
+        let root = Diagnostic::new(
+            target.unit_location(file),
+            format!(
+                "{kind} `{name}` is declared in {declared_text}, but its uses need {} ({} at {} and {} more)",
+                needed.text(),
+                needed.origin,
+                needed.at,
+                removed.saturating_sub(1)
+            ),
+        )
+        .with_help(format!(
+            "declare `{name}` in {} if that is its unit; otherwise correct the formulas that use it",
+            needed.text()
+        ));
+        best = Some((rest, root));
+    }
+    match best {
+        Some((mut rest, root)) => {
+            rest.push(root);
+            rest.sort_by_key(|d| d.location);
+            rest
+        }
+        None => first.diagnostics,
+    }
+}
+
+/// A name whose declared unit [`root_cause`] sets aside.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Target {
+    /// Parameter `i` of the file.
+    Parameter(usize),
+    /// Coordinate `i` of the file.
+    Coordinate(usize),
+}
+
+impl Target {
+    /// Where its name is (a "has no unit" error of a run without its unit is there).
+    fn location(self, file: &ModelFile) -> Location {
+        match self {
+            Target::Parameter(i) => file.parameters.get(i).map(|p| p.name.location),
+            Target::Coordinate(i) => file.coordinates.get(i).map(|c| c.name.location),
+        }
+        .unwrap_or_default()
+    }
+
+    /// Where its unit is declared (the name's location when the unit has none).
+    fn unit_location(self, file: &ModelFile) -> Location {
+        let unit = match self {
+            Target::Parameter(i) => file.parameters.get(i).and_then(|p| p.unit.as_ref()),
+            Target::Coordinate(i) => file.coordinates.get(i).and_then(|c| c.unit.as_ref()),
+        };
+        unit.map_or_else(|| self.location(file), |u| u.location)
+    }
 }
 
 /// A dimension `known · Π xᵢ^cᵢ` in the unknown units `xᵢ` (sorted by index, no zero `cᵢ`).
@@ -202,6 +329,10 @@ struct Checker<'f> {
     /// How the key being checked spells its unit, while its value is a lone name.
     spelling: Option<String>,
     solution: Vec<Option<Solved>>,
+    /// Pass 2: the names of the expression being checked (see [`Self::top`]).
+    names: Vec<String>,
+    /// Pass 2: for each failed requirement, the names of its expression.
+    failing_names: Vec<Vec<String>>,
 }
 
 /// `kg`, `N/m`: a dimension for messages.
@@ -255,7 +386,7 @@ fn write_expr(e: &Expr, outer: u8) -> String {
             ),
             4,
         ),
-        ExprKind::Binary { op, lhs, rhs } => match op {
+        ExprKind::Binary { op, lhs, rhs, .. } => match op {
             BinOp::Add | BinOp::Sub => {
                 let sign = if *op == BinOp::Add { " + " } else { " - " };
                 (
@@ -288,7 +419,7 @@ fn numeric_exponent(e: &Expr) -> Option<Rational> {
     match &e.kind {
         ExprKind::Number { text, .. } => Rational::from_decimal(text),
         ExprKind::Neg(a) => numeric_exponent(a)?.checked_neg(),
-        ExprKind::Binary { op, lhs, rhs } => {
+        ExprKind::Binary { op, lhs, rhs, .. } => {
             let (a, b) = (numeric_exponent(lhs)?, numeric_exponent(rhs)?);
             match op {
                 BinOp::Add => a.checked_add(b),
@@ -309,6 +440,7 @@ fn terms<'e>(e: &'e Expr, out: &mut Vec<&'e Expr>) {
             op: BinOp::Add | BinOp::Sub,
             lhs,
             rhs,
+            ..
         } => {
             terms(lhs, out);
             terms(rhs, out);
@@ -326,6 +458,54 @@ fn unit_part(text: &str) -> &str {
 const AXES: [&str; 3] = ["x", "y", "z"];
 
 impl<'f> Checker<'f> {
+    /// Both passes over `file`, with the unit of `undeclared` (if any) treated as unknown.
+    fn run(file: &'f ModelFile, undeclared: Option<Target>) -> Self {
+        let mut cx = Checker::new(file);
+        match undeclared {
+            Some(Target::Parameter(i)) => {
+                if let Some(u) = cx.parameters.get_mut(i) {
+                    cx.unknowns.push((false, i));
+                    *u = Unit::Var(cx.unknowns.len() - 1);
+                }
+            }
+            Some(Target::Coordinate(i)) => {
+                if let Some(u) = cx.coordinates.get_mut(i) {
+                    cx.unknowns.push((true, i));
+                    *u = Unit::Var(cx.unknowns.len() - 1);
+                }
+            }
+            None => {}
+        }
+        cx.solution = vec![None; cx.unknowns.len()];
+        // Pass 1: requirements in the unknowns; solve them.
+        cx.walk();
+        cx.solve();
+        // Pass 2: every unknown solved or left free; report.
+        cx.mode = Mode::Report;
+        cx.walk();
+        cx.undeclared();
+        cx
+    }
+
+    /// The unit solved for `target`, when it was an unknown.
+    fn solution_of(&self, target: Target) -> Option<Solved> {
+        let key = match target {
+            Target::Parameter(i) => (false, i),
+            Target::Coordinate(i) => (true, i),
+        };
+        let k = self.unknowns.iter().position(|u| *u == key)?;
+        self.solution.get(k).cloned().flatten()
+    }
+
+    /// Notes the names of the expression `e` about to be checked, for [`root_cause`].
+    fn top(&mut self, e: &Expr) {
+        if self.mode == Mode::Report {
+            let mut ids = Vec::new();
+            identifiers(e, &mut ids);
+            self.names = ids.into_iter().map(|(n, _)| n).collect();
+        }
+    }
+
     fn new(file: &'f ModelFile) -> Self {
         let mut diagnostics = Vec::new();
         let mut unknowns = Vec::new();
@@ -341,7 +521,7 @@ impl<'f> Checker<'f> {
                     Err(e) => {
                         let mut d = Diagnostic::new(
                             u.location.offset(e.offset),
-                            format!("{} in the unit of parameter `{}`", e.message, p.name.value),
+                            e.message_for(&format!("parameter `{}`", p.name.value)),
                         )
                         .with_help(e.help);
                         if u.value.contains(' ') && !u.value.contains(',') {
@@ -365,10 +545,7 @@ impl<'f> Checker<'f> {
                         diagnostics.push(
                             Diagnostic::new(
                                 u.location.offset(e.offset),
-                                format!(
-                                    "{} in the unit of coordinate `{}`",
-                                    e.message, c.name.value
-                                ),
+                                e.message_for(&format!("coordinate `{}`", c.name.value)),
                             )
                             .with_help(e.help),
                         );
@@ -398,6 +575,8 @@ impl<'f> Checker<'f> {
             equations: Vec::new(),
             constraints: Vec::new(),
             spelling: None,
+            names: Vec::new(),
+            failing_names: Vec::new(),
         }
     }
 
@@ -504,6 +683,7 @@ impl<'f> Checker<'f> {
                         d.help = Some(format!("{help} ({})", notes.join("; ")));
                     }
                     self.diagnostics.push(d);
+                    self.failing_names.push(self.names.clone());
                 }
             }
         }
@@ -541,6 +721,7 @@ impl<'f> Checker<'f> {
                 op: op @ (BinOp::Mul | BinOp::Div),
                 lhs,
                 rhs,
+                ..
             } => {
                 let a = self.dim(lhs, what);
                 let b = self.dim(rhs, what);
@@ -667,6 +848,7 @@ impl<'f> Checker<'f> {
         if numbers_only(e) {
             return;
         }
+        self.top(e);
         let got = self.dim(e, what);
         self.require(got.as_ref(), want.as_ref(), (KEY, what, e.location), report);
     }
@@ -732,6 +914,7 @@ impl<'f> Checker<'f> {
 
     /// Checks that `e` is consistent in itself (its sums, functions and powers).
     fn homogeneous(&mut self, e: &Expr, what: &str) {
+        self.top(e);
         self.dim(e, what);
     }
 
@@ -900,6 +1083,7 @@ impl<'f> Checker<'f> {
         self.constraints.clear();
         for (holonomic, list) in [(true, &file.constraints), (false, &file.nonholonomic)] {
             for (k, e) in list {
+                self.top(e);
                 let unit = self.dim(e, &format!("constraint `{}`", k.value));
                 self.constraints.push((k.value.clone(), unit, holonomic));
             }
@@ -936,8 +1120,14 @@ impl<'f> Checker<'f> {
         let checks = &self.file.checks;
         for (i, eq) in checks.equations_of_motion.iter().enumerate() {
             let what = format!("equation of motion {}", i + 1);
+            self.top(&eq.lhs);
             let lhs = self.dim(&eq.lhs, &what);
             let Some(rhs_expr) = &eq.rhs else { continue };
+            if self.mode == Mode::Report {
+                let mut ids = Vec::new();
+                identifiers(rhs_expr, &mut ids);
+                self.names.extend(ids.into_iter().map(|(n, _)| n));
+            }
             let rhs = self.dim(rhs_expr, &what);
             if numbers_only(&eq.lhs) || numbers_only(rhs_expr) {
                 continue;
@@ -1239,6 +1429,16 @@ mod tests {
             [
                 "5:15: unknown unit `mm` in the unit of parameter `k`",
                 "8:22: unknown unit `furlong` in the unit of coordinate `y`",
+            ]
+        );
+        // Issue 28: "in the unit in the unit of parameter" is said once.
+        let src = "name: a\nunits: SI\nparameters:\n  m: { value: 1.0, unit: kg }\n  k: { value: 1.0, unit: N/m) }\n  c: { value: 1.0, unit: (N*s/m }\n  d: { value: 1.0, unit: N%m }\ncoordinates:\n  - { name: x, unit: m }\nkinetic: m*x_dot^2/2\n";
+        assert_eq!(
+            errors(src),
+            [
+                "5:29: unexpected `)` in the unit of parameter `k`: it closes no `(`",
+                "6:32: unclosed `(` in the unit of parameter `c`",
+                "7:27: unexpected `%` in the unit of parameter `d`",
             ]
         );
     }

@@ -344,6 +344,18 @@ pub struct UnitError {
     pub help: String,
 }
 
+impl UnitError {
+    /// The message naming whose unit it is: "unknown unit `mm` in the unit of parameter `k`",
+    /// "unclosed `(` in the unit of coordinate `x`" (said once, where the message already
+    /// speaks of "the unit").
+    pub fn message_for(&self, whose: &str) -> String {
+        match self.message.split_once(" in the unit") {
+            Some((before, after)) => format!("{before} in the unit of {whose}{after}"),
+            None => format!("{} in the unit of {whose}", self.message),
+        }
+    }
+}
+
 /// Help shared by unit errors: what a unit may be made of.
 pub const UNIT_HELP: &str = "a unit is a product or quotient of m, kg, s, N, J, W, Pa, Hz, rad and 1, as in `N/m`, `N*s/m` or `kg*m^2`";
 
