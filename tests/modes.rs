@@ -879,6 +879,33 @@ fn issue_28_time_dependence_beside_a_stiff_coordinate() {
         "theta=0,x=0",
     ]);
     assert_eq!(out.status.code(), Some(1));
+    // With a torque T0 = 1 N·m, beyond what the pendulum can balance, Newton fails on the
+    // equations frozen at t = 0; the error names the time dependence, not Newton.
+    use eomgen::vibration::{
+        EquilibriumStart, ModalOptions, OperatingPointError, OperatingPointOptions, modal_analysis,
+    };
+    m.set_parameter("T0", 1.0).unwrap();
+    let options = ModalOptions {
+        operating_point: OperatingPointOptions {
+            start: EquilibriumStart::Guess {
+                label: "theta=0.3".to_string(),
+                q: vec![0.3, 0.0],
+            },
+            ..OperatingPointOptions::default()
+        },
+    };
+    let err = modal_analysis(m.as_ref(), &options).unwrap_err();
+    assert!(
+        matches!(
+            err,
+            OperatingPointError::Modal(ModalError::TimeDependent {
+                part: eomgen::TimeDependentPart::StiffnessMatrix,
+                ..
+            })
+        ),
+        "{err}"
+    );
+    m.set_parameter("T0", 0.0).unwrap();
     m.set_parameter("a", 0.0).unwrap();
     assert_eq!(
         eomgen::time_dependence(m.as_ref(), &[0.0, 0.0], 0.0).unwrap(),
@@ -890,8 +917,9 @@ fn issue_28_time_dependence_beside_a_stiff_coordinate() {
 /// where precession and spin turn the body about the same axis: `det M = I1² I3 sin²θ`
 /// vanishes (to rounding at θ = π, where `sin π = 1.2e-16` left a pivot of 1e-33 and mode
 /// shapes of 7.6e8). Refused, naming φ and ψ; at θ = 0.5 M is accepted and its determinant
-/// is the closed form (1e-12); at θ = 1e-6 the unit-diagonal M has smallest eigenvalue
-/// `≈ I1 θ²/(2 I3) = 1.5e-12`, below the 1e-10 bound, and at θ = 1e-3 (1.5e-6) above it.
+/// is the closed form (1e-12); at θ = 1e-7 the unit-diagonal M has smallest eigenvalue
+/// `≈ I1 θ²/(2 I3) = 1.5e-14`, below the 1e-13 bound, and at θ = 1e-6 (1.5e-12) above it.
+/// `cart_pendulum` with m1 = 1e-10 kg (ratio ≈ m1/(2 m2) = 5e-11, det M ≠ 0) is accepted.
 #[test]
 fn issue_28_singular_mass_matrix_names_the_coordinates() {
     let top: Box<dyn ModelInfo> = Box::new(eomgen::FirstOrder::new(EulerTop::default()));
@@ -904,10 +932,11 @@ fn issue_28_singular_mass_matrix_names_the_coordinates() {
         assert_eq!(coordinates, &["phi", "psi"], "{at}");
     }
     assert!(matches!(
-        linearize(top.as_ref(), &[0.0, 1e-6, 0.0], &[0.0; 3], 0.0),
+        linearize(top.as_ref(), &[0.0, 1e-7, 0.0], &[0.0; 3], 0.0),
         Err(ModalError::DegenerateCoordinates { .. })
     ));
-    linearize(top.as_ref(), &[0.0, 1e-3, 0.0], &[0.0; 3], 0.0).unwrap();
+    linearize(top.as_ref(), &[0.0, 1e-6, 0.0], &[0.0; 3], 0.0).unwrap();
+    eomgen_ok(&["modes", "cart_pendulum", "--set", "m1=1e-10"]);
     let theta: f64 = 0.5;
     let lin = linearize(top.as_ref(), &[0.0, theta, 0.0], &[0.0; 3], 0.0).unwrap();
     let (i1, i3) = (0.3, 0.1);

@@ -67,11 +67,11 @@ pub enum ModalError {
         /// The operating point.
         q: Vec<f64>,
     },
-    /// The mass matrix at the operating point is singular to working precision: some
+    /// The mass matrix at the operating point is too ill-conditioned for `f64` work: some
     /// coordinates have no inertia there, or move the mechanism the same way (Euler angles
     /// at `θ = 0`, where the precession and spin angles turn the body about the same axis).
     #[error(
-        "the mass matrix is singular at q = {q:?} in the coordinates {}: smallest eigenvalue {smallest_eigenvalue:.1e} of its unit-diagonal form (below {MASS_MATRIX_SINGULARITY:e}: these coordinates have no inertia or move the mechanism the same way here)",
+        "the mass matrix is too ill-conditioned at q = {q:?} in the coordinates {}: the smallest eigenvalue of its unit-diagonal form is {smallest_eigenvalue:.1e} (about the ratio of its smallest to largest; below {MASS_MATRIX_SINGULARITY:e} the modes would lose all but a few digits): these coordinates have nearly no inertia or move the mechanism nearly the same way here",
         coordinates.join(", ")
     )]
     DegenerateCoordinates {
@@ -176,12 +176,16 @@ impl std::fmt::Display for TimeDependentPart {
     }
 }
 
-/// Below this smallest eigenvalue of the unit-diagonal mass matrix `D^{-1/2} M D^{-1/2}` the
-/// mass matrix is refused as singular ([`ModalError::DegenerateCoordinates`]): solving with
-/// it loses `log₁₀(1/λ_min)` digits, ten of sixteen here. Scaling by the diagonal makes the
-/// test independent of units and of the sizes of the bodies (a 1000 kg cart and a 1 g bob
-/// give a ratio near 1 if their coordinates are independent).
-pub const MASS_MATRIX_SINGULARITY: f64 = 1e-10;
+/// Below this smallest eigenvalue of the unit-diagonal mass matrix `D^{-1/2} M D^{-1/2}` (its
+/// largest is between 1 and `n`, so this is the inverse of its condition number to within
+/// `n`) the mass matrix is refused as ill-conditioned for `f64` work
+/// ([`ModalError::DegenerateCoordinates`]): solving with it loses `log₁₀(1/λ_min)` digits, so
+/// the modes would be wrong by about `1e-16/λ_min ≈ 1e-3` here. Above it they are merely less
+/// accurate (`cart_pendulum` with m1 = 1e-9 kg, `λ_min ≈ 5e-10`: modes right to 4e-8).
+/// Scaling by the diagonal makes the test independent of units and of the sizes of the
+/// bodies (a 1000 kg cart and a 1 g bob give a ratio near 1 if their coordinates are
+/// independent).
+pub const MASS_MATRIX_SINGULARITY: f64 = 1e-13;
 
 /// Why Newton's method on the equilibrium equations stopped short of a root.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
@@ -517,8 +521,9 @@ pub fn constraint_hessians(model: &dyn ModelInfo, q: &[f64], t: f64) -> Vec<DMat
 }
 
 /// A load that depends on `t` at the operating point and enters neither `M`, `C` nor `K`:
-/// the linearisation is `M δq̈ + C δq̇ + K δq = F(q*, 0, t) − F(q*, 0, t₀)`, and the modes are
-/// those of its left side, the unforced equations ([`time_dependence`]).
+/// the linearisation is `M δq̈ + C δq̇ + K δq = F(q*, 0, t) − F(q*, 0, t₀)` about the equilibrium
+/// `q*` under the load's value at `t₀` (deflected by it where that value is not 0), and the
+/// modes are those of its left side, the load's variation set aside ([`time_dependence`]).
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct TimeDependentForcing {
     /// The time `t₀` (s) at which the load is frozen in the equilibrium `F(q*, 0, t₀) = 0`.
@@ -603,7 +608,8 @@ fn matrix_change(samples: &[DVector<f64>], n: usize) -> (f64, usize) {
 /// `max(√|Xᵢᵢ Xⱼⱼ|, |Xᵢⱼ|)`, so that an unrelated stiff coordinate does not hide a modulated
 /// soft one; `Fᵢ` against `max(|Fᵢ|, Σⱼ |Kᵢⱼ qⱼ|)`). A change of `F(q, 0, t)` alone is a load that
 /// enters neither `M`, `C` nor `K` — the linear oscillator driven by `F₀ cos ωt` — and is
-/// returned: the modes are those of the unforced equations, with the load frozen at `t₀` in
+/// returned: the modes are those of the equations without the load's variation, about the
+/// equilibrium under its value at `t₀` (frozen there in
 /// the equilibrium. `Ok(None)` when nothing changes.
 ///
 /// Why numerically: the model is a compiled function of `(t, y)`; sampling its values is
