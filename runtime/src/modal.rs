@@ -90,7 +90,7 @@ pub enum ModalError {
     /// equations frozen at one `t` describe no motion; a periodic dependence is analysed by
     /// its Floquet multipliers instead.
     #[error(
-        "the linearised equations depend on t: {part} at the operating point changes by {relative_change:.1e} (relative) between t = {t0} s and t = {t} s, so modes of the equations frozen at t = {t0} s describe no motion (a parametrically excited system or a moving constraint); for a periodic dependence its stability is given by Floquet multipliers"
+        "the linearised equations depend on t: {part} at the operating point changes by {relative_change:.1e} (relative) between t = {t0} s and t = {t} s, so no modes are computed from the equations frozen at t = {t0} s (a parametrically excited system or a moving constraint); for a periodic dependence its stability is given by Floquet multipliers"
     )]
     TimeDependent {
         /// What depends on `t`.
@@ -156,6 +156,10 @@ pub enum TimeDependentPart {
     Constraint {
         /// The constraint's name.
         name: String,
+        /// Whether `J` changes with `t` (a rod spun at a given rate); `false` when only `Φ`,
+        /// `Φ_t` or `γ` do, a prescribed motion with a constant Jacobian (base excitation,
+        /// `x − a cos wt`), whose modes are those of the system relative to the moving base.
+        jacobian_changes: bool,
     },
     /// The mass matrix `M(q*, t)`.
     MassMatrix,
@@ -168,7 +172,14 @@ pub enum TimeDependentPart {
 impl std::fmt::Display for TimeDependentPart {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
-            Self::Constraint { name } => write!(f, "the constraint `{name}` (Φ, J or γ)"),
+            Self::Constraint {
+                name,
+                jacobian_changes: true,
+            } => write!(f, "the constraint `{name}` (its Jacobian J)"),
+            Self::Constraint { name, .. } => write!(
+                f,
+                "the constraint `{name}` (Φ and γ, with a constant Jacobian: a prescribed motion)"
+            ),
             Self::MassMatrix => f.write_str("the mass matrix M"),
             Self::DampingMatrix => f.write_str("the damping matrix C = −∂F/∂q̇"),
             Self::StiffnessMatrix => f.write_str("the stiffness −∂F/∂q"),
@@ -655,22 +666,23 @@ pub fn time_dependence(
             .map(|&t| model.constraint_equations(t, &y))
             .collect();
         for (i, name) in model.constraint_names().iter().take(m).enumerate() {
-            let samples: Vec<DVector<f64>> = constraints
+            // The Jacobian apart from Φ, Φ_t and γ: a constant J with a moving Φ is a
+            // prescribed motion (base excitation), which the hint treats differently.
+            let jacobian: Vec<DVector<f64>> = constraints
                 .iter()
-                .map(|c| {
-                    let head = [c.phi[i], c.velocity[i], c.gamma[i]];
-                    DVector::from_iterator(
-                        n + 3,
-                        head.into_iter().chain(c.jacobian.row(i).iter().copied()),
-                    )
-                })
+                .map(|c| c.jacobian.row(i).transpose())
                 .collect();
-            refuse(
-                TimeDependentPart::Constraint {
-                    name: name.to_string(),
-                },
-                relative_change(&samples),
-            )?;
+            let rest: Vec<DVector<f64>> = constraints
+                .iter()
+                .map(|c| DVector::from_vec(vec![c.phi[i], c.velocity[i], c.gamma[i]]))
+                .collect();
+            let jacobian_change = relative_change(&jacobian);
+            let part = |jacobian_changes| TimeDependentPart::Constraint {
+                name: name.to_string(),
+                jacobian_changes,
+            };
+            refuse(part(true), jacobian_change)?;
+            refuse(part(false), relative_change(&rest))?;
         }
     }
     let flat = |a: &DMatrix<f64>| DVector::from_column_slice(a.as_slice());

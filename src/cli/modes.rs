@@ -408,6 +408,16 @@ pub(super) fn modal_hint(model: &dyn ModelInfo, e: &eomgen::ModalError) -> Strin
             "the coordinates are (nearly) degenerate at this configuration (Euler angles at θ = 0, an angle of a point at its pivot, a mass negligible beside the one it moves with): choose an operating point away from it, {start}, other coordinates or less extreme parameters"
         ),
         ModalError::TimeDependent {
+            part:
+                eomgen::TimeDependentPart::Constraint {
+                    jacobian_changes: false,
+                    ..
+                },
+            ..
+        } => format!(
+            "the constraint prescribes a motion with a constant Jacobian (base excitation, like `x − a*cos(w*t)`): the modes are those of the system relative to the moving base, which are not computed from this form; write the model in coordinates relative to the base (the base's acceleration then enters as a load, which `modes` sets aside), or simulate it (`eomgen simulate {name}`)"
+        ),
+        ModalError::TimeDependent {
             part: eomgen::TimeDependentPart::Constraint { .. },
             ..
         } => format!(
