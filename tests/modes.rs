@@ -923,12 +923,7 @@ fn issue_28_time_dependence_beside_a_stiff_coordinate() {
 /// coordinates relative to the base; the spun rod keeps its own hint.
 #[test]
 fn issue_28_prescribed_translation_has_a_truthful_hint() {
-    let out = eomgen(&[
-        "modes",
-        &fixture("shaken_base.yaml"),
-        "--at",
-        "x=0.01,y=0",
-    ]);
+    let out = eomgen(&["modes", &fixture("shaken_base.yaml"), "--at", "x=0.01,y=0"]);
     assert_eq!(out.status.code(), Some(1));
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(
@@ -940,7 +935,10 @@ fn issue_28_prescribed_translation_has_a_truthful_hint() {
     let out = eomgen(&["modes", "bead_spinning_rod"]);
     assert_eq!(out.status.code(), Some(1));
     let err = String::from_utf8_lossy(&out.stderr);
-    assert!(err.contains("its Jacobian J") && err.contains("spun"), "{err}");
+    assert!(
+        err.contains("its Jacobian J") && err.contains("spun"),
+        "{err}"
+    );
 }
 
 /// Issue 28, item 8: a top in Euler angles at θ = 0 or π (`tests/fixtures/euler_top.yaml`),
