@@ -149,7 +149,8 @@ pub enum FrfError {
         frequency: f64,
         /// The coordinate (row of `H`, from 0).
         row: usize,
-        /// The input (column of `H`, from 0).
+        /// The input (column of `H`, from 0); for [`modal_frequency_response`], the mode
+        /// (column of its contributions).
         column: usize,
         /// `log₁₀ |Hᵢⱼ|`, computed from the scaled solution.
         log10_magnitude: f64,
@@ -401,19 +402,26 @@ fn frequency_scale(frequency: f64) -> f64 {
     frequency.max(1.0)
 }
 
-/// `x/s²` (the response from the solution `x` of the scaled system), or
-/// [`FrfError::ResponseOutOfRange`] when a non-zero `x` gives a result that is not a finite
-/// normal `f64` (an exact zero, an output the input does not reach, stays zero).
+/// `x/s²` (the response from the solution `x` of the scaled system). A result below the
+/// smallest normal `f64` (`2.2e-308`) is flushed to 0 — physically no response, such as the far
+/// end of a long chain forced above its pass band — unless the entry was requested: then its
+/// size and phase would be lost, and [`FrfError::ResponseOutOfRange`] says so. A result that
+/// is not finite is always refused (it cannot happen for `s ≥ 1` and a finite `x`, but a
+/// silent infinity is never returned).
 fn descale(
     x: Complex<f64>,
     s: f64,
     frequency: f64,
     (row, column): (usize, usize),
+    requested: bool,
 ) -> Result<Complex<f64>, FrfError> {
     let h = x / s / s;
     let size = h.norm();
     if x.norm() == 0.0 || (size.is_finite() && size >= f64::MIN_POSITIVE) {
         return Ok(h);
+    }
+    if size.is_finite() && !requested {
+        return Ok(Complex::new(0.0, 0.0));
     }
     Err(FrfError::ResponseOutOfRange {
         frequency,
@@ -434,8 +442,11 @@ const SINGULAR_PIVOT: f64 = 1e-13;
 ///
 /// Above 1 rad/s the system is solved as `(Z(ω)/ω²) X = B`, `H = X/ω²`: `ω²` overflows beyond
 /// `ω ≈ 1.3e154` (an infinite `ω²M` made every damped model look undamped there), and the
-/// scaled matrix keeps the dominant `M` at its own size. Where the result itself leaves the
-/// range of `f64` (`|H| ≈ 1/(ω² m)` below `2.2e-308`) it is refused, not rounded to zero.
+/// scaled matrix keeps the dominant `M` at its own size. An entry whose size falls below the
+/// smallest normal `f64` (`2.2e-308`) is returned as 0: a coordinate the forcing does not
+/// reach to within the range of floating point (the far masses of a long chain above its
+/// pass band). To refuse such an entry instead, where it is the one asked for, use
+/// [`frequency_response_of`].
 ///
 /// # Shapes
 /// `input_matrix` is `n × r`; the result is `n × r` (complex): entry `(i, j)` is the complex
@@ -447,8 +458,7 @@ const SINGULAR_PIVOT: f64 = 1e-13;
 /// # Errors
 /// [`FrfError::InvalidFrequency`]; [`FrfError::DimensionMismatch`];
 /// [`FrfError::Singular`] at an undamped resonance (or `ω = 0` with a rigid-body mode): when
-/// a pivot of the LU factors is below `1e-13` of the largest entry of `K − ω²M + iωC`;
-/// [`FrfError::ResponseOutOfRange`] when a non-zero entry of `H` is not a finite normal `f64`.
+/// a pivot of the LU factors is below `1e-13` of the largest entry of `K − ω²M + iωC`.
 ///
 /// # References
 /// Lecture 21 (one degree of freedom), HW37 (three masses).
@@ -456,6 +466,26 @@ pub fn frequency_response(
     lin: &Linearization,
     input_matrix: &DMatrix<f64>,
     frequency: f64,
+) -> Result<DMatrix<Complex<f64>>, FrfError> {
+    frequency_response_of(lin, input_matrix, frequency, &[])
+}
+
+/// [`frequency_response`], refusing the frequency when an entry in one of the `outputs` rows
+/// (the coordinates asked for) leaves the normal `f64` range; entries of the other rows that
+/// underflow are returned as 0.
+///
+/// # Shapes
+/// As [`frequency_response`]; `outputs` are row indices `< n` (others are ignored).
+///
+/// # Errors
+/// As [`frequency_response`], and [`FrfError::ResponseOutOfRange`] when a non-zero entry
+/// `(i, j)` with `i` in `outputs` is not a finite normal `f64` (`|H| ≈ 1/(mω²) < 2.2e-308`):
+/// its size and phase cannot be given.
+pub fn frequency_response_of(
+    lin: &Linearization,
+    input_matrix: &DMatrix<f64>,
+    frequency: f64,
+    outputs: &[usize],
 ) -> Result<DMatrix<Complex<f64>>, FrfError> {
     check_forcing(lin, input_matrix.nrows(), frequency)?;
     let b = input_matrix.map(|v| Complex::new(v, 0.0));
@@ -478,8 +508,9 @@ pub fn frequency_response(
     }
     let mut h = DMatrix::zeros(x.nrows(), x.ncols());
     for i in 0..x.nrows() {
+        let requested = outputs.contains(&i);
         for j in 0..x.ncols() {
-            h[(i, j)] = descale(x[(i, j)], s, frequency, (i, j))?;
+            h[(i, j)] = descale(x[(i, j)], s, frequency, (i, j), requested)?;
         }
     }
     Ok(h)
@@ -607,7 +638,7 @@ pub fn frequency_sweep(
     let b = input_matrix.column(input).into_owned();
     let b = DMatrix::from_column_slice(n, 1, b.as_slice());
     let entry = |w: f64| -> Result<Option<Complex<f64>>, FrfError> {
-        match frequency_response(lin, &b, w) {
+        match frequency_response_of(lin, &b, w, &[output]) {
             Ok(h) => Ok(Some(h[(output, 0)])),
             Err(FrfError::Singular { .. }) => Ok(None),
             Err(e) => Err(e),
@@ -828,9 +859,10 @@ pub struct ModalResponse {
 /// # Errors
 /// [`FrfError::InvalidFrequency`]; [`FrfError::DimensionMismatch`];
 /// [`FrfError::Singular`] when a mode's denominator is below `1e-13 max(|ω_k²|, ω²)` (an
-/// undamped resonance to rounding); [`FrfError::ResponseOutOfRange`] when a non-zero
-/// contribution is not a finite normal `f64` (the denominators are scaled by `ω²` above
-/// 1 rad/s, as in [`frequency_response`]).
+/// undamped resonance to rounding); [`FrfError::ResponseOutOfRange`] (entry `(coordinate,
+/// mode)`) when a contribution is not finite. The denominators are scaled by `ω²` above
+/// 1 rad/s, as in [`frequency_response`], and a contribution below the smallest normal `f64`
+/// is 0, as there.
 ///
 /// # References
 /// HW37 (c): modal forcing of the three-mass system; HW34 (modal damping).
@@ -866,7 +898,9 @@ pub fn modal_frequency_response(
         let eta_scaled = Complex::new(force, 0.0) / denominator;
         let eta = eta_scaled / s / s;
         for i in 0..n {
-            contributions[(i, mode)] = descale(eta_scaled * shape[i], s, frequency, (i, 0))?;
+            // Only a non-finite contribution is refused, reported as entry (coordinate, mode).
+            contributions[(i, mode)] =
+                descale(eta_scaled * shape[i], s, frequency, (i, mode), false)?;
         }
         modal_forces.push(force);
         modal_coordinates.push(eta);

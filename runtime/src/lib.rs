@@ -33,9 +33,9 @@ pub use floquet::{
 };
 pub use frf::{
     ForcedLinearization, FrequencySweep, FrfError, HarmonicForcing, ModalResponse, PeakAmplitude,
-    ResonancePeak, SteadyState, SteadyStateOptions, frequency_response, frequency_sweep,
-    linearize_with_inputs, log_frequencies, modal_frequency_response, phase_degrees, settling_time,
-    simulate_steady_state,
+    ResonancePeak, SteadyState, SteadyStateOptions, frequency_response, frequency_response_of,
+    frequency_sweep, linearize_with_inputs, log_frequencies, modal_frequency_response,
+    phase_degrees, settling_time, simulate_steady_state,
 };
 pub use integrate::{
     BogackiShampine32, DormandPrince54, DormandPrince853, Event, EventDirection, EventSpec,

@@ -67,11 +67,11 @@ pub enum ModalError {
         /// The operating point.
         q: Vec<f64>,
     },
-    /// The mass matrix at the operating point is singular to working precision: some
+    /// The mass matrix at the operating point is too ill-conditioned for `f64` work: some
     /// coordinates have no inertia there, or move the mechanism the same way (Euler angles
     /// at `θ = 0`, where the precession and spin angles turn the body about the same axis).
     #[error(
-        "the mass matrix is singular at q = {q:?} in the coordinates {}: smallest eigenvalue {smallest_eigenvalue:.1e} of its unit-diagonal form (below {MASS_MATRIX_SINGULARITY:e}: these coordinates have no inertia or move the mechanism the same way here)",
+        "the mass matrix is too ill-conditioned at q = {q:?} in the coordinates {}: the smallest eigenvalue of its unit-diagonal form is {smallest_eigenvalue:.1e} (about the ratio of its smallest to largest; below {MASS_MATRIX_SINGULARITY:e} the modes would lose all but a few digits): these coordinates have nearly no inertia or move the mechanism nearly the same way here",
         coordinates.join(", ")
     )]
     DegenerateCoordinates {
@@ -90,7 +90,7 @@ pub enum ModalError {
     /// equations frozen at one `t` describe no motion; a periodic dependence is analysed by
     /// its Floquet multipliers instead.
     #[error(
-        "the linearised equations depend on t: {part} at the operating point changes by {relative_change:.1e} (relative) between t = {t0} s and t = {t} s, so modes of the equations frozen at t = {t0} s describe no motion (a parametrically excited system or a moving constraint); for a periodic dependence its stability is given by Floquet multipliers"
+        "the linearised equations depend on t: {part} at the operating point changes by {relative_change:.1e} (relative) between t = {t0} s and t = {t} s, so no modes are computed from the equations frozen at t = {t0} s (a parametrically excited system or a moving constraint); for a periodic dependence its stability is given by Floquet multipliers"
     )]
     TimeDependent {
         /// What depends on `t`.
@@ -156,6 +156,10 @@ pub enum TimeDependentPart {
     Constraint {
         /// The constraint's name.
         name: String,
+        /// Whether `J` changes with `t` (a rod spun at a given rate); `false` when only `Φ`,
+        /// `Φ_t` or `γ` do, a prescribed motion with a constant Jacobian (base excitation,
+        /// `x − a cos wt`), whose modes are those of the system relative to the moving base.
+        jacobian_changes: bool,
     },
     /// The mass matrix `M(q*, t)`.
     MassMatrix,
@@ -168,7 +172,14 @@ pub enum TimeDependentPart {
 impl std::fmt::Display for TimeDependentPart {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
-            Self::Constraint { name } => write!(f, "the constraint `{name}` (Φ, J or γ)"),
+            Self::Constraint {
+                name,
+                jacobian_changes: true,
+            } => write!(f, "the constraint `{name}` (its Jacobian J)"),
+            Self::Constraint { name, .. } => write!(
+                f,
+                "the constraint `{name}` (Φ and γ, with a constant Jacobian: a prescribed motion)"
+            ),
             Self::MassMatrix => f.write_str("the mass matrix M"),
             Self::DampingMatrix => f.write_str("the damping matrix C = −∂F/∂q̇"),
             Self::StiffnessMatrix => f.write_str("the stiffness −∂F/∂q"),
@@ -176,12 +187,16 @@ impl std::fmt::Display for TimeDependentPart {
     }
 }
 
-/// Below this smallest eigenvalue of the unit-diagonal mass matrix `D^{-1/2} M D^{-1/2}` the
-/// mass matrix is refused as singular ([`ModalError::DegenerateCoordinates`]): solving with
-/// it loses `log₁₀(1/λ_min)` digits, ten of sixteen here. Scaling by the diagonal makes the
-/// test independent of units and of the sizes of the bodies (a 1000 kg cart and a 1 g bob
-/// give a ratio near 1 if their coordinates are independent).
-pub const MASS_MATRIX_SINGULARITY: f64 = 1e-10;
+/// Below this smallest eigenvalue of the unit-diagonal mass matrix `D^{-1/2} M D^{-1/2}` (its
+/// largest is between 1 and `n`, so this is the inverse of its condition number to within
+/// `n`) the mass matrix is refused as ill-conditioned for `f64` work
+/// ([`ModalError::DegenerateCoordinates`]): solving with it loses `log₁₀(1/λ_min)` digits, so
+/// the modes would be wrong by about `1e-16/λ_min ≈ 1e-3` here. Above it they are merely less
+/// accurate (`cart_pendulum` with m1 = 1e-9 kg, `λ_min ≈ 5e-10`: modes right to 4e-8).
+/// Scaling by the diagonal makes the test independent of units and of the sizes of the
+/// bodies (a 1000 kg cart and a 1 g bob give a ratio near 1 if their coordinates are
+/// independent).
+pub const MASS_MATRIX_SINGULARITY: f64 = 1e-13;
 
 /// Why Newton's method on the equilibrium equations stopped short of a root.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
@@ -234,11 +249,14 @@ pub struct Equilibrium {
 /// singular values below `1e-12 σ_max` dropped), so neutral directions (a free cart's
 /// position, a rigid-body rotation) stay at their guess; steps are halved while the residual
 /// does not decrease (at most 30 halvings). Converged when the largest residual is at most
-/// `1e-12 (1 + r₀)`, with `r₀` the largest at the guess, or when the step is below
-/// `1e-14 (1 + |x|)` with the residual small (`≤ 1e-8 (1 + r₀)`). A small residual is
-/// accepted only where the next Newton step is below `1e-6 (1 + max |xᵢ|)`: forces that fade
-/// with distance (a central `−μm/r²`) fall below any residual tolerance as the iterates run
-/// off to infinity, each step a fixed fraction of the distance.
+/// `1e-12 r₀`, with `r₀` the larger of the largest residual at the guess and the size of its
+/// terms there, `max_i Σ_j |J_ij x_j|` (the model's force scale, whatever its units), or when every step component is below `1e-14 |xᵢ|` (or no step decreases the
+/// residual) with the residual down to `1e-8 r₀`; a degenerate root (`F = −k x³`), where
+/// Newton converges only linearly, is followed while the steps shrink (up to 100 iterations).
+/// A small residual is refused as [`ModalError::EquilibriumAtInfinity`] when `max |qᵢ|` grew
+/// to more than 10 times the guess's and the next Newton step is above `1e-3 max |qᵢ|`:
+/// forces that fade with distance (a central `−μm/r²`) fall below any residual tolerance as
+/// the iterates run off to infinity, each step a fixed fraction of the distance.
 ///
 /// # Errors
 /// [`ModalError::EquilibriumNotFound`] after 100 iterations, when no halving decreases the
@@ -318,12 +336,17 @@ pub fn find_equilibrium(
             }
         })?;
     // A small residual is a root only if the root is near: where the forces fade with
-    // distance (`−μm/r²`), |F| falls below any tolerance as Newton walks off to infinity,
-    // each step a fixed fraction of the distance. At a root the next step is of the order of
-    // the rounding of q; there it is a fraction of q itself.
-    let step = newton_step(&jacobian_of(&x), &residual_of(&x)).amax();
-    let size = x.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-    if step.is_nan() || step > RECEDING_STEP * (1.0 + size) {
+    // distance (`−μm/r²`), |F| falls below any tolerance as Newton walks off to infinity, each
+    // step a fixed fraction of the distance, |q| growing by orders of magnitude. At a simple
+    // root the next step is of the order of the rounding of q; at a degenerate one (`F = −k x³`)
+    // a fixed fraction of the distance to the root, but q does not grow. Sizes are of q alone
+    // (λ is a force).
+    let step = newton_step(&jacobian_of(&x), &residual_of(&x))
+        .rows(0, n)
+        .amax();
+    let size = x[..n].iter().fold(0.0f64, |a, v| a.max(v.abs()));
+    let start = guess.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+    if step.is_nan() || (step > RECEDING_STEP * size && size > RECEDING_GROWTH * start) {
         return Err(ModalError::EquilibriumAtInfinity {
             guess: guess.to_vec(),
             q: x[..n].to_vec(),
@@ -339,12 +362,23 @@ pub fn find_equilibrium(
     })
 }
 
-/// The largest Newton step from a converged iterate, relative to `1 + max |xᵢ|`, that
-/// [`find_equilibrium`] accepts: beyond it the residual is small only because the iterates
-/// ran away ([`ModalError::EquilibriumAtInfinity`]). At a simple root the step is of the
-/// order of the residual's rounding divided by the stiffness (`≲ 1e-12` relative); walking
-/// off to infinity under an inverse-square force, it is half the distance.
-const RECEDING_STEP: f64 = 1e-6;
+/// The largest Newton step from a converged iterate, relative to `max |qᵢ|`, that
+/// [`find_equilibrium`] accepts when the iterates grew by [`RECEDING_GROWTH`]: beyond both
+/// the residual is small only because the iterates ran away
+/// ([`ModalError::EquilibriumAtInfinity`]). Walking off to infinity the step is a fixed
+/// fraction of the distance (`r/2` under an inverse-square force, `1/r ≈ 0.04` for an
+/// exponentially fading one); at a simple root it is rounding (`≲ 1e-12` relative).
+const RECEDING_STEP: f64 = 1e-3;
+
+/// How much `max |qᵢ|` must have grown over the guess's for a converged iterate with a large
+/// step to count as walking away: a degenerate root (`F = −k x³`, steps a third of the
+/// distance) is approached with `q` shrinking or staying of the guess's size.
+const RECEDING_GROWTH: f64 = 10.0;
+
+/// Newton has converged when the largest residual is below this fraction of the largest at
+/// the guess: relative to the model's own force scale, so that a milligram pendulum
+/// (forces of 1e-12 N·m) converges as well as a heavy one.
+const RESIDUAL_REDUCTION: f64 = 1e-12;
 
 /// The minimum-norm Newton step `−J⁺F` (singular values below `1e-12 σ_max` dropped); zero
 /// when `J` is zero, not finite or the solve fails.
@@ -376,9 +410,27 @@ fn newton(
     let mut x = x0.to_vec();
     let mut f = residual_of(&x);
     let mut r = norm(&f);
-    let scale = if r.is_finite() { r } else { 0.0 };
+    // The size of the terms of F near x, `max_i Σ_j |J_ij x_j|` (a stiffness times a
+    // coordinate: units of F), which sets its rounding where F itself is near 0.
+    let terms = |jac: &DMatrix<f64>, x: &[f64]| -> f64 {
+        let t = (0..jac.nrows())
+            .map(|i| {
+                (0..jac.ncols())
+                    .map(|j| (jac[(i, j)] * x[j]).abs())
+                    .sum::<f64>()
+            })
+            .fold(0.0f64, f64::max);
+        if t.is_finite() { t } else { 0.0 }
+    };
+    // The force scale of the model at the guess, in its own units; a guess that is an exact
+    // root is returned.
+    let mut scale = if r.is_finite() { r } else { 0.0 };
+    let converged = |r: f64, scale: f64| r <= RESIDUAL_REDUCTION * scale;
+    // Converged as far as rounding allows: the residual is down by this much, yet no step
+    // reduces it further.
+    let stalled = |r: f64, scale: f64| r <= 1e-8 * scale;
     for iteration in 0..100 {
-        if r <= 1e-12 * (1.0 + scale) {
+        if r == 0.0 || converged(r, scale) {
             return Ok((x, iteration, r));
         }
         let jac = jacobian_of(&x);
@@ -388,6 +440,13 @@ fn newton(
         if jac.amax() == 0.0 {
             return Err((iteration, r, NewtonStop::ZeroJacobian));
         }
+        if iteration == 0 {
+            scale = scale.max(terms(&jac, &x));
+            if converged(r, scale) {
+                return Ok((x, 0, r));
+            }
+        }
+        let floor = scale.max(terms(&jac, &x));
         let step = newton_step(&jac, &f);
         let mut lambda = 1.0;
         let mut accepted = false;
@@ -399,14 +458,17 @@ fn newton(
                 .collect();
             let f_trial = residual_of(&trial);
             let r_trial = norm(&f_trial);
-            if r_trial < r || r_trial <= 1e-12 * (1.0 + scale) {
-                let small = lambda * step.amax()
-                    <= 1e-14 * (1.0 + x.iter().fold(0.0f64, |m, v| m.max(v.abs())));
+            if r_trial < r || converged(r_trial, scale) {
+                // A step at the rounding of x: nothing more to gain.
+                let small = step
+                    .iter()
+                    .zip(&x)
+                    .all(|(d, a)| (lambda * d).abs() <= 1e-14 * a.abs());
                 x = trial;
                 f = f_trial;
                 r = r_trial;
                 accepted = true;
-                if small && r <= 1e-8 * (1.0 + scale) {
+                if small && stalled(r, floor) {
                     return Ok((x, iteration + 1, r));
                 }
                 break;
@@ -416,13 +478,13 @@ fn newton(
         if !accepted {
             // No decrease along the Newton direction: converged as far as rounding allows,
             // or stuck.
-            if r <= 1e-8 * (1.0 + scale) {
+            if stalled(r, floor) {
                 return Ok((x, iteration + 1, r));
             }
             return Err((iteration + 1, r, NewtonStop::NoDecrease));
         }
     }
-    if r <= 1e-12 * (1.0 + scale) {
+    if converged(r, scale) {
         return Ok((x, 100, r));
     }
     Err((100, r, NewtonStop::IterationLimit))
@@ -470,8 +532,9 @@ pub fn constraint_hessians(model: &dyn ModelInfo, q: &[f64], t: f64) -> Vec<DMat
 }
 
 /// A load that depends on `t` at the operating point and enters neither `M`, `C` nor `K`:
-/// the linearisation is `M δq̈ + C δq̇ + K δq = F(q*, 0, t) − F(q*, 0, t₀)`, and the modes are
-/// those of its left side, the unforced equations ([`time_dependence`]).
+/// the linearisation is `M δq̈ + C δq̇ + K δq = F(q*, 0, t) − F(q*, 0, t₀)` about the equilibrium
+/// `q*` under the load's value at `t₀` (deflected by it where that value is not 0), and the
+/// modes are those of its left side, the load's variation set aside ([`time_dependence`]).
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct TimeDependentForcing {
     /// The time `t₀` (s) at which the load is frozen in the equilibrium `F(q*, 0, t₀) = 0`.
@@ -496,33 +559,68 @@ const TIME_OFFSETS: [f64; 6] = [0.073_1, 0.271_828, 1.523_7, 5.302_9, 19.739, 71
 const TIME_TOLERANCE: f64 = 1e-9;
 
 /// The largest change of a part of the equations from its value at `t₀` (`samples[0]`) over
-/// the later samples, relative to the largest entry of every sample (and of `floor`), with
-/// the index of the sample where it occurred; a NaN counts as an infinite change.
-fn relative_change(samples: &[DVector<f64>], floor: f64) -> (f64, usize) {
+/// the later samples, relative to the largest entry of every sample, with the index of the
+/// sample where it occurred; a NaN counts as an infinite change.
+fn relative_change(samples: &[DVector<f64>]) -> (f64, usize) {
+    let scale = samples.iter().fold(0.0f64, |a, v| a.max(v.amax()));
+    let scales = DVector::from_element(samples[0].len(), scale);
+    entrywise_change(samples, &scales)
+}
+
+/// The largest change of any entry `i` from its value at `t₀` (`samples[0]`) over the later
+/// samples, relative to `scales[i]`, with the index of the sample where it occurred; a NaN,
+/// or a change of an entry whose scale is 0, counts as an infinite change.
+fn entrywise_change(samples: &[DVector<f64>], scales: &DVector<f64>) -> (f64, usize) {
     let at_t0 = &samples[0];
-    let mut scale = floor;
     let (mut change, mut at) = (0.0f64, 0);
     for (k, value) in samples.iter().enumerate() {
-        scale = scale.max(value.amax());
-        let d = (value - at_t0).amax();
-        let d = if d.is_nan() { f64::INFINITY } else { d };
-        if d > change {
-            (change, at) = (d, k);
+        for i in 0..value.len() {
+            let d = (value[i] - at_t0[i]).abs();
+            if d == 0.0 {
+                continue;
+            }
+            let relative = if d.is_nan() || scales[i] == 0.0 {
+                f64::INFINITY
+            } else {
+                d / scales[i]
+            };
+            if relative > change {
+                (change, at) = (relative, k);
+            }
         }
     }
-    if change == 0.0 {
-        (0.0, at)
-    } else {
-        (change / scale, at)
+    (change, at)
+}
+
+/// [`entrywise_change`] for a matrix of the linearisation (`M`, `C` or `K`, `n × n`, as
+/// column-major samples): entry `(i, j)` is compared with `max(√|Xᵢᵢ Xⱼⱼ|, |Xᵢⱼ|)` over the
+/// samples — its own coordinates' scale, so that a stiff coordinate elsewhere does not hide
+/// the modulation of a soft one (a shaken 10 g pendulum beside a 1e9 N/m spring).
+fn matrix_change(samples: &[DVector<f64>], n: usize) -> (f64, usize) {
+    let mut scales = DVector::zeros(n * n);
+    for value in samples {
+        for j in 0..n {
+            for i in 0..n {
+                let own = (value[i + i * n] * value[j + j * n]).abs().sqrt();
+                let s = own.max(value[i + j * n].abs());
+                if s > scales[i + j * n] {
+                    scales[i + j * n] = s;
+                }
+            }
+        }
     }
+    entrywise_change(samples, &scales)
 }
 
 /// The explicit time dependence of `model`'s equations at rest at `q` (the operating point,
 /// length `n`), from `t₀` (s): evaluated at six later times, each holonomic constraint
 /// (`Φ`, `J`, `Φ_t`, `γ`), then `M(q, t)`, `∂F/∂q̇ (q, 0, t)` and `∂F/∂q (q, 0, t)` must not
-/// change (relative change at most `1e-9`). A change of `F(q, 0, t)` alone is a load that
+/// change (relative change at most `1e-9`, entry `(i, j)` of a matrix against
+/// `max(√|Xᵢᵢ Xⱼⱼ|, |Xᵢⱼ|)`, so that an unrelated stiff coordinate does not hide a modulated
+/// soft one; `Fᵢ` against `max(|Fᵢ|, Σⱼ |Kᵢⱼ qⱼ|)`). A change of `F(q, 0, t)` alone is a load that
 /// enters neither `M`, `C` nor `K` — the linear oscillator driven by `F₀ cos ωt` — and is
-/// returned: the modes are those of the unforced equations, with the load frozen at `t₀` in
+/// returned: the modes are those of the equations without the load's variation, about the
+/// equilibrium under its value at `t₀` (frozen there in
 /// the equilibrium. `Ok(None)` when nothing changes.
 ///
 /// Why numerically: the model is a compiled function of `(t, y)`; sampling its values is
@@ -568,22 +666,23 @@ pub fn time_dependence(
             .map(|&t| model.constraint_equations(t, &y))
             .collect();
         for (i, name) in model.constraint_names().iter().take(m).enumerate() {
-            let samples: Vec<DVector<f64>> = constraints
+            // The Jacobian apart from Φ, Φ_t and γ: a constant J with a moving Φ is a
+            // prescribed motion (base excitation), which the hint treats differently.
+            let jacobian: Vec<DVector<f64>> = constraints
                 .iter()
-                .map(|c| {
-                    let head = [c.phi[i], c.velocity[i], c.gamma[i]];
-                    DVector::from_iterator(
-                        n + 3,
-                        head.into_iter().chain(c.jacobian.row(i).iter().copied()),
-                    )
-                })
+                .map(|c| c.jacobian.row(i).transpose())
                 .collect();
-            refuse(
-                TimeDependentPart::Constraint {
-                    name: name.to_string(),
-                },
-                relative_change(&samples, 0.0),
-            )?;
+            let rest: Vec<DVector<f64>> = constraints
+                .iter()
+                .map(|c| DVector::from_vec(vec![c.phi[i], c.velocity[i], c.gamma[i]]))
+                .collect();
+            let jacobian_change = relative_change(&jacobian);
+            let part = |jacobian_changes| TimeDependentPart::Constraint {
+                name: name.to_string(),
+                jacobian_changes,
+            };
+            refuse(part(true), jacobian_change)?;
+            refuse(part(false), relative_change(&rest))?;
         }
     }
     let flat = |a: &DMatrix<f64>| DVector::from_column_slice(a.as_slice());
@@ -597,19 +696,21 @@ pub fn time_dependence(
         damping.push(flat(&jqd));
         stiffness.push(flat(&jq));
     }
-    refuse(TimeDependentPart::MassMatrix, relative_change(&mass, 0.0))?;
-    refuse(
-        TimeDependentPart::DampingMatrix,
-        relative_change(&damping, 0.0),
-    )?;
+    refuse(TimeDependentPart::MassMatrix, matrix_change(&mass, n))?;
+    refuse(TimeDependentPart::DampingMatrix, matrix_change(&damping, n))?;
     refuse(
         TimeDependentPart::StiffnessMatrix,
-        relative_change(&stiffness, 0.0),
+        matrix_change(&stiffness, n),
     )?;
-    // The load: its rounding is that of its terms, of the order of the stiffness times the
-    // displacement, so that scale is the floor of the comparison.
-    let size = q.iter().fold(1.0f64, |a, v| a.max(v.abs()));
-    let (change, k) = relative_change(&forcing, stiffness[0].amax() * size);
+    // The load, coordinate by coordinate: the rounding of `Fᵢ` is that of its terms, of the
+    // order of `Σⱼ |Kᵢⱼ qⱼ|` (units of `Fᵢ`), which is the floor of the comparison with
+    // `max |Fᵢ|` over the samples.
+    let mut scales = DVector::zeros(n);
+    for i in 0..n {
+        let terms: f64 = (0..n).map(|j| (stiffness[0][i + j * n] * q[j]).abs()).sum();
+        scales[i] = forcing.iter().fold(terms, |a, f| a.max(f[i].abs()));
+    }
+    let (change, k) = entrywise_change(&forcing, &scales);
     if change <= TIME_TOLERANCE {
         return Ok(None);
     }

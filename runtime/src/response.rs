@@ -383,7 +383,11 @@ pub fn state_response_by_exponential(
 
 /// Groups sorted eigenvalues into clusters of (numerically) repeated values: members within
 /// `tol` of the cluster's first member.
-fn clusters<T: Copy>(values: &[T], distance: impl Fn(T, T) -> f64, tol: f64) -> Vec<Vec<usize>> {
+fn clusters<T: Copy>(
+    values: &[T],
+    distance: impl Fn(T, T) -> f64,
+    tol: impl Fn(T, T) -> f64,
+) -> Vec<Vec<usize>> {
     let mut assigned = vec![false; values.len()];
     let mut out = Vec::new();
     for i in 0..values.len() {
@@ -393,7 +397,7 @@ fn clusters<T: Copy>(values: &[T], distance: impl Fn(T, T) -> f64, tol: f64) -> 
         let mut members = vec![i];
         assigned[i] = true;
         for j in i + 1..values.len() {
-            if !assigned[j] && distance(values[i], values[j]) <= tol {
+            if !assigned[j] && distance(values[i], values[j]) <= tol(values[i], values[j]) {
                 assigned[j] = true;
                 members.push(j);
             }
@@ -408,32 +412,59 @@ fn clusters<T: Copy>(values: &[T], distance: impl Fn(T, T) -> f64, tol: f64) -> 
 const MIN_SINGULAR_RATIO: f64 = 1e-6;
 
 /// A singular value of `B − λI` at most this fraction of `max |Bᵢⱼ|` is rounding: the entries
-/// of `B` and the computed `λ` carry errors of a few `ε max |Bᵢⱼ|`.
+/// of `B` and the computed `λ` carry errors of a few `ε max |Bᵢⱼ|`. Also the absolute part of
+/// the tolerance within which eigenvalues are one repeated value ([`repeated`]).
 const ROUNDING_SINGULAR_VALUE: f64 = 1e-12;
+
+/// The tolerance within which the eigenvalues of sizes `x` and `y` are one repeated value,
+/// for a matrix whose largest eigenvalue is `scale`: `1e-8` relative to their own size, and
+/// at least rounding of the whole matrix (`1e-12 scale`). Relative to their own size, not to
+/// `scale`: beside a stiff mode (ω² = 1e9) the soft ω² = 1 and 1.5 are distinct, not one
+/// value 1.25.
+fn repeated(x: f64, y: f64, scale: f64) -> f64 {
+    1e-8 * x.max(y) + ROUNDING_SINGULAR_VALUE * scale
+}
+
+/// `max_i Σ_j |Bᵢⱼ| |vⱼ|`: the size of the entries of `B` that act on `v`, the scale of the
+/// block a candidate eigenvector lives in.
+fn local_scale<T: nalgebra::ComplexField<RealField = f64>>(
+    b: &DMatrix<T>,
+    v: impl Fn(usize) -> f64,
+) -> f64 {
+    (0..b.nrows())
+        .map(|i| {
+            (0..b.ncols())
+                .map(|j| b[(i, j)].clone().abs() * v(j))
+                .sum::<f64>()
+        })
+        .fold(0.0f64, f64::max)
+}
 
 /// The rows of `Vᵀ` (right singular vectors of `B − λI`) for the `count` smallest singular
 /// values, where `count` is the multiplicity of the eigenvalue `λ`. Each is an eigenvector only
-/// if its singular value is negligible: `≤ 1e-6 σ_max(B − λI)`, or rounding
+/// if its singular value is negligible: `≤ 1e-6 max(|λ|, sₖ)`, with `sₖ` the size of the
+/// entries of `B` acting on the vector (`local(k)`, [`local_scale`]), or rounding
 /// (`≤ 1e-12 max |Bᵢⱼ|`, given as `matrix_scale`); otherwise the eigenvalue's eigenspace is
 /// smaller than its multiplicity (a Jordan block): [`ResponseError::Defective`].
 ///
-/// The second bound is for `B = λI` (an isotropic oscillator, `M = 2I`, `K = 50I`): `B − λI`
-/// is then rounding in every direction, its largest singular value too, and the first bound
-/// alone compared rounding with rounding and called the eigenvalue defective with a ratio
-/// near 1. It never loosens the test where `B − λI` has a part of the size of `B`, which is
-/// where a Jordan block shows.
+/// The first bound is the eigenvalue's own scale, not `σ_max(B − λI)`: beside a stiff mode
+/// (entries 1e8) a Jordan block of a soft one (entries 1) leaves a singular value of 1, far
+/// below `1e-6 σ_max` yet of the size of the block. The second is for `B = λI` (an isotropic
+/// oscillator, `M = 2I`, `K = 50I`): `B − λI` is then rounding in every direction.
 fn null_vectors(
     singular_values: &DVector<f64>,
     count: usize,
+    (lambda, local): (f64, &dyn Fn(usize) -> f64),
     matrix_scale: f64,
     matrix: &'static str,
 ) -> Result<Vec<usize>, ResponseError> {
     let max = singular_values.max();
-    let negligible = (1e-6 * max).max(ROUNDING_SINGULAR_VALUE * matrix_scale);
     let mut order: Vec<usize> = (0..singular_values.len()).collect();
     order.sort_by(|&i, &j| singular_values[i].total_cmp(&singular_values[j]));
     order.truncate(count);
-    if let Some(&k) = order.iter().find(|&&k| singular_values[k] > negligible) {
+    let negligible =
+        |k: usize| (1e-6 * lambda.max(local(k))).max(ROUNDING_SINGULAR_VALUE * matrix_scale);
+    if let Some(&k) = order.iter().find(|&&k| singular_values[k] > negligible(k)) {
         return Err(ResponseError::Defective {
             matrix,
             ratio: singular_values[k] / max,
@@ -464,7 +495,7 @@ fn spanning_ratio(
 /// y0` (HW32, lectures 32–33: superposition of the complex eigenvector solutions).
 ///
 /// The eigenvalues come from the real Schur form; each eigenvector (a basis of each eigenspace
-/// for eigenvalues repeated within `1e-8 max |λ|`) is the right singular vector of `A − λI`
+/// for eigenvalues repeated within `1e-8` of their size plus `1e-12 max |λ|`) is the right singular vector of `A − λI`
 /// for its smallest singular value(s), computed in complex arithmetic.
 ///
 /// # Shapes
@@ -490,7 +521,11 @@ pub fn state_response_by_eigenvectors(
     let ac: DMatrix<Complex<f64>> = a.map(|v| Complex::new(v, 0.0));
     let mut vectors: DMatrix<Complex<f64>> = DMatrix::zeros(m, m);
     let mut values = Vec::with_capacity(m);
-    for cluster in clusters(&lambdas, |x, y| (x - y).norm(), 1e-8 * scale) {
+    for cluster in clusters(
+        &lambdas,
+        |x, y| (x - y).norm(),
+        |x, y| repeated(x.norm(), y.norm(), scale),
+    ) {
         let mean = cluster.iter().map(|&i| lambdas[i]).sum::<Complex<f64>>()
             / Complex::new(cluster.len() as f64, 0.0);
         let shifted = &ac - DMatrix::<Complex<f64>>::identity(m, m) * mean;
@@ -501,7 +536,14 @@ pub fn state_response_by_eigenvectors(
                 ratio: 0.0,
             });
         };
-        for k in null_vectors(&svd.singular_values, cluster.len(), a.amax(), "A")? {
+        let local = |k: usize| local_scale(a, |j| v_t[(k, j)].norm());
+        for k in null_vectors(
+            &svd.singular_values,
+            cluster.len(),
+            (mean.norm(), &local),
+            a.amax(),
+            "A",
+        )? {
             let col = values.len();
             for i in 0..m {
                 vectors[(i, col)] = v_t[(k, i)].conj();
@@ -597,7 +639,7 @@ pub struct MInvKModes {
 /// The eigenvalues and eigenvectors of `M⁻¹K` (lecture 22, `[P, D] = eig(M⁻¹K)`).
 ///
 /// The eigenvalues come from the real Schur form; each eigenvector (a basis of the eigenspace
-/// for eigenvalues repeated within `1e-8 max |ω²|`) is the right singular vector of
+/// for eigenvalues repeated within `1e-8` of their size plus `1e-12 max |ω²|`) is the right singular vector of
 /// `M⁻¹K − ω² I` for its smallest singular value(s). `K` is used as derived (not symmetrised).
 ///
 /// # Errors
@@ -625,7 +667,11 @@ pub fn modes_of_m_inv_k(lin: &Linearization) -> Result<MInvKModes, ResponseError
     let mut eigenvalues = Vec::with_capacity(n);
     let mut kinds = Vec::with_capacity(n);
     let mut vectors = DMatrix::zeros(n, n);
-    for cluster in clusters(&lambdas, |x, y| (x - y).abs(), 1e-8 * scale) {
+    for cluster in clusters(
+        &lambdas,
+        |x, y| (x - y).abs(),
+        |x, y| repeated(x.abs(), y.abs(), scale),
+    ) {
         let mean = cluster.iter().map(|&i| lambdas[i]).sum::<f64>() / cluster.len() as f64;
         let svd = (&b - DMatrix::<f64>::identity(n, n) * mean).svd(false, true);
         let Some(v_t) = svd.v_t else {
@@ -646,7 +692,14 @@ pub fn modes_of_m_inv_k(lin: &Linearization) -> Result<MInvKModes, ResponseError
         } else {
             (mean, ModeKind::Oscillatory)
         };
-        for k in null_vectors(&svd.singular_values, cluster.len(), b.amax(), "M⁻¹K")? {
+        let local = |k: usize| local_scale(&b, |j| v_t[(k, j)].abs());
+        for k in null_vectors(
+            &svd.singular_values,
+            cluster.len(),
+            (mean.abs(), &local),
+            b.amax(),
+            "M⁻¹K",
+        )? {
             let col = eigenvalues.len();
             let mut u: DVector<f64> = v_t.row(k).transpose();
             let imax = u.iamax();

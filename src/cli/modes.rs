@@ -240,7 +240,7 @@ fn print_text(
     if let Some(forcing) = forcing {
         let _ = writeln!(
             stdout,
-            "note       F depends on t through a load that enters neither M, C nor K: F(q*, 0, t) − F(q*, 0, t₀) reaches {change:.3e} on {coordinate} (t = {t:.6e} s, t₀ = {t0} s); it is set aside as an input (the equilibrium balances its value at t₀), and the modes below are those of the unforced equations",
+            "note       F depends on t through a load that enters neither M, C nor K: F(q*, 0, t) − F(q*, 0, t₀) reaches {change:.3e} on {coordinate} (t = {t:.6e} s, t₀ = {t0} s); its variation is set aside: the operating point above is the equilibrium under the load's value at t₀ (deflected by it where that value is not 0), and the modes below are those of the equations linearised there",
             change = num(forcing.largest_change),
             coordinate = forcing.coordinate,
             t = num(forcing.t),
@@ -406,7 +406,17 @@ pub(super) fn modal_hint(model: &dyn ModelInfo, e: &eomgen::ModalError) -> Strin
             "the forces fade with distance without balancing (an attraction with nothing to oppose it: an orbit has no equilibrium at rest); start Newton nearer an equilibrium if there is one: {start}"
         ),
         ModalError::DegenerateCoordinates { .. } => format!(
-            "the coordinates are singular at this configuration (Euler angles at θ = 0, an angle of a point at its pivot): choose an operating point away from it, {start}, or other coordinates"
+            "the coordinates are (nearly) degenerate at this configuration (Euler angles at θ = 0, an angle of a point at its pivot, a mass negligible beside the one it moves with): choose an operating point away from it, {start}, other coordinates or less extreme parameters"
+        ),
+        ModalError::TimeDependent {
+            part:
+                eomgen::TimeDependentPart::Constraint {
+                    jacobian_changes: false,
+                    ..
+                },
+            ..
+        } => format!(
+            "the constraint prescribes a motion with a constant Jacobian (base excitation, like `x − a*cos(w*t)`): the modes are those of the system relative to the moving base, which are not computed from this form; write the model in coordinates relative to the base (the base's acceleration then enters as a load, which `modes` sets aside), or simulate it (`eomgen simulate {name}`)"
         ),
         ModalError::TimeDependent {
             part: eomgen::TimeDependentPart::Constraint { .. },

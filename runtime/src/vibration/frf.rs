@@ -14,8 +14,9 @@ use serde::Serialize;
 use super::operating_point::{OperatingPoint, OperatingPointError, OperatingPointOptions};
 use crate::frf::{
     ForcedLinearization, FrequencySweep, FrfError, HarmonicForcing, ModalResponse, PeakAmplitude,
-    SteadyStateOptions, frequency_response, frequency_sweep, linearize_with_inputs,
-    log_frequencies, modal_frequency_response, output_index, settling_time, simulate_steady_state,
+    SteadyStateOptions, frequency_response, frequency_response_of, frequency_sweep,
+    linearize_with_inputs, log_frequencies, modal_frequency_response, output_index, settling_time,
+    simulate_steady_state,
 };
 use crate::modal::{NormalModes, normal_modes};
 use crate::model_info::ModelInfo;
@@ -384,8 +385,9 @@ pub fn frequency_response_analysis(
     }
     let b = forced.input_matrix.column(0).into_owned();
     let mut evaluations = Vec::with_capacity(evaluation_frequencies.len());
+    let requested: Vec<usize> = outputs.iter().map(|o| o.index).collect();
     for w in evaluation_frequencies {
-        let response = match frequency_response(lin, b_matrix, w) {
+        let response = match frequency_response_of(lin, b_matrix, w, &requested) {
             Ok(h) => Some(h.column(0).into_owned()),
             Err(FrfError::Singular { .. }) => None,
             Err(e) => return Err(e.into()),

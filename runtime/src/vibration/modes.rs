@@ -9,8 +9,8 @@ use super::operating_point::{
     OperatingPoint, OperatingPointError, OperatingPointOptions, operating_point,
 };
 use crate::modal::{
-    Linearization, NormalModes, TimeDependentForcing, damped_modes, eigenvalues_of_m_inv_k,
-    linearize, normal_modes, time_dependence,
+    Linearization, ModalError, NormalModes, TimeDependentForcing, damped_modes,
+    eigenvalues_of_m_inv_k, linearize, normal_modes, time_dependence,
 };
 use crate::model_info::ModelInfo;
 
@@ -63,9 +63,11 @@ pub struct ModalAnalysis {
     /// symmetric route), relative to the largest `|ω²|`.
     pub m_inv_k_relative_difference: f64,
     /// A load that depends on `t` and enters neither `M`, `C` nor `K` (`F₀ cos ωt` on a
-    /// linear oscillator): set aside as an input, frozen at the operating point's `t` in the
-    /// equilibrium; the modes are those of the unforced equations. `None` when the equations
-    /// at the operating point do not depend on `t`.
+    /// linear oscillator): the operating point is the equilibrium under the load's value at
+    /// the operating point's `t` (deflected by it where that value is not 0: a pendulum under
+    /// `A cos wt` at `t = 0` leans by `≈ A/(m g l)`), and its variation is set aside; the
+    /// modes are those of the equations linearised there. `None` when the equations at the
+    /// operating point do not depend on `t`.
     pub time_dependent_forcing: Option<TimeDependentForcing>,
 }
 
@@ -89,8 +91,12 @@ impl ModalAnalysis {
 ///
 /// Explicit time dependence is checked at the equilibrium ([`time_dependence`]): a load that
 /// changes with `t` but enters neither `M`, `C` nor `K` is set aside (reported in
-/// [`ModalAnalysis::time_dependent_forcing`]); coefficients or constraints that change with
-/// `t` are refused, since modes of equations frozen at one instant describe no motion.
+/// [`ModalAnalysis::time_dependent_forcing`]): the operating point is the equilibrium under
+/// the load's value at the operating point's `t` (deflected by it where that value is not
+/// 0), and the modes are those of the equations linearised there, the load's variation left
+/// out. Coefficients or constraints that change with `t` are refused, since modes of
+/// equations frozen at one instant describe no motion; where the equilibrium search fails,
+/// they are looked for at the guess, so that the error names them.
 ///
 /// # Errors
 /// [`OperatingPointError::UnknownEquilibrium`]; [`OperatingPointError::Modal`] when the
@@ -123,7 +129,20 @@ pub fn modal_analysis(
     model: &dyn ModelInfo,
     options: &ModalOptions,
 ) -> Result<ModalAnalysis, OperatingPointError> {
-    let point = operating_point(model, &options.operating_point)?;
+    let point = match operating_point(model, &options.operating_point) {
+        Ok(point) => point,
+        Err(OperatingPointError::Modal(
+            error @ (ModalError::EquilibriumNotFound { .. }
+            | ModalError::EquilibriumAtInfinity { .. }),
+        )) => {
+            // Coefficients that change with t are the reason to give, not Newton's failure
+            // on the equations frozen at t₀: checked at the guess.
+            let (_, guess) = options.operating_point.start.resolve(model)?;
+            time_dependence(model, &guess, options.operating_point.t)?;
+            return Err(error.into());
+        }
+        Err(error) => return Err(error),
+    };
     let time_dependent_forcing = time_dependence(model, point.q(), point.t)?;
     let n = model.num_dofs();
     let linearization = linearize(model, point.q(), &vec![0.0; n], point.t)?;
