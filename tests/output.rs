@@ -109,8 +109,8 @@ fn read_one_line_then_close(args: &[&str]) -> Output {
 #[test]
 fn a_closed_pipe_ends_the_program_quietly_with_status_141() {
     let commands: &[&[&str]] = &[
-        // About 1.5 MB of model file.
-        &["new", "n-link-pendulum", "200"],
+        // About 400 kB of model file.
+        &["new", "n-link-pendulum", "100"],
         // Every accepted step as a JSON sample: 10⁵ samples, about 18 MB.
         &[
             "simulate",
@@ -452,7 +452,7 @@ fn sizes_over_their_limit_are_usage_errors() {
         ),
         (&["study", "euler-roundoff", "--max-n", "9"], "at most 8"),
         (&["study", "stability", "--steps", "10000000"], "10⁶"),
-        (&["new", "n-link-pendulum", "201"], "200"),
+        (&["new", "n-link-pendulum", "101"], "100"),
         (
             &[
                 "animate",
