@@ -56,7 +56,7 @@ pub fn solve_spd<const N: usize>(
     let mut d = [0.0f64; N];
     if N >= ENVELOPE_FROM {
         let mut x = *f;
-        let (mut first, mut reach) = ([0usize; N], [0usize; N]);
+        let mut envelope = [[0usize; N]; 2];
         return solve_in_envelope(
             N,
             |i, j| m[(i, j)],
@@ -64,8 +64,7 @@ pub fn solve_spd<const N: usize>(
             l.as_flattened_mut(),
             &mut d,
             &mut inv_d,
-            &mut first,
-            &mut reach,
+            envelope.as_flattened_mut(),
         )
         .map(|()| x);
     }
@@ -157,8 +156,7 @@ pub fn solve_spd_in_place(
     let (l, rest) = work.split_at_mut(n * n);
     let (d, inv_d) = rest.split_at_mut(n);
     if n >= ENVELOPE_FROM {
-        let (first, reach) = envelope.split_at_mut(n);
-        return solve_in_envelope(n, m, f, l, d, inv_d, first, reach);
+        return solve_in_envelope(n, m, f, l, d, inv_d, envelope);
     }
     // `l[i][k]` of `solve_spd` is `l[i * n + k]`.
     for j in 0..n {
@@ -212,8 +210,8 @@ pub const ENVELOPE_FROM: usize = 9;
 /// multiply–adds: 1.7 × 10⁸ per right-hand side for a chain of 1000 masses.
 ///
 /// `m(i, j)` is entry `(i, j)` of `M` (lower triangle read); `l` holds `n²` values
-/// (row-major), `d`, `inv_d`, `first` and `reach` `n` each (`first` keeps each row's `fᵢ`,
-/// `reach` each column's last row in the envelope); `f` becomes `x`. `None` when a pivot is
+/// (row-major), `d` and `inv_d` `n` each, `envelope` `2n` (each row's `fᵢ`, then each
+/// column's last row in the envelope); `f` becomes `x`. `None` when a pivot is
 /// not positive or is NaN.
 #[inline]
 fn solve_in_envelope(
@@ -223,18 +221,18 @@ fn solve_in_envelope(
     l: &mut [f64],
     d: &mut [f64],
     inv_d: &mut [f64],
-    first: &mut [usize],
-    reach: &mut [usize],
+    envelope: &mut [usize],
 ) -> Option<()> {
+    let (first, reach) = envelope.split_at_mut(n);
     // fᵢ, found column by column (contiguous in a column-major `M`): the first column whose
     // entry is non-zero; a row with none starts at its diagonal.
     for (i, fi) in first.iter_mut().enumerate().take(n) {
         *fi = i;
     }
     for j in 0..n {
-        for i in j + 1..n {
-            if m(i, j) != 0.0 && first[i] == i {
-                first[i] = j;
+        for (i, fi) in first.iter_mut().enumerate().skip(j + 1) {
+            if *fi == i && m(i, j) != 0.0 {
+                *fi = j;
             }
         }
     }
@@ -414,7 +412,9 @@ mod tests {
     /// Indefinite and NaN matrices are refused as before.
     #[test]
     fn the_envelope_solve_is_the_dense_one_on_sparse_and_dense_matrices() {
-        let shapes: [(&str, fn(usize, usize, usize) -> bool); 4] = [
+        // Whether entry (i, j) of an n × n matrix is in the pattern.
+        type Pattern = fn(usize, usize, usize) -> bool;
+        let shapes: [(&str, Pattern); 4] = [
             ("dense", |_, _, _| true),
             ("banded", |i, j, n| {
                 i.abs_diff(j) <= 2 || i == n - 1 || j == n - 1

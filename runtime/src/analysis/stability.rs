@@ -40,11 +40,11 @@ use crate::ode::OdeFn;
 pub struct StabilityOptions {
     /// Constant steps of each run of the stability-limit bisection (part a), in
     /// `[100, 10⁶]` (default: 10⁴). The bisection makes ~400 runs of this many steps over
-    /// the methods, ~40 s of CPU time at 10⁶.
+    /// the methods, ~50 s of CPU time at 10⁶.
     pub steps: usize,
     /// Periods of the oscillator in the energy study (part b), in `[1, 10⁵]` (default: 10⁴):
     /// `3296` steps per period over the four runs, every step of the three coarse ones kept,
-    /// ~14 s of CPU time and 90 MB at 10⁵.
+    /// ~19 s of CPU time and 90 MB at 10⁵.
     pub periods: usize,
     /// Stiffness ratios `k/m` (1/s²) of the stiff two-mass spring (part c), each in
     /// `(0, 1e10]`, at least one (default: 1e2, 1e4, 1e6, 1e8).

@@ -327,7 +327,7 @@ mod tests {
                         m[j * n + i] = v;
                     }
                 }
-                m[i * n + i] += rng.random_range(0.0..2.5);
+                m[i * n + i] += rng.random_range(0.0..4.0);
             }
             let smallest = dense(&m);
             if (smallest - 1e-12).abs() < 1e-6 {
