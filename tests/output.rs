@@ -112,8 +112,8 @@ fn read_one_line_then_close(args: &[&str]) -> Output {
 #[test]
 fn a_closed_pipe_ends_the_program_quietly_with_status_141() {
     let commands: &[&[&str]] = &[
-        // About 1.5 MB of model file.
-        &["new", "n-link-pendulum", "200"],
+        // About 400 kB of model file.
+        &["new", "n-link-pendulum", "100"],
         // Every accepted step as a JSON sample: 10⁵ samples, about 18 MB.
         &[
             "simulate",
@@ -453,7 +453,7 @@ fn sizes_over_their_limit_are_usage_errors() {
             ],
             "at most 1000000",
         ),
-        (&["study", "euler-roundoff", "--max-n", "11"], "at most 10"),
+        (&["study", "euler-roundoff", "--max-n", "9"], "at most 8"),
         (
             &[
                 "study",
@@ -464,8 +464,8 @@ fn sizes_over_their_limit_are_usage_errors() {
             ],
             "[0, 10000]",
         ),
-        (&["study", "stability", "--steps", "100000000"], "10⁷"),
-        (&["new", "n-link-pendulum", "201"], "200"),
+        (&["study", "stability", "--steps", "10000000"], "10⁶"),
+        (&["new", "n-link-pendulum", "101"], "100"),
         (
             &[
                 "animate",

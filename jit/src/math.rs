@@ -79,6 +79,18 @@ pub(crate) extern "C-unwind" fn atan2(y: f64, x: f64) -> f64 {
     y.atan2(x)
 }
 
+/// Sets `count` `f64`s from `out` on to `+0.0` (all bits zero): the long runs of zero outputs
+/// of a sparse matrix (a chain's mass matrix and Jacobians), one call each instead of one
+/// store per entry.
+///
+/// # Safety
+/// `out` points to at least `count` writable `f64`s.
+pub(crate) unsafe extern "C-unwind" fn fill_zero(out: *mut f64, count: usize) {
+    // SAFETY: guaranteed by the caller (the compiled code passes a range of an output buffer
+    // whose length was checked against the function's extent).
+    unsafe { std::ptr::write_bytes(out, 0, count) }
+}
+
 /// The function of one argument behind `function`.
 pub(crate) fn unary(function: Func) -> extern "C-unwind" fn(f64) -> f64 {
     match function {

@@ -15,7 +15,11 @@
 //! are compare-and-select, and the transcendentals are calls of the functions of
 //! [`crate::math`] (the same library functions the code of `eomgen::model!` calls) through
 //! absolute addresses; `sin_cos` returns its pair in two registers. Outputs are stores at
-//! fixed offsets. Cranelift's optimiser (`opt_level = speed`) and register allocator do the
+//! fixed offsets, except runs of [`ZERO_RUN`] or more consecutive outputs that are the
+//! constant `+0.0` (the structural zeros of a sparse mass matrix or Jacobian), which are one
+//! call of [`math::fill_zero`] each, first thing in the function: the mass matrix of a
+//! 1000-mass chain is a million outputs, and storing them one by one took Cranelift 6 s to
+//! compile. Cranelift's optimiser (`opt_level = speed`) and register allocator do the
 //! rest; nothing is reassociated or contracted into fused multiply–adds, so the results are
 //! the interpreter's to the bit.
 //!
@@ -63,6 +67,10 @@ pub(crate) type NativeFn = unsafe extern "C" fn(
 /// Functions of more instructions than this keep their shared values in a scratch buffer
 /// instead of registers (see [`build`]).
 const SCRATCH_FROM_INSTRUCTIONS: usize = 1500;
+
+/// Runs of at least this many consecutive outputs that are the constant `+0.0` are written by
+/// one call of [`math::fill_zero`] (see [`zero_runs`]).
+const ZERO_RUN: usize = 16;
 
 /// Why the model's functions could not be compiled to native code.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
@@ -157,6 +165,7 @@ struct Imports {
     sin_cos: FuncId,
     powf: FuncId,
     atan2: FuncId,
+    fill_zero: FuncId,
 }
 
 /// Compiles `functions` (named for errors) into one module; an empty tape gets no code.
@@ -200,6 +209,7 @@ pub(crate) fn compile(functions: &[(&str, &FunctionTape)]) -> Result<NativeCode,
     builder.symbol("eomgen_sin_cos", math::sin_cos as *const u8);
     builder.symbol("eomgen_powf", math::powf as *const u8);
     builder.symbol("eomgen_atan2", math::atan2 as *const u8);
+    builder.symbol("eomgen_fill_zero", math::fill_zero as *const u8);
     let mut module = JITModule::new(builder);
 
     let failure = |function: &str, e: &dyn std::fmt::Display| CompileError::Function {
@@ -224,14 +234,18 @@ pub(crate) fn compile(functions: &[(&str, &FunctionTape)]) -> Result<NativeCode,
     for (name, f) in HELPERS {
         unary.push((f, declare(&mut module, name, &float_signature(1, 1))?));
     }
+    let pointer = module.target_config().pointer_type();
+    let mut fill_signature = Signature::new(call_conv);
+    fill_signature.params.push(AbiParam::new(pointer));
+    fill_signature.params.push(AbiParam::new(pointer));
     let imports = Imports {
         unary,
         sin_cos: declare(&mut module, "eomgen_sin_cos", &float_signature(1, 2))?,
         powf: declare(&mut module, "eomgen_powf", &float_signature(2, 1))?,
         atan2: declare(&mut module, "eomgen_atan2", &float_signature(2, 1))?,
+        fill_zero: declare(&mut module, "eomgen_fill_zero", &fill_signature)?,
     };
 
-    let pointer = module.target_config().pointer_type();
     let mut signature = Signature::new(call_conv);
     for _ in 0..5 {
         signature.params.push(AbiParam::new(pointer));
@@ -419,6 +433,25 @@ fn build(
     let mut atan2_ref = None;
     let tape = &function.tape;
     let count = tape.instructions.len();
+    let split = function.split.min(tape.outputs.len());
+    // Long runs of zero outputs first, one call each; `filled[j]`: output `j` is written.
+    let mut filled = vec![false; tape.outputs.len()];
+    let runs = zero_runs(tape, split);
+    if !runs.is_empty() {
+        let callee = module.declare_func_in_func(imports.fill_zero, b.func);
+        let pointer = module.target_config().pointer_type();
+        for (start, end) in runs {
+            let (base, slot) = if start < split {
+                (out0, start)
+            } else {
+                (out1, start - split)
+            };
+            let address = b.ins().iadd_imm_s(base, (slot as i64) * 8);
+            let length = b.ins().iconst(pointer, (end - start) as i64);
+            b.ins().call(callee, &[address, length]);
+            filled[start..end].fill(true);
+        }
+    }
     let mut slots_used = 0u32;
     let scratch = (count > SCRATCH_FROM_INSTRUCTIONS).then(|| {
         let mut uses = vec![0u32; count];
@@ -454,11 +487,13 @@ fn build(
     // In a large function each output is stored as soon as it is computed (kept to the end,
     // every output would live through the rest of the function): per instruction, the
     // (buffer, byte offset) of the outputs it is.
-    let split = function.split.min(tape.outputs.len());
     let mut destinations: Vec<Vec<(ir::Value, i32)>> = Vec::new();
     if values.scratch.is_some() {
         destinations = vec![Vec::new(); count];
         for (j, &x) in tape.outputs.iter().enumerate() {
+            if filled[j] {
+                continue;
+            }
             let (base, slot) = if j < split {
                 (out0, j)
             } else {
@@ -595,12 +630,10 @@ fn build(
     // load within one wider store is forwarded. On the double pendulum's right-hand side this
     // was worth ~4 ns (`benches/runtime_model.rs`).
     if values.scratch.is_some() {
-        // Computed outputs are stored already; inputs and constants still are to be.
+        // Computed outputs and constants are stored already (where they are defined); inputs
+        // still are to be.
         for (j, &x) in tape.outputs.iter().enumerate() {
-            if !matches!(
-                tape.instructions[x as usize],
-                Instruction::Input(_) | Instruction::Const(_)
-            ) {
+            if filled[j] || !matches!(tape.instructions[x as usize], Instruction::Input(_)) {
                 continue;
             }
             let (base, slot) = if j < split {
@@ -616,12 +649,24 @@ fn build(
         b.finalize(module.target_config());
         return slots_used as usize;
     }
-    for (base, outputs) in [
-        (out0, &tape.outputs[..split]),
-        (out1, &tape.outputs[split..]),
+    for (base, outputs, filled) in [
+        (out0, &tape.outputs[..split], &filled[..split]),
+        (out1, &tape.outputs[split..], &filled[split..]),
     ] {
-        for (pair, chunk) in outputs.chunks(2).enumerate() {
+        for (pair, (chunk, filled)) in outputs.chunks(2).zip(filled.chunks(2)).enumerate() {
             let offset = (pair as i32) * 16;
+            // A pair half in a run of zeros: the other half alone.
+            match filled {
+                [true] | [true, true] => continue,
+                [false, true] | [true, false] => {
+                    let half = usize::from(filled[0]);
+                    let value = values.get(&mut b, tape, &arguments, chunk[half]);
+                    let at = offset + 8 * half as i32;
+                    b.ins().store(MemFlagsData::trusted(), value, base, at);
+                    continue;
+                }
+                _ => {}
+            }
             let first = values.get(&mut b, tape, &arguments, chunk[0]);
             match chunk.get(1) {
                 Some(&second) => {
@@ -639,6 +684,31 @@ fn build(
     b.ins().return_(&[]);
     b.finalize(module.target_config());
     slots_used as usize
+}
+
+/// The runs `[start, end)` of at least [`ZERO_RUN`] consecutive outputs of one buffer (the
+/// outputs before `split` or those after) that are the constant `+0.0` (a `-0.0` keeps its
+/// own store, its sign bit set).
+fn zero_runs(tape: &eomgen_symbolic::codegen::tape::Tape, split: usize) -> Vec<(usize, usize)> {
+    let zero = |j: usize| matches!(tape.instructions[tape.outputs[j] as usize], Instruction::Const(c) if c.to_bits() == 0);
+    let mut runs = Vec::new();
+    for (from, to) in [(0, split), (split, tape.outputs.len())] {
+        let mut j = from;
+        while j < to {
+            if !zero(j) {
+                j += 1;
+                continue;
+            }
+            let start = j;
+            while j < to && zero(j) {
+                j += 1;
+            }
+            if j - start >= ZERO_RUN {
+                runs.push((start, j));
+            }
+        }
+    }
+    runs
 }
 
 /// The values an instruction reads.

@@ -184,6 +184,8 @@ pub struct ConstraintWorkspace {
     mass: Vec<f64>,
     forcing: Vec<f64>,
     spd: Vec<f64>,
+    /// The envelope indices of `solve_spd_in_place` (`2n`).
+    envelope: Vec<usize>,
     /// `λ` of the last solve (length `m`).
     pub multipliers: Vec<f64>,
 }
@@ -210,6 +212,7 @@ impl ConstraintWorkspace {
             mass: vec![0.0; n * n],
             forcing: vec![0.0; n],
             spd: vec![0.0; n * n + 2 * n],
+            envelope: vec![0; 2 * n],
             multipliers: vec![0.0; m],
         }
     }
@@ -285,8 +288,14 @@ impl ConstraintWorkspace {
                     self.forcing[c] -= self.jacobian[i * n + c] * lambda;
                 }
             }
-            solve_spd_in_place(n, &self.mass, &mut self.forcing, &mut self.spd)
-                .ok_or(RhsError::SingularMassMatrix)?;
+            solve_spd_in_place(
+                n,
+                &self.mass,
+                &mut self.forcing,
+                &mut self.spd,
+                &mut self.envelope,
+            )
+            .ok_or(RhsError::SingularMassMatrix)?;
             qddot[..n].copy_from_slice(&self.forcing);
             return Ok(());
         }

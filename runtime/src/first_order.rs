@@ -272,6 +272,8 @@ pub struct DynFirstOrder<S> {
     mass: Vec<f64>,
     forcing: Vec<f64>,
     spd: Vec<f64>,
+    /// The envelope indices of `solve_spd_in_place` (`2n`).
+    envelope: Vec<usize>,
     zeros: Vec<f64>,
 }
 
@@ -291,6 +293,7 @@ impl<S: DynMechanicalSystem> DynFirstOrder<S> {
             mass: vec![0.0; n * n],
             forcing: vec![0.0; n],
             spd: vec![0.0; n * n + 2 * n],
+            envelope: vec![0; 2 * n],
             zeros: vec![0.0; n],
         }
     }
@@ -314,8 +317,14 @@ impl<S: DynMechanicalSystem> DynFirstOrder<S> {
         if self.constraints.is_empty() {
             self.system
                 .mass_matrix_and_forcing(q, qdot, t, &mut self.mass, &mut self.forcing);
-            solve_spd_in_place(n, &self.mass, &mut self.forcing, &mut self.spd)
-                .ok_or(RhsError::SingularMassMatrix)?;
+            solve_spd_in_place(
+                n,
+                &self.mass,
+                &mut self.forcing,
+                &mut self.spd,
+                &mut self.envelope,
+            )
+            .ok_or(RhsError::SingularMassMatrix)?;
             qddot[..n].copy_from_slice(&self.forcing);
         } else {
             self.constraints.accelerations_into(

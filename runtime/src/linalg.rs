@@ -22,6 +22,10 @@ use nalgebra::{SMatrix, SVector};
 /// numerators are formed while the one division runs, where the factorisation divides twice
 /// in sequence; an integration waits for each right-hand side before the next stage can
 /// start, and this shorter chain made a DOP853 run of the double pendulum ~4 % faster.
+///
+/// From [`ENVELOPE_FROM`] degrees of freedom on, the factorisation skips the zeros left of
+/// each row's first non-zero entry ([`solve_in_envelope`]): the same result (to the sign of
+/// zeros) in `O(n)` for a diagonal `M` instead of `O(n³)`.
 pub fn solve_spd<const N: usize>(
     m: &SMatrix<f64, N, N>,
     f: &SVector<f64, N>,
@@ -50,6 +54,20 @@ pub fn solve_spd<const N: usize>(
     let mut l = [[0.0f64; N]; N];
     let mut inv_d = [0.0f64; N];
     let mut d = [0.0f64; N];
+    if N >= ENVELOPE_FROM {
+        let mut x = *f;
+        let mut envelope = [[0usize; N]; 2];
+        return solve_in_envelope(
+            N,
+            |i, j| m[(i, j)],
+            x.as_mut_slice(),
+            l.as_flattened_mut(),
+            &mut d,
+            &mut inv_d,
+            envelope.as_flattened_mut(),
+        )
+        .map(|()| x);
+    }
     for j in 0..N {
         let mut dj = m[(j, j)];
         for k in 0..j {
@@ -89,7 +107,9 @@ pub fn solve_spd<const N: usize>(
 /// [`solve_spd`] for a size known at run time: solves `M x = f` in place (`f` becomes `x`)
 /// for a symmetric positive definite `M` (`n × n`, column-major, lower triangle read), with
 /// the same closed forms for `n = 1, 2` and the same `L D Lᵀ` factorisation in the same
-/// operation order, so the two agree to the bit; `work` holds at least `n² + 2n` values.
+/// operation order (within the envelope of `M` from [`ENVELOPE_FROM`] on, as `solve_spd`), so
+/// the two agree to the bit; `work` holds at least `n² + 2n` values and `envelope` `2n`
+/// indices (from [`ENVELOPE_FROM`] on; unused below).
 /// No heap allocation.
 ///
 /// `solve_spd` keeps its own copy with stack arrays and a compile-time `N`, which the
@@ -98,8 +118,15 @@ pub fn solve_spd<const N: usize>(
 /// Returns `None` when `M` is not positive definite (a pivot is not positive, or is NaN).
 ///
 /// # Panics
-/// If `mass` has fewer than `n²` entries, `f` fewer than `n` or `work` fewer than `n² + 2n`.
-pub fn solve_spd_in_place(n: usize, mass: &[f64], f: &mut [f64], work: &mut [f64]) -> Option<()> {
+/// If `mass` has fewer than `n²` entries, `f` fewer than `n`, `work` fewer than `n² + 2n` or,
+/// from [`ENVELOPE_FROM`] on, `envelope` fewer than `2n`.
+pub fn solve_spd_in_place(
+    n: usize,
+    mass: &[f64],
+    f: &mut [f64],
+    work: &mut [f64],
+    envelope: &mut [usize],
+) -> Option<()> {
     let m = |i: usize, j: usize| mass[i + j * n];
     match n {
         1 => {
@@ -128,6 +155,9 @@ pub fn solve_spd_in_place(n: usize, mass: &[f64], f: &mut [f64], work: &mut [f64
     }
     let (l, rest) = work.split_at_mut(n * n);
     let (d, inv_d) = rest.split_at_mut(n);
+    if n >= ENVELOPE_FROM {
+        return solve_in_envelope(n, m, f, l, d, inv_d, envelope);
+    }
     // `l[i][k]` of `solve_spd` is `l[i * n + k]`.
     for j in 0..n {
         let mut dj = m(j, j);
@@ -159,6 +189,101 @@ pub fn solve_spd_in_place(n: usize, mass: &[f64], f: &mut [f64], work: &mut [f64
     for i in (0..n).rev() {
         for k in i + 1..n {
             f[i] -= l[k * n + i] * f[k];
+        }
+    }
+    Some(())
+}
+
+/// The size from which [`solve_spd`] and [`solve_spd_in_place`] factorise within the envelope
+/// of `M` ([`solve_in_envelope`]); smaller systems take every row whole, which the compiler
+/// unrolls for the compiled models' hot path.
+pub const ENVELOPE_FROM: usize = 9;
+
+/// The `L D Lᵀ` solve of [`solve_spd`] restricted to the envelope of `M`: row `i` of `L` starts
+/// at the first non-zero entry `fᵢ` of row `i` of `M` (a NaN counts as non-zero), since `L`
+/// has no fill-in left of it (Golub & Van Loan, *Matrix Computations*, 4th ed., §4.3.5, on
+/// the profile of a Cholesky factor). Inside the envelope the operations are the dense ones in
+/// the same order, and every term left out is a product with an exact zero of `L`, so the
+/// result is the dense factorisation's up to the sign of zeros, and a dense `M` gives it to
+/// the bit. A diagonal `M` (a chain of point masses) is solved in `O(n)` after the `O(n²)`
+/// scan for the envelope, a banded one in `O(n b²)`, where the dense solve takes `n³/6`
+/// multiply–adds: 1.7 × 10⁸ per right-hand side for a chain of 1000 masses.
+///
+/// `m(i, j)` is entry `(i, j)` of `M` (lower triangle read); `l` holds `n²` values
+/// (row-major), `d` and `inv_d` `n` each, `envelope` `2n` (each row's `fᵢ`, then each
+/// column's last row in the envelope); `f` becomes `x`. `None` when a pivot is
+/// not positive or is NaN.
+#[inline]
+fn solve_in_envelope(
+    n: usize,
+    m: impl Fn(usize, usize) -> f64,
+    f: &mut [f64],
+    l: &mut [f64],
+    d: &mut [f64],
+    inv_d: &mut [f64],
+    envelope: &mut [usize],
+) -> Option<()> {
+    let (first, reach) = envelope.split_at_mut(n);
+    // fᵢ, found column by column (contiguous in a column-major `M`): the first column whose
+    // entry is non-zero; a row with none starts at its diagonal.
+    for (i, fi) in first.iter_mut().enumerate().take(n) {
+        *fi = i;
+    }
+    for j in 0..n {
+        for (i, fi) in first.iter_mut().enumerate().skip(j + 1) {
+            if *fi == i && m(i, j) != 0.0 {
+                *fi = j;
+            }
+        }
+    }
+    // reachⱼ = the last row `i` with `fᵢ ≤ j` (at least `j`): the rows below it have no entry
+    // in column `j` of `L`, so the loops over a column stop there.
+    for (j, r) in reach.iter_mut().enumerate().take(n) {
+        *r = j;
+    }
+    for i in 0..n {
+        reach[first[i]] = reach[first[i]].max(i);
+    }
+    for j in 1..n {
+        reach[j] = reach[j].max(reach[j - 1]);
+    }
+    for j in 0..n {
+        let fj = first[j];
+        let mut dj = m(j, j);
+        for k in fj..j {
+            dj -= l[j * n + k] * l[j * n + k] * d[k];
+        }
+        // Not positive, or NaN.
+        if dj.is_nan() || dj <= 0.0 {
+            return None;
+        }
+        d[j] = dj;
+        inv_d[j] = 1.0 / dj;
+        for i in j + 1..=reach[j] {
+            let fi = first[i];
+            if fi > j {
+                continue;
+            }
+            let mut v = m(i, j);
+            for k in fi.max(fj)..j {
+                v -= l[i * n + k] * l[j * n + k] * d[k];
+            }
+            l[i * n + j] = v * inv_d[j];
+        }
+    }
+    for i in 0..n {
+        for k in first[i]..i {
+            f[i] -= l[i * n + k] * f[k];
+        }
+    }
+    for i in 0..n {
+        f[i] *= inv_d[i];
+    }
+    for i in (0..n).rev() {
+        for k in i + 1..=reach[i] {
+            if first[k] <= i {
+                f[i] -= l[k * n + i] * f[k];
+            }
         }
     }
     Some(())
@@ -237,5 +362,115 @@ mod tests {
         let mut nan = m;
         nan[(1, 1)] = f64::NAN;
         assert_eq!(solve_spd(&nan, &f), None);
+    }
+
+    /// The `L D Lᵀ` solve taking every row whole (the factorisation below
+    /// [`ENVELOPE_FROM`]), written out for any size: the reference the envelope must match.
+    fn dense_ldlt(n: usize, m: &[f64], f: &[f64]) -> Option<Vec<f64>> {
+        let mut l = vec![0.0; n * n];
+        let (mut d, mut x) = (vec![0.0; n], f.to_vec());
+        for j in 0..n {
+            let mut dj = m[j + j * n];
+            for k in 0..j {
+                dj -= l[j * n + k] * l[j * n + k] * d[k];
+            }
+            if dj.is_nan() || dj <= 0.0 {
+                return None;
+            }
+            d[j] = dj;
+            let inv = 1.0 / dj;
+            for i in j + 1..n {
+                let mut v = m[i + j * n];
+                for k in 0..j {
+                    v -= l[i * n + k] * l[j * n + k] * d[k];
+                }
+                l[i * n + j] = v * inv;
+            }
+        }
+        for i in 0..n {
+            for k in 0..i {
+                x[i] -= l[i * n + k] * x[k];
+            }
+        }
+        for i in 0..n {
+            x[i] *= 1.0 / d[i];
+        }
+        for i in (0..n).rev() {
+            for k in i + 1..n {
+                x[i] -= l[k * n + i] * x[k];
+            }
+        }
+        Some(x)
+    }
+
+    /// From [`ENVELOPE_FROM`] on, the solve skips the zeros left of each row's first entry:
+    /// on a dense, a banded (bandwidth 2, with a full last row and column, which fills the
+    /// whole bottom row), a block-diagonal and a diagonal `M` of sizes 9–40 its result equals
+    /// the dense factorisation's to the bit (the skipped terms are exact zeros), the
+    /// compile-time and run-time entry points agree to the bit, and the residual is at
+    /// rounding level (1e-12 relative; the matrices are diagonally dominant, κ < 10).
+    /// Indefinite and NaN matrices are refused as before.
+    #[test]
+    fn the_envelope_solve_is_the_dense_one_on_sparse_and_dense_matrices() {
+        // Whether entry (i, j) of an n × n matrix is in the pattern.
+        type Pattern = fn(usize, usize, usize) -> bool;
+        let shapes: [(&str, Pattern); 4] = [
+            ("dense", |_, _, _| true),
+            ("banded", |i, j, n| {
+                i.abs_diff(j) <= 2 || i == n - 1 || j == n - 1
+            }),
+            ("blocks", |i, j, _| i / 5 == j / 5),
+            ("diagonal", |i, j, _| i == j),
+        ];
+        for n in [ENVELOPE_FROM, 12, 40] {
+            for (name, shape) in shapes {
+                // Symmetric entries in (−1, 1) on the pattern, diagonal n + 1: dominant.
+                let mut m = vec![0.0; n * n];
+                for i in 0..n {
+                    for j in 0..=i {
+                        if shape(i, j, n) {
+                            let v = if i == j {
+                                n as f64 + 1.0
+                            } else {
+                                ((i * 7 + j * 3) % 11) as f64 / 11.0 - 0.45
+                            };
+                            m[i + j * n] = v;
+                            m[j + i * n] = v;
+                        }
+                    }
+                }
+                let f: Vec<f64> = (0..n).map(|i| (i as f64 * 0.37).sin()).collect();
+                let expected = dense_ldlt(n, &m, &f).unwrap();
+                let mut x = f.clone();
+                let mut work = vec![0.0; n * n + 2 * n];
+                let mut envelope = vec![0; 2 * n];
+                solve_spd_in_place(n, &m, &mut x, &mut work, &mut envelope).unwrap();
+                for (a, b) in x.iter().zip(&expected) {
+                    assert_eq!(a.to_bits(), b.to_bits(), "{name} {n}: {x:?} {expected:?}");
+                }
+                for i in 0..n {
+                    let r: f64 = (0..n).map(|j| m[i + j * n] * x[j]).sum::<f64>() - f[i];
+                    assert!(r.abs() < 1e-12 * (n as f64), "{name} {n}: residual {r}");
+                }
+                if n == 12 {
+                    let sm = nalgebra::SMatrix::<f64, 12, 12>::from_column_slice(&m);
+                    let sf = nalgebra::SVector::<f64, 12>::from_column_slice(&f);
+                    let sx = solve_spd(&sm, &sf).unwrap();
+                    assert!(sx.iter().zip(&x).all(|(a, b)| a.to_bits() == b.to_bits()));
+                }
+                let mut indefinite = m.clone();
+                indefinite[(n - 1) + (n - 1) * n] = -1.0;
+                let mut nan = m.clone();
+                nan[(n - 1) + (n / 2) * n] = f64::NAN;
+                for bad in [indefinite, nan] {
+                    let mut x = f.clone();
+                    assert_eq!(
+                        solve_spd_in_place(n, &bad, &mut x, &mut work, &mut envelope),
+                        None,
+                        "{name} {n}"
+                    );
+                }
+            }
+        }
     }
 }

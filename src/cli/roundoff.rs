@@ -21,7 +21,7 @@ use super::{CliError, plot};
 #[derive(Debug, Args)]
 pub struct EulerRoundoffArgs {
     /// Largest n: steps h = 10⁻ⁿ for n = 0 … N, so 10ᴺ steps per method at the end
-    /// (at most 10; 7 takes about 3 s, 8 about 25 s in a release build).
+    /// (at most 8; 7 takes about 3 s, 8 about 30 s in a release build).
     #[arg(long, default_value_t = 7)]
     pub max_n: u32,
     /// Print JSON instead of the table.

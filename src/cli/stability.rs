@@ -61,8 +61,8 @@ pub struct StabilityArgs {
 /// A study that could not run, as the CLI reports it (naming the options to change).
 fn study_error(error: StabilityError) -> CliError {
     match error {
-        StabilityError::InvalidSteps { .. } => CliError::usage("--steps must be in [100, 10⁷]"),
-        StabilityError::InvalidPeriods { .. } => CliError::usage("--periods must be in [1, 10⁶]"),
+        StabilityError::InvalidSteps { .. } => CliError::usage("--steps must be in [100, 10⁶]"),
+        StabilityError::InvalidPeriods { .. } => CliError::usage("--periods must be in [1, 10⁵]"),
         StabilityError::InvalidStiffness => {
             CliError::usage("--stiffness takes ratios k/m in (0, 1e10], comma separated")
         }

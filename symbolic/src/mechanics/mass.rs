@@ -33,20 +33,35 @@ fn largest_diagonal(m: &[f64], n: usize) -> f64 {
 /// `L D Lᵀ` factorisation above `1e-12` of `reference`, or of its largest diagonal entry if
 /// that is larger. A reference measured elsewhere (the size of `M` at other states) finds a
 /// matrix that is small as a whole, as a 1 × 1 `M` near a singular configuration.
+///
+/// The factorisation works within the envelope of `m` (row `i` from its first non-zero entry
+/// on): `L` has no entry left of it, so the terms left out are zeros, and the pivots are those
+/// of the dense factorisation. A banded or diagonal `M` (a chain of masses) then costs `O(n)`
+/// to `O(n b²)` instead of `n³/6`.
 fn positive_definite(m: &[f64], n: usize, reference: f64) -> bool {
     // A zero, infinite or NaN scale fails every pivot below (`dj <= 0`, `dj <= ∞`, NaN).
     let scale = largest_diagonal(m, n).max(reference);
+    // The first column of each row's envelope (a NaN counts as non-zero).
+    let first: Vec<usize> = (0..n)
+        .map(|i| (0..i).find(|&j| m[i * n + j] != 0.0).unwrap_or(i))
+        .collect();
     let mut l = vec![0.0f64; n * n];
     let mut d = vec![0.0f64; n];
     for j in 0..n {
-        let dj = m[j * n + j] - (0..j).map(|k| l[j * n + k].powi(2) * d[k]).sum::<f64>();
+        let dj = m[j * n + j]
+            - (first[j]..j)
+                .map(|k| l[j * n + k].powi(2) * d[k])
+                .sum::<f64>();
         if dj.is_nan() || dj <= 1e-12 * scale {
             return false;
         }
         d[j] = dj;
         for i in j + 1..n {
+            if first[i] > j {
+                continue;
+            }
             let v = m[i * n + j]
-                - (0..j)
+                - (first[i].max(first[j])..j)
                     .map(|k| l[i * n + k] * l[j * n + k] * d[k])
                     .sum::<f64>();
             l[i * n + j] = v / dj;
@@ -262,5 +277,70 @@ mod tests {
         // Against a reference: 1e-13 of it is singular, 1e-11 is not.
         assert!(!positive_definite(&[1e-13], 1, 1.0));
         assert!(positive_definite(&[1e-11], 1, 1.0));
+    }
+
+    /// The factorisation within the envelope decides as the dense one does: on random
+    /// symmetric 12 × 12 matrices, banded (bandwidth 2) and block-diagonal, diagonally
+    /// shifted so that about half are positive definite, against a dense `L D Lᵀ` with the
+    /// same pivot bound (matrices within 1e-6 of the bound left out).
+    #[test]
+    fn the_envelope_decides_as_the_dense_factorisation() {
+        let n = 12;
+        let dense = |m: &[f64]| -> f64 {
+            let scale = largest_diagonal(m, n);
+            let mut l = vec![0.0f64; n * n];
+            let mut d = vec![0.0f64; n];
+            let mut smallest = f64::INFINITY;
+            for j in 0..n {
+                let dj = m[j * n + j] - (0..j).map(|k| l[j * n + k].powi(2) * d[k]).sum::<f64>();
+                smallest = smallest.min(dj / scale);
+                if dj <= 1e-12 * scale {
+                    return smallest;
+                }
+                d[j] = dj;
+                for i in j + 1..n {
+                    let v = m[i * n + j]
+                        - (0..j)
+                            .map(|k| l[i * n + k] * l[j * n + k] * d[k])
+                            .sum::<f64>();
+                    l[i * n + j] = v / dj;
+                }
+            }
+            smallest
+        };
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(12);
+        let (mut yes, mut no) = (0, 0);
+        for case in 0..2000 {
+            let pattern = |i: usize, j: usize| {
+                if case % 2 == 0 {
+                    i.abs_diff(j) <= 2
+                } else {
+                    i / 4 == j / 4
+                }
+            };
+            let mut m = vec![0.0; n * n];
+            for i in 0..n {
+                for j in 0..=i {
+                    if pattern(i, j) {
+                        let v = rng.random_range(-1.0..1.0);
+                        m[i * n + j] = v;
+                        m[j * n + i] = v;
+                    }
+                }
+                m[i * n + i] += rng.random_range(0.0..4.0);
+            }
+            let smallest = dense(&m);
+            if (smallest - 1e-12).abs() < 1e-6 {
+                continue;
+            }
+            let expected = smallest > 1e-12;
+            assert_eq!(positive_definite(&m, n, 0.0), expected, "{m:?}");
+            if expected {
+                yes += 1;
+            } else {
+                no += 1;
+            }
+        }
+        assert!(yes > 100 && no > 100, "{yes} {no}");
     }
 }

@@ -260,14 +260,14 @@ impl BodySums {
     }
 }
 
-/// The bodies grouped by the key `key(b)` (skipping `None`), groups in order of first
-/// appearance, bodies in index order.
+/// The bodies of `candidates` (in index order) grouped by the key `key(b)` (skipping
+/// `None`), groups in order of first appearance, bodies in index order.
 fn group_bodies<K: PartialEq>(
-    count: usize,
+    candidates: &[usize],
     key: impl Fn(usize) -> Option<K>,
 ) -> Vec<(K, Vec<usize>)> {
     let mut groups: Vec<(K, Vec<usize>)> = Vec::new();
-    for b in 0..count {
+    for &b in candidates {
         let Some(k) = key(b) else { continue };
         match groups.iter_mut().find(|(g, _)| *g == k) {
             Some((_, members)) => members.push(b),
@@ -305,8 +305,19 @@ impl Formulation for MomentumBalance {
         // so that each is built from the largest subset already summed. (In the order of the
         // coordinates, the bars below joint 1 would come first, and with no subset yet
         // summed every set would be summed from scratch: `O(n³)` terms for a chain.)
+        // The bodies that move with each coordinate (a non-zero partial velocity), in index
+        // order: a pair of coordinates is projected over the shorter of their two lists, so a
+        // chain of masses that each move with one coordinate costs `O(n²)`, not
+        // `O(n² × bodies)` (2.3 s for 1000 masses).
+        let moving: Vec<Vec<usize>> = (0..n)
+            .map(|i| {
+                (0..bodies.len())
+                    .filter(|&b| partials[b][i].is_some())
+                    .collect()
+            })
+            .collect();
         let mut sets: Vec<Vec<usize>> = Vec::new();
-        for groups in (0..n).map(|i| group_bodies(bodies.len(), |b| partials[b][i])) {
+        for groups in (0..n).map(|i| group_bodies(&moving[i], |b| partials[b][i])) {
             for (_, set) in groups {
                 if !sets.contains(&set) {
                     sets.push(set);
@@ -325,8 +336,12 @@ impl Formulation for MomentumBalance {
         let mut forcing_terms: Vec<Vec<ExprId>> = vec![Vec::new(); n];
         for i in 0..n {
             for j in i..n {
-                let groups =
-                    group_bodies(bodies.len(), |b| Some((partials[b][i]?, partials[b][j]?)));
+                let shorter = if moving[i].len() <= moving[j].len() {
+                    &moving[i]
+                } else {
+                    &moving[j]
+                };
+                let groups = group_bodies(shorter, |b| Some((partials[b][i]?, partials[b][j]?)));
                 for ((vi, vj), set) in groups {
                     let mass = sums.mass(arena, &bodies, &set);
                     let d = kinematics.partial_dot(arena, vi, vj);
@@ -334,7 +349,7 @@ impl Formulation for MomentumBalance {
                 }
             }
             // (Σ m g − Σ m a₀)·∂r/∂qᵢ
-            for (v, set) in group_bodies(bodies.len(), |b| partials[b][i]) {
+            for (v, set) in group_bodies(&moving[i], |b| partials[b][i]) {
                 let r = kinematics.vector(v).to_vec();
                 let w = sums.weighted_acceleration(arena, &mut kinematics, &bodies, &set);
                 let inertial = dot_multiplied_out(arena, &w, &r);

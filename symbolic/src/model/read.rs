@@ -11,7 +11,7 @@ use std::path::Path;
 use super::diagnostic::Diagnostic;
 
 /// The largest model file read, in bytes (4 MiB). The largest generated models are far
-/// below it: `eomgen new n-link-pendulum 200` is 1.6 MB and `eomgen new n-mass-chain 1000`
+/// below it: `eomgen new n-link-pendulum 100` is 0.4 MB and `eomgen new n-mass-chain 1000`
 /// 0.15 MB (`templates::MAX_SIZES`); a hand-written model is a few kB.
 pub const MAX_FILE_BYTES: u64 = 4 * 1024 * 1024;
 

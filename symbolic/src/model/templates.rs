@@ -6,12 +6,16 @@ use std::fmt::Write as _;
 /// The template names `eomgen new` accepts.
 pub const TEMPLATES: &[&str] = &["n-link-pendulum", "n-mass-chain"];
 
-/// The largest size each template is generated for, in [`TEMPLATES`] order. The `n`-link
-/// pendulum writes every point's position out in full, so its file grows as `n²` (200 links:
-/// 1.7 MB, and its longest expression, a chain of 200 terms, is far below
-/// [`MAX_TREE_HEIGHT`](super::parser::MAX_TREE_HEIGHT)); a 100-link pendulum already takes
-/// seconds to derive. The mass chain's file grows as `n`, and loading it as `n²` for now.
-pub const MAX_SIZES: [usize; 2] = [200, 1_000];
+/// The largest size each template is generated for, in [`TEMPLATES`] order: the sizes that
+/// load, check and simulate within seconds in a release build (docs/performance.md).
+///
+/// The `n`-link pendulum writes every point's position out in full, so its file grows as `n²`
+/// (100 links: 400 kB), and its equations as `n³` (each of the `n²` entries of `M` sums over
+/// the bars below both joints): at 100 links `eomgen check` takes ~3 s of CPU time and a
+/// first simulation ~5 s; at 200 links (1.6 MB) ~30 s and ~40 s, which is why the limit,
+/// once 200, is 100. The mass chain's file and equations grow as `n` (its `M` is diagonal,
+/// and every quadratic pass over it has been taken out): 1000 masses check in ~3 s.
+pub const MAX_SIZES: [usize; 2] = [100, 1_000];
 
 /// Why [`generate`] wrote no file.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
