@@ -596,3 +596,32 @@ fn issue_28_expressions_starting_with_a_short_option_letter_reach_the_option() {
     }
     assert!(!std::path::Path::new("unwritten.html").exists());
 }
+
+/// Issue 28, after review: `study floquet --tol 0.05` left no stability tolerance in
+/// `[√tol, 0.1]` and was refused naming `--stability-tolerance`, an option not given; a
+/// looser `--tol` than 1e-12 refused the default stability tolerance; a Baumgarte gain of
+/// 1e200 overflowed `β² Φ` into a NaN blamed on the model. Each is now a usage error naming
+/// the option given, and `--tol 1e-6` runs with the stability tolerance √tol = 1e-3.
+#[test]
+fn issue_28_floquet_tolerance_and_baumgarte_gain_ranges() {
+    let out = eomgen(&["study", "floquet", "mathieu_pendulum", "--tol", "0.05"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(stderr(&out).contains("'--tol <TOL>'"), "{}", stderr(&out));
+    let out = eomgen(&["study", "floquet", "mathieu_pendulum", "--tol", "1e-6"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(
+        String::from_utf8_lossy(&out.stdout).contains("(tolerance 0.001 on |μ| = 1)"),
+        "{}",
+        String::from_utf8_lossy(&out.stdout)
+    );
+    let out = eomgen(&[
+        "simulate",
+        "simple_pendulum_cartesian",
+        "--stabilization",
+        "baumgarte",
+        "--baumgarte",
+        "10,1e200",
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(stderr(&out).contains("[0, 1e6]"), "{}", stderr(&out));
+}

@@ -113,7 +113,7 @@ pub enum StabilizationError {
     /// run), and a non-finite gain makes `γ̃` NaN; `β` enters squared, and is taken ≥ 0 as
     /// Baumgarte writes it.
     #[error(
-        "Baumgarte's gains must be finite and ≥ 0 (1/s; Φ̈ + 2α Φ̇ + β² Φ = 0, where a negative α makes the drift grow), got α = {alpha}, β = {beta}"
+        "Baumgarte's gains must be in [0, 1e6] (1/s; Φ̈ + 2α Φ̇ + β² Φ = 0, where a negative α makes the drift grow and β² overflows past 1e154), got α = {alpha}, β = {beta}"
     )]
     InvalidBaumgarteGains {
         /// The damping gain `α` given (1/s).
@@ -134,9 +134,13 @@ pub enum StabilizationError {
     },
 }
 
+/// The largest Baumgarte gain `α` or `β` (1/s): a drift time constant of a microsecond, far
+/// below any step a run takes; beyond ~1e154, `β² Φ` overflows.
+pub const MAX_BAUMGARTE_GAIN: f64 = 1e6;
+
 impl Stabilization {
-    /// Checks the gains: Baumgarte's `α`, `β` finite and ≥ 0; the penalty's stiffness finite
-    /// and positive, its damping finite and ≥ 0.
+    /// Checks the gains: Baumgarte's `α`, `β` in `[0, MAX_BAUMGARTE_GAIN]` (1/s); the
+    /// penalty's stiffness finite and positive, its damping finite and ≥ 0.
     ///
     /// # Errors
     /// [`StabilizationError::InvalidBaumgarteGains`], [`StabilizationError::InvalidPenalty`].
@@ -148,11 +152,13 @@ impl Stabilization {
     /// assert!(Stabilization::Baumgarte { alpha: 0.0, beta: 0.0 }.validate().is_ok());
     /// assert!(Stabilization::Baumgarte { alpha: -10.0, beta: 10.0 }.validate().is_err());
     /// assert!(Stabilization::Baumgarte { alpha: f64::NAN, beta: 1.0 }.validate().is_err());
+    /// assert!(Stabilization::Baumgarte { alpha: 10.0, beta: 1e200 }.validate().is_err());
     /// ```
     pub fn validate(self) -> Result<(), StabilizationError> {
         let gain = |x: f64| x.is_finite() && x >= 0.0;
+        let baumgarte = |x: f64| (0.0..=MAX_BAUMGARTE_GAIN).contains(&x);
         match self {
-            Stabilization::Baumgarte { alpha, beta } if !(gain(alpha) && gain(beta)) => {
+            Stabilization::Baumgarte { alpha, beta } if !(baumgarte(alpha) && baumgarte(beta)) => {
                 Err(StabilizationError::InvalidBaumgarteGains { alpha, beta })
             }
             Stabilization::Penalty { stiffness, damping }

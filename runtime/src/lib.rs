@@ -23,7 +23,8 @@ pub mod vibration;
 
 pub use analysis::{Method, UnknownMethod};
 pub use constrained::{
-    ConstraintFunctions, ConstraintWorkspace, ProjectionError, Stabilization, StabilizationError,
+    ConstraintFunctions, ConstraintWorkspace, MAX_BAUMGARTE_GAIN, ProjectionError, Stabilization,
+    StabilizationError,
 };
 pub use dynamic::{DynMechanicalSystem, StaticSystem};
 pub use first_order::{DynFirstOrder, FirstOrder};

@@ -54,8 +54,9 @@ pub struct FloquetArgs {
     /// supports).
     #[arg(long)]
     pub stability_tolerance: Option<f64>,
-    /// Relative and absolute tolerance of DOP853 on the state and the variational equations.
-    #[arg(long, default_value_t = 1e-12, value_parser = super::values::relative_tolerance, allow_hyphen_values = true)]
+    /// Relative and absolute tolerance of DOP853 on the state and the variational equations,
+    /// in (0, 1e-4].
+    #[arg(long, default_value_t = 1e-12, value_parser = super::values::floquet_tolerance, allow_hyphen_values = true)]
     pub tol: f64,
     /// Print JSON.
     #[arg(long)]

@@ -75,8 +75,19 @@ pub fn absolute_tolerance(text: &str) -> Result<f64, String> {
 pub fn baumgarte_gain(text: &str) -> Result<f64, String> {
     number(
         text,
-        |v| v.is_finite() && v >= 0.0,
-        "a Baumgarte gain must be a finite number >= 0 (1/s), such as 10",
+        |v| (0.0..=eomgen::MAX_BAUMGARTE_GAIN).contains(&v),
+        "a Baumgarte gain must be a number in [0, 1e6] (1/s), such as 10",
+    )
+}
+
+/// Parses the integration tolerance of `study floquet` (`--tol`): in (0, 1e-4], since the
+/// stability tolerance on |μ| = 1 must be at least √tol and at most 0.1 (below 1e-4 that
+/// leaves a range of at least 1e-2 to 0.1).
+pub fn floquet_tolerance(text: &str) -> Result<f64, String> {
+    number(
+        text,
+        |v| v > 0.0 && v <= 1e-4,
+        "the tolerance of study floquet must be in (0, 1e-4]: the verdict's tolerance on |μ| = 1 is at least √tol and at most 0.1",
     )
 }
 

@@ -139,15 +139,24 @@ const SINGULAR_RATIO: f64 = 1e-10;
 /// a negative upper mass stopped at 3.8e-9, from 0.5 at the start).
 const DROP: f64 = 1e-6;
 
-/// `M`'s smallest eigenvalue over its largest magnitude at `(t, y)` (`-∞` when `M` is not
-/// finite), for `y = [q; q̇]`.
+/// The smallest eigenvalue of `M` scaled to a unit diagonal, `D^-½ M D^-½` with
+/// `D = diag |Mᵢᵢ|`, over its largest magnitude at `(t, y)` (`-∞` when `M` is not finite or a
+/// diagonal entry is 0 or negative), for `y = [q; q̇]`. The scaling makes the ratio
+/// independent of the coordinates' units (a mass in kg beside an inertia in kg·m² of 1e-11).
 fn eigenvalue_ratio(model: &dyn ModelInfo, t: f64, y: &[f64]) -> f64 {
     let (m, _) = model.mass_matrix_and_forcing(t, y);
     if m.iter().any(|v| !v.is_finite()) {
         return f64::NEG_INFINITY;
     }
-    let symmetric = (&m + m.transpose()) * 0.5;
-    let eigenvalues = SymmetricEigen::new(symmetric).eigenvalues;
+    let n = m.nrows();
+    let diagonal: Vec<f64> = (0..n).map(|i| m[(i, i)]).collect();
+    if diagonal.iter().any(|d| *d <= 0.0) {
+        return f64::NEG_INFINITY;
+    }
+    let scaled = DMatrix::from_fn(n, n, |i, j| {
+        0.5 * (m[(i, j)] + m[(j, i)]) / (diagonal[i] * diagonal[j]).sqrt()
+    });
+    let eigenvalues = SymmetricEigen::new(scaled).eigenvalues;
     let largest = eigenvalues.iter().fold(0.0_f64, |a, v| a.max(v.abs()));
     let smallest = eigenvalues.iter().fold(f64::INFINITY, |a, &v| a.min(v));
     if largest == 0.0 {
@@ -188,6 +197,10 @@ pub fn failure_cause(
         .map(|s| s.to_string())
         .zip(model.parameter_values())
         .collect();
+    // A run out of steps stopped for its settings, not at a configuration.
+    if matches!(error, IntegrationError::TooManySteps { .. }) {
+        return None;
+    }
     let ratio = eigenvalue_ratio(model, t, y);
     let start_ratio = eigenvalue_ratio(model, 0.0, y0);
     // Singular: below an absolute floor, or a millionfold below its value at the start (a
@@ -205,9 +218,19 @@ pub fn failure_cause(
         let regular_somewhere = std::iter::once(start_ratio)
             .chain(elsewhere)
             .any(|r| !singular(r) && r > ratio / DROP);
+        // A negative parameter is a suspect only if M is regular there with its sign turned
+        // (a negative offset or a gravity of -9.81 is not a negative mass).
         let negative: Vec<(String, f64)> = parameters
             .iter()
             .filter(|(_, v)| *v < 0.0)
+            .filter(|(name, value)| {
+                if model.set_parameter(name, -value).is_err() {
+                    return false;
+                }
+                let flipped = eigenvalue_ratio(model, t, y);
+                let _ = model.set_parameter(name, *value);
+                !singular(flipped) && flipped > ratio / DROP
+            })
             .cloned()
             .collect();
         return Some(if !regular_somewhere {
