@@ -24,7 +24,7 @@ use nalgebra::{SMatrix, SVector};
 /// start, and this shorter chain made a DOP853 run of the double pendulum ~4 % faster.
 ///
 /// From [`ENVELOPE_FROM`] degrees of freedom on, the factorisation skips the zeros left of
-/// each row's first non-zero entry ([`solve_in_envelope`]): the same result (to the sign of
+/// each row's first non-zero entry (`solve_in_envelope`): the same result (to the sign of
 /// zeros) in `O(n)` for a diagonal `M` instead of `O(n³)`.
 pub fn solve_spd<const N: usize>(
     m: &SMatrix<f64, N, N>,
@@ -195,7 +195,7 @@ pub fn solve_spd_in_place(
 }
 
 /// The size from which [`solve_spd`] and [`solve_spd_in_place`] factorise within the envelope
-/// of `M` ([`solve_in_envelope`]); smaller systems take every row whole, which the compiler
+/// of `M` (`solve_in_envelope`); smaller systems take every row whole, which the compiler
 /// unrolls for the compiled models' hot path.
 pub const ENVELOPE_FROM: usize = 9;
 

@@ -101,9 +101,9 @@ impl ModalAnalysis {
 /// # Errors
 /// [`OperatingPointError::UnknownEquilibrium`]; [`OperatingPointError::Modal`] when the
 /// equilibrium search, the linearisation (constraints violated, singular or non-finite
-/// matrices, [`ModalError::DegenerateCoordinates`](crate::ModalError::DegenerateCoordinates))
+/// matrices, [`ModalError::DegenerateCoordinates`])
 /// or the eigenproblems fail, or with
-/// [`ModalError::TimeDependent`](crate::ModalError::TimeDependent) for time-dependent
+/// [`ModalError::TimeDependent`] for time-dependent
 /// coefficients or constraints.
 ///
 /// # Examples
