@@ -43,9 +43,7 @@ impl RunTally {
 
 /// A study that measured nothing: every one of its runs failed (or it had none).
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error(
-    "{study}: every run failed ({failed} of {failed}), so nothing was measured; the first failed: {first_failure}"
-)]
+#[error("{}", self.message())]
 pub struct NothingMeasured {
     /// The study (`work-precision`).
     pub study: &'static str,
@@ -53,6 +51,21 @@ pub struct NothingMeasured {
     pub failed: usize,
     /// Why the first failed (`no run` when there was none).
     pub first_failure: String,
+}
+
+impl NothingMeasured {
+    /// `study: every run failed (k of k), …; the first failed: …`, or, without runs,
+    /// `study: no run was made, so nothing was measured`.
+    fn message(&self) -> String {
+        if self.failed == 0 {
+            format!("{}: no run was made, so nothing was measured", self.study)
+        } else {
+            format!(
+                "{}: every run failed ({} of {}), so nothing was measured; the first failed: {}",
+                self.study, self.failed, self.failed, self.first_failure
+            )
+        }
+    }
 }
 
 /// The report of a study made of runs, each of which measured something or failed.
@@ -86,7 +99,8 @@ pub trait StudyRuns {
     /// assert!(Runs(vec![Err("diverged".into()), Ok(1e-6)]).check_measured().is_ok());
     /// let none = Runs(vec![Err("diverged".into()), Err("underflow".into())]).check_measured();
     /// assert_eq!(none.unwrap_err().first_failure, "diverged");
-    /// assert!(Runs(vec![]).check_measured().is_err());
+    /// let empty = Runs(vec![]).check_measured().unwrap_err();
+    /// assert_eq!(empty.to_string(), "example: no run was made, so nothing was measured");
     /// ```
     fn check_measured(&self) -> Result<(), NothingMeasured> {
         let tally = self.tally();
