@@ -9,6 +9,16 @@ fn stderr(out: &std::process::Output) -> String {
     String::from_utf8_lossy(&out.stderr).into_owned()
 }
 
+/// Runs `eomgen args`, which must be a usage error (status 2) whose message contains `says`;
+/// returns its standard error.
+fn usage_error(args: &[&str], says: &str) -> String {
+    let out = eomgen(args);
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+    assert!(err.contains(says), "{args:?}: {err}");
+    err
+}
+
 /// Relative tolerances of 1 or more, and negative ones written after a space (which clap
 /// used to take for an unknown option), are usage errors in every command that takes one.
 #[test]
@@ -381,10 +391,7 @@ fn issue_28_out_of_range_options_are_usage_errors() {
         ),
     ];
     for (args, says) in cases {
-        let out = eomgen(args);
-        let err = stderr(&out);
-        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
-        assert!(err.contains(says), "{args:?}: {err}");
+        usage_error(args, says);
     }
     assert!(!std::path::Path::new("unwritten.html").exists());
 }
@@ -437,10 +444,7 @@ fn issue_28_values_starting_with_a_minus_reach_the_checks_and_numbers_print_shor
         ),
     ];
     for (args, says) in cases {
-        let out = eomgen(args);
-        let err = stderr(&out);
-        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
-        assert!(err.contains(says), "{args:?}: {err}");
+        let err = usage_error(args, says);
         assert!(!err.contains("unexpected argument"), "{args:?}: {err}");
         assert!(!err.contains("000000000000"), "{args:?}: {err}");
     }
@@ -591,10 +595,7 @@ fn issue_28_expressions_starting_with_a_short_option_letter_reach_the_option() {
         ),
     ];
     for (args, says) in cases {
-        let out = eomgen(args);
-        let err = stderr(&out);
-        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
-        assert!(err.contains(says), "{args:?}: {err}");
+        usage_error(args, says);
     }
     assert!(!std::path::Path::new("unwritten.html").exists());
 }
