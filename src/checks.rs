@@ -345,7 +345,7 @@ fn state_value(
     t: f64,
     y: &[f64],
 ) -> Result<f64, String> {
-    let coordinates = model.coordinate_names();
+    let coordinates = model.description().coordinate_names();
     let n = coordinates.len();
     eval_expr(e, &|name| {
         if name == "t" {
@@ -465,7 +465,7 @@ pub fn motion_checks(
 
     // Generic: energy conservation (conservative models, or where the file asks for it).
     let energy = &file.checks.energy_drift;
-    if model.is_conservative() || energy.is_some() {
+    if model.description().conservative || energy.is_some() {
         let (bound, run) = energy
             .as_ref()
             .map_or((DEFAULT_ENERGY_DRIFT, default_run), |d| {
@@ -489,7 +489,7 @@ pub fn motion_checks(
 
     // Generic: constraint drift (constrained models).
     let constraint = &file.checks.constraint_drift;
-    if !model.constraint_names().is_empty() || constraint.is_some() {
+    if !model.description().constraint_names().is_empty() || constraint.is_some() {
         let (bound, run) = constraint
             .as_ref()
             .map_or((DEFAULT_CONSTRAINT_DRIFT, default_run), |d| {
@@ -583,7 +583,7 @@ pub fn motion_checks(
                         .map(|(_, y)| y.to_vec())
                         .ok_or_else(|| format!("the integration stopped before t = {t}"))
                 });
-                let coordinates = model.coordinate_names();
+                let coordinates = model.description().coordinate_names();
                 let n = coordinates.len();
                 for (k, e) in &check.values {
                     let index = coordinates.iter().position(|c| *c == k.value).or_else(|| {
@@ -736,10 +736,16 @@ fn check_start(model: &dyn ModelInfo, at: Option<&str>) -> Result<EquilibriumSta
     for part in crate::expressions::split_list(at) {
         let (name, text) = split_assignment(part, "at").map_err(|e| e.to_string())?;
         let index = model
+            .description()
             .coordinate_names()
             .iter()
             .position(|c| *c == name)
-            .ok_or_else(|| format!("at: `{name}` is not a coordinate of `{}`", model.name()))?;
+            .ok_or_else(|| {
+                format!(
+                    "at: `{name}` is not a coordinate of `{}`",
+                    model.description().name
+                )
+            })?;
         q[index] = evaluate(text, &format!("at {name}"), &lookup).map_err(|e| e.to_string())?;
     }
     Ok(EquilibriumStart::Guess {
@@ -815,7 +821,7 @@ pub fn model_report(path: &str, text: &str, file: &ModelFile, source: &ModelSour
             run,
             solution: solution.clone(),
             energy: energy_drift(model.as_ref(), &y0, solution),
-            constraint_drift: (!model.constraint_names().is_empty())
+            constraint_drift: (!model.description().constraint_names().is_empty())
                 .then(|| constraint_drift(model.as_mut(), solution).drift),
         }
     }));
@@ -834,7 +840,8 @@ pub fn model_report(path: &str, text: &str, file: &ModelFile, source: &ModelSour
                     ..OperatingPointOptions::default()
                 },
             };
-            modal_analysis(model.as_ref(), &options).map_err(|e| format!("`{}`: {e}", model.name()))
+            modal_analysis(model.as_ref(), &options)
+                .map_err(|e| format!("`{}`: {e}", model.description().name))
         });
         points.push((at.map(str::to_string), result.clone()));
         result
@@ -852,7 +859,7 @@ pub fn model_report(path: &str, text: &str, file: &ModelFile, source: &ModelSour
             })
         },
     ));
-    if !model.equilibrium_guesses().is_empty() && !model.point_names().is_empty() {
+    if !model.equilibrium_guesses().is_empty() && !model.description().point_names().is_empty() {
         let at = file
             .checks
             .natural_frequencies

@@ -180,7 +180,7 @@ pub fn split_assignment<'a>(
 
 /// Looks up `model`'s current parameter values by name (for expressions beside a model).
 pub fn parameter_lookup(model: &dyn ModelInfo) -> impl Fn(&str) -> Option<f64> + '_ {
-    let names = model.parameter_names();
+    let names = model.description().parameter_names();
     let values = model.parameter_values();
     move |n: &str| names.iter().position(|p| *p == n).map(|i| values[i])
 }
@@ -268,7 +268,7 @@ pub fn set_initial_values(
     assignments: &[impl AsRef<str>],
 ) -> Result<(), ExpressionError> {
     let n = model.num_dofs();
-    let coordinates = model.coordinate_names();
+    let coordinates = model.description().coordinate_names();
     for s in assignments.iter().flat_map(|s| split_list(s.as_ref())) {
         let (name, text) = split_assignment(s, "--init")?;
         let value = evaluate(text, &format!("--init {name}"), &parameter_lookup(model))?;
@@ -286,7 +286,7 @@ pub fn set_initial_values(
                 ExpressionError::UnknownCoordinate {
                     option: "--init".to_string(),
                     name: name.to_string(),
-                    model: model.name().to_string(),
+                    model: model.description().name.to_string(),
                     coordinates: coordinates.join(", "),
                     rates: rates.join(", "),
                 }
@@ -511,15 +511,20 @@ fn resolve(
 ) -> Result<Vec<(String, Source)>, ExpressionError> {
     let n = model.num_dofs();
     let mut known: Vec<(String, Source)> = Vec::new();
-    for (name, value) in model.parameter_names().iter().zip(model.parameter_values()) {
+    for (name, value) in model
+        .description()
+        .parameter_names()
+        .iter()
+        .zip(model.parameter_values())
+    {
         known.push((name.to_string(), Source::Parameter(value)));
     }
-    for (i, c) in model.coordinate_names().iter().enumerate() {
+    for (i, c) in model.description().coordinate_names().iter().enumerate() {
         known.push((c.to_string(), Source::State(i)));
         known.push((format!("{c}_dot"), Source::State(n + i)));
         known.push((format!("{c}_ddot"), Source::Acceleration(i)));
     }
-    for (i, c) in model.constraint_names().iter().enumerate() {
+    for (i, c) in model.description().constraint_names().iter().enumerate() {
         known.push((format!("lambda_{c}"), Source::Multiplier(i)));
     }
     known.push(("t".to_string(), Source::Time));
@@ -543,7 +548,7 @@ fn resolve(
                     text: text.to_string(),
                     column: at.column,
                     name: id,
-                    model: model.name().to_string(),
+                    model: model.description().name.to_string(),
                     hint,
                 });
             }

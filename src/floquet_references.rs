@@ -219,6 +219,7 @@ impl FloquetReferences {
 /// `model`'s current parameter values by name.
 fn parameters(model: &dyn ModelInfo) -> impl Fn(&str) -> Option<f64> {
     let names: Vec<String> = model
+        .description()
         .parameter_names()
         .iter()
         .map(|n| n.to_string())

@@ -4,10 +4,12 @@
 //! `help:`) and to `type Name = ModelWithErrors<N>;`, so that the code that uses the model
 //! still type-checks and the errors of the file are the only ones the user reads (rather
 //! than "cannot find type `Name`" at every use). The crate cannot be built while those
-//! errors stand, so no value of this type is ever evaluated: its methods return empty
-//! names and zeros only to satisfy the trait.
+//! errors stand, so no value of this type is ever evaluated: its methods return an empty
+//! description and zeros only to satisfy the trait.
 
-use crate::{MechanicalSystem, UnknownParameter};
+use std::borrow::Cow;
+
+use crate::{MechanicalSystem, ModelDescription, UnknownParameter};
 use nalgebra::{SMatrix, SVector};
 
 /// What `model!` names a model with errors (see the module docs): `N` is the number of
@@ -17,17 +19,13 @@ use nalgebra::{SMatrix, SVector};
 pub struct ModelWithErrors<const N: usize>;
 
 impl<const N: usize> MechanicalSystem<N> for ModelWithErrors<N> {
-    fn name(&self) -> &'static str {
-        "model with errors"
-    }
-    fn description(&self) -> &'static str {
-        "a model file with errors (see the compile errors)"
-    }
-    fn coordinate_names(&self) -> [&'static str; N] {
-        [""; N]
-    }
-    fn parameter_names(&self) -> &'static [&'static str] {
-        &[]
+    fn description(&self) -> &ModelDescription {
+        static DESCRIPTION: ModelDescription = ModelDescription {
+            name: Cow::Borrowed("model with errors"),
+            summary: Cow::Borrowed("a model file with errors (see the compile errors)"),
+            ..ModelDescription::EMPTY
+        };
+        &DESCRIPTION
     }
     fn parameter_values(&self) -> Vec<f64> {
         Vec::new()
@@ -35,7 +33,7 @@ impl<const N: usize> MechanicalSystem<N> for ModelWithErrors<N> {
     fn set_parameter(&mut self, name: &str, value: f64) -> Result<(), UnknownParameter> {
         let _ = value;
         Err(UnknownParameter {
-            model: self.name().to_string(),
+            model: self.description().name.to_string(),
             name: name.to_string(),
             known: String::new(),
         })
@@ -87,17 +85,5 @@ impl<const N: usize> MechanicalSystem<N> for ModelWithErrors<N> {
     fn potential_energy(&self, _: &SVector<f64, N>, _: f64) -> f64 {
         0.0
     }
-    fn is_conservative(&self) -> bool {
-        false
-    }
-    fn point_names(&self) -> &'static [&'static str] {
-        &[]
-    }
     fn point_positions(&self, _: &SVector<f64, N>, _: f64, _: &mut [[f64; 3]]) {}
-    fn equations_text(&self) -> &'static str {
-        ""
-    }
-    fn equations_latex(&self) -> &'static str {
-        ""
-    }
 }

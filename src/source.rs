@@ -82,7 +82,7 @@ impl ModelSource {
     pub fn name(&self) -> &str {
         match self {
             ModelSource::Bundled(entry) => entry.name,
-            ModelSource::File { model, .. } => crate::DynMechanicalSystem::name(model),
+            ModelSource::File { model, .. } => &crate::DynMechanicalSystem::description(model).name,
         }
     }
 

@@ -15,6 +15,7 @@ fn model(name: &str) -> Box<dyn ModelInfo> {
 
 fn parameter(m: &dyn ModelInfo, name: &str) -> f64 {
     m.parameter_values()[m
+        .description()
         .parameter_names()
         .iter()
         .position(|n| *n == name)
@@ -33,7 +34,7 @@ fn run(m: &mut dyn ModelInfo, t_end: f64, times: Vec<f64>, tol: f64) -> Solution
             &OutputTimes::At(times),
             &options,
         )
-        .unwrap_or_else(|e| panic!("{} failed: {e}", m.name()))
+        .unwrap_or_else(|e| panic!("{} failed: {e}", m.description().name))
 }
 
 fn grid(t_end: f64, n: u32) -> Vec<f64> {
@@ -270,7 +271,7 @@ fn four_bar_consistent_initialisation_closure_and_energy() {
         m.constraint_drift(0.0, &y).0 > 0.1,
         "the guesses should miss the loop"
     );
-    let guesses = m.initial_guesses().to_vec();
+    let guesses = m.description().initial_guesses.to_vec();
     let iterations = m.project(0.0, &mut y, &guesses).expect("Newton converges");
     assert!(iterations > 1);
     let (p, v) = m.constraint_drift(0.0, &y);

@@ -130,6 +130,7 @@ fn eccentric_cylinder_lifts_off_where_the_normal_force_vanishes() {
     assert_eq!(event.name, "lift_off");
     assert_eq!(solution.last().map(|(t, _)| t), Some(event.t));
     let names: Vec<String> = cylinder
+        .description()
         .parameter_names()
         .iter()
         .map(|s| s.to_string())

@@ -86,7 +86,12 @@ fn pendulum_floquet(set: &[(&str, f64)]) -> eomgen::FloquetAnalysis {
 }
 
 fn parameter(m: &dyn ModelInfo, name: &str) -> f64 {
-    let i = m.parameter_names().iter().position(|p| *p == name).unwrap();
+    let i = m
+        .description()
+        .parameter_names()
+        .iter()
+        .position(|p| *p == name)
+        .unwrap();
     m.parameter_values()[i]
 }
 

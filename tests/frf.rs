@@ -262,7 +262,7 @@ fn simulated_vs_frf(model: &mut dyn ModelInfo, input: &str, amplitude: f64, freq
             assert!(
                 d <= 1e-6 * h[(i, 0)].norm(),
                 "{} ω = {w}, coordinate {i}: simulated {sim} vs H {}",
-                model.name(),
+                model.description().name,
                 h[(i, 0)]
             );
         }

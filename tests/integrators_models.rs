@@ -43,7 +43,7 @@ fn generated_jacobian_matches_finite_differences() {
     let mut checked = 0;
     for entry in ALL {
         let mut model = (entry.make)();
-        let constrained = !model.constraint_names().is_empty();
+        let constrained = !model.description().constraint_names().is_empty();
         let n = model.num_dofs();
         let dim = 2 * n;
         let system = model.as_ode_mut();
@@ -249,7 +249,7 @@ fn implicit_methods_use_the_generated_jacobian() {
 #[test]
 fn partitioned_methods_keep_the_energy_of_a_constant_mass_model() {
     let mut masses = model("three_masses");
-    assert!(masses.is_conservative());
+    assert!(masses.description().conservative);
     let mut y0 = masses.initial_state();
     if y0.iter().all(|v| *v == 0.0) {
         // Start away from equilibrium, exciting every mode.

@@ -254,7 +254,7 @@ fn point_positions_equal_engine_evaluation() {
         let model = SymbolicModel::from_file(&file).expect("lowers");
         let generated = (entry.make)();
         assert_eq!(
-            generated.point_names().len(),
+            generated.description().point_names().len(),
             model.points.len(),
             "{}",
             entry.name
@@ -303,12 +303,12 @@ fn constraint_functions_match_finite_differences() {
     let mut checked = 0;
     for entry in ALL {
         let model = (entry.make)();
-        let m = model.constraint_names().len();
+        let m = model.description().constraint_names().len();
         if m == 0 {
             continue;
         }
         let n = model.num_dofs();
-        let mh = model.holonomic_constraint_count();
+        let mh = model.description().holonomic_constraints;
         for _ in 0..10 {
             let t = rng.random_range(0.0..5.0);
             let y: Vec<f64> = (0..2 * n).map(|_| rng.random_range(-2.0..2.0)).collect();
@@ -337,7 +337,7 @@ fn constraint_functions_match_finite_differences() {
                     (fd - expected).abs() <= 1e-6 * 1f64.max(expected.abs()),
                     "{} {}: d/dt velocity residual {fd} vs J a − γ {expected}",
                     entry.name,
-                    model.constraint_names()[i]
+                    model.description().constraint_names()[i]
                 );
                 if i < mh {
                     let fd = (cp.phi[i] - cm.phi[i]) / (2.0 * h);
@@ -345,7 +345,7 @@ fn constraint_functions_match_finite_differences() {
                         (fd - c.velocity[i]).abs() <= 1e-6 * 1f64.max(fd.abs()),
                         "{} {}: dΦ/dt {fd} vs velocity residual {}",
                         entry.name,
-                        model.constraint_names()[i],
+                        model.description().constraint_names()[i],
                         c.velocity[i]
                     );
                     for k in 0..n {

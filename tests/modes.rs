@@ -20,7 +20,7 @@ fn guess(model: &dyn ModelInfo, name: &str) -> Vec<f64> {
         .equilibrium_guesses()
         .into_iter()
         .find(|(n, _)| *n == name)
-        .unwrap_or_else(|| panic!("{} names `{name}`", model.name()))
+        .unwrap_or_else(|| panic!("{} names `{name}`", model.description().name))
         .1
 }
 

@@ -41,7 +41,7 @@ fn modes_at(m: &dyn ModelInfo, at: &str) -> (Linearization, NormalModes) {
         .equilibrium_guesses()
         .into_iter()
         .find(|(n, _)| *n == at)
-        .unwrap_or_else(|| panic!("{} names `{at}`", m.name()))
+        .unwrap_or_else(|| panic!("{} names `{at}`", m.description().name))
         .1;
     let q = find_equilibrium(m, &guess, 0.0).unwrap().q;
     let lin = linearize(m, &q, &vec![0.0; q.len()], 0.0).unwrap();
@@ -753,8 +753,11 @@ fn double_pendulum_points_mode_gives_synchronous_motion() {
 fn mode_charts_are_written() {
     // The generated `draw:` accessors the charts use, as in the model file.
     let dp = model("double_pendulum_points", &[]);
-    assert_eq!(dp.draw_lines(), &[["O", "E"], ["E", "H"]]);
-    assert_eq!(dp.trace_points(), &["H"]);
+    assert_eq!(
+        dp.description().draw_line_names(),
+        &[["O", "E"], ["E", "H"]]
+    );
+    assert_eq!(dp.description().trace_point_names(), &["H"]);
     let dir = std::env::temp_dir().join(format!("eomgen-mode-charts-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     for (name, lines, modes) in [

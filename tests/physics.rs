@@ -43,7 +43,7 @@ fn solve(
             &OutputTimes::At(times),
             options,
         )
-        .unwrap_or_else(|e| panic!("{} failed: {e}", m.name()))
+        .unwrap_or_else(|e| panic!("{} failed: {e}", m.description().name))
 }
 
 /// HW2: the closed form with linear drag, tau = m/c:
@@ -53,7 +53,12 @@ fn solve(
 fn cannonball_matches_closed_form() {
     let mut m = model("cannonball");
     let p = |name: &str| {
-        m.parameter_values()[m.parameter_names().iter().position(|n| *n == name).unwrap()]
+        m.parameter_values()[m
+            .description()
+            .parameter_names()
+            .iter()
+            .position(|n| *n == name)
+            .unwrap()]
     };
     let (mass, g, c, v0, th) = (p("m"), p("g"), p("c"), p("v0"), p("theta0"));
     assert_eq!(th, PI / 4.0);
@@ -157,7 +162,7 @@ fn three_masses_released_in_a_mode_stay_in_it() {
 #[test]
 fn two_masses_centre_of_mass_obeys_total_force() {
     let mut m = model("two_masses");
-    let names = m.parameter_names();
+    let names = m.description().parameter_names();
     let p = m.parameter_values();
     let get = |n: &str| p[names.iter().position(|x| *x == n).unwrap()];
     let (m1, m2, l0, f0) = (get("m1"), get("m2"), get("l0"), get("F0"));
@@ -231,7 +236,7 @@ fn conservative_models_conserve_energy() {
     let mut checked = 0;
     for entry in models::ALL {
         let mut m = (entry.make)();
-        if !m.is_conservative() {
+        if !m.description().conservative {
             continue;
         }
         checked += 1;
@@ -536,7 +541,7 @@ fn small_oscillation_frequencies() {
 #[test]
 fn turntable_conserves_angular_momentum() {
     let mut m = model("turntable_slot");
-    let names = m.parameter_names();
+    let names = m.description().parameter_names();
     let p = m.parameter_values();
     let get = |n: &str| p[names.iter().position(|x| *x == n).unwrap()];
     let (it, ms, d) = (get("I_t"), get("m_s"), get("d"));

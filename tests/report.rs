@@ -146,7 +146,8 @@ fn report_on_three_models_writes_the_page_and_json_and_passes() {
         let name = m["name"].as_str().unwrap();
         let drawn = eomgen::models::find(name).is_some_and(|entry| {
             let model = (entry.make)();
-            !model.draw_lines().is_empty() || !model.trace_points().is_empty()
+            !model.description().draw_line_names().is_empty()
+                || !model.description().trace_point_names().is_empty()
         });
         match m["animation"].as_str() {
             Some(file) => {

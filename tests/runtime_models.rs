@@ -31,27 +31,60 @@ fn assert_same(what: &str, a: &[f64], b: &[f64]) {
 fn compare(name: &str, compiled: &mut dyn ModelInfo, runtime: &mut dyn ModelInfo, states: usize) {
     let n = compiled.num_dofs();
     assert_eq!(runtime.num_dofs(), n, "{name}: dofs");
-    assert_eq!(compiled.name(), runtime.name());
-    assert_eq!(compiled.coordinate_names(), runtime.coordinate_names());
-    assert_eq!(compiled.parameter_names(), runtime.parameter_names());
+    assert_eq!(compiled.description().name, runtime.description().name);
+    assert_eq!(
+        compiled.description().coordinate_names(),
+        runtime.description().coordinate_names()
+    );
+    assert_eq!(
+        compiled.description().parameter_names(),
+        runtime.description().parameter_names()
+    );
     assert_same(
         &format!("{name}: parameters"),
         &compiled.parameter_values(),
         &runtime.parameter_values(),
     );
-    assert_eq!(compiled.point_names(), runtime.point_names());
-    assert_eq!(compiled.draw_lines(), runtime.draw_lines());
-    assert_eq!(compiled.trace_points(), runtime.trace_points());
-    assert_eq!(compiled.body_centres(), runtime.body_centres());
-    assert_eq!(compiled.constraint_names(), runtime.constraint_names());
     assert_eq!(
-        compiled.holonomic_constraint_count(),
-        runtime.holonomic_constraint_count()
+        compiled.description().point_names(),
+        runtime.description().point_names()
     );
-    assert_eq!(compiled.initial_guesses(), runtime.initial_guesses());
-    assert_eq!(compiled.is_conservative(), runtime.is_conservative());
-    assert_eq!(compiled.equations_text(), runtime.equations_text());
-    assert_eq!(compiled.equations_latex(), runtime.equations_latex());
+    assert_eq!(
+        compiled.description().draw_line_names(),
+        runtime.description().draw_line_names()
+    );
+    assert_eq!(
+        compiled.description().trace_point_names(),
+        runtime.description().trace_point_names()
+    );
+    assert_eq!(
+        compiled.description().body_centres,
+        runtime.description().body_centres
+    );
+    assert_eq!(
+        compiled.description().constraint_names(),
+        runtime.description().constraint_names()
+    );
+    assert_eq!(
+        compiled.description().holonomic_constraints,
+        runtime.description().holonomic_constraints
+    );
+    assert_eq!(
+        compiled.description().initial_guesses,
+        runtime.description().initial_guesses
+    );
+    assert_eq!(
+        compiled.description().conservative,
+        runtime.description().conservative
+    );
+    assert_eq!(
+        compiled.description().equations_text,
+        runtime.description().equations_text
+    );
+    assert_eq!(
+        compiled.description().equations_latex,
+        runtime.description().equations_latex
+    );
     assert_eq!(compiled.event_specs(), runtime.event_specs());
     assert_same(
         &format!("{name}: initial state"),
@@ -205,6 +238,7 @@ fn parameters_set_by_name_agree() {
         let mut compiled = (entry.make)();
         let mut runtime = runtime_model(&bundled_file(entry), None);
         let names: Vec<String> = compiled
+            .description()
             .parameter_names()
             .iter()
             .map(|s| s.to_string())
@@ -243,7 +277,7 @@ fn the_readme_model_runs_and_conserves_energy() {
     let model = JitModel::from_source("spring_pendulum.yaml", &readme[start..end])
         .unwrap_or_else(|e| panic!("{e}"));
     let mut system = DynFirstOrder::new(model);
-    assert!(system.is_conservative());
+    assert!(system.description().conservative);
     let y0 = system.initial_state();
     let options = IntegratorOptions::default()
         .with_rtol(1e-10)

@@ -156,7 +156,7 @@ mod tests {
                 .collect();
             let code = native::compile(&functions).unwrap_or_else(|e| panic!("{display}: {e}"));
             let n = program.num_dofs();
-            let m = program.constraint_names.len();
+            let m = program.description.constraints.len();
             for (index, (name, function)) in functions.into_iter().enumerate() {
                 let Some(compiled) = code.functions[index] else {
                     assert!(function.tape.outputs.is_empty(), "{display}: {name}");
@@ -167,11 +167,11 @@ mod tests {
                 let mut values = Vec::new();
                 for _ in 0..50 {
                     let parameters: Vec<f64> = program
+                        .description
                         .parameters
                         .iter()
-                        .map(|(_, v)| {
-                            v * random.random_range(0.5..1.5) + random.random_range(-0.1..0.1)
-                        })
+                        .map(|p| p.default)
+                        .map(|v| v * random.random_range(0.5..1.5) + random.random_range(-0.1..0.1))
                         .collect();
                     let q = vector(&mut random, n, -2.0, 2.0);
                     let qdot = vector(&mut random, n, -2.0, 2.0);

@@ -1,16 +1,13 @@
 //! [`JitModel`]: a model file loaded, derived and compiled at run time.
 
-use std::borrow::Cow;
 use std::cell::RefCell;
 use std::sync::{Arc, Mutex, OnceLock};
 
-use eomgen_runtime::{
-    BodyCentre, DynMechanicalSystem, EventDirection, EventSpec, UnknownParameter,
-};
+use eomgen_runtime::{DynMechanicalSystem, ModelDescription, UnknownParameter};
 use eomgen_symbolic::codegen::GenerateError;
 use eomgen_symbolic::codegen::program::{Derivation, FunctionTape, ModelProgram};
 use eomgen_symbolic::codegen::tape::{Input, Instruction};
-use eomgen_symbolic::model::{Crossing, Diagnostic, ReadError, read_model_file};
+use eomgen_symbolic::model::{Diagnostic, ReadError, read_model_file};
 
 use crate::native::{CompileError, NativeCode, NativeFn};
 use crate::{Backend, Inputs, interpret, native};
@@ -201,7 +198,6 @@ struct Code {
     core: Compiled,
     backend: Option<Backend>,
     fallback_reason: Option<CompileError>,
-    events: Vec<EventSpec>,
     /// The derivation the Jacobians come from, until they are compiled.
     derivation: Mutex<Option<Derivation>>,
     jacobians: OnceLock<LazyJacobians>,
@@ -454,26 +450,12 @@ impl JitModel {
         // The tapes live on in `core`; the program keeps the names and constants.
         let mut program = program;
         program.clear_tapes();
-        let events = program
-            .events
-            .iter()
-            .map(|e| EventSpec {
-                name: Cow::Owned(e.name.clone()),
-                direction: match e.direction {
-                    Crossing::Rising => EventDirection::Rising,
-                    Crossing::Falling => EventDirection::Falling,
-                    Crossing::Both => EventDirection::Both,
-                },
-                terminal: e.terminal,
-            })
-            .collect();
-        let parameters: Vec<f64> = program.parameters.iter().map(|(_, v)| *v).collect();
+        let parameters: Vec<f64> = program.description.parameter_defaults();
         let code = Arc::new(Code {
             program,
             core,
             backend: options.backend,
             fallback_reason,
-            events,
             derivation: Mutex::new(Some(derivation)),
             jacobians: OnceLock::new(),
         });
@@ -554,7 +536,7 @@ impl JitModel {
         assert!(
             extent.admits(&inputs, out0.len(), out1.len()),
             "model `{}`: a slice passed to {routine:?} is shorter than its shape",
-            self.code.program.name
+            self.code.program.description.name
         );
         if let Some(native) = &compiled.native {
             // An empty tape (a model without constraints, events, …) has no code and no
@@ -591,49 +573,22 @@ impl JitModel {
 }
 
 impl DynMechanicalSystem for JitModel {
-    fn name(&self) -> &str {
-        &self.code.program.name
-    }
-    fn description(&self) -> &str {
+    fn description(&self) -> &ModelDescription {
         &self.code.program.description
-    }
-    fn num_dofs(&self) -> usize {
-        self.code.program.num_dofs()
-    }
-    fn coordinate_names(&self) -> Vec<&str> {
-        self.code
-            .program
-            .coordinate_names
-            .iter()
-            .map(String::as_str)
-            .collect()
-    }
-    fn parameter_names(&self) -> Vec<&str> {
-        self.code
-            .program
-            .parameters
-            .iter()
-            .map(|(n, _)| n.as_str())
-            .collect()
     }
     fn parameter_values(&self) -> Vec<f64> {
         self.parameters.clone()
     }
     fn set_parameter(&mut self, name: &str, value: f64) -> Result<(), UnknownParameter> {
-        let parameters = &self.code.program.parameters;
-        match parameters.iter().position(|(n, _)| n == name) {
+        match self.code.program.description.parameter_index(name) {
             Some(i) => {
                 self.parameters[i] = value;
                 Ok(())
             }
             None => Err(UnknownParameter {
-                model: self.code.program.name.clone(),
+                model: self.code.program.description.name.to_string(),
                 name: name.to_string(),
-                known: parameters
-                    .iter()
-                    .map(|(n, _)| n.as_str())
-                    .collect::<Vec<_>>()
-                    .join(", "),
+                known: self.code.program.description.parameter_names().join(", "),
             }),
         }
     }
@@ -728,17 +683,6 @@ impl DynMechanicalSystem for JitModel {
         );
         out[0]
     }
-    fn is_conservative(&self) -> bool {
-        self.code.program.conservative
-    }
-    fn point_names(&self) -> Vec<&str> {
-        self.code
-            .program
-            .point_names
-            .iter()
-            .map(String::as_str)
-            .collect()
-    }
     fn point_positions(&self, q: &[f64], t: f64, out: &mut [[f64; 3]]) {
         let flat = out.as_flattened_mut();
         self.run(
@@ -747,51 +691,6 @@ impl DynMechanicalSystem for JitModel {
             flat,
             &mut [],
         );
-    }
-    fn draw_lines(&self) -> Vec<[&str; 2]> {
-        self.code
-            .program
-            .draw_lines
-            .iter()
-            .map(|[a, b]| [a.as_str(), b.as_str()])
-            .collect()
-    }
-    fn trace_points(&self) -> Vec<&str> {
-        self.code
-            .program
-            .trace_points
-            .iter()
-            .map(String::as_str)
-            .collect()
-    }
-    fn body_centres(&self) -> Vec<BodyCentre<'_>> {
-        self.code
-            .program
-            .body_centres
-            .iter()
-            .map(|b| BodyCentre {
-                body: &b.body,
-                point: &b.point,
-                rigid: b.rigid,
-            })
-            .collect()
-    }
-    fn equations_text(&self) -> &str {
-        &self.code.program.equations_text
-    }
-    fn equations_latex(&self) -> &str {
-        &self.code.program.equations_latex
-    }
-    fn constraint_names(&self) -> Vec<&str> {
-        self.code
-            .program
-            .constraint_names
-            .iter()
-            .map(String::as_str)
-            .collect()
-    }
-    fn holonomic_constraint_count(&self) -> usize {
-        self.code.program.holonomic_constraint_count
     }
     fn constraint_residuals(&self, q: &[f64], t: f64, out: &mut [f64]) {
         self.run(
@@ -825,17 +724,6 @@ impl DynMechanicalSystem for JitModel {
             &mut [],
         );
     }
-    fn initial_guesses(&self) -> &[usize] {
-        &self.code.program.initial_guesses
-    }
-    fn equilibrium_names(&self) -> Vec<&str> {
-        self.code
-            .program
-            .equilibrium_names
-            .iter()
-            .map(String::as_str)
-            .collect()
-    }
     fn equilibrium_guesses(&self, out: &mut [f64]) {
         self.run(
             Routine::EquilibriumGuesses,
@@ -843,12 +731,6 @@ impl DynMechanicalSystem for JitModel {
             out,
             &mut [],
         );
-    }
-    fn event_specs(&self) -> Vec<EventSpec> {
-        self.code.events.clone()
-    }
-    fn events_need_accelerations(&self) -> bool {
-        self.code.program.events_need_accelerations
     }
     fn event_values(
         &self,

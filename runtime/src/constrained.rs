@@ -460,7 +460,7 @@ impl ConstraintWorkspace {
 )]
 pub struct ProjectionError {
     /// Index of the constraint with the largest residual, into
-    /// [`crate::MechanicalSystem::constraint_names`].
+    /// [`crate::ModelDescription::constraints`].
     pub constraint: usize,
     /// Its residual.
     pub residual: f64,

@@ -9,8 +9,7 @@
 
 use nalgebra::SVector;
 
-use crate::ode::EventSpec;
-use crate::system::{BodyCentre, MechanicalSystem, UnknownParameter};
+use crate::system::{MechanicalSystem, ModelDescription, UnknownParameter};
 
 /// Equations of motion `M(q, t) q̈ = F(q, q̇, t)` of a mechanism with `n` degrees of freedom,
 /// `n` known at run time.
@@ -27,17 +26,14 @@ use crate::system::{BodyCentre, MechanicalSystem, UnknownParameter};
 /// # Units
 /// SI, angles in rad; `F` in N or N·m per coordinate; energies in J.
 pub trait DynMechanicalSystem {
-    /// The model's name, as in its file.
-    fn name(&self) -> &str;
-    /// One-line description from the model file.
-    fn description(&self) -> &str;
-    /// Number of degrees of freedom `n`.
-    fn num_dofs(&self) -> usize;
-    /// Names of the generalized coordinates `q`, in order (length `n`).
-    fn coordinate_names(&self) -> Vec<&str>;
-    /// Names of the parameters, in file order.
-    fn parameter_names(&self) -> Vec<&str>;
-    /// Current parameter values, in the order of [`Self::parameter_names`].
+    /// Everything about the model that is not a function of the state
+    /// ([`MechanicalSystem::description`]).
+    fn description(&self) -> &ModelDescription;
+    /// Number of degrees of freedom `n` (the description's coordinates).
+    fn num_dofs(&self) -> usize {
+        self.description().num_dofs()
+    }
+    /// Current parameter values, in the order of [`ModelDescription::parameters`].
     fn parameter_values(&self) -> Vec<f64>;
     /// Sets parameter `name` to `value`.
     ///
@@ -70,30 +66,12 @@ pub trait DynMechanicalSystem {
     fn kinetic_energy(&self, q: &[f64], qdot: &[f64], t: f64) -> f64;
     /// Potential energy `V(q, t)` (J).
     fn potential_energy(&self, q: &[f64], t: f64) -> f64;
-    /// Whether `T + V` is a constant of the motion.
-    fn is_conservative(&self) -> bool;
-    /// Names of the model's points, in file order.
-    fn point_names(&self) -> Vec<&str>;
     /// Positions of the points (m), `[x, y, z]` (`z = 0` for 2-D models), into `out` (length
-    /// `point_names().len()`).
+    /// `description().points.len()`).
     fn point_positions(&self, q: &[f64], t: f64, out: &mut [[f64; 3]]);
-    /// The file's `draw: lines` as pairs of point names.
-    fn draw_lines(&self) -> Vec<[&str; 2]>;
-    /// The file's `draw: trace` point names.
-    fn trace_points(&self) -> Vec<&str>;
-    /// The bodies' centres of mass.
-    fn body_centres(&self) -> Vec<BodyCentre<'_>>;
-    /// The derived equations as plain text.
-    fn equations_text(&self) -> &str;
-    /// The derived equations as LaTeX.
-    fn equations_latex(&self) -> &str;
 
-    /// Names of the constraints, holonomic first (`m` of them).
-    fn constraint_names(&self) -> Vec<&str>;
-    /// How many of [`Self::constraint_names`] are holonomic (they come first).
-    fn holonomic_constraint_count(&self) -> usize;
     /// `Φ(q, t)` of the holonomic constraints into `out` (length
-    /// [`Self::holonomic_constraint_count`]).
+    /// [`ModelDescription::holonomic_constraints`]).
     fn constraint_residuals(&self, q: &[f64], t: f64, out: &mut [f64]);
     /// The constraint Jacobian `J` (`m × n`, **row-major**, as
     /// [`MechanicalSystem::constraint_jacobian`])
@@ -103,16 +81,8 @@ pub trait DynMechanicalSystem {
     fn constraint_velocity_residuals(&self, q: &[f64], qdot: &[f64], t: f64, out: &mut [f64]);
     /// `γ` of `J q̈ = γ` (length `m`) into `out`.
     fn constraint_gamma(&self, q: &[f64], qdot: &[f64], t: f64, out: &mut [f64]);
-    /// Indices of the coordinates whose initial values are guesses.
-    fn initial_guesses(&self) -> &[usize];
-    /// The file's `equilibria:` names, in file order.
-    fn equilibrium_names(&self) -> Vec<&str>;
-    /// The guesses of [`Self::equilibrium_names`], `n` coordinates each, one after the other.
+    /// The guesses of [`ModelDescription::equilibria`], `n` coordinates each, one after the other.
     fn equilibrium_guesses(&self, out: &mut [f64]);
-    /// The file's `events:` (names, directions, terminal flags).
-    fn event_specs(&self) -> Vec<EventSpec>;
-    /// Whether an event function uses `q̈` or `λ`.
-    fn events_need_accelerations(&self) -> bool;
     /// The event functions `gᵢ(q, q̇, q̈, λ, t)` into `out` (one per event); `lambda` may be
     /// shorter than `m` (a function that reads a missing multiplier gets NaN).
     fn event_values(
@@ -128,7 +98,7 @@ pub trait DynMechanicalSystem {
 
 /// A [`MechanicalSystem<N>`] seen as a [`DynMechanicalSystem`]: the one place where the
 /// compile-time-sized interface is mapped to the slices of the run-time one (static vectors
-/// and matrices copied from and to the slices, names and lists collected into `Vec`s).
+/// and matrices copied from and to the slices; the description is the system's own).
 ///
 /// With it, what is written once over [`DynMechanicalSystem`] serves the models compiled by
 /// `eomgen::model!` too: the constrained solve, drift and projection of
@@ -165,20 +135,11 @@ fn vector<const N: usize>(x: &[f64]) -> SVector<f64, N> {
 }
 
 impl<S: MechanicalSystem<N>, const N: usize> DynMechanicalSystem for StaticSystem<S, N> {
-    fn name(&self) -> &str {
-        self.0.name()
-    }
-    fn description(&self) -> &str {
+    fn description(&self) -> &ModelDescription {
         self.0.description()
     }
     fn num_dofs(&self) -> usize {
         N
-    }
-    fn coordinate_names(&self) -> Vec<&str> {
-        self.0.coordinate_names().to_vec()
-    }
-    fn parameter_names(&self) -> Vec<&str> {
-        self.0.parameter_names().to_vec()
     }
     fn parameter_values(&self) -> Vec<f64> {
         self.0.parameter_values()
@@ -230,35 +191,8 @@ impl<S: MechanicalSystem<N>, const N: usize> DynMechanicalSystem for StaticSyste
     fn potential_energy(&self, q: &[f64], t: f64) -> f64 {
         self.0.potential_energy(&vector::<N>(q), t)
     }
-    fn is_conservative(&self) -> bool {
-        self.0.is_conservative()
-    }
-    fn point_names(&self) -> Vec<&str> {
-        self.0.point_names().to_vec()
-    }
     fn point_positions(&self, q: &[f64], t: f64, out: &mut [[f64; 3]]) {
         self.0.point_positions(&vector::<N>(q), t, out);
-    }
-    fn draw_lines(&self) -> Vec<[&str; 2]> {
-        self.0.draw_lines().to_vec()
-    }
-    fn trace_points(&self) -> Vec<&str> {
-        self.0.trace_points().to_vec()
-    }
-    fn body_centres(&self) -> Vec<BodyCentre<'_>> {
-        self.0.body_centres().to_vec()
-    }
-    fn equations_text(&self) -> &str {
-        self.0.equations_text()
-    }
-    fn equations_latex(&self) -> &str {
-        self.0.equations_latex()
-    }
-    fn constraint_names(&self) -> Vec<&str> {
-        self.0.constraint_names().to_vec()
-    }
-    fn holonomic_constraint_count(&self) -> usize {
-        self.0.holonomic_constraint_count()
     }
     fn constraint_residuals(&self, q: &[f64], t: f64, out: &mut [f64]) {
         self.0.constraint_residuals(&vector::<N>(q), t, out);
@@ -274,20 +208,8 @@ impl<S: MechanicalSystem<N>, const N: usize> DynMechanicalSystem for StaticSyste
         self.0
             .constraint_gamma(&vector::<N>(q), &vector::<N>(qdot), t, out);
     }
-    fn initial_guesses(&self) -> &[usize] {
-        self.0.initial_guesses()
-    }
-    fn equilibrium_names(&self) -> Vec<&str> {
-        self.0.equilibrium_names().to_vec()
-    }
     fn equilibrium_guesses(&self, out: &mut [f64]) {
         self.0.equilibrium_guesses(out);
-    }
-    fn event_specs(&self) -> Vec<EventSpec> {
-        self.0.event_specs().to_vec()
-    }
-    fn events_need_accelerations(&self) -> bool {
-        self.0.events_need_accelerations()
     }
     fn event_values(
         &self,
@@ -311,6 +233,9 @@ impl<S: MechanicalSystem<N>, const N: usize> DynMechanicalSystem for StaticSyste
 
 #[cfg(test)]
 mod tests {
+    use std::borrow::Cow;
+
+    use eomgen_description::Parameter;
     use nalgebra::{Matrix2, Vector2};
 
     use super::*;
@@ -324,17 +249,22 @@ mod tests {
     }
 
     impl MechanicalSystem<2> for Skewed {
-        fn name(&self) -> &'static str {
-            "skewed"
-        }
-        fn description(&self) -> &'static str {
-            "a test system"
-        }
-        fn coordinate_names(&self) -> [&'static str; 2] {
-            ["x", "y"]
-        }
-        fn parameter_names(&self) -> &'static [&'static str] {
-            &["k"]
+        fn description(&self) -> &ModelDescription {
+            static DESCRIPTION: ModelDescription = ModelDescription {
+                name: Cow::Borrowed("skewed"),
+                summary: Cow::Borrowed("a test system"),
+                coordinates: Cow::Borrowed(&[Cow::Borrowed("x"), Cow::Borrowed("y")]),
+                parameters: Cow::Borrowed(&[Parameter {
+                    name: Cow::Borrowed("k"),
+                    default: 3.0,
+                }]),
+                points: Cow::Borrowed(&[Cow::Borrowed("p"), Cow::Borrowed("r")]),
+                equilibria: Cow::Borrowed(&[Cow::Borrowed("rest"), Cow::Borrowed("off")]),
+                equations_text: Cow::Borrowed("text"),
+                equations_latex: Cow::Borrowed("latex"),
+                ..ModelDescription::EMPTY
+            };
+            &DESCRIPTION
         }
         fn parameter_values(&self) -> Vec<f64> {
             vec![self.k]
@@ -404,24 +334,9 @@ mod tests {
         fn potential_energy(&self, q: &SVector<f64, 2>, _t: f64) -> f64 {
             0.5 * self.k * (q[0] * q[0] + 2.0 * q[1] * q[1])
         }
-        fn is_conservative(&self) -> bool {
-            false
-        }
-        fn point_names(&self) -> &'static [&'static str] {
-            &["p", "r"]
-        }
         fn point_positions(&self, q: &SVector<f64, 2>, _t: f64, out: &mut [[f64; 3]]) {
             out[0] = [q[0], 0.0, 0.0];
             out[1] = [q[0], q[1], 1.0];
-        }
-        fn equations_text(&self) -> &'static str {
-            "text"
-        }
-        fn equations_latex(&self) -> &'static str {
-            "latex"
-        }
-        fn equilibrium_names(&self) -> &'static [&'static str] {
-            &["rest", "off"]
         }
         fn equilibrium_guesses(&self, out: &mut [f64]) {
             out.copy_from_slice(&[0.0, 0.0, 0.5, -0.5]);
@@ -443,7 +358,7 @@ mod tests {
         let (q, qdot) = (Vector2::new(y[0], y[1]), Vector2::new(y[2], y[3]));
         for model in [&mut compiled as &mut dyn ModelInfo, &mut runtime] {
             assert_eq!(model.num_dofs(), 2);
-            assert_eq!(model.coordinate_names(), ["x", "y"]);
+            assert_eq!(model.description().coordinate_names(), ["x", "y"]);
             assert_eq!(model.initial_state(), y);
             let (m, f) = model.mass_matrix_and_forcing(t, &y);
             let (m0, f0) = system.mass_matrix_and_forcing(&q, &qdot, t);

@@ -19,7 +19,7 @@ use crate::system::MechanicalSystem;
 /// positive definite is [`RhsError::SingularMassMatrix`], a non-finite `q̈` is
 /// [`RhsError::NonFinite`]. No heap allocation.
 ///
-/// With constraints ([`MechanicalSystem::constraint_names`] not empty), `q̈` and the
+/// With constraints ([`ModelDescription::constraints`](crate::ModelDescription::constraints) not empty), `q̈` and the
 /// multipliers `λ` come from the index-1 system `[M Jᵀ; J 0][q̈; λ] = [F; γ]` instead, solved by
 /// LU with partial pivoting on buffers allocated in [`FirstOrder::new`]; the drift control is
 /// [`FirstOrder::stabilization`].
@@ -36,7 +36,7 @@ pub struct FirstOrder<S, const N: usize> {
     pub stabilization: Stabilization,
     /// Buffers and the last multipliers `λ` of a constrained system.
     pub constraints: ConstraintWorkspace,
-    /// The model's events ([`MechanicalSystem::event_specs`]), whose `terminal` flags may be
+    /// The model's events ([`ModelDescription::events`](crate::ModelDescription::events)), whose `terminal` flags may be
     /// changed ([`ModelInfo::set_event_terminal`](crate::ModelInfo::set_event_terminal)).
     pub events: Vec<EventSpec>,
 }
@@ -44,9 +44,10 @@ pub struct FirstOrder<S, const N: usize> {
 impl<S: MechanicalSystem<N>, const N: usize> FirstOrder<S, N> {
     /// Wraps `system`.
     pub fn new(system: S) -> Self {
-        let m = system.constraint_names().len();
-        let holonomic = system.holonomic_constraint_count();
-        let events = system.event_specs().to_vec();
+        let description = system.description();
+        let m = description.constraints.len();
+        let holonomic = description.holonomic_constraints;
+        let events = description.events.to_vec();
         Self {
             system,
             stabilization: Stabilization::None,
@@ -213,7 +214,7 @@ impl<S: MechanicalSystem<N>, const N: usize> OdeSystem for FirstOrder<S, N> {
             return Ok(());
         }
         let (q, qdot) = split::<N>(y);
-        if !self.system.events_need_accelerations() {
+        if !self.system.description().events_need_accelerations {
             let zero = SVector::<f64, N>::zeros();
             self.system.event_values(&q, &qdot, t, &zero, &[], g);
             return Ok(());
@@ -281,9 +282,10 @@ impl<S: DynMechanicalSystem> DynFirstOrder<S> {
     /// Wraps `system`.
     pub fn new(system: S) -> Self {
         let n = system.num_dofs();
-        let m = system.constraint_names().len();
-        let holonomic = system.holonomic_constraint_count();
-        let events = system.event_specs();
+        let description = system.description();
+        let m = description.constraints.len();
+        let holonomic = description.holonomic_constraints;
+        let events = description.events.to_vec();
         Self {
             system,
             stabilization: Stabilization::None,
@@ -491,7 +493,7 @@ impl<S: DynMechanicalSystem> OdeSystem for DynFirstOrder<S> {
         }
         let n = self.n;
         let (q, qdot) = (&y[..n], &y[n..2 * n]);
-        if !self.system.events_need_accelerations() {
+        if !self.system.description().events_need_accelerations {
             self.system.event_values(q, qdot, t, &self.zeros, &[], g);
             return Ok(());
         }

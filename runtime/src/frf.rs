@@ -276,6 +276,7 @@ pub fn linearize_with_inputs(
 
 fn restore(model: &mut dyn ModelInfo, values: &[f64]) {
     let names: Vec<String> = model
+        .description()
         .parameter_names()
         .iter()
         .map(|s| s.to_string())
@@ -291,18 +292,21 @@ fn linearize_with_inputs_inner(
     guess: &[f64],
     inputs: &[&str],
 ) -> Result<ForcedLinearization, FrfError> {
-    if !model.constraint_names().is_empty() {
+    if !model.description().constraint_names().is_empty() {
         return Err(FrfError::Constrained {
-            model: model.name().to_string(),
+            model: model.description().name.to_string(),
         });
     }
     let coordinates: Vec<String> = model
+        .description()
         .coordinate_names()
         .iter()
         .map(|s| s.to_string())
         .collect();
     for input in inputs {
-        if model.parameter_names().contains(input) || !coordinates.iter().any(|c| c == input) {
+        if model.description().parameter_names().contains(input)
+            || !coordinates.iter().any(|c| c == input)
+        {
             model.set_parameter(input, 0.0)?;
         }
     }
@@ -316,7 +320,7 @@ fn linearize_with_inputs_inner(
     let y: Vec<f64> = equilibrium.q.iter().chain(&zeros).copied().collect();
     let mut input_matrix = DMatrix::zeros(n, inputs.len());
     for (j, input) in inputs.iter().enumerate() {
-        if !model.parameter_names().contains(input)
+        if !model.description().parameter_names().contains(input)
             && let Some(i) = coordinates.iter().position(|c| c == input)
         {
             // A unit generalized force on coordinate `i` (N or N·m per unit input).
@@ -368,13 +372,13 @@ fn linearize_with_inputs_inner(
 /// # Errors
 /// [`FrfError::UnknownOutput`].
 pub fn output_index(model: &dyn ModelInfo, output: &str) -> Result<usize, FrfError> {
-    let names = model.coordinate_names();
+    let names = model.description().coordinate_names();
     names
         .iter()
         .position(|c| *c == output)
         .ok_or_else(|| FrfError::UnknownOutput {
             output: output.to_string(),
-            model: model.name().to_string(),
+            model: model.description().name.to_string(),
             coordinates: names.join(", "),
         })
 }

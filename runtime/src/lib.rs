@@ -27,6 +27,7 @@ pub use constrained::{
     StabilizationError,
 };
 pub use dynamic::{DynMechanicalSystem, StaticSystem};
+pub use eomgen_description::{List, Parameter, Text};
 pub use first_order::{DynFirstOrder, FirstOrder};
 pub use floquet::{
     FloquetAnalysis, FloquetError, FloquetOptions, FloquetStability, LARGEST_STABILITY_TOLERANCE,
@@ -61,4 +62,4 @@ pub use response::{
     response_with_modal_damping, state_response_by_eigenvectors, state_response_by_exponential,
     state_response_by_integration,
 };
-pub use system::{BodyCentre, MechanicalSystem, UnknownParameter};
+pub use system::{BodyCentre, MechanicalSystem, ModelDescription, UnknownParameter};

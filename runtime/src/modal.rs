@@ -271,7 +271,7 @@ pub fn find_equilibrium(
 ) -> Result<Equilibrium, ModalError> {
     let n = model.num_dofs();
     check_point(model, guess)?;
-    let m = model.holonomic_constraint_count();
+    let m = model.description().holonomic_constraints;
     let state = |q: &[f64]| -> Vec<f64> {
         q.iter()
             .copied()
@@ -499,7 +499,7 @@ fn newton(
 /// `γ` is exactly quadratic in `q̇`.
 pub fn constraint_hessians(model: &dyn ModelInfo, q: &[f64], t: f64) -> Vec<DMatrix<f64>> {
     let n = model.num_dofs();
-    let m = model.holonomic_constraint_count();
+    let m = model.description().holonomic_constraints;
     let gamma = |v: &[(usize, f64)]| -> DVector<f64> {
         let mut y: Vec<f64> = q
             .iter()
@@ -639,7 +639,7 @@ pub fn time_dependence(
 ) -> Result<Option<TimeDependentForcing>, ModalError> {
     check_point(model, q)?;
     let n = q.len();
-    let m = model.holonomic_constraint_count();
+    let m = model.description().holonomic_constraints;
     let y: Vec<f64> = q
         .iter()
         .copied()
@@ -665,7 +665,13 @@ pub fn time_dependence(
             .iter()
             .map(|&t| model.constraint_equations(t, &y))
             .collect();
-        for (i, name) in model.constraint_names().iter().take(m).enumerate() {
+        for (i, name) in model
+            .description()
+            .constraint_names()
+            .iter()
+            .take(m)
+            .enumerate()
+        {
             // The Jacobian apart from Φ, Φ_t and γ: a constant J with a moving Φ is a
             // prescribed motion (base excitation), which the hint treats differently.
             let jacobian: Vec<DVector<f64>> = constraints
@@ -718,7 +724,7 @@ pub fn time_dependence(
     let i = difference.iamax();
     Ok(Some(TimeDependentForcing {
         t0,
-        coordinate: model.coordinate_names()[i].to_string(),
+        coordinate: model.description().coordinate_names()[i].to_string(),
         largest_change: difference[i].abs(),
         t: times[k],
     }))
@@ -769,11 +775,11 @@ fn check_mass_matrix(mass: &DMatrix<f64>, names: &[&str], q: &[f64]) -> Result<(
 }
 
 fn check_point(model: &dyn ModelInfo, q: &[f64]) -> Result<(), ModalError> {
-    let names = model.constraint_names();
-    let h = model.holonomic_constraint_count();
+    let names = model.description().constraint_names();
+    let h = model.description().holonomic_constraints;
     if names.len() > h {
         return Err(ModalError::NonHolonomic {
-            model: model.name().to_string(),
+            model: model.description().name.to_string(),
             constraint: names[h].to_string(),
         });
     }
@@ -938,12 +944,12 @@ pub fn linearize(
         });
     }
     let n = q.len();
-    let m = model.holonomic_constraint_count();
+    let m = model.description().holonomic_constraints;
     let y: Vec<f64> = q.iter().chain(qdot).copied().collect();
     let (mass, f) = model.mass_matrix_and_forcing(t, &y);
     let (jq, jqd) = model.forcing_jacobians(t, &y);
     let finite = |a: &DMatrix<f64>| a.iter().all(|v| v.is_finite());
-    let names = model.coordinate_names();
+    let names = model.description().coordinate_names();
     if m == 0 {
         check_mass_matrix(&mass, &names, q)?;
         let chol = mass
@@ -982,7 +988,7 @@ pub fn linearize(
         .fold((0, 0.0f64), |b, x| if x.1 > b.1 { x } else { b });
     if residual > 1e-8 {
         return Err(ModalError::OffConstraints {
-            constraint: model.constraint_names()[worst].to_string(),
+            constraint: model.description().constraint_names()[worst].to_string(),
             residual,
         });
     }

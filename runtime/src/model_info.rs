@@ -12,7 +12,7 @@ use nalgebra::{DMatrix, DVector};
 use crate::constrained::{ConstraintWorkspace, ProjectionError, Stabilization};
 use crate::dynamic::DynMechanicalSystem;
 use crate::ode::{EventSpec, OdeSystem, RhsError};
-use crate::system::{BodyCentre, UnknownParameter};
+use crate::system::{ModelDescription, UnknownParameter};
 
 /// A model with its size erased, as the CLI holds it: `Box<dyn ModelInfo>`.
 ///
@@ -23,16 +23,14 @@ use crate::system::{BodyCentre, UnknownParameter};
 ///
 /// Vectors here are runtime-sized; `y = [q; q̇]` has length `2 num_dofs()`.
 pub trait ModelInfo: OdeSystem {
-    /// The model's name.
-    fn name(&self) -> &str;
-    /// One-line description.
-    fn description(&self) -> &str;
-    /// Number of degrees of freedom `n`.
-    fn num_dofs(&self) -> usize;
-    /// Names of the generalized coordinates (length `n`).
-    fn coordinate_names(&self) -> Vec<&str>;
-    /// Parameter names, in file order.
-    fn parameter_names(&self) -> Vec<&str>;
+    /// Everything about the model that is not a function of the state: names of the
+    /// coordinates, parameters, points and constraints, equilibria, events, drawing and the
+    /// derived equations as text ([`MechanicalSystem::description`](crate::MechanicalSystem::description)).
+    fn description(&self) -> &ModelDescription;
+    /// Number of degrees of freedom `n` (the description's coordinates).
+    fn num_dofs(&self) -> usize {
+        self.description().num_dofs()
+    }
     /// Current parameter values.
     fn parameter_values(&self) -> Vec<f64>;
     /// Sets a parameter by name.
@@ -50,22 +48,8 @@ pub trait ModelInfo: OdeSystem {
     fn energy(&self, t: f64, y: &[f64]) -> f64 {
         self.kinetic_energy(t, y) + self.potential_energy(t, y)
     }
-    /// Whether `T + V` is a constant of the motion.
-    fn is_conservative(&self) -> bool;
-    /// Names of the model's points.
-    fn point_names(&self) -> Vec<&str>;
     /// Positions of the points at `(t, y)`, `[x, y, z]` each (m).
     fn point_positions(&self, t: f64, y: &[f64]) -> Vec<[f64; 3]>;
-    /// The `draw: lines` segments as pairs of point names ([`draw_lines`](crate::MechanicalSystem::draw_lines)).
-    fn draw_lines(&self) -> Vec<[&str; 2]>;
-    /// The `draw: trace` point names ([`trace_points`](crate::MechanicalSystem::trace_points)).
-    fn trace_points(&self) -> Vec<&str>;
-    /// The bodies' centres of mass ([`body_centres`](crate::MechanicalSystem::body_centres)).
-    fn body_centres(&self) -> Vec<BodyCentre<'_>>;
-    /// The derived equations as text.
-    fn equations_text(&self) -> &str;
-    /// The derived equations as LaTeX.
-    fn equations_latex(&self) -> &str;
     /// Upcast to the first-order system for an integrator.
     fn as_ode_mut(&mut self) -> &mut dyn OdeSystem;
     /// `M` (`n × n`) and `F` (`n`) at `(t, y)`.
@@ -74,13 +58,9 @@ pub trait ModelInfo: OdeSystem {
     fn forcing_jacobians(&self, t: f64, y: &[f64]) -> (DMatrix<f64>, DMatrix<f64>);
     /// The exact `∂(M a)/∂q` (`n × n`) at `(t, q)` for the vector `a` (length `n`).
     fn mass_matrix_product_jacobian(&self, t: f64, y: &[f64], a: &[f64]) -> DMatrix<f64>;
-    /// Names of the constraints (holonomic first); empty for an unconstrained model.
-    fn constraint_names(&self) -> Vec<&str>;
-    /// How many constraints are holonomic.
-    fn holonomic_constraint_count(&self) -> usize;
     /// Selects the drift control of a constrained model.
     fn set_stabilization(&mut self, stabilization: Stabilization);
-    /// The constraint forces `λ` (length `m`; see [`constraint_names`](crate::MechanicalSystem::constraint_names) for
+    /// The constraint forces `λ` (length `m`; see [`ModelDescription::constraints`] for
     /// their meaning and sign) and `q̈` at `(t, y)`.
     ///
     /// # Errors
@@ -95,9 +75,7 @@ pub trait ModelInfo: OdeSystem {
     /// # Errors
     /// [`ProjectionError`] when Newton does not converge.
     fn project(&mut self, t: f64, y: &mut [f64], free: &[usize]) -> Result<usize, ProjectionError>;
-    /// Indices of the coordinates whose initial values are guesses.
-    fn initial_guesses(&self) -> &[usize];
-    /// The model's named equilibrium guesses `(name, q)` ([`equilibrium_names`](crate::MechanicalSystem::equilibrium_names)).
+    /// The model's named equilibrium guesses `(name, q)` ([`ModelDescription::equilibria`]).
     fn equilibrium_guesses(&self) -> Vec<(&str, Vec<f64>)>;
     /// Makes the model event `name` terminal or not (`eomgen simulate --stop-when NAME`);
     /// returns `false` if the model has no event `name`.
@@ -114,10 +92,10 @@ pub trait ModelInfo: OdeSystem {
     /// [`ProjectionError`] naming the constraint with the largest residual: Newton did not
     /// converge, or (without guesses, `iterations` = 0) the given state violates it.
     fn make_consistent(&mut self, y: &mut [f64]) -> Result<(), ProjectionError> {
-        if self.constraint_names().is_empty() {
+        if self.description().constraints.is_empty() {
             return Ok(());
         }
-        let guesses = self.initial_guesses().to_vec();
+        let guesses = self.description().initial_guesses.to_vec();
         if !guesses.is_empty() {
             return self.project(0.0, y, &guesses).map(|_| ());
         }
@@ -206,20 +184,11 @@ pub struct FirstOrderParts<'a, S: ?Sized> {
 }
 
 impl<F: FirstOrderForm> ModelInfo for F {
-    fn name(&self) -> &str {
-        self.dyn_system().name()
-    }
-    fn description(&self) -> &str {
+    fn description(&self) -> &ModelDescription {
         self.dyn_system().description()
     }
     fn num_dofs(&self) -> usize {
         self.dyn_system().num_dofs()
-    }
-    fn coordinate_names(&self) -> Vec<&str> {
-        self.dyn_system().coordinate_names()
-    }
-    fn parameter_names(&self) -> Vec<&str> {
-        self.dyn_system().parameter_names()
     }
     fn parameter_values(&self) -> Vec<f64> {
         self.dyn_system().parameter_values()
@@ -242,32 +211,11 @@ impl<F: FirstOrderForm> ModelInfo for F {
         let n = self.num_dofs();
         self.dyn_system().potential_energy(&y[..n], t)
     }
-    fn is_conservative(&self) -> bool {
-        self.dyn_system().is_conservative()
-    }
-    fn point_names(&self) -> Vec<&str> {
-        self.dyn_system().point_names()
-    }
     fn point_positions(&self, t: f64, y: &[f64]) -> Vec<[f64; 3]> {
         let system = self.dyn_system();
-        let mut out = vec![[0.0; 3]; system.point_names().len()];
+        let mut out = vec![[0.0; 3]; system.description().points.len()];
         system.point_positions(&y[..system.num_dofs()], t, &mut out);
         out
-    }
-    fn draw_lines(&self) -> Vec<[&str; 2]> {
-        self.dyn_system().draw_lines()
-    }
-    fn trace_points(&self) -> Vec<&str> {
-        self.dyn_system().trace_points()
-    }
-    fn body_centres(&self) -> Vec<BodyCentre<'_>> {
-        self.dyn_system().body_centres()
-    }
-    fn equations_text(&self) -> &str {
-        self.dyn_system().equations_text()
-    }
-    fn equations_latex(&self) -> &str {
-        self.dyn_system().equations_latex()
     }
     fn as_ode_mut(&mut self) -> &mut dyn OdeSystem {
         self
@@ -298,12 +246,6 @@ impl<F: FirstOrderForm> ModelInfo for F {
         self.dyn_system()
             .mass_matrix_product_jacobian(&y[..n], t, &a[..n], out.as_mut_slice());
         out
-    }
-    fn constraint_names(&self) -> Vec<&str> {
-        self.dyn_system().constraint_names()
-    }
-    fn holonomic_constraint_count(&self) -> usize {
-        self.dyn_system().holonomic_constraint_count()
     }
     fn set_stabilization(&mut self, stabilization: Stabilization) {
         *self.parts_mut().stabilization = stabilization;
@@ -344,19 +286,16 @@ impl<F: FirstOrderForm> ModelInfo for F {
         y[..2 * n].copy_from_slice(&projected);
         Ok(iterations)
     }
-    fn initial_guesses(&self) -> &[usize] {
-        self.dyn_system().initial_guesses()
-    }
     fn equilibrium_guesses(&self) -> Vec<(&str, Vec<f64>)> {
         let system = self.dyn_system();
         let n = system.num_dofs();
-        let names = system.equilibrium_names();
+        let names = &system.description().equilibria;
         let mut values = vec![0.0; n * names.len()];
         system.equilibrium_guesses(&mut values);
         names
-            .into_iter()
+            .iter()
             .zip(values.chunks(n.max(1)))
-            .map(|(name, q)| (name, q.to_vec()))
+            .map(|(name, q)| (name.as_ref(), q.to_vec()))
             .collect()
     }
     fn set_event_terminal(&mut self, name: &str, terminal: bool) -> bool {
@@ -372,8 +311,8 @@ impl<F: FirstOrderForm> ModelInfo for F {
         let system = self.dyn_system();
         let n = system.num_dofs();
         let (q, qdot) = (&y[..n], &y[n..2 * n]);
-        let m = system.constraint_names().len();
-        let h = system.holonomic_constraint_count();
+        let m = system.description().constraints.len();
+        let h = system.description().holonomic_constraints;
         let mut phi = vec![0.0; h];
         let mut jacobian = vec![0.0; m * n];
         let mut velocity = vec![0.0; m];

@@ -2,8 +2,6 @@
 //! and the event functions an integration locates on them ([`EventSpec`], [`EventDirection`],
 //! [`Event`]; the root finding is in [`crate::integrate`]).
 
-use std::borrow::Cow;
-
 use serde::Serialize;
 
 /// Why a right-hand side could not be evaluated at a state.
@@ -292,82 +290,7 @@ where
     }
 }
 
-/// Which zero crossings of an event function count.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
-#[serde(rename_all = "lowercase")]
-pub enum EventDirection {
-    /// `g` goes from negative to non-negative ("reaches zero from below").
-    Rising,
-    /// `g` goes from positive to non-positive ("reaches zero from above": HW21's velocity
-    /// reaching zero at a peak).
-    Falling,
-    /// Either (the default).
-    #[default]
-    Both,
-}
-
-impl EventDirection {
-    /// Parses `rising`, `falling` or `both`.
-    pub fn from_name(name: &str) -> Option<Self> {
-        match name {
-            "rising" => Some(Self::Rising),
-            "falling" => Some(Self::Falling),
-            "both" => Some(Self::Both),
-            _ => None,
-        }
-    }
-
-    /// `rising`, `falling` or `both`.
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::Rising => "rising",
-            Self::Falling => "falling",
-            Self::Both => "both",
-        }
-    }
-
-    /// Whether `g` going from `before` to `after` over a step is a crossing this direction
-    /// counts: a sign change from a nonzero `before` to an `after` of the other sign or zero.
-    pub fn crosses(self, before: f64, after: f64) -> bool {
-        let rising = before < 0.0 && after >= 0.0;
-        let falling = before > 0.0 && after <= 0.0;
-        match self {
-            Self::Rising => rising,
-            Self::Falling => falling,
-            Self::Both => rising || falling,
-        }
-    }
-}
-
-/// An event function's name, the crossings that count and whether it stops the integration.
-///
-/// The function itself is component `i` of
-/// [`OdeSystem::event_values`] for the `i`-th spec of
-/// [`OdeSystem::event_specs`].
-#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
-pub struct EventSpec {
-    /// Name, as in the model file's `events:` or given on the command line.
-    pub name: Cow<'static, str>,
-    /// Which crossings count.
-    pub direction: EventDirection,
-    /// Whether the first counted crossing ends the integration (`--stop-when`).
-    pub terminal: bool,
-}
-
-impl EventSpec {
-    /// A spec named `name`.
-    pub fn new(
-        name: impl Into<Cow<'static, str>>,
-        direction: EventDirection,
-        terminal: bool,
-    ) -> Self {
-        Self {
-            name: name.into(),
-            direction,
-            terminal,
-        }
-    }
-}
+pub use eomgen_description::{EventDirection, EventSpec};
 
 /// A located zero of an event function.
 #[derive(Debug, Clone, PartialEq, Serialize)]

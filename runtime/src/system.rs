@@ -8,8 +8,6 @@
 
 use nalgebra::{SMatrix, SVector};
 
-use crate::ode::EventSpec;
-
 /// A parameter name that the model does not have.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 #[error("model `{model}` has no parameter `{name}` (it has: {known})")]
@@ -22,17 +20,7 @@ pub struct UnknownParameter {
     pub known: String,
 }
 
-/// A body of a model's kinematic form and the point at its centre of mass, for drawings
-/// (`eomgen animate` marks it).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct BodyCentre<'a> {
-    /// The body's name in the model file.
-    pub body: &'a str,
-    /// The point at its centre of mass (one of [`MechanicalSystem::point_names`]).
-    pub point: &'a str,
-    /// A planar rigid body (`true`) or a particle.
-    pub rigid: bool,
-}
+pub use eomgen_description::{BodyCentre, ModelDescription};
 
 /// Equations of motion `M(q, t) q̈ = F(q, q̇, t)` of a mechanism with `N` degrees of freedom.
 ///
@@ -50,15 +38,12 @@ pub struct BodyCentre<'a> {
 /// Lagrange's equations in the form of lecture 9 (syllabus), with
 /// `M = ∂²T/∂q̇∂q̇ᵀ` and `F = ∂T/∂q − ∂V/∂q − (∂²T/∂q̇∂qᵀ) q̇ − ∂²T/∂q̇∂t + Q`.
 pub trait MechanicalSystem<const N: usize> {
-    /// The model's name, as in its file (`double_pendulum`).
-    fn name(&self) -> &'static str;
-    /// One-line description from the model file.
-    fn description(&self) -> &'static str;
-    /// Names of the generalized coordinates `q`, in order.
-    fn coordinate_names(&self) -> [&'static str; N];
-    /// Names of the parameters, in file order.
-    fn parameter_names(&self) -> &'static [&'static str];
-    /// Current parameter values, in the order of [`Self::parameter_names`].
+    /// Everything about the model that is not a function of the state: names of the
+    /// coordinates (`N` of them), parameters and their defaults, points, constraints,
+    /// equilibria, events, drawing and the derived equations as text. Generated code returns
+    /// a `static`.
+    fn description(&self) -> &ModelDescription;
+    /// Current parameter values, in the order of [`ModelDescription::parameters`].
     fn parameter_values(&self) -> Vec<f64>;
     /// Sets parameter `name` to `value`.
     ///
@@ -107,50 +92,12 @@ pub trait MechanicalSystem<const N: usize> {
     fn kinetic_energy(&self, q: &SVector<f64, N>, qdot: &SVector<f64, N>, t: f64) -> f64;
     /// Potential energy `V(q, t)` (J) of gravity and springs, plus the file's `potential`.
     fn potential_energy(&self, q: &SVector<f64, N>, t: f64) -> f64;
-    /// Whether every load is conservative and nothing depends explicitly on `t`, so that
-    /// `T + V` is a constant of the motion.
-    fn is_conservative(&self) -> bool;
-    /// Names of the model's points, in file order (empty for the energy form).
-    fn point_names(&self) -> &'static [&'static str];
     /// Positions of the points (m), `[x, y, z]` with `z = 0` for 2-D models, written into
-    /// `out` (length `point_names().len()`).
+    /// `out` (length `description().points.len()`).
     fn point_positions(&self, q: &SVector<f64, N>, t: f64, out: &mut [[f64; 3]]);
-    /// The file's `draw: lines`: segments between named points (names from
-    /// [`Self::point_names`]), in file order; empty by default.
-    fn draw_lines(&self) -> &'static [[&'static str; 2]] {
-        &[]
-    }
-    /// The file's `draw: trace`: points whose trajectories are traced, in file order; empty by
-    /// default.
-    fn trace_points(&self) -> &'static [&'static str] {
-        &[]
-    }
-    /// Where each body of the kinematic form sits: its centre of mass (a rigid body's `com`,
-    /// a particle's `at`), in file order; empty for the energy form.
-    fn body_centres(&self) -> &'static [BodyCentre<'static>] {
-        &[]
-    }
-    /// The derived equations as plain text (`M`, `F`, `T`, `V`).
-    fn equations_text(&self) -> &'static str;
-    /// The derived equations as LaTeX.
-    fn equations_latex(&self) -> &'static str;
 
-    /// Names of the constraints, holonomic (`constraints:`) first, then non-holonomic
-    /// (`nonholonomic:`); `m` of them, none for an unconstrained model (the default).
-    ///
-    /// With constraints, the equations of motion are the index-1 DAE
-    /// `[M Jᵀ; J 0][q̈; λ] = [F; γ]` (lectures 8–11), so `M q̈ = F − Jᵀλ`: `λᵢ` is the
-    /// generalized force of constraint `i` along `−∇Φᵢ` — for a rod written
-    /// `Φ = |r_A − r_B| − ℓ`, its tension in N, positive in tension.
-    fn constraint_names(&self) -> &'static [&'static str] {
-        &[]
-    }
-    /// How many of [`Self::constraint_names`] are holonomic (they come first).
-    fn holonomic_constraint_count(&self) -> usize {
-        0
-    }
     /// `Φ(q, t)` of the holonomic constraints, written into `out` (length
-    /// [`Self::holonomic_constraint_count`]); units of the file's expressions.
+    /// [`ModelDescription::holonomic_constraints`]); units of the file's expressions.
     fn constraint_residuals(&self, q: &SVector<f64, N>, t: f64, out: &mut [f64]) {
         let _ = (q, t, out);
     }
@@ -181,42 +128,19 @@ pub trait MechanicalSystem<const N: usize> {
     ) {
         let _ = (q, qdot, t, out);
     }
-    /// Indices of the coordinates whose initial values are guesses (`{ guess: … }` in the
-    /// file), to be solved with their rates from the constraints.
-    fn initial_guesses(&self) -> &'static [usize] {
-        &[]
-    }
 
-    /// The model file's `equilibria:` names, in file order (issue 7; lecture 25); empty by
-    /// default.
-    fn equilibrium_names(&self) -> &'static [&'static str] {
-        &[]
-    }
-
-    /// The guesses of [`Self::equilibrium_names`], `N` coordinates each, one after the other
+    /// The guesses of [`ModelDescription::equilibria`], `N` coordinates each, one after the other
     /// (`out` has `N · equilibrium_names().len()` entries).
     fn equilibrium_guesses(&self, out: &mut [f64]) {
         let _ = out;
     }
 
-    /// The model file's `events:` (issue 6, item 2; lecture 17, HW21, HW36): names,
-    /// directions and whether each ends the integration, in file order; empty by default.
-    fn event_specs(&self) -> &'static [EventSpec] {
-        &[]
-    }
-
-    /// Whether an event function uses the accelerations `q̈` or the constraint forces `λ`
-    /// (then [`FirstOrder`](crate::FirstOrder) solves for them before calling [`Self::event_values`]).
-    fn events_need_accelerations(&self) -> bool {
-        false
-    }
-
-    /// The event functions `gᵢ(q, q̇, q̈, λ, t)` into `out` (one per [`Self::event_specs`]
+    /// The event functions `gᵢ(q, q̇, q̈, λ, t)` into `out` (one per [`ModelDescription::events`]
     /// entry).
     ///
     /// # Shapes
-    /// `qddot`: `N` (zeros unless [`Self::events_need_accelerations`]); `lambda`: the `m`
-    /// constraint forces (see [`Self::constraint_names`]; empty unless needed, and a function
+    /// `qddot`: `N` (zeros unless [`ModelDescription::events_need_accelerations`]); `lambda`: the `m`
+    /// constraint forces (see [`ModelDescription::constraints`]; empty unless needed, and a function
     /// that reads a missing one gets NaN); `out`: one entry per event.
     fn event_values(
         &self,

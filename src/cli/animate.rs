@@ -142,17 +142,18 @@ impl Scene {
     /// A usage error when the model has no points, no `draw:` lines and nothing to trace,
     /// or a traced name is not one of its points.
     fn of(model: &dyn ModelInfo, trace: &[String]) -> Result<Self, CliError> {
-        let all = model.point_names();
+        let all = model.description().point_names();
         if all.is_empty() {
             return Err(CliError::usage(format!(
                 "`{}` has no points, so there is no mechanism to animate; give its model file `points:` and `draw: {{ lines: [[A, B]], trace: [B] }}`",
-                model.name()
+                model.description().name
             )));
         }
         let index = |n: &str| all.iter().position(|p| *p == n);
         let traced: Vec<usize> = if trace.is_empty() {
             model
-                .trace_points()
+                .description()
+                .trace_point_names()
                 .iter()
                 .filter_map(|p| index(p))
                 .collect()
@@ -162,7 +163,7 @@ impl Scene {
                 let i = index(name.trim()).ok_or_else(|| {
                     CliError::usage(format!(
                         "--trace {name}: `{}` has no point `{}` (points: {})",
-                        model.name(),
+                        model.description().name,
                         name.trim(),
                         all.join(", ")
                     ))
@@ -174,23 +175,25 @@ impl Scene {
             out
         };
         let lines: Vec<[usize; 2]> = model
-            .draw_lines()
+            .description()
+            .draw_line_names()
             .iter()
             .filter_map(|[a, b]| Some([index(a)?, index(b)?]))
             .collect();
         if lines.is_empty() && traced.is_empty() {
             return Err(CliError::usage(format!(
                 "`{}` has no `draw:` block, so there is nothing to animate; add `draw: {{ lines: [[{a}, {b}]], trace: [{b}] }}` to its model file, with lines between its points ({}), or pass --trace POINT",
-                model.name(),
+                model.description().name,
                 all.join(", "),
                 a = all[0],
                 b = all[all.len() - 1],
             )));
         }
         let centres: Vec<(usize, bool, String)> = model
-            .body_centres()
+            .description()
+            .body_centres
             .iter()
-            .filter_map(|c| Some((index(c.point)?, c.rigid, c.body.to_string())))
+            .filter_map(|c| Some((index(&c.point)?, c.rigid, c.body.to_string())))
             .collect();
         let mut used: Vec<usize> = lines.iter().flatten().copied().collect();
         used.extend(&traced);
@@ -208,8 +211,12 @@ impl Scene {
         dots.sort_unstable();
         dots.dedup();
         Ok(Self {
-            model: model.name().to_string(),
-            title: format!("{} — {}", model.name(), model.description()),
+            model: model.description().name.to_string(),
+            title: format!(
+                "{} — {}",
+                model.description().name,
+                model.description().summary
+            ),
             names: used.iter().map(|&i| all[i].to_string()).collect(),
             lines: lines.iter().map(|[a, b]| [local(*a), local(*b)]).collect(),
             dots,
@@ -343,7 +350,7 @@ pub(crate) fn simulation(
                 short(solution.t[m - 1])
             ),
         };
-        failure_error(model.name(), &e, cause.as_ref(), args, &kept)
+        failure_error(&model.description().name, &e, cause.as_ref(), args, &kept)
     });
     if samples == 0 {
         return Ok((None, failure));
@@ -374,7 +381,7 @@ pub(crate) fn simulation(
     let max_drift = energy_drift.drift.unwrap_or(0.0);
     let (e0, energy) = (energy_drift.initial_energy, energy_drift.energy);
     let method = format!("{method_name} ({})", args.step_control());
-    let conserved = if model.is_conservative() {
+    let conserved = if model.description().conservative {
         ""
     } else {
         " (not conserved: non-conservative loads or explicit time dependence)"
@@ -395,8 +402,8 @@ pub(crate) fn simulation(
             ""
         }
     );
-    check_finite(model.name(), &frames)?;
-    check_finite(model.name(), &trail)?;
+    check_finite(&model.description().name, &frames)?;
+    check_finite(&model.description().name, &trail)?;
     let clip = Clip {
         label: "simulation".to_string(),
         info,
@@ -476,7 +483,7 @@ pub(crate) fn modes(
                 scene.project(&positions(&mode_plot::displaced(q, &psi, amplitude)))
             })
             .collect();
-        check_finite(model.name(), &frames)?;
+        check_finite(&model.description().name, &frames)?;
         let described = mode_plot::describe(k + 1, omega, kind);
         let motion = match s {
             Some(s) => format!("q* + {} ψ{} sin(ω t)", short(s), k + 1),
@@ -515,7 +522,7 @@ pub(crate) fn modes(
     if clips.is_empty() {
         return Err(CliError::failure(format!(
             "`{}` has no modes to animate",
-            model.name()
+            model.description().name
         )));
     }
     Ok(Animation { scene, clips })

@@ -138,7 +138,7 @@ pub fn run(args: &FloquetArgs) -> Result<(), CliError> {
         FloquetStudyError::OperatingPoint(e) => super::modes::point_failure(model.as_ref(), &e),
         e => CliError::failure(format!(
             "`{}` at {label}: {}",
-            model.name(),
+            model.description().name,
             analysis_text(model.as_ref(), &e)
         )),
     })?;
@@ -158,7 +158,7 @@ pub fn run(args: &FloquetArgs) -> Result<(), CliError> {
             Some(FloquetChart { x, y, cells: grid }) => {
                 let title = format!(
                     "{} at {label}: Floquet stability over {} and {}",
-                    model.name(),
+                    model.description().name,
                     x.name,
                     y.name
                 );
@@ -170,7 +170,10 @@ pub fn run(args: &FloquetArgs) -> Result<(), CliError> {
                 stability_chart(path, &title, [x, y], &labels, grid, curves)
             }
             _ => {
-                let title = format!("{} at {label}: Floquet multipliers", model.name());
+                let title = format!(
+                    "{} at {label}: Floquet multipliers",
+                    model.description().name
+                );
                 multiplier_chart(path, &title, &point.floquet)
             }
         }
@@ -215,14 +218,14 @@ struct Report<'a> {
 /// The JSON of `report`.
 fn json_report(report: &Report<'_>) -> Value {
     let (args, model, label, point) = (report.args, report.model, report.label, report.point);
-    let names = model.coordinate_names();
+    let names = model.description().coordinate_names();
     let complex = |c: &nalgebra::Complex<f64>| json!({"re": c.re, "im": c.im, "modulus": c.norm()});
     let f = &point.floquet;
     let monodromy = super::modes::matrix_rows(&f.monodromy_matrix);
     let mut operating_point = point_json(label, &names, &point.q);
     operating_point["max_forcing_residual"] = json!(point.residual);
     let mut out = json!({
-        "model": model.name(),
+        "model": model.description().name,
         "coordinates": names,
         "operating_point": operating_point,
         "period_parameter": args.period_parameter,
@@ -263,7 +266,7 @@ fn print_report(stdout: &mut impl std::io::Write, report: &Report<'_>) {
         thresholds,
         sweep,
     } = *report;
-    let names = model.coordinate_names();
+    let names = model.description().coordinate_names();
     let f = &point.floquet;
     let q: Vec<String> = names
         .iter()
@@ -273,7 +276,7 @@ fn print_report(stdout: &mut impl std::io::Write, report: &Report<'_>) {
     let _ = writeln!(
         stdout,
         "model        {} ({} dof)",
-        model.name(),
+        model.description().name,
         names.len()
     );
     let _ = writeln!(
@@ -494,11 +497,11 @@ fn parse_sweep(spec: &str, model: &dyn ModelInfo) -> Result<(Axis, Axis), CliErr
     let mut axes = Vec::new();
     for part in spec.split(',') {
         let (name, rest) = split_assignment(part, "--sweep")?;
-        if !model.parameter_names().contains(&name) {
+        if !model.description().parameter_names().contains(&name) {
             return Err(CliError::usage(format!(
                 "--sweep: `{}` has no parameter `{name}` (it has: {})",
-                model.name(),
-                model.parameter_names().join(", ")
+                model.description().name,
+                model.description().parameter_names().join(", ")
             )));
         }
         let bad = || {

@@ -94,7 +94,7 @@ pub(super) fn study_failure(model: &dyn ModelInfo, e: &ResponseStudyError) -> Cl
             source,
         } => CliError::usage(format!("--rayleigh-modes {a},{b}: {source}")),
         ResponseStudyError::Response(e) => response_failure(model, e),
-        e => CliError::failure(format!("`{}`: {e}", model.name())),
+        e => CliError::failure(format!("`{}`: {e}", model.description().name)),
     }
 }
 
@@ -236,7 +236,7 @@ pub fn run(args: &FreeResponseArgs) -> Result<(), CliError> {
         .map_err(|e| CliError::failure(e.to_string()))?;
     let (label, responses) = (&study.operating_point.name, &study.responses);
     let n = model.num_dofs();
-    let names = model.coordinate_names();
+    let names = model.description().coordinate_names();
     if let Some(path) = &args.plot {
         let panel_list: Vec<Panel> = (0..n)
             .map(|j| {
@@ -256,7 +256,7 @@ pub fn run(args: &FreeResponseArgs) -> Result<(), CliError> {
             .collect();
         let title = format!(
             "{} at {label}: free response four ways (HW28)",
-            model.name()
+            model.description().name
         );
         panels(path, &title, &panel_list).map_err(CliError::failure)?;
     }
@@ -289,10 +289,10 @@ fn print_json(
     } = study;
     let (label, (q0, v0)) = (&point.name, (&initial.q, &initial.qdot));
     let n = model.num_dofs();
-    let names = model.coordinate_names();
+    let names = model.description().coordinate_names();
     let samples = responses[0].1.times.len();
     let out = json!({
-        "model": model.name(),
+        "model": model.description().name,
         "coordinates": names,
         "operating_point": point_json(label, &names, &study.linearization.q),
         "ignored_damping": ignored_damping,
@@ -345,12 +345,12 @@ fn print_text(stdout: &mut impl std::io::Write, model: &dyn ModelInfo, study: &F
     } = study;
     let (label, (q0, v0)) = (&point.name, (&initial.q, &initial.qdot));
     let n = model.num_dofs();
-    let names = model.coordinate_names();
+    let names = model.description().coordinate_names();
     let samples = responses[0].1.times.len();
     let _ = writeln!(
         stdout,
         "model      {} ({} dof) at {label}: M δq̈ + K δq = 0, 0 ≤ t ≤ {t_end:.6} s, {} samples",
-        model.name(),
+        model.description().name,
         n,
         samples
     );
@@ -421,6 +421,6 @@ fn print_text(stdout: &mut impl std::io::Write, model: &dyn ModelInfo, study: &F
 pub(super) fn response_failure(model: &dyn ModelInfo, e: &eomgen::ResponseError) -> CliError {
     match e {
         eomgen::ResponseError::Modal(m) => super::modes::modal_failure(model, m),
-        e => CliError::failure(format!("`{}`: {e}", model.name())),
+        e => CliError::failure(format!("`{}`: {e}", model.description().name)),
     }
 }

@@ -81,7 +81,7 @@ pub struct FrfArgs {
 
 /// The error of a failed analysis of `model`, in the words of the options.
 fn failure(model: &dyn ModelInfo, e: FrfAnalysisError) -> CliError {
-    let name = model.name();
+    let name = &model.description().name;
     match e {
         FrfAnalysisError::TooFewPoints { .. } => CliError::usage("--points must be at least 2"),
         FrfAnalysisError::UnknownInput { ref input, .. } => {
@@ -216,7 +216,11 @@ pub fn run(args: &FrfArgs) -> Result<(), CliError> {
     if let Some(path) = &args.plot {
         bode_chart(
             path,
-            &format!("{}: frequency response from {}", model.name(), args.input),
+            &format!(
+                "{}: frequency response from {}",
+                model.description().name,
+                args.input
+            ),
             &frf.outputs,
             &frf.sweeps,
             simulated.map(|(s, _)| s),
@@ -247,7 +251,7 @@ fn json_report(
     frf: &FrfAnalysis,
     simulated: Option<(&[SimulatedPoint], &FrfSimulationPlan)>,
 ) -> Value {
-    let name = model.name();
+    let name = &model.description().name;
     let (outputs, forced) = (&frf.outputs, &frf.forced);
     let (modes, damping) = (&frf.normal_modes, &frf.modal_damping);
     let b: Vec<f64> = forced.input_matrix.column(0).iter().copied().collect();
@@ -278,7 +282,7 @@ fn json_report(
         "model": name,
         "input": args.input,
         "outputs": outputs.iter().map(|o| o.name.clone()).collect::<Vec<_>>(),
-        "operating_point": point_json(&frf.operating_point.name, &model.coordinate_names(), &forced.equilibrium.q),
+        "operating_point": point_json(&frf.operating_point.name, &model.description().coordinate_names(), &forced.equilibrium.q),
         "input_matrix": b,
         "natural_frequencies": modes.natural_frequencies,
         "damping_ratios": damping.damping_ratios,
@@ -324,7 +328,7 @@ fn print_report(
     frf: &FrfAnalysis,
     simulated: Option<(&[SimulatedPoint], &FrfSimulationPlan)>,
 ) {
-    let name = model.name();
+    let name = &model.description().name;
     let (lo, hi) = frf.frequency_range;
     let FrfAnalysis {
         operating_point: point,
@@ -340,6 +344,7 @@ fn print_report(
     let n = model.num_dofs();
     let _ = writeln!(out, "model      {name} ({n} dof), input {}", args.input);
     let point: Vec<String> = model
+        .description()
         .coordinate_names()
         .iter()
         .zip(&forced.equilibrium.q)
@@ -573,7 +578,7 @@ fn simulate_points(
     frf: &FrfAnalysis,
     plan: &FrfSimulationPlan,
 ) -> Result<Vec<SimulatedPoint>, CliError> {
-    let name = model.name();
+    let name = &model.description().name;
     let k = plan.frequencies.len();
     let progress = super::render::progress_bar(
         k,

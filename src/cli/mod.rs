@@ -304,21 +304,25 @@ fn list(json: bool) -> Result<(), CliError> {
     if json {
         let items: Vec<serde_json::Value> = models
             .iter()
-            .map(|m| serde_json::json!({"name": m.name(), "dof": m.num_dofs(), "description": m.description()}))
+            .map(|m| serde_json::json!({"name": m.description().name, "dof": m.num_dofs(), "description": m.description().summary}))
             .collect();
         outln!(
             "{}",
             serde_json::to_string_pretty(&items).map_err(|e| CliError::failure(e.to_string()))?
         );
     } else {
-        let width = models.iter().map(|m| m.name().len()).max().unwrap_or(4);
+        let width = models
+            .iter()
+            .map(|m| m.description().name.len())
+            .max()
+            .unwrap_or(4);
         outln!("{:width$}  dof  description", "name");
         for m in &models {
             outln!(
                 "{:width$}  {:>3}  {}",
-                m.name(),
+                m.description().name,
                 m.num_dofs(),
-                m.description()
+                m.description().summary
             );
         }
     }

@@ -93,7 +93,7 @@ pub fn run(args: &ModalDampingArgs) -> Result<(), CliError> {
         ..
     } = &study;
     let label = &point.name;
-    let names = model.coordinate_names();
+    let names = model.description().coordinate_names();
     if let Some(path) = &args.plot {
         let panel_list: Vec<Panel> = cases
             .iter()
@@ -126,7 +126,10 @@ pub fn run(args: &ModalDampingArgs) -> Result<(), CliError> {
                 }
             })
             .collect();
-        let title = format!("{} at {label}: damped free response (HW34)", model.name());
+        let title = format!(
+            "{} at {label}: damped free response (HW34)",
+            model.description().name
+        );
         panels(path, &title, &panel_list).map_err(CliError::failure)?;
     }
 
@@ -144,11 +147,11 @@ pub fn run(args: &ModalDampingArgs) -> Result<(), CliError> {
 /// The JSON of `study`.
 fn json_report(model: &dyn ModelInfo, study: &ModalDampingStudy) -> serde_json::Value {
     let (lin, approx, cases) = (&study.linearization, &study.modal_damping, &study.releases);
-    let names = model.coordinate_names();
+    let names = model.description().coordinate_names();
     let samples = cases.first().map_or(0, |c| c.exact.times.len());
 
     json!({
-        "model": model.name(),
+        "model": model.description().name,
         "coordinates": names,
         "operating_point": point_json(&study.operating_point.name, &names, &lin.q),
         "mass_matrix": matrix_rows(&lin.mass_matrix),
@@ -206,7 +209,7 @@ fn print_report(
     let _ = writeln!(
         stdout,
         "model      {} ({} dof) at {label}: M δq̈ + C δq̇ + K δq = 0",
-        model.name(),
+        model.description().name,
         n
     );
     let _ = writeln!(

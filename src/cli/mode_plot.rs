@@ -40,10 +40,10 @@ pub fn chart_path(prefix: &str, mode: usize) -> String {
 /// # Errors
 /// A usage error naming the model when it has no `points:` (an energy-form model).
 pub fn check_drawable(model: &dyn ModelInfo) -> Result<(), CliError> {
-    if model.point_names().is_empty() {
+    if model.description().point_names().is_empty() {
         return Err(CliError::usage(format!(
             "`{}` has no points, so there is no mechanism to draw its mode shapes on; drop --plot, or give the model file `points:` and `draw: {{ lines: [[A, B]] }}`",
-            model.name()
+            model.description().name
         )));
     }
     Ok(())
@@ -67,15 +67,22 @@ impl Layout {
     /// lines' ends and the traced points, or every point when the file draws nothing.
     /// `three_d`: whether any point leaves the plane z = 0.
     pub(super) fn of(model: &dyn ModelInfo, three_d: bool) -> Self {
-        let names = model.point_names();
+        let names = model.description().point_names();
         let index = |n: &str| names.iter().position(|p| *p == n);
         let lines: Vec<[usize; 2]> = model
-            .draw_lines()
+            .description()
+            .draw_line_names()
             .iter()
             .filter_map(|[a, b]| Some([index(a)?, index(b)?]))
             .collect();
         let mut dots: Vec<usize> = lines.iter().flatten().copied().collect();
-        dots.extend(model.trace_points().iter().filter_map(|p| index(p)));
+        dots.extend(
+            model
+                .description()
+                .trace_point_names()
+                .iter()
+                .filter_map(|p| index(p)),
+        );
         if dots.is_empty() {
             dots = (0..names.len()).collect();
         }
@@ -204,7 +211,11 @@ pub fn mode_charts(
     let mut paths = Vec::with_capacity(modes.natural_frequencies.len());
     for (k, omega, kind, psi) in each_mode(modes, shapes) {
         let at = |s: f64| displaced(q, &psi, s);
-        let mut title = format!("{}, {}", model.name(), describe(k + 1, omega, kind));
+        let mut title = format!(
+            "{}, {}",
+            model.description().name,
+            describe(k + 1, omega, kind)
+        );
         let displaced = if let Some(s) = mode_scale(model, &layout, q, &psi, size) {
             let plus = frame(model, &layout, &at(s));
             let minus = frame(model, &layout, &at(-s));
@@ -212,7 +223,7 @@ pub fn mode_charts(
             if !(finite(&plus) && finite(&minus)) {
                 return Err(CliError::failure(format!(
                     "`{}`: mode {} displaced by ±{s:.3e} ψ leaves the model's domain (a point is not finite)",
-                    model.name(),
+                    model.description().name,
                     k + 1
                 )));
             }

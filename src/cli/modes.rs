@@ -108,6 +108,7 @@ pub fn run(args: &ModesArgs) -> Result<(), CliError> {
     // Mode shapes in the model's coordinates (δq = N z with constraints).
     let shapes_q = modal.mode_shape_matrix();
     let multipliers: serde_json::Map<String, serde_json::Value> = model
+        .description()
         .constraint_names()
         .iter()
         .zip(&lin.lagrange_multipliers)
@@ -168,12 +169,12 @@ fn print_json(
         time_dependent_forcing: forcing,
     } = modal;
     let (label, equilibrium) = (&point.name, &point.equilibrium);
-    let names = model.coordinate_names();
+    let names = model.description().coordinate_names();
     let mut point = point_json(label, &names, &equilibrium.q);
     point["newton_iterations"] = json!(equilibrium.iterations);
     point["residual"] = json!(equilibrium.residual);
     let out = json!({
-        "model": model.name(),
+        "model": model.description().name,
         "coordinates": names,
         "operating_point": point,
         "natural_frequencies": modes.natural_frequencies,
@@ -221,10 +222,15 @@ fn print_text(
         ..
     } = modal;
     let (label, equilibrium) = (&point.name, &point.equilibrium);
-    let names = model.coordinate_names();
+    let names = model.description().coordinate_names();
     let n = model.num_dofs();
     let undamped = modal.is_undamped();
-    let _ = writeln!(stdout, "model      {} ({} dof)", model.name(), n);
+    let _ = writeln!(
+        stdout,
+        "model      {} ({} dof)",
+        model.description().name,
+        n
+    );
     let point: Vec<String> = names
         .iter()
         .zip(&equilibrium.q)
@@ -366,7 +372,7 @@ pub(super) fn analysis_of(
 pub(super) fn modal_failure(model: &dyn ModelInfo, e: &eomgen::ModalError) -> CliError {
     CliError::failure(format!(
         "`{}`: {e}\nhelp: {}",
-        model.name(),
+        model.description().name,
         modal_hint(model, e)
     ))
 }
@@ -374,7 +380,7 @@ pub(super) fn modal_failure(model: &dyn ModelInfo, e: &eomgen::ModalError) -> Cl
 /// What to try after `e` (see [`modal_failure`]).
 pub(super) fn modal_hint(model: &dyn ModelInfo, e: &eomgen::ModalError) -> String {
     use eomgen::{ModalError, NewtonStop};
-    let name = model.name();
+    let name = &model.description().name;
     let named: Vec<&str> = model
         .equilibrium_guesses()
         .iter()
@@ -383,13 +389,13 @@ pub(super) fn modal_hint(model: &dyn ModelInfo, e: &eomgen::ModalError) -> Strin
     let start = if named.is_empty() {
         format!(
             "--at {}=…, one value per coordinate",
-            model.coordinate_names().join("=…,")
+            model.description().coordinate_names().join("=…,")
         )
     } else {
         format!(
             "--at NAME with one of the file's `equilibria:` ({}), or --at {}=…",
             named.join(", "),
-            model.coordinate_names().join("=…,")
+            model.description().coordinate_names().join("=…,")
         )
     };
     match e {
@@ -444,7 +450,7 @@ pub(super) fn modal_hint(model: &dyn ModelInfo, e: &eomgen::ModalError) -> Strin
         }
         ModalError::DimensionMismatch { .. } => format!(
             "give one value per coordinate ({})",
-            model.coordinate_names().join(", ")
+            model.description().coordinate_names().join(", ")
         ),
         _ => format!("choose another operating point: {start}"),
     }
@@ -476,14 +482,15 @@ pub(super) fn equilibrium_start(
     for part in at.split(',') {
         let (name, text) = split_assignment(part, "--at")?;
         let index = model
+            .description()
             .coordinate_names()
             .iter()
             .position(|c| *c == name)
             .ok_or_else(|| {
                 CliError::usage(format!(
                     "--at: `{name}` is not a coordinate of `{}` (coordinates: {})",
-                    model.name(),
-                    model.coordinate_names().join(", ")
+                    model.description().name,
+                    model.description().coordinate_names().join(", ")
                 ))
             })?;
         q[index] = evaluate(text, &format!("--at {name}"), &lookup)?;
@@ -500,10 +507,15 @@ pub(super) fn point_failure(model: &dyn ModelInfo, e: &OperatingPointError) -> C
     match e {
         OperatingPointError::UnknownEquilibrium { name, .. } => CliError::usage(format!(
             "--at {name}: {e}; or give guesses like `--at {}=0`",
-            model.coordinate_names().first().copied().unwrap_or("q")
+            model
+                .description()
+                .coordinate_names()
+                .first()
+                .copied()
+                .unwrap_or("q")
         )),
         OperatingPointError::Modal(m) => modal_failure(model, m),
-        e => CliError::failure(format!("`{}`: {e}", model.name())),
+        e => CliError::failure(format!("`{}`: {e}", model.description().name)),
     }
 }
 

@@ -96,7 +96,7 @@ pub fn time_histories(
     solution: &Solution,
     note: Option<&str>,
 ) -> Result<(), String> {
-    let title = format!("{}: coordinates against time", model.name());
+    let title = format!("{}: coordinates against time", model.description().name);
     per_coordinate(
         path,
         &Chart::linear(&title, "t (s)", "q (m or rad)"),
@@ -128,6 +128,7 @@ fn per_coordinate(
     }
     let n = model.num_dofs();
     let series: Vec<Series> = model
+        .description()
         .coordinate_names()
         .iter()
         .enumerate()
@@ -521,7 +522,7 @@ pub fn phase_portrait(
     solution: &Solution,
     note: Option<&str>,
 ) -> Result<(), String> {
-    let title = format!("{}: phase portrait", model.name());
+    let title = format!("{}: phase portrait", model.description().name);
     per_coordinate(
         path,
         &Chart::linear(&title, "q (m or rad)", "q̇ (m/s or rad/s)"),

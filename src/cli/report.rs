@@ -237,8 +237,8 @@ fn report_model(source: &Source, dir: &Path) -> ModelReport {
     let file = &source.file;
     let model = source.model.instantiate();
     let mut report = ModelReport {
-        name: model.name().to_string(),
-        description: model.description().to_string(),
+        name: model.description().name.to_string(),
+        description: model.description().summary.to_string(),
         header: header_comment(&source.text),
         dof: model.num_dofs(),
         equations: Vec::new(),
@@ -315,7 +315,7 @@ fn draw_default_run(
             "Energy drift E(t) − E(0)".to_string(),
             plot::energy_drift(
                 &path("energy.svg"),
-                model.name(),
+                &model.description().name,
                 &solution.t,
                 &run.energy.energy,
                 run.energy.initial_energy,
@@ -391,7 +391,9 @@ fn draw_mode_shapes(
 /// relative to the report. A failure becomes a note.
 fn animation(spec: &str, name: &str, model_dir: &Path, notes: &mut Vec<String>) -> Option<String> {
     let model = super::find_model(spec).ok()?;
-    if model.draw_lines().is_empty() && model.trace_points().is_empty() {
+    if model.description().draw_line_names().is_empty()
+        && model.description().trace_point_names().is_empty()
+    {
         return None;
     }
     let args = match super::simulate::IntegrationArgs::defaults() {

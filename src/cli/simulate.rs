@@ -255,6 +255,7 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
     }
     let n = model.num_dofs();
     let coordinates: Vec<String> = model
+        .description()
         .coordinate_names()
         .iter()
         .map(|s| s.to_string())
@@ -305,7 +306,7 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
         } else {
             plot::constraint_drift(
                 drift_path,
-                model.name(),
+                &model.description().name,
                 &solution.t,
                 &constraints.drift,
                 incomplete.as_deref(),
@@ -320,7 +321,7 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
     if let Some(path) = &args.plot_energy {
         plot::energy_drift(
             path,
-            model.name(),
+            &model.description().name,
             &solution.t,
             &report.energy,
             report.initial_energy,
@@ -344,16 +345,16 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
             })
             .collect();
         let mut out = json!({
-            "model": model.name(),
+            "model": model.description().name,
             "coordinates": coordinates,
-            "parameters": model.parameter_names().iter().zip(model.parameter_values()).map(|(k, v)| (k.to_string(), json!(v))).collect::<serde_json::Map<_, _>>(),
+            "parameters": model.description().parameter_names().iter().zip(model.parameter_values()).map(|(k, v)| (k.to_string(), json!(v))).collect::<serde_json::Map<_, _>>(),
             "method": method_name,
             "rtol": args.run.rtol,
             "atol": args.run.atol,
             "samples": samples,
             "initial_energy": report.initial_energy,
             "energy_drift": report.drift,
-            "conservative": model.is_conservative(),
+            "conservative": model.description().conservative,
             "stats": {
                 "steps": solution.stats.steps,
                 "rejected": solution.stats.rejected,
@@ -425,7 +426,7 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
     match failure {
         None => Ok(()),
         Some(e) => Err(failure_error(
-            model.name(),
+            &model.description().name,
             &e,
             cause.as_ref(),
             &args.run,
@@ -695,14 +696,14 @@ fn print_summary(
 ) {
     outln!(
         "model      {} ({} dof): {}",
-        model.name(),
+        model.description().name,
         model.num_dofs(),
-        model.description()
+        model.description().summary
     );
     outln!("method     {method} ({})", args.step_control());
     if let Some((t, y)) = solution.last() {
         let n = model.num_dofs();
-        let names = model.coordinate_names();
+        let names = model.description().coordinate_names();
         outln!("final      t = {t}");
         for (i, name) in names.iter().enumerate() {
             outln!(
@@ -720,7 +721,7 @@ fn print_summary(
             e1 = num(e1)
         );
         if let Some(d) = report.drift {
-            let note = if model.is_conservative() {
+            let note = if model.description().conservative {
                 ""
             } else {
                 " (not conserved: the model has non-conservative loads or explicit time dependence)"
@@ -759,11 +760,11 @@ fn write_csv(
 ) -> Result<(), CliError> {
     let mut out = incomplete.map_or_else(String::new, |note| format!("# {note}\n"));
     out.push('t');
-    for c in model.coordinate_names() {
+    for c in model.description().coordinate_names() {
         out.push(',');
         out.push_str(c);
     }
-    for c in model.coordinate_names() {
+    for c in model.description().coordinate_names() {
         out.push_str(&format!(",{c}_dot"));
     }
     out.push_str(",energy");
@@ -801,7 +802,7 @@ fn print_events(model: &dyn ModelInfo, solution: &Solution) {
         return;
     }
     let n = model.num_dofs();
-    let names = model.coordinate_names();
+    let names = model.description().coordinate_names();
     outln!("events     {} located:", solution.events.len());
     for e in &solution.events {
         let state: Vec<String> = names
@@ -885,10 +886,10 @@ fn write_events_csv(
     solution: &Solution,
 ) -> Result<(), CliError> {
     let mut out = String::from(EVENTS_HEADER);
-    for c in model.coordinate_names() {
+    for c in model.description().coordinate_names() {
         out.push_str(&format!(",{c}"));
     }
-    for c in model.coordinate_names() {
+    for c in model.description().coordinate_names() {
         out.push_str(&format!(",{c}_dot"));
     }
     out.push('\n');

@@ -139,7 +139,7 @@ pub fn run(args: &StabilityArgs) -> Result<(), CliError> {
             },
             "energy": {"periods": args.periods, "runs": energy},
             "stiff": {
-                "model": two_masses.name(),
+                "model": two_masses.description().name,
                 "t_end": args.t_end,
                 "tol": args.tol,
                 "reference": {"method": "dop853", "tol": STIFF_REFERENCE_TOL},

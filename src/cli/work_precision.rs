@@ -246,7 +246,11 @@ pub fn run(args: &WorkPrecisionArgs) -> Result<(), CliError> {
         );
     }
     if let Some(prefix) = &args.plot {
-        write_charts(prefix, study.model.name(), &study.report.results)?;
+        write_charts(
+            prefix,
+            &study.model.description().name,
+            &study.report.results,
+        )?;
     }
     let mut stdout = super::output::stdout();
     // A failed write (a pipe into `head` closed) is kept by `output` and sets the status.
@@ -303,11 +307,11 @@ impl Study<'_> {
             })
             .collect();
         json!({
-            "model": self.model.name(),
+            "model": self.model.description().name,
             "t_end": args.t_end,
             "samples": args.samples,
             "error_norm": format!("max over the {s} output times k·T/{s} (k = 1…{s}) and over all {} components of y = [q; q̇] of |y − y_ref|", self.report.dim, s = args.samples),
-            "conservative": self.model.is_conservative(),
+            "conservative": self.model.description().conservative,
             "target_error": args.target_error,
             "baseline_ms": args.baseline_ms,
             "timing": {
@@ -390,7 +394,7 @@ impl Study<'_> {
         writeln!(
             out,
             "model      {} ({} dof) over 0 ≤ t ≤ {} s",
-            self.model.name(),
+            self.model.description().name,
             self.model.num_dofs(),
             args.t_end
         )?;
@@ -412,7 +416,7 @@ impl Study<'_> {
             "time       median wall time of ≥ {} identical runs totalling ≥ {} ms (at most {MAX_REPEATS} runs)",
             self.report.min_repeats, args.min_time_ms
         )?;
-        let drift_note = if self.model.is_conservative() {
+        let drift_note = if self.model.description().conservative {
             ""
         } else {
             " (not conserved: the model has non-conservative loads or explicit time dependence)"

@@ -171,7 +171,7 @@ fn integrate(
 /// Positions of the points named in `names`, in that order, at every sample (NaN for a
 /// point the model does not have).
 fn positions(model: &dyn ModelInfo, solution: &Solution, names: &[&str]) -> Vec<Vec<[f64; 3]>> {
-    let own = model.point_names();
+    let own = model.description().point_names();
     solution
         .iter()
         .map(|(t, y)| {
@@ -267,9 +267,9 @@ pub fn constraint_methods(
     options: &ConstraintMethodsOptions,
 ) -> Result<ConstraintMethods, ConstraintMethodsError> {
     let mut model = make();
-    if model.holonomic_constraint_count() == 0 {
+    if model.description().holonomic_constraints == 0 {
         return Err(ConstraintMethodsError::NoHolonomicConstraints {
-            model: model.name().to_string(),
+            model: model.description().name.to_string(),
         });
     }
     let positive = |x: f64| x.is_finite() && x > 0.0;
@@ -289,7 +289,12 @@ pub fn constraint_methods(
     let times: Vec<f64> = (1..=OUTPUT_TIMES)
         .map(|i| t_end * f64::from(i) / f64::from(OUTPUT_TIMES))
         .collect();
-    let owned: Vec<String> = model.point_names().iter().map(|s| s.to_string()).collect();
+    let owned: Vec<String> = model
+        .description()
+        .point_names()
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
     let names: Vec<&str> = owned.iter().map(String::as_str).collect();
 
     // Reference: the DAE with Baumgarte at rtol = atol = 1e-13, checked against the
@@ -372,7 +377,7 @@ pub fn constraint_methods(
         ));
     }
     Ok(ConstraintMethods {
-        model: model.name().to_string(),
+        model: model.description().name.to_string(),
         reference_tol: REFERENCE_TOL,
         agreement,
         rows,

@@ -179,6 +179,7 @@ impl ConstraintDrift {
 /// ```
 pub fn constraint_drift(model: &mut dyn ModelInfo, solution: &Solution) -> ConstraintDrift {
     let constraint_names: Vec<String> = model
+        .description()
         .constraint_names()
         .iter()
         .map(|s| s.to_string())

@@ -192,6 +192,7 @@ pub fn failure_cause(
         return None;
     }
     let parameters: Vec<(String, f64)> = model
+        .description()
         .parameter_names()
         .iter()
         .map(|s| s.to_string())

@@ -330,7 +330,7 @@ pub fn simulate_with_events(
     let energy = energy_drift(model, &y0, &solution);
     let constraints = constraint_drift(model, &solution);
     let mut warnings = warnings;
-    if model.is_conservative()
+    if model.description().conservative
         && let Some(drift) = energy.drift
         && drift > ENERGY_DRIFT_LIMIT
     {
@@ -360,8 +360,9 @@ pub fn simulate_with_events(
 /// The typed error of a failed [`ModelInfo::make_consistent`].
 pub(crate) fn inconsistent(model: &dyn ModelInfo, e: &ProjectionError) -> SimulationError {
     SimulationError::InconsistentInitialState {
-        model: model.name().to_string(),
+        model: model.description().name.to_string(),
         constraint: model
+            .description()
             .constraint_names()
             .get(e.constraint)
             .copied()
@@ -369,6 +370,6 @@ pub(crate) fn inconsistent(model: &dyn ModelInfo, e: &ProjectionError) -> Simula
             .to_string(),
         residual: e.residual,
         iterations: e.iterations,
-        has_guesses: !model.initial_guesses().is_empty(),
+        has_guesses: !model.description().initial_guesses.is_empty(),
     }
 }

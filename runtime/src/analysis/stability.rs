@@ -883,12 +883,13 @@ fn stiff_runs(
         let names = &args.stiff_spring;
         let parameter = |name: &str, role: &'static str| {
             model
+                .description()
                 .parameter_names()
                 .iter()
                 .position(|p| *p == name)
                 .map(|i| model.parameter_values()[i])
                 .ok_or_else(|| StabilityError::MissingParameter {
-                    model: model.name().to_string(),
+                    model: model.description().name.to_string(),
                     name: name.to_string(),
                     role,
                 })
@@ -902,11 +903,12 @@ fn stiff_runs(
         let omega = (k * (m1 + m2) / (m1 * m2)).sqrt();
         let static_stretch = force * m1 / (k * (m1 + m2));
         let x2 = model
+            .description()
             .coordinate_names()
             .iter()
             .position(|c| *c == names.stretched)
             .ok_or_else(|| StabilityError::MissingCoordinate {
-                model: model.name().to_string(),
+                model: model.description().name.to_string(),
                 name: names.stretched.clone(),
             })?;
         for start in ["equilibrium", "rest"] {

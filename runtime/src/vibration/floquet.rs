@@ -160,11 +160,15 @@ fn check_options(
     options: &FloquetStudyOptions,
 ) -> Result<(), FloquetStudyError> {
     let name = &options.period_parameter;
-    if !model.parameter_names().contains(&name.as_str()) {
+    if !model
+        .description()
+        .parameter_names()
+        .contains(&name.as_str())
+    {
         return Err(FloquetStudyError::UnknownPeriodParameter {
-            model: model.name().to_string(),
+            model: model.description().name.to_string(),
             name: name.clone(),
-            parameters: model.parameter_names().join(", "),
+            parameters: model.description().parameter_names().join(", "),
         });
     }
     let FloquetOptions { rtol, atol, .. } = options.floquet;
@@ -236,13 +240,14 @@ fn analyse(
 ) -> Result<FloquetPoint, FloquetStudyError> {
     let parameter = &options.period_parameter;
     let index = model
+        .description()
         .parameter_names()
         .iter()
         .position(|p| p == parameter)
         .ok_or_else(|| FloquetStudyError::UnknownPeriodParameter {
-            model: model.name().to_string(),
+            model: model.description().name.to_string(),
             name: parameter.clone(),
-            parameters: model.parameter_names().join(", "),
+            parameters: model.description().parameter_names().join(", "),
         })?;
     let frequency = model.parameter_values()[index];
     if !(frequency.is_finite() && frequency > 0.0) {
@@ -353,12 +358,12 @@ fn check_period_parameter(
     time_dependence: TimeDependence,
 ) -> Result<bool, FloquetStudyError> {
     let ys = probe_states(model, q);
-    let name = model.parameter_names()[index].to_string();
+    let name = model.description().parameter_names()[index].to_string();
     let frequency = model.parameter_values()[index];
     let time_dependent = depends_on_time(model, &ys, frequency);
     if !time_dependent && time_dependence == TimeDependence::Required {
         return Err(FloquetStudyError::TimeIndependent {
-            model: model.name().to_string(),
+            model: model.description().name.to_string(),
         });
     }
     let perturbed = frequency * (1.0 + 1.0 / 64.0);
@@ -372,7 +377,7 @@ fn check_period_parameter(
         if difference > PERIOD_TOLERANCE {
             model.set_parameter(&name, frequency)?;
             return Err(FloquetStudyError::NotPeriodic {
-                model: model.name().to_string(),
+                model: model.description().name.to_string(),
                 parameter: name,
                 frequency: w,
                 period,
@@ -507,6 +512,7 @@ pub fn floquet_at_equilibrium_for_sweep(
     let (name, guess) = options.operating_point.start.resolve(model)?;
     let ys = probe_states(model, &guess);
     let names: Vec<String> = model
+        .description()
         .parameter_names()
         .iter()
         .map(|n| n.to_string())
@@ -517,7 +523,7 @@ pub fn floquet_at_equilibrium_for_sweep(
         .iter()
         .map(|a| {
             let i = index(&a.name).ok_or_else(|| UnknownParameter {
-                model: model.name().to_string(),
+                model: model.description().name.to_string(),
                 name: a.name.clone(),
                 known: names.join(", "),
             })?;

@@ -102,7 +102,7 @@ pub fn unconstrained_modal_analysis(
     let modal = modal_analysis(model, &options)?;
     if modal.linearization.num_minimal_coordinates() != model.num_dofs() {
         return Err(ResponseStudyError::Constrained {
-            model: model.name().to_string(),
+            model: model.description().name.to_string(),
         });
     }
     Ok(modal)

@@ -290,13 +290,13 @@ pub fn frequency_response_analysis(
         });
     }
     let input = options.input.as_str();
-    let parameter_input = model.parameter_names().contains(&input);
-    if !parameter_input && !model.coordinate_names().contains(&input) {
+    let parameter_input = model.description().parameter_names().contains(&input);
+    if !parameter_input && !model.description().coordinate_names().contains(&input) {
         return Err(FrfAnalysisError::UnknownInput {
-            model: model.name().to_string(),
+            model: model.description().name.to_string(),
             input: input.to_string(),
-            parameters: model.parameter_names().join(", "),
-            coordinates: model.coordinate_names().join(", "),
+            parameters: model.description().parameter_names().join(", "),
+            coordinates: model.description().coordinate_names().join(", "),
         });
     }
     if !parameter_input && options.simulation.is_some() {
@@ -312,6 +312,7 @@ pub fn frequency_response_analysis(
         e => FrfAnalysisError::Frf(e),
     })?;
     let coordinates: Vec<String> = model
+        .description()
         .coordinate_names()
         .iter()
         .map(|c| c.to_string())
@@ -355,7 +356,7 @@ pub fn frequency_response_analysis(
                 (Some(a), Some(b)) => (a / 10.0, b * 10.0),
                 _ => {
                     return Err(FrfAnalysisError::NoFrequencyRange {
-                        model: model.name().to_string(),
+                        model: model.description().name.to_string(),
                         operating_point: label,
                     });
                 }
@@ -467,20 +468,20 @@ pub fn plan_simulation(
     analysis: &FrfAnalysis,
     options: &FrfSimulationOptions,
 ) -> Result<FrfSimulationPlan, FrfAnalysisError> {
-    let parameters = model.parameter_names();
+    let parameters = model.description().parameter_names();
     let frequency_parameter = match &options.frequency_parameter {
         Some(p) => p.clone(),
         None if parameters.contains(&"w") => "w".to_string(),
         None => {
             return Err(FrfAnalysisError::NoFrequencyParameter {
-                model: model.name().to_string(),
+                model: model.description().name.to_string(),
                 parameters: parameters.join(", "),
             });
         }
     };
     if !parameters.contains(&frequency_parameter.as_str()) {
         return Err(FrfAnalysisError::UnknownFrequencyParameter {
-            model: model.name().to_string(),
+            model: model.description().name.to_string(),
             name: frequency_parameter,
             parameters: parameters.join(", "),
         });

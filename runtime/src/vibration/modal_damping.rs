@@ -208,7 +208,7 @@ pub fn modal_damping_study(
             for k in pair {
                 if k == 0 || k > n {
                     return Err(ResponseStudyError::NoSuchMode {
-                        model: model.name().to_string(),
+                        model: model.description().name.to_string(),
                         mode: k,
                         count: n,
                     });
@@ -280,7 +280,7 @@ pub fn modal_damping_study(
         .t_end
         .unwrap_or_else(|| default_duration(modes, 10.0, 5.0));
     let times = uniform_times(t_end, options.samples)?;
-    let names = model.coordinate_names();
+    let names = model.description().coordinate_names();
     let mut starts: Vec<(String, Vec<f64>, Vec<f64>)> = Vec::new();
     match &options.initial {
         None => {

@@ -175,7 +175,7 @@ pub fn modal_analysis(
     let mode_shapes = (0..r)
         .map(|k| shapes.column(k).iter().copied().collect())
         .collect();
-    let names = model.coordinate_names();
+    let names = model.description().coordinate_names();
     let minimal_coordinates = linearization
         .independent_coordinates
         .iter()

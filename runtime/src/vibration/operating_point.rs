@@ -49,7 +49,7 @@ impl EquilibriumStart {
                 .find(|(n, _)| n == name)
                 .map(|(n, q)| (n.to_string(), q.clone()))
                 .ok_or_else(|| OperatingPointError::UnknownEquilibrium {
-                    model: model.name().to_string(),
+                    model: model.description().name.to_string(),
                     name: name.clone(),
                     known: named.iter().map(|(n, _)| n.to_string()).collect(),
                 }),
@@ -153,6 +153,7 @@ pub fn operating_point(
     Ok(OperatingPoint {
         name,
         coordinates: model
+            .description()
             .coordinate_names()
             .iter()
             .map(|c| c.to_string())

@@ -6,10 +6,12 @@
 //! and builds its nalgebra static matrix from a stack array. Output is deterministic: it
 //! depends only on the model file.
 
+mod describe;
 mod listing;
 pub mod program;
 pub mod tape;
 
+pub use describe::{describe, description_source};
 pub use listing::{
     ConstraintKind, ConstraintListing, EquationsListing, GeneralizedForce, equations_latex,
     equations_text,
@@ -261,40 +263,11 @@ pub fn emit(
     }
 
     let mut imp = String::new();
-    let coord_names: Vec<String> = model
-        .coordinate_names
-        .iter()
-        .map(|c| string_literal(c))
-        .collect();
-    let param_names: Vec<String> = model
-        .parameters
-        .iter()
-        .map(|p| string_literal(&p.name))
-        .collect();
-    let point_names: Vec<String> = model
-        .points
-        .iter()
-        .map(|(p, _)| string_literal(p))
-        .collect();
+    let description = describe::describe(model, eom);
     let _ = writeln!(
         imp,
-        "fn name(&self) -> &'static str {{ {} }}",
-        string_literal(&model.name)
-    );
-    let _ = writeln!(
-        imp,
-        "fn description(&self) -> &'static str {{ {} }}",
-        string_literal(&model.description)
-    );
-    let _ = writeln!(
-        imp,
-        "fn coordinate_names(&self) -> [&'static str; {n}] {{ [{}] }}",
-        coord_names.join(", ")
-    );
-    let _ = writeln!(
-        imp,
-        "fn parameter_names(&self) -> &'static [&'static str] {{ &[{}] }}",
-        param_names.join(", ")
+        "fn description(&self) -> &{krate}::ModelDescription {{ static DESCRIPTION: {krate}::ModelDescription = {}; &DESCRIPTION }}",
+        describe::description_source(&description, krate)
     );
     let values: Vec<String> = model
         .parameters
@@ -443,19 +416,7 @@ pub fn emit(
     );
     // Constraints: the trait's defaults stand for an unconstrained model.
     let c = &model.constraints;
-    let mut constant_items = String::new();
     if !c.is_empty() {
-        let names: Vec<String> = c.names.iter().map(|s| string_literal(s)).collect();
-        let _ = writeln!(
-            constant_items,
-            "fn constraint_names(&self) -> &'static [&'static str] {{ &[{}] }}",
-            names.join(", ")
-        );
-        let _ = writeln!(
-            constant_items,
-            "fn holonomic_constraint_count(&self) -> usize {{ {} }}",
-            c.holonomic
-        );
         emit_fn(
             &format!("fn constraint_residuals(&self, {q_args}, __t: f64, __out: &mut [f64])"),
             &c.phi,
@@ -479,46 +440,7 @@ pub fn emit(
             &|v| write_out(v),
         );
     }
-    if !model.initial_guesses.is_empty() {
-        let idx: Vec<String> = model
-            .initial_guesses
-            .iter()
-            .map(|i| i.to_string())
-            .collect();
-        let _ = writeln!(
-            constant_items,
-            "fn initial_guesses(&self) -> &'static [usize] {{ &[{}] }}",
-            idx.join(", ")
-        );
-    }
     if !model.events.is_empty() {
-        let specs: Vec<String> = model
-            .events
-            .iter()
-            .map(|e| {
-                let direction = match e.direction {
-                    crate::model::Crossing::Rising => "Rising",
-                    crate::model::Crossing::Falling => "Falling",
-                    crate::model::Crossing::Both => "Both",
-                };
-                format!(
-                    "{krate}::EventSpec {{ name: ::std::borrow::Cow::Borrowed({}), direction: {krate}::EventDirection::{direction}, terminal: {} }}",
-                    string_literal(&e.name),
-                    e.terminal
-                )
-            })
-            .collect();
-        let _ = writeln!(
-            constant_items,
-            "fn event_specs(&self) -> &'static [{krate}::EventSpec] {{ static EVENTS: [{krate}::EventSpec; {}] = [{}]; &EVENTS }}",
-            specs.len(),
-            specs.join(", ")
-        );
-        let _ = writeln!(
-            constant_items,
-            "fn events_need_accelerations(&self) -> bool {{ {} }}",
-            model.events_need_accelerations()
-        );
         let roots: Vec<ExprId> = model.events.iter().map(|e| e.function).collect();
         emit_fn(
             &format!(
@@ -529,16 +451,6 @@ pub fn emit(
         );
     }
     if !model.equilibria.is_empty() {
-        let names: Vec<String> = model
-            .equilibria
-            .iter()
-            .map(|(name, _)| string_literal(name))
-            .collect();
-        let _ = writeln!(
-            constant_items,
-            "fn equilibrium_names(&self) -> &'static [&'static str] {{ &[{}] }}",
-            names.join(", ")
-        );
         let roots: Vec<ExprId> = model
             .equilibria
             .iter()
@@ -550,74 +462,6 @@ pub fn emit(
             &|v| write_out(v),
         );
     }
-    if !model.draw_lines.is_empty() {
-        let lines: Vec<String> = model
-            .draw_lines
-            .iter()
-            .filter_map(|[a, b]| {
-                let (a, b) = (&model.points.get(*a)?.0, &model.points.get(*b)?.0);
-                Some(format!("[{}, {}]", string_literal(a), string_literal(b)))
-            })
-            .collect();
-        let _ = writeln!(
-            constant_items,
-            "fn draw_lines(&self) -> &'static [[&'static str; 2]] {{ &[{}] }}",
-            lines.join(", ")
-        );
-    }
-    if !model.trace_points.is_empty() {
-        let names: Vec<String> = model
-            .trace_points
-            .iter()
-            .filter_map(|p| Some(string_literal(&model.points.get(*p)?.0)))
-            .collect();
-        let _ = writeln!(
-            constant_items,
-            "fn trace_points(&self) -> &'static [&'static str] {{ &[{}] }}",
-            names.join(", ")
-        );
-    }
-    if !model.bodies.is_empty() {
-        let centres: Vec<String> = model
-            .bodies
-            .iter()
-            .filter_map(|b| {
-                Some(format!(
-                    "{krate}::BodyCentre {{ body: {}, point: {}, rigid: {} }}",
-                    string_literal(&b.name),
-                    string_literal(&model.points.get(b.com)?.0),
-                    b.rotation.is_some()
-                ))
-            })
-            .collect();
-        let _ = writeln!(
-            constant_items,
-            "fn body_centres(&self) -> &'static [{krate}::BodyCentre<'static>] {{ &[{}] }}",
-            centres.join(", ")
-        );
-    }
-    imp.push_str(&constant_items);
-    let _ = writeln!(
-        imp,
-        "fn is_conservative(&self) -> bool {{ {} }}",
-        model.conservative
-    );
-    let _ = writeln!(
-        imp,
-        "fn point_names(&self) -> &'static [&'static str] {{ &[{}] }}",
-        point_names.join(", ")
-    );
-    let _ = writeln!(
-        imp,
-        "fn equations_text(&self) -> &'static str {{ {} }}",
-        string_literal(&equations_text(model, eom))
-    );
-    let _ = writeln!(
-        imp,
-        "fn equations_latex(&self) -> &'static str {{ {} }}",
-        string_literal(&equations_latex(model, eom))
-    );
-
     let _ = writeln!(
         src,
         "#[automatically_derived] #[allow(clippy::all, clippy::approx_constant, non_snake_case)] impl {krate}::MechanicalSystem<{n}> for {name} {{\n{imp}\n}}"

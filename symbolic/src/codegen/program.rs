@@ -13,7 +13,8 @@ use crate::expr::cse;
 use crate::expr::trig;
 use crate::expr::{ExprArena, ExprId, SymbolId};
 use crate::mechanics::{EquationsOfMotion, Jacobians, SymbolicModel};
-use crate::model::{Crossing, ModelFile};
+use crate::model::ModelFile;
+use eomgen_description::ModelDescription;
 
 use super::GenerateError;
 use super::tape::{Instruction, Tape};
@@ -35,28 +36,6 @@ impl FunctionTape {
         let split = tape.outputs.len();
         Self { tape, split }
     }
-}
-
-/// An event of the model file (`events:`).
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct EventDeclaration {
-    /// Its name.
-    pub name: String,
-    /// Which zero crossings count.
-    pub direction: Crossing,
-    /// Whether it ends the integration.
-    pub terminal: bool,
-}
-
-/// A body's centre of mass, for drawings.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct BodyCentreDeclaration {
-    /// The body's name.
-    pub body: String,
-    /// The point at its centre of mass.
-    pub point: String,
-    /// A planar rigid body (`true`) or a particle.
-    pub rigid: bool,
 }
 
 /// Every function the `model!` macro generates for a model file, as tapes, and the constants
@@ -83,42 +62,8 @@ pub struct BodyCentreDeclaration {
 /// | `equilibrium_guesses` | `n` per named equilibrium |
 #[derive(Debug, Clone, PartialEq)]
 pub struct ModelProgram {
-    /// The model's name.
-    pub name: String,
-    /// Its one-line description.
-    pub description: String,
-    /// Which derivation the equations come from (`lagrange`, `momentum balance`).
-    pub formulation: &'static str,
-    /// Coordinate names (n).
-    pub coordinate_names: Vec<String>,
-    /// Parameter names and default values, in file order.
-    pub parameters: Vec<(String, f64)>,
-    /// Point names, in file order.
-    pub point_names: Vec<String>,
-    /// `draw: lines` as pairs of point names.
-    pub draw_lines: Vec<[String; 2]>,
-    /// `draw: trace` point names.
-    pub trace_points: Vec<String>,
-    /// The bodies' centres of mass.
-    pub body_centres: Vec<BodyCentreDeclaration>,
-    /// Constraint names, holonomic first.
-    pub constraint_names: Vec<String>,
-    /// How many constraints are holonomic.
-    pub holonomic_constraint_count: usize,
-    /// Coordinates whose initial values are guesses.
-    pub initial_guesses: Vec<usize>,
-    /// The `equilibria:` names.
-    pub equilibrium_names: Vec<String>,
-    /// The `events:`.
-    pub events: Vec<EventDeclaration>,
-    /// Whether an event function reads `q̈` or `λ`.
-    pub events_need_accelerations: bool,
-    /// Whether `T + V` is a constant of the motion.
-    pub conservative: bool,
-    /// The equations as text ([`super::equations_text`]).
-    pub equations_text: String,
-    /// The equations as LaTeX ([`super::equations_latex`]).
-    pub equations_latex: String,
+    /// Everything about the model that is not a function of the state ([`super::describe`]).
+    pub description: ModelDescription,
     /// `q(0)`, `q̇(0)`.
     pub initial_state: FunctionTape,
     /// `M`, `F`.
@@ -153,21 +98,17 @@ impl ModelProgram {
     /// is singular, with the same located diagnostics as the macro.
     pub fn from_file(file: &ModelFile) -> Result<(ModelProgram, Derivation), GenerateError> {
         let mut model = SymbolicModel::from_file(file).map_err(GenerateError::Diagnostics)?;
-        let (eom, formulation) = crate::mechanics::preferred_equations(&mut model);
+        let (eom, _) = crate::mechanics::preferred_equations(&mut model);
         let problems = crate::mechanics::mass_matrix_diagnostics(&model, &eom, file);
         if !problems.is_empty() {
             return Err(GenerateError::Diagnostics(problems));
         }
-        let program = Self::plan(&model, &eom, formulation);
+        let program = Self::plan(&model, &eom);
         Ok((program, Derivation { model, eom }))
     }
 
     /// The tapes of a derived model but its Jacobians (the run-time twin of [`super::emit`]).
-    pub fn plan(
-        model: &SymbolicModel,
-        eom: &EquationsOfMotion,
-        formulation: &'static str,
-    ) -> ModelProgram {
+    pub fn plan(model: &SymbolicModel, eom: &EquationsOfMotion) -> ModelProgram {
         let n = model.num_dofs();
         let parameters: Vec<SymbolId> = model.parameters.iter().map(|p| p.symbol).collect();
         // One copy of the arena, functions planned in `emit`'s order: the angle-sum rewrite
@@ -245,56 +186,8 @@ impl ModelProgram {
         } else {
             single(&guess_roots)
         };
-        let point_name = |i: usize| model.points.get(i).map(|(p, _)| p.clone());
         ModelProgram {
-            name: model.name.clone(),
-            description: model.description.clone(),
-            formulation,
-            coordinate_names: model.coordinate_names.clone(),
-            parameters: model
-                .parameters
-                .iter()
-                .map(|p| (p.name.clone(), p.default))
-                .collect(),
-            point_names: model.points.iter().map(|(p, _)| p.clone()).collect(),
-            draw_lines: model
-                .draw_lines
-                .iter()
-                .filter_map(|[a, b]| Some([point_name(*a)?, point_name(*b)?]))
-                .collect(),
-            trace_points: model
-                .trace_points
-                .iter()
-                .filter_map(|p| point_name(*p))
-                .collect(),
-            body_centres: model
-                .bodies
-                .iter()
-                .filter_map(|b| {
-                    Some(BodyCentreDeclaration {
-                        body: b.name.clone(),
-                        point: point_name(b.com)?,
-                        rigid: b.rotation.is_some(),
-                    })
-                })
-                .collect(),
-            constraint_names: c.names.clone(),
-            holonomic_constraint_count: c.holonomic,
-            initial_guesses: model.initial_guesses.clone(),
-            equilibrium_names: model.equilibria.iter().map(|(n, _)| n.clone()).collect(),
-            events: model
-                .events
-                .iter()
-                .map(|e| EventDeclaration {
-                    name: e.name.clone(),
-                    direction: e.direction,
-                    terminal: e.terminal,
-                })
-                .collect(),
-            events_need_accelerations: model.events_need_accelerations(),
-            conservative: model.conservative,
-            equations_text: super::equations_text(model, eom),
-            equations_latex: super::equations_latex(model, eom),
+            description: super::describe(model, eom),
             initial_state: FunctionTape::single(initial_state),
             mass_matrix_and_forcing,
             kinetic_energy,
@@ -331,7 +224,7 @@ impl ModelProgram {
 
     /// Number of degrees of freedom `n`.
     pub fn num_dofs(&self) -> usize {
-        self.coordinate_names.len()
+        self.description.num_dofs()
     }
 
     /// Every function with its name, in the order of the table above (the Jacobians, planned
