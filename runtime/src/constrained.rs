@@ -12,58 +12,6 @@ use crate::linalg::solve_spd_in_place;
 use crate::ode::RhsError;
 use crate::system::MechanicalSystem;
 
-/// The functions of a constrained mechanical system the workspace evaluates, on slices
-/// (shapes as [`DynMechanicalSystem`]: `M` column-major, `J` row-major).
-///
-/// Implemented by every [`DynMechanicalSystem`], and so, through the adapter
-/// [`StaticSystem`], by every [`MechanicalSystem<N>`], so that the constrained solve, the
-/// drift and the projection are written once for the models compiled by `eomgen::model!` and
-/// those compiled at run time.
-pub trait ConstraintFunctions {
-    /// `M` (`n × n`, column-major) and `F` (length `n`).
-    fn mass_matrix_and_forcing(
-        &self,
-        q: &[f64],
-        qdot: &[f64],
-        t: f64,
-        mass: &mut [f64],
-        forcing: &mut [f64],
-    );
-    /// `Φ(q, t)` (length `m_h`).
-    fn constraint_residuals(&self, q: &[f64], t: f64, out: &mut [f64]);
-    /// `J` (`m × n`, row-major).
-    fn constraint_jacobian(&self, q: &[f64], t: f64, out: &mut [f64]);
-    /// The velocity residuals (length `m`).
-    fn constraint_velocity_residuals(&self, q: &[f64], qdot: &[f64], t: f64, out: &mut [f64]);
-    /// `γ` (length `m`).
-    fn constraint_gamma(&self, q: &[f64], qdot: &[f64], t: f64, out: &mut [f64]);
-}
-
-impl<S: DynMechanicalSystem + ?Sized> ConstraintFunctions for S {
-    fn mass_matrix_and_forcing(
-        &self,
-        q: &[f64],
-        qdot: &[f64],
-        t: f64,
-        mass: &mut [f64],
-        forcing: &mut [f64],
-    ) {
-        DynMechanicalSystem::mass_matrix_and_forcing(self, q, qdot, t, mass, forcing);
-    }
-    fn constraint_residuals(&self, q: &[f64], t: f64, out: &mut [f64]) {
-        DynMechanicalSystem::constraint_residuals(self, q, t, out);
-    }
-    fn constraint_jacobian(&self, q: &[f64], t: f64, out: &mut [f64]) {
-        DynMechanicalSystem::constraint_jacobian(self, q, t, out);
-    }
-    fn constraint_velocity_residuals(&self, q: &[f64], qdot: &[f64], t: f64, out: &mut [f64]) {
-        DynMechanicalSystem::constraint_velocity_residuals(self, q, qdot, t, out);
-    }
-    fn constraint_gamma(&self, q: &[f64], qdot: &[f64], t: f64, out: &mut [f64]) {
-        DynMechanicalSystem::constraint_gamma(self, q, qdot, t, out);
-    }
-}
-
 /// How constraint drift is controlled during an integration (selectable per run).
 ///
 /// The index-1 form `J q̈ = γ` only keeps `Φ̈ = 0`, so round-off and truncation errors make
@@ -270,7 +218,7 @@ impl ConstraintWorkspace {
     /// constraints, a singular configuration, or `M` singular on the null space of `J`);
     /// [`RhsError::SingularMassMatrix`] when a penalty solve meets an `M` that is not
     /// positive definite.
-    pub fn accelerations_into<C: ConstraintFunctions + ?Sized>(
+    pub fn accelerations_into<C: DynMechanicalSystem + ?Sized>(
         &mut self,
         system: &C,
         q: &[f64],
@@ -337,7 +285,7 @@ impl ConstraintWorkspace {
     }
 
     /// Largest `|Φᵢ|` and largest velocity residual `|Φ̇ᵢ|` (or `|A q̇ + b|`) at a state.
-    pub fn drift<C: ConstraintFunctions + ?Sized>(
+    pub fn drift<C: DynMechanicalSystem + ?Sized>(
         &mut self,
         system: &C,
         q: &[f64],
@@ -362,7 +310,7 @@ impl ConstraintWorkspace {
     /// No heap allocation (it runs after every step under [`Stabilization::Projection`]).
     /// `q` and `q̇` are changed in place, also by a projection that then fails: project a
     /// copy where the state must survive a failure (the integrators hand it a scratch copy).
-    pub fn project<C: ConstraintFunctions + ?Sized>(
+    pub fn project<C: DynMechanicalSystem + ?Sized>(
         &mut self,
         system: &C,
         q: &mut [f64],

@@ -23,7 +23,7 @@ pub mod vibration;
 
 pub use analysis::{Method, UnknownMethod};
 pub use constrained::{
-    ConstraintFunctions, ConstraintWorkspace, MAX_BAUMGARTE_GAIN, ProjectionError, Stabilization,
+    ConstraintWorkspace, MAX_BAUMGARTE_GAIN, ProjectionError, Stabilization,
     StabilizationError,
 };
 pub use dynamic::{DynMechanicalSystem, StaticSystem};
