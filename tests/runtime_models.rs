@@ -31,59 +31,17 @@ fn assert_same(what: &str, a: &[f64], b: &[f64]) {
 fn compare(name: &str, compiled: &mut dyn ModelInfo, runtime: &mut dyn ModelInfo, states: usize) {
     let n = compiled.num_dofs();
     assert_eq!(runtime.num_dofs(), n, "{name}: dofs");
-    assert_eq!(compiled.description().name, runtime.description().name);
+    // The whole description: names, parameter defaults, points, drawing, constraints,
+    // guesses, events, conservation and the equations as text and LaTeX.
     assert_eq!(
-        compiled.description().coordinate_names(),
-        runtime.description().coordinate_names()
-    );
-    assert_eq!(
-        compiled.description().parameter_names(),
-        runtime.description().parameter_names()
+        compiled.description(),
+        runtime.description(),
+        "{name}: description"
     );
     assert_same(
         &format!("{name}: parameters"),
         &compiled.parameter_values(),
         &runtime.parameter_values(),
-    );
-    assert_eq!(
-        compiled.description().point_names(),
-        runtime.description().point_names()
-    );
-    assert_eq!(
-        compiled.description().draw_line_names(),
-        runtime.description().draw_line_names()
-    );
-    assert_eq!(
-        compiled.description().trace_point_names(),
-        runtime.description().trace_point_names()
-    );
-    assert_eq!(
-        compiled.description().body_centres,
-        runtime.description().body_centres
-    );
-    assert_eq!(
-        compiled.description().constraint_names(),
-        runtime.description().constraint_names()
-    );
-    assert_eq!(
-        compiled.description().holonomic_constraints,
-        runtime.description().holonomic_constraints
-    );
-    assert_eq!(
-        compiled.description().initial_guesses,
-        runtime.description().initial_guesses
-    );
-    assert_eq!(
-        compiled.description().conservative,
-        runtime.description().conservative
-    );
-    assert_eq!(
-        compiled.description().equations_text,
-        runtime.description().equations_text
-    );
-    assert_eq!(
-        compiled.description().equations_latex,
-        runtime.description().equations_latex
     );
     assert_eq!(compiled.event_specs(), runtime.event_specs());
     assert_same(
