@@ -515,6 +515,43 @@ fn run_in(dir: &std::path::Path, args: &[&str]) -> Output {
         .expect("binary runs")
 }
 
+/// Runs `eomgen args` in `dir`, requires success and returns its standard error (the
+/// warnings).
+fn succeeds_in(dir: &std::path::Path, args: &[&str]) -> String {
+    let out = run_in(dir, args);
+    assert!(out.status.success(), "{args:?}: {}", stderr(&out));
+    stderr(&out)
+}
+
+/// Runs `eomgen args` in `dir`, requires a usage error (status 2) and returns its message.
+fn refused_in(dir: &std::path::Path, args: &[&str]) -> String {
+    let out = run_in(dir, args);
+    assert_eq!(out.status.code(), Some(2), "{args:?}: {}", stderr(&out));
+    stderr(&out)
+}
+
+/// The text of the bundled model file `models/NAME.yaml`.
+fn bundled_file(name: &str) -> String {
+    std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("models/{name}.yaml")),
+    )
+    .unwrap()
+}
+
+/// Writes the companions `CSV-events.csv` and `PLOT-drift.*` in `dir` (a pendulum that
+/// crosses q = 0, and the Cartesian pendulum's drift chart) with two runs of eomgen.
+fn write_companions(dir: &std::path::Path, csv: &str, plot: &str) {
+    let events = ["--init", "q=1", "--event", "q = 0", "--csv", csv];
+    succeeds_in(dir, &[&PENDULUM[..], &events].concat());
+    succeeds_in(
+        dir,
+        &["simulate", "simple_pendulum_cartesian", "--t-end", "1", "--plot", plot],
+    );
+}
+
+/// A one-second run of the bundled pendulum, to which a test adds its outputs.
+const PENDULUM: [&str; 4] = ["simulate", "simple_pendulum", "--t-end", "1"];
+
 /// The files of `dir` whose names start with `.eomgen-`: temporary files left behind.
 fn temporaries(dir: &std::path::Path) -> Vec<String> {
     std::fs::read_dir(dir)
@@ -905,39 +942,23 @@ fn issue_28_stale_companions_are_removed() {
     let dir = tempfile::tempdir().unwrap();
     let events = dir.path().join("e-events.csv");
     let drift = dir.path().join("d-drift.svg");
-    let succeeds = |args: &[&str]| {
-        let out = run_in(dir.path(), args);
-        assert!(out.status.success(), "{args:?}: {}", stderr(&out));
-    };
-    let pendulum = ["simulate", "simple_pendulum", "--t-end", "1"];
-    succeeds(
-        &[
-            &pendulum[..],
-            &["--init", "q=1", "--event", "q = 0", "--csv", "e.csv"],
-        ]
-        .concat(),
-    );
+    write_companions(dir.path(), "e.csv", "d.svg");
     assert!(
         std::fs::read_to_string(&events)
             .unwrap()
             .starts_with("event,direction")
     );
-    succeeds(&[
-        "simulate",
-        "simple_pendulum_cartesian",
-        "--t-end",
-        "1",
-        "--plot",
-        "d.svg",
-    ]);
     assert!(drift.exists());
 
-    succeeds(&[&pendulum[..], &["--csv", "e.csv", "--plot", "d.svg"]].concat());
+    succeeds_in(
+        dir.path(),
+        &[&PENDULUM[..], &["--csv", "e.csv", "--plot", "d.svg"]].concat(),
+    );
     assert!(!events.exists(), "a stale events file stayed");
     assert!(!drift.exists(), "a stale drift chart stayed");
 
     std::os::unix::fs::symlink("elsewhere.csv", &events).unwrap();
-    succeeds(&[&pendulum[..], &["--csv", "e.csv"]].concat());
+    succeeds_in(dir.path(), &[&PENDULUM[..], &["--csv", "e.csv"]].concat());
     assert!(
         std::fs::symlink_metadata(&events)
             .unwrap()
@@ -1048,46 +1069,21 @@ fn issue_28_diagnostics_json_on_a_full_device_is_status_1() {
 #[test]
 fn issue_28_an_output_naming_the_model_file_is_refused() {
     let dir = tempfile::tempdir().unwrap();
-    let model = std::fs::read_to_string(
-        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("models/simple_pendulum.yaml"),
-    )
-    .unwrap();
+    let model = bundled_file("simple_pendulum");
     std::fs::write(dir.path().join("pend.yaml"), &model).unwrap();
     std::os::unix::fs::symlink("pend.yaml", dir.path().join("link.csv")).unwrap();
     std::fs::hard_link(dir.path().join("pend.yaml"), dir.path().join("hard.csv")).unwrap();
+    let run = ["simulate", "pend.yaml", "--t-end", "1", "--csv"];
     let cases: &[&[&str]] = &[
-        &[
-            "simulate",
-            "pend.yaml",
-            "--t-end",
-            "1",
-            "--csv",
-            "pend.yaml",
-        ],
-        &[
-            "simulate",
-            "pend.yaml",
-            "--t-end",
-            "1",
-            "--csv",
-            "./pend.yaml",
-        ],
-        &[
-            "simulate",
-            "./pend.yaml",
-            "--t-end",
-            "1",
-            "--csv",
-            "link.csv",
-        ],
-        &["simulate", "pend.yaml", "--t-end", "1", "--csv", "hard.csv"],
+        &[&run[..], &["pend.yaml"]].concat(),
+        &[&run[..], &["./pend.yaml"]].concat(),
+        &["simulate", "./pend.yaml", "--t-end", "1", "--csv", "link.csv"],
+        &[&run[..], &["hard.csv"]].concat(),
         &["animate", "pend.yaml", "--t-end", "1", "-o", "pend.yaml"],
         &["modes", "pend.yaml", "--animate", "pend.yaml"],
     ];
     for args in cases {
-        let out = run_in(dir.path(), args);
-        let text = stderr(&out);
-        assert_eq!(out.status.code(), Some(2), "{args:?}: {text}");
+        let text = refused_in(dir.path(), args);
         assert!(
             text.contains("is the model file") && text.contains("pend.yaml"),
             "{args:?}: {text}"
@@ -1100,6 +1096,48 @@ fn issue_28_an_output_naming_the_model_file_is_refused() {
     }
 }
 
+/// `study constraint-methods` reads a second model, the minimal twin its file names
+/// (`minimal_twin:`), which was not protected: `--plot out.svg`, a link to the twin's file,
+/// replaced the twin with the chart. The twin's file is now an input like the model's (a
+/// usage error before any work, the twin left as it was).
+#[test]
+fn issue_28_an_output_naming_the_minimal_twin_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let twin = bundled_file("simple_pendulum");
+    std::fs::write(dir.path().join("twin.yaml"), &twin).unwrap();
+    let cartesian = bundled_file("simple_pendulum_cartesian").replace(
+        "minimal_twin: simple_pendulum",
+        "minimal_twin: ./twin.yaml",
+    );
+    std::fs::write(dir.path().join("cart.yaml"), cartesian).unwrap();
+    std::os::unix::fs::symlink("twin.yaml", dir.path().join("out.svg")).unwrap();
+    let study = ["study", "constraint-methods", "cart.yaml", "--t-end", "0.1"];
+    let text = refused_in(dir.path(), &[&study[..], &["--plot", "out.svg"]].concat());
+    assert!(text.contains("is the model file") && text.contains("twin.yaml"), "{text}");
+    assert_eq!(std::fs::read_to_string(dir.path().join("twin.yaml")).unwrap(), twin);
+    // The twin is read and compared with: another chart name is written.
+    succeeds_in(dir.path(), &[&study[..], &["--plot", "chart.svg"]].concat());
+    assert!(dir.path().join("chart.svg").exists());
+}
+
+/// `modes --plot PREFIX` of a model with fewer modes than an earlier run left the earlier
+/// run's `PREFIX-mode<k>` charts beside the new ones. The charts of modes this run does not
+/// have are removed when eomgen wrote them (the Software mark and a mode chart's title) and
+/// kept with a warning otherwise, as stale companions are.
+#[test]
+fn issue_28_stale_mode_charts_are_removed() {
+    let dir = tempfile::tempdir().unwrap();
+    let chart = |k: usize| dir.path().join(format!("m-mode{k}.svg"));
+    succeeds_in(dir.path(), &["modes", "double_pendulum", "--plot", "m"]);
+    assert!(chart(1).exists() && chart(2).exists());
+    std::fs::write(chart(3), "mine\n").unwrap();
+    let text = succeeds_in(dir.path(), &["modes", "simple_pendulum", "--plot", "m"]);
+    assert!(chart(1).exists(), "this run's chart");
+    assert!(!chart(2).exists(), "a stale mode chart stayed");
+    assert_eq!(std::fs::read_to_string(chart(3)).unwrap(), "mine\n");
+    assert!(text.contains("warning: `m-mode3.svg` is not from this run"), "{text}");
+}
+
 /// With `echo mine > run-events.csv`, `simulate … --csv run.csv` deleted the user's file as
 /// a stale companion. A companion is removed only when eomgen wrote it (the events CSV's
 /// header, the drift chart's title or PNG marker); another file of that name is kept, with a
@@ -1107,17 +1145,15 @@ fn issue_28_an_output_naming_the_model_file_is_refused() {
 #[test]
 fn issue_28_a_stale_companion_is_removed_only_when_eomgen_wrote_it() {
     let dir = tempfile::tempdir().unwrap();
-    let pendulum = ["simulate", "simple_pendulum", "--t-end", "1"];
-    for name in ["run-events.csv", "p-drift.svg", "p-drift.png"] {
+    let companions = ["run-events.csv", "p-drift.svg", "p-drift.png"];
+    for name in companions {
         std::fs::write(dir.path().join(name), "mine\n").unwrap();
     }
     for plot in ["p.svg", "p.png"] {
-        let out = run_in(
+        let text = succeeds_in(
             dir.path(),
-            &[&pendulum[..], &["--csv", "run.csv", "--plot", plot]].concat(),
+            &[&PENDULUM[..], &["--csv", "run.csv", "--plot", plot]].concat(),
         );
-        let text = stderr(&out);
-        assert!(out.status.success(), "{text}");
         assert!(
             text.contains("warning: `run-events.csv` is not from this run"),
             "{text}"
@@ -1125,7 +1161,7 @@ fn issue_28_a_stale_companion_is_removed_only_when_eomgen_wrote_it() {
         let drift = plot.replace('.', "-drift.");
         assert!(text.contains(&format!("warning: `{drift}`")), "{text}");
     }
-    for name in ["run-events.csv", "p-drift.svg", "p-drift.png"] {
+    for name in companions {
         assert_eq!(
             std::fs::read_to_string(dir.path().join(name)).unwrap(),
             "mine\n",
@@ -1133,38 +1169,22 @@ fn issue_28_a_stale_companion_is_removed_only_when_eomgen_wrote_it() {
         );
     }
     // The same names written by eomgen are removed by a run that has nothing for them.
-    for name in ["run-events.csv", "p-drift.svg", "p-drift.png"] {
+    for name in companions {
         std::fs::remove_file(dir.path().join(name)).unwrap();
     }
-    let succeeds = |args: &[&str]| {
-        let out = run_in(dir.path(), args);
-        assert!(out.status.success(), "{args:?}: {}", stderr(&out));
-        stderr(&out)
-    };
-    succeeds(
-        &[
-            &pendulum[..],
-            &["--init", "q=1", "--event", "q = 0", "--csv", "run.csv"],
-        ]
-        .concat(),
-    );
     for plot in ["p.svg", "p.png"] {
-        succeeds(&[
-            "simulate",
-            "simple_pendulum_cartesian",
-            "--t-end",
-            "1",
-            "--plot",
-            plot,
-        ]);
+        write_companions(dir.path(), "run.csv", plot);
     }
-    for name in ["run-events.csv", "p-drift.svg", "p-drift.png"] {
+    for name in companions {
         assert!(dir.path().join(name).exists(), "{name}");
     }
-    let text = succeeds(&[&pendulum[..], &["--csv", "run.csv", "--plot", "p.svg"]].concat());
-    let text = text + &succeeds(&[&pendulum[..], &["--plot", "p.png"]].concat());
+    let text = succeeds_in(
+        dir.path(),
+        &[&PENDULUM[..], &["--csv", "run.csv", "--plot", "p.svg"]].concat(),
+    );
+    let text = text + &succeeds_in(dir.path(), &[&PENDULUM[..], &["--plot", "p.png"]].concat());
     assert!(!text.contains("warning"), "{text}");
-    for name in ["run-events.csv", "p-drift.svg", "p-drift.png"] {
+    for name in companions {
         assert!(!dir.path().join(name).exists(), "{name} stayed");
     }
 }
