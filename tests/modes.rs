@@ -1001,7 +1001,7 @@ fn issue_28_quadratic_drag_at_rest_has_the_undamped_modes() {
     }
     let lin = &modal.linearization;
     assert!(lin.differenced_entries > 0);
-    assert_eq!(lin.stiffness_matrix, DMatrix::from_diagonal(&[4.0, 9.0].into()));
+    assert_eq!(lin.stiffness_matrix, DMatrix::from_diagonal(&nalgebra::DVector::from_vec(vec![4.0, 9.0])));
     let c = 0.5;
     assert!(lin.damping_matrix.amax() <= 1e-10 * c, "{}", lin.damping_matrix);
     assert!(modal.damping_ratios.iter().all(|z| z.abs() < 1e-10), "{:?}", modal.damping_ratios);
@@ -1028,7 +1028,7 @@ fn issue_28_zero_frequency_is_judged_on_each_mode_s_own_scale() {
     use eomgen::Linearization;
     let soft = Linearization::from_matrices(
         DMatrix::identity(2, 2),
-        DMatrix::from_diagonal(&[1e-3, 1e8].into()),
+        DMatrix::from_diagonal(&nalgebra::DVector::from_vec(vec![1e-3, 1e8])),
         DMatrix::zeros(2, 2),
     );
     let modes = normal_modes(&soft).unwrap();
@@ -1068,7 +1068,7 @@ fn issue_28_zero_frequency_is_judged_on_each_mode_s_own_scale() {
 /// `A = 20 N·m` above `m g l = 9.81 N·m` (`tests/fixtures/overdriven_pendulum.yaml`) is now
 /// refused as a time-dependent load, naming it and Newton's failure; with `A = 5 N·m` the
 /// load is set aside as before and the pendulum leaning at `sin θ* = A/(m g l)` has
-/// `ω² = (g/l) cos θ*` (to 1e-12).
+/// `ω² = (g/l) cos θ*` (to 1e-10, Newton's tolerance).
 #[test]
 fn issue_28_time_dependent_load_without_equilibrium_is_refused_as_such() {
     use eomgen::vibration::{ModalOptions, OperatingPointError, modal_analysis};
@@ -1088,7 +1088,7 @@ fn issue_28_time_dependent_load_without_equilibrium_is_refused_as_such() {
     let modal = modal_analysis(m.as_ref(), &ModalOptions::default()).unwrap();
     assert!(modal.time_dependent_forcing.is_some());
     let theta = (5.0f64 / 9.81).asin();
-    assert!((modal.operating_point.q()[0] - theta).abs() < 1e-12);
+    assert!((modal.operating_point.q()[0] - theta).abs() < 1e-10);
     let w2 = 9.81 * theta.cos();
-    assert!((modal.normal_modes.eigenvalues[0] - w2).abs() < 1e-12 * w2);
+    assert!((modal.normal_modes.eigenvalues[0] - w2).abs() < 1e-10 * w2);
 }

@@ -328,7 +328,7 @@ pub fn forward_differences<E>(
     for j in 0..d {
         let delta = (f64::EPSILON * y[j].abs().max(1e-5)).sqrt();
         work_y[j] = y[j] + delta;
-        let result = eval(work_y, work_f);
+        let result = eval(&*work_y, &mut *work_f);
         work_y[j] = y[j];
         result?;
         for i in 0..k {

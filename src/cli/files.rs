@@ -490,14 +490,13 @@ pub(super) fn remove_stale(
 pub(super) fn remove_stale_or_warn(
     path: &str,
     is_ours: impl Fn(&[u8]) -> bool,
-) -> Result<Stale, FileError> {
-    let stale = remove_stale(path, is_ours)?;
-    if stale == Stale::Kept {
+) -> Result<(), FileError> {
+    if remove_stale(path, is_ours)? == Stale::Kept {
         super::output::errln!(
             "warning: `{path}` is not from this run and was not written by eomgen; it was kept"
         );
     }
-    Ok(stale)
+    Ok(())
 }
 
 /// What an output option writes, which decides what its path must look like.
