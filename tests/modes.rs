@@ -996,15 +996,31 @@ fn issue_28_quadratic_drag_at_rest_has_the_undamped_modes() {
     let m = fixture_model("drag_oscillator.yaml");
     let modal = modal_analysis(m.as_ref(), &ModalOptions::default()).unwrap();
     assert!(modal.time_dependent_forcing.is_none());
-    for (w, expected) in modal.normal_modes.natural_frequencies.iter().zip([2.0, 3.0]) {
+    for (w, expected) in modal
+        .normal_modes
+        .natural_frequencies
+        .iter()
+        .zip([2.0, 3.0])
+    {
         assert!((w - expected).abs() < 1e-12 * expected, "{w} vs {expected}");
     }
     let lin = &modal.linearization;
     assert!(lin.differenced_entries > 0);
-    assert_eq!(lin.stiffness_matrix, DMatrix::from_diagonal(&nalgebra::DVector::from_vec(vec![4.0, 9.0])));
+    assert_eq!(
+        lin.stiffness_matrix,
+        DMatrix::from_diagonal(&nalgebra::DVector::from_vec(vec![4.0, 9.0]))
+    );
     let c = 0.5;
-    assert!(lin.damping_matrix.amax() <= 1e-10 * c, "{}", lin.damping_matrix);
-    assert!(modal.damping_ratios.iter().all(|z| z.abs() < 1e-10), "{:?}", modal.damping_ratios);
+    assert!(
+        lin.damping_matrix.amax() <= 1e-10 * c,
+        "{}",
+        lin.damping_matrix
+    );
+    assert!(
+        modal.damping_ratios.iter().all(|z| z.abs() < 1e-10),
+        "{:?}",
+        modal.damping_ratios
+    );
     // A model whose Jacobians are finite is exact, and says so.
     let exact = modal_analysis(model("three_masses").as_ref(), &ModalOptions::default()).unwrap();
     assert_eq!(exact.linearization.differenced_entries, 0);
@@ -1046,19 +1062,33 @@ fn issue_28_zero_frequency_is_judged_on_each_mode_s_own_scale() {
         if let Some(stiff) = grounded {
             stiffness[(3, 3)] = stiff;
         }
-        let chain = Linearization::from_matrices(
-            DMatrix::identity(n, n),
-            stiffness,
-            DMatrix::zeros(n, n),
-        );
+        let chain =
+            Linearization::from_matrices(DMatrix::identity(n, n), stiffness, DMatrix::zeros(n, n));
         let modes = normal_modes(&chain).unwrap();
-        assert_eq!(modes.kinds[0], ModeKind::ZeroFrequency, "{k} {grounded:?}: {:?}", modes.eigenvalues);
-        assert!(modes.kinds[1..].iter().all(|kind| *kind == ModeKind::Oscillatory));
+        assert_eq!(
+            modes.kinds[0],
+            ModeKind::ZeroFrequency,
+            "{k} {grounded:?}: {:?}",
+            modes.eigenvalues
+        );
+        assert!(
+            modes.kinds[1..]
+                .iter()
+                .all(|kind| *kind == ModeKind::Oscillatory)
+        );
         // ω² = k, 3k for the free–free chain of unit masses (to rounding of the largest
         // entry, 1e12 beside it).
         let tol = if grounded.is_some() { 1e-3 } else { 1e-12 };
-        assert!((modes.eigenvalues[1] - k).abs() < tol * k, "{:?}", modes.eigenvalues);
-        assert!((modes.eigenvalues[2] - 3.0 * k).abs() < tol * k, "{:?}", modes.eigenvalues);
+        assert!(
+            (modes.eigenvalues[1] - k).abs() < tol * k,
+            "{:?}",
+            modes.eigenvalues
+        );
+        assert!(
+            (modes.eigenvalues[2] - 3.0 * k).abs() < tol * k,
+            "{:?}",
+            modes.eigenvalues
+        );
     }
 }
 
@@ -1074,16 +1104,25 @@ fn issue_28_time_dependent_load_without_equilibrium_is_refused_as_such() {
     use eomgen::vibration::{ModalOptions, OperatingPointError, modal_analysis};
     let mut m = fixture_model("overdriven_pendulum.yaml");
     let err = modal_analysis(m.as_ref(), &ModalOptions::default()).unwrap_err();
-    let OperatingPointError::Modal(ModalError::TimeDependentLoad { forcing, equilibrium }) = &err
+    let OperatingPointError::Modal(ModalError::TimeDependentLoad {
+        forcing,
+        equilibrium,
+    }) = &err
     else {
         panic!("{err}")
     };
     assert_eq!(forcing.coordinate, "theta");
-    assert!(matches!(**equilibrium, ModalError::EquilibriumNotFound { .. }), "{equilibrium}");
+    assert!(
+        matches!(**equilibrium, ModalError::EquilibriumNotFound { .. }),
+        "{equilibrium}"
+    );
     let out = eomgen(&["modes", &fixture("overdriven_pendulum.yaml")]);
     assert_eq!(out.status.code(), Some(1));
     let text = String::from_utf8_lossy(&out.stderr);
-    assert!(text.contains("load on `theta` depends on t") && text.contains("eomgen frf"), "{text}");
+    assert!(
+        text.contains("load on `theta` depends on t") && text.contains("eomgen frf"),
+        "{text}"
+    );
     m.set_parameter("A", 5.0).unwrap();
     let modal = modal_analysis(m.as_ref(), &ModalOptions::default()).unwrap();
     assert!(modal.time_dependent_forcing.is_some());

@@ -816,7 +816,11 @@ fn check_point(model: &dyn ModelInfo, q: &[f64]) -> Result<(), ModalError> {
 /// at rest, `c vₓ²/|v|` = 0/0 where the derivative is 0; its difference is `c δ ≈ 5e-11 c`).
 /// The exact entries that are finite are kept. Where `F` itself or a difference is not finite
 /// the entry stays as it is, for the caller's finiteness check.
-fn forcing_jacobians(model: &dyn ModelInfo, t: f64, y: &[f64]) -> (DMatrix<f64>, DMatrix<f64>, usize) {
+fn forcing_jacobians(
+    model: &dyn ModelInfo,
+    t: f64,
+    y: &[f64],
+) -> (DMatrix<f64>, DMatrix<f64>, usize) {
     let (mut jq, mut jqd) = model.forcing_jacobians(t, y);
     let finite = |a: &DMatrix<f64>| a.iter().all(|v| v.is_finite());
     if finite(&jq) && finite(&jqd) {

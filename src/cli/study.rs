@@ -93,9 +93,10 @@ fn constraint_methods(args: &ConstraintMethodsArgs) -> Result<(), CliError> {
     };
     twin_file
         .into_iter()
-        .fold(super::files::Outputs::new().input(&args.model), |outputs, path| {
-            outputs.input(path)
-        })
+        .fold(
+            super::files::Outputs::new().input(&args.model),
+            |outputs, path| outputs.input(path),
+        )
         .chart("--plot", args.plot.as_deref())
         .check()?;
     let options = ConstraintMethodsOptions {

@@ -314,12 +314,7 @@ pub fn failure_cause(
 /// Relative to its own value at the start, so that units decide nothing (a mass in kg beside
 /// an inertia of 1e-11 kg·m²); entries that were not positive at the start, or are not
 /// finite, are left to the other tests.
-fn vanishing_inertia(
-    model: &dyn ModelInfo,
-    t: f64,
-    y: &[f64],
-    y0: &[f64],
-) -> Option<FailureCause> {
+fn vanishing_inertia(model: &dyn ModelInfo, t: f64, y: &[f64], y0: &[f64]) -> Option<FailureCause> {
     let (now, _) = model.mass_matrix_and_forcing(t, y);
     let (start, _) = model.mass_matrix_and_forcing(0.0, y0);
     let (i, fraction) = (0..now.nrows())

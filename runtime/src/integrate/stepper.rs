@@ -376,9 +376,14 @@ impl<'a> CheckedRhs<'a> {
             Err(error) => return Err(StepFailure::Rhs { t, error }),
         };
         if !exact {
-            crate::linalg::forward_differences(y, f, jac.as_mut_slice(), work_y, work_f, |y, f| {
-                self.eval(t, y, f)
-            })?;
+            crate::linalg::forward_differences(
+                y,
+                f,
+                jac.as_mut_slice(),
+                work_y,
+                work_f,
+                |y, f| self.eval(t, y, f),
+            )?;
         }
         let bad = (0..n).find(|&i| (0..n).any(|j| !jac[(i, j)].is_finite()));
         match bad {
