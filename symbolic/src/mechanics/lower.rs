@@ -529,8 +529,12 @@ impl<'f> Lowering<'f> {
                     BinOp::Div => self.arena.divide(a, b),
                     BinOp::Pow => self.arena.pow(a, b),
                 };
-                if let Some(error) = self.arena.take_fold_error()
+                // The arena did not form a number it could not hold; that is an error of the
+                // file only if the numbers written in this operation alone fail.
+                if self.arena.take_fold_error().is_some()
                     && !undefined
+                    && let Some(error) =
+                        crate::model::parser::written_fold_error(*op, lhs, rhs)
                 {
                     self.errors.push(crate::model::parser::fold_diagnostic(
                         *op_location,
