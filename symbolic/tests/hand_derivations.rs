@@ -310,7 +310,10 @@ fn a_torque_on_the_second_body_enters_its_balances() {
 /// [−2, 2] (a domain of |x| < 2.5 then loses no state).
 #[test]
 fn issue_28_check_draws_its_states_about_the_start() {
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/wrong/far_domain.yaml");
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../tests/wrong/far_domain.yaml"
+    );
     let wrong = std::fs::read_to_string(path).unwrap();
     let right = wrong.replace("-1000*k/(x - 10)", "-k/(x - 10)");
     assert_ne!(right, wrong);

@@ -367,7 +367,8 @@ fn issue_28_a_power_of_a_scaled_coordinate_is_evaluated_as_written() {
         -16.0 * k * 1e-20 * s.powi(15),
         -240.0 * k * 1e-40 * s.powi(14),
     ];
-    let derivations: [(&str, fn(&mut SymbolicModel) -> EquationsOfMotion); 2] = [
+    type Derive = fn(&mut SymbolicModel) -> EquationsOfMotion;
+    let derivations: [(&str, Derive); 2] = [
         ("preferred", |m| preferred_equations(m).0),
         ("Lagrange", |m| Lagrange.derive(m)),
     ];
@@ -400,7 +401,8 @@ fn issue_28_a_power_of_a_scaled_coordinate_is_evaluated_as_written() {
         ("x^2 + x*(1e-20*1e-300)", 26),
         ("(1e300*x)*1e300*1e300", 21),
     ] {
-        let src = format!("name: x\ncoordinates: [x]\nkinetic: x_dot^2/2\npotential: {potential}\n");
+        let src =
+            format!("name: x\ncoordinates: [x]\nkinetic: x_dot^2/2\npotential: {potential}\n");
         let file = load("x.yaml", &src).expect("loads");
         let errors = SymbolicModel::from_file(&file).expect_err(potential);
         assert_eq!(errors.len(), 1, "{potential}: {}", show(&errors));

@@ -595,8 +595,7 @@ impl<'f> Lowering<'f> {
                 // file only if the numbers written in this operation alone fail.
                 if self.arena.take_fold_error().is_some()
                     && !undefined
-                    && let Some(error) =
-                        crate::model::parser::written_fold_error(*op, lhs, rhs)
+                    && let Some(error) = crate::model::parser::written_fold_error(*op, lhs, rhs)
                 {
                     self.errors.push(crate::model::parser::fold_diagnostic(
                         *op_location,

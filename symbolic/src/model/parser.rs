@@ -673,9 +673,9 @@ fn combine(op: BinOp, a: Constant, b: Constant) -> Result<Constant, FoldError> {
 /// as the arena folds it; `None` for any other expression.
 fn number(e: &Expr) -> Option<Result<Constant, FoldError>> {
     match &e.kind {
-        ExprKind::Number { value, text } => {
-            Some(Ok(Constant::parse_decimal(text).or_else(|| Constant::float(*value))?))
-        }
+        ExprKind::Number { value, text } => Some(Ok(
+            Constant::parse_decimal(text).or_else(|| Constant::float(*value))?
+        )),
         ExprKind::Neg(a) => Some(number(a)?.map(Constant::negated)),
         ExprKind::Binary { op, lhs, rhs, .. } => {
             let (a, b) = (number(lhs)?, number(rhs)?);
