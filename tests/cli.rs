@@ -927,6 +927,22 @@ fn issue_28_failure_hints_name_the_model_cause() {
         assert!(h.starts_with("not stiffness"), "{method}: {h}");
         assert!(!h.contains("try --method radau5"), "{method}: {h}");
     }
+    // An inertia m (x − d)² that vanishes at x = d, reached with unbounded speed: the unit-
+    // diagonal test of M cannot see a diagonal entry collapse, and this was "not stiffness"
+    // with no cause. The entry is measured against its value at the start and named; a
+    // negative offset d is no negative mass.
+    let slider = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/fixtures/vanishing_inertia.yaml"
+    );
+    for set in [&[][..], &["--set", "d=-1", "--set", "F0=-1"][..]] {
+        let h = help(&[&["simulate", slider, "--t-end", "2"][..], set].concat());
+        assert!(h.starts_with("the inertia of `x` vanishes"), "{set:?}: {h}");
+        assert!(
+            !h.contains("not stiffness") && !h.contains("negative"),
+            "{set:?}: {h}"
+        );
+    }
     // 10⁷ fixed steps wanted, 10⁶ allowed: the step is the setting to change, not --rtol.
     let h = help(&[
         "simulate",

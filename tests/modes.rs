@@ -975,3 +975,159 @@ fn issue_28_singular_mass_matrix_names_the_coordinates() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("phi, psi") && !err.contains("e8"), "{err}");
 }
+
+/// A model file of `tests/fixtures`, compiled at run time.
+fn fixture_model(name: &str) -> Box<dyn ModelInfo> {
+    eomgen::ModelSource::open(&fixture(name))
+        .expect("fixture loads")
+        .instantiate()
+}
+
+/// Issue 28 (left open by its first round): quadratic drag `c |v| v` at rest
+/// (`tests/fixtures/drag_oscillator.yaml`). The exact `∂F/∂q̇` has `vₓ²/|v|`, 0/0 at rest,
+/// and `modes` read that NaN as a damping matrix changing with t ("changes by inf between
+/// t = 0 s and t = 0 s"). The entries that are not finite are now differenced, as the
+/// implicit integrators difference them, and counted: the linearised drag is 0 (its
+/// difference `c δ`, `δ = √(ε 1e-5) ≈ 4.7e-11`), so the modes are the undamped ones,
+/// ω = √(kx/m) = 2 and √(ky/m) = 3 rad/s (to 1e-12), with `K` exact.
+#[test]
+fn issue_28_quadratic_drag_at_rest_has_the_undamped_modes() {
+    use eomgen::vibration::{ModalOptions, modal_analysis};
+    let m = fixture_model("drag_oscillator.yaml");
+    let modal = modal_analysis(m.as_ref(), &ModalOptions::default()).unwrap();
+    assert!(modal.time_dependent_forcing.is_none());
+    for (w, expected) in modal
+        .normal_modes
+        .natural_frequencies
+        .iter()
+        .zip([2.0, 3.0])
+    {
+        assert!((w - expected).abs() < 1e-12 * expected, "{w} vs {expected}");
+    }
+    let lin = &modal.linearization;
+    assert!(lin.differenced_entries > 0);
+    assert_eq!(
+        lin.stiffness_matrix,
+        DMatrix::from_diagonal(&nalgebra::DVector::from_vec(vec![4.0, 9.0]))
+    );
+    let c = 0.5;
+    assert!(
+        lin.damping_matrix.amax() <= 1e-10 * c,
+        "{}",
+        lin.damping_matrix
+    );
+    assert!(
+        modal.damping_ratios.iter().all(|z| z.abs() < 1e-10),
+        "{:?}",
+        modal.damping_ratios
+    );
+    // A model whose Jacobians are finite is exact, and says so.
+    let exact = modal_analysis(model("three_masses").as_ref(), &ModalOptions::default()).unwrap();
+    assert_eq!(exact.linearization.differenced_entries, 0);
+    let out = eomgen_ok(&["modes", &fixture("drag_oscillator.yaml")]);
+    assert!(String::from_utf8_lossy(&out.stdout).contains("forward differences of F"));
+    let out = eomgen_ok(&["modes", &fixture("drag_oscillator.yaml"), "--json"]);
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert!(v["differenced_jacobian_entries"].as_u64().unwrap() > 0);
+    assert!((v["natural_frequencies"][1].as_f64().unwrap() - 3.0).abs() < 1e-12);
+}
+
+/// Issue 28 (left open): the zero-frequency test was global, `|ω²| ≤ 1e-9 max |ω²|`, so a
+/// soft but real mode beside a stiff one (ω² = 1e-3 next to 1e8, M = I) was called a
+/// rigid-body mode. Each eigenvalue is now judged against the stiffness acting on its own
+/// coordinates: the soft mode oscillates at √1e-3 (to 1e-12), while the rigid-body mode of a
+/// free–free chain (K = k [1 −1 0; −1 2 −1; 0 −1 1]) is still zero, also beside a grounded
+/// mass 1e12 times stiffer, whose rounding (ε 1e12 ≈ 1e-4 in absolute terms) would otherwise
+/// pass for a frequency of 0.01 rad/s.
+#[test]
+fn issue_28_zero_frequency_is_judged_on_each_mode_s_own_scale() {
+    use eomgen::Linearization;
+    let soft = Linearization::from_matrices(
+        DMatrix::identity(2, 2),
+        DMatrix::from_diagonal(&nalgebra::DVector::from_vec(vec![1e-3, 1e8])),
+        DMatrix::zeros(2, 2),
+    );
+    let modes = normal_modes(&soft).unwrap();
+    assert_eq!(modes.kinds, [ModeKind::Oscillatory, ModeKind::Oscillatory]);
+    assert!((modes.natural_frequencies[0] - 1e-3f64.sqrt()).abs() < 1e-12 * 1e-3f64.sqrt());
+    for (k, grounded) in [(1.0, None), (3.0, None), (1.0, Some(1e12))] {
+        let n = if grounded.is_some() { 4 } else { 3 };
+        let mut stiffness = DMatrix::zeros(n, n);
+        for i in 0..2 {
+            stiffness[(i, i)] += k;
+            stiffness[(i + 1, i + 1)] += k;
+            stiffness[(i, i + 1)] -= k;
+            stiffness[(i + 1, i)] -= k;
+        }
+        if let Some(stiff) = grounded {
+            stiffness[(3, 3)] = stiff;
+        }
+        let chain =
+            Linearization::from_matrices(DMatrix::identity(n, n), stiffness, DMatrix::zeros(n, n));
+        let modes = normal_modes(&chain).unwrap();
+        assert_eq!(
+            modes.kinds[0],
+            ModeKind::ZeroFrequency,
+            "{k} {grounded:?}: {:?}",
+            modes.eigenvalues
+        );
+        assert!(
+            modes.kinds[1..]
+                .iter()
+                .all(|kind| *kind == ModeKind::Oscillatory)
+        );
+        // ω² = k, 3k for the free–free chain of unit masses (to rounding of the largest
+        // entry, 1e12 beside it).
+        let tol = if grounded.is_some() { 1e-3 } else { 1e-12 };
+        assert!(
+            (modes.eigenvalues[1] - k).abs() < tol * k,
+            "{:?}",
+            modes.eigenvalues
+        );
+        assert!(
+            (modes.eigenvalues[2] - 3.0 * k).abs() < tol * k,
+            "{:?}",
+            modes.eigenvalues
+        );
+    }
+}
+
+/// Issue 28 (left open): a load that depends on t and has no equilibrium at t₀ reported
+/// Newton's failure ("start Newton nearer an equilibrium"), though the time dependence is
+/// what stands between the model and its modes. A pendulum driven by `A cos wt` with
+/// `A = 20 N·m` above `m g l = 9.81 N·m` (`tests/fixtures/overdriven_pendulum.yaml`) is now
+/// refused as a time-dependent load, naming it and Newton's failure; with `A = 5 N·m` the
+/// load is set aside as before and the pendulum leaning at `sin θ* = A/(m g l)` has
+/// `ω² = (g/l) cos θ*` (to 1e-10, Newton's tolerance).
+#[test]
+fn issue_28_time_dependent_load_without_equilibrium_is_refused_as_such() {
+    use eomgen::vibration::{ModalOptions, OperatingPointError, modal_analysis};
+    let mut m = fixture_model("overdriven_pendulum.yaml");
+    let err = modal_analysis(m.as_ref(), &ModalOptions::default()).unwrap_err();
+    let OperatingPointError::Modal(ModalError::TimeDependentLoad {
+        forcing,
+        equilibrium,
+    }) = &err
+    else {
+        panic!("{err}")
+    };
+    assert_eq!(forcing.coordinate, "theta");
+    assert!(
+        matches!(**equilibrium, ModalError::EquilibriumNotFound { .. }),
+        "{equilibrium}"
+    );
+    let out = eomgen(&["modes", &fixture("overdriven_pendulum.yaml")]);
+    assert_eq!(out.status.code(), Some(1));
+    let text = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        text.contains("load on `theta` depends on t") && text.contains("eomgen frf"),
+        "{text}"
+    );
+    m.set_parameter("A", 5.0).unwrap();
+    let modal = modal_analysis(m.as_ref(), &ModalOptions::default()).unwrap();
+    assert!(modal.time_dependent_forcing.is_some());
+    let theta = (5.0f64 / 9.81).asin();
+    assert!((modal.operating_point.q()[0] - theta).abs() < 1e-10);
+    let w2 = 9.81 * theta.cos();
+    assert!((modal.normal_modes.eigenvalues[0] - w2).abs() < 1e-10 * w2);
+}

@@ -515,6 +515,63 @@ fn run_in(dir: &std::path::Path, args: &[&str]) -> Output {
         .expect("binary runs")
 }
 
+/// Runs `eomgen args` in `dir`, requires success and returns its standard error (the
+/// warnings).
+fn succeeds_in(dir: &std::path::Path, args: &[&str]) -> String {
+    let out = run_in(dir, args);
+    assert!(out.status.success(), "{args:?}: {}", stderr(&out));
+    stderr(&out)
+}
+
+/// Runs `eomgen args` in `dir`, requires a usage error (status 2) and returns its message.
+fn refused_in(dir: &std::path::Path, args: &[&str]) -> String {
+    let out = run_in(dir, args);
+    assert_eq!(out.status.code(), Some(2), "{args:?}: {}", stderr(&out));
+    stderr(&out)
+}
+
+/// The text of the bundled model file `models/NAME.yaml`.
+fn bundled_file(name: &str) -> String {
+    std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("models/{name}.yaml")),
+    )
+    .unwrap()
+}
+
+/// Writes the companions `CSV-events.csv` and `PLOT-drift.*` in `dir` (a pendulum that
+/// crosses q = 0, and the Cartesian pendulum's drift chart) with two runs of eomgen.
+fn write_companions(dir: &std::path::Path, csv: &str, plot: &str) {
+    let events = ["--init", "q=1", "--event", "q = 0", "--csv", csv];
+    succeeds_in(dir, &[&PENDULUM[..], &events].concat());
+    succeeds_in(
+        dir,
+        &[
+            "simulate",
+            "simple_pendulum_cartesian",
+            "--t-end",
+            "1",
+            "--plot",
+            plot,
+        ],
+    );
+}
+
+/// A one-second run of the bundled pendulum, to which a test adds its outputs.
+const PENDULUM: [&str; 4] = ["simulate", "simple_pendulum", "--t-end", "1"];
+
+/// The pendulum's CSV output at `t = 1` only, to which a test adds `--csv PATH`.
+const PENDULUM_AT_1: [&str; 4] = ["simulate", "simple_pendulum", "--t-out", "1"];
+
+/// The first line of the pendulum's CSV.
+const PENDULUM_CSV_HEADER: &str = "t,q,q_dot,energy\n";
+
+/// Whether the file at `path` holds the pendulum's CSV.
+fn holds_pendulum_csv(path: &std::path::Path) -> bool {
+    std::fs::read_to_string(path)
+        .unwrap()
+        .starts_with(PENDULUM_CSV_HEADER)
+}
+
 /// The files of `dir` whose names start with `.eomgen-`: temporary files left behind.
 fn temporaries(dir: &std::path::Path) -> Vec<String> {
     std::fs::read_dir(dir)
@@ -870,9 +927,7 @@ fn issue_28_outputs_are_checked_before_any_work() {
         ),
     ];
     for (args, says) in cases {
-        let out = run_in(dir.path(), args);
-        let text = stderr(&out);
-        assert_eq!(out.status.code(), Some(2), "{args:?}: {text}");
+        let text = refused_in(dir.path(), args);
         assert!(text.contains(says), "{args:?}: {text}");
         let written: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();
         assert!(written.is_empty(), "{args:?} wrote {written:?}");
@@ -905,39 +960,23 @@ fn issue_28_stale_companions_are_removed() {
     let dir = tempfile::tempdir().unwrap();
     let events = dir.path().join("e-events.csv");
     let drift = dir.path().join("d-drift.svg");
-    let succeeds = |args: &[&str]| {
-        let out = run_in(dir.path(), args);
-        assert!(out.status.success(), "{args:?}: {}", stderr(&out));
-    };
-    let pendulum = ["simulate", "simple_pendulum", "--t-end", "1"];
-    succeeds(
-        &[
-            &pendulum[..],
-            &["--init", "q=1", "--event", "q = 0", "--csv", "e.csv"],
-        ]
-        .concat(),
-    );
+    write_companions(dir.path(), "e.csv", "d.svg");
     assert!(
         std::fs::read_to_string(&events)
             .unwrap()
             .starts_with("event,direction")
     );
-    succeeds(&[
-        "simulate",
-        "simple_pendulum_cartesian",
-        "--t-end",
-        "1",
-        "--plot",
-        "d.svg",
-    ]);
     assert!(drift.exists());
 
-    succeeds(&[&pendulum[..], &["--csv", "e.csv", "--plot", "d.svg"]].concat());
+    succeeds_in(
+        dir.path(),
+        &[&PENDULUM[..], &["--csv", "e.csv", "--plot", "d.svg"]].concat(),
+    );
     assert!(!events.exists(), "a stale events file stayed");
     assert!(!drift.exists(), "a stale drift chart stayed");
 
     std::os::unix::fs::symlink("elsewhere.csv", &events).unwrap();
-    succeeds(&[&pendulum[..], &["--csv", "e.csv"]].concat());
+    succeeds_in(dir.path(), &[&PENDULUM[..], &["--csv", "e.csv"]].concat());
     assert!(
         std::fs::symlink_metadata(&events)
             .unwrap()
@@ -1048,30 +1087,14 @@ fn issue_28_diagnostics_json_on_a_full_device_is_status_1() {
 #[test]
 fn issue_28_an_output_naming_the_model_file_is_refused() {
     let dir = tempfile::tempdir().unwrap();
-    let model = std::fs::read_to_string(
-        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("models/simple_pendulum.yaml"),
-    )
-    .unwrap();
+    let model = bundled_file("simple_pendulum");
     std::fs::write(dir.path().join("pend.yaml"), &model).unwrap();
     std::os::unix::fs::symlink("pend.yaml", dir.path().join("link.csv")).unwrap();
     std::fs::hard_link(dir.path().join("pend.yaml"), dir.path().join("hard.csv")).unwrap();
+    let run = ["simulate", "pend.yaml", "--t-end", "1", "--csv"];
     let cases: &[&[&str]] = &[
-        &[
-            "simulate",
-            "pend.yaml",
-            "--t-end",
-            "1",
-            "--csv",
-            "pend.yaml",
-        ],
-        &[
-            "simulate",
-            "pend.yaml",
-            "--t-end",
-            "1",
-            "--csv",
-            "./pend.yaml",
-        ],
+        &[&run[..], &["pend.yaml"]].concat(),
+        &[&run[..], &["./pend.yaml"]].concat(),
         &[
             "simulate",
             "./pend.yaml",
@@ -1080,14 +1103,12 @@ fn issue_28_an_output_naming_the_model_file_is_refused() {
             "--csv",
             "link.csv",
         ],
-        &["simulate", "pend.yaml", "--t-end", "1", "--csv", "hard.csv"],
+        &[&run[..], &["hard.csv"]].concat(),
         &["animate", "pend.yaml", "--t-end", "1", "-o", "pend.yaml"],
         &["modes", "pend.yaml", "--animate", "pend.yaml"],
     ];
     for args in cases {
-        let out = run_in(dir.path(), args);
-        let text = stderr(&out);
-        assert_eq!(out.status.code(), Some(2), "{args:?}: {text}");
+        let text = refused_in(dir.path(), args);
         assert!(
             text.contains("is the model file") && text.contains("pend.yaml"),
             "{args:?}: {text}"
@@ -1100,6 +1121,58 @@ fn issue_28_an_output_naming_the_model_file_is_refused() {
     }
 }
 
+/// `study constraint-methods` reads a second model, the minimal twin its file names
+/// (`minimal_twin:`), which was not protected: `--plot out.svg`, a link to the twin's file,
+/// replaced the twin with the chart. The twin's file is now an input like the model's (a
+/// usage error before any work, the twin left as it was).
+#[test]
+fn issue_28_an_output_naming_the_minimal_twin_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    // A name that is no bundled model opens the file of that name.
+    let twin = bundled_file("simple_pendulum");
+    std::fs::write(dir.path().join("pendulum_twin"), &twin).unwrap();
+    let cartesian = bundled_file("simple_pendulum_cartesian").replace(
+        "minimal_twin: simple_pendulum",
+        "minimal_twin: pendulum_twin",
+    );
+    std::fs::write(dir.path().join("cart.yaml"), cartesian).unwrap();
+    std::os::unix::fs::symlink("pendulum_twin", dir.path().join("out.svg")).unwrap();
+    let study = ["study", "constraint-methods", "cart.yaml", "--t-end", "0.1"];
+    let text = refused_in(dir.path(), &[&study[..], &["--plot", "out.svg"]].concat());
+    assert!(
+        text.contains("is the model file") && text.contains("pendulum_twin"),
+        "{text}"
+    );
+    assert_eq!(
+        std::fs::read_to_string(dir.path().join("pendulum_twin")).unwrap(),
+        twin
+    );
+    // The twin is read and compared with: another chart name is written.
+    succeeds_in(dir.path(), &[&study[..], &["--plot", "chart.svg"]].concat());
+    assert!(dir.path().join("chart.svg").exists());
+}
+
+/// `modes --plot PREFIX` of a model with fewer modes than an earlier run left the earlier
+/// run's `PREFIX-mode<k>` charts beside the new ones. The charts of modes this run does not
+/// have are removed when eomgen wrote them (the Software mark and a mode chart's title) and
+/// kept with a warning otherwise, as stale companions are.
+#[test]
+fn issue_28_stale_mode_charts_are_removed() {
+    let dir = tempfile::tempdir().unwrap();
+    let chart = |k: usize| dir.path().join(format!("m-mode{k}.svg"));
+    succeeds_in(dir.path(), &["modes", "double_pendulum", "--plot", "m"]);
+    assert!(chart(1).exists() && chart(2).exists());
+    std::fs::write(chart(3), "mine\n").unwrap();
+    let text = succeeds_in(dir.path(), &["modes", "simple_pendulum", "--plot", "m"]);
+    assert!(chart(1).exists(), "this run's chart");
+    assert!(!chart(2).exists(), "a stale mode chart stayed");
+    assert_eq!(std::fs::read_to_string(chart(3)).unwrap(), "mine\n");
+    assert!(
+        text.contains("warning: `m-mode3.svg` is not from this run"),
+        "{text}"
+    );
+}
+
 /// With `echo mine > run-events.csv`, `simulate … --csv run.csv` deleted the user's file as
 /// a stale companion. A companion is removed only when eomgen wrote it (the events CSV's
 /// header, the drift chart's title or PNG marker); another file of that name is kept, with a
@@ -1107,17 +1180,15 @@ fn issue_28_an_output_naming_the_model_file_is_refused() {
 #[test]
 fn issue_28_a_stale_companion_is_removed_only_when_eomgen_wrote_it() {
     let dir = tempfile::tempdir().unwrap();
-    let pendulum = ["simulate", "simple_pendulum", "--t-end", "1"];
-    for name in ["run-events.csv", "p-drift.svg", "p-drift.png"] {
+    let companions = ["run-events.csv", "p-drift.svg", "p-drift.png"];
+    for name in companions {
         std::fs::write(dir.path().join(name), "mine\n").unwrap();
     }
     for plot in ["p.svg", "p.png"] {
-        let out = run_in(
+        let text = succeeds_in(
             dir.path(),
-            &[&pendulum[..], &["--csv", "run.csv", "--plot", plot]].concat(),
+            &[&PENDULUM[..], &["--csv", "run.csv", "--plot", plot]].concat(),
         );
-        let text = stderr(&out);
-        assert!(out.status.success(), "{text}");
         assert!(
             text.contains("warning: `run-events.csv` is not from this run"),
             "{text}"
@@ -1125,7 +1196,7 @@ fn issue_28_a_stale_companion_is_removed_only_when_eomgen_wrote_it() {
         let drift = plot.replace('.', "-drift.");
         assert!(text.contains(&format!("warning: `{drift}`")), "{text}");
     }
-    for name in ["run-events.csv", "p-drift.svg", "p-drift.png"] {
+    for name in companions {
         assert_eq!(
             std::fs::read_to_string(dir.path().join(name)).unwrap(),
             "mine\n",
@@ -1133,38 +1204,22 @@ fn issue_28_a_stale_companion_is_removed_only_when_eomgen_wrote_it() {
         );
     }
     // The same names written by eomgen are removed by a run that has nothing for them.
-    for name in ["run-events.csv", "p-drift.svg", "p-drift.png"] {
+    for name in companions {
         std::fs::remove_file(dir.path().join(name)).unwrap();
     }
-    let succeeds = |args: &[&str]| {
-        let out = run_in(dir.path(), args);
-        assert!(out.status.success(), "{args:?}: {}", stderr(&out));
-        stderr(&out)
-    };
-    succeeds(
-        &[
-            &pendulum[..],
-            &["--init", "q=1", "--event", "q = 0", "--csv", "run.csv"],
-        ]
-        .concat(),
-    );
     for plot in ["p.svg", "p.png"] {
-        succeeds(&[
-            "simulate",
-            "simple_pendulum_cartesian",
-            "--t-end",
-            "1",
-            "--plot",
-            plot,
-        ]);
+        write_companions(dir.path(), "run.csv", plot);
     }
-    for name in ["run-events.csv", "p-drift.svg", "p-drift.png"] {
+    for name in companions {
         assert!(dir.path().join(name).exists(), "{name}");
     }
-    let text = succeeds(&[&pendulum[..], &["--csv", "run.csv", "--plot", "p.svg"]].concat());
-    let text = text + &succeeds(&[&pendulum[..], &["--plot", "p.png"]].concat());
+    let text = succeeds_in(
+        dir.path(),
+        &[&PENDULUM[..], &["--csv", "run.csv", "--plot", "p.svg"]].concat(),
+    );
+    let text = text + &succeeds_in(dir.path(), &[&PENDULUM[..], &["--plot", "p.png"]].concat());
     assert!(!text.contains("warning"), "{text}");
-    for name in ["run-events.csv", "p-drift.svg", "p-drift.png"] {
+    for name in companions {
         assert!(!dir.path().join(name).exists(), "{name} stayed");
     }
 }
@@ -1192,7 +1247,7 @@ fn issue_28_an_open_descriptor_is_written_through_not_reopened() {
     use std::os::unix::fs::MetadataExt as _;
     let dir = tempfile::tempdir().unwrap();
     let log = dir.path().join("log.csv");
-    let pendulum = ["simulate", "simple_pendulum", "--t-out", "1"];
+    let pendulum = PENDULUM_AT_1;
     for (k, path) in ["/dev/fd/3", "/proc/self/fd/3"].into_iter().enumerate() {
         std::fs::write(&log, "keep\n").unwrap();
         let out = run_redirected(
@@ -1210,30 +1265,20 @@ fn issue_28_an_open_descriptor_is_written_through_not_reopened() {
         assert!(temporaries(dir.path()).is_empty(), "{k}");
     }
     // Not open: nothing to write to.
-    let out = run_in(
+    let text = refused_in(
         dir.path(),
         &[&pendulum[..], &["--csv", "/dev/fd/9"]].concat(),
     );
-    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
-    assert!(
-        stderr(&out).contains("no such open file descriptor"),
-        "{}",
-        stderr(&out)
-    );
+    assert!(text.contains("no such open file descriptor"), "{text}");
     // Any other path under /proc is a path like any other.
     let file = dir.path().join("cwd.csv");
     std::fs::write(&file, "old\n").unwrap();
     let before = std::fs::metadata(&file).unwrap().ino();
-    let out = run_in(
+    succeeds_in(
         dir.path(),
         &[&pendulum[..], &["--csv", "/proc/self/cwd/cwd.csv"]].concat(),
     );
-    assert!(out.status.success(), "{}", stderr(&out));
-    assert!(
-        std::fs::read_to_string(&file)
-            .unwrap()
-            .starts_with("t,q,q_dot,energy\n")
-    );
+    assert!(holds_pendulum_csv(&file));
     assert_ne!(
         std::fs::metadata(&file).unwrap().ino(),
         before,
@@ -1261,35 +1306,20 @@ fn issue_28_a_planted_link_in_a_sticky_directory_is_not_followed() {
         eprintln!("skipped: only root can give a link to another user");
         return;
     }
-    let out = run(&[
-        "simulate",
-        "simple_pendulum",
-        "--t-out",
-        "1",
-        "--csv",
-        planted.to_str().unwrap(),
-    ]);
-    let text = stderr(&out);
-    assert_eq!(out.status.code(), Some(2), "{text}");
+    let text = refused_in(
+        dir.path(),
+        &[&PENDULUM_AT_1[..], &["--csv", planted.to_str().unwrap()]].concat(),
+    );
     assert!(text.contains("fs.protected_symlinks"), "{text}");
     assert_eq!(std::fs::read_to_string(&victim).unwrap(), "precious\n");
 
     let own = sticky.join("own.csv");
     std::os::unix::fs::symlink(&victim, &own).unwrap();
-    let out = run(&[
-        "simulate",
-        "simple_pendulum",
-        "--t-out",
-        "1",
-        "--csv",
-        own.to_str().unwrap(),
-    ]);
-    assert!(out.status.success(), "{}", stderr(&out));
-    assert!(
-        std::fs::read_to_string(&victim)
-            .unwrap()
-            .starts_with("t,q,q_dot,energy\n")
+    succeeds_in(
+        dir.path(),
+        &[&PENDULUM_AT_1[..], &["--csv", own.to_str().unwrap()]].concat(),
     );
+    assert!(holds_pendulum_csv(&victim));
 }
 
 /// With `mkdir -p R/index.html`, `report -o R` wrote report.json and the model's folder, then
@@ -1338,23 +1368,8 @@ fn issue_28_report_outputs_are_checked_before_any_work() {
 #[test]
 fn issue_28_a_trailing_slash_is_refused_and_dash_is_standard_output() {
     let dir = tempfile::tempdir().unwrap();
-    let out = run_in(
-        dir.path(),
-        &[
-            "simulate",
-            "simple_pendulum",
-            "--t-out",
-            "1",
-            "--csv",
-            "new/",
-        ],
-    );
-    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
-    assert!(
-        stderr(&out).contains("--csv `new/` names no file"),
-        "{}",
-        stderr(&out)
-    );
+    let text = refused_in(dir.path(), &[&PENDULUM[..], &["--csv", "new/"]].concat());
+    assert!(text.contains("--csv `new/` names no file"), "{text}");
 
     let out = run_in(
         dir.path(),

@@ -525,6 +525,27 @@ fn issue_28_a_check_over_no_state_is_never_a_pass() {
     let _ = std::fs::remove_dir_all(&out_dir);
 }
 
+/// Issue 28: `check` drew q and q̇ in [−2, 2] only, so a model defined for x > 10 and started
+/// at x = 12 (`tests/wrong/far_domain.yaml`) failed "over no state" whatever its equations.
+/// States are drawn about the start: its grossly wrong hand equation is compared, at a real
+/// number of states, and caught.
+#[test]
+fn issue_28_check_draws_about_the_start_and_catches_a_wrong_equation() {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/wrong/far_domain.yaml");
+    let out = eomgen(&["check", path, "--json"]);
+    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["passed"], false, "{v}");
+    assert!(v["failure"].is_null(), "{v}");
+    assert!(v["states"]["compared"].as_u64().unwrap() >= 50, "{v}");
+    assert!(
+        v["notes"]
+            .to_string()
+            .contains("written by hand disagree with Lagrange"),
+        "{v}"
+    );
+}
+
 /// Issue 28: negative Baumgarte gains were accepted (`--baumgarte -10 -10` took the pendulum's
 /// constraint residual to 8.4e34 with exit 0), `nan` was a failed computation rather than a
 /// usage error, and the documented `--baumgarte 10,10` was refused. Gains must be finite and

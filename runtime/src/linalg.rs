@@ -1,6 +1,7 @@
 //! Dense symmetric positive definite solves `M x = f` for the mass matrix: [`solve_spd`] with a
 //! compile-time size (the compiled models' hot path) and [`solve_spd_in_place`] with a size
-//! known at run time, the same operations in the same order.
+//! known at run time, the same operations in the same order; and [`forward_differences`], the
+//! one difference Jacobian that stands in for an exact one that is not finite.
 
 use nalgebra::{SMatrix, SVector};
 
@@ -287,6 +288,54 @@ fn solve_in_envelope(
         }
     }
     Some(())
+}
+
+/// The forward-difference Jacobian `∂f/∂y` of a function `f: ℝᵈ → ℝᵏ` at `y`, from
+/// `f0 = f(y)`, into `jac` (`k × d`, column-major), with RADAU5's increments
+/// `δⱼ = √(ε · max(10⁻⁵, |yⱼ|))` (`d` evaluations of `f`).
+///
+/// This is the one fallback for an exact Jacobian that is not finite where `f` is: a
+/// derivative can have a removable singularity that the function has not (quadratic drag
+/// `|v| v`, with `|v| = √(vₓ² + v_y²)`, has `vₓ²/|v|`, 0/0 at rest, where the derivative is
+/// 0; its difference is `c δ`, of the order of 1e-11 c). The implicit integrators' Newton
+/// iteration ([`RadauIIA5`](crate::RadauIIA5), [`ImplicitMidpoint`](crate::ImplicitMidpoint)),
+/// the linearisation of [`modal`](crate::modal) and the failure diagnosis all use it.
+///
+/// # Arguments
+/// * `y`      - the point (length `d`).
+/// * `f0`     - `f(y)` (length `k`).
+/// * `jac`    - the result, `k × d` column-major (length `k d`).
+/// * `work_y` - scratch of length `d`; holds `y` on return.
+/// * `work_f` - scratch of length `k`.
+/// * `eval`   - evaluates `f` at its first argument into its second.
+///
+/// # Errors
+/// The first error of `eval`; `jac` is then partly written.
+///
+/// # Panics
+/// If the lengths do not match (a programmer error).
+pub fn forward_differences<E>(
+    y: &[f64],
+    f0: &[f64],
+    jac: &mut [f64],
+    work_y: &mut [f64],
+    work_f: &mut [f64],
+    mut eval: impl FnMut(&[f64], &mut [f64]) -> Result<(), E>,
+) -> Result<(), E> {
+    let (d, k) = (y.len(), f0.len());
+    assert!(jac.len() == k * d && work_y.len() == d && work_f.len() == k);
+    work_y.copy_from_slice(y);
+    for j in 0..d {
+        let delta = (f64::EPSILON * y[j].abs().max(1e-5)).sqrt();
+        work_y[j] = y[j] + delta;
+        let result = eval(&*work_y, &mut *work_f);
+        work_y[j] = y[j];
+        result?;
+        for i in 0..k {
+            jac[i + j * k] = (work_f[i] - f0[i]) / delta;
+        }
+    }
+    Ok(())
 }
 
 #[cfg(test)]

@@ -1,7 +1,10 @@
 //! Equilibria, exact linearisation into `M δq̈ + C δq̇ + K δq = 0`, and undamped normal modes
 //! (issue 7; lectures 22–26).
 //!
-//! The linearisation uses the generated Jacobians, so it is exact (no finite differences):
+//! The linearisation uses the generated Jacobians, so it is exact (no finite differences,
+//! except for an entry of `∂F/∂q` or `∂F/∂q̇` that is not finite where `F` is, a removable
+//! singularity such as quadratic drag's `d|v|/dv` at rest, which is differenced as the
+//! implicit integrators difference it; [`Linearization::differenced_entries`] counts them):
 //! with `M(q, t) q̈ = F(q, q̇, t)` and an operating point `(q*, q̇*, t)` where `q̈* = M⁻¹F`,
 //!
 //! ```text
@@ -101,6 +104,22 @@ pub enum ModalError {
         t: f64,
         /// The largest change relative to the part's largest entry over the samples.
         relative_change: f64,
+    },
+    /// A load that depends on `t` (it enters neither `M`, `C` nor `K`), under whose value at
+    /// `t₀` the equations at rest have no equilibrium: the equilibrium search failed, and its
+    /// failure comes from the load's value at that one instant, so the time dependence is
+    /// what stands between the model and its modes (a pendulum driven by `A cos wt` with
+    /// `A` above `m g l`).
+    #[error(
+        "the load on `{}` depends on t (F(q, 0, t) − F(q, 0, t₀) reaches {:.3e} at t = {} s, t₀ = {} s), and under its value at t₀ the equations at rest have no equilibrium ({equilibrium}): modes need an equilibrium of equations that do not change with t",
+        forcing.coordinate, forcing.largest_change, forcing.t, forcing.t0
+    )]
+    TimeDependentLoad {
+        /// The load and how much it changes.
+        forcing: TimeDependentForcing,
+        /// Why the equilibrium search under its value at `t₀` failed
+        /// ([`ModalError::EquilibriumNotFound`] or [`ModalError::EquilibriumAtInfinity`]).
+        equilibrium: Box<ModalError>,
     },
     /// A value is not finite at the operating point.
     #[error("the linearisation is not finite at q = {q:?}")]
@@ -295,7 +314,7 @@ pub fn find_equilibrium(
     };
     let jacobian_of = |x: &[f64]| -> DMatrix<f64> {
         let y = state(&x[..n]);
-        let (jq, _) = model.forcing_jacobians(t, &y);
+        let (jq, _, _) = forcing_jacobians(model, t, &y);
         if m == 0 {
             return jq;
         }
@@ -623,6 +642,9 @@ fn matrix_change(samples: &[DVector<f64>], n: usize) -> (f64, usize) {
 /// equilibrium under its value at `t₀` (frozen there in
 /// the equilibrium. `Ok(None)` when nothing changes.
 ///
+/// The Jacobians are those of the linearisation: an entry that is not finite where `F` is
+/// (quadratic drag at rest) is differenced, as in [`linearize`], rather than read as a change.
+///
 /// Why numerically: the model is a compiled function of `(t, y)`; sampling its values is
 /// what the Floquet study does to check a period, and it sees every route by which `t`
 /// enters (a point moved with `t`, a constraint, a load).
@@ -696,7 +718,7 @@ pub fn time_dependence(
         (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for &t in &times {
         let (m_t, f_t) = model.mass_matrix_and_forcing(t, &y);
-        let (jq, jqd) = model.forcing_jacobians(t, &y);
+        let (jq, jqd, _) = forcing_jacobians(model, t, &y);
         mass.push(flat(&m_t));
         forcing.push(f_t);
         damping.push(flat(&jqd));
@@ -792,6 +814,58 @@ fn check_point(model: &dyn ModelInfo, q: &[f64]) -> Result<(), ModalError> {
     Ok(())
 }
 
+/// `∂F/∂q` and `∂F/∂q̇` at `(t, y)` (`n × n` each, `y = [q; q̇]`), with the number of their
+/// entries that were replaced by differences: the generated, exact ones, except that an entry
+/// that is not finite where `F` is finite is replaced by its forward difference of `F`
+/// ([`forward_differences`](crate::linalg::forward_differences), the integrators' fallback):
+/// a derivative can have a removable singularity that `F` has not (quadratic drag `c |v| v`
+/// at rest, `c vₓ²/|v|` = 0/0 where the derivative is 0; its difference is `c δ ≈ 5e-11 c`).
+/// The exact entries that are finite are kept. Where `F` itself or a difference is not finite
+/// the entry stays as it is, for the caller's finiteness check.
+fn forcing_jacobians(
+    model: &dyn ModelInfo,
+    t: f64,
+    y: &[f64],
+) -> (DMatrix<f64>, DMatrix<f64>, usize) {
+    let (mut jq, mut jqd) = model.forcing_jacobians(t, y);
+    let finite = |a: &DMatrix<f64>| a.iter().all(|v| v.is_finite());
+    if finite(&jq) && finite(&jqd) {
+        return (jq, jqd, 0);
+    }
+    let (_, f0) = model.mass_matrix_and_forcing(t, y);
+    let n = f0.len();
+    if !f0.iter().all(|v| v.is_finite()) || y.len() != 2 * n {
+        return (jq, jqd, 0);
+    }
+    // ∂F/∂[q; q̇], n × 2n: ∂F/∂q in the first n columns, ∂F/∂q̇ in the last n.
+    let mut both = DMatrix::zeros(n, 2 * n);
+    let (mut work_y, mut work_f) = (vec![0.0; 2 * n], vec![0.0; n]);
+    let _ = crate::linalg::forward_differences(
+        y,
+        f0.as_slice(),
+        both.as_mut_slice(),
+        &mut work_y,
+        &mut work_f,
+        |y, f| {
+            f.copy_from_slice(model.mass_matrix_and_forcing(t, y).1.as_slice());
+            Ok::<(), std::convert::Infallible>(())
+        },
+    );
+    let mut replaced = 0;
+    for (offset, exact) in [(0, &mut jq), (n, &mut jqd)] {
+        for j in 0..n {
+            for i in 0..n {
+                let difference = both[(i, offset + j)];
+                if !exact[(i, j)].is_finite() && difference.is_finite() {
+                    exact[(i, j)] = difference;
+                    replaced += 1;
+                }
+            }
+        }
+    }
+    (jq, jqd, replaced)
+}
+
 /// The linearised equations `M δq̈ + C δq̇ + K δq = 0` at an operating point.
 ///
 /// Without constraints the unknowns are `δq` itself. With holonomic constraints they are `r`
@@ -831,6 +905,12 @@ pub struct Linearization {
     /// `lagrange_multipliers` `λ*` at the operating point (length `m`; empty without
     /// constraints).
     pub lagrange_multipliers: Vec<f64>,
+    /// How many entries of the generated `∂F/∂q` and `∂F/∂q̇` (`n × n` each) were not finite
+    /// at the operating point while `F` was, and were replaced by forward differences of `F`
+    /// (a removable singularity: quadratic drag `c |v| v` at rest, whose exact derivative is
+    /// 0/0 there and whose difference is `c δ`, about `5e-11 c`); 0 when `K` and `C` are
+    /// exact.
+    pub differenced_entries: usize,
 }
 
 impl Linearization {
@@ -853,6 +933,7 @@ impl Linearization {
             coordinate_basis: DMatrix::identity(n, n),
             independent_coordinates: (0..n).collect(),
             lagrange_multipliers: Vec::new(),
+            differenced_entries: 0,
         }
     }
 
@@ -929,7 +1010,9 @@ fn asymmetry(k: &DMatrix<f64>) -> f64 {
 /// [`ModalError::DegenerateCoordinates`] (a mass matrix singular to working precision: the
 /// smallest eigenvalue of `D^{-1/2} M D^{-1/2}`, `D = diag M`, below
 /// [`MASS_MATRIX_SINGULARITY`], in the minimal coordinates with constraints),
-/// [`ModalError::NonFinite`].
+/// [`ModalError::NonFinite`] (an entry of `∂F/∂q` or `∂F/∂q̇` that is not finite is first
+/// replaced by its forward difference of `F`, as the implicit integrators do, and counted in
+/// [`Linearization::differenced_entries`]; the error is for what stays not finite).
 pub fn linearize(
     model: &dyn ModelInfo,
     q: &[f64],
@@ -947,7 +1030,7 @@ pub fn linearize(
     let m = model.description().holonomic_constraints;
     let y: Vec<f64> = q.iter().chain(qdot).copied().collect();
     let (mass, f) = model.mass_matrix_and_forcing(t, &y);
-    let (jq, jqd) = model.forcing_jacobians(t, &y);
+    let (jq, jqd, differenced_entries) = forcing_jacobians(model, t, &y);
     let finite = |a: &DMatrix<f64>| a.iter().all(|v| v.is_finite());
     let names = model.description().coordinate_names();
     if m == 0 {
@@ -973,6 +1056,7 @@ pub fn linearize(
             coordinate_basis: DMatrix::identity(n, n),
             independent_coordinates: (0..n).collect(),
             lagrange_multipliers: Vec::new(),
+            differenced_entries,
         });
     }
     let speed = qdot.iter().fold(0.0f64, |a, v| a.max(v.abs()));
@@ -1036,6 +1120,7 @@ pub fn linearize(
         coordinate_basis: basis,
         independent_coordinates: independent,
         lagrange_multipliers: lambda,
+        differenced_entries,
     })
 }
 
@@ -1113,7 +1198,8 @@ fn null_space_by_partitioning(j: &DMatrix<f64>) -> (DMatrix<f64>, Vec<usize>) {
 pub enum ModeKind {
     /// `ω² > 0`: an oscillation at `ω` rad/s.
     Oscillatory,
-    /// `ω² ≈ 0` (below `1e-9 max |ω²|`): a zero-frequency (rigid-body) mode (lecture 24).
+    /// `ω² ≈ 0`: below `1e-9` of the stiffness acting on the mode's own coordinates (or at
+    /// rounding, `1e-13 max |ω²|`), a zero-frequency (rigid-body) mode (lecture 24).
     ZeroFrequency,
     /// `ω² < 0`: an unstable direction growing like `e^{σ t}`, `σ = √(−ω²)` (1/s).
     Unstable {
@@ -1163,7 +1249,8 @@ pub fn normal_modes(lin: &Linearization) -> Result<NormalModes, ModalError> {
     if !y.iter().all(|v| v.is_finite()) {
         return Err(ModalError::NonFinite { q: lin.q.clone() });
     }
-    let eigen = SymmetricEigen::new(y);
+    let eigen = SymmetricEigen::new(y.clone());
+    let reduced = y;
     let mut order: Vec<usize> = (0..n).collect();
     order.sort_by(|&a, &b| eigen.eigenvalues[a].total_cmp(&eigen.eigenvalues[b]));
     let largest = eigen.eigenvalues.amax();
@@ -1174,7 +1261,7 @@ pub fn normal_modes(lin: &Linearization) -> Result<NormalModes, ModalError> {
     let mut kinds = Vec::with_capacity(n);
     for (col, &k) in order.iter().enumerate() {
         let mut w2 = eigen.eigenvalues[k];
-        let kind = if w2.abs() <= 1e-9 * largest || largest == 0.0 {
+        let kind = if is_zero_frequency(w2, &reduced, eigen.eigenvectors.column(k), largest) {
             w2 = 0.0;
             ModeKind::ZeroFrequency
         } else if w2 < 0.0 {
@@ -1208,6 +1295,46 @@ pub fn normal_modes(lin: &Linearization) -> Result<NormalModes, ModalError> {
         mode_shapes: shapes,
         stiffness_asymmetry: lin.stiffness_asymmetry(),
     })
+}
+
+/// An eigenvalue `ω²` below this fraction of its own scale ([`is_zero_frequency`]) is a
+/// zero-frequency (rigid-body) mode: far above the rounding of a rigid-body mode (`ε` times
+/// the stiffness acting on it, ~1e-16) and far below any real stiffness of its coordinates.
+const ZERO_FREQUENCY: f64 = 1e-9;
+
+/// Below this fraction of the largest `|ω²|` an eigenvalue is rounding whatever its own scale:
+/// the symmetric eigensolver's error is `ε ‖K̃‖` in absolute terms (a few hundred `ε` here),
+/// so a rigid-body mode of a soft part beside a stiff part has a computed `ω²` of that size.
+const EIGENVALUE_ROUNDING: f64 = 1e-13;
+
+/// Whether the eigenvalue `w2` of the reduced stiffness `reduced`, `K̃ = L⁻¹ K L⁻ᵀ`, with the
+/// unit eigenvector `v`, is a zero frequency: `|ω²|` at most
+/// [`ZERO_FREQUENCY`] of its own scale `max_i Σ_j |K̃ᵢⱼ| |vⱼ|` — the stiffness that acts on
+/// the mode's own coordinates — or at most [`EIGENVALUE_ROUNDING`] of `largest`, the largest
+/// `|ω²|` (all zero when `largest` is 0).
+///
+/// Its own scale, not the largest `|ω²|`: beside a stiff mode (`ω² = 1e8`) a soft but real one
+/// (`ω² = 1e-3`, a slack spring) is an oscillation, while the rigid-body mode of a free–free
+/// chain has `ω²` at rounding of the springs it stretches (none: `K̃ v ≈ 0` while `|K̃| |v|` is
+/// of the springs' size). The free-response study's test for a defective matrix judges each
+/// eigenvalue on its own scale in the same way.
+fn is_zero_frequency(
+    w2: f64,
+    reduced: &DMatrix<f64>,
+    v: nalgebra::DVectorView<'_, f64>,
+    largest: f64,
+) -> bool {
+    if largest == 0.0 || w2.abs() <= EIGENVALUE_ROUNDING * largest {
+        return true;
+    }
+    let own = (0..reduced.nrows())
+        .map(|i| {
+            (0..reduced.ncols())
+                .map(|j| reduced[(i, j)].abs() * v[j].abs())
+                .sum::<f64>()
+        })
+        .fold(0.0f64, f64::max);
+    w2.abs() <= ZERO_FREQUENCY * own
 }
 
 /// The eigenvalues `ω²` of the non-symmetric `M⁻¹K` (lecture 22's route), real parts sorted

@@ -482,6 +482,23 @@ pub(super) fn remove_stale(
     }
 }
 
+/// [`remove_stale`], with a warning on standard error when the file is kept (a regular file
+/// of that name that eomgen did not write).
+///
+/// # Errors
+/// As [`remove_stale`].
+pub(super) fn remove_stale_or_warn(
+    path: &str,
+    is_ours: impl Fn(&[u8]) -> bool,
+) -> Result<(), FileError> {
+    if remove_stale(path, is_ours)? == Stale::Kept {
+        super::output::errln!(
+            "warning: `{path}` is not from this run and was not written by eomgen; it was kept"
+        );
+    }
+    Ok(())
+}
+
 /// What an output option writes, which decides what its path must look like.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(super) enum Format {

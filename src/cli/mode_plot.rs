@@ -249,6 +249,31 @@ pub fn mode_charts(
     Ok(paths)
 }
 
+/// Removes the charts `PREFIX-mode<k>` (`k` from `written + 1` on, while such a file is
+/// there) that an earlier run wrote for modes this run does not have (a model with more
+/// modes), so that the charts beside the prefix come from one run: each is removed only if
+/// eomgen wrote it (its Software mark and a mode chart's title, as
+/// [`files::remove_stale`](super::files::remove_stale) recognises companion files); a file of
+/// that name that eomgen did not write is kept, with a warning.
+///
+/// # Errors
+/// A chart of ours that cannot be removed.
+pub fn remove_stale_charts(prefix: &str, written: usize) -> Result<(), CliError> {
+    for k in written + 1.. {
+        let path = chart_path(prefix, k);
+        if std::fs::symlink_metadata(&path).is_err() {
+            return Ok(());
+        }
+        super::files::remove_stale_or_warn(&path, |bytes| {
+            super::plot::is_own_chart(bytes, MODE_TITLE)
+        })?;
+    }
+    Ok(())
+}
+
+/// Every mode chart's title has this after the model's name ([`describe`]).
+const MODE_TITLE: &str = ", mode ";
+
 /// Whether a 3-D view is needed: a point off the plane z = 0 at `q` or along some column of
 /// `shapes` (`n × r`).
 pub(super) fn is_three_d(model: &dyn ModelInfo, q: &[f64], shapes: &DMatrix<f64>) -> bool {

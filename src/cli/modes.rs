@@ -116,7 +116,15 @@ pub fn run(args: &ModesArgs) -> Result<(), CliError> {
         .collect();
     let charts = match &args.plot {
         Some(prefix) => {
-            super::mode_plot::mode_charts(prefix, model.as_ref(), &equilibrium.q, modes, &shapes_q)?
+            let charts = super::mode_plot::mode_charts(
+                prefix,
+                model.as_ref(),
+                &equilibrium.q,
+                modes,
+                &shapes_q,
+            )?;
+            super::mode_plot::remove_stale_charts(prefix, charts.len())?;
+            charts
         }
         None => Vec::new(),
     };
@@ -189,6 +197,7 @@ fn print_json(
         "mass_matrix": matrix_rows(&lin.mass_matrix),
         "stiffness_matrix": matrix_rows(&lin.stiffness_matrix),
         "damping_matrix": matrix_rows(&lin.damping_matrix),
+        "differenced_jacobian_entries": lin.differenced_entries,
         "stiffness_asymmetry": modes.stiffness_asymmetry,
         "m_inv_k_eigenvalues": route22,
         "m_inv_k_relative_difference": route_difference,
@@ -263,6 +272,13 @@ fn print_text(
             "constraints {} at rest; M, K, C below are in the minimal coordinates {} (δq = N z, N spanning the null space of J)",
             forces.join(", "),
             minimal.join(", ")
+        );
+    }
+    if lin.differenced_entries > 0 {
+        let _ = writeln!(
+            stdout,
+            "note       {} entries of ∂F/∂q, ∂F/∂q̇ are not finite here while F is (a removable singularity, such as d|v|/dv = 0/0 of quadratic drag at rest): K and C use forward differences of F there, as the implicit integrators do",
+            lin.differenced_entries
         );
     }
     print_matrix(stdout, "M", &lin.mass_matrix);
@@ -429,6 +445,9 @@ pub(super) fn modal_hint(model: &dyn ModelInfo, e: &eomgen::ModalError) -> Strin
             ..
         } => format!(
             "a constraint that moves with t (a rod spun at a given rate) has no modes at rest; write the model in coordinates that move with it (the distance along a spun rod), where the equations no longer contain t, or simulate it (`eomgen simulate {name}`)"
+        ),
+        ModalError::TimeDependentLoad { .. } => format!(
+            "a load that changes with t is an input, not part of the modes: `eomgen frf {name}` gives the response to a harmonic load, `eomgen simulate {name}` follows the motion; if the equations balance the load elsewhere, start Newton there: {start}"
         ),
         ModalError::TimeDependent { .. } => format!(
             "for a periodic dependence, its stability about this operating point is given by `eomgen study floquet {name}` (Floquet multipliers over one period); `eomgen simulate {name}` follows the motion"

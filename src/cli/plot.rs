@@ -274,9 +274,15 @@ const DRIFT_TITLE: &str = ": constraint drift";
 /// comment ([`SVG_SOFTWARE`]) and the drift chart's title, or a PNG with eomgen's text chunk
 /// ([`is_own_png`]).
 pub(super) fn is_own_drift_chart(bytes: &[u8]) -> bool {
+    is_own_chart(bytes, DRIFT_TITLE)
+}
+
+/// Whether `bytes` is a chart that eomgen wrote: a PNG with eomgen's `Software` text chunk, or
+/// an SVG with the [`SVG_SOFTWARE`] comment whose text contains `title` (part of the chart's
+/// title, which tells one kind of chart from another).
+pub(super) fn is_own_chart(bytes: &[u8], title: &str) -> bool {
     let contains = |needle: &str| bytes.windows(needle.len()).any(|w| w == needle.as_bytes());
-    is_own_png(bytes)
-        || (bytes.starts_with(b"<svg") && contains(SVG_SOFTWARE) && contains(DRIFT_TITLE))
+    is_own_png(bytes) || (bytes.starts_with(b"<svg") && contains(SVG_SOFTWARE) && contains(title))
 }
 
 /// The points of `s` that can be drawn on the chart's axes.

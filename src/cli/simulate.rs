@@ -279,16 +279,9 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
     }
     // A companion this run has nothing for is removed when an earlier run of eomgen wrote
     // it; a file of that name that eomgen did not write is kept, with a warning.
-    let keep_stale = |path: &str, stale: files::Stale| {
-        if stale == files::Stale::Kept {
-            super::output::errln!(
-                "warning: `{path}` is not from this run and was not written by eomgen; it was kept"
-            );
-        }
-    };
     if let Some(events) = &events_csv {
         if solution.events.is_empty() {
-            keep_stale(events, files::remove_stale(events, is_events_csv)?);
+            files::remove_stale_or_warn(events, is_events_csv)?;
         } else {
             write_events_csv(events, model.as_ref(), &solution)?;
         }
@@ -299,10 +292,7 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
     }
     if let Some(drift_path) = &drift_chart {
         if constraints.is_empty() {
-            keep_stale(
-                drift_path,
-                files::remove_stale(drift_path, plot::is_own_drift_chart)?,
-            );
+            files::remove_stale_or_warn(drift_path, plot::is_own_drift_chart)?;
         } else {
             plot::constraint_drift(
                 drift_path,
@@ -619,7 +609,7 @@ fn failure_hint(
                 "check the parameters (--set) and that every coordinate moves some mass"
             }
             FailureCause::NegativeParameters { .. } => "masses and inertias must be positive",
-            FailureCause::SingularCoordinates { .. } => {
+            FailureCause::SingularCoordinates { .. } | FailureCause::InertiaVanishes { .. } => {
                 "choose coordinates that stay regular there, or add the motion as a constraint"
             }
             _ => "check the model's expressions and the initial state near that t",

@@ -83,12 +83,22 @@ pub fn run(study: &Study) -> Result<(), CliError> {
 /// Runs `study constraint-methods`: [`eomgen::analysis::constraint_methods`] on the model
 /// and the minimal twin its file names, rendered as a table, JSON and a chart.
 fn constraint_methods(args: &ConstraintMethodsArgs) -> Result<(), CliError> {
-    super::files::Outputs::new()
-        .input(&args.model)
-        .chart("--plot", args.plot.as_deref())
-        .check()?;
+    // The twin is read too: its file, named in the model's, is an input no output may
+    // overwrite, so it is found before the outputs are checked.
     let source = super::open_model(&args.model)?;
     let twin = minimal_twin(&source).map_err(|e| CliError::failure(e.to_string()))?;
+    let twin_file = match &twin {
+        Some((_, eomgen::ModelSource::File { path, .. })) => Some(path.as_str()),
+        _ => None,
+    };
+    twin_file
+        .into_iter()
+        .fold(
+            super::files::Outputs::new().input(&args.model),
+            |outputs, path| outputs.input(path),
+        )
+        .chart("--plot", args.plot.as_deref())
+        .check()?;
     let options = ConstraintMethodsOptions {
         t_end: args.t_end,
         tol: args.tol,

@@ -301,6 +301,53 @@ fn a_torque_on_the_second_body_enters_its_balances() {
     assert!(r < 1e-9, "{r}: {:?}", report.notes);
 }
 
+/// Issue 28: `check` drew q and q̇ in [−2, 2] whatever the model, so a valid model whose
+/// domain lies outside that box (`ln(x − 10)`, `sqrt(x − 5)`, started at `x = 12`) failed
+/// "over no state", and a grossly wrong hand equation in it was never compared. States are
+/// now drawn about the start in `initial:`, within `2 max(1, |start|)` of it: the valid model
+/// passes with states compared, the wrong equation of `tests/wrong/far_domain.yaml` is
+/// caught, the same seed draws the same states, and a model started at 0 keeps the box
+/// [−2, 2] (a domain of |x| < 2.5 then loses no state).
+#[test]
+fn issue_28_check_draws_its_states_about_the_start() {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../tests/wrong/far_domain.yaml"
+    );
+    let wrong = std::fs::read_to_string(path).unwrap();
+    let right = wrong.replace("-1000*k/(x - 10)", "-k/(x - 10)");
+    assert_ne!(right, wrong);
+    let report = check(&right);
+    // About half of [−12, 36] is in the domain x > 10.
+    assert!(
+        report.states.compared >= 5 && report.states.compared + report.states.not_finite == 20,
+        "{:?}",
+        report.states
+    );
+    assert!(residual(&report, "by_hand").unwrap() < 1e-12, "{report:?}");
+    assert!(report.passed(1e-8), "{report:?}");
+    let report = check(&wrong);
+    assert!(report.states.compared >= 5, "{:?}", report.states);
+    assert!(residual(&report, "by_hand").unwrap() > 0.5, "{report:?}");
+    assert!(!report.passed(1e-8));
+    assert!(
+        report
+            .notes
+            .iter()
+            .any(|n| n.contains("written by hand disagree with Lagrange")),
+        "{:?}",
+        report.notes
+    );
+    // The same seed, the same states (and so the same residuals).
+    let again = check(&wrong);
+    assert_eq!(again.states, report.states);
+    assert_eq!(residual(&again, "by_hand"), residual(&report, "by_hand"));
+    // Started at 0, a model is drawn in [−2, 2]: defined for |x| < 2.5, it loses no state.
+    let near = "name: near\nparameters: { m: 1.0, k: 2.0 }\ncoordinates: [x]\nkinetic: m*x_dot^2/2\npotential: -k*sqrt(6.25 - x^2)\n";
+    let report = check(near);
+    assert_eq!((report.states.compared, report.states.drawn), (20, 20));
+}
+
 /// Issue 28: a grossly wrong hand equation passed "over 0 states" when Lagrange's `F` was
 /// outside `sqrt`'s domain at every random state (`tests/wrong/sqrt_outside_domain.yaml`):
 /// a check over no state is never a pass, and it says how many states were drawn and why

@@ -128,34 +128,50 @@ fn a_hundred_thousand_parameters_load_in_linear_time() {
     assert!(report.passed(1e-9), "{:?}", report.notes);
 }
 
-/// A one-line list of 100,000 coordinates loads in linear time (0.9 s in a debug build,
-/// against 43 s before): whether a coordinate is alone on its line (so that a trailing
-/// comment describes it) was counted over the whole list for each coordinate, and every name
-/// in an expression was looked up by a scan of the coordinates, rates and parameters; both
-/// were quadratic. The coordinate alone on its line keeps its comment; those on the shared
-/// line, which ends in a comment too, have none. `T` is a sum of parenthesised groups, to
-/// stay below the parser's height limit.
+/// A one-line list of coordinates is read in linear time: whether a coordinate is alone on
+/// its line (so that a trailing comment describes it) was counted over the whole list for
+/// each coordinate, and every name in an expression was looked up by a scan of the
+/// coordinates, rates and parameters; both were quadratic (a list of 100,000 took 43 s in a
+/// debug build). A list of `MAX_COORDINATES` loads, the coordinate alone on its line keeping
+/// its comment and those on the shared line, which ends in a comment too, having none. A list
+/// of 100,000 is refused by the limit on coordinates, as the one error of the file, at the
+/// list: the whole file is still read and checked against the list, in about a second. `T`
+/// is a sum of parenthesised groups, to stay below the parser's height limit.
 #[test]
-fn a_long_one_line_coordinate_list_loads_in_linear_time() {
-    const N: usize = 100_000;
-    let names: Vec<String> = (0..N).map(|i| format!("q{i}")).collect();
-    let groups: Vec<String> = names
-        .chunks(500)
-        .map(|g| {
-            let terms: Vec<String> = g.iter().map(|q| format!("{q}_dot^2")).collect();
-            format!("({})", terms.join(" + "))
-        })
-        .collect();
-    let text = format!(
-        "name: wide\ncoordinates: [a,  # m, alone\n  {}]  # m, shared\nkinetic: a_dot^2/2 + ({})/2\npotential: a^2/2\n",
-        names.join(", "),
-        groups.join(" + ")
-    );
-    let file = load("wide.yaml", &text).expect("loads");
-    assert_eq!(file.coordinates.len(), N + 1);
+fn a_long_one_line_coordinate_list_is_read_in_linear_time() {
+    use eomgen_symbolic::model::schema::MAX_COORDINATES;
+    let source = |n: usize| {
+        let names: Vec<String> = (0..n).map(|i| format!("q{i}")).collect();
+        let groups: Vec<String> = names
+            .chunks(500)
+            .map(|g| {
+                let terms: Vec<String> = g.iter().map(|q| format!("{q}_dot^2")).collect();
+                format!("({})", terms.join(" + "))
+            })
+            .collect();
+        format!(
+            "name: wide\ncoordinates: [a,  # m, alone\n  {}]  # m, shared\nkinetic: a_dot^2/2 + ({})/2\npotential: a^2/2\n",
+            names.join(", "),
+            groups.join(" + ")
+        )
+    };
+    let n = MAX_COORDINATES - 1;
+    let file = load("wide.yaml", &source(n)).expect("loads");
+    assert_eq!(file.coordinates.len(), n + 1);
     let comment = |i: usize| file.coordinates[i].comment.clone();
     assert_eq!(comment(0).as_deref(), Some("m, alone"));
-    assert_eq!((comment(1), comment(N)), (None, None));
+    assert_eq!((comment(1), comment(n)), (None, None));
+
+    let diagnostics = load("wide.yaml", &source(100_000)).expect_err("too many coordinates");
+    assert_eq!(diagnostics.len(), 1, "{diagnostics:?}");
+    assert_eq!(diagnostics[0].location.to_string(), "2:14");
+    assert!(
+        diagnostics[0]
+            .message
+            .starts_with("the model has 100001 generalized coordinates, more than the"),
+        "{}",
+        diagnostics[0].message
+    );
 }
 
 /// An expression tree drawn at random: `ops` binary operations (`+ - * /`, and `^2` at

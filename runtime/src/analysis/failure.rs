@@ -43,6 +43,21 @@ pub enum FailureCause {
         /// `M`'s smallest eigenvalue over its largest in magnitude there.
         eigenvalue_ratio: f64,
     },
+    /// A diagonal entry of `M` has collapsed where the run stopped (to a millionth of its
+    /// value at the start or less) while `M` scaled to a unit diagonal stays regular: the
+    /// coordinate moves (nearly) no mass or inertia there — an inertia `m (1 − x)²` at
+    /// `x = 1`, a polar angle at the origin — and its speed grows without bound as it gets
+    /// there. The scaled test cannot see it: it divides each row and column by that entry.
+    InertiaVanishes {
+        /// The time at which `M` was examined (s).
+        t: f64,
+        /// The coordinate whose diagonal entry collapsed (the one that fell furthest).
+        coordinate: String,
+        /// Its diagonal entry `Mᵢᵢ` there (units of that entry: kg, kg·m², …).
+        diagonal: f64,
+        /// Its diagonal entry at the start.
+        start: f64,
+    },
     /// `M` is regular, but the forcing is not finite at the state or a little ahead of it
     /// along the motion: a function leaves its domain there (`ln` or `sqrt` of a negative
     /// number, a division by zero).
@@ -106,6 +121,15 @@ impl std::fmt::Display for FailureCause {
             } => write!(
                 f,
                 "the mass matrix loses rank at t = {t} (smallest over largest eigenvalue {eigenvalue_ratio:.3e}) though it is regular elsewhere: the coordinates are singular at that configuration"
+            ),
+            FailureCause::InertiaVanishes {
+                t,
+                coordinate,
+                diagonal,
+                start,
+            } => write!(
+                f,
+                "the inertia of `{coordinate}` vanishes at t = {t}: its diagonal entry of the mass matrix fell to {diagonal:.3e} from {start:.3e} at the start, so `{coordinate}` moves (nearly) no mass there and its speed grows without bound (a coordinate singular at that configuration, or a mass or length that goes to zero with it)"
             ),
             FailureCause::ForcingNotFinite { t, at_state: true } => write!(
                 f,
@@ -171,7 +195,9 @@ fn eigenvalue_ratio(model: &dyn ModelInfo, t: f64, y: &[f64]) -> f64 {
 /// finite there and a little ahead: then the integrator's own reason (stiffness, a
 /// singularity of the solution) stands.
 ///
-/// `M` is examined at `y`; if it is not positive definite (its smallest eigenvalue at most
+/// `M` is examined at `y`; each diagonal entry against its value at the start (a collapsed
+/// one is named, [`FailureCause::InertiaVanishes`]: the unit-diagonal test below cannot see
+/// it); if it is not positive definite (its smallest eigenvalue at most
 /// `1e-10` of its largest magnitude, or a millionfold smaller in ratio than at the start),
 /// also at the start and at eight configurations `q ± δ`
 /// around `y` (δ = 0.3 in every coordinate, alternating signs), to tell a parameter (singular
@@ -251,6 +277,9 @@ pub fn failure_cause(
             }
         });
     }
+    if let Some(cause) = vanishing_inertia(model, t, y, y0) {
+        return Some(cause);
+    }
     let (_, forcing) = model.mass_matrix_and_forcing(t, y);
     if forcing.iter().any(|v| !v.is_finite()) {
         return Some(FailureCause::ForcingNotFinite { t, at_state: true });
@@ -281,6 +310,26 @@ pub fn failure_cause(
     None
 }
 
+/// The coordinate whose diagonal entry of `M` at `(t, y)` fell furthest below its value at
+/// the start `(0, y0)`, if it fell to [`DROP`] of it or less ([`FailureCause::InertiaVanishes`]).
+/// Relative to its own value at the start, so that units decide nothing (a mass in kg beside
+/// an inertia of 1e-11 kg·m²); entries that were not positive at the start, or are not
+/// finite, are left to the other tests.
+fn vanishing_inertia(model: &dyn ModelInfo, t: f64, y: &[f64], y0: &[f64]) -> Option<FailureCause> {
+    let (now, _) = model.mass_matrix_and_forcing(t, y);
+    let (start, _) = model.mass_matrix_and_forcing(0.0, y0);
+    let (i, fraction) = (0..now.nrows())
+        .filter(|&i| start[(i, i)] > 0.0 && start[(i, i)].is_finite() && now[(i, i)].is_finite())
+        .map(|i| (i, now[(i, i)] / start[(i, i)]))
+        .min_by(|a, b| a.1.total_cmp(&b.1))?;
+    (fraction <= DROP).then(|| FailureCause::InertiaVanishes {
+        t,
+        coordinate: model.coordinate_names()[i].to_string(),
+        diagonal: now[(i, i)],
+        start: start[(i, i)],
+    })
+}
+
 /// Below this product of the failed step and the Jacobian's spectral radius, stiffness cannot
 /// explain the failure: an explicit method's stability region reaches `|h λ|` of order 1
 /// (2 to 6 for the methods here), so a step a thousand times shorter than `1/ρ` failed for
@@ -294,7 +343,7 @@ const MAX_SPECTRAL_DIM: usize = 400;
 
 /// The spectral radius and the largest real part of the eigenvalues of `∂f/∂y` at `(t, y)`:
 /// the system's exact Jacobian where it has one, else forward differences of the right-hand
-/// side with radau5's increments; `None` when it is not finite or the system is too large
+/// side ([`forward_differences`](crate::linalg::forward_differences)); `None` when it is not finite or the system is too large
 /// ([`MAX_SPECTRAL_DIM`]).
 fn spectral_radius(system: &mut dyn OdeSystem, t: f64, y: &[f64]) -> Option<(f64, f64)> {
     let dim = system.dim();
@@ -305,17 +354,11 @@ fn spectral_radius(system: &mut dyn OdeSystem, t: f64, y: &[f64]) -> Option<(f64
     if !system.jacobian(t, y, &mut jac).ok()? {
         let mut f0 = vec![0.0; dim];
         system.rhs(t, y, &mut f0).ok()?;
-        let mut shifted = y.to_vec();
-        let mut f1 = vec![0.0; dim];
-        for j in 0..dim {
-            let delta = (f64::EPSILON * y[j].abs().max(1e-5)).sqrt();
-            shifted[j] = y[j] + delta;
-            system.rhs(t, &shifted, &mut f1).ok()?;
-            shifted[j] = y[j];
-            for i in 0..dim {
-                jac[i + j * dim] = (f1[i] - f0[i]) / delta;
-            }
-        }
+        let (mut shifted, mut f1) = (vec![0.0; dim], vec![0.0; dim]);
+        crate::linalg::forward_differences(y, &f0, &mut jac, &mut shifted, &mut f1, |y, f| {
+            system.rhs(t, y, f)
+        })
+        .ok()?;
     }
     if jac.iter().any(|v| !v.is_finite()) {
         return None;

@@ -345,8 +345,8 @@ impl<'a> CheckedRhs<'a> {
     }
 
     /// The Jacobian `∂F/∂y` at `(t, y)` into `jac` (`dim × dim`): the system's own, or forward
-    /// differences of `F` from `f = F(t, y)` with RADAU5's increments
-    /// `δⱼ = √(ε · max(10⁻⁵, |yⱼ|))` (`dim` evaluations of `F`, counted as such).
+    /// differences of `F` from `f = F(t, y)` ([`forward_differences`](crate::linalg::forward_differences):
+    /// RADAU5's increments, `dim` evaluations of `F`, counted as such).
     ///
     /// `work_y` and `work_f` are `dim`-entry scratch buffers.
     ///
@@ -376,16 +376,14 @@ impl<'a> CheckedRhs<'a> {
             Err(error) => return Err(StepFailure::Rhs { t, error }),
         };
         if !exact {
-            work_y.copy_from_slice(y);
-            for j in 0..n {
-                let delta = (f64::EPSILON * y[j].abs().max(1e-5)).sqrt();
-                work_y[j] = y[j] + delta;
-                self.eval(t, work_y, work_f)?;
-                work_y[j] = y[j];
-                for i in 0..n {
-                    jac[(i, j)] = (work_f[i] - f[i]) / delta;
-                }
-            }
+            crate::linalg::forward_differences(
+                y,
+                f,
+                jac.as_mut_slice(),
+                work_y,
+                work_f,
+                |y, f| self.eval(t, y, f),
+            )?;
         }
         let bad = (0..n).find(|&i| (0..n).any(|j| !jac[(i, j)].is_finite()));
         match bad {

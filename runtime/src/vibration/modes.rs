@@ -96,7 +96,9 @@ impl ModalAnalysis {
 /// 0), and the modes are those of the equations linearised there, the load's variation left
 /// out. Coefficients or constraints that change with `t` are refused, since modes of
 /// equations frozen at one instant describe no motion; where the equilibrium search fails,
-/// they are looked for at the guess, so that the error names them.
+/// they are looked for at the guess, so that the error names them, and so is a load that
+/// changes with `t` ([`ModalError::TimeDependentLoad`]: the equilibrium failed under the
+/// load's value at one instant).
 ///
 /// # Errors
 /// [`OperatingPointError::UnknownEquilibrium`]; [`OperatingPointError::Modal`] when the
@@ -104,7 +106,8 @@ impl ModalAnalysis {
 /// matrices, [`ModalError::DegenerateCoordinates`])
 /// or the eigenproblems fail, or with
 /// [`ModalError::TimeDependent`] for time-dependent
-/// coefficients or constraints.
+/// coefficients or constraints, and [`ModalError::TimeDependentLoad`] for a load that changes
+/// with `t` when no equilibrium is found under its value at `t₀`.
 ///
 /// # Examples
 /// Three equal masses between four equal springs (`three_masses`, HW28): `ω² = (2 − √2) k/m`,
@@ -137,8 +140,16 @@ pub fn modal_analysis(
         )) => {
             // Coefficients that change with t are the reason to give, not Newton's failure
             // on the equations frozen at t₀: checked at the guess.
+            // A load that changes with t is the reason too: the equilibrium failed under its
+            // value at t₀, one instant of it.
             let (_, guess) = options.operating_point.start.resolve(model)?;
-            time_dependence(model, &guess, options.operating_point.t)?;
+            if let Some(forcing) = time_dependence(model, &guess, options.operating_point.t)? {
+                return Err(ModalError::TimeDependentLoad {
+                    forcing,
+                    equilibrium: Box::new(error),
+                }
+                .into());
+            }
             return Err(error.into());
         }
         Err(error) => return Err(error),

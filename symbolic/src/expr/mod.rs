@@ -352,8 +352,10 @@ pub struct ExprArena {
     small_ints: [Option<ExprId>; 4],
     /// The first fold of constants since the last [`Self::take_fold_error`] whose value
     /// cannot be a node (a product or sum of constants beyond ±1.8e308, a product of non-zero
-    /// ones that underflows to 0, a power that is not real): the fold is then incomplete, and
-    /// lowering a model file turns this into a located error.
+    /// ones that underflows to 0, a power that is not real): the fold is then not done, the
+    /// numbers are kept apart as they were written, and lowering a model file asks whether
+    /// the numbers written in the operation alone fail (a located error) or only a rewrite
+    /// would have.
     fold_error: std::cell::Cell<Option<FoldError>>,
 }
 
@@ -374,8 +376,9 @@ impl ExprArena {
     }
 
     /// Why folding constants failed since the last call, if it did (and clears it): a
-    /// value beyond `f64` or lost to underflow ([`FoldError`]). The expression built then is
-    /// not the one asked for: its caller reports an error.
+    /// value beyond `f64` or lost to underflow ([`FoldError`]). The fold was then not done:
+    /// the expression built keeps those numbers apart, with the value asked for, and its
+    /// caller decides whether the numbers as written are an error.
     pub fn take_fold_error(&mut self) -> Option<FoldError> {
         self.fold_error.take()
     }
@@ -602,6 +605,11 @@ impl ExprArena {
         }
         let coefficient = self.constant(c);
         let factors: Vec<ExprId> = match self.node(rest) {
+            // A product with a number of its own is one whose numbers did not fold into one
+            // ([`Self::gather_unflattened`]): it is multiplied by the rules.
+            Node::Mul(f) if f.iter().any(|&x| self.as_constant(x).is_some()) => {
+                return self.product(&[coefficient, rest]);
+            }
             Node::Mul(f) => std::iter::once(coefficient)
                 .chain(f.iter().copied())
                 .collect(),
@@ -1080,37 +1088,99 @@ impl ExprArena {
     }
 
     /// The factors of `Π factors` as `(base, exponent, factor)` in `powers` (nested products
-    /// flattened), and the product of their numbers; `None` if that is zero. A product of
-    /// numbers beyond `f64` or lost to underflow records the failed fold and leaves out the
-    /// factor that made it fail.
+    /// flattened), and the product of their numbers; `None` if that is zero.
+    ///
+    /// A product of numbers that cannot be folded (beyond `f64`, or lost to underflow) is
+    /// recorded as a failed fold and not formed: the product is then gathered again by
+    /// [`Self::gather_unflattened`], which keeps the numbers apart as written.
     fn gather_factors(
+        &self,
+        factors: &[ExprId],
+        powers: &mut Vec<(ExprId, Option<ExprId>, ExprId)>,
+    ) -> Option<Constant> {
+        let mark = powers.len();
+        match self.gather_flat(factors, powers) {
+            Ok(coefficient) => coefficient,
+            Err(error) => {
+                self.fold_failed(error);
+                powers.truncate(mark);
+                self.gather_unflattened(factors, powers)
+            }
+        }
+    }
+
+    /// [`Self::gather_factors`] with every nested product flattened and every number folded
+    /// into one, in order; the first fold that fails is the error.
+    fn gather_flat(
+        &self,
+        factors: &[ExprId],
+        powers: &mut Vec<(ExprId, Option<ExprId>, ExprId)>,
+    ) -> Result<Option<Constant>, FoldError> {
+        let mut coefficient = Constant::ONE;
+        for &f in factors {
+            match self.node(f) {
+                Node::Mul(inner) => match self.gather_flat(inner, powers)? {
+                    Some(c) => coefficient = coefficient.checked_mul(c)?,
+                    None => return Ok(None),
+                },
+                Node::Const(c) if c.is_zero() => return Ok(None),
+                Node::Const(c) => coefficient = coefficient.checked_mul(*c)?,
+                Node::Pow([b, e]) => powers.push((*b, Some(*e), f)),
+                _ => powers.push((f, None, f)),
+            }
+        }
+        // A product of non-zero numbers that folds is not zero (an underflow is an error).
+        Ok(Some(coefficient))
+    }
+
+    /// [`Self::gather_factors`] of a product whose numbers do not fold into one: the numbers
+    /// among `factors` are folded first (one that would overflow or underflow stays a factor
+    /// of its own), then a nested product is flattened only if its numbers fold into that
+    /// coefficient, and is otherwise kept whole. So `16 · (1e-300 x¹⁵) · 1e-20`, the
+    /// derivative of `(1e-20 x)¹⁶`, becomes `1.6e-19 · (1e-300 x¹⁵)`: it forms no number
+    /// below the normal range, and evaluates at `x = 1e20` as it is written.
+    fn gather_unflattened(
         &self,
         factors: &[ExprId],
         powers: &mut Vec<(ExprId, Option<ExprId>, ExprId)>,
     ) -> Option<Constant> {
         let mut coefficient = Constant::ONE;
         for &f in factors {
-            match self.node(f) {
-                Node::Mul(inner) => {
-                    let inner = self.gather_factors(inner, powers)?;
-                    coefficient = self.folded_product(coefficient, inner);
+            if let Node::Const(c) = self.node(f) {
+                if c.is_zero() {
+                    return None;
                 }
-                Node::Const(c) if c.is_zero() => return None,
-                Node::Const(c) => coefficient = self.folded_product(coefficient, *c),
+                match coefficient.checked_mul(*c) {
+                    Ok(v) => coefficient = v,
+                    Err(e) => {
+                        self.fold_failed(e);
+                        powers.push((f, None, f));
+                    }
+                }
+            }
+        }
+        for &f in factors {
+            match self.node(f) {
+                Node::Const(_) => {}
+                Node::Mul(inner) => {
+                    let mark = powers.len();
+                    match self
+                        .gather_flat(inner, powers)
+                        .and_then(|c| c.map(|c| coefficient.checked_mul(c)).transpose())
+                    {
+                        Ok(Some(v)) => coefficient = v,
+                        Ok(None) => return None,
+                        Err(_) => {
+                            powers.truncate(mark);
+                            powers.push((f, None, f));
+                        }
+                    }
+                }
                 Node::Pow([b, e]) => powers.push((*b, Some(*e), f)),
                 _ => powers.push((f, None, f)),
             }
         }
-        (!coefficient.is_zero()).then_some(coefficient)
-    }
-
-    /// `a · b` of two numbers, or `a` with the fold recorded as failed when `a · b` is beyond
-    /// `f64` or underflows.
-    fn folded_product(&self, a: Constant, b: Constant) -> Constant {
-        a.checked_mul(b).unwrap_or_else(|e| {
-            self.fold_failed(e);
-            a
-        })
+        Some(coefficient)
     }
 
     /// `a + b`.
@@ -1182,8 +1252,16 @@ impl ExprArena {
                 let product = self.times(a, exponent);
                 return self.pow(b, product);
             }
-            // (x y)^n = x^n y^n for integer n.
-            Node::Mul(factors) if integer_exponent.is_some() => {
+            // (x y)^n = x^n y^n for integer n, unless a number among the factors would
+            // overflow or underflow to the n-th power: `(1e-20 x)^16` stays as it is written,
+            // which evaluates well for x near 1e20, where 1e-320 · x^16 would be 0 · ∞.
+            Node::Mul(factors)
+                if integer_exponent.is_some()
+                    && factors.iter().all(|&f| {
+                        self.as_constant(f)
+                            .is_none_or(|c| c.pow(e.unwrap_or(Constant::ONE)).is_ok())
+                    }) =>
+            {
                 let powered: Vec<ExprId> = factors.iter().map(|&f| self.pow(f, exponent)).collect();
                 return self.product(&powered);
             }

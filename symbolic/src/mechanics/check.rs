@@ -120,7 +120,7 @@ impl SampledStates {
     pub fn nothing_compared(&self) -> Option<String> {
         (self.compared == 0).then(|| {
             format!(
-                "no state compared: of {} random states (q, q̇ in [−2, 2], t in [0, 5]), {}",
+                "no state compared: of {} random states (q, q̇ within 2·max(1, |start|) of their start in `initial:`, t in [0, 5]), {}",
                 self.drawn,
                 self.skipped()
             )
@@ -257,7 +257,9 @@ fn timed(model: &mut SymbolicModel, f: &dyn Formulation) -> (EquationsOfMotion, 
 }
 
 /// Derives `file` by every applicable formulation and cross-checks them at `states` random
-/// states (q, q̇ in [−2, 2], t in [0, 5], parameters within ±10 % of their defaults, or in [0.1, 0.5] where the default is 0).
+/// states (q and q̇ in the [`StateBox`](super::lower::StateBox) about their start: within
+/// `2 max(1, |start|)` of it; t in [0, 5]; parameters within ±10 % of their defaults, or in
+/// [0.1, 0.5] where the default is 0).
 /// A state is compared where Lagrange's `M` and `F` are finite and `M` is regular
 /// ([`CheckReport::states`]); a report that compared no state does not pass.
 ///
@@ -422,8 +424,9 @@ struct Sampled {
     states: SampledStates,
 }
 
-/// Samples `states` random states (q, q̇ in [−2, 2], t in [0, 5], parameters within ±10 % of
-/// their defaults or, where the default is 0, in [0.1, 0.5]; from `seed`) and compares
+/// Samples `states` random states (q, q̇ within `2 max(1, |start|)` of their start in
+/// `initial:`, t in [0, 5], parameters within ±10 % of their defaults or, where the default
+/// is 0, in [0.1, 0.5]; from `seed`) and compares
 /// `others` with `lagrange` there.
 fn sample_states(
     model: &mut SymbolicModel,
@@ -468,6 +471,7 @@ fn sample_states(
     let mut quadratic = true;
     let symbols = model.arena.symbols().to_vec();
     let defaults = defaults_by_symbol(model);
+    let state_box = model.state_box();
     // Where each coordinate's rate is bound.
     let rate_slots: Vec<usize> = (0..n)
         .map(|i| model.coordinate_symbols(i)[1].index())
@@ -485,7 +489,9 @@ fn sample_states(
                 // off) would hide every term it multiplies: it takes a value in [0.1, 0.5].
                 SymbolKind::Parameter if defaults[i] == 0.0 => rng.random_range(0.1..0.5),
                 SymbolKind::Parameter => defaults[i] * rng.random_range(0.9..1.1),
-                SymbolKind::Coordinate(_) | SymbolKind::Velocity(_) => rng.random_range(-2.0..2.0),
+                SymbolKind::Coordinate(_) | SymbolKind::Velocity(_) => {
+                    state_box.at(i, rng.random_range(-2.0..2.0))
+                }
                 SymbolKind::Time => t,
                 _ => 0.0,
             };
@@ -619,6 +625,7 @@ fn integrable_nonholonomic(model: &mut SymbolicModel, seed: u64) -> Vec<String> 
         }
         let mut evaluator = Evaluator::new(&model.arena, &terms);
         let defaults = defaults_by_symbol(model);
+        let state_box = model.state_box();
         let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed ^ 0x5DEE_CE66);
         let mut integrable = true;
         for _ in 0..50 {
@@ -629,7 +636,7 @@ fn integrable_nonholonomic(model: &mut SymbolicModel, seed: u64) -> Vec<String> 
                 .enumerate()
                 .map(|(i, s)| match s.kind {
                     SymbolKind::Parameter => defaults[i],
-                    _ => rng.random_range(-2.0..2.0),
+                    _ => state_box.at(i, rng.random_range(-2.0..2.0)),
                 })
                 .collect();
             let v = evaluator.eval(&bindings);

@@ -162,6 +162,34 @@ pub struct SymbolicModel {
     pub equilibria: Vec<(String, Vec<ExprId>)>,
 }
 
+/// The box in which the derivation checks draw random states (`eomgen check`, the mass
+/// matrix's diagnostics): coordinate or rate `i` at `cᵢ + sᵢ r` for a draw `r` in [−2, 2],
+/// where `cᵢ` is its value in `initial:` (the parameters at their defaults) and
+/// `sᵢ = max(1, |cᵢ|)`.
+///
+/// About the start, because a model's domain need not hold the origin (`ln(x − 10)` started
+/// at `x = 12` is defined nowhere in [−2, 2]). In proportion to the start's size, because a
+/// coordinate started at 1e6 m varies on that scale, and ±2 m about it would sample one
+/// point as far as its terms can tell; its sign may change within the box as it may at the
+/// origin. Never narrower than ±2, so that an angle started at 0.1 rad still sweeps its
+/// sines and cosines over radians. A start at 0 gives the box [−2, 2] and the very states
+/// drawn before the box followed the start (`0 + 1·r` is `r`).
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct StateBox {
+    /// Per symbol, by index: `(centre, scale)`; `(0, 1)` for a symbol that is neither a
+    /// coordinate nor a rate.
+    axes: Vec<(f64, f64)>,
+}
+
+impl StateBox {
+    /// The value of the symbol of index `k` for a draw `r` in [−2, 2] (`r` itself for a
+    /// symbol that is neither a coordinate nor a rate).
+    pub(crate) fn at(&self, k: usize, r: f64) -> f64 {
+        let (centre, scale) = self.axes[k];
+        centre + scale * r
+    }
+}
+
 /// One lowered `events:` entry.
 #[derive(Debug, Clone, PartialEq)]
 pub struct EventInfo {
@@ -206,6 +234,40 @@ impl SymbolicModel {
     /// The time symbol id.
     pub fn time_symbol(&self) -> SymbolId {
         self.time_id
+    }
+
+    /// Where the derivation checks draw their random states: around the file's start (see
+    /// [`StateBox`]).
+    pub(crate) fn state_box(&self) -> StateBox {
+        let symbols = self.arena.symbols();
+        // The start with the parameters at their defaults, every other symbol 0.
+        let mut bindings = vec![0.0; symbols.len()];
+        for p in &self.parameters {
+            bindings[p.symbol.index()] = p.default;
+        }
+        let starts: Vec<ExprId> = self
+            .initial_q
+            .iter()
+            .chain(&self.initial_qdot)
+            .copied()
+            .collect();
+        let start = crate::expr::eval::Evaluator::new(&self.arena, &starts).eval(&bindings);
+        let n = self.num_dofs();
+        let axes = symbols
+            .iter()
+            .map(|s| {
+                let centre = match s.kind {
+                    SymbolKind::Coordinate(i) => start[i as usize],
+                    SymbolKind::Velocity(i) => start[n + i as usize],
+                    _ => 0.0,
+                };
+                // A start that is not a number (a default outside a function's domain) gives
+                // no centre: the box about 0.
+                let centre = if centre.is_finite() { centre } else { 0.0 };
+                (centre, centre.abs().max(1.0))
+            })
+            .collect();
+        StateBox { axes }
     }
 
     /// Lowers a checked model file.
@@ -529,8 +591,11 @@ impl<'f> Lowering<'f> {
                     BinOp::Div => self.arena.divide(a, b),
                     BinOp::Pow => self.arena.pow(a, b),
                 };
-                if let Some(error) = self.arena.take_fold_error()
+                // The arena did not form a number it could not hold; that is an error of the
+                // file only if the numbers written in this operation alone fail.
+                if self.arena.take_fold_error().is_some()
                     && !undefined
+                    && let Some(error) = crate::model::parser::written_fold_error(*op, lhs, rhs)
                 {
                     self.errors.push(crate::model::parser::fold_diagnostic(
                         *op_location,

@@ -4,8 +4,9 @@
 //!
 //! - a coordinate without inertia (its row of `M` is identically zero), and whether it
 //!   appears in no energy and no load at all;
-//! - `M` singular at every one of 16 random states (a combination of rates that carries no
-//!   kinetic energy, as `T = m (ẋ + ẏ)²/2`);
+//! - `M` singular at every one of 16 random states, drawn about the start as `eomgen check`
+//!   draws them (a combination of rates that carries no kinetic energy, as
+//!   `T = m (ẋ + ẏ)²/2`);
 //! - `M` singular at the file's initial state (the coordinates' own singularity, as the
 //!   horizontal-position coordinate of a pendulum at the horizontal).
 //!
@@ -121,6 +122,7 @@ pub fn mass_matrix_diagnostics(
     for &(k, v) in &defaults {
         bindings[k] = v;
     }
+    let state_box = model.state_box();
     let mut rng = Xoshiro256PlusPlus::seed_from_u64(0x6d61_7373);
     let mut regular = 0;
     let mut sizes = Vec::with_capacity(STATES);
@@ -128,7 +130,7 @@ pub fn mass_matrix_diagnostics(
         for (k, s) in symbols.iter().enumerate() {
             match s.kind {
                 SymbolKind::Coordinate(_) | SymbolKind::Velocity(_) => {
-                    bindings[k] = rng.random_range(-2.0..2.0);
+                    bindings[k] = state_box.at(k, rng.random_range(-2.0..2.0));
                 }
                 SymbolKind::Time => bindings[k] = rng.random_range(0.0..5.0),
                 _ => {}

@@ -18,7 +18,7 @@
 use super::ast::{BinOp, Expr, ExprKind, FUNCTIONS};
 use super::diagnostic::Diagnostic;
 use super::located::Location;
-use crate::expr::{FoldError, Func, fold};
+use crate::expr::{Constant, FoldError, Func, fold};
 
 /// Parses one expression whose first character is at `start`; the expression is on one
 /// line, so character `i` of `text` is at column `start.column + i`.
@@ -629,6 +629,96 @@ pub fn fold_diagnostic(at: Location, op: BinOp, error: FoldError) -> Diagnostic 
     };
     Diagnostic::new(at, format!("the numbers in this {kind} {verb}: {error}"))
         .with_help("check the exponents of the numbers; rescale the units if the values are real")
+}
+
+/// How the numbers written in `lhs op rhs` fail the rule of folding ([`crate::expr::fold`]),
+/// if they do: a model file is refused for an operation on numbers written in it, never for a
+/// number that only a rewrite would form.
+///
+/// The numbers of a product are its factors that are numbers, through its chain of `*`, `/`
+/// and signs, folded in the order written (the arena gathers them into one coefficient):
+/// `k*x^2/2*1e-300*1e-300` fails at its second `*1e-300`. Likewise the number terms of a
+/// sum's chain of `+` and `-`, and a power of two numbers (`10^400`). `(x*1e-20)^16` has no
+/// operation on numbers alone: the arena keeps it as written rather than form
+/// `1e-320 · x^16`, and evaluating it as written is fine for `x` near 1e20.
+pub fn written_fold_error(op: BinOp, lhs: &Expr, rhs: &Expr) -> Option<FoldError> {
+    let result = match op {
+        BinOp::Mul | BinOp::Div => {
+            let (a, b) = (numbers_of_product(lhs).ok()?, numbers_of_product(rhs).ok()?);
+            combine(op, a, b)
+        }
+        BinOp::Add | BinOp::Sub => {
+            let (a, b) = (numbers_of_sum(lhs).ok()?, numbers_of_sum(rhs).ok()?);
+            combine(op, a, b)
+        }
+        BinOp::Pow => combine(op, number(lhs)?.ok()?, number(rhs)?.ok()?),
+    };
+    result.err()
+}
+
+/// `a op b` of two numbers as the arena folds it (a power that would not be exact is no
+/// number, and no error).
+fn combine(op: BinOp, a: Constant, b: Constant) -> Result<Constant, FoldError> {
+    match op {
+        BinOp::Add => a.checked_add(b),
+        BinOp::Sub => a.checked_add(b.negated()),
+        BinOp::Mul => a.checked_mul(b),
+        BinOp::Div if b.is_zero() => Err(FoldError::Undefined),
+        BinOp::Div => a.checked_mul(b.pow(Constant::MINUS_ONE)?.unwrap_or(Constant::ONE)),
+        BinOp::Pow => Ok(a.pow(b)?.unwrap_or(Constant::ONE)),
+    }
+}
+
+/// The value of `e` if it is written with numbers alone (no name, no function call), folded
+/// as the arena folds it; `None` for any other expression.
+fn number(e: &Expr) -> Option<Result<Constant, FoldError>> {
+    match &e.kind {
+        ExprKind::Number { value, text } => Some(Ok(
+            Constant::parse_decimal(text).or_else(|| Constant::float(*value))?
+        )),
+        ExprKind::Neg(a) => Some(number(a)?.map(Constant::negated)),
+        ExprKind::Binary { op, lhs, rhs, .. } => {
+            let (a, b) = (number(lhs)?, number(rhs)?);
+            if *op == BinOp::Pow
+                && let (Ok(a), Ok(b)) = (a, b)
+                && matches!(a.pow(b), Ok(None))
+            {
+                // An irrational power of numbers stays a power in the arena.
+                return None;
+            }
+            Some(a.and_then(|a| combine(*op, a, b?)))
+        }
+        ExprKind::Ident(_) | ExprKind::Call { .. } => None,
+    }
+}
+
+/// The product of the numbers among the factors of the product `e` (see
+/// [`written_fold_error`]); 1 if it has none.
+fn numbers_of_product(e: &Expr) -> Result<Constant, FoldError> {
+    match &e.kind {
+        ExprKind::Binary {
+            op: op @ (BinOp::Mul | BinOp::Div),
+            lhs,
+            rhs,
+            ..
+        } => combine(*op, numbers_of_product(lhs)?, numbers_of_product(rhs)?),
+        ExprKind::Neg(a) => numbers_of_product(a).map(Constant::negated),
+        _ => number(e).unwrap_or(Ok(Constant::ONE)),
+    }
+}
+
+/// The sum of the numbers among the terms of the sum `e` (see [`written_fold_error`]); 0
+/// if it has none.
+fn numbers_of_sum(e: &Expr) -> Result<Constant, FoldError> {
+    match &e.kind {
+        ExprKind::Binary {
+            op: op @ (BinOp::Add | BinOp::Sub),
+            lhs,
+            rhs,
+            ..
+        } => combine(*op, numbers_of_sum(lhs)?, numbers_of_sum(rhs)?),
+        _ => number(e).unwrap_or(Ok(Constant::ZERO)),
+    }
 }
 
 /// The located error of a function of a number that the rule of folding refuses

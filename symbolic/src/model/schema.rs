@@ -19,6 +19,18 @@ type Entries = [(Located<String>, YamlNode)];
 /// Expressions by name, in file order.
 type KeyedExprs = Vec<(Located<String>, Expr)>;
 
+/// The most generalized coordinates a model may have (a located error at the `coordinates`
+/// list beyond it). The mass matrix is derived, simplified and evaluated as a dense `n × n`
+/// matrix, so that memory and time grow as `n²` and faster: measured in a release build, a
+/// chain of N masses (`eomgen new n-mass-chain`, written by a script beyond 1000) took, in
+/// CPU time and peak memory, for `eomgen check` 4.4 s and 97 MiB at N = 1000, 22 s and
+/// 345 MiB at 2000; for `simulate --t-end 0.01` 1.9 s and 122 MiB at 1000, 8.2 s and
+/// 423 MiB at 2000 (docs/performance.md has the rest). The limit is the largest of these
+/// sizes that loads, checks and takes a first step within about 10 s and 2 GB, and the
+/// template's largest; a 10,000-mass chain (1.4 MB, within
+/// [`MAX_FILE_BYTES`](super::MAX_FILE_BYTES)) needed 5.8 GB.
+pub const MAX_COORDINATES: usize = 1_000;
+
 /// Top-level keys of a model file.
 pub const TOP_LEVEL_KEYS: &[&str] = &[
     "name",
@@ -1824,6 +1836,25 @@ impl<'s> Ctx<'s> {
                 comment,
                 unit,
             });
+        }
+        // Rule: at most `MAX_COORDINATES` coordinates. The list is kept, so that the rest of
+        // the file is checked against it (in time linear in its length) and this is the one
+        // error of an otherwise sound file.
+        if out.len() > MAX_COORDINATES {
+            self.error(
+                Diagnostic::new(
+                    node.location,
+                    format!(
+                        "the model has {} generalized coordinates, more than the {MAX_COORDINATES} a model may have: its mass matrix is derived and evaluated as a dense {}×{} matrix",
+                        out.len(),
+                        out.len(),
+                        out.len()
+                    ),
+                )
+                .with_help(format!(
+                    "use at most {MAX_COORDINATES} coordinates (a chain of {MAX_COORDINATES} masses loads, checks and takes its first step in seconds)"
+                )),
+            );
         }
         out
     }
