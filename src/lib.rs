@@ -3,8 +3,9 @@
 //!
 //! A model file (YAML) is turned at compile time by [`model!`] into a struct with an
 //! implementation of [`MechanicalSystem`]: mass matrix, forcing, exact Jacobians, energies,
-//! point positions, derived symbolically by Lagrange's equations. The runtime integrates
-//! them.
+//! point positions, derived symbolically: by momentum balance for a model given by the
+//! kinematics of its bodies, by Lagrange's equations for one given by its energies
+//! (`eomgen_symbolic::mechanics::preferred_formulation`). The runtime integrates them.
 //!
 //! ```
 //! use eomgen::{DormandPrince54, FirstOrder, Integrator, IntegratorOptions, MechanicalSystem,

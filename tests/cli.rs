@@ -526,14 +526,14 @@ fn failed_integrations_explain_themselves_and_keep_their_samples() {
 }
 
 /// `eomgen check` (which derives the file at run time) and `eomgen simulate` (which compiles
-/// it at run time) on every broken file of the compile-fail suite (`tests/ui/<category>/`)
-/// print the same diagnostics as the compile error: each `error: FILE:line:col: message`
+/// it at run time) on every broken file of the compile-fail suite
+/// (`compile-fail/tests/ui/<category>/`) print the same diagnostics as the compile error: each `error: FILE:line:col: message`
 /// headline of the recorded `.stderr` appears in the output for that file (the path prefix
 /// differs: the macro names the file as written in `model!`), the exit status is 2, and with
 /// `--json` standard output is the JSON object of the diagnostics, one entry per headline.
 #[test]
 fn check_and_simulate_print_the_compile_errors_of_every_ui_case() {
-    let root = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/ui");
+    let root = concat!(env!("CARGO_MANIFEST_DIR"), "/compile-fail/tests/ui");
     let mut checked = 0;
     let mut categories: Vec<_> = std::fs::read_dir(root).unwrap().flatten().collect();
     categories.sort_by_key(|e| e.path());

@@ -99,7 +99,7 @@ fn json_output_keeps_its_schema() {
     let report_dir = report_dir.to_str().expect("UTF-8 path").to_string();
     let wrong = concat!(
         env!("CARGO_MANIFEST_DIR"),
-        "/tests/ui/semantics/division-by-zero.yaml"
+        "/compile-fail/tests/ui/semantics/division-by-zero.yaml"
     );
     let commands: Vec<(&str, Vec<&str>)> = vec![
         ("list", vec!["list", "--json"]),

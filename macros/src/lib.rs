@@ -1,8 +1,10 @@
 //! The `model!` proc macro: a thin shell around `eomgen-symbolic`.
 //!
 //! `eomgen::model!("models/double_pendulum.yaml")` reads the file (relative to the file that
-//! invokes the macro, like `include_str!`), validates it, derives the equations of motion by
-//! Lagrange, and emits a struct named after the model with an `impl MechanicalSystem`.
+//! invokes the macro, like `include_str!`), validates it, derives the equations of motion (by
+//! momentum balance for a model given by the kinematics of its bodies, by Lagrange's equations
+//! for one given by its energies: `mechanics::preferred_formulation`), and emits a struct
+//! named after the model with an `impl MechanicalSystem`.
 //! Every problem in the file becomes a compile error `path:line:col: message`, all of them at
 //! once.
 

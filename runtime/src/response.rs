@@ -1201,4 +1201,45 @@ mod tests {
         assert!(RayleighDamping::fit([1.0, 1.0], [0.1, 0.1]).is_err());
         assert!(RayleighDamping::fit([0.0, 1.0], [0.1, 0.1]).is_err());
     }
+
+    /// Issue 28 review: a free soft coordinate (a Jordan block at 0: `x = x₀ + v₀ t`) beside a
+    /// stiff oscillator (ω² = 1e8). Against `1e-6 σ_max(A) = 100` the block's singular value 1
+    /// looked negligible and the eigenvalue was given a full eigenvector set; against its own
+    /// scale it is a Jordan block. The isotropic oscillator stays non-defective (the facade's
+    /// `tests/response.rs`, which runs its model file through the CLI too).
+    #[test]
+    fn issue_28_defective_soft_mode_beside_a_stiff_one() {
+        let mut a = DMatrix::zeros(4, 4);
+        a[(0, 2)] = 1.0; // ẋ = v (soft, free)
+        a[(1, 3)] = 1.0; // ẏ = w
+        a[(3, 1)] = -1e8; // ẇ = −1e8 y (stiff)
+        let err = state_response_by_eigenvectors(&a, &[0.0, 0.0, 1.0, 0.0], &[1.0]);
+        assert!(
+            matches!(err, Err(ResponseError::Defective { .. })),
+            "{err:?}"
+        );
+    }
+
+    /// Issue 28 review: beside a stiff mode (ω² = 1e9) the soft ω² = 2 and 5 were within
+    /// `1e-8 max |ω²| = 10` of each other, merged into one repeated value and both reported as
+    /// 3.5. Now the tolerance is relative to their own size: 2 and 5 exactly (1e-12), with
+    /// eigenvectors e₁ and e₂.
+    #[test]
+    fn issue_28_soft_eigenvalues_beside_a_stiff_one_are_distinct() {
+        let lin = Linearization::from_matrices(
+            DMatrix::identity(3, 3),
+            DMatrix::from_diagonal(&nalgebra::DVector::from_vec(vec![2.0, 5.0, 1e9])),
+            DMatrix::zeros(3, 3),
+        );
+        let modes = modes_of_m_inv_k(&lin).unwrap();
+        for (got, want) in modes.eigenvalues.iter().zip([2.0, 5.0, 1e9]) {
+            assert!(
+                (got - want).abs() <= 1e-12 * want,
+                "{:?}",
+                modes.eigenvalues
+            );
+        }
+        assert!((modes.eigenvectors[(0, 0)].abs() - 1.0).abs() < 1e-12);
+        assert!((modes.eigenvectors[(1, 1)].abs() - 1.0).abs() < 1e-12);
+    }
 }

@@ -1,6 +1,6 @@
-//! Analyses on the size-erased model ([`ModelInfo`](crate::ModelInfo)) that the CLI, an
-//! embedding Rust program and the Python bindings share: the method registry, drift
-//! measures, simulation and the numerical studies.
+//! Analyses on the size-erased model ([`ModelInfo`](crate::ModelInfo)) that the CLI and an
+//! embedding Rust program share: the method registry, drift measures, simulation and the
+//! numerical studies.
 //!
 //! Every analysis is a function with a typed options struct, a `Serialize` report and a
 //! typed error, so that a front end only parses its input and renders the report. Every

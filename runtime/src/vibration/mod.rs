@@ -1,7 +1,7 @@
 //! The vibration analyses of a model, each one library call with typed options, a
 //! `Serialize` report and a typed error, on the size-erased [`ModelInfo`](crate::ModelInfo):
-//! the CLI (`eomgen modes`, `frf`, `study free-response`, `modal-damping`, `floquet`), a Rust
-//! program and the Python bindings reach the same code.
+//! the CLI (`eomgen modes`, `frf`, `study free-response`, `modal-damping`, `floquet`) and a
+//! Rust program reach the same code.
 //!
 //! - [`operating_point()`]: the equilibrium an analysis linearises about, from a name in the
 //!   model file's `equilibria:` or an explicit guess (Newton on `F(q, 0, t) = 0`).

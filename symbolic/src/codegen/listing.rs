@@ -9,8 +9,8 @@
 //!
 //! with `λ` the Lagrange multipliers (the constraint forces, in the sign of the runtime's
 //! `lagrange_multipliers`), each holonomic constraint `Φ(q, t) = 0` with its row `J = ∂Φ/∂q`
-//! and each non-holonomic one `A(q, t) q̇ + b = 0` with its row `J = A` (DESIGN.md,
-//! "Derivations"; lectures 8–10 of the course, method II.1).
+//! and each non-holonomic one `A(q, t) q̇ + b = 0` with its row `J = A` (docs/model-format.md,
+//! *Constraints*; lectures 8–10 of the course, method II.1).
 
 use std::fmt::Write as _;
 

@@ -1,4 +1,4 @@
-//! Constraints as the runtime needs them (lectures 8–11; DESIGN.md "Constraints").
+//! Constraints as the runtime needs them (lectures 8–11; docs/model-format.md, *Constraints*).
 //!
 //! Holonomic constraints `Φ(q, t) = 0` (`constraints:`) and non-holonomic constraints
 //! `g(q, q̇, t) = A(q, t) q̇ + b(q, t) = 0` (`nonholonomic:`) are both differentiated to the

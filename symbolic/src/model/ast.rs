@@ -1,8 +1,8 @@
 //! Parsed expressions, before names are resolved: the output of the expression parser.
 //!
-//! Grammar (DESIGN.md): numbers, identifiers (parameters, coordinates, rates `x_dot`, `t`,
-//! `pi`), `+ - * / ^` with `^` right-associative and binding tighter than unary minus
-//! (`-x^2 = -(x^2)`), parentheses, and calls of the functions in [`FUNCTIONS`].
+//! Grammar (docs/model-format.md): numbers, identifiers (parameters, coordinates, rates
+//! `x_dot`, `t`, `pi`), `+ - * / ^` with `^` right-associative and binding tighter than unary
+//! minus (`-x^2 = -(x^2)`), parentheses, and calls of the functions in [`FUNCTIONS`].
 
 use super::located::Location;
 

@@ -60,7 +60,7 @@ pub const TOP_LEVEL_KEYS: &[&str] = &[
     "minimal_twin",
 ];
 
-/// Keys of the model format (DESIGN.md) that this version does not implement yet.
+/// Keys of the model format that this version does not implement yet.
 pub const LATER_KEYS: &[&str] = &["outputs"];
 
 /// Keys of `checks:`.
