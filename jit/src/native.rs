@@ -173,79 +173,10 @@ struct Imports {
 /// # Errors
 /// [`CompileError`] naming the host or the function Cranelift could not handle.
 pub(crate) fn compile(functions: &[(&str, &FunctionTape)]) -> Result<NativeCode, CompileError> {
-    let mut flags = settings::builder();
-    let set = |flags: &mut settings::Builder, name: &str, value: &str| {
-        flags
-            .set(name, value)
-            .map_err(|e| CompileError::UnsupportedHost {
-                reason: format!("setting {name}={value}: {e}"),
-            })
-    };
-    set(&mut flags, "opt_level", "speed")?;
-    set(&mut flags, "use_colocated_libcalls", "false")?;
-    set(&mut flags, "is_pic", "false")?;
-    // The tapes are built correct by construction; the verifier doubles compile time.
-    set(
-        &mut flags,
-        "enable_verifier",
-        if cfg!(debug_assertions) {
-            "true"
-        } else {
-            "false"
-        },
-    )?;
-    let isa = cranelift_native::builder()
-        .map_err(|reason| CompileError::UnsupportedHost {
-            reason: reason.to_string(),
-        })?
-        .finish(settings::Flags::new(flags))
-        .map_err(|e| CompileError::UnsupportedHost {
-            reason: e.to_string(),
-        })?;
-    let mut builder = JITBuilder::with_isa(isa, default_libcall_names());
-    for (name, f) in HELPERS {
-        builder.symbol(name, math::unary(f) as *const u8);
-    }
-    builder.symbol("eomgen_sin_cos", math::sin_cos as *const u8);
-    builder.symbol("eomgen_powf", math::powf as *const u8);
-    builder.symbol("eomgen_atan2", math::atan2 as *const u8);
-    builder.symbol("eomgen_fill_zero", math::fill_zero as *const u8);
-    let mut module = JITModule::new(builder);
-
-    let failure = |function: &str, e: &dyn std::fmt::Display| CompileError::Function {
-        function: function.to_string(),
-        reason: e.to_string(),
-    };
+    let mut module = new_module()?;
+    let imports = declare_imports(&mut module)?;
     let call_conv = module.isa().default_call_conv();
-    let float_signature = |args: usize, returns: usize| {
-        let mut s = Signature::new(call_conv);
-        s.params
-            .extend((0..args).map(|_| AbiParam::new(types::F64)));
-        s.returns
-            .extend((0..returns).map(|_| AbiParam::new(types::F64)));
-        s
-    };
-    let declare = |module: &mut JITModule, name: &str, signature: &Signature| {
-        module
-            .declare_function(name, Linkage::Import, signature)
-            .map_err(|e| failure(name, &e))
-    };
-    let mut unary = Vec::new();
-    for (name, f) in HELPERS {
-        unary.push((f, declare(&mut module, name, &float_signature(1, 1))?));
-    }
     let pointer = module.target_config().pointer_type();
-    let mut fill_signature = Signature::new(call_conv);
-    fill_signature.params.push(AbiParam::new(pointer));
-    fill_signature.params.push(AbiParam::new(pointer));
-    let imports = Imports {
-        unary,
-        sin_cos: declare(&mut module, "eomgen_sin_cos", &float_signature(1, 2))?,
-        powf: declare(&mut module, "eomgen_powf", &float_signature(2, 1))?,
-        atan2: declare(&mut module, "eomgen_atan2", &float_signature(2, 1))?,
-        fill_zero: declare(&mut module, "eomgen_fill_zero", &fill_signature)?,
-    };
-
     let mut signature = Signature::new(call_conv);
     for _ in 0..5 {
         signature.params.push(AbiParam::new(pointer));
@@ -322,6 +253,98 @@ pub(crate) fn compile(functions: &[(&str, &FunctionTape)]) -> Result<NativeCode,
         code_bytes,
         module: Mutex::new(Some(module)),
     })
+}
+
+/// A JIT module for the host, optimising for speed, that resolves the helpers of
+/// [`crate::math`] by their symbol names.
+///
+/// # Errors
+/// [`CompileError::UnsupportedHost`] when Cranelift has no code generator for the host.
+fn new_module() -> Result<JITModule, CompileError> {
+    let mut flags = settings::builder();
+    let set = |flags: &mut settings::Builder, name: &str, value: &str| {
+        flags
+            .set(name, value)
+            .map_err(|e| CompileError::UnsupportedHost {
+                reason: format!("setting {name}={value}: {e}"),
+            })
+    };
+    set(&mut flags, "opt_level", "speed")?;
+    set(&mut flags, "use_colocated_libcalls", "false")?;
+    set(&mut flags, "is_pic", "false")?;
+    // The tapes are built correct by construction; the verifier doubles compile time.
+    set(
+        &mut flags,
+        "enable_verifier",
+        if cfg!(debug_assertions) {
+            "true"
+        } else {
+            "false"
+        },
+    )?;
+    let isa = cranelift_native::builder()
+        .map_err(|reason| CompileError::UnsupportedHost {
+            reason: reason.to_string(),
+        })?
+        .finish(settings::Flags::new(flags))
+        .map_err(|e| CompileError::UnsupportedHost {
+            reason: e.to_string(),
+        })?;
+    let mut builder = JITBuilder::with_isa(isa, default_libcall_names());
+    for (name, f) in HELPERS {
+        builder.symbol(name, math::unary(f) as *const u8);
+    }
+    builder.symbol("eomgen_sin_cos", math::sin_cos as *const u8);
+    builder.symbol("eomgen_powf", math::powf as *const u8);
+    builder.symbol("eomgen_atan2", math::atan2 as *const u8);
+    builder.symbol("eomgen_fill_zero", math::fill_zero as *const u8);
+    Ok(JITModule::new(builder))
+}
+
+/// What a failure of Cranelift on `function` is.
+fn failure(function: &str, e: &dyn std::fmt::Display) -> CompileError {
+    CompileError::Function {
+        function: function.to_string(),
+        reason: e.to_string(),
+    }
+}
+
+/// Declares the helpers the code calls as imports of `module`.
+///
+/// # Errors
+/// [`CompileError::Function`] naming the helper Cranelift could not declare.
+fn declare_imports(module: &mut JITModule) -> Result<Imports, CompileError> {
+    let call_conv = module.isa().default_call_conv();
+    let float_signature = |args: usize, returns: usize| {
+        let mut s = Signature::new(call_conv);
+        s.params
+            .extend((0..args).map(|_| AbiParam::new(types::F64)));
+        s.returns
+            .extend((0..returns).map(|_| AbiParam::new(types::F64)));
+        s
+    };
+    let declare = |module: &mut JITModule, name: &str, signature: &Signature| {
+        module
+            .declare_function(name, Linkage::Import, signature)
+            .map_err(|e| failure(name, &e))
+    };
+    let mut unary = Vec::new();
+    for (name, f) in HELPERS {
+        unary.push((f, declare(module, name, &float_signature(1, 1))?));
+    }
+    let pointer = module.target_config().pointer_type();
+    let mut fill_signature = Signature::new(call_conv);
+    fill_signature.params.push(AbiParam::new(pointer));
+    fill_signature.params.push(AbiParam::new(pointer));
+    let imports = Imports {
+        unary,
+        sin_cos: declare(module, "eomgen_sin_cos", &float_signature(1, 2))?,
+        powf: declare(module, "eomgen_powf", &float_signature(2, 1))?,
+        atan2: declare(module, "eomgen_atan2", &float_signature(2, 1))?,
+        fill_zero: declare(module, "eomgen_fill_zero", &fill_signature)?,
+    };
+
+    Ok(imports)
 }
 
 /// The function's arguments as Cranelift values.
@@ -477,9 +500,7 @@ fn build(
     } else {
         emitter.store_output_pairs(&filled);
     }
-    let Emitter {
-        mut b, module, ..
-    } = emitter;
+    let Emitter { mut b, module, .. } = emitter;
     b.ins().return_(&[]);
     b.finalize(module.target_config());
     slots_used
@@ -629,11 +650,16 @@ impl Emitter<'_, '_> {
     fn unary_callee(&mut self, f: Func) -> Option<ir::FuncRef> {
         match self.callees.unary.iter().find(|(g, _)| *g == f) {
             Some((_, r)) => Some(*r),
-            None => self.imports.unary.iter().find(|(g, _)| *g == f).map(|(_, id)| {
-                let r = self.module.declare_func_in_func(*id, self.b.func);
-                self.callees.unary.push((f, r));
-                r
-            }),
+            None => self
+                .imports
+                .unary
+                .iter()
+                .find(|(g, _)| *g == f)
+                .map(|(_, id)| {
+                    let r = self.module.declare_func_in_func(*id, self.b.func);
+                    self.callees.unary.push((f, r));
+                    r
+                }),
         }
     }
 

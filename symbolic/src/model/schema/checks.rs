@@ -194,7 +194,11 @@ impl Ctx<'_> {
     }
 
     /// `period:` — `{ event, value, tolerance, method, rtol, t_end }`.
-    pub(super) fn period_check(&mut self, k: &Located<String>, v: &YamlNode) -> Option<PeriodCheck> {
+    pub(super) fn period_check(
+        &mut self,
+        k: &Located<String>,
+        v: &YamlNode,
+    ) -> Option<PeriodCheck> {
         let what = format!("check `{}`", k.value);
         let f = self.fields(k, v, &PERIOD_CHECK)?;
         let event = get(f, "event").and_then(|n| self.name(n, &format!("`event` of {what}")));
@@ -211,7 +215,11 @@ impl Ctx<'_> {
     }
 
     /// `final_state:` — `{ t, values: { x: …, x_dot: … }, tolerance, method, rtol }`.
-    pub(super) fn final_state_check(&mut self, k: &Located<String>, v: &YamlNode) -> Option<FinalStateCheck> {
+    pub(super) fn final_state_check(
+        &mut self,
+        k: &Located<String>,
+        v: &YamlNode,
+    ) -> Option<FinalStateCheck> {
         let what = format!("check `{}`", k.value);
         let f = self.fields(k, v, &FINAL_STATE_CHECK)?;
         let t = get(f, "t").and_then(|n| self.expr(n, &format!("`t` of {what}")));
@@ -294,5 +302,17 @@ impl Ctx<'_> {
             rhs,
             location: node.location,
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The readers of `checks:` are those of the keys listed to the user, in the same order.
+    #[test]
+    fn every_check_key_has_one_reader() {
+        let read: Vec<&str> = CHECKS.iter().map(|c| c.key).collect();
+        assert_eq!(read, CHECK_KEYS);
     }
 }

@@ -26,8 +26,8 @@ use super::diagnostic::{Diagnostic, Diagnostics};
 use super::file::*;
 use super::located::{Located, Location};
 use super::parser::{closest, eval_expr, identifiers, parse_expr_mapped};
-use walk::{get, get_key, misspelt};
 use super::yaml::{YamlKind, YamlNode, char_locations_in_lines, trailing_comment_of_line};
+use walk::{get, get_key, misspelt};
 
 type Entries = [(Located<String>, YamlNode)];
 
@@ -268,7 +268,6 @@ impl<'s> Ctx<'s> {
             self.incomplete.names.push(name.to_string());
         }
     }
-
 }
 
 #[cfg(test)]

@@ -316,9 +316,13 @@ impl Ctx<'_> {
             return String::new();
         }
         // A folded (`>`) description ends with a line break; keep the text only.
-        self.text(node, "`description`", "description: A pendulum of length l.")
-            .map(|d| d.value.trim().to_string())
-            .unwrap_or_default()
+        self.text(
+            node,
+            "`description`",
+            "description: A pendulum of length l.",
+        )
+        .map(|d| d.value.trim().to_string())
+        .unwrap_or_default()
     }
 
     /// `minimal_twin:` — the snake_case name of another model, the same mechanism in minimal
@@ -573,5 +577,20 @@ impl Ctx<'_> {
             }
         }
         draw
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every top-level key has exactly one reader, and every reader a listed key.
+    #[test]
+    fn every_top_level_key_has_one_section() {
+        let mut read: Vec<&str> = SECTIONS.iter().map(|s| s.key).collect();
+        let mut listed = TOP_LEVEL_KEYS.to_vec();
+        read.sort_unstable();
+        listed.sort_unstable();
+        assert_eq!(read, listed);
     }
 }

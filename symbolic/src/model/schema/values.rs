@@ -54,7 +54,12 @@ pub(super) fn cut_in_source(source: &str, end: Location) -> bool {
 
 impl Ctx<'_> {
     /// The items of the list `node`; reports anything else.
-    pub(super) fn seq<'n>(&mut self, node: &'n YamlNode, what: &str, example: &str) -> Option<&'n [YamlNode]> {
+    pub(super) fn seq<'n>(
+        &mut self,
+        node: &'n YamlNode,
+        what: &str,
+        example: &str,
+    ) -> Option<&'n [YamlNode]> {
         match &node.kind {
             YamlKind::Seq(items) => Some(items),
             other => {
@@ -71,7 +76,12 @@ impl Ctx<'_> {
     }
 
     /// The text of the scalar `node`; reports anything else.
-    pub(super) fn text(&mut self, node: &YamlNode, what: &str, example: &str) -> Option<Located<String>> {
+    pub(super) fn text(
+        &mut self,
+        node: &YamlNode,
+        what: &str,
+        example: &str,
+    ) -> Option<Located<String>> {
         match &node.kind {
             YamlKind::Scalar { text, .. } => Some(Located::new(text.clone(), node.location)),
             other => {
@@ -153,7 +163,13 @@ impl Ctx<'_> {
 
     /// Parses characters `from..to` of the scalar `node` (whose text is `text`) as an
     /// expression, with exact file locations.
-    pub(super) fn parse_part(&mut self, node: &YamlNode, text: &str, from: usize, to: usize) -> Option<Expr> {
+    pub(super) fn parse_part(
+        &mut self,
+        node: &YamlNode,
+        text: &str,
+        from: usize,
+        to: usize,
+    ) -> Option<Expr> {
         let start = node.location;
         let locations = char_locations_in_lines(&self.lines, start, text);
         let locate = |i: usize| match &locations {
@@ -182,7 +198,12 @@ impl Ctx<'_> {
     }
 
     /// A list of 2 or 3 expressions.
-    pub(super) fn vector(&mut self, node: &YamlNode, what: &str, example: &str) -> Option<Vec<Expr>> {
+    pub(super) fn vector(
+        &mut self,
+        node: &YamlNode,
+        what: &str,
+        example: &str,
+    ) -> Option<Vec<Expr>> {
         let items = match &node.kind {
             YamlKind::Seq(items) => items,
             other => {
@@ -252,7 +273,11 @@ impl Ctx<'_> {
     }
 
     /// `[A, B]`: two point names.
-    pub(super) fn point_pair(&mut self, node: &YamlNode, what: &str) -> Option<[Located<String>; 2]> {
+    pub(super) fn point_pair(
+        &mut self,
+        node: &YamlNode,
+        what: &str,
+    ) -> Option<[Located<String>; 2]> {
         let items = self.seq(node, what, "[A, B]")?;
         if items.len() != 2 {
             self.error(
@@ -270,7 +295,12 @@ impl Ctx<'_> {
     }
 
     /// One of a few words, as a scalar; an error lists them (with a "did you mean").
-    pub(super) fn choice<T: Copy>(&mut self, node: &YamlNode, what: &str, options: &[(&str, T)]) -> Option<T> {
+    pub(super) fn choice<T: Copy>(
+        &mut self,
+        node: &YamlNode,
+        what: &str,
+        options: &[(&str, T)],
+    ) -> Option<T> {
         let words: Vec<&str> = options.iter().map(|(w, _)| *w).collect();
         let text = match &node.kind {
             YamlKind::Scalar { text, .. } => text.trim(),
@@ -322,7 +352,13 @@ impl Ctx<'_> {
     }
 
     /// The optional positive number `key` of `f`, `default` when absent.
-    pub(super) fn number_or(&mut self, f: &Entries, key: &str, what: &str, default: f64) -> Option<f64> {
+    pub(super) fn number_or(
+        &mut self,
+        f: &Entries,
+        key: &str,
+        what: &str,
+        default: f64,
+    ) -> Option<f64> {
         match get(f, key) {
             None => Some(default),
             Some(n) => self.positive_number(n, &format!("`{key}` of {what}")),
@@ -330,7 +366,12 @@ impl Ctx<'_> {
     }
 
     /// A list of expressions.
-    pub(super) fn expr_list(&mut self, node: &YamlNode, what: &str, example: &str) -> Option<Vec<Expr>> {
+    pub(super) fn expr_list(
+        &mut self,
+        node: &YamlNode,
+        what: &str,
+        example: &str,
+    ) -> Option<Vec<Expr>> {
         let items = self.seq(node, what, example)?;
         let mut out = Vec::with_capacity(items.len());
         let mut complete = true;
@@ -346,7 +387,12 @@ impl Ctx<'_> {
     /// The two sides of `lhs = rhs` in the scalar `node`, or the expression alone (`rhs`
     /// `None`) when it has no `=`. `what` names the value and `help` says what to write when
     /// it has two `=`.
-    pub(super) fn sides(&mut self, node: &YamlNode, what: &str, help: &str) -> Option<(Expr, Option<Expr>)> {
+    pub(super) fn sides(
+        &mut self,
+        node: &YamlNode,
+        what: &str,
+        help: &str,
+    ) -> Option<(Expr, Option<Expr>)> {
         let text = self.scalar_expr_text(node, what)?;
         let chars: Vec<char> = text.chars().collect();
         let equals: Vec<usize> = (0..chars.len()).filter(|&i| chars[i] == '=').collect();

@@ -123,7 +123,13 @@ impl Ctx<'_> {
     }
 
     /// Reports every key of `entries` that is not in `allowed`.
-    pub(super) fn unknown_keys(&mut self, entries: &Entries, what: &str, allowed: &[&str], listed: &[&str]) {
+    pub(super) fn unknown_keys(
+        &mut self,
+        entries: &Entries,
+        what: &str,
+        allowed: &[&str],
+        listed: &[&str],
+    ) {
         for (k, _) in entries {
             if allowed.contains(&k.value.as_str()) {
                 continue;
@@ -168,7 +174,12 @@ impl Ctx<'_> {
     }
 
     /// The entries of the map `node` (none for an empty value); reports anything else.
-    pub(super) fn map<'n>(&mut self, node: &'n YamlNode, what: &str, example: &str) -> Option<&'n Entries> {
+    pub(super) fn map<'n>(
+        &mut self,
+        node: &'n YamlNode,
+        what: &str,
+        example: &str,
+    ) -> Option<&'n Entries> {
         match &node.kind {
             YamlKind::Map(e) => Some(e),
             YamlKind::Null => Some(&[]),
