@@ -173,79 +173,10 @@ struct Imports {
 /// # Errors
 /// [`CompileError`] naming the host or the function Cranelift could not handle.
 pub(crate) fn compile(functions: &[(&str, &FunctionTape)]) -> Result<NativeCode, CompileError> {
-    let mut flags = settings::builder();
-    let set = |flags: &mut settings::Builder, name: &str, value: &str| {
-        flags
-            .set(name, value)
-            .map_err(|e| CompileError::UnsupportedHost {
-                reason: format!("setting {name}={value}: {e}"),
-            })
-    };
-    set(&mut flags, "opt_level", "speed")?;
-    set(&mut flags, "use_colocated_libcalls", "false")?;
-    set(&mut flags, "is_pic", "false")?;
-    // The tapes are built correct by construction; the verifier doubles compile time.
-    set(
-        &mut flags,
-        "enable_verifier",
-        if cfg!(debug_assertions) {
-            "true"
-        } else {
-            "false"
-        },
-    )?;
-    let isa = cranelift_native::builder()
-        .map_err(|reason| CompileError::UnsupportedHost {
-            reason: reason.to_string(),
-        })?
-        .finish(settings::Flags::new(flags))
-        .map_err(|e| CompileError::UnsupportedHost {
-            reason: e.to_string(),
-        })?;
-    let mut builder = JITBuilder::with_isa(isa, default_libcall_names());
-    for (name, f) in HELPERS {
-        builder.symbol(name, math::unary(f) as *const u8);
-    }
-    builder.symbol("eomgen_sin_cos", math::sin_cos as *const u8);
-    builder.symbol("eomgen_powf", math::powf as *const u8);
-    builder.symbol("eomgen_atan2", math::atan2 as *const u8);
-    builder.symbol("eomgen_fill_zero", math::fill_zero as *const u8);
-    let mut module = JITModule::new(builder);
-
-    let failure = |function: &str, e: &dyn std::fmt::Display| CompileError::Function {
-        function: function.to_string(),
-        reason: e.to_string(),
-    };
+    let mut module = new_module()?;
+    let imports = declare_imports(&mut module)?;
     let call_conv = module.isa().default_call_conv();
-    let float_signature = |args: usize, returns: usize| {
-        let mut s = Signature::new(call_conv);
-        s.params
-            .extend((0..args).map(|_| AbiParam::new(types::F64)));
-        s.returns
-            .extend((0..returns).map(|_| AbiParam::new(types::F64)));
-        s
-    };
-    let declare = |module: &mut JITModule, name: &str, signature: &Signature| {
-        module
-            .declare_function(name, Linkage::Import, signature)
-            .map_err(|e| failure(name, &e))
-    };
-    let mut unary = Vec::new();
-    for (name, f) in HELPERS {
-        unary.push((f, declare(&mut module, name, &float_signature(1, 1))?));
-    }
     let pointer = module.target_config().pointer_type();
-    let mut fill_signature = Signature::new(call_conv);
-    fill_signature.params.push(AbiParam::new(pointer));
-    fill_signature.params.push(AbiParam::new(pointer));
-    let imports = Imports {
-        unary,
-        sin_cos: declare(&mut module, "eomgen_sin_cos", &float_signature(1, 2))?,
-        powf: declare(&mut module, "eomgen_powf", &float_signature(2, 1))?,
-        atan2: declare(&mut module, "eomgen_atan2", &float_signature(2, 1))?,
-        fill_zero: declare(&mut module, "eomgen_fill_zero", &fill_signature)?,
-    };
-
     let mut signature = Signature::new(call_conv);
     for _ in 0..5 {
         signature.params.push(AbiParam::new(pointer));
@@ -322,6 +253,98 @@ pub(crate) fn compile(functions: &[(&str, &FunctionTape)]) -> Result<NativeCode,
         code_bytes,
         module: Mutex::new(Some(module)),
     })
+}
+
+/// A JIT module for the host, optimising for speed, that resolves the helpers of
+/// [`crate::math`] by their symbol names.
+///
+/// # Errors
+/// [`CompileError::UnsupportedHost`] when Cranelift has no code generator for the host.
+fn new_module() -> Result<JITModule, CompileError> {
+    let mut flags = settings::builder();
+    let set = |flags: &mut settings::Builder, name: &str, value: &str| {
+        flags
+            .set(name, value)
+            .map_err(|e| CompileError::UnsupportedHost {
+                reason: format!("setting {name}={value}: {e}"),
+            })
+    };
+    set(&mut flags, "opt_level", "speed")?;
+    set(&mut flags, "use_colocated_libcalls", "false")?;
+    set(&mut flags, "is_pic", "false")?;
+    // The tapes are built correct by construction; the verifier doubles compile time.
+    set(
+        &mut flags,
+        "enable_verifier",
+        if cfg!(debug_assertions) {
+            "true"
+        } else {
+            "false"
+        },
+    )?;
+    let isa = cranelift_native::builder()
+        .map_err(|reason| CompileError::UnsupportedHost {
+            reason: reason.to_string(),
+        })?
+        .finish(settings::Flags::new(flags))
+        .map_err(|e| CompileError::UnsupportedHost {
+            reason: e.to_string(),
+        })?;
+    let mut builder = JITBuilder::with_isa(isa, default_libcall_names());
+    for (name, f) in HELPERS {
+        builder.symbol(name, math::unary(f) as *const u8);
+    }
+    builder.symbol("eomgen_sin_cos", math::sin_cos as *const u8);
+    builder.symbol("eomgen_powf", math::powf as *const u8);
+    builder.symbol("eomgen_atan2", math::atan2 as *const u8);
+    builder.symbol("eomgen_fill_zero", math::fill_zero as *const u8);
+    Ok(JITModule::new(builder))
+}
+
+/// What a failure of Cranelift on `function` is.
+fn failure(function: &str, e: &dyn std::fmt::Display) -> CompileError {
+    CompileError::Function {
+        function: function.to_string(),
+        reason: e.to_string(),
+    }
+}
+
+/// Declares the helpers the code calls as imports of `module`.
+///
+/// # Errors
+/// [`CompileError::Function`] naming the helper Cranelift could not declare.
+fn declare_imports(module: &mut JITModule) -> Result<Imports, CompileError> {
+    let call_conv = module.isa().default_call_conv();
+    let float_signature = |args: usize, returns: usize| {
+        let mut s = Signature::new(call_conv);
+        s.params
+            .extend((0..args).map(|_| AbiParam::new(types::F64)));
+        s.returns
+            .extend((0..returns).map(|_| AbiParam::new(types::F64)));
+        s
+    };
+    let declare = |module: &mut JITModule, name: &str, signature: &Signature| {
+        module
+            .declare_function(name, Linkage::Import, signature)
+            .map_err(|e| failure(name, &e))
+    };
+    let mut unary = Vec::new();
+    for (name, f) in HELPERS {
+        unary.push((f, declare(module, name, &float_signature(1, 1))?));
+    }
+    let pointer = module.target_config().pointer_type();
+    let mut fill_signature = Signature::new(call_conv);
+    fill_signature.params.push(AbiParam::new(pointer));
+    fill_signature.params.push(AbiParam::new(pointer));
+    let imports = Imports {
+        unary,
+        sin_cos: declare(module, "eomgen_sin_cos", &float_signature(1, 2))?,
+        powf: declare(module, "eomgen_powf", &float_signature(2, 1))?,
+        atan2: declare(module, "eomgen_atan2", &float_signature(2, 1))?,
+        fill_zero: declare(module, "eomgen_fill_zero", &fill_signature)?,
+    };
+
+    Ok(imports)
 }
 
 /// The function's arguments as Cranelift values.
@@ -405,6 +428,12 @@ impl Values {
 /// function. With the values in registers, as for small functions, the allocator spends
 /// quadratic time on the long, overlapping live ranges (a 60-link pendulum: 64 % of 4.1 s in
 /// `try_to_allocate_bundle_to_reg`).
+///
+/// The body is written in four steps, in this order (the order of the Cranelift instructions
+/// and of the imported functions' references is part of the generated code): the calls that
+/// zero long runs of outputs ([`fill_zero_runs`]), the tape's instructions one by one
+/// ([`Emitter::instruction`]), then the outputs not stored yet ([`Emitter::store_inputs`] in
+/// a large function, [`Emitter::store_output_pairs`] otherwise).
 fn build(
     module: &mut JITModule,
     func: &mut ir::Function,
@@ -426,132 +455,269 @@ fn build(
         lambda: params[4],
         t: params[5],
     };
-    let (out0, out1, buffer) = (params[6], params[7], params[8]);
-    let mut unary_refs: Vec<(Func, ir::FuncRef)> = Vec::new();
-    let mut sin_cos_ref = None;
-    let mut powf_ref = None;
-    let mut atan2_ref = None;
     let tape = &function.tape;
+    let outputs = OutputBuffers {
+        out0: params[6],
+        out1: params[7],
+        split: function.split.min(tape.outputs.len()),
+    };
     let count = tape.instructions.len();
-    let split = function.split.min(tape.outputs.len());
-    // Long runs of zero outputs first, one call each; `filled[j]`: output `j` is written.
+    let filled = fill_zero_runs(&mut b, module, imports, tape, &outputs);
+    let (scratch, slots_used) = if count > SCRATCH_FROM_INSTRUCTIONS {
+        let (slots, used) = scratch_slots(tape);
+        (Some((params[8], slots)), used)
+    } else {
+        (None, 0)
+    };
+    // In a large function each output is stored as soon as it is computed (kept to the end,
+    // every output would live through the rest of the function).
+    let destinations = if scratch.is_some() {
+        output_destinations(tape, &filled, &outputs)
+    } else {
+        Vec::new()
+    };
+    let mut emitter = Emitter {
+        b,
+        module,
+        imports,
+        tape,
+        arguments,
+        outputs,
+        values: Values {
+            values: vec![None; count],
+            loaded: vec![None; count],
+            calls: 0,
+            scratch,
+        },
+        callees: Callees::default(),
+        destinations,
+    };
+    for (k, instruction) in tape.instructions.iter().enumerate() {
+        emitter.instruction(k, *instruction);
+    }
+    if emitter.values.scratch.is_some() {
+        emitter.store_inputs(&filled);
+    } else {
+        emitter.store_output_pairs(&filled);
+    }
+    let Emitter { mut b, module, .. } = emitter;
+    b.ins().return_(&[]);
+    b.finalize(module.target_config());
+    slots_used
+}
+
+/// The two output buffers of a function: outputs before `split` go to `out0`, the others to
+/// `out1`.
+struct OutputBuffers {
+    out0: ir::Value,
+    out1: ir::Value,
+    split: usize,
+}
+
+impl OutputBuffers {
+    /// The buffer of output `j` and its index in that buffer.
+    fn slot(&self, j: usize) -> (ir::Value, usize) {
+        if j < self.split {
+            (self.out0, j)
+        } else {
+            (self.out1, j - self.split)
+        }
+    }
+}
+
+/// Writes the long runs of zero outputs ([`zero_runs`]) first, one call of
+/// [`math::fill_zero`] each; returns `filled`, where `filled[j]` says output `j` is written.
+fn fill_zero_runs(
+    b: &mut FunctionBuilder,
+    module: &mut JITModule,
+    imports: &Imports,
+    tape: &eomgen_symbolic::codegen::tape::Tape,
+    outputs: &OutputBuffers,
+) -> Vec<bool> {
     let mut filled = vec![false; tape.outputs.len()];
-    let runs = zero_runs(tape, split);
+    let runs = zero_runs(tape, outputs.split);
     if !runs.is_empty() {
         let callee = module.declare_func_in_func(imports.fill_zero, b.func);
         let pointer = module.target_config().pointer_type();
         for (start, end) in runs {
-            let (base, slot) = if start < split {
-                (out0, start)
-            } else {
-                (out1, start - split)
-            };
+            let (base, slot) = outputs.slot(start);
             let address = b.ins().iadd_imm_s(base, (slot as i64) * 8);
             let length = b.ins().iconst(pointer, (end - start) as i64);
             b.ins().call(callee, &[address, length]);
             filled[start..end].fill(true);
         }
     }
-    let mut slots_used = 0u32;
-    let scratch = (count > SCRATCH_FROM_INSTRUCTIONS).then(|| {
-        let mut uses = vec![0u32; count];
-        for instruction in &tape.instructions {
-            for x in operands(instruction) {
-                uses[x as usize] += 1;
-            }
-        }
-        for &x in &tape.outputs {
+    filled
+}
+
+/// The scratch slot of each instruction of a large function (a value used more than once, or
+/// a `sin_cos`, that is neither an input nor a constant), and how many slots there are.
+fn scratch_slots(tape: &eomgen_symbolic::codegen::tape::Tape) -> (Vec<Option<u32>>, usize) {
+    let mut uses = vec![0u32; tape.instructions.len()];
+    for instruction in &tape.instructions {
+        for x in operands(instruction) {
             uses[x as usize] += 1;
         }
-        let slots: Vec<Option<u32>> = tape
-            .instructions
-            .iter()
-            .zip(&uses)
-            .map(|(instruction, &n)| {
-                let shared = n >= 2 || matches!(instruction, Instruction::SinCos(_));
-                let kept = !matches!(instruction, Instruction::Input(_) | Instruction::Const(_));
-                (shared && kept).then(|| {
-                    slots_used += 1;
-                    slots_used - 1
-                })
+    }
+    for &x in &tape.outputs {
+        uses[x as usize] += 1;
+    }
+    let mut slots_used = 0u32;
+    let slots: Vec<Option<u32>> = tape
+        .instructions
+        .iter()
+        .zip(&uses)
+        .map(|(instruction, &n)| {
+            let shared = n >= 2 || matches!(instruction, Instruction::SinCos(_));
+            let kept = !matches!(instruction, Instruction::Input(_) | Instruction::Const(_));
+            (shared && kept).then(|| {
+                slots_used += 1;
+                slots_used - 1
             })
-            .collect();
-        (buffer, slots)
-    });
-    let mut values = Values {
-        values: vec![None; count],
-        loaded: vec![None; count],
-        calls: 0,
-        scratch,
-    };
-    // In a large function each output is stored as soon as it is computed (kept to the end,
-    // every output would live through the rest of the function): per instruction, the
-    // (buffer, byte offset) of the outputs it is.
-    let mut destinations: Vec<Vec<(ir::Value, i32)>> = Vec::new();
-    if values.scratch.is_some() {
-        destinations = vec![Vec::new(); count];
-        for (j, &x) in tape.outputs.iter().enumerate() {
-            if filled[j] {
-                continue;
-            }
-            let (base, slot) = if j < split {
-                (out0, j)
-            } else {
-                (out1, j - split)
-            };
-            destinations[x as usize].push((base, (slot as i32) * 8));
+        })
+        .collect();
+    (slots, slots_used as usize)
+}
+
+/// Per instruction, the (buffer, byte offset) of the outputs it is, leaving out the outputs
+/// a run of zeros writes (`filled`).
+fn output_destinations(
+    tape: &eomgen_symbolic::codegen::tape::Tape,
+    filled: &[bool],
+    outputs: &OutputBuffers,
+) -> Vec<Vec<(ir::Value, i32)>> {
+    let mut destinations = vec![Vec::new(); tape.instructions.len()];
+    for (j, &x) in tape.outputs.iter().enumerate() {
+        if filled[j] {
+            continue;
+        }
+        let (base, slot) = outputs.slot(j);
+        destinations[x as usize].push((base, (slot as i32) * 8));
+    }
+    destinations
+}
+
+/// The imported helpers as references from the function being built, each declared at its
+/// first call (in the order of the calls).
+#[derive(Default)]
+struct Callees {
+    unary: Vec<(Func, ir::FuncRef)>,
+    sin_cos: Option<ir::FuncRef>,
+    powf: Option<ir::FuncRef>,
+    atan2: Option<ir::FuncRef>,
+}
+
+/// The reference to the import `id` from `func`, declared on first use and kept in `cached`.
+fn imported(
+    module: &mut JITModule,
+    func: &mut ir::Function,
+    cached: &mut Option<ir::FuncRef>,
+    id: FuncId,
+) -> ir::FuncRef {
+    *cached.get_or_insert_with(|| module.declare_func_in_func(id, func))
+}
+
+/// The state of [`build`] while it writes the instructions of one tape.
+struct Emitter<'f, 'm> {
+    b: FunctionBuilder<'f>,
+    module: &'m mut JITModule,
+    imports: &'m Imports,
+    tape: &'m eomgen_symbolic::codegen::tape::Tape,
+    arguments: Arguments,
+    outputs: OutputBuffers,
+    values: Values,
+    callees: Callees,
+    /// In a large function, per instruction, the outputs it is (see [`output_destinations`]);
+    /// empty otherwise.
+    destinations: Vec<Vec<(ir::Value, i32)>>,
+}
+
+impl Emitter<'_, '_> {
+    /// The Cranelift value of tape value `x` (see [`Values::get`]).
+    fn value(&mut self, x: u32) -> ir::Value {
+        self.values.get(&mut self.b, self.tape, &self.arguments, x)
+    }
+
+    /// Calls `callee` with `arguments`, counting the call (inputs are reloaded after it).
+    fn call(&mut self, callee: ir::FuncRef, arguments: &[ir::Value]) -> ir::Inst {
+        let call = self.b.ins().call(callee, arguments);
+        self.values.calls += 1;
+        call
+    }
+
+    /// The reference to the helper of the function of one argument `f`; every such function
+    /// is imported, so it is always found.
+    fn unary_callee(&mut self, f: Func) -> Option<ir::FuncRef> {
+        match self.callees.unary.iter().find(|(g, _)| *g == f) {
+            Some((_, r)) => Some(*r),
+            None => self
+                .imports
+                .unary
+                .iter()
+                .find(|(g, _)| *g == f)
+                .map(|(_, id)| {
+                    let r = self.module.declare_func_in_func(*id, self.b.func);
+                    self.callees.unary.push((f, r));
+                    r
+                }),
         }
     }
-    // Stores `value` (instruction `k`) to its scratch slot, if it has one, and to the outputs
-    // it is, in a large function.
-    let spill = |b: &mut FunctionBuilder, values: &Values, k: usize, value: ir::Value| {
-        if let Some((buffer, slots)) = &values.scratch {
+
+    /// Stores `value` (instruction `k`) to its scratch slot, if it has one, and to the outputs
+    /// it is, in a large function.
+    fn spill(&mut self, k: usize, value: ir::Value) {
+        if let Some((buffer, slots)) = &self.values.scratch {
             if let Some(slot) = slots[k] {
-                b.ins()
+                self.b
+                    .ins()
                     .store(MemFlagsData::trusted(), value, *buffer, (slot as i32) * 8);
             }
-            for &(base, offset) in &destinations[k] {
-                b.ins().store(MemFlagsData::trusted(), value, base, offset);
+            for &(base, offset) in &self.destinations[k] {
+                self.b
+                    .ins()
+                    .store(MemFlagsData::trusted(), value, base, offset);
             }
         }
-    };
-    for (k, instruction) in tape.instructions.iter().enumerate() {
-        let mut v = |b: &mut FunctionBuilder, x: u32| values.get(b, tape, &arguments, x);
-        let value = match *instruction {
+    }
+
+    /// Writes instruction `k` of the tape (inputs are loaded at their uses instead).
+    fn instruction(&mut self, k: usize, instruction: Instruction) {
+        let value = match instruction {
             // Loaded at its uses.
-            Instruction::Input(_) => continue,
-            Instruction::Const(c) => b.ins().f64const(c),
+            Instruction::Input(_) => return,
+            Instruction::Const(c) => self.b.ins().f64const(c),
             Instruction::Neg(x) => {
-                let x = v(&mut b, x);
-                b.ins().fneg(x)
+                let x = self.value(x);
+                self.b.ins().fneg(x)
             }
             Instruction::Add(x, y) => {
-                let (x, y) = (v(&mut b, x), v(&mut b, y));
-                b.ins().fadd(x, y)
+                let (x, y) = (self.value(x), self.value(y));
+                self.b.ins().fadd(x, y)
             }
             Instruction::Sub(x, y) => {
-                let (x, y) = (v(&mut b, x), v(&mut b, y));
-                b.ins().fsub(x, y)
+                let (x, y) = (self.value(x), self.value(y));
+                self.b.ins().fsub(x, y)
             }
             Instruction::Mul(x, y) => {
-                let (x, y) = (v(&mut b, x), v(&mut b, y));
-                b.ins().fmul(x, y)
+                let (x, y) = (self.value(x), self.value(y));
+                self.b.ins().fmul(x, y)
             }
             Instruction::Div(x, y) => {
-                let (x, y) = (v(&mut b, x), v(&mut b, y));
-                b.ins().fdiv(x, y)
+                let (x, y) = (self.value(x), self.value(y));
+                self.b.ins().fdiv(x, y)
             }
             Instruction::Sqrt(x) => {
-                let x = v(&mut b, x);
-                b.ins().sqrt(x)
+                let x = self.value(x);
+                self.b.ins().sqrt(x)
             }
             Instruction::Abs(x) | Instruction::Call(Func::Abs, x) => {
-                let x = v(&mut b, x);
-                b.ins().fabs(x)
+                let x = self.value(x);
+                self.b.ins().fabs(x)
             }
             Instruction::Call(Func::Sign, x) => {
                 // −1, 0 or 1; NaN compares false both ways and gives 0, as `sign` does.
-                let x = v(&mut b, x);
+                let x = self.value(x);
+                let b = &mut self.b;
                 let zero = b.ins().f64const(0.0);
                 let one = b.ins().f64const(1.0);
                 let minus_one = b.ins().f64const(-1.0);
@@ -561,129 +727,131 @@ fn build(
                 b.ins().select(positive, one, low)
             }
             Instruction::Call(Func::Step, x) => {
-                let x = v(&mut b, x);
+                let x = self.value(x);
+                let b = &mut self.b;
                 let zero = b.ins().f64const(0.0);
                 let one = b.ins().f64const(1.0);
                 let nonnegative = b.ins().fcmp(FloatCC::GreaterThanOrEqual, x, zero);
                 b.ins().select(nonnegative, one, zero)
             }
             Instruction::Call(f, x) => {
-                let x = v(&mut b, x);
-                let callee = match unary_refs.iter().find(|(g, _)| *g == f) {
-                    Some((_, r)) => Some(*r),
-                    None => imports.unary.iter().find(|(g, _)| *g == f).map(|(_, id)| {
-                        let r = module.declare_func_in_func(*id, b.func);
-                        unary_refs.push((f, r));
-                        r
-                    }),
+                let x = self.value(x);
+                let Some(callee) = self.unary_callee(f) else {
+                    return;
                 };
-                // Every function of one argument is imported, so `callee` is always found.
-                let Some(callee) = callee else {
-                    continue;
-                };
-                let call = b.ins().call(callee, &[x]);
-                values.calls += 1;
-                b.inst_results(call)[0]
+                let call = self.call(callee, &[x]);
+                self.b.inst_results(call)[0]
             }
             Instruction::Powf(x, y) => {
-                let (x, y) = (v(&mut b, x), v(&mut b, y));
-                let callee = *powf_ref
-                    .get_or_insert_with(|| module.declare_func_in_func(imports.powf, b.func));
-                let call = b.ins().call(callee, &[x, y]);
-                values.calls += 1;
-                b.inst_results(call)[0]
+                let (x, y) = (self.value(x), self.value(y));
+                let callee = imported(
+                    self.module,
+                    self.b.func,
+                    &mut self.callees.powf,
+                    self.imports.powf,
+                );
+                let call = self.call(callee, &[x, y]);
+                self.b.inst_results(call)[0]
             }
             Instruction::Atan2(y, x) => {
-                let (y, x) = (v(&mut b, y), v(&mut b, x));
-                let callee = *atan2_ref
-                    .get_or_insert_with(|| module.declare_func_in_func(imports.atan2, b.func));
-                let call = b.ins().call(callee, &[y, x]);
-                values.calls += 1;
-                b.inst_results(call)[0]
+                let (y, x) = (self.value(y), self.value(x));
+                let callee = imported(
+                    self.module,
+                    self.b.func,
+                    &mut self.callees.atan2,
+                    self.imports.atan2,
+                );
+                let call = self.call(callee, &[y, x]);
+                self.b.inst_results(call)[0]
             }
             Instruction::SinCos(x) => {
-                let x = v(&mut b, x);
-                let callee = *sin_cos_ref
-                    .get_or_insert_with(|| module.declare_func_in_func(imports.sin_cos, b.func));
-                let call = b.ins().call(callee, &[x]);
-                values.calls += 1;
-                let results = b.inst_results(call);
+                let x = self.value(x);
+                let callee = imported(
+                    self.module,
+                    self.b.func,
+                    &mut self.callees.sin_cos,
+                    self.imports.sin_cos,
+                );
+                let call = self.call(callee, &[x]);
+                let results = self.b.inst_results(call);
                 let (s, c) = (results[0], results[1]);
-                values.values[k] = Some(s);
-                if let Some(slot) = values.values.get_mut(k + 1) {
+                self.values.values[k] = Some(s);
+                if let Some(slot) = self.values.values.get_mut(k + 1) {
                     *slot = Some(c);
                 }
-                spill(&mut b, &values, k, s);
-                spill(&mut b, &values, k + 1, c);
-                continue;
+                self.spill(k, s);
+                self.spill(k + 1, c);
+                return;
             }
             // Set with its `SinCos`.
-            Instruction::CosOfSinCos(_) => continue,
+            Instruction::CosOfSinCos(_) => return,
         };
-        values.values[k] = Some(value);
-        spill(&mut b, &values, k, value);
+        self.values.values[k] = Some(value);
+        self.spill(k, value);
     }
-    // Outputs are stored two at a time (slots 2k and 2k + 1 of a buffer as one 16-byte
-    // store): the caller reads them back at once, often 16 bytes at a time (nalgebra's
-    // copies, the solve of `M q̈ = F`), and a 16-byte load of two 8-byte stores cannot be
-    // forwarded from the store buffer — it waits ~12 cycles for the stores to retire, while a
-    // load within one wider store is forwarded. On the double pendulum's right-hand side this
-    // was worth ~4 ns (`benches/runtime_model.rs`).
-    if values.scratch.is_some() {
-        // Computed outputs and constants are stored already (where they are defined); inputs
-        // still are to be.
+
+    /// In a large function, stores the outputs that are inputs: computed outputs and
+    /// constants are stored already, where they are defined.
+    fn store_inputs(&mut self, filled: &[bool]) {
+        let tape = self.tape;
         for (j, &x) in tape.outputs.iter().enumerate() {
             if filled[j] || !matches!(tape.instructions[x as usize], Instruction::Input(_)) {
                 continue;
             }
-            let (base, slot) = if j < split {
-                (out0, j)
-            } else {
-                (out1, j - split)
-            };
-            let value = values.get(&mut b, tape, &arguments, x);
-            b.ins()
+            let (base, slot) = self.outputs.slot(j);
+            let value = self.value(x);
+            self.b
+                .ins()
                 .store(MemFlagsData::trusted(), value, base, (slot as i32) * 8);
         }
-        b.ins().return_(&[]);
-        b.finalize(module.target_config());
-        return slots_used as usize;
     }
-    for (base, outputs, filled) in [
-        (out0, &tape.outputs[..split], &filled[..split]),
-        (out1, &tape.outputs[split..], &filled[split..]),
-    ] {
-        for (pair, (chunk, filled)) in outputs.chunks(2).zip(filled.chunks(2)).enumerate() {
-            let offset = (pair as i32) * 16;
-            // A pair half in a run of zeros: the other half alone.
-            match filled {
-                [true] | [true, true] => continue,
-                [false, true] | [true, false] => {
-                    let half = usize::from(filled[0]);
-                    let value = values.get(&mut b, tape, &arguments, chunk[half]);
-                    let at = offset + 8 * half as i32;
-                    b.ins().store(MemFlagsData::trusted(), value, base, at);
-                    continue;
+
+    /// Stores the outputs of a small function two at a time (slots 2k and 2k + 1 of a buffer
+    /// as one 16-byte store): the caller reads them back at once, often 16 bytes at a time
+    /// (nalgebra's copies, the solve of `M q̈ = F`), and a 16-byte load of two 8-byte stores
+    /// cannot be forwarded from the store buffer — it waits ~12 cycles for the stores to
+    /// retire, while a load within one wider store is forwarded. On the double pendulum's
+    /// right-hand side this was worth ~4 ns (`benches/runtime_model.rs`).
+    fn store_output_pairs(&mut self, filled: &[bool]) {
+        let tape = self.tape;
+        let split = self.outputs.split;
+        for (base, outputs, filled) in [
+            (self.outputs.out0, &tape.outputs[..split], &filled[..split]),
+            (self.outputs.out1, &tape.outputs[split..], &filled[split..]),
+        ] {
+            for (pair, (chunk, filled)) in outputs.chunks(2).zip(filled.chunks(2)).enumerate() {
+                let offset = (pair as i32) * 16;
+                // A pair half in a run of zeros: the other half alone.
+                match filled {
+                    [true] | [true, true] => continue,
+                    [false, true] | [true, false] => {
+                        let half = usize::from(filled[0]);
+                        let value = self.value(chunk[half]);
+                        let at = offset + 8 * half as i32;
+                        self.b.ins().store(MemFlagsData::trusted(), value, base, at);
+                        continue;
+                    }
+                    _ => {}
                 }
-                _ => {}
-            }
-            let first = values.get(&mut b, tape, &arguments, chunk[0]);
-            match chunk.get(1) {
-                Some(&second) => {
-                    let second = values.get(&mut b, tape, &arguments, second);
-                    let vector = b.ins().splat(types::F64X2, first);
-                    let vector = b.ins().insertlane(vector, second, 1);
-                    b.ins().store(MemFlagsData::trusted(), vector, base, offset);
-                }
-                None => {
-                    b.ins().store(MemFlagsData::trusted(), first, base, offset);
+                let first = self.value(chunk[0]);
+                match chunk.get(1) {
+                    Some(&second) => {
+                        let second = self.value(second);
+                        let vector = self.b.ins().splat(types::F64X2, first);
+                        let vector = self.b.ins().insertlane(vector, second, 1);
+                        self.b
+                            .ins()
+                            .store(MemFlagsData::trusted(), vector, base, offset);
+                    }
+                    None => {
+                        self.b
+                            .ins()
+                            .store(MemFlagsData::trusted(), first, base, offset);
+                    }
                 }
             }
         }
     }
-    b.ins().return_(&[]);
-    b.finalize(module.target_config());
-    slots_used as usize
 }
 
 /// The runs `[start, end)` of at least [`ZERO_RUN`] consecutive outputs of one buffer (the

@@ -689,22 +689,17 @@ impl<'f> Lowering<'f> {
             .collect()
     }
 
+    /// Lowers the whole file, section by section, into a [`SymbolicModel`]; every error of
+    /// every section is reported.
+    ///
+    /// The sections are lowered in a fixed order, which this function spells out: the arena
+    /// interns each new expression at its first use, so the order fixes every [`ExprId`],
+    /// hence the canonical order of sums and products and the generated code.
     fn run(mut self) -> Result<SymbolicModel, Vec<Diagnostic>> {
         let file = self.file;
         let time_id = self.arena.time_id();
         let time = self.arena.symbol_expr(time_id);
-        let mut parameters = Vec::new();
-        for p in &file.parameters {
-            let symbol = self.arena.declare(&p.name.value, SymbolKind::Parameter);
-            // Interned now, in file order, as the expressions' canonical order follows it.
-            self.arena.symbol_expr(symbol);
-            parameters.push(ParameterInfo {
-                name: p.name.value.clone(),
-                default: p.value,
-                unit: p.unit.as_ref().map(|u| u.value.clone()),
-                symbol,
-            });
-        }
+        let parameters = self.parameters();
         let coordinates: Vec<[ExprId; 3]> = file
             .coordinates
             .iter()
@@ -717,271 +712,27 @@ impl<'f> Lowering<'f> {
             .map(|c| c.name.value.clone())
             .collect();
         let q_symbols: Vec<SymbolId> = self.arena.coordinates().iter().map(|c| c[0]).collect();
-
-        let points: Vec<(String, Vec<ExprId>)> = file
-            .points
-            .iter()
-            .map(|p| {
-                let r = p.position.iter().map(|c| self.expr(c)).collect();
-                (p.name.value.clone(), r)
-            })
-            .collect();
+        let points = self.points();
         let dimension = file.dimension.unwrap_or(2);
-        let point = |name: &str| points.iter().position(|(p, _)| p == name);
 
-        let mut t_terms: Vec<ExprId> = Vec::new();
-        let mut v_terms: Vec<ExprId> = Vec::new();
-        let mut q_terms: Vec<Vec<ExprId>> = vec![Vec::new(); n];
-        let half = self.arena.constant(Constant::Rational { num: 1, den: 2 });
-
-        if let Some(k) = &file.kinetic {
-            let e = self.expr(k);
-            t_terms.push(e);
-        }
-        if let Some(v) = &file.potential {
-            let e = self.expr(v);
-            v_terms.push(e);
-        }
-        for (name, q) in &file.generalized_forces {
-            let e = self.expr(q);
-            match coordinate_names.iter().position(|c| *c == name.value) {
-                Some(i) => q_terms[i].push(e),
-                None => self.errors.push(Diagnostic::new(
-                    name.location,
-                    format!("`{}` is not a coordinate", name.value),
-                )),
-            }
-        }
+        let mut terms = Terms {
+            kinetic: Vec::new(),
+            potential: Vec::new(),
+            forces: vec![Vec::new(); n],
+            half: self.arena.constant(Constant::Rational { num: 1, den: 2 }),
+        };
+        self.energies_written(&mut terms, &coordinate_names);
         let gravity: Option<Vec<ExprId>> = file
             .gravity
             .as_ref()
             .map(|g| g.value.iter().map(|c| self.expr(c)).collect());
-
-        // Bodies: T = ½ m v_G·v_G (+ ½ I ω² for planar rigid bodies), V = −m g·r_G.
-        let mut angles: Vec<(String, ExprId)> = Vec::new();
-        let mut body_infos: Vec<BodyInfo> = Vec::new();
-        let mut loads: Vec<LoadInfo> = Vec::new();
-        for body in &file.bodies {
-            let (mass, at, rigid) = match &body.kind {
-                BodyKind::Particle { mass, at } => (mass, at, None),
-                BodyKind::Rigid {
-                    mass,
-                    inertia,
-                    com,
-                    angle,
-                } => (mass, com, Some((inertia, angle))),
-            };
-            let m = self.expr(mass);
-            let Some(ip) = point(&at.value) else {
-                self.errors.push(Diagnostic::new(
-                    at.location,
-                    format!("unknown point `{}`", at.value),
-                ));
-                continue;
-            };
-            let r = points[ip].1.clone();
-            let v: Vec<ExprId> = r.iter().map(|c| self.arena.time_derivative(*c)).collect();
-            let v2 = self.dot(&v, &v);
-            t_terms.push(self.arena.product(&[half, m, v2]));
-            if let Some(g) = &gravity {
-                let gr = self.dot(g, &r);
-                let mgr = self.arena.times(m, gr);
-                v_terms.push(self.arena.neg(mgr));
-            }
-            let mut rotation = None;
-            if let Some((inertia, angle)) = rigid {
-                let i = self.expr(inertia);
-                let th = self.expr(angle);
-                rotation = Some((i, th));
-                let w = self.arena.time_derivative(th);
-                let two = self.arena.int(2);
-                let w2 = self.arena.pow(w, two);
-                t_terms.push(self.arena.product(&[half, i, w2]));
-                angles.push((body.name.value.clone(), th));
-            }
-            body_infos.push(BodyInfo {
-                name: body.name.value.clone(),
-                mass: m,
-                com: ip,
-                rotation,
-            });
-        }
-
-        // Springs: V = ½ k (|r_A − r_B| − ℓ₀)², or ½ k |r_A − r_B|² for zero rest length.
-        for s in &file.springs {
-            let (Some(a), Some(b)) = (point(&s.between[0].value), point(&s.between[1].value))
-            else {
-                self.errors.push(Diagnostic::new(
-                    s.name.location,
-                    format!("spring `{}` names an unknown point", s.name.value),
-                ));
-                continue;
-            };
-            let d = self.difference(&points[a].1, &points[b].1);
-            let d2 = self.dot(&d, &d);
-            let k = self.expr(&s.stiffness);
-            let rest = s.rest_length.as_ref().map(|l| self.expr(l));
-            loads.push(LoadInfo::Spring {
-                between: [a, b],
-                stiffness: k,
-                rest_length: rest,
-            });
-            let stretch2 = match rest {
-                None => d2,
-                Some(l0) => {
-                    let len = self.arena.sqrt(d2);
-                    let st = self.arena.minus(len, l0);
-                    let two = self.arena.int(2);
-                    self.arena.pow(st, two)
-                }
-            };
-            v_terms.push(self.arena.product(&[half, k, stretch2]));
-        }
-
-        // Dampers along the line AB: F_A = −c (ḋ·e) e with d = r_A − r_B, e = d/|d|, so
-        // Qᵢ = F_A·∂d/∂qᵢ = −c (d·ḋ)(d·∂d/∂qᵢ)/(d·d).
-        for dmp in &file.dampers {
-            let (Some(a), Some(b)) = (point(&dmp.between[0].value), point(&dmp.between[1].value))
-            else {
-                self.errors.push(Diagnostic::new(
-                    dmp.name.location,
-                    format!("damper `{}` names an unknown point", dmp.name.value),
-                ));
-                continue;
-            };
-            let d = self.difference(&points[a].1, &points[b].1);
-            let dd: Vec<ExprId> = d.iter().map(|c| self.arena.time_derivative(*c)).collect();
-            let c = self.expr(&dmp.coefficient);
-            loads.push(LoadInfo::Damper {
-                between: [a, b],
-                coefficient: c,
-            });
-            let d2 = self.dot(&d, &d);
-            let rate = self.dot(&d, &dd);
-            let c_rate = self.arena.times(c, rate);
-            let scale = self.arena.divide(c_rate, d2);
-            let scale = self.arena.neg(scale);
-            for (i, qs) in q_symbols.iter().enumerate() {
-                let partial: Vec<ExprId> = d.iter().map(|x| self.arena.diff(*x, *qs)).collect();
-                let proj = self.dot(&d, &partial);
-                if !self.arena.is_zero(proj) {
-                    q_terms[i].push(self.arena.times(scale, proj));
-                }
-            }
-        }
-
-        // Forces at points: Qᵢ = F·∂r_P/∂qᵢ (the partial velocity ∂v_P/∂q̇ᵢ).
-        for f in &file.forces {
-            let Some(ip) = point(&f.at.value) else {
-                self.errors.push(Diagnostic::new(
-                    f.at.location,
-                    format!("unknown point `{}`", f.at.value),
-                ));
-                continue;
-            };
-            let force: Vec<ExprId> = f.vector.iter().map(|c| self.expr(c)).collect();
-            loads.push(LoadInfo::Force {
-                point: ip,
-                vector: force.clone(),
-            });
-            let r = points[ip].1.clone();
-            for (i, qs) in q_symbols.iter().enumerate() {
-                let partial: Vec<ExprId> = r.iter().map(|x| self.arena.diff(*x, *qs)).collect();
-                let proj = self.dot(&force, &partial);
-                if !self.arena.is_zero(proj) {
-                    q_terms[i].push(proj);
-                }
-            }
-        }
-
-        // Torques on planar bodies: Qᵢ = τ ∂θ/∂qᵢ (partial angular velocity).
-        for tq in &file.torques {
-            let Some(th) = angles
-                .iter()
-                .find(|(b, _)| *b == tq.body.value)
-                .map(|(_, a)| *a)
-            else {
-                self.errors.push(Diagnostic::new(
-                    tq.body.location,
-                    format!("`{}` is not a planar rigid body", tq.body.value),
-                ));
-                continue;
-            };
-            let tau = self.expr(&tq.value);
-            loads.push(LoadInfo::Torque {
-                body: body_infos
-                    .iter()
-                    .position(|b| b.name == tq.body.value)
-                    .unwrap_or(0),
-                angle: th,
-                value: tau,
-            });
-            for (i, qs) in q_symbols.iter().enumerate() {
-                let partial = self.arena.diff(th, *qs);
-                if !self.arena.is_zero(partial) {
-                    q_terms[i].push(self.arena.times(tau, partial));
-                }
-            }
-        }
-
-        let mut balances = Vec::new();
-        for b in &file.balances {
-            let bodies: Vec<usize> = b
-                .bodies
-                .iter()
-                .filter_map(|name| body_infos.iter().position(|x| x.name == name.value))
-                .collect();
-            match &b.kind {
-                crate::model::BalanceKind::Amb { about, form } => match point(&about.value) {
-                    Some(about) => balances.push(BalanceInfo::Amb {
-                        about,
-                        bodies,
-                        form: *form,
-                    }),
-                    None => self.errors.push(Diagnostic::new(
-                        about.location,
-                        format!("unknown point `{}`", about.value),
-                    )),
-                },
-                crate::model::BalanceKind::Lmb { along } => {
-                    let along = along.iter().map(|e| self.expr(e)).collect();
-                    balances.push(BalanceInfo::Lmb { along, bodies });
-                }
-            }
-        }
-
-        self.allow_accelerations = true;
-        let hand_equations: Vec<ExprId> = file
-            .checks
-            .equations_of_motion
-            .iter()
-            .map(|e| {
-                let lhs = self.expr(&e.lhs);
-                match &e.rhs {
-                    Some(rhs) => {
-                        let rhs = self.expr(rhs);
-                        self.arena.minus(lhs, rhs)
-                    }
-                    None => lhs,
-                }
-            })
-            .collect();
-        self.allow_accelerations = false;
-        // Each must be linear in the accelerations: no coefficient of a q̈ⱼ may depend on one.
-        let accelerations: Vec<SymbolId> = self.arena.coordinates().iter().map(|c| c[2]).collect();
-        for (e, r) in file.checks.equations_of_motion.iter().zip(&hand_equations) {
-            let nonlinear = accelerations.iter().any(|a| {
-                let c = self.arena.diff(*r, *a);
-                let c = self.arena.expand(c);
-                accelerations.iter().any(|b| self.arena.depends_on(c, *b))
-            });
-            if nonlinear {
-                self.errors.push(
-                    Diagnostic::new(e.location, "this equation of motion is not linear in the accelerations")
-                        .with_help("equations of motion are M(q, t) q̈ = f(q, q̇, t): each `x_ddot` appears only to the first power, times a function of q, q̇ and t"),
-                );
-            }
-        }
+        let (body_infos, angles) = self.bodies(&points, gravity.as_deref(), &mut terms);
+        let mut loads = self.springs(&points, &mut terms);
+        loads.extend(self.dampers(&points, &q_symbols, &mut terms));
+        loads.extend(self.forces(&points, &q_symbols, &mut terms));
+        loads.extend(self.torques(&angles, &body_infos, &q_symbols, &mut terms));
+        let balances = self.balances(&points, &body_infos);
+        let hand_equations = self.hand_equations();
 
         let constraints = self.constraints(file, &parameters);
         if !file.events.is_empty() {
@@ -990,65 +741,25 @@ impl<'f> Lowering<'f> {
                     .symbol(&format!("lambda_{name}"), SymbolKind::Multiplier(i as u32));
             }
         }
-        self.allow_accelerations = true;
-        let events: Vec<EventInfo> = file
-            .events
-            .iter()
-            .map(|e| EventInfo {
-                name: e.name.value.clone(),
-                function: self.expr(&e.when),
-                direction: e.direction,
-                terminal: e.terminal,
-            })
-            .collect();
-        self.allow_accelerations = false;
-        let equilibria: Vec<(String, Vec<ExprId>)> = file
-            .equilibria
-            .iter()
-            .map(|q| {
-                let mut guess = vec![self.arena.int(0); n];
-                for (c, e) in &q.values {
-                    let value = self.expr(e);
-                    if let Some(i) = coordinate_names.iter().position(|x| *x == c.value) {
-                        guess[i] = value;
-                    }
-                }
-                (q.name.value.clone(), guess)
-            })
-            .collect();
+        let events = self.events();
+        let equilibria = self.equilibria(&coordinate_names);
         let initial_guesses: Vec<usize> = file
             .initial_guesses
             .iter()
             .filter_map(|g| coordinate_names.iter().position(|c| *c == g.value))
             .collect();
 
-        let kinetic = self.arena.sum(&t_terms);
-        let potential = self.arena.sum(&v_terms);
-        let generalized_forces: Vec<ExprId> =
-            q_terms.iter().map(|terms| self.arena.sum(terms)).collect();
+        let kinetic = self.arena.sum(&terms.kinetic);
+        let potential = self.arena.sum(&terms.potential);
+        let generalized_forces: Vec<ExprId> = terms
+            .forces
+            .iter()
+            .map(|terms| self.arena.sum(terms))
+            .collect();
+        let (initial_q, initial_qdot) = self.initial_state(&coordinate_names);
 
-        let mut initial_q = vec![self.arena.int(0); n];
-        let mut initial_qdot = vec![self.arena.int(0); n];
-        for (name, value) in &file.initial {
-            let e = self.expr(value);
-            if let Some(i) = coordinate_names.iter().position(|c| *c == name.value) {
-                initial_q[i] = e;
-            } else if let Some(i) = coordinate_names
-                .iter()
-                .position(|c| name.value.strip_suffix("_dot") == Some(c.as_str()))
-            {
-                initial_qdot[i] = e;
-            } else {
-                self.errors.push(Diagnostic::new(
-                    name.location,
-                    format!("`{}` is neither a coordinate nor a rate", name.value),
-                ));
-            }
-        }
-
-        let ts = time_id;
         let explicit_time =
-            self.arena.depends_on(kinetic, ts) || self.arena.depends_on(potential, ts);
+            self.arena.depends_on(kinetic, time_id) || self.arena.depends_on(potential, time_id);
         let conservative = file.dampers.is_empty()
             && file.forces.is_empty()
             && file.torques.is_empty()
@@ -1061,13 +772,13 @@ impl<'f> Lowering<'f> {
             .draw
             .lines
             .iter()
-            .filter_map(|[a, b]| Some([point(&a.value)?, point(&b.value)?]))
+            .filter_map(|[a, b]| Some([point(&points, &a.value)?, point(&points, &b.value)?]))
             .collect();
         let trace_points = file
             .draw
             .trace
             .iter()
-            .filter_map(|p| point(&p.value))
+            .filter_map(|p| point(&points, &p.value))
             .collect();
 
         if !self.errors.is_empty() {
@@ -1106,6 +817,424 @@ impl<'f> Lowering<'f> {
             equilibria,
         })
     }
+
+    /// Declares the parameters' symbols, in file order.
+    fn parameters(&mut self) -> Vec<ParameterInfo> {
+        let mut parameters = Vec::new();
+        for p in &self.file.parameters {
+            let symbol = self.arena.declare(&p.name.value, SymbolKind::Parameter);
+            // Interned now, in file order, as the expressions' canonical order follows it.
+            self.arena.symbol_expr(symbol);
+            parameters.push(ParameterInfo {
+                name: p.name.value.clone(),
+                default: p.value,
+                unit: p.unit.as_ref().map(|u| u.value.clone()),
+                symbol,
+            });
+        }
+        parameters
+    }
+
+    /// The points' positions, by name, in file order.
+    fn points(&mut self) -> Points {
+        self.file
+            .points
+            .iter()
+            .map(|p| {
+                let r = p.position.iter().map(|c| self.expr(c)).collect();
+                (p.name.value.clone(), r)
+            })
+            .collect()
+    }
+
+    /// The energies and generalized forces written as such (`kinetic:`, `potential:`,
+    /// `generalized_forces:`).
+    fn energies_written(&mut self, terms: &mut Terms, coordinate_names: &[String]) {
+        let file = self.file;
+        if let Some(k) = &file.kinetic {
+            let e = self.expr(k);
+            terms.kinetic.push(e);
+        }
+        if let Some(v) = &file.potential {
+            let e = self.expr(v);
+            terms.potential.push(e);
+        }
+        for (name, q) in &file.generalized_forces {
+            let e = self.expr(q);
+            match coordinate_names.iter().position(|c| *c == name.value) {
+                Some(i) => terms.forces[i].push(e),
+                None => self.errors.push(Diagnostic::new(
+                    name.location,
+                    format!("`{}` is not a coordinate", name.value),
+                )),
+            }
+        }
+    }
+
+    /// Bodies: T = ½ m v_G·v_G (+ ½ I ω² for planar rigid bodies), V = −m g·r_G. Returns the
+    /// bodies and the angle of each planar rigid body, by name.
+    fn bodies(
+        &mut self,
+        points: &Points,
+        gravity: Option<&[ExprId]>,
+        terms: &mut Terms,
+    ) -> (Vec<BodyInfo>, Vec<(String, ExprId)>) {
+        let half = terms.half;
+        let mut angles: Vec<(String, ExprId)> = Vec::new();
+        let mut body_infos: Vec<BodyInfo> = Vec::new();
+        for body in &self.file.bodies {
+            let (mass, at, rigid) = match &body.kind {
+                BodyKind::Particle { mass, at } => (mass, at, None),
+                BodyKind::Rigid {
+                    mass,
+                    inertia,
+                    com,
+                    angle,
+                } => (mass, com, Some((inertia, angle))),
+            };
+            let m = self.expr(mass);
+            let Some(ip) = point(points, &at.value) else {
+                self.errors.push(Diagnostic::new(
+                    at.location,
+                    format!("unknown point `{}`", at.value),
+                ));
+                continue;
+            };
+            let r = points[ip].1.clone();
+            let v: Vec<ExprId> = r.iter().map(|c| self.arena.time_derivative(*c)).collect();
+            let v2 = self.dot(&v, &v);
+            terms.kinetic.push(self.arena.product(&[half, m, v2]));
+            if let Some(g) = gravity {
+                let gr = self.dot(g, &r);
+                let mgr = self.arena.times(m, gr);
+                terms.potential.push(self.arena.neg(mgr));
+            }
+            let mut rotation = None;
+            if let Some((inertia, angle)) = rigid {
+                let i = self.expr(inertia);
+                let th = self.expr(angle);
+                rotation = Some((i, th));
+                let w = self.arena.time_derivative(th);
+                let two = self.arena.int(2);
+                let w2 = self.arena.pow(w, two);
+                terms.kinetic.push(self.arena.product(&[half, i, w2]));
+                angles.push((body.name.value.clone(), th));
+            }
+            body_infos.push(BodyInfo {
+                name: body.name.value.clone(),
+                mass: m,
+                com: ip,
+                rotation,
+            });
+        }
+        (body_infos, angles)
+    }
+
+    /// Springs: V = ½ k (|r_A − r_B| − ℓ₀)², or ½ k |r_A − r_B|² for zero rest length.
+    fn springs(&mut self, points: &Points, terms: &mut Terms) -> Vec<LoadInfo> {
+        let mut loads = Vec::new();
+        for s in &self.file.springs {
+            let (Some(a), Some(b)) = (
+                point(points, &s.between[0].value),
+                point(points, &s.between[1].value),
+            ) else {
+                self.errors.push(Diagnostic::new(
+                    s.name.location,
+                    format!("spring `{}` names an unknown point", s.name.value),
+                ));
+                continue;
+            };
+            let d = self.difference(&points[a].1, &points[b].1);
+            let d2 = self.dot(&d, &d);
+            let k = self.expr(&s.stiffness);
+            let rest = s.rest_length.as_ref().map(|l| self.expr(l));
+            loads.push(LoadInfo::Spring {
+                between: [a, b],
+                stiffness: k,
+                rest_length: rest,
+            });
+            let stretch2 = match rest {
+                None => d2,
+                Some(l0) => {
+                    let len = self.arena.sqrt(d2);
+                    let st = self.arena.minus(len, l0);
+                    let two = self.arena.int(2);
+                    self.arena.pow(st, two)
+                }
+            };
+            terms
+                .potential
+                .push(self.arena.product(&[terms.half, k, stretch2]));
+        }
+        loads
+    }
+
+    /// Dampers along the line AB: F_A = −c (ḋ·e) e with d = r_A − r_B, e = d/|d|, so
+    /// Qᵢ = F_A·∂d/∂qᵢ = −c (d·ḋ)(d·∂d/∂qᵢ)/(d·d).
+    fn dampers(
+        &mut self,
+        points: &Points,
+        q_symbols: &[SymbolId],
+        terms: &mut Terms,
+    ) -> Vec<LoadInfo> {
+        let mut loads = Vec::new();
+        for dmp in &self.file.dampers {
+            let (Some(a), Some(b)) = (
+                point(points, &dmp.between[0].value),
+                point(points, &dmp.between[1].value),
+            ) else {
+                self.errors.push(Diagnostic::new(
+                    dmp.name.location,
+                    format!("damper `{}` names an unknown point", dmp.name.value),
+                ));
+                continue;
+            };
+            let d = self.difference(&points[a].1, &points[b].1);
+            let dd: Vec<ExprId> = d.iter().map(|c| self.arena.time_derivative(*c)).collect();
+            let c = self.expr(&dmp.coefficient);
+            loads.push(LoadInfo::Damper {
+                between: [a, b],
+                coefficient: c,
+            });
+            let d2 = self.dot(&d, &d);
+            let rate = self.dot(&d, &dd);
+            let c_rate = self.arena.times(c, rate);
+            let scale = self.arena.divide(c_rate, d2);
+            let scale = self.arena.neg(scale);
+            for (i, qs) in q_symbols.iter().enumerate() {
+                let partial: Vec<ExprId> = d.iter().map(|x| self.arena.diff(*x, *qs)).collect();
+                let proj = self.dot(&d, &partial);
+                if !self.arena.is_zero(proj) {
+                    terms.forces[i].push(self.arena.times(scale, proj));
+                }
+            }
+        }
+        loads
+    }
+
+    /// Forces at points: Qᵢ = F·∂r_P/∂qᵢ (the partial velocity ∂v_P/∂q̇ᵢ).
+    fn forces(
+        &mut self,
+        points: &Points,
+        q_symbols: &[SymbolId],
+        terms: &mut Terms,
+    ) -> Vec<LoadInfo> {
+        let mut loads = Vec::new();
+        for f in &self.file.forces {
+            let Some(ip) = point(points, &f.at.value) else {
+                self.errors.push(Diagnostic::new(
+                    f.at.location,
+                    format!("unknown point `{}`", f.at.value),
+                ));
+                continue;
+            };
+            let force: Vec<ExprId> = f.vector.iter().map(|c| self.expr(c)).collect();
+            loads.push(LoadInfo::Force {
+                point: ip,
+                vector: force.clone(),
+            });
+            let r = &points[ip].1;
+            for (i, qs) in q_symbols.iter().enumerate() {
+                let partial: Vec<ExprId> = r.iter().map(|x| self.arena.diff(*x, *qs)).collect();
+                let proj = self.dot(&force, &partial);
+                if !self.arena.is_zero(proj) {
+                    terms.forces[i].push(proj);
+                }
+            }
+        }
+        loads
+    }
+
+    /// Torques on planar bodies: Qᵢ = τ ∂θ/∂qᵢ (partial angular velocity).
+    fn torques(
+        &mut self,
+        angles: &[(String, ExprId)],
+        body_infos: &[BodyInfo],
+        q_symbols: &[SymbolId],
+        terms: &mut Terms,
+    ) -> Vec<LoadInfo> {
+        let mut loads = Vec::new();
+        for tq in &self.file.torques {
+            let Some(th) = angles
+                .iter()
+                .find(|(b, _)| *b == tq.body.value)
+                .map(|(_, a)| *a)
+            else {
+                self.errors.push(Diagnostic::new(
+                    tq.body.location,
+                    format!("`{}` is not a planar rigid body", tq.body.value),
+                ));
+                continue;
+            };
+            let tau = self.expr(&tq.value);
+            loads.push(LoadInfo::Torque {
+                body: body_infos
+                    .iter()
+                    .position(|b| b.name == tq.body.value)
+                    .unwrap_or(0),
+                angle: th,
+                value: tau,
+            });
+            for (i, qs) in q_symbols.iter().enumerate() {
+                let partial = self.arena.diff(th, *qs);
+                if !self.arena.is_zero(partial) {
+                    terms.forces[i].push(self.arena.times(tau, partial));
+                }
+            }
+        }
+        loads
+    }
+
+    /// The momentum balances chosen in `balances:`, with their points and bodies by index.
+    fn balances(&mut self, points: &Points, body_infos: &[BodyInfo]) -> Vec<BalanceInfo> {
+        let mut balances = Vec::new();
+        for b in &self.file.balances {
+            let bodies: Vec<usize> = b
+                .bodies
+                .iter()
+                .filter_map(|name| body_infos.iter().position(|x| x.name == name.value))
+                .collect();
+            match &b.kind {
+                crate::model::BalanceKind::Amb { about, form } => {
+                    match point(points, &about.value) {
+                        Some(about) => balances.push(BalanceInfo::Amb {
+                            about,
+                            bodies,
+                            form: *form,
+                        }),
+                        None => self.errors.push(Diagnostic::new(
+                            about.location,
+                            format!("unknown point `{}`", about.value),
+                        )),
+                    }
+                }
+                crate::model::BalanceKind::Lmb { along } => {
+                    let along = along.iter().map(|e| self.expr(e)).collect();
+                    balances.push(BalanceInfo::Lmb { along, bodies });
+                }
+            }
+        }
+        balances
+    }
+
+    /// The equations of motion written by hand in `checks:`, each as `lhs − rhs`; reports one
+    /// that is not linear in the accelerations.
+    fn hand_equations(&mut self) -> Vec<ExprId> {
+        let file = self.file;
+        self.allow_accelerations = true;
+        let hand_equations: Vec<ExprId> = file
+            .checks
+            .equations_of_motion
+            .iter()
+            .map(|e| {
+                let lhs = self.expr(&e.lhs);
+                match &e.rhs {
+                    Some(rhs) => {
+                        let rhs = self.expr(rhs);
+                        self.arena.minus(lhs, rhs)
+                    }
+                    None => lhs,
+                }
+            })
+            .collect();
+        self.allow_accelerations = false;
+        // Each must be linear in the accelerations: no coefficient of a q̈ⱼ may depend on one.
+        let accelerations: Vec<SymbolId> = self.arena.coordinates().iter().map(|c| c[2]).collect();
+        for (e, r) in file.checks.equations_of_motion.iter().zip(&hand_equations) {
+            let nonlinear = accelerations.iter().any(|a| {
+                let c = self.arena.diff(*r, *a);
+                let c = self.arena.expand(c);
+                accelerations.iter().any(|b| self.arena.depends_on(c, *b))
+            });
+            if nonlinear {
+                self.errors.push(
+                    Diagnostic::new(e.location, "this equation of motion is not linear in the accelerations")
+                        .with_help("equations of motion are M(q, t) q̈ = f(q, q̇, t): each `x_ddot` appears only to the first power, times a function of q, q̇ and t"),
+                );
+            }
+        }
+        hand_equations
+    }
+
+    /// The events' functions, which may use the accelerations.
+    fn events(&mut self) -> Vec<EventInfo> {
+        self.allow_accelerations = true;
+        let events = self
+            .file
+            .events
+            .iter()
+            .map(|e| EventInfo {
+                name: e.name.value.clone(),
+                function: self.expr(&e.when),
+                direction: e.direction,
+                terminal: e.terminal,
+            })
+            .collect();
+        self.allow_accelerations = false;
+        events
+    }
+
+    /// The named equilibria, each a value per coordinate (0 for one it does not give).
+    fn equilibria(&mut self, coordinate_names: &[String]) -> Vec<(String, Vec<ExprId>)> {
+        self.file
+            .equilibria
+            .iter()
+            .map(|q| {
+                let mut guess = vec![self.arena.int(0); coordinate_names.len()];
+                for (c, e) in &q.values {
+                    let value = self.expr(e);
+                    if let Some(i) = coordinate_names.iter().position(|x| *x == c.value) {
+                        guess[i] = value;
+                    }
+                }
+                (q.name.value.clone(), guess)
+            })
+            .collect()
+    }
+
+    /// The initial coordinates and rates of `initial:` (0 for one it does not give).
+    fn initial_state(&mut self, coordinate_names: &[String]) -> (Vec<ExprId>, Vec<ExprId>) {
+        let n = coordinate_names.len();
+        let mut initial_q = vec![self.arena.int(0); n];
+        let mut initial_qdot = vec![self.arena.int(0); n];
+        for (name, value) in &self.file.initial {
+            let e = self.expr(value);
+            if let Some(i) = coordinate_names.iter().position(|c| *c == name.value) {
+                initial_q[i] = e;
+            } else if let Some(i) = coordinate_names
+                .iter()
+                .position(|c| name.value.strip_suffix("_dot") == Some(c.as_str()))
+            {
+                initial_qdot[i] = e;
+            } else {
+                self.errors.push(Diagnostic::new(
+                    name.location,
+                    format!("`{}` is neither a coordinate nor a rate", name.value),
+                ));
+            }
+        }
+        (initial_q, initial_qdot)
+    }
+}
+
+/// The points of a model: name and position, in file order.
+type Points = Vec<(String, Vec<ExprId>)>;
+
+/// The index of the point called `name`.
+fn point(points: &Points, name: &str) -> Option<usize> {
+    points.iter().position(|(p, _)| p == name)
+}
+
+/// `T`, `V` and the generalized forces `Q`, term by term as the sections add them.
+struct Terms {
+    /// Terms of the kinetic energy `T`.
+    kinetic: Vec<ExprId>,
+    /// Terms of the potential energy `V`.
+    potential: Vec<ExprId>,
+    /// Per coordinate, the terms of its generalized force `Qᵢ`.
+    forces: Vec<Vec<ExprId>>,
+    /// The constant ½.
+    half: ExprId,
 }
 
 /// A residual in a diagnostic: 6 significant digits, as `1`, `-0.5` or `1.2e-7`.

@@ -1,0 +1,615 @@
+//! The top-level keys of a model file, one table ([`SECTIONS`]) that says how each is read
+//! into the [`ModelFile`], and the sections about the model as a whole: its name, parameters,
+//! coordinates, expressions by name and drawing.
+
+use super::walk::{Fields, Keyed, Need};
+use super::*;
+
+/// How one top-level key of a model file is read.
+struct Section {
+    /// The key.
+    key: &'static str,
+    /// Reads its value into the model.
+    read: fn(&mut Ctx<'_>, &YamlNode, &mut ModelFile),
+    /// Reports the key missing from the file's map (`top`, which starts at the location
+    /// given); `None` when the key may be left out.
+    missing: Option<fn(&mut Ctx<'_>, &Entries, Location)>,
+}
+
+/// Every top-level key, in the order the sections are read (a section may use one read
+/// before it: `minimal_twin` the name). The order the keys are listed to the user in is
+/// [`TOP_LEVEL_KEYS`]'s.
+const SECTIONS: &[Section] = &[
+    Section {
+        key: "name",
+        read: |cx, n, file| {
+            if let Some(name) = cx.model_name(n) {
+                file.name = name;
+            }
+        },
+        missing: Some(|cx, top, at| {
+            if !misspelt(top, "name") {
+                cx.error(
+                    Diagnostic::new(at, "the model file has no `name`").with_help(
+                        "add `name: my_model` (snake_case; the generated struct is `MyModel`)",
+                    ),
+                );
+            }
+        }),
+    },
+    Section {
+        key: "description",
+        read: |cx, n, file| file.description = cx.description(n),
+        missing: None,
+    },
+    Section {
+        key: "minimal_twin",
+        read: |cx, n, file| {
+            file.minimal_twin = cx
+                .name(n, "`minimal_twin`")
+                .and_then(|twin| cx.minimal_twin(twin, &file.name));
+        },
+        missing: None,
+    },
+    Section {
+        key: "units",
+        read: |cx, n, file| {
+            file.units = cx
+                .choice(n, "`units`", &[("SI", UnitSystem::Si)])
+                .map(|u| Located::new(u, n.location));
+        },
+        missing: None,
+    },
+    Section {
+        key: "parameters",
+        read: |cx, n, file| file.parameters = cx.parameters(n),
+        missing: None,
+    },
+    Section {
+        key: "coordinates",
+        read: |cx, n, file| file.coordinates = cx.coordinates(n),
+        missing: Some(|cx, top, at| {
+            if misspelt(top, "coordinates") {
+                cx.incomplete.sections.push("coordinates".to_string());
+            } else {
+                cx.error(
+                    Diagnostic::new(at, "the model file has no `coordinates`")
+                        .with_help("list the generalized coordinates: `coordinates: [theta]`"),
+                );
+            }
+        }),
+    },
+    Section {
+        key: "kinetic",
+        read: |cx, n, file| file.kinetic = cx.expr(n, "`kinetic`"),
+        missing: None,
+    },
+    Section {
+        key: "potential",
+        read: |cx, n, file| file.potential = cx.expr(n, "`potential`"),
+        missing: None,
+    },
+    Section {
+        key: "generalized_forces",
+        read: |cx, n, file| {
+            file.generalized_forces = cx.keyed_exprs(
+                n,
+                "`generalized_forces`",
+                "generalized_forces: { x: -c*x_dot }",
+                "a generalized force",
+            );
+        },
+        missing: None,
+    },
+    Section {
+        key: "points",
+        read: |cx, n, file| file.points = cx.points(n),
+        missing: None,
+    },
+    Section {
+        key: "bodies",
+        read: |cx, n, file| file.bodies = cx.bodies(n),
+        missing: None,
+    },
+    Section {
+        key: "gravity",
+        read: |cx, n, file| {
+            file.gravity = cx
+                .vector(n, "`gravity`", "gravity: [0, -g]")
+                .map(|g| Located::new(g, n.location));
+        },
+        missing: None,
+    },
+    Section {
+        key: "springs",
+        read: |cx, n, file| file.springs = cx.springs(n),
+        missing: None,
+    },
+    Section {
+        key: "dampers",
+        read: |cx, n, file| file.dampers = cx.dampers(n),
+        missing: None,
+    },
+    Section {
+        key: "forces",
+        read: |cx, n, file| file.forces = cx.forces(n),
+        missing: None,
+    },
+    Section {
+        key: "torques",
+        read: |cx, n, file| file.torques = cx.torques(n),
+        missing: None,
+    },
+    Section {
+        key: "constraints",
+        read: |cx, n, file| {
+            file.constraints = cx.keyed_exprs(
+                n,
+                "`constraints`",
+                "constraints: { rod: sqrt(x^2 + y^2) - l }",
+                "a holonomic constraint",
+            );
+        },
+        missing: None,
+    },
+    Section {
+        key: "nonholonomic",
+        read: |cx, n, file| {
+            file.nonholonomic = cx.keyed_exprs(
+                n,
+                "`nonholonomic`",
+                "nonholonomic: { no_side_slip: -sin(theta)*x_dot + cos(theta)*y_dot }",
+                "a non-holonomic constraint",
+            );
+        },
+        missing: None,
+    },
+    Section {
+        key: "initial",
+        read: |cx, n, file| (file.initial, file.initial_guesses) = cx.initial(n),
+        missing: None,
+    },
+    Section {
+        key: "draw",
+        read: |cx, n, file| file.draw = cx.draw(n),
+        missing: None,
+    },
+    Section {
+        key: "balances",
+        read: |cx, n, file| file.balances = cx.balances(n),
+        missing: None,
+    },
+    Section {
+        key: "checks",
+        read: |cx, n, file| file.checks = cx.checks(n),
+        missing: None,
+    },
+    Section {
+        key: "events",
+        read: |cx, n, file| file.events = cx.events(n),
+        missing: None,
+    },
+    Section {
+        key: "equilibria",
+        read: |cx, n, file| file.equilibria = cx.equilibria(n),
+        missing: None,
+    },
+    Section {
+        key: "floquet",
+        read: |cx, n, file| file.floquet = cx.floquet(n),
+        missing: None,
+    },
+];
+
+/// The keys of a parameter written as a map.
+const PARAMETER: Fields = Fields {
+    kind: "parameter",
+    keys: &[("value", Need::Required), ("unit", Need::Optional)],
+    example: "{ value: 1.0, unit: kg }",
+};
+
+impl Ctx<'_> {
+    /// The model of the file whose tree is `root`: reports keys planned for later and unknown
+    /// keys, then reads every section of [`SECTIONS`] in turn, with what a section left out
+    /// recorded under its key.
+    pub(super) fn model(&mut self, path: &str, root: &YamlNode) -> Option<ModelFile> {
+        let YamlKind::Map(top) = &root.kind else {
+            self.error(
+                Diagnostic::new(
+                    root.location,
+                    format!(
+                        "a model file must be a map of `key: value`, found {}",
+                        root.kind.describe()
+                    ),
+                )
+                .with_help("start with `name: my_model` and `coordinates: [q]`"),
+            );
+            return None;
+        };
+
+        // Rule: keys planned for later versions are recognised and reported once each.
+        for (k, _) in top {
+            if LATER_KEYS.contains(&k.value.as_str()) {
+                self.error(
+                    Diagnostic::new(
+                        k.location,
+                        format!(
+                            "`{}:` is not supported yet by this version of eomgen",
+                            k.value
+                        ),
+                    )
+                    .with_help("it is planned; remove it for now"),
+                );
+            }
+        }
+        let allowed: Vec<&str> = TOP_LEVEL_KEYS.iter().chain(LATER_KEYS).copied().collect();
+        self.unknown_keys(top, "a model file", &allowed, TOP_LEVEL_KEYS);
+
+        let mut file = ModelFile {
+            path: path.to_string(),
+            // A model without a valid name is named "" at the top of the file.
+            name: Located::new(String::new(), root.location),
+            description: String::new(),
+            minimal_twin: None,
+            units: None,
+            parameters: Vec::new(),
+            coordinates: Vec::new(),
+            kinetic: None,
+            potential: None,
+            generalized_forces: Vec::new(),
+            points: Vec::new(),
+            bodies: Vec::new(),
+            gravity: None,
+            springs: Vec::new(),
+            dampers: Vec::new(),
+            forces: Vec::new(),
+            torques: Vec::new(),
+            initial: Vec::new(),
+            draw: Draw::default(),
+            dimension: None,
+            balances: Vec::new(),
+            checks: Checks::default(),
+            constraints: Vec::new(),
+            nonholonomic: Vec::new(),
+            initial_guesses: Vec::new(),
+            events: Vec::new(),
+            equilibria: Vec::new(),
+            floquet: Vec::new(),
+        };
+        for section in SECTIONS {
+            self.section = section.key;
+            match get(top, section.key) {
+                Some(node) => (section.read)(self, node, &mut file),
+                None => {
+                    if let Some(missing) = section.missing {
+                        missing(self, top, root.location);
+                    }
+                }
+            }
+        }
+        self.section = "";
+        file.dimension = file.points.first().map(|p| p.position.len());
+        Some(file)
+    }
+
+    /// `name:` — the model's snake_case name.
+    fn model_name(&mut self, node: &YamlNode) -> Option<Located<String>> {
+        let n = self.name(node, "`name`")?;
+        if is_snake_case(&n.value) {
+            return Some(n);
+        }
+        let d = Diagnostic::new(
+            n.location,
+            format!("`name` must be snake_case, found `{}`", n.value),
+        )
+        .with_help(format!(
+            "write `name: {}`; the generated struct takes its UpperCamelCase form",
+            to_snake_case(&n.value)
+        ));
+        self.error(d);
+        None
+    }
+
+    /// `description:` — a text, empty when left empty.
+    fn description(&mut self, node: &YamlNode) -> String {
+        if node.kind == YamlKind::Null {
+            return String::new();
+        }
+        // A folded (`>`) description ends with a line break; keep the text only.
+        self.text(
+            node,
+            "`description`",
+            "description: A pendulum of length l.",
+        )
+        .map(|d| d.value.trim().to_string())
+        .unwrap_or_default()
+    }
+
+    /// `minimal_twin:` — the snake_case name of another model, the same mechanism in minimal
+    /// coordinates. Rule: it is a snake_case name (a bundled model's) and not the model's own.
+    pub(super) fn minimal_twin(
+        &mut self,
+        twin: Located<String>,
+        name: &Located<String>,
+    ) -> Option<Located<String>> {
+        if !is_snake_case(&twin.value) {
+            let d = Diagnostic::new(
+                twin.location,
+                format!(
+                    "`minimal_twin` must be the snake_case name of a bundled model, found `{}`",
+                    twin.value
+                ),
+            )
+            .with_help("write `minimal_twin: simple_pendulum` (see `eomgen list`)");
+            self.error(d);
+            return None;
+        }
+        if twin.value == name.value {
+            let d = Diagnostic::new(
+                twin.location,
+                format!("`minimal_twin` names the model itself, `{}`", twin.value),
+            )
+            .with_help("name the model with the same mechanism in minimal coordinates, or leave the key out");
+            self.error(d);
+            return None;
+        }
+        Some(twin)
+    }
+
+    /// `parameters:` — `name: default` or `name: { value, unit }`.
+    pub(super) fn parameters(&mut self, node: &YamlNode) -> Vec<Parameter> {
+        // How many entries are written on each line (an entry counts once for each line its
+        // key and value are on): counted once, so that the whole section is linear in its
+        // number of parameters.
+        let mut per_line: HashMap<u32, usize> = HashMap::new();
+        if let YamlKind::Map(entries) = &node.kind {
+            for (k, v) in entries {
+                *per_line.entry(k.location.line).or_default() += 1;
+                if v.location.line != k.location.line {
+                    *per_line.entry(v.location.line).or_default() += 1;
+                }
+            }
+        }
+        let spec = Keyed {
+            what: "`parameters`",
+            example: "parameters: { m: 1.0, g: 9.81 }",
+            names: Some("parameter"),
+            drop: true,
+        };
+        self.keyed(node, spec, |cx, k, v| cx.parameter(k, v, &per_line))
+    }
+
+    /// One parameter, `name: default  # unit` or `name: { value, unit }`; `per_line` counts
+    /// the entries written on each line (see [`Ctx::parameters`]).
+    pub(super) fn parameter(
+        &mut self,
+        k: &Located<String>,
+        v: &YamlNode,
+        per_line: &HashMap<u32, usize>,
+    ) -> Option<Parameter> {
+        // The map form `{ value: 1.0, unit: N/m }`.
+        let mut unit_key = None;
+        let v = if let YamlKind::Map(_) = &v.kind {
+            let f = self.fields(k, v, &PARAMETER)?;
+            if let Some(u) = get(f, "unit") {
+                let what = format!("the unit of parameter `{}`", k.value);
+                unit_key = Some(self.text(u, &what, "unit: N/m")?);
+            }
+            get(f, "value")?
+        } else {
+            v
+        };
+        if v.kind == YamlKind::Null {
+            self.error(
+                Diagnostic::new(
+                    k.location,
+                    format!("parameter `{}` has no default value", k.value),
+                )
+                .with_help(format!("give one, as in `{}: 1.0  # kg`", k.value)),
+            );
+            return None;
+        }
+        let default = self.expr(v, &format!("the default of parameter `{}`", k.value))?;
+        // Rule: parameter defaults are constant (numbers, `pi`, functions); they may not
+        // refer to other parameters, coordinates or `t`.
+        let mut names = Vec::new();
+        identifiers(&default, &mut names);
+        if let Some((n, at)) = names.into_iter().find(|(n, _)| n != "pi") {
+            self.error(
+                Diagnostic::new(
+                    at,
+                    format!(
+                        "parameter defaults must be constant, but the default of `{}` uses `{n}`",
+                        k.value
+                    ),
+                )
+                .with_help("use numbers, `pi` and functions of them, as in `9.81`, `pi/4` or `sqrt(2)`; a default cannot refer to another parameter or a coordinate"),
+            );
+            return None;
+        }
+        let value = match eval_expr(&default, &|_| None) {
+            Ok(value) => value,
+            Err(d) => {
+                self.error(d);
+                return None;
+            }
+        };
+        if !value.is_finite() {
+            self.error(
+                Diagnostic::new(
+                    v.location,
+                    format!(
+                        "parameter `{}` has the non-finite default `{value}`",
+                        k.value
+                    ),
+                )
+                .with_help("a default must evaluate to a finite number"),
+            );
+            return None;
+        }
+        // The unit is the comment at the end of the value's line, if no other parameter
+        // shares that line (`parameters: { m: 1, g: 9.81 }  # SI` names no unit).
+        let line = v.location.line;
+        let shared = per_line.get(&line).copied().unwrap_or(0) > 1;
+        let unit = if unit_key.is_some() || shared {
+            unit_key
+        } else {
+            let text = self.line(line);
+            trailing_comment_of_line(text).map(|c| {
+                let at = comment_location(text, line, &c);
+                Located::new(c, at)
+            })
+        };
+        Some(Parameter {
+            name: k.clone(),
+            default,
+            value,
+            unit,
+        })
+    }
+
+    /// `coordinates:` — a list of names, each possibly `{ name, unit }`, whose trailing
+    /// comments describe them.
+    pub(super) fn coordinates(&mut self, node: &YamlNode) -> Vec<Coordinate> {
+        let items = match &node.kind {
+            YamlKind::Seq(items) => items,
+            other => {
+                self.error(
+                    Diagnostic::new(
+                        node.location,
+                        format!("`coordinates` must be a list of names, found {}", other.describe()),
+                    )
+                    .with_help("write `coordinates: [theta1, theta2]`, or one `- theta1  # comment` per line"),
+                );
+                return Vec::new();
+            }
+        };
+        // How many coordinates start on each line, counted once (not per coordinate, which
+        // was quadratic in a long one-line list).
+        let mut per_line: HashMap<u32, usize> = HashMap::new();
+        for item in items {
+            *per_line.entry(item.location.line).or_default() += 1;
+        }
+        let mut out = Vec::new();
+        for item in items {
+            // The map form `{ name: x, unit: m }`.
+            let mut unit = None;
+            let named = if let YamlKind::Map(f) = &item.kind {
+                const EXAMPLE: &str = "{ name: x, unit: m }";
+                self.unknown_keys(f, "a coordinate", &["name", "unit"], &["name", "unit"]);
+                if !self.require(f, item.location, "a coordinate", &["name"], EXAMPLE) {
+                    continue;
+                }
+                if let Some(u) = get(f, "unit") {
+                    unit = self.text(u, "the unit of a coordinate", "unit: m");
+                }
+                match get(f, "name") {
+                    Some(n) => n,
+                    None => continue,
+                }
+            } else {
+                item
+            };
+            let Some(n) = self.name(named, "a coordinate") else {
+                if let YamlKind::Scalar { text, .. } = &named.kind {
+                    self.drop_name(text);
+                }
+                continue;
+            };
+            // A trailing comment describes the coordinate only if it is alone on its line.
+            let alone = per_line[&item.location.line] == 1;
+            let comment = if alone {
+                trailing_comment_of_line(self.line(n.location.line))
+            } else {
+                None
+            };
+            out.push(Coordinate {
+                name: n,
+                comment,
+                unit,
+            });
+        }
+        // Rule: at most `MAX_COORDINATES` coordinates. The list is kept, so that the rest of
+        // the file is checked against it (in time linear in its length) and this is the one
+        // error of an otherwise sound file.
+        if out.len() > MAX_COORDINATES {
+            self.error(
+                Diagnostic::new(
+                    node.location,
+                    format!(
+                        "the model has {} generalized coordinates, more than the {MAX_COORDINATES} a model may have: its mass matrix is derived and evaluated as a dense {}×{} matrix",
+                        out.len(),
+                        out.len(),
+                        out.len()
+                    ),
+                )
+                .with_help(format!(
+                    "use at most {MAX_COORDINATES} coordinates (a chain of {MAX_COORDINATES} masses loads, checks and takes its first step in seconds)"
+                )),
+            );
+        }
+        out
+    }
+
+    /// A map of names to expressions (`generalized_forces`, `constraints`, `nonholonomic`):
+    /// `what` names it and `example` writes it in messages, `item` names one value.
+    pub(super) fn keyed_exprs(
+        &mut self,
+        node: &YamlNode,
+        what: &str,
+        example: &str,
+        item: &str,
+    ) -> Vec<(Located<String>, Expr)> {
+        let spec = Keyed {
+            what,
+            example,
+            names: None,
+            drop: false,
+        };
+        self.keyed(node, spec, |cx, k, v| {
+            let e = cx.expr(v, &format!("{item} (`{}`)", k.value))?;
+            Some((k.clone(), e))
+        })
+    }
+
+    /// `draw:` — `{ lines: [[A, B], …], trace: [P, …] }`.
+    pub(super) fn draw(&mut self, node: &YamlNode) -> Draw {
+        let mut draw = Draw::default();
+        let Some(f) = self.map(node, "`draw`", "draw: { lines: [[O, P]], trace: [P] }") else {
+            return draw;
+        };
+        self.unknown_keys(f, "`draw`", &["lines", "trace"], &["lines", "trace"]);
+        if let Some(lines) =
+            get(f, "lines").and_then(|n| self.seq(n, "`lines`", "lines: [[O, E], [E, H]]"))
+        {
+            for l in lines {
+                if let Some(pair) = self.point_pair(l, "a line") {
+                    draw.lines.push(pair);
+                }
+            }
+        }
+        if let Some(trace) = get(f, "trace").and_then(|n| self.seq(n, "`trace`", "trace: [H]")) {
+            for p in trace {
+                if let Some(n) = self.name(p, "a traced point") {
+                    draw.trace.push(n);
+                }
+            }
+        }
+        draw
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every top-level key has exactly one reader, and every reader a listed key.
+    #[test]
+    fn every_top_level_key_has_one_section() {
+        let mut read: Vec<&str> = SECTIONS.iter().map(|s| s.key).collect();
+        let mut listed = TOP_LEVEL_KEYS.to_vec();
+        read.sort_unstable();
+        listed.sort_unstable();
+        assert_eq!(read, listed);
+    }
+}

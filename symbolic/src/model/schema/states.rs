@@ -1,0 +1,154 @@
+//! The states of a model named in its file: the initial state, events (functions of the
+//! state that cross zero) and equilibria.
+
+use super::walk::{Fields, Keyed, Need};
+use super::*;
+
+/// The keys of an event written as a map.
+const EVENT: Fields = Fields {
+    kind: "event",
+    keys: &[
+        ("when", Need::Required),
+        ("direction", Need::Optional),
+        ("terminal", Need::Optional),
+    ],
+    example: "{ when: theta_dot, direction: falling, terminal: false }",
+};
+
+impl Ctx<'_> {
+    /// `initial:` — values, or `{ guess: value }` for coordinates solved from the constraints.
+    pub(super) fn initial(&mut self, node: &YamlNode) -> (KeyedExprs, Vec<Located<String>>) {
+        let spec = Keyed {
+            what: "`initial`",
+            example: "initial: { theta: pi/2, theta_dot: 0 }",
+            names: None,
+            drop: false,
+        };
+        let entries = self.keyed(node, spec, |cx, k, v| {
+            let what = format!("an initial value (`{}`)", k.value);
+            if let YamlKind::Map(inner) = &v.kind {
+                if inner.len() == 1 && inner[0].0.value == "guess" {
+                    let e = cx.expr(&inner[0].1, &what)?;
+                    Some((k.clone(), e, true))
+                } else {
+                    cx.error(
+                        Diagnostic::new(v.location, format!("{what} is an expression or `{{ guess: value }}`"))
+                            .with_help("`{ guess: 0.5 }` marks a starting guess that the runtime corrects to satisfy the constraints"),
+                    );
+                    None
+                }
+            } else {
+                let e = cx.expr(v, &what)?;
+                Some((k.clone(), e, false))
+            }
+        });
+        let guesses = entries
+            .iter()
+            .filter(|(_, _, guess)| *guess)
+            .map(|(k, _, _)| k.clone())
+            .collect();
+        let values = entries.into_iter().map(|(k, e, _)| (k, e)).collect();
+        (values, guesses)
+    }
+
+    /// `events:` — `name: g` or `name: { when: g, direction: rising|falling|both,
+    /// terminal: true|false }`, where `g` is an expression (the event is `g = 0`) or an
+    /// equation `lhs = rhs`.
+    pub(super) fn events(&mut self, node: &YamlNode) -> Vec<EventDef> {
+        let example = format!("events: {{ peak: {} }}", EVENT.example);
+        let spec = Keyed {
+            what: "`events`",
+            example: &example,
+            names: Some("event"),
+            drop: false,
+        };
+        self.keyed(node, spec, |cx, k, v| {
+            let what = format!("the function of event `{}`", k.value);
+            if !matches!(v.kind, YamlKind::Map(_)) {
+                let when = cx.event_function(v, &what)?;
+                return Some(EventDef {
+                    name: k.clone(),
+                    when,
+                    direction: Crossing::Both,
+                    terminal: false,
+                });
+            }
+            let f = cx.fields(k, v, &EVENT)?;
+            let when = get(f, "when").and_then(|n| cx.event_function(n, &what));
+            let direction = match get(f, "direction") {
+                None => Some(Crossing::Both),
+                Some(n) => cx.choice(
+                    n,
+                    &format!("the direction of event `{}`", k.value),
+                    &[
+                        ("rising", Crossing::Rising),
+                        ("falling", Crossing::Falling),
+                        ("both", Crossing::Both),
+                    ],
+                ),
+            };
+            let terminal = match get(f, "terminal") {
+                None => Some(false),
+                Some(n) => cx.choice(
+                    n,
+                    &format!("`terminal` of event `{}`", k.value),
+                    &[("true", true), ("false", false)],
+                ),
+            };
+            Some(EventDef {
+                name: k.clone(),
+                when: when?,
+                direction: direction?,
+                terminal: terminal?,
+            })
+        })
+    }
+
+    /// The function of an event: an expression `g` (the event is `g = 0`), or an equation
+    /// `lhs = rhs`, which means `lhs − rhs = 0` (as `--stop-when "y = 0"` on the command line).
+    pub(super) fn event_function(&mut self, node: &YamlNode, what: &str) -> Option<Expr> {
+        let (lhs, rhs) = self.sides(
+            node,
+            what,
+            "write the event as one expression that crosses zero, such as `y` or `x = l`",
+        )?;
+        Some(match rhs {
+            None => lhs,
+            // The `=` is not kept: the difference is located at its right side.
+            Some(rhs) => Expr {
+                location: lhs.location,
+                kind: ExprKind::Binary {
+                    op: BinOp::Sub,
+                    op_location: rhs.location,
+                    lhs: Box::new(lhs),
+                    rhs: Box::new(rhs),
+                },
+            },
+        })
+    }
+
+    /// `equilibria:` — `name: { coordinate: value, … }`.
+    pub(super) fn equilibria(&mut self, node: &YamlNode) -> Vec<EquilibriumDef> {
+        let spec = Keyed {
+            what: "`equilibria`",
+            example: "equilibria: { hanging: { theta: 0 }, upright: { theta: pi } }",
+            names: Some("equilibrium"),
+            drop: false,
+        };
+        self.keyed(node, spec, |cx, k, v| {
+            let what = format!("equilibrium `{}`", k.value);
+            let values = cx.map(v, &what, &format!("{}: {{ theta: pi }}", k.value))?;
+            let values = values
+                .iter()
+                .filter_map(|(c, e)| {
+                    let e = cx.expr(e, &format!("the value of `{}` in {what}", c.value))?;
+                    Some((c.clone(), e))
+                })
+                .collect();
+            Some(EquilibriumDef {
+                name: k.clone(),
+                values,
+            })
+        })
+    }
+}

@@ -1,0 +1,198 @@
+//! The scaffold that every keyed part of a model file shares, written once: a map whose keys
+//! are checked against a list, a map of named entries walked entry by entry ([`Keyed`]), and
+//! the keys of one entry with the ones it needs ([`Fields`]).
+//!
+//! A section's reader then only says how each of its values is read; what is reported for
+//! a wrong shape, an unknown key or a missing one, and where, is decided here.
+
+use super::*;
+
+/// Whether an entry must have a key.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum Need {
+    /// Reported when missing.
+    Required,
+    /// May be left out.
+    Optional,
+}
+
+/// The keys of one kind of entry (a spring, a check, …): every key it takes, in the order
+/// messages list them, and whether it needs it.
+pub(super) struct Fields {
+    /// What the entry is, for messages: `"spring"`.
+    pub(super) kind: &'static str,
+    /// Its keys.
+    pub(super) keys: &'static [(&'static str, Need)],
+    /// How to write one, after `name: ` (`{ between: [A, B], stiffness: k }`).
+    pub(super) example: &'static str,
+}
+
+/// A map of named entries (`springs: { s1: {…}, s2: {…} }`): how [`Ctx::keyed`] walks it.
+pub(super) struct Keyed<'a> {
+    /// The map as messages name it (`` `springs` ``).
+    pub(super) what: &'a str,
+    /// The map written out, for the message when it is not a map.
+    pub(super) example: &'a str,
+    /// What an entry is called when its key must be a name (`"point"`); `None` when any key
+    /// is taken as it is.
+    pub(super) names: Option<&'a str>,
+    /// Whether an entry that cannot be read is recorded as left out ([`Incomplete::names`]).
+    pub(super) drop: bool,
+}
+
+/// The value of `key` in `entries`.
+pub(super) fn get<'n>(entries: &'n Entries, key: &str) -> Option<&'n YamlNode> {
+    entries.iter().find(|(k, _)| k.value == key).map(|(_, v)| v)
+}
+
+/// Whether `entries` has a key that is a misspelling of the missing key `key`: it is then
+/// reported once, as an unknown key with "did you mean `key`?", not also as missing.
+pub(super) fn misspelt(entries: &Entries, key: &str) -> bool {
+    entries
+        .iter()
+        .any(|(k, _)| k.value != key && closest(&k.value, &[key]).is_some())
+}
+
+/// The key `key` itself, for its location.
+pub(super) fn get_key<'n>(entries: &'n Entries, key: &str) -> Option<&'n Located<String>> {
+    entries.iter().find(|(k, _)| k.value == key).map(|(k, _)| k)
+}
+
+/// The keys present, for messages: `` `inertia`, `com` ``.
+pub(super) fn listed(entries: &Entries) -> String {
+    if entries.is_empty() {
+        return "nothing".to_string();
+    }
+    entries
+        .iter()
+        .map(|(k, _)| format!("`{}`", k.value))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+impl Ctx<'_> {
+    /// Walks the map of named entries `node`: reports a value that is not a map and keys that
+    /// are not names (when `spec` asks for names), and reads each entry with `read`, in file
+    /// order; the entries read.
+    pub(super) fn keyed<T>(
+        &mut self,
+        node: &YamlNode,
+        spec: Keyed<'_>,
+        mut read: impl FnMut(&mut Self, &Located<String>, &YamlNode) -> Option<T>,
+    ) -> Vec<T> {
+        let Some(entries) = self.map(node, spec.what, spec.example) else {
+            return Vec::new();
+        };
+        let mut out = Vec::new();
+        for (k, v) in entries {
+            if let Some(names) = spec.names
+                && !self.key_name(k, names)
+            {
+                continue;
+            }
+            match read(self, k, v) {
+                Some(entry) => out.push(entry),
+                None if spec.drop => self.drop_name(&k.value),
+                None => {}
+            }
+        }
+        out
+    }
+
+    /// The fields of the entry `k: v` of kind `spec`, or `None` if it is not a map or lacks a
+    /// key it needs; reports the keys it does not take.
+    pub(super) fn fields<'n>(
+        &mut self,
+        k: &Located<String>,
+        v: &'n YamlNode,
+        spec: &Fields,
+    ) -> Option<&'n Entries> {
+        let allowed: Vec<&str> = spec.keys.iter().map(|(key, _)| *key).collect();
+        let required: Vec<&str> = spec
+            .keys
+            .iter()
+            .filter(|(_, need)| *need == Need::Required)
+            .map(|(key, _)| *key)
+            .collect();
+        let what = format!("{} `{}`", spec.kind, k.value);
+        let example = format!("{}: {}", k.value, spec.example);
+        let f = self.map(v, &what, &example)?;
+        self.unknown_keys(f, &what, &allowed, &allowed);
+        self.require(f, k.location, &what, &required, &example)
+            .then_some(f)
+    }
+
+    /// Reports every key of `entries` that is not in `allowed`.
+    pub(super) fn unknown_keys(
+        &mut self,
+        entries: &Entries,
+        what: &str,
+        allowed: &[&str],
+        listed: &[&str],
+    ) {
+        for (k, _) in entries {
+            if allowed.contains(&k.value.as_str()) {
+                continue;
+            }
+            let d = Diagnostic::new(k.location, format!("unknown key `{}` in {what}", k.value));
+            let d = match closest(&k.value, allowed) {
+                Some(c) => d.with_help(format!(
+                    "did you mean `{c}`? {what} takes: {}",
+                    listed.join(", ")
+                )),
+                None => d.with_help(format!("{what} takes: {}", listed.join(", "))),
+            };
+            self.error(d);
+        }
+    }
+
+    /// Reports every key of `required` missing from `entries`; `Ok` when none is missing.
+    pub(super) fn require(
+        &mut self,
+        entries: &Entries,
+        at: Location,
+        what: &str,
+        required: &[&str],
+        example: &str,
+    ) -> bool {
+        let mut complete = true;
+        for r in required {
+            if get(entries, r).is_none() {
+                complete = false;
+                if misspelt(entries, r) {
+                    continue;
+                }
+                self.error(
+                    Diagnostic::new(at, format!("{what} has no `{r}`")).with_help(format!(
+                        "found {}; write it like `{example}`",
+                        listed(entries)
+                    )),
+                );
+            }
+        }
+        complete
+    }
+
+    /// The entries of the map `node` (none for an empty value); reports anything else.
+    pub(super) fn map<'n>(
+        &mut self,
+        node: &'n YamlNode,
+        what: &str,
+        example: &str,
+    ) -> Option<&'n Entries> {
+        match &node.kind {
+            YamlKind::Map(e) => Some(e),
+            YamlKind::Null => Some(&[]),
+            other => {
+                self.error(
+                    Diagnostic::new(
+                        node.location,
+                        format!("{what} must be a map, found {}", other.describe()),
+                    )
+                    .with_help(format!("write it like `{example}`")),
+                );
+                None
+            }
+        }
+    }
+}
