@@ -23,8 +23,7 @@ pub mod vibration;
 
 pub use analysis::{Method, UnknownMethod};
 pub use constrained::{
-    ConstraintWorkspace, MAX_BAUMGARTE_GAIN, ProjectionError, Stabilization,
-    StabilizationError,
+    ConstraintWorkspace, MAX_BAUMGARTE_GAIN, ProjectionError, Stabilization, StabilizationError,
 };
 pub use dynamic::{DynMechanicalSystem, StaticSystem};
 pub use eomgen_description::{List, Parameter, Text};
