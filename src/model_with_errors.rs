@@ -5,7 +5,7 @@
 //! still type-checks and the errors of the file are the only ones the user reads (rather
 //! than "cannot find type `Name`" at every use). The crate cannot be built while those
 //! errors stand, so no value of this type is ever evaluated: its methods return an empty
-//! description and zeros only to satisfy the trait.
+//! description (no coordinates, although `N` may be more) and zeros only to satisfy the trait.
 
 use std::borrow::Cow;
 

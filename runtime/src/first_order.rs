@@ -45,6 +45,9 @@ impl<S: MechanicalSystem<N>, const N: usize> FirstOrder<S, N> {
     /// Wraps `system`.
     pub fn new(system: S) -> Self {
         let description = system.description();
+        // The description names the `N` coordinates the compiled functions take (a
+        // hand-written model built from `ModelDescription::EMPTY` must list them too).
+        debug_assert_eq!(description.num_dofs(), N, "the description's coordinates");
         let m = description.constraints.len();
         let holonomic = description.holonomic_constraints;
         let events = description.events.to_vec();

@@ -26,7 +26,7 @@ pub use constrained::{
     ConstraintWorkspace, MAX_BAUMGARTE_GAIN, ProjectionError, Stabilization, StabilizationError,
 };
 pub use dynamic::{DynMechanicalSystem, StaticSystem};
-pub use eomgen_description::{List, Parameter, Text};
+pub use eomgen_description::Parameter;
 pub use first_order::{DynFirstOrder, FirstOrder};
 pub use floquet::{
     FloquetAnalysis, FloquetError, FloquetOptions, FloquetStability, LARGEST_STABILITY_TOLERANCE,

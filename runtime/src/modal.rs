@@ -245,7 +245,7 @@ pub struct Equilibrium {
     pub q: Vec<f64>,
     /// `lagrange_multipliers` `λ*` of the holonomic constraints at `q*` (length `m`; empty
     /// for an unconstrained model): the constraint forces that hold the mechanism at rest, in
-    /// the sign convention of [`MechanicalSystem::constraint_names`](crate::MechanicalSystem::constraint_names).
+    /// the sign convention of [`ModelDescription::constraints`](crate::ModelDescription::constraints).
     pub lagrange_multipliers: Vec<f64>,
     /// Newton iterations used.
     pub iterations: usize,

@@ -130,7 +130,7 @@ pub trait MechanicalSystem<const N: usize> {
     }
 
     /// The guesses of [`ModelDescription::equilibria`], `N` coordinates each, one after the other
-    /// (`out` has `N · equilibrium_names().len()` entries).
+    /// (`out` has `N · description().equilibria.len()` entries).
     fn equilibrium_guesses(&self, out: &mut [f64]) {
         let _ = out;
     }

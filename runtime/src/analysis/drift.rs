@@ -156,7 +156,7 @@ impl ConstraintDrift {
 /// `solution`, by [`ModelInfo::constraint_forces`] and [`ModelInfo::constraint_drift`].
 ///
 /// # Shapes
-/// One entry per sample; `λ` has `m = model.constraint_names().len()` entries.
+/// One entry per sample; `λ` has `m = model.description().constraints.len()` entries.
 ///
 /// # Examples
 /// The cartesian pendulum (`x² + y² = l²`) integrated without stabilisation drifts off

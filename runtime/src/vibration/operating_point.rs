@@ -81,7 +81,7 @@ pub struct OperatingPointOptions {
 pub struct OperatingPoint {
     /// The equilibrium's name from `equilibria:`, the guess's label, or `q = 0`.
     pub name: String,
-    /// The model's `coordinate_names` (length `n`), the order of `q` and `guess`.
+    /// The model's coordinates (`description().coordinates`, length `n`), the order of `q` and `guess`.
     pub coordinates: Vec<String>,
     /// Newton's starting coordinates (length `n`).
     pub guess: Vec<f64>,
