@@ -257,7 +257,7 @@ fn timed(model: &mut SymbolicModel, f: &dyn Formulation) -> (EquationsOfMotion, 
 }
 
 /// Derives `file` by every applicable formulation and cross-checks them at `states` random
-/// states (q and q̇ in the [`StateBox`](super::lower::StateBox) about their start: within
+/// states (q and q̇ in the `StateBox` about their start: within
 /// `2 max(1, |start|)` of it; t in [0, 5]; parameters within ±10 % of their defaults, or in
 /// [0.1, 0.5] where the default is 0).
 /// A state is compared where Lagrange's `M` and `F` are finite and `M` is regular

@@ -5,13 +5,15 @@
 //! left out, and what was left out is recorded in [`Incomplete`] so that the cross-object
 //! checks ([`super::check`]) do not report its consequences a second time.
 //!
-//! One scaffold ([`walk`]) reads every keyed part of a file: [`sections`] holds the table of
+//! One scaffold (`walk`) reads every keyed part of a file: `sections` holds the table of
 //! top-level keys and the sections about the model as a whole, and each group of sections
-//! has its file — the mechanism ([`mechanics`]), initial state, events and equilibria
-//! ([`states`]), `checks:` ([`checks`]) and `floquet:` ([`floquet`]). How a single value is
-//! read (a name, an expression, a vector) is in [`values`].
+//! has its file — the mechanism (`mechanics`), initial state, events and equilibria
+//! (`states`), `checks:` (`checks`) and `floquet:` (`floquet`). How a single value is
+//! read (a name, an expression, a vector) is in `values`; lookups in a map's entries in
+//! `entries`.
 
 mod checks;
+mod entries;
 mod floquet;
 mod mechanics;
 mod sections;
@@ -27,9 +29,7 @@ use super::file::*;
 use super::located::{Located, Location};
 use super::parser::{closest, eval_expr, identifiers, parse_expr_mapped};
 use super::yaml::{YamlKind, YamlNode, char_locations_in_lines, trailing_comment_of_line};
-use walk::{get, get_key, misspelt};
-
-type Entries = [(Located<String>, YamlNode)];
+use entries::{Entries, get, get_key, misspelt};
 
 /// Expressions by name, in file order.
 type KeyedExprs = Vec<(Located<String>, Expr)>;

@@ -5,6 +5,7 @@
 //! A section's reader then only says how each of its values is read; what is reported for
 //! a wrong shape, an unknown key or a missing one, and where, is decided here.
 
+use super::entries::listed;
 use super::*;
 
 /// Whether an entry must have a key.
@@ -38,36 +39,6 @@ pub(super) struct Keyed<'a> {
     pub(super) names: Option<&'a str>,
     /// Whether an entry that cannot be read is recorded as left out ([`Incomplete::names`]).
     pub(super) drop: bool,
-}
-
-/// The value of `key` in `entries`.
-pub(super) fn get<'n>(entries: &'n Entries, key: &str) -> Option<&'n YamlNode> {
-    entries.iter().find(|(k, _)| k.value == key).map(|(_, v)| v)
-}
-
-/// Whether `entries` has a key that is a misspelling of the missing key `key`: it is then
-/// reported once, as an unknown key with "did you mean `key`?", not also as missing.
-pub(super) fn misspelt(entries: &Entries, key: &str) -> bool {
-    entries
-        .iter()
-        .any(|(k, _)| k.value != key && closest(&k.value, &[key]).is_some())
-}
-
-/// The key `key` itself, for its location.
-pub(super) fn get_key<'n>(entries: &'n Entries, key: &str) -> Option<&'n Located<String>> {
-    entries.iter().find(|(k, _)| k.value == key).map(|(k, _)| k)
-}
-
-/// The keys present, for messages: `` `inertia`, `com` ``.
-pub(super) fn listed(entries: &Entries) -> String {
-    if entries.is_empty() {
-        return "nothing".to_string();
-    }
-    entries
-        .iter()
-        .map(|(k, _)| format!("`{}`", k.value))
-        .collect::<Vec<_>>()
-        .join(", ")
 }
 
 impl Ctx<'_> {
