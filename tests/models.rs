@@ -337,7 +337,7 @@ fn constraint_functions_match_finite_differences() {
                     (fd - expected).abs() <= 1e-6 * 1f64.max(expected.abs()),
                     "{} {}: d/dt velocity residual {fd} vs J a − γ {expected}",
                     entry.name,
-                    model.description().constraint_names()[i]
+                    model.description().constraints[i]
                 );
                 if i < mh {
                     let fd = (cp.phi[i] - cm.phi[i]) / (2.0 * h);
@@ -345,7 +345,7 @@ fn constraint_functions_match_finite_differences() {
                         (fd - c.velocity[i]).abs() <= 1e-6 * 1f64.max(fd.abs()),
                         "{} {}: dΦ/dt {fd} vs velocity residual {}",
                         entry.name,
-                        model.description().constraint_names()[i],
+                        model.description().constraints[i],
                         c.velocity[i]
                     );
                     for k in 0..n {

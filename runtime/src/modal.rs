@@ -746,7 +746,7 @@ pub fn time_dependence(
     let i = difference.iamax();
     Ok(Some(TimeDependentForcing {
         t0,
-        coordinate: model.description().coordinate_names()[i].to_string(),
+        coordinate: model.description().coordinates[i].to_string(),
         largest_change: difference[i].abs(),
         t: times[k],
     }))
@@ -1072,7 +1072,7 @@ pub fn linearize(
         .fold((0, 0.0f64), |b, x| if x.1 > b.1 { x } else { b });
     if residual > 1e-8 {
         return Err(ModalError::OffConstraints {
-            constraint: model.description().constraint_names()[worst].to_string(),
+            constraint: model.description().constraints[worst].to_string(),
             residual,
         });
     }

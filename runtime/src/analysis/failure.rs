@@ -324,7 +324,7 @@ fn vanishing_inertia(model: &dyn ModelInfo, t: f64, y: &[f64], y0: &[f64]) -> Op
         .min_by(|a, b| a.1.total_cmp(&b.1))?;
     (fraction <= DROP).then(|| FailureCause::InertiaVanishes {
         t,
-        coordinate: model.description().coordinate_names()[i].to_string(),
+        coordinate: model.description().coordinates[i].to_string(),
         diagonal: now[(i, i)],
         start: start[(i, i)],
     })

@@ -358,7 +358,7 @@ fn check_period_parameter(
     time_dependence: TimeDependence,
 ) -> Result<bool, FloquetStudyError> {
     let ys = probe_states(model, q);
-    let name = model.description().parameter_names()[index].to_string();
+    let name = model.description().parameters[index].name.to_string();
     let frequency = model.parameter_values()[index];
     let time_dependent = depends_on_time(model, &ys, frequency);
     if !time_dependent && time_dependence == TimeDependence::Required {
