@@ -9,17 +9,13 @@ pub mod analysis;
 pub mod constrained;
 pub mod dynamic;
 pub mod first_order;
-pub mod floquet;
-pub mod frf;
 pub mod functions;
 pub mod integrate;
+pub mod linear;
 pub mod linalg;
-pub mod modal;
 pub mod model_info;
 pub mod ode;
-pub mod response;
 pub mod system;
-pub mod vibration;
 
 pub use analysis::{Method, UnknownMethod};
 pub use constrained::{
@@ -28,11 +24,11 @@ pub use constrained::{
 pub use dynamic::{DynMechanicalSystem, StaticSystem};
 pub use eomgen_description::Parameter;
 pub use first_order::{DynFirstOrder, FirstOrder};
-pub use floquet::{
+pub use linear::monodromy::{
     FloquetAnalysis, FloquetError, FloquetOptions, FloquetStability, LARGEST_STABILITY_TOLERANCE,
     check_periodic_equilibrium, floquet_analysis, floquet_multipliers, monodromy_matrix,
 };
-pub use frf::{
+pub use linear::frequency_response::{
     ForcedLinearization, FrequencySweep, FrfError, HarmonicForcing, ModalResponse, PeakAmplitude,
     ResonancePeak, SteadyState, SteadyStateOptions, frequency_response, frequency_response_of,
     frequency_sweep, linearize_with_inputs, log_frequencies, modal_frequency_response,
@@ -46,7 +42,7 @@ pub use integrate::{
     SymplecticEuler, Tableau, Tolerance,
 };
 pub use linalg::{solve_spd, solve_spd_in_place};
-pub use modal::{
+pub use linear::modal::{
     Equilibrium, Linearization, MASS_MATRIX_SINGULARITY, ModalError, ModeKind, NewtonStop,
     NormalModes, TimeDependentForcing, TimeDependentPart, constraint_hessians, damped_modes,
     eigenvalues_of_m_inv_k, find_equilibrium, linearize, matrix_exponential, normal_modes,
@@ -54,7 +50,7 @@ pub use modal::{
 };
 pub use model_info::{ConstraintValues, FirstOrderForm, FirstOrderParts, ModelInfo};
 pub use ode::{OdeFn, OdeSystem, RhsError, WithEvents};
-pub use response::{
+pub use linear::response::{
     DampedMode, FreeResponse, LinearOde, MInvKModes, ModalDamping, RayleighDamping, ResponseError,
     exact_damped_modes, modal_damping, modes_of_m_inv_k, response_by_exponential,
     response_by_integration, response_by_m_inv_k_modes, response_by_normal_modes,

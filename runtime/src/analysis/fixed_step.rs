@@ -25,7 +25,7 @@ use serde::Serialize;
 
 use crate::analysis::methods::Method;
 use crate::integrate::Tableau;
-use crate::integrate::stability::{
+use crate::integrate::stability_function::{
     StabilityPolynomial, implicit_midpoint_stability, partitioned_oscillator_spectral_radius,
 };
 use crate::model_info::ModelInfo;

@@ -16,6 +16,7 @@ pub mod outcome;
 pub mod roundoff;
 pub mod simulation;
 pub mod stability;
+pub mod vibration;
 pub mod work_precision;
 
 pub use constraint_methods::{

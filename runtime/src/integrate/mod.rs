@@ -74,7 +74,7 @@ mod options;
 mod radau5;
 mod rk4;
 mod solution;
-pub mod stability;
+pub mod stability_function;
 mod stepper;
 mod symplectic;
 mod tableau;

@@ -12,15 +12,15 @@ use nalgebra::{Complex, DVector};
 use serde::Serialize;
 
 use super::operating_point::{OperatingPoint, OperatingPointError, OperatingPointOptions};
-use crate::frf::{
+use crate::linear::frequency_response::{
     ForcedLinearization, FrequencySweep, FrfError, HarmonicForcing, ModalResponse, PeakAmplitude,
     SteadyStateOptions, frequency_response, frequency_response_of, frequency_sweep,
     linearize_with_inputs, log_frequencies, modal_frequency_response, output_index, settling_time,
     simulate_steady_state,
 };
-use crate::modal::{NormalModes, normal_modes};
+use crate::linear::modal::{NormalModes, normal_modes};
 use crate::model_info::ModelInfo;
-use crate::response::{ModalDamping, modal_damping};
+use crate::linear::response::{ModalDamping, modal_damping};
 
 /// Why a frequency-response analysis failed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -265,7 +265,7 @@ pub struct FrfAnalysis {
 /// # Examples
 /// The forced oscillator (`m = k = c = 1`): `|H(ω)| = 1/√((k − mω²)² + (cω)²)`.
 /// ```
-/// use eomgen_runtime::vibration::{FrfOptions, frequency_response_analysis};
+/// use eomgen_runtime::analysis::vibration::{FrfOptions, frequency_response_analysis};
 /// let mut model = (eomgen::models::find("forced_oscillator").unwrap().make)();
 /// let options = FrfOptions {
 ///     input: "A".to_string(),
@@ -275,7 +275,7 @@ pub struct FrfAnalysis {
 /// let frf = frequency_response_analysis(model.as_mut(), &options)?;
 /// let h = frf.evaluations[0].response.as_ref().unwrap()[0];
 /// assert!((h.norm() - 1.0 / ((1.0f64 - 4.0).powi(2) + 4.0).sqrt()).abs() < 1e-14);
-/// # Ok::<(), eomgen_runtime::vibration::FrfAnalysisError>(())
+/// # Ok::<(), eomgen_runtime::analysis::vibration::FrfAnalysisError>(())
 /// ```
 ///
 /// # References

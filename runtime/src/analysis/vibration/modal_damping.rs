@@ -12,9 +12,9 @@ use super::free_response::{
 };
 use super::operating_point::{OperatingPoint, OperatingPointOptions};
 use crate::analysis::outcome::{RunTally, StudyRuns};
-use crate::modal::{Linearization, ModeKind, NormalModes};
+use crate::linear::modal::{Linearization, ModeKind, NormalModes};
 use crate::model_info::ModelInfo;
-use crate::response::{
+use crate::linear::response::{
     DampedMode, FreeResponse, ModalDamping, RayleighDamping, exact_damped_modes, modal_damping,
     response_by_exponential, response_by_integration, response_with_modal_damping,
 };
@@ -172,7 +172,7 @@ fn damped_frequency(omega: f64, zeta: f64) -> Option<f64> {
 ///
 /// # Examples
 /// ```
-/// use eomgen_runtime::vibration::{ModalDampingOptions, modal_damping_study};
+/// use eomgen_runtime::analysis::vibration::{ModalDampingOptions, modal_damping_study};
 /// let model = (eomgen::models::find("three_masses_damped").unwrap().make)();
 /// let study = modal_damping_study(model.as_ref(), &ModalDampingOptions::default())?;
 /// // Rayleigh damping fitted to modes 1 and 3 reproduces their exact ζ.
@@ -183,7 +183,7 @@ fn damped_frequency(omega: f64, zeta: f64) -> Option<f64> {
 ///     let exact = mode.exact.unwrap().damping_ratio;
 ///     assert!((mode.rayleigh.unwrap().damping_ratio - exact).abs() < 1e-14);
 /// }
-/// # Ok::<(), eomgen_runtime::vibration::ResponseStudyError>(())
+/// # Ok::<(), eomgen_runtime::analysis::vibration::ResponseStudyError>(())
 /// ```
 ///
 /// # References
