@@ -26,8 +26,8 @@ use crate::system::MechanicalSystem;
 ///
 /// Its [`OdeSystem`] (right-hand side, Jacobian, events) is its own, on stack vectors and
 /// matrices of size `N`; its size-erased [`ModelInfo`](crate::ModelInfo) is the one written
-/// for every [`FirstOrderForm`], reaching the system through
-/// [`StaticSystem`].
+/// once for both first-order forms, reaching the system through an internal adapter to
+/// [`DynMechanicalSystem`].
 #[derive(Debug, Clone)]
 pub struct FirstOrder<S, const N: usize> {
     /// The wrapped system.

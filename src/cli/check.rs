@@ -6,7 +6,9 @@ use serde_json::json;
 use super::CliError;
 use super::output::outln;
 use super::render::num;
-use eomgen_symbolic::mechanics::check::{CheckReport, INITIAL_CONSTRAINT_TOLERANCE, check_model};
+use eomgen_symbolic::mechanics::cross_check::{
+    CheckReport, INITIAL_CONSTRAINT_TOLERANCE, check_model,
+};
 
 /// Relative tolerance of every check: the derivations differ only by rounding (~1e-14).
 const TOLERANCE: f64 = 1e-8;

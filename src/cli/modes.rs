@@ -2,7 +2,7 @@
 //! modes and damping (issue 7; lectures 22–26, 30).
 
 use clap::Args;
-use eomgen::vibration::{
+use eomgen::analysis::vibration::{
     self, EquilibriumStart, ModalAnalysis, ModalOptions, OperatingPointError, OperatingPointOptions,
 };
 use eomgen::{ModeKind, ModelInfo};
@@ -366,7 +366,7 @@ fn print_matrix(out: &mut impl std::io::Write, name: &str, m: &DMatrix<f64>) {
 }
 
 /// The model `model_name` with `--set` applied and its modal analysis at `--at`
-/// ([`eomgen::vibration::modal_analysis`]).
+/// ([`eomgen::analysis::vibration::modal_analysis`]).
 ///
 /// # Errors
 /// A bad `--set` or `--at` (usage), a failed search or analysis (with a hint).

@@ -57,8 +57,8 @@ use crate::linear::modal::{
     Equilibrium, Linearization, ModalError, ModeKind, NormalModes, damped_modes, find_equilibrium,
     linearize, time_dependence,
 };
-use crate::model_info::ModelInfo;
 use crate::linear::response::modal_damping;
+use crate::model_info::ModelInfo;
 use crate::system::UnknownParameter;
 
 /// Why an input matrix, a frequency response or a steady-state simulation failed.

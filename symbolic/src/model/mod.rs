@@ -7,12 +7,12 @@
 //! file at once.
 
 pub mod ast;
-pub mod check;
 pub mod diagnostic;
 pub mod file;
 pub mod located;
 pub mod parser;
 pub mod read;
+pub mod rules;
 pub mod schema;
 pub mod templates;
 pub mod unit_check;
@@ -43,7 +43,7 @@ pub fn load(path: &str, source: &str) -> Result<ModelFile, Vec<Diagnostic>> {
         let built = schema::build_partial(path, source, &root);
         diagnostics.extend(built.diagnostics);
         if let Some(file) = built.file {
-            let (rules, units) = check::check_parts(&file, &built.incomplete);
+            let (rules, units) = rules::check_parts(&file, &built.incomplete);
             let sound = diagnostics.is_empty() && rules.is_empty();
             diagnostics.extend(rules);
             diagnostics.extend(units);

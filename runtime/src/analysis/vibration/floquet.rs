@@ -18,11 +18,11 @@ use serde::Serialize;
 
 use super::operating_point::{OperatingPointError, OperatingPointOptions};
 use crate::analysis::outcome::{RunTally, StudyRuns};
+use crate::linear::modal::{ModalError, find_equilibrium};
 use crate::linear::monodromy::{
     FloquetAnalysis, FloquetError, FloquetOptions, FloquetStability, check_periodic_equilibrium,
     floquet_analysis,
 };
-use crate::linear::modal::{ModalError, find_equilibrium};
 use crate::model_info::ModelInfo;
 use crate::system::UnknownParameter;
 

@@ -11,11 +11,11 @@ use super::modes::{ModalAnalysis, ModalOptions, modal_analysis};
 use super::operating_point::{OperatingPoint, OperatingPointError, OperatingPointOptions};
 use crate::analysis::outcome::{RunTally, StudyRuns};
 use crate::linear::modal::{Linearization, ModeKind, NormalModes};
-use crate::model_info::ModelInfo;
 use crate::linear::response::{
     FreeResponse, ResponseError, response_by_exponential, response_by_integration,
     response_by_m_inv_k_modes, response_by_normal_modes,
 };
+use crate::model_info::ModelInfo;
 
 /// Why a free-response or modal-damping study failed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

@@ -19,8 +19,8 @@ use crate::linear::frequency_response::{
     simulate_steady_state,
 };
 use crate::linear::modal::{NormalModes, normal_modes};
-use crate::model_info::ModelInfo;
 use crate::linear::response::{ModalDamping, modal_damping};
+use crate::model_info::ModelInfo;
 
 /// Why a frequency-response analysis failed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

@@ -13,11 +13,11 @@ use super::free_response::{
 use super::operating_point::{OperatingPoint, OperatingPointOptions};
 use crate::analysis::outcome::{RunTally, StudyRuns};
 use crate::linear::modal::{Linearization, ModeKind, NormalModes};
-use crate::model_info::ModelInfo;
 use crate::linear::response::{
     DampedMode, FreeResponse, ModalDamping, RayleighDamping, exact_damped_modes, modal_damping,
     response_by_exponential, response_by_integration, response_with_modal_damping,
 };
+use crate::model_info::ModelInfo;
 
 /// Options of [`modal_damping_study`].
 #[derive(Debug, Clone, PartialEq, Serialize)]
