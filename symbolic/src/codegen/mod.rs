@@ -343,95 +343,17 @@ pub fn emit(
         }
     };
 
-    let matrix =
-        |v: &[TokenStream]| quote!(#na::SMatrix::<f64, #dim, #dim>::from_row_slice(&[#(#v),*]));
-    let vector =
-        |v: &[TokenStream]| quote!(#na::SVector::<f64, #dim>::from_column_slice(&[#(#v),*]));
-    let q_args = quote!(__q: &#vec_t);
-    let qd_args = quote!(__q: &#vec_t, __qdot: &#vec_t);
+    let types = Types {
+        na: na.clone(),
+        dim: dim.clone(),
+        n,
+        vec_t: vec_t.clone(),
+        mat_t: mat_t.clone(),
+    };
     let plans = plan::plan(model, eom, Some(jacobians), &ModelFunction::ALL);
     for function in &plans.functions {
-        let Body {
-            statements,
-            values: v,
-        } = body(&plans.arena, &function.plan, &helpers)?;
-        let (signature, result) = match function.function {
-            ModelFunction::InitialState => (quote!(fn initial_state(&self) -> (#vec_t, #vec_t)), {
-                let (q, qdot) = (vector(&v[..n]), vector(&v[n..]));
-                quote!((#q, #qdot))
-            }),
-            ModelFunction::MassMatrix => (
-                quote!(fn mass_matrix(&self, #q_args, __t: f64) -> #mat_t),
-                matrix(&v),
-            ),
-            ModelFunction::Forcing => (
-                quote!(fn forcing(&self, #qd_args, __t: f64) -> #vec_t),
-                vector(&v),
-            ),
-            ModelFunction::MassMatrixAndForcing => (
-                quote!(fn mass_matrix_and_forcing(&self, #qd_args, __t: f64) -> (#mat_t, #vec_t)),
-                {
-                    let (m, f) = (matrix(&v[..n * n]), vector(&v[n * n..]));
-                    quote!((#m, #f))
-                },
-            ),
-            ModelFunction::ForcingJacobianQ => (
-                quote!(fn forcing_jacobian_q(&self, #qd_args, __t: f64) -> #mat_t),
-                matrix(&v),
-            ),
-            ModelFunction::ForcingJacobianQdot => (
-                quote!(fn forcing_jacobian_qdot(&self, #qd_args, __t: f64) -> #mat_t),
-                matrix(&v),
-            ),
-            ModelFunction::MassMatrixProductJacobian => (
-                quote!(fn mass_matrix_product_jacobian(&self, #q_args, __t: f64, __a: &#vec_t) -> #mat_t),
-                matrix(&v),
-            ),
-            ModelFunction::KineticEnergy => (
-                quote!(fn kinetic_energy(&self, #qd_args, __t: f64) -> f64),
-                v[0].clone(),
-            ),
-            ModelFunction::PotentialEnergy => (
-                quote!(fn potential_energy(&self, #q_args, __t: f64) -> f64),
-                v[0].clone(),
-            ),
-            ModelFunction::PointPositions => (
-                quote!(fn point_positions(&self, #q_args, __t: f64, __out: &mut [[f64; 3]])),
-                point_stores(model, &v),
-            ),
-            ModelFunction::ConstraintResiduals => (
-                quote!(fn constraint_residuals(&self, #q_args, __t: f64, __out: &mut [f64])),
-                write_out(&v),
-            ),
-            ModelFunction::ConstraintJacobian => (
-                quote!(fn constraint_jacobian(&self, #q_args, __t: f64, __out: &mut [f64])),
-                write_out(&v),
-            ),
-            ModelFunction::ConstraintVelocityResiduals => (
-                quote!(fn constraint_velocity_residuals(&self, #qd_args, __t: f64, __out: &mut [f64])),
-                write_out(&v),
-            ),
-            ModelFunction::ConstraintGamma => (
-                quote!(fn constraint_gamma(&self, #qd_args, __t: f64, __out: &mut [f64])),
-                write_out(&v),
-            ),
-            ModelFunction::EventValues => (
-                quote!(fn event_values(&self, #qd_args, __t: f64, __a: &#vec_t, __lambda: &[f64], __out: &mut [f64])),
-                write_out(&v),
-            ),
-            ModelFunction::EquilibriumGuesses => (
-                quote!(fn equilibrium_guesses(&self, __out: &mut [f64])),
-                write_out(&v),
-            ),
-        };
-        methods.extend(quote! {
-            #[allow(unused_variables, non_snake_case, clippy::all)]
-            #[inline]
-            #signature {
-                #statements
-                #result
-            }
-        });
+        let body = body(&plans.arena, &function.plan, &helpers)?;
+        methods.extend(function_method(function.function, body, model, &types));
     }
     let both: Vec<ExprId> = [eom.mass_matrix.clone(), eom.forcing.clone()].concat();
     let stats = EmitStats {
@@ -462,6 +384,122 @@ pub fn emit(
         }
     };
     Ok((tokens, stats))
+}
+
+/// The types a generated method names: nalgebra's path, `N` as a literal, and the vector
+/// and matrix types of size `N`.
+struct Types {
+    na: TokenStream,
+    dim: Literal,
+    n: usize,
+    vec_t: TokenStream,
+    mat_t: TokenStream,
+}
+
+/// One method of the generated `impl MechanicalSystem<N>`: the function's signature, its body
+/// (bindings and temporaries) and its outputs built into what the trait returns (static
+/// matrices row-major from a stack array, slices written entry by entry).
+fn function_method(
+    function: ModelFunction,
+    body: Body,
+    model: &SymbolicModel,
+    types: &Types,
+) -> TokenStream {
+    let Types {
+        na,
+        dim,
+        n,
+        vec_t,
+        mat_t,
+    } = types;
+    let n = *n;
+    let Body {
+        statements,
+        values: v,
+    } = body;
+    let matrix =
+        |v: &[TokenStream]| quote!(#na::SMatrix::<f64, #dim, #dim>::from_row_slice(&[#(#v),*]));
+    let vector =
+        |v: &[TokenStream]| quote!(#na::SVector::<f64, #dim>::from_column_slice(&[#(#v),*]));
+    let q_args = quote!(__q: &#vec_t);
+    let qd_args = quote!(__q: &#vec_t, __qdot: &#vec_t);
+    let (signature, result) = match function {
+        ModelFunction::InitialState => (quote!(fn initial_state(&self) -> (#vec_t, #vec_t)), {
+            let (q, qdot) = (vector(&v[..n]), vector(&v[n..]));
+            quote!((#q, #qdot))
+        }),
+        ModelFunction::MassMatrix => (
+            quote!(fn mass_matrix(&self, #q_args, __t: f64) -> #mat_t),
+            matrix(&v),
+        ),
+        ModelFunction::Forcing => (
+            quote!(fn forcing(&self, #qd_args, __t: f64) -> #vec_t),
+            vector(&v),
+        ),
+        ModelFunction::MassMatrixAndForcing => (
+            quote!(fn mass_matrix_and_forcing(&self, #qd_args, __t: f64) -> (#mat_t, #vec_t)),
+            {
+                let (m, f) = (matrix(&v[..n * n]), vector(&v[n * n..]));
+                quote!((#m, #f))
+            },
+        ),
+        ModelFunction::ForcingJacobianQ => (
+            quote!(fn forcing_jacobian_q(&self, #qd_args, __t: f64) -> #mat_t),
+            matrix(&v),
+        ),
+        ModelFunction::ForcingJacobianQdot => (
+            quote!(fn forcing_jacobian_qdot(&self, #qd_args, __t: f64) -> #mat_t),
+            matrix(&v),
+        ),
+        ModelFunction::MassMatrixProductJacobian => (
+            quote!(fn mass_matrix_product_jacobian(&self, #q_args, __t: f64, __a: &#vec_t) -> #mat_t),
+            matrix(&v),
+        ),
+        ModelFunction::KineticEnergy => (
+            quote!(fn kinetic_energy(&self, #qd_args, __t: f64) -> f64),
+            v[0].clone(),
+        ),
+        ModelFunction::PotentialEnergy => (
+            quote!(fn potential_energy(&self, #q_args, __t: f64) -> f64),
+            v[0].clone(),
+        ),
+        ModelFunction::PointPositions => (
+            quote!(fn point_positions(&self, #q_args, __t: f64, __out: &mut [[f64; 3]])),
+            point_stores(model, &v),
+        ),
+        ModelFunction::ConstraintResiduals => (
+            quote!(fn constraint_residuals(&self, #q_args, __t: f64, __out: &mut [f64])),
+            write_out(&v),
+        ),
+        ModelFunction::ConstraintJacobian => (
+            quote!(fn constraint_jacobian(&self, #q_args, __t: f64, __out: &mut [f64])),
+            write_out(&v),
+        ),
+        ModelFunction::ConstraintVelocityResiduals => (
+            quote!(fn constraint_velocity_residuals(&self, #qd_args, __t: f64, __out: &mut [f64])),
+            write_out(&v),
+        ),
+        ModelFunction::ConstraintGamma => (
+            quote!(fn constraint_gamma(&self, #qd_args, __t: f64, __out: &mut [f64])),
+            write_out(&v),
+        ),
+        ModelFunction::EventValues => (
+            quote!(fn event_values(&self, #qd_args, __t: f64, __a: &#vec_t, __lambda: &[f64], __out: &mut [f64])),
+            write_out(&v),
+        ),
+        ModelFunction::EquilibriumGuesses => (
+            quote!(fn equilibrium_guesses(&self, __out: &mut [f64])),
+            write_out(&v),
+        ),
+    };
+    quote! {
+        #[allow(unused_variables, non_snake_case, clippy::all)]
+        #[inline]
+        #signature {
+            #statements
+            #result
+        }
+    }
 }
 
 /// Stores of `point_positions`: `[x, y, z]` per point from its flattened components `v`, 2-D
