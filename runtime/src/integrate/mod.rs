@@ -57,6 +57,9 @@
 //! # Ok::<(), eomgen_runtime::IntegrationFailure>(())
 //! ```
 
+#[macro_use]
+mod wrappers;
+
 mod bs32;
 mod controller;
 mod dense_output;

@@ -1,7 +1,7 @@
 //! Model files: YAML with source locations → typed [`ModelFile`] → checked.
 //!
 //! Pipeline: [`read`] (the file's text, bounded in size) → [`yaml`] (located YAML tree) → [`parser`] (expressions) → [`schema`] (typed
-//! model, every unknown key / wrong type reported) → [`check`] (cross-references and
+//! model, every unknown key / wrong type reported) → [`rules`] (cross-references and
 //! semantics, and [`unit_check`] — dimensional analysis with the algebra of [`units`] — when
 //! the file declares `units: SI`). [`load`] runs all of it and reports every diagnostic of a
 //! file at once.

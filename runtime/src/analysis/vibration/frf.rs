@@ -421,7 +421,7 @@ fn frf_outputs(
 fn default_range(natural_frequencies: &[f64]) -> Option<(f64, f64)> {
     let mut positive = natural_frequencies.iter().copied().filter(|w| *w > 0.0);
     let first = positive.next()?;
-    let last = positive.last().unwrap_or(first);
+    let last = positive.next_back().unwrap_or(first);
     Some((first / 10.0, last * 10.0))
 }
 
