@@ -1,7 +1,7 @@
 //! Equations → Rust tokens: a struct named after the model and an
 //! `impl MechanicalSystem<N>` with straight-line, CSE'd, allocation-free bodies.
 //!
-//! Each generated function prints one plan of [`plan::plan`] (the plans the run-time compiler
+//! Each generated function prints one plan of [`plan`] (the plans the run-time compiler
 //! lowers to tapes, [`program::ModelProgram`]): it binds only the symbols it uses, computes
 //! `sin_cos` once per angle, and builds its nalgebra static matrix from a stack array. The
 //! items are built as tokens with `quote!`; only the expressions come as text, from the
@@ -26,7 +26,7 @@ use quote::quote;
 use crate::expr::cse::{CsePlan, Temporary};
 use crate::expr::print::{Printer, Syntax};
 use crate::expr::{ExprArena, ExprId, SymbolId, SymbolKind};
-use crate::mechanics::{EquationsOfMotion, Jacobians, SymbolicModel};
+use crate::mechanics::{EquationsOfMotion, SymbolicModel};
 use crate::model::schema::RUST_KEYWORDS;
 use plan::ModelFunction;
 
@@ -60,8 +60,8 @@ fn derive(
 }
 
 /// The code `eomgen::model!` generates for a loaded model file: lowering, one derivation
-/// ([`crate::mechanics::preferred_equations`]), the mass-matrix diagnostics, the exact
-/// Jacobians, then [`emit`]. The macro and `eomgen equations --rust` both call this, so what the
+/// ([`crate::mechanics::preferred_equations`]), the mass-matrix diagnostics, the plans of
+/// every function with the exact Jacobians ([`plan::EmitPlans::of`]), then [`emit`]. The macro and `eomgen equations --rust` both call this, so what the
 /// CLI prints is what is compiled; a model compiled at run time is derived by the same steps
 /// and lowered from the same plans ([`program::ModelProgram::from_file`]).
 ///
@@ -73,9 +73,9 @@ pub fn generate(
     file: &crate::model::ModelFile,
     options: &EmitOptions,
 ) -> Result<TokenStream, GenerateError> {
-    let (mut model, eom) = derive(file)?;
-    let jacobians = Jacobians::of(&mut model, &eom);
-    emit(&model, &eom, &jacobians, options)
+    let (model, eom) = derive(file)?;
+    let plans = plan::EmitPlans::of(&model, &eom);
+    emit(&model, &eom, &plans, options)
         .map(|(tokens, _)| tokens)
         .map_err(GenerateError::Emit)
 }
@@ -262,8 +262,8 @@ fn write_out(values: &[TokenStream]) -> TokenStream {
 
 /// Generates the struct and its `MechanicalSystem` implementation: the struct with one field
 /// per parameter, its `Default`, the model's description as a `static`, and one method per
-/// function of [`plan::plan`] (all of [`ModelFunction::ALL`] the model has; the trait's
-/// defaults stand for the others).
+/// plan of `plans` ([`plan::EmitPlans::of`] of the same `model` and `eom`: every function of
+/// [`ModelFunction::ALL`] the model has; the trait's defaults stand for the others).
 ///
 /// # Errors
 /// Only if the printed code fails to tokenize, which would be a bug in the printer; the
@@ -271,7 +271,7 @@ fn write_out(values: &[TokenStream]) -> TokenStream {
 pub fn emit(
     model: &SymbolicModel,
     eom: &EquationsOfMotion,
-    jacobians: &Jacobians,
+    plans: &plan::EmitPlans,
     options: &EmitOptions,
 ) -> Result<(TokenStream, EmitStats), String> {
     let n = model.num_dofs();
@@ -350,17 +350,19 @@ pub fn emit(
         vec_t: vec_t.clone(),
         mat_t: mat_t.clone(),
     };
-    let plans = plan::plan(model, eom, Some(jacobians), &ModelFunction::ALL);
-    for function in &plans.functions {
-        let body = body(&plans.arena, &function.plan, &helpers)?;
-        methods.extend(function_method(function.function, body, model, &types));
+    // Printed in the trait's order, whatever order they were planned in.
+    for function in ModelFunction::ALL {
+        if let Some((arena, plan)) = plans.get(function) {
+            let body = body(arena, plan, &helpers)?;
+            methods.extend(function_method(function, body, model, &types));
+        }
     }
     let both: Vec<ExprId> = [eom.mass_matrix.clone(), eom.forcing.clone()].concat();
     let stats = EmitStats {
         ops_before_cse: model.arena.tree_operation_count(&both),
         ops_after_cse: plans
             .get(ModelFunction::MassMatrixAndForcing)
-            .map_or(0, CsePlan::operation_count),
+            .map_or(0, |(_, plan)| plan.operation_count()),
     };
     let tokens = quote! {
         #[doc = #doc]

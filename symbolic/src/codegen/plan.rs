@@ -1,12 +1,18 @@
-//! The one planner: a derived model's functions as CSE plans on one arena, which both the
-//! `model!` macro's Rust ([`super::emit`]) and the run-time compiler's tapes
+//! The one planner: a derived model's functions as CSE plans, which both the `model!`
+//! macro's Rust ([`super::emit`]) and the run-time compiler's tapes
 //! ([`super::program::ModelProgram`]) are made from.
 //!
 //! Each function is planned over exactly the expressions it returns, after the angle-sum
-//! rewrite ([`crate::expr::trig::expand_angle_sums`]), by [`crate::expr::cse::plan`]. Because
-//! both consumers print or lower the same plans, a model compiled at build time and one
-//! compiled at run time compute the same operations in the same order by construction (the
-//! bit-identity tests in `tests/runtime_models.rs` stay as a guard).
+//! rewrite ([`crate::expr::trig::expand_angle_sums`]), by [`crate::expr::cse::plan`], one
+//! after the other on one copy of the arena (the rewrite adds nodes, so a plan depends on
+//! what was planned before it). Both consumers go through the same two steps:
+//! [`plan_state`] plans the functions of the state ([`ModelFunction::STATE`], always first
+//! and in this order) on a copy of the derived model's arena, and [`plan_jacobians`] derives
+//! the exact Jacobians and plans them on a copy of that arena. The macro plans `mass_matrix`
+//! and `forcing` apart after the others, which leaves their plans unchanged. So a model
+//! compiled at build time and one compiled at run time compute the same operations in the
+//! same order by construction (the bit-identity tests in `tests/runtime_models.rs` stay as a
+//! guard).
 
 use crate::expr::cse::{self, CsePlan};
 use crate::expr::{ExprArena, ExprId, trig};
@@ -71,7 +77,25 @@ impl ModelFunction {
         ModelFunction::EquilibriumGuesses,
     ];
 
-    /// The exact Jacobians, which the run-time compiler plans only when first needed.
+    /// The functions of the state that every compilation plans, first and in this order
+    /// ([`plan_state`]): all but the exact Jacobians and `mass_matrix` and `forcing` apart
+    /// (a backend evaluates both in one).
+    pub const STATE: [ModelFunction; 11] = [
+        ModelFunction::InitialState,
+        ModelFunction::MassMatrixAndForcing,
+        ModelFunction::KineticEnergy,
+        ModelFunction::PotentialEnergy,
+        ModelFunction::PointPositions,
+        ModelFunction::ConstraintResiduals,
+        ModelFunction::ConstraintJacobian,
+        ModelFunction::ConstraintVelocityResiduals,
+        ModelFunction::ConstraintGamma,
+        ModelFunction::EventValues,
+        ModelFunction::EquilibriumGuesses,
+    ];
+
+    /// The exact Jacobians ([`plan_jacobians`]), which the run-time compiler plans only when
+    /// first needed.
     pub const JACOBIANS: [ModelFunction; 3] = [
         ModelFunction::ForcingJacobianQ,
         ModelFunction::ForcingJacobianQdot,
@@ -181,11 +205,62 @@ impl ModelPlans {
     }
 }
 
+/// Plans [`ModelFunction::STATE`], then `extra`, of a derived model (its equations, not yet
+/// differentiated by [`Jacobians::of`]) on one copy of its arena. The plans of
+/// [`ModelFunction::STATE`] do not depend on `extra`, which is planned after them.
+pub fn plan_state(
+    model: &SymbolicModel,
+    eom: &EquationsOfMotion,
+    extra: &[ModelFunction],
+) -> ModelPlans {
+    let functions: Vec<ModelFunction> = ModelFunction::STATE.iter().chain(extra).copied().collect();
+    plan_functions(model, eom, None, &functions)
+}
+
+/// Derives the exact Jacobians of a derived model ([`Jacobians::of`], which adds their nodes
+/// to its arena) and plans [`ModelFunction::JACOBIANS`] on a copy of its arena.
+pub fn plan_jacobians(model: &mut SymbolicModel, eom: &EquationsOfMotion) -> ModelPlans {
+    let jacobians = Jacobians::of(model, eom);
+    plan_functions(model, eom, Some(&jacobians), &ModelFunction::JACOBIANS)
+}
+
+/// Every plan the `model!` macro's code is printed from: [`plan_state`] with `mass_matrix`
+/// and `forcing` apart, and [`plan_jacobians`] on a copy of the model.
+#[derive(Debug, Clone)]
+pub struct EmitPlans {
+    /// The functions of the state.
+    pub state: ModelPlans,
+    /// The exact Jacobians.
+    pub jacobians: ModelPlans,
+}
+
+impl EmitPlans {
+    /// Plans every generated function of a derived model (its equations, not yet
+    /// differentiated).
+    pub fn of(model: &SymbolicModel, eom: &EquationsOfMotion) -> Self {
+        let state = plan_state(
+            model,
+            eom,
+            &[ModelFunction::MassMatrix, ModelFunction::Forcing],
+        );
+        let mut differentiated = model.clone();
+        let jacobians = plan_jacobians(&mut differentiated, eom);
+        Self { state, jacobians }
+    }
+
+    /// The plan of `function` and the arena it refers to, if the model has the function.
+    pub fn get(&self, function: ModelFunction) -> Option<(&ExprArena, &CsePlan)> {
+        [&self.state, &self.jacobians]
+            .into_iter()
+            .find_map(|plans| Some((&plans.arena, plans.get(function)?)))
+    }
+}
+
 /// Plans `functions` of a derived model, in the order given, one after the other on one copy
 /// of its arena. A function the model does not have ([`ModelFunction`]'s constraint, event
 /// and equilibrium functions of a model without any; the Jacobians when `jacobians` is
 /// `None`) is left out.
-pub fn plan(
+fn plan_functions(
     model: &SymbolicModel,
     eom: &EquationsOfMotion,
     jacobians: Option<&Jacobians>,

@@ -8,7 +8,7 @@
 //! code computes, operation for operation.
 
 use crate::expr::SymbolId;
-use crate::mechanics::{EquationsOfMotion, Jacobians, SymbolicModel};
+use crate::mechanics::{EquationsOfMotion, SymbolicModel};
 use crate::model::ModelFile;
 use eomgen_description::ModelDescription;
 
@@ -99,27 +99,12 @@ impl ModelProgram {
         Ok((program, Derivation { model, eom }))
     }
 
-    /// The tapes of a derived model but its Jacobians: the plans of [`super::plan`] (the
-    /// ones [`super::emit`] prints) lowered to tapes.
+    /// The tapes of a derived model but its Jacobians: the plans of
+    /// [`super::plan::plan_state`] (the ones [`super::emit`] prints) lowered to tapes.
     pub fn plan(model: &SymbolicModel, eom: &EquationsOfMotion) -> ModelProgram {
         use ModelFunction as F;
         let n = model.num_dofs();
-        // The macro's functions but `mass_matrix` and `forcing` alone (a backend evaluates
-        // both in one) and the Jacobians (planned when needed, by [`Derivation::jacobians`]).
-        let functions = [
-            F::InitialState,
-            F::MassMatrixAndForcing,
-            F::KineticEnergy,
-            F::PotentialEnergy,
-            F::PointPositions,
-            F::ConstraintResiduals,
-            F::ConstraintJacobian,
-            F::ConstraintVelocityResiduals,
-            F::ConstraintGamma,
-            F::EventValues,
-            F::EquilibriumGuesses,
-        ];
-        let plans = super::plan::plan(model, eom, None, &functions);
+        let plans = super::plan::plan_state(model, eom, &[]);
         let tapes = Tapes::new(model, &plans);
         let mut mass_and_forcing = tapes.get(F::MassMatrixAndForcing);
         // `M` column-major, then `F`.
@@ -244,18 +229,12 @@ impl JacobianProgram {
 
 impl Derivation {
     /// Derives the exact Jacobians `∂F/∂q`, `∂F/∂q̇`, `∂(M a)/∂q`
-    /// ([`crate::mechanics::Jacobians::of`]) and lowers their plans ([`super::plan`], as
-    /// [`super::emit`] prints them) to tapes.
+    /// ([`crate::mechanics::Jacobians::of`]) and lowers their plans
+    /// ([`super::plan::plan_jacobians`], as [`super::emit`] prints them) to tapes.
     pub fn jacobians(mut self) -> JacobianProgram {
         use ModelFunction as F;
         let n = self.eom.num_dofs;
-        let jacobians = Jacobians::of(&mut self.model, &self.eom);
-        let plans = super::plan::plan(
-            &self.model,
-            &self.eom,
-            Some(&jacobians),
-            &ModelFunction::JACOBIANS,
-        );
+        let plans = super::plan::plan_jacobians(&mut self.model, &self.eom);
         let tapes = Tapes::new(&self.model, &plans);
         let column_major = |function| {
             let mut tape = tapes.get(function);
