@@ -1,15 +1,15 @@
 //! The numerical studies of `analysis/` that run on a model (`simulate`, the drift measures,
-//! `work_precision`, `stability_study`, `constraint_methods`), on the small hand-written
-//! models of `common/models.rs`, each against a closed form or an independent computation.
+//! `work_precision`, `constraint_methods`; `stability_study` is in `stability.rs`), on the
+//! small hand-written models of `common/models.rs`, each against a closed form or an
+//! independent computation.
 //! Every bound is stated next to its assertion with its reason.
 
 mod common;
 
 use common::models::{CartesianPendulum, Pendulum, TwoMassChain, boxed};
-use eomgen_runtime::analysis::vibration::{ModalOptions, modal_analysis};
 use eomgen_runtime::analysis::{
-    ConstraintMethodsOptions, Method, SimulationOptions, StabilityOptions, WorkPrecisionOptions,
-    constraint_methods, energy_drift_at, simulate, stability_study, work_precision,
+    ConstraintMethodsOptions, Method, SimulationOptions, WorkPrecisionOptions, constraint_methods,
+    energy_drift_at, simulate, work_precision,
 };
 use eomgen_runtime::{OutputTimes, Stabilization};
 use nalgebra::SMatrix;
@@ -215,74 +215,6 @@ fn work_precision_of_rk4_is_its_stability_function() {
             "N = {n}: {error:e} vs {expected:e}"
         );
     }
-}
-
-/// `stability_study` with the free chain as the stiff model (`k1 = 0`, undamped): the
-/// stability limits measured by bisection against the closed forms of the stability
-/// functions (RK4 `2√2` on the imaginary axis and the root `2.7853` of `|R(x)| = 1` on the
-/// real one, explicit Euler 2 on the real axis, Störmer–Verlet 2 for `hω`), to 1 %: with
-/// 2000 steps a growth of 1e4 is detected within 0.3 % above the limit. The stiff mode's
-/// `ω = √(k (m1 + m2)/(m1 m2))` against `modal_analysis` of the same chain (1e-12), and the
-/// blow-up of `ẏ = y²` at `t = 1` (to 1e-3: the step collapses within rounding of it).
-#[test]
-fn stability_study_limits_stiff_mode_and_blow_up() {
-    let mut chain = TwoMassChain {
-        k1: 0.0,
-        f0: 1.0,
-        ..TwoMassChain::default()
-    };
-    let mut model = boxed(chain.clone());
-    let options = StabilityOptions {
-        steps: 2000,
-        periods: 1,
-        stiffness: vec![1e2],
-        stiff_spring: eomgen_runtime::analysis::StiffSpring {
-            stiffness: "k2".into(),
-            ..Default::default()
-        },
-        ..StabilityOptions::default()
-    };
-    let study = stability_study(model.as_mut(), &options).unwrap();
-    for (method, axis, limit) in [
-        ("rk4", "imaginary", 2.0 * 2f64.sqrt()),
-        ("rk4", "real", 2.785_293_563_405_282),
-        ("euler", "real", 2.0),
-        ("stormer-verlet", "imaginary", 2.0),
-    ] {
-        let row = study
-            .limits
-            .rows
-            .iter()
-            .find(|r| r.method == method && r.axis == axis)
-            .unwrap_or_else(|| panic!("no {method} row on the {axis} axis"));
-        let measured = row.measured.expect("a measured limit");
-        assert!(
-            (measured - limit).abs() < 0.01 * limit,
-            "{method} {axis}: {measured} vs {limit}"
-        );
-    }
-    chain.k2 = 1e2 * chain.m1;
-    chain.f0 = 0.0;
-    let modal = modal_analysis(boxed(chain).as_ref(), &ModalOptions::default()).unwrap();
-    assert_eq!(
-        modal.normal_modes.kinds[0],
-        eomgen_runtime::ModeKind::ZeroFrequency
-    );
-    for mode in &study.stiff_modes {
-        let omega = modal.normal_modes.natural_frequencies[1];
-        assert!(
-            (mode.omega - omega).abs() < 1e-12 * omega,
-            "{} vs {omega}",
-            mode.omega
-        );
-    }
-    let t = study
-        .underflow
-        .failure
-        .as_ref()
-        .and_then(|f| f.t)
-        .expect("ẏ = y² fails");
-    assert!((t - 1.0).abs() < 1e-3, "failed at t = {t}");
 }
 
 /// `constraint_methods` on the Cartesian pendulum with its minimal twin: the DAE rows and
