@@ -39,8 +39,8 @@ fn unknown(description: &ModelDescription, name: &str) -> UnknownParameter {
     }
 }
 
-/// `parameter_values` and `set_parameter` over fields named as the description's
-/// parameters (in its order), and `defaults`, the model at the description's defaults.
+/// `parameter_values` and `set_parameter` over the fields that hold the description's
+/// parameters, in its order.
 macro_rules! parameters {
     ($($name:literal => $field:ident),* $(,)?) => {
         fn parameter_values(&self) -> Vec<f64> {
@@ -53,6 +53,30 @@ macro_rules! parameters {
                 _ => return Err(unknown(self.description(), name)),
             }
             Ok(())
+        }
+    };
+}
+
+/// `mass_matrix_and_forcing` from `mass_matrix` and `forcing`, and the zero `∂(M a)/∂q` of a
+/// mass matrix that does not depend on `q` (every model here).
+macro_rules! constant_mass_matrix {
+    ($n:literal) => {
+        fn mass_matrix_and_forcing(
+            &self,
+            q: &SVector<f64, $n>,
+            qdot: &SVector<f64, $n>,
+            t: f64,
+        ) -> (SMatrix<f64, $n, $n>, SVector<f64, $n>) {
+            (self.mass_matrix(q, t), self.forcing(q, qdot, t))
+        }
+
+        fn mass_matrix_product_jacobian(
+            &self,
+            _q: &SVector<f64, $n>,
+            _t: f64,
+            _a: &SVector<f64, $n>,
+        ) -> SMatrix<f64, $n, $n> {
+            SMatrix::zeros()
         }
     };
 }
@@ -224,6 +248,8 @@ impl MechanicalSystem<2> for TwoMassChain {
         "F0" => f0, "A" => a, "w" => w,
     );
 
+    constant_mass_matrix!(2);
+
     fn initial_state(&self) -> (SVector<f64, 2>, SVector<f64, 2>) {
         (Vector2::from(self.initial.0), Vector2::from(self.initial.1))
     }
@@ -234,15 +260,6 @@ impl MechanicalSystem<2> for TwoMassChain {
 
     fn forcing(&self, q: &SVector<f64, 2>, qdot: &SVector<f64, 2>, t: f64) -> SVector<f64, 2> {
         -self.k() * q - self.c() * qdot + Vector2::new(0.0, self.f0 + self.a * (self.w * t).cos())
-    }
-
-    fn mass_matrix_and_forcing(
-        &self,
-        q: &SVector<f64, 2>,
-        qdot: &SVector<f64, 2>,
-        t: f64,
-    ) -> (SMatrix<f64, 2, 2>, SVector<f64, 2>) {
-        (self.m(), self.forcing(q, qdot, t))
     }
 
     fn forcing_jacobian_q(
@@ -261,15 +278,6 @@ impl MechanicalSystem<2> for TwoMassChain {
         _t: f64,
     ) -> SMatrix<f64, 2, 2> {
         -self.c()
-    }
-
-    fn mass_matrix_product_jacobian(
-        &self,
-        _q: &SVector<f64, 2>,
-        _t: f64,
-        _a: &SVector<f64, 2>,
-    ) -> SMatrix<f64, 2, 2> {
-        Matrix2::zeros()
     }
 
     fn kinetic_energy(&self, _q: &SVector<f64, 2>, qdot: &SVector<f64, 2>, _t: f64) -> f64 {
@@ -361,6 +369,8 @@ impl MechanicalSystem<1> for ForcedOscillator {
 
     parameters!("m" => m, "c" => c, "k" => k, "A" => a, "w" => w);
 
+    constant_mass_matrix!(1);
+
     fn initial_state(&self) -> (SVector<f64, 1>, SVector<f64, 1>) {
         (Vector1::new(0.0), Vector1::new(0.0))
     }
@@ -371,15 +381,6 @@ impl MechanicalSystem<1> for ForcedOscillator {
 
     fn forcing(&self, q: &SVector<f64, 1>, qdot: &SVector<f64, 1>, t: f64) -> SVector<f64, 1> {
         Vector1::new(-self.k * q[0] - self.c * qdot[0] + self.a * (self.w * t).cos())
-    }
-
-    fn mass_matrix_and_forcing(
-        &self,
-        q: &SVector<f64, 1>,
-        qdot: &SVector<f64, 1>,
-        t: f64,
-    ) -> (SMatrix<f64, 1, 1>, SVector<f64, 1>) {
-        (self.mass_matrix(q, t), self.forcing(q, qdot, t))
     }
 
     fn forcing_jacobian_q(
@@ -398,15 +399,6 @@ impl MechanicalSystem<1> for ForcedOscillator {
         _t: f64,
     ) -> SMatrix<f64, 1, 1> {
         Matrix1::new(-self.c)
-    }
-
-    fn mass_matrix_product_jacobian(
-        &self,
-        _q: &SVector<f64, 1>,
-        _t: f64,
-        _a: &SVector<f64, 1>,
-    ) -> SMatrix<f64, 1, 1> {
-        Matrix1::zeros()
     }
 
     fn kinetic_energy(&self, _q: &SVector<f64, 1>, qdot: &SVector<f64, 1>, _t: f64) -> f64 {
@@ -508,6 +500,8 @@ impl MechanicalSystem<1> for Pendulum {
 
     parameters!("m" => m, "l" => l, "g" => g, "c" => c, "a" => a, "w" => w);
 
+    constant_mass_matrix!(1);
+
     fn initial_state(&self) -> (SVector<f64, 1>, SVector<f64, 1>) {
         (Vector1::new(self.initial.0), Vector1::new(self.initial.1))
     }
@@ -519,15 +513,6 @@ impl MechanicalSystem<1> for Pendulum {
     fn forcing(&self, q: &SVector<f64, 1>, qdot: &SVector<f64, 1>, t: f64) -> SVector<f64, 1> {
         let (_, acceleration) = self.pivot(t);
         Vector1::new(-self.m * self.l * (self.g + acceleration) * q[0].sin() - self.c * qdot[0])
-    }
-
-    fn mass_matrix_and_forcing(
-        &self,
-        q: &SVector<f64, 1>,
-        qdot: &SVector<f64, 1>,
-        t: f64,
-    ) -> (SMatrix<f64, 1, 1>, SVector<f64, 1>) {
-        (self.mass_matrix(q, t), self.forcing(q, qdot, t))
     }
 
     fn forcing_jacobian_q(
@@ -547,15 +532,6 @@ impl MechanicalSystem<1> for Pendulum {
         _t: f64,
     ) -> SMatrix<f64, 1, 1> {
         Matrix1::new(-self.c)
-    }
-
-    fn mass_matrix_product_jacobian(
-        &self,
-        _q: &SVector<f64, 1>,
-        _t: f64,
-        _a: &SVector<f64, 1>,
-    ) -> SMatrix<f64, 1, 1> {
-        Matrix1::zeros()
     }
 
     /// `½ m |ṙ|²` of the bob, pivot motion included.
@@ -639,6 +615,8 @@ impl MechanicalSystem<2> for CartesianPendulum {
 
     parameters!("m" => m, "l" => l, "g" => g);
 
+    constant_mass_matrix!(2);
+
     fn initial_state(&self) -> (SVector<f64, 2>, SVector<f64, 2>) {
         let (s, c) = self.theta0.sin_cos();
         (Vector2::new(self.l * s, -self.l * c), Vector2::zeros())
@@ -650,15 +628,6 @@ impl MechanicalSystem<2> for CartesianPendulum {
 
     fn forcing(&self, _q: &SVector<f64, 2>, _qdot: &SVector<f64, 2>, _t: f64) -> SVector<f64, 2> {
         Vector2::new(0.0, -self.m * self.g)
-    }
-
-    fn mass_matrix_and_forcing(
-        &self,
-        q: &SVector<f64, 2>,
-        qdot: &SVector<f64, 2>,
-        t: f64,
-    ) -> (SMatrix<f64, 2, 2>, SVector<f64, 2>) {
-        (self.mass_matrix(q, t), self.forcing(q, qdot, t))
     }
 
     fn forcing_jacobian_q(
@@ -675,15 +644,6 @@ impl MechanicalSystem<2> for CartesianPendulum {
         _q: &SVector<f64, 2>,
         _qdot: &SVector<f64, 2>,
         _t: f64,
-    ) -> SMatrix<f64, 2, 2> {
-        Matrix2::zeros()
-    }
-
-    fn mass_matrix_product_jacobian(
-        &self,
-        _q: &SVector<f64, 2>,
-        _t: f64,
-        _a: &SVector<f64, 2>,
     ) -> SMatrix<f64, 2, 2> {
         Matrix2::zeros()
     }
