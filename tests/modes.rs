@@ -279,36 +279,12 @@ fn operating_point_from_names_and_guesses() {
     assert_eq!(json["equilibrium"]["q"], serde_json::json!([0.0]));
 }
 
-/// `modal_analysis` (what `eomgen modes` prints) on a constrained model: the Cartesian
-/// pendulum (m = 1, l = 1, g = 10) hangs with rod tension λ = m g = 10 N, one minimal
-/// coordinate, ω = √(g/l), and its mode shape in both coordinates (δy = 0 at the bottom).
-/// On three_masses_damped the damping ratios are the file's reference values (numpy, 1e-7).
+/// `modal_analysis` (what `eomgen modes` prints) on three_masses_damped: the damping ratios
+/// are the file's reference values (numpy, 1e-7). (A constrained model:
+/// `runtime/tests/vibration.rs`.)
 #[test]
-fn modal_analysis_constrained_and_damped() {
+fn modal_analysis_damped() {
     use eomgen::analysis::vibration::{ModalOptions, modal_analysis};
-    let m = model("simple_pendulum_cartesian");
-    let modal = modal_analysis(m.as_ref(), &ModalOptions::default()).unwrap();
-    assert_eq!(modal.minimal_coordinates, ["x"]);
-    assert!(close(
-        modal.linearization.lagrange_multipliers[0],
-        10.0,
-        1e-12
-    ));
-    assert!(close(
-        modal.normal_modes.natural_frequencies[0],
-        10f64.sqrt(),
-        1e-12
-    ));
-    assert_eq!(modal.mode_shapes.len(), 1);
-    let shape = &modal.mode_shapes[0];
-    assert!(
-        close(shape[0], 1.0, 1e-12) && shape[1].abs() < 1e-12,
-        "{shape:?}"
-    );
-    assert!(modal.m_inv_k_relative_difference < 1e-12);
-    assert!(modal.is_undamped());
-    assert_eq!(modal.damping_ratios, [0.0]);
-
     let m = model("three_masses_damped");
     let modal = modal_analysis(m.as_ref(), &ModalOptions::default()).unwrap();
     assert!(!modal.is_undamped());

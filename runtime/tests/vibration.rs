@@ -6,7 +6,7 @@ mod common;
 
 use std::f64::consts::{PI, TAU};
 
-use common::models::{ForcedOscillator, Pendulum, TwoMassChain, boxed};
+use common::models::{CartesianPendulum, ForcedOscillator, Pendulum, TwoMassChain, boxed};
 use eomgen_runtime::analysis::vibration::{
     EquilibriumStart, FloquetStudyError, FloquetStudyOptions, FreeResponseMethod,
     FreeResponseOptions, FrfOptions, FrfSimulationOptions, InitialDeviation, ModalDampingOptions,
@@ -139,6 +139,37 @@ fn modal_analysis_of_the_pendulum_hanging_upright_and_shaken() {
         ),
         "{refused:?}"
     );
+}
+
+/// `modal_analysis` on a constrained model, the Cartesian pendulum: it hangs with the rod's
+/// tension `λ = m g`, one minimal coordinate `x`, `ω = √(g/l)`, and its mass-normalised
+/// shape in both coordinates `(1/√m, 0)` (`δy = 0` at the bottom). 1e-12: a 1 × 1
+/// eigenproblem after the constraint's null space, all in a few roundings.
+#[test]
+fn modal_analysis_of_the_cartesian_pendulum_on_its_constraint() {
+    let pendulum = CartesianPendulum::default();
+    let model = boxed(pendulum.clone());
+    let modal = modal_analysis(model.as_ref(), &ModalOptions::default()).unwrap();
+    assert_eq!(modal.operating_point.name, "hanging");
+    assert_eq!(modal.minimal_coordinates, ["x"]);
+    let tension = pendulum.m * pendulum.g;
+    let lambda = modal.linearization.lagrange_multipliers[0];
+    assert!(close(lambda, tension, 1e-12), "λ = {lambda} vs {tension}");
+    let omega = (pendulum.g / pendulum.l).sqrt();
+    assert!(close(
+        modal.normal_modes.natural_frequencies[0],
+        omega,
+        1e-12
+    ));
+    assert_eq!(modal.mode_shapes.len(), 1);
+    let shape = &modal.mode_shapes[0];
+    assert!(
+        close(shape[0], 1.0 / pendulum.m.sqrt(), 1e-12) && shape[1].abs() < 1e-12,
+        "{shape:?}"
+    );
+    assert!(modal.m_inv_k_relative_difference < 1e-12);
+    assert!(modal.is_undamped());
+    assert_eq!(modal.damping_ratios, [0.0]);
 }
 
 /// `linearize` and `damped_modes` on the forced oscillator: `C = c`, `K = k`, `M = m`, and

@@ -98,7 +98,8 @@ pub fn boxed<S: MechanicalSystem<N> + 'static, const N: usize>(system: S) -> Box
 /// M q̈ + C q̇ + K q = [0; F0 + A cos(w t)],   q = (x1, x2) (m).
 /// ```
 ///
-/// Closed forms (D. J. Inman, *Engineering Vibration*, 4th ed., §4.1–4.2 and §4.5):
+/// Closed forms (D. J. Inman, *Engineering Vibration*, 4th ed., Pearson, 2014, ch. 4: two
+/// degrees of freedom, modal analysis, proportional damping):
 /// - `det(K − ω²M) = 0`: `ω² = (a + b ∓ √((a − b)² + 4 k2²/(m1 m2)))/2` with
 ///   `a = (k1 + k2)/m1`, `b = k2/m2`; mode `k`'s shape is `(k2, k1 + k2 − m1 ω_k²)` up to scale
 ///   ([`Self::modes`]).
@@ -203,7 +204,7 @@ impl TwoMassChain {
     }
 
     /// The free response `[q(t); q̇(t)]` of the undamped chain from `(q0, 0)`, by superposing
-    /// the closed-form modes (Inman §4.3): `q(t) = Σ_k ψ_k (ψ_kᵀ M q0) cos(ω_k t)`.
+    /// the closed-form modes (Inman ch. 4, modal analysis): `q(t) = Σ_k ψ_k (ψ_kᵀ M q0) cos(ω_k t)`.
     pub fn undamped_response(&self, q0: [f64; 2], t: f64) -> SVector<f64, 4> {
         let (w2, shapes) = self.modes();
         let q0 = Vector2::from(q0);
@@ -306,7 +307,7 @@ impl MechanicalSystem<2> for TwoMassChain {
 
 /// `m ẍ + c ẋ + k x = A cos(w t)` (lecture 21, HW21).
 ///
-/// Closed forms (Inman §2.1–2.2): `ω_n = √(k/m)`, `ζ = c/(2√(k m))`; the receptance from the
+/// Closed forms (Inman ch. 2, harmonic excitation of damped systems): `ω_n = √(k/m)`, `ζ = c/(2√(k m))`; the receptance from the
 /// load amplitude `A` is `H(ω) = 1/(k − mω² + icω)` ([`Self::receptance`]), whose modulus
 /// peaks at `ω_n √(1 − 2ζ²)` with `|H| = 1/(2ζ√(1 − ζ²) k)` (for `ζ < 1/√2`).
 #[derive(Debug, Clone, PartialEq)]
@@ -425,18 +426,20 @@ impl MechanicalSystem<1> for ForcedOscillator {
 /// m l² θ̈ = −m l (g − a w² cos(w t)) sin θ − c θ̇
 /// ```
 ///
-/// (Lagrange's equations with `T = ½ m |ṙ|²`, `V = m g y`; J. J. Thomsen, *Vibrations and
-/// Stability*, 2nd ed., Springer, 2003, §3.5.)
+/// (Lagrange's equations with `T = ½ m |ṙ|²`, `V = m g y`; the pivot's acceleration acts as
+/// extra gravity, as in `models/mathieu_pendulum.yaml`, lectures 19 and 21.)
 ///
 /// Closed forms: with `a = 0`, the simple pendulum: equilibria `θ = 0` (`hanging`) and `π`
 /// (`upright`), `ω = √(g/l)` hanging, an unstable mode growing at `σ = √(g/l)` upright,
-/// `ζ = c/(2 m l² ω)` (Inman §1.4). Shaken, its linearisation about `hanging` is Mathieu's
-/// equation `θ'' + (δ − 2q cos 2τ) θ = 0` in `τ = w t/2`, `δ = 4g/(l w²)`, `q = 2a/l`
-/// (Thomsen §3.5.2; the Ince–Strutt chart): for small `q` unstable in the first tongue
-/// `|δ − 1| < q`, where the multiplier over one period `2π/w` is `e^{π μ}` with
-/// `μ = ½ √(q² − (δ − 1)²) + O(q²)`, and stable (marginal) away from the tongues
-/// (`δ = 1/4`, `q = 0.1`). Liouville's formula gives `det Φ(T) = e^{−c T/(m l²)}` (1
-/// undamped) for any `a` (V. I. Arnold, *Ordinary Differential Equations*, §27.6).
+/// `ζ = c/(2 m l² ω)` (Inman ch. 1). Shaken, its linearisation about `hanging` is
+/// Mathieu's equation `θ'' + (δ − 2q cos 2τ) θ = 0` in `τ = w t/2`, `δ = 4g/(l w²)`,
+/// `q = 2a/l` (M. Abramowitz, I. A. Stegun, *Handbook of Mathematical Functions*, 1964,
+/// 20.1.1): unstable in the first tongue of the Ince–Strutt chart, between its characteristic
+/// values `b₁(q) = 1 − q − q²/8 + …` and `a₁(q) = 1 + q − q²/8 − …` (A&S 20.2.25), where to
+/// first order in `q` (averaging) the multiplier over one period `2π/w` is `e^{π μ}` with
+/// `μ = ½ √(q² − (δ − 1)²)`; stable (marginal) between the tongues (`δ = 1/4`, `q = 0.1`).
+/// Liouville's formula `det Φ(T) = exp ∫₀ᵀ tr(∂f/∂y) dt` gives `det Φ(T) = e^{−c T/(m l²)}`
+/// (1 undamped) for any `a` (as in `FloquetAnalysis::determinant`).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Pendulum {
     pub m: f64,
@@ -566,11 +569,11 @@ impl MechanicalSystem<1> for Pendulum {
 /// by the rod `Φ = √(x² + y²) − l = 0`: `m q̈ = (0, −m g) − Jᵀλ`, `J = (x, y)/r`, so `λ` is
 /// the rod's tension (N). The index-1 form needs `γ = −q̇ᵀ(∇²Φ)q̇ = −(|q̇|² − (r̂·q̇)²)/r`.
 ///
-/// Closed forms (lectures 8–11; energy conservation, J. L. Meriam, L. G. Kraige, *Engineering
-/// Mechanics: Dynamics*, §3/5): released at rest from `θ0`, the tension at angle `θ` is
-/// `λ = m g (3 cos θ − 2 cos θ0)` (`cos θ = −y/l`), `m g` hanging at rest; linearised on the
-/// constraint about `hanging`, `ω = √(g/l)` in the one minimal coordinate. Its
-/// minimal-coordinate twin is `Pendulum` (point `bob` the same).
+/// Closed forms (lectures 8–11): released at rest from `θ0`, energy conservation gives
+/// `v² = 2 g l (cos θ − cos θ0)` and the radial balance `λ − m g cos θ = m v²/l` the tension
+/// at angle `θ`, `λ = m g (3 cos θ − 2 cos θ0)` (`cos θ = −y/l`), `m g` hanging at rest;
+/// linearised on the constraint about `hanging`, `ω = √(g/l)` in the one minimal coordinate
+/// `x`. Its minimal-coordinate twin is `Pendulum` (point `bob` the same).
 #[derive(Debug, Clone, PartialEq)]
 pub struct CartesianPendulum {
     pub m: f64,
