@@ -8,8 +8,8 @@ mod common;
 
 use common::models::{CartesianPendulum, Pendulum, TwoMassChain, boxed};
 use eomgen_runtime::analysis::{
-    ConstraintMethodsOptions, Method, SimulationOptions, WorkPrecisionOptions, constraint_methods,
-    energy_drift_at, simulate, work_precision,
+    ConstraintMethodsOptions, Method, SimulationOptions, SimulationWarning, WorkPrecisionOptions,
+    constraint_methods, energy_drift_at, fixed_step_warnings, simulate, work_precision,
 };
 use eomgen_runtime::{OutputTimes, Stabilization};
 use nalgebra::SMatrix;
@@ -215,6 +215,43 @@ fn work_precision_of_rk4_is_its_stability_function() {
             "N = {n}: {error:e} vs {expected:e}"
         );
     }
+}
+
+/// `fixed_step_warnings` on the undamped chain: RK4 is stable on `ẍ = −ω²x` for
+/// `hω ≤ 2√2` (Hairer, Wanner II, §IV.2), so a step 5 % past `2√2/ω₂` (the fast mode) is
+/// warned about, naming the eigenvalue `±iω₂` (1e-6: central differences of a linear
+/// right-hand side) and the amplification `|R(ihω₂)|`, `|R(iy)|² = 1 − y⁶/72 + y⁸/576`
+/// (1e-6); a step 5 % inside the limit is not.
+#[test]
+fn fixed_step_warnings_at_the_rk4_limit() {
+    let chain = released_chain();
+    let mut model = boxed(chain.clone());
+    let y0 = model.initial_state();
+    let (w2, _) = chain.modes();
+    let fast = w2[1].sqrt();
+    let limit = 2.0 * 2f64.sqrt() / fast;
+    let inside = fixed_step_warnings(model.as_mut(), Method::Rk4, &y0, Some(0.95 * limit), 50.0);
+    assert!(inside.is_empty(), "{inside:?}");
+    let past = fixed_step_warnings(model.as_mut(), Method::Rk4, &y0, Some(1.05 * limit), 50.0);
+    assert_eq!(past.len(), 1, "{past:?}");
+    let SimulationWarning::StepPastStabilityLimit {
+        eigenvalue,
+        amplification,
+        ..
+    } = past[0]
+    else {
+        panic!("{:?}", past[0]);
+    };
+    assert!(
+        eigenvalue[0].abs() < 1e-6 * fast && (eigenvalue[1].abs() - fast).abs() < 1e-6 * fast,
+        "{eigenvalue:?}"
+    );
+    let y = 1.05 * limit * fast;
+    let expected = (1.0 - y.powi(6) / 72.0 + y.powi(8) / 576.0).sqrt();
+    assert!(
+        (amplification - expected).abs() < 1e-6 * expected,
+        "{amplification} vs {expected}"
+    );
 }
 
 /// `constraint_methods` on the Cartesian pendulum with its minimal twin: the DAE rows and

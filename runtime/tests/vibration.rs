@@ -10,7 +10,7 @@ use common::models::{CartesianPendulum, ForcedOscillator, Pendulum, TwoMassChain
 use eomgen_runtime::analysis::vibration::{
     EquilibriumStart, FloquetStudyError, FloquetStudyOptions, FreeResponseMethod,
     FreeResponseOptions, FrfOptions, FrfSimulationOptions, InitialDeviation, ModalDampingOptions,
-    ModalOptions, OperatingPointError, OperatingPointOptions, floquet_at_equilibrium,
+    ModalOptions, OperatingPointError, OperatingPointOptions, floquet_at_equilibrium, floquet_cell,
     free_response, frequency_response_analysis, max_simulation_error, modal_analysis,
     modal_damping_study, plan_simulation, simulate_point,
 };
@@ -769,7 +769,8 @@ fn liouville_determinant_of_the_mathieu_equation() {
 /// `ln ρ = π q/2` to 2 % (first-order perturbation theory, next terms `O(q²)` relative); at
 /// `δ = 1/4` marginal, `|ρ − 1| < 1e-6` (the stability tolerance); Liouville's
 /// `det Φ(T) = 1` undamped and `e^{−cT/(m l²)}` damped, to 1e-10 (DOP853 at 1e-12 over one
-/// period). Unshaken, the model has no period and is refused.
+/// period). Unshaken, the model has no period and is refused as a point; as a chart's cell
+/// it is analysed.
 #[test]
 fn floquet_multipliers_of_the_shaken_pendulum() {
     let base = Pendulum::default();
@@ -835,10 +836,27 @@ fn floquet_multipliers_of_the_shaken_pendulum() {
     );
     assert_eq!(f.stability, FloquetStability::AsymptoticallyStable);
 
-    let mut still = boxed(base);
+    let mut still = boxed(base.clone());
     let refused = floquet_at_equilibrium(still.as_mut(), &options);
     assert!(
         matches!(refused, Err(FloquetStudyError::TimeIndependent { .. })),
         "{refused:?}"
     );
+
+    // A chart's cells: the unshaken column (`a = 0`) is analysed as it is, its upright
+    // multiplier `e^{σT}`, `σ = √(g/l)`, `T = 2π/w` (1e-8 relative: DOP853 at 1e-12 over a
+    // growth of e^{1.6}); the resonant cell is unstable as the point above.
+    let w = 4.0 * omega;
+    let cell = floquet_cell(still.as_mut(), &[PI], &[("a", 0.0), ("w", w)], &options).unwrap();
+    let growth = (omega * TAU / w).exp();
+    assert!(
+        (cell.spectral_radius - growth).abs() < 1e-8 * growth,
+        "ρ = {} vs {growth}",
+        cell.spectral_radius
+    );
+    assert_eq!(cell.stability, FloquetStability::Unstable);
+    let values = [("a", q * base.l / 2.0), ("w", 2.0 * omega)];
+    let cell = floquet_cell(still.as_mut(), &[0.0], &values, &options).unwrap();
+    assert_eq!(cell.stability, FloquetStability::Unstable);
+    assert!((cell.spectral_radius.ln() - expected).abs() < 0.02 * expected);
 }
