@@ -27,7 +27,7 @@ use std::fs::{self, Metadata, OpenOptions};
 use std::io::{self, Write as _};
 use std::path::{Path, PathBuf};
 
-use super::CliError;
+use super::error::CliError;
 
 /// An output that cannot be written, or two outputs that would write one file.
 #[derive(Debug, thiserror::Error)]

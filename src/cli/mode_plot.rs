@@ -13,7 +13,7 @@ use eomgen::{ModeKind, ModelInfo, NormalModes};
 use nalgebra::DMatrix;
 use plotters::prelude::*;
 
-use super::CliError;
+use super::error::CliError;
 use super::plot::{register_font, tick};
 
 /// Largest point displacement of a drawn mode, as a fraction of the mechanism's size.

@@ -164,6 +164,25 @@ pub fn lines_noted(
     write_chart!(path, (960, 600), |root| draw(root, chart, series, note))
 }
 
+/// Draws `series` into `path` with a logarithmic y axis; `labels` are the title and the x and
+/// y axis descriptions.
+pub(super) fn log_y_chart(
+    path: &str,
+    labels: [&str; 3],
+    log_x: bool,
+    series: &[Series],
+) -> Result<(), super::error::CliError> {
+    let [title, x_desc, y_desc] = labels;
+    let chart = Chart {
+        title,
+        x_desc,
+        y_desc,
+        log_x,
+        log_y: true,
+    };
+    lines(path, &chart, series).map_err(super::error::CliError::failure)
+}
+
 /// The format of a chart file, named by its extension.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(super) enum ChartFormat {

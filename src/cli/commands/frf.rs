@@ -18,11 +18,12 @@ use plotters::prelude::*;
 use rayon::prelude::*;
 use serde_json::{Value, json};
 
-use super::files::Outputs;
-use super::modes::{OperatingPointArgs, point_json};
-use super::render::num;
-use super::values::{evaluate, parameter_lookup};
-use super::{CliError, plot};
+use crate::cli::error::CliError;
+use crate::cli::files::Outputs;
+use crate::cli::operating_point::{OperatingPointArgs, point_json};
+use crate::cli::plot;
+use crate::cli::render::num;
+use crate::cli::values::{evaluate, parameter_lookup};
 
 /// Options of `eomgen frf`.
 #[derive(Debug, Args)]
@@ -69,7 +70,7 @@ pub struct FrfArgs {
     #[arg(long, default_value_t = 1e-3)]
     pub amplitude: f64,
     /// Relative tolerance of the `--simulate` runs (DOP853).
-    #[arg(long, default_value_t = 1e-11, value_parser = super::values::relative_tolerance, allow_hyphen_values = true)]
+    #[arg(long, default_value_t = 1e-11, value_parser = crate::cli::values::relative_tolerance, allow_hyphen_values = true)]
     pub rtol: f64,
     /// Print JSON.
     #[arg(long)]
@@ -90,7 +91,9 @@ fn failure(model: &dyn ModelInfo, e: FrfAnalysisError) -> CliError {
         FrfAnalysisError::SimulationNeedsParameter { input } => CliError::usage(format!(
             "--simulate needs a load parameter as --input (`{input}` is a coordinate: a unit generalized force has no load in the model to drive)"
         )),
-        FrfAnalysisError::OperatingPoint(e) => super::modes::point_failure(model, &e),
+        FrfAnalysisError::OperatingPoint(e) => {
+            crate::cli::operating_point::point_failure(model, &e)
+        }
         FrfAnalysisError::Input(ref source) => {
             let input = match source {
                 FrfError::NonlinearInput { input, .. }
@@ -130,7 +133,9 @@ fn failure(model: &dyn ModelInfo, e: FrfAnalysisError) -> CliError {
         FrfAnalysisError::NoSteadyState(e) => {
             CliError::usage(format!("--simulate: `{name}`: {e}; add damping with --set"))
         }
-        FrfAnalysisError::Frf(FrfError::Modal(m)) => super::modes::modal_failure(model, &m),
+        FrfAnalysisError::Frf(FrfError::Modal(m)) => {
+            crate::cli::operating_point::modal_failure(model, &m)
+        }
         FrfAnalysisError::Frf(e @ FrfError::ResponseOutOfRange { .. }) => CliError::usage(format!(
             "--frequency/--freqs: {e}; choose frequencies where the response is representable"
         )),
@@ -139,12 +144,12 @@ fn failure(model: &dyn ModelInfo, e: FrfAnalysisError) -> CliError {
 }
 
 /// `w` (rad/s), the value of `option` typed as `text`, if it is in
-/// [`super::values::FREQUENCY`] (or 0, the static response, when `zero` is allowed).
+/// [`crate::cli::values::FREQUENCY`] (or 0, the static response, when `zero` is allowed).
 ///
 /// # Errors
 /// A usage error that quotes `text` and gives the range.
 fn frequency(option: &str, text: &str, w: f64, zero: bool) -> Result<f64, CliError> {
-    if super::values::FREQUENCY.contains(&w) || (zero && w == 0.0) {
+    if crate::cli::values::FREQUENCY.contains(&w) || (zero && w == 0.0) {
         Ok(w)
     } else {
         Err(CliError::usage(format!(
@@ -231,11 +236,11 @@ pub fn run(args: &FrfArgs) -> Result<(), CliError> {
         let text =
             serde_json::to_string_pretty(&json_report(args, model.as_ref(), &frf, simulated))
                 .map_err(|e| CliError::failure(e.to_string()))?;
-        let _ = writeln!(super::output::stdout(), "{text}");
+        let _ = writeln!(crate::cli::output::stdout(), "{text}");
         return Ok(());
     }
     print_report(
-        &mut super::output::stdout(),
+        &mut crate::cli::output::stdout(),
         args,
         model.as_ref(),
         &frf,
@@ -580,7 +585,7 @@ fn simulate_points(
 ) -> Result<Vec<SimulatedPoint>, CliError> {
     let name = &model.description().name;
     let k = plan.frequencies.len();
-    let progress = super::render::progress_bar(
+    let progress = crate::cli::render::progress_bar(
         k,
         "{msg} [{bar:30}] {pos}/{len} ({elapsed}, eta {eta})",
         "steady-state simulations",

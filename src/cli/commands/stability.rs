@@ -23,9 +23,12 @@ use eomgen::integrate::stability::GrowthTest;
 use nalgebra::Complex;
 use serde_json::json;
 
-use super::files::Outputs;
-use super::render::num;
-use super::{CliError, find_model, plot};
+use crate::cli::error::CliError;
+use crate::cli::files::Outputs;
+use crate::cli::model::find_model;
+use crate::cli::output::print_json;
+use crate::cli::plot::{self, log_y_chart};
+use crate::cli::render::num;
 
 /// The bundled model of part c: HW9's two-mass spring.
 const STIFF_MODEL: &str = "two_masses";
@@ -40,13 +43,13 @@ pub struct StabilityArgs {
     #[arg(long, default_value_t = 10_000)]
     pub periods: usize,
     /// Stiffness ratios k/m (1/s²) of the stiff two-mass spring (part c), comma separated.
-    #[arg(long, value_delimiter = ',', value_parser = super::values::stiffness, allow_hyphen_values = true, default_values_t = [1e2, 1e4, 1e6, 1e8])]
+    #[arg(long, value_delimiter = ',', value_parser = crate::cli::values::stiffness, allow_hyphen_values = true, default_values_t = [1e2, 1e4, 1e6, 1e8])]
     pub stiffness: Vec<f64>,
     /// End time of the stiff runs (s).
     #[arg(long, default_value_t = 1.0)]
     pub t_end: f64,
     /// Relative and absolute tolerance of the stiff runs and of the underflow run.
-    #[arg(long, default_value_t = 1e-6, value_parser = super::values::relative_tolerance, allow_hyphen_values = true)]
+    #[arg(long, default_value_t = 1e-6, value_parser = crate::cli::values::relative_tolerance, allow_hyphen_values = true)]
     pub tol: f64,
     /// Print JSON instead of the tables.
     #[arg(long)]
@@ -152,7 +155,7 @@ pub fn run(args: &StabilityArgs) -> Result<(), CliError> {
         write_energy(&mut text, args.periods, &energy);
         write_stiff(&mut text, args, &modes, &stiff);
         write_underflow(&mut text, &underflow);
-        let _ = write!(super::output::stdout(), "{text}");
+        let _ = write!(crate::cli::output::stdout(), "{text}");
     }
     // The limits of part a are always measured (a failure there is the study's error), so
     // the rule of a study that measured nothing has nothing to refuse here.
@@ -170,32 +173,6 @@ fn chart_path(prefix: &str, name: &str) -> String {
         let stem = prefix.strip_suffix(".svg").unwrap_or(prefix);
         format!("{stem}-{name}.svg")
     }
-}
-
-/// Draws `series` into `path` with a logarithmic y axis; `labels` are the title and the x and
-/// y axis descriptions.
-pub(super) fn log_y_chart(
-    path: &str,
-    labels: [&str; 3],
-    log_x: bool,
-    series: &[plot::Series],
-) -> Result<(), CliError> {
-    let [title, x_desc, y_desc] = labels;
-    let chart = plot::Chart {
-        title,
-        x_desc,
-        y_desc,
-        log_x,
-        log_y: true,
-    };
-    plot::lines(path, &chart, series).map_err(CliError::failure)
-}
-
-/// Prints `value` as pretty JSON on stdout.
-pub(super) fn print_json(value: &serde_json::Value) -> Result<(), CliError> {
-    let text = serde_json::to_string_pretty(value).map_err(|e| CliError::failure(e.to_string()))?;
-    let _ = writeln!(super::output::stdout(), "{text}");
-    Ok(())
 }
 
 fn optional(value: Option<f64>) -> String {

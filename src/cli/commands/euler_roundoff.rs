@@ -12,10 +12,12 @@ use eomgen::analysis::roundoff::{
 };
 use serde_json::json;
 
-use super::files::Outputs;
-use super::render::num;
-use super::stability::{log_y_chart, print_json};
-use super::{CliError, plot};
+use crate::cli::error::CliError;
+use crate::cli::files::Outputs;
+use crate::cli::output::print_json;
+use crate::cli::plot;
+use crate::cli::plot::log_y_chart;
+use crate::cli::render::num;
 
 /// Options of `eomgen study euler-roundoff`.
 #[derive(Debug, Args)]
@@ -55,7 +57,7 @@ pub fn run(args: &EulerRoundoffArgs) -> Result<(), CliError> {
     if let Some(path) = &args.plot {
         plot_errors(path, &rows)?;
     }
-    let mut stdout = super::output::stdout();
+    let mut stdout = crate::cli::output::stdout();
     if args.json {
         let out = json!({
             "problem": "x' = x, x(0) = 1 on [0, 1]; x(1) = e",
