@@ -4,6 +4,7 @@
 
 use eomgen::vibration::{InitialDeviation, ResponseStudyError};
 use eomgen::{ModeKind, ModelInfo};
+use plotters::coord::Shift;
 use plotters::prelude::*;
 use serde_json::json;
 
@@ -83,9 +84,23 @@ pub(super) struct Panel {
 /// # Errors
 /// An unknown extension, a panel with no finite point, or a failure to write the file.
 pub(super) fn panels(path: &str, title: &str, panels: &[Panel]) -> Result<(), String> {
-    plot::register_font()?;
     let size = (960, 60 + 260 * panels.len().max(1) as u32);
-    plot::write_chart!(path, size, |root| draw_panels(root, title, panels))
+    plot::write_chart(path, size, &PanelChart { title, panels })
+}
+
+/// The panels of [`panels`], drawn.
+struct PanelChart<'a> {
+    title: &'a str,
+    panels: &'a [Panel],
+}
+
+impl plot::Drawing for PanelChart<'_> {
+    fn draw<DB: DrawingBackend>(&self, root: DrawingArea<DB, Shift>) -> Result<(), String>
+    where
+        DB::ErrorType: 'static,
+    {
+        draw_panels(root, self.title, self.panels)
+    }
 }
 
 fn draw_panels<DB: DrawingBackend>(

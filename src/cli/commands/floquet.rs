@@ -22,6 +22,7 @@ use eomgen::{
     ChartAxis, FloquetAnalysis, FloquetError, FloquetOptions, FloquetReferences, FloquetStability,
     ModelInfo, ThresholdPrediction,
 };
+use plotters::coord::Shift;
 use plotters::prelude::*;
 use rayon::prelude::*;
 use serde_json::{Value, json};
@@ -29,7 +30,7 @@ use serde_json::{Value, json};
 use crate::cli::error::CliError;
 use crate::cli::files::Outputs;
 use crate::cli::operating_point::{OperatingPointArgs, point_json};
-use crate::cli::plot::{register_font, tick};
+use crate::cli::plot::{Drawing, tick, write_chart};
 use crate::cli::render::num;
 use crate::cli::values::{evaluate, parameter_lookup, set_parameters, split_assignment};
 
@@ -552,11 +553,39 @@ fn stability_chart(
     grid: &[Vec<Cell>],
     references: Option<(&FloquetReferences, &dyn ModelInfo)>,
 ) -> Result<(), String> {
-    register_font()?;
-    let size = (960, 720);
-    crate::cli::plot::write_chart!(path, size, |root| draw_stability(
-        root, title, axes, labels, grid, references
-    ))
+    let chart = StabilityChart {
+        title,
+        axes,
+        labels,
+        grid,
+        references,
+    };
+    write_chart(path, (960, 720), &chart)
+}
+
+/// The stability chart of [`stability_chart`], drawn.
+struct StabilityChart<'a> {
+    title: &'a str,
+    axes: [&'a Axis; 2],
+    labels: &'a [String; 2],
+    grid: &'a [Vec<Cell>],
+    references: Option<(&'a FloquetReferences, &'a dyn ModelInfo)>,
+}
+
+impl Drawing for StabilityChart<'_> {
+    fn draw<DB: DrawingBackend>(&self, root: DrawingArea<DB, Shift>) -> Result<(), String>
+    where
+        DB::ErrorType: 'static,
+    {
+        draw_stability(
+            root,
+            self.title,
+            self.axes,
+            self.labels,
+            self.grid,
+            self.references,
+        )
+    }
 }
 
 /// An axis label with the unit where it is known: the period parameter is a frequency in
@@ -741,9 +770,22 @@ where
 
 /// The multipliers in the complex plane, with the unit circle.
 fn multiplier_chart(path: &str, title: &str, floquet: &FloquetAnalysis) -> Result<(), String> {
-    register_font()?;
-    let size = (720, 720);
-    crate::cli::plot::write_chart!(path, size, |root| draw_multipliers(root, title, floquet))
+    write_chart(path, (720, 720), &MultiplierChart { title, floquet })
+}
+
+/// The multipliers of [`multiplier_chart`], drawn.
+struct MultiplierChart<'a> {
+    title: &'a str,
+    floquet: &'a FloquetAnalysis,
+}
+
+impl Drawing for MultiplierChart<'_> {
+    fn draw<DB: DrawingBackend>(&self, root: DrawingArea<DB, Shift>) -> Result<(), String>
+    where
+        DB::ErrorType: 'static,
+    {
+        draw_multipliers(root, self.title, self.floquet)
+    }
 }
 
 fn draw_multipliers<DB: DrawingBackend>(

@@ -14,6 +14,7 @@ use eomgen::vibration::{
 };
 use eomgen::{FrequencySweep, FrfError, ModalResponse, ModelInfo, PeakAmplitude, phase_degrees};
 use nalgebra::Complex;
+use plotters::coord::Shift;
 use plotters::prelude::*;
 use rayon::prelude::*;
 use serde_json::{Value, json};
@@ -616,11 +617,30 @@ fn bode_chart(
     sweeps: &[FrequencySweep],
     simulated: Option<&[SimulatedPoint]>,
 ) -> Result<(), String> {
-    plot::register_font()?;
-    let size = (960, 720);
-    plot::write_chart!(path, size, |root| draw_bode(
-        root, title, outputs, sweeps, simulated
-    ))
+    let chart = BodeChart {
+        title,
+        outputs,
+        sweeps,
+        simulated,
+    };
+    plot::write_chart(path, (960, 720), &chart)
+}
+
+/// The Bode chart of [`bode_chart`], drawn.
+struct BodeChart<'a> {
+    title: &'a str,
+    outputs: &'a [FrfOutput],
+    sweeps: &'a [FrequencySweep],
+    simulated: Option<&'a [SimulatedPoint]>,
+}
+
+impl plot::Drawing for BodeChart<'_> {
+    fn draw<DB: DrawingBackend>(&self, root: DrawingArea<DB, Shift>) -> Result<(), String>
+    where
+        DB::ErrorType: 'static,
+    {
+        draw_bode(root, self.title, self.outputs, self.sweeps, self.simulated)
+    }
 }
 
 /// Contiguous runs of finite points (a `None` breaks the line).

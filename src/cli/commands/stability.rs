@@ -102,7 +102,7 @@ pub fn run(args: &StabilityArgs) -> Result<(), CliError> {
     let charts = args
         .plot
         .as_deref()
-        .map(|prefix| CHARTS.map(|name| chart_path(prefix, name)));
+        .map(|prefix| CHARTS.map(|name| plot::chart_path(prefix, name)));
     charts
         .iter()
         .flatten()
@@ -162,18 +162,9 @@ pub fn run(args: &StabilityArgs) -> Result<(), CliError> {
     Ok(())
 }
 
-/// `PREFIX-name.svg`, or `.png` when the prefix ends in `.png` (a `.svg` ending is dropped).
-/// The charts of `--plot PREFIX`: `PREFIX-limits`, `PREFIX-energy`, `PREFIX-stiff`.
+/// The charts of `--plot PREFIX`: `PREFIX-limits`, `PREFIX-energy`, `PREFIX-stiff`
+/// ([`plot::chart_path`]).
 const CHARTS: [&str; 3] = ["limits", "energy", "stiff"];
-
-fn chart_path(prefix: &str, name: &str) -> String {
-    if let Some(stem) = prefix.strip_suffix(".png") {
-        format!("{stem}-{name}.png")
-    } else {
-        let stem = prefix.strip_suffix(".svg").unwrap_or(prefix);
-        format!("{stem}-{name}.svg")
-    }
-}
 
 fn optional(value: Option<f64>) -> String {
     value.map_or_else(|| "-".to_string(), |v| format!("{v:.4e}", v = num(v)))
