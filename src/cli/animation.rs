@@ -32,6 +32,9 @@ const STYLE: &str = include_str!("animate.css");
 const HOOKS: &str = include_str!("animate_hooks.js");
 const PLAYER: &str = include_str!("animate.js");
 
+/// Frames per second of simulated time of `animate` without `--fps`, and of the report's
+/// animations.
+pub(super) const DEFAULT_FPS: f64 = 30.0;
 /// Most frames an animation may have (`t_end · fps + 1`).
 const MAX_FRAMES: usize = 100_000;
 /// Frames per cycle of a mode-shape animation, and the real seconds one cycle takes at 1×.

@@ -70,16 +70,16 @@ pub enum StabilizationArg {
 #[derive(Debug, Args)]
 pub struct IntegrationArgs {
     /// End time (s).
-    #[arg(long, default_value_t = 10.0)]
+    #[arg(long, default_value_t = SimulationOptions::DEFAULT_T_END)]
     pub t_end: f64,
     /// Integration method.
-    #[arg(long, value_parser = method_parser(), default_value_t = Method::Dp54)]
+    #[arg(long, value_parser = method_parser(), default_value_t = SimulationOptions::DEFAULT_METHOD)]
     pub method: Method,
     /// Relative tolerance (adaptive methods: bs32, dp54, dop853, radau5).
-    #[arg(long, default_value_t = 1e-8, value_parser = super::values::relative_tolerance, allow_hyphen_values = true)]
+    #[arg(long, default_value_t = SimulationOptions::DEFAULT_RTOL, value_parser = super::values::relative_tolerance, allow_hyphen_values = true)]
     pub rtol: f64,
     /// Absolute tolerance (adaptive methods; implicit-midpoint's scale for components near 0).
-    #[arg(long, default_value_t = 1e-10, value_parser = super::values::absolute_tolerance, allow_hyphen_values = true)]
+    #[arg(long, default_value_t = SimulationOptions::DEFAULT_ATOL, value_parser = super::values::absolute_tolerance, allow_hyphen_values = true)]
     pub atol: f64,
     /// Step size: the fixed step of euler, midpoint, rk4, symplectic-euler, stormer-verlet and
     /// implicit-midpoint (default t_end/1000); the initial step of the adaptive methods
@@ -137,7 +137,9 @@ impl IntegrationArgs {
         if self.method.is_adaptive() {
             format!("rtol {:e}, atol {:e}", num(self.rtol), num(self.atol))
         } else {
-            let dt = self.dt.unwrap_or(self.t_end / 1000.0);
+            let dt = self
+                .dt
+                .unwrap_or(self.t_end / eomgen::IntegratorOptions::DEFAULT_FIXED_STEPS);
             format!("fixed step dt = {dt:e} s", dt = num(dt))
         }
     }

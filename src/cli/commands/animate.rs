@@ -3,7 +3,7 @@
 
 use clap::Args;
 
-use crate::cli::animation::simulation;
+use crate::cli::animation::{DEFAULT_FPS, simulation};
 use crate::cli::error::CliError;
 use crate::cli::files::{self, Outputs};
 use crate::cli::integration::IntegrationArgs;
@@ -22,7 +22,7 @@ pub struct AnimateArgs {
     #[arg(short = 'o', long = "output", value_name = "FILE.html")]
     pub output: String,
     /// Frames per second of simulated time (frames at t = k / fps, from dense output).
-    #[arg(long, default_value_t = 30.0)]
+    #[arg(long, default_value_t = DEFAULT_FPS)]
     pub fps: f64,
     /// Points whose paths are traced, comma separated (default: the file's `draw: trace`).
     #[arg(long, value_delimiter = ',', value_name = "P1,P2")]

@@ -22,13 +22,13 @@ pub struct ConstraintMethodsArgs {
     /// a bundled name or the path of any model file.
     pub model: String,
     /// End time (s), in [1e-6, 1e6].
-    #[arg(long, default_value_t = 10.0, value_parser = crate::cli::values::study_end_time, allow_hyphen_values = true)]
+    #[arg(long, default_value_t = ConstraintMethodsOptions::DEFAULT_T_END, value_parser = crate::cli::values::study_end_time, allow_hyphen_values = true)]
     pub t_end: f64,
     /// Relative and absolute tolerance of every run (Dormand–Prince 5(4)).
-    #[arg(long, default_value_t = 1e-8, value_parser = crate::cli::values::relative_tolerance, allow_hyphen_values = true)]
+    #[arg(long, default_value_t = ConstraintMethodsOptions::DEFAULT_TOL, value_parser = crate::cli::values::relative_tolerance, allow_hyphen_values = true)]
     pub tol: f64,
     /// Spring stiffnesses of method I, comma separated.
-    #[arg(long, value_delimiter = ',', value_parser = crate::cli::values::stiffness, allow_hyphen_values = true, default_values_t = [1e2, 1e4, 1e6])]
+    #[arg(long, value_delimiter = ',', value_parser = crate::cli::values::stiffness, allow_hyphen_values = true, default_values_t = ConstraintMethodsOptions::DEFAULT_STIFFNESS)]
     pub stiffness: Vec<f64>,
     /// Print JSON instead of the table.
     #[arg(long)]

@@ -24,7 +24,7 @@ use crate::cli::render::num;
 pub struct EulerRoundoffArgs {
     /// Largest n: steps h = 10⁻ⁿ for n = 0 … N, so 10ᴺ steps per method at the end
     /// (at most 8; 7 takes about 3 s, 8 about 30 s in a release build).
-    #[arg(long, default_value_t = 7)]
+    #[arg(long, default_value_t = RoundoffOptions::DEFAULT_MAX_N)]
     pub max_n: u32,
     /// Print JSON instead of the table.
     #[arg(long)]

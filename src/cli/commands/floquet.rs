@@ -43,7 +43,7 @@ pub struct FloquetArgs {
     #[command(flatten)]
     pub point: OperatingPointArgs,
     /// The parameter that is the forcing frequency w (rad/s); the period is T = 2π/w.
-    #[arg(long, default_value = "w")]
+    #[arg(long, default_value = FloquetStudyOptions::DEFAULT_PERIOD_PARAMETER)]
     pub period_parameter: String,
     /// Stability chart over two parameters, `X=LO..HI:N,Y=LO..HI:N` (N values each, ends
     /// included; `a=0..0.3:61,w=10..100:61`): the x axis first. N ≤ 10000 and at most 10⁶
@@ -57,7 +57,7 @@ pub struct FloquetArgs {
     pub stability_tolerance: Option<f64>,
     /// Relative and absolute tolerance of DOP853 on the state and the variational equations,
     /// in (0, 1e-4].
-    #[arg(long, default_value_t = 1e-12, value_parser = crate::cli::values::floquet_tolerance, allow_hyphen_values = true)]
+    #[arg(long, default_value_t = FloquetOptions::DEFAULT_TOL, value_parser = crate::cli::values::floquet_tolerance, allow_hyphen_values = true)]
     pub tol: f64,
     /// Print JSON.
     #[arg(long)]

@@ -48,7 +48,7 @@ pub struct FrfArgs {
     #[arg(long, value_name = "LO..HI")]
     pub freqs: Option<String>,
     /// Frequencies of the sweep, spaced evenly in log ω (1 to 100000).
-    #[arg(long, default_value_t = 400, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..=100_000))]
+    #[arg(long, default_value_t = FrfOptions::DEFAULT_POINTS, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..=100_000))]
     pub points: usize,
     /// Also evaluate the response at this frequency (rad/s, an expression such as
     /// `sqrt(2*k/m)` or `w`); repeatable. With `--modal`, the modal breakdown is given here.
@@ -68,10 +68,10 @@ pub struct FrfArgs {
     pub frequency_parameter: Option<String>,
     /// The input's value in the `--simulate` runs (small, so that the nonlinear model stays
     /// near its linearisation).
-    #[arg(long, default_value_t = 1e-3)]
+    #[arg(long, default_value_t = FrfSimulationOptions::DEFAULT_AMPLITUDE)]
     pub amplitude: f64,
     /// Relative tolerance of the `--simulate` runs (DOP853).
-    #[arg(long, default_value_t = 1e-11, value_parser = crate::cli::values::relative_tolerance, allow_hyphen_values = true)]
+    #[arg(long, default_value_t = FrfSimulationOptions::DEFAULT_RTOL, value_parser = crate::cli::values::relative_tolerance, allow_hyphen_values = true)]
     pub rtol: f64,
     /// Print JSON.
     #[arg(long)]

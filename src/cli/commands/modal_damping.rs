@@ -41,10 +41,10 @@ pub struct ModalDampingArgs {
     #[arg(long, value_parser = crate::cli::values::study_end_time, allow_hyphen_values = true)]
     pub t_end: Option<f64>,
     /// Number of output times, evenly spaced from 0 to the end time (2 to 1000000).
-    #[arg(long, default_value_t = 801, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(2..=1_000_000))]
+    #[arg(long, default_value_t = ModalDampingOptions::DEFAULT_SAMPLES, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(2..=1_000_000))]
     pub samples: usize,
     /// Relative and absolute tolerance of the DOP853 check of the exact response.
-    #[arg(long, default_value_t = 1e-12, value_parser = crate::cli::values::relative_tolerance, allow_hyphen_values = true)]
+    #[arg(long, default_value_t = ModalDampingOptions::DEFAULT_TOL, value_parser = crate::cli::values::relative_tolerance, allow_hyphen_values = true)]
     pub tol: f64,
     /// Print JSON instead of the table.
     #[arg(long)]

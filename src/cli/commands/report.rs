@@ -31,6 +31,7 @@ use eomgen_symbolic::codegen::equations_mathml;
 use eomgen_symbolic::mechanics::{Formulation, Lagrange, SymbolicModel};
 use eomgen_symbolic::model::ModelFile;
 
+use crate::cli::animation::DEFAULT_FPS;
 use crate::cli::error::CliError;
 use crate::cli::output::outln;
 use crate::cli::plot;
@@ -405,7 +406,7 @@ fn animation(spec: &str, name: &str, model_dir: &Path, notes: &mut Vec<String>) 
             return None;
         }
     };
-    match crate::cli::animation::simulation(spec, &args, 30.0, &[]) {
+    match crate::cli::animation::simulation(spec, &args, DEFAULT_FPS, &[]) {
         Ok((Some(animation), failure)) => {
             if let Some(e) = failure {
                 notes.push(format!("animation: {}", e.message));

@@ -37,19 +37,19 @@ const STIFF_MODEL: &str = "two_masses";
 #[derive(Debug, Args)]
 pub struct StabilityArgs {
     /// Constant steps of each run of the stability-limit bisection (part a).
-    #[arg(long, default_value_t = 10_000)]
+    #[arg(long, default_value_t = StabilityOptions::DEFAULT_STEPS)]
     pub steps: usize,
     /// Periods of the oscillator in the energy study (part b).
-    #[arg(long, default_value_t = 10_000)]
+    #[arg(long, default_value_t = StabilityOptions::DEFAULT_PERIODS)]
     pub periods: usize,
     /// Stiffness ratios k/m (1/s²) of the stiff two-mass spring (part c), comma separated.
-    #[arg(long, value_delimiter = ',', value_parser = crate::cli::values::stiffness, allow_hyphen_values = true, default_values_t = [1e2, 1e4, 1e6, 1e8])]
+    #[arg(long, value_delimiter = ',', value_parser = crate::cli::values::stiffness, allow_hyphen_values = true, default_values_t = StabilityOptions::DEFAULT_STIFFNESS)]
     pub stiffness: Vec<f64>,
     /// End time of the stiff runs (s).
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, default_value_t = StabilityOptions::DEFAULT_T_END)]
     pub t_end: f64,
     /// Relative and absolute tolerance of the stiff runs and of the underflow run.
-    #[arg(long, default_value_t = 1e-6, value_parser = crate::cli::values::relative_tolerance, allow_hyphen_values = true)]
+    #[arg(long, default_value_t = StabilityOptions::DEFAULT_TOL, value_parser = crate::cli::values::relative_tolerance, allow_hyphen_values = true)]
     pub tol: f64,
     /// Print JSON instead of the tables.
     #[arg(long)]

@@ -81,28 +81,28 @@ pub struct WorkPrecisionArgs {
     #[arg(long)]
     pub steps: Option<String>,
     /// End time T (s), in [1e-6, 1e6].
-    #[arg(long, default_value_t = 10.0, value_parser = crate::cli::values::study_end_time, allow_hyphen_values = true)]
+    #[arg(long, default_value_t = WorkPrecisionOptions::DEFAULT_T_END, value_parser = crate::cli::values::study_end_time, allow_hyphen_values = true)]
     pub t_end: f64,
     /// Number S of equally spaced output times `k T / S`, k = 1…S, at which errors are taken
     /// (1 to 100000).
-    #[arg(long, default_value_t = 100, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..=100_000))]
+    #[arg(long, default_value_t = WorkPrecisionOptions::DEFAULT_SAMPLES, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..=100_000))]
     pub samples: usize,
     /// Error at which the work of every method is interpolated (same norm as the table).
-    #[arg(long, default_value_t = 5e-4)]
+    #[arg(long, default_value_t = WorkPrecisionOptions::DEFAULT_TARGET_ERROR)]
     pub target_error: f64,
     /// A wall time (ms) to compare the time at the target error with (issue 6's anchor:
     /// `--baseline-ms 60`, MuJoCo's RK4 on the double pendulum over 10 s).
     #[arg(long, value_name = "MS")]
     pub baseline_ms: Option<f64>,
     /// Tolerance of the reference solution (DOP853, and Dormand–Prince 5(4) as its check).
-    #[arg(long, default_value_t = 1e-14)]
+    #[arg(long, default_value_t = WorkPrecisionOptions::DEFAULT_REFERENCE_TOL)]
     pub reference_tol: f64,
     /// Fewest timed runs per setting; the reported time is their median (1 to 1000).
-    #[arg(long, default_value_t = 3, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..=1000))]
+    #[arg(long, default_value_t = WorkPrecisionOptions::DEFAULT_REPEATS, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..=1000))]
     pub repeats: usize,
     /// Runs of one setting are repeated until their total wall time reaches this (ms, 0 to
     /// 10000), at most 1000 times.
-    #[arg(long, default_value_t = 20.0, value_parser = crate::cli::values::min_time_ms, allow_hyphen_values = true)]
+    #[arg(long, default_value_t = WorkPrecisionOptions::DEFAULT_MIN_TIME_S * 1e3, value_parser = crate::cli::values::min_time_ms, allow_hyphen_values = true)]
     pub min_time_ms: f64,
     /// Print JSON instead of the tables.
     #[arg(long)]
