@@ -1,11 +1,9 @@
 //! `eomgen simulate MODEL`: integrate from the model's initial state and report.
 
-use std::io::Write as _;
-
 use clap::Args;
 use eomgen::analysis::{ConstraintDrift, EnergyDrift, Simulation};
 use eomgen::{ModelInfo, OutputTimes, Solution};
-use serde_json::json;
+use serde_json::{Value, json};
 
 use crate::cli::error::CliError;
 use crate::cli::files::{self, Outputs};
@@ -103,17 +101,10 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
         warnings,
         integrator: method_name,
         ..
-    } = simulation;
-    for warning in &warnings {
+    } = &simulation;
+    for warning in warnings {
         output::errln!("warning: {warning}");
     }
-    let n = model.num_dofs();
-    let coordinates: Vec<String> = model
-        .description()
-        .coordinate_names()
-        .iter()
-        .map(|s| s.to_string())
-        .collect();
     // The files of a failed integration say so: `# incomplete: <reason> at t = <t>` above a
     // CSV's header, the same note on the charts (and `"error"` in the JSON below).
     let incomplete = failure.as_ref().map(|e| match e.t() {
@@ -174,94 +165,7 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
         .map_err(CliError::failure)?;
     }
     if args.json {
-        let samples: Vec<serde_json::Value> = solution
-            .iter()
-            .zip(&report.energy)
-            .enumerate()
-            .map(|(k, ((t, y), e))| {
-                let mut sample = json!({"t": t, "q": &y[..n], "qdot": &y[n..], "energy": e});
-                if !constraints.is_empty() {
-                    sample["constraint_forces"] = json!(constraints.lagrange_multipliers[k]);
-                    sample["constraint_drift"] =
-                        json!({"position": constraints.drift[k].0, "velocity": constraints.drift[k].1});
-                }
-                sample
-            })
-            .collect();
-        let mut out = json!({
-            "model": model.description().name,
-            "coordinates": coordinates,
-            "parameters": model.description().parameter_names().iter().zip(model.parameter_values()).map(|(k, v)| (k.to_string(), json!(v))).collect::<serde_json::Map<_, _>>(),
-            "method": method_name,
-            "rtol": args.run.rtol,
-            "atol": args.run.atol,
-            "samples": samples,
-            "initial_energy": report.initial_energy,
-            "energy_drift": report.drift,
-            "conservative": model.description().conservative,
-            "stats": {
-                "steps": solution.stats.steps,
-                "rejected": solution.stats.rejected,
-                "rhs_evals": solution.stats.rhs_evals,
-                "jacobian_evals": solution.stats.jacobian_evals,
-                "lu_decompositions": solution.stats.lu_decompositions,
-                "event_evals": solution.stats.event_evals,
-            },
-        });
-        if args.timing {
-            out["stats"]["wall_time_s"] = json!(solution.stats.wall_time_s);
-        }
-        if !constraints.is_empty() {
-            out["constraints"] = json!(constraints.constraint_names);
-            out["stabilization"] = json!(format!("{:?}", args.run.stabilization).to_lowercase());
-            out["max_constraint_drift"] = json!({
-                "position": constraints.max_drift().0,
-                "velocity": constraints.max_drift().1,
-            });
-        }
-        if !solution.events.is_empty()
-            || !args.run.stop_when.is_empty()
-            || !args.run.event.is_empty()
-        {
-            out["events"] = json!(
-                solution
-                    .events
-                    .iter()
-                    .map(|e| json!({
-                        "name": e.name,
-                        "t": e.t,
-                        "direction": e.direction.name(),
-                        "terminal": e.terminal,
-                        "q": &e.y[..n],
-                        "qdot": &e.y[n..],
-                    }))
-                    .collect::<Vec<_>>()
-            );
-            out["terminated_by_event"] = json!(
-                solution
-                    .terminated_by_event
-                    .map(|k| solution.events[k].name.clone())
-            );
-        }
-        if let Some(e) = &failure {
-            out["error"] = json!({"t": e.t(), "message": e.to_string()});
-        }
-        if !warnings.is_empty() {
-            out["warnings"] = json!(
-                warnings
-                    .iter()
-                    .map(|w| {
-                        let mut warning = json!(w);
-                        warning["message"] = json!(w.to_string());
-                        warning
-                    })
-                    .collect::<Vec<_>>()
-            );
-        }
-        let text =
-            serde_json::to_string_pretty(&out).map_err(|e| CliError::failure(e.to_string()))?;
-        let mut stdout = output::stdout();
-        let _ = writeln!(stdout, "{text}");
+        output::print_json(&json_report(model.as_ref(), args, &simulation))?;
     } else {
         print_summary(model.as_ref(), method_name, &args.run, &solution, &report);
         print_constraint_summary(&constraints, args.run.stabilization);
@@ -280,6 +184,108 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
             ),
         )),
     }
+}
+
+/// The JSON of `simulate --json` (see docs/cli.md): the samples with their energy (and
+/// constraint forces and drift), the settings, the drift measures and the integrator's
+/// statistics (`wall_time_s` only with `--timing`), then what applies: constraints, events,
+/// the error of a failed run, the warnings.
+fn json_report(model: &dyn ModelInfo, args: &SimulateArgs, simulation: &Simulation) -> Value {
+    let Simulation {
+        solution,
+        energy: report,
+        constraints,
+        failure,
+        warnings,
+        integrator: method_name,
+        ..
+    } = simulation;
+    let n = model.num_dofs();
+    let coordinates: Vec<String> = model
+        .description()
+        .coordinate_names()
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+    let samples: Vec<serde_json::Value> = solution
+        .iter()
+        .zip(&report.energy)
+        .enumerate()
+        .map(|(k, ((t, y), e))| {
+            let mut sample = json!({"t": t, "q": &y[..n], "qdot": &y[n..], "energy": e});
+            if !constraints.is_empty() {
+                sample["constraint_forces"] = json!(constraints.lagrange_multipliers[k]);
+                sample["constraint_drift"] =
+                    json!({"position": constraints.drift[k].0, "velocity": constraints.drift[k].1});
+            }
+            sample
+        })
+        .collect();
+    let mut out = json!({
+        "model": model.description().name,
+        "coordinates": coordinates,
+        "parameters": model.description().parameter_names().iter().zip(model.parameter_values()).map(|(k, v)| (k.to_string(), json!(v))).collect::<serde_json::Map<_, _>>(),
+        "method": method_name,
+        "rtol": args.run.rtol,
+        "atol": args.run.atol,
+        "samples": samples,
+        "initial_energy": report.initial_energy,
+        "energy_drift": report.drift,
+        "conservative": model.description().conservative,
+        "stats": solution.stats,
+    });
+    // The wall time is the one figure that differs between two identical runs: only asked
+    // for (`--timing`), so that the JSON is byte-identical across runs otherwise.
+    if !args.timing
+        && let Some(stats) = out["stats"].as_object_mut()
+    {
+        stats.remove("wall_time_s");
+    }
+    if !constraints.is_empty() {
+        out["constraints"] = json!(constraints.constraint_names);
+        out["stabilization"] = json!(format!("{:?}", args.run.stabilization).to_lowercase());
+        out["max_constraint_drift"] = json!({
+            "position": constraints.max_drift().0,
+            "velocity": constraints.max_drift().1,
+        });
+    }
+    if !solution.events.is_empty() || !args.run.stop_when.is_empty() || !args.run.event.is_empty() {
+        out["events"] = json!(
+            solution
+                .events
+                .iter()
+                .map(|e| json!({
+                    "name": e.name,
+                    "t": e.t,
+                    "direction": e.direction.name(),
+                    "terminal": e.terminal,
+                    "q": &e.y[..n],
+                    "qdot": &e.y[n..],
+                }))
+                .collect::<Vec<_>>()
+        );
+        out["terminated_by_event"] = json!(
+            solution
+                .terminated_by_event
+                .map(|k| solution.events[k].name.clone())
+        );
+    }
+    if let Some(e) = &failure {
+        out["error"] = json!({"t": e.t(), "message": e.to_string()});
+    }
+    if !warnings.is_empty() {
+        out["warnings"] = json!(
+            warnings
+                .iter()
+                .map(|w| {
+                    let mut warning = json!(w);
+                    warning["message"] = json!(w.to_string());
+                    warning
+                })
+                .collect::<Vec<_>>()
+        );
+    }
+    out
 }
 
 fn print_summary(
