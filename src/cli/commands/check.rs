@@ -5,6 +5,7 @@ use serde_json::json;
 
 use crate::cli::error::CliError;
 use crate::cli::output::outln;
+use crate::cli::output::print_json;
 use crate::cli::render::num;
 use eomgen_symbolic::mechanics::check::{CheckReport, INITIAL_CONSTRAINT_TOLERANCE, check_model};
 
@@ -37,11 +38,7 @@ pub fn run(args: &CheckArgs) -> Result<(), CliError> {
         crate::cli::model::diagnostics_error(&display, &source, &diagnostics)
     })?;
     if args.json {
-        outln!(
-            "{}",
-            serde_json::to_string_pretty(&to_json(&report, args.timing))
-                .map_err(|e| CliError::failure(e.to_string()))?
-        );
+        print_json(&to_json(&report, args.timing))?;
     } else {
         print_report(&report);
     }

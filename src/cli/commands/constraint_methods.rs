@@ -12,6 +12,7 @@ use eomgen::studies::minimal_twin;
 use serde_json::json;
 
 use crate::cli::error::CliError;
+use crate::cli::output::print_json;
 use crate::cli::plot;
 use crate::cli::render::num;
 
@@ -128,9 +129,7 @@ pub fn run(args: &ConstraintMethodsArgs) -> Result<(), CliError> {
                 "error": r.failure,
             })).collect::<Vec<_>>(),
         });
-        let text =
-            serde_json::to_string_pretty(&out).map_err(|e| CliError::failure(e.to_string()))?;
-        let _ = writeln!(stdout, "{text}");
+        print_json(&out)?;
     } else {
         let _ = writeln!(
             stdout,

@@ -10,7 +10,6 @@
 //! `mathieu_pendulum`, Kapitza's boundary and the series edges of the Mathieu chart.
 
 use std::f64::consts::TAU;
-use std::io::Write as _;
 
 use clap::Args;
 use eomgen::analysis::StudyRuns;
@@ -30,6 +29,7 @@ use serde_json::{Value, json};
 use crate::cli::error::CliError;
 use crate::cli::files::Outputs;
 use crate::cli::operating_point::{OperatingPointArgs, point_json};
+use crate::cli::output::print_json;
 use crate::cli::plot::{Drawing, tick, write_chart};
 use crate::cli::render::num;
 use crate::cli::values::{evaluate, parameter_lookup, set_parameters, split_assignment};
@@ -196,9 +196,7 @@ pub fn run(args: &FloquetArgs) -> Result<(), CliError> {
     };
     let mut stdout = crate::cli::output::stdout();
     if args.json {
-        let text = serde_json::to_string_pretty(&json_report(&report))
-            .map_err(|e| CliError::failure(e.to_string()))?;
-        let _ = writeln!(stdout, "{text}");
+        print_json(&json_report(&report))?;
     } else {
         print_report(&mut stdout, &report);
     }

@@ -16,6 +16,7 @@ use serde_json::json;
 use crate::cli::error::CliError;
 use crate::cli::files::Outputs;
 use crate::cli::operating_point::{OperatingPointArgs, point_json};
+use crate::cli::output::print_json;
 use crate::cli::plot::Series;
 use crate::cli::render::num;
 use crate::cli::response_study::{Panel, kind_json, panels, parse_init, study_failure};
@@ -97,7 +98,7 @@ pub fn run(args: &FreeResponseArgs) -> Result<(), CliError> {
     }
     let mut stdout = crate::cli::output::stdout();
     if args.json {
-        print_json(&mut stdout, model.as_ref(), &study)
+        print_json(&json_report(model.as_ref(), &study))
     } else {
         print_text(&mut stdout, model.as_ref(), &study);
         Ok(())
@@ -105,11 +106,7 @@ pub fn run(args: &FreeResponseArgs) -> Result<(), CliError> {
 }
 
 /// The JSON of `study free-response` (see docs/cli.md).
-fn print_json(
-    stdout: &mut impl std::io::Write,
-    model: &dyn ModelInfo,
-    study: &FreeResponseStudy,
-) -> Result<(), CliError> {
+fn json_report(model: &dyn ModelInfo, study: &FreeResponseStudy) -> serde_json::Value {
     let FreeResponseStudy {
         operating_point: point,
         normal_modes: modes,
@@ -126,7 +123,7 @@ fn print_json(
     let n = model.num_dofs();
     let names = model.description().coordinate_names();
     let samples = responses[0].1.times.len();
-    let out = json!({
+    json!({
         "model": model.description().name,
         "coordinates": names,
         "operating_point": point_json(label, &names, &study.linearization.q),
@@ -157,10 +154,7 @@ fn print_json(
             "q": r.displacements.last(),
             "qdot": r.velocities.last(),
         })).collect::<Vec<_>>(),
-    });
-    let text = serde_json::to_string_pretty(&out).map_err(|e| CliError::failure(e.to_string()))?;
-    let _ = writeln!(stdout, "{text}");
-    Ok(())
+    })
 }
 
 /// The text of `study free-response`: the set-up, the modes, the methods and their largest

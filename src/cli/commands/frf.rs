@@ -5,8 +5,6 @@
 //! [`eomgen::vibration::frequency_response_analysis`] and its simulated points; this module
 //! runs those in parallel and renders text, JSON and the chart.
 
-use std::io::Write as _;
-
 use clap::Args;
 use eomgen::vibration::{
     self, FrfAnalysis, FrfAnalysisError, FrfOptions, FrfOutput, FrfSimulationOptions,
@@ -22,6 +20,7 @@ use serde_json::{Value, json};
 use crate::cli::error::CliError;
 use crate::cli::files::Outputs;
 use crate::cli::operating_point::{OperatingPointArgs, point_json};
+use crate::cli::output::print_json;
 use crate::cli::plot;
 use crate::cli::render::num;
 use crate::cli::values::{evaluate, parameter_lookup};
@@ -234,10 +233,7 @@ pub fn run(args: &FrfArgs) -> Result<(), CliError> {
         .map_err(CliError::failure)?;
     }
     if args.json {
-        let text =
-            serde_json::to_string_pretty(&json_report(args, model.as_ref(), &frf, simulated))
-                .map_err(|e| CliError::failure(e.to_string()))?;
-        let _ = writeln!(crate::cli::output::stdout(), "{text}");
+        print_json(&json_report(args, model.as_ref(), &frf, simulated))?;
         return Ok(());
     }
     print_report(

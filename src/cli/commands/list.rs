@@ -2,6 +2,7 @@
 
 use crate::cli::error::CliError;
 use crate::cli::output::outln;
+use crate::cli::output::print_json;
 
 /// Runs `list`: a table, or with `json` a JSON list of `{"name", "dof", "description"}`.
 pub fn run(json: bool) -> Result<(), CliError> {
@@ -11,10 +12,7 @@ pub fn run(json: bool) -> Result<(), CliError> {
             .iter()
             .map(|m| serde_json::json!({"name": m.description().name, "dof": m.num_dofs(), "description": m.description().summary}))
             .collect();
-        outln!(
-            "{}",
-            serde_json::to_string_pretty(&items).map_err(|e| CliError::failure(e.to_string()))?
-        );
+        print_json(&items)?;
     } else {
         let width = models
             .iter()

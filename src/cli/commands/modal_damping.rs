@@ -4,8 +4,6 @@
 //! and the free responses from each mode shape: exact (e^{At}, checked by DOP853) against the
 //! two approximations, as a table, JSON and a chart.
 
-use std::io::Write as _;
-
 use clap::Args;
 use eomgen::ModelInfo;
 use eomgen::analysis::StudyRuns;
@@ -15,6 +13,7 @@ use serde_json::json;
 use crate::cli::error::CliError;
 use crate::cli::files::Outputs;
 use crate::cli::operating_point::{OperatingPointArgs, point_json};
+use crate::cli::output::print_json;
 use crate::cli::plot::Series;
 use crate::cli::render::matrix_rows;
 use crate::cli::render::num;
@@ -136,9 +135,7 @@ pub fn run(args: &ModalDampingArgs) -> Result<(), CliError> {
 
     let mut stdout = crate::cli::output::stdout();
     if args.json {
-        let text = serde_json::to_string_pretty(&json_report(model.as_ref(), &study))
-            .map_err(|e| CliError::failure(e.to_string()))?;
-        let _ = writeln!(stdout, "{text}");
+        print_json(&json_report(model.as_ref(), &study))?;
         return Ok(());
     }
     print_report(&mut stdout, model.as_ref(), &study);

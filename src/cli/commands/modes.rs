@@ -9,6 +9,7 @@ use serde_json::json;
 
 use crate::cli::error::CliError;
 use crate::cli::operating_point::{OperatingPointArgs, point_failure, point_json};
+use crate::cli::output::print_json;
 use crate::cli::render::matrix_rows;
 use crate::cli::render::num;
 
@@ -86,14 +87,13 @@ pub fn run(args: &ModesArgs) -> Result<(), CliError> {
     }
     let mut stdout = crate::cli::output::stdout();
     if args.json {
-        print_json(
-            &mut stdout,
+        print_json(&json_report(
             model.as_ref(),
             &modal,
             &multipliers,
             &charts,
             args,
-        )
+        ))
     } else {
         print_text(
             &mut stdout,
@@ -108,14 +108,13 @@ pub fn run(args: &ModesArgs) -> Result<(), CliError> {
 }
 
 /// The JSON of `modes` (see docs/cli.md).
-fn print_json(
-    stdout: &mut impl std::io::Write,
+fn json_report(
     model: &dyn ModelInfo,
     modal: &ModalAnalysis,
     multipliers: &serde_json::Map<String, serde_json::Value>,
     charts: &[String],
     args: &ModesArgs,
-) -> Result<(), CliError> {
+) -> serde_json::Value {
     let ModalAnalysis {
         operating_point: point,
         linearization: lin,
@@ -133,7 +132,7 @@ fn print_json(
     let mut point = point_json(label, &names, &equilibrium.q);
     point["newton_iterations"] = json!(equilibrium.iterations);
     point["residual"] = json!(equilibrium.residual);
-    let out = json!({
+    json!({
         "model": model.description().name,
         "coordinates": names,
         "operating_point": point,
@@ -156,10 +155,7 @@ fn print_json(
         "time_dependent_forcing": forcing,
         "charts": charts,
         "animation": args.animate,
-    });
-    let text = serde_json::to_string_pretty(&out).map_err(|e| CliError::failure(e.to_string()))?;
-    let _ = writeln!(stdout, "{text}");
-    Ok(())
+    })
 }
 
 /// The text of `modes`: the equilibrium, M, K, C, the modes, the check, the files written.
