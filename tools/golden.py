@@ -70,6 +70,8 @@ CASES += [
     ["simulate", "slider_crank", "--t-end", "1", "--plot", "s.png", "--plot-phase", "p.svg",
      "--plot-energy", "e.png", "--csv", "s.csv", "--event", "theta = 1"],
     ["simulate", "double_pendulum", "--t-end", "1", "--stop-when", "theta1 = 0", "--json"],
+    ["simulate", "double_pendulum", "--t-end", "1", "--json", "--timing"],
+    ["check", "double_pendulum", "--json", "--timing"],
     ["animate", "double_pendulum", "--t-end", "0.5", "--fps", "10", "-o", "a.html",
      "--gif", "a.gif"],
     ["modes", "double_pendulum", "--plot", "m.png", "--animate", "m.html"],
