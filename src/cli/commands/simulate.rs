@@ -116,9 +116,9 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
         write_csv(
             path,
             model.as_ref(),
-            &solution,
-            &report,
-            &constraints,
+            solution,
+            report,
+            constraints,
             incomplete.as_deref(),
         )?;
     }
@@ -128,11 +128,11 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
         if solution.events.is_empty() {
             files::remove_stale_or_warn(events, is_events_csv)?;
         } else {
-            write_events_csv(events, model.as_ref(), &solution)?;
+            write_events_csv(events, model.as_ref(), solution)?;
         }
     }
     if let Some(path) = &args.plot {
-        plot::time_histories(path, model.as_ref(), &solution, incomplete.as_deref())
+        plot::time_histories(path, model.as_ref(), solution, incomplete.as_deref())
             .map_err(CliError::failure)?;
     }
     if let Some(drift_path) = &drift_chart {
@@ -150,7 +150,7 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
         }
     }
     if let Some(path) = &args.plot_phase {
-        plot::phase_portrait(path, model.as_ref(), &solution, incomplete.as_deref())
+        plot::phase_portrait(path, model.as_ref(), solution, incomplete.as_deref())
             .map_err(CliError::failure)?;
     }
     if let Some(path) = &args.plot_energy {
@@ -167,15 +167,15 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
     if args.json {
         output::print_json(&json_report(model.as_ref(), args, &simulation))?;
     } else {
-        print_summary(model.as_ref(), method_name, &args.run, &solution, &report);
-        print_constraint_summary(&constraints, args.run.stabilization);
-        print_events(model.as_ref(), &solution);
+        print_summary(model.as_ref(), method_name, &args.run, solution, report);
+        print_constraint_summary(constraints, args.run.stabilization);
+        print_events(model.as_ref(), solution);
     }
     match failure {
         None => Ok(()),
         Some(e) => Err(failure_error(
             &model.description().name,
-            &e,
+            e,
             cause.as_ref(),
             &args.run,
             &format!(
