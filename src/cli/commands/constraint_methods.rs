@@ -1,5 +1,5 @@
 //! `eomgen study constraint-methods MODEL` (issue 5, item 6; lectures 8–11, HW10): the study is
-//! [`eomgen::analysis::constraint_methods`]; the minimal twin is the one the model file names
+//! [`eomgen::analysis::constraint_methods()`]; the minimal twin is the one the model file names
 //! (`minimal_twin:`). This module renders the table, the JSON and the chart.
 
 use std::io::Write as _;
@@ -39,7 +39,7 @@ pub struct ConstraintMethodsArgs {
     pub plot: Option<String>,
 }
 
-/// Runs `study constraint-methods`: [`eomgen::analysis::constraint_methods`] on the model
+/// Runs `study constraint-methods`: [`eomgen::analysis::constraint_methods()`] on the model
 /// and the minimal twin its file names, rendered as a table, JSON and a chart.
 pub fn run(args: &ConstraintMethodsArgs) -> Result<(), CliError> {
     // The twin is read too: its file, named in the model's, is an input no output may

@@ -3,7 +3,7 @@
 //! DOP853 on the linear equations, `e^{At}`, superposed modes of `M⁻¹K` and superposed
 //! mass-normalised modes — their largest differences, and a chart of every coordinate.
 //!
-//! The numbers come from [`eomgen::vibration::free_response`]; this module renders them. Also
+//! The numbers come from [`eomgen::vibration::free_response()`]; this module renders them. Also
 //! the pieces `study modal-damping` shares: `--init` parsing, the errors in the options' words
 //! and the stacked charts.
 

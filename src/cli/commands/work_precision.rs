@@ -1,5 +1,5 @@
 //! `eomgen study work-precision MODEL` (issue 6): error against work for every integration
-//! method on a model; the study is [`eomgen::analysis::work_precision`] (its module docs give
+//! method on a model; the study is [`eomgen::analysis::work_precision`](mod@eomgen::analysis::work_precision) (its module docs give
 //! the error norm and the references), this module parses the options and renders the
 //! tables, the JSON and the charts.
 
