@@ -14,12 +14,12 @@ use serde::Serialize;
 use crate::ModelSource;
 use crate::analysis::{Method, SimulationOptions, simulate};
 use crate::expressions::{evaluate, parameter_lookup, split_assignment};
-use eomgen_runtime::analysis::{EnergyDrift, RunTally, StudyRuns, constraint_drift, energy_drift};
-use eomgen_runtime::vibration::{
+use eomgen_runtime::analysis::vibration::{
     EquilibriumStart, ModalAnalysis, ModalOptions, OperatingPointOptions, modal_analysis,
 };
+use eomgen_runtime::analysis::{EnergyDrift, RunTally, StudyRuns, constraint_drift, energy_drift};
 use eomgen_runtime::{Linearization, ModelInfo, OutputTimes, Solution, damped_modes};
-use eomgen_symbolic::mechanics::check::check_model;
+use eomgen_symbolic::mechanics::cross_check::check_model;
 use eomgen_symbolic::model::parser::eval_expr;
 use eomgen_symbolic::model::{
     DEFAULT_CONSTRAINT_DRIFT, DEFAULT_ENERGY_DRIFT, Diagnostic, Expr, ModalCheck, ModelFile,
@@ -325,7 +325,7 @@ pub fn derivation_checks(
             ),
             Ok(c.residual),
             0.0,
-            eomgen_symbolic::mechanics::check::INITIAL_CONSTRAINT_TOLERANCE,
+            eomgen_symbolic::mechanics::cross_check::INITIAL_CONSTRAINT_TOLERANCE,
         ));
     }
     Ok((rows, r.notes))

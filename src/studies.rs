@@ -67,7 +67,7 @@ pub enum PeriodUnitError {
 /// Floquet study is an angular frequency: its unit is `rad/s` or `1/s` (rad is a pure
 /// number), not `Hz` (the study's period is `T = 2π/w`). A file without declared units, or
 /// a parameter it does not have, passes (the study checks the name and, numerically, the
-/// periodicity itself: [`vibration::floquet_at_equilibrium`](crate::vibration::floquet_at_equilibrium)).
+/// periodicity itself: [`vibration::floquet_at_equilibrium`](crate::analysis::vibration::floquet_at_equilibrium)).
 ///
 /// # Errors
 /// [`PeriodUnitError::NotAFrequency`], [`PeriodUnitError::Hertz`] (located at the unit), and

@@ -467,7 +467,7 @@ fn hanging_parametric_resonance_and_bad_operating_points() {
 /// parameter and an operating point that moves with `t`.
 #[test]
 fn floquet_study_point_and_cells() {
-    use eomgen::vibration::{
+    use eomgen::analysis::vibration::{
         EquilibriumStart, FloquetStudyError, FloquetStudyOptions, SweepAxis,
         floquet_at_equilibrium, floquet_cell,
     };
@@ -730,7 +730,9 @@ fn mathieu_pendulum_references_from_its_file() {
 /// report "marginal" or "unstable" multipliers of a wrong period.
 #[test]
 fn floquet_period_parameter_must_be_the_forcing_frequency() {
-    use eomgen::vibration::{FloquetStudyError, FloquetStudyOptions, floquet_at_equilibrium};
+    use eomgen::analysis::vibration::{
+        FloquetStudyError, FloquetStudyOptions, floquet_at_equilibrium,
+    };
     let named = |p: &str| FloquetStudyOptions {
         period_parameter: p.to_string(),
         ..FloquetStudyOptions::default()
@@ -778,15 +780,16 @@ fn floquet_period_parameter_must_be_the_forcing_frequency() {
 #[test]
 fn issue_28_stability_tolerance_has_a_meaningful_range() {
     let mut pendulum = model("mathieu_pendulum");
-    let options = |stability_tolerance: f64, tol: f64| eomgen::vibration::FloquetStudyOptions {
-        floquet: FloquetOptions {
-            rtol: tol,
-            atol: tol,
-            stability_tolerance,
-            ..FloquetOptions::default()
-        },
-        ..Default::default()
-    };
+    let options =
+        |stability_tolerance: f64, tol: f64| eomgen::analysis::vibration::FloquetStudyOptions {
+            floquet: FloquetOptions {
+                rtol: tol,
+                atol: tol,
+                stability_tolerance,
+                ..FloquetOptions::default()
+            },
+            ..Default::default()
+        };
     for (st, tol) in [
         (1e9, 1e-12),
         (0.0, 1e-12),
@@ -794,12 +797,14 @@ fn issue_28_stability_tolerance_has_a_meaningful_range() {
         (0.2, 1e-12),
         (1e-4, 1e-6),
     ] {
-        let refused =
-            eomgen::vibration::floquet_at_equilibrium(pendulum.as_mut(), &options(st, tol));
+        let refused = eomgen::analysis::vibration::floquet_at_equilibrium(
+            pendulum.as_mut(),
+            &options(st, tol),
+        );
         assert!(
             matches!(
                 refused,
-                Err(eomgen::vibration::FloquetStudyError::Floquet(
+                Err(eomgen::analysis::vibration::FloquetStudyError::Floquet(
                     FloquetError::InvalidStabilityTolerance { .. }
                 ))
             ),
@@ -807,8 +812,11 @@ fn issue_28_stability_tolerance_has_a_meaningful_range() {
         );
     }
     for (st, tol) in [(1e-6, 1e-12), (0.1, 1e-12), (1e-3, 1e-6)] {
-        let point = eomgen::vibration::floquet_at_equilibrium(pendulum.as_mut(), &options(st, tol))
-            .unwrap_or_else(|e| panic!("{st} at tol {tol}: {e}"));
+        let point = eomgen::analysis::vibration::floquet_at_equilibrium(
+            pendulum.as_mut(),
+            &options(st, tol),
+        )
+        .unwrap_or_else(|e| panic!("{st} at tol {tol}: {e}"));
         // Upright and shaken at the file's a, w: stable, on the unit circle.
         assert_eq!(point.floquet.stability, FloquetStability::Marginal, "{st}");
     }
@@ -872,7 +880,7 @@ fn issue_28_floquet_sweep_checks_time_dependence_at_the_swept_values() {
     assert!(err.contains("does not depend on t"), "{err}");
 
     use eomgen::analysis::StudyRuns;
-    use eomgen::vibration::{FloquetChart, SweepAxis};
+    use eomgen::analysis::vibration::{FloquetChart, SweepAxis};
     let chart = FloquetChart {
         x: SweepAxis::linear("a", 0.0, 0.1, 2).unwrap(),
         y: SweepAxis::linear("w", 40.0, 40.0, 1).unwrap(),

@@ -355,7 +355,7 @@ fn simulated_steady_state_matches_frf_hw37_damping() {
 /// (1e-14); two simulated points within 1e-6 of H (`plan_simulation`, `simulate_point`).
 #[test]
 fn frequency_response_analysis_of_the_forced_oscillator() {
-    use eomgen::vibration::{
+    use eomgen::analysis::vibration::{
         FrfOptions, FrfSimulationOptions, frequency_response_analysis, max_simulation_error,
         plan_simulation, simulate_point,
     };
@@ -404,7 +404,7 @@ fn frequency_response_analysis_of_the_forced_oscillator() {
 /// not a load.
 #[test]
 fn frequency_response_analysis_undamped_and_errors() {
-    use eomgen::vibration::{
+    use eomgen::analysis::vibration::{
         FrfAnalysisError, FrfOptions, FrfSimulationOptions, frequency_response_analysis,
         plan_simulation,
     };

@@ -220,7 +220,7 @@ fn equilibrium_search_and_its_errors() {
 /// explicit guess, and its typed errors (an unknown name lists the known ones).
 #[test]
 fn operating_point_from_names_and_guesses() {
-    use eomgen::vibration::{
+    use eomgen::analysis::vibration::{
         EquilibriumStart, OperatingPointError, OperatingPointOptions, operating_point,
     };
     let m = model("double_pendulum");
@@ -285,7 +285,7 @@ fn operating_point_from_names_and_guesses() {
 /// On three_masses_damped the damping ratios are the file's reference values (numpy, 1e-7).
 #[test]
 fn modal_analysis_constrained_and_damped() {
-    use eomgen::vibration::{ModalOptions, modal_analysis};
+    use eomgen::analysis::vibration::{ModalOptions, modal_analysis};
     let m = model("simple_pendulum_cartesian");
     let modal = modal_analysis(m.as_ref(), &ModalOptions::default()).unwrap();
     assert_eq!(modal.minimal_coordinates, ["x"]);
@@ -684,7 +684,7 @@ fn fixture(name: &str) -> String {
 /// nothing depends on t and upright grows as `e^{√(g/l) t}` (√10, to 1e-12).
 #[test]
 fn issue_28_parametric_excitation_is_refused() {
-    use eomgen::vibration::{ModalOptions, OperatingPointError, modal_analysis};
+    use eomgen::analysis::vibration::{ModalOptions, OperatingPointError, modal_analysis};
     let mut m = model("mathieu_pendulum");
     m.set_parameter("a", 0.01).unwrap();
     let err = modal_analysis(m.as_ref(), &ModalOptions::default()).unwrap_err();
@@ -722,7 +722,7 @@ fn issue_28_parametric_excitation_is_refused() {
 /// has the unstable mode with growth rate `w` (to 1e-12).
 #[test]
 fn issue_28_rheonomic_constraint_is_refused() {
-    use eomgen::vibration::{ModalOptions, OperatingPointError, modal_analysis};
+    use eomgen::analysis::vibration::{ModalOptions, OperatingPointError, modal_analysis};
     let m = model("bead_spinning_rod");
     let err = modal_analysis(m.as_ref(), &ModalOptions::default()).unwrap_err();
     let OperatingPointError::Modal(ModalError::TimeDependent {
@@ -759,7 +759,7 @@ fn issue_28_rheonomic_constraint_is_refused() {
 /// balances its t = 0 value, `x* = A/k`.
 #[test]
 fn issue_28_time_dependent_load_is_set_aside() {
-    use eomgen::vibration::{ModalOptions, modal_analysis};
+    use eomgen::analysis::vibration::{ModalOptions, modal_analysis};
     let mut m = model("forced_oscillator");
     for (mass, c, k, a, b) in [(1.0, 1.0, 1.0, 1.0, 0.0), (2.0, 0.3, 7.0, 0.5, 2.0)] {
         for (name, value) in [("m", mass), ("c", c), ("k", k), ("A", a), ("B", b)] {
@@ -885,7 +885,7 @@ fn issue_28_time_dependence_beside_a_stiff_coordinate() {
     assert_eq!(out.status.code(), Some(1));
     // With a torque T0 = 1 N·m, beyond what the pendulum can balance, Newton fails on the
     // equations frozen at t = 0; the error names the time dependence, not Newton.
-    use eomgen::vibration::{
+    use eomgen::analysis::vibration::{
         EquilibriumStart, ModalOptions, OperatingPointError, OperatingPointOptions, modal_analysis,
     };
     m.set_parameter("T0", 1.0).unwrap();
@@ -992,7 +992,7 @@ fn fixture_model(name: &str) -> Box<dyn ModelInfo> {
 /// ω = √(kx/m) = 2 and √(ky/m) = 3 rad/s (to 1e-12), with `K` exact.
 #[test]
 fn issue_28_quadratic_drag_at_rest_has_the_undamped_modes() {
-    use eomgen::vibration::{ModalOptions, modal_analysis};
+    use eomgen::analysis::vibration::{ModalOptions, modal_analysis};
     let m = fixture_model("drag_oscillator.yaml");
     let modal = modal_analysis(m.as_ref(), &ModalOptions::default()).unwrap();
     assert!(modal.time_dependent_forcing.is_none());
@@ -1101,7 +1101,7 @@ fn issue_28_zero_frequency_is_judged_on_each_mode_s_own_scale() {
 /// `ω² = (g/l) cos θ*` (to 1e-10, Newton's tolerance).
 #[test]
 fn issue_28_time_dependent_load_without_equilibrium_is_refused_as_such() {
-    use eomgen::vibration::{ModalOptions, OperatingPointError, modal_analysis};
+    use eomgen::analysis::vibration::{ModalOptions, OperatingPointError, modal_analysis};
     let mut m = fixture_model("overdriven_pendulum.yaml");
     let err = modal_analysis(m.as_ref(), &ModalOptions::default()).unwrap_err();
     let OperatingPointError::Modal(ModalError::TimeDependentLoad {

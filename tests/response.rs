@@ -448,7 +448,7 @@ fn three_masses_damped_responses_from_each_mode() {
 /// the largest |δq|, the defaults are HW28's, and the initial deviation is kept.
 #[test]
 fn free_response_study_routes_agree() {
-    use eomgen::vibration::{
+    use eomgen::analysis::vibration::{
         EquilibriumStart, FreeResponseMethod, FreeResponseOptions, InitialDeviation,
         OperatingPointOptions, ResponseStudyError, free_response,
     };
@@ -549,7 +549,7 @@ fn free_response_cli() {
 /// one by 0.1 % to 30 % (the coupling of Ĉ). Bad Rayleigh modes are typed errors.
 #[test]
 fn modal_damping_study_three_ways() {
-    use eomgen::vibration::{
+    use eomgen::analysis::vibration::{
         InitialDeviation, ModalDampingOptions, ResponseStudyError, modal_damping_study,
     };
     let m = model("three_masses_damped");

@@ -10,7 +10,7 @@ use common::{eomgen, eomgen_ok};
 
 use std::f64::consts::E;
 
-use eomgen::integrate::stability::{
+use eomgen::integrate::stability_function::{
     GrowthTest, StabilityPolynomial, TestEquation, amplification, explicit_tableau_methods,
     measured_limit, partitioned_oscillator_growth_limit, radau_iia5_stability,
 };

@@ -7,7 +7,7 @@ use eomgen_runtime::{
     DormandPrince54, DynFirstOrder, DynMechanicalSystem, Integrator, IntegratorOptions, ModelInfo,
     OdeSystem, OutputTimes,
 };
-use eomgen_symbolic::mechanics::check::check_model;
+use eomgen_symbolic::mechanics::cross_check::check_model;
 use eomgen_symbolic::model::templates::{MAX_SIZES, TEMPLATES, generate};
 
 /// The relative tolerance of `eomgen check`.

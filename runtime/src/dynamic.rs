@@ -3,7 +3,7 @@
 //! [`DynMechanicalSystem`] is [`MechanicalSystem`] with slices in
 //! place of nalgebra's static vectors and matrices: what a model compiled at run time (from any
 //! model file, with no rebuild) implements, and what every [`MechanicalSystem<N>`] is through
-//! the adapter [`StaticSystem`]. Its first-order form is
+//! an internal adapter. Its first-order form is
 //! [`DynFirstOrder`](crate::DynFirstOrder), which implements [`ModelInfo`](crate::ModelInfo),
 //! so every analysis that takes a `Box<dyn ModelInfo>` takes such a model unchanged.
 
@@ -112,7 +112,7 @@ pub trait DynMechanicalSystem {
 /// in place: a wrapper lends the names it returns with the borrow of the system itself.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 #[repr(transparent)]
-pub struct StaticSystem<S, const N: usize>(pub S);
+pub(crate) struct StaticSystem<S, const N: usize>(pub S);
 
 impl<S, const N: usize> StaticSystem<S, N> {
     /// `system` seen through the adapter, borrowed in place.

@@ -3,41 +3,53 @@
 //! Generated code (from `eomgen::model!`) implements [`MechanicalSystem`]; the runtime turns
 //! `M(q, t) q̈ = F(q, q̇, t)` into the first-order system `ẏ = [q̇; M⁻¹F]` ([`FirstOrder`]) and
 //! integrates it with any [`Integrator`].
+//!
+//! # Which model type to use
+//!
+//! | name | what it is | use it to |
+//! |---|---|---|
+//! | [`MechanicalSystem<N>`] | the equations of a model compiled by `eomgen::model!`, `N` known at build time, on stack vectors | write a model by hand, or call a compiled model's functions directly |
+//! | [`DynMechanicalSystem`] | the same equations with `n` known at run time, on slices | implement a run-time backend (the JIT's models do) |
+//! | [`FirstOrder<S, N>`] | a compiled model as `ẏ = f(t, y)`, allocation-free, with constraints solved | integrate a compiled model at full speed |
+//! | [`DynFirstOrder<S>`] | a run-time model as `ẏ = f(t, y)`, the same solves in the same order | integrate a run-time model |
+//! | [`ModelInfo`] | either first-order form with its size erased (`Box<dyn ModelInfo>`) | pass a model to an analysis; what the CLI holds |
+//! | [`OdeSystem`] | any first-order system `ẏ = f(t, y)`, with optional Jacobian and events | write an integrator, or integrate an ODE that is not a mechanism |
+//!
+//! Everything about a model that is not a function of the state (names, parameters, points,
+//! constraints, equilibria, events, the equations as text) is its [`ModelDescription`],
+//! returned by `description()` of each of the first five.
+//!
+//! # Layout
+//!
+//! - the model types above: [`system`], [`dynamic`], [`first_order`], [`model_info`], [`ode`],
+//!   [`constrained`] (the index-1 solve with constraints and drift control);
+//! - [`integrate`]: the integrators, step-size control, events and dense output;
+//! - [`linear`]: the building blocks of the linear analyses (linearisation and modes,
+//!   responses, `H(ω)`, monodromy), functions of matrices;
+//! - [`analysis`]: the analyses, each one call with typed options, a `Serialize` report and a
+//!   typed error ([`analysis::vibration`] for the vibration analyses, the rest for the
+//!   numerical studies).
 #![warn(missing_docs)]
 
 pub mod analysis;
 pub mod constrained;
 pub mod dynamic;
 pub mod first_order;
-pub mod floquet;
-pub mod frf;
 pub mod functions;
 pub mod integrate;
 pub mod linalg;
-pub mod modal;
+pub mod linear;
 pub mod model_info;
 pub mod ode;
-pub mod response;
 pub mod system;
-pub mod vibration;
 
 pub use analysis::{Method, UnknownMethod};
 pub use constrained::{
     ConstraintWorkspace, MAX_BAUMGARTE_GAIN, ProjectionError, Stabilization, StabilizationError,
 };
-pub use dynamic::{DynMechanicalSystem, StaticSystem};
+pub use dynamic::DynMechanicalSystem;
 pub use eomgen_description::Parameter;
 pub use first_order::{DynFirstOrder, FirstOrder};
-pub use floquet::{
-    FloquetAnalysis, FloquetError, FloquetOptions, FloquetStability, LARGEST_STABILITY_TOLERANCE,
-    check_periodic_equilibrium, floquet_analysis, floquet_multipliers, monodromy_matrix,
-};
-pub use frf::{
-    ForcedLinearization, FrequencySweep, FrfError, HarmonicForcing, ModalResponse, PeakAmplitude,
-    ResonancePeak, SteadyState, SteadyStateOptions, frequency_response, frequency_response_of,
-    frequency_sweep, linearize_with_inputs, log_frequencies, modal_frequency_response,
-    phase_degrees, settling_time, simulate_steady_state,
-};
 pub use integrate::{
     BogackiShampine32, DormandPrince54, DormandPrince853, Event, EventDirection, EventSpec,
     ExplicitEuler, ExplicitMidpoint, ImplicitMidpoint, IntegrationError, IntegrationFailure,
@@ -46,19 +58,29 @@ pub use integrate::{
     SymplecticEuler, Tableau, Tolerance,
 };
 pub use linalg::{solve_spd, solve_spd_in_place};
-pub use modal::{
+pub use linear::frequency_response::{
+    ForcedLinearization, FrequencySweep, FrfError, HarmonicForcing, ModalResponse, PeakAmplitude,
+    ResonancePeak, SteadyState, SteadyStateOptions, frequency_response, frequency_response_of,
+    frequency_sweep, linearize_with_inputs, log_frequencies, modal_frequency_response,
+    phase_degrees, settling_time, simulate_steady_state,
+};
+pub use linear::modal::{
     Equilibrium, Linearization, MASS_MATRIX_SINGULARITY, ModalError, ModeKind, NewtonStop,
     NormalModes, TimeDependentForcing, TimeDependentPart, constraint_hessians, damped_modes,
     eigenvalues_of_m_inv_k, find_equilibrium, linearize, matrix_exponential, normal_modes,
     time_dependence,
 };
-pub use model_info::{ConstraintValues, FirstOrderForm, FirstOrderParts, ModelInfo};
-pub use ode::{OdeFn, OdeSystem, RhsError, WithEvents};
-pub use response::{
+pub use linear::monodromy::{
+    FloquetAnalysis, FloquetError, FloquetOptions, FloquetStability, LARGEST_STABILITY_TOLERANCE,
+    check_periodic_equilibrium, floquet_analysis, floquet_multipliers, monodromy_matrix,
+};
+pub use linear::response::{
     DampedMode, FreeResponse, LinearOde, MInvKModes, ModalDamping, RayleighDamping, ResponseError,
     exact_damped_modes, modal_damping, modes_of_m_inv_k, response_by_exponential,
     response_by_integration, response_by_m_inv_k_modes, response_by_normal_modes,
     response_with_modal_damping, state_response_by_eigenvectors, state_response_by_exponential,
     state_response_by_integration,
 };
+pub use model_info::{ConstraintValues, ModelInfo};
+pub use ode::{OdeFn, OdeSystem, RhsError, WithEvents};
 pub use system::{BodyCentre, MechanicalSystem, ModelDescription, UnknownParameter};

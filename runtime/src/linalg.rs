@@ -299,7 +299,7 @@ fn solve_in_envelope(
 /// `|v| v`, with `|v| = √(vₓ² + v_y²)`, has `vₓ²/|v|`, 0/0 at rest, where the derivative is
 /// 0; its difference is `c δ`, of the order of 1e-11 c). The implicit integrators' Newton
 /// iteration ([`RadauIIA5`](crate::RadauIIA5), [`ImplicitMidpoint`](crate::ImplicitMidpoint)),
-/// the linearisation of [`modal`](crate::modal) and the failure diagnosis all use it.
+/// the linearisation of [`modal`](crate::linear::modal) and the failure diagnosis all use it.
 ///
 /// # Arguments
 /// * `y`      - the point (length `d`).

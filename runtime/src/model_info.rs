@@ -1,11 +1,11 @@
 //! The size-erased model, as the CLI and every analysis hold it: [`ModelInfo`], and the
 //! constraint functions at one state it returns ([`ConstraintValues`]).
 //!
-//! [`ModelInfo`] is implemented once, for every [`FirstOrderForm`]: a first-order form that
-//! lends its system as a [`DynMechanicalSystem`] with its constraint workspace, drift control
-//! and events. [`FirstOrder`](crate::FirstOrder) is one (its compiled system through the
-//! adapter [`StaticSystem`](crate::StaticSystem)), [`DynFirstOrder`](crate::DynFirstOrder)
-//! the other.
+//! [`ModelInfo`] is implemented once, for every first-order form that lends its system as a
+//! [`DynMechanicalSystem`] with its constraint workspace, drift control and events (the
+//! crate-private `FirstOrderForm`): [`FirstOrder`](crate::FirstOrder) is one (its compiled
+//! system through the crate-private adapter `StaticSystem`),
+//! [`DynFirstOrder`](crate::DynFirstOrder) the other.
 
 use nalgebra::{DMatrix, DVector};
 
@@ -16,7 +16,7 @@ use crate::system::{ModelDescription, UnknownParameter};
 
 /// A model with its size erased, as the CLI holds it: `Box<dyn ModelInfo>`.
 ///
-/// Implemented once, for every [`FirstOrderForm`]: [`FirstOrder`](crate::FirstOrder) for every
+/// Implemented once, for both first-order forms: [`FirstOrder`](crate::FirstOrder) for every
 /// model compiled by `eomgen::model!` and [`DynFirstOrder`](crate::DynFirstOrder) for a model
 /// compiled at run time; names are borrowed from the model (which owns them in the second
 /// case).
@@ -159,9 +159,9 @@ pub struct ConstraintValues {
 /// size-erased [`ModelInfo`] offers (metadata, energies, points, constraint functions and
 /// forces, projection, equilibrium guesses, events) is the same computation, written once in
 /// the blanket `impl<F: FirstOrderForm> ModelInfo for F` over [`DynMechanicalSystem`]. A
-/// compiled system takes part through the adapter [`StaticSystem`](crate::StaticSystem),
+/// compiled system takes part through the adapter [`StaticSystem`](crate::dynamic::StaticSystem),
 /// which copies its static vectors to and from slices (those calls are not on the hot path).
-pub trait FirstOrderForm: OdeSystem {
+pub(crate) trait FirstOrderForm: OdeSystem {
     /// The system, seen through the run-time interface.
     type System: DynMechanicalSystem + ?Sized;
     /// The system.
@@ -172,7 +172,7 @@ pub trait FirstOrderForm: OdeSystem {
 
 /// What a [`FirstOrderForm`] lends mutably ([`FirstOrderForm::parts_mut`]).
 #[derive(Debug)]
-pub struct FirstOrderParts<'a, S: ?Sized> {
+pub(crate) struct FirstOrderParts<'a, S: ?Sized> {
     /// The system.
     pub system: &'a mut S,
     /// Drift control of a constrained system.

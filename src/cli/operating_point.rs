@@ -5,7 +5,7 @@
 
 use clap::Args;
 use eomgen::ModelInfo;
-use eomgen::vibration::{EquilibriumStart, OperatingPointError, OperatingPointOptions};
+use eomgen::analysis::vibration::{EquilibriumStart, OperatingPointError, OperatingPointOptions};
 use serde_json::json;
 
 use super::error::CliError;

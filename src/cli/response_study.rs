@@ -2,7 +2,7 @@
 //! parsing, their errors in the options' words, the JSON of a mode kind and the chart of
 //! stacked panels against time.
 
-use eomgen::vibration::{InitialDeviation, ResponseStudyError};
+use eomgen::analysis::vibration::{InitialDeviation, ResponseStudyError};
 use eomgen::{ModeKind, ModelInfo};
 use plotters::coord::Shift;
 use plotters::prelude::*;

@@ -3,7 +3,7 @@
 //! `cargo run -p eomgen-symbolic --example generate -- models/double_pendulum.yaml`
 
 use eomgen_symbolic::codegen::{self, EmitOptions};
-use eomgen_symbolic::mechanics::{Jacobians, SymbolicModel, preferred_equations};
+use eomgen_symbolic::mechanics::{SymbolicModel, preferred_equations};
 
 fn main() {
     let Some(path) = std::env::args().nth(1) else {
@@ -28,8 +28,8 @@ fn main() {
     let mut model = SymbolicModel::from_file(&file).unwrap_or_else(|d| report(&path, &source, d));
     let (eom, method) = preferred_equations(&mut model);
     eprintln!("equations from {method}");
-    let jac = Jacobians::of(&mut model, &eom);
-    match codegen::emit(&model, &eom, &jac, &EmitOptions::default()) {
+    let plans = codegen::plan::EmitPlans::of(&model, &eom);
+    match codegen::emit(&model, &eom, &plans, &EmitOptions::default()) {
         Ok((tokens, stats)) => {
             println!("{tokens}");
             eprintln!(

@@ -1,16 +1,17 @@
 //! Generated code is deterministic: two independent derivations of the same file print
 //! byte-identical Rust (no hash-map iteration order reaches the output).
 
+use eomgen_symbolic::codegen::plan::EmitPlans;
 use eomgen_symbolic::codegen::{self, EmitOptions};
-use eomgen_symbolic::mechanics::{Formulation, Jacobians, Lagrange, SymbolicModel};
+use eomgen_symbolic::mechanics::{Formulation, Lagrange, SymbolicModel};
 
 fn generate(source: &str) -> String {
     let file = eomgen_symbolic::model::load("m.yaml", source).expect("loads");
     let mut model = SymbolicModel::from_file(&file).expect("lowers");
     let eom = Lagrange.derive(&mut model);
-    let jac = Jacobians::of(&mut model, &eom);
+    let plans = EmitPlans::of(&model, &eom);
     let (tokens, stats) =
-        codegen::emit(&model, &eom, &jac, &EmitOptions::default()).expect("emits");
+        codegen::emit(&model, &eom, &plans, &EmitOptions::default()).expect("emits");
     assert!(stats.ops_after_cse <= stats.ops_before_cse);
     tokens.to_string()
 }

@@ -5,7 +5,7 @@ mod common;
 
 use eomgen_symbolic::expr::SymbolKind;
 use eomgen_symbolic::expr::eval::Evaluator;
-use eomgen_symbolic::mechanics::check::solve;
+use eomgen_symbolic::mechanics::cross_check::solve;
 use eomgen_symbolic::mechanics::{
     EquationsOfMotion, Formulation, Lagrange, MomentumBalance, SymbolicModel,
 };
@@ -132,7 +132,8 @@ fn the_comparison_detects_a_missing_inertia_term() {
 /// user's balances against Lagrange.
 fn balances_residual(source: &str) -> f64 {
     let file = eomgen_symbolic::model::load("m.yaml", source).expect("loads");
-    let report = eomgen_symbolic::mechanics::check::check_model(&file, 100, 11).expect("lowers");
+    let report =
+        eomgen_symbolic::mechanics::cross_check::check_model(&file, 100, 11).expect("lowers");
     report
         .comparisons
         .iter()
@@ -179,7 +180,7 @@ fn h_dot_form_holds_about_fixed_points_only() {
 fn integrable_nonholonomic_constraints_are_reported() {
     let notes = |source: &str| {
         let file = eomgen_symbolic::model::load("m.yaml", source).expect("loads");
-        eomgen_symbolic::mechanics::check::check_model(&file, 20, 5)
+        eomgen_symbolic::mechanics::cross_check::check_model(&file, 20, 5)
             .expect("lowers")
             .notes
             .join("\n")
@@ -204,7 +205,7 @@ fn integrable_nonholonomic_constraints_are_reported() {
 fn issue_18_lagrange_is_compact_on_long_chains() {
     let source = eomgen_symbolic::model::templates::n_link_pendulum(40);
     let file = eomgen_symbolic::model::load("chain.yaml", &source).expect("loads");
-    let report = eomgen_symbolic::mechanics::check::check_model(&file, 5, 7).expect("lowers");
+    let report = eomgen_symbolic::mechanics::cross_check::check_model(&file, 5, 7).expect("lowers");
     let comparison = &report.comparisons[0];
     assert_eq!(comparison.b, "momentum");
     assert_eq!(comparison.symbolic_equal, Some(true), "{report:?}");

@@ -5,7 +5,7 @@
 
 mod common;
 
-use eomgen_symbolic::mechanics::check::{CheckReport, check_model};
+use eomgen_symbolic::mechanics::cross_check::{CheckReport, check_model};
 
 fn check(source: &str) -> CheckReport {
     let file = eomgen_symbolic::model::load("m.yaml", source).expect("loads");

@@ -10,7 +10,7 @@
 //! test binary (a stack overflow is not a panic).
 
 use eomgen_symbolic::codegen::{self, EmitOptions};
-use eomgen_symbolic::mechanics::check::check_model;
+use eomgen_symbolic::mechanics::cross_check::check_model;
 use eomgen_symbolic::model::load;
 use eomgen_symbolic::model::parser::MAX_TREE_HEIGHT;
 

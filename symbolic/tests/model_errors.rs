@@ -419,7 +419,7 @@ fn issue_28_a_power_of_a_scaled_coordinate_is_evaluated_as_written() {
 /// where it never starts, or only off its constraints, is not.
 #[test]
 fn singular_mass_matrices_are_refused_with_their_reason() {
-    use eomgen_symbolic::mechanics::check::check_model;
+    use eomgen_symbolic::mechanics::cross_check::check_model;
     let check = |body: &str| -> Vec<String> {
         let src = format!("name: x\nparameters: {{ m: 1.0, k: 1.0 }}\n{body}");
         let file = load("x.yaml", &src).expect("loads");

@@ -24,7 +24,7 @@ use nalgebra::{Complex, DMatrix};
 use serde::Serialize;
 
 use crate::analysis::methods::Method;
-use crate::integrate::stability::{
+use crate::integrate::stability_function::{
     StabilityPolynomial, implicit_midpoint_stability, partitioned_oscillator_spectral_radius,
 };
 use crate::integrate::{IntegratorOptions, Tableau};

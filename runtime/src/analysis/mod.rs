@@ -1,6 +1,7 @@
 //! Analyses on the size-erased model ([`ModelInfo`](crate::ModelInfo)) that the CLI and an
-//! embedding Rust program share: the method registry, drift measures, simulation and the
-//! numerical studies.
+//! embedding Rust program share: the method registry, drift measures, simulation, the
+//! numerical studies, and the vibration analyses ([`vibration`]), which are built on the
+//! linear-algebra blocks of [`crate::linear`].
 //!
 //! Every analysis is a function with a typed options struct, a `Serialize` report and a
 //! typed error, so that a front end only parses its input and renders the report. Every
@@ -16,6 +17,7 @@ pub mod outcome;
 pub mod roundoff;
 pub mod simulation;
 pub mod stability;
+pub mod vibration;
 pub mod work_precision;
 
 pub use constraint_methods::{

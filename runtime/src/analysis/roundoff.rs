@@ -28,7 +28,7 @@ use std::f64::consts::E;
 use serde::Serialize;
 
 use crate::analysis::outcome::{RunTally, StudyRuns};
-use crate::integrate::stability::StabilityPolynomial;
+use crate::integrate::stability_function::StabilityPolynomial;
 use crate::integrate::{
     ExplicitEuler, ExplicitMidpoint, Integrator, IntegratorOptions, OutputTimes, RungeKutta4,
     Tableau,

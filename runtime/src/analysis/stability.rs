@@ -22,7 +22,7 @@ use nalgebra::Complex;
 use serde::Serialize;
 
 use crate::UnknownParameter;
-use crate::integrate::stability::{
+use crate::integrate::stability_function::{
     GrowthTest, StabilityPolynomial, TestEquation, amplification, explicit_tableau_methods,
     implicit_midpoint_stability, measured_limit, partitioned_oscillator_growth_limit,
     partitioned_oscillator_spectral_radius, radau_iia5_stability,

@@ -58,67 +58,12 @@ pub struct BogackiShampine32 {
     controller: PiController,
 }
 
-impl Default for BogackiShampine32 {
-    fn default() -> Self {
-        Self {
-            controller: PiController::for_error_order(ERROR_ORDER),
-        }
-    }
-}
-
-impl BogackiShampine32 {
-    /// The method with [`PiController::for_error_order`]`(2)`.
-    pub fn new() -> Self {
-        Self::default()
-    }
-
-    /// Uses `controller` for the step sizes.
-    pub fn with_controller(mut self, controller: PiController) -> Self {
-        self.controller = controller;
-        self
-    }
-
-    /// The step-size controller.
-    pub fn controller(&self) -> &PiController {
-        &self.controller
-    }
-}
-
-impl Integrator for BogackiShampine32 {
-    fn name(&self) -> &'static str {
-        "bs32"
-    }
-
-    fn order(&self) -> u32 {
-        3
-    }
-
-    fn integrate(
-        &mut self,
-        system: &mut dyn OdeSystem,
-        t0: f64,
-        y0: &[f64],
-        t_end: f64,
-        output: &OutputTimes,
-        options: &IntegratorOptions,
-    ) -> Result<Solution, IntegrationFailure> {
-        let problem = Problem {
-            t0,
-            y0,
-            t_end,
-            output,
-            options,
-        };
-        let control = if options.fixed_step {
-            Control::Fixed
-        } else {
-            Control::Adaptive {
-                controller: &mut self.controller,
-                error_order: ERROR_ORDER,
-            }
-        };
-        driver::run(&problem, system, control, |shape| {
-            Ok(ExplicitRk::new(Tableau::bs32(), shape.dim))
-        })
-    }
-}
+pi_controlled_integrator!(
+    BogackiShampine32,
+    name: "bs32",
+    order: 3,
+    error_order: ERROR_ORDER,
+    controller: PiController::for_error_order(ERROR_ORDER),
+    new_doc: "The method with [`PiController::for_error_order`]`(2)`.",
+    stepper: |dim| ExplicitRk::new(Tableau::bs32(), dim),
+);

@@ -712,70 +712,15 @@ pub struct DormandPrince853 {
     controller: PiController,
 }
 
-impl Default for DormandPrince853 {
-    fn default() -> Self {
-        Self {
-            controller: PiController::dop853(),
-        }
-    }
-}
-
-impl DormandPrince853 {
-    /// The method with [`PiController::dop853`].
-    pub fn new() -> Self {
-        Self::default()
-    }
-
-    /// Uses `controller` for the step sizes.
-    pub fn with_controller(mut self, controller: PiController) -> Self {
-        self.controller = controller;
-        self
-    }
-
-    /// The step-size controller.
-    pub fn controller(&self) -> &PiController {
-        &self.controller
-    }
-}
-
-impl Integrator for DormandPrince853 {
-    fn name(&self) -> &'static str {
-        "dop853"
-    }
-
-    fn order(&self) -> u32 {
-        8
-    }
-
-    fn integrate(
-        &mut self,
-        system: &mut dyn OdeSystem,
-        t0: f64,
-        y0: &[f64],
-        t_end: f64,
-        output: &OutputTimes,
-        options: &IntegratorOptions,
-    ) -> Result<Solution, IntegrationFailure> {
-        let problem = Problem {
-            t0,
-            y0,
-            t_end,
-            output,
-            options,
-        };
-        let control = if options.fixed_step {
-            Control::Fixed
-        } else {
-            Control::Adaptive {
-                controller: &mut self.controller,
-                error_order: ERROR_ORDER,
-            }
-        };
-        driver::run(&problem, system, control, |shape| {
-            Ok(Dop853Stepper::new(shape.dim))
-        })
-    }
-}
+pi_controlled_integrator!(
+    DormandPrince853,
+    name: "dop853",
+    order: 8,
+    error_order: ERROR_ORDER,
+    controller: PiController::dop853(),
+    new_doc: "The method with [`PiController::dop853`].",
+    stepper: |dim| Dop853Stepper::new(dim),
+);
 
 #[cfg(test)]
 mod tests {

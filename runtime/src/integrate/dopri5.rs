@@ -71,67 +71,12 @@ pub struct DormandPrince54 {
     controller: PiController,
 }
 
-impl Default for DormandPrince54 {
-    fn default() -> Self {
-        Self {
-            controller: PiController::dopri5(),
-        }
-    }
-}
-
-impl DormandPrince54 {
-    /// The method with [`PiController::dopri5`].
-    pub fn new() -> Self {
-        Self::default()
-    }
-
-    /// Uses `controller` for the step sizes.
-    pub fn with_controller(mut self, controller: PiController) -> Self {
-        self.controller = controller;
-        self
-    }
-
-    /// The step-size controller.
-    pub fn controller(&self) -> &PiController {
-        &self.controller
-    }
-}
-
-impl Integrator for DormandPrince54 {
-    fn name(&self) -> &'static str {
-        "dp54"
-    }
-
-    fn order(&self) -> u32 {
-        5
-    }
-
-    fn integrate(
-        &mut self,
-        system: &mut dyn OdeSystem,
-        t0: f64,
-        y0: &[f64],
-        t_end: f64,
-        output: &OutputTimes,
-        options: &IntegratorOptions,
-    ) -> Result<Solution, IntegrationFailure> {
-        let problem = Problem {
-            t0,
-            y0,
-            t_end,
-            output,
-            options,
-        };
-        let control = if options.fixed_step {
-            Control::Fixed
-        } else {
-            Control::Adaptive {
-                controller: &mut self.controller,
-                error_order: ERROR_ORDER,
-            }
-        };
-        driver::run(&problem, system, control, |shape| {
-            Ok(ExplicitRk::new(Tableau::dopri5(), shape.dim))
-        })
-    }
-}
+pi_controlled_integrator!(
+    DormandPrince54,
+    name: "dp54",
+    order: 5,
+    error_order: ERROR_ORDER,
+    controller: PiController::dopri5(),
+    new_doc: "The method with [`PiController::dopri5`].",
+    stepper: |dim| ExplicitRk::new(Tableau::dopri5(), dim),
+);

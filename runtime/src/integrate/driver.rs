@@ -32,6 +32,25 @@ pub(crate) struct Problem<'a> {
     pub(crate) options: &'a IntegratorOptions,
 }
 
+impl<'a> Problem<'a> {
+    /// The problem of one [`Integrator::integrate`](super::Integrator::integrate) call.
+    pub(crate) fn new(
+        t0: f64,
+        y0: &'a [f64],
+        t_end: f64,
+        output: &'a OutputTimes,
+        options: &'a IntegratorOptions,
+    ) -> Self {
+        Self {
+            t0,
+            y0,
+            t_end,
+            output,
+            options,
+        }
+    }
+}
+
 /// How the step sizes are chosen.
 pub(crate) enum Control<'a> {
     /// Constant steps `dt`, the last one shortened to land on `t_end`; no error control.

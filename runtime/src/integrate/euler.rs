@@ -44,40 +44,4 @@ pub struct ExplicitEuler {
     _private: (),
 }
 
-impl ExplicitEuler {
-    /// The method.
-    pub fn new() -> Self {
-        Self::default()
-    }
-}
-
-impl Integrator for ExplicitEuler {
-    fn name(&self) -> &'static str {
-        "euler"
-    }
-
-    fn order(&self) -> u32 {
-        1
-    }
-
-    fn integrate(
-        &mut self,
-        system: &mut dyn OdeSystem,
-        t0: f64,
-        y0: &[f64],
-        t_end: f64,
-        output: &OutputTimes,
-        options: &IntegratorOptions,
-    ) -> Result<Solution, IntegrationFailure> {
-        let problem = Problem {
-            t0,
-            y0,
-            t_end,
-            output,
-            options,
-        };
-        driver::run(&problem, system, Control::Fixed, |shape| {
-            Ok(ExplicitRk::new(Tableau::euler(), shape.dim))
-        })
-    }
-}
+fixed_step_integrator!(ExplicitEuler, name: "euler", order: 1, tableau: Tableau::euler());

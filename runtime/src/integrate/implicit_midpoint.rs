@@ -392,13 +392,7 @@ impl Integrator for ImplicitMidpoint {
         output: &OutputTimes,
         options: &IntegratorOptions,
     ) -> Result<Solution, IntegrationFailure> {
-        let problem = Problem {
-            t0,
-            y0,
-            t_end,
-            output,
-            options,
-        };
+        let problem = Problem::new(t0, y0, t_end, output, options);
         let (tolerance, iterations) = (self.newton_tolerance, self.max_newton_iterations.max(1));
         driver::run(&problem, system, Control::Fixed, |shape| {
             check_absolute_tolerance(options, shape.dim, "implicit midpoint")?;

@@ -41,40 +41,4 @@ pub struct ExplicitMidpoint {
     _private: (),
 }
 
-impl ExplicitMidpoint {
-    /// The method.
-    pub fn new() -> Self {
-        Self::default()
-    }
-}
-
-impl Integrator for ExplicitMidpoint {
-    fn name(&self) -> &'static str {
-        "midpoint"
-    }
-
-    fn order(&self) -> u32 {
-        2
-    }
-
-    fn integrate(
-        &mut self,
-        system: &mut dyn OdeSystem,
-        t0: f64,
-        y0: &[f64],
-        t_end: f64,
-        output: &OutputTimes,
-        options: &IntegratorOptions,
-    ) -> Result<Solution, IntegrationFailure> {
-        let problem = Problem {
-            t0,
-            y0,
-            t_end,
-            output,
-            options,
-        };
-        driver::run(&problem, system, Control::Fixed, |shape| {
-            Ok(ExplicitRk::new(Tableau::midpoint(), shape.dim))
-        })
-    }
-}
+fixed_step_integrator!(ExplicitMidpoint, name: "midpoint", order: 2, tableau: Tableau::midpoint());

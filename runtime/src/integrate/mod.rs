@@ -57,6 +57,9 @@
 //! # Ok::<(), eomgen_runtime::IntegrationFailure>(())
 //! ```
 
+#[macro_use]
+mod wrappers;
+
 mod bs32;
 mod controller;
 mod dense_output;
@@ -74,7 +77,7 @@ mod options;
 mod radau5;
 mod rk4;
 mod solution;
-pub mod stability;
+pub mod stability_function;
 mod stepper;
 mod symplectic;
 mod tableau;

@@ -745,13 +745,7 @@ impl Integrator for RadauIIA5 {
         output: &OutputTimes,
         options: &IntegratorOptions,
     ) -> Result<Solution, IntegrationFailure> {
-        let problem = Problem {
-            t0,
-            y0,
-            t_end,
-            output,
-            options,
-        };
+        let problem = Problem::new(t0, y0, t_end, output, options);
         let control = if options.fixed_step {
             Control::Fixed
         } else {

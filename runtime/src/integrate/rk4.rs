@@ -44,40 +44,4 @@ pub struct RungeKutta4 {
     _private: (),
 }
 
-impl RungeKutta4 {
-    /// The method.
-    pub fn new() -> Self {
-        Self::default()
-    }
-}
-
-impl Integrator for RungeKutta4 {
-    fn name(&self) -> &'static str {
-        "rk4"
-    }
-
-    fn order(&self) -> u32 {
-        4
-    }
-
-    fn integrate(
-        &mut self,
-        system: &mut dyn OdeSystem,
-        t0: f64,
-        y0: &[f64],
-        t_end: f64,
-        output: &OutputTimes,
-        options: &IntegratorOptions,
-    ) -> Result<Solution, IntegrationFailure> {
-        let problem = Problem {
-            t0,
-            y0,
-            t_end,
-            output,
-            options,
-        };
-        driver::run(&problem, system, Control::Fixed, |shape| {
-            Ok(ExplicitRk::new(Tableau::rk4(), shape.dim))
-        })
-    }
-}
+fixed_step_integrator!(RungeKutta4, name: "rk4", order: 4, tableau: Tableau::rk4());

@@ -241,13 +241,7 @@ impl Integrator for SymplecticEuler {
         output: &OutputTimes,
         options: &IntegratorOptions,
     ) -> Result<Solution, IntegrationFailure> {
-        let problem = Problem {
-            t0,
-            y0,
-            t_end,
-            output,
-            options,
-        };
+        let problem = Problem::new(t0, y0, t_end, output, options);
         integrate_partitioned(Scheme::SymplecticEuler, self.name(), system, &problem)
     }
 }
@@ -333,13 +327,7 @@ impl Integrator for StormerVerlet {
         output: &OutputTimes,
         options: &IntegratorOptions,
     ) -> Result<Solution, IntegrationFailure> {
-        let problem = Problem {
-            t0,
-            y0,
-            t_end,
-            output,
-            options,
-        };
+        let problem = Problem::new(t0, y0, t_end, output, options);
         integrate_partitioned(Scheme::StormerVerlet, self.name(), system, &problem)
     }
 }

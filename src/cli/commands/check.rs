@@ -7,7 +7,9 @@ use crate::cli::error::CliError;
 use crate::cli::output::outln;
 use crate::cli::output::print_json;
 use crate::cli::render::num;
-use eomgen_symbolic::mechanics::check::{CheckReport, INITIAL_CONSTRAINT_TOLERANCE, check_model};
+use eomgen_symbolic::mechanics::cross_check::{
+    CheckReport, INITIAL_CONSTRAINT_TOLERANCE, check_model,
+};
 
 /// Relative tolerance of every check: the derivations differ only by rounding (~1e-14).
 const TOLERANCE: f64 = 1e-8;

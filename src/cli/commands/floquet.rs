@@ -2,8 +2,8 @@
 //! equilibrium, and its stability chart over two parameters (issue 7, item 7; lectures 19 and
 //! 21, the Mathieu inverted pendulum).
 //!
-//! The numbers come from [`eomgen::vibration::floquet_at_equilibrium`] and, for
-//! `--sweep a=LO..HI:N,w=LO..HI:N`, [`eomgen::vibration::floquet_cell`] on every point of the
+//! The numbers come from [`eomgen::analysis::vibration::floquet_at_equilibrium`] and, for
+//! `--sweep a=LO..HI:N,w=LO..HI:N`, [`eomgen::analysis::vibration::floquet_cell`] on every point of the
 //! grid, run here in parallel (rayon); the chart shows stable against unstable cells,
 //! coloured by the spectral radius. What the model file's `floquet:` block gives at the
 //! operating point ([`eomgen::FloquetReferences`]) is drawn and printed with it: for
@@ -13,7 +13,7 @@ use std::f64::consts::TAU;
 
 use clap::Args;
 use eomgen::analysis::StudyRuns;
-use eomgen::vibration::{
+use eomgen::analysis::vibration::{
     self, FloquetCell, FloquetChart, FloquetPoint, FloquetStudyError, FloquetStudyOptions,
     SweepAxis,
 };

@@ -3,13 +3,13 @@
 //! DOP853 on the linear equations, `e^{At}`, superposed modes of `M⁻¹K` and superposed
 //! mass-normalised modes — their largest differences, and a chart of every coordinate.
 //!
-//! The numbers come from [`eomgen::vibration::free_response()`]; this module renders them. Also
+//! The numbers come from [`eomgen::analysis::vibration::free_response()`]; this module renders them. Also
 //! the pieces `study modal-damping` shares: `--init` parsing, the errors in the options' words
 //! and the stacked charts.
 
 use clap::Args;
 use eomgen::analysis::StudyRuns;
-use eomgen::vibration::{self, FreeResponseMethod, FreeResponseOptions, FreeResponseStudy};
+use eomgen::analysis::vibration::{self, FreeResponseMethod, FreeResponseOptions, FreeResponseStudy};
 use eomgen::{ModeKind, ModelInfo};
 use serde_json::json;
 

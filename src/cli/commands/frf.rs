@@ -2,11 +2,11 @@
 //! a load parameter to coordinates, its resonance peaks, a Bode chart, the response assembled
 //! mode by mode (`--modal`), and points of the curve checked by simulating the full model
 //! (`--simulate K`) (lecture 21, HW21, HW34, HW37). The numbers come from
-//! [`eomgen::vibration::frequency_response_analysis`] and its simulated points; this module
+//! [`eomgen::analysis::vibration::frequency_response_analysis`] and its simulated points; this module
 //! runs those in parallel and renders text, JSON and the chart.
 
 use clap::Args;
-use eomgen::vibration::{
+use eomgen::analysis::vibration::{
     self, FrfAnalysis, FrfAnalysisError, FrfOptions, FrfOutput, FrfSimulationOptions,
     FrfSimulationPlan, SimulatedPoint, max_simulation_error,
 };

@@ -7,7 +7,7 @@
 use clap::Args;
 use eomgen::ModelInfo;
 use eomgen::analysis::StudyRuns;
-use eomgen::vibration::{ModalDampingOptions, ModalDampingStudy, RayleighFit};
+use eomgen::analysis::vibration::{ModalDampingOptions, ModalDampingStudy, RayleighFit};
 use serde_json::json;
 
 use crate::cli::error::CliError;
@@ -81,7 +81,7 @@ pub fn run(args: &ModalDampingArgs) -> Result<(), CliError> {
         samples: args.samples,
         tol: args.tol,
     };
-    let study = eomgen::vibration::modal_damping_study(model.as_ref(), &options)
+    let study = eomgen::analysis::vibration::modal_damping_study(model.as_ref(), &options)
         .map_err(|e| study_failure(model.as_ref(), &e))?;
     study
         .check_measured()

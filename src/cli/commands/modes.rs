@@ -2,7 +2,7 @@
 //! modes and damping (issue 7; lectures 22–26, 30).
 
 use clap::Args;
-use eomgen::vibration::{self, ModalAnalysis, ModalOptions};
+use eomgen::analysis::vibration::{self, ModalAnalysis, ModalOptions};
 use eomgen::{ModeKind, ModelInfo};
 use nalgebra::DMatrix;
 use serde_json::json;
@@ -309,7 +309,7 @@ fn print_matrix(out: &mut impl std::io::Write, name: &str, m: &DMatrix<f64>) {
 }
 
 /// The model `model_name` with `--set` applied and its modal analysis at `--at`
-/// ([`eomgen::vibration::modal_analysis`]).
+/// ([`eomgen::analysis::vibration::modal_analysis`]).
 ///
 /// # Errors
 /// A bad `--set` or `--at` (usage), a failed search or analysis (with a hint).

@@ -25,8 +25,8 @@ use serde_json::json;
 
 use eomgen::ModelInfo;
 use eomgen::analysis::StudyRuns;
+use eomgen::analysis::vibration::ModalAnalysis;
 use eomgen::checks::{DefaultRun, ReportRows, model_report};
-use eomgen::vibration::ModalAnalysis;
 use eomgen_symbolic::codegen::equations_mathml;
 use eomgen_symbolic::mechanics::{Formulation, Lagrange, SymbolicModel};
 use eomgen_symbolic::model::ModelFile;

@@ -19,7 +19,7 @@ use eomgen::analysis::stability::{
     STIFF_OUTPUT_TIMES, STIFF_REFERENCE_TOL, StabilityError, StabilityOptions, StabilityStudy,
     StiffMode, StiffRow, StiffSpring, UnderflowRun, stability_study,
 };
-use eomgen::integrate::stability::GrowthTest;
+use eomgen::integrate::stability_function::GrowthTest;
 use nalgebra::Complex;
 use serde_json::json;
 

@@ -1,10 +1,12 @@
 //! The description of a derived model ([`describe`]) and its printing as Rust
-//! ([`description_source`]): the one place where a model's data — everything that is not a
+//! ([`description_tokens`]): the one place where a model's data — everything that is not a
 //! function of the state — is gathered, for the macro (which prints it as a `static`) and for
 //! the run-time compiler (which keeps the value) alike.
 
 use std::borrow::Cow;
-use std::fmt::Write as _;
+
+use proc_macro2::TokenStream;
+use quote::quote;
 
 use eomgen_description::{
     BodyCentre, EventDirection, EventSpec, ModelDescription, Parameter, Text,
@@ -83,82 +85,100 @@ pub fn describe(model: &SymbolicModel, eom: &EquationsOfMotion) -> ModelDescript
 
 /// A Rust expression that builds `description` in a `static` (every string and list
 /// borrowed from the binary), naming the types under `krate` (`::eomgen`).
-pub fn description_source(description: &ModelDescription, krate: &str) -> String {
-    let text = |s: &str| format!("::std::borrow::Cow::Borrowed({s:?})");
-    let list =
-        |items: Vec<String>| format!("::std::borrow::Cow::Borrowed(&[{}])", items.join(", "));
-    let texts = |items: &[Text]| list(items.iter().map(|s| text(s)).collect());
+///
+/// # Errors
+/// A parameter default that does not print as a literal (the loader refuses non-finite
+/// values, so this is a bug).
+pub fn description_tokens(
+    description: &ModelDescription,
+    krate: &TokenStream,
+) -> Result<TokenStream, String> {
+    let borrowed = |items: Vec<TokenStream>| quote!(::std::borrow::Cow::Borrowed(&[#(#items),*]));
+    let text = |s: &str| quote!(::std::borrow::Cow::Borrowed(#s));
+    let texts = |items: &[Text]| borrowed(items.iter().map(|s| text(s)).collect());
     let d = description;
-    let mut src = format!("{krate}::ModelDescription {{ ");
-    let _ = write!(src, "name: {}, ", text(&d.name));
-    let _ = write!(src, "summary: {}, ", text(&d.summary));
-    let _ = write!(src, "coordinates: {}, ", texts(&d.coordinates));
+    let name = text(&d.name);
+    let summary = text(&d.summary);
+    let coordinates = texts(&d.coordinates);
     let parameters = d
         .parameters
         .iter()
         .map(|p| {
-            format!(
-                "{krate}::Parameter {{ name: {}, default: {:?}_f64 }}",
-                text(&p.name),
-                p.default
-            )
+            let name = text(&p.name);
+            let default = super::float(p.default)?;
+            Ok(quote!(#krate::Parameter { name: #name, default: #default }))
         })
-        .collect();
-    let _ = write!(src, "parameters: {}, ", list(parameters));
-    let _ = write!(src, "points: {}, ", texts(&d.points));
-    let lines = d
-        .draw_lines
-        .iter()
-        .map(|[a, b]| format!("[{}, {}]", text(a), text(b)))
-        .collect();
-    let _ = write!(src, "draw_lines: {}, ", list(lines));
-    let _ = write!(src, "trace_points: {}, ", texts(&d.trace_points));
-    let centres = d
-        .body_centres
-        .iter()
-        .map(|b| {
-            format!(
-                "{krate}::BodyCentre {{ body: {}, point: {}, rigid: {} }}",
-                text(&b.body),
-                text(&b.point),
-                b.rigid
-            )
-        })
-        .collect();
-    let _ = write!(src, "body_centres: {}, ", list(centres));
-    let _ = write!(src, "constraints: {}, ", texts(&d.constraints));
-    let _ = write!(src, "holonomic_constraints: {}, ", d.holonomic_constraints);
-    let guesses = d
+        .collect::<Result<_, String>>()?;
+    let parameters = borrowed(parameters);
+    let points = texts(&d.points);
+    let draw_lines = borrowed(
+        d.draw_lines
+            .iter()
+            .map(|[a, b]| {
+                let (a, b) = (text(a), text(b));
+                quote!([#a, #b])
+            })
+            .collect(),
+    );
+    let trace_points = texts(&d.trace_points);
+    let body_centres = borrowed(
+        d.body_centres
+            .iter()
+            .map(|c| {
+                let (body, point, rigid) = (text(&c.body), text(&c.point), c.rigid);
+                quote!(#krate::BodyCentre { body: #body, point: #point, rigid: #rigid })
+            })
+            .collect(),
+    );
+    let constraints = texts(&d.constraints);
+    let holonomic = super::index(d.holonomic_constraints);
+    let guesses: Vec<TokenStream> = d
         .initial_guesses
         .iter()
-        .map(|i| format!("{i}_usize"))
-        .collect();
-    let _ = write!(src, "initial_guesses: {}, ", list(guesses));
-    let _ = write!(src, "equilibria: {}, ", texts(&d.equilibria));
-    let events = d
-        .events
-        .iter()
-        .map(|e| {
-            let direction = match e.direction {
-                EventDirection::Rising => "Rising",
-                EventDirection::Falling => "Falling",
-                EventDirection::Both => "Both",
-            };
-            format!(
-                "{krate}::EventSpec {{ name: {}, direction: {krate}::EventDirection::{direction}, terminal: {} }}",
-                text(&e.name),
-                e.terminal
-            )
-        })
-        .collect();
-    let _ = write!(src, "events: {}, ", list(events));
-    let _ = write!(
-        src,
-        "events_need_accelerations: {}, ",
-        d.events_need_accelerations
+        .map(|i| super::tokens(&format!("{i}_usize")))
+        .collect::<Result<_, String>>()?;
+    let initial_guesses = borrowed(guesses);
+    let equilibria = texts(&d.equilibria);
+    let events = borrowed(
+        d.events
+            .iter()
+            .map(|e| {
+                let direction = match e.direction {
+                    EventDirection::Rising => quote!(Rising),
+                    EventDirection::Falling => quote!(Falling),
+                    EventDirection::Both => quote!(Both),
+                };
+                let (name, terminal) = (text(&e.name), e.terminal);
+                quote!(#krate::EventSpec {
+                    name: #name,
+                    direction: #krate::EventDirection::#direction,
+                    terminal: #terminal,
+                })
+            })
+            .collect(),
     );
-    let _ = write!(src, "conservative: {}, ", d.conservative);
-    let _ = write!(src, "equations_text: {}, ", text(&d.equations_text));
-    let _ = write!(src, "equations_latex: {} }}", text(&d.equations_latex));
-    src
+    let (needs, conservative) = (d.events_need_accelerations, d.conservative);
+    let equations_text = text(&d.equations_text);
+    let equations_latex = text(&d.equations_latex);
+    Ok(quote! {
+        #krate::ModelDescription {
+            name: #name,
+            summary: #summary,
+            coordinates: #coordinates,
+            parameters: #parameters,
+            points: #points,
+            draw_lines: #draw_lines,
+            trace_points: #trace_points,
+            body_centres: #body_centres,
+            constraints: #constraints,
+            holonomic_constraints: #holonomic,
+            initial_guesses: #initial_guesses,
+            equilibria: #equilibria,
+            events: #events,
+            events_need_accelerations: #needs,
+            conservative: #conservative,
+            equations_text: #equations_text,
+            equations_latex: #equations_latex,
+        }
+    })
 }

@@ -1,31 +1,34 @@
 //! Equations → Rust tokens: a struct named after the model and an
 //! `impl MechanicalSystem<N>` with straight-line, CSE'd, allocation-free bodies.
 //!
-//! Each generated function is planned by [`crate::expr::cse::plan`] over exactly the
-//! expressions it returns, binds only the symbols it uses, computes `sin_cos` once per angle,
-//! and builds its nalgebra static matrix from a stack array. Output is deterministic: it
-//! depends only on the model file.
+//! Each generated function prints one plan of [`plan`] (the plans the run-time compiler
+//! lowers to tapes, [`program::ModelProgram`]): it binds only the symbols it uses, computes
+//! `sin_cos` once per angle, and builds its nalgebra static matrix from a stack array. The
+//! items are built as tokens with `quote!`; only the expressions come as text, from the
+//! printer that the tapes follow operation by operation ([`crate::expr::print`]). Output is
+//! deterministic: it depends only on the model file.
 
 mod describe;
 mod listing;
+pub mod plan;
 pub mod program;
 pub mod tape;
 
-pub use describe::{describe, description_source};
+pub use describe::{describe, description_tokens};
 pub use listing::{
     ConstraintKind, ConstraintListing, EquationsListing, GeneralizedForce, equations_latex,
     equations_text,
 };
 
-use std::fmt::Write as _;
+use proc_macro2::{Ident, Literal, TokenStream, TokenTree};
+use quote::quote;
 
-use proc_macro2::TokenStream;
-
-use crate::expr::cse::{self, CsePlan, Temporary};
+use crate::expr::cse::{CsePlan, Temporary};
 use crate::expr::print::{Printer, Syntax};
-use crate::expr::{ExprArena, ExprId, SymbolId, SymbolKind, trig};
-use crate::mechanics::{EquationsOfMotion, Jacobians, SymbolicModel};
+use crate::expr::{ExprArena, ExprId, SymbolId, SymbolKind};
+use crate::mechanics::{EquationsOfMotion, SymbolicModel};
 use crate::model::schema::RUST_KEYWORDS;
+use plan::ModelFunction;
 
 /// Why [`generate`] produced no code.
 #[derive(Debug, Clone)]
@@ -37,11 +40,30 @@ pub enum GenerateError {
     Emit(String),
 }
 
+/// The first steps of every compilation of a model file, by the macro ([`generate`]) or at run
+/// time ([`program::ModelProgram::from_file`]): lowering, one derivation
+/// ([`crate::mechanics::preferred_equations`]) and the mass-matrix diagnostics.
+///
+/// # Errors
+/// [`GenerateError::Diagnostics`] for a model that cannot be lowered or whose mass matrix is
+/// singular ([`crate::mechanics::mass_matrix_diagnostics`]).
+fn derive(
+    file: &crate::model::ModelFile,
+) -> Result<(SymbolicModel, EquationsOfMotion), GenerateError> {
+    let mut model = SymbolicModel::from_file(file).map_err(GenerateError::Diagnostics)?;
+    let (eom, _) = crate::mechanics::preferred_equations(&mut model);
+    let problems = crate::mechanics::mass_matrix_diagnostics(&model, &eom, file);
+    if !problems.is_empty() {
+        return Err(GenerateError::Diagnostics(problems));
+    }
+    Ok((model, eom))
+}
+
 /// The code `eomgen::model!` generates for a loaded model file: lowering, one derivation
-/// ([`crate::mechanics::preferred_equations`]), the mass-matrix diagnostics, the exact
-/// Jacobians, then [`emit`]. The macro and `eomgen equations --rust` both call this, so what the
-/// CLI prints is what is compiled; a model compiled at run time is planned from the same steps
-/// ([`program::ModelProgram::from_file`]).
+/// ([`crate::mechanics::preferred_equations`]), the mass-matrix diagnostics, the plans of
+/// every function with the exact Jacobians ([`plan::EmitPlans::of`]), then [`emit`]. The macro and `eomgen equations --rust` both call this, so what the
+/// CLI prints is what is compiled; a model compiled at run time is derived by the same steps
+/// and lowered from the same plans ([`program::ModelProgram::from_file`]).
 ///
 /// # Errors
 /// [`GenerateError::Diagnostics`] for a model that cannot be lowered or whose mass matrix is
@@ -51,14 +73,9 @@ pub fn generate(
     file: &crate::model::ModelFile,
     options: &EmitOptions,
 ) -> Result<TokenStream, GenerateError> {
-    let mut model = SymbolicModel::from_file(file).map_err(GenerateError::Diagnostics)?;
-    let (eom, _) = crate::mechanics::preferred_equations(&mut model);
-    let problems = crate::mechanics::mass_matrix_diagnostics(&model, &eom, file);
-    if !problems.is_empty() {
-        return Err(GenerateError::Diagnostics(problems));
-    }
-    let jacobians = Jacobians::of(&mut model, &eom);
-    emit(&model, &eom, &jacobians, options)
+    let (model, eom) = derive(file)?;
+    let plans = plan::EmitPlans::of(&model, &eom);
+    emit(&model, &eom, &plans, options)
         .map(|(tokens, _)| tokens)
         .map_err(GenerateError::Emit)
 }
@@ -108,21 +125,53 @@ pub fn local_name(name: &str) -> String {
     }
 }
 
-/// Source of one function body: symbol bindings, temporaries, and the returned values
-/// (printed as Rust expressions, in root order).
-struct Body {
-    code: String,
-    values: Vec<String>,
+/// The tokens of Rust source: an expression of the printer, or a path from [`EmitOptions`].
+///
+/// # Errors
+/// Source that does not tokenize (a bug of the printer, or a bad `crate_path`), with the
+/// source.
+fn tokens(source: &str) -> Result<TokenStream, String> {
+    source
+        .parse()
+        .map_err(|e| format!("generated code does not tokenize ({e}): {source}"))
 }
 
-fn body(arena: &mut ExprArena, roots: &[ExprId], helpers: &str) -> (Body, CsePlan) {
-    let roots = &trig::expand_angle_sums(arena, roots)[..];
-    let arena: &ExprArena = arena;
-    let plan = cse::plan(arena, roots, "__e");
-    let reachable = arena.reachable(roots);
-    let mut code = String::new();
-    // Bind the symbols used, in symbol order.
-    let mut used: Vec<SymbolId> = reachable
+/// An identifier, raw for `r#name`.
+///
+/// # Errors
+/// A name that is not one identifier (the loader refuses such names, so this is a bug).
+fn ident(name: &str) -> Result<Ident, String> {
+    let mut trees = tokens(name)?.into_iter();
+    match (trees.next(), trees.next()) {
+        (Some(TokenTree::Ident(ident)), None) => Ok(ident),
+        _ => Err(format!("`{name}` is not a Rust identifier")),
+    }
+}
+
+/// An `f64` literal as the printer writes one (`9.81_f64`, `-1.0_f64`).
+fn float(value: f64) -> Result<TokenStream, String> {
+    tokens(&format!("{value:?}_f64"))
+}
+
+/// An index or size, unsuffixed (`3`).
+fn index(i: usize) -> Literal {
+    Literal::usize_unsuffixed(i)
+}
+
+/// One function body: symbol bindings and temporaries, and the returned values (in root
+/// order).
+struct Body {
+    statements: TokenStream,
+    values: Vec<TokenStream>,
+}
+
+/// The body of one planned function: the symbols its roots use bound in symbol order, the
+/// plan's temporaries, and its roots as expressions.
+fn body(arena: &ExprArena, plan: &CsePlan, helpers: &str) -> Result<Body, String> {
+    let helper_path = tokens(helpers)?;
+    let mut statements = TokenStream::new();
+    let mut used: Vec<SymbolId> = arena
+        .reachable(&plan.roots)
         .iter()
         .filter_map(|e| match arena.node(*e) {
             crate::expr::Node::Symbol(s) => Some(*s),
@@ -132,20 +181,34 @@ fn body(arena: &mut ExprArena, roots: &[ExprId], helpers: &str) -> (Body, CsePla
     used.sort();
     for s in used {
         let info = arena.symbol_info(s);
-        let local = local_name(&info.name);
+        let local = ident(&local_name(&info.name))?;
         let source = match info.kind {
-            SymbolKind::Parameter => format!("self.{}", field_name(&info.name)),
-            SymbolKind::Coordinate(i) => format!("__q[{i}]"),
-            SymbolKind::Velocity(i) => format!("__qdot[{i}]"),
-            SymbolKind::Acceleration(i) => format!("__a[{i}]"),
-            SymbolKind::Time => "__t".to_string(),
-            SymbolKind::Auxiliary => "0.0_f64".to_string(),
-            SymbolKind::Multiplier(i) => format!("__lambda.get({i}).copied().unwrap_or(f64::NAN)"),
+            SymbolKind::Parameter => {
+                let field = ident(&field_name(&info.name))?;
+                quote!(self.#field)
+            }
+            SymbolKind::Coordinate(i) => {
+                let i = index(i as usize);
+                quote!(__q[#i])
+            }
+            SymbolKind::Velocity(i) => {
+                let i = index(i as usize);
+                quote!(__qdot[#i])
+            }
+            SymbolKind::Acceleration(i) => {
+                let i = index(i as usize);
+                quote!(__a[#i])
+            }
+            SymbolKind::Time => quote!(__t),
+            SymbolKind::Auxiliary => quote!(0.0_f64),
+            SymbolKind::Multiplier(i) => {
+                let i = index(i as usize);
+                quote!(__lambda.get(#i).copied().unwrap_or(f64::NAN))
+            }
         };
-        let _ = writeln!(code, "let {local}: f64 = {source};");
+        statements.extend(quote!(let #local: f64 = #source;));
     }
-    let plan_ref = &plan;
-    let names = move |e: ExprId| plan_ref.name_of(e).map(str::to_string);
+    let names = |e: ExprId| plan.name_of(e).map(str::to_string);
     let printer = Printer::new(arena, Syntax::Rust)
         .with_symbol_names(|s| local_name(&arena.symbol_info(s).name))
         .with_temporaries(names)
@@ -154,22 +217,25 @@ fn body(arena: &mut ExprArena, roots: &[ExprId], helpers: &str) -> (Body, CsePla
         match *temp {
             Temporary::Single(e) => {
                 let (name, _) = plan.temporary_names(temp);
-                let _ = writeln!(code, "let {name}: f64 = {};", printer.print_definition(e));
+                let name = ident(&name)?;
+                let definition = tokens(&printer.print_definition(e))?;
+                statements.extend(quote!(let #name: f64 = #definition;));
             }
             Temporary::SinCos { arg, .. } => {
                 let (s, c) = plan.temporary_names(temp);
-                let c = c.unwrap_or_default();
-                let a = printer.print(arg);
-                let _ = writeln!(
-                    code,
-                    "let ({s}, {c}): (f64, f64) = {helpers}::sin_cos({a});"
-                );
+                let s = ident(&s)?;
+                let c = ident(&c.unwrap_or_default())?;
+                let a = tokens(&printer.print(arg))?;
+                statements.extend(quote!(let (#s, #c): (f64, f64) = #helper_path::sin_cos(#a);));
             }
         }
     }
-    let values = roots.iter().map(|r| printer.print(*r)).collect();
-    drop(printer);
-    (Body { code, values }, plan)
+    let values = plan
+        .roots
+        .iter()
+        .map(|r| tokens(&printer.print(*r)))
+        .collect::<Result<_, _>>()?;
+    Ok(Body { statements, values })
 }
 
 /// A parameter's field: its name, a keyword as a raw identifier (`r#type`).
@@ -183,19 +249,21 @@ fn field_name(name: &str) -> String {
 
 /// Statements that write `values` into the slice `__out` (entries beyond its length are
 /// skipped, so a short slice cannot panic).
-fn write_out(values: &[String]) -> String {
+fn write_out(values: &[TokenStream]) -> TokenStream {
     values
         .iter()
         .enumerate()
-        .map(|(i, x)| format!("if let Some(__o) = __out.get_mut({i}) {{ *__o = {x}; }}\n"))
+        .map(|(i, x)| {
+            let i = index(i);
+            quote!(if let Some(__o) = __out.get_mut(#i) { *__o = #x; })
+        })
         .collect()
 }
 
-fn string_literal(s: &str) -> String {
-    format!("{s:?}")
-}
-
-/// Generates the struct and its `MechanicalSystem` implementation.
+/// Generates the struct and its `MechanicalSystem` implementation: the struct with one field
+/// per parameter, its `Default`, the model's description as a `static`, and one method per
+/// plan of `plans` ([`plan::EmitPlans::of`] of the same `model` and `eom`: every function of
+/// [`ModelFunction::ALL`] the model has; the trait's defaults stand for the others).
 ///
 /// # Errors
 /// Only if the printed code fails to tokenize, which would be a bug in the printer; the
@@ -203,19 +271,19 @@ fn string_literal(s: &str) -> String {
 pub fn emit(
     model: &SymbolicModel,
     eom: &EquationsOfMotion,
-    jacobians: &Jacobians,
+    plans: &plan::EmitPlans,
     options: &EmitOptions,
 ) -> Result<(TokenStream, EmitStats), String> {
     let n = model.num_dofs();
-    let krate = &options.crate_path;
-    let private = format!("{krate}::__private");
-    let na = format!("{private}::nalgebra");
-    let name = struct_name(&model.name);
-    let vec_t = format!("{na}::SVector<f64, {n}>");
-    let mat_t = format!("{na}::SMatrix<f64, {n}, {n}>");
-    let mut src = String::new();
+    let krate = tokens(&options.crate_path)?;
+    let helpers = format!("{}::__private", options.crate_path);
+    let na = quote!(#krate::__private::nalgebra);
+    let name = ident(&struct_name(&model.name))?;
+    let dim = index(n);
+    let vec_t = quote!(#na::SVector<f64, #dim>);
+    let mat_t = quote!(#na::SMatrix<f64, #dim, #dim>);
 
-    // The struct, one field per parameter.
+    // The struct, one field per parameter, and its defaults.
     let doc = format!(
         "{}\n\nGenerated by `eomgen::model!` from `{}`: {} degree(s) of freedom ({}).",
         model.description,
@@ -223,253 +291,240 @@ pub fn emit(
         n,
         model.coordinate_names.join(", ")
     );
-    let _ = writeln!(src, "#[doc = {}]", string_literal(&doc));
-    let _ = writeln!(src, "#[derive(Debug, Clone, Copy, PartialEq)]");
-    let _ = writeln!(src, "#[allow(non_snake_case)]");
-    let _ = writeln!(src, "pub struct {name} {{");
+    let mut fields = Vec::new();
+    let mut defaults = Vec::new();
+    let mut values = Vec::new();
+    let mut setters = Vec::new();
     for p in &model.parameters {
         let unit = p
             .unit
             .as_deref()
             .map(|u| format!(" ({u})"))
             .unwrap_or_default();
-        let _ = writeln!(
-            src,
-            "#[doc = {}] pub {}: f64,",
-            string_literal(&format!(
-                "Parameter `{}`{unit}; default {:?}.",
-                p.name, p.default
-            )),
-            field_name(&p.name)
-        );
+        let field_doc = format!("Parameter `{}`{unit}; default {:?}.", p.name, p.default);
+        let field = ident(&field_name(&p.name))?;
+        let default = float(p.default)?;
+        let parameter = &p.name;
+        fields.push(quote!(#[doc = #field_doc] pub #field: f64,));
+        defaults.push(quote!(#field: #default,));
+        values.push(quote!(self.#field));
+        setters.push(quote!(#parameter => { self.#field = value; Ok(()) }));
     }
-    let _ = writeln!(src, "}}");
-    let _ = writeln!(
-        src,
-        "#[automatically_derived] #[allow(clippy::all, clippy::approx_constant, non_snake_case)] impl ::core::default::Default for {name} {{ fn default() -> Self {{ Self {{"
-    );
-    for p in &model.parameters {
-        let _ = writeln!(src, "{}: {:?}_f64,", field_name(&p.name), p.default);
-    }
-    let _ = writeln!(src, "}} }} }}");
-
-    // Tracking of the model file for rebuilds.
-    for f in &options.tracked_files {
-        let _ = writeln!(
-            src,
-            "const _: &[u8] = ::core::include_bytes!({});",
-            string_literal(f)
-        );
-    }
-
-    let mut imp = String::new();
-    let description = describe::describe(model, eom);
-    let _ = writeln!(
-        imp,
-        "fn description(&self) -> &{krate}::ModelDescription {{ static DESCRIPTION: {krate}::ModelDescription = {}; &DESCRIPTION }}",
-        describe::description_source(&description, krate)
-    );
-    let values: Vec<String> = model
+    let model_name = &model.name;
+    let known = model
         .parameters
         .iter()
-        .map(|p| format!("self.{}", field_name(&p.name)))
-        .collect();
-    let _ = writeln!(
-        imp,
-        "fn parameter_values(&self) -> ::std::vec::Vec<f64> {{ ::std::vec![{}] }}",
-        values.join(", ")
-    );
-    let _ = writeln!(
-        imp,
-        "fn set_parameter(&mut self, name: &str, value: f64) -> ::core::result::Result<(), {krate}::UnknownParameter> {{ match name {{"
-    );
-    for p in &model.parameters {
-        let _ = writeln!(
-            imp,
-            "{} => {{ self.{} = value; Ok(()) }}",
-            string_literal(&p.name),
-            field_name(&p.name)
-        );
-    }
-    let _ = writeln!(
-        imp,
-        "_ => Err({krate}::UnknownParameter {{ model: {}.to_string(), name: name.to_string(), known: {}.to_string() }}) }} }}",
-        string_literal(&model.name),
-        string_literal(
-            &model
-                .parameters
-                .iter()
-                .map(|p| p.name.as_str())
-                .collect::<Vec<_>>()
-                .join(", ")
+        .map(|p| p.name.as_str())
+        .collect::<Vec<_>>()
+        .join(", ");
+    // Tracking of the model file for rebuilds.
+    let tracked = options.tracked_files.iter().map(|f| {
+        quote!(
+            const _: &[u8] = ::core::include_bytes!(#f);
         )
-    );
+    });
+    let description = describe::description_tokens(&describe::describe(model, eom), &krate)?;
 
-    let helpers = private.as_str();
-    // The bodies may add nodes (the angle-sum rewrite); the model's own arena stays as it is.
-    let mut arena = model.arena.clone();
-    let mut emit_fn = |signature: &str,
-                       roots: &[ExprId],
-                       build: &dyn Fn(&[String]) -> String|
-     -> CsePlan {
-        let (b, plan) = body(&mut arena, roots, helpers);
-        let _ = writeln!(
-            imp,
-            "#[allow(unused_variables, non_snake_case, clippy::all)] #[inline] {signature} {{\n{}{}\n}}",
-            b.code,
-            build(&b.values)
-        );
-        plan
+    let mut methods = quote! {
+        fn description(&self) -> &#krate::ModelDescription {
+            static DESCRIPTION: #krate::ModelDescription = #description;
+            &DESCRIPTION
+        }
+        fn parameter_values(&self) -> ::std::vec::Vec<f64> { ::std::vec![#(#values),*] }
+        fn set_parameter(&mut self, name: &str, value: f64) -> ::core::result::Result<(), #krate::UnknownParameter> {
+            match name {
+                #(#setters)*
+                _ => Err(#krate::UnknownParameter {
+                    model: #model_name.to_string(),
+                    name: name.to_string(),
+                    known: #known.to_string(),
+                }),
+            }
+        }
     };
 
-    let mat_e = format!("{na}::SMatrix::<f64, {n}, {n}>");
-    let vec_e = format!("{na}::SVector::<f64, {n}>");
-    let matrix = |vals: &[String]| format!("{mat_e}::from_row_slice(&[{}])", vals.join(", "));
-    let vector = |vals: &[String]| format!("{vec_e}::from_column_slice(&[{}])", vals.join(", "));
-    let q_args = format!("__q: &{vec_t}");
-    let qd_args = format!("__q: &{vec_t}, __qdot: &{vec_t}");
-
-    emit_fn(
-        &format!("fn initial_state(&self) -> ({vec_t}, {vec_t})"),
-        &[model.initial_q.clone(), model.initial_qdot.clone()].concat(),
-        &|v| format!("({}, {})", vector(&v[..n]), vector(&v[n..])),
-    );
-    emit_fn(
-        &format!("fn mass_matrix(&self, {q_args}, __t: f64) -> {mat_t}"),
-        &eom.mass_matrix,
-        &|v| matrix(v),
-    );
-    emit_fn(
-        &format!("fn forcing(&self, {qd_args}, __t: f64) -> {vec_t}"),
-        &eom.forcing,
-        &|v| vector(v),
-    );
+    let types = Types {
+        na: na.clone(),
+        dim: dim.clone(),
+        n,
+        vec_t: vec_t.clone(),
+        mat_t: mat_t.clone(),
+    };
+    // Printed in the trait's order, whatever order they were planned in.
+    for function in ModelFunction::ALL {
+        if let Some((arena, plan)) = plans.get(function) {
+            let body = body(arena, plan, &helpers)?;
+            methods.extend(function_method(function, body, model, &types));
+        }
+    }
     let both: Vec<ExprId> = [eom.mass_matrix.clone(), eom.forcing.clone()].concat();
-    let plan = emit_fn(
-        &format!("fn mass_matrix_and_forcing(&self, {qd_args}, __t: f64) -> ({mat_t}, {vec_t})"),
-        &both,
-        &|v| format!("({}, {})", matrix(&v[..n * n]), vector(&v[n * n..])),
-    );
     let stats = EmitStats {
         ops_before_cse: model.arena.tree_operation_count(&both),
-        ops_after_cse: plan.operation_count(),
+        ops_after_cse: plans
+            .get(ModelFunction::MassMatrixAndForcing)
+            .map_or(0, |(_, plan)| plan.operation_count()),
     };
-    emit_fn(
-        &format!("fn forcing_jacobian_q(&self, {qd_args}, __t: f64) -> {mat_t}"),
-        &jacobians.forcing_q,
-        &|v| matrix(v),
-    );
-    emit_fn(
-        &format!("fn forcing_jacobian_qdot(&self, {qd_args}, __t: f64) -> {mat_t}"),
-        &jacobians.forcing_qdot,
-        &|v| matrix(v),
-    );
-    emit_fn(
-        &format!(
-            "fn mass_matrix_product_jacobian(&self, {q_args}, __t: f64, __a: &{vec_t}) -> {mat_t}"
+    let tokens = quote! {
+        #[doc = #doc]
+        #[derive(Debug, Clone, Copy, PartialEq)]
+        #[allow(non_snake_case)]
+        pub struct #name {
+            #(#fields)*
+        }
+        #[automatically_derived]
+        #[allow(clippy::all, clippy::approx_constant, non_snake_case)]
+        impl ::core::default::Default for #name {
+            fn default() -> Self {
+                Self { #(#defaults)* }
+            }
+        }
+        #(#tracked)*
+        #[automatically_derived]
+        #[allow(clippy::all, clippy::approx_constant, non_snake_case)]
+        impl #krate::MechanicalSystem<#dim> for #name {
+            #methods
+        }
+    };
+    Ok((tokens, stats))
+}
+
+/// The types a generated method names: nalgebra's path, `N` as a literal, and the vector
+/// and matrix types of size `N`.
+struct Types {
+    na: TokenStream,
+    dim: Literal,
+    n: usize,
+    vec_t: TokenStream,
+    mat_t: TokenStream,
+}
+
+/// One method of the generated `impl MechanicalSystem<N>`: the function's signature, its body
+/// (bindings and temporaries) and its outputs built into what the trait returns (static
+/// matrices row-major from a stack array, slices written entry by entry).
+fn function_method(
+    function: ModelFunction,
+    body: Body,
+    model: &SymbolicModel,
+    types: &Types,
+) -> TokenStream {
+    let Types {
+        na,
+        dim,
+        n,
+        vec_t,
+        mat_t,
+    } = types;
+    let n = *n;
+    let Body {
+        statements,
+        values: v,
+    } = body;
+    let matrix =
+        |v: &[TokenStream]| quote!(#na::SMatrix::<f64, #dim, #dim>::from_row_slice(&[#(#v),*]));
+    let vector =
+        |v: &[TokenStream]| quote!(#na::SVector::<f64, #dim>::from_column_slice(&[#(#v),*]));
+    let q_args = quote!(__q: &#vec_t);
+    let qd_args = quote!(__q: &#vec_t, __qdot: &#vec_t);
+    let (signature, result) = match function {
+        ModelFunction::InitialState => (quote!(fn initial_state(&self) -> (#vec_t, #vec_t)), {
+            let (q, qdot) = (vector(&v[..n]), vector(&v[n..]));
+            quote!((#q, #qdot))
+        }),
+        ModelFunction::MassMatrix => (
+            quote!(fn mass_matrix(&self, #q_args, __t: f64) -> #mat_t),
+            matrix(&v),
         ),
-        &jacobians.mass_product_q,
-        &|v| matrix(v),
-    );
-    emit_fn(
-        &format!("fn kinetic_energy(&self, {qd_args}, __t: f64) -> f64"),
-        &[model.kinetic],
-        &|v| v[0].clone(),
-    );
-    emit_fn(
-        &format!("fn potential_energy(&self, {q_args}, __t: f64) -> f64"),
-        &[model.potential],
-        &|v| v[0].clone(),
-    );
-    // Point components, flattened; 2-D points get z = 0.
-    let point_roots: Vec<ExprId> = model
+        ModelFunction::Forcing => (
+            quote!(fn forcing(&self, #qd_args, __t: f64) -> #vec_t),
+            vector(&v),
+        ),
+        ModelFunction::MassMatrixAndForcing => (
+            quote!(fn mass_matrix_and_forcing(&self, #qd_args, __t: f64) -> (#mat_t, #vec_t)),
+            {
+                let (m, f) = (matrix(&v[..n * n]), vector(&v[n * n..]));
+                quote!((#m, #f))
+            },
+        ),
+        ModelFunction::ForcingJacobianQ => (
+            quote!(fn forcing_jacobian_q(&self, #qd_args, __t: f64) -> #mat_t),
+            matrix(&v),
+        ),
+        ModelFunction::ForcingJacobianQdot => (
+            quote!(fn forcing_jacobian_qdot(&self, #qd_args, __t: f64) -> #mat_t),
+            matrix(&v),
+        ),
+        ModelFunction::MassMatrixProductJacobian => (
+            quote!(fn mass_matrix_product_jacobian(&self, #q_args, __t: f64, __a: &#vec_t) -> #mat_t),
+            matrix(&v),
+        ),
+        ModelFunction::KineticEnergy => (
+            quote!(fn kinetic_energy(&self, #qd_args, __t: f64) -> f64),
+            v[0].clone(),
+        ),
+        ModelFunction::PotentialEnergy => (
+            quote!(fn potential_energy(&self, #q_args, __t: f64) -> f64),
+            v[0].clone(),
+        ),
+        ModelFunction::PointPositions => (
+            quote!(fn point_positions(&self, #q_args, __t: f64, __out: &mut [[f64; 3]])),
+            point_stores(model, &v),
+        ),
+        ModelFunction::ConstraintResiduals => (
+            quote!(fn constraint_residuals(&self, #q_args, __t: f64, __out: &mut [f64])),
+            write_out(&v),
+        ),
+        ModelFunction::ConstraintJacobian => (
+            quote!(fn constraint_jacobian(&self, #q_args, __t: f64, __out: &mut [f64])),
+            write_out(&v),
+        ),
+        ModelFunction::ConstraintVelocityResiduals => (
+            quote!(fn constraint_velocity_residuals(&self, #qd_args, __t: f64, __out: &mut [f64])),
+            write_out(&v),
+        ),
+        ModelFunction::ConstraintGamma => (
+            quote!(fn constraint_gamma(&self, #qd_args, __t: f64, __out: &mut [f64])),
+            write_out(&v),
+        ),
+        ModelFunction::EventValues => (
+            quote!(fn event_values(&self, #qd_args, __t: f64, __a: &#vec_t, __lambda: &[f64], __out: &mut [f64])),
+            write_out(&v),
+        ),
+        ModelFunction::EquilibriumGuesses => (
+            quote!(fn equilibrium_guesses(&self, __out: &mut [f64])),
+            write_out(&v),
+        ),
+    };
+    quote! {
+        #[allow(unused_variables, non_snake_case, clippy::all)]
+        #[inline]
+        #signature {
+            #statements
+            #result
+        }
+    }
+}
+
+/// Stores of `point_positions`: `[x, y, z]` per point from its flattened components `v`, 2-D
+/// points with `z = 0`.
+fn point_stores(model: &SymbolicModel, v: &[TokenStream]) -> TokenStream {
+    let mut components = v.iter();
+    model
         .points
         .iter()
-        .flat_map(|(_, r)| r.iter().copied())
-        .collect();
-    let dims: Vec<usize> = model.points.iter().map(|(_, r)| r.len()).collect();
-    emit_fn(
-        &format!("fn point_positions(&self, {q_args}, __t: f64, __out: &mut [[f64; 3]])"),
-        &point_roots,
-        &|v| {
-            let mut s = String::new();
-            let mut offset = 0;
-            for (i, d) in dims.iter().enumerate() {
-                let c: Vec<String> = (0..3)
-                    .map(|k| {
-                        if k < *d {
-                            v[offset + k].clone()
-                        } else {
-                            "0.0_f64".to_string()
-                        }
-                    })
-                    .collect();
-                offset += d;
-                let _ = writeln!(
-                    s,
-                    "if let Some(__p) = __out.get_mut({i}) {{ *__p = [{}]; }}",
-                    c.join(", ")
-                );
-            }
-            s
-        },
-    );
-    // Constraints: the trait's defaults stand for an unconstrained model.
-    let c = &model.constraints;
-    if !c.is_empty() {
-        emit_fn(
-            &format!("fn constraint_residuals(&self, {q_args}, __t: f64, __out: &mut [f64])"),
-            &c.phi,
-            &|v| write_out(v),
-        );
-        emit_fn(
-            &format!("fn constraint_jacobian(&self, {q_args}, __t: f64, __out: &mut [f64])"),
-            &c.jacobian,
-            &|v| write_out(v),
-        );
-        emit_fn(
-            &format!(
-                "fn constraint_velocity_residuals(&self, {qd_args}, __t: f64, __out: &mut [f64])"
-            ),
-            &c.velocity,
-            &|v| write_out(v),
-        );
-        emit_fn(
-            &format!("fn constraint_gamma(&self, {qd_args}, __t: f64, __out: &mut [f64])"),
-            &c.gamma,
-            &|v| write_out(v),
-        );
-    }
-    if !model.events.is_empty() {
-        let roots: Vec<ExprId> = model.events.iter().map(|e| e.function).collect();
-        emit_fn(
-            &format!(
-                "fn event_values(&self, {qd_args}, __t: f64, __a: &{vec_t}, __lambda: &[f64], __out: &mut [f64])"
-            ),
-            &roots,
-            &|v| write_out(v),
-        );
-    }
-    if !model.equilibria.is_empty() {
-        let roots: Vec<ExprId> = model
-            .equilibria
-            .iter()
-            .flat_map(|(_, guess)| guess.iter().copied())
-            .collect();
-        emit_fn(
-            "fn equilibrium_guesses(&self, __out: &mut [f64])",
-            &roots,
-            &|v| write_out(v),
-        );
-    }
-    let _ = writeln!(
-        src,
-        "#[automatically_derived] #[allow(clippy::all, clippy::approx_constant, non_snake_case)] impl {krate}::MechanicalSystem<{n}> for {name} {{\n{imp}\n}}"
-    );
-    let tokens: TokenStream = src
-        .parse()
-        .map_err(|e| format!("generated code does not tokenize ({e}):\n{src}"))?;
-    Ok((tokens, stats))
+        .enumerate()
+        .map(|(i, (_, r))| {
+            let c: Vec<TokenStream> = (0..3)
+                .map(
+                    |k| match (k < r.len()).then(|| components.next()).flatten() {
+                        Some(x) => x.clone(),
+                        None => quote!(0.0_f64),
+                    },
+                )
+                .collect();
+            let i = index(i);
+            quote!(if let Some(__p) = __out.get_mut(#i) { *__p = [#(#c),*]; })
+        })
+        .collect()
 }
 
 /// The equations as MathML, one `<math display="block">` element per line: `T = …`,

@@ -1,22 +1,19 @@
 //! A model file as straight-line programs, one per generated function, with the data the
 //! generated struct returns as constants: what a model compiled at run time is built from.
 //!
-//! [`ModelProgram::from_file`] runs the pipeline of [`super::generate`] (lowering, the
-//! formulation of [`crate::mechanics::preferred_equations`], the mass-matrix
-//! diagnostics, the exact Jacobians) and plans every function exactly as [`super::emit`]
-//! does — angle sums expanded ([`crate::expr::trig::expand_angle_sums`]), one CSE plan per
-//! function over exactly its roots, on one copy of the arena in the same order — then lowers
-//! each plan to a [`Tape`]. A backend that evaluates the tapes therefore computes what the
-//! `model!` macro's code computes, operation for operation.
+//! [`ModelProgram::from_file`] runs the first steps of [`super::generate`] (lowering, the
+//! formulation of [`crate::mechanics::preferred_equations`], the mass-matrix diagnostics),
+//! then lowers to a [`Tape`] each plan of [`super::plan`] — the plans [`super::emit`] prints
+//! as Rust. A backend that evaluates the tapes therefore computes what the `model!` macro's
+//! code computes, operation for operation.
 
-use crate::expr::cse;
-use crate::expr::trig;
-use crate::expr::{ExprArena, ExprId, SymbolId};
-use crate::mechanics::{EquationsOfMotion, Jacobians, SymbolicModel};
+use crate::expr::SymbolId;
+use crate::mechanics::{EquationsOfMotion, SymbolicModel};
 use crate::model::ModelFile;
 use eomgen_description::ModelDescription;
 
 use super::GenerateError;
+use super::plan::{ModelFunction, ModelPlans};
 use super::tape::{Instruction, Tape};
 
 /// One function of a model, as a tape and the layout of its outputs.
@@ -97,32 +94,19 @@ impl ModelProgram {
     /// [`GenerateError::Diagnostics`] for a model that cannot be lowered or whose mass matrix
     /// is singular, with the same located diagnostics as the macro.
     pub fn from_file(file: &ModelFile) -> Result<(ModelProgram, Derivation), GenerateError> {
-        let mut model = SymbolicModel::from_file(file).map_err(GenerateError::Diagnostics)?;
-        let (eom, _) = crate::mechanics::preferred_equations(&mut model);
-        let problems = crate::mechanics::mass_matrix_diagnostics(&model, &eom, file);
-        if !problems.is_empty() {
-            return Err(GenerateError::Diagnostics(problems));
-        }
+        let (model, eom) = super::derive(file)?;
         let program = Self::plan(&model, &eom);
         Ok((program, Derivation { model, eom }))
     }
 
-    /// The tapes of a derived model but its Jacobians (the run-time twin of [`super::emit`]).
+    /// The tapes of a derived model but its Jacobians: the plans of
+    /// [`super::plan::plan_state`] (the ones [`super::emit`] prints) lowered to tapes.
     pub fn plan(model: &SymbolicModel, eom: &EquationsOfMotion) -> ModelProgram {
+        use ModelFunction as F;
         let n = model.num_dofs();
-        let parameters: Vec<SymbolId> = model.parameters.iter().map(|p| p.symbol).collect();
-        // One copy of the arena, functions planned in `emit`'s order: the angle-sum rewrite
-        // adds nodes to it, as it does for the Rust source.
-        let mut arena = model.arena.clone();
-        let mut planner = Planner {
-            arena: &mut arena,
-            parameters: &parameters,
-        };
-
-        let initial_state =
-            planner.tape(&[model.initial_q.clone(), model.initial_qdot.clone()].concat());
-        let both: Vec<ExprId> = [eom.mass_matrix.clone(), eom.forcing.clone()].concat();
-        let mut mass_and_forcing = planner.tape(&both);
+        let plans = super::plan::plan_state(model, eom, &[]);
+        let tapes = Tapes::new(model, &plans);
+        let mut mass_and_forcing = tapes.get(F::MassMatrixAndForcing);
         // `M` column-major, then `F`.
         let (mass, forcing) = mass_and_forcing.outputs.split_at(n * n);
         let mut outputs = column_major_order(mass, n);
@@ -132,14 +116,7 @@ impl ModelProgram {
             tape: mass_and_forcing,
             split: n * n,
         };
-        let kinetic_energy = FunctionTape::single(planner.tape(&[model.kinetic]));
-        let potential_energy = FunctionTape::single(planner.tape(&[model.potential]));
-        let point_roots: Vec<ExprId> = model
-            .points
-            .iter()
-            .flat_map(|(_, r)| r.iter().copied())
-            .collect();
-        let mut points = planner.tape(&point_roots);
+        let mut points = tapes.get(F::PointPositions);
         // `[x, y, z]` per point, `z = 0` for 2-D points.
         let zero = points.instructions.len() as u32;
         points.instructions.push(Instruction::Const(0.0));
@@ -152,53 +129,20 @@ impl ModelProgram {
             }
         }
         points.outputs = outputs;
-        let point_positions = FunctionTape::single(points);
-        let c = &model.constraints;
-        let mut single = |roots: &[ExprId]| FunctionTape::single(planner.tape(roots));
-        let (
-            constraint_residuals,
-            constraint_jacobian,
-            constraint_velocity_residuals,
-            constraint_gamma,
-        ) = if c.is_empty() {
-            Default::default()
-        } else {
-            (
-                single(&c.phi),
-                single(&c.jacobian),
-                single(&c.velocity),
-                single(&c.gamma),
-            )
-        };
-        let event_roots: Vec<ExprId> = model.events.iter().map(|e| e.function).collect();
-        let event_values = if event_roots.is_empty() {
-            FunctionTape::default()
-        } else {
-            single(&event_roots)
-        };
-        let guess_roots: Vec<ExprId> = model
-            .equilibria
-            .iter()
-            .flat_map(|(_, guess)| guess.iter().copied())
-            .collect();
-        let equilibrium_guesses = if guess_roots.is_empty() {
-            FunctionTape::default()
-        } else {
-            single(&guess_roots)
-        };
+        let single = |function| FunctionTape::single(tapes.get(function));
         ModelProgram {
             description: super::describe(model, eom),
-            initial_state: FunctionTape::single(initial_state),
+            initial_state: single(F::InitialState),
             mass_matrix_and_forcing,
-            kinetic_energy,
-            potential_energy,
-            point_positions,
-            constraint_residuals,
-            constraint_jacobian,
-            constraint_velocity_residuals,
-            constraint_gamma,
-            event_values,
-            equilibrium_guesses,
+            kinetic_energy: single(F::KineticEnergy),
+            potential_energy: single(F::PotentialEnergy),
+            point_positions: FunctionTape::single(points),
+            constraint_residuals: single(F::ConstraintResiduals),
+            constraint_jacobian: single(F::ConstraintJacobian),
+            constraint_velocity_residuals: single(F::ConstraintVelocityResiduals),
+            constraint_gamma: single(F::ConstraintGamma),
+            event_values: single(F::EventValues),
+            equilibrium_guesses: single(F::EquilibriumGuesses),
         }
     }
 
@@ -285,39 +229,44 @@ impl JacobianProgram {
 
 impl Derivation {
     /// Derives the exact Jacobians `∂F/∂q`, `∂F/∂q̇`, `∂(M a)/∂q`
-    /// ([`crate::mechanics::Jacobians::of`]) and plans them as [`super::emit`] does.
+    /// ([`crate::mechanics::Jacobians::of`]) and lowers their plans
+    /// ([`super::plan::plan_jacobians`], as [`super::emit`] prints them) to tapes.
     pub fn jacobians(mut self) -> JacobianProgram {
+        use ModelFunction as F;
         let n = self.eom.num_dofs;
-        let jacobians = Jacobians::of(&mut self.model, &self.eom);
-        let parameters: Vec<SymbolId> = self.model.parameters.iter().map(|p| p.symbol).collect();
-        let mut planner = Planner {
-            arena: &mut self.model.arena,
-            parameters: &parameters,
-        };
-        let mut column_major = |roots: &[ExprId]| {
-            let mut tape = planner.tape(roots);
+        let plans = super::plan::plan_jacobians(&mut self.model, &self.eom);
+        let tapes = Tapes::new(&self.model, &plans);
+        let column_major = |function| {
+            let mut tape = tapes.get(function);
             tape.outputs = column_major_order(&tape.outputs, n);
             FunctionTape::single(tape)
         };
         JacobianProgram {
-            forcing_jacobian_q: column_major(&jacobians.forcing_q),
-            forcing_jacobian_qdot: column_major(&jacobians.forcing_qdot),
-            mass_matrix_product_jacobian: column_major(&jacobians.mass_product_q),
+            forcing_jacobian_q: column_major(F::ForcingJacobianQ),
+            forcing_jacobian_qdot: column_major(F::ForcingJacobianQdot),
+            mass_matrix_product_jacobian: column_major(F::MassMatrixProductJacobian),
         }
     }
 }
 
-/// Plans functions one after the other on one arena, as `emit`'s `body` does.
-struct Planner<'a> {
-    arena: &'a mut ExprArena,
-    parameters: &'a [SymbolId],
+/// Lowers the plans of one [`ModelPlans`] to tapes.
+struct Tapes<'a> {
+    plans: &'a ModelPlans,
+    parameters: Vec<SymbolId>,
 }
 
-impl Planner<'_> {
-    fn tape(&mut self, roots: &[ExprId]) -> Tape {
-        let roots = trig::expand_angle_sums(self.arena, roots);
-        let plan = cse::plan(self.arena, &roots, "__e");
-        Tape::from_plan(self.arena, &plan, self.parameters)
+impl<'a> Tapes<'a> {
+    fn new(model: &SymbolicModel, plans: &'a ModelPlans) -> Self {
+        let parameters = model.parameters.iter().map(|p| p.symbol).collect();
+        Self { plans, parameters }
+    }
+
+    /// The tape of `function`; empty where the model has no such function.
+    fn get(&self, function: ModelFunction) -> Tape {
+        self.plans
+            .get(function)
+            .map(|plan| Tape::from_plan(&self.plans.arena, plan, &self.parameters))
+            .unwrap_or_default()
     }
 }
 

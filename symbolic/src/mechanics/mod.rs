@@ -6,8 +6,8 @@
 //! uses.
 
 mod balances;
-pub mod check;
 mod constraints;
+pub mod cross_check;
 mod lagrange;
 mod lower;
 mod mass;

@@ -285,6 +285,10 @@ impl Formulation for MomentumBalance {
     /// # Panics
     /// Never; for a model where [`MomentumBalance::applies_to`] is false the energy-form
     /// pieces are ignored, so callers check it first.
+    // One piece (about 170 lines): the steps — grouping bodies by partial velocity, the sums
+    // `Σ m a₀` per group, the terms of `M` and `F` per body and per load, and the assembly —
+    // share the kinematics cache, the group sums and the term lists, and run once in this
+    // order; split, each step would take and return all of them.
     fn derive(&self, model: &mut SymbolicModel) -> EquationsOfMotion {
         let n = model.num_dofs();
         let symbols: Vec<_> = (0..n).map(|i| model.coordinate_symbols(i)).collect();

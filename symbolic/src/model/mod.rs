@@ -1,18 +1,18 @@
 //! Model files: YAML with source locations → typed [`ModelFile`] → checked.
 //!
 //! Pipeline: [`read`] (the file's text, bounded in size) → [`yaml`] (located YAML tree) → [`parser`] (expressions) → [`schema`] (typed
-//! model, every unknown key / wrong type reported) → [`check`] (cross-references and
+//! model, every unknown key / wrong type reported) → [`rules`] (cross-references and
 //! semantics, and [`unit_check`] — dimensional analysis with the algebra of [`units`] — when
 //! the file declares `units: SI`). [`load`] runs all of it and reports every diagnostic of a
 //! file at once.
 
 pub mod ast;
-pub mod check;
 pub mod diagnostic;
 pub mod file;
 pub mod located;
 pub mod parser;
 pub mod read;
+pub mod rules;
 pub mod schema;
 pub mod templates;
 pub mod unit_check;
@@ -43,7 +43,7 @@ pub fn load(path: &str, source: &str) -> Result<ModelFile, Vec<Diagnostic>> {
         let built = schema::build_partial(path, source, &root);
         diagnostics.extend(built.diagnostics);
         if let Some(file) = built.file {
-            let (rules, units) = check::check_parts(&file, &built.incomplete);
+            let (rules, units) = rules::check_parts(&file, &built.incomplete);
             let sound = diagnostics.is_empty() && rules.is_empty();
             diagnostics.extend(rules);
             diagnostics.extend(units);

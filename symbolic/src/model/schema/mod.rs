@@ -3,7 +3,7 @@
 //!
 //! The pass never stops at the first problem: an entry that cannot be built is reported and
 //! left out, and what was left out is recorded in [`Incomplete`] so that the cross-object
-//! checks ([`super::check`]) do not report its consequences a second time.
+//! checks ([`super::rules`]) do not report its consequences a second time.
 //!
 //! One scaffold (`walk`) reads every keyed part of a file: `sections` holds the table of
 //! top-level keys and the sections about the model as a whole, and each group of sections

@@ -10,12 +10,12 @@ use serde::Serialize;
 use super::modes::{ModalAnalysis, ModalOptions, modal_analysis};
 use super::operating_point::{OperatingPoint, OperatingPointError, OperatingPointOptions};
 use crate::analysis::outcome::{RunTally, StudyRuns};
-use crate::modal::{Linearization, ModeKind, NormalModes};
-use crate::model_info::ModelInfo;
-use crate::response::{
+use crate::linear::modal::{Linearization, ModeKind, NormalModes};
+use crate::linear::response::{
     FreeResponse, ResponseError, response_by_exponential, response_by_integration,
     response_by_m_inv_k_modes, response_by_normal_modes,
 };
+use crate::model_info::ModelInfo;
 
 /// Why a free-response or modal-damping study failed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -309,14 +309,14 @@ impl StudyRuns for FreeResponseStudy {
 ///
 /// # Examples
 /// ```
-/// use eomgen_runtime::vibration::{FreeResponseOptions, free_response};
+/// use eomgen_runtime::analysis::vibration::{FreeResponseOptions, free_response};
 /// let model = (eomgen::models::find("three_masses").unwrap().make)();
 /// let study = free_response(model.as_ref(), &FreeResponseOptions::default())?;
 /// // Exact closed forms agree with e^{At} to rounding, DOP853 to its tolerance.
 /// for d in &study.differences {
 ///     assert!(d.displacement_relative < 1e-9, "{d:?}");
 /// }
-/// # Ok::<(), eomgen_runtime::vibration::ResponseStudyError>(())
+/// # Ok::<(), eomgen_runtime::analysis::vibration::ResponseStudyError>(())
 /// ```
 ///
 /// # References

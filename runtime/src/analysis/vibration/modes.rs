@@ -8,7 +8,7 @@ use serde::Serialize;
 use super::operating_point::{
     OperatingPoint, OperatingPointError, OperatingPointOptions, operating_point,
 };
-use crate::modal::{
+use crate::linear::modal::{
     Linearization, ModalError, NormalModes, TimeDependentForcing, damped_modes,
     eigenvalues_of_m_inv_k, linearize, normal_modes, time_dependence,
 };
@@ -113,7 +113,7 @@ impl ModalAnalysis {
 /// Three equal masses between four equal springs (`three_masses`, HW28): `ω² = (2 − √2) k/m`,
 /// `2k/m`, `(2 + √2) k/m`.
 /// ```
-/// use eomgen_runtime::vibration::{ModalOptions, modal_analysis};
+/// use eomgen_runtime::analysis::vibration::{ModalOptions, modal_analysis};
 /// let model = (eomgen::models::find("three_masses").unwrap().make)();
 /// let modal = modal_analysis(model.as_ref(), &ModalOptions::default())?;
 /// let (k, m) = (1.0, 1.0);
@@ -122,7 +122,7 @@ impl ModalAnalysis {
 ///     assert!((w - w2.sqrt()).abs() < 1e-12);
 /// }
 /// assert!(modal.is_undamped());
-/// # Ok::<(), eomgen_runtime::vibration::OperatingPointError>(())
+/// # Ok::<(), eomgen_runtime::analysis::vibration::OperatingPointError>(())
 /// ```
 ///
 /// # References

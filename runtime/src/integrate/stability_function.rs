@@ -53,7 +53,7 @@ const SCAN_POINTS: usize = 100_000;
 /// # Examples
 /// ```
 /// use eomgen_runtime::Tableau;
-/// use eomgen_runtime::integrate::stability::StabilityPolynomial;
+/// use eomgen_runtime::integrate::stability_function::StabilityPolynomial;
 ///
 /// // RK4: R(z) = 1 + z + z²/2 + z³/6 + z⁴/24, stable on the imaginary axis up to 2√2.
 /// let rk4 = StabilityPolynomial::of_tableau(&Tableau::rk4());

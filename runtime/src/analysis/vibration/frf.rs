@@ -8,19 +8,19 @@
 //! [`simulate_point`] runs one (independent of the others, so a caller may run them in
 //! parallel, each on its own instance of the model).
 
-use nalgebra::{Complex, DVector};
+use nalgebra::{Complex, DMatrix, DVector};
 use serde::Serialize;
 
 use super::operating_point::{OperatingPoint, OperatingPointError, OperatingPointOptions};
-use crate::frf::{
+use crate::linear::frequency_response::{
     ForcedLinearization, FrequencySweep, FrfError, HarmonicForcing, ModalResponse, PeakAmplitude,
     SteadyStateOptions, frequency_response, frequency_response_of, frequency_sweep,
     linearize_with_inputs, log_frequencies, modal_frequency_response, output_index, settling_time,
     simulate_steady_state,
 };
-use crate::modal::{NormalModes, normal_modes};
+use crate::linear::modal::{Linearization, NormalModes, normal_modes};
+use crate::linear::response::{ModalDamping, modal_damping};
 use crate::model_info::ModelInfo;
-use crate::response::{ModalDamping, modal_damping};
 
 /// Why a frequency-response analysis failed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -278,7 +278,7 @@ pub struct FrfAnalysis {
 /// # Examples
 /// The forced oscillator (`m = k = c = 1`): `|H(ω)| = 1/√((k − mω²)² + (cω)²)`.
 /// ```
-/// use eomgen_runtime::vibration::{FrfOptions, frequency_response_analysis};
+/// use eomgen_runtime::analysis::vibration::{FrfOptions, frequency_response_analysis};
 /// let mut model = (eomgen::models::find("forced_oscillator").unwrap().make)();
 /// let options = FrfOptions {
 ///     input: "A".to_string(),
@@ -288,7 +288,7 @@ pub struct FrfAnalysis {
 /// let frf = frequency_response_analysis(model.as_mut(), &options)?;
 /// let h = frf.evaluations[0].response.as_ref().unwrap()[0];
 /// assert!((h.norm() - 1.0 / ((1.0f64 - 4.0).powi(2) + 4.0).sqrt()).abs() < 1e-14);
-/// # Ok::<(), eomgen_runtime::vibration::FrfAnalysisError>(())
+/// # Ok::<(), eomgen_runtime::analysis::vibration::FrfAnalysisError>(())
 /// ```
 ///
 /// # References
@@ -330,51 +330,18 @@ pub fn frequency_response_analysis(
         .iter()
         .map(|c| c.to_string())
         .collect();
-    let outputs: Vec<FrfOutput> = if options.outputs.is_empty() {
-        coordinates
-            .iter()
-            .enumerate()
-            .map(|(index, name)| FrfOutput {
-                name: name.clone(),
-                index,
-            })
-            .collect()
-    } else {
-        let mut list = Vec::new();
-        for o in &options.outputs {
-            let index = output_index(model, o).map_err(|source| FrfAnalysisError::Output {
-                output: o.clone(),
-                source,
-            })?;
-            list.push(FrfOutput {
-                name: o.clone(),
-                index,
-            });
-        }
-        list
-    };
+    let outputs = frf_outputs(model, &options.outputs, &coordinates)?;
     let lin = &forced.linearization;
     let modes = normal_modes(lin).map_err(FrfError::from)?;
     let damping = modal_damping(lin, &modes);
     let (lo, hi) = match options.frequency_range {
         Some(range) => range,
-        None => {
-            let positive: Vec<f64> = modes
-                .natural_frequencies
-                .iter()
-                .copied()
-                .filter(|w| *w > 0.0)
-                .collect();
-            match (positive.first(), positive.last()) {
-                (Some(a), Some(b)) => (a / 10.0, b * 10.0),
-                _ => {
-                    return Err(FrfAnalysisError::NoFrequencyRange {
-                        model: model.description().name.to_string(),
-                        operating_point: label,
-                    });
-                }
+        None => default_range(&modes.natural_frequencies).ok_or_else(|| {
+            FrfAnalysisError::NoFrequencyRange {
+                model: model.description().name.to_string(),
+                operating_point: label.clone(),
             }
-        }
+        })?,
     };
     let frequencies =
         log_frequencies(lo, hi, options.points).map_err(FrfAnalysisError::FrequencyRange)?;
@@ -397,42 +364,17 @@ pub fn frequency_response_analysis(
         }
         evaluation_frequencies.sort_by(f64::total_cmp);
     }
-    let b = forced.input_matrix.column(0).into_owned();
     let mut evaluations = Vec::with_capacity(evaluation_frequencies.len());
     let requested: Vec<usize> = outputs.iter().map(|o| o.index).collect();
     for w in evaluation_frequencies {
-        let response = match frequency_response_of(lin, b_matrix, w, &requested) {
-            Ok(h) => Some(h.column(0).into_owned()),
-            Err(FrfError::Singular { .. }) => None,
-            Err(e) => return Err(e.into()),
-        };
-        let modal = if options.modal {
-            match modal_frequency_response(lin, &modes, &b, w) {
-                Ok(r) => Some(r),
-                Err(FrfError::Singular { .. }) => None,
-                Err(e) => return Err(e.into()),
-            }
-        } else {
-            None
-        };
-        let modal_difference = match (&response, &modal) {
-            (Some(d), Some(r)) => {
-                let largest = d.iter().map(|z| z.norm()).fold(0.0f64, f64::max);
-                let difference = d
-                    .iter()
-                    .zip(r.response.iter())
-                    .map(|(a, b)| (a - b).norm())
-                    .fold(0.0f64, f64::max);
-                Some(difference / largest.max(f64::MIN_POSITIVE))
-            }
-            _ => None,
-        };
-        evaluations.push(FrfEvaluation {
-            frequency: w,
-            response,
-            modal,
-            modal_difference,
-        });
+        evaluations.push(evaluate_at(
+            lin,
+            b_matrix,
+            &modes,
+            w,
+            &requested,
+            options.modal,
+        )?);
     }
     let operating_point = OperatingPoint {
         name: label,
@@ -452,6 +394,93 @@ pub fn frequency_response_analysis(
         sweeps,
         evaluations,
         forced,
+    })
+}
+
+/// The outputs of a frequency response: every coordinate when `requested` is empty, else each
+/// requested coordinate or rate by name.
+fn frf_outputs(
+    model: &dyn ModelInfo,
+    requested: &[String],
+    coordinates: &[String],
+) -> Result<Vec<FrfOutput>, FrfAnalysisError> {
+    if requested.is_empty() {
+        return Ok(coordinates
+            .iter()
+            .enumerate()
+            .map(|(index, name)| FrfOutput {
+                name: name.clone(),
+                index,
+            })
+            .collect());
+    }
+    requested
+        .iter()
+        .map(|o| {
+            let index = output_index(model, o).map_err(|source| FrfAnalysisError::Output {
+                output: o.clone(),
+                source,
+            })?;
+            Ok(FrfOutput {
+                name: o.clone(),
+                index,
+            })
+        })
+        .collect()
+}
+
+/// The default sweep: a decade below the lowest positive natural frequency to a decade above
+/// the highest (rad/s); `None` without a positive one.
+fn default_range(natural_frequencies: &[f64]) -> Option<(f64, f64)> {
+    let mut positive = natural_frequencies.iter().copied().filter(|w| *w > 0.0);
+    let first = positive.next()?;
+    let last = positive.next_back().unwrap_or(first);
+    Some((first / 10.0, last * 10.0))
+}
+
+/// `H(ω)` of the one input at `w` for the `requested` outputs, its modal sum when `modal`,
+/// and their largest difference relative to the largest `|H|`; a singular `ω` (undamped
+/// resonance) gives `None` for the response it makes singular.
+fn evaluate_at(
+    lin: &Linearization,
+    b_matrix: &DMatrix<f64>,
+    modes: &NormalModes,
+    w: f64,
+    requested: &[usize],
+    modal: bool,
+) -> Result<FrfEvaluation, FrfError> {
+    let response = match frequency_response_of(lin, b_matrix, w, requested) {
+        Ok(h) => Some(h.column(0).into_owned()),
+        Err(FrfError::Singular { .. }) => None,
+        Err(e) => return Err(e),
+    };
+    let modal = if modal {
+        let b = b_matrix.column(0).into_owned();
+        match modal_frequency_response(lin, modes, &b, w) {
+            Ok(r) => Some(r),
+            Err(FrfError::Singular { .. }) => None,
+            Err(e) => return Err(e),
+        }
+    } else {
+        None
+    };
+    let modal_difference = match (&response, &modal) {
+        (Some(d), Some(r)) => {
+            let largest = d.iter().map(|z| z.norm()).fold(0.0f64, f64::max);
+            let difference = d
+                .iter()
+                .zip(r.response.iter())
+                .map(|(a, b)| (a - b).norm())
+                .fold(0.0f64, f64::max);
+            Some(difference / largest.max(f64::MIN_POSITIVE))
+        }
+        _ => None,
+    };
+    Ok(FrfEvaluation {
+        frequency: w,
+        response,
+        modal,
+        modal_difference,
     })
 }
 

@@ -4,7 +4,7 @@
 
 use serde::Serialize;
 
-use crate::modal::{Equilibrium, ModalError, find_equilibrium};
+use crate::linear::modal::{Equilibrium, ModalError, find_equilibrium};
 use crate::model_info::ModelInfo;
 
 /// Where Newton's search for the equilibrium starts.
@@ -128,7 +128,7 @@ pub enum OperatingPointError {
 ///
 /// # Examples
 /// ```
-/// use eomgen_runtime::vibration::{EquilibriumStart, OperatingPointOptions, operating_point};
+/// use eomgen_runtime::analysis::vibration::{EquilibriumStart, OperatingPointOptions, operating_point};
 /// let mut model = (eomgen::models::find("double_pendulum").unwrap().make)();
 /// let options = OperatingPointOptions {
 ///     start: EquilibriumStart::Named("hanging".to_string()),
@@ -139,7 +139,7 @@ pub enum OperatingPointError {
 /// for theta in point.q() {
 ///     assert!((theta + std::f64::consts::FRAC_PI_2).abs() < 1e-12);
 /// }
-/// # Ok::<(), eomgen_runtime::vibration::OperatingPointError>(())
+/// # Ok::<(), eomgen_runtime::analysis::vibration::OperatingPointError>(())
 /// ```
 ///
 /// # References

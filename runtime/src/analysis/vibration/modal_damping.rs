@@ -12,12 +12,12 @@ use super::free_response::{
 };
 use super::operating_point::{OperatingPoint, OperatingPointOptions};
 use crate::analysis::outcome::{RunTally, StudyRuns};
-use crate::modal::{Linearization, ModeKind, NormalModes};
-use crate::model_info::ModelInfo;
-use crate::response::{
+use crate::linear::modal::{Linearization, ModeKind, NormalModes};
+use crate::linear::response::{
     DampedMode, FreeResponse, ModalDamping, RayleighDamping, exact_damped_modes, modal_damping,
     response_by_exponential, response_by_integration, response_with_modal_damping,
 };
+use crate::model_info::ModelInfo;
 
 /// Options of [`modal_damping_study`].
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -179,7 +179,7 @@ fn damped_frequency(omega: f64, zeta: f64) -> Option<f64> {
 ///
 /// # Examples
 /// ```
-/// use eomgen_runtime::vibration::{ModalDampingOptions, modal_damping_study};
+/// use eomgen_runtime::analysis::vibration::{ModalDampingOptions, modal_damping_study};
 /// let model = (eomgen::models::find("three_masses_damped").unwrap().make)();
 /// let study = modal_damping_study(model.as_ref(), &ModalDampingOptions::default())?;
 /// // Rayleigh damping fitted to modes 1 and 3 reproduces their exact ζ.
@@ -190,7 +190,7 @@ fn damped_frequency(omega: f64, zeta: f64) -> Option<f64> {
 ///     let exact = mode.exact.unwrap().damping_ratio;
 ///     assert!((mode.rayleigh.unwrap().damping_ratio - exact).abs() < 1e-14);
 /// }
-/// # Ok::<(), eomgen_runtime::vibration::ResponseStudyError>(())
+/// # Ok::<(), eomgen_runtime::analysis::vibration::ResponseStudyError>(())
 /// ```
 ///
 /// # References
@@ -205,55 +205,7 @@ pub fn modal_damping_study(
     let n = model.num_dofs();
     let approx = modal_damping(lin, modes);
     let exact = exact_damped_modes(lin, modes)?;
-    let oscillatory: Vec<usize> = (0..n)
-        .filter(|&k| modes.kinds[k] == ModeKind::Oscillatory)
-        .collect();
-    // The Rayleigh fit: explicit modes must be usable; by default the slowest and fastest
-    // oscillatory modes, if there are two with exact damping ratios.
-    let chosen: Option<[usize; 2]> = match options.rayleigh_modes {
-        Some(pair) => {
-            for k in pair {
-                if k == 0 || k > n {
-                    return Err(ResponseStudyError::NoSuchMode {
-                        model: model.description().name.to_string(),
-                        mode: k,
-                        count: n,
-                    });
-                }
-                if exact[k - 1].is_none() {
-                    return Err(ResponseStudyError::NotUnderdamped { mode: k });
-                }
-            }
-            Some(pair)
-        }
-        None => match (oscillatory.first(), oscillatory.last()) {
-            (Some(&a), Some(&b)) if a != b && exact[a].is_some() && exact[b].is_some() => {
-                Some([a + 1, b + 1])
-            }
-            _ => None,
-        },
-    };
-    let rayleigh = match chosen {
-        Some([a, b]) => {
-            let zeta = |k: usize| exact[k - 1].map_or(f64::NAN, |d| d.damping_ratio);
-            let damping = RayleighDamping::fit(
-                [
-                    modes.natural_frequencies[a - 1],
-                    modes.natural_frequencies[b - 1],
-                ],
-                [zeta(a), zeta(b)],
-            )
-            .map_err(|source| ResponseStudyError::RayleighFit {
-                modes: [a, b],
-                source,
-            })?;
-            Some(RayleighFit {
-                modes: [a, b],
-                damping,
-            })
-        }
-        None => None,
-    };
+    let rayleigh = rayleigh_fit(model, options.rayleigh_modes, modes, &exact)?;
     let per_mode = (0..n)
         .map(|k| {
             let w = modes.natural_frequencies[k];
@@ -363,5 +315,66 @@ pub fn modal_damping_study(
         t_end,
         tol: options.tol,
         releases,
+    })
+}
+
+/// The Rayleigh fit `C = αM + βK` to the exact damping ratios of two modes (numbered from 1):
+/// those `requested`, which must exist and be underdamped, or by default the slowest and the
+/// fastest oscillatory modes when both are underdamped; `None` without such a pair.
+fn rayleigh_fit(
+    model: &dyn ModelInfo,
+    requested: Option<[usize; 2]>,
+    modes: &NormalModes,
+    exact: &[Option<DampedMode>],
+) -> Result<Option<RayleighFit>, ResponseStudyError> {
+    let n = modes.natural_frequencies.len();
+    let oscillatory: Vec<usize> = (0..n)
+        .filter(|&k| modes.kinds[k] == ModeKind::Oscillatory)
+        .collect();
+    // The Rayleigh fit: explicit modes must be usable; by default the slowest and fastest
+    // oscillatory modes, if there are two with exact damping ratios.
+    let chosen: Option<[usize; 2]> = match requested {
+        Some(pair) => {
+            for k in pair {
+                if k == 0 || k > n {
+                    return Err(ResponseStudyError::NoSuchMode {
+                        model: model.description().name.to_string(),
+                        mode: k,
+                        count: n,
+                    });
+                }
+                if exact[k - 1].is_none() {
+                    return Err(ResponseStudyError::NotUnderdamped { mode: k });
+                }
+            }
+            Some(pair)
+        }
+        None => match (oscillatory.first(), oscillatory.last()) {
+            (Some(&a), Some(&b)) if a != b && exact[a].is_some() && exact[b].is_some() => {
+                Some([a + 1, b + 1])
+            }
+            _ => None,
+        },
+    };
+    Ok(match chosen {
+        Some([a, b]) => {
+            let zeta = |k: usize| exact[k - 1].map_or(f64::NAN, |d| d.damping_ratio);
+            let damping = RayleighDamping::fit(
+                [
+                    modes.natural_frequencies[a - 1],
+                    modes.natural_frequencies[b - 1],
+                ],
+                [zeta(a), zeta(b)],
+            )
+            .map_err(|source| ResponseStudyError::RayleighFit {
+                modes: [a, b],
+                source,
+            })?;
+            Some(RayleighFit {
+                modes: [a, b],
+                damping,
+            })
+        }
+        None => None,
     })
 }

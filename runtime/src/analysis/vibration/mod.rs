@@ -18,8 +18,8 @@
 //!   (lectures 19, 21).
 //!
 //! The building blocks (linearisation, normal modes, responses, `H(ω)`, monodromy) are in
-//! [`modal`](crate::modal), [`response`](crate::response), [`frf`](crate::frf) and
-//! [`floquet`](crate::floquet).
+//! [`modal`](crate::linear::modal), [`response`](crate::linear::response), [`frf`](crate::linear::frequency_response) and
+//! [`floquet`](crate::linear::monodromy).
 
 pub mod floquet;
 pub mod free_response;

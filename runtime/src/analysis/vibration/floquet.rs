@@ -18,11 +18,11 @@ use serde::Serialize;
 
 use super::operating_point::{OperatingPointError, OperatingPointOptions};
 use crate::analysis::outcome::{RunTally, StudyRuns};
-use crate::floquet::{
+use crate::linear::modal::{ModalError, find_equilibrium};
+use crate::linear::monodromy::{
     FloquetAnalysis, FloquetError, FloquetOptions, FloquetStability, check_periodic_equilibrium,
     floquet_analysis,
 };
-use crate::modal::{ModalError, find_equilibrium};
 use crate::model_info::ModelInfo;
 use crate::system::UnknownParameter;
 
@@ -200,7 +200,7 @@ fn check_options(
 /// named; the Mathieu pendulum's upright equilibrium is analysed (its shaking makes it
 /// stable at the file's values).
 /// ```
-/// use eomgen_runtime::vibration::{FloquetStudyError, FloquetStudyOptions, floquet_at_equilibrium};
+/// use eomgen_runtime::analysis::vibration::{FloquetStudyError, FloquetStudyOptions, floquet_at_equilibrium};
 /// let mut pendulum = (eomgen::models::find("double_pendulum").unwrap().make)();
 /// let options = FloquetStudyOptions { period_parameter: "g".into(), ..Default::default() };
 /// let refused = floquet_at_equilibrium(pendulum.as_mut(), &options);
@@ -486,7 +486,7 @@ pub fn floquet_cell(
 /// # Examples
 /// The Mathieu pendulum without shaking (`a = 0`) has no period, but a chart over `a` has:
 /// ```
-/// use eomgen_runtime::vibration::{
+/// use eomgen_runtime::analysis::vibration::{
 ///     FloquetStudyError, FloquetStudyOptions, SweepAxis, floquet_at_equilibrium,
 ///     floquet_at_equilibrium_for_sweep,
 /// };

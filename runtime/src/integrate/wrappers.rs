@@ -1,0 +1,120 @@
+//! The parts every integrator type writes alike, written once: the constructors and
+//! controller accessors of a method with a [`PiController`](super::PiController), and the
+//! [`Integrator`](super::Integrator) implementations that hand a problem to the one driver
+//! loop ([`super::driver::run`]). Each method's file keeps its type, its documentation and its
+//! stepper; these macros only spell out the glue.
+
+/// `new`, `with_controller`, `controller`, `Default` and the [`Integrator`](super::Integrator)
+/// implementation of an adaptive explicit pair: a struct with one field
+/// `controller: PiController`, adaptive unless [`IntegratorOptions::fixed_step`]
+/// (super::IntegratorOptions::fixed_step), whose stepper is `$stepper` for a system of
+/// dimension `$dim`.
+macro_rules! pi_controlled_integrator {
+    (
+        $ty:ident,
+        name: $name:literal,
+        order: $order:literal,
+        error_order: $error_order:expr,
+        controller: $controller:expr,
+        new_doc: $new_doc:literal,
+        stepper: |$dim:ident| $stepper:expr $(,)?
+    ) => {
+        impl Default for $ty {
+            fn default() -> Self {
+                Self {
+                    controller: $controller,
+                }
+            }
+        }
+
+        impl $ty {
+            #[doc = $new_doc]
+            pub fn new() -> Self {
+                Self::default()
+            }
+
+            /// Uses `controller` for the step sizes.
+            pub fn with_controller(mut self, controller: PiController) -> Self {
+                self.controller = controller;
+                self
+            }
+
+            /// The step-size controller.
+            pub fn controller(&self) -> &PiController {
+                &self.controller
+            }
+        }
+
+        impl Integrator for $ty {
+            fn name(&self) -> &'static str {
+                $name
+            }
+
+            fn order(&self) -> u32 {
+                $order
+            }
+
+            fn integrate(
+                &mut self,
+                system: &mut dyn OdeSystem,
+                t0: f64,
+                y0: &[f64],
+                t_end: f64,
+                output: &OutputTimes,
+                options: &IntegratorOptions,
+            ) -> Result<Solution, IntegrationFailure> {
+                let problem = Problem::new(t0, y0, t_end, output, options);
+                let control = if options.fixed_step {
+                    Control::Fixed
+                } else {
+                    Control::Adaptive {
+                        controller: &mut self.controller,
+                        error_order: $error_order,
+                    }
+                };
+                driver::run(&problem, system, control, |shape| {
+                    let $dim = shape.dim;
+                    Ok($stepper)
+                })
+            }
+        }
+    };
+}
+
+/// `new` and the [`Integrator`](super::Integrator) implementation of a constant-step explicit
+/// Runge–Kutta method given by its tableau (a `Default` struct with no settings).
+macro_rules! fixed_step_integrator {
+    ($ty:ident, name: $name:literal, order: $order:literal, tableau: $tableau:expr $(,)?) => {
+        impl $ty {
+            /// The method.
+            pub fn new() -> Self {
+                Self::default()
+            }
+        }
+
+        impl Integrator for $ty {
+            fn name(&self) -> &'static str {
+                $name
+            }
+
+            fn order(&self) -> u32 {
+                $order
+            }
+
+            fn integrate(
+                &mut self,
+                system: &mut dyn OdeSystem,
+                t0: f64,
+                y0: &[f64],
+                t_end: f64,
+                output: &OutputTimes,
+                options: &IntegratorOptions,
+            ) -> Result<Solution, IntegrationFailure> {
+                let problem = Problem::new(t0, y0, t_end, output, options);
+                driver::run(&problem, system, Control::Fixed, |shape| {
+                    Ok(ExplicitRk::new($tableau, shape.dim))
+                })
+            }
+        }
+    };
+}
