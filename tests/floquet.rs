@@ -10,60 +10,12 @@ use std::f64::consts::TAU;
 
 use eomgen::{
     DormandPrince853, FloquetError, FloquetOptions, FloquetStability, Integrator,
-    IntegratorOptions, ModelInfo, OdeSystem, OutputTimes, RhsError, check_periodic_equilibrium,
-    find_equilibrium, floquet_analysis, linearize, matrix_exponential,
+    IntegratorOptions, ModelInfo, OutputTimes, check_periodic_equilibrium, find_equilibrium,
+    floquet_analysis, linearize, matrix_exponential,
 };
-use nalgebra::DMatrix;
 
 fn model(name: &str) -> Box<dyn ModelInfo> {
     (eomgen::models::find(name).expect("bundled model").make)()
-}
-
-/// `ẏ = A y` with the exact Jacobian `A`.
-struct Linear(DMatrix<f64>);
-
-impl OdeSystem for Linear {
-    fn dim(&self) -> usize {
-        self.0.nrows()
-    }
-    fn rhs(&mut self, _t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), RhsError> {
-        for (i, d) in dy.iter_mut().enumerate() {
-            *d = self.0.row(i).iter().zip(y).map(|(a, b)| a * b).sum();
-        }
-        Ok(())
-    }
-    fn jacobian(&mut self, _t: f64, _y: &[f64], jac: &mut [f64]) -> Result<bool, RhsError> {
-        jac.copy_from_slice(self.0.as_slice());
-        Ok(true)
-    }
-}
-
-/// The damped Mathieu equation `ẍ + 2ζ ẋ + (δ + ε cos t) x = 0`, period 2π, written by hand.
-struct Mathieu {
-    delta: f64,
-    epsilon: f64,
-    zeta: f64,
-}
-
-impl OdeSystem for Mathieu {
-    fn dim(&self) -> usize {
-        2
-    }
-    fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), RhsError> {
-        dy[0] = y[1];
-        dy[1] = -2.0 * self.zeta * y[1] - (self.delta + self.epsilon * t.cos()) * y[0];
-        Ok(())
-    }
-    fn jacobian(&mut self, t: f64, _y: &[f64], jac: &mut [f64]) -> Result<bool, RhsError> {
-        // Column-major [0 1; −(δ + ε cos t) −2ζ].
-        jac.copy_from_slice(&[
-            0.0,
-            -(self.delta + self.epsilon * t.cos()),
-            1.0,
-            -2.0 * self.zeta,
-        ]);
-        Ok(true)
-    }
 }
 
 /// Floquet analysis of `mathieu_pendulum` about `upright` with parameters `set`.
@@ -95,41 +47,12 @@ fn parameter(m: &dyn ModelInfo, name: &str) -> f64 {
     m.parameter_values()[i]
 }
 
-/// For constant coefficients `Φ(T) = e^{AT}`. A hand-written 4 × 4 `A` (a damped, gyroscopic
-/// two-mass system), and the double pendulum's generated Jacobian at `hanging` against
-/// `e^{AT}` from its exact linearisation. Tolerance 1e-10 relative to `‖Φ‖`: DOP853 at 1e-12
-/// over one period leaves a global error of order 1e-11; Padé 13 is exact to rounding.
+/// For constant coefficients `Φ(T) = e^{AT}`: the double pendulum's generated Jacobian at
+/// `hanging` against `e^{AT}` from its exact linearisation. Tolerance 1e-10 relative to
+/// `‖Φ‖`: DOP853 at 1e-12 over one period leaves a global error of order 1e-11; Padé 13 is
+/// exact to rounding. (A hand-written `A`: `runtime/tests/vibration.rs`.)
 #[test]
 fn monodromy_of_a_constant_coefficient_system_is_the_matrix_exponential() {
-    #[rustfmt::skip]
-    let a = DMatrix::from_row_slice(4, 4, &[
-        0.0, 0.0, 1.0, 0.0,
-        0.0, 0.0, 0.0, 1.0,
-        -3.0, 1.0, -0.2, 0.5,
-        1.0, -2.0, -0.5, -0.1,
-    ]);
-    let period = 1.7;
-    let f = floquet_analysis(
-        &mut Linear(a.clone()),
-        &[0.0; 4],
-        0.3,
-        period,
-        &FloquetOptions::default(),
-    )
-    .unwrap();
-    let expected = matrix_exponential(&(&a * period));
-    let err = (&f.monodromy_matrix - &expected).amax() / expected.amax();
-    eprintln!("hand-written A: |Φ(T) − e^(AT)|/|e^(AT)| = {err:.1e}");
-    assert!(err < 1e-10, "hand-written A: |Φ − e^(AT)| = {err:e}");
-    // Liouville: det e^{AT} = e^{T tr A}.
-    let det = (period * a.trace()).exp();
-    assert!(
-        (f.determinant - det).abs() < 1e-10 * det,
-        "{} vs {det}",
-        f.determinant
-    );
-    assert_eq!(f.stability, FloquetStability::AsymptoticallyStable);
-
     let mut m = model("double_pendulum");
     let guess = m
         .equilibrium_guesses()
@@ -157,59 +80,11 @@ fn monodromy_of_a_constant_coefficient_system_is_the_matrix_exponential() {
     );
 }
 
-/// Liouville's formula `det Φ(T) = exp ∫ tr J dt`: 1 for the undamped Mathieu equation (the
-/// product of its multipliers), `e^{−2ζT}` with damping, and 1 for the undamped
-/// `mathieu_pendulum`, `e^{−cT/(m l²)}` with hinge damping. Tolerance 1e-10: the integration
-/// error of DOP853 at 1e-12 over one period.
+/// Liouville's formula `det Φ(T) = exp ∫ tr J dt`: 1 for the undamped `mathieu_pendulum`,
+/// `e^{−cT/(m l²)}` with hinge damping. Tolerance 1e-10: the integration error of DOP853 at
+/// 1e-12 over one period. (The hand-written Mathieu equation: `runtime/tests/vibration.rs`.)
 #[test]
 fn liouville_determinant_and_multiplier_product() {
-    for (delta, epsilon) in [(0.3, 0.2), (1.0, 0.5), (-0.2, 1.0), (2.5, 3.0)] {
-        let f = floquet_analysis(
-            &mut Mathieu {
-                delta,
-                epsilon,
-                zeta: 0.0,
-            },
-            &[0.0, 0.0],
-            0.0,
-            TAU,
-            &FloquetOptions::default(),
-        )
-        .unwrap();
-        let product = f.multipliers[0] * f.multipliers[1];
-        eprintln!(
-            "Mathieu δ = {delta}, ε = {epsilon}: μ = {:.6}, {:.6}; |μ₁μ₂ − 1| = {:.1e}",
-            f.multipliers[0],
-            f.multipliers[1],
-            (product - 1.0).norm()
-        );
-        assert!(
-            (product.re - 1.0).abs() < 1e-10 && product.im.abs() < 1e-10,
-            "δ = {delta}, ε = {epsilon}: μ₁μ₂ = {product}"
-        );
-        assert!((f.determinant - 1.0).abs() < 1e-10);
-        assert!(f.stability != FloquetStability::AsymptoticallyStable);
-    }
-    let zeta = 0.05;
-    let f = floquet_analysis(
-        &mut Mathieu {
-            delta: 0.3,
-            epsilon: 0.2,
-            zeta,
-        },
-        &[0.0, 0.0],
-        0.0,
-        TAU,
-        &FloquetOptions::default(),
-    )
-    .unwrap();
-    let det = (-2.0 * zeta * TAU).exp();
-    assert!(
-        (f.determinant - det).abs() < 1e-10,
-        "{} vs {det}",
-        f.determinant
-    );
-
     let f = pendulum_floquet(&[]);
     assert!((f.determinant - 1.0).abs() < 1e-10, "{}", f.determinant);
     let (c, m, l) = (0.3, 2.0, 0.8);

@@ -6,10 +6,9 @@ mod common;
 use common::{eomgen, eomgen_ok};
 
 use eomgen::{
-    FrfError, HarmonicForcing, MechanicalSystem, ModelInfo, PeakAmplitude, SteadyStateOptions,
-    frequency_response, frequency_response_of, frequency_sweep, linearize, linearize_with_inputs,
-    log_frequencies, modal_damping, modal_frequency_response, normal_modes, settling_time,
-    simulate_steady_state,
+    FrfError, HarmonicForcing, MechanicalSystem, ModelInfo, SteadyStateOptions, frequency_response,
+    frequency_response_of, frequency_sweep, linearize, linearize_with_inputs, modal_damping,
+    modal_frequency_response, normal_modes, settling_time, simulate_steady_state,
 };
 use nalgebra::{Complex, DMatrix, DVector};
 
@@ -22,53 +21,6 @@ fn model(name: &str) -> Box<dyn ModelInfo> {
 fn forced(model: &mut dyn ModelInfo, input: &str) -> eomgen::ForcedLinearization {
     let n = model.num_dofs();
     linearize_with_inputs(model, &vec![0.0; n], &[input]).expect("linearises")
-}
-
-/// Lecture 21: `H(ω) = 1/(k − mω² + icω)` for `m ẍ + c ẋ + k x = A cos(ω t)`. Both sides are a
-/// few floating-point operations on the same numbers, so 1e-12 relative leaves room only for
-/// rounding.
-#[test]
-fn forced_oscillator_frf_matches_closed_form() {
-    let mut m = model("forced_oscillator");
-    for (mass, c, k) in [(1.0, 1.0, 1.0), (2.0, 0.05, 7.0), (0.3, 3.0, 0.5)] {
-        m.set_parameter("m", mass).unwrap();
-        m.set_parameter("c", c).unwrap();
-        m.set_parameter("k", k).unwrap();
-        let f = forced(m.as_mut(), "A");
-        assert_eq!(f.input_matrix, DMatrix::from_element(1, 1, 1.0));
-        for w in [0.0, 0.1, 0.9, (k / mass).sqrt(), 3.0, 40.0] {
-            let h = frequency_response(&f.linearization, &f.input_matrix, w).unwrap()[(0, 0)];
-            let exact = Complex::new(1.0, 0.0) / Complex::new(k - mass * w * w, c * w);
-            assert!(
-                (h - exact).norm() <= 1e-12 * exact.norm(),
-                "m = {mass}, c = {c}, k = {k}, ω = {w}: {h} vs {exact}"
-            );
-        }
-        // The peak of |H|: ω_n √(1 − 2ζ²), height 1/(2ζ k √(1 − ζ²)) when ζ < 1/√2. The
-        // height is exact to rounding; the location of a flat maximum only to ~√ε.
-        let wn = (k / mass).sqrt();
-        let zeta = c / (2.0 * (k * mass).sqrt());
-        let freqs = log_frequencies(wn / 10.0, wn * 10.0, 200).unwrap();
-        let sweep = frequency_sweep(&f.linearization, &f.input_matrix, 0, 0, &freqs).unwrap();
-        if zeta < std::f64::consts::FRAC_1_SQRT_2 {
-            assert_eq!(sweep.peaks.len(), 1, "{:?}", sweep.peaks);
-            let peak = sweep.peaks[0];
-            let w_peak = wn * (1.0 - 2.0 * zeta * zeta).sqrt();
-            let h_peak = 1.0 / (2.0 * zeta * k * (1.0 - zeta * zeta).sqrt());
-            assert!((peak.frequency - w_peak).abs() < 1e-7 * w_peak, "{peak:?}");
-            assert_eq!(peak.amplitude, PeakAmplitude::Finite(peak_value(&peak)));
-            assert!((peak_value(&peak) - h_peak).abs() < 1e-12 * h_peak);
-        } else {
-            assert!(sweep.peaks.is_empty(), "overdamped: {:?}", sweep.peaks);
-        }
-    }
-}
-
-fn peak_value(peak: &eomgen::ResonancePeak) -> f64 {
-    match peak.amplitude {
-        PeakAmplitude::Finite(a) => a,
-        PeakAmplitude::Unbounded => f64::INFINITY,
-    }
 }
 
 /// The equilibrium is found with the input set to 0: `three_masses_forced` has `A = 1` by
@@ -346,56 +298,6 @@ fn simulated_steady_state_matches_frf_hw37_damping() {
         1e-3,
         &[0.3, 0.7620582161, 1.0, 1.4095590611, 1.8761065400, 4.0],
     );
-}
-
-/// `vibration::frequency_response_analysis` (what `eomgen frf` prints) on the forced
-/// oscillator (m = k = 1, c = 1, ζ = 1/2): the peak at the closed-form √(1 − 2ζ²) = 1/√2
-/// (1e-7: the maximum is flat) with height 1/(2ζ√(1 − ζ²)) = 2/√3 (1e-12); at ω = ω_n,
-/// |H| = 1/(cω) = 1 and phase −90° (1e-12, 1e-10); one mode, so the modal sum is the response
-/// (1e-14); two simulated points within 1e-6 of H (`plan_simulation`, `simulate_point`).
-#[test]
-fn frequency_response_analysis_of_the_forced_oscillator() {
-    use eomgen::analysis::vibration::{
-        FrfOptions, FrfSimulationOptions, frequency_response_analysis, max_simulation_error,
-        plan_simulation, simulate_point,
-    };
-    let mut m = model("forced_oscillator");
-    let simulation = FrfSimulationOptions {
-        count: 2,
-        ..FrfSimulationOptions::default()
-    };
-    let options = FrfOptions {
-        input: "A".into(),
-        outputs: vec!["x".into()],
-        points: 60,
-        frequencies: vec![1.0],
-        modal: true,
-        simulation: Some(simulation.clone()),
-        ..FrfOptions::default()
-    };
-    let frf = frequency_response_analysis(m.as_mut(), &options).unwrap();
-    assert_eq!(frf.frequencies.len(), 60);
-    assert_eq!(frf.outputs[0].index, 0);
-    let peak = frf.sweeps[0].peaks[0];
-    assert!((peak.frequency - 0.5f64.sqrt()).abs() < 1e-7);
-    assert!((peak_value(&peak) - 2.0 / 3f64.sqrt()).abs() < 1e-12);
-    let at = &frf.evaluations[0];
-    let h = at.response.as_ref().unwrap()[0];
-    assert!((h.norm() - 1.0).abs() < 1e-12);
-    assert!((eomgen::phase_degrees(h) + 90.0).abs() < 1e-10);
-    assert!(at.modal_difference.unwrap() < 1e-14);
-    let plan = plan_simulation(m.as_ref(), &frf, &simulation).unwrap();
-    assert_eq!(plan.frequency_parameter, "w");
-    assert_eq!(plan.frequencies.len(), 2);
-    let points: Vec<_> = plan
-        .frequencies
-        .iter()
-        .map(|&w| simulate_point(m.as_mut(), &frf, &plan, w).unwrap())
-        .collect();
-    assert!(max_simulation_error(&points) < 1e-6);
-    for p in &points {
-        assert!(p.values[0].relative_error() < 1e-6, "{p:?}");
-    }
 }
 
 /// Undamped three masses: the peaks of x2 (which mode 2, [1, 0, −1], leaves still) are modes

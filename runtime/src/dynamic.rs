@@ -2,8 +2,10 @@
 //!
 //! [`DynMechanicalSystem`] is [`MechanicalSystem`] with slices in
 //! place of nalgebra's static vectors and matrices: what a model compiled at run time (from any
-//! model file, with no rebuild) implements, and what every [`MechanicalSystem<N>`] is through
-//! an internal adapter. Its first-order form is
+//! model file, with no rebuild) implements. (Inside this crate every [`MechanicalSystem<N>`] is
+//! one through a private adapter, so that the constrained solve and [`ModelInfo`](crate::ModelInfo)
+//! are written once; outside it, a compiled model is reached through
+//! [`FirstOrder`](crate::FirstOrder) and `ModelInfo`.) Its first-order form is
 //! [`DynFirstOrder`](crate::DynFirstOrder), which implements [`ModelInfo`](crate::ModelInfo),
 //! so every analysis that takes a `Box<dyn ModelInfo>` takes such a model unchanged.
 

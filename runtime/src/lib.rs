@@ -41,6 +41,7 @@ pub mod linalg;
 pub mod linear;
 pub mod model_info;
 pub mod ode;
+pub(crate) mod serde_matrix;
 pub mod system;
 
 pub use analysis::{Method, UnknownMethod};

@@ -214,7 +214,7 @@ pub struct ForcedLinearization {
     /// `B = ∂F/∂u`, `n × r`: column `j` is the generalized force per unit of input `j` at
     /// `t = 0` (N or N·m per unit of the parameter). The state-space input matrix is
     /// [`ForcedLinearization::state_input_matrix`].
-    #[serde(serialize_with = "crate::analysis::vibration::serde_matrix::rows")]
+    #[serde(serialize_with = "crate::serde_matrix::rows")]
     pub input_matrix: DMatrix<f64>,
 }
 
@@ -549,7 +549,7 @@ pub struct FrequencySweep {
     pub frequencies: Vec<f64>,
     /// `H(ω)` at each; `None` where `K − ω²M + iωC` is singular (an undamped resonance hit
     /// exactly).
-    #[serde(serialize_with = "crate::analysis::vibration::serde_matrix::option_complex_list")]
+    #[serde(serialize_with = "crate::serde_matrix::option_complex_list")]
     pub response: Vec<Option<Complex<f64>>>,
     /// `arg H` in degrees, unwrapped along the sweep so that it is continuous where the
     /// response is (starts in `[−180, 180)`; `None` where `response` is).
@@ -839,13 +839,13 @@ pub struct ModalResponse {
     /// The modal forces `ψ_kᵀ b` per unit input, one per mode.
     pub modal_forces: Vec<f64>,
     /// The modal coordinates `η_k = ψ_kᵀ b / (ω_k² − ω² + iω Ĉ_kk)` per unit input (complex).
-    #[serde(serialize_with = "crate::analysis::vibration::serde_matrix::complex_list")]
+    #[serde(serialize_with = "crate::serde_matrix::complex_list")]
     pub modal_coordinates: Vec<Complex<f64>>,
     /// `n × k` (complex): column `k` is mode `k`'s contribution `ψ_k η_k` to the coordinates.
-    #[serde(serialize_with = "crate::analysis::vibration::serde_matrix::complex_rows")]
+    #[serde(serialize_with = "crate::serde_matrix::complex_rows")]
     pub contributions: DMatrix<Complex<f64>>,
     /// `Σ_k ψ_k η_k` (length `n`, complex): the response per unit input.
-    #[serde(serialize_with = "crate::analysis::vibration::serde_matrix::complex_vector")]
+    #[serde(serialize_with = "crate::serde_matrix::complex_vector")]
     pub response: DVector<Complex<f64>>,
 }
 
@@ -1019,7 +1019,7 @@ pub struct SteadyState {
     /// The complex amplitudes `Xᵢ` of the coordinates at the forcing frequency, one per
     /// coordinate: `qᵢ(t) ≈ q̄ᵢ + Re(Xᵢ e^{iωt})` (m or rad). `Xᵢ / amplitude` estimates
     /// `Hᵢ(ω)`.
-    #[serde(serialize_with = "crate::analysis::vibration::serde_matrix::complex_list")]
+    #[serde(serialize_with = "crate::serde_matrix::complex_list")]
     pub complex_amplitudes: Vec<Complex<f64>>,
     /// The means `q̄ᵢ` over the window (m or rad).
     pub means: Vec<f64>,

@@ -1,5 +1,7 @@
-//! The linear-algebra building blocks the analyses are made of, each a function of matrices
-//! (or of a model at one operating point) with no options struct and no report:
+//! The linear-algebra building blocks the analyses are made of: functions of matrices, or of
+//! a model about one operating point (the steady state and the monodromy matrix integrate
+//! it, with their own small options), each with a typed error and results that are plain
+//! values (serialisable where a report embeds them):
 //!
 //! - [`modal`]: equilibria, the exact linearisation `M δq̈ + C δq̇ + K δq = 0` and its state
 //!   matrix, undamped normal modes, damped modes, the matrix exponential;
@@ -10,9 +12,9 @@
 //! - [`monodromy`]: the monodromy matrix of a periodic linearisation, Floquet multipliers and
 //!   the stability they imply.
 //!
-//! The analyses on top of them — typed options, a `Serialize` report and a typed error, one
-//! call per CLI command — are in [`crate::analysis`] ([`crate::analysis::vibration`] for
-//! these).
+//! The analyses on top of them — one call per CLI command or study, with its options, a
+//! `Serialize` report and a typed error — are in [`crate::analysis`]
+//! ([`crate::analysis::vibration`] for these).
 
 pub mod frequency_response;
 pub mod modal;

@@ -888,17 +888,17 @@ pub struct Linearization {
     pub t: f64,
     /// `mass_matrix` `M(q*)` (`r × r`, `r = n` without constraints), symmetric positive
     /// definite.
-    #[serde(serialize_with = "crate::analysis::vibration::serde_matrix::rows")]
+    #[serde(serialize_with = "crate::serde_matrix::rows")]
     pub mass_matrix: DMatrix<f64>,
     /// `stiffness_matrix` `K`, `r × r`, as derived (not symmetrised).
-    #[serde(serialize_with = "crate::analysis::vibration::serde_matrix::rows")]
+    #[serde(serialize_with = "crate::serde_matrix::rows")]
     pub stiffness_matrix: DMatrix<f64>,
     /// `damping_matrix` `C = −∂F/∂q̇` (`r × r`; velocity-dependent gyroscopic terms make it
     /// non-symmetric).
-    #[serde(serialize_with = "crate::analysis::vibration::serde_matrix::rows")]
+    #[serde(serialize_with = "crate::serde_matrix::rows")]
     pub damping_matrix: DMatrix<f64>,
     /// `N` (`n × r`): `δq = N z`; the identity without constraints.
-    #[serde(serialize_with = "crate::analysis::vibration::serde_matrix::rows")]
+    #[serde(serialize_with = "crate::serde_matrix::rows")]
     pub coordinate_basis: DMatrix<f64>,
     /// Indices (into `q`, ascending) of the `r` coordinates whose increments are `z`.
     pub independent_coordinates: Vec<usize>,
@@ -1222,7 +1222,7 @@ pub struct NormalModes {
     /// `mode_shapes`, `r × r` in the linearisation's coordinates ([`Linearization::to_coordinates`] gives
     /// them in `q`), column `k` the shape of mode `k`, mass-normalised:
     /// `ΨᵀMΨ = I`; sign fixed so that the largest-magnitude entry is positive.
-    #[serde(serialize_with = "crate::analysis::vibration::serde_matrix::rows")]
+    #[serde(serialize_with = "crate::serde_matrix::rows")]
     pub mode_shapes: DMatrix<f64>,
     /// `‖K − Kᵀ‖_max / ‖K‖_max` before symmetrisation.
     pub stiffness_asymmetry: f64,

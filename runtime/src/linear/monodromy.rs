@@ -268,16 +268,16 @@ pub struct FloquetAnalysis {
     pub t0: f64,
     /// The monodromy matrix `Φ(t₀ + T)`, `n × n` with `n = dim()` (`2 num_dofs()` for a model,
     /// `y = [q; q̇]`); column `j` is the deviation after one period that starts as `eⱼ`.
-    #[serde(serialize_with = "crate::analysis::vibration::serde_matrix::rows")]
+    #[serde(serialize_with = "crate::serde_matrix::rows")]
     pub monodromy_matrix: DMatrix<f64>,
     /// The Floquet multipliers `μ` (eigenvalues of the monodromy matrix), `n` of them, sorted
     /// by modulus, largest first (ties: larger imaginary part first). Dimensionless.
-    #[serde(serialize_with = "crate::analysis::vibration::serde_matrix::complex_list")]
+    #[serde(serialize_with = "crate::serde_matrix::complex_list")]
     pub multipliers: Vec<Complex<f64>>,
     /// The Floquet exponents `ln(μ)/T` (principal logarithm), in the order of
     /// `multipliers`: real part the growth rate (1/s), imaginary part a frequency (rad/s)
     /// determined modulo `2π/T`. A zero multiplier gives a real part of `−∞`.
-    #[serde(serialize_with = "crate::analysis::vibration::serde_matrix::complex_list")]
+    #[serde(serialize_with = "crate::serde_matrix::complex_list")]
     pub exponents: Vec<Complex<f64>>,
     /// The spectral radius `ρ = max |μ|`.
     pub spectral_radius: f64,

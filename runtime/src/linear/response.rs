@@ -999,7 +999,7 @@ impl RayleighDamping {
 pub struct ModalDamping {
     /// `Ĉ = ΨᵀCΨ` (`n × n`, 1/s; the same as `Pᵀ M^{-1/2} C M^{-1/2} P` with orthonormal `P`),
     /// serialised as a list of rows.
-    #[serde(serialize_with = "crate::analysis::vibration::serde_matrix::rows")]
+    #[serde(serialize_with = "crate::serde_matrix::rows")]
     pub modal_damping_matrix: DMatrix<f64>,
     /// The approximation's `damping_ratios` `ζ_k = Ĉ_kk/(2ω_k)` of the oscillatory modes
     /// (`None` for zero-frequency and unstable modes, where `ζ` is not defined).
@@ -1067,7 +1067,7 @@ pub fn modal_damping(lin: &Linearization, modes: &NormalModes) -> ModalDamping {
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct DampedMode {
     /// The eigenvalue `s` with `Im s > 0` (1/s), serialised as `{"re", "im"}`.
-    #[serde(serialize_with = "crate::analysis::vibration::serde_matrix::complex")]
+    #[serde(serialize_with = "crate::serde_matrix::complex")]
     pub eigenvalue: Complex<f64>,
     /// `ζ = −Re s/|s|`.
     pub damping_ratio: f64,

@@ -87,7 +87,7 @@ pub fn describe(model: &SymbolicModel, eom: &EquationsOfMotion) -> ModelDescript
 /// borrowed from the binary), naming the types under `krate` (`::eomgen`).
 ///
 /// # Errors
-/// A parameter default that does not print as a literal (the loader refuses non-finite
+/// A parameter default that is not finite, which has no literal (the loader refuses such
 /// values, so this is a bug).
 pub fn description_tokens(
     description: &ModelDescription,

@@ -149,7 +149,14 @@ fn ident(name: &str) -> Result<Ident, String> {
 }
 
 /// An `f64` literal as the printer writes one (`9.81_f64`, `-1.0_f64`).
+///
+/// # Errors
+/// A value that is not finite, which has no literal (the loader refuses such defaults, so
+/// this is a bug).
 fn float(value: f64) -> Result<TokenStream, String> {
+    if !value.is_finite() {
+        return Err(format!("{value} has no Rust literal"));
+    }
     tokens(&format!("{value:?}_f64"))
 }
 
@@ -507,6 +514,8 @@ fn function_method(
 /// Stores of `point_positions`: `[x, y, z]` per point from its flattened components `v`, 2-D
 /// points with `z = 0`.
 fn point_stores(model: &SymbolicModel, v: &[TokenStream]) -> TokenStream {
+    // The loader gives every point 2 or 3 components.
+    debug_assert!(model.points.iter().all(|(_, r)| r.len() <= 3));
     let mut components = v.iter();
     model
         .points

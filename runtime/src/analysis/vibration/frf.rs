@@ -234,7 +234,7 @@ fn option_complex_vector<S: serde::Serializer>(
     s: S,
 ) -> Result<S::Ok, S::Error> {
     match v {
-        Some(v) => super::serde_matrix::complex_vector(v, s),
+        Some(v) => crate::serde_matrix::complex_vector(v, s),
         None => s.serialize_none(),
     }
 }
@@ -559,10 +559,10 @@ pub fn plan_simulation(
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct SimulatedValue {
     /// The simulated complex amplitude over the input's amplitude (`{"re", "im"}`).
-    #[serde(serialize_with = "super::serde_matrix::complex")]
+    #[serde(serialize_with = "crate::serde_matrix::complex")]
     pub simulated: Complex<f64>,
     /// The predicted `H(ω)` (`{"re", "im"}`).
-    #[serde(serialize_with = "super::serde_matrix::complex")]
+    #[serde(serialize_with = "crate::serde_matrix::complex")]
     pub predicted: Complex<f64>,
 }
 

@@ -18,8 +18,9 @@
 //!   (lectures 19, 21).
 //!
 //! The building blocks (linearisation, normal modes, responses, `H(ω)`, monodromy) are in
-//! [`modal`](crate::linear::modal), [`response`](crate::linear::response), [`frf`](crate::linear::frequency_response) and
-//! [`floquet`](crate::linear::monodromy).
+//! [`linear::modal`](crate::linear::modal), [`linear::response`](crate::linear::response),
+//! [`linear::frequency_response`](crate::linear::frequency_response) and
+//! [`linear::monodromy`](crate::linear::monodromy).
 
 pub mod floquet;
 pub mod free_response;
@@ -27,7 +28,6 @@ pub mod frf;
 pub mod modal_damping;
 pub mod modes;
 pub mod operating_point;
-pub(crate) mod serde_matrix;
 
 pub use floquet::{
     FloquetCell, FloquetChart, FloquetPoint, FloquetStudyError, FloquetStudyOptions, SweepAxis,

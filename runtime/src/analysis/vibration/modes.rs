@@ -26,7 +26,7 @@ pub struct ModalOptions {
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct DampedEigenvalue {
     /// The eigenvalue `s` (1/s), serialised as `{"re", "im"}`.
-    #[serde(serialize_with = "super::serde_matrix::complex")]
+    #[serde(serialize_with = "crate::serde_matrix::complex")]
     pub eigenvalue: Complex<f64>,
     /// `ζ = −Re s/|s|` (0 for `s = 0`).
     pub damping_ratio: f64,
