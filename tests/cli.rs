@@ -975,3 +975,34 @@ fn issue_28_failure_hints_name_the_model_cause() {
         assert!(!err.contains("inf"), "{method}: {err}");
     }
 }
+
+/// The CLI's two layers (issue 29, item 4): a command in `src/cli/commands/` imports the
+/// library and the shared pieces beside `src/cli/mod.rs` (`crate::cli::…`), never another
+/// command. Inside `commands/`, `super::` can only name a sibling command and `commands::`
+/// the commands themselves, so neither may appear outside a file's `#[cfg(test)]` module
+/// (where `super::` is the command itself).
+#[test]
+fn commands_import_no_other_command() {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/src/cli/commands");
+    let mut checked = 0;
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_none_or(|e| e != "rs") || path.ends_with("mod.rs") {
+            continue;
+        }
+        let text = std::fs::read_to_string(&path).unwrap();
+        let code = text.split("#[cfg(test)]").next().unwrap_or_default();
+        for (k, line) in code.lines().enumerate() {
+            assert!(
+                !line.contains("super::") && !line.contains("commands::"),
+                "{}:{}: a command imports another command (or names it): `{}`; move what \
+                 they share to a file beside src/cli/mod.rs",
+                path.display(),
+                k + 1,
+                line.trim()
+            );
+        }
+        checked += 1;
+    }
+    assert!(checked >= 10, "only {checked} command files found in {dir}");
+}

@@ -64,7 +64,48 @@ CASES += [
     ["new", "n-link-pendulum", "4"],
     ["check", "nope_model"],
     ["simulate", "double_pendulum", "--set", "l1=0", "--t-end", "1"],
+    # Text outputs, PNG charts and the other studies (the chart writer and the shared helpers
+    # of every command).
+    ["check", "double_pendulum"],
+    ["simulate", "slider_crank", "--t-end", "1", "--plot", "s.png", "--plot-phase", "p.svg",
+     "--plot-energy", "e.png", "--csv", "s.csv", "--event", "theta = 1"],
+    ["simulate", "double_pendulum", "--t-end", "1", "--stop-when", "theta1 = 0", "--json"],
+    ["simulate", "double_pendulum", "--t-end", "1", "--json", "--timing"],
+    ["check", "double_pendulum", "--json", "--timing"],
+    ["animate", "double_pendulum", "--t-end", "0.5", "--fps", "10", "-o", "a.html",
+     "--gif", "a.gif"],
+    ["modes", "double_pendulum", "--plot", "m.png", "--animate", "m.html"],
+    ["modes", "three_masses_damped", "--json", "--at", "x1=0.1"],
+    ["frf", "three_masses_forced", "--input", "A", "--plot", "frf.png"],
+    ["frf", "three_masses_forced", "--input", "A", "--modal"],
+    ["study", "free-response", "three_masses", "--plot", "fr.svg"],
+    ["study", "free-response", "three_masses", "--plot", "fr.png", "--json"],
+    ["study", "modal-damping", "three_masses_damped", "--plot", "md.svg"],
+    ["study", "floquet", "mathieu_pendulum", "--plot", "fl.svg"],
+    ["study", "floquet", "mathieu_pendulum", "--sweep", "a=0..0.2:3,w=40..60:3", "--json",
+     "--plot", "sw.png"],
+    ["study", "constraint-methods", "two_masses_rod", "--t-end", "1", "--plot", "cm.svg"],
+    ["study", "euler-roundoff", "--max-n", "4", "--plot", "er.png"],
+    ["study", "euler-roundoff", "--max-n", "4"],
+    ["study", "stability", "--steps", "200", "--periods", "20", "--plot", "st.svg"],
+    ["study", "stability", "--steps", "200", "--periods", "20", "--json"],
+    ["study", "work-precision", "double_pendulum", "--t-end", "1", "--tols", "1e-3..1e-6",
+     "--steps", "64..256", "--methods", "dp54,rk4", "--repeats", "1", "--min-time-ms", "0",
+     "--json", "--plot", "wp"],
+    ["study", "work-precision", "double_pendulum", "--t-end", "1", "--tols", "1e-3..1e-5",
+     "--steps", "64..128", "--methods", "dp54,rk4", "--repeats", "1", "--min-time-ms", "0"],
 ]
+# Every command's help: the defaults shown must not change.
+for c in [["simulate"], ["animate"], ["check"], ["equations"], ["modes"], ["frf"], ["new"],
+          ["report"], ["list"], ["study"], ["study", "work-precision"], ["study", "stability"],
+          ["study", "euler-roundoff"], ["study", "constraint-methods"],
+          ["study", "free-response"], ["study", "modal-damping"], ["study", "floquet"]]:
+    CASES.append(c + ["--help"])
+CASES.append(["--help"])
+
+# Cases whose text has unlabelled wall-time columns (milliseconds with three decimals) and
+# whose `-time` charts plot wall time: those columns and charts are masked.
+TIMED = ("constraint-methods", "work-precision")
 
 TIME_KEYS = re.compile(r"(^|_)(time|times|seconds|elapsed|ms|wall|time_s|wall_s|ns)(_|$)")
 
@@ -77,10 +118,13 @@ def mask_json(value):
     return value
 
 
-def mask_text(text):
+def mask_text(text, timed=False):
     try:
-        return json.dumps(mask_json(json.loads(text)), indent=1, sort_keys=True)
+        # Key order kept: it is part of what a user sees.
+        return json.dumps(mask_json(json.loads(text)), indent=1)
     except ValueError:
+        if timed:
+            text = re.sub(r"\b\d+\.\d{3}\b", "<ms>", text)
         # Durations printed in tables and summaries.
         return re.sub(r"\b\d+(\.\d+)?(e-?\d+)? ?(ms|µs|us|ns|s)\b", "<dur>", text)
 
@@ -89,6 +133,7 @@ def record(out):
     binary = os.path.abspath(os.environ.get("EOMGEN", "target/release/eomgen"))
     os.makedirs(out, exist_ok=True)
     for i, case in enumerate(CASES):
+        timed = any(word in TIMED for word in case) and "--help" not in case
         with tempfile.TemporaryDirectory() as cwd:
             p = subprocess.run([binary] + case, cwd=cwd, capture_output=True, text=True)
             files = {}
@@ -98,6 +143,9 @@ def record(out):
                     with open(path, "rb") as f:
                         data = f.read()
                     rel = os.path.relpath(path, cwd)
+                    if timed and "-time." in n:
+                        files[rel] = "<wall-time chart>"
+                        continue
                     try:
                         files[rel] = mask_text(data.decode())
                     except UnicodeDecodeError:
@@ -105,7 +153,7 @@ def record(out):
             rec = {
                 "case": case,
                 "status": p.returncode,
-                "stdout": mask_text(p.stdout),
+                "stdout": mask_text(p.stdout, timed),
                 "stderr": mask_text(p.stderr),
                 "files": files,
             }

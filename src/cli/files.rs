@@ -1,4 +1,4 @@
-//! Output files: the one writer of every file the command line writes ([`write`]), and the
+//! Output files: the one writer of every file the command line writes ([`write()`]), and the
 //! check of a command's outputs before it does any work ([`Outputs::check`]).
 //!
 //! What a path names decides how it is written (docs/reliability.md, "Atomic outputs"):
@@ -27,7 +27,7 @@ use std::fs::{self, Metadata, OpenOptions};
 use std::io::{self, Write as _};
 use std::path::{Path, PathBuf};
 
-use super::CliError;
+use super::error::CliError;
 
 /// An output that cannot be written, or two outputs that would write one file.
 #[derive(Debug, thiserror::Error)]
@@ -433,7 +433,7 @@ fn replace(target: &Path, existing: Option<&Metadata>, bytes: &[u8]) -> io::Resu
     Ok(())
 }
 
-/// Whether `path` is written in place (a device, FIFO or standard stream, see [`write`])
+/// Whether `path` is written in place (a device, FIFO or standard stream, see [`write()`])
 /// rather than replaced as a regular file.
 pub(super) fn writes_in_place(path: &str) -> bool {
     matches!(

@@ -11,10 +11,11 @@
 
 use eomgen::{ModeKind, ModelInfo, NormalModes};
 use nalgebra::DMatrix;
+use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::CliError;
-use super::plot::{register_font, tick};
+use super::error::CliError;
+use super::plot::{Drawing, tick, write_chart};
 
 /// Largest point displacement of a drawn mode, as a fraction of the mechanism's size.
 const AMPLITUDE_FRACTION: f64 = 0.2;
@@ -27,12 +28,7 @@ const Y_LABEL_AREA: u32 = 70;
 
 /// `PREFIX-mode<k>.svg`, or `.png` when the prefix ends in `.png` (`k` counts from 1).
 pub fn chart_path(prefix: &str, mode: usize) -> String {
-    if let Some(stem) = prefix.strip_suffix(".png") {
-        format!("{stem}-mode{mode}.png")
-    } else {
-        let stem = prefix.strip_suffix(".svg").unwrap_or(prefix);
-        format!("{stem}-mode{mode}.svg")
-    }
+    super::plot::chart_path(prefix, &format!("mode{mode}"))
 }
 
 /// Checks that `model` has points to draw a mode shape on.
@@ -204,7 +200,6 @@ pub fn mode_charts(
     shapes: &DMatrix<f64>,
 ) -> Result<Vec<String>, CliError> {
     check_drawable(model)?;
-    register_font().map_err(CliError::failure)?;
     let layout = Layout::of(model, is_three_d(model, q, shapes));
     let rest = frame(model, &layout, q);
     let size = drawing_size(&rest, &layout.dots);
@@ -242,8 +237,15 @@ pub fn mode_charts(
             displaced,
         };
         // The messages name the file (a write error names it itself).
-        super::plot::write_chart!(&path, SIZE, |root| draw(root, &layout, &drawing))
-            .map_err(CliError::failure)?;
+        write_chart(
+            &path,
+            SIZE,
+            &ModeChart {
+                layout: &layout,
+                drawing: &drawing,
+            },
+        )
+        .map_err(CliError::failure)?;
         paths.push(path);
     }
     Ok(paths)
@@ -362,6 +364,21 @@ fn equal_ranges(frames: &[&Frame], dots: &[usize], pixels: (f64, f64)) -> ((f64,
     let (cx, cy) = (0.5 * (x0 + x1), 0.5 * (y0 + y1));
     let (hw, hh) = (0.5 * per_pixel * pixels.0, 0.5 * per_pixel * pixels.1);
     ((cx - hw, cx + hw), (cy - hh, cy + hh))
+}
+
+/// One mode chart of [`mode_charts`], drawn.
+struct ModeChart<'a> {
+    layout: &'a Layout,
+    drawing: &'a ModeDrawing,
+}
+
+impl Drawing for ModeChart<'_> {
+    fn draw<DB: DrawingBackend>(&self, root: DrawingArea<DB, Shift>) -> Result<(), String>
+    where
+        DB::ErrorType: 'static,
+    {
+        draw(root, self.layout, self.drawing)
+    }
 }
 
 fn draw<DB: DrawingBackend>(

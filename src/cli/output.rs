@@ -1,6 +1,6 @@
 //! Standard output, written as a Unix tool writes it: every command prints through
 //! [`stdout`] (or [`outln!`], [`out!`]), which keeps the first write error; [`finish`]
-//! flushes and returns it, and [`super::run`] turns it into the exit status.
+//! flushes and returns it, and [`super::error::exit`] turns it into the exit status.
 //!
 //! - A closed pipe (`eomgen … | head -1`: the reader went away, `EPIPE`) ends the program
 //!   quietly with status 141, what a shell reports for a tool that the signal `SIGPIPE`
@@ -107,7 +107,7 @@ pub(super) fn finish() -> Result<(), io::Error> {
     }
 }
 
-/// How [`super::run`] reports a failed standard output: nothing for a closed pipe (the reader
+/// How [`super::error::exit`] reports a failed standard output: nothing for a closed pipe (the reader
 /// chose to stop), else `cannot write standard output: <reason>`.
 pub(super) fn message(error: &io::Error) -> Option<String> {
     (error.kind() != io::ErrorKind::BrokenPipe)
@@ -122,4 +122,15 @@ pub(super) fn status(error: &io::Error) -> u8 {
     } else {
         1
     }
+}
+
+/// Prints `value` as pretty JSON on stdout: the one form of every command's `--json`.
+///
+/// # Errors
+/// A value that cannot be encoded (a map with keys that are not strings).
+pub(super) fn print_json(value: &impl serde::Serialize) -> Result<(), super::error::CliError> {
+    let text = serde_json::to_string_pretty(value)
+        .map_err(|e| super::error::CliError::failure(e.to_string()))?;
+    let _ = writeln!(stdout(), "{text}");
+    Ok(())
 }

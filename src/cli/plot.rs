@@ -1,46 +1,51 @@
 //! Charts with plotters: SVG or PNG chosen by the file extension.
 
 use eomgen::{ModelInfo, Solution};
+use plotters::coord::Shift;
 use plotters::prelude::*;
 
-/// Draws a chart of `$size` pixels in memory, in the format `$path`'s extension names, with
-/// `$draw` (an expression of the drawing area `$root` that returns `Result<(), String>`), and
-/// writes the file with [`super::files::write`]; a drawing error is prefixed with the path. Drawing in memory keeps the file system out
-/// of plotters: one writer handles regular files, links, devices and FIFOs, and names the
-/// file and the operating system's reason when a write fails.
-macro_rules! write_chart {
-    ($path:expr, $size:expr, |$root:ident| $draw:expr) => {{
-        use ::plotters::prelude::IntoDrawingArea as _;
-        let path: &str = $path;
-        let size: (u32, u32) = $size;
-        match $crate::cli::plot::ChartFormat::of(path) {
-            Err(e) => Err(e),
-            Ok($crate::cli::plot::ChartFormat::Svg) => {
-                let mut text = String::new();
-                let drawn = {
-                    let $root = ::plotters::prelude::SVGBackend::with_string(&mut text, size)
-                        .into_drawing_area();
-                    $draw
-                };
-                drawn
-                    .map_err(|e| format!("`{path}`: {e}"))
-                    .and_then(|()| $crate::cli::plot::save_svg(path, &text))
-            }
-            Ok($crate::cli::plot::ChartFormat::Png) => {
-                let mut pixels = vec![0u8; size.0 as usize * size.1 as usize * 3];
-                let drawn = {
-                    let $root = ::plotters::prelude::BitMapBackend::with_buffer(&mut pixels, size)
-                        .into_drawing_area();
-                    $draw
-                };
-                drawn
-                    .map_err(|e| format!("`{path}`: {e}"))
-                    .and_then(|()| $crate::cli::plot::save_png(path, &pixels, size))
-            }
-        }
-    }};
+/// A chart that draws itself on any plotters backend: what [`write_chart`] writes as SVG or
+/// PNG. Each kind of chart is a small value holding what it shows.
+pub(super) trait Drawing {
+    /// Draws the whole picture on `root`.
+    ///
+    /// # Errors
+    /// A message saying what could not be drawn.
+    fn draw<DB: DrawingBackend>(&self, root: DrawingArea<DB, Shift>) -> Result<(), String>
+    where
+        DB::ErrorType: 'static;
 }
-pub(crate) use write_chart;
+
+/// Draws `chart` at `size` pixels in memory, in the format `path`'s extension names
+/// ([`ChartFormat`]), and writes the file with [`super::files::write`] (atomically for a
+/// regular file, in place for a device or FIFO); a drawing error is prefixed with the path.
+/// Drawing in memory keeps the file system out of plotters: one writer handles regular
+/// files, links, devices and FIFOs, and names the file and the operating system's reason
+/// when a write fails. The one place a chart file is written.
+///
+/// # Errors
+/// The bundled font not loading, an extension other than `.svg`/`.png`, a drawing error or
+/// a failed write.
+pub(super) fn write_chart(
+    path: &str,
+    size: (u32, u32),
+    chart: &impl Drawing,
+) -> Result<(), String> {
+    register_font()?;
+    let drawn = |result: Result<(), String>| result.map_err(|e| format!("`{path}`: {e}"));
+    match ChartFormat::of(path)? {
+        ChartFormat::Svg => {
+            let mut text = String::new();
+            drawn(chart.draw(SVGBackend::with_string(&mut text, size).into_drawing_area()))?;
+            save_svg(path, &text)
+        }
+        ChartFormat::Png => {
+            let mut pixels = vec![0u8; size.0 as usize * size.1 as usize * 3];
+            drawn(chart.draw(BitMapBackend::with_buffer(&mut pixels, size).into_drawing_area()))?;
+            save_png(path, &pixels, size)
+        }
+    }
+}
 
 static FONT: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
 
@@ -160,8 +165,62 @@ pub fn lines_noted(
     series: &[Series],
     note: Option<&str>,
 ) -> Result<(), String> {
-    register_font()?;
-    write_chart!(path, (960, 600), |root| draw(root, chart, series, note))
+    write_chart(
+        path,
+        (960, 600),
+        &LineChart {
+            chart,
+            series,
+            note,
+        },
+    )
+}
+
+/// The lines of [`lines_noted`], drawn.
+struct LineChart<'a> {
+    chart: &'a Chart<'a>,
+    series: &'a [Series],
+    note: Option<&'a str>,
+}
+
+impl Drawing for LineChart<'_> {
+    fn draw<DB: DrawingBackend>(&self, root: DrawingArea<DB, Shift>) -> Result<(), String>
+    where
+        DB::ErrorType: 'static,
+    {
+        draw(root, self.chart, self.series, self.note)
+    }
+}
+
+/// Draws `series` into `path` with a logarithmic y axis; `labels` are the title and the x and
+/// y axis descriptions.
+pub(super) fn log_y_chart(
+    path: &str,
+    labels: [&str; 3],
+    log_x: bool,
+    series: &[Series],
+) -> Result<(), super::error::CliError> {
+    let [title, x_desc, y_desc] = labels;
+    let chart = Chart {
+        title,
+        x_desc,
+        y_desc,
+        log_x,
+        log_y: true,
+    };
+    lines(path, &chart, series).map_err(super::error::CliError::failure)
+}
+
+/// The chart `PREFIX-tag.svg` of an option that names a prefix for several charts, or
+/// `.png` when the prefix ends in `.png` (a `.svg` ending is dropped): `out/dp` and
+/// `out/dp.svg` give `out/dp-tag.svg`, `out/dp.png` gives `out/dp-tag.png`.
+pub(super) fn chart_path(prefix: &str, tag: &str) -> String {
+    if let Some(stem) = prefix.strip_suffix(".png") {
+        format!("{stem}-{tag}.png")
+    } else {
+        let stem = prefix.strip_suffix(".svg").unwrap_or(prefix);
+        format!("{stem}-{tag}.svg")
+    }
 }
 
 /// The format of a chart file, named by its extension.

@@ -1,7 +1,7 @@
 //! `NAME=VALUE` arguments whose values are expressions (`theta1=pi/2`, `k=4*10^2`): the
 //! library's [`eomgen::expressions`] with its errors as usage errors.
 
-use super::CliError;
+use super::error::CliError;
 use eomgen::ModelInfo;
 pub use eomgen::expressions::parameter_lookup;
 use eomgen::expressions::{self, ExpressionError};

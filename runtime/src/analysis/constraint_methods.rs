@@ -45,12 +45,21 @@ pub struct ConstraintMethodsOptions {
     pub stiffness: Vec<f64>,
 }
 
+impl ConstraintMethodsOptions {
+    /// The default end time (s).
+    pub const DEFAULT_T_END: f64 = 10.0;
+    /// The default relative and absolute tolerance of every run.
+    pub const DEFAULT_TOL: f64 = 1e-8;
+    /// The default spring stiffnesses of method I.
+    pub const DEFAULT_STIFFNESS: [f64; 3] = [1e2, 1e4, 1e6];
+}
+
 impl Default for ConstraintMethodsOptions {
     fn default() -> Self {
         Self {
-            t_end: 10.0,
-            tol: 1e-8,
-            stiffness: vec![1e2, 1e4, 1e6],
+            t_end: Self::DEFAULT_T_END,
+            tol: Self::DEFAULT_TOL,
+            stiffness: Self::DEFAULT_STIFFNESS.to_vec(),
         }
     }
 }

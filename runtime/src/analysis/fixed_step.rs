@@ -24,10 +24,10 @@ use nalgebra::{Complex, DMatrix};
 use serde::Serialize;
 
 use crate::analysis::methods::Method;
-use crate::integrate::Tableau;
 use crate::integrate::stability_function::{
     StabilityPolynomial, implicit_midpoint_stability, partitioned_oscillator_spectral_radius,
 };
+use crate::integrate::{IntegratorOptions, Tableau};
 use crate::model_info::ModelInfo;
 
 /// The growth of a mode that should not grow, over the whole run, beyond which a fixed step
@@ -199,7 +199,7 @@ pub fn fixed_step_warnings(
     if method.is_adaptive() || !(t_end.is_finite() && t_end > 0.0) {
         return warnings;
     }
-    let h = dt.unwrap_or(t_end / 1000.0);
+    let h = dt.unwrap_or(t_end / IntegratorOptions::DEFAULT_FIXED_STEPS);
     if !(h.is_finite() && h > 0.0) {
         return warnings;
     }

@@ -43,9 +43,16 @@ pub struct RoundoffOptions {
     pub max_n: u32,
 }
 
+impl RoundoffOptions {
+    /// The default largest n (steps h = 10⁻ⁿ).
+    pub const DEFAULT_MAX_N: u32 = 7;
+}
+
 impl Default for RoundoffOptions {
     fn default() -> Self {
-        Self { max_n: 7 }
+        Self {
+            max_n: Self::DEFAULT_MAX_N,
+        }
     }
 }
 

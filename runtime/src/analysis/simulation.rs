@@ -49,13 +49,26 @@ pub struct SimulationOptions {
     pub initial_state: Option<Vec<f64>>,
 }
 
+impl SimulationOptions {
+    /// The default method, Dormand–Prince 5(4): what `eomgen simulate` uses without `--method`.
+    pub const DEFAULT_METHOD: Method = Method::Dp54;
+    /// The default end time (s).
+    pub const DEFAULT_T_END: f64 = 10.0;
+    /// The default relative tolerance, tighter than [`IntegratorOptions::DEFAULT_RTOL`]: a
+    /// simulation reports its energy drift and constraint drift, which a looser tolerance would
+    /// swamp.
+    pub const DEFAULT_RTOL: f64 = 1e-8;
+    /// The default absolute tolerance (see [`Self::DEFAULT_RTOL`]).
+    pub const DEFAULT_ATOL: f64 = 1e-10;
+}
+
 impl Default for SimulationOptions {
     fn default() -> Self {
         Self {
-            method: Method::Dp54,
-            t_end: 10.0,
-            rtol: 1e-8,
-            atol: 1e-10,
+            method: Self::DEFAULT_METHOD,
+            t_end: Self::DEFAULT_T_END,
+            rtol: Self::DEFAULT_RTOL,
+            atol: Self::DEFAULT_ATOL,
             dt: None,
             output: OutputTimes::Steps,
             stabilization: Stabilization::None,

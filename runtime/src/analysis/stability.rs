@@ -91,14 +91,27 @@ impl Default for StiffSpring {
     }
 }
 
+impl StabilityOptions {
+    /// The default number of constant steps of each stability-limit run.
+    pub const DEFAULT_STEPS: usize = 10_000;
+    /// The default number of periods of the energy study.
+    pub const DEFAULT_PERIODS: usize = 10_000;
+    /// The default stiffness ratios k/m (1/s²) of the stiff two-mass spring.
+    pub const DEFAULT_STIFFNESS: [f64; 4] = [1e2, 1e4, 1e6, 1e8];
+    /// The default end time of the stiff runs (s).
+    pub const DEFAULT_T_END: f64 = 1.0;
+    /// The default tolerance of the stiff runs and of the underflow run.
+    pub const DEFAULT_TOL: f64 = 1e-6;
+}
+
 impl Default for StabilityOptions {
     fn default() -> Self {
         Self {
-            steps: 10_000,
-            periods: 10_000,
-            stiffness: vec![1e2, 1e4, 1e6, 1e8],
-            t_end: 1.0,
-            tol: 1e-6,
+            steps: Self::DEFAULT_STEPS,
+            periods: Self::DEFAULT_PERIODS,
+            stiffness: Self::DEFAULT_STIFFNESS.to_vec(),
+            t_end: Self::DEFAULT_T_END,
+            tol: Self::DEFAULT_TOL,
             stiff_spring: StiffSpring::default(),
         }
     }

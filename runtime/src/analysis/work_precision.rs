@@ -91,19 +91,34 @@ pub struct WorkPrecisionOptions {
     pub min_time_s: f64,
 }
 
+impl WorkPrecisionOptions {
+    /// The default end time (s).
+    pub const DEFAULT_T_END: f64 = 10.0;
+    /// The default number of output times at which errors are taken.
+    pub const DEFAULT_SAMPLES: usize = 100;
+    /// The default error at which the work of every method is interpolated.
+    pub const DEFAULT_TARGET_ERROR: f64 = 5e-4;
+    /// The default tolerance of the reference solution.
+    pub const DEFAULT_REFERENCE_TOL: f64 = 1e-14;
+    /// The default fewest timed runs per setting.
+    pub const DEFAULT_REPEATS: usize = 3;
+    /// The default total wall time (s) the runs of one setting reach.
+    pub const DEFAULT_MIN_TIME_S: f64 = 0.02;
+}
+
 impl Default for WorkPrecisionOptions {
     fn default() -> Self {
         Self {
             methods: DEFAULT_METHODS.to_vec(),
             tolerances: (3..=12).map(|k| 10f64.powi(-k)).collect(),
             steps: None,
-            t_end: 10.0,
-            samples: 100,
-            target_error: 5e-4,
+            t_end: Self::DEFAULT_T_END,
+            samples: Self::DEFAULT_SAMPLES,
+            target_error: Self::DEFAULT_TARGET_ERROR,
             baseline_ms: None,
-            reference_tol: 1e-14,
-            repeats: 3,
-            min_time_s: 0.02,
+            reference_tol: Self::DEFAULT_REFERENCE_TOL,
+            repeats: Self::DEFAULT_REPEATS,
+            min_time_s: Self::DEFAULT_MIN_TIME_S,
         }
     }
 }

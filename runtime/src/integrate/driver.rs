@@ -15,9 +15,6 @@ use super::options::{
 use super::solution::Solution;
 use super::stepper::{CheckedRhs, StepFailure, Stepper, SystemShape};
 
-/// Number of fixed steps over `[t0, t_end]` when `dt` is not given.
-const DEFAULT_FIXED_STEPS: f64 = 1000.0;
-
 /// Most samples reserved up front for [`OutputTimes::Steps`]; beyond this the solution grows
 /// by amortised doubling.
 const MAX_RESERVED_SAMPLES: usize = 1 << 16;
@@ -187,7 +184,10 @@ fn integrate_into<S: Stepper>(
 /// The fixed step: `dt` (default `(t_end − t0)/1000`), at most `dt_max`.
 fn fixed_step(problem: &Problem<'_>) -> f64 {
     let span = problem.t_end - problem.t0;
-    let dt = problem.options.dt.unwrap_or(span / DEFAULT_FIXED_STEPS);
+    let dt = problem
+        .options
+        .dt
+        .unwrap_or(span / IntegratorOptions::DEFAULT_FIXED_STEPS);
     problem.options.dt_max.map_or(dt, |dt_max| dt.min(dt_max))
 }
 

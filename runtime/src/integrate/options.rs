@@ -110,14 +110,27 @@ pub struct IntegratorOptions {
     pub fixed_step: bool,
 }
 
+impl IntegratorOptions {
+    /// The default relative tolerance of an integrator used on its own (the common default of
+    /// general-purpose ODE solvers); a simulation of a model uses
+    /// `SimulationOptions::DEFAULT_RTOL` (1e-8) instead.
+    pub const DEFAULT_RTOL: f64 = 1e-6;
+    /// The default absolute tolerance of an integrator used on its own.
+    pub const DEFAULT_ATOL: f64 = 1e-9;
+    /// Number of fixed steps over `[t0, t_end]` when a fixed-step method is given no `dt`.
+    pub const DEFAULT_FIXED_STEPS: f64 = 1000.0;
+    /// The default limit on step attempts.
+    pub const DEFAULT_MAX_STEPS: usize = 1_000_000;
+}
+
 impl Default for IntegratorOptions {
     fn default() -> Self {
         Self {
-            rtol: Tolerance::Scalar(1e-6),
-            atol: Tolerance::Scalar(1e-9),
+            rtol: Tolerance::Scalar(Self::DEFAULT_RTOL),
+            atol: Tolerance::Scalar(Self::DEFAULT_ATOL),
             dt: None,
             dt_max: None,
-            max_steps: 1_000_000,
+            max_steps: Self::DEFAULT_MAX_STEPS,
             fixed_step: false,
         }
     }

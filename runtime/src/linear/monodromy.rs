@@ -241,11 +241,17 @@ impl FloquetOptions {
     }
 }
 
+impl FloquetOptions {
+    /// The default relative and absolute tolerance of DOP853 on the state and the variational
+    /// equations.
+    pub const DEFAULT_TOL: f64 = 1e-12;
+}
+
 impl Default for FloquetOptions {
     fn default() -> Self {
         Self {
-            rtol: 1e-12,
-            atol: 1e-12,
+            rtol: Self::DEFAULT_TOL,
+            atol: Self::DEFAULT_TOL,
             max_steps: 1_000_000,
             stability_tolerance: 1e-6,
         }

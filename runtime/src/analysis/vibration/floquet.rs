@@ -125,11 +125,16 @@ pub struct FloquetStudyOptions {
     pub floquet: FloquetOptions,
 }
 
+impl FloquetStudyOptions {
+    /// The default parameter that holds the forcing frequency.
+    pub const DEFAULT_PERIOD_PARAMETER: &'static str = "w";
+}
+
 impl Default for FloquetStudyOptions {
     fn default() -> Self {
         Self {
             operating_point: OperatingPointOptions::default(),
-            period_parameter: "w".to_string(),
+            period_parameter: Self::DEFAULT_PERIOD_PARAMETER.to_string(),
             floquet: FloquetOptions::default(),
         }
     }

@@ -218,14 +218,21 @@ pub struct FreeResponseOptions {
     pub tol: f64,
 }
 
+impl FreeResponseOptions {
+    /// The default number of output times.
+    pub const DEFAULT_SAMPLES: usize = 401;
+    /// The default relative and absolute tolerance of the DOP853 integration.
+    pub const DEFAULT_TOL: f64 = 1e-13;
+}
+
 impl Default for FreeResponseOptions {
     fn default() -> Self {
         Self {
             operating_point: OperatingPointOptions::default(),
             initial: None,
             t_end: None,
-            samples: 401,
-            tol: 1e-13,
+            samples: Self::DEFAULT_SAMPLES,
+            tol: Self::DEFAULT_TOL,
         }
     }
 }

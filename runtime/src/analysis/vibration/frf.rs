@@ -140,13 +140,21 @@ pub struct FrfSimulationOptions {
     pub rtol: f64,
 }
 
+impl FrfSimulationOptions {
+    /// The default input value of the runs (small, so that the model stays near its
+    /// linearisation).
+    pub const DEFAULT_AMPLITUDE: f64 = 1e-3;
+    /// The default relative tolerance of the runs.
+    pub const DEFAULT_RTOL: f64 = 1e-11;
+}
+
 impl Default for FrfSimulationOptions {
     fn default() -> Self {
         Self {
             count: 0,
             frequency_parameter: None,
-            amplitude: 1e-3,
-            rtol: 1e-11,
+            amplitude: Self::DEFAULT_AMPLITUDE,
+            rtol: Self::DEFAULT_RTOL,
         }
     }
 }
@@ -176,6 +184,11 @@ pub struct FrfOptions {
     pub simulation: Option<FrfSimulationOptions>,
 }
 
+impl FrfOptions {
+    /// The default number of log-spaced frequencies of the sweep.
+    pub const DEFAULT_POINTS: usize = 400;
+}
+
 impl Default for FrfOptions {
     fn default() -> Self {
         Self {
@@ -183,7 +196,7 @@ impl Default for FrfOptions {
             input: String::new(),
             outputs: Vec::new(),
             frequency_range: None,
-            points: 400,
+            points: Self::DEFAULT_POINTS,
             frequencies: Vec::new(),
             modal: false,
             simulation: None,

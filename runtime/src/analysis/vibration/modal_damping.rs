@@ -41,6 +41,13 @@ pub struct ModalDampingOptions {
     pub tol: f64,
 }
 
+impl ModalDampingOptions {
+    /// The default number of output times.
+    pub const DEFAULT_SAMPLES: usize = 801;
+    /// The default relative and absolute tolerance of the DOP853 check.
+    pub const DEFAULT_TOL: f64 = 1e-12;
+}
+
 impl Default for ModalDampingOptions {
     fn default() -> Self {
         Self {
@@ -48,8 +55,8 @@ impl Default for ModalDampingOptions {
             rayleigh_modes: None,
             initial: None,
             t_end: None,
-            samples: 801,
-            tol: 1e-12,
+            samples: Self::DEFAULT_SAMPLES,
+            tol: Self::DEFAULT_TOL,
         }
     }
 }

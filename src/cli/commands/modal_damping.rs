@@ -4,20 +4,20 @@
 //! and the free responses from each mode shape: exact (e^{At}, checked by DOP853) against the
 //! two approximations, as a table, JSON and a chart.
 
-use std::io::Write as _;
-
 use clap::Args;
 use eomgen::ModelInfo;
 use eomgen::analysis::StudyRuns;
 use eomgen::analysis::vibration::{ModalDampingOptions, ModalDampingStudy, RayleighFit};
 use serde_json::json;
 
-use super::CliError;
-use super::files::Outputs;
-use super::free_response::{Panel, kind_json, panels, parse_init, study_failure};
-use super::modes::{OperatingPointArgs, matrix_rows, point_json};
-use super::plot::Series;
-use super::render::num;
+use crate::cli::error::CliError;
+use crate::cli::files::Outputs;
+use crate::cli::operating_point::{OperatingPointArgs, point_json};
+use crate::cli::output::print_json;
+use crate::cli::plot::Series;
+use crate::cli::render::matrix_rows;
+use crate::cli::render::num;
+use crate::cli::response_study::{Panel, kind_json, panels, parse_init, study_failure};
 
 /// Options of `eomgen study modal-damping`.
 #[derive(Debug, Args)]
@@ -37,13 +37,13 @@ pub struct ModalDampingArgs {
     #[arg(long, value_name = "NAME=VALUE,…")]
     pub init: Vec<String>,
     /// End time (s). Default: ten periods of the slowest oscillatory mode.
-    #[arg(long, value_parser = super::values::study_end_time, allow_hyphen_values = true)]
+    #[arg(long, value_parser = crate::cli::values::study_end_time, allow_hyphen_values = true)]
     pub t_end: Option<f64>,
     /// Number of output times, evenly spaced from 0 to the end time (2 to 1000000).
-    #[arg(long, default_value_t = 801, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(2..=1_000_000))]
+    #[arg(long, default_value_t = ModalDampingOptions::DEFAULT_SAMPLES, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(2..=1_000_000))]
     pub samples: usize,
     /// Relative and absolute tolerance of the DOP853 check of the exact response.
-    #[arg(long, default_value_t = 1e-12, value_parser = super::values::relative_tolerance, allow_hyphen_values = true)]
+    #[arg(long, default_value_t = ModalDampingOptions::DEFAULT_TOL, value_parser = crate::cli::values::relative_tolerance, allow_hyphen_values = true)]
     pub tol: f64,
     /// Print JSON instead of the table.
     #[arg(long)]
@@ -133,11 +133,9 @@ pub fn run(args: &ModalDampingArgs) -> Result<(), CliError> {
         panels(path, &title, &panel_list).map_err(CliError::failure)?;
     }
 
-    let mut stdout = super::output::stdout();
+    let mut stdout = crate::cli::output::stdout();
     if args.json {
-        let text = serde_json::to_string_pretty(&json_report(model.as_ref(), &study))
-            .map_err(|e| CliError::failure(e.to_string()))?;
-        let _ = writeln!(stdout, "{text}");
+        print_json(&json_report(model.as_ref(), &study))?;
         return Ok(());
     }
     print_report(&mut stdout, model.as_ref(), &study);

@@ -5,8 +5,6 @@
 //! [`eomgen::analysis::vibration::frequency_response_analysis`] and its simulated points; this module
 //! runs those in parallel and renders text, JSON and the chart.
 
-use std::io::Write as _;
-
 use clap::Args;
 use eomgen::analysis::vibration::{
     self, FrfAnalysis, FrfAnalysisError, FrfOptions, FrfOutput, FrfSimulationOptions,
@@ -14,15 +12,18 @@ use eomgen::analysis::vibration::{
 };
 use eomgen::{FrequencySweep, FrfError, ModalResponse, ModelInfo, PeakAmplitude, phase_degrees};
 use nalgebra::Complex;
+use plotters::coord::Shift;
 use plotters::prelude::*;
 use rayon::prelude::*;
 use serde_json::{Value, json};
 
-use super::files::Outputs;
-use super::modes::{OperatingPointArgs, point_json};
-use super::render::num;
-use super::values::{evaluate, parameter_lookup};
-use super::{CliError, plot};
+use crate::cli::error::CliError;
+use crate::cli::files::Outputs;
+use crate::cli::operating_point::{OperatingPointArgs, point_json};
+use crate::cli::output::print_json;
+use crate::cli::plot;
+use crate::cli::render::num;
+use crate::cli::values::{evaluate, parameter_lookup};
 
 /// Options of `eomgen frf`.
 #[derive(Debug, Args)]
@@ -46,7 +47,7 @@ pub struct FrfArgs {
     #[arg(long, value_name = "LO..HI")]
     pub freqs: Option<String>,
     /// Frequencies of the sweep, spaced evenly in log ω (1 to 100000).
-    #[arg(long, default_value_t = 400, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..=100_000))]
+    #[arg(long, default_value_t = FrfOptions::DEFAULT_POINTS, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..=100_000))]
     pub points: usize,
     /// Also evaluate the response at this frequency (rad/s, an expression such as
     /// `sqrt(2*k/m)` or `w`); repeatable. With `--modal`, the modal breakdown is given here.
@@ -66,10 +67,10 @@ pub struct FrfArgs {
     pub frequency_parameter: Option<String>,
     /// The input's value in the `--simulate` runs (small, so that the nonlinear model stays
     /// near its linearisation).
-    #[arg(long, default_value_t = 1e-3)]
+    #[arg(long, default_value_t = FrfSimulationOptions::DEFAULT_AMPLITUDE)]
     pub amplitude: f64,
     /// Relative tolerance of the `--simulate` runs (DOP853).
-    #[arg(long, default_value_t = 1e-11, value_parser = super::values::relative_tolerance, allow_hyphen_values = true)]
+    #[arg(long, default_value_t = FrfSimulationOptions::DEFAULT_RTOL, value_parser = crate::cli::values::relative_tolerance, allow_hyphen_values = true)]
     pub rtol: f64,
     /// Print JSON.
     #[arg(long)]
@@ -90,7 +91,9 @@ fn failure(model: &dyn ModelInfo, e: FrfAnalysisError) -> CliError {
         FrfAnalysisError::SimulationNeedsParameter { input } => CliError::usage(format!(
             "--simulate needs a load parameter as --input (`{input}` is a coordinate: a unit generalized force has no load in the model to drive)"
         )),
-        FrfAnalysisError::OperatingPoint(e) => super::modes::point_failure(model, &e),
+        FrfAnalysisError::OperatingPoint(e) => {
+            crate::cli::operating_point::point_failure(model, &e)
+        }
         FrfAnalysisError::Input(ref source) => {
             let input = match source {
                 FrfError::NonlinearInput { input, .. }
@@ -130,7 +133,9 @@ fn failure(model: &dyn ModelInfo, e: FrfAnalysisError) -> CliError {
         FrfAnalysisError::NoSteadyState(e) => {
             CliError::usage(format!("--simulate: `{name}`: {e}; add damping with --set"))
         }
-        FrfAnalysisError::Frf(FrfError::Modal(m)) => super::modes::modal_failure(model, &m),
+        FrfAnalysisError::Frf(FrfError::Modal(m)) => {
+            crate::cli::operating_point::modal_failure(model, &m)
+        }
         FrfAnalysisError::Frf(e @ FrfError::ResponseOutOfRange { .. }) => CliError::usage(format!(
             "--frequency/--freqs: {e}; choose frequencies where the response is representable"
         )),
@@ -139,12 +144,12 @@ fn failure(model: &dyn ModelInfo, e: FrfAnalysisError) -> CliError {
 }
 
 /// `w` (rad/s), the value of `option` typed as `text`, if it is in
-/// [`super::values::FREQUENCY`] (or 0, the static response, when `zero` is allowed).
+/// [`crate::cli::values::FREQUENCY`] (or 0, the static response, when `zero` is allowed).
 ///
 /// # Errors
 /// A usage error that quotes `text` and gives the range.
 fn frequency(option: &str, text: &str, w: f64, zero: bool) -> Result<f64, CliError> {
-    if super::values::FREQUENCY.contains(&w) || (zero && w == 0.0) {
+    if crate::cli::values::FREQUENCY.contains(&w) || (zero && w == 0.0) {
         Ok(w)
     } else {
         Err(CliError::usage(format!(
@@ -228,14 +233,11 @@ pub fn run(args: &FrfArgs) -> Result<(), CliError> {
         .map_err(CliError::failure)?;
     }
     if args.json {
-        let text =
-            serde_json::to_string_pretty(&json_report(args, model.as_ref(), &frf, simulated))
-                .map_err(|e| CliError::failure(e.to_string()))?;
-        let _ = writeln!(super::output::stdout(), "{text}");
+        print_json(&json_report(args, model.as_ref(), &frf, simulated))?;
         return Ok(());
     }
     print_report(
-        &mut super::output::stdout(),
+        &mut crate::cli::output::stdout(),
         args,
         model.as_ref(),
         &frf,
@@ -580,7 +582,7 @@ fn simulate_points(
 ) -> Result<Vec<SimulatedPoint>, CliError> {
     let name = &model.description().name;
     let k = plan.frequencies.len();
-    let progress = super::render::progress_bar(
+    let progress = crate::cli::render::progress_bar(
         k,
         "{msg} [{bar:30}] {pos}/{len} ({elapsed}, eta {eta})",
         "steady-state simulations",
@@ -611,11 +613,30 @@ fn bode_chart(
     sweeps: &[FrequencySweep],
     simulated: Option<&[SimulatedPoint]>,
 ) -> Result<(), String> {
-    plot::register_font()?;
-    let size = (960, 720);
-    plot::write_chart!(path, size, |root| draw_bode(
-        root, title, outputs, sweeps, simulated
-    ))
+    let chart = BodeChart {
+        title,
+        outputs,
+        sweeps,
+        simulated,
+    };
+    plot::write_chart(path, (960, 720), &chart)
+}
+
+/// The Bode chart of [`bode_chart`], drawn.
+struct BodeChart<'a> {
+    title: &'a str,
+    outputs: &'a [FrfOutput],
+    sweeps: &'a [FrequencySweep],
+    simulated: Option<&'a [SimulatedPoint]>,
+}
+
+impl plot::Drawing for BodeChart<'_> {
+    fn draw<DB: DrawingBackend>(&self, root: DrawingArea<DB, Shift>) -> Result<(), String>
+    where
+        DB::ErrorType: 'static,
+    {
+        draw_bode(root, self.title, self.outputs, self.sweeps, self.simulated)
+    }
 }
 
 /// Contiguous runs of finite points (a `None` breaks the line).

@@ -31,9 +31,11 @@ use eomgen_symbolic::codegen::equations_mathml;
 use eomgen_symbolic::mechanics::{Formulation, Lagrange, SymbolicModel};
 use eomgen_symbolic::model::ModelFile;
 
-use super::output::outln;
-use super::report_html::{Figure, ModelReport};
-use super::{CliError, plot};
+use crate::cli::animation::DEFAULT_FPS;
+use crate::cli::error::CliError;
+use crate::cli::output::outln;
+use crate::cli::plot;
+use crate::cli::report_html::{Figure, ModelReport};
 
 /// Options of `eomgen report`.
 #[derive(Debug, Args)]
@@ -78,7 +80,7 @@ pub fn run(args: &ReportArgs) -> Result<(), CliError> {
     check_outputs(args, &sources)?;
     std::fs::create_dir_all(&args.out)
         .map_err(|e| CliError::failure(format!("cannot create `{}`: {e}", args.out.display())))?;
-    let bar = super::render::progress_bar(
+    let bar = crate::cli::render::progress_bar(
         sources.len(),
         "{msg} [{bar:30}] {pos}/{len} models ({elapsed})",
         "report",
@@ -98,12 +100,13 @@ pub fn run(args: &ReportArgs) -> Result<(), CliError> {
     let text = serde_json::to_string_pretty(&json).map_err(|e| CliError::failure(e.to_string()))?;
     let write = |name: &str, content: &str| {
         let path = args.out.join(name);
-        super::files::write(&path.to_string_lossy(), content.as_bytes()).map_err(CliError::from)
+        crate::cli::files::write(&path.to_string_lossy(), content.as_bytes())
+            .map_err(CliError::from)
     };
     write("report.json", &format!("{text}\n"))?;
     write(
         "index.html",
-        &super::report_html::page(&reports, args.timing),
+        &crate::cli::report_html::page(&reports, args.timing),
     )?;
     if args.json {
         outln!("{text}");
@@ -132,7 +135,7 @@ pub fn run(args: &ReportArgs) -> Result<(), CliError> {
     .err()
     .map_or(String::new(), |e| format!("{e}\n"));
     if failed.is_empty() && nothing.is_empty() {
-        super::output::errln!(
+        crate::cli::output::errln!(
             "report: {} models, {total} checks, all passed: {}",
             reports.len(),
             index.display()
@@ -149,7 +152,7 @@ pub fn run(args: &ReportArgs) -> Result<(), CliError> {
 }
 
 /// Checks the report's files before any work, as every command checks its outputs
-/// ([`super::files::Outputs::check`]): `DIR/report.json` and `DIR/index.html` (not
+/// ([`crate::cli::files::Outputs::check`]): `DIR/report.json` and `DIR/index.html` (not
 /// directories, not a model file read), and each model's folder `DIR/<name>` (a directory or
 /// nothing yet). A directory that does not exist yet is created empty, so nothing in it can
 /// be in the way.
@@ -164,7 +167,7 @@ fn check_outputs(args: &ReportArgs, sources: &[Source]) -> Result<(), CliError> 
     let (json, index) = (path("report.json"), path("index.html"));
     args.models
         .iter()
-        .fold(super::files::Outputs::new(), |outputs, model| {
+        .fold(crate::cli::files::Outputs::new(), |outputs, model| {
             outputs.input(model)
         })
         .file("--out (its report.json)", Some(&json))
@@ -195,12 +198,12 @@ fn sources(models: &[String]) -> Result<Vec<Source>, CliError> {
     };
     let mut out: Vec<Source> = Vec::with_capacity(names.len());
     for name in &names {
-        let (display, text) = super::equations::read_model(name)?;
+        let (display, text) = crate::cli::model::read_model(name)?;
         let file = eomgen_symbolic::model::load(&display, &text)
-            .map_err(|d| super::equations::render(&display, &text, &d))?;
+            .map_err(|d| crate::cli::model::diagnostics_error(&display, &text, &d))?;
         // A bundled name runs the compiled model; a path runs the file's own equations,
         // compiled at run time (even for a copy of a bundled model).
-        let model = super::open_model(name)?;
+        let model = crate::cli::model::open_model(name)?;
         if out.iter().any(|s| s.model.name() == model.name()) {
             return Err(CliError::usage(format!(
                 "`{}` is named twice in --models",
@@ -257,7 +260,7 @@ fn report_model(source: &Source, dir: &Path) -> ModelReport {
         }
         Err(d) => report
             .notes
-            .push(super::equations::render(&source.display, &source.text, &d).message),
+            .push(crate::cli::model::diagnostics_error(&source.display, &source.text, &d).message),
     }
 
     let checks = model_report(&source.display, &source.text, file, &source.model);
@@ -359,7 +362,7 @@ fn draw_mode_shapes(
     };
     let modes = &modal.normal_modes;
     let prefix = model_dir.join("shape.svg");
-    match super::mode_plot::mode_charts(
+    match crate::cli::mode_plot::mode_charts(
         &prefix.to_string_lossy(),
         model,
         &modal.operating_point.equilibrium.q,
@@ -390,26 +393,26 @@ fn draw_mode_shapes(
 /// default options, 30 frames per second), when its file draws something; returns its path
 /// relative to the report. A failure becomes a note.
 fn animation(spec: &str, name: &str, model_dir: &Path, notes: &mut Vec<String>) -> Option<String> {
-    let model = super::find_model(spec).ok()?;
+    let model = crate::cli::model::find_model(spec).ok()?;
     if model.description().draw_line_names().is_empty()
         && model.description().trace_point_names().is_empty()
     {
         return None;
     }
-    let args = match super::simulate::IntegrationArgs::defaults() {
+    let args = match crate::cli::integration::IntegrationArgs::defaults() {
         Ok(args) => args,
         Err(e) => {
             notes.push(format!("animation: {}", e.message));
             return None;
         }
     };
-    match super::animate::simulation(spec, &args, 30.0, &[]) {
+    match crate::cli::animation::simulation(spec, &args, DEFAULT_FPS, &[]) {
         Ok((Some(animation), failure)) => {
             if let Some(e) = failure {
                 notes.push(format!("animation: {}", e.message));
             }
             let file = "animation.html";
-            match super::files::write(
+            match crate::cli::files::write(
                 &model_dir.join(file).to_string_lossy(),
                 animation.to_html().as_bytes(),
             ) {

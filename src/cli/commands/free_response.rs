@@ -3,26 +3,23 @@
 //! DOP853 on the linear equations, `e^{At}`, superposed modes of `M⁻¹K` and superposed
 //! mass-normalised modes — their largest differences, and a chart of every coordinate.
 //!
-//! The numbers come from [`eomgen::analysis::vibration::free_response`]; this module renders them. Also
+//! The numbers come from [`eomgen::analysis::vibration::free_response()`]; this module renders them. Also
 //! the pieces `study modal-damping` shares: `--init` parsing, the errors in the options' words
 //! and the stacked charts.
 
 use clap::Args;
 use eomgen::analysis::StudyRuns;
-use eomgen::analysis::vibration::{
-    self, FreeResponseMethod, FreeResponseOptions, FreeResponseStudy, InitialDeviation,
-    ResponseStudyError,
-};
+use eomgen::analysis::vibration::{self, FreeResponseMethod, FreeResponseOptions, FreeResponseStudy};
 use eomgen::{ModeKind, ModelInfo};
-use plotters::prelude::*;
 use serde_json::json;
 
-use super::CliError;
-use super::files::Outputs;
-use super::modes::{OperatingPointArgs, point_json};
-use super::plot::{self, Series};
-use super::render::num;
-use eomgen::expressions::set_initial_values;
+use crate::cli::error::CliError;
+use crate::cli::files::Outputs;
+use crate::cli::operating_point::{OperatingPointArgs, point_json};
+use crate::cli::output::print_json;
+use crate::cli::plot::Series;
+use crate::cli::render::num;
+use crate::cli::response_study::{Panel, kind_json, panels, parse_init, study_failure};
 
 /// Options of `eomgen study free-response`.
 #[derive(Debug, Args)]
@@ -38,13 +35,13 @@ pub struct FreeResponseArgs {
     pub init: Vec<String>,
     /// End time (s). Default: four periods of the slowest oscillatory mode, or the time an
     /// unstable mode grows by e⁵ if that is shorter, else 10 s; in [1e-6, 1e6].
-    #[arg(long, value_parser = super::values::study_end_time, allow_hyphen_values = true)]
+    #[arg(long, value_parser = crate::cli::values::study_end_time, allow_hyphen_values = true)]
     pub t_end: Option<f64>,
     /// Number of output times, evenly spaced from 0 to the end time (2 to 1000000).
-    #[arg(long, default_value_t = 401, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(2..=1_000_000))]
+    #[arg(long, default_value_t = FreeResponseOptions::DEFAULT_SAMPLES, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(2..=1_000_000))]
     pub samples: usize,
     /// Relative and absolute tolerance of the DOP853 integration.
-    #[arg(long, default_value_t = 1e-13, value_parser = super::values::relative_tolerance, allow_hyphen_values = true)]
+    #[arg(long, default_value_t = FreeResponseOptions::DEFAULT_TOL, value_parser = crate::cli::values::relative_tolerance, allow_hyphen_values = true)]
     pub tol: f64,
     /// Print JSON instead of the table.
     #[arg(long)]
@@ -52,167 +49,6 @@ pub struct FreeResponseArgs {
     /// Chart of each coordinate against time, the four responses overlaid (.svg or .png).
     #[arg(long, value_name = "FILE")]
     pub plot: Option<String>,
-}
-
-/// Parses `--init NAME=VALUE,…` (repeatable, as `simulate --init`) into `(δq₀, δq̇₀)`,
-/// starting from zeros (`None` without `--init`: the study's default).
-pub(super) fn parse_init(
-    model: &dyn ModelInfo,
-    init: &[String],
-) -> Result<Option<InitialDeviation>, CliError> {
-    if init.is_empty() {
-        return Ok(None);
-    }
-    // The deviation from rest, as `--init` sets a state: [δq₀; δq̇₀] from zeros.
-    let n = model.num_dofs();
-    let mut y = vec![0.0; 2 * n];
-    set_initial_values(model, &mut y, init).map_err(super::values::usage)?;
-    let v0 = y.split_off(n);
-    let q0 = y;
-    Ok(Some(InitialDeviation { q: q0, qdot: v0 }))
-}
-
-/// The error of a failed free-response or modal-damping study of `model`, in the words of
-/// the options (`--tol`, `--t-end`, `--rayleigh-modes`); failed searches get their hint.
-pub(super) fn study_failure(model: &dyn ModelInfo, e: &ResponseStudyError) -> CliError {
-    match e {
-        ResponseStudyError::OperatingPoint(e) => super::modes::point_failure(model, e),
-        ResponseStudyError::Constrained { model: name } => CliError::usage(format!(
-            "`{name}` has constraints; this study takes unconstrained models (`eomgen modes {name}` gives its modes in minimal coordinates)"
-        )),
-        ResponseStudyError::InvalidTolerance { .. } => CliError::usage("--tol must be positive"),
-        ResponseStudyError::InvalidEndTime { t_end } => CliError::usage(format!(
-            "--t-end must be positive and finite, got {:e}",
-            super::render::num(t_end)
-        )),
-        ResponseStudyError::TooFewSamples { .. } => CliError::usage("--samples must be at least 2"),
-        ResponseStudyError::NoSuchMode { .. } | ResponseStudyError::NotUnderdamped { .. } => {
-            CliError::usage(format!("--rayleigh-modes: {e}"))
-        }
-        ResponseStudyError::RayleighFit {
-            modes: [a, b],
-            source,
-        } => CliError::usage(format!("--rayleigh-modes {a},{b}: {source}")),
-        ResponseStudyError::Response(e) => response_failure(model, e),
-        e => CliError::failure(format!("`{}`: {e}", model.description().name)),
-    }
-}
-
-/// The JSON description of a mode kind.
-pub(super) fn kind_json(kind: &ModeKind) -> serde_json::Value {
-    match kind {
-        ModeKind::Oscillatory => json!("oscillatory"),
-        ModeKind::ZeroFrequency => json!("zero_frequency"),
-        ModeKind::Unstable { .. } => json!("unstable"),
-    }
-}
-
-/// One panel of a stacked chart: an optional caption, the y-axis label (with units) and the
-/// lines against time.
-pub(super) struct Panel {
-    /// Shown above the panel.
-    pub caption: Option<String>,
-    /// The y-axis label, with its unit.
-    pub y_desc: String,
-    /// The lines, drawn in this order.
-    pub series: Vec<Series>,
-}
-
-/// A chart of stacked panels sharing the time axis, each with its own y label and lines
-/// (drawn thick to thin, so that coinciding lines all stay visible), into `path` (`.svg` or
-/// `.png`).
-///
-/// # Errors
-/// An unknown extension, a panel with no finite point, or a failure to write the file.
-pub(super) fn panels(path: &str, title: &str, panels: &[Panel]) -> Result<(), String> {
-    plot::register_font()?;
-    let size = (960, 60 + 260 * panels.len().max(1) as u32);
-    plot::write_chart!(path, size, |root| draw_panels(root, title, panels))
-}
-
-fn draw_panels<DB: DrawingBackend>(
-    root: DrawingArea<DB, plotters::coord::Shift>,
-    title: &str,
-    panels: &[Panel],
-) -> Result<(), String>
-where
-    DB::ErrorType: 'static,
-{
-    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| format!("plotting failed: {e}");
-    root.fill(&WHITE).map_err(err)?;
-    let root = root.titled(title, ("sans-serif", 22)).map_err(err)?;
-    let areas = root.split_evenly((panels.len().max(1), 1));
-    for (panel, area) in panels.iter().zip(&areas) {
-        let (y_desc, series) = (&panel.y_desc, &panel.series);
-        let finite = || {
-            series
-                .iter()
-                .flat_map(|s| s.points.iter())
-                .filter(|(x, y)| x.is_finite() && y.is_finite())
-        };
-        let (mut x0, mut x1, mut y0, mut y1) = (
-            f64::INFINITY,
-            f64::NEG_INFINITY,
-            f64::INFINITY,
-            f64::NEG_INFINITY,
-        );
-        for (x, y) in finite() {
-            x0 = x0.min(*x);
-            x1 = x1.max(*x);
-            y0 = y0.min(*y);
-            y1 = y1.max(*y);
-        }
-        if !(x0.is_finite() && y0.is_finite()) {
-            return Err(format!("nothing to plot for `{y_desc}`: no finite point"));
-        }
-        let (x0, x1) = plot::range(x0, x1, false);
-        let (y0, y1) = plot::range(y0, y1, false);
-        let mut builder = ChartBuilder::on(area);
-        builder
-            .margin(10)
-            .x_label_area_size(40)
-            .y_label_area_size(90);
-        if let Some(caption) = &panel.caption {
-            builder.caption(caption, ("sans-serif", 16));
-        }
-        let mut ctx = builder.build_cartesian_2d(x0..x1, y0..y1).map_err(err)?;
-        // Ticks within rounding of zero print as 0, not as 1e-17.
-        let snap = |v: f64, span: f64| if v.abs() < 1e-9 * span { 0.0 } else { v };
-        let (x_span, y_span) = (x1 - x0, y1 - y0);
-        ctx.configure_mesh()
-            .x_desc("t (s)")
-            .y_desc(y_desc.as_str())
-            .x_label_formatter(&|v| plot::tick(snap(*v, x_span), false))
-            .y_label_formatter(&|v| plot::tick(snap(*v, y_span), false))
-            .label_style(("sans-serif", 14))
-            .draw()
-            .map_err(err)?;
-        let count = series.len();
-        for (i, s) in series.iter().enumerate() {
-            let color = Palette99::pick(i).to_rgba();
-            let width = 1 + 2 * (count - 1 - i) as u32;
-            let points = s
-                .points
-                .iter()
-                .copied()
-                .filter(|(x, y)| x.is_finite() && y.is_finite());
-            ctx.draw_series(LineSeries::new(points, color.stroke_width(width)))
-                .map_err(err)?
-                .label(s.name.clone())
-                .legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(width))
-                });
-        }
-        ctx.configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .background_style(WHITE.mix(0.8))
-            .border_style(BLACK)
-            .label_font(("sans-serif", 13))
-            .draw()
-            .map_err(err)?;
-    }
-    root.present().map_err(err)?;
-    Ok(())
 }
 
 /// Runs `study free-response`.
@@ -260,9 +96,9 @@ pub fn run(args: &FreeResponseArgs) -> Result<(), CliError> {
         );
         panels(path, &title, &panel_list).map_err(CliError::failure)?;
     }
-    let mut stdout = super::output::stdout();
+    let mut stdout = crate::cli::output::stdout();
     if args.json {
-        print_json(&mut stdout, model.as_ref(), &study)
+        print_json(&json_report(model.as_ref(), &study))
     } else {
         print_text(&mut stdout, model.as_ref(), &study);
         Ok(())
@@ -270,11 +106,7 @@ pub fn run(args: &FreeResponseArgs) -> Result<(), CliError> {
 }
 
 /// The JSON of `study free-response` (see docs/cli.md).
-fn print_json(
-    stdout: &mut impl std::io::Write,
-    model: &dyn ModelInfo,
-    study: &FreeResponseStudy,
-) -> Result<(), CliError> {
+fn json_report(model: &dyn ModelInfo, study: &FreeResponseStudy) -> serde_json::Value {
     let FreeResponseStudy {
         operating_point: point,
         normal_modes: modes,
@@ -291,7 +123,7 @@ fn print_json(
     let n = model.num_dofs();
     let names = model.description().coordinate_names();
     let samples = responses[0].1.times.len();
-    let out = json!({
+    json!({
         "model": model.description().name,
         "coordinates": names,
         "operating_point": point_json(label, &names, &study.linearization.q),
@@ -322,10 +154,7 @@ fn print_json(
             "q": r.displacements.last(),
             "qdot": r.velocities.last(),
         })).collect::<Vec<_>>(),
-    });
-    let text = serde_json::to_string_pretty(&out).map_err(|e| CliError::failure(e.to_string()))?;
-    let _ = writeln!(stdout, "{text}");
-    Ok(())
+    })
 }
 
 /// The text of `study free-response`: the set-up, the modes, the methods and their largest
@@ -413,14 +242,5 @@ fn print_text(stdout: &mut impl std::io::Write, model: &dyn ModelInfo, study: &F
             num(d.velocity),
             num(d.velocity_relative)
         );
-    }
-}
-
-/// The error of a failed response computation of `model`; a modal failure gets its hint
-/// ([`super::modes::modal_failure`]).
-pub(super) fn response_failure(model: &dyn ModelInfo, e: &eomgen::ResponseError) -> CliError {
-    match e {
-        eomgen::ResponseError::Modal(m) => super::modes::modal_failure(model, m),
-        e => CliError::failure(format!("`{}`: {e}", model.description().name)),
     }
 }

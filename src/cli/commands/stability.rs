@@ -23,9 +23,12 @@ use eomgen::integrate::stability_function::GrowthTest;
 use nalgebra::Complex;
 use serde_json::json;
 
-use super::files::Outputs;
-use super::render::num;
-use super::{CliError, find_model, plot};
+use crate::cli::error::CliError;
+use crate::cli::files::Outputs;
+use crate::cli::model::find_model;
+use crate::cli::output::print_json;
+use crate::cli::plot::{self, log_y_chart};
+use crate::cli::render::num;
 
 /// The bundled model of part c: HW9's two-mass spring.
 const STIFF_MODEL: &str = "two_masses";
@@ -34,19 +37,19 @@ const STIFF_MODEL: &str = "two_masses";
 #[derive(Debug, Args)]
 pub struct StabilityArgs {
     /// Constant steps of each run of the stability-limit bisection (part a).
-    #[arg(long, default_value_t = 10_000)]
+    #[arg(long, default_value_t = StabilityOptions::DEFAULT_STEPS)]
     pub steps: usize,
     /// Periods of the oscillator in the energy study (part b).
-    #[arg(long, default_value_t = 10_000)]
+    #[arg(long, default_value_t = StabilityOptions::DEFAULT_PERIODS)]
     pub periods: usize,
     /// Stiffness ratios k/m (1/s²) of the stiff two-mass spring (part c), comma separated.
-    #[arg(long, value_delimiter = ',', value_parser = super::values::stiffness, allow_hyphen_values = true, default_values_t = [1e2, 1e4, 1e6, 1e8])]
+    #[arg(long, value_delimiter = ',', value_parser = crate::cli::values::stiffness, allow_hyphen_values = true, default_values_t = StabilityOptions::DEFAULT_STIFFNESS)]
     pub stiffness: Vec<f64>,
     /// End time of the stiff runs (s).
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, default_value_t = StabilityOptions::DEFAULT_T_END)]
     pub t_end: f64,
     /// Relative and absolute tolerance of the stiff runs and of the underflow run.
-    #[arg(long, default_value_t = 1e-6, value_parser = super::values::relative_tolerance, allow_hyphen_values = true)]
+    #[arg(long, default_value_t = StabilityOptions::DEFAULT_TOL, value_parser = crate::cli::values::relative_tolerance, allow_hyphen_values = true)]
     pub tol: f64,
     /// Print JSON instead of the tables.
     #[arg(long)]
@@ -99,7 +102,7 @@ pub fn run(args: &StabilityArgs) -> Result<(), CliError> {
     let charts = args
         .plot
         .as_deref()
-        .map(|prefix| CHARTS.map(|name| chart_path(prefix, name)));
+        .map(|prefix| CHARTS.map(|name| plot::chart_path(prefix, name)));
     charts
         .iter()
         .flatten()
@@ -152,51 +155,16 @@ pub fn run(args: &StabilityArgs) -> Result<(), CliError> {
         write_energy(&mut text, args.periods, &energy);
         write_stiff(&mut text, args, &modes, &stiff);
         write_underflow(&mut text, &underflow);
-        let _ = write!(super::output::stdout(), "{text}");
+        let _ = write!(crate::cli::output::stdout(), "{text}");
     }
     // The limits of part a are always measured (a failure there is the study's error), so
     // the rule of a study that measured nothing has nothing to refuse here.
     Ok(())
 }
 
-/// `PREFIX-name.svg`, or `.png` when the prefix ends in `.png` (a `.svg` ending is dropped).
-/// The charts of `--plot PREFIX`: `PREFIX-limits`, `PREFIX-energy`, `PREFIX-stiff`.
+/// The charts of `--plot PREFIX`: `PREFIX-limits`, `PREFIX-energy`, `PREFIX-stiff`
+/// ([`plot::chart_path`]).
 const CHARTS: [&str; 3] = ["limits", "energy", "stiff"];
-
-fn chart_path(prefix: &str, name: &str) -> String {
-    if let Some(stem) = prefix.strip_suffix(".png") {
-        format!("{stem}-{name}.png")
-    } else {
-        let stem = prefix.strip_suffix(".svg").unwrap_or(prefix);
-        format!("{stem}-{name}.svg")
-    }
-}
-
-/// Draws `series` into `path` with a logarithmic y axis; `labels` are the title and the x and
-/// y axis descriptions.
-pub(super) fn log_y_chart(
-    path: &str,
-    labels: [&str; 3],
-    log_x: bool,
-    series: &[plot::Series],
-) -> Result<(), CliError> {
-    let [title, x_desc, y_desc] = labels;
-    let chart = plot::Chart {
-        title,
-        x_desc,
-        y_desc,
-        log_x,
-        log_y: true,
-    };
-    plot::lines(path, &chart, series).map_err(CliError::failure)
-}
-
-/// Prints `value` as pretty JSON on stdout.
-pub(super) fn print_json(value: &serde_json::Value) -> Result<(), CliError> {
-    let text = serde_json::to_string_pretty(value).map_err(|e| CliError::failure(e.to_string()))?;
-    let _ = writeln!(super::output::stdout(), "{text}");
-    Ok(())
-}
 
 fn optional(value: Option<f64>) -> String {
     value.map_or_else(|| "-".to_string(), |v| format!("{v:.4e}", v = num(v)))

@@ -3,12 +3,13 @@
 
 use clap::{Args, ValueEnum};
 
-use super::CliError;
-use super::output::out;
+use crate::cli::error::CliError;
+use crate::cli::model::{diagnostics_error, read_model};
+use crate::cli::output::out;
 use eomgen_symbolic::codegen::{EquationsListing, GenerateError, equations_latex, equations_text};
 use eomgen_symbolic::expr::print::Syntax;
 use eomgen_symbolic::mechanics::{Formulation, Lagrange, MomentumBalance, SymbolicModel};
-use eomgen_symbolic::model::{ReadError, templates};
+use eomgen_symbolic::model::templates;
 
 /// Which derivation to print.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -49,35 +50,6 @@ pub struct NewArgs {
     pub n: usize,
 }
 
-/// Reads a bundled model by name or any file by path: `(display path, source)`.
-pub fn read_model(model: &str) -> Result<(String, String), CliError> {
-    let resolved = eomgen::resolve(model).map_err(super::open_error)?;
-    let display = resolved.path().to_string();
-    let source = match &resolved {
-        // Compiled into the binary: no file is read.
-        eomgen::Resolved::Bundled(entry) => entry.source.to_string(),
-        eomgen::Resolved::File(path) => eomgen_symbolic::model::read_model_file(
-            std::path::Path::new(path),
-        )
-        .map_err(|e| match e {
-            ReadError::NotText { diagnostic, text } => {
-                super::diagnostics_error(&display, &text, &[diagnostic])
-            }
-            e => CliError::usage(format!("cannot read `{display}`: {e}")).before_output(),
-        })?,
-    };
-    Ok((display, source))
-}
-
-/// Renders diagnostics for the terminal (exit 2; JSON with `--json`).
-pub fn render(
-    display: &str,
-    source: &str,
-    diagnostics: &[eomgen_symbolic::model::Diagnostic],
-) -> CliError {
-    super::diagnostics_error(display, source, diagnostics)
-}
-
 /// What `eomgen equations --json` prints.
 #[derive(serde::Serialize)]
 struct EquationsReport<'a> {
@@ -95,7 +67,7 @@ struct EquationsReport<'a> {
 pub fn run(args: &EquationsArgs) -> Result<(), CliError> {
     let (display, source) = read_model(&args.model)?;
     let file = eomgen_symbolic::model::load(&display, &source)
-        .map_err(|d| render(&display, &source, &d))?;
+        .map_err(|d| diagnostics_error(&display, &source, &d))?;
     if args.rust {
         let options = eomgen_symbolic::codegen::EmitOptions {
             crate_path: "::eomgen".to_string(),
@@ -103,7 +75,7 @@ pub fn run(args: &EquationsArgs) -> Result<(), CliError> {
             source_display: display.clone(),
         };
         let tokens = eomgen_symbolic::codegen::generate(&file, &options).map_err(|e| match e {
-            GenerateError::Diagnostics(d) => render(&display, &source, &d),
+            GenerateError::Diagnostics(d) => diagnostics_error(&display, &source, &d),
             GenerateError::Emit(message) => CliError::failure(message),
         })?;
         let code = syn::parse2::<syn::File>(tokens)
@@ -111,7 +83,8 @@ pub fn run(args: &EquationsArgs) -> Result<(), CliError> {
         out!("{}", prettyplease::unparse(&code));
         return Ok(());
     }
-    let mut model = SymbolicModel::from_file(&file).map_err(|d| render(&display, &source, &d))?;
+    let mut model =
+        SymbolicModel::from_file(&file).map_err(|d| diagnostics_error(&display, &source, &d))?;
     let eom = match args.method {
         Method::Lagrange => Lagrange.derive(&mut model),
         Method::Momentum => {

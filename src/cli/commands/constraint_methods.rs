@@ -1,48 +1,20 @@
-//! `eomgen study …`: numerical experiments that compare methods on a model.
-//!
-//! `constraint-methods` (issue 5, item 6; lectures 8–11, HW10): the study is
-//! [`eomgen::analysis::constraint_methods`]; the minimal twin is the one the model file names
+//! `eomgen study constraint-methods MODEL` (issue 5, item 6; lectures 8–11, HW10): the study is
+//! [`eomgen::analysis::constraint_methods()`]; the minimal twin is the one the model file names
 //! (`minimal_twin:`). This module renders the table, the JSON and the chart.
 
 use std::io::Write as _;
 
-use clap::{Args, Subcommand};
+use clap::Args;
 use eomgen::analysis::{
     ConstraintMethods, ConstraintMethodsError, ConstraintMethodsOptions, StudyRuns,
 };
 use eomgen::studies::minimal_twin;
 use serde_json::json;
 
-use super::render::num;
-use super::{CliError, plot};
-
-/// The studies.
-#[derive(Debug, Subcommand)]
-pub enum Study {
-    /// Constraint handled by stiff springs, as a DAE (with and without Baumgarte) and in
-    /// minimal coordinates: accuracy of the point positions, constraint drift, RHS
-    /// evaluations and time, as a table, JSON and a chart.
-    ConstraintMethods(ConstraintMethodsArgs),
-    /// Error against work for every integration method on a model: error of the state at
-    /// the output times against a verified reference, RHS evaluations, wall time and energy
-    /// drift, per tolerance (or step size); a table, JSON and log–log charts.
-    WorkPrecision(super::work_precision::WorkPrecisionArgs),
-    /// Where each method fails: stability limits on the oscillator against theory, energy
-    /// growth over 10⁴ periods, a stiff two-mass spring, step-size underflow.
-    Stability(super::stability::StabilityArgs),
-    /// HW1: explicit Euler on ẋ = x with h = 10⁻ⁿ, truncation against roundoff error and
-    /// the optimal n.
-    EulerRoundoff(super::roundoff::EulerRoundoffArgs),
-    /// HW28: the free response of the linearised, undamped equations four ways (integration,
-    /// e^{At}, modes of M⁻¹K, mass-normalised modes), their differences and a chart.
-    FreeResponse(super::free_response::FreeResponseArgs),
-    /// HW34: damping ratios exact (eigenvalues of A) vs the diagonal of Ĉ = ΨᵀCΨ vs Rayleigh
-    /// damping fitted to two modes, and the free responses from each mode shape.
-    ModalDamping(super::modal_damping::ModalDampingArgs),
-    /// Floquet multipliers of a time-periodic model about an equilibrium (the Mathieu
-    /// inverted pendulum), and its stability chart over two parameters (`--sweep`).
-    Floquet(super::floquet::FloquetArgs),
-}
+use crate::cli::error::CliError;
+use crate::cli::output::print_json;
+use crate::cli::plot;
+use crate::cli::render::num;
 
 /// Options of `eomgen study constraint-methods`.
 #[derive(Debug, Args)]
@@ -51,13 +23,13 @@ pub struct ConstraintMethodsArgs {
     /// a bundled name or the path of any model file.
     pub model: String,
     /// End time (s), in [1e-6, 1e6].
-    #[arg(long, default_value_t = 10.0, value_parser = super::values::study_end_time, allow_hyphen_values = true)]
+    #[arg(long, default_value_t = ConstraintMethodsOptions::DEFAULT_T_END, value_parser = crate::cli::values::study_end_time, allow_hyphen_values = true)]
     pub t_end: f64,
     /// Relative and absolute tolerance of every run (Dormand–Prince 5(4)).
-    #[arg(long, default_value_t = 1e-8, value_parser = super::values::relative_tolerance, allow_hyphen_values = true)]
+    #[arg(long, default_value_t = ConstraintMethodsOptions::DEFAULT_TOL, value_parser = crate::cli::values::relative_tolerance, allow_hyphen_values = true)]
     pub tol: f64,
     /// Spring stiffnesses of method I, comma separated.
-    #[arg(long, value_delimiter = ',', value_parser = super::values::stiffness, allow_hyphen_values = true, default_values_t = [1e2, 1e4, 1e6])]
+    #[arg(long, value_delimiter = ',', value_parser = crate::cli::values::stiffness, allow_hyphen_values = true, default_values_t = ConstraintMethodsOptions::DEFAULT_STIFFNESS)]
     pub stiffness: Vec<f64>,
     /// Print JSON instead of the table.
     #[arg(long)]
@@ -67,25 +39,12 @@ pub struct ConstraintMethodsArgs {
     pub plot: Option<String>,
 }
 
-/// Runs a study.
-pub fn run(study: &Study) -> Result<(), CliError> {
-    match study {
-        Study::ConstraintMethods(args) => constraint_methods(args),
-        Study::WorkPrecision(args) => super::work_precision::run(args),
-        Study::Stability(args) => super::stability::run(args),
-        Study::EulerRoundoff(args) => super::roundoff::run(args),
-        Study::FreeResponse(args) => super::free_response::run(args),
-        Study::ModalDamping(args) => super::modal_damping::run(args),
-        Study::Floquet(args) => super::floquet::run(args),
-    }
-}
-
-/// Runs `study constraint-methods`: [`eomgen::analysis::constraint_methods`] on the model
+/// Runs `study constraint-methods`: [`eomgen::analysis::constraint_methods()`] on the model
 /// and the minimal twin its file names, rendered as a table, JSON and a chart.
-fn constraint_methods(args: &ConstraintMethodsArgs) -> Result<(), CliError> {
+pub fn run(args: &ConstraintMethodsArgs) -> Result<(), CliError> {
     // The twin is read too: its file, named in the model's, is an input no output may
     // overwrite, so it is found before the outputs are checked.
-    let source = super::open_model(&args.model)?;
+    let source = crate::cli::model::open_model(&args.model)?;
     let twin = minimal_twin(&source).map_err(|e| CliError::failure(e.to_string()))?;
     let twin_file = match &twin {
         Some((_, eomgen::ModelSource::File { path, .. })) => Some(path.as_str()),
@@ -94,7 +53,7 @@ fn constraint_methods(args: &ConstraintMethodsArgs) -> Result<(), CliError> {
     twin_file
         .into_iter()
         .fold(
-            super::files::Outputs::new().input(&args.model),
+            crate::cli::files::Outputs::new().input(&args.model),
             |outputs, path| outputs.input(path),
         )
         .chart("--plot", args.plot.as_deref())
@@ -152,7 +111,7 @@ fn constraint_methods(args: &ConstraintMethodsArgs) -> Result<(), CliError> {
         )
         .map_err(CliError::failure)?;
     }
-    let mut stdout = super::output::stdout();
+    let mut stdout = crate::cli::output::stdout();
     if args.json {
         let out = json!({
             "model": model,
@@ -170,9 +129,7 @@ fn constraint_methods(args: &ConstraintMethodsArgs) -> Result<(), CliError> {
                 "error": r.failure,
             })).collect::<Vec<_>>(),
         });
-        let text =
-            serde_json::to_string_pretty(&out).map_err(|e| CliError::failure(e.to_string()))?;
-        let _ = writeln!(stdout, "{text}");
+        print_json(&out)?;
     } else {
         let _ = writeln!(
             stdout,

@@ -1,5 +1,5 @@
 //! `eomgen study work-precision MODEL` (issue 6): error against work for every integration
-//! method on a model; the study is [`eomgen::analysis::work_precision`] (its module docs give
+//! method on a model; the study is [`eomgen::analysis::work_precision`](mod@eomgen::analysis::work_precision) (its module docs give
 //! the error norm and the references), this module parses the options and renders the
 //! tables, the JSON and the charts.
 
@@ -14,9 +14,11 @@ use eomgen::analysis::work_precision::{
 };
 use serde_json::json;
 
-use super::render::num;
-use super::simulate::Method;
-use super::{CliError, find_model, plot};
+use crate::cli::error::CliError;
+use crate::cli::integration::Method;
+use crate::cli::model::find_model;
+use crate::cli::plot;
+use crate::cli::render::num;
 
 /// A measure of work of a run: RHS evaluations or wall time.
 type Work = fn(&Measured) -> f64;
@@ -47,7 +49,7 @@ fn study_error(args: &WorkPrecisionArgs, error: WorkPrecisionError) -> CliError 
             "--min-time-ms must be in [0, 10000], got {:e}",
             num(args.min_time_ms)
         )),
-        WorkPrecisionError::InitialState(e) => super::simulate::simulation_error(e),
+        WorkPrecisionError::InitialState(e) => crate::cli::integration::simulation_error(e),
         e @ WorkPrecisionError::ReferenceFailed { .. } => CliError::failure(format!(
             "{e}; try a looser --reference-tol or a shorter --t-end"
         )),
@@ -66,7 +68,7 @@ pub struct WorkPrecisionArgs {
     pub model: String,
     /// Methods to compare, comma separated (default: bs32, dp54, dop853, radau5, rk4,
     /// stormer-verlet).
-    #[arg(long, value_parser = super::simulate::method_parser(), value_delimiter = ',', default_values_t = DEFAULT_METHODS)]
+    #[arg(long, value_parser = crate::cli::integration::method_parser(), value_delimiter = ',', default_values_t = DEFAULT_METHODS)]
     pub methods: Vec<Method>,
     /// Tolerances of the adaptive methods (`rtol = atol = tol`): `A..B`, every decade from A
     /// to B (e.g. `1e-3..1e-12`), or a comma-separated list; each in (0, 1).
@@ -79,28 +81,28 @@ pub struct WorkPrecisionArgs {
     #[arg(long)]
     pub steps: Option<String>,
     /// End time T (s), in [1e-6, 1e6].
-    #[arg(long, default_value_t = 10.0, value_parser = super::values::study_end_time, allow_hyphen_values = true)]
+    #[arg(long, default_value_t = WorkPrecisionOptions::DEFAULT_T_END, value_parser = crate::cli::values::study_end_time, allow_hyphen_values = true)]
     pub t_end: f64,
     /// Number S of equally spaced output times `k T / S`, k = 1…S, at which errors are taken
     /// (1 to 100000).
-    #[arg(long, default_value_t = 100, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..=100_000))]
+    #[arg(long, default_value_t = WorkPrecisionOptions::DEFAULT_SAMPLES, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..=100_000))]
     pub samples: usize,
     /// Error at which the work of every method is interpolated (same norm as the table).
-    #[arg(long, default_value_t = 5e-4)]
+    #[arg(long, default_value_t = WorkPrecisionOptions::DEFAULT_TARGET_ERROR)]
     pub target_error: f64,
     /// A wall time (ms) to compare the time at the target error with (issue 6's anchor:
     /// `--baseline-ms 60`, MuJoCo's RK4 on the double pendulum over 10 s).
     #[arg(long, value_name = "MS")]
     pub baseline_ms: Option<f64>,
     /// Tolerance of the reference solution (DOP853, and Dormand–Prince 5(4) as its check).
-    #[arg(long, default_value_t = 1e-14)]
+    #[arg(long, default_value_t = WorkPrecisionOptions::DEFAULT_REFERENCE_TOL)]
     pub reference_tol: f64,
     /// Fewest timed runs per setting; the reported time is their median (1 to 1000).
-    #[arg(long, default_value_t = 3, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..=1000))]
+    #[arg(long, default_value_t = WorkPrecisionOptions::DEFAULT_REPEATS, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..=1000))]
     pub repeats: usize,
     /// Runs of one setting are repeated until their total wall time reaches this (ms, 0 to
     /// 10000), at most 1000 times.
-    #[arg(long, default_value_t = 20.0, value_parser = super::values::min_time_ms, allow_hyphen_values = true)]
+    #[arg(long, default_value_t = WorkPrecisionOptions::DEFAULT_MIN_TIME_S * 1e3, value_parser = crate::cli::values::min_time_ms, allow_hyphen_values = true)]
     pub min_time_ms: f64,
     /// Print JSON instead of the tables.
     #[arg(long)]
@@ -211,7 +213,7 @@ pub fn run(args: &WorkPrecisionArgs) -> Result<(), CliError> {
             .iter()
             .flat_map(|tag| ["svg", "png"].map(|ext| chart_path(prefix, tag, ext)))
             .fold(
-                super::files::Outputs::new().input(&args.model),
+                crate::cli::files::Outputs::new().input(&args.model),
                 |outputs, path| outputs.chart("--plot", Some(&path)),
             )
             .check()?;
@@ -220,7 +222,7 @@ pub fn run(args: &WorkPrecisionArgs) -> Result<(), CliError> {
     options.steps = args.steps.as_deref().map(parse_steps).transpose()?;
     let mut model = find_model(&args.model)?;
     // The runs take seconds to minutes: a bar on a terminal, nothing otherwise.
-    let bar = super::render::progress_bar(
+    let bar = crate::cli::render::progress_bar(
         0,
         "{msg} [{bar:30}] {pos}/{len} runs ({elapsed}, eta {eta})",
         "work-precision",
@@ -240,7 +242,7 @@ pub fn run(args: &WorkPrecisionArgs) -> Result<(), CliError> {
     let num_unresolved = study.report.num_unresolved();
     let agreement = study.report.agreement;
     if num_unresolved > 0 {
-        super::output::errln!(
+        crate::cli::output::errln!(
             "warning: {num_unresolved} run(s) have an error below 10 × the reference's agreement ({agreement:.2e}): the reference does not resolve them, their errors are upper bounds at best (marked `!` in the table, `\"resolved\": false` in JSON)",
             agreement = num(agreement)
         );
@@ -252,7 +254,7 @@ pub fn run(args: &WorkPrecisionArgs) -> Result<(), CliError> {
             &study.report.results,
         )?;
     }
-    let mut stdout = super::output::stdout();
+    let mut stdout = crate::cli::output::stdout();
     // A failed write (a pipe into `head` closed) is kept by `output` and sets the status.
     let _ = if args.json {
         serde_json::to_string_pretty(&study.to_json())

@@ -12,17 +12,19 @@ use eomgen::analysis::roundoff::{
 };
 use serde_json::json;
 
-use super::files::Outputs;
-use super::render::num;
-use super::stability::{log_y_chart, print_json};
-use super::{CliError, plot};
+use crate::cli::error::CliError;
+use crate::cli::files::Outputs;
+use crate::cli::output::print_json;
+use crate::cli::plot;
+use crate::cli::plot::log_y_chart;
+use crate::cli::render::num;
 
 /// Options of `eomgen study euler-roundoff`.
 #[derive(Debug, Args)]
 pub struct EulerRoundoffArgs {
     /// Largest n: steps h = 10⁻ⁿ for n = 0 … N, so 10ᴺ steps per method at the end
     /// (at most 8; 7 takes about 3 s, 8 about 30 s in a release build).
-    #[arg(long, default_value_t = 7)]
+    #[arg(long, default_value_t = RoundoffOptions::DEFAULT_MAX_N)]
     pub max_n: u32,
     /// Print JSON instead of the table.
     #[arg(long)]
@@ -55,7 +57,7 @@ pub fn run(args: &EulerRoundoffArgs) -> Result<(), CliError> {
     if let Some(path) = &args.plot {
         plot_errors(path, &rows)?;
     }
-    let mut stdout = super::output::stdout();
+    let mut stdout = crate::cli::output::stdout();
     if args.json {
         let out = json!({
             "problem": "x' = x, x(0) = 1 on [0, 1]; x(1) = e",

@@ -1,6 +1,7 @@
-//! `eomgen animate MODEL -o FILE.html` and `eomgen modes MODEL --animate FILE.html`: the
-//! mechanism's `draw:` lines moving in one self-contained HTML page (HW39's "simulate and
-//! animate"; lecture 17's line-drawing animations; HW19's trace of the end of the forearm).
+//! The animation page that `eomgen animate MODEL -o FILE.html`, `eomgen modes MODEL --animate
+//! FILE.html` and the report write: the mechanism's `draw:` lines moving in one
+//! self-contained HTML page (HW39's "simulate and animate"; lecture 17's line-drawing
+//! animations; HW19's trace of the end of the forearm).
 //!
 //! The page needs no network: the frames (positions of the drawn points at uniform times,
 //! sampled by the integrator's dense output, with `t` and the energy), a small stylesheet and
@@ -14,17 +15,16 @@
 
 use std::fmt::Write as _;
 
-use clap::Args;
 use eomgen::analysis::energy_drift_at;
 use eomgen::{ModeKind, ModelInfo, NormalModes, OutputTimes};
 use nalgebra::DMatrix;
 use plotters::prelude::*;
 
+use super::error::CliError;
+use super::integration::{IntegrationArgs, Run, failure_error, integrate};
 use super::mode_plot::{self, Frame, Layout};
-use super::output::outln;
+use super::plot;
 use super::render::escape;
-use super::simulate::{IntegrationArgs, Run, failure_error, integrate};
-use super::{CliError, plot};
 
 /// The stylesheet, the error hooks (first script: they record script errors and
 /// `console.error` into `#errors`) and the player.
@@ -32,6 +32,9 @@ const STYLE: &str = include_str!("animate.css");
 const HOOKS: &str = include_str!("animate_hooks.js");
 const PLAYER: &str = include_str!("animate.js");
 
+/// Frames per second of simulated time of `animate` without `--fps`, and of the report's
+/// animations.
+pub(super) const DEFAULT_FPS: f64 = 30.0;
 /// Most frames an animation may have (`t_end · fps + 1`).
 const MAX_FRAMES: usize = 100_000;
 /// Frames per cycle of a mode-shape animation, and the real seconds one cycle takes at 1×.
@@ -53,62 +56,6 @@ const LINK: (u8, u8, u8) = (0x2b, 0x59, 0xc3);
 const JOINT: (u8, u8, u8) = (0x1b, 0x1b, 0x1b);
 const TRACE: (u8, u8, u8) = (0xe8, 0x87, 0x1e);
 const GRID: (u8, u8, u8) = (0xe8, 0xe8, 0xe8);
-
-/// Options of `eomgen animate`.
-#[derive(Debug, Args)]
-pub struct AnimateArgs {
-    /// A bundled model's name (see `eomgen list`) or the path of any model file; it needs a
-    /// `draw:` block.
-    pub model: String,
-    /// What to integrate and how (as `eomgen simulate`).
-    #[command(flatten)]
-    pub run: IntegrationArgs,
-    /// The HTML file to write (self-contained: no network needed to view it).
-    #[arg(short = 'o', long = "output", value_name = "FILE.html")]
-    pub output: String,
-    /// Frames per second of simulated time (frames at t = k / fps, from dense output).
-    #[arg(long, default_value_t = 30.0)]
-    pub fps: f64,
-    /// Points whose paths are traced, comma separated (default: the file's `draw: trace`).
-    #[arg(long, value_delimiter = ',', value_name = "P1,P2")]
-    pub trace: Vec<String>,
-    /// Also write the animation as an animated GIF (for slides).
-    #[arg(long, value_name = "FILE.gif")]
-    pub gif: Option<String>,
-}
-
-/// Runs `animate`.
-pub fn run(args: &AnimateArgs) -> Result<(), CliError> {
-    super::files::Outputs::new()
-        .input(&args.model)
-        .file("--output", Some(&args.output))
-        .file("--gif", args.gif.as_deref())
-        .check()?;
-    let (animation, failure) = simulation(&args.model, &args.run, args.fps, &args.trace)?;
-    let Some(animation) = animation else {
-        return Err(failure.unwrap_or_else(|| CliError::failure("no frame was computed")));
-    };
-    let html = animation.to_html();
-    write(&args.output, &html)?;
-    outln!(
-        "animation  {} ({} frames, {:.1} kB)",
-        args.output,
-        animation.clips[0].t.len(),
-        html.len() as f64 / 1e3
-    );
-    if let Some(path) = &args.gif {
-        animation.write_gif(path, 0)?;
-        outln!("gif        {path}");
-    }
-    match failure {
-        None => Ok(()),
-        Some(e) => Err(e),
-    }
-}
-
-fn write(path: &str, text: &str) -> Result<(), CliError> {
-    Ok(super::files::write(path, text.as_bytes())?)
-}
 
 /// What every frame draws: the points used, the segments between them, the points marked
 /// with a dot and the points whose paths are traced.
@@ -315,7 +262,7 @@ pub(crate) fn simulation(
         )));
     }
     // Check the model's drawing before integrating.
-    let scene = Scene::of(super::find_model(model_name)?.as_ref(), trace)?;
+    let scene = Scene::of(super::model::find_model(model_name)?.as_ref(), trace)?;
     let sub = if scene.traces.is_empty() {
         1
     } else {

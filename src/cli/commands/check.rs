@@ -3,9 +3,10 @@
 use clap::Args;
 use serde_json::json;
 
-use super::CliError;
-use super::output::outln;
-use super::render::num;
+use crate::cli::error::CliError;
+use crate::cli::output::outln;
+use crate::cli::output::print_json;
+use crate::cli::render::num;
 use eomgen_symbolic::mechanics::cross_check::{
     CheckReport, INITIAL_CONSTRAINT_TOLERANCE, check_model,
 };
@@ -32,17 +33,14 @@ pub struct CheckArgs {
 
 /// Runs `check`.
 pub fn run(args: &CheckArgs) -> Result<(), CliError> {
-    let (display, source) = super::equations::read_model(&args.model)?;
+    let (display, source) = crate::cli::model::read_model(&args.model)?;
     let file = eomgen_symbolic::model::load(&display, &source)
-        .map_err(|d| super::equations::render(&display, &source, &d))?;
-    let report = check_model(&file, args.states, 0x5EED)
-        .map_err(|diagnostics| super::diagnostics_error(&display, &source, &diagnostics))?;
+        .map_err(|d| crate::cli::model::diagnostics_error(&display, &source, &d))?;
+    let report = check_model(&file, args.states, 0x5EED).map_err(|diagnostics| {
+        crate::cli::model::diagnostics_error(&display, &source, &diagnostics)
+    })?;
     if args.json {
-        outln!(
-            "{}",
-            serde_json::to_string_pretty(&to_json(&report, args.timing))
-                .map_err(|e| CliError::failure(e.to_string()))?
-        );
+        print_json(&to_json(&report, args.timing))?;
     } else {
         print_report(&report);
     }

@@ -10,7 +10,6 @@
 //! `mathieu_pendulum`, Kapitza's boundary and the series edges of the Mathieu chart.
 
 use std::f64::consts::TAU;
-use std::io::Write as _;
 
 use clap::Args;
 use eomgen::analysis::StudyRuns;
@@ -22,16 +21,18 @@ use eomgen::{
     ChartAxis, FloquetAnalysis, FloquetError, FloquetOptions, FloquetReferences, FloquetStability,
     ModelInfo, ThresholdPrediction,
 };
+use plotters::coord::Shift;
 use plotters::prelude::*;
 use rayon::prelude::*;
 use serde_json::{Value, json};
 
-use super::CliError;
-use super::files::Outputs;
-use super::modes::{OperatingPointArgs, point_json};
-use super::plot::{register_font, tick};
-use super::render::num;
-use super::values::{evaluate, parameter_lookup, set_parameters, split_assignment};
+use crate::cli::error::CliError;
+use crate::cli::files::Outputs;
+use crate::cli::operating_point::{OperatingPointArgs, point_json};
+use crate::cli::output::print_json;
+use crate::cli::plot::{Drawing, tick, write_chart};
+use crate::cli::render::num;
+use crate::cli::values::{evaluate, parameter_lookup, set_parameters, split_assignment};
 
 /// Options of `eomgen study floquet`.
 #[derive(Debug, Args)]
@@ -42,7 +43,7 @@ pub struct FloquetArgs {
     #[command(flatten)]
     pub point: OperatingPointArgs,
     /// The parameter that is the forcing frequency w (rad/s); the period is T = 2π/w.
-    #[arg(long, default_value = "w")]
+    #[arg(long, default_value = FloquetStudyOptions::DEFAULT_PERIOD_PARAMETER)]
     pub period_parameter: String,
     /// Stability chart over two parameters, `X=LO..HI:N,Y=LO..HI:N` (N values each, ends
     /// included; `a=0..0.3:61,w=10..100:61`): the x axis first. N ≤ 10000 and at most 10⁶
@@ -56,7 +57,7 @@ pub struct FloquetArgs {
     pub stability_tolerance: Option<f64>,
     /// Relative and absolute tolerance of DOP853 on the state and the variational equations,
     /// in (0, 1e-4].
-    #[arg(long, default_value_t = 1e-12, value_parser = super::values::floquet_tolerance, allow_hyphen_values = true)]
+    #[arg(long, default_value_t = FloquetOptions::DEFAULT_TOL, value_parser = crate::cli::values::floquet_tolerance, allow_hyphen_values = true)]
     pub tol: f64,
     /// Print JSON.
     #[arg(long)]
@@ -72,7 +73,10 @@ pub struct FloquetArgs {
 fn analysis_text(model: &dyn ModelInfo, e: &FloquetStudyError) -> String {
     match e {
         FloquetStudyError::Equilibrium(m) => {
-            format!("{m}\nhelp: {}", super::modes::modal_hint(model, m))
+            format!(
+                "{m}\nhelp: {}",
+                crate::cli::operating_point::modal_hint(model, m)
+            )
         }
         e => e.to_string(),
     }
@@ -97,7 +101,7 @@ pub fn run(args: &FloquetArgs) -> Result<(), CliError> {
         .chart("--plot", args.plot.as_deref())
         .check()?;
     let mut model = args.point.model(&args.model)?;
-    let source = super::open_model(&args.model)?;
+    let source = crate::cli::model::open_model(&args.model)?;
     // A file that cannot be read here (a bundled model's file moved away from an installed
     // binary) declares no unit this check could read; the numerical check still runs.
     match eomgen::studies::check_period_parameter_unit(&source, &args.period_parameter) {
@@ -135,7 +139,9 @@ pub fn run(args: &FloquetArgs) -> Result<(), CliError> {
         FloquetStudyError::Floquet(e @ FloquetError::InvalidStabilityTolerance { .. }) => {
             CliError::usage(format!("--stability-tolerance: {e}"))
         }
-        FloquetStudyError::OperatingPoint(e) => super::modes::point_failure(model.as_ref(), &e),
+        FloquetStudyError::OperatingPoint(e) => {
+            crate::cli::operating_point::point_failure(model.as_ref(), &e)
+        }
         e => CliError::failure(format!(
             "`{}` at {label}: {}",
             model.description().name,
@@ -188,11 +194,9 @@ pub fn run(args: &FloquetArgs) -> Result<(), CliError> {
         thresholds: &thresholds,
         sweep: sweep.as_ref(),
     };
-    let mut stdout = super::output::stdout();
+    let mut stdout = crate::cli::output::stdout();
     if args.json {
-        let text = serde_json::to_string_pretty(&json_report(&report))
-            .map_err(|e| CliError::failure(e.to_string()))?;
-        let _ = writeln!(stdout, "{text}");
+        print_json(&json_report(&report))?;
     } else {
         print_report(&mut stdout, &report);
     }
@@ -221,7 +225,7 @@ fn json_report(report: &Report<'_>) -> Value {
     let names = model.description().coordinate_names();
     let complex = |c: &nalgebra::Complex<f64>| json!({"re": c.re, "im": c.im, "modulus": c.norm()});
     let f = &point.floquet;
-    let monodromy = super::modes::matrix_rows(&f.monodromy_matrix);
+    let monodromy = crate::cli::render::matrix_rows(&f.monodromy_matrix);
     let mut operating_point = point_json(label, &names, &point.q);
     operating_point["max_forcing_residual"] = json!(point.residual);
     let mut out = json!({
@@ -365,9 +369,9 @@ fn run_sweep(
     y: Axis,
     options: &FloquetStudyOptions,
 ) -> Result<FloquetChart, CliError> {
-    let source = super::open_model(&args.model)?;
+    let source = crate::cli::model::open_model(&args.model)?;
     let total = x.values.len() * y.values.len();
-    let bar = super::render::progress_bar(
+    let bar = crate::cli::render::progress_bar(
         total,
         "{msg} [{bar:40}] {pos}/{len} analyses, {elapsed} (eta {eta})",
         "floquet",
@@ -547,11 +551,39 @@ fn stability_chart(
     grid: &[Vec<Cell>],
     references: Option<(&FloquetReferences, &dyn ModelInfo)>,
 ) -> Result<(), String> {
-    register_font()?;
-    let size = (960, 720);
-    super::plot::write_chart!(path, size, |root| draw_stability(
-        root, title, axes, labels, grid, references
-    ))
+    let chart = StabilityChart {
+        title,
+        axes,
+        labels,
+        grid,
+        references,
+    };
+    write_chart(path, (960, 720), &chart)
+}
+
+/// The stability chart of [`stability_chart`], drawn.
+struct StabilityChart<'a> {
+    title: &'a str,
+    axes: [&'a Axis; 2],
+    labels: &'a [String; 2],
+    grid: &'a [Vec<Cell>],
+    references: Option<(&'a FloquetReferences, &'a dyn ModelInfo)>,
+}
+
+impl Drawing for StabilityChart<'_> {
+    fn draw<DB: DrawingBackend>(&self, root: DrawingArea<DB, Shift>) -> Result<(), String>
+    where
+        DB::ErrorType: 'static,
+    {
+        draw_stability(
+            root,
+            self.title,
+            self.axes,
+            self.labels,
+            self.grid,
+            self.references,
+        )
+    }
 }
 
 /// An axis label with the unit where it is known: the period parameter is a frequency in
@@ -736,9 +768,22 @@ where
 
 /// The multipliers in the complex plane, with the unit circle.
 fn multiplier_chart(path: &str, title: &str, floquet: &FloquetAnalysis) -> Result<(), String> {
-    register_font()?;
-    let size = (720, 720);
-    super::plot::write_chart!(path, size, |root| draw_multipliers(root, title, floquet))
+    write_chart(path, (720, 720), &MultiplierChart { title, floquet })
+}
+
+/// The multipliers of [`multiplier_chart`], drawn.
+struct MultiplierChart<'a> {
+    title: &'a str,
+    floquet: &'a FloquetAnalysis,
+}
+
+impl Drawing for MultiplierChart<'_> {
+    fn draw<DB: DrawingBackend>(&self, root: DrawingArea<DB, Shift>) -> Result<(), String>
+    where
+        DB::ErrorType: 'static,
+    {
+        draw_multipliers(root, self.title, self.floquet)
+    }
 }
 
 fn draw_multipliers<DB: DrawingBackend>(

@@ -1,0 +1,327 @@
+//! `eomgen modes MODEL`: equilibrium, exact linearisation `M δq̈ + C δq̇ + K δq = 0`, normal
+//! modes and damping (issue 7; lectures 22–26, 30).
+
+use clap::Args;
+use eomgen::analysis::vibration::{self, ModalAnalysis, ModalOptions};
+use eomgen::{ModeKind, ModelInfo};
+use nalgebra::DMatrix;
+use serde_json::json;
+
+use crate::cli::error::CliError;
+use crate::cli::operating_point::{OperatingPointArgs, point_failure, point_json};
+use crate::cli::output::print_json;
+use crate::cli::render::matrix_rows;
+use crate::cli::render::num;
+
+/// Options of `eomgen modes`.
+#[derive(Debug, Args)]
+pub struct ModesArgs {
+    /// A bundled model's name (see `eomgen list`) or the path of any model file.
+    pub model: String,
+    #[command(flatten)]
+    pub point: OperatingPointArgs,
+    /// Print JSON.
+    #[arg(long)]
+    pub json: bool,
+    /// Draw each mode shape on the mechanism: `PREFIX-mode<k>.svg` (`.png` when PREFIX ends
+    /// in .png).
+    #[arg(long, value_name = "PREFIX")]
+    pub plot: Option<String>,
+    /// Write the mode shapes moving, `q* + s ψₖ sin(ωₖ t)`, as one self-contained HTML page
+    /// with a mode selector.
+    #[arg(long, value_name = "FILE.html")]
+    pub animate: Option<String>,
+}
+
+/// Runs `modes`.
+pub fn run(args: &ModesArgs) -> Result<(), CliError> {
+    // The charts `PREFIX-mode<k>` (at most one per degree of freedom) and the page, checked
+    // before the analysis.
+    let num_dofs = args.point.model(&args.model)?.num_dofs();
+    let charts: Vec<String> = match &args.plot {
+        Some(prefix) => (1..=num_dofs)
+            .map(|k| crate::cli::mode_plot::chart_path(prefix, k))
+            .collect(),
+        None => Vec::new(),
+    };
+    charts
+        .iter()
+        .fold(
+            crate::cli::files::Outputs::new().input(&args.model),
+            |outputs, path| outputs.chart("--plot", Some(path)),
+        )
+        .file("--animate", args.animate.as_deref())
+        .check()?;
+    let (model, modal) = analysis_of(&args.model, &args.point)?;
+    if args.plot.is_some() {
+        crate::cli::mode_plot::check_drawable(model.as_ref())?;
+    }
+    let (lin, modes) = (&modal.linearization, &modal.normal_modes);
+    let equilibrium = &modal.operating_point.equilibrium;
+    // Mode shapes in the model's coordinates (δq = N z with constraints).
+    let shapes_q = modal.mode_shape_matrix();
+    let multipliers: serde_json::Map<String, serde_json::Value> = model
+        .description()
+        .constraint_names()
+        .iter()
+        .zip(&lin.lagrange_multipliers)
+        .map(|(c, v)| (c.to_string(), json!(v)))
+        .collect();
+    let charts = match &args.plot {
+        Some(prefix) => {
+            let charts = crate::cli::mode_plot::mode_charts(
+                prefix,
+                model.as_ref(),
+                &equilibrium.q,
+                modes,
+                &shapes_q,
+            )?;
+            crate::cli::mode_plot::remove_stale_charts(prefix, charts.len())?;
+            charts
+        }
+        None => Vec::new(),
+    };
+    if let Some(path) = &args.animate {
+        let page = crate::cli::animation::modes(model.as_ref(), &equilibrium.q, modes, &shapes_q)?;
+        crate::cli::files::write(path, page.to_html().as_bytes())?;
+    }
+    let mut stdout = crate::cli::output::stdout();
+    if args.json {
+        print_json(&json_report(
+            model.as_ref(),
+            &modal,
+            &multipliers,
+            &charts,
+            args,
+        ))
+    } else {
+        print_text(
+            &mut stdout,
+            model.as_ref(),
+            &modal,
+            &multipliers,
+            &charts,
+            args,
+        );
+        Ok(())
+    }
+}
+
+/// The JSON of `modes` (see docs/cli.md).
+fn json_report(
+    model: &dyn ModelInfo,
+    modal: &ModalAnalysis,
+    multipliers: &serde_json::Map<String, serde_json::Value>,
+    charts: &[String],
+    args: &ModesArgs,
+) -> serde_json::Value {
+    let ModalAnalysis {
+        operating_point: point,
+        linearization: lin,
+        normal_modes: modes,
+        mode_shapes: shapes,
+        minimal_coordinates: minimal,
+        damped_modes: damped,
+        damping_ratios,
+        m_inv_k_eigenvalues: route22,
+        m_inv_k_relative_difference: route_difference,
+        time_dependent_forcing: forcing,
+    } = modal;
+    let (label, equilibrium) = (&point.name, &point.equilibrium);
+    let names = model.description().coordinate_names();
+    let mut point = point_json(label, &names, &equilibrium.q);
+    point["newton_iterations"] = json!(equilibrium.iterations);
+    point["residual"] = json!(equilibrium.residual);
+    json!({
+        "model": model.description().name,
+        "coordinates": names,
+        "operating_point": point,
+        "natural_frequencies": modes.natural_frequencies,
+        "frequencies_hz": modes.natural_frequencies.iter().map(|w| w / std::f64::consts::TAU).collect::<Vec<_>>(),
+        "eigenvalues": modes.eigenvalues,
+        "kinds": modes.kinds,
+        "damping_ratios": damping_ratios,
+        "damped_modes": damped.iter().map(|d| json!({"re": d.eigenvalue.re, "im": d.eigenvalue.im, "damping_ratio": d.damping_ratio, "damped_frequency": d.damped_frequency})).collect::<Vec<_>>(),
+        "mode_shapes": shapes,
+        "minimal_coordinates": minimal,
+        "lagrange_multipliers": multipliers,
+        "mass_matrix": matrix_rows(&lin.mass_matrix),
+        "stiffness_matrix": matrix_rows(&lin.stiffness_matrix),
+        "damping_matrix": matrix_rows(&lin.damping_matrix),
+        "differenced_jacobian_entries": lin.differenced_entries,
+        "stiffness_asymmetry": modes.stiffness_asymmetry,
+        "m_inv_k_eigenvalues": route22,
+        "m_inv_k_relative_difference": route_difference,
+        "time_dependent_forcing": forcing,
+        "charts": charts,
+        "animation": args.animate,
+    })
+}
+
+/// The text of `modes`: the equilibrium, M, K, C, the modes, the check, the files written.
+fn print_text(
+    stdout: &mut impl std::io::Write,
+    model: &dyn ModelInfo,
+    modal: &ModalAnalysis,
+    multipliers: &serde_json::Map<String, serde_json::Value>,
+    charts: &[String],
+    args: &ModesArgs,
+) {
+    let ModalAnalysis {
+        operating_point: point,
+        linearization: lin,
+        normal_modes: modes,
+        mode_shapes: shapes,
+        minimal_coordinates: minimal,
+        damping_ratios,
+        m_inv_k_relative_difference: route_difference,
+        time_dependent_forcing: forcing,
+        ..
+    } = modal;
+    let (label, equilibrium) = (&point.name, &point.equilibrium);
+    let names = model.description().coordinate_names();
+    let n = model.num_dofs();
+    let undamped = modal.is_undamped();
+    let _ = writeln!(
+        stdout,
+        "model      {} ({} dof)",
+        model.description().name,
+        n
+    );
+    let point: Vec<String> = names
+        .iter()
+        .zip(&equilibrium.q)
+        .map(|(c, v)| format!("{c} = {v:.12e}", v = num(v)))
+        .collect();
+    let _ = writeln!(
+        stdout,
+        "equilibrium {label}: {} (Newton: {} iterations, max |F| = {:.1e})",
+        point.join(", "),
+        equilibrium.iterations,
+        num(equilibrium.residual)
+    );
+    if let Some(forcing) = forcing {
+        let _ = writeln!(
+            stdout,
+            "note       F depends on t through a load that enters neither M, C nor K: F(q*, 0, t) − F(q*, 0, t₀) reaches {change:.3e} on {coordinate} (t = {t:.6e} s, t₀ = {t0} s); its variation is set aside: the operating point above is the equilibrium under the load's value at t₀ (deflected by it where that value is not 0), and the modes below are those of the equations linearised there",
+            change = num(forcing.largest_change),
+            coordinate = forcing.coordinate,
+            t = num(forcing.t),
+            t0 = forcing.t0,
+        );
+    }
+    if !lin.lagrange_multipliers.is_empty() {
+        let forces: Vec<String> = multipliers
+            .iter()
+            .map(|(c, v)| format!("λ_{c} = {:.6e}", num(v.as_f64().unwrap_or(f64::NAN))))
+            .collect();
+        let _ = writeln!(
+            stdout,
+            "constraints {} at rest; M, K, C below are in the minimal coordinates {} (δq = N z, N spanning the null space of J)",
+            forces.join(", "),
+            minimal.join(", ")
+        );
+    }
+    if lin.differenced_entries > 0 {
+        let _ = writeln!(
+            stdout,
+            "note       {} entries of ∂F/∂q, ∂F/∂q̇ are not finite here while F is (a removable singularity, such as d|v|/dv = 0/0 of quadratic drag at rest): K and C use forward differences of F there, as the implicit integrators do",
+            lin.differenced_entries
+        );
+    }
+    print_matrix(stdout, "M", &lin.mass_matrix);
+    print_matrix(stdout, "K", &lin.stiffness_matrix);
+    if !undamped {
+        print_matrix(stdout, "C", &lin.damping_matrix);
+    }
+    if modes.stiffness_asymmetry > 1e-12 {
+        let _ = writeln!(
+            stdout,
+            "note       K is not symmetric (‖K − Kᵀ‖/‖K‖ = {:.2e}); its symmetric part is used",
+            num(modes.stiffness_asymmetry)
+        );
+    }
+    let _ = writeln!(
+        stdout,
+        "{:>4}  {:>16}  {:>14}  {:>10}  mode shape (mass-normalised; {})",
+        "mode",
+        "ω (rad/s)",
+        "f (Hz)",
+        "ζ",
+        names.join(", ")
+    );
+    for (k, shape) in shapes.iter().enumerate() {
+        let w = modes.natural_frequencies[k];
+        let note = match modes.kinds[k] {
+            ModeKind::Oscillatory => String::new(),
+            ModeKind::ZeroFrequency => "  zero-frequency".to_string(),
+            ModeKind::Unstable { growth_rate } => {
+                format!(
+                    "  unstable, grows as e^({growth_rate:.6e} t)",
+                    growth_rate = num(growth_rate)
+                )
+            }
+        };
+        let shape: Vec<String> = shape
+            .iter()
+            .map(|v| format!("{:>11.4e}", num(v + 0.0)))
+            .collect();
+        let zeta = damping_ratios
+            .get(k)
+            .map_or("-".to_string(), |z| format!("{z:.4e}", z = num(z)));
+        let _ = writeln!(
+            stdout,
+            "{:>4}  {:>16.10e}  {:>14.6e}  {:>10}  [{}]{note}",
+            k + 1,
+            num(w),
+            num(w / std::f64::consts::TAU),
+            zeta,
+            shape.join(", ")
+        );
+    }
+    let _ = writeln!(
+        stdout,
+        "check      eigenvalues of M⁻¹K (lecture 22) vs the symmetric Cholesky route (lecture 24): max difference {route_difference:.1e} of max |ω²|",
+        route_difference = num(route_difference)
+    );
+    for path in charts {
+        let _ = writeln!(stdout, "chart      {path}");
+    }
+    if let Some(path) = &args.animate {
+        let _ = writeln!(stdout, "animation  {path}");
+    }
+}
+
+fn print_matrix(out: &mut impl std::io::Write, name: &str, m: &DMatrix<f64>) {
+    for i in 0..m.nrows() {
+        let row: Vec<String> = m
+            .row(i)
+            .iter()
+            .map(|v| format!("{v:>13.6e}", v = num(v)))
+            .collect();
+        let label = if i == 0 {
+            format!("{name} =")
+        } else {
+            String::new()
+        };
+        let _ = writeln!(out, "{label:<10} [{}]", row.join(", "));
+    }
+}
+
+/// The model `model_name` with `--set` applied and its modal analysis at `--at`
+/// ([`eomgen::analysis::vibration::modal_analysis`]).
+///
+/// # Errors
+/// A bad `--set` or `--at` (usage), a failed search or analysis (with a hint).
+pub(super) fn analysis_of(
+    model_name: &str,
+    point: &OperatingPointArgs,
+) -> Result<(Box<dyn ModelInfo>, ModalAnalysis), CliError> {
+    let model = point.model(model_name)?;
+    let options = ModalOptions {
+        operating_point: point.options(model.as_ref())?,
+    };
+    let modal = vibration::modal_analysis(model.as_ref(), &options)
+        .map_err(|e| point_failure(model.as_ref(), &e))?;
+    Ok((model, modal))
+}

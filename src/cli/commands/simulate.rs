@@ -1,0 +1,587 @@
+//! `eomgen simulate MODEL`: integrate from the model's initial state and report.
+
+use clap::Args;
+use eomgen::analysis::{ConstraintDrift, EnergyDrift, Simulation};
+use eomgen::{ModelInfo, OutputTimes, Solution};
+use serde_json::{Value, json};
+
+use crate::cli::error::CliError;
+use crate::cli::files::{self, Outputs};
+use crate::cli::integration::{IntegrationArgs, StabilizationArg, failure_error, simulation};
+use crate::cli::output::{self, outln};
+use crate::cli::plot;
+use crate::cli::render::num;
+use crate::cli::values::evaluate;
+
+/// Most output times `--t-out` may list.
+const MAX_OUTPUT_TIMES: usize = 100_000;
+
+/// Options of `eomgen simulate`.
+#[derive(Debug, Args)]
+pub struct SimulateArgs {
+    /// A bundled model's name (see `eomgen list`) or the path of any model file.
+    pub model: String,
+    /// Output times, comma separated (expressions allowed), e.g. `--t-out 1,2,2.5`; samples
+    /// come from dense output at exactly these times (at most 100000). Default: every accepted
+    /// step.
+    #[arg(long, value_delimiter = ',')]
+    pub t_out: Vec<String>,
+    /// What to integrate and how.
+    #[command(flatten)]
+    pub run: IntegrationArgs,
+    /// Print the result as JSON on stdout (byte-identical across runs: the wall time is left
+    /// out unless `--timing` is given).
+    #[arg(long)]
+    pub json: bool,
+    /// Add the wall time (`stats.wall_time_s`) to the JSON output.
+    #[arg(long)]
+    pub timing: bool,
+    /// Write the samples as CSV (t, coordinates, rates, energy).
+    #[arg(long, value_name = "FILE")]
+    pub csv: Option<String>,
+    /// Plot the coordinates against time (.svg or .png); a constrained model also gets its
+    /// constraint drift in `FILE-drift.svg`.
+    #[arg(long, value_name = "FILE")]
+    pub plot: Option<String>,
+    /// Plot the phase portrait, each rate against its coordinate (.svg or .png).
+    #[arg(long, value_name = "FILE")]
+    pub plot_phase: Option<String>,
+    /// Plot the energy drift E(t) − E(0) against time (.svg or .png).
+    #[arg(long, value_name = "FILE")]
+    pub plot_energy: Option<String>,
+}
+
+/// Runs `simulate`.
+pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
+    // Every file this run may write or remove, checked before any work: `--csv FILE` owns
+    // `FILE-events.csv` and `--plot FILE` owns `FILE-drift.EXT` (written when the run has
+    // events or constraints, else removed when an earlier run left one). An output written
+    // in place (`/dev/stdout`, a FIFO) has no directory beside it, so no companion.
+    let companion = |path: &Option<String>, tag: &str| {
+        path.as_deref()
+            .filter(|path| !files::writes_in_place(path))
+            .map(|path| sibling(path, tag))
+    };
+    let events_csv = companion(&args.csv, "events");
+    let drift_chart = companion(&args.plot, "drift");
+    Outputs::new()
+        .input(&args.model)
+        .file("--csv", args.csv.as_deref())
+        .file("--csv (its events file)", events_csv.as_deref())
+        .chart("--plot", args.plot.as_deref())
+        .chart(
+            "--plot (its constraint drift chart)",
+            drift_chart.as_deref(),
+        )
+        .chart("--plot-phase", args.plot_phase.as_deref())
+        .chart("--plot-energy", args.plot_energy.as_deref())
+        .check()?;
+    if args.t_out.len() > MAX_OUTPUT_TIMES {
+        return Err(CliError::usage(format!(
+            "--t-out lists {} times; at most {MAX_OUTPUT_TIMES} are allowed",
+            args.t_out.len()
+        )));
+    }
+    let mut times = Vec::with_capacity(args.t_out.len());
+    for t in &args.t_out {
+        times.push(evaluate(t, "--t-out", &|_| None)?);
+    }
+    let output = if times.is_empty() {
+        OutputTimes::Steps
+    } else {
+        OutputTimes::At(times)
+    };
+    let (model, simulation) = simulation(&args.model, &args.run, output)?;
+    let Simulation {
+        solution,
+        energy: report,
+        constraints,
+        failure,
+        cause,
+        warnings,
+        integrator: method_name,
+        ..
+    } = &simulation;
+    for warning in warnings {
+        output::errln!("warning: {warning}");
+    }
+    // The files of a failed integration say so: `# incomplete: <reason> at t = <t>` above a
+    // CSV's header, the same note on the charts (and `"error"` in the JSON below).
+    let incomplete = failure.as_ref().map(|e| match e.t() {
+        // The reasons with a time say "at t = …" themselves.
+        Some(t) if !e.to_string().contains("t = ") => format!("incomplete: {e} at t = {t}"),
+        _ => format!("incomplete: {e}"),
+    });
+    if let Some(path) = &args.csv {
+        write_csv(
+            path,
+            model.as_ref(),
+            solution,
+            report,
+            constraints,
+            incomplete.as_deref(),
+        )?;
+    }
+    // A companion this run has nothing for is removed when an earlier run of eomgen wrote
+    // it; a file of that name that eomgen did not write is kept, with a warning.
+    if let Some(events) = &events_csv {
+        if solution.events.is_empty() {
+            files::remove_stale_or_warn(events, is_events_csv)?;
+        } else {
+            write_events_csv(events, model.as_ref(), solution)?;
+        }
+    }
+    if let Some(path) = &args.plot {
+        plot::time_histories(path, model.as_ref(), solution, incomplete.as_deref())
+            .map_err(CliError::failure)?;
+    }
+    if let Some(drift_path) = &drift_chart {
+        if constraints.is_empty() {
+            files::remove_stale_or_warn(drift_path, plot::is_own_drift_chart)?;
+        } else {
+            plot::constraint_drift(
+                drift_path,
+                &model.description().name,
+                &solution.t,
+                &constraints.drift,
+                incomplete.as_deref(),
+            )
+            .map_err(CliError::failure)?;
+        }
+    }
+    if let Some(path) = &args.plot_phase {
+        plot::phase_portrait(path, model.as_ref(), solution, incomplete.as_deref())
+            .map_err(CliError::failure)?;
+    }
+    if let Some(path) = &args.plot_energy {
+        plot::energy_drift(
+            path,
+            &model.description().name,
+            &solution.t,
+            &report.energy,
+            report.initial_energy,
+            incomplete.as_deref(),
+        )
+        .map_err(CliError::failure)?;
+    }
+    if args.json {
+        output::print_json(&json_report(model.as_ref(), args, &simulation))?;
+    } else {
+        print_summary(model.as_ref(), method_name, &args.run, solution, report);
+        print_constraint_summary(constraints, args.run.stabilization);
+        print_events(model.as_ref(), solution);
+    }
+    match failure {
+        None => Ok(()),
+        Some(e) => Err(failure_error(
+            &model.description().name,
+            e,
+            cause.as_ref(),
+            &args.run,
+            &format!(
+                "the {} samples computed before it were kept",
+                solution.len()
+            ),
+        )),
+    }
+}
+
+/// The JSON of `simulate --json` (see docs/cli.md): the samples with their energy (and
+/// constraint forces and drift), the settings, the drift measures and the integrator's
+/// statistics (`wall_time_s` only with `--timing`), then what applies: constraints, events,
+/// the error of a failed run, the warnings.
+fn json_report(model: &dyn ModelInfo, args: &SimulateArgs, simulation: &Simulation) -> Value {
+    let Simulation {
+        solution,
+        energy: report,
+        constraints,
+        failure,
+        warnings,
+        integrator: method_name,
+        ..
+    } = simulation;
+    let n = model.num_dofs();
+    let coordinates: Vec<String> = model
+        .description()
+        .coordinate_names()
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+    let samples: Vec<serde_json::Value> = solution
+        .iter()
+        .zip(&report.energy)
+        .enumerate()
+        .map(|(k, ((t, y), e))| {
+            let mut sample = json!({"t": t, "q": &y[..n], "qdot": &y[n..], "energy": e});
+            if !constraints.is_empty() {
+                sample["constraint_forces"] = json!(constraints.lagrange_multipliers[k]);
+                sample["constraint_drift"] =
+                    json!({"position": constraints.drift[k].0, "velocity": constraints.drift[k].1});
+            }
+            sample
+        })
+        .collect();
+    let mut out = json!({
+        "model": model.description().name,
+        "coordinates": coordinates,
+        "parameters": model.description().parameter_names().iter().zip(model.parameter_values()).map(|(k, v)| (k.to_string(), json!(v))).collect::<serde_json::Map<_, _>>(),
+        "method": method_name,
+        "rtol": args.run.rtol,
+        "atol": args.run.atol,
+        "samples": samples,
+        "initial_energy": report.initial_energy,
+        "energy_drift": report.drift,
+        "conservative": model.description().conservative,
+        "stats": solution.stats,
+    });
+    // The wall time is the one figure that differs between two identical runs: only asked
+    // for (`--timing`), so that the JSON is byte-identical across runs otherwise.
+    if !args.timing
+        && let Some(stats) = out["stats"].as_object_mut()
+    {
+        stats.remove("wall_time_s");
+    }
+    if !constraints.is_empty() {
+        out["constraints"] = json!(constraints.constraint_names);
+        out["stabilization"] = json!(format!("{:?}", args.run.stabilization).to_lowercase());
+        out["max_constraint_drift"] = json!({
+            "position": constraints.max_drift().0,
+            "velocity": constraints.max_drift().1,
+        });
+    }
+    if !solution.events.is_empty() || !args.run.stop_when.is_empty() || !args.run.event.is_empty() {
+        out["events"] = json!(
+            solution
+                .events
+                .iter()
+                .map(|e| json!({
+                    "name": e.name,
+                    "t": e.t,
+                    "direction": e.direction.name(),
+                    "terminal": e.terminal,
+                    "q": &e.y[..n],
+                    "qdot": &e.y[n..],
+                }))
+                .collect::<Vec<_>>()
+        );
+        out["terminated_by_event"] = json!(
+            solution
+                .terminated_by_event
+                .map(|k| solution.events[k].name.clone())
+        );
+    }
+    if let Some(e) = &failure {
+        out["error"] = json!({"t": e.t(), "message": e.to_string()});
+    }
+    if !warnings.is_empty() {
+        out["warnings"] = json!(
+            warnings
+                .iter()
+                .map(|w| {
+                    let mut warning = json!(w);
+                    warning["message"] = json!(w.to_string());
+                    warning
+                })
+                .collect::<Vec<_>>()
+        );
+    }
+    out
+}
+
+fn print_summary(
+    model: &dyn ModelInfo,
+    method: &str,
+    args: &IntegrationArgs,
+    solution: &Solution,
+    report: &EnergyDrift,
+) {
+    outln!(
+        "model      {} ({} dof): {}",
+        model.description().name,
+        model.num_dofs(),
+        model.description().summary
+    );
+    outln!("method     {method} ({})", args.step_control());
+    if let Some((t, y)) = solution.last() {
+        let n = model.num_dofs();
+        let names = model.description().coordinate_names();
+        outln!("final      t = {t}");
+        for (i, name) in names.iter().enumerate() {
+            outln!(
+                "           {name:>12} = {:>22.15e}   {:>16} = {:>22.15e}",
+                num(y[i]),
+                format!("{name}_dot"),
+                num(y[n + i])
+            );
+        }
+    }
+    if let (e0, Some(e1)) = (report.initial_energy, report.energy.last()) {
+        outln!(
+            "energy     E(0) = {e0:.12e} J, E(end) = {e1:.12e} J",
+            e0 = num(e0),
+            e1 = num(e1)
+        );
+        if let Some(d) = report.drift {
+            let note = if model.description().conservative {
+                ""
+            } else {
+                " (not conserved: the model has non-conservative loads or explicit time dependence)"
+            };
+            outln!(
+                "drift      max|E - E(0)| / max(T + |V|) = {d:.3e}{note}",
+                d = num(d)
+            );
+        }
+    }
+    let s = &solution.stats;
+    let implicit = if s.jacobian_evals > 0 {
+        format!(
+            ", {} Jacobians, {} LU factorisations",
+            s.jacobian_evals, s.lu_decompositions
+        )
+    } else {
+        String::new()
+    };
+    outln!(
+        "work       {} steps ({} rejected), {} RHS evaluations{implicit}, {:.3} ms",
+        s.steps,
+        s.rejected,
+        s.rhs_evals,
+        s.wall_time_s * 1e3
+    );
+}
+
+fn write_csv(
+    path: &str,
+    model: &dyn ModelInfo,
+    solution: &Solution,
+    report: &EnergyDrift,
+    constraints: &ConstraintDrift,
+    incomplete: Option<&str>,
+) -> Result<(), CliError> {
+    let mut out = incomplete.map_or_else(String::new, |note| format!("# {note}\n"));
+    out.push('t');
+    for c in model.description().coordinate_names() {
+        out.push(',');
+        out.push_str(c);
+    }
+    for c in model.description().coordinate_names() {
+        out.push_str(&format!(",{c}_dot"));
+    }
+    out.push_str(",energy");
+    for c in &constraints.constraint_names {
+        out.push_str(&format!(",lambda_{c}"));
+    }
+    if !constraints.is_empty() {
+        out.push_str(",drift_position,drift_velocity");
+    }
+    out.push('\n');
+    for (k, ((t, y), e)) in solution.iter().zip(&report.energy).enumerate() {
+        out.push_str(&format!("{t:e}"));
+        for v in y {
+            out.push_str(&format!(",{v:e}"));
+        }
+        out.push_str(&format!(",{e:e}"));
+        if !constraints.is_empty() {
+            // A state where λ cannot be solved (singular KKT matrix) leaves empty cells.
+            match &constraints.lagrange_multipliers[k] {
+                Some(forces) => forces.iter().for_each(|l| out.push_str(&format!(",{l:e}"))),
+                None => out.push_str(&",".repeat(constraints.constraint_names.len())),
+            }
+            let (p, v) = constraints.drift[k];
+            out.push_str(&format!(",{p:e},{v:e}"));
+        }
+        out.push('\n');
+    }
+    Ok(files::write(path, out.as_bytes())?)
+}
+
+/// The located events: name, direction, time and state, and the intervals between
+/// successive zeros of the same function (HW21: the period from successive peaks).
+fn print_events(model: &dyn ModelInfo, solution: &Solution) {
+    if solution.events.is_empty() {
+        return;
+    }
+    let n = model.num_dofs();
+    let names = model.description().coordinate_names();
+    outln!("events     {} located:", solution.events.len());
+    for e in &solution.events {
+        let state: Vec<String> = names
+            .iter()
+            .enumerate()
+            .map(|(i, c)| {
+                format!(
+                    "{c} = {:.9e}, {c}_dot = {:.9e}",
+                    num(e.y[i]),
+                    num(e.y[n + i])
+                )
+            })
+            .collect();
+        outln!(
+            "           {:<16} {:<8} t = {:.15e}   {}",
+            e.name,
+            e.direction.name(),
+            num(e.t),
+            state.join(", ")
+        );
+    }
+    let mut seen: Vec<&str> = Vec::new();
+    for e in &solution.events {
+        if seen.contains(&e.name.as_str()) {
+            continue;
+        }
+        seen.push(&e.name);
+        let times: Vec<f64> = solution
+            .events
+            .iter()
+            .filter(|x| x.name == e.name)
+            .map(|x| x.t)
+            .collect();
+        if times.len() >= 2 {
+            let intervals: Vec<String> = times
+                .windows(2)
+                .map(|w| format!("{:.12e}", num(w[1] - w[0])))
+                .collect();
+            outln!(
+                "intervals  between successive `{}`: {} s",
+                e.name,
+                intervals.join(", ")
+            );
+        }
+    }
+    if let Some(k) = solution.terminated_by_event {
+        let e = &solution.events[k];
+        outln!("stopped    at t = {:.15e} by event `{}`", num(e.t), e.name);
+    }
+}
+
+/// The first columns of an events CSV's header ([`write_events_csv`]).
+const EVENTS_HEADER: &str = "event,direction,terminal,t";
+
+/// Whether `bytes` is an events CSV that eomgen wrote, for any model: its first line is the
+/// exact header [`write_events_csv`] writes, [`EVENTS_HEADER`] then the coordinates `c₁…cₙ`
+/// and their rates `c₁_dot…cₙ_dot`.
+fn is_events_csv(bytes: &[u8]) -> bool {
+    let Some(line) = bytes.split(|&b| b == b'\n').next() else {
+        return false;
+    };
+    let Some(columns) = std::str::from_utf8(line)
+        .ok()
+        .and_then(|line| line.strip_prefix(EVENTS_HEADER)?.strip_prefix(','))
+    else {
+        return false;
+    };
+    let columns: Vec<&str> = columns.split(',').collect();
+    let (coordinates, rates) = columns.split_at(columns.len() / 2);
+    columns.len().is_multiple_of(2)
+        && coordinates
+            .iter()
+            .zip(rates)
+            .all(|(c, r)| !c.is_empty() && r.strip_suffix("_dot") == Some(c))
+}
+
+/// The located events as CSV: name, direction, t, coordinates, rates.
+fn write_events_csv(
+    path: &str,
+    model: &dyn ModelInfo,
+    solution: &Solution,
+) -> Result<(), CliError> {
+    let mut out = String::from(EVENTS_HEADER);
+    for c in model.description().coordinate_names() {
+        out.push_str(&format!(",{c}"));
+    }
+    for c in model.description().coordinate_names() {
+        out.push_str(&format!(",{c}_dot"));
+    }
+    out.push('\n');
+    for e in &solution.events {
+        out.push_str(&format!(
+            "{},{},{},{:e}",
+            e.name,
+            e.direction.name(),
+            e.terminal,
+            num(e.t)
+        ));
+        for v in &e.y {
+            out.push_str(&format!(",{v:e}"));
+        }
+        out.push('\n');
+    }
+    Ok(files::write(path, out.as_bytes())?)
+}
+
+/// `dir/name.svg` → `dir/name-{tag}.svg`, `dir.d/name` → `dir.d/name-{tag}` (only the
+/// file name's extension counts; a leading dot starts no extension).
+fn sibling(path: &str, tag: &str) -> String {
+    let name = path.rfind('/').map_or(0, |i| i + 1);
+    match path[name..].rfind('.') {
+        Some(dot) if dot > 0 => {
+            let (stem, ext) = path.split_at(name + dot);
+            format!("{stem}-{tag}{ext}")
+        }
+        _ => format!("{path}-{tag}"),
+    }
+}
+
+/// The constraint forces at the end and the largest drift, under `stabilization`.
+fn print_constraint_summary(constraints: &ConstraintDrift, stabilization: StabilizationArg) {
+    if constraints.is_empty() {
+        return;
+    }
+    if let Some(Some(last)) = constraints.lagrange_multipliers.last() {
+        let forces: Vec<String> = constraints
+            .constraint_names
+            .iter()
+            .zip(last)
+            .map(|(n, l)| format!("{n} = {l:.9e}", l = num(l)))
+            .collect();
+        outln!("lambda     at the end: {}", forces.join(", "));
+    }
+    let (p, v) = constraints.max_drift();
+    outln!(
+        "drift      constraints ({}): max |Φ| = {p:.3e}, max |Φ̇| = {v:.3e}",
+        format!("{stabilization:?}").to_lowercase(),
+        p = num(p),
+        v = num(v)
+    );
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{is_events_csv, sibling};
+
+    /// Only the file name's extension counts (a dot in a directory name used to put the tag
+    /// inside the directory's name), and a leading dot starts no extension.
+    #[test]
+    fn siblings_keep_the_extension_of_the_file_name() {
+        assert_eq!(sibling("out/run.csv", "events"), "out/run-events.csv");
+        assert_eq!(sibling("out.d/run", "events"), "out.d/run-events");
+        assert_eq!(sibling("run", "drift"), "run-drift");
+        assert_eq!(sibling("dir/.hidden", "drift"), "dir/.hidden-drift");
+        assert_eq!(sibling("a.b/c.tar.svg", "drift"), "a.b/c.tar-drift.svg");
+    }
+
+    /// An events CSV is recognised by the exact header eomgen writes, for any model; a file
+    /// whose first line differs in any way is not ours.
+    #[test]
+    fn an_events_csv_is_recognised_by_its_header() {
+        for ours in [
+            "event,direction,terminal,t,q,q_dot\n",
+            "event,direction,terminal,t,x,theta,x_dot,theta_dot\nhit,rising,true,1e0,0,0,0,0\n",
+        ] {
+            assert!(is_events_csv(ours.as_bytes()), "{ours}");
+        }
+        for theirs in [
+            "mine\n",
+            "",
+            "event,direction,terminal,t\n",
+            "event,direction,terminal,t,q\n",
+            "event,direction,terminal,t,q,p_dot\n",
+            "event,direction,terminal,time,q,q_dot\n",
+            "event,direction,terminal,t,q,q_dot,extra\n",
+            "# event,direction,terminal,t,q,q_dot\n",
+        ] {
+            assert!(!is_events_csv(theirs.as_bytes()), "{theirs}");
+        }
+    }
+}

@@ -1,0 +1,113 @@
+//! Opening a model as every command does: a bundled model by name or a model file by path
+//! (compiled once per process), and the errors of a model that cannot be opened or read,
+//! with a file's diagnostics rendered on their source lines.
+
+use eomgen_symbolic::model::ReadError;
+
+use super::error::CliError;
+use super::output;
+
+/// The model `name_or_path` names, with its default parameters: a bundled model, or a model
+/// file compiled at run time ([`eomgen::ModelSource::open`]).
+pub(super) fn find_model(name_or_path: &str) -> Result<Box<dyn eomgen::ModelInfo>, CliError> {
+    Ok(open_model(name_or_path)?.instantiate())
+}
+
+/// [`eomgen::ModelSource::open`] with its errors as the CLI reports them. A file is loaded
+/// and compiled once per process: the commands that simulate a model several times (`report`,
+/// the studies, `animate`) name it again by its path, and each use gets a fresh instance of
+/// the same compiled code.
+pub(super) fn open_model(name_or_path: &str) -> Result<eomgen::ModelSource, CliError> {
+    static FILES: std::sync::Mutex<Vec<(String, eomgen::ModelSource)>> =
+        std::sync::Mutex::new(Vec::new());
+    let cached = |files: &[(String, eomgen::ModelSource)]| {
+        files
+            .iter()
+            .find(|(path, _)| path == name_or_path)
+            .map(|(_, s)| s.clone())
+    };
+    if let Ok(files) = FILES.lock()
+        && let Some(source) = cached(&files)
+    {
+        return Ok(source);
+    }
+    let source = eomgen::ModelSource::open(name_or_path).map_err(open_error)?;
+    if let eomgen::ModelSource::File { path, model } = &source
+        && let Some(reason) = model.fallback_reason()
+    {
+        // Slower, but the same numbers: say so rather than run silently interpreted.
+        output::errln!("note: `{path}` runs on the interpreter: {reason}");
+    }
+    if source.is_file()
+        && let Ok(mut files) = FILES.lock()
+    {
+        files.push((name_or_path.to_string(), source.clone()));
+    }
+    Ok(source)
+}
+
+/// A model that could not be opened: an unknown name or an unreadable file is a usage error
+/// (exit 2), and so is a file with mistakes, whose located diagnostics are rendered with
+/// their source lines (and, for `--json`, given as JSON on standard output).
+pub(super) fn open_error(error: eomgen::OpenError) -> CliError {
+    let error = match error {
+        eomgen::OpenError::Load(eomgen::LoadError::Diagnostics {
+            path,
+            text,
+            diagnostics,
+        }) => diagnostics_error(&path, &text, &diagnostics),
+        eomgen::OpenError::Load(e @ eomgen::LoadError::Compile(_))
+        | eomgen::OpenError::Load(e @ eomgen::LoadError::Generate(_)) => {
+            CliError::failure(e.to_string())
+        }
+        other => CliError::usage(other.to_string()),
+    };
+    error.before_output()
+}
+
+/// The error of a model file with mistakes: every diagnostic rendered for the terminal, exit
+/// 2, and the JSON object `{"error", "diagnostics": [{"file", "line", "column", "message",
+/// "help"}]}` for `--json`.
+pub(super) fn diagnostics_error(
+    path: &str,
+    source: &str,
+    diagnostics: &[eomgen_symbolic::model::Diagnostic],
+) -> CliError {
+    let text: Vec<String> = diagnostics.iter().map(|d| d.render(path, source)).collect();
+    let summary = format!("{} error(s) in the model file `{path}`", diagnostics.len());
+    let json = serde_json::json!({
+        "error": summary,
+        "diagnostics": diagnostics.iter().map(|d| serde_json::json!({
+            "file": path,
+            "line": d.location.line,
+            "column": d.location.column,
+            "message": d.message,
+            "help": d.help,
+        })).collect::<Vec<_>>(),
+    });
+    CliError {
+        message: format!("{summary}\n{}", text.join("\n")),
+        code: 2,
+        json: Some(json),
+    }
+}
+
+/// Reads a bundled model by name or any file by path: `(display path, source)`.
+pub(super) fn read_model(model: &str) -> Result<(String, String), CliError> {
+    let resolved = eomgen::resolve(model).map_err(open_error)?;
+    let display = resolved.path().to_string();
+    let source = match &resolved {
+        // Compiled into the binary: no file is read.
+        eomgen::Resolved::Bundled(entry) => entry.source.to_string(),
+        eomgen::Resolved::File(path) => eomgen_symbolic::model::read_model_file(
+            std::path::Path::new(path),
+        )
+        .map_err(|e| match e {
+            ReadError::NotText { diagnostic, text } => {
+                diagnostics_error(&display, &text, &[diagnostic])
+            }
+            e => CliError::usage(format!("cannot read `{display}`: {e}")).before_output(),
+        })?,
+    };
+    Ok((display, source))
+}
