@@ -13,6 +13,7 @@ mod commands;
 mod error;
 mod files;
 mod integration;
+mod json;
 mod mode_plot;
 mod model;
 mod operating_point;

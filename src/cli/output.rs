@@ -123,14 +123,3 @@ pub(super) fn status(error: &io::Error) -> u8 {
         1
     }
 }
-
-/// Prints `value` as pretty JSON on stdout: the one form of every command's `--json`.
-///
-/// # Errors
-/// A value that cannot be encoded (a map with keys that are not strings).
-pub(super) fn print_json(value: &impl serde::Serialize) -> Result<(), super::error::CliError> {
-    let text = serde_json::to_string_pretty(value)
-        .map_err(|e| super::error::CliError::failure(e.to_string()))?;
-    let _ = writeln!(stdout(), "{text}");
-    Ok(())
-}

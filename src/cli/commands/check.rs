@@ -4,8 +4,8 @@ use clap::Args;
 use serde_json::json;
 
 use crate::cli::error::CliError;
+use crate::cli::json::print_json;
 use crate::cli::output::outln;
-use crate::cli::output::print_json;
 use crate::cli::render::num;
 use eomgen_symbolic::mechanics::cross_check::{
     CheckReport, INITIAL_CONSTRAINT_TOLERANCE, check_model,

@@ -12,7 +12,7 @@ use eomgen::studies::minimal_twin;
 use serde_json::json;
 
 use crate::cli::error::CliError;
-use crate::cli::output::print_json;
+use crate::cli::json::print_json;
 use crate::cli::plot;
 use crate::cli::render::num;
 

@@ -14,7 +14,7 @@ use serde_json::json;
 
 use crate::cli::error::CliError;
 use crate::cli::files::Outputs;
-use crate::cli::output::print_json;
+use crate::cli::json::print_json;
 use crate::cli::plot;
 use crate::cli::plot::log_y_chart;
 use crate::cli::render::num;

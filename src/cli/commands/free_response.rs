@@ -9,14 +9,16 @@
 
 use clap::Args;
 use eomgen::analysis::StudyRuns;
-use eomgen::analysis::vibration::{self, FreeResponseMethod, FreeResponseOptions, FreeResponseStudy};
+use eomgen::analysis::vibration::{
+    self, FreeResponseMethod, FreeResponseOptions, FreeResponseStudy,
+};
 use eomgen::{ModeKind, ModelInfo};
 use serde_json::json;
 
 use crate::cli::error::CliError;
 use crate::cli::files::Outputs;
+use crate::cli::json::print_json;
 use crate::cli::operating_point::{OperatingPointArgs, point_json};
-use crate::cli::output::print_json;
 use crate::cli::plot::Series;
 use crate::cli::render::num;
 use crate::cli::response_study::{Panel, kind_json, panels, parse_init, study_failure};

@@ -19,8 +19,8 @@ use serde_json::{Value, json};
 
 use crate::cli::error::CliError;
 use crate::cli::files::Outputs;
+use crate::cli::json::print_json;
 use crate::cli::operating_point::{OperatingPointArgs, point_json};
-use crate::cli::output::print_json;
 use crate::cli::plot;
 use crate::cli::render::num;
 use crate::cli::values::{evaluate, parameter_lookup};

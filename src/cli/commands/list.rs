@@ -1,8 +1,8 @@
 //! `eomgen list`: the bundled models, their degrees of freedom and descriptions.
 
 use crate::cli::error::CliError;
+use crate::cli::json::print_json;
 use crate::cli::output::outln;
-use crate::cli::output::print_json;
 
 /// Runs `list`: a table, or with `json` a JSON list of `{"name", "dof", "description"}`.
 pub fn run(json: bool) -> Result<(), CliError> {

@@ -12,8 +12,8 @@ use serde_json::json;
 
 use crate::cli::error::CliError;
 use crate::cli::files::Outputs;
+use crate::cli::json::print_json;
 use crate::cli::operating_point::{OperatingPointArgs, point_json};
-use crate::cli::output::print_json;
 use crate::cli::plot::Series;
 use crate::cli::render::matrix_rows;
 use crate::cli::render::num;

@@ -8,8 +8,8 @@ use nalgebra::DMatrix;
 use serde_json::json;
 
 use crate::cli::error::CliError;
+use crate::cli::json::print_json;
 use crate::cli::operating_point::{OperatingPointArgs, point_failure, point_json};
-use crate::cli::output::print_json;
 use crate::cli::render::matrix_rows;
 use crate::cli::render::num;
 

@@ -165,7 +165,7 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
         .map_err(CliError::failure)?;
     }
     if args.json {
-        output::print_json(&json_report(model.as_ref(), args, &simulation))?;
+        crate::cli::json::print_json(&json_report(model.as_ref(), args, &simulation))?;
     } else {
         print_summary(model.as_ref(), method_name, &args.run, solution, report);
         print_constraint_summary(constraints, args.run.stabilization);

@@ -25,8 +25,8 @@ use serde_json::json;
 
 use crate::cli::error::CliError;
 use crate::cli::files::Outputs;
+use crate::cli::json::print_json;
 use crate::cli::model::find_model;
-use crate::cli::output::print_json;
 use crate::cli::plot::{self, log_y_chart};
 use crate::cli::render::num;
 

@@ -1,0 +1,241 @@
+//! The animation as an animated GIF for slides: the same picture drawn frame by frame with
+//! plotters, a fixed palette, and each frame only the rectangle that changed.
+
+use super::*;
+
+impl Animation {
+    /// Writes clip `clip` as an animated GIF: the same picture (equal scales, the whole run's
+    /// box), at most [`GIF_MAX_FPS`] frames per second of `t` and [`GIF_MAX_FRAMES`] frames,
+    /// played in real time, looping.
+    ///
+    /// # Errors
+    /// A failure when drawing or writing the file fails.
+    pub(crate) fn write_gif(&self, path: &str, clip: usize) -> Result<(), CliError> {
+        let fail = |e: String| CliError::failure(format!("`{path}`: {e}"));
+        plot::register_font().map_err(fail)?;
+        let scene = &self.scene;
+        let clip = &self.clips[clip];
+        let (x0, x1, y0, y1) = bounding_box(&self.clips);
+        let per_pixel = (x1 - x0).max(y1 - y0) / f64::from(GIF_SIDE);
+        let width = ((x1 - x0) / per_pixel).round().max(240.0) as u32;
+        let height = ((y1 - y0) / per_pixel).round().max(80.0) as u32 + GIF_CAPTION;
+        // The frame step: a frame interval of at least 1/GIF_MAX_FPS s and at most
+        // GIF_MAX_FRAMES frames.
+        let n = clip.t.len();
+        let dt = if n > 1 {
+            (clip.t[n - 1] - clip.t[0]) / (n - 1) as f64
+        } else {
+            1.0
+        };
+        let step = ((1.0 / (GIF_MAX_FPS * dt)).ceil() as usize)
+            .max(n.div_ceil(GIF_MAX_FRAMES))
+            .max(1);
+        let delay = (100.0 * dt * step as f64 / clip.rate)
+            .round()
+            .clamp(2.0, 6000.0) as u16;
+        let palette = Palette::new();
+        // Encoded in memory (at most GIF_MAX_FRAMES frames of a small picture) and written
+        // atomically.
+        let mut encoder = gif::Encoder::new(Vec::new(), width as u16, height as u16, &palette.rgb)
+            .map_err(|e| fail(e.to_string()))?;
+        encoder
+            .set_repeat(gif::Repeat::Infinite)
+            .map_err(|e| fail(e.to_string()))?;
+        let to_pixel = |(x, y): (f64, f64)| -> (i32, i32) {
+            (
+                ((x - x0) / per_pixel).round() as i32,
+                (GIF_CAPTION as f64 + (y1 - y) / per_pixel).round() as i32,
+            )
+        };
+        let mut buffer = vec![0u8; (width * height * 3) as usize];
+        let rgb = |(r, g, b): (u8, u8, u8)| RGBColor(r, g, b);
+        let mut previous: Vec<u8> = Vec::new();
+        let mut k = 0;
+        while k < n {
+            {
+                let root =
+                    BitMapBackend::with_buffer(&mut buffer, (width, height)).into_drawing_area();
+                let err = |e: DrawingAreaErrorKind<_>| fail(format!("drawing failed: {e}"));
+                root.fill(&WHITE).map_err(err)?;
+                let step_m = grid_step((x1 - x0).max(y1 - y0));
+                for i in (x0 / step_m).ceil() as i64..=(x1 / step_m).floor() as i64 {
+                    let x = i as f64 * step_m;
+                    root.draw(&PathElement::new(
+                        vec![to_pixel((x, y0)), to_pixel((x, y1))],
+                        rgb(GRID),
+                    ))
+                    .map_err(err)?;
+                }
+                for i in (y0 / step_m).ceil() as i64..=(y1 / step_m).floor() as i64 {
+                    let y = i as f64 * step_m;
+                    root.draw(&PathElement::new(
+                        vec![to_pixel((x0, y)), to_pixel((x1, y))],
+                        rgb(GRID),
+                    ))
+                    .map_err(err)?;
+                }
+                let frame = &clip.frames[k];
+                for trail in &clip.trail {
+                    let path: Vec<(i32, i32)> = trail[..=k * clip.sub]
+                        .iter()
+                        .map(|p| to_pixel(*p))
+                        .collect();
+                    root.draw(&PathElement::new(path, rgb(TRACE).stroke_width(2)))
+                        .map_err(err)?;
+                }
+                for [a, b] in &scene.lines {
+                    root.draw(&PathElement::new(
+                        vec![to_pixel(frame[*a]), to_pixel(frame[*b])],
+                        rgb(LINK).stroke_width(5),
+                    ))
+                    .map_err(err)?;
+                }
+                for &d in &scene.dots {
+                    root.draw(&Circle::new(to_pixel(frame[d]), 5, rgb(JOINT).filled()))
+                        .map_err(err)?;
+                }
+                for &(c, _, _) in &scene.centres {
+                    root.draw(&Circle::new(
+                        to_pixel(frame[c]),
+                        8,
+                        rgb(JOINT).stroke_width(2),
+                    ))
+                    .map_err(err)?;
+                }
+                let caption = match &clip.energy {
+                    Some(e) => format!(
+                        "{}   t = {:.2} s   E = {} J",
+                        scene.model,
+                        clip.t[k],
+                        mode_plot::significant(e.energy[k])
+                    ),
+                    None => format!("{}, {}   t = {:.3} s", scene.model, clip.label, clip.t[k]),
+                };
+                root.draw(&Text::new(caption, (10, 7), ("sans-serif", 16).into_font()))
+                    .map_err(err)?;
+                root.present().map_err(err)?;
+            }
+            let indices = palette.map(&buffer);
+            let mut frame = changed_rectangle(&previous, &indices, width as usize);
+            frame.delay = delay;
+            frame.dispose = gif::DisposalMethod::Keep;
+            encoder
+                .write_frame(&frame)
+                .map_err(|e| fail(e.to_string()))?;
+            previous = indices;
+            k += step;
+        }
+        let bytes = encoder.into_inner().map_err(|e| fail(e.to_string()))?;
+        Ok(crate::cli::files::write(path, &bytes)?)
+    }
+}
+
+/// A GIF frame of the pixels of `current` (palette indices, rows of `width`) inside the
+/// smallest rectangle holding every pixel that differs from `previous` (the whole image when
+/// `previous` is empty; one pixel when nothing changed), to be drawn over the previous frame.
+fn changed_rectangle(previous: &[u8], current: &[u8], width: usize) -> gif::Frame<'static> {
+    let height = current.len() / width;
+    let (mut x0, mut x1, mut y0, mut y1) = (width, 0, height, 0);
+    if previous.len() == current.len() {
+        for (i, (a, b)) in previous.iter().zip(current).enumerate() {
+            if a != b {
+                let (x, y) = (i % width, i / width);
+                x0 = x0.min(x);
+                x1 = x1.max(x);
+                y0 = y0.min(y);
+                y1 = y1.max(y);
+            }
+        }
+        if x0 > x1 {
+            (x0, x1, y0, y1) = (0, 0, 0, 0);
+        }
+    } else {
+        (x0, x1, y0, y1) = (0, width - 1, 0, height - 1);
+    }
+    let pixels: Vec<u8> = (y0..=y1)
+        .flat_map(|y| current[y * width + x0..=y * width + x1].iter().copied())
+        .collect();
+    let mut frame =
+        gif::Frame::from_indexed_pixels((x1 - x0 + 1) as u16, (y1 - y0 + 1) as u16, pixels, None);
+    frame.left = x0 as u16;
+    frame.top = y0 as u16;
+    frame
+}
+
+/// The GIF's global palette: white, a grey ramp (text, joints, grid) and ramps from white
+/// to each drawing colour (anti-aliased edges), with a lookup table from 5-bit RGB to the
+/// nearest entry — fixed, so the file is deterministic and no quantiser is needed.
+struct Palette {
+    rgb: Vec<u8>,
+    table: Vec<u8>,
+}
+
+impl Palette {
+    fn new() -> Self {
+        let mut colours: Vec<(u8, u8, u8)> = Vec::new();
+        for i in 0..32u32 {
+            let g = (255 * i / 31) as u8;
+            colours.push((g, g, g));
+        }
+        for c in [LINK, TRACE] {
+            for i in 1..=16u32 {
+                let mix = |from: u8, to: u8| {
+                    (f64::from(from) + (f64::from(to) - f64::from(from)) * f64::from(i) / 16.0)
+                        .round() as u8
+                };
+                colours.push((mix(255, c.0), mix(255, c.1), mix(255, c.2)));
+            }
+        }
+        let rgb: Vec<u8> = colours.iter().flat_map(|c| [c.0, c.1, c.2]).collect();
+        let mut table = vec![0u8; 1 << 15];
+        for (key, entry) in table.iter_mut().enumerate() {
+            let channel = |shift: usize| (((key >> shift) & 31) * 255 / 31) as i32;
+            let (r, g, b) = (channel(10), channel(5), channel(0));
+            let nearest = colours
+                .iter()
+                .enumerate()
+                .min_by_key(|(_, c)| {
+                    let d = |a: u8, b: i32| (i32::from(a) - b).pow(2);
+                    d(c.0, r) + d(c.1, g) + d(c.2, b)
+                })
+                .map_or(0, |(i, _)| i);
+            *entry = nearest as u8;
+        }
+        Self { rgb, table }
+    }
+
+    /// Palette indices of an RGB buffer.
+    fn map(&self, buffer: &[u8]) -> Vec<u8> {
+        buffer
+            .chunks_exact(3)
+            .map(|p| {
+                let key = (usize::from(p[0] >> 3) << 10)
+                    | (usize::from(p[1] >> 3) << 5)
+                    | usize::from(p[2] >> 3);
+                self.table[key]
+            })
+            .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The palette maps its own colours to themselves (drawn pixels keep their colour).
+    #[test]
+    fn palette_keeps_the_drawing_colours() {
+        let palette = Palette::new();
+        for c in [LINK, TRACE, (255, 255, 255), (0, 0, 0)] {
+            let i = usize::from(palette.map(&[c.0, c.1, c.2])[0]);
+            let entry = &palette.rgb[3 * i..3 * i + 3];
+            // 5-bit keys: within 8 per channel of the colour.
+            for (a, b) in entry.iter().zip([c.0, c.1, c.2]) {
+                assert!(
+                    (i32::from(*a) - i32::from(b)).abs() <= 8,
+                    "{c:?} → {entry:?}"
+                );
+            }
+        }
+    }
+}

@@ -1,0 +1,285 @@
+//! The animation as one self-contained HTML page: the frames as inline JSON, the drawing as
+//! inline SVG, the stylesheet and the player inline.
+
+use super::*;
+
+/// The stylesheet, the error hooks (first script: they record script errors and
+/// `console.error` into `#errors`) and the player.
+const STYLE: &str = include_str!("animate.css");
+const HOOKS: &str = include_str!("animate_hooks.js");
+const PLAYER: &str = include_str!("animate.js");
+
+/// A JSON string literal safe inside `<script>` (no `</script>`).
+fn json_string(s: &str) -> String {
+    serde_json::Value::from(s)
+        .to_string()
+        .replace('<', "\\u003c")
+}
+
+impl Animation {
+    /// The page: HTML with the data, stylesheet and player inline, deterministic.
+    pub(crate) fn to_html(&self) -> String {
+        let scene = &self.scene;
+        let (x0, x1, y0, y1) = bounding_box(&self.clips);
+        let span = (x1 - x0).max(y1 - y0);
+        let magnitude = span.log10().floor() as i32;
+        let decimals = (POSITION_DIGITS - magnitude).clamp(0, 17) as usize;
+        let view_decimals = (5 - magnitude).clamp(0, 17) as usize;
+        let p = |v: f64| fixed(v, decimals);
+        let v = |v: f64| fixed(v, view_decimals);
+        let data = self.data_json(&p);
+
+        let step = grid_step(span);
+        let svg = self.scene_svg((x0, x1, y0, y1), &p, &v);
+
+        let choice = if self.clips.len() > 1 || self.clips[0].period.is_some() {
+            let options: Vec<String> = self
+                .clips
+                .iter()
+                .enumerate()
+                .map(|(i, c)| format!("<option value=\"{i}\">{}</option>", escape(&c.label)))
+                .collect();
+            format!(
+                "<select id=\"clip\" aria-label=\"mode\">{}</select>",
+                options.join("")
+            )
+        } else {
+            String::new()
+        };
+        let speeds = [0.25, 0.5, 1.0, 2.0, 4.0]
+            .iter()
+            .map(|s| {
+                let selected = if *s == 1.0 { " selected" } else { "" };
+                format!("<option value=\"{s}\"{selected}>{s}×</option>")
+            })
+            .collect::<Vec<_>>()
+            .join("");
+        let last_frame = self.clips[0].t.len() - 1;
+        let view = if scene.three_d {
+            "isometric view: across (x − y) cos 30°, up z + (x + y) sin 30°; "
+        } else {
+            ""
+        };
+        format!(
+            r#"<!DOCTYPE html>
+<html lang="en">
+<head>
+<meta charset="utf-8">
+<meta name="viewport" content="width=device-width, initial-scale=1">
+<title>{title}</title>
+<script>
+{HOOKS}</script>
+<style>
+{STYLE}</style>
+</head>
+<body>
+<h1>{title}</h1>
+<p id="info">{info}</p>
+{svg}
+<div class="controls">
+{choice}
+<button id="play" type="button" title="play or pause (space)">Pause</button>
+<label>speed <select id="speed">{speeds}</select></label>
+<input id="scrub" type="range" min="0" max="{last_frame}" step="1" value="0" aria-label="frame">
+</div>
+<div class="readout"><span id="time" data-t="0">t = 0 s</span><span id="energy"></span><span id="drift"></span><span id="frame" data-frame="0">frame 1 / {frames}</span><span class="hint">{view}grid {grid} m · space: play/pause · ←/→: step</span></div>
+<pre id="errors"></pre>
+<script>
+const DATA = {data};
+</script>
+<script>
+{PLAYER}</script>
+</body>
+</html>
+"#,
+            title = escape(&scene.title),
+            info = escape(&self.clips[0].info),
+            frames = last_frame + 1,
+            grid = short(step),
+        )
+    }
+
+    /// The data of the player, a JS object literal: the scene (names, lines, dots, traces,
+    /// centres) and every clip's times and frames; positions through `p`.
+    fn data_json(&self, p: &dyn Fn(f64) -> String) -> String {
+        let scene = &self.scene;
+        let mut data = String::new();
+        let names: Vec<String> = scene.names.iter().map(|n| json_string(n)).collect();
+        let pairs = |list: &[usize]| {
+            list.iter()
+                .map(usize::to_string)
+                .collect::<Vec<_>>()
+                .join(",")
+        };
+        let _ = write!(
+            data,
+            "{{\"title\":{},\"names\":[{}],\"lines\":[{}],\"dots\":[{}],\"traces\":[{}],\"centres\":[{}],\"clips\":[",
+            json_string(&scene.title),
+            names.join(","),
+            scene
+                .lines
+                .iter()
+                .map(|[a, b]| format!("[{a},{b}]"))
+                .collect::<Vec<_>>()
+                .join(","),
+            pairs(&scene.dots),
+            pairs(&scene.traces),
+            pairs(&scene.centres.iter().map(|c| c.0).collect::<Vec<_>>()),
+        );
+        for (c, clip) in self.clips.iter().enumerate() {
+            if c > 0 {
+                data.push(',');
+            }
+            let _ = write!(
+                data,
+                "\n{{\"label\":{},\"info\":{},\"rate\":{:e},\"period\":{},\"t\":[{}],\n\"xy\":[",
+                json_string(&clip.label),
+                json_string(&clip.info),
+                clip.rate,
+                clip.period.map_or("null".to_string(), |p| format!("{p:e}")),
+                clip.t
+                    .iter()
+                    .map(|t| format!("{t:e}"))
+                    .collect::<Vec<_>>()
+                    .join(","),
+            );
+            for (k, f) in clip.frames.iter().enumerate() {
+                if k > 0 {
+                    data.push_str(",\n");
+                }
+                data.push('[');
+                for (i, (x, y)) in f.iter().enumerate() {
+                    if i > 0 {
+                        data.push(',');
+                    }
+                    let _ = write!(data, "{},{}", p(*x), p(*y));
+                }
+                data.push(']');
+            }
+            data.push_str("],\n\"trail\":[");
+            for (i, path) in clip.trail.iter().enumerate() {
+                if i > 0 {
+                    data.push_str(",\n");
+                }
+                let xy: Vec<String> = path
+                    .iter()
+                    .map(|(x, y)| format!("{},{}", p(*x), p(*y)))
+                    .collect();
+                let _ = write!(data, "[{}]", xy.join(","));
+            }
+            let _ = write!(data, "],\"sub\":{}", clip.sub);
+            if let Some(e) = &clip.energy {
+                let _ = write!(
+                    data,
+                    ",\n\"e\":[{}],\n\"de\":[{}]",
+                    e.energy
+                        .iter()
+                        .map(|v| format!("{v:e}"))
+                        .collect::<Vec<_>>()
+                        .join(","),
+                    e.drift
+                        .iter()
+                        .map(|v| format!("{v:.2e}"))
+                        .collect::<Vec<_>>()
+                        .join(",")
+                );
+            }
+            data.push('}');
+        }
+        data.push_str("]}");
+        data
+    }
+
+    /// The picture: the grid over the box `(x0, x1, y0, y1)` and the mechanism at the first
+    /// frame, positions through `p`, view-box sizes through `v`.
+    fn scene_svg(
+        &self,
+        (x0, x1, y0, y1): (f64, f64, f64, f64),
+        p: &dyn Fn(f64) -> String,
+        v: &dyn Fn(f64) -> String,
+    ) -> String {
+        let scene = &self.scene;
+        let span = (x1 - x0).max(y1 - y0);
+        // The picture: y up (a flipped group), the view box of the whole run.
+        let mut svg = String::new();
+        let _ = write!(
+            svg,
+            "<svg id=\"scene\" viewBox=\"{} {} {} {}\" role=\"img\" aria-label=\"{}\">\n<g transform=\"scale(1,-1)\">\n<g class=\"grid\">",
+            v(x0),
+            v(-y1),
+            v(x1 - x0),
+            v(y1 - y0),
+            escape(&scene.title)
+        );
+        // The grid covers twice the box about its centre, so it fills a view box widened to
+        // the page's shape.
+        let step = grid_step(span);
+        let (cx, cy) = (0.5 * (x0 + x1), 0.5 * (y0 + y1));
+        let (gx0, gx1, gy0, gy1) = (cx - span, cx + span, cy - span, cy + span);
+        let first = |lo: f64| (lo / step).ceil() as i64;
+        let last = |hi: f64| (hi / step).floor() as i64;
+        for i in first(gx0)..=last(gx1) {
+            let x = i as f64 * step;
+            let class = if i == 0 { " class=\"axis\"" } else { "" };
+            let _ = write!(
+                svg,
+                "<line{class} x1=\"{}\" y1=\"{}\" x2=\"{}\" y2=\"{}\"/>",
+                v(x),
+                v(gy0),
+                v(x),
+                v(gy1)
+            );
+        }
+        for i in first(gy0)..=last(gy1) {
+            let y = i as f64 * step;
+            let class = if i == 0 { " class=\"axis\"" } else { "" };
+            let _ = write!(
+                svg,
+                "<line{class} x1=\"{}\" y1=\"{}\" x2=\"{}\" y2=\"{}\"/>",
+                v(gx0),
+                v(y),
+                v(gx1),
+                v(y)
+            );
+        }
+        svg.push_str("</g>\n");
+        let f0 = &self.clips[0].frames[0];
+        for i in 0..scene.traces.len() {
+            let _ = write!(svg, "<polyline id=\"tr{i}\" class=\"trace\" points=\"\"/>");
+        }
+        for (i, [a, b]) in scene.lines.iter().enumerate() {
+            let _ = write!(
+                svg,
+                "<line id=\"l{i}\" class=\"link\" x1=\"{}\" y1=\"{}\" x2=\"{}\" y2=\"{}\"/>",
+                p(f0[*a].0),
+                p(f0[*a].1),
+                p(f0[*b].0),
+                p(f0[*b].1)
+            );
+        }
+        let radius = v(0.012 * span);
+        for (i, d) in scene.dots.iter().enumerate() {
+            let _ = write!(
+                svg,
+                "<circle id=\"d{i}\" class=\"joint\" cx=\"{}\" cy=\"{}\" r=\"{radius}\"><title>{}</title></circle>",
+                p(f0[*d].0),
+                p(f0[*d].1),
+                escape(&scene.names[*d])
+            );
+        }
+        for (i, (c, rigid, body)) in scene.centres.iter().enumerate() {
+            let kind = if *rigid { "rigid body" } else { "particle" };
+            let _ = write!(
+                svg,
+                "<circle id=\"c{i}\" class=\"centre\" cx=\"{}\" cy=\"{}\" r=\"{}\"><title>{} ({kind}), centre of mass {}</title></circle>",
+                p(f0[*c].0),
+                p(f0[*c].1),
+                v(0.022 * span),
+                escape(body),
+                escape(&scene.names[*c])
+            );
+        }
+        svg.push_str("\n</g>\n</svg>");
+        svg
+    }
+}
