@@ -978,31 +978,61 @@ fn issue_28_failure_hints_name_the_model_cause() {
 
 /// The CLI's two layers (issue 29, item 4): a command in `src/cli/commands/` imports the
 /// library and the shared pieces beside `src/cli/mod.rs` (`crate::cli::…`), never another
-/// command. Inside `commands/`, `super::` can only name a sibling command and `commands::`
-/// the commands themselves, so neither may appear outside a file's `#[cfg(test)]` module
-/// (where `super::` is the command itself).
+/// command. Checked over every file below `src/cli/` (folders included), in the code before
+/// the file's test module (`#[cfg(test)]` followed by `mod`):
+/// - inside `commands/`, neither `super::` (a sibling command) nor the word `commands` (a
+///   path to the commands, or an alias of it) may appear;
+/// - outside it, only `src/cli/mod.rs` (which dispatches) may name `commands`, so that no
+///   shared piece re-exports a command.
 #[test]
 fn commands_import_no_other_command() {
-    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/src/cli/commands");
-    let mut checked = 0;
-    for entry in std::fs::read_dir(dir).unwrap() {
-        let path = entry.unwrap().path();
-        if path.extension().is_none_or(|e| e != "rs") || path.ends_with("mod.rs") {
+    fn files(dir: &std::path::Path, out: &mut Vec<std::path::PathBuf>) {
+        for entry in std::fs::read_dir(dir).unwrap() {
+            let path = entry.unwrap().path();
+            if path.is_dir() {
+                files(&path, out);
+            } else if path.extension().is_some_and(|e| e == "rs") {
+                out.push(path);
+            }
+        }
+    }
+    let root = std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/src/cli"));
+    let mut all = Vec::new();
+    files(root, &mut all);
+    let mut commands = 0;
+    for path in &all {
+        let relative = path.strip_prefix(root).unwrap();
+        let in_commands = relative.starts_with("commands");
+        if relative == std::path::Path::new("mod.rs")
+            || relative == std::path::Path::new("commands/mod.rs")
+        {
             continue;
         }
-        let text = std::fs::read_to_string(&path).unwrap();
-        let code = text.split("#[cfg(test)]").next().unwrap_or_default();
+        let text = std::fs::read_to_string(path).unwrap();
+        let code = text.split("#[cfg(test)]\nmod ").next().unwrap_or_default();
         for (k, line) in code.lines().enumerate() {
+            let names_commands = line
+                .split(|c: char| !(c.is_alphanumeric() || c == '_'))
+                .any(|word| word == "commands");
+            let bad = if in_commands {
+                line.contains("super::") || names_commands
+            } else {
+                names_commands && !line.trim_start().starts_with("//")
+            };
             assert!(
-                !line.contains("super::") && !line.contains("commands::"),
-                "{}:{}: a command imports another command (or names it): `{}`; move what \
-                 they share to a file beside src/cli/mod.rs",
+                !bad,
+                "{}:{}: a command imports another command, or a shared piece names the \
+                 commands: `{}`; move what they share to a file beside src/cli/mod.rs",
                 path.display(),
                 k + 1,
                 line.trim()
             );
         }
-        checked += 1;
+        commands += usize::from(in_commands);
     }
-    assert!(checked >= 10, "only {checked} command files found in {dir}");
+    assert!(
+        commands >= 10,
+        "only {commands} command files found below {}",
+        root.display()
+    );
 }

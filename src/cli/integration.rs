@@ -381,7 +381,7 @@ fn failure_hint(
             "the run needs more steps than allowed: loosen --rtol/--atol or shorten --t-end"
         }
         IntegrationError::JacobianNonFinite { .. } => {
-            "the Jacobian of the right-hand side is not finite there, even by differences, though the right-hand side is: a term of the model grows without bound in its derivative; smooth the model there, or use an explicit method (--method dopri5)"
+            "the Jacobian of the right-hand side is not finite there, even by differences, though the right-hand side is: a term of the model grows without bound in its derivative; smooth the model there, or use an explicit method (--method dp54)"
         }
         IntegrationError::NonFiniteState { .. } | IntegrationError::RhsNonFinite { .. }
             if !adaptive =>

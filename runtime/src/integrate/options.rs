@@ -111,8 +111,9 @@ pub struct IntegratorOptions {
 }
 
 impl IntegratorOptions {
-    /// The default relative tolerance of an integrator used on its own (the common default of
-    /// general-purpose ODE solvers); a simulation of a model uses
+    /// The default relative tolerance of an integrator used on its own (tighter than SciPy's
+    /// `solve_ivp` and MATLAB's `ode45`, whose defaults are 1e-3 and 1e-6); a simulation of a
+    /// model uses
     /// `SimulationOptions::DEFAULT_RTOL` (1e-8) instead.
     pub const DEFAULT_RTOL: f64 = 1e-6;
     /// The default absolute tolerance of an integrator used on its own.

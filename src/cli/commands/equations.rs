@@ -107,9 +107,7 @@ pub fn run(args: &EquationsArgs) -> Result<(), CliError> {
             equations: EquationsListing::of(&model, &eom, Syntax::Text),
             latex: EquationsListing::of(&model, &eom, Syntax::Latex),
         };
-        let text = serde_json::to_string_pretty(&report)
-            .map_err(|e| CliError::failure(format!("cannot encode the equations: {e}")))?;
-        out!("{text}\n");
+        crate::cli::json::print_json(&report)?;
     } else if args.latex {
         out!("{}", equations_latex(&model, &eom));
     } else {

@@ -254,15 +254,12 @@ pub fn run(args: &WorkPrecisionArgs) -> Result<(), CliError> {
             &study.report.results,
         )?;
     }
-    let mut stdout = crate::cli::output::stdout();
-    // A failed write (a pipe into `head` closed) is kept by `output` and sets the status.
-    let _ = if args.json {
-        serde_json::to_string_pretty(&study.to_json())
-            .map_err(|e| CliError::failure(e.to_string()))
-            .map(|text| writeln!(stdout, "{text}"))?
+    if args.json {
+        crate::cli::json::print_json(&study.to_json())?;
     } else {
-        study.write_text(&mut stdout)
-    };
+        // A failed write (a pipe into `head` closed) is kept by `output` and sets the status.
+        let _ = study.write_text(&mut crate::cli::output::stdout());
+    }
     study.report.check_measured().map_err(|e| {
         CliError::failure(format!(
             "{e}; try tolerances between 1e-3 and 1e-13{}",
