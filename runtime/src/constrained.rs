@@ -87,6 +87,17 @@ pub enum StabilizationError {
 pub const MAX_BAUMGARTE_GAIN: f64 = 1e6;
 
 impl Stabilization {
+    /// The default Baumgarte gains `[α, β]` (1/s) of `--baumgarte` and of the constraint
+    /// methods study: a drift decaying like a critically damped oscillator of 10 rad/s,
+    /// fast against the motions of the bundled mechanisms (periods of about a second).
+    pub const DEFAULT_BAUMGARTE_GAINS: [f64; 2] = [10.0, 10.0];
+
+    /// Baumgarte's stabilisation with [`Self::DEFAULT_BAUMGARTE_GAINS`].
+    pub const fn default_baumgarte() -> Self {
+        let [alpha, beta] = Self::DEFAULT_BAUMGARTE_GAINS;
+        Stabilization::Baumgarte { alpha, beta }
+    }
+
     /// Checks the gains: Baumgarte's `α`, `β` in `[0, MAX_BAUMGARTE_GAIN]` (1/s); the
     /// penalty's stiffness finite and positive, its damping finite and ≥ 0.
     ///

@@ -100,7 +100,7 @@ pub struct IntegrationArgs {
     #[arg(long, value_enum, default_value_t = StabilizationArg::None)]
     pub stabilization: StabilizationArg,
     /// Baumgarte's α and β (1/s, in [0, 1e6]), `ALPHA,BETA`.
-    #[arg(long, value_name = "ALPHA,BETA", value_delimiter = ',', value_parser = super::values::baumgarte_gain, allow_hyphen_values = true, default_values_t = [10.0, 10.0])]
+    #[arg(long, value_name = "ALPHA,BETA", value_delimiter = ',', value_parser = super::values::baumgarte_gain, allow_hyphen_values = true, default_values_t = eomgen::Stabilization::DEFAULT_BAUMGARTE_GAINS)]
     pub baumgarte: Vec<f64>,
     /// Stop at the first zero of a function: a model event's name (`--stop-when lift_off`)
     /// or `EXPR` / `LHS = RHS`, optionally followed by `, rising`, `, falling` or `, both`

@@ -252,7 +252,7 @@ impl Default for FloquetOptions {
         Self {
             rtol: Self::DEFAULT_TOL,
             atol: Self::DEFAULT_TOL,
-            max_steps: 1_000_000,
+            max_steps: crate::IntegratorOptions::DEFAULT_MAX_STEPS,
             stability_tolerance: 1e-6,
         }
     }
