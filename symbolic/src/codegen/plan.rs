@@ -8,7 +8,7 @@
 //! what was planned before it). Both consumers go through the same two steps:
 //! [`plan_state`] plans the functions of the state ([`ModelFunction::STATE`], always first
 //! and in this order) on a copy of the derived model's arena, and [`plan_jacobians`] derives
-//! the exact Jacobians and plans them on a copy of that arena. The macro plans `mass_matrix`
+//! the exact Jacobians and plans them on the arena they were added to. The macro plans `mass_matrix`
 //! and `forcing` apart after the others, which leaves their plans unchanged. So a model
 //! compiled at build time and one compiled at run time compute the same operations in the
 //! same order by construction (the bit-identity tests in `tests/runtime_models.rs` stay as a
@@ -214,14 +214,22 @@ pub fn plan_state(
     extra: &[ModelFunction],
 ) -> ModelPlans {
     let functions: Vec<ModelFunction> = ModelFunction::STATE.iter().chain(extra).copied().collect();
-    plan_functions(model, eom, None, &functions)
+    plan_functions(model.arena.clone(), model, eom, None, &functions)
 }
 
 /// Derives the exact Jacobians of a derived model ([`Jacobians::of`], which adds their nodes
-/// to its arena) and plans [`ModelFunction::JACOBIANS`] on a copy of its arena.
-pub fn plan_jacobians(model: &mut SymbolicModel, eom: &EquationsOfMotion) -> ModelPlans {
-    let jacobians = Jacobians::of(model, eom);
-    plan_functions(model, eom, Some(&jacobians), &ModelFunction::JACOBIANS)
+/// to its arena) and plans [`ModelFunction::JACOBIANS`] on that arena, which the plans keep
+/// (the model is consumed: nothing else needs it once its Jacobians are planned).
+pub fn plan_jacobians(mut model: SymbolicModel, eom: &EquationsOfMotion) -> ModelPlans {
+    let jacobians = Jacobians::of(&mut model, eom);
+    let arena = std::mem::take(&mut model.arena);
+    plan_functions(
+        arena,
+        &model,
+        eom,
+        Some(&jacobians),
+        &ModelFunction::JACOBIANS,
+    )
 }
 
 /// Every plan the `model!` macro's code is printed from: [`plan_state`] with `mass_matrix`
@@ -243,8 +251,7 @@ impl EmitPlans {
             eom,
             &[ModelFunction::MassMatrix, ModelFunction::Forcing],
         );
-        let mut differentiated = model.clone();
-        let jacobians = plan_jacobians(&mut differentiated, eom);
+        let jacobians = plan_jacobians(model.clone(), eom);
         Self { state, jacobians }
     }
 
@@ -256,17 +263,18 @@ impl EmitPlans {
     }
 }
 
-/// Plans `functions` of a derived model, in the order given, one after the other on one copy
-/// of its arena. A function the model does not have ([`ModelFunction`]'s constraint, event
+/// Plans `functions` of a derived model, in the order given, one after the other on `arena`
+/// (the model's arena or a copy of it; the roots are looked up in the model, never its
+/// arena). A function the model does not have ([`ModelFunction`]'s constraint, event
 /// and equilibrium functions of a model without any; the Jacobians when `jacobians` is
 /// `None`) is left out.
 fn plan_functions(
+    mut arena: ExprArena,
     model: &SymbolicModel,
     eom: &EquationsOfMotion,
     jacobians: Option<&Jacobians>,
     functions: &[ModelFunction],
 ) -> ModelPlans {
-    let mut arena = model.arena.clone();
     let functions = functions
         .iter()
         .filter_map(|&function| {

@@ -231,11 +231,15 @@ impl Derivation {
     /// Derives the exact Jacobians `∂F/∂q`, `∂F/∂q̇`, `∂(M a)/∂q`
     /// ([`crate::mechanics::Jacobians::of`]) and lowers their plans
     /// ([`super::plan::plan_jacobians`], as [`super::emit`] prints them) to tapes.
-    pub fn jacobians(mut self) -> JacobianProgram {
+    pub fn jacobians(self) -> JacobianProgram {
         use ModelFunction as F;
         let n = self.eom.num_dofs;
-        let plans = super::plan::plan_jacobians(&mut self.model, &self.eom);
-        let tapes = Tapes::new(&self.model, &plans);
+        let parameters = self.model.parameters.iter().map(|p| p.symbol).collect();
+        let plans = super::plan::plan_jacobians(self.model, &self.eom);
+        let tapes = Tapes {
+            plans: &plans,
+            parameters,
+        };
         let column_major = |function| {
             let mut tape = tapes.get(function);
             tape.outputs = column_major_order(&tape.outputs, n);
