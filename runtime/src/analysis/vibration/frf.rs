@@ -366,14 +366,15 @@ pub fn frequency_response_analysis(
     }
     let mut evaluations = Vec::with_capacity(evaluation_frequencies.len());
     let requested: Vec<usize> = outputs.iter().map(|o| o.index).collect();
+    let b = options.modal.then(|| b_matrix.column(0).into_owned());
     for w in evaluation_frequencies {
         evaluations.push(evaluate_at(
             lin,
             b_matrix,
+            b.as_ref(),
             &modes,
             w,
             &requested,
-            options.modal,
         )?);
     }
     let operating_point = OperatingPoint {
@@ -438,31 +439,26 @@ fn default_range(natural_frequencies: &[f64]) -> Option<(f64, f64)> {
     Some((first / 10.0, last * 10.0))
 }
 
-/// `H(ω)` of the one input at `w` for the `requested` outputs, its modal sum when `modal`,
-/// and their largest difference relative to the largest `|H|`; a singular `ω` (undamped
+/// `H(ω)` of the one input (column `b` of `b_matrix`) at `w` for the `requested` outputs,
+/// its modal sum when `b` is given, and their largest difference relative to the largest `|H|`; a singular `ω` (undamped
 /// resonance) gives `None` for the response it makes singular.
 fn evaluate_at(
     lin: &Linearization,
     b_matrix: &DMatrix<f64>,
+    b: Option<&DVector<f64>>,
     modes: &NormalModes,
     w: f64,
     requested: &[usize],
-    modal: bool,
 ) -> Result<FrfEvaluation, FrfError> {
     let response = match frequency_response_of(lin, b_matrix, w, requested) {
         Ok(h) => Some(h.column(0).into_owned()),
         Err(FrfError::Singular { .. }) => None,
         Err(e) => return Err(e),
     };
-    let modal = if modal {
-        let b = b_matrix.column(0).into_owned();
-        match modal_frequency_response(lin, modes, &b, w) {
-            Ok(r) => Some(r),
-            Err(FrfError::Singular { .. }) => None,
-            Err(e) => return Err(e),
-        }
-    } else {
-        None
+    let modal = match b.map(|b| modal_frequency_response(lin, modes, b, w)) {
+        Some(Ok(r)) => Some(r),
+        None | Some(Err(FrfError::Singular { .. })) => None,
+        Some(Err(e)) => return Err(e),
     };
     let modal_difference = match (&response, &modal) {
         (Some(d), Some(r)) => {
