@@ -18,12 +18,13 @@ use eomgen_runtime::analysis::vibration::{
     EquilibriumStart, ModalAnalysis, ModalOptions, OperatingPointOptions, modal_analysis,
 };
 use eomgen_runtime::analysis::{EnergyDrift, RunTally, StudyRuns, constraint_drift, energy_drift};
+use eomgen_runtime::description::checks::{ModalCheck, RunSettings};
 use eomgen_runtime::{Linearization, ModelInfo, OutputTimes, Solution, damped_modes};
 use eomgen_symbolic::mechanics::cross_check::check_model;
 use eomgen_symbolic::model::parser::eval_expr;
+use eomgen_symbolic::model::parser::parse_expr;
 use eomgen_symbolic::model::{
-    DEFAULT_CONSTRAINT_DRIFT, DEFAULT_ENERGY_DRIFT, Diagnostic, Expr, ModalCheck, ModelFile,
-    RunSettings,
+    DEFAULT_CONSTRAINT_DRIFT, DEFAULT_ENERGY_DRIFT, Diagnostic, Expr, Location, ModelFile,
 };
 
 /// Relative tolerance of the derivation cross-checks, as `eomgen check`: the derivations
@@ -149,7 +150,7 @@ impl CheckRun {
         let method = settings
             .method
             .as_ref()
-            .and_then(|m| m.value.parse::<Method>().ok())
+            .and_then(|m| m.parse::<Method>().ok())
             .unwrap_or(Method::Dop853);
         Self {
             method,
@@ -331,9 +332,15 @@ pub fn derivation_checks(
     Ok((rows, r.notes))
 }
 
+/// Parses an expression of the model's description (printed from the parsed file, so it
+/// parses back; the error is the parser's message).
+fn parse(text: &str) -> Result<Expr, String> {
+    parse_expr(text, Location { line: 1, column: 1 }).map_err(|d| d.message)
+}
+
 /// Evaluates an expected value (an expression of the parameters).
-fn expected(e: &Expr, model: &dyn ModelInfo) -> Result<f64, String> {
-    eval_expr(e, &parameter_lookup(model)).map_err(|d| d.message)
+fn expected(text: &str, model: &dyn ModelInfo) -> Result<f64, String> {
+    eval_expr(&parse(text)?, &parameter_lookup(model)).map_err(|d| d.message)
 }
 
 /// Evaluates a function of the parameters (`parameters`), coordinates, rates and `t` at
@@ -375,7 +382,7 @@ fn modal_rows(
     model: &dyn ModelInfo,
     computed: Result<(String, Vec<f64>), String>,
 ) -> Vec<CheckRow> {
-    let at = check.at.as_ref().map_or("", |a| a.value.as_str());
+    let at = check.at.as_deref().unwrap_or("");
     let (label, values) = match computed {
         Ok(c) => c,
         Err(e) => {
@@ -418,7 +425,7 @@ fn modal_rows(
 fn against_expected(
     what: String,
     computed: Result<f64, String>,
-    e: &Expr,
+    e: &str,
     model: &dyn ModelInfo,
     tolerance: f64,
 ) -> CheckRow {
@@ -431,7 +438,9 @@ fn against_expected(
 /// The rows of the checks that need a motion or an equilibrium of `model`, in this order:
 /// energy drift (conservative models, or where the file asks), constraint drift (constrained
 /// models), `natural_frequencies:`, `damping_ratios:`, `period:`, `final_state:` and
-/// `conserved:`.
+/// `conserved:` — the file's entries as the model's description carries them
+/// ([`eomgen_runtime::description::checks`]), so a compiled model is checked as a file
+/// loaded at run time.
 ///
 /// `y0` is the model's consistent initial state; `simulations` runs (and keeps) the
 /// simulations of the model; `modes(at)` gives the modal values at the operating point `at`
@@ -442,19 +451,16 @@ fn against_expected(
 /// use eomgen::checks::{Simulations, motion_checks};
 ///
 /// let source = eomgen::ModelSource::open("simple_pendulum")?;
-/// let entry = eomgen::models::find("simple_pendulum").unwrap();
-/// let file = eomgen_symbolic::model::load(entry.file, entry.source).unwrap();
 /// let mut model = source.instantiate();
 /// let y0 = model.consistent_initial_state().unwrap();
 /// let mut simulations = Simulations::new(source);
-/// let rows = motion_checks(&file, model.as_mut(), &y0, &mut simulations,
+/// let rows = motion_checks(model.as_mut(), &y0, &mut simulations,
 ///                          &mut |_| Err("not computed here".to_string()));
 /// let period = rows.iter().find(|r| r.check.starts_with("period")).unwrap();
 /// assert!(period.passed, "{period:?}");
 /// # Ok::<(), eomgen::OpenError>(())
 /// ```
 pub fn motion_checks(
-    file: &ModelFile,
     model: &mut dyn ModelInfo,
     y0: &[f64],
     simulations: &mut Simulations,
@@ -462,9 +468,12 @@ pub fn motion_checks(
 ) -> Vec<CheckRow> {
     let mut checks = Vec::new();
     let default_run = CheckRun::default();
+    // The file's reference results, from the model's description (a copy: the model is
+    // borrowed mutably below).
+    let file_checks = model.description().checks.clone();
 
     // Generic: energy conservation (conservative models, or where the file asks for it).
-    let energy = &file.checks.energy_drift;
+    let energy = &file_checks.energy_drift;
     if model.description().conservative || energy.is_some() {
         let (bound, run) = energy
             .as_ref()
@@ -488,7 +497,7 @@ pub fn motion_checks(
     }
 
     // Generic: constraint drift (constrained models).
-    let constraint = &file.checks.constraint_drift;
+    let constraint = &file_checks.constraint_drift;
     if !model.description().constraint_names().is_empty() || constraint.is_some() {
         let (bound, run) = constraint
             .as_ref()
@@ -511,8 +520,8 @@ pub fn motion_checks(
     }
 
     // Reference values stated in the file.
-    let at_of = |check: &ModalCheck| check.at.as_ref().map(|a| a.value.clone());
-    if let Some(check) = &file.checks.natural_frequencies {
+    let at_of = |check: &ModalCheck| check.at.as_ref().map(|a| a.to_string());
+    if let Some(check) = &file_checks.natural_frequencies {
         let computed = modes(at_of(check).as_deref()).map(|m| (m.label, m.natural_frequencies));
         checks.extend(modal_rows(
             "natural_frequencies",
@@ -522,7 +531,7 @@ pub fn motion_checks(
             computed,
         ));
     }
-    if let Some(check) = &file.checks.damping_ratios {
+    if let Some(check) = &file_checks.damping_ratios {
         let computed = modes(at_of(check).as_deref()).and_then(|m| {
             damped_modes(&m.linearization)
                 .map(|d| (m.label, d.iter().map(|mode| mode.1).collect()))
@@ -530,7 +539,7 @@ pub fn motion_checks(
         });
         checks.extend(modal_rows("damping_ratios", "", check, model, computed));
     }
-    if let Some(check) = &file.checks.period {
+    if let Some(check) = &file_checks.period {
         let mut run = CheckRun::of(&check.run);
         // Without `t_end:`, long enough for two zeros a period apart whatever the phase of
         // the first: at least PERIODS_PER_RUN expected periods.
@@ -541,7 +550,7 @@ pub fn motion_checks(
         {
             run.t_end = run.t_end.max(PERIODS_PER_RUN * period);
         }
-        let event = check.event.value.as_str();
+        let event = &*check.event;
         let computed = simulations.get(run).and_then(|s| {
             let times: Vec<f64> = s
                 .events
@@ -570,7 +579,7 @@ pub fn motion_checks(
             check.tolerance,
         ));
     }
-    if let Some(check) = &file.checks.final_state {
+    if let Some(check) = &file_checks.final_state {
         match expected(&check.t, model) {
             Ok(t) if t.is_finite() && t > 0.0 => {
                 let run = CheckRun {
@@ -585,19 +594,18 @@ pub fn motion_checks(
                 });
                 let coordinates = model.description().coordinate_names();
                 let n = coordinates.len();
-                for (k, e) in &check.values {
-                    let index = coordinates.iter().position(|c| *c == k.value).or_else(|| {
-                        k.value
-                            .strip_suffix("_dot")
+                for (k, e) in check.values.iter() {
+                    let index = coordinates.iter().position(|c| *c == k).or_else(|| {
+                        k.strip_suffix("_dot")
                             .and_then(|b| coordinates.iter().position(|c| *c == b))
                             .map(|i| n + i)
                     });
                     let computed = state.clone().and_then(|y| {
                         index
                             .map(|i| y[i])
-                            .ok_or_else(|| format!("`{}` is not a coordinate or rate", k.value))
+                            .ok_or_else(|| format!("`{k}` is not a coordinate or rate"))
                     });
-                    let what = format!("{} at t = {} s ({})", k.value, fixed(t, 6), run.describe());
+                    let what = format!("{k} at t = {} s ({})", fixed(t, 6), run.describe());
                     checks.push(against_expected(what, computed, e, model, check.tolerance));
                 }
             }
@@ -616,12 +624,14 @@ pub fn motion_checks(
         }
     }
     let parameters = parameter_lookup(model);
-    for c in &file.checks.conserved {
+    for c in file_checks.conserved.iter() {
+        let value = parse(&c.value);
         let computed = simulations.get(default_run).and_then(|s| {
+            let value = value.clone()?;
             let mut q0 = None;
             let mut worst: f64 = 0.0;
             for (t, y) in s.iter() {
-                let q = state_value(&c.value, model, &parameters, t, y)?;
+                let q = state_value(&value, model, &parameters, t, y)?;
                 let q0 = *q0.get_or_insert(q);
                 worst = worst.max((q - q0).abs() / q0.abs().max(1.0));
             }
@@ -630,7 +640,7 @@ pub fn motion_checks(
         checks.push(CheckRow::compare(
             format!(
                 "conserved `{}`: max |Q − Q(0)|/max(1, |Q(0)|) ({})",
-                c.name.value,
+                c.name,
                 default_run.describe()
             ),
             computed,
@@ -847,7 +857,6 @@ pub fn model_report(path: &str, text: &str, file: &ModelFile, source: &ModelSour
         result
     };
     out.rows.extend(motion_checks(
-        file,
         model.as_mut(),
         &y0,
         &mut simulations,
@@ -860,11 +869,12 @@ pub fn model_report(path: &str, text: &str, file: &ModelFile, source: &ModelSour
         },
     ));
     if !model.equilibrium_guesses().is_empty() && !model.description().point_names().is_empty() {
-        let at = file
+        let at = model
+            .description()
             .checks
             .natural_frequencies
             .as_ref()
-            .and_then(|check| check.at.as_ref().map(|a| a.value.clone()));
+            .and_then(|check| check.at.as_ref().map(|a| a.to_string()));
         out.mode_shapes = Some(analysis(at.as_deref()));
     }
     out.time_s = started.elapsed().as_secs_f64();

@@ -1,40 +1,60 @@
 //! The reference results a model file gives for its Floquet charts (`floquet:`), evaluated
 //! at a model's parameters: stability thresholds (Kapitza's `a w > √(2 g l)`) and reference
 //! curves over two swept parameters (the edges of the Mathieu chart). `eomgen study floquet`
-//! draws and prints them; the model knowledge lives in the file, not in the program.
+//! draws and prints them; the model knowledge lives in the file, and reaches here through the
+//! model's description ([`eomgen_runtime::description::floquet`]).
 
+use eomgen_runtime::description::floquet::{FloquetReference, FloquetThreshold};
+use eomgen_symbolic::model::Location;
 use eomgen_symbolic::model::ast::Expr;
-use eomgen_symbolic::model::file::FloquetReference;
-use eomgen_symbolic::model::parser::eval_expr;
+use eomgen_symbolic::model::parser::{eval_expr, parse_expr};
 
-use crate::{ModelInfo, ModelSource};
+use crate::{ModelDescription, ModelInfo};
 
-/// Why a model file's `floquet:` references could not be read.
+/// Why a model's `floquet:` references could not be read.
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum ReferenceError {
-    /// The model file could not be read.
-    #[error("cannot read `{path}`: {source}")]
-    Read {
-        /// The file.
-        path: String,
-        /// Why.
-        source: std::io::Error,
-    },
-    /// The model file has mistakes (located diagnostics, one per line).
-    #[error("`{path}` has mistakes:\n{}", messages.join("\n"))]
-    Model {
-        /// The file.
-        path: String,
-        /// The diagnostics, rendered.
-        messages: Vec<String>,
+    /// An expression of the references does not parse (the description was not printed
+    /// from a parsed file).
+    #[error("`{model}`: `floquet:` at `{at}`: `{text}`: {message}")]
+    Expression {
+        /// The model.
+        model: String,
+        /// The equilibrium the references hold at.
+        at: String,
+        /// The expression.
+        text: String,
+        /// The parser's message.
+        message: String,
     },
 }
 
-/// A model file's `floquet:` references at one equilibrium.
+/// A threshold with its expressions parsed.
+#[derive(Debug, Clone, PartialEq)]
+struct Threshold {
+    spec: FloquetThreshold,
+    value: Expr,
+    critical: Expr,
+}
+
+/// A reference curve with its expressions parsed.
+#[derive(Debug, Clone, PartialEq)]
+struct Curve {
+    label: String,
+    color: Vec<Expr>,
+    along: String,
+    gives: String,
+    value: Expr,
+    domain: Option<Expr>,
+}
+
+/// A model's `floquet:` references at one equilibrium, their expressions parsed.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FloquetReferences {
-    entry: FloquetReference,
+    axis_units: Vec<(String, String)>,
+    thresholds: Vec<Threshold>,
+    curves: Vec<Curve>,
 }
 
 /// A stability prediction evaluated at a model's parameters: stable when `value > critical`.
@@ -86,73 +106,108 @@ pub struct ChartAxis<'a> {
 const SAMPLES: u32 = 4000;
 
 impl FloquetReferences {
-    /// The references of `source`'s model file at the equilibrium named `equilibrium`
-    /// (`None` when the file gives none there).
+    /// The references `description` carries (the model file's `floquet:`) at the
+    /// equilibrium named `equilibrium` (`None` when the file gives none there).
     ///
     /// # Errors
-    /// [`ReferenceError::Read`], [`ReferenceError::Model`].
+    /// [`ReferenceError::Expression`] when an expression does not parse (never for a
+    /// description built from a model file).
     ///
     /// # Examples
     /// ```
-    /// let source = eomgen::ModelSource::open("mathieu_pendulum")?;
-    /// let refs = eomgen::FloquetReferences::of(&source, "upright")?.unwrap();
-    /// let model = source.instantiate();
+    /// let model = eomgen::ModelSource::open("mathieu_pendulum")?.instantiate();
+    /// let refs = eomgen::FloquetReferences::of(model.description(), "upright")?.unwrap();
     /// let kapitza = &refs.thresholds(model.as_ref())[0];
     /// // a w = 0.1 × 60 = 6 against √(2 g l) = √20.
     /// assert_eq!(kapitza.value, 6.0);
     /// assert!((kapitza.critical - 20f64.sqrt()).abs() < 1e-15 && kapitza.predicts_stable);
     /// # Ok::<(), Box<dyn std::error::Error>>(())
     /// ```
-    pub fn of(source: &ModelSource, equilibrium: &str) -> Result<Option<Self>, ReferenceError> {
-        let path = source.path();
-        let bytes = source.bytes().map_err(|e| ReferenceError::Read {
-            path: path.to_string(),
-            source: e,
-        })?;
-        let mistakes = |diagnostics: &[eomgen_symbolic::model::Diagnostic]| ReferenceError::Model {
-            path: path.to_string(),
-            messages: diagnostics
-                .iter()
-                .map(|d| format!("{}:{}: {}", d.location.line, d.location.column, d.message))
-                .collect(),
+    pub fn of(
+        description: &ModelDescription,
+        equilibrium: &str,
+    ) -> Result<Option<Self>, ReferenceError> {
+        let Some(entry) = description.floquet.iter().find(|e| e.at == equilibrium) else {
+            return Ok(None);
         };
-        let text = eomgen_symbolic::model::decode(&bytes).map_err(|d| mistakes(&[d]))?;
-        let file = eomgen_symbolic::model::load(path, text).map_err(|d| mistakes(&d))?;
-        Ok(file
-            .floquet
-            .into_iter()
-            .find(|e| e.at.value == equilibrium)
-            .map(|entry| Self { entry }))
+        Self::parse(&description.name, entry).map(Some)
+    }
+
+    /// `entry` with its expressions parsed.
+    fn parse(model: &str, entry: &FloquetReference) -> Result<Self, ReferenceError> {
+        let parse = |text: &str| {
+            parse_expr(text, Location { line: 1, column: 1 }).map_err(|d| {
+                ReferenceError::Expression {
+                    model: model.to_string(),
+                    at: entry.at.to_string(),
+                    text: text.to_string(),
+                    message: d.message,
+                }
+            })
+        };
+        let thresholds = entry
+            .thresholds
+            .iter()
+            .map(|t| {
+                Ok(Threshold {
+                    spec: t.clone(),
+                    value: parse(&t.value)?,
+                    critical: parse(&t.critical)?,
+                })
+            })
+            .collect::<Result<_, ReferenceError>>()?;
+        let curves = entry
+            .curves
+            .iter()
+            .map(|c| {
+                Ok(Curve {
+                    label: c.label.to_string(),
+                    color: c.color.iter().map(|e| parse(e)).collect::<Result<_, _>>()?,
+                    along: c.along.to_string(),
+                    gives: c.gives.to_string(),
+                    value: parse(&c.value)?,
+                    domain: c.domain.as_deref().map(parse).transpose()?,
+                })
+            })
+            .collect::<Result<_, ReferenceError>>()?;
+        Ok(Self {
+            axis_units: entry
+                .axis_units
+                .iter()
+                .map(|(p, u)| (p.to_string(), u.to_string()))
+                .collect(),
+            thresholds,
+            curves,
+        })
     }
 
     /// The unit the file gives for `parameter` on a chart's axis.
     pub fn axis_unit(&self, parameter: &str) -> Option<&str> {
-        self.entry
-            .axis_units
+        self.axis_units
             .iter()
-            .find(|(p, _)| p.value == parameter)
-            .map(|(_, u)| u.value.as_str())
+            .find(|(p, _)| p == parameter)
+            .map(|(_, u)| u.as_str())
     }
 
     /// The thresholds evaluated at `model`'s parameters (a value that cannot be evaluated is
     /// NaN, and predicts nothing stable).
     pub fn thresholds(&self, model: &dyn ModelInfo) -> Vec<ThresholdPrediction> {
         let lookup = parameters(model);
-        self.entry
-            .thresholds
+        self.thresholds
             .iter()
             .map(|t| {
                 let value = eval(&t.value, &lookup);
                 let critical = eval(&t.critical, &lookup);
+                let spec = &t.spec;
                 ThresholdPrediction {
-                    name: t.name.value.clone(),
-                    key: t.key.value.clone(),
-                    label: t.label.clone(),
+                    name: spec.name.to_string(),
+                    key: spec.key.to_string(),
+                    label: spec.label.to_string(),
                     value,
                     critical,
-                    critical_label: t.critical_label.clone(),
-                    by: t.by.clone(),
-                    note: t.note.clone(),
+                    critical_label: spec.critical_label.to_string(),
+                    by: spec.by.to_string(),
+                    note: spec.note.to_string(),
                     predicts_stable: value > critical,
                 }
             })
@@ -171,8 +226,8 @@ impl FloquetReferences {
     ) -> Vec<ReferenceCurvePoints> {
         let values = parameters(model);
         let mut out = Vec::new();
-        for c in &self.entry.curves {
-            let (along, gives) = (c.along.value.as_str(), c.gives.value.as_str());
+        for c in &self.curves {
+            let (along, gives) = (c.along.as_str(), c.gives.as_str());
             let along_x = if (x.name, y.name) == (along, gives) {
                 true
             } else if (x.name, y.name) == (gives, along) {

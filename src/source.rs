@@ -2,7 +2,7 @@
 //! time.
 
 use crate::models::ModelEntry;
-use crate::{DynFirstOrder, JitModel, LoadError, ModelInfo};
+use crate::{DynFirstOrder, JitModel, LoadError, LoadOptions, ModelInfo};
 
 /// A model named by a user: bundled (compiled into the crate by `eomgen::model!`) or a model
 /// file compiled at run time ([`JitModel`]). Both give the same [`ModelInfo`], so every
@@ -61,10 +61,18 @@ impl ModelSource {
     /// [`OpenError::Load`] for a file that cannot be read, has mistakes (located
     /// diagnostics) or cannot be compiled.
     pub fn open(name_or_path: &str) -> Result<ModelSource, OpenError> {
+        Self::open_with(name_or_path, LoadOptions::default())
+    }
+
+    /// [`Self::open`], a file compiled with `options` (a bundled model is compiled already).
+    ///
+    /// # Errors
+    /// As [`Self::open`].
+    pub fn open_with(name_or_path: &str, options: LoadOptions) -> Result<ModelSource, OpenError> {
         match resolve(name_or_path)? {
             Resolved::Bundled(entry) => Ok(ModelSource::Bundled(entry)),
             Resolved::File(path) => {
-                let model = JitModel::load(&path)?;
+                let model = JitModel::load_with(&path, options)?;
                 Ok(ModelSource::File { path, model })
             }
         }

@@ -512,7 +512,9 @@ fn mathieu_pendulum_references_from_its_file() {
     let source = ModelSource::open("mathieu_pendulum").unwrap();
     let model = source.instantiate();
     let (g, l) = (10.0f64, 1.0f64);
-    let upright = FloquetReferences::of(&source, "upright").unwrap().unwrap();
+    let upright = FloquetReferences::of(model.description(), "upright")
+        .unwrap()
+        .unwrap();
     assert_eq!(upright.axis_unit("a"), Some("m"));
     assert_eq!(upright.axis_unit("w"), None);
     let t = &upright.thresholds(model.as_ref())[0];
@@ -574,7 +576,9 @@ fn mathieu_pendulum_references_from_its_file() {
     };
     assert!(upright.curves(model.as_ref(), other, y).is_empty());
 
-    let hanging = FloquetReferences::of(&source, "hanging").unwrap().unwrap();
+    let hanging = FloquetReferences::of(model.description(), "hanging")
+        .unwrap()
+        .unwrap();
     assert!(hanging.thresholds(model.as_ref()).is_empty());
     let curves = hanging.curves(model.as_ref(), x, y);
     assert_eq!(curves.len(), 2);
@@ -590,7 +594,7 @@ fn mathieu_pendulum_references_from_its_file() {
         }
     }
     assert!(
-        FloquetReferences::of(&source, "sideways")
+        FloquetReferences::of(model.description(), "sideways")
             .unwrap()
             .is_none()
     );

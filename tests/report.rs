@@ -326,7 +326,7 @@ fn mathml_of_the_simple_pendulum_equation() {
     let file = eomgen_symbolic::model::load(entry.file, entry.source).expect("loads");
     let mut model = SymbolicModel::from_file(&file).expect("lowers");
     let eom = Lagrange.derive(&mut model);
-    let lines = equations_mathml(&mut model, &eom);
+    let lines = equations_mathml(&model, &eom);
     assert_eq!(lines.len(), 3, "T, V and one equation: {lines:#?}");
     let root = parse(&lines[2]);
     assert_eq!(tag(&root), "math");
@@ -581,7 +581,7 @@ fn checks_of_a_file_through_the_library() {
         })
     };
     let mut simulations = Simulations::new(source);
-    let rows = motion_checks(&file, model.as_mut(), &y0, &mut simulations, &mut modes);
+    let rows = motion_checks(model.as_mut(), &y0, &mut simulations, &mut modes);
     let find = |prefix: &str| rows.iter().find(|r| r.check.starts_with(prefix)).unwrap();
     let w = find("natural_frequencies[1] at hanging");
     assert!(!w.passed);

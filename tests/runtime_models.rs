@@ -32,7 +32,8 @@ fn compare(name: &str, compiled: &mut dyn ModelInfo, runtime: &mut dyn ModelInfo
     let n = compiled.num_dofs();
     assert_eq!(runtime.num_dofs(), n, "{name}: dofs");
     // The whole description: names, parameter defaults, points, drawing, constraints,
-    // guesses, events, conservation and the equations as text and LaTeX.
+    // guesses, events, conservation, the equations as text, LaTeX and MathML, and the file's
+    // `checks:` and `floquet:` references.
     assert_eq!(
         compiled.description(),
         runtime.description(),
@@ -152,8 +153,11 @@ fn bundled_file(entry: &eomgen::models::ModelEntry) -> String {
 }
 
 fn runtime_model(path: &str, backend: Option<Backend>) -> Box<dyn ModelInfo> {
+    // With the MathML, which a compiled model always carries, so that the descriptions
+    // compare whole.
     let options = LoadOptions {
         backend,
+        equations_mathml: true,
         ..LoadOptions::default()
     };
     let model = JitModel::load_with(path, options).unwrap_or_else(|e| panic!("{path}: {e}"));
@@ -257,4 +261,37 @@ fn the_readme_model_runs_and_conserves_energy() {
         "E(0) = {e0}, E(5) = {e1}"
     );
     assert!((y[0] - y0[0]).abs() > 1e-3, "the spring moved");
+}
+
+/// A model compiled at run time carries its equations as MathML only when its loader asks
+/// (they are printed at load time, and only the report shows them); the file's `checks:` and
+/// `floquet:` come with every description.
+#[test]
+fn run_time_descriptions_carry_mathml_on_request_and_the_files_references_always() {
+    let path = format!(
+        "{}/models/mathieu_pendulum.yaml",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let plain = DynFirstOrder::new(JitModel::load(&path).unwrap());
+    let d = plain.description();
+    assert_eq!(d.equations_mathml, None);
+    assert!(d.floquet.iter().any(|r| r.at == "upright"));
+    let with = runtime_model(&path, None);
+    let lines = with.description().equations_mathml.clone().unwrap();
+    // T, V, one equation of motion.
+    assert!(
+        lines.len() >= 3
+            && lines
+                .iter()
+                .all(|l| l.starts_with("<math display=\"block\">"))
+    );
+    let pendulum = DynFirstOrder::new(
+        JitModel::load(format!(
+            "{}/models/simple_pendulum.yaml",
+            env!("CARGO_MANIFEST_DIR")
+        ))
+        .unwrap(),
+    );
+    let period = pendulum.description().checks.period.clone().unwrap();
+    assert_eq!(period.value, "4*sqrt(l/g)*1.8540746773013719");
 }

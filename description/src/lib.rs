@@ -19,6 +19,9 @@ use std::borrow::Cow;
 
 use serde::Serialize;
 
+pub mod checks;
+pub mod floquet;
+
 /// Text of a description: borrowed from the binary (compiled models) or owned (run time).
 pub type Text = Cow<'static, str>;
 
@@ -33,8 +36,10 @@ pub type List<T> = Cow<'static, [T]>;
 /// non-holonomic (`A(q, t) q̇ + b = 0`).
 ///
 /// # Source
-/// The model file's keys (docs/model-format.md); `equations_text` and `equations_latex` are
-/// the derived `M q̈ = F` printed by the symbolic crate.
+/// The model file's keys (docs/model-format.md); `equations_text`, `equations_latex` and
+/// `equations_mathml` are the derived `M q̈ = F` (the derivation the model's functions are
+/// compiled from: momentum balance for the kinematic form, Lagrange's equations for the
+/// energy form) printed by the symbolic crate.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ModelDescription {
     /// The model's name, as in its file (`double_pendulum`).
@@ -82,6 +87,19 @@ pub struct ModelDescription {
     pub equations_text: Text,
     /// The derived equations as LaTeX.
     pub equations_latex: Text,
+    /// The derived equations as MathML Core, one `<math display="block">` element per line
+    /// (`T`, `V`, each non-zero `Q`, one equation of motion per coordinate, each holonomic
+    /// constraint), for pages rendered without scripts.
+    ///
+    /// Always there for a compiled model; `None` for a model compiled at run time unless its
+    /// loader asked for it (`eomgen::LoadOptions::equations_mathml`): the markup is five times
+    /// the size of the LaTeX (0.74 MB for a 20-link pendulum) and printing it would add a
+    /// sixth to every run-time load, for the one page that shows it.
+    pub equations_mathml: Option<List<Text>>,
+    /// The file's `checks:` reference results (closed forms the model must reproduce).
+    pub checks: checks::Checks,
+    /// The file's `floquet:` references, by equilibrium, in file order.
+    pub floquet: List<floquet::FloquetReference>,
 }
 
 impl ModelDescription {
@@ -105,6 +123,9 @@ impl ModelDescription {
         conservative: false,
         equations_text: Cow::Borrowed(""),
         equations_latex: Cow::Borrowed(""),
+        equations_mathml: None,
+        checks: checks::Checks::NONE,
+        floquet: Cow::Borrowed(&[]),
     };
 
     /// The number of degrees of freedom `n` (the number of coordinates).

@@ -59,6 +59,10 @@ pub struct LoadOptions {
     /// rather than when first used (the default: simulation with an explicit method never
     /// uses them, and for a 40-link chain they are three quarters of the code).
     pub eager_jacobians: bool,
+    /// Print the equations as MathML into the description
+    /// ([`ModelDescription::equations_mathml`](eomgen_runtime::ModelDescription::equations_mathml))
+    /// at load time; without it that field is `None`. Compiled models always carry it.
+    pub equations_mathml: bool,
 }
 
 /// The functions of a model: the first eleven in the order of [`ModelProgram::functions`],
@@ -449,6 +453,15 @@ impl JitModel {
         let (core, fallback_reason) = Compiled::new(&program.functions(), options.backend)?;
         // The tapes live on in `core`; the program keeps the names and constants.
         let mut program = program;
+        if options.equations_mathml {
+            program.description.equations_mathml = Some(
+                derivation
+                    .equations_mathml()
+                    .into_iter()
+                    .map(std::borrow::Cow::Owned)
+                    .collect(),
+            );
+        }
         program.clear_tapes();
         let parameters: Vec<f64> = program.description.parameter_defaults();
         let code = Arc::new(Code {

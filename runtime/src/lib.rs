@@ -49,6 +49,9 @@ pub use constrained::{
     ConstraintWorkspace, MAX_BAUMGARTE_GAIN, ProjectionError, Stabilization, StabilizationError,
 };
 pub use dynamic::DynMechanicalSystem;
+/// The model description's crate: [`ModelDescription`] and the file's reference results it
+/// carries ([`description::checks`], [`description::floquet`]).
+pub use eomgen_description as description;
 pub use eomgen_description::Parameter;
 pub use first_order::{DynFirstOrder, FirstOrder};
 pub use integrate::{

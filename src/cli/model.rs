@@ -18,20 +18,37 @@ pub(super) fn find_model(name_or_path: &str) -> Result<Box<dyn eomgen::ModelInfo
 /// the studies, `animate`) name it again by its path, and each use gets a fresh instance of
 /// the same compiled code.
 pub(super) fn open_model(name_or_path: &str) -> Result<eomgen::ModelSource, CliError> {
-    static FILES: std::sync::Mutex<Vec<(String, eomgen::ModelSource)>> =
-        std::sync::Mutex::new(Vec::new());
-    let cached = |files: &[(String, eomgen::ModelSource)]| {
+    open_model_with(name_or_path, eomgen::LoadOptions::default())
+}
+
+/// [`open_model`] with the options a file is compiled with. A file compiled with the
+/// equations as MathML serves later uses that do not ask for them (the report's animation
+/// reuses the report's model).
+pub(super) fn open_model_with(
+    name_or_path: &str,
+    options: eomgen::LoadOptions,
+) -> Result<eomgen::ModelSource, CliError> {
+    type Files = Vec<(String, eomgen::LoadOptions, eomgen::ModelSource)>;
+    static FILES: std::sync::Mutex<Files> = std::sync::Mutex::new(Vec::new());
+    let serves = |o: &eomgen::LoadOptions| {
+        eomgen::LoadOptions {
+            equations_mathml: options.equations_mathml,
+            ..*o
+        } == options
+            && (o.equations_mathml || !options.equations_mathml)
+    };
+    let cached = |files: &Files| {
         files
             .iter()
-            .find(|(path, _)| path == name_or_path)
-            .map(|(_, s)| s.clone())
+            .find(|(path, o, _)| path == name_or_path && serves(o))
+            .map(|(_, _, s)| s.clone())
     };
     if let Ok(files) = FILES.lock()
         && let Some(source) = cached(&files)
     {
         return Ok(source);
     }
-    let source = eomgen::ModelSource::open(name_or_path).map_err(open_error)?;
+    let source = eomgen::ModelSource::open_with(name_or_path, options).map_err(open_error)?;
     if let eomgen::ModelSource::File { path, model } = &source
         && let Some(reason) = model.fallback_reason()
     {
@@ -41,7 +58,7 @@ pub(super) fn open_model(name_or_path: &str) -> Result<eomgen::ModelSource, CliE
     if source.is_file()
         && let Ok(mut files) = FILES.lock()
     {
-        files.push((name_or_path.to_string(), source.clone()));
+        files.push((name_or_path.to_string(), options, source.clone()));
     }
     Ok(source)
 }

@@ -149,8 +149,50 @@ fn a_location_map_places_errors_on_later_lines() {
     assert_eq!(d.location, Location { line: 2, column: 4 });
 }
 
+/// An expression printed in the file's syntax parses back to the same tree, with no more
+/// parentheses than the grammar needs: the model description keeps the file's `checks:` and
+/// `floquet:` expressions as this text.
+#[test]
+fn printed_expressions_parse_back_with_few_parentheses() {
+    let printed = |s: &str| {
+        parse_expr(s, Location { line: 1, column: 1 })
+            .unwrap()
+            .to_string()
+    };
+    for (text, expected) in [
+        ("2*pi*sqrt(l/g)", "2*pi*sqrt(l/g)"),
+        ("a - (b - c)", "a - (b - c)"),
+        ("(a - b) - c", "a - b - c"),
+        ("a/(b*c)", "a/(b*c)"),
+        ("-x^2", "-x^2"),
+        ("(-x)^2", "(-x)^2"),
+        ("a*-b", "a*(-b)"),
+        ("2^-1", "2^(-1)"),
+        ("a^b^c", "a^b^c"),
+        ("(a^b)^c", "(a^b)^c"),
+        ("--x", "-(-x)"),
+        ("-a*b + atan2(-1, 0)", "-a*b + atan2(-1, 0)"),
+        ("1e-3*x_dot", "1e-3*x_dot"),
+    ] {
+        let out = printed(text);
+        assert_eq!(out, expected, "{text}");
+        assert_eq!(p(&out), p(text), "{text} → {out}");
+    }
+}
+
 proptest! {
     #![proptest_config(ProptestConfig { cases: 1000, .. ProptestConfig::default() })]
+
+    /// Whatever parses, printed, parses back to the same tree.
+    #[test]
+    fn printed_expressions_round_trip(text in "([a-z]{1,3}|[0-9]{1,3}(\\.[0-9])?(e-?[0-9])?|[-+*/^(),]| |sin\\(|atan2\\(|_dot){0,40}") {
+        if let Ok(e) = parse_expr(&text, Location { line: 1, column: 1 }) {
+            let out = e.to_string();
+            let back = parse_expr(&out, Location { line: 1, column: 1 });
+            prop_assert!(back.is_ok(), "{} printed as {} does not parse: {:?}", text, out, back);
+            prop_assert_eq!(show(&back.unwrap()), show(&e), "{} printed as {}", text, out);
+        }
+    }
 
     /// Arbitrary text never panics the parser, and an error is located on the line.
     #[test]

@@ -152,8 +152,8 @@ pub fn run(args: &FloquetArgs) -> Result<(), CliError> {
         Some((x, y)) => Some(run_sweep(args, &guess, x, y, &options)?),
         None => None,
     };
-    let references =
-        FloquetReferences::of(&source, &label).map_err(|e| CliError::failure(e.to_string()))?;
+    let references = FloquetReferences::of(model.description(), &label)
+        .map_err(|e| CliError::failure(e.to_string()))?;
     let thresholds = references
         .as_ref()
         .map(|r| r.thresholds(model.as_ref()))

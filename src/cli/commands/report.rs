@@ -27,8 +27,6 @@ use eomgen::ModelInfo;
 use eomgen::analysis::StudyRuns;
 use eomgen::analysis::vibration::ModalAnalysis;
 use eomgen::checks::{DefaultRun, ReportRows, model_report};
-use eomgen_symbolic::codegen::equations_mathml;
-use eomgen_symbolic::mechanics::{Formulation, Lagrange, SymbolicModel};
 use eomgen_symbolic::model::ModelFile;
 
 use crate::cli::animation::DEFAULT_FPS;
@@ -203,7 +201,12 @@ fn sources(models: &[String]) -> Result<Vec<Source>, CliError> {
             .map_err(|d| crate::cli::model::diagnostics_error(&display, &text, &d))?;
         // A bundled name runs the compiled model; a path runs the file's own equations,
         // compiled at run time (even for a copy of a bundled model).
-        let model = crate::cli::model::open_model(name)?;
+        // With the equations as MathML, which the page shows.
+        let options = eomgen::LoadOptions {
+            equations_mathml: true,
+            ..eomgen::LoadOptions::default()
+        };
+        let model = crate::cli::model::open_model_with(name, options)?;
         if out.iter().any(|s| s.model.name() == model.name()) {
             return Err(CliError::usage(format!(
                 "`{}` is named twice in --models",
@@ -252,16 +255,14 @@ fn report_model(source: &Source, dir: &Path) -> ModelReport {
         time_s: 0.0,
     };
 
-    // The equations, derived at run time from the file, as MathML.
-    match SymbolicModel::from_file(file) {
-        Ok(mut symbolic) => {
-            let eom = Lagrange.derive(&mut symbolic);
-            report.equations = equations_mathml(&mut symbolic, &eom);
-        }
-        Err(d) => report
-            .notes
-            .push(crate::cli::model::diagnostics_error(&source.display, &source.text, &d).message),
-    }
+    // The equations the model's functions were compiled from, as MathML.
+    report.equations = model
+        .description()
+        .equations_mathml
+        .iter()
+        .flat_map(|lines| lines.iter())
+        .map(|e| e.to_string())
+        .collect();
 
     let checks = model_report(&source.display, &source.text, file, &source.model);
     report.checks = checks.rows;

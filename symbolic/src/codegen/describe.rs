@@ -8,6 +8,8 @@ use std::borrow::Cow;
 use proc_macro2::TokenStream;
 use quote::quote;
 
+use eomgen_description::checks::{Checks, DriftCheck, ModalCheck, RunSettings};
+use eomgen_description::floquet::FloquetReference;
 use eomgen_description::{
     BodyCentre, EventDirection, EventSpec, ModelDescription, Parameter, Text,
 };
@@ -16,12 +18,14 @@ use crate::mechanics::{EquationsOfMotion, SymbolicModel};
 use crate::model::Crossing;
 
 /// Everything about `model` that is not a function of the state, with `eom`'s equations as
-/// text and LaTeX ([`super::equations_text`], [`super::equations_latex`]).
+/// text and LaTeX ([`super::equations_text`], [`super::equations_latex`]), as MathML
+/// ([`super::equations_mathml`]) if `mathml`, and the file's `checks:` and `floquet:`
+/// references.
 ///
 /// Names of points that a drawing or a body refers to are looked up in `model.points`; an
 /// index out of range (which the model file's checks exclude) drops the entry rather than
 /// panicking.
-pub fn describe(model: &SymbolicModel, eom: &EquationsOfMotion) -> ModelDescription {
+pub fn describe(model: &SymbolicModel, eom: &EquationsOfMotion, mathml: bool) -> ModelDescription {
     let text = |s: &str| -> Text { Cow::Owned(s.to_string()) };
     let point_name = |i: usize| model.points.get(i).map(|(p, _)| text(p));
     let c = &model.constraints;
@@ -80,6 +84,14 @@ pub fn describe(model: &SymbolicModel, eom: &EquationsOfMotion) -> ModelDescript
         conservative: model.conservative,
         equations_text: Cow::Owned(super::equations_text(model, eom)),
         equations_latex: Cow::Owned(super::equations_latex(model, eom)),
+        equations_mathml: mathml.then(|| {
+            super::equations_mathml(model, eom)
+                .into_iter()
+                .map(Cow::Owned)
+                .collect()
+        }),
+        checks: model.checks.clone(),
+        floquet: Cow::Owned(model.floquet.clone()),
     }
 }
 
@@ -93,8 +105,6 @@ pub fn description_tokens(
     description: &ModelDescription,
     krate: &TokenStream,
 ) -> Result<TokenStream, String> {
-    let borrowed = |items: Vec<TokenStream>| quote!(::std::borrow::Cow::Borrowed(&[#(#items),*]));
-    let text = |s: &str| quote!(::std::borrow::Cow::Borrowed(#s));
     let texts = |items: &[Text]| borrowed(items.iter().map(|s| text(s)).collect());
     let d = description;
     let name = text(&d.name);
@@ -160,6 +170,14 @@ pub fn description_tokens(
     let (needs, conservative) = (d.events_need_accelerations, d.conservative);
     let equations_text = text(&d.equations_text);
     let equations_latex = text(&d.equations_latex);
+    let equations_mathml = optional(d.equations_mathml.as_deref().map(texts));
+    let checks = checks_tokens(&d.checks, krate)?;
+    let floquet = borrowed(
+        d.floquet
+            .iter()
+            .map(|r| floquet_tokens(r, krate))
+            .collect::<Result<_, String>>()?,
+    );
     Ok(quote! {
         #krate::ModelDescription {
             name: #name,
@@ -179,6 +197,175 @@ pub fn description_tokens(
             conservative: #conservative,
             equations_text: #equations_text,
             equations_latex: #equations_latex,
+            equations_mathml: #equations_mathml,
+            checks: #checks,
+            floquet: #floquet,
         }
     })
+}
+
+/// A string in a `static`.
+fn text(s: &str) -> TokenStream {
+    quote!(::std::borrow::Cow::Borrowed(#s))
+}
+
+/// A list in a `static`.
+fn borrowed(items: Vec<TokenStream>) -> TokenStream {
+    quote!(::std::borrow::Cow::Borrowed(&[#(#items),*]))
+}
+
+/// `Some(tokens)` or `None`.
+fn optional(value: Option<TokenStream>) -> TokenStream {
+    match value {
+        Some(v) => quote!(::core::option::Option::Some(#v)),
+        None => quote!(::core::option::Option::None),
+    }
+}
+
+/// A float literal, or the error of a non-finite one.
+fn float(v: f64) -> Result<TokenStream, String> {
+    super::float(v)
+}
+
+/// An optional float literal.
+fn optional_float(v: Option<f64>) -> Result<TokenStream, String> {
+    Ok(optional(v.map(float).transpose()?))
+}
+
+/// The file's `checks:` as a Rust expression for a `static`.
+fn checks_tokens(c: &Checks, krate: &TokenStream) -> Result<TokenStream, String> {
+    let m = quote!(#krate::description::checks);
+    let run = |r: &RunSettings| -> Result<TokenStream, String> {
+        let method = optional(r.method.as_deref().map(text));
+        let (rtol, t_end) = (optional_float(r.rtol)?, optional_float(r.t_end)?);
+        Ok(quote!(#m::RunSettings { method: #method, rtol: #rtol, t_end: #t_end }))
+    };
+    let modal = |c: &Option<ModalCheck>| -> Result<TokenStream, String> {
+        c.as_ref()
+            .map(|c| {
+                let at = optional(c.at.as_deref().map(text));
+                let values = borrowed(c.values.iter().map(|v| text(v)).collect());
+                let tolerance = float(c.tolerance)?;
+                Ok(quote!(#m::ModalCheck { at: #at, values: #values, tolerance: #tolerance }))
+            })
+            .transpose()
+            .map(optional)
+    };
+    let drift = |c: &Option<DriftCheck>| -> Result<TokenStream, String> {
+        c.as_ref()
+            .map(|c| {
+                let (max, run) = (float(c.max)?, run(&c.run)?);
+                Ok(quote!(#m::DriftCheck { max: #max, run: #run }))
+            })
+            .transpose()
+            .map(optional)
+    };
+    let period = c
+        .period
+        .as_ref()
+        .map(|c| -> Result<TokenStream, String> {
+            let (event, value) = (text(&c.event), text(&c.value));
+            let (tolerance, run) = (float(c.tolerance)?, run(&c.run)?);
+            Ok(quote!(#m::PeriodCheck {
+                event: #event, value: #value, tolerance: #tolerance, run: #run,
+            }))
+        })
+        .transpose()?;
+    let final_state = c
+        .final_state
+        .as_ref()
+        .map(|c| -> Result<TokenStream, String> {
+            let t = text(&c.t);
+            let values = borrowed(
+                c.values
+                    .iter()
+                    .map(|(k, v)| {
+                        let (k, v) = (text(k), text(v));
+                        quote!((#k, #v))
+                    })
+                    .collect(),
+            );
+            let (tolerance, run) = (float(c.tolerance)?, run(&c.run)?);
+            Ok(quote!(#m::FinalStateCheck {
+                t: #t, values: #values, tolerance: #tolerance, run: #run,
+            }))
+        })
+        .transpose()?;
+    let conserved = borrowed(
+        c.conserved
+            .iter()
+            .map(|c| {
+                let (name, value, tolerance) = (text(&c.name), text(&c.value), float(c.tolerance)?);
+                Ok(quote!(#m::ConservedCheck { name: #name, value: #value, tolerance: #tolerance }))
+            })
+            .collect::<Result<_, String>>()?,
+    );
+    let (natural_frequencies, damping_ratios) =
+        (modal(&c.natural_frequencies)?, modal(&c.damping_ratios)?);
+    let (period, final_state) = (optional(period), optional(final_state));
+    let (energy_drift, constraint_drift) = (drift(&c.energy_drift)?, drift(&c.constraint_drift)?);
+    Ok(quote!(#m::Checks {
+        natural_frequencies: #natural_frequencies,
+        damping_ratios: #damping_ratios,
+        period: #period,
+        final_state: #final_state,
+        conserved: #conserved,
+        energy_drift: #energy_drift,
+        constraint_drift: #constraint_drift,
+    }))
+}
+
+/// One `floquet:` entry as a Rust expression for a `static`.
+fn floquet_tokens(r: &FloquetReference, krate: &TokenStream) -> Result<TokenStream, String> {
+    let m = quote!(#krate::description::floquet);
+    let at = text(&r.at);
+    let axis_units = borrowed(
+        r.axis_units
+            .iter()
+            .map(|(p, u)| {
+                let (p, u) = (text(p), text(u));
+                quote!((#p, #u))
+            })
+            .collect(),
+    );
+    let thresholds = borrowed(
+        r.thresholds
+            .iter()
+            .map(|t| {
+                let [name, key, label, value, critical, critical_label, by, note] = [
+                    &t.name,
+                    &t.key,
+                    &t.label,
+                    &t.value,
+                    &t.critical,
+                    &t.critical_label,
+                    &t.by,
+                    &t.note,
+                ]
+                .map(|s| text(s));
+                quote!(#m::FloquetThreshold {
+                    name: #name, key: #key, label: #label, value: #value, critical: #critical,
+                    critical_label: #critical_label, by: #by, note: #note,
+                })
+            })
+            .collect(),
+    );
+    let curves = borrowed(
+        r.curves
+            .iter()
+            .map(|c| {
+                let [name, label, along, gives, value] =
+                    [&c.name, &c.label, &c.along, &c.gives, &c.value].map(|s| text(s));
+                let color = borrowed(c.color.iter().map(|s| text(s)).collect());
+                let domain = optional(c.domain.as_deref().map(text));
+                quote!(#m::ReferenceCurve {
+                    name: #name, label: #label, color: #color, along: #along, gives: #gives,
+                    value: #value, domain: #domain,
+                })
+            })
+            .collect(),
+    );
+    Ok(quote!(#m::FloquetReference {
+        at: #at, axis_units: #axis_units, thresholds: #thresholds, curves: #curves,
+    }))
 }

@@ -330,7 +330,7 @@ pub fn emit(
             const _: &[u8] = ::core::include_bytes!(#f);
         )
     });
-    let description = describe::description_tokens(&describe::describe(model, eom), &krate)?;
+    let description = describe::description_tokens(&describe::describe(model, eom, true), &krate)?;
 
     let mut methods = quote! {
         fn description(&self) -> &#krate::ModelDescription {
@@ -542,39 +542,37 @@ fn point_stores(model: &SymbolicModel, v: &[TokenStream]) -> TokenStream {
 /// constrained models, `[M Jᵀ; J 0][q̈; λ] = [F; γ]`), and `Φₖ = 0` for each holonomic
 /// constraint. For HTML pages rendered without scripts or network (MathML Core).
 ///
-/// The left-hand sides are built as expressions in the model's arena, which is why the model
-/// is borrowed mutably; nothing already in it changes.
-pub fn equations_mathml(model: &mut SymbolicModel, eom: &EquationsOfMotion) -> Vec<String> {
+/// The left-hand sides are built as expressions in a copy of the model's arena, so that the
+/// model (and the plans made on its arena) stays as it was.
+pub fn equations_mathml(model: &SymbolicModel, eom: &EquationsOfMotion) -> Vec<String> {
     let n = eom.num_dofs;
+    let mut arena = model.arena.clone();
     let mut lhs = Vec::with_capacity(n);
-    let constraints = model.constraints.names.clone();
-    let multipliers: Vec<ExprId> = constraints
+    let multipliers: Vec<ExprId> = model
+        .constraints
+        .names
         .iter()
         .enumerate()
-        .map(|(k, name)| {
-            model
-                .arena
-                .symbol(&format!("lambda_{name}"), SymbolKind::Multiplier(k as u32))
-        })
+        .map(|(k, name)| arena.symbol(&format!("lambda_{name}"), SymbolKind::Multiplier(k as u32)))
         .collect();
     for i in 0..n {
         let mut terms = Vec::new();
         for j in 0..n {
             let m = eom.mass(i, j);
-            if !model.arena.is_zero(m) {
+            if !arena.is_zero(m) {
                 let acceleration = model.coordinates[j][2];
-                terms.push(model.arena.product(&[m, acceleration]));
+                terms.push(arena.product(&[m, acceleration]));
             }
         }
         for (k, lambda) in multipliers.iter().enumerate() {
             let j = model.constraints.jacobian[k * n + i];
-            if !model.arena.is_zero(j) {
-                terms.push(model.arena.product(&[j, *lambda]));
+            if !arena.is_zero(j) {
+                terms.push(arena.product(&[j, *lambda]));
             }
         }
-        lhs.push(model.arena.sum(&terms));
+        lhs.push(arena.sum(&terms));
     }
-    let p = Printer::new(&model.arena, Syntax::MathMl);
+    let p = Printer::new(&arena, Syntax::MathMl);
     let line = |body: String| format!("<math display=\"block\">{body}</math>");
     let equals = "<mo>=</mo>";
     let mut out = vec![
@@ -582,7 +580,7 @@ pub fn equations_mathml(model: &mut SymbolicModel, eom: &EquationsOfMotion) -> V
         line(format!("<mi>V</mi>{equals}{}", p.print(model.potential))),
     ];
     for (i, q) in model.generalized_forces.iter().enumerate() {
-        if !model.arena.is_zero(*q) {
+        if !arena.is_zero(*q) {
             out.push(line(format!(
                 "<msub><mi>Q</mi>{}</msub>{equals}{}",
                 crate::expr::print::mathml_symbol(&model.coordinate_names[i]),

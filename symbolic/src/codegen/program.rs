@@ -131,7 +131,7 @@ impl ModelProgram {
         points.outputs = outputs;
         let single = |function| FunctionTape::single(tapes.get(function));
         ModelProgram {
-            description: super::describe(model, eom),
+            description: super::describe(model, eom, false),
             initial_state: single(F::InitialState),
             mass_matrix_and_forcing,
             kinetic_energy: single(F::KineticEnergy),
@@ -228,6 +228,12 @@ impl JacobianProgram {
 }
 
 impl Derivation {
+    /// The equations as MathML ([`super::equations_mathml`]), for a description that was
+    /// planned without them.
+    pub fn equations_mathml(&self) -> Vec<String> {
+        super::equations_mathml(&self.model, &self.eom)
+    }
+
     /// Derives the exact Jacobians `∂F/∂q`, `∂F/∂q̇`, `∂(M a)/∂q`
     /// ([`crate::mechanics::Jacobians::of`]) and lowers their plans
     /// ([`super::plan::plan_jacobians`], as [`super::emit`] prints them) to tapes.

@@ -6,7 +6,7 @@ use rustc_hash::FxHashMap;
 
 use super::constraints::{ConstraintEquations, linear_in_rates, redundant_rows};
 use crate::expr::{Constant, ExprArena, ExprId, Func, SymbolId, SymbolKind};
-use crate::model::{BinOp, BodyKind, Diagnostic, Expr, ExprKind, ModelFile};
+use crate::model::{BinOp, BodyKind, Diagnostic, Expr, ExprKind, FloquetReference, ModelFile};
 use crate::model::{Located, Location};
 
 /// A parameter of a lowered model.
@@ -160,6 +160,10 @@ pub struct SymbolicModel {
     pub events: Vec<EventInfo>,
     /// The file's `equilibria:`: name and a guess per coordinate (0 where not given).
     pub equilibria: Vec<(String, Vec<ExprId>)>,
+    /// The file's `checks:` reference results, as the model's description keeps them.
+    pub checks: eomgen_description::checks::Checks,
+    /// The file's `floquet:` references, as the model's description keeps them.
+    pub floquet: Vec<eomgen_description::floquet::FloquetReference>,
 }
 
 /// The box in which the derivation checks draw random states (`eomgen check`, the mass
@@ -815,6 +819,12 @@ impl<'f> Lowering<'f> {
             initial_guesses,
             events,
             equilibria,
+            checks: file.checks.describe(),
+            floquet: file
+                .floquet
+                .iter()
+                .map(FloquetReference::describe)
+                .collect(),
         })
     }
 

@@ -84,3 +84,94 @@ pub enum ExprKind {
         args: Vec<Expr>,
     },
 }
+
+impl BinOp {
+    /// The operator as written: `+`, `-`, `*`, `/`, `^`.
+    pub fn symbol(self) -> char {
+        match self {
+            BinOp::Add => '+',
+            BinOp::Sub => '-',
+            BinOp::Mul => '*',
+            BinOp::Div => '/',
+            BinOp::Pow => '^',
+        }
+    }
+}
+
+/// How tightly a form binds, loosest first, as the parser reads them: sums, products, unary
+/// minus, powers, then numbers, names, calls and parenthesised expressions.
+const SUM: u8 = 1;
+const PRODUCT: u8 = 2;
+const UNARY: u8 = 3;
+const POWER: u8 = 4;
+const ATOM: u8 = 5;
+
+impl Expr {
+    /// How tightly this expression's outermost form binds.
+    fn binding(&self) -> u8 {
+        match &self.kind {
+            ExprKind::Number { .. } | ExprKind::Ident(_) | ExprKind::Call { .. } => ATOM,
+            ExprKind::Neg(_) => UNARY,
+            ExprKind::Binary { op, .. } => match op {
+                BinOp::Add | BinOp::Sub => SUM,
+                BinOp::Mul | BinOp::Div => PRODUCT,
+                BinOp::Pow => POWER,
+            },
+        }
+    }
+
+    /// Writes `self`, in parentheses unless it binds at least as tightly as `least`.
+    fn write_within(&self, least: u8, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        if self.binding() >= least {
+            write!(f, "{self}")
+        } else {
+            write!(f, "({self})")
+        }
+    }
+}
+
+/// The expression in the model file's syntax, parenthesised so that it parses back to the
+/// same tree (locations aside): numbers as written, `+ -` and `* /` left-associative,
+/// `^`'s base an atom, and a unary minus in parentheses wherever it is a right operand or
+/// negated (`a*(-b)`, `a^(-2)`, `-(-x)`).
+impl std::fmt::Display for Expr {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match &self.kind {
+            ExprKind::Number { text, .. } => f.write_str(text),
+            ExprKind::Ident(name) => f.write_str(name),
+            ExprKind::Neg(a) => {
+                f.write_str("-")?;
+                a.write_within(POWER, f)
+            }
+            ExprKind::Binary { op, lhs, rhs, .. } => {
+                // The right operand of a left-associative operator binds one level tighter
+                // (`a - (b - c)` keeps its parentheses); a unary minus on the right goes in
+                // parentheses (`a*(-b)`), on the left it reads as the parser reads it
+                // (`-a*b` is `(-a)*b`).
+                let (left, right) = match op {
+                    BinOp::Add | BinOp::Sub => (SUM, PRODUCT),
+                    BinOp::Mul | BinOp::Div => (PRODUCT, POWER),
+                    BinOp::Pow => (ATOM, POWER),
+                };
+                lhs.write_within(left, f)?;
+                let spaced = matches!(op, BinOp::Add | BinOp::Sub);
+                if spaced {
+                    write!(f, " {} ", op.symbol())?;
+                } else {
+                    write!(f, "{}", op.symbol())?;
+                }
+                rhs.write_within(right, f)
+            }
+            ExprKind::Call { func, args } => {
+                write!(f, "{func}(")?;
+                for (i, a) in args.iter().enumerate() {
+                    if i > 0 {
+                        f.write_str(", ")?;
+                    }
+                    write!(f, "{a}")?;
+                }
+                f.write_str(")")
+            }
+        }
+    }
+}

@@ -544,3 +544,116 @@ pub struct ModelFile {
     /// The spatial dimension of the points (2 or 3); `None` when there are no points.
     pub dimension: Option<usize>,
 }
+
+/// Owned text of a description.
+fn owned(s: &str) -> eomgen_description::Text {
+    std::borrow::Cow::Owned(s.to_string())
+}
+
+/// An expression as description text ([`Expr`]'s `Display`, which parses back to it).
+fn expression(e: &Expr) -> eomgen_description::Text {
+    std::borrow::Cow::Owned(e.to_string())
+}
+
+impl RunSettings {
+    /// The settings as the model's description keeps them.
+    pub fn describe(&self) -> eomgen_description::checks::RunSettings {
+        eomgen_description::checks::RunSettings {
+            method: self.method.as_ref().map(|m| owned(&m.value)),
+            rtol: self.rtol,
+            t_end: self.t_end,
+        }
+    }
+}
+
+impl Checks {
+    /// The reference results as the model's description keeps them: every expression as
+    /// text, locations dropped; the hand-derived `equations_of_motion` left out (they are
+    /// compared with the derivation, from the file).
+    pub fn describe(&self) -> eomgen_description::checks::Checks {
+        use eomgen_description::checks as d;
+        let modal = |c: &ModalCheck| d::ModalCheck {
+            at: c.at.as_ref().map(|a| owned(&a.value)),
+            values: c.values.iter().map(expression).collect(),
+            tolerance: c.tolerance,
+        };
+        let drift = |c: &DriftCheck| d::DriftCheck {
+            max: c.max,
+            run: c.run.describe(),
+        };
+        d::Checks {
+            natural_frequencies: self.natural_frequencies.as_ref().map(modal),
+            damping_ratios: self.damping_ratios.as_ref().map(modal),
+            period: self.period.as_ref().map(|c| d::PeriodCheck {
+                event: owned(&c.event.value),
+                value: expression(&c.value),
+                tolerance: c.tolerance,
+                run: c.run.describe(),
+            }),
+            final_state: self.final_state.as_ref().map(|c| d::FinalStateCheck {
+                t: expression(&c.t),
+                values: c
+                    .values
+                    .iter()
+                    .map(|(k, e)| (owned(&k.value), expression(e)))
+                    .collect(),
+                tolerance: c.tolerance,
+                run: c.run.describe(),
+            }),
+            conserved: self
+                .conserved
+                .iter()
+                .map(|c| d::ConservedCheck {
+                    name: owned(&c.name.value),
+                    value: expression(&c.value),
+                    tolerance: c.tolerance,
+                })
+                .collect(),
+            energy_drift: self.energy_drift.as_ref().map(drift),
+            constraint_drift: self.constraint_drift.as_ref().map(drift),
+        }
+    }
+}
+
+impl FloquetReference {
+    /// The references as the model's description keeps them: every expression as text,
+    /// locations dropped.
+    pub fn describe(&self) -> eomgen_description::floquet::FloquetReference {
+        use eomgen_description::floquet as d;
+        d::FloquetReference {
+            at: owned(&self.at.value),
+            axis_units: self
+                .axis_units
+                .iter()
+                .map(|(p, u)| (owned(&p.value), owned(&u.value)))
+                .collect(),
+            thresholds: self
+                .thresholds
+                .iter()
+                .map(|t| d::FloquetThreshold {
+                    name: owned(&t.name.value),
+                    key: owned(&t.key.value),
+                    label: owned(&t.label),
+                    value: expression(&t.value),
+                    critical: expression(&t.critical),
+                    critical_label: owned(&t.critical_label),
+                    by: owned(&t.by),
+                    note: owned(&t.note),
+                })
+                .collect(),
+            curves: self
+                .curves
+                .iter()
+                .map(|c| d::ReferenceCurve {
+                    name: owned(&c.name.value),
+                    label: owned(&c.label),
+                    color: c.color.iter().map(expression).collect(),
+                    along: owned(&c.along.value),
+                    gives: owned(&c.gives.value),
+                    value: expression(&c.value),
+                    domain: c.domain.as_ref().map(expression),
+                })
+                .collect(),
+        }
+    }
+}

@@ -221,16 +221,6 @@ pub const MAX_TREE_HEIGHT: usize = 2_000;
 /// A parsed sub-expression and the height of its tree (1 for a leaf).
 type Parsed = Result<(Expr, usize), Diagnostic>;
 
-fn symbol(op: BinOp) -> char {
-    match op {
-        BinOp::Add => '+',
-        BinOp::Sub => '-',
-        BinOp::Mul => '*',
-        BinOp::Div => '/',
-        BinOp::Pow => '^',
-    }
-}
-
 /// `lhs op rhs`, with its height; an error at `at` (the operator) when it would be taller
 /// than [`MAX_TREE_HEIGHT`].
 fn binary(op: BinOp, (lhs, lh): (Expr, usize), (rhs, rh): (Expr, usize), at: Location) -> Parsed {
@@ -339,7 +329,7 @@ impl P<'_> {
                 self.at(),
                 format!(
                     "expected an operand after `{}`, found {}",
-                    symbol(op),
+                    op.symbol(),
                     self.describe()
                 ),
             );
@@ -349,7 +339,7 @@ impl P<'_> {
                 }
                 _ => d.with_help(format!(
                     "write a number, a name or a parenthesised expression after `{}`",
-                    symbol(op)
+                    op.symbol()
                 )),
             });
         }
@@ -859,7 +849,7 @@ mod tests {
             ExprKind::Ident(n) => n.clone(),
             ExprKind::Neg(a) => format!("(-{})", show(a)),
             ExprKind::Binary { op, lhs, rhs, .. } => {
-                format!("({} {} {})", show(lhs), symbol(*op), show(rhs))
+                format!("({} {} {})", show(lhs), op.symbol(), show(rhs))
             }
             ExprKind::Call { func, args } => format!(
                 "{func}({})",
