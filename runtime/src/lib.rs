@@ -62,6 +62,7 @@ pub use integrate::{
     SymplecticEuler, Tableau, Tolerance,
 };
 pub use linalg::{solve_spd, solve_spd_in_place};
+pub use linear::eigenvalues::{LinearStability, Stability, linear_stability, state_eigenvalues};
 pub use linear::frequency_response::{
     ForcedLinearization, FrequencySweep, FrfError, HarmonicForcing, ModalResponse, PeakAmplitude,
     ResonancePeak, SteadyState, SteadyStateOptions, frequency_response, frequency_response_of,

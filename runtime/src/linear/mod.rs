@@ -3,6 +3,8 @@
 //! it, with their own small options), each with a typed error and results that are plain
 //! values (serialisable where a report embeds them):
 //!
+//! - [`eigenvalues`]: the eigenvalues of the whole state matrix (damping and gyroscopic
+//!   terms), accurate on badly scaled models, and the stability verdict from them;
 //! - [`modal`]: equilibria, the exact linearisation `M δq̈ + C δq̇ + K δq = 0` and its state
 //!   matrix, undamped normal modes, damped modes, the matrix exponential;
 //! - [`response`]: the free response of a linearisation computed several independent ways,
@@ -16,6 +18,7 @@
 //! `Serialize` report and a typed error — are in [`crate::analysis`]
 //! ([`crate::analysis::vibration`] for these).
 
+pub mod eigenvalues;
 pub mod frequency_response;
 pub mod modal;
 pub mod monodromy;
