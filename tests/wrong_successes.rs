@@ -649,3 +649,42 @@ fn issue_28_floquet_tolerance_and_baumgarte_gain_ranges() {
     assert_eq!(out.status.code(), Some(2));
     assert!(stderr(&out).contains("[0, 1e6]"), "{}", stderr(&out));
 }
+
+/// Issue 30: a kinematic file with a written `potential:` and `generalized_forces:` lost its
+/// momentum-balance cross-check and `check` still said "passed" having compared nothing.
+/// Now the written terms enter momentum balance, which agrees with Lagrange symbolically;
+/// and a file where no second derivation applies (the energy form with no hand-derived
+/// equations) is "not cross-checked", exit 1, never passed.
+#[test]
+fn check_never_passes_without_a_second_derivation() {
+    let dir = tempfile::tempdir().unwrap();
+    let kinematic = dir.path().join("spring_cart.yaml");
+    std::fs::write(
+        &kinematic,
+        "name: spring_cart\nparameters: { m: 2.0, k: 4.0, c: 0.3 }\ncoordinates: [x]\n\
+         points: { P: [x, 0] }\nbodies: { cart: { mass: m, at: P } }\n\
+         potential: k*x^2/2\ngeneralized_forces: { x: -c*x_dot }\ninitial: { x: 0.1 }\n",
+    )
+    .unwrap();
+    let out = eomgen(&["check", kinematic.to_str().unwrap(), "--json"]);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let checks = report["checks"].as_array().unwrap();
+    let momentum = checks
+        .iter()
+        .find(|c| c["b"] == "momentum")
+        .unwrap_or_else(|| panic!("{report}"));
+    assert_eq!(momentum["symbolic_equal"], true, "{report}");
+
+    let energy = dir.path().join("energy_only.yaml");
+    std::fs::write(
+        &energy,
+        "name: energy_only\nparameters: { m: 1.0, k: 4.0 }\ncoordinates: [x]\n\
+         kinetic: m*x_dot^2/2\npotential: k*x^2/2\ninitial: { x: 0.1 }\n",
+    )
+    .unwrap();
+    let out = eomgen(&["check", energy.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("not cross-checked"), "{text}");
+}

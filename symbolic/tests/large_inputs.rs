@@ -24,13 +24,14 @@ fn on_small_stack<T: Send + 'static>(f: impl FnOnce() -> T + Send + 'static) -> 
         .expect("no panic")
 }
 
-/// A one-coordinate model whose potential is `k*x^2/2` followed by `terms` more `+ x`
-/// (a tree of height `terms + 3`), the same chain as a parameter's default and in `initial:`.
+/// A one-coordinate model — a unit mass at `(x, 0)`, so that momentum balance cross-checks
+/// Lagrange — whose potential is `k*x^2/2` followed by `terms` more `+ x` (a tree of height
+/// `terms + 3`), the same chain as a parameter's default and in `initial:`.
 fn flat_model(terms: usize) -> String {
     let chain = " + x".repeat(terms);
     let constant = " + 1".repeat(terms);
     format!(
-        "name: flat\ncoordinates: [x]\nparameters: {{ k: 1.0, c: 0{constant} }}\nkinetic: x_dot^2/2\npotential: k*x^2/2{chain}\ninitial: {{ x: 0{constant} }}\n"
+        "name: flat\ncoordinates: [x]\nparameters: {{ k: 1.0, c: 0{constant} }}\npoints: {{ P: [x, 0] }}\nbodies: {{ b: {{ mass: 1, at: P }} }}\npotential: k*x^2/2{chain}\ninitial: {{ x: 0{constant} }}\n"
     )
 }
 
@@ -58,9 +59,9 @@ fn longer_chains_are_a_located_error() {
         on_small_stack(move || {
             let source = flat_model(terms);
             let diagnostics = load("flat.yaml", &source).expect_err("too long");
-            // The parameter's default (line 3), the potential (line 5) and `initial:` (line 6).
+            // The parameter's default (line 3), the potential (line 6) and `initial:` (line 7).
             let lines: Vec<u32> = diagnostics.iter().map(|d| d.location.line).collect();
-            assert_eq!(lines, [3, 5, 6], "{diagnostics:?}");
+            assert_eq!(lines, [3, 6, 7], "{diagnostics:?}");
             for d in &diagnostics {
                 assert!(d.message.contains("too long"), "{}", d.message);
                 assert!(d.location.column > 1000, "{d:?}");
@@ -115,7 +116,7 @@ fn a_hundred_thousand_parameters_load_in_linear_time() {
     for i in 0..N {
         text.push_str(&format!("  p{i}: {}  # kg, number {i}\n", i + 1));
     }
-    text.push_str("  k: 2.0  # N/m\nkinetic: x_dot^2/2\npotential: k*x^2/2\ninitial: { x: 1 }\n");
+    text.push_str("  k: 2.0  # N/m\npoints: { P: [x, 0] }\nbodies: { b: { mass: 1, at: P } }\npotential: k*x^2/2\ninitial: { x: 1 }\n");
     let file = load("many.yaml", &text).expect("loads");
     assert_eq!(file.parameters.len(), N + 1);
     for i in [0, 1, N / 2, N - 1] {

@@ -90,7 +90,7 @@ pub fn run(args: &EquationsArgs) -> Result<(), CliError> {
         Method::Momentum => {
             if !MomentumBalance::applies_to(&model) {
                 return Err(CliError::usage(format!(
-                    "`{}` uses the energy form (kinetic/potential/generalized_forces), which momentum balance cannot use; try --method lagrange",
+                    "`{}` has no bodies or writes `kinetic:`, which momentum balance cannot derive from; try --method lagrange",
                     model.name
                 )));
             }

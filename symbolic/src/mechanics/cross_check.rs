@@ -162,11 +162,26 @@ impl SampledStates {
     }
 }
 
+/// The note of a model that momentum balance cannot derive.
+const NO_MOMENTUM_BALANCE: &str =
+    "momentum balance needs bodies and no written `kinetic:`: compared nothing";
+
 impl CheckReport {
+    /// Why the derivation was not cross-checked, when no second derivation was compared
+    /// with Lagrange's (`None` when one was): a model with no bodies, or one that writes
+    /// `kinetic:`, and no `balances:` or hand-written `equations_of_motion:`.
+    pub fn not_cross_checked(&self) -> Option<&'static str> {
+        self.comparisons.is_empty().then_some(
+            "not cross-checked: only Lagrange's equations apply (momentum balance needs bodies and no written `kinetic:`; add `checks: equations_of_motion:` derived by hand, or `balances:`)",
+        )
+    }
+
     /// Whether every check passed at relative tolerance `tolerance`; never when no random
-    /// state was compared ([`SampledStates::nothing_compared`]).
+    /// state was compared ([`SampledStates::nothing_compared`]) or no second derivation was
+    /// ([`Self::not_cross_checked`]).
     pub fn passed(&self, tolerance: f64) -> bool {
         self.states.compared > 0
+            && self.not_cross_checked().is_none()
             && self
                 .comparisons
                 .iter()
@@ -285,7 +300,7 @@ pub fn check_model(
         derivations.push(stats);
         others.push((MomentumBalance.name(), eom));
     } else {
-        notes.push("momentum balance needs the kinematic form (bodies and loads, no `kinetic`, `potential` or `generalized_forces`): compared nothing".to_string());
+        notes.push(NO_MOMENTUM_BALANCE.to_string());
     }
     for name in integrable_nonholonomic(&mut model, seed) {
         notes.push(format!(
@@ -395,7 +410,7 @@ pub fn check_model(
         })
     };
     let initial_constraints = initial_constraints(&model);
-    Ok(CheckReport {
+    let mut report = CheckReport {
         model: model.name.clone(),
         comparisons,
         power_balance,
@@ -403,7 +418,13 @@ pub fn check_model(
         notes,
         initial_constraints,
         states: sampled,
-    })
+    };
+    if let Some(reason) = report.not_cross_checked() {
+        // Said once, as the reason the check fails.
+        report.notes.retain(|n| n != NO_MOMENTUM_BALANCE);
+        report.notes.push(reason.to_string());
+    }
+    Ok(report)
 }
 
 /// What [`check_model`] measures at random states: q̈ of each other derivation against

@@ -148,6 +148,14 @@ pub struct SymbolicModel {
     /// Whether the file uses the energy form (`kinetic`, `potential` or
     /// `generalized_forces`), which a derivation from the kinematics alone cannot use.
     pub uses_energy_form: bool,
+    /// Whether the file writes `kinetic:` (which momentum balance, deriving the inertia of
+    /// the bodies from their kinematics, cannot use).
+    pub kinetic_written: bool,
+    /// The file's `potential:` alone (0 if none): momentum balance adds `−∂V/∂qᵢ` to `Fᵢ`.
+    pub written_potential: ExprId,
+    /// The file's `generalized_forces:` alone, per coordinate (0 where none): momentum
+    /// balance adds them to `F`.
+    pub written_forces: Vec<ExprId>,
     /// The residuals `lhs − rhs` of the file's equations of motion written by hand
     /// (`checks: equations_of_motion`), in the coordinates, rates and accelerations; empty
     /// when the file gives none.
@@ -726,6 +734,14 @@ impl<'f> Lowering<'f> {
             half: self.arena.constant(Constant::Rational { num: 1, den: 2 }),
         };
         self.energies_written(&mut terms, &coordinate_names);
+        // The written pieces alone, for momentum balance (which derives the rest from the
+        // kinematics): they are the first terms of `V` and of each `Q`.
+        let written_potential = self.arena.sum(&terms.potential);
+        let written_forces: Vec<ExprId> = terms
+            .forces
+            .iter()
+            .map(|terms| self.arena.sum(terms))
+            .collect();
         let gravity: Option<Vec<ExprId>> = file
             .gravity
             .as_ref()
@@ -814,6 +830,9 @@ impl<'f> Lowering<'f> {
             uses_energy_form: file.kinetic.is_some()
                 || file.potential.is_some()
                 || !file.generalized_forces.is_empty(),
+            kinetic_written: file.kinetic.is_some(),
+            written_potential,
+            written_forces,
             hand_equations,
             constraints,
             initial_guesses,

@@ -98,7 +98,11 @@ impl Jacobians {
 }
 
 /// The formulation whose equations generated code uses: momentum balance for a model in the
-/// kinematic form ([`MomentumBalance::applies_to`]), Lagrange otherwise.
+/// kinematic form with no written energy or generalized forces
+/// ([`MomentumBalance::applies_to`] and not [`SymbolicModel::uses_energy_form`]), Lagrange
+/// otherwise. (A kinematic file with a written `potential:` or `generalized_forces:` is
+/// cross-checked by momentum balance but generated from Lagrange's equations, as it was
+/// before momentum balance took those terms: its generated code stays as it was.)
 ///
 /// The rule needs no derivation, so a model is derived once however it is loaded (the
 /// `model!` macro and the run-time loader both go through [`preferred_equations`]). Both
@@ -110,7 +114,7 @@ impl Jacobians {
 /// (the rule before issue 18), no bundled model gets more than one more operation, and the
 /// 3-spring line loses 26 in its Jacobians for its one operation in `F`.
 pub fn preferred_formulation(model: &SymbolicModel) -> &'static dyn Formulation {
-    if MomentumBalance::applies_to(model) {
+    if MomentumBalance::applies_to(model) && !model.uses_energy_form {
         &MomentumBalance
     } else {
         &Lagrange

@@ -52,10 +52,11 @@ use crate::expr::{ExprArena, ExprId, SymbolId};
 pub struct MomentumBalance;
 
 impl MomentumBalance {
-    /// Whether the model can be derived from its kinematics alone: it has bodies and no
-    /// energy-form pieces (`kinetic`, `potential`, `generalized_forces`).
+    /// Whether the model can be derived by momentum balance: it has bodies and no written
+    /// `kinetic:` (a written `potential:` enters as the generalized forces `−∂V/∂qᵢ`, written
+    /// `generalized_forces:` as themselves).
     pub fn applies_to(model: &SymbolicModel) -> bool {
-        !model.uses_energy_form && !model.bodies.is_empty()
+        !model.kinetic_written && !model.bodies.is_empty()
     }
 }
 
@@ -283,8 +284,8 @@ impl Formulation for MomentumBalance {
     }
 
     /// # Panics
-    /// Never; for a model where [`MomentumBalance::applies_to`] is false the energy-form
-    /// pieces are ignored, so callers check it first.
+    /// Never; for a model where [`MomentumBalance::applies_to`] is false a written `kinetic:`
+    /// is ignored, so callers check it first.
     // One piece (about 170 lines): the steps — grouping bodies by partial velocity, the sums
     // `Σ m a₀` per group, the terms of `M` and `F` per body and per load, and the assembly —
     // share the kinematics cache, the group sums and the term lists, and run once in this
@@ -297,6 +298,8 @@ impl Formulation for MomentumBalance {
         let bodies = model.bodies.clone();
         let loads = model.loads.clone();
         let gravity = model.gravity.clone();
+        let (model_potential, written_forces) =
+            (model.written_potential, model.written_forces.clone());
         let arena = &mut model.arena;
         let mut kinematics = Kinematics::new(&points, &symbols, time);
         let mut sums = BodySums::default();
@@ -383,6 +386,17 @@ impl Formulation for MomentumBalance {
                     let torque = arena.product(&[inertia, alpha, rates[i]]);
                     forcing_terms[i].push(arena.neg(torque));
                 }
+            }
+        }
+        // The file's written potential and generalized forces: `−∂V/∂qᵢ + Qᵢ`.
+        let (potential, written) = (model_potential, written_forces);
+        for (i, s) in symbols.iter().enumerate() {
+            let dv = arena.diff(potential, s[0]);
+            if !arena.is_zero(dv) {
+                forcing_terms[i].push(arena.neg(dv));
+            }
+            if !arena.is_zero(written[i]) {
+                forcing_terms[i].push(written[i]);
             }
         }
         for load in &loads {
