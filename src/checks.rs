@@ -303,6 +303,15 @@ pub fn derivation_checks(
             DERIVATION_TOLERANCE,
         ));
     }
+    // A model that only Lagrange derives is not cross-checked: a failed row, never a pass.
+    if let Some(reason) = r.not_cross_checked() {
+        rows.push(CheckRow::compare(
+            "derivations cross-checked",
+            Err(reason.to_string()),
+            0.0,
+            DERIVATION_TOLERANCE,
+        ));
+    }
     if rows.is_empty()
         && let Some(reason) = &nothing_compared
     {
