@@ -1354,16 +1354,18 @@ pub fn eigenvalues_of_m_inv_k(lin: &Linearization) -> Result<Vec<f64>, ModalErro
 /// the damped frequency `ω_d = |Im s|` and the `damping_ratios` `ζ = −Re s / |s|`.
 ///
 /// Returns `(s, ζ, ω_d)` sorted by `|s|`, one entry per eigenvalue with `Im s ≥ 0` (so a
-/// complex pair appears once; real eigenvalues each appear with `ω_d = 0`).
+/// complex pair appears once; real eigenvalues each appear with `ω_d = 0`). The eigenvalues
+/// are [`super::eigenvalues::state_eigenvalues`]': accurate to rounding of their own size on
+/// badly scaled models, undamped ones exactly on the imaginary axis (`ζ = 0`).
 ///
 /// # Errors
-/// [`ModalError::SingularMassMatrix`].
+/// [`ModalError::SingularMassMatrix`]; [`ModalError::NonFinite`] for a `K` or `C` that is
+/// not finite.
 pub fn damped_modes(
     lin: &Linearization,
 ) -> Result<Vec<(nalgebra::Complex<f64>, f64, f64)>, ModalError> {
-    let a = lin.state_matrix()?;
-    let mut out: Vec<(nalgebra::Complex<f64>, f64, f64)> = a
-        .complex_eigenvalues()
+    let mut out: Vec<(nalgebra::Complex<f64>, f64, f64)> =
+        super::eigenvalues::state_eigenvalues(lin)?
         .iter()
         .filter(|s| s.im >= 0.0)
         .map(|s| {
