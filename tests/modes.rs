@@ -973,3 +973,73 @@ fn issue_28_time_dependent_load_without_equilibrium_is_refused_as_such() {
     let w2 = 9.81 * theta.cos();
     assert!((modal.normal_modes.eigenvalues[0] - w2).abs() < 1e-10 * w2);
 }
+
+/// Issue 30: the particle in a spinning bowl (tests/fixtures/spinning_bowl.yaml) has `K`
+/// negative definite — `K` alone calls both modes unstable, with growth rates √15.19 and
+/// √5.38 — while its whole linearisation, Coriolis terms included, is stable: the library's
+/// verdict is "marginally stable" with the closed-form gyroscopic frequencies (roots of
+/// `s⁴ + (k_a + k_b + 4W²) s² + k_a k_b`, to 1e-12), `C` is all gyroscopic and the
+/// eigenvalues lie on the imaginary axis. Spun slower (W = 3.5, between √(g a) and √(g b)
+/// the roots leave the axis), it is unstable with the closed-form growth rate.
+#[test]
+fn spinning_bowl_is_stable_by_its_whole_linearisation() {
+    use eomgen::analysis::vibration::{ModalOptions, modal_analysis};
+    use eomgen::{ModeKind, Stability};
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/fixtures/spinning_bowl.yaml"
+    );
+    let source = eomgen::ModelSource::open(path).unwrap();
+    let (g, a, b) = (9.81f64, 1.0, 2.0);
+    for w in [5.0f64, 3.5] {
+        let mut model = source.instantiate();
+        model.set_parameter("W", w).unwrap();
+        let analysis = modal_analysis(model.as_ref(), &ModalOptions::default()).unwrap();
+        let (ka, kb) = (g * a - w * w, g * b - w * w);
+        // s² = x, x² + (ka + kb + 4W²) x + ka kb = 0.
+        let p = ka + kb + 4.0 * w * w;
+        let disc = p * p - 4.0 * ka * kb;
+        let s = &analysis.stability;
+        assert_eq!(s.gyroscopic_part[(1, 0)], 2.0 * w);
+        assert_eq!(s.damping_part.amax(), 0.0);
+        if disc >= 0.0 && p > 0.0 && ka * kb > 0.0 {
+            assert!(matches!(
+                analysis.normal_modes.kinds[0],
+                ModeKind::Unstable { .. }
+            ));
+            assert_eq!(s.stability, Stability::MarginallyStable, "W = {w}");
+            let mut expected = [
+                ((p - disc.sqrt()) / 2.0).sqrt(),
+                ((p + disc.sqrt()) / 2.0).sqrt(),
+            ];
+            expected.sort_by(f64::total_cmp);
+            let got = s.gyroscopic_frequencies.as_ref().unwrap();
+            assert_eq!(got.len(), 2);
+            for (x, e) in got.iter().zip(expected) {
+                assert!((x - e).abs() <= 1e-12 * e, "W = {w}: {x} against {e}");
+            }
+            assert!(s.eigenvalues.iter().all(|e| e.re == 0.0));
+        } else {
+            // x complex: s = ±√x, growth rate max Re √x over the roots.
+            let roots = [
+                nalgebra::Complex::new(-p, 0.0) / 2.0
+                    + nalgebra::Complex::new(disc, 0.0).sqrt() / 2.0,
+                nalgebra::Complex::new(-p, 0.0) / 2.0
+                    - nalgebra::Complex::new(disc, 0.0).sqrt() / 2.0,
+            ];
+            let growth = roots
+                .iter()
+                .map(|x| x.sqrt().re.abs())
+                .fold(0.0f64, f64::max);
+            match s.stability {
+                Stability::Unstable { growth_rate } => {
+                    assert!(
+                        (growth_rate - growth).abs() <= 1e-12 * growth,
+                        "{growth_rate} {growth}"
+                    )
+                }
+                other => panic!("W = {w}: {other:?}"),
+            }
+        }
+    }
+}

@@ -1366,14 +1366,14 @@ pub fn damped_modes(
 ) -> Result<Vec<(nalgebra::Complex<f64>, f64, f64)>, ModalError> {
     let mut out: Vec<(nalgebra::Complex<f64>, f64, f64)> =
         super::eigenvalues::state_eigenvalues(lin)?
-        .iter()
-        .filter(|s| s.im >= 0.0)
-        .map(|s| {
-            let r = s.norm();
-            let zeta = if r == 0.0 { 0.0 } else { -s.re / r };
-            (*s, zeta, s.im.abs())
-        })
-        .collect();
+            .iter()
+            .filter(|s| s.im >= 0.0)
+            .map(|s| {
+                let r = s.norm();
+                let zeta = if r == 0.0 { 0.0 } else { -s.re / r };
+                (*s, zeta, s.im.abs())
+            })
+            .collect();
     out.sort_by(|a, b| a.0.norm().total_cmp(&b.0.norm()));
     Ok(out)
 }

@@ -126,6 +126,7 @@ fn json_report(
         m_inv_k_eigenvalues: route22,
         m_inv_k_relative_difference: route_difference,
         time_dependent_forcing: forcing,
+        stability: _,
     } = modal;
     let (label, equilibrium) = (&point.name, &point.equilibrium);
     let names = model.description().coordinate_names();

@@ -8,6 +8,7 @@ use serde::Serialize;
 use super::operating_point::{
     OperatingPoint, OperatingPointError, OperatingPointOptions, operating_point,
 };
+use crate::linear::eigenvalues::{LinearStability, linear_stability};
 use crate::linear::modal::{
     Linearization, ModalError, NormalModes, TimeDependentForcing, damped_modes,
     eigenvalues_of_m_inv_k, linearize, normal_modes, time_dependence,
@@ -69,6 +70,12 @@ pub struct ModalAnalysis {
     /// modes are those of the equations linearised there. `None` when the equations at the
     /// operating point do not depend on `t`.
     pub time_dependent_forcing: Option<TimeDependentForcing>,
+    /// The stability of the operating point from the eigenvalues of the whole state matrix
+    /// (damping and gyroscopic terms included; issue 30), with `C` split into its damping and
+    /// gyroscopic parts and the gyroscopic frequencies. The `kinds` of
+    /// [`Self::normal_modes`] come from `K` alone (undamped, non-gyroscopic): a spinning
+    /// system whose `K` has negative eigenvalues can be stable.
+    pub stability: LinearStability,
 }
 
 impl ModalAnalysis {
@@ -157,6 +164,7 @@ pub fn modal_analysis(
     let time_dependent_forcing = time_dependence(model, point.q(), point.t)?;
     let n = model.num_dofs();
     let linearization = linearize(model, point.q(), &vec![0.0; n], point.t)?;
+    let stability = linear_stability(&linearization)?;
     let modes = normal_modes(&linearization)?;
     let m_inv_k_eigenvalues = eigenvalues_of_m_inv_k(&linearization)?;
     let damped_modes: Vec<DampedEigenvalue> = damped_modes(&linearization)?
@@ -203,5 +211,6 @@ pub fn modal_analysis(
         m_inv_k_eigenvalues,
         m_inv_k_relative_difference,
         time_dependent_forcing,
+        stability,
     })
 }
