@@ -139,7 +139,7 @@ impl IntegrationArgs {
         } else {
             let dt = self
                 .dt
-                .unwrap_or(self.t_end / eomgen::IntegratorOptions::DEFAULT_FIXED_STEPS);
+                .unwrap_or(self.t_end / f64::from(eomgen::IntegratorOptions::DEFAULT_FIXED_STEPS));
             format!("fixed step dt = {dt:e} s", dt = num(dt))
         }
     }

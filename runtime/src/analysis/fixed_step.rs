@@ -199,7 +199,7 @@ pub fn fixed_step_warnings(
     if method.is_adaptive() || !(t_end.is_finite() && t_end > 0.0) {
         return warnings;
     }
-    let h = dt.unwrap_or(t_end / IntegratorOptions::DEFAULT_FIXED_STEPS);
+    let h = dt.unwrap_or(t_end / f64::from(IntegratorOptions::DEFAULT_FIXED_STEPS));
     if !(h.is_finite() && h > 0.0) {
         return warnings;
     }

@@ -187,7 +187,7 @@ fn fixed_step(problem: &Problem<'_>) -> f64 {
     let dt = problem
         .options
         .dt
-        .unwrap_or(span / IntegratorOptions::DEFAULT_FIXED_STEPS);
+        .unwrap_or(span / f64::from(IntegratorOptions::DEFAULT_FIXED_STEPS));
     problem.options.dt_max.map_or(dt, |dt_max| dt.min(dt_max))
 }
 

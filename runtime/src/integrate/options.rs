@@ -119,7 +119,7 @@ impl IntegratorOptions {
     /// The default absolute tolerance of an integrator used on its own.
     pub const DEFAULT_ATOL: f64 = 1e-9;
     /// Number of fixed steps over `[t0, t_end]` when a fixed-step method is given no `dt`.
-    pub const DEFAULT_FIXED_STEPS: f64 = 1000.0;
+    pub const DEFAULT_FIXED_STEPS: u32 = 1000;
     /// The default limit on step attempts.
     pub const DEFAULT_MAX_STEPS: usize = 1_000_000;
 }
