@@ -7,7 +7,10 @@
 //! velocity-dependent forces of a rotating or moving frame, which do no work). A verdict
 //! taken from `K` alone is wrong exactly where `G` matters: a particle in a spinning bowl
 //! with `K` negative definite is stable when the spin is fast enough (gyroscopic
-//! stabilisation; Meirovitch, *Methods of Analytical Dynamics*, §6.13).
+//! stabilisation; Meirovitch, *Methods of Analytical Dynamics*, §6.13). For a system with no
+//! Lagrangian structure (a non-holonomic linearisation, a follower load) the two parts are
+//! bookkeeping only — the symmetric part of the bicycle's `C` is not dissipation — and the
+//! verdict comes from the eigenvalues, never from the parts.
 //!
 //! # Method
 //! With `M = L Lᵀ` and `δq = L⁻ᵀ x`, the system is `ẍ + C̃ ẋ + K̃ x = 0` with
