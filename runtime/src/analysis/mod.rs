@@ -31,7 +31,9 @@ pub use methods::{Method, UnknownMethod};
 pub use outcome::{NothingMeasured, RunTally, StudyRuns};
 pub use roundoff::{EulerRoundoff, RoundoffError, RoundoffOptions, euler_roundoff};
 pub use simulation::{
-    AddedEvents, Simulation, SimulationError, SimulationOptions, simulate, simulate_with_events,
+    AddedEvents, DriftPair, EventSummary, FailureSummary, Simulation, SimulationError,
+    SimulationOptions, SimulationSample, SimulationSummary, WarningSummary, simulate,
+    simulate_with_events,
 };
 pub use stability::{
     StabilityError, StabilityOptions, StabilityStudy, StiffSpring, stability_study,
