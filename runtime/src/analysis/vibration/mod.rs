@@ -34,8 +34,8 @@ pub use floquet::{
     floquet_at_equilibrium, floquet_at_equilibrium_for_sweep, floquet_cell,
 };
 pub use free_response::{
-    FreeResponseMethod, FreeResponseOptions, FreeResponseStudy, InitialDeviation,
-    ResponseDifference, ResponseStudyError, default_duration, free_response,
+    FinalState, FreeResponseMethod, FreeResponseOptions, FreeResponseStudy, FreeResponseSummary,
+    InitialDeviation, MethodSummary, ModeSummary, ResponseDifference, ResponseStudyError, default_duration, free_response,
     unconstrained_modal_analysis, uniform_times,
 };
 pub use frf::{
@@ -44,10 +44,14 @@ pub use frf::{
     max_simulation_error, plan_simulation, simulate_point,
 };
 pub use modal_damping::{
-    ModalDampingOptions, ModalDampingStudy, ModalRatio, ModeDamping, RayleighFit, Release,
-    modal_damping_study,
+    ModalDampingOptions, ModalDampingStudy, ModalDampingSummary, ModalRatio, ModeDamping,
+    ModeDampingSummary, RayleighFit, Release, ReleaseSummary, modal_damping_study,
 };
-pub use modes::{DampedEigenvalue, ModalAnalysis, ModalOptions, modal_analysis};
+pub use modes::{
+    DampedEigenvalue, DampedEigenvalueSummary, ModalAnalysis, ModalOptions, ModesSummary,
+    modal_analysis,
+};
 pub use operating_point::{
-    EquilibriumStart, OperatingPoint, OperatingPointError, OperatingPointOptions, operating_point,
+    EquilibriumStart, OperatingPoint, OperatingPointError, OperatingPointOptions, PointSummary,
+    operating_point,
 };
