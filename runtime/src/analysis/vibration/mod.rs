@@ -39,8 +39,10 @@ pub use free_response::{
     unconstrained_modal_analysis, uniform_times,
 };
 pub use frf::{
-    FrfAnalysis, FrfAnalysisError, FrfEvaluation, FrfOptions, FrfOutput, FrfSimulationOptions,
-    FrfSimulationPlan, SimulatedPoint, SimulatedValue, frequency_response_analysis,
+    FrfAnalysis, FrfAnalysisError, FrfEvaluation, FrfEvaluationSummary, FrfOptions, FrfOutput,
+    FrfSimulationOptions, FrfSimulationPlan, FrfSimulationSummary, FrfSummary, FrfSweepSummary,
+    ModalSumSummary, ModalTermSummary, PeakSummary, Phasor, SimulatedPoint,
+    SimulatedPointSummary, SimulatedValue, SimulatedValueSummary, frequency_response_analysis,
     max_simulation_error, plan_simulation, simulate_point,
 };
 pub use modal_damping::{
