@@ -39,6 +39,7 @@ pub use stability::{
     StabilityError, StabilityOptions, StabilityStudy, StiffSpring, stability_study,
 };
 pub use work_precision::{
-    AtTarget, Measured, MethodRuns, RunFailure, Setting, SettingRun, WorkPrecision,
-    WorkPrecisionError, WorkPrecisionOptions, work_precision,
+    AtTarget, Measured, MethodRuns, MethodRunsSummary, ReferenceSummary, RunFailure, RunSummary,
+    Setting, SettingRun, TargetSummary, TimingSummary, WorkPrecision, WorkPrecisionError,
+    WorkPrecisionOptions, WorkPrecisionSummary, work_precision,
 };
