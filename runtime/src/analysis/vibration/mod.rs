@@ -30,7 +30,9 @@ pub mod modes;
 pub mod operating_point;
 
 pub use floquet::{
-    FloquetCell, FloquetChart, FloquetPoint, FloquetStudyError, FloquetStudyOptions, SweepAxis,
+    FailedCell, FloquetCell, FloquetChart, FloquetChartSummary, FloquetIntegrationSummary,
+    FloquetPoint, FloquetStudyError, FloquetStudyOptions, FloquetSummary, MultiplierSummary,
+    PredictionSummary, SweepAxis,
     floquet_at_equilibrium, floquet_at_equilibrium_for_sweep, floquet_cell,
 };
 pub use free_response::{

@@ -129,6 +129,10 @@ pub struct PointSummary {
     /// The residual Newton left ([`Equilibrium::residual`]; left out when `None`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub residual: Option<f64>,
+    /// `max |F(q*, 0, t)|` over a forcing period (a time-periodic model's Floquet analysis;
+    /// left out when `None`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub max_forcing_residual: Option<f64>,
 }
 
 impl PointSummary {
@@ -143,6 +147,7 @@ impl PointSummary {
                 .collect(),
             newton_iterations: None,
             residual: None,
+            max_forcing_residual: None,
         }
     }
 }
