@@ -21,7 +21,8 @@ pub mod vibration;
 pub mod work_precision;
 
 pub use constraint_methods::{
-    ConstraintMethodRow, ConstraintMethods, ConstraintMethodsError, ConstraintMethodsOptions,
+    ConstraintMethodRow, ConstraintMethodSummary, ConstraintMethods, ConstraintMethodsError,
+    ConstraintMethodsOptions, ConstraintMethodsSummary, ConstraintReferenceSummary,
     constraint_methods,
 };
 pub use drift::{ConstraintDrift, EnergyDrift, constraint_drift, energy_drift, energy_drift_at};
