@@ -2,8 +2,8 @@
 //! parsing, their errors in the options' words, the JSON of a mode kind and the chart of
 //! stacked panels against time.
 
-use eomgen::analysis::vibration::{InitialDeviation, ResponseStudyError};
 use eomgen::ModelInfo;
+use eomgen::analysis::vibration::{InitialDeviation, ResponseStudyError};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 

@@ -39,7 +39,7 @@ pub fn run(args: &CheckArgs) -> Result<(), CliError> {
         crate::cli::model::diagnostics_error(&display, &source, &diagnostics)
     })?;
     if args.json {
-        print_json_sorted(&report.summary(TOLERANCE, args.timing), |_| {})?;
+        print_json_sorted(&report.summary(TOLERANCE, args.timing))?;
     } else {
         print_report(&report);
     }

@@ -112,7 +112,7 @@ pub fn run(args: &ConstraintMethodsArgs) -> Result<(), CliError> {
     }
     let mut stdout = crate::cli::output::stdout();
     if args.json {
-        print_json_sorted(&study.summary(&options), |_| {})?;
+        print_json_sorted(&study.summary(&options))?;
     } else {
         let _ = writeln!(
             stdout,

@@ -58,7 +58,7 @@ pub fn run(args: &EulerRoundoffArgs) -> Result<(), CliError> {
     }
     let mut stdout = crate::cli::output::stdout();
     if args.json {
-        print_json_sorted(&study.summary(), |_| {})?;
+        print_json_sorted(&study.summary())?;
     } else {
         let _ = writeln!(
             stdout,

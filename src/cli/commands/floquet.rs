@@ -207,7 +207,7 @@ pub fn run(args: &FloquetArgs) -> Result<(), CliError> {
             })
             .collect();
         let summary = point.summary(model.as_ref(), &options, predictions, sweep.as_ref());
-        print_json_sorted(&summary, |_| {})?;
+        print_json_sorted(&summary)?;
     } else {
         print_report(&mut stdout, &report);
     }

@@ -99,7 +99,7 @@ pub fn run(args: &FreeResponseArgs) -> Result<(), CliError> {
     }
     let mut stdout = crate::cli::output::stdout();
     if args.json {
-        print_json_sorted(&study.summary(model.as_ref()), |_| {})
+        print_json_sorted(&study.summary(model.as_ref()))
     } else {
         print_text(&mut stdout, model.as_ref(), &study);
         Ok(())

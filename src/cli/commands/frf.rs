@@ -232,7 +232,7 @@ pub fn run(args: &FrfArgs) -> Result<(), CliError> {
         .map_err(CliError::failure)?;
     }
     if args.json {
-        print_json_sorted(&frf.summary(model.as_ref(), simulated), |_| {})?;
+        print_json_sorted(&frf.summary(model.as_ref(), simulated))?;
         return Ok(());
     }
     print_report(

@@ -12,7 +12,7 @@ pub fn run(json: bool) -> Result<(), CliError> {
             .iter()
             .map(|m| eomgen::ModelSummary::of(m.as_ref()))
             .collect();
-        print_json_sorted(&items, |_| {})?;
+        print_json_sorted(&items)?;
     } else {
         let width = models
             .iter()

@@ -133,7 +133,7 @@ pub fn run(args: &ModalDampingArgs) -> Result<(), CliError> {
 
     let mut stdout = crate::cli::output::stdout();
     if args.json {
-        print_json_sorted(&study.summary(model.as_ref()), |_| {})?;
+        print_json_sorted(&study.summary(model.as_ref()))?;
         return Ok(());
     }
     print_report(&mut stdout, model.as_ref(), &study);

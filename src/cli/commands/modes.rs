@@ -79,14 +79,11 @@ pub fn run(args: &ModesArgs) -> Result<(), CliError> {
     }
     let mut stdout = crate::cli::output::stdout();
     if args.json {
-        print_json_sorted(
-            &ModesJson {
-                summary,
-                charts: &charts,
-                animation: &args.animate,
-            },
-            |_| {},
-        )
+        print_json_sorted(&ModesJson {
+            summary,
+            charts: &charts,
+            animation: &args.animate,
+        })
     } else {
         print_text(
             &mut stdout,

@@ -166,13 +166,13 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
     if args.json {
         // The wall time is the one figure that differs between two identical runs: only
         // printed when asked for (`--timing`), so that the JSON is byte-identical otherwise.
-        crate::cli::json::print_json_sorted(&simulation.summary(model.as_ref()), |json| {
-            if !args.timing
-                && let Some(stats) = json["stats"].as_object_mut()
-            {
-                stats.remove("wall_time_s");
-            }
-        })?;
+        let mut json = crate::cli::json::sorted(&simulation.summary(model.as_ref()))?;
+        if !args.timing
+            && let Some(stats) = json["stats"].as_object_mut()
+        {
+            stats.remove("wall_time_s");
+        }
+        crate::cli::json::print_json(&json)?;
     } else {
         print_summary(model.as_ref(), method_name, &args.run, solution, report);
         print_constraint_summary(constraints, args.run.stabilization);

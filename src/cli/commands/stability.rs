@@ -125,7 +125,7 @@ pub fn run(args: &StabilityArgs) -> Result<(), CliError> {
         underflow,
     } = &study;
     if args.json {
-        print_json_sorted(&study.summary(two_masses.as_ref(), &options), |_| {})?;
+        print_json_sorted(&study.summary(two_masses.as_ref(), &options))?;
     } else {
         let mut text = String::new();
         write_limits(&mut text, test, limits);

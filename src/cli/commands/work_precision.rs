@@ -249,7 +249,7 @@ pub fn run(args: &WorkPrecisionArgs) -> Result<(), CliError> {
         )?;
     }
     if args.json {
-        crate::cli::json::print_json_sorted(&study.report.summary(study.model, &options), |_| {})?;
+        crate::cli::json::print_json_sorted(&study.report.summary(study.model, &options))?;
     } else {
         // A failed write (a pipe into `head` closed) is kept by `output` and sets the status.
         let _ = study.write_text(&mut crate::cli::output::stdout());

@@ -703,9 +703,7 @@ impl FrfAnalysis {
             model: model.description().name.to_string(),
             input: self.input.clone(),
             outputs: outputs.iter().map(|o| o.name.clone()).collect(),
-            operating_point: self
-                .operating_point
-                .summary_at(&self.forced.equilibrium.q),
+            operating_point: self.operating_point.summary_at(&self.forced.equilibrium.q),
             input_matrix: self.forced.input_matrix.column(0).iter().copied().collect(),
             natural_frequencies: modes.natural_frequencies.clone(),
             damping_ratios: damping.damping_ratios.clone(),

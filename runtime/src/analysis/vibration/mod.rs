@@ -32,20 +32,20 @@ pub mod operating_point;
 pub use floquet::{
     FailedCell, FloquetCell, FloquetChart, FloquetChartSummary, FloquetIntegrationSummary,
     FloquetPoint, FloquetStudyError, FloquetStudyOptions, FloquetSummary, MultiplierSummary,
-    PredictionSummary, SweepAxis,
-    floquet_at_equilibrium, floquet_at_equilibrium_for_sweep, floquet_cell,
+    PredictionSummary, SweepAxis, floquet_at_equilibrium, floquet_at_equilibrium_for_sweep,
+    floquet_cell,
 };
 pub use free_response::{
     FinalState, FreeResponseMethod, FreeResponseOptions, FreeResponseStudy, FreeResponseSummary,
-    InitialDeviation, MethodSummary, ModeSummary, ResponseDifference, ResponseStudyError, default_duration, free_response,
-    unconstrained_modal_analysis, uniform_times,
+    InitialDeviation, MethodSummary, ModeSummary, ResponseDifference, ResponseStudyError,
+    default_duration, free_response, unconstrained_modal_analysis, uniform_times,
 };
 pub use frf::{
     FrfAnalysis, FrfAnalysisError, FrfEvaluation, FrfEvaluationSummary, FrfOptions, FrfOutput,
     FrfSimulationOptions, FrfSimulationPlan, FrfSimulationSummary, FrfSummary, FrfSweepSummary,
-    ModalSumSummary, ModalTermSummary, PeakSummary, Phasor, SimulatedPoint,
-    SimulatedPointSummary, SimulatedValue, SimulatedValueSummary, frequency_response_analysis,
-    max_simulation_error, plan_simulation, simulate_point,
+    ModalSumSummary, ModalTermSummary, PeakSummary, Phasor, SimulatedPoint, SimulatedPointSummary,
+    SimulatedValue, SimulatedValueSummary, frequency_response_analysis, max_simulation_error,
+    plan_simulation, simulate_point,
 };
 pub use modal_damping::{
     ModalDampingOptions, ModalDampingStudy, ModalDampingSummary, ModalRatio, ModeDamping,
