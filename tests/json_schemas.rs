@@ -259,3 +259,51 @@ fn json_output_keeps_its_schema() {
     let _ = std::fs::remove_dir_all(&report_dir);
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
+
+/// The JSON of `simulate`, `modes` and `study euler-roundoff` is the library's summary of
+/// the same call, value for value: a Rust program (or another front end) that calls the
+/// library gets what the command prints.
+#[test]
+fn command_json_is_the_library_summary() {
+    use eomgen::analysis::vibration::{ModalOptions, modal_analysis};
+    use eomgen::analysis::{RoundoffOptions, SimulationOptions, euler_roundoff, simulate};
+
+    let make = |name: &str| (eomgen::models::find(name).expect("bundled model").make)();
+
+    // A constrained model with an event, so that the optional keys are there.
+    let mut model = make("simple_pendulum_cartesian");
+    let options = SimulationOptions {
+        t_end: 0.5,
+        ..SimulationOptions::default()
+    };
+    let run = simulate(model.as_mut(), &options).expect("simulates");
+    let mut library = serde_json::to_value(run.summary(model.as_ref())).unwrap();
+    // The CLI prints the wall time only with `--timing`.
+    library["stats"]
+        .as_object_mut()
+        .unwrap()
+        .remove("wall_time_s");
+    let printed = json_of(&[
+        "simulate",
+        "simple_pendulum_cartesian",
+        "--t-end",
+        "0.5",
+        "--json",
+    ]);
+    assert_eq!(printed, library);
+
+    let mut model = make("three_masses_damped");
+    let modal = modal_analysis(model.as_mut(), &ModalOptions::default()).expect("modes");
+    let mut library = serde_json::to_value(modal.summary(model.as_ref())).unwrap();
+    // What the command adds: the files it wrote (none here).
+    library["charts"] = serde_json::json!([]);
+    library["animation"] = Value::Null;
+    assert_eq!(json_of(&["modes", "three_masses_damped", "--json"]), library);
+
+    let study = euler_roundoff(&RoundoffOptions { max_n: 3 }).expect("runs");
+    let library = serde_json::to_value(study.summary()).unwrap();
+    assert_eq!(
+        json_of(&["study", "euler-roundoff", "--max-n", "3", "--json"]),
+        library
+    );
+}

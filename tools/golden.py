@@ -94,9 +94,18 @@ CASES += [
      "--json", "--plot", "wp"],
     ["study", "work-precision", "double_pendulum", "--t-end", "1", "--tols", "1e-3..1e-5",
      "--steps", "64..128", "--methods", "dp54,rk4", "--repeats", "1", "--min-time-ms", "0"],
-    # JSON of rarer shapes: a failed run with warnings, an added event that never fires, the
-    # modal sums and simulated points of `frf`, unbounded peaks, failed cells of a sweep,
-    # a given Rayleigh fit.
+]
+# Every command's help: the defaults shown must not change.
+for c in [["simulate"], ["animate"], ["check"], ["equations"], ["modes"], ["frf"], ["new"],
+          ["report"], ["list"], ["study"], ["study", "work-precision"], ["study", "stability"],
+          ["study", "euler-roundoff"], ["study", "constraint-methods"],
+          ["study", "free-response"], ["study", "modal-damping"], ["study", "floquet"]]:
+    CASES.append(c + ["--help"])
+CASES.append(["--help"])
+# JSON of rarer shapes (added last, so that the earlier cases keep their numbers): a failed
+# run with warnings, an added event that never fires, the modal sums and simulated points of
+# `frf`, unbounded peaks, failed cells of a sweep, a given Rayleigh fit.
+CASES += [
     ["simulate", "double_pendulum", "--method", "euler", "--dt", "0.5", "--t-end", "2000",
      "--json"],
     ["simulate", "double_pendulum", "--t-end", "0.5", "--event", "theta1 = 100", "--json"],
@@ -107,13 +116,6 @@ CASES += [
     ["study", "floquet", "mathieu_pendulum", "--sweep", "a=0..0.2:2,w=0..60:3", "--json"],
     ["study", "modal-damping", "three_masses_damped", "--rayleigh-modes", "1,2", "--json"],
 ]
-# Every command's help: the defaults shown must not change.
-for c in [["simulate"], ["animate"], ["check"], ["equations"], ["modes"], ["frf"], ["new"],
-          ["report"], ["list"], ["study"], ["study", "work-precision"], ["study", "stability"],
-          ["study", "euler-roundoff"], ["study", "constraint-methods"],
-          ["study", "free-response"], ["study", "modal-damping"], ["study", "floquet"]]:
-    CASES.append(c + ["--help"])
-CASES.append(["--help"])
 
 # Cases whose text has unlabelled wall-time columns (milliseconds with three decimals) and
 # whose `-time` charts plot wall time: those columns and charts are masked.
