@@ -259,3 +259,77 @@ fn json_output_keeps_its_schema() {
     let _ = std::fs::remove_dir_all(&report_dir);
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
+
+/// Whether `a` and `b` have the same keys, strings, booleans and nulls everywhere and
+/// numbers equal to a relative 1e-9: the command and this test compile the numerical code
+/// apart (the command's model from its file at run time), so a last bit may differ.
+fn same_up_to_rounding(a: &Value, b: &Value) -> bool {
+    match (a, b) {
+        (Value::Number(x), Value::Number(y)) => {
+            let (x, y) = (x.as_f64().unwrap(), y.as_f64().unwrap());
+            (x - y).abs() <= 1e-9 * x.abs().max(y.abs()).max(1e-300)
+        }
+        (Value::Array(x), Value::Array(y)) => {
+            x.len() == y.len() && x.iter().zip(y).all(|(x, y)| same_up_to_rounding(x, y))
+        }
+        (Value::Object(x), Value::Object(y)) => {
+            x.len() == y.len()
+                && x.iter()
+                    .all(|(k, v)| y.get(k).is_some_and(|w| same_up_to_rounding(v, w)))
+        }
+        _ => a == b,
+    }
+}
+
+/// The JSON of `simulate`, `modes` and `study euler-roundoff` is the library's summary of
+/// the same call, key for key and value for value (to rounding): a Rust program (or another
+/// front end) that calls the library gets what the command prints.
+#[test]
+fn command_json_is_the_library_summary() {
+    use eomgen::analysis::vibration::{ModalOptions, modal_analysis};
+    use eomgen::analysis::{RoundoffOptions, SimulationOptions, euler_roundoff, simulate};
+
+    let make = |name: &str| (eomgen::models::find(name).expect("bundled model").make)();
+
+    // A constrained model with an event, so that the optional keys are there.
+    let mut model = make("simple_pendulum_cartesian");
+    let options = SimulationOptions {
+        t_end: 0.5,
+        ..SimulationOptions::default()
+    };
+    let run = simulate(model.as_mut(), &options).expect("simulates");
+    let mut library = serde_json::to_value(run.summary(model.as_ref())).unwrap();
+    // The CLI prints the wall time only with `--timing`.
+    library["stats"]
+        .as_object_mut()
+        .unwrap()
+        .remove("wall_time_s");
+    let printed = json_of(&[
+        "simulate",
+        "simple_pendulum_cartesian",
+        "--t-end",
+        "0.5",
+        "--json",
+    ]);
+    assert!(
+        same_up_to_rounding(&printed, &library),
+        "{printed}\n{library}"
+    );
+
+    let mut model = make("three_masses_damped");
+    let modal = modal_analysis(model.as_mut(), &ModalOptions::default()).expect("modes");
+    let mut library = serde_json::to_value(modal.summary(model.as_ref())).unwrap();
+    // What the command adds: the files it wrote (none here).
+    library["charts"] = serde_json::json!([]);
+    library["animation"] = Value::Null;
+    let printed = json_of(&["modes", "three_masses_damped", "--json"]);
+    assert!(
+        same_up_to_rounding(&printed, &library),
+        "{printed}\n{library}"
+    );
+
+    let study = euler_roundoff(&RoundoffOptions { max_n: 3 }).expect("runs");
+    let library = serde_json::to_value(study.summary()).unwrap();
+    let printed = json_of(&["study", "euler-roundoff", "--max-n", "3", "--json"]);
+    assert!(same_up_to_rounding(&printed, &library), "{printed}\n{library}");
+}

@@ -102,6 +102,20 @@ for c in [["simulate"], ["animate"], ["check"], ["equations"], ["modes"], ["frf"
           ["study", "free-response"], ["study", "modal-damping"], ["study", "floquet"]]:
     CASES.append(c + ["--help"])
 CASES.append(["--help"])
+# JSON of rarer shapes (added last, so that the earlier cases keep their numbers): a failed
+# run with warnings, an added event that never fires, the modal sums and simulated points of
+# `frf`, unbounded peaks, failed cells of a sweep, a given Rayleigh fit.
+CASES += [
+    ["simulate", "double_pendulum", "--method", "euler", "--dt", "0.5", "--t-end", "2000",
+     "--json"],
+    ["simulate", "double_pendulum", "--t-end", "0.5", "--event", "theta1 = 100", "--json"],
+    ["frf", "three_masses_forced", "--input", "A", "--modal", "--simulate", "2",
+     "--frequency", "3", "--json"],
+    ["frf", "forced_oscillator", "--input", "A", "--set", "c=0", "--modal", "--frequency", "1",
+     "--json"],
+    ["study", "floquet", "mathieu_pendulum", "--sweep", "a=0..0.2:2,w=0..60:3", "--json"],
+    ["study", "modal-damping", "three_masses_damped", "--rayleigh-modes", "1,2", "--json"],
+]
 
 # Cases whose text has unlabelled wall-time columns (milliseconds with three decimals) and
 # whose `-time` charts plot wall time: those columns and charts are masked.

@@ -92,6 +92,17 @@ impl Stabilization {
     /// fast against the motions of the bundled mechanisms (periods of about a second).
     pub const DEFAULT_BAUMGARTE_GAINS: [f64; 2] = [10.0, 10.0];
 
+    /// The drift control's name without its gains, as `--stabilization` spells it: `"none"`,
+    /// `"baumgarte"`, `"projection"` or `"penalty"`.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Self::None => "none",
+            Self::Baumgarte { .. } => "baumgarte",
+            Self::Projection => "projection",
+            Self::Penalty { .. } => "penalty",
+        }
+    }
+
     /// Baumgarte's stabilisation with [`Self::DEFAULT_BAUMGARTE_GAINS`].
     pub const fn default_baumgarte() -> Self {
         let [alpha, beta] = Self::DEFAULT_BAUMGARTE_GAINS;

@@ -86,6 +86,6 @@ pub use linear::response::{
     response_with_modal_damping, state_response_by_eigenvectors, state_response_by_exponential,
     state_response_by_integration,
 };
-pub use model_info::{ConstraintValues, ModelInfo};
+pub use model_info::{ConstraintValues, ModelInfo, ModelSummary};
 pub use ode::{OdeFn, OdeSystem, RhsError, WithEvents};
 pub use system::{BodyCentre, MechanicalSystem, ModelDescription, UnknownParameter};

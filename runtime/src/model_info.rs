@@ -14,6 +14,28 @@ use crate::dynamic::DynMechanicalSystem;
 use crate::ode::{EventSpec, OdeSystem, RhsError};
 use crate::system::{ModelDescription, UnknownParameter};
 
+/// A model as `eomgen list --json` lists it: `{"name", "dof", "description"}`.
+#[derive(Debug, Clone, PartialEq, Eq, serde::Serialize)]
+pub struct ModelSummary {
+    /// The model's name.
+    pub name: String,
+    /// Its degrees of freedom `n`.
+    pub dof: usize,
+    /// Its one-line description (the file's `description:`).
+    pub description: String,
+}
+
+impl ModelSummary {
+    /// The summary of `model`.
+    pub fn of(model: &dyn ModelInfo) -> Self {
+        Self {
+            name: model.description().name.to_string(),
+            dof: model.num_dofs(),
+            description: model.description().summary.to_string(),
+        }
+    }
+}
+
 /// A model with its size erased, as the CLI holds it: `Box<dyn ModelInfo>`.
 ///
 /// Implemented once, for both first-order forms: [`FirstOrder`](crate::FirstOrder) for every

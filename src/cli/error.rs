@@ -37,6 +37,7 @@ impl CliError {
     /// file's diagnostics, without them), so that a script reading the output always gets JSON.
     pub(super) fn before_output(mut self) -> Self {
         if self.json.is_none() {
+            // Pure rendering of this error's message: no library report behind it.
             self.json = Some(serde_json::json!({ "error": self.message }));
         }
         self

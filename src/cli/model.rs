@@ -92,6 +92,7 @@ pub(super) fn diagnostics_error(
 ) -> CliError {
     let text: Vec<String> = diagnostics.iter().map(|d| d.render(path, source)).collect();
     let summary = format!("{} error(s) in the model file `{path}`", diagnostics.len());
+    // Pure rendering of the diagnostics, with the path as the user wrote it: no report.
     let json = serde_json::json!({
         "error": summary,
         "diagnostics": diagnostics.iter().map(|d| serde_json::json!({

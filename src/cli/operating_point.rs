@@ -6,7 +6,6 @@
 use clap::Args;
 use eomgen::ModelInfo;
 use eomgen::analysis::vibration::{EquilibriumStart, OperatingPointError, OperatingPointOptions};
-use serde_json::json;
 
 use super::error::CliError;
 use super::model::find_model;
@@ -212,13 +211,4 @@ pub(super) fn point_failure(model: &dyn ModelInfo, e: &OperatingPointError) -> C
         OperatingPointError::Modal(m) => modal_failure(model, m),
         e => CliError::failure(format!("`{}`: {e}", model.description().name)),
     }
-}
-
-/// The JSON of an operating point, `{"name", "q": {coordinate: value}}`, which each command
-/// extends with its own fields.
-pub(super) fn point_json(name: &str, coordinates: &[&str], q: &[f64]) -> serde_json::Value {
-    json!({
-        "name": name,
-        "q": coordinates.iter().zip(q).map(|(c, v)| (c.to_string(), json!(v))).collect::<serde_json::Map<_, _>>(),
-    })
 }

@@ -102,11 +102,6 @@ impl std::fmt::LowerExp for Number {
     }
 }
 
-/// `m` as a list of rows, for JSON.
-pub(super) fn matrix_rows(m: &nalgebra::DMatrix<f64>) -> Vec<Vec<f64>> {
-    m.row_iter().map(|r| r.iter().copied().collect()).collect()
-}
-
 #[cfg(test)]
 mod tests {
     use super::{num, number};

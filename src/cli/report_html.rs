@@ -10,7 +10,7 @@ use eomgen::checks::CheckRow;
 
 /// A figure of a model's section: the file (relative to the report's directory) and what
 /// it shows.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, serde::Serialize)]
 pub(super) struct Figure {
     /// Relative path, `model/kind.svg`.
     pub file: String,

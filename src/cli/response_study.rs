@@ -2,11 +2,10 @@
 //! parsing, their errors in the options' words, the JSON of a mode kind and the chart of
 //! stacked panels against time.
 
+use eomgen::ModelInfo;
 use eomgen::analysis::vibration::{InitialDeviation, ResponseStudyError};
-use eomgen::{ModeKind, ModelInfo};
 use plotters::coord::Shift;
 use plotters::prelude::*;
-use serde_json::json;
 
 use super::error::CliError;
 use super::operating_point::{modal_failure, point_failure};
@@ -54,15 +53,6 @@ pub(super) fn study_failure(model: &dyn ModelInfo, e: &ResponseStudyError) -> Cl
         } => CliError::usage(format!("--rayleigh-modes {a},{b}: {source}")),
         ResponseStudyError::Response(e) => response_failure(model, e),
         e => CliError::failure(format!("`{}`: {e}", model.description().name)),
-    }
-}
-
-/// The JSON description of a mode kind.
-pub(super) fn kind_json(kind: &ModeKind) -> serde_json::Value {
-    match kind {
-        ModeKind::Oscillatory => json!("oscillatory"),
-        ModeKind::ZeroFrequency => json!("zero_frequency"),
-        ModeKind::Unstable { .. } => json!("unstable"),
     }
 }
 

@@ -137,6 +137,86 @@ pub struct ConstraintMethods {
     pub rows: Vec<ConstraintMethodRow>,
 }
 
+impl ConstraintMethods {
+    /// The study as `eomgen study constraint-methods --json` prints it
+    /// ([`ConstraintMethodsSummary`]); `options` are those the study ran with.
+    pub fn summary(&self, options: &ConstraintMethodsOptions) -> ConstraintMethodsSummary {
+        ConstraintMethodsSummary {
+            model: self.model.clone(),
+            t_end: options.t_end,
+            tol: options.tol,
+            reference: ConstraintReferenceSummary {
+                method: "dp54, DAE with Baumgarte α = β = 10/s",
+                tol: self.reference_tol,
+                agreement_with_unstabilised_dae_m: self.agreement,
+            },
+            methods: self
+                .rows
+                .iter()
+                .map(|r| {
+                    // A failed run measured nothing: its error and drift are null, not 0.
+                    let measured = r.failure.is_none();
+                    ConstraintMethodSummary {
+                        method: r.method.clone(),
+                        position_error_m: measured.then_some(r.position_error),
+                        max_constraint_drift: r.drift.filter(|_| measured),
+                        rhs_evals: r.rhs_evals,
+                        steps: r.steps,
+                        wall_time_s: r.wall_time_s,
+                        error: r.failure.clone(),
+                    }
+                })
+                .collect(),
+        }
+    }
+}
+
+/// A [`ConstraintMethods`] study as `eomgen study constraint-methods --json` prints it
+/// ([`ConstraintMethods::summary`]): the rows without their error histories.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ConstraintMethodsSummary {
+    /// The model's name.
+    pub model: String,
+    /// The end time (s).
+    pub t_end: f64,
+    /// The tolerance of every run.
+    pub tol: f64,
+    /// The reference solution.
+    pub reference: ConstraintReferenceSummary,
+    /// One entry per method, in the study's order.
+    pub methods: Vec<ConstraintMethodSummary>,
+}
+
+/// The reference of a [`ConstraintMethodsSummary`].
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct ConstraintReferenceSummary {
+    /// How it is computed, in words.
+    pub method: &'static str,
+    /// Its tolerance ([`REFERENCE_TOL`]).
+    pub tol: f64,
+    /// [`ConstraintMethods::agreement`] (m).
+    pub agreement_with_unstabilised_dae_m: f64,
+}
+
+/// One method of a [`ConstraintMethodsSummary`]; a failed run has null error and drift.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ConstraintMethodSummary {
+    /// [`ConstraintMethodRow::method`].
+    pub method: String,
+    /// [`ConstraintMethodRow::position_error`] (m; null for a failed run).
+    pub position_error_m: Option<f64>,
+    /// [`ConstraintMethodRow::drift`] (null for a failed run).
+    pub max_constraint_drift: Option<f64>,
+    /// [`ConstraintMethodRow::rhs_evals`].
+    pub rhs_evals: usize,
+    /// [`ConstraintMethodRow::steps`].
+    pub steps: usize,
+    /// [`ConstraintMethodRow::wall_time_s`] (s).
+    pub wall_time_s: f64,
+    /// [`ConstraintMethodRow::failure`].
+    pub error: Option<String>,
+}
+
 /// Every method's run is a run of the study; the reference is not (it fails the study as a
 /// whole, [`ConstraintMethodsError::ReferenceFailed`]).
 impl StudyRuns for ConstraintMethods {

@@ -21,7 +21,8 @@ pub mod vibration;
 pub mod work_precision;
 
 pub use constraint_methods::{
-    ConstraintMethodRow, ConstraintMethods, ConstraintMethodsError, ConstraintMethodsOptions,
+    ConstraintMethodRow, ConstraintMethodSummary, ConstraintMethods, ConstraintMethodsError,
+    ConstraintMethodsOptions, ConstraintMethodsSummary, ConstraintReferenceSummary,
     constraint_methods,
 };
 pub use drift::{ConstraintDrift, EnergyDrift, constraint_drift, energy_drift, energy_drift_at};
@@ -31,12 +32,15 @@ pub use methods::{Method, UnknownMethod};
 pub use outcome::{NothingMeasured, RunTally, StudyRuns};
 pub use roundoff::{EulerRoundoff, RoundoffError, RoundoffOptions, euler_roundoff};
 pub use simulation::{
-    AddedEvents, Simulation, SimulationError, SimulationOptions, simulate, simulate_with_events,
+    AddedEvents, DriftPair, EventSummary, FailureSummary, Simulation, SimulationError,
+    SimulationOptions, SimulationSample, SimulationSummary, WarningSummary, simulate,
+    simulate_with_events,
 };
 pub use stability::{
     StabilityError, StabilityOptions, StabilityStudy, StiffSpring, stability_study,
 };
 pub use work_precision::{
-    AtTarget, Measured, MethodRuns, RunFailure, Setting, SettingRun, WorkPrecision,
-    WorkPrecisionError, WorkPrecisionOptions, work_precision,
+    AtTarget, Measured, MethodRuns, MethodRunsSummary, ReferenceSummary, RunFailure, RunSummary,
+    Setting, SettingRun, TargetSummary, TimingSummary, WorkPrecision, WorkPrecisionError,
+    WorkPrecisionOptions, WorkPrecisionSummary, work_precision,
 };

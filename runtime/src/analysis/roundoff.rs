@@ -91,6 +91,40 @@ pub struct EulerRoundoff {
     pub notes: Vec<String>,
 }
 
+impl EulerRoundoff {
+    /// The study as `eomgen study euler-roundoff --json` prints it
+    /// ([`EulerRoundoffSummary`]): the problem, its exact answer and the machine epsilon with
+    /// the rows.
+    pub fn summary(&self) -> EulerRoundoffSummary<'_> {
+        EulerRoundoffSummary {
+            problem: "x' = x, x(0) = 1 on [0, 1]; x(1) = e",
+            exact: E,
+            epsilon: f64::EPSILON,
+            rows: &self.rows,
+            summary: &self.summary,
+            notes: &self.notes,
+        }
+    }
+}
+
+/// An [`EulerRoundoff`] study as `eomgen study euler-roundoff --json` prints it
+/// ([`EulerRoundoff::summary`]).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct EulerRoundoffSummary<'a> {
+    /// The problem, in words.
+    pub problem: &'static str,
+    /// Its exact answer `x(1) = e`.
+    pub exact: f64,
+    /// The machine epsilon of `f64`.
+    pub epsilon: f64,
+    /// [`EulerRoundoff::rows`].
+    pub rows: &'a [RoundoffRow],
+    /// [`EulerRoundoff::summary`].
+    pub summary: &'a [RoundoffSummary],
+    /// [`EulerRoundoff::notes`].
+    pub notes: &'a [String],
+}
+
 /// Each method at each `h` is a run; a failed one fails the study as a whole
 /// ([`RoundoffError::Integration`]), so every run of a report measured something.
 impl StudyRuns for EulerRoundoff {

@@ -2,6 +2,8 @@
 //! consistent initial state, the drift control, the integration with the model's events and
 //! any added ones, and the drift measures of the result.
 
+use std::collections::BTreeMap;
+
 use serde::{Serialize, Serializer};
 
 use crate::analysis::drift::{ConstraintDrift, EnergyDrift, constraint_drift, energy_drift};
@@ -11,6 +13,7 @@ use crate::analysis::methods::Method;
 use crate::constrained::{ProjectionError, Stabilization, StabilizationError};
 use crate::integrate::{
     EventSpec, IntegrationError, IntegrationFailure, IntegratorOptions, OutputTimes, Solution,
+    Stats,
 };
 use crate::model_info::ModelInfo;
 use crate::ode::{RhsError, WithEvents};
@@ -180,23 +183,23 @@ pub struct Simulation {
     /// that is not positive definite, or a forcing that leaves a function's domain; `None`
     /// without a failure, or when the model shows nothing wrong there.
     pub cause: Option<FailureCause>,
+    /// The options the simulation ran with (not serialised: [`Simulation::summary`] reports
+    /// the tolerances and the drift control).
+    #[serde(skip)]
+    pub options: SimulationOptions,
+    /// How many event functions were added to the model's own ([`AddedEvents::specs`]; 0
+    /// for [`simulate`]; not serialised).
+    #[serde(skip)]
+    pub num_added_events: usize,
 }
 
 fn serialize_failure<S: Serializer>(
     failure: &Option<IntegrationError>,
     serializer: S,
 ) -> Result<S::Ok, S::Error> {
-    #[derive(Serialize)]
-    struct Failure {
-        t: Option<f64>,
-        message: String,
-    }
     failure
         .as_ref()
-        .map(|e| Failure {
-            t: e.t(),
-            message: e.to_string(),
-        })
+        .map(FailureSummary::from)
         .serialize(serializer)
 }
 
@@ -299,6 +302,7 @@ pub fn simulate_with_events(
     let warnings = fixed_step_warnings(model, options.method, &y0, options.dt, options.t_end);
     let integrator_options = options.integrator_options();
     let mut integrator = options.method.integrator();
+    let num_added_events = added.as_ref().map_or(0, |added| added.specs().len());
     let result = match added {
         Some(added) => {
             let specs = added.specs();
@@ -367,7 +371,228 @@ pub fn simulate_with_events(
         warnings,
         failure,
         cause,
+        options: options.clone(),
+        num_added_events,
     })
+}
+
+/// What `eomgen simulate --json` prints: a [`Simulation`] summarised for a reader, with the
+/// model's names, the settings and the drift measures next to the samples ([`Simulation::summary`]).
+///
+/// Keys that apply only to some runs are left out otherwise: `constraints`, `stabilization`
+/// and `max_constraint_drift` without constraints, `events` and `terminated_by_event` when
+/// no event was located nor added, `error` without a failure, `warnings` without warnings.
+///
+/// # Shapes
+/// `coordinates` has `n` names (`n` = the model's degrees of freedom); every sample's `q` and
+/// `qdot` have `n` entries, its `constraint_forces` (when the model has constraints) `m`.
+#[derive(Debug, Clone, Serialize)]
+pub struct SimulationSummary {
+    /// The model's name.
+    pub model: String,
+    /// The generalized coordinates' names, in the state's order.
+    pub coordinates: Vec<String>,
+    /// The parameters' values, by name (units of the model file).
+    pub parameters: BTreeMap<String, f64>,
+    /// The integrator's name ([`Simulation::integrator`], `"dp54"`).
+    pub method: &'static str,
+    /// The relative tolerance the run used.
+    pub rtol: f64,
+    /// The absolute tolerance the run used.
+    pub atol: f64,
+    /// Every sample: time, state, energy (and the constraint forces and drift).
+    pub samples: Vec<SimulationSample>,
+    /// `E(0) = T + V` (J).
+    pub initial_energy: f64,
+    /// The energy drift `max |E − E(0)| / scale` ([`EnergyDrift::drift`]; null without samples).
+    pub energy_drift: Option<f64>,
+    /// Whether the model declares itself conservative (then the energy should not drift).
+    pub conservative: bool,
+    /// The integrator's work.
+    pub stats: Stats,
+    /// The constraints' names (constrained models only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub constraints: Option<Vec<String>>,
+    /// The drift control ([`Stabilization::name`]; constrained models only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub stabilization: Option<&'static str>,
+    /// The largest constraint residuals over the samples (constrained models only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub max_constraint_drift: Option<DriftPair>,
+    /// The located events, in time order (when events were located or added).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub events: Option<Vec<EventSummary>>,
+    /// The name of the terminal event that stopped the run, null when none did (present with
+    /// `events`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub terminated_by_event: Option<Option<String>>,
+    /// Why the integration stopped early: `{"t", "message"}` (a failed run only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub error: Option<FailureSummary>,
+    /// The warnings, each serialised as [`SimulationWarning`] with its `message` added.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub warnings: Vec<WarningSummary>,
+}
+
+/// One sample of a [`SimulationSummary`].
+#[derive(Debug, Clone, Serialize)]
+pub struct SimulationSample {
+    /// Time (s).
+    pub t: f64,
+    /// The generalized coordinates `q` (`n` entries).
+    pub q: Vec<f64>,
+    /// The generalized velocities `q̇` (`n` entries).
+    pub qdot: Vec<f64>,
+    /// The energy `T + V` (J).
+    pub energy: f64,
+    /// The Lagrange multipliers `λ` (`m` entries, null where the constrained system is
+    /// singular; constrained models only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub constraint_forces: Option<Option<Vec<f64>>>,
+    /// The largest constraint residuals at this sample (constrained models only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub constraint_drift: Option<DriftPair>,
+}
+
+/// The largest position-level and velocity-level constraint residuals, `max |Φ|` and
+/// `max |Φ̇|` (units of the constraints: m or rad, per second for the velocity).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct DriftPair {
+    /// `max |Φᵢ|`.
+    pub position: f64,
+    /// `max |Φ̇ᵢ|`.
+    pub velocity: f64,
+}
+
+impl From<(f64, f64)> for DriftPair {
+    fn from((position, velocity): (f64, f64)) -> Self {
+        Self { position, velocity }
+    }
+}
+
+/// One located event of a [`SimulationSummary`].
+#[derive(Debug, Clone, Serialize)]
+pub struct EventSummary {
+    /// The event's name.
+    pub name: String,
+    /// Time of the zero (s).
+    pub t: f64,
+    /// `"rising"` or `"falling"` ([`EventDirection::name`](crate::EventDirection::name)).
+    pub direction: &'static str,
+    /// Whether it ended the integration.
+    pub terminal: bool,
+    /// `q` at the event (`n` entries).
+    pub q: Vec<f64>,
+    /// `q̇` at the event (`n` entries).
+    pub qdot: Vec<f64>,
+}
+
+/// A failed integration in a [`SimulationSummary`]: where and why.
+#[derive(Debug, Clone, Serialize)]
+pub struct FailureSummary {
+    /// The time of the failure (s; null for a failure before the first step).
+    pub t: Option<f64>,
+    /// The error's message.
+    pub message: String,
+}
+
+impl From<&IntegrationError> for FailureSummary {
+    fn from(error: &IntegrationError) -> Self {
+        Self {
+            t: error.t(),
+            message: error.to_string(),
+        }
+    }
+}
+
+/// A [`SimulationWarning`] with its message: the warning's own keys (`kind` and its fields)
+/// and `message`.
+#[derive(Debug, Clone, Serialize)]
+pub struct WarningSummary {
+    /// The warning.
+    #[serde(flatten)]
+    pub warning: SimulationWarning,
+    /// Its message ([`SimulationWarning`]'s `Display`).
+    pub message: String,
+}
+
+impl Simulation {
+    /// The summary `eomgen simulate --json` prints (see [`SimulationSummary`]); `model` is
+    /// the model simulated (for its names and parameters).
+    pub fn summary(&self, model: &dyn ModelInfo) -> SimulationSummary {
+        let n = model.num_dofs();
+        let description = model.description();
+        let constrained = !self.constraints.is_empty();
+        let samples = self
+            .solution
+            .iter()
+            .zip(&self.energy.energy)
+            .enumerate()
+            .map(|(k, ((t, y), &energy))| SimulationSample {
+                t,
+                q: y[..n].to_vec(),
+                qdot: y[n..].to_vec(),
+                energy,
+                constraint_forces: constrained
+                    .then(|| self.constraints.lagrange_multipliers[k].clone()),
+                constraint_drift: constrained.then(|| self.constraints.drift[k].into()),
+            })
+            .collect();
+        let with_events = !self.solution.events.is_empty() || self.num_added_events > 0;
+        SimulationSummary {
+            model: description.name.to_string(),
+            coordinates: description
+                .coordinate_names()
+                .iter()
+                .map(|s| s.to_string())
+                .collect(),
+            parameters: description
+                .parameter_names()
+                .iter()
+                .zip(model.parameter_values())
+                .map(|(k, v)| (k.to_string(), v))
+                .collect(),
+            method: self.integrator,
+            rtol: self.options.rtol,
+            atol: self.options.atol,
+            samples,
+            initial_energy: self.energy.initial_energy,
+            energy_drift: self.energy.drift,
+            conservative: description.conservative,
+            stats: self.solution.stats,
+            constraints: constrained.then(|| self.constraints.constraint_names.clone()),
+            stabilization: constrained.then(|| self.options.stabilization.name()),
+            max_constraint_drift: constrained.then(|| self.constraints.max_drift().into()),
+            events: with_events.then(|| {
+                self.solution
+                    .events
+                    .iter()
+                    .map(|e| EventSummary {
+                        name: e.name.clone(),
+                        t: e.t,
+                        direction: e.direction.name(),
+                        terminal: e.terminal,
+                        q: e.y[..n].to_vec(),
+                        qdot: e.y[n..].to_vec(),
+                    })
+                    .collect()
+            }),
+            terminated_by_event: with_events.then(|| {
+                self.solution
+                    .terminated_by_event
+                    .map(|k| self.solution.events[k].name.clone())
+            }),
+            error: self.failure.as_ref().map(FailureSummary::from),
+            warnings: self
+                .warnings
+                .iter()
+                .map(|w| WarningSummary {
+                    warning: w.clone(),
+                    message: w.to_string(),
+                })
+                .collect(),
+        }
+    }
 }
 
 /// The typed error of a failed [`ModelInfo::make_consistent`].

@@ -257,6 +257,112 @@ pub struct StabilityStudy {
     pub underflow: UnderflowRun,
 }
 
+impl StabilityStudy {
+    /// The study as `eomgen study stability --json` prints it ([`StabilitySummary`]);
+    /// `stiff_model` is the two-mass spring of part c and `options` those the study ran with.
+    pub fn summary<'a>(
+        &'a self,
+        stiff_model: &dyn ModelInfo,
+        options: &StabilityOptions,
+    ) -> StabilitySummary<'a> {
+        StabilitySummary {
+            limits: LimitsSummary {
+                growth_threshold: GROWTH_THRESHOLD,
+                steps: options.steps,
+                smallest_detected_growth: self.test.smallest_detected_growth(),
+                bisection_tolerance: BISECTION_TOLERANCE,
+                rows: &self.limits.rows,
+                amplification: &self.limits.amplification,
+                polynomials: &self.limits.polynomials,
+            },
+            energy: EnergySummary {
+                periods: options.periods,
+                runs: &self.energy,
+            },
+            stiff: StiffSummary {
+                model: stiff_model.description().name.to_string(),
+                t_end: options.t_end,
+                tol: options.tol,
+                reference: StiffReferenceSummary {
+                    method: "dop853",
+                    tol: STIFF_REFERENCE_TOL,
+                },
+                modes: &self.stiff_modes,
+                runs: &self.stiff,
+            },
+            underflow: &self.underflow,
+        }
+    }
+}
+
+/// A [`StabilityStudy`] as `eomgen study stability --json` prints it
+/// ([`StabilityStudy::summary`]): each part with the settings it ran with.
+#[derive(Debug, Serialize)]
+pub struct StabilitySummary<'a> {
+    /// Part a.
+    pub limits: LimitsSummary<'a>,
+    /// Part b.
+    pub energy: EnergySummary<'a>,
+    /// Part c.
+    pub stiff: StiffSummary<'a>,
+    /// Part d.
+    pub underflow: &'a UnderflowRun,
+}
+
+/// Part a of a [`StabilitySummary`]: the bisection's settings and the limits found.
+#[derive(Debug, Serialize)]
+pub struct LimitsSummary<'a> {
+    /// [`GROWTH_THRESHOLD`].
+    pub growth_threshold: f64,
+    /// Steps of each growth test.
+    pub steps: usize,
+    /// [`GrowthTest::smallest_detected_growth`].
+    pub smallest_detected_growth: f64,
+    /// [`BISECTION_TOLERANCE`].
+    pub bisection_tolerance: f64,
+    /// [`Limits::rows`].
+    pub rows: &'a [LimitRow],
+    /// [`Limits::amplification`].
+    pub amplification: &'a [AmplificationRow],
+    /// [`Limits::polynomials`].
+    pub polynomials: &'a [PolynomialRow],
+}
+
+/// Part b of a [`StabilitySummary`].
+#[derive(Debug, Serialize)]
+pub struct EnergySummary<'a> {
+    /// Periods integrated.
+    pub periods: usize,
+    /// One row per run.
+    pub runs: &'a [EnergyRow],
+}
+
+/// Part c of a [`StabilitySummary`].
+#[derive(Debug, Serialize)]
+pub struct StiffSummary<'a> {
+    /// The two-mass spring's name.
+    pub model: String,
+    /// The end time (s).
+    pub t_end: f64,
+    /// The adaptive methods' tolerance.
+    pub tol: f64,
+    /// The reference solution.
+    pub reference: StiffReferenceSummary,
+    /// The stiff mode at every `k/m` and start.
+    pub modes: &'a [StiffMode],
+    /// Every method at every `k/m` and start.
+    pub runs: &'a [StiffRow],
+}
+
+/// The reference of part c: DOP853 at [`STIFF_REFERENCE_TOL`].
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct StiffReferenceSummary {
+    /// `"dop853"`.
+    pub method: &'static str,
+    /// Its tolerance.
+    pub tol: f64,
+}
+
 // Not a `StudyRuns` report: the rule that a study whose every run failed measured nothing
 // cannot apply here. Part a always measures: its methods are a fixed list, run on test
 // equations the options do not reach (only the number of steps), and a failure there fails

@@ -1208,6 +1208,25 @@ pub enum ModeKind {
     },
 }
 
+impl ModeKind {
+    /// Its name in reports: `"oscillatory"`, `"zero_frequency"` or `"unstable"`.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Self::Oscillatory => "oscillatory",
+            Self::ZeroFrequency => "zero_frequency",
+            Self::Unstable { .. } => "unstable",
+        }
+    }
+
+    /// The growth rate `σ` (1/s) of an unstable mode, `None` for the others.
+    pub fn growth_rate(&self) -> Option<f64> {
+        match self {
+            Self::Unstable { growth_rate } => Some(*growth_rate),
+            _ => None,
+        }
+    }
+}
+
 /// The undamped normal modes `K ψ = ω² M ψ` at an operating point (serialised with the mode
 /// shapes as a list of rows).
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]

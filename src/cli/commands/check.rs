@@ -1,10 +1,9 @@
 //! `eomgen check MODEL|FILE.yaml`: derive a model two ways at run time and cross-check.
 
 use clap::Args;
-use serde_json::json;
 
 use crate::cli::error::CliError;
-use crate::cli::json::print_json;
+use crate::cli::json::print_json_sorted;
 use crate::cli::output::outln;
 use crate::cli::render::num;
 use eomgen_symbolic::mechanics::cross_check::{
@@ -40,7 +39,7 @@ pub fn run(args: &CheckArgs) -> Result<(), CliError> {
         crate::cli::model::diagnostics_error(&display, &source, &diagnostics)
     })?;
     if args.json {
-        print_json(&to_json(&report, args.timing))?;
+        print_json_sorted(&report.summary(TOLERANCE, args.timing))?;
     } else {
         print_report(&report);
     }
@@ -58,37 +57,6 @@ pub fn run(args: &CheckArgs) -> Result<(), CliError> {
             TOLERANCE = num(TOLERANCE)
         )))
     }
-}
-
-fn to_json(r: &CheckReport, timing: bool) -> serde_json::Value {
-    let derivation: serde_json::Map<String, serde_json::Value> = r
-        .derivations
-        .iter()
-        .map(|d| {
-            (
-                d.name.to_string(),
-                if timing {
-                    json!({"time_s": d.time_s, "ops": d.ops, "ops_after_cse": d.ops_after_cse})
-                } else {
-                    json!({"ops": d.ops, "ops_after_cse": d.ops_after_cse})
-                },
-            )
-        })
-        .collect();
-    let sampled = r.states.compared > 0;
-    json!({
-        "model": r.model,
-        "tolerance": TOLERANCE,
-        "failure": r.states.nothing_compared(),
-        "passed": r.passed(TOLERANCE),
-        // A residual over no state is null, not 0.
-        "checks": r.comparisons.iter().map(|c| json!({"a": c.a, "b": c.b, "max_rel_residual": sampled.then_some(c.max_rel_residual), "symbolic_equal": c.symbolic_equal, "states": c.states})).collect::<Vec<_>>(),
-        "power_balance": r.power_balance.as_ref().map(|p| json!({"max_rel_residual": sampled.then_some(p.max_rel_residual)})),
-        "initial_constraints": r.initial_constraints.as_ref().map(|c| json!({"constraint": c.constraint, "residual": c.residual, "velocity": c.velocity, "tolerance": INITIAL_CONSTRAINT_TOLERANCE, "passed": c.passed()})),
-        "states": {"drawn": r.states.drawn, "compared": r.states.compared, "not_finite": r.states.not_finite, "singular": r.states.singular},
-        "derivation": derivation,
-        "notes": r.notes,
-    })
 }
 
 fn print_report(r: &CheckReport) {

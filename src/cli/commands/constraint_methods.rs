@@ -9,10 +9,9 @@ use eomgen::analysis::{
     ConstraintMethods, ConstraintMethodsError, ConstraintMethodsOptions, StudyRuns,
 };
 use eomgen::studies::minimal_twin;
-use serde_json::json;
 
 use crate::cli::error::CliError;
-use crate::cli::json::print_json;
+use crate::cli::json::print_json_sorted;
 use crate::cli::plot;
 use crate::cli::render::num;
 
@@ -113,23 +112,7 @@ pub fn run(args: &ConstraintMethodsArgs) -> Result<(), CliError> {
     }
     let mut stdout = crate::cli::output::stdout();
     if args.json {
-        let out = json!({
-            "model": model,
-            "t_end": args.t_end,
-            "tol": args.tol,
-            "reference": {"method": "dp54, DAE with Baumgarte α = β = 10/s", "tol": reference_tol, "agreement_with_unstabilised_dae_m": agreement},
-            // A failed run measured nothing: its error and drift are null, not 0.
-            "methods": rows.iter().map(|r| json!({
-                "method": r.method,
-                "position_error_m": r.failure.is_none().then_some(r.position_error),
-                "max_constraint_drift": r.drift.filter(|_| r.failure.is_none()),
-                "rhs_evals": r.rhs_evals,
-                "steps": r.steps,
-                "wall_time_s": r.wall_time_s,
-                "error": r.failure,
-            })).collect::<Vec<_>>(),
-        });
-        print_json(&out)?;
+        print_json_sorted(&study.summary(&options))?;
     } else {
         let _ = writeln!(
             stdout,

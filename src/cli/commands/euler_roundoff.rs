@@ -10,11 +10,10 @@ use eomgen::analysis::StudyRuns;
 use eomgen::analysis::roundoff::{
     EulerRoundoff, RoundoffError, RoundoffOptions, RoundoffRow, euler_roundoff,
 };
-use serde_json::json;
 
 use crate::cli::error::CliError;
 use crate::cli::files::Outputs;
-use crate::cli::json::print_json;
+use crate::cli::json::print_json_sorted;
 use crate::cli::plot;
 use crate::cli::plot::log_y_chart;
 use crate::cli::render::num;
@@ -52,22 +51,14 @@ pub fn run(args: &EulerRoundoffArgs) -> Result<(), CliError> {
         rows,
         summary: summaries,
         notes,
-    } = study;
+    } = &study;
 
     if let Some(path) = &args.plot {
-        plot_errors(path, &rows)?;
+        plot_errors(path, rows)?;
     }
     let mut stdout = crate::cli::output::stdout();
     if args.json {
-        let out = json!({
-            "problem": "x' = x, x(0) = 1 on [0, 1]; x(1) = e",
-            "exact": E,
-            "epsilon": f64::EPSILON,
-            "rows": rows,
-            "summary": summaries,
-            "notes": notes,
-        });
-        print_json(&out)?;
+        print_json_sorted(&study.summary())?;
     } else {
         let _ = writeln!(
             stdout,
@@ -92,7 +83,7 @@ pub fn run(args: &EulerRoundoffArgs) -> Result<(), CliError> {
             "f32 euler",
             "ε₃₂√N"
         );
-        for r in &rows {
+        for r in rows {
             let [euler, midpoint, rk4] = [&r.runs[0], &r.runs[1], &r.runs[2]];
             let _ = writeln!(
                 stdout,
@@ -113,7 +104,7 @@ pub fn run(args: &EulerRoundoffArgs) -> Result<(), CliError> {
                 num(r.single_precision_euler.epsilon_sqrt_steps)
             );
         }
-        for s in &summaries {
+        for s in summaries {
             let _ = writeln!(
                 stdout,
                 "{:<9} optimal n = {} (|error| {:.2e}); roundoff grows as N^{}",
@@ -126,7 +117,7 @@ pub fn run(args: &EulerRoundoffArgs) -> Result<(), CliError> {
                     ))
             );
         }
-        for note in &notes {
+        for note in notes {
             let _ = writeln!(stdout, "note: {note}");
         }
     }

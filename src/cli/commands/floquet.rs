@@ -15,7 +15,7 @@ use clap::Args;
 use eomgen::analysis::StudyRuns;
 use eomgen::analysis::vibration::{
     self, FloquetCell, FloquetChart, FloquetPoint, FloquetStudyError, FloquetStudyOptions,
-    SweepAxis,
+    PredictionSummary, SweepAxis,
 };
 use eomgen::{
     ChartAxis, FloquetAnalysis, FloquetError, FloquetOptions, FloquetReferences, FloquetStability,
@@ -24,12 +24,11 @@ use eomgen::{
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use rayon::prelude::*;
-use serde_json::{Value, json};
 
 use crate::cli::error::CliError;
 use crate::cli::files::Outputs;
-use crate::cli::json::print_json;
-use crate::cli::operating_point::{OperatingPointArgs, point_json};
+use crate::cli::json::print_json_sorted;
+use crate::cli::operating_point::OperatingPointArgs;
 use crate::cli::plot::{Drawing, tick, write_chart};
 use crate::cli::render::num;
 use crate::cli::values::{evaluate, parameter_lookup, set_parameters, split_assignment};
@@ -196,7 +195,19 @@ pub fn run(args: &FloquetArgs) -> Result<(), CliError> {
     };
     let mut stdout = crate::cli::output::stdout();
     if args.json {
-        print_json(&json_report(&report))?;
+        let predictions = thresholds
+            .iter()
+            .map(|t| PredictionSummary {
+                name: t.name.clone(),
+                key: t.key.clone(),
+                value: t.value,
+                critical: t.critical,
+                equilibrium: label.clone(),
+                predicts_stable: t.predicts_stable,
+            })
+            .collect();
+        let summary = point.summary(model.as_ref(), &options, predictions, sweep.as_ref());
+        print_json_sorted(&summary)?;
     } else {
         print_report(&mut stdout, &report);
     }
@@ -217,47 +228,6 @@ struct Report<'a> {
     point: &'a FloquetPoint,
     thresholds: &'a [ThresholdPrediction],
     sweep: Option<&'a FloquetChart>,
-}
-
-/// The JSON of `report`.
-fn json_report(report: &Report<'_>) -> Value {
-    let (args, model, label, point) = (report.args, report.model, report.label, report.point);
-    let names = model.description().coordinate_names();
-    let complex = |c: &nalgebra::Complex<f64>| json!({"re": c.re, "im": c.im, "modulus": c.norm()});
-    let f = &point.floquet;
-    let monodromy = crate::cli::render::matrix_rows(&f.monodromy_matrix);
-    let mut operating_point = point_json(label, &names, &point.q);
-    operating_point["max_forcing_residual"] = json!(point.residual);
-    let mut out = json!({
-        "model": model.description().name,
-        "coordinates": names,
-        "operating_point": operating_point,
-        "period_parameter": args.period_parameter,
-        "frequency": point.frequency,
-        "period": f.period,
-        "monodromy_matrix": monodromy,
-        "multipliers": f.multipliers.iter().map(complex).collect::<Vec<_>>(),
-        "exponents": f.exponents.iter().map(|c| json!({"re": c.re, "im": c.im})).collect::<Vec<_>>(),
-        "spectral_radius": f.spectral_radius,
-        "determinant": f.determinant,
-        "stability": f.stability.as_str(),
-        "stable": f.stability.is_stable(),
-        "stability_tolerance": args.stability_tolerance(),
-        "closure_error": f.closure_error,
-        "integration": {"method": "dop853", "tol": args.tol, "steps": f.stats.steps, "rhs_evals": f.stats.rhs_evals},
-    });
-    for t in report.thresholds {
-        let mut prediction = serde_json::Map::new();
-        prediction.insert(t.key.clone(), json!(t.value));
-        prediction.insert(format!("critical_{}", t.key), json!(t.critical));
-        prediction.insert(format!("predicts_stable_{label}"), json!(t.predicts_stable));
-        out[t.name.as_str()] = Value::Object(prediction);
-    }
-    out["time_dependent"] = json!(point.time_dependent);
-    if let Some(chart) = report.sweep {
-        out["sweep"] = sweep_json(&chart.x, &chart.y, &chart.cells);
-    }
-    out
 }
 
 /// The text of `report`.
@@ -398,52 +368,6 @@ fn run_sweep(
     bar.finish_and_clear();
     let cells = flat.chunks(y.values.len()).map(<[Cell]>::to_vec).collect();
     Ok(FloquetChart { x, y, cells })
-}
-
-fn sweep_json(x: &Axis, y: &Axis, grid: &[Vec<Cell>]) -> Value {
-    let rho: Vec<Vec<Value>> = grid
-        .iter()
-        .map(|col| {
-            col.iter()
-                .map(|c| c.as_ref().map_or(Value::Null, |c| json!(c.spectral_radius)))
-                .collect()
-        })
-        .collect();
-    let stability: Vec<Vec<Value>> = grid
-        .iter()
-        .map(|col| {
-            col.iter()
-                .map(|c| {
-                    c.as_ref()
-                        .map_or(Value::Null, |c| json!(c.stability.as_str()))
-                })
-                .collect()
-        })
-        .collect();
-    let mut failures = Vec::new();
-    for (i, col) in grid.iter().enumerate() {
-        for (j, c) in col.iter().enumerate() {
-            if let Err(e) = c {
-                failures.push(
-                    json!({x.name.as_str(): x.values[i], y.name.as_str(): y.values[j], "error": e}),
-                );
-            }
-        }
-    }
-    let stable = grid
-        .iter()
-        .flatten()
-        .filter(|c| matches!(c, Ok(c) if c.stability.is_stable()))
-        .count();
-    json!({
-        "x": {"name": x.name, "values": x.values},
-        "y": {"name": y.name, "values": y.values},
-        "layout": "spectral_radius[i][j] and stability[i][j] at (x[i], y[j]); null where the analysis failed",
-        "spectral_radius": rho,
-        "stability": stability,
-        "stable_points": stable,
-        "failures": failures,
-    })
 }
 
 /// The widest sweep whose map is printed as text, one character per point.

@@ -13,15 +13,14 @@ use eomgen::analysis::vibration::{
     self, FreeResponseMethod, FreeResponseOptions, FreeResponseStudy,
 };
 use eomgen::{ModeKind, ModelInfo};
-use serde_json::json;
 
 use crate::cli::error::CliError;
 use crate::cli::files::Outputs;
-use crate::cli::json::print_json;
-use crate::cli::operating_point::{OperatingPointArgs, point_json};
+use crate::cli::json::print_json_sorted;
+use crate::cli::operating_point::OperatingPointArgs;
 use crate::cli::plot::Series;
 use crate::cli::render::num;
-use crate::cli::response_study::{Panel, kind_json, panels, parse_init, study_failure};
+use crate::cli::response_study::{Panel, panels, parse_init, study_failure};
 
 /// Options of `eomgen study free-response`.
 #[derive(Debug, Args)]
@@ -100,63 +99,11 @@ pub fn run(args: &FreeResponseArgs) -> Result<(), CliError> {
     }
     let mut stdout = crate::cli::output::stdout();
     if args.json {
-        print_json(&json_report(model.as_ref(), &study))
+        print_json_sorted(&study.summary(model.as_ref()))
     } else {
         print_text(&mut stdout, model.as_ref(), &study);
         Ok(())
     }
-}
-
-/// The JSON of `study free-response` (see docs/cli.md).
-fn json_report(model: &dyn ModelInfo, study: &FreeResponseStudy) -> serde_json::Value {
-    let FreeResponseStudy {
-        operating_point: point,
-        normal_modes: modes,
-        ignored_damping,
-        initial,
-        t_end,
-        responses,
-        max_displacement: q_scale,
-        max_velocity: v_scale,
-        differences,
-        ..
-    } = study;
-    let (label, (q0, v0)) = (&point.name, (&initial.q, &initial.qdot));
-    let n = model.num_dofs();
-    let names = model.description().coordinate_names();
-    let samples = responses[0].1.times.len();
-    json!({
-        "model": model.description().name,
-        "coordinates": names,
-        "operating_point": point_json(label, &names, &study.linearization.q),
-        "ignored_damping": ignored_damping,
-        "modes": (0..n).map(|k| json!({
-            "kind": kind_json(&modes.kinds[k]),
-            "eigenvalue": modes.eigenvalues[k],
-            "natural_frequency": modes.natural_frequencies[k],
-            "growth_rate": match modes.kinds[k] { ModeKind::Unstable { growth_rate } => Some(growth_rate), _ => None },
-        })).collect::<Vec<_>>(),
-        "initial": {"q": q0, "qdot": v0},
-        "t_end": t_end,
-        "samples": samples,
-        "tol": study.tol,
-        "methods": FreeResponseMethod::ALL.iter().map(|m| json!({"name": m.name(), "description": m.description()})).collect::<Vec<_>>(),
-        "max_displacement": q_scale,
-        "max_velocity": v_scale,
-        "max_differences": differences.iter().map(|d| json!({
-            "a": d.a.name(),
-            "b": d.b.name(),
-            "displacement": d.displacement,
-            "velocity": d.velocity,
-            "displacement_relative": d.displacement_relative,
-            "velocity_relative": d.velocity_relative,
-        })).collect::<Vec<_>>(),
-        "final": responses.iter().map(|(method, r)| json!({
-            "method": method.name(),
-            "q": r.displacements.last(),
-            "qdot": r.velocities.last(),
-        })).collect::<Vec<_>>(),
-    })
 }
 
 /// The text of `study free-response`: the set-up, the modes, the methods and their largest

@@ -15,12 +15,11 @@ use nalgebra::Complex;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use rayon::prelude::*;
-use serde_json::{Value, json};
 
 use crate::cli::error::CliError;
 use crate::cli::files::Outputs;
-use crate::cli::json::print_json;
-use crate::cli::operating_point::{OperatingPointArgs, point_json};
+use crate::cli::json::print_json_sorted;
+use crate::cli::operating_point::OperatingPointArgs;
 use crate::cli::plot;
 use crate::cli::render::num;
 use crate::cli::values::{evaluate, parameter_lookup};
@@ -233,7 +232,7 @@ pub fn run(args: &FrfArgs) -> Result<(), CliError> {
         .map_err(CliError::failure)?;
     }
     if args.json {
-        print_json(&json_report(args, model.as_ref(), &frf, simulated))?;
+        print_json_sorted(&frf.summary(model.as_ref(), simulated))?;
         return Ok(());
     }
     print_report(
@@ -244,82 +243,6 @@ pub fn run(args: &FrfArgs) -> Result<(), CliError> {
         simulated,
     );
     Ok(())
-}
-
-/// The JSON of `frf` (and of the simulated points).
-fn json_report(
-    args: &FrfArgs,
-    model: &dyn ModelInfo,
-    frf: &FrfAnalysis,
-    simulated: Option<(&[SimulatedPoint], &FrfSimulationPlan)>,
-) -> Value {
-    let name = &model.description().name;
-    let (outputs, forced) = (&frf.outputs, &frf.forced);
-    let (modes, damping) = (&frf.normal_modes, &frf.modal_damping);
-    let b: Vec<f64> = forced.input_matrix.column(0).iter().copied().collect();
-    let amp_phase = |z: Complex<f64>| json!({"re": z.re, "im": z.im, "amplitude": z.norm(), "phase_deg": phase_degrees(z)});
-    let modal_json = |r: &ModalResponse, difference: Option<f64>| {
-        json!({
-            "modes": (0..modes.natural_frequencies.len()).map(|k| json!({
-                "mode": k + 1,
-                "natural_frequency": modes.natural_frequencies[k],
-                "damping_ratio": damping.damping_ratios[k],
-                "modal_force": r.modal_forces[k],
-                "modal_coordinate": amp_phase(r.modal_coordinates[k]),
-                "contributions": outputs.iter().map(|o| (o.name.clone(), amp_phase(r.contributions[(o.index, k)]))).collect::<serde_json::Map<_, _>>(),
-            })).collect::<Vec<_>>(),
-            "sum": outputs.iter().map(|o| (o.name.clone(), amp_phase(r.response[o.index]))).collect::<serde_json::Map<_, _>>(),
-            "max_relative_difference_from_direct": difference,
-        })
-    };
-    let peak_json = |p: &eomgen::ResonancePeak| match p.amplitude {
-        PeakAmplitude::Finite(a) => {
-            json!({"frequency": p.frequency, "amplitude": a, "unbounded": false, "phase_deg": p.phase_deg})
-        }
-        PeakAmplitude::Unbounded => {
-            json!({"frequency": p.frequency, "amplitude": Value::Null, "unbounded": true, "phase_deg": Value::Null})
-        }
-    };
-    json!({
-        "model": name,
-        "input": args.input,
-        "outputs": outputs.iter().map(|o| o.name.clone()).collect::<Vec<_>>(),
-        "operating_point": point_json(&frf.operating_point.name, &model.description().coordinate_names(), &forced.equilibrium.q),
-        "input_matrix": b,
-        "natural_frequencies": modes.natural_frequencies,
-        "damping_ratios": damping.damping_ratios,
-        "modal_damping_coupling": damping.coupling,
-        "frequencies": frf.frequencies,
-        "responses": outputs.iter().zip(&frf.sweeps).map(|(o, s)| json!({
-            "output": o.name,
-            "amplitude": s.amplitudes(),
-            "phase_deg": s.phases_deg,
-            "peaks": s.peaks.iter().map(peak_json).collect::<Vec<_>>(),
-        })).collect::<Vec<_>>(),
-        "evaluations": frf.evaluations.iter().map(|e| json!({
-            "frequency": e.frequency,
-            "response": e.response.as_ref().map(|d| outputs.iter().map(|o| (o.name.clone(), amp_phase(d[o.index]))).collect::<serde_json::Map<_, _>>()),
-            "unbounded": e.response.is_none(),
-            "modal": e.modal.as_ref().map(|r| modal_json(r, e.modal_difference)),
-        })).collect::<Vec<_>>(),
-        "simulation": simulated.map(|(points, plan)| json!({
-            "amplitude": args.amplitude,
-            "frequency_parameter": plan.frequency_parameter,
-            "rtol": args.rtol,
-            "points": points.iter().map(|p| json!({
-                "frequency": p.frequency,
-                "settling_time": p.settling_time,
-                "steps": p.steps,
-                "rhs_evals": p.rhs_evals,
-                "outputs": outputs.iter().zip(&p.values).map(|(o, v)| (o.name.clone(), json!({
-                    "simulated": amp_phase(v.simulated),
-                    "predicted": amp_phase(v.predicted),
-                    "relative_error": v.relative_error(),
-                }))).collect::<serde_json::Map<_, _>>(),
-            })).collect::<Vec<_>>(),
-            "max_relative_error": max_simulation_error(points),
-        })),
-    })
 }
 
 /// The text of `frf` (and of the simulated points).

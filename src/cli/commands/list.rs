@@ -1,18 +1,18 @@
 //! `eomgen list`: the bundled models, their degrees of freedom and descriptions.
 
 use crate::cli::error::CliError;
-use crate::cli::json::print_json;
+use crate::cli::json::print_json_sorted;
 use crate::cli::output::outln;
 
 /// Runs `list`: a table, or with `json` a JSON list of `{"name", "dof", "description"}`.
 pub fn run(json: bool) -> Result<(), CliError> {
     let models: Vec<_> = eomgen::models::ALL.iter().map(|e| (e.make)()).collect();
     if json {
-        let items: Vec<serde_json::Value> = models
+        let items: Vec<eomgen::ModelSummary> = models
             .iter()
-            .map(|m| serde_json::json!({"name": m.description().name, "dof": m.num_dofs(), "description": m.description().summary}))
+            .map(|m| eomgen::ModelSummary::of(m.as_ref()))
             .collect();
-        print_json(&items)?;
+        print_json_sorted(&items)?;
     } else {
         let width = models
             .iter()

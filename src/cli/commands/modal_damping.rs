@@ -8,16 +8,14 @@ use clap::Args;
 use eomgen::ModelInfo;
 use eomgen::analysis::StudyRuns;
 use eomgen::analysis::vibration::{ModalDampingOptions, ModalDampingStudy, RayleighFit};
-use serde_json::json;
 
 use crate::cli::error::CliError;
 use crate::cli::files::Outputs;
-use crate::cli::json::print_json;
-use crate::cli::operating_point::{OperatingPointArgs, point_json};
+use crate::cli::json::print_json_sorted;
+use crate::cli::operating_point::OperatingPointArgs;
 use crate::cli::plot::Series;
-use crate::cli::render::matrix_rows;
 use crate::cli::render::num;
-use crate::cli::response_study::{Panel, kind_json, panels, parse_init, study_failure};
+use crate::cli::response_study::{Panel, panels, parse_init, study_failure};
 
 /// Options of `eomgen study modal-damping`.
 #[derive(Debug, Args)]
@@ -135,55 +133,11 @@ pub fn run(args: &ModalDampingArgs) -> Result<(), CliError> {
 
     let mut stdout = crate::cli::output::stdout();
     if args.json {
-        print_json(&json_report(model.as_ref(), &study))?;
+        print_json_sorted(&study.summary(model.as_ref()))?;
         return Ok(());
     }
     print_report(&mut stdout, model.as_ref(), &study);
     Ok(())
-}
-
-/// The JSON of `study`.
-fn json_report(model: &dyn ModelInfo, study: &ModalDampingStudy) -> serde_json::Value {
-    let (lin, approx, cases) = (&study.linearization, &study.modal_damping, &study.releases);
-    let names = model.description().coordinate_names();
-    let samples = cases.first().map_or(0, |c| c.exact.times.len());
-
-    json!({
-        "model": model.description().name,
-        "coordinates": names,
-        "operating_point": point_json(&study.operating_point.name, &names, &lin.q),
-        "mass_matrix": matrix_rows(&lin.mass_matrix),
-        "stiffness_matrix": matrix_rows(&lin.stiffness_matrix),
-        "damping_matrix": matrix_rows(&lin.damping_matrix),
-        "modal_damping_matrix": matrix_rows(&approx.modal_damping_matrix),
-        "coupling": approx.coupling,
-        "rayleigh": study.rayleigh,
-        "modes": study.modes.iter().map(|m| json!({
-            "mode": m.mode,
-            "kind": kind_json(&m.kind),
-            "natural_frequency": m.natural_frequency,
-            "exact": m.exact.map(|d| json!({
-                "re": d.eigenvalue.re,
-                "im": d.eigenvalue.im,
-                "damping_ratio": d.damping_ratio,
-                "damped_frequency": d.damped_frequency,
-            })),
-            "diagonal": m.diagonal,
-            "rayleigh": m.rayleigh,
-        })).collect::<Vec<_>>(),
-        "t_end": study.t_end,
-        "samples": samples,
-        "tol": study.tol,
-        "cases": cases.iter().map(|c| json!({
-            "name": c.name,
-            "q0": c.q0,
-            "qdot0": c.qdot0,
-            "amplitude": c.amplitude,
-            "integration_vs_exact": c.integration_vs_exact,
-            "diagonal_vs_exact": c.diagonal_vs_exact,
-            "rayleigh_vs_exact": c.rayleigh_vs_exact,
-        })).collect::<Vec<_>>(),
-    })
 }
 
 /// The text of `study`.

@@ -5,12 +5,10 @@ use clap::Args;
 use eomgen::analysis::vibration::{self, ModalAnalysis, ModalOptions};
 use eomgen::{ModeKind, ModelInfo};
 use nalgebra::DMatrix;
-use serde_json::json;
 
 use crate::cli::error::CliError;
-use crate::cli::json::print_json;
-use crate::cli::operating_point::{OperatingPointArgs, point_failure, point_json};
-use crate::cli::render::matrix_rows;
+use crate::cli::json::print_json_sorted;
+use crate::cli::operating_point::{OperatingPointArgs, point_failure};
 use crate::cli::render::num;
 
 /// Options of `eomgen modes`.
@@ -56,17 +54,11 @@ pub fn run(args: &ModesArgs) -> Result<(), CliError> {
     if args.plot.is_some() {
         crate::cli::mode_plot::check_drawable(model.as_ref())?;
     }
-    let (lin, modes) = (&modal.linearization, &modal.normal_modes);
+    let modes = &modal.normal_modes;
     let equilibrium = &modal.operating_point.equilibrium;
     // Mode shapes in the model's coordinates (δq = N z with constraints).
     let shapes_q = modal.mode_shape_matrix();
-    let multipliers: serde_json::Map<String, serde_json::Value> = model
-        .description()
-        .constraint_names()
-        .iter()
-        .zip(&lin.lagrange_multipliers)
-        .map(|(c, v)| (c.to_string(), json!(v)))
-        .collect();
+    let summary = modal.summary(model.as_ref());
     let charts = match &args.plot {
         Some(prefix) => {
             let charts = crate::cli::mode_plot::mode_charts(
@@ -87,19 +79,17 @@ pub fn run(args: &ModesArgs) -> Result<(), CliError> {
     }
     let mut stdout = crate::cli::output::stdout();
     if args.json {
-        print_json(&json_report(
-            model.as_ref(),
-            &modal,
-            &multipliers,
-            &charts,
-            args,
-        ))
+        print_json_sorted(&ModesJson {
+            summary,
+            charts: &charts,
+            animation: &args.animate,
+        })
     } else {
         print_text(
             &mut stdout,
             model.as_ref(),
             &modal,
-            &multipliers,
+            &summary.lagrange_multipliers,
             &charts,
             args,
         );
@@ -107,56 +97,16 @@ pub fn run(args: &ModesArgs) -> Result<(), CliError> {
     }
 }
 
-/// The JSON of `modes` (see docs/cli.md).
-fn json_report(
-    model: &dyn ModelInfo,
-    modal: &ModalAnalysis,
-    multipliers: &serde_json::Map<String, serde_json::Value>,
-    charts: &[String],
-    args: &ModesArgs,
-) -> serde_json::Value {
-    let ModalAnalysis {
-        operating_point: point,
-        linearization: lin,
-        normal_modes: modes,
-        mode_shapes: shapes,
-        minimal_coordinates: minimal,
-        damped_modes: damped,
-        damping_ratios,
-        m_inv_k_eigenvalues: route22,
-        m_inv_k_relative_difference: route_difference,
-        time_dependent_forcing: forcing,
-        stability: _,
-    } = modal;
-    let (label, equilibrium) = (&point.name, &point.equilibrium);
-    let names = model.description().coordinate_names();
-    let mut point = point_json(label, &names, &equilibrium.q);
-    point["newton_iterations"] = json!(equilibrium.iterations);
-    point["residual"] = json!(equilibrium.residual);
-    json!({
-        "model": model.description().name,
-        "coordinates": names,
-        "operating_point": point,
-        "natural_frequencies": modes.natural_frequencies,
-        "frequencies_hz": modes.natural_frequencies.iter().map(|w| w / std::f64::consts::TAU).collect::<Vec<_>>(),
-        "eigenvalues": modes.eigenvalues,
-        "kinds": modes.kinds,
-        "damping_ratios": damping_ratios,
-        "damped_modes": damped.iter().map(|d| json!({"re": d.eigenvalue.re, "im": d.eigenvalue.im, "damping_ratio": d.damping_ratio, "damped_frequency": d.damped_frequency})).collect::<Vec<_>>(),
-        "mode_shapes": shapes,
-        "minimal_coordinates": minimal,
-        "lagrange_multipliers": multipliers,
-        "mass_matrix": matrix_rows(&lin.mass_matrix),
-        "stiffness_matrix": matrix_rows(&lin.stiffness_matrix),
-        "damping_matrix": matrix_rows(&lin.damping_matrix),
-        "differenced_jacobian_entries": lin.differenced_entries,
-        "stiffness_asymmetry": modes.stiffness_asymmetry,
-        "m_inv_k_eigenvalues": route22,
-        "m_inv_k_relative_difference": route_difference,
-        "time_dependent_forcing": forcing,
-        "charts": charts,
-        "animation": args.animate,
-    })
+/// What `modes --json` prints (see docs/cli.md): the library's summary with the files this
+/// run wrote.
+#[derive(serde::Serialize)]
+struct ModesJson<'a> {
+    #[serde(flatten)]
+    summary: eomgen::analysis::vibration::ModesSummary,
+    /// The mode-shape charts written (`--plot`).
+    charts: &'a [String],
+    /// The animation page written (`--animate`).
+    animation: &'a Option<String>,
 }
 
 /// The text of `modes`: the equilibrium, M, K, C, the modes, the check, the files written.
@@ -164,7 +114,7 @@ fn print_text(
     stdout: &mut impl std::io::Write,
     model: &dyn ModelInfo,
     modal: &ModalAnalysis,
-    multipliers: &serde_json::Map<String, serde_json::Value>,
+    multipliers: &std::collections::BTreeMap<String, f64>,
     charts: &[String],
     args: &ModesArgs,
 ) {
@@ -214,7 +164,7 @@ fn print_text(
     if !lin.lagrange_multipliers.is_empty() {
         let forces: Vec<String> = multipliers
             .iter()
-            .map(|(c, v)| format!("λ_{c} = {:.6e}", num(v.as_f64().unwrap_or(f64::NAN))))
+            .map(|(c, v)| format!("λ_{c} = {:.6e}", num(v)))
             .collect();
         let _ = writeln!(
             stdout,

@@ -3,7 +3,6 @@
 use clap::Args;
 use eomgen::analysis::{ConstraintDrift, EnergyDrift, Simulation};
 use eomgen::{ModelInfo, OutputTimes, Solution};
-use serde_json::{Value, json};
 
 use crate::cli::error::CliError;
 use crate::cli::files::{self, Outputs};
@@ -165,7 +164,15 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
         .map_err(CliError::failure)?;
     }
     if args.json {
-        crate::cli::json::print_json(&json_report(model.as_ref(), args, &simulation))?;
+        // The wall time is the one figure that differs between two identical runs: only
+        // printed when asked for (`--timing`), so that the JSON is byte-identical otherwise.
+        let mut json = crate::cli::json::sorted(&simulation.summary(model.as_ref()))?;
+        if !args.timing
+            && let Some(stats) = json["stats"].as_object_mut()
+        {
+            stats.remove("wall_time_s");
+        }
+        crate::cli::json::print_json(&json)?;
     } else {
         print_summary(model.as_ref(), method_name, &args.run, solution, report);
         print_constraint_summary(constraints, args.run.stabilization);
@@ -184,108 +191,6 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
             ),
         )),
     }
-}
-
-/// The JSON of `simulate --json` (see docs/cli.md): the samples with their energy (and
-/// constraint forces and drift), the settings, the drift measures and the integrator's
-/// statistics (`wall_time_s` only with `--timing`), then what applies: constraints, events,
-/// the error of a failed run, the warnings.
-fn json_report(model: &dyn ModelInfo, args: &SimulateArgs, simulation: &Simulation) -> Value {
-    let Simulation {
-        solution,
-        energy: report,
-        constraints,
-        failure,
-        warnings,
-        integrator: method_name,
-        ..
-    } = simulation;
-    let n = model.num_dofs();
-    let coordinates: Vec<String> = model
-        .description()
-        .coordinate_names()
-        .iter()
-        .map(|s| s.to_string())
-        .collect();
-    let samples: Vec<serde_json::Value> = solution
-        .iter()
-        .zip(&report.energy)
-        .enumerate()
-        .map(|(k, ((t, y), e))| {
-            let mut sample = json!({"t": t, "q": &y[..n], "qdot": &y[n..], "energy": e});
-            if !constraints.is_empty() {
-                sample["constraint_forces"] = json!(constraints.lagrange_multipliers[k]);
-                sample["constraint_drift"] =
-                    json!({"position": constraints.drift[k].0, "velocity": constraints.drift[k].1});
-            }
-            sample
-        })
-        .collect();
-    let mut out = json!({
-        "model": model.description().name,
-        "coordinates": coordinates,
-        "parameters": model.description().parameter_names().iter().zip(model.parameter_values()).map(|(k, v)| (k.to_string(), json!(v))).collect::<serde_json::Map<_, _>>(),
-        "method": method_name,
-        "rtol": args.run.rtol,
-        "atol": args.run.atol,
-        "samples": samples,
-        "initial_energy": report.initial_energy,
-        "energy_drift": report.drift,
-        "conservative": model.description().conservative,
-        "stats": solution.stats,
-    });
-    // The wall time is the one figure that differs between two identical runs: only asked
-    // for (`--timing`), so that the JSON is byte-identical across runs otherwise.
-    if !args.timing
-        && let Some(stats) = out["stats"].as_object_mut()
-    {
-        stats.remove("wall_time_s");
-    }
-    if !constraints.is_empty() {
-        out["constraints"] = json!(constraints.constraint_names);
-        out["stabilization"] = json!(format!("{:?}", args.run.stabilization).to_lowercase());
-        out["max_constraint_drift"] = json!({
-            "position": constraints.max_drift().0,
-            "velocity": constraints.max_drift().1,
-        });
-    }
-    if !solution.events.is_empty() || !args.run.stop_when.is_empty() || !args.run.event.is_empty() {
-        out["events"] = json!(
-            solution
-                .events
-                .iter()
-                .map(|e| json!({
-                    "name": e.name,
-                    "t": e.t,
-                    "direction": e.direction.name(),
-                    "terminal": e.terminal,
-                    "q": &e.y[..n],
-                    "qdot": &e.y[n..],
-                }))
-                .collect::<Vec<_>>()
-        );
-        out["terminated_by_event"] = json!(
-            solution
-                .terminated_by_event
-                .map(|k| solution.events[k].name.clone())
-        );
-    }
-    if let Some(e) = &failure {
-        out["error"] = json!({"t": e.t(), "message": e.to_string()});
-    }
-    if !warnings.is_empty() {
-        out["warnings"] = json!(
-            warnings
-                .iter()
-                .map(|w| {
-                    let mut warning = json!(w);
-                    warning["message"] = json!(w.to_string());
-                    warning
-                })
-                .collect::<Vec<_>>()
-        );
-    }
-    out
 }
 
 fn print_summary(

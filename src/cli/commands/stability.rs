@@ -21,11 +21,10 @@ use eomgen::analysis::stability::{
 };
 use eomgen::integrate::stability_function::GrowthTest;
 use nalgebra::Complex;
-use serde_json::json;
 
 use crate::cli::error::CliError;
 use crate::cli::files::Outputs;
-use crate::cli::json::print_json;
+use crate::cli::json::print_json_sorted;
 use crate::cli::model::find_model;
 use crate::cli::plot::{self, log_y_chart};
 use crate::cli::render::num;
@@ -111,50 +110,28 @@ pub fn run(args: &StabilityArgs) -> Result<(), CliError> {
         })
         .check()?;
     let mut two_masses = find_model(STIFF_MODEL)?;
-    let study = stability_study(two_masses.as_mut(), &options).map_err(study_error)?;
+    let mut study = stability_study(two_masses.as_mut(), &options).map_err(study_error)?;
+    if let Some([limits_path, energy_path, stiff_path]) = &charts {
+        plot_limits(limits_path, &mut study.limits.explicit)?;
+        plot_energy(energy_path, &study.energy)?;
+        plot_stiff(stiff_path, &study.stiff)?;
+    }
     let StabilityStudy {
         test,
-        mut limits,
+        limits,
         energy,
         stiff_modes: modes,
         stiff,
         underflow,
-    } = study;
-
-    if let Some([limits_path, energy_path, stiff_path]) = &charts {
-        plot_limits(limits_path, &mut limits.explicit)?;
-        plot_energy(energy_path, &energy)?;
-        plot_stiff(stiff_path, &stiff)?;
-    }
+    } = &study;
     if args.json {
-        let out = json!({
-            "limits": {
-                "growth_threshold": GROWTH_THRESHOLD,
-                "steps": args.steps,
-                "smallest_detected_growth": test.smallest_detected_growth(),
-                "bisection_tolerance": BISECTION_TOLERANCE,
-                "rows": limits.rows,
-                "amplification": limits.amplification,
-                "polynomials": limits.polynomials,
-            },
-            "energy": {"periods": args.periods, "runs": energy},
-            "stiff": {
-                "model": two_masses.description().name,
-                "t_end": args.t_end,
-                "tol": args.tol,
-                "reference": {"method": "dop853", "tol": STIFF_REFERENCE_TOL},
-                "modes": modes,
-                "runs": stiff,
-            },
-            "underflow": underflow,
-        });
-        print_json(&out)?;
+        print_json_sorted(&study.summary(two_masses.as_ref(), &options))?;
     } else {
         let mut text = String::new();
-        write_limits(&mut text, &test, &limits);
-        write_energy(&mut text, args.periods, &energy);
-        write_stiff(&mut text, args, &modes, &stiff);
-        write_underflow(&mut text, &underflow);
+        write_limits(&mut text, test, limits);
+        write_energy(&mut text, args.periods, energy);
+        write_stiff(&mut text, args, modes, stiff);
+        write_underflow(&mut text, underflow);
         let _ = write!(crate::cli::output::stdout(), "{text}");
     }
     // The limits of part a are always measured (a failure there is the study's error), so

@@ -9,10 +9,9 @@ use clap::Args;
 use eomgen::ModelInfo;
 use eomgen::analysis::StudyRuns;
 use eomgen::analysis::work_precision::{
-    AtTarget, DEFAULT_METHODS, MAX_REPEATS, Measured, MethodRuns, SMALLEST_TOLERANCE, Setting,
-    SettingRun, WorkPrecision, WorkPrecisionError, WorkPrecisionOptions, decades, work_precision,
+    AtTarget, DEFAULT_METHODS, MAX_REPEATS, Measured, MethodRuns, SMALLEST_TOLERANCE,
+    WorkPrecision, WorkPrecisionError, WorkPrecisionOptions, decades, work_precision,
 };
-use serde_json::json;
 
 use crate::cli::error::CliError;
 use crate::cli::integration::Method;
@@ -181,11 +180,6 @@ fn parse_steps(text: &str) -> Result<Vec<usize>, CliError> {
     Ok(steps)
 }
 
-/// A finite number as JSON, anything else as `null`.
-fn finite(x: f64) -> serde_json::Value {
-    if x.is_finite() { json!(x) } else { json!(null) }
-}
-
 /// Runs `eomgen study work-precision MODEL`.
 ///
 /// # Errors
@@ -255,7 +249,7 @@ pub fn run(args: &WorkPrecisionArgs) -> Result<(), CliError> {
         )?;
     }
     if args.json {
-        crate::cli::json::print_json(&study.to_json())?;
+        crate::cli::json::print_json_sorted(&study.report.summary(study.model, &options))?;
     } else {
         // A failed write (a pipe into `head` closed) is kept by `output` and sets the status.
         let _ = study.write_text(&mut crate::cli::output::stdout());
@@ -283,108 +277,6 @@ impl Study<'_> {
     /// Whether a run's error is within 10× of the reference's agreement.
     fn unresolved(&self, m: &Measured) -> bool {
         self.report.unresolved(m)
-    }
-
-    /// The JSON document of `--json` (schema in docs/cli.md).
-    fn to_json(&self) -> serde_json::Value {
-        let args = self.args;
-        let methods: Vec<serde_json::Value> = self
-            .report
-            .results
-            .iter()
-            .map(|r| {
-                let runs: Vec<serde_json::Value> =
-                    r.runs.iter().map(|run| self.run_json(run)).collect();
-                json!({
-                    "method": r.method.name(),
-                    "name": r.method.display_name(),
-                    "order": r.method.integrator().order(),
-                    "adaptive": r.method.is_adaptive(),
-                    "runs": runs,
-                    "at_target": self.target_json(&r.at_target),
-                })
-            })
-            .collect();
-        json!({
-            "model": self.model.description().name,
-            "t_end": args.t_end,
-            "samples": args.samples,
-            "error_norm": format!("max over the {s} output times k·T/{s} (k = 1…{s}) and over all {} components of y = [q; q̇] of |y − y_ref|", self.report.dim, s = args.samples),
-            "conservative": self.model.description().conservative,
-            "target_error": args.target_error,
-            "baseline_ms": args.baseline_ms,
-            "timing": {
-                "statistic": "median",
-                "min_repeats": self.report.min_repeats,
-                "min_total_s": self.report.min_time_s,
-                "max_repeats": MAX_REPEATS,
-            },
-            "reference": {
-                "method": "dop853",
-                "rtol": args.reference_tol,
-                "atol": args.reference_tol,
-                "steps": self.report.reference_steps,
-                "check_method": "dp54",
-                "agreement": self.report.agreement,
-            },
-            "methods": methods,
-        })
-    }
-
-    /// One run: every key always present, `null` where a failed run has no value.
-    fn run_json(&self, run: &SettingRun) -> serde_json::Value {
-        let (tol, num_steps, dt) = match run.setting {
-            Setting::Tolerance(tol) => (Some(tol), None, None),
-            Setting::Steps { steps, dt } => (None, Some(steps), Some(dt)),
-        };
-        let m = run.outcome.as_ref().ok();
-        let failure = run
-            .outcome
-            .as_ref()
-            .err()
-            .map(|f| json!({"t": f.t.filter(|t| t.is_finite()), "message": f.message}));
-        json!({
-            "tol": tol,
-            "num_steps": num_steps,
-            "dt": dt,
-            "error": m.map(|m| finite(m.error)),
-            "resolved": m.map(|m| !self.unresolved(m)),
-            "rhs_evals": m.map(|m| m.rhs_evals),
-            "steps": m.map(|m| m.steps),
-            "rejected": m.map(|m| m.rejected),
-            "jacobian_evals": m.map(|m| m.jacobian_evals),
-            "lu_decompositions": m.map(|m| m.lu_decompositions),
-            "wall_time_s": m.map(|m| finite(m.wall_time_s)),
-            "repeats": m.map(|m| m.repeats),
-            "energy_drift": m.and_then(|m| m.energy_drift),
-            "failure": failure,
-        })
-    }
-
-    /// The work at the target error: interpolated values, or `null`s and a note.
-    fn target_json(&self, target: &AtTarget) -> serde_json::Value {
-        let (reached, evals, steps, time, note) = match *target {
-            AtTarget::Reached {
-                rhs_evals,
-                steps,
-                wall_time_s,
-            } => (true, Some(rhs_evals), Some(steps), Some(wall_time_s), None),
-            AtTarget::BelowAtLoosest { .. } | AtTarget::NotReached => (
-                !matches!(target, AtTarget::NotReached),
-                None,
-                None,
-                None,
-                Some(target.note()),
-            ),
-        };
-        json!({
-            "reached": reached,
-            "rhs_evals": evals.map(finite),
-            "steps": steps.map(finite),
-            "wall_time_s": time.map(finite),
-            "baseline_ratio": time.zip(self.args.baseline_ms).map(|(t, b)| finite(b * 1e-3 / t)),
-            "note": note,
-        })
     }
 
     /// The header, the table of runs and the table of work at the target error.

@@ -101,7 +101,7 @@ pub struct CheckReport {
 
 /// How many random states [`check_model`] compared, and why it skipped the others: a state
 /// is compared only where Lagrange's `M` and `F` are finite and `M` is regular.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize)]
 pub struct SampledStates {
     /// States drawn.
     pub drawn: usize,
@@ -195,6 +195,133 @@ impl CheckReport {
                 .as_ref()
                 .is_none_or(InitialConstraints::passed)
     }
+}
+
+impl CheckReport {
+    /// The report as `eomgen check --json` prints it ([`CheckSummary`]), judged at relative
+    /// tolerance `tolerance`; with `with_times` the derivations' wall times are included
+    /// (they are the one figure that differs between two identical runs).
+    pub fn summary(&self, tolerance: f64, with_times: bool) -> CheckSummary {
+        // A residual over no state is null, not 0.
+        let sampled = self.states.compared > 0;
+        CheckSummary {
+            model: self.model.clone(),
+            tolerance,
+            failure: self.states.nothing_compared(),
+            passed: self.passed(tolerance),
+            checks: self
+                .comparisons
+                .iter()
+                .map(|c| ComparisonSummary {
+                    a: c.a,
+                    b: c.b,
+                    max_rel_residual: sampled.then_some(c.max_rel_residual),
+                    symbolic_equal: c.symbolic_equal,
+                    states: c.states,
+                })
+                .collect(),
+            power_balance: self.power_balance.as_ref().map(|p| PowerBalanceSummary {
+                max_rel_residual: sampled.then_some(p.max_rel_residual),
+            }),
+            initial_constraints: self.initial_constraints.as_ref().map(|c| {
+                InitialConstraintsSummary {
+                    constraint: c.constraint.clone(),
+                    residual: c.residual,
+                    velocity: c.velocity,
+                    tolerance: INITIAL_CONSTRAINT_TOLERANCE,
+                    passed: c.passed(),
+                }
+            }),
+            states: self.states,
+            derivation: self
+                .derivations
+                .iter()
+                .map(|d| {
+                    let summary = DerivationSummary {
+                        time_s: with_times.then_some(d.time_s),
+                        ops: d.ops,
+                        ops_after_cse: d.ops_after_cse,
+                    };
+                    (d.name, summary)
+                })
+                .collect(),
+            notes: self.notes.clone(),
+        }
+    }
+}
+
+/// A [`CheckReport`] as `eomgen check --json` prints it ([`CheckReport::summary`]).
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct CheckSummary {
+    /// The model's name.
+    pub model: String,
+    /// The relative tolerance the checks were judged at.
+    pub tolerance: f64,
+    /// Why nothing was compared ([`SampledStates::nothing_compared`]; null when states were).
+    pub failure: Option<String>,
+    /// Whether every check passed ([`CheckReport::passed`]).
+    pub passed: bool,
+    /// The comparisons of `q̈` between derivations.
+    pub checks: Vec<ComparisonSummary>,
+    /// The power balance check (null when the model has none).
+    pub power_balance: Option<PowerBalanceSummary>,
+    /// The initial state's constraint residual (null without constraints or with guesses).
+    pub initial_constraints: Option<InitialConstraintsSummary>,
+    /// How many random states were drawn, compared and skipped.
+    pub states: SampledStates,
+    /// Each derivation's size (and wall time, when asked for), by name.
+    pub derivation: std::collections::BTreeMap<&'static str, DerivationSummary>,
+    /// Notes on what was found.
+    pub notes: Vec<String>,
+}
+
+/// One [`Comparison`] in a [`CheckSummary`].
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct ComparisonSummary {
+    /// The first derivation's name.
+    pub a: &'static str,
+    /// The second's.
+    pub b: &'static str,
+    /// [`Comparison::max_rel_residual`] (null when no state was compared).
+    pub max_rel_residual: Option<f64>,
+    /// [`Comparison::symbolic_equal`].
+    pub symbolic_equal: Option<bool>,
+    /// The states compared.
+    pub states: usize,
+}
+
+/// The [`PowerBalance`] in a [`CheckSummary`].
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct PowerBalanceSummary {
+    /// [`PowerBalance::max_rel_residual`] (null when no state was compared).
+    pub max_rel_residual: Option<f64>,
+}
+
+/// The [`InitialConstraints`] in a [`CheckSummary`], with the tolerance it is judged at.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct InitialConstraintsSummary {
+    /// [`InitialConstraints::constraint`].
+    pub constraint: String,
+    /// [`InitialConstraints::residual`].
+    pub residual: f64,
+    /// [`InitialConstraints::velocity`].
+    pub velocity: bool,
+    /// [`INITIAL_CONSTRAINT_TOLERANCE`].
+    pub tolerance: f64,
+    /// [`InitialConstraints::passed`].
+    pub passed: bool,
+}
+
+/// One derivation's size in a [`CheckSummary`].
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct DerivationSummary {
+    /// [`DerivationStats::time_s`] (s; left out unless asked for).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub time_s: Option<f64>,
+    /// [`DerivationStats::ops`].
+    pub ops: u64,
+    /// [`DerivationStats::ops_after_cse`].
+    pub ops_after_cse: u64,
 }
 
 /// The largest constraint residual of the file's `initial:` state (t = 0, parameters at

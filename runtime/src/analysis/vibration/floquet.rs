@@ -14,9 +14,12 @@
 
 use std::f64::consts::TAU;
 
+use std::collections::BTreeMap;
+
+use nalgebra::{Complex, DMatrix};
 use serde::Serialize;
 
-use super::operating_point::{OperatingPointError, OperatingPointOptions};
+use super::operating_point::{OperatingPointError, OperatingPointOptions, PointSummary};
 use crate::analysis::outcome::{RunTally, StudyRuns};
 use crate::linear::modal::{ModalError, find_equilibrium};
 use crate::linear::monodromy::{
@@ -593,5 +596,270 @@ impl StudyRuns for FloquetChart {
             }
         }
         tally
+    }
+}
+
+impl FloquetPoint {
+    /// The analysis as `eomgen study floquet --json` prints it ([`FloquetSummary`]): `model`
+    /// is the model analysed (for its names), `options` those of the analysis, `predictions`
+    /// what the model file's references predict at this point, `sweep` the stability chart
+    /// when one was computed.
+    pub fn summary(
+        &self,
+        model: &dyn ModelInfo,
+        options: &FloquetStudyOptions,
+        predictions: Vec<PredictionSummary>,
+        sweep: Option<&FloquetChart>,
+    ) -> FloquetSummary {
+        let f = &self.floquet;
+        let coordinates: Vec<String> = model
+            .description()
+            .coordinate_names()
+            .iter()
+            .map(|c| c.to_string())
+            .collect();
+        FloquetSummary {
+            model: model.description().name.to_string(),
+            operating_point: PointSummary {
+                max_forcing_residual: Some(self.residual),
+                ..PointSummary::new(&self.name, &coordinates, &self.q)
+            },
+            coordinates,
+            period_parameter: options.period_parameter.clone(),
+            frequency: self.frequency,
+            period: f.period,
+            monodromy_matrix: f.monodromy_matrix.clone(),
+            multipliers: f
+                .multipliers
+                .iter()
+                .map(|c| MultiplierSummary {
+                    re: c.re,
+                    im: c.im,
+                    modulus: c.norm(),
+                })
+                .collect(),
+            exponents: f.exponents.clone(),
+            spectral_radius: f.spectral_radius,
+            determinant: f.determinant,
+            stability: f.stability.as_str(),
+            stable: f.stability.is_stable(),
+            stability_tolerance: options.floquet.stability_tolerance,
+            closure_error: f.closure_error,
+            integration: FloquetIntegrationSummary {
+                method: "dop853",
+                tol: options.floquet.rtol,
+                steps: f.stats.steps,
+                rhs_evals: f.stats.rhs_evals,
+            },
+            predictions: predictions
+                .into_iter()
+                .map(|p| (p.name.clone(), p))
+                .collect(),
+            time_dependent: self.time_dependent,
+            sweep: sweep.map(FloquetChart::summary),
+        }
+    }
+}
+
+/// A [`FloquetPoint`] as `eomgen study floquet --json` prints it ([`FloquetPoint::summary`]),
+/// with each prediction of the model file's references under its own name and the stability
+/// chart under `sweep` (left out without one).
+///
+/// # Shapes
+/// `n` coordinates: `monodromy_matrix` `2n × 2n` as rows, `multipliers` and `exponents` `2n`.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FloquetSummary {
+    /// The model's name.
+    pub model: String,
+    /// The coordinates' names.
+    pub coordinates: Vec<String>,
+    /// The equilibrium, with `max_forcing_residual` (`max |F(q*, 0, t)|` over the period).
+    pub operating_point: PointSummary,
+    /// The parameter that is the forcing frequency.
+    pub period_parameter: String,
+    /// The forcing frequency `w` (rad/s).
+    pub frequency: f64,
+    /// `T = 2π/w` (s).
+    pub period: f64,
+    /// `Φ(T)`, as rows.
+    #[serde(serialize_with = "crate::serde_matrix::rows")]
+    pub monodromy_matrix: DMatrix<f64>,
+    /// The multipliers `μ` with their moduli.
+    pub multipliers: Vec<MultiplierSummary>,
+    /// The exponents `ln(μ)/T` (1/s), each `{"re", "im"}`.
+    #[serde(serialize_with = "crate::serde_matrix::complex_list")]
+    pub exponents: Vec<Complex<f64>>,
+    /// `ρ = max |μ|`.
+    pub spectral_radius: f64,
+    /// `det Φ(T)`.
+    pub determinant: f64,
+    /// [`FloquetStability::as_str`].
+    pub stability: &'static str,
+    /// [`FloquetStability::is_stable`].
+    pub stable: bool,
+    /// The tolerance on `|μ| = 1`.
+    pub stability_tolerance: f64,
+    /// [`FloquetAnalysis::closure_error`].
+    pub closure_error: f64,
+    /// How the period was integrated.
+    pub integration: FloquetIntegrationSummary,
+    /// The predictions by name (each a key of the summary).
+    #[serde(flatten)]
+    pub predictions: BTreeMap<String, PredictionSummary>,
+    /// [`FloquetPoint::time_dependent`].
+    pub time_dependent: bool,
+    /// The stability chart (left out without one).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sweep: Option<FloquetChartSummary>,
+}
+
+/// A Floquet multiplier `μ` as `{"re", "im", "modulus"}`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct MultiplierSummary {
+    /// `Re μ`.
+    pub re: f64,
+    /// `Im μ`.
+    pub im: f64,
+    /// `|μ|`.
+    pub modulus: f64,
+}
+
+/// How a [`FloquetSummary`]'s period was integrated.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct FloquetIntegrationSummary {
+    /// The integrator (`"dop853"`).
+    pub method: &'static str,
+    /// Its relative and absolute tolerance.
+    pub tol: f64,
+    /// Accepted steps.
+    pub steps: usize,
+    /// Right-hand-side evaluations.
+    pub rhs_evals: usize,
+}
+
+/// A stability prediction at the analysed point, serialised as an object with three keys
+/// named after it: `{KEY: value, "critical_KEY": critical, "predicts_stable_EQUILIBRIUM":
+/// predicts_stable}`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PredictionSummary {
+    /// Its name (`kapitza`): its key in the [`FloquetSummary`].
+    pub name: String,
+    /// The value's key (`a_w`).
+    pub key: String,
+    /// The value.
+    pub value: f64,
+    /// The critical value.
+    pub critical: f64,
+    /// The equilibrium's name (`upright`).
+    pub equilibrium: String,
+    /// Whether the prediction says stable (`value > critical`).
+    pub predicts_stable: bool,
+}
+
+impl Serialize for PredictionSummary {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeMap as _;
+        let mut map = s.serialize_map(Some(3))?;
+        map.serialize_entry(&self.key, &self.value)?;
+        map.serialize_entry(&format!("critical_{}", self.key), &self.critical)?;
+        map.serialize_entry(
+            &format!("predicts_stable_{}", self.equilibrium),
+            &self.predicts_stable,
+        )?;
+        map.end()
+    }
+}
+
+impl FloquetChart {
+    /// The chart as `eomgen study floquet --sweep … --json` prints it ([`FloquetChartSummary`]).
+    pub fn summary(&self) -> FloquetChartSummary {
+        let (x, y) = (&self.x, &self.y);
+        let mut failures = Vec::new();
+        for (i, column) in self.cells.iter().enumerate() {
+            for (j, cell) in column.iter().enumerate() {
+                if let Err(e) = cell {
+                    failures.push(FailedCell {
+                        x: (x.name.clone(), x.values[i]),
+                        y: (y.name.clone(), y.values[j]),
+                        error: e.clone(),
+                    });
+                }
+            }
+        }
+        let grid = |f: &dyn Fn(&FloquetCell) -> f64| -> Vec<Vec<Option<f64>>> {
+            self.cells
+                .iter()
+                .map(|column| column.iter().map(|c| c.as_ref().ok().map(f)).collect())
+                .collect()
+        };
+        FloquetChartSummary {
+            x: x.clone(),
+            y: y.clone(),
+            layout: "spectral_radius[i][j] and stability[i][j] at (x[i], y[j]); null where the analysis failed",
+            spectral_radius: grid(&|c| c.spectral_radius),
+            stability: self
+                .cells
+                .iter()
+                .map(|column| {
+                    column
+                        .iter()
+                        .map(|c| c.as_ref().ok().map(|c| c.stability.as_str()))
+                        .collect()
+                })
+                .collect(),
+            stable_points: self
+                .cells
+                .iter()
+                .flatten()
+                .filter(|c| matches!(c, Ok(c) if c.stability.is_stable()))
+                .count(),
+            failures,
+        }
+    }
+}
+
+/// A [`FloquetChart`] as `eomgen study floquet --sweep … --json` prints it.
+///
+/// # Shapes
+/// `spectral_radius` and `stability` are `len(x.values) × len(y.values)`, `[i][j]` at
+/// `(x.values[i], y.values[j])`.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FloquetChartSummary {
+    /// The x axis.
+    pub x: SweepAxis,
+    /// The y axis.
+    pub y: SweepAxis,
+    /// The grids' layout, in words.
+    pub layout: &'static str,
+    /// `ρ` at every cell (null where the analysis failed).
+    pub spectral_radius: Vec<Vec<Option<f64>>>,
+    /// [`FloquetStability::as_str`] at every cell (null where the analysis failed).
+    pub stability: Vec<Vec<Option<&'static str>>>,
+    /// The number of stable cells.
+    pub stable_points: usize,
+    /// The failed cells.
+    pub failures: Vec<FailedCell>,
+}
+
+/// A failed cell of a [`FloquetChartSummary`], serialised as `{X: x, Y: y, "error":
+/// message}` with the axes' parameter names as keys.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FailedCell {
+    /// The x parameter's name and value.
+    pub x: (String, f64),
+    /// The y parameter's name and value.
+    pub y: (String, f64),
+    /// Why the analysis failed there.
+    pub error: String,
+}
+
+impl Serialize for FailedCell {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeMap as _;
+        let mut map = s.serialize_map(Some(3))?;
+        map.serialize_entry(&self.x.0, &self.x.1)?;
+        map.serialize_entry(&self.y.0, &self.y.1)?;
+        map.serialize_entry("error", &self.error)?;
+        map.end()
     }
 }

@@ -8,7 +8,9 @@
 use serde::Serialize;
 
 use super::modes::{ModalAnalysis, ModalOptions, modal_analysis};
-use super::operating_point::{OperatingPoint, OperatingPointError, OperatingPointOptions};
+use super::operating_point::{
+    OperatingPoint, OperatingPointError, OperatingPointOptions, PointSummary,
+};
 use crate::analysis::outcome::{RunTally, StudyRuns};
 use crate::linear::modal::{Linearization, ModeKind, NormalModes};
 use crate::linear::response::{
@@ -283,6 +285,128 @@ pub struct FreeResponseStudy {
 
 /// Each of the four responses is a run; a failed one fails the study as a whole
 /// ([`ResponseStudyError::Response`]).
+impl FreeResponseStudy {
+    /// The study as `eomgen study free-response --json` prints it ([`FreeResponseSummary`]);
+    /// `model` is the model studied (for its name).
+    pub fn summary(&self, model: &dyn ModelInfo) -> FreeResponseSummary {
+        let modes = &self.normal_modes;
+        FreeResponseSummary {
+            model: model.description().name.to_string(),
+            coordinates: self.operating_point.coordinates.clone(),
+            operating_point: self.operating_point.summary_at(&self.linearization.q),
+            ignored_damping: self.ignored_damping,
+            modes: modes
+                .kinds
+                .iter()
+                .zip(&modes.eigenvalues)
+                .zip(&modes.natural_frequencies)
+                .map(|((kind, &eigenvalue), &natural_frequency)| ModeSummary {
+                    kind: kind.name(),
+                    eigenvalue,
+                    natural_frequency,
+                    growth_rate: kind.growth_rate(),
+                })
+                .collect(),
+            initial: self.initial.clone(),
+            t_end: self.t_end,
+            samples: self.responses.first().map_or(0, |(_, r)| r.times.len()),
+            tol: self.tol,
+            methods: FreeResponseMethod::ALL
+                .iter()
+                .map(|m| MethodSummary {
+                    name: m.name(),
+                    description: m.description(),
+                })
+                .collect(),
+            max_displacement: self.max_displacement,
+            max_velocity: self.max_velocity,
+            max_differences: self.differences.clone(),
+            final_states: self
+                .responses
+                .iter()
+                .map(|(method, r)| FinalState {
+                    method: method.name(),
+                    q: r.displacements.last().cloned(),
+                    qdot: r.velocities.last().cloned(),
+                })
+                .collect(),
+        }
+    }
+}
+
+/// A [`FreeResponseStudy`] as `eomgen study free-response --json` prints it
+/// ([`FreeResponseStudy::summary`]): the set-up, the modes, the methods, their largest
+/// differences and each method's final state (the responses themselves left out).
+///
+/// # Shapes
+/// `n` coordinates: `coordinates`, `modes`, the `initial` and `final` states `n` each.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FreeResponseSummary {
+    /// The model's name.
+    pub model: String,
+    /// The coordinates' names.
+    pub coordinates: Vec<String>,
+    /// The operating point at the linearisation's `q`.
+    pub operating_point: PointSummary,
+    /// [`FreeResponseStudy::ignored_damping`].
+    pub ignored_damping: f64,
+    /// The undamped modes.
+    pub modes: Vec<ModeSummary>,
+    /// The initial deviation `{"q", "qdot"}` from the equilibrium.
+    pub initial: InitialDeviation,
+    /// The end time (s).
+    pub t_end: f64,
+    /// The number of sample times.
+    pub samples: usize,
+    /// The integration's tolerance.
+    pub tol: f64,
+    /// The four methods, in the order reported.
+    pub methods: Vec<MethodSummary>,
+    /// [`FreeResponseStudy::max_displacement`] (m or rad).
+    pub max_displacement: f64,
+    /// [`FreeResponseStudy::max_velocity`] (m/s or rad/s).
+    pub max_velocity: f64,
+    /// The largest differences between the methods.
+    pub max_differences: Vec<ResponseDifference>,
+    /// Each method's state at `t_end`.
+    #[serde(rename = "final")]
+    pub final_states: Vec<FinalState>,
+}
+
+/// One mode in a study's summary: `{"kind", "eigenvalue", "natural_frequency",
+/// "growth_rate"}`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct ModeSummary {
+    /// [`ModeKind::name`].
+    pub kind: &'static str,
+    /// `ω²` (1/s²).
+    pub eigenvalue: f64,
+    /// `ω` (rad/s).
+    pub natural_frequency: f64,
+    /// `σ` (1/s) of an unstable mode, null for the others.
+    pub growth_rate: Option<f64>,
+}
+
+/// A method of [`free_response`] by name, with what it computes.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct MethodSummary {
+    /// [`FreeResponseMethod::name`].
+    pub name: &'static str,
+    /// [`FreeResponseMethod::description`].
+    pub description: &'static str,
+}
+
+/// A method's last sample in a [`FreeResponseSummary`].
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FinalState {
+    /// [`FreeResponseMethod::name`].
+    pub method: &'static str,
+    /// `δq` at the last sample (m or rad; null without samples).
+    pub q: Option<Vec<f64>>,
+    /// `δq̇` at the last sample (m/s or rad/s; null without samples).
+    pub qdot: Option<Vec<f64>>,
+}
+
 impl StudyRuns for FreeResponseStudy {
     fn study(&self) -> &'static str {
         "free-response"

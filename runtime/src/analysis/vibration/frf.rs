@@ -8,10 +8,14 @@
 //! [`simulate_point`] runs one (independent of the others, so a caller may run them in
 //! parallel, each on its own instance of the model).
 
+use std::collections::BTreeMap;
+
 use nalgebra::{Complex, DMatrix, DVector};
 use serde::Serialize;
 
-use super::operating_point::{OperatingPoint, OperatingPointError, OperatingPointOptions};
+use super::operating_point::{
+    OperatingPoint, OperatingPointError, OperatingPointOptions, PointSummary,
+};
 use crate::linear::frequency_response::{
     ForcedLinearization, FrequencySweep, FrfError, HarmonicForcing, ModalResponse, PeakAmplitude,
     SteadyStateOptions, frequency_response, frequency_response_of, frequency_sweep,
@@ -662,4 +666,287 @@ pub fn max_simulation_error(points: &[SimulatedPoint]) -> f64 {
                 .fold(0.0f64, f64::max)
         })
         .fold(0.0f64, f64::max)
+}
+
+impl FrfAnalysis {
+    /// The analysis as `eomgen frf --json` prints it ([`FrfSummary`]); `model` is the model
+    /// analysed (for its name), `simulated` the points of [`simulate_point`] with their plan
+    /// when the prediction was checked by simulation.
+    pub fn summary(
+        &self,
+        model: &dyn ModelInfo,
+        simulated: Option<(&[SimulatedPoint], &FrfSimulationPlan)>,
+    ) -> FrfSummary {
+        let outputs = &self.outputs;
+        let by_output = |values: &dyn Fn(usize) -> Complex<f64>| -> BTreeMap<String, Phasor> {
+            outputs
+                .iter()
+                .map(|o| (o.name.clone(), values(o.index).into()))
+                .collect()
+        };
+        let (modes, damping) = (&self.normal_modes, &self.modal_damping);
+        let modal = |r: &ModalResponse, difference: Option<f64>| ModalSumSummary {
+            modes: (0..modes.natural_frequencies.len())
+                .map(|k| ModalTermSummary {
+                    mode: k + 1,
+                    natural_frequency: modes.natural_frequencies[k],
+                    damping_ratio: damping.damping_ratios[k],
+                    modal_force: r.modal_forces[k],
+                    modal_coordinate: r.modal_coordinates[k].into(),
+                    contributions: by_output(&|i| r.contributions[(i, k)]),
+                })
+                .collect(),
+            sum: by_output(&|i| r.response[i]),
+            max_relative_difference_from_direct: difference,
+        };
+        FrfSummary {
+            model: model.description().name.to_string(),
+            input: self.input.clone(),
+            outputs: outputs.iter().map(|o| o.name.clone()).collect(),
+            operating_point: self.operating_point.summary_at(&self.forced.equilibrium.q),
+            input_matrix: self.forced.input_matrix.column(0).iter().copied().collect(),
+            natural_frequencies: modes.natural_frequencies.clone(),
+            damping_ratios: damping.damping_ratios.clone(),
+            modal_damping_coupling: damping.coupling,
+            frequencies: self.frequencies.clone(),
+            responses: outputs
+                .iter()
+                .zip(&self.sweeps)
+                .map(|(o, s)| FrfSweepSummary {
+                    output: o.name.clone(),
+                    amplitude: s.amplitudes(),
+                    phase_deg: s.phases_deg.clone(),
+                    peaks: s.peaks.iter().map(PeakSummary::from).collect(),
+                })
+                .collect(),
+            evaluations: self
+                .evaluations
+                .iter()
+                .map(|e| FrfEvaluationSummary {
+                    frequency: e.frequency,
+                    response: e.response.as_ref().map(|d| by_output(&|i| d[i])),
+                    unbounded: e.response.is_none(),
+                    modal: e.modal.as_ref().map(|r| modal(r, e.modal_difference)),
+                })
+                .collect(),
+            simulation: simulated.map(|(points, plan)| FrfSimulationSummary {
+                amplitude: plan.options.amplitude,
+                frequency_parameter: plan.frequency_parameter.clone(),
+                rtol: plan.options.rtol,
+                points: points
+                    .iter()
+                    .map(|p| SimulatedPointSummary {
+                        frequency: p.frequency,
+                        settling_time: p.settling_time,
+                        steps: p.steps,
+                        rhs_evals: p.rhs_evals,
+                        outputs: outputs
+                            .iter()
+                            .zip(&p.values)
+                            .map(|(o, v)| {
+                                (
+                                    o.name.clone(),
+                                    SimulatedValueSummary {
+                                        simulated: v.simulated.into(),
+                                        predicted: v.predicted.into(),
+                                        relative_error: v.relative_error(),
+                                    },
+                                )
+                            })
+                            .collect(),
+                    })
+                    .collect(),
+                max_relative_error: max_simulation_error(points),
+            }),
+        }
+    }
+}
+
+/// An [`FrfAnalysis`] as `eomgen frf --json` prints it ([`FrfAnalysis::summary`]): every
+/// complex response as a [`Phasor`], the values of each output by its name.
+///
+/// # Shapes
+/// `n` coordinates, `k` modes, `o` outputs, `f` frequencies: `input_matrix` `n` entries,
+/// `natural_frequencies` and `damping_ratios` `k`, `frequencies` `f`, `responses` `o` sweeps
+/// of `f` values each.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FrfSummary {
+    /// The model's name.
+    pub model: String,
+    /// The input parameter's name.
+    pub input: String,
+    /// The outputs' names.
+    pub outputs: Vec<String>,
+    /// The equilibrium at input 0.
+    pub operating_point: PointSummary,
+    /// The input column `b` (generalized force per unit input at `t = 0`).
+    pub input_matrix: Vec<f64>,
+    /// `ωₖ` (rad/s).
+    pub natural_frequencies: Vec<f64>,
+    /// The modal damping ratios ([`ModalDamping::damping_ratios`]).
+    pub damping_ratios: Vec<Option<f64>>,
+    /// [`ModalDamping::coupling`].
+    pub modal_damping_coupling: f64,
+    /// The sweep's frequencies (rad/s).
+    pub frequencies: Vec<f64>,
+    /// One sweep per output.
+    pub responses: Vec<FrfSweepSummary>,
+    /// The responses at the frequencies asked for one by one.
+    pub evaluations: Vec<FrfEvaluationSummary>,
+    /// The check by simulation (null without one).
+    pub simulation: Option<FrfSimulationSummary>,
+}
+
+/// A complex response per unit input as `{"re", "im", "amplitude", "phase_deg"}`
+/// (`amplitude = |z|`, `phase_deg = arg z` in degrees by [`phase_degrees`](crate::linear::frequency_response::phase_degrees)).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Phasor {
+    /// `Re z`.
+    pub re: f64,
+    /// `Im z`.
+    pub im: f64,
+    /// `|z|`.
+    pub amplitude: f64,
+    /// `arg z` (degrees, in `[−180, 180)`).
+    pub phase_deg: f64,
+}
+
+impl From<Complex<f64>> for Phasor {
+    fn from(z: Complex<f64>) -> Self {
+        Self {
+            re: z.re,
+            im: z.im,
+            amplitude: z.norm(),
+            phase_deg: crate::linear::frequency_response::phase_degrees(z),
+        }
+    }
+}
+
+/// One output's sweep in an [`FrfSummary`].
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FrfSweepSummary {
+    /// The output's name.
+    pub output: String,
+    /// `|H|` at every frequency (null where unbounded).
+    pub amplitude: Vec<Option<f64>>,
+    /// `arg H` (degrees) at every frequency (null where unbounded).
+    pub phase_deg: Vec<Option<f64>>,
+    /// The resonance peaks.
+    pub peaks: Vec<PeakSummary>,
+}
+
+/// A resonance peak in an [`FrfSummary`]: `amplitude` and `phase_deg` null and `unbounded`
+/// true for an undamped resonance.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct PeakSummary {
+    /// Where `|H|` is largest (rad/s).
+    pub frequency: f64,
+    /// `|H|` there (null when unbounded).
+    pub amplitude: Option<f64>,
+    /// Whether `|H| → ∞` there.
+    pub unbounded: bool,
+    /// `arg H` there (degrees; null when unbounded).
+    pub phase_deg: Option<f64>,
+}
+
+impl From<&crate::linear::frequency_response::ResonancePeak> for PeakSummary {
+    fn from(p: &crate::linear::frequency_response::ResonancePeak) -> Self {
+        match p.amplitude {
+            PeakAmplitude::Finite(a) => Self {
+                frequency: p.frequency,
+                amplitude: Some(a),
+                unbounded: false,
+                phase_deg: p.phase_deg,
+            },
+            PeakAmplitude::Unbounded => Self {
+                frequency: p.frequency,
+                amplitude: None,
+                unbounded: true,
+                phase_deg: None,
+            },
+        }
+    }
+}
+
+/// The response at one frequency asked for, in an [`FrfSummary`].
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FrfEvaluationSummary {
+    /// The frequency (rad/s).
+    pub frequency: f64,
+    /// Each output's response (null when unbounded).
+    pub response: Option<BTreeMap<String, Phasor>>,
+    /// Whether the response is unbounded (an undamped resonance).
+    pub unbounded: bool,
+    /// The modal sum (null unless asked for).
+    pub modal: Option<ModalSumSummary>,
+}
+
+/// The modal sum at one frequency: each mode's terms, their sum per output and how far it
+/// is from the direct solve.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ModalSumSummary {
+    /// One entry per mode.
+    pub modes: Vec<ModalTermSummary>,
+    /// `Σ_k ψ_k η_k` per output.
+    pub sum: BTreeMap<String, Phasor>,
+    /// [`FrfEvaluation::modal_difference`].
+    pub max_relative_difference_from_direct: Option<f64>,
+}
+
+/// One mode's term of a [`ModalSumSummary`].
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ModalTermSummary {
+    /// The mode's number (from 1).
+    pub mode: usize,
+    /// `ωₖ` (rad/s).
+    pub natural_frequency: f64,
+    /// Its damping ratio (null when not defined).
+    pub damping_ratio: Option<f64>,
+    /// `ψ_kᵀ b` per unit input.
+    pub modal_force: f64,
+    /// `η_k` per unit input.
+    pub modal_coordinate: Phasor,
+    /// `ψ_k η_k` per output.
+    pub contributions: BTreeMap<String, Phasor>,
+}
+
+/// The check by simulation in an [`FrfSummary`].
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FrfSimulationSummary {
+    /// The forcing amplitude simulated (units of the input).
+    pub amplitude: f64,
+    /// The parameter set to each frequency.
+    pub frequency_parameter: String,
+    /// The integration's relative tolerance.
+    pub rtol: f64,
+    /// The simulated frequencies.
+    pub points: Vec<SimulatedPointSummary>,
+    /// [`max_simulation_error`].
+    pub max_relative_error: f64,
+}
+
+/// One simulated frequency in an [`FrfSimulationSummary`].
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SimulatedPointSummary {
+    /// The frequency (rad/s).
+    pub frequency: f64,
+    /// The time simulated before the measured period (s).
+    pub settling_time: f64,
+    /// Accepted steps.
+    pub steps: usize,
+    /// Right-hand-side evaluations.
+    pub rhs_evals: usize,
+    /// Each output's simulated and predicted response.
+    pub outputs: BTreeMap<String, SimulatedValueSummary>,
+}
+
+/// One output at one simulated frequency.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct SimulatedValueSummary {
+    /// The response measured from the simulation, per unit input.
+    pub simulated: Phasor,
+    /// The linear prediction, per unit input.
+    pub predicted: Phasor,
+    /// [`SimulatedValue::relative_error`].
+    pub relative_error: f64,
 }

@@ -30,24 +30,32 @@ pub mod modes;
 pub mod operating_point;
 
 pub use floquet::{
-    FloquetCell, FloquetChart, FloquetPoint, FloquetStudyError, FloquetStudyOptions, SweepAxis,
-    floquet_at_equilibrium, floquet_at_equilibrium_for_sweep, floquet_cell,
+    FailedCell, FloquetCell, FloquetChart, FloquetChartSummary, FloquetIntegrationSummary,
+    FloquetPoint, FloquetStudyError, FloquetStudyOptions, FloquetSummary, MultiplierSummary,
+    PredictionSummary, SweepAxis, floquet_at_equilibrium, floquet_at_equilibrium_for_sweep,
+    floquet_cell,
 };
 pub use free_response::{
-    FreeResponseMethod, FreeResponseOptions, FreeResponseStudy, InitialDeviation,
-    ResponseDifference, ResponseStudyError, default_duration, free_response,
-    unconstrained_modal_analysis, uniform_times,
+    FinalState, FreeResponseMethod, FreeResponseOptions, FreeResponseStudy, FreeResponseSummary,
+    InitialDeviation, MethodSummary, ModeSummary, ResponseDifference, ResponseStudyError,
+    default_duration, free_response, unconstrained_modal_analysis, uniform_times,
 };
 pub use frf::{
-    FrfAnalysis, FrfAnalysisError, FrfEvaluation, FrfOptions, FrfOutput, FrfSimulationOptions,
-    FrfSimulationPlan, SimulatedPoint, SimulatedValue, frequency_response_analysis,
-    max_simulation_error, plan_simulation, simulate_point,
+    FrfAnalysis, FrfAnalysisError, FrfEvaluation, FrfEvaluationSummary, FrfOptions, FrfOutput,
+    FrfSimulationOptions, FrfSimulationPlan, FrfSimulationSummary, FrfSummary, FrfSweepSummary,
+    ModalSumSummary, ModalTermSummary, PeakSummary, Phasor, SimulatedPoint, SimulatedPointSummary,
+    SimulatedValue, SimulatedValueSummary, frequency_response_analysis, max_simulation_error,
+    plan_simulation, simulate_point,
 };
 pub use modal_damping::{
-    ModalDampingOptions, ModalDampingStudy, ModalRatio, ModeDamping, RayleighFit, Release,
-    modal_damping_study,
+    ModalDampingOptions, ModalDampingStudy, ModalDampingSummary, ModalRatio, ModeDamping,
+    ModeDampingSummary, RayleighFit, Release, ReleaseSummary, modal_damping_study,
 };
-pub use modes::{DampedEigenvalue, ModalAnalysis, ModalOptions, modal_analysis};
+pub use modes::{
+    DampedEigenvalue, DampedEigenvalueSummary, ModalAnalysis, ModalOptions, ModesSummary,
+    modal_analysis,
+};
 pub use operating_point::{
-    EquilibriumStart, OperatingPoint, OperatingPointError, OperatingPointOptions, operating_point,
+    EquilibriumStart, OperatingPoint, OperatingPointError, OperatingPointOptions, PointSummary,
+    operating_point,
 };

@@ -4,13 +4,15 @@
 //! fitted to two modes — and the free responses from each mode shape: exact (`e^{At}`, checked
 //! by DOP853) against the two approximations.
 
+use nalgebra::DMatrix;
 use serde::Serialize;
 
 use super::free_response::{
     InitialDeviation, ResponseStudyError, check_tolerance, default_duration,
     unconstrained_modal_analysis, uniform_times,
 };
-use super::operating_point::{OperatingPoint, OperatingPointOptions};
+use super::modes::DampedEigenvalueSummary;
+use super::operating_point::{OperatingPoint, OperatingPointOptions, PointSummary};
 use crate::analysis::outcome::{RunTally, StudyRuns};
 use crate::linear::modal::{Linearization, ModeKind, NormalModes};
 use crate::linear::response::{
@@ -149,6 +151,132 @@ pub struct ModalDampingStudy {
 
 /// Each release is a run; a failed response fails the study as a whole
 /// ([`ResponseStudyError::Response`]).
+impl ModalDampingStudy {
+    /// The study as `eomgen study modal-damping --json` prints it ([`ModalDampingSummary`]);
+    /// `model` is the model studied (for its name).
+    pub fn summary(&self, model: &dyn ModelInfo) -> ModalDampingSummary {
+        let (lin, approx) = (&self.linearization, &self.modal_damping);
+        ModalDampingSummary {
+            model: model.description().name.to_string(),
+            coordinates: self.operating_point.coordinates.clone(),
+            operating_point: self.operating_point.summary_at(&lin.q),
+            mass_matrix: lin.mass_matrix.clone(),
+            stiffness_matrix: lin.stiffness_matrix.clone(),
+            damping_matrix: lin.damping_matrix.clone(),
+            modal_damping_matrix: approx.modal_damping_matrix.clone(),
+            coupling: approx.coupling,
+            rayleigh: self.rayleigh,
+            modes: self
+                .modes
+                .iter()
+                .map(|m| ModeDampingSummary {
+                    mode: m.mode,
+                    kind: m.kind.name(),
+                    natural_frequency: m.natural_frequency,
+                    exact: m.exact.as_ref().map(Into::into),
+                    diagonal: m.diagonal,
+                    rayleigh: m.rayleigh,
+                })
+                .collect(),
+            t_end: self.t_end,
+            samples: self.releases.first().map_or(0, |c| c.exact.times.len()),
+            tol: self.tol,
+            cases: self
+                .releases
+                .iter()
+                .map(|c| ReleaseSummary {
+                    name: c.name.clone(),
+                    q0: c.q0.clone(),
+                    qdot0: c.qdot0.clone(),
+                    amplitude: c.amplitude,
+                    integration_vs_exact: c.integration_vs_exact,
+                    diagonal_vs_exact: c.diagonal_vs_exact,
+                    rayleigh_vs_exact: c.rayleigh_vs_exact,
+                })
+                .collect(),
+        }
+    }
+}
+
+/// A [`ModalDampingStudy`] as `eomgen study modal-damping --json` prints it
+/// ([`ModalDampingStudy::summary`]): the matrices as lists of rows, each mode's damping three
+/// ways and each release's differences (the responses themselves left out).
+///
+/// # Shapes
+/// `n` coordinates: the matrices `n × n`, each case's `q0` and `qdot0` `n` entries.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ModalDampingSummary {
+    /// The model's name.
+    pub model: String,
+    /// The coordinates' names.
+    pub coordinates: Vec<String>,
+    /// The operating point at the linearisation's `q`.
+    pub operating_point: PointSummary,
+    /// `M`, as rows.
+    #[serde(serialize_with = "crate::serde_matrix::rows")]
+    pub mass_matrix: DMatrix<f64>,
+    /// `K`, as rows.
+    #[serde(serialize_with = "crate::serde_matrix::rows")]
+    pub stiffness_matrix: DMatrix<f64>,
+    /// `C`, as rows.
+    #[serde(serialize_with = "crate::serde_matrix::rows")]
+    pub damping_matrix: DMatrix<f64>,
+    /// `Ĉ = ΨᵀCΨ`, as rows.
+    #[serde(serialize_with = "crate::serde_matrix::rows")]
+    pub modal_damping_matrix: DMatrix<f64>,
+    /// The off-diagonal share of `Ĉ` ([`ModalDamping::coupling`]).
+    pub coupling: f64,
+    /// The Rayleigh fit, null without one.
+    pub rayleigh: Option<RayleighFit>,
+    /// Each mode's damping.
+    pub modes: Vec<ModeDampingSummary>,
+    /// The end time (s).
+    pub t_end: f64,
+    /// The number of sample times.
+    pub samples: usize,
+    /// The integration's tolerance.
+    pub tol: f64,
+    /// The releases.
+    pub cases: Vec<ReleaseSummary>,
+}
+
+/// One mode of a [`ModalDampingSummary`] ([`ModeDamping`] with its kind by name and the
+/// exact eigenvalue flat).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct ModeDampingSummary {
+    /// The mode's number (from 1).
+    pub mode: usize,
+    /// [`ModeKind::name`].
+    pub kind: &'static str,
+    /// `ω` (rad/s).
+    pub natural_frequency: f64,
+    /// The exact damped eigenvalue, null when none.
+    pub exact: Option<DampedEigenvalueSummary>,
+    /// The modal-damping approximation's ratio.
+    pub diagonal: Option<ModalRatio>,
+    /// The Rayleigh damping's ratio.
+    pub rayleigh: Option<ModalRatio>,
+}
+
+/// One release of a [`ModalDampingSummary`]: [`Release`] without its responses.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ReleaseSummary {
+    /// [`Release::name`].
+    pub name: String,
+    /// `δq₀` (m or rad).
+    pub q0: Vec<f64>,
+    /// `δq̇₀` (m/s or rad/s).
+    pub qdot0: Vec<f64>,
+    /// [`Release::amplitude`] (m or rad).
+    pub amplitude: f64,
+    /// [`Release::integration_vs_exact`].
+    pub integration_vs_exact: f64,
+    /// [`Release::diagonal_vs_exact`].
+    pub diagonal_vs_exact: f64,
+    /// [`Release::rayleigh_vs_exact`].
+    pub rayleigh_vs_exact: Option<f64>,
+}
+
 impl StudyRuns for ModalDampingStudy {
     fn study(&self) -> &'static str {
         "modal-damping"

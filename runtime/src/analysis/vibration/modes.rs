@@ -2,15 +2,17 @@
 //! `M δq̈ + C δq̇ + K δq = 0` there, the undamped normal modes and the damped eigenvalues
 //! (issue 7; lectures 22–26, 30).
 
+use std::collections::BTreeMap;
+
 use nalgebra::{Complex, DMatrix};
 use serde::Serialize;
 
 use super::operating_point::{
-    OperatingPoint, OperatingPointError, OperatingPointOptions, operating_point,
+    OperatingPoint, OperatingPointError, OperatingPointOptions, PointSummary, operating_point,
 };
 use crate::linear::eigenvalues::{LinearStability, linear_stability};
 use crate::linear::modal::{
-    Linearization, ModalError, NormalModes, TimeDependentForcing, damped_modes,
+    Linearization, ModalError, ModeKind, NormalModes, TimeDependentForcing, damped_modes,
     eigenvalues_of_m_inv_k, linearize, normal_modes, time_dependence,
 };
 use crate::model_info::ModelInfo;
@@ -89,6 +91,135 @@ impl ModalAnalysis {
     pub fn mode_shape_matrix(&self) -> DMatrix<f64> {
         self.linearization
             .to_coordinates(&self.normal_modes.mode_shapes)
+    }
+
+    /// The analysis as `eomgen modes --json` prints it ([`ModesSummary`]); `model` is the
+    /// model analysed (for its name and its constraints' names).
+    pub fn summary(&self, model: &dyn ModelInfo) -> ModesSummary {
+        let (lin, modes) = (&self.linearization, &self.normal_modes);
+        ModesSummary {
+            model: model.description().name.to_string(),
+            coordinates: self.operating_point.coordinates.clone(),
+            operating_point: self.operating_point.summary(),
+            natural_frequencies: modes.natural_frequencies.clone(),
+            frequencies_hz: modes
+                .natural_frequencies
+                .iter()
+                .map(|w| w / std::f64::consts::TAU)
+                .collect(),
+            eigenvalues: modes.eigenvalues.clone(),
+            kinds: modes.kinds.clone(),
+            damping_ratios: self.damping_ratios.clone(),
+            damped_modes: self.damped_modes.iter().map(Into::into).collect(),
+            mode_shapes: self.mode_shapes.clone(),
+            minimal_coordinates: self.minimal_coordinates.clone(),
+            lagrange_multipliers: model
+                .description()
+                .constraint_names()
+                .iter()
+                .zip(&lin.lagrange_multipliers)
+                .map(|(c, &v)| (c.to_string(), v))
+                .collect(),
+            mass_matrix: lin.mass_matrix.clone(),
+            stiffness_matrix: lin.stiffness_matrix.clone(),
+            damping_matrix: lin.damping_matrix.clone(),
+            differenced_jacobian_entries: lin.differenced_entries,
+            stiffness_asymmetry: modes.stiffness_asymmetry,
+            m_inv_k_eigenvalues: self.m_inv_k_eigenvalues.clone(),
+            m_inv_k_relative_difference: self.m_inv_k_relative_difference,
+            time_dependent_forcing: self.time_dependent_forcing.clone(),
+        }
+    }
+}
+
+/// A [`ModalAnalysis`] as `eomgen modes --json` prints it ([`ModalAnalysis::summary`]): the
+/// names, the operating point with Newton's figures, the modes with their frequencies in Hz,
+/// the matrices as lists of rows and the checks.
+///
+/// # Shapes
+/// `n` coordinates, `r` minimal coordinates, `m` constraints: `coordinates` `n`,
+/// `natural_frequencies`, `frequencies_hz`, `eigenvalues` and `kinds` `r`, `mode_shapes`
+/// `r` rows of `n`, the matrices `r × r`, `lagrange_multipliers` `m` entries.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ModesSummary {
+    /// The model's name.
+    pub model: String,
+    /// The model's coordinates' names.
+    pub coordinates: Vec<String>,
+    /// The equilibrium, with Newton's iterations and residual.
+    pub operating_point: PointSummary,
+    /// `ωₖ` (rad/s), ascending.
+    pub natural_frequencies: Vec<f64>,
+    /// `ωₖ / 2π` (Hz).
+    pub frequencies_hz: Vec<f64>,
+    /// `ωₖ²` (1/s²; negative for an unstable mode).
+    pub eigenvalues: Vec<f64>,
+    /// What each mode is (serialised as `{"kind", …}`).
+    pub kinds: Vec<ModeKind>,
+    /// `ζ` of each damped mode ([`ModalAnalysis::damping_ratios`]).
+    pub damping_ratios: Vec<f64>,
+    /// The eigenvalues of the state matrix with `Im s ≥ 0`, each flat.
+    pub damped_modes: Vec<DampedEigenvalueSummary>,
+    /// The mass-normalised mode shapes in the model's coordinates ([`ModalAnalysis::mode_shapes`]).
+    pub mode_shapes: Vec<Vec<f64>>,
+    /// The minimal coordinates' names.
+    pub minimal_coordinates: Vec<String>,
+    /// `λ*` by constraint name (the constraint forces at rest; empty without constraints).
+    pub lagrange_multipliers: BTreeMap<String, f64>,
+    /// `M` (`r × r`), as rows.
+    #[serde(serialize_with = "crate::serde_matrix::rows")]
+    pub mass_matrix: DMatrix<f64>,
+    /// `K` (`r × r`), as rows.
+    #[serde(serialize_with = "crate::serde_matrix::rows")]
+    pub stiffness_matrix: DMatrix<f64>,
+    /// `C` (`r × r`), as rows.
+    #[serde(serialize_with = "crate::serde_matrix::rows")]
+    pub damping_matrix: DMatrix<f64>,
+    /// Jacobian entries taken by finite differences ([`Linearization::differenced_entries`]).
+    pub differenced_jacobian_entries: usize,
+    /// [`NormalModes::stiffness_asymmetry`].
+    pub stiffness_asymmetry: f64,
+    /// [`ModalAnalysis::m_inv_k_eigenvalues`] (1/s²).
+    pub m_inv_k_eigenvalues: Vec<f64>,
+    /// [`ModalAnalysis::m_inv_k_relative_difference`].
+    pub m_inv_k_relative_difference: f64,
+    /// [`ModalAnalysis::time_dependent_forcing`] (null when none).
+    pub time_dependent_forcing: Option<TimeDependentForcing>,
+}
+
+/// A damped eigenvalue flat, as reports print it: `{"re", "im", "damping_ratio",
+/// "damped_frequency"}`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct DampedEigenvalueSummary {
+    /// `Re s` (1/s).
+    pub re: f64,
+    /// `Im s` (rad/s).
+    pub im: f64,
+    /// `ζ = −Re s/|s|`.
+    pub damping_ratio: f64,
+    /// `ω_d` (rad/s).
+    pub damped_frequency: f64,
+}
+
+impl From<&DampedEigenvalue> for DampedEigenvalueSummary {
+    fn from(d: &DampedEigenvalue) -> Self {
+        Self {
+            re: d.eigenvalue.re,
+            im: d.eigenvalue.im,
+            damping_ratio: d.damping_ratio,
+            damped_frequency: d.damped_frequency,
+        }
+    }
+}
+
+impl From<&crate::linear::response::DampedMode> for DampedEigenvalueSummary {
+    fn from(d: &crate::linear::response::DampedMode) -> Self {
+        Self {
+            re: d.eigenvalue.re,
+            im: d.eigenvalue.im,
+            damping_ratio: d.damping_ratio,
+            damped_frequency: d.damped_frequency,
+        }
     }
 }
 

@@ -2,6 +2,8 @@
 //! holonomic constraints `F = Jᵀλ*`, `Φ(q*, t) = 0`) found by Newton's method from a named
 //! guess of the model file's `equilibria:` or from explicit coordinates (lecture 25).
 
+use std::collections::BTreeMap;
+
 use serde::Serialize;
 
 use crate::linear::modal::{Equilibrium, ModalError, find_equilibrium};
@@ -95,6 +97,58 @@ impl OperatingPoint {
     /// The equilibrium's coordinates `q*` (length `n`).
     pub fn q(&self) -> &[f64] {
         &self.equilibrium.q
+    }
+
+    /// The point as the studies' reports print it, at the coordinates `q` (length `n`; the
+    /// equilibrium's, or a linearisation's taken there), without Newton's figures.
+    pub fn summary_at(&self, q: &[f64]) -> PointSummary {
+        PointSummary::new(&self.name, &self.coordinates, q)
+    }
+
+    /// The point as `eomgen modes` prints it: name, `q*`, Newton's iterations and residual.
+    pub fn summary(&self) -> PointSummary {
+        PointSummary {
+            newton_iterations: Some(self.equilibrium.iterations),
+            residual: Some(self.equilibrium.residual),
+            ..self.summary_at(&self.equilibrium.q)
+        }
+    }
+}
+
+/// An operating point in a report: `{"name", "q": {coordinate: value}}`, with Newton's
+/// figures where the report gives them.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PointSummary {
+    /// The equilibrium's name ([`OperatingPoint::name`]).
+    pub name: String,
+    /// The coordinates' values by name (m or rad).
+    pub q: BTreeMap<String, f64>,
+    /// Newton iterations used (left out when `None`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub newton_iterations: Option<usize>,
+    /// The residual Newton left ([`Equilibrium::residual`]; left out when `None`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub residual: Option<f64>,
+    /// `max |F(q*, 0, t)|` over a forcing period (a time-periodic model's Floquet analysis;
+    /// left out when `None`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub max_forcing_residual: Option<f64>,
+}
+
+impl PointSummary {
+    /// The point `name` at `q`, one value per name of `coordinates` (`n` each).
+    pub fn new(name: &str, coordinates: &[impl AsRef<str>], q: &[f64]) -> Self {
+        Self {
+            name: name.to_string(),
+            q: coordinates
+                .iter()
+                .zip(q)
+                .map(|(c, &v)| (c.as_ref().to_string(), v))
+                .collect(),
+            newton_iterations: None,
+            residual: None,
+            max_forcing_residual: None,
+        }
     }
 }
 
