@@ -331,5 +331,8 @@ fn command_json_is_the_library_summary() {
     let study = euler_roundoff(&RoundoffOptions { max_n: 3 }).expect("runs");
     let library = serde_json::to_value(study.summary()).unwrap();
     let printed = json_of(&["study", "euler-roundoff", "--max-n", "3", "--json"]);
-    assert!(same_up_to_rounding(&printed, &library), "{printed}\n{library}");
+    assert!(
+        same_up_to_rounding(&printed, &library),
+        "{printed}\n{library}"
+    );
 }

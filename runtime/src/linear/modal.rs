@@ -1389,7 +1389,8 @@ pub fn damped_modes(
             .filter(|s| s.im >= 0.0)
             .map(|s| {
                 let r = s.norm();
-                let zeta = if r == 0.0 { 0.0 } else { -s.re / r };
+                // `s.re == 0` (on the axis) is `ζ = 0`, not `-0`.
+                let zeta = if s.re == 0.0 { 0.0 } else { -s.re / r };
                 (*s, zeta, s.im.abs())
             })
             .collect();
