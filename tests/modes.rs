@@ -1043,3 +1043,25 @@ fn spinning_bowl_is_stable_by_its_whole_linearisation() {
         }
     }
 }
+
+/// Issue 30: `modes` printed both modes of the spinning bowl "unstable, grows as e^(3.897 t)"
+/// (from K alone) and exited 0. Its text now gives the verdict of the whole linearisation
+/// and the gyroscopic frequencies, and labels K's modes as what they are; the JSON carries
+/// the same verdict and eigenvalues under `stability`.
+#[test]
+fn modes_cli_gives_the_gyroscopic_verdict() {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/fixtures/spinning_bowl.yaml"
+    );
+    let text = String::from_utf8(eomgen_ok(&["modes", path]).stdout).unwrap();
+    assert!(!text.contains("unstable, grows"), "{text}");
+    assert!(text.contains("stability  marginally stable"), "{text}");
+    assert!(text.contains("1.0210493510, 8.8536691955 rad/s"), "{text}");
+    let json: serde_json::Value =
+        serde_json::from_slice(&eomgen_ok(&["modes", path, "--json"]).stdout).unwrap();
+    let s = &json["stability"];
+    assert_eq!(s["verdict"], "marginally_stable", "{s}");
+    assert_eq!(s["gyroscopic_part"][1][0], 10.0, "{s}");
+    assert_eq!(s["eigenvalues"].as_array().unwrap().len(), 4, "{s}");
+}

@@ -85,7 +85,9 @@ pub struct LinearStability {
     /// square, are set to zero.
     #[serde(serialize_with = "complex_pairs")]
     pub eigenvalues: Vec<Complex<f64>>,
-    /// The verdict.
+    /// The verdict (in JSON its fields are this object's: `"verdict"` and `"decay_rate"` or
+    /// `"growth_rate"`).
+    #[serde(flatten)]
     pub stability: Stability,
     /// `D = (C + Cᵀ)/2` (`r × r`), the damping part of `C` (rows in JSON).
     #[serde(serialize_with = "crate::serde_matrix::rows")]

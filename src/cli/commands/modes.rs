@@ -3,7 +3,7 @@
 
 use clap::Args;
 use eomgen::analysis::vibration::{self, ModalAnalysis, ModalOptions};
-use eomgen::{ModeKind, ModelInfo};
+use eomgen::{ModeKind, ModelInfo, Stability};
 use nalgebra::DMatrix;
 
 use crate::cli::error::CliError;
@@ -127,6 +127,7 @@ fn print_text(
         damping_ratios,
         m_inv_k_relative_difference: route_difference,
         time_dependent_forcing: forcing,
+        stability,
         ..
     } = modal;
     let (label, equilibrium) = (&point.name, &point.equilibrium);
@@ -194,9 +195,9 @@ fn print_text(
     }
     let _ = writeln!(
         stdout,
-        "{:>4}  {:>16}  {:>14}  {:>10}  mode shape (mass-normalised; {})",
+        "{:>4}  {:>18}  {:>14}  {:>10}  mode shape (mass-normalised; {})",
         "mode",
-        "ω (rad/s)",
+        "undamped ω (rad/s)",
         "f (Hz)",
         "ζ",
         names.join(", ")
@@ -206,9 +207,16 @@ fn print_text(
         let note = match modes.kinds[k] {
             ModeKind::Oscillatory => String::new(),
             ModeKind::ZeroFrequency => "  zero-frequency".to_string(),
-            ModeKind::Unstable { growth_rate } => {
+            // From K alone: the verdict of the whole linearisation only when C = 0.
+            ModeKind::Unstable { growth_rate } if undamped => {
                 format!(
                     "  unstable, grows as e^({growth_rate:.6e} t)",
+                    growth_rate = num(growth_rate)
+                )
+            }
+            ModeKind::Unstable { growth_rate } => {
+                format!(
+                    "  ω² < 0: without C it would grow as e^({growth_rate:.6e} t)",
                     growth_rate = num(growth_rate)
                 )
             }
@@ -222,7 +230,7 @@ fn print_text(
             .map_or("-".to_string(), |z| format!("{z:.4e}", z = num(z)));
         let _ = writeln!(
             stdout,
-            "{:>4}  {:>16.10e}  {:>14.6e}  {:>10}  [{}]{note}",
+            "{:>4}  {:>18.10e}  {:>14.6e}  {:>10}  [{}]{note}",
             k + 1,
             num(w),
             num(w / std::f64::consts::TAU),
@@ -230,6 +238,7 @@ fn print_text(
             shape.join(", ")
         );
     }
+    write_stability(stdout, stability);
     let _ = writeln!(
         stdout,
         "check      eigenvalues of M⁻¹K (lecture 22) vs the symmetric Cholesky route (lecture 24): max difference {route_difference:.1e} of max |ω²|",
@@ -240,6 +249,43 @@ fn print_text(
     }
     if let Some(path) = &args.animate {
         let _ = writeln!(stdout, "animation  {path}");
+    }
+}
+
+/// The verdict of the whole linearisation (`C` included) and, with a gyroscopic part, its
+/// size and the frequencies with it.
+fn write_stability(out: &mut impl std::io::Write, s: &eomgen::LinearStability) {
+    let on_axis = s.eigenvalues.iter().filter(|e| e.re == 0.0).count();
+    let verdict = match s.stability {
+        Stability::Stable { decay_rate } => format!(
+            "stable: every eigenvalue of the linearisation has Re s < 0, the slowest decaying as e^(-{:.6e} t)",
+            num(decay_rate)
+        ),
+        Stability::MarginallyStable => format!(
+            "marginally stable: no eigenvalue of the linearisation has Re s > 0, {on_axis} of {} lie on the imaginary axis",
+            s.eigenvalues.len()
+        ),
+        Stability::Unstable { growth_rate } => format!(
+            "unstable: the largest Re s of the linearisation grows as e^({:.6e} t)",
+            num(growth_rate)
+        ),
+    };
+    let _ = writeln!(out, "stability  {verdict}");
+    if let Some(frequencies) = &s.gyroscopic_frequencies {
+        let w: Vec<String> = frequencies
+            .iter()
+            .map(|w| format!("{:.10e}", num(w)))
+            .collect();
+        let listed = if w.is_empty() {
+            "none on the imaginary axis".to_string()
+        } else {
+            format!("{} rad/s", w.join(", "))
+        };
+        let _ = writeln!(
+            out,
+            "gyroscopic C has a skew part G = (C − Cᵀ)/2 (max |G| = {:.6e}); the frequencies of M q̈ + G q̇ + K q = 0: {listed}",
+            num(s.gyroscopic_part.amax())
+        );
     }
 }
 

@@ -128,6 +128,7 @@ impl ModalAnalysis {
             m_inv_k_eigenvalues: self.m_inv_k_eigenvalues.clone(),
             m_inv_k_relative_difference: self.m_inv_k_relative_difference,
             time_dependent_forcing: self.time_dependent_forcing.clone(),
+            stability: self.stability.clone(),
         }
     }
 }
@@ -185,6 +186,9 @@ pub struct ModesSummary {
     pub m_inv_k_relative_difference: f64,
     /// [`ModalAnalysis::time_dependent_forcing`] (null when none).
     pub time_dependent_forcing: Option<TimeDependentForcing>,
+    /// [`ModalAnalysis::stability`]: the verdict from the whole linearisation, its
+    /// eigenvalues, the symmetric and skew parts of `C`, the gyroscopic frequencies.
+    pub stability: LinearStability,
 }
 
 /// A damped eigenvalue flat, as reports print it: `{"re", "im", "damping_ratio",
