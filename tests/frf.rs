@@ -664,3 +664,31 @@ fn issue_28_cli_frf_ignores_underflow_of_other_outputs() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Issue 30: for the gyroscopic spinning bowl (`K` negative definite) `frf` refused to pick a
+/// range ("no oscillatory mode"), and with one listed `ω = 0` twice and "off-diagonal inf
+/// of the diagonal". Its mode table is now the whole linearisation's — the closed-form
+/// gyroscopic frequencies (tests/modes.rs) — the range is chosen from them, and the
+/// resonances of the sweep lie at them.
+#[test]
+fn a_gyroscopic_model_gets_its_own_modes_and_range() {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/fixtures/spinning_bowl.yaml"
+    );
+    let out = eomgen(&["frf", path, "--input", "F0"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(!text.contains("inf"), "{text}");
+    assert!(text.contains("   1      1.0210493510"), "{text}");
+    assert!(text.contains("   2      8.8536691955"), "{text}");
+    assert!(text.contains("C has a gyroscopic part"), "{text}");
+    assert!(
+        text.contains("peak  x    ω = 8.8536691955 rad/s  |H| unbounded"),
+        "{text}"
+    );
+}

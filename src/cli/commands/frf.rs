@@ -283,13 +283,36 @@ fn print_report(
         column.join(", "),
         args.input
     );
-    let _ = writeln!(out, "{:>4}  {:>16}  {:>12}", "mode", "ω (rad/s)", "ζ");
-    for (k, w) in modes.natural_frequencies.iter().enumerate() {
-        let zeta =
-            damping.damping_ratios[k].map_or("-".to_string(), |z| format!("{z:.6e}", z = num(z)));
-        let _ = writeln!(out, "{:>4}  {:>16.10e}  {:>12}", k + 1, num(w), zeta);
+    let gyroscopic = frf.stability.gyroscopic_frequencies.is_some();
+    if gyroscopic {
+        // The undamped modes of K are not the system's: the whole linearisation's are.
+        let _ = writeln!(out, "{:>4}  {:>16}  {:>12}", "mode", "|s| (rad/s)", "ζ");
+        let upper = frf.stability.eigenvalues.iter().filter(|s| s.im > 0.0);
+        for (k, s) in upper.enumerate() {
+            let zeta = -s.re / s.norm() + 0.0;
+            let _ = writeln!(
+                out,
+                "{:>4}  {:>16.10e}  {:>12.6e}",
+                k + 1,
+                num(s.norm()),
+                num(zeta)
+            );
+        }
+        let _ = writeln!(
+            out,
+            "note       C has a gyroscopic part G = (C − Cᵀ)/2 (max |G| = {:.6e}): the modes above are the eigenvalues s of the whole linearisation ({}), and modal sums over the undamped modes of K do not apply",
+            num(frf.stability.gyroscopic_part.amax()),
+            frf.stability.stability.name()
+        );
+    } else {
+        let _ = writeln!(out, "{:>4}  {:>16}  {:>12}", "mode", "ω (rad/s)", "ζ");
+        for (k, w) in modes.natural_frequencies.iter().enumerate() {
+            let zeta = damping.damping_ratios[k]
+                .map_or("-".to_string(), |z| format!("{z:.6e}", z = num(z)));
+            let _ = writeln!(out, "{:>4}  {:>16.10e}  {:>12}", k + 1, num(w), zeta);
+        }
     }
-    if damping.coupling > 1e-12 {
+    if !gyroscopic && damping.coupling > 1e-12 {
         let _ = writeln!(
             out,
             "note       ΨᵀCΨ is not diagonal (off-diagonal {:.2e} of the diagonal): the modal sum drops the coupling",

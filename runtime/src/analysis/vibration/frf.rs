@@ -16,6 +16,7 @@ use serde::Serialize;
 use super::operating_point::{
     OperatingPoint, OperatingPointError, OperatingPointOptions, PointSummary,
 };
+use crate::linear::eigenvalues::{LinearStability, linear_stability};
 use crate::linear::frequency_response::{
     ForcedLinearization, FrequencySweep, FrfError, HarmonicForcing, ModalResponse, PeakAmplitude,
     SteadyStateOptions, frequency_response, frequency_response_of, frequency_sweep,
@@ -258,6 +259,10 @@ pub struct FrfAnalysis {
     pub normal_modes: NormalModes,
     /// `ΨᵀCΨ` and the modal damping ratios.
     pub modal_damping: ModalDamping,
+    /// The stability of the equilibrium from the whole linearisation, with the damping and
+    /// gyroscopic parts of `C` ([`linear_stability`]); with a gyroscopic part the undamped
+    /// modes are not the system's, and neither are the modal sums over them.
+    pub stability: LinearStability,
     /// The sweep's range (rad/s).
     pub frequency_range: (f64, f64),
     /// The sweep's frequencies (rad/s, log-spaced).
@@ -338,14 +343,24 @@ pub fn frequency_response_analysis(
     let lin = &forced.linearization;
     let modes = normal_modes(lin).map_err(FrfError::from)?;
     let damping = modal_damping(lin, &modes);
+    let stability = linear_stability(lin).map_err(FrfError::from)?;
+    // Without an undamped oscillation (a gyroscopic system whose K is not positive), the
+    // oscillations of the whole linearisation set the range.
+    let mut oscillations: Vec<f64> = stability
+        .eigenvalues
+        .iter()
+        .filter(|s| s.im > 0.0)
+        .map(|s| s.im)
+        .collect();
+    oscillations.sort_by(f64::total_cmp);
     let (lo, hi) = match options.frequency_range {
         Some(range) => range,
-        None => default_range(&modes.natural_frequencies).ok_or_else(|| {
-            FrfAnalysisError::NoFrequencyRange {
+        None => default_range(&modes.natural_frequencies)
+            .or_else(|| default_range(&oscillations))
+            .ok_or_else(|| FrfAnalysisError::NoFrequencyRange {
                 model: model.description().name.to_string(),
                 operating_point: label.clone(),
-            }
-        })?,
+            })?,
     };
     let frequencies =
         log_frequencies(lo, hi, options.points).map_err(FrfAnalysisError::FrequencyRange)?;
@@ -394,6 +409,7 @@ pub fn frequency_response_analysis(
         outputs,
         normal_modes: modes,
         modal_damping: damping,
+        stability,
         frequency_range: (lo, hi),
         frequencies,
         sweeps,
@@ -708,6 +724,7 @@ impl FrfAnalysis {
             natural_frequencies: modes.natural_frequencies.clone(),
             damping_ratios: damping.damping_ratios.clone(),
             modal_damping_coupling: damping.coupling,
+            stability: self.stability.clone(),
             frequencies: self.frequencies.clone(),
             responses: outputs
                 .iter()
@@ -795,6 +812,8 @@ pub struct FrfSummary {
     pub evaluations: Vec<FrfEvaluationSummary>,
     /// The check by simulation (null without one).
     pub simulation: Option<FrfSimulationSummary>,
+    /// [`FrfAnalysis::stability`].
+    pub stability: LinearStability,
 }
 
 /// A complex response per unit input as `{"re", "im", "amplitude", "phase_deg"}`
