@@ -27,13 +27,14 @@ use eomgen_symbolic::model::{
     DEFAULT_CONSTRAINT_DRIFT, DEFAULT_ENERGY_DRIFT, Diagnostic, Expr, Location, ModelFile,
 };
 
-/// Relative tolerance of the derivation cross-checks, as `eomgen check`: the derivations
-/// differ only by rounding (~1e-14).
-pub const DERIVATION_TOLERANCE: f64 = 1e-8;
-/// Random states of the derivation cross-checks.
+/// Relative tolerance of the derivation cross-checks, as `eomgen check`'s.
+pub const DERIVATION_TOLERANCE: f64 = eomgen_symbolic::mechanics::cross_check::CHECK_TOLERANCE;
+/// Random states of the report's derivation cross-checks: half of `eomgen check`'s default
+/// ([`eomgen_symbolic::mechanics::cross_check::DEFAULT_CHECK_STATES`]), as the report runs
+/// every model.
 pub const DERIVATION_STATES: usize = 100;
-/// Seed of the derivation cross-checks' random states.
-pub const DERIVATION_SEED: u64 = 0x5EED;
+/// Seed of the derivation cross-checks' random states, as `eomgen check`'s.
+pub const DERIVATION_SEED: u64 = eomgen_symbolic::mechanics::cross_check::CHECK_SEED;
 /// Default end time of a check's simulation (s).
 pub const DEFAULT_T_END: f64 = 10.0;
 /// Default relative and absolute tolerance of a check's simulation.

@@ -7,11 +7,9 @@ use crate::cli::json::print_json_sorted;
 use crate::cli::output::outln;
 use crate::cli::render::num;
 use eomgen_symbolic::mechanics::cross_check::{
-    CheckReport, INITIAL_CONSTRAINT_TOLERANCE, check_model,
+    CHECK_SEED, CHECK_TOLERANCE as TOLERANCE, CheckReport, DEFAULT_CHECK_STATES,
+    INITIAL_CONSTRAINT_TOLERANCE, check_model,
 };
-
-/// Relative tolerance of every check: the derivations differ only by rounding (~1e-14).
-const TOLERANCE: f64 = 1e-8;
 
 /// Options of `eomgen check`.
 #[derive(Debug, Args)]
@@ -19,7 +17,7 @@ pub struct CheckArgs {
     /// A bundled model's name, or the path of any model file (`path/to/x.yaml`).
     pub model: String,
     /// Number of random states (1 to 100000).
-    #[arg(long, default_value_t = 200, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..=100_000))]
+    #[arg(long, default_value_t = DEFAULT_CHECK_STATES, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..=100_000))]
     pub states: usize,
     /// Print the report as JSON (byte-identical across runs: derivation times are left out
     /// unless `--timing` is given).
@@ -35,7 +33,7 @@ pub fn run(args: &CheckArgs) -> Result<(), CliError> {
     let (display, source) = crate::cli::model::read_model(&args.model)?;
     let file = eomgen_symbolic::model::load(&display, &source)
         .map_err(|d| crate::cli::model::diagnostics_error(&display, &source, &d))?;
-    let report = check_model(&file, args.states, 0x5EED).map_err(|diagnostics| {
+    let report = check_model(&file, args.states, CHECK_SEED).map_err(|diagnostics| {
         crate::cli::model::diagnostics_error(&display, &source, &diagnostics)
     })?;
     if args.json {

@@ -58,6 +58,16 @@ pub struct PowerBalance {
 /// (`make_consistent`): a start farther from `Φ = 0` or `Φ̇ = 0` is refused by `simulate`.
 pub const INITIAL_CONSTRAINT_TOLERANCE: f64 = 1e-9;
 
+/// Relative tolerance of the cross-checks (`eomgen check`, the report's derivation rows): the
+/// derivations differ only by rounding (~1e-14).
+pub const CHECK_TOLERANCE: f64 = 1e-8;
+
+/// Random states `eomgen check` compares by default.
+pub const DEFAULT_CHECK_STATES: usize = 200;
+
+/// Seed of the random states (the same states on every run).
+pub const CHECK_SEED: u64 = 0x5EED;
+
 /// The constraint residuals of the file's `initial:` state (t = 0, parameters at their
 /// defaults), when no coordinate is a `{ guess: … }` (else the runtime solves the start).
 #[derive(Debug, Clone, PartialEq)]
