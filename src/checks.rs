@@ -339,7 +339,15 @@ pub fn derivation_checks(
             eomgen_symbolic::mechanics::cross_check::INITIAL_CONSTRAINT_TOLERANCE,
         ));
     }
-    Ok((rows, r.notes))
+    // The reason of "not cross-checked" is its row's; not a note as well.
+    let reason = r.not_cross_checked();
+    let notes = r
+        .notes
+        .iter()
+        .filter(|n| Some(n.as_str()) != reason)
+        .cloned()
+        .collect();
+    Ok((rows, notes))
 }
 
 /// Parses an expression of the model's description (printed from the parsed file, so it

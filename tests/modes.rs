@@ -1020,7 +1020,8 @@ fn spinning_bowl_is_stable_by_its_whole_linearisation() {
             }
             assert!(s.eigenvalues.iter().all(|e| e.re == 0.0));
         } else {
-            // x complex: s = ±√x, growth rate max Re √x over the roots.
+            // Not both roots x = s² negative (here real, of opposite signs): s = ±√x, the
+            // growth rate the largest Re √x.
             let roots = [
                 nalgebra::Complex::new(-p, 0.0) / 2.0
                     + nalgebra::Complex::new(disc, 0.0).sqrt() / 2.0,

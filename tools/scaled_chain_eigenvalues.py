@@ -1,9 +1,9 @@
 #!/usr/bin/env python3
-"""Reference eigenvalues of a badly scaled spring-mass chain, to 40 digits (mpmath).
+"""Reference eigenvalues of a badly scaled spring-mass chain, to 60 digits (mpmath).
 
 Six masses from 1e-3 to 2 kg between two walls, seven springs from 0.5 to 1e6 N/m, once
 undamped and once with a dashpot beside each spring. The eigenvalues of the state matrix
-A = [0 I; -M^-1 K; -M^-1 C] are computed with mpmath's eigensolver at 60 significant digits
+A = [0 I; -M^-1 K  -M^-1 C] are computed with mpmath's eigensolver at 60 significant digits
 and written, rounded to 17, with the matrices, to runtime/tests/fixtures/scaled_chain.json,
 which the runtime's eigenvalue tests compare with (`cargo test -p eomgen-runtime --test
 vibration scaled_chain`).

@@ -2,8 +2,8 @@
 //! damping and gyroscopic terms included — accurate on badly scaled models, and the
 //! stability verdict they give (lectures 25–26, 30–32).
 //!
-//! `C` is split into its symmetric part `D = (C + Cᵀ)/2` (damping: dissipates `½ q̇ᵀD q̇`
-//! per unit time when positive semi-definite) and its skew part `G = (C − Cᵀ)/2` (gyroscopic:
+//! `C` is split into its symmetric part `D = (C + Cᵀ)/2` (damping: the energy falls at the
+//! rate `q̇ᵀD q̇` when it is positive semi-definite) and its skew part `G = (C − Cᵀ)/2` (gyroscopic:
 //! velocity-dependent forces of a rotating or moving frame, which do no work). A verdict
 //! taken from `K` alone is wrong exactly where `G` matters: a particle in a spinning bowl
 //! with `K` negative definite is stable when the spin is fast enough (gyroscopic
@@ -16,20 +16,20 @@
 //! With `M = L Lᵀ` and `δq = L⁻ᵀ x`, the system is `ẍ + C̃ ẋ + K̃ x = 0` with
 //! `C̃ = L⁻¹ C L⁻ᵀ`, `K̃ = L⁻¹ K L⁻ᵀ`: the masses no longer scale the problem.
 //!
-//! - `C = 0`: the eigenvalues are `±√(−ω²)` from the symmetric eigenvalues `ω²` of `K̃`
-//!   ([`super::modal::normal_modes`]): exactly on the imaginary axis, as accurate as the
-//!   symmetric solver.
-//! - otherwise: the eigenvalues of `[0 sI; −K̃/s −C̃]` (similar to the state matrix, with
-//!   `s = √‖K̃‖` balancing the two blocks) by nalgebra's real Schur decomposition, each then
-//!   refined by Newton's method on `det P(λ) = 0`, `P(λ) = λ²I + λC̃ + K̃`, with the
-//!   two-sided Rayleigh functional (`λ ← λ − wᴴPv / wᴴP′v`, `v` and `w` from one inverse
-//!   iteration with the LU factors of `P(λ)`; Ruhe, SIAM J. Numer. Anal. 10 (1973)
-//!   674–689; Tisseur, Linear Algebra Appl. 309 (2000) 339–361 for the backward errors).
-//!   The Schur eigenvalue carries an error of `ε‖A‖`, which for a chain with stiffnesses
-//!   from 0.5 to 1e6 and masses from 1e-3 to 2 is 4e-8 of its slowest mode; the refinement
-//!   brings each simple eigenvalue to rounding of its own size.
+//! The eigenvalues of `[0 sI; −K̃/s −C̃]` (similar to the state matrix, with `s = √‖K̃‖`
+//! balancing the two blocks) by nalgebra's real Schur decomposition, each then refined by
+//! Newton's method on `det P(λ) = 0`, `P(λ) = λ²I + λC̃ + K̃`, with the two-sided Rayleigh
+//! functional (`λ ← λ − wᴴPv / wᴴP′v`, `v` and `w` from one inverse iteration with the LU
+//! factors of `P(λ)`; Ruhe, SIAM J. Numer. Anal. 10 (1973) 674–689; Tisseur, Linear Algebra
+//! Appl. 309 (2000) 339–361 for the backward errors), never farther than half-way to the
+//! nearest other eigenvalue. The Schur eigenvalue carries an error of `ε‖A‖`, which for a
+//! chain with stiffnesses from 0.5 to 1e6 and masses from 1e-3 to 2 is 1.6e-8 of its slowest
+//! mode; the refinement brings each simple eigenvalue to rounding of its own size. A
+//! multiple eigenvalue (rigid-body modes, repeated frequencies of a symmetric structure)
+//! keeps its Schur value. Real parts below [`ZERO_REAL_PART`] of `|s|` are then set to 0,
+//! which puts undamped and gyroscopic oscillations exactly on the imaginary axis.
 
-use nalgebra::{Complex, DMatrix, SymmetricEigen};
+use nalgebra::{Complex, DMatrix};
 
 use super::modal::{Linearization, ModalError};
 
@@ -38,10 +38,10 @@ use super::modal::{Linearization, ModalError};
 /// than 1e-9 of an oscillation's frequency is not resolved by a linearisation either.
 pub const ZERO_REAL_PART: f64 = 1e-9;
 
-/// An eigenvalue whose square is below this fraction of the largest square is zero (a
-/// rigid-body mode): as for the normal modes' `ω²` (`K̃`'s rounding is a few hundred `ε` of
-/// its largest eigenvalue), and a double zero eigenvalue, split by rounding into `±√ε`-sized
-/// values, falls under it.
+/// An eigenvalue is zero (a rigid-body mode) below this fraction of the largest modulus when
+/// Newton converged on it (rounding of the largest is a few hundred `ε` of it), and when its
+/// *square* is below this fraction of the largest square when Newton could not (a multiple
+/// eigenvalue: a double zero is split by rounding into `±√ε`-sized values).
 pub const ZERO_EIGENVALUE: f64 = 1e-13;
 
 /// The linear stability of an operating point, from the eigenvalues of its state matrix.
@@ -56,7 +56,9 @@ pub enum Stability {
     },
     /// No eigenvalue has a positive real part and some lie on the imaginary axis:
     /// undamped or gyroscopic oscillations that neither grow nor decay, or zero eigenvalues
-    /// (rigid-body modes, which drift) — stable to linear order only.
+    /// — stable to linear order only. A repeated eigenvalue on the axis can still grow
+    /// linearly in time: a rigid-body mode drifts, and at the boundary of gyroscopic
+    /// stability two frequencies merge.
     MarginallyStable,
     /// Some eigenvalue has a positive real part: a disturbance grows like `e^{σ t}`.
     Unstable {
@@ -81,8 +83,8 @@ impl Stability {
 pub struct LinearStability {
     /// The `2r` eigenvalues `s` (1/s; `[re, im]` in JSON), by ascending `|s|`, then `Im s`;
     /// a complex pair appears as both conjugates. Real parts below [`ZERO_REAL_PART`] of
-    /// `|s|`, and eigenvalues whose square is below [`ZERO_EIGENVALUE`] of the largest
-    /// square, are set to zero.
+    /// `|s|`, and eigenvalues at rounding of the largest ([`ZERO_EIGENVALUE`]), are set to
+    /// zero.
     #[serde(serialize_with = "complex_pairs")]
     pub eigenvalues: Vec<Complex<f64>>,
     /// The verdict (in JSON its fields are this object's: `"verdict"` and `"decay_rate"` or
@@ -181,9 +183,9 @@ pub fn linear_stability(lin: &Linearization) -> Result<LinearStability, ModalErr
 }
 
 /// The `2r` eigenvalues of the state matrix `[0 I; −M⁻¹K −M⁻¹C]` of `lin`, accurate to
-/// rounding of each one's own size (see the module documentation), sorted by ascending
-/// `|s|` then `Im s`; real parts below [`ZERO_REAL_PART`] of `|s|` and eigenvalues
-/// whose square is below [`ZERO_EIGENVALUE`] of the largest square are set to zero.
+/// rounding of each one's own size where simple (see the module documentation), sorted by
+/// ascending `|s|` then `Im s`; real parts below [`ZERO_REAL_PART`] of `|s|` and eigenvalues
+/// at rounding of the largest ([`ZERO_EIGENVALUE`]) are set to zero.
 ///
 /// # Errors
 /// As [`linear_stability`].
@@ -214,79 +216,101 @@ pub fn state_eigenvalues(lin: &Linearization) -> Result<Vec<Complex<f64>>, Modal
     if !k.iter().chain(c.iter()).all(|v| v.is_finite()) {
         return Err(not_finite());
     }
-    let symmetric_k = (&k - k.transpose()).amax() == 0.0;
-    let mut values: Vec<Complex<f64>> = if c.iter().all(|v| *v == 0.0) && symmetric_k {
-        // Undamped and conservative: ±√(−ω²), exactly on an axis.
-        let eigen = SymmetricEigen::new(k);
-        eigen
-            .eigenvalues
-            .iter()
-            .flat_map(|&w2| {
-                if w2 >= 0.0 {
-                    let w = w2.sqrt();
-                    [Complex::new(0.0, w), Complex::new(0.0, -w)]
-                } else {
-                    let s = (-w2).sqrt();
-                    [Complex::new(s, 0.0), Complex::new(-s, 0.0)]
-                }
-            })
-            .collect()
-    } else {
-        let s = k.amax().sqrt().max(c.amax()).max(f64::MIN_POSITIVE);
-        let mut a = DMatrix::zeros(2 * r, 2 * r);
-        for i in 0..r {
-            a[(i, r + i)] = s;
-            for j in 0..r {
-                a[(r + i, j)] = -k[(i, j)] / s;
-                a[(r + i, r + j)] = -c[(i, j)];
-            }
-        }
-        let rough = a.complex_eigenvalues();
-        if !rough.iter().all(|v| v.re.is_finite() && v.im.is_finite()) {
-            return Err(not_finite());
-        }
-        // Refine the upper half-plane and the real axis; conjugates mirror them.
-        let mut out = Vec::with_capacity(2 * r);
-        for &s0 in rough.iter().filter(|v| v.im >= 0.0) {
-            let refined = refine(&k, &c, s0);
-            if s0.im == 0.0 {
-                out.push(Complex::new(refined.re, 0.0));
-            } else {
-                out.push(refined);
-                out.push(refined.conj());
-            }
-        }
-        out
-    };
-    let largest = values.iter().map(|v| v.norm_sqr()).fold(0.0, f64::max);
-    for v in &mut values {
-        if v.norm_sqr() <= ZERO_EIGENVALUE * largest {
-            *v = Complex::new(0.0, 0.0);
-        } else if v.re.abs() <= ZERO_REAL_PART * v.norm() {
-            v.re = 0.0;
+    let s = k.amax().sqrt().max(c.amax()).max(f64::MIN_POSITIVE);
+    let mut a = DMatrix::zeros(2 * r, 2 * r);
+    for i in 0..r {
+        a[(i, r + i)] = s;
+        for j in 0..r {
+            a[(r + i, j)] = -k[(i, j)] / s;
+            a[(r + i, r + j)] = -c[(i, j)];
         }
     }
-    values.sort_by(|a, b| a.norm().total_cmp(&b.norm()).then(a.im.total_cmp(&b.im)));
-    Ok(values)
+    let rough: Vec<Complex<f64>> = a.complex_eigenvalues().iter().copied().collect();
+    if !rough.iter().all(|v| v.re.is_finite() && v.im.is_finite()) {
+        return Err(not_finite());
+    }
+    // Refine the upper half-plane and the real axis; conjugates mirror them. Each value
+    // remembers whether Newton converged on it (a simple eigenvalue, now accurate to its own
+    // size) or not (a multiple one, as Schur left it).
+    let mut values: Vec<(Complex<f64>, bool)> = Vec::with_capacity(2 * r);
+    for (index, &s0) in rough.iter().enumerate() {
+        if s0.im < 0.0 {
+            continue;
+        }
+        // Newton may not move farther than half-way to the nearest other Schur value.
+        let reach = rough
+            .iter()
+            .enumerate()
+            .filter(|&(other, _)| other != index)
+            .map(|(_, v)| (v - s0).norm())
+            .fold(f64::INFINITY, f64::min)
+            / 2.0;
+        let (refined, converged) = refine(&k, &c, s0, reach);
+        if s0.im == 0.0 {
+            values.push((Complex::new(refined.re, 0.0), converged));
+        } else {
+            values.push((refined, converged));
+            values.push((refined.conj(), converged));
+        }
+    }
+    let largest = values.iter().map(|(v, _)| v.norm()).fold(0.0, f64::max);
+    let mut out: Vec<Complex<f64>> = values
+        .into_iter()
+        .map(|(mut v, converged)| {
+            // A converged value is zero only at rounding of the largest; one Newton could
+            // not resolve (a double zero split into ±√ε-sized values) by its square.
+            let zero = if converged {
+                v.norm() <= ZERO_EIGENVALUE * largest
+            } else {
+                v.norm_sqr() <= ZERO_EIGENVALUE * largest * largest
+            };
+            if zero {
+                v = Complex::new(0.0, 0.0);
+            } else if v.re.abs() <= ZERO_REAL_PART * v.norm() {
+                v.re = 0.0;
+            }
+            v
+        })
+        .collect();
+    out.sort_by(|a, b| a.norm().total_cmp(&b.norm()).then(a.im.total_cmp(&b.im)));
+    Ok(out)
 }
 
 /// Newton steps on `det P(λ) = 0`, `P(λ) = λ²I + λC + K`, from `s0` with the two-sided
-/// Rayleigh functional; `s0` itself when a step fails or wanders (a multiple eigenvalue, a
-/// singular factorisation), and at most four steps.
-fn refine(k: &DMatrix<f64>, c: &DMatrix<f64>, s0: Complex<f64>) -> Complex<f64> {
+/// Rayleigh functional, never farther than `reach` from `s0` (half-way to the nearest other
+/// eigenvalue); at most eight steps. Returns the value and whether Newton converged (its
+/// last step below `4ε|λ|`, or below `1e-10|λ|` when rounding stalls it); `s0` unconverged
+/// when a step fails or would leave `reach` (a multiple eigenvalue); converged at once where
+/// `P(λ)` is singular to working precision.
+///
+/// The right-hand side of the inverse iteration is a fixed irregular vector, not all ones,
+/// which an antisymmetric mode of a symmetric structure is orthogonal to.
+fn refine(
+    k: &DMatrix<f64>,
+    c: &DMatrix<f64>,
+    s0: Complex<f64>,
+    reach: f64,
+) -> (Complex<f64>, bool) {
     let r = k.nrows();
     let kc = k.map(|v| Complex::new(v, 0.0));
     let cc = c.map(|v| Complex::new(v, 0.0));
     let identity = DMatrix::<Complex<f64>>::identity(r, r);
+    // Entries 1 + frac(i φ), φ the golden ratio: irregular, deterministic, real (so that a
+    // real eigenvalue stays real).
+    let b = nalgebra::DVector::from_fn(r, |i, _| {
+        Complex::new(1.0 + ((i + 1) as f64 * 0.618_033_988_749_895).fract(), 0.0)
+    });
     let mut s = s0;
-    for _ in 0..4 {
+    let mut last = f64::INFINITY;
+    for _ in 0..8 {
         let p = &identity * (s * s) + &cc * s + &kc;
         let dp = &identity * (s * 2.0) + &cc;
-        let lu = p.clone().lu();
-        let ones = nalgebra::DVector::from_element(r, Complex::new(1.0, 0.0));
-        let Some(v) = lu.solve(&ones) else { break };
-        let Some(w) = p.adjoint().lu().solve(&ones) else {
-            break;
+        // A singular `P(s)`: `s` is an eigenvalue to working precision.
+        let Some(v) = p.clone().lu().solve(&b) else {
+            return (s, true);
+        };
+        let Some(w) = p.adjoint().lu().solve(&b) else {
+            return (s, true);
         };
         let numerator = w.dotc(&(&p * &v));
         let denominator = w.dotc(&(&dp * &v));
@@ -298,17 +322,21 @@ fn refine(k: &DMatrix<f64>, c: &DMatrix<f64>, s0: Complex<f64>) -> Complex<f64> 
             break;
         }
         let next = s - step;
-        // A step far from where the Schur value put it has left its eigenvalue.
-        if (next - s0).norm() > 1e-6 * s0.norm().max(f64::MIN_POSITIVE) {
-            return s0;
-        }
-        let done = step.norm() <= 4.0 * f64::EPSILON * next.norm();
-        s = next;
-        if done {
+        if (next - s0).norm() > reach {
             break;
         }
+        s = next;
+        last = step.norm();
+        if last <= 4.0 * f64::EPSILON * s.norm() {
+            return (s, true);
+        }
     }
-    s
+    // Steps that stall a little above rounding have still converged.
+    if last <= 1e-10 * s.norm() {
+        (s, true)
+    } else {
+        (s0, false)
+    }
 }
 
 #[cfg(test)]
@@ -400,5 +428,87 @@ mod tests {
         let s = linear_stability(&free).unwrap();
         assert_eq!(s.stability, Stability::MarginallyStable);
         assert_eq!(&s.eigenvalues[..2], &[Complex::new(0.0, 0.0); 2]);
+    }
+
+    /// A light mass on a stiff dashpot, `m s² + c s + k = 0` with `m = 1e-4`, `c = 100`:
+    /// roots near `−k/c` and `−c/m`, 1e8 apart. With `k = −1` the slow root `+0.01` grows —
+    /// "unstable", not zeroed beside the fast one; with `k = +1` it decays — "stable".
+    #[test]
+    fn a_slow_root_beside_a_fast_one_keeps_its_sign() {
+        let (m, c) = (1e-4, 100.0);
+        for k in [-1.0f64, 1.0] {
+            let lin = Linearization::from_matrices(
+                DMatrix::from_element(1, 1, m),
+                DMatrix::from_element(1, 1, k),
+                DMatrix::from_element(1, 1, c),
+            );
+            // The root of smaller modulus, without cancellation: 2k / (−c − √(c² − 4mk)).
+            let slow = 2.0 * k / (-c - (c * c - 4.0 * m * k).sqrt());
+            let s = linear_stability(&lin).unwrap();
+            match s.stability {
+                Stability::Unstable { growth_rate } if k < 0.0 => {
+                    assert!(
+                        (growth_rate - slow).abs() <= 1e-12 * slow.abs(),
+                        "{growth_rate} {slow}"
+                    )
+                }
+                Stability::Stable { decay_rate } if k > 0.0 => {
+                    assert!(
+                        (decay_rate + slow).abs() <= 1e-12 * slow.abs(),
+                        "{decay_rate} {slow}"
+                    )
+                }
+                other => panic!("k = {k}: {other:?}"),
+            }
+        }
+    }
+
+    /// A symmetric damped chain of four masses (mirror-symmetric: half its modes are
+    /// antisymmetric, orthogonal to a vector of ones) has eight distinct eigenvalues, each
+    /// an exact root of `det(s²M + sC + K)`: the refinement neither skips the antisymmetric
+    /// modes nor lands two values on one eigenvalue.
+    #[test]
+    fn antisymmetric_modes_of_a_symmetric_chain_are_refined_too() {
+        let m = DMatrix::from_diagonal(&nalgebra::DVector::from_vec(vec![1.0, 3.0, 3.0, 1.0]));
+        let chain = |a: f64, b: f64| {
+            DMatrix::from_row_slice(
+                4,
+                4,
+                &[
+                    a + b,
+                    -b,
+                    0.0,
+                    0.0,
+                    -b,
+                    2.0 * b,
+                    -b,
+                    0.0,
+                    0.0,
+                    -b,
+                    2.0 * b,
+                    -b,
+                    0.0,
+                    0.0,
+                    -b,
+                    a + b,
+                ],
+            )
+        };
+        let (k, c) = (chain(50.0, 1e4), chain(0.01, 0.5));
+        let lin = Linearization::from_matrices(m.clone(), k.clone(), c.clone());
+        let values = state_eigenvalues(&lin).unwrap();
+        assert_eq!(values.len(), 8);
+        for (i, &a) in values.iter().enumerate() {
+            for b in &values[i + 1..] {
+                assert!((a - b).norm() > 1e-6 * a.norm(), "{a} repeated as {b}");
+            }
+            // The smallest singular value of P(s), relative to its size, is at rounding.
+            let p = (m.map(|v| Complex::new(v, 0.0)) * (a * a)
+                + c.map(|v| Complex::new(v, 0.0)) * a
+                + k.map(|v| Complex::new(v, 0.0)))
+            .svd(false, false);
+            let sigma = p.singular_values;
+            assert!(sigma.min() <= 1e-13 * sigma.max(), "{a}: {sigma}");
+        }
     }
 }

@@ -182,7 +182,7 @@ impl CheckReport {
     /// `kinetic:`, and no `balances:` or hand-written `equations_of_motion:`.
     pub fn not_cross_checked(&self) -> Option<&'static str> {
         self.comparisons.is_empty().then_some(
-            "not cross-checked: only Lagrange's equations apply (momentum balance needs bodies and no written `kinetic:`; add `checks: equations_of_motion:` derived by hand, or `balances:`)",
+            "not cross-checked: only Lagrange's equations apply (momentum balance needs bodies and no written `kinetic:`); add the equations of motion derived by hand under `checks: equations_of_motion:`",
         )
     }
 
@@ -217,7 +217,10 @@ impl CheckReport {
         CheckSummary {
             model: self.model.clone(),
             tolerance,
-            failure: self.states.nothing_compared(),
+            failure: self
+                .states
+                .nothing_compared()
+                .or_else(|| self.not_cross_checked().map(str::to_string)),
             passed: self.passed(tolerance),
             checks: self
                 .comparisons
@@ -267,7 +270,8 @@ pub struct CheckSummary {
     pub model: String,
     /// The relative tolerance the checks were judged at.
     pub tolerance: f64,
-    /// Why nothing was compared ([`SampledStates::nothing_compared`]; null when states were).
+    /// Why nothing was compared ([`SampledStates::nothing_compared`]) or nothing was
+    /// cross-checked ([`CheckReport::not_cross_checked`]); null otherwise.
     pub failure: Option<String>,
     /// Whether every check passed ([`CheckReport::passed`]).
     pub passed: bool,

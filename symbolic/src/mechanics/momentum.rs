@@ -1,5 +1,7 @@
-//! Momentum balance, derived from the kinematics alone (syllabus lectures 6–7, 11–12, 19;
-//! HW19 a, HW20): never from `T` or `V`.
+//! Momentum balance, derived from the kinematics (syllabus lectures 6–7, 11–12, 19; HW19 a,
+//! HW20): never from `T`, nor from a `V` of gravity or springs, which enter as forces; a
+//! potential the file writes (`potential:`) enters as the forces `−∂V/∂qᵢ`, and written
+//! `generalized_forces:` as themselves.
 //!
 //! For each body, linear momentum balance `m a_G = ΣF` and angular momentum balance about the
 //! centre of mass `I_G θ̈ = ΣM_G` are projected on the partial velocities `∂r/∂qᵢ` and partial
@@ -22,6 +24,7 @@
 //! ```text
 //! Mᵢⱼ = Σ_bodies m (∂r/∂qᵢ)·(∂r/∂qⱼ) + I (∂θ/∂qᵢ)(∂θ/∂qⱼ)        (i ≤ j, mirrored)
 //! Fᵢ  = Σ_bodies (m g − m a₀)·∂r/∂qᵢ − I α₀ ∂θ/∂qᵢ + Σ_loads F·∂r_P/∂qᵢ + τ ∂θ/∂qᵢ
+//!       − ∂V_written/∂qᵢ + Q_written,i
 //! ```
 //!
 //! Bodies whose partial velocities for `qᵢ` (and `qⱼ`) are the same expressions, as are those

@@ -132,8 +132,10 @@ impl Expr {
 
 /// The expression in the model file's syntax, parenthesised so that it parses back to the
 /// same tree (locations aside): numbers as written, `+ -` and `* /` left-associative,
-/// `^`'s base an atom, and a unary minus in parentheses wherever it is a right operand or
-/// negated (`a*(-b)`, `a^(-2)`, `-(-x)`).
+/// `^`'s base an atom, and a unary minus in parentheses where it is the right operand of a
+/// product or power or is negated (`a*(-b)`, `a^(-2)`, `-(-x)`; `a - -b` reads as the parser
+/// reads it). The parentheses add nesting: an expression within a few levels of the
+/// parser's depth limit may print as one beyond it.
 impl std::fmt::Display for Expr {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match &self.kind {
