@@ -937,7 +937,8 @@ fn check_forcing(lin: &Linearization, rows: usize, frequency: f64) -> Result<(),
 }
 
 /// The time for the slowest free decay to shrink by `reduction`: `ln(1/reduction) / σ_min`
-/// with `σ_min = min −Re s` over the eigenvalues `s` of the state matrix (s).
+/// with `σ_min = min −Re s` over the eigenvalues `s` of the state matrix (s), as
+/// [`crate::linear::eigenvalues::linear_stability`] computes them.
 ///
 /// # Errors
 /// [`FrfError::NoSteadyState`] if some eigenvalue has `Re s ≥ 0` (an undamped or unstable
@@ -951,19 +952,20 @@ pub fn settling_time(lin: &Linearization, reduction: f64) -> Result<f64, FrfErro
             expected: "0 < reduction < 1",
         });
     }
-    let eigenvalues = lin.state_matrix()?.complex_eigenvalues();
-    let slowest = eigenvalues
-        .iter()
-        .map(|s| -s.re)
-        .fold(f64::INFINITY, f64::min);
-    // A decay rate at rounding level of the largest eigenvalue is no decay.
-    let largest = eigenvalues.iter().map(|s| s.norm()).fold(0.0f64, f64::max);
-    if slowest.is_nan() || slowest <= 1e-10 * largest {
-        return Err(FrfError::NoSteadyState {
-            slowest_decay_rate: slowest,
-        });
+    // The verdict of `modes`: a steady state exists exactly when the equilibrium is stable.
+    let stability = crate::linear::eigenvalues::linear_stability(lin)?;
+    match stability.stability {
+        crate::linear::eigenvalues::Stability::Stable { decay_rate } => {
+            Ok((1.0 / reduction).ln() / decay_rate)
+        }
+        _ => Err(FrfError::NoSteadyState {
+            slowest_decay_rate: stability
+                .eigenvalues
+                .iter()
+                .map(|s| -s.re)
+                .fold(f64::INFINITY, f64::min),
+        }),
     }
-    Ok((1.0 / reduction).ln() / slowest)
 }
 
 /// A harmonic load for [`simulate_steady_state`]: the input parameter's value and the forcing

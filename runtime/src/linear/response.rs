@@ -1089,11 +1089,9 @@ pub fn exact_damped_modes(
     lin: &Linearization,
     modes: &NormalModes,
 ) -> Result<Vec<Option<DampedMode>>, ResponseError> {
-    let a = lin.state_matrix()?;
-    let complex: Vec<Complex<f64>> = a
-        .complex_eigenvalues()
-        .iter()
-        .copied()
+    // The refined eigenvalues of the whole linearisation, as `modes` reports them.
+    let complex: Vec<Complex<f64>> = crate::linear::eigenvalues::state_eigenvalues(lin)?
+        .into_iter()
         .filter(|s| s.im > 0.0)
         .collect();
     let mut used = vec![false; complex.len()];
@@ -1114,7 +1112,7 @@ pub fn exact_damped_modes(
             let s = complex[i];
             DampedMode {
                 eigenvalue: s,
-                damping_ratio: -s.re / s.norm(),
+                damping_ratio: if s.re == 0.0 { 0.0 } else { -s.re / s.norm() },
                 damped_frequency: s.im,
             }
         }));
