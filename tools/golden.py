@@ -115,6 +115,8 @@ CASES += [
      "--json"],
     ["study", "floquet", "mathieu_pendulum", "--sweep", "a=0..0.2:2,w=0..60:3", "--json"],
     ["study", "modal-damping", "three_masses_damped", "--rayleigh-modes", "1,2", "--json"],
+    # A fixed-step method without `--dt`: the library's default number of steps.
+    ["simulate", "double_pendulum", "--method", "rk4", "--t-end", "1", "--json"],
 ]
 
 # Cases whose text has unlabelled wall-time columns (milliseconds with three decimals) and

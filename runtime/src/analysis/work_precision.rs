@@ -104,13 +104,22 @@ impl WorkPrecisionOptions {
     pub const DEFAULT_REPEATS: usize = 3;
     /// The default total wall time (s) the runs of one setting reach.
     pub const DEFAULT_MIN_TIME_S: f64 = 0.02;
+    /// The default tolerances, as `eomgen study work-precision --tols` writes a range: every
+    /// decade from the first to the second ([`Self::default_tolerances`]).
+    pub const DEFAULT_TOLERANCE_RANGE: (f64, f64) = (1e-3, 1e-12);
+
+    /// Every decade of [`Self::DEFAULT_TOLERANCE_RANGE`], loosest first.
+    pub fn default_tolerances() -> Vec<f64> {
+        let (a, b) = Self::DEFAULT_TOLERANCE_RANGE;
+        decades(a, b).unwrap_or_else(|| vec![a, b])
+    }
 }
 
 impl Default for WorkPrecisionOptions {
     fn default() -> Self {
         Self {
             methods: DEFAULT_METHODS.to_vec(),
-            tolerances: (3..=12).map(|k| 10f64.powi(-k)).collect(),
+            tolerances: Self::default_tolerances(),
             steps: None,
             t_end: Self::DEFAULT_T_END,
             samples: Self::DEFAULT_SAMPLES,

@@ -71,7 +71,7 @@ pub struct WorkPrecisionArgs {
     pub methods: Vec<Method>,
     /// Tolerances of the adaptive methods (`rtol = atol = tol`): `A..B`, every decade from A
     /// to B (e.g. `1e-3..1e-12`), or a comma-separated list; each in (0, 1).
-    #[arg(long, default_value = "1e-3..1e-12", allow_hyphen_values = true)]
+    #[arg(long, default_value_t = default_tols(), allow_hyphen_values = true)]
     pub tols: String,
     /// Step counts N of the fixed-step methods (step `h = t_end / N`): `A..B`, doubling from
     /// A up to B (e.g. `64..65536`), or a comma-separated list of positive integers. Default
@@ -110,6 +110,12 @@ pub struct WorkPrecisionArgs {
     /// `PREFIX-time.svg/.png` (error against wall time), log–log, one line per method.
     #[arg(long, value_name = "PREFIX")]
     pub plot: Option<String>,
+}
+
+/// `--tols`' default, the library's range written as `A..B`.
+fn default_tols() -> String {
+    let (a, b) = WorkPrecisionOptions::DEFAULT_TOLERANCE_RANGE;
+    format!("{a:e}..{b:e}")
 }
 
 /// Parses `--tols`: `A..B` (every decade from A towards B, either direction) or a comma list.
