@@ -62,7 +62,9 @@ pub use integrate::{
     SymplecticEuler, Tableau, Tolerance,
 };
 pub use linalg::{solve_spd, solve_spd_in_place};
-pub use linear::eigenvalues::{LinearStability, Stability, linear_stability, state_eigenvalues};
+pub use linear::eigenvalues::{
+    LinearStability, Stability, damped_modes, linear_stability, state_eigenvalues,
+};
 pub use linear::frequency_response::{
     ForcedLinearization, FrequencySweep, FrfError, HarmonicForcing, ModalResponse, PeakAmplitude,
     ResonancePeak, SteadyState, SteadyStateOptions, frequency_response, frequency_response_of,
@@ -71,7 +73,7 @@ pub use linear::frequency_response::{
 };
 pub use linear::modal::{
     Equilibrium, Linearization, MASS_MATRIX_SINGULARITY, ModalError, ModeKind, NewtonStop,
-    NormalModes, TimeDependentForcing, TimeDependentPart, constraint_hessians, damped_modes,
+    NormalModes, TimeDependentForcing, TimeDependentPart, constraint_hessians,
     eigenvalues_of_m_inv_k, find_equilibrium, linearize, matrix_exponential, normal_modes,
     time_dependence,
 };

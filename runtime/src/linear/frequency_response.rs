@@ -53,9 +53,10 @@ use nalgebra::{Complex, DMatrix, DVector};
 use crate::integrate::{
     DormandPrince853, IntegrationError, Integrator, IntegratorOptions, OutputTimes,
 };
+use crate::linear::eigenvalues::damped_modes;
 use crate::linear::modal::{
-    Equilibrium, Linearization, ModalError, ModeKind, NormalModes, damped_modes, find_equilibrium,
-    linearize, time_dependence,
+    Equilibrium, Linearization, ModalError, ModeKind, NormalModes, find_equilibrium, linearize,
+    time_dependence,
 };
 use crate::linear::response::modal_damping;
 use crate::model_info::ModelInfo;

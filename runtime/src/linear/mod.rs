@@ -4,9 +4,10 @@
 //! values (serialisable where a report embeds them):
 //!
 //! - [`eigenvalues`]: the eigenvalues of the whole state matrix (damping and gyroscopic
-//!   terms), accurate on badly scaled models, and the stability verdict from them;
+//!   terms), accurate on badly scaled models, the damped modes and the stability verdict
+//!   from them;
 //! - [`modal`]: equilibria, the exact linearisation `M δq̈ + C δq̇ + K δq = 0` and its state
-//!   matrix, undamped normal modes, damped modes, the matrix exponential;
+//!   matrix, undamped normal modes, the matrix exponential;
 //! - [`response`]: the free response of a linearisation computed several independent ways,
 //!   and damping models (modal, Rayleigh) against the exact damped modes;
 //! - [`frequency_response`]: input matrices of load parameters, `H(ω) = (K − ω²M + iωC)⁻¹ B`,

@@ -1369,35 +1369,6 @@ pub fn eigenvalues_of_m_inv_k(lin: &Linearization) -> Result<Vec<f64>, ModalErro
     Ok(values)
 }
 
-/// The eigenvalues `s` of the state matrix `A` (complex, `2n`), and from each oscillatory pair
-/// the damped frequency `ω_d = |Im s|` and the `damping_ratios` `ζ = −Re s / |s|`.
-///
-/// Returns `(s, ζ, ω_d)` sorted by `|s|`, one entry per eigenvalue with `Im s ≥ 0` (so a
-/// complex pair appears once; real eigenvalues each appear with `ω_d = 0`). The eigenvalues
-/// are [`super::eigenvalues::state_eigenvalues`]': accurate to rounding of their own size on
-/// badly scaled models, undamped ones exactly on the imaginary axis (`ζ = 0`).
-///
-/// # Errors
-/// [`ModalError::SingularMassMatrix`]; [`ModalError::NonFinite`] for a `K` or `C` that is
-/// not finite.
-pub fn damped_modes(
-    lin: &Linearization,
-) -> Result<Vec<(nalgebra::Complex<f64>, f64, f64)>, ModalError> {
-    let mut out: Vec<(nalgebra::Complex<f64>, f64, f64)> =
-        super::eigenvalues::state_eigenvalues(lin)?
-            .iter()
-            .filter(|s| s.im >= 0.0)
-            .map(|s| {
-                let r = s.norm();
-                // `s.re == 0` (on the axis) is `ζ = 0`, not `-0`.
-                let zeta = if s.re == 0.0 { 0.0 } else { -s.re / r };
-                (*s, zeta, s.im.abs())
-            })
-            .collect();
-    out.sort_by(|a, b| a.0.norm().total_cmp(&b.0.norm()));
-    Ok(out)
-}
-
 /// The matrix exponential `e^A`, for the free response `y(t) = e^{At} y(0)` of the linearised
 /// system (lectures 30–32, HW32) and the monodromy of a constant-coefficient system.
 ///

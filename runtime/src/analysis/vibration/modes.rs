@@ -10,10 +10,10 @@ use serde::Serialize;
 use super::operating_point::{
     OperatingPoint, OperatingPointError, OperatingPointOptions, PointSummary, operating_point,
 };
-use crate::linear::eigenvalues::{LinearStability, linear_stability};
+use crate::linear::eigenvalues::{LinearStability, damped_modes, linear_stability};
 use crate::linear::modal::{
-    Linearization, ModalError, ModeKind, NormalModes, TimeDependentForcing, damped_modes,
-    eigenvalues_of_m_inv_k, linearize, normal_modes, time_dependence,
+    Linearization, ModalError, ModeKind, NormalModes, TimeDependentForcing, eigenvalues_of_m_inv_k,
+    linearize, normal_modes, time_dependence,
 };
 use crate::model_info::ModelInfo;
 
