@@ -290,7 +290,13 @@ pub fn state_eigenvalues(lin: &Linearization) -> Result<Vec<Complex<f64>>, Modal
 pub fn damped_modes(
     lin: &Linearization,
 ) -> Result<Vec<(nalgebra::Complex<f64>, f64, f64)>, ModalError> {
-    let mut out: Vec<(nalgebra::Complex<f64>, f64, f64)> = state_eigenvalues(lin)?
+    Ok(damped_modes_of(&state_eigenvalues(lin)?))
+}
+
+/// [`damped_modes`] of eigenvalues already computed by [`state_eigenvalues`] (as
+/// [`LinearStability::eigenvalues`] holds them).
+pub fn damped_modes_of(eigenvalues: &[Complex<f64>]) -> Vec<(Complex<f64>, f64, f64)> {
+    let mut out: Vec<(Complex<f64>, f64, f64)> = eigenvalues
         .iter()
         .filter(|s| s.im >= 0.0)
         .map(|s| {
@@ -301,7 +307,7 @@ pub fn damped_modes(
         })
         .collect();
     out.sort_by(|a, b| a.0.norm().total_cmp(&b.0.norm()));
-    Ok(out)
+    out
 }
 
 /// Newton steps on `det P(λ) = 0`, `P(λ) = λ²I + λC + K`, from `s0` with the two-sided

@@ -10,7 +10,7 @@ use serde::Serialize;
 use super::operating_point::{
     OperatingPoint, OperatingPointError, OperatingPointOptions, PointSummary, operating_point,
 };
-use crate::linear::eigenvalues::{LinearStability, damped_modes, linear_stability};
+use crate::linear::eigenvalues::{LinearStability, damped_modes_of, linear_stability};
 use crate::linear::modal::{
     Linearization, ModalError, ModeKind, NormalModes, TimeDependentForcing, eigenvalues_of_m_inv_k,
     linearize, normal_modes, time_dependence,
@@ -302,7 +302,8 @@ pub fn modal_analysis(
     let stability = linear_stability(&linearization)?;
     let modes = normal_modes(&linearization)?;
     let m_inv_k_eigenvalues = eigenvalues_of_m_inv_k(&linearization)?;
-    let damped_modes: Vec<DampedEigenvalue> = damped_modes(&linearization)?
+    // The eigenvalues the verdict came from, not computed a second time.
+    let damped_modes: Vec<DampedEigenvalue> = damped_modes_of(&stability.eigenvalues)
         .into_iter()
         .map(|(s, zeta, wd)| DampedEigenvalue {
             eigenvalue: s,
