@@ -5,8 +5,12 @@
 use rustc_hash::FxHashMap;
 
 use super::constraints::{ConstraintEquations, linear_in_rates, redundant_rows};
+use super::frames::{Frames, Vector3};
 use crate::expr::{Constant, ExprArena, ExprId, Func, SymbolId, SymbolKind};
-use crate::model::{BinOp, BodyKind, Diagnostic, Expr, ExprKind, FloquetReference, ModelFile};
+use crate::model::{
+    BinOp, BodyKind, Diagnostic, Expr, ExprKind, FloquetReference, GROUND_FRAME, ModelFile,
+    TorqueValue,
+};
 use crate::model::{Located, Location};
 
 /// A parameter of a lowered model.
@@ -33,6 +37,20 @@ pub struct BodyInfo {
     pub com: usize,
     /// `(centroidal inertia, angle)` of a planar rigid body; `None` for a particle.
     pub rotation: Option<(ExprId, ExprId)>,
+    /// The orientation and inertia of a 3-D rigid body; `None` for a particle or a planar
+    /// body.
+    pub spatial: Option<SpatialBody>,
+}
+
+/// A 3-D rigid body's frame, angular velocity and inertia, all in the body frame's axes.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SpatialBody {
+    /// Index of its frame in [`SymbolicModel::frames`].
+    pub frame: usize,
+    /// `^N ω^B` (rad/s) in the body frame's components, linear in the rates.
+    pub angular_velocity: Vector3,
+    /// The inertia tensor about the centre of mass (kg·m²): `[xx, yy, zz, xy, yz, xz]`.
+    pub inertia: [ExprId; 6],
 }
 
 /// A load of the kinematic form, kept as a force or torque (not a potential), for the
@@ -54,6 +72,13 @@ pub enum LoadInfo {
         angle: ExprId,
         /// Torque, counter-clockwise.
         value: ExprId,
+    },
+    /// A torque vector (N·m) on a 3-D rigid body, in the body frame's components.
+    SpatialTorque {
+        /// Index into [`SymbolicModel::bodies`] of the body it acts on.
+        body: usize,
+        /// Components along the body frame's axes.
+        vector: Vector3,
     },
     /// A linear spring between two points (equal and opposite forces along the line).
     Spring {
@@ -114,8 +139,10 @@ pub struct SymbolicModel {
     pub time: ExprId,
     /// The time symbol's id.
     pub time_id: SymbolId,
-    /// Named points and their position components (2 or 3).
+    /// Named points and their position components (2 or 3) in the ground frame.
     pub points: Vec<(String, Vec<ExprId>)>,
+    /// The reference frames (3-D models; only the ground frame otherwise).
+    pub frames: Frames,
     /// Kinetic energy `T(q, q̇, t)` (J).
     pub kinetic: ExprId,
     /// Potential energy `V(q, t)` (J): gravity, springs and the file's `potential`.
@@ -724,7 +751,8 @@ impl<'f> Lowering<'f> {
             .map(|c| c.name.value.clone())
             .collect();
         let q_symbols: Vec<SymbolId> = self.arena.coordinates().iter().map(|c| c[0]).collect();
-        let points = self.points();
+        let mut frames = self.frames();
+        let points = self.points(&frames);
         let dimension = file.dimension.unwrap_or(2);
 
         let mut terms = Terms {
@@ -746,11 +774,12 @@ impl<'f> Lowering<'f> {
             .gravity
             .as_ref()
             .map(|g| g.value.iter().map(|c| self.expr(c)).collect());
-        let (body_infos, angles) = self.bodies(&points, gravity.as_deref(), &mut terms);
+        let (body_infos, angles) =
+            self.bodies(&points, &mut frames, gravity.as_deref(), &mut terms);
         let mut loads = self.springs(&points, &mut terms);
         loads.extend(self.dampers(&points, &q_symbols, &mut terms));
-        loads.extend(self.forces(&points, &q_symbols, &mut terms));
-        loads.extend(self.torques(&angles, &body_infos, &q_symbols, &mut terms));
+        loads.extend(self.forces(&points, &frames, &q_symbols, &mut terms));
+        loads.extend(self.torques(&angles, &body_infos, &frames, &q_symbols, &mut terms));
         let balances = self.balances(&points, &body_infos);
         let hand_equations = self.hand_equations();
 
@@ -814,6 +843,7 @@ impl<'f> Lowering<'f> {
             time,
             time_id,
             points,
+            frames,
             kinetic,
             potential,
             generalized_forces,
@@ -864,16 +894,69 @@ impl<'f> Lowering<'f> {
         parameters
     }
 
-    /// The points' positions, by name, in file order.
-    fn points(&mut self) -> Points {
-        self.file
-            .points
-            .iter()
-            .map(|p| {
+    /// The frames of `frames:`, after the ground frame `N`, each with its rotations.
+    fn frames(&mut self) -> Frames {
+        let mut frames = Frames::ground(GROUND_FRAME);
+        for f in &self.file.frames {
+            let Some(parent) = frames.index(&f.parent.value) else {
+                self.errors.push(Diagnostic::new(
+                    f.parent.location,
+                    format!("unknown frame `{}`", f.parent.value),
+                ));
+                continue;
+            };
+            let rotations = f
+                .rotations
+                .iter()
+                .map(|r| (r.axis.value.index(), self.expr(&r.angle)))
+                .collect();
+            frames.add(&f.name.value, parent, rotations);
+        }
+        frames
+    }
+
+    /// The points' positions in the ground frame, by name, in file order: a list of
+    /// components as written, or a point plus vectors in frames carried into the ground
+    /// frame's components.
+    fn points(&mut self, frames: &Frames) -> Points {
+        let mut points: Points = Vec::new();
+        for p in &self.file.points {
+            let Some(relative) = &p.relative else {
                 let r = p.position.iter().map(|c| self.expr(c)).collect();
-                (p.name.value.clone(), r)
-            })
-            .collect()
+                points.push((p.name.value.clone(), r));
+                continue;
+            };
+            let zero = self.arena.int(0);
+            let mut r: Vec<ExprId> = match &relative.from {
+                Some(from) => match point(&points, &from.value) {
+                    Some(i) => points[i].1.clone(),
+                    None => {
+                        self.errors.push(Diagnostic::new(
+                            from.location,
+                            format!("unknown point `{}`", from.value),
+                        ));
+                        vec![zero; 3]
+                    }
+                },
+                None => vec![zero; 3],
+            };
+            for (frame, v) in &relative.vectors {
+                let Some(f) = frames.index(&frame.value) else {
+                    self.errors.push(Diagnostic::new(
+                        frame.location,
+                        format!("unknown frame `{}`", frame.value),
+                    ));
+                    continue;
+                };
+                let v = [&v[0], &v[1], &v[2]].map(|c| self.expr(c));
+                let v = frames.express(&mut self.arena, v, f, 0);
+                for (x, c) in r.iter_mut().zip(v) {
+                    *x = self.arena.plus(*x, c);
+                }
+            }
+            points.push((p.name.value.clone(), r));
+        }
+        points
     }
 
     /// The energies and generalized forces written as such (`kinetic:`, `potential:`,
@@ -900,11 +983,13 @@ impl<'f> Lowering<'f> {
         }
     }
 
-    /// Bodies: T = ½ m v_G·v_G (+ ½ I ω² for planar rigid bodies), V = −m g·r_G. Returns the
-    /// bodies and the angle of each planar rigid body, by name.
+    /// Bodies: T = ½ m v_G·v_G (+ ½ I ω² for planar rigid bodies, + ½ ω·I_G ω for 3-D
+    /// ones), V = −m g·r_G. Returns the bodies and the angle of each planar rigid body, by
+    /// name.
     fn bodies(
         &mut self,
         points: &Points,
+        frames: &mut Frames,
         gravity: Option<&[ExprId]>,
         terms: &mut Terms,
     ) -> (Vec<BodyInfo>, Vec<(String, ExprId)>) {
@@ -920,6 +1005,7 @@ impl<'f> Lowering<'f> {
                     com,
                     angle,
                 } => (mass, com, Some((inertia, angle))),
+                BodyKind::Spatial { mass, com, .. } => (mass, com, None),
             };
             let m = self.expr(mass);
             let Some(ip) = point(points, &at.value) else {
@@ -949,14 +1035,53 @@ impl<'f> Lowering<'f> {
                 terms.kinetic.push(self.arena.product(&[half, i, w2]));
                 angles.push((body.name.value.clone(), th));
             }
+            let spatial = match &body.kind {
+                BodyKind::Spatial { frame, inertia, .. } => {
+                    self.spatial_body(frames, frame, inertia, terms)
+                }
+                _ => None,
+            };
             body_infos.push(BodyInfo {
                 name: body.name.value.clone(),
                 mass: m,
                 com: ip,
                 rotation,
+                spatial,
             });
         }
         (body_infos, angles)
+    }
+
+    /// A 3-D body's angular velocity (from its frame's rotations) and inertia tensor, with
+    /// its rotational kinetic energy `½ ω·I_G ω` (body components) added to `T`.
+    fn spatial_body(
+        &mut self,
+        frames: &mut Frames,
+        frame: &Located<String>,
+        inertia: &crate::model::InertiaTensor,
+        terms: &mut Terms,
+    ) -> Option<SpatialBody> {
+        let Some(f) = frames.index(&frame.value) else {
+            self.errors.push(Diagnostic::new(
+                frame.location,
+                format!("unknown frame `{}`", frame.value),
+            ));
+            return None;
+        };
+        let zero = self.arena.int(0);
+        let inertia = inertia
+            .entries
+            .clone()
+            .map(|e| e.map_or(zero, |e| self.expr(&e)));
+        let w = frames.angular_velocity(&mut self.arena, f);
+        let iw = super::frames::tensor_times(&mut self.arena, &inertia, &w);
+        let wiw = self.dot(&w, &iw);
+        terms.kinetic.push(self.arena.times(terms.half, wiw));
+        Some(SpatialBody {
+            frame: f,
+            angular_velocity: w,
+            inertia,
+        })
     }
 
     /// Springs: V = ½ k (|r_A − r_B| − ℓ₀)², or ½ k |r_A − r_B|² for zero rest length.
@@ -1041,10 +1166,12 @@ impl<'f> Lowering<'f> {
         loads
     }
 
-    /// Forces at points: Qᵢ = F·∂r_P/∂qᵢ (the partial velocity ∂v_P/∂q̇ᵢ).
+    /// Forces at points: Qᵢ = F·∂r_P/∂qᵢ (the partial velocity ∂v_P/∂q̇ᵢ); a force written
+    /// in a frame (`in: B`) is carried into the ground frame's components first.
     fn forces(
         &mut self,
         points: &Points,
+        frames: &Frames,
         q_symbols: &[SymbolId],
         terms: &mut Terms,
     ) -> Vec<LoadInfo> {
@@ -1057,7 +1184,12 @@ impl<'f> Lowering<'f> {
                 ));
                 continue;
             };
-            let force: Vec<ExprId> = f.vector.iter().map(|c| self.expr(c)).collect();
+            let mut force: Vec<ExprId> = f.vector.iter().map(|c| self.expr(c)).collect();
+            if let Some(frame) = &f.frame
+                && let (Some(from), &[x, y, z]) = (frames.index(&frame.value), &force[..])
+            {
+                force = frames.express(&mut self.arena, [x, y, z], from, 0).to_vec();
+            }
             loads.push(LoadInfo::Force {
                 point: ip,
                 vector: force.clone(),
@@ -1074,16 +1206,54 @@ impl<'f> Lowering<'f> {
         loads
     }
 
-    /// Torques on planar bodies: Qᵢ = τ ∂θ/∂qᵢ (partial angular velocity).
+    /// Torques on planar bodies: Qᵢ = τ ∂θ/∂qᵢ (partial angular velocity); on 3-D bodies
+    /// Qᵢ = τ·∂ω/∂q̇ᵢ, both in the body frame's components.
     fn torques(
         &mut self,
         angles: &[(String, ExprId)],
         body_infos: &[BodyInfo],
+        frames: &Frames,
         q_symbols: &[SymbolId],
         terms: &mut Terms,
     ) -> Vec<LoadInfo> {
         let mut loads = Vec::new();
         for tq in &self.file.torques {
+            let value = match &tq.value {
+                TorqueValue::Planar(value) => value,
+                TorqueValue::Spatial { vector, frame, .. } => {
+                    let body = body_infos.iter().position(|b| b.name == tq.body.value);
+                    let Some((b, Some(spatial))) =
+                        body.map(|b| (b, body_infos[b].spatial.as_ref()))
+                    else {
+                        self.errors.push(Diagnostic::new(
+                            tq.body.location,
+                            format!("`{}` is not a 3-D rigid body", tq.body.value),
+                        ));
+                        continue;
+                    };
+                    let from = match frame {
+                        Some(f) => frames.index(&f.value).unwrap_or(0),
+                        None => 0,
+                    };
+                    let [x, y, z] = &vector[..] else { continue };
+                    let v = [x, y, z].map(|c| self.expr(c));
+                    let v = frames.express(&mut self.arena, v, from, spatial.frame);
+                    for i in 0..q_symbols.len() {
+                        let rate = self.arena.coordinates()[i][1];
+                        let partial: Vec<ExprId> = spatial
+                            .angular_velocity
+                            .iter()
+                            .map(|w| self.arena.diff(*w, rate))
+                            .collect();
+                        let proj = self.dot(&v, &partial);
+                        if !self.arena.is_zero(proj) {
+                            terms.forces[i].push(proj);
+                        }
+                    }
+                    loads.push(LoadInfo::SpatialTorque { body: b, vector: v });
+                    continue;
+                }
+            };
             let Some(th) = angles
                 .iter()
                 .find(|(b, _)| *b == tq.body.value)
@@ -1095,7 +1265,7 @@ impl<'f> Lowering<'f> {
                 ));
                 continue;
             };
-            let tau = self.expr(&tq.value);
+            let tau = self.expr(value);
             loads.push(LoadInfo::Torque {
                 body: body_infos
                     .iter()

@@ -8,6 +8,7 @@
 mod balances;
 mod constraints;
 pub mod cross_check;
+pub mod frames;
 mod lagrange;
 mod lower;
 mod mass;
@@ -17,7 +18,9 @@ mod numeric;
 pub use balances::{HandEquations, UserBalances};
 pub use constraints::{ConstraintEquations, linear_in_rates, redundant_rows};
 pub use lagrange::Lagrange;
-pub use lower::{BalanceInfo, BodyInfo, EventInfo, LoadInfo, ParameterInfo, SymbolicModel};
+pub use lower::{
+    BalanceInfo, BodyInfo, EventInfo, LoadInfo, ParameterInfo, SpatialBody, SymbolicModel,
+};
 pub use mass::mass_matrix_diagnostics;
 pub use momentum::MomentumBalance;
 

@@ -46,6 +46,7 @@
 
 use rustc_hash::FxHashMap;
 
+use super::frames::{Vector3, cross, tensor_times};
 use super::lower::{BodyInfo, LoadInfo};
 use super::{EquationsOfMotion, Formulation, SymbolicModel};
 use crate::expr::{ExprArena, ExprId, SymbolId};
@@ -391,6 +392,43 @@ impl Formulation for MomentumBalance {
                 }
             }
         }
+        // 3-D bodies: Euler's equations `I_G α + ω × I_G ω` projected on the partial angular
+        // velocities `Wᵢ = ∂ω/∂q̇ᵢ`, all in the body frame's components (where `I_G` is
+        // constant and `α` is the time derivative of ω's components). With `α = Σ Wⱼ q̈ⱼ +
+        // α₀`: `Mᵢⱼ += Wᵢ·I Wⱼ`, `Fᵢ −= Wᵢ·(I α₀ + ω × I ω)`.
+        for body in &bodies {
+            let Some(spatial) = &body.spatial else {
+                continue;
+            };
+            let w = spatial.angular_velocity;
+            let partial: Vec<Option<Vector3>> = symbols
+                .iter()
+                .map(|s| {
+                    let p = w.map(|c| arena.diff(c, s[1]));
+                    (!p.iter().all(|c| arena.is_zero(*c))).then_some(p)
+                })
+                .collect();
+            let alpha = w.map(|c| velocity_product(arena, c, &symbols, time));
+            let i_alpha = tensor_times(arena, &spatial.inertia, &alpha);
+            let i_w = tensor_times(arena, &spatial.inertia, &w);
+            let gyroscopic = cross(arena, &w, &i_w);
+            let euler: Vec<ExprId> = i_alpha
+                .iter()
+                .zip(&gyroscopic)
+                .map(|(a, b)| arena.plus(*a, *b))
+                .collect();
+            for i in 0..n {
+                let Some(wi) = &partial[i] else { continue };
+                let i_wi = tensor_times(arena, &spatial.inertia, wi);
+                for j in i..n {
+                    if let Some(wj) = &partial[j] {
+                        mass_terms[i * n + j].push(dot_multiplied_out(arena, &i_wi, wj));
+                    }
+                }
+                let inertial = dot_multiplied_out(arena, &euler, wi);
+                forcing_terms[i].push(arena.neg(inertial));
+            }
+        }
         // The file's written potential and generalized forces: `−∂V/∂qᵢ + Qᵢ`.
         let (potential, written) = (model_potential, written_forces);
         for (i, s) in symbols.iter().enumerate() {
@@ -407,6 +445,18 @@ impl Formulation for MomentumBalance {
             let mut forces: Vec<(usize, Vec<ExprId>)> = Vec::new();
             let mut torque: Option<(ExprId, ExprId)> = None;
             match load {
+                LoadInfo::SpatialTorque { body, vector } => {
+                    // τ·∂ω/∂q̇ᵢ, both in the body frame's components.
+                    if let Some(spatial) = &bodies[*body].spatial {
+                        for (i, s) in symbols.iter().enumerate() {
+                            let partial = spatial.angular_velocity.map(|c| arena.diff(c, s[1]));
+                            let power = dot(arena, vector, &partial);
+                            if !arena.is_zero(power) {
+                                forcing_terms[i].push(power);
+                            }
+                        }
+                    }
+                }
                 LoadInfo::Force { point, vector } => forces.push((*point, vector.clone())),
                 LoadInfo::Torque { angle, value, .. } => torque = Some((*angle, *value)),
                 LoadInfo::Spring {

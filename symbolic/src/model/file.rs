@@ -47,15 +47,111 @@ pub struct Coordinate {
     pub unit: Option<Located<String>>,
 }
 
-/// A named point: a position expression in `q` and `t` with 2 or 3 components.
+/// A named point: a position expression in `q` and `t` with 2 or 3 components, or (in 3-D)
+/// another point plus vectors written in frames.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Point {
     /// Name.
     pub name: Located<String>,
-    /// Components `[x, y]` or `[x, y, z]` (m).
+    /// Components `[x, y]` or `[x, y, z]` (m) in the ground frame; empty for a point written
+    /// as a point plus vectors (`{ from: O, B: [0, 0, l] }`).
     pub position: Vec<Expr>,
-    /// Where the position list starts.
+    /// The point plus vectors form: `{ from: O, B: [0, 0, l], N: [x, 0, 0] }`; `None` for a
+    /// list of components.
+    pub relative: Option<RelativePosition>,
+    /// Where the position list or map starts.
     pub location: Location,
+}
+
+impl Point {
+    /// Number of components: 3 for a point written as a point plus vectors in frames.
+    pub fn dimension(&self) -> usize {
+        if self.relative.is_some() {
+            3
+        } else {
+            self.position.len()
+        }
+    }
+}
+
+/// A point written as another point plus vectors in frames:
+/// `r_P = r_from + Σ_F [v_F]_F` (each vector's components along the axes of frame F).
+#[derive(Debug, Clone, PartialEq)]
+pub struct RelativePosition {
+    /// The point it is measured from; `None`: the origin.
+    pub from: Option<Located<String>>,
+    /// Vectors by frame (`N` is the ground), each three components (m), in file order.
+    pub vectors: Vec<(Located<String>, Vec<Expr>)>,
+}
+
+/// The name of the ground (Newtonian) frame, predefined in every 3-D model.
+pub const GROUND_FRAME: &str = "N";
+
+/// An axis of a frame.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Axis {
+    /// The frame's x axis.
+    X,
+    /// The frame's y axis.
+    Y,
+    /// The frame's z axis.
+    Z,
+}
+
+impl Axis {
+    /// 0, 1, 2 for x, y, z.
+    pub fn index(self) -> usize {
+        match self {
+            Axis::X => 0,
+            Axis::Y => 1,
+            Axis::Z => 2,
+        }
+    }
+
+    /// `x`, `y` or `z`.
+    pub fn letter(self) -> char {
+        ['x', 'y', 'z'][self.index()]
+    }
+}
+
+/// One simple rotation: the new frame is the previous one turned by `angle` (rad, right-hand
+/// rule) about `axis`, an axis fixed in both.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SimpleRotation {
+    /// The axis.
+    pub axis: Located<Axis>,
+    /// The angle (rad), an expression of the parameters, coordinates and `t`.
+    pub angle: Expr,
+}
+
+/// A reference frame: its parent turned by successive simple rotations (Kane & Levinson,
+/// *Dynamics: Theory and Applications*, 1985, §1.7–1.9).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Frame {
+    /// Name.
+    pub name: Located<String>,
+    /// The parent frame ([`GROUND_FRAME`] or a frame defined earlier in the file).
+    pub parent: Located<String>,
+    /// The rotations in the order they are applied, each about an axis of the frame the
+    /// previous ones produced (body-fixed; `about: parent` is stored here already reversed,
+    /// which gives the same orientation).
+    pub rotations: Vec<SimpleRotation>,
+}
+
+/// A 3-D inertia tensor about a body's centre of mass in the body's frame (kg·m²): the
+/// moments `xx, yy, zz` and the tensor's off-diagonal entries `xy, yz, xz` (which are the
+/// negatives of the products of inertia `∫xy dm`); absent entries are 0.
+#[derive(Debug, Clone, PartialEq)]
+pub struct InertiaTensor {
+    /// `[xx, yy, zz, xy, yz, xz]`; `None` for an entry not written (0).
+    pub entries: [Option<Expr>; 6],
+    /// Where the inertia is written.
+    pub location: Location,
+}
+
+impl InertiaTensor {
+    /// The names of the entries, in [`InertiaTensor::entries`]'s order.
+    pub const KEYS: [&'static str; 6] = ["xx", "yy", "zz", "xy", "yz", "xz"];
 }
 
 /// What kind of body.
@@ -79,6 +175,37 @@ pub enum BodyKind {
         /// Orientation angle (rad), counter-clockwise; an expression in `q` and `t`.
         angle: Expr,
     },
+    /// A rigid body in 3-D: `{ mass: m, com: G, frame: B, inertia: [I1, I2, I3] }`.
+    Spatial {
+        /// Mass (kg).
+        mass: Expr,
+        /// Centre-of-mass point.
+        com: Located<String>,
+        /// The frame fixed in the body.
+        frame: Located<String>,
+        /// Inertia tensor about the centre of mass, in the body frame's axes (boxed: six
+        /// expressions would make every body as large).
+        inertia: Box<InertiaTensor>,
+    },
+}
+
+impl BodyKind {
+    /// The body's mass.
+    pub fn mass(&self) -> &Expr {
+        match self {
+            BodyKind::Particle { mass, .. }
+            | BodyKind::Rigid { mass, .. }
+            | BodyKind::Spatial { mass, .. } => mass,
+        }
+    }
+
+    /// The point of its mass: `at` of a particle, `com` of a rigid body.
+    pub fn com(&self) -> &Located<String> {
+        match self {
+            BodyKind::Particle { at, .. } => at,
+            BodyKind::Rigid { com, .. } | BodyKind::Spatial { com, .. } => com,
+        }
+    }
 }
 
 /// A body of the kinematic form.
@@ -125,11 +252,14 @@ pub struct Force {
     pub at: Located<String>,
     /// Components (N), as many as the model's dimension.
     pub vector: Vec<Expr>,
+    /// The frame the components are written in (`in: B`); `None`: the ground frame.
+    pub frame: Option<Located<String>>,
     /// Where the vector list starts.
     pub location: Location,
 }
 
-/// A torque on a planar rigid body: `{ body: B, value: tau }` (N·m, counter-clockwise).
+/// A torque on a rigid body: `{ body: B, value: tau }` (N·m, counter-clockwise) on a planar
+/// body, `{ body: B, vector: [Tx, Ty, Tz], in: F }` on a 3-D one.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Torque {
     /// Name.
@@ -137,7 +267,33 @@ pub struct Torque {
     /// The body it acts on.
     pub body: Located<String>,
     /// Torque (N·m).
-    pub value: Expr,
+    pub value: TorqueValue,
+}
+
+/// The value of a [`Torque`].
+#[derive(Debug, Clone, PartialEq)]
+pub enum TorqueValue {
+    /// `value: tau` — about the axis normal to the plane, counter-clockwise (planar models).
+    Planar(Expr),
+    /// `vector: [Tx, Ty, Tz]` in the frame `in:` (the ground frame if `None`).
+    Spatial {
+        /// Components (N·m).
+        vector: Vec<Expr>,
+        /// The frame of the components.
+        frame: Option<Located<String>>,
+        /// Where the vector list starts.
+        location: Location,
+    },
+}
+
+impl TorqueValue {
+    /// Every expression of the value.
+    pub fn expressions(&self) -> Vec<&Expr> {
+        match self {
+            TorqueValue::Planar(e) => vec![e],
+            TorqueValue::Spatial { vector, .. } => vector.iter().collect(),
+        }
+    }
 }
 
 /// Which momentum balance a [`Balance`] writes.
@@ -504,6 +660,9 @@ pub struct ModelFile {
     pub potential: Option<Expr>,
     /// `generalized_forces:` Q by coordinate name (energy form).
     pub generalized_forces: Vec<(Located<String>, Expr)>,
+    /// `frames:` — reference frames by successive simple rotations, in file order (3-D
+    /// models; the ground frame `N` is predefined).
+    pub frames: Vec<Frame>,
     /// `points:`.
     pub points: Vec<Point>,
     /// `bodies:`.

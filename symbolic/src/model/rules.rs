@@ -8,7 +8,9 @@ use rustc_hash::FxHashSet;
 
 use super::ast::{Expr, FUNCTIONS};
 use super::diagnostic::{Diagnostic, Diagnostics};
-use super::file::{BalanceKind, BodyKind, ModelFile, Parameter};
+use super::file::{
+    BalanceKind, BodyKind, GROUND_FRAME, InertiaTensor, ModelFile, Parameter, TorqueValue,
+};
 use super::located::{Located, Location};
 use super::parser::{closest, eval_expr, identifiers};
 use super::schema::{self, Incomplete, UNRAW_KEYWORDS};
@@ -48,6 +50,7 @@ pub(crate) fn check_parts(
     checker.presence();
     checker.expressions();
     checker.dimensions();
+    checker.frames();
     checker.references();
     checker.masses();
     checker.balances();
@@ -305,11 +308,21 @@ impl<'f> Checker<'f> {
             );
         }
         for p in &file.points {
-            for c in &p.position {
+            let relative = p.relative.iter().flat_map(|r| &r.vectors);
+            for c in p.position.iter().chain(relative.flat_map(|(_, v)| v)) {
                 self.resolve(
                     c,
                     Depends::Position,
                     &format!("the position of point `{}`", p.name.value),
+                );
+            }
+        }
+        for f in &file.frames {
+            for r in &f.rotations {
+                self.resolve(
+                    &r.angle,
+                    Depends::Position,
+                    &format!("the rotation of frame `{}`", f.name.value),
                 );
             }
         }
@@ -344,6 +357,20 @@ impl<'f> Checker<'f> {
                         Depends::Position,
                         &format!("the angle of body `{name}`"),
                     );
+                }
+                BodyKind::Spatial { mass, inertia, .. } => {
+                    self.resolve(
+                        mass,
+                        Depends::Constant,
+                        &format!("the mass of body `{name}`"),
+                    );
+                    for e in inertia.entries.iter().flatten() {
+                        self.resolve(
+                            e,
+                            Depends::Constant,
+                            &format!("the inertia of body `{name}`"),
+                        );
+                    }
                 }
             }
         }
@@ -380,11 +407,9 @@ impl<'f> Checker<'f> {
             }
         }
         for t in &file.torques {
-            self.resolve(
-                &t.value,
-                Depends::Motion,
-                &format!("torque `{}`", t.name.value),
-            );
+            for e in t.value.expressions() {
+                self.resolve(e, Depends::Motion, &format!("torque `{}`", t.name.value));
+            }
         }
         for (k, e) in &file.initial {
             self.resolve(
@@ -570,16 +595,16 @@ impl<'f> Checker<'f> {
             }
             return;
         };
-        let dim = first.position.len();
+        let dim = first.dimension();
         for p in &file.points[1..] {
-            if p.position.len() != dim {
+            if p.dimension() != dim {
                 self.error(
                     Diagnostic::new(
                         p.location,
                         format!(
                             "point `{}` has {} components but point `{}` has {dim}",
                             p.name.value,
-                            p.position.len(),
+                            p.dimension(),
                             first.name.value
                         ),
                     )
@@ -614,18 +639,169 @@ impl<'f> Checker<'f> {
                 ));
             }
         }
-        if dim == 3 {
-            for b in &file.bodies {
-                if matches!(b.kind, BodyKind::Rigid { .. }) {
+        for b in &file.bodies {
+            match (&b.kind, dim) {
+                (BodyKind::Rigid { .. }, 3) => self.error(
+                    Diagnostic::new(
+                        b.name.location,
+                        format!("body `{}` is a planar rigid body, but the points are 3-D", b.name.value),
+                    )
+                    .with_help("a planar body (`inertia` a number, `angle`) turns in the plane of 2-component points; in 3-D a rigid body has a frame and an inertia tensor: `{ mass: m, com: G, frame: B, inertia: [I1, I2, I3] }`"),
+                ),
+                (BodyKind::Spatial { frame, .. }, 2) => self.error(
+                    Diagnostic::new(
+                        frame.location,
+                        format!("body `{}` is a 3-D rigid body, but the points are planar", b.name.value),
+                    )
+                    .with_help("a 3-D body's centre of mass is a 3-D point (`[x, y, z]` or `{ from: O, B: [0, 0, l] }`); a planar body is `{ mass: m, inertia: I, com: G, angle: theta }`"),
+                ),
+                _ => {}
+            }
+        }
+        for f in &file.forces {
+            if let Some(frame) = &f.frame
+                && f.vector.len() != 3
+            {
+                self.error(
+                    Diagnostic::new(frame.location, format!("force `{}` is written in frame `{}`, which needs 3 components", f.name.value, frame.value))
+                        .with_help("frames are 3-D: write `vector: [Fx, Fy, Fz]`, or leave out `in` for components in the plane"),
+                );
+            }
+        }
+        for t in &file.torques {
+            if let TorqueValue::Spatial {
+                vector, location, ..
+            } = &t.value
+                && vector.len() != 3
+            {
+                self.error(
+                    Diagnostic::new(*location, format!("the vector of torque `{}` has {} components; a torque on a 3-D body has 3", t.name.value, vector.len()))
+                        .with_help("write `vector: [Tx, Ty, Tz]`; a torque on a planar body is `value: tau`"),
+                );
+            }
+        }
+        if dim == 2
+            && let Some(f) = file.frames.first()
+        {
+            self.error(
+                Diagnostic::new(f.name.location, format!("frame `{}` is 3-D, but the points are planar", f.name.value))
+                    .with_help("frames orient 3-D bodies and place 3-D points; a planar model gives its bodies an `angle`"),
+            );
+        }
+    }
+
+    // Rule: frames have distinct names other than the ground `N` and `from`; each frame's
+    // parent is `N` or a frame defined before it (so that frames form a tree); a point
+    // written from another point names one defined before it, and its vectors known frames.
+    fn frames(&mut self) {
+        let file = self.file;
+        let mut defined: Vec<&str> = vec![GROUND_FRAME];
+        for f in &file.frames {
+            let n = f.name.value.as_str();
+            if n == GROUND_FRAME || n == "from" {
+                let why = if n == "from" {
+                    "`from` is the key of a point's start"
+                } else {
+                    "`N` is the ground frame"
+                };
+                self.error(
+                    Diagnostic::new(
+                        f.name.location,
+                        format!("frame name `{n}` is reserved: {why}"),
+                    )
+                    .with_help("choose another name"),
+                );
+                continue;
+            }
+            let p = f.parent.value.as_str();
+            if !defined.contains(&p) {
+                let later = file.frames.iter().any(|g| g.name.value == p);
+                let d = if later {
+                    Diagnostic::new(f.parent.location, format!("frame `{n}` is turned from `{p}`, which is not defined before it"))
+                        .with_help("define a frame's parent above it (frames form a tree rooted at the ground frame `N`)")
+                } else {
+                    self.unknown_frame_message(&f.parent, &defined)
+                };
+                self.error(d);
+            }
+            if defined.contains(&n) {
+                self.error(
+                    Diagnostic::new(f.name.location, format!("duplicate frame name `{n}`"))
+                        .with_help("rename one"),
+                );
+            }
+            defined.push(n);
+        }
+        let frames: Vec<&str> = file
+            .frames
+            .iter()
+            .map(|f| f.name.value.as_str())
+            .chain([GROUND_FRAME])
+            .collect();
+        for (i, p) in file.points.iter().enumerate() {
+            let Some(relative) = &p.relative else {
+                continue;
+            };
+            if let Some(from) = &relative.from {
+                let earlier = file.points[..i].iter().any(|q| q.name.value == from.value);
+                let later = file.points[i..].iter().any(|q| q.name.value == from.value);
+                if later && !earlier {
                     self.error(
                         Diagnostic::new(
-                            b.name.location,
-                            format!("body `{}` is a planar rigid body, but the points are 3-D", b.name.value),
+                            from.location,
+                            format!(
+                                "point `{}` is measured from `{}`, which is not defined before it",
+                                p.name.value, from.value
+                            ),
                         )
-                        .with_help("rigid bodies (with `inertia` and `angle`) are planar: use 2-component points, or model the body as particles"),
+                        .with_help("define the point it starts from above it"),
                     );
+                } else {
+                    self.point(from);
                 }
             }
+            for (frame, _) in &relative.vectors {
+                self.frame(frame, &frames);
+            }
+        }
+        for b in &file.bodies {
+            if let BodyKind::Spatial { frame, .. } = &b.kind {
+                self.frame(frame, &frames);
+            }
+        }
+        for f in &file.forces {
+            if let Some(frame) = &f.frame {
+                self.frame(frame, &frames);
+            }
+        }
+        for t in &file.torques {
+            if let TorqueValue::Spatial {
+                frame: Some(frame), ..
+            } = &t.value
+            {
+                self.frame(frame, &frames);
+            }
+        }
+    }
+
+    /// Reports `name` if it is not one of `frames`.
+    fn frame(&mut self, name: &Located<String>, frames: &[&str]) {
+        if frames.contains(&name.value.as_str()) || self.incomplete.has_name(&name.value) {
+            return;
+        }
+        let d = self.unknown_frame_message(name, frames);
+        self.error(d);
+    }
+
+    /// "unknown frame", with the closest of `frames`.
+    fn unknown_frame_message(&self, name: &Located<String>, frames: &[&str]) -> Diagnostic {
+        let d = Diagnostic::new(name.location, format!("unknown frame `{}`", name.value));
+        match closest(&name.value, frames) {
+            Some(c) => d.with_help(format!("did you mean `{c}`?")),
+            None => d.with_help(format!(
+                "frames are: {} (the ground); declare one under `frames:`",
+                frames.join(", ")
+            )),
         }
     }
 
@@ -653,10 +829,7 @@ impl<'f> Checker<'f> {
     fn references(&mut self) {
         let file = self.file;
         for b in &file.bodies {
-            match &b.kind {
-                BodyKind::Particle { at, .. } => self.point(at),
-                BodyKind::Rigid { com, .. } => self.point(com),
-            }
+            self.point(b.kind.com());
         }
         for s in &file.springs {
             s.between.iter().for_each(|p| self.point(p));
@@ -676,14 +849,25 @@ impl<'f> Checker<'f> {
         for t in &file.torques {
             let name = &t.body.value;
             match file.bodies.iter().find(|b| b.name.value == *name) {
-                Some(b) if matches!(b.kind, BodyKind::Rigid { .. }) => {}
-                Some(_) => self.error(
-                    Diagnostic::new(
-                        t.body.location,
-                        format!("torque `{}` acts on `{name}`, which is a particle", t.name.value),
-                    )
-                    .with_help("torques act on planar rigid bodies (with `inertia` and `angle`); apply a force to a particle"),
-                ),
+                Some(b) => match (&b.kind, &t.value) {
+                    (BodyKind::Rigid { .. }, TorqueValue::Planar(_))
+                    | (BodyKind::Spatial { .. }, TorqueValue::Spatial { .. }) => {}
+                    (BodyKind::Rigid { .. }, TorqueValue::Spatial { location, .. }) => self.error(
+                        Diagnostic::new(*location, format!("torque `{}` is a 3-D vector, but `{name}` is a planar rigid body", t.name.value))
+                            .with_help("a torque on a planar body is `value: tau` (counter-clockwise, about the axis normal to the plane)"),
+                    ),
+                    (BodyKind::Spatial { .. }, TorqueValue::Planar(e)) => self.error(
+                        Diagnostic::new(e.location, format!("torque `{}` is a number, but `{name}` is a 3-D rigid body", t.name.value))
+                            .with_help("a torque on a 3-D body is a vector: `{ body: B, vector: [0, 0, T], in: B }`"),
+                    ),
+                    (BodyKind::Particle { .. }, _) => self.error(
+                        Diagnostic::new(
+                            t.body.location,
+                            format!("torque `{}` acts on `{name}`, which is a particle", t.name.value),
+                        )
+                        .with_help("torques act on rigid bodies (planar with `inertia` and `angle`, 3-D with `frame`); apply a force to a particle"),
+                    ),
+                },
                 None if self.incomplete.has_name(name)
                     || self.section_lost("bodies", file.bodies.is_empty()) => {}
                 None => {
@@ -1200,6 +1384,10 @@ impl<'f> Checker<'f> {
             let (mass, inertia) = match &b.kind {
                 BodyKind::Particle { mass, .. } => (mass, None),
                 BodyKind::Rigid { mass, inertia, .. } => (mass, Some(inertia)),
+                BodyKind::Spatial { mass, inertia, .. } => {
+                    self.inertia_tensor(&b.name.value, inertia);
+                    (mass, None)
+                }
             };
             if let Some(m) = evaluate(mass, &file.parameters)
                 && (m.is_nan() || m <= 0.0)
@@ -1229,6 +1417,49 @@ impl<'f> Checker<'f> {
                     ),
                 );
             }
+        }
+    }
+}
+
+impl Checker<'_> {
+    /// Reports a 3-D inertia tensor that is not positive definite at the parameters'
+    /// defaults (Sylvester's criterion on its leading minors). (Symmetric it is by
+    /// construction: each off-diagonal entry is written once.)
+    fn inertia_tensor(&mut self, body: &str, inertia: &InertiaTensor) {
+        let parameters = &self.file.parameters;
+        let mut e = [0.0; 6];
+        for (slot, entry) in e.iter_mut().zip(&inertia.entries) {
+            if let Some(x) = entry {
+                match evaluate(x, parameters) {
+                    Some(v) if v.is_finite() => *slot = v,
+                    _ => return,
+                }
+            }
+        }
+        let [xx, yy, zz, xy, yz, xz] = e;
+        let minors = [
+            xx,
+            xx * yy - xy * xy,
+            xx * (yy * zz - yz * yz) - xy * (xy * zz - yz * xz) + xz * (xy * yz - yy * xz),
+        ];
+        // Relative to the tensor's size, so that rounding of a singular tensor is not
+        // taken for definiteness.
+        let scale = xx.abs().max(yy.abs()).max(zz.abs());
+        let definite = scale > 0.0
+            && minors
+                .iter()
+                .zip(1..)
+                .all(|(m, k)| *m > 1e-12 * scale.powi(k));
+        if !definite {
+            self.error(
+                Diagnostic::new(
+                    inertia.location,
+                    format!(
+                        "the inertia of body `{body}` is not positive definite: [[{xx}, {xy}, {xz}], [{xy}, {yy}, {yz}], [{xz}, {yz}, {zz}]] kg·m² at the parameters' defaults"
+                    ),
+                )
+                .with_help("a rigid body's inertia tensor about its centre of mass is positive definite (its three principal moments are positive); a moment ≤ 0, or an off-diagonal entry as large as the moments it joins, is not"),
+            );
         }
     }
 }

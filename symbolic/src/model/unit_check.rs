@@ -32,7 +32,7 @@ use std::collections::HashMap;
 
 use super::ast::{BinOp, Expr, ExprKind};
 use super::diagnostic::Diagnostic;
-use super::file::{BalanceKind, BodyKind, ModelFile};
+use super::file::{BalanceKind, BodyKind, InertiaTensor, ModelFile, TorqueValue};
 use super::located::Location;
 use super::parser::identifiers;
 use super::units::{Dimension, Rational, parse_unit};
@@ -969,7 +969,9 @@ impl<'f> Checker<'f> {
             });
         }
         for p in &file.points {
-            for (axis, c) in AXES.iter().zip(&p.position) {
+            let relative = p.relative.iter().flat_map(|r| &r.vectors);
+            let in_frames = relative.flat_map(|(_, v)| AXES.iter().zip(v));
+            for (axis, c) in AXES.iter().zip(&p.position).chain(in_frames) {
                 self.fixed(
                     c,
                     Dimension::METRE,
@@ -980,10 +982,37 @@ impl<'f> Checker<'f> {
                 );
             }
         }
+        for f in &file.frames {
+            for r in &f.rotations {
+                self.fixed(
+                    &r.angle,
+                    Dimension::ONE,
+                    &format!("the rotation angle of frame `{}`", f.name.value),
+                    "an angle",
+                    "rad (a pure number)",
+                    "a rotation angle is an angle coordinate, or a function of the coordinates that gives a pure number",
+                );
+            }
+        }
         for b in &file.bodies {
             let name = &b.name.value;
             let (mass, inertia_angle) = match &b.kind {
                 BodyKind::Particle { mass, .. } => (mass, None),
+                BodyKind::Spatial { mass, inertia, .. } => {
+                    for (key, e) in InertiaTensor::KEYS.iter().zip(&inertia.entries) {
+                        if let Some(e) = e {
+                            self.fixed(
+                                e,
+                                Dimension::INERTIA,
+                                &format!("the `{key}` inertia of body `{name}`"),
+                                "a moment of inertia",
+                                "kg*m^2",
+                                "an entry of an inertia tensor is mass × length², as in `m*r^2/2` for a disc about its axis",
+                            );
+                        }
+                    }
+                    (mass, None)
+                }
                 BodyKind::Rigid {
                     mass,
                     inertia,
@@ -1074,14 +1103,22 @@ impl<'f> Checker<'f> {
             }
         }
         for t in &file.torques {
-            self.fixed(
-                &t.value,
-                Dimension::JOULE,
-                &format!("torque `{}`", t.name.value),
-                "a torque",
-                "N*m",
-                "a torque is force × lever arm, N*m",
-            );
+            for (i, e) in t.value.expressions().into_iter().enumerate() {
+                let what = match &t.value {
+                    TorqueValue::Planar(_) => format!("torque `{}`", t.name.value),
+                    TorqueValue::Spatial { .. } => {
+                        format!("the {} component of torque `{}`", AXES[i], t.name.value)
+                    }
+                };
+                self.fixed(
+                    e,
+                    Dimension::JOULE,
+                    &what,
+                    "a torque",
+                    "N*m",
+                    "a torque is force × lever arm, N*m",
+                );
+            }
         }
         self.constraints.clear();
         for (holonomic, list) in [(true, &file.constraints), (false, &file.nonholonomic)] {

@@ -4,9 +4,11 @@
 use super::walk::{Fields, Keyed, Need};
 use super::*;
 
-const BODY_KEYS: &[&str] = &["mass", "at", "inertia", "com", "angle"];
+const BODY_KEYS: &[&str] = &["mass", "at", "inertia", "com", "angle", "frame"];
 const PARTICLE_EXAMPLE: &str = "{ mass: m, at: P }";
 const RIGID_EXAMPLE: &str = "{ mass: m, inertia: m*l^2/12, com: G, angle: theta }";
+const SPATIAL_EXAMPLE: &str = "{ mass: m, com: G, frame: B, inertia: [I1, I2, I3] }";
+const FRAME_EXAMPLE: &str = "{ parent: N, axes: zxz, angles: [psi, theta, phi] }";
 
 /// The keys of a spring.
 const SPRING: Fields = Fields {
@@ -29,15 +31,38 @@ const DAMPER: Fields = Fields {
 /// The keys of a force.
 const FORCE: Fields = Fields {
     kind: "force",
-    keys: &[("at", Need::Required), ("vector", Need::Required)],
+    keys: &[
+        ("at", Need::Required),
+        ("vector", Need::Required),
+        ("in", Need::Optional),
+    ],
     example: "{ at: P, vector: [F0*cos(w*t), 0] }",
 };
 
-/// The keys of a torque.
+/// The keys of a torque (`value` on a planar body, `vector` and `in` on a 3-D one).
 const TORQUE: Fields = Fields {
     kind: "torque",
-    keys: &[("body", Need::Required), ("value", Need::Required)],
+    keys: &[
+        ("body", Need::Required),
+        ("value", Need::Optional),
+        ("vector", Need::Optional),
+        ("in", Need::Optional),
+    ],
     example: "{ body: arm, value: tau0*sin(w*t) }",
+};
+
+/// The keys of a frame.
+const FRAME: Fields = Fields {
+    kind: "frame",
+    keys: &[
+        ("parent", Need::Optional),
+        ("axis", Need::Optional),
+        ("angle", Need::Optional),
+        ("axes", Need::Optional),
+        ("angles", Need::Optional),
+        ("about", Need::Optional),
+    ],
+    example: FRAME_EXAMPLE,
 };
 
 /// The keys of an angular momentum balance.
@@ -68,6 +93,15 @@ impl Ctx<'_> {
             drop: true,
         };
         self.keyed(node, spec, |cx, k, v| {
+            if let YamlKind::Map(entries) = &v.kind {
+                let relative = cx.relative_position(k, entries, v.location)?;
+                return Some(Point {
+                    name: k.clone(),
+                    position: Vec::new(),
+                    relative: Some(relative),
+                    location: v.location,
+                });
+            }
             let position = cx.vector(
                 v,
                 &format!("point `{}`", k.value),
@@ -76,9 +110,203 @@ impl Ctx<'_> {
             Some(Point {
                 name: k.clone(),
                 position,
+                relative: None,
                 location: v.location,
             })
         })
+    }
+
+    /// A point written as a point plus vectors in frames: `{ from: O, B: [0, 0, l] }`.
+    fn relative_position(
+        &mut self,
+        k: &Located<String>,
+        entries: &Entries,
+        at: Location,
+    ) -> Option<RelativePosition> {
+        let what = format!("point `{}`", k.value);
+        let example = format!("{}: {{ from: O, B: [0, 0, l] }}", k.value);
+        let mut from = None;
+        let mut vectors = Vec::new();
+        let mut complete = true;
+        for (key, value) in entries {
+            if key.value == "from" {
+                match self.name(value, "`from`") {
+                    Some(p) => from = Some(p),
+                    None => complete = false,
+                }
+                continue;
+            }
+            if !self.key_name(key, "a frame") {
+                complete = false;
+                continue;
+            }
+            let in_frame = format!("the vector of {what} in frame `{}`", key.value);
+            match self.vector(value, &in_frame, "B: [0, 0, l]") {
+                Some(v) if v.len() == 3 => vectors.push((key.clone(), v)),
+                Some(v) => {
+                    self.error(
+                        Diagnostic::new(
+                            value.location,
+                            format!("{in_frame} has {} components; a vector in a frame has 3", v.len()),
+                        )
+                        .with_help("write its components along the frame's x, y and z axes, as in `B: [0, 0, l]`"),
+                    );
+                    complete = false;
+                }
+                None => complete = false,
+            }
+        }
+        if from.is_none() && vectors.is_empty() && complete {
+            self.error(
+                Diagnostic::new(
+                    at,
+                    format!("{what} is a map with neither `from` nor a vector"),
+                )
+                .with_help(format!(
+                    "a point is a list `[x, y, z]` or a point plus vectors in frames: `{example}`"
+                )),
+            );
+            return None;
+        }
+        complete.then_some(RelativePosition { from, vectors })
+    }
+
+    /// `frames:` — `name: { parent, axis, angle }` or `name: { parent, axes, angles, about }`.
+    pub(super) fn frames(&mut self, node: &YamlNode) -> Vec<Frame> {
+        let example = format!("frames: {{ B: {FRAME_EXAMPLE} }}");
+        let spec = Keyed {
+            what: "`frames`",
+            example: &example,
+            names: Some("frame"),
+            drop: true,
+        };
+        self.keyed(node, spec, Self::frame)
+    }
+
+    /// One frame: its parent (the ground `N` if not given) turned by one simple rotation
+    /// (`axis`, `angle`) or by several (`axes: zxz`, `angles: [...]`), each about an axis of
+    /// the newest frame (`about: body`, the default) or of the parent (`about: parent`).
+    fn frame(&mut self, k: &Located<String>, v: &YamlNode) -> Option<Frame> {
+        let f = self.fields(k, v, &FRAME)?;
+        let what = format!("frame `{}`", k.value);
+        let example = format!("{}: {FRAME_EXAMPLE}", k.value);
+        let parent = match get(f, "parent") {
+            Some(n) => self.name(n, "`parent`")?,
+            None => Located::new(GROUND_FRAME.to_string(), k.location),
+        };
+        let single = get(f, "axis").is_some() || get(f, "angle").is_some();
+        let several = get(f, "axes").is_some() || get(f, "angles").is_some();
+        if single == several {
+            let message = if single {
+                format!("{what} has both `axis`/`angle` and `axes`/`angles`")
+            } else {
+                format!("{what} has no rotation")
+            };
+            self.error(Diagnostic::new(k.location, message).with_help(format!(
+                "one simple rotation is `{}: {{ parent: N, axis: z, angle: psi }}`; successive ones `{example}`",
+                k.value
+            )));
+            return None;
+        }
+        let (axes_key, angles_key) = if single {
+            ("axis", "angle")
+        } else {
+            ("axes", "angles")
+        };
+        if !self.require(f, k.location, &what, &[axes_key, angles_key], &example) {
+            return None;
+        }
+        let axes_node = get(f, axes_key)?;
+        let axes = self.axes(axes_node, single)?;
+        let angles: Vec<Expr> = if single {
+            vec![self.expr(get(f, "angle")?, "a rotation angle")?]
+        } else {
+            let node = get(f, "angles")?;
+            let items = self.seq(node, "`angles`", "angles: [psi, theta, phi]")?;
+            if items.len() != axes.len() {
+                self.error(
+                    Diagnostic::new(
+                        node.location,
+                        format!("{what} has {} axes but {} angles", axes.len(), items.len()),
+                    )
+                    .with_help("give one angle per axis, in the same order"),
+                );
+                return None;
+            }
+            let angles: Vec<Option<Expr>> = items
+                .iter()
+                .map(|i| self.expr(i, "a rotation angle"))
+                .collect();
+            angles.into_iter().collect::<Option<_>>()?
+        };
+        let about_parent = match get(f, "about") {
+            None => false,
+            Some(n) => self.choice(n, "`about`", &[("body", false), ("parent", true)])?,
+        };
+        let mut rotations: Vec<SimpleRotation> = axes
+            .into_iter()
+            .zip(angles)
+            .map(|(axis, angle)| SimpleRotation { axis, angle })
+            .collect();
+        // Rotations about the parent's fixed axes in the order a, b, c give the orientation
+        // of rotations about the newest frame's axes in the order c, b, a.
+        if about_parent {
+            rotations.reverse();
+        }
+        Some(Frame {
+            name: k.clone(),
+            parent,
+            rotations,
+        })
+    }
+
+    /// The axes of a frame's rotations: `x`, `y` or `z` (one, for `axis`), or a word of
+    /// them (`zxz`, for `axes`).
+    fn axes(&mut self, node: &YamlNode, single: bool) -> Option<Vec<Located<Axis>>> {
+        let what = if single { "`axis`" } else { "`axes`" };
+        let text = match &node.kind {
+            YamlKind::Scalar { text, .. } => text.trim().to_string(),
+            _ => String::new(),
+        };
+        let axes: Option<Vec<Located<Axis>>> = text
+            .chars()
+            .enumerate()
+            .map(|(i, c)| {
+                let axis = match c {
+                    'x' => Axis::X,
+                    'y' => Axis::Y,
+                    'z' => Axis::Z,
+                    _ => return None,
+                };
+                Some(Located::new(axis, node.location.offset(i)))
+            })
+            .collect();
+        match axes {
+            Some(a) if !a.is_empty() && (!single || a.len() == 1) => Some(a),
+            _ => {
+                let help = if single {
+                    "a simple rotation is about the `x`, `y` or `z` axis (write `axis: z`; to turn the other way, negate the angle)"
+                } else {
+                    "write the axes of the successive rotations as one word of `x`, `y` and `z`, as in `axes: zxz` (Euler angles) or `axes: zyx` (yaw, pitch, roll)"
+                };
+                self.error(
+                    Diagnostic::new(
+                        node.location,
+                        format!(
+                            "{what} must be {}, found {}",
+                            if single {
+                                "x, y or z"
+                            } else {
+                                "a word of x, y and z"
+                            },
+                            node.kind.describe()
+                        ),
+                    )
+                    .with_help(help),
+                );
+                None
+            }
+        }
     }
 
     /// `bodies:` — `name: { mass, at }` or `name: { mass, inertia, com, angle }`.
@@ -98,6 +326,23 @@ impl Ctx<'_> {
         let what = format!("body `{}`", k.value);
         let f = self.map(v, &what, &format!("{}: {PARTICLE_EXAMPLE}", k.value))?;
         self.unknown_keys(f, &what, BODY_KEYS, BODY_KEYS);
+        if get(f, "frame").is_some() {
+            return self.spatial_body(k, f);
+        }
+        if let Some(inertia) = get(f, "inertia")
+            && !matches!(inertia.kind, YamlKind::Scalar { .. })
+        {
+            self.error(
+                Diagnostic::new(
+                    inertia.location,
+                    format!("{what} has an inertia tensor but no `frame`"),
+                )
+                .with_help(format!(
+                    "a planar rigid body has a scalar inertia about the axis normal to the plane (`{RIGID_EXAMPLE}`); a 3-D body has the frame its inertia is written in: `{SPATIAL_EXAMPLE}`"
+                )),
+            );
+            return None;
+        }
         let rigid_key = ["inertia", "com", "angle"]
             .into_iter()
             .find(|r| get(f, r).is_some());
@@ -162,6 +407,114 @@ impl Ctx<'_> {
                 com,
                 angle,
             },
+        })
+    }
+
+    /// A 3-D rigid body: `{ mass, com, frame, inertia }`.
+    fn spatial_body(&mut self, k: &Located<String>, f: &Entries) -> Option<Body> {
+        let what = format!("body `{}`", k.value);
+        let example = format!("{}: {SPATIAL_EXAMPLE}", k.value);
+        for (key, planar) in [("angle", true), ("at", false)] {
+            if let Some(at) = get_key(f, key) {
+                let help = if planar {
+                    format!(
+                        "the orientation of a 3-D body is its `frame`, whose rotations give its angular velocity; `angle` is for planar bodies: `{example}`"
+                    )
+                } else {
+                    format!("a rigid body's position is its centre of mass `com`: `{example}`")
+                };
+                self.error(
+                    Diagnostic::new(
+                        at.location,
+                        format!(
+                            "{what} has a `frame`, so it is a 3-D rigid body, which has no `{key}`"
+                        ),
+                    )
+                    .with_help(help),
+                );
+            }
+        }
+        let complete = self.require(
+            f,
+            k.location,
+            &format!("{what} (a 3-D rigid body, as it has `frame`)"),
+            &["mass", "com", "frame", "inertia"],
+            &example,
+        );
+        let mass = get(f, "mass").and_then(|n| self.expr(n, "a mass"));
+        let com = get(f, "com").and_then(|n| self.name(n, "`com`"));
+        let frame = get(f, "frame").and_then(|n| self.name(n, "`frame`"));
+        let inertia = get(f, "inertia").and_then(|n| self.inertia_tensor(n));
+        let (Some(mass), Some(com), Some(frame), Some(inertia), true) = (
+            mass,
+            com,
+            frame,
+            inertia,
+            complete && get(f, "angle").is_none() && get(f, "at").is_none(),
+        ) else {
+            return None;
+        };
+        Some(Body {
+            name: k.clone(),
+            kind: BodyKind::Spatial {
+                mass,
+                com,
+                frame,
+                inertia: Box::new(inertia),
+            },
+        })
+    }
+
+    /// A 3-D inertia tensor: `[Ixx, Iyy, Izz]` (principal axes along the frame's) or
+    /// `{ xx, yy, zz, xy, yz, xz }` (the off-diagonal tensor entries optional, 0 if left out).
+    fn inertia_tensor(&mut self, node: &YamlNode) -> Option<InertiaTensor> {
+        const HELP: &str = "the inertia of a 3-D body about its centre of mass, in its frame's axes, is `[Ixx, Iyy, Izz]` (principal axes) or `{ xx: Ixx, yy: Iyy, zz: Izz, xz: Ixz }` (off-diagonal tensor entries, −∫xz dm, 0 if left out)";
+        let mut entries: [Option<Expr>; 6] = Default::default();
+        match &node.kind {
+            YamlKind::Seq(items) if items.len() == 3 => {
+                for (slot, item) in entries.iter_mut().zip(items) {
+                    *slot = Some(self.expr(item, "a moment of inertia")?);
+                }
+            }
+            YamlKind::Map(map) => {
+                self.unknown_keys(
+                    map,
+                    "a 3-D inertia",
+                    &InertiaTensor::KEYS,
+                    &InertiaTensor::KEYS,
+                );
+                if !self.require(
+                    map,
+                    node.location,
+                    "a 3-D inertia",
+                    &InertiaTensor::KEYS[..3],
+                    "inertia: { xx: Ixx, yy: Iyy, zz: Izz, xz: Ixz }",
+                ) {
+                    return None;
+                }
+                for (slot, key) in entries.iter_mut().zip(InertiaTensor::KEYS) {
+                    if let Some(n) = get(map, key) {
+                        *slot = Some(self.expr(n, "an entry of an inertia tensor")?);
+                    }
+                }
+            }
+            other => {
+                self.error(
+                    Diagnostic::new(
+                        node.location,
+                        format!(
+                            "a 3-D body's inertia must be a list of three moments or a map of tensor entries, found {}",
+                            other.describe()
+                        ),
+                    )
+                    .with_help(HELP),
+                );
+                return None;
+            }
+        }
+        Some(InertiaTensor {
+            entries,
+            location: node.location,
         })
     }
 
@@ -233,11 +586,16 @@ impl Ctx<'_> {
                 )
                 .map(|x| (x, n.location))
             });
+            let frame = match get(f, "in") {
+                Some(n) => cx.name(n, "`in`").map(Some),
+                None => Some(None),
+            };
             let (vector, location) = vector?;
             Some(Force {
                 name: k.clone(),
                 at: at?,
                 vector,
+                frame: frame?,
                 location,
             })
         })
@@ -255,7 +613,38 @@ impl Ctx<'_> {
         self.keyed(node, spec, |cx, k, v| {
             let f = cx.fields(k, v, &TORQUE)?;
             let body = get(f, "body").and_then(|n| cx.name(n, "`body`"));
-            let value = get(f, "value").and_then(|n| cx.expr(n, "a torque"));
+            let what = format!("torque `{}`", k.value);
+            let value = match (get(f, "value"), get(f, "vector")) {
+                (Some(n), None) => {
+                    if let Some(i) = get_key(f, "in") {
+                        cx.error(
+                            Diagnostic::new(i.location, format!("{what} has a `value`, which is about the axis normal to the plane, so it has no frame `in`"))
+                                .with_help("a torque on a 3-D body is `{ body: B, vector: [Tx, Ty, Tz], in: B }`"),
+                        );
+                        return None;
+                    }
+                    cx.expr(n, "a torque").map(TorqueValue::Planar)
+                }
+                (None, Some(n)) => {
+                    let frame = match get(f, "in") {
+                        Some(i) => Some(cx.name(i, "`in`")?),
+                        None => None,
+                    };
+                    let vector = cx.vector(n, &format!("the vector of {what}"), "vector: [0, 0, T]")?;
+                    Some(TorqueValue::Spatial {
+                        vector,
+                        frame,
+                        location: n.location,
+                    })
+                }
+                (Some(_), Some(_)) | (None, None) => {
+                    cx.error(
+                        Diagnostic::new(k.location, format!("{what} needs one of `value` (planar bodies) and `vector` (3-D bodies)"))
+                            .with_help("on a planar body `{ body: arm, value: tau }` (counter-clockwise); on a 3-D body `{ body: B, vector: [Tx, Ty, Tz], in: B }`"),
+                    );
+                    None
+                }
+            };
             Some(Torque {
                 name: k.clone(),
                 body: body?,

@@ -56,6 +56,7 @@ pub const TOP_LEVEL_KEYS: &[&str] = &[
     "kinetic",
     "potential",
     "generalized_forces",
+    "frames",
     "points",
     "bodies",
     "gravity",

@@ -102,6 +102,11 @@ const SECTIONS: &[Section] = &[
         missing: None,
     },
     Section {
+        key: "frames",
+        read: |cx, n, file| file.frames = cx.frames(n),
+        missing: None,
+    },
+    Section {
         key: "points",
         read: |cx, n, file| file.points = cx.points(n),
         missing: None,
@@ -257,6 +262,7 @@ impl Ctx<'_> {
             kinetic: None,
             potential: None,
             generalized_forces: Vec::new(),
+            frames: Vec::new(),
             points: Vec::new(),
             bodies: Vec::new(),
             gravity: None,
@@ -288,7 +294,7 @@ impl Ctx<'_> {
             }
         }
         self.section = "";
-        file.dimension = file.points.first().map(|p| p.position.len());
+        file.dimension = file.points.first().map(Point::dimension);
         Some(file)
     }
 

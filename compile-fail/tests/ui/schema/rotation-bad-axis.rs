@@ -1,0 +1,3 @@
+eomgen::model!("rotation-bad-axis.yaml");
+
+fn main() {}

@@ -1,0 +1,3 @@
+eomgen::model!("inertia-not-positive-definite.yaml");
+
+fn main() {}

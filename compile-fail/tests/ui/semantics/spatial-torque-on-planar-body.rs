@@ -1,0 +1,3 @@
+eomgen::model!("spatial-torque-on-planar-body.yaml");
+
+fn main() {}

@@ -1,0 +1,3 @@
+eomgen::model!("unknown-frame.yaml");
+
+fn main() {}

@@ -1,0 +1,215 @@
+//! Reference frames as chains of simple rotations from the ground frame `N`: vectors carried
+//! between frames, and the angular velocity of a frame in `N`.
+//!
+//! A frame is its parent turned by successive simple rotations, each by an angle `a` about
+//! an axis fixed in both the frame before and the frame after it (Kane & Levinson, *Dynamics:
+//! Theory and Applications*, McGraw-Hill 1985, §1.7–1.9 and §2.4–2.5). A rotation by `a` about
+//! axis `i` (with `j`, `k` the next axes in cyclic order) carries components in the turned
+//! frame to the frame before it as
+//!
+//! ```text
+//! v′ⱼ = cos a vⱼ − sin a vₖ,   v′ₖ = sin a vⱼ + cos a vₖ,   v′ᵢ = vᵢ
+//! ```
+//!
+//! and back by the transpose. Vectors are carried through the tree of frames rotation by
+//! rotation, up to the lowest common ancestor and down again, never by multiplied-out
+//! direction-cosine matrices, which keeps the expressions as short as the chain allows.
+//!
+//! Angular velocity is the sum of the simple angular velocities along the chain (the
+//! addition theorem, Kane & Levinson §2.4): `^N ω^F = Σ ȧₖ eₖ`, each axis `eₖ` carried into
+//! `F`'s components — no derivative of a rotation matrix is taken.
+
+use crate::expr::{ExprArena, ExprId};
+
+/// A 3-vector of expressions: components along the axes of some frame.
+pub type Vector3 = [ExprId; 3];
+
+/// The frames of a model: index 0 is the ground frame `N`, the others follow in file order.
+#[derive(Debug, Clone, Default)]
+pub struct Frames {
+    /// Names, `N` first.
+    names: Vec<String>,
+    /// Parent of each frame (index); the ground's is itself.
+    parents: Vec<usize>,
+    /// Each frame's rotations from its parent, in the order they are applied: `(axis, angle)`.
+    rotations: Vec<Vec<(usize, ExprId)>>,
+}
+
+impl Frames {
+    /// Only the ground frame `N`.
+    pub fn ground(name: &str) -> Self {
+        Self {
+            names: vec![name.to_string()],
+            parents: vec![0],
+            rotations: vec![Vec::new()],
+        }
+    }
+
+    /// Adds frame `name`, turned from `parent` (an index) by `rotations` (axis index 0–2 and
+    /// angle, in the order applied); returns its index.
+    pub fn add(&mut self, name: &str, parent: usize, rotations: Vec<(usize, ExprId)>) -> usize {
+        self.names.push(name.to_string());
+        self.parents.push(parent);
+        self.rotations.push(rotations);
+        self.names.len() - 1
+    }
+
+    /// The index of the frame called `name`.
+    pub fn index(&self, name: &str) -> Option<usize> {
+        self.names.iter().position(|n| n == name)
+    }
+
+    /// The frames from the ground down to `frame`, both included.
+    fn path(&self, frame: usize) -> Vec<usize> {
+        let mut path = vec![frame];
+        let mut f = frame;
+        while f != 0 {
+            f = self.parents[f];
+            path.push(f);
+        }
+        path.reverse();
+        path
+    }
+
+    /// `v`, given in `from`'s components, in `to`'s components.
+    pub fn express(&self, arena: &mut ExprArena, v: Vector3, from: usize, to: usize) -> Vector3 {
+        let (up, down) = (self.path(from), self.path(to));
+        let common = up.iter().zip(&down).take_while(|(a, b)| a == b).count();
+        let mut v = v;
+        // Up from `from` to the common ancestor: each frame's rotations undone, last first.
+        for &f in up[common..].iter().rev() {
+            for &(axis, angle) in self.rotations[f].iter().rev() {
+                v = rotate(arena, v, axis, angle, false);
+            }
+        }
+        // Down to `to`: each frame's rotations applied, first first.
+        for &f in &down[common..] {
+            for &(axis, angle) in &self.rotations[f] {
+                v = rotate(arena, v, axis, angle, true);
+            }
+        }
+        v
+    }
+
+    /// `^N ω^F`, the angular velocity of `frame` in the ground frame, in `frame`'s components
+    /// (rad/s): the simple angular velocities `ȧ e` of the rotations from `N` down to it,
+    /// each carried into its components.
+    pub fn angular_velocity(&mut self, arena: &mut ExprArena, frame: usize) -> Vector3 {
+        let zero = arena.int(0);
+        let mut w = [zero; 3];
+        for f in self.path(frame).into_iter().skip(1) {
+            for &(axis, angle) in &self.rotations[f] {
+                w = rotate(arena, w, axis, angle, true);
+                let rate = arena.time_derivative(angle);
+                w[axis] = arena.plus(w[axis], rate);
+            }
+        }
+        w
+    }
+}
+
+/// Components `v` carried across one simple rotation by `angle` about `axis`: from the frame
+/// before it into the turned frame (`into_turned`), or back.
+fn rotate(
+    arena: &mut ExprArena,
+    v: Vector3,
+    axis: usize,
+    angle: ExprId,
+    into_turned: bool,
+) -> Vector3 {
+    let (j, k) = ((axis + 1) % 3, (axis + 2) % 3);
+    if arena.is_zero(v[j]) && arena.is_zero(v[k]) {
+        return v;
+    }
+    let (c, s) = (arena.cos(angle), arena.sin(angle));
+    // Into the turned frame the rotation is transposed: `−sin a` where the way back has
+    // `sin a`.
+    let s = if into_turned { arena.neg(s) } else { s };
+    let cj = arena.times(c, v[j]);
+    let sk = arena.times(s, v[k]);
+    let sj = arena.times(s, v[j]);
+    let ck = arena.times(c, v[k]);
+    let mut out = v;
+    out[j] = arena.minus(cj, sk);
+    out[k] = arena.plus(sj, ck);
+    out
+}
+
+/// `a × b`.
+pub fn cross(arena: &mut ExprArena, a: &Vector3, b: &Vector3) -> Vector3 {
+    let mut out = *a;
+    for (i, slot) in out.iter_mut().enumerate() {
+        let (j, k) = ((i + 1) % 3, (i + 2) % 3);
+        let p = arena.times(a[j], b[k]);
+        let q = arena.times(a[k], b[j]);
+        *slot = arena.minus(p, q);
+    }
+    out
+}
+
+/// `I v` for the symmetric tensor `I` given as `[xx, yy, zz, xy, yz, xz]`.
+pub fn tensor_times(arena: &mut ExprArena, inertia: &[ExprId; 6], v: &Vector3) -> Vector3 {
+    let [xx, yy, zz, xy, yz, xz] = *inertia;
+    let rows = [[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]];
+    rows.map(|row| {
+        let terms: Vec<ExprId> = row
+            .iter()
+            .zip(v)
+            .map(|(a, b)| arena.times(*a, *b))
+            .collect();
+        arena.sum(&terms)
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Numbers of `v` at `q = values` (coordinates in order), rates from `rates`.
+    fn numbers(arena: &ExprArena, v: &Vector3, values: &[f64], rates: &[f64]) -> [f64; 3] {
+        let mut bindings = vec![0.0; 64];
+        for (i, s) in arena.coordinates().iter().enumerate() {
+            bindings[s[0].0 as usize] = values[i];
+            bindings[s[1].0 as usize] = rates[i];
+        }
+        v.map(|e| arena.eval(e, &bindings))
+    }
+
+    /// A z-x-z (Euler angle) chain: the angular velocity in the body's components is the
+    /// textbook `ω = (φ̇ sin θ sin ψ + θ̇ cos ψ, φ̇ sin θ cos ψ − θ̇ sin ψ, φ̇ cos θ + ψ̇)`
+    /// (Goldstein, *Classical Mechanics*, 3rd ed., eq. 4.87), and carrying a vector down and
+    /// up again gives it back.
+    #[test]
+    fn euler_angles_give_the_textbook_angular_velocity() {
+        let mut a = ExprArena::new();
+        let [phi, _, _] = a.coordinate("phi");
+        let [theta, _, _] = a.coordinate("theta");
+        let [psi, _, _] = a.coordinate("psi");
+        let mut frames = Frames::ground("N");
+        let b = frames.add("B", 0, vec![(2, phi), (0, theta), (2, psi)]);
+        let w = frames.angular_velocity(&mut a, b);
+        let (q, r) = ([0.3, 1.1, -0.7], [0.5, -0.2, 1.3]);
+        let got = numbers(&a, &w, &q, &r);
+        let (st, ct) = (q[1].sin(), q[1].cos());
+        let (sp, cp) = (q[2].sin(), q[2].cos());
+        let want = [
+            r[0] * st * sp + r[1] * cp,
+            r[0] * st * cp - r[1] * sp,
+            r[0] * ct + r[2],
+        ];
+        for i in 0..3 {
+            assert!((got[i] - want[i]).abs() < 1e-14, "{got:?} {want:?}");
+        }
+        // The body's z axis in N: (sin θ sin φ, −sin θ cos φ, cos θ).
+        let (one, zero) = (a.int(1), a.int(0));
+        let z = frames.express(&mut a, [zero, zero, one], b, 0);
+        let got = numbers(&a, &z, &q, &r);
+        let want = [st * q[0].sin(), -st * q[0].cos(), ct];
+        for i in 0..3 {
+            assert!((got[i] - want[i]).abs() < 1e-15, "{got:?} {want:?}");
+        }
+        let back = frames.express(&mut a, z, 0, b);
+        let got = numbers(&a, &back, &q, &r);
+        assert!((got[0]).abs() < 1e-15 && got[1].abs() < 1e-15 && (got[2] - 1.0).abs() < 1e-15);
+    }
+}
