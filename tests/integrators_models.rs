@@ -46,12 +46,25 @@ fn generated_jacobian_matches_finite_differences() {
         let constrained = !model.description().constraint_names().is_empty();
         let n = model.num_dofs();
         let dim = 2 * n;
-        let system = model.as_ode_mut();
-        assert_eq!(system.second_order_dim(), Some(n), "{}", entry.name);
+        assert_eq!(
+            model.as_ode_mut().second_order_dim(),
+            Some(n),
+            "{}",
+            entry.name
+        );
         let mut states = 0;
         for _ in 0..20 {
             let t = rng.random_range(0.0..2.0);
             let y: Vec<f64> = (0..dim).map(|_| rng.random_range(-1.0..1.0)).collect();
+            // Near a singular configuration (Euler angles at θ = 0: heavy_top) `M⁻¹` turns
+            // the rounding of `F` into differences of 1e-6 and more; those states test the
+            // differences, not the Jacobian.
+            let (mass, _) = model.mass_matrix_and_forcing(t, &y);
+            let eigen = mass.symmetric_eigenvalues();
+            if eigen.min() < 1e-3 * eigen.max() {
+                continue;
+            }
+            let system = model.as_ode_mut();
             let mut jac = vec![f64::NAN; dim * dim];
             let exact = match system.jacobian(t, &y, &mut jac) {
                 Ok(exact) => exact,

@@ -147,20 +147,33 @@ fn largest_distance(a: &Frame, b: &Frame, which: &[usize]) -> f64 {
         .fold(0.0, f64::max)
 }
 
-/// What each mode's chart says about the mode, for its title.
-pub(super) fn describe(k: usize, omega: f64, kind: ModeKind) -> String {
+/// What each mode's chart says about the mode, for its title. The shapes are the modes of
+/// `M` and `K`; where the linearisation also has a velocity matrix `C` (`c_left_out`: damping
+/// or gyroscopic terms, which can stabilise what `K` alone would not, or the reverse), the
+/// title says that they are the undamped modes and what `K` alone predicts, not the verdict
+/// of the whole linearisation (which `eomgen modes` prints).
+pub(super) fn describe(k: usize, omega: f64, kind: ModeKind, c_left_out: bool) -> String {
     let hz = omega / std::f64::consts::TAU;
+    let mode = if c_left_out {
+        format!("undamped mode {k} (M, K without C)")
+    } else {
+        format!("mode {k}")
+    };
     match kind {
         ModeKind::Oscillatory => format!(
-            "mode {k}: ω = {} rad/s ({} Hz), oscillatory",
+            "{mode}: ω = {} rad/s ({} Hz), oscillatory",
             significant(omega),
             significant(hz)
         ),
         ModeKind::ZeroFrequency => {
-            format!("mode {k}: ω = 0 rad/s, zero-frequency (rigid-body or mechanism)")
+            format!("{mode}: ω = 0 rad/s, zero-frequency (rigid-body or mechanism)")
         }
+        ModeKind::Unstable { growth_rate } if c_left_out => format!(
+            "{mode}: negative stiffness, σ = {} 1/s without C",
+            significant(growth_rate)
+        ),
         ModeKind::Unstable { growth_rate } => format!(
-            "mode {k}: unstable, grows as e^(σt), σ = {} 1/s",
+            "{mode}: unstable, grows as e^(σt), σ = {} 1/s",
             significant(growth_rate)
         ),
     }
@@ -187,7 +200,9 @@ struct ModeDrawing {
 ///
 /// `q` is the equilibrium the modes were computed at (length `n`), `modes` its normal modes
 /// and `shapes` their shapes in the model's coordinates (`n × r`; `N Ψ` for a constrained
-/// model, whose modes are computed in minimal coordinates).
+/// model, whose modes are computed in minimal coordinates); `c_left_out` whether the
+/// linearisation has a velocity matrix `C` that the modes of `M` and `K` leave out (see
+/// [`describe`]).
 ///
 /// # Errors
 /// A usage error when the model has no points ([`check_drawable`]); a failure when a file
@@ -198,6 +213,7 @@ pub fn mode_charts(
     q: &[f64],
     modes: &NormalModes,
     shapes: &DMatrix<f64>,
+    c_left_out: bool,
 ) -> Result<Vec<String>, CliError> {
     check_drawable(model)?;
     let layout = Layout::of(model, is_three_d(model, q, shapes));
@@ -209,7 +225,7 @@ pub fn mode_charts(
         let mut title = format!(
             "{}, {}",
             model.description().name,
-            describe(k + 1, omega, kind)
+            describe(k + 1, omega, kind, c_left_out)
         );
         let displaced = if let Some(s) = mode_scale(model, &layout, q, &psi, size) {
             let plus = frame(model, &layout, &at(s));

@@ -384,7 +384,8 @@ fn check_finite(model: &str, frames: &[Frame]) -> Result<(), CliError> {
 /// mode, `q* + s ψₖ sin(ωₖ t)` over one period with [`MODE_FRAMES`] frames, played at one
 /// cycle per [`MODE_CYCLE_SECONDS`] at 1×, `s` as in the mode-shape charts (the largest
 /// point displacement a fifth of the mechanism's size). Zero-frequency and unstable modes
-/// swing their shape over a nominal 2 s cycle. `shapes`: `n × r` in the model's coordinates.
+/// swing their shape over a nominal 2 s cycle. `shapes`: `n × r` in the model's coordinates;
+/// `c_left_out` as for [`mode_plot::mode_charts`].
 ///
 /// # Errors
 /// A usage error for a model that cannot be drawn ([`Scene::of`]); a failure when a
@@ -394,6 +395,7 @@ pub(crate) fn modes(
     q: &[f64],
     modes: &NormalModes,
     shapes: &DMatrix<f64>,
+    c_left_out: bool,
 ) -> Result<Animation, CliError> {
     let mut scene = Scene::of(model, &[])?;
     scene.three_d = mode_plot::is_three_d(model, q, shapes);
@@ -428,7 +430,7 @@ pub(crate) fn modes(
             })
             .collect();
         check_finite(&model.description().name, &frames)?;
-        let described = mode_plot::describe(k + 1, omega, kind);
+        let described = mode_plot::describe(k + 1, omega, kind, c_left_out);
         let motion = match s {
             Some(s) => format!("q* + {} ψ{} sin(ω t)", short(s), k + 1),
             None => "it moves no drawn point".to_string(),

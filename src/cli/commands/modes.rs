@@ -67,6 +67,7 @@ pub fn run(args: &ModesArgs) -> Result<(), CliError> {
                 &equilibrium.q,
                 modes,
                 &shapes_q,
+                !modal.is_undamped(),
             )?;
             crate::cli::mode_plot::remove_stale_charts(prefix, charts.len())?;
             charts
@@ -74,7 +75,13 @@ pub fn run(args: &ModesArgs) -> Result<(), CliError> {
         None => Vec::new(),
     };
     if let Some(path) = &args.animate {
-        let page = crate::cli::animation::modes(model.as_ref(), &equilibrium.q, modes, &shapes_q)?;
+        let page = crate::cli::animation::modes(
+            model.as_ref(),
+            &equilibrium.q,
+            modes,
+            &shapes_q,
+            !modal.is_undamped(),
+        )?;
         crate::cli::files::write(path, page.to_html().as_bytes())?;
     }
     let mut stdout = crate::cli::output::stdout();

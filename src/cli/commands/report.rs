@@ -369,6 +369,7 @@ fn draw_mode_shapes(
         &modal.operating_point.equilibrium.q,
         modes,
         &modal.mode_shape_matrix(),
+        !modal.is_undamped(),
     ) {
         Ok(paths) => {
             for (k, (path, omega)) in paths.iter().zip(&modes.natural_frequencies).enumerate() {
