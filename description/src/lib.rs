@@ -74,6 +74,14 @@ pub struct ModelDescription {
     pub initial_guesses: List<usize>,
     /// The file's `equilibria:` names, in file order (lecture 25).
     pub equilibria: List<Text>,
+    /// Whether an entry of `equilibria:` is a steady motion (it holds rates): the model's
+    /// equilibrium guesses then give `2 n` values per entry, its coordinates and then its
+    /// rates, instead of `n`.
+    pub equilibrium_rates: bool,
+    /// The coordinates each entry of `equilibria:` declares ignorable, as
+    /// `[entry, coordinate]` index pairs (a steady motion's cyclic coordinates, which its
+    /// linearisation leaves out).
+    pub ignorable_coordinates: List<[usize; 2]>,
     /// The file's `events:`: names, directions and whether each ends the integration, in
     /// file order (lecture 17, HW21, HW36).
     pub events: List<EventSpec>,
@@ -118,6 +126,8 @@ impl ModelDescription {
         holonomic_constraints: 0,
         initial_guesses: Cow::Borrowed(&[]),
         equilibria: Cow::Borrowed(&[]),
+        equilibrium_rates: false,
+        ignorable_coordinates: Cow::Borrowed(&[]),
         events: Cow::Borrowed(&[]),
         events_need_accelerations: false,
         conservative: false,

@@ -99,6 +99,9 @@ pub trait ModelInfo: OdeSystem {
     fn project(&mut self, t: f64, y: &mut [f64], free: &[usize]) -> Result<usize, ProjectionError>;
     /// The model's named equilibrium guesses `(name, q)` ([`ModelDescription::equilibria`]).
     fn equilibrium_guesses(&self) -> Vec<(&str, Vec<f64>)>;
+    /// The rates `q̇` (length `n`) each entry of [`ModelDescription::equilibria`] holds: a
+    /// steady motion's, all 0 for an equilibrium.
+    fn equilibrium_rates(&self) -> Vec<Vec<f64>>;
     /// Makes the model event `name` terminal or not (`eomgen simulate --stop-when NAME`);
     /// returns `false` if the model has no event `name`.
     fn set_event_terminal(&mut self, name: &str, terminal: bool) -> bool;
@@ -205,6 +208,17 @@ pub(crate) struct FirstOrderParts<'a, S: ?Sized> {
     pub events: &'a mut Vec<EventSpec>,
 }
 
+/// The values of each entry of `equilibria:` as the system's `equilibrium_guesses` gives
+/// them: `n` coordinates, followed by `n` rates when the model has a steady motion
+/// ([`ModelDescription::equilibrium_rates`]).
+fn equilibrium_values<S: DynMechanicalSystem + ?Sized>(system: &S) -> Vec<Vec<f64>> {
+    let d = system.description();
+    let per = system.num_dofs() * if d.equilibrium_rates { 2 } else { 1 };
+    let mut values = vec![0.0; per * d.equilibria.len()];
+    system.equilibrium_guesses(&mut values);
+    values.chunks(per.max(1)).map(<[f64]>::to_vec).collect()
+}
+
 impl<F: FirstOrderForm> ModelInfo for F {
     fn description(&self) -> &ModelDescription {
         self.dyn_system().description()
@@ -309,15 +323,19 @@ impl<F: FirstOrderForm> ModelInfo for F {
         Ok(iterations)
     }
     fn equilibrium_guesses(&self) -> Vec<(&str, Vec<f64>)> {
-        let system = self.dyn_system();
-        let n = system.num_dofs();
-        let names = &system.description().equilibria;
-        let mut values = vec![0.0; n * names.len()];
-        system.equilibrium_guesses(&mut values);
+        let n = self.num_dofs();
+        let names = &self.description().equilibria;
         names
             .iter()
-            .zip(values.chunks(n.max(1)))
-            .map(|(name, q)| (name.as_ref(), q.to_vec()))
+            .zip(equilibrium_values(self.dyn_system()))
+            .map(|(name, values)| (name.as_ref(), values[..n].to_vec()))
+            .collect()
+    }
+    fn equilibrium_rates(&self) -> Vec<Vec<f64>> {
+        let n = self.num_dofs();
+        equilibrium_values(self.dyn_system())
+            .into_iter()
+            .map(|values| values.get(n..).map_or(vec![0.0; n], <[f64]>::to_vec))
             .collect()
     }
     fn set_event_terminal(&mut self, name: &str, terminal: bool) -> bool {

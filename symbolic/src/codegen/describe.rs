@@ -66,7 +66,14 @@ pub fn describe(model: &SymbolicModel, eom: &EquationsOfMotion, mathml: bool) ->
         constraints: c.names.iter().map(|n| text(n)).collect(),
         holonomic_constraints: c.holonomic,
         initial_guesses: Cow::Owned(model.initial_guesses.clone()),
-        equilibria: model.equilibria.iter().map(|(n, _)| text(n)).collect(),
+        equilibria: model.equilibria.iter().map(|e| text(&e.name)).collect(),
+        equilibrium_rates: model.has_steady_motions(),
+        ignorable_coordinates: model
+            .equilibria
+            .iter()
+            .enumerate()
+            .flat_map(|(k, e)| e.ignorable.iter().map(move |&c| [k, c]))
+            .collect(),
         events: model
             .events
             .iter()
@@ -149,6 +156,13 @@ pub fn description_tokens(
         .collect::<Result<_, String>>()?;
     let initial_guesses = borrowed(guesses);
     let equilibria = texts(&d.equilibria);
+    let equilibrium_rates = d.equilibrium_rates;
+    let ignorable: Vec<TokenStream> = d
+        .ignorable_coordinates
+        .iter()
+        .map(|[k, c]| super::tokens(&format!("[{k}_usize, {c}_usize]")))
+        .collect::<Result<_, String>>()?;
+    let ignorable_coordinates = borrowed(ignorable);
     let events = borrowed(
         d.events
             .iter()
@@ -192,6 +206,8 @@ pub fn description_tokens(
             holonomic_constraints: #holonomic,
             initial_guesses: #initial_guesses,
             equilibria: #equilibria,
+            equilibrium_rates: #equilibrium_rates,
+            ignorable_coordinates: #ignorable_coordinates,
             events: #events,
             events_need_accelerations: #needs,
             conservative: #conservative,

@@ -52,7 +52,8 @@ pub enum ModelFunction {
     ConstraintGamma,
     /// Event functions `g` (e); `q̈` as the acceleration symbols, `λ` as the multipliers.
     EventValues,
-    /// `n` values per named equilibrium.
+    /// `n` values per named equilibrium (`2 n`, coordinates then rates, when one is a steady
+    /// motion).
     EquilibriumGuesses,
 }
 
@@ -164,11 +165,16 @@ impl ModelFunction {
             ModelFunction::EventValues => {
                 unless_empty(model.events.iter().map(|e| e.function).collect())
             }
+            // With a steady motion among them, each entry's rates follow its coordinates
+            // ([`ModelDescription::equilibrium_rates`](eomgen_description::ModelDescription)).
             ModelFunction::EquilibriumGuesses => unless_empty(
                 model
                     .equilibria
                     .iter()
-                    .flat_map(|(_, guess)| guess.iter().copied())
+                    .flat_map(|e| {
+                        let rates = model.has_steady_motions().then_some(&e.rates);
+                        e.guess.iter().chain(rates.into_iter().flatten()).copied()
+                    })
                     .collect(),
             ),
         }

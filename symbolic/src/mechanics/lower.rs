@@ -193,12 +193,26 @@ pub struct SymbolicModel {
     pub initial_guesses: Vec<usize>,
     /// The file's `events:` (empty if none).
     pub events: Vec<EventInfo>,
-    /// The file's `equilibria:`: name and a guess per coordinate (0 where not given).
-    pub equilibria: Vec<(String, Vec<ExprId>)>,
+    /// The file's `equilibria:`, in file order.
+    pub equilibria: Vec<Equilibrium>,
     /// The file's `checks:` reference results, as the model's description keeps them.
     pub checks: eomgen_description::checks::Checks,
     /// The file's `floquet:` references, as the model's description keeps them.
     pub floquet: Vec<eomgen_description::floquet::FloquetReference>,
+}
+
+/// An entry of the file's `equilibria:`: an equilibrium or a steady motion.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Equilibrium {
+    /// Its name.
+    pub name: String,
+    /// A guess per coordinate (0 where not given), an expression of the parameters.
+    pub guess: Vec<ExprId>,
+    /// The rate per coordinate that a steady motion holds (0 where not given; all 0 for an
+    /// equilibrium).
+    pub rates: Vec<ExprId>,
+    /// Indices of the coordinates the linearisation leaves out (`ignorable:`).
+    pub ignorable: Vec<usize>,
 }
 
 /// The box in which the derivation checks draw random states (`eomgen check`, the mass
@@ -260,6 +274,14 @@ impl SymbolicModel {
 }
 
 impl SymbolicModel {
+    /// Whether an entry of `equilibria:` is a steady motion: it gives a rate that is not
+    /// identically 0.
+    pub fn has_steady_motions(&self) -> bool {
+        self.equilibria
+            .iter()
+            .any(|e| e.rates.iter().any(|r| !self.arena.is_zero(*r)))
+    }
+
     /// Number of degrees of freedom `n`.
     pub fn num_dofs(&self) -> usize {
         self.coordinates.len()
@@ -1373,20 +1395,37 @@ impl<'f> Lowering<'f> {
         events
     }
 
-    /// The named equilibria, each a value per coordinate (0 for one it does not give).
-    fn equilibria(&mut self, coordinate_names: &[String]) -> Vec<(String, Vec<ExprId>)> {
+    /// The named equilibria, each a value per coordinate (0 for one it does not give), with
+    /// the rates of a steady motion (0 where not given) and its ignorable coordinates.
+    fn equilibria(&mut self, coordinate_names: &[String]) -> Vec<Equilibrium> {
         self.file
             .equilibria
             .iter()
             .map(|q| {
                 let mut guess = vec![self.arena.int(0); coordinate_names.len()];
+                let mut rates = guess.clone();
                 for (c, e) in &q.values {
                     let value = self.expr(e);
                     if let Some(i) = coordinate_names.iter().position(|x| *x == c.value) {
                         guess[i] = value;
+                    } else if let Some(i) = coordinate_names
+                        .iter()
+                        .position(|x| c.value.strip_suffix("_dot") == Some(x.as_str()))
+                    {
+                        rates[i] = value;
                     }
                 }
-                (q.name.value.clone(), guess)
+                let ignorable = q
+                    .ignorable
+                    .iter()
+                    .filter_map(|c| coordinate_names.iter().position(|x| *x == c.value))
+                    .collect();
+                Equilibrium {
+                    name: q.name.value.clone(),
+                    guess,
+                    rates,
+                    ignorable,
+                }
             })
             .collect()
     }

@@ -560,8 +560,12 @@ pub struct EventDef {
 pub struct EquilibriumDef {
     /// Its name (`hanging`, `upright`).
     pub name: Located<String>,
-    /// Guessed coordinate values by coordinate name (constant expressions).
+    /// Guessed coordinate values by coordinate name, and the constant rates of a steady
+    /// motion by rate name (`phi_dot`), as constant expressions.
     pub values: Vec<(Located<String>, Expr)>,
+    /// `ignorable: [phi]` — coordinates that a steady motion's linearisation leaves out
+    /// (cyclic coordinates: nothing else depends on them).
+    pub ignorable: Vec<Located<String>>,
 }
 
 /// One entry of `floquet:`: the reference results that `eomgen study floquet` draws on its

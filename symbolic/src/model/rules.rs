@@ -899,20 +899,42 @@ impl<'f> Checker<'f> {
         for q in &file.equilibria {
             for (k, _) in &q.values {
                 let n = k.value.as_str();
-                if self.sets.coords.contains(n) || self.incomplete.has_name(n) || coordinates_lost {
+                let base = n.strip_suffix("_dot").unwrap_or(n);
+                if self.sets.coords.contains(n)
+                    || self.sets.rates.contains(n)
+                    || self.incomplete.has_name(base)
+                    || coordinates_lost
+                {
                     continue;
                 }
                 let d = Diagnostic::new(
                     k.location,
                     format!(
-                        "`{n}` in equilibrium `{}` is not a coordinate",
+                        "`{n}` in equilibrium `{}` is neither a coordinate nor a rate",
                         q.name.value
                     ),
                 );
-                let d = match closest(n, &self.coords) {
+                let mut candidates: Vec<&str> = self.coords.clone();
+                candidates.extend(self.rates.iter().map(String::as_str));
+                let d = match closest(n, &candidates) {
                     Some(c) => d.with_help(format!(
-                        "did you mean `{c}`? an equilibrium gives coordinates only (rates are 0)"
+                        "did you mean `{c}`? an equilibrium gives coordinates (a steady motion also the rates it holds, and `ignorable`)"
                     )),
+                    None => d.with_help(format!("coordinates are: {}", self.coords.join(", "))),
+                };
+                self.error(d);
+            }
+            for k in &q.ignorable {
+                let n = k.value.as_str();
+                if self.sets.coords.contains(n) || self.incomplete.has_name(n) || coordinates_lost {
+                    continue;
+                }
+                let d = Diagnostic::new(
+                    k.location,
+                    format!("`{n}` in `ignorable` of `{}` is not a coordinate", q.name.value),
+                );
+                let d = match closest(n, &self.coords) {
+                    Some(c) => d.with_help(format!("did you mean `{c}`?")),
                     None => d.with_help(format!("coordinates are: {}", self.coords.join(", "))),
                 };
                 self.error(d);

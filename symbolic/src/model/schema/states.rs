@@ -127,7 +127,8 @@ impl Ctx<'_> {
         })
     }
 
-    /// `equilibria:` — `name: { coordinate: value, … }`.
+    /// `equilibria:` — `name: { coordinate: value, … }`; a steady motion also gives rates
+    /// (`phi_dot: Omega`) and the coordinates it leaves out (`ignorable: [phi]`).
     pub(super) fn equilibria(&mut self, node: &YamlNode) -> Vec<EquilibriumDef> {
         let spec = Keyed {
             what: "`equilibria`",
@@ -137,17 +138,24 @@ impl Ctx<'_> {
         };
         self.keyed(node, spec, |cx, k, v| {
             let what = format!("equilibrium `{}`", k.value);
-            let values = cx.map(v, &what, &format!("{}: {{ theta: pi }}", k.value))?;
-            let values = values
-                .iter()
-                .filter_map(|(c, e)| {
-                    let e = cx.expr(e, &format!("the value of `{}` in {what}", c.value))?;
-                    Some((c.clone(), e))
-                })
-                .collect();
+            let entries = cx.map(v, &what, &format!("{}: {{ theta: pi }}", k.value))?;
+            let mut ignorable = Vec::new();
+            let mut values = Vec::new();
+            for (c, e) in entries {
+                if c.value == "ignorable" {
+                    if let Some(items) = cx.seq(e, "`ignorable`", "ignorable: [phi]") {
+                        ignorable.extend(items.iter().filter_map(|i| cx.name(i, "a coordinate")));
+                    }
+                    continue;
+                }
+                if let Some(e) = cx.expr(e, &format!("the value of `{}` in {what}", c.value)) {
+                    values.push((c.clone(), e));
+                }
+            }
             Some(EquilibriumDef {
                 name: k.clone(),
                 values,
+                ignorable,
             })
         })
     }
