@@ -63,7 +63,7 @@ pub use integrate::{
 };
 pub use linalg::{solve_spd, solve_spd_in_place};
 pub use linear::eigenvalues::{
-    LinearStability, Stability, damped_modes, linear_stability, state_eigenvalues,
+    LinearStability, Stability, damped_modes, linear_stability, state_eigenvalues, verdict,
 };
 pub use linear::frequency_response::{
     ForcedLinearization, FrequencySweep, FrfError, HarmonicForcing, ModalResponse, PeakAmplitude,
@@ -87,6 +87,10 @@ pub use linear::response::{
     response_by_integration, response_by_m_inv_k_modes, response_by_normal_modes,
     response_with_modal_damping, state_response_by_eigenvectors, state_response_by_exponential,
     state_response_by_integration,
+};
+pub use linear::steady::{
+    SteadyLinearization, SteadyMotion, SteadyMotionError, find_steady_motion, general_eigenvalues,
+    linearize_steady_motion, steady_stability,
 };
 pub use model_info::{ConstraintValues, ModelInfo, ModelSummary};
 pub use ode::{OdeFn, OdeSystem, RhsError, WithEvents};

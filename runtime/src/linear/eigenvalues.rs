@@ -156,11 +156,26 @@ pub fn linear_stability(lin: &Linearization) -> Result<LinearStability, ModalErr
     } else {
         None
     };
+    let stability = verdict(&eigenvalues);
+    Ok(LinearStability {
+        eigenvalues,
+        stability,
+        damping_part,
+        gyroscopic_part,
+        gyroscopic_frequencies,
+    })
+}
+
+/// The stability verdict of eigenvalues whose real parts at rounding are already set to 0
+/// (as [`state_eigenvalues`] gives them): unstable with the largest positive real part,
+/// stable with the slowest decay when all are negative, marginally stable otherwise (and
+/// for no eigenvalues).
+pub fn verdict(eigenvalues: &[Complex<f64>]) -> Stability {
     let abscissa = eigenvalues
         .iter()
         .map(|s| s.re)
         .fold(f64::NEG_INFINITY, f64::max);
-    let stability = if eigenvalues.is_empty() {
+    if eigenvalues.is_empty() {
         Stability::MarginallyStable
     } else if abscissa > 0.0 {
         Stability::Unstable {
@@ -172,14 +187,7 @@ pub fn linear_stability(lin: &Linearization) -> Result<LinearStability, ModalErr
         }
     } else {
         Stability::MarginallyStable
-    };
-    Ok(LinearStability {
-        eigenvalues,
-        stability,
-        damping_part,
-        gyroscopic_part,
-        gyroscopic_frequencies,
-    })
+    }
 }
 
 /// The `2r` eigenvalues of the state matrix `[0 I; −M⁻¹K −M⁻¹C]` of `lin`, accurate to

@@ -12,6 +12,8 @@
 //!   and damping models (modal, Rayleigh) against the exact damped modes;
 //! - [`frequency_response`]: input matrices of load parameters, `H(ω) = (K − ω²M + iωC)⁻¹ B`,
 //!   resonance peaks, modal sums, and the steady state of the full model by simulation;
+//! - [`steady`]: steady motions (constant rates, ignorable coordinates drifting) and their
+//!   linearisation restricted to the constraints, holonomic and non-holonomic;
 //! - [`monodromy`]: the monodromy matrix of a periodic linearisation, Floquet multipliers and
 //!   the stability they imply.
 //!
@@ -24,3 +26,4 @@ pub mod frequency_response;
 pub mod modal;
 pub mod monodromy;
 pub mod response;
+pub mod steady;

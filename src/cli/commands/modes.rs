@@ -1,6 +1,8 @@
 //! `eomgen modes MODEL`: equilibrium, exact linearisation `M δq̈ + C δq̇ + K δq = 0`, normal
 //! modes and damping (issue 7; lectures 22–26, 30).
 
+use std::io::Write as _;
+
 use clap::Args;
 use eomgen::analysis::vibration::{self, ModalAnalysis, ModalOptions};
 use eomgen::{ModeKind, ModelInfo, Stability};
@@ -35,7 +37,18 @@ pub struct ModesArgs {
 pub fn run(args: &ModesArgs) -> Result<(), CliError> {
     // The charts `PREFIX-mode<k>` (at most one per degree of freedom) and the page, checked
     // before the analysis.
-    let num_dofs = args.point.model(&args.model)?.num_dofs();
+    let mut model = args.point.model(&args.model)?;
+    let num_dofs = model.num_dofs();
+    let options = args.point.options(model.as_ref())?;
+    if vibration::is_steady_motion(model.as_ref(), &options.start) {
+        if args.plot.is_some() || args.animate.is_some() {
+            return Err(CliError::usage(format!(
+                "`{}` at this operating point is a steady motion (or has non-holonomic constraints): its modes are eigenvectors of the reduced state matrix, which --plot and --animate do not draw",
+                model.description().name
+            )));
+        }
+        return steady(args, model.as_mut(), &options);
+    }
     let charts: Vec<String> = match &args.plot {
         Some(prefix) => (1..=num_dofs)
             .map(|k| crate::cli::mode_plot::chart_path(prefix, k))
@@ -102,6 +115,96 @@ pub fn run(args: &ModesArgs) -> Result<(), CliError> {
         );
         Ok(())
     }
+}
+
+/// `modes` at a steady motion: the steady motion, the reduced state, the eigenvalues and the
+/// verdict.
+fn steady(
+    args: &ModesArgs,
+    model: &mut dyn ModelInfo,
+    options: &eomgen::analysis::vibration::OperatingPointOptions,
+) -> Result<(), CliError> {
+    let analysis = vibration::steady_motion_analysis(model, options).map_err(|e| match e {
+        vibration::SteadyAnalysisError::OperatingPoint(e) => point_failure(model, &e),
+        e => CliError::failure(format!("`{}`: {e}", model.description().name)),
+    })?;
+    let summary = analysis.summary(model);
+    if args.json {
+        return print_json_sorted(&summary);
+    }
+    let mut out = crate::cli::output::stdout();
+    let p = &summary.operating_point;
+    let show = |values: &std::collections::BTreeMap<String, f64>| {
+        values
+            .iter()
+            .map(|(k, v)| format!("{k} = {v}"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let lin = &summary.linearization;
+    let _ = writeln!(
+        out,
+        "steady motion  {}: {}; rates held {}",
+        p.name,
+        show(&p.q),
+        show(&p.qdot)
+    );
+    let _ = writeln!(
+        out,
+        "found          {} Gauss–Newton iterations, largest residual {:.3e}",
+        p.iterations, p.residual
+    );
+    let _ = writeln!(out, "reduced state  {}", lin.states.join(", "));
+    for (what, list) in [
+        (
+            "left out: ignorable coordinates",
+            &lin.ignorable_coordinates,
+        ),
+        (
+            "left out: rates constant to first order",
+            &lin.constant_rates,
+        ),
+        ("solved: dependent coordinates", &lin.dependent_coordinates),
+        ("solved: dependent rates", &lin.dependent_rates),
+    ] {
+        if !list.is_empty() {
+            let _ = writeln!(out, "               {what}: {}", list.join(", "));
+        }
+    }
+    let _ = writeln!(
+        out,
+        "jacobian       {}",
+        if lin.exact_jacobian {
+            "exact (generated)"
+        } else {
+            "central differences with Richardson extrapolation"
+        }
+    );
+    let _ = writeln!(
+        out,
+        "eigenvalue           Re s (1/s)           Im s (rad/s)        ζ"
+    );
+    for (k, d) in summary.damped_modes.iter().enumerate() {
+        let _ = writeln!(
+            out,
+            "{:>4}  {:>20.12}  {:>20}  {:>8.4}",
+            k + 1,
+            d.re,
+            if d.im == 0.0 {
+                "0".to_string()
+            } else {
+                format!("±{:.12}", d.im)
+            },
+            d.damping_ratio
+        );
+    }
+    let verdict = match summary.stability {
+        Stability::Stable { decay_rate } => format!("stable: the slowest decays as e^(-{decay_rate:.6} t)"),
+        Stability::MarginallyStable => "marginally stable: no eigenvalue has a positive real part (stable to linear order only)".to_string(),
+        Stability::Unstable { growth_rate } => format!("unstable: grows as e^({growth_rate:.6} t)"),
+    };
+    let _ = writeln!(out, "stability      {verdict}");
+    Ok(())
 }
 
 /// What `modes --json` prints (see docs/cli.md): the library's summary with the files this

@@ -19,7 +19,8 @@ pub use balances::{HandEquations, UserBalances};
 pub use constraints::{ConstraintEquations, linear_in_rates, redundant_rows};
 pub use lagrange::Lagrange;
 pub use lower::{
-    BalanceInfo, BodyInfo, Equilibrium, EventInfo, LoadInfo, ParameterInfo, SpatialBody, SymbolicModel,
+    BalanceInfo, BodyInfo, Equilibrium, EventInfo, LoadInfo, ParameterInfo, SpatialBody,
+    SymbolicModel,
 };
 pub use mass::mass_matrix_diagnostics;
 pub use momentum::MomentumBalance;

@@ -931,7 +931,10 @@ impl<'f> Checker<'f> {
                 }
                 let d = Diagnostic::new(
                     k.location,
-                    format!("`{n}` in `ignorable` of `{}` is not a coordinate", q.name.value),
+                    format!(
+                        "`{n}` in `ignorable` of `{}` is not a coordinate",
+                        q.name.value
+                    ),
                 );
                 let d = match closest(n, &self.coords) {
                     Some(c) => d.with_help(format!("did you mean `{c}`?")),

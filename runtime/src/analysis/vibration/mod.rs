@@ -7,6 +7,9 @@
 //!   model file's `equilibria:` or an explicit guess (Newton on `F(q, 0, t) = 0`).
 //! - [`modal_analysis`]: the exact linearisation `M δq̈ + C δq̇ + K δq = 0` there, natural
 //!   frequencies, mass-normalised mode shapes, damping ratios (`eomgen modes`).
+//! - [`steady_motion_analysis`]: a steady motion (rates held, ignorable coordinates
+//!   drifting), its linearisation restricted to the constraints and its stability
+//!   (`eomgen modes` at a steady motion or on a non-holonomic model).
 //! - [`free_response()`]: the undamped free response four ways and their differences (HW28).
 //! - [`modal_damping_study`]: damping ratios exact, by the diagonal of `ΨᵀCΨ` and by a
 //!   Rayleigh fit, and the damped responses from each mode shape (HW34).
@@ -28,6 +31,7 @@ pub mod frf;
 pub mod modal_damping;
 pub mod modes;
 pub mod operating_point;
+pub mod steady;
 
 pub use floquet::{
     FailedCell, FloquetCell, FloquetChart, FloquetChartSummary, FloquetIntegrationSummary,
@@ -58,4 +62,8 @@ pub use modes::{
 pub use operating_point::{
     EquilibriumStart, OperatingPoint, OperatingPointError, OperatingPointOptions, PointSummary,
     operating_point,
+};
+pub use steady::{
+    SteadyAnalysisError, SteadyMotionAnalysis, SteadyMotionSummary, SteadyPointSummary,
+    damped_summaries, held_rates, is_steady_motion, steady_motion_analysis,
 };

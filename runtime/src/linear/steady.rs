@@ -1,0 +1,575 @@
+//! Steady motions and their linearisation, with or without constraints (holonomic and
+//! non-holonomic): a spinning body, a precessing top, a sleigh, disc or bicycle moving
+//! straight at constant speed.
+//!
+//! A *steady motion* holds every rate `q̇*` constant (`q̈ = 0`) while the coordinates that
+//! nothing depends on — *ignorable* (cyclic) coordinates: heading, wheel angles, contact
+//! position, spin angle — drift at their rates and the others stay put. It is an operating
+//! point of the equations of motion, not an equilibrium. [`find_steady_motion`] finds the
+//! coordinates of one from a guess with the rates held (Gauss–Newton); an equilibrium is the
+//! case `q̇* = 0`.
+//!
+//! [`linearize_steady_motion`] linearises the first-order equations `ẏ = f(y)`, `y = (q, q̇)`
+//! about it and restricts them to the motions the constraints allow, in the manner of the
+//! partition of Peterson, Gede & Hubbard ("Symbolic linearization of equations of motion of
+//! constrained multibody systems", *Multibody System Dynamics* 33:143–161, 2015,
+//! doi:10.1007/s11044-014-9436-5), done numerically:
+//!
+//! 1. `A = ∂f/∂y` (`2n × 2n`): exact from the generated Jacobians for an unconstrained model,
+//!    else by central differences with one Richardson extrapolation (error `O(h⁴)`, about
+//!    `1e-11` relative).
+//! 2. The tangent space of the constraints at the point: `Φ_q δq = 0` for the holonomic
+//!    constraints and `V_q δq + J δq̇ = 0` for every velocity-level constraint `V = J q̇ + b`
+//!    (the holonomic ones differentiated, and the non-holonomic ones). Dependent coordinates
+//!    are chosen among the non-ignorable ones by pivoting on `Φ_q`, dependent rates by
+//!    pivoting on `J` (the rates of the dependent coordinates first, then those of the
+//!    ignorable ones: a contact point's rates and the heading rate are outputs of the motion).
+//!    The independent coordinates and rates parametrise the tangent space: `δy = N z`,
+//!    `δq_d = C₀ δq_i` and `δq̇_d = C₁ δq + C₂ δq̇_i` as in the paper — the `C₁ δq` term, which
+//!    makes the dependent rates answer a change of configuration at a speed `q̇* ≠ 0`, is the
+//!    one a hand linearisation most often drops.
+//! 3. The space is invariant under the linearised flow (the equations keep the constraints'
+//!    second derivatives at zero), so `A N = N A_z` with `A_z = S A N`, `S` picking the
+//!    independent entries of `δy`: `A_z` is the state matrix of the constrained motion, and
+//!    has its eigenvalues.
+//! 4. Ignorable coordinates are left out: their columns must vanish in every other row (a
+//!    located error names the row otherwise), so that they only integrate the rest, and each
+//!    carries an exact zero eigenvalue. Then every remaining row that is zero — a rate that
+//!    stays constant to first order, as the bicycle's forward speed — is left out with its
+//!    column: another exact zero eigenvalue. What remains is the reduced state matrix whose
+//!    eigenvalues decide the stability; what was left out is reported.
+
+use nalgebra::{Complex, DMatrix, DVector};
+use serde::Serialize;
+
+use super::eigenvalues::{Stability, ZERO_EIGENVALUE, ZERO_REAL_PART, verdict};
+use crate::model_info::ModelInfo;
+use crate::ode::RhsError;
+
+/// Why a steady motion or its linearisation could not be found.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum SteadyMotionError {
+    /// Gauss–Newton did not bring the accelerations and constraint residuals to zero with
+    /// the rates held.
+    #[error(
+        "no steady motion found with the rates held: after {iterations} Gauss–Newton iterations the largest residual is {residual:e} ({worst})"
+    )]
+    NotSteady {
+        /// Iterations made.
+        iterations: usize,
+        /// Largest residual left (an acceleration, or a constraint residual).
+        residual: f64,
+        /// What it is: `theta_ddot`, or a constraint's name.
+        worst: String,
+    },
+    /// The holonomic constraints do not determine dependent coordinates among the
+    /// non-ignorable ones at the point (`Φ_q` restricted to them has rank below `m_h`).
+    #[error(
+        "the holonomic constraints are singular at the operating point: {found} of {needed} dependent coordinates found among the non-ignorable ones"
+    )]
+    SingularConstraints {
+        /// Holonomic constraints.
+        needed: usize,
+        /// Independent columns found.
+        found: usize,
+    },
+    /// The velocity constraints do not determine dependent rates at the point.
+    #[error(
+        "the velocity constraints are singular at the operating point: {found} of {needed} dependent rates found"
+    )]
+    SingularVelocityConstraints {
+        /// Velocity-level constraints.
+        needed: usize,
+        /// Independent columns found.
+        found: usize,
+    },
+    /// A coordinate declared ignorable moves something else at the point.
+    #[error(
+        "`{coordinate}` is declared ignorable, but the linearised `{state}` depends on it (entry {value:e} of the state matrix)"
+    )]
+    NotIgnorable {
+        /// The coordinate.
+        coordinate: String,
+        /// The state whose rate depends on it.
+        state: String,
+        /// The entry.
+        value: f64,
+    },
+    /// The right-hand side failed at (or near) the point.
+    #[error("the equations cannot be evaluated at the operating point: {0}")]
+    Rhs(#[from] RhsError),
+    /// A derivative came out not finite.
+    #[error("the linearisation is not finite at the operating point")]
+    NonFinite,
+}
+
+/// A steady motion: coordinates `q*` and rates `q̇*` at which `q̈ = 0` and the constraints
+/// hold.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SteadyMotion {
+    /// `q*` (length `n`).
+    pub q: Vec<f64>,
+    /// `q̇*` (length `n`), as held.
+    pub qdot: Vec<f64>,
+    /// Gauss–Newton iterations.
+    pub iterations: usize,
+    /// The largest `|q̈ᵢ|`, `|Φᵢ|` or velocity residual left.
+    pub residual: f64,
+}
+
+impl SteadyMotion {
+    /// `y* = (q*, q̇*)` (length `2n`).
+    pub fn state(&self) -> Vec<f64> {
+        self.q.iter().chain(&self.qdot).copied().collect()
+    }
+}
+
+/// `[q̈; Φ; V]` at `(q, q̇)`: the residuals of a steady motion.
+fn steady_residuals(
+    model: &mut dyn ModelInfo,
+    t: f64,
+    q: &[f64],
+    qdot: &[f64],
+) -> Result<Vec<f64>, RhsError> {
+    let n = q.len();
+    let y: Vec<f64> = q.iter().chain(qdot).copied().collect();
+    let mut dy = vec![0.0; 2 * n];
+    model.as_ode_mut().rhs(t, &y, &mut dy)?;
+    let mut r = dy[n..].to_vec();
+    if !model.description().constraints.is_empty() {
+        let c = model.constraint_equations(t, &y);
+        r.extend(c.phi.iter());
+        r.extend(c.velocity.iter());
+    }
+    Ok(r)
+}
+
+/// The name of residual `i` of [`steady_residuals`].
+fn residual_name(model: &dyn ModelInfo, i: usize) -> String {
+    let d = model.description();
+    let n = d.coordinates.len();
+    let m_h = d.holonomic_constraints;
+    if i < n {
+        format!("{}_ddot", d.coordinates[i])
+    } else if i < n + m_h {
+        format!("constraint `{}`", d.constraints[i - n])
+    } else {
+        let k = i - n - m_h;
+        format!("velocity of constraint `{}`", d.constraints[k])
+    }
+}
+
+/// Largest absolute entry and its index.
+fn largest(v: &[f64]) -> (f64, usize) {
+    v.iter().enumerate().fold((0.0, 0), |(m, k), (i, x)| {
+        if x.abs() > m || x.is_nan() {
+            (x.abs(), i)
+        } else {
+            (m, k)
+        }
+    })
+}
+
+/// Finds a steady motion near `guess` (length `n`) with the rates `rates` (length `n`)
+/// held: Gauss–Newton on the coordinates that are not `ignorable` (indices) so that
+/// `q̈ = 0`, `Φ = 0` and the velocity constraints hold, with central-difference Jacobians and
+/// least-squares steps (SVD, singular values below `1e-12 σ_max` dropped, so that directions
+/// the residuals do not see stay at their guess). An equilibrium is the case `rates = 0`.
+///
+/// Converged when the largest residual is below `1e-11 (1 + s)`, `s` the size of the
+/// residuals at the guess, or when a step no longer changes the coordinates (below
+/// `1e-14 max(1, |q|)`) with the residual below `1e-8 (1 + s)`.
+///
+/// # Errors
+/// [`SteadyMotionError::NotSteady`] naming the largest residual when it does not converge
+/// within 50 iterations; [`SteadyMotionError::Rhs`] when the equations cannot be evaluated.
+pub fn find_steady_motion(
+    model: &mut dyn ModelInfo,
+    t: f64,
+    guess: &[f64],
+    rates: &[f64],
+    ignorable: &[usize],
+) -> Result<SteadyMotion, SteadyMotionError> {
+    let n = guess.len();
+    let free: Vec<usize> = (0..n).filter(|i| !ignorable.contains(i)).collect();
+    let mut q = guess.to_vec();
+    let mut r = steady_residuals(model, t, &q, rates)?;
+    let scale = 1.0 + largest(&r).0;
+    let mut iterations = 0;
+    loop {
+        let (worst, at) = largest(&r);
+        if !worst.is_finite() {
+            return Err(SteadyMotionError::NonFinite);
+        }
+        if worst <= 1e-11 * scale || free.is_empty() {
+            break;
+        }
+        if iterations == 50 {
+            return Err(SteadyMotionError::NotSteady {
+                iterations,
+                residual: worst,
+                worst: residual_name(model, at),
+            });
+        }
+        iterations += 1;
+        let mut jac = DMatrix::zeros(r.len(), free.len());
+        for (col, &j) in free.iter().enumerate() {
+            let h = 1e-6 * q[j].abs().max(1.0);
+            let (mut up, mut down) = (q.clone(), q.clone());
+            up[j] += h;
+            down[j] -= h;
+            let (ru, rd) = (
+                steady_residuals(model, t, &up, rates)?,
+                steady_residuals(model, t, &down, rates)?,
+            );
+            for i in 0..r.len() {
+                jac[(i, col)] = (ru[i] - rd[i]) / (2.0 * h);
+            }
+        }
+        let svd = jac.svd(true, true);
+        let cut = 1e-12 * svd.singular_values.max();
+        let step = svd
+            .solve(&DVector::from_vec(r.clone()), cut)
+            .map_err(|_| SteadyMotionError::NonFinite)?;
+        let mut moved = 0.0_f64;
+        for (col, &j) in free.iter().enumerate() {
+            q[j] -= step[col];
+            moved = moved.max(step[col].abs() / q[j].abs().max(1.0));
+        }
+        r = steady_residuals(model, t, &q, rates)?;
+        if moved <= 1e-14 && largest(&r).0 <= 1e-8 * scale {
+            break;
+        }
+    }
+    Ok(SteadyMotion {
+        q,
+        qdot: rates.to_vec(),
+        iterations,
+        residual: largest(&r).0,
+    })
+}
+
+/// The linearisation of a model about a steady motion, restricted to the motions its
+/// constraints allow and reduced by its ignorable coordinates and constant rates.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SteadyLinearization {
+    /// The reduced state's entries by name: coordinates (`theta`) and rates (`theta_dot`),
+    /// `k` of them.
+    pub states: Vec<String>,
+    /// The reduced state matrix `A` (`k × k`, 1/s), rows in JSON: `δż = A δz`.
+    #[serde(serialize_with = "crate::serde_matrix::rows")]
+    pub state_matrix: DMatrix<f64>,
+    /// Coordinates solved from the holonomic constraints (left out of the state).
+    pub dependent_coordinates: Vec<String>,
+    /// Rates solved from the velocity constraints (left out of the state).
+    pub dependent_rates: Vec<String>,
+    /// Ignorable coordinates left out (each an exact zero eigenvalue).
+    pub ignorable_coordinates: Vec<String>,
+    /// Rates left out because they stay constant to first order (a zero row of the state
+    /// matrix; each an exact zero eigenvalue).
+    pub constant_rates: Vec<String>,
+    /// Whether `∂f/∂y` came from the exact generated Jacobians (else central differences
+    /// with Richardson extrapolation).
+    pub exact_jacobian: bool,
+}
+
+/// Linearises `model` about the steady motion `y* = (q*, q̇*)` (length `2n`) at time `t`,
+/// leaving out the coordinates `ignorable` (indices); see the module documentation for the
+/// method.
+///
+/// # Errors
+/// [`SteadyMotionError::SingularConstraints`] or
+/// [`SteadyMotionError::SingularVelocityConstraints`] when the constraints do not determine
+/// dependent coordinates or rates there; [`SteadyMotionError::NotIgnorable`] when an
+/// ignorable coordinate feeds back; [`SteadyMotionError::Rhs`] and
+/// [`SteadyMotionError::NonFinite`] when the equations fail there.
+// One piece: the Jacobian, the partition, the basis of the tangent space and the reduction
+// share the matrices and index lists and run once in this order.
+pub fn linearize_steady_motion(
+    model: &mut dyn ModelInfo,
+    t: f64,
+    y: &[f64],
+    ignorable: &[usize],
+) -> Result<SteadyLinearization, SteadyMotionError> {
+    let d = model.description().clone();
+    let n = d.coordinates.len();
+    let (m, m_h) = (d.constraints.len(), d.holonomic_constraints);
+    let (a, exact_jacobian) = state_jacobian(model, t, y)?;
+    // Constraint Jacobians at the point: Φ_q (the first m_h rows of J), J, and V_q by
+    // differences of the velocity residuals.
+    let (j_all, v_q) = if m > 0 {
+        let c = model.constraint_equations(t, y);
+        let v_q = richardson(n, m, y, |yy| {
+            Ok(model
+                .constraint_equations(t, yy)
+                .velocity
+                .as_slice()
+                .to_vec())
+        })?;
+        (c.jacobian, v_q)
+    } else {
+        (DMatrix::zeros(0, n), DMatrix::zeros(0, n))
+    };
+    let phi_q = j_all.rows(0, m_h).into_owned();
+    // Dependent coordinates among the non-ignorable ones, dependent rates preferring the
+    // dependent coordinates' rates and then the ignorable ones'.
+    let coordinate_order: Vec<usize> = (0..n).filter(|i| !ignorable.contains(i)).collect();
+    let dependent_q = pivot_columns(&phi_q, &coordinate_order, m_h);
+    if dependent_q.len() < m_h {
+        return Err(SteadyMotionError::SingularConstraints {
+            needed: m_h,
+            found: dependent_q.len(),
+        });
+    }
+    let mut rate_order: Vec<usize> = dependent_q.clone();
+    for i in ignorable.iter().copied().chain(0..n) {
+        if !rate_order.contains(&i) {
+            rate_order.push(i);
+        }
+    }
+    let dependent_u = pivot_columns(&j_all, &rate_order, m);
+    if dependent_u.len() < m {
+        return Err(SteadyMotionError::SingularVelocityConstraints {
+            needed: m,
+            found: dependent_u.len(),
+        });
+    }
+    let independent_q: Vec<usize> = (0..n).filter(|i| !dependent_q.contains(i)).collect();
+    let independent_u: Vec<usize> = (0..n).filter(|i| !dependent_u.contains(i)).collect();
+    // The basis N of the tangent space, one column per independent coordinate and rate.
+    let phi_d = select_columns(&phi_q, &dependent_q);
+    let j_d = select_columns(&j_all, &dependent_u);
+    let phi_lu = phi_d.lu();
+    let j_lu = j_d.lu();
+    let k = independent_q.len() + independent_u.len();
+    let mut basis = DMatrix::zeros(2 * n, k);
+    for (col, &i) in independent_q.iter().enumerate() {
+        let mut dq = DVector::zeros(n);
+        dq[i] = 1.0;
+        if m_h > 0 {
+            let dd = phi_lu
+                .solve(&phi_q.column(i).into_owned())
+                .ok_or(SteadyMotionError::NonFinite)?;
+            for (r, &c) in dependent_q.iter().enumerate() {
+                dq[c] = -dd[r];
+            }
+        }
+        if m > 0 {
+            let rhs = &v_q * &dq;
+            let du = j_lu.solve(&rhs).ok_or(SteadyMotionError::NonFinite)?;
+            for (r, &c) in dependent_u.iter().enumerate() {
+                basis[(n + c, col)] = -du[r];
+            }
+        }
+        basis.view_mut((0, col), (n, 1)).copy_from(&dq);
+    }
+    for (offset, &j) in independent_u.iter().enumerate() {
+        let col = independent_q.len() + offset;
+        basis[(n + j, col)] = 1.0;
+        if m > 0 {
+            let du = j_lu
+                .solve(&j_all.column(j).into_owned())
+                .ok_or(SteadyMotionError::NonFinite)?;
+            for (r, &c) in dependent_u.iter().enumerate() {
+                basis[(n + c, col)] = -du[r];
+            }
+        }
+    }
+    let rows: Vec<usize> = independent_q
+        .iter()
+        .copied()
+        .chain(independent_u.iter().map(|j| n + j))
+        .collect();
+    let a_basis = &a * &basis;
+    let mut reduced = DMatrix::from_fn(k, k, |r, c| a_basis[(rows[r], c)]);
+    if reduced.iter().any(|v| !v.is_finite()) {
+        return Err(SteadyMotionError::NonFinite);
+    }
+    let mut names: Vec<String> = independent_q
+        .iter()
+        .map(|&i| d.coordinates[i].to_string())
+        .chain(
+            independent_u
+                .iter()
+                .map(|&j| format!("{}_dot", d.coordinates[j])),
+        )
+        .collect();
+    // Entries below this fraction of the largest are zero: rounding of exact Jacobians, or
+    // the differences' error.
+    let zero = if exact_jacobian { 1e-12 } else { 1e-8 } * reduced.amax().max(f64::MIN_POSITIVE);
+    // Ignorable coordinates: their columns must vanish outside their own rows.
+    let ignorable_states: Vec<usize> = (0..independent_q.len())
+        .filter(|&s| ignorable.contains(&independent_q[s]))
+        .collect();
+    for &s in &ignorable_states {
+        for r in 0..k {
+            if !ignorable_states.contains(&r) && reduced[(r, s)].abs() > zero {
+                return Err(SteadyMotionError::NotIgnorable {
+                    coordinate: names[s].clone(),
+                    state: names[r].clone(),
+                    value: reduced[(r, s)],
+                });
+            }
+        }
+    }
+    let ignorable_coordinates: Vec<String> =
+        ignorable_states.iter().map(|&s| names[s].clone()).collect();
+    remove_states(&mut reduced, &mut names, &ignorable_states);
+    // Rates that stay constant: zero rows, left out with their columns, one at a time.
+    let mut constant_rates = Vec::new();
+    while let Some(r) = (0..names.len())
+        .find(|&r| names[r].ends_with("_dot") && reduced.row(r).iter().all(|v| v.abs() <= zero))
+    {
+        constant_rates.push(names[r].clone());
+        remove_states(&mut reduced, &mut names, &[r]);
+    }
+    Ok(SteadyLinearization {
+        states: names,
+        state_matrix: reduced,
+        dependent_coordinates: dependent_q
+            .iter()
+            .map(|&i| d.coordinates[i].to_string())
+            .collect(),
+        dependent_rates: dependent_u
+            .iter()
+            .map(|&i| format!("{}_dot", d.coordinates[i]))
+            .collect(),
+        ignorable_coordinates,
+        constant_rates,
+        exact_jacobian,
+    })
+}
+
+/// `∂f/∂y` of the first-order equations at `y` (`2n × 2n`) and whether it is exact.
+fn state_jacobian(
+    model: &mut dyn ModelInfo,
+    t: f64,
+    y: &[f64],
+) -> Result<(DMatrix<f64>, bool), SteadyMotionError> {
+    let dim = y.len();
+    let mut jac = vec![0.0; dim * dim];
+    if model.as_ode_mut().jacobian(t, y, &mut jac)? {
+        let a = DMatrix::from_column_slice(dim, dim, &jac);
+        if a.iter().all(|v| v.is_finite()) {
+            return Ok((a, true));
+        }
+        return Err(SteadyMotionError::NonFinite);
+    }
+    let system = model.as_ode_mut();
+    let a = richardson(dim, dim, y, |yy| {
+        let mut dy = vec![0.0; dim];
+        system.rhs(t, yy, &mut dy)?;
+        Ok(dy)
+    })?;
+    Ok((a, false))
+}
+
+/// `∂g/∂y` (`rows × cols`, `cols` the leading entries of `y` that are varied) of `g` by
+/// central differences with one Richardson extrapolation: `(4 D(h/2) − D(h))/3`, with
+/// `h = 1e-3 max(1, |yⱼ|)` (error `O(h⁴)` against rounding `ε/h`: about `1e-11` relative).
+fn richardson(
+    cols: usize,
+    rows: usize,
+    y: &[f64],
+    mut g: impl FnMut(&[f64]) -> Result<Vec<f64>, RhsError>,
+) -> Result<DMatrix<f64>, SteadyMotionError> {
+    let mut out = DMatrix::zeros(rows, cols);
+    for j in 0..cols {
+        let h = 1e-3 * y[j].abs().max(1.0);
+        let mut central = |h: f64| -> Result<Vec<f64>, RhsError> {
+            let (mut up, mut down) = (y.to_vec(), y.to_vec());
+            up[j] += h;
+            down[j] -= h;
+            let (gu, gd) = (g(&up)?, g(&down)?);
+            Ok(gu
+                .iter()
+                .zip(&gd)
+                .map(|(a, b)| (a - b) / (2.0 * h))
+                .collect())
+        };
+        let (coarse, fine) = (central(h)?, central(h / 2.0)?);
+        for i in 0..rows {
+            out[(i, j)] = (4.0 * fine[i] - coarse[i]) / 3.0;
+        }
+    }
+    if out.iter().all(|v| v.is_finite()) {
+        Ok(out)
+    } else {
+        Err(SteadyMotionError::NonFinite)
+    }
+}
+
+/// Up to `count` columns of `a`, taken greedily in the order `order` where each adds to the
+/// rank (its part orthogonal to the columns taken is above `1e-9` of the largest column).
+fn pivot_columns(a: &DMatrix<f64>, order: &[usize], count: usize) -> Vec<usize> {
+    let size = order
+        .iter()
+        .map(|&j| a.column(j).norm())
+        .fold(0.0, f64::max);
+    let mut taken: Vec<usize> = Vec::new();
+    let mut basis: Vec<DVector<f64>> = Vec::new();
+    for &j in order {
+        if taken.len() == count {
+            break;
+        }
+        let mut v = a.column(j).into_owned();
+        for b in &basis {
+            let p = b.dot(&v);
+            v -= b * p;
+        }
+        let norm = v.norm();
+        if norm > 1e-9 * size && norm > 0.0 {
+            basis.push(v / norm);
+            taken.push(j);
+        }
+    }
+    taken
+}
+
+/// The columns `cols` of `a`, in that order.
+fn select_columns(a: &DMatrix<f64>, cols: &[usize]) -> DMatrix<f64> {
+    DMatrix::from_fn(a.nrows(), cols.len(), |r, c| a[(r, cols[c])])
+}
+
+/// Removes the states `which` (rows and columns, and names).
+fn remove_states(a: &mut DMatrix<f64>, names: &mut Vec<String>, which: &[usize]) {
+    let keep: Vec<usize> = (0..names.len()).filter(|i| !which.contains(i)).collect();
+    *a = DMatrix::from_fn(keep.len(), keep.len(), |r, c| a[(keep[r], keep[c])]);
+    *names = keep.iter().map(|&i| names[i].clone()).collect();
+}
+
+/// The eigenvalues of a general real state matrix `a` (`k × k`), by balancing
+/// (Parlett–Reinsch) and the Schur form, sorted by ascending `|s|` then `Im s`; eigenvalues
+/// below [`ZERO_EIGENVALUE`] of the largest are set to 0 and real parts below
+/// [`ZERO_REAL_PART`] of `|s|` to 0 (`tolerance` widens both, for a matrix taken by
+/// differences).
+pub fn general_eigenvalues(a: &DMatrix<f64>, tolerance: f64) -> Vec<Complex<f64>> {
+    if a.is_empty() {
+        return Vec::new();
+    }
+    let mut balanced = a.clone();
+    nalgebra::linalg::balancing::balance_parlett_reinsch(&mut balanced);
+    let mut values: Vec<Complex<f64>> = balanced.complex_eigenvalues().iter().copied().collect();
+    let largest = values.iter().map(|v| v.norm()).fold(0.0, f64::max);
+    for v in &mut values {
+        if v.norm() <= ZERO_EIGENVALUE.max(tolerance) * largest {
+            *v = Complex::new(0.0, 0.0);
+        } else if v.re.abs() <= ZERO_REAL_PART.max(tolerance) * v.norm() {
+            v.re = 0.0;
+        }
+        if v.im.abs() <= ZERO_EIGENVALUE.max(tolerance) * largest {
+            v.im = 0.0;
+        }
+    }
+    values.sort_by(|a, b| a.norm().total_cmp(&b.norm()).then(a.im.total_cmp(&b.im)));
+    values
+}
+
+/// The eigenvalues of a steady linearisation and its stability verdict.
+pub fn steady_stability(lin: &SteadyLinearization) -> (Vec<Complex<f64>>, Stability) {
+    let tolerance = if lin.exact_jacobian { 0.0 } else { 1e-8 };
+    let eigenvalues = general_eigenvalues(&lin.state_matrix, tolerance);
+    let stability = verdict(&eigenvalues);
+    (eigenvalues, stability)
+}
