@@ -30,7 +30,7 @@ use clap::{Parser, Subcommand};
 
 use commands::{
     animate, check, constraint_methods, equations, euler_roundoff, floquet, free_response, frf,
-    list, modal_damping, modes, report, simulate, stability, work_precision,
+    list, modal_damping, modes, parameter_sweep, report, simulate, stability, work_precision,
 };
 
 /// eomgen: equations of motion derived at compile time from model files, simulated.
@@ -104,6 +104,10 @@ pub enum Study {
     /// Floquet multipliers of a time-periodic model about an equilibrium (the Mathieu
     /// inverted pendulum), and its stability chart over two parameters (`--sweep`).
     Floquet(floquet::FloquetArgs),
+    /// The eigenvalues of an operating point (an equilibrium or a steady motion) against
+    /// one parameter, the values where its stability changes (refined by bisection), and
+    /// the root-locus chart.
+    ParameterSweep(parameter_sweep::ParameterSweepArgs),
 }
 
 /// Runs the CLI on the process arguments. Exit status: 0 success, 1 a failed computation or
@@ -137,6 +141,7 @@ pub fn run() -> ExitCode {
             Study::FreeResponse(args) => free_response::run(&args),
             Study::ModalDamping(args) => modal_damping::run(&args),
             Study::Floquet(args) => floquet::run(&args),
+            Study::ParameterSweep(args) => parameter_sweep::run(&args),
         },
     };
     error::exit(result)

@@ -396,8 +396,11 @@ pub fn linearize_steady_motion(
         )
         .collect();
     // Entries below this fraction of the largest are zero: rounding of exact Jacobians, or
-    // the differences' error.
-    let zero = if exact_jacobian { 1e-12 } else { 1e-8 } * reduced.amax().max(f64::MIN_POSITIVE);
+    // the differences' (central differences of a function even in the varied entry cancel
+    // to rounding, so a structurally zero entry comes out near `1e-13` of the largest). Kept
+    // small, so that a rate that changes slowly (a sleigh at a speed of 1e-9 m/s) is not
+    // taken for a constant one.
+    let zero = if exact_jacobian { 1e-13 } else { 1e-10 } * reduced.amax().max(f64::MIN_POSITIVE);
     // Ignorable coordinates: their columns must vanish outside their own rows.
     let ignorable_states: Vec<usize> = (0..independent_q.len())
         .filter(|&s| ignorable.contains(&independent_q[s]))
@@ -545,12 +548,7 @@ fn remove_states(a: &mut DMatrix<f64>, names: &mut Vec<String>, which: &[usize])
 /// [`ZERO_REAL_PART`] of `|s|` to 0 (`tolerance` widens both, for a matrix taken by
 /// differences).
 pub fn general_eigenvalues(a: &DMatrix<f64>, tolerance: f64) -> Vec<Complex<f64>> {
-    if a.is_empty() {
-        return Vec::new();
-    }
-    let mut balanced = a.clone();
-    nalgebra::linalg::balancing::balance_parlett_reinsch(&mut balanced);
-    let mut values: Vec<Complex<f64>> = balanced.complex_eigenvalues().iter().copied().collect();
+    let mut values = raw_eigenvalues(a);
     let largest = values.iter().map(|v| v.norm()).fold(0.0, f64::max);
     for v in &mut values {
         if v.norm() <= ZERO_EIGENVALUE.max(tolerance) * largest {
@@ -564,6 +562,17 @@ pub fn general_eigenvalues(a: &DMatrix<f64>, tolerance: f64) -> Vec<Complex<f64>
     }
     values.sort_by(|a, b| a.norm().total_cmp(&b.norm()).then(a.im.total_cmp(&b.im)));
     values
+}
+
+/// The eigenvalues of a general real matrix `a` as the balanced Schur form gives them, in its
+/// order, with nothing set to zero: for locating where a real part changes sign.
+pub fn raw_eigenvalues(a: &DMatrix<f64>) -> Vec<Complex<f64>> {
+    if a.is_empty() {
+        return Vec::new();
+    }
+    let mut balanced = a.clone();
+    nalgebra::linalg::balancing::balance_parlett_reinsch(&mut balanced);
+    balanced.complex_eigenvalues().iter().copied().collect()
 }
 
 /// The eigenvalues of a steady linearisation and its stability verdict.

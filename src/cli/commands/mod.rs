@@ -18,6 +18,7 @@ pub(super) mod frf;
 pub(super) mod list;
 pub(super) mod modal_damping;
 pub(super) mod modes;
+pub(super) mod parameter_sweep;
 pub(super) mod report;
 pub(super) mod simulate;
 pub(super) mod stability;

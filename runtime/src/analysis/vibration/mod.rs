@@ -10,6 +10,9 @@
 //! - [`steady_motion_analysis`]: a steady motion (rates held, ignorable coordinates
 //!   drifting), its linearisation restricted to the constraints and its stability
 //!   (`eomgen modes` at a steady motion or on a non-holonomic model).
+//! - [`parameter_sweep()`]: the eigenvalues of an operating point against one parameter and
+//!   the values where the stability changes, refined by bisection (`eomgen study
+//!   parameter-sweep`).
 //! - [`free_response()`]: the undamped free response four ways and their differences (HW28).
 //! - [`modal_damping_study`]: damping ratios exact, by the diagonal of `ΨᵀCΨ` and by a
 //!   Rayleigh fit, and the damped responses from each mode shape (HW34).
@@ -31,6 +34,7 @@ pub mod frf;
 pub mod modal_damping;
 pub mod modes;
 pub mod operating_point;
+pub mod parameter_sweep;
 pub mod steady;
 
 pub use floquet::{
@@ -62,6 +66,10 @@ pub use modes::{
 pub use operating_point::{
     EquilibriumStart, OperatingPoint, OperatingPointError, OperatingPointOptions, PointSummary,
     operating_point,
+};
+pub use parameter_sweep::{
+    Crossing, Direction, ParameterSweep, ParameterSweepError, ParameterSweepOptions,
+    StabilityChange, SweepPoint, eigenvalues_at, parameter_sweep,
 };
 pub use steady::{
     SteadyAnalysisError, SteadyMotionAnalysis, SteadyMotionSummary, SteadyPointSummary,

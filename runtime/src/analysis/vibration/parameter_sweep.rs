@@ -1,0 +1,353 @@
+//! The eigenvalues of an operating point against a parameter (`eomgen study parameter-sweep`):
+//! the root locus of a steady motion or an equilibrium over a range of one parameter (a
+//! bicycle's speed, a top's spin), and the values where the stability changes, each refined
+//! by bisection.
+//!
+//! At every value the operating point is found again (its rates, expressions of the
+//! parameters, follow the value) and linearised as `eomgen modes` does: the reduced state
+//! matrix of [`crate::linear::steady`] for a steady motion or a model with non-holonomic
+//! constraints, and the state matrix of `M δq̈ + C δq̇ + K δq = 0`
+//! ([`crate::linear::eigenvalues`]) for an equilibrium.
+//!
+//! A *stability change* lies between two neighbouring values whose numbers of eigenvalues
+//! with a positive real part differ; bisection on that number narrows it to
+//! `1e-12 max(1, |value|)` (about 40 halvings), and the eigenvalue nearest the imaginary axis
+//! there says whether a real eigenvalue crossed (through 0, a divergence such as a capsize)
+//! or a complex pair (at `±iω`, a flutter or weave). Locating the change on the count rather
+//! than on a tracked eigenvalue's real part needs no tracking, and is exact wherever the
+//! count is: it is decided by the eigenvalues' signs, which the reduced matrices give to
+//! rounding away from the crossing.
+
+use nalgebra::Complex;
+use serde::Serialize;
+
+use super::floquet::SweepAxis;
+use super::operating_point::{OperatingPointError, OperatingPointOptions};
+use super::steady::{SteadyAnalysisError, is_steady_motion, steady_motion_analysis};
+use crate::linear::eigenvalues::{Stability, linear_stability};
+use crate::linear::modal::linearize;
+use crate::linear::steady::raw_eigenvalues;
+use crate::model_info::ModelInfo;
+
+/// Options of [`parameter_sweep`].
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ParameterSweepOptions {
+    /// The parameter and its values (ascending).
+    pub axis: SweepAxis,
+    /// The operating point at every value.
+    pub operating_point: OperatingPointOptions,
+    /// Whether to refine every stability change by bisection (default `true`).
+    pub refine: bool,
+}
+
+/// Why a sweep could not start.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum ParameterSweepError {
+    /// The model has no such parameter.
+    #[error("`{model}` has no parameter `{name}` (it has: {})", known.join(", "))]
+    UnknownParameter {
+        /// The model.
+        model: String,
+        /// The name asked for.
+        name: String,
+        /// Its parameters.
+        known: Vec<String>,
+    },
+    /// No value of the sweep gave eigenvalues: the first failure.
+    #[error("no value of the sweep could be analysed; at {value}: {reason}")]
+    EveryPointFailed {
+        /// The first value.
+        value: f64,
+        /// Why it failed there.
+        reason: String,
+    },
+}
+
+/// The eigenvalues at one value of the parameter, or why there are none.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SweepPoint {
+    /// The parameter's value.
+    pub value: f64,
+    /// The eigenvalues (1/s), by ascending `|s|`, `[re, im]` in JSON; empty when it failed.
+    #[serde(serialize_with = "crate::serde_matrix::complex_list")]
+    pub eigenvalues: Vec<Complex<f64>>,
+    /// The verdict (`None` when it failed).
+    pub stability: Option<Stability>,
+    /// Why the operating point or its linearisation failed there (`None` when it did not).
+    pub error: Option<String>,
+}
+
+/// How an eigenvalue crossed the imaginary axis.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Crossing {
+    /// A real eigenvalue through 0 (a divergence: the capsize of a bicycle).
+    Real,
+    /// A complex pair through `±iω` (a flutter: the weave of a bicycle).
+    Complex,
+}
+
+/// Whether a change makes the operating point more stable as the parameter grows.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Direction {
+    /// Fewer eigenvalues with a positive real part above the value.
+    Stabilising,
+    /// More above the value.
+    Destabilising,
+}
+
+/// A value of the parameter where the stability changes.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct StabilityChange {
+    /// The parameter's value, refined by bisection.
+    pub value: f64,
+    /// Real or complex crossing.
+    pub eigenvalue: Crossing,
+    /// Stabilising or destabilising with growing value.
+    pub direction: Direction,
+    /// `|Im s|` of the crossing eigenvalue (rad/s; 0 for a real one).
+    pub frequency: f64,
+    /// The bracket the bisection ended with, `[below, above]`.
+    pub bracket: [f64; 2],
+}
+
+/// The eigenvalues against a parameter and the stability changes.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ParameterSweep {
+    /// The model.
+    pub model: String,
+    /// The parameter.
+    pub parameter: String,
+    /// The operating point's name.
+    pub operating_point: String,
+    /// One entry per value, in order.
+    pub points: Vec<SweepPoint>,
+    /// Every stability change, in ascending value.
+    pub stability_changes: Vec<StabilityChange>,
+}
+
+impl ParameterSweep {
+    /// The eigenvalues tracked across the sweep: `slots` series of `(value, s)`, each point's
+    /// eigenvalues matched to the previous point's by nearest neighbour in the complex plane
+    /// (greedy), so that a chart draws each eigenvalue as one curve. Points that failed or
+    /// have a different number of eigenvalues start the matching afresh.
+    pub fn tracked(&self) -> Vec<Vec<(f64, Complex<f64>)>> {
+        let mut series: Vec<Vec<(f64, Complex<f64>)>> = Vec::new();
+        let mut last: Vec<Complex<f64>> = Vec::new();
+        for p in &self.points {
+            if p.eigenvalues.is_empty() {
+                continue;
+            }
+            let mut order: Vec<Complex<f64>> = p.eigenvalues.clone();
+            if last.len() == order.len() {
+                let mut free = order.clone();
+                order = last
+                    .iter()
+                    .map(|prev| {
+                        let (k, _) =
+                            free.iter()
+                                .enumerate()
+                                .fold((0, f64::INFINITY), |(bk, bd), (k, s)| {
+                                    let d = (s - prev).norm();
+                                    if d < bd { (k, d) } else { (bk, bd) }
+                                });
+                        free.swap_remove(k)
+                    })
+                    .collect();
+            }
+            if series.len() < order.len() {
+                series.resize(order.len(), Vec::new());
+            }
+            for (slot, s) in order.iter().enumerate() {
+                series[slot].push((p.value, *s));
+            }
+            last = order;
+        }
+        series
+    }
+}
+
+/// The eigenvalues of `model` at its operating point for the current parameters: the
+/// reduced state matrix's for a steady motion, `M δq̈ + C δq̇ + K δq = 0`'s for an
+/// equilibrium; with them the raw eigenvalues of the state matrix (nothing set to zero) by
+/// which a change of sign is located.
+///
+/// # Errors
+/// The failure as text (no operating point, a singular linearisation).
+pub fn eigenvalues_at(
+    model: &mut dyn ModelInfo,
+    options: &OperatingPointOptions,
+) -> Result<(Vec<Complex<f64>>, Stability, Vec<Complex<f64>>), String> {
+    if is_steady_motion(model, &options.start) {
+        let a = steady_motion_analysis(model, options).map_err(|e| match e {
+            SteadyAnalysisError::OperatingPoint(e) => e.to_string(),
+            e => e.to_string(),
+        })?;
+        let raw = raw_eigenvalues(&a.linearization.state_matrix);
+        return Ok((a.eigenvalues, a.stability, raw));
+    }
+    let point = super::operating_point::operating_point(model, options)
+        .map_err(|e: OperatingPointError| e.to_string())?;
+    let n = model.num_dofs();
+    let lin = linearize(model, point.q(), &vec![0.0; n], point.t).map_err(|e| e.to_string())?;
+    let s = linear_stability(&lin).map_err(|e| e.to_string())?;
+    let raw = raw_eigenvalues(&lin.state_matrix().map_err(|e| e.to_string())?);
+    Ok((s.eigenvalues, s.stability, raw))
+}
+
+/// Below this fraction of `|s|` a real part counts as 0 when the changes of stability are
+/// located: above the rounding of an exact or differenced state matrix on the imaginary
+/// axis (`1e-16` to `1e-12` of `|s|`), far below what would move a crossing (a weave
+/// eigenvalue of modulus 3.4 whose real part grows by 1 per m/s is located to 3e-10 m/s).
+pub const CROSSING_TOLERANCE: f64 = 1e-10;
+
+/// Number of eigenvalues with a real part above [`CROSSING_TOLERANCE`] of their modulus.
+fn unstable_count(eigenvalues: &[Complex<f64>]) -> usize {
+    eigenvalues
+        .iter()
+        .filter(|s| s.re > CROSSING_TOLERANCE * s.norm())
+        .count()
+}
+
+/// Runs the sweep: the eigenvalues at every value of `options.axis`, then every stability
+/// change refined by bisection. `progress(done, total)` is called after each value (for a
+/// progress bar). The parameter is left at its value before the call.
+///
+/// # Errors
+/// [`ParameterSweepError::UnknownParameter`]; [`ParameterSweepError::EveryPointFailed`] when
+/// no value could be analysed (a sweep of failures is not a result).
+pub fn parameter_sweep(
+    model: &mut dyn ModelInfo,
+    options: &ParameterSweepOptions,
+    mut progress: impl FnMut(usize, usize),
+) -> Result<ParameterSweep, ParameterSweepError> {
+    let name = &options.axis.name;
+    let d = model.description();
+    let Some(index) = d.parameters.iter().position(|p| p.name == *name) else {
+        return Err(ParameterSweepError::UnknownParameter {
+            model: d.name.to_string(),
+            name: name.clone(),
+            known: d.parameters.iter().map(|p| p.name.to_string()).collect(),
+        });
+    };
+    let before = model.parameter_values()[index];
+    let at = |model: &mut dyn ModelInfo, value: f64| {
+        // The name is known, so setting it cannot fail.
+        let _ = model.set_parameter(name, value);
+        eigenvalues_at(model, &options.operating_point)
+    };
+    let total = options.axis.values.len();
+    let mut points = Vec::with_capacity(total);
+    // Per point, the number of raw eigenvalues with a positive real part.
+    let mut counts: Vec<Option<usize>> = Vec::with_capacity(total);
+    for (k, &value) in options.axis.values.iter().enumerate() {
+        points.push(match at(model, value) {
+            Ok((eigenvalues, stability, raw)) => {
+                counts.push(Some(unstable_count(&raw)));
+                SweepPoint {
+                    value,
+                    eigenvalues,
+                    stability: Some(stability),
+                    error: None,
+                }
+            }
+            Err(reason) => {
+                counts.push(None);
+                SweepPoint {
+                    value,
+                    eigenvalues: Vec::new(),
+                    stability: None,
+                    error: Some(reason),
+                }
+            }
+        });
+        progress(k + 1, total);
+    }
+    if let Some(first) = points.first()
+        && points.iter().all(|p| p.error.is_some())
+    {
+        let _ = model.set_parameter(name, before);
+        return Err(ParameterSweepError::EveryPointFailed {
+            value: first.value,
+            reason: first.error.clone().unwrap_or_default(),
+        });
+    }
+    let mut stability_changes = Vec::new();
+    if options.refine {
+        for k in 1..points.len() {
+            let (Some(count_a), Some(count_b)) = (counts[k - 1], counts[k]) else {
+                continue;
+            };
+            if count_a == count_b {
+                continue;
+            }
+            let (mut lo, mut hi) = (points[k - 1].value, points[k].value);
+            // The raw eigenvalues on the side with more unstable ones, as near the crossing
+            // as the bisection gets.
+            let mut unstable_side: Option<Vec<Complex<f64>>> = None;
+            for _ in 0..200 {
+                if hi - lo <= 1e-12 * lo.abs().max(hi.abs()).max(1.0) {
+                    break;
+                }
+                let mid = 0.5 * (lo + hi);
+                let Ok((_, _, values)) = at(model, mid) else {
+                    break;
+                };
+                let count = unstable_count(&values);
+                if count == count_a {
+                    lo = mid;
+                } else {
+                    hi = mid;
+                }
+                if count == count_a.max(count_b) {
+                    unstable_side = Some(values);
+                }
+            }
+            // The crossing eigenvalue: the unstable one nearest the axis on that side.
+            let side = match unstable_side {
+                Some(values) => values,
+                None => {
+                    let v = if count_a > count_b { lo } else { hi };
+                    at(model, v).map(|(_, _, raw)| raw).unwrap_or_default()
+                }
+            };
+            let crossing = side
+                .iter()
+                .copied()
+                .filter(|s| s.re > CROSSING_TOLERANCE * s.norm())
+                .min_by(|x, y| x.re.total_cmp(&y.re))
+                .unwrap_or_default();
+            let complex = crossing.im.abs() > 1e-6 * crossing.norm().max(1e-300);
+            stability_changes.push(StabilityChange {
+                value: 0.5 * (lo + hi),
+                eigenvalue: if complex {
+                    Crossing::Complex
+                } else {
+                    Crossing::Real
+                },
+                direction: if count_b < count_a {
+                    Direction::Stabilising
+                } else {
+                    Direction::Destabilising
+                },
+                frequency: if complex { crossing.im.abs() } else { 0.0 },
+                bracket: [lo, hi],
+            });
+        }
+    }
+    let _ = model.set_parameter(name, before);
+    Ok(ParameterSweep {
+        model: model.description().name.to_string(),
+        parameter: name.clone(),
+        operating_point: options
+            .operating_point
+            .start
+            .resolve(model)
+            .map(|(label, _)| label)
+            .unwrap_or_default(),
+        points,
+        stability_changes,
+    })
+}
