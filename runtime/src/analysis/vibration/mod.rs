@@ -69,7 +69,8 @@ pub use operating_point::{
 };
 pub use parameter_sweep::{
     Crossing, Direction, ParameterSweep, ParameterSweepError, ParameterSweepOptions,
-    StabilityChange, SweepPoint, eigenvalues_at, parameter_sweep,
+    PointEigenvalues, StabilityChange, SweepPoint, SweepPointError, eigenvalues_at,
+    parameter_sweep,
 };
 pub use steady::{
     SteadyAnalysisError, SteadyMotionAnalysis, SteadyMotionSummary, SteadyPointSummary,

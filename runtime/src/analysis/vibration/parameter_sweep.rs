@@ -25,6 +25,7 @@ use super::floquet::SweepAxis;
 use super::operating_point::{OperatingPointError, OperatingPointOptions};
 use super::steady::{SteadyAnalysisError, is_steady_motion, steady_motion_analysis};
 use crate::linear::eigenvalues::{Stability, linear_stability};
+use crate::linear::modal::ModalError;
 use crate::linear::modal::linearize;
 use crate::linear::steady::raw_eigenvalues;
 use crate::model_info::ModelInfo;
@@ -169,32 +170,61 @@ impl ParameterSweep {
     }
 }
 
+/// The eigenvalues of an operating point ([`eigenvalues_at`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct PointEigenvalues {
+    /// The eigenvalues as `eomgen modes` reports them (real parts at rounding set to 0).
+    pub eigenvalues: Vec<Complex<f64>>,
+    /// The verdict from them.
+    pub stability: Stability,
+    /// The eigenvalues of the state matrix with nothing set to 0, by which a change of sign
+    /// is located.
+    pub raw: Vec<Complex<f64>>,
+}
+
+/// Why the eigenvalues at one value could not be found.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum SweepPointError {
+    /// The steady motion or its linearisation failed.
+    #[error(transparent)]
+    Steady(#[from] SteadyAnalysisError),
+    /// The equilibrium was not found.
+    #[error(transparent)]
+    OperatingPoint(#[from] OperatingPointError),
+    /// The linearisation about the equilibrium failed.
+    #[error(transparent)]
+    Modal(#[from] ModalError),
+}
+
 /// The eigenvalues of `model` at its operating point for the current parameters: the
 /// reduced state matrix's for a steady motion, `M δq̈ + C δq̇ + K δq = 0`'s for an
-/// equilibrium; with them the raw eigenvalues of the state matrix (nothing set to zero) by
-/// which a change of sign is located.
+/// equilibrium.
 ///
 /// # Errors
-/// The failure as text (no operating point, a singular linearisation).
+/// [`SweepPointError`]: no operating point, or a linearisation that fails there.
 pub fn eigenvalues_at(
     model: &mut dyn ModelInfo,
     options: &OperatingPointOptions,
-) -> Result<(Vec<Complex<f64>>, Stability, Vec<Complex<f64>>), String> {
+) -> Result<PointEigenvalues, SweepPointError> {
     if is_steady_motion(model, &options.start) {
-        let a = steady_motion_analysis(model, options).map_err(|e| match e {
-            SteadyAnalysisError::OperatingPoint(e) => e.to_string(),
-            e => e.to_string(),
-        })?;
+        let a = steady_motion_analysis(model, options)?;
         let raw = raw_eigenvalues(&a.linearization.state_matrix);
-        return Ok((a.eigenvalues, a.stability, raw));
+        return Ok(PointEigenvalues {
+            eigenvalues: a.eigenvalues,
+            stability: a.stability,
+            raw,
+        });
     }
-    let point = super::operating_point::operating_point(model, options)
-        .map_err(|e: OperatingPointError| e.to_string())?;
+    let point = super::operating_point::operating_point(model, options)?;
     let n = model.num_dofs();
-    let lin = linearize(model, point.q(), &vec![0.0; n], point.t).map_err(|e| e.to_string())?;
-    let s = linear_stability(&lin).map_err(|e| e.to_string())?;
-    let raw = raw_eigenvalues(&lin.state_matrix().map_err(|e| e.to_string())?);
-    Ok((s.eigenvalues, s.stability, raw))
+    let lin = linearize(model, point.q(), &vec![0.0; n], point.t)?;
+    let s = linear_stability(&lin)?;
+    Ok(PointEigenvalues {
+        eigenvalues: s.eigenvalues,
+        stability: s.stability,
+        raw: raw_eigenvalues(&lin.state_matrix()?),
+    })
 }
 
 /// Below this fraction of `|s|` a real part counts as 0 when the changes of stability are
@@ -244,12 +274,12 @@ pub fn parameter_sweep(
     let mut counts: Vec<Option<usize>> = Vec::with_capacity(total);
     for (k, &value) in options.axis.values.iter().enumerate() {
         points.push(match at(model, value) {
-            Ok((eigenvalues, stability, raw)) => {
-                counts.push(Some(unstable_count(&raw)));
+            Ok(found) => {
+                counts.push(Some(unstable_count(&found.raw)));
                 SweepPoint {
                     value,
-                    eigenvalues,
-                    stability: Some(stability),
+                    eigenvalues: found.eigenvalues,
+                    stability: Some(found.stability),
                     error: None,
                 }
             }
@@ -259,7 +289,7 @@ pub fn parameter_sweep(
                     value,
                     eigenvalues: Vec::new(),
                     stability: None,
-                    error: Some(reason),
+                    error: Some(reason.to_string()),
                 }
             }
         });
@@ -292,7 +322,7 @@ pub fn parameter_sweep(
                     break;
                 }
                 let mid = 0.5 * (lo + hi);
-                let Ok((_, _, values)) = at(model, mid) else {
+                let Ok(PointEigenvalues { raw: values, .. }) = at(model, mid) else {
                     break;
                 };
                 let count = unstable_count(&values);
@@ -310,7 +340,7 @@ pub fn parameter_sweep(
                 Some(values) => values,
                 None => {
                     let v = if count_a > count_b { lo } else { hi };
-                    at(model, v).map(|(_, _, raw)| raw).unwrap_or_default()
+                    at(model, v).map(|p| p.raw).unwrap_or_default()
                 }
             };
             let crossing = side
