@@ -893,7 +893,15 @@ pub fn model_report(path: &str, text: &str, file: &ModelFile, source: &ModelSour
             .natural_frequencies
             .as_ref()
             .and_then(|check| check.at.as_ref().map(|a| a.to_string()));
-        out.mode_shapes = Some(analysis(at.as_deref()));
+        // A steady motion (or any operating point of a non-holonomic model) has no mode
+        // shapes of `M` and `K` to draw: its eigenvectors are those of the reduced state
+        // matrix (`eomgen modes --at NAME`).
+        let start = at.as_deref().map_or(EquilibriumStart::FirstNamed, |name| {
+            EquilibriumStart::Named(name.to_string())
+        });
+        if !eomgen_runtime::analysis::vibration::is_steady_motion(model.as_ref(), &start) {
+            out.mode_shapes = Some(analysis(at.as_deref()));
+        }
     }
     out.time_s = started.elapsed().as_secs_f64();
     out

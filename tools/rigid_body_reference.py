@@ -57,6 +57,24 @@ a, b, c = J1 * mp.cos(th0), -J3 * w3, m * g * l
 slow = (-b - mp.sqrt(b * b - 4 * a * c)) / (2 * a)
 fast = (-b + mp.sqrt(b * b - 4 * a * c)) / (2 * a)
 print(f"heavy_top: steady precession at 30 degrees, w3 = 100: slow {mp.nstr(slow, 16)}, fast {mp.nstr(fast, 16)} rad/s")
+# Nutation about the slow steady precession: Routh's reduction by the conserved momenta
+# p_phi, p_psi leaves I1 theta'' = -U'(theta) with
+# U = (p_phi - p_psi cos theta)^2/(2 I1 sin^2 theta) + m g l cos theta; U'(theta0) = 0 and the
+# linearised frequency is sqrt(U''(theta0)/I1).
+p_psi = J3 * w3
+p_phi = J1 * slow * mp.sin(th0) ** 2 + p_psi * mp.cos(th0)
+
+
+def routh(th):
+    return (p_phi - p_psi * mp.cos(th)) ** 2 / (2 * J1 * mp.sin(th) ** 2) + m * g * l * mp.cos(th)
+
+
+assert abs(mp.diff(routh, th0)) < mp.mpf("1e-30")
+nutation = mp.sqrt(mp.diff(routh, th0, 2) / J1)
+print(f"  nutation about the slow precession: {mp.nstr(nutation, 16)} rad/s")
+# The sleeping top (tests/fixtures/sleeping_top.yaml): stable for w3 > 2 sqrt(I1 m g l)/I3,
+# I1 = A + m l^2 about O (A = 0.01, l = 0.1, m = 1: I1 = 0.02).
+print(f"sleeping_top: critical spin {mp.nstr(2 * mp.sqrt(J1 * m * g * l) / J3, 16)} rad/s")
 
 t = sp.symbols("t")
 phi, theta, psi = (sp.Function(n)(t) for n in ("phi", "theta", "psi"))
