@@ -185,3 +185,94 @@ fn the_cli_reports_sweeps_and_steady_modes_as_json() {
     assert_eq!(json["stability"]["verdict"], "stable");
     assert_eq!(json["operating_point"]["qdot"]["x_dot"], 1.0);
 }
+
+/// The rolling disc (`rolling_disc`) against the equations of SymPy's rolling-disc example
+/// (Kane's method with the generalized speeds `u1 = lean'`, `u2 = spin' + yaw' sin(lean)`,
+/// `u3 = yaw' cos(lean)`; thin disc): `u̇1 = (6 r u2 u3 − r u3² tan q2 + 4 g sin q2)/(5 r)`,
+/// `u̇2 = −2 u1 u3/3`, `u̇3 = u1 (u3 tan q2 − 2 u2)`, at random states that roll (the
+/// contact point moves at `r spin'` along the heading). Rounding: 1e-11 of the largest term.
+#[test]
+fn the_rolling_disc_moves_as_kanes_equations_say() {
+    let mut m = model("rolling_disc");
+    let (r, g) = (0.2_f64, 9.81_f64);
+    let mut rng = common::seeded_rng(0x5EED_D15C);
+    use rand::RngExt;
+    for _ in 0..20 {
+        let (yaw, lean, spin): (f64, f64, f64) = (
+            rng.random_range(-3.0..3.0),
+            rng.random_range(-1.2..1.2),
+            rng.random_range(-3.0..3.0),
+        );
+        let (yaw_dot, lean_dot, spin_dot): (f64, f64, f64) = (
+            rng.random_range(-4.0..4.0),
+            rng.random_range(-4.0..4.0),
+            rng.random_range(-20.0..20.0),
+        );
+        let (x_dot, y_dot) = (r * spin_dot * yaw.cos(), r * spin_dot * yaw.sin());
+        let y = [
+            0.3, -0.2, yaw, lean, spin, x_dot, y_dot, yaw_dot, lean_dot, spin_dot,
+        ];
+        let mut dy = [0.0; 10];
+        m.as_ode_mut().rhs(0.0, &y, &mut dy).unwrap();
+        let (yaw_dd, lean_dd, spin_dd) = (dy[7], dy[8], dy[9]);
+        let (s, c) = (lean.sin(), lean.cos());
+        let (u1, u2, u3) = (lean_dot, spin_dot + yaw_dot * s, yaw_dot * c);
+        let du1 = lean_dd;
+        let du2 = spin_dd + yaw_dd * s + yaw_dot * lean_dot * c;
+        let du3 = yaw_dd * c - yaw_dot * lean_dot * s;
+        let t = lean.tan();
+        let expected = [
+            (6.0 * r * u2 * u3 - r * u3 * u3 * t + 4.0 * g * s) / (5.0 * r),
+            -2.0 * u1 * u3 / 3.0,
+            u1 * (u3 * t - 2.0 * u2),
+        ];
+        let scale = 1.0 + u2.abs() * u3.abs() + u3 * u3 * t.abs() + g / r;
+        for (got, want) in [du1, du2, du3].iter().zip(expected) {
+            assert!(
+                (got - want).abs() <= 1e-11 * scale,
+                "{got} against {want} at {y:?}"
+            );
+        }
+    }
+}
+
+/// Upright rolling at v (`rolling_disc --at rolling`): the pair
+/// `s² = −(J (J + m r²) W² − m g r I)/(I (I + m r²))`, `W = v/r` (SymPy's linearised disc,
+/// Peterson et al. 2015), and the sweep over v finds the critical speed `√(g r/3)`, real
+/// (two real roots meet at zero and leave as an imaginary pair) and stabilising. Differenced
+/// Jacobian: 1e-9 for the eigenvalue, 1e-10 for the speed.
+#[test]
+fn the_rolling_disc_is_stable_above_its_critical_speed() {
+    let mut m = model("rolling_disc");
+    let (mass, r, g, v): (f64, f64, f64, f64) = (1.0, 0.2, 9.81, 2.0);
+    let (i, j) = (mass * r * r / 4.0, mass * r * r / 2.0);
+    let w = v / r;
+    let s2 = -(j * (j + mass * r * r) * w * w - mass * g * r * i) / (i * (i + mass * r * r));
+    let (s, states) = steady(m.as_mut(), "rolling");
+    assert_eq!(states, ["lean", "yaw_dot", "lean_dot"]);
+    assert!(
+        holds(&s, Complex::new(0.0, (-s2).sqrt()), 1e-9 * (-s2).sqrt()),
+        "{s:?}"
+    );
+    let options = ParameterSweepOptions {
+        axis: SweepAxis::linear("v", 0.2, 3.0, 15).unwrap(),
+        operating_point: at("rolling"),
+        refine: true,
+    };
+    let sweep = vibration::parameter_sweep(m.as_mut(), &options, |_, _| {}).unwrap();
+    let critical = (g * r / 3.0).sqrt();
+    assert_eq!(
+        sweep.stability_changes.len(),
+        1,
+        "{:?}",
+        sweep.stability_changes
+    );
+    let change = &sweep.stability_changes[0];
+    assert!(
+        (change.value - critical).abs() <= 1e-10,
+        "{} against {critical}",
+        change.value
+    );
+    assert_eq!(change.eigenvalue, Crossing::Real);
+    assert_eq!(change.direction, Direction::Stabilising);
+}

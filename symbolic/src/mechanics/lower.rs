@@ -366,6 +366,7 @@ impl<'f> Lowering<'f> {
         &mut self,
         file: &ModelFile,
         parameters: &[ParameterInfo],
+        kinematics: Kinematics<'_>,
     ) -> ConstraintEquations {
         let before = self.errors.len();
         let holonomic: Vec<(String, ExprId)> = file
@@ -373,11 +374,14 @@ impl<'f> Lowering<'f> {
             .iter()
             .map(|(k, e)| (k.value.clone(), self.expr(e)))
             .collect();
-        let nonholonomic: Vec<(String, ExprId)> = file
+        let mut nonholonomic: Vec<(String, ExprId)> = file
             .nonholonomic
             .iter()
             .map(|(k, e)| (k.value.clone(), self.expr(e)))
             .collect();
+        for r in &file.rolling {
+            nonholonomic.extend(self.rolling_contact(r, kinematics));
+        }
         if holonomic.is_empty() && nonholonomic.is_empty() {
             return ConstraintEquations::default();
         }
@@ -424,17 +428,16 @@ impl<'f> Lowering<'f> {
                 samples.push(values);
             }
         }
-        let all: Vec<&(Located<String>, crate::model::Expr)> =
-            file.constraints.iter().chain(&file.nonholonomic).collect();
+        let all: Vec<Located<String>> = file.constraint_names();
         let dependent = redundant_rows(&samples, m, n);
         let independent: Vec<usize> = (0..eqs.holonomic)
             .filter(|i| dependent.iter().all(|(d, _)| d != i))
             .collect();
         for (i, with) in dependent {
-            let (k, _) = all[i];
+            let k = &all[i];
             let others: Vec<String> = with
                 .iter()
-                .map(|j| format!("`{}`", all[*j].0.value))
+                .map(|j| format!("`{}`", all[*j].value))
                 .collect();
             // A holonomic constraint that repeats holonomic ones: redundant if it holds where
             // they hold, contradictory if not.
@@ -805,7 +808,12 @@ impl<'f> Lowering<'f> {
         let balances = self.balances(&points, &body_infos);
         let hand_equations = self.hand_equations();
 
-        let constraints = self.constraints(file, &parameters);
+        let kinematics = Kinematics {
+            points: &points,
+            bodies: &body_infos,
+            frames: &frames,
+        };
+        let constraints = self.constraints(file, &parameters, kinematics);
         if !file.events.is_empty() {
             for (i, name) in constraints.names.iter().enumerate() {
                 self.arena
@@ -1452,6 +1460,100 @@ impl<'f> Lowering<'f> {
             }
         }
         (initial_q, initial_qdot)
+    }
+}
+
+/// What a rolling contact reads of the lowered model: the points, the bodies and the frames.
+#[derive(Clone, Copy)]
+struct Kinematics<'a> {
+    points: &'a Points,
+    bodies: &'a [BodyInfo],
+    frames: &'a Frames,
+}
+
+impl Lowering<'_> {
+    /// The constraints of a rolling contact, `(v_G + ω × (r_C − r_G))·e_k = 0` for each axis
+    /// `e_k` of its frame, by name; none (with an error) when its body, point or frame is
+    /// unknown.
+    fn rolling_contact(
+        &mut self,
+        r: &crate::model::RollingContact,
+        k: Kinematics<'_>,
+    ) -> Vec<(String, ExprId)> {
+        let body = k.bodies.iter().find(|b| b.name == r.body.value);
+        let contact = point(k.points, &r.point.value);
+        let frame = match &r.frame {
+            Some(f) => k.frames.index(&f.value),
+            None => Some(0),
+        };
+        let (Some(body), Some(contact), Some(frame)) = (body, contact, frame) else {
+            self.errors.push(Diagnostic::new(
+                r.name.location,
+                format!(
+                    "rolling contact `{}` names an unknown body, point or frame",
+                    r.name.value
+                ),
+            ));
+            return Vec::new();
+        };
+        let centre = &k.points[body.com].1;
+        let offset: Vec<ExprId> = k.points[contact]
+            .1
+            .iter()
+            .zip(centre)
+            .map(|(c, g)| self.arena.minus(*c, *g))
+            .collect();
+        let velocity: Vec<ExprId> = centre
+            .iter()
+            .map(|c| self.arena.time_derivative(*c))
+            .collect();
+        // ω × r: in 3-D with ω carried into the ground frame; in the plane ω = θ̇ about z.
+        let spin: Vec<ExprId> = match (&body.spatial, body.rotation, offset.len()) {
+            (Some(s), _, 3) => {
+                let w = k
+                    .frames
+                    .express(&mut self.arena, s.angular_velocity, s.frame, 0);
+                let r3 = [offset[0], offset[1], offset[2]];
+                super::frames::cross(&mut self.arena, &w, &r3).to_vec()
+            }
+            (None, Some((_, angle)), 2) => {
+                let w = self.arena.time_derivative(angle);
+                let a = self.arena.times(w, offset[1]);
+                let b = self.arena.times(w, offset[0]);
+                vec![self.arena.neg(a), b]
+            }
+            _ => {
+                self.errors.push(Diagnostic::new(
+                    r.body.location,
+                    format!(
+                        "rolling contact `{}`: `{}` is not a rigid body of the model's dimension",
+                        r.name.value, r.body.value
+                    ),
+                ));
+                return Vec::new();
+            }
+        };
+        let slip: Vec<ExprId> = velocity
+            .iter()
+            .zip(&spin)
+            .map(|(v, s)| self.arena.plus(*v, *s))
+            .collect();
+        let (zero, one) = (self.arena.int(0), self.arena.int(1));
+        r.along
+            .iter()
+            .zip(r.constraint_names())
+            .map(|(axis, name)| {
+                let mut e = vec![zero; slip.len()];
+                e[axis.value.index()] = one;
+                if slip.len() == 3 {
+                    e = k
+                        .frames
+                        .express(&mut self.arena, [e[0], e[1], e[2]], frame, 0)
+                        .to_vec();
+                }
+                (name.value, self.dot(&slip, &e))
+            })
+            .collect()
     }
 }
 

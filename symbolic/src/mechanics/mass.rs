@@ -78,7 +78,7 @@ pub fn mass_matrix_diagnostics(
     eom: &EquationsOfMotion,
     file: &ModelFile,
 ) -> Vec<Diagnostic> {
-    if !file.constraints.is_empty() || !file.nonholonomic.is_empty() {
+    if !file.constraints.is_empty() || !file.nonholonomic.is_empty() || !file.rolling.is_empty() {
         return Vec::new();
     }
     let n = eom.num_dofs;

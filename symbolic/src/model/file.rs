@@ -138,6 +138,40 @@ pub struct Frame {
     pub rotations: Vec<SimpleRotation>,
 }
 
+/// Rolling without slip, `nonholonomic: { roll: { body: wheel, point: C, along: [x, y], in: N } }`:
+/// the velocity of the material point of `body` that is at `point`,
+/// `v_G + ω × (r_C − r_G)`, has no component along the axes `along` of frame `in` (the
+/// ground frame if not given). One constraint per axis, named `roll_x`, `roll_y`, … after the
+/// entry and the axis, after the constraints written as expressions.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RollingContact {
+    /// The entry's name (the constraints are `<name>_<axis>`).
+    pub name: Located<String>,
+    /// The rigid body that rolls (planar or 3-D).
+    pub body: Located<String>,
+    /// The point of contact (a point of `points:`).
+    pub point: Located<String>,
+    /// The axes along which the contact point's velocity vanishes.
+    pub along: Vec<Located<Axis>>,
+    /// The frame of the axes; `None`: the ground frame.
+    pub frame: Option<Located<String>>,
+}
+
+impl RollingContact {
+    /// The names of its constraints, `<name>_<axis>`, located at the entry.
+    pub fn constraint_names(&self) -> Vec<Located<String>> {
+        self.along
+            .iter()
+            .map(|a| {
+                Located::new(
+                    format!("{}_{}", self.name.value, a.value.letter()),
+                    self.name.location,
+                )
+            })
+            .collect()
+    }
+}
+
 /// A 3-D inertia tensor about a body's centre of mass in the body's frame (kg·m²): the
 /// moments `xx, yy, zz` and the tensor's off-diagonal entries `xy, yz, xz` (which are the
 /// negatives of the products of inertia `∫xy dm`); absent entries are 0.
@@ -693,6 +727,9 @@ pub struct ModelFile {
     /// `nonholonomic:` — constraints `A(q, t) q̇ + b(q, t) = 0` by name (the expression is the
     /// left-hand side, linear in the rates), in file order.
     pub nonholonomic: Vec<(Located<String>, Expr)>,
+    /// `nonholonomic:` entries that are rolling contacts, in file order (their constraints
+    /// come after those of [`Self::nonholonomic`]).
+    pub rolling: Vec<RollingContact>,
     /// Coordinates whose `initial:` value is only a guess (`theta2: { guess: 0.5 }`): the
     /// runtime solves them, and their rates, from the constraints.
     pub initial_guesses: Vec<Located<String>>,
@@ -706,6 +743,31 @@ pub struct ModelFile {
     pub floquet: Vec<FloquetReference>,
     /// The spatial dimension of the points (2 or 3); `None` when there are no points.
     pub dimension: Option<usize>,
+}
+
+impl ModelFile {
+    /// The names of every non-holonomic constraint, located: the expressions', then each
+    /// rolling contact's rows.
+    pub fn nonholonomic_names(&self) -> Vec<Located<String>> {
+        self.nonholonomic
+            .iter()
+            .map(|(k, _)| k.clone())
+            .chain(
+                self.rolling
+                    .iter()
+                    .flat_map(RollingContact::constraint_names),
+            )
+            .collect()
+    }
+
+    /// The names of every constraint, holonomic first, located.
+    pub fn constraint_names(&self) -> Vec<Located<String>> {
+        self.constraints
+            .iter()
+            .map(|(k, _)| k.clone())
+            .chain(self.nonholonomic_names())
+            .collect()
+    }
 }
 
 /// Owned text of a description.

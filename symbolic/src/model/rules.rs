@@ -9,7 +9,8 @@ use rustc_hash::FxHashSet;
 use super::ast::{Expr, FUNCTIONS};
 use super::diagnostic::{Diagnostic, Diagnostics};
 use super::file::{
-    BalanceKind, BodyKind, GROUND_FRAME, InertiaTensor, ModelFile, Parameter, TorqueValue,
+    Axis, BalanceKind, BodyKind, GROUND_FRAME, InertiaTensor, ModelFile, Parameter, RollingContact,
+    TorqueValue,
 };
 use super::located::{Located, Location};
 use super::parser::{closest, eval_expr, identifiers};
@@ -144,10 +145,9 @@ impl<'f> Checker<'f> {
             rates: coords.iter().map(|c| format!("{c}_dot")).collect(),
             accelerations: coords.iter().map(|c| format!("{c}_ddot")).collect(),
             multipliers: file
-                .constraints
+                .constraint_names()
                 .iter()
-                .chain(&file.nonholonomic)
-                .map(|(k, _)| format!("lambda_{}", k.value))
+                .map(|k| format!("lambda_{}", k.value))
                 .collect(),
             coords,
             points: file.points.iter().map(|p| p.name.value.as_str()).collect(),
@@ -975,32 +975,31 @@ impl<'f> Checker<'f> {
     // coordinates (not rates) of a model that has constraints.
     fn constraints(&mut self) {
         let file = self.file;
-        let mut seen: Vec<(&str, Location)> = Vec::new();
         for (k, e) in &file.constraints {
             self.resolve(e, Depends::Position, &format!("constraint `{}`", k.value));
         }
         for (k, e) in &file.nonholonomic {
             self.resolve(e, Depends::Motion, &format!("constraint `{}`", k.value));
         }
-        for (k, _) in file.constraints.iter().chain(&file.nonholonomic) {
+        let names = file.constraint_names();
+        let mut seen: Vec<(&str, Location)> = Vec::new();
+        for k in &names {
             if let Some((_, first)) = seen.iter().find(|(n, _)| *n == k.value) {
                 self.error(
                     Diagnostic::new(k.location, format!("duplicate constraint name `{}`: already used at {first}", k.value))
-                        .with_help("constraints under `constraints` and `nonholonomic` share one namespace; rename one"),
+                        .with_help("constraints under `constraints` and `nonholonomic` share one namespace (a rolling contact `roll` names its rows `roll_x`, `roll_y`, …); rename one"),
                 );
             } else {
                 seen.push((&k.value, k.location));
             }
         }
-        let m = file.constraints.len() + file.nonholonomic.len();
+        for r in &file.rolling {
+            self.rolling_contact(r);
+        }
+        let m = names.len();
         let n = file.coordinates.len();
         if m > n && !self.incomplete.has_section("coordinates") {
-            let at = file
-                .constraints
-                .iter()
-                .chain(&file.nonholonomic)
-                .nth(n)
-                .map_or(file.name.location, |(k, _)| k.location);
+            let at = names.get(n).map_or(file.name.location, |k| k.location);
             self.error(
                 Diagnostic::new(at, format!("{m} constraints on {n} coordinate(s): more constraints than coordinates"))
                     .with_help("each constraint removes one degree of freedom; remove redundant constraints or add coordinates"),
@@ -1203,6 +1202,7 @@ impl<'f> Checker<'f> {
                 .saturating_sub(file.constraints.len());
             if key == "natural_frequencies"
                 && file.nonholonomic.is_empty()
+                && file.rolling.is_empty()
                 && modal.values.len() != modes
                 && !self.incomplete.has_section("coordinates")
                 && !self.incomplete.has_section("constraints")
@@ -1447,6 +1447,69 @@ impl<'f> Checker<'f> {
 }
 
 impl Checker<'_> {
+    /// Reports a rolling contact whose body is not a rigid body, whose point is unknown, or
+    /// whose frame is unknown or given in a planar model, and an axis `z` in a planar one.
+    fn rolling_contact(&mut self, r: &RollingContact) {
+        let file = self.file;
+        self.point(&r.point);
+        match file.bodies.iter().find(|b| b.name.value == r.body.value) {
+            Some(b) if matches!(b.kind, BodyKind::Particle { .. }) => self.error(
+                Diagnostic::new(r.body.location, format!("rolling contact `{}` names `{}`, which is a particle", r.name.value, r.body.value))
+                    .with_help("a body rolls about its centre of mass: name a rigid body (planar with `angle`, 3-D with `frame`)"),
+            ),
+            Some(_) => {}
+            None if self.incomplete.has_name(&r.body.value)
+                || self.section_lost("bodies", file.bodies.is_empty()) => {}
+            None => {
+                let d = Diagnostic::new(r.body.location, format!("unknown body `{}`", r.body.value));
+                let d = match closest(&r.body.value, &self.bodies) {
+                    Some(c) => d.with_help(format!("did you mean `{c}`?")),
+                    None => d.with_help("declare it under `bodies:` as a rigid body"),
+                };
+                self.error(d);
+            }
+        }
+        let planar = file.dimension == Some(2);
+        if let Some(frame) = &r.frame {
+            if planar {
+                self.error(
+                    Diagnostic::new(
+                        frame.location,
+                        format!(
+                            "rolling contact `{}` is in a planar model, which has no frames",
+                            r.name.value
+                        ),
+                    )
+                    .with_help("leave out `in`: the axes are the plane's x and y"),
+                );
+            } else {
+                let frames: Vec<&str> = file
+                    .frames
+                    .iter()
+                    .map(|f| f.name.value.as_str())
+                    .chain([GROUND_FRAME])
+                    .collect();
+                self.frame(frame, &frames);
+            }
+        }
+        if planar {
+            for a in &r.along {
+                if a.value == Axis::Z {
+                    self.error(
+                        Diagnostic::new(
+                            a.location,
+                            format!(
+                                "rolling contact `{}` is planar, so it has no `z` axis",
+                                r.name.value
+                            ),
+                        )
+                        .with_help("in a planar model `along` lists `x` and `y`"),
+                    );
+                }
+            }
+        }
+    }
+
     /// Reports a 3-D inertia tensor that is not positive definite at the parameters'
     /// defaults (Sylvester's criterion on its leading minors). (Symmetric it is by
     /// construction: each off-diagonal entry is written once.)

@@ -1128,6 +1128,13 @@ impl<'f> Checker<'f> {
                 self.constraints.push((k.value.clone(), unit, holonomic));
             }
         }
+        // A rolling contact's rows are velocities (m/s).
+        for r in &file.rolling {
+            for k in r.constraint_names() {
+                let velocity = Dim::of(Dimension::integers(1, 0, -1));
+                self.constraints.push((k.value, Some(velocity), false));
+            }
+        }
         for (k, e) in &file.initial {
             self.value_of(&k.value, e, &format!("the initial value of `{}`", k.value));
         }

@@ -233,10 +233,30 @@ pub fn eigenvalues_at(
 /// eigenvalue of modulus 3.4 whose real part grows by 1 per m/s is located to 3e-10 m/s).
 pub const CROSSING_TOLERANCE: f64 = 1e-10;
 
-/// Number of eigenvalues with a real part above [`CROSSING_TOLERANCE`] of their modulus.
-fn unstable_count(eigenvalues: &[Complex<f64>]) -> usize {
+/// An eigenvalue below this fraction of the largest modulus is zero to the accuracy of a
+/// differenced state matrix (about `1e-11` of it).
+const ZERO_MODULUS: f64 = 1e-9;
+
+/// How many of `eigenvalues` are zero ([`ZERO_MODULUS`] of the largest).
+fn zero_count(eigenvalues: &[Complex<f64>]) -> usize {
+    let largest = eigenvalues.iter().map(|s| s.norm()).fold(0.0, f64::max);
     eigenvalues
         .iter()
+        .filter(|s| s.norm() <= ZERO_MODULUS * largest)
+        .count()
+}
+
+/// Number of eigenvalues with a real part above [`CROSSING_TOLERANCE`] of their modulus,
+/// leaving out the `structural` ones nearest zero: the zeros every value of the sweep has (a
+/// family of neighbouring steady motions, a conserved quantity), whose rounding would
+/// otherwise flip their sign from value to value. A physical eigenvalue crossing zero is
+/// nearer zero than they are only within rounding of the crossing.
+fn unstable_count(eigenvalues: &[Complex<f64>], structural: usize) -> usize {
+    let mut sorted = eigenvalues.to_vec();
+    sorted.sort_by(|a, b| a.norm().total_cmp(&b.norm()));
+    sorted
+        .iter()
+        .skip(structural)
         .filter(|s| s.re > CROSSING_TOLERANCE * s.norm())
         .count()
 }
@@ -270,12 +290,13 @@ pub fn parameter_sweep(
     };
     let total = options.axis.values.len();
     let mut points = Vec::with_capacity(total);
-    // Per point, the number of raw eigenvalues with a positive real part.
-    let mut counts: Vec<Option<usize>> = Vec::with_capacity(total);
+    // Per point, the raw eigenvalues (the numbers of unstable ones are counted once the
+    // structural zeros are known).
+    let mut raws: Vec<Option<Vec<Complex<f64>>>> = Vec::with_capacity(total);
     for (k, &value) in options.axis.values.iter().enumerate() {
         points.push(match at(model, value) {
             Ok(found) => {
-                counts.push(Some(unstable_count(&found.raw)));
+                raws.push(Some(found.raw));
                 SweepPoint {
                     value,
                     eigenvalues: found.eigenvalues,
@@ -284,7 +305,7 @@ pub fn parameter_sweep(
                 }
             }
             Err(reason) => {
-                counts.push(None);
+                raws.push(None);
                 SweepPoint {
                     value,
                     eigenvalues: Vec::new(),
@@ -304,6 +325,16 @@ pub fn parameter_sweep(
             reason: first.error.clone().unwrap_or_default(),
         });
     }
+    let structural = raws
+        .iter()
+        .flatten()
+        .map(|raw| zero_count(raw))
+        .min()
+        .unwrap_or(0);
+    let counts: Vec<Option<usize>> = raws
+        .iter()
+        .map(|raw| raw.as_ref().map(|r| unstable_count(r, structural)))
+        .collect();
     let mut stability_changes = Vec::new();
     if options.refine {
         for k in 1..points.len() {
@@ -325,7 +356,7 @@ pub fn parameter_sweep(
                 let Ok(PointEigenvalues { raw: values, .. }) = at(model, mid) else {
                     break;
                 };
-                let count = unstable_count(&values);
+                let count = unstable_count(&values, structural);
                 if count == count_a {
                     lo = mid;
                 } else {
@@ -343,13 +374,28 @@ pub fn parameter_sweep(
                     at(model, v).map(|p| p.raw).unwrap_or_default()
                 }
             };
+            let mut side = side;
+            side.sort_by(|a, b| a.norm().total_cmp(&b.norm()));
             let crossing = side
                 .iter()
+                .skip(structural)
                 .copied()
                 .filter(|s| s.re > CROSSING_TOLERANCE * s.norm())
                 .min_by(|x, y| x.re.total_cmp(&y.re))
                 .unwrap_or_default();
-            let complex = crossing.im.abs() > 1e-6 * crossing.norm().max(1e-300);
+            // Real or complex is read at the grid value on the unstable side, away from the
+            // crossing: a real pair that meets at zero and leaves as an imaginary pair (a
+            // spinning body, a rolling disc) is split by rounding into a complex pair right
+            // at the crossing.
+            let grid_side = if count_a > count_b { k - 1 } else { k };
+            let mut grid = raws[grid_side].clone().unwrap_or_default();
+            grid.sort_by(|a, b| a.norm().total_cmp(&b.norm()));
+            let complex = grid
+                .iter()
+                .skip(structural)
+                .filter(|s| s.re > CROSSING_TOLERANCE * s.norm())
+                .min_by(|x, y| x.re.total_cmp(&y.re))
+                .is_some_and(|s| s.im.abs() > 1e-6 * s.norm());
             stability_changes.push(StabilityChange {
                 value: 0.5 * (lo + hi),
                 eigenvalue: if complex {

@@ -51,6 +51,18 @@ const TORQUE: Fields = Fields {
     example: "{ body: arm, value: tau0*sin(w*t) }",
 };
 
+/// The keys of a rolling contact.
+const ROLLING: Fields = Fields {
+    kind: "rolling contact",
+    keys: &[
+        ("body", Need::Required),
+        ("point", Need::Required),
+        ("along", Need::Required),
+        ("in", Need::Optional),
+    ],
+    example: "{ body: wheel, point: C, along: [x, y], in: N }",
+};
+
 /// The keys of a frame.
 const FRAME: Fields = Fields {
     kind: "frame",
@@ -169,6 +181,68 @@ impl Ctx<'_> {
             return None;
         }
         complete.then_some(RelativePosition { from, vectors })
+    }
+
+    /// `nonholonomic:` — `name: A(q, t) q̇ + b(q, t)` (an expression), or a rolling contact
+    /// `name: { body, point, along, in }`.
+    pub(super) fn nonholonomic(
+        &mut self,
+        node: &YamlNode,
+    ) -> (Vec<(Located<String>, Expr)>, Vec<RollingContact>) {
+        let spec = Keyed {
+            what: "`nonholonomic`",
+            example: "nonholonomic: { no_side_slip: -sin(theta)*x_dot + cos(theta)*y_dot }",
+            names: None,
+            drop: false,
+        };
+        let mut rolling = Vec::new();
+        let expressions = self.keyed(node, spec, |cx, k, v| {
+            if matches!(v.kind, YamlKind::Map(_)) {
+                if let Some(r) = cx.rolling_contact(k, v) {
+                    rolling.push(r);
+                }
+                return None;
+            }
+            cx.expr(v, "a non-holonomic constraint")
+                .map(|e| (k.clone(), e))
+        });
+        (expressions, rolling)
+    }
+
+    /// A rolling contact: `{ body, point, along: [x, y], in: N }`.
+    fn rolling_contact(&mut self, k: &Located<String>, v: &YamlNode) -> Option<RollingContact> {
+        let f = self.fields(k, v, &ROLLING)?;
+        let body = get(f, "body").and_then(|n| self.name(n, "`body`"));
+        let point = get(f, "point").and_then(|n| self.name(n, "`point`"));
+        let frame = match get(f, "in") {
+            Some(n) => Some(Some(self.name(n, "`in`")?)),
+            None => Some(None),
+        };
+        let along = get(f, "along").and_then(|n| {
+            let items = self.seq(n, "`along`", "along: [x, y]")?;
+            let axes: Option<Vec<Located<Axis>>> = items
+                .iter()
+                .map(|i| self.axes(i, true).and_then(|mut a| a.pop()))
+                .collect();
+            match axes {
+                Some(a) if !a.is_empty() => Some(a),
+                Some(_) => {
+                    self.error(
+                        Diagnostic::new(n.location, "`along` names no axis")
+                            .with_help("list the axes along which the contact point does not slip, as in `along: [x, y]`"),
+                    );
+                    None
+                }
+                None => None,
+            }
+        });
+        Some(RollingContact {
+            name: k.clone(),
+            body: body?,
+            point: point?,
+            along: along?,
+            frame: frame?,
+        })
     }
 
     /// `frames:` — `name: { parent, axis, angle }` or `name: { parent, axes, angles, about }`.

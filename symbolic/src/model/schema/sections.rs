@@ -159,14 +159,7 @@ const SECTIONS: &[Section] = &[
     },
     Section {
         key: "nonholonomic",
-        read: |cx, n, file| {
-            file.nonholonomic = cx.keyed_exprs(
-                n,
-                "`nonholonomic`",
-                "nonholonomic: { no_side_slip: -sin(theta)*x_dot + cos(theta)*y_dot }",
-                "a non-holonomic constraint",
-            );
-        },
+        read: |cx, n, file| (file.nonholonomic, file.rolling) = cx.nonholonomic(n),
         missing: None,
     },
     Section {
@@ -263,6 +256,7 @@ impl Ctx<'_> {
             potential: None,
             generalized_forces: Vec::new(),
             frames: Vec::new(),
+            rolling: Vec::new(),
             points: Vec::new(),
             bodies: Vec::new(),
             gravity: None,
