@@ -276,3 +276,161 @@ fn the_rolling_disc_is_stable_above_its_critical_speed() {
     assert_eq!(change.eigenvalue, Crossing::Real);
     assert_eq!(change.direction, Direction::Stabilising);
 }
+
+/// The Whipple bicycle benchmark (`whipple_bicycle`, Meijaard, Papadopoulos, Ruina & Schwab,
+/// Proc. R. Soc. A 463, 2007): the eigenvalues of upright straight rolling at v = 0, 1, …,
+/// 10 m/s equal the paper's Table 2 to 1e-10 (the paper prints 14 decimals; its own
+/// recomputation at 50 digits agrees with the table to 1.1e-13 except the castering value at
+/// v = 7, 6e-13 off; the table's value is used), and the sweep finds the weave speed 4.29238253634111 m/s (complex,
+/// stabilising) and the capsize speed 6.02426201538837 m/s (real, destabilising) to 1e-9.
+#[test]
+fn the_benchmark_bicycle_has_the_papers_eigenvalues_and_speeds() {
+    // (weave or the two real roots at v = 0, capsize, castering) per v, Table 2.
+    let table: [(f64, [Complex<f64>; 4]); 11] = [
+        (
+            0.0,
+            [
+                re(3.13164324790656),
+                re(5.53094371765393),
+                re(-3.13164324790656),
+                re(-5.53094371765393),
+            ],
+        ),
+        (
+            1.0,
+            [
+                pair(3.52696170990070, 0.80774027519930),
+                conj(3.52696170990070, 0.80774027519930),
+                re(-3.13423125066578),
+                re(-7.11008014637442),
+            ],
+        ),
+        (
+            2.0,
+            [
+                pair(2.68234517512745, 1.68066296590675),
+                conj(2.68234517512745, 1.68066296590675),
+                re(-3.07158645641514),
+                re(-8.67387984831735),
+            ],
+        ),
+        (
+            3.0,
+            [
+                pair(1.70675605663975, 2.31582447384325),
+                conj(1.70675605663975, 2.31582447384325),
+                re(-2.63366137253667),
+                re(-10.35101467245920),
+            ],
+        ),
+        (
+            4.0,
+            [
+                pair(0.41325331521125, 3.07910818603206),
+                conj(0.41325331521125, 3.07910818603206),
+                re(-1.42944427361326),
+                re(-12.15861426576450),
+            ],
+        ),
+        (
+            5.0,
+            [
+                pair(-0.77534188219585, 4.46486771378823),
+                conj(-0.77534188219585, 4.46486771378823),
+                re(-0.32286642900409),
+                re(-14.07838969279820),
+            ],
+        ),
+        (
+            6.0,
+            [
+                pair(-1.52644486584142, 5.87673060598709),
+                conj(-1.52644486584142, 5.87673060598709),
+                re(-0.00406690076970),
+                re(-16.08537123098030),
+            ],
+        ),
+        (
+            7.0,
+            [
+                pair(-2.13875644258362, 7.19525913329805),
+                conj(-2.13875644258362, 7.19525913329805),
+                re(0.10268170574766),
+                re(-18.15788466125262),
+            ],
+        ),
+        (
+            8.0,
+            [
+                pair(-2.69348683581097, 8.46037971396931),
+                conj(-2.69348683581097, 8.46037971396931),
+                re(0.14327879765713),
+                re(-20.27940894394569),
+            ],
+        ),
+        (
+            9.0,
+            [
+                pair(-3.21675402252485, 9.69377351531791),
+                conj(-3.21675402252485, 9.69377351531791),
+                re(0.15790184030917),
+                re(-22.43788559040858),
+            ],
+        ),
+        (
+            10.0,
+            [
+                pair(-3.72016840437287, 10.90681139476287),
+                conj(-3.72016840437287, 10.90681139476287),
+                re(0.16105338653172),
+                re(-24.62459635017404),
+            ],
+        ),
+    ];
+    let mut m = model("whipple_bicycle");
+    for (v, expected) in &table {
+        m.set_parameter("v", *v).unwrap();
+        let (s, states) = steady(m.as_mut(), "upright");
+        assert_eq!(states, ["lean", "steer", "lean_dot", "steer_dot"]);
+        assert_eq!(s.len(), 4, "v = {v}: {s:?}");
+        for e in expected {
+            assert!(holds(&s, *e, 1e-10), "v = {v}: {e} not among {s:?}");
+        }
+    }
+    let options = ParameterSweepOptions {
+        axis: SweepAxis::linear("v", 0.0, 10.0, 11).unwrap(),
+        operating_point: at("upright"),
+        refine: true,
+    };
+    let sweep = vibration::parameter_sweep(m.as_mut(), &options, |_, _| {}).unwrap();
+    let changes = &sweep.stability_changes;
+    assert_eq!(changes.len(), 2, "{changes:?}");
+    assert!(
+        (changes[0].value - 4.29238253634111).abs() <= 1e-9,
+        "{changes:?}"
+    );
+    assert_eq!(changes[0].eigenvalue, Crossing::Complex);
+    assert_eq!(changes[0].direction, Direction::Stabilising);
+    assert!(
+        (changes[0].frequency - 3.43503384866144).abs() <= 1e-8,
+        "{changes:?}"
+    );
+    assert!(
+        (changes[1].value - 6.02426201538837).abs() <= 1e-9,
+        "{changes:?}"
+    );
+    assert_eq!(changes[1].eigenvalue, Crossing::Real);
+    assert_eq!(changes[1].direction, Direction::Destabilising);
+}
+
+fn re(x: f64) -> Complex<f64> {
+    Complex::new(x, 0.0)
+}
+
+fn pair(x: f64, y: f64) -> Complex<f64> {
+    Complex::new(x, y)
+}
+
+fn conj(x: f64, y: f64) -> Complex<f64> {
+    Complex::new(x, -y)
+}

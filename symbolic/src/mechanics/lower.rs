@@ -369,11 +369,43 @@ impl<'f> Lowering<'f> {
         kinematics: Kinematics<'_>,
     ) -> ConstraintEquations {
         let before = self.errors.len();
-        let holonomic: Vec<(String, ExprId)> = file
+        let mut holonomic: Vec<(String, ExprId)> = file
             .constraints
             .iter()
             .map(|(k, e)| (k.value.clone(), self.expr(e)))
             .collect();
+        for c in &file.point_constraints {
+            let (Some(p), Some(frame)) = (
+                point(kinematics.points, &c.point.value),
+                match &c.frame {
+                    Some(f) => kinematics.frames.index(&f.value),
+                    None => Some(0),
+                },
+            ) else {
+                self.errors.push(Diagnostic::new(
+                    c.name.location,
+                    format!(
+                        "constraint `{}` names an unknown point or frame",
+                        c.name.value
+                    ),
+                ));
+                continue;
+            };
+            let r = kinematics.points[p].1.clone();
+            let (zero, one) = (self.arena.int(0), self.arena.int(1));
+            let mut e = vec![zero; r.len()];
+            if let Some(slot) = e.get_mut(c.along.value.index()) {
+                *slot = one;
+            }
+            if r.len() == 3 {
+                e = kinematics
+                    .frames
+                    .express(&mut self.arena, [e[0], e[1], e[2]], frame, 0)
+                    .to_vec();
+            }
+            let phi = self.dot(&r, &e);
+            holonomic.push((c.name.value.clone(), phi));
+        }
         let mut nonholonomic: Vec<(String, ExprId)> = file
             .nonholonomic
             .iter()
@@ -951,6 +983,11 @@ impl<'f> Lowering<'f> {
     fn points(&mut self, frames: &Frames) -> Points {
         let mut points: Points = Vec::new();
         for p in &self.file.points {
+            if let Some(wheel) = &p.wheel {
+                let r = self.wheel_contact(wheel, &points, frames);
+                points.push((p.name.value.clone(), r));
+                continue;
+            }
             let Some(relative) = &p.relative else {
                 let r = p.position.iter().map(|c| self.expr(c)).collect();
                 points.push((p.name.value.clone(), r));
@@ -987,6 +1024,47 @@ impl<'f> Lowering<'f> {
             points.push((p.name.value.clone(), r));
         }
         points
+    }
+
+    /// A wheel's contact point: its centre less the radius along the unit vector of the
+    /// wheel's plane (normal to the axle `a`) nearest the ground frame's `z`:
+    /// `r_C = r_centre − r (n − (n·a) a)/|n − (n·a) a|`, `n = N.z`, computed in the wheel
+    /// frame's components (where `a` is a unit axis and the projection drops one component)
+    /// and carried into the ground frame's.
+    fn wheel_contact(
+        &mut self,
+        wheel: &crate::model::WheelContact,
+        points: &Points,
+        frames: &Frames,
+    ) -> Vec<ExprId> {
+        let (Some(centre), Some(frame)) = (
+            point(points, &wheel.centre.value),
+            frames.index(&wheel.frame.value),
+        ) else {
+            self.errors.push(Diagnostic::new(
+                wheel.centre.location,
+                "a wheel contact names an unknown point or frame",
+            ));
+            return vec![self.arena.int(0); 3];
+        };
+        let (zero, one) = (self.arena.int(0), self.arena.int(1));
+        let mut n = frames.express(&mut self.arena, [zero, zero, one], 0, frame);
+        n[wheel.axle.value.index()] = zero;
+        let n2 = self.dot(&n, &n);
+        let length = self.arena.sqrt(n2);
+        let radius = self.expr(&wheel.radius);
+        let scale = self.arena.divide(radius, length);
+        let down = n.map(|c| {
+            let t = self.arena.times(scale, c);
+            self.arena.neg(t)
+        });
+        let down = frames.express(&mut self.arena, down, frame, 0);
+        points[centre]
+            .1
+            .iter()
+            .zip(down)
+            .map(|(c, d)| self.arena.plus(*c, d))
+            .collect()
     }
 
     /// The energies and generalized forces written as such (`kinetic:`, `potential:`,

@@ -59,6 +59,8 @@ pub struct Point {
     /// The point plus vectors form: `{ from: O, B: [0, 0, l], N: [x, 0, 0] }`; `None` for a
     /// list of components.
     pub relative: Option<RelativePosition>,
+    /// The contact point of a wheel: `{ wheel: { centre, frame, axle, radius } }`.
+    pub wheel: Option<WheelContact>,
     /// Where the position list or map starts.
     pub location: Location,
 }
@@ -66,7 +68,7 @@ pub struct Point {
 impl Point {
     /// Number of components: 3 for a point written as a point plus vectors in frames.
     pub fn dimension(&self) -> usize {
-        if self.relative.is_some() {
+        if self.relative.is_some() || self.wheel.is_some() {
             3
         } else {
             self.position.len()
@@ -155,6 +157,37 @@ pub struct RollingContact {
     pub along: Vec<Located<Axis>>,
     /// The frame of the axes; `None`: the ground frame.
     pub frame: Option<Located<String>>,
+}
+
+/// A holonomic constraint on a point, `constraints: { on_ground: { point: C, along: z, in: N } }`:
+/// the point's position along the axis `along` of frame `in` (the ground frame if not given)
+/// is 0 — a contact point kept on the ground plane.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PointConstraint {
+    /// The constraint's name.
+    pub name: Located<String>,
+    /// The point.
+    pub point: Located<String>,
+    /// The axis.
+    pub along: Located<Axis>,
+    /// The frame of the axis; `None`: the ground frame.
+    pub frame: Option<Located<String>>,
+}
+
+/// A wheel's contact point, `points: { C: { wheel: { centre: F, frame: H, axle: y, radius: r } } }`:
+/// the point of the circle of radius `radius` about `centre`, in the plane normal to the axis
+/// `axle` of `frame`, that is lowest (farthest along the ground frame's `−z`) — where a
+/// knife-edge wheel touches a horizontal ground (Meijaard et al. 2007, §3).
+#[derive(Debug, Clone, PartialEq)]
+pub struct WheelContact {
+    /// The wheel's centre (a point).
+    pub centre: Located<String>,
+    /// A frame in which the axle is fixed.
+    pub frame: Located<String>,
+    /// The axle's axis in that frame.
+    pub axle: Located<Axis>,
+    /// The radius (m), a constant expression.
+    pub radius: Expr,
 }
 
 impl RollingContact {
@@ -724,6 +757,9 @@ pub struct ModelFile {
     pub balances: Vec<Balance>,
     /// `constraints:` — holonomic constraints `Φ(q, t) = 0` by name, in file order.
     pub constraints: Vec<(Located<String>, Expr)>,
+    /// `constraints:` entries on a point's position, in file order (after those of
+    /// [`Self::constraints`]).
+    pub point_constraints: Vec<PointConstraint>,
     /// `nonholonomic:` — constraints `A(q, t) q̇ + b(q, t) = 0` by name (the expression is the
     /// left-hand side, linear in the rates), in file order.
     pub nonholonomic: Vec<(Located<String>, Expr)>,
@@ -760,11 +796,20 @@ impl ModelFile {
             .collect()
     }
 
-    /// The names of every constraint, holonomic first, located.
-    pub fn constraint_names(&self) -> Vec<Located<String>> {
+    /// The names of every holonomic constraint, located: the expressions', then those on
+    /// points.
+    pub fn holonomic_names(&self) -> Vec<Located<String>> {
         self.constraints
             .iter()
             .map(|(k, _)| k.clone())
+            .chain(self.point_constraints.iter().map(|c| c.name.clone()))
+            .collect()
+    }
+
+    /// The names of every constraint, holonomic first, located.
+    pub fn constraint_names(&self) -> Vec<Located<String>> {
+        self.holonomic_names()
+            .into_iter()
             .chain(self.nonholonomic_names())
             .collect()
     }

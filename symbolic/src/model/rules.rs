@@ -739,6 +739,30 @@ impl<'f> Checker<'f> {
             .chain([GROUND_FRAME])
             .collect();
         for (i, p) in file.points.iter().enumerate() {
+            if let Some(wheel) = &p.wheel {
+                let earlier = file.points[..i]
+                    .iter()
+                    .any(|q| q.name.value == wheel.centre.value);
+                if !earlier
+                    && file.points[i..]
+                        .iter()
+                        .any(|q| q.name.value == wheel.centre.value)
+                {
+                    self.error(
+                        Diagnostic::new(wheel.centre.location, format!("the wheel of point `{}` is centred at `{}`, which is not defined before it", p.name.value, wheel.centre.value))
+                            .with_help("define the wheel's centre above its contact point"),
+                    );
+                } else {
+                    self.point(&wheel.centre);
+                }
+                self.frame(&wheel.frame, &frames);
+                self.resolve(
+                    &wheel.radius,
+                    Depends::Constant,
+                    &format!("the wheel radius of point `{}`", p.name.value),
+                );
+                continue;
+            }
             let Some(relative) = &p.relative else {
                 continue;
             };
@@ -996,6 +1020,43 @@ impl<'f> Checker<'f> {
         for r in &file.rolling {
             self.rolling_contact(r);
         }
+        for c in &file.point_constraints {
+            self.point(&c.point);
+            if file.dimension == Some(2) {
+                if let Some(frame) = &c.frame {
+                    self.error(
+                        Diagnostic::new(
+                            frame.location,
+                            format!(
+                                "constraint `{}` is in a planar model, which has no frames",
+                                c.name.value
+                            ),
+                        )
+                        .with_help("leave out `in`: the axes are the plane's x and y"),
+                    );
+                }
+                if c.along.value == Axis::Z {
+                    self.error(
+                        Diagnostic::new(
+                            c.along.location,
+                            format!(
+                                "constraint `{}` is planar, so it has no `z` axis",
+                                c.name.value
+                            ),
+                        )
+                        .with_help("in a planar model `along` is `x` or `y`"),
+                    );
+                }
+            } else if let Some(frame) = &c.frame {
+                let frames: Vec<&str> = file
+                    .frames
+                    .iter()
+                    .map(|f| f.name.value.as_str())
+                    .chain([GROUND_FRAME])
+                    .collect();
+                self.frame(frame, &frames);
+            }
+        }
         let m = names.len();
         let n = file.coordinates.len();
         if m > n && !self.incomplete.has_section("coordinates") {
@@ -1199,7 +1260,7 @@ impl<'f> Checker<'f> {
             let modes = file
                 .coordinates
                 .len()
-                .saturating_sub(file.constraints.len());
+                .saturating_sub(file.holonomic_names().len());
             if key == "natural_frequencies"
                 && file.nonholonomic.is_empty()
                 && file.rolling.is_empty()

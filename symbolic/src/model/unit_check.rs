@@ -982,6 +982,18 @@ impl<'f> Checker<'f> {
                 );
             }
         }
+        for p in &file.points {
+            if let Some(wheel) = &p.wheel {
+                self.fixed(
+                    &wheel.radius,
+                    Dimension::METRE,
+                    &format!("the wheel radius of point `{}`", p.name.value),
+                    "a length",
+                    "m",
+                    "a wheel's radius is a length",
+                );
+            }
+        }
         for f in &file.frames {
             for r in &f.rotations {
                 self.fixed(
@@ -1128,7 +1140,12 @@ impl<'f> Checker<'f> {
                 self.constraints.push((k.value.clone(), unit, holonomic));
             }
         }
-        // A rolling contact's rows are velocities (m/s).
+        // A constraint on a point is a length (m), a rolling contact's rows velocities (m/s).
+        for c in &file.point_constraints {
+            let length = Dim::of(Dimension::METRE);
+            self.constraints
+                .push((c.name.value.clone(), Some(length), true));
+        }
         for r in &file.rolling {
             for k in r.constraint_names() {
                 let velocity = Dim::of(Dimension::integers(1, 0, -1));

@@ -396,8 +396,54 @@ pub fn parameter_sweep(
                 .filter(|s| s.re > CROSSING_TOLERANCE * s.norm())
                 .min_by(|x, y| x.re.total_cmp(&y.re))
                 .is_some_and(|s| s.im.abs() > 1e-6 * s.norm());
+            // A complex pair crosses simply: its real part is smooth in the parameter, and
+            // the secant method on it removes the bias of the count's threshold
+            // ([`CROSSING_TOLERANCE`] of |s|, which ends the bisection where Re s is that
+            // large rather than 0). The real part is followed as the eigenvalue nearest the
+            // crossing one; the secant step is kept only inside the bracket widened by its own
+            // width.
+            let mut value = 0.5 * (lo + hi);
+            // Only where the pair comes from (or goes into) the left half-plane: where it
+            // meets another pair on the imaginary axis and leaves it (a gyroscopic system's
+            // Krein collision, the sleeping top), the real part grows as a square root, and
+            // the bisection's count is the better locator.
+            let stable_grid = if count_a > count_b { k } else { k - 1 };
+            let transversal = raws[stable_grid].as_ref().is_some_and(|raw| {
+                raw.iter()
+                    .min_by(|x, y| (*x - crossing).norm().total_cmp(&(*y - crossing).norm()))
+                    .is_some_and(|s| s.re < -CROSSING_TOLERANCE * s.norm())
+            });
+            if complex && transversal {
+                let mut real_part = |v: f64| -> Option<f64> {
+                    let raw = at(model, v).ok()?.raw;
+                    raw.iter()
+                        .min_by(|x, y| (*x - crossing).norm().total_cmp(&(*y - crossing).norm()))
+                        .map(|s| s.re)
+                };
+                let width = (hi - lo).max(1e-9 * lo.abs().max(1.0));
+                let (mut v0, mut v1) = (lo - width, hi + width);
+                if let (Some(mut f0), Some(mut f1)) = (real_part(v0), real_part(v1)) {
+                    for _ in 0..6 {
+                        if f1 == f0 {
+                            break;
+                        }
+                        let v2 = v1 - f1 * (v1 - v0) / (f1 - f0);
+                        if !v2.is_finite() || (v2 - value).abs() > 2.0 * width {
+                            break;
+                        }
+                        let Some(f2) = real_part(v2) else { break };
+                        (v0, f0, v1, f1) = (v1, f1, v2, f2);
+                        if (v1 - v0).abs() <= 1e-15 * v1.abs().max(1.0) {
+                            break;
+                        }
+                    }
+                    if (v1 - value).abs() <= 2.0 * width {
+                        value = v1;
+                    }
+                }
+            }
             stability_changes.push(StabilityChange {
-                value: 0.5 * (lo + hi),
+                value,
                 eigenvalue: if complex {
                     Crossing::Complex
                 } else {

@@ -63,6 +63,29 @@ const ROLLING: Fields = Fields {
     example: "{ body: wheel, point: C, along: [x, y], in: N }",
 };
 
+/// The keys of a constraint on a point.
+const POINT_CONSTRAINT: Fields = Fields {
+    kind: "constraint on a point",
+    keys: &[
+        ("point", Need::Required),
+        ("along", Need::Required),
+        ("in", Need::Optional),
+    ],
+    example: "{ point: C, along: z, in: N }",
+};
+
+/// The keys of a wheel's contact point.
+const WHEEL: Fields = Fields {
+    kind: "wheel contact",
+    keys: &[
+        ("centre", Need::Required),
+        ("frame", Need::Required),
+        ("axle", Need::Required),
+        ("radius", Need::Required),
+    ],
+    example: "{ centre: F, frame: H, axle: y, radius: r }",
+};
+
 /// The keys of a frame.
 const FRAME: Fields = Fields {
     kind: "frame",
@@ -106,11 +129,25 @@ impl Ctx<'_> {
         };
         self.keyed(node, spec, |cx, k, v| {
             if let YamlKind::Map(entries) = &v.kind {
+                if let [(key, wheel)] = entries.as_slice()
+                    && key.value == "wheel"
+                {
+                    let what = Located::new(format!("{}'s wheel", k.value), key.location);
+                    let wheel = cx.wheel_contact(&what, wheel)?;
+                    return Some(Point {
+                        name: k.clone(),
+                        position: Vec::new(),
+                        relative: None,
+                        wheel: Some(wheel),
+                        location: v.location,
+                    });
+                }
                 let relative = cx.relative_position(k, entries, v.location)?;
                 return Some(Point {
                     name: k.clone(),
                     position: Vec::new(),
                     relative: Some(relative),
+                    wheel: None,
                     location: v.location,
                 });
             }
@@ -123,6 +160,7 @@ impl Ctx<'_> {
                 name: k.clone(),
                 position,
                 relative: None,
+                wheel: None,
                 location: v.location,
             })
         })
@@ -181,6 +219,63 @@ impl Ctx<'_> {
             return None;
         }
         complete.then_some(RelativePosition { from, vectors })
+    }
+
+    /// `constraints:` — `name: Φ(q, t)` (an expression), or a point kept on a plane
+    /// `name: { point, along, in }`.
+    pub(super) fn holonomic(
+        &mut self,
+        node: &YamlNode,
+    ) -> (Vec<(Located<String>, Expr)>, Vec<PointConstraint>) {
+        let spec = Keyed {
+            what: "`constraints`",
+            example: "constraints: { rod: sqrt(x^2 + y^2) - l }",
+            names: None,
+            drop: false,
+        };
+        let mut on_points = Vec::new();
+        let expressions = self.keyed(node, spec, |cx, k, v| {
+            if matches!(v.kind, YamlKind::Map(_)) {
+                if let Some(c) = cx.point_constraint(k, v) {
+                    on_points.push(c);
+                }
+                return None;
+            }
+            cx.expr(v, "a holonomic constraint").map(|e| (k.clone(), e))
+        });
+        (expressions, on_points)
+    }
+
+    /// A constraint on a point: `{ point: C, along: z, in: N }`.
+    fn point_constraint(&mut self, k: &Located<String>, v: &YamlNode) -> Option<PointConstraint> {
+        let f = self.fields(k, v, &POINT_CONSTRAINT)?;
+        let point = get(f, "point").and_then(|n| self.name(n, "`point`"));
+        let along = get(f, "along").and_then(|n| self.axes(n, true).and_then(|mut a| a.pop()));
+        let frame = match get(f, "in") {
+            Some(n) => Some(Some(self.name(n, "`in`")?)),
+            None => Some(None),
+        };
+        Some(PointConstraint {
+            name: k.clone(),
+            point: point?,
+            along: along?,
+            frame: frame?,
+        })
+    }
+
+    /// A wheel's contact point: `{ centre, frame, axle, radius }`.
+    fn wheel_contact(&mut self, k: &Located<String>, v: &YamlNode) -> Option<WheelContact> {
+        let f = self.fields(k, v, &WHEEL)?;
+        let centre = get(f, "centre").and_then(|n| self.name(n, "`centre`"));
+        let frame = get(f, "frame").and_then(|n| self.name(n, "`frame`"));
+        let axle = get(f, "axle").and_then(|n| self.axes(n, true).and_then(|mut a| a.pop()));
+        let radius = get(f, "radius").and_then(|n| self.expr(n, "a wheel radius"));
+        Some(WheelContact {
+            centre: centre?,
+            frame: frame?,
+            axle: axle?,
+            radius: radius?,
+        })
     }
 
     /// `nonholonomic:` — `name: A(q, t) q̇ + b(q, t)` (an expression), or a rolling contact

@@ -147,14 +147,7 @@ const SECTIONS: &[Section] = &[
     },
     Section {
         key: "constraints",
-        read: |cx, n, file| {
-            file.constraints = cx.keyed_exprs(
-                n,
-                "`constraints`",
-                "constraints: { rod: sqrt(x^2 + y^2) - l }",
-                "a holonomic constraint",
-            );
-        },
+        read: |cx, n, file| (file.constraints, file.point_constraints) = cx.holonomic(n),
         missing: None,
     },
     Section {
@@ -257,6 +250,7 @@ impl Ctx<'_> {
             generalized_forces: Vec::new(),
             frames: Vec::new(),
             rolling: Vec::new(),
+            point_constraints: Vec::new(),
             points: Vec::new(),
             bodies: Vec::new(),
             gravity: None,
