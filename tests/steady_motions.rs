@@ -284,6 +284,8 @@ fn the_rolling_disc_is_stable_above_its_critical_speed() {
 /// v = 7, 6e-13 off; the table's value is used), and the sweep finds the weave speed 4.29238253634111 m/s (complex,
 /// stabilising) and the capsize speed 6.02426201538837 m/s (real, destabilising) to 1e-9.
 #[test]
+// The table's digits as the paper prints them.
+#[allow(clippy::excessive_precision)]
 fn the_benchmark_bicycle_has_the_papers_eigenvalues_and_speeds() {
     // (weave or the two real roots at v = 0, capsize, castering) per v, Table 2.
     let table: [(f64, [Complex<f64>; 4]); 11] = [
