@@ -879,12 +879,16 @@ impl<'f> Lowering<'f> {
             && self.kinetic_is_quadratic_in_rates(kinetic)
             && self.constraints_are_workless(&constraints);
 
-        let draw_lines = file
+        let mut draw_lines: Vec<[usize; 2]> = file
             .draw
             .lines
             .iter()
             .filter_map(|[a, b]| Some([point(&points, &a.value)?, point(&points, &b.value)?]))
             .collect();
+        let mut points = points;
+        for w in &file.draw.wheels {
+            draw_lines.extend(self.drawn_wheel(w, &mut points, &frames));
+        }
         let trace_points = file
             .draw
             .trace
@@ -1064,6 +1068,51 @@ impl<'f> Lowering<'f> {
             .iter()
             .zip(down)
             .map(|(c, d)| self.arena.plus(*c, d))
+            .collect()
+    }
+
+    /// Points on the rim of a drawn wheel (every 15°, named `<centre>.rim<k>`, added after the
+    /// file's points) and the segments that draw it: the rim and four spokes, which turn
+    /// with the wheel's frame.
+    fn drawn_wheel(
+        &mut self,
+        wheel: &crate::model::WheelContact,
+        points: &mut Points,
+        frames: &Frames,
+    ) -> Vec<[usize; 2]> {
+        const RIM: usize = 24;
+        let (Some(centre), Some(frame)) = (
+            point(points, &wheel.centre.value),
+            frames.index(&wheel.frame.value),
+        ) else {
+            return Vec::new();
+        };
+        let axle = wheel.axle.value.index();
+        let (u, v) = ((axle + 1) % 3, (axle + 2) % 3);
+        let radius = self.expr(&wheel.radius);
+        let zero = self.arena.int(0);
+        let first = points.len();
+        for k in 0..RIM {
+            let angle = std::f64::consts::TAU * k as f64 / RIM as f64;
+            let mut r = [zero; 3];
+            for (slot, f) in [(u, angle.cos()), (v, angle.sin())] {
+                let c = self
+                    .arena
+                    .constant(Constant::float(f).unwrap_or(Constant::ZERO));
+                r[slot] = self.arena.times(radius, c);
+            }
+            let r = frames.express(&mut self.arena, r, frame, 0);
+            let position: Vec<ExprId> = points[centre]
+                .1
+                .iter()
+                .zip(r)
+                .map(|(a, b)| self.arena.plus(*a, b))
+                .collect();
+            points.push((format!("{}.rim{k}", wheel.centre.value), position));
+        }
+        (0..RIM)
+            .map(|k| [first + k, first + (k + 1) % RIM])
+            .chain((0..4).map(|s| [centre, first + s * RIM / 4]))
             .collect()
     }
 

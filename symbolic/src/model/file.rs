@@ -580,6 +580,9 @@ pub struct Draw {
     pub lines: Vec<[Located<String>; 2]>,
     /// Points whose trajectories are traced.
     pub trace: Vec<Located<String>>,
+    /// Wheels drawn as circles with four spokes (3-D models): each a circle of `radius`
+    /// about `centre` in the plane normal to the axis `axle` of `frame`, turning with it.
+    pub wheels: Vec<WheelContact>,
 }
 
 /// Which zero crossings of an event function count (`direction:` of an `events:` entry).

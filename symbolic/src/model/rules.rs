@@ -798,6 +798,11 @@ impl<'f> Checker<'f> {
                 self.frame(frame, &frames);
             }
         }
+        for w in &file.draw.wheels {
+            self.point(&w.centre);
+            self.frame(&w.frame, &frames);
+            self.resolve(&w.radius, Depends::Constant, "the radius of a drawn wheel");
+        }
         for t in &file.torques {
             if let TorqueValue::Spatial {
                 frame: Some(frame), ..

@@ -264,7 +264,11 @@ impl Ctx<'_> {
     }
 
     /// A wheel's contact point: `{ centre, frame, axle, radius }`.
-    fn wheel_contact(&mut self, k: &Located<String>, v: &YamlNode) -> Option<WheelContact> {
+    pub(super) fn wheel_contact(
+        &mut self,
+        k: &Located<String>,
+        v: &YamlNode,
+    ) -> Option<WheelContact> {
         let f = self.fields(k, v, &WHEEL)?;
         let centre = get(f, "centre").and_then(|n| self.name(n, "`centre`"));
         let frame = get(f, "frame").and_then(|n| self.name(n, "`frame`"));

@@ -572,7 +572,8 @@ impl Ctx<'_> {
         let Some(f) = self.map(node, "`draw`", "draw: { lines: [[O, P]], trace: [P] }") else {
             return draw;
         };
-        self.unknown_keys(f, "`draw`", &["lines", "trace"], &["lines", "trace"]);
+        const KEYS: [&str; 3] = ["lines", "trace", "wheels"];
+        self.unknown_keys(f, "`draw`", &KEYS, &KEYS);
         if let Some(lines) =
             get(f, "lines").and_then(|n| self.seq(n, "`lines`", "lines: [[O, E], [E, H]]"))
         {
@@ -586,6 +587,20 @@ impl Ctx<'_> {
             for p in trace {
                 if let Some(n) = self.name(p, "a traced point") {
                     draw.trace.push(n);
+                }
+            }
+        }
+        if let Some(wheels) = get(f, "wheels").and_then(|n| {
+            self.seq(
+                n,
+                "`wheels`",
+                "wheels: [{ centre: RH, frame: WR, axle: y, radius: rR }]",
+            )
+        }) {
+            for w in wheels {
+                let k = Located::new("wheel".to_string(), w.location);
+                if let Some(wheel) = self.wheel_contact(&k, w) {
+                    draw.wheels.push(wheel);
                 }
             }
         }
