@@ -21,7 +21,7 @@ use criterion::{Criterion, criterion_group, criterion_main};
 use eomgen::analysis::vibration::{
     self, EquilibriumStart, OperatingPointOptions, ParameterSweepOptions, SweepAxis,
 };
-use eomgen::{JitModel, LoadOptions, ModelInfo};
+use eomgen::{JitModel, LoadOptions};
 use eomgen_symbolic::codegen::{self, EmitOptions};
 use eomgen_symbolic::mechanics::{Jacobians, SymbolicModel, preferred_equations};
 
