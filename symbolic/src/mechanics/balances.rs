@@ -59,6 +59,7 @@ impl Formulation for UserBalances {
         let loads = model.loads.clone();
         let gravity = model.gravity.clone();
         let balances = model.balances.clone();
+        let frames = model.frames.clone();
         let arena = &mut model.arena;
         let mut residuals: Vec<Vec<ExprId>> = Vec::with_capacity(balances.len());
         for balance in &balances {
@@ -66,8 +67,29 @@ impl Formulation for UserBalances {
             let (chosen, about, along, form) = match balance {
                 BalanceInfo::Amb {
                     about,
+                    bodies: chosen,
+                    form,
+                    axis: Some(axis),
+                } => {
+                    residuals.push(spatial_amb(
+                        arena,
+                        &frames,
+                        &points,
+                        &bodies,
+                        &loads,
+                        gravity.as_deref(),
+                        chosen,
+                        *about,
+                        *form,
+                        axis,
+                    ));
+                    continue;
+                }
+                BalanceInfo::Amb {
+                    about,
                     bodies,
                     form,
+                    axis: None,
                 } => (bodies, Some(*about), None, *form),
                 BalanceInfo::Lmb { along, bodies } => {
                     (bodies, None, Some(along.clone()), AmbForm::RCrossMa)
@@ -140,6 +162,103 @@ impl Formulation for UserBalances {
         }
         linear_in_accelerations(arena, &residuals, &symbols)
     }
+}
+
+/// The terms of a 3-D angular momentum balance about the point `about` along the axis `e`
+/// (ground-frame components) of the bodies `chosen`:
+/// `Σ [(r_G − r_A) × m a_G + I_G α + ω × I_G ω − (r_G − r_A) × m g − τ]·e` (`form: r_x_ma`,
+/// right about any point), or with `form: h_dot` the derivative of
+/// `H_A = Σ (r_G − r_A) × m v_G + I_G ω` in place of the inertial terms (right about a fixed
+/// point or the centre of mass). `I_G`, `ω`, `α` and the torques are in the body frame's
+/// components and carried into the ground frame's; `α` is the time derivative of `ω`'s body
+/// components (the derivatives in the body and in the ground frame agree for `ω`).
+#[allow(clippy::too_many_arguments)]
+fn spatial_amb(
+    arena: &mut ExprArena,
+    frames: &super::frames::Frames,
+    points: &[Vec<ExprId>],
+    bodies: &[super::lower::BodyInfo],
+    loads: &[LoadInfo],
+    gravity: Option<&[ExprId]>,
+    chosen: &[usize],
+    about: usize,
+    form: AmbForm,
+    e: &[ExprId],
+) -> Vec<ExprId> {
+    use super::frames::{cross, tensor_times};
+    let three = |v: &[ExprId]| [v[0], v[1], v[2]];
+    let project = |arena: &mut ExprArena, v: &[ExprId; 3]| {
+        let t: Vec<ExprId> = v.iter().zip(e).map(|(a, b)| arena.times(*a, *b)).collect();
+        arena.sum(&t)
+    };
+    let mut terms = Vec::new();
+    for &b in chosen {
+        let body = &bodies[b];
+        let r = &points[body.com];
+        let rel: Vec<ExprId> = r
+            .iter()
+            .zip(&points[about])
+            .map(|(x, y)| arena.minus(*x, *y))
+            .collect();
+        let rel = three(&rel);
+        let v: Vec<ExprId> = r.iter().map(|c| arena.time_derivative(*c)).collect();
+        if let Some(g) = gravity {
+            let mg: Vec<ExprId> = g.iter().map(|c| arena.times(body.mass, *c)).collect();
+            let moment = cross(arena, &rel, &three(&mg));
+            let m = project(arena, &moment);
+            terms.push(arena.neg(m));
+        }
+        match form {
+            AmbForm::RCrossMa => {
+                let ma: Vec<ExprId> = v
+                    .iter()
+                    .map(|c| {
+                        let a = arena.time_derivative(*c);
+                        arena.times(body.mass, a)
+                    })
+                    .collect();
+                let moment = cross(arena, &rel, &three(&ma));
+                terms.push(project(arena, &moment));
+                if let Some(s) = &body.spatial {
+                    let w = s.angular_velocity;
+                    let alpha = w.map(|c| arena.time_derivative(c));
+                    let i_alpha = tensor_times(arena, &s.inertia, &alpha);
+                    let i_w = tensor_times(arena, &s.inertia, &w);
+                    let gyro = cross(arena, &w, &i_w);
+                    let mut h_dot = i_alpha;
+                    for (x, y) in h_dot.iter_mut().zip(gyro) {
+                        *x = arena.plus(*x, y);
+                    }
+                    let h_dot = frames.express(arena, h_dot, s.frame, 0);
+                    terms.push(project(arena, &h_dot));
+                }
+            }
+            AmbForm::HDot => {
+                let mv: Vec<ExprId> = v.iter().map(|c| arena.times(body.mass, *c)).collect();
+                let mut h = cross(arena, &rel, &three(&mv));
+                if let Some(s) = &body.spatial {
+                    let i_w = tensor_times(arena, &s.inertia, &s.angular_velocity);
+                    let i_w = frames.express(arena, i_w, s.frame, 0);
+                    for (x, y) in h.iter_mut().zip(i_w) {
+                        *x = arena.plus(*x, y);
+                    }
+                }
+                let h_dot = h.map(|c| arena.time_derivative(c));
+                terms.push(project(arena, &h_dot));
+            }
+        }
+        for load in loads {
+            if let LoadInfo::SpatialTorque { body: on, vector } = load
+                && *on == b
+                && let Some(s) = &body.spatial
+            {
+                let tau = frames.express(arena, *vector, s.frame, 0);
+                let m = project(arena, &tau);
+                terms.push(arena.neg(m));
+            }
+        }
+    }
+    terms
 }
 
 /// The equations of motion the file states as derived by hand (`checks:

@@ -110,6 +110,9 @@ pub enum BalanceInfo {
         bodies: Vec<usize>,
         /// How the balance is written.
         form: crate::model::AmbForm,
+        /// The axis `e` of a 3-D balance, in the ground frame's components; `None` in the
+        /// plane.
+        axis: Option<Vec<ExprId>>,
     },
     /// Linear momentum balance of `bodies` along `along`.
     Lmb {
@@ -837,7 +840,7 @@ impl<'f> Lowering<'f> {
         loads.extend(self.dampers(&points, &q_symbols, &mut terms));
         loads.extend(self.forces(&points, &frames, &q_symbols, &mut terms));
         loads.extend(self.torques(&angles, &body_infos, &frames, &q_symbols, &mut terms));
-        let balances = self.balances(&points, &body_infos);
+        let balances = self.balances(&points, &body_infos, &frames);
         let hand_equations = self.hand_equations();
 
         let kinematics = Kinematics {
@@ -1442,7 +1445,12 @@ impl<'f> Lowering<'f> {
     }
 
     /// The momentum balances chosen in `balances:`, with their points and bodies by index.
-    fn balances(&mut self, points: &Points, body_infos: &[BodyInfo]) -> Vec<BalanceInfo> {
+    fn balances(
+        &mut self,
+        points: &Points,
+        body_infos: &[BodyInfo],
+        frames: &Frames,
+    ) -> Vec<BalanceInfo> {
         let mut balances = Vec::new();
         for b in &self.file.balances {
             let bodies: Vec<usize> = b
@@ -1451,12 +1459,30 @@ impl<'f> Lowering<'f> {
                 .filter_map(|name| body_infos.iter().position(|x| x.name == name.value))
                 .collect();
             match &b.kind {
-                crate::model::BalanceKind::Amb { about, form } => {
+                crate::model::BalanceKind::Amb {
+                    about,
+                    form,
+                    axis,
+                    frame,
+                } => {
+                    // A 3-D axis, carried into the ground frame's components.
+                    let axis = axis.as_ref().and_then(|axis| {
+                        let [x, y, z] = &axis.value[..] else {
+                            return None;
+                        };
+                        let e = [x, y, z].map(|c| self.expr(c));
+                        let from = match frame {
+                            Some(f) => frames.index(&f.value)?,
+                            None => 0,
+                        };
+                        Some(frames.express(&mut self.arena, e, from, 0).to_vec())
+                    });
                     match point(points, &about.value) {
                         Some(about) => balances.push(BalanceInfo::Amb {
                             about,
                             bodies,
                             form: *form,
+                            axis,
                         }),
                         None => self.errors.push(Diagnostic::new(
                             about.location,

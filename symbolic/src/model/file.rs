@@ -373,6 +373,11 @@ pub enum BalanceKind {
         about: Located<String>,
         /// How the balance is written (`form:`; default [`AmbForm::RCrossMa`]).
         form: AmbForm,
+        /// In a 3-D model, the axis `e` the moments are taken about (`axis: [0, 0, 1]`,
+        /// components in the frame `in`): `Σ M_A·e = (dH_A/dt)·e`. `None` in the plane.
+        axis: Option<Located<Vec<Expr>>>,
+        /// The frame of the axis's components (`in: B`); `None`: the ground frame.
+        frame: Option<Located<String>>,
     },
     /// Linear momentum balance of the chosen bodies along a direction `e`:
     /// `Σ m a_G·e = Σ F·e`.

@@ -1410,7 +1410,9 @@ impl<'f> Checker<'f> {
                 seen.push(body.value.as_str());
             }
             match &b.kind {
-                BalanceKind::Amb { about, .. } => {
+                BalanceKind::Amb {
+                    about, axis, frame, ..
+                } => {
                     if !self.points.contains(&about.value.as_str()) {
                         let d = Diagnostic::new(
                             about.location,
@@ -1422,11 +1424,34 @@ impl<'f> Checker<'f> {
                         };
                         self.error(d);
                     }
-                    if file.dimension == Some(3) {
-                        self.error(Diagnostic::new(
-                            b.location,
-                            "`amb` balances are planar, but the points are 3-D",
-                        ));
+                    match (file.dimension, axis) {
+                        (Some(3), None) => self.error(
+                            Diagnostic::new(b.location, "an `amb` balance of a 3-D model needs the `axis` it takes moments about")
+                                .with_help("write `{ amb: { about: O, bodies: [top], axis: [0, 0, 1], in: N } }`: the balance Σ M_O·e = (dH_O/dt)·e along that axis"),
+                        ),
+                        (Some(3), Some(axis)) if axis.value.len() != 3 => self.error(
+                            Diagnostic::new(axis.location, format!("`axis` has {} components; a 3-D axis has 3", axis.value.len()))
+                                .with_help("write `axis: [0, 0, 1]`"),
+                        ),
+                        (Some(2), Some(axis)) => self.error(
+                            Diagnostic::new(axis.location, "an `amb` balance of a planar model takes moments about the normal to the plane: it has no `axis`")
+                                .with_help("leave out `axis` (and `in`)"),
+                        ),
+                        _ => {}
+                    }
+                    if let Some(axis) = axis {
+                        for c in &axis.value {
+                            self.resolve(c, Depends::Position, "the axis of an `amb` balance");
+                        }
+                    }
+                    if let Some(frame) = frame {
+                        let frames: Vec<&str> = file
+                            .frames
+                            .iter()
+                            .map(|f| f.name.value.as_str())
+                            .chain([GROUND_FRAME])
+                            .collect();
+                        self.frame(frame, &frames);
                     }
                 }
                 BalanceKind::Lmb { along } => {

@@ -107,6 +107,8 @@ const AMB: Fields = Fields {
         ("about", Need::Required),
         ("bodies", Need::Required),
         ("form", Need::Optional),
+        ("axis", Need::Optional),
+        ("in", Need::Optional),
     ],
     example: "{ about: O, bodies: [upper, fore] }",
 };
@@ -884,7 +886,22 @@ impl Ctx<'_> {
                 get(f, "about")
                     .and_then(|n| self.name(n, "`about`"))
                     .zip(form)
-                    .map(|(about, form)| BalanceKind::Amb { about, form })
+                    .zip(match get(f, "axis") {
+                        Some(n) => self
+                            .vector(n, "`axis`", "axis: [0, 0, 1]")
+                            .map(|v| Some(Located::new(v, n.location))),
+                        None => Some(None),
+                    })
+                    .zip(match get(f, "in") {
+                        Some(n) => self.name(n, "`in`").map(Some),
+                        None => Some(None),
+                    })
+                    .map(|(((about, form), axis), frame)| BalanceKind::Amb {
+                        about,
+                        form,
+                        axis,
+                        frame,
+                    })
             } else {
                 get(f, "along")
                     .and_then(|n| self.vector(n, "`along`", "along: [cos(theta), sin(theta)]"))
