@@ -1,0 +1,3 @@
+eomgen::model!("rolling-contact-on-particle.yaml");
+
+fn main() {}

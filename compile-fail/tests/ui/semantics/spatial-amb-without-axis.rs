@@ -1,0 +1,3 @@
+eomgen::model!("spatial-amb-without-axis.yaml");
+
+fn main() {}
