@@ -436,3 +436,23 @@ fn pair(x: f64, y: f64) -> Complex<f64> {
 fn conj(x: f64, y: f64) -> Complex<f64> {
     Complex::new(x, -y)
 }
+
+/// An analysis about an equilibrium refuses a steady motion, naming the commands that take
+/// one (it used to search an equilibrium from the steady motion's coordinates and stop at
+/// the Euler angles' singularity).
+#[test]
+fn equilibrium_analyses_refuse_steady_motions() {
+    for args in [
+        ["study", "free-response", "heavy_top"],
+        ["study", "modal-damping", "heavy_top"],
+    ] {
+        let out = common::eomgen(&args);
+        assert_eq!(out.status.code(), Some(1), "{args:?}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            err.contains("`precessing` of `heavy_top` is a steady motion")
+                && err.contains("eomgen modes --at precessing"),
+            "{err}"
+        );
+    }
+}

@@ -65,7 +65,7 @@ pub use modes::{
 };
 pub use operating_point::{
     EquilibriumStart, OperatingPoint, OperatingPointError, OperatingPointOptions, PointSummary,
-    operating_point,
+    held_rates, operating_point,
 };
 pub use parameter_sweep::{
     Crossing, Direction, ParameterSweep, ParameterSweepError, ParameterSweepOptions,
@@ -74,5 +74,5 @@ pub use parameter_sweep::{
 };
 pub use steady::{
     SteadyAnalysisError, SteadyMotionAnalysis, SteadyMotionSummary, SteadyPointSummary,
-    damped_summaries, held_rates, is_steady_motion, steady_motion_analysis,
+    damped_summaries, is_steady_motion, steady_motion_analysis,
 };

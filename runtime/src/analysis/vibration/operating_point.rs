@@ -69,6 +69,33 @@ impl EquilibriumStart {
     }
 }
 
+/// The rates an operating point holds and the coordinates it declares ignorable: those of
+/// its entry of `equilibria:` (none for a guess).
+pub fn held_rates(model: &dyn ModelInfo, start: &EquilibriumStart) -> (Vec<f64>, Vec<usize>) {
+    let n = model.num_dofs();
+    let d = model.description();
+    let entry = match start {
+        EquilibriumStart::FirstNamed => (!d.equilibria.is_empty()).then_some(0),
+        EquilibriumStart::Named(name) => d.equilibria.iter().position(|e| e == name),
+        EquilibriumStart::Guess { .. } => None,
+    };
+    match entry {
+        Some(k) => (
+            model
+                .equilibrium_rates()
+                .get(k)
+                .cloned()
+                .unwrap_or_else(|| vec![0.0; n]),
+            d.ignorable_coordinates
+                .iter()
+                .filter(|[e, _]| *e == k)
+                .map(|[_, c]| *c)
+                .collect(),
+        ),
+        None => (vec![0.0; n], Vec::new()),
+    }
+}
+
 /// Options of [`operating_point`].
 #[derive(Debug, Clone, PartialEq, Default, Serialize)]
 pub struct OperatingPointOptions {
@@ -166,6 +193,17 @@ pub enum OperatingPointError {
         /// The names the file gives, in its order.
         known: Vec<String>,
     },
+    /// The operating point is a steady motion (it holds rates), which an analysis about an
+    /// equilibrium cannot take.
+    #[error(
+        "`{name}` of `{model}` is a steady motion (it holds rates): this analysis linearises about an equilibrium; `eomgen modes --at {name}` and `study parameter-sweep` analyse steady motions"
+    )]
+    SteadyMotion {
+        /// The model.
+        model: String,
+        /// The entry's name.
+        name: String,
+    },
     /// The search or a later linearisation failed.
     #[error(transparent)]
     Modal(#[from] ModalError),
@@ -176,7 +214,8 @@ pub enum OperatingPointError {
 /// the `checks:` of a model file that name an operating point (`at: hanging`).
 ///
 /// # Errors
-/// [`OperatingPointError::UnknownEquilibrium`]; [`OperatingPointError::Modal`] with
+/// [`OperatingPointError::UnknownEquilibrium`]; [`OperatingPointError::SteadyMotion`] for an
+/// entry that holds rates; [`OperatingPointError::Modal`] with
 /// [`ModalError::EquilibriumNotFound`], [`ModalError::NonHolonomic`] or
 /// [`ModalError::DimensionMismatch`].
 ///
@@ -203,6 +242,16 @@ pub fn operating_point(
     options: &OperatingPointOptions,
 ) -> Result<OperatingPoint, OperatingPointError> {
     let (name, guess) = options.start.resolve(model)?;
+    if held_rates(model, &options.start)
+        .0
+        .iter()
+        .any(|r| *r != 0.0)
+    {
+        return Err(OperatingPointError::SteadyMotion {
+            model: model.description().name.to_string(),
+            name,
+        });
+    }
     let equilibrium = find_equilibrium(model, &guess, options.t)?;
     Ok(OperatingPoint {
         name,

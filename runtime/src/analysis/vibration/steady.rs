@@ -9,7 +9,9 @@ use nalgebra::Complex;
 use serde::Serialize;
 
 use super::modes::DampedEigenvalueSummary;
-use super::operating_point::{EquilibriumStart, OperatingPointError, OperatingPointOptions};
+use super::operating_point::{
+    EquilibriumStart, OperatingPointError, OperatingPointOptions, held_rates,
+};
 use crate::linear::eigenvalues::Stability;
 use crate::linear::steady::{
     SteadyLinearization, SteadyMotion, SteadyMotionError, find_steady_motion,
@@ -27,33 +29,6 @@ pub enum SteadyAnalysisError {
     /// The steady motion or its linearisation failed.
     #[error(transparent)]
     Steady(#[from] SteadyMotionError),
-}
-
-/// The rates an operating point holds and the coordinates it declares ignorable: those of
-/// its entry of `equilibria:` (none for a guess).
-pub fn held_rates(model: &dyn ModelInfo, start: &EquilibriumStart) -> (Vec<f64>, Vec<usize>) {
-    let n = model.num_dofs();
-    let d = model.description();
-    let entry = match start {
-        EquilibriumStart::FirstNamed => (!d.equilibria.is_empty()).then_some(0),
-        EquilibriumStart::Named(name) => d.equilibria.iter().position(|e| e == name),
-        EquilibriumStart::Guess { .. } => None,
-    };
-    match entry {
-        Some(k) => (
-            model
-                .equilibrium_rates()
-                .get(k)
-                .cloned()
-                .unwrap_or_else(|| vec![0.0; n]),
-            d.ignorable_coordinates
-                .iter()
-                .filter(|[e, _]| *e == k)
-                .map(|[_, c]| *c)
-                .collect(),
-        ),
-        None => (vec![0.0; n], Vec::new()),
-    }
 }
 
 /// Whether the operating point `start` of `model` is analysed as a steady motion: it holds
