@@ -225,7 +225,7 @@ pub struct BodyCentre {
     pub body: Text,
     /// The point at its centre of mass (one of [`ModelDescription::points`]).
     pub point: Text,
-    /// A planar rigid body (`true`) or a particle.
+    /// A rigid body, planar or 3-D (`true`), or a particle.
     pub rigid: bool,
 }
 

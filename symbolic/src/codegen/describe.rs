@@ -59,7 +59,7 @@ pub fn describe(model: &SymbolicModel, eom: &EquationsOfMotion, mathml: bool) ->
                 Some(BodyCentre {
                     body: text(&b.name),
                     point: point_name(b.com)?,
-                    rigid: b.rotation.is_some(),
+                    rigid: b.rotation.is_some() || b.spatial.is_some(),
                 })
             })
             .collect(),
