@@ -456,3 +456,45 @@ fn equilibrium_analyses_refuse_steady_motions() {
         );
     }
 }
+
+/// A frame's angular velocity in expressions (`omega_B_x`, …): a spherical body under the
+/// damping torque `−c ω` (`tests/fixtures/damped_spinning_body.yaml`) loses its kinetic
+/// energy as `T(0) e^{−2ct/I}` (every component of ω decays as `e^{−ct/I}`): 1e-9 relative
+/// at t = 2 s (DOP853 at its default tolerances is far tighter). The conserved quantities of
+/// `checks:`, evaluated from the state alone, may not read it.
+#[test]
+fn angular_velocities_can_be_read_in_expressions() {
+    let out = eomgen_ok(&[
+        "simulate",
+        &fixture("damped_spinning_body.yaml"),
+        "--t-end",
+        "2",
+        "--rtol",
+        "1e-12",
+        "--atol",
+        "1e-12",
+        "--json",
+    ]);
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let e0 = json["initial_energy"].as_f64().unwrap();
+    let drift = json["energy_drift"].as_f64().unwrap();
+    let (i, c): (f64, f64) = (0.5, 0.1);
+    let expected = e0 * (-2.0 * c * 2.0 / i).exp();
+    let end = e0 * (1.0 - drift);
+    assert!(
+        (end - expected).abs() <= 1e-9 * e0,
+        "{end} against {expected}"
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let source = std::fs::read_to_string(fixture("damped_spinning_body.yaml")).unwrap();
+    let path = dir.path().join("bad.yaml");
+    std::fs::write(
+        &path,
+        format!("{source}checks:\n  conserved: {{ spin: omega_B_z }}\n"),
+    )
+    .unwrap();
+    let out = common::eomgen(&["check", path.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("unknown name `omega_B_z`"), "{err}");
+}

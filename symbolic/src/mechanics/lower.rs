@@ -347,6 +347,9 @@ impl SymbolicModel {
 struct Lowering<'f> {
     file: &'f ModelFile,
     arena: ExprArena,
+    /// `omega_<frame>_<axis>` by name: the components of the frames' angular velocities in
+    /// their own axes, once the frames are lowered.
+    angular_velocities: FxHashMap<String, ExprId>,
     errors: Vec<Diagnostic>,
     /// Whether accelerations (`x_ddot`) may appear: only in equations written by hand.
     allow_accelerations: bool,
@@ -357,6 +360,7 @@ impl<'f> Lowering<'f> {
         Self {
             file,
             arena: ExprArena::new(),
+            angular_velocities: FxHashMap::default(),
             errors: Vec::new(),
             allow_accelerations: false,
         }
@@ -647,6 +651,11 @@ impl<'f> Lowering<'f> {
             ExprKind::Ident(name) => match name.as_str() {
                 // `t` is the first symbol declared (in `run`), so it is found like the others.
                 "pi" => self.arena.pi(),
+                _ if self.arena.symbol_id(name).is_none()
+                    && self.angular_velocities.contains_key(name) =>
+                {
+                    self.angular_velocities[name]
+                }
                 _ => match self.arena.symbol_id(name) {
                     Some(s)
                         if self.allow_accelerations
@@ -812,6 +821,15 @@ impl<'f> Lowering<'f> {
             .collect();
         let q_symbols: Vec<SymbolId> = self.arena.coordinates().iter().map(|c| c[0]).collect();
         let mut frames = self.frames();
+        for f in &file.frames {
+            if let Some(index) = frames.index(&f.name.value) {
+                let w = frames.angular_velocity(&mut self.arena, index);
+                for (axis, c) in ['x', 'y', 'z'].into_iter().zip(w) {
+                    self.angular_velocities
+                        .insert(format!("omega_{}_{axis}", f.name.value), c);
+                }
+            }
+        }
         let points = self.points(&frames);
         let dimension = file.dimension.unwrap_or(2);
 

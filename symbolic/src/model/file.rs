@@ -790,6 +790,22 @@ pub struct ModelFile {
 }
 
 impl ModelFile {
+    /// The frame and axis that `name` reads if it is `omega_<frame>_<axis>`, the component
+    /// of the frame's angular velocity in the ground frame along its own axis (rad/s), with
+    /// `<frame>` one of [`Self::frames`].
+    pub fn angular_velocity_name(&self, name: &str) -> Option<(&Frame, Axis)> {
+        let rest = name.strip_prefix("omega_")?;
+        let (frame, axis) = rest.rsplit_once('_')?;
+        let axis = match axis {
+            "x" => Axis::X,
+            "y" => Axis::Y,
+            "z" => Axis::Z,
+            _ => return None,
+        };
+        let frame = self.frames.iter().find(|f| f.name.value == frame)?;
+        Some((frame, axis))
+    }
+
     /// The names of every non-holonomic constraint, located: the expressions', then each
     /// rolling contact's rows.
     pub fn nonholonomic_names(&self) -> Vec<Located<String>> {

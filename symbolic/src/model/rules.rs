@@ -111,6 +111,9 @@ struct Checker<'f> {
     multipliers: Vec<String>,
     points: Vec<&'f str>,
     bodies: Vec<&'f str>,
+    /// Whether `omega_<frame>_<axis>` may be read: in expressions the derivation lowers, not
+    /// in the conserved quantities of `checks:`, which are evaluated from the state alone.
+    angular_velocities: bool,
     /// The names above as sets, for lookups in time independent of their number (the lists
     /// keep the file's order for suggestions and help).
     sets: NameSets,
@@ -152,6 +155,7 @@ impl<'f> Checker<'f> {
             coords,
             points: file.points.iter().map(|p| p.name.value.as_str()).collect(),
             bodies: file.bodies.iter().map(|b| b.name.value.as_str()).collect(),
+            angular_velocities: true,
             sets: NameSets::default(),
         };
         let owned = |v: &[&str]| v.iter().map(|s| s.to_string()).collect();
@@ -448,11 +452,13 @@ impl<'f> Checker<'f> {
             let is_acceleration =
                 depends >= Depends::Acceleration && self.sets.accelerations.contains(n);
             let is_multiplier = depends >= Depends::Event && self.sets.multipliers.contains(n);
+            let is_angular_velocity =
+                self.angular_velocities && self.file.angular_velocity_name(n).is_some();
             let needs = if is_param {
                 Depends::Constant
             } else if is_coord || n == "t" {
                 Depends::Position
-            } else if is_rate {
+            } else if is_rate || is_angular_velocity {
                 Depends::Motion
             } else if is_acceleration {
                 Depends::Acceleration
@@ -1339,6 +1345,7 @@ impl<'f> Checker<'f> {
                 self.error(d);
             }
         }
+        self.angular_velocities = false;
         for c in &checks.conserved {
             self.resolve(
                 &c.value,
@@ -1346,6 +1353,7 @@ impl<'f> Checker<'f> {
                 &format!("conserved quantity `{}`", c.name.value),
             );
         }
+        self.angular_velocities = true;
     }
 
     // Rule: user balances name existing bodies (each once per balance) and, for AMB, an

@@ -641,6 +641,9 @@ impl<'f> Checker<'f> {
             };
             return Dim::of(work).div(unit.as_ref()?);
         }
+        if self.file.angular_velocity_name(n).is_some() {
+            return Some(Dim::of(Dimension::FREQUENCY));
+        }
         // Names already reported take any unit.
         self.motion(n).flatten()
     }
