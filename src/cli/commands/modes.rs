@@ -63,7 +63,13 @@ pub fn run(args: &ModesArgs) -> Result<(), CliError> {
         )
         .file("--animate", args.animate.as_deref())
         .check()?;
-    let (model, modal) = analysis_of(&args.model, &args.point)?;
+    let modal = vibration::modal_analysis(
+        model.as_ref(),
+        &ModalOptions {
+            operating_point: options,
+        },
+    )
+    .map_err(|e| point_failure(model.as_ref(), &e))?;
     if args.plot.is_some() {
         crate::cli::mode_plot::check_drawable(model.as_ref())?;
     }
@@ -413,22 +419,4 @@ fn print_matrix(out: &mut impl std::io::Write, name: &str, m: &DMatrix<f64>) {
         };
         let _ = writeln!(out, "{label:<10} [{}]", row.join(", "));
     }
-}
-
-/// The model `model_name` with `--set` applied and its modal analysis at `--at`
-/// ([`eomgen::analysis::vibration::modal_analysis`]).
-///
-/// # Errors
-/// A bad `--set` or `--at` (usage), a failed search or analysis (with a hint).
-pub(super) fn analysis_of(
-    model_name: &str,
-    point: &OperatingPointArgs,
-) -> Result<(Box<dyn ModelInfo>, ModalAnalysis), CliError> {
-    let model = point.model(model_name)?;
-    let options = ModalOptions {
-        operating_point: point.options(model.as_ref())?,
-    };
-    let modal = vibration::modal_analysis(model.as_ref(), &options)
-        .map_err(|e| point_failure(model.as_ref(), &e))?;
-    Ok((model, modal))
 }
