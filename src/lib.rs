@@ -45,6 +45,7 @@ mod source;
 #[cfg(feature = "jit")]
 pub mod checks;
 pub mod expressions;
+pub mod listing;
 #[cfg(feature = "jit")]
 pub mod studies;
 
@@ -79,8 +80,9 @@ pub mod models {
         pub file: &'static str,
         /// The text of the model file, as it was compiled.
         pub source: &'static str,
-        /// Builds the model with its default parameters.
-        pub make: fn() -> Box<dyn crate::ModelInfo>,
+        /// Builds the model with its default parameters (`Send`, so that a thread pool or
+        /// another language's threads may own it).
+        pub make: fn() -> Box<dyn crate::ModelInfo + Send>,
     }
 
     /// The bundled model named `name`.

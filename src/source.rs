@@ -80,6 +80,12 @@ impl ModelSource {
 
     /// A new instance with the file's default parameters.
     pub fn instantiate(&self) -> Box<dyn ModelInfo> {
+        self.instantiate_send()
+    }
+
+    /// [`Self::instantiate`] as a `Send` box, for an instance that moves between threads
+    /// (a thread pool's task, an interpreter's objects).
+    pub fn instantiate_send(&self) -> Box<dyn ModelInfo + Send> {
         match self {
             ModelSource::Bundled(entry) => (entry.make)(),
             ModelSource::File { model, .. } => Box::new(DynFirstOrder::new(model.clone())),

@@ -521,7 +521,6 @@ impl Simulation {
     /// the model simulated (for its names and parameters).
     pub fn summary(&self, model: &dyn ModelInfo) -> SimulationSummary {
         let n = model.num_dofs();
-        let description = model.description();
         let constrained = !self.constraints.is_empty();
         let samples = self
             .solution
@@ -538,6 +537,21 @@ impl Simulation {
                 constraint_drift: constrained.then(|| self.constraints.drift[k].into()),
             })
             .collect();
+        SimulationSummary {
+            samples,
+            ..self.summary_without_samples(model)
+        }
+    }
+
+    /// [`Self::summary`] with `samples` left empty: the names, settings, drift measures,
+    /// events and work, for a front end that hands the samples over as arrays
+    /// ([`Simulation::solution`], [`EnergyDrift::energy`], [`ConstraintDrift`]) rather than
+    /// one object per sample.
+    pub fn summary_without_samples(&self, model: &dyn ModelInfo) -> SimulationSummary {
+        let n = model.num_dofs();
+        let description = model.description();
+        let constrained = !self.constraints.is_empty();
+        let samples = Vec::new();
         let with_events = !self.solution.events.is_empty() || self.num_added_events > 0;
         SimulationSummary {
             model: description.name.to_string(),

@@ -6,9 +6,8 @@ use clap::{Args, ValueEnum};
 use crate::cli::error::CliError;
 use crate::cli::model::{diagnostics_error, read_model};
 use crate::cli::output::out;
-use eomgen_symbolic::codegen::{EquationsListing, GenerateError, equations_latex, equations_text};
-use eomgen_symbolic::expr::print::Syntax;
-use eomgen_symbolic::mechanics::{Formulation, Lagrange, MomentumBalance, SymbolicModel};
+use eomgen::listing::{Derivation, ListingError, equations};
+use eomgen_symbolic::codegen::GenerateError;
 use eomgen_symbolic::model::templates;
 
 /// Which derivation to print.
@@ -50,25 +49,12 @@ pub struct NewArgs {
     pub n: usize,
 }
 
-/// What `eomgen equations --json` prints.
-#[derive(serde::Serialize)]
-struct EquationsReport<'a> {
-    /// The model's name.
-    model: &'a str,
-    /// `lagrange` or `momentum`.
-    method: &'static str,
-    /// The equations in the model file's syntax.
-    equations: EquationsListing,
-    /// The same in LaTeX.
-    latex: EquationsListing,
-}
-
 /// Runs `equations`.
 pub fn run(args: &EquationsArgs) -> Result<(), CliError> {
     let (display, source) = read_model(&args.model)?;
-    let file = eomgen_symbolic::model::load(&display, &source)
-        .map_err(|d| diagnostics_error(&display, &source, &d))?;
     if args.rust {
+        let file = eomgen_symbolic::model::load(&display, &source)
+            .map_err(|d| diagnostics_error(&display, &source, &d))?;
         let options = eomgen_symbolic::codegen::EmitOptions {
             crate_path: "::eomgen".to_string(),
             tracked_files: vec![display.clone()],
@@ -83,35 +69,23 @@ pub fn run(args: &EquationsArgs) -> Result<(), CliError> {
         out!("{}", prettyplease::unparse(&code));
         return Ok(());
     }
-    let mut model =
-        SymbolicModel::from_file(&file).map_err(|d| diagnostics_error(&display, &source, &d))?;
-    let eom = match args.method {
-        Method::Lagrange => Lagrange.derive(&mut model),
-        Method::Momentum => {
-            if !MomentumBalance::applies_to(&model) {
-                return Err(CliError::usage(format!(
-                    "`{}` has no bodies or writes `kinetic:`, which momentum balance cannot derive from; try --method lagrange",
-                    model.name
-                )));
-            }
-            MomentumBalance.derive(&mut model)
-        }
+    let derivation = match args.method {
+        Method::Lagrange => Derivation::Lagrange,
+        Method::Momentum => Derivation::Momentum,
     };
+    let listing = equations(&display, &source, derivation).map_err(|e| match e {
+        ListingError::Diagnostics(d) => diagnostics_error(&display, &source, &d),
+        ListingError::NoMomentumForm { model } => CliError::usage(format!(
+            "`{model}` has no bodies or writes `kinetic:`, which momentum balance cannot derive from; try --method lagrange"
+        )),
+        e => CliError::failure(e.to_string()),
+    })?;
     if args.json {
-        let report = EquationsReport {
-            model: &model.name,
-            method: match args.method {
-                Method::Lagrange => "lagrange",
-                Method::Momentum => "momentum",
-            },
-            equations: EquationsListing::of(&model, &eom, Syntax::Text),
-            latex: EquationsListing::of(&model, &eom, Syntax::Latex),
-        };
-        crate::cli::json::print_json(&report)?;
+        crate::cli::json::print_json(&listing)?;
     } else if args.latex {
-        out!("{}", equations_latex(&model, &eom));
+        out!("{}", listing.latex_document);
     } else {
-        out!("{}", equations_text(&model, &eom));
+        out!("{}", listing.text);
     }
     Ok(())
 }

@@ -1,0 +1,45 @@
+"""eomgen: declarative models of mechanisms compiled into equations of motion, simulated and
+analysed — from Python.
+
+>>> import eomgen
+>>> m = eomgen.load("double_pendulum")            # a bundled name or a path to a .yaml file
+>>> sol = m.simulate(t_end=10.0, t_out=[1.0, 2.0, 5.0], method="dop853", rtol=1e-12, atol=1e-12)
+>>> sol.q.shape
+(3, 2)
+
+Every computation runs in the compiled Rust library with the interpreter released; the
+results are numpy arrays and dicts equal to the command line's ``--json`` output. See
+docs/python.md.
+"""
+
+from ._eomgen import __version__
+from ._model import (
+    METHODS,
+    Batch,
+    Equations,
+    Model,
+    Modes,
+    Solution,
+    SteadyMotion,
+    bundled_models,
+    load,
+)
+from .errors import AnalysisError, EomgenError, IntegrationError, ModelError, ParameterError
+
+__all__ = [
+    "METHODS",
+    "AnalysisError",
+    "Batch",
+    "EomgenError",
+    "Equations",
+    "IntegrationError",
+    "Model",
+    "ModelError",
+    "Modes",
+    "ParameterError",
+    "Solution",
+    "SteadyMotion",
+    "__version__",
+    "bundled_models",
+    "load",
+]

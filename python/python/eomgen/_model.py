@@ -1,0 +1,682 @@
+"""Models, simulations and modal analyses: the Python face of the compiled library.
+
+Every number comes from the Rust library (``eomgen._eomgen``); this module names the
+arguments, documents shapes and units, and wraps the reports in small result objects.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any, Dict, Iterable, List, Mapping, Optional, Sequence, Tuple, Union
+
+import numpy as np
+
+from . import _eomgen
+from .errors import IntegrationError
+
+ArrayLike = Union[Sequence[float], np.ndarray]
+
+#: The integration methods (``method=``): fixed-step ``euler``, ``midpoint``, ``rk4``,
+#: ``symplectic-euler``, ``stormer-verlet``, ``implicit-midpoint`` (step ``dt``); adaptive
+#: ``bs32``, ``dp54`` (Dormand–Prince 5(4), the default), ``dop853`` and ``radau5``
+#: (``rtol``/``atol``).
+METHODS = (
+    "euler",
+    "midpoint",
+    "rk4",
+    "bs32",
+    "dp54",
+    "dop853",
+    "symplectic-euler",
+    "stormer-verlet",
+    "implicit-midpoint",
+    "radau5",
+)
+
+#: ``simulate``'s defaults, those of ``eomgen simulate`` without options.
+DEFAULT_T_END = 10.0
+DEFAULT_METHOD = "dp54"
+DEFAULT_RTOL = 1e-8
+DEFAULT_ATOL = 1e-10
+DEFAULT_BAUMGARTE = (10.0, 10.0)
+
+
+def load(name_or_path: str) -> "Model":
+    """Opens a model: a bundled model's name (``"double_pendulum"``, see
+    :func:`bundled_models`) or the path of any model file (``"my/model.yaml"``), whose
+    equations are derived and compiled to machine code now (milliseconds).
+
+    Raises:
+        ModelError: an unknown name, an unreadable file, or a file with mistakes (its
+            ``diagnostics`` give file, line, column, message and help for each).
+    """
+    return Model(_eomgen._Model.load(str(name_or_path)))
+
+
+def bundled_models() -> List[str]:
+    """The names of the bundled models (``eomgen list``)."""
+    return list(_eomgen.bundled_models())
+
+
+def _restore(argument: str, text: str, overrides: List[Tuple[str, float]]) -> "Model":
+    """Rebuilds a pickled model from its file's text and parameter values."""
+    return Model(_eomgen._Model.restore(argument, text, overrides))
+
+
+class Model:
+    """A model of a mechanism with its equations compiled, and parameter values of its own.
+
+    Open one with :func:`eomgen.load`. A model is immutable: :meth:`with_parameters` returns
+    a copy. It pickles by its file's text and its parameter values, so that
+    ``concurrent.futures``, multiprocessing, Dask and Ray can send it to other processes
+    (the file is compiled again there, once per process).
+
+    Units are those of the model file (SI unless it says otherwise); angles are in rad,
+    frequencies in rad/s unless the name ends in ``_hz``.
+    """
+
+    __slots__ = ("_core",)
+
+    def __init__(self, core: "_eomgen._Model"):
+        self._core = core
+
+    # --- what the model is -----------------------------------------------------------
+
+    @property
+    def name(self) -> str:
+        """The model's ``name``."""
+        return self._core.name
+
+    @property
+    def path(self) -> str:
+        """The model file as messages name it (``models/<file>`` for a bundled model)."""
+        return self._core.path
+
+    @property
+    def text(self) -> str:
+        """The model file's text."""
+        return self._core.text
+
+    @property
+    def coordinates(self) -> List[str]:
+        """The generalized coordinates' names ``q``, in the state's order (``n`` names)."""
+        return list(self._core.coordinates)
+
+    @property
+    def parameters(self) -> Dict[str, float]:
+        """Every parameter's value, by name, in the file's order (this model's values)."""
+        return dict(self._core.parameters)
+
+    @property
+    def num_dofs(self) -> int:
+        """The number of degrees of freedom ``n`` (coordinates)."""
+        return self._core.num_dofs
+
+    def description(self) -> dict:
+        """The model's description: names, default parameters, points, constraints,
+        equilibria, events, drawing and the equations as text."""
+        return self._core.description()
+
+    def with_parameters(self, values: Optional[Mapping[str, float]] = None, **kwargs: float) -> "Model":
+        """A copy of this model with parameters set: ``m.with_parameters(g=9.81)`` or
+        ``m.with_parameters({"g": 9.81})``.
+
+        Raises:
+            ParameterError: a name the model does not have, or a value that is not finite.
+        """
+        merged = dict(values or {})
+        merged.update(kwargs)
+        return Model(self._core.with_parameters([(str(k), float(v)) for k, v in merged.items()]))
+
+    def initial_state(self, initial: Optional[Union[Mapping[str, float], ArrayLike]] = None) -> np.ndarray:
+        """The state ``y0 = [q; q̇]`` (``2n``) a simulation starts from: the file's
+        ``initial:``, with ``initial`` applied — a dict of coordinates and rates
+        (``{"theta1": 0.5, "theta1_dot": 0.0}``) or a whole state of ``2n`` entries.
+
+        Raises:
+            ValueError: a name that is neither a coordinate nor a rate ``<coordinate>_dot``,
+                or a state of the wrong length.
+        """
+        y0 = np.array(self._core.initial_state(), dtype=float)
+        if initial is None:
+            return y0
+        if isinstance(initial, Mapping):
+            names = self.coordinates
+            index = {c: i for i, c in enumerate(names)}
+            index.update({c + "_dot": len(names) + i for i, c in enumerate(names)})
+            for key, value in initial.items():
+                if key not in index:
+                    raise ValueError(
+                        f"`{key}` is not a coordinate or rate of `{self.name}` "
+                        f"(coordinates: {', '.join(names)}; rates: <coordinate>_dot)"
+                    )
+                y0[index[key]] = float(value)
+            return y0
+        y = np.asarray(initial, dtype=float).reshape(-1)
+        if y.shape != y0.shape:
+            raise ValueError(f"the initial state must have {y0.size} entries ([q; q̇]), got {y.size}")
+        return y
+
+    # --- simulation --------------------------------------------------------------------
+
+    def simulate(
+        self,
+        t_end: float = DEFAULT_T_END,
+        t_out: Optional[ArrayLike] = None,
+        method: str = DEFAULT_METHOD,
+        rtol: float = DEFAULT_RTOL,
+        atol: float = DEFAULT_ATOL,
+        dt: Optional[float] = None,
+        initial: Optional[Union[Mapping[str, float], ArrayLike]] = None,
+        stabilization: str = "none",
+        baumgarte: Tuple[float, float] = DEFAULT_BAUMGARTE,
+        stop_when: Iterable[str] = (),
+        events: Iterable[str] = (),
+    ) -> "Solution":
+        """Integrates the model from its initial state to ``t_end`` (``eomgen simulate``).
+
+        Args:
+            t_end: end time (s).
+            t_out: output times (s), ascending in ``[0, t_end]``; samples come from dense
+                output at exactly these times. ``None``: every accepted step.
+            method: one of :data:`METHODS` (default ``dp54``, Dormand–Prince 5(4)).
+            rtol, atol: tolerances of the adaptive methods (defaults 1e-8, 1e-10).
+            dt: the step of a fixed-step method (default ``t_end/1000``); the first step of
+                an adaptive one (default automatic).
+            initial: coordinates and rates to change (see :meth:`initial_state`), or a whole
+                state ``[q; q̇]``. A constrained model's state is made consistent first.
+            stabilization: drift control of a constrained model: ``none``, ``baumgarte``
+                (gains ``baumgarte = (alpha, beta)``, 1/s) or ``projection``.
+            stop_when: event functions that stop the run at their first zero: a model
+                event's name or an expression ``"theta_dot = 0, falling"``.
+            events: event functions located without stopping (same syntax).
+
+        Returns:
+            a :class:`Solution`: ``t`` (k,), ``q`` and ``qdot`` (k, n), ``energy`` (k,),
+            ``stats``, ``events``.
+
+        Raises:
+            IntegrationError: the integration stopped early (``t``, ``reason``, and the
+                samples before it in ``solution``).
+            AnalysisError: no state consistent with the constraints.
+            ValueError: an unknown method, a bad tolerance, end time or output times, an
+                event expression that does not parse.
+        """
+        y0 = None if initial is None else self.initial_state(initial).tolist()
+        result = self._core.simulate(
+            float(t_end),
+            None if t_out is None else [float(t) for t in np.atleast_1d(t_out)],
+            str(method),
+            float(rtol),
+            float(atol),
+            None if dt is None else float(dt),
+            y0,
+            str(stabilization),
+            (float(baumgarte[0]), float(baumgarte[1])),
+            [str(s) for s in stop_when],
+            [str(s) for s in events],
+        )
+        solution = Solution(result, self.num_dofs)
+        failure = solution.summary_header.get("error")
+        if failure is not None:
+            t = failure.get("t")
+            reason = failure["message"]
+            kept = f"the {len(solution.t)} samples computed before it were kept"
+            if t is None or "t = " in reason:
+                message = f"integration of `{self.name}` stopped: {reason}; {kept}"
+            else:
+                message = f"integration of `{self.name}` stopped: {reason} at t = {t}; {kept}"
+            if t is None:
+                raise ValueError(reason)
+            raise IntegrationError(message, t, reason, solution)
+        return solution
+
+    def simulate_many(
+        self,
+        initial_states: Optional[ArrayLike] = None,
+        parameters: Optional[Union[Sequence[Mapping[str, float]], Mapping[str, ArrayLike]]] = None,
+        t_end: float = DEFAULT_T_END,
+        t_out: Optional[ArrayLike] = None,
+        method: str = DEFAULT_METHOD,
+        rtol: float = DEFAULT_RTOL,
+        atol: float = DEFAULT_ATOL,
+        dt: Optional[float] = None,
+        stabilization: str = "none",
+        baumgarte: Tuple[float, float] = DEFAULT_BAUMGARTE,
+        threads: Optional[int] = None,
+        errors: str = "raise",
+    ) -> "Batch":
+        """Runs a batch of simulations across the machine's cores and stacks the results:
+        the building block of a sweep. Each run is the same computation as
+        :meth:`simulate` on its own model instance, so the results equal the serial loop's
+        bit for bit, whatever the number of threads.
+
+        Args:
+            initial_states: ``(b, 2n)`` states ``[q; q̇]``, one row per run (``None``: the
+                file's initial state for every run).
+            parameters: one dict of parameter values per run, or a dict of arrays
+                (``{"l1": [1.0, 1.1, ...]}``), each of length ``b`` (``None``: this
+                model's values).
+            t_end, method, rtol, atol, dt, stabilization, baumgarte: as :meth:`simulate`.
+            t_out: output times (default ``[t_end]``: the final state).
+            threads: worker threads (default: one per core; ``1`` inside a Dask or
+                multiprocessing worker that already has one process per core).
+            errors: ``"raise"`` raises :class:`IntegrationError` for the first run that
+                failed; ``"keep"`` returns the batch with ``ok[i] = False`` and the failed
+                runs' samples after the failure set to NaN (``failures`` says where and why).
+
+        Returns:
+            a :class:`Batch`: ``t`` (k,), ``y`` (b, k, 2n), ``q``, ``qdot`` (b, k, n),
+            ``energy`` (b, k), ``ok`` (b,), ``failures``, ``stats``.
+        """
+        if errors not in ("raise", "keep"):
+            raise ValueError(f"errors must be `raise` or `keep`, got `{errors}`")
+        states = None
+        if initial_states is not None:
+            states = np.ascontiguousarray(np.atleast_2d(np.asarray(initial_states, dtype=float)))
+        sets = None
+        if parameters is not None:
+            if isinstance(parameters, Mapping):
+                columns = {k: np.atleast_1d(np.asarray(v, dtype=float)) for k, v in parameters.items()}
+                lengths = {len(v) for v in columns.values()}
+                if len(lengths) != 1:
+                    raise ValueError("every parameter's values must have the same length")
+                (count,) = lengths
+                sets = [[(k, float(v[i])) for k, v in columns.items()] for i in range(count)]
+            else:
+                sets = [[(str(k), float(v)) for k, v in p.items()] for p in parameters]
+        times = [float(t_end)] if t_out is None else [float(t) for t in np.atleast_1d(t_out)]
+        result = _eomgen.simulate_many(
+            self._core,
+            states,
+            sets,
+            float(t_end),
+            times,
+            str(method),
+            float(rtol),
+            float(atol),
+            None if dt is None else float(dt),
+            str(stabilization),
+            (float(baumgarte[0]), float(baumgarte[1])),
+            threads,
+        )
+        batch = Batch(result, self.num_dofs)
+        if errors == "raise" and batch.failures:
+            index, t, reason = batch.failures[0]
+            raise IntegrationError(
+                f"integration of `{self.name}` stopped in run {index} of {len(batch.ok)}: {reason}"
+                f" ({len(batch.failures)} run(s) failed; errors='keep' returns the batch)",
+                None if math.isnan(t) else t,
+                reason,
+                batch,
+            )
+        return batch
+
+    # --- linearisation and modes ----------------------------------------------------------
+
+    def modes(self, at: Optional[Union[str, Mapping[str, float], ArrayLike]] = None, t: float = 0.0) -> Union["Modes", "SteadyMotion"]:
+        """Normal modes about an operating point (``eomgen modes``): the equilibrium found
+        by Newton's method, the exact linearisation ``M δq̈ + C δq̇ + K δq = 0`` there, the
+        natural frequencies and mass-normalised mode shapes, the eigenvalues of the whole
+        state matrix and the stability verdict from them.
+
+        Args:
+            at: where Newton starts: a name from the file's ``equilibria:`` (``"hanging"``,
+                ``"upright"``), coordinates as a dict (others 0) or ``n`` values. Default:
+                the file's first equilibrium, else ``q = 0``. A named steady motion (rates
+                held, a bicycle at speed) or a non-holonomic model gives a
+                :class:`SteadyMotion`.
+            t: the time (s) of the equilibrium equations.
+
+        Raises:
+            AnalysisError: no equilibrium found, or a model whose equations change with
+                ``t`` in ``M``, ``C`` or ``K``.
+        """
+        label = None
+        if isinstance(at, Mapping):
+            q = np.zeros(self.num_dofs)
+            names = self.coordinates
+            for key, value in at.items():
+                if key not in names:
+                    raise ValueError(f"`{key}` is not a coordinate of `{self.name}` (coordinates: {', '.join(names)})")
+                q[names.index(key)] = float(value)
+            label = ",".join(f"{k}={v}" for k, v in at.items())
+            at = q.tolist()
+        elif at is not None and not isinstance(at, str):
+            at = [float(v) for v in np.asarray(at, dtype=float).reshape(-1)]
+        kind, summary = self._core.modes(at, label, float(t))
+        if kind == "steady":
+            return SteadyMotion(summary)
+        return Modes(summary)
+
+    # --- derivations --------------------------------------------------------------------
+
+    def check(self, states: int = 200, timing: bool = False) -> dict:
+        """Derives the model two ways (Lagrange and momentum balance, and the file's own
+        balances) and compares ``q̈`` at ``states`` random states: the dict
+        ``eomgen check --json`` prints (``passed``, ``checks``, ``power_balance``, …;
+        with ``timing``, the derivation times too). Its ``passed`` is ``False`` when a check
+        failed or nothing was compared.
+
+        Raises:
+            ModelError: a file that does not derive.
+        """
+        _passed, summary = self._core.check(int(states), bool(timing))
+        return summary
+
+    def equations(self, latex: bool = False, method: str = "lagrange") -> "Equations":
+        """The equations of motion ``M(q) q̈ = F(q, q̇, t)`` (with ``T``, ``V``, ``Q`` and
+        each constraint), derived by ``method`` (``lagrange`` or ``momentum``), as text
+        (``eomgen equations``) or, with ``latex``, as LaTeX. The string shows as LaTeX in
+        Jupyter; ``.listing`` is the dict of ``eomgen equations --json``."""
+        listing, text, latex_document = self._core.equations(str(method))
+        return Equations(latex_document if latex else text, latex_document, listing)
+
+    # --- evaluations for users' own solvers --------------------------------------------------
+
+    def rhs(self, t: float, y: ArrayLike) -> np.ndarray:
+        """The right-hand side ``ẏ = f(t, y)`` of the first-order form, ``y = [q; q̇]``
+        (``2n`` in, ``2n`` out): ``q̈`` from ``M q̈ = F`` (with constraints, the KKT
+        system). For SciPy's ``solve_ivp(m.rhs, ...)`` and other solvers."""
+        return self._core.rhs(float(t), np.ascontiguousarray(y, dtype=float))
+
+    def mass_matrix(self, q: ArrayLike, t: float = 0.0) -> np.ndarray:
+        """The mass matrix ``M(q, t)`` (``n × n``, symmetric positive definite)."""
+        q = np.ascontiguousarray(q, dtype=float)
+        mass, _ = self._core.mass_matrix_and_forcing(q, np.zeros_like(q), float(t))
+        return mass
+
+    def forcing(self, q: ArrayLike, qdot: ArrayLike, t: float = 0.0) -> np.ndarray:
+        """The forcing ``F(q, q̇, t)`` (``n``) of ``M q̈ = F``: generalized forces, gravity,
+        springs, velocity-product terms."""
+        _, forcing = self._core.mass_matrix_and_forcing(
+            np.ascontiguousarray(q, dtype=float), np.ascontiguousarray(qdot, dtype=float), float(t)
+        )
+        return forcing
+
+    def energy(self, y: ArrayLike, t: float = 0.0) -> Tuple[float, float]:
+        """The kinetic and potential energies ``(T, V)`` (J) at the state ``y = [q; q̇]``."""
+        return self._core.energies(float(t), np.ascontiguousarray(y, dtype=float))
+
+    # --- studies -------------------------------------------------------------------------
+
+    def work_precision(self, methods: Optional[Sequence[str]] = None, tolerances: Optional[Sequence[float]] = None,
+                       steps: Optional[Sequence[int]] = None, t_end: Optional[float] = None,
+                       samples: Optional[int] = None, target_error: Optional[float] = None,
+                       reference_tol: Optional[float] = None, repeats: Optional[int] = None,
+                       min_time_s: Optional[float] = None) -> dict:
+        """Error against work of integration methods (``eomgen study work-precision``):
+        every method at every tolerance (adaptive) or step count (fixed step), its error
+        against a DOP853 reference at ``samples`` output times over ``[0, t_end]``, RHS
+        evaluations and median wall time; ``None`` arguments take the study's defaults.
+        Returns the ``--json`` report with numeric lists as numpy arrays."""
+        return _eomgen.study_work_precision(
+            self._core, None if methods is None else list(methods),
+            None if tolerances is None else [float(x) for x in tolerances],
+            None if steps is None else [int(x) for x in steps],
+            t_end, samples, target_error, reference_tol, repeats, min_time_s)
+
+    def parameter_sweep(self, parameter: str, values: ArrayLike,
+                        at: Optional[Union[str, ArrayLike]] = None, refine: bool = True) -> dict:
+        """The eigenvalues of an equilibrium or steady motion against one parameter
+        (``eomgen study parameter-sweep``), with every stability change located by
+        bisection (``stability_changes``). ``values`` ascending. Returns the ``--json``
+        report with numeric lists as numpy arrays.
+
+        Raises:
+            ParameterError: an unknown parameter.
+            AnalysisError: no value of the sweep could be analysed.
+        """
+        at_arg = at if (at is None or isinstance(at, str)) else [float(v) for v in np.asarray(at).reshape(-1)]
+        return _eomgen.study_parameter_sweep(
+            self._core, str(parameter), [float(v) for v in np.atleast_1d(values)], at_arg, bool(refine))
+
+    def frf(self, input: str, outputs: Sequence[str] = (), frequency_range: Optional[Tuple[float, float]] = None,
+            points: int = 400, frequencies: Sequence[float] = (), modal: bool = False,
+            at: Optional[Union[str, ArrayLike]] = None) -> dict:
+        """The frequency response ``H(ω)`` about an equilibrium (``eomgen frf``) to a
+        harmonic ``input`` (a load parameter that enters the forcing linearly, or a
+        coordinate's name for a unit generalized force on it), on ``points`` log-spaced
+        frequencies (rad/s) in ``frequency_range`` (default: a decade around the natural
+        frequencies), with the peaks, and at ``frequencies``. Returns the ``--json``
+        report with numeric lists as numpy arrays."""
+        at_arg = at if (at is None or isinstance(at, str)) else [float(v) for v in np.asarray(at).reshape(-1)]
+        return _eomgen.study_frf(
+            self._core, str(input), [str(o) for o in outputs],
+            None if frequency_range is None else (float(frequency_range[0]), float(frequency_range[1])),
+            int(points), [float(f) for f in frequencies], bool(modal), at_arg)
+
+    # --- Python protocols --------------------------------------------------------------
+
+    def __reduce__(self):
+        argument, text, overrides = self._core.state()
+        return (_restore, (argument, text, list(overrides)))
+
+    def __repr__(self) -> str:
+        changed = dict(self._core.overrides)
+        extra = f", {changed}" if changed else ""
+        return f"eomgen.Model({self.name!r} from {self.path!r}, {self.num_dofs} dof{extra})"
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, Model):
+            return NotImplemented
+        return self._core.state() == other._core.state()
+
+    def __hash__(self) -> int:
+        argument, text, overrides = self._core.state()
+        return hash((argument, text, tuple(overrides)))
+
+
+class Solution:
+    """The samples of one simulation, with its energy, work and events.
+
+    Attributes:
+        t: times (s), shape ``(k,)``.
+        y: states ``[q; q̇]``, shape ``(k, 2n)``.
+        q, qdot: coordinates and rates, ``(k, n)`` each (views of ``y``).
+        energy: ``T + V`` (J) at every sample, ``(k,)``.
+        stats: the integrator's work: ``steps``, ``rejected``, ``rhs_evals``,
+            ``jacobian_evals``, ``lu_decompositions``, ``event_evals``, ``wall_time_s``.
+        events: the located events, each ``{"name", "t", "direction", "terminal", "q",
+            "qdot"}``.
+        lagrange_multipliers: a constrained model's ``λ`` at every sample, ``(k, m)``
+            (NaN rows where the constrained system is singular; ``None`` without
+            constraints).
+        constraint_drift: ``max |Φ|`` and ``max |Φ̇|`` at every sample, ``(k, 2)``.
+        summary: the whole report as ``eomgen simulate --json`` prints it (built on first
+            use).
+    """
+
+    def __init__(self, result: dict, num_dofs: int):
+        self.summary_header = result["summary"]
+        self.t = result["t"]
+        self.y = result["y"]
+        self.q = self.y[:, :num_dofs]
+        self.qdot = self.y[:, num_dofs:]
+        self.energy = result["energy"]
+        self.lagrange_multipliers = result.get("lagrange_multipliers")
+        self._solved = result.get("multipliers_solved")
+        self.constraint_drift = result.get("constraint_drift")
+        self._summary = None
+
+    @property
+    def stats(self) -> dict:
+        """The integrator's work (see the class's attributes)."""
+        return self.summary_header["stats"]
+
+    @property
+    def events(self) -> List[dict]:
+        """The located events, in time order."""
+        return self.summary_header.get("events") or []
+
+    @property
+    def energy_drift(self) -> Optional[float]:
+        """``max |E − E(0)|`` over the samples, relative to ``max(T + |V|)``."""
+        return self.summary_header["energy_drift"]
+
+    @property
+    def warnings(self) -> List[dict]:
+        """Warnings about the settings or the result (a step past the stability limit, an
+        energy that drifted on a conservative model)."""
+        return self.summary_header.get("warnings", [])
+
+    @property
+    def summary(self) -> dict:
+        """The report as ``eomgen simulate --json`` prints it, samples included."""
+        if self._summary is None:
+            summary = dict(self.summary_header)
+            samples = []
+            constrained = self.lagrange_multipliers is not None
+            for k in range(len(self.t)):
+                sample = {
+                    "t": float(self.t[k]),
+                    "q": self.q[k].tolist(),
+                    "qdot": self.qdot[k].tolist(),
+                    "energy": _json_number(self.energy[k]),
+                }
+                if constrained:
+                    sample["constraint_forces"] = self.lagrange_multipliers[k].tolist() if self._solved[k] else None
+                    sample["constraint_drift"] = {
+                        "position": float(self.constraint_drift[k, 0]),
+                        "velocity": float(self.constraint_drift[k, 1]),
+                    }
+                samples.append(sample)
+            summary["samples"] = samples
+            self._summary = summary
+        return self._summary
+
+    def __len__(self) -> int:
+        return len(self.t)
+
+    def __repr__(self) -> str:
+        return (f"eomgen.Solution({self.summary_header['model']!r}, {len(self.t)} samples, "
+                f"t = {self.t[0] if len(self.t) else '-'} … {self.t[-1] if len(self.t) else '-'}, "
+                f"{self.stats['steps']} steps)")
+
+
+def _json_number(x: float) -> Optional[float]:
+    """A float as the command line's JSON gives it: non-finite numbers are ``null``."""
+    x = float(x)
+    return x if math.isfinite(x) else None
+
+
+class Batch:
+    """The stacked results of :meth:`Model.simulate_many` (``b`` runs, ``k`` output times).
+
+    Attributes:
+        t: output times (s), ``(k,)``.
+        y: states, ``(b, k, 2n)``; ``q``, ``qdot``: ``(b, k, n)``.
+        energy: ``(b, k)``.
+        ok: ``(b,)`` booleans: the run reached ``t_end``.
+        failures: ``[(index, t, reason)]`` of the runs that stopped early (their samples
+            after the failure are NaN).
+        stats: ``steps``, ``rejected``, ``rhs_evals``, each ``(b,)``.
+    """
+
+    def __init__(self, result: dict, num_dofs: int):
+        self.t = result["t"]
+        self.y = result["y"]
+        self.q = self.y[:, :, :num_dofs]
+        self.qdot = self.y[:, :, num_dofs:]
+        self.energy = result["energy"]
+        self.ok = result["ok"]
+        self.failures = [tuple(f) for f in result["failures"]]
+        self.stats = {k: result[k] for k in ("steps", "rejected", "rhs_evals")}
+
+    def __len__(self) -> int:
+        return len(self.ok)
+
+    def __repr__(self) -> str:
+        return f"eomgen.Batch({len(self.ok)} runs × {len(self.t)} output times, {len(self.failures)} failed)"
+
+
+class Modes:
+    """The modal analysis about an equilibrium (``eomgen modes``), ``n`` coordinates,
+    ``r`` minimal coordinates (``r = n`` without constraints).
+
+    Attributes:
+        natural_frequencies: ``ωₖ`` (rad/s), ascending, ``(r,)``.
+        frequencies_hz: ``ωₖ/2π`` (Hz).
+        mode_shapes: ``(n, r)``: column ``k`` is mode ``k`` in the model's coordinates,
+            mass-normalised (``ΨᵀMΨ = I`` in the minimal coordinates).
+        mass_matrix, stiffness_matrix, damping_matrix: ``M``, ``K``, ``C`` (``r × r``).
+        damping_ratios: ``ζ`` of each damped mode.
+        eigenvalues: ``ωₖ²`` (1/s², negative for an unstable mode).
+        equilibrium: ``q*`` (``n``).
+        stability: the verdict from the eigenvalues of the whole state matrix (damping and
+            gyroscopic terms included), with ``C`` split into damping and gyroscopic parts.
+        summary: the report as ``eomgen modes --json`` prints it.
+    """
+
+    def __init__(self, summary: dict):
+        self.summary = summary
+        self.natural_frequencies = np.array(summary["natural_frequencies"], dtype=float)
+        self.frequencies_hz = np.array(summary["frequencies_hz"], dtype=float)
+        self.eigenvalues = np.array(summary["eigenvalues"], dtype=float)
+        n = len(summary["coordinates"])
+        shapes = np.array(summary["mode_shapes"], dtype=float).reshape(-1, n)
+        self.mode_shapes = shapes.T
+        r = len(summary["minimal_coordinates"])
+        self.mass_matrix = np.array(summary["mass_matrix"], dtype=float).reshape(r, r)
+        self.stiffness_matrix = np.array(summary["stiffness_matrix"], dtype=float).reshape(r, r)
+        self.damping_matrix = np.array(summary["damping_matrix"], dtype=float).reshape(r, r)
+        self.damping_ratios = np.array(summary["damping_ratios"], dtype=float)
+        self.equilibrium = np.array(summary["operating_point"]["q"] if isinstance(summary["operating_point"]["q"], list)
+                                    else [summary["operating_point"]["q"][c] for c in summary["coordinates"]], dtype=float)
+        self.stability = summary["stability"]
+        self.kinds = summary["kinds"]
+        self.coordinates = summary["coordinates"]
+
+    @property
+    def damped_eigenvalues(self) -> np.ndarray:
+        """The eigenvalues ``s`` of the state matrix with ``Im s ≥ 0`` (complex)."""
+        return np.array([complex(d["re"], d["im"]) for d in self.summary["damped_modes"]])
+
+    def __repr__(self) -> str:
+        freqs = ", ".join(f"{w:.6g}" for w in self.natural_frequencies)
+        return f"eomgen.Modes({self.summary['model']!r} at {self.summary['operating_point']['name']!r}: ω = [{freqs}] rad/s)"
+
+
+class SteadyMotion:
+    """The linearisation about a steady motion (rates held, or a non-holonomic model):
+    the reduced state, its eigenvalues and the stability verdict (``eomgen modes`` at a
+    steady motion).
+
+    Attributes:
+        eigenvalues: the eigenvalues ``s`` of the reduced state matrix (complex), sorted as
+            the report lists them.
+        summary: the report as ``eomgen modes --json`` prints it.
+    """
+
+    def __init__(self, summary: dict):
+        self.summary = summary
+        self.eigenvalues = np.array([complex(d["re"], d["im"]) for d in summary["damped_modes"]])
+        self.stability = summary.get("stability")
+
+    def __repr__(self) -> str:
+        return f"eomgen.SteadyMotion({self.summary['model']!r}: {len(self.eigenvalues)} eigenvalues)"
+
+
+class Equations(str):
+    """The equations of motion as text (or LaTeX); shown as LaTeX in Jupyter.
+
+    Attributes:
+        latex: the LaTeX listing (amsmath).
+        listing: ``{"model", "method", "equations", "latex"}`` as
+            ``eomgen equations --json`` prints it.
+    """
+
+    latex: str
+    listing: dict
+
+    def __new__(cls, text: str, latex: str, listing: dict):
+        self = super().__new__(cls, text)
+        self.latex = latex
+        self.listing = listing
+        return self
+
+    def _repr_latex_(self) -> str:
+        return self.latex
+
+    def __reduce__(self):
+        return (Equations, (str(self), self.latex, self.listing))

@@ -1,0 +1,31 @@
+//! The Python package `eomgen`'s compiled module, `eomgen._eomgen`: a thin layer over the
+//! library. Every computation is a library call (`eomgen::analysis`, `eomgen::listing`, the
+//! cross-check of `eomgen_symbolic`); this crate converts arguments, releases the
+//! interpreter while the call runs, and turns the report (the same `Serialize` value the
+//! command line prints with `--json`) into dicts and numpy arrays. The Python package
+//! (`python/python/eomgen`) adds docstrings, result objects and exceptions.
+
+mod batch;
+mod convert;
+mod errors;
+mod model;
+mod studies;
+
+use pyo3::prelude::*;
+
+/// The compiled half of the `eomgen` package.
+#[pymodule]
+fn _eomgen(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<model::CoreModel>()?;
+    m.add_function(wrap_pyfunction!(batch::simulate_many, m)?)?;
+    m.add_function(wrap_pyfunction!(bundled_models, m)?)?;
+    studies::register(m)?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    Ok(())
+}
+
+/// The bundled models' names, in the order `eomgen list` shows them.
+#[pyfunction]
+fn bundled_models() -> Vec<&'static str> {
+    eomgen::models::ALL.iter().map(|e| e.name).collect()
+}

@@ -1,0 +1,156 @@
+//! The library's studies from Python: each one library call with its options from keyword
+//! arguments (the library's defaults where one is not given), its report as the command
+//! line's `--json` prints it, with numeric lists as numpy arrays.
+
+use eomgen::analysis::vibration::{
+    self, FrfOptions, OperatingPointOptions, ParameterSweepOptions, SweepAxis,
+};
+use eomgen::analysis::{WorkPrecisionOptions, work_precision};
+use pyo3::prelude::*;
+
+use crate::convert::{Lists, to_python};
+use crate::errors::analysis_error;
+use crate::model::{CoreModel, equilibrium_start, method};
+
+/// Registers the studies.
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(study_work_precision, m)?)?;
+    m.add_function(wrap_pyfunction!(study_parameter_sweep, m)?)?;
+    m.add_function(wrap_pyfunction!(study_frf, m)?)?;
+    Ok(())
+}
+
+/// Error against work of integration methods on `model` (`eomgen study work-precision`).
+#[pyfunction]
+#[allow(clippy::too_many_arguments)]
+#[pyo3(signature = (model, methods = None, tolerances = None, steps = None, t_end = None, samples = None, target_error = None, reference_tol = None, repeats = None, min_time_s = None))]
+fn study_work_precision<'py>(
+    py: Python<'py>,
+    model: &CoreModel,
+    methods: Option<Vec<String>>,
+    tolerances: Option<Vec<f64>>,
+    steps: Option<Vec<usize>>,
+    t_end: Option<f64>,
+    samples: Option<usize>,
+    target_error: Option<f64>,
+    reference_tol: Option<f64>,
+    repeats: Option<usize>,
+    min_time_s: Option<f64>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let defaults = WorkPrecisionOptions::default();
+    let methods = match methods {
+        Some(names) => names
+            .iter()
+            .map(|m| method(m))
+            .collect::<PyResult<Vec<_>>>()?,
+        None => defaults.methods.clone(),
+    };
+    let mut tolerances = tolerances.unwrap_or(defaults.tolerances.clone());
+    tolerances.sort_by(|a, b| b.total_cmp(a));
+    tolerances.dedup();
+    let steps = steps.map(|mut s| {
+        s.sort_unstable();
+        s.dedup();
+        s
+    });
+    let options = WorkPrecisionOptions {
+        methods,
+        tolerances,
+        steps,
+        t_end: t_end.unwrap_or(defaults.t_end),
+        samples: samples.unwrap_or(defaults.samples),
+        target_error: target_error.unwrap_or(defaults.target_error),
+        baseline_ms: None,
+        reference_tol: reference_tol.unwrap_or(defaults.reference_tol),
+        repeats: repeats.unwrap_or(defaults.repeats),
+        min_time_s: min_time_s.unwrap_or(defaults.min_time_s),
+    };
+    let mut instance = model.fresh()?;
+    let report = py
+        .detach(|| work_precision(instance.as_mut(), &options, &mut |_, _| {}))
+        .map_err(analysis_error)?;
+    to_python(
+        py,
+        &report.summary(instance.as_ref(), &options),
+        Lists::Arrays,
+    )
+}
+
+/// Eigenvalues of an operating point against one parameter, with the stability changes
+/// (`eomgen study parameter-sweep`).
+#[pyfunction]
+#[pyo3(signature = (model, parameter, values, at = None, refine = true))]
+fn study_parameter_sweep<'py>(
+    py: Python<'py>,
+    model: &CoreModel,
+    parameter: String,
+    values: Vec<f64>,
+    at: Option<&Bound<'py, PyAny>>,
+    refine: bool,
+) -> PyResult<Bound<'py, PyAny>> {
+    if values.is_empty() || values.windows(2).any(|w| !(w[0] < w[1])) {
+        return Err(pyo3::exceptions::PyValueError::new_err(
+            "values must be a non-empty, strictly ascending sequence",
+        ));
+    }
+    let options = ParameterSweepOptions {
+        axis: SweepAxis {
+            name: parameter,
+            values,
+        },
+        operating_point: OperatingPointOptions {
+            start: equilibrium_start(at, None)?,
+            t: 0.0,
+        },
+        refine,
+    };
+    let mut instance = model.fresh()?;
+    let sweep = py
+        .detach(|| vibration::parameter_sweep(instance.as_mut(), &options, |_, _| {}))
+        .map_err(|e| match e {
+            e @ vibration::ParameterSweepError::UnknownParameter { .. } => {
+                crate::errors::parameter_error(e)
+            }
+            e => analysis_error(e),
+        })?;
+    to_python(py, &sweep, Lists::Arrays)
+}
+
+/// The frequency response to a harmonic input about an equilibrium (`eomgen frf`).
+#[pyfunction]
+#[allow(clippy::too_many_arguments)]
+#[pyo3(signature = (model, input, outputs = Vec::new(), frequency_range = None, points = FrfOptions::DEFAULT_POINTS, frequencies = Vec::new(), modal = false, at = None))]
+fn study_frf<'py>(
+    py: Python<'py>,
+    model: &CoreModel,
+    input: String,
+    outputs: Vec<String>,
+    frequency_range: Option<(f64, f64)>,
+    points: usize,
+    frequencies: Vec<f64>,
+    modal: bool,
+    at: Option<&Bound<'py, PyAny>>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let options = FrfOptions {
+        operating_point: OperatingPointOptions {
+            start: equilibrium_start(at, None)?,
+            t: 0.0,
+        },
+        input,
+        outputs,
+        frequency_range,
+        points,
+        frequencies,
+        modal,
+        simulation: None,
+    };
+    let mut instance = model.fresh()?;
+    let analysis = py
+        .detach(|| vibration::frequency_response_analysis(instance.as_mut(), &options))
+        .map_err(analysis_error)?;
+    to_python(
+        py,
+        &analysis.summary(instance.as_ref(), None),
+        Lists::Arrays,
+    )
+}

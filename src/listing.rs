@@ -1,0 +1,114 @@
+//! The equations of motion of a model file as text and LaTeX: what `eomgen equations`
+//! prints, and what the Python package's `Model.equations` returns.
+
+use eomgen_symbolic::codegen::{EquationsListing, equations_latex, equations_text};
+use eomgen_symbolic::expr::print::Syntax;
+use eomgen_symbolic::mechanics::{Formulation, Lagrange, MomentumBalance, SymbolicModel};
+use eomgen_symbolic::model::Diagnostic;
+use serde::Serialize;
+
+/// Which derivation to list.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Derivation {
+    /// Lagrange's equations, from `T`, `V` and `Q`.
+    Lagrange,
+    /// Momentum balance projected on the partial velocities (a model given by the
+    /// kinematics of its bodies only).
+    Momentum,
+}
+
+impl Derivation {
+    /// `lagrange` or `momentum`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Derivation::Lagrange => "lagrange",
+            Derivation::Momentum => "momentum",
+        }
+    }
+}
+
+/// The equations of a model by one derivation: `{"model", "method", "equations", "latex"}`
+/// as `eomgen equations --json` prints them, and the whole listing as text and as LaTeX.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Equations {
+    /// The model's name.
+    pub model: String,
+    /// `lagrange` or `momentum`.
+    pub method: &'static str,
+    /// `T`, `V`, `Q`, `M`, `F` and each constraint's equation, Jacobian row and `γ`, in the
+    /// model file's syntax (they parse back with the model parser).
+    pub equations: EquationsListing,
+    /// The same in LaTeX.
+    pub latex: EquationsListing,
+    /// The listing as `eomgen equations` prints it (not serialised).
+    #[serde(skip)]
+    pub text: String,
+    /// The listing as `eomgen equations --latex` prints it: an amsmath document body (not
+    /// serialised).
+    #[serde(skip)]
+    pub latex_document: String,
+}
+
+/// Why [`equations`] could not list a model's equations.
+#[derive(Debug, Clone, thiserror::Error)]
+#[non_exhaustive]
+pub enum ListingError {
+    /// The file has mistakes (located diagnostics).
+    #[error("{} error(s) in the model file", .0.len())]
+    Diagnostics(Vec<Diagnostic>),
+    /// Momentum balance was asked of a model it cannot derive.
+    #[error(
+        "`{model}` has no bodies or writes `kinetic:`, which momentum balance cannot derive from; use the Lagrange derivation"
+    )]
+    NoMomentumForm {
+        /// The model's name.
+        model: String,
+    },
+}
+
+/// Loads the model file `text` (`path` names it in diagnostics) and derives its equations
+/// by `derivation`.
+///
+/// # Errors
+/// [`ListingError::Diagnostics`] for a file with mistakes, [`ListingError::NoMomentumForm`]
+/// for momentum balance on a model written in energy form or without bodies.
+///
+/// # Examples
+/// ```
+/// use eomgen::listing::{Derivation, equations};
+/// let text = eomgen::models::find("simple_pendulum").unwrap().source;
+/// let listing = equations("simple_pendulum.yaml", text, Derivation::Lagrange)?;
+/// assert_eq!(listing.equations.coordinates, ["q"]);
+/// # Ok::<(), eomgen::listing::ListingError>(())
+/// ```
+///
+/// # References
+/// Lectures 8–10 (Lagrange's equations and momentum balance as two routes to one equation).
+pub fn equations(
+    path: &str,
+    text: &str,
+    derivation: Derivation,
+) -> Result<Equations, ListingError> {
+    let file = eomgen_symbolic::model::load(path, text).map_err(ListingError::Diagnostics)?;
+    let mut model = SymbolicModel::from_file(&file).map_err(ListingError::Diagnostics)?;
+    let eom = match derivation {
+        Derivation::Lagrange => Lagrange.derive(&mut model),
+        Derivation::Momentum => {
+            if !MomentumBalance::applies_to(&model) {
+                return Err(ListingError::NoMomentumForm {
+                    model: model.name.clone(),
+                });
+            }
+            MomentumBalance.derive(&mut model)
+        }
+    };
+    Ok(Equations {
+        model: model.name.clone(),
+        method: derivation.name(),
+        equations: EquationsListing::of(&model, &eom, Syntax::Text),
+        latex: EquationsListing::of(&model, &eom, Syntax::Latex),
+        text: equations_text(&model, &eom),
+        latex_document: equations_latex(&model, &eom),
+    })
+}
