@@ -19,7 +19,10 @@ pub enum Lists {
     Plain,
     /// A non-empty list of numbers as a 1-D array (`int64` when every entry is an integer,
     /// else `float64`), a non-empty list of equal-length non-empty lists of numbers as a 2-D
-    /// array (one row per inner list); anything else as in `Plain`.
+    /// array (one row per inner list), and a table — a non-empty list of objects with the
+    /// same keys and scalar values (a study's runs) — as a dict of columns (numbers as
+    /// arrays, `None` in a column of numbers as NaN, booleans as a `bool` array, anything
+    /// else as a list); anything else as in `Plain`.
     Arrays,
 }
 
@@ -59,6 +62,11 @@ pub fn value_to_python<'py>(
                 && let Some(array) = numeric_array(py, items)?
             {
                 return Ok(array);
+            }
+            if lists == Lists::Arrays
+                && let Some(columns) = table(py, items)?
+            {
+                return Ok(columns);
             }
             let list = PyList::empty(py);
             for item in items {
@@ -111,6 +119,52 @@ fn numeric_array<'py>(py: Python<'py>, items: &[Value]) -> PyResult<Option<Bound
     let cells: Vec<Value> = rows.into_iter().flatten().cloned().collect();
     let array = flat(py, &cells)?;
     Ok(Some(array.call_method1("reshape", (items.len(), width))?))
+}
+
+/// `items` as a dict of columns, if it is a non-empty list of objects with the same keys
+/// whose values are all scalars (numbers, `null`, booleans, strings); `None` otherwise.
+fn table<'py>(py: Python<'py>, items: &[Value]) -> PyResult<Option<Bound<'py, PyAny>>> {
+    let rows: Option<Vec<&serde_json::Map<String, Value>>> =
+        items.iter().map(Value::as_object).collect();
+    let Some(rows) = rows else {
+        return Ok(None);
+    };
+    let Some(first) = rows.first() else {
+        return Ok(None);
+    };
+    let scalar = |v: &Value| !(v.is_array() || v.is_object());
+    let same = rows.iter().all(|r| {
+        r.len() == first.len() && r.iter().all(|(k, v)| first.contains_key(k) && scalar(v))
+    });
+    if !same {
+        return Ok(None);
+    }
+    let dict = PyDict::new(py);
+    for key in first.keys() {
+        let column: Vec<&Value> = rows.iter().map(|r| &r[key]).collect();
+        let numbers = column.iter().all(|v| v.is_number() || v.is_null())
+            && column.iter().any(|v| v.is_number());
+        if numbers && column.iter().all(|v| v.is_i64()) {
+            let ints: Vec<i64> = column.iter().filter_map(|v| v.as_i64()).collect();
+            dict.set_item(key, PyArray1::from_vec(py, ints))?;
+        } else if numbers {
+            let floats: Vec<f64> = column
+                .iter()
+                .map(|v| v.as_f64().unwrap_or(f64::NAN))
+                .collect();
+            dict.set_item(key, PyArray1::from_vec(py, floats))?;
+        } else if column.iter().all(|v| v.is_boolean()) {
+            let flags: Vec<bool> = column.iter().filter_map(|v| v.as_bool()).collect();
+            dict.set_item(key, PyArray1::from_vec(py, flags))?;
+        } else {
+            let list = PyList::empty(py);
+            for v in column {
+                list.append(value_to_python(py, v, Lists::Plain)?)?;
+            }
+            dict.set_item(key, list)?;
+        }
+    }
+    Ok(Some(dict.into_any()))
 }
 
 /// Numbers as a 1-D array: `int64` when every one is an integer, else `float64`.

@@ -13,6 +13,7 @@ docs/python.md.
 """
 
 from ._eomgen import __version__
+from . import sweep
 from ._model import (
     METHODS,
     Batch,
@@ -42,4 +43,5 @@ __all__ = [
     "__version__",
     "bundled_models",
     "load",
+    "sweep",
 ]

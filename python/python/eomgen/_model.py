@@ -497,6 +497,9 @@ class Solution:
         self.lagrange_multipliers = result.get("lagrange_multipliers")
         self._solved = result.get("multipliers_solved")
         self.constraint_drift = result.get("constraint_drift")
+        #: The wall time (s) of the library's simulation call alone (instance, integration,
+        #: energy and drift measures), without the binding's conversions.
+        self.library_time_s = result.get("library_time_s")
         self._summary = None
 
     @property

@@ -1,0 +1,429 @@
+"""The Python API against closed forms, independent derivations and the command line's JSON.
+
+Tolerances: results computed by the same library call as the command line's are compared
+exactly (the JSON prints the shortest decimal that reads back to the same f64); results
+against closed forms at the analysis' own accuracy (stated per test).
+"""
+
+import json
+import math
+import pickle
+import subprocess
+import threading
+import time
+
+import numpy as np
+import pytest
+
+import eomgen
+
+
+def run_cli(cli, *args):
+    """`eomgen ARGS --json`, parsed (the exit status is returned too)."""
+    out = subprocess.run([cli, *args, "--json"], capture_output=True, text=True, timeout=600)
+    return out.returncode, json.loads(out.stdout)
+
+
+# --- opening models --------------------------------------------------------------------------
+
+
+def test_bundled_model_names_parameters_and_coordinates():
+    m = eomgen.load("double_pendulum")
+    assert m.name == "double_pendulum"
+    assert m.coordinates == ["theta1", "theta2"]
+    assert m.parameters == {"m1": 1.0, "m2": 1.0, "l1": 1.0, "l2": 1.0, "g": 10.0}
+    assert m.num_dofs == 2
+    assert "double_pendulum" in eomgen.bundled_models()
+    assert m.path == "models/double_pendulum.yaml"
+
+
+def test_a_file_runs_the_same_bits_as_the_bundled_model(model_file):
+    bundled = eomgen.load("double_pendulum")
+    loaded = eomgen.load(model_file("double_pendulum"))
+    assert loaded.path.endswith("double_pendulum.yaml") and loaded.path != bundled.path
+    a = bundled.simulate(t_end=2.0, rtol=1e-10, atol=1e-10)
+    b = loaded.simulate(t_end=2.0, rtol=1e-10, atol=1e-10)
+    assert np.array_equal(a.t, b.t) and np.array_equal(a.y, b.y)
+
+
+def test_with_parameters_returns_a_copy():
+    m = eomgen.load("simple_pendulum")
+    name = next(iter(m.parameters))
+    m2 = m.with_parameters({name: 2.5})
+    assert m2.parameters[name] == 2.5
+    assert m.parameters[name] != 2.5
+    assert m2.with_parameters(**{name: 3.0}).parameters[name] == 3.0
+
+
+def test_an_unknown_or_non_finite_parameter_raises():
+    m = eomgen.load("double_pendulum")
+    with pytest.raises(eomgen.ParameterError, match="no_such"):
+        m.with_parameters(no_such=1.0)
+    with pytest.raises(eomgen.ParameterError, match="finite"):
+        m.with_parameters(g=float("nan"))
+    with pytest.raises(ValueError):  # ParameterError is a ValueError
+        m.with_parameters(g=float("inf"))
+
+
+def test_an_unknown_name_raises_model_error():
+    with pytest.raises(eomgen.ModelError, match="double_pendulm") as info:
+        eomgen.load("double_pendulm")
+    assert "double_pendulum" in str(info.value)  # the suggestion
+    assert info.value.diagnostics == []
+
+
+def test_a_broken_file_raises_located_diagnostics(model_file, cli):
+    text = eomgen.load("simple_pendulum").text
+    broken = text.replace("coordinates:", "coordinates:\n  - q\n  - q\nbogus_key: 1\ncoordinates_x:", 1)
+    path = model_file("broken", broken)
+    with pytest.raises(eomgen.ModelError) as info:
+        eomgen.load(path)
+    diagnostics = info.value.diagnostics
+    assert diagnostics, "a broken file must carry its diagnostics"
+    for d in diagnostics:
+        assert d["file"] == path
+        assert d["line"] >= 1 and d["column"] >= 1
+        assert d["message"]
+    # The same diagnostics as the command line's JSON error.
+    status, cli_json = run_cli(cli, "check", path)
+    assert status == 2
+    assert cli_json["diagnostics"] == diagnostics
+
+
+# --- simulation --------------------------------------------------------------------------------
+
+
+def test_simulate_shapes_and_output_times():
+    m = eomgen.load("double_pendulum")
+    sol = m.simulate(t_end=10.0, t_out=[1.0, 2.0, 5.0], method="dop853", rtol=1e-12, atol=1e-12)
+    assert sol.t.tolist() == [1.0, 2.0, 5.0]
+    assert sol.q.shape == (3, 2) and sol.qdot.shape == (3, 2) and sol.energy.shape == (3,)
+    assert sol.y.shape == (3, 4)
+    assert set(sol.stats) >= {"steps", "rejected", "rhs_evals"}
+    # A conservative model at 1e-12: the energy stays put to well below 1e-9 relative.
+    assert abs(sol.energy[-1] - sol.energy[0]) <= 1e-9 * abs(sol.energy[0]) + 1e-9
+
+
+def test_simulate_equals_the_command_line_json(cli):
+    m = eomgen.load("double_pendulum")
+    sol = m.simulate(t_end=3.0, method="dop853", rtol=1e-10, atol=1e-10)
+    status, expected = run_cli(cli, "simulate", "double_pendulum", "--t-end", "3", "--method", "dop853",
+                               "--rtol", "1e-10", "--atol", "1e-10")
+    assert status == 0
+    got = json.loads(json.dumps(sol.summary))
+    got["stats"].pop("wall_time_s")
+    assert got == expected
+
+
+def test_simulate_defaults_are_the_command_line_defaults(cli):
+    sol = eomgen.load("simple_pendulum").simulate()
+    status, expected = run_cli(cli, "simulate", "simple_pendulum")
+    assert status == 0
+    got = json.loads(json.dumps(sol.summary))
+    got["stats"].pop("wall_time_s")
+    assert got == expected
+
+
+def test_a_constrained_model_gives_multipliers_and_drift(cli):
+    m = eomgen.load("four_bar")
+    sol = m.simulate(t_end=1.0, t_out=[0.5, 1.0], stabilization="projection")
+    assert sol.lagrange_multipliers.shape[0] == 2
+    assert sol.constraint_drift.shape == (2, 2)
+    status, expected = run_cli(cli, "simulate", "four_bar", "--t-end", "1", "--t-out", "0.5,1",
+                               "--stabilization", "projection")
+    assert status == 0
+    got = json.loads(json.dumps(sol.summary))
+    got["stats"].pop("wall_time_s")
+    assert got == expected
+
+
+def test_initial_values_by_name():
+    m = eomgen.load("double_pendulum")
+    y0 = m.initial_state({"theta1": 0.25, "theta2_dot": -1.0})
+    assert y0[0] == 0.25 and y0[3] == -1.0
+    sol = m.simulate(t_end=0.5, t_out=[0.0, 0.5], initial={"theta1": 0.25, "theta2_dot": -1.0})
+    assert np.array_equal(sol.y[0], y0)
+    with pytest.raises(ValueError, match="theta3"):
+        m.initial_state({"theta3": 1.0})
+
+
+def test_events_stop_a_run():
+    # A pendulum released at 0.5 rad turns back at -0.5 rad after half a period.
+    m = eomgen.load("simple_pendulum")
+    sol = m.simulate(t_end=10.0, initial=[0.5, 0.0], stop_when=["q_dot = 0, rising"], rtol=1e-12, atol=1e-12)
+    assert len(sol.events) == 1
+    # Energy conservation: the turning points lie symmetrically about the hanging position.
+    hanging = m.modes(at="hanging").equilibrium[0]
+    assert abs((sol.events[0]["q"][0] + 0.5) / 2 - hanging) < 1e-9
+
+
+def test_a_failing_integration_raises_with_the_partial_solution():
+    m = eomgen.load("triple_pendulum")
+    with pytest.raises(eomgen.IntegrationError) as info:
+        m.simulate(method="rk4", dt=0.5)
+    e = info.value
+    assert e.t is not None and 0 < e.t < 10.0
+    assert "triple_pendulum" in str(e) and e.reason
+    assert isinstance(e.solution, eomgen.Solution)
+    assert len(e.solution.t) >= 1 and e.solution.t[-1] <= e.t
+    assert np.all(np.isfinite(e.solution.y))
+
+
+def test_bad_options_raise_value_errors():
+    m = eomgen.load("simple_pendulum")
+    with pytest.raises(ValueError, match="dp54"):
+        m.simulate(method="no-such-method")
+    with pytest.raises(ValueError):
+        m.simulate(t_end=-1.0)
+    with pytest.raises(ValueError):
+        m.simulate(rtol=2.0)
+    with pytest.raises(ValueError):
+        m.simulate(t_out=[2.0, 1.0])
+
+
+# --- evaluations --------------------------------------------------------------------------------
+
+
+def test_mass_matrix_and_forcing_equal_the_hand_derivation():
+    # HW19's double pendulum derived by hand (tools/double_pendulum_reference.py): two uniform
+    # bars, absolute angles from +x, gravity −y.
+    m = eomgen.load("double_pendulum")
+    p = m.parameters
+    m1, m2, l1, l2, g = p["m1"], p["m2"], p["l1"], p["l2"], p["g"]
+    rng = np.random.default_rng(5)
+    for _ in range(10):
+        t1, t2, w1, w2 = rng.uniform(-3, 3, 4)
+        mass = m.mass_matrix([t1, t2])
+        expected = np.array([[m1 * l1**2 / 3 + m2 * l1**2, m2 * l1 * l2 / 2 * math.cos(t1 - t2)],
+                             [m2 * l1 * l2 / 2 * math.cos(t1 - t2), m2 * l2**2 / 3]])
+        np.testing.assert_allclose(mass, expected, rtol=1e-14, atol=1e-14)
+        forcing = m.forcing([t1, t2], [w1, w2])
+        f1 = -m2 * l1 * l2 / 2 * math.sin(t1 - t2) * w2**2 - (m1 / 2 + m2) * g * l1 * math.cos(t1)
+        f2 = m2 * l1 * l2 / 2 * math.sin(t1 - t2) * w1**2 - m2 * g * l2 / 2 * math.cos(t2)
+        np.testing.assert_allclose(forcing, [f1, f2], rtol=1e-13, atol=1e-12)
+        dy = m.rhs(0.0, [t1, t2, w1, w2])
+        np.testing.assert_allclose(dy[:2], [w1, w2], rtol=0, atol=0)
+        np.testing.assert_allclose(dy[2:], np.linalg.solve(expected, [f1, f2]), rtol=1e-12, atol=1e-12)
+
+
+def test_rhs_drives_scipy_to_the_same_answer():
+    scipy_integrate = pytest.importorskip("scipy.integrate")
+    m = eomgen.load("double_pendulum")
+    y0 = m.initial_state()
+    ours = m.simulate(t_end=2.0, t_out=[2.0], method="dop853", rtol=1e-12, atol=1e-12)
+    theirs = scipy_integrate.solve_ivp(m.rhs, (0.0, 2.0), y0, method="DOP853", rtol=1e-12, atol=1e-12)
+    # Two integrators at 1e-12 over a chaotic 2 s: agreement to 1e-7 (their own errors).
+    np.testing.assert_allclose(theirs.y[:, -1], ours.y[-1], rtol=0, atol=1e-7)
+
+
+def test_wrong_lengths_raise():
+    m = eomgen.load("double_pendulum")
+    with pytest.raises(ValueError):
+        m.rhs(0.0, [0.0, 1.0])
+    with pytest.raises(ValueError):
+        m.mass_matrix([0.0])
+
+
+# --- modes ----------------------------------------------------------------------------------------
+
+
+def test_modes_equal_the_closed_form_and_are_mass_normalised():
+    # HW28: three equal masses between four equal springs: ω² = (2 − √2), 2, (2 + √2) k/m.
+    m = eomgen.load("three_masses")
+    k, mass = m.parameters["k"], m.parameters["m"]
+    modes = m.modes()
+    expected = np.sqrt(np.array([2 - math.sqrt(2), 2.0, 2 + math.sqrt(2)]) * k / mass)
+    np.testing.assert_allclose(modes.natural_frequencies, expected, rtol=1e-12)
+    psi = modes.mode_shapes
+    assert psi.shape == (3, 3)
+    np.testing.assert_allclose(psi.T @ modes.mass_matrix @ psi, np.eye(3), atol=1e-12)
+    np.testing.assert_allclose(psi.T @ modes.stiffness_matrix @ psi, np.diag(expected**2), atol=1e-12)
+
+
+def test_modes_equal_the_command_line_json(cli):
+    m = eomgen.load("double_pendulum")
+    modes = m.modes(at="hanging")
+    status, expected = run_cli(cli, "modes", "double_pendulum", "--at", "hanging")
+    assert status == 0
+    expected.pop("charts")
+    expected.pop("animation")
+    assert json.loads(json.dumps(modes.summary)) == expected
+
+
+def test_modes_from_a_guess_and_at_a_steady_motion():
+    m = eomgen.load("simple_pendulum")
+    hanging = m.modes()
+    guessed = m.modes(at={m.coordinates[0]: 0.1})
+    np.testing.assert_allclose(guessed.natural_frequencies, hanging.natural_frequencies, rtol=1e-12)
+    with pytest.raises(eomgen.AnalysisError):
+        eomgen.load("cannonball").modes()
+    steady = eomgen.load("chaplygin_sleigh").modes()
+    assert isinstance(steady, eomgen.SteadyMotion)
+    assert steady.eigenvalues.size >= 1
+
+
+# --- derivations -------------------------------------------------------------------------------
+
+
+def test_check_equals_the_command_line_json(cli):
+    m = eomgen.load("double_pendulum_points")
+    report = m.check()
+    assert report["passed"] is True
+    status, expected = run_cli(cli, "check", "double_pendulum_points")
+    assert status == 0
+    assert report == expected
+
+
+def test_equations_as_text_and_latex(cli):
+    m = eomgen.load("double_pendulum")
+    text = m.equations()
+    out = subprocess.run([cli, "equations", "double_pendulum"], capture_output=True, text=True, timeout=600)
+    assert out.returncode == 0
+    assert text + "\n" == out.stdout or text == out.stdout
+    latex = m.equations(latex=True)
+    assert "\\" in latex and latex._repr_latex_() == latex.latex
+    assert text._repr_latex_() == latex.latex
+    status, expected = run_cli(cli, "equations", "double_pendulum")
+    assert status == 0 and text.listing == expected
+    with pytest.raises(ValueError, match="momentum"):
+        eomgen.load("simple_pendulum").equations(method="momentum")
+
+
+# --- pickling ------------------------------------------------------------------------------------
+
+
+def test_models_pickle_by_text_and_parameters(model_file, tmp_path):
+    m = eomgen.load("double_pendulum").with_parameters(g=9.81)
+    m2 = pickle.loads(pickle.dumps(m))
+    assert m2 == m and m2.parameters["g"] == 9.81
+    a, b = m.simulate(t_end=1.0), m2.simulate(t_end=1.0)
+    assert np.array_equal(a.y, b.y)
+    # A file's model travels as its text: the file may be gone when it is unpickled.
+    path = model_file("simple_pendulum")
+    f = eomgen.load(path).with_parameters(g=3.0)
+    data = pickle.dumps(f)
+    (tmp_path / "simple_pendulum.yaml").unlink()
+    f2 = pickle.loads(data)
+    assert f2.parameters["g"] == 3.0 and f2.path == path
+    assert np.array_equal(f.simulate(t_end=1.0).y, f2.simulate(t_end=1.0).y)
+
+
+def test_exceptions_pickle_with_their_attributes():
+    try:
+        eomgen.load("triple_pendulum").simulate(method="rk4", dt=0.5)
+    except eomgen.IntegrationError as e:
+        e2 = pickle.loads(pickle.dumps(e))
+        assert (e2.t, e2.reason, str(e2)) == (e.t, e.reason, str(e))
+        assert np.array_equal(e2.solution.y, e.solution.y)
+    error = eomgen.ModelError("bad", [{"file": "f", "line": 1, "column": 2, "message": "m", "help": None}])
+    again = pickle.loads(pickle.dumps(error))
+    assert again.diagnostics == error.diagnostics and str(again) == "bad"
+
+
+# --- batches -------------------------------------------------------------------------------------
+
+
+def test_simulate_many_equals_the_serial_loop_bit_for_bit():
+    m = eomgen.load("double_pendulum")
+    y0 = m.initial_state()
+    states = np.tile(y0, (24, 1))
+    states[:, 0] += np.linspace(-0.3, 0.3, 24)
+    batch = m.simulate_many(initial_states=states, t_end=2.0, t_out=[1.0, 2.0], rtol=1e-10, atol=1e-10)
+    assert batch.y.shape == (24, 2, 4) and batch.q.shape == (24, 2, 2) and batch.energy.shape == (24, 2)
+    assert batch.ok.all() and not batch.failures
+    for i, state in enumerate(states):
+        serial = m.simulate(t_end=2.0, t_out=[1.0, 2.0], initial=state, rtol=1e-10, atol=1e-10)
+        assert np.array_equal(batch.y[i], serial.y), i
+        assert batch.stats["steps"][i] == serial.stats["steps"]
+    one_thread = m.simulate_many(initial_states=states, t_end=2.0, t_out=[1.0, 2.0], rtol=1e-10, atol=1e-10, threads=1)
+    assert np.array_equal(one_thread.y, batch.y)
+
+
+def test_simulate_many_over_parameters():
+    m = eomgen.load("simple_pendulum")
+    gs = np.array([1.0, 4.0, 9.0])
+    batch = m.simulate_many(parameters={"g": gs}, t_end=1.0)
+    for i, g in enumerate(gs):
+        assert np.array_equal(batch.y[i], m.with_parameters(g=g).simulate(t_end=1.0, t_out=[1.0]).y)
+    with pytest.raises(eomgen.ParameterError):
+        m.simulate_many(parameters=[{"nope": 1.0}], t_end=1.0)
+    with pytest.raises(ValueError):
+        m.simulate_many(t_end=1.0)
+
+
+def test_simulate_many_keeps_or_raises_failures():
+    m = eomgen.load("triple_pendulum")
+    y0 = m.initial_state()
+    with pytest.raises(eomgen.IntegrationError):
+        m.simulate_many(initial_states=[y0, y0], method="rk4", dt=0.5)
+    batch = m.simulate_many(initial_states=[y0, y0], method="rk4", dt=0.5, errors="keep")
+    assert not batch.ok.any() and len(batch.failures) == 2
+    assert np.isnan(batch.y[:, -1]).all()
+
+
+def test_long_calls_release_the_interpreter():
+    # While one thread integrates, another must run Python: with the interpreter held for
+    # the whole call, no bytecode of the main thread could run inside the call's interval.
+    m = eomgen.load("double_pendulum")
+    states = np.tile(m.initial_state(), (400, 1))
+    interval = {}
+
+    def work():
+        interval["start"] = time.perf_counter()
+        m.simulate_many(initial_states=states, t_end=10.0, rtol=1e-11, atol=1e-11, threads=1)
+        interval["end"] = time.perf_counter()
+
+    worker = threading.Thread(target=work)
+    worker.start()
+    ticks = []
+    while worker.is_alive():
+        ticks.append(time.perf_counter())
+    worker.join()
+    start, end = interval["start"], interval["end"]
+    inside = [t for t in ticks if start + 0.1 * (end - start) < t < end - 0.1 * (end - start)]
+    assert inside, f"no Python ran in the main thread during a {end - start:.3f} s call"
+
+
+# --- studies -----------------------------------------------------------------------------------
+
+
+def test_frf_equals_the_closed_form():
+    # m x'' + c x' + k x = A cos wt: |X/A| = (1/k)/sqrt((1 − r²)² + (2ζr)²).
+    m = eomgen.load("forced_oscillator")
+    p = m.parameters
+    zeta = p["c"] / (2 * math.sqrt(p["k"] * p["m"]))
+    wn = math.sqrt(p["k"] / p["m"])
+    report = m.frf("A", frequencies=[0.5, 1.0, 2.0], points=50)
+    assert isinstance(report["frequencies"], np.ndarray) and report["frequencies"].shape == (50,)
+    for e in report["evaluations"]:
+        r = e["frequency"] / wn
+        expected = (1 / p["k"]) / math.sqrt((1 - r**2) ** 2 + (2 * zeta * r) ** 2)
+        assert abs(e["response"]["x"]["amplitude"] - expected) < 1e-12 * expected
+
+
+def test_parameter_sweep_finds_the_rolling_disc_critical_speed():
+    # The rolling disc upright is stable above v = sqrt(g r / 3).
+    m = eomgen.load("rolling_disc")
+    steady = next(name for name in m.description()["equilibria"])
+    names = [n for n in m.parameters if n in ("v", "speed", "v0")]
+    if not names:
+        pytest.skip("rolling_disc names its speed otherwise")
+    report = m.parameter_sweep(names[0], np.linspace(0.2, 2.0, 10), at=steady)
+    changes = report["stability_changes"]
+    assert changes
+    r, g = m.parameters.get("r"), m.parameters.get("g")
+    critical = math.sqrt(g * r / 3)
+    assert min(abs(c["value"] - critical) for c in changes) < 1e-9
+
+
+def test_work_precision_errors_fall_with_the_tolerance():
+    m = eomgen.load("simple_pendulum")
+    report = m.work_precision(methods=["dp54", "rk4"], tolerances=[1e-4, 1e-8], steps=[100, 1000], t_end=2.0,
+                              samples=10, repeats=1, min_time_s=0.0)
+    by_method = {entry["method"]: entry["runs"] for entry in report["methods"]}
+    dp54, rk4 = by_method["dp54"], by_method["rk4"]
+    # The runs come as columns (dict of arrays).
+    assert isinstance(dp54["error"], np.ndarray) and dp54["tol"].tolist() == [1e-4, 1e-8]
+    assert dp54["error"][1] < dp54["error"][0]
+    # RK4 over 10x more steps: the error falls by about 10^4 (order 4); at least 10^3.
+    assert rk4["error"][1] < rk4["error"][0] / 1e3
