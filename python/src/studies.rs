@@ -88,9 +88,12 @@ fn study_parameter_sweep<'py>(
     at: Option<&Bound<'py, PyAny>>,
     refine: bool,
 ) -> PyResult<Bound<'py, PyAny>> {
-    if values.is_empty() || values.windows(2).any(|w| !(w[0] < w[1])) {
+    let ascending = values
+        .windows(2)
+        .all(|w| w[0].partial_cmp(&w[1]) == Some(std::cmp::Ordering::Less));
+    if values.is_empty() || !ascending || values.iter().any(|v| !v.is_finite()) {
         return Err(pyo3::exceptions::PyValueError::new_err(
-            "values must be a non-empty, strictly ascending sequence",
+            "values must be a non-empty, strictly ascending sequence of finite numbers",
         ));
     }
     let options = ParameterSweepOptions {
