@@ -3,7 +3,7 @@
 //! line's `--json` prints it, with numeric lists as numpy arrays.
 
 use eomgen::analysis::vibration::{
-    self, FrfOptions, OperatingPointOptions, ParameterSweepOptions, SweepAxis,
+    self, FloquetStudyOptions, FrfOptions, OperatingPointOptions, ParameterSweepOptions, SweepAxis,
 };
 use eomgen::analysis::{WorkPrecisionOptions, work_precision};
 use pyo3::prelude::*;
@@ -17,6 +17,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(study_work_precision, m)?)?;
     m.add_function(wrap_pyfunction!(study_parameter_sweep, m)?)?;
     m.add_function(wrap_pyfunction!(study_frf, m)?)?;
+    m.add_function(wrap_pyfunction!(study_floquet, m)?)?;
     Ok(())
 }
 
@@ -156,4 +157,40 @@ fn study_frf<'py>(
         &analysis.summary(instance.as_ref(), None),
         Lists::Arrays,
     )
+}
+
+/// The Floquet multipliers of a periodically forced model about its equilibrium
+/// (`eomgen study floquet`, without the stability chart).
+#[pyfunction]
+#[pyo3(signature = (model, period_parameter = None, at = None, rtol = None, atol = None, stability_tolerance = None))]
+fn study_floquet<'py>(
+    py: Python<'py>,
+    model: &CoreModel,
+    period_parameter: Option<String>,
+    at: Option<&Bound<'py, PyAny>>,
+    rtol: Option<f64>,
+    atol: Option<f64>,
+    stability_tolerance: Option<f64>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let defaults = FloquetStudyOptions::default();
+    let options = FloquetStudyOptions {
+        operating_point: OperatingPointOptions {
+            start: equilibrium_start(at, None)?,
+            t: 0.0,
+        },
+        period_parameter: period_parameter.unwrap_or(defaults.period_parameter),
+        floquet: eomgen::FloquetOptions {
+            rtol: rtol.unwrap_or(defaults.floquet.rtol),
+            atol: atol.unwrap_or(defaults.floquet.atol),
+            stability_tolerance: stability_tolerance
+                .unwrap_or(defaults.floquet.stability_tolerance),
+            ..defaults.floquet
+        },
+    };
+    let mut instance = model.fresh()?;
+    let point = py
+        .detach(|| vibration::floquet_at_equilibrium(instance.as_mut(), &options))
+        .map_err(analysis_error)?;
+    let summary = point.summary(instance.as_ref(), &options, Vec::new(), None);
+    to_python(py, &summary, Lists::Arrays)
 }

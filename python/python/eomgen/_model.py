@@ -446,6 +446,24 @@ class Model:
             None if frequency_range is None else (float(frequency_range[0]), float(frequency_range[1])),
             int(points), [float(f) for f in frequencies], bool(modal), at_arg)
 
+    def floquet(self, period_parameter: Optional[str] = None, at: Optional[Union[str, ArrayLike]] = None,
+                rtol: Optional[float] = None, atol: Optional[float] = None,
+                stability_tolerance: Optional[float] = None) -> dict:
+        """The Floquet analysis of a periodically forced model about its equilibrium
+        (``eomgen study floquet``): the monodromy matrix over one period ``T = 2π/w`` of the
+        forcing frequency parameter ``period_parameter`` (default ``w``), integrated with its
+        variational equations by DOP853 at ``rtol``/``atol`` (default 1e-12), its multipliers
+        ``μ`` and exponents, the spectral radius and the verdict (``|μ| ≤ 1`` within
+        ``stability_tolerance``, default 1e-6). Returns the ``--json`` report with numeric
+        lists as numpy arrays.
+
+        Raises:
+            AnalysisError: an unknown period parameter, a model that does not depend on
+                ``t``, no equilibrium that stays one over the period.
+        """
+        at_arg = at if (at is None or isinstance(at, str)) else [float(v) for v in np.asarray(at).reshape(-1)]
+        return _eomgen.study_floquet(self._core, period_parameter, at_arg, rtol, atol, stability_tolerance)
+
     # --- Python protocols --------------------------------------------------------------
 
     def __reduce__(self):
