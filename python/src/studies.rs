@@ -3,7 +3,8 @@
 //! line's `--json` prints it, with numeric lists as numpy arrays.
 
 use eomgen::analysis::vibration::{
-    self, FloquetStudyOptions, FrfOptions, OperatingPointOptions, ParameterSweepOptions, SweepAxis,
+    self, FloquetStudyOptions, FreeResponseOptions, FrfOptions, InitialDeviation,
+    ModalDampingOptions, OperatingPointOptions, ParameterSweepOptions, SweepAxis,
 };
 use eomgen::analysis::{WorkPrecisionOptions, work_precision};
 use pyo3::prelude::*;
@@ -18,6 +19,8 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(study_parameter_sweep, m)?)?;
     m.add_function(wrap_pyfunction!(study_frf, m)?)?;
     m.add_function(wrap_pyfunction!(study_floquet, m)?)?;
+    m.add_function(wrap_pyfunction!(study_free_response, m)?)?;
+    m.add_function(wrap_pyfunction!(study_modal_damping, m)?)?;
     Ok(())
 }
 
@@ -193,4 +196,83 @@ fn study_floquet<'py>(
         .map_err(analysis_error)?;
     let summary = point.summary(instance.as_ref(), &options, Vec::new(), None);
     to_python(py, &summary, Lists::Arrays)
+}
+
+/// An initial deviation `(δq₀, δq̇₀)` from keyword arguments: both or neither.
+fn deviation(q: Option<Vec<f64>>, qdot: Option<Vec<f64>>, n: usize) -> Option<InitialDeviation> {
+    match (q, qdot) {
+        (None, None) => None,
+        (q, qdot) => Some(InitialDeviation {
+            q: q.unwrap_or_else(|| vec![0.0; n]),
+            qdot: qdot.unwrap_or_else(|| vec![0.0; n]),
+        }),
+    }
+}
+
+/// The free response about an equilibrium four ways: superposed modes, `e^{At}`, the
+/// linearised and the nonlinear equations integrated (`eomgen study free-response`).
+#[pyfunction]
+#[allow(clippy::too_many_arguments)]
+#[pyo3(signature = (model, at = None, dq0 = None, dqdot0 = None, t_end = None, samples = FreeResponseOptions::DEFAULT_SAMPLES, tol = FreeResponseOptions::DEFAULT_TOL))]
+fn study_free_response<'py>(
+    py: Python<'py>,
+    model: &CoreModel,
+    at: Option<&Bound<'py, PyAny>>,
+    dq0: Option<Vec<f64>>,
+    dqdot0: Option<Vec<f64>>,
+    t_end: Option<f64>,
+    samples: usize,
+    tol: f64,
+) -> PyResult<Bound<'py, PyAny>> {
+    let mut instance = model.fresh()?;
+    let options = FreeResponseOptions {
+        operating_point: OperatingPointOptions {
+            start: equilibrium_start(at, None)?,
+            t: 0.0,
+        },
+        initial: deviation(dq0, dqdot0, instance.num_dofs()),
+        t_end,
+        samples,
+        tol,
+    };
+    let model_ref = &mut instance;
+    let study = py
+        .detach(move || vibration::free_response(model_ref.as_ref(), &options))
+        .map_err(analysis_error)?;
+    to_python(py, &study.summary(instance.as_ref()), Lists::Arrays)
+}
+
+/// Modal damping against the exact damped response, with a Rayleigh fit to two modes
+/// (`eomgen study modal-damping`).
+#[pyfunction]
+#[allow(clippy::too_many_arguments)]
+#[pyo3(signature = (model, at = None, rayleigh_modes = None, dq0 = None, dqdot0 = None, t_end = None, samples = ModalDampingOptions::DEFAULT_SAMPLES, tol = ModalDampingOptions::DEFAULT_TOL))]
+fn study_modal_damping<'py>(
+    py: Python<'py>,
+    model: &CoreModel,
+    at: Option<&Bound<'py, PyAny>>,
+    rayleigh_modes: Option<[usize; 2]>,
+    dq0: Option<Vec<f64>>,
+    dqdot0: Option<Vec<f64>>,
+    t_end: Option<f64>,
+    samples: usize,
+    tol: f64,
+) -> PyResult<Bound<'py, PyAny>> {
+    let mut instance = model.fresh()?;
+    let options = ModalDampingOptions {
+        operating_point: OperatingPointOptions {
+            start: equilibrium_start(at, None)?,
+            t: 0.0,
+        },
+        rayleigh_modes,
+        initial: deviation(dq0, dqdot0, instance.num_dofs()),
+        t_end,
+        samples,
+        tol,
+    };
+    let model_ref = &mut instance;
+    let study = py
+        .detach(move || vibration::modal_damping_study(model_ref.as_ref(), &options))
+        .map_err(analysis_error)?;
+    to_python(py, &study.summary(instance.as_ref()), Lists::Arrays)
 }

@@ -427,3 +427,37 @@ def test_work_precision_errors_fall_with_the_tolerance():
     assert dp54["error"][1] < dp54["error"][0]
     # RK4 over 10x more steps: the error falls by about 10^4 (order 4); at least 10^3.
     assert rk4["error"][1] < rk4["error"][0] / 1e3
+
+
+def test_floquet_multipliers_of_the_mathieu_pendulum(cli):
+    # Undamped and Hamiltonian: det Φ(T) = exp(∫ tr A dt) = 1 (Liouville), so the multipliers'
+    # product is 1; at the file's values the shaken upright pendulum is stable.
+    m = eomgen.load("mathieu_pendulum")
+    report = m.floquet()
+    mu = report["multipliers"]["re"] + 1j * report["multipliers"]["im"]
+    assert abs(np.prod(mu) - 1.0) < 1e-9
+    assert report["spectral_radius"] <= 1.0 + 1e-6 and report["stable"]
+    status, expected = run_cli(cli, "study", "floquet", "mathieu_pendulum")
+    assert status == 0
+    for key in ("multipliers", "monodromy_matrix", "spectral_radius", "period", "determinant"):
+        got = report[key]
+        want = expected[key]
+        if isinstance(got, dict):  # a table comes as columns; the JSON has rows
+            for part in got:
+                np.testing.assert_array_equal(np.asarray(got[part]), np.asarray([row[part] for row in want]))
+        else:
+            np.testing.assert_array_equal(np.asarray(got), np.asarray(want))
+
+
+def test_free_response_four_ways_agree():
+    # Superposed modes two ways, e^{At} and DOP853 on the linearisation: the same response
+    # (HW28), to the integration's tolerance.
+    report = eomgen.load("three_masses").free_response()
+    assert report["max_differences"]["displacement_relative"].max() < 1e-9
+    assert report["max_differences"]["velocity_relative"].max() < 1e-9
+
+
+def test_modal_damping_integration_agrees_with_the_exact_response():
+    report = eomgen.load("three_masses_damped").modal_damping()
+    for case in report["cases"]:
+        assert case["integration_vs_exact"] < 1e-8

@@ -427,9 +427,8 @@ class Model:
             ParameterError: an unknown parameter.
             AnalysisError: no value of the sweep could be analysed.
         """
-        at_arg = at if (at is None or isinstance(at, str)) else [float(v) for v in np.asarray(at).reshape(-1)]
         return _eomgen.study_parameter_sweep(
-            self._core, str(parameter), [float(v) for v in np.atleast_1d(values)], at_arg, bool(refine))
+            self._core, str(parameter), [float(v) for v in np.atleast_1d(values)], _at(at), bool(refine))
 
     def frf(self, input: str, outputs: Sequence[str] = (), frequency_range: Optional[Tuple[float, float]] = None,
             points: int = 400, frequencies: Sequence[float] = (), modal: bool = False,
@@ -440,11 +439,10 @@ class Model:
         frequencies (rad/s) in ``frequency_range`` (default: a decade around the natural
         frequencies), with the peaks, and at ``frequencies``. Returns the ``--json``
         report with numeric lists as numpy arrays."""
-        at_arg = at if (at is None or isinstance(at, str)) else [float(v) for v in np.asarray(at).reshape(-1)]
         return _eomgen.study_frf(
             self._core, str(input), [str(o) for o in outputs],
             None if frequency_range is None else (float(frequency_range[0]), float(frequency_range[1])),
-            int(points), [float(f) for f in frequencies], bool(modal), at_arg)
+            int(points), [float(f) for f in frequencies], bool(modal), _at(at))
 
     def floquet(self, period_parameter: Optional[str] = None, at: Optional[Union[str, ArrayLike]] = None,
                 rtol: Optional[float] = None, atol: Optional[float] = None,
@@ -461,8 +459,31 @@ class Model:
             AnalysisError: an unknown period parameter, a model that does not depend on
                 ``t``, no equilibrium that stays one over the period.
         """
-        at_arg = at if (at is None or isinstance(at, str)) else [float(v) for v in np.asarray(at).reshape(-1)]
-        return _eomgen.study_floquet(self._core, period_parameter, at_arg, rtol, atol, stability_tolerance)
+        return _eomgen.study_floquet(self._core, period_parameter, _at(at), rtol, atol, stability_tolerance)
+
+    def free_response(self, at: Optional[Union[str, ArrayLike]] = None, dq0: Optional[ArrayLike] = None,
+                      dqdot0: Optional[ArrayLike] = None, t_end: Optional[float] = None, samples: int = 401,
+                      tol: float = 1e-13) -> dict:
+        """The free response about an equilibrium from a deviation ``(dq0, dqdot0)`` (default
+        0.1 in every coordinate, at rest), four ways: superposed normal modes, ``e^{At}``,
+        the linearised and the nonlinear equations integrated by DOP853 at ``tol``, on
+        ``samples`` times over ``[0, t_end]`` (default: four periods of the slowest mode)
+        (``eomgen study free-response``; HW28). Returns the ``--json`` report with numeric
+        lists as numpy arrays."""
+        return _eomgen.study_free_response(self._core, _at(at), _floats(dq0), _floats(dqdot0), t_end,
+                                           int(samples), float(tol))
+
+    def modal_damping(self, at: Optional[Union[str, ArrayLike]] = None,
+                      rayleigh_modes: Optional[Tuple[int, int]] = None, dq0: Optional[ArrayLike] = None,
+                      dqdot0: Optional[ArrayLike] = None, t_end: Optional[float] = None, samples: int = 801,
+                      tol: float = 1e-12) -> dict:
+        """Modal damping against the exact damped response, and Rayleigh damping fitted to
+        two modes (1-based ``rayleigh_modes``; default the slowest and fastest oscillatory
+        ones) (``eomgen study modal-damping``; HW34). Returns the ``--json`` report with
+        numeric lists as numpy arrays."""
+        modes = None if rayleigh_modes is None else (int(rayleigh_modes[0]), int(rayleigh_modes[1]))
+        return _eomgen.study_modal_damping(self._core, _at(at), modes, _floats(dq0), _floats(dqdot0), t_end,
+                                           int(samples), float(tol))
 
     # --- Python protocols --------------------------------------------------------------
 
@@ -573,6 +594,18 @@ class Solution:
         return (f"eomgen.Solution({self.summary_header['model']!r}, {len(self.t)} samples, "
                 f"t = {self.t[0] if len(self.t) else '-'} … {self.t[-1] if len(self.t) else '-'}, "
                 f"{self.stats['steps']} steps)")
+
+
+def _at(at):
+    """An operating point argument for the library: ``None``, a name, or ``n`` values."""
+    if at is None or isinstance(at, str):
+        return at
+    return [float(v) for v in np.asarray(at, dtype=float).reshape(-1)]
+
+
+def _floats(values):
+    """``None`` or a list of floats."""
+    return None if values is None else [float(v) for v in np.asarray(values, dtype=float).reshape(-1)]
 
 
 def _json_number(x: float) -> Optional[float]:
