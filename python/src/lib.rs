@@ -19,6 +19,8 @@ fn _eomgen(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<model::CoreModel>()?;
     m.add_function(wrap_pyfunction!(batch::simulate_many, m)?)?;
     m.add_function(wrap_pyfunction!(bundled_models, m)?)?;
+    m.add_function(wrap_pyfunction!(methods, m)?)?;
+    m.add_function(wrap_pyfunction!(simulation_defaults, m)?)?;
     studies::register(m)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
@@ -28,4 +30,25 @@ fn _eomgen(m: &Bound<'_, PyModule>) -> PyResult<()> {
 #[pyfunction]
 fn bundled_models() -> Vec<&'static str> {
     eomgen::models::ALL.iter().map(|e| e.name).collect()
+}
+
+/// The integration methods' names (`Method::ALL`, in its order).
+#[pyfunction]
+fn methods() -> Vec<&'static str> {
+    eomgen::Method::ALL.iter().map(|m| m.name()).collect()
+}
+
+/// The defaults of a simulation, those of `eomgen simulate` without options:
+/// `(t_end, method, rtol, atol, (alpha, beta))`.
+#[pyfunction]
+fn simulation_defaults() -> (f64, &'static str, f64, f64, (f64, f64)) {
+    use eomgen::analysis::SimulationOptions as Defaults;
+    let [alpha, beta] = eomgen::Stabilization::DEFAULT_BAUMGARTE_GAINS;
+    (
+        Defaults::DEFAULT_T_END,
+        Defaults::DEFAULT_METHOD.name(),
+        Defaults::DEFAULT_RTOL,
+        Defaults::DEFAULT_ATOL,
+        (alpha, beta),
+    )
 }

@@ -13,6 +13,14 @@ use crate::convert::{Lists, to_python};
 use crate::errors::analysis_error;
 use crate::model::{CoreModel, equilibrium_start, method};
 
+/// The operating point at `at` (`None`, a name or coordinates), `t = 0`.
+fn point(at: Option<&Bound<'_, PyAny>>) -> PyResult<OperatingPointOptions> {
+    Ok(OperatingPointOptions {
+        start: equilibrium_start(at, None)?,
+        t: 0.0,
+    })
+}
+
 /// Registers the studies.
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(study_work_precision, m)?)?;
@@ -105,10 +113,7 @@ fn study_parameter_sweep<'py>(
             name: parameter,
             values,
         },
-        operating_point: OperatingPointOptions {
-            start: equilibrium_start(at, None)?,
-            t: 0.0,
-        },
+        operating_point: point(at)?,
         refine,
     };
     let mut instance = model.fresh()?;
@@ -139,10 +144,7 @@ fn study_frf<'py>(
     at: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyAny>> {
     let options = FrfOptions {
-        operating_point: OperatingPointOptions {
-            start: equilibrium_start(at, None)?,
-            t: 0.0,
-        },
+        operating_point: point(at)?,
         input,
         outputs,
         frequency_range,
@@ -177,10 +179,7 @@ fn study_floquet<'py>(
 ) -> PyResult<Bound<'py, PyAny>> {
     let defaults = FloquetStudyOptions::default();
     let options = FloquetStudyOptions {
-        operating_point: OperatingPointOptions {
-            start: equilibrium_start(at, None)?,
-            t: 0.0,
-        },
+        operating_point: point(at)?,
         period_parameter: period_parameter.unwrap_or(defaults.period_parameter),
         floquet: eomgen::FloquetOptions {
             rtol: rtol.unwrap_or(defaults.floquet.rtol),
@@ -226,10 +225,7 @@ fn study_free_response<'py>(
 ) -> PyResult<Bound<'py, PyAny>> {
     let mut instance = model.fresh()?;
     let options = FreeResponseOptions {
-        operating_point: OperatingPointOptions {
-            start: equilibrium_start(at, None)?,
-            t: 0.0,
-        },
+        operating_point: point(at)?,
         initial: deviation(dq0, dqdot0, instance.num_dofs()),
         t_end,
         samples,
@@ -260,10 +256,7 @@ fn study_modal_damping<'py>(
 ) -> PyResult<Bound<'py, PyAny>> {
     let mut instance = model.fresh()?;
     let options = ModalDampingOptions {
-        operating_point: OperatingPointOptions {
-            start: equilibrium_start(at, None)?,
-            t: 0.0,
-        },
+        operating_point: point(at)?,
         rayleigh_modes,
         initial: deviation(dq0, dqdot0, instance.num_dofs()),
         t_end,

@@ -20,25 +20,11 @@ ArrayLike = Union[Sequence[float], np.ndarray]
 #: ``symplectic-euler``, ``stormer-verlet``, ``implicit-midpoint`` (step ``dt``); adaptive
 #: ``bs32``, ``dp54`` (Dormand–Prince 5(4), the default), ``dop853`` and ``radau5``
 #: (``rtol``/``atol``).
-METHODS = (
-    "euler",
-    "midpoint",
-    "rk4",
-    "bs32",
-    "dp54",
-    "dop853",
-    "symplectic-euler",
-    "stormer-verlet",
-    "implicit-midpoint",
-    "radau5",
-)
+METHODS = tuple(_eomgen.methods())
 
-#: ``simulate``'s defaults, those of ``eomgen simulate`` without options.
-DEFAULT_T_END = 10.0
-DEFAULT_METHOD = "dp54"
-DEFAULT_RTOL = 1e-8
-DEFAULT_ATOL = 1e-10
-DEFAULT_BAUMGARTE = (10.0, 10.0)
+#: ``simulate``'s defaults, those of ``eomgen simulate`` without options: end time (s),
+#: method, tolerances, Baumgarte's gains (1/s).
+DEFAULT_T_END, DEFAULT_METHOD, DEFAULT_RTOL, DEFAULT_ATOL, DEFAULT_BAUMGARTE = _eomgen.simulation_defaults()
 
 
 def load(name_or_path: str) -> "Model":
@@ -274,17 +260,9 @@ class Model:
         states = None
         if initial_states is not None:
             states = np.ascontiguousarray(np.atleast_2d(np.asarray(initial_states, dtype=float)))
-        sets = None
-        if parameters is not None:
-            if isinstance(parameters, Mapping):
-                columns = {k: np.atleast_1d(np.asarray(v, dtype=float)) for k, v in parameters.items()}
-                lengths = {len(v) for v in columns.values()}
-                if len(lengths) != 1:
-                    raise ValueError("every parameter's values must have the same length")
-                (count,) = lengths
-                sets = [[(k, float(v[i])) for k, v in columns.items()] for i in range(count)]
-            else:
-                sets = [[(str(k), float(v)) for k, v in p.items()] for p in parameters]
+        sets = parameter_sets(parameters)
+        if sets is not None:
+            sets = [[(str(k), float(v)) for k, v in p.items()] for p in sets]
         times = [float(t_end)] if t_out is None else [float(t) for t in np.atleast_1d(t_out)]
         result = _eomgen.simulate_many(
             self._core,
@@ -594,6 +572,25 @@ class Solution:
         return (f"eomgen.Solution({self.summary_header['model']!r}, {len(self.t)} samples, "
                 f"t = {self.t[0] if len(self.t) else '-'} … {self.t[-1] if len(self.t) else '-'}, "
                 f"{self.stats['steps']} steps)")
+
+
+def parameter_sets(parameters) -> Optional[List[Dict[str, float]]]:
+    """Parameters of a batch as one dict per run: a sequence of dicts as given, or a dict
+    of columns (``{"l1": [1.0, 1.1, …]}``, every column of the same length) cut into rows.
+
+    Raises:
+        ValueError: columns of different lengths.
+    """
+    if parameters is None:
+        return None
+    if isinstance(parameters, Mapping):
+        columns = {k: np.atleast_1d(np.asarray(v, dtype=float)) for k, v in parameters.items()}
+        lengths = {len(v) for v in columns.values()}
+        if len(lengths) != 1:
+            raise ValueError("every parameter's values must have the same length")
+        (count,) = lengths
+        return [{k: float(v[i]) for k, v in columns.items()} for i in range(count)]
+    return [dict(p) for p in parameters]
 
 
 def _at(at):

@@ -22,7 +22,7 @@ from typing import Any, Dict, List, Mapping, Optional, Sequence, Union
 
 import numpy as np
 
-from ._model import Batch, Model
+from ._model import Batch, Model, parameter_sets
 
 
 def run_chunk(model: Model, initial_states: Optional[np.ndarray], parameters: Optional[List[Mapping[str, float]]],
@@ -69,7 +69,7 @@ def run(executor: Any, model: Model, initial_states: Optional[Any] = None,
     from .errors import IntegrationError
 
     states = None if initial_states is None else np.atleast_2d(np.asarray(initial_states, dtype=float))
-    sets = _parameter_sets(parameters)
+    sets = parameter_sets(parameters)
     count = len(states) if states is not None else (len(sets) if sets is not None else 0)
     if states is not None and sets is not None and len(states) != len(sets):
         raise ValueError(f"initial_states has {len(states)} rows and parameters {len(sets)} entries")
@@ -115,20 +115,6 @@ def run(executor: Any, model: Model, initial_states: Optional[Any] = None,
             f"({len(failures)} run(s) failed; errors='keep' returns the batch)",
             None if t != t else t, reason, batch)
     return batch
-
-
-def _parameter_sets(parameters):
-    """Parameters as one dict per run (a dict of columns is split into rows)."""
-    if parameters is None:
-        return None
-    if isinstance(parameters, Mapping):
-        columns = {k: np.atleast_1d(np.asarray(v, dtype=float)) for k, v in parameters.items()}
-        lengths = {len(v) for v in columns.values()}
-        if len(lengths) != 1:
-            raise ValueError("every parameter's values must have the same length")
-        (count,) = lengths
-        return [{k: float(v[i]) for k, v in columns.items()} for i in range(count)]
-    return [dict(p) for p in parameters]
 
 
 def _workers(executor: Any) -> int:
