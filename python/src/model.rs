@@ -72,30 +72,41 @@ fn open(argument: &str, text: Option<&str>) -> Result<Loaded, eomgen::OpenError>
             text: text.to_string(),
         });
     }
-    let source = match eomgen::resolve(argument)? {
-        eomgen::Resolved::Bundled(entry) => ModelSource::Bundled(entry),
-        resolved @ eomgen::Resolved::File(_) => {
-            let bytes = resolved.bytes().map_err(|source| eomgen::LoadError::Read {
-                path: argument.to_string(),
-                source: eomgen_symbolic::model::ReadError::Io(source),
-            })?;
-            let text = String::from_utf8_lossy(&bytes).into_owned();
-            ModelSource::File {
-                path: argument.to_string(),
-                model: compile_text(argument, &text)?,
-            }
+    match eomgen::resolve(argument)? {
+        eomgen::Resolved::Bundled(entry) => Ok(Loaded {
+            source: ModelSource::Bundled(entry),
+            argument: argument.to_string(),
+            text: entry.source.to_string(),
+        }),
+        eomgen::Resolved::File(path) => {
+            // Read once: the text compiled is the text a pickle carries.
+            let text = read_text(&path)?;
+            Ok(Loaded {
+                source: ModelSource::File {
+                    path: path.clone(),
+                    model: compile_text(&path, &text)?,
+                },
+                argument: path,
+                text,
+            })
         }
-    };
-    let text = match &source {
-        ModelSource::Bundled(entry) => entry.source.to_string(),
-        ModelSource::File { .. } => {
-            String::from_utf8_lossy(&source.bytes().unwrap_or_default()).into_owned()
-        }
-    };
-    Ok(Loaded {
-        source,
-        argument: argument.to_string(),
-        text,
+    }
+}
+
+/// A model file's text, through the loader's size limit; a file that is not UTF-8 is a
+/// located diagnostic, as `JitModel::load` reports it.
+fn read_text(path: &str) -> Result<String, eomgen::LoadError> {
+    use eomgen_symbolic::model::{ReadError, read_model_file};
+    read_model_file(std::path::Path::new(path)).map_err(|e| match e {
+        ReadError::NotText { diagnostic, text } => eomgen::LoadError::Diagnostics {
+            path: path.to_string(),
+            text,
+            diagnostics: vec![diagnostic],
+        },
+        source => eomgen::LoadError::Read {
+            path: path.to_string(),
+            source,
+        },
     })
 }
 

@@ -461,3 +461,15 @@ def test_modal_damping_integration_agrees_with_the_exact_response():
     report = eomgen.load("three_masses_damped").modal_damping()
     for case in report["cases"]:
         assert case["integration_vs_exact"] < 1e-8
+
+
+def test_a_missing_or_binary_file_raises_model_error(tmp_path):
+    with pytest.raises(eomgen.ModelError) as missing:
+        eomgen.load(str(tmp_path / "absent.yaml"))
+    assert "absent.yaml" in str(missing.value) and missing.value.diagnostics == []
+    binary = tmp_path / "binary.yaml"
+    binary.write_bytes(b"name: x\n\xff\xfe\n")
+    with pytest.raises(eomgen.ModelError) as info:
+        eomgen.load(str(binary))
+    (d,) = info.value.diagnostics
+    assert d["line"] == 2 and d["file"] == str(binary)
