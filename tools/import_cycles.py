@@ -26,7 +26,7 @@ import os
 import re
 import sys
 
-DEFAULT_DIRS = ["runtime/src", "symbolic/src", "jit/src", "macros/src", "src"]
+DEFAULT_DIRS = ["runtime/src", "symbolic/src", "jit/src", "macros/src", "src", "description/src", "python/src"]
 ITEM_KEYWORDS = {"fn", "struct", "enum", "trait", "type", "const", "static", "union"}
 TOKEN = re.compile(r"[A-Za-z_][A-Za-z0-9_]*|::|[{}();,*!#=<>\[\]]|.", re.S)
 

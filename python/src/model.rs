@@ -242,26 +242,27 @@ pub(crate) fn run_error(message: String) -> PyErr {
 pub(crate) fn simulation_dict<'py>(
     py: Python<'py>,
     model: &dyn ModelInfo,
-    simulation: &eomgen::analysis::Simulation,
+    mut simulation: eomgen::analysis::Simulation,
 ) -> PyResult<Bound<'py, PyDict>> {
     let dim = 2 * model.num_dofs();
-    let solution = &simulation.solution;
     let out = PyDict::new(py);
     out.set_item(
         "summary",
         to_python(py, &simulation.summary_without_samples(model), Lists::Plain)?,
     )?;
-    out.set_item("t", PyArray1::from_slice(py, &solution.t))?;
-    out.set_item("y", matrix(py, solution.y.clone(), solution.len(), dim)?)?;
-    out.set_item(
-        "energy",
-        PyArray1::from_slice(py, &simulation.energy.energy),
-    )?;
+    // The samples' buffers become the arrays' (no copy).
+    let samples = simulation.solution.len();
+    let t = std::mem::take(&mut simulation.solution.t);
+    let y = std::mem::take(&mut simulation.solution.y);
+    out.set_item("t", PyArray1::from_vec(py, t))?;
+    out.set_item("y", matrix(py, y, samples, dim)?)?;
+    let energy = std::mem::take(&mut simulation.energy.energy);
+    out.set_item("energy", PyArray1::from_vec(py, energy))?;
     let constraints = &simulation.constraints;
     if !constraints.is_empty() {
         let m = constraints.constraint_names.len();
-        let mut forces = Vec::with_capacity(solution.len() * m);
-        let mut solved = Vec::with_capacity(solution.len());
+        let mut forces = Vec::with_capacity(samples * m);
+        let mut solved = Vec::with_capacity(samples);
         for row in &constraints.lagrange_multipliers {
             match row {
                 Some(values) => forces.extend_from_slice(values),
@@ -271,7 +272,7 @@ pub(crate) fn simulation_dict<'py>(
         }
         out.set_item(
             "lagrange_multipliers",
-            matrix(py, forces, solution.len(), m)?,
+            matrix(py, forces, samples, m)?,
         )?;
         out.set_item("multipliers_solved", PyArray1::from_vec(py, solved))?;
         let drift: Vec<f64> = constraints
@@ -279,7 +280,7 @@ pub(crate) fn simulation_dict<'py>(
             .iter()
             .flat_map(|&(p, v)| [p, v])
             .collect();
-        out.set_item("constraint_drift", matrix(py, drift, solution.len(), 2)?)?;
+        out.set_item("constraint_drift", matrix(py, drift, samples, 2)?)?;
     }
     Ok(out)
 }
@@ -481,7 +482,7 @@ impl CoreModel {
             .detach(|| run_simulation(model.as_mut(), &run))
             .map_err(run_error)?;
         let library_time = started.elapsed().as_secs_f64();
-        let out = simulation_dict(py, model.as_ref(), &simulation)?;
+        let out = simulation_dict(py, model.as_ref(), simulation)?;
         // The library call's own wall time, for the measurement of what the binding adds.
         out.set_item("library_time_s", library_time)?;
         Ok(out)
