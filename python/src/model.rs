@@ -250,6 +250,11 @@ pub(crate) fn simulation_dict<'py>(
         "summary",
         to_python(py, &simulation.summary_without_samples(model), Lists::Plain)?,
     )?;
+    // What the model shows where a failed run stopped (a singular mass matrix, a forcing
+    // out of its domain), for the exception's message.
+    if let Some(cause) = &simulation.cause {
+        out.set_item("cause", cause.to_string())?;
+    }
     // The samples' buffers become the arrays' (no copy).
     let samples = simulation.solution.len();
     let t = std::mem::take(&mut simulation.solution.t);

@@ -473,3 +473,13 @@ def test_a_missing_or_binary_file_raises_model_error(tmp_path):
         eomgen.load(str(binary))
     (d,) = info.value.diagnostics
     assert d["line"] == 2 and d["file"] == str(binary)
+
+
+def test_a_failure_says_what_the_model_shows_there():
+    # m1 = −1: det M = m2²/9 − m2² cos²(θ1 − θ2)/4 + m1 m2/9 vanishes when cos² = 8/9; the
+    # integration stops there, and the exception names the negative mass.
+    m = eomgen.load("double_pendulum").with_parameters(m1=-1.0)
+    with pytest.raises(eomgen.IntegrationError) as info:
+        m.simulate()
+    assert info.value.solution.cause is not None
+    assert "m1 = -1" in str(info.value)

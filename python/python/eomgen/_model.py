@@ -214,6 +214,8 @@ class Model:
                 message = f"integration of `{self.name}` stopped: {reason} at t = {t}; {kept}"
             if t is None:
                 raise ValueError(reason)
+            if solution.cause is not None:
+                message += f"\n{solution.cause}"
             raise IntegrationError(message, t, reason, solution)
         return solution
 
@@ -517,6 +519,9 @@ class Solution:
         #: The wall time (s) of the library's simulation call alone (instance, integration,
         #: energy and drift measures), without the binding's conversions.
         self.library_time_s = result.get("library_time_s")
+        #: What the model shows where a failed integration stopped (a mass matrix that is
+        #: not positive definite, a forcing out of its domain), or ``None``.
+        self.cause = result.get("cause")
         self._summary = None
 
     @property
