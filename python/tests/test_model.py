@@ -281,8 +281,11 @@ def test_equations_as_text_and_latex(cli):
     assert out.returncode == 0
     assert text + "\n" == out.stdout or text == out.stdout
     latex = m.equations(latex=True)
-    assert "\\" in latex and latex._repr_latex_() == latex.latex
-    assert text._repr_latex_() == latex.latex
+    assert "\\" in latex and latex == latex.latex
+    # Jupyter's LaTeX: the listing inside math delimiters.
+    shown = text._repr_latex_()
+    assert shown.startswith("$$\\begin{gathered}") and shown.endswith("\\end{gathered}$$")
+    assert latex.latex.strip() in shown
     status, expected = run_cli(cli, "equations", "double_pendulum")
     assert status == 0 and text.listing == expected
     with pytest.raises(ValueError, match="momentum"):

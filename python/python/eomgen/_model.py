@@ -732,7 +732,9 @@ class Equations(str):
         return self
 
     def _repr_latex_(self) -> str:
-        return self.latex
+        # Jupyter typesets text/latex with MathJax, which needs math delimiters; the listing's
+        # lines are separated by `\\`, as inside `gathered`.
+        return "$$\\begin{gathered}\n" + self.latex.strip() + "\n\\end{gathered}$$"
 
     def __reduce__(self):
         return (Equations, (str(self), self.latex, self.listing))
