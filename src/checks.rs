@@ -14,6 +14,7 @@ use serde::Serialize;
 use crate::ModelSource;
 use crate::analysis::{Method, SimulationOptions, simulate};
 use crate::expressions::{evaluate, parameter_lookup, split_assignment};
+use crate::text::fixed;
 use eomgen_runtime::analysis::vibration::{
     EquilibriumStart, ModalAnalysis, ModalOptions, OperatingPointOptions, modal_analysis,
 };
@@ -170,22 +171,6 @@ impl CheckRun {
 impl Default for CheckRun {
     fn default() -> Self {
         Self::of(&RunSettings::default())
-    }
-}
-
-/// `v` with `decimals` decimals, trailing zeros dropped, `-0` as `0` (`fixed(10.0, 6)` is
-/// `10`, `fixed(0.25, 6)` is `0.25`), as the rows write times.
-pub fn fixed(v: f64, decimals: usize) -> String {
-    let s = format!("{v:.decimals$}");
-    let s = if s.contains('.') {
-        s.trim_end_matches('0').trim_end_matches('.')
-    } else {
-        &s
-    };
-    if s == "-0" {
-        "0".to_string()
-    } else {
-        s.to_string()
     }
 }
 

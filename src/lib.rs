@@ -41,6 +41,7 @@ pub use nalgebra;
 #[cfg(feature = "jit")]
 mod source;
 
+pub mod animation;
 // The rows of a model file's `checks:` need the run-time loader for the file's model.
 #[cfg(feature = "jit")]
 pub mod checks;
@@ -48,6 +49,7 @@ pub mod expressions;
 pub mod listing;
 #[cfg(feature = "jit")]
 pub mod studies;
+pub mod text;
 
 #[cfg(feature = "jit")]
 pub use floquet_references::{

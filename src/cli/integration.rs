@@ -10,7 +10,7 @@ use eomgen::analysis::{
     AddedEvents, FailureCause, Simulation, SimulationError, SimulationOptions, simulate_with_events,
 };
 use eomgen::expressions::{ExpressionEvents, set_initial_values};
-use eomgen::{IntegrationError, ModelInfo, OutputTimes, Solution};
+use eomgen::{IntegrationError, ModelInfo, OutputTimes};
 
 use super::error::CliError;
 use super::model::find_model;
@@ -132,16 +132,17 @@ impl IntegrationArgs {
     }
 
     /// How the method controls its step: `rtol 1e-8, atol 1e-10` for an adaptive method,
-    /// `fixed step dt = 1e-2 s` otherwise (`--dt`, default `t_end/1000`).
+    /// `fixed step dt = 1e-2 s` otherwise (`--dt`, default `t_end/1000`), as
+    /// [`eomgen::text::step_control`] says it.
     pub(crate) fn step_control(&self) -> String {
-        if self.method.is_adaptive() {
-            format!("rtol {:e}, atol {:e}", num(self.rtol), num(self.atol))
-        } else {
-            let dt = self
-                .dt
-                .unwrap_or(self.t_end / f64::from(eomgen::IntegratorOptions::DEFAULT_FIXED_STEPS));
-            format!("fixed step dt = {dt:e} s", dt = num(dt))
-        }
+        eomgen::text::step_control(&SimulationOptions {
+            method: self.method,
+            t_end: self.t_end,
+            rtol: self.rtol,
+            atol: self.atol,
+            dt: self.dt,
+            ..SimulationOptions::default()
+        })
     }
 }
 
@@ -177,22 +178,6 @@ impl IntegrationArgs {
             initial_state: Some(y0),
         })
     }
-}
-
-/// One integration of a model from its initial state, as `simulate` and `animate` run it.
-pub(super) struct Run {
-    /// The model, with `--set` and the drift control applied.
-    pub model: Box<dyn ModelInfo>,
-    /// The consistent initial state `[q; q̇]`.
-    pub y0: Vec<f64>,
-    /// The samples: all of them, or those computed before a failure.
-    pub solution: Solution,
-    /// Why the integration stopped early, if it did.
-    pub failure: Option<IntegrationError>,
-    /// What the model shows where it stopped, if anything.
-    pub cause: Option<FailureCause>,
-    /// The integrator's name (`dp54`).
-    pub method_name: &'static str,
 }
 
 /// Simulates `model_name` (a bundled model or a model file) with `args`: `--set` and
@@ -278,27 +263,6 @@ fn inconsistent_message(
             residual = num(residual)
         )
     }
-}
-
-/// Integrates `model_name` with `args` as `simulate` does (see [`simulation`]), sampled at
-/// `output`: the shared start of `simulate`, `animate` and `report`.
-///
-/// # Errors
-/// As [`simulation`]; report a failed integration with [`failure_error`].
-pub(super) fn integrate(
-    model_name: &str,
-    args: &IntegrationArgs,
-    output: OutputTimes,
-) -> Result<Run, CliError> {
-    let (model, simulation) = simulation(model_name, args, output)?;
-    Ok(Run {
-        model,
-        y0: simulation.initial_state,
-        solution: simulation.solution,
-        failure: simulation.failure,
-        cause: simulation.cause,
-        method_name: simulation.integrator,
-    })
 }
 
 /// The error of a failed integration of `model`: where and why it stopped, what became of

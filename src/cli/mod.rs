@@ -4,7 +4,7 @@
 //! Two layers: each command (and each study) is a file of [`commands`], which parses its own
 //! options, calls the library and renders the result; the pieces several commands share sit
 //! beside this file (the error and exit status, opening a model, the integration and
-//! operating-point options, files, charts, the animation page, number formatting). A
+//! operating-point options, files, charts, the animation's GIF, progress bars). A
 //! command imports shared pieces, never another command.
 
 mod animation;

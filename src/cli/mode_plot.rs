@@ -9,7 +9,11 @@
 //! mode read alike whatever their mass normalisation. Axes have equal scales, so angles and
 //! lengths look as they are; 3-D models are drawn in an isometric view.
 
-use eomgen::{ModeKind, ModelInfo, NormalModes};
+use eomgen::animation::drawing::{
+    Frame, Layout, describe, displaced, drawing_size, each_mode, frame, is_three_d, mode_scale,
+};
+use eomgen::text::significant;
+use eomgen::{ModelInfo, NormalModes};
 use nalgebra::DMatrix;
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -17,8 +21,6 @@ use plotters::prelude::*;
 use super::error::CliError;
 use super::plot::{Drawing, tick, write_chart};
 
-/// Largest point displacement of a drawn mode, as a fraction of the mechanism's size.
-const AMPLITUDE_FRACTION: f64 = 0.2;
 /// Chart size (px).
 const SIZE: (u32, u32) = (900, 760);
 /// Margin, x-label and y-label areas of the chart (px).
@@ -43,150 +45,6 @@ pub fn check_drawable(model: &dyn ModelInfo) -> Result<(), CliError> {
         )));
     }
     Ok(())
-}
-
-/// The drawing of one configuration: 2-D coordinates of every point (m).
-pub(super) type Frame = Vec<(f64, f64)>;
-
-/// What the charts draw: the point pairs of the lines and the points marked with a dot.
-pub(super) struct Layout {
-    /// Point indices of the `draw:` lines.
-    pub(super) lines: Vec<[usize; 2]>,
-    /// Indices of the points marked with a dot.
-    pub(super) dots: Vec<usize>,
-    /// Whether the view is isometric (a 3-D model).
-    pub(super) three_d: bool,
-}
-
-impl Layout {
-    /// The model's `draw:` lines and trace points as indices; the points marked are the
-    /// lines' ends and the traced points, or every point when the file draws nothing.
-    /// `three_d`: whether any point leaves the plane z = 0.
-    pub(super) fn of(model: &dyn ModelInfo, three_d: bool) -> Self {
-        let names = model.description().point_names();
-        let index = |n: &str| names.iter().position(|p| *p == n);
-        let lines: Vec<[usize; 2]> = model
-            .description()
-            .draw_line_names()
-            .iter()
-            .filter_map(|[a, b]| Some([index(a)?, index(b)?]))
-            .collect();
-        let mut dots: Vec<usize> = lines.iter().flatten().copied().collect();
-        dots.extend(
-            model
-                .description()
-                .trace_point_names()
-                .iter()
-                .filter_map(|p| index(p)),
-        );
-        if dots.is_empty() {
-            dots = (0..names.len()).collect();
-        }
-        dots.sort_unstable();
-        dots.dedup();
-        Self {
-            lines,
-            dots,
-            three_d,
-        }
-    }
-
-    /// The chart coordinates of a point: `(x, y)`, or for a 3-D model the isometric view
-    /// `((x − y) cos 30°, z + (x + y) sin 30°)`.
-    pub(super) fn project(&self, p: [f64; 3]) -> (f64, f64) {
-        if self.three_d {
-            let c = 30f64.to_radians();
-            ((p[0] - p[1]) * c.cos(), p[2] + (p[0] + p[1]) * c.sin())
-        } else {
-            (p[0], p[1])
-        }
-    }
-}
-
-/// Positions of every point at `q` (m; the rates do not matter).
-pub(super) fn positions(model: &dyn ModelInfo, q: &[f64]) -> Vec<[f64; 3]> {
-    let y: Vec<f64> = q
-        .iter()
-        .copied()
-        .chain(std::iter::repeat_n(0.0, q.len()))
-        .collect();
-    model.point_positions(0.0, &y)
-}
-
-/// The configuration `q + s ψ`.
-pub(super) fn displaced(q: &[f64], psi: &[f64], s: f64) -> Vec<f64> {
-    q.iter().zip(psi).map(|(a, p)| a + s * p).collect()
-}
-
-/// Every mode of `modes` as `(k, ω, kind, ψ)`: its index from 0, frequency (rad/s), kind and
-/// shape (column `k` of `shapes`, `n × r` in the model's coordinates).
-pub(super) fn each_mode<'a>(
-    modes: &'a NormalModes,
-    shapes: &'a DMatrix<f64>,
-) -> impl Iterator<Item = (usize, f64, ModeKind, Vec<f64>)> + 'a {
-    modes
-        .natural_frequencies
-        .iter()
-        .zip(&modes.kinds)
-        .enumerate()
-        .map(|(k, (&omega, &kind))| (k, omega, kind, shapes.column(k).iter().copied().collect()))
-}
-
-/// Positions of every point at `q`, projected.
-pub(super) fn frame(model: &dyn ModelInfo, layout: &Layout, q: &[f64]) -> Frame {
-    positions(model, q)
-        .into_iter()
-        .map(|p| layout.project(p))
-        .collect()
-}
-
-fn largest_distance(a: &Frame, b: &Frame, which: &[usize]) -> f64 {
-    which
-        .iter()
-        .map(|&i| (a[i].0 - b[i].0).hypot(a[i].1 - b[i].1))
-        .fold(0.0, f64::max)
-}
-
-/// What each mode's chart says about the mode, for its title. The shapes are the modes of
-/// `M` and `K`; where the linearisation also has a velocity matrix `C` (`c_left_out`: damping
-/// or gyroscopic terms, which can stabilise what `K` alone would not, or the reverse), the
-/// title says that they are the undamped modes and what `K` alone predicts, not the verdict
-/// of the whole linearisation (which `eomgen modes` prints).
-pub(super) fn describe(k: usize, omega: f64, kind: ModeKind, c_left_out: bool) -> String {
-    let hz = omega / std::f64::consts::TAU;
-    let mode = if c_left_out {
-        format!("undamped mode {k} (M, K without C)")
-    } else {
-        format!("mode {k}")
-    };
-    match kind {
-        ModeKind::Oscillatory => format!(
-            "{mode}: ω = {} rad/s ({} Hz), oscillatory",
-            significant(omega),
-            significant(hz)
-        ),
-        ModeKind::ZeroFrequency => {
-            format!("{mode}: ω = 0 rad/s, zero-frequency (rigid-body or mechanism)")
-        }
-        ModeKind::Unstable { growth_rate } if c_left_out => format!(
-            "{mode}: negative stiffness, σ = {} 1/s without C",
-            significant(growth_rate)
-        ),
-        ModeKind::Unstable { growth_rate } => format!(
-            "{mode}: unstable, grows as e^(σt), σ = {} 1/s",
-            significant(growth_rate)
-        ),
-    }
-}
-
-/// Six significant digits.
-pub(super) fn significant(v: f64) -> String {
-    if v == 0.0 || !(1e-3..1e5).contains(&v.abs()) {
-        format!("{v:.5e}")
-    } else {
-        let digits = (5 - v.abs().log10().floor() as i32).max(0) as usize;
-        format!("{v:.digits$}")
-    }
 }
 
 /// One chart: its title, the three frames and the legend labels of the displaced ones.
@@ -291,59 +149,6 @@ pub fn remove_stale_charts(prefix: &str, written: usize) -> Result<(), CliError>
 
 /// Every mode chart's title has this after the model's name ([`describe`]).
 const MODE_TITLE: &str = ", mode ";
-
-/// Whether a 3-D view is needed: a point off the plane z = 0 at `q` or along some column of
-/// `shapes` (`n × r`).
-pub(super) fn is_three_d(model: &dyn ModelInfo, q: &[f64], shapes: &DMatrix<f64>) -> bool {
-    std::iter::once(q.to_vec())
-        .chain((0..shapes.ncols()).map(|k| {
-            let psi: Vec<f64> = shapes.column(k).iter().copied().collect();
-            displaced(q, &psi, 1e-3)
-        }))
-        .any(|qk| positions(model, &qk).iter().any(|p| p[2] != 0.0))
-}
-
-/// The mechanism's size (m): the larger side of the bounding box of the points `which` of
-/// `frame`, or 1 when it is empty or degenerate.
-pub(super) fn drawing_size(frame: &Frame, which: &[usize]) -> f64 {
-    let (mut lo, mut hi) = (
-        (f64::INFINITY, f64::INFINITY),
-        (f64::NEG_INFINITY, f64::NEG_INFINITY),
-    );
-    for &i in which {
-        lo = (lo.0.min(frame[i].0), lo.1.min(frame[i].1));
-        hi = (hi.0.max(frame[i].0), hi.1.max(frame[i].1));
-    }
-    let size = (hi.0 - lo.0).max(hi.1 - lo.1);
-    if size.is_finite() && size > 0.0 {
-        size
-    } else {
-        1.0
-    }
-}
-
-/// The scale `s` of a drawn mode `q* + s ψ`: the largest linearised point displacement is
-/// [`AMPLITUDE_FRACTION`] of `size`; `None` when the mode moves no drawn point.
-pub(super) fn mode_scale(
-    model: &dyn ModelInfo,
-    layout: &Layout,
-    q: &[f64],
-    psi: &[f64],
-    size: f64,
-) -> Option<f64> {
-    let at = |s: f64| displaced(q, psi, s);
-    // The linearised displacement of the points per unit of s, by a central difference with
-    // a step small against q.
-    let q_scale = 1.0 + q.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-    let psi_max = psi.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-    let h = 1e-6 * q_scale / psi_max.max(f64::MIN_POSITIVE);
-    let rate = largest_distance(
-        &frame(model, layout, &at(h)),
-        &frame(model, layout, &at(-h)),
-        &layout.dots,
-    ) / (2.0 * h);
-    (rate.is_finite() && rate > 0.0).then(|| AMPLITUDE_FRACTION * size / rate)
-}
 
 /// A tick label; a tick within rounding of 0 (`1e-16` from the range arithmetic) reads `0`.
 fn label(v: f64, span: f64) -> String {

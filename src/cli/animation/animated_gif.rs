@@ -1,133 +1,152 @@
-//! The animation as an animated GIF for slides: the same picture drawn frame by frame with
-//! plotters, a fixed palette, and each frame only the rectangle that changed.
+//! The animation as an animated GIF for slides: the same picture as the library's page
+//! ([`eomgen::animation`]) drawn frame by frame with plotters, a fixed palette, and each
+//! frame only the rectangle that changed.
 
-use super::*;
+use eomgen::animation::{Animation, grid_step};
+use eomgen::text::significant;
+use plotters::prelude::*;
 
-impl Animation {
-    /// Writes clip `clip` as an animated GIF: the same picture (equal scales, the whole run's
-    /// box), at most [`GIF_MAX_FPS`] frames per second of `t` and [`GIF_MAX_FRAMES`] frames,
-    /// played in real time, looping.
-    ///
-    /// # Errors
-    /// A failure when drawing or writing the file fails.
-    pub(crate) fn write_gif(&self, path: &str, clip: usize) -> Result<(), CliError> {
-        let fail = |e: String| CliError::failure(format!("`{path}`: {e}"));
-        plot::register_font().map_err(fail)?;
-        let scene = &self.scene;
-        let clip = &self.clips[clip];
-        let (x0, x1, y0, y1) = bounding_box(&self.clips);
-        let per_pixel = (x1 - x0).max(y1 - y0) / f64::from(GIF_SIDE);
-        let width = ((x1 - x0) / per_pixel).round().max(240.0) as u32;
-        let height = ((y1 - y0) / per_pixel).round().max(80.0) as u32 + GIF_CAPTION;
-        // The frame step: a frame interval of at least 1/GIF_MAX_FPS s and at most
-        // GIF_MAX_FRAMES frames.
-        let n = clip.t.len();
-        let dt = if n > 1 {
-            (clip.t[n - 1] - clip.t[0]) / (n - 1) as f64
-        } else {
-            1.0
-        };
-        let step = ((1.0 / (GIF_MAX_FPS * dt)).ceil() as usize)
-            .max(n.div_ceil(GIF_MAX_FRAMES))
-            .max(1);
-        let delay = (100.0 * dt * step as f64 / clip.rate)
-            .round()
-            .clamp(2.0, 6000.0) as u16;
-        let palette = Palette::new();
-        // Encoded in memory (at most GIF_MAX_FRAMES frames of a small picture) and written
-        // atomically.
-        let mut encoder = gif::Encoder::new(Vec::new(), width as u16, height as u16, &palette.rgb)
-            .map_err(|e| fail(e.to_string()))?;
-        encoder
-            .set_repeat(gif::Repeat::Infinite)
-            .map_err(|e| fail(e.to_string()))?;
-        let to_pixel = |(x, y): (f64, f64)| -> (i32, i32) {
-            (
-                ((x - x0) / per_pixel).round() as i32,
-                (GIF_CAPTION as f64 + (y1 - y) / per_pixel).round() as i32,
-            )
-        };
-        let mut buffer = vec![0u8; (width * height * 3) as usize];
-        let rgb = |(r, g, b): (u8, u8, u8)| RGBColor(r, g, b);
-        let mut previous: Vec<u8> = Vec::new();
-        let mut k = 0;
-        while k < n {
-            {
-                let root =
-                    BitMapBackend::with_buffer(&mut buffer, (width, height)).into_drawing_area();
-                let err = |e: DrawingAreaErrorKind<_>| fail(format!("drawing failed: {e}"));
-                root.fill(&WHITE).map_err(err)?;
-                let step_m = grid_step((x1 - x0).max(y1 - y0));
-                for i in (x0 / step_m).ceil() as i64..=(x1 / step_m).floor() as i64 {
-                    let x = i as f64 * step_m;
-                    root.draw(&PathElement::new(
-                        vec![to_pixel((x, y0)), to_pixel((x, y1))],
-                        rgb(GRID),
-                    ))
-                    .map_err(err)?;
-                }
-                for i in (y0 / step_m).ceil() as i64..=(y1 / step_m).floor() as i64 {
-                    let y = i as f64 * step_m;
-                    root.draw(&PathElement::new(
-                        vec![to_pixel((x0, y)), to_pixel((x1, y))],
-                        rgb(GRID),
-                    ))
-                    .map_err(err)?;
-                }
-                let frame = &clip.frames[k];
-                for trail in &clip.trail {
-                    let path: Vec<(i32, i32)> = trail[..=k * clip.sub]
-                        .iter()
-                        .map(|p| to_pixel(*p))
-                        .collect();
-                    root.draw(&PathElement::new(path, rgb(TRACE).stroke_width(2)))
-                        .map_err(err)?;
-                }
-                for [a, b] in &scene.lines {
-                    root.draw(&PathElement::new(
-                        vec![to_pixel(frame[*a]), to_pixel(frame[*b])],
-                        rgb(LINK).stroke_width(5),
-                    ))
-                    .map_err(err)?;
-                }
-                for &d in &scene.dots {
-                    root.draw(&Circle::new(to_pixel(frame[d]), 5, rgb(JOINT).filled()))
-                        .map_err(err)?;
-                }
-                for &(c, _, _) in &scene.centres {
-                    root.draw(&Circle::new(
-                        to_pixel(frame[c]),
-                        8,
-                        rgb(JOINT).stroke_width(2),
-                    ))
-                    .map_err(err)?;
-                }
-                let caption = match &clip.energy {
-                    Some(e) => format!(
-                        "{}   t = {:.2} s   E = {} J",
-                        scene.model,
-                        clip.t[k],
-                        mode_plot::significant(e.energy[k])
-                    ),
-                    None => format!("{}, {}   t = {:.3} s", scene.model, clip.label, clip.t[k]),
-                };
-                root.draw(&Text::new(caption, (10, 7), ("sans-serif", 16).into_font()))
-                    .map_err(err)?;
-                root.present().map_err(err)?;
+use crate::cli::error::CliError;
+use crate::cli::plot;
+
+/// The GIF: largest side of the drawing (px), band for the caption (px), frames per second
+/// and frame count at most.
+const GIF_SIDE: u32 = 440;
+const GIF_CAPTION: u32 = 30;
+const GIF_MAX_FPS: f64 = 25.0;
+const GIF_MAX_FRAMES: usize = 600;
+/// Colours of the links, joints and traces (those of the page's stylesheet) and of the grid.
+const LINK: (u8, u8, u8) = (0x2b, 0x59, 0xc3);
+const JOINT: (u8, u8, u8) = (0x1b, 0x1b, 0x1b);
+const TRACE: (u8, u8, u8) = (0xe8, 0x87, 0x1e);
+const GRID: (u8, u8, u8) = (0xe8, 0xe8, 0xe8);
+
+/// Writes clip `clip` of `animation` as an animated GIF: the same picture as the page (equal
+/// scales, the whole run's box), at most [`GIF_MAX_FPS`] frames per second of `t` and
+/// [`GIF_MAX_FRAMES`] frames, played in real time, looping.
+///
+/// # Errors
+/// A failure when drawing or writing the file fails.
+///
+/// # Panics
+/// If `clip` is not an index of [`Animation::clips`].
+pub(crate) fn write_gif(animation: &Animation, path: &str, clip: usize) -> Result<(), CliError> {
+    let fail = |e: String| CliError::failure(format!("`{path}`: {e}"));
+    plot::register_font().map_err(fail)?;
+    let scene = animation.scene();
+    let clip = &animation.clips()[clip];
+    let (x0, x1, y0, y1) = animation.bounding_box();
+    let per_pixel = (x1 - x0).max(y1 - y0) / f64::from(GIF_SIDE);
+    let width = ((x1 - x0) / per_pixel).round().max(240.0) as u32;
+    let height = ((y1 - y0) / per_pixel).round().max(80.0) as u32 + GIF_CAPTION;
+    // The frame step: a frame interval of at least 1/GIF_MAX_FPS s and at most
+    // GIF_MAX_FRAMES frames.
+    let t = clip.times();
+    let n = t.len();
+    let dt = if n > 1 {
+        (t[n - 1] - t[0]) / (n - 1) as f64
+    } else {
+        1.0
+    };
+    let step = ((1.0 / (GIF_MAX_FPS * dt)).ceil() as usize)
+        .max(n.div_ceil(GIF_MAX_FRAMES))
+        .max(1);
+    let delay = (100.0 * dt * step as f64 / clip.rate())
+        .round()
+        .clamp(2.0, 6000.0) as u16;
+    let palette = Palette::new();
+    // Encoded in memory (at most GIF_MAX_FRAMES frames of a small picture) and written
+    // atomically.
+    let mut encoder = gif::Encoder::new(Vec::new(), width as u16, height as u16, &palette.rgb)
+        .map_err(|e| fail(e.to_string()))?;
+    encoder
+        .set_repeat(gif::Repeat::Infinite)
+        .map_err(|e| fail(e.to_string()))?;
+    let to_pixel = |(x, y): (f64, f64)| -> (i32, i32) {
+        (
+            ((x - x0) / per_pixel).round() as i32,
+            (GIF_CAPTION as f64 + (y1 - y) / per_pixel).round() as i32,
+        )
+    };
+    let mut buffer = vec![0u8; (width * height * 3) as usize];
+    let rgb = |(r, g, b): (u8, u8, u8)| RGBColor(r, g, b);
+    let mut previous: Vec<u8> = Vec::new();
+    let mut k = 0;
+    while k < n {
+        {
+            let root = BitMapBackend::with_buffer(&mut buffer, (width, height)).into_drawing_area();
+            let err = |e: DrawingAreaErrorKind<_>| fail(format!("drawing failed: {e}"));
+            root.fill(&WHITE).map_err(err)?;
+            let step_m = grid_step((x1 - x0).max(y1 - y0));
+            for i in (x0 / step_m).ceil() as i64..=(x1 / step_m).floor() as i64 {
+                let x = i as f64 * step_m;
+                root.draw(&PathElement::new(
+                    vec![to_pixel((x, y0)), to_pixel((x, y1))],
+                    rgb(GRID),
+                ))
+                .map_err(err)?;
             }
-            let indices = palette.map(&buffer);
-            let mut frame = changed_rectangle(&previous, &indices, width as usize);
-            frame.delay = delay;
-            frame.dispose = gif::DisposalMethod::Keep;
-            encoder
-                .write_frame(&frame)
-                .map_err(|e| fail(e.to_string()))?;
-            previous = indices;
-            k += step;
+            for i in (y0 / step_m).ceil() as i64..=(y1 / step_m).floor() as i64 {
+                let y = i as f64 * step_m;
+                root.draw(&PathElement::new(
+                    vec![to_pixel((x0, y)), to_pixel((x1, y))],
+                    rgb(GRID),
+                ))
+                .map_err(err)?;
+            }
+            let frame = &clip.frames()[k];
+            for trail in clip.trails() {
+                let path: Vec<(i32, i32)> = trail[..=k * clip.trail_substeps()]
+                    .iter()
+                    .map(|p| to_pixel(*p))
+                    .collect();
+                root.draw(&PathElement::new(path, rgb(TRACE).stroke_width(2)))
+                    .map_err(err)?;
+            }
+            for [a, b] in scene.lines() {
+                root.draw(&PathElement::new(
+                    vec![to_pixel(frame[*a]), to_pixel(frame[*b])],
+                    rgb(LINK).stroke_width(5),
+                ))
+                .map_err(err)?;
+            }
+            for &d in scene.dots() {
+                root.draw(&Circle::new(to_pixel(frame[d]), 5, rgb(JOINT).filled()))
+                    .map_err(err)?;
+            }
+            for c in scene.centre_points() {
+                root.draw(&Circle::new(
+                    to_pixel(frame[c]),
+                    8,
+                    rgb(JOINT).stroke_width(2),
+                ))
+                .map_err(err)?;
+            }
+            let caption = match clip.energy() {
+                Some(energy) => format!(
+                    "{}   t = {:.2} s   E = {} J",
+                    scene.model(),
+                    t[k],
+                    significant(energy[k])
+                ),
+                None => format!("{}, {}   t = {:.3} s", scene.model(), clip.label(), t[k]),
+            };
+            root.draw(&Text::new(caption, (10, 7), ("sans-serif", 16).into_font()))
+                .map_err(err)?;
+            root.present().map_err(err)?;
         }
-        let bytes = encoder.into_inner().map_err(|e| fail(e.to_string()))?;
-        Ok(crate::cli::files::write(path, &bytes)?)
+        let indices = palette.map(&buffer);
+        let mut frame = changed_rectangle(&previous, &indices, width as usize);
+        frame.delay = delay;
+        frame.dispose = gif::DisposalMethod::Keep;
+        encoder
+            .write_frame(&frame)
+            .map_err(|e| fail(e.to_string()))?;
+        previous = indices;
+        k += step;
     }
+    let bytes = encoder.into_inner().map_err(|e| fail(e.to_string()))?;
+    Ok(crate::cli::files::write(path, &bytes)?)
 }
 
 /// A GIF frame of the pixels of `current` (palette indices, rows of `width`) inside the

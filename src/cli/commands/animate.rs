@@ -1,9 +1,10 @@
 //! `eomgen animate MODEL -o FILE.html`: a simulation's `draw:` lines moving in one
-//! self-contained HTML page, optionally also a GIF ([`crate::cli::animation`] builds both).
+//! self-contained HTML page ([`eomgen::animation`]), optionally also a GIF
+//! ([`crate::cli::animation`]).
 
 use clap::Args;
 
-use crate::cli::animation::{DEFAULT_FPS, simulation};
+use crate::cli::animation::{DEFAULT_FPS, simulation, write_gif};
 use crate::cli::error::CliError;
 use crate::cli::files::{self, Outputs};
 use crate::cli::integration::IntegrationArgs;
@@ -48,11 +49,11 @@ pub fn run(args: &AnimateArgs) -> Result<(), CliError> {
     outln!(
         "animation  {} ({} frames, {:.1} kB)",
         args.output,
-        animation.clips[0].t.len(),
+        animation.clips()[0].times().len(),
         html.len() as f64 / 1e3
     );
     if let Some(path) = &args.gif {
-        animation.write_gif(path, 0)?;
+        write_gif(&animation, path, 0)?;
         outln!("gif        {path}");
     }
     match failure {

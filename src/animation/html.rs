@@ -1,7 +1,10 @@
 //! The animation as one self-contained HTML page: the frames as inline JSON, the drawing as
 //! inline SVG, the stylesheet and the player inline.
 
-use super::*;
+use std::fmt::Write as _;
+
+use super::{Animation, POSITION_DIGITS, grid_step};
+use crate::text::{escape, fixed, short};
 
 /// The stylesheet, the error hooks (first script: they record script errors and
 /// `console.error` into `#errors`) and the player.
@@ -17,10 +20,12 @@ fn json_string(s: &str) -> String {
 }
 
 impl Animation {
-    /// The page: HTML with the data, stylesheet and player inline, deterministic.
-    pub(crate) fn to_html(&self) -> String {
+    /// The page: one self-contained HTML document (UTF-8) with the frames as inline JSON,
+    /// the drawing as inline SVG in the box of [`Animation::bounding_box`], and the
+    /// stylesheet and player inline; the same animation gives the same bytes.
+    pub fn to_html(&self) -> String {
         let scene = &self.scene;
-        let (x0, x1, y0, y1) = bounding_box(&self.clips);
+        let (x0, x1, y0, y1) = self.bounding_box();
         let span = (x1 - x0).max(y1 - y0);
         let magnitude = span.log10().floor() as i32;
         let decimals = (POSITION_DIGITS - magnitude).clamp(0, 17) as usize;
