@@ -5,6 +5,7 @@
 //! command line prints with `--json`) into dicts and numpy arrays. The Python package
 //! (`python/python/eomgen`) adds docstrings, result objects and exceptions.
 
+mod animate;
 mod batch;
 mod convert;
 mod errors;
@@ -18,6 +19,8 @@ use pyo3::prelude::*;
 fn _eomgen(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<model::CoreModel>()?;
     m.add_function(wrap_pyfunction!(batch::simulate_many, m)?)?;
+    m.add_function(wrap_pyfunction!(animate::animate_simulation, m)?)?;
+    m.add_function(wrap_pyfunction!(animate::animate_modes, m)?)?;
     m.add_function(wrap_pyfunction!(bundled_models, m)?)?;
     m.add_function(wrap_pyfunction!(methods, m)?)?;
     m.add_function(wrap_pyfunction!(simulation_defaults, m)?)?;

@@ -275,10 +275,7 @@ pub(crate) fn simulation_dict<'py>(
             }
             solved.push(row.is_some());
         }
-        out.set_item(
-            "lagrange_multipliers",
-            matrix(py, forces, samples, m)?,
-        )?;
+        out.set_item("lagrange_multipliers", matrix(py, forces, samples, m)?)?;
         out.set_item("multipliers_solved", PyArray1::from_vec(py, solved))?;
         let drift: Vec<f64> = constraints
             .drift

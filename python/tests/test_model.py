@@ -486,3 +486,51 @@ def test_a_failure_says_what_the_model_shows_there():
         m.simulate()
     assert info.value.solution.cause is not None
     assert "m1 = -1" in str(info.value)
+
+
+# --- animations ------------------------------------------------------------------------------
+
+
+def test_animate_writes_the_command_line_page(cli, tmp_path):
+    m = eomgen.load("double_pendulum")
+    animation = m.animate(t_end=2.0, fps=15)
+    page = tmp_path / "dp.html"
+    out = subprocess.run([cli, "animate", "double_pendulum", "--t-end", "2", "--fps", "15", "-o", str(page)],
+                         capture_output=True, text=True, timeout=600)
+    assert out.returncode == 0, out.stderr
+    assert animation.html == page.read_text(encoding="utf-8")
+    assert animation.html.startswith("<!DOCTYPE html>")
+    shown = animation._repr_html_()
+    assert shown.startswith("<iframe srcdoc=") and "&lt;!DOCTYPE html&gt;" in shown
+    saved = tmp_path / "saved.html"
+    animation.save(str(saved))
+    assert saved.read_text(encoding="utf-8") == animation.html
+
+
+def test_animate_modes_writes_the_command_line_page(cli, tmp_path):
+    page = tmp_path / "modes.html"
+    out = subprocess.run([cli, "modes", "three_masses", "--animate", str(page)], capture_output=True, text=True,
+                         timeout=600)
+    assert out.returncode == 0, out.stderr
+    assert eomgen.load("three_masses").animate_modes().html == page.read_text(encoding="utf-8")
+
+
+def test_a_failed_animation_keeps_its_frames(cli, tmp_path):
+    page = tmp_path / "tp.html"
+    out = subprocess.run([cli, "animate", "triple_pendulum", "--method", "rk4", "--dt", "0.5", "-o", str(page)],
+                         capture_output=True, text=True, timeout=600)
+    assert out.returncode == 1
+    with pytest.raises(eomgen.IntegrationError) as info:
+        eomgen.load("triple_pendulum").animate(method="rk4", dt=0.5)
+    assert info.value.animation is not None
+    assert info.value.animation.html == page.read_text(encoding="utf-8")
+
+
+def test_animate_refuses_what_it_cannot_draw(model_file):
+    with pytest.raises(ValueError, match="fps"):
+        eomgen.load("double_pendulum").animate(fps=0.0)
+    with pytest.raises(ValueError, match="no point"):
+        eomgen.load("double_pendulum").animate(trace=["nowhere"])
+    energy_form = "name: bare\nparameters: { k: 1.0 }\ncoordinates: [x]\nkinetic: x_dot^2/2\npotential: k*x^2/2\n"
+    with pytest.raises(eomgen.AnalysisError, match="no points"):
+        eomgen.load(model_file("bare", energy_form)).animate(t_end=1.0)

@@ -16,6 +16,7 @@ from ._eomgen import __version__
 from . import sweep
 from ._model import (
     METHODS,
+    Animation,
     Batch,
     Equations,
     Model,
@@ -30,6 +31,7 @@ from .errors import AnalysisError, EomgenError, IntegrationError, ModelError, Pa
 __all__ = [
     "METHODS",
     "AnalysisError",
+    "Animation",
     "Batch",
     "EomgenError",
     "Equations",

@@ -203,21 +203,74 @@ class Model:
             [str(s) for s in events],
         )
         solution = Solution(result, self.num_dofs)
-        failure = solution.summary_header.get("error")
-        if failure is not None:
-            t = failure.get("t")
-            reason = failure["message"]
-            kept = f"the {len(solution.t)} samples computed before it were kept"
-            if t is None or "t = " in reason:
-                message = f"integration of `{self.name}` stopped: {reason}; {kept}"
-            else:
-                message = f"integration of `{self.name}` stopped: {reason} at t = {t}; {kept}"
-            if t is None:
-                raise ValueError(reason)
-            if solution.cause is not None:
-                message += f"\n{solution.cause}"
-            raise IntegrationError(message, t, reason, solution)
+        self._raise_failure(solution, f"the {len(solution.t)} samples computed before it were kept")
         return solution
+
+    def _raise_failure(self, solution: "Solution", kept: str, animation: Optional["Animation"] = None) -> None:
+        """Raises the failure of `solution`'s run, if it stopped early: `IntegrationError`
+        (`ValueError` for options refused before the first step)."""
+        failure = solution.summary_header.get("error")
+        if failure is None:
+            return
+        t = failure.get("t")
+        reason = failure["message"]
+        if t is None:
+            raise ValueError(reason)
+        at = "" if "t = " in reason else f" at t = {t}"
+        message = f"integration of `{self.name}` stopped: {reason}{at}; {kept}"
+        if solution.cause is not None:
+            message += f"\n{solution.cause}"
+        raise IntegrationError(message, t, reason, solution, animation)
+
+    def animate(
+        self,
+        t_end: float = DEFAULT_T_END,
+        fps: float = 30.0,
+        trace: Iterable[str] = (),
+        method: str = DEFAULT_METHOD,
+        rtol: float = DEFAULT_RTOL,
+        atol: float = DEFAULT_ATOL,
+        dt: Optional[float] = None,
+        initial: Optional[Union[Mapping[str, float], ArrayLike]] = None,
+        stabilization: str = "none",
+        baumgarte: Tuple[float, float] = DEFAULT_BAUMGARTE,
+        stop_when: Iterable[str] = (),
+        events: Iterable[str] = (),
+    ) -> "Animation":
+        """Simulates the model and animates its ``draw:`` lines (``eomgen animate``): the
+        same self-contained HTML page, frames at ``t = k / fps`` from the integrator's dense
+        output, the paths of the ``trace`` points (default: the file's ``draw: trace``), the
+        energy drift over the frames. Shown inline in Jupyter; ``.save(path)`` writes the
+        page. The other arguments are :meth:`simulate`'s.
+
+        Raises:
+            IntegrationError: the integration stopped early; its ``animation`` holds the
+                frames computed before it.
+            AnalysisError: a model with nothing to draw.
+            ValueError: a bad ``fps``, an unknown trace point, options :meth:`simulate`
+                refuses.
+        """
+        y0 = None if initial is None else self.initial_state(initial).tolist()
+        page, result = _eomgen.animate_simulation(
+            self._core, float(t_end), float(fps), [str(p) for p in trace], str(method), float(rtol),
+            float(atol), None if dt is None else float(dt), y0, str(stabilization),
+            (float(baumgarte[0]), float(baumgarte[1])), [str(s) for s in stop_when], [str(s) for s in events])
+        animation = None if page is None else Animation(page)
+        solution = Solution(result, self.num_dofs)
+        frames = "no frame was computed" if animation is None else "the frames computed before it are in the animation"
+        self._raise_failure(solution, frames, animation)
+        return animation
+
+    def animate_modes(self, at: Optional[Union[str, Mapping[str, float], ArrayLike]] = None, t: float = 0.0) -> "Animation":
+        """The normal modes at an equilibrium moving, ``q* + s ψₖ sin(ωₖ t)``, one clip per
+        mode with a selector (``eomgen modes --animate``); ``at`` and ``t`` as in
+        :meth:`modes`.
+
+        Raises:
+            AnalysisError: no equilibrium found, a steady motion, a model with nothing to draw.
+        """
+        at, label = self._operating_point(at)
+        return Animation(_eomgen.animate_modes(self._core, at, label, float(t)))
 
     def simulate_many(
         self,
@@ -312,7 +365,14 @@ class Model:
             AnalysisError: no equilibrium found, or a model whose equations change with
                 ``t`` in ``M``, ``C`` or ``K``.
         """
-        label = None
+        at, label = self._operating_point(at)
+        kind, summary = self._core.modes(at, label, float(t))
+        if kind == "steady":
+            return SteadyMotion(summary)
+        return Modes(summary)
+
+    def _operating_point(self, at):
+        """`at` for the library: a name, or coordinates (a dict's, others 0) with a label."""
         if isinstance(at, Mapping):
             q = np.zeros(self.num_dofs)
             names = self.coordinates
@@ -320,14 +380,8 @@ class Model:
                 if key not in names:
                     raise ValueError(f"`{key}` is not a coordinate of `{self.name}` (coordinates: {', '.join(names)})")
                 q[names.index(key)] = float(value)
-            label = ",".join(f"{k}={v}" for k, v in at.items())
-            at = q.tolist()
-        elif at is not None and not isinstance(at, str):
-            at = [float(v) for v in np.asarray(at, dtype=float).reshape(-1)]
-        kind, summary = self._core.modes(at, label, float(t))
-        if kind == "steady":
-            return SteadyMotion(summary)
-        return Modes(summary)
+            return q.tolist(), ",".join(f"{k}={v}" for k, v in at.items())
+        return _at(at), None
 
     # --- derivations --------------------------------------------------------------------
 
@@ -711,6 +765,33 @@ class SteadyMotion:
 
     def __repr__(self) -> str:
         return f"eomgen.SteadyMotion({self.summary['model']!r}: {len(self.eigenvalues)} eigenvalues)"
+
+
+class Animation:
+    """A self-contained HTML page (no network needed) with the mechanism moving: the page
+    ``eomgen animate`` and ``eomgen modes --animate`` write, to the byte.
+
+    Attributes:
+        html: the page.
+    """
+
+    def __init__(self, html: str):
+        self.html = html
+
+    def save(self, path: str) -> None:
+        """Writes the page to ``path`` (UTF-8)."""
+        with open(path, "w", encoding="utf-8") as f:
+            f.write(self.html)
+
+    def _repr_html_(self) -> str:
+        # In its own frame: the page's script and element ids cannot meet another output's.
+        import html as _html
+
+        return (f'<iframe srcdoc="{_html.escape(self.html, quote=True)}" style="width: 100%; height: 640px; '
+                'border: 0" sandbox="allow-scripts"></iframe>')
+
+    def __repr__(self) -> str:
+        return f"eomgen.Animation({len(self.html)} bytes of HTML)"
 
 
 class Equations(str):

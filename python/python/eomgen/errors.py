@@ -51,15 +51,20 @@ class IntegrationError(EomgenError):
         message: what the command line prints: the model, the reason and the time.
         t: the time (s) at which it stopped (``None`` when it stopped before the first step).
         reason: the integrator's own message (step size too small, a non-finite state, …).
-        solution: the :class:`eomgen.Solution` of the samples computed before the failure.
+        solution: the samples computed before the failure: a :class:`eomgen.Solution`
+            (a :class:`eomgen.Batch` for a batch).
+        animation: for :meth:`eomgen.Model.animate`, the :class:`eomgen.Animation` of the
+            frames computed before the failure (``None`` when there was none).
     """
 
-    def __init__(self, message: str, t: Optional[float], reason: str, solution: Any = None):
-        super().__init__(message, t, reason, solution)
+    def __init__(self, message: str, t: Optional[float], reason: str, solution: Any = None,
+                 animation: Any = None):
+        super().__init__(message, t, reason, solution, animation)
         self.message = message
         self.t = t
         self.reason = reason
         self.solution = solution
+        self.animation = animation
 
     def __str__(self) -> str:
         return self.message
