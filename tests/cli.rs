@@ -1039,3 +1039,41 @@ fn commands_import_no_other_command() {
         root.display()
     );
 }
+
+/// Constraints that fix every coordinate leave no degree of freedom: the modal analyses say
+/// so (exit 1) instead of panicking on a 0 × 0 eigenproblem, and the model still simulates.
+#[test]
+fn issue_31_a_model_without_freedom_has_no_modes_and_no_panic() {
+    let file = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/fixtures/fully_constrained.yaml"
+    );
+    for args in [
+        &["modes", file][..],
+        &[
+            "study",
+            "parameter-sweep",
+            file,
+            "--parameter",
+            "g",
+            "--values",
+            "1..2:3",
+        ][..],
+        &["study", "free-response", file][..],
+    ] {
+        let out = eomgen(args);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {stderr}");
+        assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+        assert!(
+            stderr.contains("no degree of freedom"),
+            "{args:?}: {stderr}"
+        );
+    }
+    let out = eomgen(&["simulate", file, "--t-end", "1"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}

@@ -155,6 +155,16 @@ pub enum ModalError {
         /// The largest `|q̇ᵢ|` given.
         speed: f64,
     },
+    /// The constraints fix every coordinate: no motion is left to have modes.
+    #[error(
+        "the {constraints} constraint(s) fix all {coordinates} coordinate(s) at the operating point: no degree of freedom is left, so there are no modes"
+    )]
+    NoDegreesOfFreedom {
+        /// `n`.
+        coordinates: usize,
+        /// The holonomic constraints `m` (independent ones at least `n`).
+        constraints: usize,
+    },
     /// The operating point has the wrong number of coordinates.
     #[error("the operating point has {found} coordinates, the model {expected}")]
     DimensionMismatch {
@@ -1101,6 +1111,12 @@ pub fn linearize(
         k_full += h * *l;
     }
     let (basis, independent) = null_space_by_partitioning(&j);
+    if basis.ncols() == 0 {
+        return Err(ModalError::NoDegreesOfFreedom {
+            coordinates: n,
+            constraints: m,
+        });
+    }
     let nt = basis.transpose();
     let mass_matrix = &nt * &mass * &basis;
     let minimal: Vec<&str> = independent.iter().map(|&i| names[i]).collect();
