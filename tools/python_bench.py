@@ -413,8 +413,8 @@ def bench_equal_error(args, files, built, tmp):
         def fun(t, y):
             # PyDy's generated function returns the same output array on every call; SciPy
             # keeps the stages' derivatives, so without a copy each call overwrites the
-            # previous stages (7x the RHS evaluations and 1000x the error on the double
-            # pendulum at 1e-12).
+            # previous stages (at tol 1e-12 on the double pendulum: 6.8x the RHS evaluations
+            # and 3,500x the error).
             return f(y, t, p).copy()
 
         log(f"pydy: n = {n}, t_end = {t_end}: references")

@@ -11,7 +11,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::errors::analysis_error;
-use crate::model::{CoreModel, RunOptions, equilibrium_start, run_error, run_simulation};
+use crate::model::{CoreModel, RunError, RunOptions, equilibrium_start, run_simulation};
 
 /// An animation that cannot be made, in the Python API's words (the library's messages name
 /// the command line's options).
@@ -51,7 +51,7 @@ pub fn animate_simulation<'py>(
     py: Python<'py>,
     model: &CoreModel,
     t_end: f64,
-    fps: f64,
+    fps: Option<f64>,
     trace: Vec<String>,
     method_name: &str,
     rtol: f64,
@@ -63,7 +63,10 @@ pub fn animate_simulation<'py>(
     stop_when: Vec<String>,
     event: Vec<String>,
 ) -> PyResult<(Option<String>, Bound<'py, PyDict>)> {
-    let options = AnimationOptions { fps, trace };
+    let options = AnimationOptions {
+        fps: fps.unwrap_or(eomgen::animation::DEFAULT_FPS),
+        trace,
+    };
     let mut instance = model.fresh()?;
     options.frame_count(t_end).map_err(animation_error)?;
     let times = frame_times(instance.as_ref(), t_end, &options).map_err(animation_error)?;
@@ -87,9 +90,9 @@ pub fn animate_simulation<'py>(
             let simulation = run_simulation(model_ref.as_mut(), &run)?;
             let page = simulation_animation(model_ref.as_ref(), &simulation, &options)
                 .map(|animation| animation.map(|a| a.to_html()));
-            Ok::<_, String>((simulation, page))
+            Ok::<_, RunError>((simulation, page))
         })
-        .map_err(run_error)?;
+        .map_err(RunError::into_py)?;
     let page = page.map_err(animation_error)?;
     let report = crate::model::simulation_dict(py, instance.as_ref(), simulation)?;
     Ok((page, report))

@@ -12,27 +12,41 @@ use rayon::prelude::*;
 
 use crate::convert::matrix;
 use crate::model::{
-    CoreModel, RunOptions, instantiate, method, run_simulation, set_parameter, stabilization,
+    CoreModel, RunError, RunOptions, method, run_simulation, set_parameter, stabilization,
 };
 
-/// One run's outcome: the samples at the output times (NaN past a failure), the energy,
-/// the work, and the failure if any.
+/// How a run ended.
+enum Ended {
+    /// At `t_end`.
+    Reached,
+    /// At a terminal event of the model file: `(t, name)`.
+    Event(f64, String),
+    /// An integration failure: `(t, reason)`.
+    Failed(f64, String),
+    /// No start: the initial state does not satisfy the constraints (kept with
+    /// `errors="keep"`).
+    NotStarted(String),
+}
+
+/// One run's outcome: the samples at the output times (NaN past the run's end), the energy,
+/// the work, and how it ended.
 struct Outcome {
     y: Vec<f64>,
     energy: Vec<f64>,
     stats: eomgen::Stats,
-    /// `(t, message)` of a failed integration (`t` NaN before the first step).
-    failure: Option<(f64, String)>,
+    end: Ended,
 }
 
 /// Runs `b` simulations of `model` and stacks them: see `eomgen.Model.simulate_many`.
 ///
-/// Returns `{"t" (k,), "y" (b, k, 2n), "energy" (b, k), "ok" (b,), "steps", "rejected",
-/// "rhs_evals" (b,), "failures": [(index, t, message)]}`; a run that could not start (an
-/// unknown parameter, constraints that cannot be met) raises.
+/// Returns `{"t" (k,), "y" (b, k, 2n), "energy" (b, k), "ok" (b,), "t_final" (b,), "steps",
+/// "rejected", "rhs_evals" (b,), "failures": [(index, t, reason)], "stopped_by_event":
+/// [(index, t, event)]}`. Options every run shares that are refused raise `ValueError`; a
+/// run whose initial state the constraints cannot accept raises `AnalysisError`, or with
+/// `keep_failures` is a failure with `t` NaN.
 #[pyfunction]
 #[allow(clippy::too_many_arguments)]
-#[pyo3(signature = (model, initial_states, parameters, t_end, t_out, method_name, rtol, atol, dt, stabilization_name, baumgarte, threads))]
+#[pyo3(signature = (model, initial_states, parameters, t_end, t_out, method_name, rtol, atol, dt, stabilization_name, baumgarte, threads, keep_failures))]
 pub fn simulate_many<'py>(
     py: Python<'py>,
     model: &CoreModel,
@@ -47,7 +61,13 @@ pub fn simulate_many<'py>(
     stabilization_name: &str,
     baumgarte: (f64, f64),
     threads: Option<usize>,
+    keep_failures: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
+    if threads == Some(0) {
+        return Err(pyo3::exceptions::PyValueError::new_err(
+            "threads must be at least 1 (None: one per core)",
+        ));
+    }
     let dim = 2 * model.fresh()?.num_dofs();
     let states: Option<Vec<Vec<f64>>> = match &initial_states {
         Some(a) => {
@@ -110,14 +130,16 @@ pub fn simulate_many<'py>(
     let loaded = model.loaded.clone();
     let overrides = model.overrides.clone();
     let k = t_out.len();
-    let one = |i: usize| -> Result<Outcome, String> {
-        let mut instance = instantiate(&loaded, &overrides).map_err(|e| e.to_string())?;
-        if let Some(sets) = &parameters {
-            for (name, value) in &sets[i] {
-                instance
-                    .set_parameter(name, *value)
-                    .map_err(|e| e.to_string())?;
-            }
+    // One run on a thread of the pool: plain data in and out (no interpreter objects).
+    let one = |i: usize| -> Result<Outcome, RunError> {
+        let mut instance = loaded.source.instantiate_send();
+        let sets = overrides
+            .iter()
+            .chain(parameters.iter().flat_map(|p| &p[i]));
+        for (name, value) in sets {
+            instance
+                .set_parameter(name, *value)
+                .map_err(|e| RunError::Value(e.to_string()))?;
         }
         let run = RunOptions {
             options: SimulationOptions {
@@ -127,8 +149,29 @@ pub fn simulate_many<'py>(
             stop_when: Vec::new(),
             event: Vec::new(),
         };
-        let simulation =
-            run_simulation(instance.as_mut(), &run).map_err(|e| format!("run {i}: {e}"))?;
+        let simulation = match run_simulation(instance.as_mut(), &run) {
+            Ok(simulation) => simulation,
+            // A state the constraints cannot accept is this run's; kept when asked.
+            Err(RunError::Analysis(reason)) if keep_failures => {
+                return Ok(Outcome {
+                    y: vec![f64::NAN; k * dim],
+                    energy: vec![f64::NAN; k],
+                    stats: eomgen::Stats::default(),
+                    end: Ended::NotStarted(reason),
+                });
+            }
+            Err(e) => return Err(e.context(&format!("run {i}"))),
+        };
+        let end = match (&simulation.failure, simulation.solution.terminated_by_event) {
+            // Options refused before the first step are every run's: not a run's failure.
+            (Some(e), _) if e.t().is_none() => return Err(RunError::Value(e.to_string())),
+            (Some(e), _) => Ended::Failed(e.t().unwrap_or(f64::NAN), e.to_string()),
+            (None, Some(k)) => {
+                let event = &simulation.solution.events[k];
+                Ended::Event(event.t, event.name.clone())
+            }
+            (None, None) => Ended::Reached,
+        };
         let mut y = simulation.solution.y;
         let mut energy = simulation.energy.energy;
         y.resize(k * dim, f64::NAN);
@@ -137,34 +180,29 @@ pub fn simulate_many<'py>(
             y,
             energy,
             stats: simulation.solution.stats,
-            failure: simulation
-                .failure
-                .map(|e| (e.t().unwrap_or(f64::NAN), e.to_string())),
+            end,
         })
     };
-    let outcomes: Result<Vec<Outcome>, String> = py.detach(|| {
+    let outcomes: Result<Vec<Outcome>, RunError> = py.detach(|| {
         let run_all = || (0..batch).into_par_iter().map(one).collect();
         match threads {
             Some(n) => rayon::ThreadPoolBuilder::new()
-                .num_threads(n.max(1))
+                .num_threads(n)
                 .build()
-                .map_err(|e| format!("the thread pool: {e}"))?
+                .map_err(|e| RunError::Analysis(format!("the thread pool: {e}")))?
                 .install(run_all),
             None => run_all(),
         }
     });
-    let outcomes = outcomes.map_err(|message| match message.split_once(": ") {
-        Some((_, rest)) if rest.starts_with("analysis: ") => {
-            crate::errors::analysis_error(message.replacen("analysis: ", "", 1))
-        }
-        _ => pyo3::exceptions::PyValueError::new_err(message.replacen("value: ", "", 1)),
-    })?;
+    let outcomes = outcomes.map_err(RunError::into_py)?;
     let out = PyDict::new(py);
     out.set_item("t", PyArray1::from_vec(py, t_out))?;
     let mut y = Vec::with_capacity(batch * k * dim);
     let mut energy = Vec::with_capacity(batch * k);
     let failures = PyList::empty(py);
-    let (mut ok, mut steps, mut rejected, mut rhs_evals) = (
+    let stopped = PyList::empty(py);
+    let (mut ok, mut t_final, mut steps, mut rejected, mut rhs_evals) = (
+        Vec::with_capacity(batch),
         Vec::with_capacity(batch),
         Vec::with_capacity(batch),
         Vec::with_capacity(batch),
@@ -173,12 +211,29 @@ pub fn simulate_many<'py>(
     for (i, o) in outcomes.into_iter().enumerate() {
         y.extend_from_slice(&o.y);
         energy.extend_from_slice(&o.energy);
-        ok.push(o.failure.is_none());
         steps.push(o.stats.steps as u64);
         rejected.push(o.stats.rejected as u64);
         rhs_evals.push(o.stats.rhs_evals as u64);
-        if let Some((t, message)) = o.failure {
-            failures.append((i, t, message))?;
+        match o.end {
+            Ended::Reached => {
+                ok.push(true);
+                t_final.push(t_end);
+            }
+            Ended::Event(t, name) => {
+                ok.push(true);
+                t_final.push(t);
+                stopped.append((i, t, name))?;
+            }
+            Ended::Failed(t, reason) => {
+                ok.push(false);
+                t_final.push(t);
+                failures.append((i, t, reason))?;
+            }
+            Ended::NotStarted(reason) => {
+                ok.push(false);
+                t_final.push(f64::NAN);
+                failures.append((i, f64::NAN, reason))?;
+            }
         }
     }
     let y = matrix(py, y, batch, k * dim)?.call_method1("reshape", (batch, k, dim))?;
@@ -189,5 +244,7 @@ pub fn simulate_many<'py>(
     out.set_item("rejected", PyArray1::from_vec(py, rejected))?;
     out.set_item("rhs_evals", PyArray1::from_vec(py, rhs_evals))?;
     out.set_item("failures", failures)?;
+    out.set_item("t_final", PyArray1::from_vec(py, t_final))?;
+    out.set_item("stopped_by_event", stopped)?;
     Ok(out)
 }

@@ -18,7 +18,7 @@ pub enum Lists {
     /// As Python lists: the dict equals `json.loads` of the command line's `--json` output.
     Plain,
     /// A non-empty list of numbers as a 1-D array (`int64` when every entry is an integer,
-    /// else `float64`), a non-empty list of equal-length non-empty lists of numbers as a 2-D
+    /// else `float64`, with `None` — a value not defined there — as NaN), a non-empty list of equal-length non-empty lists of numbers as a 2-D
     /// array (one row per inner list), and a table — a non-empty list of objects with the
     /// same keys and scalar values (a study's runs) — as a dict of columns (numbers as
     /// arrays, `None` in a column of numbers as NaN, booleans as a `bool` array, anything
@@ -101,7 +101,9 @@ fn numeric_array<'py>(py: Python<'py>, items: &[Value]) -> PyResult<Option<Bound
     if items.is_empty() {
         return Ok(None);
     }
-    if items.iter().all(Value::is_number) {
+    // Numbers with `null` among them (a value that is not finite, or not defined there:
+    // an unbounded resonance) are a float array with NaN there, as in a table's columns.
+    if items.iter().all(|v| v.is_number() || v.is_null()) && items.iter().any(Value::is_number) {
         return flat(py, items).map(Some);
     }
     let rows: Option<Vec<&Vec<Value>>> = items.iter().map(Value::as_array).collect();

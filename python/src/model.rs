@@ -144,12 +144,14 @@ impl CoreModel {
         instantiate(&self.loaded, &self.overrides)
     }
 
-    /// Runs `f` on the cached instance.
+    /// Runs `f` on the cached instance. An evaluation that panicked (a bug, reported as
+    /// such by pyo3) left nothing half-done that the next one reads: every evaluation
+    /// computes from the state it is given, so the lock is taken back.
     fn with_instance<T>(&self, f: impl FnOnce(&mut dyn ModelInfo) -> T) -> PyResult<T> {
         let mut guard = self
             .instance
             .lock()
-            .map_err(|_| analysis_error("the model's instance was poisoned by a panic"))?;
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
         Ok(f(guard.as_mut()))
     }
 }
@@ -210,31 +212,58 @@ pub(crate) struct RunOptions {
     pub event: Vec<String>,
 }
 
+/// Why a simulation could not start, as the exception it becomes: options or event
+/// expressions that are refused (`ValueError`), or a state the constraints cannot accept
+/// (`AnalysisError`). Plain data, so that it crosses threads without the interpreter.
+#[derive(Debug, Clone)]
+pub(crate) enum RunError {
+    /// A refused option or expression.
+    Value(String),
+    /// An initial state that cannot be made consistent with the constraints.
+    Analysis(String),
+}
+
+impl RunError {
+    /// The exception.
+    pub(crate) fn into_py(self) -> PyErr {
+        match self {
+            RunError::Value(m) => pyo3::exceptions::PyValueError::new_err(m),
+            RunError::Analysis(m) => analysis_error(m),
+        }
+    }
+
+    /// The same error with `context` before its message.
+    pub(crate) fn context(self, context: &str) -> RunError {
+        match self {
+            RunError::Value(m) => RunError::Value(format!("{context}: {m}")),
+            RunError::Analysis(m) => RunError::Analysis(format!("{context}: {m}")),
+        }
+    }
+}
+
 /// One simulation on `model` (events added from expressions), off the interpreter.
 pub(crate) fn run_simulation(
     model: &mut dyn ModelInfo,
     run: &RunOptions,
-) -> Result<eomgen::analysis::Simulation, String> {
+) -> Result<eomgen::analysis::Simulation, RunError> {
     let mut added = ExpressionEvents::parse(model, &run.stop_when, &run.event)
-        .map_err(|e| format!("value: {e}"))?;
+        .map_err(|e| RunError::Value(e.to_string()))?;
     let added: Option<&mut dyn AddedEvents> = if added.is_empty() {
         None
     } else {
         Some(&mut added)
     };
     simulate_with_events(model, &run.options, added).map_err(|e| match e {
-        e @ SimulationError::InconsistentInitialState { .. } => format!("analysis: {e}"),
-        e => format!("value: {e}"),
+        e @ SimulationError::InconsistentInitialState { has_guesses, .. } => {
+            let what_to_do = if has_guesses {
+                "start Newton from other guesses (initial=…)"
+            } else {
+                "give the dependent coordinates consistent values (initial=…), or mark them `{ guess: … }` in the model file's `initial:`"
+            };
+            RunError::Analysis(format!("{e}; {what_to_do}"))
+        }
+        e => RunError::Value(e.to_string()),
     })
-}
-
-/// An error string of [`run_simulation`] as its exception.
-pub(crate) fn run_error(message: String) -> PyErr {
-    match message.split_once(": ") {
-        Some(("analysis", m)) => analysis_error(m),
-        Some(("value", m)) => pyo3::exceptions::PyValueError::new_err(m.to_string()),
-        _ => analysis_error(message),
-    }
 }
 
 /// A simulation's results for the Python layer: `{"summary", "t", "y", "energy",
@@ -300,6 +329,7 @@ pub(crate) fn equilibrium_start(
         return Ok(EquilibriumStart::Named(name));
     }
     let q: Vec<f64> = at.extract()?;
+    finite("at", &q)?;
     let label = label.unwrap_or_else(|| {
         format!(
             "q = [{}]",
@@ -307,6 +337,28 @@ pub(crate) fn equilibrium_start(
         )
     });
     Ok(EquilibriumStart::Guess { label, q })
+}
+
+/// `values` (argument `name`) when every entry is finite, else a `ValueError` naming it.
+pub(crate) fn finite<'a>(name: &str, values: &'a [f64]) -> PyResult<&'a [f64]> {
+    match values.iter().position(|v| !v.is_finite()) {
+        None => Ok(values),
+        Some(i) => Err(pyo3::exceptions::PyValueError::new_err(format!(
+            "{name}[{i}] is {}: the model is evaluated at finite values only",
+            values[i]
+        ))),
+    }
+}
+
+/// `t` when it is finite, else a `ValueError`.
+fn finite_time(t: f64) -> PyResult<f64> {
+    if t.is_finite() {
+        Ok(t)
+    } else {
+        Err(pyo3::exceptions::PyValueError::new_err(format!(
+            "t is {t}: the model is evaluated at finite times only"
+        )))
+    }
 }
 
 /// An operating point that could not be found or analysed as `AnalysisError`.
@@ -482,7 +534,7 @@ impl CoreModel {
         let started = std::time::Instant::now();
         let simulation = py
             .detach(|| run_simulation(model.as_mut(), &run))
-            .map_err(run_error)?;
+            .map_err(RunError::into_py)?;
         let library_time = started.elapsed().as_secs_f64();
         let out = simulation_dict(py, model.as_ref(), simulation)?;
         // The library call's own wall time, for the measurement of what the binding adds.
@@ -596,7 +648,8 @@ impl CoreModel {
         t: f64,
         y: PyReadonlyArray1<'py, f64>,
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-        let y = y.as_slice()?;
+        let y = finite("y", y.as_slice()?)?;
+        let t = finite_time(t)?;
         let dy = self.with_instance(|m| {
             let dim = 2 * m.num_dofs();
             if y.len() != dim {
@@ -620,7 +673,11 @@ impl CoreModel {
         qdot: PyReadonlyArray1<'py, f64>,
         t: f64,
     ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyArray1<f64>>)> {
-        let (q, qdot) = (q.as_slice()?, qdot.as_slice()?);
+        let (q, qdot) = (
+            finite("q", q.as_slice()?)?,
+            finite("qdot", qdot.as_slice()?)?,
+        );
+        let t = finite_time(t)?;
         let result = self.with_instance(|m| {
             let n = m.num_dofs();
             if q.len() != n || qdot.len() != n {
@@ -645,7 +702,8 @@ impl CoreModel {
 
     /// The kinetic and potential energies `(T, V)` (J) at `(t, y)`.
     fn energies(&self, t: f64, y: PyReadonlyArray1<'_, f64>) -> PyResult<(f64, f64)> {
-        let y = y.as_slice()?;
+        let y = finite("y", y.as_slice()?)?;
+        let t = finite_time(t)?;
         let result = self.with_instance(|m| {
             if y.len() != 2 * m.num_dofs() {
                 return Err(format!(

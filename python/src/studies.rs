@@ -131,14 +131,14 @@ fn study_parameter_sweep<'py>(
 /// The frequency response to a harmonic input about an equilibrium (`eomgen frf`).
 #[pyfunction]
 #[allow(clippy::too_many_arguments)]
-#[pyo3(signature = (model, input, outputs = Vec::new(), frequency_range = None, points = FrfOptions::DEFAULT_POINTS, frequencies = Vec::new(), modal = false, at = None))]
+#[pyo3(signature = (model, input, outputs = Vec::new(), frequency_range = None, points = None, frequencies = Vec::new(), modal = false, at = None))]
 fn study_frf<'py>(
     py: Python<'py>,
     model: &CoreModel,
     input: String,
     outputs: Vec<String>,
     frequency_range: Option<(f64, f64)>,
-    points: usize,
+    points: Option<usize>,
     frequencies: Vec<f64>,
     modal: bool,
     at: Option<&Bound<'py, PyAny>>,
@@ -148,7 +148,7 @@ fn study_frf<'py>(
         input,
         outputs,
         frequency_range,
-        points,
+        points: points.unwrap_or(FrfOptions::DEFAULT_POINTS),
         frequencies,
         modal,
         simulation: None,
@@ -190,10 +190,32 @@ fn study_floquet<'py>(
         },
     };
     let mut instance = model.fresh()?;
+    let (label, _) = options
+        .operating_point
+        .start
+        .resolve(instance.as_ref())
+        .map_err(analysis_error)?;
     let point = py
         .detach(|| vibration::floquet_at_equilibrium(instance.as_mut(), &options))
         .map_err(analysis_error)?;
-    let summary = point.summary(instance.as_ref(), &options, Vec::new(), None);
+    // What the model file's `floquet:` references predict here (the Kapitza threshold of
+    // the Mathieu pendulum), as the command line reports them.
+    let references =
+        eomgen::FloquetReferences::of(instance.description(), &label).map_err(analysis_error)?;
+    let predictions = references
+        .map(|r| r.thresholds(instance.as_ref()))
+        .unwrap_or_default()
+        .into_iter()
+        .map(|t| vibration::PredictionSummary {
+            name: t.name,
+            key: t.key,
+            value: t.value,
+            critical: t.critical,
+            equilibrium: label.clone(),
+            predicts_stable: t.predicts_stable,
+        })
+        .collect();
+    let summary = point.summary(instance.as_ref(), &options, predictions, None);
     to_python(py, &summary, Lists::Arrays)
 }
 
@@ -212,7 +234,7 @@ fn deviation(q: Option<Vec<f64>>, qdot: Option<Vec<f64>>, n: usize) -> Option<In
 /// linearised and the nonlinear equations integrated (`eomgen study free-response`).
 #[pyfunction]
 #[allow(clippy::too_many_arguments)]
-#[pyo3(signature = (model, at = None, dq0 = None, dqdot0 = None, t_end = None, samples = FreeResponseOptions::DEFAULT_SAMPLES, tol = FreeResponseOptions::DEFAULT_TOL))]
+#[pyo3(signature = (model, at = None, dq0 = None, dqdot0 = None, t_end = None, samples = None, tol = None))]
 fn study_free_response<'py>(
     py: Python<'py>,
     model: &CoreModel,
@@ -220,16 +242,16 @@ fn study_free_response<'py>(
     dq0: Option<Vec<f64>>,
     dqdot0: Option<Vec<f64>>,
     t_end: Option<f64>,
-    samples: usize,
-    tol: f64,
+    samples: Option<usize>,
+    tol: Option<f64>,
 ) -> PyResult<Bound<'py, PyAny>> {
     let mut instance = model.fresh()?;
     let options = FreeResponseOptions {
         operating_point: point(at)?,
         initial: deviation(dq0, dqdot0, instance.num_dofs()),
         t_end,
-        samples,
-        tol,
+        samples: samples.unwrap_or(FreeResponseOptions::DEFAULT_SAMPLES),
+        tol: tol.unwrap_or(FreeResponseOptions::DEFAULT_TOL),
     };
     let model_ref = &mut instance;
     let study = py
@@ -242,7 +264,7 @@ fn study_free_response<'py>(
 /// (`eomgen study modal-damping`).
 #[pyfunction]
 #[allow(clippy::too_many_arguments)]
-#[pyo3(signature = (model, at = None, rayleigh_modes = None, dq0 = None, dqdot0 = None, t_end = None, samples = ModalDampingOptions::DEFAULT_SAMPLES, tol = ModalDampingOptions::DEFAULT_TOL))]
+#[pyo3(signature = (model, at = None, rayleigh_modes = None, dq0 = None, dqdot0 = None, t_end = None, samples = None, tol = None))]
 fn study_modal_damping<'py>(
     py: Python<'py>,
     model: &CoreModel,
@@ -251,8 +273,8 @@ fn study_modal_damping<'py>(
     dq0: Option<Vec<f64>>,
     dqdot0: Option<Vec<f64>>,
     t_end: Option<f64>,
-    samples: usize,
-    tol: f64,
+    samples: Option<usize>,
+    tol: Option<f64>,
 ) -> PyResult<Bound<'py, PyAny>> {
     let mut instance = model.fresh()?;
     let options = ModalDampingOptions {
@@ -260,8 +282,8 @@ fn study_modal_damping<'py>(
         rayleigh_modes,
         initial: deviation(dq0, dqdot0, instance.num_dofs()),
         t_end,
-        samples,
-        tol,
+        samples: samples.unwrap_or(ModalDampingOptions::DEFAULT_SAMPLES),
+        tol: tol.unwrap_or(ModalDampingOptions::DEFAULT_TOL),
     };
     let model_ref = &mut instance;
     let study = py

@@ -1,5 +1,9 @@
 """Shared fixtures: the command-line program (for comparisons with its `--json`), model files
-written to a temporary directory."""
+written to a temporary directory.
+
+With EOMGEN_CI=1 (as `.ci/run` sets it) nothing may be skipped: the command-line program must
+be found, and a test skipped for any other reason (Dask or SciPy missing) fails the run.
+"""
 
 import os
 import pathlib
@@ -25,11 +29,11 @@ def cli_path():
 @pytest.fixture(scope="session")
 def cli():
     """The path of the `eomgen` program; the tests that compare with it are skipped where
-    it is not built, and fail instead when EOMGEN_REQUIRE_CLI=1 (CI builds it first)."""
+    it is not built, and fail instead when EOMGEN_CI=1 (CI builds it first)."""
     path = cli_path()
     if path is None:
-        if os.environ.get("EOMGEN_REQUIRE_CLI") == "1":
-            pytest.fail("EOMGEN_REQUIRE_CLI=1 but no eomgen program was found (set EOMGEN_CLI)")
+        if os.environ.get("EOMGEN_CI") == "1":
+            pytest.fail("EOMGEN_CI=1 but no eomgen program was found (set EOMGEN_CLI)")
         pytest.skip("the eomgen program is not built (cargo build); set EOMGEN_CLI to compare with it")
     return path
 
@@ -47,3 +51,14 @@ def model_file(tmp_path):
         return str(path)
 
     return write
+
+
+def pytest_sessionfinish(session, exitstatus):
+    """With EOMGEN_CI=1, a run that skipped a test is a failed run."""
+    if os.environ.get("EOMGEN_CI") != "1":
+        return
+    reporter = session.config.pluginmanager.get_plugin("terminalreporter")
+    skipped = reporter.stats.get("skipped", []) if reporter is not None else []
+    if skipped:
+        reporter.write_line(f"EOMGEN_CI=1: {len(skipped)} test(s) skipped; every test must run in CI", red=True)
+        session.exitstatus = 1

@@ -18,6 +18,31 @@ import pytest
 import eomgen
 
 
+def assert_report_equals_json(got, want, path="report"):
+    """A study's report (numeric lists as arrays, tables as columns) equals the command
+    line's JSON object exactly: the same keys, the same numbers (None in the JSON where the
+    array has NaN)."""
+    if isinstance(got, np.ndarray):
+        expected = np.array([np.nan if v is None else v for v in np.ravel(np.array(want, dtype=object))],
+                            dtype=float).reshape(np.shape(want))
+        np.testing.assert_array_equal(got, expected, err_msg=path)
+    elif isinstance(got, dict) and isinstance(want, list):
+        assert len(want) > 0 and all(isinstance(r, dict) for r in want), path
+        assert set(got) == set(want[0]), path
+        for key in got:
+            assert_report_equals_json(got[key], [r[key] for r in want], f"{path}.{key}")
+    elif isinstance(got, dict):
+        assert set(got) == set(want), (path, set(got) ^ set(want))
+        for key in got:
+            assert_report_equals_json(got[key], want[key], f"{path}.{key}")
+    elif isinstance(got, list):
+        assert len(got) == len(want), path
+        for i, (a, b) in enumerate(zip(got, want)):
+            assert_report_equals_json(a, b, f"{path}[{i}]")
+    else:
+        assert got == want, (path, got, want)
+
+
 def run_cli(cli, *args):
     """`eomgen ARGS --json`, parsed (the exit status is returned too)."""
     out = subprocess.run([cli, *args, "--json"], capture_output=True, text=True, timeout=600)
@@ -407,11 +432,7 @@ def test_frf_equals_the_closed_form():
 def test_parameter_sweep_finds_the_rolling_disc_critical_speed():
     # The rolling disc upright is stable above v = sqrt(g r / 3).
     m = eomgen.load("rolling_disc")
-    steady = next(name for name in m.description()["equilibria"])
-    names = [n for n in m.parameters if n in ("v", "speed", "v0")]
-    if not names:
-        pytest.skip("rolling_disc names its speed otherwise")
-    report = m.parameter_sweep(names[0], np.linspace(0.2, 2.0, 10), at=steady)
+    report = m.parameter_sweep("v", np.linspace(0.2, 2.0, 10), at="rolling")
     changes = report["stability_changes"]
     assert changes
     r, g = m.parameters.get("r"), m.parameters.get("g")
@@ -442,14 +463,23 @@ def test_floquet_multipliers_of_the_mathieu_pendulum(cli):
     assert report["spectral_radius"] <= 1.0 + 1e-6 and report["stable"]
     status, expected = run_cli(cli, "study", "floquet", "mathieu_pendulum")
     assert status == 0
-    for key in ("multipliers", "monodromy_matrix", "spectral_radius", "period", "determinant"):
-        got = report[key]
-        want = expected[key]
-        if isinstance(got, dict):  # a table comes as columns; the JSON has rows
-            for part in got:
-                np.testing.assert_array_equal(np.asarray(got[part]), np.asarray([row[part] for row in want]))
-        else:
-            np.testing.assert_array_equal(np.asarray(got), np.asarray(want))
+    assert_report_equals_json(report, expected)
+    assert "kapitza" in report  # the file's `floquet:` reference, evaluated
+
+
+def test_studies_equal_the_command_line_json(cli):
+    cases = [
+        (eomgen.load("three_masses").free_response(), ("study", "free-response", "three_masses")),
+        (eomgen.load("three_masses_damped").modal_damping(), ("study", "modal-damping", "three_masses_damped")),
+        (eomgen.load("forced_oscillator").frf("A", frequencies=[0.5, 2.0]),
+         ("frf", "forced_oscillator", "--input", "A", "--frequency", "0.5", "--frequency", "2")),
+    ]
+    for report, args in cases:
+        status, expected = run_cli(cli, *args)
+        assert status == 0, args
+        expected.pop("chart", None)
+        expected.pop("charts", None)
+        assert_report_equals_json(report, expected, " ".join(args))
 
 
 def test_free_response_four_ways_agree():
@@ -534,3 +564,67 @@ def test_animate_refuses_what_it_cannot_draw(model_file):
     energy_form = "name: bare\nparameters: { k: 1.0 }\ncoordinates: [x]\nkinetic: x_dot^2/2\npotential: k*x^2/2\n"
     with pytest.raises(eomgen.AnalysisError, match="no points"):
         eomgen.load(model_file("bare", energy_form)).animate(t_end=1.0)
+
+
+def test_a_terminal_event_ends_a_batch_run_without_failing_it():
+    # The eccentric cylinder's `lift_off` event is terminal: the run ends there, not at t_end.
+    m = eomgen.load("eccentric_cylinder")
+    t_out = np.linspace(0.0, 10.0, 11)
+    batch = m.simulate_many(initial_states=[m.initial_state()], t_end=10.0, t_out=t_out)
+    single = m.simulate(t_end=10.0, t_out=t_out)
+    (index, t, event), = batch.stopped_by_event
+    assert (index, event) == (0, single.events[-1]["name"]) and single.events[-1]["terminal"]
+    assert t == single.events[-1]["t"] == batch.t_final[0] < 10.0
+    assert batch.ok[0] and not batch.failures
+    reached = len(single.t)
+    assert np.array_equal(batch.y[0, :reached], single.y)
+    assert np.isnan(batch.y[0, reached:]).all()
+
+
+def test_a_batch_refuses_shared_options_and_keeps_runs_that_cannot_start():
+    m = eomgen.load("simple_pendulum_cartesian")
+    y0 = m.initial_state()
+    for keep in ("raise", "keep"):
+        with pytest.raises(ValueError, match="outside"):
+            m.simulate_many(initial_states=[y0, y0], t_end=1.0, t_out=[0.5, 2.0], errors=keep)
+    bad = np.array([y0, [5.0, 5.0, 0.0, 0.0], y0])
+    with pytest.raises(eomgen.AnalysisError, match="run 1"):
+        m.simulate_many(initial_states=bad, t_end=1.0)
+    batch = m.simulate_many(initial_states=bad, t_end=1.0, errors="keep")
+    assert batch.ok.tolist() == [True, False, True]
+    (index, t, reason), = batch.failures
+    assert index == 1 and math.isnan(t) and "violates" in reason
+    assert np.isnan(batch.y[1]).all() and np.isfinite(batch.y[[0, 2]]).all()
+    with pytest.raises(ValueError, match="threads"):
+        m.simulate_many(initial_states=[y0], threads=0)
+    with pytest.raises(ValueError, match="shape"):
+        m.simulate_many(initial_states=np.zeros((2, 2, 4)))
+
+
+def test_evaluations_refuse_values_that_are_not_finite():
+    m = eomgen.load("double_pendulum")
+    for call in (lambda: m.rhs(0.0, [math.nan, 0, 0, 0]), lambda: m.mass_matrix([math.nan, 0.0]),
+                 lambda: m.forcing([0.0, 0.0], [math.inf, 0.0]), lambda: m.energy([0, 0, math.nan, 0]),
+                 lambda: m.rhs(math.nan, [0, 0, 0, 0]), lambda: m.modes(at=[math.nan, 0.0])):
+        with pytest.raises(ValueError, match="finite"):
+            call()
+
+
+def test_an_undamped_resonance_is_nan_in_an_array():
+    # c = 0: |H| is unbounded at ω = ωn = 1; the amplitude array holds NaN there (the JSON's
+    # null) and the closed form 1/|k − m ω²| elsewhere.
+    m = eomgen.load("forced_oscillator").with_parameters(c=0.0)
+    report = m.frf("A", frequency_range=(0.5, 2.0), points=3)
+    amplitude = report["responses"][0]["amplitude"]
+    assert isinstance(amplitude, np.ndarray) and np.isnan(amplitude[1])
+    np.testing.assert_allclose(amplitude[[0, 2]], [1 / (1 - 0.25), 1 / (4 - 1)], rtol=1e-12)
+
+
+def test_a_model_without_freedom_has_no_modes(model_file):
+    text = ("name: fixed\nparameters: { m: 1.0, g: 10.0, l: 1.0 }\ncoordinates: [x, y]\n"
+            "points: { O: [0, 0], P: [x, y] }\nbodies: { bob: { mass: m, at: P } }\ngravity: [0, -g]\n"
+            "constraints: { cx: x - l, cy: y }\ninitial: { x: l, y: 0 }\n")
+    m = eomgen.load(model_file("fixed", text))
+    assert np.isfinite(m.simulate(t_end=1.0).y).all()
+    with pytest.raises(eomgen.AnalysisError, match="no degree of freedom"):
+        m.modes()

@@ -36,7 +36,11 @@ def load(name_or_path: str) -> "Model":
         ModelError: an unknown name, an unreadable file, or a file with mistakes (its
             ``diagnostics`` give file, line, column, message and help for each).
     """
-    return Model(_eomgen._Model.load(str(name_or_path)))
+    if not isinstance(name_or_path, (str, bytes)) and not hasattr(name_or_path, "__fspath__"):
+        raise TypeError(f"load takes a model's name or a path, got {type(name_or_path).__name__}")
+    import os
+
+    return Model(_eomgen._Model.load(os.fsdecode(name_or_path)))
 
 
 def bundled_models() -> List[str]:
@@ -225,7 +229,7 @@ class Model:
     def animate(
         self,
         t_end: float = DEFAULT_T_END,
-        fps: float = 30.0,
+        fps: Optional[float] = None,
         trace: Iterable[str] = (),
         method: str = DEFAULT_METHOD,
         rtol: float = DEFAULT_RTOL,
@@ -238,7 +242,8 @@ class Model:
         events: Iterable[str] = (),
     ) -> "Animation":
         """Simulates the model and animates its ``draw:`` lines (``eomgen animate``): the
-        same self-contained HTML page, frames at ``t = k / fps`` from the integrator's dense
+        same self-contained HTML page, frames at ``t = k / fps`` (default 30 frames per
+        second of simulated time) from the integrator's dense
         output, the paths of the ``trace`` points (default: the file's ``draw: trace``), the
         energy drift over the frames. Shown inline in Jupyter; ``.save(path)`` writes the
         page. The other arguments are :meth:`simulate`'s.
@@ -252,7 +257,7 @@ class Model:
         """
         y0 = None if initial is None else self.initial_state(initial).tolist()
         page, result = _eomgen.animate_simulation(
-            self._core, float(t_end), float(fps), [str(p) for p in trace], str(method), float(rtol),
+            self._core, float(t_end), None if fps is None else float(fps), [str(p) for p in trace], str(method), float(rtol),
             float(atol), None if dt is None else float(dt), y0, str(stabilization),
             (float(baumgarte[0]), float(baumgarte[1])), [str(s) for s in stop_when], [str(s) for s in events])
         animation = None if page is None else Animation(page)
@@ -302,19 +307,33 @@ class Model:
             t_out: output times (default ``[t_end]``: the final state).
             threads: worker threads (default: one per core; ``1`` inside a Dask or
                 multiprocessing worker that already has one process per core).
-            errors: ``"raise"`` raises :class:`IntegrationError` for the first run that
-                failed; ``"keep"`` returns the batch with ``ok[i] = False`` and the failed
-                runs' samples after the failure set to NaN (``failures`` says where and why).
+            errors: ``"raise"`` raises for the first run that failed
+                (:class:`IntegrationError`, or :class:`AnalysisError` for an initial state
+                the constraints cannot accept); ``"keep"`` returns the batch with
+                ``ok[i] = False`` for those runs (``failures`` says where and why).
+
+        A run ends at ``t_end``, at a terminal event of the model file (``stopped_by_event``
+        says which and when; ``ok`` stays true), or at a failure. Samples after a run's end
+        are NaN; ``t_final`` is the time each run reached.
 
         Returns:
             a :class:`Batch`: ``t`` (k,), ``y`` (b, k, 2n), ``q``, ``qdot`` (b, k, n),
-            ``energy`` (b, k), ``ok`` (b,), ``failures``, ``stats``.
+            ``energy`` (b, k), ``ok``, ``t_final`` (b,), ``failures``, ``stopped_by_event``,
+            ``stats``.
+
+        Raises:
+            ValueError: options every run shares that are refused (an unknown method, output
+                times outside ``[0, t_end]``, a bad tolerance), ``initial_states`` of the
+                wrong shape, parameter columns of different lengths, ``threads < 1``.
+            ParameterError: a parameter the model does not have.
         """
         if errors not in ("raise", "keep"):
             raise ValueError(f"errors must be `raise` or `keep`, got `{errors}`")
         states = None
         if initial_states is not None:
             states = np.ascontiguousarray(np.atleast_2d(np.asarray(initial_states, dtype=float)))
+            if states.ndim != 2:
+                raise ValueError(f"initial_states must be a (b, 2n) array, got shape {states.shape}")
         sets = parameter_sets(parameters)
         if sets is not None:
             sets = [[(str(k), float(v)) for k, v in p.items()] for p in sets]
@@ -331,7 +350,8 @@ class Model:
             None if dt is None else float(dt),
             str(stabilization),
             (float(baumgarte[0]), float(baumgarte[1])),
-            threads,
+            None if threads is None else int(threads),
+            errors == "keep",
         )
         batch = Batch(result, self.num_dofs)
         if errors == "raise" and batch.failures:
@@ -385,9 +405,10 @@ class Model:
 
     # --- derivations --------------------------------------------------------------------
 
-    def check(self, states: int = 200, timing: bool = False) -> dict:
+    def check(self, states: Optional[int] = None, timing: bool = False) -> dict:
         """Derives the model two ways (Lagrange and momentum balance, and the file's own
-        balances) and compares ``q̈`` at ``states`` random states: the dict
+        balances) and compares ``q̈`` at ``states`` random states (default 200, as
+        ``eomgen check``): the dict
         ``eomgen check --json`` prints (``passed``, ``checks``, ``power_balance``, …;
         with ``timing``, the derivation times too). Its ``passed`` is ``False`` when a check
         failed or nothing was compared.
@@ -395,7 +416,10 @@ class Model:
         Raises:
             ModelError: a file that does not derive.
         """
-        _passed, summary = self._core.check(int(states), bool(timing))
+        if states is None:
+            _passed, summary = self._core.check(timing=bool(timing))
+        else:
+            _passed, summary = self._core.check(int(states), bool(timing))
         return summary
 
     def equations(self, latex: bool = False, method: str = "lagrange") -> "Equations":
@@ -465,18 +489,18 @@ class Model:
             self._core, str(parameter), [float(v) for v in np.atleast_1d(values)], _at(at), bool(refine))
 
     def frf(self, input: str, outputs: Sequence[str] = (), frequency_range: Optional[Tuple[float, float]] = None,
-            points: int = 400, frequencies: Sequence[float] = (), modal: bool = False,
+            points: Optional[int] = None, frequencies: Sequence[float] = (), modal: bool = False,
             at: Optional[Union[str, ArrayLike]] = None) -> dict:
         """The frequency response ``H(ω)`` about an equilibrium (``eomgen frf``) to a
         harmonic ``input`` (a load parameter that enters the forcing linearly, or a
         coordinate's name for a unit generalized force on it), on ``points`` log-spaced
-        frequencies (rad/s) in ``frequency_range`` (default: a decade around the natural
-        frequencies), with the peaks, and at ``frequencies``. Returns the ``--json``
+        frequencies (rad/s; default 400) in ``frequency_range`` (default: a decade around the
+        natural frequencies), with the peaks, and at ``frequencies``. Returns the ``--json``
         report with numeric lists as numpy arrays."""
         return _eomgen.study_frf(
             self._core, str(input), [str(o) for o in outputs],
             None if frequency_range is None else (float(frequency_range[0]), float(frequency_range[1])),
-            int(points), [float(f) for f in frequencies], bool(modal), _at(at))
+            None if points is None else int(points), [float(f) for f in frequencies], bool(modal), _at(at))
 
     def floquet(self, period_parameter: Optional[str] = None, at: Optional[Union[str, ArrayLike]] = None,
                 rtol: Optional[float] = None, atol: Optional[float] = None,
@@ -496,28 +520,30 @@ class Model:
         return _eomgen.study_floquet(self._core, period_parameter, _at(at), rtol, atol, stability_tolerance)
 
     def free_response(self, at: Optional[Union[str, ArrayLike]] = None, dq0: Optional[ArrayLike] = None,
-                      dqdot0: Optional[ArrayLike] = None, t_end: Optional[float] = None, samples: int = 401,
-                      tol: float = 1e-13) -> dict:
+                      dqdot0: Optional[ArrayLike] = None, t_end: Optional[float] = None,
+                      samples: Optional[int] = None, tol: Optional[float] = None) -> dict:
         """The free response about an equilibrium from a deviation ``(dq0, dqdot0)`` (default
         0.1 in every coordinate, at rest), four ways: superposed normal modes, ``e^{At}``,
-        the linearised and the nonlinear equations integrated by DOP853 at ``tol``, on
-        ``samples`` times over ``[0, t_end]`` (default: four periods of the slowest mode)
+        the linearised and the nonlinear equations integrated by DOP853 at ``tol`` (default
+        1e-13), on ``samples`` times (default 401) over ``[0, t_end]`` (default: four
+        periods of the slowest mode)
         (``eomgen study free-response``; HW28). Returns the ``--json`` report with numeric
         lists as numpy arrays."""
         return _eomgen.study_free_response(self._core, _at(at), _floats(dq0), _floats(dqdot0), t_end,
-                                           int(samples), float(tol))
+                                           samples, tol)
 
     def modal_damping(self, at: Optional[Union[str, ArrayLike]] = None,
                       rayleigh_modes: Optional[Tuple[int, int]] = None, dq0: Optional[ArrayLike] = None,
-                      dqdot0: Optional[ArrayLike] = None, t_end: Optional[float] = None, samples: int = 801,
-                      tol: float = 1e-12) -> dict:
+                      dqdot0: Optional[ArrayLike] = None, t_end: Optional[float] = None,
+                      samples: Optional[int] = None, tol: Optional[float] = None) -> dict:
         """Modal damping against the exact damped response, and Rayleigh damping fitted to
         two modes (1-based ``rayleigh_modes``; default the slowest and fastest oscillatory
-        ones) (``eomgen study modal-damping``; HW34). Returns the ``--json`` report with
+        ones), checked on ``samples`` times (default 801) by DOP853 at ``tol`` (default
+        1e-12) (``eomgen study modal-damping``; HW34). Returns the ``--json`` report with
         numeric lists as numpy arrays."""
         modes = None if rayleigh_modes is None else (int(rayleigh_modes[0]), int(rayleigh_modes[1]))
         return _eomgen.study_modal_damping(self._core, _at(at), modes, _floats(dq0), _floats(dqdot0), t_end,
-                                           int(samples), float(tol))
+                                           samples, tol)
 
     # --- Python protocols --------------------------------------------------------------
 
@@ -675,11 +701,15 @@ class Batch:
 
     Attributes:
         t: output times (s), ``(k,)``.
-        y: states, ``(b, k, 2n)``; ``q``, ``qdot``: ``(b, k, n)``.
+        y: states, ``(b, k, 2n)``; ``q``, ``qdot``: ``(b, k, n)``. Samples after a run's
+            end (a failure or a terminal event) are NaN.
         energy: ``(b, k)``.
-        ok: ``(b,)`` booleans: the run reached ``t_end``.
-        failures: ``[(index, t, reason)]`` of the runs that stopped early (their samples
-            after the failure are NaN).
+        ok: ``(b,)`` booleans: the run ended without a failure (at ``t_end``, or at a
+            terminal event of the model file).
+        t_final: ``(b,)``: the time (s) each run reached (NaN for a run that did not start).
+        failures: ``[(index, t, reason)]`` of the runs that failed (``t`` NaN for one that
+            did not start).
+        stopped_by_event: ``[(index, t, event)]`` of the runs a terminal event ended.
         stats: ``steps``, ``rejected``, ``rhs_evals``, each ``(b,)``.
     """
 
@@ -690,7 +720,9 @@ class Batch:
         self.qdot = self.y[:, :, num_dofs:]
         self.energy = result["energy"]
         self.ok = result["ok"]
+        self.t_final = result["t_final"]
         self.failures = [tuple(f) for f in result["failures"]]
+        self.stopped_by_event = [tuple(s) for s in result["stopped_by_event"]]
         self.stats = {k: result[k] for k in ("steps", "rejected", "rhs_evals")}
 
     def __len__(self) -> int:
@@ -707,9 +739,12 @@ class Modes:
     Attributes:
         natural_frequencies: ``ωₖ`` (rad/s), ascending, ``(r,)``.
         frequencies_hz: ``ωₖ/2π`` (Hz).
-        mode_shapes: ``(n, r)``: column ``k`` is mode ``k`` in the model's coordinates,
-            mass-normalised (``ΨᵀMΨ = I`` in the minimal coordinates).
-        mass_matrix, stiffness_matrix, damping_matrix: ``M``, ``K``, ``C`` (``r × r``).
+        mode_shapes: ``(n, r)``: column ``k`` is mode ``k`` in the model's coordinates
+            (``δq = N ψ`` for a constrained model), mass-normalised:
+            ``ΨᵀM(q*)Ψ = I`` with ``M(q*) = model.mass_matrix(modes.equilibrium)``.
+        mass_matrix, stiffness_matrix, damping_matrix: ``M``, ``K``, ``C`` in the ``r``
+            minimal coordinates (``NᵀMN`` … for a constrained model; the model's own
+            without constraints).
         damping_ratios: ``ζ`` of each damped mode.
         eigenvalues: ``ωₖ²`` (1/s², negative for an unstable mode).
         equilibrium: ``q*`` (``n``).
@@ -753,8 +788,9 @@ class SteadyMotion:
     steady motion).
 
     Attributes:
-        eigenvalues: the eigenvalues ``s`` of the reduced state matrix (complex), sorted as
-            the report lists them.
+        eigenvalues: the eigenvalues ``s`` of the reduced state matrix with ``Im s ≥ 0``
+            (complex): each complex pair once, each real eigenvalue once, as the report
+            lists them.
         summary: the report as ``eomgen modes --json`` prints it.
     """
 

@@ -37,7 +37,9 @@ def run_chunk(model: Model, initial_states: Optional[np.ndarray], parameters: Op
         "y": batch.y,
         "energy": batch.energy,
         "ok": batch.ok,
+        "t_final": batch.t_final,
         "failures": batch.failures,
+        "stopped_by_event": batch.stopped_by_event,
         "steps": batch.stats["steps"],
         "rejected": batch.stats["rejected"],
         "rhs_evals": batch.stats["rhs_evals"],
@@ -68,6 +70,11 @@ def run(executor: Any, model: Model, initial_states: Optional[Any] = None,
     """
     from .errors import IntegrationError
 
+    if errors not in ("raise", "keep"):
+        raise ValueError(f"errors must be `raise` or `keep`, got `{errors}`")
+    reserved = {"threads", "errors", "initial_states", "parameters"} & set(options)
+    if reserved:
+        raise TypeError(f"sweep.run sets {', '.join(sorted(reserved))} itself")
     states = None if initial_states is None else np.atleast_2d(np.asarray(initial_states, dtype=float))
     sets = parameter_sets(parameters)
     count = len(states) if states is not None else (len(sets) if sets is not None else 0)
@@ -93,16 +100,19 @@ def run(executor: Any, model: Model, initial_states: Optional[Any] = None,
     else:
         futures = [executor.submit(run_chunk, *a) for a in args]
         parts = [f.result() for f in futures]
-    failures = []
+    failures, stopped = [], []
     for (a, _), part in zip(pieces, parts):
         failures.extend((a + i, t, reason) for i, t, reason in part["failures"])
+        stopped.extend((a + i, t, event) for i, t, event in part["stopped_by_event"])
     n = model.num_dofs
     result = {
         "t": parts[0]["t"],
         "y": np.concatenate([p["y"] for p in parts]),
         "energy": np.concatenate([p["energy"] for p in parts]),
         "ok": np.concatenate([p["ok"] for p in parts]),
+        "t_final": np.concatenate([p["t_final"] for p in parts]),
         "failures": failures,
+        "stopped_by_event": stopped,
         "steps": np.concatenate([p["steps"] for p in parts]),
         "rejected": np.concatenate([p["rejected"] for p in parts]),
         "rhs_evals": np.concatenate([p["rhs_evals"] for p in parts]),
