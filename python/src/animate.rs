@@ -11,7 +11,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::errors::analysis_error;
-use crate::model::{CoreModel, RunError, RunOptions, equilibrium_start, run_simulation};
+use crate::model::{CoreModel, RunArgs, RunError, equilibrium_start, run_simulation};
 
 /// An animation that cannot be made, in the Python API's words (the library's messages name
 /// the command line's options).
@@ -45,45 +45,22 @@ fn animation_error(error: AnimationError) -> PyErr {
 /// Animates one simulation: the page and, when the integration stopped early, the
 /// simulation's report (`{"summary", "t", …}` as `simulate` returns it) for the exception.
 #[pyfunction]
-#[allow(clippy::too_many_arguments)]
-#[pyo3(signature = (model, t_end, fps, trace, method_name, rtol, atol, dt, initial_state, stabilization_name, baumgarte, stop_when, event))]
+#[pyo3(signature = (model, args, fps, trace))]
 pub fn animate_simulation<'py>(
     py: Python<'py>,
     model: &CoreModel,
-    t_end: f64,
+    args: RunArgs,
     fps: Option<f64>,
     trace: Vec<String>,
-    method_name: &str,
-    rtol: f64,
-    atol: f64,
-    dt: Option<f64>,
-    initial_state: Option<Vec<f64>>,
-    stabilization_name: &str,
-    baumgarte: (f64, f64),
-    stop_when: Vec<String>,
-    event: Vec<String>,
 ) -> PyResult<(Option<String>, Bound<'py, PyDict>)> {
     let options = AnimationOptions {
         fps: fps.unwrap_or(eomgen::animation::DEFAULT_FPS),
         trace,
     };
     let mut instance = model.fresh()?;
-    options.frame_count(t_end).map_err(animation_error)?;
-    let times = frame_times(instance.as_ref(), t_end, &options).map_err(animation_error)?;
-    let run = RunOptions {
-        options: eomgen::analysis::SimulationOptions {
-            method: crate::model::method(method_name)?,
-            t_end,
-            rtol,
-            atol,
-            dt,
-            output: OutputTimes::At(times),
-            stabilization: crate::model::stabilization(stabilization_name, baumgarte)?,
-            initial_state,
-        },
-        stop_when,
-        event,
-    };
+    options.frame_count(args.t_end()).map_err(animation_error)?;
+    let times = frame_times(instance.as_ref(), args.t_end(), &options).map_err(animation_error)?;
+    let run = args.options(OutputTimes::At(times))?;
     let model_ref = &mut instance;
     let (simulation, page) = py
         .detach(move || {

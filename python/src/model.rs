@@ -212,6 +212,51 @@ pub(crate) struct RunOptions {
     pub event: Vec<String>,
 }
 
+/// A simulation's options as the Python layer hands them over, one dict for `simulate` and
+/// `animate` alike (`eomgen._model._run_args`).
+#[derive(FromPyObject)]
+#[pyo3(from_item_all)]
+pub(crate) struct RunArgs {
+    t_end: f64,
+    method: String,
+    rtol: f64,
+    atol: f64,
+    dt: Option<f64>,
+    initial_state: Option<Vec<f64>>,
+    stabilization: String,
+    baumgarte: (f64, f64),
+    stop_when: Vec<String>,
+    events: Vec<String>,
+}
+
+impl RunArgs {
+    /// The run's options, sampled at `output`.
+    ///
+    /// # Errors
+    /// `ValueError` for an unknown method or drift control.
+    pub(crate) fn options(self, output: OutputTimes) -> PyResult<RunOptions> {
+        Ok(RunOptions {
+            options: SimulationOptions {
+                method: method(&self.method)?,
+                t_end: self.t_end,
+                rtol: self.rtol,
+                atol: self.atol,
+                dt: self.dt,
+                output,
+                stabilization: stabilization(&self.stabilization, self.baumgarte)?,
+                initial_state: self.initial_state,
+            },
+            stop_when: self.stop_when,
+            event: self.events,
+        })
+    }
+
+    /// The end time (s).
+    pub(crate) fn t_end(&self) -> f64 {
+        self.t_end
+    }
+}
+
 /// Why a simulation could not start, as the exception it becomes: options or event
 /// expressions that are refused (`ValueError`), or a state the constraints cannot accept
 /// (`AnalysisError`). Plain data, so that it crosses threads without the interpreter.
@@ -499,37 +544,14 @@ impl CoreModel {
     }
 
     /// One simulation; see `eomgen.Model.simulate`.
-    #[allow(clippy::too_many_arguments)]
-    #[pyo3(signature = (t_end, t_out, method, rtol, atol, dt, initial_state, stabilization, baumgarte, stop_when, event))]
+    #[pyo3(signature = (args, t_out))]
     fn simulate<'py>(
         &self,
         py: Python<'py>,
-        t_end: f64,
+        args: RunArgs,
         t_out: Option<Vec<f64>>,
-        method: &str,
-        rtol: f64,
-        atol: f64,
-        dt: Option<f64>,
-        initial_state: Option<Vec<f64>>,
-        stabilization: &str,
-        baumgarte: (f64, f64),
-        stop_when: Vec<String>,
-        event: Vec<String>,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let run = RunOptions {
-            options: SimulationOptions {
-                method: self::method(method)?,
-                t_end,
-                rtol,
-                atol,
-                dt,
-                output: t_out.map_or(OutputTimes::Steps, OutputTimes::At),
-                stabilization: self::stabilization(stabilization, baumgarte)?,
-                initial_state,
-            },
-            stop_when,
-            event,
-        };
+        let run = args.options(t_out.map_or(OutputTimes::Steps, OutputTimes::At))?;
         let mut model = self.fresh()?;
         let started = std::time::Instant::now();
         let simulation = py

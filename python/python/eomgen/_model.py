@@ -192,23 +192,26 @@ class Model:
             ValueError: an unknown method, a bad tolerance, end time or output times, an
                 event expression that does not parse.
         """
-        y0 = None if initial is None else self.initial_state(initial).tolist()
-        result = self._core.simulate(
-            float(t_end),
-            None if t_out is None else [float(t) for t in np.atleast_1d(t_out)],
-            str(method),
-            float(rtol),
-            float(atol),
-            None if dt is None else float(dt),
-            y0,
-            str(stabilization),
-            (float(baumgarte[0]), float(baumgarte[1])),
-            [str(s) for s in stop_when],
-            [str(s) for s in events],
-        )
+        args = self._run_args(t_end, method, rtol, atol, dt, initial, stabilization, baumgarte, stop_when, events)
+        result = self._core.simulate(args, None if t_out is None else [float(t) for t in np.atleast_1d(t_out)])
         solution = Solution(result, self.num_dofs)
         self._raise_failure(solution, f"the {len(solution.t)} samples computed before it were kept")
         return solution
+
+    def _run_args(self, t_end, method, rtol, atol, dt, initial, stabilization, baumgarte, stop_when, events) -> dict:
+        """One simulation's options as the library takes them (``simulate``, ``animate``)."""
+        return {
+            "t_end": float(t_end),
+            "method": str(method),
+            "rtol": float(rtol),
+            "atol": float(atol),
+            "dt": None if dt is None else float(dt),
+            "initial_state": None if initial is None else self.initial_state(initial).tolist(),
+            "stabilization": str(stabilization),
+            "baumgarte": (float(baumgarte[0]), float(baumgarte[1])),
+            "stop_when": [str(s) for s in stop_when],
+            "events": [str(s) for s in events],
+        }
 
     def _raise_failure(self, solution: "Solution", kept: str, animation: Optional["Animation"] = None) -> None:
         """Raises the failure of `solution`'s run, if it stopped early: `IntegrationError`
@@ -255,11 +258,9 @@ class Model:
             ValueError: a bad ``fps``, an unknown trace point, options :meth:`simulate`
                 refuses.
         """
-        y0 = None if initial is None else self.initial_state(initial).tolist()
-        page, result = _eomgen.animate_simulation(
-            self._core, float(t_end), None if fps is None else float(fps), [str(p) for p in trace], str(method), float(rtol),
-            float(atol), None if dt is None else float(dt), y0, str(stabilization),
-            (float(baumgarte[0]), float(baumgarte[1])), [str(s) for s in stop_when], [str(s) for s in events])
+        args = self._run_args(t_end, method, rtol, atol, dt, initial, stabilization, baumgarte, stop_when, events)
+        page, result = _eomgen.animate_simulation(self._core, args, None if fps is None else float(fps),
+                                                  [str(p) for p in trace])
         animation = None if page is None else Animation(page)
         solution = Solution(result, self.num_dofs)
         frames = "no frame was computed" if animation is None else "the frames computed before it are in the animation"
