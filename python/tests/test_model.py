@@ -628,3 +628,22 @@ def test_a_model_without_freedom_has_no_modes(model_file):
     assert np.isfinite(m.simulate(t_end=1.0).y).all()
     with pytest.raises(eomgen.AnalysisError, match="no degree of freedom"):
         m.modes()
+
+
+def test_the_docs_session_runs():
+    # docs/python.md's "A session" block, run as written (its first Python block).
+    import pathlib
+    import re
+
+    page = pathlib.Path(__file__).resolve().parents[2] / "docs" / "python.md"
+    if not page.is_file():
+        pytest.skip("docs/python.md is not beside the tests (an installed copy of the tests)")
+    blocks = re.findall(r"```python\n(.*?)```", page.read_text(encoding="utf-8"), re.S)
+    session = next(b for b in blocks if "A session" in b or "m.check()" in b)
+    namespace = {}
+    exec(compile(session, str(page), "exec"), namespace)
+    assert namespace["sol"].q.shape == (3, 2)
+    # Hanging bars (m = l = 1, g = 10): M = [[4/3, 1/2], [1/2, 1/3]], K = diag(15, 5), so
+    # ω⁴ − 60 ω² + 2700/7 = 0: the page's [2.7059…, 7.2579…].
+    w2 = 30 + np.array([-1.0, 1.0]) * math.sqrt(900 - 2700 / 7)
+    np.testing.assert_allclose(namespace["modes"].natural_frequencies, np.sqrt(w2), rtol=1e-12)
