@@ -29,6 +29,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(study_floquet, m)?)?;
     m.add_function(wrap_pyfunction!(study_free_response, m)?)?;
     m.add_function(wrap_pyfunction!(study_modal_damping, m)?)?;
+    m.add_function(wrap_pyfunction!(study_constraint_methods, m)?)?;
     Ok(())
 }
 
@@ -290,4 +291,47 @@ fn study_modal_damping<'py>(
         .detach(move || vibration::modal_damping_study(model_ref.as_ref(), &options))
         .map_err(analysis_error)?;
     to_python(py, &study.summary(instance.as_ref()), Lists::Arrays)
+}
+
+/// Constraint methods compared on a model with holonomic constraints (`eomgen study
+/// constraint-methods`): a stiff spring (method I), the KKT system with and without drift
+/// control, and the file's minimal-coordinate twin, against a reference.
+#[pyfunction]
+#[pyo3(signature = (model, t_end = None, tol = None, stiffness = None))]
+fn study_constraint_methods<'py>(
+    py: Python<'py>,
+    model: &CoreModel,
+    t_end: Option<f64>,
+    tol: Option<f64>,
+    stiffness: Option<Vec<f64>>,
+) -> PyResult<Bound<'py, PyAny>> {
+    use eomgen::analysis::{ConstraintMethodsOptions, constraint_methods};
+    let defaults = ConstraintMethodsOptions::default();
+    let options = ConstraintMethodsOptions {
+        t_end: t_end.unwrap_or(defaults.t_end),
+        tol: tol.unwrap_or(defaults.tol),
+        stiffness: stiffness.unwrap_or(defaults.stiffness),
+    };
+    let loaded = model.loaded.clone();
+    let overrides = model.overrides.clone();
+    // This model's parameter values go to the twin too, where it has the parameter, so that
+    // both describe the same mechanism.
+    let with_values = move |mut m: Box<dyn eomgen::ModelInfo>| {
+        for (name, value) in &overrides {
+            let _ = m.set_parameter(name, *value);
+        }
+        m
+    };
+    let study = py.detach(move || {
+        let twin = eomgen::studies::minimal_twin(&loaded.source).map_err(|e| e.to_string())?;
+        let mut make = || with_values(loaded.source.instantiate());
+        let twin_model = twin
+            .as_ref()
+            .map(|(name, twin)| (name.as_str(), with_values(twin.instantiate())));
+        constraint_methods(&mut make, twin_model, &options)
+            .map(|study| (study, options))
+            .map_err(|e| e.to_string())
+    });
+    let (study, options) = study.map_err(analysis_error)?;
+    to_python(py, &study.summary(&options), Lists::Arrays)
 }

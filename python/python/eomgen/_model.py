@@ -546,6 +546,23 @@ class Model:
         return _eomgen.study_modal_damping(self._core, _at(at), modes, _floats(dq0), _floats(dqdot0), t_end,
                                            samples, tol)
 
+    def constraint_methods(self, t_end: Optional[float] = None, tol: Optional[float] = None,
+                           stiffness: Optional[Sequence[float]] = None) -> dict:
+        """Lectures 8–10's constraint methods compared on a model with holonomic
+        constraints (``eomgen study constraint-methods``): the constraint replaced by a stiff
+        spring of each ``stiffness`` (method I; default 1e2, 1e4, 1e6), the Lagrange
+        multipliers with and without drift control, and the model file's
+        ``minimal_twin:`` in minimal coordinates, each against a reference over
+        ``[0, t_end]`` (default 10 s) at ``tol`` (default 1e-8). This model's parameter
+        values are set on the twin too where it has them. Returns the ``--json`` report with
+        numeric lists as numpy arrays.
+
+        Raises:
+            AnalysisError: a model without holonomic constraints, options the study refuses.
+        """
+        return _eomgen.study_constraint_methods(self._core, t_end, tol,
+                                                None if stiffness is None else [float(k) for k in stiffness])
+
     # --- Python protocols --------------------------------------------------------------
 
     def __reduce__(self):
