@@ -261,6 +261,22 @@ pub fn derivation_checks(
     let sampled = |value: f64| nothing_compared.clone().map_or(Ok(value), Err);
     let mut rows = Vec::new();
     for c in &r.comparisons {
+        if c.expect_disagreement {
+            // A set of balances kept to show a wrong form: it must differ from Lagrange.
+            let computed = sampled(c.max_rel_residual);
+            rows.push(CheckRow {
+                check: format!(
+                    "derivations disagree, as the file states: {} vs {} (max relative q̈ difference, above the tolerance)",
+                    c.a, c.b
+                ),
+                computed: computed.as_ref().ok().copied(),
+                expected: 0.0,
+                tolerance: DERIVATION_TOLERANCE,
+                passed: computed.is_ok() && c.passed(DERIVATION_TOLERANCE),
+                note: computed.err(),
+            });
+            continue;
+        }
         let computed = sampled(c.max_rel_residual).and_then(|v| {
             if v.is_nan() {
                 Err(format!(
@@ -441,7 +457,8 @@ fn against_expected(
 /// The rows of the checks that need a motion or an equilibrium of `model`, in this order:
 /// energy drift (conservative models, or where the file asks), constraint drift (constrained
 /// models), `natural_frequencies:`, `damping_ratios:`, `period:`, `final_state:` and
-/// `conserved:` — the file's entries as the model's description carries them
+/// `conserved:`, then the `outputs:` declared conserved — the file's entries as the model's
+/// description carries them
 /// ([`eomgen_runtime::description::checks`]), so a compiled model is checked as a file
 /// loaded at run time.
 ///
@@ -650,6 +667,37 @@ pub fn motion_checks(
             0.0,
             c.tolerance,
         ));
+    }
+    // `outputs:` declared conserved: the drift of each over the default run, as a
+    // `conserved:` entry's, against the output's bound.
+    let conserved_outputs: Vec<(String, f64)> = model
+        .description()
+        .outputs
+        .iter()
+        .filter(|o| o.conserved)
+        .map(|o| (o.name.to_string(), o.tolerance))
+        .collect();
+    if !conserved_outputs.is_empty() {
+        let series = simulations
+            .get(default_run)
+            .and_then(|s| crate::outputs::evaluate_outputs(&*model, s).map_err(|e| e.to_string()));
+        for (name, tolerance) in conserved_outputs {
+            let computed = series.clone().and_then(|all| {
+                all.iter()
+                    .find(|o| o.name == name)
+                    .and_then(|o| o.drift)
+                    .ok_or_else(|| "no samples".to_string())
+            });
+            checks.push(CheckRow::compare(
+                format!(
+                    "conserved output `{name}`: max |Q − Q(0)|/max(1, |Q(0)|) ({})",
+                    default_run.describe()
+                ),
+                computed,
+                0.0,
+                tolerance,
+            ));
+        }
     }
     checks
 }

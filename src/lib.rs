@@ -47,6 +47,10 @@ pub mod animation;
 pub mod checks;
 pub mod expressions;
 pub mod listing;
+pub mod outputs;
+// Method II.2 for the studies: a reduced model file compiled at run time.
+#[cfg(feature = "jit")]
+pub mod reduction;
 #[cfg(feature = "jit")]
 pub mod studies;
 pub mod text;

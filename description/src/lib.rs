@@ -21,6 +21,7 @@ use serde::Serialize;
 
 pub mod checks;
 pub mod floquet;
+pub mod outputs;
 
 /// Text of a description: borrowed from the binary (compiled models) or owned (run time).
 pub type Text = Cow<'static, str>;
@@ -108,6 +109,8 @@ pub struct ModelDescription {
     pub checks: checks::Checks,
     /// The file's `floquet:` references, by equilibrium, in file order.
     pub floquet: List<floquet::FloquetReference>,
+    /// The file's `outputs:`, in file order.
+    pub outputs: List<outputs::OutputSpec>,
 }
 
 impl ModelDescription {
@@ -136,6 +139,7 @@ impl ModelDescription {
         equations_mathml: None,
         checks: checks::Checks::NONE,
         floquet: Cow::Borrowed(&[]),
+        outputs: Cow::Borrowed(&[]),
     };
 
     /// The number of degrees of freedom `n` (the number of coordinates).

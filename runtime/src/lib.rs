@@ -71,6 +71,9 @@ pub use linear::frequency_response::{
     frequency_sweep, linearize_with_inputs, log_frequencies, modal_frequency_response,
     phase_degrees, settling_time, simulate_steady_state,
 };
+pub use linear::frequency_response::{
+    frequency_response_to, frequency_sweep_with_rates, harmonic_input, linearize_with_input_rates,
+};
 pub use linear::modal::{
     Equilibrium, Linearization, MASS_MATRIX_SINGULARITY, ModalError, ModeKind, NewtonStop,
     NormalModes, TimeDependentForcing, TimeDependentPart, constraint_hessians,

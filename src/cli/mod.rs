@@ -68,6 +68,9 @@ enum Command {
     Frf(commands::frf::FrfArgs),
     /// Print a generated model file: `n-link-pendulum N` or `n-mass-chain N`.
     New(commands::equations::NewArgs),
+    /// Eliminate a model's holonomic constraints (method II.2): solve them for the
+    /// coordinates not kept (`--keep x`) and write the model file in minimal coordinates.
+    Reduce(commands::reduce::ReduceArgs),
     /// Run every model's checks (derivations, conservation, the reference values of its
     /// `checks:`) and write DIR/index.html (equations, figures, pass/fail tables) and
     /// DIR/report.json; exit 1 if a check fails.
@@ -95,12 +98,20 @@ pub enum Study {
     /// HW1: explicit Euler on ẋ = x with h = 10⁻ⁿ, truncation against roundoff error and
     /// the optimal n.
     EulerRoundoff(euler_roundoff::EulerRoundoffArgs),
+    /// HW2: the range against the launch angle at each launch speed, the best angle θ* by
+    /// golden-section search, and the shape of the paths (apex, landing angle) at θ* and at a
+    /// fixed angle as v0 grows.
+    Launch(commands::launch::LaunchArgs),
     /// HW28: the free response of the linearised, undamped equations four ways (integration,
     /// e^{At}, modes of M⁻¹K, mass-normalised modes), their differences and a chart.
     FreeResponse(free_response::FreeResponseArgs),
     /// HW34: damping ratios exact (eigenvalues of A) vs the diagonal of Ĉ = ΨᵀCΨ vs Rayleigh
     /// damping fitted to two modes, and the free responses from each mode shape.
     ModalDamping(modal_damping::ModalDampingArgs),
+    /// Lecture 21: the response of the linearised model to an impulse, a step or any f(t)
+    /// through one input, by Duhamel's integral over the impulse response, against DOP853
+    /// and the closed form.
+    Convolution(commands::convolution::ConvolutionArgs),
     /// Floquet multipliers of a time-periodic model about an equilibrium (the Mathieu
     /// inverted pendulum), and its stability chart over two parameters (`--sweep`).
     Floquet(floquet::FloquetArgs),
@@ -108,6 +119,21 @@ pub enum Study {
     /// one parameter, the values where its stability changes (refined by bisection), and
     /// the root-locus chart.
     ParameterSweep(parameter_sweep::ParameterSweepArgs),
+    /// HW5, HW39: a periodic orbit by shooting (Newton on the flow map with the monodromy
+    /// matrix, period free or fixed): period, initial state, residual, iterations, Floquet
+    /// multipliers, and a chart of the orbit.
+    PeriodicOrbit(commands::periodic_orbit::PeriodicOrbitArgs),
+    /// HW32: ż = A z for a random real n × n A three ways (e^{At}, complex eigenvector
+    /// superposition, DOP853), the eigenvalues, the eigenvector matrix's condition number
+    /// and the largest differences.
+    Expm(commands::expm::ExpmArgs),
+    /// Lectures 35–37: the Rayleigh quotient of a trial shape against the lowest natural
+    /// frequency, the bound R ≥ ω₁² and its stationarity (error second order in the shape's).
+    Rayleigh(commands::rayleigh::RayleighArgs),
+    /// HW36: the friction coefficient μ(t) = |F_t|/N a rolling body needs up to its lift-off,
+    /// from the constraint forces and by Newton–Euler, and (`--after-lift-off`) the free
+    /// flight to the landing, joined and checked against its closed forms.
+    RollingContact(commands::rolling_contact::RollingContactArgs),
 }
 
 /// Runs the CLI on the process arguments. Exit status: 0 success, 1 a failed computation or
@@ -133,15 +159,22 @@ pub fn run() -> ExitCode {
         Command::Modes(args) => modes::run(&args),
         Command::Frf(args) => frf::run(&args),
         Command::Report(args) => report::run(&args),
+        Command::Reduce(args) => commands::reduce::run(&args),
         Command::Study(study) => match study {
             Study::ConstraintMethods(args) => constraint_methods::run(&args),
             Study::WorkPrecision(args) => work_precision::run(&args),
             Study::Stability(args) => stability::run(&args),
             Study::EulerRoundoff(args) => euler_roundoff::run(&args),
+            Study::Launch(args) => commands::launch::run(&args),
             Study::FreeResponse(args) => free_response::run(&args),
             Study::ModalDamping(args) => modal_damping::run(&args),
             Study::Floquet(args) => floquet::run(&args),
+            Study::Convolution(args) => commands::convolution::run(&args),
             Study::ParameterSweep(args) => parameter_sweep::run(&args),
+            Study::PeriodicOrbit(args) => commands::periodic_orbit::run(&args),
+            Study::Expm(args) => commands::expm::run(&args),
+            Study::Rayleigh(args) => commands::rayleigh::run(&args),
+            Study::RollingContact(args) => commands::rolling_contact::run(&args),
         },
     };
     error::exit(result)

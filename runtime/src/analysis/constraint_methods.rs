@@ -1,7 +1,9 @@
 //! Constraint methods compared (issue 5, item 6; lectures 8–11, HW10's "which one is faster?
 //! more accurate?"): the holonomic constraints of a model handled as stiff springs (method I,
-//! several stiffnesses `k`), as a DAE without and with Baumgarte stabilisation (II.1), and in
-//! minimal coordinates (II.3) where the model has a minimal-coordinate twin, side by side.
+//! several stiffnesses `k`), as a DAE without and with Baumgarte stabilisation (II.1), with
+//! the multipliers and dependent coordinates eliminated symbolically (II.2, where the caller
+//! gives the reduced model: `eomgen_symbolic::model::reduce`), and in minimal coordinates
+//! (II.3) where the model has a minimal-coordinate twin, side by side.
 //!
 //! Every run is Dormand–Prince 5(4) at `rtol = atol = tol`, sampled at 200 equally spaced
 //! times. Its accuracy is the largest distance of any point from its position in a reference
@@ -132,8 +134,8 @@ pub struct ConstraintMethods {
     /// Largest point distance (m) between the reference and the unstabilised DAE at the
     /// reference tolerance.
     pub agreement: f64,
-    /// Method I at every stiffness, II.1 without and with Baumgarte, and II.3 if there is a
-    /// twin, in that order.
+    /// Method I at every stiffness, II.1 without and with Baumgarte, II.2 if a reduced model
+    /// is given and II.3 if there is a twin, in that order.
     pub rows: Vec<ConstraintMethodRow>,
 }
 
@@ -355,6 +357,46 @@ pub fn constraint_methods(
     twin: Option<(&str, Box<dyn ModelInfo>)>,
     options: &ConstraintMethodsOptions,
 ) -> Result<ConstraintMethods, ConstraintMethodsError> {
+    constraint_methods_with_reduced(make, None, twin, options)
+}
+
+/// [`constraint_methods()`] with method II.2 too: `reduced` is the model with its
+/// constraints, multipliers and dependent coordinates eliminated symbolically (the kept
+/// coordinates named in its label, `x`), whose points of the same names are compared. It
+/// starts from its own initial state (the kept coordinates of the model's); a reduced model
+/// whose coordinates become singular on the motion (where the branches of a quadratic
+/// constraint meet, HW13) fails there, and its row says so.
+///
+/// # Errors
+/// As [`constraint_methods()`].
+///
+/// # Examples
+/// ```
+/// use eomgen::analysis::{ConstraintMethodsOptions, constraint_methods_with_reduced};
+///
+/// let rod = eomgen::ModelSource::open("two_masses_rod").unwrap();
+/// // x2 = x1 + l0 substituted, compiled at run time (what `eomgen reduce two_masses_rod
+/// // --keep x1` writes).
+/// let reduced = eomgen::reduction::reduced_twin(&rod).unwrap();
+/// let options = ConstraintMethodsOptions { t_end: 1.0, stiffness: vec![1e4], ..Default::default() };
+/// let study = constraint_methods_with_reduced(
+///     &mut || rod.instantiate(),
+///     Some((&reduced.label(), reduced.instantiate())),
+///     None,
+///     &options,
+/// )?;
+/// assert_eq!(study.rows.len(), 4);
+/// // A linear constraint: the reduced model is exact, as accurate as the DAE.
+/// assert!(study.rows[3].position_error < 1e-6);
+/// assert!(study.rows[3].method.starts_with("II.2"));
+/// # Ok::<(), eomgen::analysis::ConstraintMethodsError>(())
+/// ```
+pub fn constraint_methods_with_reduced(
+    make: &mut dyn FnMut() -> Box<dyn ModelInfo>,
+    reduced: Option<(&str, Box<dyn ModelInfo>)>,
+    twin: Option<(&str, Box<dyn ModelInfo>)>,
+    options: &ConstraintMethodsOptions,
+) -> Result<ConstraintMethods, ConstraintMethodsError> {
     let mut model = make();
     if model.description().holonomic_constraints == 0 {
         return Err(ConstraintMethodsError::NoHolonomicConstraints {
@@ -443,6 +485,19 @@ pub fn constraint_methods(
         m.set_stabilization(stab);
         let (s, f) = integrate(m.as_mut(), &y0, t_end, &times, tol);
         rows.push(row(label, m.as_mut(), &s, f, &reference, &names, true));
+    }
+    if let Some((kept, mut m)) = reduced {
+        let y0 = m.initial_state();
+        let (s, f) = integrate(m.as_mut(), &y0, t_end, &times, tol);
+        rows.push(row(
+            format!("II.2: eliminated, keeping {kept}"),
+            m.as_mut(),
+            &s,
+            f,
+            &reference,
+            &names,
+            false,
+        ));
     }
     if let Some((twin, mut m)) = twin {
         let y0 = m.initial_state();

@@ -12,8 +12,11 @@ pub mod constraint_methods;
 pub mod drift;
 pub mod failure;
 pub mod fixed_step;
+pub mod launch;
 pub mod methods;
 pub mod outcome;
+pub mod periodic_orbit;
+pub mod rolling_contact;
 pub mod roundoff;
 pub mod simulation;
 pub mod stability;
@@ -23,13 +26,20 @@ pub mod work_precision;
 pub use constraint_methods::{
     ConstraintMethodRow, ConstraintMethodSummary, ConstraintMethods, ConstraintMethodsError,
     ConstraintMethodsOptions, ConstraintMethodsSummary, ConstraintReferenceSummary,
-    constraint_methods,
+    constraint_methods, constraint_methods_with_reduced,
 };
 pub use drift::{ConstraintDrift, EnergyDrift, constraint_drift, energy_drift, energy_drift_at};
 pub use failure::{FailureCause, failure_cause};
 pub use fixed_step::{ENERGY_DRIFT_LIMIT, SimulationWarning, fixed_step_warnings};
 pub use methods::{Method, UnknownMethod};
 pub use outcome::{NothingMeasured, RunTally, StudyRuns};
+pub use periodic_orbit::{
+    NewtonStep, OrbitSamples, PeriodicOrbit, PeriodicOrbitError, PeriodicOrbitOptions,
+    periodic_orbit,
+};
+pub use rolling_contact::{
+    RollingContact, RollingContactError, RollingContactOptions, rolling_contact,
+};
 pub use roundoff::{EulerRoundoff, RoundoffError, RoundoffOptions, euler_roundoff};
 pub use simulation::{
     AddedEvents, DriftPair, EventSummary, FailureSummary, Simulation, SimulationError,

@@ -21,6 +21,25 @@
 //! `A cos(ω t)` with `w = ω`: `x(t) = x* + Re(H(ω) A e^{iωt})`. A time function that vanishes at
 //! `t = 0` (`B sin(w t)`) gives a zero column: [`FrfError::InputNotInForcing`].
 //!
+//! # Inputs that enter through their rate (base excitation)
+//!
+//! A prescribed base motion `y_b = Y cos(w t)` acting through a spring `k` and a dashpot `c`
+//! loads the mass with `k y_b + c ẏ_b = k Y cos(w t) − c Y w sin(w t)`: the input `Y` enters
+//! through its value and its rate, `F = … + B₀ u + B₁ u̇` with `u = Y cos(w t)`. At `t = 0` only
+//! `B₀ = k` is seen. [`linearize_with_input_rates`] also reads the load a quarter period later,
+//! `t = π/(2w)` with `w` the model's frequency parameter, where `∂F/∂p = −w B₁`, and checks at a
+//! second frequency `w' = 3w/2` that `B₁` does not change (else [`FrfError::InputRateNotConstant`]:
+//! the time function is not `cos(w t)` and its rate). For `u = Re(û e^{iωt})` the load is then
+//! `Re((B₀ + iω B₁) û e^{iωt})` and
+//!
+//! ```text
+//! H(ω) = (K − ω²M + iωC)⁻¹ (B₀ + iω B₁)
+//! ```
+//!
+//! — for the base-excited oscillator the transmissibility `(k + iωc)/(k − mω² + iωc)` (lecture
+//! 38). A load `A cos(w t)` has `B₁ = 0` exactly (the quarter-period value, `cos(π/2) ≈ 6e-17`,
+//! is below `1e-12` of the load and taken as 0), so its response is unchanged.
+//!
 //! # Frequency response
 //!
 //! Linearising `M q̈ = F + B u` at `q*` gives `M δq̈ + C δq̇ + K δq = B u`; for
@@ -156,6 +175,20 @@ pub enum FrfError {
         /// `log₁₀ |Hᵢⱼ|`, computed from the scaled solution.
         log10_magnitude: f64,
     },
+    /// The load of an input read a quarter period after `t = 0` is not `−w B₁` with a `B₁`
+    /// independent of the frequency: the input's time function is not `cos(w t)` (with its
+    /// rate), so `B₀ + iω B₁` would not be its load at other frequencies.
+    #[error(
+        "input `{input}` does not enter as B₀ u + B₁ u̇ with u = {input} cos({frequency_parameter} t): its rate column changes by {deviation:e} (relative) between {frequency_parameter} and 3{frequency_parameter}/2 (a base motion `Y*cos(w*t)` through a spring and a dashpot does; so does a load `A*cos(w*t)`, with B₁ = 0)"
+    )]
+    InputRateNotConstant {
+        /// The parameter.
+        input: String,
+        /// The frequency parameter.
+        frequency_parameter: String,
+        /// `max |B₁(3w/2) − B₁(w)| / max |B₁(w)|`.
+        deviation: f64,
+    },
     /// The input matrix has the wrong number of rows.
     #[error("the input matrix has {found} rows, the model {expected} coordinates")]
     DimensionMismatch {
@@ -217,6 +250,12 @@ pub struct ForcedLinearization {
     /// [`ForcedLinearization::state_input_matrix`].
     #[serde(serialize_with = "crate::serde_matrix::rows")]
     pub input_matrix: DMatrix<f64>,
+    /// `B₁`, `n × r`: column `j` is the generalized force per unit *rate* of input `j` (N s or
+    /// N·m·s per unit of the parameter), as for a base motion through a dashpot (see the
+    /// [module](self) docs); zero unless found by [`linearize_with_input_rates`]. The input
+    /// column at `ω` is `B₀ + iω B₁` ([`ForcedLinearization::input_at`]).
+    #[serde(serialize_with = "crate::serde_matrix::rows")]
+    pub input_rate_matrix: DMatrix<f64>,
 }
 
 impl ForcedLinearization {
@@ -236,6 +275,34 @@ impl ForcedLinearization {
         b.view_mut((n, 0), (n, r)).copy_from(&minv_b);
         Ok(b)
     }
+
+    /// The complex input matrix `B₀ + iω B₁` at `frequency` (rad/s), `n × r`: the complex
+    /// amplitude of the generalized force per unit complex amplitude `û` of each input under
+    /// `u = Re(û e^{iωt})`.
+    pub fn input_at(&self, frequency: f64) -> DMatrix<Complex<f64>> {
+        harmonic_input(&self.input_matrix, &self.input_rate_matrix, frequency)
+    }
+
+    /// Whether some input enters through its rate (`B₁ ≠ 0`).
+    pub fn has_input_rates(&self) -> bool {
+        self.input_rate_matrix.amax() > 0.0
+    }
+}
+
+/// `B₀ + iω B₁` (`n × r`, complex) from the input matrix `B₀` and the input-rate matrix `B₁`
+/// (both `n × r`) at `frequency` (rad/s).
+///
+/// # Panics
+/// If the shapes of `input_matrix` and `input_rate_matrix` differ (a programmer error).
+pub fn harmonic_input(
+    input_matrix: &DMatrix<f64>,
+    input_rate_matrix: &DMatrix<f64>,
+    frequency: f64,
+) -> DMatrix<Complex<f64>> {
+    assert_eq!(input_matrix.shape(), input_rate_matrix.shape());
+    input_matrix.zip_map(input_rate_matrix, |b0, b1| {
+        Complex::new(b0, if b1 == 0.0 { 0.0 } else { frequency * b1 })
+    })
 }
 
 /// Relative tolerance of the linearity test `F(2) − F(1) = F(1) − F(0)`, against `max |F|`:
@@ -364,8 +431,153 @@ fn linearize_with_inputs_inner(
         equilibrium,
         linearization,
         inputs: inputs.iter().map(|s| s.to_string()).collect(),
+        input_rate_matrix: DMatrix::zeros(n, inputs.len()),
         input_matrix,
     })
+}
+
+/// A quarter-period load below this fraction of the largest generalized force is rounding
+/// (`cos(π/2)` evaluates to `6.1e-17`), not a rate term: its `B₁` column is 0.
+const RATE_TOLERANCE: f64 = 1e-12;
+
+/// A change of `B₁` between two frequencies above this fraction of `max |B₁|` means the input's
+/// time function is not `cos(w t)` with its rate (rounding of `w t` near `π/2` gives ~1e-15).
+const RATE_CONSTANCY_TOLERANCE: f64 = 1e-9;
+
+/// [`linearize_with_inputs`], and the input-rate matrix `B₁` of the parameter inputs read from
+/// the load a quarter period after `t = 0` (see the [module](self) docs): with
+/// `w = frequency_parameter` (the model's value), column `j` is
+///
+/// ```text
+/// B₁ = −(F(q*, 0, π/(2w); p = 1) − F(q*, 0, π/(2w); p = 0)) / w
+/// ```
+///
+/// set to 0 where it is below `1e-12` of the load (a load `A cos(w t)`), and checked to be
+/// the same at `3w/2`. Only a load that reverses over half a period
+/// (`∂F/∂p(π/w) = −∂F/∂p(0)` to `1e-9`) is read so: a constant load, or one that `w` does not
+/// time, keeps `B₁ = 0`, as does a coordinate input (a unit generalized force). When the
+/// frequency parameter is not finite and `> 0` the load is read at `w = 1` rad/s.
+///
+/// The model's parameter values are restored before returning, on success and on error.
+///
+/// # Shapes
+/// As [`linearize_with_inputs`]; `input_rate_matrix` is `n × r`.
+///
+/// # Errors
+/// As [`linearize_with_inputs`]; [`FrfError::UnknownParameter`] for a frequency parameter the
+/// model does not have; [`FrfError::InputRateNotConstant`] when `B₁` differs between `w` and
+/// `3w/2`;
+/// [`FrfError::NonlinearInput`] when the quarter-period load is not linear in the input.
+///
+/// # References
+/// Lecture 38 (vibration isolation), HW21 (a): the base-excited oscillator
+/// `m ẍ + c ẋ + k x = k y_b + c ẏ_b`; D. J. Inman, *Engineering Vibration*, chapter 2 (base
+/// excitation).
+pub fn linearize_with_input_rates(
+    model: &mut dyn ModelInfo,
+    guess: &[f64],
+    inputs: &[&str],
+    frequency_parameter: &str,
+) -> Result<ForcedLinearization, FrfError> {
+    let mut forced = linearize_with_inputs(model, guess, inputs)?;
+    let saved = model.parameter_values();
+    let result = input_rate_matrix(model, &forced, frequency_parameter);
+    restore(model, &saved);
+    forced.input_rate_matrix = result?;
+    Ok(forced)
+}
+
+fn input_rate_matrix(
+    model: &mut dyn ModelInfo,
+    forced: &ForcedLinearization,
+    frequency_parameter: &str,
+) -> Result<DMatrix<f64>, FrfError> {
+    let names: Vec<String> = model
+        .description()
+        .parameter_names()
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+    let index = names
+        .iter()
+        .position(|p| p == frequency_parameter)
+        .ok_or_else(|| UnknownParameter {
+            name: frequency_parameter.to_string(),
+            model: model.description().name.to_string(),
+            known: names.join(", "),
+        })?;
+    // `B₁` does not depend on the frequency (checked below), so any positive one will do.
+    let w = match model.parameter_values()[index] {
+        w if w.is_finite() && w > 0.0 => w,
+        _ => 1.0,
+    };
+    let n = forced.input_matrix.nrows();
+    let y: Vec<f64> = forced
+        .equilibrium
+        .q
+        .iter()
+        .copied()
+        .chain(std::iter::repeat_n(0.0, n))
+        .collect();
+    for input in &forced.inputs {
+        if names.iter().any(|p| p == input) {
+            model.set_parameter(input, 0.0)?;
+        }
+    }
+    let mut rates = DMatrix::zeros(n, forced.inputs.len());
+    for (j, input) in forced.inputs.iter().enumerate() {
+        if !names.iter().any(|p| p == input) || input == frequency_parameter {
+            continue;
+        }
+        // The generalized force per unit input at time `t` with the frequency set to `w`.
+        let mut load = |w: f64, t: f64| -> Result<DVector<f64>, FrfError> {
+            model.set_parameter(frequency_parameter, w)?;
+            let mut f = Vec::with_capacity(3);
+            for p in [0.0, 1.0, 2.0] {
+                model.set_parameter(input, p)?;
+                f.push(model.mass_matrix_and_forcing(t, &y).1);
+            }
+            model.set_parameter(input, 0.0)?;
+            let d1 = &f[1] - &f[0];
+            let scale = f.iter().fold(0.0f64, |a, v| a.max(v.amax()));
+            let deviation = (&(&f[2] - &f[1]) - &d1).amax();
+            if deviation.is_nan() || deviation > LINEARITY_TOLERANCE * scale {
+                return Err(FrfError::NonlinearInput {
+                    input: input.clone(),
+                    deviation: if scale > 0.0 {
+                        deviation / scale
+                    } else {
+                        f64::INFINITY
+                    },
+                });
+            }
+            Ok(d1)
+        };
+        let quarter = std::f64::consts::FRAC_PI_2 / w;
+        let start = load(w, 0.0)?;
+        let half = load(w, 2.0 * quarter)?;
+        let at_quarter = load(w, quarter)?;
+        let scale = start.amax().max(half.amax()).max(at_quarter.amax());
+        // Only a load that reverses over half a period (`cos(w t)` and its rate) has a rate
+        // column; a constant load, or one that `w` does not time, keeps `B₁ = 0`.
+        let reverses = (&start + &half).amax() <= RATE_CONSTANCY_TOLERANCE * scale;
+        if !reverses || at_quarter.amax() <= RATE_TOLERANCE * scale {
+            continue;
+        }
+        let b1 = -at_quarter / w;
+        let other = 1.5 * w;
+        let b1_other = -load(other, std::f64::consts::FRAC_PI_2 / other)? / other;
+        let deviation = (&b1_other - &b1).amax() / b1.amax();
+        if deviation.is_nan() || deviation > RATE_CONSTANCY_TOLERANCE {
+            return Err(FrfError::InputRateNotConstant {
+                input: input.clone(),
+                frequency_parameter: frequency_parameter.to_string(),
+                deviation,
+            });
+        }
+        rates.set_column(j, &b1);
+    }
+    Ok(rates)
 }
 
 /// The index of the coordinate `output` of `model`.
@@ -492,8 +704,27 @@ pub fn frequency_response_of(
     frequency: f64,
     outputs: &[usize],
 ) -> Result<DMatrix<Complex<f64>>, FrfError> {
-    check_forcing(lin, input_matrix.nrows(), frequency)?;
     let b = input_matrix.map(|v| Complex::new(v, 0.0));
+    frequency_response_to(lin, &b, frequency, outputs)
+}
+
+/// [`frequency_response_of`] for a complex input matrix: `H(ω) = (K − ω²M + iωC)⁻¹ B(ω)`,
+/// such as `B₀ + iω B₁` of an input that enters through its rate
+/// ([`ForcedLinearization::input_at`]).
+///
+/// # Shapes
+/// `input_matrix` is `n × r` (complex); the result is `n × r`.
+///
+/// # Errors
+/// As [`frequency_response_of`].
+pub fn frequency_response_to(
+    lin: &Linearization,
+    input_matrix: &DMatrix<Complex<f64>>,
+    frequency: f64,
+    outputs: &[usize],
+) -> Result<DMatrix<Complex<f64>>, FrfError> {
+    check_forcing(lin, input_matrix.nrows(), frequency)?;
+    let b = input_matrix;
     let s = frequency_scale(frequency);
     let z = scaled_dynamic_stiffness(lin, frequency, s);
     let scale = z.iter().map(|v| v.norm()).fold(0.0f64, f64::max);
@@ -507,7 +738,7 @@ pub fn frequency_response_of(
     if smallest_pivot.is_nan() || smallest_pivot <= SINGULAR_PIVOT * scale {
         return Err(FrfError::Singular { frequency });
     }
-    let x = lu.solve(&b).ok_or(FrfError::Singular { frequency })?;
+    let x = lu.solve(b).ok_or(FrfError::Singular { frequency })?;
     if !x.iter().all(|v| v.re.is_finite() && v.im.is_finite()) {
         return Err(FrfError::Singular { frequency });
     }
@@ -627,7 +858,38 @@ pub fn frequency_sweep(
     output: usize,
     frequencies: &[f64],
 ) -> Result<FrequencySweep, FrfError> {
+    let rates = DMatrix::zeros(input_matrix.nrows(), input_matrix.ncols());
+    frequency_sweep_with_rates(lin, input_matrix, &rates, input, output, frequencies)
+}
+
+/// [`frequency_sweep`] for an input that also enters through its rate: the input column at
+/// `ω` is `B₀ + iω B₁` (column `input` of `input_matrix` and of `input_rate_matrix`), as
+/// [`linearize_with_input_rates`] finds for a base motion.
+///
+/// # Shapes
+/// `input_matrix` and `input_rate_matrix` are `n × r`; otherwise as [`frequency_sweep`].
+///
+/// # Errors
+/// As [`frequency_sweep`]; [`FrfError::DimensionMismatch`] also when the two matrices differ
+/// in shape.
+///
+/// # References
+/// Lecture 38 (transmissibility), HW21 (a).
+pub fn frequency_sweep_with_rates(
+    lin: &Linearization,
+    input_matrix: &DMatrix<f64>,
+    input_rate_matrix: &DMatrix<f64>,
+    input: usize,
+    output: usize,
+    frequencies: &[f64],
+) -> Result<FrequencySweep, FrfError> {
     let n = lin.mass_matrix.nrows();
+    if input_rate_matrix.shape() != input_matrix.shape() {
+        return Err(FrfError::DimensionMismatch {
+            expected: input_matrix.nrows(),
+            found: input_rate_matrix.nrows(),
+        });
+    }
     if input_matrix.nrows() != n {
         return Err(FrfError::DimensionMismatch {
             expected: n,
@@ -640,10 +902,11 @@ pub fn frequency_sweep(
             found: output.max(input),
         });
     }
-    let b = input_matrix.column(input).into_owned();
-    let b = DMatrix::from_column_slice(n, 1, b.as_slice());
+    let b = DMatrix::from_column_slice(n, 1, input_matrix.column(input).as_slice());
+    let b1 = DMatrix::from_column_slice(n, 1, input_rate_matrix.column(input).as_slice());
+    let column = Column { b0: &b, b1: &b1 };
     let entry = |w: f64| -> Result<Option<Complex<f64>>, FrfError> {
-        match frequency_response_of(lin, &b, w, &[output]) {
+        match column.response(lin, w, &[output]) {
             Ok(h) => Ok(Some(h[(output, 0)])),
             Err(FrfError::Singular { .. }) => Ok(None),
             Err(e) => Err(e),
@@ -679,7 +942,7 @@ pub fn frequency_sweep(
             (a.min(w), b.max(w))
         });
     let peaks = if lo < hi {
-        find_peaks(lin, &b, output, frequencies, lo, hi)?
+        find_peaks(lin, column, output, frequencies, lo, hi)?
     } else {
         Vec::new()
     };
@@ -722,16 +985,36 @@ fn mode_frequencies(lin: &Linearization) -> Result<(Vec<f64>, Vec<f64>), FrfErro
     Ok((undamped, damped))
 }
 
+/// One input column `B₀ + iω B₁` (`n × 1` each).
+#[derive(Clone, Copy)]
+struct Column<'a> {
+    b0: &'a DMatrix<f64>,
+    b1: &'a DMatrix<f64>,
+}
+
+impl Column<'_> {
+    fn response(
+        &self,
+        lin: &Linearization,
+        frequency: f64,
+        outputs: &[usize],
+    ) -> Result<DMatrix<Complex<f64>>, FrfError> {
+        let b = harmonic_input(self.b0, self.b1, frequency);
+        frequency_response_to(lin, &b, frequency, outputs)
+    }
+}
+
 fn find_peaks(
     lin: &Linearization,
-    b: &DMatrix<f64>,
+    column: Column<'_>,
     output: usize,
     frequencies: &[f64],
     lo: f64,
     hi: f64,
 ) -> Result<Vec<ResonancePeak>, FrfError> {
     let magnitude = |w: f64| -> Option<f64> {
-        frequency_response(lin, b, w)
+        column
+            .response(lin, w, &[])
             .ok()
             .map(|h| h[(output, 0)].norm())
     };
@@ -782,7 +1065,7 @@ fn find_peaks(
         }
         let w = golden_section_max(|x| magnitude(x.exp()).unwrap_or(0.0), w_lo.ln(), w_hi.ln());
         let w = w.exp();
-        if let Ok(h) = frequency_response(lin, b, w) {
+        if let Ok(h) = column.response(lin, w, &[]) {
             let h = h[(output, 0)];
             // Two grid maxima can refine to the same peak.
             if peaks

@@ -79,15 +79,19 @@ fn print_report(r: &CheckReport) {
             format!("{:.2e}", num(c.max_rel_residual))
         };
         outln!(
-            "{} {} vs {}: max relative difference of q'' {residual} over {} states; symbolically equal: {}",
-            mark(c.max_rel_residual <= TOLERANCE),
+            "{} {} vs {}: max relative difference of q'' {residual} over {} states; {}",
+            mark(c.passed(TOLERANCE)),
             c.a,
             c.b,
             c.states,
-            match c.symbolic_equal {
-                Some(true) => "yes",
-                Some(false) => "no",
-                None => "not applicable",
+            if c.expect_disagreement {
+                "expected to disagree"
+            } else {
+                match c.symbolic_equal {
+                    Some(true) => "symbolically equal: yes",
+                    Some(false) => "symbolically equal: no",
+                    None => "symbolically equal: not applicable",
+                }
             }
         );
     }
@@ -116,9 +120,16 @@ fn print_report(r: &CheckReport) {
             );
         }
     }
+    let width = r
+        .derivations
+        .iter()
+        .map(|d| d.name.chars().count())
+        .max()
+        .unwrap_or(0)
+        .max(9);
     for d in &r.derivations {
         outln!(
-            "     {:<9} derived in {:.3} ms: {} operations, {} after CSE",
+            "     {:<width$} derived in {:.3} ms: {} operations, {} after CSE",
             d.name,
             d.time_s * 1e3,
             d.ops,

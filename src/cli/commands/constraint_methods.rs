@@ -1,6 +1,8 @@
 //! `eomgen study constraint-methods MODEL` (issue 5, item 6; lectures 8–11, HW10): the study is
-//! [`eomgen::analysis::constraint_methods()`]; the minimal twin is the one the model file names
-//! (`minimal_twin:`). This module renders the table, the JSON and the chart.
+//! [`eomgen::analysis::constraint_methods_with_reduced()`]; the reduced model of method II.2 is
+//! [`eomgen::reduction::reduced_twin()`] (the constraints eliminated symbolically, compiled at
+//! run time) and the minimal twin is the one the model file names (`minimal_twin:`). This
+//! module renders the table, the JSON and the chart.
 
 use std::io::Write as _;
 
@@ -62,8 +64,24 @@ pub fn run(args: &ConstraintMethodsArgs) -> Result<(), CliError> {
         tol: args.tol,
         stiffness: args.stiffness.clone(),
     };
-    let study = eomgen::analysis::constraint_methods(
+    // Method II.2 where the constraints can be eliminated; a model whose constraints cannot
+    // (trigonometric in every coordinate) has no such row, and the reason is said.
+    let reduced = match eomgen::reduction::reduced_twin(&source) {
+        Ok(r) => Some(r),
+        Err(e) => {
+            if !args.json {
+                crate::cli::output::errln!("note: no II.2 row: {e}");
+            }
+            None
+        }
+    };
+    let label = reduced.as_ref().map(eomgen::reduction::ReducedTwin::label);
+    let study = eomgen::analysis::constraint_methods_with_reduced(
         &mut || source.instantiate(),
+        reduced
+            .as_ref()
+            .zip(label.as_deref())
+            .map(|(r, label)| (label, r.instantiate())),
         twin.as_ref().map(|(name, twin)| (name.as_str(), twin.instantiate())),
         &options,
     )
@@ -127,6 +145,15 @@ pub fn run(args: &ConstraintMethodsArgs) -> Result<(), CliError> {
             reference_tol = num(reference_tol),
             agreement = num(agreement)
         );
+        if let Some(r) = &reduced {
+            for e in &r.reduced.eliminations {
+                let _ = writeln!(
+                    stdout,
+                    "II.2       {} = {} (from `{}`), {}_dot = {}",
+                    e.coordinate, e.solution, e.constraint, e.coordinate, e.rate
+                );
+            }
+        }
         let _ = writeln!(
             stdout,
             "{:<44} {:>12} {:>12} {:>10} {:>8} {:>10}",

@@ -90,7 +90,8 @@ pub fn run(args: &EquationsArgs) -> Result<(), CliError> {
     Ok(())
 }
 
-/// Runs `new`.
+/// Runs `new`: prints the generated file, which names its equilibria (`hanging` and
+/// `upright`, or `rest`) and states its `checks:` ([`templates::generate`]).
 pub fn new(args: &NewArgs) -> Result<(), CliError> {
     let text =
         templates::generate(&args.template, args.n).map_err(|e| CliError::usage(e.to_string()))?;

@@ -33,7 +33,10 @@ pub struct FrfArgs {
     /// `A*cos(w*t)`; its time function is taken at t = 0, so for `A*cos(w*t)` the response is
     /// the steady state under `A cos(ω t)`), or a coordinate's name: a unit generalized force
     /// on that coordinate (no `--simulate` then: the model has no load to drive). The
-    /// equilibrium (`--at`) is found with the input set to 0.
+    /// equilibrium (`--at`) is found with the input set to 0. An input whose load reverses
+    /// over half a period of `w` (or `--frequency-parameter`) and is read a quarter period
+    /// later too also enters through its rate: a base motion `Y*cos(w*t)` through a spring and
+    /// a dashpot gives the input column `k + iωc` and the transmissibility.
     #[arg(long)]
     pub input: String,
     /// An output coordinate; repeatable (default: every coordinate).
@@ -60,8 +63,8 @@ pub struct FrfArgs {
     /// model to steady state, in parallel (1 to 1000).
     #[arg(long, value_name = "K", value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..=1000))]
     pub simulate: Option<usize>,
-    /// The parameter holding the forcing frequency, set to each ω by `--simulate` (default:
-    /// `w` if the model has it).
+    /// The parameter holding the forcing frequency, set to each ω by `--simulate` and used to
+    /// read an input's rate column (default: `w` if the model has it).
     #[arg(long, value_name = "NAME")]
     pub frequency_parameter: Option<String>,
     /// The input's value in the `--simulate` runs (small, so that the nonlinear model stays
@@ -97,10 +100,14 @@ fn failure(model: &dyn ModelInfo, e: FrfAnalysisError) -> CliError {
             let input = match source {
                 FrfError::NonlinearInput { input, .. }
                 | FrfError::InputNotInForcing { input }
-                | FrfError::InputChangesMassMatrix { input } => input.as_str(),
+                | FrfError::InputChangesMassMatrix { input }
+                | FrfError::InputRateNotConstant { input, .. } => input.as_str(),
                 _ => "",
             };
             CliError::usage(format!("--input {input}: {e}"))
+        }
+        FrfAnalysisError::ModalWithInputRate { ref input } => {
+            CliError::usage(format!("--modal with --input {input}: {e}"))
         }
         FrfAnalysisError::Output { output, source } => {
             CliError::usage(format!("--output {output}: {source}"))
@@ -283,6 +290,20 @@ fn print_report(
         column.join(", "),
         args.input
     );
+    if forced.has_input_rates() {
+        let rates: Vec<String> = forced
+            .input_rate_matrix
+            .column(0)
+            .iter()
+            .map(|v| format!("{v:.6e}", v = num(v)))
+            .collect();
+        let _ = writeln!(
+            out,
+            "B₁         [{}] (generalized force per unit rate of {}: the input column at ω is B + iω B₁)",
+            rates.join(", "),
+            args.input
+        );
+    }
     let gyroscopic = frf.stability.gyroscopic_frequencies.is_some();
     if gyroscopic {
         // The undamped modes of K are not the system's: the whole linearisation's are.

@@ -2,6 +2,7 @@
 
 use clap::Args;
 use eomgen::analysis::{ConstraintDrift, EnergyDrift, Simulation};
+use eomgen::outputs::{OutputSeries, evaluate_outputs};
 use eomgen::{ModelInfo, OutputTimes, Solution};
 
 use crate::cli::error::CliError;
@@ -35,7 +36,8 @@ pub struct SimulateArgs {
     /// Add the wall time (`stats.wall_time_s`) to the JSON output.
     #[arg(long)]
     pub timing: bool,
-    /// Write the samples as CSV (t, coordinates, rates, energy).
+    /// Write the samples as CSV (t, coordinates, rates, energy, then the constraint forces
+    /// and drift of a constrained model, then the model's `outputs:`).
     #[arg(long, value_name = "FILE")]
     pub csv: Option<String>,
     /// Plot the coordinates against time (.svg or .png); a constrained model also gets its
@@ -111,6 +113,12 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
         Some(t) if !e.to_string().contains("t = ") => format!("incomplete: {e} at t = {t}"),
         _ => format!("incomplete: {e}"),
     });
+    // The file's `outputs:` at every sample; one that cannot be evaluated (not a number
+    // where the run went) fails the command after everything else is written.
+    let (outputs, outputs_error) = match evaluate_outputs(model.as_ref(), solution) {
+        Ok(outputs) => (outputs, None),
+        Err(e) => (Vec::new(), Some(e)),
+    };
     if let Some(path) = &args.csv {
         write_csv(
             path,
@@ -118,6 +126,7 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
             solution,
             report,
             constraints,
+            &outputs,
             incomplete.as_deref(),
         )?;
     }
@@ -172,13 +181,33 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
         {
             stats.remove("wall_time_s");
         }
+        if !outputs.is_empty()
+            && let Some(object) = json.as_object_mut()
+        {
+            object.insert("outputs".to_string(), crate::cli::json::sorted(&outputs)?);
+            json = crate::cli::json::sorted(&json)?;
+        }
         crate::cli::json::print_json(&json)?;
     } else {
-        print_summary(model.as_ref(), method_name, &args.run, solution, report);
+        print_summary(
+            model.as_ref(),
+            method_name,
+            &args.run,
+            solution,
+            report,
+            &outputs,
+        );
         print_constraint_summary(constraints, args.run.stabilization);
         print_events(model.as_ref(), solution);
     }
+    if let Some(e) = &outputs_error {
+        output::errln!("error: {e}");
+    }
     match failure {
+        None if outputs_error.is_some() => Err(CliError::failure(format!(
+            "the outputs of `{}` could not be evaluated along the run",
+            model.description().name
+        ))),
         None => Ok(()),
         Some(e) => Err(failure_error(
             &model.description().name,
@@ -199,6 +228,7 @@ fn print_summary(
     args: &IntegrationArgs,
     solution: &Solution,
     report: &EnergyDrift,
+    outputs: &[OutputSeries],
 ) {
     outln!(
         "model      {} ({} dof): {}",
@@ -238,6 +268,7 @@ fn print_summary(
             );
         }
     }
+    print_conserved_outputs(outputs, args.rtol);
     let s = &solution.stats;
     let implicit = if s.jacobian_evals > 0 {
         format!(
@@ -256,12 +287,46 @@ fn print_summary(
     );
 }
 
+/// The drift of each output the file declares conserved, as the energy's: its start and
+/// `max |Q − Q(0)| / max(1, |Q(0)|)`. The file's bound holds for `eomgen report`'s run
+/// (DOP853 at 1e-12); a run at a looser `rtol` drifts in proportion, so a drift is called
+/// "not conserved" (with a warning) only beyond both the bound and 1000 × `rtol`, and
+/// noted as above the bound otherwise.
+fn print_conserved_outputs(outputs: &[OutputSeries], rtol: f64) {
+    for o in outputs.iter().filter(|o| o.conserved) {
+        let (Some(q0), Some(d), Some(bound)) = (o.values.first(), o.drift, o.tolerance) else {
+            continue;
+        };
+        let note = if d > bound.max(1e3 * rtol) {
+            output::errln!(
+                "warning: output `{}` is declared conserved, but it drifted by {:.3e}, beyond its bound {bound:e} and 1000 × rtol",
+                o.name,
+                num(d)
+            );
+            format!(" (exceeds the bound {bound:e} and 1000 × rtol: not conserved along this run)")
+        } else if o.drifted() {
+            format!(
+                " (above the file's bound {bound:e}, which `eomgen report` checks at rtol 1e-12)"
+            )
+        } else {
+            String::new()
+        };
+        outln!(
+            "conserved  {name}: Q(0) = {q0:.12e}, max|Q - Q(0)| / max(1, |Q(0)|) = {d:.3e}{note}",
+            name = o.name,
+            q0 = num(q0),
+            d = num(d)
+        );
+    }
+}
+
 fn write_csv(
     path: &str,
     model: &dyn ModelInfo,
     solution: &Solution,
     report: &EnergyDrift,
     constraints: &ConstraintDrift,
+    outputs: &[OutputSeries],
     incomplete: Option<&str>,
 ) -> Result<(), CliError> {
     let mut out = incomplete.map_or_else(String::new, |note| format!("# {note}\n"));
@@ -280,6 +345,10 @@ fn write_csv(
     if !constraints.is_empty() {
         out.push_str(",drift_position,drift_velocity");
     }
+    for o in outputs {
+        out.push(',');
+        out.push_str(&o.name);
+    }
     out.push('\n');
     for (k, ((t, y), e)) in solution.iter().zip(&report.energy).enumerate() {
         out.push_str(&format!("{t:e}"));
@@ -295,6 +364,9 @@ fn write_csv(
             }
             let (p, v) = constraints.drift[k];
             out.push_str(&format!(",{p:e},{v:e}"));
+        }
+        for o in outputs {
+            out.push_str(&format!(",{:e}", o.values[k]));
         }
         out.push('\n');
     }

@@ -99,6 +99,7 @@ pub fn describe(model: &SymbolicModel, eom: &EquationsOfMotion, mathml: bool) ->
         }),
         checks: model.checks.clone(),
         floquet: Cow::Owned(model.floquet.clone()),
+        outputs: Cow::Owned(model.outputs.clone()),
     }
 }
 
@@ -192,6 +193,12 @@ pub fn description_tokens(
             .map(|r| floquet_tokens(r, krate))
             .collect::<Result<_, String>>()?,
     );
+    let outputs = borrowed(
+        d.outputs
+            .iter()
+            .map(|o| output_tokens(o, krate))
+            .collect::<Result<_, String>>()?,
+    );
     Ok(quote! {
         #krate::ModelDescription {
             name: #name,
@@ -216,6 +223,7 @@ pub fn description_tokens(
             equations_mathml: #equations_mathml,
             checks: #checks,
             floquet: #floquet,
+            outputs: #outputs,
         }
     })
 }
@@ -328,6 +336,21 @@ fn checks_tokens(c: &Checks, krate: &TokenStream) -> Result<TokenStream, String>
         conserved: #conserved,
         energy_drift: #energy_drift,
         constraint_drift: #constraint_drift,
+    }))
+}
+
+/// One `outputs:` entry as a Rust expression for a `static`.
+fn output_tokens(
+    o: &eomgen_description::outputs::OutputSpec,
+    krate: &TokenStream,
+) -> Result<TokenStream, String> {
+    let (name, value, conserved) = (text(&o.name), text(&o.value), o.conserved);
+    let tolerance = float(o.tolerance)?;
+    Ok(quote!(#krate::description::outputs::OutputSpec {
+        name: #name,
+        value: #value,
+        conserved: #conserved,
+        tolerance: #tolerance,
     }))
 }
 

@@ -28,13 +28,18 @@ use super::{EquationsOfMotion, Formulation, SymbolicModel};
 use crate::expr::{ExprArena, ExprId};
 use crate::model::AmbForm;
 
-/// The model's `balances:` as equations of motion.
+/// One set of the model's `balances:` as equations of motion: the set at index `set` of
+/// [`SymbolicModel::balance_sets`] (the only one in the plain list form).
 #[derive(Debug, Clone, Copy, Default)]
-pub struct UserBalances;
+pub struct UserBalances {
+    /// Index into [`SymbolicModel::balance_sets`].
+    pub set: usize,
+}
 
 impl UserBalances {
     /// Whether the model has balances. [`crate::model::load`] refuses a file whose count of
-    /// balances differs from its count of coordinates, so they are then one per coordinate.
+    /// balances in a set differs from its count of coordinates, so they are then one per
+    /// coordinate.
     pub fn applies_to(model: &SymbolicModel) -> bool {
         !model.balances.is_empty()
     }
@@ -58,7 +63,11 @@ impl Formulation for UserBalances {
         let bodies = model.bodies.clone();
         let loads = model.loads.clone();
         let gravity = model.gravity.clone();
-        let balances = model.balances.clone();
+        let range = model
+            .balance_sets
+            .get(self.set)
+            .map_or(0..model.balances.len(), |s| s.range.clone());
+        let balances = model.balances[range].to_vec();
         let frames = model.frames.clone();
         let arena = &mut model.arena;
         let mut residuals: Vec<Vec<ExprId>> = Vec::with_capacity(balances.len());
@@ -129,6 +138,25 @@ impl Formulation for UserBalances {
                             let mv: Vec<ExprId> =
                                 v.iter().map(|c| arena.times(body.mass, *c)).collect();
                             let mut h = cross_z(arena, &rel, &mv);
+                            if let Some((inertia, angle)) = body.rotation {
+                                let w = arena.time_derivative(angle);
+                                let iw = arena.times(inertia, w);
+                                h = arena.plus(h, iw);
+                            }
+                            terms.push(arena.time_derivative(h));
+                        }
+                        AmbForm::HRelDot => {
+                            // H_A/rel = r_G/A × m (v_G − v_A) + I ω, differentiated as a whole.
+                            let rel_v: Vec<ExprId> = v
+                                .iter()
+                                .zip(&points[about])
+                                .map(|(vg, ra)| {
+                                    let va = arena.time_derivative(*ra);
+                                    let d = arena.minus(*vg, va);
+                                    arena.times(body.mass, d)
+                                })
+                                .collect();
+                            let mut h = cross_z(arena, &rel, &rel_v);
                             if let Some((inertia, angle)) = body.rotation {
                                 let w = arena.time_derivative(angle);
                                 let iw = arena.times(inertia, w);
@@ -233,8 +261,21 @@ fn spatial_amb(
                     terms.push(project(arena, &h_dot));
                 }
             }
-            AmbForm::HDot => {
-                let mv: Vec<ExprId> = v.iter().map(|c| arena.times(body.mass, *c)).collect();
+            AmbForm::HDot | AmbForm::HRelDot => {
+                // H_A = r_G/A × m v_G + I_G ω; relative to A (`h_rel_dot`), v_G − v_A.
+                let mv: Vec<ExprId> = v
+                    .iter()
+                    .zip(&points[about])
+                    .map(|(vg, ra)| {
+                        let vg = if form == AmbForm::HRelDot {
+                            let va = arena.time_derivative(*ra);
+                            arena.minus(*vg, va)
+                        } else {
+                            *vg
+                        };
+                        arena.times(body.mass, vg)
+                    })
+                    .collect();
                 let mut h = cross(arena, &rel, &three(&mv));
                 if let Some(s) = &body.spatial {
                     let i_w = tensor_times(arena, &s.inertia, &s.angular_velocity);

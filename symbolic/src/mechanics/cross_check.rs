@@ -10,8 +10,8 @@ use rustc_hash::FxHashMap;
 use super::BalanceInfo;
 pub use super::numeric::solve;
 use super::{
-    EquationsOfMotion, Formulation, HandEquations, Lagrange, MomentumBalance, SymbolicModel,
-    UserBalances,
+    EnergyRate, EquationsOfMotion, Formulation, HandEquations, Lagrange, MomentumBalance,
+    PowerRoute, SymbolicModel, UserBalances, energy_routes_skipped,
 };
 use crate::expr::eval::Evaluator;
 use crate::expr::{ExprId, SymbolKind, cse};
@@ -20,8 +20,9 @@ use crate::model::{AmbForm, Diagnostic, ModelFile};
 /// Cost and time of one derivation.
 #[derive(Debug, Clone, PartialEq)]
 pub struct DerivationStats {
-    /// Formulation name (`lagrange`, `momentum`).
-    pub name: &'static str,
+    /// Formulation name (`lagrange`, `momentum`, `energy`, `power`, `by_hand`, and
+    /// `balances` or the name of each set of balances).
+    pub name: String,
     /// Wall time of the derivation of `M` and `F` (s).
     pub time_s: f64,
     /// Operations of `M` and `F` as trees.
@@ -35,8 +36,8 @@ pub struct DerivationStats {
 pub struct Comparison {
     /// First formulation.
     pub a: &'static str,
-    /// Second formulation.
-    pub b: &'static str,
+    /// Second formulation ([`DerivationStats::name`]).
+    pub b: String,
     /// Largest `|q̈_a − q̈_b| / max(1, |q̈|)` over the random states: infinite where `b`'s
     /// `M′` is singular, NaN where `b` is not finite at a state where `a` is (a failure).
     pub max_rel_residual: f64,
@@ -45,6 +46,21 @@ pub struct Comparison {
     pub symbolic_equal: Option<bool>,
     /// Number of states compared.
     pub states: usize,
+    /// Whether the file states that `b` disagrees with `a` (a set of balances with `expect:
+    /// disagree`, kept to show a wrong form): the comparison passes when they differ.
+    pub expect_disagreement: bool,
+}
+
+impl Comparison {
+    /// Whether the comparison passed at relative tolerance `tolerance`: `b` agrees with `a`
+    /// to it, or, where [`Self::expect_disagreement`], differs by more (and is finite).
+    pub fn passed(&self, tolerance: f64) -> bool {
+        if self.expect_disagreement {
+            self.max_rel_residual > tolerance && !self.max_rel_residual.is_nan()
+        } else {
+            self.max_rel_residual <= tolerance
+        }
+    }
 }
 
 /// The power balance `dE/dt = Σ Qᵢ q̇ᵢ`, with `E = T + V` and `Q` the non-potential forces.
@@ -192,10 +208,7 @@ impl CheckReport {
     pub fn passed(&self, tolerance: f64) -> bool {
         self.states.compared > 0
             && self.not_cross_checked().is_none()
-            && self
-                .comparisons
-                .iter()
-                .all(|c| c.max_rel_residual <= tolerance)
+            && self.comparisons.iter().all(|c| c.passed(tolerance))
             && self
                 .power_balance
                 .as_ref()
@@ -227,10 +240,11 @@ impl CheckReport {
                 .iter()
                 .map(|c| ComparisonSummary {
                     a: c.a,
-                    b: c.b,
+                    b: c.b.clone(),
                     max_rel_residual: sampled.then_some(c.max_rel_residual),
                     symbolic_equal: c.symbolic_equal,
                     states: c.states,
+                    expect_disagreement: c.expect_disagreement,
                 })
                 .collect(),
             power_balance: self.power_balance.as_ref().map(|p| PowerBalanceSummary {
@@ -255,7 +269,7 @@ impl CheckReport {
                         ops: d.ops,
                         ops_after_cse: d.ops_after_cse,
                     };
-                    (d.name, summary)
+                    (d.name.clone(), summary)
                 })
                 .collect(),
             notes: self.notes.clone(),
@@ -284,24 +298,27 @@ pub struct CheckSummary {
     /// How many random states were drawn, compared and skipped.
     pub states: SampledStates,
     /// Each derivation's size (and wall time, when asked for), by name.
-    pub derivation: std::collections::BTreeMap<&'static str, DerivationSummary>,
+    pub derivation: std::collections::BTreeMap<String, DerivationSummary>,
     /// Notes on what was found.
     pub notes: Vec<String>,
 }
 
 /// One [`Comparison`] in a [`CheckSummary`].
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct ComparisonSummary {
     /// The first derivation's name.
     pub a: &'static str,
     /// The second's.
-    pub b: &'static str,
+    pub b: String,
     /// [`Comparison::max_rel_residual`] (null when no state was compared).
     pub max_rel_residual: Option<f64>,
     /// [`Comparison::symbolic_equal`].
     pub symbolic_equal: Option<bool>,
     /// The states compared.
     pub states: usize,
+    /// [`Comparison::expect_disagreement`] (left out when false).
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub expect_disagreement: bool,
 }
 
 /// The [`PowerBalance`] in a [`CheckSummary`].
@@ -393,7 +410,11 @@ fn initial_constraints(model: &SymbolicModel) -> Option<InitialConstraints> {
     worst
 }
 
-fn timed(model: &mut SymbolicModel, f: &dyn Formulation) -> (EquationsOfMotion, DerivationStats) {
+fn timed(
+    model: &mut SymbolicModel,
+    f: &dyn Formulation,
+    name: &str,
+) -> (EquationsOfMotion, DerivationStats) {
     let start = Instant::now();
     let eom = f.derive(model);
     let time_s = start.elapsed().as_secs_f64();
@@ -404,7 +425,7 @@ fn timed(model: &mut SymbolicModel, f: &dyn Formulation) -> (EquationsOfMotion, 
         .copied()
         .collect();
     let stats = DerivationStats {
-        name: f.name(),
+        name: name.to_string(),
         time_s,
         ops: model.arena.tree_operation_count(&roots),
         ops_after_cse: cse::operation_count(&model.arena, &roots),
@@ -429,17 +450,20 @@ pub fn check_model(
     let mut model = SymbolicModel::from_file(file)?;
     let n = model.num_dofs();
     let mut notes = Vec::new();
-    let (lagrange, lagrange_stats) = timed(&mut model, &Lagrange);
+    let (lagrange, lagrange_stats) = timed(&mut model, &Lagrange, Lagrange.name());
     let problems = super::mass_matrix_diagnostics(&model, &lagrange, file);
     if !problems.is_empty() {
         return Err(problems);
     }
     let mut derivations = vec![lagrange_stats];
-    let mut others: Vec<(&'static str, EquationsOfMotion)> = Vec::new();
+    let mut others: Vec<(String, EquationsOfMotion)> = Vec::new();
+    // The index in `model.balance_sets` of each of `others` that is a set of balances.
+    let mut balance_set_of: Vec<Option<usize>> = Vec::new();
     if MomentumBalance::applies_to(&model) {
-        let (eom, stats) = timed(&mut model, &MomentumBalance);
+        let (eom, stats) = timed(&mut model, &MomentumBalance, MomentumBalance.name());
         derivations.push(stats);
-        others.push((MomentumBalance.name(), eom));
+        others.push((MomentumBalance.name().to_string(), eom));
+        balance_set_of.push(None);
     } else {
         notes.push(NO_MOMENTUM_BALANCE.to_string());
     }
@@ -449,19 +473,40 @@ pub fn check_model(
         ));
     }
     if UserBalances::applies_to(&model) {
-        let (eom, stats) = timed(&mut model, &UserBalances);
-        derivations.push(stats);
-        others.push((UserBalances.name(), eom));
+        for set in 0..model.balance_sets.len() {
+            let name = model.balance_sets[set].name.clone();
+            let (eom, stats) = timed(&mut model, &UserBalances { set }, &name);
+            derivations.push(stats);
+            others.push((name, eom));
+            balance_set_of.push(Some(set));
+        }
     }
     if HandEquations::applies_to(&model) {
-        let (eom, stats) = timed(&mut model, &HandEquations);
+        let (eom, stats) = timed(&mut model, &HandEquations, HandEquations.name());
         derivations.push(stats);
-        others.push((HandEquations.name(), eom));
+        others.push((HandEquations.name().to_string(), eom));
+        balance_set_of.push(None);
+    }
+    // Lecture 10's energy routes: one equation each, for one coordinate.
+    if let Some(reason) = energy_routes_skipped(&model) {
+        if n == 1 {
+            notes.push(reason.to_string());
+        }
+    } else {
+        for route in [&EnergyRate as &dyn Formulation, &PowerRoute] {
+            if route.name() == PowerRoute.name() && !PowerRoute::applies_to(&model) {
+                continue;
+            }
+            let (eom, stats) = timed(&mut model, route, route.name());
+            derivations.push(stats);
+            others.push((route.name().to_string(), eom));
+            balance_set_of.push(None);
+        }
     }
     let symbolic_equal: Vec<Option<bool>> = others
         .iter()
         .map(|(name, b)| {
-            (*name == MomentumBalance.name()).then(|| {
+            (name == MomentumBalance.name()).then(|| {
                 let arena = &mut model.arena;
                 lagrange
                     .mass_matrix
@@ -495,40 +540,52 @@ pub fn check_model(
         .zip(&symbolic_equal)
         .map(|(((name, _), worst), symbolic)| Comparison {
             a: "lagrange",
-            b: name,
+            b: name.clone(),
             max_rel_residual: *worst,
             symbolic_equal: *symbolic,
             states: compared,
+            expect_disagreement: false,
         })
         .collect();
-    let moving_h_dot = model.balances.iter().any(|b| match b {
-        BalanceInfo::Amb {
-            about,
-            form: AmbForm::HDot,
-            ..
-        } => model.points[*about]
-            .1
-            .iter()
-            .any(|c| (0..n).any(|i| model.arena.depends_on(*c, model.coordinate_symbols(i)[0]))),
-        _ => false,
-    });
-    for c in &comparisons {
+    let mut comparisons = comparisons;
+    for (c, set) in comparisons.iter_mut().zip(&balance_set_of) {
+        c.expect_disagreement = set.is_some_and(|s| model.balance_sets[s].expect_disagreement);
+    }
+    for (c, set) in comparisons.iter().zip(&balance_set_of) {
+        if c.expect_disagreement {
+            let which = set.map_or_else(String::new, |s| balance_set_label(&model, s));
+            let why = set.and_then(|s| moving_point_form(&model, s));
+            notes.push(if c.passed(CHECK_TOLERANCE) {
+                match why {
+                    Some(why) => format!("{which} disagree with Lagrange, as the file states: {why}"),
+                    None => format!("{which} disagree with Lagrange, as the file states"),
+                }
+            } else {
+                format!("{which} agree with Lagrange, but the file states that they disagree (`expect: disagree`): here the form holds, or the set is not the one meant")
+            });
+            continue;
+        }
         if c.max_rel_residual.is_nan() || c.max_rel_residual > 1e-8 {
             let singular = c.max_rel_residual.is_infinite();
+            let balances = set.map(|s| balance_set_label(&model, s));
             if c.max_rel_residual.is_nan() {
-                let which = if c.b == UserBalances.name() {
-                    "the balances"
-                } else {
-                    "the equations of motion written by hand"
-                };
+                let which = balances
+                    .clone()
+                    .unwrap_or_else(|| format!("the {} equations", c.b));
                 notes.push(format!("{which} are not finite at some of the states where Lagrange's are (a function outside its domain, such as sqrt or asin, or an overflow)"));
-            } else if c.b == UserBalances.name() {
+            } else if let (Some(set), Some(which)) = (set, balances) {
                 notes.push(if singular {
-                    "the balances are not independent: their M′ is singular".to_string()
-                } else if moving_h_dot {
-                    "the balances disagree with Lagrange: an `amb` with `form: h_dot` is taken about a moving point, where Σ M_A = dH_A/dt misses v_A × m v_G (HW4, HW15); use the default `form: r_x_ma` or a fixed point".to_string()
+                    format!("{which} are not independent: their M′ is singular")
+                } else if let Some(why) = moving_point_form(&model, *set) {
+                    format!("{which} disagree with Lagrange: {why}")
                 } else {
-                    "the balances disagree with Lagrange: a chosen balance leaves a reaction force in, or misses a load (choose balances about the joints whose reactions they must eliminate)".to_string()
+                    format!("{which} disagree with Lagrange: a chosen balance leaves a reaction force in, or misses a load (choose balances about the joints whose reactions they must eliminate)")
+                });
+            } else if c.b == EnergyRate.name() || c.b == PowerRoute.name() {
+                notes.push(if singular {
+                    format!("the {} route is singular at a compared state (q̇ = 0 there: the route's equation is q̇ times the equation of motion)", c.b)
+                } else {
+                    format!("the {} route disagrees with Lagrange: a load's power is missing or a force does work that the equations do not see", c.b)
                 });
             } else if c.b == HandEquations.name() {
                 notes.push(if singular {
@@ -568,6 +625,46 @@ pub fn check_model(
     Ok(report)
 }
 
+/// How the notes of [`check_model`] name a set of balances: `the balances` in the plain
+/// list form, `` the balances `NAME` `` for a named set.
+fn balance_set_label(model: &SymbolicModel, set: usize) -> String {
+    match model.balance_sets.get(set) {
+        Some(s) if model.balance_sets.len() > 1 || s.name != "balances" => {
+            format!("the balances `{}`", s.name)
+        }
+        _ => "the balances".to_string(),
+    }
+}
+
+/// Why a set of balances that disagrees with Lagrange is wrong, when it takes an `amb` in a
+/// form that holds only about a fixed point or a special moving one: `form: h_dot` about a
+/// moving point A misses `v_A × m v_G` (it holds only where `v_A × v_G = 0`), `form:
+/// h_rel_dot` misses `r_G/A × m a_A` (it holds only where `r_G/A × a_A = 0`). `None` when
+/// the set has neither about a point that moves.
+fn moving_point_form(model: &SymbolicModel, set: usize) -> Option<String> {
+    let range = model.balance_sets.get(set)?.range.clone();
+    let n = model.num_dofs();
+    model.balances[range].iter().find_map(|b| {
+        let BalanceInfo::Amb { about, form, .. } = b else {
+            return None;
+        };
+        let point = &model.points[*about];
+        let moves = point.1.iter().any(|c| {
+            model.arena.depends_on(*c, model.time_symbol())
+                || (0..n).any(|i| model.arena.depends_on(*c, model.coordinate_symbols(i)[0]))
+        });
+        if !moves {
+            return None;
+        }
+        let about = &point.0;
+        match form {
+            AmbForm::HDot => Some(format!("the `amb` about `{about}` has `form: h_dot`, Σ M_A = dH_A/dt with H_A = Σ r_G/A × m v_G (absolute velocities), which misses v_A × m v_G about a moving point: it holds only where v_A × v_G = 0 (A fixed or the centre of mass); use the default `form: r_x_ma`")),
+            AmbForm::HRelDot => Some(format!("the `amb` about `{about}` has `form: h_rel_dot`, Σ M_A = dH_A/rel/dt with velocities relative to A, which misses r_G/A × m a_A about an accelerating point: it holds only where r_G/A × a_A = 0 (A fixed, the centre of mass, or accelerating along the line to it); use the default `form: r_x_ma`")),
+            AmbForm::RCrossMa => None,
+        }
+    })
+}
+
 /// What [`check_model`] measures at random states: q̈ of each other derivation against
 /// Lagrange's, the power balance, and whether `T` is homogeneous of degree 2 in the rates.
 #[derive(Debug, Clone, PartialEq)]
@@ -593,7 +690,7 @@ struct Sampled {
 fn sample_states(
     model: &mut SymbolicModel,
     lagrange: &EquationsOfMotion,
-    others: &[(&'static str, EquationsOfMotion)],
+    others: &[(String, EquationsOfMotion)],
     states: usize,
     seed: u64,
 ) -> Sampled {
@@ -838,7 +935,7 @@ mod tests {
         let mut m = model("double_pendulum");
         let lagrange = Lagrange.derive(&mut m);
         let momentum = MomentumBalance.derive(&mut m);
-        let others = vec![("momentum", momentum)];
+        let others = vec![("momentum".to_string(), momentum)];
         let right = sample_states(&mut m, &lagrange, &others, 30, 3);
         assert_eq!(right.states.compared, 30);
         assert!(right.quadratic);
@@ -869,7 +966,7 @@ mod tests {
         {
             *e = h.arena.times(factor, *e);
         }
-        let found = sample_states(&mut h, &hl, &[("scaled", scaled)], 30, 3);
+        let found = sample_states(&mut h, &hl, &[("scaled".to_string(), scaled)], 30, 3);
         assert!(
             found.max_rel[0] < 1e-12 && found.power_rel < 1e-12,
             "{found:?}"
@@ -901,12 +998,12 @@ mod tests {
         let lagrange = Lagrange.derive(&mut m);
         let mut singular = lagrange.clone();
         singular.mass_matrix = vec![m.arena.int(0); 4];
-        let found = sample_states(&mut m, &lagrange, &[("x", singular.clone())], 5, 1);
+        let found = sample_states(&mut m, &lagrange, &[("x".to_string(), singular.clone())], 5, 1);
         assert!(
             found.max_rel[0].is_infinite() && found.states.compared == 5,
             "{found:?}"
         );
-        let found = sample_states(&mut m, &singular, &[("x", lagrange)], 5, 1);
+        let found = sample_states(&mut m, &singular, &[("x".to_string(), lagrange)], 5, 1);
         assert_eq!((found.states.compared, found.states.singular), (0, 5));
     }
 

@@ -98,6 +98,17 @@ pub enum LoadInfo {
     },
 }
 
+/// A set of the user's balances: one derivation of the equations of motion.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BalanceSet {
+    /// Its name; `balances` for the plain list form.
+    pub name: String,
+    /// Its entries' range in [`SymbolicModel::balances`].
+    pub range: std::ops::Range<usize>,
+    /// Whether the file states that it disagrees with Lagrange (`expect: disagree`).
+    pub expect_disagreement: bool,
+}
+
 /// A user-chosen momentum balance (`balances:`), as expressions.
 #[derive(Debug, Clone, PartialEq)]
 pub enum BalanceInfo {
@@ -173,8 +184,10 @@ pub struct SymbolicModel {
     pub gravity: Option<Vec<ExprId>>,
     /// Springs, dampers, forces and torques as loads.
     pub loads: Vec<LoadInfo>,
-    /// The user's balances (empty if none).
+    /// The user's balances (empty if none), every set's in file order.
     pub balances: Vec<BalanceInfo>,
+    /// The sets of [`Self::balances`], in file order.
+    pub balance_sets: Vec<BalanceSet>,
     /// Whether the file uses the energy form (`kinetic`, `potential` or
     /// `generalized_forces`), which a derivation from the kinematics alone cannot use.
     pub uses_energy_form: bool,
@@ -202,6 +215,9 @@ pub struct SymbolicModel {
     pub checks: eomgen_description::checks::Checks,
     /// The file's `floquet:` references, as the model's description keeps them.
     pub floquet: Vec<eomgen_description::floquet::FloquetReference>,
+    /// The file's `outputs:`, as the model's description keeps them (an output that uses
+    /// the vector functions written out in the coordinates and rates).
+    pub outputs: Vec<eomgen_description::outputs::OutputSpec>,
 }
 
 /// An entry of the file's `equilibria:`: an equilibrium or a steady motion.
@@ -353,6 +369,10 @@ struct Lowering<'f> {
     errors: Vec<Diagnostic>,
     /// Whether accelerations (`x_ddot`) may appear: only in equations written by hand.
     allow_accelerations: bool,
+    /// The points' positions, once lowered, for the vector functions (`dot(P - O, …)`).
+    points: Points,
+    /// Names bound while lowering one expression: an interaction's `r` and `r_dot`.
+    locals: Vec<(String, ExprId)>,
 }
 
 impl<'f> Lowering<'f> {
@@ -363,6 +383,8 @@ impl<'f> Lowering<'f> {
             angular_velocities: FxHashMap::default(),
             errors: Vec::new(),
             allow_accelerations: false,
+            points: Vec::new(),
+            locals: Vec::new(),
         }
     }
 
@@ -651,6 +673,12 @@ impl<'f> Lowering<'f> {
             ExprKind::Ident(name) => match name.as_str() {
                 // `t` is the first symbol declared (in `run`), so it is found like the others.
                 "pi" => self.arena.pi(),
+                _ if self.locals.iter().any(|(n, _)| n == name) => self
+                    .locals
+                    .iter()
+                    .rev()
+                    .find(|(n, _)| n == name)
+                    .map_or_else(|| self.arena.int(0), |(_, e)| *e),
                 _ if self.arena.symbol_id(name).is_none()
                     && self.angular_velocities.contains_key(name) =>
                 {
@@ -712,6 +740,9 @@ impl<'f> Lowering<'f> {
                     ));
                 }
                 result
+            }
+            ExprKind::Call { func, args } if crate::model::vectors::is_vector_function(func) => {
+                self.vector_call(e, func, args)
             }
             ExprKind::Call { func, args } => {
                 let args: Vec<ExprId> = args.iter().map(|a| self.lower(a)).collect();
@@ -781,6 +812,356 @@ impl<'f> Lowering<'f> {
         self.arena.int(0)
     }
 
+    /// A call of a vector function that gives a number: `dot(a, b)`, `cross(a, b)` in the
+    /// plane (`a_x b_y − a_y b_x`), `norm(a)`, `distance(A, B)`.
+    fn vector_call(&mut self, e: &Expr, func: &str, args: &[Expr]) -> ExprId {
+        let vectors: Vec<Vec<ExprId>> = args.iter().map(|a| self.vector(a)).collect();
+        match (func, vectors.as_slice()) {
+            ("dot", [a, b]) => self.dot(a, b),
+            ("cross", [a, b]) if a.len() == 2 && b.len() == 2 => {
+                let ab = self.arena.times(a[0], b[1]);
+                let ba = self.arena.times(a[1], b[0]);
+                self.arena.minus(ab, ba)
+            }
+            ("norm", [a]) => {
+                let a2 = self.dot(a, a);
+                self.arena.sqrt(a2)
+            }
+            ("distance", [a, b]) => {
+                let d = self.difference(a, b);
+                let d2 = self.dot(&d, &d);
+                self.arena.sqrt(d2)
+            }
+            _ => {
+                self.errors.push(Diagnostic::new(
+                    e.location,
+                    format!("`{func}(…)` is a vector here, where a number is expected"),
+                ));
+                self.arena.int(0)
+            }
+        }
+    }
+
+    /// A vector expression of the points' positions (ground-frame components), as the
+    /// rules of [`crate::model::vectors`] shape it.
+    fn vector(&mut self, e: &Expr) -> Vec<ExprId> {
+        let names: Vec<&str> = self.points.iter().map(|(n, _)| n.as_str()).collect();
+        let dimension = self.points.first().map_or(2, |(_, r)| r.len());
+        let is_vector = |e: &Expr| {
+            crate::model::vectors::shape_of(e, &names, dimension)
+                == Some(crate::model::vectors::Shape::Vector)
+        };
+        let (lhs_vector, rhs_vector) = match &e.kind {
+            ExprKind::Binary { lhs, rhs, .. } => (is_vector(lhs), is_vector(rhs)),
+            _ => (false, false),
+        };
+        match &e.kind {
+            ExprKind::Ident(n) if point(&self.points, n).is_some() => self.points
+                [point(&self.points, n).unwrap_or_default()]
+            .1
+            .clone(),
+            ExprKind::Neg(a) => {
+                let a = self.vector(a);
+                a.iter().map(|c| self.arena.neg(*c)).collect()
+            }
+            ExprKind::Binary {
+                op: op @ (BinOp::Add | BinOp::Sub),
+                lhs,
+                rhs,
+                ..
+            } => {
+                let (a, b) = (self.vector(lhs), self.vector(rhs));
+                a.iter()
+                    .zip(&b)
+                    .map(|(x, y)| match op {
+                        BinOp::Add => self.arena.plus(*x, *y),
+                        _ => self.arena.minus(*x, *y),
+                    })
+                    .collect()
+            }
+            ExprKind::Binary {
+                op: op @ (BinOp::Mul | BinOp::Div),
+                lhs,
+                rhs,
+                ..
+            } if lhs_vector || rhs_vector => {
+                let (v, s) = if lhs_vector {
+                    (self.vector(lhs), self.lower(rhs))
+                } else {
+                    (self.vector(rhs), self.lower(lhs))
+                };
+                v.iter()
+                    .map(|c| match op {
+                        BinOp::Mul => self.arena.times(*c, s),
+                        _ => self.arena.divide(*c, s),
+                    })
+                    .collect()
+            }
+            ExprKind::Call { func, args } if func == "vel" && args.len() == 1 => {
+                let v = self.vector(&args[0]);
+                v.iter().map(|c| self.arena.time_derivative(*c)).collect()
+            }
+            ExprKind::Call { func, args } if func == "cross" && args.len() == 2 => {
+                let (a, b) = (self.vector(&args[0]), self.vector(&args[1]));
+                if let ([a0, a1, a2], [b0, b1, b2]) = (&a[..], &b[..]) {
+                    let mut component = |p: ExprId, q: ExprId, u: ExprId, v: ExprId| {
+                        let pq = self.arena.times(p, q);
+                        let uv = self.arena.times(u, v);
+                        self.arena.minus(pq, uv)
+                    };
+                    vec![
+                        component(*a1, *b2, *a2, *b1),
+                        component(*a2, *b0, *a0, *b2),
+                        component(*a0, *b1, *a1, *b0),
+                    ]
+                } else {
+                    self.errors.push(Diagnostic::new(
+                        e.location,
+                        "`cross(a, b)` is a number in the plane, where a vector is expected",
+                    ));
+                    vec![self.arena.int(0); dimension]
+                }
+            }
+            _ => {
+                self.errors.push(Diagnostic::new(
+                    e.location,
+                    format!("`{e}` is a number, where a vector of points is expected"),
+                ));
+                vec![self.arena.int(0); dimension]
+            }
+        }
+    }
+
+    /// The expression as the model's description keeps it: as written, or, when it uses
+    /// the vector functions, lowered (the points' positions and velocities written out in
+    /// the coordinates and rates) and printed back in the file's syntax, so that it is
+    /// evaluated from the state alone.
+    fn state_text(&mut self, e: &Expr) -> String {
+        if !crate::model::vectors::uses_vectors(e) {
+            return e.to_string();
+        }
+        let lowered = self.expr(e);
+        crate::expr::print::Printer::new(&self.arena, crate::expr::print::Syntax::Text)
+            .print(lowered)
+    }
+
+    /// `interactions:` — equal and opposite forces `f e` on `B` and `−f e` on `A` along
+    /// `e = d/r`, `d = r_B − r_A`, `r = |d|`, `ṙ = d·ḋ/r`. A magnitude that is a sum of
+    /// powers of `r` times factors constant in the motion (parameters, `t`) is integrated to
+    /// a potential, `V(r) = −∫ f dr` (`−c ln r` for `c/r`), so that `T + V` stays the
+    /// energy; any other enters `Q` as `Qᵢ = f d·∂d/∂qᵢ / r` (its virtual work `f e·δd`).
+    /// Either way momentum balance gets the two forces at the points.
+    ///
+    /// Returns the loads and, per interaction, `(r, f)` at the points' positions, for the
+    /// check of the initial state.
+    fn interactions(
+        &mut self,
+        points: &Points,
+        q_symbols: &[SymbolId],
+        terms: &mut Terms,
+    ) -> (Vec<LoadInfo>, Vec<(ExprId, ExprId)>) {
+        let mut loads = Vec::new();
+        let mut at_start = Vec::new();
+        if self.file.interactions.is_empty() {
+            return (loads, at_start);
+        }
+        // Names no model symbol can have (a space is not in a name), substituted away below.
+        let r_symbol = self.arena.declare("interaction r", SymbolKind::Auxiliary);
+        let rdot_symbol = self
+            .arena
+            .declare("interaction r_dot", SymbolKind::Auxiliary);
+        for it in &self.file.interactions {
+            let (Some(a), Some(b)) = (
+                point(points, &it.between[0].value),
+                point(points, &it.between[1].value),
+            ) else {
+                self.errors.push(Diagnostic::new(
+                    it.name.location,
+                    format!("interaction `{}` names an unknown point", it.name.value),
+                ));
+                continue;
+            };
+            let d = self.difference(&points[b].1, &points[a].1);
+            let dd: Vec<ExprId> = d.iter().map(|c| self.arena.time_derivative(*c)).collect();
+            let d2 = self.dot(&d, &d);
+            let r = self.arena.sqrt(d2);
+            let d_dd = self.dot(&d, &dd);
+            let rdot = self.arena.divide(d_dd, r);
+            let (r_local, rdot_local) = (
+                self.arena.symbol_expr(r_symbol),
+                self.arena.symbol_expr(rdot_symbol),
+            );
+            self.locals = vec![
+                ("r".to_string(), r_local),
+                ("r_dot".to_string(), rdot_local),
+            ];
+            let f_of_r = self.expr(&it.magnitude);
+            self.locals.clear();
+            let mut values = FxHashMap::default();
+            values.insert(r_symbol, r);
+            values.insert(rdot_symbol, rdot);
+            let f = self.arena.substitute(f_of_r, &values);
+            // f e on B, −f e on A.
+            let scale = self.arena.divide(f, r);
+            let on_b: Vec<ExprId> = d.iter().map(|c| self.arena.times(scale, *c)).collect();
+            let on_a: Vec<ExprId> = on_b.iter().map(|c| self.arena.neg(*c)).collect();
+            loads.push(LoadInfo::Force {
+                point: b,
+                vector: on_b,
+            });
+            loads.push(LoadInfo::Force {
+                point: a,
+                vector: on_a,
+            });
+            at_start.push((r, f));
+            match self.power_law_potential(f_of_r, r_symbol, rdot_symbol) {
+                Some(v_of_r) => {
+                    let v = self.arena.substitute(v_of_r, &values);
+                    terms.potential.push(v);
+                }
+                None => {
+                    for (i, qs) in q_symbols.iter().enumerate() {
+                        let partial: Vec<ExprId> =
+                            d.iter().map(|x| self.arena.diff(*x, *qs)).collect();
+                        let proj = self.dot(&d, &partial);
+                        if !self.arena.is_zero(proj) {
+                            terms.forces[i].push(self.arena.times(scale, proj));
+                        }
+                    }
+                }
+            }
+        }
+        (loads, at_start)
+    }
+
+    /// `V(r) = −∫ f dr` of a magnitude `f` that is a sum of terms `c rᵏ`, `k` a number and
+    /// `c` free of `r`, `ṙ`, the coordinates and the rates: `−c r^(k+1)/(k+1)`, or `−c ln r`
+    /// for `k = −1`. `None` for any other magnitude (it is not, or not visibly, the
+    /// derivative of a potential of `r`).
+    fn power_law_potential(
+        &mut self,
+        f: ExprId,
+        r_symbol: SymbolId,
+        rdot_symbol: SymbolId,
+    ) -> Option<ExprId> {
+        use crate::expr::Node;
+        if self.arena.depends_on(f, rdot_symbol) {
+            return None;
+        }
+        let motion: Vec<SymbolId> = self
+            .arena
+            .coordinates()
+            .iter()
+            .flat_map(|c| [c[0], c[1]])
+            .collect();
+        let f = self.arena.expand(f);
+        let terms: Vec<ExprId> = match self.arena.node(f) {
+            Node::Add(ts) => ts.to_vec(),
+            _ => vec![f],
+        };
+        let mut potential = Vec::new();
+        for term in terms {
+            let factors: Vec<ExprId> = match self.arena.node(term) {
+                Node::Mul(fs) => fs.to_vec(),
+                _ => vec![term],
+            };
+            let mut power = vec![self.arena.int(0)];
+            let mut coefficient = Vec::new();
+            for factor in factors {
+                if !self.arena.depends_on(factor, r_symbol) {
+                    if motion.iter().any(|s| self.arena.depends_on(factor, *s)) {
+                        return None;
+                    }
+                    coefficient.push(factor);
+                    continue;
+                }
+                match self.arena.node(factor).clone() {
+                    Node::Symbol(s) if s == r_symbol => power.push(self.arena.int(1)),
+                    Node::Pow([base, exponent])
+                        if matches!(self.arena.node(base), Node::Symbol(s) if *s == r_symbol)
+                            && self.arena.as_constant(exponent).is_some() =>
+                    {
+                        power.push(exponent);
+                    }
+                    _ => return None,
+                }
+            }
+            let c = self.arena.product(&coefficient);
+            let k = self.arena.sum(&power);
+            let one = self.arena.int(1);
+            let k1 = self.arena.plus(k, one);
+            let r = self.arena.symbol_expr(r_symbol);
+            let integral = if self.arena.is_zero(k1) {
+                let ln = self.arena.func(Func::Ln, r);
+                self.arena.times(c, ln)
+            } else {
+                let rk1 = self.arena.pow(r, k1);
+                let crk1 = self.arena.times(c, rk1);
+                self.arena.divide(crk1, k1)
+            };
+            potential.push(self.arena.neg(integral));
+        }
+        Some(self.arena.sum(&potential))
+    }
+
+    /// Reports an interaction whose points coincide at the initial state (`r = 0`: no
+    /// direction), or whose magnitude is not a finite number there; the parameters at
+    /// their defaults.
+    fn check_interactions_at_start(
+        &mut self,
+        at_start: &[(ExprId, ExprId)],
+        parameters: &[ParameterInfo],
+        initial: (&[ExprId], &[ExprId]),
+    ) {
+        if at_start.is_empty() {
+            return;
+        }
+        let mut bindings = vec![0.0; self.arena.symbols().len()];
+        for p in parameters {
+            bindings[p.symbol.index()] = p.default;
+        }
+        let starts: Vec<ExprId> = initial.0.iter().chain(initial.1).copied().collect();
+        let start = crate::expr::eval::Evaluator::new(&self.arena, &starts).eval(&bindings);
+        let n = initial.0.len();
+        for (i, s) in self.arena.symbols().iter().enumerate() {
+            match s.kind {
+                SymbolKind::Coordinate(k) => bindings[i] = start[k as usize],
+                SymbolKind::Velocity(k) => bindings[i] = start[n + k as usize],
+                _ => {}
+            }
+        }
+        let roots: Vec<ExprId> = at_start.iter().flat_map(|(r, f)| [*r, *f]).collect();
+        let values = crate::expr::eval::Evaluator::new(&self.arena, &roots).eval(&bindings);
+        for (it, v) in self.file.interactions.iter().zip(values.chunks(2)) {
+            let (r, f) = (v[0], v[1]);
+            let [a, b] = &it.between;
+            if r == 0.0 {
+                self.errors.push(
+                    Diagnostic::new(
+                        b.location,
+                        format!(
+                            "the points `{}` and `{}` of interaction `{}` coincide at the initial state (r = 0): the line of its force is undefined there",
+                            a.value, b.value, it.name.value
+                        ),
+                    )
+                    .with_help("start the points apart (`initial:`), or check their positions under `points:`"),
+                );
+            } else if !f.is_finite() && r.is_finite() {
+                self.errors.push(
+                    Diagnostic::new(
+                        it.magnitude.location,
+                        format!(
+                            "the magnitude of interaction `{}` is {f} at the initial state (r = {})",
+                            it.name.value,
+                            short(r)
+                        ),
+                    )
+                    .with_help("a magnitude must be a finite number where the motion starts; check the formula and the initial state"),
+                );
+            }
+        }
+    }
+
     fn dot(&mut self, a: &[ExprId], b: &[ExprId]) -> ExprId {
         let terms: Vec<ExprId> = a
             .iter()
@@ -831,6 +1212,7 @@ impl<'f> Lowering<'f> {
             }
         }
         let points = self.points(&frames);
+        self.points = points.clone();
         let dimension = file.dimension.unwrap_or(2);
 
         let mut terms = Terms {
@@ -858,7 +1240,11 @@ impl<'f> Lowering<'f> {
         loads.extend(self.dampers(&points, &q_symbols, &mut terms));
         loads.extend(self.forces(&points, &frames, &q_symbols, &mut terms));
         loads.extend(self.torques(&angles, &body_infos, &frames, &q_symbols, &mut terms));
+        let (interaction_loads, interactions_at_start) =
+            self.interactions(&points, &q_symbols, &mut terms);
+        loads.extend(interaction_loads);
         let balances = self.balances(&points, &body_infos, &frames);
+        let balance_sets = balance_sets(self.file);
         let hand_equations = self.hand_equations();
 
         let kinematics = Kinematics {
@@ -889,6 +1275,11 @@ impl<'f> Lowering<'f> {
             .map(|terms| self.arena.sum(terms))
             .collect();
         let (initial_q, initial_qdot) = self.initial_state(&coordinate_names);
+        self.check_interactions_at_start(
+            &interactions_at_start,
+            &parameters,
+            (&initial_q, &initial_qdot),
+        );
 
         let explicit_time =
             self.arena.depends_on(kinetic, time_id) || self.arena.depends_on(potential, time_id);
@@ -915,6 +1306,26 @@ impl<'f> Lowering<'f> {
             .trace
             .iter()
             .filter_map(|p| point(&points, &p.value))
+            .collect();
+
+        // The outputs, and conserved quantities that use the vector functions, as text the
+        // runtime evaluates from the state; lowered last, so that they change no identifier
+        // of the equations' expressions.
+        let mut checks = file.checks.describe();
+        for (c, described) in file.checks.conserved.iter().zip(checks.conserved.to_mut()) {
+            if crate::model::vectors::uses_vectors(&c.value) {
+                described.value = self.state_text(&c.value).into();
+            }
+        }
+        let outputs = file
+            .outputs
+            .iter()
+            .map(|o| eomgen_description::outputs::OutputSpec {
+                name: o.name.value.clone().into(),
+                value: self.state_text(&o.value).into(),
+                conserved: o.conserved,
+                tolerance: o.tolerance,
+            })
             .collect();
 
         if !self.errors.is_empty() {
@@ -944,6 +1355,7 @@ impl<'f> Lowering<'f> {
             gravity,
             loads,
             balances,
+            balance_sets,
             uses_energy_form: file.kinetic.is_some()
                 || file.potential.is_some()
                 || !file.generalized_forces.is_empty(),
@@ -955,7 +1367,8 @@ impl<'f> Lowering<'f> {
             initial_guesses,
             events,
             equilibria,
-            checks: file.checks.describe(),
+            checks,
+            outputs,
             floquet: file
                 .floquet
                 .iter()
@@ -1806,4 +2219,23 @@ mod tests {
         assert_eq!(s.ignorable, [2]);
         assert!(model.has_steady_motions());
     }
+}
+
+/// The sets of the file's `balances:` with their ranges in the lowered list: each set's
+/// entries are consecutive (a set is one list under its name), and the plain list form is one
+/// set named `balances`.
+fn balance_sets(file: &ModelFile) -> Vec<BalanceSet> {
+    let mut sets: Vec<BalanceSet> = Vec::new();
+    for (i, b) in file.balances.iter().enumerate() {
+        let name = b.set_name().unwrap_or("balances");
+        match sets.last_mut() {
+            Some(last) if last.name == name => last.range.end = i + 1,
+            _ => sets.push(BalanceSet {
+                name: name.to_string(),
+                range: i..i + 1,
+                expect_disagreement: b.expect_disagreement,
+            }),
+        }
+    }
+    sets
 }

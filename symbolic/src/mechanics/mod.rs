@@ -8,6 +8,7 @@
 mod balances;
 mod constraints;
 pub mod cross_check;
+mod energy;
 pub mod frames;
 mod lagrange;
 mod lower;
@@ -17,10 +18,11 @@ mod numeric;
 
 pub use balances::{HandEquations, UserBalances};
 pub use constraints::{ConstraintEquations, linear_in_rates, redundant_rows};
+pub use energy::{EnergyRate, PowerRoute, energy_routes_skipped};
 pub use lagrange::Lagrange;
 pub use lower::{
-    BalanceInfo, BodyInfo, Equilibrium, EventInfo, LoadInfo, ParameterInfo, SpatialBody,
-    SymbolicModel,
+    BalanceInfo, BalanceSet, BodyInfo, Equilibrium, EventInfo, LoadInfo, ParameterInfo,
+    SpatialBody, SymbolicModel,
 };
 pub use mass::mass_matrix_diagnostics;
 pub use momentum::MomentumBalance;

@@ -442,10 +442,8 @@ impl Formulation for MomentumBalance {
         }
         for load in &loads {
             // Each load as forces at points (and torques), projected on partial velocities.
-            let mut forces: Vec<(usize, Vec<ExprId>)> = Vec::new();
-            let mut torque: Option<(ExprId, ExprId)> = None;
-            match load {
-                LoadInfo::SpatialTorque { body, vector } => {
+            let LoadForces { forces, torque } =
+                if let LoadInfo::SpatialTorque { body, vector } = load {
                     // τ·∂ω/∂q̇ᵢ, both in the body frame's components.
                     if let Some(spatial) = &bodies[*body].spatial {
                         for (i, s) in symbols.iter().enumerate() {
@@ -456,44 +454,10 @@ impl Formulation for MomentumBalance {
                             }
                         }
                     }
-                }
-                LoadInfo::Force { point, vector } => forces.push((*point, vector.clone())),
-                LoadInfo::Torque { angle, value, .. } => torque = Some((*angle, *value)),
-                LoadInfo::Spring {
-                    between: [pa, pb],
-                    stiffness,
-                    rest_length,
-                } => {
-                    // F_A = −k (|d| − ℓ₀) d/|d| with d = r_A − r_B; F_B = −F_A.
-                    let d = separation(arena, &points, *pa, *pb);
-                    let scale = match rest_length {
-                        None => arena.neg(*stiffness),
-                        Some(l0) => {
-                            let d2 = dot(arena, &d, &d);
-                            let len = arena.sqrt(d2);
-                            let ratio = arena.divide(*l0, len);
-                            let one = arena.int(1);
-                            let s = arena.minus(ratio, one);
-                            arena.times(*stiffness, s)
-                        }
-                    };
-                    forces.extend(equal_and_opposite(arena, *pa, *pb, &d, scale));
-                }
-                LoadInfo::Damper {
-                    between: [pa, pb],
-                    coefficient,
-                } => {
-                    // F_A = −c (ḋ·d) d/(d·d); F_B = −F_A.
-                    let d = separation(arena, &points, *pa, *pb);
-                    let dd: Vec<ExprId> = d.iter().map(|c| arena.time_derivative(*c)).collect();
-                    let rate = dot(arena, &d, &dd);
-                    let d2 = dot(arena, &d, &d);
-                    let cr = arena.times(*coefficient, rate);
-                    let q = arena.divide(cr, d2);
-                    let scale = arena.neg(q);
-                    forces.extend(equal_and_opposite(arena, *pa, *pb, &d, scale));
-                }
-            }
+                    LoadForces::default()
+                } else {
+                    load_forces(arena, &points, load)
+                };
             for (point, f) in &forces {
                 for (i, r) in kinematics.partials(arena, *point).into_iter().enumerate() {
                     if let Some(r) = r {
@@ -554,7 +518,7 @@ fn cheaper_of_raw_and_collected(
 }
 
 /// `a·b`.
-fn dot(arena: &mut ExprArena, a: &[ExprId], b: &[ExprId]) -> ExprId {
+pub(crate) fn dot(arena: &mut ExprArena, a: &[ExprId], b: &[ExprId]) -> ExprId {
     let t: Vec<ExprId> = a.iter().zip(b).map(|(x, y)| arena.times(*x, *y)).collect();
     arena.sum(&t)
 }
@@ -566,6 +530,70 @@ fn separation(arena: &mut ExprArena, points: &[Vec<ExprId>], a: usize, b: usize)
         .zip(&points[b])
         .map(|(x, y)| arena.minus(*x, *y))
         .collect()
+}
+
+/// A planar or point load as what it does: forces at points and a torque on a body's angle.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct LoadForces {
+    /// `(point, force vector)` pairs (N): a spring or damper gives an equal and opposite pair.
+    pub(crate) forces: Vec<(usize, Vec<ExprId>)>,
+    /// `(angle, torque)`: a planar torque (N·m) on the body whose angle expression is `angle`.
+    pub(crate) torque: Option<(ExprId, ExprId)>,
+}
+
+/// The forces at points and the planar torque of `load` ([`LoadInfo`]), shared by the
+/// momentum balance (projected on partial velocities), the power route `P = Ė_K` (dotted
+/// with velocities) and linear momentum balances (summed along a direction). A spring pulls
+/// its end `A` by `F_A = −k (|d| − ℓ₀) d/|d|`, `d = r_A − r_B`, a damper by
+/// `F_A = −c (ḋ·d) d/(d·d)`, each with `F_B = −F_A`. A 3-D torque
+/// ([`LoadInfo::SpatialTorque`]) acts through the body's angular velocity and is not a force
+/// or a planar torque: it gives nothing here.
+pub(crate) fn load_forces(
+    arena: &mut ExprArena,
+    points: &[Vec<ExprId>],
+    load: &LoadInfo,
+) -> LoadForces {
+    let mut out = LoadForces::default();
+    match load {
+        LoadInfo::SpatialTorque { .. } => {}
+        LoadInfo::Force { point, vector } => out.forces.push((*point, vector.clone())),
+        LoadInfo::Torque { angle, value, .. } => out.torque = Some((*angle, *value)),
+        LoadInfo::Spring {
+            between: [pa, pb],
+            stiffness,
+            rest_length,
+        } => {
+            let d = separation(arena, points, *pa, *pb);
+            let scale = match rest_length {
+                None => arena.neg(*stiffness),
+                Some(l0) => {
+                    let d2 = dot(arena, &d, &d);
+                    let len = arena.sqrt(d2);
+                    let ratio = arena.divide(*l0, len);
+                    let one = arena.int(1);
+                    let s = arena.minus(ratio, one);
+                    arena.times(*stiffness, s)
+                }
+            };
+            out.forces
+                .extend(equal_and_opposite(arena, *pa, *pb, &d, scale));
+        }
+        LoadInfo::Damper {
+            between: [pa, pb],
+            coefficient,
+        } => {
+            let d = separation(arena, points, *pa, *pb);
+            let dd: Vec<ExprId> = d.iter().map(|c| arena.time_derivative(*c)).collect();
+            let rate = dot(arena, &d, &dd);
+            let d2 = dot(arena, &d, &d);
+            let cr = arena.times(*coefficient, rate);
+            let q = arena.divide(cr, d2);
+            let scale = arena.neg(q);
+            out.forces
+                .extend(equal_and_opposite(arena, *pa, *pb, &d, scale));
+        }
+    }
+    out
 }
 
 /// The pair of forces `s·d` on `a` and `−s·d` on `b` (a spring or damper along the line).

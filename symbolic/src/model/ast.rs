@@ -26,6 +26,31 @@ pub const FUNCTIONS: &[(&str, usize)] = &[
     ("step", 1),
 ];
 
+/// The vector functions an expression may call, with their number of arguments: functions of
+/// the points' positions (docs/model-format.md, "Vector functions"). Their arguments are
+/// vectors — a point's name (its position from the origin of the ground frame), sums and
+/// differences of vectors, a vector times or divided by a number, `vel(v)` and, in 3-D,
+/// `cross(a, b)` — and every other name is a number:
+///
+/// - `dot(a, b)`: the scalar product `a·b`;
+/// - `cross(a, b)`: in the plane the scalar `a_x b_y − a_y b_x` (the `z` component of the
+///   cross product), in 3-D the vector `a × b` (usable where a vector is expected, as in
+///   `dot(cross(a, b), c)`);
+/// - `norm(a)`: the length `|a|`;
+/// - `distance(A, B)`: `|A − B|`;
+/// - `vel(a)`: the time derivative of `a` (`vel(P)` is the velocity of point `P` in the
+///   ground frame), a vector.
+///
+/// Unlike [`FUNCTIONS`] their names are not reserved: a parameter may be called `distance`,
+/// since a call is told from a name by its parentheses.
+pub const VECTOR_FUNCTIONS: &[(&str, usize)] = &[
+    ("dot", 2),
+    ("cross", 2),
+    ("norm", 1),
+    ("distance", 2),
+    ("vel", 1),
+];
+
 /// A binary operator.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum BinOp {
@@ -76,7 +101,8 @@ pub enum ExprKind {
         /// Where the operator is (the `*` of `a * b`): errors of the operation point here.
         op_location: Location,
     },
-    /// `f(a, …)` with `f` one of [`FUNCTIONS`] and the right number of arguments.
+    /// `f(a, …)` with `f` one of [`FUNCTIONS`] or [`VECTOR_FUNCTIONS`] and the right number
+    /// of arguments.
     Call {
         /// Function name.
         func: String,

@@ -309,6 +309,41 @@ pub struct Damper {
     pub coefficient: Expr,
 }
 
+/// A force between two points (`interactions:`): `{ between: [A, B], magnitude: f }`, equal
+/// and opposite forces along the line of the points, `f e` on `B` and `−f e` on `A` with
+/// `e = (B − A)/r` and `r = |B − A|`: `f > 0` pushes the points apart, `f < 0` pulls them
+/// together (gravity is `-G*m1*m2/r^2`). The magnitude is any expression of `r`, its rate
+/// `r_dot` (`ṙ = e·(v_B − v_A)`), the parameters, coordinates, rates and `t` (lectures 3–7:
+/// central forces and many particles).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Interaction {
+    /// Name.
+    pub name: Located<String>,
+    /// The two points `[A, B]`.
+    pub between: [Located<String>; 2],
+    /// The magnitude `f` (N), positive apart.
+    pub magnitude: Expr,
+}
+
+/// The names an interaction's magnitude reads for the distance of its points and its rate.
+pub const INTERACTION_NAMES: [&str; 2] = ["r", "r_dot"];
+
+/// One `outputs:` entry: a named expression of the state evaluated along a simulation,
+/// `name: expr` or `name: { value: expr, conserved: true, tolerance: 1e-9 }`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct OutputDef {
+    /// Its name.
+    pub name: Located<String>,
+    /// The expression: parameters, coordinates, rates, `t` and the vector functions of
+    /// points.
+    pub value: Expr,
+    /// Whether it is a constant of the motion, which `eomgen simulate` measures the drift of
+    /// and `eomgen report` checks.
+    pub conserved: bool,
+    /// Bound on the drift `max |Q(t) − Q(0)| / max(1, |Q(0)|)` of a conserved output.
+    pub tolerance: f64,
+}
+
 /// A force applied at a point: `{ at: P, vector: [Fx, Fy] }`, components any expression of
 /// `q`, `q̇` and `t`.
 #[derive(Debug, Clone, PartialEq)]
@@ -399,6 +434,13 @@ pub enum AmbForm {
     /// moving parallel to it); about any other moving point it misses `v_A × m v_G`, the
     /// classic mistake of HW4 and HW15 that `eomgen check` detects.
     HDot,
+    /// `form: h_rel_dot`: `Σ M_A = dH_A/rel/dt` with the angular momentum of the motion
+    /// relative to A, `H_A/rel = Σ (r_G − r_A) × m (v_G − v_A) + I θ̇`. Since
+    /// `dH_A/rel/dt = Σ (r_G − r_A) × m a_G + I θ̈ − Σ (r_G − r_A) × m a_A`, it holds only when
+    /// `(r_G − r_A) × a_A = 0` summed with the masses: A fixed or moving at constant velocity,
+    /// A the centre of mass, or A accelerating toward or away from it (a disc's contact point
+    /// rolling on flat ground; HW4, HW15).
+    HRelDot,
 }
 
 /// One equation of motion derived by hand (`checks: { equations_of_motion: [...] }`),
@@ -574,8 +616,22 @@ pub struct Balance {
     pub kind: BalanceKind,
     /// The bodies whose momentum is balanced.
     pub bodies: Vec<Located<String>>,
+    /// The named set the balance belongs to (`balances: { NAME: [...] }`); `None` in the
+    /// plain list form, one set.
+    pub set: Option<Located<String>>,
+    /// Whether its set is stated to disagree with Lagrange (`{ expect: disagree, balances:
+    /// [...] }`): a wrong form kept to show why it is wrong; `eomgen check` then passes it
+    /// only when it does disagree.
+    pub expect_disagreement: bool,
     /// Where the entry starts.
     pub location: Location,
+}
+
+impl Balance {
+    /// The name of the set the balance belongs to; `None` in the plain list form.
+    pub fn set_name(&self) -> Option<&str> {
+        self.set.as_ref().map(|s| s.value.as_str())
+    }
 }
 
 /// What an animation draws (`draw:`): the lines and traced points of `eomgen animate`.
@@ -756,6 +812,10 @@ pub struct ModelFile {
     pub forces: Vec<Force>,
     /// `torques:`.
     pub torques: Vec<Torque>,
+    /// `interactions:` — forces between two points along their line, in file order.
+    pub interactions: Vec<Interaction>,
+    /// `outputs:` — named expressions of the state, in file order.
+    pub outputs: Vec<OutputDef>,
     /// `initial:` by coordinate or rate name (`theta1`, `theta1_dot`); expressions of the
     /// parameters.
     pub initial: Vec<(Located<String>, Expr)>,
@@ -818,6 +878,18 @@ impl ModelFile {
                     .flat_map(RollingContact::constraint_names),
             )
             .collect()
+    }
+
+    /// The sets of [`Self::balances`] in file order, by name (`None`: the plain list form,
+    /// one set).
+    pub fn balance_sets(&self) -> Vec<Option<&str>> {
+        let mut sets: Vec<Option<&str>> = Vec::new();
+        for b in &self.balances {
+            if !sets.contains(&b.set_name()) {
+                sets.push(b.set_name());
+            }
+        }
+        sets
     }
 
     /// The names of every holonomic constraint, located: the expressions', then those on

@@ -12,11 +12,13 @@ pub mod file;
 pub mod located;
 pub mod parser;
 pub mod read;
+pub mod reduce;
 pub mod rules;
 pub mod schema;
 pub mod templates;
 pub mod unit_check;
 pub mod units;
+pub mod vectors;
 pub mod yaml;
 
 pub use ast::{BinOp, Expr, ExprKind};

@@ -15,7 +15,7 @@
 //! expression, its `(`). Errors point at the exact column of the problem and say what was
 //! expected there.
 
-use super::ast::{BinOp, Expr, ExprKind, FUNCTIONS};
+use super::ast::{BinOp, Expr, ExprKind, FUNCTIONS, VECTOR_FUNCTIONS};
 use super::diagnostic::Diagnostic;
 use super::located::Location;
 use crate::expr::{Constant, FoldError, Func, fold};
@@ -396,7 +396,9 @@ impl P<'_> {
                 self.bump();
                 let function = FUNCTIONS.iter().find(|(f, _)| *f == name);
                 if matches!(self.peek(), Tok::Op('(')) {
-                    let Some(&(_, arity)) = function else {
+                    let callable =
+                        function.or_else(|| VECTOR_FUNCTIONS.iter().find(|(f, _)| *f == name));
+                    let Some(&(_, arity)) = callable else {
                         return Err(unknown_function(&name, loc));
                     };
                     self.call(name, arity, loc)
@@ -516,10 +518,14 @@ impl P<'_> {
                 loc,
                 format!("`{name}` takes {}, found {}", arguments(arity), args.len()),
             )
-            .with_help(if name == "atan2" {
-                "write `atan2(y, x)`".to_string()
-            } else {
-                format!("write `{name}(x)`")
+            .with_help(match name.as_str() {
+                "atan2" => "write `atan2(y, x)`".to_string(),
+                "dot" | "cross" => {
+                    format!("write `{name}(a, b)` of two vectors, as in `{name}(P - O, vel(P))`")
+                }
+                "distance" => "write `distance(A, B)` of two points".to_string(),
+                "norm" | "vel" => format!("write `{name}(a)` of a vector, as in `{name}(P - O)`"),
+                _ => format!("write `{name}(x)`"),
             }));
         }
         Ok((
@@ -541,7 +547,11 @@ fn arguments(n: usize) -> String {
 }
 
 fn unknown_function(name: &str, loc: Location) -> Diagnostic {
-    let known: Vec<&str> = FUNCTIONS.iter().map(|(f, _)| *f).collect();
+    let known: Vec<&str> = FUNCTIONS
+        .iter()
+        .chain(VECTOR_FUNCTIONS)
+        .map(|(f, _)| *f)
+        .collect();
     let d = Diagnostic::new(loc, format!("unknown function `{name}`"));
     // Other names of the same functions, which spelling distance would not find.
     let alias = match name {

@@ -15,6 +15,7 @@ use super::file::{
 use super::located::{Located, Location};
 use super::parser::{closest, eval_expr, identifiers};
 use super::schema::{self, Incomplete, UNRAW_KEYWORDS};
+use super::vectors;
 
 /// Runs every rule on `file`.
 ///
@@ -59,6 +60,8 @@ pub(crate) fn check_parts(
     checker.reference_checks();
     checker.floquet_references();
     checker.constraints();
+    checker.interactions();
+    checker.outputs();
     let units = super::unit_check::check(file);
     // A unit mistake at the place of another mistake is its consequence (`initial: { theta:
     // x }` is not constant, and so not in rad either): one message per mistake.
@@ -114,6 +117,12 @@ struct Checker<'f> {
     /// Whether `omega_<frame>_<axis>` may be read: in expressions the derivation lowers, not
     /// in the conserved quantities of `checks:`, which are evaluated from the state alone.
     angular_velocities: bool,
+    /// Whether the vector functions (`dot(P - O, …)`) may be used: not in the positions of
+    /// points and the rotations of frames, which define the points they would read.
+    vectors: bool,
+    /// Whether `r` and `r_dot` name an interaction's distance and its rate (in its
+    /// magnitude).
+    interaction: bool,
     /// The names above as sets, for lookups in time independent of their number (the lists
     /// keep the file's order for suggestions and help).
     sets: NameSets,
@@ -156,6 +165,8 @@ impl<'f> Checker<'f> {
             points: file.points.iter().map(|p| p.name.value.as_str()).collect(),
             bodies: file.bodies.iter().map(|b| b.name.value.as_str()).collect(),
             angular_velocities: true,
+            vectors: true,
+            interaction: false,
             sets: NameSets::default(),
         };
         let owned = |v: &[&str]| v.iter().map(|s| s.to_string()).collect();
@@ -311,6 +322,7 @@ impl<'f> Checker<'f> {
                 &format!("the generalized force `{}`", k.value),
             );
         }
+        self.vectors = false;
         for p in &file.points {
             let relative = p.relative.iter().flat_map(|r| &r.vectors);
             for c in p.position.iter().chain(relative.flat_map(|(_, v)| v)) {
@@ -330,6 +342,7 @@ impl<'f> Checker<'f> {
                 );
             }
         }
+        self.vectors = true;
         for b in &file.bodies {
             let name = &b.name.value;
             match &b.kind {
@@ -444,8 +457,26 @@ impl<'f> Checker<'f> {
     fn resolve(&mut self, e: &Expr, depends: Depends, what: &str) {
         let mut ids = Vec::new();
         identifiers(e, &mut ids);
+        if vectors::uses_vectors(e) {
+            let Some(points) = self.vector_points(e, depends, what) else {
+                return;
+            };
+            ids.retain(|id| !points.contains(id));
+        }
         for (n, at) in ids {
             let n = n.as_str();
+            if self.interaction && n == "r" {
+                continue;
+            }
+            if self.interaction && n == "r_dot" {
+                if depends < Depends::Motion {
+                    self.error(
+                        Diagnostic::new(at, format!("{what} cannot depend on the rate `r_dot`"))
+                            .with_help("it may use parameters, coordinates, `t` and `r`"),
+                    );
+                }
+                continue;
+            }
             let is_param = n == "pi" || self.sets.params.contains(n);
             let is_coord = self.sets.coords.contains(n);
             let is_rate = self.sets.rates.contains(n);
@@ -489,6 +520,52 @@ impl<'f> Checker<'f> {
             };
             self.error(d);
         }
+    }
+
+    /// The points `e` reads as vectors through the vector functions, with their locations;
+    /// `None` after reporting why it cannot: vectors where they are not allowed (the
+    /// definitions of points and frames, constants), shapes that do not fit
+    /// ([`vectors::check_shapes`]), `vel` where the rates are not allowed.
+    fn vector_points(
+        &mut self,
+        e: &Expr,
+        depends: Depends,
+        what: &str,
+    ) -> Option<Vec<(String, Location)>> {
+        if !self.vectors || depends < Depends::Position {
+            let why = if self.vectors {
+                "which must be constant"
+            } else {
+                "which defines the points and frames they read"
+            };
+            self.error(
+                Diagnostic::new(
+                    e.location,
+                    format!("{what} uses the vector functions of points (`dot`, `cross`, `norm`, `distance`, `vel`), {why}"),
+                )
+                .with_help("write the expression with parameters, numbers and functions of them"),
+            );
+            return None;
+        }
+        let dimension = self.file.dimension.unwrap_or(2);
+        let used = match vectors::check_shapes(e, &self.points, dimension, what) {
+            Ok(used) => used,
+            Err(errors) => {
+                errors.into_iter().for_each(|d| self.error(d));
+                return None;
+            }
+        };
+        if depends < Depends::Motion && vectors::uses_velocities(e) {
+            self.error(
+                Diagnostic::new(
+                    e.location,
+                    format!("{what} cannot depend on the rates, but it uses `vel`"),
+                )
+                .with_help("it may use the positions of points, not their velocities"),
+            );
+            return None;
+        }
+        Some(used)
     }
 
     fn unknown(&mut self, n: &str, at: Location, depends: Depends, what: &str) {
@@ -1214,6 +1291,80 @@ impl<'f> Checker<'f> {
     }
 
     /// Reports `name` unless it is a parameter; `what` says where it was written.
+    // Rule: an interaction acts between two distinct points of the model; its magnitude is
+    // a function of the motion, where `r` and `r_dot` are the distance and its rate, which
+    // are then no other name of the model.
+    fn interactions(&mut self) {
+        let file = self.file;
+        for i in &file.interactions {
+            let name = &i.name.value;
+            i.between.iter().for_each(|p| self.point(p));
+            let [a, b] = &i.between;
+            if a.value == b.value {
+                self.error(
+                    Diagnostic::new(
+                        b.location,
+                        format!("interaction `{name}` acts between `{}` and itself", a.value),
+                    )
+                    .with_help("an interaction acts along the line of two distinct points; name the other point"),
+                );
+            }
+            let what = format!("the magnitude of interaction `{name}`");
+            let mut ids = Vec::new();
+            identifiers(&i.magnitude, &mut ids);
+            for (n, at) in &ids {
+                let taken = if self.sets.params.contains(n.as_str()) {
+                    Some("a parameter")
+                } else if self.sets.coords.contains(n.as_str()) {
+                    Some("a coordinate")
+                } else if n == "r_dot" && self.sets.rates.contains(n.as_str()) {
+                    Some("the rate of coordinate `r`")
+                } else if self.points.contains(&n.as_str()) {
+                    Some("a point")
+                } else {
+                    None
+                };
+                if let Some(kind) = taken
+                    && super::file::INTERACTION_NAMES.contains(&n.as_str())
+                {
+                    self.error(
+                        Diagnostic::new(
+                            *at,
+                            format!("`{n}` in {what} is ambiguous: it names the distance of the points (or its rate), and {kind} of the model"),
+                        )
+                        .with_help("rename the model's `r`, or write the distance as `distance(A, B)` and its rate as `dot(A - B, vel(A) - vel(B))/distance(A, B)`"),
+                    );
+                }
+            }
+            self.interaction = true;
+            self.resolve(&i.magnitude, Depends::Motion, &what);
+            self.interaction = false;
+        }
+    }
+
+    // Rule: outputs are functions of the motion, named apart from the columns beside them
+    // in a simulation's output (`t`, the coordinates and rates, `energy`).
+    fn outputs(&mut self) {
+        let file = self.file;
+        for o in &file.outputs {
+            let n = o.name.value.as_str();
+            if n == "t"
+                || n == "energy"
+                || self.sets.coords.contains(n)
+                || self.sets.rates.contains(n)
+            {
+                self.error(
+                    Diagnostic::new(
+                        o.name.location,
+                        format!("output name `{n}` is taken: a simulation's output already has a column `{n}`"),
+                    )
+                    .with_help("choose another name, such as `L` or `angular_momentum`"),
+                );
+            }
+            self.resolve(&o.value, Depends::Motion, &format!("output `{n}`"));
+        }
+    }
+
     fn parameter_name(&mut self, name: &Located<String>, what: &str) {
         let n = name.value.as_str();
         if self.sets.params.contains(n) || self.incomplete.has_name(n) {
@@ -1368,14 +1519,25 @@ impl<'f> Checker<'f> {
             return;
         }
         let n = file.coordinates.len();
-        if file.balances.len() != n {
-            self.error(
-                Diagnostic::new(
-                    file.balances[0].location,
-                    format!("{} balance(s) for {n} coordinate(s): the balances must give one equation per coordinate", file.balances.len()),
-                )
-                .with_help("choose as many balances as coordinates, each free of reaction forces (HW19: AMB/O of both bars and AMB/E of the forearm)"),
-            );
+        for set in file.balance_sets() {
+            let count = file.balances.iter().filter(|b| b.set_name() == set).count();
+            let first = file.balances.iter().find(|b| b.set_name() == set);
+            if count != n
+                && let Some(first) = first
+            {
+                let location = first.set.as_ref().map_or(first.location, |s| s.location);
+                let which = match set {
+                    Some(name) => format!("the set `{name}` has "),
+                    None => String::new(),
+                };
+                self.error(
+                    Diagnostic::new(
+                        location,
+                        format!("{which}{count} balance(s) for {n} coordinate(s): the balances must give one equation per coordinate"),
+                    )
+                    .with_help("choose as many balances as coordinates, each free of reaction forces (HW19: AMB/O of both bars and AMB/E of the forearm)"),
+                );
+            }
         }
         let point_loads = file
             .forces

@@ -1,5 +1,7 @@
 //! Model files generated for a size `N`, so that scaling is measured on files like any other
-//! (`eomgen new n-link-pendulum N`, `eomgen new n-mass-chain N`).
+//! (`eomgen new n-link-pendulum N`, `eomgen new n-mass-chain N`). Each file names its
+//! equilibria and states its `checks:` against closed forms, so that `eomgen modes FILE` and
+//! `eomgen report` work on it as on a bundled model.
 
 use std::fmt::Write as _;
 
@@ -63,6 +65,11 @@ pub fn generate(name: &str, n: usize) -> Result<String, TemplateError> {
 /// A chain of `n ≥ 1` uniform bars (m = ℓ = 1, g = 10) hinged at O, with absolute angles
 /// `theta1..thetan` from +x (the course's convention, HW19 and HW39), released from rest with
 /// every bar horizontal.
+///
+/// The file names the equilibria `hanging` (every bar down) and `upright` (every bar up,
+/// lecture 25) and states its `checks:`: the natural frequencies about `hanging` in closed
+/// form for `n ≤ 3` (for equal bars: `√(3g/(2ℓ))`; HW19's pair; HW39's three), else the
+/// energy drift (`max: 1e-9`), since from `n = 4` the frequencies have no closed form.
 pub fn n_link_pendulum(n: usize) -> String {
     let mut w = String::new();
     let _ = writeln!(
@@ -77,7 +84,40 @@ pub fn n_link_pendulum(n: usize) -> String {
         w,
         "# +x; bar i runs from P(i-1) to Pi (P0 = O) with its centre of mass Gi at its middle."
     );
-    let _ = writeln!(w, "# Gravity is -y. Reference values: T + V is conserved.");
+    let _ = writeln!(
+        w,
+        "# Gravity is -y. Reference values: T + V is conserved. Linearised about hanging"
+    );
+    let _ = writeln!(
+        w,
+        "# (every bar down), for equal bars (m, l): M_ij = m l^2 (1/3 + bars below i) on the"
+    );
+    let _ = writeln!(
+        w,
+        "# diagonal, m l^2 (1/2 + bars below j) off it (j > i), K = m g l diag(bars below i + 1/2);"
+    );
+    match n {
+        1..=3 => {
+            let _ = writeln!(
+                w,
+                "# det(K - omega^2 M) = 0 has the closed form of `checks:` (n = 1: omega^2 = 3g/(2l);"
+            );
+            let _ = writeln!(
+                w,
+                "# n = 2: HW19's (g/l)(3 -+ 6/sqrt(7)); n = 3: HW39's 3g/l and (g/l)(291 -+ 3 sqrt(7849))/52)."
+            );
+        }
+        _ => {
+            let _ = writeln!(
+                w,
+                "# from n = 4 its roots have no closed form (the checks state the energy drift)."
+            );
+        }
+    }
+    let _ = writeln!(
+        w,
+        "# `hanging` is stable, `upright` (every bar up) unstable."
+    );
     let _ = writeln!(w, "name: n_link_pendulum_{n}");
     let _ = writeln!(w, "description: Chain of {n} uniform bars hinged at O.");
     let _ = writeln!(w, "units: SI");
@@ -120,11 +160,64 @@ pub fn n_link_pendulum(n: usize) -> String {
         "draw: {{ lines: [{}], trace: [P{n}] }}",
         lines.join(", ")
     );
+    let angles = |value: &str| -> String {
+        let entries: Vec<String> = (1..=n).map(|i| format!("theta{i}: {value}")).collect();
+        entries.join(", ")
+    };
+    let _ = writeln!(
+        w,
+        "equilibria:                 # lecture 25; angles from +x"
+    );
+    let _ = writeln!(w, "  hanging: {{ {} }}", angles("-pi/2"));
+    let _ = writeln!(w, "  upright: {{ {} }}", angles("pi/2"));
+    let _ = writeln!(w, "checks:");
+    match pendulum_frequencies(n) {
+        Some(values) => {
+            let _ = writeln!(
+                w,
+                "  natural_frequencies:       # equal bars (m_i = m1, l_i = l1), see above"
+            );
+            let _ = writeln!(w, "    at: hanging");
+            let _ = writeln!(w, "    values: [{}]", values.join(", "));
+        }
+        None => {
+            let _ = writeln!(
+                w,
+                "  energy_drift: {{ max: 1e-9 }}  # no closed form for the frequencies; T + V is conserved"
+            );
+        }
+    }
     w
+}
+
+/// The natural frequencies about `hanging` of `n` equal uniform bars, as expressions of `g`
+/// and `l1` (rad/s, ascending), where a closed form is known: `n = 1` (the compound
+/// pendulum, `ω² = 3g/(2ℓ)`), `n = 2` (HW19, `models/double_pendulum.yaml`: `ω² = (g/ℓ)(3 ∓
+/// 6/√7)`) and `n = 3` (HW39, `models/triple_pendulum.yaml`: `ω² = 3g/ℓ` and `(g/ℓ)(291 ∓
+/// 3√7849)/52`); `None` from `n = 4`, whose characteristic polynomial has no factor of
+/// degree below 2 to give a closed form.
+fn pendulum_frequencies(n: usize) -> Option<Vec<&'static str>> {
+    match n {
+        1 => Some(vec!["sqrt(3*g/(2*l1))"]),
+        2 => Some(vec![
+            "sqrt(g/l1*(3 - 6/sqrt(7)))",
+            "sqrt(g/l1*(3 + 6/sqrt(7)))",
+        ]),
+        3 => Some(vec![
+            "sqrt(g/l1*(291 - 3*sqrt(7849))/52)",
+            "sqrt(3*g/l1)",
+            "sqrt(g/l1*(291 + 3*sqrt(7849))/52)",
+        ]),
+        _ => None,
+    }
 }
 
 /// `n ≥ 1` equal masses in a line between two walls, joined by `n + 1` equal springs of rest
 /// length `a` (HW23 for n = 3); `x_i` is the displacement of mass i; mass 1 starts displaced.
+///
+/// The file names the equilibrium `rest` (every `x_i = 0`) and checks its natural
+/// frequencies against the closed form `ω_j = 2√(k/m) sin(jπ/(2(n + 1)))`, `j = 1..n`
+/// (rad/s, ascending; lecture 30, the fixed–fixed chain).
 pub fn n_mass_chain(n: usize) -> String {
     let mut w = String::new();
     let _ = writeln!(
@@ -189,6 +282,21 @@ pub fn n_mass_chain(n: usize) -> String {
         .map(|i| format!("[{}, {}]", name(i), name(i + 1)))
         .collect();
     let _ = writeln!(w, "draw: {{ lines: [{}] }}", lines.join(", "));
+    let _ = writeln!(w, "equilibria:");
+    let _ = writeln!(
+        w,
+        "  rest: {{ x1: 0 }}          # every mass at its spacing"
+    );
+    let _ = writeln!(w, "checks:");
+    let _ = writeln!(
+        w,
+        "  natural_frequencies:       # omega_j = 2 sqrt(k/m) sin(j pi / (2 (n + 1))), ascending"
+    );
+    let _ = writeln!(w, "    at: rest");
+    let _ = writeln!(w, "    values:");
+    for j in 1..=n {
+        let _ = writeln!(w, "      - 2*sqrt(k/m)*sin({j}*pi/{})", 2 * (n + 1));
+    }
     w
 }
 

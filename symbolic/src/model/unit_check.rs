@@ -333,6 +333,8 @@ struct Checker<'f> {
     names: Vec<String>,
     /// Pass 2: for each failed requirement, the names of its expression.
     failing_names: Vec<Vec<String>>,
+    /// Whether `r` and `r_dot` are an interaction's distance (m) and its rate (m/s).
+    interaction: bool,
 }
 
 /// `kg`, `N/m`: a dimension for messages.
@@ -577,6 +579,7 @@ impl<'f> Checker<'f> {
             spelling: None,
             names: Vec::new(),
             failing_names: Vec::new(),
+            interaction: false,
         }
     }
 
@@ -624,6 +627,10 @@ impl<'f> Checker<'f> {
         match n {
             "pi" => return Some(Dim::of(Dimension::ONE)),
             "t" => return Some(Dim::of(Dimension::SECOND)),
+            "r" if self.interaction => return Some(Dim::of(Dimension::METRE)),
+            "r_dot" if self.interaction => {
+                return Some(Dim::of(Dimension::integers(1, 0, -1)));
+            }
             _ => {}
         }
         if let Some(i) = self.file.parameters.iter().position(|p| p.name.value == n) {
@@ -796,7 +803,109 @@ impl<'f> Checker<'f> {
         (self.diagnostics.len() == before).then_some(one)
     }
 
+    /// The unit of a vector expression of the points (their positions in m): a sum takes
+    /// the unit of its terms, `vel` divides by s, `cross` multiplies; anything else is
+    /// [`Self::dim`]. (The rules checked the shapes: vectors and numbers are where they
+    /// belong.)
+    fn vector_dim(&mut self, e: &Expr, what: &str) -> Option<Dim> {
+        let vector = |cx: &Self, e: &Expr| {
+            let points: Vec<&str> = cx
+                .file
+                .points
+                .iter()
+                .map(|p| p.name.value.as_str())
+                .collect();
+            super::vectors::shape_of(e, &points, cx.file.dimension.unwrap_or(2))
+                == Some(super::vectors::Shape::Vector)
+        };
+        match &e.kind {
+            ExprKind::Ident(n) if self.file.points.iter().any(|p| p.name.value == *n) => {
+                Some(Dim::of(Dimension::METRE))
+            }
+            ExprKind::Neg(a) => self.vector_dim(a, what),
+            ExprKind::Binary {
+                op: BinOp::Add | BinOp::Sub,
+                lhs,
+                rhs,
+                ..
+            } => {
+                let (a, b) = (self.vector_dim(lhs, what), self.vector_dim(rhs, what));
+                let (l, r, at) = (text(lhs), text(rhs), rhs.location);
+                self.require(
+                    b.as_ref(),
+                    a.as_ref(),
+                    (HOMOGENEITY, what, at),
+                    |got, want| {
+                        Diagnostic::new(
+                            at,
+                            format!(
+                                "sum of unlike units in {what}: `{l}` is {} but `{r}` is {}",
+                                show(want),
+                                show(got)
+                            ),
+                        )
+                        .with_help("every term of a sum of vectors has the same unit")
+                    },
+                );
+                a.or(b)
+            }
+            ExprKind::Binary {
+                op: op @ (BinOp::Mul | BinOp::Div),
+                lhs,
+                rhs,
+                ..
+            } => {
+                let a = if vector(self, lhs) {
+                    self.vector_dim(lhs, what)
+                } else {
+                    self.dim(lhs, what)
+                };
+                let b = if vector(self, rhs) {
+                    self.vector_dim(rhs, what)
+                } else {
+                    self.dim(rhs, what)
+                };
+                match op {
+                    BinOp::Mul => a?.mul(&b?),
+                    _ => a?.div(&b?),
+                }
+            }
+            ExprKind::Call { func, args } if func == "vel" => {
+                let a = self.vector_dim(args.first()?, what);
+                a?.div(&Dim::of(Dimension::SECOND))
+            }
+            ExprKind::Call { func, args } if func == "cross" => {
+                let dims: Vec<Option<Dim>> =
+                    args.iter().map(|a| self.vector_dim(a, what)).collect();
+                match dims.as_slice() {
+                    [Some(a), Some(b)] => a.mul(b),
+                    _ => None,
+                }
+            }
+            _ => self.dim(e, what),
+        }
+    }
+
     fn call(&mut self, func: &str, args: &[Expr], what: &str) -> Option<Dim> {
+        if super::vectors::is_vector_function(func) {
+            let dims: Vec<Option<Dim>> = args.iter().map(|a| self.vector_dim(a, what)).collect();
+            return match (func, dims.as_slice()) {
+                ("dot" | "cross", [Some(a), Some(b)]) => a.mul(b),
+                ("norm", [a]) => a.clone(),
+                ("distance", [a, b]) => {
+                    let (l, r, at) = (text(&args[0]), text(&args[1]), args[1].location);
+                    self.require(b.as_ref(), a.as_ref(), (HOMOGENEITY, what, at), |got, want| {
+                        Diagnostic::new(
+                            at,
+                            format!("the arguments of `distance` in {what} have unlike units: `{l}` is {} but `{r}` is {}", show(want), show(got)),
+                        )
+                        .with_help("`distance(A, B)` is the length of `A - B`: both are positions")
+                    });
+                    a.clone().or_else(|| b.clone())
+                }
+                _ => None,
+            };
+        }
         let dims: Vec<Option<Dim>> = args.iter().map(|a| self.dim(a, what)).collect();
         let one = Dim::of(Dimension::ONE);
         match (func, args, dims.as_slice()) {
@@ -1116,6 +1225,21 @@ impl<'f> Checker<'f> {
                     "a force is mass × acceleration, kg*m/s^2 = N",
                 );
             }
+        }
+        self.interaction = true;
+        for i in &file.interactions {
+            self.fixed(
+                &i.magnitude,
+                Dimension::NEWTON,
+                &format!("the magnitude of interaction `{}`", i.name.value),
+                "a force",
+                "N",
+                "an interaction's magnitude is a force, with `r` in m and `r_dot` in m/s",
+            );
+        }
+        self.interaction = false;
+        for o in &file.outputs {
+            self.homogeneous(&o.value, &format!("output `{}`", o.name.value));
         }
         for t in &file.torques {
             for (i, e) in t.value.expressions().into_iter().enumerate() {

@@ -10,7 +10,7 @@
 
 use std::collections::BTreeMap;
 
-use nalgebra::{Complex, DMatrix, DVector};
+use nalgebra::{Complex, DVector};
 use serde::Serialize;
 
 use super::operating_point::{
@@ -19,11 +19,11 @@ use super::operating_point::{
 use crate::linear::eigenvalues::{LinearStability, linear_stability};
 use crate::linear::frequency_response::{
     ForcedLinearization, FrequencySweep, FrfError, HarmonicForcing, ModalResponse, PeakAmplitude,
-    SteadyStateOptions, frequency_response, frequency_response_of, frequency_sweep,
-    linearize_with_inputs, log_frequencies, modal_frequency_response, output_index, settling_time,
-    simulate_steady_state,
+    SteadyStateOptions, frequency_response_to, frequency_sweep_with_rates,
+    linearize_with_input_rates, linearize_with_inputs, log_frequencies, modal_frequency_response,
+    output_index, settling_time, simulate_steady_state,
 };
-use crate::linear::modal::{Linearization, NormalModes, normal_modes};
+use crate::linear::modal::{NormalModes, normal_modes};
 use crate::linear::response::{ModalDamping, modal_damping};
 use crate::model_info::ModelInfo;
 
@@ -124,6 +124,15 @@ pub enum FrfAnalysisError {
     /// The free response does not decay: no steady state to simulate.
     #[error(transparent)]
     NoSteadyState(FrfError),
+    /// A modal sum was asked for an input that enters through its rate (a base motion): the
+    /// modal forces `ψₖᵀ(B₀ + iωB₁)` are complex, which the modal sum does not take.
+    #[error(
+        "the modal sum takes a load, and input `{input}` also enters through its rate (B₁ ≠ 0, a base motion through a dashpot)"
+    )]
+    ModalWithInputRate {
+        /// The input.
+        input: String,
+    },
     /// The linearisation, a response or a simulation failed.
     #[error(transparent)]
     Frf(#[from] FrfError),
@@ -277,7 +286,16 @@ pub struct FrfAnalysis {
 /// from the input to each output, finds the resonance peaks and evaluates the response (and,
 /// with `modal`, its modal sum) at the evaluation frequencies.
 ///
+/// A parameter input whose load reverses over half a period of the frequency parameter (the
+/// simulation's `frequency_parameter`, else `w` when the model has it) may also enter through
+/// its rate, as a base motion `Y cos(w t)` does through a dashpot: its rate column `B₁` is
+/// read a quarter period after `t = 0`
+/// ([`linearize_with_input_rates`](crate::linear::frequency_response::linearize_with_input_rates))
+/// and the input column at `ω` is `B₀ + iωB₁`, so `H` is the transmissibility
+/// `(k + iωc)/(k − mω² + iωc)` of `models/base_excited_oscillator.yaml` (lecture 38).
+///
 /// # Errors
+/// [`FrfAnalysisError::ModalWithInputRate`] (`modal` with `B₁ ≠ 0`),
 /// [`FrfAnalysisError::TooFewPoints`], [`FrfAnalysisError::UnknownInput`],
 /// [`FrfAnalysisError::SimulationNeedsParameter`], [`FrfAnalysisError::OperatingPoint`],
 /// [`FrfAnalysisError::Input`] (not a load amplitude), [`FrfAnalysisError::Output`],
@@ -327,12 +345,31 @@ pub fn frequency_response_analysis(
         });
     }
     let (label, guess) = options.operating_point.start.resolve(model)?;
-    let forced = linearize_with_inputs(model, &guess, &[input]).map_err(|e| match e {
+    // The parameter that times the load (the simulation's, else `w`) also says where to read
+    // an input's rate column (a base motion through a dashpot).
+    let parameters = model.description().parameter_names();
+    let frequency_parameter = options
+        .simulation
+        .as_ref()
+        .and_then(|s| s.frequency_parameter.clone())
+        .or_else(|| Some("w".to_string()))
+        .filter(|p| parameter_input && p != input && parameters.contains(&p.as_str()));
+    let forced = match &frequency_parameter {
+        Some(p) => linearize_with_input_rates(model, &guess, &[input], p),
+        None => linearize_with_inputs(model, &guess, &[input]),
+    }
+    .map_err(|e| match e {
         FrfError::NonlinearInput { .. }
         | FrfError::InputNotInForcing { .. }
-        | FrfError::InputChangesMassMatrix { .. } => FrfAnalysisError::Input(e),
+        | FrfError::InputChangesMassMatrix { .. }
+        | FrfError::InputRateNotConstant { .. } => FrfAnalysisError::Input(e),
         e => FrfAnalysisError::Frf(e),
     })?;
+    if options.modal && forced.has_input_rates() {
+        return Err(FrfAnalysisError::ModalWithInputRate {
+            input: input.to_string(),
+        });
+    }
     let coordinates: Vec<String> = model
         .description()
         .coordinate_names()
@@ -368,7 +405,14 @@ pub fn frequency_response_analysis(
     let b_matrix = &forced.input_matrix;
     let mut sweeps = Vec::with_capacity(outputs.len());
     for o in &outputs {
-        sweeps.push(frequency_sweep(lin, b_matrix, 0, o.index, &frequencies)?);
+        sweeps.push(frequency_sweep_with_rates(
+            lin,
+            b_matrix,
+            &forced.input_rate_matrix,
+            0,
+            o.index,
+            &frequencies,
+        )?);
     }
     let mut evaluation_frequencies = options.frequencies.clone();
     if options.modal && evaluation_frequencies.is_empty() {
@@ -387,14 +431,7 @@ pub fn frequency_response_analysis(
     let requested: Vec<usize> = outputs.iter().map(|o| o.index).collect();
     let b = options.modal.then(|| b_matrix.column(0).into_owned());
     for w in evaluation_frequencies {
-        evaluations.push(evaluate_at(
-            lin,
-            b_matrix,
-            b.as_ref(),
-            &modes,
-            w,
-            &requested,
-        )?);
+        evaluations.push(evaluate_at(&forced, b.as_ref(), &modes, w, &requested)?);
     }
     let operating_point = OperatingPoint {
         name: label,
@@ -459,18 +496,18 @@ fn default_range(natural_frequencies: &[f64]) -> Option<(f64, f64)> {
     Some((first / 10.0, last * 10.0))
 }
 
-/// `H(ω)` of the one input (column `b` of `b_matrix`) at `w` for the `requested` outputs,
+/// `H(ω)` of the one input (`B₀ + iωB₁` of `forced`) at `w` for the `requested` outputs,
 /// its modal sum when `b` is given, and their largest difference relative to the largest `|H|`; a singular `ω` (undamped
 /// resonance) gives `None` for the response it makes singular.
 fn evaluate_at(
-    lin: &Linearization,
-    b_matrix: &DMatrix<f64>,
+    forced: &ForcedLinearization,
     b: Option<&DVector<f64>>,
     modes: &NormalModes,
     w: f64,
     requested: &[usize],
 ) -> Result<FrfEvaluation, FrfError> {
-    let response = match frequency_response_of(lin, b_matrix, w, requested) {
+    let lin = &forced.linearization;
+    let response = match frequency_response_to(lin, &forced.input_at(w), w, requested) {
         Ok(h) => Some(h.column(0).into_owned()),
         Err(FrfError::Singular { .. }) => None,
         Err(e) => return Err(e),
@@ -622,10 +659,11 @@ pub fn simulate_point(
 ) -> Result<SimulatedPoint, FrfError> {
     let w = frequency;
     let amplitude = plan.options.amplitude;
-    let h = frequency_response(
+    let h = frequency_response_to(
         &analysis.forced.linearization,
-        &analysis.forced.input_matrix,
+        &analysis.forced.input_at(w),
         w,
+        &[],
     )?;
     let scale = h.iter().map(|z| z.norm()).fold(0.0f64, f64::max) * amplitude.abs() * w.max(1.0);
     let options = SteadyStateOptions {
@@ -721,6 +759,13 @@ impl FrfAnalysis {
             outputs: outputs.iter().map(|o| o.name.clone()).collect(),
             operating_point: self.operating_point.summary_at(&self.forced.equilibrium.q),
             input_matrix: self.forced.input_matrix.column(0).iter().copied().collect(),
+            input_rate_matrix: self
+                .forced
+                .input_rate_matrix
+                .column(0)
+                .iter()
+                .copied()
+                .collect(),
             natural_frequencies: modes.natural_frequencies.clone(),
             damping_ratios: damping.damping_ratios.clone(),
             modal_damping_coupling: damping.coupling,
@@ -798,6 +843,9 @@ pub struct FrfSummary {
     pub operating_point: PointSummary,
     /// The input column `b` (generalized force per unit input at `t = 0`).
     pub input_matrix: Vec<f64>,
+    /// The input's rate column `B₁` (generalized force per unit rate of the input; zero for a
+    /// load): the input column at `ω` is `b + iω B₁`.
+    pub input_rate_matrix: Vec<f64>,
     /// `ωₖ` (rad/s).
     pub natural_frequencies: Vec<f64>,
     /// The modal damping ratios ([`ModalDamping::damping_ratios`]).

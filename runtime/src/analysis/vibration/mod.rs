@@ -19,6 +19,13 @@
 //! - [`frequency_response_analysis`]: `H(ω)` from one input over a sweep, its peaks, its modal
 //!   sum; [`plan_simulation`] and [`simulate_point`] check points of the curve by simulating
 //!   the full model to steady state (lecture 21, HW37).
+//! - [`expm_study()`]: `ż = A z` for a random `A` three ways (`e^{At}`, eigenvector
+//!   superposition, DOP853), the eigenvalues and `κ(V)` (HW32).
+//! - [`rayleigh_study`]: the Rayleigh quotient of a trial shape against the lowest natural
+//!   frequency, the bound and its stationarity (lectures 35–37).
+//! - [`convolution_response`]: the response to an impulse, a step or any `f(t)` through one
+//!   input by Duhamel's integral over the impulse response, against DOP853 and the closed
+//!   forms (lecture 21).
 //! - [`floquet_at_equilibrium`]: the Floquet multipliers of a time-periodic model about an
 //!   equilibrium; [`floquet_cell`], one cell of a stability chart over two parameters
 //!   (lectures 19, 21).
@@ -28,6 +35,8 @@
 //! [`linear::frequency_response`](crate::linear::frequency_response) and
 //! [`linear::monodromy`](crate::linear::monodromy).
 
+pub mod expm_study;
+pub mod convolution;
 pub mod floquet;
 pub mod free_response;
 pub mod frf;
@@ -35,8 +44,18 @@ pub mod modal_damping;
 pub mod modes;
 pub mod operating_point;
 pub mod parameter_sweep;
+pub mod rayleigh;
 pub mod steady;
 
+pub use expm_study::{
+    EigenvectorOutcome, ExpmOptions, ExpmRoute, ExpmStudy, ExpmStudyError, RandomProblem,
+    RouteDifference, eigenvector_condition, expected_difference, expm_study, expm_study_of,
+    random_problem,
+};
+pub use convolution::{
+    ClosedForm, ConvolutionError, ConvolutionOptions, ConvolutionStudy, Forcing, Quadrature,
+    convolution_response,
+};
 pub use floquet::{
     FailedCell, FloquetCell, FloquetChart, FloquetChartSummary, FloquetIntegrationSummary,
     FloquetPoint, FloquetStudyError, FloquetStudyOptions, FloquetSummary, MultiplierSummary,
@@ -71,6 +90,10 @@ pub use parameter_sweep::{
     Crossing, Direction, ParameterSweep, ParameterSweepError, ParameterSweepOptions,
     PointEigenvalues, StabilityChange, SweepPoint, SweepPointError, eigenvalues_at,
     parameter_sweep,
+};
+pub use rayleigh::{
+    PerturbationDirection, PerturbedQuotient, RayleighError, RayleighOptions, RayleighStudy,
+    RayleighSummary, Stationarity, rayleigh_study,
 };
 pub use steady::{
     SteadyAnalysisError, SteadyMotionAnalysis, SteadyMotionSummary, SteadyPointSummary,

@@ -28,6 +28,13 @@ const DAMPER: Fields = Fields {
     example: "{ between: [A, B], coefficient: c }",
 };
 
+/// The keys of an interaction.
+const INTERACTION: Fields = Fields {
+    kind: "interaction",
+    keys: &[("between", Need::Required), ("magnitude", Need::Required)],
+    example: "{ between: [P1, P2], magnitude: -G*m1*m2/r^2 }",
+};
+
 /// The keys of a force.
 const FORCE: Fields = Fields {
     kind: "force",
@@ -741,6 +748,28 @@ impl Ctx<'_> {
         })
     }
 
+    /// `interactions:` — `name: { between, magnitude }`.
+    pub(super) fn interactions(&mut self, node: &YamlNode) -> Vec<Interaction> {
+        let example = format!("interactions: {{ gravity: {} }}", INTERACTION.example);
+        let spec = Keyed {
+            what: "`interactions`",
+            example: &example,
+            names: None,
+            drop: false,
+        };
+        self.keyed(node, spec, |cx, k, v| {
+            let f = cx.fields(k, v, &INTERACTION)?;
+            let between = get(f, "between").and_then(|n| cx.point_pair(n, "`between`"));
+            let magnitude = get(f, "magnitude")
+                .and_then(|n| cx.expr(n, &format!("the magnitude of interaction `{}`", k.value)));
+            Some(Interaction {
+                name: k.clone(),
+                between: between?,
+                magnitude: magnitude?,
+            })
+        })
+    }
+
     /// `forces:` — `name: { at, vector }`.
     pub(super) fn forces(&mut self, node: &YamlNode) -> Vec<Force> {
         let example = format!("forces: {{ push: {} }}", FORCE.example);
@@ -829,8 +858,64 @@ impl Ctx<'_> {
     }
 
     /// `balances:` — a list of `amb: { about, bodies, form }` (angular momentum balance) and
-    /// `lmb: { bodies, along }` (linear momentum balance).
+    /// `lmb: { bodies, along }` (linear momentum balance), one set; or a map of named sets,
+    /// `{ NAME: [ … ], … }`, each such a list (several derivations of the same equations).
     pub(super) fn balances(&mut self, node: &YamlNode) -> Vec<Balance> {
+        let YamlKind::Map(sets) = &node.kind else {
+            return self.balance_list(node, None);
+        };
+        let mut out = Vec::new();
+        for (name, value) in sets {
+            // `NAME: [...]`, or `NAME: { expect: disagree, balances: [...] }`.
+            let (list, expect_disagreement) = match &value.kind {
+                YamlKind::Map(entries) => {
+                    let expect = entries.iter().find(|(k, _)| k.value == "expect");
+                    let list = entries.iter().find(|(k, _)| k.value == "balances");
+                    let unknown = entries
+                        .iter()
+                        .find(|(k, _)| !matches!(k.value.as_str(), "expect" | "balances"));
+                    let disagree = expect.is_some_and(|(_, v)| {
+                        matches!(&v.kind, YamlKind::Scalar { text, .. } if text == "disagree")
+                    });
+                    if let Some((k, _)) = unknown {
+                        self.error(
+                            Diagnostic::new(k.location, format!("unknown key `{}` in the set of balances `{}`", k.value, name.value))
+                                .with_help("a set is a list of balances, or `{ expect: disagree, balances: [...] }` for a set kept to show a wrong form"),
+                        );
+                    }
+                    if let Some((_, v)) = expect.filter(|_| !disagree) {
+                        self.error(
+                            Diagnostic::new(
+                                v.location,
+                                "`expect` of a set of balances is `disagree`",
+                            )
+                            .with_help(
+                                "leave `expect` out for a set that must agree with Lagrange",
+                            ),
+                        );
+                    }
+                    let Some((_, list)) = list else {
+                        self.error(
+                            Diagnostic::new(name.location, format!("the set of balances `{}` has no `balances:` list", name.value))
+                                .with_help("write `{ expect: disagree, balances: [ { amb: { about: E, bodies: [fore], form: h_dot } } ] }`"),
+                        );
+                        continue;
+                    };
+                    (list, disagree)
+                }
+                _ => (value, false),
+            };
+            let mut set = self.balance_list(list, Some(name.clone()));
+            for b in &mut set {
+                b.expect_disagreement = expect_disagreement;
+            }
+            out.extend(set);
+        }
+        out
+    }
+
+    /// One set of balances, a list, as [`Self::balances`] reads it.
+    fn balance_list(&mut self, node: &YamlNode, set: Option<Located<String>>) -> Vec<Balance> {
         const EXAMPLE: &str = "balances:\n  - { amb: { about: O, bodies: [upper, fore] } }\n  - { lmb: { bodies: [slider], along: [cos(theta), sin(theta)] } }";
         let Some(items) = self.seq(node, "`balances`", EXAMPLE) else {
             return Vec::new();
@@ -874,10 +959,13 @@ impl Ctx<'_> {
                             Some(AmbForm::RCrossMa)
                         }
                         YamlKind::Scalar { text, .. } if text == "h_dot" => Some(AmbForm::HDot),
+                        YamlKind::Scalar { text, .. } if text == "h_rel_dot" => {
+                            Some(AmbForm::HRelDot)
+                        }
                         _ => {
                             self.error(
-                                Diagnostic::new(n.location, "`form` of an angular momentum balance is `r_x_ma` or `h_dot`")
-                                    .with_help("`r_x_ma` (the default): Σ M_A = Σ r_G/A × m a_G + I θ̈, valid about any point; `h_dot`: Σ M_A = dH_A/dt, valid about a fixed point or the centre of mass"),
+                                Diagnostic::new(n.location, "`form` of an angular momentum balance is `r_x_ma`, `h_dot` or `h_rel_dot`")
+                                    .with_help("`r_x_ma` (the default): Σ M_A = Σ r_G/A × m a_G + I θ̈, valid about any point; `h_dot`: Σ M_A = dH_A/dt with absolute velocities, valid when v_A × v_G = 0; `h_rel_dot`: Σ M_A = dH_A/rel/dt with velocities relative to A, valid when r_G/A × a_A = 0"),
                             );
                             None
                         }
@@ -913,6 +1001,8 @@ impl Ctx<'_> {
                 out.push(Balance {
                     kind,
                     bodies,
+                    set: set.clone(),
+                    expect_disagreement: false,
                     location: item.location,
                 });
             }

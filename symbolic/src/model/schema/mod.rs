@@ -64,6 +64,8 @@ pub const TOP_LEVEL_KEYS: &[&str] = &[
     "dampers",
     "forces",
     "torques",
+    "interactions",
+    "outputs",
     "initial",
     "draw",
     "balances",
@@ -77,7 +79,7 @@ pub const TOP_LEVEL_KEYS: &[&str] = &[
 ];
 
 /// Keys of the model format (DESIGN.md) that this version does not implement yet.
-pub const LATER_KEYS: &[&str] = &["outputs"];
+pub const LATER_KEYS: &[&str] = &[];
 
 /// Keys of `checks:`.
 pub const CHECK_KEYS: &[&str] = &[
@@ -359,14 +361,9 @@ mod tests {
 
     #[test]
     fn later_keys_and_unknown_keys() {
-        let m = messages("name: a\ncoordinates: [q]\noutputs: []\nkinetc: q_dot^2\n");
-        assert_eq!(
-            m,
-            [
-                "3:1: `outputs:` is not supported yet by this version of eomgen",
-                "4:1: unknown key `kinetc` in a model file"
-            ]
-        );
+        // `outputs:`, once a key for later, is read now.
+        let m = messages("name: a\ncoordinates: [q]\noutputs: { p: q_dot }\nkinetc: q_dot^2\n");
+        assert_eq!(m, ["4:1: unknown key `kinetc` in a model file"]);
         let b = built("name: a\ncoordinates: [q]\nkinetc: q_dot^2\n");
         assert!(
             b.diagnostics[0]

@@ -146,6 +146,16 @@ const SECTIONS: &[Section] = &[
         missing: None,
     },
     Section {
+        key: "interactions",
+        read: |cx, n, file| file.interactions = cx.interactions(n),
+        missing: None,
+    },
+    Section {
+        key: "outputs",
+        read: |cx, n, file| file.outputs = cx.outputs(n),
+        missing: None,
+    },
+    Section {
         key: "constraints",
         read: |cx, n, file| (file.constraints, file.point_constraints) = cx.holonomic(n),
         missing: None,
@@ -258,6 +268,8 @@ impl Ctx<'_> {
             dampers: Vec::new(),
             forces: Vec::new(),
             torques: Vec::new(),
+            interactions: Vec::new(),
+            outputs: Vec::new(),
             initial: Vec::new(),
             draw: Draw::default(),
             dimension: None,

@@ -4,6 +4,17 @@
 use super::walk::{Fields, Keyed, Need};
 use super::*;
 
+/// The keys of an output written as a map.
+const OUTPUT: Fields = Fields {
+    kind: "output",
+    keys: &[
+        ("value", Need::Required),
+        ("conserved", Need::Optional),
+        ("tolerance", Need::Optional),
+    ],
+    example: "{ value: m*cross(P - O, vel(P)), conserved: true, tolerance: 1e-9 }",
+};
+
 /// The keys of an event written as a map.
 const EVENT: Fields = Fields {
     kind: "event",
@@ -49,6 +60,46 @@ impl Ctx<'_> {
             .collect();
         let values = entries.into_iter().map(|(k, e, _)| (k, e)).collect();
         (values, guesses)
+    }
+
+    /// `outputs:` — `name: expr` or `name: { value: expr, conserved: true|false,
+    /// tolerance: number }`.
+    pub(super) fn outputs(&mut self, node: &YamlNode) -> Vec<OutputDef> {
+        let spec = Keyed {
+            what: "`outputs`",
+            example: "outputs: { L: m*cross(P - O, vel(P)) }",
+            names: Some("output"),
+            drop: false,
+        };
+        self.keyed(node, spec, |cx, k, v| {
+            let what = format!("output `{}`", k.value);
+            if !matches!(v.kind, YamlKind::Map(_)) {
+                let value = cx.expr(v, &what)?;
+                return Some(OutputDef {
+                    name: k.clone(),
+                    value,
+                    conserved: false,
+                    tolerance: DEFAULT_CHECK_TOLERANCE,
+                });
+            }
+            let f = cx.fields(k, v, &OUTPUT)?;
+            let value = get(f, "value").and_then(|n| cx.expr(n, &what));
+            let conserved = match get(f, "conserved") {
+                None => Some(false),
+                Some(n) => cx.choice(
+                    n,
+                    &format!("`conserved` of output `{}`", k.value),
+                    &[("true", true), ("false", false)],
+                ),
+            };
+            let tolerance = cx.number_or(f, "tolerance", &what, DEFAULT_CHECK_TOLERANCE);
+            Some(OutputDef {
+                name: k.clone(),
+                value: value?,
+                conserved: conserved?,
+                tolerance: tolerance?,
+            })
+        })
     }
 
     /// `events:` — `name: g` or `name: { when: g, direction: rising|falling|both,

@@ -1,0 +1,171 @@
+//! A model's `outputs:` along a simulation: each named expression of the state evaluated at
+//! every sample, and for the outputs the file declares conserved (`conserved: true`) their
+//! drift `max |Q(t) − Q(0)| / max(1, |Q(0)|)` against the file's bound — the measure of a
+//! `checks: conserved:` entry, beside the energy drift (lectures 3–7: the angular momentum
+//! of a central force and of many particles is a constant of the motion).
+//!
+//! `eomgen simulate` prints the drift of every conserved output and writes every output to
+//! its CSV and JSON; `eomgen report` checks the conserved ones
+//! ([`crate::checks::motion_checks`]). The expressions are the model's description's
+//! ([`eomgen_runtime::description::outputs::OutputSpec`]), so a compiled model and a file
+//! loaded at run time give the same values.
+
+use eomgen_runtime::{ModelInfo, Solution};
+use eomgen_symbolic::model::parser::{eval_expr, parse_expr};
+use eomgen_symbolic::model::{Expr, Location};
+use serde::Serialize;
+
+use crate::expressions::parameter_lookup;
+
+/// One output along a simulation.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct OutputSeries {
+    /// Its name in the model file (`L`).
+    pub name: String,
+    /// Its expression, as the model's description keeps it.
+    pub value: String,
+    /// Whether the file declares it a constant of the motion.
+    pub conserved: bool,
+    /// The bound on [`Self::drift`] (conserved outputs only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub tolerance: Option<f64>,
+    /// Its value at each sample of the solution (units of the expression).
+    pub values: Vec<f64>,
+    /// `max |Q(t) − Q(0)| / max(1, |Q(0)|)` over the samples (conserved outputs with at
+    /// least one sample only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub drift: Option<f64>,
+    /// Whether [`Self::drift`] is within [`Self::tolerance`] (conserved outputs only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub within_tolerance: Option<bool>,
+}
+
+impl OutputSeries {
+    /// Whether the output is declared conserved but drifted beyond its bound.
+    pub fn drifted(&self) -> bool {
+        self.within_tolerance == Some(false)
+    }
+}
+
+/// Why an output could not be evaluated.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum OutputError {
+    /// The expression does not parse or names something the model lacks (a model
+    /// description not built from its file).
+    #[error("output `{name}`: {message} in `{value}`")]
+    Expression {
+        /// The output.
+        name: String,
+        /// Its expression.
+        value: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// The value is not a finite number at a sample.
+    #[error("output `{name}` is {value} at t = {t}, not a finite number")]
+    NotFinite {
+        /// The output.
+        name: String,
+        /// The time of the sample.
+        t: f64,
+        /// The value.
+        value: f64,
+    },
+}
+
+/// Evaluates `model`'s outputs at every sample of `solution` (a solution of `model`, with
+/// its current parameter values); for a conserved output also its drift
+/// `max |Q(t) − Q(0)| / max(1, |Q(0)|)` and whether it is within the file's bound.
+///
+/// `solution`'s states are `[q; q̇]` of `model` (length `2n`). An empty `solution` gives
+/// empty series without drift.
+///
+/// # Errors
+/// [`OutputError::Expression`] if an expression does not evaluate,
+/// [`OutputError::NotFinite`] at the first sample where a value is infinite or NaN.
+///
+/// # Examples
+/// ```
+/// use eomgen::analysis::{SimulationOptions, simulate};
+///
+/// let source = eomgen::ModelSource::open("two_body")?;
+/// let mut model = source.instantiate();
+/// let options = SimulationOptions {
+///     method: eomgen::Method::Dop853,
+///     t_end: 1.0,
+///     rtol: 1e-12,
+///     atol: 1e-12,
+///     ..SimulationOptions::default()
+/// };
+/// let run = simulate(model.as_mut(), &options).unwrap();
+/// let outputs = eomgen::outputs::evaluate_outputs(model.as_ref(), &run.solution).unwrap();
+/// let l = outputs.iter().find(|o| o.name == "angular_momentum").unwrap();
+/// // L = m1 m2/(m1 + m2) d² ω = 2/√3 (the file's header), kept to the integration's error.
+/// assert!((l.values[0] - 2.0 / 3f64.sqrt()).abs() < 1e-15);
+/// assert!(l.within_tolerance == Some(true), "{:?}", l.drift);
+/// # Ok::<(), eomgen::OpenError>(())
+/// ```
+pub fn evaluate_outputs(
+    model: &dyn ModelInfo,
+    solution: &Solution,
+) -> Result<Vec<OutputSeries>, OutputError> {
+    let description = model.description();
+    let parameters = parameter_lookup(model);
+    let coordinates = description.coordinate_names();
+    let n = coordinates.len();
+    let mut series = Vec::with_capacity(description.outputs.len());
+    for output in description.outputs.iter() {
+        let (name, value) = (output.name.to_string(), output.value.to_string());
+        let expression_error = |message: String| OutputError::Expression {
+            name: name.clone(),
+            value: value.clone(),
+            message,
+        };
+        let e: Expr = parse_expr(&value, Location { line: 1, column: 1 })
+            .map_err(|d| expression_error(d.message))?;
+        let mut values = Vec::with_capacity(solution.len());
+        for (t, y) in solution.iter() {
+            let v = eval_expr(&e, &|k| {
+                if k == "t" {
+                    return Some(t);
+                }
+                if let Some(v) = parameters(k) {
+                    return Some(v);
+                }
+                if let Some(i) = coordinates.iter().position(|c| *c == k) {
+                    return Some(y[i]);
+                }
+                let base = k.strip_suffix("_dot")?;
+                coordinates
+                    .iter()
+                    .position(|c| *c == base)
+                    .map(|i| y[n + i])
+            })
+            .map_err(|d| expression_error(d.message))?;
+            if !v.is_finite() {
+                return Err(OutputError::NotFinite { name, t, value: v });
+            }
+            values.push(v);
+        }
+        let drift = match (output.conserved, values.first()) {
+            (true, Some(&q0)) => Some(
+                values
+                    .iter()
+                    .map(|q| (q - q0).abs() / q0.abs().max(1.0))
+                    .fold(0.0, f64::max),
+            ),
+            _ => None,
+        };
+        series.push(OutputSeries {
+            name,
+            value,
+            conserved: output.conserved,
+            tolerance: output.conserved.then_some(output.tolerance),
+            values,
+            drift,
+            within_tolerance: drift.map(|d| d <= output.tolerance),
+        });
+    }
+    Ok(series)
+}
