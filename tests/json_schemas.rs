@@ -240,6 +240,34 @@ fn json_output_keeps_its_schema() {
                 "--json",
             ],
         ),
+        ("expm", vec!["study", "expm", "--n", "3", "--json"]),
+        (
+            "rayleigh",
+            vec!["study", "rayleigh", "three_masses", "--shape", "1,1,1", "--json"],
+        ),
+        (
+            "convolution",
+            vec![
+                "study",
+                "convolution",
+                "forced_oscillator",
+                "--input",
+                "A",
+                "--forcing",
+                "step",
+                "--t-end",
+                "1",
+                "--json",
+            ],
+        ),
+        (
+            "launch",
+            vec!["study", "launch", "projectile_drag", "--speeds", "1", "--json"],
+        ),
+        (
+            "rolling_contact",
+            vec!["study", "rolling-contact", "eccentric_cylinder", "--json"],
+        ),
         (
             "report",
             vec![

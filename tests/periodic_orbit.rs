@@ -396,8 +396,8 @@ fn pendulum_period_against_the_elliptic_integral() {
 }
 
 /// The errors: a constrained model is refused, a start at rest at the equilibrium collapses,
-/// a time-dependent model with the period free is refused, and too few iterations report the
-/// residual and the count.
+/// an energy that is not finite cannot be fixed, a time-dependent model with the period free
+/// is refused, and too few iterations report the residual and the count.
 #[test]
 fn errors() {
     let mut four_bar = model("four_bar");
@@ -413,6 +413,13 @@ fn errors() {
     assert!(matches!(
         periodic_orbit(pendulum.as_mut(), &at_rest),
         Err(PeriodicOrbitError::Collapsed { .. })
+    ));
+    // n = −1: the file's potential divides by n + 1, so the energy cannot be fixed.
+    let mut log_force = model("central_force");
+    log_force.set_parameter("n", -1.0).unwrap();
+    assert!(matches!(
+        periodic_orbit(log_force.as_mut(), &PeriodicOrbitOptions::new(3.0)),
+        Err(PeriodicOrbitError::InvalidEnergy { .. })
     ));
     let mut mathieu = model("mathieu_pendulum");
     assert!(matches!(

@@ -76,7 +76,9 @@ enum Command {
     /// DIR/report.json; exit 1 if a check fails.
     Report(commands::report::ReportArgs),
     /// Numerical experiments: `work-precision`, `stability`, `euler-roundoff`,
-    /// `constraint-methods`, `free-response`, `modal-damping`, `floquet`.
+    /// `constraint-methods`, `launch`, `free-response`, `modal-damping`, `floquet`,
+    /// `convolution`, `parameter-sweep`, `periodic-orbit`, `expm`, `rayleigh`,
+    /// `rolling-contact`.
     #[command(subcommand)]
     Study(Study),
 }

@@ -34,6 +34,12 @@
 //! 12 times) until the residual norm decreases; if none does, the cut is lowered to `κ‖r‖/10`,
 //! `κ‖r‖/100`, then `ε σ_max`, and the step tried again.
 //!
+//! The period's unknown is its relative change `ΔT/T` (the column `T f(φ_T(y₀))`), so that the
+//! minimum-norm step weighs it like a change of state. Far from the orbit the integrations run
+//! at `1e-4 ‖r‖²` (at most [`LOOSEST_TOL`]): Newton's next residual is about `‖r‖²`, and no
+//! more accuracy is needed to reach it; convergence is declared only on an evaluation at
+//! [`PeriodicOrbitOptions::integration_tol`].
+//!
 //! The Floquet multipliers are the eigenvalues of `Φ(T)` at the solution
 //! ([`floquet_multipliers`]). For a Hamiltonian system each first integral with its symmetry
 //! gives a pair of multipliers 1 (a 2 × 2 Jordan block): time shift and energy, and one pair per
@@ -114,8 +120,9 @@ pub enum PeriodicOrbitError {
         /// Largest allowed.
         largest: f64,
     },
-    /// The energy level is not finite.
-    #[error("the energy level must be finite, got {energy}")]
+    /// The energy level, or the energy `T + V` at the start, is not finite (with the period
+    /// free in a conservative model, where the energy is fixed).
+    #[error("the energy must be finite to be fixed, got {energy}")]
     InvalidEnergy {
         /// Given (J).
         energy: f64,
@@ -412,6 +419,14 @@ pub fn periodic_orbit(
     let conservative = model.description().conservative && !time_dependent;
     let energy_level = (conservative && !options.fix_period)
         .then(|| options.energy.unwrap_or_else(|| model.energy(0.0, &start)));
+    if let Some(level) = energy_level {
+        let at_start = model.energy(0.0, &start);
+        for energy in [level, at_start] {
+            if !energy.is_finite() {
+                return Err(PeriodicOrbitError::InvalidEnergy { energy });
+            }
+        }
+    }
     let shooting = Shooting {
         n,
         free_period: !options.fix_period,
@@ -460,7 +475,7 @@ pub fn periodic_orbit(
         }
         // The Jacobian at the current iterate, also for the symmetry count at the solution.
         let jacobian = jacobian(model, &shooting, &current, &f0)?;
-        let svd = jacobian.clone().svd(true, true);
+        let svd = jacobian.svd(true, true);
         let sigma_max = svd.singular_values.max();
         let cut = (RANK_TOLERANCE * sigma_max).max(SYMMETRY_FACTOR * current.merit);
         let rank = svd.singular_values.iter().filter(|s| **s > cut).count();
@@ -528,7 +543,7 @@ pub fn periodic_orbit(
                     tol_for(current.merit),
                     &mut stats,
                 ) {
-                    Ok(candidate) if candidate.merit < current.merit => {
+                    Ok(candidate) if {if std::env::var("PO_DEBUG").is_ok() { eprintln!("DBG cur merit {:e} tol {:e} | cand merit {:e} tol {:e} cut {:e} damping {} rank {}", current.merit, current.tol, candidate.merit, candidate.tol, level, damping, used_rank); } candidate.merit < current.merit} => {
                         accepted = Some(candidate);
                         break 'cuts;
                     }
@@ -653,11 +668,6 @@ fn validate(options: &PeriodicOrbitOptions) -> Result<(), PeriodicOrbitError> {
         1e-8,
         0.1,
     )?;
-    if let Some(e) = options.energy
-        && !e.is_finite()
-    {
-        return Err(PeriodicOrbitError::InvalidEnergy { energy: e });
-    }
     Ok(())
 }
 

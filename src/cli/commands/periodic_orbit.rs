@@ -93,7 +93,9 @@ pub fn run(args: &PeriodicOrbitArgs) -> Result<(), CliError> {
     let orbit = periodic_orbit(model.as_mut(), &options).map_err(|e| match e {
         PeriodicOrbitError::InvalidPeriod { .. } => CliError::usage(format!("--period: {e}")),
         PeriodicOrbitError::InvalidTolerance { .. } => CliError::usage(format!("--tol: {e}")),
-        PeriodicOrbitError::InvalidEnergy { .. } => CliError::usage(format!("--energy: {e}")),
+        PeriodicOrbitError::InvalidEnergy { .. } => CliError::usage(format!(
+            "{e}: T + V is not finite here (a potential undefined at this state or these parameters); fix the period instead (--fix-period --period T)"
+        )),
         PeriodicOrbitError::Constrained { .. } => CliError::usage(e.to_string()),
         PeriodicOrbitError::TimeDependent { .. } => CliError::usage(format!(
             "{e} (--fix-period --period T, T the forcing's period)"

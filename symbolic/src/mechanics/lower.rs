@@ -933,11 +933,17 @@ impl<'f> Lowering<'f> {
     }
 
     /// The expression as the model's description keeps it: as written, or, when it uses
-    /// the vector functions, lowered (the points' positions and velocities written out in
-    /// the coordinates and rates) and printed back in the file's syntax, so that it is
-    /// evaluated from the state alone.
+    /// the vector functions or a frame's angular velocity (`omega_B_x`), lowered (the points'
+    /// positions and velocities written out in the coordinates and rates) and printed back in
+    /// the file's syntax, so that it is evaluated from the state alone.
     fn state_text(&mut self, e: &Expr) -> String {
-        if !crate::model::vectors::uses_vectors(e) {
+        // A frame's angular velocity (`omega_B_x`) is no name of the state either.
+        let mut ids = Vec::new();
+        crate::model::parser::identifiers(e, &mut ids);
+        let reads_angular_velocity = ids.iter().any(|(n, _)| {
+            self.arena.symbol_id(n).is_none() && self.angular_velocities.contains_key(n)
+        });
+        if !crate::model::vectors::uses_vectors(e) && !reads_angular_velocity {
             return e.to_string();
         }
         let lowered = self.expr(e);
