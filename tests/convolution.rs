@@ -449,3 +449,39 @@ fn cli_step_response() {
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(text.contains("max |Duhamel − DOP853|"), "{text}");
 }
+
+/// Below 4 intervals the grids `Δ` and `2Δ` share no point where Simpson's sums differ, so
+/// Richardson's estimate would be exactly 0 while the result is off by O(1) (2 intervals over
+/// ten periods: the step response is 1 from its closed form): such a grid is refused; at 4
+/// intervals the estimate is positive.
+#[test]
+fn too_few_intervals_are_refused_not_estimated_as_exact() {
+    let mut osc = model("forced_oscillator");
+    for intervals in [0, 1, 2, 3] {
+        let err = study(osc.as_mut(), "A", Forcing::Step, 20.0, intervals).unwrap_err();
+        assert!(
+            matches!(
+                err,
+                ConvolutionError::InvalidOption {
+                    option: "intervals",
+                    ..
+                }
+            ),
+            "{intervals}: {err:?}"
+        );
+    }
+    let four = study(osc.as_mut(), "A", Forcing::Step, 20.0, 4).unwrap();
+    assert!(four.quadrature.error_estimate > 0.0, "{:?}", four.quadrature);
+    let out = eomgen(&[
+        "study",
+        "convolution",
+        "forced_oscillator",
+        "--input",
+        "A",
+        "--forcing",
+        "step",
+        "--intervals",
+        "2",
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+}

@@ -440,3 +440,44 @@ fn commands() {
     let out = eomgen(&["study", "expm", "--matrix", "1,2;3"]);
     assert_eq!(out.status.code(), Some(2));
 }
+
+/// `R(v)` does not depend on the shape's scale: `(1, 1, 1)` on three masses gives `2/3`
+/// (to 1e-13, as at scale 1) at 1e300 and 1e-300 too — not NaN (and a failed bound) from
+/// overflowing `vᵀKv`, nor a zero shape from underflowing `vᵀMv`; the forms scale by the
+/// square of the scale (checked where it is representable) and the projected shape by the
+/// scale.
+#[test]
+fn rayleigh_quotient_is_independent_of_the_shape_scale() {
+    let masses = model("three_masses");
+    let unit = rayleigh_study(masses.as_ref(), &RayleighOptions::new(vec![1.0; 3])).unwrap();
+    for scale in [1e300, 1e-300, -3.5] {
+        let study = rayleigh_study(masses.as_ref(), &RayleighOptions::new(vec![scale; 3])).unwrap();
+        assert!(
+            (study.rayleigh_quotient - 2.0 / 3.0).abs() < 1e-13,
+            "{scale}: R = {}",
+            study.rayleigh_quotient
+        );
+        assert!(study.bound_holds, "{scale}");
+        assert!(
+            study.modal_participation.iter().all(|p| p.is_finite()),
+            "{scale}: {:?}",
+            study.modal_participation
+        );
+        for (p, u) in study.projected_shape.iter().zip(&unit.projected_shape) {
+            assert!((p / scale - u).abs() < 1e-13, "{scale}: {p} vs {u}");
+        }
+        if (1e-100..1e100).contains(&scale.abs()) {
+            // (vᵀMv itself is beyond f64 at 1e±300.)
+            assert!(
+                (study.mass_form / (scale * scale) - unit.mass_form).abs() < 1e-12 * unit.mass_form
+            );
+        }
+    }
+    eomgen_ok(&[
+        "study",
+        "rayleigh",
+        "three_masses",
+        "--shape",
+        "1e300,1e300,1e300",
+    ]);
+}

@@ -459,3 +459,35 @@ fn compiled_and_run_time_models_agree_to_the_bit() {
         }
     }
 }
+
+/// An output that reads a frame's angular velocity (`omega_B_x`, a name of the derivation,
+/// not of the state) is written out in the coordinates and rates, so that it evaluates along
+/// a run: the body-frame x component of the free body's angular velocity,
+/// `θ̇ cos ψ − φ̇ cos θ sin ψ` (z-x-y angles), at every sample to rounding (1e-14: the same
+/// products in another order).
+#[test]
+fn an_output_of_a_frames_angular_velocity_is_evaluated() {
+    let text = model_text("free_rigid_body");
+    let text = format!(
+        "{}outputs:\n  wx: omega_B_x\n",
+        &text[..text.find("events:").expect("an events block")]
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("spin.yaml");
+    std::fs::write(&path, text).unwrap();
+    let mut model = DynFirstOrder::new(JitModel::load(path.to_str().unwrap()).unwrap());
+    let described = model.description().outputs[0].value.to_string();
+    assert!(!described.contains("omega"), "{described}");
+    let options = SimulationOptions {
+        t_end: 1.0,
+        ..SimulationOptions::default()
+    };
+    let run = simulate(&mut model, &options).unwrap();
+    let outputs = eomgen::outputs::evaluate_outputs(&model, &run.solution).unwrap();
+    for ((_, y), wx) in run.solution.iter().zip(&outputs[0].values) {
+        let [phi_dot, theta_dot] = [y[3], y[4]];
+        let (theta, psi) = (y[1], y[2]);
+        let expected = theta_dot * psi.cos() - phi_dot * theta.cos() * psi.sin();
+        assert!((wx - expected).abs() < 1e-14, "{wx} vs {expected}");
+    }
+}

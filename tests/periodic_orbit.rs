@@ -155,6 +155,116 @@ fn figure_eight_with_the_period_fixed() {
     assert!(closure(m.as_mut(), &orbit.initial_state, orbit.period) < 1e-9);
 }
 
+/// The figure eight from the model's own data (within 1e-7 of the orbit) and from that data
+/// moved by up to ±1e-6: Gauss–Newton must converge, and quadratically, from starts this close
+/// (a regression: the first residual used to be evaluated at the loosest integration
+/// tolerance, 1e-8, where the data's residual 7.5e-8 reads 3.7e-8, half of it integration
+/// error; the step computed from it, and the damped steps compared with it, failed).
+///
+/// - The residual reported at the start is the data's own, `‖φ_T(y₀) − y₀‖` from an
+///   independent plain DOP853 run at 1e-13, to 1e-9 (1 % of it; both integrations err by
+///   ~1e-11), not the loose integration's.
+/// - The data converges in one step (7.5e-8 to ~5e-12: the square of the residual is below
+///   the integration's error), the 1e-6 start in at most two; both end below Newton's
+///   allowed residual `tol (1 + ‖y₀‖)`, and close in the independent run to 1e-9.
+/// - The two periods agree to 1e-8 (two Newton paths to one orbit at one energy; Newton's
+///   tolerance 1e-10 on the state over `‖f‖ ≈ 1.6` bounds each period's error by about
+///   1e-10), and with Simó's 6.32591398 to 5e-8 (the data's 8 decimals fix the energy, and
+///   with it the period, to about 3e-8: the period at the data's energy is 6.3259140114).
+/// - With the period fixed at Simó's value, the data also converges in one step.
+/// - The sampled orbit ends at `T` itself (the last sample time used to round past it).
+#[test]
+fn figure_eight_from_its_own_data_and_a_start_within_1e_6() {
+    let mut m = model("figure_eight");
+    let initial = m.initial_state();
+    let energy = m.energy(0.0, &initial);
+    let solve = |m: &mut dyn ModelInfo, start: Vec<f64>, fix_period: bool| {
+        periodic_orbit(
+            m,
+            &PeriodicOrbitOptions {
+                start: Some(start),
+                energy: Some(energy),
+                fix_period,
+                ..PeriodicOrbitOptions::new(SIMO_PERIOD)
+            },
+        )
+        .unwrap_or_else(|e| panic!("{e}"))
+    };
+    let allowed = |orbit: &PeriodicOrbit| 1e-10 * (1.0 + norm(&orbit.initial_state));
+
+    let data_closure = closure_norm(m.as_mut(), &initial, SIMO_PERIOD);
+    let own = solve(m.as_mut(), initial.clone(), false);
+    assert!(
+        (own.history[0].residual - data_closure).abs() < 1e-9,
+        "start residual {} against an independent {data_closure}",
+        own.history[0].residual
+    );
+    assert!(data_closure > 1e-8, "the data is not exactly periodic");
+    assert_eq!(own.iterations, 1, "{:?}", own.history);
+    assert!(own.residual < allowed(&own), "residual {}", own.residual);
+    assert!(closure(m.as_mut(), &own.initial_state, own.period) < 1e-9);
+    assert_eq!(*own.orbit.t.last().unwrap(), own.period);
+
+    let mut rng = seeded_rng(6);
+    let near: Vec<f64> = initial
+        .iter()
+        .map(|v| v + rng.random_range(-1e-6..1e-6))
+        .collect();
+    let close = solve(m.as_mut(), near, false);
+    assert!(close.iterations <= 2, "{:?}", close.history);
+    assert!(
+        close.residual < allowed(&close),
+        "residual {}",
+        close.residual
+    );
+    assert!(closure(m.as_mut(), &close.initial_state, close.period) < 1e-9);
+
+    assert!(
+        (own.period - close.period).abs() < 1e-8,
+        "T = {} and {}",
+        own.period,
+        close.period
+    );
+    for orbit in [&own, &close] {
+        assert!(
+            (orbit.period - SIMO_PERIOD).abs() < 5e-8,
+            "T = {}",
+            orbit.period
+        );
+    }
+
+    let fixed = solve(m.as_mut(), initial, true);
+    assert_eq!(fixed.iterations, 1, "{:?}", fixed.history);
+    assert!(
+        fixed.residual < allowed(&fixed),
+        "residual {}",
+        fixed.residual
+    );
+}
+
+fn norm(v: &[f64]) -> f64 {
+    v.iter().map(|x| x * x).sum::<f64>().sqrt()
+}
+
+/// `‖φ_T(y₀) − y₀‖₂` by a plain DOP853 run at 1e-13, like [`closure`].
+fn closure_norm(model: &mut dyn ModelInfo, y0: &[f64], period: f64) -> f64 {
+    let options = IntegratorOptions::default()
+        .with_rtol(1e-13)
+        .with_atol(1e-13);
+    let solution = DormandPrince853::new()
+        .integrate(
+            model.as_ode_mut(),
+            0.0,
+            y0,
+            period,
+            &OutputTimes::At(vec![period]),
+            &options,
+        )
+        .unwrap();
+    let (_, end) = solution.last().unwrap();
+    norm(&end.iter().zip(y0).map(|(a, b)| a - b).collect::<Vec<f64>>())
+}
+
 /// A Kepler circle (lecture 4, HW5): `central_force` at its defaults (μ = 4 m³/s²) started on
 /// the circle r = 1.5 m (v0 = √(μ/r)) with a period guess 20 % short. Newton finds Kepler's
 /// third law `T = 2π √(r³/μ)` to 1e-9 relative (Newton's tolerance 1e-10 on the state). A

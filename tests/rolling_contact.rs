@@ -334,3 +334,28 @@ fn cli_prints_and_plots() {
     ]);
     assert_eq!(out.status.code(), Some(2));
 }
+
+/// A friction coefficient below `μ(0) = |F_t(0)|/N(0)` is reached at the start — the body
+/// slips from the first instant — not at a later rising crossing after `μ` dips (nor never,
+/// for μ = 0): `F_t² − μ² N²` is already ≥ 0 at t = 0, where a rising event cannot fire.
+/// Above `μ(0)` (and below the first peak) the time is the event's, after the start, where
+/// `μ(t)` computed from the samples has reached the threshold.
+#[test]
+fn a_threshold_below_the_initial_mu_is_reached_at_the_start() {
+    let first = study(&[], vec![]);
+    let mu0 = first.rolling.samples[0].mu.expect("N(0) > 0");
+    assert!(mu0 > 0.0, "μ(0) = {mu0}");
+    let s = study(&[], vec![0.0, 0.5 * mu0, 1.5 * mu0]);
+    let e = &s.rolling.exceedances;
+    assert_eq!(e[0].t, Some(0.0), "{e:?}");
+    assert_eq!(e[1].t, Some(0.0), "{e:?}");
+    let later = e[2].t.expect("reached before the lift-off");
+    assert!(later > 0.0, "{e:?}");
+    let reached = s
+        .rolling
+        .samples
+        .iter()
+        .filter(|x| x.t <= later)
+        .all(|x| x.mu.is_some_and(|m| m <= 1.5 * mu0 * (1.0 + 1e-9)));
+    assert!(reached, "μ(t) exceeds 1.5 μ(0) before {later} s");
+}

@@ -237,7 +237,7 @@ fn preferred_formulation_needs_no_derivation() {
         ("double_pendulum.yaml", "momentum"),
         ("spring_line_three.yaml", "momentum"),
         ("simple_pendulum.yaml", "lagrange"),
-        ("figure_eight.yaml", "lagrange"),
+        ("central_force.yaml", "lagrange"),
     ] {
         let source = std::fs::read_to_string(format!("{dir}{path}")).expect("bundled");
         let file = eomgen_symbolic::model::load(path, &source).expect("loads");

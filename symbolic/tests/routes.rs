@@ -233,3 +233,80 @@ fn balance_sets_are_diagnosed() {
         "{errors:?}"
     );
 }
+
+/// A set named after another derivation would share its row and its key in the summary
+/// (`momentum` beside momentum balance), and an empty set would be dropped unseen: both are
+/// errors located at the set's name (the name on line 15 of the file).
+#[test]
+fn balance_sets_need_their_own_names_and_balances() {
+    let pair = "\n    - { amb: { about: O, bodies: [elbow, hand] } }\n    - { amb: { about: E, bodies: [hand] } }\n";
+    for reserved in ["lagrange", "momentum", "by_hand", "energy", "power"] {
+        let text = with_balances(&format!("  {reserved}:{pair}"));
+        let errors = eomgen_symbolic::model::load("m.yaml", &text).unwrap_err();
+        let d = errors
+            .iter()
+            .find(|d| d.message.contains("names another derivation"))
+            .unwrap_or_else(|| panic!("{reserved}: {errors:?}"));
+        assert_eq!((d.location.line, d.location.column), (15, 3), "{d:?}");
+    }
+    let empty = with_balances(&format!("  right:{pair}  none: []\n"));
+    let errors = eomgen_symbolic::model::load("m.yaml", &empty).unwrap_err();
+    let d = errors
+        .iter()
+        .find(|d| d.message.contains("the set of balances `none` is empty"))
+        .unwrap_or_else(|| panic!("{errors:?}"));
+    assert_eq!(d.location.line, 18, "{d:?}");
+    // The same sets under their own names load and are compared under them.
+    let report = check(&with_balances(&format!("  right:{pair}")));
+    assert!(residual(&report, "right") < CHECK_TOLERANCE);
+}
+
+/// A damper to a driven base (`B` moves with `t`, `T` and `V` do not): the energy route
+/// `Ė = Q q̇` holds, but the damper's power at `B` is the driver's, not drawn from `T`, so
+/// `P = dT/dt` with every load's `F·v` would be wrong: the power route is not taken and the
+/// check passes. A rod spun at a constant rate written as `T = ½ m (ṙ² + r² ω²)` has no
+/// explicit `t`, but `T` is not a quadratic form in `ṙ`, so `Ė = 0` is not `ṙ` times the
+/// equation of motion `r̈ = ω² r`: the energy route is skipped with that reason (the
+/// hand-derived equation, right, still passes).
+#[test]
+fn energy_routes_need_undriven_loads_and_a_quadratic_t() {
+    let base = r#"
+name: base
+parameters: { m: 1.0, c: 0.5, Y: 0.2, w: 2.0 }
+coordinates: [x]
+points:
+  B: [Y*sin(w*t), 0]
+  P: [x, 0]
+bodies:
+  mass: { mass: m, at: P }
+dampers:
+  d: { between: [B, P], coefficient: c }
+initial: { x: 1 }
+"#;
+    let report = check(base);
+    assert!(residual(&report, "energy") < CHECK_TOLERANCE);
+    assert!(!report.comparisons.iter().any(|c| c.b == "power"));
+    assert!(report.passed(CHECK_TOLERANCE), "{:?}", report.notes);
+
+    let spun = r#"
+name: spun
+parameters: { m: 1.0, w: 1.5 }
+coordinates: [r]
+kinetic: m*(r_dot^2 + r^2*w^2)/2
+initial: { r: 1 }
+checks:
+  equations_of_motion:
+    - m*r_ddot = m*w^2*r
+"#;
+    let report = check(spun);
+    assert!(!report.comparisons.iter().any(|c| c.b == "energy"));
+    assert!(
+        report
+            .notes
+            .iter()
+            .any(|n| n.contains("T is not a quadratic form in q̇")),
+        "{:?}",
+        report.notes
+    );
+    assert!(report.passed(CHECK_TOLERANCE), "{:?}", report.notes);
+}

@@ -309,7 +309,8 @@ pub struct MuPeak {
 pub struct Exceedance {
     /// The friction coefficient (1).
     pub mu: f64,
-    /// The first time `|F_t| = μ N`, rising (s); `None` if `μ(t)` stays below it up to the
+    /// The first time `|F_t| = μ N`, rising (s), or the start if `μ(0) ≥ μ` already (the
+    /// body slips from the first instant); `None` if `μ(t)` stays below it up to the
     /// lift-off (only possible when `F_t = 0` there).
     pub t: Option<f64>,
 }
@@ -1133,10 +1134,16 @@ fn rolling_phase(
         .enumerate()
         .map(|(i, mu)| Exceedance {
             mu: *mu,
-            t: events
-                .iter()
-                .find(|e| e.name == format!("rolling_contact_mu_{i}"))
-                .map(|e| e.t),
+            // Already reached at the start (`F_t² ≥ μ² N²` there, `μ(0) ≥ μ`): the rising
+            // event cannot fire from a value ≥ 0, and the body slips from the first instant.
+            t: if out[0].friction_force.powi(2) >= (mu * out[0].normal_force).powi(2) {
+                Some(out[0].t)
+            } else {
+                events
+                    .iter()
+                    .find(|e| e.name == format!("rolling_contact_mu_{i}"))
+                    .map(|e| e.t)
+            },
         })
         .collect();
     let last = &out[count - 1];

@@ -44,9 +44,9 @@ pub struct ConvolutionArgs {
     /// End time (s). Default: ten periods of the lowest natural frequency; in [1e-6, 1e6].
     #[arg(long, value_parser = crate::cli::values::study_end_time, allow_hyphen_values = true)]
     pub t_end: Option<f64>,
-    /// Intervals of the time grid (2 to 100000); the quadrature's error falls as its fourth
+    /// Intervals of the time grid (4 to 100000); the quadrature's error falls as its fourth
     /// power, its cost grows as its square.
-    #[arg(long, default_value_t = ConvolutionOptions::DEFAULT_INTERVALS, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(2..=100_000))]
+    #[arg(long, default_value_t = ConvolutionOptions::DEFAULT_INTERVALS, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(4..=100_000))]
     pub intervals: usize,
     /// Relative tolerance of the DOP853 check.
     #[arg(long, default_value_t = ConvolutionOptions::DEFAULT_RTOL, value_parser = crate::cli::values::relative_tolerance, allow_hyphen_values = true)]

@@ -201,6 +201,33 @@ pub fn run(args: &FrfArgs) -> Result<(), CliError> {
         amplitude: args.amplitude,
         rtol: args.rtol,
     });
+    // `--frequency-parameter` also says where to read a parameter input's rate column: without
+    // `--simulate` it is checked here and passed on with no runs, not ignored.
+    let simulation = match (simulation, &args.frequency_parameter) {
+        (None, Some(p)) => {
+            let parameters = model.description().parameter_names();
+            if !parameters.contains(&p.as_str()) {
+                return Err(CliError::usage(format!(
+                    "--frequency-parameter {p}: `{}` has no such parameter (parameters: {})",
+                    model.description().name,
+                    parameters.join(", ")
+                )));
+            }
+            if *p == args.input {
+                return Err(CliError::usage(
+                    "--frequency-parameter must differ from --input",
+                ));
+            }
+            parameters
+                .contains(&args.input.as_str())
+                .then(|| FrfSimulationOptions {
+                    count: 0,
+                    frequency_parameter: Some(p.clone()),
+                    ..FrfSimulationOptions::default()
+                })
+        }
+        (simulation, _) => simulation,
+    };
     let options = FrfOptions {
         operating_point: args.point.options(model.as_ref())?,
         input: args.input.clone(),

@@ -193,12 +193,14 @@ const NO_MOMENTUM_BALANCE: &str =
     "momentum balance needs bodies and no written `kinetic:`: compared nothing";
 
 impl CheckReport {
-    /// Why the derivation was not cross-checked, when no second derivation was compared
-    /// with Lagrange's (`None` when one was): a model with no bodies, or one that writes
-    /// `kinetic:`, and no `balances:` or hand-written `equations_of_motion:`.
+    /// Why the derivation was not cross-checked, when no second derivation independent of
+    /// Lagrange's was compared with it (`None` when one was): a model with no bodies, or one
+    /// that writes `kinetic:`, and no `balances:` or hand-written `equations_of_motion:`. The
+    /// energy equation ([`EnergyRate`]) does not count: it differentiates the same `T` and
+    /// `V` that Lagrange's equations do, so it checks the derivation, not the model's energies.
     pub fn not_cross_checked(&self) -> Option<&'static str> {
-        self.comparisons.is_empty().then_some(
-            "not cross-checked: only Lagrange's equations apply (momentum balance needs bodies and no written `kinetic:`); add the equations of motion derived by hand under `checks: equations_of_motion:`",
+        self.comparisons.iter().all(|c| c.b == EnergyRate.name()).then_some(
+            "not cross-checked: only Lagrange's equations (and the energy equation, from the same T and V) apply (momentum balance needs bodies and no written `kinetic:`); add the equations of motion derived by hand under `checks: equations_of_motion:`",
         )
     }
 
@@ -569,9 +571,13 @@ pub fn check_model(
             let singular = c.max_rel_residual.is_infinite();
             let balances = set.map(|s| balance_set_label(&model, s));
             if c.max_rel_residual.is_nan() {
-                let which = balances
-                    .clone()
-                    .unwrap_or_else(|| format!("the {} equations", c.b));
+                let which = balances.clone().unwrap_or_else(|| {
+                    if c.b == HandEquations.name() {
+                        "the equations of motion written by hand".to_string()
+                    } else {
+                        format!("the equations of the {} derivation", c.b)
+                    }
+                });
                 notes.push(format!("{which} are not finite at some of the states where Lagrange's are (a function outside its domain, such as sqrt or asin, or an overflow)"));
             } else if let (Some(set), Some(which)) = (set, balances) {
                 notes.push(if singular {
@@ -998,7 +1004,13 @@ mod tests {
         let lagrange = Lagrange.derive(&mut m);
         let mut singular = lagrange.clone();
         singular.mass_matrix = vec![m.arena.int(0); 4];
-        let found = sample_states(&mut m, &lagrange, &[("x".to_string(), singular.clone())], 5, 1);
+        let found = sample_states(
+            &mut m,
+            &lagrange,
+            &[("x".to_string(), singular.clone())],
+            5,
+            1,
+        );
         assert!(
             found.max_rel[0].is_infinite() && found.states.compared == 5,
             "{found:?}"

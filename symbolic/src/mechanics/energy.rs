@@ -21,7 +21,10 @@
 //!
 //! Both routes give one scalar equation, so they determine the motion of a model with one
 //! coordinate and no constraints only; and both need the energy to be exchanged only with the
-//! loads: no explicit `t` in `T` or `V` (a driven support does work through its reaction).
+//! loads: no explicit `t` in `T` or `V` (a driven support does work through its reaction), and
+//! `T` a quadratic form in `q̇` (a driven motion can leave `T = ½ m (ṙ² + r² ω²)` with no `t`).
+//! The power route also needs every load to act at points (and torques on angles) that do not
+//! move with `t`: the power at a driven point is the driver's.
 //!
 //! # References
 //! - A. Ruina and R. Pratap, *Introduction to Statics and Dynamics*, §§ 7.1 and 10.3 (the
@@ -45,7 +48,8 @@ pub struct EnergyRate;
 pub struct PowerRoute;
 
 /// Why the energy routes do not apply to `model`, or `None` when they do: one coordinate, no
-/// constraints, and neither `T` nor `V` depending on `t` explicitly.
+/// constraints, neither `T` nor `V` depending on `t` explicitly, and `T` a quadratic form in
+/// `q̇`.
 pub fn energy_routes_skipped(model: &SymbolicModel) -> Option<&'static str> {
     let t = model.time_symbol();
     if model.num_dofs() != 1 {
@@ -61,9 +65,41 @@ pub fn energy_routes_skipped(model: &SymbolicModel) -> Option<&'static str> {
         Some(
             "energy and power routes skipped: T or V depends explicitly on t (a driven support works through its reaction force)",
         )
+    } else if !kinetic_is_quadratic_in_rate(model) {
+        Some(
+            "energy and power routes skipped: T is not a quadratic form in q̇ (a driven motion, such as a rod spun at a constant rate, gives T terms of degree 0 or 1 in q̇): then Ė is not q̇ times the equation of motion",
+        )
     } else {
         None
     }
+}
+
+/// Whether `T = a q̇² + b q̇ + c` of a one-coordinate model has `b = c = 0` (homogeneous of
+/// degree 2 in the rate, which `Ė = q̇ (m q̈ + ½ m′ q̇² + V′)` assumes), measured at a few
+/// configurations and times with the parameters at their defaults: `c = T(q̇ = 0)` and
+/// `2b = T(q̇ = 1) − T(q̇ = −1)`, each to 1e-12 relative to `|a| + 1`. A driven motion that
+/// leaves no explicit `t` in `T` (a bead on a rod spun at a constant rate, `T = ½ m (ṙ² +
+/// r² ω²)`) has `c ≠ 0`.
+fn kinetic_is_quadratic_in_rate(model: &SymbolicModel) -> bool {
+    let mut bindings = vec![0.0; model.arena.symbols().len()];
+    for p in &model.parameters {
+        bindings[p.symbol.index()] = p.default;
+    }
+    let [q, rate, _] = model.coordinate_symbols(0);
+    let mut evaluator = crate::expr::eval::Evaluator::new(&model.arena, &[model.kinetic]);
+    [(0.3, 0.0), (-1.1, 0.7), (2.0, 1.9)].iter().all(|&(qv, tv)| {
+        bindings[q.index()] = qv;
+        bindings[model.time_symbol().index()] = tv;
+        let mut at = |v: f64| {
+            bindings[rate.index()] = v;
+            evaluator.eval(&bindings)[0]
+        };
+        let (c, plus, minus) = (at(0.0), at(1.0), at(-1.0));
+        let a = (plus + minus) / 2.0 - c;
+        let b = (plus - minus) / 2.0;
+        let scale = 1e-12 * (a.abs() + 1.0);
+        c.abs() <= scale && b.abs() <= scale
+    })
 }
 
 impl EnergyRate {
@@ -78,8 +114,32 @@ impl PowerRoute {
     /// (bodies, no written `kinetic:`), where the power of the forces is not the rate of a
     /// written potential — for an energy-form model it would repeat [`EnergyRate`].
     pub fn applies_to(model: &SymbolicModel) -> bool {
-        EnergyRate::applies_to(model) && !model.kinetic_written && !model.bodies.is_empty()
+        EnergyRate::applies_to(model)
+            && !model.kinetic_written
+            && !model.bodies.is_empty()
+            && !loads_at_driven_points(model)
     }
+}
+
+/// Whether a spring, damper or force acts at a point whose position depends explicitly on
+/// `t` (a driven support), or a torque on a body whose angle does: the power of the load there is supplied by the driver, not drawn
+/// from the kinetic energy, so `P = dT/dt` with every load's `F·v` does not hold.
+fn loads_at_driven_points(model: &SymbolicModel) -> bool {
+    let t = model.time_symbol();
+    let driven = |p: usize| {
+        model.points[p]
+            .1
+            .iter()
+            .any(|c| model.arena.depends_on(*c, t))
+    };
+    model.loads.iter().any(|load| match load {
+        LoadInfo::Force { point, .. } => driven(*point),
+        LoadInfo::Spring { between, .. } | LoadInfo::Damper { between, .. } => {
+            between.iter().any(|p| driven(*p))
+        }
+        LoadInfo::Torque { angle, .. } => model.arena.depends_on(*angle, t),
+        LoadInfo::SpatialTorque { .. } => false,
+    })
 }
 
 impl Formulation for EnergyRate {

@@ -376,7 +376,14 @@ pub fn rayleigh_study(
     let mass_form = |v: &DVector<f64>| v.dot(&(m * v));
     let quotient = |v: &DVector<f64>| v.dot(&(&k_sym * v)) / mass_form(v);
 
-    let v = DVector::from_column_slice(&options.shape);
+    // The quotient does not depend on the shape's scale: it is taken of `v / max|vᵢ|`, so a
+    // shape of 1e300 or 1e-300 neither overflows nor underflows the forms (the forms and the
+    // projected shape are scaled back for the report).
+    let scale = options.shape.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+    if scale == 0.0 {
+        return Err(RayleighError::ZeroShape);
+    }
+    let v = DVector::from_column_slice(&options.shape) / scale;
     let full = mass_form(&v);
     if full.is_nan() || full <= 0.0 {
         return Err(RayleighError::ZeroShape);
@@ -431,11 +438,11 @@ pub fn rayleigh_study(
     );
     Ok(RayleighStudy {
         shape: options.shape.clone(),
-        projected_shape: projected.iter().copied().collect(),
+        projected_shape: projected.iter().map(|x| x * scale).collect(),
         zero_modes_removed: zero.len(),
         zero_mode_fraction,
-        stiffness_form,
-        mass_form: mass,
+        stiffness_form: stiffness_form * scale * scale,
+        mass_form: mass * scale * scale,
         rayleigh_quotient,
         frequency_estimate,
         lowest_mode: lowest + 1,

@@ -28,6 +28,10 @@ const DAMPER: Fields = Fields {
     example: "{ between: [A, B], coefficient: c }",
 };
 
+/// The names of the other derivations that `eomgen check` lists beside a named set of
+/// balances, which a set may not take.
+const RESERVED_SET_NAMES: [&str; 5] = ["lagrange", "momentum", "by_hand", "energy", "power"];
+
 /// The keys of an interaction.
 const INTERACTION: Fields = Fields {
     kind: "interaction",
@@ -866,6 +870,22 @@ impl Ctx<'_> {
         };
         let mut out = Vec::new();
         for (name, value) in sets {
+            // A set's name labels its derivation beside the others in `eomgen check`.
+            if RESERVED_SET_NAMES.contains(&name.value.as_str()) {
+                self.error(
+                    Diagnostic::new(
+                        name.location,
+                        format!(
+                            "`{}` names another derivation of the equations of motion; a set of balances needs its own name",
+                            name.value
+                        ),
+                    )
+                    .with_help(format!(
+                        "`{}` are the other derivations' names; call the set after its form, such as `r_x_ma` or `about_E`",
+                        RESERVED_SET_NAMES.join("`, `")
+                    )),
+                );
+            }
             // `NAME: [...]`, or `NAME: { expect: disagree, balances: [...] }`.
             let (list, expect_disagreement) = match &value.kind {
                 YamlKind::Map(entries) => {
@@ -906,6 +926,15 @@ impl Ctx<'_> {
                 _ => (value, false),
             };
             let mut set = self.balance_list(list, Some(name.clone()));
+            if matches!(&list.kind, YamlKind::Seq(items) if items.is_empty()) {
+                self.error(
+                    Diagnostic::new(
+                        name.location,
+                        format!("the set of balances `{}` is empty", name.value),
+                    )
+                    .with_help("a set gives one balance per coordinate; remove the set or list its balances"),
+                );
+            }
             for b in &mut set {
                 b.expect_disagreement = expect_disagreement;
             }
