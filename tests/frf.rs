@@ -692,3 +692,46 @@ fn a_gyroscopic_model_gets_its_own_modes_and_range() {
         "{text}"
     );
 }
+
+/// `--frequency-parameter` also says where a parameter input's rate column is read, with or
+/// without `--simulate`: without it, an unknown name or the input itself is a usage error
+/// (exit 2) as with it, not ignored; and a parameter that does not time the base motion
+/// (`m`) reads no rate column, so the JSON's `B₁` is 0 where the default `w` gives `c`.
+#[test]
+fn frequency_parameter_is_used_without_simulate() {
+    for (parameter, needle) in [
+        ("nope", "has no such parameter"),
+        ("Y", "must differ from --input"),
+    ] {
+        let out = eomgen(&[
+            "frf",
+            "base_excited_oscillator",
+            "--input",
+            "Y",
+            "--frequency-parameter",
+            parameter,
+        ]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{parameter}: {err}");
+        assert!(err.contains(needle), "{parameter}: {err}");
+    }
+    let rate = |parameter: &str| -> f64 {
+        let out = eomgen_ok(&[
+            "frf",
+            "base_excited_oscillator",
+            "--input",
+            "Y",
+            "--frequency-parameter",
+            parameter,
+            "--json",
+        ]);
+        let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        // One input: the column, one entry per coordinate.
+        json["input_rate_matrix"][0]
+            .as_f64()
+            .unwrap_or_else(|| panic!("no input_rate_matrix in {json}"))
+    };
+    // c = 0.4 in the file: the dashpot's B₁.
+    assert!((rate("w") - 0.4).abs() < 1e-12);
+    assert_eq!(rate("m"), 0.0);
+}

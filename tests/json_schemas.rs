@@ -265,6 +265,10 @@ fn json_output_keeps_its_schema() {
             vec!["study", "launch", "projectile_drag", "--speeds", "1", "--json"],
         ),
         (
+            "periodic_orbit",
+            vec!["study", "periodic-orbit", "simple_pendulum", "--json"],
+        ),
+        (
             "rolling_contact",
             vec!["study", "rolling-contact", "eccentric_cylinder", "--json"],
         ),

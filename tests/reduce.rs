@@ -552,3 +552,30 @@ fn the_writer_round_trips_the_bundled_models() {
     }
     assert!(written >= 20, "only {written} models written");
 }
+
+/// A dependent coordinate started as `{ guess: … }` is only near the constraint (the run
+/// projects it onto it): the branch is the root nearest the guess, here the hanging
+/// `y = −√(ℓ² − x²)` for a guess of −0.7 at x = 0.6 (root −0.8; the other, +0.8, is 1.5 away),
+/// and the upright one for a guess of +0.7, each checked on the reduced file's start.
+#[test]
+fn a_guessed_start_chooses_the_nearest_branch() {
+    let text = |guess: f64| {
+        format!(
+            "name: guessed\nparameters: {{ m: 1.0, l: 1.0, g: 10.0 }}\ncoordinates: [x, y]\npoints:\n  O: [0, 0]\n  P: [x, y]\nbodies:\n  bob: {{ mass: m, at: P }}\ngravity: [0, -g]\nconstraints:\n  rod: sqrt(x^2 + y^2) - l\ninitial: {{ x: 0.6, y: {{ guess: {guess} }} }}\n"
+        )
+    };
+    for (guess, branch, solution) in [
+        (-0.7, Branch::Minus, "-sqrt(l^2 - x^2)"),
+        (0.7, Branch::Plus, "sqrt(l^2 - x^2)"),
+    ] {
+        let reduced = reduce(
+            &file("guessed.yaml", &text(guess)),
+            &["x"],
+            &ReduceOptions::default(),
+        )
+        .unwrap_or_else(|e| panic!("{guess}: {e}"));
+        let e = &reduced.eliminations[0];
+        assert_eq!(e.branch, Some((branch, BranchReason::InitialState)), "{guess}");
+        assert_eq!(e.solution, solution);
+    }
+}

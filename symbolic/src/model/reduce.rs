@@ -10,8 +10,9 @@
 //! - a constraint **linear** in the coordinate, `c₁ y + c₀ = 0`, gives `y = −c₀/c₁`;
 //! - a **quadratic** one, `a y² + b y + c = 0`, gives `y = (−b ± √(b² − 4ac))/(2a)`
 //!   (`y = ±√(−c/a)` when `b = 0`); the sign — the branch — is the option's, else the one the
-//!   file's initial state lies on, else (where the initial state is where the two branches
-//!   meet) the one the first deciding entry of `equilibria:` lies on;
+//!   file's initial state lies on (for a start given as `{ guess: … }`, the root nearest the
+//!   guess), else (where the initial state is where the two branches meet) the one the first
+//!   deciding entry of `equilibria:` lies on;
 //! - a constraint `k √P + R = 0` with `P` polynomial in the coordinate is squared first,
 //!   `k² P − R² = 0` (the rod `√(x² + y²) − ℓ = 0` gives `x² + y² − ℓ² = 0`), and a root is
 //!   taken only where the constraint as written holds.
@@ -932,6 +933,34 @@ impl<'f> Reducer<'f> {
         let mut start = self.bindings(&self.file.initial);
         if let Some(b) = decide(self, &mut start) {
             return Ok((b, BranchReason::InitialState));
+        }
+        // A start given as `{ guess: … }` is only near the constraint: the root nearest it
+        // among those on the constraint as written (the one the start's projection finds).
+        if self
+            .file
+            .initial_guesses
+            .iter()
+            .any(|g| g.value == coordinate)
+        {
+            let guess = start[d.index()];
+            let mut near: Vec<(f64, Branch)> = Vec::new();
+            for (root, branch) in roots.iter().zip([Branch::Plus, Branch::Minus]) {
+                let r = self.arena.eval(*root, &start);
+                start[d.index()] = r;
+                let residual = self.arena.eval(phi, &start);
+                start[d.index()] = guess;
+                if r.is_finite() && residual.abs() <= BRANCH_TOL * r.abs().max(1.0) {
+                    near.push(((r - guess).abs(), branch));
+                }
+            }
+            near.sort_by(|a, b| a.0.total_cmp(&b.0));
+            match near.as_slice() {
+                [(_, b)] => return Ok((*b, BranchReason::InitialState)),
+                [(da, b), (db, _)] if db - da > BRANCH_TOL * (da + db).max(1.0) => {
+                    return Ok((*b, BranchReason::InitialState));
+                }
+                _ => {}
+            }
         }
         for eq in &self.file.equilibria {
             let mut at = self.bindings(&eq.values);
