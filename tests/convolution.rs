@@ -471,7 +471,11 @@ fn too_few_intervals_are_refused_not_estimated_as_exact() {
         );
     }
     let four = study(osc.as_mut(), "A", Forcing::Step, 20.0, 4).unwrap();
-    assert!(four.quadrature.error_estimate > 0.0, "{:?}", four.quadrature);
+    assert!(
+        four.quadrature.error_estimate > 0.0,
+        "{:?}",
+        four.quadrature
+    );
     let out = eomgen(&[
         "study",
         "convolution",

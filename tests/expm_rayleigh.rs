@@ -481,3 +481,51 @@ fn rayleigh_quotient_is_independent_of_the_shape_scale() {
         "1e300,1e300,1e300",
     ]);
 }
+
+/// With a repeated lowest frequency (the ring of eight springs: `cos(2πi/n)` and
+/// `sin(2πi/n)` share `ω₁`), any shape in that eigenspace is a lowest mode: its `tan θ` is 0
+/// to rounding (not 1, its angle to the one `ψ₁` the solver returned), and a shape `0.01`
+/// off it along a higher mode has `tan θ = 0.01` with `R − ω₁² = tan²θ (R(w) − ω₁²)/(1 +
+/// tan²θ)` (1e-9 relative: rounding of the forms).
+#[test]
+fn rayleigh_shape_error_is_measured_from_a_repeated_lowest_eigenspace() {
+    let ring = model("spring_ring");
+    let n = ring.num_dofs();
+    let tau = std::f64::consts::TAU;
+    let shape = |f: &dyn Fn(f64) -> f64| -> Vec<f64> { (1..=n).map(|i| f(i as f64)).collect() };
+    let exact = rayleigh_study(
+        ring.as_ref(),
+        &RayleighOptions::new(shape(&|i| (tau * i / n as f64).cos())),
+    )
+    .unwrap();
+    let w = exact.natural_frequency;
+    let repeated = exact
+        .normal_modes
+        .natural_frequencies
+        .iter()
+        .filter(|x| (*x - w).abs() < 1e-9 * w)
+        .count();
+    assert_eq!(repeated, 2, "{:?}", exact.normal_modes.natural_frequencies);
+    assert!(
+        exact.shape_error.unwrap() < 1e-12,
+        "{:?}",
+        exact.shape_error
+    );
+    let off = rayleigh_study(
+        ring.as_ref(),
+        &RayleighOptions::new(shape(&|i| {
+            (tau * i / n as f64).sin() + 0.01 * (2.0 * tau * i / n as f64).cos()
+        })),
+    )
+    .unwrap();
+    let tan = off.shape_error.unwrap();
+    // The part along cos(4πi/n) over the part along sin(2πi/n): equal norms, so 0.01.
+    assert!((tan - 0.01).abs() < 1e-12, "tan θ = {tan}");
+    let rw = off.stationarity.as_ref().unwrap().direction_quotient;
+    let predicted = tan * tan * (rw - w * w) / (1.0 + tan * tan);
+    assert!(
+        (off.excess - predicted).abs() < 1e-9 * predicted,
+        "{} vs {predicted}",
+        off.excess
+    );
+}

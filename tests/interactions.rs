@@ -343,6 +343,12 @@ fn mistakes_are_located() {
             "initial: { x2: norm(P1) }\n",
             "10:16: the initial value of `x2` uses the vector functions of points",
         ),
+        // The user's balances take no forces at points yet: an interaction would be left
+        // out of them unseen (and `check` would blame the balances).
+        (
+            "interactions:\n  g: { between: [P1, P2], magnitude: -G/r^2 }\nbalances:\n  - { lmb: { bodies: [a, b], along: [1, 0] } }\n  - { lmb: { bodies: [a, b], along: [0, 1] } }\n  - { lmb: { bodies: [a], along: [1, 0] } }\n  - { lmb: { bodies: [a], along: [0, 1] } }\ninitial: { x2: 1 }\n",
+            "11:3: an interaction in a model with `balances` is not supported yet",
+        ),
     ];
     let mut wrong = Vec::new();
     for (tail, expected) in cases {

@@ -575,7 +575,11 @@ fn a_guessed_start_chooses_the_nearest_branch() {
         )
         .unwrap_or_else(|e| panic!("{guess}: {e}"));
         let e = &reduced.eliminations[0];
-        assert_eq!(e.branch, Some((branch, BranchReason::InitialState)), "{guess}");
+        assert_eq!(
+            e.branch,
+            Some((branch, BranchReason::InitialState)),
+            "{guess}"
+        );
         assert_eq!(e.solution, solution);
     }
 }

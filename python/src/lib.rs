@@ -8,6 +8,7 @@
 mod animate;
 mod batch;
 mod convert;
+mod course;
 mod errors;
 mod model;
 mod studies;
@@ -25,6 +26,7 @@ fn _eomgen(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(methods, m)?)?;
     m.add_function(wrap_pyfunction!(simulation_defaults, m)?)?;
     studies::register(m)?;
+    course::register(m)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

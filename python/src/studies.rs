@@ -295,7 +295,8 @@ fn study_modal_damping<'py>(
 
 /// Constraint methods compared on a model with holonomic constraints (`eomgen study
 /// constraint-methods`): a stiff spring (method I), the KKT system with and without drift
-/// control, and the file's minimal-coordinate twin, against a reference.
+/// control, the constraints eliminated symbolically (method II.2, where they can be) and the
+/// file's minimal-coordinate twin, against a reference.
 #[pyfunction]
 #[pyo3(signature = (model, t_end = None, tol = None, stiffness = None))]
 fn study_constraint_methods<'py>(
@@ -305,7 +306,7 @@ fn study_constraint_methods<'py>(
     tol: Option<f64>,
     stiffness: Option<Vec<f64>>,
 ) -> PyResult<Bound<'py, PyAny>> {
-    use eomgen::analysis::{ConstraintMethodsOptions, constraint_methods};
+    use eomgen::analysis::{ConstraintMethodsOptions, constraint_methods_with_reduced};
     let defaults = ConstraintMethodsOptions::default();
     let options = ConstraintMethodsOptions {
         t_end: t_end.unwrap_or(defaults.t_end),
@@ -324,11 +325,19 @@ fn study_constraint_methods<'py>(
     };
     let study = py.detach(move || {
         let twin = eomgen::studies::minimal_twin(&loaded.source).map_err(|e| e.to_string())?;
+        // Method II.2 where the constraints can be eliminated symbolically (as the command
+        // line: a model whose constraints cannot be has no such row).
+        let reduced = eomgen::reduction::reduced_twin(&loaded.source).ok();
+        let label = reduced.as_ref().map(eomgen::reduction::ReducedTwin::label);
         let mut make = || with_values(loaded.source.instantiate());
+        let reduced_model = reduced
+            .as_ref()
+            .zip(label.as_deref())
+            .map(|(r, label)| (label, with_values(r.instantiate())));
         let twin_model = twin
             .as_ref()
             .map(|(name, twin)| (name.as_str(), with_values(twin.instantiate())));
-        constraint_methods(&mut make, twin_model, &options)
+        constraint_methods_with_reduced(&mut make, reduced_model, twin_model, &options)
             .map(|study| (study, options))
             .map_err(|e| e.to_string())
     });

@@ -310,3 +310,29 @@ checks:
     );
     assert!(report.passed(CHECK_TOLERANCE), "{:?}", report.notes);
 }
+
+/// A set stated to disagree whose equations are not finite (an `lmb` direction outside the
+/// domain of `sqrt`) fails, and the note says so rather than that it agrees.
+#[test]
+fn a_set_stated_to_disagree_must_be_finite() {
+    let text = with_balances(
+        "  tried:\n    expect: disagree\n    balances:\n      - { amb: { about: O, bodies: [elbow, hand] } }\n      - { lmb: { bodies: [hand], along: [sqrt(-1 - a^2), 0] } }\n",
+    );
+    let report = check(&text);
+    assert!(residual(&report, "tried").is_nan());
+    assert!(!report.passed(CHECK_TOLERANCE));
+    assert!(
+        report
+            .notes
+            .iter()
+            .any(|n| n.contains("the balances `tried` are not finite")),
+        "{:?}",
+        report.notes
+    );
+    assert!(
+        !report
+            .notes
+            .iter()
+            .any(|n| n.contains("agree with Lagrange, but"))
+    );
+}

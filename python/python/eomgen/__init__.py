@@ -21,10 +21,13 @@ from ._model import (
     Equations,
     Model,
     Modes,
+    Reduction,
     Solution,
     SteadyMotion,
     bundled_models,
+    expm_study,
     load,
+    reduce,
 )
 from .errors import AnalysisError, EomgenError, IntegrationError, ModelError, ParameterError
 
@@ -40,10 +43,13 @@ __all__ = [
     "ModelError",
     "Modes",
     "ParameterError",
+    "Reduction",
     "Solution",
     "SteadyMotion",
     "__version__",
     "bundled_models",
+    "expm_study",
     "load",
+    "reduce",
     "sweep",
 ]

@@ -7,7 +7,7 @@ arguments, documents shapes and units, and wraps the reports in small result obj
 from __future__ import annotations
 
 import math
-from typing import Dict, Iterable, List, Mapping, Optional, Sequence, Tuple, Union
+from typing import Callable, Dict, Iterable, List, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
@@ -46,6 +46,110 @@ def load(name_or_path: str) -> "Model":
 def bundled_models() -> List[str]:
     """The names of the bundled models (``eomgen list``)."""
     return list(_eomgen.bundled_models())
+
+
+def expm_study(n: int = 10, seed: int = 32, t: float = 5.0, samples: int = 21, tol: float = 1e-13,
+               matrix: Optional[ArrayLike] = None, z0: Optional[ArrayLike] = None,
+               times: Optional[ArrayLike] = None) -> dict:
+    """``ż = A z`` solved three ways — ``e^{At} z₀``, the superposition of the complex
+    eigenvector solutions and DOP853 at ``tol`` — with the eigenvalues, the condition number
+    of the eigenvector matrix and the largest differences between the routes against their
+    bounds (``eomgen study expm``; HW32, lectures 30–33). ``A`` is random ``n × n`` with
+    entries N(0, 1)/√n (SplitMix64 from ``seed``, the same numbers on every platform), or
+    ``matrix`` (``(n, n)``); ``z₀`` the seed's unit vector, or ``z0``; times ``samples``
+    evenly spaced on ``[0, t]`` (s), or ``times``. Returns the ``--json`` report with numeric
+    lists as numpy arrays; ``differences``' ``passed`` flags say whether the routes agreed
+    (the command line exits 1 otherwise).
+
+    Raises:
+        AnalysisError: a size out of 1 … 400, a matrix that is not square or not finite, a
+            bad tolerance, end time or times, a zero solution.
+        ValueError: a matrix that is not square (``z0`` or ``times`` given).
+    """
+    rows = None if matrix is None else [[float(v) for v in row] for row in np.atleast_2d(np.asarray(matrix, dtype=float))]
+    return _eomgen.study_expm(int(n), int(seed), float(t), int(samples), float(tol), rows,
+                              _floats(z0), _floats(times))
+
+
+def reduce(model: Union[str, "Model"], keep: Union[str, Sequence[str]],
+           branches: Optional[Mapping[str, str]] = None, initial: Optional[Mapping[str, Union[str, float]]] = None,
+           name: Optional[str] = None) -> "Reduction":
+    """A model with its holonomic constraints solved for the dependent coordinates and
+    substituted, written as a model file in minimal coordinates (``eomgen reduce``; method
+    II.2 of lectures 8–10, HW13).
+
+    Args:
+        model: a :class:`Model`, a bundled model's name, the path of a model file, or a model
+            file's text (YAML, with a newline).
+        keep: the coordinates to keep (one name or several); the others are eliminated, one
+            per holonomic constraint.
+        branches: the branch of a quadratic solution by eliminated coordinate
+            (``{"y": "-"}``; default the one the initial state lies on).
+        initial: new initial values of kept coordinates or rates (``{"x": "l/2"}``, numbers
+            or expressions of the parameters).
+        name: the reduced model's name (default ``<name>_in_<kept coordinates>``).
+
+    Returns:
+        a :class:`Reduction`: the reduced file's ``text``, the ``summary`` as
+        ``eomgen reduce --json`` prints it, and :meth:`Reduction.load`.
+
+    Raises:
+        ModelError: a model that cannot be opened, or a text with mistakes.
+        ValueError: an unknown coordinate to keep, the wrong number of them, an unused
+            branch, a bad initial value.
+        AnalysisError: a model that cannot be reduced (no holonomic constraints, a constraint
+            that cannot be solved, a start where the reduction is singular).
+    """
+    if isinstance(model, Model):
+        path, text = model.path, model.text
+    elif isinstance(model, str) and "\n" in model:
+        path, text = "<text>", model
+    else:
+        opened = load(model)
+        path, text = opened.path, opened.text
+    keep = [keep] if isinstance(keep, str) else [str(k) for k in keep]
+    summary = _eomgen.reduce_model(
+        path, text, keep, [(str(k), str(v)) for k, v in (branches or {}).items()],
+        [(str(k), str(v)) for k, v in (initial or {}).items()], name)
+    return Reduction(summary)
+
+
+class Reduction:
+    """A model file in minimal coordinates from :func:`reduce`.
+
+    Attributes:
+        text: the reduced model file's YAML text.
+        kept: the coordinates kept.
+        eliminations: one dict per eliminated coordinate (its solution, rate, constraint,
+            degree and branch).
+        notes: what of the original file was left out or changed.
+        summary: the report as ``eomgen reduce --json`` prints it.
+    """
+
+    def __init__(self, summary: dict):
+        self.summary = summary
+        self.text = summary["text"]
+        self.kept = list(summary["kept"])
+        self.eliminations = summary["eliminations"]
+        self.notes = summary["notes"]
+
+    def load(self) -> "Model":
+        """The reduced model, compiled (as :func:`eomgen.load` on its file)."""
+        import re
+
+        found = re.search(r"^name:\s*(\S+)", self.text, re.MULTILINE)
+        return _restore(f"{found.group(1) if found else 'reduced'}.yaml", self.text, [])
+
+    def save(self, path: str) -> None:
+        """Writes the reduced model file to ``path`` (UTF-8)."""
+        with open(path, "w", encoding="utf-8") as f:
+            f.write(self.text)
+
+    def __str__(self) -> str:
+        return self.text
+
+    def __repr__(self) -> str:
+        return f"eomgen.Reduction(keeping {', '.join(self.kept)}; {len(self.text)} characters)"
 
 
 def _restore(argument: str, text: str, overrides: List[Tuple[str, float]]) -> "Model":
@@ -562,6 +666,167 @@ class Model:
         """
         return _eomgen.study_constraint_methods(self._core, t_end, tol,
                                                 None if stiffness is None else [float(k) for k in stiffness])
+
+    def rayleigh(self, shape: Union[str, ArrayLike], at: Optional[Union[str, ArrayLike]] = None,
+                 perturbations: Optional[ArrayLike] = None) -> dict:
+        """The Rayleigh quotient ``R(v) = vᵀKv / vᵀMv`` of a trial shape ``v`` at an
+        equilibrium (``eomgen study rayleigh``; lectures 35–37): ``√R`` against the exact
+        lowest natural frequency ``ω₁`` (rad/s), the bound ``R ≥ ω₁²`` (``bound_holds``), the
+        modal participation and the stationarity of ``R`` at ``ψ₁ + ε w`` for each
+        ``perturbations`` ``ε`` (default 1e-1 … 1e-3). ``shape``: one number per coordinate
+        (``n``, any scale), or the command line's text — entries comma separated
+        (``"1,sqrt(2),1"``) or one expression of the 1-based index ``i`` and ``n``
+        (``"sin(pi*i/(n+1))"``), with the parameters. Returns the ``--json`` report with
+        numeric lists as numpy arrays.
+
+        Raises:
+            AnalysisError: no equilibrium, a shape of the wrong length, zero or not finite,
+                a constrained or unstable model.
+            ValueError: a shape text that does not parse or names something unknown.
+        """
+        if not isinstance(shape, str):
+            shape = _floats(shape)
+        return _eomgen.study_rayleigh(self._core, shape, _at(at), _floats(perturbations))
+
+    def convolution(self, input: str, forcing: Union[str, Callable[[float], float]],
+                    at: Optional[Union[str, ArrayLike]] = None, t_end: Optional[float] = None,
+                    intervals: Optional[int] = None, rtol: Optional[float] = None,
+                    label: Optional[str] = None) -> dict:
+        """The response of the model linearised at an equilibrium to a forcing ``f(t)``
+        through one ``input`` (a load parameter such as ``A`` in ``A*cos(w*t)``, or a
+        coordinate's name for a unit generalized force on it), by Duhamel's integral over the
+        impulse response, against DOP853 on the same linear equations at ``rtol`` (default
+        1e-12) and, for one degree of freedom, the closed form (``eomgen study convolution``;
+        lecture 21). ``forcing``: ``"impulse"`` (the response is ``h``), ``"step"``, an
+        expression of ``t`` (s) and the parameters (``"sin(2*t)"``, ``"step(t - 1)"``), or a
+        Python function of ``t`` (called with the interpreter held; ``label`` names it in the
+        report, default its ``__name__``). On ``intervals`` (default 2000) grid intervals of
+        ``[0, t_end]`` (default: ten periods of the lowest natural frequency). Returns the
+        ``--json`` report with numeric lists as numpy arrays (``times`` (k,), ``convolution``
+        and ``direct`` (k, n)).
+
+        Raises:
+            AnalysisError: an unknown input or one that is not a load, no equilibrium,
+                options out of range, a forcing that is not finite.
+            ValueError: a forcing text that does not parse or names something unknown.
+            Exception: the first exception a forcing function raised.
+        """
+        if not isinstance(forcing, str) and not callable(forcing):
+            raise TypeError("forcing must be `impulse`, `step`, an expression of t, or a function of t")
+        return _eomgen.study_convolution(self._core, str(input), forcing, _at(at),
+                                         None if t_end is None else float(t_end),
+                                         None if intervals is None else int(intervals),
+                                         None if rtol is None else float(rtol), label)
+
+    def launch(self, speeds: Optional[ArrayLike] = None, angle_parameter: Optional[str] = None,
+               speed_parameter: Optional[str] = None, event: Optional[str] = None,
+               range_coordinate: Optional[str] = None, height_coordinate: Optional[str] = None,
+               angles: Optional[int] = None, angle_tol: Optional[float] = None, rtol: Optional[float] = None,
+               t_max: Optional[float] = None, path_samples: Optional[int] = None,
+               shape_angle: Optional[Union[float, str]] = math.pi / 4) -> dict:
+        """For each launch speed (m/s; default the model's value of ``speed_parameter``,
+        ``v0``), the range against the launch angle ``angle_parameter`` (default ``theta0``)
+        on ``angles`` (default 89) angles inside (0°, 90°), the best angle ``θ*`` by
+        golden-section search to ``angle_tol`` (default 1e-7 rad), the best path's apex and
+        landing angle, and the path at ``shape_angle`` (rad, a number or an expression such
+        as ``"pi/3"``; default π/4, ``None`` for none) (``eomgen study launch``; lecture 2,
+        HW2). Flights end at the model event ``event`` (default ``ground``), integrated by
+        DOP853 at ``rtol`` (default 1e-12) for at most ``t_max`` s. Returns the ``--json``
+        report with numeric lists as numpy arrays.
+
+        Raises:
+            ParameterError: no angle or speed parameter of that name.
+            AnalysisError: an unknown event or coordinate, a speed that is not positive, a
+                flight that does not land.
+        """
+        if isinstance(shape_angle, (int, float)):
+            shape_angle = float(shape_angle)
+        return _eomgen.study_launch(
+            self._core, [] if speeds is None else _floats(speeds), angle_parameter, speed_parameter, event,
+            range_coordinate, height_coordinate, None if angles is None else int(angles),
+            angle_tol, rtol, t_max, None if path_samples is None else int(path_samples), shape_angle)
+
+    def periodic_orbit(self, guess: Optional[Union[Mapping[str, float], ArrayLike]] = None,
+                       period: Optional[Union[float, str]] = None, fix_period: bool = False,
+                       energy: Optional[Union[float, str]] = None, tol: Optional[float] = None,
+                       max_iterations: Optional[int] = None, integration_tol: Optional[float] = None,
+                       samples: Optional[int] = None,
+                       unit_multiplier_tolerance: Optional[float] = None) -> dict:
+        """A periodic orbit found by shooting (``eomgen study periodic-orbit``; HW5, HW7,
+        HW39): Gauss–Newton on the flow map and its monodromy matrix with a phase condition
+        and, with the period free in a conservative model, the energy fixed. Returns its
+        period, initial state, residual, Newton iterations and Floquet multipliers, the
+        ``--json`` report with numeric lists as numpy arrays.
+
+        Args:
+            guess: Newton's start: the model's initial state with these coordinates and rates
+                changed (``{"x1": -0.971, "x3_dot": 0.933}``, see :meth:`initial_state`), or a
+                whole state ``[q; q̇]``; default the initial state.
+            period: the period (s) — the guess, or the period itself with ``fix_period`` — a
+                number or an expression of the parameters; default the model file's
+                ``checks:`` (``period:``, else the time of ``final_state:``).
+            fix_period: keep the period fixed and solve for the start only.
+            energy: the energy ``T + V`` (J) of the orbit sought with the period free: a
+                number, an expression, or ``"start"`` for the guess's; default the energy of
+                the model's initial state, so that ``guess`` moves Newton's start, not the
+                orbit sought.
+            tol: Newton's tolerance ``‖φ_T(y₀) − y₀‖ ≤ tol (1 + ‖y₀‖)`` (default 1e-10).
+            max_iterations: most Newton iterations (default 30).
+            integration_tol: DOP853's tolerance (default 1e-12).
+            samples: samples of the orbit over one period (default 400).
+            unit_multiplier_tolerance: ``|μ − 1|`` below which a multiplier is trivial
+                (default 1e-3).
+
+        Raises:
+            AnalysisError: Newton did not converge, a constrained model, a time-dependent
+                model with the period free, options out of range.
+            ValueError: no period given or in the file, a bad guess or expression.
+        """
+        start = None if guess is None else self.initial_state(guess).tolist()
+        return _eomgen.study_periodic_orbit(
+            self._core, start, period, bool(fix_period), energy, tol,
+            None if max_iterations is None else int(max_iterations), integration_tol,
+            None if samples is None else int(samples), unit_multiplier_tolerance)
+
+    def rolling_contact(self, after_lift_off: bool = False, flight: Optional[Union[str, "Model"]] = None,
+                        mu: Optional[ArrayLike] = None, ground: Optional[str] = None,
+                        normal: Optional[str] = None, angle: Optional[str] = None,
+                        lift_off: Optional[str] = None, landing: Optional[str] = None,
+                        samples: Optional[int] = None, t_end: Optional[float] = None,
+                        rtol: Optional[float] = None) -> dict:
+        """The friction coefficient ``μ(t) = |F_t|/N`` a body rolling on the ground needs, from
+        its constraint forces up to the lift-off (event ``lift_off``), checked against
+        Newton–Euler, with the first time ``μ(t)`` exceeds each of ``mu`` (default 0.2, 0.5,
+        1) (``eomgen study rolling-contact``; HW36). With ``after_lift_off``, the free flight
+        that follows, on the ``flight`` model (a :class:`Model` or a name; default this
+        model's name with ``_flight``, with this model's parameter values where it has them),
+        to its event ``landing``, checked against its closed forms. ``ground``, ``normal``,
+        ``angle``: the coordinates (default ``x``, ``y``, ``theta``); ``samples`` per phase
+        (default 2001), ``t_end`` the longest phase (s, default 10), DOP853 at ``rtol``
+        (default 1e-12). Returns the ``--json`` report with numeric lists as numpy arrays;
+        its checks' ``passed`` flags say whether they held (the command line exits 1
+        otherwise).
+
+        Raises:
+            AnalysisError: an unknown coordinate or event, a model without constraints,
+                options out of range, a failed integration.
+            ModelError: no flight model of that name.
+        """
+        flight_core = None
+        if after_lift_off:
+            if not isinstance(flight, Model):
+                # As `--flight NAME --set …`: this model's values where the flight has them.
+                flight = load(f"{self.name}_flight" if flight is None else flight)
+                own = flight.parameters
+                values = {k: v for k, v in self._core.overrides if k in own}
+                if values:
+                    flight = flight.with_parameters(values)
+            flight_core = flight._core
+        elif flight is not None:
+            raise ValueError("flight is used with after_lift_off=True only")
+        return _eomgen.study_rolling_contact(
+            self._core, flight_core, _floats(mu), ground, normal, angle, lift_off, landing,
+            None if samples is None else int(samples), t_end, rtol)
 
     # --- Python protocols --------------------------------------------------------------
 

@@ -562,6 +562,8 @@ pub fn check_model(
                     Some(why) => format!("{which} disagree with Lagrange, as the file states: {why}"),
                     None => format!("{which} disagree with Lagrange, as the file states"),
                 }
+            } else if c.max_rel_residual.is_nan() {
+                format!("{which} are not finite at some of the states where Lagrange's are (a function outside its domain, such as sqrt or asin, or an overflow): a set stated to disagree must still give finite equations")
             } else {
                 format!("{which} agree with Lagrange, but the file states that they disagree (`expect: disagree`): here the form holds, or the set is not the one meant")
             });

@@ -87,19 +87,21 @@ fn kinetic_is_quadratic_in_rate(model: &SymbolicModel) -> bool {
     }
     let [q, rate, _] = model.coordinate_symbols(0);
     let mut evaluator = crate::expr::eval::Evaluator::new(&model.arena, &[model.kinetic]);
-    [(0.3, 0.0), (-1.1, 0.7), (2.0, 1.9)].iter().all(|&(qv, tv)| {
-        bindings[q.index()] = qv;
-        bindings[model.time_symbol().index()] = tv;
-        let mut at = |v: f64| {
-            bindings[rate.index()] = v;
-            evaluator.eval(&bindings)[0]
-        };
-        let (c, plus, minus) = (at(0.0), at(1.0), at(-1.0));
-        let a = (plus + minus) / 2.0 - c;
-        let b = (plus - minus) / 2.0;
-        let scale = 1e-12 * (a.abs() + 1.0);
-        c.abs() <= scale && b.abs() <= scale
-    })
+    [(0.3, 0.0), (-1.1, 0.7), (2.0, 1.9)]
+        .iter()
+        .all(|&(qv, tv)| {
+            bindings[q.index()] = qv;
+            bindings[model.time_symbol().index()] = tv;
+            let mut at = |v: f64| {
+                bindings[rate.index()] = v;
+                evaluator.eval(&bindings)[0]
+            };
+            let (c, plus, minus) = (at(0.0), at(1.0), at(-1.0));
+            let a = (plus + minus) / 2.0 - c;
+            let b = (plus - minus) / 2.0;
+            let scale = 1e-12 * (a.abs() + 1.0);
+            c.abs() <= scale && b.abs() <= scale
+        })
 }
 
 impl EnergyRate {

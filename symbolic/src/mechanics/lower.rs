@@ -2177,6 +2177,25 @@ fn short(v: f64) -> String {
     }
 }
 
+/// The sets of the file's `balances:` with their ranges in the lowered list: each set's
+/// entries are consecutive (a set is one list under its name), and the plain list form is one
+/// set named `balances`.
+fn balance_sets(file: &ModelFile) -> Vec<BalanceSet> {
+    let mut sets: Vec<BalanceSet> = Vec::new();
+    for (i, b) in file.balances.iter().enumerate() {
+        let name = b.set_name().unwrap_or("balances");
+        match sets.last_mut() {
+            Some(last) if last.name == name => last.range.end = i + 1,
+            _ => sets.push(BalanceSet {
+                name: name.to_string(),
+                range: i..i + 1,
+                expect_disagreement: b.expect_disagreement,
+            }),
+        }
+    }
+    sets
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -2225,23 +2244,4 @@ mod tests {
         assert_eq!(s.ignorable, [2]);
         assert!(model.has_steady_motions());
     }
-}
-
-/// The sets of the file's `balances:` with their ranges in the lowered list: each set's
-/// entries are consecutive (a set is one list under its name), and the plain list form is one
-/// set named `balances`.
-fn balance_sets(file: &ModelFile) -> Vec<BalanceSet> {
-    let mut sets: Vec<BalanceSet> = Vec::new();
-    for (i, b) in file.balances.iter().enumerate() {
-        let name = b.set_name().unwrap_or("balances");
-        match sets.last_mut() {
-            Some(last) if last.name == name => last.range.end = i + 1,
-            _ => sets.push(BalanceSet {
-                name: name.to_string(),
-                range: i..i + 1,
-                expect_disagreement: b.expect_disagreement,
-            }),
-        }
-    }
-    sets
 }

@@ -1542,12 +1542,17 @@ impl<'f> Checker<'f> {
         let point_loads = file
             .forces
             .first()
-            .map(|f| (f.name.location, "force"))
-            .or_else(|| file.springs.first().map(|s| (s.name.location, "spring")))
-            .or_else(|| file.dampers.first().map(|d| (d.name.location, "damper")));
+            .map(|f| (f.name.location, "a force"))
+            .or_else(|| file.springs.first().map(|s| (s.name.location, "a spring")))
+            .or_else(|| file.dampers.first().map(|d| (d.name.location, "a damper")))
+            .or_else(|| {
+                file.interactions
+                    .first()
+                    .map(|i| (i.name.location, "an interaction"))
+            });
         if let Some((location, what)) = point_loads {
             self.error(
-                Diagnostic::new(location, format!("a {what} in a model with `balances` is not supported yet"))
+                Diagnostic::new(location, format!("{what} in a model with `balances` is not supported yet"))
                     .with_help("a balance needs to know which body each load acts on; for now balances take gravity and torques only"),
             );
         }

@@ -204,7 +204,9 @@ pub struct RayleighStudy {
     /// `R ≥ ω₁²` to rounding (`R − ω₁² ≥ −1e-12 max ω²`).
     pub bound_holds: bool,
     /// `tan θ = ‖v − (ψ₁ᵀMv) ψ₁‖_M / |ψ₁ᵀMv|`, the shape's error relative to its `ψ₁` part
-    /// (`None` when `v ⊥_M ψ₁`).
+    /// (`None` when `v ⊥_M ψ₁`); for a repeated `ω₁`, relative to its part in the whole
+    /// eigenspace of `ω₁` (`v − P₁v` against `P₁v`, `P₁` the `M`-orthogonal projection), so
+    /// that `R − ω₁² = tan²θ (R(w) − ω₁²)/(1 + tan²θ)` holds either way.
     pub shape_error: Option<f64>,
     /// `η_k² / Σ η²` of each mode, `η = ΨᵀM v`: how the quotient averages the `ω_k²`.
     pub modal_participation: Vec<f64>,
@@ -426,10 +428,22 @@ pub fn rayleigh_study(
     let eta_norm = eta.norm_squared();
     let modal_participation = eta.iter().map(|e| e * e / eta_norm).collect();
     let psi1 = psi.column(lowest).into_owned();
-    let a1 = psi1.dot(&(m * &projected));
-    let remainder = &projected - &psi1 * a1;
+    // The shape's part in the eigenspace of ω₁ (`ψ₁ (ψ₁ᵀMv)` when ω₁ is simple): with a
+    // repeated ω₁ (a ring's pair of modes) any vector of that space is a lowest mode, and the
+    // error is measured from the space, not from the one `ψ₁` the solver returned.
+    let mp = m * &projected;
+    let mut lowest_part = DVector::zeros(n);
+    for k in 0..n {
+        if modes.kinds[k] == ModeKind::Oscillatory
+            && (modes.eigenvalues[k] - w1).abs() <= SAME_FREQUENCY * w1.abs()
+        {
+            lowest_part += psi.column(k) * psi.column(k).dot(&mp);
+        }
+    }
+    let remainder = &projected - &lowest_part;
     let remainder_norm = mass_form(&remainder).max(0.0).sqrt();
-    let shape_error = (a1 != 0.0).then(|| remainder_norm / a1.abs());
+    let part_norm = mass_form(&lowest_part).max(0.0).sqrt();
+    let shape_error = (part_norm > 0.0).then(|| remainder_norm / part_norm);
     let stationarity = stationarity(
         (m, modes),
         (lowest, &remainder, projected.norm()),
