@@ -529,3 +529,23 @@ fn rayleigh_shape_error_is_measured_from_a_repeated_lowest_eigenspace() {
         off.excess
     );
 }
+
+/// The bounds grow with the number of time scales the samples span (`‖A‖_F t`): a rotation
+/// followed for 10⁵ s loses about 1e-9 of its size to DOP853's global error at tolerance
+/// 1e-12 — an accurate integration, which a fixed bound of 1e-9 would fail — while the bound
+/// stays far below an O(1) error, which it still catches.
+#[test]
+fn expm_bounds_grow_with_the_time_scales_spanned() {
+    let rotation = DMatrix::from_row_slice(2, 2, &[0.0, 1.0, -1.0, 0.0]);
+    let times: Vec<f64> = (0..=10).map(|k| 1e4 * k as f64).collect();
+    let study = expm_study_of(&rotation, &[1.0, 0.0], &times, 1e-12).unwrap();
+    assert!(study.passed(), "{:?}", study.differences);
+    for d in &study.differences {
+        // ‖A‖_F t = √2 · 1e5.
+        assert!(d.tolerance < 1e-2 && d.relative < 1e-6, "{d:?}");
+    }
+    // Over 5 s (‖A‖_F t ≈ 7.1) the bounds stay at their base times 7.1.
+    let short: Vec<f64> = (0..=10).map(|k| 0.5 * k as f64).collect();
+    let study = expm_study_of(&rotation, &[1.0, 0.0], &short, 1e-12).unwrap();
+    assert!(study.differences.iter().all(|d| d.tolerance <= 1e-8 * 7.1));
+}

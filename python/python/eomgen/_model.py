@@ -655,8 +655,9 @@ class Model:
         """Lectures 8–10's constraint methods compared on a model with holonomic
         constraints (``eomgen study constraint-methods``): the constraint replaced by a stiff
         spring of each ``stiffness`` (method I; default 1e2, 1e4, 1e6), the Lagrange
-        multipliers with and without drift control, and the model file's
-        ``minimal_twin:`` in minimal coordinates, each against a reference over
+        multipliers with and without drift control, the constraints eliminated
+        symbolically (method II.2, as :func:`eomgen.reduce`, where they can be) and the model
+        file's ``minimal_twin:`` in minimal coordinates, each against a reference over
         ``[0, t_end]`` (default 10 s) at ``tol`` (default 1e-8). This model's parameter
         values are set on the twin too where it has them. Returns the ``--json`` report with
         numeric lists as numpy arrays.
