@@ -812,6 +812,7 @@ class Model:
             AnalysisError: an unknown coordinate or event, a model without constraints,
                 options out of range, a failed integration.
             ModelError: no flight model of that name.
+            ValueError: a ``flight`` without ``after_lift_off``.
         """
         flight_core = None
         if after_lift_off:

@@ -290,7 +290,7 @@ pub struct FrfAnalysis {
 /// simulation's `frequency_parameter`, else `w` when the model has it) may also enter through
 /// its rate, as a base motion `Y cos(w t)` does through a dashpot: its rate column `B₁` is
 /// read a quarter period after `t = 0`
-/// ([`linearize_with_input_rates`](crate::linear::frequency_response::linearize_with_input_rates))
+/// ([`linearize_with_input_rates`])
 /// and the input column at `ω` is `B₀ + iωB₁`, so `H` is the transmissibility
 /// `(k + iωc)/(k − mω² + iωc)` of `models/base_excited_oscillator.yaml` (lecture 38).
 ///
