@@ -556,3 +556,111 @@ fn resolve(
     }
     Ok(names)
 }
+
+/// A function of time given as text beside a model (`study convolution --forcing`, the Python
+/// package's `Model.convolution`): an expression of `t` and the model's parameters (at their
+/// values when it was parsed), or one of the names `impulse` and `step`, which the caller
+/// handles and for which [`TimeFunction::value`] is 0.
+#[derive(Debug, Clone)]
+pub struct TimeFunction {
+    /// The trimmed text.
+    text: String,
+    /// The expression; `None` for `impulse` and `step`.
+    expression: Option<Expr>,
+    /// The parameters' names and values.
+    parameters: Vec<(String, f64)>,
+}
+
+impl TimeFunction {
+    /// Parses `text` against `model`'s parameters and evaluates it once at `t = 0`, so that an
+    /// unknown name is found here; `what` names where the text came from in the errors
+    /// (`--forcing`).
+    ///
+    /// # Errors
+    /// [`ExpressionError::Syntax`] when the text does not parse, and
+    /// [`ExpressionError::Evaluation`] when it names something other than `t` and the
+    /// parameters (the message lists them). A value that is not finite at some `t` is for
+    /// the caller to refuse, where it is used.
+    ///
+    /// # Examples
+    /// ```
+    /// use eomgen::expressions::TimeFunction;
+    /// let model = (eomgen::models::find("forced_oscillator").unwrap().make)();
+    /// let f = TimeFunction::parse("k*sin(2*t)", "--forcing", model.as_ref()).unwrap();
+    /// assert!((f.value(0.25).unwrap() - model.parameter_values()[1] * 0.5f64.sin()).abs() < 1e-15);
+    /// assert!(TimeFunction::parse("sin(2*s)", "--forcing", model.as_ref()).is_err());
+    /// assert_eq!(TimeFunction::parse(" step ", "--forcing", model.as_ref()).unwrap().name(), Some("step"));
+    /// ```
+    pub fn parse(text: &str, what: &str, model: &dyn ModelInfo) -> Result<Self, ExpressionError> {
+        let text = text.trim().to_string();
+        let expression = match text.as_str() {
+            "impulse" | "step" => None,
+            _ => Some(
+                parse_expr(&text, Location { line: 1, column: 1 }).map_err(|d| {
+                    ExpressionError::Syntax {
+                        what: what.to_string(),
+                        text: text.clone(),
+                        column: d.location.column,
+                        message: format!(
+                            "{}; give `impulse`, `step` or an expression of t such as `sin(2*t)`",
+                            d.message
+                        ),
+                    }
+                })?,
+            ),
+        };
+        let lookup = parameter_lookup(model);
+        let parameters = model
+            .description()
+            .parameter_names()
+            .iter()
+            .filter_map(|p| lookup(p).map(|v| (p.to_string(), v)))
+            .collect();
+        let function = TimeFunction {
+            text,
+            expression,
+            parameters,
+        };
+        function
+            .value(0.0)
+            .map_err(|message| ExpressionError::Evaluation {
+                what: what.to_string(),
+                text: function.text.clone(),
+                message: format!(
+                    "{message} (names: t and the parameters {})",
+                    model.description().parameter_names().join(", ")
+                ),
+            })?;
+        Ok(function)
+    }
+
+    /// `impulse` or `step` when the text is one of those names, else `None`.
+    pub fn name(&self) -> Option<&str> {
+        self.expression.is_none().then_some(self.text.as_str())
+    }
+
+    /// The trimmed text.
+    pub fn text(&self) -> &str {
+        &self.text
+    }
+
+    /// The value at `t` (0 for `impulse` and `step`).
+    ///
+    /// # Errors
+    /// Why the expression cannot be evaluated at `t` (a name it does not know).
+    pub fn value(&self, t: f64) -> Result<f64, String> {
+        let Some(expression) = &self.expression else {
+            return Ok(0.0);
+        };
+        let lookup = |name: &str| -> Option<f64> {
+            if name == "t" {
+                return Some(t);
+            }
+            self.parameters
+                .iter()
+                .find(|(p, _)| p == name)
+                .map(|(_, v)| *v)
+        };
+        eval_expr(expression, &lookup).map_err(|d| d.message.clone())
+    }
+}

@@ -404,7 +404,7 @@ fn bad_inputs_and_forcings_are_errors() {
         ),
         (
             vec!["--input", "A", "--forcing", "sin("],
-            "--forcing `sin(`",
+            "--forcing: `sin(` is not an expression",
         ),
     ] {
         let mut all = vec!["study", "convolution", "forced_oscillator"];

@@ -18,7 +18,7 @@ use eomgen::analysis::vibration::{
     self, ConvolutionOptions, ExpmOptions, Forcing, OperatingPointOptions, RayleighOptions,
 };
 use eomgen::analysis::{PeriodicOrbitOptions, periodic_orbit};
-use eomgen::expressions::{evaluate, parameter_lookup, split_list};
+use eomgen::expressions::{TimeFunction, evaluate, parameter_lookup, split_list};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
@@ -146,8 +146,6 @@ fn study_convolution<'py>(
     rtol: Option<f64>,
     label: Option<String>,
 ) -> PyResult<Bound<'py, PyAny>> {
-    use eomgen_symbolic::model::Location;
-    use eomgen_symbolic::model::parser::{eval_expr, parse_expr};
     let mut instance = model.fresh()?;
     let operating_point = point(at)?;
     let intervals = intervals.unwrap_or(ConvolutionOptions::DEFAULT_INTERVALS);
@@ -162,54 +160,18 @@ fn study_convolution<'py>(
     let name = instance.description().name.to_string();
     let failure = |e: vibration::ConvolutionError| analysis_error(format!("`{name}`: {e}"));
     if let Ok(text) = forcing.extract::<String>() {
-        let text = text.trim().to_string();
-        let expression = match text.as_str() {
-            "impulse" | "step" => None,
-            _ => Some(parse_expr(&text, Location { line: 1, column: 1 }).map_err(|d| {
-                PyValueError::new_err(format!(
-                    "forcing `{text}` (column {}): {}; give `impulse`, `step` or an expression of t such as `sin(2*t)`",
-                    d.location.column, d.message
-                ))
-            })?),
-        };
-        let parameters: Vec<(String, f64)> = {
-            let lookup = parameter_lookup(instance.as_ref());
-            instance
-                .description()
-                .parameter_names()
-                .iter()
-                .filter_map(|p| lookup(p).map(|v| (p.to_string(), v)))
-                .collect()
-        };
-        let value_at = |t: f64| -> Result<f64, String> {
-            let lookup = |name: &str| -> Option<f64> {
-                if name == "t" {
-                    return Some(t);
-                }
-                parameters.iter().find(|(p, _)| p == name).map(|(_, v)| *v)
-            };
-            match &expression {
-                Some(e) => eval_expr(e, &lookup).map_err(|d| d.message.clone()),
-                None => Ok(0.0),
-            }
-        };
-        // Unknown names are found at t = 0; a value that is not finite somewhere is the
-        // library's error.
-        value_at(0.0).map_err(|message| {
-            PyValueError::new_err(format!(
-                "forcing `{text}`: {message} (names: t and the parameters {})",
-                instance.description().parameter_names().join(", ")
-            ))
-        })?;
+        let time_function = TimeFunction::parse(&text, "forcing", instance.as_ref())
+            .map_err(|e| PyValueError::new_err(e.to_string()))?;
         let model_ref = &mut instance;
         let study = py
             .detach(move || {
-                let function = |t: f64| value_at(t).unwrap_or(f64::NAN);
-                let forcing = match text.as_str() {
-                    "impulse" => Forcing::Impulse,
-                    "step" => Forcing::Step,
-                    _ => Forcing::Function {
-                        label: &text,
+                // A value that is not finite somewhere is the library's error.
+                let function = |t: f64| time_function.value(t).unwrap_or(f64::NAN);
+                let forcing = match time_function.name() {
+                    Some("impulse") => Forcing::Impulse,
+                    Some(_) => Forcing::Step,
+                    None => Forcing::Function {
+                        label: time_function.text(),
                         f: &function,
                     },
                 };

@@ -11,9 +11,8 @@ use clap::Args;
 use eomgen::analysis::vibration::{
     self, ConvolutionError, ConvolutionOptions, ConvolutionStudy, Forcing,
 };
+use eomgen::expressions::TimeFunction;
 use eomgen::{FrfError, ModelInfo};
-use eomgen_symbolic::model::Location;
-use eomgen_symbolic::model::parser::{eval_expr, parse_expr};
 
 use crate::cli::error::CliError;
 use crate::cli::files::Outputs;
@@ -21,7 +20,6 @@ use crate::cli::json::print_json_sorted;
 use crate::cli::operating_point::OperatingPointArgs;
 use crate::cli::plot::{Chart, Series, lines};
 use crate::cli::render::num;
-use crate::cli::values::parameter_lookup;
 
 /// Options of `eomgen study convolution`.
 #[derive(Debug, Args)]
@@ -89,50 +87,15 @@ pub fn run(args: &ConvolutionArgs) -> Result<(), CliError> {
         .chart("--plot", args.plot.as_deref())
         .check()?;
     let mut model = args.point.model(&args.model)?;
-    let text = args.forcing.trim();
-    let expression = match text {
-        "impulse" | "step" => None,
-        _ => Some(parse_expr(text, Location { line: 1, column: 1 }).map_err(|d| {
-            CliError::usage(format!(
-                "--forcing `{text}` (column {}): {}; give `impulse`, `step` or an expression of t such as `sin(2*t)`",
-                d.location.column, d.message
-            ))
-        })?),
-    };
-    let parameters: Vec<(String, f64)> = {
-        let lookup = parameter_lookup(model.as_ref());
-        model
-            .description()
-            .parameter_names()
-            .iter()
-            .filter_map(|p| lookup(p).map(|v| (p.to_string(), v)))
-            .collect()
-    };
-    let value_at = |t: f64| -> Result<f64, String> {
-        let lookup = |name: &str| -> Option<f64> {
-            if name == "t" {
-                return Some(t);
-            }
-            parameters.iter().find(|(p, _)| p == name).map(|(_, v)| *v)
-        };
-        match &expression {
-            Some(e) => eval_expr(e, &lookup).map_err(|d| d.message.clone()),
-            None => Ok(0.0),
-        }
-    };
-    // Unknown names are found at t = 0; a value that is not finite somewhere is the library's.
-    value_at(0.0).map_err(|message| {
-        CliError::usage(format!(
-            "--forcing `{text}`: {message} (names: t and the parameters {})",
-            model.description().parameter_names().join(", ")
-        ))
-    })?;
-    let function = |t: f64| value_at(t).unwrap_or(f64::NAN);
-    let forcing = match text {
-        "impulse" => Forcing::Impulse,
-        "step" => Forcing::Step,
-        _ => Forcing::Function {
-            label: text,
+    let time_function = TimeFunction::parse(&args.forcing, "--forcing", model.as_ref())
+        .map_err(|e| CliError::usage(e.to_string()))?;
+    // A value that is not finite somewhere is the library's error.
+    let function = |t: f64| time_function.value(t).unwrap_or(f64::NAN);
+    let forcing = match time_function.name() {
+        Some("impulse") => Forcing::Impulse,
+        Some(_) => Forcing::Step,
+        None => Forcing::Function {
+            label: time_function.text(),
             f: &function,
         },
     };
