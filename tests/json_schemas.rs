@@ -243,7 +243,14 @@ fn json_output_keeps_its_schema() {
         ("expm", vec!["study", "expm", "--n", "3", "--json"]),
         (
             "rayleigh",
-            vec!["study", "rayleigh", "three_masses", "--shape", "1,1,1", "--json"],
+            vec![
+                "study",
+                "rayleigh",
+                "three_masses",
+                "--shape",
+                "1,1,1",
+                "--json",
+            ],
         ),
         (
             "convolution",
@@ -262,7 +269,14 @@ fn json_output_keeps_its_schema() {
         ),
         (
             "launch",
-            vec!["study", "launch", "projectile_drag", "--speeds", "1", "--json"],
+            vec![
+                "study",
+                "launch",
+                "projectile_drag",
+                "--speeds",
+                "1",
+                "--json",
+            ],
         ),
         (
             "periodic_orbit",

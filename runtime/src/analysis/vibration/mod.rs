@@ -35,8 +35,8 @@
 //! [`linear::frequency_response`](crate::linear::frequency_response) and
 //! [`linear::monodromy`](crate::linear::monodromy).
 
-pub mod expm_study;
 pub mod convolution;
+pub mod expm_study;
 pub mod floquet;
 pub mod free_response;
 pub mod frf;
@@ -47,14 +47,14 @@ pub mod parameter_sweep;
 pub mod rayleigh;
 pub mod steady;
 
+pub use convolution::{
+    ClosedForm, ConvolutionError, ConvolutionOptions, ConvolutionStudy, Forcing, Quadrature,
+    convolution_response,
+};
 pub use expm_study::{
     EigenvectorOutcome, ExpmOptions, ExpmRoute, ExpmStudy, ExpmStudyError, RandomProblem,
     RouteDifference, eigenvector_condition, expected_difference, expm_study, expm_study_of,
     random_problem,
-};
-pub use convolution::{
-    ClosedForm, ConvolutionError, ConvolutionOptions, ConvolutionStudy, Forcing, Quadrature,
-    convolution_response,
 };
 pub use floquet::{
     FailedCell, FloquetCell, FloquetChart, FloquetChartSummary, FloquetIntegrationSummary,
