@@ -106,6 +106,9 @@ pub mod __private {
 
     pub use eomgen_runtime::functions::{sign, step};
 
+    // The Taylor recurrences the generated `taylor_order` inlines (`eomgen_runtime::taylor::apply`).
+    pub use eomgen_runtime::taylor;
+
     // The generated code's sine and cosine come from the `libm` crate (a pure-Rust port of
     // musl's correctly range-reduced fdlibm kernels, < 1 ulp) rather than the platform's libm
     // behind `f64::sin`: the same bits on every platform, inlinable, and a `sincos` that

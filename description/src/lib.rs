@@ -22,6 +22,7 @@ use serde::Serialize;
 pub mod checks;
 pub mod floquet;
 pub mod outputs;
+pub mod taylor;
 
 /// Text of a description: borrowed from the binary (compiled models) or owned (run time).
 pub type Text = Cow<'static, str>;

@@ -64,3 +64,50 @@ pub(crate) fn evaluate(
         *o = values[x as usize];
     }
 }
+
+/// Order 0 of a model's Taylor series ([`eomgen_symbolic::codegen::taylor`]): the extended
+/// tape of `M` and `F` evaluated in place, instruction `k`'s value into `series[k · capacity]`,
+/// each with the operation or library function [`evaluate`] uses (so the compiled model's
+/// `taylor_order_zero` gets the same bits). The inputs `q`, `q̇`, `t` are read from their
+/// slots, where the caller has written them; parameters from `parameters`.
+///
+/// # Panics
+/// If `series` has fewer than `tape.instructions.len() · capacity` entries.
+pub(crate) fn order_zero_in_place(
+    tape: &eomgen_symbolic::codegen::tape::Tape,
+    parameters: &[f64],
+    capacity: usize,
+    series: &mut [f64],
+) {
+    let c = capacity;
+    for (k, instruction) in tape.instructions.iter().enumerate() {
+        let v = |x: u32| series[x as usize * c];
+        let value = match *instruction {
+            Instruction::Input(Input::Parameter(i)) => {
+                parameters.get(i as usize).copied().unwrap_or(f64::NAN)
+            }
+            // Written by the caller.
+            Instruction::Input(_) => continue,
+            Instruction::Const(x) => x,
+            Instruction::Neg(x) => -v(x),
+            Instruction::Add(x, y) => v(x) + v(y),
+            Instruction::Sub(x, y) => v(x) - v(y),
+            Instruction::Mul(x, y) => v(x) * v(y),
+            Instruction::Div(x, y) => v(x) / v(y),
+            Instruction::Sqrt(x) => v(x).sqrt(),
+            Instruction::Abs(x) => v(x).abs(),
+            Instruction::Call(f, x) => math::unary(f)(v(x)),
+            Instruction::Powf(x, y) => math::powf(v(x), v(y)),
+            Instruction::Atan2(y, x) => math::atan2(v(y), v(x)),
+            Instruction::SinCos(x) => {
+                let pair = math::sin_cos(v(x));
+                if let Some(cos) = series.get_mut((k + 1) * c) {
+                    *cos = pair.cos;
+                }
+                pair.sin
+            }
+            Instruction::CosOfSinCos(_) => continue,
+        };
+        series[k * c] = value;
+    }
+}

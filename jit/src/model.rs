@@ -7,6 +7,8 @@ use eomgen_runtime::{DynMechanicalSystem, ModelDescription, UnknownParameter};
 use eomgen_symbolic::codegen::GenerateError;
 use eomgen_symbolic::codegen::program::{Derivation, FunctionTape, ModelProgram};
 use eomgen_symbolic::codegen::tape::{Input, Instruction};
+use eomgen_symbolic::codegen::taylor::{TaylorPlan, taylor_program};
+use eomgen_runtime::taylor::{TaylorProgram, TaylorUnsupported};
 use eomgen_symbolic::model::{Diagnostic, ReadError, read_model_file};
 
 use crate::native::{CompileError, NativeCode, NativeFn};
@@ -205,6 +207,8 @@ struct Code {
     /// The derivation the Jacobians come from, until they are compiled.
     derivation: Mutex<Option<Derivation>>,
     jacobians: OnceLock<LazyJacobians>,
+    /// The Taylor recurrences ([`eomgen_symbolic::codegen::taylor`]), or why there are none.
+    taylor: Result<TaylorPlan, TaylorUnsupported>,
 }
 
 impl Code {
@@ -462,6 +466,11 @@ impl JitModel {
                     .collect(),
             );
         }
+        let taylor = taylor_program(
+            &program.mass_matrix_and_forcing,
+            program.num_dofs(),
+            program.description.constraints.len(),
+        );
         program.clear_tapes();
         let parameters: Vec<f64> = program.description.parameter_defaults();
         let code = Arc::new(Code {
@@ -471,6 +480,7 @@ impl JitModel {
             fallback_reason,
             derivation: Mutex::new(Some(derivation)),
             jacobians: OnceLock::new(),
+            taylor,
         });
         if options.eager_jacobians
             && let Some(e @ CompileError::Function { .. }) = &code.jacobians().fallback_reason
@@ -588,6 +598,24 @@ impl JitModel {
 impl DynMechanicalSystem for JitModel {
     fn description(&self) -> &ModelDescription {
         &self.code.program.description
+    }
+    fn taylor_program(&self) -> Result<&TaylorProgram, TaylorUnsupported> {
+        match &self.code.taylor {
+            Ok(plan) => Ok(&plan.program),
+            Err(reason) => Err(reason.clone()),
+        }
+    }
+    fn taylor_order_zero(&self, capacity: usize, series: &mut [f64]) {
+        if let Ok(plan) = &self.code.taylor {
+            interpret::order_zero_in_place(&plan.order_zero, &self.parameters, capacity, series);
+        }
+    }
+    // The recurrences of orders k ≥ 1 are the runtime's, op by op (`evaluate_order`), the
+    // definitions the compiled model's code inlines: the same bits.
+    fn taylor_order(&self, k: usize, capacity: usize, series: &mut [f64]) {
+        if let Ok(plan) = &self.code.taylor {
+            eomgen_runtime::taylor::evaluate_order(&plan.program.ops, k, capacity, series);
+        }
     }
     fn parameter_values(&self) -> Vec<f64> {
         self.parameters.clone()

@@ -12,6 +12,7 @@
 use nalgebra::SVector;
 
 use crate::system::{MechanicalSystem, ModelDescription, UnknownParameter};
+use crate::taylor::{TaylorProgram, TaylorUnsupported};
 
 /// Equations of motion `M(q, t) q̈ = F(q, q̇, t)` of a mechanism with `n` degrees of freedom,
 /// `n` known at run time.
@@ -96,6 +97,24 @@ pub trait DynMechanicalSystem {
         lambda: &[f64],
         out: &mut [f64],
     );
+
+    /// [`MechanicalSystem::taylor_program`].
+    ///
+    /// # Errors
+    /// [`TaylorUnsupported`] naming what is missing.
+    fn taylor_program(&self) -> Result<&TaylorProgram, TaylorUnsupported> {
+        Err(TaylorUnsupported::NotGenerated)
+    }
+    /// [`MechanicalSystem::taylor_order_zero`].
+    fn taylor_order_zero(&self, capacity: usize, series: &mut [f64]) {
+        let _ = (capacity, series);
+    }
+    /// [`MechanicalSystem::taylor_order`].
+    fn taylor_order(&self, k: usize, capacity: usize, series: &mut [f64]) {
+        if let Ok(program) = self.taylor_program() {
+            crate::taylor::evaluate_order(&program.ops, k, capacity, series);
+        }
+    }
 }
 
 /// A [`MechanicalSystem<N>`] seen as a [`DynMechanicalSystem`]: the one place where the
@@ -230,6 +249,15 @@ impl<S: MechanicalSystem<N>, const N: usize> DynMechanicalSystem for StaticSyste
             lambda,
             out,
         );
+    }
+    fn taylor_program(&self) -> Result<&TaylorProgram, TaylorUnsupported> {
+        self.0.taylor_program()
+    }
+    fn taylor_order_zero(&self, capacity: usize, series: &mut [f64]) {
+        self.0.taylor_order_zero(capacity, series);
+    }
+    fn taylor_order(&self, k: usize, capacity: usize, series: &mut [f64]) {
+        self.0.taylor_order(k, capacity, series);
     }
 }
 

@@ -11,6 +11,7 @@ use crate::linalg::{solve_spd, solve_spd_in_place};
 use crate::model_info::{FirstOrderForm, FirstOrderParts};
 use crate::ode::{EventSpec, OdeSystem, RhsError};
 use crate::system::MechanicalSystem;
+use crate::taylor::TaylorWorkspace;
 
 /// The first-order form `y = [q; q̇]`, `ẏ = [q̇; M⁻¹F]` of a [`MechanicalSystem`].
 ///
@@ -38,7 +39,8 @@ pub struct FirstOrder<S, const N: usize> {
     pub constraints: ConstraintWorkspace,
     /// The model's events ([`ModelDescription::events`](crate::ModelDescription::events)), whose `terminal` flags may be
     /// changed ([`ModelInfo::set_event_terminal`](crate::ModelInfo::set_event_terminal)).
-    pub events: Vec<EventSpec>,
+    pub events: Vec<EventSpec>,    /// Buffers of the Taylor series ([`crate::taylor`]), allocated on first use.
+    taylor: TaylorWorkspace,
 }
 
 impl<S: MechanicalSystem<N>, const N: usize> FirstOrder<S, N> {
@@ -56,6 +58,7 @@ impl<S: MechanicalSystem<N>, const N: usize> FirstOrder<S, N> {
             stabilization: Stabilization::None,
             constraints: ConstraintWorkspace::new(N, m, holonomic),
             events,
+            taylor: TaylorWorkspace::new(),
         }
     }
 
@@ -216,6 +219,21 @@ impl<S: MechanicalSystem<N>, const N: usize> OdeSystem for FirstOrder<S, N> {
         &self.events
     }
 
+    fn taylor_support(&self) -> Result<(), crate::taylor::TaylorUnsupported> {
+        crate::taylor::support(StaticSystem::from_ref(&self.system)).map(|_| ())
+    }
+
+    fn taylor_coefficients(
+        &mut self,
+        t: f64,
+        y: &[f64],
+        order: usize,
+        out: &mut [f64],
+    ) -> Result<(), RhsError> {
+        let system = StaticSystem::from_ref(&self.system);
+        crate::taylor::coefficients(system, &mut self.taylor, t, y, order, out)
+    }
+
     fn event_values(&mut self, t: f64, y: &[f64], g: &mut [f64]) -> Result<(), RhsError> {
         if self.events.is_empty() {
             return Ok(());
@@ -277,6 +295,7 @@ pub struct DynFirstOrder<S> {
     /// ([`ModelInfo::set_event_terminal`](crate::ModelInfo::set_event_terminal)).
     pub events: Vec<EventSpec>,
     n: usize,
+    taylor: TaylorWorkspace,
     mass: Vec<f64>,
     forcing: Vec<f64>,
     spd: Vec<f64>,
@@ -304,6 +323,7 @@ impl<S: DynMechanicalSystem> DynFirstOrder<S> {
             spd: vec![0.0; n * n + 2 * n],
             envelope: vec![0; 2 * n],
             zeros: vec![0.0; n],
+            taylor: TaylorWorkspace::new(),
         }
     }
 
@@ -492,6 +512,20 @@ impl<S: DynMechanicalSystem> OdeSystem for DynFirstOrder<S> {
 
     fn event_specs(&self) -> &[EventSpec] {
         &self.events
+    }
+
+    fn taylor_support(&self) -> Result<(), crate::taylor::TaylorUnsupported> {
+        crate::taylor::support(&self.system).map(|_| ())
+    }
+
+    fn taylor_coefficients(
+        &mut self,
+        t: f64,
+        y: &[f64],
+        order: usize,
+        out: &mut [f64],
+    ) -> Result<(), RhsError> {
+        crate::taylor::coefficients(&self.system, &mut self.taylor, t, y, order, out)
     }
 
     fn event_values(&mut self, t: f64, y: &[f64], g: &mut [f64]) -> Result<(), RhsError> {

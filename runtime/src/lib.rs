@@ -43,6 +43,7 @@ pub mod model_info;
 pub mod ode;
 pub(crate) mod serde_matrix;
 pub mod system;
+pub mod taylor;
 
 pub use analysis::{Method, UnknownMethod};
 pub use constrained::{
@@ -59,7 +60,7 @@ pub use integrate::{
     ExplicitEuler, ExplicitMidpoint, ImplicitMidpoint, IntegrationError, IntegrationFailure,
     Integrator, IntegratorOptions, NewtonWork, OutputTimes, PiController, PredictiveController,
     RadauIIA5, RungeKutta4, Solution, Stats, StepOutcome, StepSizeController, StormerVerlet,
-    SymplecticEuler, Tableau, Tolerance,
+    SymplecticEuler, Tableau, Taylor, Tolerance, Verner65, Verner76, Verner87, Verner98,
 };
 pub use linalg::{solve_spd, solve_spd_in_place};
 pub use linear::eigenvalues::{

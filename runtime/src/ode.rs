@@ -133,6 +133,36 @@ pub trait OdeSystem {
         let _ = (t, y, g);
         Ok(())
     }
+
+    /// Whether [`taylor_coefficients`](Self::taylor_coefficients) works: `Ok` for a model with
+    /// generated Taylor recurrences ([`crate::taylor`]), else why not. The default (equations
+    /// written as a closure) has none.
+    ///
+    /// # Errors
+    /// [`TaylorUnsupported`](crate::taylor::TaylorUnsupported) naming what is missing.
+    fn taylor_support(&self) -> Result<(), crate::taylor::TaylorUnsupported> {
+        Err(crate::taylor::TaylorUnsupported::NotGenerated)
+    }
+
+    /// The Taylor coefficients of the solution through `(t, y)` up to `order`:
+    /// `out[k · dim + i] = yᵢ^[k] = yᵢ⁽ᵏ⁾(t)/k!` for `k = 0 … order`, for the
+    /// [`Taylor`](crate::Taylor) method ([`crate::taylor::series_of_motion`]).
+    ///
+    /// # Errors
+    /// [`RhsError::SingularMassMatrix`], [`RhsError::NonFinite`] (a coefficient, by
+    /// component); the default, for a system without recurrences, is
+    /// [`RhsError::NonFinite`] at component 0 (the Taylor method checks
+    /// [`taylor_support`](Self::taylor_support) before it asks).
+    fn taylor_coefficients(
+        &mut self,
+        t: f64,
+        y: &[f64],
+        order: usize,
+        out: &mut [f64],
+    ) -> Result<(), RhsError> {
+        let _ = (t, y, order, out);
+        Err(RhsError::NonFinite { index: 0 })
+    }
 }
 
 /// A closure `|t, y, dy| { … }` is an [`OdeSystem`] of a given dimension.
@@ -287,6 +317,20 @@ where
         let (own, added) = g.split_at_mut(self.own.min(g.len()));
         self.system.event_values(t, y, own)?;
         (self.g)(self.system, t, y, added)
+    }
+
+    fn taylor_support(&self) -> Result<(), crate::taylor::TaylorUnsupported> {
+        self.system.taylor_support()
+    }
+
+    fn taylor_coefficients(
+        &mut self,
+        t: f64,
+        y: &[f64],
+        order: usize,
+        out: &mut [f64],
+    ) -> Result<(), RhsError> {
+        self.system.taylor_coefficients(t, y, order, out)
     }
 }
 

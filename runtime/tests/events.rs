@@ -124,6 +124,10 @@ fn every_method_locates_the_returns() {
             Method::Bs32 => (&adaptive, 2e-7),
             Method::Dp54 => (&adaptive, 5e-8),
             Method::Dop853 => (&adaptive, 2e-9),
+            Method::Vern6 => (&adaptive, 1e-6),
+            Method::Vern7 => (&adaptive, 1e-6),
+            Method::Vern8 => (&adaptive, 1e-6),
+            Method::Vern9 => (&adaptive, 1e-6),
             Method::Radau5 => (&adaptive, 1e-10),
         };
         let mut method = method.integrator();

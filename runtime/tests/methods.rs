@@ -91,6 +91,26 @@ fn studies() -> Vec<Study> {
                     (oscillator(), [32, 64, 128]),
                     (damped_oscillator(), [8, 16, 32]),
                 ],
+                Method::Vern6 => vec![
+                    (oscillator(), [64, 128, 256]),
+                    (forced_decay(), [10, 20, 40]),
+                    (logistic(), [10, 20, 40]),
+                ],
+                Method::Vern7 => vec![
+                    (oscillator(), [48, 96, 192]),
+                    (forced_decay(), [8, 16, 32]),
+                    (logistic(), [8, 16, 32]),
+                ],
+                Method::Vern8 => vec![
+                    (oscillator(), [32, 64, 128]),
+                    (damped_oscillator(), [8, 16, 32]),
+                    (logistic(), [6, 12, 24]),
+                ],
+                Method::Vern9 => vec![
+                    (oscillator(), [24, 48, 96]),
+                    (damped_oscillator(), [6, 12, 24]),
+                    (logistic(), [4, 8, 16]),
+                ],
                 Method::SymplecticEuler => vec![
                     first_order(oscillator()),
                     first_order(forced_oscillator()),

@@ -27,6 +27,13 @@ fn method_help(method: Method) -> &'static str {
         Method::Bs32 => "Bogacki–Shampine 3(2) (ode23), adaptive, Hermite dense output",
         Method::Dp54 => "Dormand–Prince 5(4), adaptive, dense output (default)",
         Method::Dop853 => "DOP853, Hairer's Dormand–Prince 8(5,3), adaptive, order-7 dense output",
+        Method::Vern6 => "Verner's most efficient 6(5) pair, adaptive, order-6 dense output",
+        Method::Vern7 => "Verner's most efficient 7(6) pair, adaptive, order-7 dense output",
+        Method::Vern8 => "Verner's most efficient 8(7) pair, adaptive, order-8 dense output",
+        Method::Vern9 => "Verner's most efficient 9(8) pair, adaptive, order-9 dense output (tolerances of 1e-12 and below)",
+        Method::Taylor => {
+            "Taylor series of the model's generated recurrences, order and step from the tolerance (Jorba & Zou), the series as dense output; unconstrained models without abs, sign, step"
+        }
         Method::SymplecticEuler => {
             "Symplectic Euler, order 1, fixed step `--dt` (symplectic for constant M and velocity-independent forces)"
         }
@@ -75,7 +82,8 @@ pub struct IntegrationArgs {
     /// Integration method.
     #[arg(long, value_parser = method_parser(), default_value_t = SimulationOptions::DEFAULT_METHOD)]
     pub method: Method,
-    /// Relative tolerance (adaptive methods: bs32, dp54, dop853, radau5).
+    /// Relative tolerance (adaptive methods: bs32, dp54, dop853, vern6, vern7, vern8, vern9,
+    /// radau5).
     #[arg(long, default_value_t = SimulationOptions::DEFAULT_RTOL, value_parser = super::values::relative_tolerance, allow_hyphen_values = true)]
     pub rtol: f64,
     /// Absolute tolerance (adaptive methods; implicit-midpoint's scale for components near 0).

@@ -132,7 +132,15 @@ fn amplification(method: Method, z: Complex<f64>) -> Option<f64> {
         Method::SymplecticEuler | Method::StormerVerlet => {
             Some(partitioned_oscillator_spectral_radius(z.norm()))
         }
-        Method::Bs32 | Method::Dp54 | Method::Dop853 | Method::Radau5 => None,
+        Method::Bs32
+        | Method::Dp54
+        | Method::Dop853
+        | Method::Vern6
+        | Method::Vern7
+        | Method::Vern8
+        | Method::Vern9
+        | Method::Taylor
+        | Method::Radau5 => None,
     }
 }
 

@@ -18,6 +18,7 @@ use serde::Serialize;
 use crate::integrate::{
     BogackiShampine32, DormandPrince54, DormandPrince853, ExplicitEuler, ExplicitMidpoint,
     ImplicitMidpoint, Integrator, RadauIIA5, RungeKutta4, StormerVerlet, SymplecticEuler,
+    Taylor, Verner65, Verner76, Verner87, Verner98,
 };
 
 /// An integration method, by its command-line name.
@@ -53,6 +54,18 @@ pub enum Method {
     Dp54,
     /// DOP853, Hairer's Dormand–Prince 8(5,3), adaptive, order-7 dense output.
     Dop853,
+    /// Verner's "most efficient" 6(5) pair, adaptive, order-6 dense output.
+    Vern6,
+    /// Verner's "most efficient" 7(6) pair, adaptive, order-7 dense output.
+    Vern7,
+    /// Verner's "most efficient" 8(7) pair, adaptive, order-8 dense output.
+    Vern8,
+    /// Verner's "most efficient" 9(8) pair, adaptive, order-9 dense output.
+    Vern9,
+    /// The Taylor method of the model's generated recurrences, adaptive order and step from
+    /// the tolerance (Jorba & Zou 2005); unconstrained models whose equations have
+    /// recurrences.
+    Taylor,
     /// Symplectic Euler, order 1, fixed step (symplectic for constant M and
     /// velocity-independent forces).
     SymplecticEuler,
@@ -76,13 +89,18 @@ pub struct UnknownMethod {
 
 impl Method {
     /// Every method, in the order the CLI lists them.
-    pub const ALL: [Method; 10] = [
+    pub const ALL: [Method; 15] = [
         Method::Euler,
         Method::Midpoint,
         Method::Rk4,
         Method::Bs32,
         Method::Dp54,
         Method::Dop853,
+        Method::Vern6,
+        Method::Vern7,
+        Method::Vern8,
+        Method::Vern9,
+        Method::Taylor,
         Method::SymplecticEuler,
         Method::StormerVerlet,
         Method::ImplicitMidpoint,
@@ -98,6 +116,11 @@ impl Method {
             Method::Bs32 => "bs32",
             Method::Dp54 => "dp54",
             Method::Dop853 => "dop853",
+            Method::Vern6 => "vern6",
+            Method::Vern7 => "vern7",
+            Method::Vern8 => "vern8",
+            Method::Vern9 => "vern9",
+            Method::Taylor => "taylor",
             Method::SymplecticEuler => "symplectic-euler",
             Method::StormerVerlet => "stormer-verlet",
             Method::ImplicitMidpoint => "implicit-midpoint",
@@ -120,6 +143,11 @@ impl Method {
             Method::Bs32 => "Bogacki–Shampine 3(2)",
             Method::Dp54 => "Dormand–Prince 5(4)",
             Method::Dop853 => "DOP853",
+            Method::Vern6 => "Verner 6(5)",
+            Method::Vern7 => "Verner 7(6)",
+            Method::Vern8 => "Verner 8(7)",
+            Method::Vern9 => "Verner 9(8)",
+            Method::Taylor => "Taylor",
             Method::SymplecticEuler => "symplectic Euler",
             Method::StormerVerlet => "Störmer–Verlet",
             Method::ImplicitMidpoint => "implicit midpoint",
@@ -136,6 +164,11 @@ impl Method {
             Method::Bs32 => Box::new(BogackiShampine32::new()),
             Method::Dp54 => Box::new(DormandPrince54::new()),
             Method::Dop853 => Box::new(DormandPrince853::new()),
+            Method::Vern6 => Box::new(Verner65::new()),
+            Method::Vern7 => Box::new(Verner76::new()),
+            Method::Vern8 => Box::new(Verner87::new()),
+            Method::Vern9 => Box::new(Verner98::new()),
+            Method::Taylor => Box::new(Taylor::new()),
             Method::SymplecticEuler => Box::new(SymplecticEuler::new()),
             Method::StormerVerlet => Box::new(StormerVerlet::new()),
             Method::ImplicitMidpoint => Box::new(ImplicitMidpoint::new()),
@@ -148,7 +181,15 @@ impl Method {
     pub fn is_adaptive(self) -> bool {
         matches!(
             self,
-            Method::Bs32 | Method::Dp54 | Method::Dop853 | Method::Radau5
+            Method::Bs32
+                | Method::Dp54
+                | Method::Dop853
+                | Method::Vern6
+                | Method::Vern7
+                | Method::Vern8
+                | Method::Vern9
+                | Method::Taylor
+                | Method::Radau5
         )
     }
 
@@ -207,7 +248,16 @@ mod tests {
             .collect();
         assert_eq!(
             adaptive,
-            [Method::Bs32, Method::Dp54, Method::Dop853, Method::Radau5]
+            [
+                Method::Bs32,
+                Method::Dp54,
+                Method::Dop853,
+                Method::Vern6,
+                Method::Vern7,
+                Method::Vern8,
+                Method::Vern9,
+                Method::Radau5
+            ]
         );
     }
 
@@ -225,7 +275,7 @@ mod tests {
         assert_eq!(e.name, "Dp54");
         assert_eq!(
             e.to_string(),
-            "unknown integration method `Dp54` (valid: euler, midpoint, rk4, bs32, dp54, dop853, symplectic-euler, stormer-verlet, implicit-midpoint, radau5)"
+            "unknown integration method `Dp54` (valid: euler, midpoint, rk4, bs32, dp54, dop853, vern6, vern7, vern8, vern9, symplectic-euler, stormer-verlet, implicit-midpoint, radau5)"
         );
     }
 }

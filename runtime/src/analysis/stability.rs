@@ -30,7 +30,7 @@ use crate::integrate::stability_function::{
 use crate::integrate::{
     BogackiShampine32, DormandPrince54, DormandPrince853, ExplicitEuler, ImplicitMidpoint,
     IntegrationFailure, Integrator, IntegratorOptions, OutputTimes, RadauIIA5, RungeKutta4,
-    Solution, StormerVerlet, SymplecticEuler, Tableau,
+    Solution, StormerVerlet, SymplecticEuler, Tableau, verner_methods,
 };
 use crate::model_info::ModelInfo;
 use crate::ode::OdeFn;
@@ -617,7 +617,8 @@ pub struct ExplicitMethod {
 }
 
 /// The explicit methods, their polynomials from their tableaus (DOP853's from one step of it,
-/// its tableau being private), each checked against one step of its implementation.
+/// its tableau being private), each checked against one step of its implementation; Verner's
+/// pairs follow DOP853.
 fn explicit_methods() -> Result<Vec<ExplicitMethod>, StabilityError> {
     let failed = |e: IntegrationFailure| StabilityError::PolynomialStep {
         message: e.to_string(),
@@ -648,6 +649,22 @@ fn explicit_methods() -> Result<Vec<ExplicitMethod>, StabilityError> {
         polynomial,
         implementation_difference: None,
     });
+    // Verner's pairs: the polynomial of each tableau, checked like the public tableaus'.
+    for (polynomial, stages, mut method) in verner_methods() {
+        let stepped = StabilityPolynomial::of_method(method.as_mut(), stages).map_err(failed)?;
+        let difference = polynomial
+            .coefficients()
+            .iter()
+            .zip(stepped.coefficients())
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max);
+        methods.push(ExplicitMethod {
+            name: method.name(),
+            method,
+            polynomial,
+            implementation_difference: Some(difference),
+        });
+    }
     Ok(methods)
 }
 

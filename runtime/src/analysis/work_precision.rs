@@ -35,10 +35,14 @@ use crate::model_info::ModelInfo;
 
 /// The methods compared by default: every adaptive method, and the fixed-step RK4 and
 /// Störmer–Verlet.
-pub const DEFAULT_METHODS: [Method; 6] = [
+pub const DEFAULT_METHODS: [Method; 10] = [
     Method::Bs32,
     Method::Dp54,
     Method::Dop853,
+    Method::Vern6,
+    Method::Vern7,
+    Method::Vern8,
+    Method::Vern9,
     Method::Radau5,
     Method::Rk4,
     Method::StormerVerlet,

@@ -61,6 +61,9 @@ pub(crate) enum Control<'a> {
         controller: &'a mut dyn StepSizeController,
         error_order: u32,
     },
+    /// Steps the stepper proposes from its current state ([`Stepper::proposed_step`]: the
+    /// Taylor method), capped by `dt_max` and the end of the interval; none is rejected.
+    Proposed,
 }
 
 /// Integrates `problem` with the stepper `make_stepper(shape)` under `control`.
@@ -97,6 +100,7 @@ pub(crate) fn run<S: Stepper>(
     solution.stats.jacobian_evals = rhs.jacobian_evals();
     solution.stats.lu_decompositions = rhs.lu_decompositions();
     solution.stats.event_evals = rhs.event_evals();
+    solution.stats.taylor_series = rhs.taylor_series();
     solution.stats.wall_time_s = start.elapsed().as_secs_f64();
     match result {
         Ok(()) => Ok(solution),
@@ -178,7 +182,65 @@ fn integrate_into<S: Stepper>(
             };
             adaptive_steps(problem, adaptive, rhs, &mut stepper, &mut finish, solution)
         }
+        Control::Proposed => {
+            if let OutputTimes::Steps = problem.output {
+                solution.reserve(ADAPTIVE_RESERVED_SAMPLES);
+            }
+            finish.recorder.start(solution, problem.t0, problem.y0);
+            proposed_steps(problem, &weights, rhs, &mut stepper, &mut finish, solution)
+        }
     }
+}
+
+/// Steps of the sizes the stepper proposes ([`Stepper::proposed_step`]), at most `dt_max`; a
+/// step within 1 % of the end is stretched onto it, as in adaptive stepping. A failure ends
+/// the run: with the step chosen a priori there is no error to shrink it by.
+fn proposed_steps<S: Stepper>(
+    problem: &Problem<'_>,
+    weights: &ErrorWeights,
+    rhs: &mut CheckedRhs<'_>,
+    stepper: &mut S,
+    finish: &mut Finish<'_, '_>,
+    solution: &mut Solution,
+) -> Result<(), IntegrationError> {
+    let (t0, t_end) = (problem.t0, problem.t_end);
+    let mut corrected = vec![0.0; stepper.y().len()];
+    let span = t_end - t0;
+    let dt_max = problem
+        .options
+        .dt_max
+        .map_or(span, |dt_max| dt_max.min(span));
+    while stepper.t() < t_end {
+        let t = stepper.t();
+        if solution.stats.steps >= problem.options.max_steps {
+            return Err(IntegrationError::TooManySteps {
+                t,
+                max_steps: problem.options.max_steps,
+            });
+        }
+        let dt = stepper.proposed_step().unwrap_or(f64::NAN).min(dt_max);
+        // A NaN step (a non-finite series) is too small as well.
+        if dt.is_nan() || dt < min_step(t, span) {
+            return Err(IntegrationError::StepSizeTooSmall { t, dt });
+        }
+        let t_new = if t + 1.01 * dt >= t_end {
+            t_end
+        } else {
+            t + dt
+        };
+        stepper
+            .attempt(rhs, t_new, weights, false)
+            .map_err(StepFailure::into_error)?;
+        stepper.accept(rhs).map_err(StepFailure::into_error)?;
+        solution.stats.steps += 1;
+        if finish
+            .step(rhs, stepper, &mut corrected, solution)
+            .map_err(StepFailure::into_error)?
+        {
+            return Ok(());
+        }
+    }
+    Ok(())
 }
 
 /// The fixed step: `dt` (default `(t_end − t0)/1000`), at most `dt_max`.
@@ -625,7 +687,7 @@ mod tests {
     use crate::integrate::controller::{PiController, StepOutcome, StepSizeController};
     use crate::integrate::explicit_rk::ExplicitRk;
     use crate::integrate::tableau::Tableau;
-    use crate::integrate::{DormandPrince54, Integrator, RungeKutta4};
+    use crate::integrate::{DormandPrince54, DormandPrince853, Integrator, RungeKutta4};
     use crate::ode::{OdeFn, RhsError};
 
     /// DOPRI5's stepper over `[t0, t_end]` with the given controller, every step recorded.
@@ -972,5 +1034,206 @@ mod tests {
         let norm = weighted_rms(2, |i| ([0.0, 3.0][i], [0.0, 1.0][i]));
         assert!((norm - 4.5_f64.sqrt()).abs() < 1e-15);
         assert_eq!(weighted_rms(1, |_| (1.0, 0.0)), f64::INFINITY);
+    }
+
+    /// The restricted three-body problem (Arenstorf's orbit, Hairer–Nørsett–Wanner I,
+    /// §II.0): `y = [y₁, y₂, ẏ₁, ẏ₂]`, the moon's mass ratio `μ = 0.012277471`. Only `+ − × /`
+    /// and `√`, which IEEE 754 rounds exactly, so its bits are the same on every platform.
+    fn arenstorf() -> OdeFn<impl FnMut(f64, &[f64], &mut [f64])> {
+        OdeFn::new(4, |_t: f64, y: &[f64], dy: &mut [f64]| {
+            let mu = 0.012277471;
+            let mu1 = 1.0 - mu;
+            let r1 = (y[0] + mu) * (y[0] + mu) + y[1] * y[1];
+            let r2 = (y[0] - mu1) * (y[0] - mu1) + y[1] * y[1];
+            let (d1, d2) = (r1 * r1.sqrt(), r2 * r2.sqrt());
+            dy[0] = y[2];
+            dy[1] = y[3];
+            dy[2] = y[0] + 2.0 * y[3] - mu1 * (y[0] + mu) / d1 - mu * (y[0] - mu1) / d2;
+            dy[3] = y[1] - 2.0 * y[2] - mu1 * y[1] / d1 - mu * y[1] / d2;
+        })
+    }
+
+    /// Arenstorf's initial state and period (Hairer–Nørsett–Wanner I, §II.0, (0.2)).
+    const ARENSTORF_Y0: [f64; 4] = [0.994, 0.0, 0.0, -2.00158510637908252240537862224];
+    const ARENSTORF_PERIOD: f64 = 17.0652165601579625588917206249;
+
+    /// Lorenz's system (σ = 10, ρ = 28, β = 8/3): three components, so the stages take the
+    /// general path rather than the copies compiled for 2, 4, 6 and 8 components.
+    fn lorenz() -> OdeFn<impl FnMut(f64, &[f64], &mut [f64])> {
+        OdeFn::new(3, |_t: f64, y: &[f64], dy: &mut [f64]| {
+            dy[0] = 10.0 * (y[1] - y[0]);
+            dy[1] = y[0] * (28.0 - y[2]) - y[1];
+            dy[2] = y[0] * y[1] - 8.0 / 3.0 * y[2];
+        })
+    }
+
+    /// FNV-1a over the bits of every sample (times and states) of `solution`.
+    fn sample_hash(solution: &Solution) -> u64 {
+        let words = solution.t.iter().chain(&solution.y).map(|v| v.to_bits());
+        words.fold(0xcbf2_9ce4_8422_2325, |hash, word| {
+            word.to_le_bytes().iter().fold(hash, |h, &b| {
+                (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
+            })
+        })
+    }
+
+    /// What pins a run: accepted and rejected steps, evaluations of `F`, the bits of the last
+    /// sample's state and a hash of every sample.
+    #[derive(Debug, PartialEq)]
+    struct Pin {
+        steps: usize,
+        rejected: usize,
+        rhs_evals: usize,
+        last: Vec<u64>,
+        hash: u64,
+    }
+
+    fn pin(solution: &Solution) -> Pin {
+        let (_, last) = solution.last().unwrap();
+        Pin {
+            steps: solution.stats.steps,
+            rejected: solution.stats.rejected,
+            rhs_evals: solution.stats.rhs_evals,
+            last: last.iter().map(|v| v.to_bits()).collect(),
+            hash: sample_hash(solution),
+        }
+    }
+
+    /// A regression pin for the bookkeeping around the steps of DP5(4) and DOP853 (error
+    /// norm, copies on accept, dense output, output recording): the exact step sequences and
+    /// final states of Arenstorf's orbit (4 components, the compiled stages) over one period
+    /// and of Lorenz's system (3 components, the general stages) to t = 2, every step
+    /// recorded and at requested times (dense output). The bits were recorded before that
+    /// bookkeeping was reorganised for speed; any change of a floating-point operation in a
+    /// step, its order included, changes them. (The problems use only `+ − × /` and `√`, but
+    /// the step-size controller takes `ln` and `exp` from the platform's math library: the
+    /// bits are those of glibc on x86-64 Linux, where CI runs.) Independently of the pin,
+    /// the orbit closes (the state after one period equals the initial state to 1e-4, a loose
+    /// bound: a run that lost the orbit, which passes close to the moon, misses it by order 1)
+    /// and every run with requested times ends on the same state, to the bit, as the run
+    /// that records every step.
+    #[test]
+    fn dormand_prince_runs_are_pinned_to_the_bit() {
+        let options = IntegratorOptions::default().with_rtol(1e-9).with_atol(1e-9);
+        let arenstorf_times: Vec<f64> = (1..=40)
+            .map(|k| ARENSTORF_PERIOD * f64::from(k) / 40.0)
+            .collect();
+        let lorenz_times: Vec<f64> = (1..=40).map(|k| 2.0 * f64::from(k) / 40.0).collect();
+        let mut actual = Vec::new();
+        for method in [
+            &mut DormandPrince54::new() as &mut dyn Integrator,
+            &mut DormandPrince853::new(),
+        ] {
+            let mut system = arenstorf();
+            let y0 = ARENSTORF_Y0;
+            for output in [OutputTimes::Steps, OutputTimes::At(arenstorf_times.clone())] {
+                let solution = method
+                    .integrate(&mut system, 0.0, &y0, ARENSTORF_PERIOD, &output, &options)
+                    .unwrap();
+                let (t, y) = solution.last().unwrap();
+                assert_eq!(t, ARENSTORF_PERIOD);
+                for (a, b) in y.iter().zip(&y0) {
+                    assert!((a - b).abs() < 1e-4, "{}: {y:?}", method.name());
+                }
+                actual.push(pin(&solution));
+            }
+            let mut system = lorenz();
+            for output in [OutputTimes::Steps, OutputTimes::At(lorenz_times.clone())] {
+                let solution = method
+                    .integrate(&mut system, 0.0, &[1.0, 1.0, 1.0], 2.0, &output, &options)
+                    .unwrap();
+                actual.push(pin(&solution));
+            }
+        }
+        for pair in actual.chunks(2) {
+            assert_eq!(pair[0].last, pair[1].last, "Steps and At end alike");
+        }
+        let expected = vec![
+            // DP5(4), Arenstorf, every step.
+            Pin {
+                steps: 530,
+                rejected: 5,
+                rhs_evals: 3212,
+                last: vec![
+                    0x3fefced8fdde5cf1,
+                    0xbe7e40568bd2d000,
+                    0xbef3678ca5546000,
+                    0xc0000342cd11c8f4,
+                ],
+                hash: 0xd155cd3cd02586d0,
+            },
+            // DP5(4), Arenstorf, at 40 times.
+            Pin {
+                steps: 530,
+                rejected: 5,
+                rhs_evals: 3212,
+                last: vec![
+                    0x3fefced8fdde5cf1,
+                    0xbe7e40568bd2d000,
+                    0xbef3678ca5546000,
+                    0xc0000342cd11c8f4,
+                ],
+                hash: 0xa0ae95a52819fd3c,
+            },
+            // DP5(4), Lorenz, every step.
+            Pin {
+                steps: 313,
+                rejected: 0,
+                rhs_evals: 1880,
+                last: vec![0xc02058d4fc199472, 0xc0231fc19184eb36, 0x40389ee655013efd],
+                hash: 0x4a5cf0ca3efeea1d,
+            },
+            // DP5(4), Lorenz, at 40 times.
+            Pin {
+                steps: 313,
+                rejected: 0,
+                rhs_evals: 1880,
+                last: vec![0xc02058d4fc199472, 0xc0231fc19184eb36, 0x40389ee655013efd],
+                hash: 0x5c372d12f87933ea,
+            },
+            // DOP853, Arenstorf, every step.
+            Pin {
+                steps: 136,
+                rejected: 50,
+                rhs_evals: 2184,
+                last: vec![
+                    0x3fefced91dab5e47,
+                    0x3e68165b5e982000,
+                    0x3ede8ac525d82000,
+                    0xc000033df742a703,
+                ],
+                hash: 0xe67b4d8581dc05da,
+            },
+            // DOP853, Arenstorf, at 40 times.
+            Pin {
+                steps: 136,
+                rejected: 50,
+                rhs_evals: 2301,
+                last: vec![
+                    0x3fefced91dab5e47,
+                    0x3e68165b5e982000,
+                    0x3ede8ac525d82000,
+                    0xc000033df742a703,
+                ],
+                hash: 0x9075b0ed3960a1f3,
+            },
+            // DOP853, Lorenz, every step.
+            Pin {
+                steps: 59,
+                rejected: 10,
+                rhs_evals: 820,
+                last: vec![0xc02058d4fb88dc98, 0xc0231fc191782d47, 0x40389ee6543c5fc9],
+                hash: 0x975a03c5a2041a6d,
+            },
+            // DOP853, Lorenz, at 40 times.
+            Pin {
+                steps: 59,
+                rejected: 10,
+                rhs_evals: 937,
+                last: vec![0xc02058d4fb88dc98, 0xc0231fc191782d47, 0x40389ee6543c5fc9],
+                hash: 0xae328b89715d00ca,
+            },
+        ];
+        assert_eq!(actual, expected);
     }
 }

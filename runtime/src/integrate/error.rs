@@ -109,6 +109,15 @@ pub enum IntegrationError {
         /// The method's [`name`](super::Integrator::name).
         method: &'static str,
     },
+    /// The Taylor method needs the system's Taylor recurrences
+    /// ([`OdeSystem::taylor_support`](crate::OdeSystem::taylor_support)), and this one has
+    /// none: equations given as a closure, a model with constraints, or equations that use a
+    /// function without a recurrence (the reason says which).
+    #[error("the Taylor method cannot integrate this system: {reason}")]
+    NoTaylorRecurrences {
+        /// Why, naming what is missing.
+        reason: String,
+    },
     /// The step size fell below `16 ε · max(|t|, t_end − t0)`: the solution changes faster
     /// than the method can follow (a singularity, or stiffness for an explicit method).
     #[error("the step size {dt:e} fell below the smallest usable step at t = {t}")]
@@ -240,7 +249,8 @@ impl IntegrationError {
             | IntegrationError::InvalidStepSize { .. }
             | IntegrationError::OutputTimesNotSorted { .. }
             | IntegrationError::OutputTimeOutOfRange { .. }
-            | IntegrationError::NotSecondOrder { .. } => None,
+            | IntegrationError::NotSecondOrder { .. }
+            | IntegrationError::NoTaylorRecurrences { .. } => None,
         }
     }
 }

@@ -9,6 +9,10 @@
 //! | Bogacki–Shampine 3(2) | [`BogackiShampine32`] | 3 | adaptive ([`PiController`]) or fixed | cubic Hermite (order 3) |
 //! | Dormand–Prince 5(4) | [`DormandPrince54`] | 5 | adaptive ([`PiController`]) or fixed | Shampine's quartic (order 4) |
 //! | DOP853 | [`DormandPrince853`] | 8 | adaptive ([`PiController`]) or fixed | Hairer's septic (order 7) |
+//! | Verner 6(5) | [`Verner65`] | 6 | adaptive ([`PiController`]) or fixed | Verner's (order 6, 3 extra stages) |
+//! | Verner 7(6) | [`Verner76`] | 7 | adaptive ([`PiController`]) or fixed | Verner's (order 7, 5 extra stages) |
+//! | Verner 8(7) | [`Verner87`] | 8 | adaptive ([`PiController`]) or fixed | Verner's (order 8, 7 extra stages) |
+//! | Verner 9(8) | [`Verner98`] | 9 | adaptive ([`PiController`]) or fixed | Verner's (order 9, 9 extra stages) |
 //! | symplectic Euler | [`SymplecticEuler`] | 1 | fixed `dt`, `y = [q; q̇]` | cubic Hermite |
 //! | Störmer–Verlet | [`StormerVerlet`] | 2 | fixed `dt`, `y = [q; q̇]` | cubic Hermite |
 //! | implicit midpoint | [`ImplicitMidpoint`] | 2 | fixed `dt`, Newton with `∂F/∂y` | cubic Hermite (order 3) |
@@ -81,6 +85,9 @@ pub mod stability_function;
 mod stepper;
 mod symplectic;
 mod tableau;
+mod taylor;
+mod verner;
+mod verner_tableaus;
 
 pub use bs32::BogackiShampine32;
 pub use controller::{
@@ -98,6 +105,9 @@ pub use rk4::RungeKutta4;
 pub use solution::{Solution, Stats};
 pub use symplectic::{StormerVerlet, SymplecticEuler};
 pub use tableau::Tableau;
+pub use taylor::Taylor;
+pub use verner::{Verner65, Verner76, Verner87, Verner98};
+pub(crate) use verner::verner_methods;
 
 // The event types belong to the ODE interface (`OdeSystem::event_specs`); the root finding is
 // `events`.
@@ -110,7 +120,7 @@ use crate::ode::OdeSystem;
 /// Object safe: the CLI holds methods as `Box<dyn Integrator>`.
 pub trait Integrator {
     /// Short name of the method (`"euler"`, `"midpoint"`, `"rk4"`, `"bs32"`, `"dp54"`,
-    /// `"dop853"`, `"symplectic-euler"`, `"stormer-verlet"`, `"implicit-midpoint"`,
+    /// `"dop853"`, `"vern6"`, `"vern7"`, `"vern8"`, `"vern9"`, `"symplectic-euler"`, `"stormer-verlet"`, `"implicit-midpoint"`,
     /// `"radau5"`).
     fn name(&self) -> &'static str;
 

@@ -24,6 +24,9 @@ pub struct Stats {
     /// Evaluations of the event functions `g(t, y)` (one per accepted step and one per
     /// root-finding iteration; none without events).
     pub event_evals: usize,
+    /// Taylor series of the solution computed by the Taylor method (one per step, each
+    /// to the step's order); 0 for the other methods.
+    pub taylor_series: usize,
     /// Wall-clock time of the whole `integrate` call (s).
     pub wall_time_s: f64,
 }

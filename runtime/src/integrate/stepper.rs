@@ -181,6 +181,7 @@ pub(crate) struct CheckedRhs<'a> {
     jacobian_evals: usize,
     lu_decompositions: usize,
     event_evals: usize,
+    taylor_series: usize,
 }
 
 impl<'a> CheckedRhs<'a> {
@@ -192,6 +193,7 @@ impl<'a> CheckedRhs<'a> {
             jacobian_evals: 0,
             lu_decompositions: 0,
             event_evals: 0,
+            taylor_series: 0,
         }
     }
 
@@ -208,6 +210,29 @@ impl<'a> CheckedRhs<'a> {
     /// Number of factorisations counted with [`count_lu`](Self::count_lu) so far.
     pub(crate) fn lu_decompositions(&self) -> usize {
         self.lu_decompositions
+    }
+
+    /// Number of Taylor series computed so far ([`Self::taylor_coefficients`]).
+    pub(crate) fn taylor_series(&self) -> usize {
+        self.taylor_series
+    }
+
+    /// The Taylor coefficients of the solution through `(t, y)` up to `order`
+    /// ([`OdeSystem::taylor_coefficients`]), counted.
+    ///
+    /// # Errors
+    /// [`StepFailure::Rhs`] at `t` if the series cannot be computed or is not finite.
+    pub(crate) fn taylor_coefficients(
+        &mut self,
+        t: f64,
+        y: &[f64],
+        order: usize,
+        out: &mut [f64],
+    ) -> Result<(), StepFailure> {
+        self.taylor_series += 1;
+        self.system
+            .taylor_coefficients(t, y, order, out)
+            .map_err(|error| StepFailure::Rhs { t, error })
     }
 
     /// Number of evaluations of the event functions so far.
@@ -449,6 +474,13 @@ pub(crate) trait Stepper: DenseOutput {
     /// The Newton work of the last successful attempt, for methods that iterate (the
     /// controller adapts the step size to it); `None` (the default) for the others.
     fn newton_work(&self) -> Option<NewtonWork> {
+        None
+    }
+
+    /// The step the method proposes from its current state, for methods that choose their
+    /// steps a priori (the Taylor method, [`Control::Proposed`](super::driver::Control));
+    /// `None` (the default) for the others.
+    fn proposed_step(&self) -> Option<f64> {
         None
     }
 

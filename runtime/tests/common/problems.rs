@@ -318,6 +318,10 @@ pub fn needs_second_order(name: &str) -> bool {
         | Method::Bs32
         | Method::Dp54
         | Method::Dop853
+        | Method::Vern6
+        | Method::Vern7
+        | Method::Vern8
+        | Method::Vern9
         | Method::ImplicitMidpoint
         | Method::Radau5 => false,
     }

@@ -13,6 +13,7 @@ mod listing;
 pub mod plan;
 pub mod program;
 pub mod tape;
+pub mod taylor;
 
 pub use describe::{describe, description_tokens};
 pub use listing::{
@@ -364,6 +365,18 @@ pub fn emit(
             methods.extend(function_method(function, body, model, &types));
         }
     }
+    // The Taylor recurrences, from the tape of `M` and `F` the run-time compiler builds too.
+    let taylor = taylor::taylor_program(
+        &program::mass_matrix_and_forcing_tape(model, &plans.state),
+        n,
+        model.constraints.len(),
+    );
+    let parameter_fields = model
+        .parameters
+        .iter()
+        .map(|p| ident(&field_name(&p.name)))
+        .collect::<Result<Vec<_>, _>>()?;
+    methods.extend(taylor::methods(&taylor, &krate, &parameter_fields)?);
     let both: Vec<ExprId> = [eom.mass_matrix.clone(), eom.forcing.clone()].concat();
     let stats = EmitStats {
         ops_before_cse: model.arena.tree_operation_count(&both),

@@ -103,19 +103,9 @@ impl ModelProgram {
     /// [`super::plan::plan_state`] (the ones [`super::emit`] prints) lowered to tapes.
     pub fn plan(model: &SymbolicModel, eom: &EquationsOfMotion) -> ModelProgram {
         use ModelFunction as F;
-        let n = model.num_dofs();
         let plans = super::plan::plan_state(model, eom, &[]);
         let tapes = Tapes::new(model, &plans);
-        let mut mass_and_forcing = tapes.get(F::MassMatrixAndForcing);
-        // `M` column-major, then `F`.
-        let (mass, forcing) = mass_and_forcing.outputs.split_at(n * n);
-        let mut outputs = column_major_order(mass, n);
-        outputs.extend_from_slice(forcing);
-        mass_and_forcing.outputs = outputs;
-        let mass_matrix_and_forcing = FunctionTape {
-            tape: mass_and_forcing,
-            split: n * n,
-        };
+        let mass_matrix_and_forcing = mass_matrix_and_forcing_tape(model, &plans);
         let mut points = tapes.get(F::PointPositions);
         // `[x, y, z]` per point, `z = 0` for 2-D points.
         let zero = points.instructions.len() as u32;
@@ -278,6 +268,21 @@ impl<'a> Tapes<'a> {
             .map(|plan| Tape::from_plan(&self.plans.arena, plan, &self.parameters))
             .unwrap_or_default()
     }
+}
+
+/// The tape of [`ModelFunction::MassMatrixAndForcing`] of `plans` (as
+/// [`super::plan::plan_state`] made them): `M` column-major, then `F` — what the run-time
+/// compiler evaluates, and what the Taylor recurrences ([`super::taylor`]) are built from
+/// by both backends.
+pub fn mass_matrix_and_forcing_tape(model: &SymbolicModel, plans: &ModelPlans) -> FunctionTape {
+    let n = model.num_dofs();
+    let tapes = Tapes::new(model, plans);
+    let mut tape = tapes.get(ModelFunction::MassMatrixAndForcing);
+    let (mass, forcing) = tape.outputs.split_at((n * n).min(tape.outputs.len()));
+    let mut outputs = column_major_order(mass, n);
+    outputs.extend_from_slice(forcing);
+    tape.outputs = outputs;
+    FunctionTape { tape, split: n * n }
 }
 
 /// The outputs of a row-major `n × n` matrix in column-major order.

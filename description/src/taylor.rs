@@ -1,0 +1,300 @@
+//! The recurrences of a model's Taylor series: [`TaylorProgram`].
+//!
+//! A model's equations `M(q, t) q̈ = F(q, q̇, t)` are a straight-line program over `q`, `q̇`,
+//! `t` and the parameters (the CSE plan the model's code is printed from). Read with series
+//! `x(t₀ + τ) = Σₖ x^[k] τᵏ` for every value of that program, each operation has a recurrence
+//! that gives its coefficient of order `k` from those of its operands of orders `≤ k` and its
+//! own of orders `< k` (automatic differentiation in Taylor mode: Jorba & Zou 2005, §2;
+//! Biscani & Izzo 2021, heyoka's `doc/ad_notes.rst`). A [`TaylorProgram`] lists those
+//! operations, one [`SeriesOp`] each, over numbered *slots* (one series per value):
+//!
+//! - order 0 is the model's own evaluation of `M` and `F`, every value kept (the generated
+//!   `taylor_values` of a compiled model, the run-time model's tape);
+//! - orders `k ≥ 1` are [`TaylorProgram::ops`] in order, for one `k` at a time; values that
+//!   depend only on parameters and constants are *constant* (their series stops at order 0)
+//!   and never appear as an op's output.
+//!
+//! The symbolic crate builds one program per model (`eomgen_symbolic::codegen::taylor`), the
+//! `model!` macro prints it as a `static` (and its ops as inlined calls), the run-time compiler
+//! keeps it as a value, and the runtime's series of motion (`eomgen_runtime::taylor`) drives
+//! it: state series in, series of `M` and `F` out, `M^[0] a^[k] = F^[k] − Σⱼ M^[j] a^[k−j]`
+//! for the accelerations.
+//!
+//! Series are stored by slot: order `k` of slot `s` at `s · capacity + k`, `capacity` the
+//! highest order plus one.
+
+use std::borrow::Cow;
+
+use serde::Serialize;
+
+use crate::List;
+
+/// A slot: the index of one series (a value of the model's program, or an auxiliary series
+/// an op keeps).
+pub type Slot = u32;
+
+/// One operation of the orders `k ≥ 1`: it writes order `k` of its output slot(s) from the
+/// orders `≤ k` of its operands and the orders `< k` of its outputs.
+///
+/// Operands named `constant` are constant slots (only order 0 is read). The recurrences are
+/// those of Jorba & Zou (2005, §2.1) and heyoka's `doc/ad_notes.rst`; `x^[k]` is the
+/// coefficient of order `k`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub enum SeriesOp {
+    /// `out^[k] = −a^[k]`.
+    Neg {
+        /// Output.
+        out: Slot,
+        /// Operand.
+        a: Slot,
+    },
+    /// `out^[k] = a^[k]` (a series plus or minus a constant).
+    Copy {
+        /// Output.
+        out: Slot,
+        /// Operand.
+        a: Slot,
+    },
+    /// `out^[k] = a^[k] + b^[k]`.
+    Add {
+        /// Output.
+        out: Slot,
+        /// First operand.
+        a: Slot,
+        /// Second operand.
+        b: Slot,
+    },
+    /// `out^[k] = a^[k] − b^[k]`.
+    Sub {
+        /// Output.
+        out: Slot,
+        /// First operand.
+        a: Slot,
+        /// Second operand.
+        b: Slot,
+    },
+    /// `out^[k] = Σⱼ₌₀ᵏ a^[j] b^[k−j]` (Cauchy product).
+    Mul {
+        /// Output.
+        out: Slot,
+        /// First operand.
+        a: Slot,
+        /// Second operand.
+        b: Slot,
+    },
+    /// `out^[k] = a^[k] · constant^[0]`.
+    Scale {
+        /// Output.
+        out: Slot,
+        /// Series operand.
+        a: Slot,
+        /// Constant operand.
+        constant: Slot,
+    },
+    /// `out = a / b`: `out^[k] = (a^[k] − Σⱼ₌₁ᵏ b^[j] out^[k−j]) / b^[0]`.
+    Div {
+        /// Output.
+        out: Slot,
+        /// Numerator.
+        a: Slot,
+        /// Denominator.
+        b: Slot,
+    },
+    /// `out = a / constant`: `out^[k] = a^[k] / constant^[0]`.
+    DivByConstant {
+        /// Output.
+        out: Slot,
+        /// Numerator.
+        a: Slot,
+        /// Constant denominator.
+        constant: Slot,
+    },
+    /// `out = constant / b`: `out^[k] = −(Σⱼ₌₁ᵏ b^[j] out^[k−j]) / b^[0]`.
+    ConstantDiv {
+        /// Output.
+        out: Slot,
+        /// Denominator.
+        b: Slot,
+    },
+    /// `out = √a`: `out^[k] = (a^[k] − Σⱼ₌₁ᵏ⁻¹ out^[j] out^[k−j]) / (2 out^[0])`.
+    Sqrt {
+        /// Output.
+        out: Slot,
+        /// Operand.
+        a: Slot,
+    },
+    /// `out = a^α` for a constant `α = exponent^[0]`:
+    /// `out^[k] = Σⱼ₌₀ᵏ⁻¹ (k α − j (α + 1)) a^[k−j] out^[j] / (k a^[0])`.
+    PowConstant {
+        /// Output.
+        out: Slot,
+        /// Base.
+        a: Slot,
+        /// Constant exponent.
+        exponent: Slot,
+    },
+    /// `out = eᵃ`: `out^[k] = (Σⱼ₌₁ᵏ j a^[j] out^[k−j]) / k`.
+    Exp {
+        /// Output.
+        out: Slot,
+        /// Operand.
+        a: Slot,
+    },
+    /// `out = ln a`: `out^[k] = (k a^[k] − Σⱼ₌₁ᵏ⁻¹ j a^[k−j] out^[j]) / (k a^[0])`.
+    Ln {
+        /// Output.
+        out: Slot,
+        /// Operand.
+        a: Slot,
+    },
+    /// `sin a` and `cos a` together: `sin^[k] = (Σⱼ₌₁ᵏ j a^[j] cos^[k−j]) / k`,
+    /// `cos^[k] = −(Σⱼ₌₁ᵏ j a^[j] sin^[k−j]) / k`.
+    SinCos {
+        /// `sin a`.
+        sin: Slot,
+        /// `cos a`.
+        cos: Slot,
+        /// Operand.
+        a: Slot,
+    },
+    /// `sinh a` and `cosh a` together: as [`SeriesOp::SinCos`] with `+` in both.
+    SinhCosh {
+        /// `sinh a`.
+        sinh: Slot,
+        /// `cosh a`.
+        cosh: Slot,
+        /// Operand.
+        a: Slot,
+    },
+    /// `out = tan a`, `square = out²`: `out^[k] = a^[k] + (Σⱼ₌₁ᵏ j a^[j] square^[k−j]) / k`,
+    /// then `square^[k]` by the Cauchy product.
+    Tan {
+        /// Output.
+        out: Slot,
+        /// Operand.
+        a: Slot,
+        /// Auxiliary `tan² a`.
+        square: Slot,
+    },
+    /// `out = tanh a`, `square = out²`: `out^[k] = a^[k] − (Σⱼ₌₁ᵏ j a^[j] square^[k−j]) / k`,
+    /// then `square^[k]`.
+    Tanh {
+        /// Output.
+        out: Slot,
+        /// Operand.
+        a: Slot,
+        /// Auxiliary `tanh² a`.
+        square: Slot,
+    },
+    /// `out = asin a` (`sign = 1`) or `acos a` (`sign = −1`), `root = √(1 − a²)`:
+    /// `root^[k]` from `root² = 1 − a²`, then
+    /// `out^[k] = (sign k a^[k] − Σⱼ₌₁ᵏ⁻¹ j out^[j] root^[k−j]) / (k root^[0])`.
+    Asin {
+        /// Output.
+        out: Slot,
+        /// Operand.
+        a: Slot,
+        /// Auxiliary `√(1 − a²)`.
+        root: Slot,
+        /// Whether this is `acos` (`out' = −a'/root`).
+        acos: bool,
+    },
+    /// `out = atan a`, `square = a²`: `square^[k]` first, then
+    /// `out^[k] = (k a^[k] − Σⱼ₌₁ᵏ⁻¹ j out^[j] square^[k−j]) / (k (1 + square^[0]))`.
+    Atan {
+        /// Output.
+        out: Slot,
+        /// Operand.
+        a: Slot,
+        /// Auxiliary `a²`.
+        square: Slot,
+    },
+    /// `out = atan2(y, x)`, `norm = x² + y²`: `norm^[k]` first, then
+    /// `out^[k] = (Σⱼ₌₁ᵏ j (x^[k−j] y^[j] − y^[k−j] x^[j]) − Σⱼ₌₁ᵏ⁻¹ j out^[j] norm^[k−j]) / (k norm^[0])`.
+    Atan2 {
+        /// Output.
+        out: Slot,
+        /// `y`.
+        y: Slot,
+        /// `x`.
+        x: Slot,
+        /// Auxiliary `x² + y²`.
+        norm: Slot,
+    },
+    /// `out^[k] = 0`: a constant slot read as a whole series by an op without a constant form
+    /// ([`SeriesOp::Atan2`]), zeroed above order 0 before its readers.
+    Zero {
+        /// Output.
+        out: Slot,
+    },
+}
+
+/// A model's Taylor recurrences, with where the state goes in and `M` and `F` come out.
+///
+/// # Shapes
+/// `n` degrees of freedom; `coordinates`, `velocities`: `n` slots each (or `None` for an
+/// input the equations do not read); `mass_matrix`: `n × n` slots, **column-major**;
+/// `forcing`: `n` slots. A slot marked constant ([`Self::constant`]) holds only order 0.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct TaylorProgram {
+    /// Number of slots: the series a workspace holds.
+    pub slots: usize,
+    /// Where `qᵢ` is read (its series is written there before each order).
+    pub coordinates: List<Option<Slot>>,
+    /// Where `q̇ᵢ` is read.
+    pub velocities: List<Option<Slot>>,
+    /// Where `t` is read (`t^[0] = t₀`, `t^[1] = 1`, the rest 0).
+    pub time: Option<Slot>,
+    /// `M` entry by entry, column-major.
+    pub mass_matrix: List<Slot>,
+    /// `F`.
+    pub forcing: List<Slot>,
+    /// Whether each slot is constant (its orders above 0 are never written nor read).
+    pub constant: List<bool>,
+    /// The operations of orders `k ≥ 1`, in order.
+    pub ops: List<SeriesOp>,
+}
+
+/// Why a model has no Taylor recurrences.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+pub enum TaylorUnsupported {
+    /// The model has constraints: the Taylor method integrates `M q̈ = F` only.
+    Constraints {
+        /// How many.
+        count: usize,
+    },
+    /// A function of the equations has no recurrence (`abs`, `sign`, `step`: piecewise, their
+    /// series would not see the switch), or a power has a non-constant exponent.
+    Functions {
+        /// The functions, by name, each once, in order of appearance.
+        names: List<Cow<'static, str>>,
+    },
+    /// The model was written by hand, without a program.
+    NotGenerated,
+}
+
+impl std::fmt::Display for TaylorUnsupported {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            TaylorUnsupported::Constraints { count } => write!(
+                f,
+                "the model has {count} constraint(s); the Taylor method integrates unconstrained \
+                 equations M q̈ = F only"
+            ),
+            TaylorUnsupported::Functions { names } => {
+                let list: Vec<String> = names.iter().map(|n| format!("`{n}`")).collect();
+                write!(
+                    f,
+                    "the equations use {} which has no Taylor recurrence (a piecewise function \
+                     or a power with a variable exponent)",
+                    list.join(", ")
+                )
+            }
+            TaylorUnsupported::NotGenerated => {
+                write!(f, "the model has no generated Taylor recurrences")
+            }
+        }
+    }
+}
+
+impl std::error::Error for TaylorUnsupported {}

@@ -1,0 +1,416 @@
+//! The Rust side of the work–precision comparison with peer codes: eomgen's integration
+//! methods (by their [`Method`] names) and the peer crate `ode_solvers` (0.6.2, a
+//! dev-dependency) on the same compiled model, one JSON line per run on stdout.
+//! `tools/work_precision_peers.py` runs this program in alternating rounds with
+//! `tools/heyoka_peer.py` and builds the tables and the chart.
+//!
+//! ```sh
+//! cargo build --release --no-default-features --example work_precision_peers
+//! P=target/release/examples/work_precision_peers
+//! $P initial --model double_pendulum            # y(0) as JSON (shortest round-trip digits)
+//! $P rhs --model double_pendulum --state 0.1,0.2,0.3,0.4   # F(0, y) as JSON
+//! $P run --model double_pendulum --t-end 10 --methods dp54,dop853,ode_solvers-dop853 \
+//!     --tols 1e-2,1e-3,1e-4 --reps 5 [--reference reference.json]
+//! ```
+//!
+//! Models: `double_pendulum` (`models/double_pendulum.yaml`, HW19, 4 states) and
+//! `figure_eight` (`models/figure_eight.yaml`, HW7, 12 states), with the files' default
+//! parameters and initial states, as compiled by `model!` into [`eomgen::models`].
+//!
+//! Methods: every adaptive [`Method`] by its command-line name (`dp54`, `dop853`, and any
+//! method added to [`Method::ALL`] later), run through [`Method::integrator`] with
+//! `rtol = atol = tol`, at most 10⁶ steps, every accepted step recorded
+//! ([`OutputTimes::Steps`]), the system passed as its concrete [`FirstOrder`] type (as the
+//! command line and `benches/peers.rs` do); and `ode_solvers-dop853`, `ode_solvers-dopri5`:
+//! ode_solvers' Dop853 and Dopri5 with `rtol = atol = tol` and their default controllers
+//! (the settings of `benches/peers.rs`: safety 0.9, Dop853 `beta = 0`, step ratio in
+//! `[0.333, 6]`, Dopri5 `beta = 0.04`, `[0.2, 10]`, `h_max = t_end`, automatic first step,
+//! at most 10⁶ steps, `OutputType::Sparse`), calling the same [`FirstOrder`] right-hand
+//! side through a `RefCell` (ode_solvers' `System::system` takes `&self`). Fixed-step
+//! methods have no tolerance and are rejected.
+//!
+//! `run` prints, for each method and tolerance, one line
+//! `{"side", "method", "model", "tol", "t_end", "time_s", "times_s", "rhs_evals", "steps",
+//! "rejected", "final_state", "error", "energy_drift"}`: `time_s` is the median of `reps`
+//! timed integrations (s, wall clock, `Instant`, the integrator built before the clock
+//! starts), `error = max |yᵢ(t_end) − y_refᵢ|` over the state (the rule of
+//! `benches/peers.rs`; `null` without `--reference`), `energy_drift = |E(t_end) − E(0)| /
+//! |E(0)|` (total energy by [`ModelInfo::energy`]). A failed run prints
+//! `{"side", "method", "model", "tol", "failed": message}`. The reference file is JSON
+//! `{"<model>": {"t_end": 10.0, "state": ["<decimal>", …]}, …}` (as written by
+//! `tools/heyoka_peer.py reference`); its decimals are read as the nearest `f64`.
+
+use std::cell::RefCell;
+use std::hint::black_box;
+use std::process::ExitCode;
+use std::str::FromStr;
+use std::time::Instant;
+
+use eomgen::models::{DoublePendulum, FigureEight};
+use eomgen::{FirstOrder, IntegratorOptions, Method, ModelInfo, OdeSystem, OutputTimes};
+use ode_solvers::{Dop853, Dopri5, OutputType};
+use serde_json::{Value, json};
+
+/// Largest number of steps of any run.
+const MAX_STEPS: usize = 1_000_000;
+
+/// A method of the comparison: one of eomgen's, or one of ode_solvers'.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Runner {
+    /// An adaptive eomgen method.
+    Eomgen(Method),
+    /// ode_solvers' Dop853 (Hairer's DOP853).
+    PeerDop853,
+    /// ode_solvers' Dopri5 (Dormand–Prince 5(4)).
+    PeerDopri5,
+}
+
+impl Runner {
+    /// The name in the output: eomgen's [`Method::name`], or `ode_solvers-dop853`,
+    /// `ode_solvers-dopri5`.
+    fn name(self) -> String {
+        match self {
+            Runner::Eomgen(m) => m.name().to_string(),
+            Runner::PeerDop853 => "ode_solvers-dop853".to_string(),
+            Runner::PeerDopri5 => "ode_solvers-dopri5".to_string(),
+        }
+    }
+
+    /// The code that runs it: `eomgen` or `ode_solvers`.
+    fn side(self) -> &'static str {
+        match self {
+            Runner::Eomgen(_) => "eomgen",
+            Runner::PeerDop853 | Runner::PeerDopri5 => "ode_solvers",
+        }
+    }
+}
+
+impl FromStr for Runner {
+    type Err = String;
+
+    /// `ode_solvers-dop853`, `ode_solvers-dopri5`, or an adaptive [`Method`]'s name.
+    fn from_str(name: &str) -> Result<Self, String> {
+        match name {
+            "ode_solvers-dop853" => Ok(Runner::PeerDop853),
+            "ode_solvers-dopri5" => Ok(Runner::PeerDopri5),
+            _ => {
+                let method: Method = name.parse().map_err(|e| format!("{e}"))?;
+                if method.is_adaptive() {
+                    Ok(Runner::Eomgen(method))
+                } else {
+                    Err(format!(
+                        "`{name}` is a fixed-step method (no tolerance to sweep)"
+                    ))
+                }
+            }
+        }
+    }
+}
+
+/// What one run measured.
+struct Measurement {
+    final_state: Vec<f64>,
+    rhs_evals: usize,
+    steps: usize,
+    rejected: usize,
+    times_s: Vec<f64>,
+}
+
+/// `y(t_end)` of ode_solvers' `$solver` (`Dop853` or `Dopri5`) on `$system` (a
+/// `&RefCell<FirstOrder<…>>`) from `$y0` (a `&[f64]` of length `$dim`) at `rtol = atol =
+/// $tol`, with the controller's `beta` and step-ratio bounds; `(state, evaluations, accepted,
+/// rejected)` or the solver's error message.
+macro_rules! peer_run {
+    ($solver:ident, $dim:literal, $system:expr, $y0:expr, $t_end:expr, $tol:expr,
+     $beta:expr, $fac_min:expr, $fac_max:expr) => {{
+        /// The shared first-order system as an ode_solvers `System`.
+        struct Peer<'a, S>(&'a RefCell<S>);
+        impl<S: OdeSystem> ode_solvers::System<f64, ode_solvers::SVector<f64, $dim>> for Peer<'_, S> {
+            /// # Panics
+            /// If the right-hand side fails (ode_solvers has no error channel); neither
+            /// model's does at the states of these orbits.
+            fn system(
+                &self,
+                t: f64,
+                y: &ode_solvers::SVector<f64, $dim>,
+                dy: &mut ode_solvers::SVector<f64, $dim>,
+            ) {
+                self.0
+                    .borrow_mut()
+                    .rhs(t, y.as_slice(), dy.as_mut_slice())
+                    .expect("the model's right-hand side");
+            }
+        }
+        // (f, x, x_end, dx (unused by Sparse), y, rtol, atol, safety, beta, fac_min,
+        //  fac_max, h_max, h (0: automatic), n_max, n_stiff, out_type)
+        let mut stepper = $solver::from_param(
+            Peer($system),
+            0.0,
+            $t_end,
+            $t_end,
+            ode_solvers::SVector::<f64, $dim>::from_column_slice($y0),
+            $tol,
+            $tol,
+            0.9,
+            $beta,
+            $fac_min,
+            $fac_max,
+            $t_end,
+            0.0,
+            MAX_STEPS as u32,
+            1000,
+            OutputType::Sparse,
+        );
+        match stepper.integrate() {
+            Ok(stats) => match (stepper.x_out().last(), stepper.y_out().last()) {
+                (Some(&t), Some(y)) if t == $t_end => Ok((
+                    y.as_slice().to_vec(),
+                    stats.num_eval as usize,
+                    stats.accepted_steps as usize,
+                    stats.rejected_steps as usize,
+                )),
+                _ => Err(format!("ode_solvers stopped before t = {}", $t_end)),
+            },
+            Err(e) => Err(format!("ode_solvers: {e:?}")),
+        }
+    }};
+}
+
+/// One run of `runner` on `system` from `y0` to `t_end` at `rtol = atol = tol`:
+/// `(final state, evaluations, accepted steps, rejected steps)`.
+macro_rules! run_once {
+    ($dim:literal, $runner:expr, $system:expr, $y0:expr, $t_end:expr, $tol:expr) => {{
+        let (runner, system, y0, t_end, tol): (Runner, &RefCell<_>, &[f64], f64, f64) =
+            ($runner, $system, $y0, $t_end, $tol);
+        match runner {
+            Runner::Eomgen(method) => {
+                let options = IntegratorOptions::default()
+                    .with_rtol(tol)
+                    .with_atol(tol)
+                    .with_max_steps(MAX_STEPS);
+                let mut integrator = method.integrator();
+                let mut system = system.borrow_mut();
+                integrator
+                    .integrate(&mut *system, 0.0, y0, t_end, &OutputTimes::Steps, &options)
+                    .map_err(|e| format!("{e}"))
+                    .and_then(|solution| match solution.last() {
+                        Some((t, y)) if t == t_end => Ok((
+                            y.to_vec(),
+                            solution.stats.rhs_evals,
+                            solution.stats.steps,
+                            solution.stats.rejected,
+                        )),
+                        _ => Err(format!("stopped before t = {t_end}")),
+                    })
+            }
+            Runner::PeerDop853 => peer_run!(Dop853, $dim, system, y0, t_end, tol, 0.0, 0.333, 6.0),
+            Runner::PeerDopri5 => peer_run!(Dopri5, $dim, system, y0, t_end, tol, 0.04, 0.2, 10.0),
+        }
+    }};
+}
+
+/// Runs `runner` `reps` times (the first run also gives the state and counts) and times each
+/// run.
+macro_rules! measure {
+    ($dim:literal, $runner:expr, $system:expr, $y0:expr, $t_end:expr, $tol:expr, $reps:expr) => {{
+        let (final_state, rhs_evals, steps, rejected) =
+            run_once!($dim, $runner, $system, $y0, $t_end, $tol)?;
+        let mut times_s = Vec::with_capacity($reps);
+        for _ in 0..$reps {
+            let start = Instant::now();
+            let outcome = run_once!($dim, $runner, $system, black_box($y0), $t_end, $tol);
+            times_s.push(start.elapsed().as_secs_f64());
+            black_box(outcome)?;
+        }
+        Ok::<Measurement, String>(Measurement {
+            final_state,
+            rhs_evals,
+            steps,
+            rejected,
+            times_s,
+        })
+    }};
+}
+
+/// The median of `values` (the upper one of an even count).
+fn median(values: &[f64]) -> f64 {
+    let mut sorted = values.to_vec();
+    sorted.sort_by(f64::total_cmp);
+    sorted.get(sorted.len() / 2).copied().unwrap_or(f64::NAN)
+}
+
+/// The command line's options after the subcommand, as `(name, value)` pairs.
+fn options(args: &[String]) -> Result<Vec<(String, String)>, String> {
+    args.chunks(2)
+        .map(|pair| match pair {
+            [name, value] if name.starts_with("--") => Ok((name[2..].to_string(), value.clone())),
+            _ => Err(format!("expected `--name value` pairs, got {pair:?}")),
+        })
+        .collect()
+}
+
+/// The value of option `name`, if given.
+fn option<'a>(options: &'a [(String, String)], name: &str) -> Option<&'a str> {
+    options
+        .iter()
+        .find(|(n, _)| n == name)
+        .map(|(_, v)| v.as_str())
+}
+
+/// A comma-separated list of numbers.
+fn numbers(list: &str) -> Result<Vec<f64>, String> {
+    list.split(',')
+        .map(|x| x.trim().parse::<f64>().map_err(|e| format!("`{x}`: {e}")))
+        .collect()
+}
+
+/// The reference state of `model` in the JSON file at `path`, as `(t_end, state)`.
+fn reference(path: &str, model: &str) -> Result<(f64, Vec<f64>), String> {
+    let text = std::fs::read_to_string(path).map_err(|e| format!("{path}: {e}"))?;
+    let json: Value = serde_json::from_str(&text).map_err(|e| format!("{path}: {e}"))?;
+    let entry = &json[model];
+    let t_end = entry["t_end"]
+        .as_f64()
+        .ok_or_else(|| format!("{path}: no `{model}.t_end`"))?;
+    let state = entry["state"]
+        .as_array()
+        .ok_or_else(|| format!("{path}: no `{model}.state`"))?
+        .iter()
+        .map(|v| match v {
+            Value::String(s) => s.parse::<f64>().map_err(|e| format!("{path}: `{s}`: {e}")),
+            _ => v
+                .as_f64()
+                .ok_or_else(|| format!("{path}: {v} is not a number")),
+        })
+        .collect::<Result<Vec<f64>, String>>()?;
+    Ok((t_end, state))
+}
+
+/// The subcommands for one model type: `initial`, `rhs`, `run`.
+macro_rules! command {
+    ($dim:literal, $model:ty, $name:expr, $command:expr, $opts:expr) => {{
+        let (name, command, opts): (&str, &str, &[(String, String)]) = ($name, $command, $opts);
+        let system = RefCell::new(FirstOrder::new(<$model>::default()));
+        let y0 = ModelInfo::initial_state(&*system.borrow());
+        match command {
+            "initial" => {
+                println!("{}", json!({"model": name, "initial_state": y0}));
+                Ok(())
+            }
+            "rhs" => {
+                let state = numbers(option(opts, "state").ok_or("`rhs` needs --state")?)?;
+                if state.len() != $dim {
+                    return Err(format!("--state needs {} numbers", $dim));
+                }
+                let mut dy = vec![0.0; $dim];
+                system
+                    .borrow_mut()
+                    .rhs(0.0, &state, &mut dy)
+                    .map_err(|e| format!("{e}"))?;
+                println!("{}", json!({"model": name, "state": state, "rhs": dy}));
+                Ok(())
+            }
+            "run" => {
+                let t_end: f64 = option(opts, "t-end")
+                    .ok_or("`run` needs --t-end")?
+                    .parse()
+                    .map_err(|e| format!("--t-end: {e}"))?;
+                let runners = option(opts, "methods")
+                    .ok_or("`run` needs --methods")?
+                    .split(',')
+                    .map(Runner::from_str)
+                    .collect::<Result<Vec<_>, _>>()?;
+                let tols = numbers(option(opts, "tols").ok_or("`run` needs --tols")?)?;
+                let reps: usize = option(opts, "reps")
+                    .unwrap_or("5")
+                    .parse()
+                    .map_err(|e| format!("--reps: {e}"))?;
+                let reference = option(opts, "reference")
+                    .map(|path| reference(path, name))
+                    .transpose()?;
+                if let Some((t_ref, state)) = &reference {
+                    if *t_ref != t_end || state.len() != $dim {
+                        return Err(format!(
+                            "the reference is at t = {t_ref} with {} states, not t = {t_end} \
+                             with {}",
+                            state.len(),
+                            $dim
+                        ));
+                    }
+                }
+                let e0 = system.borrow().energy(0.0, &y0);
+                for &tol in &tols {
+                    for &runner in &runners {
+                        let measured = (|| measure!($dim, runner, &system, &y0, t_end, tol, reps))();
+                        let line = match measured {
+                            Ok(m) => {
+                                let error = reference.as_ref().map(|(_, r)| {
+                                    m.final_state
+                                        .iter()
+                                        .zip(r)
+                                        .map(|(a, b)| (a - b).abs())
+                                        .fold(0.0, f64::max)
+                                });
+                                let e1 = system.borrow().energy(t_end, &m.final_state);
+                                json!({
+                                    "side": runner.side(),
+                                    "method": runner.name(),
+                                    "model": name,
+                                    "tol": tol,
+                                    "t_end": t_end,
+                                    "time_s": median(&m.times_s),
+                                    "times_s": m.times_s,
+                                    "rhs_evals": m.rhs_evals,
+                                    "steps": m.steps,
+                                    "rejected": m.rejected,
+                                    "final_state": m.final_state,
+                                    "error": error,
+                                    "energy_drift": ((e1 - e0) / e0).abs(),
+                                })
+                            }
+                            Err(message) => json!({
+                                "side": runner.side(),
+                                "method": runner.name(),
+                                "model": name,
+                                "tol": tol,
+                                "failed": message,
+                            }),
+                        };
+                        println!("{line}");
+                    }
+                }
+                Ok(())
+            }
+            _ => Err(format!(
+                "unknown command `{command}` (valid: initial, rhs, run)"
+            )),
+        }
+    }};
+}
+
+/// Parses the command line and runs the subcommand.
+fn main_inner() -> Result<(), String> {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let (command, rest) = args
+        .split_first()
+        .ok_or("usage: work_precision_peers initial|rhs|run --model NAME [options]")?;
+    let opts = options(rest)?;
+    let model = option(&opts, "model").ok_or("--model is required")?;
+    match model {
+        "double_pendulum" => command!(4, DoublePendulum, model, command, &opts),
+        "figure_eight" => command!(12, FigureEight, model, command, &opts),
+        _ => Err(format!(
+            "unknown model `{model}` (valid: double_pendulum, figure_eight)"
+        )),
+    }
+}
+
+fn main() -> ExitCode {
+    match main_inner() {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(message) => {
+            eprintln!("error: {message}");
+            ExitCode::FAILURE
+        }
+    }
+}

@@ -1,0 +1,289 @@
+//! The Taylor method: each step is the Taylor polynomial of the solution, its coefficients
+//! from the model's generated recurrences ([`crate::taylor`]), its order and step size from
+//! the tolerance (Jorba & Zou 2005, §3, as heyoka implements it).
+
+use super::driver::{self, Control, Problem};
+use super::error::{IntegrationError, IntegrationFailure};
+use super::options::{ErrorWeights, IntegratorOptions, OutputTimes, Tolerance};
+use super::solution::Solution;
+use super::stepper::{CheckedRhs, StepFailure, Stepper, SystemShape};
+use super::dense_output::DenseOutput;
+use super::Integrator;
+use crate::ode::OdeSystem;
+
+/// The Taylor method of adaptive order and step (Jorba & Zou 2005; Biscani & Izzo 2021):
+/// every step evaluates the Taylor polynomial of the solution at the current state, its
+/// coefficients computed to order `p` by the model's generated recurrences
+/// ([`OdeSystem::taylor_coefficients`]), which is also the step's dense output.
+///
+/// # Order and step size
+/// With `‖·‖` the max norm over the state `y` and `ε`, `N` chosen as in Jorba & Zou's
+/// eq. (3-3) — `ε = atol`, `N = 1` if `rtol ‖y‖ ≤ atol` (absolute mode), else `ε = rtol`,
+/// `N = ‖y‖` — the order is `p = ⌈−½ ln ε + 1⌉` (at least 2) and the step
+///
+/// ```text
+/// h = min(ρ_{p−1}, ρ_p) · e^{−0.7/(p−1)} / e²,    ρ_k = (N / ‖y^[k]‖)^{1/k}
+/// ```
+///
+/// (heyoka's `taylor_determine_h`: `ρ` estimates the radius of convergence, and the last term
+/// is then about `N e^{−2p} ≤ N ε`). For `rtol = atol` this is heyoka's `tol`. A tolerance
+/// given per component takes its smallest entry. There is no error estimate and no rejected
+/// step; `dt_max` and the end of the interval cap `h`, and with
+/// [`IntegratorOptions::fixed_step`] the steps are `dt` at the order of the tolerance.
+///
+/// # Dense output and events
+/// The step's polynomial, evaluated by Horner's rule (`θ = 1` gives the step's end to the bit):
+/// output times and events are located on it.
+///
+/// # Errors
+/// As every [`Integrator`], and [`IntegrationError::NoTaylorRecurrences`] before any step for a
+/// system without recurrences (equations given as a closure; a model with constraints, or
+/// whose equations use `abs`, `sign`, `step` or a power with a variable exponent).
+///
+/// # Source
+/// À. Jorba, M. Zou, *A software package for the numerical integration of ODEs by means of
+/// high-order Taylor methods*, Exp. Math. 14(1) (2005) 99–117, §3; F. Biscani, D. Izzo,
+/// *Revisiting high-order Taylor methods for astrodynamics and celestial mechanics*, MNRAS
+/// 504(2) (2021) 2614–2628.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Taylor;
+
+impl Taylor {
+    /// The method.
+    pub fn new() -> Self {
+        Self
+    }
+
+    /// The order `p = ⌈−½ ln ε + 1⌉` (at least 2) for a tolerance `ε` (heyoka's
+    /// `taylor_order_from_tol`): 8 for 1e-6, 12 for 1e-9, 15 for 1e-12, 20 for 2.2e-16.
+    pub fn order_for_tolerance(tolerance: f64) -> usize {
+        let p = (-0.5 * tolerance.ln() + 1.0).ceil();
+        if p.is_finite() && p >= 2.0 {
+            (p as usize).min(MAX_ORDER)
+        } else {
+            2
+        }
+    }
+}
+
+/// The highest order used: a tolerance below the smallest normal `f64` asks for no more.
+const MAX_ORDER: usize = 400;
+
+impl Integrator for Taylor {
+    fn name(&self) -> &'static str {
+        "taylor"
+    }
+
+    /// The order at the default tolerances' relative mode (`rtol = 10⁻⁶`): the method's order
+    /// follows the tolerance ([`Taylor::order_for_tolerance`]).
+    fn order(&self) -> u32 {
+        Taylor::order_for_tolerance(IntegratorOptions::DEFAULT_RTOL) as u32
+    }
+
+    fn integrate(
+        &mut self,
+        system: &mut dyn OdeSystem,
+        t0: f64,
+        y0: &[f64],
+        t_end: f64,
+        output: &OutputTimes,
+        options: &IntegratorOptions,
+    ) -> Result<Solution, IntegrationFailure> {
+        let problem = Problem::new(t0, y0, t_end, output, options);
+        let control = if options.fixed_step {
+            Control::Fixed
+        } else {
+            Control::Proposed
+        };
+        let support = system.taylor_support();
+        let (rtol, atol) = (smallest(&options.rtol), smallest(&options.atol));
+        driver::run(&problem, system, control, |shape| {
+            support.map_err(|reason| IntegrationError::NoTaylorRecurrences {
+                reason: reason.to_string(),
+            })?;
+            Ok(TaylorStepper::new(shape, rtol, atol))
+        })
+    }
+}
+
+fn smallest(tolerance: &Tolerance) -> f64 {
+    match tolerance {
+        Tolerance::Scalar(x) => *x,
+        Tolerance::PerComponent(v) => v.iter().copied().fold(f64::INFINITY, f64::min),
+    }
+}
+
+/// The Taylor method's state: the coefficients at the current point (which give the next
+/// step) and at the start of the last accepted step (its dense output).
+pub(crate) struct TaylorStepper {
+    dim: usize,
+    rtol: f64,
+    atol: f64,
+    /// The order used at the current point.
+    order: usize,
+    t: f64,
+    t_prev: f64,
+    t_new: f64,
+    y: Vec<f64>,
+    y_new: Vec<f64>,
+    /// `(order + 1) · dim` coefficients at `(t, y)`, order-major.
+    coefficients: Vec<f64>,
+    /// The same at the start of the last accepted step.
+    previous: Vec<f64>,
+    previous_order: usize,
+    /// Scratch for the coefficients at a candidate.
+    scratch: Vec<f64>,
+    /// The step the coefficients at `(t, y)` propose.
+    proposed: f64,
+}
+
+impl TaylorStepper {
+    fn new(shape: SystemShape, rtol: f64, atol: f64) -> Self {
+        let dim = shape.dim;
+        let max_order = Taylor::order_for_tolerance(rtol.min(atol));
+        let size = (max_order + 1) * dim;
+        Self {
+            dim,
+            rtol,
+            atol,
+            order: max_order,
+            t: 0.0,
+            t_prev: 0.0,
+            t_new: 0.0,
+            y: vec![0.0; dim],
+            y_new: vec![0.0; dim],
+            coefficients: vec![0.0; size],
+            previous: vec![0.0; size],
+            previous_order: 0,
+            scratch: vec![0.0; size],
+            proposed: f64::INFINITY,
+        }
+    }
+
+    /// The mode of Jorba & Zou's eq. (3-3) at a state of max norm `norm`: `(ε, N)`.
+    fn mode(&self, norm: f64) -> (f64, f64) {
+        if self.rtol * norm <= self.atol {
+            (self.atol, 1.0)
+        } else {
+            (self.rtol, norm)
+        }
+    }
+
+    /// Computes the coefficients at `(t, y)` into `scratch`; the order used.
+    fn series(
+        &mut self,
+        rhs: &mut CheckedRhs<'_>,
+        t: f64,
+        y: &[f64],
+    ) -> Result<usize, StepFailure> {
+        let norm = max_norm(y);
+        let (epsilon, _) = self.mode(norm);
+        let order = Taylor::order_for_tolerance(epsilon);
+        let size = (order + 1) * self.dim;
+        rhs.taylor_coefficients(t, y, order, &mut self.scratch[..size])?;
+        Ok(order)
+    }
+
+    /// Makes the coefficients in `scratch` (of `order`) the current ones and proposes the
+    /// next step from them.
+    fn commit(&mut self, order: usize) {
+        std::mem::swap(&mut self.coefficients, &mut self.scratch);
+        self.order = order;
+        let dim = self.dim;
+        let c = &self.coefficients;
+        let (_, n) = self.mode(max_norm(&c[..dim]));
+        let rho = |k: usize| (n / max_norm(&c[k * dim..(k + 1) * dim])).powf(1.0 / k as f64);
+        let p = order;
+        let rho = rho(p - 1).min(rho(p));
+        self.proposed = rho * (-0.7 / (p - 1) as f64).exp() / std::f64::consts::E.powi(2);
+    }
+
+    /// The polynomial of `coefficients` (of `order`) at `τ`, by Horner's rule.
+    fn horner(coefficients: &[f64], order: usize, dim: usize, tau: f64, out: &mut [f64]) {
+        out.copy_from_slice(&coefficients[order * dim..(order + 1) * dim]);
+        for k in (0..order).rev() {
+            let row = &coefficients[k * dim..(k + 1) * dim];
+            for (o, &c) in out.iter_mut().zip(row) {
+                *o = *o * tau + c;
+            }
+        }
+    }
+}
+
+fn max_norm(v: &[f64]) -> f64 {
+    v.iter().fold(0.0, |m: f64, x| m.max(x.abs()))
+}
+
+impl DenseOutput for TaylorStepper {
+    fn interval(&self) -> (f64, f64) {
+        (self.t_prev, self.t)
+    }
+
+    fn interpolate(&self, t: f64, out: &mut [f64]) {
+        if self.t == self.t_prev {
+            out.copy_from_slice(&self.y);
+            return;
+        }
+        let tau = t - self.t_prev;
+        Self::horner(&self.previous, self.previous_order, self.dim, tau, out);
+    }
+}
+
+impl Stepper for TaylorStepper {
+    fn t(&self) -> f64 {
+        self.t
+    }
+
+    fn y(&self) -> &[f64] {
+        &self.y
+    }
+
+    fn derivative(&self) -> &[f64] {
+        &self.coefficients[self.dim..2 * self.dim]
+    }
+
+    fn reset(&mut self, rhs: &mut CheckedRhs<'_>, t0: f64, y0: &[f64]) -> Result<(), StepFailure> {
+        self.t = t0;
+        self.t_prev = t0;
+        self.t_new = t0;
+        self.y.copy_from_slice(y0);
+        let order = self.series(rhs, t0, y0)?;
+        self.commit(order);
+        Ok(())
+    }
+
+    fn attempt(
+        &mut self,
+        _rhs: &mut CheckedRhs<'_>,
+        t_new: f64,
+        _weights: &ErrorWeights,
+        _estimate_error: bool,
+    ) -> Result<Option<f64>, StepFailure> {
+        self.t_new = t_new;
+        let tau = t_new - self.t;
+        Self::horner(&self.coefficients, self.order, self.dim, tau, &mut self.y_new);
+        match self.y_new.iter().position(|v| !v.is_finite()) {
+            Some(index) => Err(StepFailure::NonFiniteState { t: t_new, index }),
+            None => Ok(None),
+        }
+    }
+
+    fn proposed_step(&self) -> Option<f64> {
+        Some(self.proposed)
+    }
+
+    fn accept(&mut self, rhs: &mut CheckedRhs<'_>) -> Result<(), StepFailure> {
+        let (t_new, y_new) = (self.t_new, std::mem::take(&mut self.y_new));
+        let order = self.series(rhs, t_new, &y_new);
+        self.y_new = y_new;
+        let order = order?;
+        // The coefficients at the step's start become its dense output.
+        std::mem::swap(&mut self.previous, &mut self.coefficients);
+        self.previous_order = self.order;
+        self.commit(order);
+        self.t_prev = self.t;
+        self.t = t_new;
+        std::mem::swap(&mut self.y, &mut self.y_new);
+        Ok(())
+    }
+}

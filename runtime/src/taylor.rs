@@ -1,0 +1,458 @@
+//! Taylor series of the motion: the recurrences of a model's [`TaylorProgram`] run order by
+//! order, and `M q̈ = F` solved as a series.
+//!
+//! With `x(t₀ + τ) = Σₖ x^[k] τᵏ` for every value of the model's program, the state
+//! `y = [q; q̇]` has `q^[k+1] = q̇^[k] / (k + 1)` and `q̇^[k+1] = a^[k] / (k + 1)`, where the
+//! accelerations `a = q̈` solve `M a = F` as series (the Cauchy product of `M(t) a(t) = F(t)`):
+//!
+//! ```text
+//! M^[0] a^[k] = F^[k] − Σⱼ₌₁ᵏ M^[j] a^[k−j]
+//! ```
+//!
+//! — one `L D Lᵀ` factorisation of `M^[0]` per step, one pair of triangular solves per order.
+//! [`series_of_motion`] runs that loop over a model's two generated functions (order 0: the
+//! model's own evaluation, every value kept; order `k ≥ 1`: its [`SeriesOp`]s), for compiled
+//! models and models compiled at run time alike; [`evaluate_order`] is the one definition of
+//! each recurrence, which the `model!` macro's code inlines op by op and the run-time model
+//! calls, so both compute the same bits.
+//!
+//! # Source
+//! Jorba & Zou, *A software package for the numerical integration of ODEs by means of
+//! high-order Taylor methods*, Exp. Math. 14(1) (2005) 99–117, §2 (the recurrences);
+//! Biscani & Izzo, MNRAS 504(2) (2021) 2614–2628 and heyoka's `doc/ad_notes.rst` (the
+//! decomposition with hidden partners); the mass-matrix series is the quotient rule of §2
+//! with a matrix denominator.
+
+pub use eomgen_description::taylor::{SeriesOp, Slot, TaylorProgram, TaylorUnsupported};
+
+use crate::ode::RhsError;
+
+/// The series of one slot: its `capacity` coefficients.
+#[inline(always)]
+fn series(s: &[f64], capacity: usize, slot: Slot) -> &[f64] {
+    let start = slot as usize * capacity;
+    &s[start..start + capacity]
+}
+
+/// `Σ_{j=from}^{to} a[j] b[k − j]` (`from ≤ to ≤ k`), in increasing `j`.
+///
+/// Written with iterators over the two ranges (one of them reversed) rather than indexing, so
+/// that the loop carries no bounds checks: the recurrences spend most of a Taylor step here.
+#[inline(always)]
+fn convolution(a: &[f64], b: &[f64], k: usize, from: usize, to: usize) -> f64 {
+    let a = &a[from..=to];
+    let b = &b[k - to..=k - from];
+    let mut sum = 0.0;
+    for (x, y) in a.iter().zip(b.iter().rev()) {
+        sum += x * y;
+    }
+    sum
+}
+
+/// `Σ_{j=from}^{to} j a[j] b[k − j]`, in increasing `j` (each term `(j · a[j]) · b[k − j]`).
+#[inline(always)]
+fn weighted_convolution(a: &[f64], b: &[f64], k: usize, from: usize, to: usize) -> f64 {
+    let a = &a[from..=to];
+    let b = &b[k - to..=k - from];
+    let mut sum = 0.0;
+    let mut j = from as f64;
+    for (x, y) in a.iter().zip(b.iter().rev()) {
+        sum += j * x * y;
+        j += 1.0;
+    }
+    sum
+}
+
+/// Order `k ≥ 1` of the output(s) of one op, from the orders `≤ k` of its operands and `< k`
+/// of its outputs, in `s` (slot `x`'s order `i` at `x · capacity + i`).
+///
+/// The recurrence of each op is written once here: the `model!` macro's generated code calls
+/// this with constant ops (inlined, the match folds away) and the run-time model through
+/// [`evaluate_order`].
+///
+/// # Panics
+/// If a slot is beyond `s` or `k ≥ capacity` (a program and workspace that do not belong
+/// together).
+#[inline(always)]
+pub fn apply(op: SeriesOp, k: usize, capacity: usize, s: &mut [f64]) {
+    let c = capacity;
+    let kf = k as f64;
+    let at = |s: &[f64], x: Slot, i: usize| s[x as usize * c + i];
+    let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
+    match op {
+        SeriesOp::Neg { out, a } => {
+            let v = -at(s, a, k);
+            write(s, out, v);
+        }
+        SeriesOp::Copy { out, a } => {
+            let v = at(s, a, k);
+            write(s, out, v);
+        }
+        SeriesOp::Add { out, a, b } => {
+            let v = at(s, a, k) + at(s, b, k);
+            write(s, out, v);
+        }
+        SeriesOp::Sub { out, a, b } => {
+            let v = at(s, a, k) - at(s, b, k);
+            write(s, out, v);
+        }
+        SeriesOp::Mul { out, a, b } => {
+            let v = convolution(series(s, c, a), series(s, c, b), k, 0, k);
+            write(s, out, v);
+        }
+        SeriesOp::Scale { out, a, constant } => {
+            let v = at(s, a, k) * at(s, constant, 0);
+            write(s, out, v);
+        }
+        SeriesOp::Div { out, a, b } => {
+            let sum = convolution(series(s, c, b), series(s, c, out), k, 1, k);
+            let v = (at(s, a, k) - sum) / at(s, b, 0);
+            write(s, out, v);
+        }
+        SeriesOp::DivByConstant { out, a, constant } => {
+            let v = at(s, a, k) / at(s, constant, 0);
+            write(s, out, v);
+        }
+        SeriesOp::ConstantDiv { out, b } => {
+            let sum = convolution(series(s, c, b), series(s, c, out), k, 1, k);
+            let v = -sum / at(s, b, 0);
+            write(s, out, v);
+        }
+        SeriesOp::Sqrt { out, a } => {
+            let o = series(s, c, out);
+            let sum = if k > 1 {
+                convolution(o, o, k, 1, k - 1)
+            } else {
+                0.0
+            };
+            let v = (at(s, a, k) - sum) / (2.0 * o[0]);
+            write(s, out, v);
+        }
+        SeriesOp::PowConstant { out, a, exponent } => {
+            let alpha = at(s, exponent, 0);
+            let (x, o) = (series(s, c, a), series(s, c, out));
+            let mut sum = 0.0;
+            for j in 0..k {
+                sum += (kf * alpha - j as f64 * (alpha + 1.0)) * x[k - j] * o[j];
+            }
+            let v = sum / (kf * x[0]);
+            write(s, out, v);
+        }
+        SeriesOp::Exp { out, a } => {
+            let v = weighted_convolution(series(s, c, a), series(s, c, out), k, 1, k) / kf;
+            write(s, out, v);
+        }
+        SeriesOp::Ln { out, a } => {
+            let (x, o) = (series(s, c, a), series(s, c, out));
+            let sum = if k > 1 {
+                weighted_convolution(o, x, k, 1, k - 1)
+            } else {
+                0.0
+            };
+            let v = (kf * x[k] - sum) / (kf * x[0]);
+            write(s, out, v);
+        }
+        SeriesOp::SinCos { sin, cos, a } => {
+            let x = series(s, c, a);
+            let vs = weighted_convolution(x, series(s, c, cos), k, 1, k) / kf;
+            let vc = -weighted_convolution(x, series(s, c, sin), k, 1, k) / kf;
+            write(s, sin, vs);
+            write(s, cos, vc);
+        }
+        SeriesOp::SinhCosh { sinh, cosh, a } => {
+            let x = series(s, c, a);
+            let vs = weighted_convolution(x, series(s, c, cosh), k, 1, k) / kf;
+            let vc = weighted_convolution(x, series(s, c, sinh), k, 1, k) / kf;
+            write(s, sinh, vs);
+            write(s, cosh, vc);
+        }
+        SeriesOp::Tan { out, a, square } | SeriesOp::Tanh { out, a, square } => {
+            let sign = if matches!(op, SeriesOp::Tan { .. }) {
+                1.0
+            } else {
+                -1.0
+            };
+            let x = series(s, c, a);
+            let v = x[k] + sign * (weighted_convolution(x, series(s, c, square), k, 1, k) / kf);
+            write(s, out, v);
+            let o = series(s, c, out);
+            let q = convolution(o, o, k, 0, k);
+            write(s, square, q);
+        }
+        SeriesOp::Asin { out, a, root, acos } => {
+            let x = series(s, c, a);
+            let a2 = convolution(x, x, k, 0, k);
+            let r = series(s, c, root);
+            let sum = if k > 1 {
+                convolution(r, r, k, 1, k - 1)
+            } else {
+                0.0
+            };
+            let rk = (-a2 - sum) / (2.0 * r[0]);
+            let sign = if acos { -1.0 } else { 1.0 };
+            let sum = if k > 1 {
+                weighted_convolution(series(s, c, out), r, k, 1, k - 1)
+            } else {
+                0.0
+            };
+            let v = (sign * kf * x[k] - sum) / (kf * r[0]);
+            write(s, root, rk);
+            write(s, out, v);
+        }
+        SeriesOp::Atan { out, a, square } => {
+            let x = series(s, c, a);
+            let q = convolution(x, x, k, 0, k);
+            write(s, square, q);
+            let (x, sq) = (series(s, c, a), series(s, c, square));
+            let sum = if k > 1 {
+                weighted_convolution(series(s, c, out), sq, k, 1, k - 1)
+            } else {
+                0.0
+            };
+            let v = (kf * x[k] - sum) / (kf * (1.0 + sq[0]));
+            write(s, out, v);
+        }
+        SeriesOp::Atan2 { out, y, x, norm } => {
+            let (ys, xs) = (series(s, c, y), series(s, c, x));
+            let nk = convolution(xs, xs, k, 0, k) + convolution(ys, ys, k, 0, k);
+            let cross = weighted_convolution(ys, xs, k, 1, k) - weighted_convolution(xs, ys, k, 1, k);
+            write(s, norm, nk);
+            let ns = series(s, c, norm);
+            let sum = if k > 1 {
+                weighted_convolution(series(s, c, out), ns, k, 1, k - 1)
+            } else {
+                0.0
+            };
+            let v = (cross - sum) / (kf * ns[0]);
+            write(s, out, v);
+        }
+        SeriesOp::Zero { out } => write(s, out, 0.0),
+    }
+}
+
+/// Order `k ≥ 1` of every series of `ops`, in order ([`apply`] for each).
+pub fn evaluate_order(ops: &[SeriesOp], k: usize, capacity: usize, s: &mut [f64]) {
+    for &op in ops {
+        apply(op, k, capacity, s);
+    }
+}
+
+/// The buffers of [`series_of_motion`], allocated on first use and grown when a higher order
+/// is asked for (never per step).
+#[derive(Debug, Clone, Default)]
+pub struct TaylorWorkspace {
+    capacity: usize,
+    series: Vec<f64>,
+    accelerations: Vec<f64>,
+    lower: Vec<f64>,
+    pivots: Vec<f64>,
+    rhs: Vec<f64>,
+}
+
+impl TaylorWorkspace {
+    /// Empty buffers.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    fn fit(&mut self, program: &TaylorProgram, n: usize, order: usize) {
+        let capacity = order + 1;
+        if self.capacity != capacity || self.series.len() != program.slots * capacity {
+            self.capacity = capacity;
+            self.series = vec![0.0; program.slots * capacity];
+            self.accelerations = vec![0.0; n * capacity];
+        }
+        self.lower.resize(n * n, 0.0);
+        self.pivots.resize(n, 0.0);
+        self.rhs.resize(n, 0.0);
+    }
+}
+
+/// The order-0 and order-`k` functions of a model's Taylor program.
+pub trait TaylorFunctions {
+    /// The program.
+    fn program(&self) -> &TaylorProgram;
+    /// Order 0 of every slot, reading the state from the input slots.
+    fn order_zero(&self, capacity: usize, series: &mut [f64]);
+    /// Order `k ≥ 1` of every series slot.
+    fn order(&self, k: usize, capacity: usize, series: &mut [f64]);
+}
+
+/// The Taylor coefficients of the motion through `(t, y)`, `y = [q; q̇]` (`2n` entries), up
+/// to `order`: `out[k · 2n + i] = yᵢ^[k]` for `k = 0 … order` (so `out[..2n] = y`).
+///
+/// # Errors
+/// [`RhsError::SingularMassMatrix`] if `M(q, t)` is not positive definite;
+/// [`RhsError::NonFinite`] with the component of the first coefficient that is not finite.
+///
+/// # Panics
+/// If `y` has fewer than `2n` entries or `out` fewer than `(order + 1) · 2n`.
+pub fn series_of_motion(
+    model: &impl TaylorFunctions,
+    workspace: &mut TaylorWorkspace,
+    t: f64,
+    y: &[f64],
+    order: usize,
+    out: &mut [f64],
+) -> Result<(), RhsError> {
+    let program = model.program();
+    let n = program.coordinates.len();
+    let dim = 2 * n;
+    workspace.fit(program, n, order);
+    let c = workspace.capacity;
+    let TaylorWorkspace {
+        series: s,
+        accelerations: acc,
+        lower,
+        pivots,
+        rhs,
+        ..
+    } = workspace;
+    out[..dim].copy_from_slice(&y[..dim]);
+    for k in 0..order {
+        // The inputs at order k: the state's coefficients, and t = t₀ + τ.
+        for i in 0..n {
+            if let Some(slot) = program.coordinates[i] {
+                s[slot as usize * c + k] = out[k * dim + i];
+            }
+            if let Some(slot) = program.velocities[i] {
+                s[slot as usize * c + k] = out[k * dim + n + i];
+            }
+        }
+        if let Some(slot) = program.time {
+            s[slot as usize * c + k] = match k {
+                0 => t,
+                1 => 1.0,
+                _ => 0.0,
+            };
+        }
+        if k == 0 {
+            model.order_zero(c, s);
+            factor(n, |i, j| s[program.mass_matrix[i + j * n] as usize * c], lower, pivots)
+                .ok_or(RhsError::SingularMassMatrix)?;
+        } else {
+            model.order(k, c, s);
+        }
+        // M^[0] a^[k] = F^[k] − Σⱼ₌₁ᵏ M^[j] a^[k−j].
+        for (i, r) in rhs.iter_mut().enumerate() {
+            let mut v = s[program.forcing[i] as usize * c + k];
+            for l in 0..n {
+                let slot = program.mass_matrix[i + l * n];
+                if program.constant[slot as usize] {
+                    continue;
+                }
+                let m = &s[slot as usize * c..][..=k];
+                let a = &acc[l * c..][..=k];
+                for j in 1..=k {
+                    v -= m[j] * a[k - j];
+                }
+            }
+            *r = v;
+        }
+        solve(n, lower, pivots, rhs);
+        let next = (k + 1) as f64;
+        for i in 0..n {
+            acc[i * c + k] = rhs[i];
+            out[(k + 1) * dim + i] = out[k * dim + n + i] / next;
+            out[(k + 1) * dim + n + i] = rhs[i] / next;
+        }
+    }
+    match out[..(order + 1) * dim].iter().position(|v| !v.is_finite()) {
+        Some(at) => Err(RhsError::NonFinite { index: at % dim }),
+        None => Ok(()),
+    }
+}
+
+/// `L D Lᵀ` of the symmetric `n × n` matrix `m(i, j)` (lower triangle read) into `lower`
+/// (row-major, unit diagonal implied) and `pivots` (`D`); `None` unless positive definite.
+#[inline]
+fn factor(
+    n: usize,
+    m: impl Fn(usize, usize) -> f64,
+    lower: &mut [f64],
+    pivots: &mut [f64],
+) -> Option<()> {
+    for j in 0..n {
+        let mut d = m(j, j);
+        for k in 0..j {
+            d -= lower[j * n + k] * lower[j * n + k] * pivots[k];
+        }
+        // Not positive, or NaN.
+        if d.is_nan() || d <= 0.0 {
+            return None;
+        }
+        pivots[j] = d;
+        for i in j + 1..n {
+            let mut v = m(i, j);
+            for k in 0..j {
+                v -= lower[i * n + k] * lower[j * n + k] * pivots[k];
+            }
+            lower[i * n + j] = v / d;
+        }
+    }
+    Some(())
+}
+
+/// Solves `L D Lᵀ x = b` in place.
+#[inline]
+fn solve(n: usize, lower: &[f64], pivots: &[f64], b: &mut [f64]) {
+    for i in 0..n {
+        for k in 0..i {
+            b[i] -= lower[i * n + k] * b[k];
+        }
+    }
+    for i in 0..n {
+        b[i] /= pivots[i];
+    }
+    for i in (0..n).rev() {
+        for k in i + 1..n {
+            b[i] -= lower[k * n + i] * b[k];
+        }
+    }
+}
+
+/// A [`DynMechanicalSystem`](crate::DynMechanicalSystem) with a program, as
+/// [`TaylorFunctions`].
+pub(crate) struct ModelSeries<'a, S: ?Sized> {
+    pub(crate) system: &'a S,
+    pub(crate) program: &'a TaylorProgram,
+}
+
+impl<S: crate::DynMechanicalSystem + ?Sized> TaylorFunctions for ModelSeries<'_, S> {
+    fn program(&self) -> &TaylorProgram {
+        self.program
+    }
+    fn order_zero(&self, capacity: usize, series: &mut [f64]) {
+        self.system.taylor_order_zero(capacity, series);
+    }
+    fn order(&self, k: usize, capacity: usize, series: &mut [f64]) {
+        self.system.taylor_order(k, capacity, series);
+    }
+}
+
+/// [`OdeSystem::taylor_support`](crate::OdeSystem::taylor_support) of a first-order form:
+/// the system's program, refused with constraints.
+pub(crate) fn support<S: crate::DynMechanicalSystem + ?Sized>(
+    system: &S,
+) -> Result<&TaylorProgram, TaylorUnsupported> {
+    let count = system.description().constraints.len();
+    if count > 0 {
+        return Err(TaylorUnsupported::Constraints { count });
+    }
+    system.taylor_program()
+}
+
+/// [`OdeSystem::taylor_coefficients`](crate::OdeSystem::taylor_coefficients) of a first-order
+/// form.
+pub(crate) fn coefficients<S: crate::DynMechanicalSystem + ?Sized>(
+    system: &S,
+    workspace: &mut TaylorWorkspace,
+    t: f64,
+    y: &[f64],
+    order: usize,
+    out: &mut [f64],
+) -> Result<(), RhsError> {
+    let program = support(system).map_err(|_| RhsError::NonFinite { index: 0 })?;
+    let model = ModelSeries { system, program };
+    series_of_motion(&model, workspace, t, y, order, out)
+}

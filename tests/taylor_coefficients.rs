@@ -1,0 +1,255 @@
+//! The Taylor coefficients of every bundled model's motion (`OdeSystem::taylor_coefficients`)
+//! against an independent high-precision reference, `tests/data/taylor_coefficients.json`,
+//! written by `tools/taylor_reference.py` (see its docstring to regenerate it).
+//!
+//! The reference shares no code with eomgen: the script reads each model's `M` and `F` as text
+//! (`eomgen equations FILE --json`), evaluates them with SymPy and mpmath on truncated power
+//! series at 50 digits (functions by composition with their Taylor expansions, not by the
+//! recurrences the models generate), solves `M a = F` order by order, and cross-checks every
+//! model against mpmath's own ODE Taylor method (finite differences of tiny Euler steps); the
+//! two routes agree to 1e-34 relative. Each model is checked at its own state: `t = 0.3`, the
+//! file's initial state plus a seeded perturbation, order 12.
+//!
+//! Three properties, for every bundled model:
+//! - the coefficients of the macro-compiled model and of its file compiled at run time agree
+//!   with the reference within [`tolerance`];
+//! - the two are bit-identical (they run the same recurrences, `eomgen_runtime::taylor::apply`,
+//!   on the same values in the same order);
+//! - a model without coefficients says why: its constraints (with their number), or the
+//!   functions of its equations without a recurrence (`abs`, `sign`, `step`), which its file
+//!   uses.
+
+use std::collections::BTreeSet;
+
+use eomgen::taylor::TaylorUnsupported;
+use eomgen::{DynFirstOrder, JitModel, ModelInfo};
+use serde::Deserialize;
+
+/// The reference file, as `tools/taylor_reference.py` writes it.
+#[derive(Deserialize)]
+struct Reference {
+    models: Vec<Entry>,
+}
+
+/// One model of the reference: its coefficients at `(t, y)`, or why it has none.
+#[derive(Deserialize)]
+struct Entry {
+    name: String,
+    /// `models/<file>.yaml`, as `ModelEntry::file`.
+    file: String,
+    /// Why there are no coefficients (constraints, functions without a recurrence).
+    #[serde(default)]
+    skip: Option<String>,
+    /// The number of constraints of a skipped model.
+    #[serde(default)]
+    constraints: usize,
+    /// The functions without a recurrence the equations use, for a skipped model.
+    #[serde(default)]
+    functions: Vec<String>,
+    /// `2n`.
+    #[serde(default)]
+    dim: usize,
+    #[serde(default)]
+    t: String,
+    /// `y = [q; q̇]`, doubles written with 25 digits.
+    #[serde(default)]
+    y: Vec<String>,
+    #[serde(default)]
+    order: usize,
+    /// `coefficients[k · dim + i] = yᵢ⁽ᵏ⁾(t)/k!`, 30 digits.
+    #[serde(default)]
+    coefficients: Vec<String>,
+}
+
+fn reference() -> Reference {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/data/taylor_coefficients.json"
+    );
+    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{path}: {e}"));
+    serde_json::from_str(&text).unwrap_or_else(|e| panic!("{path}: {e}"))
+}
+
+fn number(text: &str) -> f64 {
+    text.parse()
+        .unwrap_or_else(|e| panic!("`{text}` is not a number: {e}"))
+}
+
+/// The file of a bundled model in this source tree.
+fn bundled_file(entry: &eomgen::models::ModelEntry) -> String {
+    format!("{}/{}", env!("CARGO_MANIFEST_DIR"), entry.file)
+}
+
+/// Every bundled model with its reference entry (every model has one, and every entry is a
+/// bundled model), the macro-compiled model and its file compiled at run time.
+fn models() -> Vec<(Entry, Box<dyn ModelInfo + Send>, Box<dyn ModelInfo>)> {
+    let reference = reference();
+    assert_eq!(
+        reference.models.len(),
+        eomgen::models::ALL.len(),
+        "the reference has an entry per bundled model (regenerate it after adding one)"
+    );
+    let mut entries: Vec<Option<Entry>> = reference.models.into_iter().map(Some).collect();
+    eomgen::models::ALL
+        .iter()
+        .map(|bundled| {
+            let entry = entries
+                .iter_mut()
+                .find(|e| e.as_ref().is_some_and(|e| e.file == bundled.file))
+                .and_then(Option::take)
+                .unwrap_or_else(|| panic!("{}: no reference entry", bundled.file));
+            assert_eq!(entry.name, bundled.name, "{}", bundled.file);
+            let path = bundled_file(bundled);
+            let runtime = JitModel::load(&path).unwrap_or_else(|e| panic!("{path}: {e}"));
+            (
+                entry,
+                (bundled.make)(),
+                Box::new(DynFirstOrder::new(runtime)) as _,
+            )
+        })
+        .collect()
+}
+
+/// The coefficients of `model` at the entry's `(t, y)` and order.
+fn coefficients(entry: &Entry, model: &mut dyn ModelInfo) -> Vec<f64> {
+    let t = number(&entry.t);
+    let y: Vec<f64> = entry.y.iter().map(|v| number(v)).collect();
+    assert_eq!(y.len(), entry.dim, "{}: y", entry.name);
+    assert_eq!(model.num_dofs() * 2, entry.dim, "{}: dim", entry.name);
+    let mut out = vec![f64::NAN; (entry.order + 1) * entry.dim];
+    model
+        .as_ode_mut()
+        .taylor_coefficients(t, &y, entry.order, &mut out)
+        .unwrap_or_else(|e| panic!("{}: {e}", entry.name));
+    out
+}
+
+/// The allowed error of an order-`k` coefficient, relative to `1 + |c|` with `|c|` the
+/// largest reference coefficient of that order (the order's scale: a component that is small
+/// by cancellation carries the rounding error of the order's large terms).
+///
+/// Order `k` is a sum of `O(k)` products of lower orders, each carrying their own error, so
+/// the bound grows with `k`: `3e-15 · (1 + k)²`. Measured (see the test's output), the worst
+/// error of any model is below a tenth of the bound at every order; the bound is `8e-14` at
+/// order 1 and `5e-13` at order 12 — still far below an error of the recurrences (a wrong
+/// term is wrong at order one).
+fn tolerance(k: usize) -> f64 {
+    3e-15 * ((1 + k) * (1 + k)) as f64
+}
+
+#[test]
+fn coefficients_agree_with_the_high_precision_reference() {
+    let mut worst = Vec::<(f64, String)>::new();
+    let mut checked = 0;
+    for (entry, mut compiled, mut runtime) in models() {
+        if entry.skip.is_some() {
+            continue;
+        }
+        let reference: Vec<f64> = entry.coefficients.iter().map(|c| number(c)).collect();
+        assert_eq!(reference.len(), (entry.order + 1) * entry.dim);
+        for (how, model) in [
+            ("compiled", compiled.as_mut() as &mut dyn ModelInfo),
+            ("run time", runtime.as_mut()),
+        ] {
+            let got = coefficients(&entry, model);
+            for k in 0..=entry.order {
+                let row = k * entry.dim..(k + 1) * entry.dim;
+                let scale = 1.0
+                    + reference[row.clone()]
+                        .iter()
+                        .fold(0.0, |m, c| c.abs().max(m));
+                for i in 0..entry.dim {
+                    let (c, r) = (got[row.start + i], reference[row.start + i]);
+                    let error = (c - r).abs() / scale;
+                    assert!(
+                        error <= tolerance(k),
+                        "{} ({how}): order {k}, component {i}: {c:e}, reference {r:e}: \
+                         error {error:.2e} · (1 + {:.3e}) > tolerance {:.2e}",
+                        entry.name,
+                        scale - 1.0,
+                        tolerance(k)
+                    );
+                    if worst.len() <= k {
+                        worst.resize(k + 1, (0.0, String::new()));
+                    }
+                    if error >= worst[k].0 {
+                        worst[k] = (error, format!("{} [{i}]", entry.name));
+                    }
+                }
+            }
+        }
+        checked += 1;
+    }
+    for (k, (error, at)) in worst.iter().enumerate() {
+        println!(
+            "order {k:2}: worst error {error:.2e} (tolerance {:.2e}) at {at}",
+            tolerance(k)
+        );
+    }
+    assert!(checked >= 30, "only {checked} models have coefficients");
+}
+
+#[test]
+fn compiled_and_run_time_coefficients_are_bit_identical() {
+    for (entry, mut compiled, mut runtime) in models() {
+        if entry.skip.is_some() {
+            continue;
+        }
+        let a = coefficients(&entry, compiled.as_mut());
+        let b = coefficients(&entry, runtime.as_mut());
+        for (j, (x, y)) in a.iter().zip(&b).enumerate() {
+            assert_eq!(
+                x.to_bits(),
+                y.to_bits(),
+                "{}: order {}, component {}: compiled {x:e}, run time {y:e}",
+                entry.name,
+                j / entry.dim,
+                j % entry.dim
+            );
+        }
+    }
+}
+
+#[test]
+fn models_without_coefficients_say_why() {
+    for (entry, compiled, runtime) in models() {
+        let source = eomgen::models::ALL
+            .iter()
+            .find(|m| m.file == entry.file)
+            .map(|m| m.source)
+            .unwrap_or_default();
+        for (how, support) in [
+            ("compiled", compiled.taylor_support()),
+            ("run time", runtime.taylor_support()),
+        ] {
+            let name = &entry.name;
+            match (&entry.skip, support) {
+                (None, Ok(())) => {}
+                (None, Err(e)) => panic!("{name} ({how}): the reference has coefficients: {e}"),
+                (Some(reason), Ok(())) => {
+                    panic!("{name} ({how}): has recurrences, the reference skips it: {reason}")
+                }
+                (Some(_), Err(TaylorUnsupported::Constraints { count })) => {
+                    assert_eq!(count, entry.constraints, "{name} ({how}): constraints");
+                    assert!(count > 0, "{name} ({how})");
+                }
+                (Some(reason), Err(TaylorUnsupported::Functions { names })) => {
+                    assert_eq!(entry.constraints, 0, "{name} ({how}): {reason}");
+                    let got: BTreeSet<&str> = names.iter().map(|n| n.as_ref()).collect();
+                    let want: BTreeSet<&str> = entry.functions.iter().map(String::as_str).collect();
+                    assert_eq!(got, want, "{name} ({how}): functions");
+                    for function in &want {
+                        assert!(
+                            ["abs", "sign", "step"].contains(function)
+                                && source.contains(&format!("{function}(")),
+                            "{name} ({how}): `{function}` is not a function of its file"
+                        );
+                    }
+                }
+                (Some(reason), Err(e)) => {
+                    panic!("{name} ({how}): {e}; the reference skips it: {reason}")
+                }
+            }
+        }
+    }
+}
