@@ -80,9 +80,18 @@ fn bundled_file(entry: &eomgen::models::ModelEntry) -> String {
     format!("{}/{}", env!("CARGO_MANIFEST_DIR"), entry.file)
 }
 
+/// A bundled model with its reference entry.
+struct Case {
+    entry: Entry,
+    /// Compiled by `eomgen::model!`.
+    compiled: Box<dyn ModelInfo + Send>,
+    /// Its file, compiled at run time.
+    runtime: Box<dyn ModelInfo>,
+}
+
 /// Every bundled model with its reference entry (every model has one, and every entry is a
-/// bundled model), the macro-compiled model and its file compiled at run time.
-fn models() -> Vec<(Entry, Box<dyn ModelInfo + Send>, Box<dyn ModelInfo>)> {
+/// bundled model).
+fn models() -> Vec<Case> {
     let reference = reference();
     assert_eq!(
         reference.models.len(),
@@ -101,11 +110,11 @@ fn models() -> Vec<(Entry, Box<dyn ModelInfo + Send>, Box<dyn ModelInfo>)> {
             assert_eq!(entry.name, bundled.name, "{}", bundled.file);
             let path = bundled_file(bundled);
             let runtime = JitModel::load(&path).unwrap_or_else(|e| panic!("{path}: {e}"));
-            (
+            Case {
                 entry,
-                (bundled.make)(),
-                Box::new(DynFirstOrder::new(runtime)) as _,
-            )
+                compiled: (bundled.make)(),
+                runtime: Box::new(DynFirstOrder::new(runtime)),
+            }
         })
         .collect()
 }
@@ -126,22 +135,32 @@ fn coefficients(entry: &Entry, model: &mut dyn ModelInfo) -> Vec<f64> {
 
 /// The allowed error of an order-`k` coefficient, relative to `1 + |c|` with `|c|` the
 /// largest reference coefficient of that order (the order's scale: a component that is small
-/// by cancellation carries the rounding error of the order's large terms).
+/// by cancellation carries the rounding error of the order's large terms):
+/// `1e-14 · (1 + k) · 3^(k/2)`.
 ///
-/// Order `k` is a sum of `O(k)` products of lower orders, each carrying their own error, so
-/// the bound grows with `k`: `3e-15 · (1 + k)²`. Measured (see the test's output), the worst
-/// error of any model is below a tenth of the bound at every order; the bound is `8e-14` at
-/// order 1 and `5e-13` at order 12 — still far below an error of the recurrences (a wrong
-/// term is wrong at order one).
+/// Order `k` is a sum of `O(k)` products of lower orders, each carrying their own error; for
+/// most models the measured error stays below 1.2e-14 up to order 12, but `heavy_top` (spin
+/// 100 rad/s, the large `φ̇` and `ψ̇` series cancel in the conserved spin) grows about ×3 per
+/// two orders: 1.6e-14 at order 5, 3.7e-13 at 8, 1.4e-11 at 12. The same series arithmetic
+/// run in 53-bit mpmath by `tools/taylor_reference.py` shows the same growth there
+/// (6.7e-11 at order 12), so it is the state's conditioning, not the recurrences. The bound
+/// (3.5e-14 at order 1, 7.3e-12 at 8, 9.5e-11 at 12) keeps a margin of ~7 over that worst
+/// case and is still far below an error of the recurrences (a wrong term is wrong at order
+/// one).
 fn tolerance(k: usize) -> f64 {
-    3e-15 * ((1 + k) * (1 + k)) as f64
+    1e-14 * (1 + k) as f64 * 3f64.powf(k as f64 / 2.0)
 }
 
 #[test]
 fn coefficients_agree_with_the_high_precision_reference() {
     let mut worst = Vec::<(f64, String)>::new();
     let mut checked = 0;
-    for (entry, mut compiled, mut runtime) in models() {
+    for Case {
+        entry,
+        mut compiled,
+        mut runtime,
+    } in models()
+    {
         if entry.skip.is_some() {
             continue;
         }
@@ -191,7 +210,12 @@ fn coefficients_agree_with_the_high_precision_reference() {
 
 #[test]
 fn compiled_and_run_time_coefficients_are_bit_identical() {
-    for (entry, mut compiled, mut runtime) in models() {
+    for Case {
+        entry,
+        mut compiled,
+        mut runtime,
+    } in models()
+    {
         if entry.skip.is_some() {
             continue;
         }
@@ -212,7 +236,12 @@ fn compiled_and_run_time_coefficients_are_bit_identical() {
 
 #[test]
 fn models_without_coefficients_say_why() {
-    for (entry, compiled, runtime) in models() {
+    for Case {
+        entry,
+        compiled,
+        runtime,
+    } in models()
+    {
         let source = eomgen::models::ALL
             .iter()
             .find(|m| m.file == entry.file)

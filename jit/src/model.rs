@@ -3,12 +3,12 @@
 use std::cell::RefCell;
 use std::sync::{Arc, Mutex, OnceLock};
 
+use eomgen_runtime::taylor::{TaylorProgram, TaylorUnsupported};
 use eomgen_runtime::{DynMechanicalSystem, ModelDescription, UnknownParameter};
 use eomgen_symbolic::codegen::GenerateError;
 use eomgen_symbolic::codegen::program::{Derivation, FunctionTape, ModelProgram};
 use eomgen_symbolic::codegen::tape::{Input, Instruction};
 use eomgen_symbolic::codegen::taylor::{TaylorPlan, taylor_program};
-use eomgen_runtime::taylor::{TaylorProgram, TaylorUnsupported};
 use eomgen_symbolic::model::{Diagnostic, ReadError, read_model_file};
 
 use crate::native::{CompileError, NativeCode, NativeFn};

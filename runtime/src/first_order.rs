@@ -39,7 +39,8 @@ pub struct FirstOrder<S, const N: usize> {
     pub constraints: ConstraintWorkspace,
     /// The model's events ([`ModelDescription::events`](crate::ModelDescription::events)), whose `terminal` flags may be
     /// changed ([`ModelInfo::set_event_terminal`](crate::ModelInfo::set_event_terminal)).
-    pub events: Vec<EventSpec>,    /// Buffers of the Taylor series ([`crate::taylor`]), allocated on first use.
+    pub events: Vec<EventSpec>,
+    /// Buffers of the Taylor series ([`crate::taylor`]), allocated on first use.
     taylor: TaylorWorkspace,
 }
 

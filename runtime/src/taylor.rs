@@ -36,8 +36,11 @@ fn series(s: &[f64], capacity: usize, slot: Slot) -> &[f64] {
 
 /// `Σ_{j=from}^{to} a[j] b[k − j]` (`from ≤ to ≤ k`), in increasing `j`.
 ///
-/// Written with iterators over the two ranges (one of them reversed) rather than indexing, so
-/// that the loop carries no bounds checks: the recurrences spend most of a Taylor step here.
+/// The recurrences spend most of a Taylor step here, in sums of a few to twenty terms.
+/// Iterators over the two ranges (one reversed) leave the loop without bounds checks; a
+/// version with four interleaved partial sums (to overlap the additions) was 2.4× slower on
+/// the double pendulum's orders 8–15 (`study work-precision`, same run), its set-up and
+/// remainder loops outweighing the gain on sums this short.
 #[inline(always)]
 fn convolution(a: &[f64], b: &[f64], k: usize, from: usize, to: usize) -> f64 {
     let a = &a[from..=to];
@@ -66,168 +69,325 @@ fn weighted_convolution(a: &[f64], b: &[f64], k: usize, from: usize, to: usize) 
 /// Order `k ≥ 1` of the output(s) of one op, from the orders `≤ k` of its operands and `< k`
 /// of its outputs, in `s` (slot `x`'s order `i` at `x · capacity + i`).
 ///
-/// The recurrence of each op is written once here: the `model!` macro's generated code calls
-/// this with constant ops (inlined, the match folds away) and the run-time model through
-/// [`evaluate_order`].
+/// The recurrence of each op is written once, as the kernel function of its kind (`mul`,
+/// `sin_cos`, …): the `model!` macro's generated code calls the kernels directly with its
+/// slots as constants (inlined in optimised builds, calls in debug builds, which keeps the
+/// generated code small to compile), and the run-time model reaches the same kernels through
+/// this dispatch ([`evaluate_order`]), so both compute the same bits.
 ///
 /// # Panics
 /// If a slot is beyond `s` or `k ≥ capacity` (a program and workspace that do not belong
 /// together).
-#[inline(always)]
+#[inline]
 pub fn apply(op: SeriesOp, k: usize, capacity: usize, s: &mut [f64]) {
     let c = capacity;
+    match op {
+        SeriesOp::Neg { out, a } => neg(k, c, s, out, a),
+        SeriesOp::Copy { out, a } => copy(k, c, s, out, a),
+        SeriesOp::Add { out, a, b } => add(k, c, s, out, a, b),
+        SeriesOp::Sub { out, a, b } => sub(k, c, s, out, a, b),
+        SeriesOp::Mul { out, a, b } => mul(k, c, s, out, a, b),
+        SeriesOp::Scale { out, a, constant } => scale(k, c, s, out, a, constant),
+        SeriesOp::Div { out, a, b } => div(k, c, s, out, a, b),
+        SeriesOp::DivByConstant { out, a, constant } => div_by_constant(k, c, s, out, a, constant),
+        SeriesOp::ConstantDiv { out, b } => constant_div(k, c, s, out, b),
+        SeriesOp::Sqrt { out, a } => sqrt(k, c, s, out, a),
+        SeriesOp::PowConstant { out, a, exponent } => pow_constant(k, c, s, out, a, exponent),
+        SeriesOp::Exp { out, a } => exp(k, c, s, out, a),
+        SeriesOp::Ln { out, a } => ln(k, c, s, out, a),
+        SeriesOp::SinCos { sin, cos, a } => sin_cos(k, c, s, sin, cos, a),
+        SeriesOp::SinhCosh { sinh, cosh, a } => sinh_cosh(k, c, s, sinh, cosh, a),
+        SeriesOp::Tan { out, a, square } => tan_or_tanh(k, c, s, out, a, square, 1.0),
+        SeriesOp::Tanh { out, a, square } => tan_or_tanh(k, c, s, out, a, square, -1.0),
+        SeriesOp::Asin { out, a, root, acos } => asin(k, c, s, out, a, root, acos),
+        SeriesOp::Atan { out, a, square } => atan(k, c, s, out, a, square),
+        SeriesOp::Atan2 { out, y, x, norm } => atan2(k, c, s, out, y, x, norm),
+        SeriesOp::Zero { out } => zero(k, c, s, out),
+    }
+}
+
+/// Order `k ≥ 1` of [`SeriesOp::Neg`].
+#[inline(always)]
+pub fn neg(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot) {
     let kf = k as f64;
     let at = |s: &[f64], x: Slot, i: usize| s[x as usize * c + i];
     let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
-    match op {
-        SeriesOp::Neg { out, a } => {
-            let v = -at(s, a, k);
-            write(s, out, v);
-        }
-        SeriesOp::Copy { out, a } => {
-            let v = at(s, a, k);
-            write(s, out, v);
-        }
-        SeriesOp::Add { out, a, b } => {
-            let v = at(s, a, k) + at(s, b, k);
-            write(s, out, v);
-        }
-        SeriesOp::Sub { out, a, b } => {
-            let v = at(s, a, k) - at(s, b, k);
-            write(s, out, v);
-        }
-        SeriesOp::Mul { out, a, b } => {
-            let v = convolution(series(s, c, a), series(s, c, b), k, 0, k);
-            write(s, out, v);
-        }
-        SeriesOp::Scale { out, a, constant } => {
-            let v = at(s, a, k) * at(s, constant, 0);
-            write(s, out, v);
-        }
-        SeriesOp::Div { out, a, b } => {
-            let sum = convolution(series(s, c, b), series(s, c, out), k, 1, k);
-            let v = (at(s, a, k) - sum) / at(s, b, 0);
-            write(s, out, v);
-        }
-        SeriesOp::DivByConstant { out, a, constant } => {
-            let v = at(s, a, k) / at(s, constant, 0);
-            write(s, out, v);
-        }
-        SeriesOp::ConstantDiv { out, b } => {
-            let sum = convolution(series(s, c, b), series(s, c, out), k, 1, k);
-            let v = -sum / at(s, b, 0);
-            write(s, out, v);
-        }
-        SeriesOp::Sqrt { out, a } => {
-            let o = series(s, c, out);
-            let sum = if k > 1 {
-                convolution(o, o, k, 1, k - 1)
-            } else {
-                0.0
-            };
-            let v = (at(s, a, k) - sum) / (2.0 * o[0]);
-            write(s, out, v);
-        }
-        SeriesOp::PowConstant { out, a, exponent } => {
-            let alpha = at(s, exponent, 0);
-            let (x, o) = (series(s, c, a), series(s, c, out));
-            let mut sum = 0.0;
-            for j in 0..k {
-                sum += (kf * alpha - j as f64 * (alpha + 1.0)) * x[k - j] * o[j];
-            }
-            let v = sum / (kf * x[0]);
-            write(s, out, v);
-        }
-        SeriesOp::Exp { out, a } => {
-            let v = weighted_convolution(series(s, c, a), series(s, c, out), k, 1, k) / kf;
-            write(s, out, v);
-        }
-        SeriesOp::Ln { out, a } => {
-            let (x, o) = (series(s, c, a), series(s, c, out));
-            let sum = if k > 1 {
-                weighted_convolution(o, x, k, 1, k - 1)
-            } else {
-                0.0
-            };
-            let v = (kf * x[k] - sum) / (kf * x[0]);
-            write(s, out, v);
-        }
-        SeriesOp::SinCos { sin, cos, a } => {
-            let x = series(s, c, a);
-            let vs = weighted_convolution(x, series(s, c, cos), k, 1, k) / kf;
-            let vc = -weighted_convolution(x, series(s, c, sin), k, 1, k) / kf;
-            write(s, sin, vs);
-            write(s, cos, vc);
-        }
-        SeriesOp::SinhCosh { sinh, cosh, a } => {
-            let x = series(s, c, a);
-            let vs = weighted_convolution(x, series(s, c, cosh), k, 1, k) / kf;
-            let vc = weighted_convolution(x, series(s, c, sinh), k, 1, k) / kf;
-            write(s, sinh, vs);
-            write(s, cosh, vc);
-        }
-        SeriesOp::Tan { out, a, square } | SeriesOp::Tanh { out, a, square } => {
-            let sign = if matches!(op, SeriesOp::Tan { .. }) {
-                1.0
-            } else {
-                -1.0
-            };
-            let x = series(s, c, a);
-            let v = x[k] + sign * (weighted_convolution(x, series(s, c, square), k, 1, k) / kf);
-            write(s, out, v);
-            let o = series(s, c, out);
-            let q = convolution(o, o, k, 0, k);
-            write(s, square, q);
-        }
-        SeriesOp::Asin { out, a, root, acos } => {
-            let x = series(s, c, a);
-            let a2 = convolution(x, x, k, 0, k);
-            let r = series(s, c, root);
-            let sum = if k > 1 {
-                convolution(r, r, k, 1, k - 1)
-            } else {
-                0.0
-            };
-            let rk = (-a2 - sum) / (2.0 * r[0]);
-            let sign = if acos { -1.0 } else { 1.0 };
-            let sum = if k > 1 {
-                weighted_convolution(series(s, c, out), r, k, 1, k - 1)
-            } else {
-                0.0
-            };
-            let v = (sign * kf * x[k] - sum) / (kf * r[0]);
-            write(s, root, rk);
-            write(s, out, v);
-        }
-        SeriesOp::Atan { out, a, square } => {
-            let x = series(s, c, a);
-            let q = convolution(x, x, k, 0, k);
-            write(s, square, q);
-            let (x, sq) = (series(s, c, a), series(s, c, square));
-            let sum = if k > 1 {
-                weighted_convolution(series(s, c, out), sq, k, 1, k - 1)
-            } else {
-                0.0
-            };
-            let v = (kf * x[k] - sum) / (kf * (1.0 + sq[0]));
-            write(s, out, v);
-        }
-        SeriesOp::Atan2 { out, y, x, norm } => {
-            let (ys, xs) = (series(s, c, y), series(s, c, x));
-            let nk = convolution(xs, xs, k, 0, k) + convolution(ys, ys, k, 0, k);
-            let cross = weighted_convolution(ys, xs, k, 1, k) - weighted_convolution(xs, ys, k, 1, k);
-            write(s, norm, nk);
-            let ns = series(s, c, norm);
-            let sum = if k > 1 {
-                weighted_convolution(series(s, c, out), ns, k, 1, k - 1)
-            } else {
-                0.0
-            };
-            let v = (cross - sum) / (kf * ns[0]);
-            write(s, out, v);
-        }
-        SeriesOp::Zero { out } => write(s, out, 0.0),
+    let _ = (kf, at);
+    let v = -at(s, a, k);
+    write(s, out, v);
+}
+
+/// Order `k ≥ 1` of [`SeriesOp::Copy`].
+#[inline(always)]
+pub fn copy(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot) {
+    let kf = k as f64;
+    let at = |s: &[f64], x: Slot, i: usize| s[x as usize * c + i];
+    let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
+    let _ = (kf, at);
+    let v = at(s, a, k);
+    write(s, out, v);
+}
+
+/// Order `k ≥ 1` of [`SeriesOp::Add`].
+#[inline(always)]
+pub fn add(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot, b: Slot) {
+    let kf = k as f64;
+    let at = |s: &[f64], x: Slot, i: usize| s[x as usize * c + i];
+    let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
+    let _ = (kf, at);
+    let v = at(s, a, k) + at(s, b, k);
+    write(s, out, v);
+}
+
+/// Order `k ≥ 1` of [`SeriesOp::Sub`].
+#[inline(always)]
+pub fn sub(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot, b: Slot) {
+    let kf = k as f64;
+    let at = |s: &[f64], x: Slot, i: usize| s[x as usize * c + i];
+    let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
+    let _ = (kf, at);
+    let v = at(s, a, k) - at(s, b, k);
+    write(s, out, v);
+}
+
+/// Order `k ≥ 1` of [`SeriesOp::Mul`].
+#[inline(always)]
+pub fn mul(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot, b: Slot) {
+    let kf = k as f64;
+    let at = |s: &[f64], x: Slot, i: usize| s[x as usize * c + i];
+    let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
+    let _ = (kf, at);
+    let v = convolution(series(s, c, a), series(s, c, b), k, 0, k);
+    write(s, out, v);
+}
+
+/// Order `k ≥ 1` of [`SeriesOp::Scale`].
+#[inline(always)]
+pub fn scale(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot, constant: Slot) {
+    let kf = k as f64;
+    let at = |s: &[f64], x: Slot, i: usize| s[x as usize * c + i];
+    let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
+    let _ = (kf, at);
+    let v = at(s, a, k) * at(s, constant, 0);
+    write(s, out, v);
+}
+
+/// Order `k ≥ 1` of [`SeriesOp::Div`].
+#[inline(always)]
+pub fn div(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot, b: Slot) {
+    let kf = k as f64;
+    let at = |s: &[f64], x: Slot, i: usize| s[x as usize * c + i];
+    let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
+    let _ = (kf, at);
+    let sum = convolution(series(s, c, b), series(s, c, out), k, 1, k);
+    let v = (at(s, a, k) - sum) / at(s, b, 0);
+    write(s, out, v);
+}
+
+/// Order `k ≥ 1` of [`SeriesOp::DivByConstant`].
+#[inline(always)]
+pub fn div_by_constant(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot, constant: Slot) {
+    let kf = k as f64;
+    let at = |s: &[f64], x: Slot, i: usize| s[x as usize * c + i];
+    let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
+    let _ = (kf, at);
+    let v = at(s, a, k) / at(s, constant, 0);
+    write(s, out, v);
+}
+
+/// Order `k ≥ 1` of [`SeriesOp::ConstantDiv`].
+#[inline(always)]
+pub fn constant_div(k: usize, c: usize, s: &mut [f64], out: Slot, b: Slot) {
+    let kf = k as f64;
+    let at = |s: &[f64], x: Slot, i: usize| s[x as usize * c + i];
+    let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
+    let _ = (kf, at);
+    let sum = convolution(series(s, c, b), series(s, c, out), k, 1, k);
+    let v = -sum / at(s, b, 0);
+    write(s, out, v);
+}
+
+/// Order `k ≥ 1` of [`SeriesOp::Sqrt`].
+#[inline(always)]
+pub fn sqrt(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot) {
+    let kf = k as f64;
+    let at = |s: &[f64], x: Slot, i: usize| s[x as usize * c + i];
+    let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
+    let _ = (kf, at);
+    let o = series(s, c, out);
+    let sum = if k > 1 {
+        convolution(o, o, k, 1, k - 1)
+    } else {
+        0.0
+    };
+    let v = (at(s, a, k) - sum) / (2.0 * o[0]);
+    write(s, out, v);
+}
+
+/// Order `k ≥ 1` of [`SeriesOp::PowConstant`].
+#[inline(always)]
+pub fn pow_constant(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot, exponent: Slot) {
+    let kf = k as f64;
+    let at = |s: &[f64], x: Slot, i: usize| s[x as usize * c + i];
+    let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
+    let _ = (kf, at);
+    let alpha = at(s, exponent, 0);
+    let (x, o) = (series(s, c, a), series(s, c, out));
+    let mut sum = 0.0;
+    for j in 0..k {
+        sum += (kf * alpha - j as f64 * (alpha + 1.0)) * x[k - j] * o[j];
     }
+    let v = sum / (kf * x[0]);
+    write(s, out, v);
+}
+
+/// Order `k ≥ 1` of [`SeriesOp::Exp`].
+#[inline(always)]
+pub fn exp(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot) {
+    let kf = k as f64;
+    let at = |s: &[f64], x: Slot, i: usize| s[x as usize * c + i];
+    let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
+    let _ = (kf, at);
+    let v = weighted_convolution(series(s, c, a), series(s, c, out), k, 1, k) / kf;
+    write(s, out, v);
+}
+
+/// Order `k ≥ 1` of [`SeriesOp::Ln`].
+#[inline(always)]
+pub fn ln(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot) {
+    let kf = k as f64;
+    let at = |s: &[f64], x: Slot, i: usize| s[x as usize * c + i];
+    let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
+    let _ = (kf, at);
+    let (x, o) = (series(s, c, a), series(s, c, out));
+    let sum = if k > 1 {
+        weighted_convolution(o, x, k, 1, k - 1)
+    } else {
+        0.0
+    };
+    let v = (kf * x[k] - sum) / (kf * x[0]);
+    write(s, out, v);
+}
+
+/// Order `k ≥ 1` of [`SeriesOp::SinCos`].
+#[inline(always)]
+pub fn sin_cos(k: usize, c: usize, s: &mut [f64], sin: Slot, cos: Slot, a: Slot) {
+    let kf = k as f64;
+    let at = |s: &[f64], x: Slot, i: usize| s[x as usize * c + i];
+    let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
+    let _ = (kf, at);
+    let x = series(s, c, a);
+    let vs = weighted_convolution(x, series(s, c, cos), k, 1, k) / kf;
+    let vc = -weighted_convolution(x, series(s, c, sin), k, 1, k) / kf;
+    write(s, sin, vs);
+    write(s, cos, vc);
+}
+
+/// Order `k ≥ 1` of [`SeriesOp::SinhCosh`].
+#[inline(always)]
+pub fn sinh_cosh(k: usize, c: usize, s: &mut [f64], sinh: Slot, cosh: Slot, a: Slot) {
+    let kf = k as f64;
+    let at = |s: &[f64], x: Slot, i: usize| s[x as usize * c + i];
+    let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
+    let _ = (kf, at);
+    let x = series(s, c, a);
+    let vs = weighted_convolution(x, series(s, c, cosh), k, 1, k) / kf;
+    let vc = weighted_convolution(x, series(s, c, sinh), k, 1, k) / kf;
+    write(s, sinh, vs);
+    write(s, cosh, vc);
+}
+
+/// Order `k ≥ 1` of `tan a` (`sign = 1`) or `tanh a` (`sign = −1`), with `square` its square: [`SeriesOp::Tan`], [`SeriesOp::Tanh`].
+#[inline(always)]
+pub fn tan_or_tanh(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot, square: Slot, sign: f64) {
+    let kf = k as f64;
+    let at = |s: &[f64], x: Slot, i: usize| s[x as usize * c + i];
+    let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
+    let _ = (kf, at);
+    let x = series(s, c, a);
+    let v = x[k] + sign * (weighted_convolution(x, series(s, c, square), k, 1, k) / kf);
+    write(s, out, v);
+    let o = series(s, c, out);
+    let q = convolution(o, o, k, 0, k);
+    write(s, square, q);
+}
+
+/// Order `k ≥ 1` of [`SeriesOp::Asin`].
+#[inline(always)]
+pub fn asin(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot, root: Slot, acos: bool) {
+    let kf = k as f64;
+    let at = |s: &[f64], x: Slot, i: usize| s[x as usize * c + i];
+    let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
+    let _ = (kf, at);
+    let x = series(s, c, a);
+    let a2 = convolution(x, x, k, 0, k);
+    let r = series(s, c, root);
+    let sum = if k > 1 {
+        convolution(r, r, k, 1, k - 1)
+    } else {
+        0.0
+    };
+    let rk = (-a2 - sum) / (2.0 * r[0]);
+    let sign = if acos { -1.0 } else { 1.0 };
+    let sum = if k > 1 {
+        weighted_convolution(series(s, c, out), r, k, 1, k - 1)
+    } else {
+        0.0
+    };
+    let v = (sign * kf * x[k] - sum) / (kf * r[0]);
+    write(s, root, rk);
+    write(s, out, v);
+}
+
+/// Order `k ≥ 1` of [`SeriesOp::Atan`].
+#[inline(always)]
+pub fn atan(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot, square: Slot) {
+    let kf = k as f64;
+    let at = |s: &[f64], x: Slot, i: usize| s[x as usize * c + i];
+    let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
+    let _ = (kf, at);
+    let x = series(s, c, a);
+    let q = convolution(x, x, k, 0, k);
+    write(s, square, q);
+    let (x, sq) = (series(s, c, a), series(s, c, square));
+    let sum = if k > 1 {
+        weighted_convolution(series(s, c, out), sq, k, 1, k - 1)
+    } else {
+        0.0
+    };
+    let v = (kf * x[k] - sum) / (kf * (1.0 + sq[0]));
+    write(s, out, v);
+}
+
+/// Order `k ≥ 1` of [`SeriesOp::Atan2`].
+#[inline(always)]
+pub fn atan2(k: usize, c: usize, s: &mut [f64], out: Slot, y: Slot, x: Slot, norm: Slot) {
+    let kf = k as f64;
+    let at = |s: &[f64], x: Slot, i: usize| s[x as usize * c + i];
+    let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
+    let _ = (kf, at);
+    let (ys, xs) = (series(s, c, y), series(s, c, x));
+    let nk = convolution(xs, xs, k, 0, k) + convolution(ys, ys, k, 0, k);
+    let cross = weighted_convolution(ys, xs, k, 1, k) - weighted_convolution(xs, ys, k, 1, k);
+    write(s, norm, nk);
+    let ns = series(s, c, norm);
+    let sum = if k > 1 {
+        weighted_convolution(series(s, c, out), ns, k, 1, k - 1)
+    } else {
+        0.0
+    };
+    let v = (cross - sum) / (kf * ns[0]);
+    write(s, out, v);
+}
+
+/// Order `k ≥ 1` of [`SeriesOp::Zero`].
+#[inline(always)]
+pub fn zero(k: usize, c: usize, s: &mut [f64], out: Slot) {
+    let kf = k as f64;
+    let at = |s: &[f64], x: Slot, i: usize| s[x as usize * c + i];
+    let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
+    let _ = (kf, at);
+    write(s, out, 0.0);
 }
 
 /// Order `k ≥ 1` of every series of `ops`, in order ([`apply`] for each).
@@ -328,8 +488,13 @@ pub fn series_of_motion(
         }
         if k == 0 {
             model.order_zero(c, s);
-            factor(n, |i, j| s[program.mass_matrix[i + j * n] as usize * c], lower, pivots)
-                .ok_or(RhsError::SingularMassMatrix)?;
+            factor(
+                n,
+                |i, j| s[program.mass_matrix[i + j * n] as usize * c],
+                lower,
+                pivots,
+            )
+            .ok_or(RhsError::SingularMassMatrix)?;
         } else {
             model.order(k, c, s);
         }

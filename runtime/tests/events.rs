@@ -115,6 +115,8 @@ fn every_method_locates_the_returns() {
     // Every method of the registry (the match is exhaustive: a new method needs its bound).
     for method in Method::ALL {
         let (options, tolerance) = match method {
+            // Needs a model's recurrences, not a closure: tests/taylor.rs locates its events.
+            Method::Taylor => continue,
             Method::Euler => (&fixed, 0.1),
             Method::Midpoint => (&fixed, 5e-4),
             Method::Rk4 => (&fixed, 3e-8),
@@ -124,10 +126,10 @@ fn every_method_locates_the_returns() {
             Method::Bs32 => (&adaptive, 2e-7),
             Method::Dp54 => (&adaptive, 5e-8),
             Method::Dop853 => (&adaptive, 2e-9),
-            Method::Vern6 => (&adaptive, 1e-6),
-            Method::Vern7 => (&adaptive, 1e-6),
-            Method::Vern8 => (&adaptive, 1e-6),
-            Method::Vern9 => (&adaptive, 1e-6),
+            Method::Vern6 => (&adaptive, 1e-9),
+            Method::Vern7 => (&adaptive, 3e-11),
+            Method::Vern8 => (&adaptive, 2e-9),
+            Method::Vern9 => (&adaptive, 1e-10),
             Method::Radau5 => (&adaptive, 1e-10),
         };
         let mut method = method.integrator();

@@ -130,6 +130,12 @@ fn every_integrator_solves_every_reference_problem() {
             "dp54" => assert_eq!(stats.rhs_evals, 6 * attempts + 2, "{label}"),
             // Eleven per attempt, one at each accepted state, F(t0) and the probe.
             "dop853" => assert_eq!(stats.rhs_evals, 11 * attempts + stats.steps + 2, "{label}"),
+            // Verner 6(5) is FSAL: eight per attempt. The others: s − 1 per attempt (9, 12,
+            // 15) and one at each accepted state.
+            "vern6" => assert_eq!(stats.rhs_evals, 8 * attempts + 2, "{label}"),
+            "vern7" => assert_eq!(stats.rhs_evals, 9 * attempts + stats.steps + 2, "{label}"),
+            "vern8" => assert_eq!(stats.rhs_evals, 12 * attempts + stats.steps + 2, "{label}"),
+            "vern9" => assert_eq!(stats.rhs_evals, 15 * attempts + stats.steps + 2, "{label}"),
             // At least one Newton evaluation per step (two, to confirm the residual) and
             // one at the new state; Jacobians are kept while Newton converges fast.
             "implicit-midpoint" => {

@@ -384,3 +384,48 @@ fn work_on_a_double_pendulum_beside_dop853() {
         }
     }
 }
+
+/// Not a test: the time per evaluation of `F` of each pair beside DOP853 on the double
+/// pendulum at tol 1e-10 (4 components, the stage sums compiled for a fixed dimension), and
+/// with a fifth, constant component (the general stage sums). Run with
+/// `cargo test --release --test verner -- --ignored --nocapture timing`; nothing is asserted.
+#[test]
+#[ignore]
+fn timing_per_evaluation() {
+    use std::time::Instant;
+    let options = IntegratorOptions::default()
+        .with_rtol(1e-10)
+        .with_atol(1e-10);
+    let mut methods = verners();
+    methods.insert(0, Box::new(DormandPrince853::new()));
+    for method in &mut methods {
+        for dim in [4usize, 5] {
+            let mut inner = double_pendulum();
+            let mut system = OdeFn::new(dim, |t: f64, y: &[f64], dy: &mut [f64]| {
+                use eomgen_runtime::OdeSystem;
+                inner.rhs(t, &y[..4], &mut dy[..4]).unwrap();
+                if dy.len() > 4 {
+                    dy[4] = 0.0;
+                }
+            });
+            let mut y0 = vec![1.0, 0.5, 0.0, 0.0];
+            y0.resize(dim, 0.0);
+            let mut best = f64::INFINITY;
+            let mut evals = 0;
+            for _ in 0..30 {
+                let start = Instant::now();
+                let solution = method
+                    .integrate(&mut system, 0.0, &y0, 10.0, &OutputTimes::Steps, &options)
+                    .unwrap();
+                best = best.min(start.elapsed().as_secs_f64());
+                evals = solution.stats.rhs_evals;
+            }
+            println!(
+                "{:>6} dim {dim}: {evals} evaluations, best of 30 {:.3} ms, {:.1} ns per evaluation",
+                method.name(),
+                best * 1e3,
+                best * 1e9 / evals as f64
+            );
+        }
+    }
+}

@@ -30,7 +30,9 @@ fn method_help(method: Method) -> &'static str {
         Method::Vern6 => "Verner's most efficient 6(5) pair, adaptive, order-6 dense output",
         Method::Vern7 => "Verner's most efficient 7(6) pair, adaptive, order-7 dense output",
         Method::Vern8 => "Verner's most efficient 8(7) pair, adaptive, order-8 dense output",
-        Method::Vern9 => "Verner's most efficient 9(8) pair, adaptive, order-9 dense output (tolerances of 1e-12 and below)",
+        Method::Vern9 => {
+            "Verner's most efficient 9(8) pair, adaptive, order-9 dense output (tolerances of 1e-12 and below)"
+        }
         Method::Taylor => {
             "Taylor series of the model's generated recurrences, order and step from the tolerance (Jorba & Zou), the series as dense output; unconstrained models without abs, sign, step"
         }

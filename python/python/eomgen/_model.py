@@ -18,8 +18,8 @@ ArrayLike = Union[Sequence[float], np.ndarray]
 
 #: The integration methods (``method=``): fixed-step ``euler``, ``midpoint``, ``rk4``,
 #: ``symplectic-euler``, ``stormer-verlet``, ``implicit-midpoint`` (step ``dt``); adaptive
-#: ``bs32``, ``dp54`` (Dormand–Prince 5(4), the default), ``dop853`` and ``radau5``
-#: (``rtol``/``atol``).
+#: ``bs32``, ``dp54`` (Dormand–Prince 5(4), the default), ``dop853``, ``vern6``, ``vern7``,
+#: ``vern8``, ``vern9`` (Verner's pairs 6(5) … 9(8)) and ``radau5`` (``rtol``/``atol``).
 METHODS = tuple(_eomgen.methods())
 
 #: ``simulate``'s defaults, those of ``eomgen simulate`` without options: end time (s),

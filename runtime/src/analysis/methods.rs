@@ -8,7 +8,9 @@
 //! I*, 2nd ed., Springer, 1993 (the explicit Runge–Kutta methods and DOP853); E. Hairer,
 //! G. Wanner, *Solving Ordinary Differential Equations II*, 2nd ed., Springer, 1996 (Radau
 //! IIA 5); E. Hairer, C. Lubich, G. Wanner, *Geometric Numerical Integration*, 2nd ed.,
-//! Springer, 2006 (symplectic Euler, Störmer–Verlet, implicit midpoint).
+//! Springer, 2006 (symplectic Euler, Störmer–Verlet, implicit midpoint); J. H. Verner,
+//! "Numerically optimal Runge–Kutta pairs with interpolants", Numer. Algorithms 53, 383–396,
+//! 2010, doi:10.1007/s11075-009-9290-3 (the Verner pairs).
 
 use std::fmt;
 use std::str::FromStr;
@@ -17,8 +19,8 @@ use serde::Serialize;
 
 use crate::integrate::{
     BogackiShampine32, DormandPrince54, DormandPrince853, ExplicitEuler, ExplicitMidpoint,
-    ImplicitMidpoint, Integrator, RadauIIA5, RungeKutta4, StormerVerlet, SymplecticEuler,
-    Taylor, Verner65, Verner76, Verner87, Verner98,
+    ImplicitMidpoint, Integrator, RadauIIA5, RungeKutta4, StormerVerlet, SymplecticEuler, Taylor,
+    Verner65, Verner76, Verner87, Verner98,
 };
 
 /// An integration method, by its command-line name.
@@ -240,6 +242,8 @@ mod tests {
         }
     }
 
+    /// Adaptive: the methods with an error estimate, and the Taylor method, whose steps come
+    /// from its series' radius of convergence.
     #[test]
     fn adaptive_methods_are_those_with_an_error_estimate() {
         let adaptive: Vec<_> = Method::ALL
@@ -256,6 +260,7 @@ mod tests {
                 Method::Vern7,
                 Method::Vern8,
                 Method::Vern9,
+                Method::Taylor,
                 Method::Radau5
             ]
         );
@@ -275,7 +280,7 @@ mod tests {
         assert_eq!(e.name, "Dp54");
         assert_eq!(
             e.to_string(),
-            "unknown integration method `Dp54` (valid: euler, midpoint, rk4, bs32, dp54, dop853, vern6, vern7, vern8, vern9, symplectic-euler, stormer-verlet, implicit-midpoint, radau5)"
+            "unknown integration method `Dp54` (valid: euler, midpoint, rk4, bs32, dp54, dop853, vern6, vern7, vern8, vern9, taylor, symplectic-euler, stormer-verlet, implicit-midpoint, radau5)"
         );
     }
 }

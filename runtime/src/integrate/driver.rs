@@ -1053,8 +1053,11 @@ mod tests {
         })
     }
 
-    /// Arenstorf's initial state and period (Hairer–Nørsett–Wanner I, §II.0, (0.2)).
+    /// Arenstorf's initial state and period (Hairer–Nørsett–Wanner I, §II.0, (0.2)), with
+    /// every digit the book prints; the compiler rounds them to f64.
+    #[allow(clippy::excessive_precision, reason = "the digits of the source")]
     const ARENSTORF_Y0: [f64; 4] = [0.994, 0.0, 0.0, -2.00158510637908252240537862224];
+    #[allow(clippy::excessive_precision, reason = "the digits of the source")]
     const ARENSTORF_PERIOD: f64 = 17.0652165601579625588917206249;
 
     /// Lorenz's system (σ = 10, ρ = 28, β = 8/3): three components, so the stages take the

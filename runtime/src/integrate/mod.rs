@@ -13,6 +13,7 @@
 //! | Verner 7(6) | [`Verner76`] | 7 | adaptive ([`PiController`]) or fixed | Verner's (order 7, 5 extra stages) |
 //! | Verner 8(7) | [`Verner87`] | 8 | adaptive ([`PiController`]) or fixed | Verner's (order 8, 7 extra stages) |
 //! | Verner 9(8) | [`Verner98`] | 9 | adaptive ([`PiController`]) or fixed | Verner's (order 9, 9 extra stages) |
+//! | Taylor | [`Taylor`] | `⌈−½ ln ε + 1⌉` from the tolerance | a priori from the series (Jorba & Zou), or fixed | the step's series (its order) |
 //! | symplectic Euler | [`SymplecticEuler`] | 1 | fixed `dt`, `y = [q; q̇]` | cubic Hermite |
 //! | Störmer–Verlet | [`StormerVerlet`] | 2 | fixed `dt`, `y = [q; q̇]` | cubic Hermite |
 //! | implicit midpoint | [`ImplicitMidpoint`] | 2 | fixed `dt`, Newton with `∂F/∂y` | cubic Hermite (order 3) |
@@ -106,8 +107,8 @@ pub use solution::{Solution, Stats};
 pub use symplectic::{StormerVerlet, SymplecticEuler};
 pub use tableau::Tableau;
 pub use taylor::Taylor;
-pub use verner::{Verner65, Verner76, Verner87, Verner98};
 pub(crate) use verner::verner_methods;
+pub use verner::{Verner65, Verner76, Verner87, Verner98};
 
 // The event types belong to the ODE interface (`OdeSystem::event_specs`); the root finding is
 // `events`.

@@ -2,13 +2,13 @@
 //! from the model's generated recurrences ([`crate::taylor`]), its order and step size from
 //! the tolerance (Jorba & Zou 2005, §3, as heyoka implements it).
 
+use super::Integrator;
+use super::dense_output::DenseOutput;
 use super::driver::{self, Control, Problem};
 use super::error::{IntegrationError, IntegrationFailure};
 use super::options::{ErrorWeights, IntegratorOptions, OutputTimes, Tolerance};
 use super::solution::Solution;
 use super::stepper::{CheckedRhs, StepFailure, Stepper, SystemShape};
-use super::dense_output::DenseOutput;
-use super::Integrator;
 use crate::ode::OdeSystem;
 
 /// The Taylor method of adaptive order and step (Jorba & Zou 2005; Biscani & Izzo 2021):
@@ -261,7 +261,13 @@ impl Stepper for TaylorStepper {
     ) -> Result<Option<f64>, StepFailure> {
         self.t_new = t_new;
         let tau = t_new - self.t;
-        Self::horner(&self.coefficients, self.order, self.dim, tau, &mut self.y_new);
+        Self::horner(
+            &self.coefficients,
+            self.order,
+            self.dim,
+            tau,
+            &mut self.y_new,
+        );
         match self.y_new.iter().position(|v| !v.is_finite()) {
             Some(index) => Err(StepFailure::NonFiniteState { t: t_new, index }),
             None => Ok(None),

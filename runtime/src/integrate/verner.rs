@@ -47,7 +47,10 @@ pub(crate) struct VernerTableau {
     pub(crate) error: &'static [f64],
     /// Degree of the interpolant's weights `bᵢ(θ)` in θ.
     pub(crate) degree: usize,
-    /// `rᵢₘ` of `bᵢ(θ) = Σₘ rᵢₘ θᵐ` (`m = 1 … degree`), stage-major: `num_all_stages × degree`.
+    /// `rᵢₘ` of `bᵢ(θ) = Σₘ rᵢₘ θᵐ` (`m = 1 … degree`), stage-major: `num_all_stages × degree`,
+    /// as Verner publishes them. The stepper uses `node_weights`, computed from these; the
+    /// tests check the order conditions on these and the one against the other.
+    #[cfg_attr(not(test), allow(dead_code))]
     pub(crate) interpolant: &'static [f64],
     /// Nodes `θ₁ < … < θ_degree = 1` at which the interpolant is represented.
     pub(crate) nodes: &'static [f64],
@@ -328,7 +331,13 @@ impl Stepper for VernerStepper {
         let stage_time = |r: usize| times.at(c[r + 1]);
         // The stage sums go through `combine`, whose copies for 2, 4, 6 and 8 components keep
         // the sums in registers.
-        for i in 1..s {
+        for (i, (&ci, a_row)) in c
+            .iter()
+            .zip(&self.a_differences)
+            .enumerate()
+            .take(s)
+            .skip(1)
+        {
             let (earlier, rest) = self.k.split_at_mut((i - 1) * n);
             // The last stage of the FSAL pair is evaluated at the candidate itself.
             let input = if tableau.fsal && i == s - 1 {
@@ -336,16 +345,9 @@ impl Stepper for VernerStepper {
             } else {
                 &mut self.scratch
             };
-            combine(
-                input,
-                &self.ends.y,
-                h,
-                &self.a_differences[i],
-                &self.ends.f,
-                earlier,
-            );
+            combine(input, &self.ends.y, h, a_row, &self.ends.f, earlier);
             let row = &mut rest[..n];
-            if let Err(failure) = rhs.eval_stage(times.at(c[i]), input, row) {
+            if let Err(failure) = rhs.eval_stage(times.at(ci), input, row) {
                 return Err(CheckedRhs::stage_failure(earlier, n, stage_time, failure));
             }
             // A non-finite stage stays non-finite as a difference (k₀ is finite).
@@ -988,6 +990,37 @@ mod tests {
                 assert!(order > expected - 0.5, "{name}: {order} in {errors:?}");
             }
         }
+    }
+
+    /// A NaN in a stage without weight in the candidate and in the error estimate (6(5)'s
+    /// stage at `c = 0.06`; `F` ignores `y`, so nothing else could show it) is reported at its
+    /// own time, by the stage sums for a fixed dimension (2) and the general ones (3); and a
+    /// NaN in a weighted stage (`c = 0.4973`) at its time too, not as a non-finite state.
+    #[test]
+    fn a_non_finite_stage_is_reported_at_its_time() {
+        for (c_nan, dim) in [(0.06, 2), (0.06, 3), (0.4973, 2), (0.4973, 3)] {
+            let t_nan = c_nan * 0.5;
+            let mut system = OdeFn::new(dim, move |t: f64, _y: &[f64], dy: &mut [f64]| {
+                dy.fill(if (t - t_nan).abs() < 1e-6 {
+                    f64::NAN
+                } else {
+                    1.0
+                });
+            });
+            let mut rhs = CheckedRhs::new(&mut system);
+            let mut stepper = VernerStepper::new(&VERN6, dim);
+            stepper.reset(&mut rhs, 0.0, &vec![0.0; dim]).unwrap();
+            let weights = ErrorWeights::uniform(dim, 1e-6, 1e-6);
+            match stepper.attempt(&mut rhs, 0.5, &weights, true).unwrap_err() {
+                StepFailure::Rhs {
+                    t,
+                    error: RhsError::NonFinite { index: 0 },
+                } => assert!((t - t_nan).abs() < 1e-15, "t = {t}"),
+                other => panic!("{other:?}"),
+            }
+            assert_eq!(stepper.t(), 0.0);
+        }
+        assert_eq!(VernerStepper::new(&VERN6, 1).unweighted_rows, vec![0, 1]);
     }
 
     /// The tableau's stability polynomial agrees with one step of the implementation on the

@@ -297,8 +297,16 @@ pub fn method(name: &str) -> Method {
 
 /// Every registered method ([`Method::ALL`]), each a new integrator in its default
 /// configuration.
+///
+/// The Taylor method is left out: it needs a model's generated recurrences, which equations
+/// written as closures do not have (it is tested on models in the root package's
+/// `tests/taylor.rs`).
 pub fn integrators() -> Vec<Box<dyn Integrator>> {
-    Method::ALL.iter().map(|m| m.integrator()).collect()
+    Method::ALL
+        .iter()
+        .filter(|&&m| m != Method::Taylor)
+        .map(|m| m.integrator())
+        .collect()
 }
 
 /// Whether the method named `name` takes constant steps `dt` (by default
@@ -322,6 +330,7 @@ pub fn needs_second_order(name: &str) -> bool {
         | Method::Vern7
         | Method::Vern8
         | Method::Vern9
+        | Method::Taylor
         | Method::ImplicitMidpoint
         | Method::Radau5 => false,
     }

@@ -66,7 +66,7 @@ pub struct WorkPrecisionArgs {
     /// A bundled model's name (see `eomgen list`) or the path of any model file.
     pub model: String,
     /// Methods to compare, comma separated (default: bs32, dp54, dop853, vern6, vern7, vern8,
-    /// vern9, radau5, rk4, stormer-verlet).
+    /// vern9, taylor, radau5, rk4, stormer-verlet).
     #[arg(long, value_parser = crate::cli::integration::method_parser(), value_delimiter = ',', default_values_t = DEFAULT_METHODS)]
     pub methods: Vec<Method>,
     /// Tolerances of the adaptive methods (`rtol = atol = tol`): `A..B`, every decade from A

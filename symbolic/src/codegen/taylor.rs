@@ -66,7 +66,10 @@ pub fn taylor_program(
         ..
     } = builder;
     // Constants read as whole series are zeroed above order 0 before anything reads them.
-    let zero_ops: Vec<SeriesOp> = zeroed.into_iter().map(|out| SeriesOp::Zero { out }).collect();
+    let zero_ops: Vec<SeriesOp> = zeroed
+        .into_iter()
+        .map(|out| SeriesOp::Zero { out })
+        .collect();
     ops.splice(0..0, zero_ops);
     let program = TaylorProgram {
         slots: order_zero.instructions.len(),
@@ -188,7 +191,9 @@ impl<'a> Builder<'a> {
                     }
                 },
                 Instruction::Const(_) => true,
-                instruction => operands(instruction).iter().all(|&v| self.constant[v as usize]),
+                instruction => operands(instruction)
+                    .iter()
+                    .all(|&v| self.constant[v as usize]),
             };
             self.constant.push(constant);
         }
@@ -287,19 +292,11 @@ impl<'a> Builder<'a> {
                 }
                 Func::Sinh => {
                     let cosh = self.aux(Instruction::Call(Func::Cosh, a), false);
-                    SeriesOp::SinhCosh {
-                        sinh: out,
-                        cosh,
-                        a,
-                    }
+                    SeriesOp::SinhCosh { sinh: out, cosh, a }
                 }
                 Func::Cosh => {
                     let sinh = self.aux(Instruction::Call(Func::Sinh, a), false);
-                    SeriesOp::SinhCosh {
-                        sinh,
-                        cosh: out,
-                        a,
-                    }
+                    SeriesOp::SinhCosh { sinh, cosh: out, a }
                 }
                 Func::Tan => {
                     let square = self.aux(Instruction::Mul(out, out), false);
@@ -504,10 +501,7 @@ pub(super) fn methods(
             Ok(quote!(__s[#k * __c] = #name;))
         })
         .collect::<Result<Vec<_>, String>>()?;
-    let calls = program.ops.iter().map(|op| {
-        let op = op_tokens(op, &t);
-        quote!(#t::apply(#op, __k, __c, __s);)
-    });
+    let calls: Vec<_> = program.ops.iter().map(|op| call_tokens(op, &t)).collect();
     Ok(quote! {
         fn taylor_program(&self) -> ::core::result::Result<&#t::TaylorProgram, #t::TaylorUnsupported> {
             #statics
@@ -591,5 +585,46 @@ fn op_tokens(op: &SeriesOp, t: &proc_macro2::TokenStream) -> proc_macro2::TokenS
             quote!(#t::SeriesOp::Atan2 { out: #out, y: #y, x: #x, norm: #norm })
         }
         SeriesOp::Zero { out } => quote!(#t::SeriesOp::Zero { out: #out }),
+    }
+}
+
+/// The call of an op's kernel (`eomgen_runtime::taylor::{mul, sin_cos, …}`) in
+/// `taylor_order`, the kernel [`SeriesOp`]'s dispatch (`apply`) calls for the run-time model.
+fn call_tokens(op: &SeriesOp, t: &proc_macro2::TokenStream) -> proc_macro2::TokenStream {
+    use quote::quote;
+    let args = |kernel: &str, slots: &[Slot]| {
+        let kernel = proc_macro2::Ident::new(kernel, proc_macro2::Span::call_site());
+        quote!(#t::#kernel(__k, __c, __s, #(#slots),*);)
+    };
+    match *op {
+        SeriesOp::Neg { out, a } => args("neg", &[out, a]),
+        SeriesOp::Copy { out, a } => args("copy", &[out, a]),
+        SeriesOp::Add { out, a, b } => args("add", &[out, a, b]),
+        SeriesOp::Sub { out, a, b } => args("sub", &[out, a, b]),
+        SeriesOp::Mul { out, a, b } => args("mul", &[out, a, b]),
+        SeriesOp::Scale { out, a, constant } => args("scale", &[out, a, constant]),
+        SeriesOp::Div { out, a, b } => args("div", &[out, a, b]),
+        SeriesOp::DivByConstant { out, a, constant } => {
+            args("div_by_constant", &[out, a, constant])
+        }
+        SeriesOp::ConstantDiv { out, b } => args("constant_div", &[out, b]),
+        SeriesOp::Sqrt { out, a } => args("sqrt", &[out, a]),
+        SeriesOp::PowConstant { out, a, exponent } => args("pow_constant", &[out, a, exponent]),
+        SeriesOp::Exp { out, a } => args("exp", &[out, a]),
+        SeriesOp::Ln { out, a } => args("ln", &[out, a]),
+        SeriesOp::SinCos { sin, cos, a } => args("sin_cos", &[sin, cos, a]),
+        SeriesOp::SinhCosh { sinh, cosh, a } => args("sinh_cosh", &[sinh, cosh, a]),
+        SeriesOp::Tan { out, a, square } => {
+            quote!(#t::tan_or_tanh(__k, __c, __s, #out, #a, #square, 1.0);)
+        }
+        SeriesOp::Tanh { out, a, square } => {
+            quote!(#t::tan_or_tanh(__k, __c, __s, #out, #a, #square, -1.0);)
+        }
+        SeriesOp::Asin { out, a, root, acos } => {
+            quote!(#t::asin(__k, __c, __s, #out, #a, #root, #acos);)
+        }
+        SeriesOp::Atan { out, a, square } => args("atan", &[out, a, square]),
+        SeriesOp::Atan2 { out, y, x, norm } => args("atan2", &[out, y, x, norm]),
+        SeriesOp::Zero { out } => args("zero", &[out]),
     }
 }

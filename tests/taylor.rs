@@ -1,0 +1,307 @@
+//! The Taylor method (`eomgen_runtime::Taylor`): its step rule against heyoka's, accuracy
+//! against closed forms over long runs, its dense output and events, the order of its
+//! fixed-step form, and its refusals (a closure, constraints, a piecewise function).
+//!
+//! The coefficients themselves are checked against an independent high-precision computation
+//! in `tests/taylor_coefficients.rs`.
+
+use eomgen::{
+    DynFirstOrder, IntegrationError, Integrator, IntegratorOptions, JitModel, OdeFn, OdeSystem,
+    OutputTimes, Taylor,
+};
+
+/// A model file compiled at run time, as the first-order form the integrators take.
+fn model(source: &str) -> DynFirstOrder<JitModel> {
+    let model = JitModel::from_source("test.yaml", source).expect("the model loads");
+    DynFirstOrder::new(model)
+}
+
+/// `ẍ = −9.8 sin x`: heyoka's pendulum example.
+const PENDULUM: &str = "
+name: pendulum
+description: x'' = -9.8 sin x.
+parameters: { g: 9.8 }
+coordinates: [x]
+kinetic: x_dot^2/2
+potential: -g*cos(x)
+initial: { x: 0.05, x_dot: 0.025 }
+events:
+  turn: { when: x_dot, direction: falling }
+";
+
+/// `ẍ = −x`: `x = cos t` from `(1, 0)`.
+const OSCILLATOR: &str = "
+name: oscillator
+description: x'' = -x.
+parameters: { k: 1 }
+coordinates: [x]
+kinetic: x_dot^2/2
+potential: k*x^2/2
+initial: { x: 1, x_dot: 0 }
+";
+
+fn tolerance(tol: f64) -> IntegratorOptions {
+    IntegratorOptions::default().with_rtol(tol).with_atol(tol)
+}
+
+/// The order rule is heyoka's `taylor_order_from_tol`: ⌈−½ ln ε + 1⌉ (its table: 8, 12, 15,
+/// 20 at 1e-6, 1e-9, 1e-12 and machine epsilon).
+#[test]
+fn the_order_follows_the_tolerance_as_in_heyoka() {
+    for (tol, order) in [(1e-6, 8), (1e-9, 12), (1e-12, 15), (f64::EPSILON, 20)] {
+        assert_eq!(Taylor::order_for_tolerance(tol), order, "tol {tol:e}");
+    }
+    assert_eq!(Taylor::order_for_tolerance(0.9), 2);
+}
+
+/// heyoka's first step on its pendulum example (x₀ = (0.05, 0.025), tol 1e-9) is
+/// h = 0.2024724481278614 (integrators-and-python reference, §1.5, re-run there): ours, from
+/// the same rule on our coefficients, agrees to a few ulps (the ∞-norms and powers may round
+/// differently).
+#[test]
+fn the_first_step_is_heyokas() {
+    let mut system = model(PENDULUM);
+    let solution = Taylor::new()
+        .integrate(
+            &mut system,
+            0.0,
+            &[0.05, 0.025],
+            1.0,
+            &OutputTimes::Steps,
+            &tolerance(1e-9),
+        )
+        .unwrap();
+    let h = solution.t[1] - solution.t[0];
+    assert!((h / 0.2024724481278614 - 1.0).abs() < 1e-14, "h = {h:?}");
+}
+
+/// Over 1,000 periods of `ẍ = −x` the state stays on `(cos t, −sin t)`: the error grows
+/// like the number of steps times the local error, far below 1e-8 at tol 1e-14, and the
+/// energy error stays at rounding level.
+#[test]
+fn a_thousand_periods_of_the_oscillator_stay_on_the_circle() {
+    let mut system = model(OSCILLATOR);
+    let t_end = 2000.0 * std::f64::consts::PI;
+    let solution = Taylor::new()
+        .integrate(
+            &mut system,
+            0.0,
+            &[1.0, 0.0],
+            t_end,
+            &OutputTimes::Steps,
+            &tolerance(1e-14),
+        )
+        .unwrap();
+    let mut worst = 0.0f64;
+    for (t, y) in solution.iter() {
+        worst = worst
+            .max((y[0] - t.cos()).abs())
+            .max((y[1] + t.sin()).abs());
+    }
+    assert!(worst < 1e-8, "worst error {worst:e}");
+    let y = solution.state(solution.len() - 1);
+    let energy = (y[0] * y[0] + y[1] * y[1]) / 2.0;
+    assert!((energy - 0.5).abs() < 1e-11, "energy {energy}");
+}
+
+/// The dense output is the step's series: between steps it is as accurate as at the steps
+/// (here against `cos t` at 1,000 times that fall inside steps), and a requested time that
+/// is a step's end gives that step's end.
+#[test]
+fn dense_output_is_as_accurate_as_the_steps() {
+    let times: Vec<f64> = (1..=1000).map(|i| i as f64 * 0.0123).collect();
+    let t_end = 12.3;
+    for tol in [1e-6, 1e-10, 1e-14] {
+        let mut system = model(OSCILLATOR);
+        let dense = Taylor::new()
+            .integrate(
+                &mut system,
+                0.0,
+                &[1.0, 0.0],
+                t_end,
+                &OutputTimes::At(times.clone()),
+                &tolerance(tol),
+            )
+            .unwrap();
+        let mut system = model(OSCILLATOR);
+        let steps = Taylor::new()
+            .integrate(
+                &mut system,
+                0.0,
+                &[1.0, 0.0],
+                t_end,
+                &OutputTimes::Steps,
+                &tolerance(tol),
+            )
+            .unwrap();
+        let error = |(t, y): (f64, &[f64])| (y[0] - t.cos()).abs().max((y[1] + t.sin()).abs());
+        let dense_error = dense.iter().map(error).fold(0.0, f64::max);
+        let step_error = steps.iter().map(error).fold(0.0, f64::max);
+        // Within a factor 10 of the error at the steps, and of the tolerance's order.
+        assert!(
+            dense_error <= 10.0 * step_error.max(tol),
+            "tol {tol:e}: dense {dense_error:e}, steps {step_error:e}"
+        );
+        assert!(dense_error < 100.0 * tol, "tol {tol:e}: {dense_error:e}");
+        assert_eq!(dense.state(dense.len() - 1), steps.state(steps.len() - 1));
+    }
+}
+
+/// Events are located on the series: the pendulum's turning points (`ẋ` falling through 0)
+/// come every period `T = 4 K(sin²(a/2)) / √g` of the amplitude `a`; the time between the
+/// first and the eleventh matches ten periods to 1e-11 s. The amplitude comes from the
+/// energy, `1 − cos a = (ẋ₀²/2 + g (1 − cos x₀)) / g`, and K by the arithmetic–geometric mean.
+#[test]
+fn events_are_located_to_the_accuracy_of_the_series() {
+    let mut system = model(PENDULUM);
+    let (x0, v0, g) = (0.05f64, 0.025f64, 9.8f64);
+    let solution = Taylor::new()
+        .integrate(
+            &mut system,
+            0.0,
+            &[x0, v0],
+            25.0,
+            &OutputTimes::Steps,
+            &tolerance(1e-13),
+        )
+        .unwrap();
+    let turns: Vec<f64> = solution
+        .events
+        .iter()
+        .filter(|e| e.index == 0)
+        .map(|e| e.t)
+        .collect();
+    assert!(turns.len() >= 11, "{} turns", turns.len());
+    let cos_a = 1.0 - (v0 * v0 / 2.0 + g * (1.0 - x0.cos())) / g;
+    let k2 = (1.0 - cos_a) / 2.0; // sin²(a/2)
+    // K(m) = π / (2 AGM(1, √(1 − m))).
+    let (mut a, mut b) = (1.0f64, (1.0 - k2).sqrt());
+    for _ in 0..10 {
+        (a, b) = ((a + b) / 2.0, (a * b).sqrt());
+    }
+    let period = 4.0 * (std::f64::consts::PI / (2.0 * a)) / g.sqrt();
+    let measured = (turns[10] - turns[0]) / 10.0;
+    assert!(
+        (measured - period).abs() < 1e-12,
+        "period {measured} against {period}"
+    );
+}
+
+/// With fixed steps the method is of the order its tolerance gives: halving the step of an
+/// order-8 series (tol 1e-6) divides the error at t = 3 by about 2⁸.
+#[test]
+fn fixed_steps_converge_at_the_order_of_the_series() {
+    let error = |dt: f64| {
+        let mut system = model(OSCILLATOR);
+        let options = tolerance(1e-6).with_fixed_step(true).with_dt(dt);
+        let solution = Taylor::new()
+            .integrate(
+                &mut system,
+                0.0,
+                &[1.0, 0.0],
+                3.0,
+                &OutputTimes::Steps,
+                &options,
+            )
+            .unwrap();
+        let y = solution.state(solution.len() - 1);
+        (y[0] - 3.0f64.cos()).abs().max((y[1] + 3.0f64.sin()).abs())
+    };
+    let (coarse, fine) = (error(0.6), error(0.3));
+    let observed = (coarse / fine).log2();
+    assert!((observed - 8.0).abs() < 0.6, "observed order {observed}");
+}
+
+/// Looser tolerances give larger errors, tighter ones smaller, roughly in proportion: the
+/// error at t = 20 of the pendulum stays within two decades of the tolerance, falling
+/// with it at every step.
+#[test]
+fn the_error_follows_the_tolerance() {
+    let mut reference = model(PENDULUM);
+    let exact = Taylor::new()
+        .integrate(
+            &mut reference,
+            0.0,
+            &[0.05, 0.025],
+            20.0,
+            &OutputTimes::At(vec![20.0]),
+            &tolerance(1e-16),
+        )
+        .unwrap();
+    let exact = exact.state(0).to_vec();
+    let mut previous = f64::INFINITY;
+    for tol in [1e-4, 1e-6, 1e-8, 1e-10, 1e-12] {
+        let mut system = model(PENDULUM);
+        let solution = Taylor::new()
+            .integrate(
+                &mut system,
+                0.0,
+                &[0.05, 0.025],
+                20.0,
+                &OutputTimes::At(vec![20.0]),
+                &tolerance(tol),
+            )
+            .unwrap();
+        let y = solution.state(0);
+        let error = (y[0] - exact[0]).abs().max((y[1] - exact[1]).abs());
+        assert!(error < 100.0 * tol, "tol {tol:e}: error {error:e}");
+        assert!(
+            error < previous,
+            "tol {tol:e}: {error:e} after {previous:e}"
+        );
+        previous = error;
+    }
+}
+
+/// What the method cannot integrate is refused before any step, naming why: equations given
+/// as a closure, a constrained model, equations with `sign`.
+#[test]
+fn systems_without_recurrences_are_refused_with_the_reason() {
+    let mut closure = OdeFn::new(1, |_t: f64, y: &[f64], dy: &mut [f64]| dy[0] = -y[0]);
+    let failure = Taylor::new()
+        .integrate(
+            &mut closure,
+            0.0,
+            &[1.0],
+            1.0,
+            &OutputTimes::Steps,
+            &IntegratorOptions::default(),
+        )
+        .unwrap_err();
+    assert!(
+        matches!(failure.error, IntegrationError::NoTaylorRecurrences { .. }),
+        "{failure}"
+    );
+    let piecewise = model(
+        "
+name: stop
+description: a spring that only pushes.
+parameters: { k: 1 }
+coordinates: [x]
+kinetic: x_dot^2/2
+generalized_forces:
+  x: -k*x*step(-x)
+initial: { x: -1, x_dot: 0 }
+",
+    );
+    let mut piecewise = piecewise;
+    assert!(piecewise.taylor_support().is_err());
+    let failure = Taylor::new()
+        .integrate(
+            &mut piecewise,
+            0.0,
+            &[-1.0, 0.0],
+            1.0,
+            &OutputTimes::Steps,
+            &IntegratorOptions::default(),
+        )
+        .unwrap_err();
+    let message = failure.to_string();
+    assert!(message.contains("`step`"), "{message}");
+    assert_eq!(failure.partial.len(), 0, "no step was taken");
+    let constrained = DynFirstOrder::new(
+        JitModel::load("models/simple_pendulum_cartesian.yaml").expect("bundled"),
+    );
+    let message = constrained.taylor_support().unwrap_err().to_string();
+    assert!(message.contains("constraint"), "{message}");
+}
