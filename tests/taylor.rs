@@ -305,3 +305,57 @@ initial: { x: -1, x_dot: 0 }
     let message = constrained.taylor_support().unwrap_err().to_string();
     assert!(message.contains("constraint"), "{message}");
 }
+
+/// Tolerances that differ, or that are 0, size the buffers for the highest order either mode
+/// asks for: `atol = 0` (relative only), `rtol = 0` (absolute only) and `rtol ≠ atol` with a
+/// state that crosses between the modes all integrate the oscillator to the accuracy asked.
+#[test]
+fn zero_and_unequal_tolerances_work() {
+    for (rtol, atol) in [(1e-10, 0.0), (0.0, 1e-10), (1e-6, 1e-12), (1e-12, 1e-6)] {
+        let mut system = model(OSCILLATOR);
+        let options = IntegratorOptions::default().with_rtol(rtol).with_atol(atol);
+        let solution = Taylor::new()
+            .integrate(
+                &mut system,
+                0.0,
+                &[1.0, 0.0],
+                20.0,
+                &OutputTimes::Steps,
+                &options,
+            )
+            .unwrap_or_else(|e| panic!("rtol {rtol:e}, atol {atol:e}: {e}"));
+        let (t, y) = solution.last().unwrap();
+        let error = (y[0] - t.cos()).abs().max((y[1] + t.sin()).abs());
+        let asked = rtol.max(atol);
+        assert!(
+            error < 100.0 * asked,
+            "rtol {rtol:e}, atol {atol:e}: {error:e}"
+        );
+    }
+}
+
+/// A step never exceeds `dt_max`, even the last one (which is not stretched past it to land
+/// on the end).
+#[test]
+fn steps_respect_dt_max() {
+    let mut system = model(OSCILLATOR);
+    let options = tolerance(1e-8).with_dt_max(0.1);
+    let solution = Taylor::new()
+        .integrate(
+            &mut system,
+            0.0,
+            &[1.0, 0.0],
+            1.005,
+            &OutputTimes::Steps,
+            &options,
+        )
+        .unwrap();
+    let longest = solution
+        .t
+        .windows(2)
+        .map(|w| w[1] - w[0])
+        .fold(0.0, f64::max);
+    // Differences of rounded times: a few ulps over.
+    assert!(longest <= 0.1 * (1.0 + 1e-12), "longest step {longest}");
+    assert_eq!(*solution.t.last().unwrap(), 1.005);
+}

@@ -11,7 +11,7 @@ use crate::linalg::{solve_spd, solve_spd_in_place};
 use crate::model_info::{FirstOrderForm, FirstOrderParts};
 use crate::ode::{EventSpec, OdeSystem, RhsError};
 use crate::system::MechanicalSystem;
-use crate::taylor::TaylorWorkspace;
+use crate::taylor::{TaylorProgram, TaylorUnsupported, TaylorWorkspace};
 
 /// The first-order form `y = [q; q̇]`, `ẏ = [q̇; M⁻¹F]` of a [`MechanicalSystem`].
 ///
@@ -221,7 +221,7 @@ impl<S: MechanicalSystem<N>, const N: usize> OdeSystem for FirstOrder<S, N> {
     }
 
     fn taylor_support(&self) -> Result<(), crate::taylor::TaylorUnsupported> {
-        crate::taylor::support(StaticSystem::from_ref(&self.system)).map(|_| ())
+        taylor_support(StaticSystem::from_ref(&self.system)).map(|_| ())
     }
 
     fn taylor_coefficients(
@@ -232,7 +232,7 @@ impl<S: MechanicalSystem<N>, const N: usize> OdeSystem for FirstOrder<S, N> {
         out: &mut [f64],
     ) -> Result<(), RhsError> {
         let system = StaticSystem::from_ref(&self.system);
-        crate::taylor::coefficients(system, &mut self.taylor, t, y, order, out)
+        taylor_coefficients(system, &mut self.taylor, t, y, order, out)
     }
 
     fn event_values(&mut self, t: f64, y: &[f64], g: &mut [f64]) -> Result<(), RhsError> {
@@ -516,7 +516,7 @@ impl<S: DynMechanicalSystem> OdeSystem for DynFirstOrder<S> {
     }
 
     fn taylor_support(&self) -> Result<(), crate::taylor::TaylorUnsupported> {
-        crate::taylor::support(&self.system).map(|_| ())
+        taylor_support(&self.system).map(|_| ())
     }
 
     fn taylor_coefficients(
@@ -526,7 +526,7 @@ impl<S: DynMechanicalSystem> OdeSystem for DynFirstOrder<S> {
         order: usize,
         out: &mut [f64],
     ) -> Result<(), RhsError> {
-        crate::taylor::coefficients(&self.system, &mut self.taylor, t, y, order, out)
+        taylor_coefficients(&self.system, &mut self.taylor, t, y, order, out)
     }
 
     fn event_values(&mut self, t: f64, y: &[f64], g: &mut [f64]) -> Result<(), RhsError> {
@@ -568,4 +568,50 @@ impl<S: DynMechanicalSystem> FirstOrderForm for DynFirstOrder<S> {
             events: &mut self.events,
         }
     }
+}
+
+/// A [`DynMechanicalSystem`](DynMechanicalSystem) with a program, as
+/// [`TaylorFunctions`].
+struct ModelSeries<'a, S: ?Sized> {
+    system: &'a S,
+    program: &'a TaylorProgram,
+}
+
+impl<S: DynMechanicalSystem + ?Sized> crate::taylor::TaylorFunctions for ModelSeries<'_, S> {
+    fn program(&self) -> &TaylorProgram {
+        self.program
+    }
+    fn order_zero(&self, capacity: usize, series: &mut [f64]) {
+        self.system.taylor_order_zero(capacity, series);
+    }
+    fn order(&self, k: usize, capacity: usize, series: &mut [f64]) {
+        self.system.taylor_order(k, capacity, series);
+    }
+}
+
+/// [`OdeSystem::taylor_support`](crate::OdeSystem::taylor_support) of a first-order form:
+/// the system's program, refused with constraints.
+fn taylor_support<S: DynMechanicalSystem + ?Sized>(
+    system: &S,
+) -> Result<&TaylorProgram, TaylorUnsupported> {
+    let count = system.description().constraints.len();
+    if count > 0 {
+        return Err(TaylorUnsupported::Constraints { count });
+    }
+    system.taylor_program()
+}
+
+/// [`OdeSystem::taylor_coefficients`](crate::OdeSystem::taylor_coefficients) of a first-order
+/// form.
+fn taylor_coefficients<S: DynMechanicalSystem + ?Sized>(
+    system: &S,
+    workspace: &mut TaylorWorkspace,
+    t: f64,
+    y: &[f64],
+    order: usize,
+    out: &mut [f64],
+) -> Result<(), RhsError> {
+    let program = taylor_support(system).map_err(|_| RhsError::NonFinite { index: 0 })?;
+    let model = ModelSeries { system, program };
+    crate::taylor::series_of_motion(&model, workspace, t, y, order, out)
 }

@@ -415,8 +415,11 @@ impl TaylorWorkspace {
         Self::default()
     }
 
+    /// Buffers for `order`: grown when a higher order or another program asks for more,
+    /// never shrunk (the stride `capacity` is the kernels' argument, so a longer one serves a
+    /// lower order), so a method switching order between steps does not reallocate.
     fn fit(&mut self, program: &TaylorProgram, n: usize, order: usize) {
-        let capacity = order + 1;
+        let capacity = self.capacity.max(order + 1);
         if self.capacity != capacity || self.series.len() != program.slots * capacity {
             self.capacity = capacity;
             self.series = vec![0.0; program.slots * capacity];
@@ -574,50 +577,4 @@ fn solve(n: usize, lower: &[f64], pivots: &[f64], b: &mut [f64]) {
             b[i] -= lower[k * n + i] * b[k];
         }
     }
-}
-
-/// A [`DynMechanicalSystem`](crate::DynMechanicalSystem) with a program, as
-/// [`TaylorFunctions`].
-pub(crate) struct ModelSeries<'a, S: ?Sized> {
-    pub(crate) system: &'a S,
-    pub(crate) program: &'a TaylorProgram,
-}
-
-impl<S: crate::DynMechanicalSystem + ?Sized> TaylorFunctions for ModelSeries<'_, S> {
-    fn program(&self) -> &TaylorProgram {
-        self.program
-    }
-    fn order_zero(&self, capacity: usize, series: &mut [f64]) {
-        self.system.taylor_order_zero(capacity, series);
-    }
-    fn order(&self, k: usize, capacity: usize, series: &mut [f64]) {
-        self.system.taylor_order(k, capacity, series);
-    }
-}
-
-/// [`OdeSystem::taylor_support`](crate::OdeSystem::taylor_support) of a first-order form:
-/// the system's program, refused with constraints.
-pub(crate) fn support<S: crate::DynMechanicalSystem + ?Sized>(
-    system: &S,
-) -> Result<&TaylorProgram, TaylorUnsupported> {
-    let count = system.description().constraints.len();
-    if count > 0 {
-        return Err(TaylorUnsupported::Constraints { count });
-    }
-    system.taylor_program()
-}
-
-/// [`OdeSystem::taylor_coefficients`](crate::OdeSystem::taylor_coefficients) of a first-order
-/// form.
-pub(crate) fn coefficients<S: crate::DynMechanicalSystem + ?Sized>(
-    system: &S,
-    workspace: &mut TaylorWorkspace,
-    t: f64,
-    y: &[f64],
-    order: usize,
-    out: &mut [f64],
-) -> Result<(), RhsError> {
-    let program = support(system).map_err(|_| RhsError::NonFinite { index: 0 })?;
-    let model = ModelSeries { system, program };
-    series_of_motion(&model, workspace, t, y, order, out)
 }

@@ -218,12 +218,14 @@ fn proposed_steps<S: Stepper>(
                 max_steps: problem.options.max_steps,
             });
         }
-        let dt = stepper.proposed_step().unwrap_or(f64::NAN).min(dt_max);
-        // A NaN step (a non-finite series) is too small as well.
-        if dt.is_nan() || dt < min_step(t, span) {
-            return Err(IntegrationError::StepSizeTooSmall { t, dt });
+        // A NaN proposal (a non-finite series), or none, is too small as well (checked before
+        // `min`, which would return `dt_max` for NaN).
+        let proposed = stepper.proposed_step().unwrap_or(f64::NAN);
+        if proposed.is_nan() || proposed < min_step(t, span) {
+            return Err(IntegrationError::StepSizeTooSmall { t, dt: proposed });
         }
-        let t_new = if t + 1.01 * dt >= t_end {
+        let dt = proposed.min(dt_max);
+        let t_new = if t + 1.01 * dt >= t_end && t_end - t <= dt_max {
             t_end
         } else {
             t + dt

@@ -56,12 +56,17 @@ impl Taylor {
 
     /// The order `p = ⌈−½ ln ε + 1⌉` (at least 2) for a tolerance `ε` (heyoka's
     /// `taylor_order_from_tol`): 8 for 1e-6, 12 for 1e-9, 15 for 1e-12, 20 for 2.2e-16.
+    ///
+    /// A tolerance of 0 (or below the smallest positive `f64`) gives the highest order used,
+    /// 400; the method itself never asks with 0 (a zero `rtol` or `atol` only fixes the mode).
     pub fn order_for_tolerance(tolerance: f64) -> usize {
         let p = (-0.5 * tolerance.ln() + 1.0).ceil();
-        if p.is_finite() && p >= 2.0 {
+        if p.is_nan() || p < 2.0 {
+            2
+        } else if p.is_finite() {
             (p as usize).min(MAX_ORDER)
         } else {
-            2
+            MAX_ORDER
         }
     }
 }
@@ -106,11 +111,19 @@ impl Integrator for Taylor {
     }
 }
 
+/// The smallest positive entry of a tolerance, or 0 if it has none (0 for every component:
+/// that tolerance plays no part).
 fn smallest(tolerance: &Tolerance) -> f64 {
-    match tolerance {
-        Tolerance::Scalar(x) => *x,
-        Tolerance::PerComponent(v) => v.iter().copied().fold(f64::INFINITY, f64::min),
-    }
+    let values: &[f64] = match tolerance {
+        Tolerance::Scalar(x) => std::slice::from_ref(x),
+        Tolerance::PerComponent(v) => v,
+    };
+    let positive = values
+        .iter()
+        .copied()
+        .filter(|&x| x > 0.0)
+        .fold(f64::INFINITY, f64::min);
+    if positive.is_finite() { positive } else { 0.0 }
 }
 
 /// The Taylor method's state: the coefficients at the current point (which give the next
@@ -140,7 +153,16 @@ pub(crate) struct TaylorStepper {
 impl TaylorStepper {
     fn new(shape: SystemShape, rtol: f64, atol: f64) -> Self {
         let dim = shape.dim;
-        let max_order = Taylor::order_for_tolerance(rtol.min(atol));
+        // The highest order either mode can ask for (the driver refuses tolerances that are
+        // both 0 for a component).
+        let order = |tol: f64| {
+            if tol > 0.0 {
+                Taylor::order_for_tolerance(tol)
+            } else {
+                2
+            }
+        };
+        let max_order = order(rtol).max(order(atol));
         let size = (max_order + 1) * dim;
         Self {
             dim,
@@ -161,11 +183,21 @@ impl TaylorStepper {
     }
 
     /// The mode of Jorba & Zou's eq. (3-3) at a state of max norm `norm`: `(ε, N)`.
+    ///
+    /// With `atol = 0` the mode is always relative (`N = ‖y‖`, or 1 at `y = 0`), with
+    /// `rtol = 0` always absolute.
     fn mode(&self, norm: f64) -> (f64, f64) {
-        if self.rtol * norm <= self.atol {
-            (self.atol, 1.0)
+        let relative = if self.atol == 0.0 {
+            true
+        } else if self.rtol == 0.0 {
+            false
         } else {
-            (self.rtol, norm)
+            self.rtol * norm > self.atol
+        };
+        if relative {
+            (self.rtol, if norm > 0.0 { norm } else { 1.0 })
+        } else {
+            (self.atol, 1.0)
         }
     }
 

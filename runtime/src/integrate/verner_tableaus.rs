@@ -25,7 +25,105 @@
 // checked against it.
 #![allow(clippy::excessive_precision)]
 
-use super::verner::VernerTableau;
+use crate::integrate::stability_function::StabilityPolynomial;
+
+/// The coefficients of one of Verner's pairs with its interpolant (the numbers below).
+///
+/// Stages `0 … stages − 1` make a step; `F` at the step's end is stage `stages − 1` for an
+/// FSAL pair (the 6(5)), else stage `stages` (the first of the interpolant's extra stages,
+/// whose row of `a` is `b`, and the next step's first stage). The remaining rows of `a` are the
+/// interpolant's extra stages, evaluated from the step's start.
+#[derive(Debug)]
+pub(crate) struct VernerTableau {
+    /// Order `p` of the propagated solution (the embedded one has order `p − 1`).
+    pub(crate) order: u32,
+    /// Number `s` of stages of a step.
+    pub(crate) stages: usize,
+    /// Whether the last stage of a step is `F` at its end (first same as last).
+    pub(crate) fsal: bool,
+    /// Nodes of all stages, the interpolant's included.
+    pub(crate) c: &'static [f64],
+    /// Row `i`: `aᵢ₀ … aᵢ,ᵢ₋₁`, for all stages.
+    pub(crate) a: &'static [&'static [f64]],
+    /// Weights `b` of the propagated solution, `s` entries.
+    pub(crate) b: &'static [f64],
+    /// `b − b̂`, `s` entries.
+    pub(crate) error: &'static [f64],
+    /// Degree of the interpolant's weights `bᵢ(θ)` in θ.
+    pub(crate) degree: usize,
+    /// `rᵢₘ` of `bᵢ(θ) = Σₘ rᵢₘ θᵐ` (`m = 1 … degree`), stage-major: `num_all_stages × degree`,
+    /// as Verner publishes them. The stepper uses `node_weights`, computed from these; the
+    /// tests check the order conditions on these and the one against the other.
+    #[cfg_attr(not(test), allow(dead_code))]
+    pub(crate) interpolant: &'static [f64],
+    /// Nodes `θ₁ < … < θ_degree = 1` at which the interpolant is represented.
+    pub(crate) nodes: &'static [f64],
+    /// `bᵢ(θⱼ)`, node-major: `degree × num_all_stages`.
+    pub(crate) node_weights: &'static [f64],
+}
+
+impl VernerTableau {
+    /// Number of stages, the interpolant's included.
+    pub(crate) fn num_all_stages(&self) -> usize {
+        self.c.len()
+    }
+
+    /// The stage that is `F` at the step's end.
+    pub(crate) fn end_stage(&self) -> usize {
+        if self.fsal {
+            self.stages - 1
+        } else {
+            self.stages
+        }
+    }
+
+    /// The interpolant's weights `bᵢ(θ)` at `θ`, one per stage.
+    #[cfg(test)]
+    pub(crate) fn interpolant_weights(&self, theta: f64) -> Vec<f64> {
+        self.interpolant
+            .chunks_exact(self.degree)
+            .map(|r| r.iter().rev().fold(0.0, |acc, &x| acc * theta + x) * theta)
+            .collect()
+    }
+
+    /// The stability polynomial `R(z) = 1 + Σₖ (bᵀAᵏ⁻¹𝟙) zᵏ` of the step's tableau (Hairer–Wanner
+    /// II, Prop. IV.2.11), of degree `s`, in the form with differences the stepper uses
+    /// ([`VernerStepper`]): `(Av)ᵢ = cᵢ v₀ + Σⱼ≥₁ aᵢⱼ (vⱼ − v₀)` and
+    /// `bᵀv = v₀ + Σⱼ≥₁ bⱼ (vⱼ − v₀)`, so that `A𝟙 = c` and `bᵀ𝟙 = 1` hold exactly (with the
+    /// rounded coefficients summed plainly, `bᵀA𝟙` of 6(5) is off by 6.5e-12).
+    pub(crate) fn stability_polynomial(&self) -> StabilityPolynomial {
+        let s = self.stages;
+        let weighted = |w: &[f64], v: &[f64]| -> f64 {
+            v[0] + w
+                .iter()
+                .zip(v)
+                .skip(1)
+                .map(|(w, vj)| w * (vj - v[0]))
+                .sum::<f64>()
+        };
+        let mut power = vec![1.0; s];
+        let mut coefficients = vec![1.0];
+        for _ in 0..s {
+            coefficients.push(weighted(self.b, &power));
+            power = (0..s)
+                .map(|i| {
+                    let row = self.a[i];
+                    if row.is_empty() {
+                        return 0.0;
+                    }
+                    self.c[i] * power[0]
+                        + row
+                            .iter()
+                            .zip(&power)
+                            .skip(1)
+                            .map(|(a, vj)| a * (vj - power[0]))
+                            .sum::<f64>()
+                })
+                .collect();
+        }
+        StabilityPolynomial::from_coefficients(coefficients)
+    }
+}
 
 // Verner 6(5): RKV65.IIIXb.Efficient.00000144617.081204.RATOnWeb (rationals).
 

@@ -102,8 +102,6 @@ struct Builder<'a> {
     coordinates: Vec<Option<Slot>>,
     velocities: Vec<Option<Slot>>,
     time: Option<Slot>,
-    /// Inputs read twice: `(slot, first slot of the same input)`.
-    duplicates: Vec<(Slot, Slot)>,
     unsupported: Vec<String>,
 }
 
@@ -118,7 +116,6 @@ impl<'a> Builder<'a> {
             coordinates: Vec::new(),
             velocities: Vec::new(),
             time: None,
-            duplicates: Vec::new(),
             unsupported: Vec::new(),
         }
     }
@@ -135,15 +132,17 @@ impl<'a> Builder<'a> {
         slot
     }
 
-    /// Records instruction `k` as the slot of input `i` of `list`, or as a copy of the input's
-    /// first slot.
+    /// Records instruction `k` as the slot of input `i` of `list` (refusing an input read
+    /// twice).
     fn input(&mut self, k: usize, list: fn(&mut Self) -> &mut Vec<Option<Slot>>, i: usize) {
         let slots = list(self);
         if slots.len() <= i {
             slots.resize(i + 1, None);
         }
         match slots[i] {
-            Some(first) => self.duplicates.push((k as Slot, first)),
+            // The tapes bind each symbol once; an input read twice would need its order 0
+            // copied too, so it is refused rather than half supported.
+            Some(_) => self.refuse("an input read twice"),
             None => slots[i] = Some(k as Slot),
         }
     }
@@ -180,7 +179,7 @@ impl<'a> Builder<'a> {
                     }
                     Input::Time => {
                         match self.time {
-                            Some(first) => self.duplicates.push((k as Slot, first)),
+                            Some(_) => self.refuse("an input read twice"),
                             None => self.time = Some(k as Slot),
                         }
                         false
@@ -213,11 +212,7 @@ impl<'a> Builder<'a> {
     fn op(&mut self, out: Slot, instruction: Instruction) -> Option<SeriesOp> {
         let c = |b: &Self, v: Slot| b.is_constant(v);
         Some(match instruction {
-            Instruction::Input(_) => {
-                let first = self.duplicates.iter().find(|(d, _)| *d == out)?.1;
-                SeriesOp::Copy { out, a: first }
-            }
-            Instruction::Const(_) => return None,
+            Instruction::Input(_) | Instruction::Const(_) => return None,
             Instruction::Neg(a) => SeriesOp::Neg { out, a },
             Instruction::Add(a, b) => match (c(self, a), c(self, b)) {
                 (false, false) => SeriesOp::Add { out, a, b },
@@ -425,6 +420,10 @@ pub(super) fn methods(
                 quote!(self.#field)
             }
             Instruction::Input(_) => quote!(__s[#k * __c]),
+            // A constant without a literal (NaN stands for a missing parameter) as `f64`'s.
+            Instruction::Const(c) if c.is_nan() => quote!(f64::NAN),
+            Instruction::Const(c) if c.is_infinite() && c > 0.0 => quote!(f64::INFINITY),
+            Instruction::Const(c) if c.is_infinite() => quote!(f64::NEG_INFINITY),
             Instruction::Const(c) => super::float(c)?,
             Instruction::Neg(x) => {
                 let x = v(&x)?;
