@@ -52,6 +52,20 @@ fn convolution(a: &[f64], b: &[f64], k: usize, from: usize, to: usize) -> f64 {
     sum
 }
 
+/// Order `k ≥ 1` of the Cauchy product `Σ_{j=0}^{k} a[j] b[k − j]`, summed with the two terms
+/// that hold an order-`k` coefficient last: `(Σ_{j=1}^{k−1} a[j] b[k − j] + a[0] b[k]) +
+/// a[k] b[0]`.
+///
+/// The order-`k` coefficients of a program are computed op after op, each waiting for its
+/// operands' order `k`; summing the older terms first lets the processor run those sums
+/// ahead while the operands are still being computed (3–4 % faster on the double pendulum
+/// at order 12, same run; two interleaved partial sums instead were 18 % slower).
+#[inline(always)]
+fn cauchy(a: &[f64], b: &[f64], k: usize) -> f64 {
+    let older = if k > 1 { convolution(a, b, k, 1, k - 1) } else { 0.0 };
+    older + a[0] * b[k] + a[k] * b[0]
+}
+
 /// `Σ_{j=from}^{to} j a[j] b[k − j]`, in increasing `j` (each term `(j · a[j]) · b[k − j]`).
 #[inline(always)]
 fn weighted_convolution(a: &[f64], b: &[f64], k: usize, from: usize, to: usize) -> f64 {
@@ -157,7 +171,7 @@ pub fn mul(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot, b: Slot) {
     let at = |s: &[f64], x: Slot, i: usize| s[x as usize * c + i];
     let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
     let _ = (kf, at);
-    let v = convolution(series(s, c, a), series(s, c, b), k, 0, k);
+    let v = cauchy(series(s, c, a), series(s, c, b), k);
     write(s, out, v);
 }
 
@@ -233,8 +247,9 @@ pub fn pow_constant(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot, expon
     let _ = (kf, at);
     let alpha = at(s, exponent, 0);
     let (x, o) = (series(s, c, a), series(s, c, out));
+    // Decreasing j: the term with x[k], this order's, comes last (see `cauchy`).
     let mut sum = 0.0;
-    for j in 0..k {
+    for j in (0..k).rev() {
         sum += (kf * alpha - j as f64 * (alpha + 1.0)) * x[k - j] * o[j];
     }
     let v = sum / (kf * x[0]);
@@ -248,7 +263,7 @@ pub fn exp(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot) {
     let at = |s: &[f64], x: Slot, i: usize| s[x as usize * c + i];
     let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
     let _ = (kf, at);
-    let v = weighted_convolution(series(s, c, a), series(s, c, out), k, 1, k) / kf;
+    let v = weighted_convolution(series(s, c, a), series(s, c, out), k, 1, k) * (1.0 / kf);
     write(s, out, v);
 }
 
@@ -277,8 +292,8 @@ pub fn sin_cos(k: usize, c: usize, s: &mut [f64], sin: Slot, cos: Slot, a: Slot)
     let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
     let _ = (kf, at);
     let x = series(s, c, a);
-    let vs = weighted_convolution(x, series(s, c, cos), k, 1, k) / kf;
-    let vc = -weighted_convolution(x, series(s, c, sin), k, 1, k) / kf;
+    let vs = weighted_convolution(x, series(s, c, cos), k, 1, k) * (1.0 / kf);
+    let vc = -weighted_convolution(x, series(s, c, sin), k, 1, k) * (1.0 / kf);
     write(s, sin, vs);
     write(s, cos, vc);
 }
@@ -291,8 +306,8 @@ pub fn sinh_cosh(k: usize, c: usize, s: &mut [f64], sinh: Slot, cosh: Slot, a: S
     let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
     let _ = (kf, at);
     let x = series(s, c, a);
-    let vs = weighted_convolution(x, series(s, c, cosh), k, 1, k) / kf;
-    let vc = weighted_convolution(x, series(s, c, sinh), k, 1, k) / kf;
+    let vs = weighted_convolution(x, series(s, c, cosh), k, 1, k) * (1.0 / kf);
+    let vc = weighted_convolution(x, series(s, c, sinh), k, 1, k) * (1.0 / kf);
     write(s, sinh, vs);
     write(s, cosh, vc);
 }
@@ -305,10 +320,10 @@ pub fn tan_or_tanh(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot, square
     let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
     let _ = (kf, at);
     let x = series(s, c, a);
-    let v = x[k] + sign * (weighted_convolution(x, series(s, c, square), k, 1, k) / kf);
+    let v = x[k] + sign * (weighted_convolution(x, series(s, c, square), k, 1, k) * (1.0 / kf));
     write(s, out, v);
     let o = series(s, c, out);
-    let q = convolution(o, o, k, 0, k);
+    let q = cauchy(o, o, k);
     write(s, square, q);
 }
 
@@ -320,7 +335,7 @@ pub fn asin(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot, root: Slot, a
     let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
     let _ = (kf, at);
     let x = series(s, c, a);
-    let a2 = convolution(x, x, k, 0, k);
+    let a2 = cauchy(x, x, k);
     let r = series(s, c, root);
     let sum = if k > 1 {
         convolution(r, r, k, 1, k - 1)
@@ -347,7 +362,7 @@ pub fn atan(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot, square: Slot)
     let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
     let _ = (kf, at);
     let x = series(s, c, a);
-    let q = convolution(x, x, k, 0, k);
+    let q = cauchy(x, x, k);
     write(s, square, q);
     let (x, sq) = (series(s, c, a), series(s, c, square));
     let sum = if k > 1 {
@@ -367,7 +382,7 @@ pub fn atan2(k: usize, c: usize, s: &mut [f64], out: Slot, y: Slot, x: Slot, nor
     let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
     let _ = (kf, at);
     let (ys, xs) = (series(s, c, y), series(s, c, x));
-    let nk = convolution(xs, xs, k, 0, k) + convolution(ys, ys, k, 0, k);
+    let nk = cauchy(xs, xs, k) + cauchy(ys, ys, k);
     let cross = weighted_convolution(ys, xs, k, 1, k) - weighted_convolution(xs, ys, k, 1, k);
     write(s, norm, nk);
     let ns = series(s, c, norm);
@@ -406,7 +421,17 @@ pub struct TaylorWorkspace {
     accelerations: Vec<f64>,
     lower: Vec<f64>,
     pivots: Vec<f64>,
+    inverse_pivots: Vec<f64>,
+    /// `(row, column, L[row][column])` for each entry of `L` below the diagonal that is not
+    /// zero, row by row.
+    nonzeros: Vec<(u32, u32, f64)>,
     rhs: Vec<f64>,
+    /// `1 / (k + 1)` for `k = 0 … capacity − 1`.
+    reciprocals: Vec<f64>,
+    /// `(row, column, slot)` of each entry of `M` that is not constant, row by row.
+    coupled: Vec<(u32, u32, Slot)>,
+    /// `(slot, state index)` of each input of the program.
+    inputs: Vec<(Slot, u32)>,
 }
 
 impl TaylorWorkspace {
@@ -417,17 +442,39 @@ impl TaylorWorkspace {
 
     /// Buffers for `order`: grown when a higher order or another program asks for more,
     /// never shrunk (the stride `capacity` is the kernels' argument, so a longer one serves a
-    /// lower order), so a method switching order between steps does not reallocate.
+    /// lower order), so a method switching order between steps does not reallocate. The
+    /// lists of inputs and of non-constant mass-matrix entries are rebuilt in place (`n²`
+    /// reads per step, next to the `O(order²)` work of the orders).
     fn fit(&mut self, program: &TaylorProgram, n: usize, order: usize) {
         let capacity = self.capacity.max(order + 1);
         if self.capacity != capacity || self.series.len() != program.slots * capacity {
             self.capacity = capacity;
             self.series = vec![0.0; program.slots * capacity];
             self.accelerations = vec![0.0; n * capacity];
+            self.reciprocals = (0..capacity).map(|k| 1.0 / (k + 1) as f64).collect();
         }
         self.lower.resize(n * n, 0.0);
         self.pivots.resize(n, 0.0);
+        self.inverse_pivots.resize(n, 0.0);
         self.rhs.resize(n, 0.0);
+        self.coupled.clear();
+        for i in 0..n {
+            for l in 0..n {
+                let slot = program.mass_matrix[i + l * n];
+                if !program.constant[slot as usize] {
+                    self.coupled.push((i as u32, l as u32, slot));
+                }
+            }
+        }
+        self.inputs.clear();
+        for i in 0..n {
+            if let Some(slot) = program.coordinates[i] {
+                self.inputs.push((slot, i as u32));
+            }
+            if let Some(slot) = program.velocities[i] {
+                self.inputs.push((slot, (n + i) as u32));
+            }
+        }
     }
 }
 
@@ -468,19 +515,21 @@ pub fn series_of_motion(
         accelerations: acc,
         lower,
         pivots,
+        inverse_pivots,
+        nonzeros,
         rhs,
+        reciprocals,
+        coupled,
+        inputs,
         ..
     } = workspace;
+    let out = &mut out[..(order + 1) * dim];
     out[..dim].copy_from_slice(&y[..dim]);
     for k in 0..order {
         // The inputs at order k: the state's coefficients, and t = t₀ + τ.
-        for i in 0..n {
-            if let Some(slot) = program.coordinates[i] {
-                s[slot as usize * c + k] = out[k * dim + i];
-            }
-            if let Some(slot) = program.velocities[i] {
-                s[slot as usize * c + k] = out[k * dim + n + i];
-            }
+        let (now, next) = out[k * dim..(k + 2) * dim].split_at_mut(dim);
+        for &(slot, index) in inputs.iter() {
+            s[slot as usize * c + k] = now[index as usize];
         }
         if let Some(slot) = program.time {
             s[slot as usize * c + k] = match k {
@@ -496,49 +545,63 @@ pub fn series_of_motion(
                 |i, j| s[program.mass_matrix[i + j * n] as usize * c],
                 lower,
                 pivots,
+                inverse_pivots,
             )
             .ok_or(RhsError::SingularMassMatrix)?;
+            // The solves of every order visit only these (a model's M is often sparse:
+            // bodies that do not share a coordinate).
+            nonzeros.clear();
+            for i in 0..n {
+                for (j, &l) in lower[i * n..i * n + i].iter().enumerate() {
+                    if l != 0.0 {
+                        nonzeros.push((i as u32, j as u32, l));
+                    }
+                }
+            }
         } else {
             model.order(k, c, s);
         }
-        // M^[0] a^[k] = F^[k] − Σⱼ₌₁ᵏ M^[j] a^[k−j].
-        for (i, r) in rhs.iter_mut().enumerate() {
-            let mut v = s[program.forcing[i] as usize * c + k];
-            for l in 0..n {
-                let slot = program.mass_matrix[i + l * n];
-                if program.constant[slot as usize] {
-                    continue;
-                }
-                let m = &s[slot as usize * c..][..=k];
-                let a = &acc[l * c..][..=k];
-                for j in 1..=k {
-                    v -= m[j] * a[k - j];
-                }
-            }
-            *r = v;
+        // M^[0] a^[k] = F^[k] − Σⱼ₌₁ᵏ M^[j] a^[k−j], over the entries of M that vary.
+        for (r, &slot) in rhs.iter_mut().zip(program.forcing.iter()) {
+            *r = s[slot as usize * c + k];
         }
-        solve(n, lower, pivots, rhs);
-        let next = (k + 1) as f64;
+        if k > 0 {
+            for &(i, l, slot) in coupled.iter() {
+                let m = &s[slot as usize * c + 1..][..k];
+                let a = &acc[l as usize * c..][..k];
+                let mut v = rhs[i as usize];
+                for (x, y) in m.iter().zip(a.iter().rev()) {
+                    v -= x * y;
+                }
+                rhs[i as usize] = v;
+            }
+        }
+        solve(nonzeros, inverse_pivots, rhs);
+        let inverse = reciprocals[k];
+        let velocities = &now[n..];
+        let (q_next, v_next) = next.split_at_mut(n);
         for i in 0..n {
             acc[i * c + k] = rhs[i];
-            out[(k + 1) * dim + i] = out[k * dim + n + i] / next;
-            out[(k + 1) * dim + n + i] = rhs[i] / next;
+            q_next[i] = velocities[i] * inverse;
+            v_next[i] = rhs[i] * inverse;
         }
     }
-    match out[..(order + 1) * dim].iter().position(|v| !v.is_finite()) {
+    match out.iter().position(|v| !v.is_finite()) {
         Some(at) => Err(RhsError::NonFinite { index: at % dim }),
         None => Ok(()),
     }
 }
 
 /// `L D Lᵀ` of the symmetric `n × n` matrix `m(i, j)` (lower triangle read) into `lower`
-/// (row-major, unit diagonal implied) and `pivots` (`D`); `None` unless positive definite.
+/// (row-major, unit diagonal implied), `pivots` (`D`) and `inverse_pivots` (`D⁻¹`, so that
+/// each order's solve multiplies where it would divide); `None` unless positive definite.
 #[inline]
 fn factor(
     n: usize,
     m: impl Fn(usize, usize) -> f64,
     lower: &mut [f64],
     pivots: &mut [f64],
+    inverse_pivots: &mut [f64],
 ) -> Option<()> {
     for j in 0..n {
         let mut d = m(j, j);
@@ -549,32 +612,33 @@ fn factor(
         if d.is_nan() || d <= 0.0 {
             return None;
         }
+        let inverse = 1.0 / d;
         pivots[j] = d;
+        inverse_pivots[j] = inverse;
         for i in j + 1..n {
             let mut v = m(i, j);
             for k in 0..j {
                 v -= lower[i * n + k] * lower[j * n + k] * pivots[k];
             }
-            lower[i * n + j] = v / d;
+            lower[i * n + j] = v * inverse;
         }
     }
     Some(())
 }
 
-/// Solves `L D Lᵀ x = b` in place.
-#[inline]
-fn solve(n: usize, lower: &[f64], pivots: &[f64], b: &mut [f64]) {
-    for i in 0..n {
-        for k in 0..i {
-            b[i] -= lower[i * n + k] * b[k];
-        }
+/// Solves `L D Lᵀ x = b` in place, with `L`'s entries below the diagonal that are not zero
+/// listed row by row as `(row, column, value)` and `inverse_pivots` = `D⁻¹`.
+#[inline(always)]
+fn solve(nonzeros: &[(u32, u32, f64)], inverse_pivots: &[f64], b: &mut [f64]) {
+    // L z = b, row by row: each row's earlier entries are final when it is reached.
+    for &(i, j, l) in nonzeros {
+        b[i as usize] -= l * b[j as usize];
     }
-    for i in 0..n {
-        b[i] /= pivots[i];
+    for (x, d) in b.iter_mut().zip(inverse_pivots) {
+        *x *= d;
     }
-    for i in (0..n).rev() {
-        for k in i + 1..n {
-            b[i] -= lower[k * n + i] * b[k];
-        }
+    // Lᵀ x = z, from the last row of L up: x[row] is final before its column is updated.
+    for &(i, j, l) in nonzeros.iter().rev() {
+        b[j as usize] -= l * b[i as usize];
     }
 }

@@ -278,11 +278,16 @@ fn print_summary(
     } else {
         String::new()
     };
+    // The Taylor method evaluates series of the motion, not the right-hand side.
+    let evaluations = match (s.taylor_series, s.rhs_evals) {
+        (0, evals) => format!("{evals} RHS evaluations"),
+        (series, 0) => format!("{series} Taylor series"),
+        (series, evals) => format!("{series} Taylor series, {evals} RHS evaluations"),
+    };
     outln!(
-        "work       {} steps ({} rejected), {} RHS evaluations{implicit}, {:.3} ms",
+        "work       {} steps ({} rejected), {evaluations}{implicit}, {:.3} ms",
         s.steps,
         s.rejected,
-        s.rhs_evals,
         s.wall_time_s * 1e3
     );
 }
