@@ -253,6 +253,61 @@ fn the_error_follows_the_tolerance() {
     }
 }
 
+/// A pendulum released at rest from the horizontal, `ẍ = −9.8 cos x` from `x = 0` (exactly)
+/// and `ẍ = −9.8 sin x` from `x = π/2` (where `cos x` is 6e-17, not 0): the force is even
+/// about the release point, so the coefficients of `x` vanish but at orders 2, 6, 10, … and
+/// those of `ẋ` but at 1, 5, 9, … (exactly, or to rounding). At orders 8 and 12 (tol 1e-6,
+/// 1e-9) the last two orders of the series are then both zero, which Jorba & Zou's rule on
+/// those two alone reads as an infinite radius of convergence: one step to the end with a
+/// wrong polynomial (from π/2: one step, error 47 at t = 1.2 s, before the rule looked at
+/// four orders). Against
+/// the same model at tol 1e-15, the error must be within 100 × tol, as everywhere else.
+#[test]
+fn a_series_with_vanishing_last_orders_is_not_taken_to_end() {
+    let from_horizontal = |potential: &str| {
+        format!(
+            "
+name: released
+description: released at rest from the horizontal.
+parameters: {{ g: 9.8 }}
+coordinates: [x]
+kinetic: x_dot^2/2
+potential: {potential}
+"
+        )
+    };
+    let cases = [
+        (from_horizontal("g*sin(x)"), 0.0),
+        (from_horizontal("-g*cos(x)"), std::f64::consts::FRAC_PI_2),
+    ];
+    for (source, x0) in cases {
+        let run = |tol: f64| {
+            let mut system = model(&source);
+            Taylor::new()
+                .integrate(
+                    &mut system,
+                    0.0,
+                    &[x0, 0.0],
+                    1.2,
+                    &OutputTimes::At(vec![1.2]),
+                    &tolerance(tol),
+                )
+                .unwrap()
+        };
+        let exact = run(1e-15).state(0).to_vec();
+        for tol in [1e-6, 1e-9] {
+            let solution = run(tol);
+            let y = solution.state(0);
+            let error = (y[0] - exact[0]).abs().max((y[1] - exact[1]).abs());
+            assert!(
+                error < 100.0 * tol,
+                "x0 = {x0}, tol {tol:e}: error {error:e} in {} steps",
+                solution.stats.steps
+            );
+        }
+    }
+}
+
 /// What the method cannot integrate is refused before any step, naming why: equations given
 /// as a closure, a constrained model, equations with `sign`.
 #[test]

@@ -226,8 +226,24 @@ impl TaylorStepper {
         let (_, n) = self.mode(max_norm(&c[..dim]));
         let rho = |k: usize| (n / max_norm(&c[k * dim..(k + 1) * dim])).powf(1.0 / k as f64);
         let p = order;
-        let rho = rho(p - 1).min(rho(p));
-        self.proposed = rho * (-0.7 / (p - 1) as f64).exp() / std::f64::consts::E.powi(2);
+        // Jorba & Zou (and heyoka) estimate the radius of convergence from the last two
+        // orders, so that a series with only odd or only even terms is not taken for one
+        // that ends. A mechanism released from rest in a symmetric position can have its
+        // coefficients vanish in a period of four (the pendulum from horizontal at rest:
+        // q^[2], q^[6], q^[10], … and q̇^[1], q̇^[5], …), and then both of the last two
+        // orders are 0 at p = 8, 12, 16, … and the radius comes out infinite: one step to
+        // the end with a wrong polynomial. The last four orders see through periods of one
+        // to four; if all four vanish, the highest order below them that does not.
+        let first = p.saturating_sub(3).max(1);
+        let mut radius = (first..=p).map(rho).fold(f64::INFINITY, f64::min);
+        if radius == f64::INFINITY {
+            radius = (1..first)
+                .rev()
+                .map(rho)
+                .find(|r| r.is_finite())
+                .unwrap_or(f64::INFINITY);
+        }
+        self.proposed = radius * (-0.7 / (p - 1) as f64).exp() / std::f64::consts::E.powi(2);
     }
 
     /// The polynomial of `coefficients` (of `order`) at `τ`, by Horner's rule.
