@@ -6,8 +6,8 @@
 //! in `tests/taylor_coefficients.rs`.
 
 use eomgen::{
-    DynFirstOrder, IntegrationError, Integrator, IntegratorOptions, JitModel, OdeFn, OdeSystem,
-    OutputTimes, Taylor,
+    DormandPrince853, DynFirstOrder, IntegrationError, Integrator, IntegratorOptions, JitModel,
+    OdeFn, OdeSystem, OutputTimes, Taylor,
 };
 
 /// A model file compiled at run time, as the first-order form the integrators take.
@@ -306,6 +306,65 @@ potential: {potential}
             );
         }
     }
+}
+
+/// Quadratic drag `−c₂ √(ẋ² + ẏ²) (ẋ, ẏ)` (`models/projectile_drag.yaml`): the speed is a
+/// root of a near-perfect square at the top of a vertical throw (`ẋ` is 1.2e-15 there), so
+/// its series reads as `ẏ`'s and a step over the top would continue it negative, the drag
+/// pushing along the motion on the way down (the run used to land 5e-3 s early at tol 1e-6
+/// and 8e-2 s late at 1e-9, in 8 steps). The series must not be taken off the root's branch
+/// ([`eomgen::taylor::branch_step`]): the vertical throw ends at the top, t = 1.6805508526
+/// (the model's closed form), with a step-size failure — the speed is not analytic there —
+/// and an oblique throw, where the speed stays away from 0, agrees with DOP853 at 1e-13.
+#[test]
+fn a_step_never_leaves_the_branch_of_a_square_root() {
+    let source = include_str!("../models/projectile_drag.yaml");
+    let throw = |angle: f64, tol: f64| {
+        let model = JitModel::from_source("projectile_drag.yaml", source).expect("loads");
+        let mut system = DynFirstOrder::new(model);
+        let y0 = [0.0, 0.0, 20.0 * angle.cos(), 20.0 * angle.sin()];
+        Taylor::new().integrate(
+            &mut system,
+            0.0,
+            &y0,
+            3.0,
+            &OutputTimes::At(vec![3.0]),
+            &tolerance(tol),
+        )
+    };
+    for tol in [1e-6, 1e-9, 1e-12] {
+        let failure = throw(std::f64::consts::FRAC_PI_2, tol).expect_err("the top is reached");
+        match failure.error {
+            IntegrationError::StepSizeTooSmall { t, .. } => {
+                assert!(
+                    (t - 1.6805508526).abs() < 1e-6,
+                    "tol {tol:e}: stopped at {t}"
+                )
+            }
+            other => panic!("tol {tol:e}: {other}"),
+        }
+    }
+    let angle: f64 = 1.0;
+    let model = JitModel::from_source("projectile_drag.yaml", source).expect("loads");
+    let mut system = DynFirstOrder::new(model);
+    let reference = DormandPrince853::new()
+        .integrate(
+            &mut system,
+            0.0,
+            &[0.0, 0.0, 20.0 * angle.cos(), 20.0 * angle.sin()],
+            3.0,
+            &OutputTimes::At(vec![3.0]),
+            &tolerance(1e-13),
+        )
+        .unwrap();
+    let solution = throw(angle, 1e-10).unwrap();
+    let error = solution
+        .state(0)
+        .iter()
+        .zip(reference.state(0))
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f64::max);
+    assert!(error < 1e-8, "oblique throw: error {error:e}");
 }
 
 /// What the method cannot integrate is refused before any step, naming why: equations given

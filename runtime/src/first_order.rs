@@ -235,6 +235,10 @@ impl<S: MechanicalSystem<N>, const N: usize> OdeSystem for FirstOrder<S, N> {
         taylor_coefficients(system, &mut self.taylor, t, y, order, out)
     }
 
+    fn taylor_branch_step(&self, order: usize, h: f64) -> f64 {
+        taylor_branch_step(StaticSystem::from_ref(&self.system), &self.taylor, order, h)
+    }
+
     fn event_values(&mut self, t: f64, y: &[f64], g: &mut [f64]) -> Result<(), RhsError> {
         if self.events.is_empty() {
             return Ok(());
@@ -529,6 +533,10 @@ impl<S: DynMechanicalSystem> OdeSystem for DynFirstOrder<S> {
         taylor_coefficients(&self.system, &mut self.taylor, t, y, order, out)
     }
 
+    fn taylor_branch_step(&self, order: usize, h: f64) -> f64 {
+        taylor_branch_step(&self.system, &self.taylor, order, h)
+    }
+
     fn event_values(&mut self, t: f64, y: &[f64], g: &mut [f64]) -> Result<(), RhsError> {
         if self.events.is_empty() {
             return Ok(());
@@ -614,4 +622,18 @@ fn taylor_coefficients<S: DynMechanicalSystem + ?Sized>(
     let program = taylor_support(system).map_err(|_| RhsError::NonFinite { index: 0 })?;
     let model = ModelSeries { system, program };
     crate::taylor::series_of_motion(&model, workspace, t, y, order, out)
+}
+
+/// [`OdeSystem::taylor_branch_step`](crate::OdeSystem::taylor_branch_step) of a first-order
+/// form.
+fn taylor_branch_step<S: DynMechanicalSystem + ?Sized>(
+    system: &S,
+    workspace: &TaylorWorkspace,
+    order: usize,
+    h: f64,
+) -> f64 {
+    match taylor_support(system) {
+        Ok(program) => crate::taylor::branch_step(program, workspace, order, h),
+        Err(_) => h,
+    }
 }

@@ -163,6 +163,16 @@ pub trait OdeSystem {
         let _ = (t, y, order, out);
         Err(RhsError::NonFinite { index: 0 })
     }
+
+    /// The largest step `≤ h` over which the last [`taylor_coefficients`]' series stay on
+    /// the principal branch of every square root and non-integer power
+    /// ([`crate::taylor::branch_step`]); `h` for a system without recurrences.
+    ///
+    /// [`taylor_coefficients`]: Self::taylor_coefficients
+    fn taylor_branch_step(&self, order: usize, h: f64) -> f64 {
+        let _ = order;
+        h
+    }
 }
 
 /// A closure `|t, y, dy| { … }` is an [`OdeSystem`] of a given dimension.
@@ -331,6 +341,10 @@ where
         out: &mut [f64],
     ) -> Result<(), RhsError> {
         self.system.taylor_coefficients(t, y, order, out)
+    }
+
+    fn taylor_branch_step(&self, order: usize, h: f64) -> f64 {
+        self.system.taylor_branch_step(order, h)
     }
 }
 

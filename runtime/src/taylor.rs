@@ -62,7 +62,11 @@ fn convolution(a: &[f64], b: &[f64], k: usize, from: usize, to: usize) -> f64 {
 /// at order 12, same run; two interleaved partial sums instead were 18 % slower).
 #[inline(always)]
 fn cauchy(a: &[f64], b: &[f64], k: usize) -> f64 {
-    let older = if k > 1 { convolution(a, b, k, 1, k - 1) } else { 0.0 };
+    let older = if k > 1 {
+        convolution(a, b, k, 1, k - 1)
+    } else {
+        0.0
+    };
     older + a[0] * b[k] + a[k] * b[0]
 }
 
@@ -641,4 +645,104 @@ fn solve(nonzeros: &[(u32, u32, f64)], inverse_pivots: &[f64], b: &mut [f64]) {
     for &(i, j, l) in nonzeros.iter().rev() {
         b[j as usize] -= l * b[i as usize];
     }
+}
+
+/// The largest step `τ ≤ h` over which the series of the last [`series_of_motion`] into
+/// `workspace` (of `program`, to `order`) stay on the principal branch of every square root
+/// and of every power with a non-integer exponent: `τ = h` unless, on `(0, h]`, the series
+/// of a square root (`√a`, positive at `τ = 0`) or the base of such a power changes sign,
+/// or the square of a root's series leaves its argument's by more than 10⁻³ of it; then
+/// half the first such point (located to 2⁻³⁰ of the step by bisection between 16
+/// samples).
+///
+/// A square root of a perfect square hides its branch point from the series: `√(u² + δ²)`
+/// with `δ` tiny has coefficients that read as those of `u`, so the radius of convergence
+/// estimated from the last orders is `u`'s, and a step through `u = 0` continues the series
+/// as `u` — negative — where the root is `|u|`. This is the speed `√(ẋ² + ẏ²)` of a
+/// quadratic drag at the top of a vertical throw (the drag would push along the motion on
+/// the way down). Halving the step toward the sign change each time, the method either
+/// reaches where the branch point shows in the coefficients (`δ` not tiny: small steps
+/// pass it) or its step falls below the smallest usable one (the motion is not analytic
+/// there, and the run ends with [`StepSizeTooSmall`](crate::IntegrationError::StepSizeTooSmall)
+/// at that time).
+///
+/// # Panics
+/// If `workspace` does not hold a series of `program` to `order`.
+pub fn branch_step(
+    program: &TaylorProgram,
+    workspace: &TaylorWorkspace,
+    order: usize,
+    h: f64,
+) -> f64 {
+    let c = workspace.capacity;
+    // Orders 0 … order − 1 of the program's slots are computed.
+    let degree = order.saturating_sub(1);
+    let value = |slot: Slot, tau: f64| {
+        let series = &workspace.series[slot as usize * c..][..=degree];
+        series.iter().rev().fold(0.0, |v, &x| v * tau + x)
+    };
+    // Through a constant series the step is infinite: nothing to bound.
+    if !h.is_finite() {
+        return h;
+    }
+    let mut limit = h;
+    for op in program.ops.iter() {
+        let (slot, square) = match *op {
+            SeriesOp::Sqrt { out, a } => (out, Some(a)),
+            SeriesOp::PowConstant { a, exponent, .. } => {
+                let alpha = workspace.series[exponent as usize * c];
+                if alpha.fract() == 0.0 {
+                    continue;
+                }
+                (a, None)
+            }
+            _ => continue,
+        };
+        let start = value(slot, 0.0);
+        if !(start != 0.0) {
+            continue;
+        }
+        // No sign change is possible where Σₖ₌₁ |xᵏ| τᵏ < |x⁰| (a single sum, the usual
+        // case: a root's argument moves by a fraction of itself in a step).
+        let series = &workspace.series[slot as usize * c..][..=degree];
+        let moved = series[1..]
+            .iter()
+            .rev()
+            .fold(0.0, |v, &x| v * limit + x.abs())
+            * limit;
+        if moved < start.abs() {
+            continue;
+        }
+        // Off the branch: a sign change, or (a root) a series whose square is not its
+        // argument's any more — near a hidden branch point the higher orders of `√a` are
+        // rounding errors divided by powers of `2 √a⁰`, and their polynomial, though
+        // positive, is not a root of anything. (`1e-3`: far above any truncation error the
+        // step rule allows, far below such noise.)
+        let crosses = |tau: f64| {
+            let v = value(slot, tau);
+            v * start.signum() <= 0.0
+                || square.is_some_and(|a| {
+                    let argument = value(a, tau);
+                    (v * v - argument).abs() > 1e-3 * argument.abs().max(start * start)
+                })
+        };
+        const SAMPLES: usize = 16;
+        let Some(j) = (1..=SAMPLES).find(|&j| crosses(limit * j as f64 / SAMPLES as f64)) else {
+            continue;
+        };
+        let (mut below, mut above) = (
+            limit * (j - 1) as f64 / SAMPLES as f64,
+            limit * j as f64 / SAMPLES as f64,
+        );
+        for _ in 0..30 {
+            let middle = 0.5 * (below + above);
+            if crosses(middle) {
+                above = middle;
+            } else {
+                below = middle;
+            }
+        }
+        limit = 0.5 * above;
+    }
+    limit
 }

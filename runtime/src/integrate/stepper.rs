@@ -235,6 +235,12 @@ impl<'a> CheckedRhs<'a> {
             .map_err(|error| StepFailure::Rhs { t, error })
     }
 
+    /// The largest step `≤ h` on the branches of the last series' roots and powers
+    /// ([`OdeSystem::taylor_branch_step`]).
+    pub(crate) fn taylor_branch_step(&self, order: usize, h: f64) -> f64 {
+        self.system.taylor_branch_step(order, h)
+    }
+
     /// Number of evaluations of the event functions so far.
     pub(crate) fn event_evals(&self) -> usize {
         self.event_evals

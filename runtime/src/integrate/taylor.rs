@@ -297,6 +297,7 @@ impl Stepper for TaylorStepper {
         self.y.copy_from_slice(y0);
         let order = self.series(rhs, t0, y0)?;
         self.commit(order);
+        self.proposed = rhs.taylor_branch_step(order, self.proposed);
         Ok(())
     }
 
@@ -335,6 +336,7 @@ impl Stepper for TaylorStepper {
         std::mem::swap(&mut self.previous, &mut self.coefficients);
         self.previous_order = self.order;
         self.commit(order);
+        self.proposed = rhs.taylor_branch_step(order, self.proposed);
         self.t_prev = self.t;
         self.t = t_new;
         std::mem::swap(&mut self.y, &mut self.y_new);
