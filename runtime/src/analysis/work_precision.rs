@@ -363,8 +363,9 @@ pub struct SettingRun {
 pub enum AtTarget {
     /// Two consecutive settings bracket the target: RHS evaluations, steps and time (s).
     Reached {
-        /// RHS evaluations.
-        rhs_evals: f64,
+        /// RHS evaluations; `None` for a method that evaluates none (the Taylor method,
+        /// which computes series of the motion), whose work is its steps and time.
+        rhs_evals: Option<f64>,
         /// Steps.
         steps: f64,
         /// Wall time (s).
@@ -389,10 +390,16 @@ impl AtTarget {
             AtTarget::BelowAtLoosest {
                 rhs_evals,
                 wall_time_s,
-            } => format!(
-                "below the target already at the loosest setting (≤ {rhs_evals} RHS evals, ≤ {:.3} ms): add looser settings",
-                wall_time_s * 1e3
-            ),
+            } => {
+                let evals = match rhs_evals {
+                    0 => String::new(),
+                    n => format!("≤ {n} RHS evals, "),
+                };
+                format!(
+                    "below the target already at the loosest setting ({evals}≤ {:.3} ms): add looser settings",
+                    wall_time_s * 1e3
+                )
+            }
             AtTarget::NotReached => {
                 "not bracketed by two consecutive settings: add tighter settings or smaller steps"
                     .to_string()
@@ -534,7 +541,7 @@ fn target_summary(target: &AtTarget, baseline_ms: Option<f64>) -> TargetSummary 
             wall_time_s,
         } => TargetSummary {
             reached: true,
-            rhs_evals: Some(rhs_evals),
+            rhs_evals,
             steps: Some(steps),
             wall_time_s: Some(wall_time_s),
             baseline_ratio: baseline_ms.map(|b| b * 1e-3 / wall_time_s),
@@ -808,9 +815,11 @@ pub fn at_target(runs: &[SettingRun], target: f64) -> AtTarget {
     let evals = interpolate(&series(|m| m.rhs_evals as f64), target);
     let steps = interpolate(&series(|m| m.steps as f64), target);
     let time = interpolate(&series(|m| m.wall_time_s), target);
-    match (evals, steps, time) {
-        (Some(rhs_evals), Some(steps), Some(wall_time_s)) => AtTarget::Reached {
-            rhs_evals,
+    // A method that evaluates no right-hand side has no evaluations to interpolate.
+    let no_evals = measured.iter().flatten().all(|m| m.rhs_evals == 0);
+    match (steps, time) {
+        (Some(steps), Some(wall_time_s)) if evals.is_some() || no_evals => AtTarget::Reached {
+            rhs_evals: evals,
             steps,
             wall_time_s,
         },
@@ -1113,6 +1122,52 @@ mod tests {
                 .is_ok()
         );
         assert!(study(vec![]).check_measured().is_err());
+    }
+
+    /// The Taylor method evaluates no right-hand side: its work at the target is its steps
+    /// and time, with no evaluations, rather than "not reached"; a method whose evaluations
+    /// cannot be interpolated while others can is still not reached.
+    #[test]
+    fn work_at_target_without_evaluations() {
+        let run = |tol: f64, error: f64, rhs_evals: usize, steps: usize| SettingRun {
+            setting: Setting::Tolerance(tol),
+            outcome: Ok(Measured {
+                error,
+                rhs_evals,
+                steps,
+                rejected: 0,
+                jacobian_evals: 0,
+                lu_decompositions: 0,
+                wall_time_s: steps as f64 * 1e-6,
+                repeats: 1,
+                energy_drift: None,
+            }),
+        };
+        let taylor = [run(1e-4, 1e-3, 0, 10), run(1e-6, 1e-5, 0, 1000)];
+        match at_target(&taylor, 1e-4) {
+            AtTarget::Reached {
+                rhs_evals, steps, ..
+            } => {
+                assert_eq!(rhs_evals, None);
+                assert!((steps - 100.0).abs() < 1e-9, "{steps}");
+            }
+            other => panic!("{other:?}"),
+        }
+        let runge_kutta = [run(1e-4, 1e-3, 60, 10), run(1e-6, 1e-5, 6000, 1000)];
+        assert!(matches!(
+            at_target(&runge_kutta, 1e-4),
+            AtTarget::Reached { rhs_evals: Some(e), .. } if (e - 600.0).abs() < 1e-6
+        ));
+        let broken = [run(1e-4, 1e-3, 0, 10), run(1e-6, 1e-5, 6000, 1000)];
+        assert_eq!(at_target(&broken, 1e-4), AtTarget::NotReached);
+        assert!(
+            AtTarget::BelowAtLoosest {
+                rhs_evals: 0,
+                wall_time_s: 1e-3
+            }
+            .note()
+            .contains("(≤ 1.000 ms)")
+        );
     }
 
     #[test]

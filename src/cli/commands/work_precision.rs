@@ -371,9 +371,10 @@ impl Study<'_> {
                     let ratio = args.baseline_ms.map_or(String::new(), |b| {
                         format!(" {:>16.1}", b * 1e-3 / wall_time_s)
                     });
+                    let evals = rhs_evals.map_or("-".to_string(), |e| format!("{e:.0}"));
                     writeln!(
                         out,
-                        "{name:<22} {rhs_evals:>11.0} {steps:>9.0} {:>11.3}{ratio}",
+                        "{name:<22} {evals:>11} {steps:>9.0} {:>11.3}{ratio}",
                         wall_time_s * 1e3
                     )?;
                 }
