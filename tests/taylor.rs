@@ -316,6 +316,7 @@ potential: {potential}
 /// ([`eomgen::taylor::branch_step`]): the vertical throw ends at the top, t = 1.6805508526
 /// (the model's closed form), with a step-size failure — the speed is not analytic there —
 /// and an oblique throw, where the speed stays away from 0, agrees with DOP853 at 1e-13.
+/// The same for a spring of potential `|x|³`.
 #[test]
 fn a_step_never_leaves_the_branch_of_a_square_root() {
     let source = include_str!("../models/projectile_drag.yaml");
@@ -345,8 +346,8 @@ fn a_step_never_leaves_the_branch_of_a_square_root() {
         }
     }
     let angle: f64 = 1.0;
-    let model = JitModel::from_source("projectile_drag.yaml", source).expect("loads");
-    let mut system = DynFirstOrder::new(model);
+    let drag = JitModel::from_source("projectile_drag.yaml", source).expect("loads");
+    let mut system = DynFirstOrder::new(drag);
     let reference = DormandPrince853::new()
         .integrate(
             &mut system,
@@ -365,6 +366,35 @@ fn a_step_never_leaves_the_branch_of_a_square_root() {
         .map(|(a, b)| (a - b).abs())
         .fold(0.0, f64::max);
     assert!(error < 1e-8, "oblique throw: error {error:e}");
+    // The spring of potential |x|³, written (x²)^(3/2): its force −3x√(x²) hides |x| as x, and
+    // x passes 0 at the quarter period (1/√2)·B(1/3, 1/2)/3 = 0.99149247513406 s from
+    // x = 1 at rest (energy ẋ²/2 + x³ = 1; mpmath's quadrature agrees to 6e-18), where the
+    // run must end rather than continue with the force pushing outward.
+    let cubic = "
+name: cubic_spring
+description: the potential |x|^3.
+parameters: { k: 1 }
+coordinates: [x]
+kinetic: x_dot^2/2
+potential: k*(x^2)^1.5
+";
+    let mut system = model(cubic);
+    let failure = Taylor::new()
+        .integrate(
+            &mut system,
+            0.0,
+            &[1.0, 0.0],
+            5.0,
+            &OutputTimes::At(vec![5.0]),
+            &tolerance(1e-9),
+        )
+        .expect_err("x reaches 0");
+    match failure.error {
+        IntegrationError::StepSizeTooSmall { t, .. } => {
+            assert!((t - 0.99149247513406).abs() < 1e-9, "stopped at {t}")
+        }
+        other => panic!("{other}"),
+    }
 }
 
 /// What the method cannot integrate is refused before any step, naming why: equations given

@@ -451,7 +451,10 @@ impl TaylorWorkspace {
     /// reads per step, next to the `O(order²)` work of the orders).
     fn fit(&mut self, program: &TaylorProgram, n: usize, order: usize) {
         let capacity = self.capacity.max(order + 1);
-        if self.capacity != capacity || self.series.len() != program.slots * capacity {
+        if self.capacity != capacity
+            || self.series.len() != program.slots * capacity
+            || self.accelerations.len() != n * capacity
+        {
             self.capacity = capacity;
             self.series = vec![0.0; program.slots * capacity];
             self.accelerations = vec![0.0; n * capacity];
@@ -649,63 +652,72 @@ fn solve(nonzeros: &[(u32, u32, f64)], inverse_pivots: &[f64], b: &mut [f64]) {
 
 /// The largest step `τ ≤ h` over which the series of the last [`series_of_motion`] into
 /// `workspace` (of `program`, to `order`) stay on the principal branch of every square root
-/// and of every power with a non-integer exponent: `τ = h` unless, on `(0, h]`, the series
-/// of a square root (`√a`, positive at `τ = 0`) or the base of such a power changes sign,
-/// or the square of a root's series leaves its argument's by more than 10⁻³ of it; then
-/// half the first such point (located to 2⁻³⁰ of the step by bisection between 16
-/// samples).
+/// (`Sqrt`, and the `√(1 − a²)` of `Asin`) and of every power with a non-integer exponent.
 ///
-/// A square root of a perfect square hides its branch point from the series: `√(u² + δ²)`
+/// A root of a near-perfect square hides its branch point from the series: `√(u² + δ²)`
 /// with `δ` tiny has coefficients that read as those of `u`, so the radius of convergence
 /// estimated from the last orders is `u`'s, and a step through `u = 0` continues the series
 /// as `u` — negative — where the root is `|u|`. This is the speed `√(ẋ² + ẏ²)` of a
 /// quadratic drag at the top of a vertical throw (the drag would push along the motion on
-/// the way down). Halving the step toward the sign change each time, the method either
-/// reaches where the branch point shows in the coefficients (`δ` not tiny: small steps
-/// pass it) or its step falls below the smallest usable one (the motion is not analytic
-/// there, and the run ends with [`StepSizeTooSmall`](crate::IntegrationError::StepSizeTooSmall)
-/// at that time).
+/// the way down), `(ẋ² + ẏ²)^{3/2}` likewise, and `acos(cos q)` at `q = 0`.
 ///
-/// # Panics
-/// If `workspace` does not hold a series of `program` to `order`.
+/// For each such op whose output `f` (with argument `g`: `f = g^α`) can move by `|f⁰|` in
+/// the step (`Σₖ₌₁ |fᵏ| hᵏ ≥ |f⁰|`; otherwise neither changes sign), the step is sampled at
+/// 16 points: at the first where `f` or `g` has left its sign at `τ = 0`, or `f` is no longer
+/// `g^α` to 10⁻³ of `max(|f|, |f⁰|)` (near a hidden branch point the higher orders of `f`
+/// are rounding errors divided by powers of `f⁰`), or either is not finite, the point is
+/// located by bisection (to `h / 2³⁴`) and the step is half of it. Halving toward that
+/// point each step, the method either reaches where the branch point shows in the
+/// coefficients (`δ` not tiny: small steps pass it) or its step falls below the smallest
+/// usable one — the motion is not analytic there, and the run ends with
+/// [`StepSizeTooSmall`](crate::IntegrationError::StepSizeTooSmall) at that time. Between
+/// samples nothing is checked.
+///
+/// The result is unspecified (it may panic) unless `workspace` holds the series of
+/// `program` to `order` from the last [`series_of_motion`].
 pub fn branch_step(
     program: &TaylorProgram,
     workspace: &TaylorWorkspace,
     order: usize,
     h: f64,
 ) -> f64 {
+    // Through a constant series the step is infinite: nothing to bound.
+    if !h.is_finite() || order == 0 {
+        return h;
+    }
     let c = workspace.capacity;
     // Orders 0 … order − 1 of the program's slots are computed.
-    let degree = order.saturating_sub(1);
-    let value = |slot: Slot, tau: f64| {
-        let series = &workspace.series[slot as usize * c..][..=degree];
-        series.iter().rev().fold(0.0, |v, &x| v * tau + x)
-    };
-    // Through a constant series the step is infinite: nothing to bound.
-    if !h.is_finite() {
-        return h;
+    let degree = order - 1;
+    let series = |slot: Slot| &workspace.series[slot as usize * c..][..=degree];
+    let value = |slot: Slot, tau: f64| series(slot).iter().rev().fold(0.0, |v, &x| v * tau + x);
+    /// The argument of a root or power: a slot, or `1 − a²` of `Asin`'s slot `a`.
+    #[derive(Clone, Copy)]
+    enum Argument {
+        Slot(Slot),
+        OneMinusSquare(Slot),
     }
     let mut limit = h;
     for op in program.ops.iter() {
-        let (slot, square) = match *op {
-            SeriesOp::Sqrt { out, a } => (out, Some(a)),
-            SeriesOp::PowConstant { a, exponent, .. } => {
+        let (out, argument, alpha) = match *op {
+            SeriesOp::Sqrt { out, a } => (out, Argument::Slot(a), 0.5),
+            SeriesOp::Asin { a, root, .. } => (root, Argument::OneMinusSquare(a), 0.5),
+            SeriesOp::PowConstant { out, a, exponent } => {
                 let alpha = workspace.series[exponent as usize * c];
                 if alpha.fract() == 0.0 {
                     continue;
                 }
-                (a, None)
+                (out, Argument::Slot(a), alpha)
             }
             _ => continue,
         };
-        let start = value(slot, 0.0);
-        if !(start != 0.0) {
+        // A root or a real power of a positive argument is positive; anything else (a
+        // model's NaN, an exact 0) is not this check's to judge.
+        let start = value(out, 0.0);
+        if !(start > 0.0 && start.is_finite()) {
             continue;
         }
-        // No sign change is possible where Σₖ₌₁ |xᵏ| τᵏ < |x⁰| (a single sum, the usual
-        // case: a root's argument moves by a fraction of itself in a step).
-        let series = &workspace.series[slot as usize * c..][..=degree];
-        let moved = series[1..]
+        // Σₖ₌₁ |fᵏ| τᵏ < |f⁰|: f cannot change sign, nor g (f = g^α), in the step.
+        let moved = series(out)[1..]
             .iter()
             .rev()
             .fold(0.0, |v, &x| v * limit + x.abs())
@@ -713,21 +725,24 @@ pub fn branch_step(
         if moved < start.abs() {
             continue;
         }
-        // Off the branch: a sign change, or (a root) a series whose square is not its
-        // argument's any more — near a hidden branch point the higher orders of `√a` are
-        // rounding errors divided by powers of `2 √a⁰`, and their polynomial, though
-        // positive, is not a root of anything. (`1e-3`: far above any truncation error the
-        // step rule allows, far below such noise.)
-        let crosses = |tau: f64| {
-            let v = value(slot, tau);
-            v * start.signum() <= 0.0
-                || square.is_some_and(|a| {
-                    let argument = value(a, tau);
-                    (v * v - argument).abs() > 1e-3 * argument.abs().max(start * start)
-                })
+        let argument_at = |tau: f64| match argument {
+            Argument::Slot(a) => value(a, tau),
+            Argument::OneMinusSquare(a) => {
+                let x = value(a, tau);
+                1.0 - x * x
+            }
+        };
+        if !(argument_at(0.0) > 0.0) {
+            continue;
+        }
+        // Written so that a NaN is off the branch.
+        let off = |tau: f64| {
+            let (f, g) = (value(out, tau), argument_at(tau));
+            let on = f > 0.0 && g > 0.0 && (f - g.powf(alpha)).abs() <= 1e-3 * f.max(start);
+            !on
         };
         const SAMPLES: usize = 16;
-        let Some(j) = (1..=SAMPLES).find(|&j| crosses(limit * j as f64 / SAMPLES as f64)) else {
+        let Some(j) = (1..=SAMPLES).find(|&j| off(limit * j as f64 / SAMPLES as f64)) else {
             continue;
         };
         let (mut below, mut above) = (
@@ -736,7 +751,7 @@ pub fn branch_step(
         );
         for _ in 0..30 {
             let middle = 0.5 * (below + above);
-            if crosses(middle) {
+            if off(middle) {
                 above = middle;
             } else {
                 below = middle;

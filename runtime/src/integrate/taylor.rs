@@ -25,11 +25,18 @@ use crate::ode::OdeSystem;
 /// h = min(ρ_{p−1}, ρ_p) · e^{−0.7/(p−1)} / e²,    ρ_k = (N / ‖y^[k]‖)^{1/k}
 /// ```
 ///
-/// (heyoka's `taylor_determine_h`: `ρ` estimates the radius of convergence, and the last term
-/// is then about `N e^{−2p} ≤ N ε`). For `rtol = atol` this is heyoka's `tol`. A tolerance
-/// given per component takes its smallest entry. There is no error estimate and no rejected
-/// step; `dt_max` and the end of the interval cap `h`, and with
-/// [`IntegratorOptions::fixed_step`] the steps are `dt` at the order of the tolerance.
+/// (heyoka's `taylor_determine_h`: `ρ` estimates the radius of convergence, and the last
+/// term is then about `N e^{−2p} ≤ N ε`), unless that radius is more than twice
+/// `min(ρ_{p−3}, ρ_{p−2})`, which then replaces it: coefficients that vanish in a period of
+/// four (a mechanism released at rest from a symmetric position) make the last two orders
+/// 0, or rounding errors, and the radius infinite or huge; if all four vanish, the highest
+/// order below them that does not decides. The step then stays on the principal branch of
+/// every square root and non-integer power of the model ([`crate::taylor::branch_step`],
+/// checked on the proposed steps only, not with [`IntegratorOptions::fixed_step`]). For `rtol = atol` the
+/// tolerance is heyoka's `tol`. A tolerance given per component takes its smallest entry.
+/// There is no error estimate and no rejected step; `dt_max` and the end of the interval cap
+/// `h`, and with [`IntegratorOptions::fixed_step`] the steps are `dt` at the order of the
+/// tolerance.
 ///
 /// # Dense output and events
 /// The step's polynomial, evaluated by Horner's rule (`θ = 1` gives the step's end to the bit):
@@ -230,19 +237,22 @@ impl TaylorStepper {
         // orders, so that a series with only odd or only even terms is not taken for one
         // that ends. A mechanism released from rest in a symmetric position can have its
         // coefficients vanish in a period of four (the pendulum from horizontal at rest:
-        // q^[2], q^[6], q^[10], … and q̇^[1], q̇^[5], …), and then both of the last two
-        // orders are 0 at p = 8, 12, 16, … and the radius comes out infinite: one step to
-        // the end with a wrong polynomial. The last four orders see through periods of one
-        // to four; if all four vanish, the highest order below them that does not.
+        // q^[2], q^[6], q^[10], … and q̇^[1], q̇^[5], …), and then the last two orders are 0
+        // (or rounding errors) at p = 8, 12, 16, …: the radius comes out infinite (or
+        // huge), one step to the end with a wrong polynomial. So when the last two orders
+        // give more than twice the radius of the two before (ρ_k of a smooth solution grows
+        // far more slowly: 1.26× from order 6 to 8 for `cos t`), those two decide; if all
+        // four vanish, the highest order below them that does not.
         let first = p.saturating_sub(3).max(1);
-        // ρ_k < r exactly when ‖x^[k]‖ rᵏ > n: the two earlier orders cost a power (`powf`,
-        // a quarter of the rule's time) only when they are the smaller.
         let mut radius = rho(p - 1).min(rho(p));
-        for k in (first..p - 1).rev() {
+        // ρ_k < r/2 exactly when ‖x^[k]‖ (r/2)ᵏ > N: the earlier orders cost a power
+        // (`powf`, a quarter of the rule's time) only when they decide.
+        let anomalous = (first..p - 1).any(|k| {
             let norm = max_norm(&c[k * dim..(k + 1) * dim]);
-            if norm * radius.powi(k as i32) > n {
-                radius = radius.min(rho(k));
-            }
+            norm > 0.0 && norm * (0.5 * radius).powi(k as i32) > n
+        });
+        if anomalous {
+            radius = (first..p - 1).map(rho).fold(f64::INFINITY, f64::min);
         }
         if radius == f64::INFINITY {
             radius = (1..first)
