@@ -661,8 +661,9 @@ fn solve(nonzeros: &[(u32, u32, f64)], inverse_pivots: &[f64], b: &mut [f64]) {
 /// quadratic drag at the top of a vertical throw (the drag would push along the motion on
 /// the way down), `(ẋ² + ẏ²)^{3/2}` likewise, and `acos(cos q)` at `q = 0`.
 ///
-/// For each such op whose output `f` (with argument `g`: `f = g^α`) can move by `|f⁰|` in
-/// the step (`Σₖ₌₁ |fᵏ| hᵏ ≥ |f⁰|`; otherwise neither changes sign), the step is sampled at
+/// For each such op, `f = g^α`, whose argument can come near 0 in the step
+/// (`Σₖ₌₁ |gᵏ| hᵏ ≥ g⁰/2`; for `Asin`'s root, whose argument has no series of its own, when
+/// `Σₖ₌₁ |fᵏ| hᵏ ≥ f⁰`), the step is sampled at
 /// 16 points: at the first where `f` or `g` has left its sign at `τ = 0`, or `f` is no longer
 /// `g^α` to 10⁻³ of `max(|f|, |f⁰|)` (near a hidden branch point the higher orders of `f`
 /// are rounding errors divided by powers of `f⁰`), or either is not finite, the point is
@@ -716,13 +717,22 @@ pub fn branch_step(
         if !(start > 0.0 && start.is_finite()) {
             continue;
         }
-        // Σₖ₌₁ |fᵏ| τᵏ < |f⁰|: f cannot change sign, nor g (f = g^α), in the step.
-        let moved = series(out)[1..]
-            .iter()
-            .rev()
-            .fold(0.0, |v, &x| v * limit + x.abs())
-            * limit;
-        if moved < start.abs() {
+        // Where the argument's series cannot fall below half its start in the step
+        // (Σₖ₌₁ |gᵏ| τᵏ < g⁰/2), the branch point g = 0 is away from the step and f = g^α is
+        // its series (the usual case, decided by one sum); for `Asin`'s root, whose argument
+        // 1 − a² has no series of its own, where f cannot change sign (Σₖ₌₁ |fᵏ| τᵏ < f⁰).
+        let moved = |slot: Slot| {
+            series(slot)[1..]
+                .iter()
+                .rev()
+                .fold(0.0, |v, &x| v * limit + x.abs())
+                * limit
+        };
+        let far = match argument {
+            Argument::Slot(a) => moved(a) < 0.5 * value(a, 0.0),
+            Argument::OneMinusSquare(_) => moved(out) < start,
+        };
+        if far {
             continue;
         }
         let argument_at = |tau: f64| match argument {
