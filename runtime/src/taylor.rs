@@ -742,7 +742,8 @@ pub fn branch_step(
                 1.0 - x * x
             }
         };
-        if !(argument_at(0.0) > 0.0) {
+        // Also skips a NaN argument.
+        if argument_at(0.0).partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
             continue;
         }
         // Written so that a NaN is off the branch.
