@@ -106,7 +106,7 @@ pub mod __private {
 
     pub use eomgen_runtime::functions::{sign, step};
 
-    // The Taylor recurrences the generated `taylor_order` inlines (`eomgen_runtime::taylor::apply`).
+    // The Taylor recurrences the generated `taylor_order` calls (`eomgen_runtime::taylor::{mul, …}`).
     pub use eomgen_runtime::taylor;
 
     // The generated code's sine and cosine come from the `libm` crate (a pure-Rust port of

@@ -23,15 +23,16 @@
 
 use std::collections::{BTreeMap, BTreeSet};
 
-use eomgen::taylor::{SeriesOp, Slot, apply};
+use eomgen::taylor::{SeriesOp, Slot, apply, evaluate_order};
 use serde::Deserialize;
 
 /// The highest order the reference holds (and the kernels are run to).
 const ORDER: usize = 16;
 
 /// The workspace stride, longer than `ORDER + 1` so that a kernel confusing the stride with
-/// the order reads a NaN spare entry.
-const CAPACITY: usize = ORDER + 4;
+/// the order reads a NaN spare entry; the stride of the unrolled kernels, so that
+/// `evaluate_order` runs them.
+const CAPACITY: usize = eomgen::taylor::UNROLLED_CAPACITY;
 
 /// The reference file, as `tools/taylor_kernel_reference.py` writes it.
 #[derive(Deserialize)]
@@ -281,13 +282,25 @@ fn setup(case: &Case) -> Setup {
 /// If the op changed an operand or wrote beyond order `ORDER` of an output (its spare entries
 /// must stay NaN).
 fn run(setup: &mut Setup) -> BTreeMap<String, Vec<f64>> {
+    // The kernels compiled for any order (`K = 0`) and for each order (`evaluate_order`'s
+    // unrolled variants, here for k ≤ 16) must give the same bits.
+    let mut unrolled = setup.s.clone();
     let s = &mut setup.s;
     for k in 1..=ORDER {
         for (slot, values) in &setup.operands {
             s[*slot as usize * CAPACITY + k] = values[k];
+            unrolled[*slot as usize * CAPACITY + k] = values[k];
         }
-        apply(setup.op, k, CAPACITY, s);
+        apply::<0>(setup.op, k, CAPACITY, s);
+        evaluate_order(&[setup.op], k, CAPACITY, &mut unrolled);
     }
+    assert!(
+        s.iter()
+            .zip(&unrolled)
+            .all(|(a, b)| a.to_bits() == b.to_bits()),
+        "{:?}: the unrolled kernels differ from the general ones",
+        setup.op
+    );
     for (slot, values) in &setup.operands {
         let start = *slot as usize * CAPACITY;
         assert!(

@@ -34,32 +34,84 @@ fn series(s: &[f64], capacity: usize, slot: Slot) -> &[f64] {
     &s[start..start + capacity]
 }
 
-/// `Σ_{j=from}^{to} a[j] b[k − j]` (`from ≤ to ≤ k`), in increasing `j`.
+/// The order and the stride a kernel computes with: `(K, UNROLLED_CAPACITY)` when `K` is not
+/// 0, else `(k, c)`.
 ///
-/// The recurrences spend most of a Taylor step here, in sums of a few to twenty terms.
-/// Iterators over the two ranges (one reversed) leave the loop without bounds checks; a
-/// version with four interleaved partial sums (to overlap the additions) was 2.4× slower on
-/// the double pendulum's orders 8–15 (`study work-precision`, same run), its set-up and
-/// remainder loops outweighing the gain on sums this short.
+/// [`run_order`] (and so [`evaluate_order`] and the `model!` macro's code in optimised
+/// builds) picks `K = k` for `k ≤` [`UNROLLED_ORDERS`] when the workspace's stride is
+/// [`UNROLLED_CAPACITY`] (as [`series_of_motion`]'s is up to that order): the sums then have
+/// a known number of terms and unroll into straight-line code, and every coefficient is at a
+/// known offset, so the compiler passes an op's result to the next in a register instead of
+/// through memory. Both variants run the same operations in the same order, so they compute
+/// the same bits.
+#[inline(always)]
+const fn known<const K: usize>(k: usize, c: usize) -> (usize, usize) {
+    if K == 0 {
+        (k, c)
+    } else {
+        (K, UNROLLED_CAPACITY)
+    }
+}
+
+/// The orders `k = 1 …` this many that [`run_order`] runs with `k` known to the compiler;
+/// higher orders run the same kernels with `k` a variable. Order 23 is what a tolerance of
+/// 10⁻¹⁸ asks for.
+pub const UNROLLED_ORDERS: usize = 24;
+
+/// The stride (coefficients per slot) of a workspace whose orders up to
+/// [`UNROLLED_ORDERS`] run as code compiled for each order.
+pub const UNROLLED_CAPACITY: usize = UNROLLED_ORDERS + 1;
+
+/// `Σᵢ₌₀^{m−1} term(i)` in four partial sums — term `i` into sum `i mod 4`, in increasing `i`
+/// — added as `(s₀ + s₁) + (s₂ + s₃)`.
+///
+/// The recurrences spend most of a Taylor step in these sums (a few to twenty terms), and
+/// the order-`k` coefficients of a program are computed op after op, each waiting for its
+/// operands' order `k`: one running sum makes every op wait `m` additions (4 cycles each)
+/// for the previous one, four partial sums a quarter of that. With `m` known (the unrolled
+/// orders) the four sums are registers and the loop disappears; with `m` a variable the loop
+/// runs four terms per turn. (With the known orders and strides of [`run_order`] and the
+/// solves of known size of [`series_of_motion`], a double-pendulum Taylor run at 10⁻⁹ takes
+/// RATIO_ALL of the time it took with one running sum and loops; docs/performance.md.)
+#[inline(always)]
+fn sum4(m: usize, term: impl Fn(usize) -> f64) -> f64 {
+    let (mut s0, mut s1, mut s2, mut s3) = (0.0, 0.0, 0.0, 0.0);
+    let mut i = 0;
+    while i + 4 <= m {
+        s0 += term(i);
+        s1 += term(i + 1);
+        s2 += term(i + 2);
+        s3 += term(i + 3);
+        i += 4;
+    }
+    if i < m {
+        s0 += term(i);
+    }
+    if i + 1 < m {
+        s1 += term(i + 1);
+    }
+    if i + 2 < m {
+        s2 += term(i + 2);
+    }
+    (s0 + s1) + (s2 + s3)
+}
+
+/// `Σ_{j=from}^{to} a[j] b[k − j]` (`from ≤ to ≤ k`), by [`sum4`] over increasing `j`.
 #[inline(always)]
 fn convolution(a: &[f64], b: &[f64], k: usize, from: usize, to: usize) -> f64 {
     let a = &a[from..=to];
     let b = &b[k - to..=k - from];
-    let mut sum = 0.0;
-    for (x, y) in a.iter().zip(b.iter().rev()) {
-        sum += x * y;
-    }
-    sum
+    let m = a.len();
+    sum4(m, |i| a[i] * b[m - 1 - i])
 }
 
 /// Order `k ≥ 1` of the Cauchy product `Σ_{j=0}^{k} a[j] b[k − j]`, summed with the two terms
 /// that hold an order-`k` coefficient last: `(Σ_{j=1}^{k−1} a[j] b[k − j] + a[0] b[k]) +
 /// a[k] b[0]`.
 ///
-/// The order-`k` coefficients of a program are computed op after op, each waiting for its
-/// operands' order `k`; summing the older terms first lets the processor run those sums
-/// ahead while the operands are still being computed (3–4 % faster on the double pendulum
-/// at order 12, same run; two interleaved partial sums instead were 18 % slower).
+/// The older terms are ready before the operands' order `k` is computed: summing them first
+/// lets the processor run those sums ahead (3–4 % faster on the double pendulum at order
+/// 12 with one running sum, same run).
 #[inline(always)]
 fn cauchy(a: &[f64], b: &[f64], k: usize) -> f64 {
     let older = if k > 1 {
@@ -70,18 +122,14 @@ fn cauchy(a: &[f64], b: &[f64], k: usize) -> f64 {
     older + a[0] * b[k] + a[k] * b[0]
 }
 
-/// `Σ_{j=from}^{to} j a[j] b[k − j]`, in increasing `j` (each term `(j · a[j]) · b[k − j]`).
+/// `Σ_{j=from}^{to} j a[j] b[k − j]`, by [`sum4`] over increasing `j` (each term
+/// `(j · a[j]) · b[k − j]`).
 #[inline(always)]
 fn weighted_convolution(a: &[f64], b: &[f64], k: usize, from: usize, to: usize) -> f64 {
     let a = &a[from..=to];
     let b = &b[k - to..=k - from];
-    let mut sum = 0.0;
-    let mut j = from as f64;
-    for (x, y) in a.iter().zip(b.iter().rev()) {
-        sum += j * x * y;
-        j += 1.0;
-    }
-    sum
+    let m = a.len();
+    sum4(m, |i| (from + i) as f64 * a[i] * b[m - 1 - i])
 }
 
 /// Order `k ≥ 1` of the output(s) of one op, from the orders `≤ k` of its operands and `< k`
@@ -97,36 +145,39 @@ fn weighted_convolution(a: &[f64], b: &[f64], k: usize, from: usize, to: usize) 
 /// If a slot is beyond `s` or `k ≥ capacity` (a program and workspace that do not belong
 /// together).
 #[inline]
-pub fn apply(op: SeriesOp, k: usize, capacity: usize, s: &mut [f64]) {
+pub fn apply<const K: usize>(op: SeriesOp, k: usize, capacity: usize, s: &mut [f64]) {
     let c = capacity;
     match op {
-        SeriesOp::Neg { out, a } => neg(k, c, s, out, a),
-        SeriesOp::Copy { out, a } => copy(k, c, s, out, a),
-        SeriesOp::Add { out, a, b } => add(k, c, s, out, a, b),
-        SeriesOp::Sub { out, a, b } => sub(k, c, s, out, a, b),
-        SeriesOp::Mul { out, a, b } => mul(k, c, s, out, a, b),
-        SeriesOp::Scale { out, a, constant } => scale(k, c, s, out, a, constant),
-        SeriesOp::Div { out, a, b } => div(k, c, s, out, a, b),
-        SeriesOp::DivByConstant { out, a, constant } => div_by_constant(k, c, s, out, a, constant),
-        SeriesOp::ConstantDiv { out, b } => constant_div(k, c, s, out, b),
-        SeriesOp::Sqrt { out, a } => sqrt(k, c, s, out, a),
-        SeriesOp::PowConstant { out, a, exponent } => pow_constant(k, c, s, out, a, exponent),
-        SeriesOp::Exp { out, a } => exp(k, c, s, out, a),
-        SeriesOp::Ln { out, a } => ln(k, c, s, out, a),
-        SeriesOp::SinCos { sin, cos, a } => sin_cos(k, c, s, sin, cos, a),
-        SeriesOp::SinhCosh { sinh, cosh, a } => sinh_cosh(k, c, s, sinh, cosh, a),
-        SeriesOp::Tan { out, a, square } => tan_or_tanh(k, c, s, out, a, square, 1.0),
-        SeriesOp::Tanh { out, a, square } => tan_or_tanh(k, c, s, out, a, square, -1.0),
-        SeriesOp::Asin { out, a, root, acos } => asin(k, c, s, out, a, root, acos),
-        SeriesOp::Atan { out, a, square } => atan(k, c, s, out, a, square),
-        SeriesOp::Atan2 { out, y, x, norm } => atan2(k, c, s, out, y, x, norm),
-        SeriesOp::Zero { out } => zero(k, c, s, out),
+        SeriesOp::Neg { out, a } => neg::<K>(k, c, s, out, a),
+        SeriesOp::Copy { out, a } => copy::<K>(k, c, s, out, a),
+        SeriesOp::Add { out, a, b } => add::<K>(k, c, s, out, a, b),
+        SeriesOp::Sub { out, a, b } => sub::<K>(k, c, s, out, a, b),
+        SeriesOp::Mul { out, a, b } => mul::<K>(k, c, s, out, a, b),
+        SeriesOp::Scale { out, a, constant } => scale::<K>(k, c, s, out, a, constant),
+        SeriesOp::Div { out, a, b } => div::<K>(k, c, s, out, a, b),
+        SeriesOp::DivByConstant { out, a, constant } => {
+            div_by_constant::<K>(k, c, s, out, a, constant)
+        }
+        SeriesOp::ConstantDiv { out, b } => constant_div::<K>(k, c, s, out, b),
+        SeriesOp::Sqrt { out, a } => sqrt::<K>(k, c, s, out, a),
+        SeriesOp::PowConstant { out, a, exponent } => pow_constant::<K>(k, c, s, out, a, exponent),
+        SeriesOp::Exp { out, a } => exp::<K>(k, c, s, out, a),
+        SeriesOp::Ln { out, a } => ln::<K>(k, c, s, out, a),
+        SeriesOp::SinCos { sin, cos, a } => sin_cos::<K>(k, c, s, sin, cos, a),
+        SeriesOp::SinhCosh { sinh, cosh, a } => sinh_cosh::<K>(k, c, s, sinh, cosh, a),
+        SeriesOp::Tan { out, a, square } => tan_or_tanh::<K>(k, c, s, out, a, square, 1.0),
+        SeriesOp::Tanh { out, a, square } => tan_or_tanh::<K>(k, c, s, out, a, square, -1.0),
+        SeriesOp::Asin { out, a, root, acos } => asin::<K>(k, c, s, out, a, root, acos),
+        SeriesOp::Atan { out, a, square } => atan::<K>(k, c, s, out, a, square),
+        SeriesOp::Atan2 { out, y, x, norm } => atan2::<K>(k, c, s, out, y, x, norm),
+        SeriesOp::Zero { out } => zero::<K>(k, c, s, out),
     }
 }
 
 /// Order `k ≥ 1` of [`SeriesOp::Neg`].
 #[inline(always)]
-pub fn neg(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot) {
+pub fn neg<const K: usize>(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot) {
+    let (k, c) = known::<K>(k, c);
     let kf = k as f64;
     let at = |s: &[f64], x: Slot, i: usize| s[x as usize * c + i];
     let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
@@ -137,7 +188,8 @@ pub fn neg(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot) {
 
 /// Order `k ≥ 1` of [`SeriesOp::Copy`].
 #[inline(always)]
-pub fn copy(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot) {
+pub fn copy<const K: usize>(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot) {
+    let (k, c) = known::<K>(k, c);
     let kf = k as f64;
     let at = |s: &[f64], x: Slot, i: usize| s[x as usize * c + i];
     let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
@@ -148,7 +200,8 @@ pub fn copy(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot) {
 
 /// Order `k ≥ 1` of [`SeriesOp::Add`].
 #[inline(always)]
-pub fn add(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot, b: Slot) {
+pub fn add<const K: usize>(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot, b: Slot) {
+    let (k, c) = known::<K>(k, c);
     let kf = k as f64;
     let at = |s: &[f64], x: Slot, i: usize| s[x as usize * c + i];
     let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
@@ -159,7 +212,8 @@ pub fn add(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot, b: Slot) {
 
 /// Order `k ≥ 1` of [`SeriesOp::Sub`].
 #[inline(always)]
-pub fn sub(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot, b: Slot) {
+pub fn sub<const K: usize>(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot, b: Slot) {
+    let (k, c) = known::<K>(k, c);
     let kf = k as f64;
     let at = |s: &[f64], x: Slot, i: usize| s[x as usize * c + i];
     let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
@@ -170,7 +224,8 @@ pub fn sub(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot, b: Slot) {
 
 /// Order `k ≥ 1` of [`SeriesOp::Mul`].
 #[inline(always)]
-pub fn mul(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot, b: Slot) {
+pub fn mul<const K: usize>(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot, b: Slot) {
+    let (k, c) = known::<K>(k, c);
     let kf = k as f64;
     let at = |s: &[f64], x: Slot, i: usize| s[x as usize * c + i];
     let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
@@ -181,7 +236,15 @@ pub fn mul(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot, b: Slot) {
 
 /// Order `k ≥ 1` of [`SeriesOp::Scale`].
 #[inline(always)]
-pub fn scale(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot, constant: Slot) {
+pub fn scale<const K: usize>(
+    k: usize,
+    c: usize,
+    s: &mut [f64],
+    out: Slot,
+    a: Slot,
+    constant: Slot,
+) {
+    let (k, c) = known::<K>(k, c);
     let kf = k as f64;
     let at = |s: &[f64], x: Slot, i: usize| s[x as usize * c + i];
     let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
@@ -192,7 +255,8 @@ pub fn scale(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot, constant: Sl
 
 /// Order `k ≥ 1` of [`SeriesOp::Div`].
 #[inline(always)]
-pub fn div(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot, b: Slot) {
+pub fn div<const K: usize>(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot, b: Slot) {
+    let (k, c) = known::<K>(k, c);
     let kf = k as f64;
     let at = |s: &[f64], x: Slot, i: usize| s[x as usize * c + i];
     let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
@@ -204,7 +268,15 @@ pub fn div(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot, b: Slot) {
 
 /// Order `k ≥ 1` of [`SeriesOp::DivByConstant`].
 #[inline(always)]
-pub fn div_by_constant(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot, constant: Slot) {
+pub fn div_by_constant<const K: usize>(
+    k: usize,
+    c: usize,
+    s: &mut [f64],
+    out: Slot,
+    a: Slot,
+    constant: Slot,
+) {
+    let (k, c) = known::<K>(k, c);
     let kf = k as f64;
     let at = |s: &[f64], x: Slot, i: usize| s[x as usize * c + i];
     let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
@@ -215,7 +287,8 @@ pub fn div_by_constant(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot, co
 
 /// Order `k ≥ 1` of [`SeriesOp::ConstantDiv`].
 #[inline(always)]
-pub fn constant_div(k: usize, c: usize, s: &mut [f64], out: Slot, b: Slot) {
+pub fn constant_div<const K: usize>(k: usize, c: usize, s: &mut [f64], out: Slot, b: Slot) {
+    let (k, c) = known::<K>(k, c);
     let kf = k as f64;
     let at = |s: &[f64], x: Slot, i: usize| s[x as usize * c + i];
     let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
@@ -227,7 +300,8 @@ pub fn constant_div(k: usize, c: usize, s: &mut [f64], out: Slot, b: Slot) {
 
 /// Order `k ≥ 1` of [`SeriesOp::Sqrt`].
 #[inline(always)]
-pub fn sqrt(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot) {
+pub fn sqrt<const K: usize>(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot) {
+    let (k, c) = known::<K>(k, c);
     let kf = k as f64;
     let at = |s: &[f64], x: Slot, i: usize| s[x as usize * c + i];
     let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
@@ -244,7 +318,15 @@ pub fn sqrt(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot) {
 
 /// Order `k ≥ 1` of [`SeriesOp::PowConstant`].
 #[inline(always)]
-pub fn pow_constant(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot, exponent: Slot) {
+pub fn pow_constant<const K: usize>(
+    k: usize,
+    c: usize,
+    s: &mut [f64],
+    out: Slot,
+    a: Slot,
+    exponent: Slot,
+) {
+    let (k, c) = known::<K>(k, c);
     let kf = k as f64;
     let at = |s: &[f64], x: Slot, i: usize| s[x as usize * c + i];
     let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
@@ -252,17 +334,16 @@ pub fn pow_constant(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot, expon
     let alpha = at(s, exponent, 0);
     let (x, o) = (series(s, c, a), series(s, c, out));
     // Decreasing j: the term with x[k], this order's, comes last (see `cauchy`).
-    let mut sum = 0.0;
-    for j in (0..k).rev() {
-        sum += (kf * alpha - j as f64 * (alpha + 1.0)) * x[k - j] * o[j];
-    }
-    let v = sum / (kf * x[0]);
+    let term = |j: usize| (kf * alpha - j as f64 * (alpha + 1.0)) * x[k - j] * o[j];
+    let older = sum4(k - 1, |i| term(k - 1 - i));
+    let v = (older + term(0)) / (kf * x[0]);
     write(s, out, v);
 }
 
 /// Order `k ≥ 1` of [`SeriesOp::Exp`].
 #[inline(always)]
-pub fn exp(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot) {
+pub fn exp<const K: usize>(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot) {
+    let (k, c) = known::<K>(k, c);
     let kf = k as f64;
     let at = |s: &[f64], x: Slot, i: usize| s[x as usize * c + i];
     let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
@@ -273,7 +354,8 @@ pub fn exp(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot) {
 
 /// Order `k ≥ 1` of [`SeriesOp::Ln`].
 #[inline(always)]
-pub fn ln(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot) {
+pub fn ln<const K: usize>(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot) {
+    let (k, c) = known::<K>(k, c);
     let kf = k as f64;
     let at = |s: &[f64], x: Slot, i: usize| s[x as usize * c + i];
     let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
@@ -290,7 +372,8 @@ pub fn ln(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot) {
 
 /// Order `k ≥ 1` of [`SeriesOp::SinCos`].
 #[inline(always)]
-pub fn sin_cos(k: usize, c: usize, s: &mut [f64], sin: Slot, cos: Slot, a: Slot) {
+pub fn sin_cos<const K: usize>(k: usize, c: usize, s: &mut [f64], sin: Slot, cos: Slot, a: Slot) {
+    let (k, c) = known::<K>(k, c);
     let kf = k as f64;
     let at = |s: &[f64], x: Slot, i: usize| s[x as usize * c + i];
     let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
@@ -304,7 +387,15 @@ pub fn sin_cos(k: usize, c: usize, s: &mut [f64], sin: Slot, cos: Slot, a: Slot)
 
 /// Order `k ≥ 1` of [`SeriesOp::SinhCosh`].
 #[inline(always)]
-pub fn sinh_cosh(k: usize, c: usize, s: &mut [f64], sinh: Slot, cosh: Slot, a: Slot) {
+pub fn sinh_cosh<const K: usize>(
+    k: usize,
+    c: usize,
+    s: &mut [f64],
+    sinh: Slot,
+    cosh: Slot,
+    a: Slot,
+) {
+    let (k, c) = known::<K>(k, c);
     let kf = k as f64;
     let at = |s: &[f64], x: Slot, i: usize| s[x as usize * c + i];
     let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
@@ -318,7 +409,16 @@ pub fn sinh_cosh(k: usize, c: usize, s: &mut [f64], sinh: Slot, cosh: Slot, a: S
 
 /// Order `k ≥ 1` of `tan a` (`sign = 1`) or `tanh a` (`sign = −1`), with `square` its square: [`SeriesOp::Tan`], [`SeriesOp::Tanh`].
 #[inline(always)]
-pub fn tan_or_tanh(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot, square: Slot, sign: f64) {
+pub fn tan_or_tanh<const K: usize>(
+    k: usize,
+    c: usize,
+    s: &mut [f64],
+    out: Slot,
+    a: Slot,
+    square: Slot,
+    sign: f64,
+) {
+    let (k, c) = known::<K>(k, c);
     let kf = k as f64;
     let at = |s: &[f64], x: Slot, i: usize| s[x as usize * c + i];
     let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
@@ -333,7 +433,16 @@ pub fn tan_or_tanh(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot, square
 
 /// Order `k ≥ 1` of [`SeriesOp::Asin`].
 #[inline(always)]
-pub fn asin(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot, root: Slot, acos: bool) {
+pub fn asin<const K: usize>(
+    k: usize,
+    c: usize,
+    s: &mut [f64],
+    out: Slot,
+    a: Slot,
+    root: Slot,
+    acos: bool,
+) {
+    let (k, c) = known::<K>(k, c);
     let kf = k as f64;
     let at = |s: &[f64], x: Slot, i: usize| s[x as usize * c + i];
     let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
@@ -360,7 +469,8 @@ pub fn asin(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot, root: Slot, a
 
 /// Order `k ≥ 1` of [`SeriesOp::Atan`].
 #[inline(always)]
-pub fn atan(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot, square: Slot) {
+pub fn atan<const K: usize>(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot, square: Slot) {
+    let (k, c) = known::<K>(k, c);
     let kf = k as f64;
     let at = |s: &[f64], x: Slot, i: usize| s[x as usize * c + i];
     let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
@@ -380,7 +490,16 @@ pub fn atan(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot, square: Slot)
 
 /// Order `k ≥ 1` of [`SeriesOp::Atan2`].
 #[inline(always)]
-pub fn atan2(k: usize, c: usize, s: &mut [f64], out: Slot, y: Slot, x: Slot, norm: Slot) {
+pub fn atan2<const K: usize>(
+    k: usize,
+    c: usize,
+    s: &mut [f64],
+    out: Slot,
+    y: Slot,
+    x: Slot,
+    norm: Slot,
+) {
+    let (k, c) = known::<K>(k, c);
     let kf = k as f64;
     let at = |s: &[f64], x: Slot, i: usize| s[x as usize * c + i];
     let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
@@ -401,7 +520,8 @@ pub fn atan2(k: usize, c: usize, s: &mut [f64], out: Slot, y: Slot, x: Slot, nor
 
 /// Order `k ≥ 1` of [`SeriesOp::Zero`].
 #[inline(always)]
-pub fn zero(k: usize, c: usize, s: &mut [f64], out: Slot) {
+pub fn zero<const K: usize>(k: usize, c: usize, s: &mut [f64], out: Slot) {
+    let (k, c) = known::<K>(k, c);
     let kf = k as f64;
     let at = |s: &[f64], x: Slot, i: usize| s[x as usize * c + i];
     let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
@@ -409,11 +529,49 @@ pub fn zero(k: usize, c: usize, s: &mut [f64], out: Slot) {
     write(s, out, 0.0);
 }
 
-/// Order `k ≥ 1` of every series of `ops`, in order ([`apply`] for each).
+/// Order `k ≥ 1` of every series of `ops`, in order ([`apply`] for each, with the order
+/// known to the compiler for `k ≤` [`UNROLLED_ORDERS`]).
 pub fn evaluate_order(ops: &[SeriesOp], k: usize, capacity: usize, s: &mut [f64]) {
-    for &op in ops {
-        apply(op, k, capacity, s);
+    /// The ops of a run-time program as [`OrderCode`].
+    struct Ops<'a>(&'a [SeriesOp]);
+    impl OrderCode for Ops<'_> {
+        #[inline(never)]
+        fn run<const K: usize>(&self, k: usize, capacity: usize, s: &mut [f64]) {
+            for &op in self.0 {
+                apply::<K>(op, k, capacity, s);
+            }
+        }
     }
+    run_order(&Ops(ops), k, capacity, s);
+}
+
+/// The code of one order of a program, compiled for each order `K` in `1 …`
+/// [`UNROLLED_ORDERS`] (and `K = 0`: any order, `k` read at run time) — what
+/// [`run_order`] calls. Implemented by the `model!` macro's code (its kernel calls with
+/// `::<K>`) and by [`evaluate_order`].
+pub trait OrderCode {
+    /// Order `k` of every series slot (`K` is `k`, or 0).
+    fn run<const K: usize>(&self, k: usize, capacity: usize, s: &mut [f64]);
+}
+
+/// Runs `code` for order `k ≥ 1`: its variant compiled for `K = k` when `k ≤`
+/// [`UNROLLED_ORDERS`] and `capacity` is [`UNROLLED_CAPACITY`], else its variant for any
+/// order.
+#[inline]
+pub fn run_order(code: &impl OrderCode, k: usize, capacity: usize, s: &mut [f64]) {
+    if capacity != UNROLLED_CAPACITY {
+        return code.run::<0>(k, capacity, s);
+    }
+    macro_rules! orders {
+        ($($order:literal)*) => {
+            match k {
+                $($order => code.run::<$order>(k, capacity, s),)*
+                _ => code.run::<0>(k, capacity, s),
+            }
+        };
+    }
+    const _: () = assert!(UNROLLED_ORDERS == 24);
+    orders!(1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23 24)
 }
 
 /// The buffers of [`series_of_motion`], allocated on first use and grown when a higher order
@@ -447,10 +605,12 @@ impl TaylorWorkspace {
     /// Buffers for `order`: grown when a higher order or another program asks for more,
     /// never shrunk (the stride `capacity` is the kernels' argument, so a longer one serves a
     /// lower order), so a method switching order between steps does not reallocate. The
+    /// stride is at least [`UNROLLED_CAPACITY`], the one the kernels compiled for each order
+    /// run with (so orders up to [`UNROLLED_ORDERS`] always do). The
     /// lists of inputs and of non-constant mass-matrix entries are rebuilt in place (`n²`
     /// reads per step, next to the `O(order²)` work of the orders).
     fn fit(&mut self, program: &TaylorProgram, n: usize, order: usize) {
-        let capacity = self.capacity.max(order + 1);
+        let capacity = self.capacity.max(order + 1).max(UNROLLED_CAPACITY);
         if self.capacity != capacity
             || self.series.len() != program.slots * capacity
             || self.accelerations.len() != n * capacity
@@ -532,70 +692,217 @@ pub fn series_of_motion(
     } = workspace;
     let out = &mut out[..(order + 1) * dim];
     out[..dim].copy_from_slice(&y[..dim]);
-    for k in 0..order {
-        // The inputs at order k: the state's coefficients, and t = t₀ + τ.
-        let (now, next) = out[k * dim..(k + 2) * dim].split_at_mut(dim);
-        for &(slot, index) in inputs.iter() {
-            s[slot as usize * c + k] = now[index as usize];
-        }
-        if let Some(slot) = program.time {
-            s[slot as usize * c + k] = match k {
-                0 => t,
-                1 => 1.0,
-                _ => 0.0,
-            };
-        }
-        if k == 0 {
-            model.order_zero(c, s);
-            factor(
-                n,
-                |i, j| s[program.mass_matrix[i + j * n] as usize * c],
-                lower,
-                pivots,
-                inverse_pivots,
-            )
-            .ok_or(RhsError::SingularMassMatrix)?;
-            // The solves of every order visit only these (a model's M is often sparse:
-            // bodies that do not share a coordinate).
-            nonzeros.clear();
-            for i in 0..n {
-                for (j, &l) in lower[i * n..i * n + i].iter().enumerate() {
-                    if l != 0.0 {
-                        nonzeros.push((i as u32, j as u32, l));
-                    }
-                }
+    // Order 0: the state, t, the model's own evaluation and M⁰'s factors.
+    for &(slot, index) in inputs.iter() {
+        s[slot as usize * c] = y[index as usize];
+    }
+    if let Some(slot) = program.time {
+        s[slot as usize * c] = t;
+    }
+    model.order_zero(c, s);
+    factor(
+        n,
+        |i, j| s[program.mass_matrix[i + j * n] as usize * c],
+        lower,
+        pivots,
+        inverse_pivots,
+    )
+    .ok_or(RhsError::SingularMassMatrix)?;
+    // The solves of every order visit only these (a model's M is often sparse: bodies that
+    // do not share a coordinate).
+    nonzeros.clear();
+    for i in 0..n {
+        for (j, &l) in lower[i * n..i * n + i].iter().enumerate() {
+            if l != 0.0 {
+                nonzeros.push((i as u32, j as u32, l));
             }
-        } else {
+        }
+    }
+    let mut orders = Orders {
+        n,
+        c,
+        forcing: &program.forcing,
+        time: program.time,
+        coupled,
+        inputs,
+        nonzeros,
+        lower,
+        inverse_pivots,
+        reciprocals,
+        rhs,
+        acc,
+    };
+    for k in 0..order {
+        if k > 0 {
             model.order(k, c, s);
         }
-        // M^[0] a^[k] = F^[k] − Σⱼ₌₁ᵏ M^[j] a^[k−j], over the entries of M that vary.
-        for (r, &slot) in rhs.iter_mut().zip(program.forcing.iter()) {
-            *r = s[slot as usize * c + k];
-        }
-        if k > 0 {
-            for &(i, l, slot) in coupled.iter() {
-                let m = &s[slot as usize * c + 1..][..k];
-                let a = &acc[l as usize * c..][..k];
-                let mut v = rhs[i as usize];
-                for (x, y) in m.iter().zip(a.iter().rev()) {
-                    v -= x * y;
-                }
-                rhs[i as usize] = v;
-            }
-        }
-        solve(nonzeros, inverse_pivots, rhs);
-        let inverse = reciprocals[k];
-        let velocities = &now[n..];
-        let (q_next, v_next) = next.split_at_mut(n);
-        for i in 0..n {
-            acc[i * c + k] = rhs[i];
-            q_next[i] = velocities[i] * inverse;
-            v_next[i] = rhs[i] * inverse;
-        }
+        // Order k of q̈, order k + 1 of the state (into `out` and the input slots).
+        let (now, next) = out[k * dim..(k + 2) * dim].split_at_mut(dim);
+        orders.accelerations(k, s, &now[n..], next);
     }
     match out.iter().position(|v| !v.is_finite()) {
         Some(at) => Err(RhsError::NonFinite { index: at % dim }),
         None => Ok(()),
+    }
+}
+
+/// The per-order work of [`series_of_motion`] after a model's ops: `q̈^[k]` from `M q̈ = F` as
+/// a series, and the state's next order.
+struct Orders<'a> {
+    n: usize,
+    c: usize,
+    forcing: &'a [Slot],
+    time: Option<Slot>,
+    coupled: &'a [(u32, u32, Slot)],
+    inputs: &'a [(Slot, u32)],
+    nonzeros: &'a [(u32, u32, f64)],
+    /// `L`, row-major `n × n`.
+    lower: &'a [f64],
+    inverse_pivots: &'a [f64],
+    reciprocals: &'a [f64],
+    rhs: &'a mut [f64],
+    acc: &'a mut [f64],
+}
+
+/// The largest `n` whose solves [`Orders`] compiles for a known `n` (dense `L` in registers).
+const FIXED_DEGREES: usize = 6;
+
+impl Orders<'_> {
+    /// `a^[k]` (into `acc`), `q^[k+1] = q̇^[k] / (k + 1)` and `q̇^[k+1] = a^[k] / (k + 1)`
+    /// (into `next` and the input slots of `s`), and `t`'s order `k + 1`; `velocities` is
+    /// `q̇^[k]`.
+    ///
+    /// The orders follow each other through this function (order `k + 1` of every op waits
+    /// for `a^[k]`): for `n ≤` [`FIXED_DEGREES`] and `k ≤` [`UNROLLED_ORDERS`] it runs as code
+    /// compiled for that `n` and `k`, the right-hand side and the solve in registers.
+    #[inline]
+    fn accelerations(&mut self, k: usize, s: &mut [f64], velocities: &[f64], next: &mut [f64]) {
+        let unrolled = self.c == UNROLLED_CAPACITY;
+        macro_rules! orders {
+            ($n:literal; $($order:literal)*) => {
+                match k {
+                    $($order if unrolled => self.fixed::<$n, $order>(k, s, velocities, next),)*
+                    _ => self.fixed::<$n, 0>(k, s, velocities, next),
+                }
+            };
+        }
+        const _: () = assert!(UNROLLED_ORDERS == 24 && FIXED_DEGREES == 6);
+        match self.n {
+            1 => orders!(1; 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23 24),
+            2 => orders!(2; 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23 24),
+            3 => orders!(3; 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23 24),
+            4 => orders!(4; 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23 24),
+            5 => orders!(5; 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23 24),
+            6 => orders!(6; 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23 24),
+            _ => self.general(k, s, velocities, next),
+        }
+    }
+
+    /// [`Self::accelerations`] for `n = N` (`k` known when `K ≠ 0`).
+    #[inline(never)]
+    fn fixed<const N: usize, const K: usize>(
+        &mut self,
+        k: usize,
+        s: &mut [f64],
+        velocities: &[f64],
+        next: &mut [f64],
+    ) {
+        let (k, c) = known::<K>(k, self.c);
+        let mut b = [0.0; N];
+        for (r, &slot) in b.iter_mut().zip(self.forcing) {
+            *r = s[slot as usize * c + k];
+        }
+        coupled_sums::<K>(k, c, s, self.coupled, self.acc, &mut b);
+        // L z = b, z ← D⁻¹ z, Lᵀ x = z, with L dense (its zeros give exact zeros).
+        let lower = &self.lower[..N * N];
+        for i in 0..N {
+            for j in 0..i {
+                b[i] -= lower[i * N + j] * b[j];
+            }
+        }
+        for (x, d) in b.iter_mut().zip(self.inverse_pivots) {
+            *x *= d;
+        }
+        for i in (0..N).rev() {
+            for j in 0..i {
+                b[j] -= lower[i * N + j] * b[i];
+            }
+        }
+        self.next_order(k, c, s, &b, velocities, next);
+    }
+
+    /// [`Self::accelerations`] for any `n`: the solve over `L`'s non-zero entries.
+    #[inline(never)]
+    fn general(&mut self, k: usize, s: &mut [f64], velocities: &[f64], next: &mut [f64]) {
+        let c = self.c;
+        let b = std::mem::take(&mut self.rhs);
+        for (r, &slot) in b.iter_mut().zip(self.forcing) {
+            *r = s[slot as usize * c + k];
+        }
+        let unrolled = c == UNROLLED_CAPACITY;
+        macro_rules! orders {
+            ($($order:literal)*) => {
+                match k {
+                    $($order if unrolled => coupled_sums::<$order>(k, c, s, self.coupled, self.acc, b),)*
+                    _ => coupled_sums::<0>(k, c, s, self.coupled, self.acc, b),
+                }
+            };
+        }
+        orders!(1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23 24);
+        solve(self.nonzeros, self.inverse_pivots, b);
+        self.next_order(k, c, s, b, velocities, next);
+        self.rhs = b;
+    }
+
+    /// Stores `a^[k] = b` and the state's order `k + 1` (see [`Self::accelerations`]).
+    #[inline(always)]
+    fn next_order(
+        &mut self,
+        k: usize,
+        c: usize,
+        s: &mut [f64],
+        b: &[f64],
+        velocities: &[f64],
+        next: &mut [f64],
+    ) {
+        let n = b.len();
+        let inverse = self.reciprocals[k];
+        let (q_next, v_next) = next.split_at_mut(n);
+        for i in 0..n {
+            self.acc[i * c + k] = b[i];
+            q_next[i] = velocities[i] * inverse;
+            v_next[i] = b[i] * inverse;
+        }
+        if k + 1 < c {
+            for &(slot, index) in self.inputs {
+                s[slot as usize * c + k + 1] = next[index as usize];
+            }
+            if let Some(slot) = self.time {
+                s[slot as usize * c + k + 1] = if k == 0 { 1.0 } else { 0.0 };
+            }
+        }
+    }
+}
+
+/// `b[i] −= Σⱼ₌₁ᵏ M_il^[j] a_l^[k−j]` for each entry `(i, l, slot)` of `M` that varies (`k`
+/// known when `K ≠ 0`; nothing at `k = 0`).
+#[inline(always)]
+fn coupled_sums<const K: usize>(
+    k: usize,
+    c: usize,
+    s: &[f64],
+    coupled: &[(u32, u32, Slot)],
+    acc: &[f64],
+    b: &mut [f64],
+) {
+    let (k, c) = known::<K>(k, c);
+    if k == 0 {
+        return;
+    }
+    for &(i, l, slot) in coupled {
+        let m = &s[slot as usize * c + 1..][..k];
+        let a = &acc[l as usize * c..][..k];
+        b[i as usize] -= sum4(k, |j| m[j] * a[k - 1 - j]);
     }
 }
 

@@ -349,8 +349,10 @@ fn operands(instruction: Instruction) -> Vec<Slot> {
 
 /// The Taylor methods of a generated `impl MechanicalSystem<N>`: `taylor_program` (the
 /// program as a `static`, or the reason there is none), `taylor_order_zero` (the extended
-/// tape as straight-line code) and `taylor_order` (one inlined
-/// `eomgen::__private::taylor::apply` per op, the match folding away for each constant op).
+/// tape as straight-line code) and `taylor_order` (one call of the op's kernel,
+/// `eomgen::__private::taylor::{mul, sin_cos, …}`, per op, with its slots as constants; in
+/// optimised builds compiled once per order `k ≤ UNROLLED_ORDERS` through
+/// `taylor::run_order`, so that each kernel's sums have a known length).
 ///
 /// `parameters` are the fields of the struct, in parameter order.
 ///
@@ -513,7 +515,19 @@ pub(super) fn methods(
         }
         #[inline(never)]
         fn taylor_order(&self, __k: usize, __c: usize, __s: &mut [f64]) {
-            #(#calls)*
+            struct __Order;
+            impl #t::OrderCode for __Order {
+                #[inline(never)]
+                fn run<const __K: usize>(&self, __k: usize, __c: usize, __s: &mut [f64]) {
+                    #(#calls)*
+                }
+            }
+            // Debug builds compile one variant, for any order (the unrolled ones compute the
+            // same bits, and are what optimised builds are for).
+            #[cfg(debug_assertions)]
+            #t::OrderCode::run::<0>(&__Order, __k, __c, __s);
+            #[cfg(not(debug_assertions))]
+            #t::run_order(&__Order, __k, __c, __s);
         }
     })
 }
@@ -593,7 +607,7 @@ fn call_tokens(op: &SeriesOp, t: &proc_macro2::TokenStream) -> proc_macro2::Toke
     use quote::quote;
     let args = |kernel: &str, slots: &[Slot]| {
         let kernel = proc_macro2::Ident::new(kernel, proc_macro2::Span::call_site());
-        quote!(#t::#kernel(__k, __c, __s, #(#slots),*);)
+        quote!(#t::#kernel::<__K>(__k, __c, __s, #(#slots),*);)
     };
     match *op {
         SeriesOp::Neg { out, a } => args("neg", &[out, a]),
@@ -614,13 +628,13 @@ fn call_tokens(op: &SeriesOp, t: &proc_macro2::TokenStream) -> proc_macro2::Toke
         SeriesOp::SinCos { sin, cos, a } => args("sin_cos", &[sin, cos, a]),
         SeriesOp::SinhCosh { sinh, cosh, a } => args("sinh_cosh", &[sinh, cosh, a]),
         SeriesOp::Tan { out, a, square } => {
-            quote!(#t::tan_or_tanh(__k, __c, __s, #out, #a, #square, 1.0);)
+            quote!(#t::tan_or_tanh::<__K>(__k, __c, __s, #out, #a, #square, 1.0);)
         }
         SeriesOp::Tanh { out, a, square } => {
-            quote!(#t::tan_or_tanh(__k, __c, __s, #out, #a, #square, -1.0);)
+            quote!(#t::tan_or_tanh::<__K>(__k, __c, __s, #out, #a, #square, -1.0);)
         }
         SeriesOp::Asin { out, a, root, acos } => {
-            quote!(#t::asin(__k, __c, __s, #out, #a, #root, #acos);)
+            quote!(#t::asin::<__K>(__k, __c, __s, #out, #a, #root, #acos);)
         }
         SeriesOp::Atan { out, a, square } => args("atan", &[out, a, square]),
         SeriesOp::Atan2 { out, y, x, norm } => args("atan2", &[out, y, x, norm]),
