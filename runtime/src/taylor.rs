@@ -39,11 +39,12 @@ fn series(s: &[f64], capacity: usize, slot: Slot) -> &[f64] {
 ///
 /// [`run_order`] (and so [`evaluate_order`] and the `model!` macro's code in optimised
 /// builds) picks `K = k` for `k ≤` [`UNROLLED_ORDERS`] when the workspace's stride is
-/// [`UNROLLED_CAPACITY`] (as [`series_of_motion`]'s is up to that order): the sums then have
-/// a known number of terms and unroll into straight-line code, and every coefficient is at a
-/// known offset, so the compiler passes an op's result to the next in a register instead of
-/// through memory. Both variants run the same operations in the same order, so they compute
-/// the same bits.
+/// [`UNROLLED_CAPACITY`] (as [`series_of_motion`]'s is when [`unrolled_code_fits`]): the
+/// sums then have a known number of terms and unroll into straight-line code, and every
+/// coefficient is at a known offset, so the compiler passes an op's result to the next in a
+/// register instead of through memory (a double-pendulum run at 10⁻⁹ in 0.72 of the time,
+/// same runs). Both variants run the same operations in the same order, so they compute the
+/// same bits.
 #[inline(always)]
 const fn known<const K: usize>(k: usize, c: usize) -> (usize, usize) {
     if K == 0 {
@@ -62,47 +63,23 @@ pub const UNROLLED_ORDERS: usize = 24;
 /// [`UNROLLED_ORDERS`] run as code compiled for each order.
 pub const UNROLLED_CAPACITY: usize = UNROLLED_ORDERS + 1;
 
-/// `Σᵢ₌₀^{m−1} term(i)` in four partial sums — term `i` into sum `i mod 4`, in increasing `i`
-/// — added as `(s₀ + s₁) + (s₂ + s₃)`.
+/// `Σ_{j=from}^{to} a[j] b[k − j]` (`from ≤ to ≤ k`), in increasing `j`.
 ///
-/// The recurrences spend most of a Taylor step in these sums (a few to twenty terms), and
-/// the order-`k` coefficients of a program are computed op after op, each waiting for its
-/// operands' order `k`: one running sum makes every op wait `m` additions (4 cycles each)
-/// for the previous one, four partial sums a quarter of that. With `m` known (the unrolled
-/// orders) the four sums are registers and the loop disappears; with `m` a variable the loop
-/// runs four terms per turn. (With the known orders and strides of [`run_order`] and the
-/// solves of known size of [`series_of_motion`], a double-pendulum Taylor run at 10⁻⁹ takes
-/// RATIO_ALL of the time it took with one running sum and loops; docs/performance.md.)
-#[inline(always)]
-fn sum4(m: usize, term: impl Fn(usize) -> f64) -> f64 {
-    let (mut s0, mut s1, mut s2, mut s3) = (0.0, 0.0, 0.0, 0.0);
-    let mut i = 0;
-    while i + 4 <= m {
-        s0 += term(i);
-        s1 += term(i + 1);
-        s2 += term(i + 2);
-        s3 += term(i + 3);
-        i += 4;
-    }
-    if i < m {
-        s0 += term(i);
-    }
-    if i + 1 < m {
-        s1 += term(i + 1);
-    }
-    if i + 2 < m {
-        s2 += term(i + 2);
-    }
-    (s0 + s1) + (s2 + s3)
-}
-
-/// `Σ_{j=from}^{to} a[j] b[k − j]` (`from ≤ to ≤ k`), by [`sum4`] over increasing `j`.
+/// The recurrences spend most of a Taylor step here, in sums of a few to twenty terms.
+/// Iterators over the two ranges (one reversed) leave the loop without bounds checks. One
+/// running sum: four partial sums (to overlap the additions) were 2.4× slower with `k` a
+/// variable, their set-up and remainder loops outweighing the gain on sums this short, and
+/// no faster with `k` known ([`run_order`]; the double pendulum at orders 12 and 15, same
+/// run: the gain of the unrolled code is in the known offsets, not in the sums' latency).
 #[inline(always)]
 fn convolution(a: &[f64], b: &[f64], k: usize, from: usize, to: usize) -> f64 {
     let a = &a[from..=to];
     let b = &b[k - to..=k - from];
-    let m = a.len();
-    sum4(m, |i| a[i] * b[m - 1 - i])
+    let mut sum = 0.0;
+    for (x, y) in a.iter().zip(b.iter().rev()) {
+        sum += x * y;
+    }
+    sum
 }
 
 /// Order `k ≥ 1` of the Cauchy product `Σ_{j=0}^{k} a[j] b[k − j]`, summed with the two terms
@@ -122,14 +99,18 @@ fn cauchy(a: &[f64], b: &[f64], k: usize) -> f64 {
     older + a[0] * b[k] + a[k] * b[0]
 }
 
-/// `Σ_{j=from}^{to} j a[j] b[k − j]`, by [`sum4`] over increasing `j` (each term
-/// `(j · a[j]) · b[k − j]`).
+/// `Σ_{j=from}^{to} j a[j] b[k − j]`, in increasing `j` (each term `(j · a[j]) · b[k − j]`).
 #[inline(always)]
 fn weighted_convolution(a: &[f64], b: &[f64], k: usize, from: usize, to: usize) -> f64 {
     let a = &a[from..=to];
     let b = &b[k - to..=k - from];
-    let m = a.len();
-    sum4(m, |i| (from + i) as f64 * a[i] * b[m - 1 - i])
+    let mut sum = 0.0;
+    let mut j = from as f64;
+    for (x, y) in a.iter().zip(b.iter().rev()) {
+        sum += j * x * y;
+        j += 1.0;
+    }
+    sum
 }
 
 /// Order `k ≥ 1` of the output(s) of one op, from the orders `≤ k` of its operands and `< k`
@@ -334,9 +315,11 @@ pub fn pow_constant<const K: usize>(
     let alpha = at(s, exponent, 0);
     let (x, o) = (series(s, c, a), series(s, c, out));
     // Decreasing j: the term with x[k], this order's, comes last (see `cauchy`).
-    let term = |j: usize| (kf * alpha - j as f64 * (alpha + 1.0)) * x[k - j] * o[j];
-    let older = sum4(k - 1, |i| term(k - 1 - i));
-    let v = (older + term(0)) / (kf * x[0]);
+    let mut sum = 0.0;
+    for j in (0..k).rev() {
+        sum += (kf * alpha - j as f64 * (alpha + 1.0)) * x[k - j] * o[j];
+    }
+    let v = sum / (kf * x[0]);
     write(s, out, v);
 }
 
@@ -605,12 +588,20 @@ impl TaylorWorkspace {
     /// Buffers for `order`: grown when a higher order or another program asks for more,
     /// never shrunk (the stride `capacity` is the kernels' argument, so a longer one serves a
     /// lower order), so a method switching order between steps does not reallocate. The
-    /// stride is at least [`UNROLLED_CAPACITY`], the one the kernels compiled for each order
-    /// run with (so orders up to [`UNROLLED_ORDERS`] always do). The
+    /// stride is [`UNROLLED_CAPACITY`], the one the kernels compiled for each order run with,
+    /// when [`unrolled_code_fits`], else any other (so that they do not). The
     /// lists of inputs and of non-constant mass-matrix entries are rebuilt in place (`n²`
     /// reads per step, next to the `O(order²)` work of the orders).
     fn fit(&mut self, program: &TaylorProgram, n: usize, order: usize) {
-        let capacity = self.capacity.max(order + 1).max(UNROLLED_CAPACITY);
+        let unrolled = unrolled_code_fits(program, order);
+        let capacity = if unrolled {
+            UNROLLED_CAPACITY
+        } else if self.capacity != UNROLLED_CAPACITY && self.capacity > order {
+            self.capacity
+        } else {
+            // Any stride but the unrolled code's.
+            (order + 1).max(UNROLLED_CAPACITY + 1)
+        };
         if self.capacity != capacity
             || self.series.len() != program.slots * capacity
             || self.accelerations.len() != n * capacity
@@ -643,6 +634,53 @@ impl TaylorWorkspace {
             }
         }
     }
+}
+
+/// Whether a step of `program` to `order` runs the kernels compiled for each order
+/// ([`run_order`]): `order ≤` [`UNROLLED_ORDERS`] and the step's unrolled code is small,
+/// `Σₖ₌₁^{order−1} (w k + ops) ≤ 2100` with `w` the convolutions per order of the program's
+/// ops (one for a product, quotient or power, two for a sine–cosine pair, …).
+///
+/// Each order is its own code, so a step runs all of it once: past what the processor's
+/// instruction cache holds, the unrolled code is slower than the loops. Measured on one
+/// machine (2 cores, 32 KiB instruction cache; time of a run against the loops', same runs):
+/// the double pendulum (24 ops, w = 12) at orders 8, 12, 15 (sizes 504, 1056, 1596) in 0.74,
+/// 0.72, 0.75, at 18 and 20 (2244, 2736) 1.09 and 1.2; the figure eight (58 ops, w = 21)
+/// at orders 8 and 12 (994, 2024) in 0.73 and 0.78, at 15 and 18 (3017, 4199) 1.1.
+pub fn unrolled_code_fits(program: &TaylorProgram, order: usize) -> bool {
+    if order > UNROLLED_ORDERS {
+        return false;
+    }
+    let w: usize = program
+        .ops
+        .iter()
+        .map(|op| match op {
+            SeriesOp::Mul { .. }
+            | SeriesOp::Div { .. }
+            | SeriesOp::ConstantDiv { .. }
+            | SeriesOp::Sqrt { .. }
+            | SeriesOp::PowConstant { .. }
+            | SeriesOp::Exp { .. }
+            | SeriesOp::Ln { .. } => 1,
+            SeriesOp::SinCos { .. }
+            | SeriesOp::SinhCosh { .. }
+            | SeriesOp::Tan { .. }
+            | SeriesOp::Tanh { .. }
+            | SeriesOp::Atan { .. } => 2,
+            SeriesOp::Asin { .. } => 3,
+            SeriesOp::Atan2 { .. } => 4,
+            SeriesOp::Neg { .. }
+            | SeriesOp::Copy { .. }
+            | SeriesOp::Add { .. }
+            | SeriesOp::Sub { .. }
+            | SeriesOp::Scale { .. }
+            | SeriesOp::DivByConstant { .. }
+            | SeriesOp::Zero { .. } => 0,
+        })
+        .sum();
+    let p = order.max(1);
+    let size = w * p * (p - 1) / 2 + program.ops.len() * (p - 1);
+    size <= 2100
 }
 
 /// The order-0 and order-`k` functions of a model's Taylor program.
@@ -774,10 +812,16 @@ impl Orders<'_> {
     ///
     /// The orders follow each other through this function (order `k + 1` of every op waits
     /// for `a^[k]`): for `n ≤` [`FIXED_DEGREES`] and `k ≤` [`UNROLLED_ORDERS`] it runs as code
-    /// compiled for that `n` and `k`, the right-hand side and the solve in registers.
+    /// compiled for that `n` and `k`, the right-hand side and the solve in registers, unless
+    /// `L` is less than half full.
     #[inline]
     fn accelerations(&mut self, k: usize, s: &mut [f64], velocities: &[f64], next: &mut [f64]) {
         let unrolled = self.c == UNROLLED_CAPACITY;
+        // A factor with few non-zero entries (a diagonal M: the figure eight's) is solved
+        // faster over its list.
+        if 2 * self.nonzeros.len() < self.n * self.n.saturating_sub(1) {
+            return self.general(k, s, velocities, next);
+        }
         macro_rules! orders {
             ($n:literal; $($order:literal)*) => {
                 match k {
@@ -902,7 +946,11 @@ fn coupled_sums<const K: usize>(
     for &(i, l, slot) in coupled {
         let m = &s[slot as usize * c + 1..][..k];
         let a = &acc[l as usize * c..][..k];
-        b[i as usize] -= sum4(k, |j| m[j] * a[k - 1 - j]);
+        let mut v = b[i as usize];
+        for (x, y) in m.iter().zip(a.iter().rev()) {
+            v -= x * y;
+        }
+        b[i as usize] = v;
     }
 }
 
