@@ -255,6 +255,80 @@ pub struct TaylorProgram {
     pub ops: List<SeriesOp>,
 }
 
+/// The orders `k = 1 …` this many that the Taylor kernels are compiled for with `k` known
+/// (`eomgen_runtime::taylor::run_order`); higher orders run the same kernels with `k` a
+/// variable. Order 23 is what a tolerance of 10⁻¹⁸ asks for.
+pub const UNROLLED_ORDERS: usize = 24;
+
+/// The stride (coefficients per slot) of a workspace whose orders up to [`UNROLLED_ORDERS`]
+/// run as the code compiled for each order.
+pub const UNROLLED_CAPACITY: usize = UNROLLED_ORDERS + 1;
+
+/// The largest [`TaylorProgram::unrolled_code_size`] of a step that runs the code compiled
+/// for each order (see [`TaylorProgram::unrolled_code_fits`]).
+pub const UNROLLED_CODE_BUDGET: usize = 2100;
+
+impl TaylorProgram {
+    /// The size of the code compiled for each order that a step to `order` runs, in
+    /// convolution terms and ops: `Σₖ₌₁^{order−1} (w k + ops)` with `w` the convolutions per
+    /// order of the program's ops (one for a product, quotient or power, two for a
+    /// sine–cosine pair, …).
+    pub fn unrolled_code_size(&self, order: usize) -> usize {
+        let w: usize = self
+            .ops
+            .iter()
+            .map(|op| match op {
+                SeriesOp::Mul { .. }
+                | SeriesOp::Div { .. }
+                | SeriesOp::ConstantDiv { .. }
+                | SeriesOp::Sqrt { .. }
+                | SeriesOp::PowConstant { .. }
+                | SeriesOp::Exp { .. }
+                | SeriesOp::Ln { .. } => 1,
+                SeriesOp::SinCos { .. }
+                | SeriesOp::SinhCosh { .. }
+                | SeriesOp::Tan { .. }
+                | SeriesOp::Tanh { .. }
+                | SeriesOp::Atan { .. } => 2,
+                SeriesOp::Asin { .. } => 3,
+                SeriesOp::Atan2 { .. } => 4,
+                SeriesOp::Neg { .. }
+                | SeriesOp::Copy { .. }
+                | SeriesOp::Add { .. }
+                | SeriesOp::Sub { .. }
+                | SeriesOp::Scale { .. }
+                | SeriesOp::DivByConstant { .. }
+                | SeriesOp::Zero { .. } => 0,
+            })
+            .sum();
+        let p = order.max(1);
+        w * p * (p - 1) / 2 + self.ops.len() * (p - 1)
+    }
+
+    /// Whether a step to `order` runs the kernels compiled for each order: `order ≤`
+    /// [`UNROLLED_ORDERS`] and [`Self::unrolled_code_size`] `≤` [`UNROLLED_CODE_BUDGET`].
+    ///
+    /// Each order is its own code, so a step runs all of it once: past what the processor's
+    /// instruction cache holds, the unrolled code is slower than the loops. Measured on one
+    /// machine (2 cores, 32 KiB instruction cache; time of a run against the loops', same
+    /// runs): the double pendulum (24 ops, w = 12) at orders 8, 12, 15 (sizes 504, 1056,
+    /// 1596) in 0.74, 0.72, 0.75, at 18 and 20 (2244, 2736) 1.09 and 1.2× the loops' time;
+    /// the figure eight (58 ops, w = 21) at orders 8 and 12 (994, 2024) in 0.73 and 0.78, at
+    /// 15 and 18 (3017, 4199) 1.1×.
+    pub fn unrolled_code_fits(&self, order: usize) -> bool {
+        order <= UNROLLED_ORDERS && self.unrolled_code_size(order) <= UNROLLED_CODE_BUDGET
+    }
+
+    /// The highest order `k` whose code compiled for `k` a step of this program can run: the
+    /// order below the highest that [`Self::unrolled_code_fits`] (0 if none).
+    pub fn highest_unrolled_order(&self) -> usize {
+        (2..=UNROLLED_ORDERS)
+            .take_while(|&p| self.unrolled_code_fits(p))
+            .last()
+            .map_or(0, |p| p - 1)
+    }
+}
+
 /// Why a model has no Taylor recurrences.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize)]
 pub enum TaylorUnsupported {
@@ -298,3 +372,51 @@ impl std::fmt::Display for TaylorUnsupported {
 }
 
 impl std::error::Error for TaylorUnsupported {}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A program of `products` products, `pairs` sine–cosine pairs and `others` additions
+    /// (nothing but the ops is read).
+    fn program(products: usize, pairs: usize, others: usize) -> TaylorProgram {
+        let mut ops = Vec::new();
+        ops.extend((0..products).map(|_| SeriesOp::Mul { out: 0, a: 0, b: 0 }));
+        ops.extend((0..pairs).map(|_| SeriesOp::SinCos {
+            sin: 0,
+            cos: 0,
+            a: 0,
+        }));
+        ops.extend((0..others).map(|_| SeriesOp::Add { out: 0, a: 0, b: 0 }));
+        TaylorProgram {
+            slots: 1,
+            coordinates: List::Owned(vec![]),
+            velocities: List::Owned(vec![]),
+            time: None,
+            mass_matrix: List::Owned(vec![]),
+            forcing: List::Owned(vec![]),
+            constant: List::Owned(vec![false]),
+            ops: List::Owned(ops),
+        }
+    }
+
+    /// The double pendulum's program (8 products, 2 sine–cosine pairs, 14 other ops: w = 12,
+    /// 24 ops): the sizes quoted in `unrolled_code_fits`' measurements, summed term by term.
+    #[test]
+    fn unrolled_code_size_counts_the_terms_of_each_order() {
+        let p = program(8, 2, 14);
+        for order in [1, 2, 8, 12, 15, 17, 18] {
+            let by_order: usize = (1..order).map(|k| 12 * k + 24).sum();
+            assert_eq!(p.unrolled_code_size(order), by_order, "order {order}");
+        }
+        assert_eq!(p.unrolled_code_size(12), 1056);
+        assert!(p.unrolled_code_fits(17) && !p.unrolled_code_fits(18));
+        assert_eq!(p.highest_unrolled_order(), 16);
+        // A program too large for any unrolled order, and an empty one.
+        assert_eq!(program(2000, 0, 0).highest_unrolled_order(), 0);
+        assert_eq!(
+            program(0, 0, 0).highest_unrolled_order(),
+            UNROLLED_ORDERS - 1
+        );
+    }
+}

@@ -23,7 +23,9 @@
 //! decomposition with hidden partners); the mass-matrix series is the quotient rule of §2
 //! with a matrix denominator.
 
-pub use eomgen_description::taylor::{SeriesOp, Slot, TaylorProgram, TaylorUnsupported};
+pub use eomgen_description::taylor::{
+    SeriesOp, Slot, TaylorProgram, TaylorUnsupported, UNROLLED_CAPACITY, UNROLLED_ORDERS,
+};
 
 use crate::ode::RhsError;
 
@@ -39,7 +41,7 @@ fn series(s: &[f64], capacity: usize, slot: Slot) -> &[f64] {
 ///
 /// [`run_order`] (and so [`evaluate_order`] and the `model!` macro's code in optimised
 /// builds) picks `K = k` for `k ≤` [`UNROLLED_ORDERS`] when the workspace's stride is
-/// [`UNROLLED_CAPACITY`] (as [`series_of_motion`]'s is when [`unrolled_code_fits`]): the
+/// [`UNROLLED_CAPACITY`] (as [`series_of_motion`]'s is when [`TaylorProgram::unrolled_code_fits`]): the
 /// sums then have a known number of terms and unroll into straight-line code, and every
 /// coefficient is at a known offset, so the compiler passes an op's result to the next in a
 /// register instead of through memory (a double-pendulum run at 10⁻⁹ in 0.72 of the time,
@@ -53,15 +55,6 @@ const fn known<const K: usize>(k: usize, c: usize) -> (usize, usize) {
         (K, UNROLLED_CAPACITY)
     }
 }
-
-/// The orders `k = 1 …` this many that [`run_order`] runs with `k` known to the compiler;
-/// higher orders run the same kernels with `k` a variable. Order 23 is what a tolerance of
-/// 10⁻¹⁸ asks for.
-pub const UNROLLED_ORDERS: usize = 24;
-
-/// The stride (coefficients per slot) of a workspace whose orders up to
-/// [`UNROLLED_ORDERS`] run as code compiled for each order.
-pub const UNROLLED_CAPACITY: usize = UNROLLED_ORDERS + 1;
 
 /// `Σ_{j=from}^{to} a[j] b[k − j]` (`from ≤ to ≤ k`), in increasing `j`.
 ///
@@ -589,11 +582,11 @@ impl TaylorWorkspace {
     /// never shrunk (the stride `capacity` is the kernels' argument, so a longer one serves a
     /// lower order), so a method switching order between steps does not reallocate. The
     /// stride is [`UNROLLED_CAPACITY`], the one the kernels compiled for each order run with,
-    /// when [`unrolled_code_fits`], else any other (so that they do not). The
+    /// when [`TaylorProgram::unrolled_code_fits`], else any other (so that they do not). The
     /// lists of inputs and of non-constant mass-matrix entries are rebuilt in place (`n²`
     /// reads per step, next to the `O(order²)` work of the orders).
     fn fit(&mut self, program: &TaylorProgram, n: usize, order: usize) {
-        let unrolled = unrolled_code_fits(program, order);
+        let unrolled = program.unrolled_code_fits(order);
         let capacity = if unrolled {
             UNROLLED_CAPACITY
         } else if self.capacity != UNROLLED_CAPACITY && self.capacity > order {
@@ -634,53 +627,6 @@ impl TaylorWorkspace {
             }
         }
     }
-}
-
-/// Whether a step of `program` to `order` runs the kernels compiled for each order
-/// ([`run_order`]): `order ≤` [`UNROLLED_ORDERS`] and the step's unrolled code is small,
-/// `Σₖ₌₁^{order−1} (w k + ops) ≤ 2100` with `w` the convolutions per order of the program's
-/// ops (one for a product, quotient or power, two for a sine–cosine pair, …).
-///
-/// Each order is its own code, so a step runs all of it once: past what the processor's
-/// instruction cache holds, the unrolled code is slower than the loops. Measured on one
-/// machine (2 cores, 32 KiB instruction cache; time of a run against the loops', same runs):
-/// the double pendulum (24 ops, w = 12) at orders 8, 12, 15 (sizes 504, 1056, 1596) in 0.74,
-/// 0.72, 0.75, at 18 and 20 (2244, 2736) 1.09 and 1.2; the figure eight (58 ops, w = 21)
-/// at orders 8 and 12 (994, 2024) in 0.73 and 0.78, at 15 and 18 (3017, 4199) 1.1.
-pub fn unrolled_code_fits(program: &TaylorProgram, order: usize) -> bool {
-    if order > UNROLLED_ORDERS {
-        return false;
-    }
-    let w: usize = program
-        .ops
-        .iter()
-        .map(|op| match op {
-            SeriesOp::Mul { .. }
-            | SeriesOp::Div { .. }
-            | SeriesOp::ConstantDiv { .. }
-            | SeriesOp::Sqrt { .. }
-            | SeriesOp::PowConstant { .. }
-            | SeriesOp::Exp { .. }
-            | SeriesOp::Ln { .. } => 1,
-            SeriesOp::SinCos { .. }
-            | SeriesOp::SinhCosh { .. }
-            | SeriesOp::Tan { .. }
-            | SeriesOp::Tanh { .. }
-            | SeriesOp::Atan { .. } => 2,
-            SeriesOp::Asin { .. } => 3,
-            SeriesOp::Atan2 { .. } => 4,
-            SeriesOp::Neg { .. }
-            | SeriesOp::Copy { .. }
-            | SeriesOp::Add { .. }
-            | SeriesOp::Sub { .. }
-            | SeriesOp::Scale { .. }
-            | SeriesOp::DivByConstant { .. }
-            | SeriesOp::Zero { .. } => 0,
-        })
-        .sum();
-    let p = order.max(1);
-    let size = w * p * (p - 1) / 2 + program.ops.len() * (p - 1);
-    size <= 2100
 }
 
 /// The order-0 and order-`k` functions of a model's Taylor program.

@@ -351,8 +351,9 @@ fn operands(instruction: Instruction) -> Vec<Slot> {
 /// program as a `static`, or the reason there is none), `taylor_order_zero` (the extended
 /// tape as straight-line code) and `taylor_order` (one call of the op's kernel,
 /// `eomgen::__private::taylor::{mul, sin_cos, …}`, per op, with its slots as constants; in
-/// optimised builds compiled once per order `k ≤ UNROLLED_ORDERS` through
-/// `taylor::run_order`, so that each kernel's sums have a known length).
+/// optimised builds compiled once more for each order `k` a step can run unrolled
+/// (`TaylorProgram::highest_unrolled_order`), so that each kernel's sums have a known length
+/// and each coefficient a known offset, as `taylor::run_order` does for the run-time model).
 ///
 /// `parameters` are the fields of the struct, in parameter order.
 ///
@@ -503,6 +504,9 @@ pub(super) fn methods(
         })
         .collect::<Result<Vec<_>, String>>()?;
     let calls: Vec<_> = program.ops.iter().map(|op| call_tokens(op, &t)).collect();
+    // The orders whose compiled code a step can run (`TaylorProgram::unrolled_code_fits`):
+    // compiling the others would only lengthen the build.
+    let unrolled: Vec<usize> = (1..=program.highest_unrolled_order()).collect();
     Ok(quote! {
         fn taylor_program(&self) -> ::core::result::Result<&#t::TaylorProgram, #t::TaylorUnsupported> {
             #statics
@@ -527,7 +531,10 @@ pub(super) fn methods(
             #[cfg(debug_assertions)]
             #t::OrderCode::run::<0>(&__Order, __k, __c, __s);
             #[cfg(not(debug_assertions))]
-            #t::run_order(&__Order, __k, __c, __s);
+            match __k {
+                #(#unrolled if __c == #t::UNROLLED_CAPACITY => #t::OrderCode::run::<#unrolled>(&__Order, __k, __c, __s),)*
+                _ => #t::OrderCode::run::<0>(&__Order, __k, __c, __s),
+            }
         }
     })
 }
