@@ -257,12 +257,13 @@ pub struct TaylorProgram {
 
 /// The orders `k = 1 …` this many that the Taylor kernels are compiled for with `k` known
 /// (`eomgen_runtime::taylor::run_order`); higher orders run the same kernels with `k` a
-/// variable. Order 23 is what a tolerance of 10⁻¹⁸ asks for.
-pub const UNROLLED_ORDERS: usize = 24;
+/// variable. A step to order `p` computes the orders `k = 1 … p − 1` of the program, so
+/// this serves steps to order 24, what tolerances down to 10⁻²⁰ ask for.
+pub const UNROLLED_ORDERS: usize = 23;
 
-/// The stride (coefficients per slot) of a workspace whose orders up to [`UNROLLED_ORDERS`]
-/// run as the code compiled for each order.
-pub const UNROLLED_CAPACITY: usize = UNROLLED_ORDERS + 1;
+/// The stride (coefficients per slot) of a workspace whose steps run the code compiled for
+/// each order: orders `0 … UNROLLED_ORDERS + 1`.
+pub const UNROLLED_CAPACITY: usize = UNROLLED_ORDERS + 2;
 
 /// The largest [`TaylorProgram::unrolled_code_size`] of a step that runs the code compiled
 /// for each order (see [`TaylorProgram::unrolled_code_fits`]).
@@ -272,7 +273,7 @@ impl TaylorProgram {
     /// The size of the code compiled for each order that a step to `order` runs, in
     /// convolution terms and ops: `Σₖ₌₁^{order−1} (w k + ops)` with `w` the convolutions per
     /// order of the program's ops (one for a product, quotient or power, two for a
-    /// sine–cosine pair, …).
+    /// sine–cosine pair, …, five for `atan2`).
     pub fn unrolled_code_size(&self, order: usize) -> usize {
         let w: usize = self
             .ops
@@ -291,7 +292,7 @@ impl TaylorProgram {
                 | SeriesOp::Tanh { .. }
                 | SeriesOp::Atan { .. } => 2,
                 SeriesOp::Asin { .. } => 3,
-                SeriesOp::Atan2 { .. } => 4,
+                SeriesOp::Atan2 { .. } => 5,
                 SeriesOp::Neg { .. }
                 | SeriesOp::Copy { .. }
                 | SeriesOp::Add { .. }
@@ -306,7 +307,8 @@ impl TaylorProgram {
     }
 
     /// Whether a step to `order` runs the kernels compiled for each order: `order ≤`
-    /// [`UNROLLED_ORDERS`] and [`Self::unrolled_code_size`] `≤` [`UNROLLED_CODE_BUDGET`].
+    /// [`UNROLLED_ORDERS`]` + 1` and [`Self::unrolled_code_size`] `≤`
+    /// [`UNROLLED_CODE_BUDGET`].
     ///
     /// Each order is its own code, so a step runs all of it once: past what the processor's
     /// instruction cache holds, the unrolled code is slower than the loops. Measured on one
@@ -316,13 +318,13 @@ impl TaylorProgram {
     /// the figure eight (58 ops, w = 21) at orders 8 and 12 (994, 2024) in 0.73 and 0.78, at
     /// 15 and 18 (3017, 4199) 1.1×.
     pub fn unrolled_code_fits(&self, order: usize) -> bool {
-        order <= UNROLLED_ORDERS && self.unrolled_code_size(order) <= UNROLLED_CODE_BUDGET
+        order <= UNROLLED_ORDERS + 1 && self.unrolled_code_size(order) <= UNROLLED_CODE_BUDGET
     }
 
     /// The highest order `k` whose code compiled for `k` a step of this program can run: the
     /// order below the highest that [`Self::unrolled_code_fits`] (0 if none).
     pub fn highest_unrolled_order(&self) -> usize {
-        (2..=UNROLLED_ORDERS)
+        (2..=UNROLLED_ORDERS + 1)
             .take_while(|&p| self.unrolled_code_fits(p))
             .last()
             .map_or(0, |p| p - 1)
@@ -414,9 +416,6 @@ mod tests {
         assert_eq!(p.highest_unrolled_order(), 16);
         // A program too large for any unrolled order, and an empty one.
         assert_eq!(program(2000, 0, 0).highest_unrolled_order(), 0);
-        assert_eq!(
-            program(0, 0, 0).highest_unrolled_order(),
-            UNROLLED_ORDERS - 1
-        );
+        assert_eq!(program(0, 0, 0).highest_unrolled_order(), UNROLLED_ORDERS);
     }
 }

@@ -12,9 +12,10 @@
 //! — one `L D Lᵀ` factorisation of `M^[0]` per step, one pair of triangular solves per order.
 //! [`series_of_motion`] runs that loop over a model's two generated functions (order 0: the
 //! model's own evaluation, every value kept; order `k ≥ 1`: its [`SeriesOp`]s), for compiled
-//! models and models compiled at run time alike; [`evaluate_order`] is the one definition of
-//! each recurrence, which the `model!` macro's code inlines op by op and the run-time model
-//! calls, so both compute the same bits.
+//! models and models compiled at run time alike. Each recurrence is defined once, as the
+//! kernel of its op (`mul`, `sin_cos`, …): the `model!` macro's code calls the kernels op by
+//! op with its slots as constants, the run-time model reaches them through [`apply`]
+//! ([`evaluate_order`]), so both compute the same bits.
 //!
 //! # Source
 //! Jorba & Zou, *A software package for the numerical integration of ODEs by means of
@@ -49,6 +50,7 @@ fn series(s: &[f64], capacity: usize, slot: Slot) -> &[f64] {
 /// same bits.
 #[inline(always)]
 const fn known<const K: usize>(k: usize, c: usize) -> (usize, usize) {
+    debug_assert!(K == 0 || (k == K && c == UNROLLED_CAPACITY));
     if K == 0 {
         (k, c)
     } else {
@@ -546,8 +548,8 @@ pub fn run_order(code: &impl OrderCode, k: usize, capacity: usize, s: &mut [f64]
             }
         };
     }
-    const _: () = assert!(UNROLLED_ORDERS == 24);
-    orders!(1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23 24)
+    const _: () = assert!(UNROLLED_ORDERS == 23);
+    orders!(1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23)
 }
 
 /// The buffers of [`series_of_motion`], allocated on first use and grown when a higher order
@@ -599,10 +601,16 @@ impl TaylorWorkspace {
             || self.series.len() != program.slots * capacity
             || self.accelerations.len() != n * capacity
         {
+            // The contents need not survive (each step writes before it reads): a stride
+            // switching between steps reuses the allocations.
             self.capacity = capacity;
-            self.series = vec![0.0; program.slots * capacity];
-            self.accelerations = vec![0.0; n * capacity];
-            self.reciprocals = (0..capacity).map(|k| 1.0 / (k + 1) as f64).collect();
+            self.series.clear();
+            self.series.resize(program.slots * capacity, 0.0);
+            self.accelerations.clear();
+            self.accelerations.resize(n * capacity, 0.0);
+            self.reciprocals.clear();
+            self.reciprocals
+                .extend((0..capacity).map(|k| 1.0 / (k + 1) as f64));
         }
         self.lower.resize(n * n, 0.0);
         self.pivots.resize(n, 0.0);
@@ -676,6 +684,12 @@ pub fn series_of_motion(
     } = workspace;
     let out = &mut out[..(order + 1) * dim];
     out[..dim].copy_from_slice(&y[..dim]);
+    if order == 0 {
+        return match out.iter().position(|v| !v.is_finite()) {
+            Some(at) => Err(RhsError::NonFinite { index: at }),
+            None => Ok(()),
+        };
+    }
     // Order 0: the state, t, the model's own evaluation and M⁰'s factors.
     for &(slot, index) in inputs.iter() {
         s[slot as usize * c] = y[index as usize];
@@ -758,13 +772,15 @@ impl Orders<'_> {
     ///
     /// The orders follow each other through this function (order `k + 1` of every op waits
     /// for `a^[k]`): for `n ≤` [`FIXED_DEGREES`] and `k ≤` [`UNROLLED_ORDERS`] it runs as code
-    /// compiled for that `n` and `k`, the right-hand side and the solve in registers, unless
-    /// `L` is less than half full.
+    /// compiled for that `n` and `k` (when the stride is [`UNROLLED_CAPACITY`]), the
+    /// right-hand side and the solve in registers, unless `L` has a zero below its diagonal.
     #[inline]
     fn accelerations(&mut self, k: usize, s: &mut [f64], velocities: &[f64], next: &mut [f64]) {
         let unrolled = self.c == UNROLLED_CAPACITY;
-        // A factor with few non-zero entries (a diagonal M: the figure eight's) is solved
-        // faster over its list.
+        // A factor with a zero below its diagonal is solved over the list of its non-zero
+        // entries (faster for a sparse one: the figure eight's diagonal M; and the dense
+        // loops below never meet a zero, whose `b − 0·x` would not be `b` to the bit for
+        // `b = −0` or `x` infinite).
         if 2 * self.nonzeros.len() < self.n * self.n.saturating_sub(1) {
             return self.general(k, s, velocities, next);
         }
@@ -776,14 +792,14 @@ impl Orders<'_> {
                 }
             };
         }
-        const _: () = assert!(UNROLLED_ORDERS == 24 && FIXED_DEGREES == 6);
+        const _: () = assert!(UNROLLED_ORDERS == 23 && FIXED_DEGREES == 6);
         match self.n {
-            1 => orders!(1; 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23 24),
-            2 => orders!(2; 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23 24),
-            3 => orders!(3; 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23 24),
-            4 => orders!(4; 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23 24),
-            5 => orders!(5; 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23 24),
-            6 => orders!(6; 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23 24),
+            1 => orders!(1; 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23),
+            2 => orders!(2; 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23),
+            3 => orders!(3; 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23),
+            4 => orders!(4; 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23),
+            5 => orders!(5; 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23),
+            6 => orders!(6; 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23),
             _ => self.general(k, s, velocities, next),
         }
     }
@@ -803,7 +819,7 @@ impl Orders<'_> {
             *r = s[slot as usize * c + k];
         }
         coupled_sums::<K>(k, c, s, self.coupled, self.acc, &mut b);
-        // L z = b, z ← D⁻¹ z, Lᵀ x = z, with L dense (its zeros give exact zeros).
+        // L z = b, z ← D⁻¹ z, Lᵀ x = z, with L full (no zero below its diagonal).
         let lower = &self.lower[..N * N];
         for i in 0..N {
             for j in 0..i {
@@ -838,7 +854,7 @@ impl Orders<'_> {
                 }
             };
         }
-        orders!(1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23 24);
+        orders!(1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23);
         solve(self.nonzeros, self.inverse_pivots, b);
         self.next_order(k, c, s, b, velocities, next);
         self.rhs = b;
