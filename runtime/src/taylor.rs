@@ -45,7 +45,7 @@ fn series(s: &[f64], capacity: usize, slot: Slot) -> &[f64] {
 /// [`UNROLLED_CAPACITY`] (as [`series_of_motion`]'s is when [`TaylorProgram::unrolled_code_fits`]): the
 /// sums then have a known number of terms and unroll into straight-line code, and every
 /// coefficient is at a known offset, so the compiler passes an op's result to the next in a
-/// register instead of through memory (a double-pendulum run at 10⁻⁹ in 0.72 of the time,
+/// register instead of through memory (a double-pendulum run at 10⁻⁹ in 0.71 of the time,
 /// same runs). Both variants run the same operations in the same order, so they compute the
 /// same bits.
 #[inline(always)]
