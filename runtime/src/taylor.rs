@@ -37,6 +37,15 @@ fn series(s: &[f64], capacity: usize, slot: Slot) -> &[f64] {
     &s[start..start + capacity]
 }
 
+/// `$m!($($arg)*; 1 2 … 23)`: the orders compiled with `k` known ([`UNROLLED_ORDERS`]), one
+/// list for every dispatch on the order.
+macro_rules! unrolled_orders {
+    ($m:ident $(, $arg:tt)*) => {{
+        const _: () = assert!(UNROLLED_ORDERS == 23);
+        $m!($($arg)*; 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23)
+    }};
+}
+
 /// The order and the stride a kernel computes with: `(K, UNROLLED_CAPACITY)` when `K` is not
 /// 0, else `(k, c)`.
 ///
@@ -154,10 +163,8 @@ pub fn apply<const K: usize>(op: SeriesOp, k: usize, capacity: usize, s: &mut [f
 #[inline(always)]
 pub fn neg<const K: usize>(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot) {
     let (k, c) = known::<K>(k, c);
-    let kf = k as f64;
     let at = |s: &[f64], x: Slot, i: usize| s[x as usize * c + i];
     let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
-    let _ = (kf, at);
     let v = -at(s, a, k);
     write(s, out, v);
 }
@@ -166,10 +173,8 @@ pub fn neg<const K: usize>(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot
 #[inline(always)]
 pub fn copy<const K: usize>(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot) {
     let (k, c) = known::<K>(k, c);
-    let kf = k as f64;
     let at = |s: &[f64], x: Slot, i: usize| s[x as usize * c + i];
     let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
-    let _ = (kf, at);
     let v = at(s, a, k);
     write(s, out, v);
 }
@@ -178,10 +183,8 @@ pub fn copy<const K: usize>(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slo
 #[inline(always)]
 pub fn add<const K: usize>(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot, b: Slot) {
     let (k, c) = known::<K>(k, c);
-    let kf = k as f64;
     let at = |s: &[f64], x: Slot, i: usize| s[x as usize * c + i];
     let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
-    let _ = (kf, at);
     let v = at(s, a, k) + at(s, b, k);
     write(s, out, v);
 }
@@ -190,10 +193,8 @@ pub fn add<const K: usize>(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot
 #[inline(always)]
 pub fn sub<const K: usize>(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot, b: Slot) {
     let (k, c) = known::<K>(k, c);
-    let kf = k as f64;
     let at = |s: &[f64], x: Slot, i: usize| s[x as usize * c + i];
     let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
-    let _ = (kf, at);
     let v = at(s, a, k) - at(s, b, k);
     write(s, out, v);
 }
@@ -202,10 +203,7 @@ pub fn sub<const K: usize>(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot
 #[inline(always)]
 pub fn mul<const K: usize>(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot, b: Slot) {
     let (k, c) = known::<K>(k, c);
-    let kf = k as f64;
-    let at = |s: &[f64], x: Slot, i: usize| s[x as usize * c + i];
     let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
-    let _ = (kf, at);
     let v = cauchy(series(s, c, a), series(s, c, b), k);
     write(s, out, v);
 }
@@ -221,10 +219,8 @@ pub fn scale<const K: usize>(
     constant: Slot,
 ) {
     let (k, c) = known::<K>(k, c);
-    let kf = k as f64;
     let at = |s: &[f64], x: Slot, i: usize| s[x as usize * c + i];
     let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
-    let _ = (kf, at);
     let v = at(s, a, k) * at(s, constant, 0);
     write(s, out, v);
 }
@@ -233,10 +229,8 @@ pub fn scale<const K: usize>(
 #[inline(always)]
 pub fn div<const K: usize>(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot, b: Slot) {
     let (k, c) = known::<K>(k, c);
-    let kf = k as f64;
     let at = |s: &[f64], x: Slot, i: usize| s[x as usize * c + i];
     let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
-    let _ = (kf, at);
     let sum = convolution(series(s, c, b), series(s, c, out), k, 1, k);
     let v = (at(s, a, k) - sum) / at(s, b, 0);
     write(s, out, v);
@@ -253,10 +247,8 @@ pub fn div_by_constant<const K: usize>(
     constant: Slot,
 ) {
     let (k, c) = known::<K>(k, c);
-    let kf = k as f64;
     let at = |s: &[f64], x: Slot, i: usize| s[x as usize * c + i];
     let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
-    let _ = (kf, at);
     let v = at(s, a, k) / at(s, constant, 0);
     write(s, out, v);
 }
@@ -265,10 +257,8 @@ pub fn div_by_constant<const K: usize>(
 #[inline(always)]
 pub fn constant_div<const K: usize>(k: usize, c: usize, s: &mut [f64], out: Slot, b: Slot) {
     let (k, c) = known::<K>(k, c);
-    let kf = k as f64;
     let at = |s: &[f64], x: Slot, i: usize| s[x as usize * c + i];
     let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
-    let _ = (kf, at);
     let sum = convolution(series(s, c, b), series(s, c, out), k, 1, k);
     let v = -sum / at(s, b, 0);
     write(s, out, v);
@@ -278,10 +268,8 @@ pub fn constant_div<const K: usize>(k: usize, c: usize, s: &mut [f64], out: Slot
 #[inline(always)]
 pub fn sqrt<const K: usize>(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot) {
     let (k, c) = known::<K>(k, c);
-    let kf = k as f64;
     let at = |s: &[f64], x: Slot, i: usize| s[x as usize * c + i];
     let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
-    let _ = (kf, at);
     let o = series(s, c, out);
     let sum = if k > 1 {
         convolution(o, o, k, 1, k - 1)
@@ -306,7 +294,6 @@ pub fn pow_constant<const K: usize>(
     let kf = k as f64;
     let at = |s: &[f64], x: Slot, i: usize| s[x as usize * c + i];
     let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
-    let _ = (kf, at);
     let alpha = at(s, exponent, 0);
     let (x, o) = (series(s, c, a), series(s, c, out));
     // Decreasing j: the term with x[k], this order's, comes last (see `cauchy`).
@@ -323,9 +310,7 @@ pub fn pow_constant<const K: usize>(
 pub fn exp<const K: usize>(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot) {
     let (k, c) = known::<K>(k, c);
     let kf = k as f64;
-    let at = |s: &[f64], x: Slot, i: usize| s[x as usize * c + i];
     let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
-    let _ = (kf, at);
     let v = weighted_convolution(series(s, c, a), series(s, c, out), k, 1, k) * (1.0 / kf);
     write(s, out, v);
 }
@@ -335,9 +320,7 @@ pub fn exp<const K: usize>(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot
 pub fn ln<const K: usize>(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot) {
     let (k, c) = known::<K>(k, c);
     let kf = k as f64;
-    let at = |s: &[f64], x: Slot, i: usize| s[x as usize * c + i];
     let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
-    let _ = (kf, at);
     let (x, o) = (series(s, c, a), series(s, c, out));
     let sum = if k > 1 {
         weighted_convolution(o, x, k, 1, k - 1)
@@ -353,9 +336,7 @@ pub fn ln<const K: usize>(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot)
 pub fn sin_cos<const K: usize>(k: usize, c: usize, s: &mut [f64], sin: Slot, cos: Slot, a: Slot) {
     let (k, c) = known::<K>(k, c);
     let kf = k as f64;
-    let at = |s: &[f64], x: Slot, i: usize| s[x as usize * c + i];
     let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
-    let _ = (kf, at);
     let x = series(s, c, a);
     let vs = weighted_convolution(x, series(s, c, cos), k, 1, k) * (1.0 / kf);
     let vc = -weighted_convolution(x, series(s, c, sin), k, 1, k) * (1.0 / kf);
@@ -375,9 +356,7 @@ pub fn sinh_cosh<const K: usize>(
 ) {
     let (k, c) = known::<K>(k, c);
     let kf = k as f64;
-    let at = |s: &[f64], x: Slot, i: usize| s[x as usize * c + i];
     let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
-    let _ = (kf, at);
     let x = series(s, c, a);
     let vs = weighted_convolution(x, series(s, c, cosh), k, 1, k) * (1.0 / kf);
     let vc = weighted_convolution(x, series(s, c, sinh), k, 1, k) * (1.0 / kf);
@@ -398,9 +377,7 @@ pub fn tan_or_tanh<const K: usize>(
 ) {
     let (k, c) = known::<K>(k, c);
     let kf = k as f64;
-    let at = |s: &[f64], x: Slot, i: usize| s[x as usize * c + i];
     let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
-    let _ = (kf, at);
     let x = series(s, c, a);
     let v = x[k] + sign * (weighted_convolution(x, series(s, c, square), k, 1, k) * (1.0 / kf));
     write(s, out, v);
@@ -422,9 +399,7 @@ pub fn asin<const K: usize>(
 ) {
     let (k, c) = known::<K>(k, c);
     let kf = k as f64;
-    let at = |s: &[f64], x: Slot, i: usize| s[x as usize * c + i];
     let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
-    let _ = (kf, at);
     let x = series(s, c, a);
     let a2 = cauchy(x, x, k);
     let r = series(s, c, root);
@@ -450,9 +425,7 @@ pub fn asin<const K: usize>(
 pub fn atan<const K: usize>(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot, square: Slot) {
     let (k, c) = known::<K>(k, c);
     let kf = k as f64;
-    let at = |s: &[f64], x: Slot, i: usize| s[x as usize * c + i];
     let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
-    let _ = (kf, at);
     let x = series(s, c, a);
     let q = cauchy(x, x, k);
     write(s, square, q);
@@ -479,9 +452,7 @@ pub fn atan2<const K: usize>(
 ) {
     let (k, c) = known::<K>(k, c);
     let kf = k as f64;
-    let at = |s: &[f64], x: Slot, i: usize| s[x as usize * c + i];
     let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
-    let _ = (kf, at);
     let (ys, xs) = (series(s, c, y), series(s, c, x));
     let nk = cauchy(xs, xs, k) + cauchy(ys, ys, k);
     let cross = weighted_convolution(ys, xs, k, 1, k) - weighted_convolution(xs, ys, k, 1, k);
@@ -500,10 +471,7 @@ pub fn atan2<const K: usize>(
 #[inline(always)]
 pub fn zero<const K: usize>(k: usize, c: usize, s: &mut [f64], out: Slot) {
     let (k, c) = known::<K>(k, c);
-    let kf = k as f64;
-    let at = |s: &[f64], x: Slot, i: usize| s[x as usize * c + i];
     let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
-    let _ = (kf, at);
     write(s, out, 0.0);
 }
 
@@ -541,15 +509,14 @@ pub fn run_order(code: &impl OrderCode, k: usize, capacity: usize, s: &mut [f64]
         return code.run::<0>(k, capacity, s);
     }
     macro_rules! orders {
-        ($($order:literal)*) => {
+        (; $($order:literal)*) => {
             match k {
                 $($order => code.run::<$order>(k, capacity, s),)*
                 _ => code.run::<0>(k, capacity, s),
             }
         };
     }
-    const _: () = assert!(UNROLLED_ORDERS == 23);
-    orders!(1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23)
+    unrolled_orders!(orders)
 }
 
 /// The buffers of [`series_of_motion`], allocated on first use and grown when a higher order
@@ -792,14 +759,14 @@ impl Orders<'_> {
                 }
             };
         }
-        const _: () = assert!(UNROLLED_ORDERS == 23 && FIXED_DEGREES == 6);
+        const _: () = assert!(FIXED_DEGREES == 6);
         match self.n {
-            1 => orders!(1; 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23),
-            2 => orders!(2; 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23),
-            3 => orders!(3; 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23),
-            4 => orders!(4; 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23),
-            5 => orders!(5; 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23),
-            6 => orders!(6; 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23),
+            1 => unrolled_orders!(orders, 1),
+            2 => unrolled_orders!(orders, 2),
+            3 => unrolled_orders!(orders, 3),
+            4 => unrolled_orders!(orders, 4),
+            5 => unrolled_orders!(orders, 5),
+            6 => unrolled_orders!(orders, 6),
             _ => self.general(k, s, velocities, next),
         }
     }
@@ -847,14 +814,14 @@ impl Orders<'_> {
         }
         let unrolled = c == UNROLLED_CAPACITY;
         macro_rules! orders {
-            ($($order:literal)*) => {
+            (; $($order:literal)*) => {
                 match k {
                     $($order if unrolled => coupled_sums::<$order>(k, c, s, self.coupled, self.acc, b),)*
                     _ => coupled_sums::<0>(k, c, s, self.coupled, self.acc, b),
                 }
             };
         }
-        orders!(1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23);
+        unrolled_orders!(orders);
         solve(self.nonzeros, self.inverse_pivots, b);
         self.next_order(k, c, s, b, velocities, next);
         self.rhs = b;

@@ -236,12 +236,12 @@ impl TaylorStepper {
         let dim = self.dim;
         let c = &self.coefficients;
         let (_, n) = self.mode(max_norm(&c[..dim]));
-        let rho = |k: usize| (n / max_norm(&c[k * dim..(k + 1) * dim])).powf(1.0 / k as f64);
         let ln_n = n.ln();
         // ln ρ_k: the radius of the last two orders as one exponential of the smaller
         // logarithm (three `ln` and one `exp` in place of two `powf` and an `exp`; in `perf`,
         // 5 % of a double-pendulum step at 1e-9 in `pow` before, 4 % in `log` and `exp`).
         let ln_rho = |k: usize| (ln_n - max_norm(&c[k * dim..(k + 1) * dim]).ln()) / k as f64;
+        let rho = |k: usize| ln_rho(k).exp();
         let p = order;
         // Jorba & Zou (and heyoka) estimate the radius of convergence from the last two
         // orders, so that a series with only odd or only even terms is not taken for one
