@@ -67,6 +67,18 @@ const fn known<const K: usize>(k: usize, c: usize) -> (usize, usize) {
     }
 }
 
+/// Order `i` of `slot`, in a workspace of stride `c`.
+#[inline(always)]
+fn at(s: &[f64], c: usize, slot: Slot, i: usize) -> f64 {
+    s[slot as usize * c + i]
+}
+
+/// Writes `v` as order `k` of `slot`, in a workspace of stride `c`.
+#[inline(always)]
+fn put(s: &mut [f64], c: usize, slot: Slot, k: usize, v: f64) {
+    s[slot as usize * c + k] = v;
+}
+
 /// `Σ_{j=from}^{to} a[j] b[k − j]` (`from ≤ to ≤ k`), in increasing `j`.
 ///
 /// The recurrences spend most of a Taylor step here, in sums of a few to twenty terms.
@@ -163,49 +175,40 @@ pub fn apply<const K: usize>(op: SeriesOp, k: usize, capacity: usize, s: &mut [f
 #[inline(always)]
 pub fn neg<const K: usize>(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot) {
     let (k, c) = known::<K>(k, c);
-    let at = |s: &[f64], x: Slot, i: usize| s[x as usize * c + i];
-    let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
-    let v = -at(s, a, k);
-    write(s, out, v);
+    let v = -at(s, c, a, k);
+    put(s, c, out, k, v);
 }
 
 /// Order `k ≥ 1` of [`SeriesOp::Copy`].
 #[inline(always)]
 pub fn copy<const K: usize>(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot) {
     let (k, c) = known::<K>(k, c);
-    let at = |s: &[f64], x: Slot, i: usize| s[x as usize * c + i];
-    let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
-    let v = at(s, a, k);
-    write(s, out, v);
+    let v = at(s, c, a, k);
+    put(s, c, out, k, v);
 }
 
 /// Order `k ≥ 1` of [`SeriesOp::Add`].
 #[inline(always)]
 pub fn add<const K: usize>(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot, b: Slot) {
     let (k, c) = known::<K>(k, c);
-    let at = |s: &[f64], x: Slot, i: usize| s[x as usize * c + i];
-    let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
-    let v = at(s, a, k) + at(s, b, k);
-    write(s, out, v);
+    let v = at(s, c, a, k) + at(s, c, b, k);
+    put(s, c, out, k, v);
 }
 
 /// Order `k ≥ 1` of [`SeriesOp::Sub`].
 #[inline(always)]
 pub fn sub<const K: usize>(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot, b: Slot) {
     let (k, c) = known::<K>(k, c);
-    let at = |s: &[f64], x: Slot, i: usize| s[x as usize * c + i];
-    let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
-    let v = at(s, a, k) - at(s, b, k);
-    write(s, out, v);
+    let v = at(s, c, a, k) - at(s, c, b, k);
+    put(s, c, out, k, v);
 }
 
 /// Order `k ≥ 1` of [`SeriesOp::Mul`].
 #[inline(always)]
 pub fn mul<const K: usize>(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot, b: Slot) {
     let (k, c) = known::<K>(k, c);
-    let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
     let v = cauchy(series(s, c, a), series(s, c, b), k);
-    write(s, out, v);
+    put(s, c, out, k, v);
 }
 
 /// Order `k ≥ 1` of [`SeriesOp::Scale`].
@@ -219,21 +222,17 @@ pub fn scale<const K: usize>(
     constant: Slot,
 ) {
     let (k, c) = known::<K>(k, c);
-    let at = |s: &[f64], x: Slot, i: usize| s[x as usize * c + i];
-    let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
-    let v = at(s, a, k) * at(s, constant, 0);
-    write(s, out, v);
+    let v = at(s, c, a, k) * at(s, c, constant, 0);
+    put(s, c, out, k, v);
 }
 
 /// Order `k ≥ 1` of [`SeriesOp::Div`].
 #[inline(always)]
 pub fn div<const K: usize>(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot, b: Slot) {
     let (k, c) = known::<K>(k, c);
-    let at = |s: &[f64], x: Slot, i: usize| s[x as usize * c + i];
-    let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
     let sum = convolution(series(s, c, b), series(s, c, out), k, 1, k);
-    let v = (at(s, a, k) - sum) / at(s, b, 0);
-    write(s, out, v);
+    let v = (at(s, c, a, k) - sum) / at(s, c, b, 0);
+    put(s, c, out, k, v);
 }
 
 /// Order `k ≥ 1` of [`SeriesOp::DivByConstant`].
@@ -247,37 +246,31 @@ pub fn div_by_constant<const K: usize>(
     constant: Slot,
 ) {
     let (k, c) = known::<K>(k, c);
-    let at = |s: &[f64], x: Slot, i: usize| s[x as usize * c + i];
-    let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
-    let v = at(s, a, k) / at(s, constant, 0);
-    write(s, out, v);
+    let v = at(s, c, a, k) / at(s, c, constant, 0);
+    put(s, c, out, k, v);
 }
 
 /// Order `k ≥ 1` of [`SeriesOp::ConstantDiv`].
 #[inline(always)]
 pub fn constant_div<const K: usize>(k: usize, c: usize, s: &mut [f64], out: Slot, b: Slot) {
     let (k, c) = known::<K>(k, c);
-    let at = |s: &[f64], x: Slot, i: usize| s[x as usize * c + i];
-    let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
     let sum = convolution(series(s, c, b), series(s, c, out), k, 1, k);
-    let v = -sum / at(s, b, 0);
-    write(s, out, v);
+    let v = -sum / at(s, c, b, 0);
+    put(s, c, out, k, v);
 }
 
 /// Order `k ≥ 1` of [`SeriesOp::Sqrt`].
 #[inline(always)]
 pub fn sqrt<const K: usize>(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot) {
     let (k, c) = known::<K>(k, c);
-    let at = |s: &[f64], x: Slot, i: usize| s[x as usize * c + i];
-    let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
     let o = series(s, c, out);
     let sum = if k > 1 {
         convolution(o, o, k, 1, k - 1)
     } else {
         0.0
     };
-    let v = (at(s, a, k) - sum) / (2.0 * o[0]);
-    write(s, out, v);
+    let v = (at(s, c, a, k) - sum) / (2.0 * o[0]);
+    put(s, c, out, k, v);
 }
 
 /// Order `k ≥ 1` of [`SeriesOp::PowConstant`].
@@ -292,9 +285,7 @@ pub fn pow_constant<const K: usize>(
 ) {
     let (k, c) = known::<K>(k, c);
     let kf = k as f64;
-    let at = |s: &[f64], x: Slot, i: usize| s[x as usize * c + i];
-    let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
-    let alpha = at(s, exponent, 0);
+    let alpha = at(s, c, exponent, 0);
     let (x, o) = (series(s, c, a), series(s, c, out));
     // Decreasing j: the term with x[k], this order's, comes last (see `cauchy`).
     let mut sum = 0.0;
@@ -302,7 +293,7 @@ pub fn pow_constant<const K: usize>(
         sum += (kf * alpha - j as f64 * (alpha + 1.0)) * x[k - j] * o[j];
     }
     let v = sum / (kf * x[0]);
-    write(s, out, v);
+    put(s, c, out, k, v);
 }
 
 /// Order `k ≥ 1` of [`SeriesOp::Exp`].
@@ -310,9 +301,8 @@ pub fn pow_constant<const K: usize>(
 pub fn exp<const K: usize>(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot) {
     let (k, c) = known::<K>(k, c);
     let kf = k as f64;
-    let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
     let v = weighted_convolution(series(s, c, a), series(s, c, out), k, 1, k) * (1.0 / kf);
-    write(s, out, v);
+    put(s, c, out, k, v);
 }
 
 /// Order `k ≥ 1` of [`SeriesOp::Ln`].
@@ -320,7 +310,6 @@ pub fn exp<const K: usize>(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot
 pub fn ln<const K: usize>(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot) {
     let (k, c) = known::<K>(k, c);
     let kf = k as f64;
-    let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
     let (x, o) = (series(s, c, a), series(s, c, out));
     let sum = if k > 1 {
         weighted_convolution(o, x, k, 1, k - 1)
@@ -328,7 +317,7 @@ pub fn ln<const K: usize>(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot)
         0.0
     };
     let v = (kf * x[k] - sum) / (kf * x[0]);
-    write(s, out, v);
+    put(s, c, out, k, v);
 }
 
 /// Order `k ≥ 1` of [`SeriesOp::SinCos`].
@@ -336,12 +325,11 @@ pub fn ln<const K: usize>(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot)
 pub fn sin_cos<const K: usize>(k: usize, c: usize, s: &mut [f64], sin: Slot, cos: Slot, a: Slot) {
     let (k, c) = known::<K>(k, c);
     let kf = k as f64;
-    let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
     let x = series(s, c, a);
     let vs = weighted_convolution(x, series(s, c, cos), k, 1, k) * (1.0 / kf);
     let vc = -weighted_convolution(x, series(s, c, sin), k, 1, k) * (1.0 / kf);
-    write(s, sin, vs);
-    write(s, cos, vc);
+    put(s, c, sin, k, vs);
+    put(s, c, cos, k, vc);
 }
 
 /// Order `k ≥ 1` of [`SeriesOp::SinhCosh`].
@@ -356,12 +344,11 @@ pub fn sinh_cosh<const K: usize>(
 ) {
     let (k, c) = known::<K>(k, c);
     let kf = k as f64;
-    let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
     let x = series(s, c, a);
     let vs = weighted_convolution(x, series(s, c, cosh), k, 1, k) * (1.0 / kf);
     let vc = weighted_convolution(x, series(s, c, sinh), k, 1, k) * (1.0 / kf);
-    write(s, sinh, vs);
-    write(s, cosh, vc);
+    put(s, c, sinh, k, vs);
+    put(s, c, cosh, k, vc);
 }
 
 /// Order `k ≥ 1` of `tan a` (`sign = 1`) or `tanh a` (`sign = −1`), with `square` its square: [`SeriesOp::Tan`], [`SeriesOp::Tanh`].
@@ -377,13 +364,12 @@ pub fn tan_or_tanh<const K: usize>(
 ) {
     let (k, c) = known::<K>(k, c);
     let kf = k as f64;
-    let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
     let x = series(s, c, a);
     let v = x[k] + sign * (weighted_convolution(x, series(s, c, square), k, 1, k) * (1.0 / kf));
-    write(s, out, v);
+    put(s, c, out, k, v);
     let o = series(s, c, out);
     let q = cauchy(o, o, k);
-    write(s, square, q);
+    put(s, c, square, k, q);
 }
 
 /// Order `k ≥ 1` of [`SeriesOp::Asin`].
@@ -399,7 +385,6 @@ pub fn asin<const K: usize>(
 ) {
     let (k, c) = known::<K>(k, c);
     let kf = k as f64;
-    let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
     let x = series(s, c, a);
     let a2 = cauchy(x, x, k);
     let r = series(s, c, root);
@@ -416,8 +401,8 @@ pub fn asin<const K: usize>(
         0.0
     };
     let v = (sign * kf * x[k] - sum) / (kf * r[0]);
-    write(s, root, rk);
-    write(s, out, v);
+    put(s, c, root, k, rk);
+    put(s, c, out, k, v);
 }
 
 /// Order `k ≥ 1` of [`SeriesOp::Atan`].
@@ -425,10 +410,9 @@ pub fn asin<const K: usize>(
 pub fn atan<const K: usize>(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot, square: Slot) {
     let (k, c) = known::<K>(k, c);
     let kf = k as f64;
-    let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
     let x = series(s, c, a);
     let q = cauchy(x, x, k);
-    write(s, square, q);
+    put(s, c, square, k, q);
     let (x, sq) = (series(s, c, a), series(s, c, square));
     let sum = if k > 1 {
         weighted_convolution(series(s, c, out), sq, k, 1, k - 1)
@@ -436,7 +420,7 @@ pub fn atan<const K: usize>(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slo
         0.0
     };
     let v = (kf * x[k] - sum) / (kf * (1.0 + sq[0]));
-    write(s, out, v);
+    put(s, c, out, k, v);
 }
 
 /// Order `k ≥ 1` of [`SeriesOp::Atan2`].
@@ -452,11 +436,10 @@ pub fn atan2<const K: usize>(
 ) {
     let (k, c) = known::<K>(k, c);
     let kf = k as f64;
-    let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
     let (ys, xs) = (series(s, c, y), series(s, c, x));
     let nk = cauchy(xs, xs, k) + cauchy(ys, ys, k);
     let cross = weighted_convolution(ys, xs, k, 1, k) - weighted_convolution(xs, ys, k, 1, k);
-    write(s, norm, nk);
+    put(s, c, norm, k, nk);
     let ns = series(s, c, norm);
     let sum = if k > 1 {
         weighted_convolution(series(s, c, out), ns, k, 1, k - 1)
@@ -464,15 +447,14 @@ pub fn atan2<const K: usize>(
         0.0
     };
     let v = (cross - sum) / (kf * ns[0]);
-    write(s, out, v);
+    put(s, c, out, k, v);
 }
 
 /// Order `k ≥ 1` of [`SeriesOp::Zero`].
 #[inline(always)]
 pub fn zero<const K: usize>(k: usize, c: usize, s: &mut [f64], out: Slot) {
     let (k, c) = known::<K>(k, c);
-    let write = |s: &mut [f64], x: Slot, v: f64| s[x as usize * c + k] = v;
-    write(s, out, 0.0);
+    put(s, c, out, k, 0.0);
 }
 
 /// Order `k ≥ 1` of every series of `ops`, in order ([`apply`] for each, with the order
