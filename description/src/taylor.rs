@@ -321,6 +321,42 @@ impl TaylorProgram {
         order <= UNROLLED_ORDERS + 1 && self.unrolled_code_size(order) <= UNROLLED_CODE_BUDGET
     }
 
+    /// Appends to `out` `(row, column, slot)` for each entry of `M` that is not constant,
+    /// row by row: the terms of `Σⱼ₌₁ᵏ M^[j] a^[k−j]` in the solve of each order (a constant
+    /// entry has no `M^[j]` for `j ≥ 1`). Into a caller's buffer: a step rebuilds the list
+    /// without allocating.
+    pub fn push_varying_mass_entries(&self, out: &mut Vec<(u32, u32, Slot)>) {
+        let n = self.forcing.len();
+        for i in 0..n {
+            for l in 0..n {
+                let slot = self.mass_matrix[i + l * n];
+                if !self.constant[slot as usize] {
+                    out.push((i as u32, l as u32, slot));
+                }
+            }
+        }
+    }
+
+    /// Appends to `out` `(slot, state index)` for each input the equations read: `qᵢ`
+    /// (index `i`) then `q̇ᵢ` (index `n + i`) for each coordinate in turn.
+    pub fn push_inputs(&self, out: &mut Vec<(Slot, u32)>) {
+        let n = self.forcing.len();
+        for i in 0..n {
+            if let Some(slot) = self.coordinates[i] {
+                out.push((slot, i as u32));
+            }
+            if let Some(slot) = self.velocities[i] {
+                out.push((slot, (n + i) as u32));
+            }
+        }
+    }
+
+    /// The slot of the series of the first acceleration `q̈₀` in a workspace of
+    /// `slots + n` series: `q̈ᵢ`'s is this plus `i`, after the program's own slots.
+    pub fn acceleration_slot(&self) -> Slot {
+        self.slots as Slot
+    }
+
     /// The highest order `k` whose code compiled for `k` a step of this program can run: the
     /// order below the highest that [`Self::unrolled_code_fits`] (0 if none).
     pub fn highest_unrolled_order(&self) -> usize {

@@ -115,6 +115,17 @@ pub trait DynMechanicalSystem {
             crate::taylor::evaluate_order(&program.ops, k, capacity, series);
         }
     }
+    /// [`MechanicalSystem::taylor_orders`].
+    fn taylor_orders(
+        &self,
+        solve: &mut crate::taylor::MotionSolve<'_>,
+        order: usize,
+        series: &mut [f64],
+        out: &mut [f64],
+    ) -> usize {
+        let _ = (solve, order, series, out);
+        1
+    }
 }
 
 /// A [`MechanicalSystem<N>`] seen as a [`DynMechanicalSystem`]: the one place where the
@@ -258,6 +269,15 @@ impl<S: MechanicalSystem<N>, const N: usize> DynMechanicalSystem for StaticSyste
     }
     fn taylor_order(&self, k: usize, capacity: usize, series: &mut [f64]) {
         self.0.taylor_order(k, capacity, series);
+    }
+    fn taylor_orders(
+        &self,
+        solve: &mut crate::taylor::MotionSolve<'_>,
+        order: usize,
+        series: &mut [f64],
+        out: &mut [f64],
+    ) -> usize {
+        self.0.taylor_orders(solve, order, series, out)
     }
 }
 

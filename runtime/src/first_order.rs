@@ -595,6 +595,15 @@ impl<S: DynMechanicalSystem + ?Sized> crate::taylor::TaylorFunctions for ModelSe
     fn order(&self, k: usize, capacity: usize, series: &mut [f64]) {
         self.system.taylor_order(k, capacity, series);
     }
+    fn orders(
+        &self,
+        solve: &mut crate::taylor::MotionSolve<'_>,
+        order: usize,
+        s: &mut [f64],
+        out: &mut [f64],
+    ) -> usize {
+        self.system.taylor_orders(solve, order, s, out)
+    }
 }
 
 /// [`OdeSystem::taylor_support`](crate::OdeSystem::taylor_support) of a first-order form:

@@ -89,8 +89,8 @@ fn put(s: &mut [f64], c: usize, slot: Slot, k: usize, v: f64) {
 /// run: the gain of the unrolled code is in the known offsets, not in the sums' latency).
 #[inline(always)]
 fn convolution(a: &[f64], b: &[f64], k: usize, from: usize, to: usize) -> f64 {
-    let a = &a[from..=to];
-    let b = &b[k - to..=k - from];
+    let a = &a[from..to + 1];
+    let b = &b[k - to..k - from + 1];
     let mut sum = 0.0;
     for (x, y) in a.iter().zip(b.iter().rev()) {
         sum += x * y;
@@ -118,8 +118,8 @@ fn cauchy(a: &[f64], b: &[f64], k: usize) -> f64 {
 /// `Σ_{j=from}^{to} j a[j] b[k − j]`, in increasing `j` (each term `(j · a[j]) · b[k − j]`).
 #[inline(always)]
 fn weighted_convolution(a: &[f64], b: &[f64], k: usize, from: usize, to: usize) -> f64 {
-    let a = &a[from..=to];
-    let b = &b[k - to..=k - from];
+    let a = &a[from..to + 1];
+    let b = &b[k - to..k - from + 1];
     let mut sum = 0.0;
     let mut j = from as f64;
     for (x, y) in a.iter().zip(b.iter().rev()) {
@@ -506,8 +506,9 @@ pub fn run_order(code: &impl OrderCode, k: usize, capacity: usize, s: &mut [f64]
 #[derive(Debug, Clone, Default)]
 pub struct TaylorWorkspace {
     capacity: usize,
+    /// The program's slots, then one per acceleration `q̈ᵢ`
+    /// ([`TaylorProgram::acceleration_slot`]).
     series: Vec<f64>,
-    accelerations: Vec<f64>,
     lower: Vec<f64>,
     pivots: Vec<f64>,
     inverse_pivots: Vec<f64>,
@@ -517,9 +518,9 @@ pub struct TaylorWorkspace {
     rhs: Vec<f64>,
     /// `1 / (k + 1)` for `k = 0 … capacity − 1`.
     reciprocals: Vec<f64>,
-    /// `(row, column, slot)` of each entry of `M` that is not constant, row by row.
+    /// [`TaylorProgram::push_varying_mass_entries`].
     coupled: Vec<(u32, u32, Slot)>,
-    /// `(slot, state index)` of each input of the program.
+    /// [`TaylorProgram::push_inputs`].
     inputs: Vec<(Slot, u32)>,
 }
 
@@ -546,17 +547,13 @@ impl TaylorWorkspace {
             // Any stride but the unrolled code's.
             (order + 1).max(UNROLLED_CAPACITY + 1)
         };
-        if self.capacity != capacity
-            || self.series.len() != program.slots * capacity
-            || self.accelerations.len() != n * capacity
-        {
+        let size = (program.slots + n) * capacity;
+        if self.capacity != capacity || self.series.len() != size {
             // The contents need not survive (each step writes before it reads): a stride
             // switching between steps reuses the allocations.
             self.capacity = capacity;
             self.series.clear();
-            self.series.resize(program.slots * capacity, 0.0);
-            self.accelerations.clear();
-            self.accelerations.resize(n * capacity, 0.0);
+            self.series.resize(size, 0.0);
             self.reciprocals.clear();
             self.reciprocals
                 .extend((0..capacity).map(|k| 1.0 / (k + 1) as f64));
@@ -566,23 +563,9 @@ impl TaylorWorkspace {
         self.inverse_pivots.resize(n, 0.0);
         self.rhs.resize(n, 0.0);
         self.coupled.clear();
-        for i in 0..n {
-            for l in 0..n {
-                let slot = program.mass_matrix[i + l * n];
-                if !program.constant[slot as usize] {
-                    self.coupled.push((i as u32, l as u32, slot));
-                }
-            }
-        }
+        program.push_varying_mass_entries(&mut self.coupled);
         self.inputs.clear();
-        for i in 0..n {
-            if let Some(slot) = program.coordinates[i] {
-                self.inputs.push((slot, i as u32));
-            }
-            if let Some(slot) = program.velocities[i] {
-                self.inputs.push((slot, (n + i) as u32));
-            }
-        }
+        program.push_inputs(&mut self.inputs);
     }
 }
 
@@ -594,6 +577,20 @@ pub trait TaylorFunctions {
     fn order_zero(&self, capacity: usize, series: &mut [f64]);
     /// Order `k ≥ 1` of every series slot.
     fn order(&self, k: usize, capacity: usize, series: &mut [f64]);
+    /// Orders `k = 1, 2, …` of every series slot, each followed by [`motion_order`], in one
+    /// function (the `model!` macro's [`MechanicalSystem::taylor_orders`](crate::MechanicalSystem::taylor_orders)),
+    /// stopping before `order`; the first order it did not compute. The default computes
+    /// none (1).
+    fn orders(
+        &self,
+        solve: &mut MotionSolve<'_>,
+        order: usize,
+        s: &mut [f64],
+        out: &mut [f64],
+    ) -> usize {
+        let _ = (solve, order, s, out);
+        1
+    }
 }
 
 /// The Taylor coefficients of the motion through `(t, y)`, `y = [q; q̇]` (`2n` entries), up
@@ -620,7 +617,6 @@ pub fn series_of_motion(
     let c = workspace.capacity;
     let TaylorWorkspace {
         series: s,
-        accelerations: acc,
         lower,
         pivots,
         inverse_pivots,
@@ -665,27 +661,38 @@ pub fn series_of_motion(
             }
         }
     }
-    let mut orders = Orders {
-        n,
-        c,
+    let layout = MotionLayout {
         forcing: &program.forcing,
-        time: program.time,
         coupled,
         inputs,
+        time: program.time,
+        accelerations: program.acceleration_slot(),
+    };
+    let mut solve = MotionSolve {
+        n,
+        c,
+        // A factor with a zero below its diagonal is solved over the list of its non-zero
+        // entries (faster for a sparse one: the figure eight's diagonal M; and the dense
+        // loops never meet a zero, whose `b − 0·x` would not be `b` to the bit for `b = −0`
+        // or `x` infinite).
+        dense: 2 * nonzeros.len() >= n * n.saturating_sub(1),
         nonzeros,
         lower,
         inverse_pivots,
         reciprocals,
         rhs,
-        acc,
     };
-    for k in 0..order {
-        if k > 0 {
-            model.order(k, c, s);
-        }
-        // Order k of q̈, order k + 1 of the state (into `out` and the input slots).
-        let (now, next) = out[k * dim..(k + 2) * dim].split_at_mut(dim);
-        orders.accelerations(k, s, &now[n..], next);
+    // Order 0 of q̈, order 1 of the state; then the model's fused orders (compiled models in
+    // optimised builds), and the rest one order at a time.
+    accelerations(&layout, &mut solve, 0, s, out);
+    let from = if order > 1 {
+        model.orders(&mut solve, order, s, out)
+    } else {
+        1
+    };
+    for k in from..order {
+        model.order(k, c, s);
+        accelerations(&layout, &mut solve, k, s, out);
     }
     match out.iter().position(|v| !v.is_finite()) {
         Some(at) => Err(RhsError::NonFinite { index: at % dim }),
@@ -693,148 +700,206 @@ pub fn series_of_motion(
     }
 }
 
-/// The per-order work of [`series_of_motion`] after a model's ops: `q̈^[k]` from `M q̈ = F` as
-/// a series, and the state's next order.
-struct Orders<'a> {
+/// Where [`motion_order`] finds the series of `F`, of the entries of `M` that vary and of
+/// the accelerations, and where it writes the state's next order: the same lists for a
+/// program whether the run-time [`series_of_motion`] builds them from the program or the
+/// `model!` macro prints them as constants (so that the compiler folds the loops over them
+/// into straight-line code).
+#[derive(Debug, Clone, Copy)]
+pub struct MotionLayout<'a> {
+    /// `F`'s slots ([`TaylorProgram::forcing`]), one per coordinate.
+    pub forcing: &'a [Slot],
+    /// [`TaylorProgram::push_varying_mass_entries`].
+    pub coupled: &'a [(u32, u32, Slot)],
+    /// [`TaylorProgram::push_inputs`].
+    pub inputs: &'a [(Slot, u32)],
+    /// [`TaylorProgram::time`].
+    pub time: Option<Slot>,
+    /// [`TaylorProgram::acceleration_slot`].
+    pub accelerations: Slot,
+}
+
+/// `M⁰`'s factor and the stride of one [`series_of_motion`], for [`motion_order`].
+#[derive(Debug)]
+pub struct MotionSolve<'a> {
     n: usize,
     c: usize,
-    forcing: &'a [Slot],
-    time: Option<Slot>,
-    coupled: &'a [(u32, u32, Slot)],
-    inputs: &'a [(Slot, u32)],
+    /// `L` has no zero below its diagonal.
+    dense: bool,
     nonzeros: &'a [(u32, u32, f64)],
     /// `L`, row-major `n × n`.
     lower: &'a [f64],
     inverse_pivots: &'a [f64],
     reciprocals: &'a [f64],
     rhs: &'a mut [f64],
-    acc: &'a mut [f64],
 }
 
-/// The largest `n` whose solves [`Orders`] compiles for a known `n` (dense `L` in registers).
+impl MotionSolve<'_> {
+    /// Whether the workspace has the stride of the code compiled for each order
+    /// ([`UNROLLED_CAPACITY`]), the one [`motion_order`] with `K ≠ 0` needs.
+    pub fn unrolled(&self) -> bool {
+        self.c == UNROLLED_CAPACITY
+    }
+}
+
+/// The largest `n` whose solves [`motion_order`] compiles for a known `n` (dense `L` in
+/// registers).
 const FIXED_DEGREES: usize = 6;
 
-impl Orders<'_> {
-    /// `a^[k]` (into `acc`), `q^[k+1] = q̇^[k] / (k + 1)` and `q̇^[k+1] = a^[k] / (k + 1)`
-    /// (into `next` and the input slots of `s`), and `t`'s order `k + 1`; `velocities` is
-    /// `q̇^[k]`.
-    ///
-    /// The orders follow each other through this function (order `k + 1` of every op waits
-    /// for `a^[k]`): for `n ≤` [`FIXED_DEGREES`] and `k ≤` [`UNROLLED_ORDERS`] it runs as code
-    /// compiled for that `n` and `k` (when the stride is [`UNROLLED_CAPACITY`]), the
-    /// right-hand side and the solve in registers, unless `L` has a zero below its diagonal.
-    #[inline]
-    fn accelerations(&mut self, k: usize, s: &mut [f64], velocities: &[f64], next: &mut [f64]) {
-        let unrolled = self.c == UNROLLED_CAPACITY;
-        // A factor with a zero below its diagonal is solved over the list of its non-zero
-        // entries (faster for a sparse one: the figure eight's diagonal M; and the dense
-        // loops below never meet a zero, whose `b − 0·x` would not be `b` to the bit for
-        // `b = −0` or `x` infinite).
-        if 2 * self.nonzeros.len() < self.n * self.n.saturating_sub(1) {
-            return self.general(k, s, velocities, next);
-        }
-        macro_rules! orders {
-            ($n:literal; $($order:literal)*) => {
-                match k {
-                    $($order if unrolled => self.fixed::<$n, $order>(k, s, velocities, next),)*
-                    _ => self.fixed::<$n, 0>(k, s, velocities, next),
-                }
-            };
-        }
-        const _: () = assert!(FIXED_DEGREES == 6);
-        match self.n {
-            1 => unrolled_orders!(orders, 1),
-            2 => unrolled_orders!(orders, 2),
-            3 => unrolled_orders!(orders, 3),
-            4 => unrolled_orders!(orders, 4),
-            5 => unrolled_orders!(orders, 5),
-            6 => unrolled_orders!(orders, 6),
-            _ => self.general(k, s, velocities, next),
-        }
+/// Order `k` of the accelerations `a` (into their slots) and order `k + 1` of the state
+/// (into `out` and the input slots), once every slot holds its orders `≤ k`: `M⁰ a^[k] =
+/// F^[k] − Σⱼ₌₁ᵏ M^[j] a^[k−j]` solved with the step's factor, `q^[k+1] = q̇^[k] / (k + 1)`,
+/// `q̇^[k+1] = a^[k] / (k + 1)`, and `t`'s order `k + 1`.
+///
+/// `N` is `n` for the solve compiled for `n` (`L` dense, in registers; `n ≤ 6`), or 0 for
+/// the solve over `L`'s non-zero entries, which the function takes anyway when `L` has a
+/// zero below its diagonal; `K` is `k` for the code compiled for that order (the workspace
+/// then has [`MotionSolve::unrolled`]'s stride), or 0. Every variant computes the same
+/// bits. The orders follow each other through this function (order `k + 1` of every op
+/// waits for `a^[k]`): the `model!` macro's code inlines it after each order's ops, with its
+/// `layout` a constant.
+///
+/// # Panics
+/// If `out` has fewer than `(k + 2) · 2n` entries, or `layout` and `s` are not those of the
+/// [`series_of_motion`] `solve` comes from.
+#[inline(always)]
+pub fn motion_order<const N: usize, const K: usize>(
+    layout: &MotionLayout<'_>,
+    solve: &mut MotionSolve<'_>,
+    k: usize,
+    s: &mut [f64],
+    out: &mut [f64],
+) {
+    if N != 0 && N <= FIXED_DEGREES && solve.dense {
+        dense_order::<N, K>(layout, solve, k, s, out);
+    } else {
+        sparse_order::<K>(layout, solve, k, s, out);
     }
+}
 
-    /// [`Self::accelerations`] for `n = N` (`k` known when `K ≠ 0`).
+/// [`motion_order`] for the run-time `n` and `k`: the variant compiled for them.
+#[inline]
+fn accelerations(
+    layout: &MotionLayout<'_>,
+    solve: &mut MotionSolve<'_>,
+    k: usize,
+    s: &mut [f64],
+    out: &mut [f64],
+) {
+    /// One variant, out of line (the dispatch would otherwise inline 6 × 24 of them).
     #[inline(never)]
-    fn fixed<const N: usize, const K: usize>(
-        &mut self,
+    fn variant<const N: usize, const K: usize>(
+        layout: &MotionLayout<'_>,
+        solve: &mut MotionSolve<'_>,
         k: usize,
         s: &mut [f64],
-        velocities: &[f64],
-        next: &mut [f64],
+        out: &mut [f64],
     ) {
-        let (k, c) = known::<K>(k, self.c);
-        let mut b = [0.0; N];
-        for (r, &slot) in b.iter_mut().zip(self.forcing) {
-            *r = s[slot as usize * c + k];
-        }
-        coupled_sums::<K>(k, c, s, self.coupled, self.acc, &mut b);
-        // L z = b, z ← D⁻¹ z, Lᵀ x = z, with L full (no zero below its diagonal).
-        let lower = &self.lower[..N * N];
-        for i in 0..N {
-            for j in 0..i {
-                b[i] -= lower[i * N + j] * b[j];
-            }
-        }
-        for (x, d) in b.iter_mut().zip(self.inverse_pivots) {
-            *x *= d;
-        }
-        for i in (0..N).rev() {
-            for j in 0..i {
-                b[j] -= lower[i * N + j] * b[i];
-            }
-        }
-        self.next_order(k, c, s, &b, velocities, next);
+        motion_order::<N, K>(layout, solve, k, s, out);
     }
-
-    /// [`Self::accelerations`] for any `n`: the solve over `L`'s non-zero entries.
-    #[inline(never)]
-    fn general(&mut self, k: usize, s: &mut [f64], velocities: &[f64], next: &mut [f64]) {
-        let c = self.c;
-        let b = std::mem::take(&mut self.rhs);
-        for (r, &slot) in b.iter_mut().zip(self.forcing) {
-            *r = s[slot as usize * c + k];
-        }
-        let unrolled = c == UNROLLED_CAPACITY;
-        macro_rules! orders {
-            (; $($order:literal)*) => {
-                match k {
-                    $($order if unrolled => coupled_sums::<$order>(k, c, s, self.coupled, self.acc, b),)*
-                    _ => coupled_sums::<0>(k, c, s, self.coupled, self.acc, b),
-                }
-            };
-        }
-        unrolled_orders!(orders);
-        solve(self.nonzeros, self.inverse_pivots, b);
-        self.next_order(k, c, s, b, velocities, next);
-        self.rhs = b;
+    let unrolled = solve.unrolled();
+    macro_rules! orders {
+        ($n:literal; $($order:literal)*) => {
+            match k {
+                $($order if unrolled => variant::<$n, $order>(layout, solve, k, s, out),)*
+                _ => variant::<$n, 0>(layout, solve, k, s, out),
+            }
+        };
     }
+    const _: () = assert!(FIXED_DEGREES == 6);
+    if !solve.dense {
+        return unrolled_orders!(orders, 0);
+    }
+    match solve.n {
+        1 => unrolled_orders!(orders, 1),
+        2 => unrolled_orders!(orders, 2),
+        3 => unrolled_orders!(orders, 3),
+        4 => unrolled_orders!(orders, 4),
+        5 => unrolled_orders!(orders, 5),
+        6 => unrolled_orders!(orders, 6),
+        _ => unrolled_orders!(orders, 0),
+    }
+}
 
-    /// Stores `a^[k] = b` and the state's order `k + 1` (see [`Self::accelerations`]).
-    #[inline(always)]
-    fn next_order(
-        &mut self,
-        k: usize,
-        c: usize,
-        s: &mut [f64],
-        b: &[f64],
-        velocities: &[f64],
-        next: &mut [f64],
-    ) {
-        let n = b.len();
-        let inverse = self.reciprocals[k];
-        let (q_next, v_next) = next.split_at_mut(n);
-        for i in 0..n {
-            self.acc[i * c + k] = b[i];
-            q_next[i] = velocities[i] * inverse;
-            v_next[i] = b[i] * inverse;
+/// [`motion_order`] with `L` dense, `n = N`.
+#[inline(always)]
+fn dense_order<const N: usize, const K: usize>(
+    layout: &MotionLayout<'_>,
+    solve: &MotionSolve<'_>,
+    k: usize,
+    s: &mut [f64],
+    out: &mut [f64],
+) {
+    let (k, c) = known::<K>(k, solve.c);
+    let mut b = [0.0; N];
+    for (r, &slot) in b.iter_mut().zip(layout.forcing) {
+        *r = at(s, c, slot, k);
+    }
+    coupled_sums::<K>(k, c, s, layout, &mut b);
+    // L z = b, z ← D⁻¹ z, Lᵀ x = z, with L full (no zero below its diagonal).
+    let lower = &solve.lower[..N * N];
+    for i in 0..N {
+        for j in 0..i {
+            b[i] -= lower[i * N + j] * b[j];
         }
-        if k + 1 < c {
-            for &(slot, index) in self.inputs {
-                s[slot as usize * c + k + 1] = next[index as usize];
-            }
-            if let Some(slot) = self.time {
-                s[slot as usize * c + k + 1] = if k == 0 { 1.0 } else { 0.0 };
-            }
+    }
+    for (x, d) in b.iter_mut().zip(solve.inverse_pivots) {
+        *x *= d;
+    }
+    for i in (0..N).rev() {
+        for j in 0..i {
+            b[j] -= lower[i * N + j] * b[i];
+        }
+    }
+    next_order(layout, solve.reciprocals, k, c, s, &b, out);
+}
+
+/// [`motion_order`] over `L`'s non-zero entries, any `n`.
+#[inline(always)]
+fn sparse_order<const K: usize>(
+    layout: &MotionLayout<'_>,
+    solve: &mut MotionSolve<'_>,
+    k: usize,
+    s: &mut [f64],
+    out: &mut [f64],
+) {
+    let (k, c) = known::<K>(k, solve.c);
+    let b = &mut *solve.rhs;
+    for (r, &slot) in b.iter_mut().zip(layout.forcing) {
+        *r = at(s, c, slot, k);
+    }
+    coupled_sums::<K>(k, c, s, layout, b);
+    self::solve(solve.nonzeros, solve.inverse_pivots, b);
+    next_order(layout, solve.reciprocals, k, c, s, b, out);
+}
+
+/// Stores `a^[k] = b` and the state's order `k + 1` (see [`motion_order`]).
+#[inline(always)]
+fn next_order(
+    layout: &MotionLayout<'_>,
+    reciprocals: &[f64],
+    k: usize,
+    c: usize,
+    s: &mut [f64],
+    b: &[f64],
+    out: &mut [f64],
+) {
+    let n = b.len();
+    let dim = 2 * n;
+    let inverse = reciprocals[k];
+    let (now, next) = out[k * dim..(k + 2) * dim].split_at_mut(dim);
+    let (q_next, v_next) = next.split_at_mut(n);
+    for i in 0..n {
+        put(s, c, layout.accelerations + i as Slot, k, b[i]);
+        q_next[i] = now[n + i] * inverse;
+        v_next[i] = b[i] * inverse;
+    }
+    if k + 1 < c {
+        for &(slot, index) in layout.inputs {
+            put(s, c, slot, k + 1, next[index as usize]);
+        }
+        if let Some(slot) = layout.time {
+            put(s, c, slot, k + 1, if k == 0 { 1.0 } else { 0.0 });
         }
     }
 }
@@ -846,22 +911,24 @@ fn coupled_sums<const K: usize>(
     k: usize,
     c: usize,
     s: &[f64],
-    coupled: &[(u32, u32, Slot)],
-    acc: &[f64],
+    layout: &MotionLayout<'_>,
     b: &mut [f64],
 ) {
     let (k, c) = known::<K>(k, c);
     if k == 0 {
         return;
     }
-    for &(i, l, slot) in coupled {
+    for &(i, l, slot) in layout.coupled {
         let m = &s[slot as usize * c + 1..][..k];
-        let a = &acc[l as usize * c..][..k];
-        let mut v = b[i as usize];
+        let a = &series(s, c, layout.accelerations + l)[..k];
+        // The sum apart from `b`, in increasing `j`: every term but the last (`M^[k] a^[0]`)
+        // and `b` (`F^[k]`) is known when the order starts, so the processor sums them while
+        // the order's ops run, and only one product and two subtractions wait for them.
+        let mut sum = 0.0;
         for (x, y) in m.iter().zip(a.iter().rev()) {
-            v -= x * y;
+            sum += x * y;
         }
-        b[i as usize] = v;
+        b[i as usize] -= sum;
     }
 }
 

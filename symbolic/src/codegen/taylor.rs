@@ -507,6 +507,17 @@ pub(super) fn methods(
     // The orders whose compiled code a step can run (`TaylorProgram::unrolled_code_fits`):
     // compiling the others would only lengthen the build.
     let unrolled: Vec<usize> = (1..=program.highest_unrolled_order()).collect();
+    // The fused orders' layout (`taylor_orders`): the lists `series_of_motion` builds from
+    // the program, as constants.
+    let n = program.forcing.len();
+    let next = unrolled.len() + 1;
+    let forcing_slots = program.forcing.iter();
+    let (mut coupled, mut inputs) = (Vec::new(), Vec::new());
+    program.push_varying_mass_entries(&mut coupled);
+    program.push_inputs(&mut inputs);
+    let coupled = coupled.iter().map(|(i, l, slot)| quote!((#i, #l, #slot)));
+    let inputs = inputs.iter().map(|(slot, index)| quote!((#slot, #index)));
+    let accelerations = program.acceleration_slot();
     Ok(quote! {
         fn taylor_program(&self) -> ::core::result::Result<&#t::TaylorProgram, #t::TaylorUnsupported> {
             #statics
@@ -535,6 +546,54 @@ pub(super) fn methods(
                 #(#unrolled if __c == #t::UNROLLED_CAPACITY => #t::OrderCode::run::<#unrolled>(&__Order, __k, __c, __s),)*
                 _ => #t::OrderCode::run::<0>(&__Order, __k, __c, __s),
             }
+        }
+        #[inline(never)]
+        fn taylor_orders(
+            &self,
+            __solve: &mut #t::MotionSolve<'_>,
+            __order: usize,
+            __s: &mut [f64],
+            __out: &mut [f64],
+        ) -> usize {
+            #[inline(always)]
+            fn __ops<const __K: usize>(__k: usize, __c: usize, __s: &mut [f64]) {
+                #(#calls)*
+            }
+            const __LAYOUT: #t::MotionLayout<'static> = #t::MotionLayout {
+                forcing: &[#(#forcing_slots),*],
+                coupled: &[#(#coupled),*],
+                inputs: &[#(#inputs),*],
+                time: #time,
+                accelerations: #accelerations,
+            };
+            if !__solve.unrolled() {
+                return 1;
+            }
+            // A known length: the compiler drops the bounds checks of the constant offsets.
+            let __s = &mut __s[..(#slots + #n) * #t::UNROLLED_CAPACITY];
+            // Debug builds run the same orders with `k` a variable (one variant to compile;
+            // the same bits).
+            #[cfg(debug_assertions)]
+            let __next = {
+                let __end = __order.min(#next);
+                for __k in 1..__end {
+                    __ops::<0>(__k, #t::UNROLLED_CAPACITY, __s);
+                    #t::motion_order::<#n, 0>(&__LAYOUT, __solve, __k, __s, __out);
+                }
+                __end.max(1)
+            };
+            #[cfg(not(debug_assertions))]
+            let __next = 'fused: {
+                #(
+                    if #unrolled >= __order {
+                        break 'fused #unrolled;
+                    }
+                    __ops::<#unrolled>(#unrolled, #t::UNROLLED_CAPACITY, __s);
+                    #t::motion_order::<#n, #unrolled>(&__LAYOUT, __solve, #unrolled, __s, __out);
+                )*
+                #next
+            };
+            __next
         }
     })
 }
