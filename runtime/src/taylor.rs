@@ -694,7 +694,16 @@ pub fn series_of_motion(
         model.order(k, c, s);
         accelerations(&layout, &mut solve, k, s, out);
     }
-    match out.iter().position(|v| !v.is_finite()) {
+    // Whether any exponent field is all ones (infinite or NaN), as one OR over the bits
+    // (vectorised; a branch per value took 3 % of a double-pendulum step), then where.
+    const EXPONENT: u64 = 0x7ff0_0000_0000_0000;
+    let any = out.iter().fold(0u64, |m, v| {
+        m | u64::from(v.to_bits() & EXPONENT == EXPONENT)
+    });
+    match (any != 0)
+        .then(|| out.iter().position(|v| !v.is_finite()))
+        .flatten()
+    {
         Some(at) => Err(RhsError::NonFinite { index: at % dim }),
         None => Ok(()),
     }
@@ -921,9 +930,11 @@ fn coupled_sums<const K: usize>(
     for &(i, l, slot) in layout.coupled {
         let m = &s[slot as usize * c + 1..][..k];
         let a = &series(s, c, layout.accelerations + l)[..k];
-        // The sum apart from `b`, in increasing `j`: every term but the last (`M^[k] a^[0]`)
-        // and `b` (`F^[k]`) is known when the order starts, so the processor sums them while
-        // the order's ops run, and only one product and two subtractions wait for them.
+        // The sum apart from `b` (`F^[k]`, the order's last value), in increasing `j`:
+        // formed while the order's ops run, then one subtraction (subtracting term by term
+        // from `b` made the whole sum wait for `F^[k]`: 3–4 % of a double-pendulum run at
+        // 10⁻⁹ and 10⁻¹²; the term of `a^[k−1]`, the newest, last instead of first: no
+        // change).
         let mut sum = 0.0;
         for (x, y) in m.iter().zip(a.iter().rev()) {
             sum += x * y;

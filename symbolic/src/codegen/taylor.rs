@@ -349,11 +349,15 @@ fn operands(instruction: Instruction) -> Vec<Slot> {
 
 /// The Taylor methods of a generated `impl MechanicalSystem<N>`: `taylor_program` (the
 /// program as a `static`, or the reason there is none), `taylor_order_zero` (the extended
-/// tape as straight-line code) and `taylor_order` (one call of the op's kernel,
-/// `eomgen::__private::taylor::{mul, sin_cos, …}`, per op, with its slots as constants; in
-/// optimised builds compiled once more for each order `k` a step can run unrolled
-/// (`TaylorProgram::highest_unrolled_order`), so that each kernel's sums have a known length
-/// and each coefficient a known offset, as `taylor::run_order` does for the run-time model).
+/// tape as straight-line code), `taylor_order` (one call of the op's kernel,
+/// `eomgen::__private::taylor::{mul, sin_cos, …}`, per op, with its slots as constants, for
+/// any order) and `taylor_orders`: in optimised builds, the orders `k = 1 …` a step can run
+/// with `k` known (`TaylorProgram::highest_unrolled_order`) in one function, each order's
+/// kernel calls compiled for that `k` (sums of a known length, coefficients at known
+/// offsets) followed by its solve (`taylor::motion_order`, with the slots of `F`, of the
+/// varying entries of `M` and of the inputs as a constant `MotionLayout`), so that the
+/// values of one order pass to the next in registers; debug builds run the same orders with
+/// `k` a variable.
 ///
 /// `parameters` are the fields of the struct, in parameter order.
 ///
@@ -530,22 +534,13 @@ pub(super) fn methods(
         }
         #[inline(never)]
         fn taylor_order(&self, __k: usize, __c: usize, __s: &mut [f64]) {
-            struct __Order;
-            impl #t::OrderCode for __Order {
-                #[inline(never)]
-                fn run<const __K: usize>(&self, __k: usize, __c: usize, __s: &mut [f64]) {
-                    #(#calls)*
-                }
+            // Any order, any stride: the orders a step runs with `k` known are in
+            // `taylor_orders` (the same bits).
+            #[inline(always)]
+            fn __ops<const __K: usize>(__k: usize, __c: usize, __s: &mut [f64]) {
+                #(#calls)*
             }
-            // Debug builds compile one variant, for any order (the unrolled ones compute the
-            // same bits, and are what optimised builds are for).
-            #[cfg(debug_assertions)]
-            #t::OrderCode::run::<0>(&__Order, __k, __c, __s);
-            #[cfg(not(debug_assertions))]
-            match __k {
-                #(#unrolled if __c == #t::UNROLLED_CAPACITY => #t::OrderCode::run::<#unrolled>(&__Order, __k, __c, __s),)*
-                _ => #t::OrderCode::run::<0>(&__Order, __k, __c, __s),
-            }
+            __ops::<0>(__k, __c, __s);
         }
         #[inline(never)]
         fn taylor_orders(
