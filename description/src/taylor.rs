@@ -253,6 +253,29 @@ pub struct TaylorProgram {
     pub constant: List<bool>,
     /// The operations of orders `k ≥ 1`, in order.
     pub ops: List<SeriesOp>,
+    /// Derived from the fields above once, for the per-step work
+    /// ([`TaylorProgram::with_derived`] fills it).
+    pub derived: DerivedLists,
+}
+
+/// What a [`TaylorProgram`]'s steps read of it besides its ops, derived from its other
+/// fields once ([`TaylorProgram::with_derived`]) rather than at every step (a tenth of a
+/// double-pendulum step's instructions went into rebuilding these).
+#[derive(Debug, Clone, PartialEq, Default, Serialize)]
+pub struct DerivedLists {
+    /// `(row, column, slot)` of each entry of `M` that is not constant, row by row: the
+    /// terms of `Σⱼ₌₁ᵏ M^[j] a^[k−j]` in the solve of each order (a constant entry has no
+    /// `M^[j]` for `j ≥ 1`).
+    pub varying_mass_entries: List<(u32, u32, Slot)>,
+    /// `(slot, state index)` of each input the equations read: `qᵢ` (index `i`) then `q̇ᵢ`
+    /// (index `n + i`) for each coordinate in turn.
+    pub inputs: List<(Slot, u32)>,
+    /// The convolutions per order of the ops: one for a product, quotient or power, two for
+    /// a sine–cosine pair, …, five for `atan2` ([`TaylorProgram::unrolled_code_size`]'s `w`).
+    pub convolutions: usize,
+    /// Whether an op has a branch point (a square root, `asin`/`acos`'s root, a power): the
+    /// runtime's `branch_step` looks at the series only then.
+    pub branch_points: bool,
 }
 
 /// The orders `k = 1 …` this many that the Taylor kernels are compiled for with `k` known
@@ -275,33 +298,7 @@ impl TaylorProgram {
     /// order of the program's ops (one for a product, quotient or power, two for a
     /// sine–cosine pair, …, five for `atan2`).
     pub fn unrolled_code_size(&self, order: usize) -> usize {
-        let w: usize = self
-            .ops
-            .iter()
-            .map(|op| match op {
-                SeriesOp::Mul { .. }
-                | SeriesOp::Div { .. }
-                | SeriesOp::ConstantDiv { .. }
-                | SeriesOp::Sqrt { .. }
-                | SeriesOp::PowConstant { .. }
-                | SeriesOp::Exp { .. }
-                | SeriesOp::Ln { .. } => 1,
-                SeriesOp::SinCos { .. }
-                | SeriesOp::SinhCosh { .. }
-                | SeriesOp::Tan { .. }
-                | SeriesOp::Tanh { .. }
-                | SeriesOp::Atan { .. } => 2,
-                SeriesOp::Asin { .. } => 3,
-                SeriesOp::Atan2 { .. } => 5,
-                SeriesOp::Neg { .. }
-                | SeriesOp::Copy { .. }
-                | SeriesOp::Add { .. }
-                | SeriesOp::Sub { .. }
-                | SeriesOp::Scale { .. }
-                | SeriesOp::DivByConstant { .. }
-                | SeriesOp::Zero { .. } => 0,
-            })
-            .sum();
+        let w = self.derived.convolutions;
         let p = order.max(1);
         w * p * (p - 1) / 2 + self.ops.len() * (p - 1)
     }
@@ -321,34 +318,41 @@ impl TaylorProgram {
         order <= UNROLLED_ORDERS + 1 && self.unrolled_code_size(order) <= UNROLLED_CODE_BUDGET
     }
 
-    /// Appends to `out` `(row, column, slot)` for each entry of `M` that is not constant,
-    /// row by row: the terms of `Σⱼ₌₁ᵏ M^[j] a^[k−j]` in the solve of each order (a constant
-    /// entry has no `M^[j]` for `j ≥ 1`). Into a caller's buffer: a step rebuilds the list
-    /// without allocating.
-    pub fn push_varying_mass_entries(&self, out: &mut Vec<(u32, u32, Slot)>) {
+    /// The program with [`Self::derived`] computed from its other fields.
+    pub fn with_derived(mut self) -> Self {
         let n = self.forcing.len();
+        let mut varying = Vec::new();
         for i in 0..n {
             for l in 0..n {
                 let slot = self.mass_matrix[i + l * n];
                 if !self.constant[slot as usize] {
-                    out.push((i as u32, l as u32, slot));
+                    varying.push((i as u32, l as u32, slot));
                 }
             }
         }
-    }
-
-    /// Appends to `out` `(slot, state index)` for each input the equations read: `qᵢ`
-    /// (index `i`) then `q̇ᵢ` (index `n + i`) for each coordinate in turn.
-    pub fn push_inputs(&self, out: &mut Vec<(Slot, u32)>) {
-        let n = self.forcing.len();
+        let mut inputs = Vec::new();
         for i in 0..n {
             if let Some(slot) = self.coordinates[i] {
-                out.push((slot, i as u32));
+                inputs.push((slot, i as u32));
             }
             if let Some(slot) = self.velocities[i] {
-                out.push((slot, (n + i) as u32));
+                inputs.push((slot, (n + i) as u32));
             }
         }
+        let convolutions = self.ops.iter().map(convolutions).sum();
+        let branch_points = self.ops.iter().any(|op| {
+            matches!(
+                op,
+                SeriesOp::Sqrt { .. } | SeriesOp::Asin { .. } | SeriesOp::PowConstant { .. }
+            )
+        });
+        self.derived = DerivedLists {
+            varying_mass_entries: List::Owned(varying),
+            inputs: List::Owned(inputs),
+            convolutions,
+            branch_points,
+        };
+        self
     }
 
     /// The slot of the series of the first acceleration `q̈₀` in a workspace of
@@ -364,6 +368,33 @@ impl TaylorProgram {
             .take_while(|&p| self.unrolled_code_fits(p))
             .last()
             .map_or(0, |p| p - 1)
+    }
+}
+
+/// The convolutions per order of one op (see [`DerivedLists::convolutions`]).
+fn convolutions(op: &SeriesOp) -> usize {
+    match op {
+        SeriesOp::Mul { .. }
+        | SeriesOp::Div { .. }
+        | SeriesOp::ConstantDiv { .. }
+        | SeriesOp::Sqrt { .. }
+        | SeriesOp::PowConstant { .. }
+        | SeriesOp::Exp { .. }
+        | SeriesOp::Ln { .. } => 1,
+        SeriesOp::SinCos { .. }
+        | SeriesOp::SinhCosh { .. }
+        | SeriesOp::Tan { .. }
+        | SeriesOp::Tanh { .. }
+        | SeriesOp::Atan { .. } => 2,
+        SeriesOp::Asin { .. } => 3,
+        SeriesOp::Atan2 { .. } => 5,
+        SeriesOp::Neg { .. }
+        | SeriesOp::Copy { .. }
+        | SeriesOp::Add { .. }
+        | SeriesOp::Sub { .. }
+        | SeriesOp::Scale { .. }
+        | SeriesOp::DivByConstant { .. }
+        | SeriesOp::Zero { .. } => 0,
     }
 }
 
@@ -435,7 +466,9 @@ mod tests {
             forcing: List::Owned(vec![]),
             constant: List::Owned(vec![false]),
             ops: List::Owned(ops),
+            derived: DerivedLists::default(),
         }
+        .with_derived()
     }
 
     /// The double pendulum's program (8 products, 2 sine–cosine pairs, 14 other ops: w = 12,
@@ -453,5 +486,48 @@ mod tests {
         // A program too large for any unrolled order, and an empty one.
         assert_eq!(program(2000, 0, 0).highest_unrolled_order(), 0);
         assert_eq!(program(0, 0, 0).highest_unrolled_order(), UNROLLED_ORDERS);
+    }
+
+    /// The derived lists of a two-coordinate program whose `M₁₁` and `M₂₂` are constant
+    /// and whose `q₁` the equations do not read: the varying entries row by row, the inputs
+    /// that exist in state order, and the weights of its ops.
+    #[test]
+    fn derived_lists_follow_the_program() {
+        let program = TaylorProgram {
+            slots: 7,
+            coordinates: List::Owned(vec![None, Some(1)]),
+            velocities: List::Owned(vec![Some(2), Some(3)]),
+            time: None,
+            // Column-major: M₁₁ = slot 4, M₂₁ = M₁₂ = slot 5, M₂₂ = slot 6.
+            mass_matrix: List::Owned(vec![4, 5, 5, 6]),
+            forcing: List::Owned(vec![0, 0]),
+            constant: List::Owned(vec![false, false, false, false, true, false, true]),
+            ops: List::Owned(vec![
+                SeriesOp::SinCos {
+                    sin: 0,
+                    cos: 5,
+                    a: 1,
+                },
+                SeriesOp::Mul { out: 0, a: 2, b: 3 },
+            ]),
+            derived: DerivedLists::default(),
+        }
+        .with_derived();
+        assert_eq!(
+            program.derived,
+            DerivedLists {
+                varying_mass_entries: List::Owned(vec![(0, 1, 5), (1, 0, 5)]),
+                inputs: List::Owned(vec![(2, 2), (1, 1), (3, 3)]),
+                convolutions: 3,
+                branch_points: false,
+            }
+        );
+        let rooted = TaylorProgram {
+            ops: List::Owned(vec![SeriesOp::Sqrt { out: 0, a: 1 }]),
+            ..program
+        }
+        .with_derived();
+        assert!(rooted.derived.branch_points);
+        assert_eq!(rooted.derived.convolutions, 1);
     }
 }

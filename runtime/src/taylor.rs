@@ -25,7 +25,8 @@
 //! with a matrix denominator.
 
 pub use eomgen_description::taylor::{
-    SeriesOp, Slot, TaylorProgram, TaylorUnsupported, UNROLLED_CAPACITY, UNROLLED_ORDERS,
+    DerivedLists, SeriesOp, Slot, TaylorProgram, TaylorUnsupported, UNROLLED_CAPACITY,
+    UNROLLED_ORDERS,
 };
 
 use crate::ode::RhsError;
@@ -518,10 +519,6 @@ pub struct TaylorWorkspace {
     rhs: Vec<f64>,
     /// `1 / (k + 1)` for `k = 0 … capacity − 1`.
     reciprocals: Vec<f64>,
-    /// [`TaylorProgram::push_varying_mass_entries`].
-    coupled: Vec<(u32, u32, Slot)>,
-    /// [`TaylorProgram::push_inputs`].
-    inputs: Vec<(Slot, u32)>,
 }
 
 impl TaylorWorkspace {
@@ -534,9 +531,7 @@ impl TaylorWorkspace {
     /// never shrunk (the stride `capacity` is the kernels' argument, so a longer one serves a
     /// lower order), so a method switching order between steps does not reallocate. The
     /// stride is [`UNROLLED_CAPACITY`], the one the kernels compiled for each order run with,
-    /// when [`TaylorProgram::unrolled_code_fits`], else any other (so that they do not). The
-    /// lists of inputs and of non-constant mass-matrix entries are rebuilt in place (`n²`
-    /// reads per step, next to the `O(order²)` work of the orders).
+    /// when [`TaylorProgram::unrolled_code_fits`], else any other (so that they do not).
     fn fit(&mut self, program: &TaylorProgram, n: usize, order: usize) {
         let unrolled = program.unrolled_code_fits(order);
         let capacity = if unrolled {
@@ -562,10 +557,6 @@ impl TaylorWorkspace {
         self.pivots.resize(n, 0.0);
         self.inverse_pivots.resize(n, 0.0);
         self.rhs.resize(n, 0.0);
-        self.coupled.clear();
-        program.push_varying_mass_entries(&mut self.coupled);
-        self.inputs.clear();
-        program.push_inputs(&mut self.inputs);
     }
 }
 
@@ -623,10 +614,9 @@ pub fn series_of_motion(
         nonzeros,
         rhs,
         reciprocals,
-        coupled,
-        inputs,
         ..
     } = workspace;
+    let inputs = &program.derived.inputs;
     let out = &mut out[..(order + 1) * dim];
     out[..dim].copy_from_slice(&y[..dim]);
     if order == 0 {
@@ -663,7 +653,7 @@ pub fn series_of_motion(
     }
     let layout = MotionLayout {
         forcing: &program.forcing,
-        coupled,
+        coupled: &program.derived.varying_mass_entries,
         inputs,
         time: program.time,
         accelerations: program.acceleration_slot(),
@@ -718,9 +708,9 @@ pub fn series_of_motion(
 pub struct MotionLayout<'a> {
     /// `F`'s slots ([`TaylorProgram::forcing`]), one per coordinate.
     pub forcing: &'a [Slot],
-    /// [`TaylorProgram::push_varying_mass_entries`].
+    /// [`DerivedLists::varying_mass_entries`].
     pub coupled: &'a [(u32, u32, Slot)],
-    /// [`TaylorProgram::push_inputs`].
+    /// [`DerivedLists::inputs`].
     pub inputs: &'a [(Slot, u32)],
     /// [`TaylorProgram::time`].
     pub time: Option<Slot>,
@@ -1026,8 +1016,9 @@ pub fn branch_step(
     order: usize,
     h: f64,
 ) -> f64 {
-    // Through a constant series the step is infinite: nothing to bound.
-    if !h.is_finite() || order == 0 {
+    // Through a constant series the step is infinite: nothing to bound; nor without a root
+    // or power.
+    if !h.is_finite() || order == 0 || !program.derived.branch_points {
         return h;
     }
     let c = workspace.capacity;

@@ -14,7 +14,7 @@
 
 use std::borrow::Cow;
 
-use eomgen_description::taylor::{SeriesOp, Slot, TaylorProgram, TaylorUnsupported};
+use eomgen_description::taylor::{DerivedLists, SeriesOp, Slot, TaylorProgram, TaylorUnsupported};
 
 use crate::expr::Func;
 
@@ -80,7 +80,9 @@ pub fn taylor_program(
         forcing: Cow::Owned(forcing.to_vec()),
         constant: Cow::Owned(constant),
         ops: Cow::Owned(ops),
-    };
+        derived: DerivedLists::default(),
+    }
+    .with_derived();
     Ok(TaylorPlan {
         program,
         order_zero,
@@ -401,6 +403,18 @@ pub(super) fn methods(
     let constant = program.constant.iter();
     let ops: Vec<_> = program.ops.iter().map(|op| op_tokens(op, &t)).collect();
     let slots = program.slots;
+    let derived = &program.derived;
+    let coupled: Vec<_> = derived
+        .varying_mass_entries
+        .iter()
+        .map(|(i, l, slot)| quote!((#i, #l, #slot)))
+        .collect();
+    let inputs: Vec<_> = derived
+        .inputs
+        .iter()
+        .map(|(slot, index)| quote!((#slot, #index)))
+        .collect();
+    let (convolutions, branch_points) = (derived.convolutions, derived.branch_points);
     let statics = quote! {
         static PROGRAM: #t::TaylorProgram = #t::TaylorProgram {
             slots: #slots,
@@ -411,6 +425,12 @@ pub(super) fn methods(
             forcing: #cow::Borrowed(&[#(#forcing),*]),
             constant: #cow::Borrowed(&[#(#constant),*]),
             ops: #cow::Borrowed(&[#(#ops),*]),
+            derived: #t::DerivedLists {
+                varying_mass_entries: #cow::Borrowed(&[#(#coupled),*]),
+                inputs: #cow::Borrowed(&[#(#inputs),*]),
+                convolutions: #convolutions,
+                branch_points: #branch_points,
+            },
         };
     };
     // Order 0: the extended tape, every value stored in its slot.
@@ -516,11 +536,6 @@ pub(super) fn methods(
     let n = program.forcing.len();
     let next = unrolled.len() + 1;
     let forcing_slots = program.forcing.iter();
-    let (mut coupled, mut inputs) = (Vec::new(), Vec::new());
-    program.push_varying_mass_entries(&mut coupled);
-    program.push_inputs(&mut inputs);
-    let coupled = coupled.iter().map(|(i, l, slot)| quote!((#i, #l, #slot)));
-    let inputs = inputs.iter().map(|(slot, index)| quote!((#slot, #index)));
     let accelerations = program.acceleration_slot();
     Ok(quote! {
         fn taylor_program(&self) -> ::core::result::Result<&#t::TaylorProgram, #t::TaylorUnsupported> {
