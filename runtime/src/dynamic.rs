@@ -124,7 +124,7 @@ pub trait DynMechanicalSystem {
         out: &mut [f64],
     ) -> usize {
         let _ = (solve, order, series, out);
-        1
+        0
     }
 }
 

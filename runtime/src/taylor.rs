@@ -568,10 +568,10 @@ pub trait TaylorFunctions {
     fn order_zero(&self, capacity: usize, series: &mut [f64]);
     /// Order `k ≥ 1` of every series slot.
     fn order(&self, k: usize, capacity: usize, series: &mut [f64]);
-    /// Orders `k = 1, 2, …` of every series slot, each followed by [`motion_order`], in one
-    /// function (the `model!` macro's [`MechanicalSystem::taylor_orders`](crate::MechanicalSystem::taylor_orders)),
-    /// stopping before `order`; the first order it did not compute. The default computes
-    /// none (1).
+    /// [`motion_order`] for `k = 0`, then orders `k = 1, 2, …` of every series slot, each
+    /// followed by its [`motion_order`], in one function (the `model!` macro's
+    /// [`MechanicalSystem::taylor_orders`](crate::MechanicalSystem::taylor_orders)), stopping
+    /// before `order`; the first order it did not compute. The default computes none (0).
     fn orders(
         &self,
         solve: &mut MotionSolve<'_>,
@@ -580,7 +580,7 @@ pub trait TaylorFunctions {
         out: &mut [f64],
     ) -> usize {
         let _ = (solve, order, s, out);
-        1
+        0
     }
 }
 
@@ -672,16 +672,13 @@ pub fn series_of_motion(
         reciprocals,
         rhs,
     };
-    // Order 0 of q̈, order 1 of the state; then the model's fused orders (compiled models in
-    // optimised builds), and the rest one order at a time.
-    accelerations(&layout, &mut solve, 0, s, out);
-    let from = if order > 1 {
-        model.orders(&mut solve, order, s, out)
-    } else {
-        1
-    };
+    // The model's fused orders (compiled models with the unrolled stride), then the rest one
+    // order at a time: order k of the ops (none at 0), of q̈, and order k + 1 of the state.
+    let from = model.orders(&mut solve, order, s, out);
     for k in from..order {
-        model.order(k, c, s);
+        if k > 0 {
+            model.order(k, c, s);
+        }
         accelerations(&layout, &mut solve, k, s, out);
     }
     // Whether any exponent field is all ones (infinite or NaN), as one OR over the bits

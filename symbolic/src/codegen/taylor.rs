@@ -577,7 +577,7 @@ pub(super) fn methods(
                 accelerations: #accelerations,
             };
             if !__solve.unrolled() {
-                return 1;
+                return 0;
             }
             // A known length: the compiler drops the bounds checks of the constant offsets.
             let __s = &mut __s[..(#slots + #n) * #t::UNROLLED_CAPACITY];
@@ -586,14 +586,20 @@ pub(super) fn methods(
             #[cfg(debug_assertions)]
             let __next = {
                 let __end = __order.min(#next);
-                for __k in 1..__end {
-                    __ops::<0>(__k, #t::UNROLLED_CAPACITY, __s);
+                for __k in 0..__end {
+                    if __k > 0 {
+                        __ops::<0>(__k, #t::UNROLLED_CAPACITY, __s);
+                    }
                     #t::motion_order::<#n, 0>(&__LAYOUT, __solve, __k, __s, __out);
                 }
-                __end.max(1)
+                __end
             };
             #[cfg(not(debug_assertions))]
             let __next = 'fused: {
+                if __order == 0 {
+                    break 'fused 0;
+                }
+                #t::motion_order::<#n, 0>(&__LAYOUT, __solve, 0, __s, __out);
                 #(
                     if #unrolled >= __order {
                         break 'fused #unrolled;
