@@ -126,6 +126,10 @@ pub trait DynMechanicalSystem {
         let _ = (solve, order, series, out);
         0
     }
+    /// [`MechanicalSystem::taylor_fused_orders`].
+    fn taylor_fused_orders(&self) -> usize {
+        0
+    }
 }
 
 /// A [`MechanicalSystem<N>`] seen as a [`DynMechanicalSystem`]: the one place where the
@@ -278,6 +282,9 @@ impl<S: MechanicalSystem<N>, const N: usize> DynMechanicalSystem for StaticSyste
         out: &mut [f64],
     ) -> usize {
         self.0.taylor_orders(solve, order, series, out)
+    }
+    fn taylor_fused_orders(&self) -> usize {
+        self.0.taylor_fused_orders()
     }
 }
 

@@ -604,6 +604,9 @@ impl<S: DynMechanicalSystem + ?Sized> crate::taylor::TaylorFunctions for ModelSe
     ) -> usize {
         self.system.taylor_orders(solve, order, s, out)
     }
+    fn fused_orders(&self) -> usize {
+        self.system.taylor_fused_orders()
+    }
 }
 
 /// [`OdeSystem::taylor_support`](crate::OdeSystem::taylor_support) of a first-order form:

@@ -200,4 +200,12 @@ pub trait MechanicalSystem<const N: usize> {
         let _ = (solve, order, series, out);
         0
     }
+
+    /// The highest order `k` [`Self::taylor_orders`] computes when `solve` has the unrolled
+    /// stride (`TaylorProgram::highest_unrolled_order` for `model!`'s code; 0, the default,
+    /// when it computes none). A step to a higher order then runs those orders fused and the
+    /// rest one at a time at the same stride.
+    fn taylor_fused_orders(&self) -> usize {
+        0
+    }
 }

@@ -532,8 +532,12 @@ impl TaylorWorkspace {
     /// lower order), so a method switching order between steps does not reallocate. The
     /// stride is [`UNROLLED_CAPACITY`], the one the kernels compiled for each order run with,
     /// when [`TaylorProgram::unrolled_code_fits`], else any other (so that they do not).
-    fn fit(&mut self, program: &TaylorProgram, n: usize, order: usize) {
-        let unrolled = program.unrolled_code_fits(order);
+    fn fit(&mut self, program: &TaylorProgram, n: usize, order: usize, fused: usize) {
+        // With fused orders (a compiled model's), those run compiled for each order and the
+        // rest as loops at the same stride, whatever the order (to its limit): the fused
+        // code alone is what must fit the instruction cache.
+        let unrolled =
+            program.unrolled_code_fits(order) || (fused > 0 && order <= UNROLLED_ORDERS + 1);
         let capacity = if unrolled {
             UNROLLED_CAPACITY
         } else if self.capacity != UNROLLED_CAPACITY && self.capacity > order {
@@ -582,6 +586,11 @@ pub trait TaylorFunctions {
         let _ = (solve, order, s, out);
         0
     }
+    /// The highest order `k` that [`Self::orders`] computes (0: it computes none; the
+    /// default).
+    fn fused_orders(&self) -> usize {
+        0
+    }
 }
 
 /// The Taylor coefficients of the motion through `(t, y)`, `y = [q; q̇]` (`2n` entries), up
@@ -604,7 +613,7 @@ pub fn series_of_motion(
     let program = model.program();
     let n = program.coordinates.len();
     let dim = 2 * n;
-    workspace.fit(program, n, order);
+    workspace.fit(program, n, order, model.fused_orders());
     let c = workspace.capacity;
     let TaylorWorkspace {
         series: s,

@@ -534,7 +534,8 @@ pub(super) fn methods(
     // The fused orders' layout (`taylor_orders`): the lists `series_of_motion` builds from
     // the program, as constants.
     let n = program.forcing.len();
-    let next = unrolled.len() + 1;
+    let highest = unrolled.len();
+    let next = highest + 1;
     let forcing_slots = program.forcing.iter();
     let accelerations = program.acceleration_slot();
     Ok(quote! {
@@ -556,6 +557,9 @@ pub(super) fn methods(
                 #(#calls)*
             }
             __ops::<0>(__k, __c, __s);
+        }
+        fn taylor_fused_orders(&self) -> usize {
+            #highest
         }
         #[inline(never)]
         fn taylor_orders(
