@@ -121,13 +121,19 @@ fn models() -> Vec<Case> {
 
 /// The coefficients of `model` at the entry's `(t, y)` and order.
 fn coefficients(entry: &Entry, model: &mut dyn ModelInfo) -> Vec<f64> {
-    coefficients_to(entry, model, entry.order)
+    coefficients_to(entry, model, entry.order, 0.0)
 }
 
-/// The coefficients of `model` at the entry's `(t, y)` to `order`.
-fn coefficients_to(entry: &Entry, model: &mut dyn ModelInfo, order: usize) -> Vec<f64> {
-    let t = number(&entry.t);
-    let y: Vec<f64> = entry.y.iter().map(|v| number(v)).collect();
+/// The coefficients of `model` to `order` at the entry's `(t, y)` moved by `shift`: `t +
+/// shift`, `yᵢ + 10⁻³ shift (i + 1)`.
+fn coefficients_to(entry: &Entry, model: &mut dyn ModelInfo, order: usize, shift: f64) -> Vec<f64> {
+    let t = number(&entry.t) + shift;
+    let y: Vec<f64> = entry
+        .y
+        .iter()
+        .enumerate()
+        .map(|(i, v)| number(v) + 1e-3 * shift * (i + 1) as f64)
+        .collect();
     assert_eq!(y.len(), entry.dim, "{}: y", entry.name);
     assert_eq!(model.num_dofs() * 2, entry.dim, "{}: dim", entry.name);
     let mut out = vec![f64::NAN; (order + 1) * entry.dim];
@@ -226,10 +232,32 @@ fn compiled_and_run_time_coefficients_are_bit_identical() {
         }
         // The reference's order, then orders that cross the code compiled for each order
         // (the compiled model's fused orders end at its `highest_unrolled_order`, at most
-        // 23) and the switches of the workspace's stride, through one workspace each.
-        for order in [entry.order, 1, 2, 3, 5, 8, 13, 17, 18, 21, 24, 25, 30, 12] {
-            let a = coefficients_to(&entry, compiled.as_mut(), order);
-            let b = coefficients_to(&entry, runtime.as_mut(), order);
+        // 23) and the switches of the workspace's stride, through one workspace each, at a
+        // state that moves from call to call (what an earlier call left in the workspace
+        // must not show).
+        let orders = [
+            entry.order,
+            1,
+            2,
+            3,
+            5,
+            8,
+            13,
+            17,
+            18,
+            21,
+            24,
+            25,
+            30,
+            12,
+            0,
+            7,
+            23,
+        ];
+        for (shift, order) in orders.into_iter().enumerate() {
+            let shift = shift as f64;
+            let a = coefficients_to(&entry, compiled.as_mut(), order, shift);
+            let b = coefficients_to(&entry, runtime.as_mut(), order, shift);
             for (j, (x, y)) in a.iter().zip(&b).enumerate() {
                 assert_eq!(
                     x.to_bits(),

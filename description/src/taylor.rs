@@ -253,8 +253,10 @@ pub struct TaylorProgram {
     pub constant: List<bool>,
     /// The operations of orders `k ≥ 1`, in order.
     pub ops: List<SeriesOp>,
-    /// Derived from the fields above once, for the per-step work
-    /// ([`TaylorProgram::with_derived`] fills it).
+    /// Derived from the fields above once, for the per-step work: must be what
+    /// [`TaylorProgram::with_derived`] fills in (a program written by hand ends with
+    /// `.with_derived()`; the runtime checks it in debug builds). Left at its default, the
+    /// series would read no state.
     pub derived: DerivedLists,
 }
 

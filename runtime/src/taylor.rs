@@ -10,9 +10,10 @@
 //! ```
 //!
 //! — one `L D Lᵀ` factorisation of `M^[0]` per step, one pair of triangular solves per order.
-//! [`series_of_motion`] runs that loop over a model's two generated functions (order 0: the
-//! model's own evaluation, every value kept; order `k ≥ 1`: its [`SeriesOp`]s), for compiled
-//! models and models compiled at run time alike. Each recurrence is defined once, as the
+//! [`series_of_motion`] runs that loop over a model's generated functions (order 0: the
+//! model's own evaluation, every value kept; order `k ≥ 1`: its [`SeriesOp`]s; and, for a
+//! compiled model, the orders a step can run compiled for each order, fused with their solves
+//! into one function), for compiled models and models compiled at run time alike. Each recurrence is defined once, as the
 //! kernel of its op (`mul`, `sin_cos`, …): the `model!` macro's code calls the kernels op by
 //! op with its slots as constants, the run-time model reaches them through [`apply`]
 //! ([`evaluate_order`]), so both compute the same bits.
@@ -50,14 +51,14 @@ macro_rules! unrolled_orders {
 /// The order and the stride a kernel computes with: `(K, UNROLLED_CAPACITY)` when `K` is not
 /// 0, else `(k, c)`.
 ///
-/// [`run_order`] (and so [`evaluate_order`] and the `model!` macro's code in optimised
-/// builds) picks `K = k` for `k ≤` [`UNROLLED_ORDERS`] when the workspace's stride is
-/// [`UNROLLED_CAPACITY`] (as [`series_of_motion`]'s is when [`TaylorProgram::unrolled_code_fits`]): the
-/// sums then have a known number of terms and unroll into straight-line code, and every
-/// coefficient is at a known offset, so the compiler passes an op's result to the next in a
-/// register instead of through memory (a double-pendulum run at 10⁻⁹ in 0.71 of the time,
-/// same runs). Both variants run the same operations in the same order, so they compute the
-/// same bits.
+/// [`run_order`] (and so [`evaluate_order`], the run-time model's orders) and the `model!`
+/// macro's `taylor_orders` in optimised builds pick `K = k` for `k ≤` [`UNROLLED_ORDERS`]
+/// when the workspace's stride is [`UNROLLED_CAPACITY`] (as [`series_of_motion`]'s is when
+/// [`TaylorProgram::unrolled_code_fits`], or the model has fused orders): the sums then have
+/// a known number of terms and unroll into straight-line code, and every coefficient is at
+/// a known offset, so the compiler passes an op's result to the next in a register instead
+/// of through memory. Both variants run the same operations in the same order, so they
+/// compute the same bits.
 #[inline(always)]
 const fn known<const K: usize>(k: usize, c: usize) -> (usize, usize) {
     debug_assert!(K == 0 || (k == K && c == UNROLLED_CAPACITY));
@@ -476,8 +477,8 @@ pub fn evaluate_order(ops: &[SeriesOp], k: usize, capacity: usize, s: &mut [f64]
 
 /// The code of one order of a program, compiled for each order `K` in `1 …`
 /// [`UNROLLED_ORDERS`] (and `K = 0`: any order, `k` read at run time) — what
-/// [`run_order`] calls. Implemented by the `model!` macro's code (its kernel calls with
-/// `::<K>`) and by [`evaluate_order`].
+/// [`run_order`] calls. Implemented by [`evaluate_order`] for the run-time model (the
+/// `model!` macro's code calls its kernels with `::<K>` in its own functions).
 pub trait OrderCode {
     /// Order `k` of every series slot (`K` is `k`, or 0).
     fn run<const K: usize>(&self, k: usize, capacity: usize, s: &mut [f64]);
@@ -625,6 +626,10 @@ pub fn series_of_motion(
         reciprocals,
         ..
     } = workspace;
+    debug_assert!(
+        program.derived == program.clone().with_derived().derived,
+        "TaylorProgram::derived is not with_derived()'s"
+    );
     let inputs = &program.derived.inputs;
     let out = &mut out[..(order + 1) * dim];
     out[..dim].copy_from_slice(&y[..dim]);
@@ -756,9 +761,9 @@ const FIXED_DEGREES: usize = 6;
 /// F^[k] − Σⱼ₌₁ᵏ M^[j] a^[k−j]` solved with the step's factor, `q^[k+1] = q̇^[k] / (k + 1)`,
 /// `q̇^[k+1] = a^[k] / (k + 1)`, and `t`'s order `k + 1`.
 ///
-/// `N` is `n` for the solve compiled for `n` (`L` dense, in registers; `n ≤ 6`), or 0 for
-/// the solve over `L`'s non-zero entries, which the function takes anyway when `L` has a
-/// zero below its diagonal; `K` is `k` for the code compiled for that order (the workspace
+/// `N` is `n` (the dense solve, `L` in registers, for `n ≤ 6`; larger `n` take the other),
+/// or 0 for the solve over `L`'s non-zero entries, which the function takes anyway when `L`
+/// has a zero below its diagonal; `K` is `k` for the code compiled for that order (the workspace
 /// then has [`MotionSolve::unrolled`]'s stride), or 0. Every variant computes the same
 /// bits. The orders follow each other through this function (order `k + 1` of every op
 /// waits for `a^[k]`): the `model!` macro's code inlines it after each order's ops, with its
