@@ -320,8 +320,14 @@ impl TaylorProgram {
         order <= UNROLLED_ORDERS + 1 && self.unrolled_code_size(order) <= UNROLLED_CODE_BUDGET
     }
 
-    /// The program with [`Self::derived`] computed from its other fields.
+    /// The program with [`Self::derived`] computed from its other fields ([`Self::derive`]).
     pub fn with_derived(mut self) -> Self {
+        self.derived = self.derive();
+        self
+    }
+
+    /// [`Self::derived`] as its other fields give it.
+    pub fn derive(&self) -> DerivedLists {
         let n = self.forcing.len();
         let mut varying = Vec::new();
         for i in 0..n {
@@ -348,13 +354,12 @@ impl TaylorProgram {
                 SeriesOp::Sqrt { .. } | SeriesOp::Asin { .. } | SeriesOp::PowConstant { .. }
             )
         });
-        self.derived = DerivedLists {
+        DerivedLists {
             varying_mass_entries: List::Owned(varying),
             inputs: List::Owned(inputs),
             convolutions,
             branch_points,
-        };
-        self
+        }
     }
 
     /// The slot of the series of the first acceleration `q̈₀` in a workspace of

@@ -627,7 +627,7 @@ pub fn series_of_motion(
         ..
     } = workspace;
     debug_assert!(
-        program.derived == program.clone().with_derived().derived,
+        program.derived == program.derive(),
         "TaylorProgram::derived is not with_derived()'s"
     );
     let inputs = &program.derived.inputs;
