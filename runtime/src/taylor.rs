@@ -12,9 +12,9 @@
 //! — one `L D Lᵀ` factorisation of `M^[0]` per step, one pair of triangular solves per order.
 //! [`series_of_motion`] runs that loop over a model's generated functions (order 0: the
 //! model's own evaluation, every value kept; order `k ≥ 1`: its [`SeriesOp`]s; and, for a
-//! compiled model, the orders a step can run compiled for each order, fused with their solves
-//! into one function), for compiled models and models compiled at run time alike. Each recurrence is defined once, as the
-//! kernel of its op (`mul`, `sin_cos`, …): the `model!` macro's code calls the kernels op by
+//! compiled model, the orders a step can run compiled for each order, fused with their
+//! solves into one function), for compiled models and models compiled at run time alike.
+//! Each recurrence is defined once, as the kernel of its op (`mul`, `sin_cos`, …): the `model!` macro's code calls the kernels op by
 //! op with its slots as constants, the run-time model reaches them through [`apply`]
 //! ([`evaluate_order`]), so both compute the same bits.
 //!
@@ -51,7 +51,7 @@ macro_rules! unrolled_orders {
 /// The order and the stride a kernel computes with: `(K, UNROLLED_CAPACITY)` when `K` is not
 /// 0, else `(k, c)`.
 ///
-/// [`run_order`] (and so [`evaluate_order`], the run-time model's orders) and the `model!`
+/// [`evaluate_order`] (the run-time model's orders) and the `model!`
 /// macro's `taylor_orders` in optimised builds pick `K = k` for `k ≤` [`UNROLLED_ORDERS`]
 /// when the workspace's stride is [`UNROLLED_CAPACITY`] (as [`series_of_motion`]'s is when
 /// [`TaylorProgram::unrolled_code_fits`], or the model has fused orders): the sums then have
@@ -87,8 +87,10 @@ fn put(s: &mut [f64], c: usize, slot: Slot, k: usize, v: f64) {
 /// Iterators over the two ranges (one reversed) leave the loop without bounds checks. One
 /// running sum: four partial sums (to overlap the additions) were 2.4× slower with `k` a
 /// variable, their set-up and remainder loops outweighing the gain on sums this short, and
-/// no faster with `k` known ([`run_order`]; the double pendulum at orders 12 and 15, same
-/// run: the gain of the unrolled code is in the known offsets, not in the sums' latency).
+/// no faster with `k` known (the double pendulum at orders 12 and 15, same run: the gain of
+/// the unrolled code is in the known offsets, not in the sums' latency). The ranges are
+/// half-open (`from..to + 1`): an inclusive range's indexing was not inlined into the
+/// model's fused orders, a call per sum (3× slower).
 #[inline(always)]
 fn convolution(a: &[f64], b: &[f64], k: usize, from: usize, to: usize) -> f64 {
     let a = &a[from..to + 1];
@@ -459,44 +461,25 @@ pub fn zero<const K: usize>(k: usize, c: usize, s: &mut [f64], out: Slot) {
     put(s, c, out, k, 0.0);
 }
 
-/// Order `k ≥ 1` of every series of `ops`, in order ([`apply`] for each, with the order
-/// known to the compiler for `k ≤` [`UNROLLED_ORDERS`]).
+/// Order `k ≥ 1` of every series of `ops`, in order ([`apply`] for each): the run-time
+/// model's orders, compiled for `K = k` when `k ≤` [`UNROLLED_ORDERS`] and `capacity` is
+/// [`UNROLLED_CAPACITY`], else for any order.
 pub fn evaluate_order(ops: &[SeriesOp], k: usize, capacity: usize, s: &mut [f64]) {
-    /// The ops of a run-time program as [`OrderCode`].
-    struct Ops<'a>(&'a [SeriesOp]);
-    impl OrderCode for Ops<'_> {
-        #[inline(never)]
-        fn run<const K: usize>(&self, k: usize, capacity: usize, s: &mut [f64]) {
-            for &op in self.0 {
-                apply::<K>(op, k, capacity, s);
-            }
+    /// The ops for one `K`, out of line (one variant per order).
+    #[inline(never)]
+    fn run<const K: usize>(ops: &[SeriesOp], k: usize, capacity: usize, s: &mut [f64]) {
+        for &op in ops {
+            apply::<K>(op, k, capacity, s);
         }
     }
-    run_order(&Ops(ops), k, capacity, s);
-}
-
-/// The code of one order of a program, compiled for each order `K` in `1 …`
-/// [`UNROLLED_ORDERS`] (and `K = 0`: any order, `k` read at run time) — what
-/// [`run_order`] calls. Implemented by [`evaluate_order`] for the run-time model (the
-/// `model!` macro's code calls its kernels with `::<K>` in its own functions).
-pub trait OrderCode {
-    /// Order `k` of every series slot (`K` is `k`, or 0).
-    fn run<const K: usize>(&self, k: usize, capacity: usize, s: &mut [f64]);
-}
-
-/// Runs `code` for order `k ≥ 1`: its variant compiled for `K = k` when `k ≤`
-/// [`UNROLLED_ORDERS`] and `capacity` is [`UNROLLED_CAPACITY`], else its variant for any
-/// order.
-#[inline]
-pub fn run_order(code: &impl OrderCode, k: usize, capacity: usize, s: &mut [f64]) {
     if capacity != UNROLLED_CAPACITY {
-        return code.run::<0>(k, capacity, s);
+        return run::<0>(ops, k, capacity, s);
     }
     macro_rules! orders {
         (; $($order:literal)*) => {
             match k {
-                $($order => code.run::<$order>(k, capacity, s),)*
-                _ => code.run::<0>(k, capacity, s),
+                $($order => run::<$order>(ops, k, capacity, s),)*
+                _ => run::<0>(ops, k, capacity, s),
             }
         };
     }
@@ -532,7 +515,8 @@ impl TaylorWorkspace {
     /// never shrunk (the stride `capacity` is the kernels' argument, so a longer one serves a
     /// lower order), so a method switching order between steps does not reallocate. The
     /// stride is [`UNROLLED_CAPACITY`], the one the kernels compiled for each order run with,
-    /// when [`TaylorProgram::unrolled_code_fits`], else any other (so that they do not).
+    /// when [`TaylorProgram::unrolled_code_fits`] or the model has `fused` orders (and
+    /// `order` is within the stride), else any other (so that they do not).
     fn fit(&mut self, program: &TaylorProgram, n: usize, order: usize, fused: usize) {
         // With fused orders (a compiled model's), those run compiled for each order and the
         // rest as loops at the same stride, whatever the order (to its limit): the fused

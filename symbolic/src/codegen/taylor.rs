@@ -531,8 +531,8 @@ pub(super) fn methods(
     // The orders whose compiled code a step can run (`TaylorProgram::unrolled_code_fits`):
     // compiling the others would only lengthen the build.
     let unrolled: Vec<usize> = (1..=program.highest_unrolled_order()).collect();
-    // The fused orders' layout (`taylor_orders`): the lists `series_of_motion` builds from
-    // the program, as constants.
+    // The fused orders' layout (`taylor_orders`): the program's derived lists, as constants
+    // (the run-time `series_of_motion` reads the same lists from the program).
     let n = program.forcing.len();
     let highest = unrolled.len();
     let next = highest + 1;
