@@ -320,3 +320,50 @@ fn models_without_coefficients_say_why() {
         }
     }
 }
+
+/// The sines and cosines of angle differences that the equations form by the addition
+/// theorems (`sin θ₁ cos θ₂ − cos θ₁ sin θ₂`, …) run at orders ≥ 1 as one `sin_cos` of the
+/// difference: no product of two sines or cosines is left in the chains' programs, each pair
+/// of angles has a `sin_cos` of its difference, and (above) the coefficients still agree with
+/// the reference computed from the equations as they stand.
+#[test]
+fn angle_differences_run_as_one_sin_cos() {
+    use eomgen::DynMechanicalSystem;
+    use eomgen::taylor::SeriesOp;
+    for (file, pairs) in [("double_pendulum", 1), ("triple_pendulum", 3)] {
+        let path = format!("{}/models/{file}.yaml", env!("CARGO_MANIFEST_DIR"));
+        let model = JitModel::load(&path).unwrap_or_else(|e| panic!("{path}: {e}"));
+        let program = model.taylor_program().expect("recurrences");
+        let trig: BTreeSet<u32> = program
+            .ops
+            .iter()
+            .filter_map(|op| match *op {
+                SeriesOp::SinCos { sin, cos, .. } => Some([sin, cos]),
+                _ => None,
+            })
+            .flatten()
+            .collect();
+        let products = program
+            .ops
+            .iter()
+            .filter(|op| matches!(**op, SeriesOp::Mul { a, b, .. } if trig.contains(&a) && trig.contains(&b)))
+            .count();
+        assert_eq!(products, 0, "{file}: products of sines and cosines left");
+        let differences = program
+            .ops
+            .iter()
+            .filter(|op| match **op {
+                SeriesOp::SinCos { a, .. } => program.ops.iter().any(|other| {
+                    matches!(*other, SeriesOp::Sub { out, a: x, b: y }
+                        if out == a && program.coordinates.contains(&Some(x))
+                            && program.coordinates.contains(&Some(y)))
+                }),
+                _ => false,
+            })
+            .count();
+        assert_eq!(
+            differences, pairs,
+            "{file}: sin_cos of coordinate differences"
+        );
+    }
+}

@@ -18,6 +18,8 @@ use eomgen_description::taylor::{DerivedLists, SeriesOp, Slot, TaylorProgram, Ta
 
 use crate::expr::Func;
 
+use rustc_hash::{FxHashMap, FxHashSet};
+
 use super::program::FunctionTape;
 use super::tape::{Input, Instruction, Tape};
 
@@ -198,16 +200,222 @@ impl<'a> Builder<'a> {
             };
             self.constant.push(constant);
         }
+        let pairs = self.angle_sum_pairs();
+        let mut emitted = FxHashMap::default();
+        let mut angles = FxHashMap::default();
         for k in 0..count {
             if self.constant[k] {
                 continue;
             }
             let out = k as Slot;
+            if let Some((sin, cos, angle)) = pairs.get(&out) {
+                // The pair's op goes where the first of the two is, before any reader.
+                if emitted.insert((*sin, *cos), ()).is_none() {
+                    let a = self.angle_slot(angle, &mut angles);
+                    self.ops.push(SeriesOp::SinCos {
+                        sin: *sin,
+                        cos: *cos,
+                        a,
+                    });
+                }
+                continue;
+            }
             let instruction = self.tape.instructions[k];
             if let Some(op) = self.op(out, instruction) {
                 self.ops.push(op);
             }
         }
+        self.ops = live_ops(std::mem::take(&mut self.ops), self.tape);
+    }
+
+    /// The sines and cosines of sums of angles that the tape forms by the addition theorems
+    /// ([`crate::expr::trig::expand_angle_sums`]: `sin a cos b − cos a sin b` and
+    /// `cos a cos b + sin a sin b` from the angles' own sines and cosines), found in pairs of
+    /// a sine and a cosine of the same sum: each slot of a pair mapped to `(sin, cos,
+    /// angle)`, the angle as its terms `(negated, slot)` in the sine's sign.
+    ///
+    /// Such a pair costs four products of series and two sums per order as the tape forms
+    /// it, one `sin_cos` recurrence (two sums of products) and the angle's difference as a
+    /// series: the pair's order-0 values stay the tape's (no `sin_cos` call is added), its
+    /// higher orders come from the recurrence of `sin_cos` of the angle, and the products
+    /// no other op reads are dropped ([`live_ops`]). Sums of sums (chains of three or more
+    /// angles) are found level by level.
+    fn angle_sum_pairs(&self) -> FxHashMap<Slot, (Slot, Slot, Angle)> {
+        let mut found: FxHashMap<Slot, (bool, Angle)> = FxHashMap::default();
+        loop {
+            let mut sines: FxHashMap<Angle, (Slot, Angle)> = FxHashMap::default();
+            let mut cosines: FxHashMap<Angle, Slot> = FxHashMap::default();
+            for k in 0..self.tape.instructions.len() {
+                if self.constant[k] {
+                    continue;
+                }
+                let Some((cos, angle)) = self.angle_sum(k as Slot, &found) else {
+                    continue;
+                };
+                if cos {
+                    cosines.entry(canonical(&angle)).or_insert(k as Slot);
+                } else if angle.iter().any(|&(negated, _)| !negated) {
+                    sines.entry(canonical(&angle)).or_insert((k as Slot, angle));
+                }
+            }
+            let mut next: FxHashMap<Slot, (bool, Angle)> = FxHashMap::default();
+            for (key, (sin, angle)) in sines {
+                if let Some(&cos) = cosines.get(&key) {
+                    next.insert(sin, (false, angle.clone()));
+                    next.insert(cos, (true, angle));
+                }
+            }
+            if next.len() == found.len() {
+                let mut pairs = FxHashMap::default();
+                for (&slot, (cos, angle)) in &found {
+                    if !cos {
+                        let key = canonical(angle);
+                        let partner = found
+                            .iter()
+                            .find(|(_, (c, a))| *c && canonical(a) == key)
+                            .map(|(&s, _)| s)
+                            .expect("a found sine has its cosine");
+                        pairs.insert(slot, (slot, partner, angle.clone()));
+                        pairs.insert(partner, (slot, partner, angle.clone()));
+                    }
+                }
+                return pairs;
+            }
+            found = next;
+        }
+    }
+
+    /// The value of `slot` as `±sin` or `±cos` of an angle: `(negated, cos, angle)`, from
+    /// the tape's sines and cosines, their negations and the sums already `found`.
+    fn trig(
+        &self,
+        slot: Slot,
+        found: &FxHashMap<Slot, (bool, Angle)>,
+    ) -> Option<(bool, bool, Angle)> {
+        if self.constant[slot as usize] {
+            return None;
+        }
+        let single = |a: Slot| vec![(false, a)];
+        match self.tape.instructions[slot as usize] {
+            Instruction::SinCos(a) | Instruction::Call(Func::Sin, a) => {
+                Some((false, false, single(a)))
+            }
+            Instruction::Call(Func::Cos, a) => Some((false, true, single(a))),
+            Instruction::CosOfSinCos(s) => match self.tape.instructions[s as usize] {
+                Instruction::SinCos(a) => Some((false, true, single(a))),
+                _ => None,
+            },
+            Instruction::Neg(x) => self.trig(x, found).map(|(n, c, a)| (!n, c, a)),
+            _ => found
+                .get(&slot)
+                .map(|(cos, angle)| (false, *cos, angle.clone())),
+        }
+    }
+
+    /// `slot` as `±` a product of two sines or cosines: `(negated, first, second)`, each
+    /// factor `(cos, angle)`.
+    fn trig_product(
+        &self,
+        slot: Slot,
+        found: &FxHashMap<Slot, (bool, Angle)>,
+    ) -> Option<(bool, Factor, Factor)> {
+        match self.tape.instructions[slot as usize] {
+            Instruction::Mul(x, y) => {
+                let (nx, cx, ax) = self.trig(x, found)?;
+                let (ny, cy, ay) = self.trig(y, found)?;
+                Some((nx != ny, (cx, ax), (cy, ay)))
+            }
+            Instruction::Neg(x) => self.trig_product(x, found).map(|(n, f, g)| (!n, f, g)),
+            _ => None,
+        }
+    }
+
+    /// `slot` as the sine (`false`) or cosine (`true`) of a sum of angles by the addition
+    /// theorems, with the sum's terms.
+    fn angle_sum(
+        &self,
+        slot: Slot,
+        found: &FxHashMap<Slot, (bool, Angle)>,
+    ) -> Option<(bool, Angle)> {
+        let (p, q, q_negated) = match self.tape.instructions[slot as usize] {
+            Instruction::Add(p, q) => (p, q, false),
+            Instruction::Sub(p, q) => (p, q, true),
+            _ => return None,
+        };
+        let (np, p1, p2) = self.trig_product(p, found)?;
+        let (nq, q1, q2) = self.trig_product(q, found)?;
+        let nq = nq != q_negated;
+        // The product `f(α) g(β)` with `f` of `first` and `g` of `second`, in either order.
+        let split = |f: bool, g: bool, x: &Factor, y: &Factor| {
+            if x.0 == f && y.0 == g {
+                Some((x.1.clone(), y.1.clone()))
+            } else if y.0 == f && x.0 == g {
+                Some((y.1.clone(), x.1.clone()))
+            } else {
+                None
+            }
+        };
+        let same = |x: &(Angle, Angle), y: &(Angle, Angle)| x.0 == y.0 && x.1 == y.1;
+        // ±sin α cos β ± cos α sin β.
+        if let (Some(sc), Some(cs)) = (split(false, true, &p1, &p2), split(true, false, &q1, &q2))
+            && same(&sc, &cs)
+        {
+            let (alpha, beta) = sc;
+            return match (np, nq) {
+                (false, false) => Some((false, sum(&alpha, &beta, false))),
+                (false, true) => Some((false, sum(&alpha, &beta, true))),
+                (true, false) => Some((false, sum(&beta, &alpha, true))),
+                (true, true) => None,
+            };
+        }
+        // cos α cos β ± sin α sin β (either product first).
+        for ((nc, c1, c2), (ns, s1, s2)) in [
+            ((np, &p1, &p2), (nq, &q1, &q2)),
+            ((nq, &q1, &q2), (np, &p1, &p2)),
+        ] {
+            if let (Some(cc), Some(ss)) = (split(true, true, c1, c2), split(false, false, s1, s2))
+                && (same(&cc, &ss) || (cc.0 == ss.1 && cc.1 == ss.0))
+            {
+                let (alpha, beta) = cc;
+                return match (nc, ns) {
+                    (false, true) => Some((true, sum(&alpha, &beta, false))),
+                    (false, false) => Some((true, sum(&alpha, &beta, true))),
+                    _ => None,
+                };
+            }
+        }
+        None
+    }
+
+    /// The slot of an angle's sum as a series, appended once per angle: its first term that
+    /// is not negated, then the others added or subtracted.
+    fn angle_slot(&mut self, angle: &Angle, memo: &mut FxHashMap<Angle, Slot>) -> Slot {
+        if let Some(&slot) = memo.get(angle) {
+            return slot;
+        }
+        let first = angle
+            .iter()
+            .position(|&(negated, _)| !negated)
+            .expect("a sine's angle has a term that is not negated");
+        let mut slot = angle[first].1;
+        for (i, &(negated, x)) in angle.iter().enumerate() {
+            if i == first {
+                continue;
+            }
+            let out = if negated {
+                self.aux(Instruction::Sub(slot, x), false)
+            } else {
+                self.aux(Instruction::Add(slot, x), false)
+            };
+            self.ops.push(if negated {
+                SeriesOp::Sub { out, a: slot, b: x }
+            } else {
+                SeriesOp::Add { out, a: slot, b: x }
+            });
+            slot = out;
+        }
+        memo.insert(angle.clone(), slot);
+        slot
     }
 
     /// The recurrence of the non-constant instruction `out`.
@@ -328,6 +536,78 @@ impl<'a> Builder<'a> {
             },
         })
     }
+}
+
+/// A sum of angles `Σ ±xᵢ`: its terms `(negated, slot)`, sorted.
+type Angle = Vec<(bool, Slot)>;
+
+/// A sine (`false`) or cosine (`true`) of an angle.
+type Factor = (bool, Angle);
+
+/// `α + β`, or `α − β` if `minus`, sorted.
+fn sum(alpha: &Angle, beta: &Angle, minus: bool) -> Angle {
+    let mut terms: Angle = alpha
+        .iter()
+        .copied()
+        .chain(beta.iter().map(|&(negated, x)| (negated != minus, x)))
+        .collect();
+    terms.sort_unstable_by_key(|&(negated, x)| (x, negated));
+    terms
+}
+
+/// The key an angle and its negation share (a cosine is even, and a sine is matched with
+/// the cosine of its own angle or of the negation).
+fn canonical(angle: &Angle) -> Angle {
+    let mut negation: Angle = angle.iter().map(|&(negated, x)| (!negated, x)).collect();
+    negation.sort_unstable_by_key(|&(negated, x)| (x, negated));
+    let mut own = angle.clone();
+    own.sort_unstable_by_key(|&(negated, x)| (x, negated));
+    own.min(negation)
+}
+
+/// `ops` without those whose results no op reads at orders `k ≥ 1` and that are not `M`'s
+/// or `F`'s (the products of the addition theorems replaced by a `sin_cos`), in order. Only
+/// ops whose slots are all outputs or inputs are dropped (one or two outputs, each written
+/// by that op alone); the others are kept, every slot of theirs read.
+fn live_ops(ops: Vec<SeriesOp>, tape: &Tape) -> Vec<SeriesOp> {
+    let mut read: FxHashSet<Slot> = tape.outputs.iter().copied().collect();
+    let mut keep = vec![true; ops.len()];
+    for (i, op) in ops.iter().enumerate().rev() {
+        let (outputs, inputs): (Vec<Slot>, Vec<Slot>) = match *op {
+            SeriesOp::Neg { out, a }
+            | SeriesOp::Copy { out, a }
+            | SeriesOp::Sqrt { out, a }
+            | SeriesOp::Exp { out, a }
+            | SeriesOp::Ln { out, a }
+            | SeriesOp::Scale { out, a, .. }
+            | SeriesOp::DivByConstant { out, a, .. }
+            | SeriesOp::PowConstant { out, a, .. } => (vec![out], vec![a]),
+            SeriesOp::Add { out, a, b }
+            | SeriesOp::Sub { out, a, b }
+            | SeriesOp::Mul { out, a, b }
+            | SeriesOp::Div { out, a, b } => (vec![out], vec![a, b]),
+            SeriesOp::ConstantDiv { out, b } => (vec![out], vec![b]),
+            SeriesOp::SinCos { sin, cos, a } => (vec![sin, cos], vec![a]),
+            SeriesOp::SinhCosh { sinh, cosh, a } => (vec![sinh, cosh], vec![a]),
+            // Kept, every slot read.
+            SeriesOp::Tan { out, a, square } | SeriesOp::Tanh { out, a, square } => {
+                (vec![], vec![out, a, square])
+            }
+            SeriesOp::Asin { out, a, root, .. } => (vec![], vec![out, a, root]),
+            SeriesOp::Atan { out, a, square } => (vec![], vec![out, a, square]),
+            SeriesOp::Atan2 { out, y, x, norm } => (vec![], vec![out, y, x, norm]),
+            SeriesOp::Zero { out } => (vec![], vec![out]),
+        };
+        if !outputs.is_empty() && !outputs.iter().any(|s| read.contains(s)) {
+            keep[i] = false;
+            continue;
+        }
+        read.extend(inputs);
+    }
+    ops.into_iter()
+        .zip(keep)
+        .filter_map(|(op, keep)| keep.then_some(op))
+        .collect()
 }
 
 /// The operands of an instruction.
