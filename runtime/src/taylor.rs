@@ -522,7 +522,7 @@ impl TaylorWorkspace {
         // rest as loops at the same stride, whatever the order (to its limit): the fused
         // code alone is what must fit the instruction cache.
         let unrolled =
-            program.unrolled_code_fits(order) || (fused > 0 && order <= UNROLLED_ORDERS + 1);
+            (fused > 0 && order <= UNROLLED_ORDERS + 1) || program.unrolled_code_fits(order);
         let capacity = if unrolled {
             UNROLLED_CAPACITY
         } else if self.capacity != UNROLLED_CAPACITY && self.capacity > order {
@@ -939,6 +939,24 @@ fn factor(
     pivots: &mut [f64],
     inverse_pivots: &mut [f64],
 ) -> Option<()> {
+    if n == 2 {
+        // The second pivot as `det M / M₁₁`, so that its reciprocal `M₁₁ / det M` does not
+        // wait for the first (the two divisions run side by side; one after the other they
+        // lay on the path from a step's order 0 to its order 1).
+        let (m11, m21, m22) = (m(0, 0), m(1, 0), m(1, 1));
+        let det = m11 * m22 - m21 * m21;
+        // Not positive definite, or NaN.
+        if !(m11 > 0.0 && det > 0.0) {
+            return None;
+        }
+        let (inverse, inverse_det) = (1.0 / m11, 1.0 / det);
+        pivots[0] = m11;
+        inverse_pivots[0] = inverse;
+        lower[2] = m21 * inverse;
+        pivots[1] = det * inverse;
+        inverse_pivots[1] = m11 * inverse_det;
+        return Some(());
+    }
     for j in 0..n {
         let mut d = m(j, j);
         for k in 0..j {
@@ -1101,4 +1119,59 @@ pub fn branch_step(
         limit = 0.5 * above;
     }
     limit
+}
+
+#[cfg(test)]
+mod tests {
+    use super::factor;
+
+    /// `L D Lᵀ` reproduces the matrix (to rounding: a few ulps of its largest entry), for two
+    /// coordinates (the closed form) and three (the loops), and a matrix that is not positive
+    /// definite, or NaN, has no factor.
+    #[test]
+    fn factor_reproduces_the_matrix_and_refuses_what_is_not_positive_definite() {
+        let cases: [&[f64]; 3] = [
+            &[4.0, 1.5, 1.5, 2.0],
+            &[1e-3, 2e-4, 2e-4, 5e2],
+            &[4.0, 1.0, 0.5, 1.0, 3.0, -0.7, 0.5, -0.7, 2.0],
+        ];
+        for m in cases {
+            let n = (m.len() as f64).sqrt() as usize;
+            let (mut lower, mut d, mut inverse) = (vec![0.0; n * n], vec![0.0; n], vec![0.0; n]);
+            factor(n, |i, j| m[i + j * n], &mut lower, &mut d, &mut inverse).expect("a factor");
+            let l = |i: usize, j: usize| match i.cmp(&j) {
+                std::cmp::Ordering::Equal => 1.0,
+                std::cmp::Ordering::Greater => lower[i * n + j],
+                std::cmp::Ordering::Less => 0.0,
+            };
+            let largest = m.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+            for i in 0..n {
+                assert!(
+                    (d[i] * inverse[i] - 1.0).abs() < 4.0 * f64::EPSILON,
+                    "{m:?}"
+                );
+                for j in 0..n {
+                    let v: f64 = (0..n).map(|k| l(i, k) * d[k] * l(j, k)).sum();
+                    assert!(
+                        (v - m[i + j * n]).abs() <= 8.0 * f64::EPSILON * largest,
+                        "{m:?}: ({i}, {j}) {v}"
+                    );
+                }
+            }
+        }
+        let refused: [&[f64]; 4] = [
+            &[1.0, 2.0, 2.0, 1.0],
+            &[-1.0, 0.0, 0.0, 1.0],
+            &[1.0, f64::NAN, f64::NAN, 1.0],
+            &[1.0, 2.0, 0.0, 2.0, 1.0, 0.0, 0.0, 0.0, 1.0],
+        ];
+        for m in refused {
+            let n = (m.len() as f64).sqrt() as usize;
+            let (mut lower, mut d, mut inverse) = (vec![0.0; n * n], vec![0.0; n], vec![0.0; n]);
+            assert!(
+                factor(n, |i, j| m[i + j * n], &mut lower, &mut d, &mut inverse).is_none(),
+                "{m:?}"
+            );
+        }
+    }
 }
