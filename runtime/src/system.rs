@@ -173,8 +173,8 @@ pub trait MechanicalSystem<const N: usize> {
         let _ = (capacity, series);
     }
 
-    /// Order `k ≥ 1` of every series slot ([`crate::taylor::evaluate_order`] over the
-    /// program's ops; generated code inlines them). Does nothing without a program.
+    /// Order `k ≥ 1` of every slot the program's ops write ([`crate::taylor::evaluate_order`]
+    /// over the ops; generated code inlines them). Does nothing without a program.
     fn taylor_order(&self, k: usize, capacity: usize, series: &mut [f64]) {
         if let Ok(program) = self.taylor_program() {
             crate::taylor::evaluate_order(&program.ops, k, capacity, series);

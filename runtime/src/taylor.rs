@@ -555,9 +555,10 @@ pub trait TaylorFunctions {
     fn program(&self) -> &TaylorProgram;
     /// Order 0 of every slot, reading the state from the input slots.
     fn order_zero(&self, capacity: usize, series: &mut [f64]);
-    /// Order `k ≥ 1` of every series slot.
+    /// Order `k ≥ 1` of every slot the program's ops write (the slots that an op, `M` or `F`
+    /// reads; others keep what the workspace held).
     fn order(&self, k: usize, capacity: usize, series: &mut [f64]);
-    /// [`motion_order`] for `k = 0`, then orders `k = 1, 2, …` of every series slot, each
+    /// [`motion_order`] for `k = 0`, then orders `k = 1, 2, …` of the ops' slots, each
     /// followed by its [`motion_order`], in one function (the `model!` macro's
     /// [`MechanicalSystem::taylor_orders`](crate::MechanicalSystem::taylor_orders)), stopping
     /// before `order`; the first order it did not compute. The default computes none (0).
@@ -771,6 +772,23 @@ pub fn motion_order<const N: usize, const K: usize>(
     }
 }
 
+/// Order `k` of `M a = F` as [`motion_order`] computes it, for a run-time `n` and `k` (the
+/// variant compiled for them): what a run-time backend's own fused orders call between its
+/// orders (the JIT's Cranelift code), the same bits as a compiled model's.
+///
+/// # Panics
+/// If `s` or `out` is too short for the layout and `k` (a program and workspace that do not
+/// belong together).
+pub fn motion_order_at(
+    layout: &MotionLayout<'_>,
+    solve: &mut MotionSolve<'_>,
+    k: usize,
+    s: &mut [f64],
+    out: &mut [f64],
+) {
+    accelerations(layout, solve, k, s, out);
+}
+
 /// [`motion_order`] for the run-time `n` and `k`: the variant compiled for them.
 #[inline]
 fn accelerations(
@@ -942,20 +960,22 @@ fn factor(
     if n == 2 {
         // The second pivot as `det M / M₁₁`, so that its reciprocal `M₁₁ / det M` does not
         // wait for the first (the two divisions run side by side; one after the other they
-        // lay on the path from a step's order 0 to its order 1).
+        // lay on the path from a step's order 0 to its order 1). Only where `det M` and that
+        // reciprocal are normal numbers: `M₁₁ M₂₂` overflows or underflows for entries
+        // beyond about 1e±154, where the loop below, which never forms it, still factors.
         let (m11, m21, m22) = (m(0, 0), m(1, 0), m(1, 1));
         let det = m11 * m22 - m21 * m21;
-        // Not positive definite, or NaN.
-        if !(m11 > 0.0 && det > 0.0) {
-            return None;
+        let inverse_det = 1.0 / det;
+        let second = m11 * inverse_det;
+        if m11 > 0.0 && m11.is_finite() && det.is_normal() && det > 0.0 && second.is_normal() {
+            let inverse = 1.0 / m11;
+            pivots[0] = m11;
+            inverse_pivots[0] = inverse;
+            lower[2] = m21 * inverse;
+            pivots[1] = det * inverse;
+            inverse_pivots[1] = second;
+            return Some(());
         }
-        let (inverse, inverse_det) = (1.0 / m11, 1.0 / det);
-        pivots[0] = m11;
-        inverse_pivots[0] = inverse;
-        lower[2] = m21 * inverse;
-        pivots[1] = det * inverse;
-        inverse_pivots[1] = m11 * inverse_det;
-        return Some(());
     }
     for j in 0..n {
         let mut d = m(j, j);
@@ -1158,6 +1178,22 @@ mod tests {
                     );
                 }
             }
+        }
+        // Beyond the closed form's range (`M₁₁ M₂₂` overflows or underflows): the loop's
+        // factor, exact for these diagonal and scaled matrices.
+        for scale in [1e160, 1e200, 1e-160, 1e-170] {
+            let m = [scale, 0.5 * scale, 0.5 * scale, scale];
+            let (mut lower, mut d, mut inverse) = ([0.0; 4], [0.0; 2], [0.0; 2]);
+            factor(2, |i, j| m[i + j * 2], &mut lower, &mut d, &mut inverse).expect("a factor");
+            assert_eq!((d[0], lower[2]), (scale, 0.5), "{scale:e}");
+            assert!(
+                (d[1] / (0.75 * scale) - 1.0).abs() < 4.0 * f64::EPSILON,
+                "{scale:e}: {d:?}"
+            );
+            assert!(
+                (inverse[1] * d[1] - 1.0).abs() < 4.0 * f64::EPSILON,
+                "{scale:e}"
+            );
         }
         let refused: [&[f64]; 4] = [
             &[1.0, 2.0, 2.0, 1.0],

@@ -4,10 +4,14 @@
 //! both backends compile — is read as a program over series: each instruction is a slot, and
 //! [`taylor_program`] gives each instruction that depends on the state its recurrence
 //! ([`SeriesOp`]). Order 0 is the tape itself, extended by the auxiliary values some
-//! recurrences need (the cosine of a lone sine, `tan²`, `√(1 − a²)`, `x² + y²`): those are
-//! appended as instructions, so the order-0 values of the tape's own instructions are the
-//! right-hand side's to the bit, and both backends evaluate the extended tape as they evaluate
-//! any tape. Constant instructions (parameters and numbers only) keep their order 0 alone.
+//! recurrences need (the cosine of a lone sine, `tan²`, `√(1 − a²)`, `x² + y²`, the sums of
+//! angles whose sine and cosine the tape forms by the addition theorems): those are appended
+//! as instructions, so the order-0 values of the tape's own instructions are the right-hand
+//! side's to the bit, and both backends evaluate the extended tape as they evaluate any tape.
+//! Constant instructions (parameters and numbers only) keep their order 0 alone. Above order
+//! 0, a sine and cosine of a sum of angles come from one `sin_cos` of the sum, and an
+//! instruction whose value no op, `M` or `F` reads there has no op (its orders `k ≥ 1` are
+//! not computed).
 //!
 //! Source: the decomposition of Biscani & Izzo (2021), heyoka's `taylor_decompose`, with
 //! hidden partners (`sin`↔`cos`, `tan`↔`tan²`); the recurrences of Jorba & Zou (2005, §2.1).
@@ -241,48 +245,49 @@ impl<'a> Builder<'a> {
     /// no other op reads are dropped ([`live_ops`]). Sums of sums (chains of three or more
     /// angles) are found level by level.
     fn angle_sum_pairs(&self) -> FxHashMap<Slot, (Slot, Slot, Angle)> {
+        // The pairs by their angle's key, and each paired slot as a sine or cosine (what the
+        // next level reads): both only grow, a round at a time, until a round adds none.
+        let mut pairs: FxHashMap<Angle, (Slot, Slot, Angle)> = FxHashMap::default();
         let mut found: FxHashMap<Slot, (bool, Angle)> = FxHashMap::default();
         loop {
             let mut sines: FxHashMap<Angle, (Slot, Angle)> = FxHashMap::default();
             let mut cosines: FxHashMap<Angle, Slot> = FxHashMap::default();
             for k in 0..self.tape.instructions.len() {
-                if self.constant[k] {
+                let slot = k as Slot;
+                if self.constant[k] || found.contains_key(&slot) {
                     continue;
                 }
-                let Some((cos, angle)) = self.angle_sum(k as Slot, &found) else {
+                let Some((cos, angle)) = self.angle_sum(slot, &found) else {
                     continue;
                 };
+                let key = canonical(&angle);
+                if pairs.contains_key(&key) {
+                    continue;
+                }
                 if cos {
-                    cosines.entry(canonical(&angle)).or_insert(k as Slot);
+                    cosines.entry(key).or_insert(slot);
                 } else if angle.iter().any(|&(negated, _)| !negated) {
-                    sines.entry(canonical(&angle)).or_insert((k as Slot, angle));
+                    sines.entry(key).or_insert((slot, angle));
                 }
             }
-            let mut next: FxHashMap<Slot, (bool, Angle)> = FxHashMap::default();
+            let before = pairs.len();
             for (key, (sin, angle)) in sines {
                 if let Some(&cos) = cosines.get(&key) {
-                    next.insert(sin, (false, angle.clone()));
-                    next.insert(cos, (true, angle));
+                    found.insert(sin, (false, angle.clone()));
+                    found.insert(cos, (true, angle.clone()));
+                    pairs.insert(key, (sin, cos, angle));
                 }
             }
-            if next.len() == found.len() {
-                let mut pairs = FxHashMap::default();
-                for (&slot, (cos, angle)) in &found {
-                    if !cos {
-                        let key = canonical(angle);
-                        let partner = found
-                            .iter()
-                            .find(|(_, (c, a))| *c && canonical(a) == key)
-                            .map(|(&s, _)| s)
-                            .expect("a found sine has its cosine");
-                        pairs.insert(slot, (slot, partner, angle.clone()));
-                        pairs.insert(partner, (slot, partner, angle.clone()));
-                    }
-                }
-                return pairs;
+            if pairs.len() == before {
+                break;
             }
-            found = next;
         }
+        let mut by_slot = FxHashMap::default();
+        for (sin, cos, angle) in pairs.into_values() {
+            by_slot.insert(sin, (sin, cos, angle.clone()));
+            by_slot.insert(cos, (sin, cos, angle));
+        }
+        by_slot
     }
 
     /// The value of `slot` as `±sin` or `±cos` of an angle: `(negated, cos, angle)`, from
