@@ -22,7 +22,7 @@
 use std::collections::BTreeSet;
 
 use eomgen::taylor::TaylorUnsupported;
-use eomgen::{DynFirstOrder, JitModel, ModelInfo};
+use eomgen::{DynFirstOrder, JitModel, LoadOptions, ModelInfo};
 use serde::Deserialize;
 
 /// The reference file, as `tools/taylor_reference.py` writes it.
@@ -254,19 +254,36 @@ fn compiled_and_run_time_coefficients_are_bit_identical() {
             7,
             23,
         ];
+        // The run-time model's orders by the runtime's kernels (`runtime`: fewer series than
+        // it computes before compiling them) and compiled to native code from the first
+        // series (`native`).
+        let path = bundled_file(
+            eomgen::models::ALL
+                .iter()
+                .find(|m| m.file == entry.file)
+                .expect("a bundled model"),
+        );
+        let options = LoadOptions {
+            eager_taylor: true,
+            ..LoadOptions::default()
+        };
+        let native = JitModel::load_with(&path, options).unwrap_or_else(|e| panic!("{path}: {e}"));
+        let mut native: Box<dyn ModelInfo> = Box::new(DynFirstOrder::new(native));
         for (shift, order) in orders.into_iter().enumerate() {
             let shift = shift as f64;
             let a = coefficients_to(&entry, compiled.as_mut(), order, shift);
-            let b = coefficients_to(&entry, runtime.as_mut(), order, shift);
-            for (j, (x, y)) in a.iter().zip(&b).enumerate() {
-                assert_eq!(
-                    x.to_bits(),
-                    y.to_bits(),
-                    "{} to order {order}: order {}, component {}: compiled {x:e}, run time {y:e}",
-                    entry.name,
-                    j / entry.dim,
-                    j % entry.dim
-                );
+            for (how, model) in [("run time", &mut runtime), ("native orders", &mut native)] {
+                let b = coefficients_to(&entry, model.as_mut(), order, shift);
+                for (j, (x, y)) in a.iter().zip(&b).enumerate() {
+                    assert_eq!(
+                        x.to_bits(),
+                        y.to_bits(),
+                        "{} to order {order}: order {}, component {}: compiled {x:e}, {how} {y:e}",
+                        entry.name,
+                        j / entry.dim,
+                        j % entry.dim
+                    );
+                }
             }
         }
     }

@@ -50,8 +50,9 @@ mod interpret;
 mod math;
 mod model;
 mod native;
+mod taylor;
 
-pub use model::{JitModel, LoadError, LoadOptions};
+pub use model::{COMPILE_TAYLOR_AFTER, JitModel, LoadError, LoadOptions};
 pub use native::CompileError;
 
 /// Which evaluator runs a run-time model's functions.

@@ -1,9 +1,12 @@
 //! [`JitModel`]: a model file loaded, derived and compiled at run time.
 
 use std::cell::RefCell;
+use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex, OnceLock};
 
-use eomgen_runtime::taylor::{TaylorProgram, TaylorUnsupported};
+use eomgen_runtime::taylor::{
+    MotionLayout, MotionSolve, TaylorProgram, TaylorUnsupported, UNROLLED_CAPACITY,
+};
 use eomgen_runtime::{DynMechanicalSystem, ModelDescription, UnknownParameter};
 use eomgen_symbolic::codegen::GenerateError;
 use eomgen_symbolic::codegen::program::{Derivation, FunctionTape, ModelProgram};
@@ -12,6 +15,7 @@ use eomgen_symbolic::codegen::taylor::{TaylorPlan, taylor_program};
 use eomgen_symbolic::model::{Diagnostic, ReadError, read_model_file};
 
 use crate::native::{CompileError, NativeCode, NativeFn};
+use crate::taylor::NativeOrders;
 use crate::{Backend, Inputs, interpret, native};
 
 /// Why a model file could not be made into a run-time model.
@@ -65,6 +69,10 @@ pub struct LoadOptions {
     /// ([`ModelDescription::equations_mathml`](eomgen_runtime::ModelDescription::equations_mathml))
     /// at load time; without it that field is `None`. Compiled models always carry it.
     pub equations_mathml: bool,
+    /// Compile the Taylor method's orders to native code at the first Taylor series, rather
+    /// than after [`COMPILE_TAYLOR_AFTER`] of them computed by the runtime's kernels (the
+    /// same bits either way; with the interpreter backend they are never compiled).
+    pub eager_taylor: bool,
 }
 
 /// The functions of a model: the first eleven in the order of [`ModelProgram::functions`],
@@ -209,9 +217,50 @@ struct Code {
     jacobians: OnceLock<LazyJacobians>,
     /// The Taylor recurrences ([`eomgen_symbolic::codegen::taylor`]), or why there are none.
     taylor: Result<TaylorPlan, TaylorUnsupported>,
+    /// The recurrences' orders compiled to native code ([`Code::taylor_orders`]; `None`:
+    /// interpreted, Cranelift having failed on them or no order fitting the cache).
+    taylor_orders: OnceLock<Option<NativeOrders>>,
+    /// Taylor series computed so far without the compiled orders.
+    taylor_series: AtomicUsize,
+    /// How many before they are compiled ([`LoadOptions::eager_taylor`]).
+    compile_taylor_after: usize,
 }
 
+/// Taylor series a run-time model computes with the runtime's kernels before its orders are
+/// compiled to native code: compiling costs 14–22 ms (the bundled models with recurrences,
+/// 10–18 orders), what about 20,000 double-pendulum series at tol 1e-9 cost interpreted
+/// (0.9 µs each, against 0.6 µs compiled), so a run never pays more than about twice what
+/// the better choice in hindsight costs (the rent-or-buy rule), and a short run pays nothing.
+pub const COMPILE_TAYLOR_AFTER: usize = 20_000;
+
 impl Code {
+    /// Whether the Taylor orders may be compiled to native code: a model with recurrences
+    /// and the native backend.
+    fn taylor_native(&self) -> bool {
+        self.taylor.is_ok() && self.backend != Some(Backend::Interpreter)
+    }
+
+    /// The Taylor orders compiled to native code ([`crate::taylor`]), once
+    /// [`COMPILE_TAYLOR_AFTER`] series have been computed by the runtime's kernels
+    /// (`evaluate_order`, the same bits); `None` before, and for good if Cranelift fails on
+    /// them or no order fits the instruction cache.
+    fn taylor_orders(&self) -> Option<&NativeOrders> {
+        if let Some(compiled) = self.taylor_orders.get() {
+            return compiled.as_ref();
+        }
+        if !self.taylor_native()
+            || self.taylor_series.fetch_add(1, Ordering::Relaxed) < self.compile_taylor_after
+        {
+            return None;
+        }
+        self.taylor_orders
+            .get_or_init(|| {
+                let plan = self.taylor.as_ref().ok()?;
+                crate::taylor::compile_orders(&plan.program).ok().flatten()
+            })
+            .as_ref()
+    }
+
     /// The Jacobians, derived and compiled on first use. A function Cranelift cannot compile
     /// is interpreted instead (the reason is kept: [`JitModel::fallback_reason`]).
     fn jacobians(&self) -> &LazyJacobians {
@@ -481,6 +530,13 @@ impl JitModel {
             derivation: Mutex::new(Some(derivation)),
             jacobians: OnceLock::new(),
             taylor,
+            taylor_orders: OnceLock::new(),
+            taylor_series: AtomicUsize::new(0),
+            compile_taylor_after: if options.eager_taylor {
+                0
+            } else {
+                COMPILE_TAYLOR_AFTER
+            },
         });
         if options.eager_jacobians
             && let Some(e @ CompileError::Function { .. }) = &code.jacobians().fallback_reason
@@ -615,6 +671,61 @@ impl DynMechanicalSystem for JitModel {
     fn taylor_order(&self, k: usize, capacity: usize, series: &mut [f64]) {
         if let Ok(plan) = &self.code.taylor {
             eomgen_runtime::taylor::evaluate_order(&plan.program.ops, k, capacity, series);
+        }
+    }
+    fn taylor_orders(
+        &self,
+        solve: &mut MotionSolve<'_>,
+        order: usize,
+        series: &mut [f64],
+        out: &mut [f64],
+    ) -> usize {
+        let (Ok(plan), Some(orders)) = (&self.code.taylor, self.code.taylor_orders()) else {
+            return 0;
+        };
+        let program = &plan.program;
+        let n = program.coordinates.len();
+        // The code's offsets assume the stride of 25 and every slot present; `solve` checks
+        // its own reads and writes.
+        if !solve.unrolled() || series.len() < (program.slots + n) * UNROLLED_CAPACITY {
+            return 0;
+        }
+        let mut context = OrderContext {
+            layout: MotionLayout {
+                forcing: &program.forcing,
+                coupled: &program.derived.varying_mass_entries,
+                inputs: &program.derived.inputs,
+                time: program.time,
+                accelerations: program.acceleration_slot(),
+            },
+            solve,
+            series: series.as_mut_ptr(),
+            series_len: series.len(),
+            out: out.as_mut_ptr(),
+            out_len: out.len(),
+        };
+        // SAFETY: `series` holds every slot at the stride of 25 (checked above), and
+        // `solve_order` is called with the context built for it; `series` and `out` are not
+        // used otherwise until the call returns.
+        unsafe {
+            (orders.function)(
+                context.series,
+                order,
+                (&raw mut context).cast::<u8>(),
+                solve_order,
+            )
+        }
+    }
+    fn taylor_fused_orders(&self) -> usize {
+        // Before they are compiled, the orders they will be (so that the workspace already
+        // has their stride).
+        match (self.code.taylor_orders.get(), &self.code.taylor) {
+            (Some(compiled), _) => compiled.as_ref().map_or(0, |orders| orders.highest),
+            (None, Ok(plan)) if self.code.taylor_native() => plan
+                .program
+                .highest_unrolled_order()
+                .min(UNROLLED_CAPACITY - 1),
+            _ => 0,
         }
     }
     fn parameter_values(&self) -> Vec<f64> {
@@ -800,4 +911,30 @@ impl DynMechanicalSystem for JitModel {
         };
         self.run(Routine::EventValues, inputs, out, &mut []);
     }
+}
+
+/// What the compiled Taylor orders pass to [`solve_order`] between orders.
+struct OrderContext<'a, 'b> {
+    layout: MotionLayout<'a>,
+    solve: &'a mut MotionSolve<'b>,
+    series: *mut f64,
+    series_len: usize,
+    out: *mut f64,
+    out_len: usize,
+}
+
+/// Order `k` of `M a = F` for the compiled Taylor orders
+/// ([`eomgen_runtime::taylor::motion_order_at`]); non-zero if it panicked (the orders then
+/// stop and report none computed, and the step computes them again by the runtime's
+/// kernels: a panic must not unwind through the compiled code).
+extern "C" fn solve_order(context: *mut u8, k: usize) -> u8 {
+    let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        // SAFETY: `context` is the `OrderContext` of the `taylor_orders` call in progress,
+        // whose `series` and `out` are exclusively lent to this call chain.
+        let context = unsafe { &mut *context.cast::<OrderContext<'_, '_>>() };
+        let series = unsafe { std::slice::from_raw_parts_mut(context.series, context.series_len) };
+        let out = unsafe { std::slice::from_raw_parts_mut(context.out, context.out_len) };
+        eomgen_runtime::taylor::motion_order_at(&context.layout, context.solve, k, series, out);
+    }));
+    u8::from(result.is_err())
 }

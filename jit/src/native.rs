@@ -260,7 +260,7 @@ pub(crate) fn compile(functions: &[(&str, &FunctionTape)]) -> Result<NativeCode,
 ///
 /// # Errors
 /// [`CompileError::UnsupportedHost`] when Cranelift has no code generator for the host.
-fn new_module() -> Result<JITModule, CompileError> {
+pub(crate) fn new_module() -> Result<JITModule, CompileError> {
     let mut flags = settings::builder();
     let set = |flags: &mut settings::Builder, name: &str, value: &str| {
         flags
@@ -302,7 +302,7 @@ fn new_module() -> Result<JITModule, CompileError> {
 }
 
 /// What a failure of Cranelift on `function` is.
-fn failure(function: &str, e: &dyn std::fmt::Display) -> CompileError {
+pub(crate) fn failure(function: &str, e: &dyn std::fmt::Display) -> CompileError {
     CompileError::Function {
         function: function.to_string(),
         reason: e.to_string(),

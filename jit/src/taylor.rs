@@ -1,0 +1,530 @@
+//! A run-time model's Taylor orders compiled to native code by Cranelift: the counterpart of
+//! the `taylor_orders` that `eomgen::model!` generates for a compiled model.
+//!
+//! # What is compiled
+//! One function for a model's [`TaylorProgram`], with the signature [`OrdersFn`] (the
+//! platform's C calling convention):
+//!
+//! ```text
+//! fn(series: *mut f64, order: usize, context: *mut u8,
+//!    solve: extern "C" fn(context: *mut u8, k: usize) -> u8) -> usize
+//! ```
+//!
+//! For `k = 0, 1, …, H` while `k < order`, it computes order `k` of every op of the program
+//! (none at `k = 0`), then calls `solve(context, k)` for order `k` of `M a = F`
+//! ([`eomgen_runtime::taylor::motion_order_at`], which writes the accelerations' order `k`
+//! and the state's order `k + 1`); it returns the first order it did not compute, or 0 if a
+//! call of `solve` returned non-zero. `H` is [`TaylorProgram::highest_unrolled_order`], the
+//! orders whose code fits the instruction cache, as for a compiled model; the series has the
+//! stride [`UNROLLED_CAPACITY`] (slot `x`'s order `i` at `x · 25 + i`).
+//!
+//! Each op's order `k` is its kernel of `eomgen_runtime::taylor` (`mul`, `sin_cos`, …) with `k`
+//! and every offset constants: the same operations in the same order, and Cranelift neither
+//! reassociates nor contracts into fused multiply–adds, so the results are the kernels' to
+//! the bit (`tests/taylor_coefficients.rs` compares them with the compiled models'). Within one
+//! order a coefficient is loaded once and a result is reused from its register where it was
+//! stored; after each call of `solve`, which writes the series, everything is loaded again.
+//!
+//! # Memory
+//! As for [`crate::native`]: the module owning the code lives in [`NativeOrders`] and is freed
+//! with it.
+
+use std::sync::Mutex;
+
+use cranelift_codegen::ir;
+use cranelift_codegen::ir::condcodes::IntCC;
+use cranelift_codegen::ir::{
+    AbiParam, BlockArg, InstBuilder, MemFlagsData, Signature, UserFuncName, types,
+};
+use cranelift_frontend::{FunctionBuilder, FunctionBuilderContext};
+use cranelift_jit::JITModule;
+use cranelift_module::{Linkage, Module};
+use std::collections::HashMap;
+
+use eomgen_runtime::taylor::{SeriesOp, Slot, TaylorProgram, UNROLLED_CAPACITY};
+
+use crate::native::{CompileError, failure, new_module};
+
+/// The compiled orders: see the module documentation for the arguments.
+///
+/// # Safety
+/// `series` holds at least `(program.slots + n) · UNROLLED_CAPACITY` values; `solve` may be
+/// called with `context` for each order computed.
+pub(crate) type OrdersFn =
+    unsafe extern "C" fn(*mut f64, usize, *mut u8, extern "C" fn(*mut u8, usize) -> u8) -> usize;
+
+/// A model's compiled Taylor orders and the memory that holds them.
+pub(crate) struct NativeOrders {
+    /// The function.
+    pub(crate) function: OrdersFn,
+    /// The highest order it computes, `H`.
+    pub(crate) highest: usize,
+    module: Mutex<Option<JITModule>>,
+}
+
+impl std::fmt::Debug for NativeOrders {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("NativeOrders")
+            .field("highest", &self.highest)
+            .finish()
+    }
+}
+
+// SAFETY: as for `NativeCode`: after `finalize_definitions` the module is only freed, in
+// `Drop`; the code is immutable and reentrant (it reads and writes only the series and calls
+// `solve` with the context it was given).
+unsafe impl Send for NativeOrders {}
+// SAFETY: as above.
+unsafe impl Sync for NativeOrders {}
+
+impl Drop for NativeOrders {
+    fn drop(&mut self) {
+        let module = match self.module.get_mut() {
+            Ok(m) => m.take(),
+            Err(poisoned) => poisoned.into_inner().take(),
+        };
+        if let Some(module) = module {
+            // SAFETY: the only pointer into this memory is `self.function`, dropped with it.
+            unsafe { module.free_memory() };
+        }
+    }
+}
+
+/// Compiles the orders `1 …` [`TaylorProgram::highest_unrolled_order`] of `program` (see the
+/// module documentation); `None` when that is 0 (no order fits the cache).
+///
+/// # Errors
+/// [`CompileError`] if Cranelift has no code generator for the host or fails on the code.
+pub(crate) fn compile_orders(
+    program: &TaylorProgram,
+) -> Result<Option<NativeOrders>, CompileError> {
+    const NAME: &str = "taylor_orders";
+    let highest = program.highest_unrolled_order().min(UNROLLED_CAPACITY - 1);
+    if highest == 0 {
+        return Ok(None);
+    }
+    let mut module = new_module()?;
+    let call_conv = module.isa().default_call_conv();
+    let pointer = module.target_config().pointer_type();
+    let mut solve_signature = Signature::new(call_conv);
+    solve_signature.params.push(AbiParam::new(pointer));
+    solve_signature.params.push(AbiParam::new(pointer));
+    solve_signature.returns.push(AbiParam::new(types::I8));
+    let mut signature = Signature::new(call_conv);
+    for _ in 0..4 {
+        signature.params.push(AbiParam::new(pointer));
+    }
+    signature.returns.push(AbiParam::new(pointer));
+    let id = module
+        .declare_function(NAME, Linkage::Local, &signature)
+        .map_err(|e| failure(NAME, &e))?;
+    let mut context = module.make_context();
+    context.func.signature = signature;
+    context.func.name = UserFuncName::user(0, 0);
+    let mut builder_context = FunctionBuilderContext::new();
+    build(
+        &mut context.func,
+        &mut builder_context,
+        program,
+        highest,
+        solve_signature,
+        module.target_config(),
+    );
+    module
+        .define_function(id, &mut context)
+        .map_err(|e| failure(NAME, &e))?;
+    module.clear_context(&mut context);
+    module
+        .finalize_definitions()
+        .map_err(|e| CompileError::Finalize {
+            reason: e.to_string(),
+        })?;
+    let address = module.get_finalized_function(id);
+    // SAFETY: `address` is the entry of the function compiled above with exactly the
+    // signature of `OrdersFn` in the platform's default (C) calling convention.
+    let function = unsafe { std::mem::transmute::<*const u8, OrdersFn>(address) };
+    Ok(Some(NativeOrders {
+        function,
+        highest,
+        module: Mutex::new(Some(module)),
+    }))
+}
+
+/// Writes the function's body (see the module documentation).
+fn build(
+    func: &mut ir::Function,
+    builder_context: &mut FunctionBuilderContext,
+    program: &TaylorProgram,
+    highest: usize,
+    solve_signature: Signature,
+    target: cranelift_codegen::isa::TargetFrontendConfig,
+) {
+    let pointer = target.pointer_type();
+    let mut b = FunctionBuilder::new(func, builder_context);
+    let entry = b.create_block();
+    b.append_block_params_for_function_params(entry);
+    b.switch_to_block(entry);
+    b.seal_block(entry);
+    let params = b.block_params(entry).to_vec();
+    let (series, order, context, solve) = (params[0], params[1], params[2], params[3]);
+    let solve_signature = b.import_signature(solve_signature);
+    // One exit, returning its argument.
+    let exit = b.create_block();
+    b.append_block_param(exit, pointer);
+    let mut emitter = Emitter {
+        series,
+        known: HashMap::default(),
+    };
+    for k in 0..=highest {
+        // k ≥ order: return k.
+        let kv = b.ins().iconst(pointer, k as i64);
+        let done = b.ins().icmp(IntCC::UnsignedGreaterThanOrEqual, kv, order);
+        let body = b.create_block();
+        b.ins().brif(done, exit, &[BlockArg::Value(kv)], body, &[]);
+        b.switch_to_block(body);
+        b.seal_block(body);
+        if k > 0 {
+            for op in program.ops.iter() {
+                emitter.op(&mut b, *op, k);
+            }
+        }
+        let kv = b.ins().iconst(pointer, k as i64);
+        let call = b
+            .ins()
+            .call_indirect(solve_signature, solve, &[context, kv]);
+        let status = b.inst_results(call)[0];
+        // The call wrote the series: nothing known is current any more.
+        emitter.known.clear();
+        let next = b.create_block();
+        let zero = b.ins().iconst(pointer, 0);
+        b.ins()
+            .brif(status, exit, &[BlockArg::Value(zero)], next, &[]);
+        b.switch_to_block(next);
+        b.seal_block(next);
+    }
+    let after = b.ins().iconst(pointer, (highest + 1) as i64);
+    b.ins().jump(exit, &[BlockArg::Value(after)]);
+    b.switch_to_block(exit);
+    b.seal_block(exit);
+    let result = b.block_params(exit)[0];
+    b.ins().return_(&[result]);
+    b.finalize(target);
+}
+
+/// Writes the kernels' arithmetic, with the coefficients known in registers.
+struct Emitter {
+    series: ir::Value,
+    /// `(slot, order) → value` loaded or stored since the last call of `solve`.
+    known: HashMap<(Slot, usize), ir::Value>,
+}
+
+impl Emitter {
+    /// Order `i` of `slot`.
+    fn at(&mut self, b: &mut FunctionBuilder, slot: Slot, i: usize) -> ir::Value {
+        if let Some(&v) = self.known.get(&(slot, i)) {
+            return v;
+        }
+        let offset = ((slot as usize * UNROLLED_CAPACITY + i) * 8) as i32;
+        let v = b
+            .ins()
+            .load(types::F64, MemFlagsData::trusted(), self.series, offset);
+        self.known.insert((slot, i), v);
+        v
+    }
+
+    /// Writes `v` as order `k` of `slot`.
+    fn put(&mut self, b: &mut FunctionBuilder, slot: Slot, k: usize, v: ir::Value) {
+        let offset = ((slot as usize * UNROLLED_CAPACITY + k) * 8) as i32;
+        b.ins()
+            .store(MemFlagsData::trusted(), v, self.series, offset);
+        self.known.insert((slot, k), v);
+    }
+
+    fn constant(b: &mut FunctionBuilder, x: f64) -> ir::Value {
+        b.ins().f64const(x)
+    }
+
+    /// `convolution`: `Σ_{j=from}^{to} a[j] b[k − j]` from `0.0`, in increasing `j`.
+    fn convolution(
+        &mut self,
+        b: &mut FunctionBuilder,
+        x: Slot,
+        y: Slot,
+        k: usize,
+        from: usize,
+        to: usize,
+    ) -> ir::Value {
+        let mut sum = Self::constant(b, 0.0);
+        for j in from..=to {
+            let (u, v) = (self.at(b, x, j), self.at(b, y, k - j));
+            let term = b.ins().fmul(u, v);
+            sum = b.ins().fadd(sum, term);
+        }
+        sum
+    }
+
+    /// `weighted_convolution`: `Σ_{j=from}^{to} (j a[j]) b[k − j]` from `0.0`.
+    fn weighted_convolution(
+        &mut self,
+        b: &mut FunctionBuilder,
+        x: Slot,
+        y: Slot,
+        k: usize,
+        from: usize,
+        to: usize,
+    ) -> ir::Value {
+        let mut sum = Self::constant(b, 0.0);
+        for j in from..=to {
+            let (u, v) = (self.at(b, x, j), self.at(b, y, k - j));
+            let weight = Self::constant(b, j as f64);
+            let weighted = b.ins().fmul(weight, u);
+            let term = b.ins().fmul(weighted, v);
+            sum = b.ins().fadd(sum, term);
+        }
+        sum
+    }
+
+    /// `cauchy`: `(Σ_{j=1}^{k−1} a[j] b[k − j] + a[0] b[k]) + a[k] b[0]`.
+    fn cauchy(&mut self, b: &mut FunctionBuilder, x: Slot, y: Slot, k: usize) -> ir::Value {
+        let older = if k > 1 {
+            self.convolution(b, x, y, k, 1, k - 1)
+        } else {
+            Self::constant(b, 0.0)
+        };
+        let (x0, yk, xk, y0) = (
+            self.at(b, x, 0),
+            self.at(b, y, k),
+            self.at(b, x, k),
+            self.at(b, y, 0),
+        );
+        let first = b.ins().fmul(x0, yk);
+        let sum = b.ins().fadd(older, first);
+        let last = b.ins().fmul(xk, y0);
+        b.ins().fadd(sum, last)
+    }
+
+    /// `v · (1/k)`.
+    fn over_k(b: &mut FunctionBuilder, v: ir::Value, k: usize) -> ir::Value {
+        let r = Self::constant(b, 1.0 / k as f64);
+        b.ins().fmul(v, r)
+    }
+
+    /// Order `k ≥ 1` of `op`: the kernel of `eomgen_runtime::taylor` of its kind.
+    fn op(&mut self, b: &mut FunctionBuilder, op: SeriesOp, k: usize) {
+        let kf = k as f64;
+        match op {
+            SeriesOp::Neg { out, a } => {
+                let x = self.at(b, a, k);
+                let v = b.ins().fneg(x);
+                self.put(b, out, k, v);
+            }
+            SeriesOp::Copy { out, a } => {
+                let v = self.at(b, a, k);
+                self.put(b, out, k, v);
+            }
+            SeriesOp::Add { out, a, b: y } => {
+                let (u, w) = (self.at(b, a, k), self.at(b, y, k));
+                let v = b.ins().fadd(u, w);
+                self.put(b, out, k, v);
+            }
+            SeriesOp::Sub { out, a, b: y } => {
+                let (u, w) = (self.at(b, a, k), self.at(b, y, k));
+                let v = b.ins().fsub(u, w);
+                self.put(b, out, k, v);
+            }
+            SeriesOp::Mul { out, a, b: y } => {
+                let v = self.cauchy(b, a, y, k);
+                self.put(b, out, k, v);
+            }
+            SeriesOp::Scale { out, a, constant } => {
+                let (u, c) = (self.at(b, a, k), self.at(b, constant, 0));
+                let v = b.ins().fmul(u, c);
+                self.put(b, out, k, v);
+            }
+            SeriesOp::Div { out, a, b: y } => {
+                let sum = self.convolution(b, y, out, k, 1, k);
+                let (ak, y0) = (self.at(b, a, k), self.at(b, y, 0));
+                let d = b.ins().fsub(ak, sum);
+                let v = b.ins().fdiv(d, y0);
+                self.put(b, out, k, v);
+            }
+            SeriesOp::DivByConstant { out, a, constant } => {
+                let (u, c) = (self.at(b, a, k), self.at(b, constant, 0));
+                let v = b.ins().fdiv(u, c);
+                self.put(b, out, k, v);
+            }
+            SeriesOp::ConstantDiv { out, b: y } => {
+                let sum = self.convolution(b, y, out, k, 1, k);
+                let y0 = self.at(b, y, 0);
+                let minus = b.ins().fneg(sum);
+                let v = b.ins().fdiv(minus, y0);
+                self.put(b, out, k, v);
+            }
+            SeriesOp::Sqrt { out, a } => {
+                let sum = if k > 1 {
+                    self.convolution(b, out, out, k, 1, k - 1)
+                } else {
+                    Self::constant(b, 0.0)
+                };
+                let (ak, o0) = (self.at(b, a, k), self.at(b, out, 0));
+                let d = b.ins().fsub(ak, sum);
+                let two = Self::constant(b, 2.0);
+                let twice = b.ins().fmul(two, o0);
+                let v = b.ins().fdiv(d, twice);
+                self.put(b, out, k, v);
+            }
+            SeriesOp::PowConstant { out, a, exponent } => {
+                let alpha = self.at(b, exponent, 0);
+                let kc = Self::constant(b, kf);
+                let one = Self::constant(b, 1.0);
+                let mut sum = Self::constant(b, 0.0);
+                for j in (0..k).rev() {
+                    let ka = b.ins().fmul(kc, alpha);
+                    let jc = Self::constant(b, j as f64);
+                    let a1 = b.ins().fadd(alpha, one);
+                    let ja = b.ins().fmul(jc, a1);
+                    let weight = b.ins().fsub(ka, ja);
+                    let (xv, ov) = (self.at(b, a, k - j), self.at(b, out, j));
+                    let t = b.ins().fmul(weight, xv);
+                    let term = b.ins().fmul(t, ov);
+                    sum = b.ins().fadd(sum, term);
+                }
+                let x0 = self.at(b, a, 0);
+                let d = b.ins().fmul(kc, x0);
+                let v = b.ins().fdiv(sum, d);
+                self.put(b, out, k, v);
+            }
+            SeriesOp::Exp { out, a } => {
+                let w = self.weighted_convolution(b, a, out, k, 1, k);
+                let v = Self::over_k(b, w, k);
+                self.put(b, out, k, v);
+            }
+            SeriesOp::Ln { out, a } => {
+                let sum = if k > 1 {
+                    self.weighted_convolution(b, out, a, k, 1, k - 1)
+                } else {
+                    Self::constant(b, 0.0)
+                };
+                let kc = Self::constant(b, kf);
+                let (xk, x0) = (self.at(b, a, k), self.at(b, a, 0));
+                let kx = b.ins().fmul(kc, xk);
+                let n = b.ins().fsub(kx, sum);
+                let d = b.ins().fmul(kc, x0);
+                let v = b.ins().fdiv(n, d);
+                self.put(b, out, k, v);
+            }
+            SeriesOp::SinCos { sin, cos, a } => {
+                let ws = self.weighted_convolution(b, a, cos, k, 1, k);
+                let vs = Self::over_k(b, ws, k);
+                let wc = self.weighted_convolution(b, a, sin, k, 1, k);
+                let minus = b.ins().fneg(wc);
+                let vc = Self::over_k(b, minus, k);
+                self.put(b, sin, k, vs);
+                self.put(b, cos, k, vc);
+            }
+            SeriesOp::SinhCosh { sinh, cosh, a } => {
+                let ws = self.weighted_convolution(b, a, cosh, k, 1, k);
+                let vs = Self::over_k(b, ws, k);
+                let wc = self.weighted_convolution(b, a, sinh, k, 1, k);
+                let vc = Self::over_k(b, wc, k);
+                self.put(b, sinh, k, vs);
+                self.put(b, cosh, k, vc);
+            }
+            SeriesOp::Tan { out, a, square } => self.tan_or_tanh(b, k, out, a, square, 1.0),
+            SeriesOp::Tanh { out, a, square } => self.tan_or_tanh(b, k, out, a, square, -1.0),
+            SeriesOp::Asin { out, a, root, acos } => {
+                let a2 = self.cauchy(b, a, a, k);
+                let sum = if k > 1 {
+                    self.convolution(b, root, root, k, 1, k - 1)
+                } else {
+                    Self::constant(b, 0.0)
+                };
+                let r0 = self.at(b, root, 0);
+                let minus = b.ins().fneg(a2);
+                let n = b.ins().fsub(minus, sum);
+                let two = Self::constant(b, 2.0);
+                let twice = b.ins().fmul(two, r0);
+                let rk = b.ins().fdiv(n, twice);
+                let sign = if acos { -1.0 } else { 1.0 };
+                let sum = if k > 1 {
+                    self.weighted_convolution(b, out, root, k, 1, k - 1)
+                } else {
+                    Self::constant(b, 0.0)
+                };
+                let sk = Self::constant(b, sign * kf);
+                let xk = self.at(b, a, k);
+                let sx = b.ins().fmul(sk, xk);
+                let n = b.ins().fsub(sx, sum);
+                let kc = Self::constant(b, kf);
+                let d = b.ins().fmul(kc, r0);
+                let v = b.ins().fdiv(n, d);
+                self.put(b, root, k, rk);
+                self.put(b, out, k, v);
+            }
+            SeriesOp::Atan { out, a, square } => {
+                let q = self.cauchy(b, a, a, k);
+                self.put(b, square, k, q);
+                let sum = if k > 1 {
+                    self.weighted_convolution(b, out, square, k, 1, k - 1)
+                } else {
+                    Self::constant(b, 0.0)
+                };
+                let kc = Self::constant(b, kf);
+                let xk = self.at(b, a, k);
+                let kx = b.ins().fmul(kc, xk);
+                let n = b.ins().fsub(kx, sum);
+                let one = Self::constant(b, 1.0);
+                let sq0 = self.at(b, square, 0);
+                let s = b.ins().fadd(one, sq0);
+                let d = b.ins().fmul(kc, s);
+                let v = b.ins().fdiv(n, d);
+                self.put(b, out, k, v);
+            }
+            SeriesOp::Atan2 { out, y, x, norm } => {
+                let xx = self.cauchy(b, x, x, k);
+                let yy = self.cauchy(b, y, y, k);
+                let nk = b.ins().fadd(xx, yy);
+                let wy = self.weighted_convolution(b, y, x, k, 1, k);
+                let wx = self.weighted_convolution(b, x, y, k, 1, k);
+                let cross = b.ins().fsub(wy, wx);
+                self.put(b, norm, k, nk);
+                let sum = if k > 1 {
+                    self.weighted_convolution(b, out, norm, k, 1, k - 1)
+                } else {
+                    Self::constant(b, 0.0)
+                };
+                let n = b.ins().fsub(cross, sum);
+                let kc = Self::constant(b, kf);
+                let n0 = self.at(b, norm, 0);
+                let d = b.ins().fmul(kc, n0);
+                let v = b.ins().fdiv(n, d);
+                self.put(b, out, k, v);
+            }
+            SeriesOp::Zero { out } => {
+                let v = Self::constant(b, 0.0);
+                self.put(b, out, k, v);
+            }
+        }
+    }
+
+    /// `tan_or_tanh`.
+    fn tan_or_tanh(
+        &mut self,
+        b: &mut FunctionBuilder,
+        k: usize,
+        out: Slot,
+        a: Slot,
+        square: Slot,
+        sign: f64,
+    ) {
+        let w = self.weighted_convolution(b, a, square, k, 1, k);
+        let scaled = Self::over_k(b, w, k);
+        let s = Self::constant(b, sign);
+        let signed = b.ins().fmul(s, scaled);
+        let xk = self.at(b, a, k);
+        let v = b.ins().fadd(xk, signed);
+        self.put(b, out, k, v);
+        let q = self.cauchy(b, out, out, k);
+        self.put(b, square, k, q);
+    }
+}
