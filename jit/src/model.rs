@@ -685,11 +685,23 @@ impl DynMechanicalSystem for JitModel {
         };
         let program = &plan.program;
         let n = program.coordinates.len();
-        // The code's offsets assume the stride of 25 and every slot present; `solve` checks
-        // its own reads and writes.
-        if !solve.unrolled() || series.len() < (program.slots + n) * UNROLLED_CAPACITY {
+        // The code's offsets assume the stride of 25 and every slot present, and the orders
+        // it computes (below `order`, to `highest`) write `out` to the next one.
+        let computed = order.min(orders.highest + 1);
+        if !solve.unrolled()
+            || series.len() < (program.slots + n) * UNROLLED_CAPACITY
+            || out.len() < (computed + 1) * 2 * n
+        {
             return 0;
         }
+        // With a dense factor the code solves in line (the same operations as
+        // `motion_order`'s), else it calls `solve_order`.
+        let (lower, inverse_pivots) = match solve.dense_factor() {
+            Some((lower, inverse)) if lower.len() == n * n && inverse.len() == n => {
+                (lower.as_ptr(), inverse.as_ptr())
+            }
+            _ => (std::ptr::null(), std::ptr::null()),
+        };
         let mut context = OrderContext {
             layout: MotionLayout {
                 forcing: &program.forcing,
@@ -704,15 +716,20 @@ impl DynMechanicalSystem for JitModel {
             out: out.as_mut_ptr(),
             out_len: out.len(),
         };
-        // SAFETY: `series` holds every slot at the stride of 25 (checked above), and
-        // `solve_order` is called with the context built for it; `series` and `out` are not
-        // used otherwise until the call returns.
+        // SAFETY: `series` holds every slot at the stride of 25 and `out` every order the
+        // code writes (checked above); `lower` and `inverse_pivots`, when not null, hold
+        // `n × n` and `n` values that nothing writes during the call; `solve_order` is called
+        // with the context built for it; `series` and `out` are not used otherwise until the
+        // call returns.
         unsafe {
             (orders.function)(
                 context.series,
                 order,
                 (&raw mut context).cast::<u8>(),
                 solve_order,
+                context.out,
+                lower,
+                inverse_pivots,
             )
         }
     }

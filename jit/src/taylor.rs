@@ -50,8 +50,15 @@ use crate::native::{CompileError, failure, new_module};
 /// # Safety
 /// `series` holds at least `(program.slots + n) · UNROLLED_CAPACITY` values; `solve` may be
 /// called with `context` for each order computed.
-pub(crate) type OrdersFn =
-    unsafe extern "C" fn(*mut f64, usize, *mut u8, extern "C" fn(*mut u8, usize) -> u8) -> usize;
+pub(crate) type OrdersFn = unsafe extern "C" fn(
+    *mut f64,
+    usize,
+    *mut u8,
+    extern "C" fn(*mut u8, usize) -> u8,
+    *mut f64,
+    *const f64,
+    *const f64,
+) -> usize;
 
 /// A model's compiled Taylor orders and the memory that holds them.
 pub(crate) struct NativeOrders {
@@ -111,7 +118,7 @@ pub(crate) fn compile_orders(
     solve_signature.params.push(AbiParam::new(pointer));
     solve_signature.returns.push(AbiParam::new(types::I8));
     let mut signature = Signature::new(call_conv);
-    for _ in 0..4 {
+    for _ in 0..7 {
         signature.params.push(AbiParam::new(pointer));
     }
     signature.returns.push(AbiParam::new(pointer));
@@ -167,6 +174,8 @@ fn build(
     b.seal_block(entry);
     let params = b.block_params(entry).to_vec();
     let (series, order, context, solve) = (params[0], params[1], params[2], params[3]);
+    let (out, lower, inverse_pivots) = (params[4], params[5], params[6]);
+    let n = program.coordinates.len();
     let solve_signature = b.import_signature(solve_signature);
     // One exit, returning its argument.
     let exit = b.create_block();
@@ -188,19 +197,32 @@ fn build(
                 emitter.op(&mut b, *op, k);
             }
         }
+        // Order k of M a = F: in line with a dense factor, else by `solve`.
+        let (inline, call, next) = (b.create_block(), b.create_block(), b.create_block());
+        let null = b.ins().iconst(pointer, 0);
+        let sparse = b.ins().icmp(IntCC::Equal, lower, null);
+        b.ins().brif(sparse, call, &[], inline, &[]);
+        b.switch_to_block(inline);
+        b.seal_block(inline);
+        // What the two branches write differs (and the values of one do not reach the
+        // other): those entries are forgotten after them; the ops' slots stay known.
+        let before = emitter.known.clone();
+        emitter.dense_solve(&mut b, program, n, k, out, lower, inverse_pivots);
+        emitter.known = before;
+        b.ins().jump(next, &[]);
+        b.switch_to_block(call);
+        b.seal_block(call);
         let kv = b.ins().iconst(pointer, k as i64);
-        let call = b
+        let called = b
             .ins()
             .call_indirect(solve_signature, solve, &[context, kv]);
-        let status = b.inst_results(call)[0];
-        // The call wrote the series: nothing known is current any more.
-        emitter.known.clear();
-        let next = b.create_block();
+        let status = b.inst_results(called)[0];
         let zero = b.ins().iconst(pointer, 0);
         b.ins()
             .brif(status, exit, &[BlockArg::Value(zero)], next, &[]);
         b.switch_to_block(next);
         b.seal_block(next);
+        emitter.forget_solved(program, n, k);
     }
     let after = b.ins().iconst(pointer, (highest + 1) as i64);
     b.ins().jump(exit, &[BlockArg::Value(after)]);
@@ -219,6 +241,109 @@ struct Emitter {
 }
 
 impl Emitter {
+    /// Forgets what order `k`'s solve writes: the accelerations' order `k`, the inputs' and
+    /// time's order `k + 1`.
+    fn forget_solved(&mut self, program: &TaylorProgram, n: usize, k: usize) {
+        let accelerations = program.acceleration_slot();
+        for i in 0..n {
+            self.known.remove(&(accelerations + i as Slot, k));
+        }
+        for &(slot, _) in program.derived.inputs.iter() {
+            self.known.remove(&(slot, k + 1));
+        }
+        if let Some(slot) = program.time {
+            self.known.remove(&(slot, k + 1));
+        }
+    }
+
+    /// `motion_order`'s dense solve of order `k` (`dense_order`, then `next_order`), the same
+    /// operations in the same order: `b = F^[k]`, minus each varying entry's sum
+    /// `Σⱼ₌₁ᵏ M_il^[j] a_l^[k−j]` (increasing `j`, from `0.0`), `L z = b`, `z ← D⁻¹ z`,
+    /// `Lᵀ x = z`; then `a^[k] = x` into the series, `q^[k+1] = q̇^[k]/(k+1)` and
+    /// `q̇^[k+1] = x/(k+1)` into `out` (`2n` per order) and the inputs' and time's order
+    /// `k + 1` into the series.
+    #[allow(clippy::too_many_arguments)]
+    fn dense_solve(
+        &mut self,
+        b: &mut FunctionBuilder,
+        program: &TaylorProgram,
+        n: usize,
+        k: usize,
+        out: ir::Value,
+        lower: ir::Value,
+        inverse_pivots: ir::Value,
+    ) {
+        let flags = MemFlagsData::trusted();
+        let accelerations = program.acceleration_slot();
+        let mut x: Vec<ir::Value> = program
+            .forcing
+            .iter()
+            .map(|&slot| self.at(b, slot, k))
+            .collect();
+        if k > 0 {
+            for &(i, l, slot) in program.derived.varying_mass_entries.iter() {
+                let mut sum = Self::constant(b, 0.0);
+                for j in 0..k {
+                    let m = self.at(b, slot, 1 + j);
+                    let a = self.at(b, accelerations + l, k - 1 - j);
+                    let term = b.ins().fmul(m, a);
+                    sum = b.ins().fadd(sum, term);
+                }
+                x[i as usize] = b.ins().fsub(x[i as usize], sum);
+            }
+        }
+        let entry = |b: &mut FunctionBuilder, i: usize, j: usize| {
+            b.ins()
+                .load(types::F64, flags, lower, ((i * n + j) * 8) as i32)
+        };
+        for i in 0..n {
+            for j in 0..i {
+                let l = entry(b, i, j);
+                let t = b.ins().fmul(l, x[j]);
+                x[i] = b.ins().fsub(x[i], t);
+            }
+        }
+        for (i, xi) in x.iter_mut().enumerate() {
+            let d = b
+                .ins()
+                .load(types::F64, flags, inverse_pivots, (i * 8) as i32);
+            *xi = b.ins().fmul(*xi, d);
+        }
+        for i in (0..n).rev() {
+            for j in 0..i {
+                let l = entry(b, i, j);
+                let t = b.ins().fmul(l, x[i]);
+                x[j] = b.ins().fsub(x[j], t);
+            }
+        }
+        let inverse = Self::constant(b, 1.0 / (k + 1) as f64);
+        let dim = 2 * n;
+        let mut next = Vec::with_capacity(dim);
+        for i in 0..n {
+            let now = b
+                .ins()
+                .load(types::F64, flags, out, ((k * dim + n + i) * 8) as i32);
+            next.push(b.ins().fmul(now, inverse));
+        }
+        for (i, &xi) in x.iter().enumerate() {
+            self.put(b, accelerations + i as Slot, k, xi);
+            next.push(b.ins().fmul(xi, inverse));
+        }
+        for (i, &v) in next.iter().enumerate() {
+            b.ins()
+                .store(flags, v, out, (((k + 1) * dim + i) * 8) as i32);
+        }
+        if k + 1 < UNROLLED_CAPACITY {
+            for &(slot, index) in program.derived.inputs.iter() {
+                self.put(b, slot, k + 1, next[index as usize]);
+            }
+            if let Some(slot) = program.time {
+                let v = Self::constant(b, if k == 0 { 1.0 } else { 0.0 });
+                self.put(b, slot, k + 1, v);
+            }
+        }
+    }
+
     /// Order `i` of `slot`.
     fn at(&mut self, b: &mut FunctionBuilder, slot: Slot, i: usize) -> ir::Value {
         if let Some(&v) = self.known.get(&(slot, i)) {

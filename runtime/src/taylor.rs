@@ -735,6 +735,19 @@ impl MotionSolve<'_> {
     pub fn unrolled(&self) -> bool {
         self.c == UNROLLED_CAPACITY
     }
+
+    /// `(L, D⁻¹)` (`L` row-major `n × n`, unit diagonal implied) when [`motion_order`] solves
+    /// with them as a dense factor in registers — `n ≤ 6` and no zero below `L`'s diagonal —
+    /// for a run-time backend that does the same: `L z = b` row by row, `z ← D⁻¹ z`, then
+    /// `Lᵀ x = z` from the last row up; `None` when it solves over `L`'s non-zero entries.
+    pub fn dense_factor(&self) -> Option<(&[f64], &[f64])> {
+        (self.n <= FIXED_DEGREES && self.dense).then(|| {
+            (
+                &self.lower[..self.n * self.n],
+                &self.inverse_pivots[..self.n],
+            )
+        })
+    }
 }
 
 /// The largest `n` whose solves [`motion_order`] compiles for a known `n` (dense `L` in
