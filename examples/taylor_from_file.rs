@@ -1,0 +1,97 @@
+//! The Taylor method on a bundled model three ways, in the same run: compiled by `model!`,
+//! loaded from its file with its orders compiled to native code from the first series
+//! (`LoadOptions::eager_taylor`), and loaded from its file with the runtime's kernels alone
+//! (the interpreter backend: what a file-loaded model runs before it has computed
+//! `eomgen_jit::COMPILE_TAYLOR_AFTER` series). All three compute the same bits
+//! (`tests/taylor_coefficients.rs`); this times them.
+//!
+//! ```sh
+//! cargo run --release --example taylor_from_file -- double_pendulum 1e-9 200
+//! ```
+//!
+//! Arguments: a bundled model's name, the tolerance (`rtol = atol`), the number of timed runs
+//! of each (default 100), alternated A B C A B C …; each run integrates the model's initial
+//! state over 0–10 s with every step recorded. Prints, per variant, the median time of a run
+//! and the first run's (which includes compiling the orders for the eager variant), and the
+//! steps.
+
+use std::hint::black_box;
+use std::time::Instant;
+
+use eomgen::{
+    Backend, DynFirstOrder, Integrator, IntegratorOptions, JitModel, LoadOptions, ModelInfo,
+    OutputTimes, Taylor,
+};
+
+fn main() -> Result<(), String> {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let name = args
+        .first()
+        .ok_or("usage: taylor_from_file MODEL TOL [RUNS]")?;
+    let tol: f64 = args
+        .get(1)
+        .ok_or("usage: taylor_from_file MODEL TOL [RUNS]")?
+        .parse()
+        .map_err(|e| format!("the tolerance: {e}"))?;
+    let runs: usize = match args.get(2) {
+        Some(r) => r.parse().map_err(|e| format!("the number of runs: {e}"))?,
+        None => 100,
+    };
+    let entry = eomgen::models::find(name).ok_or_else(|| format!("no bundled model `{name}`"))?;
+    let path = format!("{}/models/{name}.yaml", env!("CARGO_MANIFEST_DIR"));
+    let load = |options: LoadOptions| -> Result<Box<dyn ModelInfo>, String> {
+        let model = JitModel::load_with(&path, options).map_err(|e| format!("{path}: {e}"))?;
+        Ok(Box::new(DynFirstOrder::new(model)))
+    };
+    let mut variants: Vec<(&str, Box<dyn ModelInfo>)> = vec![
+        ("compiled (model!)", (entry.make)()),
+        (
+            "file, orders compiled",
+            load(LoadOptions {
+                eager_taylor: true,
+                ..LoadOptions::default()
+            })?,
+        ),
+        (
+            "file, runtime kernels",
+            load(LoadOptions {
+                backend: Some(Backend::Interpreter),
+                ..LoadOptions::default()
+            })?,
+        ),
+    ];
+    let options = IntegratorOptions::default().with_rtol(tol).with_atol(tol);
+    let mut times = vec![Vec::with_capacity(runs); variants.len()];
+    let mut steps = vec![0; variants.len()];
+    for _ in 0..runs {
+        for (i, (label, model)) in variants.iter_mut().enumerate() {
+            let y0 = model.initial_state();
+            let start = Instant::now();
+            let solution = Taylor::new()
+                .integrate(
+                    model.as_mut(),
+                    0.0,
+                    &y0,
+                    10.0,
+                    &OutputTimes::Steps,
+                    &options,
+                )
+                .map_err(|e| format!("{label}: {e}"))?;
+            times[i].push(start.elapsed().as_secs_f64());
+            steps[i] = solution.stats.steps;
+            black_box(solution);
+        }
+    }
+    for (i, (label, _)) in variants.iter().enumerate() {
+        let first = times[i][0];
+        let mut sorted = times[i].clone();
+        sorted.sort_by(f64::total_cmp);
+        println!(
+            "{label:<24} median {:8.1} µs   first {:8.3} ms   {} steps",
+            sorted[sorted.len() / 2] * 1e6,
+            first * 1e3,
+            steps[i]
+        );
+    }
+    Ok(())
+}
