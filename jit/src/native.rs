@@ -109,7 +109,7 @@ pub(crate) struct NativeCode {
     /// Bytes of machine code (without alignment padding and the module's bookkeeping).
     pub(crate) code_bytes: usize,
     /// The module that owns the executable memory, freed on drop.
-    module: Mutex<Option<JITModule>>,
+    _memory: ModuleMemory,
 }
 
 impl std::fmt::Debug for NativeCode {
@@ -121,23 +121,34 @@ impl std::fmt::Debug for NativeCode {
     }
 }
 
-// SAFETY: after `finalize_definitions` the module is never used again except to free its
-// memory in `Drop`, which has exclusive access; the code itself is immutable and reentrant
-// (it reads only its arguments and writes only its output buffers), so calling it from
-// several threads at once is sound. The `Mutex` makes the module's own `Sync` moot.
-unsafe impl Send for NativeCode {}
-// SAFETY: as above.
-unsafe impl Sync for NativeCode {}
+/// A finalised module's executable memory, freed when dropped (with the function pointers
+/// into it, which its owner holds beside it and never hands out).
+pub(crate) struct ModuleMemory(Mutex<Option<JITModule>>);
 
-impl Drop for NativeCode {
+impl ModuleMemory {
+    /// Takes `module`, its definitions finalised.
+    pub(crate) fn new(module: JITModule) -> Self {
+        Self(Mutex::new(Some(module)))
+    }
+}
+
+// SAFETY: after `finalize_definitions` the module is never used again except to free its
+// memory in `Drop`, which has exclusive access; the code in it is immutable and reentrant
+// (it reads only its arguments and writes only the buffers it is given), so calling it from
+// several threads at once is sound. The `Mutex` makes the module's own `Sync` moot.
+unsafe impl Send for ModuleMemory {}
+// SAFETY: as above.
+unsafe impl Sync for ModuleMemory {}
+
+impl Drop for ModuleMemory {
     fn drop(&mut self) {
-        let module = match self.module.get_mut() {
+        let module = match self.0.get_mut() {
             Ok(m) => m.take(),
             Err(poisoned) => poisoned.into_inner().take(),
         };
         if let Some(module) = module {
-            // SAFETY: the function pointers into this memory are in `self.functions`, which
-            // is being dropped with it; nothing else holds them (they never leave the crate).
+            // SAFETY: the function pointers into this memory belong to the owner being
+            // dropped with it; nothing else holds them (they never leave the crate).
             unsafe { module.free_memory() };
         }
     }
@@ -251,7 +262,7 @@ pub(crate) fn compile(functions: &[(&str, &FunctionTape)]) -> Result<NativeCode,
         functions,
         scratch,
         code_bytes,
-        module: Mutex::new(Some(module)),
+        _memory: ModuleMemory::new(module),
     })
 }
 

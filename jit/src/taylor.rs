@@ -29,21 +29,18 @@
 //! As for [`crate::native`]: the module owning the code lives in [`NativeOrders`] and is freed
 //! with it.
 
-use std::sync::Mutex;
-
 use cranelift_codegen::ir;
 use cranelift_codegen::ir::condcodes::IntCC;
 use cranelift_codegen::ir::{
     AbiParam, BlockArg, InstBuilder, MemFlagsData, Signature, UserFuncName, types,
 };
 use cranelift_frontend::{FunctionBuilder, FunctionBuilderContext};
-use cranelift_jit::JITModule;
 use cranelift_module::{Linkage, Module};
 use std::collections::HashMap;
 
 use eomgen_runtime::taylor::{SeriesOp, Slot, TaylorProgram, UNROLLED_CAPACITY};
 
-use crate::native::{CompileError, failure, new_module};
+use crate::native::{CompileError, ModuleMemory, failure, new_module};
 
 /// The compiled orders: see the module documentation for the arguments.
 ///
@@ -66,7 +63,7 @@ pub(crate) struct NativeOrders {
     pub(crate) function: OrdersFn,
     /// The highest order it computes, `H`.
     pub(crate) highest: usize,
-    module: Mutex<Option<JITModule>>,
+    _memory: ModuleMemory,
 }
 
 impl std::fmt::Debug for NativeOrders {
@@ -74,26 +71,6 @@ impl std::fmt::Debug for NativeOrders {
         f.debug_struct("NativeOrders")
             .field("highest", &self.highest)
             .finish()
-    }
-}
-
-// SAFETY: as for `NativeCode`: after `finalize_definitions` the module is only freed, in
-// `Drop`; the code is immutable and reentrant (it reads and writes only the series and calls
-// `solve` with the context it was given).
-unsafe impl Send for NativeOrders {}
-// SAFETY: as above.
-unsafe impl Sync for NativeOrders {}
-
-impl Drop for NativeOrders {
-    fn drop(&mut self) {
-        let module = match self.module.get_mut() {
-            Ok(m) => m.take(),
-            Err(poisoned) => poisoned.into_inner().take(),
-        };
-        if let Some(module) = module {
-            // SAFETY: the only pointer into this memory is `self.function`, dropped with it.
-            unsafe { module.free_memory() };
-        }
     }
 }
 
@@ -153,7 +130,7 @@ pub(crate) fn compile_orders(
     Ok(Some(NativeOrders {
         function,
         highest,
-        module: Mutex::new(Some(module)),
+        _memory: ModuleMemory::new(module),
     }))
 }
 
@@ -379,13 +356,7 @@ impl Emitter {
         from: usize,
         to: usize,
     ) -> ir::Value {
-        let mut sum = Self::constant(b, 0.0);
-        for j in from..=to {
-            let (u, v) = (self.at(b, x, j), self.at(b, y, k - j));
-            let term = b.ins().fmul(u, v);
-            sum = b.ins().fadd(sum, term);
-        }
-        sum
+        self.sum_of_products(b, (x, y, k), from..=to, false)
     }
 
     /// `weighted_convolution`: `Σ_{j=from}^{to} (j a[j]) b[k − j]` from `0.0`.
@@ -398,12 +369,28 @@ impl Emitter {
         from: usize,
         to: usize,
     ) -> ir::Value {
+        self.sum_of_products(b, (x, y, k), from..=to, true)
+    }
+
+    /// `Σ_{j ∈ range} a[j] b[k − j]`, each term `(j a[j]) b[k − j]` if `weighted`, summed
+    /// from `0.0` in increasing `j`.
+    fn sum_of_products(
+        &mut self,
+        b: &mut FunctionBuilder,
+        (x, y, k): (Slot, Slot, usize),
+        range: std::ops::RangeInclusive<usize>,
+        weighted: bool,
+    ) -> ir::Value {
         let mut sum = Self::constant(b, 0.0);
-        for j in from..=to {
+        for j in range {
             let (u, v) = (self.at(b, x, j), self.at(b, y, k - j));
-            let weight = Self::constant(b, j as f64);
-            let weighted = b.ins().fmul(weight, u);
-            let term = b.ins().fmul(weighted, v);
+            let u = if weighted {
+                let weight = Self::constant(b, j as f64);
+                b.ins().fmul(weight, u)
+            } else {
+                u
+            };
+            let term = b.ins().fmul(u, v);
             sum = b.ins().fadd(sum, term);
         }
         sum
