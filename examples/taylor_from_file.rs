@@ -1,8 +1,8 @@
 //! The Taylor method on a bundled model three ways, in the same run: compiled by `model!`,
 //! loaded from its file with its orders compiled to native code from the first series
 //! (`LoadOptions::eager_taylor`), and loaded from its file with the runtime's kernels alone
-//! (the interpreter backend: what a file-loaded model runs before it has computed
-//! `eomgen_jit::COMPILE_TAYLOR_AFTER` series). All three compute the same bits
+//! (the interpreter backend, whose Taylor orders are what a file-loaded model runs before it
+//! has computed `eomgen_jit::COMPILE_TAYLOR_AFTER` series). All three compute the same bits
 //! (`tests/taylor_coefficients.rs`); this times them.
 //!
 //! ```sh
@@ -37,6 +37,9 @@ fn main() -> Result<(), String> {
         Some(r) => r.parse().map_err(|e| format!("the number of runs: {e}"))?,
         None => 100,
     };
+    if runs == 0 {
+        return Err("the number of runs must be at least 1".into());
+    }
     let entry = eomgen::models::find(name).ok_or_else(|| format!("no bundled model `{name}`"))?;
     let path = format!("{}/models/{name}.yaml", env!("CARGO_MANIFEST_DIR"));
     let load = |options: LoadOptions| -> Result<Box<dyn ModelInfo>, String> {

@@ -227,9 +227,9 @@ struct Code {
 }
 
 /// Taylor series a run-time model computes with the runtime's kernels before its orders are
-/// compiled to native code: compiling costs 14–22 ms (the bundled models with recurrences,
-/// 10–18 orders), what about 20,000 double-pendulum series at tol 1e-9 cost interpreted
-/// (0.9 µs each, against 0.6 µs compiled), so a run never pays more than about twice what
+/// compiled to native code: compiling the double pendulum's 18 orders or the figure eight's
+/// 11 costs 18–28 ms, what about 20,000 double-pendulum series at tol 1e-9 cost with the
+/// kernels (0.9 µs each, against 0.45 µs compiled), so a run never pays more than about twice what
 /// the better choice in hindsight costs (the rent-or-buy rule), and a short run pays nothing.
 pub const COMPILE_TAYLOR_AFTER: usize = 20_000;
 
@@ -256,7 +256,12 @@ impl Code {
         self.taylor_orders
             .get_or_init(|| {
                 let plan = self.taylor.as_ref().ok()?;
-                crate::taylor::compile_orders(&plan.program).ok().flatten()
+                // A panic in Cranelift leaves the orders to the kernels for good (not a
+                // compilation attempted again at every series).
+                std::panic::catch_unwind(|| crate::taylor::compile_orders(&plan.program))
+                    .ok()?
+                    .ok()
+                    .flatten()
             })
             .as_ref()
     }
@@ -734,16 +739,13 @@ impl DynMechanicalSystem for JitModel {
         }
     }
     fn taylor_fused_orders(&self) -> usize {
-        // Before they are compiled, the orders they will be (so that the workspace already
-        // has their stride).
-        match (self.code.taylor_orders.get(), &self.code.taylor) {
-            (Some(compiled), _) => compiled.as_ref().map_or(0, |orders| orders.highest),
-            (None, Ok(plan)) if self.code.taylor_native() => plan
-                .program
-                .highest_unrolled_order()
-                .min(UNROLLED_CAPACITY - 1),
-            _ => 0,
-        }
+        // None before they are compiled: until then the workspace's stride follows the
+        // kernels' rule (`TaylorProgram::unrolled_code_fits`), as for a model without them.
+        self.code
+            .taylor_orders
+            .get()
+            .and_then(Option::as_ref)
+            .map_or(0, |orders| orders.highest)
     }
     fn parameter_values(&self) -> Vec<f64> {
         self.parameters.clone()

@@ -7,23 +7,29 @@
 //!
 //! ```text
 //! fn(series: *mut f64, order: usize, context: *mut u8,
-//!    solve: extern "C" fn(context: *mut u8, k: usize) -> u8) -> usize
+//!    solve: extern "C" fn(context: *mut u8, k: usize) -> u8,
+//!    out: *mut f64, lower: *const f64, inverse_pivots: *const f64) -> usize
 //! ```
 //!
 //! For `k = 0, 1, …, H` while `k < order`, it computes order `k` of every op of the program
-//! (none at `k = 0`), then calls `solve(context, k)` for order `k` of `M a = F`
-//! ([`eomgen_runtime::taylor::motion_order_at`], which writes the accelerations' order `k`
-//! and the state's order `k + 1`); it returns the first order it did not compute, or 0 if a
-//! call of `solve` returned non-zero. `H` is [`TaylorProgram::highest_unrolled_order`], the
-//! orders whose code fits the instruction cache, as for a compiled model; the series has the
-//! stride [`UNROLLED_CAPACITY`] (slot `x`'s order `i` at `x · 25 + i`).
+//! (none at `k = 0`), then order `k` of `M a = F` (the accelerations' order `k` into the
+//! series, the state's order `k + 1` into `out`, `2n` values per order, and into the inputs'
+//! slots): in line, with `L` and `D⁻¹` of a dense factor (`lower` not null: the operations of
+//! `motion_order`'s dense solve), else by calling `solve(context, k)`
+//! ([`eomgen_runtime::taylor::motion_order_at`]). It returns the first order it did not
+//! compute, or 0 if a call of `solve` returned non-zero. `H` is
+//! [`TaylorProgram::highest_unrolled_order`], the orders whose code fits the instruction
+//! cache, as for a compiled model; the series has the stride [`UNROLLED_CAPACITY`] (slot
+//! `x`'s order `i` at `x · 25 + i`).
 //!
 //! Each op's order `k` is its kernel of `eomgen_runtime::taylor` (`mul`, `sin_cos`, …) with `k`
 //! and every offset constants: the same operations in the same order, and Cranelift neither
 //! reassociates nor contracts into fused multiply–adds, so the results are the kernels' to
-//! the bit (`tests/taylor_coefficients.rs` compares them with the compiled models'). Within one
-//! order a coefficient is loaded once and a result is reused from its register where it was
-//! stored; after each call of `solve`, which writes the series, everything is loaded again.
+//! the bit (`tests/taylor_coefficients.rs` compares them with the compiled models' and with
+//! the kernels on models using every op kind). A coefficient is loaded once and a result
+//! reused from where it was computed, across orders; what the solve writes (the
+//! accelerations' order `k`, the inputs' and time's order `k + 1`) is forgotten after it,
+//! which holds because `motion_order_at` writes nothing else of the series.
 //!
 //! # Memory
 //! As for [`crate::native`]: the module owning the code lives in [`NativeOrders`] and is freed
@@ -45,8 +51,9 @@ use crate::native::{CompileError, ModuleMemory, failure, new_module};
 /// The compiled orders: see the module documentation for the arguments.
 ///
 /// # Safety
-/// `series` holds at least `(program.slots + n) · UNROLLED_CAPACITY` values; `solve` may be
-/// called with `context` for each order computed.
+/// `series` holds at least `(program.slots + n) · UNROLLED_CAPACITY` values; `out` at least
+/// `(min(order, H + 1) + 1) · 2n`; `lower` and `inverse_pivots` are null or hold `n · n` and
+/// `n` values of a dense factor; `solve` may be called with `context` for each order.
 pub(crate) type OrdersFn = unsafe extern "C" fn(
     *mut f64,
     usize,
@@ -213,7 +220,7 @@ fn build(
 /// Writes the kernels' arithmetic, with the coefficients known in registers.
 struct Emitter {
     series: ir::Value,
-    /// `(slot, order) → value` loaded or stored since the last call of `solve`.
+    /// `(slot, order) → value` loaded or stored, less what each solve writes.
     known: HashMap<(Slot, usize), ir::Value>,
 }
 
