@@ -388,14 +388,19 @@ fn angle_differences_run_as_one_sin_cos() {
 /// The run-time model's Taylor orders compiled to native code against the runtime's kernels
 /// (the interpreter backend), to the bit, on two models that use every op kind (`exp`, `ln`,
 /// `sinh`/`cosh`, `tan`, `tanh`, `asin`, `acos`, `atan`, `atan2`, powers, roots, quotients:
-/// the bundled models use only some) and a mass matrix that varies, dense (solved in line by
-/// the compiled orders) and diagonal (solved by their call per order); and the orders really
+/// the bundled models use only some) and a mass matrix that varies: dense and diagonal (the
+/// compiled orders solve them in line) and with a factor that is neither (solved by their
+/// call per order); and the orders really
 /// are compiled (`taylor_fused_orders` after the first series: a failure of Cranelift would
 /// leave them to the kernels and this comparison would prove nothing).
 #[test]
 fn compiled_orders_of_every_op_kind_are_the_kernels_bits() {
     use eomgen::{Backend, DynMechanicalSystem, OdeSystem};
-    for file in ["taylor_ops_dense", "taylor_ops_diagonal"] {
+    for file in [
+        "taylor_ops_dense",
+        "taylor_ops_diagonal",
+        "taylor_ops_sparse",
+    ] {
         let path = format!("{}/tests/fixtures/{file}.yaml", env!("CARGO_MANIFEST_DIR"));
         let load =
             |options| JitModel::load_with(&path, options).unwrap_or_else(|e| panic!("{path}: {e}"));
@@ -414,15 +419,20 @@ fn compiled_orders_of_every_op_kind_are_the_kernels_bits() {
         }));
         let handle = native.clone();
         let mut native = DynFirstOrder::new(native);
+        let y0 = ModelInfo::initial_state(&native);
         for (shift, order) in [12, 1, 2, 5, 8, 13, 17, 23, 24, 25, 30, 0, 7]
             .into_iter()
             .enumerate()
         {
             let t = 0.1 * shift as f64;
-            let y: Vec<f64> = (0..4)
-                .map(|i| [0.3, -0.2, 0.1, 0.4][i] + 1e-2 * (shift * (i + 1)) as f64)
+            // The file's initial state, moved from call to call.
+            let y: Vec<f64> = y0
+                .iter()
+                .enumerate()
+                .map(|(i, v)| v + 1e-2 * (shift * (i + 1)) as f64)
                 .collect();
-            let mut a = vec![f64::NAN; (order + 1) * 4];
+            let dim = y.len();
+            let mut a = vec![f64::NAN; (order + 1) * dim];
             let mut b = a.clone();
             native
                 .taylor_coefficients(t, &y, order, &mut a)
@@ -435,8 +445,8 @@ fn compiled_orders_of_every_op_kind_are_the_kernels_bits() {
                     x.to_bits(),
                     z.to_bits(),
                     "{file} to order {order}: order {}, component {}: compiled {x:e}, kernels {z:e}",
-                    j / 4,
-                    j % 4
+                    j / dim,
+                    j % dim
                 );
             }
             assert_eq!(

@@ -699,12 +699,13 @@ impl DynMechanicalSystem for JitModel {
         {
             return 0;
         }
-        // With a dense factor the code solves in line (the same operations as
+        // With a dense or a diagonal factor the code solves in line (the same operations as
         // `motion_order`'s), else it calls `solve_order`.
-        let (lower, inverse_pivots) = match solve.dense_factor() {
-            Some((lower, inverse)) if lower.len() == n * n && inverse.len() == n => {
+        let (lower, inverse_pivots) = match (solve.dense_factor(), solve.diagonal_factor()) {
+            (Some((lower, inverse)), _) if lower.len() == n * n && inverse.len() == n => {
                 (lower.as_ptr(), inverse.as_ptr())
             }
+            (_, Some(inverse)) if inverse.len() == n => (std::ptr::null(), inverse.as_ptr()),
             _ => (std::ptr::null(), std::ptr::null()),
         };
         let mut context = OrderContext {

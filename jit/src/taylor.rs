@@ -15,7 +15,8 @@
 //! (none at `k = 0`), then order `k` of `M a = F` (the accelerations' order `k` into the
 //! series, the state's order `k + 1` into `out`, `2n` values per order, and into the inputs'
 //! slots): in line, with `L` and `D⁻¹` of a dense factor (`lower` not null: the operations of
-//! `motion_order`'s dense solve), else by calling `solve(context, k)`
+//! `motion_order`'s dense solve) or `D⁻¹` of a diagonal one (`lower` null, `inverse_pivots`
+//! not), else by calling `solve(context, k)`
 //! ([`eomgen_runtime::taylor::motion_order_at`]). It returns the first order it did not
 //! compute, or 0 if a call of `solve` returned non-zero. `H` is
 //! [`TaylorProgram::highest_unrolled_order`], the orders whose code fits the instruction
@@ -52,8 +53,9 @@ use crate::native::{CompileError, ModuleMemory, failure, new_module};
 ///
 /// # Safety
 /// `series` holds at least `(program.slots + n) · UNROLLED_CAPACITY` values; `out` at least
-/// `(min(order, H + 1) + 1) · 2n`; `lower` and `inverse_pivots` are null or hold `n · n` and
-/// `n` values of a dense factor; `solve` may be called with `context` for each order.
+/// `(min(order, H + 1) + 1) · 2n`; `lower` is null or holds the `n · n` values of a dense
+/// factor, `inverse_pivots` null or its `n` pivots' reciprocals (with `lower` null: a diagonal
+/// factor's); `solve` may be called with `context` for each order.
 pub(crate) type OrdersFn = unsafe extern "C" fn(
     *mut f64,
     usize,
@@ -181,19 +183,33 @@ fn build(
                 emitter.op(&mut b, *op, k);
             }
         }
-        // Order k of M a = F: in line with a dense factor, else by `solve`.
-        let (inline, call, next) = (b.create_block(), b.create_block(), b.create_block());
+        // Order k of M a = F: in line with a dense or a diagonal factor, else by `solve`.
+        let (inline, not_dense, diagonal, call, next) = (
+            b.create_block(),
+            b.create_block(),
+            b.create_block(),
+            b.create_block(),
+            b.create_block(),
+        );
         let null = b.ins().iconst(pointer, 0);
-        let sparse = b.ins().icmp(IntCC::Equal, lower, null);
-        b.ins().brif(sparse, call, &[], inline, &[]);
-        b.switch_to_block(inline);
-        b.seal_block(inline);
-        // What the two branches write differs (and the values of one do not reach the
-        // other): those entries are forgotten after them; the ops' slots stay known.
-        let before = emitter.known.clone();
-        emitter.dense_solve(&mut b, program, n, k, out, lower, inverse_pivots);
-        emitter.known = before;
-        b.ins().jump(next, &[]);
+        let no_lower = b.ins().icmp(IntCC::Equal, lower, null);
+        b.ins().brif(no_lower, not_dense, &[], inline, &[]);
+        // What the branches write differs (and the values of one do not reach the others):
+        // those entries are forgotten after them; the ops' slots stay known.
+        for (block, lower) in [(inline, Some(lower)), (diagonal, None)] {
+            b.switch_to_block(block);
+            b.seal_block(block);
+            let before = emitter.known.clone();
+            emitter.dense_solve(&mut b, program, n, k, out, lower, inverse_pivots);
+            emitter.known = before;
+            b.ins().jump(next, &[]);
+            if lower.is_some() {
+                b.switch_to_block(not_dense);
+                b.seal_block(not_dense);
+                let no_inverse = b.ins().icmp(IntCC::Equal, inverse_pivots, null);
+                b.ins().brif(no_inverse, call, &[], diagonal, &[]);
+            }
+        }
         b.switch_to_block(call);
         b.seal_block(call);
         let kv = b.ins().iconst(pointer, k as i64);
@@ -243,7 +259,8 @@ impl Emitter {
     /// `motion_order`'s dense solve of order `k` (`dense_order`, then `next_order`), the same
     /// operations in the same order: `b = F^[k]`, minus each varying entry's sum
     /// `Σⱼ₌₁ᵏ M_il^[j] a_l^[k−j]` (increasing `j`, from `0.0`), `L z = b`, `z ← D⁻¹ z`,
-    /// `Lᵀ x = z`; then `a^[k] = x` into the series, `q^[k+1] = q̇^[k]/(k+1)` and
+    /// `Lᵀ x = z` (with `lower` `None`, a diagonal factor: `x = D⁻¹ b` alone, as
+    /// `sparse_order` over no non-zero entries); then `a^[k] = x` into the series, `q^[k+1] = q̇^[k]/(k+1)` and
     /// `q̇^[k+1] = x/(k+1)` into `out` (`2n` per order) and the inputs' and time's order
     /// `k + 1` into the series.
     #[allow(clippy::too_many_arguments)]
@@ -254,7 +271,7 @@ impl Emitter {
         n: usize,
         k: usize,
         out: ir::Value,
-        lower: ir::Value,
+        lower: Option<ir::Value>,
         inverse_pivots: ir::Value,
     ) {
         let flags = MemFlagsData::trusted();
@@ -276,15 +293,17 @@ impl Emitter {
                 x[i as usize] = b.ins().fsub(x[i as usize], sum);
             }
         }
-        let entry = |b: &mut FunctionBuilder, i: usize, j: usize| {
+        let entry = |b: &mut FunctionBuilder, lower: ir::Value, i: usize, j: usize| {
             b.ins()
                 .load(types::F64, flags, lower, ((i * n + j) * 8) as i32)
         };
-        for i in 0..n {
-            for j in 0..i {
-                let l = entry(b, i, j);
-                let t = b.ins().fmul(l, x[j]);
-                x[i] = b.ins().fsub(x[i], t);
+        if let Some(lower) = lower {
+            for i in 0..n {
+                for j in 0..i {
+                    let l = entry(b, lower, i, j);
+                    let t = b.ins().fmul(l, x[j]);
+                    x[i] = b.ins().fsub(x[i], t);
+                }
             }
         }
         for (i, xi) in x.iter_mut().enumerate() {
@@ -293,11 +312,13 @@ impl Emitter {
                 .load(types::F64, flags, inverse_pivots, (i * 8) as i32);
             *xi = b.ins().fmul(*xi, d);
         }
-        for i in (0..n).rev() {
-            for j in 0..i {
-                let l = entry(b, i, j);
-                let t = b.ins().fmul(l, x[i]);
-                x[j] = b.ins().fsub(x[j], t);
+        if let Some(lower) = lower {
+            for i in (0..n).rev() {
+                for j in 0..i {
+                    let l = entry(b, lower, i, j);
+                    let t = b.ins().fmul(l, x[i]);
+                    x[j] = b.ins().fsub(x[j], t);
+                }
             }
         }
         let inverse = Self::constant(b, 1.0 / (k + 1) as f64);

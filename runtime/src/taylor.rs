@@ -748,6 +748,15 @@ impl MotionSolve<'_> {
             )
         })
     }
+
+    /// `D⁻¹` when `L` is the identity (no non-zero entry below its diagonal: a diagonal `M`),
+    /// whose solve is then `x = D⁻¹ b` alone, for a run-time backend that does the same;
+    /// `None` otherwise.
+    pub fn diagonal_factor(&self) -> Option<&[f64]> {
+        self.nonzeros
+            .is_empty()
+            .then(|| &self.inverse_pivots[..self.n])
+    }
 }
 
 /// The largest `n` whose solves [`motion_order`] compiles for a known `n` (dense `L` in
