@@ -374,34 +374,9 @@ impl Emitter {
         b.ins().f64const(x)
     }
 
-    /// `convolution`: `Σ_{j=from}^{to} a[j] b[k − j]` from `0.0`, in increasing `j`.
-    fn convolution(
-        &mut self,
-        b: &mut FunctionBuilder,
-        x: Slot,
-        y: Slot,
-        k: usize,
-        from: usize,
-        to: usize,
-    ) -> ir::Value {
-        self.sum_of_products(b, (x, y, k), from..=to, false)
-    }
-
-    /// `weighted_convolution`: `Σ_{j=from}^{to} (j a[j]) b[k − j]` from `0.0`.
-    fn weighted_convolution(
-        &mut self,
-        b: &mut FunctionBuilder,
-        x: Slot,
-        y: Slot,
-        k: usize,
-        from: usize,
-        to: usize,
-    ) -> ir::Value {
-        self.sum_of_products(b, (x, y, k), from..=to, true)
-    }
-
-    /// `Σ_{j ∈ range} a[j] b[k − j]`, each term `(j a[j]) b[k − j]` if `weighted`, summed
-    /// from `0.0` in increasing `j`.
+    /// The kernels' `convolution` (`Σ_{j ∈ range} a[j] b[k − j]`) or, if `weighted`, their
+    /// `weighted_convolution` (each term `(j a[j]) b[k − j]`), summed from `0.0` in increasing
+    /// `j`.
     fn sum_of_products(
         &mut self,
         b: &mut FunctionBuilder,
@@ -427,7 +402,7 @@ impl Emitter {
     /// `cauchy`: `(Σ_{j=1}^{k−1} a[j] b[k − j] + a[0] b[k]) + a[k] b[0]`.
     fn cauchy(&mut self, b: &mut FunctionBuilder, x: Slot, y: Slot, k: usize) -> ir::Value {
         let older = if k > 1 {
-            self.convolution(b, x, y, k, 1, k - 1)
+            self.sum_of_products(b, (x, y, k), 1..=k - 1, false)
         } else {
             Self::constant(b, 0.0)
         };
@@ -482,7 +457,7 @@ impl Emitter {
                 self.put(b, out, k, v);
             }
             SeriesOp::Div { out, a, b: y } => {
-                let sum = self.convolution(b, y, out, k, 1, k);
+                let sum = self.sum_of_products(b, (y, out, k), 1..=k, false);
                 let (ak, y0) = (self.at(b, a, k), self.at(b, y, 0));
                 let d = b.ins().fsub(ak, sum);
                 let v = b.ins().fdiv(d, y0);
@@ -494,7 +469,7 @@ impl Emitter {
                 self.put(b, out, k, v);
             }
             SeriesOp::ConstantDiv { out, b: y } => {
-                let sum = self.convolution(b, y, out, k, 1, k);
+                let sum = self.sum_of_products(b, (y, out, k), 1..=k, false);
                 let y0 = self.at(b, y, 0);
                 let minus = b.ins().fneg(sum);
                 let v = b.ins().fdiv(minus, y0);
@@ -502,7 +477,7 @@ impl Emitter {
             }
             SeriesOp::Sqrt { out, a } => {
                 let sum = if k > 1 {
-                    self.convolution(b, out, out, k, 1, k - 1)
+                    self.sum_of_products(b, (out, out, k), 1..=k - 1, false)
                 } else {
                     Self::constant(b, 0.0)
                 };
@@ -535,13 +510,13 @@ impl Emitter {
                 self.put(b, out, k, v);
             }
             SeriesOp::Exp { out, a } => {
-                let w = self.weighted_convolution(b, a, out, k, 1, k);
+                let w = self.sum_of_products(b, (a, out, k), 1..=k, true);
                 let v = Self::over_k(b, w, k);
                 self.put(b, out, k, v);
             }
             SeriesOp::Ln { out, a } => {
                 let sum = if k > 1 {
-                    self.weighted_convolution(b, out, a, k, 1, k - 1)
+                    self.sum_of_products(b, (out, a, k), 1..=k - 1, true)
                 } else {
                     Self::constant(b, 0.0)
                 };
@@ -554,18 +529,18 @@ impl Emitter {
                 self.put(b, out, k, v);
             }
             SeriesOp::SinCos { sin, cos, a } => {
-                let ws = self.weighted_convolution(b, a, cos, k, 1, k);
+                let ws = self.sum_of_products(b, (a, cos, k), 1..=k, true);
                 let vs = Self::over_k(b, ws, k);
-                let wc = self.weighted_convolution(b, a, sin, k, 1, k);
+                let wc = self.sum_of_products(b, (a, sin, k), 1..=k, true);
                 let minus = b.ins().fneg(wc);
                 let vc = Self::over_k(b, minus, k);
                 self.put(b, sin, k, vs);
                 self.put(b, cos, k, vc);
             }
             SeriesOp::SinhCosh { sinh, cosh, a } => {
-                let ws = self.weighted_convolution(b, a, cosh, k, 1, k);
+                let ws = self.sum_of_products(b, (a, cosh, k), 1..=k, true);
                 let vs = Self::over_k(b, ws, k);
-                let wc = self.weighted_convolution(b, a, sinh, k, 1, k);
+                let wc = self.sum_of_products(b, (a, sinh, k), 1..=k, true);
                 let vc = Self::over_k(b, wc, k);
                 self.put(b, sinh, k, vs);
                 self.put(b, cosh, k, vc);
@@ -575,7 +550,7 @@ impl Emitter {
             SeriesOp::Asin { out, a, root, acos } => {
                 let a2 = self.cauchy(b, a, a, k);
                 let sum = if k > 1 {
-                    self.convolution(b, root, root, k, 1, k - 1)
+                    self.sum_of_products(b, (root, root, k), 1..=k - 1, false)
                 } else {
                     Self::constant(b, 0.0)
                 };
@@ -587,7 +562,7 @@ impl Emitter {
                 let rk = b.ins().fdiv(n, twice);
                 let sign = if acos { -1.0 } else { 1.0 };
                 let sum = if k > 1 {
-                    self.weighted_convolution(b, out, root, k, 1, k - 1)
+                    self.sum_of_products(b, (out, root, k), 1..=k - 1, true)
                 } else {
                     Self::constant(b, 0.0)
                 };
@@ -605,7 +580,7 @@ impl Emitter {
                 let q = self.cauchy(b, a, a, k);
                 self.put(b, square, k, q);
                 let sum = if k > 1 {
-                    self.weighted_convolution(b, out, square, k, 1, k - 1)
+                    self.sum_of_products(b, (out, square, k), 1..=k - 1, true)
                 } else {
                     Self::constant(b, 0.0)
                 };
@@ -624,12 +599,12 @@ impl Emitter {
                 let xx = self.cauchy(b, x, x, k);
                 let yy = self.cauchy(b, y, y, k);
                 let nk = b.ins().fadd(xx, yy);
-                let wy = self.weighted_convolution(b, y, x, k, 1, k);
-                let wx = self.weighted_convolution(b, x, y, k, 1, k);
+                let wy = self.sum_of_products(b, (y, x, k), 1..=k, true);
+                let wx = self.sum_of_products(b, (x, y, k), 1..=k, true);
                 let cross = b.ins().fsub(wy, wx);
                 self.put(b, norm, k, nk);
                 let sum = if k > 1 {
-                    self.weighted_convolution(b, out, norm, k, 1, k - 1)
+                    self.sum_of_products(b, (out, norm, k), 1..=k - 1, true)
                 } else {
                     Self::constant(b, 0.0)
                 };
@@ -657,7 +632,7 @@ impl Emitter {
         square: Slot,
         sign: f64,
     ) {
-        let w = self.weighted_convolution(b, a, square, k, 1, k);
+        let w = self.sum_of_products(b, (a, square, k), 1..=k, true);
         let scaled = Self::over_k(b, w, k);
         let s = Self::constant(b, sign);
         let signed = b.ins().fmul(s, scaled);

@@ -398,13 +398,21 @@ impl<'a> Builder<'a> {
         if let Some(&slot) = memo.get(angle) {
             return slot;
         }
-        let first = angle
-            .iter()
-            .position(|&(negated, _)| !negated)
-            .expect("a sine's angle has a term that is not negated");
-        let mut slot = angle[first].1;
+        // The first term that is not negated starts the sum (the pairs found have one); with
+        // none, the first term's negation.
+        let first = angle.iter().position(|&(negated, _)| !negated);
+        let mut slot = match first {
+            Some(i) => angle[i].1,
+            None => {
+                let x = angle[0].1;
+                let out = self.aux(Instruction::Neg(x), false);
+                self.ops.push(SeriesOp::Neg { out, a: x });
+                out
+            }
+        };
+        let start = first.unwrap_or(0);
         for (i, &(negated, x)) in angle.iter().enumerate() {
-            if i == first {
+            if i == start {
                 continue;
             }
             let out = if negated {
