@@ -257,8 +257,11 @@ impl TaylorStepper {
         // ln ρ_k: the radius of the last two orders as one exponential of the smaller
         // logarithm (three `ln` and one `exp` in place of two `powf` and an `exp`; in `perf`,
         // 5 % of a double-pendulum step at 1e-9 in `pow` before, 4 % in `log` and `exp`).
-        let ln_rho = |k: usize| (ln_n - max_norm(&c[k * dim..(k + 1) * dim]).ln()) / k as f64;
-        let rho = |k: usize| ln_rho(k).exp();
+        // `ln ρ_k` as `(ln N − ln ‖x^[k]‖) · reciprocal`, `reciprocal = 1/k`.
+        let ln_rho = |k: usize, reciprocal: f64| {
+            (ln_n - max_norm(&c[k * dim..(k + 1) * dim]).ln()) * reciprocal
+        };
+        let rho = |k: usize| ln_rho(k, 1.0 / k as f64).exp();
         let p = order;
         if self.factor_order != p {
             self.factor_order = p;
@@ -276,16 +279,12 @@ impl TaylorStepper {
         // far more slowly: 1.26× from order 6 to 8 for `cos t`), those two decide; if all
         // four vanish, the highest order below them that does not.
         let first = p.saturating_sub(3).max(1);
-        // The two radii's logarithms times `1/k` (a division each lay on the path from one
-        // step's coefficients to the next step's state).
-        let ln_last = |k: usize, reciprocal: f64| {
-            (ln_n - max_norm(&c[k * dim..(k + 1) * dim]).ln()) * reciprocal
-        };
+        // The last two radii with their `1/k` computed once per order (a division each lay on
+        // the path from one step's coefficients to the next step's state).
         let (r1, r0) = self.reciprocals;
-        let mut radius = ln_last(p - 1, r1).min(ln_last(p, r0)).exp();
-        // ρ_k < r/2 exactly when ‖x^[k]‖ (r/2)ᵏ > N: the earlier orders cost a power
-        // (`powf`, a quarter of the rule's time) only when they decide.
-        // (r/2)^k by one power and then products.
+        let mut radius = ln_rho(p - 1, r1).min(ln_rho(p, r0)).exp();
+        // ρ_k < r/2 exactly when ‖x^[k]‖ (r/2)ᵏ > N: the earlier orders cost no logarithm
+        // unless they decide, and (r/2)ᵏ is one power and then products.
         let mut power = (0.5 * radius).powi(first as i32);
         let anomalous = (first..p - 1).any(|k| {
             let norm = max_norm(&c[k * dim..(k + 1) * dim]);
