@@ -40,7 +40,7 @@ Usage (from the repository root):
         [--methods dp54,dop853] [--peers ode_solvers-dop853] [--rounds 7] [--reps 5] \
         [--per-decade 2] [--reference /tmp/peers-out/reference.json] \
         [--out /tmp/peers-out/work_precision_peers.md] [--svg /tmp/peers-out/work_precision_peers.svg] \
-        [--raw /tmp/peers-out/raw.jsonl] [--warm-cache]
+        [--raw /tmp/peers-out/raw.jsonl] [--warm-cache] [--heyoka-high-accuracy]
 Without --out the markdown is printed. The chart (log-log, error against median time, one
 line per method) is drawn with matplotlib.
 """
@@ -61,6 +61,8 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 # Imported in main(), after the choice of heyoka's cache directory.
 heyoka_peer = None
+# heyoka's method label: heyoka_peer.METHOD, or METHOD_HIGH_ACCURACY with --heyoka-high-accuracy.
+HEYOKA_METHOD = None
 
 ROOT = Path(__file__).resolve().parent.parent
 DP, FE = "double_pendulum", "figure_eight"
@@ -140,7 +142,7 @@ def fmt_ratio(a, b):
 
 def report(merged, methods, peers, tols, args, meta):
     """The markdown text: equal-error table, the sweep, the figure eight."""
-    all_methods = methods + peers + [heyoka_peer.METHOD]
+    all_methods = methods + peers + [HEYOKA_METHOD]
     sweeps = {m: sorted([merged[(m, DP, t)] for t in tols if (m, DP, t) in merged],
                         key=lambda r: -r["tol"]) for m in all_methods}
     lines = []
@@ -164,10 +166,10 @@ def report(merged, methods, peers, tols, args, meta):
         eomgen = [(costs[m]["time_s"], m) for m in methods if costs[m] is not None]
         best = min(eomgen) if eomgen else None
         row = [f"{target:.0e}"] + [cell[m] for m in methods] + [cell[p] for p in peers] + \
-            [cell[heyoka_peer.METHOD], "-" if best is None else best[1]]
+            [cell[HEYOKA_METHOD], "-" if best is None else best[1]]
         best_t = best[0] if best else None
         row += [fmt_ratio(costs[p]["time_s"] if costs[p] else None, best_t) for p in peers]
-        hy_cost = costs[heyoka_peer.METHOD]
+        hy_cost = costs[HEYOKA_METHOD]
         row += [fmt_ratio(hy_cost["time_s"] if hy_cost else None, best_t)]
         w("| " + " | ".join(row) + " |")
     w("")
@@ -212,7 +214,7 @@ def report(merged, methods, peers, tols, args, meta):
               if r.get("construct_s") is not None]
     if builds:
         dp_builds = [b for _, model, b in builds if model == DP]
-        orders = [r["order"] for r in sweeps[heyoka_peer.METHOD] if "order" in r]
+        orders = [r["order"] for r in sweeps[HEYOKA_METHOD] if "order" in r]
         cache = "from heyoka's on-disk cache" if args.warm_cache else \
             "first compilation, empty cache"
         w(f"heyoka construction (Taylor decomposition + LLVM compilation, {cache}) per "
@@ -230,8 +232,9 @@ def label(method):
     """The chart's name of a method: the code and its method."""
     if method.startswith("ode_solvers-"):
         return "ode_solvers " + method.split("-", 1)[1].capitalize()
-    if method == heyoka_peer.METHOD:
-        return "heyoka taylor_adaptive"
+    if method == HEYOKA_METHOD:
+        return "heyoka taylor_adaptive" + (
+            " (high_accuracy)" if method == heyoka_peer.METHOD_HIGH_ACCURACY else "")
     return "eomgen " + method
 
 
@@ -273,6 +276,9 @@ def main():
     parser.add_argument("--out")
     parser.add_argument("--svg")
     parser.add_argument("--raw")
+    parser.add_argument("--heyoka-high-accuracy", action="store_true",
+                        help="run heyoka with high_accuracy=True (compensated sums, as "
+                             "eomgen's Taylor method)")
     parser.add_argument("--warm-cache", action="store_true",
                         help="let heyoka use its on-disk cache of compiled integrators")
     args = parser.parse_args()
@@ -281,7 +287,7 @@ def main():
         # reported construction times those of a first compilation.
         os.environ["XDG_CACHE_HOME"] = tempfile.mkdtemp(prefix="heyoka-cache-")
         atexit.register(shutil.rmtree, os.environ["XDG_CACHE_HOME"], ignore_errors=True)
-    global heyoka_peer
+    global heyoka_peer, HEYOKA_METHOD
     import heyoka_peer as module
     heyoka_peer = module
     methods = [m for m in args.methods.split(",") if m]
@@ -289,7 +295,9 @@ def main():
     tols = tolerances(args.per_decade)
     if not Path(args.reference).exists():
         heyoka_peer.command_reference(argparse.Namespace(out=args.reference))
-    peer = heyoka_peer.HeyokaPeer(heyoka_peer.load_reference(args.reference))
+    peer = heyoka_peer.HeyokaPeer(heyoka_peer.load_reference(args.reference),
+                                  high_accuracy=args.heyoka_high_accuracy)
+    HEYOKA_METHOD = peer.method
     start = time.perf_counter()
     heyoka_batch(peer, tols, 1)  # builds and compiles every integrator once
     print(f"heyoka integrators built in {time.perf_counter() - start:.1f} s", file=sys.stderr)
