@@ -258,10 +258,12 @@ impl Code {
                 let plan = self.taylor.as_ref().ok()?;
                 // A panic in Cranelift leaves the orders to the kernels for good (not a
                 // compilation attempted again at every series).
-                std::panic::catch_unwind(|| crate::taylor::compile_orders(&plan.program))
-                    .ok()?
-                    .ok()
-                    .flatten()
+                std::panic::catch_unwind(|| {
+                    crate::taylor::compile_orders(plan, self.program.description.parameters.len())
+                })
+                .ok()?
+                .ok()
+                .flatten()
             })
             .as_ref()
     }
@@ -668,6 +670,18 @@ impl DynMechanicalSystem for JitModel {
     }
     fn taylor_order_zero(&self, capacity: usize, series: &mut [f64]) {
         if let Ok(plan) = &self.code.taylor {
+            // Compiled with the orders (at their stride), else interpreted: the same bits.
+            if let Some(Some(orders)) = self.code.taylor_orders.get()
+                && capacity == UNROLLED_CAPACITY
+                && series.len() >= plan.order_zero.instructions.len() * UNROLLED_CAPACITY
+            {
+                // SAFETY: `series` holds every instruction's slot at the stride of 25
+                // (checked above) and the caller has written the inputs' order 0;
+                // `parameters` holds the model's parameters, the count the code was
+                // compiled for.
+                unsafe { (orders.order_zero)(series.as_mut_ptr(), self.parameters.as_ptr()) };
+                return;
+            }
             interpret::order_zero_in_place(&plan.order_zero, &self.parameters, capacity, series);
         }
     }

@@ -171,11 +171,12 @@ const HELPERS: [(&str, Func); 13] = [
     ("eomgen_step", Func::Step),
 ];
 
-struct Imports {
-    unary: Vec<(Func, FuncId)>,
-    sin_cos: FuncId,
-    powf: FuncId,
-    atan2: FuncId,
+/// The helpers of [`crate::math`] declared as imports of a module.
+pub(crate) struct Imports {
+    pub(crate) unary: Vec<(Func, FuncId)>,
+    pub(crate) sin_cos: FuncId,
+    pub(crate) powf: FuncId,
+    pub(crate) atan2: FuncId,
     fill_zero: FuncId,
 }
 
@@ -324,7 +325,7 @@ pub(crate) fn failure(function: &str, e: &dyn std::fmt::Display) -> CompileError
 ///
 /// # Errors
 /// [`CompileError::Function`] naming the helper Cranelift could not declare.
-fn declare_imports(module: &mut JITModule) -> Result<Imports, CompileError> {
+pub(crate) fn declare_imports(module: &mut JITModule) -> Result<Imports, CompileError> {
     let call_conv = module.isa().default_call_conv();
     let float_signature = |args: usize, returns: usize| {
         let mut s = Signature::new(call_conv);

@@ -32,6 +32,12 @@
 //! accelerations' order `k`, the inputs' and time's order `k + 1`) is forgotten after it,
 //! which holds because `motion_order_at` writes nothing else of the series.
 //!
+//! With it, in the same module, order 0 ([`OrderZeroFn`], `fn(series: *mut f64, parameters:
+//! *const f64)`): the extended tape of `M` and `F` (`TaylorPlan::order_zero`), instruction
+//! `k`'s value into `series[k · 25]`, each with the operation or helper of [`crate::math`]
+//! that the interpreter's `order_zero_in_place` uses (the same bits); the inputs `q`, `q̇`,
+//! `t` are read from their slots, where the caller has written them.
+//!
 //! # Memory
 //! As for [`crate::native`]: the module owning the code lives in [`NativeOrders`] and is freed
 //! with it.
@@ -45,9 +51,13 @@ use cranelift_frontend::{FunctionBuilder, FunctionBuilderContext};
 use cranelift_module::{Linkage, Module};
 use std::collections::HashMap;
 
+use cranelift_jit::JITModule;
 use eomgen_runtime::taylor::{SeriesOp, Slot, TaylorProgram, UNROLLED_CAPACITY};
+use eomgen_symbolic::codegen::tape::{Input, Instruction, Tape};
+use eomgen_symbolic::codegen::taylor::TaylorPlan;
+use eomgen_symbolic::expr::Func;
 
-use crate::native::{CompileError, ModuleMemory, failure, new_module};
+use crate::native::{CompileError, Imports, ModuleMemory, declare_imports, failure, new_module};
 
 /// The compiled orders: see the module documentation for the arguments.
 ///
@@ -66,10 +76,20 @@ pub(crate) type OrdersFn = unsafe extern "C" fn(
     *const f64,
 ) -> usize;
 
+/// The compiled order 0 (see the module documentation).
+///
+/// # Safety
+/// `series` holds at least `order_zero.instructions.len() · UNROLLED_CAPACITY` values, with
+/// the inputs' order 0 written; `parameters` holds the model's parameters (one per
+/// `Input::Parameter` index of the tape).
+pub(crate) type OrderZeroFn = unsafe extern "C" fn(*mut f64, *const f64);
+
 /// A model's compiled Taylor orders and the memory that holds them.
 pub(crate) struct NativeOrders {
     /// The function.
     pub(crate) function: OrdersFn,
+    /// Order 0.
+    pub(crate) order_zero: OrderZeroFn,
     /// The highest order it computes, `H`.
     pub(crate) highest: usize,
     _memory: ModuleMemory,
@@ -83,20 +103,25 @@ impl std::fmt::Debug for NativeOrders {
     }
 }
 
-/// Compiles the orders `1 …` [`TaylorProgram::highest_unrolled_order`] of `program` (see the
-/// module documentation); `None` when that is 0 (no order fits the cache).
+/// Compiles the orders `1 …` [`TaylorProgram::highest_unrolled_order`] of `plan`'s program and
+/// its order 0 (see the module documentation), for a model of `parameters` parameters; `None`
+/// when no order fits the cache.
 ///
 /// # Errors
 /// [`CompileError`] if Cranelift has no code generator for the host or fails on the code.
 pub(crate) fn compile_orders(
-    program: &TaylorProgram,
+    plan: &TaylorPlan,
+    parameters: usize,
 ) -> Result<Option<NativeOrders>, CompileError> {
     const NAME: &str = "taylor_orders";
+    const ORDER_ZERO: &str = "taylor_order_zero";
+    let program = &plan.program;
     let highest = program.highest_unrolled_order().min(UNROLLED_CAPACITY - 1);
     if highest == 0 {
         return Ok(None);
     }
     let mut module = new_module()?;
+    let imports = declare_imports(&mut module)?;
     let call_conv = module.isa().default_call_conv();
     let pointer = module.target_config().pointer_type();
     let mut solve_signature = Signature::new(call_conv);
@@ -127,6 +152,26 @@ pub(crate) fn compile_orders(
         .define_function(id, &mut context)
         .map_err(|e| failure(NAME, &e))?;
     module.clear_context(&mut context);
+    let mut zero_signature = Signature::new(call_conv);
+    zero_signature.params.push(AbiParam::new(pointer));
+    zero_signature.params.push(AbiParam::new(pointer));
+    let zero_id = module
+        .declare_function(ORDER_ZERO, Linkage::Local, &zero_signature)
+        .map_err(|e| failure(ORDER_ZERO, &e))?;
+    context.func.signature = zero_signature;
+    context.func.name = UserFuncName::user(0, 1);
+    build_order_zero(
+        &mut module,
+        &mut context.func,
+        &mut builder_context,
+        &plan.order_zero,
+        parameters,
+        &imports,
+    );
+    module
+        .define_function(zero_id, &mut context)
+        .map_err(|e| failure(ORDER_ZERO, &e))?;
+    module.clear_context(&mut context);
     module
         .finalize_definitions()
         .map_err(|e| CompileError::Finalize {
@@ -136,8 +181,12 @@ pub(crate) fn compile_orders(
     // SAFETY: `address` is the entry of the function compiled above with exactly the
     // signature of `OrdersFn` in the platform's default (C) calling convention.
     let function = unsafe { std::mem::transmute::<*const u8, OrdersFn>(address) };
+    let address = module.get_finalized_function(zero_id);
+    // SAFETY: as above, with the signature of `OrderZeroFn`.
+    let order_zero = unsafe { std::mem::transmute::<*const u8, OrderZeroFn>(address) };
     Ok(Some(NativeOrders {
         function,
+        order_zero,
         highest,
         _memory: ModuleMemory::new(module),
     }))
@@ -230,6 +279,127 @@ fn build(
     b.seal_block(exit);
     let result = b.block_params(exit)[0];
     b.ins().return_(&[result]);
+    b.finalize(target);
+}
+
+/// Writes order 0's body (see the module documentation): each instruction's value stored to
+/// its slot at the stride [`UNROLLED_CAPACITY`] and kept as a Cranelift value for its uses
+/// (the inputs loaded from their slots at each use); a parameter index beyond `parameters`
+/// reads NaN, as the interpreter's.
+fn build_order_zero(
+    module: &mut JITModule,
+    func: &mut ir::Function,
+    builder_context: &mut FunctionBuilderContext,
+    tape: &Tape,
+    parameters: usize,
+    imports: &Imports,
+) {
+    let target = module.target_config();
+    let mut b = FunctionBuilder::new(func, builder_context);
+    let entry = b.create_block();
+    b.append_block_params_for_function_params(entry);
+    b.switch_to_block(entry);
+    b.seal_block(entry);
+    let params = b.block_params(entry).to_vec();
+    let (series, parameter_values) = (params[0], params[1]);
+    let offset = |k: u32| (k as usize * UNROLLED_CAPACITY * 8) as i32;
+    let flags = MemFlagsData::trusted();
+    let count = tape.instructions.len();
+    let mut values: Vec<Option<ir::Value>> = vec![None; count];
+    let mut unary: Vec<(Func, ir::FuncRef)> = Vec::new();
+    let (mut sin_cos, mut powf, mut atan2) = (None, None, None);
+    for (k, instruction) in tape.instructions.iter().enumerate() {
+        let value = |b: &mut FunctionBuilder, x: u32| match values[x as usize] {
+            Some(v) => v,
+            None => b.ins().load(types::F64, flags, series, offset(x)),
+        };
+        let v = match *instruction {
+            Instruction::Input(Input::Parameter(i)) if (i as usize) < parameters => {
+                b.ins()
+                    .load(types::F64, flags, parameter_values, (i as i32) * 8)
+            }
+            Instruction::Input(Input::Parameter(_)) => b.ins().f64const(f64::NAN),
+            // Written by the caller: loaded at each use.
+            Instruction::Input(_) => continue,
+            Instruction::Const(x) => b.ins().f64const(x),
+            Instruction::Neg(x) => {
+                let x = value(&mut b, x);
+                b.ins().fneg(x)
+            }
+            Instruction::Add(x, y) => {
+                let (x, y) = (value(&mut b, x), value(&mut b, y));
+                b.ins().fadd(x, y)
+            }
+            Instruction::Sub(x, y) => {
+                let (x, y) = (value(&mut b, x), value(&mut b, y));
+                b.ins().fsub(x, y)
+            }
+            Instruction::Mul(x, y) => {
+                let (x, y) = (value(&mut b, x), value(&mut b, y));
+                b.ins().fmul(x, y)
+            }
+            Instruction::Div(x, y) => {
+                let (x, y) = (value(&mut b, x), value(&mut b, y));
+                b.ins().fdiv(x, y)
+            }
+            Instruction::Sqrt(x) => {
+                let x = value(&mut b, x);
+                b.ins().sqrt(x)
+            }
+            Instruction::Abs(x) => {
+                let x = value(&mut b, x);
+                b.ins().fabs(x)
+            }
+            Instruction::Call(f, x) => {
+                let x = value(&mut b, x);
+                let callee = match unary.iter().find(|(g, _)| *g == f) {
+                    Some(&(_, r)) => r,
+                    None => {
+                        // Every function of one argument is imported.
+                        let Some(&(_, id)) = imports.unary.iter().find(|(g, _)| *g == f) else {
+                            continue;
+                        };
+                        let r = module.declare_func_in_func(id, b.func);
+                        unary.push((f, r));
+                        r
+                    }
+                };
+                let call = b.ins().call(callee, &[x]);
+                b.inst_results(call)[0]
+            }
+            Instruction::Powf(x, y) => {
+                let (x, y) = (value(&mut b, x), value(&mut b, y));
+                let callee =
+                    *powf.get_or_insert_with(|| module.declare_func_in_func(imports.powf, b.func));
+                let call = b.ins().call(callee, &[x, y]);
+                b.inst_results(call)[0]
+            }
+            Instruction::Atan2(y, x) => {
+                let (y, x) = (value(&mut b, y), value(&mut b, x));
+                let callee = *atan2
+                    .get_or_insert_with(|| module.declare_func_in_func(imports.atan2, b.func));
+                let call = b.ins().call(callee, &[y, x]);
+                b.inst_results(call)[0]
+            }
+            Instruction::SinCos(x) => {
+                let x = value(&mut b, x);
+                let callee = *sin_cos
+                    .get_or_insert_with(|| module.declare_func_in_func(imports.sin_cos, b.func));
+                let call = b.ins().call(callee, &[x]);
+                let (s, c) = (b.inst_results(call)[0], b.inst_results(call)[1]);
+                if k + 1 < count {
+                    b.ins().store(flags, c, series, offset(k as u32 + 1));
+                    values[k + 1] = Some(c);
+                }
+                s
+            }
+            // Stored with its `SinCos`.
+            Instruction::CosOfSinCos(_) => continue,
+        };
+        b.ins().store(flags, v, series, offset(k as u32));
+        values[k] = Some(v);
+    }
+    b.ins().return_(&[]);
     b.finalize(target);
 }
 
