@@ -185,9 +185,9 @@ class HeyokaPeer:
     """Cached heyoka integrators, one per (model, tol), and the timed runs."""
 
     def __init__(self, reference=None, high_accuracy=False):
-        """`high_accuracy`: heyoka's mode of that name (compensated sums in the evaluation of
-        the Taylor polynomial and the state update, as eomgen's Taylor method always uses);
-        its results are then labelled `METHOD_HIGH_ACCURACY`."""
+        """`high_accuracy`: heyoka's mode of that name (the terms of each step's Taylor
+        polynomial summed with compensation, the error not carried to the next step, unlike
+        eomgen's Taylor method); its results are then labelled `METHOD_HIGH_ACCURACY`."""
         self.reference = reference or {}
         self.integrators = {}
         self.high_accuracy = high_accuracy

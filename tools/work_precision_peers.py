@@ -277,8 +277,8 @@ def main():
     parser.add_argument("--svg")
     parser.add_argument("--raw")
     parser.add_argument("--heyoka-high-accuracy", action="store_true",
-                        help="run heyoka with high_accuracy=True (compensated sums, as "
-                             "eomgen's Taylor method)")
+                        help="run heyoka with high_accuracy=True (each step's polynomial "
+                             "summed with compensation)")
     parser.add_argument("--warm-cache", action="store_true",
                         help="let heyoka use its on-disk cache of compiled integrators")
     args = parser.parse_args()

@@ -42,14 +42,16 @@ use crate::ode::OdeSystem;
 /// A step's end is `y + (δ + e)`, with `δ = h Σₖ₌₁ᵖ y^[k] hᵏ⁻¹` by Horner's rule and `e` the
 /// rounding error of the last step's sum `y + (δ + e)`, kept exactly by Knuth's two-sum and
 /// carried from step to step (compensated summation: Kahan 1965; Hairer, Lubich & Wanner,
-/// *Geometric Numerical Integration*, 2nd ed., §VIII.5; heyoka's `high_accuracy` mode does
-/// the same). The rounding of `y + δ` (`‖y‖ ε/2` a step, against the increment's own
+/// *Geometric Numerical Integration*, 2nd ed., §VIII.5; heyoka's `high_accuracy` mode
+/// compensates the sum of each step's polynomial but starts every step afresh). The
+/// rounding of `y + δ` (`‖y‖ ε/2` a step, against the increment's own
 /// `‖δ‖ ε`, far smaller when the step moves `y` little) then no longer accumulates: on the
 /// figure eight over ten periods at `tol = 10⁻¹⁴` the error of the final state fell from
 /// 3.1e-13 to 6.1e-14 and the energy drift from 3.3e-15 to 6.9e-16, for 0–6 % more time
-/// (docs/performance.md). The first step (`e = 0`) is the plain sum to the bit. The
-/// coefficients of each step are those at the rounded state `y`, so a step long against the
-/// scale on which the forces vary gains little.
+/// (docs/performance.md). The first step (`e = 0`) is the plain sum to the bit (but for the
+/// sign of a zero). The coefficients of each step are those at the rounded state `y`, and
+/// the carry is added as if the flow moved it unchanged, so a step long against the scale
+/// on which the forces vary gains nothing.
 ///
 /// # Dense output and events
 /// The step's polynomial, evaluated the same way with the carry of the step's start (`θ = 1`
