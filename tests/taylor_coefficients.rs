@@ -400,6 +400,7 @@ fn compiled_orders_of_every_op_kind_are_the_kernels_bits() {
         "taylor_ops_dense",
         "taylor_ops_diagonal",
         "taylor_ops_sparse",
+        "taylor_order_zero_constants",
     ] {
         let path = format!("{}/tests/fixtures/{file}.yaml", env!("CARGO_MANIFEST_DIR"));
         let load =

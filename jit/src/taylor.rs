@@ -120,6 +120,11 @@ pub(crate) fn compile_orders(
     if highest == 0 {
         return Ok(None);
     }
+    // The order-0 code indexes the series by the tape's operands unchecked: each must be an
+    // earlier instruction.
+    plan.order_zero
+        .validate()
+        .map_err(|reason| failure(ORDER_ZERO, &reason))?;
     let mut module = new_module()?;
     let imports = declare_imports(&mut module)?;
     let call_conv = module.isa().default_call_conv();
@@ -346,7 +351,7 @@ fn build_order_zero(
                 let x = value(&mut b, x);
                 b.ins().sqrt(x)
             }
-            Instruction::Abs(x) => {
+            Instruction::Abs(x) | Instruction::Call(Func::Abs, x) => {
                 let x = value(&mut b, x);
                 b.ins().fabs(x)
             }
@@ -355,8 +360,12 @@ fn build_order_zero(
                 let callee = match unary.iter().find(|(g, _)| *g == f) {
                     Some(&(_, r)) => r,
                     None => {
-                        // Every function of one argument is imported.
+                        // Every other function of one argument is imported; were one not,
+                        // its value would be NaN, never the last series' value.
                         let Some(&(_, id)) = imports.unary.iter().find(|(g, _)| *g == f) else {
+                            let nan = b.ins().f64const(f64::NAN);
+                            b.ins().store(flags, nan, series, offset(k as u32));
+                            values[k] = Some(nan);
                             continue;
                         };
                         let r = module.declare_func_in_func(id, b.func);
