@@ -454,11 +454,7 @@ fn build(
     imports: &Imports,
 ) -> usize {
     let mut b = FunctionBuilder::new(func, builder_context);
-    let block = b.create_block();
-    b.append_block_params_for_function_params(block);
-    b.switch_to_block(block);
-    b.seal_block(block);
-    let params = b.block_params(block).to_vec();
+    let params = enter(&mut b);
     let arguments = Arguments {
         parameters: params[0],
         q: params[1],
@@ -516,6 +512,16 @@ fn build(
     b.ins().return_(&[]);
     b.finalize(module.target_config());
     slots_used
+}
+
+/// Opens the function's one entry block (sealed, current) and returns its parameters, the
+/// function's arguments.
+pub(crate) fn enter(b: &mut FunctionBuilder) -> Vec<ir::Value> {
+    let entry = b.create_block();
+    b.append_block_params_for_function_params(entry);
+    b.switch_to_block(entry);
+    b.seal_block(entry);
+    b.block_params(entry).to_vec()
 }
 
 /// The two output buffers of a function: outputs before `split` go to `out0`, the others to

@@ -57,7 +57,9 @@ use eomgen_symbolic::codegen::tape::{Input, Instruction, Tape};
 use eomgen_symbolic::codegen::taylor::TaylorPlan;
 use eomgen_symbolic::expr::Func;
 
-use crate::native::{CompileError, Imports, ModuleMemory, declare_imports, failure, new_module};
+use crate::native::{
+    CompileError, Imports, ModuleMemory, declare_imports, enter, failure, new_module,
+};
 
 /// The compiled orders: see the module documentation for the arguments.
 ///
@@ -208,11 +210,7 @@ fn build(
 ) {
     let pointer = target.pointer_type();
     let mut b = FunctionBuilder::new(func, builder_context);
-    let entry = b.create_block();
-    b.append_block_params_for_function_params(entry);
-    b.switch_to_block(entry);
-    b.seal_block(entry);
-    let params = b.block_params(entry).to_vec();
+    let params = enter(&mut b);
     let (series, order, context, solve) = (params[0], params[1], params[2], params[3]);
     let (out, lower, inverse_pivots) = (params[4], params[5], params[6]);
     let n = program.coordinates.len();
@@ -301,11 +299,7 @@ fn build_order_zero(
 ) {
     let target = module.target_config();
     let mut b = FunctionBuilder::new(func, builder_context);
-    let entry = b.create_block();
-    b.append_block_params_for_function_params(entry);
-    b.switch_to_block(entry);
-    b.seal_block(entry);
-    let params = b.block_params(entry).to_vec();
+    let params = enter(&mut b);
     let (series, parameter_values) = (params[0], params[1]);
     let offset = |k: u32| (k as usize * UNROLLED_CAPACITY * 8) as i32;
     let flags = MemFlagsData::trusted();
