@@ -50,9 +50,11 @@ Usage (from the repository root; P = the Rust program of examples/work_precision
     python tools/heyoka_peer.py reference --out /tmp/peers-out/reference.json
     python tools/heyoka_peer.py check --binary $P          # RHS and y0 against eomgen's
     python tools/heyoka_peer.py run --jobs double_pendulum:1e-8,figure_eight:1e-14 \
-        --reps 5 [--reference /tmp/peers-out/reference.json]
-    python tools/heyoka_peer.py serve [--reference FILE]    # one JSON job list per stdin line
-As a module: `HeyokaPeer(reference).run([(model, tol), ...], reps)` returns the result dicts
+        --reps 5 [--reference /tmp/peers-out/reference.json] [--high-accuracy]
+    python tools/heyoka_peer.py serve [--reference FILE] [--high-accuracy]  # a job list per line
+(`--high-accuracy`: heyoka's mode of that name, method "heyoka-taylor-high-accuracy".)
+As a module: `HeyokaPeer(reference, high_accuracy).run([(model, tol), ...], reps)` returns the
+result dicts
 (the driver, tools/work_precision_peers.py, uses this and keeps the integrators between rounds).
 
 Output: one JSON line per job: {"side": "heyoka", "method": "heyoka-taylor", "model", "tol",
@@ -364,20 +366,23 @@ def main():
     p = sub.add_parser("check", help="compare y0 and the RHS with eomgen's")
     p.add_argument("--binary", required=True)
     p.add_argument("--states", type=int, default=5)
-    p = sub.add_parser("run", help="run jobs model:tol,...")
-    p.add_argument("--jobs", required=True)
-    p.add_argument("--reps", type=int, default=5)
-    p.add_argument("--reference")
-    p = sub.add_parser("serve", help="read one JSON job list per line on stdin")
-    p.add_argument("--reps", type=int, default=5)
-    p.add_argument("--reference")
+    for name, text in (("run", "run jobs model:tol,..."),
+                       ("serve", "read one JSON job list per line on stdin")):
+        p = sub.add_parser(name, help=text)
+        if name == "run":
+            p.add_argument("--jobs", required=True)
+        p.add_argument("--reps", type=int, default=5)
+        p.add_argument("--reference")
+        p.add_argument("--high-accuracy", action="store_true",
+                       help="heyoka's high_accuracy mode (method label " + METHOD_HIGH_ACCURACY + ")")
     args = parser.parse_args()
     if args.command == "reference":
         command_reference(args)
         return 0
     if args.command == "check":
         return command_check(args)
-    peer = HeyokaPeer(load_reference(args.reference) if args.reference else None)
+    peer = HeyokaPeer(load_reference(args.reference) if args.reference else None,
+                      high_accuracy=args.high_accuracy)
     if args.command == "run":
         for result in peer.run(parse_jobs(args.jobs), args.reps):
             print(json.dumps(result), flush=True)
