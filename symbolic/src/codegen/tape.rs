@@ -168,6 +168,7 @@ impl Tape {
             temporaries: FxHashMap::default(),
             symbols: FxHashMap::default(),
             constants: FxHashMap::default(),
+            operations: FxHashMap::default(),
         };
         // Inputs first, in symbol order (as the Rust bodies bind them).
         let mut used: Vec<SymbolId> = arena
@@ -230,12 +231,66 @@ struct Lowering<'a> {
     temporaries: FxHashMap<ExprId, Value>,
     symbols: FxHashMap<SymbolId, Value>,
     constants: FxHashMap<u64, Value>,
+    /// The value of each operation pushed so far, by [`Operation`].
+    operations: FxHashMap<Operation, Value>,
+}
+
+/// An operation's kind and operands, the key under which the lowering numbers its values:
+/// commutative operations with their operands in increasing order.
+#[derive(Clone, Copy, PartialEq, Eq, Hash)]
+enum Operation {
+    Unary(u8, Option<Func>, Value),
+    Binary(u8, Value, Value),
+}
+
+impl Operation {
+    /// The key of `instruction`; `None` for inputs and constants (numbered elsewhere).
+    fn of(instruction: Instruction) -> Option<Self> {
+        use Instruction as I;
+        let unary = |tag, x| Some(Self::Unary(tag, None, x));
+        let binary = |tag, x, y| Some(Self::Binary(tag, x, y));
+        let commutative = |tag, x: Value, y: Value| Some(Self::Binary(tag, x.min(y), x.max(y)));
+        match instruction {
+            I::Input(_) | I::Const(_) => None,
+            I::Neg(x) => unary(0, x),
+            I::Sqrt(x) => unary(1, x),
+            I::Abs(x) => unary(2, x),
+            I::SinCos(x) => unary(3, x),
+            I::CosOfSinCos(x) => unary(4, x),
+            I::Call(f, x) => Some(Self::Unary(5, Some(f), x)),
+            I::Add(x, y) => commutative(0, x, y),
+            I::Mul(x, y) => commutative(1, x, y),
+            I::Sub(x, y) => binary(2, x, y),
+            I::Div(x, y) => binary(3, x, y),
+            I::Powf(x, y) => binary(4, x, y),
+            I::Atan2(x, y) => binary(5, x, y),
+        }
+    }
 }
 
 impl Lowering<'_> {
+    /// Appends `instruction`, or returns the value of the same operation on the same
+    /// operands pushed before (value numbering; `x + y` and `y + x`, `x · y` and `y · x`
+    /// are the same operation).
+    ///
+    /// The plan's temporaries share what the expression DAG shares; the printer's chains
+    /// repeat what it does not: the same product prefix in `−G·d·m²/r³` and `G·d·m²/r³`
+    /// (both written out), a sine's `SinCos` and the `CosOfSinCos` after it. An operation
+    /// on the same operands computes the same bits (IEEE addition and multiplication are
+    /// commutative), so sharing it changes no value, only the work: the three-body figure
+    /// eight's `M` and `F` lose each pair's pull computed a second time with the opposite
+    /// sign (Newton's third law), 12 of its 103 instructions.
     fn push(&mut self, instruction: Instruction) -> Value {
+        let key = Operation::of(instruction);
+        if let Some(&v) = key.as_ref().and_then(|k| self.operations.get(k)) {
+            return v;
+        }
         self.tape.instructions.push(instruction);
-        (self.tape.instructions.len() - 1) as Value
+        let v = (self.tape.instructions.len() - 1) as Value;
+        if let Some(k) = key {
+            self.operations.insert(k, v);
+        }
+        v
     }
 
     fn constant(&mut self, x: f64) -> Value {
