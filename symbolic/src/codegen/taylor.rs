@@ -1,7 +1,9 @@
 //! A model's Taylor recurrences ([`TaylorProgram`]) from the tape of `M` and `F`.
 //!
 //! The tape of [`ModelFunction::MassMatrixAndForcing`](super::plan::ModelFunction) — the plan
-//! both backends compile — is read as a program over series: each instruction is a slot, and
+//! both backends compile — numbered ([`Tape::numbered`]: an operation the lowering repeats,
+//! such as a pull written in the equations of both bodies it acts on, computed once; the
+//! same bits) is read as a program over series: each instruction is a slot, and
 //! [`taylor_program`] gives each instruction that depends on the state its recurrence
 //! ([`SeriesOp`]). Order 0 is the tape itself, extended by the auxiliary values some
 //! recurrences need (the cosine of a lone sine, `tan²`, `√(1 − a²)`, `x² + y²`, the sums of
@@ -32,8 +34,9 @@ use super::tape::{Input, Instruction, Tape};
 pub struct TaylorPlan {
     /// The recurrences of orders `k ≥ 1` and the slots of the state, `M` and `F`.
     pub program: TaylorProgram,
-    /// Order 0: the tape of `M` and `F` with the auxiliary instructions appended; slot `s` is
-    /// instruction `s`. Its outputs are those of the tape of `M` and `F`.
+    /// Order 0: the tape of `M` and `F` numbered ([`Tape::numbered`]: each operation on the
+    /// same operands once, the same bits) with the auxiliary instructions appended; slot `s`
+    /// is instruction `s`. Its outputs are those of the numbered tape of `M` and `F`.
     pub order_zero: Tape,
 }
 
@@ -52,14 +55,16 @@ pub fn taylor_program(
     if constraints > 0 {
         return Err(TaylorUnsupported::Constraints { count: constraints });
     }
-    let mut builder = Builder::new(&tape.tape);
+    // Each value a series: a repeated operation would cost a convolution per order.
+    let numbered = tape.tape.numbered();
+    let mut builder = Builder::new(&numbered);
     builder.build();
     if !builder.unsupported.is_empty() {
         return Err(TaylorUnsupported::Functions {
             names: Cow::Owned(builder.unsupported.into_iter().map(Cow::Owned).collect()),
         });
     }
-    let outputs = &tape.tape.outputs;
+    let outputs = &numbered.outputs;
     let (mass, forcing) = outputs.split_at((n * n).min(outputs.len()));
     let Builder {
         order_zero,
