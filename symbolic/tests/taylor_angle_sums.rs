@@ -345,15 +345,19 @@ fn random_addition_theorem_tapes() {
         };
         let want = reference(&tape, &inputs);
         let got = program_series(&plan, &inputs);
+        // The program's slots are those of the numbered tape (`Tape::numbered`, which the
+        // program is built from), the reference's those of `tape`: outputs by position.
+        let numbered = tape.numbered();
         total_pairs += plan
             .program
             .ops
             .iter()
-            .filter(|op| matches!(op, SeriesOp::SinCos { sin, .. } if (*sin as usize) < tape.instructions.len() && matches!(tape.instructions[*sin as usize], Instruction::Add(..) | Instruction::Sub(..))))
+            .filter(|op| matches!(op, SeriesOp::SinCos { sin, .. } if (*sin as usize) < numbered.instructions.len() && matches!(numbered.instructions[*sin as usize], Instruction::Add(..) | Instruction::Sub(..))))
             .count();
-        for &o in &outputs {
+        assert_eq!(plan.order_zero.outputs.len(), outputs.len());
+        for (&o, &p) in outputs.iter().zip(plan.order_zero.outputs.iter()) {
             for k in 0..=K {
-                let (w, g) = (want[o as usize][k], got[o as usize][k]);
+                let (w, g) = (want[o as usize][k], got[p as usize][k]);
                 assert!(
                     (w - g).abs() <= 1e-9 * w.abs().max(1.0),
                     "case {case}: output {o} order {k}: want {w}, got {g}\n{:?}\nops {:?}",
