@@ -100,6 +100,50 @@ mod tests {
         (0..len).map(|_| random.random_range(low..high)).collect()
     }
 
+    /// Random inputs of a model: each parameter its default scaled by a factor in
+    /// `[0.5, 1.5)` and moved by up to ±0.1, `q`, `q̇`, the acceleration inputs and `λ` in
+    /// `[−2, 2)`, `t` in `[0, 10)`.
+    struct Drawn {
+        parameters: Vec<f64>,
+        q: Vec<f64>,
+        qdot: Vec<f64>,
+        acceleration: Vec<f64>,
+        lambda: Vec<f64>,
+        t: f64,
+    }
+
+    impl Drawn {
+        fn new(random: &mut Xoshiro256PlusPlus, program: &ModelProgram) -> Self {
+            let (n, m) = (program.num_dofs(), program.description.constraints.len());
+            let parameters = program
+                .description
+                .parameters
+                .iter()
+                .map(|p| p.default)
+                .map(|v| v * random.random_range(0.5..1.5) + random.random_range(-0.1..0.1))
+                .collect();
+            Self {
+                parameters,
+                q: vector(random, n, -2.0, 2.0),
+                qdot: vector(random, n, -2.0, 2.0),
+                acceleration: vector(random, n, -2.0, 2.0),
+                lambda: vector(random, m, -2.0, 2.0),
+                t: random.random_range(0.0..10.0),
+            }
+        }
+
+        fn inputs(&self) -> Inputs<'_> {
+            Inputs {
+                parameters: &self.parameters,
+                q: &self.q,
+                qdot: &self.qdot,
+                acceleration: &self.acceleration,
+                lambda: &self.lambda,
+                t: self.t,
+            }
+        }
+    }
+
     pub(crate) fn bundled_programs() -> Vec<(String, ModelProgram, JacobianProgram)> {
         let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../models");
         let mut paths: Vec<_> = std::fs::read_dir(dir)
@@ -134,8 +178,6 @@ mod tests {
         let mut random = Xoshiro256PlusPlus::seed_from_u64(0x5DEE_CE66_D1CE_4E5B);
         let (mut compared, mut shortened) = (0usize, 0usize);
         for (display, program, jacobians) in bundled_programs() {
-            let n = program.num_dofs();
-            let m = program.description.constraints.len();
             let functions: Vec<_> = program
                 .functions()
                 .into_iter()
@@ -156,24 +198,8 @@ mod tests {
                 let rest = function.tape.outputs.len() - split;
                 let mut values = Vec::new();
                 for _ in 0..20 {
-                    let parameters: Vec<f64> = program
-                        .description
-                        .parameters
-                        .iter()
-                        .map(|p| p.default * random.random_range(0.5..1.5))
-                        .collect();
-                    let q = vector(&mut random, n, -2.0, 2.0);
-                    let qdot = vector(&mut random, n, -2.0, 2.0);
-                    let acceleration = vector(&mut random, n, -2.0, 2.0);
-                    let lambda = vector(&mut random, m, -2.0, 2.0);
-                    let inputs = Inputs {
-                        parameters: &parameters,
-                        q: &q,
-                        qdot: &qdot,
-                        acceleration: &acceleration,
-                        lambda: &lambda,
-                        t: random.random_range(0.0..10.0),
-                    };
+                    let drawn = Drawn::new(&mut random, &program);
+                    let inputs = drawn.inputs();
                     let (mut a0, mut a1) = (vec![0.0; split], vec![0.0; rest]);
                     interpret::evaluate(function, &inputs, &mut values, &mut a0, &mut a1);
                     let (mut b0, mut b1) = (vec![f64::NAN; split], vec![f64::NAN; rest]);
@@ -225,8 +251,6 @@ mod tests {
                 .chain(jacobians.functions())
                 .collect();
             let code = native::compile(&functions).unwrap_or_else(|e| panic!("{display}: {e}"));
-            let n = program.num_dofs();
-            let m = program.description.constraints.len();
             for (index, (name, function)) in functions.into_iter().enumerate() {
                 let Some(compiled) = code.functions[index] else {
                     assert!(function.tape.outputs.is_empty(), "{display}: {name}");
@@ -236,25 +260,8 @@ mod tests {
                 let rest = function.tape.outputs.len() - split;
                 let mut values = Vec::new();
                 for _ in 0..50 {
-                    let parameters: Vec<f64> = program
-                        .description
-                        .parameters
-                        .iter()
-                        .map(|p| p.default)
-                        .map(|v| v * random.random_range(0.5..1.5) + random.random_range(-0.1..0.1))
-                        .collect();
-                    let q = vector(&mut random, n, -2.0, 2.0);
-                    let qdot = vector(&mut random, n, -2.0, 2.0);
-                    let acceleration = vector(&mut random, n, -2.0, 2.0);
-                    let lambda = vector(&mut random, m, -2.0, 2.0);
-                    let inputs = Inputs {
-                        parameters: &parameters,
-                        q: &q,
-                        qdot: &qdot,
-                        acceleration: &acceleration,
-                        lambda: &lambda,
-                        t: random.random_range(0.0..10.0),
-                    };
+                    let drawn = Drawn::new(&mut random, &program);
+                    let inputs = drawn.inputs();
                     let (mut a0, mut a1) = (vec![0.0; split], vec![0.0; rest]);
                     interpret::evaluate(function, &inputs, &mut values, &mut a0, &mut a1);
                     let (mut b0, mut b1) = (vec![f64::NAN; split], vec![f64::NAN; rest]);
@@ -264,12 +271,12 @@ mod tests {
                     // and writes in bounds.
                     unsafe {
                         compiled(
-                            parameters.as_ptr(),
-                            q.as_ptr(),
-                            qdot.as_ptr(),
-                            acceleration.as_ptr(),
-                            lambda.as_ptr(),
-                            inputs.t,
+                            drawn.parameters.as_ptr(),
+                            drawn.q.as_ptr(),
+                            drawn.qdot.as_ptr(),
+                            drawn.acceleration.as_ptr(),
+                            drawn.lambda.as_ptr(),
+                            drawn.t,
                             b0.as_mut_ptr(),
                             b1.as_mut_ptr(),
                             scratch.as_mut_ptr(),
