@@ -385,14 +385,18 @@ fn angle_differences_run_as_one_sin_cos() {
     }
 }
 
-/// The run-time model's Taylor orders compiled to native code against the runtime's kernels
-/// (the interpreter backend), to the bit, on two models that use every op kind (`exp`, `ln`,
-/// `sinh`/`cosh`, `tan`, `tanh`, `asin`, `acos`, `atan`, `atan2`, powers, roots, quotients:
-/// the bundled models use only some) and a mass matrix that varies: dense and diagonal (the
-/// compiled orders solve them in line) and with a factor that is neither (solved by their
-/// call per order); and the orders really
-/// are compiled (`taylor_fused_orders` after the first series: a failure of Cranelift would
-/// leave them to the kernels and this comparison would prove nothing).
+/// The run-time model's Taylor orders and their order 0, compiled to native code, against
+/// the runtime's kernels and tape interpreter (the interpreter backend), to the bit, on
+/// fixtures that use every op kind (`exp`, `ln`, `sinh`/`cosh`, `tan`, `tanh`, `asin`,
+/// `acos`, `atan`, `atan2`, powers, roots, quotients: the bundled models use only some), a
+/// mass matrix that varies (dense and diagonal, which the compiled orders solve in line, and
+/// with a factor that is neither, solved by their call per order), and functions without a
+/// recurrence applied to parameters alone (constants of order 0); and the orders really are
+/// compiled (`taylor_fused_orders` after the first series: a failure of Cranelift would
+/// leave them to the kernels and this comparison would prove nothing). Then again with every
+/// parameter changed on both models after the code was compiled: the compiled code reads
+/// the parameters at each call (a value baked in at compilation would show here), and the
+/// coefficients must change.
 #[test]
 fn compiled_orders_of_every_op_kind_are_the_kernels_bits() {
     use eomgen::{Backend, DynMechanicalSystem, OdeSystem};
@@ -421,40 +425,65 @@ fn compiled_orders_of_every_op_kind_are_the_kernels_bits() {
         let handle = native.clone();
         let mut native = DynFirstOrder::new(native);
         let y0 = ModelInfo::initial_state(&native);
-        for (shift, order) in [12, 1, 2, 5, 8, 13, 17, 23, 24, 25, 30, 0, 7]
-            .into_iter()
-            .enumerate()
-        {
-            let t = 0.1 * shift as f64;
-            // The file's initial state, moved from call to call.
-            let y: Vec<f64> = y0
-                .iter()
+        let mut before = Vec::new();
+        for pass in 0..2 {
+            if pass == 1 {
+                let names: Vec<String> = native
+                    .description()
+                    .parameter_names()
+                    .into_iter()
+                    .map(str::to_owned)
+                    .collect();
+                assert!(!names.is_empty(), "{file}: no parameters");
+                for (name, value) in names.iter().zip(native.parameter_values()) {
+                    native.set_parameter(name, 1.25 * value).unwrap();
+                    kernels.set_parameter(name, 1.25 * value).unwrap();
+                }
+            }
+            let mut coefficients = Vec::new();
+            for (shift, order) in [12, 1, 2, 5, 8, 13, 17, 23, 24, 25, 30, 0, 7]
+                .into_iter()
                 .enumerate()
-                .map(|(i, v)| v + 1e-2 * (shift * (i + 1)) as f64)
-                .collect();
-            let dim = y.len();
-            let mut a = vec![f64::NAN; (order + 1) * dim];
-            let mut b = a.clone();
-            native
-                .taylor_coefficients(t, &y, order, &mut a)
-                .unwrap_or_else(|e| panic!("{file}: {e}"));
-            kernels
-                .taylor_coefficients(t, &y, order, &mut b)
-                .unwrap_or_else(|e| panic!("{file}: {e}"));
-            for (j, (x, z)) in a.iter().zip(&b).enumerate() {
+            {
+                let t = 0.1 * shift as f64;
+                // The file's initial state, moved from call to call.
+                let y: Vec<f64> = y0
+                    .iter()
+                    .enumerate()
+                    .map(|(i, v)| v + 1e-2 * (shift * (i + 1)) as f64)
+                    .collect();
+                let dim = y.len();
+                let mut a = vec![f64::NAN; (order + 1) * dim];
+                let mut b = a.clone();
+                native
+                    .taylor_coefficients(t, &y, order, &mut a)
+                    .unwrap_or_else(|e| panic!("{file}: {e}"));
+                kernels
+                    .taylor_coefficients(t, &y, order, &mut b)
+                    .unwrap_or_else(|e| panic!("{file}: {e}"));
+                for (j, (x, z)) in a.iter().zip(&b).enumerate() {
+                    assert_eq!(
+                        x.to_bits(),
+                        z.to_bits(),
+                        "{file} to order {order}: order {}, component {}: compiled {x:e}, kernels {z:e}",
+                        j / dim,
+                        j % dim
+                    );
+                }
                 assert_eq!(
-                    x.to_bits(),
-                    z.to_bits(),
-                    "{file} to order {order}: order {}, component {}: compiled {x:e}, kernels {z:e}",
-                    j / dim,
-                    j % dim
+                    handle.taylor_fused_orders(),
+                    highest.min(24),
+                    "{file}: the orders are not compiled"
+                );
+                coefficients.push(a);
+            }
+            if pass == 1 {
+                assert_ne!(
+                    coefficients, before,
+                    "{file}: the parameters changed nothing"
                 );
             }
-            assert_eq!(
-                handle.taylor_fused_orders(),
-                highest.min(24),
-                "{file}: the orders are not compiled"
-            );
+            before = coefficients;
         }
     }
 }

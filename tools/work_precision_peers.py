@@ -155,7 +155,7 @@ def report(merged, methods, peers, tols, args, meta):
       "meets the target (tolerance in parentheses); ratios > 1: eomgen cheaper.")
     w("")
     head = ["target error"] + [f"eomgen {m}" for m in methods] + \
-        [p for p in peers] + ["heyoka taylor", "eomgen best"] + \
+        [p for p in peers] + [label(HEYOKA_METHOD), "eomgen best"] + \
         [f"{p} / eomgen best" for p in peers] + ["heyoka / eomgen best"]
     w("| " + " | ".join(head) + " |")
     w("|" + "---|" * len(head))

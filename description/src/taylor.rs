@@ -312,10 +312,11 @@ impl TaylorProgram {
     /// Each order is its own code, so a step runs all of it once: past what the processor's
     /// instruction cache holds, the unrolled code is slower than the loops. Measured on one
     /// machine (2 cores, 32 KiB instruction cache; time of a run against the loops', same
-    /// runs): the double pendulum (24 ops, w = 12) at orders 8, 12, 15 (sizes 504, 1056,
-    /// 1596) in 0.74, 0.71, 0.75, at 18 and 20 (2244, 2736) 1.09 and 1.2× the loops' time;
-    /// the figure eight (58 ops, w = 21) at orders 8 and 12 (994, 2024) in 0.73 and 0.77, at
-    /// 15 and 18 (3017, 4199) 1.1×.
+    /// runs, when the programs were larger than today's): the double pendulum (24 ops,
+    /// w = 12; 20 and 10 now) at orders 8, 12, 15 (sizes 504, 1056, 1596) in 0.74, 0.71, 0.75,
+    /// at 18 and 20 (2244, 2736) 1.09 and 1.2× the loops' time; the figure eight (58 ops,
+    /// w = 21; 44 and 15 now, its pulls formed once) at orders 8 and 12 (994, 2024) in 0.73
+    /// and 0.77, at 15 and 18 (3017, 4199) 1.1×.
     pub fn unrolled_code_fits(&self, order: usize) -> bool {
         order <= UNROLLED_ORDERS + 1 && self.unrolled_code_size(order) <= UNROLLED_CODE_BUDGET
     }

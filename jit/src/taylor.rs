@@ -127,6 +127,13 @@ pub(crate) fn compile_orders(
     plan.order_zero
         .validate()
         .map_err(|reason| failure(ORDER_ZERO, &reason))?;
+    // Its slots' byte offsets are 32-bit immediates.
+    if plan.order_zero.instructions.len() > i32::MAX as usize / (UNROLLED_CAPACITY * 8) {
+        return Err(failure(
+            ORDER_ZERO,
+            &"the tape has too many instructions for 32-bit offsets",
+        ));
+    }
     let mut module = new_module()?;
     let imports = declare_imports(&mut module)?;
     let call_conv = module.isa().default_call_conv();

@@ -110,3 +110,54 @@ fn the_figure_eight_forms_each_pull_once() {
     assert_eq!(pulls(&program.mass_matrix_and_forcing.tape), (3, 12));
     assert_eq!(pulls(&taylor.unwrap().order_zero), (3, 6));
 }
+
+/// What may and may not be merged, on a tape written by hand: only `Add` and `Mul` are
+/// commutative, so `x − y`, `x / y`, `xʸ` and `atan2(x, y)` stay apart from their operands
+/// swapped; calls of different functions on one operand stay apart, and from the `sin_cos`
+/// of it; a repeated `sin_cos` goes with its cosine, the pair adjacent, and its users are
+/// renumbered to the first. (No bundled model has a swapped quotient, power or `atan2`, or
+/// two functions of one operand, so the bundled-model tests would not see such a merge.)
+#[test]
+fn only_the_same_operation_on_the_same_operands_is_merged() {
+    use Instruction as I;
+    use eomgen_symbolic::codegen::tape::Input;
+    use eomgen_symbolic::expr::Func;
+    let (x, y) = (0, 1);
+    let tape = Tape {
+        instructions: vec![
+            I::Input(Input::Coordinate(0)), // 0: x
+            I::Input(Input::Velocity(0)),   // 1: y
+            I::Sub(x, y),                   // 2
+            I::Sub(y, x),                   // 3: kept
+            I::Div(x, y),                   // 4
+            I::Div(y, x),                   // 5: kept
+            I::Powf(x, y),                  // 6
+            I::Powf(y, x),                  // 7: kept
+            I::Atan2(x, y),                 // 8
+            I::Atan2(y, x),                 // 9: kept
+            I::Call(Func::Sin, x),          // 10
+            I::Call(Func::Tan, x),          // 11: kept
+            I::SinCos(x),                   // 12: kept (not the call of sin)
+            I::CosOfSinCos(12),             // 13
+            I::Add(x, y),                   // 14
+            I::Add(y, x),                   // 15: merged with 14
+            I::Mul(x, y),                   // 16
+            I::Mul(y, x),                   // 17: merged with 16
+            I::SinCos(x),                   // 18: merged with 12
+            I::CosOfSinCos(18),             // 19: merged with 13
+            I::Mul(15, 19),                 // 20: (x + y) cos x, read through the merged values
+            I::Div(17, 18),                 // 21: x y / sin x
+        ],
+        outputs: vec![15, 17, 19, 20, 21, 3, 5, 7, 9, 11],
+    };
+    tape.validate().unwrap();
+    let numbered = tape.numbered();
+    numbered.validate().unwrap();
+    assert_eq!(numbered.instructions.len(), tape.instructions.len() - 4);
+    assert_eq!(numbered.instructions[..15], tape.instructions[..15]);
+    assert_eq!(
+        numbered.instructions[15..],
+        [I::Mul(x, y), I::Mul(14, 13), I::Div(15, 12)]
+    );
+    assert_eq!(numbered.outputs, [14, 15, 13, 16, 17, 3, 5, 7, 9, 11]);
+}

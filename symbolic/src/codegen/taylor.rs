@@ -46,7 +46,8 @@ pub struct TaylorPlan {
 /// # Errors
 /// [`TaylorUnsupported::Constraints`] if `constraints > 0`;
 /// [`TaylorUnsupported::Functions`] naming each function without a recurrence (`abs`, `sign`,
-/// `step`, `pow` with a variable exponent) that the equations use.
+/// `step`, `pow` with a variable exponent) that the equations apply to the state or time (of
+/// parameters alone they are constants, computed once at order 0).
 pub fn taylor_program(
     tape: &FunctionTape,
     n: usize,
