@@ -10,7 +10,7 @@
 //! $P initial --model double_pendulum            # y(0) as JSON (shortest round-trip digits)
 //! $P rhs --model double_pendulum --state 0.1,0.2,0.3,0.4   # F(0, y) as JSON
 //! $P run --model double_pendulum --t-end 10 --methods dp54,dop853,ode_solvers-dop853 \
-//!     --tols 1e-2,1e-3,1e-4 --reps 5 [--reference reference.json]
+//!     --tols 1e-2,1e-3,1e-4 --reps 5 [--reference reference.json] [--host-features off]
 //! ```
 //!
 //! Models: `double_pendulum` (`models/double_pendulum.yaml`, HW19, 4 states) and
@@ -39,6 +39,8 @@
 //! `{"side", "method", "model", "tol", "failed": message}`. The reference file is JSON
 //! `{"<model>": {"t_end": 10.0, "state": ["<decimal>", …]}, …}` (as written by
 //! `tools/heyoka_peer.py reference`); its decimals are read as the nearest `f64`.
+//! `--host-features off` runs every Taylor step in the code compiled for any x86-64
+//! ([`eomgen::taylor::set_host_features`]; the same bits, for comparing the cost).
 
 use std::cell::RefCell;
 use std::hint::black_box;
@@ -328,6 +330,11 @@ macro_rules! command {
                 let reference = option(opts, "reference")
                     .map(|path| reference(path, name))
                     .transpose()?;
+                match option(opts, "host-features") {
+                    None | Some("on") => {}
+                    Some("off") => eomgen::taylor::set_host_features(false),
+                    Some(other) => return Err(format!("--host-features: `{other}`, not on or off")),
+                }
                 if let Some((t_ref, state)) = &reference {
                     if *t_ref != t_end || state.len() != $dim {
                         return Err(format!(

@@ -487,3 +487,76 @@ fn compiled_orders_of_every_op_kind_are_the_kernels_bits() {
         }
     }
 }
+
+/// The Taylor method's code for AVX2 and FMA (`eomgen::taylor::host_features`: the runtime's
+/// series of the motion, Horner's rule and step rule and, in an optimised build, each model's
+/// fused orders) computes the bits of the code for any x86-64: the coefficients of every
+/// bundled model, compiled and loaded from its file, at orders across the fused ones, and
+/// whole Taylor runs of the double pendulum and the figure eight, with the variant turned off
+/// and on. A debug build has no fused orders to compare; `cargo test --release --test
+/// taylor_coefficients` compares them too. On a processor without AVX2 and FMA (or not x86-64)
+/// both runs take the same code and the test only checks that turning the variant off changes
+/// nothing.
+#[test]
+fn the_code_for_the_hosts_instruction_sets_computes_the_same_bits() {
+    use eomgen::analysis::{SimulationOptions, simulate};
+    use eomgen::taylor::set_host_features;
+    let bits = |v: &[f64]| -> Vec<u64> { v.iter().map(|x| x.to_bits()).collect() };
+    let mut compared = 0;
+    for Case {
+        entry,
+        mut compiled,
+        mut runtime,
+    } in models()
+    {
+        if entry.skip.is_some() {
+            continue;
+        }
+        for order in [entry.order, 3, 8, 17, 24] {
+            let models: [(&str, &mut dyn ModelInfo); 2] =
+                [("compiled", compiled.as_mut()), ("file", runtime.as_mut())];
+            for (how, model) in models {
+                set_host_features(false);
+                let baseline = coefficients_to(&entry, model, order, 0.5);
+                set_host_features(true);
+                let host = coefficients_to(&entry, model, order, 0.5);
+                assert!(
+                    bits(&baseline) == bits(&host),
+                    "{} ({how}) to order {order}: the variants' coefficients differ",
+                    entry.name
+                );
+                compared += 1;
+            }
+        }
+    }
+    assert!(compared >= 35 * 10, "{compared} comparisons");
+    for entry in eomgen::models::ALL
+        .iter()
+        .filter(|m| ["double_pendulum", "figure_eight"].contains(&m.name))
+    {
+        let run = |tol: f64| {
+            let mut model = (entry.make)();
+            let options = SimulationOptions {
+                method: eomgen::Method::Taylor,
+                t_end: 5.0,
+                rtol: tol,
+                atol: tol,
+                ..SimulationOptions::default()
+            };
+            let s = simulate(model.as_mut(), &options).expect("the simulation starts");
+            assert!(s.failure.is_none(), "{}: {:?}", entry.name, s.failure);
+            (s.solution.t, s.solution.y)
+        };
+        for tol in [1e-4, 1e-9, 1e-14] {
+            set_host_features(false);
+            let (t0, y0) = run(tol);
+            set_host_features(true);
+            let (t1, y1) = run(tol);
+            assert!(
+                bits(&t0) == bits(&t1) && bits(&y0) == bits(&y1),
+                "{} at tol {tol}: the variants' runs differ",
+                entry.name
+            );
+        }
+    }
+}

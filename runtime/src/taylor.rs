@@ -489,6 +489,66 @@ pub fn zero<const K: usize>(k: usize, c: usize, s: &mut [f64], out: Slot) {
     put(s, c, out, k, 0.0);
 }
 
+/// Whether the code compiled for each order runs in its variant for AVX2 and FMA: on an
+/// x86-64 processor that has both (detected once), unless [`set_host_features`] turned it off;
+/// never elsewhere.
+///
+/// The variant is the same Rust code compiled with those instruction sets enabled — VEX
+/// encodings with three operands, fewer register copies — for a binary that still runs on
+/// any x86-64. Rust neither contracts a product and a sum into a fused multiply–add nor
+/// reassociates, so both variants compute the same bits (`tests/taylor_coefficients.rs`
+/// compares them). On the double pendulum (AMD EPYC, Zen 3) a step's recurrences took
+/// about 0.85 of the time (docs/performance.md).
+pub fn host_features() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::sync::atomic::Ordering;
+        match HOST_FEATURES.load(Ordering::Relaxed) {
+            ENABLED => true,
+            DISABLED => false,
+            _ => {
+                let found =
+                    std::is_x86_feature_detected!("avx2") && std::is_x86_feature_detected!("fma");
+                let state = if found { ENABLED } else { DISABLED };
+                // A concurrent `set_host_features(false)` wins over the detection.
+                let _ = HOST_FEATURES.compare_exchange(
+                    UNKNOWN,
+                    state,
+                    Ordering::Relaxed,
+                    Ordering::Relaxed,
+                );
+                HOST_FEATURES.load(Ordering::Relaxed) == ENABLED
+            }
+        }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
+}
+
+/// Turns the variant of [`host_features`] off (`false`: every model runs its baseline code
+/// from then on, in the whole process) or back to what the processor has (`true`): for
+/// comparing the two variants' bits and cost. The results are the same either way.
+pub fn set_host_features(enabled: bool) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        let state = if enabled { UNKNOWN } else { DISABLED };
+        HOST_FEATURES.store(state, std::sync::atomic::Ordering::Relaxed);
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = enabled;
+}
+
+#[cfg(target_arch = "x86_64")]
+static HOST_FEATURES: std::sync::atomic::AtomicU8 = std::sync::atomic::AtomicU8::new(UNKNOWN);
+#[cfg(target_arch = "x86_64")]
+const UNKNOWN: u8 = 0;
+#[cfg(target_arch = "x86_64")]
+const ENABLED: u8 = 1;
+#[cfg(target_arch = "x86_64")]
+const DISABLED: u8 = 2;
+
 /// Order `k ≥ 1` of every series of `ops`, in order ([`apply`] for each): the run-time
 /// model's orders, compiled for `K = k` when `k ≤` [`UNROLLED_ORDERS`] and `capacity` is
 /// [`UNROLLED_CAPACITY`], else for any order.
@@ -617,6 +677,36 @@ pub trait TaylorFunctions {
 /// # Panics
 /// If `y` has fewer than `2n` entries or `out` fewer than `(order + 1) · 2n`.
 pub fn series_of_motion(
+    model: &impl TaylorFunctions,
+    workspace: &mut TaylorWorkspace,
+    t: f64,
+    y: &[f64],
+    order: usize,
+    out: &mut [f64],
+) -> Result<(), RhsError> {
+    #[cfg(target_arch = "x86_64")]
+    if host_features() {
+        /// The same code with AVX2 and FMA enabled ([`host_features`]).
+        #[target_feature(enable = "avx2,fma")]
+        unsafe fn with_avx2(
+            model: &impl TaylorFunctions,
+            workspace: &mut TaylorWorkspace,
+            t: f64,
+            y: &[f64],
+            order: usize,
+            out: &mut [f64],
+        ) -> Result<(), RhsError> {
+            series_in(model, workspace, t, y, order, out)
+        }
+        // SAFETY: the processor has AVX2 and FMA (`host_features`).
+        return unsafe { with_avx2(model, workspace, t, y, order, out) };
+    }
+    series_in(model, workspace, t, y, order, out)
+}
+
+/// [`series_of_motion`]'s body, compiled into its two variants.
+#[inline(always)]
+fn series_in(
     model: &impl TaylorFunctions,
     workspace: &mut TaylorWorkspace,
     t: f64,

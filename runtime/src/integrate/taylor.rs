@@ -272,6 +272,22 @@ impl TaylorStepper {
     /// Makes the coefficients in `scratch` (of `order`) the current ones and proposes the
     /// next step from them.
     fn commit(&mut self, order: usize) {
+        #[cfg(target_arch = "x86_64")]
+        if crate::taylor::host_features() {
+            /// The same code with AVX2 and FMA enabled ([`crate::taylor::host_features`]).
+            #[target_feature(enable = "avx2,fma")]
+            unsafe fn with_avx2(stepper: &mut TaylorStepper, order: usize) {
+                stepper.commit_in(order);
+            }
+            // SAFETY: the processor has AVX2 and FMA (`host_features`).
+            return unsafe { with_avx2(self, order) };
+        }
+        self.commit_in(order);
+    }
+
+    /// [`Self::commit`]'s body, compiled into its two variants.
+    #[inline(always)]
+    fn commit_in(&mut self, order: usize) {
         std::mem::swap(&mut self.coefficients, &mut self.scratch);
         self.order = order;
         let dim = self.dim;
@@ -343,6 +359,38 @@ impl TaylorStepper {
     /// registers with no loop over the components: the generic loop was 6 % of a
     /// double-pendulum step at 10⁻⁶); the products and sums are the same, in the same order.
     fn horner(
+        coefficients: &[f64],
+        order: usize,
+        dim: usize,
+        tau: f64,
+        carry: &[f64],
+        out: &mut [f64],
+        carry_out: Option<&mut [f64]>,
+    ) {
+        #[cfg(target_arch = "x86_64")]
+        if crate::taylor::host_features() {
+            /// The same code with AVX2 and FMA enabled ([`crate::taylor::host_features`]).
+            #[target_feature(enable = "avx2,fma")]
+            unsafe fn with_avx2(
+                coefficients: &[f64],
+                order: usize,
+                dim: usize,
+                tau: f64,
+                carry: &[f64],
+                out: &mut [f64],
+                carry_out: Option<&mut [f64]>,
+            ) {
+                TaylorStepper::horner_in(coefficients, order, dim, tau, carry, out, carry_out);
+            }
+            // SAFETY: the processor has AVX2 and FMA (`host_features`).
+            return unsafe { with_avx2(coefficients, order, dim, tau, carry, out, carry_out) };
+        }
+        Self::horner_in(coefficients, order, dim, tau, carry, out, carry_out);
+    }
+
+    /// [`Self::horner`]'s body, compiled into its two variants.
+    #[inline(always)]
+    fn horner_in(
         coefficients: &[f64],
         order: usize,
         dim: usize,

@@ -898,19 +898,50 @@ pub(super) fn methods(
                 __end
             };
             #[cfg(not(debug_assertions))]
-            let __next = 'fused: {
-                if __order == 0 {
-                    break 'fused 0;
-                }
-                #t::motion_order::<#n, 0>(&__LAYOUT, __solve, 0, __s, __out);
-                #(
-                    if #unrolled >= __order {
-                        break 'fused #unrolled;
+            let __next = {
+                #[inline(always)]
+                fn __fused(
+                    __solve: &mut #t::MotionSolve<'_>,
+                    __order: usize,
+                    __s: &mut [f64],
+                    __out: &mut [f64],
+                ) -> usize {
+                    if __order == 0 {
+                        return 0;
                     }
-                    __ops::<#unrolled>(#unrolled, #t::UNROLLED_CAPACITY, __s);
-                    #t::motion_order::<#n, #unrolled>(&__LAYOUT, __solve, #unrolled, __s, __out);
-                )*
-                #next
+                    #t::motion_order::<#n, 0>(&__LAYOUT, __solve, 0, __s, __out);
+                    #(
+                        if #unrolled >= __order {
+                            return #unrolled;
+                        }
+                        __ops::<#unrolled>(#unrolled, #t::UNROLLED_CAPACITY, __s);
+                        #t::motion_order::<#n, #unrolled>(&__LAYOUT, __solve, #unrolled, __s, __out);
+                    )*
+                    #next
+                }
+                // The same code with AVX2 and FMA's encodings where the processor has them
+                // (`eomgen_runtime::taylor::host_features`): the same operations, so the same
+                // bits (Rust neither contracts nor reassociates).
+                #[cfg(target_arch = "x86_64")]
+                #[target_feature(enable = "avx2,fma")]
+                unsafe fn __fused_avx2(
+                    __solve: &mut #t::MotionSolve<'_>,
+                    __order: usize,
+                    __s: &mut [f64],
+                    __out: &mut [f64],
+                ) -> usize {
+                    __fused(__solve, __order, __s, __out)
+                }
+                #[cfg(target_arch = "x86_64")]
+                let __next = if #t::host_features() {
+                    // SAFETY: the processor has AVX2 and FMA (`host_features`).
+                    unsafe { __fused_avx2(__solve, __order, __s, __out) }
+                } else {
+                    __fused(__solve, __order, __s, __out)
+                };
+                #[cfg(not(target_arch = "x86_64"))]
+                let __next = __fused(__solve, __order, __s, __out);
+                __next
             };
             __next
         }
