@@ -31,7 +31,8 @@
 //!
 //! `run` prints, for each method and tolerance, one line
 //! `{"side", "method", "model", "tol", "t_end", "time_s", "times_s", "rhs_evals", "steps",
-//! "rejected", "final_state", "error", "energy_drift"}`: `time_s` is the median of `reps`
+//! "rejected", "final_state", "error", "energy_drift", "host_features"}`: `time_s` is the
+//! median of `reps`
 //! timed integrations (s, wall clock, `Instant`, the integrator built before the clock
 //! starts), `error = max |yᵢ(t_end) − y_refᵢ|` over the state (the rule of
 //! `benches/peers.rs`; `null` without `--reference`), `energy_drift = |E(t_end) − E(0)| /
@@ -40,7 +41,8 @@
 //! `{"<model>": {"t_end": 10.0, "state": ["<decimal>", …]}, …}` (as written by
 //! `tools/heyoka_peer.py reference`); its decimals are read as the nearest `f64`.
 //! `--host-features off` runs every Taylor step in the code compiled for any x86-64
-//! ([`eomgen::taylor::set_host_features`]; the same bits, for comparing the cost).
+//! ([`eomgen::taylor::set_host_features`]; the same bits, for comparing the cost);
+//! `host_features` says which copy ran ([`eomgen::taylor::host_features`]).
 
 use std::cell::RefCell;
 use std::hint::black_box;
@@ -373,6 +375,7 @@ macro_rules! command {
                                     "final_state": m.final_state,
                                     "error": error,
                                     "energy_drift": ((e1 - e0) / e0).abs(),
+                                    "host_features": eomgen::taylor::host_features(),
                                 })
                             }
                             Err(message) => json!({

@@ -488,9 +488,9 @@ fn compiled_orders_of_every_op_kind_are_the_kernels_bits() {
     }
 }
 
-/// The Taylor method's code for AVX2 and FMA (`eomgen::taylor::host_features`: the runtime's
-/// series of the motion, Horner's rule and step rule and, in an optimised build, each model's
-/// fused orders) computes the bits of the code for any x86-64: the coefficients of every
+/// The Taylor method's copy of its code for AVX2 and FMA (`eomgen::taylor::host_features`:
+/// the runtime's series of the motion, Horner's rule and step rule and, in an optimised
+/// build, each model's fused orders) computes the bits of the code for any x86-64: the coefficients of every
 /// bundled model, compiled and loaded from its file, at orders across the fused ones, and
 /// whole Taylor runs of the double pendulum and the figure eight, with the variant turned off
 /// and on. A debug build has no fused orders to compare; `cargo test --release --test
@@ -500,7 +500,16 @@ fn compiled_orders_of_every_op_kind_are_the_kernels_bits() {
 #[test]
 fn the_code_for_the_hosts_instruction_sets_computes_the_same_bits() {
     use eomgen::analysis::{SimulationOptions, simulate};
-    use eomgen::taylor::set_host_features;
+    use eomgen::taylor::{host_features, set_host_features};
+    // The switch itself: off when turned off, and what the processor has when turned on.
+    set_host_features(false);
+    assert!(!host_features());
+    set_host_features(true);
+    #[cfg(target_arch = "x86_64")]
+    let expected = std::is_x86_feature_detected!("avx2") && std::is_x86_feature_detected!("fma");
+    #[cfg(not(target_arch = "x86_64"))]
+    let expected = false;
+    assert_eq!(host_features(), expected);
     let bits = |v: &[f64]| -> Vec<u64> { v.iter().map(|x| x.to_bits()).collect() };
     let mut compared = 0;
     for Case {

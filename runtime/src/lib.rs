@@ -31,6 +31,32 @@
 //!   numerical studies).
 #![warn(missing_docs)]
 
+/// Defines `fn $name` whose body runs in one of two copies: the code compiled for any
+/// processor of the target, or — on x86-64, when [`taylor::host_features`] says the processor
+/// has AVX2 and FMA — the same body compiled a second time with those instruction sets
+/// enabled. The body is inlined into both copies (functions it calls that are not inlined run
+/// their one copy, compiled for any x86-64); both compute the same bits (see
+/// `host_features`). For the Taylor method's hot functions.
+macro_rules! with_host_features {
+    ($(#[$meta:meta])* $vis:vis fn $name:ident($($arg:ident: $ty:ty),* $(,)?) $(-> $ret:ty)? $body:block) => {
+        $(#[$meta])*
+        $vis fn $name($($arg: $ty),*) $(-> $ret)? {
+            #[inline(always)]
+            fn body($($arg: $ty),*) $(-> $ret)? $body
+            #[cfg(target_arch = "x86_64")]
+            if $crate::taylor::host_features() {
+                #[target_feature(enable = "avx2,fma")]
+                unsafe fn with_avx2($($arg: $ty),*) $(-> $ret)? {
+                    body($($arg),*)
+                }
+                // SAFETY: the processor has AVX2 and FMA (`host_features`).
+                return unsafe { with_avx2($($arg),*) };
+            }
+            body($($arg),*)
+        }
+    };
+}
+
 pub mod analysis;
 pub mod constrained;
 pub mod dynamic;

@@ -489,36 +489,29 @@ pub fn zero<const K: usize>(k: usize, c: usize, s: &mut [f64], out: Slot) {
     put(s, c, out, k, 0.0);
 }
 
-/// Whether the code compiled for each order runs in its variant for AVX2 and FMA: on an
+/// Whether the Taylor method's steps run in their copy compiled for AVX2 and FMA: on an
 /// x86-64 processor that has both (detected once), unless [`set_host_features`] turned it off;
 /// never elsewhere.
 ///
-/// The variant is the same Rust code compiled with those instruction sets enabled — VEX
-/// encodings with three operands, fewer register copies — for a binary that still runs on
-/// any x86-64. Rust neither contracts a product and a sum into a fused multiply–add nor
-/// reassociates, so both variants compute the same bits (`tests/taylor_coefficients.rs`
-/// compares them). On the double pendulum (AMD EPYC, Zen 3) a step's recurrences took
-/// about 0.85 of the time (docs/performance.md).
+/// The copy covers each compiled model's fused orders (the `model!` macro's `taylor_orders`,
+/// in optimised builds), the rest of [`series_of_motion`], and the Taylor method's Horner's
+/// rule and step rule: the same Rust code compiled a second time with those instruction sets
+/// enabled — three-operand VEX encodings, fewer register copies — in a binary that still runs
+/// on any x86-64. Rust neither contracts a product and a sum into a fused multiply–add nor
+/// reassociates, so both copies compute the same bits (`tests/taylor_coefficients.rs`
+/// compares them). Orders above the fused ones (`taylor_order`, the run-time model's
+/// `evaluate_order`) run the baseline code; a model compiled at run time gets the host's
+/// instructions from Cranelift anyway. On the double pendulum (AMD EPYC, Zen 3) a run took
+/// 0.73–0.94 of the time at tolerances 1e-4 to 1e-12; on a processor with AVX-512 the whole
+/// crate compiled for it had left the Taylor method's times unchanged (docs/performance.md).
+#[inline]
 pub fn host_features() -> bool {
     #[cfg(target_arch = "x86_64")]
     {
-        use std::sync::atomic::Ordering;
-        match HOST_FEATURES.load(Ordering::Relaxed) {
+        match HOST_FEATURES.load(std::sync::atomic::Ordering::Relaxed) {
             ENABLED => true,
             DISABLED => false,
-            _ => {
-                let found =
-                    std::is_x86_feature_detected!("avx2") && std::is_x86_feature_detected!("fma");
-                let state = if found { ENABLED } else { DISABLED };
-                // A concurrent `set_host_features(false)` wins over the detection.
-                let _ = HOST_FEATURES.compare_exchange(
-                    UNKNOWN,
-                    state,
-                    Ordering::Relaxed,
-                    Ordering::Relaxed,
-                );
-                HOST_FEATURES.load(Ordering::Relaxed) == ENABLED
-            }
+            _ => detect_host_features(),
         }
     }
     #[cfg(not(target_arch = "x86_64"))]
@@ -527,9 +520,22 @@ pub fn host_features() -> bool {
     }
 }
 
-/// Turns the variant of [`host_features`] off (`false`: every model runs its baseline code
-/// from then on, in the whole process) or back to what the processor has (`true`): for
-/// comparing the two variants' bits and cost. The results are the same either way.
+/// [`host_features`]' first call: detects AVX2 and FMA and records the answer.
+#[cfg(target_arch = "x86_64")]
+#[cold]
+#[inline(never)]
+fn detect_host_features() -> bool {
+    use std::sync::atomic::Ordering;
+    let found = std::is_x86_feature_detected!("avx2") && std::is_x86_feature_detected!("fma");
+    let state = if found { ENABLED } else { DISABLED };
+    // A concurrent `set_host_features(false)` wins over the detection.
+    let _ = HOST_FEATURES.compare_exchange(UNKNOWN, state, Ordering::Relaxed, Ordering::Relaxed);
+    HOST_FEATURES.load(Ordering::Relaxed) == ENABLED
+}
+
+/// Turns the copy of [`host_features`] off (`false`: every Taylor step runs the baseline
+/// code from then on, in the whole process) or back to what the processor has (`true`): for
+/// comparing the two copies' bits and cost. The results are the same either way.
 pub fn set_host_features(enabled: bool) {
     #[cfg(target_arch = "x86_64")]
     {
@@ -540,6 +546,7 @@ pub fn set_host_features(enabled: bool) {
     let _ = enabled;
 }
 
+/// [`host_features`]' answer: [`UNKNOWN`] until the first call.
 #[cfg(target_arch = "x86_64")]
 static HOST_FEATURES: std::sync::atomic::AtomicU8 = std::sync::atomic::AtomicU8::new(UNKNOWN);
 #[cfg(target_arch = "x86_64")]
@@ -667,44 +674,29 @@ pub trait TaylorFunctions {
     }
 }
 
-/// The Taylor coefficients of the motion through `(t, y)`, `y = [q; q̇]` (`2n` entries), up
-/// to `order`: `out[k · 2n + i] = yᵢ^[k]` for `k = 0 … order` (so `out[..2n] = y`).
-///
-/// # Errors
-/// [`RhsError::SingularMassMatrix`] if `M(q, t)` is not positive definite;
-/// [`RhsError::NonFinite`] with the component of the first coefficient that is not finite.
-///
-/// # Panics
-/// If `y` has fewer than `2n` entries or `out` fewer than `(order + 1) · 2n`.
-pub fn series_of_motion(
-    model: &impl TaylorFunctions,
-    workspace: &mut TaylorWorkspace,
-    t: f64,
-    y: &[f64],
-    order: usize,
-    out: &mut [f64],
-) -> Result<(), RhsError> {
-    #[cfg(target_arch = "x86_64")]
-    if host_features() {
-        /// The same code with AVX2 and FMA enabled ([`host_features`]).
-        #[target_feature(enable = "avx2,fma")]
-        unsafe fn with_avx2(
-            model: &impl TaylorFunctions,
-            workspace: &mut TaylorWorkspace,
-            t: f64,
-            y: &[f64],
-            order: usize,
-            out: &mut [f64],
-        ) -> Result<(), RhsError> {
-            series_in(model, workspace, t, y, order, out)
-        }
-        // SAFETY: the processor has AVX2 and FMA (`host_features`).
-        return unsafe { with_avx2(model, workspace, t, y, order, out) };
+with_host_features! {
+    /// The Taylor coefficients of the motion through `(t, y)`, `y = [q; q̇]` (`2n` entries), up
+    /// to `order`: `out[k · 2n + i] = yᵢ^[k]` for `k = 0 … order` (so `out[..2n] = y`).
+    ///
+    /// # Errors
+    /// [`RhsError::SingularMassMatrix`] if `M(q, t)` is not positive definite;
+    /// [`RhsError::NonFinite`] with the component of the first coefficient that is not finite.
+    ///
+    /// # Panics
+    /// If `y` has fewer than `2n` entries or `out` fewer than `(order + 1) · 2n`.
+    pub fn series_of_motion(
+        model: &impl TaylorFunctions,
+        workspace: &mut TaylorWorkspace,
+        t: f64,
+        y: &[f64],
+        order: usize,
+        out: &mut [f64],
+    ) -> Result<(), RhsError> {
+        series_in(model, workspace, t, y, order, out)
     }
-    series_in(model, workspace, t, y, order, out)
 }
 
-/// [`series_of_motion`]'s body, compiled into its two variants.
+/// [`series_of_motion`]'s body, inlined into its two copies.
 #[inline(always)]
 fn series_in(
     model: &impl TaylorFunctions,

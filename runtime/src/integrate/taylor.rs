@@ -269,23 +269,15 @@ impl TaylorStepper {
         Ok(order)
     }
 
-    /// Makes the coefficients in `scratch` (of `order`) the current ones and proposes the
-    /// next step from them.
-    fn commit(&mut self, order: usize) {
-        #[cfg(target_arch = "x86_64")]
-        if crate::taylor::host_features() {
-            /// The same code with AVX2 and FMA enabled ([`crate::taylor::host_features`]).
-            #[target_feature(enable = "avx2,fma")]
-            unsafe fn with_avx2(stepper: &mut TaylorStepper, order: usize) {
-                stepper.commit_in(order);
-            }
-            // SAFETY: the processor has AVX2 and FMA (`host_features`).
-            return unsafe { with_avx2(self, order) };
+    with_host_features! {
+        /// Makes the coefficients in `scratch` (of `order`) the current ones and proposes the
+        /// next step from them.
+        fn commit(stepper: &mut TaylorStepper, order: usize) {
+            stepper.commit_in(order);
         }
-        self.commit_in(order);
     }
 
-    /// [`Self::commit`]'s body, compiled into its two variants.
+    /// [`Self::commit`]'s body, inlined into its two copies.
     #[inline(always)]
     fn commit_in(&mut self, order: usize) {
         std::mem::swap(&mut self.coefficients, &mut self.scratch);
@@ -346,49 +338,33 @@ impl TaylorStepper {
         self.proposed = radius * self.factor;
     }
 
-    /// The polynomial of `coefficients` (of `order`, order-major rows, row 0 the state `y`)
-    /// at `τ`: `y + (τ P(τ) + carry)` with `P(τ) = Σₖ₌₁ᵖ y^[k] τᵏ⁻¹` by Horner's rule, into
-    /// `out`; with `carry_out`, the rounding error of that last sum by Knuth's two-sum (see
-    /// [`Taylor`]'s compensated summation).
-    ///
-    /// (The even and odd orders as two chains in `τ²` were 1 % faster on the double pendulum
-    /// at 10⁻⁹ — the chain is not what a step waits for — and round differently: kept as
-    /// it is.)
-    ///
-    /// The state's usual sizes are compiled for their size (the rows then load as whole
-    /// registers with no loop over the components: the generic loop was 6 % of a
-    /// double-pendulum step at 10⁻⁶); the products and sums are the same, in the same order.
-    fn horner(
-        coefficients: &[f64],
-        order: usize,
-        dim: usize,
-        tau: f64,
-        carry: &[f64],
-        out: &mut [f64],
-        carry_out: Option<&mut [f64]>,
-    ) {
-        #[cfg(target_arch = "x86_64")]
-        if crate::taylor::host_features() {
-            /// The same code with AVX2 and FMA enabled ([`crate::taylor::host_features`]).
-            #[target_feature(enable = "avx2,fma")]
-            unsafe fn with_avx2(
-                coefficients: &[f64],
-                order: usize,
-                dim: usize,
-                tau: f64,
-                carry: &[f64],
-                out: &mut [f64],
-                carry_out: Option<&mut [f64]>,
-            ) {
-                TaylorStepper::horner_in(coefficients, order, dim, tau, carry, out, carry_out);
-            }
-            // SAFETY: the processor has AVX2 and FMA (`host_features`).
-            return unsafe { with_avx2(coefficients, order, dim, tau, carry, out, carry_out) };
+    with_host_features! {
+        /// The polynomial of `coefficients` (of `order`, order-major rows, row 0 the state `y`)
+        /// at `τ`: `y + (τ P(τ) + carry)` with `P(τ) = Σₖ₌₁ᵖ y^[k] τᵏ⁻¹` by Horner's rule, into
+        /// `out`; with `carry_out`, the rounding error of that last sum by Knuth's two-sum (see
+        /// [`Taylor`]'s compensated summation).
+        ///
+        /// (The even and odd orders as two chains in `τ²` were 1 % faster on the double pendulum
+        /// at 10⁻⁹ — the chain is not what a step waits for — and round differently: kept as
+        /// it is.)
+        ///
+        /// The state's usual sizes are compiled for their size (the rows then load as whole
+        /// registers with no loop over the components: the generic loop was 6 % of a
+        /// double-pendulum step at 10⁻⁶); the products and sums are the same, in the same order.
+        fn horner(
+            coefficients: &[f64],
+            order: usize,
+            dim: usize,
+            tau: f64,
+            carry: &[f64],
+            out: &mut [f64],
+            carry_out: Option<&mut [f64]>,
+        ) {
+            TaylorStepper::horner_in(coefficients, order, dim, tau, carry, out, carry_out);
         }
-        Self::horner_in(coefficients, order, dim, tau, carry, out, carry_out);
     }
 
-    /// [`Self::horner`]'s body, compiled into its two variants.
+    /// [`Self::horner`]'s body, inlined into its two copies.
     #[inline(always)]
     fn horner_in(
         coefficients: &[f64],
@@ -531,7 +507,7 @@ impl Stepper for TaylorStepper {
         self.y.copy_from_slice(y0);
         self.carry.fill(0.0);
         let order = self.series(rhs, t0, y0)?;
-        self.commit(order);
+        Self::commit(self, order);
         self.proposed = rhs.taylor_branch_step(order, self.proposed);
         Ok(())
     }
@@ -572,7 +548,7 @@ impl Stepper for TaylorStepper {
         // The coefficients at the step's start become its dense output.
         std::mem::swap(&mut self.previous, &mut self.coefficients);
         self.previous_order = self.order;
-        self.commit(order);
+        Self::commit(self, order);
         self.proposed = rhs.taylor_branch_step(order, self.proposed);
         self.t_prev = self.t;
         self.t = t_new;

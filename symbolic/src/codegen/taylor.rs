@@ -657,8 +657,10 @@ fn operands(instruction: Instruction) -> Vec<Slot> {
 /// kernel calls compiled for that `k` (sums of a known length, coefficients at known
 /// offsets) followed by its solve (`taylor::motion_order`, with the slots of `F`, of the
 /// varying entries of `M` and of the inputs as a constant `MotionLayout`), so that the
-/// values of one order pass to the next in registers; debug builds run the same orders with
-/// `k` a variable.
+/// values of one order pass to the next in registers — that function compiled twice on
+/// x86-64, the second copy with AVX2 and FMA enabled and run where the processor has them
+/// (`taylor::host_features`; the same bits); debug builds run the same orders with `k` a
+/// variable.
 ///
 /// `parameters` are the fields of the struct, in parameter order.
 ///
@@ -882,12 +884,11 @@ pub(super) fn methods(
             if !__solve.unrolled() {
                 return 0;
             }
-            // A known length: the compiler drops the bounds checks of the constant offsets.
-            let __s = &mut __s[..(#slots + #n) * #t::UNROLLED_CAPACITY];
             // Debug builds run the same orders with `k` a variable (one variant to compile;
             // the same bits).
             #[cfg(debug_assertions)]
             let __next = {
+                let __s = &mut __s[..(#slots + #n) * #t::UNROLLED_CAPACITY];
                 let __end = __order.min(#next);
                 for __k in 0..__end {
                     if __k > 0 {
@@ -906,6 +907,9 @@ pub(super) fn methods(
                     __s: &mut [f64],
                     __out: &mut [f64],
                 ) -> usize {
+                    // A known length: the compiler drops the bounds checks of the constant
+                    // offsets (in each copy: the one for AVX2 and FMA is not inlined here).
+                    let __s = &mut __s[..(#slots + #n) * #t::UNROLLED_CAPACITY];
                     if __order == 0 {
                         return 0;
                     }
@@ -919,9 +923,9 @@ pub(super) fn methods(
                     )*
                     #next
                 }
-                // The same code with AVX2 and FMA's encodings where the processor has them
-                // (`eomgen_runtime::taylor::host_features`): the same operations, so the same
-                // bits (Rust neither contracts nor reassociates).
+                // The same code compiled a second time with AVX2 and FMA enabled, run where
+                // the processor has them (`eomgen_runtime::taylor::host_features`): the same
+                // operations, so the same bits (Rust neither contracts nor reassociates).
                 #[cfg(target_arch = "x86_64")]
                 #[target_feature(enable = "avx2,fma")]
                 unsafe fn __fused_avx2(
