@@ -490,13 +490,13 @@ fn compiled_orders_of_every_op_kind_are_the_kernels_bits() {
 
 /// The Taylor method's copy of its code for AVX2 and FMA (`eomgen::taylor::host_features`:
 /// the runtime's series of the motion, Horner's rule and step rule and, in an optimised
-/// build, each model's fused orders) computes the bits of the code for any x86-64: the coefficients of every
-/// bundled model, compiled and loaded from its file, at orders across the fused ones, and
-/// whole Taylor runs of the double pendulum and the figure eight, with the variant turned off
-/// and on. A debug build has no fused orders to compare; `cargo test --release --test
-/// taylor_coefficients` compares them too. On a processor without AVX2 and FMA (or not x86-64)
-/// both runs take the same code and the test only checks that turning the variant off changes
-/// nothing.
+/// build, each model's fused orders) computes the bits of the code for any x86-64: the
+/// coefficients of every bundled model, compiled and loaded from its file, at orders across
+/// the fused ones, and whole Taylor runs of the double pendulum and the figure eight, with
+/// the copy turned off and on. A debug build has no fused orders to compare; `cargo test
+/// --release --test taylor_coefficients` compares them too. On a processor without AVX2 and
+/// FMA (or not x86-64) both runs take the same code and the test only checks that turning
+/// the copy off changes nothing.
 #[test]
 fn the_code_for_the_hosts_instruction_sets_computes_the_same_bits() {
     use eomgen::analysis::{SimulationOptions, simulate};
@@ -531,7 +531,7 @@ fn the_code_for_the_hosts_instruction_sets_computes_the_same_bits() {
                 let host = coefficients_to(&entry, model, order, 0.5);
                 assert!(
                     bits(&baseline) == bits(&host),
-                    "{} ({how}) to order {order}: the variants' coefficients differ",
+                    "{} ({how}) to order {order}: the two copies' coefficients differ",
                     entry.name
                 );
                 compared += 1;
@@ -539,10 +539,16 @@ fn the_code_for_the_hosts_instruction_sets_computes_the_same_bits() {
         }
     }
     assert!(compared >= 35 * 10, "{compared} comparisons");
-    for entry in eomgen::models::ALL
+    let runs: Vec<_> = eomgen::models::ALL
         .iter()
         .filter(|m| ["double_pendulum", "figure_eight"].contains(&m.name))
-    {
+        .collect();
+    assert_eq!(
+        runs.len(),
+        2,
+        "the two models of the whole runs are bundled"
+    );
+    for entry in runs {
         let run = |tol: f64| {
             let mut model = (entry.make)();
             let options = SimulationOptions {
@@ -563,7 +569,7 @@ fn the_code_for_the_hosts_instruction_sets_computes_the_same_bits() {
             let (t1, y1) = run(tol);
             assert!(
                 bits(&t0) == bits(&t1) && bits(&y0) == bits(&y1),
-                "{} at tol {tol}: the variants' runs differ",
+                "{} at tol {tol}: the two copies' runs differ",
                 entry.name
             );
         }
