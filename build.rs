@@ -1,16 +1,24 @@
-//! Compiles every `models/*.yaml` into the crate: writes `$OUT_DIR/models.rs` with one
-//! `model!` per file and a registry, so a file dropped into `models/` is available at the
-//! next build with no code edited.
+//! Embeds every `models/*.yaml` into the crate as text: writes `$OUT_DIR/models.rs` with one
+//! [`ModelEntry`] per file (its name, its file and its text), so a file dropped into
+//! `models/` is available at the next build with no code edited. Nothing is derived or
+//! compiled here: a bundled model is compiled at run time at its first use, as any model
+//! file is (`eomgen::models`).
 
 use std::fmt::Write as _;
 use std::path::Path;
 
-/// The model's `name` (for the struct the macro will generate), read with the same loader the
-/// macro uses; a broken file falls back to its stem, and the macro then reports the errors.
-fn model_name(path: &Path, source: &str, stem: &str) -> String {
-    eomgen_symbolic::model::load(&path.display().to_string(), source)
-        .map(|file| file.name.value)
-        .unwrap_or_else(|_| stem.to_string())
+/// The model's `name:` as the loader reads it from a bundled file: the value of the first
+/// top-level `name:` line, without a trailing comment or quotes. A test
+/// (`every_bundled_model_compiles`, tests/models.rs) checks it against the loader; a file
+/// without one falls back to its stem, and its first use reports the loader's diagnostics.
+fn model_name(source: &str, stem: &str) -> String {
+    source
+        .lines()
+        .find_map(|l| l.strip_prefix("name:"))
+        .and_then(|v| v.split('#').next())
+        .map(|v| v.trim().trim_matches(|c| c == '"' || c == '\'').to_string())
+        .filter(|v| !v.is_empty())
+        .unwrap_or_else(|| stem.to_string())
 }
 
 fn main() {
@@ -26,32 +34,14 @@ fn main() {
         })
         .unwrap_or_default();
     files.sort();
-    let mut out = String::new();
     let mut registry = String::new();
-    for f in &files {
+    for (index, f) in files.iter().enumerate() {
         let stem = f.file_stem().and_then(|s| s.to_str()).unwrap_or("model");
-        let module: String = stem
-            .chars()
-            .map(|c| {
-                if c.is_ascii_alphanumeric() {
-                    c.to_ascii_lowercase()
-                } else {
-                    '_'
-                }
-            })
-            .collect();
         let source = std::fs::read_to_string(f).unwrap_or_default();
-        let name = model_name(f, &source, stem);
-        let ty = eomgen_symbolic::codegen::struct_name(&name);
-        let _ = writeln!(
-            out,
-            "/// Generated from `models/{stem}.{ext}`.\npub mod {module} {{ ::eomgen::model!({path:?}); }}\npub use {module}::{ty};",
-            ext = f.extension().and_then(|s| s.to_str()).unwrap_or("yaml"),
-            path = f.display().to_string(),
-        );
+        let name = model_name(&source, stem);
         let _ = writeln!(
             registry,
-            "    ModelEntry {{ name: {name:?}, file: {file:?}, source: include_str!({path:?}), make: || ::std::boxed::Box::new(crate::FirstOrder::new({module}::{ty}::default())) }},",
+            "    ModelEntry {{ name: {name:?}, file: {file:?}, source: include_str!({path:?}), make: || instantiate({index}) }},",
             file = format!(
                 "models/{}",
                 f.file_name()
@@ -61,9 +51,10 @@ fn main() {
             path = f.display().to_string(),
         );
     }
-    let _ = writeln!(
-        out,
-        "/// Every bundled model, sorted by file name.\npub const ALL: &[ModelEntry] = &[\n{registry}];"
+    let out = format!(
+        "/// Every bundled model, sorted by file name.\npub const ALL: &[ModelEntry] = &[\n{registry}];\n\
+         /// How many models are bundled.\nconst COUNT: usize = {};\n",
+        files.len()
     );
     let out_dir = std::env::var("OUT_DIR").unwrap_or_default();
     if let Err(e) = std::fs::write(Path::new(&out_dir).join("models.rs"), out) {

@@ -33,7 +33,7 @@ use std::hint::black_box;
 use std::time::{Duration, Instant};
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use eomgen::models::DoublePendulum;
+eomgen::model!("../models/double_pendulum.yaml");
 use eomgen::{
     DormandPrince54, DormandPrince853, FirstOrder, Integrator, IntegratorOptions, ModelInfo,
     OdeSystem, OutputTimes,

@@ -61,7 +61,7 @@ use std::path::PathBuf;
 use std::time::{Duration, Instant, SystemTime};
 
 use criterion::{BenchmarkId, Criterion};
-use eomgen::models::DoublePendulum;
+eomgen::model!("../models/double_pendulum.yaml");
 use eomgen::{
     BogackiShampine32, DormandPrince54, DormandPrince853, FirstOrder, Integrator,
     IntegratorOptions, ModelInfo, OdeSystem, OutputTimes, RhsError, RungeKutta4,

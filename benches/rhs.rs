@@ -30,7 +30,7 @@
 use std::hint::black_box;
 
 use criterion::{BatchSize, Criterion, criterion_group, criterion_main};
-use eomgen::models::DoublePendulum;
+eomgen::model!("../models/double_pendulum.yaml");
 use eomgen::{
     DormandPrince54, FirstOrder, Integrator, IntegratorOptions, MechanicalSystem, ModelInfo,
     OdeSystem, OutputTimes, RhsError,

@@ -25,7 +25,7 @@ use std::hint::black_box;
 use std::path::PathBuf;
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use eomgen::models::DoublePendulum;
+eomgen::model!("../models/double_pendulum.yaml");
 use eomgen::{
     Backend, DormandPrince54, DormandPrince853, DynFirstOrder, FirstOrder, Integrator,
     IntegratorOptions, JitModel, LoadOptions, ModelInfo, OdeSystem, OutputTimes,

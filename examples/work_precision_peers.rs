@@ -15,7 +15,7 @@
 //!
 //! Models: `double_pendulum` (`models/double_pendulum.yaml`, HW19, 4 states) and
 //! `figure_eight` (`models/figure_eight.yaml`, HW7, 12 states), with the files' default
-//! parameters and initial states, as compiled by `model!` into [`eomgen::models`].
+//! parameters and initial states, as compiled into this program by `model!`.
 //!
 //! Methods: every adaptive [`Method`] by its command-line name (`dp54`, `dop853`, and any
 //! method added to [`Method::ALL`] later), run through [`Method::integrator`] with
@@ -50,8 +50,12 @@ use std::process::ExitCode;
 use std::str::FromStr;
 use std::time::Instant;
 
-use eomgen::models::{DoublePendulum, FigureEight};
+mod models {
+    eomgen::model!("../models/double_pendulum.yaml");
+    eomgen::model!("../models/figure_eight.yaml");
+}
 use eomgen::{FirstOrder, IntegratorOptions, Method, ModelInfo, OdeSystem, OutputTimes};
+use models::{DoublePendulum, FigureEight};
 use ode_solvers::{Dop853, Dopri5, OutputType};
 use serde_json::{Value, json};
 

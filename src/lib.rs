@@ -10,7 +10,8 @@
 //! ```
 //! use eomgen::{DormandPrince54, FirstOrder, Integrator, IntegratorOptions, MechanicalSystem,
 //!              OdeSystem, OutputTimes};
-//! use eomgen::models::DoublePendulum;
+//!
+//! eomgen::model!("../models/double_pendulum.yaml");
 //!
 //! let pendulum = DoublePendulum::default();
 //! let (q0, qdot0) = pendulum.initial_state();
@@ -73,31 +74,8 @@ pub struct ReadmeDoctests;
 #[doc = include_str!("../docs/rust.md")]
 pub struct RustPageDoctests;
 
-/// Every model in `models/`, compiled in: one module and struct per file, and [`models::ALL`].
-pub mod models {
-    /// A bundled model: its name, its file's text (compiled into the binary, so an installed
-    /// or moved program needs no source tree), and a constructor of its first-order form with
-    /// the file's default parameters.
-    #[derive(Debug, Clone, Copy)]
-    pub struct ModelEntry {
-        /// The model's `name`.
-        pub name: &'static str,
-        /// The file as it is shown in messages and diagnostics: `models/<file name>`.
-        pub file: &'static str,
-        /// The text of the model file, as it was compiled.
-        pub source: &'static str,
-        /// Builds the model with its default parameters (`Send`, so that a thread pool or
-        /// another language's threads may own it).
-        pub make: fn() -> Box<dyn crate::ModelInfo + Send>,
-    }
-
-    /// The bundled model named `name`.
-    pub fn find(name: &str) -> Option<&'static ModelEntry> {
-        ALL.iter().find(|e| e.name == name)
-    }
-
-    include!(concat!(env!("OUT_DIR"), "/models.rs"));
-}
+#[cfg(feature = "jit")]
+pub mod models;
 
 /// Support for generated code. Not part of the public API.
 #[doc(hidden)]

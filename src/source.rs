@@ -4,8 +4,8 @@
 use crate::models::ModelEntry;
 use crate::{DynFirstOrder, JitModel, LoadError, LoadOptions, ModelInfo};
 
-/// A model named by a user: bundled (compiled into the crate by `eomgen::model!`) or a model
-/// file compiled at run time ([`JitModel`]). Both give the same [`ModelInfo`], so every
+/// A model named by a user: bundled (its text embedded in the program) or a model file. Both
+/// are compiled at run time ([`JitModel`]) and give the same [`ModelInfo`], so every
 /// analysis takes either.
 ///
 /// # Examples
@@ -17,8 +17,13 @@ use crate::{DynFirstOrder, JitModel, LoadError, LoadOptions, ModelInfo};
 /// ```
 #[derive(Debug, Clone)]
 pub enum ModelSource {
-    /// A model of `models/`, compiled in.
-    Bundled(&'static ModelEntry),
+    /// A model of `models/`, embedded.
+    Bundled {
+        /// Its name, file and text.
+        entry: &'static ModelEntry,
+        /// The compiled model (with the file's default parameters).
+        model: JitModel,
+    },
     /// A model file loaded, derived and compiled at run time.
     File {
         /// The path as the user gave it.
@@ -52,9 +57,10 @@ pub enum OpenError {
 }
 
 impl ModelSource {
-    /// Opens `name_or_path`: a bundled model's name gives the compiled model; a path (ending
-    /// in `.yaml` or `.yml`, containing a `/`, or naming an existing file) loads that file at
-    /// run time — even if the file is a copy of a bundled model, its own equations run.
+    /// Opens `name_or_path`: a bundled model's name compiles its embedded text (once per
+    /// process); a path (ending in `.yaml` or `.yml`, containing a `/`, or naming an existing
+    /// file) loads that file — even if the file is a copy of a bundled model, its own
+    /// equations run.
     ///
     /// # Errors
     /// [`OpenError::UnknownModel`] for a name that is neither bundled nor a file;
@@ -64,13 +70,16 @@ impl ModelSource {
         Self::open_with(name_or_path, LoadOptions::default())
     }
 
-    /// [`Self::open`], a file compiled with `options` (a bundled model is compiled already).
+    /// [`Self::open`], compiled with `options`.
     ///
     /// # Errors
     /// As [`Self::open`].
     pub fn open_with(name_or_path: &str, options: LoadOptions) -> Result<ModelSource, OpenError> {
         match resolve(name_or_path)? {
-            Resolved::Bundled(entry) => Ok(ModelSource::Bundled(entry)),
+            Resolved::Bundled(entry) => Ok(ModelSource::Bundled {
+                entry,
+                model: entry.load_with(options)?,
+            }),
             Resolved::File(path) => {
                 let model = JitModel::load_with(&path, options)?;
                 Ok(ModelSource::File { path, model })
@@ -86,16 +95,13 @@ impl ModelSource {
     /// [`Self::instantiate`] as a `Send` box, for an instance that moves between threads
     /// (a thread pool's task, an interpreter's objects).
     pub fn instantiate_send(&self) -> Box<dyn ModelInfo + Send> {
-        match self {
-            ModelSource::Bundled(entry) => (entry.make)(),
-            ModelSource::File { model, .. } => Box::new(DynFirstOrder::new(model.clone())),
-        }
+        Box::new(DynFirstOrder::new(self.model().clone()))
     }
 
     /// The model's name (its file's `name:`).
     pub fn name(&self) -> &str {
         match self {
-            ModelSource::Bundled(entry) => entry.name,
+            ModelSource::Bundled { entry, .. } => entry.name,
             ModelSource::File { model, .. } => &crate::DynMechanicalSystem::description(model).name,
         }
     }
@@ -104,7 +110,7 @@ impl ModelSource {
     /// given.
     pub fn path(&self) -> &str {
         match self {
-            ModelSource::Bundled(entry) => entry.file,
+            ModelSource::Bundled { entry, .. } => entry.file,
             ModelSource::File { path, .. } => path,
         }
     }
@@ -116,7 +122,9 @@ impl ModelSource {
     /// The operating system's error when the file cannot be read.
     pub fn bytes(&self) -> std::io::Result<std::borrow::Cow<'static, [u8]>> {
         match self {
-            ModelSource::Bundled(entry) => Ok(std::borrow::Cow::Borrowed(entry.source.as_bytes())),
+            ModelSource::Bundled { entry, .. } => {
+                Ok(std::borrow::Cow::Borrowed(entry.source.as_bytes()))
+            }
             ModelSource::File { path, .. } => read_file(path).map(std::borrow::Cow::Owned),
         }
     }
@@ -125,12 +133,19 @@ impl ModelSource {
     /// model's name, or the file's path.
     pub fn argument(&self) -> &str {
         match self {
-            ModelSource::Bundled(entry) => entry.name,
+            ModelSource::Bundled { entry, .. } => entry.name,
             ModelSource::File { path, .. } => path,
         }
     }
 
-    /// Whether the model was compiled at run time from a file.
+    /// The compiled model.
+    pub fn model(&self) -> &JitModel {
+        match self {
+            ModelSource::Bundled { model, .. } | ModelSource::File { model, .. } => model,
+        }
+    }
+
+    /// Whether the model was read from a file (not bundled).
     pub fn is_file(&self) -> bool {
         matches!(self, ModelSource::File { .. })
     }

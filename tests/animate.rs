@@ -3,7 +3,7 @@
 //! computed states (closed-form kinematics of the triple pendulum and the four-bar on
 //! `simulate --t-out` states), its energies are the closed-form energy, and the GIF decodes.
 
-mod common;
+use crate::common;
 use common::{eomgen, eomgen_ok};
 
 use serde_json::Value;

@@ -11,7 +11,7 @@
 //! `--dump-dom` prints once `--virtual-time-budget` ms of page time have passed (timers run
 //! in virtual time, so the check does not depend on the machine's speed).
 
-mod common;
+use crate::common;
 
 use std::io::{Read as _, Write as _};
 use std::os::unix::process::CommandExt as _;

@@ -1,7 +1,7 @@
 //! The `eomgen` binary end to end: `list --json`, `simulate --json` output contract, dense
 //! output at requested times, expressions in options, and clear usage errors.
 
-mod common;
+use crate::common;
 use common::{eomgen, eomgen_ok};
 
 #[test]

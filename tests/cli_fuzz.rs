@@ -10,7 +10,7 @@
 //! `LIMIT` (a value such as `--t-end 1e300` asks for a long integration that the step limit
 //! ends) is killed and not judged.
 
-mod common;
+use crate::common;
 
 use std::io::Read;
 use std::process::{Command, Stdio};

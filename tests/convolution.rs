@@ -4,7 +4,7 @@
 //! response — against the closed-form impulse and step responses, its order, direct
 //! integration on three masses and the modal closed form of their undamped step response.
 
-mod common;
+use crate::common;
 use common::{eomgen, eomgen_ok};
 
 use eomgen::analysis::vibration::{

@@ -3,7 +3,7 @@
 //! generated code is the same for two derivations in separate processes. Timing is the one
 //! thing that differs between runs; it is only in the JSON with `--timing`.
 
-mod common;
+use crate::common;
 use common::eomgen;
 
 /// Runs `args` twice and returns both outputs' stdout, asserting success.

@@ -2,7 +2,7 @@
 //! (exact elliptic integral), HW21's damped period and logarithmic decrement from successive
 //! peaks, HW36's lift-off where the normal force reaches zero, and `--stop-when`/`--event`.
 
-mod common;
+use crate::common;
 use common::{eomgen, eomgen_ok};
 
 use eomgen::analysis::{SimulationOptions, simulate_with_events};

@@ -1,7 +1,7 @@
 //! `study expm` (HW32) and `study rayleigh` (lectures 35–37): the routes against each other
 //! and against closed forms written here, the refusals, and the commands.
 
-mod common;
+use crate::common;
 use common::{eomgen, eomgen_ok, seeded_rng};
 
 use eomgen::ModelInfo;

@@ -3,7 +3,7 @@
 //! unshaken pendulum, Kapitza's stability region confirmed by nonlinear simulation, the
 //! computed stability boundary against Kapitza and the Mathieu series, and the CLI.
 
-mod common;
+use crate::common;
 use common::{eomgen, eomgen_ok};
 
 use std::f64::consts::TAU;

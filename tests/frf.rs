@@ -2,7 +2,7 @@
 //! parameter, the frequency response against closed forms and against simulations of the
 //! full model, modal forcing against the direct solve, and `eomgen frf`.
 
-mod common;
+use crate::common;
 use common::{eomgen, eomgen_ok};
 
 use eomgen::{

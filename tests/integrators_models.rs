@@ -4,7 +4,7 @@
 //! with a tight explicit reference and with themselves using differenced Jacobians; the
 //! partitioned methods keep the energy of a constant-mass model bounded.
 
-mod common;
+use crate::common;
 use common::seeded_rng;
 use rand::RngExt;
 

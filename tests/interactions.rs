@@ -8,7 +8,7 @@
 //! conserved output is measured along a run and a quantity that is not conserved is caught;
 //! mistakes are located; a compiled and a run-time model integrate to the same bits.
 
-mod common;
+use crate::common;
 
 use common::{eomgen, seeded_rng};
 use eomgen::analysis::{SimulationOptions, simulate};
@@ -445,7 +445,7 @@ fn magnitudes_are_forces() {
 fn compiled_and_run_time_models_agree_to_the_bit() {
     for name in ["three_body_circle", "two_body"] {
         let entry = eomgen::models::find(name).unwrap();
-        let mut compiled = (entry.make)();
+        let mut compiled = crate::compiled_models::make(name).expect("compiled by model!");
         let path = format!("{}/{}", env!("CARGO_MANIFEST_DIR"), entry.file);
         let mut runtime = DynFirstOrder::new(JitModel::load(&path).unwrap());
         assert_eq!(

@@ -10,7 +10,7 @@
 //! √(2 ε R*/|R''|) ≈ 1e-6 rad at ε = 1e-12 (|R''| ≈ 4 R* without drag); θ* is asserted to
 //! 5e-6 rad, the golden-section bracket being 1e-7 rad.
 
-mod common;
+use crate::common;
 use common::eomgen;
 
 use eomgen::ModelInfo;

@@ -29,7 +29,7 @@
 //! Run with `cargo test --test long_runs -- --nocapture` (about 4 s in a debug build) to see
 //! the figures.
 
-use eomgen::models::FigureEight;
+use crate::compiled_models::figure_eight::FigureEight;
 use eomgen::{
     DormandPrince853, FirstOrder, Integrator, IntegratorOptions, ModelInfo, OutputTimes, Solution,
     StormerVerlet,

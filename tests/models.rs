@@ -5,7 +5,7 @@
 //! Lagrange → Jacobians) and evaluates the expression DAG directly, with no code generation,
 //! printing or CSE in between; the generated side is the compiled `impl MechanicalSystem`.
 
-mod common;
+use crate::common;
 use common::seeded_rng;
 use rand::RngExt;
 
@@ -367,4 +367,21 @@ fn constraint_functions_match_finite_differences() {
         }
     }
     assert!(checked >= 60, "only {checked} constrained states checked");
+}
+
+/// Every bundled file compiles at run time (native code, not the interpreter fallback), so
+/// `ModelEntry::make` never meets an error, and the name `build.rs` reads from the file's
+/// `name:` line is the name the loader reads.
+#[test]
+fn every_bundled_model_compiles() {
+    assert!(ALL.len() >= 50, "{} bundled models", ALL.len());
+    for entry in ALL {
+        let model = entry
+            .model()
+            .unwrap_or_else(|e| panic!("{}: {e}", entry.file));
+        assert_eq!(model.backend(), eomgen::Backend::Native, "{}", entry.name);
+        let file = eomgen_symbolic::model::load(entry.file, entry.source).expect("loads");
+        assert_eq!(file.name.value, entry.name, "{}", entry.file);
+        assert_eq!(eomgen::models::find(entry.name).map(|e| e.file), Some(entry.file));
+    }
 }

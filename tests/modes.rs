@@ -1,7 +1,7 @@
 //! Equilibria, exact linearisation and normal modes (issue 7, items 1–3) against analytic
 //! frequencies and independent hand derivations.
 
-mod common;
+use crate::common;
 use common::{eomgen, eomgen_ok};
 use rand::RngExt;
 

@@ -9,12 +9,12 @@
 //! largest frequency) covers every model here. Zero-frequency modes are those with
 //! `|ω²| ≤ 1e-9 max |ω²|` (the library's rule); the exact ones come out at ~1e-16.
 
-mod common;
+use crate::common;
 use common::eomgen_ok;
 
 use std::f64::consts::PI;
 
-use eomgen::models::DoublePendulumPoints;
+use crate::compiled_models::double_pendulum_points::DoublePendulumPoints;
 use eomgen::{
     DormandPrince853, EventDirection, EventSpec, FirstOrder, Integrator, IntegratorOptions,
     Linearization, ModeKind, ModelInfo, NormalModes, OutputTimes, WithEvents, find_equilibrium,

@@ -4,7 +4,7 @@
 //! quadrature of the apsidal angle and the radial period, the pendulum against its elliptic
 //! integral, the multipliers 1 each symmetry brings, the errors and the CLI.
 
-mod common;
+use crate::common;
 use common::{eomgen, seeded_rng};
 
 use std::f64::consts::{PI, TAU};

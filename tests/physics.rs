@@ -3,7 +3,7 @@
 //! Each test states its tolerance and why. References are computed here from formulas, never
 //! copied from a previous run.
 
-mod common;
+use crate::common;
 use common::seeded_rng;
 use rand::RngExt;
 

@@ -4,7 +4,7 @@
 //! `simulate` draws the phase portrait and the energy drift. The full report on every bundled
 //! model runs too (under a second in a debug build).
 
-mod common;
+use crate::common;
 use common::{eomgen, eomgen_ok};
 
 use std::path::{Path, PathBuf};

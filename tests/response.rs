@@ -1,7 +1,7 @@
 //! Free response three ways (HW28) and damping models compared (HW34): the routes against
 //! each other and against closed forms written here from hand-derived M, C, K.
 
-mod common;
+use crate::common;
 use common::{eomgen, eomgen_ok};
 
 use eomgen::{

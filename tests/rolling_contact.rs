@@ -3,7 +3,7 @@
 //! ground at the lift-off against its closed form; and the free flight after it against the
 //! parabola, the constant spin and the energy.
 
-mod common;
+use crate::common;
 use common::{eomgen, eomgen_ok};
 
 use eomgen::ModelInfo;

@@ -3,7 +3,7 @@
 //! Radau IIA on the stiff two-mass spring, round-off) are tested in the runtime crate,
 //! `runtime/tests/stability.rs`.
 
-mod common;
+use crate::common;
 use common::{eomgen, eomgen_ok};
 
 use std::f64::consts::E;

@@ -2,7 +2,7 @@
 //! restricted to the constraints, and the stability changes of a parameter sweep (issue 30,
 //! items 4 and 5), against closed forms.
 
-mod common;
+use crate::common;
 use common::eomgen_ok;
 
 use eomgen::ModelInfo;

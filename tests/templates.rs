@@ -4,7 +4,7 @@
 //! `checks:` pass (the pendulum chain is lecture 25 and HW19/HW39, the mass chain lecture 30
 //! and HW23).
 
-mod common;
+use crate::common;
 use common::eomgen_ok;
 
 use eomgen::analysis::vibration::{

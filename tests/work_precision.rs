@@ -6,7 +6,7 @@
 //! settings and `--repeats 1 --min-time-ms 0`, so the file stays fast in the debug profile.
 //! No assertion involves a wall time.
 
-mod common;
+use crate::common;
 use common::{eomgen, eomgen_ok};
 
 use eomgen::analysis::{

@@ -2,7 +2,7 @@
 //! (exit 2), a warning, a failure (exit 1) or a hint that names the real cause. Each of these
 //! commands was run before the change and did what its test's comment says.
 
-mod common;
+use crate::common;
 use common::eomgen;
 
 fn stderr(out: &std::process::Output) -> String {

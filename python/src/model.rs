@@ -58,7 +58,10 @@ fn open(argument: &str, text: Option<&str>) -> Result<Loaded, eomgen::OpenError>
             && entry.source == text
         {
             return Ok(Loaded {
-                source: ModelSource::Bundled(entry),
+                source: ModelSource::Bundled {
+                    entry,
+                    model: entry.model()?,
+                },
                 argument: argument.to_string(),
                 text: text.to_string(),
             });
@@ -74,7 +77,10 @@ fn open(argument: &str, text: Option<&str>) -> Result<Loaded, eomgen::OpenError>
     }
     match eomgen::resolve(argument)? {
         eomgen::Resolved::Bundled(entry) => Ok(Loaded {
-            source: ModelSource::Bundled(entry),
+            source: ModelSource::Bundled {
+                entry,
+                model: entry.model()?,
+            },
             argument: argument.to_string(),
             text: entry.source.to_string(),
         }),

@@ -12,7 +12,7 @@ use eomgen_runtime::{
     Tolerance,
 };
 
-mod common;
+use crate::common;
 use common::problems::{
     Problem, System, every_method_on_every_problem, forced_decay, growth, integrators,
     is_fixed_step, needs_second_order, oscillator, problems,

@@ -18,7 +18,7 @@ use eomgen_runtime::{
 // Problems with closed-form solutions (shared with `integrators.rs`)
 // ---------------------------------------------------------------------------------------------
 
-mod common;
+use crate::common;
 use common::problems::{
     self, Problem, damped_oscillator, forced_decay, forced_oscillator, oscillator,
 };

@@ -8,7 +8,7 @@
 //! variants are `#[ignore]`d:
 //! `cargo test -p eomgen-runtime --release --test stability -- --ignored`.
 
-mod common;
+use crate::common;
 
 use std::f64::consts::E;
 

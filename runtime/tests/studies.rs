@@ -4,7 +4,7 @@
 //! independent computation.
 //! Every bound is stated next to its assertion with its reason.
 
-mod common;
+use crate::common;
 
 use common::models::{CartesianPendulum, Pendulum, TwoMassChain, boxed};
 use eomgen_runtime::analysis::{

@@ -2,7 +2,7 @@
 //! the small hand-written models of `common/models.rs`, each against a closed form or an
 //! independent computation. Every bound is stated next to its assertion with its reason.
 
-mod common;
+use crate::common;
 
 use std::f64::consts::{PI, TAU};
 

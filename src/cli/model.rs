@@ -13,7 +13,7 @@ pub(super) fn find_model(name_or_path: &str) -> Result<Box<dyn eomgen::ModelInfo
     Ok(open_model(name_or_path)?.instantiate())
 }
 
-/// [`eomgen::ModelSource::open`] with its errors as the CLI reports them. A file is loaded
+/// [`eomgen::ModelSource::open`] with its errors as the CLI reports them. A model is loaded
 /// and compiled once per process: the commands that simulate a model several times (`report`,
 /// the studies, `animate`) name it again by its path, and each use gets a fresh instance of
 /// the same compiled code.
@@ -49,15 +49,14 @@ pub(super) fn open_model_with(
         return Ok(source);
     }
     let source = eomgen::ModelSource::open_with(name_or_path, options).map_err(open_error)?;
-    if let eomgen::ModelSource::File { path, model } = &source
-        && let Some(reason) = model.fallback_reason()
-    {
+    if let Some(reason) = source.model().fallback_reason() {
         // Slower, but the same numbers: say so rather than run silently interpreted.
-        output::errln!("note: `{path}` runs on the interpreter: {reason}");
+        output::errln!(
+            "note: `{}` runs on the interpreter: {reason}",
+            source.path()
+        );
     }
-    if source.is_file()
-        && let Ok(mut files) = FILES.lock()
-    {
+    if let Ok(mut files) = FILES.lock() {
         files.push((name_or_path.to_string(), options, source.clone()));
     }
     Ok(source)

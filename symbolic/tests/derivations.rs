@@ -1,7 +1,7 @@
 //! Lagrange ≡ momentum balance: two independent derivations of every kinematic-form model give
 //! the same generalized accelerations q̈ at random states.
 
-mod common;
+use crate::common;
 
 use eomgen_symbolic::expr::SymbolKind;
 use eomgen_symbolic::expr::eval::Evaluator;

@@ -3,7 +3,7 @@
 //! every bundled set agrees, a set that is not there is not compared, and each term the
 //! balances take (gravity, a torque on a body, `form: h_dot`) is needed for the agreement.
 
-mod common;
+use crate::common;
 
 use eomgen_symbolic::mechanics::cross_check::{CheckReport, check_model};
 

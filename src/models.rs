@@ -1,0 +1,90 @@
+//! The bundled models: every file of `models/`, embedded as text and compiled at run time
+//! (Cranelift) at its first use in a process, as any model file is.
+//!
+//! Nothing of a bundled model is compiled into the library: a program that wants a model's
+//! equations compiled into its own crate names the file in [`eomgen::model!`](crate::model).
+//! The text is compiled once per process and model; each [`ModelEntry::make`] is a fresh
+//! instance of the same code (a [`JitModel`] clone, with its own parameter values).
+
+use std::sync::OnceLock;
+
+use crate::{DynFirstOrder, JitModel, LoadError, LoadOptions, ModelInfo};
+
+/// A bundled model: its name, its file's text (embedded, so an installed or moved program
+/// needs no source tree), and a constructor of its first-order form with the file's default
+/// parameters.
+#[derive(Debug, Clone, Copy)]
+pub struct ModelEntry {
+    /// The model's `name`.
+    pub name: &'static str,
+    /// The file as it is shown in messages and diagnostics: `models/<file name>`.
+    pub file: &'static str,
+    /// The text of the model file.
+    pub source: &'static str,
+    /// Builds the model with its default parameters (`Send`, so that a thread pool or
+    /// another language's threads may own it), compiling the file at the first call in the
+    /// process ([`ModelEntry::model`]).
+    ///
+    /// # Panics
+    /// If the bundled file does not compile (a defect of the bundle, which the test
+    /// `every_bundled_model_compiles` rules out; use [`ModelEntry::load_with`] for the error).
+    pub make: fn() -> Box<dyn ModelInfo + Send>,
+}
+
+impl ModelEntry {
+    /// The model compiled with the default [`LoadOptions`]: compiled at the first call in
+    /// the process, then a clone of the same code (cheap: clones share the compiled code).
+    ///
+    /// # Errors
+    /// As [`JitModel::from_source`]: a bundled file always compiles (the test
+    /// `every_bundled_model_compiles`), so an error here is a defect of the bundle.
+    pub fn model(&self) -> Result<JitModel, LoadError> {
+        let Some(index) = ALL.iter().position(|e| e.file == self.file) else {
+            return self.load_with(LoadOptions::default());
+        };
+        let cached = COMPILED[index].get_or_init(|| {
+            JitModel::from_source(self.file, self.source).map_err(|e| e.to_string())
+        });
+        match cached {
+            Ok(model) => Ok(model.clone()),
+            // The first call's error, compiled again to return it typed.
+            Err(_) => self.load_with(LoadOptions::default()),
+        }
+    }
+
+    /// The model compiled with `options` (a new compilation unless they are the defaults,
+    /// which [`ModelEntry::model`] serves from its cache).
+    ///
+    /// # Errors
+    /// As [`JitModel::from_source`].
+    pub fn load_with(&self, options: LoadOptions) -> Result<JitModel, LoadError> {
+        if options == LoadOptions::default()
+            && let Some(index) = ALL.iter().position(|e| e.file == self.file)
+            && let Some(Ok(model)) = COMPILED[index].get()
+        {
+            return Ok(model.clone());
+        }
+        JitModel::from_source_with(self.file, self.source, options)
+    }
+}
+
+/// The bundled model named `name`.
+pub fn find(name: &str) -> Option<&'static ModelEntry> {
+    ALL.iter().find(|e| e.name == name)
+}
+
+/// The compiled code of each bundled model, by its index in [`ALL`], once compiled (the
+/// error as text if it could not be).
+static COMPILED: [OnceLock<Result<JitModel, String>>; COUNT] = [const { OnceLock::new() }; COUNT];
+
+/// [`ModelEntry::make`] of the `index`-th bundled model.
+fn instantiate(index: usize) -> Box<dyn ModelInfo + Send> {
+    let entry = &ALL[index];
+    match entry.model() {
+        Ok(model) => Box::new(DynFirstOrder::new(model)),
+        // A defect of the bundle, ruled out by a test (see `ModelEntry::make`).
+        Err(e) => panic!("the bundled model `{}` does not compile: {e}", entry.name),
+    }
+}
+
+include!(concat!(env!("OUT_DIR"), "/models.rs"));

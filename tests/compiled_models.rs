@@ -1,0 +1,53 @@
+//! A handful of bundled model files compiled into the test binary by `eomgen::model!`, for the
+//! tests that compare the macro's code with the same file compiled at run time (the path every
+//! bundled model takes in the program). Chosen to cover every kind of equation the code
+//! generators write: energies and points (`double_pendulum`, `double_pendulum_points`), a
+//! diagonal mass matrix and central forces (`figure_eight`, `two_body`, `three_body_circle`,
+//! with interactions and outputs), a 3-D body (`heavy_top`), a holonomic constraint
+//! (`simple_pendulum_cartesian`), a time-dependent load (`forced_oscillator`), functions
+//! without a Taylor recurrence (`two_masses`: `sign`, `step`) and rolling constraints
+//! (`whipple_bicycle`).
+
+use eomgen::{FirstOrder, ModelInfo};
+
+macro_rules! compiled {
+    ($($module:ident: $ty:ident = $file:literal;)*) => {
+        $(
+            pub mod $module {
+                eomgen::model!($file);
+            }
+        )*
+
+        /// Every model compiled here: `(name, constructor)`.
+        pub const ALL: &[(&str, fn() -> Box<dyn ModelInfo + Send>)] = &[
+            $((stringify!($module), || Box::new(FirstOrder::new($module::$ty::default()))),)*
+        ];
+    };
+}
+
+compiled! {
+    double_pendulum: DoublePendulum = "../models/double_pendulum.yaml";
+    double_pendulum_points: DoublePendulumPoints = "../models/double_pendulum_points.yaml";
+    figure_eight: FigureEight = "../models/figure_eight.yaml";
+    forced_oscillator: ForcedOscillator = "../models/forced_oscillator.yaml";
+    heavy_top: HeavyTop = "../models/heavy_top.yaml";
+    simple_pendulum_cartesian: SimplePendulumCartesian = "../models/simple_pendulum_cartesian.yaml";
+    three_body_circle: ThreeBodyCircle = "../models/three_body_circle.yaml";
+    two_body: TwoBody = "../models/two_body.yaml";
+    two_masses: TwoMasses = "../models/two_masses.yaml";
+    whipple_bicycle: WhippleBicycle = "../models/whipple_bicycle.yaml";
+}
+
+/// The bundled model `name` compiled by `model!`, if it is one of the handful.
+pub fn make(name: &str) -> Option<Box<dyn ModelInfo + Send>> {
+    ALL.iter().find(|(n, _)| *n == name).map(|(_, make)| make())
+}
+
+/// Every compiled model is the bundled model of its name (its file's `name:`).
+#[test]
+fn each_compiled_model_is_the_bundled_model_of_its_name() {
+    for (name, make) in ALL {
+        assert_eq!(make().description().name, *name);
+        assert!(eomgen::models::find(name).is_some(), "{name}");
+    }
+}

@@ -1,0 +1,41 @@
+//! The integration tests, one module per file, built as one test binary (a test binary links
+//! the whole crate, so one binary is built once rather than once per file).
+
+mod animate;
+mod browser;
+mod cli;
+mod cli_fuzz;
+mod common;
+mod compiled_models;
+mod constraints;
+mod convolution;
+mod determinism;
+mod events;
+mod expm_rayleigh;
+mod floquet;
+mod frf;
+mod integrators_models;
+mod interactions;
+mod json_schemas;
+mod launch;
+mod long_runs;
+mod models;
+mod modes;
+mod modes_models;
+mod output;
+mod periodic_orbit;
+mod physics;
+mod reduce;
+mod report;
+mod response;
+mod rolling_contact;
+mod runtime_models;
+mod simulation;
+mod stability;
+mod steady_motions;
+mod taylor;
+mod taylor_coefficients;
+mod taylor_kernels;
+mod templates;
+mod work_precision;
+mod wrong_successes;
