@@ -5,7 +5,7 @@
 //! The harness mutates the value of one option of a valid command at a time: empty, text,
 //! `nan`, `inf`, `-inf`, zero, negative, huge, tiny, an integer too large for `u64`, a
 //! malformed list, a control character. The suite runs one value per option chosen by the
-//! seeded generator of `tests/common` (about 100 runs); `cargo test --test cli_fuzz -- --ignored`
+//! seeded generator of `tests/common` (about 100 runs); `cargo test --test suite -- cli_fuzz:: --ignored`
 //! runs every value at every option (about 1,000 runs, a few minutes). A run still going after
 //! `LIMIT` (a value such as `--t-end 1e300` asks for a long integration that the step limit
 //! ends) is killed and not judged.

@@ -287,7 +287,7 @@ fn large_amplitude_departs_from_frf() {
 
 /// HW37's light damping (c = 0.1 √(mk)) needs ~800 s to settle; its three peaks and points
 /// between them are in the long check. Run with
-/// `cargo test --release --test frf -- --ignored`.
+/// `cargo test --release --test suite -- frf:: --ignored`.
 #[test]
 #[ignore]
 fn simulated_steady_state_matches_frf_hw37_damping() {

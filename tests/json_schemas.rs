@@ -3,7 +3,7 @@
 //! type of every value, recursively; an array by its first element) is compared with a golden
 //! file in `tests/fixtures/json_schemas/`. A key removed, renamed or retyped fails the test; a
 //! key added on purpose is added to the golden file too (`EOMGEN_UPDATE_SCHEMAS=1 cargo test
-//! --test json_schemas` rewrites the files from the current output, for review in the diff).
+//! --test suite json_schemas::` rewrites the files from the current output, for review in the diff).
 //!
 //! The values themselves are the other tests' business; only the shapes are compared here, so
 //! the runs are short (a second or less each in a debug build).

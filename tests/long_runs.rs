@@ -26,7 +26,7 @@
 //! `L` of the two halves of a period largely cancel. The tests assert only that it is far
 //! above roundoff, not that it grows.
 //!
-//! Run with `cargo test --test long_runs -- --nocapture` (about 4 s in a debug build) to see
+//! Run with `cargo test --test suite -- long_runs:: --nocapture` (about 4 s in a debug build) to see
 //! the figures.
 
 use crate::compiled_models::figure_eight::FigureEight;

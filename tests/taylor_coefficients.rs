@@ -495,7 +495,7 @@ fn compiled_orders_of_every_op_kind_are_the_kernels_bits() {
 /// coefficients of every bundled model, compiled and loaded from its file, at orders across
 /// the fused ones, and whole Taylor runs of the double pendulum and the figure eight, with
 /// the copy turned off and on. A debug build has no fused orders to compare; `cargo test
-/// --release --test taylor_coefficients` compares them too. On a processor without AVX2 and
+/// --release --test suite taylor_coefficients::` compares them too. On a processor without AVX2 and
 /// FMA (or not x86-64) both runs take the same code and the test only checks that turning
 /// the copy off changes nothing.
 #[test]

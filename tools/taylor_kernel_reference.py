@@ -36,7 +36,7 @@ Run from the repository root (a few tens of seconds; needs mpmath, installed in 
 
     /work/venv/bin/python tools/taylor_kernel_reference.py
 
-then `cargo test --release --test taylor_kernels`.  `--check` recomputes and compares with
+then `cargo test --release --test suite taylor_kernels::`.  `--check` recomputes and compares with
 the existing file instead of writing it.
 """
 

@@ -4,7 +4,7 @@
 //! and the failure paths of the implicit methods.
 //!
 //! Every bound is stated next to its assertion with the reason for its size. The measured
-//! figures are printed (`cargo test -p eomgen-runtime --test methods -- --nocapture`).
+//! figures are printed (`cargo test -p eomgen-runtime --test suite -- methods:: --nocapture`).
 
 use std::f64::consts::PI;
 

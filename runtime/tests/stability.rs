@@ -6,7 +6,7 @@
 //!
 //! Every tolerance is stated next to its assertion with the reason for its size. The heavy
 //! variants are `#[ignore]`d:
-//! `cargo test -p eomgen-runtime --release --test stability -- --ignored`.
+//! `cargo test -p eomgen-runtime --release --test suite -- stability:: --ignored`.
 
 use crate::common;
 
@@ -305,7 +305,7 @@ fn euler_roundoff_study_shows_truncation_and_roundoff() {
 }
 
 /// Heavier: the full default range in release, with Euler's roundoff growing.
-/// `cargo test -p eomgen-runtime --release --test stability -- --ignored`.
+/// `cargo test -p eomgen-runtime --release --test suite -- stability:: --ignored`.
 #[test]
 #[ignore = "10⁸ steps per method; run in release"]
 fn euler_roundoff_full_range() {

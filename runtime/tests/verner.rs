@@ -388,7 +388,7 @@ fn work_on_a_double_pendulum_beside_dop853() {
 /// Not a test: the time per evaluation of `F` of each pair beside DOP853 on the double
 /// pendulum at tol 1e-10 (4 components, the stage sums compiled for a fixed dimension), and
 /// with a fifth, constant component (the general stage sums). Run with
-/// `cargo test --release --test verner -- --ignored --nocapture timing`; nothing is asserted.
+/// `cargo test --release -p eomgen-runtime --test suite -- verner::timing --ignored --nocapture`; nothing is asserted.
 #[test]
 #[ignore]
 fn timing_per_evaluation() {
