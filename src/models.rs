@@ -8,7 +8,7 @@
 
 use std::sync::OnceLock;
 
-use crate::{DynFirstOrder, JitModel, LoadError, LoadOptions, ModelInfo};
+use crate::{DynFirstOrder, JitModel, LoadError, LoadOptions, ModelInfo, ModelSummary};
 
 /// A bundled model: its name, its file's text (embedded, so an installed or moved program
 /// needs no source tree), and a constructor of its first-order form with the file's default
@@ -65,6 +65,30 @@ impl ModelEntry {
             return Ok(model.clone());
         }
         JitModel::from_source_with(self.file, self.source, options)
+    }
+}
+
+impl ModelEntry {
+    /// The model's name, degrees of freedom and one-line description, read from its file
+    /// without deriving or compiling it (what `eomgen list` shows: 0.2 s for the 51 models
+    /// compiled, against 3 ms read). Equal to [`ModelSummary::of`] the compiled model (the
+    /// test `every_bundled_model_compiles`).
+    ///
+    /// # Errors
+    /// [`LoadError::Diagnostics`] if the file has mistakes (a defect of the bundle).
+    pub fn summary(&self) -> Result<ModelSummary, LoadError> {
+        let file = eomgen_symbolic::model::load(self.file, self.source).map_err(|diagnostics| {
+            LoadError::Diagnostics {
+                path: self.file.to_string(),
+                text: self.source.to_string(),
+                diagnostics,
+            }
+        })?;
+        Ok(ModelSummary {
+            name: file.name.value,
+            dof: file.coordinates.len(),
+            description: file.description,
+        })
     }
 }
 

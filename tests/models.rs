@@ -382,6 +382,11 @@ fn every_bundled_model_compiles() {
         assert_eq!(model.backend(), eomgen::Backend::Native, "{}", entry.name);
         let file = eomgen_symbolic::model::load(entry.file, entry.source).expect("loads");
         assert_eq!(file.name.value, entry.name, "{}", entry.file);
-        assert_eq!(eomgen::models::find(entry.name).map(|e| e.file), Some(entry.file));
+        assert_eq!(
+            eomgen::models::find(entry.name).map(|e| e.file),
+            Some(entry.file)
+        );
+        let compiled = eomgen::ModelSummary::of(&eomgen::DynFirstOrder::new(model));
+        assert_eq!(entry.summary().expect("reads"), compiled, "{}", entry.name);
     }
 }

@@ -4,29 +4,21 @@ use crate::cli::error::CliError;
 use crate::cli::json::print_json_sorted;
 use crate::cli::output::outln;
 
-/// Runs `list`: a table, or with `json` a JSON list of `{"name", "dof", "description"}`.
+/// Runs `list`: a table, or with `json` a JSON list of `{"name", "dof", "description"}`. The
+/// files are read, not compiled ([`eomgen::models::ModelEntry::summary`]).
 pub fn run(json: bool) -> Result<(), CliError> {
-    let models: Vec<_> = eomgen::models::ALL.iter().map(|e| (e.make)()).collect();
+    let models = eomgen::models::ALL
+        .iter()
+        .map(|e| e.summary())
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(|e| CliError::failure(e.to_string()))?;
     if json {
-        let items: Vec<eomgen::ModelSummary> = models
-            .iter()
-            .map(|m| eomgen::ModelSummary::of(m.as_ref()))
-            .collect();
-        print_json_sorted(&items)?;
+        print_json_sorted(&models)?;
     } else {
-        let width = models
-            .iter()
-            .map(|m| m.description().name.len())
-            .max()
-            .unwrap_or(4);
+        let width = models.iter().map(|m| m.name.len()).max().unwrap_or(4);
         outln!("{:width$}  dof  description", "name");
         for m in &models {
-            outln!(
-                "{:width$}  {:>3}  {}",
-                m.description().name,
-                m.num_dofs(),
-                m.description().summary
-            );
+            outln!("{:width$}  {:>3}  {}", m.name, m.dof, m.description);
         }
     }
     Ok(())
