@@ -2,11 +2,13 @@
 //! `model!`, simulated, and analysed through the library alone (no command line).
 //!
 //! ```sh
-//! cargo run --example embed --no-default-features
+//! cargo run -p eomgen-embed
 //! ```
 //!
-//! With `default-features = false`, eomgen is the macro, the runtime and the analyses; the
-//! command line and its dependencies (arguments, charts, progress bars) are not built.
+//! A crate of its own (`examples/embed/Cargo.toml`), which depends on eomgen with
+//! `default-features = false` as a user's program would: the macro, the runtime and the
+//! analyses; the command line and its dependencies (arguments, charts, progress bars), the
+//! run-time compiler and eomgen's own test dependencies are not built.
 
 use eomgen::nalgebra::DMatrix;
 use eomgen::{
