@@ -82,10 +82,14 @@ fn derive(c: &mut Criterion) {
     group.finish();
 }
 
+/// The bicycle compiled by `model!` (the figures of docs/performance.md were measured so).
+mod compiled {
+    eomgen::model!("../models/whipple_bicycle.yaml");
+}
+
 fn stability(c: &mut Criterion) {
-    let mut model = (eomgen::models::find("whipple_bicycle")
-        .expect("bundled")
-        .make)();
+    let mut model: Box<dyn eomgen::ModelInfo> =
+        Box::new(eomgen::FirstOrder::new(compiled::WhippleBicycle::default()));
     let mut group = c.benchmark_group("bicycle");
     group.sample_size(10);
     group.bench_function("steady_motion", |b| {

@@ -13,12 +13,16 @@ use criterion::Criterion;
 use eomgen::ModelInfo;
 use eomgen::analysis::{PeriodicOrbitOptions, periodic_orbit};
 
+/// The figure eight compiled by `model!` (the figures of docs/performance.md were measured so).
+mod compiled {
+    eomgen::model!("../models/figure_eight.yaml");
+}
+
 /// The figure eight and the options of the run: the model's initial state moved by
 /// `1e-3 sin(0.7 i)` in component `i`, period guess 6.3.
 fn setup() -> (Box<dyn ModelInfo>, PeriodicOrbitOptions) {
-    let model = (eomgen::models::find("figure_eight")
-        .expect("bundled model")
-        .make)();
+    let model: Box<dyn ModelInfo> =
+        Box::new(eomgen::FirstOrder::new(compiled::FigureEight::default()));
     let initial = model.initial_state();
     let energy = model.energy(0.0, &initial);
     let start = initial

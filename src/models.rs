@@ -39,31 +39,42 @@ impl ModelEntry {
     /// As [`JitModel::from_source`]: a bundled file always compiles (the test
     /// `every_bundled_model_compiles`), so an error here is a defect of the bundle.
     pub fn model(&self) -> Result<JitModel, LoadError> {
-        let Some(index) = ALL.iter().position(|e| e.file == self.file) else {
-            return self.load_with(LoadOptions::default());
+        let Some(index) = self.index() else {
+            return self.compile(LoadOptions::default());
         };
         let cached = COMPILED[index].get_or_init(|| {
-            JitModel::from_source(self.file, self.source).map_err(|e| e.to_string())
+            self.compile(LoadOptions::default())
+                .map_err(|e| e.to_string())
         });
         match cached {
             Ok(model) => Ok(model.clone()),
-            // The first call's error, compiled again to return it typed.
-            Err(_) => self.load_with(LoadOptions::default()),
+            // Not cached: the error compiled again to return it typed (a defect of the
+            // bundle, which the test rules out).
+            Err(_) => self.compile(LoadOptions::default()),
         }
     }
 
-    /// The model compiled with `options` (a new compilation unless they are the defaults,
-    /// which [`ModelEntry::model`] serves from its cache).
+    /// The model compiled with `options`: with the defaults, [`ModelEntry::model`] (compiled
+    /// once per process); with any other options, a new compilation.
     ///
     /// # Errors
-    /// As [`JitModel::from_source`].
+    /// As [`JitModel::from_source`] (with `Some(Backend::Native)`, a host that Cranelift
+    /// cannot compile for).
     pub fn load_with(&self, options: LoadOptions) -> Result<JitModel, LoadError> {
-        if options == LoadOptions::default()
-            && let Some(index) = ALL.iter().position(|e| e.file == self.file)
-            && let Some(Ok(model)) = COMPILED[index].get()
-        {
-            return Ok(model.clone());
+        if options == LoadOptions::default() {
+            self.model()
+        } else {
+            self.compile(options)
         }
+    }
+
+    /// This entry's index in [`ALL`]: the entry itself, not one with the same fields (a
+    /// `ModelEntry` written elsewhere is compiled, never served from the cache).
+    fn index(&self) -> Option<usize> {
+        ALL.iter().position(|e| std::ptr::eq(e, self))
+    }
+
+    fn compile(&self, options: LoadOptions) -> Result<JitModel, LoadError> {
         JitModel::from_source_with(self.file, self.source, options)
     }
 }

@@ -115,7 +115,7 @@ impl ModelSource {
         }
     }
 
-    /// The bytes of the model file: a bundled model's text as compiled into the program (no
+    /// The bytes of the model file: a bundled model's text as embedded in the program (no
     /// file is read, so an installed program needs no source tree), or the file read again.
     ///
     /// # Errors

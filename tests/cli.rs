@@ -752,7 +752,7 @@ fn modes_prints_its_chart_paths_after_the_results() {
 }
 
 /// An installed program (`cargo install`, a copied binary, a moved checkout) needs no source
-/// tree (issue 28, item 3): the bundled models' files are compiled into the binary, so every
+/// tree (issue 28, item 3): the bundled models' files are embedded in the binary, so every
 /// command that reads a bundled model's file — `check`, `equations`, `report`, `study floquet`,
 /// `study constraint-methods` — works from a copy of the binary run in an empty directory.
 /// (Before, `build.rs` recorded each file's absolute path and these commands read it: "cannot

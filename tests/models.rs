@@ -3,7 +3,8 @@
 //!
 //! The engine side re-derives each model at test run time from its YAML file (load → lower →
 //! Lagrange → Jacobians) and evaluates the expression DAG directly, with no code generation,
-//! printing or CSE in between; the generated side is the compiled `impl MechanicalSystem`.
+//! printing or CSE in between; the generated side is the model the program runs (its file
+//! compiled at run time) and, for the models of `compiled_models`, the code of `model!` too.
 
 use crate::common;
 use common::seeded_rng;
@@ -41,10 +42,25 @@ fn outside_domain(model: &dyn eomgen::ModelInfo, t: f64, y: &[f64]) -> bool {
         .any(|v| !v.is_finite())
 }
 
+/// Every bundled model as the program runs it, and the models of `compiled_models` as
+/// `model!` compiles them.
+fn generated_models() -> Vec<(
+    &'static eomgen::models::ModelEntry,
+    Box<dyn eomgen::ModelInfo + Send>,
+)> {
+    let mut out: Vec<_> = ALL.iter().map(|e| (e, (e.make)())).collect();
+    for entry in ALL {
+        if let Some(compiled) = crate::compiled_models::make(entry.name) {
+            out.push((entry, compiled));
+        }
+    }
+    out
+}
+
 #[test]
 fn generated_code_equals_engine_evaluation() {
     let mut rng = seeded_rng(0x9E37_79B9_7F4A_7C15);
-    for entry in ALL {
+    for (entry, generated) in generated_models() {
         let file =
             eomgen_symbolic::model::load(entry.file, entry.source).expect("bundled model loads");
         let mut model = SymbolicModel::from_file(&file).expect("bundled model lowers");
@@ -61,7 +77,6 @@ fn generated_code_equals_engine_evaluation() {
         ]
         .concat();
         let mut evaluator = Evaluator::new(&model.arena, &roots);
-        let generated = (entry.make)();
         assert_eq!(generated.num_dofs(), n, "{}", entry.name);
         let params = generated.parameter_values();
         for _ in 0..50 {
@@ -249,10 +264,9 @@ fn every_model_simulates_from_its_initial_state() {
 #[test]
 fn point_positions_equal_engine_evaluation() {
     let mut rng = seeded_rng(2024);
-    for entry in ALL {
+    for (entry, generated) in generated_models() {
         let file = eomgen_symbolic::model::load(entry.file, entry.source).expect("loads");
         let model = SymbolicModel::from_file(&file).expect("lowers");
-        let generated = (entry.make)();
         assert_eq!(
             generated.description().point_names().len(),
             model.points.len(),
@@ -389,4 +403,35 @@ fn every_bundled_model_compiles() {
         let compiled = eomgen::ModelSummary::of(&eomgen::DynFirstOrder::new(model));
         assert_eq!(entry.summary().expect("reads"), compiled, "{}", entry.name);
     }
+}
+
+/// A bundled model opened with options is compiled with them (here the interpreter), and
+/// with the default options it is the model the registry compiled once for the process.
+#[test]
+fn a_bundled_model_is_compiled_with_the_options_it_is_opened_with() {
+    let interpreted = eomgen::LoadOptions {
+        backend: Some(eomgen::Backend::Interpreter),
+        ..eomgen::LoadOptions::default()
+    };
+    let source = eomgen::ModelSource::open_with("double_pendulum", interpreted).expect("opens");
+    assert_eq!(source.model().backend(), eomgen::Backend::Interpreter);
+    assert!(!source.is_file());
+    let source = eomgen::ModelSource::open("double_pendulum").expect("opens");
+    assert_eq!(source.model().backend(), eomgen::Backend::Native);
+    assert_eq!(source.path(), "models/double_pendulum.yaml");
+    let mathml = eomgen::LoadOptions {
+        equations_mathml: true,
+        ..eomgen::LoadOptions::default()
+    };
+    let with = eomgen::ModelSource::open_with("double_pendulum", mathml).expect("opens");
+    assert!(
+        eomgen::DynMechanicalSystem::description(with.model())
+            .equations_mathml
+            .is_some()
+    );
+    assert!(
+        eomgen::DynMechanicalSystem::description(source.model())
+            .equations_mathml
+            .is_none()
+    );
 }

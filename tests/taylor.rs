@@ -546,8 +546,9 @@ initial: { x: 1000.1, x_dot: 0.1 }
 }
 
 /// `simulate --method taylor` and `--method vern9` (the library's `simulate`, which the
-/// command calls) on every bundled unconstrained model, compiled by `model!` and loaded from
-/// its file, 0–1 s from the file's initial state:
+/// command calls) on every bundled unconstrained model, compiled by `model!` (the thirteen of
+/// `compiled_models`; the others interpreted) and loaded from its file, 0–1 s from the file's
+/// initial state:
 /// - the Taylor method either integrates to the end (or to the same terminal event, within
 ///   1e-9 s) or is refused before its first step with the reason (a function without a
 ///   recurrence applied to the state), the same for both builds;
@@ -580,9 +581,10 @@ fn taylor_and_verner_9_run_every_unconstrained_model_compiled_and_from_its_file(
     };
     let (mut integrated, mut refused) = (Vec::new(), Vec::new());
     for entry in eomgen::models::ALL {
-        // Compiled by `model!` for the handful of `compiled_models`, else as the program
-        // serves a bundled model (its embedded text compiled at run time).
-        let mut compiled = crate::compiled_models::make(entry.name).unwrap_or_else(entry.make);
+        // Compiled by `model!` for the models of `compiled_models`, else the file on the
+        // run-time compiler's interpreter backend: another route than the native code of
+        // `file` below.
+        let mut compiled = crate::compiled_models::make_or_interpreted(entry);
         if !compiled.description().constraint_names().is_empty() {
             continue;
         }

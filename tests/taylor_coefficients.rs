@@ -11,8 +11,9 @@
 //! file's initial state plus a seeded perturbation, order 12.
 //!
 //! Three properties, for every bundled model:
-//! - the coefficients of the model compiled at run time from its file, and of the handful
-//!   compiled by `model!` (`compiled_models`), agree with the reference within [`tolerance`];
+//! - the coefficients of the model compiled at run time from its file, and of the same model
+//!   compiled by `model!` (the thirteen of `compiled_models`) or else interpreted, agree with
+//!   the reference within [`tolerance`];
 //! - the two are bit-identical (they run the same recurrences, `eomgen_runtime::taylor::apply`,
 //!   on the same values in the same order);
 //! - a model without coefficients says why: its constraints (with their number), or the
@@ -83,8 +84,8 @@ fn bundled_file(entry: &eomgen::models::ModelEntry) -> String {
 /// A bundled model with its reference entry.
 struct Case {
     entry: Entry,
-    /// Compiled by `eomgen::model!` for the handful of `compiled_models`, else the bundled
-    /// model as the program serves it (its embedded text compiled at run time).
+    /// Compiled by `eomgen::model!` for the models of `compiled_models`, else the file on
+    /// the run-time compiler's interpreter backend (`make_or_interpreted`).
     compiled: Box<dyn ModelInfo + Send>,
     /// Its file, compiled at run time.
     runtime: Box<dyn ModelInfo>,
@@ -113,7 +114,7 @@ fn models() -> Vec<Case> {
             let runtime = JitModel::load(&path).unwrap_or_else(|e| panic!("{path}: {e}"));
             Case {
                 entry,
-                compiled: crate::compiled_models::make(bundled.name).unwrap_or_else(bundled.make),
+                compiled: crate::compiled_models::make_or_interpreted(bundled),
                 runtime: Box::new(DynFirstOrder::new(runtime)),
             }
         })
@@ -492,7 +493,8 @@ fn compiled_orders_of_every_op_kind_are_the_kernels_bits() {
 /// The Taylor method's copy of its code for AVX2 and FMA (`eomgen::taylor::host_features`:
 /// the runtime's series of the motion, Horner's rule and step rule and, in an optimised
 /// build, each model's fused orders) computes the bits of the code for any x86-64: the
-/// coefficients of every bundled model, compiled and loaded from its file, at orders across
+/// coefficients of every bundled model, compiled by `model!` (or interpreted) and loaded from
+/// its file, at orders across
 /// the fused ones, and whole Taylor runs of the double pendulum and the figure eight, with
 /// the copy turned off and on. A debug build has no fused orders to compare; `cargo test
 /// --release --test suite taylor_coefficients::` compares them too. On a processor without AVX2 and

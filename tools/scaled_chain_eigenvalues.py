@@ -6,7 +6,7 @@ undamped and once with a dashpot beside each spring. The eigenvalues of the stat
 A = [0 I; -M^-1 K  -M^-1 C] are computed with mpmath's eigensolver at 60 significant digits
 and written, rounded to 17, with the matrices, to runtime/tests/fixtures/scaled_chain.json,
 which the runtime's eigenvalue tests compare with (`cargo test -p eomgen-runtime --test
-vibration scaled_chain`).
+suite vibration::scaled_chain`).
 
     python3 tools/scaled_chain_eigenvalues.py
 """

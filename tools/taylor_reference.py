@@ -5,8 +5,9 @@ For each model file `models/*.yaml` this computes the Taylor coefficients
 `y_i^[k] = y_i^(k)(t0)/k!`, k = 0..12, of the solution of `M(q, t) q'' = F(q, q', t)` through a
 fixed state `(t0, y)`, `y = [q; q']`, at 50 significant digits, and writes them to
 `tests/data/taylor_coefficients.json`, which `tests/taylor_coefficients.rs` compares with
-`OdeSystem::taylor_coefficients` of the model compiled by `eomgen::model!` and of the same file
-compiled at run time.
+`OdeSystem::taylor_coefficients` of the model compiled at run time from its file and of the
+same file compiled by `eomgen::model!` (the models of `tests/compiled_models.rs`) or
+interpreted.
 
 Nothing here shares code with eomgen: the equations are read as text from the CLI
 (`eomgen equations models/<file>.yaml --json`, the fields `equations.mass_matrix`,

@@ -26,7 +26,7 @@
 //! Each op's order `k` is its kernel of `eomgen_runtime::taylor` (`mul`, `sin_cos`, …) with `k`
 //! and every offset constants: the same operations in the same order, and Cranelift neither
 //! reassociates nor contracts into fused multiply–adds, so the results are the kernels' to
-//! the bit (`tests/taylor_coefficients.rs` compares them with the compiled models' and with
+//! the bit (`tests/taylor_coefficients.rs` compares them with the `model!`-compiled models' and with
 //! the kernels on models using every op kind). A coefficient is loaded once and a result
 //! reused from where it was computed, across orders; what the solve writes (the
 //! accelerations' order `k`, the inputs' and time's order `k + 1`) is forgotten after it,

@@ -51,7 +51,7 @@ fn compiled_files() -> &'static Mutex<Vec<(String, String, JitModel)>> {
 const MAX_CACHED_FILES: usize = 64;
 
 /// Opens `argument` as [`ModelSource::open`] does, or, when `text` is given (a pickle's),
-/// compiles that text — a bundled model whose compiled-in text equals it is taken as is.
+/// compiles that text — a bundled model whose embedded text equals it is taken as is.
 fn open(argument: &str, text: Option<&str>) -> Result<Loaded, eomgen::OpenError> {
     if let Some(text) = text {
         if let Some(entry) = eomgen::models::find(argument)
@@ -491,7 +491,7 @@ impl CoreModel {
         self.loaded.text.clone()
     }
 
-    /// Whether the model was compiled at run time from a file.
+    /// Whether the model was read from a file (not bundled).
     #[getter]
     fn is_file(&self) -> bool {
         self.loaded.source.is_file()

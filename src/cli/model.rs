@@ -114,7 +114,7 @@ pub(super) fn read_model(model: &str) -> Result<(String, String), CliError> {
     let resolved = eomgen::resolve(model).map_err(open_error)?;
     let display = resolved.path().to_string();
     let source = match &resolved {
-        // Compiled into the binary: no file is read.
+        // Embedded in the binary: no file is read.
         eomgen::Resolved::Bundled(entry) => entry.source.to_string(),
         eomgen::Resolved::File(path) => eomgen_symbolic::model::read_model_file(
             std::path::Path::new(path),

@@ -240,10 +240,20 @@ fn fuzz(cases: usize, seed: u64, target: fn(&str) -> bool) -> (usize, Vec<(Strin
     for (path, text) in &corpus {
         assert_eq!(run_one(text, target), Ok(true), "{path}");
     }
-    // The panic hook is the process's: one fuzzing run at a time silences it.
+    // The panic hook is the process's, shared with every other test of the binary: one
+    // fuzzing run at a time silences it, on its own thread only (another test's panic is
+    // still reported by the previous hook).
     let _silenced = SILENCED.lock().unwrap_or_else(|e| e.into_inner());
-    let previous = std::panic::take_hook();
-    std::panic::set_hook(Box::new(|_| {}));
+    let previous = std::sync::Arc::new(std::panic::take_hook());
+    let fuzzing = std::thread::current().id();
+    {
+        let previous = std::sync::Arc::clone(&previous);
+        std::panic::set_hook(Box::new(move |info| {
+            if std::thread::current().id() != fuzzing {
+                previous(info);
+            }
+        }));
+    }
     let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
     let mut loaded = 0;
     let mut panics = Vec::new();
@@ -258,7 +268,12 @@ fn fuzz(cases: usize, seed: u64, target: fn(&str) -> bool) -> (usize, Vec<(Strin
             Err(message) => panics.push((message, src)),
         }
     }
-    std::panic::set_hook(previous);
+    // The hook set above holds the other reference; taking it back releases it.
+    drop(std::panic::take_hook());
+    match std::sync::Arc::try_unwrap(previous) {
+        Ok(previous) => std::panic::set_hook(previous),
+        Err(previous) => std::panic::set_hook(Box::new(move |info| previous(info))),
+    }
     (loaded, panics)
 }
 

@@ -216,7 +216,7 @@ fn expressions_may_span_lines_and_keep_exact_locations() {
     );
 }
 
-/// The project's own models load (they are compiled into the CLI; a failure here is either a
+/// The project's own models load (they are embedded in the CLI; a failure here is either a
 /// loader bug or a model that uses a feature this version does not have).
 #[test]
 fn the_project_models_load() {

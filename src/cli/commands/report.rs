@@ -199,8 +199,8 @@ fn sources(models: &[String]) -> Result<Vec<Source>, CliError> {
         let (display, text) = crate::cli::model::read_model(name)?;
         let file = eomgen_symbolic::model::load(&display, &text)
             .map_err(|d| crate::cli::model::diagnostics_error(&display, &text, &d))?;
-        // A bundled name runs the compiled model; a path runs the file's own equations,
-        // compiled at run time (even for a copy of a bundled model).
+        // A bundled name runs its embedded text, a path the file's own equations (even for a
+        // copy of a bundled model), both compiled at run time.
         // With the equations as MathML, which the page shows.
         let options = eomgen::LoadOptions {
             equations_mathml: true,
