@@ -52,7 +52,7 @@ fn main() {
         );
     }
     let out = format!(
-        "/// Every bundled model, sorted by file name (a `static`: one address, which the cache of\n/// compiled models keys on).\npub static ALL: &[ModelEntry] = &[\n{registry}];\n\
+        "/// Every bundled model, sorted by file name (a `static`: one address for each embedded\n/// text, which the cache of compiled models keys on).\npub static ALL: &[ModelEntry] = &[\n{registry}];\n\
          /// How many models are bundled.\nconst COUNT: usize = {};\n",
         files.len()
     );

@@ -33,7 +33,8 @@ pub struct ModelEntry {
 
 impl ModelEntry {
     /// The model compiled with the default [`LoadOptions`]: compiled at the first call in
-    /// the process, then a clone of the same code (cheap: clones share the compiled code).
+    /// the process, then a clone of the same code (cheap: clones share the compiled code),
+    /// for an entry of [`ALL`] or a copy of one.
     ///
     /// # Errors
     /// As [`JitModel::from_source`]: a bundled file always compiles (the test
@@ -68,10 +69,12 @@ impl ModelEntry {
         }
     }
 
-    /// This entry's index in [`ALL`]: the entry itself, not one with the same fields (a
-    /// `ModelEntry` written elsewhere is compiled, never served from the cache).
+    /// This entry's index in [`ALL`]: an entry of the registry or a copy of one (the same
+    /// embedded text, by its address, and the same file). A `ModelEntry` written elsewhere
+    /// is compiled, never served from the cache.
     fn index(&self) -> Option<usize> {
-        ALL.iter().position(|e| std::ptr::eq(e, self))
+        ALL.iter()
+            .position(|e| std::ptr::eq(e.source, self.source) && e.file == self.file)
     }
 
     fn compile(&self, options: LoadOptions) -> Result<JitModel, LoadError> {

@@ -4,10 +4,10 @@
 //! generators write: energies and points (`double_pendulum`, `double_pendulum_points`), a
 //! diagonal mass matrix and central forces (`figure_eight`, `two_body`, `three_body_circle`,
 //! with interactions and outputs), a 3-D body (`heavy_top`), a holonomic constraint
-//! (`simple_pendulum_cartesian`) and a time-dependent one with `sinh` and `cosh`
+//! (`simple_pendulum_cartesian`) and a time-dependent one, with `cosh` of time in a point
 //! (`bead_spinning_rod`), a time-dependent load (`forced_oscillator`), `asin`
-//! (`slider_crank`), `tan`, `atan` and `tanh` with events (`projectile_drag`), functions
-//! without a Taylor recurrence (`two_masses`: `sign`, `step`) and rolling constraints
+//! (`slider_crank`), `sqrt` of the rates and events (`projectile_drag`), functions without a
+//! Taylor recurrence (`two_masses`: `sign`, `step`) and rolling constraints
 //! (`whipple_bicycle`). The other bundled files go through the macro's code generator in
 //! `determinism.rs` (`eomgen equations NAME --rust`: generated and parsed, not compiled).
 
@@ -44,7 +44,7 @@ compiled! {
     whipple_bicycle: WhippleBicycle = "../models/whipple_bicycle.yaml";
 }
 
-/// The bundled model `name` compiled by `model!`, if it is one of the handful.
+/// The bundled model `name` compiled by `model!`, if it is one of these.
 pub fn make(name: &str) -> Option<Box<dyn ModelInfo + Send>> {
     ALL.iter().find(|(n, _)| *n == name).map(|(_, make)| make())
 }

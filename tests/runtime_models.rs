@@ -1,6 +1,7 @@
 //! A bundled model compiled at run time from its file equals the same file compiled by
-//! `eomgen::model!` (issue 18; the handful of `compiled_models`, which cover every kind of
-//! equation), and on every bundled model the native code equals the interpreter: `M`, `F`, the exact Jacobians, the constraint functions
+//! `eomgen::model!` (issue 18; the thirteen of `compiled_models`, which cover the kinds of
+//! equation), and on every bundled model the native code equals the interpreter: `M`, `F`,
+//! the exact Jacobians, the constraint functions
 //! (`Φ`, `J`, velocity residuals, `γ`) and forces, the events, energies, points, initial
 //! state and equilibrium guesses, the right-hand side and its Jacobian, at 50 random states
 //! each.

@@ -589,7 +589,14 @@ fn taylor_and_verner_9_run_every_unconstrained_model_compiled_and_from_its_file(
             continue;
         }
         let path = format!("{}/{}", env!("CARGO_MANIFEST_DIR"), entry.file);
-        let mut file = DynFirstOrder::new(JitModel::load(&path).expect("a bundled file loads"));
+        // Its Taylor orders compiled by Cranelift from the first series: the native route,
+        // against `model!`'s code or the interpreter's.
+        let eager = eomgen::LoadOptions {
+            eager_taylor: true,
+            ..eomgen::LoadOptions::default()
+        };
+        let mut file =
+            DynFirstOrder::new(JitModel::load_with(&path, eager).expect("a bundled file loads"));
         let name = entry.name;
         let reference = run(compiled.as_mut(), Method::Dop853, 1e-13);
         assert!(reference.failure.is_none(), "{name}: DOP853 failed");
