@@ -405,8 +405,8 @@ fn every_bundled_model_compiles() {
     }
 }
 
-/// A bundled model opened with options is compiled with them (here the interpreter), and
-/// with the default options it is the model the registry compiled once for the process.
+/// A bundled model opened with options is compiled with them (the interpreter; the equations
+/// as MathML), and with the default options it is native code without the MathML.
 #[test]
 fn a_bundled_model_is_compiled_with_the_options_it_is_opened_with() {
     let interpreted = eomgen::LoadOptions {
