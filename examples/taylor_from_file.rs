@@ -11,7 +11,8 @@
 //!
 //! Arguments: a bundled model's name (`double_pendulum`, `figure_eight` or `heavy_top`, the
 //! three compiled into this example by `model!`), the tolerance (`rtol = atol`), the number of timed runs
-//! of each (default 100), alternated A B C A B C …; each run integrates the model's initial
+//! of each (default 100), alternated A B C A B C …, and optionally one variant alone (`model`,
+//! `file` or `kernels`, for a profiler); each run integrates the model's initial
 //! state over 0–10 s with every step recorded. Prints, per variant, the median time of a run
 //! and the first run's (which includes compiling the orders for the eager variant), and the
 //! steps.
@@ -87,6 +88,17 @@ fn main() -> Result<(), String> {
             })?,
         ),
     ];
+    // An optional fourth argument keeps one variant (for a profiler): `model`, `file` or
+    // `kernels`.
+    if let Some(only) = args.get(3) {
+        let keep = match only.as_str() {
+            "model" => 0,
+            "file" => 1,
+            "kernels" => 2,
+            other => return Err(format!("the variant `{other}`: model, file or kernels")),
+        };
+        variants = variants.into_iter().skip(keep).take(1).collect();
+    }
     let options = IntegratorOptions::default().with_rtol(tol).with_atol(tol);
     let mut times = vec![Vec::with_capacity(runs); variants.len()];
     let mut steps = vec![0; variants.len()];

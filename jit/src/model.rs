@@ -15,7 +15,7 @@ use eomgen_symbolic::codegen::taylor::{TaylorPlan, taylor_program};
 use eomgen_symbolic::model::{Diagnostic, ReadError, read_model_file};
 
 use crate::native::{CompileError, NativeCode, NativeFn};
-use crate::taylor::NativeOrders;
+use crate::taylor::{FACTOR_DENSE, FACTOR_DIAGONAL, FACTOR_SMALL, NativeOrders, PairLanes};
 use crate::{Backend, Inputs, interpret, native};
 
 /// Why a model file could not be made into a run-time model.
@@ -713,14 +713,21 @@ impl DynMechanicalSystem for JitModel {
         {
             return 0;
         }
-        // With a dense or a diagonal factor the code solves in line (the same operations as
-        // `motion_order`'s), else it calls `solve_order`.
-        let (lower, inverse_pivots) = match (solve.dense_factor(), solve.diagonal_factor()) {
-            (Some((lower, inverse)), _) if lower.len() == n * n && inverse.len() == n => {
-                (lower.as_ptr(), inverse.as_ptr())
+        // With a diagonal factor, or any of `n ≤ 6`, the code solves in line (the same
+        // operations as `motion_order`'s), else it calls `solve_order`.
+        let (lower, inverse_pivots, mode) = match (solve.small_factor(), solve.diagonal_factor()) {
+            (_, Some(inverse)) if inverse.len() == n => {
+                (std::ptr::null(), inverse.as_ptr(), FACTOR_DIAGONAL)
             }
-            (_, Some(inverse)) if inverse.len() == n => (std::ptr::null(), inverse.as_ptr()),
-            _ => (std::ptr::null(), std::ptr::null()),
+            (Some((lower, inverse)), _) if lower.len() == n * n && inverse.len() == n => {
+                let mode = if solve.dense_factor().is_some() {
+                    FACTOR_DENSE
+                } else {
+                    FACTOR_SMALL
+                };
+                (lower.as_ptr(), inverse.as_ptr(), mode)
+            }
+            _ => (std::ptr::null(), std::ptr::null(), 0),
         };
         let mut context = OrderContext {
             layout: MotionLayout {
@@ -736,22 +743,49 @@ impl DynMechanicalSystem for JitModel {
             out: out.as_mut_ptr(),
             out_len: out.len(),
         };
-        // SAFETY: `series` holds every slot at the stride of 25 and `out` every order the
-        // code writes (checked above); `lower` and `inverse_pivots`, when not null, hold
-        // `n × n` and `n` values that nothing writes during the call; `solve_order` is called
-        // with the context built for it; `series` and `out` are not used otherwise until the
-        // call returns.
-        unsafe {
-            (orders.function)(
-                context.series,
-                order,
-                (&raw mut context).cast::<u8>(),
-                solve_order,
-                context.out,
-                lower,
-                inverse_pivots,
-            )
+        thread_local! {
+            /// The compiled orders' scratch ([`crate::taylor::PairScratch`]), kept between
+            /// calls on this thread.
+            static SCRATCH: std::cell::RefCell<Vec<PairLanes>> = const { std::cell::RefCell::new(Vec::new()) };
         }
+        let ran = SCRATCH.with(|scratch| {
+            let Ok(mut scratch) = scratch.try_borrow_mut() else {
+                return false;
+            };
+            if scratch.len() < orders.scratch_units {
+                scratch.resize(orders.scratch_units, PairLanes::default());
+            }
+            let scratch = scratch.as_mut_ptr();
+            for function in &orders.orders[..computed] {
+                // SAFETY: `series` holds every slot at the stride of 25 with the orders below
+                // `k` computed (by the calls before this one), and `out` every order the code
+                // writes (checked above); `lower` and `inverse_pivots`, when not null, hold
+                // `n × n` and `n` values that nothing writes during the call; `solve_order` is
+                // called with the context built for it; `scratch` holds the units the orders
+                // use, with the orders below `k` written by the calls before; `series`, `out`
+                // and `scratch` are not used otherwise until the call returns.
+                let status = unsafe {
+                    function(
+                        context.series,
+                        (&raw mut context).cast::<u8>(),
+                        solve_order,
+                        context.out,
+                        lower,
+                        inverse_pivots,
+                        mode,
+                        scratch,
+                    )
+                };
+                if status != 0 {
+                    return false;
+                }
+            }
+            true
+        });
+        if !ran {
+            return 0;
+        }
+        computed
     }
     fn taylor_fused_orders(&self) -> usize {
         // None before they are compiled: until then the workspace's stride follows the

@@ -2,23 +2,24 @@
 //! the `taylor_orders` that `eomgen::model!` generates for a compiled model.
 //!
 //! # What is compiled
-//! One function for a model's [`TaylorProgram`], with the signature [`OrdersFn`] (the
-//! platform's C calling convention):
+//! One function per order `k = 0 … H`, each with the signature [`OrderFn`] (the platform's
+//! C calling convention):
 //!
 //! ```text
-//! fn(series: *mut f64, order: usize, context: *mut u8,
+//! fn(series: *mut f64, context: *mut u8,
 //!    solve: extern "C" fn(context: *mut u8, k: usize) -> u8,
-//!    out: *mut f64, lower: *const f64, inverse_pivots: *const f64) -> usize
+//!    out: *mut f64, lower: *const f64, inverse_pivots: *const f64,
+//!    factor: i64, scratch: *mut PairLanes) -> u8
 //! ```
 //!
-//! For `k = 0, 1, …, H` while `k < order`, it computes order `k` of every op of the program
-//! (none at `k = 0`), then order `k` of `M a = F` (the accelerations' order `k` into the
-//! series, the state's order `k + 1` into `out`, `2n` values per order, and into the inputs'
-//! slots): in line, with `L` and `D⁻¹` of a dense factor (`lower` not null: the operations of
-//! `motion_order`'s dense solve) or `D⁻¹` of a diagonal one (`lower` null, `inverse_pivots`
-//! not), else by calling `solve(context, k)`
-//! ([`eomgen_runtime::taylor::motion_order_at`]). It returns the first order it did not
-//! compute, or 0 if a call of `solve` returned non-zero. `H` is
+//! Order `k`'s function computes order `k` of every op of the program (none at `k = 0`), then
+//! order `k` of `M a = F` (the accelerations' order `k` into the series, the state's order
+//! `k + 1` into `out`, `2n` values per order, and into the inputs' slots): in line with the
+//! factor `factor` names ([`Factor`]: `L` and `D⁻¹` of a dense factor, of a small one with
+//! zeros below its diagonal, or `D⁻¹` of a diagonal one: the operations of `motion_order`'s
+//! solves), else by calling `solve(context, k)`
+//! ([`eomgen_runtime::taylor::motion_order_at`]). It returns 0, or what `solve` returned
+//! if that was not 0. The caller runs orders `0, 1, …` in turn. `H` is
 //! [`TaylorProgram::highest_unrolled_order`], the orders whose code fits the instruction
 //! cache, as for a compiled model; the series has the stride [`UNROLLED_CAPACITY`] (slot
 //! `x`'s order `i` at `x · 25 + i`).
@@ -26,11 +27,18 @@
 //! Each op's order `k` is its kernel of `eomgen_runtime::taylor` (`mul`, `sin_cos`, …) with `k`
 //! and every offset constants: the same operations in the same order, and Cranelift neither
 //! reassociates nor contracts into fused multiply–adds, so the results are the kernels' to
-//! the bit (`tests/taylor_coefficients.rs` compares them with the `model!`-compiled models' and with
-//! the kernels on models using every op kind). A coefficient is loaded once and a result
-//! reused from where it was computed, across orders; what the solve writes (the
-//! accelerations' order `k`, the inputs' and time's order `k + 1`) is forgotten after it,
-//! which holds because `motion_order_at` writes nothing else of the series.
+//! the bit (`tests/taylor_coefficients.rs` compares them with the `model!`-compiled models'
+//! and with the kernels on models using every op kind). The sine–cosine pairs sum as the
+//! kernels do, two lanes of one vector, with their operands side by side in a scratch
+//! ([`PairScratch`]).
+//!
+//! Why one function per order: within an order's function, what earlier orders computed is
+//! never written, so its loads are pure to Cranelift ([`settled`]) and are placed next to
+//! their uses; in one function for all orders every coefficient stayed in a register from
+//! the order that computed it to the last that read it, and the register allocator spilled
+//! most of them (5,059 16-byte reloads in the double pendulum's code) and took most of the
+//! compile. Per order, the double pendulum's 18 orders compile in 20–30 ms instead of 30–35,
+//! and run as fast or faster (docs/performance.md).
 //!
 //! With it, in the same module, order 0 ([`OrderZeroFn`], `fn(series: *mut f64, parameters:
 //! *const f64)`): the extended tape of `M` and `F` (`TaylorPlan::order_zero`), instruction
@@ -43,10 +51,8 @@
 //! with it.
 
 use cranelift_codegen::ir;
-use cranelift_codegen::ir::condcodes::IntCC;
-use cranelift_codegen::ir::{
-    AbiParam, BlockArg, InstBuilder, MemFlagsData, Signature, UserFuncName, types,
-};
+use cranelift_codegen::ir::condcodes::{FloatCC, IntCC};
+use cranelift_codegen::ir::{AbiParam, InstBuilder, MemFlagsData, Signature, UserFuncName, types};
 use cranelift_frontend::{FunctionBuilder, FunctionBuilderContext};
 use cranelift_module::{Linkage, Module};
 use std::collections::HashMap;
@@ -61,22 +67,55 @@ use crate::native::{
     CompileError, Imports, ModuleMemory, declare_imports, enter, failure, new_module,
 };
 
-/// The compiled orders: see the module documentation for the arguments.
+/// One compiled order `k`: see the module documentation for the arguments.
 ///
 /// # Safety
-/// `series` holds at least `(program.slots + n) · UNROLLED_CAPACITY` values; `out` at least
-/// `(min(order, H + 1) + 1) · 2n`; `lower` is null or holds the `n · n` values of a dense
-/// factor, `inverse_pivots` null or its `n` pivots' reciprocals (with `lower` null: a diagonal
-/// factor's); `solve` may be called with `context` for each order.
-pub(crate) type OrdersFn = unsafe extern "C" fn(
+/// `series` holds at least `(program.slots + n) · UNROLLED_CAPACITY` values with the orders
+/// below `k` computed; `out` at least `(k + 2) · 2n`; with `factor` [`FACTOR_DENSE`] or
+/// [`FACTOR_SMALL`], `lower` holds the `n · n` values of `L` and `inverse_pivots` the `n` of
+/// `D⁻¹`, with [`FACTOR_DIAGONAL`] `inverse_pivots` the `n` of `D⁻¹`; `solve` may be called
+/// with `context` for order `k`; `scratch` holds [`NativeOrders::scratch_units`] units
+/// (16-byte aligned) with the orders below `k` written by the orders' functions.
+pub(crate) type OrderFn = unsafe extern "C" fn(
     *mut f64,
-    usize,
     *mut u8,
     extern "C" fn(*mut u8, usize) -> u8,
     *mut f64,
     *const f64,
     *const f64,
-) -> usize;
+    i64,
+    *mut PairLanes,
+) -> u8;
+
+/// Two `f64`s aligned for one 16-byte load: the unit of [`PairScratch`].
+#[derive(Debug, Clone, Copy, Default)]
+#[repr(C, align(16))]
+pub(crate) struct PairLanes(pub(crate) [f64; 2]);
+
+/// The layout of the orders' scratch: for the `p`-th sine–cosine or sinh–cosh op of the
+/// program, [`UNROLLED_CAPACITY`] units `(y[i], z[i])` (its cosine and sine, or cosh and
+/// sinh, order `i` side by side) then as many `(i x[i], i x[i])` (its argument's order `i`
+/// weighted by `i`, in both lanes): what the kernels' `weighted_convolution_pair` reads as
+/// vectors, each one 16-byte load here instead of two loads and two shuffles. Order `k`'s
+/// function writes order `k` of each, order 0's function the pairs' order 0.
+pub(crate) struct PairScratch;
+
+impl PairScratch {
+    /// The units a program with `pairs` pair ops needs.
+    pub(crate) fn units(pairs: usize) -> usize {
+        pairs * 2 * UNROLLED_CAPACITY
+    }
+
+    /// The byte offset of pair `p`'s `(y[i], z[i])`.
+    fn pair(p: usize, i: usize) -> i32 {
+        ((p * 2 * UNROLLED_CAPACITY + i) * 16) as i32
+    }
+
+    /// The byte offset of pair `p`'s `(i x[i], i x[i])`.
+    fn weighted(p: usize, i: usize) -> i32 {
+        ((p * 2 * UNROLLED_CAPACITY + UNROLLED_CAPACITY + i) * 16) as i32
+    }
+}
 
 /// The compiled order 0 (see the module documentation).
 ///
@@ -88,12 +127,14 @@ pub(crate) type OrderZeroFn = unsafe extern "C" fn(*mut f64, *const f64);
 
 /// A model's compiled Taylor orders and the memory that holds them.
 pub(crate) struct NativeOrders {
-    /// The function.
-    pub(crate) function: OrdersFn,
+    /// Order `k`'s function at index `k`, for `k = 0 … highest`.
+    pub(crate) orders: Vec<OrderFn>,
     /// Order 0.
     pub(crate) order_zero: OrderZeroFn,
     /// The highest order it computes, `H`.
     pub(crate) highest: usize,
+    /// The units of scratch the orders use ([`PairScratch::units`]).
+    pub(crate) scratch_units: usize,
     _memory: ModuleMemory,
 }
 
@@ -143,29 +184,34 @@ pub(crate) fn compile_orders(
     solve_signature.params.push(AbiParam::new(pointer));
     solve_signature.returns.push(AbiParam::new(types::I8));
     let mut signature = Signature::new(call_conv);
-    for _ in 0..7 {
+    for _ in 0..8 {
         signature.params.push(AbiParam::new(pointer));
     }
-    signature.returns.push(AbiParam::new(pointer));
-    let id = module
-        .declare_function(NAME, Linkage::Local, &signature)
-        .map_err(|e| failure(NAME, &e))?;
+    signature.returns.push(AbiParam::new(types::I8));
     let mut context = module.make_context();
-    context.func.signature = signature;
-    context.func.name = UserFuncName::user(0, 0);
     let mut builder_context = FunctionBuilderContext::new();
-    build(
-        &mut context.func,
-        &mut builder_context,
-        program,
-        highest,
-        solve_signature,
-        module.target_config(),
-    );
-    module
-        .define_function(id, &mut context)
-        .map_err(|e| failure(NAME, &e))?;
-    module.clear_context(&mut context);
+    let mut ids = Vec::with_capacity(highest + 1);
+    for k in 0..=highest {
+        let name = format!("{NAME}_{k}");
+        let id = module
+            .declare_function(&name, Linkage::Local, &signature)
+            .map_err(|e| failure(&name, &e))?;
+        context.func.signature = signature.clone();
+        context.func.name = UserFuncName::user(0, k as u32 + 1);
+        build_order(
+            &mut context.func,
+            &mut builder_context,
+            program,
+            k,
+            solve_signature.clone(),
+            module.target_config(),
+        );
+        module
+            .define_function(id, &mut context)
+            .map_err(|e| failure(&name, &e))?;
+        module.clear_context(&mut context);
+        ids.push(id);
+    }
     let mut zero_signature = Signature::new(call_conv);
     zero_signature.params.push(AbiParam::new(pointer));
     zero_signature.params.push(AbiParam::new(pointer));
@@ -173,7 +219,7 @@ pub(crate) fn compile_orders(
         .declare_function(ORDER_ZERO, Linkage::Local, &zero_signature)
         .map_err(|e| failure(ORDER_ZERO, &e))?;
     context.func.signature = zero_signature;
-    context.func.name = UserFuncName::user(0, 1);
+    context.func.name = UserFuncName::user(0, 0);
     build_order_zero(
         &mut module,
         &mut context.func,
@@ -191,104 +237,112 @@ pub(crate) fn compile_orders(
         .map_err(|e| CompileError::Finalize {
             reason: e.to_string(),
         })?;
-    let address = module.get_finalized_function(id);
-    // SAFETY: `address` is the entry of the function compiled above with exactly the
-    // signature of `OrdersFn` in the platform's default (C) calling convention.
-    let function = unsafe { std::mem::transmute::<*const u8, OrdersFn>(address) };
+    let orders = ids
+        .into_iter()
+        .map(|id| {
+            let address = module.get_finalized_function(id);
+            // SAFETY: `address` is the entry of a function compiled above with exactly the
+            // signature of `OrderFn` in the platform's default (C) calling convention.
+            unsafe { std::mem::transmute::<*const u8, OrderFn>(address) }
+        })
+        .collect();
     let address = module.get_finalized_function(zero_id);
     // SAFETY: as above, with the signature of `OrderZeroFn`.
     let order_zero = unsafe { std::mem::transmute::<*const u8, OrderZeroFn>(address) };
+    let pairs = program
+        .ops
+        .iter()
+        .filter(|op| matches!(op, SeriesOp::SinCos { .. } | SeriesOp::SinhCosh { .. }))
+        .count();
     Ok(Some(NativeOrders {
-        function,
+        orders,
         order_zero,
         highest,
+        scratch_units: PairScratch::units(pairs),
         _memory: ModuleMemory::new(module),
     }))
 }
 
-/// Writes the function's body (see the module documentation).
-fn build(
+/// Writes order `k`'s function (see the module documentation): its ops, then its solve.
+fn build_order(
     func: &mut ir::Function,
     builder_context: &mut FunctionBuilderContext,
     program: &TaylorProgram,
-    highest: usize,
+    k: usize,
     solve_signature: Signature,
     target: cranelift_codegen::isa::TargetFrontendConfig,
 ) {
     let pointer = target.pointer_type();
     let mut b = FunctionBuilder::new(func, builder_context);
     let params = enter(&mut b);
-    let (series, order, context, solve) = (params[0], params[1], params[2], params[3]);
-    let (out, lower, inverse_pivots) = (params[4], params[5], params[6]);
+    let (series, context, solve) = (params[0], params[1], params[2]);
+    let (out, lower, inverse_pivots, mode) = (params[3], params[4], params[5], params[6]);
+    let scratch = params[7];
     let n = program.coordinates.len();
     let solve_signature = b.import_signature(solve_signature);
-    // One exit, returning its argument.
-    let exit = b.create_block();
-    b.append_block_param(exit, pointer);
     let mut emitter = Emitter {
         series,
+        scratch,
+        pairs: 0,
         known: HashMap::default(),
     };
-    for k in 0..=highest {
-        // k ≥ order: return k.
-        let kv = b.ins().iconst(pointer, k as i64);
-        let done = b.ins().icmp(IntCC::UnsignedGreaterThanOrEqual, kv, order);
-        let body = b.create_block();
-        b.ins().brif(done, exit, &[BlockArg::Value(kv)], body, &[]);
-        b.switch_to_block(body);
-        b.seal_block(body);
-        if k > 0 {
-            for op in program.ops.iter() {
-                emitter.op(&mut b, *op, k);
+    if k > 0 {
+        for op in program.ops.iter() {
+            emitter.op(&mut b, *op, k);
+        }
+    } else {
+        // The pairs' order 0, from the series (order 0 wrote them there).
+        for op in program.ops.iter() {
+            if let SeriesOp::SinCos { sin: z, cos: y, .. }
+            | SeriesOp::SinhCosh {
+                sinh: z, cosh: y, ..
+            } = *op
+            {
+                let p = emitter.next_pair();
+                let (y0, z0) = (emitter.at(&mut b, y, 0), emitter.at(&mut b, z, 0));
+                emitter.store_pair(&mut b, p, 0, (y0, z0));
             }
         }
-        // Order k of M a = F: in line with a dense or a diagonal factor, else by `solve`.
-        let (inline, not_dense, diagonal, call, next) = (
-            b.create_block(),
-            b.create_block(),
-            b.create_block(),
-            b.create_block(),
-            b.create_block(),
-        );
-        let null = b.ins().iconst(pointer, 0);
-        let no_lower = b.ins().icmp(IntCC::Equal, lower, null);
-        b.ins().brif(no_lower, not_dense, &[], inline, &[]);
-        // What the branches write differs (and the values of one do not reach the others):
-        // those entries are forgotten after them; the ops' slots stay known.
-        for (block, lower) in [(inline, Some(lower)), (diagonal, None)] {
-            b.switch_to_block(block);
-            b.seal_block(block);
-            let before = emitter.known.clone();
-            emitter.dense_solve(&mut b, program, n, k, out, lower, inverse_pivots);
-            emitter.known = before;
-            b.ins().jump(next, &[]);
-            if lower.is_some() {
-                b.switch_to_block(not_dense);
-                b.seal_block(not_dense);
-                let no_inverse = b.ins().icmp(IntCC::Equal, inverse_pivots, null);
-                b.ins().brif(no_inverse, call, &[], diagonal, &[]);
-            }
-        }
-        b.switch_to_block(call);
-        b.seal_block(call);
-        let kv = b.ins().iconst(pointer, k as i64);
-        let called = b
-            .ins()
-            .call_indirect(solve_signature, solve, &[context, kv]);
-        let status = b.inst_results(called)[0];
-        let zero = b.ins().iconst(pointer, 0);
-        b.ins()
-            .brif(status, exit, &[BlockArg::Value(zero)], next, &[]);
-        b.switch_to_block(next);
-        b.seal_block(next);
-        emitter.forget_solved(program, n, k);
     }
-    let after = b.ins().iconst(pointer, (highest + 1) as i64);
-    b.ins().jump(exit, &[BlockArg::Value(after)]);
-    b.switch_to_block(exit);
-    b.seal_block(exit);
-    let result = b.block_params(exit)[0];
-    b.ins().return_(&[result]);
+    // Order k of M a = F: in line with the factor `mode` names, else by `solve`.
+    let mut test = b.create_block();
+    b.ins().jump(test, &[]);
+    for (code, factor) in [
+        (FACTOR_DENSE, Factor::Dense),
+        (FACTOR_SMALL, Factor::Small),
+        (FACTOR_DIAGONAL, Factor::Diagonal),
+    ] {
+        b.switch_to_block(test);
+        b.seal_block(test);
+        let (inline, next) = (b.create_block(), b.create_block());
+        let is = b.ins().icmp_imm_s(IntCC::Equal, mode, code);
+        b.ins().brif(is, inline, &[], next, &[]);
+        b.switch_to_block(inline);
+        b.seal_block(inline);
+        // What the branches write differs (and the values of one do not reach the others).
+        let before = emitter.known.clone();
+        emitter.dense_solve(
+            &mut b,
+            program,
+            (n, k),
+            out,
+            factor,
+            (lower, inverse_pivots),
+        );
+        emitter.known = before;
+        let ok = b.ins().iconst(types::I8, 0);
+        b.ins().return_(&[ok]);
+        test = next;
+    }
+    let call = test;
+    b.switch_to_block(call);
+    b.seal_block(call);
+    let kv = b.ins().iconst(pointer, k as i64);
+    let called = b
+        .ins()
+        .call_indirect(solve_signature, solve, &[context, kv]);
+    let status = b.inst_results(called)[0];
+    b.ins().return_(&[status]);
     b.finalize(target);
 }
 
@@ -413,27 +467,52 @@ fn build_order_zero(
     b.finalize(target);
 }
 
+/// The flags of a load of a value that order `k`'s function reads and does not write: a
+/// series' coefficient of an order below `k` (or an input's or time's order `k`, which order
+/// `k − 1` wrote), and order `k` of the state's series in `out`. Such a load is pure to
+/// Cranelift, so it is placed next to its use and folded into the instruction that uses it,
+/// rather than every coefficient an order reads being loaded first and kept (spilled) in
+/// registers; the memory is always the series' (never behind a null pointer), so moving the
+/// load across the function's branches is sound.
+fn settled() -> MemFlagsData {
+    MemFlagsData::trusted().with_readonly().with_can_move()
+}
+
+/// How order `k`'s function solves `M a = F` (its last argument): with a dense factor
+/// ([`FACTOR_DENSE`]: `L`, row-major `n × n`, and `D⁻¹`), with the factor of a small `M`
+/// that has zeros below its diagonal ([`FACTOR_SMALL`]: the same arrays, each zero entry's
+/// update skipped as the runtime's solve over the non-zero entries skips it), with a diagonal
+/// one ([`FACTOR_DIAGONAL`]: `D⁻¹` alone), or by calling `solve` (any other value).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Factor {
+    Dense,
+    Small,
+    Diagonal,
+}
+
+/// [`Factor::Dense`]'s code.
+pub(crate) const FACTOR_DENSE: i64 = 1;
+/// [`Factor::Small`]'s code.
+pub(crate) const FACTOR_SMALL: i64 = 2;
+/// [`Factor::Diagonal`]'s code.
+pub(crate) const FACTOR_DIAGONAL: i64 = 3;
+
 /// Writes the kernels' arithmetic, with the coefficients known in registers.
 struct Emitter {
     series: ir::Value,
+    /// The scratch of the pair ops ([`PairScratch`]).
+    scratch: ir::Value,
+    /// Pair ops met so far in this order.
+    pairs: usize,
     /// `(slot, order) → value` loaded or stored, less what each solve writes.
     known: HashMap<(Slot, usize), ir::Value>,
 }
 
 impl Emitter {
-    /// Forgets what order `k`'s solve writes: the accelerations' order `k`, the inputs' and
-    /// time's order `k + 1`.
-    fn forget_solved(&mut self, program: &TaylorProgram, n: usize, k: usize) {
-        let accelerations = program.acceleration_slot();
-        for i in 0..n {
-            self.known.remove(&(accelerations + i as Slot, k));
-        }
-        for &(slot, _) in program.derived.inputs.iter() {
-            self.known.remove(&(slot, k + 1));
-        }
-        if let Some(slot) = program.time {
-            self.known.remove(&(slot, k + 1));
-        }
+    /// The index of the next pair op in the program's order (see [`PairScratch`]).
+    fn next_pair(&mut self) -> usize {
+        self.pairs += 1;
+        self.pairs - 1
     }
 
     /// `motion_order`'s dense solve of order `k` (`dense_order`, then `next_order`), the same
@@ -448,11 +527,10 @@ impl Emitter {
         &mut self,
         b: &mut FunctionBuilder,
         program: &TaylorProgram,
-        n: usize,
-        k: usize,
+        (n, k): (usize, usize),
         out: ir::Value,
-        lower: Option<ir::Value>,
-        inverse_pivots: ir::Value,
+        factor: Factor,
+        (lower, inverse_pivots): (ir::Value, ir::Value),
     ) {
         let flags = MemFlagsData::trusted();
         let accelerations = program.acceleration_slot();
@@ -477,12 +555,24 @@ impl Emitter {
             b.ins()
                 .load(types::F64, flags, lower, ((i * n + j) * 8) as i32)
         };
-        if let Some(lower) = lower {
+        // `x − l·y`, or `x` where a factor with zeros has `l = 0` (the runtime's solve over
+        // the non-zero entries skips them; `x − 0·y` is not `x` for `x = −0` or `y` infinite).
+        let update = |b: &mut FunctionBuilder, x: ir::Value, l: ir::Value, y: ir::Value| {
+            let t = b.ins().fmul(l, y);
+            let updated = b.ins().fsub(x, t);
+            if factor == Factor::Small {
+                let zero = b.ins().f64const(0.0);
+                let skip = b.ins().fcmp(FloatCC::Equal, l, zero);
+                b.ins().select(skip, x, updated)
+            } else {
+                updated
+            }
+        };
+        if factor != Factor::Diagonal {
             for i in 0..n {
                 for j in 0..i {
                     let l = entry(b, lower, i, j);
-                    let t = b.ins().fmul(l, x[j]);
-                    x[i] = b.ins().fsub(x[i], t);
+                    x[i] = update(b, x[i], l, x[j]);
                 }
             }
         }
@@ -492,12 +582,11 @@ impl Emitter {
                 .load(types::F64, flags, inverse_pivots, (i * 8) as i32);
             *xi = b.ins().fmul(*xi, d);
         }
-        if let Some(lower) = lower {
+        if factor != Factor::Diagonal {
             for i in (0..n).rev() {
                 for j in 0..i {
                     let l = entry(b, lower, i, j);
-                    let t = b.ins().fmul(l, x[i]);
-                    x[j] = b.ins().fsub(x[j], t);
+                    x[j] = update(b, x[j], l, x[i]);
                 }
             }
         }
@@ -507,7 +596,7 @@ impl Emitter {
         for i in 0..n {
             let now = b
                 .ins()
-                .load(types::F64, flags, out, ((k * dim + n + i) * 8) as i32);
+                .load(types::F64, settled(), out, ((k * dim + n + i) * 8) as i32);
             next.push(b.ins().fmul(now, inverse));
         }
         for (i, &xi) in x.iter().enumerate() {
@@ -535,9 +624,7 @@ impl Emitter {
             return v;
         }
         let offset = ((slot as usize * UNROLLED_CAPACITY + i) * 8) as i32;
-        let v = b
-            .ins()
-            .load(types::F64, MemFlagsData::trusted(), self.series, offset);
+        let v = b.ins().load(types::F64, settled(), self.series, offset);
         self.known.insert((slot, i), v);
         v
     }
@@ -577,6 +664,68 @@ impl Emitter {
             sum = b.ins().fadd(sum, term);
         }
         sum
+    }
+
+    /// The kernels' `weighted_convolution_pair` of pair `p` (a sine–cosine or sinh–cosh op
+    /// over `x`): `Σ_{j=1}^{k} (j x[j]) y[k − j]` and the same with `z`, as the two lanes of
+    /// one 2-wide vector sum. Each lane adds the same products in the same order as its
+    /// scalar sum, so the bits are the kernels'. The lanes' operands come from the scratch
+    /// ([`PairScratch`]): `(j x[j], j x[j])` and `(y[i], z[i])` as one 16-byte load each;
+    /// `(k x[k], k x[k])` is stored there for the orders above.
+    fn weighted_pair(
+        &mut self,
+        b: &mut FunctionBuilder,
+        p: usize,
+        x: Slot,
+        k: usize,
+    ) -> (ir::Value, ir::Value) {
+        let xk = self.at(b, x, k);
+        let kc = Self::constant(b, k as f64);
+        let weighted = b.ins().fmul(kc, xk);
+        let newest = b.ins().splat(types::F64X2, weighted);
+        b.ins().store(
+            MemFlagsData::trusted(),
+            newest,
+            self.scratch,
+            PairScratch::weighted(p, k),
+        );
+        let zero = Self::constant(b, 0.0);
+        let mut sum = b.ins().splat(types::F64X2, zero);
+        for j in 1..=k {
+            let w = if j == k {
+                newest
+            } else {
+                b.ins().load(
+                    types::F64X2,
+                    settled(),
+                    self.scratch,
+                    PairScratch::weighted(p, j),
+                )
+            };
+            let pair = b.ins().load(
+                types::F64X2,
+                settled(),
+                self.scratch,
+                PairScratch::pair(p, k - j),
+            );
+            let term = b.ins().fmul(w, pair);
+            sum = b.ins().fadd(sum, term);
+        }
+        (b.ins().extractlane(sum, 0), b.ins().extractlane(sum, 1))
+    }
+
+    /// Stores `(y[k], z[k])` as pair `p`'s order `k` in the scratch ([`PairScratch`]).
+    fn store_pair(
+        &mut self,
+        b: &mut FunctionBuilder,
+        p: usize,
+        k: usize,
+        (y, z): (ir::Value, ir::Value),
+    ) {
+        let flags = MemFlagsData::trusted();
+        let offset = PairScratch::pair(p, k);
+        b.ins().store(flags, y, self.scratch, offset);
+        b.ins().store(flags, z, self.scratch, offset + 8);
     }
 
     /// `cauchy`: `(Σ_{j=1}^{k−1} a[j] b[k − j] + a[0] b[k]) + a[k] b[0]`.
@@ -709,21 +858,23 @@ impl Emitter {
                 self.put(b, out, k, v);
             }
             SeriesOp::SinCos { sin, cos, a } => {
-                let ws = self.sum_of_products(b, (a, cos, k), 1..=k, true);
+                let p = self.next_pair();
+                let (ws, wc) = self.weighted_pair(b, p, a, k);
                 let vs = Self::over_k(b, ws, k);
-                let wc = self.sum_of_products(b, (a, sin, k), 1..=k, true);
                 let minus = b.ins().fneg(wc);
                 let vc = Self::over_k(b, minus, k);
                 self.put(b, sin, k, vs);
                 self.put(b, cos, k, vc);
+                self.store_pair(b, p, k, (vc, vs));
             }
             SeriesOp::SinhCosh { sinh, cosh, a } => {
-                let ws = self.sum_of_products(b, (a, cosh, k), 1..=k, true);
+                let p = self.next_pair();
+                let (ws, wc) = self.weighted_pair(b, p, a, k);
                 let vs = Self::over_k(b, ws, k);
-                let wc = self.sum_of_products(b, (a, sinh, k), 1..=k, true);
                 let vc = Self::over_k(b, wc, k);
                 self.put(b, sinh, k, vs);
                 self.put(b, cosh, k, vc);
+                self.store_pair(b, p, k, (vc, vs));
             }
             SeriesOp::Tan { out, a, square } => self.tan_or_tanh(b, k, out, a, square, 1.0),
             SeriesOp::Tanh { out, a, square } => self.tan_or_tanh(b, k, out, a, square, -1.0),

@@ -859,6 +859,19 @@ impl MotionSolve<'_> {
         })
     }
 
+    /// `(L, D⁻¹)` as [`Self::dense_factor`] gives them, for any `L` with `n ≤ 6` — with zeros
+    /// below its diagonal too, whose updates a run-time backend that solves with it must skip
+    /// (as [`motion_order`]'s solve over `L`'s non-zero entries does: `b − 0·x` is not `b` for
+    /// `b = −0` or `x` infinite); `None` for larger `n`.
+    pub fn small_factor(&self) -> Option<(&[f64], &[f64])> {
+        (self.n <= FIXED_DEGREES).then(|| {
+            (
+                &self.lower[..self.n * self.n],
+                &self.inverse_pivots[..self.n],
+            )
+        })
+    }
+
     /// `D⁻¹` when `L` is the identity (no non-zero entry below its diagonal: a diagonal `M`),
     /// whose solve is then `x = D⁻¹ b` alone, for a run-time backend that does the same;
     /// `None` otherwise.
