@@ -28,7 +28,10 @@
 extern crate self as eomgen;
 
 #[cfg(feature = "jit")]
-pub use eomgen_jit::{Backend, CompileError, JitModel, LoadError, LoadOptions};
+pub use eomgen_jit::{
+    Backend, COMPILE_TAYLOR_AFTER, CompileError, JitModel, LoadError, LoadOptions,
+    TAYLOR_COMPILE_STARTS_AFTER,
+};
 pub use eomgen_macros::model;
 pub use eomgen_runtime::*;
 #[cfg(feature = "jit")]
@@ -84,7 +87,7 @@ pub mod __private {
 
     pub use eomgen_runtime::functions::{sign, step};
 
-    // The Taylor recurrences the generated `taylor_order` calls (`eomgen_runtime::taylor::{mul, …}`).
+    // The Taylor recurrences the generated `TaylorFunctions::order` calls (`eomgen_runtime::taylor::{mul, …}`).
     pub use eomgen_runtime::taylor;
 
     // The generated code's sine and cosine come from the `libm` crate (a pure-Rust port of

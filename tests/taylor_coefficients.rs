@@ -352,7 +352,7 @@ fn angle_differences_run_as_one_sin_cos() {
     for (file, pairs) in [("double_pendulum", 1), ("triple_pendulum", 3)] {
         let path = format!("{}/models/{file}.yaml", env!("CARGO_MANIFEST_DIR"));
         let model = JitModel::load(&path).unwrap_or_else(|e| panic!("{path}: {e}"));
-        let program = model.taylor_program().expect("recurrences");
+        let program = model.taylor().expect("recurrences").program();
         let trig: BTreeSet<u32> = program
             .ops
             .iter()
@@ -394,7 +394,7 @@ fn angle_differences_run_as_one_sin_cos() {
 /// mass matrix that varies (dense and diagonal, which the compiled orders solve in line, and
 /// with a factor that is neither, solved by their call per order), and functions without a
 /// recurrence applied to parameters alone (constants of order 0); and the orders really are
-/// compiled (`taylor_fused_orders` after the first series: a failure of Cranelift would
+/// compiled (`TaylorFunctions::fused_orders` after the first series: a failure of Cranelift would
 /// leave them to the kernels and this comparison would prove nothing). Then again with every
 /// parameter changed on both models after the code was compiled: the compiled code reads
 /// the parameters at each call (a value baked in at compilation would show here), and the
@@ -416,8 +416,9 @@ fn compiled_orders_of_every_op_kind_are_the_kernels_bits() {
             ..LoadOptions::default()
         });
         let highest = native
-            .taylor_program()
+            .taylor()
             .expect("recurrences")
+            .program()
             .highest_unrolled_order();
         assert!(highest > 0, "{file}: no order fits the cache");
         let mut kernels = DynFirstOrder::new(load(LoadOptions {
@@ -473,7 +474,7 @@ fn compiled_orders_of_every_op_kind_are_the_kernels_bits() {
                     );
                 }
                 assert_eq!(
-                    handle.taylor_fused_orders(),
+                    handle.taylor().map_or(0, |t| t.fused_orders()),
                     highest.min(24),
                     "{file}: the orders are not compiled"
                 );
@@ -577,4 +578,46 @@ fn the_code_for_the_hosts_instruction_sets_computes_the_same_bits() {
             );
         }
     }
+}
+
+/// A run-time model's Taylor orders are compiled on a thread of their own once
+/// `TAYLOR_COMPILE_STARTS_AFTER` series have been computed by the kernels: with no further
+/// series asked for, the orders become compiled (within a minute, however busy the machine);
+/// and every series before, during and after computes the same bits.
+#[test]
+fn the_orders_are_compiled_in_the_background_with_the_same_bits() {
+    use eomgen::{COMPILE_TAYLOR_AFTER, TAYLOR_COMPILE_STARTS_AFTER};
+    use eomgen::{DynMechanicalSystem, OdeSystem};
+    let path = format!("{}/models/double_pendulum.yaml", env!("CARGO_MANIFEST_DIR"));
+    let model = JitModel::load(&path).unwrap_or_else(|e| panic!("{path}: {e}"));
+    let handle = model.clone();
+    let mut model = DynFirstOrder::new(model);
+    let y = ModelInfo::initial_state(&model);
+    let order = 12;
+    let series = |model: &mut DynFirstOrder<JitModel>| {
+        let mut out = vec![f64::NAN; (order + 1) * y.len()];
+        model
+            .taylor_coefficients(0.3, &y, order, &mut out)
+            .expect("coefficients");
+        out.iter().map(|v| v.to_bits()).collect::<Vec<u64>>()
+    };
+    let first = series(&mut model);
+    for _ in 0..TAYLOR_COMPILE_STARTS_AFTER {
+        assert_eq!(series(&mut model), first, "a series by the kernels");
+    }
+    assert_eq!(
+        handle.taylor().map_or(0, |t| t.fused_orders()),
+        0,
+        "compiled before the series asked for it"
+    );
+    let start = std::time::Instant::now();
+    while handle.taylor().map_or(0, |t| t.fused_orders()) == 0 {
+        assert!(
+            start.elapsed() < std::time::Duration::from_secs(60),
+            "the orders were not compiled in the background within a minute"
+        );
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+    const { assert!(TAYLOR_COMPILE_STARTS_AFTER + 1 < COMPILE_TAYLOR_AFTER) };
+    assert_eq!(series(&mut model), first, "a series by the compiled orders");
 }

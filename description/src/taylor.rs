@@ -281,7 +281,7 @@ pub struct DerivedLists {
 }
 
 /// The orders `k = 1 …` this many that the Taylor kernels are compiled for with `k` known
-/// (`eomgen_runtime::taylor::evaluate_order`, the `model!` code's `taylor_orders`); higher orders run the same kernels with `k` a
+/// (`eomgen_runtime::taylor::evaluate_order`, the `model!` code's `TaylorFunctions::orders`); higher orders run the same kernels with `k` a
 /// variable. A step to order `p` computes the orders `k = 1 … p − 1` of the program, so
 /// this serves steps to order 24, what tolerances down to 10⁻²⁰ ask for.
 pub const UNROLLED_ORDERS: usize = 23;

@@ -68,7 +68,7 @@ pub(crate) fn evaluate(
 /// Order 0 of a model's Taylor series ([`eomgen_symbolic::codegen::taylor`]): the extended
 /// tape of `M` and `F` evaluated in place, instruction `k`'s value into `series[k · capacity]`,
 /// each with the operation or library function [`evaluate`] uses (so the compiled model's
-/// `taylor_order_zero` gets the same bits). The inputs `q`, `q̇`, `t` are read from their
+/// `TaylorFunctions::order_zero` gets the same bits). The inputs `q`, `q̇`, `t` are read from their
 /// slots, where the caller has written them; parameters from `parameters`.
 ///
 /// # Panics

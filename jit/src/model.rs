@@ -1,11 +1,13 @@
 //! [`JitModel`]: a model file loaded, derived and compiled at run time.
 
+use std::borrow::Cow;
 use std::cell::RefCell;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex, OnceLock};
 
 use eomgen_runtime::taylor::{
-    MotionLayout, MotionSolve, TaylorProgram, TaylorUnsupported, UNROLLED_CAPACITY,
+    DerivedLists, MotionLayout, MotionSolve, TaylorFunctions, TaylorProgram, TaylorUnsupported,
+    UNROLLED_CAPACITY,
 };
 use eomgen_runtime::{DynMechanicalSystem, ModelDescription, UnknownParameter};
 use eomgen_symbolic::codegen::GenerateError;
@@ -70,8 +72,9 @@ pub struct LoadOptions {
     /// at load time; without it that field is `None`. Compiled models always carry it.
     pub equations_mathml: bool,
     /// Compile the Taylor method's orders to native code at the first Taylor series, rather
-    /// than after [`COMPILE_TAYLOR_AFTER`] of them computed by the runtime's kernels (the
-    /// same bits either way; with the interpreter backend they are never compiled).
+    /// than on a thread of their own after [`TAYLOR_COMPILE_STARTS_AFTER`] of them computed
+    /// by the runtime's kernels (at most [`COMPILE_TAYLOR_AFTER`]; the same bits either way;
+    /// with the interpreter backend they are never compiled).
     pub eager_taylor: bool,
 }
 
@@ -227,11 +230,20 @@ struct Code {
 }
 
 /// Taylor series a run-time model computes with the runtime's kernels before its orders are
-/// compiled to native code: compiling the double pendulum's 18 orders or the figure eight's
-/// 11 costs 18–28 ms, what about 20,000 double-pendulum series at tol 1e-9 cost with the
-/// kernels (0.9 µs each, against 0.45 µs compiled), so a run never pays more than about twice what
-/// the better choice in hindsight costs (the rent-or-buy rule), and a short run pays nothing.
+/// compiled to native code on the thread that needs them, if the compilation started in the
+/// background ([`TAYLOR_COMPILE_STARTS_AFTER`]) has not finished by then (or could not
+/// start): compiling the double pendulum's 18 orders or the heavy top's 11 costs 20–35 ms,
+/// what about 20,000 double-pendulum series at tol 1e-9 cost with the kernels (about 1 µs
+/// each, against 0.5 µs compiled), so a run never pays more than about twice what the better
+/// choice in hindsight costs (the rent-or-buy rule).
 pub const COMPILE_TAYLOR_AFTER: usize = 20_000;
+
+/// Taylor series a run-time model computes with the runtime's kernels before it starts
+/// compiling its orders on a thread of their own: about 1 ms of a run, so that a short run
+/// spends no processor time on a compilation it would not use, and a longer one runs on the
+/// compiled orders from about 25 ms after that (the compile's time) without waiting for them.
+/// The series computed meanwhile are the kernels', the same bits.
+pub const TAYLOR_COMPILE_STARTS_AFTER: usize = 1_000;
 
 impl Code {
     /// Whether the Taylor orders may be compiled to native code: a model with recurrences
@@ -240,32 +252,52 @@ impl Code {
         self.taylor.is_ok() && self.backend != Some(Backend::Interpreter)
     }
 
-    /// The Taylor orders compiled to native code ([`crate::taylor`]), once
-    /// [`COMPILE_TAYLOR_AFTER`] series have been computed by the runtime's kernels
-    /// (`evaluate_order`, the same bits); `None` before, and for good if Cranelift fails on
-    /// them or no order fits the instruction cache.
-    fn taylor_orders(&self) -> Option<&NativeOrders> {
-        if let Some(compiled) = self.taylor_orders.get() {
+    /// The Taylor orders compiled to native code ([`crate::taylor`]) once they are: from the
+    /// first series with [`LoadOptions::eager_taylor`], else after a compilation started on
+    /// a thread of its own at series [`TAYLOR_COMPILE_STARTS_AFTER`] has finished, or at
+    /// series [`COMPILE_TAYLOR_AFTER`] on this thread (waiting for that compilation if it is
+    /// under way). `None` before, and for good if Cranelift fails on them or no order fits
+    /// the instruction cache; until then the series are the runtime's kernels'
+    /// (`evaluate_order`, the same bits).
+    fn taylor_orders(code: &Arc<Code>) -> Option<&NativeOrders> {
+        if let Some(compiled) = code.taylor_orders.get() {
             return compiled.as_ref();
         }
-        if !self.taylor_native()
-            || self.taylor_series.fetch_add(1, Ordering::Relaxed) < self.compile_taylor_after
-        {
+        if !code.taylor_native() {
             return None;
         }
-        self.taylor_orders
-            .get_or_init(|| {
-                let plan = self.taylor.as_ref().ok()?;
-                // A panic in Cranelift leaves the orders to the kernels for good (not a
-                // compilation attempted again at every series).
-                std::panic::catch_unwind(|| {
-                    crate::taylor::compile_orders(plan, self.program.description.parameters.len())
-                })
-                .ok()?
-                .ok()
-                .flatten()
-            })
-            .as_ref()
+        let series = code.taylor_series.fetch_add(1, Ordering::Relaxed);
+        if series >= code.compile_taylor_after {
+            return code
+                .taylor_orders
+                .get_or_init(|| code.compile_orders())
+                .as_ref();
+        }
+        if series == TAYLOR_COMPILE_STARTS_AFTER {
+            let background = Arc::clone(code);
+            // If no thread can be started, the orders are compiled at `COMPILE_TAYLOR_AFTER`.
+            let _ = std::thread::Builder::new()
+                .name("eomgen-taylor-compile".into())
+                .spawn(move || {
+                    background
+                        .taylor_orders
+                        .get_or_init(|| background.compile_orders());
+                });
+        }
+        None
+    }
+
+    /// Compiles the Taylor orders; `None` if Cranelift fails or panics on them (the orders
+    /// are then the kernels' for good, not a compilation attempted again at every series),
+    /// or no order fits the instruction cache.
+    fn compile_orders(&self) -> Option<NativeOrders> {
+        let plan = self.taylor.as_ref().ok()?;
+        std::panic::catch_unwind(|| {
+            crate::taylor::compile_orders(plan, self.program.description.parameters.len())
+        })
+        .ok()?
+        .ok()
+        .flatten()
     }
 
     /// The Jacobians, derived and compiled on first use. A function Cranelift cannot compile
@@ -662,139 +694,11 @@ impl DynMechanicalSystem for JitModel {
     fn description(&self) -> &ModelDescription {
         &self.code.program.description
     }
-    fn taylor_program(&self) -> Result<&TaylorProgram, TaylorUnsupported> {
+    fn taylor(&self) -> Result<&dyn TaylorFunctions, TaylorUnsupported> {
         match &self.code.taylor {
-            Ok(plan) => Ok(&plan.program),
+            Ok(_) => Ok(self),
             Err(reason) => Err(reason.clone()),
         }
-    }
-    fn taylor_order_zero(&self, capacity: usize, series: &mut [f64]) {
-        if let Ok(plan) = &self.code.taylor {
-            // Compiled with the orders (at their stride), else interpreted: the same bits.
-            if let Some(Some(orders)) = self.code.taylor_orders.get()
-                && capacity == UNROLLED_CAPACITY
-                && series.len() >= plan.order_zero.instructions.len() * UNROLLED_CAPACITY
-            {
-                // SAFETY: `series` holds every instruction's slot at the stride of 25
-                // (checked above) and the caller has written the inputs' order 0;
-                // `parameters` holds the model's parameters, the count the code was
-                // compiled for.
-                unsafe { (orders.order_zero)(series.as_mut_ptr(), self.parameters.as_ptr()) };
-                return;
-            }
-            interpret::order_zero_in_place(&plan.order_zero, &self.parameters, capacity, series);
-        }
-    }
-    // The recurrences of orders k ≥ 1 are the runtime's, op by op (`evaluate_order`), the
-    // definitions the compiled model's code inlines: the same bits.
-    fn taylor_order(&self, k: usize, capacity: usize, series: &mut [f64]) {
-        if let Ok(plan) = &self.code.taylor {
-            eomgen_runtime::taylor::evaluate_order(&plan.program.ops, k, capacity, series);
-        }
-    }
-    fn taylor_orders(
-        &self,
-        solve: &mut MotionSolve<'_>,
-        order: usize,
-        series: &mut [f64],
-        out: &mut [f64],
-    ) -> usize {
-        let (Ok(plan), Some(orders)) = (&self.code.taylor, self.code.taylor_orders()) else {
-            return 0;
-        };
-        let program = &plan.program;
-        let n = program.coordinates.len();
-        // The code's offsets assume the stride of 25 and every slot present, and the orders
-        // it computes (below `order`, to `highest`) write `out` to the next one.
-        let computed = order.min(orders.highest + 1);
-        if !solve.unrolled()
-            || series.len() < (program.slots + n) * UNROLLED_CAPACITY
-            || out.len() < (computed + 1) * 2 * n
-        {
-            return 0;
-        }
-        // With a diagonal factor, or any of `n ≤ 6`, the code solves in line (the same
-        // operations as `motion_order`'s), else it calls `solve_order`.
-        let (lower, inverse_pivots, mode) = match (solve.small_factor(), solve.diagonal_factor()) {
-            (_, Some(inverse)) if inverse.len() == n => {
-                (std::ptr::null(), inverse.as_ptr(), FACTOR_DIAGONAL)
-            }
-            (Some((lower, inverse)), _) if lower.len() == n * n && inverse.len() == n => {
-                let mode = if solve.dense_factor().is_some() {
-                    FACTOR_DENSE
-                } else {
-                    FACTOR_SMALL
-                };
-                (lower.as_ptr(), inverse.as_ptr(), mode)
-            }
-            _ => (std::ptr::null(), std::ptr::null(), 0),
-        };
-        let mut context = OrderContext {
-            layout: MotionLayout {
-                forcing: &program.forcing,
-                coupled: &program.derived.varying_mass_entries,
-                inputs: &program.derived.inputs,
-                time: program.time,
-                accelerations: program.acceleration_slot(),
-            },
-            solve,
-            series: series.as_mut_ptr(),
-            series_len: series.len(),
-            out: out.as_mut_ptr(),
-            out_len: out.len(),
-        };
-        thread_local! {
-            /// The compiled orders' scratch ([`crate::taylor::PairScratch`]), kept between
-            /// calls on this thread.
-            static SCRATCH: std::cell::RefCell<Vec<PairLanes>> = const { std::cell::RefCell::new(Vec::new()) };
-        }
-        let ran = SCRATCH.with(|scratch| {
-            let Ok(mut scratch) = scratch.try_borrow_mut() else {
-                return false;
-            };
-            if scratch.len() < orders.scratch_units {
-                scratch.resize(orders.scratch_units, PairLanes::default());
-            }
-            let scratch = scratch.as_mut_ptr();
-            for function in &orders.orders[..computed] {
-                // SAFETY: `series` holds every slot at the stride of 25 with the orders below
-                // `k` computed (by the calls before this one), and `out` every order the code
-                // writes (checked above); `lower` and `inverse_pivots`, when not null, hold
-                // `n × n` and `n` values that nothing writes during the call; `solve_order` is
-                // called with the context built for it; `scratch` holds the units the orders
-                // use, with the orders below `k` written by the calls before; `series`, `out`
-                // and `scratch` are not used otherwise until the call returns.
-                let status = unsafe {
-                    function(
-                        context.series,
-                        (&raw mut context).cast::<u8>(),
-                        solve_order,
-                        context.out,
-                        lower,
-                        inverse_pivots,
-                        mode,
-                        scratch,
-                    )
-                };
-                if status != 0 {
-                    return false;
-                }
-            }
-            true
-        });
-        if !ran {
-            return 0;
-        }
-        computed
-    }
-    fn taylor_fused_orders(&self) -> usize {
-        // None before they are compiled: until then the workspace's stride follows the
-        // kernels' rule (`TaylorProgram::unrolled_code_fits`), as for a model without them.
-        self.code
-            .taylor_orders
-            .get()
-            .and_then(Option::as_ref)
-            .map_or(0, |orders| orders.highest)
     }
     fn parameter_values(&self) -> Vec<f64> {
         self.parameters.clone()
@@ -981,6 +885,160 @@ impl DynMechanicalSystem for JitModel {
     }
 }
 
+/// The program of no model: what [`TaylorFunctions::program`] of a [`JitModel`] without
+/// recurrences would read, which [`DynMechanicalSystem::taylor`] never hands out.
+static EMPTY_PROGRAM: TaylorProgram = TaylorProgram {
+    slots: 0,
+    coordinates: Cow::Borrowed(&[]),
+    velocities: Cow::Borrowed(&[]),
+    time: None,
+    mass_matrix: Cow::Borrowed(&[]),
+    forcing: Cow::Borrowed(&[]),
+    constant: Cow::Borrowed(&[]),
+    ops: Cow::Borrowed(&[]),
+    derived: DerivedLists {
+        varying_mass_entries: Cow::Borrowed(&[]),
+        inputs: Cow::Borrowed(&[]),
+        convolutions: 0,
+        branch_points: false,
+    },
+};
+
+/// The model's Taylor method ([`DynMechanicalSystem::taylor`] hands it out once the model has
+/// recurrences): order 0 compiled with the orders (at their stride) or interpreted, orders on
+/// the runtime's kernels (the trait's default `order`, the definitions the compiled model's
+/// code inlines) until they are compiled ([`Code::taylor_orders`]); the same bits.
+impl TaylorFunctions for JitModel {
+    fn program(&self) -> &TaylorProgram {
+        match &self.code.taylor {
+            Ok(plan) => &plan.program,
+            // `taylor` hands the model out only with a plan.
+            Err(_) => &EMPTY_PROGRAM,
+        }
+    }
+    fn order_zero(&self, capacity: usize, series: &mut [f64]) {
+        if let Ok(plan) = &self.code.taylor {
+            // Compiled with the orders (at their stride), else interpreted: the same bits.
+            if let Some(Some(orders)) = self.code.taylor_orders.get()
+                && capacity == UNROLLED_CAPACITY
+                && series.len() >= plan.order_zero.instructions.len() * UNROLLED_CAPACITY
+            {
+                // SAFETY: `series` holds every instruction's slot at the stride of 25
+                // (checked above) and the caller has written the inputs' order 0;
+                // `parameters` holds the model's parameters, the count the code was
+                // compiled for.
+                unsafe { (orders.order_zero)(series.as_mut_ptr(), self.parameters.as_ptr()) };
+                return;
+            }
+            interpret::order_zero_in_place(&plan.order_zero, &self.parameters, capacity, series);
+        }
+    }
+    fn orders(
+        &self,
+        solve: &mut MotionSolve<'_>,
+        order: usize,
+        series: &mut [f64],
+        out: &mut [f64],
+    ) -> usize {
+        let (Ok(plan), Some(orders)) = (&self.code.taylor, Code::taylor_orders(&self.code)) else {
+            return 0;
+        };
+        let program = &plan.program;
+        let n = program.coordinates.len();
+        // The code's offsets assume the stride of 25 and every slot present, and the orders
+        // it computes (below `order`, to `highest`) write `out` to the next one.
+        let computed = order.min(orders.highest + 1);
+        if !solve.unrolled()
+            || series.len() < (program.slots + n) * UNROLLED_CAPACITY
+            || out.len() < (computed + 1) * 2 * n
+        {
+            return 0;
+        }
+        // With a diagonal factor, or any of `n ≤ 6`, the code solves in line (the same
+        // operations as `motion_order`'s), else it calls `solve_order`.
+        let (lower, inverse_pivots, mode) = match (solve.small_factor(), solve.diagonal_factor()) {
+            (_, Some(inverse)) if inverse.len() == n => {
+                (std::ptr::null(), inverse.as_ptr(), FACTOR_DIAGONAL)
+            }
+            (Some((lower, inverse)), _) if lower.len() == n * n && inverse.len() == n => {
+                let mode = if solve.dense_factor().is_some() {
+                    FACTOR_DENSE
+                } else {
+                    FACTOR_SMALL
+                };
+                (lower.as_ptr(), inverse.as_ptr(), mode)
+            }
+            _ => (std::ptr::null(), std::ptr::null(), 0),
+        };
+        let mut context = OrderContext {
+            layout: MotionLayout {
+                forcing: &program.forcing,
+                coupled: &program.derived.varying_mass_entries,
+                inputs: &program.derived.inputs,
+                time: program.time,
+                accelerations: program.acceleration_slot(),
+            },
+            solve,
+            series: series.as_mut_ptr(),
+            series_len: series.len(),
+            out: out.as_mut_ptr(),
+            out_len: out.len(),
+        };
+        thread_local! {
+            /// The compiled orders' scratch ([`crate::taylor::PairScratch`]), kept between
+            /// calls on this thread.
+            static SCRATCH: std::cell::RefCell<Vec<PairLanes>> = const { std::cell::RefCell::new(Vec::new()) };
+        }
+        let ran = SCRATCH.with(|scratch| {
+            let Ok(mut scratch) = scratch.try_borrow_mut() else {
+                return false;
+            };
+            if scratch.len() < orders.scratch_units {
+                scratch.resize(orders.scratch_units, PairLanes::default());
+            }
+            let scratch = scratch.as_mut_ptr();
+            for function in &orders.orders[..computed] {
+                // SAFETY: `series` holds every slot at the stride of 25 with the orders below
+                // `k` computed (by the calls before this one), and `out` every order the code
+                // writes (checked above); `lower` and `inverse_pivots`, when not null, hold
+                // `n × n` and `n` values that nothing writes during the call; `solve_order` is
+                // called with the context built for it; `scratch` holds the units the orders
+                // use, with the orders below `k` written by the calls before; `series`, `out`
+                // and `scratch` are not used otherwise until the call returns.
+                let status = unsafe {
+                    function(
+                        context.series,
+                        (&raw mut context).cast::<u8>(),
+                        solve_order,
+                        context.out,
+                        lower,
+                        inverse_pivots,
+                        mode,
+                        scratch,
+                    )
+                };
+                if status != 0 {
+                    return false;
+                }
+            }
+            true
+        });
+        if !ran {
+            return 0;
+        }
+        computed
+    }
+    fn fused_orders(&self) -> usize {
+        // None before they are compiled: until then the workspace's stride follows the
+        // kernels' rule (`TaylorProgram::unrolled_code_fits`), as for a model without them.
+        self.code
+            .taylor_orders
+            .get()
+            .and_then(Option::as_ref)
+            .map_or(0, |orders| orders.highest)
+    }
+}
+
 /// What the compiled Taylor orders pass to [`solve_order`] between orders.
 struct OrderContext<'a, 'b> {
     layout: MotionLayout<'a>,
@@ -997,7 +1055,7 @@ struct OrderContext<'a, 'b> {
 /// kernels: a panic must not unwind through the compiled code).
 extern "C" fn solve_order(context: *mut u8, k: usize) -> u8 {
     let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        // SAFETY: `context` is the `OrderContext` of the `taylor_orders` call in progress,
+        // SAFETY: `context` is the `OrderContext` of the `orders` call in progress,
         // whose `series` and `out` are exclusively lent to this call chain.
         let context = unsafe { &mut *context.cast::<OrderContext<'_, '_>>() };
         let series = unsafe { std::slice::from_raw_parts_mut(context.series, context.series_len) };

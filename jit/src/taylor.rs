@@ -1,5 +1,5 @@
 //! A run-time model's Taylor orders compiled to native code by Cranelift: the counterpart of
-//! the `taylor_orders` that `eomgen::model!` generates for a compiled model.
+//! the `TaylorFunctions::orders` that `eomgen::model!` generates for a compiled model.
 //!
 //! # What is compiled
 //! One function per order `k = 0 … H`, each with the signature [`OrderFn`] (the platform's

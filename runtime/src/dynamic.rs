@@ -12,7 +12,7 @@
 use nalgebra::SVector;
 
 use crate::system::{MechanicalSystem, ModelDescription, UnknownParameter};
-use crate::taylor::{TaylorProgram, TaylorUnsupported};
+use crate::taylor::{TaylorFunctions, TaylorUnsupported};
 
 /// Equations of motion `M(q, t) q̈ = F(q, q̇, t)` of a mechanism with `n` degrees of freedom,
 /// `n` known at run time.
@@ -98,37 +98,12 @@ pub trait DynMechanicalSystem {
         out: &mut [f64],
     );
 
-    /// [`MechanicalSystem::taylor_program`].
+    /// [`MechanicalSystem::taylor`].
     ///
     /// # Errors
     /// [`TaylorUnsupported`] naming what is missing.
-    fn taylor_program(&self) -> Result<&TaylorProgram, TaylorUnsupported> {
+    fn taylor(&self) -> Result<&dyn TaylorFunctions, TaylorUnsupported> {
         Err(TaylorUnsupported::NotGenerated)
-    }
-    /// [`MechanicalSystem::taylor_order_zero`].
-    fn taylor_order_zero(&self, capacity: usize, series: &mut [f64]) {
-        let _ = (capacity, series);
-    }
-    /// [`MechanicalSystem::taylor_order`].
-    fn taylor_order(&self, k: usize, capacity: usize, series: &mut [f64]) {
-        if let Ok(program) = self.taylor_program() {
-            crate::taylor::evaluate_order(&program.ops, k, capacity, series);
-        }
-    }
-    /// [`MechanicalSystem::taylor_orders`].
-    fn taylor_orders(
-        &self,
-        solve: &mut crate::taylor::MotionSolve<'_>,
-        order: usize,
-        series: &mut [f64],
-        out: &mut [f64],
-    ) -> usize {
-        let _ = (solve, order, series, out);
-        0
-    }
-    /// [`MechanicalSystem::taylor_fused_orders`].
-    fn taylor_fused_orders(&self) -> usize {
-        0
     }
 }
 
@@ -265,26 +240,8 @@ impl<S: MechanicalSystem<N>, const N: usize> DynMechanicalSystem for StaticSyste
             out,
         );
     }
-    fn taylor_program(&self) -> Result<&TaylorProgram, TaylorUnsupported> {
-        self.0.taylor_program()
-    }
-    fn taylor_order_zero(&self, capacity: usize, series: &mut [f64]) {
-        self.0.taylor_order_zero(capacity, series);
-    }
-    fn taylor_order(&self, k: usize, capacity: usize, series: &mut [f64]) {
-        self.0.taylor_order(k, capacity, series);
-    }
-    fn taylor_orders(
-        &self,
-        solve: &mut crate::taylor::MotionSolve<'_>,
-        order: usize,
-        series: &mut [f64],
-        out: &mut [f64],
-    ) -> usize {
-        self.0.taylor_orders(solve, order, series, out)
-    }
-    fn taylor_fused_orders(&self) -> usize {
-        self.0.taylor_fused_orders()
+    fn taylor(&self) -> Result<&dyn TaylorFunctions, TaylorUnsupported> {
+        self.0.taylor()
     }
 }
 

@@ -11,7 +11,7 @@ use crate::linalg::{solve_spd, solve_spd_in_place};
 use crate::model_info::{FirstOrderForm, FirstOrderParts};
 use crate::ode::{EventSpec, OdeSystem, RhsError};
 use crate::system::MechanicalSystem;
-use crate::taylor::{TaylorProgram, TaylorUnsupported, TaylorWorkspace};
+use crate::taylor::{TaylorFunctions, TaylorUnsupported, TaylorWorkspace};
 
 /// The first-order form `y = [q; q̇]`, `ẏ = [q̇; M⁻¹F]` of a [`MechanicalSystem`].
 ///
@@ -578,47 +578,16 @@ impl<S: DynMechanicalSystem> FirstOrderForm for DynFirstOrder<S> {
     }
 }
 
-/// A [`DynMechanicalSystem`](DynMechanicalSystem) with a program, as
-/// [`TaylorFunctions`].
-struct ModelSeries<'a, S: ?Sized> {
-    system: &'a S,
-    program: &'a TaylorProgram,
-}
-
-impl<S: DynMechanicalSystem + ?Sized> crate::taylor::TaylorFunctions for ModelSeries<'_, S> {
-    fn program(&self) -> &TaylorProgram {
-        self.program
-    }
-    fn order_zero(&self, capacity: usize, series: &mut [f64]) {
-        self.system.taylor_order_zero(capacity, series);
-    }
-    fn order(&self, k: usize, capacity: usize, series: &mut [f64]) {
-        self.system.taylor_order(k, capacity, series);
-    }
-    fn orders(
-        &self,
-        solve: &mut crate::taylor::MotionSolve<'_>,
-        order: usize,
-        s: &mut [f64],
-        out: &mut [f64],
-    ) -> usize {
-        self.system.taylor_orders(solve, order, s, out)
-    }
-    fn fused_orders(&self) -> usize {
-        self.system.taylor_fused_orders()
-    }
-}
-
 /// [`OdeSystem::taylor_support`](crate::OdeSystem::taylor_support) of a first-order form:
-/// the system's program, refused with constraints.
+/// the system's Taylor method, refused with constraints.
 fn taylor_support<S: DynMechanicalSystem + ?Sized>(
     system: &S,
-) -> Result<&TaylorProgram, TaylorUnsupported> {
+) -> Result<&dyn TaylorFunctions, TaylorUnsupported> {
     let count = system.description().constraints.len();
     if count > 0 {
         return Err(TaylorUnsupported::Constraints { count });
     }
-    system.taylor_program()
+    system.taylor()
 }
 
 /// [`OdeSystem::taylor_coefficients`](crate::OdeSystem::taylor_coefficients) of a first-order
@@ -631,9 +600,8 @@ fn taylor_coefficients<S: DynMechanicalSystem + ?Sized>(
     order: usize,
     out: &mut [f64],
 ) -> Result<(), RhsError> {
-    let program = taylor_support(system).map_err(|_| RhsError::NonFinite { index: 0 })?;
-    let model = ModelSeries { system, program };
-    crate::taylor::series_of_motion(&model, workspace, t, y, order, out)
+    let taylor = taylor_support(system).map_err(|_| RhsError::NonFinite { index: 0 })?;
+    crate::taylor::series_of_motion(taylor, workspace, t, y, order, out)
 }
 
 /// [`OdeSystem::taylor_branch_step`](crate::OdeSystem::taylor_branch_step) of a first-order
@@ -645,7 +613,7 @@ fn taylor_branch_step<S: DynMechanicalSystem + ?Sized>(
     h: f64,
 ) -> f64 {
     match taylor_support(system) {
-        Ok(program) => crate::taylor::branch_step(program, workspace, order, h),
+        Ok(taylor) => crate::taylor::branch_step(taylor.program(), workspace, order, h),
         Err(_) => h,
     }
 }

@@ -53,7 +53,7 @@ macro_rules! unrolled_orders {
 /// 0, else `(k, c)`.
 ///
 /// [`evaluate_order`] (the run-time model's orders) and the `model!`
-/// macro's `taylor_orders` in optimised builds pick `K = k` for `k ≤` [`UNROLLED_ORDERS`]
+/// macro's `TaylorFunctions::orders` in optimised builds pick `K = k` for `k ≤` [`UNROLLED_ORDERS`]
 /// when the workspace's stride is [`UNROLLED_CAPACITY`] (as [`series_of_motion`]'s is when
 /// [`TaylorProgram::unrolled_code_fits`], or the model has fused orders): the sums then have
 /// a known number of terms and unroll into straight-line code, and every coefficient is at
@@ -493,13 +493,13 @@ pub fn zero<const K: usize>(k: usize, c: usize, s: &mut [f64], out: Slot) {
 /// x86-64 processor that has both (detected once), unless [`set_host_features`] turned it off;
 /// never elsewhere.
 ///
-/// The copy covers each compiled model's fused orders (the `model!` macro's `taylor_orders`,
+/// The copy covers each compiled model's fused orders (the `model!` macro's `TaylorFunctions::orders`,
 /// in optimised builds), the rest of [`series_of_motion`], and the Taylor method's Horner's
 /// rule and step rule: the same Rust code compiled a second time with those instruction sets
 /// enabled — three-operand VEX encodings, fewer register copies — in a binary that still runs
 /// on any x86-64. Rust neither contracts a product and a sum into a fused multiply–add nor
 /// reassociates, so both copies compute the same bits (`tests/taylor_coefficients.rs`
-/// compares them). Orders above the fused ones (`taylor_order`, the run-time model's
+/// compares them). Orders above the fused ones (`TaylorFunctions::order`, the run-time model's
 /// `evaluate_order`) run the baseline code; a model compiled at run time gets the host's
 /// instructions from Cranelift anyway. On the double pendulum (AMD EPYC, Zen 3) a run took
 /// 0.73–0.94 of the time at tolerances 1e-4 to 1e-12; on a processor with AVX-512 the whole
@@ -644,31 +644,57 @@ impl TaylorWorkspace {
     }
 }
 
-/// The order-0 and order-`k` functions of a model's Taylor program.
+/// A model's Taylor method: its recurrences ([`TaylorProgram`]) and the code that runs them,
+/// which [`series_of_motion`] drives. A model hands it out through one accessor,
+/// [`MechanicalSystem::taylor`](crate::MechanicalSystem::taylor) (or
+/// [`DynMechanicalSystem::taylor`](crate::DynMechanicalSystem::taylor)), the way it hands
+/// out its description. The `model!` macro implements it for the struct it generates
+/// (order 0 as straight-line code, every op's kernel inlined with its slots as constants, and
+/// in optimised builds the fused orders); a model compiled at run time implements it with
+/// its tape interpreted or compiled, and its orders on the kernels or compiled by Cranelift.
+/// Every implementation computes the same bits.
+///
+/// Source: Jorba & Zou (2005, §2) for the recurrences; the layout of the series is
+/// [`series_of_motion`]'s.
 pub trait TaylorFunctions {
-    /// The program.
+    /// The program: its ops, slots and the slots of the state, `M` and `F`.
     fn program(&self) -> &TaylorProgram;
-    /// Order 0 of every slot, reading the state from the input slots.
+
+    /// Order 0 of every slot of [`Self::program`] into `series` (slot `s` at
+    /// `s · capacity`): the model's own evaluation of `M` and `F`, reading `q`, `q̇` and `t`
+    /// from their slots, every intermediate value kept.
     fn order_zero(&self, capacity: usize, series: &mut [f64]);
+
     /// Order `k ≥ 1` of every slot the program's ops write (the slots that an op, `M` or `F`
-    /// reads; others keep what the workspace held).
-    fn order(&self, k: usize, capacity: usize, series: &mut [f64]);
+    /// reads; others keep what the workspace held), from the orders below `k`. The default
+    /// runs the program's ops on the kernels ([`evaluate_order`]).
+    fn order(&self, k: usize, capacity: usize, series: &mut [f64]) {
+        evaluate_order(&self.program().ops, k, capacity, series);
+    }
+
     /// [`motion_order`] for `k = 0`, then orders `k = 1, 2, …` of the ops' slots, each
-    /// followed by its [`motion_order`], in one function (the `model!` macro's
-    /// [`MechanicalSystem::taylor_orders`](crate::MechanicalSystem::taylor_orders)), stopping
-    /// before `order`; the first order it did not compute. The default computes none (0).
+    /// followed by its [`motion_order`], stopping before `order`; returns the first order it
+    /// did not compute, from which [`series_of_motion`] goes on one order at a time. The
+    /// `model!` macro's code (when `solve` has the unrolled stride,
+    /// [`MotionSolve::unrolled`]; optimised builds compile each order
+    /// `k ≤ TaylorProgram::highest_unrolled_order` for that `k`) passes the values of an
+    /// order's ops and solve in registers and lists its slots as constants; a run-time model's
+    /// orders compiled by Cranelift do the same. The same bits as one order at a time. The
+    /// default computes none and returns 0.
     fn orders(
         &self,
         solve: &mut MotionSolve<'_>,
         order: usize,
-        s: &mut [f64],
+        series: &mut [f64],
         out: &mut [f64],
     ) -> usize {
-        let _ = (solve, order, s, out);
+        let _ = (solve, order, series, out);
         0
     }
-    /// The highest order `k` that [`Self::orders`] computes (0: it computes none; the
-    /// default).
+
+    /// The highest order `k` that [`Self::orders`] computes when `solve` has the unrolled
+    /// stride (0, the default, when it computes none). A step to a higher order then runs
+    /// those orders fused and the rest one at a time at the same stride.
     fn fused_orders(&self) -> usize {
         0
     }
@@ -685,7 +711,7 @@ with_host_features! {
     /// # Panics
     /// If `y` has fewer than `2n` entries or `out` fewer than `(order + 1) · 2n`.
     pub fn series_of_motion(
-        model: &impl TaylorFunctions,
+        model: &(impl TaylorFunctions + ?Sized),
         workspace: &mut TaylorWorkspace,
         t: f64,
         y: &[f64],
@@ -699,7 +725,7 @@ with_host_features! {
 /// [`series_of_motion`]'s body, inlined into its two copies.
 #[inline(always)]
 fn series_in(
-    model: &impl TaylorFunctions,
+    model: &(impl TaylorFunctions + ?Sized),
     workspace: &mut TaylorWorkspace,
     t: f64,
     y: &[f64],

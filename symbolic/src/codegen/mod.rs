@@ -376,7 +376,8 @@ pub fn emit(
         .iter()
         .map(|p| ident(&field_name(&p.name)))
         .collect::<Result<Vec<_>, _>>()?;
-    methods.extend(taylor::methods(&taylor, &krate, &parameter_fields)?);
+    let (accessor, taylor_functions) = taylor::methods(&taylor, &krate, &parameter_fields, &name)?;
+    methods.extend(accessor);
     let both: Vec<ExprId> = [eom.mass_matrix.clone(), eom.forcing.clone()].concat();
     let stats = EmitStats {
         ops_before_cse: model.arena.tree_operation_count(&both),
@@ -404,6 +405,7 @@ pub fn emit(
         impl #krate::MechanicalSystem<#dim> for #name {
             #methods
         }
+        #taylor_functions
     };
     Ok((tokens, stats))
 }

@@ -648,11 +648,12 @@ fn operands(instruction: Instruction) -> Vec<Slot> {
     }
 }
 
-/// The Taylor methods of a generated `impl MechanicalSystem<N>`: `taylor_program` (the
-/// program as a `static`, or the reason there is none), `taylor_order_zero` (the extended
-/// tape as straight-line code), `taylor_order` (one call of the op's kernel,
+/// The Taylor method of a generated model: the accessor `taylor` of its `impl
+/// MechanicalSystem<N>` (the model itself, or the reason there is none), and its `impl
+/// TaylorFunctions` (none without a program): `program` (the program as a `static`),
+/// `order_zero` (the extended tape as straight-line code), `order` (one call of the op's kernel,
 /// `eomgen::__private::taylor::{mul, sin_cos, …}`, per op, with its slots as constants, for
-/// any order) and `taylor_orders`: in optimised builds, the orders `k = 1 …` a step can run
+/// any order), `fused_orders` and `orders`: in optimised builds, the orders `k = 1 …` a step can run
 /// with `k` known (`TaylorProgram::highest_unrolled_order`) in one function, each order's
 /// kernel calls compiled for that `k` (sums of a known length, coefficients at known
 /// offsets) followed by its solve (`taylor::motion_order`, with the slots of `F`, of the
@@ -662,7 +663,7 @@ fn operands(instruction: Instruction) -> Vec<Slot> {
 /// (`taylor::host_features`; the same bits); debug builds run the same orders with `k` a
 /// variable.
 ///
-/// `parameters` are the fields of the struct, in parameter order.
+/// `parameters` are the fields of the struct, in parameter order; `name` is the struct.
 ///
 /// # Errors
 /// Only if a constant of the tape is not finite (a bug: the loader refuses such values).
@@ -670,7 +671,8 @@ pub(super) fn methods(
     taylor: &Result<TaylorPlan, TaylorUnsupported>,
     krate: &proc_macro2::TokenStream,
     parameters: &[proc_macro2::Ident],
-) -> Result<proc_macro2::TokenStream, String> {
+    name: &proc_macro2::Ident,
+) -> Result<(proc_macro2::TokenStream, proc_macro2::TokenStream), String> {
     use quote::quote;
     let t = quote!(#krate::__private::taylor);
     let cow = quote!(::std::borrow::Cow);
@@ -678,11 +680,12 @@ pub(super) fn methods(
         Ok(plan) => plan,
         Err(reason) => {
             let reason = unsupported_tokens(reason, &t, &cow);
-            return Ok(quote! {
-                fn taylor_program(&self) -> ::core::result::Result<&#t::TaylorProgram, #t::TaylorUnsupported> {
+            let accessor = quote! {
+                fn taylor(&self) -> ::core::result::Result<&dyn #t::TaylorFunctions, #t::TaylorUnsupported> {
                     ::core::result::Result::Err(#reason)
                 }
-            });
+            };
+            return Ok((accessor, proc_macro2::TokenStream::new()));
         }
     };
     let program = &plan.program;
@@ -832,38 +835,43 @@ pub(super) fn methods(
     // The orders whose compiled code a step can run (`TaylorProgram::unrolled_code_fits`):
     // compiling the others would only lengthen the build.
     let unrolled: Vec<usize> = (1..=program.highest_unrolled_order()).collect();
-    // The fused orders' layout (`taylor_orders`): the program's derived lists, as constants
+    // The fused orders' layout (`orders`): the program's derived lists, as constants
     // (the run-time `series_of_motion` reads the same lists from the program).
     let n = program.forcing.len();
     let highest = unrolled.len();
     let next = highest + 1;
     let forcing_slots = program.forcing.iter();
     let accelerations = program.acceleration_slot();
-    Ok(quote! {
-        fn taylor_program(&self) -> ::core::result::Result<&#t::TaylorProgram, #t::TaylorUnsupported> {
+    let accessor = quote! {
+        fn taylor(&self) -> ::core::result::Result<&dyn #t::TaylorFunctions, #t::TaylorUnsupported> {
+            ::core::result::Result::Ok(self)
+        }
+    };
+    let functions = quote! {
+        fn program(&self) -> &#t::TaylorProgram {
             #statics
-            ::core::result::Result::Ok(&PROGRAM)
+            &PROGRAM
         }
         #[allow(unused_variables)]
-        fn taylor_order_zero(&self, __c: usize, __s: &mut [f64]) {
+        fn order_zero(&self, __c: usize, __s: &mut [f64]) {
             #statements
             #(#stores)*
         }
         #[inline(never)]
-        fn taylor_order(&self, __k: usize, __c: usize, __s: &mut [f64]) {
+        fn order(&self, __k: usize, __c: usize, __s: &mut [f64]) {
             // Any order, any stride: the orders a step runs with `k` known are in
-            // `taylor_orders` (the same bits).
+            // `orders` (the same bits).
             #[inline(always)]
             fn __ops<const __K: usize>(__k: usize, __c: usize, __s: &mut [f64]) {
                 #(#calls)*
             }
             __ops::<0>(__k, __c, __s);
         }
-        fn taylor_fused_orders(&self) -> usize {
+        fn fused_orders(&self) -> usize {
             #highest
         }
         #[inline(never)]
-        fn taylor_orders(
+        fn orders(
             &self,
             __solve: &mut #t::MotionSolve<'_>,
             __order: usize,
@@ -949,7 +957,15 @@ pub(super) fn methods(
             };
             __next
         }
-    })
+    };
+    let implementation = quote! {
+        #[automatically_derived]
+        #[allow(clippy::all, clippy::approx_constant, non_snake_case)]
+        impl #t::TaylorFunctions for #name {
+            #functions
+        }
+    };
+    Ok((accessor, implementation))
 }
 
 fn unsupported_tokens(
@@ -1022,7 +1038,7 @@ fn op_tokens(op: &SeriesOp, t: &proc_macro2::TokenStream) -> proc_macro2::TokenS
 }
 
 /// The call of an op's kernel (`eomgen_runtime::taylor::{mul, sin_cos, …}`) in
-/// `taylor_order`, the kernel [`SeriesOp`]'s dispatch (`apply`) calls for the run-time model.
+/// `order`, the kernel [`SeriesOp`]'s dispatch (`apply`) calls for the run-time model.
 fn call_tokens(op: &SeriesOp, t: &proc_macro2::TokenStream) -> proc_macro2::TokenStream {
     use quote::quote;
     let args = |kernel: &str, slots: &[Slot]| {
