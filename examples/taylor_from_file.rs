@@ -2,7 +2,7 @@
 //! loaded from its file with its orders compiled to native code from the first series
 //! (`LoadOptions::eager_taylor`), and loaded from its file with the runtime's kernels alone
 //! (the interpreter backend, whose Taylor orders are what a file-loaded model runs before it
-//! has computed `eomgen_jit::COMPILE_TAYLOR_AFTER` series). All three compute the same bits
+//! has computed `eomgen::COMPILE_TAYLOR_AFTER` series). All three compute the same bits
 //! (`tests/taylor_coefficients.rs`); this times them.
 //!
 //! ```sh

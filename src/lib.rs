@@ -30,7 +30,6 @@ extern crate self as eomgen;
 #[cfg(feature = "jit")]
 pub use eomgen_jit::{
     Backend, COMPILE_TAYLOR_AFTER, CompileError, JitModel, LoadError, LoadOptions,
-    TAYLOR_COMPILE_STARTS_AFTER,
 };
 pub use eomgen_macros::model;
 pub use eomgen_runtime::*;

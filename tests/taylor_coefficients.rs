@@ -391,8 +391,9 @@ fn angle_differences_run_as_one_sin_cos() {
 /// the runtime's kernels and tape interpreter (the interpreter backend), to the bit, on
 /// fixtures that use every op kind (`exp`, `ln`, `sinh`/`cosh`, `tan`, `tanh`, `asin`,
 /// `acos`, `atan`, `atan2`, powers, roots, quotients: the bundled models use only some), a
-/// mass matrix that varies (dense and diagonal, which the compiled orders solve in line, and
-/// with a factor that is neither, solved by their call per order), and functions without a
+/// mass matrix that varies (dense, diagonal, and with zeros below its factor's diagonal, which
+/// the compiled orders solve in line, the zeros skipped; and the last with seven coordinates,
+/// more than they solve in line, solved by their call per order), and functions without a
 /// recurrence applied to parameters alone (constants of order 0); and the orders really are
 /// compiled (`TaylorFunctions::fused_orders` after the first series: a failure of Cranelift would
 /// leave them to the kernels and this comparison would prove nothing). Then again with every
@@ -406,6 +407,7 @@ fn compiled_orders_of_every_op_kind_are_the_kernels_bits() {
         "taylor_ops_dense",
         "taylor_ops_diagonal",
         "taylor_ops_sparse",
+        "taylor_ops_large_sparse",
         "taylor_order_zero_constants",
     ] {
         let path = format!("{}/tests/fixtures/{file}.yaml", env!("CARGO_MANIFEST_DIR"));
@@ -580,44 +582,35 @@ fn the_code_for_the_hosts_instruction_sets_computes_the_same_bits() {
     }
 }
 
-/// A run-time model's Taylor orders are compiled on a thread of their own once
-/// `TAYLOR_COMPILE_STARTS_AFTER` series have been computed by the kernels: with no further
-/// series asked for, the orders become compiled (within a minute, however busy the machine);
-/// and every series before, during and after computes the same bits.
+/// A run-time model's Taylor orders are compiled once `COMPILE_TAYLOR_AFTER` series have
+/// been computed by the kernels, not before; and every series before and after computes the
+/// same bits.
 #[test]
-fn the_orders_are_compiled_in_the_background_with_the_same_bits() {
-    use eomgen::{COMPILE_TAYLOR_AFTER, TAYLOR_COMPILE_STARTS_AFTER};
-    use eomgen::{DynMechanicalSystem, OdeSystem};
+fn the_orders_are_compiled_after_the_kernels_series_with_the_same_bits() {
+    use eomgen::{COMPILE_TAYLOR_AFTER, DynMechanicalSystem, OdeSystem};
     let path = format!("{}/models/double_pendulum.yaml", env!("CARGO_MANIFEST_DIR"));
     let model = JitModel::load(&path).unwrap_or_else(|e| panic!("{path}: {e}"));
     let handle = model.clone();
+    let fused = || handle.taylor().map_or(0, |t| t.fused_orders());
     let mut model = DynFirstOrder::new(model);
     let y = ModelInfo::initial_state(&model);
     let order = 12;
-    let series = |model: &mut DynFirstOrder<JitModel>| {
+    let mut series = || {
         let mut out = vec![f64::NAN; (order + 1) * y.len()];
         model
             .taylor_coefficients(0.3, &y, order, &mut out)
             .expect("coefficients");
         out.iter().map(|v| v.to_bits()).collect::<Vec<u64>>()
     };
-    let first = series(&mut model);
-    for _ in 0..TAYLOR_COMPILE_STARTS_AFTER {
-        assert_eq!(series(&mut model), first, "a series by the kernels");
+    let first = series();
+    for _ in 1..COMPILE_TAYLOR_AFTER {
+        assert_eq!(series(), first, "a series by the kernels");
     }
-    assert_eq!(
-        handle.taylor().map_or(0, |t| t.fused_orders()),
-        0,
-        "compiled before the series asked for it"
+    assert_eq!(fused(), 0, "compiled before the series asked for it");
+    assert_eq!(series(), first, "the series that compiles the orders");
+    assert!(
+        fused() > 0,
+        "not compiled after {COMPILE_TAYLOR_AFTER} series"
     );
-    let start = std::time::Instant::now();
-    while handle.taylor().map_or(0, |t| t.fused_orders()) == 0 {
-        assert!(
-            start.elapsed() < std::time::Duration::from_secs(60),
-            "the orders were not compiled in the background within a minute"
-        );
-        std::thread::sleep(std::time::Duration::from_millis(5));
-    }
-    const { assert!(TAYLOR_COMPILE_STARTS_AFTER + 1 < COMPILE_TAYLOR_AFTER) };
-    assert_eq!(series(&mut model), first, "a series by the compiled orders");
+    assert_eq!(series(), first, "a series by the compiled orders");
 }

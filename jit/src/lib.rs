@@ -52,9 +52,7 @@ mod model;
 mod native;
 mod taylor;
 
-pub use model::{
-    COMPILE_TAYLOR_AFTER, JitModel, LoadError, LoadOptions, TAYLOR_COMPILE_STARTS_AFTER,
-};
+pub use model::{COMPILE_TAYLOR_AFTER, JitModel, LoadError, LoadOptions};
 pub use native::CompileError;
 
 /// Which evaluator runs a run-time model's functions.

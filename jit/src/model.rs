@@ -72,9 +72,8 @@ pub struct LoadOptions {
     /// at load time; without it that field is `None`. Compiled models always carry it.
     pub equations_mathml: bool,
     /// Compile the Taylor method's orders to native code at the first Taylor series, rather
-    /// than on a thread of their own after [`TAYLOR_COMPILE_STARTS_AFTER`] of them computed
-    /// by the runtime's kernels (at most [`COMPILE_TAYLOR_AFTER`]; the same bits either way;
-    /// with the interpreter backend they are never compiled).
+    /// than after [`COMPILE_TAYLOR_AFTER`] of them computed by the runtime's kernels (the
+    /// same bits either way; with the interpreter backend they are never compiled).
     pub eager_taylor: bool,
 }
 
@@ -230,20 +229,14 @@ struct Code {
 }
 
 /// Taylor series a run-time model computes with the runtime's kernels before its orders are
-/// compiled to native code on the thread that needs them, if the compilation started in the
-/// background ([`TAYLOR_COMPILE_STARTS_AFTER`]) has not finished by then (or could not
-/// start): compiling the double pendulum's 18 orders or the heavy top's 11 costs 20–35 ms,
-/// what about 20,000 double-pendulum series at tol 1e-9 cost with the kernels (about 1 µs
-/// each, against 0.5 µs compiled), so a run never pays more than about twice what the better
-/// choice in hindsight costs (the rent-or-buy rule).
+/// compiled to native code: compiling the double pendulum's 18 orders costs 15–30 ms, what
+/// about 20,000 of its series at tol 1e-9 cost with the kernels (1.3 µs each, against 0.5 µs
+/// compiled), so a run never pays more than about twice what the better choice in hindsight
+/// costs (the rent-or-buy rule), and a short run pays nothing. (Compiling them on a thread of
+/// their own from the 1,000th series instead made runs of 10–30 ms 10–20 % slower in wall
+/// time and 50–75 % in processor time on the 2-core development machine, and runs of 60 ms
+/// 22 % faster: docs/performance.md.)
 pub const COMPILE_TAYLOR_AFTER: usize = 20_000;
-
-/// Taylor series a run-time model computes with the runtime's kernels before it starts
-/// compiling its orders on a thread of their own: about 1 ms of a run, so that a short run
-/// spends no processor time on a compilation it would not use, and a longer one runs on the
-/// compiled orders from about 25 ms after that (the compile's time) without waiting for them.
-/// The series computed meanwhile are the kernels', the same bits.
-pub const TAYLOR_COMPILE_STARTS_AFTER: usize = 1_000;
 
 impl Code {
     /// Whether the Taylor orders may be compiled to native code: a model with recurrences
@@ -253,38 +246,25 @@ impl Code {
     }
 
     /// The Taylor orders compiled to native code ([`crate::taylor`]) once they are: from the
-    /// first series with [`LoadOptions::eager_taylor`], else after a compilation started on
-    /// a thread of its own at series [`TAYLOR_COMPILE_STARTS_AFTER`] has finished, or at
-    /// series [`COMPILE_TAYLOR_AFTER`] on this thread (waiting for that compilation if it is
-    /// under way). `None` before, and for good if Cranelift fails on them or no order fits
-    /// the instruction cache; until then the series are the runtime's kernels'
+    /// first series with [`LoadOptions::eager_taylor`], else from series
+    /// [`COMPILE_TAYLOR_AFTER`] + 1. `None` before, and for good if Cranelift fails on them or
+    /// no order fits the instruction cache; until then the series are the runtime's kernels'
     /// (`evaluate_order`, the same bits).
-    fn taylor_orders(code: &Arc<Code>) -> Option<&NativeOrders> {
-        if let Some(compiled) = code.taylor_orders.get() {
+    fn taylor_orders(&self) -> Option<&NativeOrders> {
+        if let Some(compiled) = self.taylor_orders.get() {
             return compiled.as_ref();
         }
-        if !code.taylor_native() {
+        if !self.taylor_native()
+            || self.taylor_series.fetch_add(1, Ordering::Relaxed) < self.compile_taylor_after
+        {
             return None;
         }
-        let series = code.taylor_series.fetch_add(1, Ordering::Relaxed);
-        if series >= code.compile_taylor_after {
-            return code
-                .taylor_orders
-                .get_or_init(|| code.compile_orders())
-                .as_ref();
-        }
-        if series == TAYLOR_COMPILE_STARTS_AFTER {
-            let background = Arc::clone(code);
-            // If no thread can be started, the orders are compiled at `COMPILE_TAYLOR_AFTER`.
-            let _ = std::thread::Builder::new()
-                .name("eomgen-taylor-compile".into())
-                .spawn(move || {
-                    background
-                        .taylor_orders
-                        .get_or_init(|| background.compile_orders());
-                });
-        }
-        None
+        // Compiled outside the cell's lock (a thread racing here may compile them too, and
+        // one result is kept): a process forked while the lock is held would wait on it for
+        // good.
+        let compiled = self.compile_orders();
+        let _ = self.taylor_orders.set(compiled);
+        self.taylor_orders.get().and_then(Option::as_ref)
     }
 
     /// Compiles the Taylor orders; `None` if Cranelift fails or panics on them (the orders
@@ -696,7 +676,7 @@ impl DynMechanicalSystem for JitModel {
     }
     fn taylor(&self) -> Result<&dyn TaylorFunctions, TaylorUnsupported> {
         match &self.code.taylor {
-            Ok(_) => Ok(self),
+            Ok(_) => Ok(Recurrences::of(self)),
             Err(reason) => Err(reason.clone()),
         }
     }
@@ -886,7 +866,8 @@ impl DynMechanicalSystem for JitModel {
 }
 
 /// The program of no model: what [`TaylorFunctions::program`] of a [`JitModel`] without
-/// recurrences would read, which [`DynMechanicalSystem::taylor`] never hands out.
+/// recurrences would read ([`Recurrences`], which [`DynMechanicalSystem::taylor`] never hands
+/// out for such a model).
 static EMPTY_PROGRAM: TaylorProgram = TaylorProgram {
     slots: 0,
     coordinates: Cow::Borrowed(&[]),
@@ -904,22 +885,35 @@ static EMPTY_PROGRAM: TaylorProgram = TaylorProgram {
     },
 };
 
-/// The model's Taylor method ([`DynMechanicalSystem::taylor`] hands it out once the model has
-/// recurrences): order 0 compiled with the orders (at their stride) or interpreted, orders on
+/// A [`JitModel`] that has recurrences, as its Taylor method ([`TaylorFunctions`]):
+/// [`DynMechanicalSystem::taylor`] hands the model out as this type only then, so that no
+/// caller runs the Taylor method of a model without recurrences.
+#[repr(transparent)]
+struct Recurrences(JitModel);
+
+impl Recurrences {
+    /// `model` as its Taylor method (which reads [`EMPTY_PROGRAM`] without recurrences).
+    fn of(model: &JitModel) -> &Self {
+        // SAFETY: `Recurrences` is `repr(transparent)` over `JitModel`: the same layout.
+        unsafe { &*std::ptr::from_ref(model).cast::<Self>() }
+    }
+}
+
+/// The model's Taylor method: order 0 compiled with the orders (at their stride) or interpreted, orders on
 /// the runtime's kernels (the trait's default `order`, the definitions the compiled model's
 /// code inlines) until they are compiled ([`Code::taylor_orders`]); the same bits.
-impl TaylorFunctions for JitModel {
+impl TaylorFunctions for Recurrences {
     fn program(&self) -> &TaylorProgram {
-        match &self.code.taylor {
+        match &self.0.code.taylor {
             Ok(plan) => &plan.program,
-            // `taylor` hands the model out only with a plan.
+            // Not handed out without a plan.
             Err(_) => &EMPTY_PROGRAM,
         }
     }
     fn order_zero(&self, capacity: usize, series: &mut [f64]) {
-        if let Ok(plan) = &self.code.taylor {
+        if let Ok(plan) = &self.0.code.taylor {
             // Compiled with the orders (at their stride), else interpreted: the same bits.
-            if let Some(Some(orders)) = self.code.taylor_orders.get()
+            if let Some(Some(orders)) = self.0.code.taylor_orders.get()
                 && capacity == UNROLLED_CAPACITY
                 && series.len() >= plan.order_zero.instructions.len() * UNROLLED_CAPACITY
             {
@@ -927,10 +921,10 @@ impl TaylorFunctions for JitModel {
                 // (checked above) and the caller has written the inputs' order 0;
                 // `parameters` holds the model's parameters, the count the code was
                 // compiled for.
-                unsafe { (orders.order_zero)(series.as_mut_ptr(), self.parameters.as_ptr()) };
+                unsafe { (orders.order_zero)(series.as_mut_ptr(), self.0.parameters.as_ptr()) };
                 return;
             }
-            interpret::order_zero_in_place(&plan.order_zero, &self.parameters, capacity, series);
+            interpret::order_zero_in_place(&plan.order_zero, &self.0.parameters, capacity, series);
         }
     }
     fn orders(
@@ -940,7 +934,7 @@ impl TaylorFunctions for JitModel {
         series: &mut [f64],
         out: &mut [f64],
     ) -> usize {
-        let (Ok(plan), Some(orders)) = (&self.code.taylor, Code::taylor_orders(&self.code)) else {
+        let (Ok(plan), Some(orders)) = (&self.0.code.taylor, self.0.code.taylor_orders()) else {
             return 0;
         };
         let program = &plan.program;
@@ -989,7 +983,7 @@ impl TaylorFunctions for JitModel {
             /// calls on this thread.
             static SCRATCH: std::cell::RefCell<Vec<PairLanes>> = const { std::cell::RefCell::new(Vec::new()) };
         }
-        let ran = SCRATCH.with(|scratch| {
+        let ran = SCRATCH.try_with(|scratch| {
             let Ok(mut scratch) = scratch.try_borrow_mut() else {
                 return false;
             };
@@ -1023,7 +1017,7 @@ impl TaylorFunctions for JitModel {
             }
             true
         });
-        if !ran {
+        if ran != Ok(true) {
             return 0;
         }
         computed
@@ -1031,7 +1025,8 @@ impl TaylorFunctions for JitModel {
     fn fused_orders(&self) -> usize {
         // None before they are compiled: until then the workspace's stride follows the
         // kernels' rule (`TaylorProgram::unrolled_code_fits`), as for a model without them.
-        self.code
+        self.0
+            .code
             .taylor_orders
             .get()
             .and_then(Option::as_ref)

@@ -32,13 +32,16 @@
 //! kernels do, two lanes of one vector, with their operands side by side in a scratch
 //! ([`PairScratch`]).
 //!
-//! Why one function per order: within an order's function, what earlier orders computed is
-//! never written, so its loads are pure to Cranelift ([`settled`]) and are placed next to
-//! their uses; in one function for all orders every coefficient stayed in a register from
-//! the order that computed it to the last that read it, and the register allocator spilled
-//! most of them (5,059 16-byte reloads in the double pendulum's code) and took most of the
-//! compile. Per order, the double pendulum's 18 orders compile in 20–30 ms instead of 30–35,
-//! and run as fast or faster (docs/performance.md).
+//! Why one function per order: in one function for all orders every coefficient stayed in
+//! a register (a Cranelift value) from the order that computed it to the last that read it,
+//! and the register allocator spilled most of them (5,059 16-byte reloads in the double
+//! pendulum's code) and took most of the compile. Per order, a coefficient of an earlier
+//! order is loaded from the series where it is first used in that order (what the order
+//! writes, it never reads back from memory: see [`settled`]). The module is compiled without
+//! Cranelift's e-graph pass ([`OptLevel::None`]): the code repeats no work for it to remove.
+//! The double pendulum's 18 orders compile in 15–30 ms instead of 25–40, and run in 1.1–1.2×
+//! the time of `model!`'s instead of 1.3–1.5× (docs/performance.md, "The Taylor method on
+//! the run-time path").
 //!
 //! With it, in the same module, order 0 ([`OrderZeroFn`], `fn(series: *mut f64, parameters:
 //! *const f64)`): the extended tape of `M` and `F` (`TaylorPlan::order_zero`), instruction
@@ -64,7 +67,7 @@ use eomgen_symbolic::codegen::taylor::TaylorPlan;
 use eomgen_symbolic::expr::Func;
 
 use crate::native::{
-    CompileError, Imports, ModuleMemory, declare_imports, enter, failure, new_module,
+    CompileError, Imports, ModuleMemory, OptLevel, declare_imports, enter, failure, new_module,
 };
 
 /// One compiled order `k`: see the module documentation for the arguments.
@@ -175,7 +178,7 @@ pub(crate) fn compile_orders(
             &"the tape has too many instructions for 32-bit offsets",
         ));
     }
-    let mut module = new_module()?;
+    let mut module = new_module(OptLevel::None)?;
     let imports = declare_imports(&mut module)?;
     let call_conv = module.isa().default_call_conv();
     let pointer = module.target_config().pointer_type();
@@ -469,11 +472,12 @@ fn build_order_zero(
 
 /// The flags of a load of a value that order `k`'s function reads and does not write: a
 /// series' coefficient of an order below `k` (or an input's or time's order `k`, which order
-/// `k − 1` wrote), and order `k` of the state's series in `out`. Such a load is pure to
-/// Cranelift, so it is placed next to its use and folded into the instruction that uses it,
-/// rather than every coefficient an order reads being loaded first and kept (spilled) in
-/// registers; the memory is always the series' (never behind a null pointer), so moving the
-/// load across the function's branches is sound.
+/// `k − 1` wrote), order `k` of the state's series in `out`, and the pair scratch's orders
+/// below `k`. Such a load is pure to Cranelift (with its e-graph pass, it may be merged with
+/// another of the same address or moved next to its use); the memory is always there (the
+/// series, `out`, the scratch: never behind a null pointer), so moving the load across the
+/// function's branches is sound. What order `k` writes it never loads: its values are
+/// Cranelift values from where they are computed.
 fn settled() -> MemFlagsData {
     MemFlagsData::trusted().with_readonly().with_can_move()
 }
@@ -504,7 +508,7 @@ struct Emitter {
     scratch: ir::Value,
     /// Pair ops met so far in this order.
     pairs: usize,
-    /// `(slot, order) → value` loaded or stored, less what each solve writes.
+    /// `(slot, order) → value` loaded or stored in this order's function.
     known: HashMap<(Slot, usize), ir::Value>,
 }
 
@@ -515,11 +519,12 @@ impl Emitter {
         self.pairs - 1
     }
 
-    /// `motion_order`'s dense solve of order `k` (`dense_order`, then `next_order`), the same
-    /// operations in the same order: `b = F^[k]`, minus each varying entry's sum
-    /// `Σⱼ₌₁ᵏ M_il^[j] a_l^[k−j]` (increasing `j`, from `0.0`), `L z = b`, `z ← D⁻¹ z`,
-    /// `Lᵀ x = z` (with `lower` `None`, a diagonal factor: `x = D⁻¹ b` alone, as
-    /// `sparse_order` over no non-zero entries); then `a^[k] = x` into the series, `q^[k+1] = q̇^[k]/(k+1)` and
+    /// `motion_order`'s solve of order `k` with `factor` (`dense_order`, or `sparse_order`,
+    /// then `next_order`), the same operations in the same order: `b = F^[k]`, minus each
+    /// varying entry's sum `Σⱼ₌₁ᵏ M_il^[j] a_l^[k−j]` (increasing `j`, from `0.0`), `L z = b`,
+    /// `z ← D⁻¹ z`, `Lᵀ x = z` (each update by a zero entry of `L` skipped for
+    /// [`Factor::Small`], as `sparse_order` visits only the non-zero ones; a diagonal factor:
+    /// `x = D⁻¹ b` alone, as `sparse_order` over no non-zero entries); then `a^[k] = x` into the series, `q^[k+1] = q̇^[k]/(k+1)` and
     /// `q̇^[k+1] = x/(k+1)` into `out` (`2n` per order) and the inputs' and time's order
     /// `k + 1` into the series.
     #[allow(clippy::too_many_arguments)]
