@@ -229,7 +229,7 @@ struct Code {
 }
 
 /// Taylor series a run-time model computes with the runtime's kernels before its orders are
-/// compiled to native code: compiling the double pendulum's 18 orders costs 15–30 ms, what
+/// compiled to native code: compiling the double pendulum's 18 orders costs 20–30 ms, what
 /// about 20,000 of its series at tol 1e-9 cost with the kernels (1.3 µs each, against 0.5 µs
 /// compiled), so a run never pays more than about twice what the better choice in hindsight
 /// costs (the rent-or-buy rule), and a short run pays nothing. (Compiling them on a thread of

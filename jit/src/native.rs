@@ -185,7 +185,7 @@ pub(crate) struct Imports {
 /// # Errors
 /// [`CompileError`] naming the host or the function Cranelift could not handle.
 pub(crate) fn compile(functions: &[(&str, &FunctionTape)]) -> Result<NativeCode, CompileError> {
-    let mut module = new_module(OptLevel::Speed)?;
+    let mut module = new_module()?;
     let imports = declare_imports(&mut module)?;
     let call_conv = module.isa().default_call_conv();
     let pointer = module.target_config().pointer_type();
@@ -267,24 +267,12 @@ pub(crate) fn compile(functions: &[(&str, &FunctionTape)]) -> Result<NativeCode,
     })
 }
 
-/// Cranelift's optimisation level for a module ([`new_module`]).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) enum OptLevel {
-    /// Its e-graph pass: value numbering, algebraic simplification and code motion (the
-    /// tapes' functions, whose expressions a lowering repeats).
-    Speed,
-    /// None: for code already free of repeated work (the Taylor orders: each coefficient
-    /// loaded once per order and each operation written once), which then compiles in
-    /// about two thirds of the time and runs as fast (docs/performance.md).
-    None,
-}
-
 /// A JIT module for the host, optimising for speed, that resolves the helpers of
 /// [`crate::math`] by their symbol names.
 ///
 /// # Errors
 /// [`CompileError::UnsupportedHost`] when Cranelift has no code generator for the host.
-pub(crate) fn new_module(opt_level: OptLevel) -> Result<JITModule, CompileError> {
+pub(crate) fn new_module() -> Result<JITModule, CompileError> {
     let mut flags = settings::builder();
     let set = |flags: &mut settings::Builder, name: &str, value: &str| {
         flags
@@ -293,14 +281,7 @@ pub(crate) fn new_module(opt_level: OptLevel) -> Result<JITModule, CompileError>
                 reason: format!("setting {name}={value}: {e}"),
             })
     };
-    set(
-        &mut flags,
-        "opt_level",
-        match opt_level {
-            OptLevel::Speed => "speed",
-            OptLevel::None => "none",
-        },
-    )?;
+    set(&mut flags, "opt_level", "speed")?;
     set(&mut flags, "use_colocated_libcalls", "false")?;
     set(&mut flags, "is_pic", "false")?;
     // The tapes are built correct by construction; the verifier doubles compile time.

@@ -37,11 +37,11 @@
 //! and the register allocator spilled most of them (5,059 16-byte reloads in the double
 //! pendulum's code) and took most of the compile. Per order, a coefficient of an earlier
 //! order is loaded from the series where it is first used in that order (what the order
-//! writes, it never reads back from memory: see [`settled`]). The module is compiled without
-//! Cranelift's e-graph pass ([`OptLevel::None`]): the code repeats no work for it to remove.
-//! The double pendulum's 18 orders compile in 15–30 ms instead of 25–40, and run in 1.1–1.2×
-//! the time of `model!`'s instead of 1.3–1.5× (docs/performance.md, "The Taylor method on
-//! the run-time path").
+//! writes, it never reads back from memory: see [`settled`]). The double pendulum's 18
+//! orders compile in 20–30 ms instead of 30–40, and run in 1.15–1.2× the time of `model!`'s
+//! instead of 1.3–1.5× (docs/performance.md, "Build and test cost"). Without Cranelift's
+//! e-graph pass (`opt_level` `none`: the code repeats no work for it to remove) they compile
+//! in three quarters of the time and run 2–5 % slower.
 //!
 //! With it, in the same module, order 0 ([`OrderZeroFn`], `fn(series: *mut f64, parameters:
 //! *const f64)`): the extended tape of `M` and `F` (`TaylorPlan::order_zero`), instruction
@@ -67,7 +67,7 @@ use eomgen_symbolic::codegen::taylor::TaylorPlan;
 use eomgen_symbolic::expr::Func;
 
 use crate::native::{
-    CompileError, Imports, ModuleMemory, OptLevel, declare_imports, enter, failure, new_module,
+    CompileError, Imports, ModuleMemory, declare_imports, enter, failure, new_module,
 };
 
 /// One compiled order `k`: see the module documentation for the arguments.
@@ -178,7 +178,7 @@ pub(crate) fn compile_orders(
             &"the tape has too many instructions for 32-bit offsets",
         ));
     }
-    let mut module = new_module(OptLevel::None)?;
+    let mut module = new_module()?;
     let imports = declare_imports(&mut module)?;
     let call_conv = module.isa().default_call_conv();
     let pointer = module.target_config().pointer_type();
