@@ -536,10 +536,13 @@ fn failed_integrations_explain_themselves_and_keep_their_samples() {
 
 /// `eomgen check` (which derives the file at run time) and `eomgen simulate` (which compiles
 /// it at run time) on every broken file of the compile-fail suite
-/// (`compile-fail/tests/ui/<category>/`) print the same diagnostics as the compile error: each `error: FILE:line:col: message`
-/// headline of the recorded `.stderr` appears in the output for that file (the path prefix
-/// differs: the macro names the file as written in `model!`), the exit status is 2, and with
-/// `--json` standard output is the JSON object of the diagnostics, one entry per headline.
+/// (`compile-fail/tests/ui/<category>/`) print the diagnostics recorded in its `.stderr`
+/// (for the few with a `.rs`, the compile error of `model!`, which trybuild checks; for the
+/// others the loader's diagnostics alone): each diagnostic's `error: FILE:line:col: message`
+/// headline appears in the output for that file (the path prefix differs: the macro names the
+/// file as written in `model!`), followed by the same source excerpt, caret and `help:` lines
+/// (the indentation differs), the exit status is 2, and with `--json` standard output is the
+/// JSON object of the diagnostics, one entry per headline.
 #[test]
 fn check_and_simulate_print_the_compile_errors_of_every_ui_case() {
     let root = concat!(env!("CARGO_MANIFEST_DIR"), "/compile-fail/tests/ui");
@@ -556,20 +559,28 @@ fn check_and_simulate_print_the_compile_errors_of_every_ui_case() {
         files.sort();
         for yaml in files {
             let expected = std::fs::read_to_string(yaml.with_extension("stderr")).unwrap();
-            let headlines: Vec<&str> = expected
-                .lines()
-                .filter(|l| l.starts_with("error: "))
-                .filter_map(|l| l.split_once(".yaml:").map(|(_, rest)| rest))
-                .collect();
+            let blocks = diagnostic_blocks(&expected);
+            let headlines: Vec<&str> = blocks.iter().map(|(headline, _)| *headline).collect();
+            assert!(
+                !headlines.is_empty(),
+                "{}: no diagnostic recorded",
+                yaml.display()
+            );
             let path = yaml.to_str().unwrap();
             for command in ["check", "simulate"] {
                 let out = eomgen(&[command, path]);
                 assert_eq!(out.status.code(), Some(2), "{command} {}", yaml.display());
                 let got = String::from_utf8_lossy(&out.stderr);
-                for rest in &headlines {
+                let lines: Vec<&str> = got.lines().map(str::trim).collect();
+                for (rest, body) in &blocks {
+                    let headline = format!(".yaml:{rest}");
+                    let found = lines.iter().enumerate().any(|(i, line)| {
+                        line.ends_with(&headline)
+                            && lines.get(i + 1..i + 1 + body.len()) == Some(&body[..])
+                    });
                     assert!(
-                        got.contains(&format!(".yaml:{rest}")),
-                        "{}: `{command}` does not print `{rest}`:\n{got}",
+                        found,
+                        "{}: `{command}` does not print `{rest}` followed by {body:?}:\n{got}",
                         yaml.display()
                     );
                 }
@@ -597,6 +608,28 @@ fn check_and_simulate_print_the_compile_errors_of_every_ui_case() {
         }
     }
     assert!(checked >= 28, "only {checked} ui cases");
+}
+
+/// The diagnostics of a recorded `.stderr`: each `error: FILE.yaml:line:col: message`
+/// headline (from `line:`) with the lines that follow it up to the next diagnostic, rustc's
+/// location of the `model!` call (`-->`) or a blank line, trimmed.
+fn diagnostic_blocks(stderr: &str) -> Vec<(&str, Vec<&str>)> {
+    let mut blocks: Vec<(&str, Vec<&str>)> = Vec::new();
+    let mut open = false;
+    for line in stderr.lines() {
+        if let Some(rest) = line
+            .strip_prefix("error: ")
+            .and_then(|l| l.split_once(".yaml:").map(|(_, rest)| rest))
+        {
+            blocks.push((rest, Vec::new()));
+            open = true;
+        } else if line.trim().is_empty() || line.starts_with(" --> ") {
+            open = false;
+        } else if open && let Some((_, body)) = blocks.last_mut() {
+            body.push(line.trim());
+        }
+    }
+    blocks
 }
 
 /// Files are written to a temporary file beside them and renamed into place: after a run the

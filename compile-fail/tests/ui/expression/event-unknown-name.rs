@@ -1,3 +1,0 @@
-eomgen::model!("event-unknown-name.yaml");
-
-fn main() {}

@@ -1,3 +1,0 @@
-eomgen::model!("rate-of-a-parameter.yaml");
-
-fn main() {}

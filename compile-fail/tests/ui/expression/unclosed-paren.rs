@@ -1,3 +1,0 @@
-eomgen::model!("unclosed-paren.yaml");
-
-fn main() {}

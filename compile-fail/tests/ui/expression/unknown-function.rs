@@ -1,3 +1,0 @@
-eomgen::model!("unknown-function.yaml");
-
-fn main() {}

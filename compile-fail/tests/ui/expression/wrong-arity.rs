@@ -1,3 +1,0 @@
-eomgen::model!("wrong-arity.yaml");
-
-fn main() {}

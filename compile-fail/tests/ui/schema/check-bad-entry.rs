@@ -1,3 +1,0 @@
-eomgen::model!("check-bad-entry.yaml");
-
-fn main() {}

@@ -1,3 +1,0 @@
-eomgen::model!("coordinates-not-a-list.yaml");
-
-fn main() {}

@@ -1,3 +1,0 @@
-eomgen::model!("event-direction.yaml");
-
-fn main() {}

@@ -1,3 +1,0 @@
-eomgen::model!("not-supported-yet.yaml");
-
-fn main() {}

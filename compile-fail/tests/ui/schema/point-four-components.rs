@@ -1,3 +1,0 @@
-eomgen::model!("point-four-components.yaml");
-
-fn main() {}

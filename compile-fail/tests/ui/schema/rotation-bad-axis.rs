@@ -1,3 +1,0 @@
-eomgen::model!("rotation-bad-axis.yaml");
-
-fn main() {}

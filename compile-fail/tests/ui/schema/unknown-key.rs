@@ -1,3 +1,0 @@
-eomgen::model!("unknown-key.yaml");
-
-fn main() {}

@@ -1,3 +1,0 @@
-eomgen::model!("constant-overflow.yaml");
-
-fn main() {}

@@ -1,3 +1,0 @@
-eomgen::model!("constant-power-overflow.yaml");
-
-fn main() {}

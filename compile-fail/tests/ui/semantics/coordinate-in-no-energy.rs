@@ -1,3 +1,0 @@
-eomgen::model!("coordinate-in-no-energy.yaml");
-
-fn main() {}

@@ -1,3 +1,0 @@
-eomgen::model!("duplicate-name.yaml");
-
-fn main() {}

@@ -1,3 +1,0 @@
-eomgen::model!("hand-equation-not-linear.yaml");
-
-fn main() {}

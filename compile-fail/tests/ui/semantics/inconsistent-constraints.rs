@@ -1,3 +1,0 @@
-eomgen::model!("inconsistent-constraints.yaml");
-
-fn main() {}

@@ -1,3 +1,0 @@
-eomgen::model!("inertia-not-positive-definite.yaml");
-
-fn main() {}

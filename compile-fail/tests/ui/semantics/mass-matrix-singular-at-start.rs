@@ -1,3 +1,0 @@
-eomgen::model!("mass-matrix-singular-at-start.yaml");
-
-fn main() {}

@@ -1,3 +1,0 @@
-eomgen::model!("mass-matrix-singular-everywhere.yaml");
-
-fn main() {}

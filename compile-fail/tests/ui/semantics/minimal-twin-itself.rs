@@ -1,3 +1,0 @@
-eomgen::model!("minimal-twin-itself.yaml");
-
-fn main() {}

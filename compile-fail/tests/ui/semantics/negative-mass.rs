@@ -1,3 +1,0 @@
-eomgen::model!("negative-mass.yaml");
-
-fn main() {}

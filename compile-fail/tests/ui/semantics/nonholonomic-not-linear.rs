@@ -1,3 +1,0 @@
-eomgen::model!("nonholonomic-not-linear.yaml");
-
-fn main() {}

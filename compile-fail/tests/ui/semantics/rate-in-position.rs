@@ -1,3 +1,0 @@
-eomgen::model!("rate-in-position.yaml");
-
-fn main() {}

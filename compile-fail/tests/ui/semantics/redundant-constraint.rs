@@ -1,3 +1,0 @@
-eomgen::model!("redundant-constraint.yaml");
-
-fn main() {}

@@ -1,3 +1,0 @@
-eomgen::model!("rigid-body-in-3d.yaml");
-
-fn main() {}

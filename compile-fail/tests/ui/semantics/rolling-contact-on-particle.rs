@@ -1,3 +1,0 @@
-eomgen::model!("rolling-contact-on-particle.yaml");
-
-fn main() {}

@@ -1,3 +1,0 @@
-eomgen::model!("several-errors.yaml");
-
-fn main() {}

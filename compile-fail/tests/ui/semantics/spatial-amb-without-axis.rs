@@ -1,3 +1,0 @@
-eomgen::model!("spatial-amb-without-axis.yaml");
-
-fn main() {}

@@ -1,3 +1,0 @@
-eomgen::model!("spatial-torque-on-planar-body.yaml");
-
-fn main() {}

@@ -1,3 +1,0 @@
-eomgen::model!("too-many-constraints.yaml");
-
-fn main() {}

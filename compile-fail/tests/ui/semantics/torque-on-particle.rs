@@ -1,3 +1,0 @@
-eomgen::model!("torque-on-particle.yaml");
-
-fn main() {}

@@ -1,3 +1,0 @@
-eomgen::model!("unknown-frame.yaml");
-
-fn main() {}

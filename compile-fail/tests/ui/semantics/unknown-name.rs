@@ -1,3 +1,0 @@
-eomgen::model!("unknown-name.yaml");
-
-fn main() {}

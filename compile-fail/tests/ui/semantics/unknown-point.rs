@@ -1,3 +1,0 @@
-eomgen::model!("unknown-point.yaml");
-
-fn main() {}

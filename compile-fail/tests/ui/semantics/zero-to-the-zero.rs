@@ -1,3 +1,0 @@
-eomgen::model!("zero-to-the-zero.yaml");
-
-fn main() {}

@@ -1,3 +1,0 @@
-eomgen::model!("generalized-force-of-an-angle.yaml");
-
-fn main() {}

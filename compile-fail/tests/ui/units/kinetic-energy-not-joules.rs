@@ -1,3 +1,0 @@
-eomgen::model!("kinetic-energy-not-joules.yaml");
-
-fn main() {}

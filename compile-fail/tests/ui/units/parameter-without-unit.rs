@@ -1,3 +1,0 @@
-eomgen::model!("parameter-without-unit.yaml");
-
-fn main() {}

@@ -1,3 +1,0 @@
-eomgen::model!("spring-stiffness-in-newtons.yaml");
-
-fn main() {}

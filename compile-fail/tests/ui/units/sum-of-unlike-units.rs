@@ -1,3 +1,0 @@
-eomgen::model!("sum-of-unlike-units.yaml");
-
-fn main() {}

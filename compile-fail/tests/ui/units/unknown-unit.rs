@@ -1,3 +1,0 @@
-eomgen::model!("unknown-unit.yaml");
-
-fn main() {}

@@ -1,3 +1,0 @@
-eomgen::model!("duplicate-key.yaml");
-
-fn main() {}
