@@ -566,3 +566,109 @@ fn turntable_conserves_angular_momentum() {
         assert!((h(y) - h0).abs() < 1e-10, "t={t}: H {} vs {h0}", h(y));
     }
 }
+
+/// A spring of rest length 0 pulls with `−k·d`, smooth where its ends meet: a mass on such a
+/// spring to a fixed point, at that point and away from it, has `q̈ = −(k/m) q` (to 1e-15
+/// relative: one division and one product), its equations finite at rest, and the same bits
+/// whether the file writes `rest_length: 0`, a rest length that is 0 as written (`0*k`), or
+/// none. (A rest length that is a parameter of value 0 still gives `0/0` where the ends meet:
+/// the force `−k(1 − ℓ₀/|d|) d` is compiled for any `ℓ₀`.)
+#[test]
+fn a_zero_rest_length_spring_is_smooth_where_its_ends_meet() {
+    use eomgen::{DynFirstOrder, JitModel, OdeSystem};
+    let (m, k) = (2.0, 5.0);
+    let states = [
+        [0.0, 0.0, 0.0, 0.0],
+        [0.3, -0.2, 0.1, 0.4],
+        [1e-9, 0.0, 0.0, 0.0],
+    ];
+    let mut by_rest: Vec<Vec<u64>> = Vec::new();
+    for rest in ["", ", rest_length: 0", ", rest_length: 0*k"] {
+        let text = format!(
+            "name: zero_rest_length\nparameters: {{ m: {m}, k: {k} }}\ncoordinates: [x, y]\n\
+             points:\n  O: [0, 0]\n  P: [x, y]\nbodies:\n  mass: {{ mass: m, at: P }}\n\
+             springs:\n  s: {{ between: [P, O], stiffness: k{rest} }}\n"
+        );
+        let model =
+            JitModel::from_source("zero.yaml", &text).unwrap_or_else(|e| panic!("{e}\n{text}"));
+        let mut system = DynFirstOrder::new(model);
+        let mut bits = Vec::new();
+        for y in states {
+            let mut dy = [f64::NAN; 4];
+            system
+                .rhs(0.0, &y, &mut dy)
+                .unwrap_or_else(|e| panic!("{rest:?} at {y:?}: {e}"));
+            for i in 0..2 {
+                let expected = -k / m * y[i];
+                assert!(
+                    (dy[2 + i] - expected).abs() <= 1e-15 * expected.abs(),
+                    "{rest:?} at {y:?}: q̈{i} = {} against {expected}",
+                    dy[2 + i]
+                );
+            }
+            bits.extend(dy.map(f64::to_bits));
+        }
+        by_rest.push(bits);
+    }
+    assert_eq!(by_rest[1], by_rest[0], "`rest_length: 0` differs from none");
+    assert_eq!(
+        by_rest[2], by_rest[0],
+        "`rest_length: 0*k` differs from none"
+    );
+}
+
+/// The sign conventions the Whipple bicycle's file states in its comments: axes with `x` ahead
+/// at zero yaw, `y` to the left and `z` up; a positive lean tilts the frame to the right (the
+/// rear hub, at height `rR`, moves to `y = −rR sin(lean)`, to 1e-12 m: one sine and one
+/// product), and a positive steer turns the front wheel to the left (its hub, ahead of the
+/// steer axis by the fork offset, moves to `+y`).
+#[test]
+fn the_whipple_bicycles_stated_sign_conventions_hold() {
+    let model = model("whipple_bicycle");
+    let description = model.description();
+    let names: Vec<&str> = description.points.iter().map(|p| &**p).collect();
+    let index = |name: &str| {
+        names
+            .iter()
+            .position(|p| *p == name)
+            .unwrap_or_else(|| panic!("point {name} in {names:?}"))
+    };
+    let coordinate = |name: &str| {
+        description
+            .coordinates
+            .iter()
+            .position(|c| &**c == name)
+            .unwrap_or_else(|| panic!("coordinate {name}"))
+    };
+    let rr = model.parameter_values()[description
+        .parameter_index("rR")
+        .expect("the rear wheel's radius")];
+    let n = description.coordinates.len();
+    let at = |name: &str, value: f64| {
+        let mut y = vec![0.0; 2 * n];
+        y[coordinate(name)] = value;
+        model.point_positions(0.0, &y)
+    };
+    let upright = at("lean", 0.0);
+    let leaning = at("lean", 0.1);
+    let hub = index("RH");
+    assert!(
+        upright[hub][1].abs() < 1e-15,
+        "the rear hub upright: {:?}",
+        upright[hub]
+    );
+    let expected = -rr * 0.1f64.sin();
+    assert!(
+        (leaning[hub][1] - expected).abs() < 1e-12,
+        "lean = 0.1 puts the rear hub at y = {}, not {expected} (to the right)",
+        leaning[hub][1]
+    );
+    let steered = at("steer", 0.1);
+    let front = index("FH");
+    assert!(
+        steered[front][1] > upright[front][1] + 1e-3,
+        "steer = 0.1 moves the front hub from y = {} to {}, not to the left",
+        upright[front][1],
+        steered[front][1]
+    );
+}
