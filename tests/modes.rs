@@ -1066,3 +1066,36 @@ fn modes_cli_gives_the_gyroscopic_verdict() {
     assert_eq!(s["gyroscopic_part"][1][0], 10.0, "{s}");
     assert_eq!(s["eigenvalues"].as_array().unwrap().len(), 4, "{s}");
 }
+
+/// A guess that is the equilibrium to rounding is accepted: a weight hung on two inclined
+/// springs whose rest lengths put it in balance at `x = z = 0`, where the residual is 8.5e-14
+/// N against the 118 N weight that the springs balance, and Newton cannot reduce it further.
+/// From the exact guess and from a guess 1 mm off, the same point (to 1e-12 m) with residuals
+/// at rounding (below 1e-12 N).
+#[test]
+fn a_guess_that_is_the_equilibrium_to_rounding_is_accepted() {
+    use eomgen::JitModel;
+    use eomgen::find_equilibrium;
+    let text = "name: block\nparameters: { m: 12, g: 9.81, k: 4000, a: 0.3, h: 0.4 }\n\
+                coordinates: [x, z]\npoints:\n  P: [x, z]\n  A: [-a, h]\n  B: [a, h]\n\
+                bodies:\n  block: { mass: m, at: P }\ngravity: [0, -g]\nsprings:\n  \
+                left: { between: [P, A], stiffness: k, rest_length: sqrt(a^2 + h^2) - m*g*sqrt(a^2 + h^2)/(2*k*h) }\n  \
+                right: { between: [P, B], stiffness: k, rest_length: sqrt(a^2 + h^2) - m*g*sqrt(a^2 + h^2)/(2*k*h) }\n";
+    let model = eomgen::DynFirstOrder::new(
+        JitModel::from_source("block.yaml", text).unwrap_or_else(|e| panic!("{e}")),
+    );
+    for guess in [[0.0, 0.0], [0.0, 1e-3]] {
+        let found =
+            find_equilibrium(&model, &guess, 0.0).unwrap_or_else(|e| panic!("from {guess:?}: {e}"));
+        assert!(
+            found.q.iter().all(|v| v.abs() < 1e-12),
+            "from {guess:?}: {:?}",
+            found.q
+        );
+        assert!(
+            found.residual < 1e-12,
+            "from {guess:?}: |F| = {}",
+            found.residual
+        );
+    }
+}

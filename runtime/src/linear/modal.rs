@@ -280,7 +280,9 @@ pub struct Equilibrium {
 /// does not decrease (at most 30 halvings). Converged when the largest residual is at most
 /// `1e-12 r₀`, with `r₀` the larger of the largest residual at the guess and the size of its
 /// terms there, `max_i Σ_j |J_ij x_j|` (the model's force scale, whatever its units), or when every step component is below `1e-14 |xᵢ|` (or no step decreases the
-/// residual) with the residual down to `1e-8 r₀`; a degenerate root (`F = −k x³`), where
+/// residual) with the residual down to `1e-8 r₀`, or when no step decreases a residual below
+/// `1e-12 max_i Σ_j |J_ij|` (an exact guess, where the residual and the coordinates are both
+/// near 0 and the loads that cancel there show in neither); a degenerate root (`F = −k x³`), where
 /// Newton converges only linearly, is followed while the steps shrink (up to 100 iterations).
 /// A small residual is refused as [`ModalError::EquilibriumAtInfinity`] when `max |qᵢ|` grew
 /// to more than 10 times the guess's and the next Newton step is above `1e-3 max |qᵢ|`:
@@ -409,6 +411,16 @@ const RECEDING_GROWTH: f64 = 10.0;
 /// (forces of 1e-12 N·m) converges as well as a heavy one.
 const RESIDUAL_REDUCTION: f64 = 1e-12;
 
+/// `max_i Σ_j |J_ij|`: the force a stiffness of `J` gives at one unit (m or rad) of each
+/// coordinate, in the units of `F`; 0 if not finite.
+fn unit_terms(jac: &DMatrix<f64>) -> f64 {
+    let t = jac
+        .row_iter()
+        .map(|row| row.iter().map(|v| v.abs()).sum::<f64>())
+        .fold(0.0f64, f64::max);
+    if t.is_finite() { t } else { 0.0 }
+}
+
 /// The minimum-norm Newton step `−J⁺F` (singular values below `1e-12 σ_max` dropped); zero
 /// when `J` is zero, not finite or the solve fails.
 fn newton_step(jac: &DMatrix<f64>, f: &DVector<f64>) -> DVector<f64> {
@@ -506,8 +518,11 @@ fn newton(
         }
         if !accepted {
             // No decrease along the Newton direction: converged as far as rounding allows,
-            // or stuck.
-            if stalled(r, floor) {
+            // or stuck. At an exact guess the residual and the coordinates are both near 0,
+            // and the loads that cancel there (a weight on its springs) show in neither, so
+            // the residual is also held against a stiffness times one unit of each
+            // coordinate (m or rad).
+            if stalled(r, floor) || converged(r, unit_terms(&jac)) {
                 return Ok((x, iteration + 1, r));
             }
             return Err((iteration + 1, r, NewtonStop::NoDecrease));
