@@ -7,6 +7,7 @@ use rustc_hash::FxHashMap;
 use super::constraints::{ConstraintEquations, linear_in_rates, redundant_rows};
 use super::frames::{Frames, Vector3};
 use crate::expr::{Constant, ExprArena, ExprId, Func, SymbolId, SymbolKind};
+use crate::model::rules::short;
 use crate::model::{
     BinOp, BodyKind, Diagnostic, Expr, ExprKind, FloquetReference, GROUND_FRAME, ModelFile,
     TorqueValue,
@@ -2165,16 +2166,6 @@ struct Terms {
     forces: Vec<Vec<ExprId>>,
     /// The constant ½.
     half: ExprId,
-}
-
-/// A residual in a diagnostic: 6 significant digits, as `1`, `-0.5` or `1.2e-7`.
-fn short(v: f64) -> String {
-    if v != 0.0 && (v.abs() < 1e-3 || v.abs() >= 1e6) {
-        format!("{v:.5e}")
-    } else {
-        let s = format!("{v:.6}");
-        s.trim_end_matches('0').trim_end_matches('.').to_string()
-    }
 }
 
 /// The sets of the file's `balances:` with their ranges in the lowered list: each set's

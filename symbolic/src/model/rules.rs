@@ -1777,8 +1777,9 @@ impl Checker<'_> {
     }
 
     /// Reports a 3-D inertia tensor that is not positive definite at the parameters'
-    /// defaults (Sylvester's criterion on its leading minors). (Symmetric it is by
-    /// construction: each off-diagonal entry is written once.)
+    /// defaults (Sylvester's criterion on its leading minors), or whose principal moments
+    /// break the triangle inequality `I₃ ≤ I₁ + I₂`, which every mass distribution satisfies.
+    /// (Symmetric it is by construction: each off-diagonal entry is written once.)
     fn inertia_tensor(&mut self, body: &str, inertia: &InertiaTensor) {
         let parameters = &self.file.parameters;
         let mut e = [0.0; 6];
@@ -1814,13 +1815,89 @@ impl Checker<'_> {
                 )
                 .with_help("a rigid body's inertia tensor about its centre of mass is positive definite (its three principal moments are positive); a moment ≤ 0, or an off-diagonal entry as large as the moments it joins, is not"),
             );
+            return;
+        }
+        // The triangle inequality of the principal moments: `I₃ = ∫(x² + y²) dm ≤ ∫(y² + z²) dm
+        // + ∫(x² + z²) dm = I₁ + I₂` in principal axes (equal for a flat body), beyond the
+        // eigenvalues' rounding (`1e-9` of the largest).
+        let [a, b, c] = principal_moments([xx, yy, zz, xy, yz, xz]);
+        if c - (a + b) > 1e-9 * c {
+            self.error(
+                Diagnostic::new(
+                    inertia.location,
+                    format!(
+                        "the inertia of body `{body}` is not a rigid body's: its principal moments {}, {} and {} kg·m² break the triangle inequality I₃ ≤ I₁ + I₂ at the parameters' defaults",
+                        short(a),
+                        short(b),
+                        short(c)
+                    ),
+                )
+                .with_help("no mass distribution has one principal moment larger than the sum of the other two (I_zz = ∫(x² + y²) dm ≤ ∫(y² + z²) dm + ∫(x² + z²) dm; equal for a flat body); check the moments and their axes"),
+            );
         }
     }
+}
+
+/// A number in a diagnostic: 6 significant digits, as `1`, `-0.5` or `1.2e-7`.
+pub(crate) fn short(v: f64) -> String {
+    if v != 0.0 && (v.abs() < 1e-3 || v.abs() >= 1e6) {
+        format!("{v:.5e}")
+    } else {
+        let s = format!("{v:.6}");
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    }
+}
+
+/// The eigenvalues of the symmetric 3 × 3 tensor `[xx, yy, zz, xy, yz, xz]`, ascending, by
+/// the trigonometric solution of its characteristic cubic (Smith, *Eigenvalues of a symmetric
+/// 3 × 3 matrix*, Commun. ACM 4(4), 1961), accurate to rounding of the largest.
+fn principal_moments([xx, yy, zz, xy, yz, xz]: [f64; 6]) -> [f64; 3] {
+    let off = xy * xy + yz * yz + xz * xz;
+    let mut e = if off == 0.0 {
+        [xx, yy, zz]
+    } else {
+        let q = (xx + yy + zz) / 3.0;
+        let p = ((xx - q).powi(2) + (yy - q).powi(2) + (zz - q).powi(2) + 2.0 * off) / 6.0;
+        let p = p.sqrt();
+        // B = (A − qI)/p; det B / 2 = cos 3φ.
+        let (bxx, byy, bzz) = ((xx - q) / p, (yy - q) / p, (zz - q) / p);
+        let (bxy, byz, bxz) = (xy / p, yz / p, xz / p);
+        let det = bxx * (byy * bzz - byz * byz) - bxy * (bxy * bzz - byz * bxz)
+            + bxz * (bxy * byz - byy * bxz);
+        let phi = (det / 2.0).clamp(-1.0, 1.0).acos() / 3.0;
+        let largest = q + 2.0 * p * phi.cos();
+        let smallest = q + 2.0 * p * (phi + 2.0 * std::f64::consts::PI / 3.0).cos();
+        [smallest, 3.0 * q - largest - smallest, largest]
+    };
+    e.sort_by(f64::total_cmp);
+    e
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The principal moments against diagonal tensors and a rotated one: `diag(1, 2, 3)`
+    /// rotated by 30° about `z` (`xx = 1.25`, `yy = 1.75`, `xy = 0.25·√3 · (−1)`) keeps its
+    /// eigenvalues 1, 2, 3 to 1e-14.
+    #[test]
+    fn principal_moments_are_the_eigenvalues() {
+        assert_eq!(
+            principal_moments([3.0, 1.0, 2.0, 0.0, 0.0, 0.0]),
+            [1.0, 2.0, 3.0]
+        );
+        let (c, s) = (30f64.to_radians().cos(), 30f64.to_radians().sin());
+        let (xx, yy, xy) = (
+            c * c + 2.0 * s * s,
+            s * s + 2.0 * c * c,
+            (1.0 - 2.0) * c * s,
+        );
+        let e = principal_moments([xx, yy, 3.0, xy, 0.0, 0.0]);
+        for (got, want) in e.iter().zip([1.0, 2.0, 3.0]) {
+            assert!((got - want).abs() < 1e-14, "{e:?}");
+        }
+    }
+
     use crate::model::{schema, yaml};
 
     fn errors(src: &str) -> Vec<String> {
@@ -1914,5 +1991,45 @@ mod tests {
                 "7:26: body `b` has negative inertia `-2.0` (kg·m²)",
             ]
         );
+    }
+
+    /// A 3-D inertia whose largest principal moment exceeds the sum of the others is refused,
+    /// also when products of inertia hide it (`diag(1, 1, 3)` rotated by 30° about `x`); a
+    /// flat body's (`I₃ = I₁ + I₂`, here `diag(1, 2, 3)` rotated) and an ordinary one pass.
+    #[test]
+    fn an_inertia_breaking_the_triangle_inequality_is_refused() {
+        let body = |inertia: &str| {
+            format!(
+                "name: t\nparameters: {{ m: 1.0 }}\ncoordinates: [psi]\nframes:\n  B: {{ parent: N, axis: z, angle: psi }}\npoints:\n  G: [0, 0, 0]\nbodies:\n  disc: {{ mass: m, com: G, frame: B, inertia: {inertia} }}\n"
+            )
+        };
+        let (c, s) = (30f64.to_radians().cos(), 30f64.to_radians().sin());
+        // diag(1, 1, 3) rotated about x: yy = c²·1 + s²·3, zz = s²·1 + c²·3, yz = (3 − 1)cs.
+        let hidden = format!(
+            "{{ xx: 1, yy: {}, zz: {}, yz: {} }}",
+            c * c + 3.0 * s * s,
+            s * s + 3.0 * c * c,
+            2.0 * c * s
+        );
+        for inertia in ["{ xx: 1, yy: 1, zz: 3 }", hidden.as_str()] {
+            let found = errors(&body(inertia));
+            assert!(
+                found.len() == 1 && found[0].contains("triangle inequality I₃ ≤ I₁ + I₂"),
+                "{inertia}: {found:?}"
+            );
+        }
+        let flat = format!(
+            "{{ xx: 1, yy: {}, zz: {}, yz: {} }}",
+            2.0 * c * c + 3.0 * s * s,
+            2.0 * s * s + 3.0 * c * c,
+            c * s
+        );
+        for inertia in [
+            "{ xx: 1, yy: 2, zz: 3 }",
+            "{ xx: 2, yy: 2, zz: 3 }",
+            flat.as_str(),
+        ] {
+            assert_eq!(errors(&body(inertia)), Vec::<String>::new(), "{inertia}");
+        }
     }
 }
