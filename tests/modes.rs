@@ -1071,7 +1071,9 @@ fn modes_cli_gives_the_gyroscopic_verdict() {
 /// springs whose rest lengths put it in balance at `x = z = 0`, where the residual is 8.5e-14
 /// N against the 118 N weight that the springs balance, and Newton cannot reduce it further.
 /// From the exact guess and from a guess 1 mm off, the same point (to 1e-12 m) with residuals
-/// at rounding (below 1e-12 N).
+/// at rounding (below 1e-12 N). A residual no step reduces but that is not rounding is still
+/// refused: a cart pushed by a constant 1e-4 N beside a 1e9 N/m spring (the push's row of
+/// `∂F/∂q` is zero, so the stiffness of the other row must not excuse it).
 #[test]
 fn a_guess_that_is_the_equilibrium_to_rounding_is_accepted() {
     use eomgen::JitModel;
@@ -1098,4 +1100,13 @@ fn a_guess_that_is_the_equilibrium_to_rounding_is_accepted() {
             found.residual
         );
     }
+    let pushed = "name: pushed\nparameters: { m: 1, k: 1e9, F: 1e-4 }\ncoordinates: [x, y]\n\
+                  points:\n  P: [x, 0]\n  Q: [0, y]\n  O: [0, 0]\nbodies:\n  cart: { mass: m, at: P }\n  \
+                  bob: { mass: m, at: Q }\nsprings:\n  s: { between: [Q, O], stiffness: k }\n\
+                  forces:\n  push: { at: P, vector: [F, 0] }\n";
+    let model = eomgen::DynFirstOrder::new(
+        JitModel::from_source("pushed.yaml", pushed).unwrap_or_else(|e| panic!("{e}")),
+    );
+    let result = find_equilibrium(&model, &[0.0, 0.0], 0.0);
+    assert!(result.is_err(), "a pushed cart at rest: {result:?}");
 }

@@ -280,9 +280,10 @@ pub struct Equilibrium {
 /// does not decrease (at most 30 halvings). Converged when the largest residual is at most
 /// `1e-12 r₀`, with `r₀` the larger of the largest residual at the guess and the size of its
 /// terms there, `max_i Σ_j |J_ij x_j|` (the model's force scale, whatever its units), or when every step component is below `1e-14 |xᵢ|` (or no step decreases the
-/// residual) with the residual down to `1e-8 r₀`, or when no step decreases a residual below
-/// `1e-12 max_i Σ_j |J_ij|` (an exact guess, where the residual and the coordinates are both
-/// near 0 and the loads that cancel there show in neither); a degenerate root (`F = −k x³`), where
+/// residual) with the residual down to `1e-8 r₀`, or when no step decreases the residual and
+/// it is at rounding row by row — the Newton step would cancel it (`|F + J δ| ≤ 1e-6 |F|`)
+/// and each `|F_i| ≤ 1e-12 Σ_j |J_ij|` (an exact guess, where the residual and the coordinates
+/// are both near 0 and the loads that cancel there show in neither); a degenerate root (`F = −k x³`), where
 /// Newton converges only linearly, is followed while the steps shrink (up to 100 iterations).
 /// A small residual is refused as [`ModalError::EquilibriumAtInfinity`] when `max |qᵢ|` grew
 /// to more than 10 times the guess's and the next Newton step is above `1e-3 max |qᵢ|`:
@@ -411,14 +412,19 @@ const RECEDING_GROWTH: f64 = 10.0;
 /// (forces of 1e-12 N·m) converges as well as a heavy one.
 const RESIDUAL_REDUCTION: f64 = 1e-12;
 
-/// `max_i Σ_j |J_ij|`: the force a stiffness of `J` gives at one unit (m or rad) of each
-/// coordinate, in the units of `F`; 0 if not finite.
-fn unit_terms(jac: &DMatrix<f64>) -> f64 {
-    let t = jac
-        .row_iter()
-        .map(|row| row.iter().map(|v| v.abs()).sum::<f64>())
-        .fold(0.0f64, f64::max);
-    if t.is_finite() { t } else { 0.0 }
+/// `Σ_j |J_ij| w_j` for each row `i` of `J` (0 where not finite): with `w = |x|`, the size
+/// of the terms of `F` near `x` (a stiffness times a coordinate, in the units of that row of
+/// `F`); with `w = 1`, the force a row's stiffness gives at one unit (m or rad) of each
+/// coordinate.
+fn row_sums(jac: &DMatrix<f64>, weight: impl Fn(usize) -> f64) -> Vec<f64> {
+    (0..jac.nrows())
+        .map(|i| {
+            let t: f64 = (0..jac.ncols())
+                .map(|j| (jac[(i, j)] * weight(j)).abs())
+                .sum();
+            if t.is_finite() { t } else { 0.0 }
+        })
+        .collect()
 }
 
 /// The minimum-norm Newton step `−J⁺F` (singular values below `1e-12 σ_max` dropped); zero
@@ -454,14 +460,7 @@ fn newton(
     // The size of the terms of F near x, `max_i Σ_j |J_ij x_j|` (a stiffness times a
     // coordinate: units of F), which sets its rounding where F itself is near 0.
     let terms = |jac: &DMatrix<f64>, x: &[f64]| -> f64 {
-        let t = (0..jac.nrows())
-            .map(|i| {
-                (0..jac.ncols())
-                    .map(|j| (jac[(i, j)] * x[j]).abs())
-                    .sum::<f64>()
-            })
-            .fold(0.0f64, f64::max);
-        if t.is_finite() { t } else { 0.0 }
+        row_sums(jac, |j| x[j]).into_iter().fold(0.0f64, f64::max)
     };
     // The force scale of the model at the guess, in its own units; a guess that is an exact
     // root is returned.
@@ -519,10 +518,18 @@ fn newton(
         if !accepted {
             // No decrease along the Newton direction: converged as far as rounding allows,
             // or stuck. At an exact guess the residual and the coordinates are both near 0,
-            // and the loads that cancel there (a weight on its springs) show in neither, so
-            // the residual is also held against a stiffness times one unit of each
-            // coordinate (m or rad).
-            if stalled(r, floor) || converged(r, unit_terms(&jac)) {
+            // and the loads that cancel there (a weight on its springs) show in neither: then
+            // the guess is a root if the linear model says the step would cancel F (F lies
+            // in J's range, so only rounding stopped the decrease) and each row's residual
+            // is at rounding of that row's stiffness times one unit of each coordinate (a
+            // row J does not reach, a constant push on a free cart, is never so).
+            let predicted = &f + &jac * &step;
+            let at_rounding = predicted.amax() <= 1e-6 * r
+                && row_sums(&jac, |_| 1.0)
+                    .iter()
+                    .zip(f.iter())
+                    .all(|(unit, fi)| converged(fi.abs(), *unit));
+            if stalled(r, floor) || at_rounding {
                 return Ok((x, iteration + 1, r));
             }
             return Err((iteration + 1, r, NewtonStop::NoDecrease));

@@ -2191,24 +2191,6 @@ fn balance_sets(file: &ModelFile) -> Vec<BalanceSet> {
 mod tests {
     use super::*;
 
-    #[test]
-    fn residuals_print_with_six_significant_digits() {
-        for (v, s) in [
-            (0.0, "0"),
-            (1.0, "1"),
-            (-0.5, "-0.5"),
-            (0.001, "0.001"),
-            (0.000_999_9, "9.99900e-4"),
-            (1.2e-7, "1.20000e-7"),
-            (999_999.0, "999999"),
-            (1e6, "1.00000e6"),
-            (-2.5e6, "-2.50000e6"),
-            (1.0 / 3.0, "0.333333"),
-        ] {
-            assert_eq!(short(v), s, "{v}");
-        }
-    }
-
     /// `equilibria:` (coordinates, rates and ignorable coordinates) and `{ guess: … }` map to
     /// their coordinates by name, in any order.
     #[test]
