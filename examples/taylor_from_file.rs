@@ -9,8 +9,8 @@
 //! cargo run --release --example taylor_from_file -- double_pendulum 1e-9 200
 //! ```
 //!
-//! Arguments: a bundled model's name (`double_pendulum`, `figure_eight` or `heavy_top`, the
-//! three compiled into this example by `model!`), the tolerance (`rtol = atol`), the number of timed runs
+//! Arguments: a bundled model's name (`double_pendulum`, `figure_eight`, `heavy_top` or
+//! `two_body`, the four compiled into this example by `model!`), the tolerance (`rtol = atol`), the number of timed runs
 //! of each (default 100), alternated A B C A B C …, and optionally one variant alone (`model`,
 //! `file` or `kernels`, for a profiler); each run integrates the model's initial
 //! state over 0–10 s with every step recorded. Prints, per variant, the median time of a run
@@ -34,6 +34,9 @@ mod figure_eight {
 mod heavy_top {
     eomgen::model!("../models/heavy_top.yaml");
 }
+mod two_body {
+    eomgen::model!("../models/two_body.yaml");
+}
 
 /// The model `name` compiled into this example by `model!`.
 fn compiled(name: &str) -> Result<Box<dyn ModelInfo>, String> {
@@ -41,9 +44,10 @@ fn compiled(name: &str) -> Result<Box<dyn ModelInfo>, String> {
         "double_pendulum" => Box::new(FirstOrder::new(double_pendulum::DoublePendulum::default())),
         "figure_eight" => Box::new(FirstOrder::new(figure_eight::FigureEight::default())),
         "heavy_top" => Box::new(FirstOrder::new(heavy_top::HeavyTop::default())),
+        "two_body" => Box::new(FirstOrder::new(two_body::TwoBody::default())),
         _ => {
             return Err(format!(
-                "`{name}` is not compiled into this example: double_pendulum, figure_eight or heavy_top"
+                "`{name}` is not compiled into this example: double_pendulum, figure_eight, heavy_top or two_body"
             ));
         }
     })

@@ -1,6 +1,12 @@
 //! Taylor series of the motion: the recurrences of a model's [`TaylorProgram`] run order by
 //! order, and `M q̈ = F` solved as a series.
 //!
+//! long: the kernels of every op, their dispatch and the series of the motion share private
+//! helpers that must inline into the fused orders (`known`, `at`, `put`, the convolutions) and
+//! the two macros that keep their variants' bits equal (`with_host_features!`,
+//! `unrolled_orders!`); splitting them into submodules belongs with the code's shape (the
+//! element-per-module work), not with this file's features.
+//!
 //! With `x(t₀ + τ) = Σₖ x^[k] τᵏ` for every value of the model's program, the state
 //! `y = [q; q̇]` has `q^[k+1] = q̇^[k] / (k + 1)` and `q̇^[k+1] = a^[k] / (k + 1)`, where the
 //! accelerations `a = q̈` solve `M a = F` as series (the Cauchy product of `M(t) a(t) = F(t)`):

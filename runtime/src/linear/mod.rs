@@ -6,7 +6,8 @@
 //! - [`eigenvalues`]: the eigenvalues of the whole state matrix (damping and gyroscopic
 //!   terms), accurate on badly scaled models, the damped modes and the stability verdict
 //!   from them;
-//! - [`modal`]: equilibria, the exact linearisation `M δq̈ + C δq̇ + K δq = 0` and its state
+//! - [`equilibrium`]: equilibria by damped Newton;
+//! - [`modal`]: the exact linearisation `M δq̈ + C δq̇ + K δq = 0` and its state
 //!   matrix, undamped normal modes, the matrix exponential;
 //! - [`response`]: the free response of a linearisation computed several independent ways,
 //!   and damping models (modal, Rayleigh) against the exact damped modes;
@@ -22,8 +23,10 @@
 //! ([`crate::analysis::vibration`] for these).
 
 pub mod eigenvalues;
+pub mod equilibrium;
 pub mod frequency_response;
 pub mod modal;
 pub mod monodromy;
 pub mod response;
 pub mod steady;
+pub mod time_dependence;
