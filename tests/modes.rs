@@ -1110,3 +1110,35 @@ fn a_guess_that_is_the_equilibrium_to_rounding_is_accepted() {
     let result = find_equilibrium(&model, &[0.0, 0.0], 0.0);
     assert!(result.is_err(), "a pushed cart at rest: {result:?}");
 }
+
+/// Issue 49: where the equations are singular at the operating point itself (0/0), the error
+/// says so rather than that they depend on `t`. The dumbbell's rod and the Cartesian
+/// pendulum's rod at q = 0 (both ends at one point) have a Jacobian `d/|d|` that is 0/0, and a
+/// zero-rest-length spring whose length is a parameter of value 0 has a force
+/// `k (1 − ℓ₀/|d|) d` that is 0·∞ where its ends meet. Before, each was "the linearised
+/// equations depend on t … changes by inf between t = 0 s and t = 0 s".
+#[test]
+fn a_singularity_at_the_operating_point_is_not_called_a_time_dependence() {
+    for (name, n) in [("dumbbell", 4), ("simple_pendulum_cartesian", 2)] {
+        let m = model(name);
+        assert_eq!(m.num_dofs(), n, "{name}");
+        let err = eomgen::time_dependence(m.as_ref(), &vec![0.0; n], 0.0).unwrap_err();
+        assert!(matches!(err, ModalError::NonFinite { .. }), "{name}: {err}");
+    }
+    let text = "name: zero_rest\nparameters:\n  m: 1.0   # kg\n  k: 20.0  # N/m\n  r0: 0.0  # m\n\
+                coordinates: [x]\npoints:\n  O: [0, 0]\n  P: [x, 0]\n\
+                bodies:\n  mass: { mass: m, at: P }\n\
+                springs:\n  s: { between: [P, O], stiffness: k, rest_length: r0 }\n";
+    let m = eomgen::DynFirstOrder::new(
+        eomgen::JitModel::from_source("zero_rest.yaml", text).unwrap_or_else(|e| panic!("{e}")),
+    );
+    let err = eomgen::time_dependence(&m, &[0.0], 0.0).unwrap_err();
+    assert!(matches!(err, ModalError::NonFinite { .. }), "{err}");
+    let out = eomgen(&["modes", "dumbbell"]);
+    assert_eq!(out.status.code(), Some(1));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("not finite") && !stderr.contains("depend on t"),
+        "{stderr}"
+    );
+}

@@ -131,7 +131,7 @@ pub(super) fn modal_hint(model: &dyn ModelInfo, e: &eomgen::ModalError) -> Strin
             "a coordinate has no inertia at this configuration (the mass matrix loses rank there, e.g. an angle of a point at its pivot): choose another operating point, {start}"
         ),
         ModalError::NonFinite { .. } => format!(
-            "the model's forces or mass matrix are singular at this configuration (a division by zero, a root of a negative number): choose another operating point, {start}"
+            "the model's forces, mass matrix or constraints are singular at this configuration (a division by zero such as the direction between two points that coincide, a root of a negative number): choose another operating point, {start}"
         ),
         ModalError::NonHolonomic { .. } => format!(
             "its motion is computed by `eomgen simulate {name}`; the stability of its steady motions is not a normal-mode problem"

@@ -148,6 +148,8 @@ fn matrix_change(samples: &[DVector<f64>], n: usize) -> (f64, usize) {
 /// enters (a point moved with `t`, a constraint, a load).
 ///
 /// # Errors
+/// [`ModalError::NonFinite`] when a part is not finite at `t₀` itself (a singularity of the
+/// equations at `q`, which is not a change with `t`);
 /// [`ModalError::TimeDependent`] naming the first part found to change, in the order above
 /// (a rheonomic constraint such as a rod spun at a constant rate written with `t`, a
 /// parametrically excited stiffness such as a pendulum on a shaken pivot);
@@ -180,11 +182,28 @@ pub fn time_dependence(
             Ok(())
         }
     };
+    // A value that is not finite at `t₀` itself is a singularity of the equations at this
+    // configuration (a 0/0: the direction of a rod of zero length, a spring's ends that
+    // coincide), not a change with `t`.
+    let singular = || ModalError::NonFinite { q: q.to_vec() };
+    let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
     if m > 0 {
         let constraints: Vec<_> = times
             .iter()
             .map(|&t| model.constraint_equations(t, &y))
             .collect();
+        let at_t0 = &constraints[0];
+        if ![
+            at_t0.phi.as_slice(),
+            at_t0.velocity.as_slice(),
+            at_t0.gamma.as_slice(),
+            at_t0.jacobian.as_slice(),
+        ]
+        .into_iter()
+        .all(finite)
+        {
+            return Err(singular());
+        }
         for (i, name) in model
             .description()
             .constraint_names()
@@ -221,6 +240,12 @@ pub fn time_dependence(
         forcing.push(f_t);
         damping.push(flat(&jqd));
         stiffness.push(flat(&jq));
+    }
+    if ![&mass[0], &forcing[0], &damping[0], &stiffness[0]]
+        .into_iter()
+        .all(|v| finite(v.as_slice()))
+    {
+        return Err(singular());
     }
     refuse(TimeDependentPart::MassMatrix, matrix_change(&mass, n))?;
     refuse(TimeDependentPart::DampingMatrix, matrix_change(&damping, n))?;
