@@ -28,6 +28,10 @@
 //! multiple eigenvalue (rigid-body modes, repeated frequencies of a symmetric structure)
 //! keeps its Schur value. Real parts below [`ZERO_REAL_PART`] of `|s|` are then set to 0,
 //! which puts undamped and gyroscopic oscillations exactly on the imaginary axis.
+//!
+//! Before all this, the free coordinates (columns of `K` and `C` exactly zero: a cyclic
+//! coordinate at rest, a free body) are eliminated, and each gives a double zero
+//! eigenvalue exactly, from the structure rather than from a threshold on rounding.
 
 use nalgebra::{Complex, DMatrix};
 
@@ -208,6 +212,12 @@ pub fn state_eigenvalues(lin: &Linearization) -> Result<Vec<Complex<f64>>, Modal
     {
         return Err(not_finite());
     }
+    if let Some((reduced, free)) = without_free_coordinates(lin)? {
+        let mut out = state_eigenvalues(&reduced)?;
+        out.extend(std::iter::repeat_n(Complex::new(0.0, 0.0), 2 * free));
+        out.sort_by(|a, b| a.norm().total_cmp(&b.norm()).then(a.im.total_cmp(&b.im)));
+        return Ok(out);
+    }
     let chol = lin.mass_cholesky()?;
     let l = chol.l();
     let singular = || ModalError::SingularMassMatrix { q: lin.q.clone() };
@@ -282,6 +292,53 @@ pub fn state_eigenvalues(lin: &Linearization) -> Result<Vec<Complex<f64>>, Modal
         .collect();
     out.sort_by(|a, b| a.norm().total_cmp(&b.norm()).then(a.im.total_cmp(&b.im)));
     Ok(out)
+}
+
+/// The linearisation without its free coordinates, and how many there were; `None` when
+/// there are none, or when every coordinate is free (the caller's solve then gives the
+/// zeros).
+///
+/// A coordinate `j` is free at the operating point when its columns of `K` and `C` are
+/// exactly zero: a cyclic coordinate at rest (the plate angle of a chaos pendulum, the yaw
+/// of a body hanging on a ball joint), a free body's position. Then
+/// `P(λ) = λ²M + λC + K` has the column `λ² M eⱼ`, so `det P(λ) = λ²·det P̂(λ)`, where `P̂`
+/// has the column `M eⱼ` instead: a double zero eigenvalue, exactly. Eliminating the free
+/// coordinates `J` from `P̂` (a Schur complement on `M_JJ`, Routh's reduction at rest) leaves
+/// `λ² M̄ + λ C̄ + K̄` on the others `F`, with `X̄ = X_FF − M_FJ M_JJ⁻¹ X_JF` for `X = M, C, K`
+/// (`M̄` is positive definite as `M` is), whose eigenvalues are the others. Computed on the
+/// whole state matrix instead, a double zero of a coordinate coupled to the others through
+/// `M` is split by rounding into a real pair of size `√ε ‖A‖`, which a threshold then has to
+/// tell from a slow growth.
+///
+/// # Errors
+/// [`ModalError::SingularMassMatrix`] if `M_JJ` is not positive definite.
+fn without_free_coordinates(
+    lin: &Linearization,
+) -> Result<Option<(Linearization, usize)>, ModalError> {
+    let r = lin.mass_matrix.nrows();
+    let (k, c, m) = (&lin.stiffness_matrix, &lin.damping_matrix, &lin.mass_matrix);
+    let free: Vec<usize> = (0..r)
+        .filter(|&j| k.column(j).iter().all(|v| *v == 0.0) && c.column(j).iter().all(|v| *v == 0.0))
+        .collect();
+    if free.is_empty() || free.len() == r {
+        return Ok(None);
+    }
+    let kept: Vec<usize> = (0..r).filter(|j| !free.contains(j)).collect();
+    let block = |x: &DMatrix<f64>, rows: &[usize], columns: &[usize]| {
+        DMatrix::from_fn(rows.len(), columns.len(), |i, j| x[(rows[i], columns[j])])
+    };
+    let chol = block(m, &free, &free)
+        .cholesky()
+        .ok_or_else(|| ModalError::SingularMassMatrix { q: lin.q.clone() })?;
+    // M_FJ M_JJ⁻¹ = (M_JJ⁻¹ M_JF)ᵀ.
+    let coupling = chol.solve(&block(m, &free, &kept)).transpose();
+    let reduce = |x: &DMatrix<f64>| block(x, &kept, &kept) - &coupling * block(x, &free, &kept);
+    let mass = reduce(m);
+    // Symmetric in exact arithmetic; rounding would otherwise leave it slightly not.
+    let mass = (&mass + mass.transpose()) * 0.5;
+    let mut reduced = Linearization::from_matrices(mass, reduce(k), reduce(c));
+    reduced.q.clone_from(&lin.q);
+    Ok(Some((reduced, free.len())))
 }
 
 /// The eigenvalues `s` of the state matrix `A` (complex, `2n`), and from each oscillatory pair
@@ -384,6 +441,87 @@ fn refine(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Free coordinates coupled to the others through `M` alone (a cyclic angle at rest: the
+    /// chaos pendulum's plate, the yaw of a body on a ball joint): `K` and `C` are zero in
+    /// their columns and rows, and the others have stiffness. Over 3,000 random cases with 2 to
+    /// 6 coordinates, 1 to `r − 1` of them free: exactly `2f` eigenvalues are 0, the verdict is
+    /// marginally stable, and the others are `±iω` with `ω²` the eigenvalues of `K̄` against
+    /// `M̄` (the reduced system, by a symmetric eigensolver: another route) to 1e-10.
+    #[test]
+    fn free_coordinates_coupled_through_the_mass_matrix_give_exact_double_zeros() {
+        let mut state = 0x9e37_79b9_7f4a_7c15_u64;
+        let mut uniform = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for case in 0..3000 {
+            let r = 2 + case % 5;
+            let free = 1 + (case / 5) % (r - 1);
+            let b = DMatrix::from_fn(r, r, |_, _| uniform() - 0.5);
+            let scale = 10f64.powf(4.0 * uniform() - 2.0);
+            let m = (&b * b.transpose() + DMatrix::identity(r, r) * 0.05) * scale;
+            let kept = r - free;
+            let a = DMatrix::from_fn(kept, kept, |_, _| uniform() - 0.5);
+            let k_kept = &a * a.transpose() + DMatrix::identity(kept, kept) * 0.1;
+            let mut k = DMatrix::zeros(r, r);
+            // The free coordinates are the first `free` or the last, in turn.
+            let offset = if case % 2 == 0 { free } else { 0 };
+            k.view_mut((offset, offset), (kept, kept))
+                .copy_from(&k_kept);
+            let lin = Linearization::from_matrices(m.clone(), k, DMatrix::zeros(r, r));
+            let s = linear_stability(&lin).unwrap();
+            assert_eq!(
+                s.stability,
+                Stability::MarginallyStable,
+                "case {case}: {:?}",
+                s.eigenvalues
+            );
+            let zeros = s.eigenvalues.iter().filter(|v| v.norm() == 0.0).count();
+            assert_eq!(zeros, 2 * free, "case {case}: {:?}", s.eigenvalues);
+            // ω² of the reduced system, by Cholesky and a symmetric eigensolver.
+            let (fr, kp): (Vec<usize>, Vec<usize>) = if offset == 0 {
+                ((kept..r).collect(), (0..kept).collect())
+            } else {
+                ((0..free).collect(), (free..r).collect())
+            };
+            let pick = |x: &DMatrix<f64>, rows: &[usize], cols: &[usize]| {
+                DMatrix::from_fn(rows.len(), cols.len(), |i, j| x[(rows[i], cols[j])])
+            };
+            let m_bar = pick(&m, &kp, &kp)
+                - pick(&m, &kp, &fr)
+                    * pick(&m, &fr, &fr).try_inverse().unwrap()
+                    * pick(&m, &fr, &kp);
+            let l = m_bar.cholesky().unwrap().l();
+            let li = l.clone().try_inverse().unwrap();
+            let mut w2: Vec<f64> = (&li * &k_kept * li.transpose())
+                .symmetric_eigen()
+                .eigenvalues
+                .iter()
+                .copied()
+                .collect();
+            w2.sort_by(f64::total_cmp);
+            let mut got: Vec<f64> = s
+                .eigenvalues
+                .iter()
+                .filter(|v| v.im > 0.0)
+                .map(|v| {
+                    assert_eq!(v.re, 0.0, "case {case}: {v}");
+                    v.im * v.im
+                })
+                .collect();
+            got.sort_by(f64::total_cmp);
+            assert_eq!(got.len(), kept, "case {case}");
+            for (g, w) in got.iter().zip(&w2) {
+                assert!(
+                    (g - w).abs() <= 1e-10 * w,
+                    "case {case}: ω² {g} against {w}"
+                );
+            }
+        }
+    }
 
     /// The particle in a spinning bowl: `λ⁴ + (k₁ + k₂ + g²) λ² + k₁k₂ = 0` with
     /// `G = [[0, −g], [g, 0]]`, `K = diag(k₁, k₂)`, `M = I`; both `K` negative and the
