@@ -1783,34 +1783,50 @@ impl Checker<'_> {
     fn inertia_tensor(&mut self, body: &str, inertia: &InertiaTensor) {
         let parameters = &self.file.parameters;
         let mut e = [0.0; 6];
-        for (slot, entry) in e.iter_mut().zip(&inertia.entries) {
+        for ((slot, entry), name) in e
+            .iter_mut()
+            .zip(&inertia.entries)
+            .zip(["xx", "yy", "zz", "xy", "yz", "xz"])
+        {
             if let Some(x) = entry {
                 match evaluate(x, parameters) {
                     Some(v) if v.is_finite() => *slot = v,
-                    _ => return,
+                    Some(v) => {
+                        self.error(
+                            Diagnostic::new(
+                                inertia.location,
+                                format!(
+                                    "the inertia of body `{body}` is not finite: its entry {name} is {v} at the parameters' defaults"
+                                ),
+                            )
+                            .with_help("each entry of an inertia tensor is a finite number of kg·m² (check the parameters it is written with: a 0/0, a root of a negative number)"),
+                        );
+                        return;
+                    }
+                    None => return,
                 }
             }
         }
-        let [xx, yy, zz, xy, yz, xz] = e;
+        // Scaled by the largest entry, so that neither 1e300 nor 1e-300 kg·m² overflows or
+        // underflows in the minors and moments below.
+        let scale = e.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        let [xx, yy, zz, xy, yz, xz] = e.map(|v| if scale > 0.0 { v / scale } else { v });
         let minors = [
             xx,
             xx * yy - xy * xy,
             xx * (yy * zz - yz * yz) - xy * (xy * zz - yz * xz) + xz * (xy * yz - yy * xz),
         ];
-        // Relative to the tensor's size, so that rounding of a singular tensor is not
-        // taken for definiteness.
-        let scale = xx.abs().max(yy.abs()).max(zz.abs());
-        let definite = scale > 0.0
-            && minors
-                .iter()
-                .zip(1..)
-                .all(|(m, k)| *m > 1e-12 * scale.powi(k));
+        // Each scaled minor carries a rounding error of a few ε: above 64ε it is positive,
+        // so a needle whose smallest moment is 1e-12 of the others is definite, and the
+        // rounding of a singular tensor (a rotated zero moment) is not taken for definiteness.
+        let definite = scale > 0.0 && minors.iter().all(|m| *m > 64.0 * f64::EPSILON);
         if !definite {
+            let [exx, eyy, ezz, exy, eyz, exz] = e.map(short);
             self.error(
                 Diagnostic::new(
                     inertia.location,
                     format!(
-                        "the inertia of body `{body}` is not positive definite: [[{xx}, {xy}, {xz}], [{xy}, {yy}, {yz}], [{xz}, {yz}, {zz}]] kg·m² at the parameters' defaults"
+                        "the inertia of body `{body}` is not positive definite: [[{exx}, {exy}, {exz}], [{exy}, {eyy}, {eyz}], [{exz}, {eyz}, {ezz}]] kg·m² at the parameters' defaults"
                     ),
                 )
                 .with_help("a rigid body's inertia tensor about its centre of mass is positive definite (its three principal moments are positive); a moment ≤ 0, or an off-diagonal entry as large as the moments it joins, is not"),
@@ -1821,7 +1837,7 @@ impl Checker<'_> {
         // + ∫(x² + z²) dm = I₁ + I₂` in principal axes (equal for a flat body). Refused beyond
         // 0.1 % of `I₃`: a flat body's moments typed to four digits may miss the equality by
         // a few parts in 10⁴, and the moments computed here carry `√ε` where two coincide.
-        let [a, b, c] = principal_moments([xx, yy, zz, xy, yz, xz]);
+        let [a, b, c] = principal_moments([xx, yy, zz, xy, yz, xz]).map(|v| v * scale);
         let excess = c - (a + b);
         if excess > 1e-3 * c {
             self.error(
@@ -2054,5 +2070,50 @@ mod tests {
         ] {
             assert_eq!(errors(&body(inertia)), Vec::<String>::new(), "{inertia}");
         }
+    }
+
+    /// Definiteness judged on the tensor scaled by its largest entry: `diag(1e300, 1e300,
+    /// 1e300)`, `diag(1e-300, …)` and needles whose axial moment is 1e-12 of the others (along
+    /// `x`, and rotated by 30° about `z`) are positive definite (before, each was refused: the
+    /// minors overflowed, underflowed or sat at a threshold of 1e-12 of the largest entry). A
+    /// rotated zero moment, `diag(0, 1, 1)` turned by 30°, is refused with its entries in six
+    /// digits; a NaN entry is named as not finite (before, skipped here and reported later as a
+    /// singular mass matrix).
+    #[test]
+    fn inertias_are_judged_at_their_own_scale() {
+        let body = |inertia: &str| {
+            format!(
+                "name: t\nparameters: {{ m: 1.0, z: 0.0 }}\ncoordinates: [psi]\nframes:\n  B: {{ parent: N, axis: z, angle: psi }}\npoints:\n  G: [0, 0, 0]\nbodies:\n  disc: {{ mass: m, com: G, frame: B, inertia: {inertia} }}\n"
+            )
+        };
+        let (c, s) = (30f64.to_radians().cos(), 30f64.to_radians().sin());
+        // diag(a, 1, 1) rotated about z: xx = c²a + s², yy = s²a + c², xy = (a − 1)cs.
+        let rotated = |a: f64| {
+            format!(
+                "{{ xx: {:e}, yy: {:e}, zz: 1, xy: {:e} }}",
+                c * c * a + s * s,
+                s * s * a + c * c,
+                (a - 1.0) * c * s
+            )
+        };
+        for inertia in [
+            "[1e300, 1e300, 1e300]".to_string(),
+            "[1e-300, 1e-300, 1e-300]".to_string(),
+            "[1e-12, 1, 1]".to_string(),
+            rotated(1e-12),
+        ] {
+            assert_eq!(errors(&body(&inertia)), Vec::<String>::new(), "{inertia}");
+        }
+        let found = errors(&body(&rotated(0.0)));
+        assert!(
+            found.len() == 1
+                && found[0].contains("is not positive definite: [[0.25, -0.433013, 0]"),
+            "{found:?}"
+        );
+        let found = errors(&body("[z/z, 1, 1]"));
+        assert!(
+            found.len() == 1 && found[0].contains("is not finite: its entry xx is NaN"),
+            "{found:?}"
+        );
     }
 }
