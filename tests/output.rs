@@ -1152,6 +1152,76 @@ fn issue_28_an_output_naming_the_minimal_twin_is_refused() {
     assert!(dir.path().join("chart.svg").exists());
 }
 
+/// Issue 49: `study rolling-contact --after-lift-off --flight F --plot F` (or `--plot out.svg`,
+/// a link to F) replaced the flight model with the chart and exited 0. The flight model is an
+/// input like the rolling one: a usage error before any work, the file left as it was.
+#[test]
+fn an_output_naming_the_flight_model_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let flight = bundled_file("eccentric_cylinder_flight");
+    std::fs::write(dir.path().join("flight.yaml"), &flight).unwrap();
+    std::fs::write(dir.path().join("F.svg"), &flight).unwrap();
+    std::os::unix::fs::symlink("flight.yaml", dir.path().join("out.svg")).unwrap();
+    let study = [
+        "study",
+        "rolling-contact",
+        "eccentric_cylinder",
+        "--after-lift-off",
+    ];
+    for (model, plot) in [("flight.yaml", "out.svg"), ("F.svg", "F.svg")] {
+        let args = [&study[..], &["--flight", model, "--plot", plot]].concat();
+        let text = refused_in(dir.path(), &args);
+        assert!(
+            text.contains("is the model file") && text.contains(model),
+            "{text}"
+        );
+        assert_eq!(
+            std::fs::read_to_string(dir.path().join(model)).unwrap(),
+            flight
+        );
+    }
+    let args = [
+        &study[..],
+        &["--flight", "flight.yaml", "--plot", "chart.svg"],
+    ]
+    .concat();
+    succeeds_in(dir.path(), &args);
+    assert!(dir.path().join("chart.svg").exists());
+}
+
+/// Issue 49: `report --models out/simple_pendulum/phase.svg -o out` drew the phase portrait
+/// over the model it read (the figures of each model's folder were never checked), and
+/// `--models "two_masses, out/report.json"` wrote the report over its model (the check saw
+/// the name with its space, the command read it without). Both are usage errors now.
+#[test]
+fn report_outputs_never_replace_a_model_it_reads() {
+    let dir = tempfile::tempdir().unwrap();
+    succeeds_in(
+        dir.path(),
+        &["report", "--models", "simple_pendulum", "-o", "out"],
+    );
+    let model = bundled_file("simple_pendulum");
+    for (file, models) in [
+        (
+            "out/simple_pendulum/phase.svg",
+            "out/simple_pendulum/phase.svg",
+        ),
+        (
+            "out/simple_pendulum/shape-mode1.svg",
+            "out/simple_pendulum/shape-mode1.svg",
+        ),
+        ("out/report.json", "two_masses, out/report.json"),
+    ] {
+        std::fs::write(dir.path().join(file), &model).unwrap();
+        let text = refused_in(dir.path(), &["report", "--models", models, "-o", "out"]);
+        assert!(text.contains("is the model file"), "{models}: {text}");
+        assert_eq!(
+            std::fs::read_to_string(dir.path().join(file)).unwrap(),
+            model
+        );
+    }
+}
+
 /// `modes --plot PREFIX` of a model with fewer modes than an earlier run left the earlier
 /// run's `PREFIX-mode<k>` charts beside the new ones. The charts of modes this run does not
 /// have are removed when eomgen wrote them (the Software mark and a mode chart's title) and

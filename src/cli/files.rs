@@ -374,7 +374,20 @@ pub(super) fn write(path: &str, bytes: &[u8]) -> Result<(), FileError> {
         Target::Regular {
             path: target,
             existing,
-        } => replace(&target, existing.as_ref(), bytes).map_err(fail),
+        } => {
+            // The last guard of an input: a file this process read is never replaced, even
+            // where a command did not name it before the work.
+            if let Some((device, inode)) = existing.as_ref().and_then(inode)
+                && let Some(input) = input_named(&Identity::Inode(device, inode))
+            {
+                return Err(FileError::InputFile {
+                    option: "the output".to_string(),
+                    path: path.to_string(),
+                    input,
+                });
+            }
+            replace(&target, existing.as_ref(), bytes).map_err(fail)
+        }
     }
 }
 
@@ -528,6 +541,32 @@ enum Identity {
     Stream,
 }
 
+/// Every file this process has read as an input (a model file, under any of its names),
+/// recorded where it is read ([`read_input`]): no output may replace one, whether or not the
+/// command named it among its inputs ([`Outputs::check`] before the work, [`write`] at the
+/// write).
+static READ_INPUTS: std::sync::Mutex<Vec<(Identity, String)>> = std::sync::Mutex::new(Vec::new());
+
+/// Records that the process reads `path` (a model file). Anything that is not a regular file
+/// (a bundled model's name, a missing path) records nothing.
+pub(super) fn read_input(path: &str) {
+    if let Some(identity) = input_identity(path)
+        && let Ok(mut inputs) = READ_INPUTS.lock()
+        && !inputs.iter().any(|(i, _)| *i == identity)
+    {
+        inputs.push((identity, path.to_string()));
+    }
+}
+
+/// The input recorded by [`read_input`] that `identity` is, as it was named.
+fn input_named(identity: &Identity) -> Option<String> {
+    let inputs = READ_INPUTS.lock().ok()?;
+    inputs
+        .iter()
+        .find(|(i, _)| i == identity)
+        .map(|(_, name)| name.clone())
+}
+
 /// A command's outputs, checked together before it does any work ([`Outputs::check`]), and
 /// the files it reads, which no output may overwrite.
 #[derive(Debug, Default)]
@@ -592,11 +631,16 @@ impl Outputs {
         let mut seen: Vec<(Identity, &str)> = Vec::with_capacity(self.outputs.len());
         for planned in &self.outputs {
             let identity = check_one(planned)?;
-            if let Some((_, input)) = inputs.iter().find(|(i, _)| *i == identity) {
+            let input = inputs
+                .iter()
+                .find(|(i, _)| *i == identity)
+                .map(|(_, input)| input.to_string())
+                .or_else(|| input_named(&identity));
+            if let Some(input) = input {
                 return Err(FileError::InputFile {
                     option: planned.option.clone(),
                     path: planned.path.clone(),
-                    input: input.to_string(),
+                    input,
                 });
             }
             if identity != Identity::Stream
@@ -721,6 +765,24 @@ mod tests {
             "{error:?}"
         );
         assert_eq!(CliError::from(error).code, 1);
+    }
+
+    /// A file the process has read is never replaced by a write, under any of its names (a
+    /// link to it here), even where no command named it before the work; another file is.
+    #[test]
+    fn a_file_read_as_an_input_is_never_replaced() {
+        let dir = tempfile::tempdir().unwrap();
+        let model = dir.path().join("model.yaml");
+        std::fs::write(&model, "name: m\n").unwrap();
+        let link = dir.path().join("chart.svg");
+        std::os::unix::fs::symlink(&model, &link).unwrap();
+        read_input(&model.to_string_lossy());
+        let error = write(&link.to_string_lossy(), b"<svg/>").unwrap_err();
+        assert!(matches!(error, FileError::InputFile { .. }), "{error:?}");
+        assert_eq!(std::fs::read_to_string(&model).unwrap(), "name: m\n");
+        let other = dir.path().join("other.svg");
+        write(&other.to_string_lossy(), b"<svg/>").unwrap();
+        assert_eq!(std::fs::read_to_string(&other).unwrap(), "<svg/>");
     }
 
     /// Exactly `/dev/fd/N` and `/proc/<pid>/fd/N` name descriptors; other paths under

@@ -28,6 +28,8 @@ pub(super) fn open_model_with(
     name_or_path: &str,
     options: eomgen::LoadOptions,
 ) -> Result<eomgen::ModelSource, CliError> {
+    // An input that no output may replace (`files::write`).
+    super::files::read_input(name_or_path);
     type Files = Vec<(String, eomgen::LoadOptions, eomgen::ModelSource)>;
     static FILES: std::sync::Mutex<Files> = std::sync::Mutex::new(Vec::new());
     let serves = |o: &eomgen::LoadOptions| {
@@ -116,15 +118,17 @@ pub(super) fn read_model(model: &str) -> Result<(String, String), CliError> {
     let source = match &resolved {
         // Embedded in the binary: no file is read.
         eomgen::Resolved::Bundled(entry) => entry.source.to_string(),
-        eomgen::Resolved::File(path) => eomgen_symbolic::model::read_model_file(
-            std::path::Path::new(path),
-        )
-        .map_err(|e| match e {
-            ReadError::NotText { diagnostic, text } => {
-                diagnostics_error(&display, &text, &[diagnostic])
-            }
-            e => CliError::usage(format!("cannot read `{display}`: {e}")).before_output(),
-        })?,
+        eomgen::Resolved::File(path) => {
+            super::files::read_input(path);
+            eomgen_symbolic::model::read_model_file(std::path::Path::new(path)).map_err(
+                |e| match e {
+                    ReadError::NotText { diagnostic, text } => {
+                        diagnostics_error(&display, &text, &[diagnostic])
+                    }
+                    e => CliError::usage(format!("cannot read `{display}`: {e}")).before_output(),
+                },
+            )?
+        }
     };
     Ok((display, source))
 }

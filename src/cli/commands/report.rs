@@ -163,26 +163,45 @@ fn check_outputs(args: &ReportArgs, sources: &[Source]) -> Result<(), CliError> 
     }
     let path = |name: &str| args.out.join(name).to_string_lossy().into_owned();
     let (json, index) = (path("report.json"), path("index.html"));
-    args.models
-        .iter()
-        .fold(crate::cli::files::Outputs::new(), |outputs, model| {
-            outputs.input(model)
-        })
+    // The models read are inputs (`read_model` recorded each file under the name it was
+    // read by), and so each model's folder of figures is checked too.
+    let mut outputs = crate::cli::files::Outputs::new()
         .file("--out (its report.json)", Some(&json))
-        .file("--out (its index.html)", Some(&index))
-        .check()?;
+        .file("--out (its index.html)", Some(&index));
     for source in sources {
-        let folder = args.out.join(source.model.name());
+        let name = source.model.name();
+        let folder = args.out.join(name);
         if folder.exists() && !folder.is_dir() {
             return Err(CliError::usage(format!(
-                "--out: `{}`, the folder of `{}`'s figures, is not a directory",
+                "--out: `{}`, the folder of `{name}`'s figures, is not a directory",
                 folder.display(),
-                source.model.name()
             )));
         }
+        if folder.is_dir() {
+            let option = format!("--out (the figures of `{name}`)");
+            let file = |f: &str| folder.join(f).to_string_lossy().into_owned();
+            for figure in FIGURES {
+                outputs = outputs.file(&option, Some(&file(figure)));
+            }
+            let prefix = file("shape.svg");
+            for k in 1..=source.file.coordinates.len() {
+                let chart = crate::cli::mode_plot::chart_path(&prefix, k);
+                outputs = outputs.file(&option, Some(&chart));
+            }
+        }
     }
+    outputs.check()?;
     Ok(())
 }
+
+/// The files every model's folder of figures may hold, beside its mode shapes.
+const FIGURES: [&str; 5] = [
+    "time.svg",
+    "phase.svg",
+    "energy.svg",
+    "constraints.svg",
+    "animation.html",
+];
 
 /// The models named by `--models` (every bundled model when empty), loaded.
 fn sources(models: &[String]) -> Result<Vec<Source>, CliError> {

@@ -80,10 +80,6 @@ pub struct RollingContactArgs {
 
 /// Runs `study rolling-contact`; exits 1 when a check fails.
 pub fn run(args: &RollingContactArgs) -> Result<(), CliError> {
-    Outputs::new()
-        .input(&args.model)
-        .chart("--plot", args.plot.as_deref())
-        .check()?;
     let mut rolling = find_model(&args.model)?;
     set_parameters(rolling.as_mut(), &args.set)?;
     let mut flight = match args.after_lift_off {
@@ -111,6 +107,12 @@ pub fn run(args: &RollingContactArgs) -> Result<(), CliError> {
         }
         false => None,
     };
+    // After both models are open, so that the flight model is among the inputs no output
+    // may replace (`files::read_input`).
+    Outputs::new()
+        .input(&args.model)
+        .chart("--plot", args.plot.as_deref())
+        .check()?;
     let options = RollingContactOptions {
         ground: args.ground.clone(),
         normal: args.normal.clone(),
