@@ -678,9 +678,9 @@ pub fn motion_checks(
         .map(|o| (o.name.to_string(), o.tolerance))
         .collect();
     if !conserved_outputs.is_empty() {
-        let series = simulations
-            .get(default_run)
-            .and_then(|s| crate::outputs::evaluate_outputs(&*model, s).map_err(|e| e.to_string()));
+        let series = simulations.get(default_run).and_then(|s| {
+            crate::outputs::evaluate_outputs(&*model, y0, s).map_err(|e| e.to_string())
+        });
         for (name, tolerance) in conserved_outputs {
             let computed = series.clone().and_then(|all| {
                 all.iter()

@@ -29,10 +29,13 @@ pub struct OutputSeries {
     /// The bound on [`Self::drift`] (conserved outputs only).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub tolerance: Option<f64>,
+    /// Its value `Q(0)` at the initial state (units of the expression), the reference of
+    /// [`Self::drift`]: a run's samples need not include `t = 0` (`--t-out 1000`).
+    pub initial: f64,
     /// Its value at each sample of the solution (units of the expression).
     pub values: Vec<f64>,
-    /// `max |Q(t) − Q(0)| / max(1, |Q(0)|)` over the samples (conserved outputs with at
-    /// least one sample only).
+    /// `max |Q(t) − Q(0)| / max(1, |Q(0)|)` over the samples, `Q(0)` the value at the
+    /// initial state (conserved outputs with at least one sample only).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub drift: Option<f64>,
     /// Whether [`Self::drift`] is within [`Self::tolerance`] (conserved outputs only).
@@ -74,12 +77,14 @@ pub enum OutputError {
     },
 }
 
-/// Evaluates `model`'s outputs at every sample of `solution` (a solution of `model`, with
-/// its current parameter values); for a conserved output also its drift
-/// `max |Q(t) − Q(0)| / max(1, |Q(0)|)` and whether it is within the file's bound.
+/// Evaluates `model`'s outputs at the initial state `y0` (at `t = 0`) and at every sample of
+/// `solution` (a solution of `model` from `y0`, with its current parameter values); for a
+/// conserved output also its drift `max |Q(t) − Q(0)| / max(1, |Q(0)|)` from the initial
+/// value, as [`crate::analysis::energy_drift`] measures the energy's, and whether it is within
+/// the file's bound.
 ///
-/// `solution`'s states are `[q; q̇]` of `model` (length `2n`). An empty `solution` gives
-/// empty series without drift.
+/// `y0` and `solution`'s states are `[q; q̇]` of `model` (length `2n`). An empty `solution`
+/// gives empty series without drift.
 ///
 /// # Errors
 /// [`OutputError::Expression`] if an expression does not evaluate,
@@ -99,7 +104,9 @@ pub enum OutputError {
 ///     ..SimulationOptions::default()
 /// };
 /// let run = simulate(model.as_mut(), &options).unwrap();
-/// let outputs = eomgen::outputs::evaluate_outputs(model.as_ref(), &run.solution).unwrap();
+/// let outputs =
+///     eomgen::outputs::evaluate_outputs(model.as_ref(), &run.initial_state, &run.solution)
+///         .unwrap();
 /// let l = outputs.iter().find(|o| o.name == "angular_momentum").unwrap();
 /// // L = m1 m2/(m1 + m2) d² ω = 2/√3 (the file's header), kept to the integration's error.
 /// assert!((l.values[0] - 2.0 / 3f64.sqrt()).abs() < 1e-15);
@@ -108,6 +115,7 @@ pub enum OutputError {
 /// ```
 pub fn evaluate_outputs(
     model: &dyn ModelInfo,
+    y0: &[f64],
     solution: &Solution,
 ) -> Result<Vec<OutputSeries>, OutputError> {
     let description = model.description();
@@ -125,7 +133,8 @@ pub fn evaluate_outputs(
         let e: Expr = parse_expr(&value, Location { line: 1, column: 1 })
             .map_err(|d| expression_error(d.message))?;
         let mut values = Vec::with_capacity(solution.len());
-        for (t, y) in solution.iter() {
+        let mut initial = None;
+        for (t, y) in std::iter::once((0.0, y0)).chain(solution.iter()) {
             let v = eval_expr(&e, &|k| {
                 if k == "t" {
                     return Some(t);
@@ -146,20 +155,26 @@ pub fn evaluate_outputs(
             if !v.is_finite() {
                 return Err(OutputError::NotFinite { name, t, value: v });
             }
-            values.push(v);
+            match initial {
+                None => initial = Some(v),
+                Some(_) => values.push(v),
+            }
         }
-        let drift = match (output.conserved, values.first()) {
-            (true, Some(&q0)) => Some(
+        let initial = initial.unwrap_or(f64::NAN);
+        let drift = match (output.conserved, values.is_empty()) {
+            (true, false) => Some({
+                let q0 = initial;
                 values
                     .iter()
                     .map(|q| (q - q0).abs() / q0.abs().max(1.0))
-                    .fold(0.0, f64::max),
-            ),
+                    .fold(0.0, f64::max)
+            }),
             _ => None,
         };
         series.push(OutputSeries {
             name,
             value,
+            initial,
             conserved: output.conserved,
             tolerance: output.conserved.then_some(output.tolerance),
             values,

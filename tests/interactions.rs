@@ -163,7 +163,9 @@ fn a_conserved_output_is_measured_along_a_run() {
         ..SimulationOptions::default()
     };
     let run = simulate(model.as_mut(), &options).unwrap();
-    let outputs = eomgen::outputs::evaluate_outputs(model.as_ref(), &run.solution).unwrap();
+    let outputs =
+        eomgen::outputs::evaluate_outputs(model.as_ref(), &run.initial_state, &run.solution)
+            .unwrap();
     let l = &outputs[0];
     assert_eq!((l.name.as_str(), l.conserved), ("angular_momentum", true));
     // L = m1 m2/(m1 + m2) d^2 w = 2/sqrt(3) (the file's header).
@@ -176,6 +178,7 @@ fn a_conserved_output_is_measured_along_a_run() {
         l.drift.unwrap() < 1e-9 && l.within_tolerance == Some(true),
         "{l:?}"
     );
+    assert_eq!(l.initial, l.values[0], "the first sample is at t = 0");
     let d = &outputs[1];
     assert!(!d.conserved && d.drift.is_none());
     assert!(
@@ -186,6 +189,40 @@ fn a_conserved_output_is_measured_along_a_run() {
 }
 
 const NOT_CONSERVED: &str = "name: falsely_conserved\nparameters: { m: 1.0, k: 1.0 }\ncoordinates: [x, y]\npoints:\n  O: [0, 0]\n  P: [x, y]\nbodies:\n  p: { mass: m, at: P }\ninteractions:\n  pull: { between: [O, P], magnitude: -k*r }\noutputs:\n  L:\n    value: m*cross(P - O, vel(P))\n    conserved: true\n  px: { value: m*x_dot, conserved: true }\ninitial: { x: 1, y: 0, x_dot: 0, y_dot: 0.5 }\nchecks:\n  conserved: { L2: \"m*cross(P - O, vel(P))\" }\n";
+
+/// Issue 49: with one output time (`--t-out 2`) the drift of a conserved output was measured
+/// from that sample, so it was 0 and "within tolerance" whatever the motion. `Q(0)` is the
+/// initial state's: `p_x = m ẋ` goes from 0 to `−sin 2 = −0.909`, drift 0.909 against its
+/// bound 1e-9, and the angular momentum (really conserved) stays within it.
+#[test]
+fn a_conserved_output_drifts_from_the_initial_state() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("falsely_conserved.yaml");
+    std::fs::write(&path, NOT_CONSERVED).unwrap();
+    let out = eomgen(&[
+        "simulate",
+        path.to_str().unwrap(),
+        "--t-out",
+        "2",
+        "--rtol",
+        "1e-12",
+        "--atol",
+        "1e-12",
+        "--json",
+    ]);
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let outputs = json["outputs"].as_array().unwrap();
+    let (l, px) = (&outputs[0], &outputs[1]);
+    assert_eq!(
+        (l["name"].as_str(), px["name"].as_str()),
+        (Some("L"), Some("px"))
+    );
+    assert_eq!(px["initial"], 0.0);
+    let drift = px["drift"].as_f64().unwrap();
+    assert!((drift - 2f64.sin()).abs() < 1e-9, "{px}");
+    assert_eq!(px["within_tolerance"], false);
+    assert_eq!(l["within_tolerance"], true, "{l}");
+}
 
 /// A quantity declared conserved that is not (the momentum of a particle pulled to a fixed
 /// point) is reported: its drift is beyond the bound, and `eomgen report` and the library's
@@ -205,7 +242,8 @@ fn a_falsely_conserved_output_is_caught() {
         ..SimulationOptions::default()
     };
     let run = simulate(&mut model, &options).unwrap();
-    let outputs = eomgen::outputs::evaluate_outputs(&model, &run.solution).unwrap();
+    let outputs =
+        eomgen::outputs::evaluate_outputs(&model, &run.initial_state, &run.solution).unwrap();
     assert_eq!(
         outputs[0].within_tolerance,
         Some(true),
@@ -489,7 +527,8 @@ fn an_output_of_a_frames_angular_velocity_is_evaluated() {
         ..SimulationOptions::default()
     };
     let run = simulate(&mut model, &options).unwrap();
-    let outputs = eomgen::outputs::evaluate_outputs(&model, &run.solution).unwrap();
+    let outputs =
+        eomgen::outputs::evaluate_outputs(&model, &run.initial_state, &run.solution).unwrap();
     for ((_, y), wx) in run.solution.iter().zip(&outputs[0].values) {
         let [phi_dot, theta_dot] = [y[3], y[4]];
         let (theta, psi) = (y[1], y[2]);

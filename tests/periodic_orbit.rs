@@ -524,6 +524,17 @@ fn errors() {
         periodic_orbit(pendulum.as_mut(), &at_rest),
         Err(PeriodicOrbitError::Collapsed { .. })
     ));
+    // Issue 49: a damped model has no periodic orbit but its equilibrium. Newton shrank y₀
+    // to ~8e-10, where every state closes to the residual it accepts, and the study reported
+    // "T = 4.432 s, asymptotically stable" (exit 0). An orbit must move more than 1000 times
+    // that residual over a period.
+    let mut damped = model("three_masses_damped");
+    match periodic_orbit(damped.as_mut(), &PeriodicOrbitOptions::new(4.0)) {
+        Err(PeriodicOrbitError::Collapsed {
+            travel, allowed, ..
+        }) => assert!(travel < allowed / 1e-3, "{travel} {allowed}"),
+        other => panic!("{other:?}"),
+    }
     // n = −1: the file's potential divides by n + 1, so the energy cannot be fixed.
     let mut log_force = model("central_force");
     log_force.set_parameter("n", -1.0).unwrap();
@@ -590,4 +601,15 @@ fn cli() {
     let out = eomgen(&["study", "periodic-orbit", "four_bar", "--period", "1"]);
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("constraints"));
+
+    // The damped masses' equilibrium is no orbit: exit 1, as docs/cli.md promises.
+    let out = eomgen(&[
+        "study",
+        "periodic-orbit",
+        "three_masses_damped",
+        "--period",
+        "4",
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("collapsed to an equilibrium"));
 }

@@ -115,10 +115,11 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
     });
     // The file's `outputs:` at every sample; one that cannot be evaluated (not a number
     // where the run went) fails the command after everything else is written.
-    let (outputs, outputs_error) = match evaluate_outputs(model.as_ref(), solution) {
-        Ok(outputs) => (outputs, None),
-        Err(e) => (Vec::new(), Some(e)),
-    };
+    let (outputs, outputs_error) =
+        match evaluate_outputs(model.as_ref(), &simulation.initial_state, solution) {
+            Ok(outputs) => (outputs, None),
+            Err(e) => (Vec::new(), Some(e)),
+        };
     if let Some(path) = &args.csv {
         write_csv(
             path,
@@ -299,7 +300,7 @@ fn print_summary(
 /// noted as above the bound otherwise.
 fn print_conserved_outputs(outputs: &[OutputSeries], rtol: f64) {
     for o in outputs.iter().filter(|o| o.conserved) {
-        let (Some(q0), Some(d), Some(bound)) = (o.values.first(), o.drift, o.tolerance) else {
+        let (q0, Some(d), Some(bound)) = (o.initial, o.drift, o.tolerance) else {
             continue;
         };
         let note = if d > bound.max(1e3 * rtol) {
