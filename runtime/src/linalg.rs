@@ -1,9 +1,60 @@
 //! Dense symmetric positive definite solves `M x = f` for the mass matrix: [`solve_spd`] with a
 //! compile-time size (the compiled models' hot path) and [`solve_spd_in_place`] with a size
 //! known at run time, the same operations in the same order; and [`forward_differences`], the
-//! one difference Jacobian that stands in for an exact one that is not finite.
+//! one difference Jacobian that stands in for an exact one that is not finite; and
+//! [`eigenvalues`] and [`symmetric_eigen`], nalgebra's eigensolvers with a bound on their
+//! iterations.
 
-use nalgebra::{SMatrix, SVector};
+use nalgebra::{Complex, DMatrix, Dyn, SMatrix, SVector, SymmetricEigen};
+
+/// QR sweeps allowed per row of a matrix in [`eigenvalues`] and [`symmetric_eigen`] (at least
+/// ten rows' worth): the implicit QR algorithm takes two to three sweeps per eigenvalue
+/// (Golub & Van Loan, *Matrix Computations*, 4th ed., §7.5.6 and §8.3.5), so this is never
+/// reached by a matrix that converges.
+const SWEEPS_PER_ROW: usize = 100;
+
+/// The eigenvalues of the real square matrix `a` (`n × n`, any order), by nalgebra's real
+/// Schur decomposition with at most `100·max(n, 10)` QR sweeps. nalgebra's own
+/// `complex_eigenvalues` has no bound, and its QR iteration can cycle forever on some finite
+/// matrices (nalgebra issues #611 and #1528); a non-finite entry would make it cycle too.
+///
+/// Returns `None` when `a` has an entry that is not finite, when the iteration does not
+/// converge within the bound, or when an eigenvalue is not finite.
+pub fn eigenvalues(a: &DMatrix<f64>) -> Option<Vec<Complex<f64>>> {
+    if a.iter().any(|v| !v.is_finite()) {
+        return None;
+    }
+    if a.is_empty() {
+        return Some(Vec::new());
+    }
+    let sweeps = SWEEPS_PER_ROW * a.nrows().max(10);
+    let values: Vec<Complex<f64>> = nalgebra::Schur::try_new(a.clone(), f64::EPSILON, sweeps)?
+        .complex_eigenvalues()
+        .iter()
+        .copied()
+        .collect();
+    values
+        .iter()
+        .all(|v| v.re.is_finite() && v.im.is_finite())
+        .then_some(values)
+}
+
+/// The eigenvalues and eigenvectors of the symmetric matrix `a` (`n × n`, lower triangle
+/// read), by nalgebra's symmetric QR algorithm with at most `100·max(n, 10)` sweeps (see
+/// [`eigenvalues`]).
+///
+/// Returns `None` when `a` has an entry that is not finite, when the iteration does not
+/// converge within the bound, or when a result is not finite.
+pub fn symmetric_eigen(a: DMatrix<f64>) -> Option<SymmetricEigen<f64, Dyn>> {
+    if a.iter().any(|v| !v.is_finite()) {
+        return None;
+    }
+    let sweeps = SWEEPS_PER_ROW * a.nrows().max(10);
+    let eigen = SymmetricEigen::try_new(a, f64::EPSILON, sweeps)?;
+    (eigen.eigenvalues.iter().all(|v| v.is_finite())
+        && eigen.eigenvectors.iter().all(|v| v.is_finite()))
+    .then_some(eigen)
+}
 
 /// Solves `M x = f` for a symmetric positive definite `M` (`N × N`, lower triangle read) by
 /// the square-root-free factorisation `M = L D Lᵀ` (`L` unit lower triangular, `D` diagonal;
@@ -521,5 +572,43 @@ mod tests {
                 }
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod bounded_eigen_tests {
+    use super::*;
+
+    /// The companion matrix of `x¹¹ − 770.97/434.4` from nalgebra issue #611, on which its
+    /// unbounded Schur iteration cycled forever in 2019 (nalgebra 0.35 converges on it, and on
+    /// a NaN entry, so this cannot show the bound biting): the bounded one returns (the test
+    /// runs it on a thread and waits 20 s at most), with eigenvalues or with `None`; the 11
+    /// roots, where given, have modulus `(770.97/434.4)^(1/11)` to 1e-10. A non-finite entry
+    /// gives `None` without iterating.
+    #[test]
+    fn the_bounded_eigenvalues_return_on_a_matrix_that_cycles_nalgebra() {
+        let n = 11;
+        let mut a = DMatrix::zeros(n, n);
+        for i in 1..n {
+            a[(i, i - 1)] = 1.0;
+        }
+        a[(0, n - 1)] = 770.970_005_929_470_1 / 434.395_990_908_145_9;
+        let (send, receive) = std::sync::mpsc::channel();
+        std::thread::spawn(move || {
+            let _ = send.send(eigenvalues(&a));
+        });
+        let values = receive
+            .recv_timeout(std::time::Duration::from_secs(20))
+            .expect("the bounded Schur iteration returns");
+        if let Some(values) = values {
+            let r = (770.970_005_929_470_1f64 / 434.395_990_908_145_9).powf(1.0 / 11.0);
+            for v in values {
+                assert!((v.norm() - r).abs() < 1e-10, "{v}");
+            }
+        }
+        let mut bad = DMatrix::identity(3, 3);
+        bad[(0, 1)] = f64::NAN;
+        assert!(eigenvalues(&bad).is_none());
+        assert!(symmetric_eigen(bad).is_none());
     }
 }

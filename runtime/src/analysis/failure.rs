@@ -4,7 +4,7 @@
 //! underflow says only that the integrator could not go on; these say what in the model made
 //! it so, so that a front end does not blame stiffness for a negative mass.
 
-use nalgebra::{DMatrix, SymmetricEigen};
+use nalgebra::DMatrix;
 use serde::Serialize;
 
 use crate::integrate::IntegrationError;
@@ -165,29 +165,32 @@ const DROP: f64 = 1e-6;
 
 /// The smallest eigenvalue of `M` scaled to a unit diagonal, `D^-½ M D^-½` with
 /// `D = diag |Mᵢᵢ|`, over its largest magnitude at `(t, y)` (`-∞` when `M` is not finite or a
-/// diagonal entry is 0 or negative), for `y = [q; q̇]`. The scaling makes the ratio
-/// independent of the coordinates' units (a mass in kg beside an inertia in kg·m² of 1e-11).
-fn eigenvalue_ratio(model: &dyn ModelInfo, t: f64, y: &[f64]) -> f64 {
+/// diagonal entry is 0 or negative), for `y = [q; q̇]`; `None`, no verdict, where the
+/// eigenvalue solver does not converge. The scaling makes the ratio independent of the
+/// coordinates' units (a mass in kg beside an inertia in kg·m² of 1e-11).
+fn eigenvalue_ratio(model: &dyn ModelInfo, t: f64, y: &[f64]) -> Option<f64> {
     let (m, _) = model.mass_matrix_and_forcing(t, y);
     if m.iter().any(|v| !v.is_finite()) {
-        return f64::NEG_INFINITY;
+        return Some(f64::NEG_INFINITY);
     }
     let n = m.nrows();
     let diagonal: Vec<f64> = (0..n).map(|i| m[(i, i)]).collect();
     if diagonal.iter().any(|d| *d <= 0.0) {
-        return f64::NEG_INFINITY;
+        return Some(f64::NEG_INFINITY);
     }
+    // √dᵢ √dⱼ rather than √(dᵢ dⱼ), which overflows or underflows for entries beyond 1e±154.
+    let root: Vec<f64> = diagonal.iter().map(|d| d.sqrt()).collect();
     let scaled = DMatrix::from_fn(n, n, |i, j| {
-        0.5 * (m[(i, j)] + m[(j, i)]) / (diagonal[i] * diagonal[j]).sqrt()
+        0.5 * (m[(i, j)] + m[(j, i)]) / (root[i] * root[j])
     });
-    let eigenvalues = SymmetricEigen::new(scaled).eigenvalues;
+    let eigenvalues = crate::linalg::symmetric_eigen(scaled)?.eigenvalues;
     let largest = eigenvalues.iter().fold(0.0_f64, |a, v| a.max(v.abs()));
     let smallest = eigenvalues.iter().fold(f64::INFINITY, |a, &v| a.min(v));
-    if largest == 0.0 {
+    Some(if largest == 0.0 {
         f64::NEG_INFINITY
     } else {
         smallest / largest
-    }
+    })
 }
 
 /// What the model shows at the state `(t, y)` where an integration stopped (`y = [q; q̇]`,
@@ -228,13 +231,13 @@ pub fn failure_cause(
     if matches!(error, IntegrationError::TooManySteps { .. }) {
         return None;
     }
-    let ratio = eigenvalue_ratio(model, t, y);
-    let start_ratio = eigenvalue_ratio(model, 0.0, y0);
+    let ratio = eigenvalue_ratio(model, t, y)?;
+    let start_ratio = eigenvalue_ratio(model, 0.0, y0)?;
     // Singular: below an absolute floor, or a millionfold below its value at the start (a
     // badly scaled but regular M keeps its ratio along the motion).
     let singular = |r: f64| r.is_nan() || r <= SINGULAR_RATIO;
     if singular(ratio) || ratio < DROP * start_ratio {
-        let elsewhere = (0..8).map(|k| {
+        let elsewhere = (0..8).filter_map(|k| {
             let mut other = y.to_vec();
             for (i, q) in other.iter_mut().take(n).enumerate() {
                 let sign = if (i + k) % 2 == 0 { 1.0 } else { -1.0 };
@@ -256,7 +259,7 @@ pub fn failure_cause(
                 }
                 let flipped = eigenvalue_ratio(model, t, y);
                 let _ = model.set_parameter(name, *value);
-                !singular(flipped) && flipped > ratio / DROP
+                flipped.is_some_and(|f| !singular(f) && f > ratio / DROP)
             })
             .cloned()
             .collect();
@@ -364,7 +367,7 @@ fn spectral_radius(system: &mut dyn OdeSystem, t: f64, y: &[f64]) -> Option<(f64
         return None;
     }
     let matrix = DMatrix::from_column_slice(dim, dim, &jac);
-    let eigenvalues = matrix.complex_eigenvalues();
+    let eigenvalues = crate::linalg::eigenvalues(&matrix)?;
     let rho = eigenvalues.iter().fold(0.0_f64, |a, z| a.max(z.norm()));
     let growth = eigenvalues
         .iter()

@@ -222,8 +222,10 @@ pub fn fixed_step_warnings(
         return warnings;
     }
     let limit = SPURIOUS_GROWTH_LIMIT.ln();
-    let worst = a
-        .complex_eigenvalues()
+    let Some(eigenvalues) = crate::linalg::eigenvalues(&a) else {
+        return warnings;
+    };
+    let worst = eigenvalues
         .iter()
         .filter(|l| l.re <= 1e-8 * l.norm())
         .map(|&l| (l, log_growth(method, l, h, t_end)))

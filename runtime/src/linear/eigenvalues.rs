@@ -243,10 +243,11 @@ pub fn state_eigenvalues(lin: &Linearization) -> Result<Vec<Complex<f64>>, Modal
             a[(r + i, r + j)] = -c[(i, j)];
         }
     }
-    let rough: Vec<Complex<f64>> = a.complex_eigenvalues().iter().copied().collect();
-    if !rough.iter().all(|v| v.re.is_finite() && v.im.is_finite()) {
-        return Err(not_finite());
-    }
+    let rough =
+        crate::linalg::eigenvalues(&a).ok_or_else(|| ModalError::EigenvaluesDidNotConverge {
+            size: 2 * r,
+            q: lin.q.clone(),
+        })?;
     // Refine the upper half-plane and the real axis; conjugates mirror them. Each value
     // remembers whether Newton converged on it (a simple eigenvalue, now accurate to its own
     // size) or not (a multiple one, as Schur left it).

@@ -25,7 +25,7 @@
 //! constraint Jacobian (minimal coordinates; see [`Linearization`]); non-holonomic constraints
 //! are refused ([`ModalError::NonHolonomic`]).
 
-use nalgebra::{DMatrix, DVector, SymmetricEigen};
+use nalgebra::{DMatrix, DVector};
 
 use crate::model_info::ModelInfo;
 
@@ -63,6 +63,17 @@ pub enum ModalError {
         /// Largest entry of the Newton step from there (units of `q`; and of `λ` with
         /// constraints).
         step: f64,
+    },
+    /// The eigenvalue solver (nalgebra's QR iteration, bounded by
+    /// [`crate::linalg::eigenvalues`]) did not converge on a matrix of the linearisation.
+    #[error(
+        "the eigenvalue solver did not converge on the {size} × {size} matrix of the linearisation at q = {q:?}"
+    )]
+    EigenvaluesDidNotConverge {
+        /// The matrix's order.
+        size: usize,
+        /// The operating point.
+        q: Vec<f64>,
     },
     /// The mass matrix at the operating point is not positive definite.
     #[error("the mass matrix is not positive definite at q = {q:?}")]
@@ -260,7 +271,12 @@ fn check_mass_matrix(mass: &DMatrix<f64>, names: &[&str], q: &[f64]) -> Result<(
     let scaled = DMatrix::from_fn(r, r, |i, j| {
         0.5 * (mass[(i, j)] + mass[(j, i)]) / (root[i] * root[j])
     });
-    let eigen = SymmetricEigen::new(scaled);
+    let eigen = crate::linalg::symmetric_eigen(scaled).ok_or_else(|| {
+        ModalError::EigenvaluesDidNotConverge {
+            size: r,
+            q: q.to_vec(),
+        }
+    })?;
     let k = eigen.eigenvalues.imin();
     let smallest = eigen.eigenvalues[k];
     if smallest >= MASS_MATRIX_SINGULARITY {
@@ -753,7 +769,12 @@ pub fn normal_modes(lin: &Linearization) -> Result<NormalModes, ModalError> {
     if !y.iter().all(|v| v.is_finite()) {
         return Err(ModalError::NonFinite { q: lin.q.clone() });
     }
-    let eigen = SymmetricEigen::new(y.clone());
+    let eigen = crate::linalg::symmetric_eigen(y.clone()).ok_or_else(|| {
+        ModalError::EigenvaluesDidNotConverge {
+            size: n,
+            q: lin.q.clone(),
+        }
+    })?;
     let reduced = y;
     let mut order: Vec<usize> = (0..n).collect();
     order.sort_by(|&a, &b| eigen.eigenvalues[a].total_cmp(&eigen.eigenvalues[b]));
@@ -849,7 +870,14 @@ fn is_zero_frequency(
 pub fn eigenvalues_of_m_inv_k(lin: &Linearization) -> Result<Vec<f64>, ModalError> {
     let chol = lin.mass_cholesky()?;
     let mk = chol.solve(&lin.stiffness_matrix);
-    let mut values: Vec<f64> = mk.complex_eigenvalues().iter().map(|c| c.re).collect();
+    let mut values: Vec<f64> = crate::linalg::eigenvalues(&mk)
+        .ok_or_else(|| ModalError::EigenvaluesDidNotConverge {
+            size: mk.nrows(),
+            q: lin.q.clone(),
+        })?
+        .iter()
+        .map(|c| c.re)
+        .collect();
     values.sort_by(f64::total_cmp);
     Ok(values)
 }

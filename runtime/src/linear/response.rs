@@ -515,7 +515,11 @@ pub fn state_response_by_eigenvectors(
     let m = a.nrows();
     check_vector(y0, m, "state")?;
     check_times(times)?;
-    let mut lambdas: Vec<Complex<f64>> = a.complex_eigenvalues().iter().copied().collect();
+    let mut lambdas =
+        crate::linalg::eigenvalues(a).ok_or_else(|| ModalError::EigenvaluesDidNotConverge {
+            size: m,
+            q: Vec::new(),
+        })?;
     lambdas.sort_by(|x, y| x.re.total_cmp(&y.re).then(x.im.total_cmp(&y.im)));
     let scale = lambdas.iter().fold(0.0f64, |s, l| s.max(l.norm()));
     let ac: DMatrix<Complex<f64>> = a.map(|v| Complex::new(v, 0.0));
@@ -654,7 +658,11 @@ pub fn modes_of_m_inv_k(lin: &Linearization) -> Result<MInvKModes, ResponseError
     if !b.iter().all(|v| v.is_finite()) {
         return Err(ModalError::NonFinite { q: lin.q.clone() }.into());
     }
-    let complex = b.complex_eigenvalues();
+    let complex =
+        crate::linalg::eigenvalues(&b).ok_or_else(|| ModalError::EigenvaluesDidNotConverge {
+            size: n,
+            q: lin.q.clone(),
+        })?;
     let scale = complex.iter().fold(0.0f64, |s, l| s.max(l.norm()));
     if let Some(c) = complex.iter().find(|c| c.im.abs() > 1e-8 * scale) {
         return Err(ResponseError::ComplexEigenvalue {

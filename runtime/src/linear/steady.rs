@@ -102,6 +102,13 @@ pub enum SteadyMotionError {
     /// A derivative came out not finite.
     #[error("the linearisation is not finite at the operating point")]
     NonFinite,
+    /// The eigenvalue solver (bounded: [`crate::linalg::eigenvalues`]) did not converge on
+    /// the reduced state matrix.
+    #[error("the eigenvalue solver did not converge on the {size} × {size} reduced state matrix")]
+    EigenvaluesDidNotConverge {
+        /// The matrix's order.
+        size: usize,
+    },
 }
 
 /// A steady motion: coordinates `q*` and rates `q̇*` at which `q̈ = 0` and the constraints
@@ -546,9 +553,9 @@ fn remove_states(a: &mut DMatrix<f64>, names: &mut Vec<String>, which: &[usize])
 /// (Parlett–Reinsch) and the Schur form, sorted by ascending `|s|` then `Im s`; eigenvalues
 /// below [`ZERO_EIGENVALUE`] of the largest are set to 0 and real parts below
 /// [`ZERO_REAL_PART`] of `|s|` to 0 (`tolerance` widens both, for a matrix taken by
-/// differences).
-pub fn general_eigenvalues(a: &DMatrix<f64>, tolerance: f64) -> Vec<Complex<f64>> {
-    let mut values = raw_eigenvalues(a);
+/// differences). `None` as [`raw_eigenvalues`].
+pub fn general_eigenvalues(a: &DMatrix<f64>, tolerance: f64) -> Option<Vec<Complex<f64>>> {
+    let mut values = raw_eigenvalues(a)?;
     let largest = values.iter().map(|v| v.norm()).fold(0.0, f64::max);
     for v in &mut values {
         if v.norm() <= ZERO_EIGENVALUE.max(tolerance) * largest {
@@ -561,24 +568,40 @@ pub fn general_eigenvalues(a: &DMatrix<f64>, tolerance: f64) -> Vec<Complex<f64>
         }
     }
     values.sort_by(|a, b| a.norm().total_cmp(&b.norm()).then(a.im.total_cmp(&b.im)));
-    values
+    Some(values)
 }
 
 /// The eigenvalues of a general real matrix `a` as the balanced Schur form gives them, in its
 /// order, with nothing set to zero: for locating where a real part changes sign.
-pub fn raw_eigenvalues(a: &DMatrix<f64>) -> Vec<Complex<f64>> {
+///
+/// `None` when `a` is not finite or the Schur iteration does not converge
+/// ([`crate::linalg::eigenvalues`]).
+pub fn raw_eigenvalues(a: &DMatrix<f64>) -> Option<Vec<Complex<f64>>> {
     if a.is_empty() {
-        return Vec::new();
+        return Some(Vec::new());
+    }
+    if a.iter().any(|v| !v.is_finite()) {
+        return None;
     }
     let mut balanced = a.clone();
     nalgebra::linalg::balancing::balance_parlett_reinsch(&mut balanced);
-    balanced.complex_eigenvalues().iter().copied().collect()
+    crate::linalg::eigenvalues(&balanced)
 }
 
 /// The eigenvalues of a steady linearisation and its stability verdict.
-pub fn steady_stability(lin: &SteadyLinearization) -> (Vec<Complex<f64>>, Stability) {
+///
+/// # Errors
+/// [`SteadyMotionError::EigenvaluesDidNotConverge`] (a state matrix that is not finite, or a
+/// Schur iteration past its bound).
+pub fn steady_stability(
+    lin: &SteadyLinearization,
+) -> Result<(Vec<Complex<f64>>, Stability), SteadyMotionError> {
     let tolerance = if lin.exact_jacobian { 0.0 } else { 1e-8 };
-    let eigenvalues = general_eigenvalues(&lin.state_matrix, tolerance);
+    let eigenvalues = general_eigenvalues(&lin.state_matrix, tolerance).ok_or(
+        SteadyMotionError::EigenvaluesDidNotConverge {
+            size: lin.state_matrix.nrows(),
+        },
+    )?;
     let stability = verdict(&eigenvalues);
-    (eigenvalues, stability)
+    Ok((eigenvalues, stability))
 }

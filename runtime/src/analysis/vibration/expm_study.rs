@@ -505,7 +505,14 @@ pub fn expm_study_of(
         return Err(ExpmStudyError::ZeroSolution);
     }
     let integration = state_response_by_integration(a, z0, times, tol)?;
-    let mut eigenvalues: Vec<Complex<f64>> = a.complex_eigenvalues().iter().copied().collect();
+    let mut eigenvalues = crate::linalg::eigenvalues(a).ok_or_else(|| {
+        ResponseError::from(
+            crate::linear::modal::ModalError::EigenvaluesDidNotConverge {
+                size: a.nrows(),
+                q: Vec::new(),
+            },
+        )
+    })?;
     eigenvalues.sort_by(|x, y| x.re.total_cmp(&y.re).then(x.im.total_cmp(&y.im)));
     let eigenvector_condition = eigenvector_condition(a, &eigenvalues);
     let eigenvectors = match state_response_by_eigenvectors(a, z0, times) {

@@ -209,7 +209,12 @@ pub fn eigenvalues_at(
 ) -> Result<PointEigenvalues, SweepPointError> {
     if is_steady_motion(model, &options.start) {
         let a = steady_motion_analysis(model, options)?;
-        let raw = raw_eigenvalues(&a.linearization.state_matrix);
+        let raw = raw_eigenvalues(&a.linearization.state_matrix).ok_or(
+            ModalError::EigenvaluesDidNotConverge {
+                size: a.linearization.state_matrix.nrows(),
+                q: a.steady_motion.q.clone(),
+            },
+        )?;
         return Ok(PointEigenvalues {
             eigenvalues: a.eigenvalues,
             stability: a.stability,
@@ -223,7 +228,13 @@ pub fn eigenvalues_at(
     Ok(PointEigenvalues {
         eigenvalues: s.eigenvalues,
         stability: s.stability,
-        raw: raw_eigenvalues(&lin.state_matrix()?),
+        raw: {
+            let a = lin.state_matrix()?;
+            raw_eigenvalues(&a).ok_or(ModalError::EigenvaluesDidNotConverge {
+                size: a.nrows(),
+                q: lin.q.clone(),
+            })?
+        },
     })
 }
 

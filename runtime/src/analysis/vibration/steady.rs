@@ -158,7 +158,7 @@ pub fn steady_motion_analysis(
     let steady_motion = find_steady_motion(model, options.t, &guess, &rates, &ignorable)?;
     let linearization =
         linearize_steady_motion(model, options.t, &steady_motion.state(), &ignorable)?;
-    let (eigenvalues, stability) = steady_stability(&linearization);
+    let (eigenvalues, stability) = steady_stability(&linearization)?;
     Ok(SteadyMotionAnalysis {
         name,
         coordinates: model
