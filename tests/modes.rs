@@ -1142,3 +1142,47 @@ fn a_singularity_at_the_operating_point_is_not_called_a_time_dependence() {
         "{stderr}"
     );
 }
+
+/// Issue 49: a parameter sweep refuses what `modes` refuses. The shaken pendulum's stiffness
+/// changes with t (the sweep over `a` reported a change at `a = 0.0027778`, "stabilising":
+/// the frozen `K = g/l − a w²/l` at t = 0 through 0, which has nothing to do with the Kapitza
+/// boundary), and the spun rod's constraint does; the same error and hint as `modes`, exit 1.
+#[test]
+fn parameter_sweeps_refuse_time_dependent_equations() {
+    for (args, hint) in [
+        (
+            &[
+                "study",
+                "parameter-sweep",
+                "mathieu_pendulum",
+                "--at",
+                "upright",
+                "--parameter",
+                "a",
+                "--values",
+                "0..0.5:6",
+            ][..],
+            "eomgen study floquet mathieu_pendulum",
+        ),
+        (
+            &[
+                "study",
+                "parameter-sweep",
+                "bead_spinning_rod",
+                "--parameter",
+                "w",
+                "--values",
+                "1..3:3",
+            ][..],
+            "a constraint that moves with t",
+        ),
+    ] {
+        let out = eomgen(args);
+        assert_eq!(out.status.code(), Some(1), "{args:?}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            err.contains("the linearised equations depend on t") && err.contains(hint),
+            "{err}"
+        );
+    }
+}

@@ -71,6 +71,10 @@ pub fn run(args: &ParameterSweepArgs) -> Result<(), CliError> {
         ParameterSweepError::UnknownParameter { .. } => {
             CliError::usage(format!("--parameter: {e}"))
         }
+        // The error and hint of `modes`, which refuses the same equations.
+        ParameterSweepError::TimeDependent { source, .. } => {
+            crate::cli::operating_point::modal_failure(model.as_ref(), &source)
+        }
         e => CliError::failure(format!("`{}`: {e}", model.description().name)),
     })?;
     if let Some(path) = &args.plot {

@@ -55,6 +55,16 @@ pub enum ParameterSweepError {
         /// Its parameters.
         known: Vec<String>,
     },
+    /// The linearised equations depend on `t` at the first value where that was found (a
+    /// parametric excitation, a moving constraint): a property of the model, which `modes`
+    /// refuses too; the sweep stops there, as the equations frozen at `t₀` have no modes.
+    #[error("{source}")]
+    TimeDependent {
+        /// The parameter's value where it was found.
+        value: f64,
+        /// What depends on `t` ([`ModalError::TimeDependent`]).
+        source: ModalError,
+    },
     /// No value of the sweep gave eigenvalues: the first failure.
     #[error("no value of the sweep could be analysed; at {value}: {reason}")]
     EveryPointFailed {
@@ -222,6 +232,9 @@ pub fn eigenvalues_at(
         });
     }
     let point = super::operating_point::operating_point(model, options)?;
+    // As `modes`: equations that change with t have no modes frozen at t₀ (a load that only
+    // moves the equilibrium is allowed).
+    crate::linear::time_dependence::time_dependence(&*model, point.q(), point.t)?;
     let n = model.num_dofs();
     let lin = linearize(model, point.q(), &vec![0.0; n], point.t)?;
     let s = linear_stability(&lin)?;
@@ -314,6 +327,10 @@ pub fn parameter_sweep(
                     stability: Some(found.stability),
                     error: None,
                 }
+            }
+            Err(SweepPointError::Modal(source @ ModalError::TimeDependent { .. })) => {
+                let _ = model.set_parameter(name, before);
+                return Err(ParameterSweepError::TimeDependent { value, source });
             }
             Err(reason) => {
                 raws.push(None);
