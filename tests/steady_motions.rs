@@ -277,6 +277,44 @@ fn the_rolling_disc_is_stable_above_its_critical_speed() {
     assert_eq!(change.direction, Direction::Stabilising);
 }
 
+/// Issue 49: the rolling disc swept from rest. At v = 0 the turning rate's row vanishes and is
+/// left out, so that value has no zero eigenvalue; the steady turns' zero, counted by its
+/// rounding's sign against its own modulus, then made 10 "changes" on `0..10:21` and 82 on
+/// `0..10:201`, and the real one was put at 0.808516 inside a 1e-12 bracket that did not hold
+/// it (the disc still unstable there, e^(0.1346 t)). Counted against the largest |s| and
+/// located by the sign change of the characteristic polynomial's coefficient (here
+/// `−(39.24 − 60 v²)`): one change, at `√(g r/3)` to 1e-13, inside its bracket.
+#[test]
+fn the_rolling_disc_swept_from_rest_changes_stability_once() {
+    let mut m = model("rolling_disc");
+    let critical = (9.81f64 * 0.2 / 3.0).sqrt();
+    for count in [21, 201] {
+        let options = ParameterSweepOptions {
+            axis: SweepAxis::linear("v", 0.0, 10.0, count).unwrap(),
+            operating_point: at("rolling"),
+            refine: true,
+        };
+        let sweep = vibration::parameter_sweep(m.as_mut(), &options, |_, _| {}).unwrap();
+        let changes = &sweep.stability_changes;
+        assert_eq!(changes.len(), 1, "{count}: {changes:?}");
+        let c = &changes[0];
+        assert!(
+            (c.value - critical).abs() <= 1e-13,
+            "{} against {critical}",
+            c.value
+        );
+        // Two ulps of slack: the bracket is of the computed coefficient's sign change.
+        let slack = 4.0 * f64::EPSILON * critical;
+        assert!(
+            c.bracket[0] - slack <= critical && critical <= c.bracket[1] + slack,
+            "{:?}",
+            c.bracket
+        );
+        assert_eq!(c.eigenvalue, Crossing::Real);
+        assert_eq!(c.direction, Direction::Stabilising);
+    }
+}
+
 /// The Whipple bicycle benchmark (`whipple_bicycle`, Meijaard, Papadopoulos, Ruina & Schwab,
 /// Proc. R. Soc. A 463, 2007): the eigenvalues of upright straight rolling at v = 0, 1, …,
 /// 10 m/s equal the paper's Table 2 to 1e-10 (the paper prints 14 decimals; its own
