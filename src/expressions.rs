@@ -58,6 +58,16 @@ pub enum ExpressionError {
     /// A parameter the model does not have.
     #[error(transparent)]
     UnknownParameter(#[from] UnknownParameter),
+    /// Parameter values at which a body is not a physical one (a mass ≤ 0, an inertia that
+    /// is not positive definite or breaks `I₃ ≤ I₁ + I₂`): the rules the model file's
+    /// defaults are held to ([`check_bodies`]).
+    #[error("{set}: {problem} with these values")]
+    Unphysical {
+        /// The assignments that led there (`--set l=1`).
+        set: String,
+        /// What is wrong, as the model file's check says it.
+        problem: String,
+    },
     /// An initial value for a name that is neither a coordinate nor a rate.
     #[error(
         "{option} {name}: `{model}` has no coordinate or rate `{name}` (coordinates: {coordinates}; rates: {rates})"
@@ -207,6 +217,66 @@ pub fn set_parameters(
         let (name, text) = split_assignment(s.as_ref(), "--set")?;
         let value = evaluate(text, &format!("--set {name}"), &parameter_lookup(model))?;
         model.set_parameter(name, value)?;
+    }
+    if !assignments.is_empty() {
+        check_bodies(model).map_err(|problem| ExpressionError::Unphysical {
+            set: assignments
+                .iter()
+                .map(|s| format!("--set {}", s.as_ref()))
+                .collect::<Vec<_>>()
+                .join(" "),
+            problem,
+        })?;
+    }
+    Ok(())
+}
+
+/// Holds `model`'s bodies at its current parameter values to the rules a model file's
+/// defaults are held to when it is loaded (`eomgen_symbolic::model::rules`): every mass
+/// positive, every planar moment of inertia ≥ 0, every 3-D inertia tensor finite, positive
+/// definite and within the triangle inequality `I₃ ≤ I₁ + I₂` (to 0.1 %). Applied after
+/// parameters are set (`--set`, and the Python package's parameters), once all are set, so
+/// that a value may pass through an impossible body on the way (`I1`, then `I3`). A body
+/// whose mass or inertia depends on more than the parameters is not judged here.
+///
+/// # Errors
+/// The first problem, in the words of the model file's check (`the inertia of body `top` is
+/// not positive definite: [[-0.98, 0, 0], …] kg·m²`).
+pub fn check_bodies(model: &dyn ModelInfo) -> Result<(), String> {
+    use eomgen_symbolic::model::rules::{
+        InertiaProblem, inertia_problem, mass_problem, planar_inertia_problem,
+    };
+    let lookup = parameter_lookup(model);
+    // A value that is not finite is judged (a NaN mass is not positive); an expression of
+    // more than the parameters is not.
+    let value = |text: &str| match evaluate(text, "", &lookup) {
+        Ok(v) => Some(v),
+        Err(ExpressionError::NotFinite { value, .. }) => Some(value),
+        Err(_) => None,
+    };
+    for body in model.description().body_centres.iter() {
+        let name = &*body.body;
+        if let Some(problem) = value(&body.mass).and_then(|m| mass_problem(name, m)) {
+            return Err(problem);
+        }
+        let inertia: Option<Vec<f64>> = body.inertia.iter().map(|i| value(i)).collect();
+        match inertia.as_deref() {
+            Some(&[i]) => {
+                if let Some(problem) = planar_inertia_problem(name, i) {
+                    return Err(problem);
+                }
+            }
+            Some(&[xx, yy, zz, xy, yz, xz]) => {
+                if let Some(
+                    InertiaProblem::NotPositiveDefinite(problem)
+                    | InertiaProblem::NotARigidBody(problem),
+                ) = inertia_problem(name, [xx, yy, zz, xy, yz, xz])
+                {
+                    return Err(problem);
+                }
+            }
+            _ => {}
+        }
     }
     Ok(())
 }

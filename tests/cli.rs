@@ -920,6 +920,60 @@ fn stdout(out: std::process::Output) -> String {
     String::from_utf8(out.stdout).unwrap()
 }
 
+/// Issue 49: `--set` values meet the rules the model file's defaults meet (masses positive, a
+/// positive definite inertia, `I₃ ≤ I₁ + I₂` within 0.1 %), with the file check's words and
+/// the assignments named, exit 2. Before, `heavy_top --set l=1` (centroidal moments
+/// `I1 − m l² = −0.98`) simulated with exit 0, `whipple_bicycle --set IBxz=100` (an indefinite
+/// frame) failed at t = 0.23 blaming the constraints, and `free_rigid_body --set I3=3.5`
+/// (17 % beyond the triangle inequality) ran. Within the margin it runs, and so does a value
+/// that passes through an impossible body on the way (`I3`, then `I1`).
+#[test]
+fn set_values_meet_the_body_rules() {
+    for (model, set, body, what) in [
+        ("heavy_top", "l=1", "top", "not positive definite"),
+        (
+            "whipple_bicycle",
+            "IBxz=100",
+            "rear_frame",
+            "not positive definite",
+        ),
+        ("free_rigid_body", "I3=3.5", "body", "triangle inequality"),
+        ("double_pendulum", "m1=-1", "upper", "non-positive mass"),
+    ] {
+        for command in [&["simulate", model][..], &["modes", model]] {
+            let out = eomgen(&[command, &["--set", set]].concat());
+            assert_eq!(out.status.code(), Some(2), "{command:?} {set}");
+            let err = String::from_utf8_lossy(&out.stderr);
+            assert!(
+                err.contains(&format!("body `{body}`"))
+                    && err.contains(what)
+                    && err.contains(&format!("--set {set}")),
+                "{err}"
+            );
+        }
+    }
+    eomgen_ok(&[
+        "simulate",
+        "free_rigid_body",
+        "--set",
+        "I3=3.002",
+        "--t-end",
+        "0.1",
+    ]);
+    // I1 = 1, I2 = 2, I3 = 3 by default: I3 = 5 alone breaks the inequality, with I1 = 3 too
+    // it holds (5 ≤ 3 + 2).
+    eomgen_ok(&[
+        "simulate",
+        "free_rigid_body",
+        "--set",
+        "I3=5",
+        "--set",
+        "I1=3",
+        "--t-end",
+        "0.1",
+    ]);
+}
+
 /// After a failed integration the help names what the model shows where it stopped, before
 /// any guess about the method (issue 28, item 7): "the model may be stiff; try radau5" was
 /// given for a mass matrix singular because of a parameter (`l1 = 0`, then described as
@@ -947,11 +1001,17 @@ fn issue_28_failure_hints_name_the_model_cause() {
         !h.contains("coordinates are singular") && !h.contains("stiff"),
         "{h}"
     );
-    // m1 = −1: det M = m2²/9 − m2² cos²(θ1 − θ2)/4 + m1 m2/9 vanishes when cos² = 8/9.
+    // m1 = −1: det M = m2²/9 − m2² cos²(θ1 − θ2)/4 + m1 m2/9 vanishes when cos² = 8/9. The
+    // double pendulum in energy form: with bodies, `--set m1=-1` is refused before the run
+    // (`set_values_meet_the_body_rules`).
+    let energy_form = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/fixtures/energy_double_pendulum.yaml"
+    );
     for method in ["dp54", "radau5"] {
         let h = help(&[
             "simulate",
-            "double_pendulum",
+            energy_form,
             "--set",
             "m1=-1",
             "--method",

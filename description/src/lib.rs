@@ -222,8 +222,10 @@ pub struct Parameter {
     pub default: f64,
 }
 
-/// A body of a model's kinematic form and the point at its centre of mass, for drawings
-/// (`eomgen animate` marks it).
+/// A body of a model's kinematic form: the point at its centre of mass, for drawings
+/// (`eomgen animate` marks it), and its mass and inertia as expressions of the parameters, by
+/// which values set after loading are held to the rules the file's defaults were
+/// (`eomgen::expressions::check_bodies`).
 #[derive(Debug, Clone, PartialEq, Eq, Serialize)]
 pub struct BodyCentre {
     /// The body's name in the model file.
@@ -232,6 +234,12 @@ pub struct BodyCentre {
     pub point: Text,
     /// A rigid body, planar or 3-D (`true`), or a particle.
     pub rigid: bool,
+    /// Its mass (kg), an expression of the parameters in the model file's syntax.
+    pub mass: Text,
+    /// Its centroidal inertia (kg·m²), expressions in the model file's syntax: none for a
+    /// particle, the moment of a planar body, or a 3-D body's tensor `[xx, yy, zz, xy, yz,
+    /// xz]` in its frame's axes.
+    pub inertia: List<Text>,
 }
 
 /// Which zero crossings of an event function count.

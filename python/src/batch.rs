@@ -12,7 +12,8 @@ use rayon::prelude::*;
 
 use crate::convert::matrix;
 use crate::model::{
-    CoreModel, RunError, RunOptions, method, run_simulation, set_parameter, stabilization,
+    CoreModel, RunError, RunOptions, check_bodies, method, run_simulation, set_parameter,
+    stabilization,
 };
 
 /// How a run ended.
@@ -120,11 +121,13 @@ pub fn simulate_many<'py>(
     };
     // Every run's parameters are checked before any runs.
     if let Some(sets) = &parameters {
-        let mut probe = model.fresh()?;
         for set in sets {
+            let mut probe = model.fresh()?;
             for (name, value) in set {
                 set_parameter(probe.as_mut(), name, *value)?;
             }
+            let all: Vec<(String, f64)> = model.overrides.iter().chain(set).cloned().collect();
+            check_bodies(probe.as_ref(), &all)?;
         }
     }
     let loaded = model.loaded.clone();

@@ -171,7 +171,21 @@ pub(crate) fn instantiate(
     for (name, value) in overrides {
         set_parameter(model.as_mut(), name, *value)?;
     }
+    check_bodies(model.as_ref(), overrides)?;
     Ok(model)
+}
+
+/// The bodies of `model` held, once `overrides` are set, to the rules the model file's
+/// defaults are held to ([`eomgen::expressions::check_bodies`]): a `ParameterError` naming
+/// the values otherwise.
+pub(crate) fn check_bodies(model: &dyn ModelInfo, overrides: &[(String, f64)]) -> PyResult<()> {
+    if overrides.is_empty() {
+        return Ok(());
+    }
+    eomgen::expressions::check_bodies(model).map_err(|problem| {
+        let values: Vec<String> = overrides.iter().map(|(n, v)| format!("{n}={v}")).collect();
+        parameter_error(format!("{problem} with {}", values.join(", ")))
+    })
 }
 
 /// Sets one parameter: a finite value of a parameter the model has.

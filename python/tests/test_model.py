@@ -7,6 +7,7 @@ against closed forms at the analysis' own accuracy (stated per test).
 
 import json
 import math
+import pathlib
 import pickle
 import subprocess
 import threading
@@ -514,12 +515,28 @@ def test_a_missing_or_binary_file_raises_model_error(tmp_path):
 
 def test_a_failure_says_what_the_model_shows_there():
     # m1 = −1: det M = m2²/9 − m2² cos²(θ1 − θ2)/4 + m1 m2/9 vanishes when cos² = 8/9; the
-    # integration stops there, and the exception names the negative mass.
-    m = eomgen.load("double_pendulum").with_parameters(m1=-1.0)
+    # integration stops there, and the exception names the negative mass. The double
+    # pendulum in energy form: with bodies, the value is refused when it is set (below).
+    path = pathlib.Path(__file__).resolve().parents[2] / "tests" / "fixtures" / "energy_double_pendulum.yaml"
+    m = eomgen.load(str(path)).with_parameters(m1=-1.0)
     with pytest.raises(eomgen.IntegrationError) as info:
         m.simulate()
     assert info.value.solution.cause is not None
     assert "m1 = -1" in str(info.value)
+
+
+def test_parameters_meet_the_body_rules():
+    # The rules the file's defaults meet hold for values set later: the heavy top with l = 1
+    # has centroidal moments I1 − m l² = −0.98; the free body with I3 = 3.5 breaks
+    # I3 ≤ I1 + I2; a batch run with such values is refused before any run.
+    with pytest.raises(eomgen.ParameterError, match="body `top` is not positive definite"):
+        eomgen.load("heavy_top").with_parameters(l=1.0)
+    with pytest.raises(eomgen.ParameterError, match="triangle inequality"):
+        eomgen.load("free_rigid_body").with_parameters(I3=3.5)
+    body = eomgen.load("free_rigid_body")
+    body.with_parameters(I3=5.0, I1=3.0)  # an impossible body on the way is no matter
+    with pytest.raises(eomgen.ParameterError, match="I3=3.5"):
+        body.simulate_many(parameters=[{"I3": 3.0}, {"I3": 3.5}], t_end=0.1)
 
 
 # --- animations ------------------------------------------------------------------------------

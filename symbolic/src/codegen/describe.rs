@@ -29,6 +29,8 @@ pub fn describe(model: &SymbolicModel, eom: &EquationsOfMotion, mathml: bool) ->
     let text = |s: &str| -> Text { Cow::Owned(s.to_string()) };
     let point_name = |i: usize| model.points.get(i).map(|(p, _)| text(p));
     let c = &model.constraints;
+    let printer = crate::expr::print::Printer::new(&model.arena, crate::expr::print::Syntax::Text);
+    let expression = |e: crate::expr::ExprId| -> Text { Cow::Owned(printer.print(e)) };
     ModelDescription {
         name: text(&model.name),
         summary: text(&model.description),
@@ -60,6 +62,12 @@ pub fn describe(model: &SymbolicModel, eom: &EquationsOfMotion, mathml: bool) ->
                     body: text(&b.name),
                     point: point_name(b.com)?,
                     rigid: b.rotation.is_some() || b.spatial.is_some(),
+                    mass: expression(b.mass),
+                    inertia: match (&b.rotation, &b.spatial) {
+                        (_, Some(spatial)) => spatial.inertia.map(expression).to_vec().into(),
+                        (Some((inertia, _)), None) => vec![expression(*inertia)].into(),
+                        (None, None) => Cow::Borrowed(&[]),
+                    },
                 })
             })
             .collect(),
@@ -144,7 +152,15 @@ pub fn description_tokens(
             .iter()
             .map(|c| {
                 let (body, point, rigid) = (text(&c.body), text(&c.point), c.rigid);
-                quote!(#krate::BodyCentre { body: #body, point: #point, rigid: #rigid })
+                let mass = text(&c.mass);
+                let inertia = texts(&c.inertia);
+                quote!(#krate::BodyCentre {
+                    body: #body,
+                    point: #point,
+                    rigid: #rigid,
+                    mass: #mass,
+                    inertia: #inertia,
+                })
             })
             .collect(),
     );

@@ -1680,33 +1680,21 @@ impl<'f> Checker<'f> {
                     (mass, None)
                 }
             };
-            if let Some(m) = evaluate(mass, &file.parameters)
-                && (m.is_nan() || m <= 0.0)
+            if let Some(problem) =
+                evaluate(mass, &file.parameters).and_then(|m| mass_problem(&b.name.value, m))
             {
                 self.error(
-                    Diagnostic::new(
-                        mass.location,
-                        format!("body `{}` has non-positive mass `{m:?}` (kg)", b.name.value),
-                    )
-                    .with_help("a mass must be positive (at the parameters' defaults)"),
+                    Diagnostic::new(mass.location, problem)
+                        .with_help("a mass must be positive (at the parameters' defaults)"),
                 );
             }
             if let Some(inertia) = inertia
-                && let Some(i) = evaluate(inertia, &file.parameters)
-                && (i.is_nan() || i < 0.0)
+                && let Some(problem) = evaluate(inertia, &file.parameters)
+                    .and_then(|i| planar_inertia_problem(&b.name.value, i))
             {
-                self.error(
-                    Diagnostic::new(
-                        inertia.location,
-                        format!(
-                            "body `{}` has negative inertia `{i:?}` (kg·m²)",
-                            b.name.value
-                        ),
-                    )
-                    .with_help(
-                        "a centroidal moment of inertia is ≥ 0 (at the parameters' defaults)",
-                    ),
-                );
+                self.error(Diagnostic::new(inertia.location, problem).with_help(
+                    "a centroidal moment of inertia is ≥ 0 (at the parameters' defaults)",
+                ));
             }
         }
     }
@@ -1807,54 +1795,97 @@ impl Checker<'_> {
                 }
             }
         }
-        // Scaled by the largest entry, so that neither 1e300 nor 1e-300 kg·m² overflows or
-        // underflows in the minors and moments below.
-        let scale = e.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-        let [xx, yy, zz, xy, yz, xz] = e.map(|v| if scale > 0.0 { v / scale } else { v });
-        let minors = [
-            xx,
-            xx * yy - xy * xy,
-            xx * (yy * zz - yz * yz) - xy * (xy * zz - yz * xz) + xz * (xy * yz - yy * xz),
-        ];
-        // Each scaled minor carries a rounding error of a few ε: above 64ε it is positive,
-        // so a needle whose smallest moment is 1e-12 of the others is definite, and the
-        // rounding of a singular tensor (a rotated zero moment) is not taken for definiteness.
-        let definite = scale > 0.0 && minors.iter().all(|m| *m > 64.0 * f64::EPSILON);
-        if !definite {
-            let [exx, eyy, ezz, exy, eyz, exz] = e.map(short);
-            self.error(
-                Diagnostic::new(
+        if let Some(problem) = inertia_problem(body, e) {
+            let at = "at the parameters' defaults";
+            let diagnostic = match problem {
+                InertiaProblem::NotPositiveDefinite(message) => Diagnostic::new(
                     inertia.location,
-                    format!(
-                        "the inertia of body `{body}` is not positive definite: [[{exx}, {exy}, {exz}], [{exy}, {eyy}, {eyz}], [{exz}, {eyz}, {ezz}]] kg·m² at the parameters' defaults"
-                    ),
+                    format!("{message} {at}"),
                 )
                 .with_help("a rigid body's inertia tensor about its centre of mass is positive definite (its three principal moments are positive); a moment ≤ 0, or an off-diagonal entry as large as the moments it joins, is not"),
-            );
-            return;
-        }
-        // The triangle inequality of the principal moments: `I₃ = ∫(x² + y²) dm ≤ ∫(y² + z²) dm
-        // + ∫(x² + z²) dm = I₁ + I₂` in principal axes (equal for a flat body). Refused beyond
-        // 0.1 % of `I₃`: a flat body's moments typed to four digits may miss the equality by
-        // a few parts in 10⁴, and the moments computed here carry `√ε` where two coincide.
-        let [a, b, c] = principal_moments([xx, yy, zz, xy, yz, xz]).map(|v| v * scale);
-        let excess = c - (a + b);
-        if excess > 1e-3 * c {
-            self.error(
-                Diagnostic::new(
+                InertiaProblem::NotARigidBody(message) => Diagnostic::new(
                     inertia.location,
-                    format!(
-                        "the inertia of body `{body}` is not a rigid body's: its principal moments {}, {} and {} kg·m² break the triangle inequality I₃ ≤ I₁ + I₂ by {} kg·m² at the parameters' defaults",
-                        short(a),
-                        short(b),
-                        short(c),
-                        short(excess)
-                    ),
+                    format!("{message} {at}"),
                 )
                 .with_help("no mass distribution has one principal moment larger than the sum of the other two (in principal axes, I₃ = ∫(x² + y²) dm ≤ ∫(y² + z²) dm + ∫(x² + z²) dm = I₁ + I₂; equal for a flat body); check the moments and their axes"),
-            );
+            };
+            self.error(diagnostic);
         }
     }
+}
+
+/// What is wrong with the mass `m` (kg) of body `body`: `None` for a positive mass.
+pub fn mass_problem(body: &str, m: f64) -> Option<String> {
+    (m.is_nan() || m <= 0.0).then(|| format!("body `{body}` has non-positive mass `{m:?}` (kg)"))
+}
+
+/// What is wrong with the centroidal moment of inertia `i` (kg·m²) of the planar body
+/// `body`: `None` for `i ≥ 0`.
+pub fn planar_inertia_problem(body: &str, i: f64) -> Option<String> {
+    (i.is_nan() || i < 0.0).then(|| format!("body `{body}` has negative inertia `{i:?}` (kg·m²)"))
+}
+
+/// Why a 3-D inertia tensor is not a rigid body's ([`inertia_problem`]).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum InertiaProblem {
+    /// Not positive definite (or not finite): the message.
+    NotPositiveDefinite(String),
+    /// Positive definite, but its principal moments break `I₃ ≤ I₁ + I₂`: the message.
+    NotARigidBody(String),
+}
+
+/// What is wrong with the inertia tensor `[xx, yy, zz, xy, yz, xz]` (kg·m², about the centre
+/// of mass) of body `body`, by the rules every rigid body meets: finite entries, positive
+/// definite (Sylvester's criterion on the leading minors of the tensor scaled by its largest
+/// entry, each above `64ε`, so that neither 1e300 nor 1e-300 kg·m² overflows and a needle
+/// whose axial moment is 1e-12 of the others passes, while a rotated zero moment does not),
+/// and principal moments within the triangle inequality `I₃ ≤ I₁ + I₂` to 0.1 % of `I₃`.
+/// `None` for a rigid body's tensor. The messages end where a caller says at which
+/// parameter values.
+pub fn inertia_problem(body: &str, e: [f64; 6]) -> Option<InertiaProblem> {
+    if let Some((name, v)) = ["xx", "yy", "zz", "xy", "yz", "xz"]
+        .iter()
+        .zip(e)
+        .find(|(_, v)| !v.is_finite())
+    {
+        return Some(InertiaProblem::NotPositiveDefinite(format!(
+            "the inertia of body `{body}` is not finite: its entry {name} is {v}"
+        )));
+    }
+    // Scaled by the largest entry, so that neither 1e300 nor 1e-300 kg·m² overflows or
+    // underflows in the minors and moments below.
+    let scale = e.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+    let [xx, yy, zz, xy, yz, xz] = e.map(|v| if scale > 0.0 { v / scale } else { v });
+    let minors = [
+        xx,
+        xx * yy - xy * xy,
+        xx * (yy * zz - yz * yz) - xy * (xy * zz - yz * xz) + xz * (xy * yz - yy * xz),
+    ];
+    // Each scaled minor carries a rounding error of a few ε: above 64ε it is positive, so a
+    // needle whose smallest moment is 1e-12 of the others is definite, and the rounding of a
+    // singular tensor (a rotated zero moment) is not taken for definiteness.
+    let definite = scale > 0.0 && minors.iter().all(|m| *m > 64.0 * f64::EPSILON);
+    if !definite {
+        let [exx, eyy, ezz, exy, eyz, exz] = e.map(short);
+        return Some(InertiaProblem::NotPositiveDefinite(format!(
+            "the inertia of body `{body}` is not positive definite: [[{exx}, {exy}, {exz}], [{exy}, {eyy}, {eyz}], [{exz}, {eyz}, {ezz}]] kg·m²"
+        )));
+    }
+    // The triangle inequality of the principal moments: `I₃ = ∫(x² + y²) dm ≤ ∫(y² + z²) dm
+    // + ∫(x² + z²) dm = I₁ + I₂` in principal axes (equal for a flat body). Refused beyond
+    // 0.1 % of `I₃`: a flat body's moments typed to four digits may miss the equality by a
+    // few parts in 10⁴, and the moments computed here carry `√ε` where two coincide.
+    let [a, b, c] = principal_moments([xx, yy, zz, xy, yz, xz]).map(|v| v * scale);
+    let excess = c - (a + b);
+    (excess > 1e-3 * c).then(|| {
+        InertiaProblem::NotARigidBody(format!(
+            "the inertia of body `{body}` is not a rigid body's: its principal moments {}, {} and {} kg·m² break the triangle inequality I₃ ≤ I₁ + I₂ by {} kg·m²",
+            short(a),
+            short(b),
+            short(c),
+            short(excess)
+        ))
+    })
 }
 
 /// A number in a diagnostic: 6 decimals between 1e-3 and 1e6 (trailing zeros dropped, as `1`,
