@@ -315,6 +315,33 @@ fn the_rolling_disc_swept_from_rest_changes_stability_once() {
     }
 }
 
+/// Issue 49: a steady motion moves only cyclic coordinates. A pendulum at the bottom of its
+/// swing declared a steady motion (`q_dot = 1` held, `q` not ignorable) was "found, residual
+/// 6e-16, marginally stable"; a particle running in at `ṙ = −1` with `r` declared ignorable
+/// (`r` is in M and F) was "unstable, e^(1.0 t)", where a turn in fact grows as `1/r²`. Both
+/// are refused, naming the coordinate; the bundled steady motions (the tops, the disc, the
+/// sleigh, the bicycle) pass, by the tests around this one.
+#[test]
+fn steady_motions_move_only_cyclic_coordinates() {
+    for (file, point, words) in [
+        (
+            "held_rate_not_ignorable.yaml",
+            "swinging",
+            ["`q_dot` = 1", "not declared ignorable"],
+        ),
+        (
+            "ignorable_not_cyclic.yaml",
+            "inward",
+            ["`r` moves", "the mass matrix M"],
+        ),
+    ] {
+        let out = common::eomgen(&["modes", &fixture(file), "--at", point]);
+        assert_eq!(out.status.code(), Some(1), "{file}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(words.iter().all(|w| err.contains(w)), "{file}: {err}");
+    }
+}
+
 /// The Whipple bicycle benchmark (`whipple_bicycle`, Meijaard, Papadopoulos, Ruina & Schwab,
 /// Proc. R. Soc. A 463, 2007): the eigenvalues of upright straight rolling at v = 0, 1, …,
 /// 10 m/s equal the paper's Table 2 to 1e-10 (the paper prints 14 decimals; its own

@@ -96,6 +96,36 @@ pub enum SteadyMotionError {
         /// The entry.
         value: f64,
     },
+    /// A rate is held for a coordinate not declared ignorable: the coordinate moves, and
+    /// unless nothing depends on it the state is an instant of a motion, not a steady one
+    /// (a pendulum at the bottom of its swing).
+    #[error(
+        "the rate `{coordinate}_dot` = {rate} is held, but `{coordinate}` is not declared ignorable: a steady motion moves only cyclic coordinates; list `{coordinate}` in the entry's `ignorable:` if nothing depends on it, else this state is an instant of a motion, not a steady one"
+    )]
+    HeldRateNotIgnorable {
+        /// The coordinate.
+        coordinate: String,
+        /// Its held rate.
+        rate: f64,
+    },
+    /// A coordinate that moves in the steady motion (declared ignorable, with a held rate)
+    /// is not cyclic: the equations change as it moves, so the motion is not steady and its
+    /// linearisation at one instant says nothing of its stability.
+    #[error(
+        "`{coordinate}` moves in the steady motion (`{coordinate}_dot` = {rate}) and is declared ignorable, but {part} depends on it (relative change {change:.1e} when it moves by {shift} from the steady motion or a state near it): a steady motion moves only cyclic coordinates"
+    )]
+    NotCyclic {
+        /// The coordinate.
+        coordinate: String,
+        /// Its held rate.
+        rate: f64,
+        /// What depends on it: the mass matrix, the forces, a constraint.
+        part: String,
+        /// The largest relative change found.
+        change: f64,
+        /// The shift of the coordinate where it was found.
+        shift: f64,
+    },
     /// The right-hand side failed at (or near) the point.
     #[error("the equations cannot be evaluated at the operating point: {0}")]
     Rhs(#[from] RhsError),
@@ -199,6 +229,15 @@ pub fn find_steady_motion(
     ignorable: &[usize],
 ) -> Result<SteadyMotion, SteadyMotionError> {
     let n = guess.len();
+    let names = model.description().coordinate_names();
+    if let Some(i) = (0..n.min(rates.len())).find(|&i| rates[i] != 0.0 && !ignorable.contains(&i)) {
+        return Err(SteadyMotionError::HeldRateNotIgnorable {
+            coordinate: names
+                .get(i)
+                .map_or_else(|| i.to_string(), |c| c.to_string()),
+            rate: rates[i],
+        });
+    }
     let free: Vec<usize> = (0..n).filter(|i| !ignorable.contains(i)).collect();
     let mut q = guess.to_vec();
     let mut r = steady_residuals(model, t, &q, rates)?;
@@ -249,12 +288,111 @@ pub fn find_steady_motion(
             break;
         }
     }
+    let moving: Vec<usize> = (0..n.min(rates.len()))
+        .filter(|&i| rates[i] != 0.0)
+        .collect();
+    check_cyclic(model, t, &q, rates, &moving)?;
     Ok(SteadyMotion {
         q,
         qdot: rates.to_vec(),
         iterations,
         residual: largest(&r).0,
     })
+}
+
+/// Shifts (in the coordinate's units) by which [`check_cyclic`] moves a coordinate:
+/// irrational-looking and of both signs, so that no periodic dependence hides in all.
+const CYCLIC_SHIFTS: [f64; 3] = [0.271_828, 1.523_7, -0.731_3];
+
+/// Checks that each of the `moving` coordinates is cyclic: `M`, `F` and the constraints'
+/// `Φ`, `J`, velocity terms and `γ` do not change when it is shifted ([`CYCLIC_SHIFTS`]), at
+/// the steady motion `(q, rates)` and at a state near it (every entry moved by 0.1–0.2, which
+/// catches a dependence multiplied by a rate that is 0 at the steady motion, as the
+/// Coriolis force `−2 m r ṙ θ̇` of a particle running in at θ̇ = 0). Relative to each
+/// part's largest entry, above 1e-9 (the time-dependence check's tolerance): numerically,
+/// because derived expressions keep cyclic coordinates that cancel only in value
+/// (`cos² φ + sin² φ`). A state where the equations are not finite is skipped.
+///
+/// # Errors
+/// [`SteadyMotionError::NotCyclic`] naming the coordinate and the part that depends on it.
+fn check_cyclic(
+    model: &dyn ModelInfo,
+    t: f64,
+    q: &[f64],
+    rates: &[f64],
+    moving: &[usize],
+) -> Result<(), SteadyMotionError> {
+    if moving.is_empty() {
+        return Ok(());
+    }
+    let steady: Vec<f64> = q.iter().chain(rates).copied().collect();
+    let near: Vec<f64> = steady
+        .iter()
+        .enumerate()
+        .map(|(k, v)| v + 0.1 * (1.0 + (k as f64 * 0.618_033_988_749_895).fract()))
+        .collect();
+    let constrained = !model.description().constraints.is_empty();
+    let parts = |y: &[f64]| -> Option<Vec<(&'static str, DVector<f64>)>> {
+        let (m, f) = model.mass_matrix_and_forcing(t, y);
+        let mut out = vec![
+            (
+                "the mass matrix M",
+                DVector::from_column_slice(m.as_slice()),
+            ),
+            ("the forces F", f),
+        ];
+        if constrained {
+            let c = model.constraint_equations(t, y);
+            out.push(("the constraints (Φ, their velocity terms and γ)", {
+                DVector::from_iterator(
+                    c.phi.len() + c.velocity.len() + c.gamma.len(),
+                    c.phi
+                        .iter()
+                        .chain(c.velocity.iter())
+                        .chain(c.gamma.iter())
+                        .copied(),
+                )
+            }));
+            out.push((
+                "the constraint Jacobian J",
+                DVector::from_column_slice(c.jacobian.as_slice()),
+            ));
+        }
+        out.iter()
+            .all(|(_, v)| v.iter().all(|x| x.is_finite()))
+            .then_some(out)
+    };
+    for base in [&steady, &near] {
+        let Some(at_base) = parts(base) else { continue };
+        for &i in moving {
+            for shift in CYCLIC_SHIFTS {
+                let mut y = base.clone();
+                y[i] += shift;
+                let Some(shifted) = parts(&y) else { continue };
+                for ((part, a), (_, b)) in at_base.iter().zip(&shifted) {
+                    let scale = a.amax().max(b.amax());
+                    let change = if scale == 0.0 {
+                        0.0
+                    } else {
+                        (a - b).amax() / scale
+                    };
+                    if change > 1e-9 {
+                        let names = model.description().coordinate_names();
+                        return Err(SteadyMotionError::NotCyclic {
+                            coordinate: names
+                                .get(i)
+                                .map_or_else(|| i.to_string(), |c| c.to_string()),
+                            rate: rates[i],
+                            part: (*part).to_string(),
+                            change,
+                            shift,
+                        });
+                    }
+                }
+            }
+        }
+    }
+    Ok(())
 }
 
 /// The linearisation of a model about a steady motion, restricted to the motions its
