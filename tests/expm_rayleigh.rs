@@ -541,11 +541,40 @@ fn expm_bounds_grow_with_the_time_scales_spanned() {
     let study = expm_study_of(&rotation, &[1.0, 0.0], &times, 1e-12).unwrap();
     assert!(study.passed(), "{:?}", study.differences);
     for d in &study.differences {
-        // ‖A‖_F t = √2 · 1e5.
+        // ρ(A) t = 1e5 (a rotation: no transient amplification).
         assert!(d.tolerance < 1e-2 && d.relative < 1e-6, "{d:?}");
     }
-    // Over 5 s (‖A‖_F t ≈ 7.1) the bounds stay at their base times 7.1.
+    // Over 5 s (ρ(A) t = 5) the bounds stay at their base times 5, times the amplification
+    // bound √2 (the Frobenius norm of a rotation, an upper bound of its 2-norm 1).
     let short: Vec<f64> = (0..=10).map(|k| 0.5 * k as f64).collect();
     let study = expm_study_of(&rotation, &[1.0, 0.0], &short, 1e-12).unwrap();
-    assert!(study.differences.iter().all(|d| d.tolerance <= 1e-8 * 7.1));
+    let most = 1e-8 * 5.0 * 2f64.sqrt() * (1.0 + 1e-12);
+    assert!(study.differences.iter().all(|d| d.tolerance <= most));
+}
+
+/// Issue 49: a strongly non-normal `A = [[1, 1e10], [0, 1]]` (eigenvalues 1, 1: one time
+/// scale per second). The bound grew with `‖A‖_F t = 5e10` to 50, which no relative
+/// difference can exceed; with `ρ(A) t` and the sampled amplification of `e^{At}` it is
+/// 5.6e-9, and the routes agree to 7e-14. A bound of 1e-2 or more is never a pass: with
+/// `tol = 1e-5` and a horizon of 5, the integration pair's bound is 0.5, unchecked.
+#[test]
+fn expm_bounds_are_never_vacuous() {
+    let a = DMatrix::from_row_slice(2, 2, &[1.0, 1e10, 0.0, 1.0]);
+    let times: Vec<f64> = (0..=20).map(|k| 0.25 * k as f64).collect();
+    let study = expm_study_of(&a, &[0.6, 0.8], &times, 1e-13).unwrap();
+    assert!(study.passed(), "{:?}", study.differences);
+    for d in &study.differences {
+        assert!(d.checked && d.tolerance < 1e-7, "{d:?}");
+    }
+    let study = expm_study_of(&a, &[0.6, 0.8], &times, 1e-5).unwrap();
+    let integration = study
+        .differences
+        .iter()
+        .find(|d| d.tolerance >= 1e-2)
+        .expect("a pair with a bound that tests nothing");
+    assert!(
+        !integration.checked && !integration.passed,
+        "{integration:?}"
+    );
+    assert!(!study.passed());
 }

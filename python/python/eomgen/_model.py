@@ -62,7 +62,7 @@ def expm_study(n: int = 10, seed: int = 32, t: float = 5.0, samples: int = 21, t
     (the command line exits 1 otherwise).
 
     Raises:
-        AnalysisError: a size out of 1 … 400, a matrix that is not square or not finite, a
+        AnalysisError: a size out of 1 … 150, a matrix that is not square or not finite, a
             bad tolerance, end time or times, a zero solution.
         ValueError: a matrix that is not square (``z0`` or ``times`` given).
     """
