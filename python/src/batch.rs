@@ -16,6 +16,13 @@ use crate::model::{
     stabilization,
 };
 
+/// Most worker threads a batch may ask for (`threads=10000` spawned that many).
+const MAX_THREADS: usize = 256;
+/// Most output times per run: `eomgen simulate --t-out`'s limit (docs/cli.md).
+pub(crate) const MAX_OUTPUT_TIMES: usize = 100_000;
+/// Most numbers a batch returns (states and energies): 800 MB of `f64`.
+const MAX_RESULT_VALUES: usize = 100_000_000;
+
 /// How a run ended.
 enum Ended {
     /// At `t_end`.
@@ -64,10 +71,18 @@ pub fn simulate_many<'py>(
     threads: Option<usize>,
     keep_failures: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
-    if threads == Some(0) {
-        return Err(pyo3::exceptions::PyValueError::new_err(
-            "threads must be at least 1 (None: one per core)",
-        ));
+    if let Some(n) = threads
+        && !(1..=MAX_THREADS).contains(&n)
+    {
+        return Err(pyo3::exceptions::PyValueError::new_err(format!(
+            "threads must be 1 to {MAX_THREADS}, got {n} (None: one per core)"
+        )));
+    }
+    if t_out.len() > MAX_OUTPUT_TIMES {
+        return Err(pyo3::exceptions::PyValueError::new_err(format!(
+            "t_out has {} times, at most {MAX_OUTPUT_TIMES} are allowed (as `eomgen simulate --t-out`)",
+            t_out.len()
+        )));
     }
     let dim = 2 * model.fresh()?.num_dofs();
     let states: Option<Vec<Vec<f64>>> = match &initial_states {
@@ -108,6 +123,18 @@ pub fn simulate_many<'py>(
         return Err(pyo3::exceptions::PyValueError::new_err(
             "t_out must list at least one output time",
         ));
+    }
+    // The states and energies returned: refused before any run when they would not fit
+    // (1e5 runs of 1e5 times aborted the interpreter on a failed allocation).
+    let values = batch
+        .checked_mul(t_out.len())
+        .and_then(|v| v.checked_mul(dim + 1));
+    if values.is_none_or(|v| v > MAX_RESULT_VALUES) {
+        return Err(pyo3::exceptions::PyValueError::new_err(format!(
+            "{batch} runs × {} output times × {} values per sample is more than the {MAX_RESULT_VALUES} numbers (800 MB) a batch may return; run it in parts",
+            t_out.len(),
+            dim + 1
+        )));
     }
     let base = SimulationOptions {
         method: method(method_name)?,
@@ -186,18 +213,36 @@ pub fn simulate_many<'py>(
             end,
         })
     };
-    let outcomes: Result<Vec<Outcome>, RunError> = py.detach(|| {
-        let run_all = || (0..batch).into_par_iter().map(one).collect();
-        match threads {
-            Some(n) => rayon::ThreadPoolBuilder::new()
-                .num_threads(n)
-                .build()
-                .map_err(|e| RunError::Analysis(format!("the thread pool: {e}")))?
-                .install(run_all),
-            None => run_all(),
+    // In chunks of a few runs per thread, with the interpreter's signals checked between
+    // them: Ctrl-C raises KeyboardInterrupt within a chunk's time, not at the batch's end.
+    let outcomes: PyResult<Vec<Outcome>> = py.detach(|| {
+        let pool = match threads {
+            Some(n) => Some(
+                rayon::ThreadPoolBuilder::new()
+                    .num_threads(n)
+                    .build()
+                    .map_err(|e| RunError::Analysis(format!("the thread pool: {e}")).into_py())?,
+            ),
+            None => None,
+        };
+        let workers = pool.as_ref().map_or_else(
+            rayon::current_num_threads,
+            rayon::ThreadPool::current_num_threads,
+        );
+        let chunk = 4 * workers.max(1);
+        let mut all = Vec::with_capacity(batch);
+        for start in (0..batch).step_by(chunk) {
+            let runs = start..(start + chunk).min(batch);
+            let part: Result<Vec<Outcome>, RunError> = match &pool {
+                Some(pool) => pool.install(|| runs.into_par_iter().map(&one).collect()),
+                None => runs.into_par_iter().map(&one).collect(),
+            };
+            all.extend(part.map_err(RunError::into_py)?);
+            Python::attach(|py| py.check_signals())?;
         }
+        Ok(all)
     });
-    let outcomes = outcomes.map_err(RunError::into_py)?;
+    let outcomes = outcomes?;
     let out = PyDict::new(py);
     out.set_item("t", PyArray1::from_vec(py, t_out))?;
     let mut y = Vec::with_capacity(batch * k * dim);

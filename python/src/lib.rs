@@ -18,6 +18,10 @@ use pyo3::prelude::*;
 /// The compiled half of the `eomgen` package.
 #[pymodule]
 fn _eomgen(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    // NumPy's C API is looked up at the first array made; made here, at import, rather than
+    // in a call that Ctrl-C interrupts, where the lookup failed and rust-numpy panicked
+    // ("Failed to access NumPy array API capsule … KeyboardInterrupt").
+    let _ = numpy::PyArray1::<f64>::zeros(m.py(), 0, false);
     m.add_class::<model::CoreModel>()?;
     m.add_function(wrap_pyfunction!(batch::simulate_many, m)?)?;
     m.add_function(wrap_pyfunction!(animate::animate_simulation, m)?)?;

@@ -195,13 +195,10 @@ pub(crate) fn set_parameter(model: &mut dyn ModelInfo, name: &str, value: f64) -
             "parameter `{name}` must be a finite number, got {value}"
         )));
     }
-    model.set_parameter(name, value).map_err(|e| {
-        let known = model.description().parameter_names().join(", ");
-        parameter_error(format!(
-            "{e} (parameters of `{}`: {known})",
-            model.description().name
-        ))
-    })
+    // The error names the model and lists its parameters itself.
+    model
+        .set_parameter(name, value)
+        .map_err(|e| parameter_error(e.to_string()))
 }
 
 /// The method named `name` ([`Method`]'s names: `dp54`, `dop853`, `radau5`, …).
@@ -571,6 +568,15 @@ impl CoreModel {
         args: RunArgs,
         t_out: Option<Vec<f64>>,
     ) -> PyResult<Bound<'py, PyDict>> {
+        if let Some(times) = &t_out
+            && times.len() > crate::batch::MAX_OUTPUT_TIMES
+        {
+            return Err(pyo3::exceptions::PyValueError::new_err(format!(
+                "t_out has {} times, at most {} are allowed (as `eomgen simulate --t-out`)",
+                times.len(),
+                crate::batch::MAX_OUTPUT_TIMES
+            )));
+        }
         let run = args.options(t_out.map_or(OutputTimes::Steps, OutputTimes::At))?;
         let mut model = self.fresh()?;
         let started = std::time::Instant::now();

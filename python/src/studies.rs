@@ -109,6 +109,12 @@ fn study_parameter_sweep<'py>(
             "values must be a non-empty, strictly ascending sequence of finite numbers",
         ));
     }
+    if values.len() > 10_000 {
+        return Err(pyo3::exceptions::PyValueError::new_err(format!(
+            "values has {} entries, at most 10000 are allowed (as `study parameter-sweep --values`)",
+            values.len()
+        )));
+    }
     let options = ParameterSweepOptions {
         axis: SweepAxis {
             name: parameter,

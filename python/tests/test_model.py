@@ -539,6 +539,34 @@ def test_parameters_meet_the_body_rules():
         body.simulate_many(parameters=[{"I3": 3.0}, {"I3": 3.5}], t_end=0.1)
 
 
+def test_bad_values_are_value_errors_and_sizes_are_bounded():
+    # Issue 49: a NaN initial value was an IntegrationError, t = nan accepted, a one-element
+    # baumgarte an IndexError, an unknown parameter listed the parameters twice; the CLI's
+    # size limits did not apply (1e7 output times, 20,001 sweep values, 10,000 threads, and
+    # a batch whose result could not be allocated aborted the interpreter).
+    m = eomgen.load("double_pendulum")
+    with pytest.raises(ValueError, match="finite"):
+        m.simulate(initial={"theta1": float("nan")})
+    with pytest.raises(ValueError, match="finite"):
+        m.simulate(initial=[0.0, float("inf"), 0.0, 0.0])
+    with pytest.raises(ValueError, match="finite"):
+        m.modes(t=float("nan"))
+    with pytest.raises(ValueError, match="two gains"):
+        m.simulate(stabilization="baumgarte", baumgarte=(1.0,))
+    with pytest.raises(eomgen.ParameterError) as info:
+        m.with_parameters(mass=1.0)
+    assert str(info.value).count("m1, m2") == 1, str(info.value)
+    with pytest.raises(ValueError, match="at most 100000"):
+        m.simulate(t_end=1.0, t_out=np.linspace(0.0, 1.0, 100_001))
+    with pytest.raises(ValueError, match="threads must be 1 to 256"):
+        m.simulate_many(parameters={"m1": [1.0, 2.0]}, t_end=0.1, threads=10_000)
+    with pytest.raises(ValueError, match="a batch may return"):
+        m.simulate_many(parameters={"m1": np.linspace(1.0, 2.0, 100_000)},
+                        t_end=1.0, t_out=np.linspace(0.0, 1.0, 100_000))
+    with pytest.raises(ValueError, match="at most 10000"):
+        m.parameter_sweep("m1", np.linspace(1.0, 2.0, 10_001), at="hanging")
+
+
 # --- animations ------------------------------------------------------------------------------
 
 

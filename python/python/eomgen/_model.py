@@ -27,6 +27,23 @@ METHODS = tuple(_eomgen.methods())
 DEFAULT_T_END, DEFAULT_METHOD, DEFAULT_RTOL, DEFAULT_ATOL, DEFAULT_BAUMGARTE = _eomgen.simulation_defaults()
 
 
+def _finite(value: float, what: str) -> float:
+    """``value`` as a float, or a ValueError naming ``what`` when it is not a finite number."""
+    x = float(value)
+    if not math.isfinite(x):
+        raise ValueError(f"{what} must be a finite number, got {x}")
+    return x
+
+
+def _gains(baumgarte) -> Tuple[float, float]:
+    """Baumgarte's two gains ``(alpha, beta)`` (1/s), or a ValueError."""
+    try:
+        alpha, beta = baumgarte
+    except (TypeError, ValueError):
+        raise ValueError(f"baumgarte must be two gains (alpha, beta), got {baumgarte!r}") from None
+    return float(alpha), float(beta)
+
+
 def load(name_or_path: str) -> "Model":
     """Opens a model: a bundled model's name (``"double_pendulum"``, see
     :func:`bundled_models`) or the path of any model file (``"my/model.yaml"``), whose
@@ -229,7 +246,7 @@ class Model:
 
         Raises:
             ValueError: a name that is neither a coordinate nor a rate ``<coordinate>_dot``,
-                or a state of the wrong length.
+                a value that is not a finite number, or a state of the wrong length.
         """
         y0 = np.array(self._core.initial_state(), dtype=float)
         if initial is None:
@@ -244,11 +261,14 @@ class Model:
                         f"`{key}` is not a coordinate or rate of `{self.name}` "
                         f"(coordinates: {', '.join(names)}; rates: <coordinate>_dot)"
                     )
-                y0[index[key]] = float(value)
+                y0[index[key]] = _finite(value, f"initial `{key}`")
             return y0
         y = np.asarray(initial, dtype=float).reshape(-1)
         if y.shape != y0.shape:
             raise ValueError(f"the initial state must have {y0.size} entries ([q; q̇]), got {y.size}")
+        bad = np.flatnonzero(~np.isfinite(y))
+        if bad.size:
+            raise ValueError(f"the initial state must be finite; entry {bad[0]} is {y[bad[0]]}")
         return y
 
     # --- simulation --------------------------------------------------------------------
@@ -312,7 +332,7 @@ class Model:
             "dt": None if dt is None else float(dt),
             "initial_state": None if initial is None else self.initial_state(initial).tolist(),
             "stabilization": str(stabilization),
-            "baumgarte": (float(baumgarte[0]), float(baumgarte[1])),
+            "baumgarte": _gains(baumgarte),
             "stop_when": [str(s) for s in stop_when],
             "events": [str(s) for s in events],
         }
@@ -454,7 +474,7 @@ class Model:
             float(atol),
             None if dt is None else float(dt),
             str(stabilization),
-            (float(baumgarte[0]), float(baumgarte[1])),
+            _gains(baumgarte),
             None if threads is None else int(threads),
             errors == "keep",
         )
@@ -491,7 +511,7 @@ class Model:
                 ``t`` in ``M``, ``C`` or ``K``.
         """
         at, label = self._operating_point(at)
-        kind, summary = self._core.modes(at, label, float(t))
+        kind, summary = self._core.modes(at, label, _finite(t, "t"))
         if kind == "steady":
             return SteadyMotion(summary)
         return Modes(summary)
@@ -504,7 +524,7 @@ class Model:
             for key, value in at.items():
                 if key not in names:
                     raise ValueError(f"`{key}` is not a coordinate of `{self.name}` (coordinates: {', '.join(names)})")
-                q[names.index(key)] = float(value)
+                q[names.index(key)] = _finite(value, f"`{key}`")
             return q.tolist(), ",".join(f"{k}={v}" for k, v in at.items())
         return _at(at), None
 

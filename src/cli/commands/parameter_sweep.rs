@@ -114,7 +114,7 @@ fn parse_values(name: &str, spec: &str, model: &dyn ModelInfo) -> Result<SweepAx
     let count: usize = count.trim().parse().map_err(|_| bad())?;
     SweepAxis::linear(name, lo, hi, count).map_err(|_| {
         CliError::usage(format!(
-            "--values: need 1 ≤ N ≤ 10000 values and LO < HI, got `{spec}`"
+            "--values: need 1 ≤ N ≤ 10000 values and finite LO < HI, got `{spec}`"
         ))
     })
 }

@@ -55,7 +55,7 @@ pub enum FloquetStudyError {
         atol: f64,
     },
     /// A swept axis is malformed.
-    #[error("need 1 ≤ N ≤ 10000 values and LO < HI, got {lo}..{hi}:{count}")]
+    #[error("need 1 ≤ N ≤ 10000 values and finite LO < HI, got {lo}..{hi}:{count}")]
     InvalidAxis {
         /// Lower end.
         lo: f64,
@@ -412,17 +412,31 @@ impl SweepAxis {
     /// `count = 1`).
     ///
     /// # Errors
-    /// [`FloquetStudyError::InvalidAxis`] unless `1 ≤ count ≤ 10000` and, for `count > 1`,
-    /// `lo < hi`.
+    /// [`FloquetStudyError::InvalidAxis`] unless `1 ≤ count ≤ 10000`, `lo` and `hi` are
+    /// finite and, for `count > 1`, `lo < hi`.
     pub fn linear(name: &str, lo: f64, hi: f64, count: usize) -> Result<Self, FloquetStudyError> {
-        if !(1..=10_000).contains(&count) || (count > 1 && hi <= lo) {
+        if !(1..=10_000).contains(&count)
+            || !lo.is_finite()
+            || !hi.is_finite()
+            || (count > 1 && hi <= lo)
+        {
             return Err(FloquetStudyError::InvalidAxis { lo, hi, count });
         }
         let values = if count == 1 {
             vec![lo]
         } else {
             (0..count)
-                .map(|k| lo + (hi - lo) * k as f64 / (count - 1) as f64)
+                .map(|k| {
+                    let v = lo + (hi - lo) * k as f64 / (count - 1) as f64;
+                    // Near the largest numbers `hi − lo` or its product overflows (`0..1e308`
+                    // gave inf and NaN values): the weighted mean cannot.
+                    if v.is_finite() {
+                        v
+                    } else {
+                        let f = k as f64 / (count - 1) as f64;
+                        lo * (1.0 - f) + hi * f
+                    }
+                })
                 .collect()
         };
         Ok(Self {
