@@ -377,13 +377,15 @@ pub(super) fn write(path: &str, bytes: &[u8]) -> Result<(), FileError> {
         } => {
             // The last guard of an input: a file this process read is never replaced, even
             // where a command did not name it before the work.
+            // Found after the work, like a directory in the way: a failed write (status 1).
             if let Some((device, inode)) = existing.as_ref().and_then(inode)
                 && let Some(input) = input_named(&Identity::Inode(device, inode))
             {
-                return Err(FileError::InputFile {
-                    option: "the output".to_string(),
+                return Err(FileError::Write {
                     path: path.to_string(),
-                    input,
+                    reason: format!(
+                        "it is the model file `{input}` that this command reads, which no output replaces"
+                    ),
                 });
             }
             replace(&target, existing.as_ref(), bytes).map_err(fail)
@@ -623,10 +625,15 @@ impl Outputs {
     /// # Errors
     /// The first refused output ([`FileError`], a usage error).
     pub(super) fn check(&self) -> Result<(), FileError> {
+        // A model's name that resolves to a bundled model is no file, even where a file of
+        // that name exists (an earlier run's output named after the model).
         let inputs: Vec<(Identity, &str)> = self
             .inputs
             .iter()
-            .filter_map(|path| Some((input_identity(path)?, path.as_str())))
+            .filter_map(|name| match eomgen::resolve(name) {
+                Ok(eomgen::Resolved::File(path)) => Some((input_identity(&path)?, name.as_str())),
+                _ => None,
+            })
             .collect();
         let mut seen: Vec<(Identity, &str)> = Vec::with_capacity(self.outputs.len());
         for planned in &self.outputs {
@@ -778,7 +785,11 @@ mod tests {
         std::os::unix::fs::symlink(&model, &link).unwrap();
         read_input(&model.to_string_lossy());
         let error = write(&link.to_string_lossy(), b"<svg/>").unwrap_err();
-        assert!(matches!(error, FileError::InputFile { .. }), "{error:?}");
+        assert!(
+            matches!(&error, FileError::Write { reason, .. } if reason.contains("model file")),
+            "{error:?}"
+        );
+        assert_eq!(CliError::from(error).code, 1);
         assert_eq!(std::fs::read_to_string(&model).unwrap(), "name: m\n");
         let other = dir.path().join("other.svg");
         write(&other.to_string_lossy(), b"<svg/>").unwrap();

@@ -28,8 +28,11 @@ pub(super) fn open_model_with(
     name_or_path: &str,
     options: eomgen::LoadOptions,
 ) -> Result<eomgen::ModelSource, CliError> {
-    // An input that no output may replace (`files::write`).
-    super::files::read_input(name_or_path);
+    // An input that no output may replace (`files::write`): the file the name resolves to
+    // (a bundled model's name wins over a file of that name, which is then no input).
+    if let Ok(eomgen::Resolved::File(path)) = eomgen::resolve(name_or_path) {
+        super::files::read_input(&path);
+    }
     type Files = Vec<(String, eomgen::LoadOptions, eomgen::ModelSource)>;
     static FILES: std::sync::Mutex<Files> = std::sync::Mutex::new(Vec::new());
     let serves = |o: &eomgen::LoadOptions| {

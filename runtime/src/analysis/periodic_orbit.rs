@@ -177,7 +177,7 @@ pub enum PeriodicOrbitError {
     },
     /// The iterates collapsed to an equilibrium: `T → 0`, or `y` hardly moves over a period.
     #[error(
-        "the orbit collapsed to an equilibrium after {iterations} Newton iterations: T = {period:.6e} s and the state moves {travel:.3e} over a period (|f(y₀)| T), which the residual Newton accepts ({allowed:.3e}) does not tell from rest; start on a motion, not at rest"
+        "the orbit collapsed to an equilibrium after {iterations} Newton iterations: T = {period:.6e} s and the state moves {travel:.3e} over a period (|f(y₀)| T); start on a motion, not at rest"
     )]
     Collapsed {
         /// Iterations done.
@@ -186,10 +186,25 @@ pub enum PeriodicOrbitError {
         period: f64,
         /// `‖f(y₀)‖ T`: how far the state moves over a period (units of `y`).
         travel: f64,
-        /// The residual Newton accepts there, `tol (1 + ‖y₀‖)`: an orbit that moves less than
-        /// `allowed / RESOLUTION_FACTOR` is within it of an equilibrium (near a stable one
-        /// every state closes to that residual).
-        allowed: f64,
+    },
+    /// Newton closed the state to its tolerance, but no Floquet multiplier is 1, which every
+    /// periodic orbit of an autonomous model has (the flow's own direction, `Φ f(y₀) =
+    /// f(y₀)`): near a stable equilibrium of a damped model every small state closes to the
+    /// tolerance, and that is not an orbit.
+    #[error(
+        "no periodic orbit: Newton closed the state to {residual:.3e} with T = {period:.6e} s, but no Floquet multiplier is within {tolerance:e} of 1 (the largest |μ| is {spectral_radius:.6}), as every periodic orbit of an autonomous model has one along the flow; the state moves {travel:.3e} over that time, so it is near an equilibrium that motions decay to or leave, not on an orbit"
+    )]
+    NoUnitMultiplier {
+        /// The period there (s).
+        period: f64,
+        /// The residual Newton reached.
+        residual: f64,
+        /// `‖f(y₀)‖ T` (units of `y`).
+        travel: f64,
+        /// The tolerance of a multiplier 1.
+        tolerance: f64,
+        /// `max |μ|`.
+        spectral_radius: f64,
     },
     /// The integration of the state and variational equations, or the multipliers, failed.
     #[error(transparent)]
@@ -487,18 +502,11 @@ pub fn periodic_orbit(
         };
         let f0 = rhs(model, &current.y)?;
         let travel = norm(&f0) * current.period;
-        // Also collapsed: a motion not resolved above the residual Newton accepts. Near a
-        // stable equilibrium of a damped model every small state closes to that residual
-        // (three damped masses shrank to ‖y₀‖ = 8e-10, moving 5e-9 over "T = 4.43 s", and were
-        // reported an asymptotically stable orbit).
-        if current.period < 1e-6 * options.period
-            || travel < travel_floor(&current.y).max(allowed / RESOLUTION_FACTOR)
-        {
+        if current.period < 1e-6 * options.period || travel < travel_floor(&current.y) {
             return Err(PeriodicOrbitError::Collapsed {
                 iterations,
                 period: current.period,
                 travel,
-                allowed,
             });
         }
         // The Jacobian at the current iterate, also for the symmetry count at the solution.
@@ -615,6 +623,19 @@ pub fn periodic_orbit(
         .iter()
         .partition(|m| (*m - one).norm() <= options.unit_multiplier_tolerance);
     let unit_multipliers = trivial.len();
+    // An autonomous model's orbit has the multiplier 1 of the flow's direction. Without it
+    // the state closed only to the tolerance: three damped masses shrank to ‖y₀‖ = 8e-10
+    // (multipliers 0.946 and below) and were reported an asymptotically stable orbit.
+    if !time_dependent && unit_multipliers == 0 {
+        let f0 = rhs(model, &current.y)?;
+        return Err(PeriodicOrbitError::NoUnitMultiplier {
+            period: current.period,
+            residual: current.residual_norm,
+            travel: norm(&f0) * current.period,
+            tolerance: options.unit_multiplier_tolerance,
+            spectral_radius: analysis.spectral_radius,
+        });
+    }
     let unit_mean_error = if trivial.is_empty() {
         0.0
     } else {

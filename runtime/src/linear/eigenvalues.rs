@@ -202,7 +202,6 @@ pub fn verdict(eigenvalues: &[Complex<f64>]) -> Stability {
 /// # Errors
 /// As [`linear_stability`].
 pub fn state_eigenvalues(lin: &Linearization) -> Result<Vec<Complex<f64>>, ModalError> {
-    let r = lin.mass_matrix.nrows();
     let not_finite = || ModalError::NonFinite { q: lin.q.clone() };
     if lin
         .stiffness_matrix
@@ -234,6 +233,76 @@ pub fn state_eigenvalues(lin: &Linearization) -> Result<Vec<Complex<f64>>, Modal
     if !k.iter().chain(c.iter()).all(|v| v.is_finite()) {
         return Err(not_finite());
     }
+    let (k, c, rigid) = without_rigid_modes(k, c, &lin.q)?;
+    let mut out = normalized_eigenvalues(&k, &c, &lin.q)?;
+    out.extend(std::iter::repeat_n(Complex::new(0.0, 0.0), 2 * rigid));
+    out.sort_by(|a, b| a.norm().total_cmp(&b.norm()).then(a.im.total_cmp(&b.im)));
+    Ok(out)
+}
+
+/// The modes of `ẍ + c ẋ + k x = 0` (mass-normalised, `r × r`) on which neither `k` nor `c`
+/// acts: the common null space of `k` and `c` (right null vectors of `[k; σc]`, `σ = √‖k‖`
+/// balancing the units, by a singular value below `1e-13` of the largest: rounding of the
+/// normalisation), such as the translations and rotations of a free structure, which no
+/// coordinate is alone. Each gives a double zero eigenvalue exactly: with an orthonormal
+/// basis `[N R]`, `N` the null space, `P(λ) = λ²I + λc + k` becomes block triangular,
+/// `[[λ²I, NᵀPR], [0, RᵀPR]]`, so the other eigenvalues are those of
+/// `λ²I + λ RᵀcR + RᵀkR`. Returns that reduced pair and the number of such modes (`k`, `c`
+/// and 0 when there are none, or when every mode is one). Computed on the whole state matrix
+/// instead, each double zero is split by rounding into a real pair of size `√ε ‖A‖`: the
+/// bundled `spring_square` was "unstable, e^(1.3e-9 t)".
+///
+/// # Errors
+/// [`ModalError::EigenvaluesDidNotConverge`] if the singular value decomposition does not
+/// converge within its bound.
+fn without_rigid_modes(
+    k: DMatrix<f64>,
+    c: DMatrix<f64>,
+    q: &[f64],
+) -> Result<(DMatrix<f64>, DMatrix<f64>, usize), ModalError> {
+    let r = k.nrows();
+    let sigma = k.amax().sqrt();
+    let mut stacked = DMatrix::zeros(2 * r, r);
+    stacked.view_mut((0, 0), (r, r)).copy_from(&k);
+    stacked.view_mut((r, 0), (r, r)).copy_from(&(&c * sigma));
+    if r == 0 || stacked.amax() == 0.0 {
+        return Ok((k, c, 0));
+    }
+    let svd = nalgebra::SVD::try_new(stacked, false, true, f64::EPSILON, 100 * r.max(10))
+        .ok_or_else(|| ModalError::EigenvaluesDidNotConverge {
+            size: r,
+            q: q.to_vec(),
+        })?;
+    let v_t = svd
+        .v_t
+        .as_ref()
+        .ok_or_else(|| ModalError::EigenvaluesDidNotConverge {
+            size: r,
+            q: q.to_vec(),
+        })?;
+    let largest = svd.singular_values.max();
+    let kept: Vec<usize> = (0..r)
+        .filter(|&i| svd.singular_values[i] > 1e-13 * largest)
+        .collect();
+    let rigid = r - kept.len();
+    if rigid == 0 || kept.is_empty() {
+        return Ok((k, c, 0));
+    }
+    // R: the kept right singular vectors as columns (orthonormal, orthogonal to N).
+    let basis = DMatrix::from_fn(r, kept.len(), |i, j| v_t[(kept[j], i)]);
+    let project = |x: &DMatrix<f64>| basis.transpose() * x * &basis;
+    Ok((project(&k), project(&c), rigid))
+}
+
+/// The eigenvalues of `ẍ + c ẋ + k x = 0` (mass-normalised, `r × r`): the balanced state
+/// matrix's by the Schur form, refined by Newton (see the module documentation); real parts
+/// at rounding set to 0.
+fn normalized_eigenvalues(
+    k: &DMatrix<f64>,
+    c: &DMatrix<f64>,
+    q: &[f64],
+) -> Result<Vec<Complex<f64>>, ModalError> {
+    let r = k.nrows();
     let s = k.amax().sqrt().max(c.amax()).max(f64::MIN_POSITIVE);
     let mut a = DMatrix::zeros(2 * r, 2 * r);
     for i in 0..r {
@@ -246,7 +315,7 @@ pub fn state_eigenvalues(lin: &Linearization) -> Result<Vec<Complex<f64>>, Modal
     let rough =
         crate::linalg::eigenvalues(&a).ok_or_else(|| ModalError::EigenvaluesDidNotConverge {
             size: 2 * r,
-            q: lin.q.clone(),
+            q: q.to_vec(),
         })?;
     // Refine the upper half-plane and the real axis; conjugates mirror them. Each value
     // remembers whether Newton converged on it (a simple eigenvalue, now accurate to its own
@@ -264,7 +333,7 @@ pub fn state_eigenvalues(lin: &Linearization) -> Result<Vec<Complex<f64>>, Modal
             .map(|(_, v)| (v - s0).norm())
             .fold(f64::INFINITY, f64::min)
             / 2.0;
-        let (refined, converged) = refine(&k, &c, s0, reach);
+        let (refined, converged) = refine(k, c, s0, reach);
         if s0.im == 0.0 {
             values.push((Complex::new(refined.re, 0.0), converged));
         } else {
