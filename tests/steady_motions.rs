@@ -303,8 +303,9 @@ fn the_rolling_disc_swept_from_rest_changes_stability_once() {
             "{} against {critical}",
             c.value
         );
-        // Two ulps of slack: the bracket is of the computed coefficient's sign change.
-        let slack = 4.0 * f64::EPSILON * critical;
+        // The bracket is of the computed coefficient's sign change, whose entries (39.24 and
+        // 60 v² here) carry rounding: 1e-14 of slack (the bracket found lies 9e-16 below).
+        let slack = 1e-14 * critical;
         assert!(
             c.bracket[0] - slack <= critical && critical <= c.bracket[1] + slack,
             "{:?}",
@@ -339,6 +340,35 @@ fn steady_motions_move_only_cyclic_coordinates() {
         assert_eq!(out.status.code(), Some(1), "{file}");
         let err = String::from_utf8_lossy(&out.stderr);
         assert!(words.iter().all(|w| err.contains(w)), "{file}: {err}");
+    }
+}
+
+/// The review of issue 49's sweep: a real crossing at `p = 0` beside a slow damped mode
+/// (`−ky/100`) and a 1e5 rad/s oscillator. With the slow mode at `−0.01` (below 1e-6 of the
+/// largest |s|) counted among the zeros, the regula falsi settled at `p = −0.0100`; counted
+/// against the largest |s| rather than as the printed verdicts count, a point printed
+/// "unstable" (`p = −1e-5`) was on the stable side of the reported change. Both find 0 now.
+#[test]
+fn a_real_crossing_beside_slow_and_stiff_modes_is_found_at_zero() {
+    let mut m = fixture_model("slow_and_stiff.yaml");
+    m.set_parameter("ku", 1e10).unwrap();
+    for (ky, lo, hi, count) in [(1.0, -1.1, 0.9, 11), (5.0, -2e-5, 1e-5, 4)] {
+        m.set_parameter("ky", ky).unwrap();
+        let options = ParameterSweepOptions {
+            axis: SweepAxis::linear("p", lo, hi, count).unwrap(),
+            operating_point: OperatingPointOptions::default(),
+            refine: true,
+        };
+        let sweep = vibration::parameter_sweep(m.as_mut(), &options, |_, _| {}).unwrap();
+        let changes = &sweep.stability_changes;
+        assert_eq!(changes.len(), 1, "ky = {ky}: {changes:?}");
+        assert!(changes[0].value.abs() <= 1e-12, "ky = {ky}: {changes:?}");
+        assert_eq!(changes[0].direction, Direction::Stabilising);
+        // The change lies between the last point printed unstable and the first that is not.
+        for point in &sweep.points {
+            let unstable = matches!(point.stability, Some(eomgen::Stability::Unstable { .. }));
+            assert_eq!(unstable, point.value < changes[0].value, "{point:?}");
+        }
     }
 }
 

@@ -194,10 +194,6 @@ pub struct PointEigenvalues {
     /// The eigenvalues of the state matrix with nothing set to 0, by which a change of sign
     /// is located.
     pub raw: Vec<Complex<f64>>,
-    /// The largest `|s|` of [`Self::raw`] (1/s; the balanced state matrix's size): the scale of
-    /// the eigenvalues' rounding, against which a real part counts as 0
-    /// ([`CROSSING_TOLERANCE`]).
-    pub scale: f64,
 }
 
 /// Why the eigenvalues at one value could not be found.
@@ -236,7 +232,6 @@ pub fn eigenvalues_at(
         return Ok(PointEigenvalues {
             eigenvalues: a.eigenvalues,
             stability: a.stability,
-            scale: spectral_radius(&raw),
             raw,
         });
     }
@@ -255,34 +250,194 @@ pub fn eigenvalues_at(
     Ok(PointEigenvalues {
         eigenvalues: s.eigenvalues,
         stability: s.stability,
-        scale: spectral_radius(&raw),
         raw,
     })
 }
 
-/// The largest `|s|` of `eigenvalues` (0 for none).
-fn spectral_radius(eigenvalues: &[Complex<f64>]) -> f64 {
-    eigenvalues.iter().map(|s| s.norm()).fold(0.0, f64::max)
+/// Number of eigenvalues with a positive real part, among the verdict's eigenvalues (real
+/// parts at rounding already 0, as `modes` prints them): the count agrees with each point's
+/// printed verdict.
+fn unstable_count(eigenvalues: &[Complex<f64>]) -> usize {
+    eigenvalues.iter().filter(|s| s.re > 0.0).count()
 }
 
-/// Below this fraction of the largest `|s|` a real part counts as 0 when the changes of
-/// stability are located: above the rounding of the eigenvalues of an exact or differenced
-/// (balanced) state matrix (`1e-16` to `1e-12` of its size, for a simple eigenvalue), so that the zeros of a family of
-/// steady motions or of a conserved quantity never count, whatever the sign of their
-/// rounding. Relative to each eigenvalue's own modulus instead, such a zero (of modulus
-/// `1e-16 ‖A‖`) counted by its sign: the rolling disc swept from rest found 10 changes of
-/// stability on 21 values and put the one real change 1.9e-4 m/s off. A crossing is then
-/// located by a secant on a smooth function of the parameter, which removes the bias of the
-/// bound.
-pub const CROSSING_TOLERANCE: f64 = 1e-10;
+/// How many of a point's verdict eigenvalues are exactly 0 (a family of steady motions, a
+/// conserved quantity, a rigid-body mode).
+fn zero_count(point: &PointEigenvalues) -> usize {
+    point.eigenvalues.iter().filter(|s| s.norm() == 0.0).count()
+}
 
-/// Number of eigenvalues with a real part above [`CROSSING_TOLERANCE`] of `scale` (the
-/// largest `|s|`).
-fn unstable_count(eigenvalues: &[Complex<f64>], scale: f64) -> usize {
-    eigenvalues
+/// The stability change between two neighbouring values `[(v, eigenvalues); 2]` whose
+/// numbers of unstable eigenvalues `counts` differ, with `at(v)` the eigenvalues at `v`:
+/// bisection on the count to 1e-12 relative, then, for a real eigenvalue, the sign change of
+/// the characteristic polynomial's coefficient of `s^z` (`z` the zeros both values share),
+/// kept where the crossing eigenvalue is at rounding of zero there; for a complex pair from
+/// the left half-plane, the secant on its real part.
+fn locate_change(
+    at: &mut impl FnMut(f64) -> Option<PointEigenvalues>,
+    [(v_a, a), (v_b, b)]: [(f64, &PointEigenvalues); 2],
+    [count_a, count_b]: [usize; 2],
+) -> StabilityChange {
+    let (mut lo, mut hi) = (v_a, v_b);
+    // The eigenvalues on the side with more unstable ones, as near the crossing as the
+    // bisection gets.
+    let mut unstable_side: Option<PointEigenvalues> = None;
+    for _ in 0..200 {
+        if hi - lo <= 1e-12 * lo.abs().max(hi.abs()).max(1.0) {
+            break;
+        }
+        let mid = 0.5 * (lo + hi);
+        let Some(point) = at(mid) else { break };
+        let count = unstable_count(&point.eigenvalues);
+        if count == count_a {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+        if count == count_a.max(count_b) {
+            unstable_side = Some(point);
+        }
+    }
+    let (unstable_grid, stable_grid) = if count_a > count_b { (a, b) } else { (b, a) };
+    // The crossing eigenvalue: the unstable one nearest the axis on that side.
+    let side = unstable_side.unwrap_or_else(|| unstable_grid.clone());
+    let crossing = side
+        .eigenvalues
         .iter()
-        .filter(|s| s.re > CROSSING_TOLERANCE * scale)
-        .count()
+        .copied()
+        .filter(|s| s.re > 0.0)
+        .min_by(|x, y| x.re.total_cmp(&y.re))
+        .unwrap_or_default();
+    // Real or complex is read at the grid value on the unstable side, away from the
+    // crossing: a real pair that meets at zero and leaves as an imaginary pair (a spinning
+    // body, a rolling disc) is split by rounding into a complex pair right at the crossing.
+    let complex = unstable_grid
+        .eigenvalues
+        .iter()
+        .filter(|s| s.re > 0.0)
+        .min_by(|x, y| x.re.total_cmp(&y.re))
+        .is_some_and(|s| s.im.abs() > 1e-6 * s.norm());
+    let mut value = 0.5 * (lo + hi);
+    let mut bracket = [lo, hi];
+    if complex {
+        // Only where the pair comes from (or goes into) the left half-plane: where it meets
+        // another pair on the imaginary axis and leaves it (a gyroscopic system's Krein
+        // collision, the sleeping top), the real part grows as a square root, and the
+        // bisection's count is the better locator.
+        let transversal = stable_grid
+            .eigenvalues
+            .iter()
+            .min_by(|x, y| (*x - crossing).norm().total_cmp(&(*y - crossing).norm()))
+            .is_some_and(|s| s.re < 0.0);
+        if transversal {
+            value = secant_on_real_part(at, crossing, [lo, hi], [v_a, v_b], value);
+        }
+    } else {
+        // A real eigenvalue through 0: the coefficient of `s^z` in `det(sI − A)` changes
+        // sign there, smooth where the eigenvalue is not (a pair that meets at 0 and leaves
+        // as an imaginary pair, whose real part grows as a square root).
+        let z = zero_count(a).min(zero_count(b));
+        let size = stable_grid.raw.len();
+        let mut coefficient = |v: f64| -> Option<f64> {
+            let raw = at(v)?.raw;
+            (raw.len() == size).then(|| characteristic_coefficient(&raw, z))
+        };
+        if let Some((root, around)) = sign_change(&mut coefficient, [lo, hi], [v_a, v_b]) {
+            // Kept where the crossing eigenvalue (the `z + 1`-th smallest) is near zero, a
+            // thousandth of its size on the stable side (near a crossing where a pair meets at
+            // 0 beside a zero, the computed eigenvalues of the near-triple zero carry
+            // `(ε ‖A‖)^(1/3)`): a slow eigenvalue, or a pole, also changes the coefficient's
+            // sign.
+            let nearest = |raw: &[Complex<f64>]| {
+                let mut m: Vec<f64> = raw.iter().map(|s| s.norm()).collect();
+                m.sort_by(f64::total_cmp);
+                m.get(z).copied()
+            };
+            let there = at(root).and_then(|p| nearest(&p.raw));
+            if let (Some(there), Some(away)) = (there, nearest(&stable_grid.raw))
+                && there <= 1e-3 * away
+            {
+                value = root;
+                bracket = around;
+            }
+        }
+    }
+    StabilityChange {
+        value,
+        eigenvalue: if complex {
+            Crossing::Complex
+        } else {
+            Crossing::Real
+        },
+        direction: if count_b < count_a {
+            Direction::Stabilising
+        } else {
+            Direction::Destabilising
+        },
+        // At the refined value: the pair's frequency where its real part is 0.
+        frequency: if complex {
+            at(value)
+                .and_then(|p| {
+                    p.raw
+                        .iter()
+                        .copied()
+                        .min_by(|x, y| (*x - crossing).norm().total_cmp(&(*y - crossing).norm()))
+                })
+                .unwrap_or(crossing)
+                .im
+                .abs()
+        } else {
+            0.0
+        },
+        bracket,
+    }
+}
+
+/// A complex pair's crossing refined by the secant method on its real part (smooth in the
+/// parameter), followed as the raw eigenvalue nearest `crossing`: this removes the bias of
+/// the count, which ends the bisection where the verdict's real part leaves rounding (below
+/// `1e-9 |s|`) rather than at 0. Steps stay between the grid values `[grid_lo, grid_hi]`; the
+/// result is kept where the real part is below `1e-12 |s|` there, `value` otherwise.
+fn secant_on_real_part(
+    at: &mut impl FnMut(f64) -> Option<PointEigenvalues>,
+    crossing: Complex<f64>,
+    [lo, hi]: [f64; 2],
+    [grid_lo, grid_hi]: [f64; 2],
+    value: f64,
+) -> f64 {
+    let mut real_part = |v: f64| -> Option<f64> {
+        let raw = at(v)?.raw;
+        raw.iter()
+            .min_by(|x, y| (*x - crossing).norm().total_cmp(&(*y - crossing).norm()))
+            .map(|s| s.re)
+    };
+    let width = (hi - lo).max(1e-9 * lo.abs().max(1.0));
+    let (mut v0, mut v1) = (lo - width, hi + width);
+    let (Some(mut f0), Some(mut f1)) = (real_part(v0), real_part(v1)) else {
+        return value;
+    };
+    for _ in 0..12 {
+        if f1 == f0 {
+            break;
+        }
+        let v2 = v1 - f1 * (v1 - v0) / (f1 - f0);
+        if !v2.is_finite() || v2 < grid_lo.min(grid_hi) || v2 > grid_lo.max(grid_hi) {
+            break;
+        }
+        let Some(f2) = real_part(v2) else { break };
+        (v0, f0, v1, f1) = (v1, f1, v2, f2);
+        if (v1 - v0).abs() <= 1e-15 * v1.abs().max(1.0) {
+            break;
+        }
+    }
+    if f1.abs() <= 1e-12 * crossing.norm()
+        && v1 >= grid_lo.min(grid_hi)
+        && v1 <= grid_lo.max(grid_hi)
+    {
+        v1
+    } else {
+        value
+    }
 }
 
 /// A sign change of `g` near `[lo, hi]` inside `grid` (the two values of the sweep around
@@ -404,18 +559,19 @@ pub fn parameter_sweep(
     };
     let total = options.axis.values.len();
     let mut points = Vec::with_capacity(total);
-    // Per point, the raw eigenvalues and their scale `‖A‖₁`.
-    let mut raws: Vec<Option<(Vec<Complex<f64>>, f64)>> = Vec::with_capacity(total);
+    // Per point, its eigenvalues (the verdict's and the raw ones).
+    let mut raws: Vec<Option<PointEigenvalues>> = Vec::with_capacity(total);
     for (k, &value) in options.axis.values.iter().enumerate() {
         points.push(match at(model, value) {
             Ok(found) => {
-                raws.push(Some((found.raw, found.scale)));
-                SweepPoint {
+                let point = SweepPoint {
                     value,
-                    eigenvalues: found.eigenvalues,
+                    eigenvalues: found.eigenvalues.clone(),
                     stability: Some(found.stability),
                     error: None,
-                }
+                };
+                raws.push(Some(found));
+                point
             }
             Err(SweepPointError::Modal(source @ ModalError::TimeDependent { .. })) => {
                 let _ = model.set_parameter(name, before);
@@ -444,7 +600,7 @@ pub fn parameter_sweep(
     }
     let counts: Vec<Option<usize>> = raws
         .iter()
-        .map(|raw| raw.as_ref().map(|(r, scale)| unstable_count(r, *scale)))
+        .map(|seen| seen.as_ref().map(|p| unstable_count(&p.eigenvalues)))
         .collect();
     let mut stability_changes = Vec::new();
     if options.refine {
@@ -455,140 +611,19 @@ pub fn parameter_sweep(
             if count_a == count_b {
                 continue;
             }
-            let (mut lo, mut hi) = (points[k - 1].value, points[k].value);
-            // The raw eigenvalues on the side with more unstable ones, as near the crossing
-            // as the bisection gets.
-            let mut unstable_side: Option<(Vec<Complex<f64>>, f64)> = None;
-            for _ in 0..200 {
-                if hi - lo <= 1e-12 * lo.abs().max(hi.abs()).max(1.0) {
-                    break;
-                }
-                let mid = 0.5 * (lo + hi);
-                let Ok(PointEigenvalues {
-                    raw: values, scale, ..
-                }) = at(model, mid)
-                else {
-                    break;
-                };
-                let count = unstable_count(&values, scale);
-                if count == count_a {
-                    lo = mid;
-                } else {
-                    hi = mid;
-                }
-                if count == count_a.max(count_b) {
-                    unstable_side = Some((values, scale));
-                }
-            }
-            // The crossing eigenvalue: the unstable one nearest the axis on that side.
-            let (side, side_scale) = match unstable_side {
-                Some(side) => side,
-                None => {
-                    let v = if count_a > count_b { lo } else { hi };
-                    at(model, v).map(|p| (p.raw, p.scale)).unwrap_or_default()
-                }
+            let grid = [
+                (points[k - 1].value, raws[k - 1].as_ref()),
+                (points[k].value, raws[k].as_ref()),
+            ];
+            let (Some(a), Some(b)) = (grid[0].1, grid[1].1) else {
+                continue;
             };
-            let crossing = side
-                .iter()
-                .copied()
-                .filter(|s| s.re > CROSSING_TOLERANCE * side_scale)
-                .min_by(|x, y| x.re.total_cmp(&y.re))
-                .unwrap_or_default();
-            // Real or complex is read at the grid value on the unstable side, away from the
-            // crossing: a real pair that meets at zero and leaves as an imaginary pair (a
-            // spinning body, a rolling disc) is split by rounding into a complex pair right
-            // at the crossing.
-            let grid_side = if count_a > count_b { k - 1 } else { k };
-            let (grid, grid_scale) = raws[grid_side].clone().unwrap_or_default();
-            let complex = grid
-                .iter()
-                .filter(|s| s.re > CROSSING_TOLERANCE * grid_scale)
-                .min_by(|x, y| x.re.total_cmp(&y.re))
-                .is_some_and(|s| s.im.abs() > 1e-6 * s.norm());
-            // A complex pair crosses simply: its real part is smooth in the parameter, and
-            // the secant method on it removes the bias of the count's threshold
-            // ([`CROSSING_TOLERANCE`] of |s|, which ends the bisection where Re s is that
-            // large rather than 0). The real part is followed as the eigenvalue nearest the
-            // crossing one; the secant step is kept only inside the bracket widened by its own
-            // width.
-            let mut value = 0.5 * (lo + hi);
-            // Only where the pair comes from (or goes into) the left half-plane: where it
-            // meets another pair on the imaginary axis and leaves it (a gyroscopic system's
-            // Krein collision, the sleeping top), the real part grows as a square root, and
-            // the bisection's count is the better locator.
-            let stable_grid = if count_a > count_b { k } else { k - 1 };
-            let transversal = raws[stable_grid].as_ref().is_some_and(|(raw, scale)| {
-                raw.iter()
-                    .min_by(|x, y| (*x - crossing).norm().total_cmp(&(*y - crossing).norm()))
-                    .is_some_and(|s| s.re < -CROSSING_TOLERANCE * scale)
-            });
-            let mut bracket = [lo, hi];
-            if !complex && let Some((grid_raw, grid_scale)) = raws[stable_grid].as_ref() {
-                // A real eigenvalue through 0, located as a sign change of the coefficient of
-                // `s^z` of the characteristic polynomial, `z` the eigenvalues at 0 on the
-                // stable side (a family of steady motions; `1e-6` of the largest `|s|` also
-                // takes a differenced matrix's zeros): smooth where the eigenvalue is not
-                // (a pair that meets at 0 and leaves as an imaginary pair, whose real part
-                // grows as a square root).
-                let z = grid_raw
-                    .iter()
-                    .filter(|s| s.norm() <= 1e-6 * grid_scale)
-                    .count();
-                let size = grid_raw.len();
-                let mut coefficient = |v: f64| -> Option<f64> {
-                    let raw = at(model, v).ok()?.raw;
-                    (raw.len() == size).then(|| characteristic_coefficient(&raw, z))
-                };
-                let grid = [points[k - 1].value, points[k].value];
-                if let Some((root, around)) = sign_change(&mut coefficient, [lo, hi], grid) {
-                    value = root;
-                    bracket = around;
-                }
-            }
-            if complex && transversal {
-                let mut real_part = |v: f64| -> Option<f64> {
-                    let raw = at(model, v).ok()?.raw;
-                    raw.iter()
-                        .min_by(|x, y| (*x - crossing).norm().total_cmp(&(*y - crossing).norm()))
-                        .map(|s| s.re)
-                };
-                let width = (hi - lo).max(1e-9 * lo.abs().max(1.0));
-                let (mut v0, mut v1) = (lo - width, hi + width);
-                if let (Some(mut f0), Some(mut f1)) = (real_part(v0), real_part(v1)) {
-                    for _ in 0..6 {
-                        if f1 == f0 {
-                            break;
-                        }
-                        let v2 = v1 - f1 * (v1 - v0) / (f1 - f0);
-                        if !v2.is_finite() || (v2 - value).abs() > 2.0 * width {
-                            break;
-                        }
-                        let Some(f2) = real_part(v2) else { break };
-                        (v0, f0, v1, f1) = (v1, f1, v2, f2);
-                        if (v1 - v0).abs() <= 1e-15 * v1.abs().max(1.0) {
-                            break;
-                        }
-                    }
-                    if (v1 - value).abs() <= 2.0 * width {
-                        value = v1;
-                    }
-                }
-            }
-            stability_changes.push(StabilityChange {
-                value,
-                eigenvalue: if complex {
-                    Crossing::Complex
-                } else {
-                    Crossing::Real
-                },
-                direction: if count_b < count_a {
-                    Direction::Stabilising
-                } else {
-                    Direction::Destabilising
-                },
-                frequency: if complex { crossing.im.abs() } else { 0.0 },
-                bracket,
-            });
+            let change = locate_change(
+                &mut |v: f64| at(model, v).ok(),
+                [(grid[0].0, a), (grid[1].0, b)],
+                [count_a, count_b],
+            );
+            stability_changes.push(change);
         }
     }
     let _ = model.set_parameter(name, before);
