@@ -28,11 +28,12 @@ pub fn eigenvalues(a: &DMatrix<f64>) -> Option<Vec<Complex<f64>>> {
         return Some(Vec::new());
     }
     let sweeps = SWEEPS_PER_ROW * a.nrows().max(10);
-    let values: Vec<Complex<f64>> = nalgebra::Schur::try_new(a.clone(), f64::EPSILON, sweeps)?
-        .complex_eigenvalues()
-        .iter()
-        .copied()
-        .collect();
+    // The transpose has the same eigenvalues and other rounding: where the iteration cycles
+    // on one (a matrix with Jordan blocks of zeros, as a free structure's state matrix has),
+    // it converges on the other.
+    let schur = nalgebra::Schur::try_new(a.clone(), f64::EPSILON, sweeps)
+        .or_else(|| nalgebra::Schur::try_new(a.transpose(), f64::EPSILON, sweeps))?;
+    let values: Vec<Complex<f64>> = schur.complex_eigenvalues().iter().copied().collect();
     values
         .iter()
         .all(|v| v.re.is_finite() && v.im.is_finite())
