@@ -648,11 +648,12 @@ pub fn motion_checks(
         let value = parse(&c.value);
         let computed = simulations.get(default_run).and_then(|s| {
             let value = value.clone()?;
-            let mut q0 = None;
+            // Q(0) at the initial state, as `simulate` measures an output's drift (the run's
+            // samples need not begin at t = 0).
+            let q0 = state_value(&value, model, &parameters, 0.0, y0)?;
             let mut worst: f64 = 0.0;
             for (t, y) in s.iter() {
                 let q = state_value(&value, model, &parameters, t, y)?;
-                let q0 = *q0.get_or_insert(q);
                 worst = worst.max((q - q0).abs() / q0.abs().max(1.0));
             }
             Ok(worst)

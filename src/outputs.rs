@@ -134,7 +134,13 @@ pub fn evaluate_outputs(
             .map_err(|d| expression_error(d.message))?;
         let mut values = Vec::with_capacity(solution.len());
         let mut initial = None;
-        for (t, y) in std::iter::once((0.0, y0)).chain(solution.iter()) {
+        // The initial state only with samples to compare with it: an empty solution gives an
+        // empty series (and `initial` NaN), whatever the output is at the start.
+        let start = (!solution.is_empty()).then_some((0.0, y0));
+        if start.is_none() {
+            initial = Some(f64::NAN);
+        }
+        for (t, y) in start.into_iter().chain(solution.iter()) {
             let v = eval_expr(&e, &|k| {
                 if k == "t" {
                     return Some(t);

@@ -29,6 +29,15 @@ use nalgebra::{DMatrix, DVector};
 
 use crate::model_info::ModelInfo;
 
+/// ` of the linearisation at q = […]`, or nothing for a matrix given as such (no `q`).
+fn operating_point(q: &[f64]) -> String {
+    if q.is_empty() {
+        String::new()
+    } else {
+        format!(" of the linearisation at q = {q:?}")
+    }
+}
+
 /// Why an equilibrium, a linearisation or a modal analysis failed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[non_exhaustive]
@@ -67,7 +76,8 @@ pub enum ModalError {
     /// The eigenvalue solver (nalgebra's QR iteration, bounded by
     /// [`crate::linalg::eigenvalues`]) did not converge on a matrix of the linearisation.
     #[error(
-        "the eigenvalue solver did not converge on the {size} × {size} matrix of the linearisation at q = {q:?}"
+        "the eigenvalue solver did not converge on a {size} × {size} matrix{}",
+        operating_point(q)
     )]
     EigenvaluesDidNotConverge {
         /// The matrix's order.

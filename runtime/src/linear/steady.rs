@@ -735,6 +735,9 @@ pub fn steady_stability(
     lin: &SteadyLinearization,
 ) -> Result<(Vec<Complex<f64>>, Stability), SteadyMotionError> {
     let tolerance = if lin.exact_jacobian { 0.0 } else { 1e-8 };
+    if lin.state_matrix.iter().any(|v| !v.is_finite()) {
+        return Err(SteadyMotionError::NonFinite);
+    }
     let eigenvalues = general_eigenvalues(&lin.state_matrix, tolerance).ok_or(
         SteadyMotionError::EigenvaluesDidNotConverge {
             size: lin.state_matrix.nrows(),

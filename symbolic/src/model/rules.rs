@@ -1864,7 +1864,15 @@ pub fn inertia_problem(body: &str, e: [f64; 6]) -> Option<InertiaProblem> {
     // Each scaled minor carries a rounding error of a few ε: above 64ε it is positive, so a
     // needle whose smallest moment is 1e-12 of the others is definite, and the rounding of a
     // singular tensor (a rotated zero moment) is not taken for definiteness.
-    let definite = scale > 0.0 && minors.iter().all(|m| *m > 64.0 * f64::EPSILON);
+    // A diagonal tensor has no rounding to tell apart: positive moments are definite
+    // (`diag(1e-14, 1, 1)`, a needle).
+    let diagonal = xy == 0.0 && yz == 0.0 && xz == 0.0;
+    let definite = scale > 0.0
+        && if diagonal {
+            xx > 0.0 && yy > 0.0 && zz > 0.0
+        } else {
+            minors.iter().all(|m| *m > 64.0 * f64::EPSILON)
+        };
     if !definite {
         let [exx, eyy, ezz, exy, eyz, exz] = e.map(short);
         return Some(InertiaProblem::NotPositiveDefinite(format!(
@@ -2131,6 +2139,7 @@ mod tests {
             "[1e300, 1e300, 1e300]".to_string(),
             "[1e-300, 1e-300, 1e-300]".to_string(),
             "[1e-12, 1, 1]".to_string(),
+            "[1e-14, 1, 1]".to_string(),
             rotated(1e-12),
         ] {
             assert_eq!(errors(&body(&inertia)), Vec::<String>::new(), "{inertia}");

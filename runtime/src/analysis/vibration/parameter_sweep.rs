@@ -475,7 +475,8 @@ fn sign_change(
     }
     let mut side = 0i8;
     for _ in 0..100 {
-        if (b - a).abs() <= 1e-15 * a.abs().max(b.abs()).max(f64::MIN_POSITIVE) {
+        // Relative to the grid's values too, so that a root at 0 ends as quickly.
+        if (b - a).abs() <= 1e-15 * a.abs().max(b.abs()).max(grid_lo.abs().max(grid_hi.abs())) {
             break;
         }
         let c = (a * fb - b * fa) / (fb - fa);
