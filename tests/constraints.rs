@@ -497,3 +497,30 @@ fn issue_28_constraint_methods_that_measured_nothing_fail() {
     let study = constraint_methods(&mut || (entry.make)(), None, &options).expect("runs");
     assert!(study.check_measured().is_ok());
 }
+
+/// Issue 49: a rolling contact `along: [x, y, z]` on the rolling disc. The z row (the contact
+/// point's velocity along the ground normal, zero with the geometry) evaluates to rounding,
+/// 1e-17, so the rank test took it for a constraint: `check` passed and every run stopped on
+/// a singular `[M Jᵀ; J 0]` at t = 0. It is a located load-time error now, and the file with
+/// `along: [x, y]` loads.
+#[test]
+fn a_rolling_contact_along_the_normal_constrains_nothing() {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/models/rolling_disc.yaml");
+    let text = std::fs::read_to_string(path).unwrap();
+    assert!(eomgen::JitModel::from_source("rolling_disc.yaml", &text).is_ok());
+    let along_z = text.replace("along: [x, y] }", "along: [x, y, z] }");
+    assert_ne!(along_z, text);
+    let Err(eomgen::LoadError::Diagnostics { diagnostics, .. }) =
+        eomgen::JitModel::from_source("rolling_disc.yaml", &along_z)
+    else {
+        panic!("`along: [x, y, z]` loaded");
+    };
+    assert_eq!(diagnostics.len(), 1, "{diagnostics:?}");
+    let d = &diagnostics[0];
+    assert_eq!((d.location.line, d.location.column), (41, 3));
+    assert!(
+        d.message.contains("`roll_z` constrains nothing"),
+        "{}",
+        d.message
+    );
+}

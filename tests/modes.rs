@@ -1245,3 +1245,49 @@ fn a_sweep_of_a_free_structure_finds_no_change() {
         );
     }
 }
+
+/// Issue 49's review: a swept value whose state matrix has entries beyond 1e154 hung in
+/// nalgebra's balancing (its squared column norms are infinite and its scaling loop never
+/// ends). The pendulum with g = 1e200 is marginally stable, `±1e100 i` to 1e-14, and its
+/// table prints 1e200 in exponent form, not 200 digits.
+#[test]
+fn a_sweep_of_huge_values_is_answered() {
+    use eomgen::analysis::vibration::{self, ParameterSweepOptions, SweepAxis};
+    let mut m = model("simple_pendulum");
+    let options = ParameterSweepOptions {
+        axis: SweepAxis::linear("g", 1e200, 2e200, 1).unwrap(),
+        operating_point: eomgen::analysis::vibration::OperatingPointOptions {
+            start: eomgen::analysis::vibration::EquilibriumStart::Named("hanging".to_string()),
+            ..Default::default()
+        },
+        refine: true,
+    };
+    let sweep = vibration::parameter_sweep(m.as_mut(), &options, |_, _| {}).unwrap();
+    let point = &sweep.points[0];
+    assert_eq!(
+        point.stability,
+        Some(eomgen::Stability::MarginallyStable),
+        "{point:?}"
+    );
+    let l = m.parameter_values()[1];
+    let omega = (1e200f64 / l).sqrt();
+    assert!(
+        point
+            .eigenvalues
+            .iter()
+            .all(|s| (s.im.abs() - omega).abs() <= 1e-14 * omega),
+        "{point:?}"
+    );
+    let out = eomgen_ok(&[
+        "study",
+        "parameter-sweep",
+        "simple_pendulum",
+        "--parameter",
+        "g",
+        "--values=1e200..2e200:1",
+        "--at",
+        "hanging",
+    ]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("1.00000000e200  marginal"), "{text}");
+}

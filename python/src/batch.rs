@@ -12,14 +12,12 @@ use rayon::prelude::*;
 
 use crate::convert::matrix;
 use crate::model::{
-    CoreModel, RunError, RunOptions, check_bodies, method, run_simulation, set_parameter,
-    stabilization,
+    CoreModel, MAX_OUTPUT_TIMES, RunError, RunOptions, check_bodies, method, run_simulation,
+    set_parameter, stabilization,
 };
 
 /// Most worker threads a batch may ask for (`threads=10000` spawned that many).
 const MAX_THREADS: usize = 256;
-/// Most output times per run: `eomgen simulate --t-out`'s limit (docs/cli.md).
-pub(crate) const MAX_OUTPUT_TIMES: usize = 100_000;
 /// Most numbers a batch returns (states and energies): 800 MB of `f64`.
 const MAX_RESULT_VALUES: usize = 100_000_000;
 

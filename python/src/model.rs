@@ -162,6 +162,9 @@ impl CoreModel {
     }
 }
 
+/// Most output times per run: `eomgen simulate --t-out`'s limit (docs/cli.md).
+pub(crate) const MAX_OUTPUT_TIMES: usize = 100_000;
+
 /// An instance of `loaded` with `overrides` set, in order.
 pub(crate) fn instantiate(
     loaded: &Loaded,
@@ -569,12 +572,12 @@ impl CoreModel {
         t_out: Option<Vec<f64>>,
     ) -> PyResult<Bound<'py, PyDict>> {
         if let Some(times) = &t_out
-            && times.len() > crate::batch::MAX_OUTPUT_TIMES
+            && times.len() > MAX_OUTPUT_TIMES
         {
             return Err(pyo3::exceptions::PyValueError::new_err(format!(
                 "t_out has {} times, at most {} are allowed (as `eomgen simulate --t-out`)",
                 times.len(),
-                crate::batch::MAX_OUTPUT_TIMES
+                MAX_OUTPUT_TIMES
             )));
         }
         let run = args.options(t_out.map_or(OutputTimes::Steps, OutputTimes::At))?;

@@ -123,7 +123,7 @@ pub enum PeriodicOrbitError {
         period: f64,
     },
     /// A tolerance is outside its range.
-    #[error("{what} must be in [{smallest:e}, {largest:e}], got {value}")]
+    #[error("{what} must be in [{smallest:e}, {largest:e}], got {value:e}")]
     InvalidTolerance {
         /// Which tolerance.
         what: &'static str,

@@ -83,7 +83,7 @@ pub enum FloquetError {
     /// The tolerance on `|μ| = 1` is outside
     /// `[FloquetOptions::smallest_stability_tolerance(), LARGEST_STABILITY_TOLERANCE]`.
     #[error(
-        "the stability tolerance must be in [{smallest:.3e}, {largest}], got {stability_tolerance}: below √tol = {smallest:.3e} the integration error (at tol = {tol:e}) decides between stable, marginal and unstable (an undamped system's multipliers lie on the unit circle only to that error), and above {largest} a growth of more than 10 % per period would be called marginal"
+        "the stability tolerance must be in [{smallest:.3e}, {largest}], got {stability_tolerance:e}: below √tol = {smallest:.3e} the integration error (at tol = {tol:e}) decides between stable, marginal and unstable (an undamped system's multipliers lie on the unit circle only to that error), and above {largest} a growth of more than 10 % per period would be called marginal"
     )]
     InvalidStabilityTolerance {
         /// The tolerance given.

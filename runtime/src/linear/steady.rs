@@ -721,9 +721,19 @@ pub fn raw_eigenvalues(a: &DMatrix<f64>) -> Option<Vec<Complex<f64>>> {
     if a.iter().any(|v| !v.is_finite()) {
         return None;
     }
-    let mut balanced = a.clone();
+    // Scaled by a power of two (exactly) so that the largest entry is about 1: nalgebra's
+    // balancing squares column norms, and past 1.3e154 they are infinite and its loop never
+    // ends (a sweep of g from 1e200 hung there).
+    let largest = a.amax();
+    let scale = if largest > 0.0 {
+        2f64.powi(-(largest.log2().round() as i32))
+    } else {
+        1.0
+    };
+    let mut balanced = a * scale;
     nalgebra::linalg::balancing::balance_parlett_reinsch(&mut balanced);
-    crate::linalg::eigenvalues(&balanced)
+    let values = crate::linalg::eigenvalues(&balanced)?;
+    Some(values.into_iter().map(|v| v / scale).collect())
 }
 
 /// The eigenvalues of a steady linearisation and its stability verdict.

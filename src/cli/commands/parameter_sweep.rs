@@ -141,9 +141,9 @@ fn print_text(sweep: &ParameterSweep, chart: Option<&str>) {
             .filter(|s| s.im >= 0.0)
             .map(|s| {
                 if s.im == 0.0 {
-                    format!("{:.8}", s.re)
+                    decimals(s.re, 8)
                 } else {
-                    format!("{:.8}±{:.8}i", s.re, s.im)
+                    format!("{}±{}i", decimals(s.re, 8), decimals(s.im, 8))
                 }
             })
             .collect();
@@ -151,7 +151,7 @@ fn print_text(sweep: &ParameterSweep, chart: Option<&str>) {
             Some(e) => e.clone(),
             None => values.join("  "),
         };
-        let _ = writeln!(out, "{:>14.8}  {verdict:<9} {tail}", p.value);
+        let _ = writeln!(out, "{:>14}  {verdict:<9} {tail}", decimals(p.value, 8));
     }
     if sweep.stability_changes.is_empty() {
         let _ = writeln!(out, "stability changes: none in this range");
@@ -167,12 +167,24 @@ fn print_text(sweep: &ParameterSweep, chart: Option<&str>) {
         };
         let _ = writeln!(
             out,
-            "stability change  {} = {:.14}: {kind}, {direction} as {} grows",
-            sweep.parameter, c.value, sweep.parameter
+            "stability change  {} = {}: {kind}, {direction} as {} grows",
+            sweep.parameter,
+            decimals(c.value, 14),
+            sweep.parameter
         );
     }
     if let Some(path) = chart {
         let _ = writeln!(out, "chart      {path}");
+    }
+}
+
+/// `v` with `digits` decimals, or in exponent form with as many significant digits where
+/// that would print more than a few digits before the point (1e200 is not 200 digits).
+fn decimals(v: f64, digits: usize) -> String {
+    if v.is_finite() && v.abs() >= 1e6 {
+        format!("{v:.digits$e}")
+    } else {
+        format!("{v:.digits$}")
     }
 }
 

@@ -138,7 +138,7 @@ fn parse_tols(text: &str) -> Result<Vec<f64>, CliError> {
             Ok(v)
         } else {
             Err(bad(&format!(
-                "{v} is not a tolerance in [{SMALLEST_TOLERANCE:e}, 1) (f64 cannot deliver less)"
+                "{v:e} is not a tolerance in [{SMALLEST_TOLERANCE:e}, 1) (f64 cannot deliver less)"
             )))
         }
     };

@@ -108,14 +108,20 @@ pub fn linear_in_rates(arena: &mut ExprArena, g: ExprId, symbols: &[[SymbolId; 3
 ///
 /// `rows` holds, per sample, the `m × n` Jacobian row-major. A row is dependent at a sample
 /// when its component orthogonal to the earlier independent rows is below `1e-9` of its
-/// norm (or the row is zero); a constraint is reported only if that holds at every sample, so
-/// a singular configuration that a random sample happens to hit is not an error.
+/// norm, or when the row itself is below `1e-12` of the largest row: a row that is zero in
+/// exact arithmetic but evaluates to rounding (`x − (x + a) + a`, a rolling contact's row
+/// along the ground normal, 1e-17) is a zero row, not a constraint. A constraint is reported
+/// only if that holds at every sample, so a singular configuration that a random sample
+/// happens to hit is not an error.
 pub fn redundant_rows(samples: &[Vec<f64>], m: usize, n: usize) -> Vec<(usize, Vec<usize>)> {
     let mut found = Vec::new();
     let mut dependent_everywhere = vec![true; m];
     let mut combination: Vec<Vec<usize>> = vec![Vec::new(); m];
     for (k, jac) in samples.iter().enumerate() {
         let row = |i: usize| &jac[i * n..(i + 1) * n];
+        let largest = (0..m)
+            .map(|i| row(i).iter().map(|x| x * x).sum::<f64>().sqrt())
+            .fold(0.0f64, f64::max);
         // Orthonormal basis of the independent rows so far (modified Gram–Schmidt).
         let mut basis: Vec<Vec<f64>> = Vec::new();
         let mut independent: Vec<usize> = Vec::new();
@@ -129,7 +135,12 @@ pub fn redundant_rows(samples: &[Vec<f64>], m: usize, n: usize) -> Vec<(usize, V
                 }
             }
             let norm = r.iter().map(|x| x * x).sum::<f64>().sqrt();
-            if norm0 == 0.0 || norm <= 1e-9 * norm0 {
+            if norm0 <= 1e-12 * largest {
+                // A zero row: it combines nothing.
+                if k == 0 {
+                    combination[i] = Vec::new();
+                }
+            } else if norm <= 1e-9 * norm0 {
                 if k == 0 {
                     combination[i] = involved(row(i), &independent, &row, n);
                 }
