@@ -1496,6 +1496,24 @@ impl<'f> Lowering<'f> {
         let mut n = frames.express(&mut self.arena, [zero, zero, one], 0, frame);
         n[wheel.axle.value.index()] = zero;
         let n2 = self.dot(&n, &n);
+        // The wheel's plane has no direction nearest the ground's z when its axle is that z
+        // in every configuration (a disc lying flat): `r/|n|` times components that are all 0
+        // would put the contact point at the centre, silently.
+        if self.arena.is_zero(n2) {
+            self.errors.push(
+                Diagnostic::new(
+                    wheel.axle.location,
+                    format!(
+                        "the wheel centred at `{}` has its axle `{}` of frame `{}` along the ground's z in every configuration: a wheel lying flat has no lowest point of its rim",
+                        wheel.centre.value,
+                        wheel.axle.value.letter(),
+                        wheel.frame.value
+                    ),
+                )
+                .with_help("a wheel contact needs an axle that is not vertical (the axle `y` of a frame that leans and steers); for a disc sliding flat, write its contact point directly"),
+            );
+            return vec![zero; 3];
+        }
         let length = self.arena.sqrt(n2);
         let radius = self.expr(&wheel.radius);
         let scale = self.arena.divide(radius, length);
