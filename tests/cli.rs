@@ -974,6 +974,50 @@ fn set_values_meet_the_body_rules() {
     ]);
 }
 
+/// Issue 49: settings that make a run impossible are named before guesses about the model.
+/// An end time of 1e300 s (f64 resolves t there to 3.6e285 s) was "the model may divide by
+/// zero" for dp54 and dop853, with a time of 300 digits, and a Newton failure for radau5;
+/// `--rtol 1e-15 --atol 0` from rest was "the model may be stiff".
+#[test]
+fn impossible_settings_are_blamed_not_the_model() {
+    for method in ["dp54", "dop853", "radau5", "taylor"] {
+        let out = eomgen(&[
+            "simulate",
+            "simple_pendulum",
+            "--t-end",
+            "1e300",
+            "--method",
+            method,
+        ]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{method}: {err}");
+        assert!(
+            err.contains("the end time 1e300 s is so large"),
+            "{method}: {err}"
+        );
+        assert!(
+            !err.contains("divide by zero") && err.lines().all(|l| l.len() < 400),
+            "{method}: {err}"
+        );
+    }
+    let out = eomgen(&[
+        "simulate",
+        "simple_pendulum",
+        "--rtol",
+        "1e-15",
+        "--atol",
+        "0",
+        "--method",
+        "dop853",
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("give --atol above 0") && !err.contains("stiff"),
+        "{err}"
+    );
+}
+
 /// After a failed integration the help names what the model shows where it stopped, before
 /// any guess about the method (issue 28, item 7): "the model may be stiff; try radau5" was
 /// given for a mass matrix singular because of a parameter (`l1 = 0`, then described as

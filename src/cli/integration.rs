@@ -309,6 +309,32 @@ fn failure_hint(
     let method = args.method;
     let explicit = !method.is_implicit();
     let adaptive = method.is_adaptive();
+    // Settings that make the run impossible come first: whatever the model shows where a
+    // run with them stopped is their consequence (an end time of 1e300 s made a first step
+    // of 3.6e285 s, and then an infinite state, read as a division by zero).
+    let coarse_end = || {
+        format!(
+            "the end time {:e} s is so large that f64 resolves t only to about {:.1e} s near it, coarser than the steps the motion needs; shorten --t-end (or rescale time in the model)",
+            args.t_end,
+            16.0 * f64::EPSILON * args.t_end
+        )
+    };
+    // Beyond 2.8e14 s, t is resolved to a second or worse: every failure is the end time's.
+    if 16.0 * f64::EPSILON * args.t_end >= 1.0 {
+        return coarse_end();
+    }
+    if adaptive && args.rtol < eomgen::analysis::work_precision::SMALLEST_TOLERANCE {
+        return format!(
+            "--rtol {:e} is below what f64 delivers (its rounding, 1.1e-16 per operation, accumulates over a step to more than that): use --rtol 1e-15 or larger",
+            args.rtol
+        );
+    }
+    if adaptive && args.atol == 0.0 && error.t() == Some(0.0) {
+        return format!(
+            "--atol 0 leaves --rtol {:e} alone in control, and a component that starts at 0 (a rate at rest) then asks for its error relative to 0: give --atol above 0 (such as 1e-12)",
+            args.rtol
+        );
+    }
     // What the model shows where the run stopped comes before any guess about the method.
     if let Some(cause) = cause {
         let what_to_do = match cause {
@@ -325,11 +351,7 @@ fn failure_hint(
     }
     let hint = match error {
         IntegrationError::StepSizeTooSmall { .. } if args.t_end >= COARSE_TIME_END => {
-            return format!(
-                "the end time {:e} s is so large that f64 resolves t only to about {:.1e} s near it, coarser than the steps the motion needs; shorten --t-end (or rescale time in the model)",
-                args.t_end,
-                16.0 * f64::EPSILON * args.t_end
-            );
+            return coarse_end();
         }
         IntegrationError::StepSizeTooSmall { .. } if adaptive && args.rtol >= LOOSE_RTOL => {
             return format!(

@@ -120,7 +120,7 @@ pub enum IntegrationError {
     },
     /// The step size fell below `16 ε · max(|t|, t_end − t0)`: the solution changes faster
     /// than the method can follow (a singularity, or stiffness for an explicit method).
-    #[error("the step size {dt:e} fell below the smallest usable step at t = {t}")]
+    #[error("the step size {dt:e} fell below the smallest usable step at t = {}", time(.t))]
     StepSizeTooSmall {
         /// Time reached.
         t: f64,
@@ -128,7 +128,7 @@ pub enum IntegrationError {
         dt: f64,
     },
     /// `max_steps` step attempts did not reach `t_end`.
-    #[error("{max_steps} step attempts did not reach t_end (stopped at t = {t})")]
+    #[error("{max_steps} step attempts did not reach t_end (stopped at t = {})", time(.t))]
     TooManySteps {
         /// Time reached.
         t: f64,
@@ -137,7 +137,7 @@ pub enum IntegrationError {
     },
     /// A component of the state is NaN or infinite, at `t0` (the initial state) or after a
     /// step (overflow).
-    #[error("component {index} of the state is not finite at t = {t}")]
+    #[error("component {index} of the state is not finite at t = {}", time(.t))]
     NonFiniteState {
         /// Time of the non-finite state.
         t: f64,
@@ -146,7 +146,7 @@ pub enum IntegrationError {
     },
     /// The right-hand side is NaN or infinite, as reported by the system
     /// ([`RhsError::NonFinite`](crate::RhsError::NonFinite)) or found by the integrator.
-    #[error("component {index} of the right-hand side is not finite at t = {t}")]
+    #[error("component {index} of the right-hand side is not finite at t = {}", time(.t))]
     RhsNonFinite {
         /// Time at which the right-hand side was evaluated (a stage time of the failed step).
         t: f64,
@@ -155,7 +155,7 @@ pub enum IntegrationError {
     },
     /// The Jacobian `∂F/∂y` an implicit method needs is NaN or infinite in row `row`, even
     /// by differences of `F` ([`RhsError::JacobianNonFinite`](crate::RhsError::JacobianNonFinite)).
-    #[error("row {row} of the Jacobian of the right-hand side is not finite at t = {t}")]
+    #[error("row {row} of the Jacobian of the right-hand side is not finite at t = {}", time(.t))]
     JacobianNonFinite {
         /// Time at which the Jacobian was evaluated (the start of the failed step).
         t: f64,
@@ -164,7 +164,7 @@ pub enum IntegrationError {
     },
     /// The mass matrix is not positive definite
     /// ([`RhsError::SingularMassMatrix`](crate::RhsError::SingularMassMatrix)).
-    #[error("the mass matrix is not positive definite at t = {t}")]
+    #[error("the mass matrix is not positive definite at t = {}", time(.t))]
     SingularMassMatrix {
         /// Time at which the right-hand side was evaluated (a stage time of the failed step).
         t: f64,
@@ -172,7 +172,8 @@ pub enum IntegrationError {
     /// The constrained system `[M Jᵀ; J 0]` is singular
     /// ([`RhsError::SingularConstraintMatrix`](crate::RhsError::SingularConstraintMatrix)).
     #[error(
-        "the constrained system [M Jᵀ; J 0] is singular at t = {t} (redundant constraints or a singular configuration)"
+        "the constrained system [M Jᵀ; J 0] is singular at t = {} (redundant constraints or a singular configuration)",
+        time(.t)
     )]
     SingularConstraintMatrix {
         /// Time at which the right-hand side was evaluated (a stage time of the failed step).
@@ -180,7 +181,7 @@ pub enum IntegrationError {
     },
     /// Projection onto the constraints after the step ending at `t` failed
     /// ([`RhsError::ProjectionFailed`](crate::RhsError::ProjectionFailed)).
-    #[error("projection onto the constraints failed at t = {t}: residual {residual:e} left")]
+    #[error("projection onto the constraints failed at t = {}: residual {residual:e} left", time(.t))]
     ProjectionFailed {
         /// End of the step whose state could not be projected.
         t: f64,
@@ -190,7 +191,7 @@ pub enum IntegrationError {
     /// An event function ([`OdeSystem::event_values`](crate::OdeSystem::event_values)) is NaN
     /// at `t`, so its sign, and whether it crossed zero, is unknown
     /// ([`RhsError::EventNotFinite`](crate::RhsError::EventNotFinite)).
-    #[error("event function {index} is NaN at t = {t}")]
+    #[error("event function {index} is NaN at t = {}", time(.t))]
     EventNotFinite {
         /// Time at which the event functions were evaluated.
         t: f64,
@@ -201,7 +202,8 @@ pub enum IntegrationError {
     /// with a fixed step at once; with adaptive steps after the step was shrunk until it
     /// was too small.
     #[error(
-        "the Newton iteration did not converge for the step from t = {t} ({iterations} iterations, residual norm {residual_norm:e})"
+        "the Newton iteration did not converge for the step from t = {} ({iterations} iterations, residual norm {residual_norm:e})",
+        time(.t)
     )]
     NewtonDidNotConverge {
         /// Start of the step whose stage equations could not be solved.
@@ -218,7 +220,7 @@ pub enum IntegrationError {
     /// The Newton iteration matrix (`I − (h/2) J` for implicit midpoint, `γ/h I − J` and its
     /// complex twin for Radau IIA) was exactly singular at the step from `t`, and a smaller
     /// step did not help.
-    #[error("the Newton iteration matrix is singular at t = {t}")]
+    #[error("the Newton iteration matrix is singular at t = {}", time(.t))]
     SingularIterationMatrix {
         /// Start of the step.
         t: f64,
@@ -302,5 +304,15 @@ mod tests {
             failure.to_string(),
             "the mass matrix is not positive definite at t = 0.5"
         );
+    }
+}
+
+/// A time in an error message: as Rust prints it (shortest round trip), or in exponent form
+/// from 1e6 s on (an end time of 1e300 s printed a time of 300 digits).
+fn time(t: &f64) -> String {
+    if t.is_finite() && t.abs() >= 1e6 {
+        format!("{t:e}")
+    } else {
+        format!("{t}")
     }
 }
