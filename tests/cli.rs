@@ -812,11 +812,23 @@ fn issue_28_bundled_models_run_without_the_source_tree() {
         ],
     ];
     for args in runs {
-        let out = std::process::Command::new(&binary)
-            .args(args)
-            .current_dir(dir.path())
-            .output()
-            .unwrap();
+        // The copy's file descriptor was open for writing while other tests forked: a child
+        // holds it until it executes its own program, and until then this one cannot run
+        // ("Text file busy", ETXTBSY). Waiting out that instant is all it takes.
+        let mut tries = 0;
+        let out = loop {
+            match std::process::Command::new(&binary)
+                .args(args)
+                .current_dir(dir.path())
+                .output()
+            {
+                Err(e) if e.kind() == std::io::ErrorKind::ExecutableFileBusy && tries < 100 => {
+                    tries += 1;
+                    std::thread::sleep(std::time::Duration::from_millis(20));
+                }
+                other => break other.unwrap(),
+            }
+        };
         let err = String::from_utf8_lossy(&out.stderr);
         assert!(out.status.success(), "{args:?}: {err}");
         assert!(!err.contains("cannot read"), "{args:?}: {err}");
