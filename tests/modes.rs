@@ -1291,3 +1291,27 @@ fn a_sweep_of_huge_values_is_answered() {
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(text.contains("1.00000000e200  marginal"), "{text}");
 }
+
+/// The second review of issue 49: a soft spring beside a stiff one is no rigid-body mode. With
+/// `k = −1e-3` beside `1e10` (undamped), the first version of the rigid-mode elimination
+/// (singular values below 1e-13 of the largest) made the soft mode two exact zeros and said
+/// "marginally stable"; it grows as `e^(√1e-3 t)`. A candidate is confirmed on its own scale.
+#[test]
+fn a_soft_mode_beside_a_stiff_one_keeps_its_growth() {
+    let path = format!(
+        "{}/tests/fixtures/slow_and_stiff.yaml",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let mut m = eomgen::ModelSource::open(&path).unwrap().instantiate();
+    m.set_parameter("c", 0.0).unwrap();
+    m.set_parameter("p", -1e-3).unwrap();
+    let lin = linearize(m.as_ref(), &[0.0; 3], &[0.0; 3], 0.0).unwrap();
+    let s = eomgen::linear_stability(&lin).unwrap();
+    let eomgen::Stability::Unstable { growth_rate } = s.stability else {
+        panic!("{:?}", s.eigenvalues)
+    };
+    assert!(
+        (growth_rate - 1e-3f64.sqrt()).abs() <= 1e-12,
+        "{growth_rate}"
+    );
+}

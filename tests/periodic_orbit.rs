@@ -545,6 +545,16 @@ fn errors() {
     };
     let orbit = periodic_orbit(pendulum.as_mut(), &swing).unwrap();
     assert!(orbit.unit_multipliers >= 1, "{:?}", orbit.multipliers);
+    // Near the separatrix (1e-3 rad from upright, T = 11.368 s) the pair at 1 is a Jordan
+    // block with a large shear, split by rounding beyond 1e-3, but Φ f = f holds: an orbit
+    // (the second review found it refused).
+    let near_top = PeriodicOrbitOptions {
+        start: Some(vec![PI / 2.0 - 1e-3, 0.0]),
+        energy: Some(pendulum.energy(0.0, &[PI / 2.0 - 1e-3, 0.0])),
+        ..PeriodicOrbitOptions::new(11.368005377845044)
+    };
+    let orbit = periodic_orbit(pendulum.as_mut(), &near_top).unwrap();
+    assert!((orbit.period - 11.368005).abs() < 1e-4, "{}", orbit.period);
     // n = −1: the file's potential divides by n + 1, so the energy cannot be fixed.
     let mut log_force = model("central_force");
     log_force.set_parameter("n", -1.0).unwrap();

@@ -372,6 +372,33 @@ fn a_real_crossing_beside_slow_and_stiff_modes_is_found_at_zero() {
     }
 }
 
+/// The second review of issue 49: a cyclic coordinate that cancels only in value (the
+/// azimuth of a particle on a spring in a conical steady motion, `cos² φ + sin² φ` in F) was
+/// refused as "F depends on it", because F = M q̈ is at rounding on the steady motion itself;
+/// a change is measured against each part's size near the motion too. A spinning sleeping
+/// top at a rate inside its unstable band (w3 = 2) failed: the Schur iteration stalled on
+/// its gyroscopic state matrix and on its transpose; a reflected copy converges, to numpy's
+/// ±6.9857 ± 0.5i.
+#[test]
+fn cyclic_coordinates_cancelling_in_value_and_a_stalled_schur_iteration() {
+    let out = common::eomgen(&["modes", &fixture("conical_spring.yaml")]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(text.contains("marginally stable"), "{text}");
+    let out = common::eomgen(&["modes", &fixture("sleeping_top.yaml"), "--set", "w3=2"]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(text.contains("grows as e^(6.98570"), "{text}");
+}
+
 /// The Whipple bicycle benchmark (`whipple_bicycle`, Meijaard, Papadopoulos, Ruina & Schwab,
 /// Proc. R. Soc. A 463, 2007): the eigenvalues of upright straight rolling at v = 0, 1, …,
 /// 10 m/s equal the paper's Table 2 to 1e-10 (the paper prints 14 decimals; its own

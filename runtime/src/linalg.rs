@@ -31,8 +31,20 @@ pub fn eigenvalues(a: &DMatrix<f64>) -> Option<Vec<Complex<f64>>> {
     // The transpose has the same eigenvalues and other rounding: where the iteration cycles
     // on one (a matrix with Jordan blocks of zeros, as a free structure's state matrix has),
     // it converges on the other.
+    // Then a reflection `H A H` (`H = I − 2 w wᵀ/wᵀw`, `w` irregular and fixed): the same
+    // eigenvalues, without the structure that stalls the shifts (a gyroscopic `[[0, I],
+    // [k I, g J]]` stalled on both `A` and `Aᵀ`).
+    let reflected = || {
+        let n = a.nrows();
+        let w = nalgebra::DVector::from_fn(n, |i, _| {
+            1.0 + ((i + 1) as f64 * 0.618_033_988_749_895).fract()
+        });
+        let h = DMatrix::identity(n, n) - (&w * w.transpose()) * (2.0 / w.norm_squared());
+        &h * a * &h
+    };
     let schur = nalgebra::Schur::try_new(a.clone(), f64::EPSILON, sweeps)
-        .or_else(|| nalgebra::Schur::try_new(a.transpose(), f64::EPSILON, sweeps))?;
+        .or_else(|| nalgebra::Schur::try_new(a.transpose(), f64::EPSILON, sweeps))
+        .or_else(|| nalgebra::Schur::try_new(reflected(), f64::EPSILON, sweeps))?;
     let values: Vec<Complex<f64>> = schur.complex_eigenvalues().iter().copied().collect();
     values
         .iter()

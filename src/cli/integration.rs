@@ -319,17 +319,29 @@ fn failure_hint(
             16.0 * f64::EPSILON * args.t_end
         )
     };
-    // Beyond 2.8e14 s, t is resolved to a second or worse: every failure is the end time's.
-    if 16.0 * f64::EPSILON * args.t_end >= 1.0 {
+    // Beyond 2.8e14 s, t is resolved to a second or worse near the end: a failure within the
+    // first such step is the end time's (the first step is at least that long).
+    let resolution = 16.0 * f64::EPSILON * args.t_end;
+    if resolution >= 1.0
+        && error
+            .t()
+            .is_some_and(|t| t == 0.0 || t.abs() >= 1e-3 * resolution)
+    {
         return coarse_end();
     }
-    if adaptive && args.rtol < eomgen::analysis::work_precision::SMALLEST_TOLERANCE {
+    // The tolerances explain a step that collapsed at the start, not a run that met something
+    // in the model on its way (a blow-up at t = 2.38 stops the same at --rtol 1e-16 and 1e-10).
+    let collapsed = matches!(
+        error,
+        IntegrationError::StepSizeTooSmall { .. } | IntegrationError::TooManySteps { .. }
+    ) && error.t() == Some(0.0);
+    if collapsed && adaptive && args.rtol < eomgen::analysis::work_precision::SMALLEST_TOLERANCE {
         return format!(
             "--rtol {:e} is below what f64 delivers (its rounding, 1.1e-16 per operation, accumulates over a step to more than that): use --rtol 1e-15 or larger",
             args.rtol
         );
     }
-    if adaptive && args.atol == 0.0 && error.t() == Some(0.0) {
+    if collapsed && adaptive && args.atol == 0.0 {
         return format!(
             "--atol 0 leaves --rtol {:e} alone in control, and a component that starts at 0 (a rate at rest) then asks for its error relative to 0: give --atol above 0 (such as 1e-12)",
             args.rtol

@@ -275,6 +275,16 @@ pub struct IntegrationFailure {
     pub partial: Box<Solution>,
 }
 
+/// A time in an error message: as Rust prints it (shortest round trip), or in exponent form
+/// from 1e6 s on (an end time of 1e300 s printed a time of 300 digits).
+fn time(t: &f64) -> String {
+    if t.is_finite() && t.abs() >= 1e6 {
+        format!("{t:e}")
+    } else {
+        format!("{t}")
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -304,15 +314,5 @@ mod tests {
             failure.to_string(),
             "the mass matrix is not positive definite at t = 0.5"
         );
-    }
-}
-
-/// A time in an error message: as Rust prints it (shortest round trip), or in exponent form
-/// from 1e6 s on (an end time of 1e300 s printed a time of 300 digits).
-fn time(t: &f64) -> String {
-    if t.is_finite() && t.abs() >= 1e6 {
-        format!("{t:e}")
-    } else {
-        format!("{t}")
     }
 }

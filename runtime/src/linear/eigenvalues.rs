@@ -242,8 +242,9 @@ pub fn state_eigenvalues(lin: &Linearization) -> Result<Vec<Complex<f64>>, Modal
 
 /// The modes of `ẍ + c ẋ + k x = 0` (mass-normalised, `r × r`) on which neither `k` nor `c`
 /// acts: the common null space of `k` and `c` (right null vectors of `[k; σc]`, `σ = √‖k‖`
-/// balancing the units, by a singular value below `1e-13` of the largest: rounding of the
-/// normalisation), such as the translations and rotations of a free structure, which no
+/// balancing the units, by a singular value below `1e-10` of the largest, each confirmed on
+/// its own scale: `k v` and `c v` at `1e-9` of the terms `|k| |v|` and `|c| |v|` they sum),
+/// such as the translations and rotations of a free structure, which no
 /// coordinate is alone. Each gives a double zero eigenvalue exactly: with an orthonormal
 /// basis `[N R]`, `N` the null space, `P(λ) = λ²I + λc + k` becomes block triangular,
 /// `[[λ²I, NᵀPR], [0, RᵀPR]]`, so the other eigenvalues are those of
@@ -281,8 +282,19 @@ fn without_rigid_modes(
             q: q.to_vec(),
         })?;
     let largest = svd.singular_values.max();
+    // A candidate is a rigid-body mode only on its own scale: `k v` and `c v` at rounding of
+    // the terms they sum (`|k| |v|`), as a translation of a free structure cancels its
+    // springs' forces. A soft spring's mode is not, however small it is beside a stiff one
+    // (diag(1e6, −1e-8) keeps its unstable mode).
+    let cancels = |x: &DMatrix<f64>, v: &nalgebra::DVector<f64>| {
+        let terms = x.abs() * v.abs();
+        (x * v).amax() <= 1e-9 * terms.amax()
+    };
     let kept: Vec<usize> = (0..r)
-        .filter(|&i| svd.singular_values[i] > 1e-13 * largest)
+        .filter(|&i| {
+            let v = v_t.row(i).transpose();
+            svd.singular_values[i] > 1e-10 * largest || !cancels(&k, &v) || !cancels(&c, &v)
+        })
         .collect();
     let rigid = r - kept.len();
     if rigid == 0 || kept.is_empty() {

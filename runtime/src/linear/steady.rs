@@ -300,6 +300,9 @@ pub fn find_steady_motion(
     })
 }
 
+/// The parts of the equations [`check_cyclic`] compares, by name, each flattened.
+type Parts = Vec<(&'static str, DVector<f64>)>;
+
 /// Shifts (in the coordinate's units) by which [`check_cyclic`] moves a coordinate:
 /// irrational-looking and of both signs, so that no periodic dependence hides in all.
 const CYCLIC_SHIFTS: [f64; 3] = [0.271_828, 1.523_7, -0.731_3];
@@ -332,7 +335,7 @@ fn check_cyclic(
         .map(|(k, v)| v + 0.1 * (1.0 + (k as f64 * 0.618_033_988_749_895).fract()))
         .collect();
     let constrained = !model.description().constraints.is_empty();
-    let parts = |y: &[f64]| -> Option<Vec<(&'static str, DVector<f64>)>> {
+    let parts = |y: &[f64]| -> Option<Parts> {
         let (m, f) = model.mass_matrix_and_forcing(t, y);
         let mut out = vec![
             (
@@ -362,15 +365,30 @@ fn check_cyclic(
             .all(|(_, v)| v.iter().all(|x| x.is_finite()))
             .then_some(out)
     };
-    for base in [&steady, &near] {
-        let Some(at_base) = parts(base) else { continue };
+    // Each part's size over both states: at the steady motion itself `F = M q̈` and `Φ` are
+    // at rounding, against which a cancellation of a cyclic coordinate in value
+    // (`cos² φ + sin² φ`) would look like a change.
+    let bases: Vec<(&Vec<f64>, Parts)> = [&steady, &near]
+        .into_iter()
+        .filter_map(|y| Some((y, parts(y)?)))
+        .collect();
+    let sizes: Vec<f64> = bases.first().map_or_else(Vec::new, |(_, first)| {
+        (0..first.len())
+            .map(|p| {
+                bases
+                    .iter()
+                    .fold(0.0f64, |m, (_, at)| m.max(at[p].1.amax()))
+            })
+            .collect()
+    });
+    for (base, at_base) in &bases {
         for &i in moving {
             for shift in CYCLIC_SHIFTS {
-                let mut y = base.clone();
+                let mut y = (*base).clone();
                 y[i] += shift;
                 let Some(shifted) = parts(&y) else { continue };
-                for ((part, a), (_, b)) in at_base.iter().zip(&shifted) {
-                    let scale = a.amax().max(b.amax());
+                for (p, ((part, a), (_, b))) in at_base.iter().zip(&shifted).enumerate() {
+                    let scale = sizes[p].max(b.amax());
                     let change = if scale == 0.0 {
                         0.0
                     } else {
@@ -726,7 +744,8 @@ pub fn raw_eigenvalues(a: &DMatrix<f64>) -> Option<Vec<Complex<f64>>> {
     // ends (a sweep of g from 1e200 hung there).
     let largest = a.amax();
     let scale = if largest > 0.0 {
-        2f64.powi(-(largest.log2().round() as i32))
+        // Clamped: below 2^-1000 (subnormal) the inverse power would overflow.
+        2f64.powi(-(largest.log2().round().clamp(-1000.0, 1000.0) as i32))
     } else {
         1.0
     };

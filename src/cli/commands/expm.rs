@@ -92,7 +92,7 @@ pub fn run(args: &ExpmArgs) -> Result<(), CliError> {
     match study.differences.iter().find(|d| !d.passed) {
         None => Ok(()),
         Some(d) if !d.checked => Err(CliError::failure(format!(
-            "study expm: the bound {:.1e} on {} against {} tests nothing (at or above {:.0e}: A is so far from normal that a disturbance grows by orders of magnitude more than the solution shows), so the routes are not compared",
+            "study expm: the bound {:.1e} on {} against {} tests nothing (at or above {:.0e}: the tolerance, the time scales the samples span or the transient growth of a non-normal A make it that large), so the routes are not compared; tighten --tol or shorten --t",
             num(d.tolerance),
             d.a.name(),
             d.b.name(),

@@ -119,9 +119,12 @@ pub fn redundant_rows(samples: &[Vec<f64>], m: usize, n: usize) -> Vec<(usize, V
     let mut combination: Vec<Vec<usize>> = vec![Vec::new(); m];
     for (k, jac) in samples.iter().enumerate() {
         let row = |i: usize| &jac[i * n..(i + 1) * n];
-        let largest = (0..m)
-            .map(|i| row(i).iter().map(|x| x * x).sum::<f64>().sqrt())
-            .fold(0.0f64, f64::max);
+        // Against the largest row: a row in other units 1e12 times smaller (an angle beside a
+        // length of 1e13 m) would be taken for zero, as the test below already takes rows
+        // apart by 1e9 for dependent; column scaling cannot tell a row of rounding from one
+        // of small units, since a column that only rounding fills is scaled up with it.
+        let norm_of = |i: usize| row(i).iter().map(|x| x * x).sum::<f64>().sqrt();
+        let largest = (0..m).map(norm_of).fold(0.0f64, f64::max);
         // Orthonormal basis of the independent rows so far (modified Gram–Schmidt).
         let mut basis: Vec<Vec<f64>> = Vec::new();
         let mut independent: Vec<usize> = Vec::new();
