@@ -1225,10 +1225,7 @@ fn a_sweep_of_a_free_structure_finds_no_change() {
     let mut m = model("spring_square");
     let options = ParameterSweepOptions {
         axis: SweepAxis::linear("k", 0.5, 5.0, 120).unwrap(),
-        operating_point: eomgen::analysis::vibration::OperatingPointOptions {
-            start: eomgen::analysis::vibration::EquilibriumStart::Named("rest".to_string()),
-            ..Default::default()
-        },
+        operating_point: named("rest"),
         refine: true,
     };
     let sweep = vibration::parameter_sweep(m.as_mut(), &options, |_, _| {}).unwrap();
@@ -1256,10 +1253,7 @@ fn a_sweep_of_huge_values_is_answered() {
     let mut m = model("simple_pendulum");
     let options = ParameterSweepOptions {
         axis: SweepAxis::linear("g", 1e200, 2e200, 1).unwrap(),
-        operating_point: eomgen::analysis::vibration::OperatingPointOptions {
-            start: eomgen::analysis::vibration::EquilibriumStart::Named("hanging".to_string()),
-            ..Default::default()
-        },
+        operating_point: named("hanging"),
         refine: true,
     };
     let sweep = vibration::parameter_sweep(m.as_mut(), &options, |_, _| {}).unwrap();
@@ -1314,4 +1308,12 @@ fn a_soft_mode_beside_a_stiff_one_keeps_its_growth() {
         (growth_rate - 1e-3f64.sqrt()).abs() <= 1e-12,
         "{growth_rate}"
     );
+}
+
+/// The operating point of the file's `equilibria:` entry `name`, for a sweep.
+fn named(name: &str) -> eomgen::analysis::vibration::OperatingPointOptions {
+    eomgen::analysis::vibration::OperatingPointOptions {
+        start: eomgen::analysis::vibration::EquilibriumStart::Named(name.to_string()),
+        ..Default::default()
+    }
 }

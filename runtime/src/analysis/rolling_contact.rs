@@ -47,6 +47,10 @@
 //! as constraint forces, `M q̈ = F − Jᵀλ`); B. Fornberg, "Generation of finite difference
 //! formulas on arbitrarily spaced grids", Math. Comp. 51 (1988) 699–706 (the five-point
 //! stencil).
+//!
+//! long: the rolling phase (contact forces, the friction needed, the Newton–Euler agreement)
+//! and the flight phase after lift-off share the run and event helpers; each phase could be a
+//! module of its own, a split left to the issue on the code's shape.
 
 use serde::Serialize;
 

@@ -26,6 +26,11 @@
 //! mode); [`exact_damped_modes`], each mode's complex eigenvalue of `A`. For a general state
 //! matrix (HW32) [`state_response_by_eigenvectors`] superposes the complex eigenvector
 //! solutions `e^{λt} v`.
+//!
+//! long: the free response by integration, exponential, eigenvectors and modes, and the
+//! damping models compared against it, share the eigenvector clusters and the modal
+//! coordinates; the damping models (Rayleigh, modal) could move to a room of their own, a split
+//! left to the issue on the code's shape.
 
 use nalgebra::{Complex, DMatrix, DVector};
 

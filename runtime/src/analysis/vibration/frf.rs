@@ -7,6 +7,10 @@
 //! [`plan_simulation`] checks their options and picks the frequencies, and
 //! [`simulate_point`] runs one (independent of the others, so a caller may run them in
 //! parallel, each on its own instance of the model).
+//!
+//! long: over half of it is the `Serialize` summaries of the analysis (`*Summary`), which
+//! mirror its types field by field; they could move beside the other summaries, a split left
+//! to the issue on the code's shape.
 
 use std::collections::BTreeMap;
 
