@@ -342,7 +342,7 @@ fn new_and_equations() {
 /// reaction left in (AMB about the elbow of both bars), dependent balances (the same AMB
 /// twice), AMB about the moving elbow without the `v_E × m v_G` correction (HW4, HW15), hand
 /// equations with a dropped Coriolis term (HW20) and with a spring force of the wrong sign
-/// (HW9). HW19's own balances pass.
+/// (HW9), each wrong equation named. HW19's own balances pass.
 #[test]
 fn check_detects_wrong_derivations() {
     let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/wrong");
@@ -350,8 +350,15 @@ fn check_detects_wrong_derivations() {
         ("reaction_left_in.yaml", "leaves a reaction force in"),
         ("dependent_balances.yaml", "not independent"),
         ("h_dot_about_elbow.yaml", "misses v_A × m v_G"),
-        ("dropped_coriolis.yaml", "written by hand disagree"),
-        ("spring_sign.yaml", "written by hand disagree"),
+        // The note names the wrong equation (the one that fails at Lagrange's q̈).
+        (
+            "dropped_coriolis.yaml",
+            "written by hand disagree with Lagrange in equation 1 (line 35)",
+        ),
+        (
+            "spring_sign.yaml",
+            "written by hand disagree with Lagrange in equation 1 (line 33)",
+        ),
     ] {
         let path = format!("{dir}/{file}");
         let out = eomgen(&["check", &path, "--states", "50", "--json"]);

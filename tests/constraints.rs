@@ -4,6 +4,7 @@
 
 use std::f64::consts::PI;
 
+use crate::common;
 use eomgen::models;
 use eomgen::{
     DormandPrince54, Integrator, IntegratorOptions, ModelInfo, OutputTimes, Solution, Stabilization,
@@ -523,4 +524,48 @@ fn a_rolling_contact_along_the_normal_constrains_nothing() {
         "{}",
         d.message
     );
+}
+
+/// HW10's rod pushed by `F0 = 1e300` N: the masses reach 2.5e301 m in 10 s. The study's
+/// errors stay finite (distances by `hypot`: their squares used to overflow to "inf" with
+/// exit 0), relative to the positions at rounding (the DAE rows below 1e-14 of 2.5e301 m) and
+/// the springs' error `F0/(2k)`; and the elimination of `x2 = x1 + l0` is not called
+/// singular (its slope 1 was compared with the square of the largest parameter).
+#[test]
+fn constraint_methods_measure_a_huge_push_without_overflow() {
+    let source = std::fs::read_to_string(format!(
+        "{}/models/two_masses_rod.yaml",
+        env!("CARGO_MANIFEST_DIR")
+    ))
+    .unwrap();
+    let text = source.replace("  F0: 1.0", "  F0: 1e300");
+    assert_ne!(text, source, "the file's F0 line");
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("pushed.yaml");
+    std::fs::write(&path, text).unwrap();
+    let out = common::eomgen(&[
+        "study",
+        "constraint-methods",
+        path.to_str().unwrap(),
+        "--json",
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let rows = json["methods"].as_array().expect("methods");
+    assert!(
+        rows.iter()
+            .any(|r| r["method"].as_str().unwrap().starts_with("II.2")),
+        "{rows:?} {err}"
+    );
+    for r in rows {
+        let e = r["position_error_m"].as_f64().expect("a finite error");
+        let method = r["method"].as_str().unwrap();
+        let bound = if method.starts_with("I: stiff") {
+            1e299
+        } else {
+            1e-14 * 2.5e301
+        };
+        assert!(e.is_finite() && e < bound, "{method}: {e}");
+    }
 }

@@ -735,3 +735,33 @@ fn frequency_parameter_is_used_without_simulate() {
     assert!((rate("w") - 0.4).abs() < 1e-12);
     assert_eq!(rate("m"), 0.0);
 }
+
+/// A steady motion named where an analysis linearises about an equilibrium is refused by
+/// name, by `frf` as by the other commands (it used to search for an equilibrium from the
+/// steady motion's coordinates and reach the top standing upright, "ill-conditioned"); the
+/// same for `study convolution`.
+#[test]
+fn an_equilibrium_analysis_at_a_steady_motion_says_so() {
+    for args in [
+        &["frf", "heavy_top", "--input", "theta", "--at", "precessing"][..],
+        &[
+            "study",
+            "convolution",
+            "heavy_top",
+            "--input",
+            "theta",
+            "--forcing",
+            "sin(t)",
+            "--at",
+            "precessing",
+        ][..],
+    ] {
+        let out = eomgen(args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {err}");
+        assert!(
+            err.contains("`precessing` of `heavy_top` is a steady motion"),
+            "{args:?}: {err}"
+        );
+    }
+}

@@ -407,6 +407,29 @@ fn the_command_writes_a_file_the_other_commands_run() {
     assert!(String::from_utf8_lossy(&unsolvable.stderr).contains("cannot be solved for"));
     let wrong = eomgen(&["reduce", "simple_pendulum_cartesian", "--keep", "z"]);
     assert_eq!(wrong.status.code(), Some(2));
+    // Usage errors of the options, each named, exit 2: a name that is not one, a start where
+    // the eliminated `y = −√(ℓ² − x²)` is not real (x = 2 > ℓ = 1), a branch given twice.
+    for (extra, says) in [
+        (
+            &["--name", "Bad-Name"][..],
+            "`Bad-Name` is not a model name",
+        ),
+        (&["--initial", "x=2"][..], "l^2 - x^2 = -3 < 0: no real `y`"),
+        (
+            &["--branch", "y=-", "--branch", "y=+"][..],
+            "a branch is given twice for `y`",
+        ),
+    ] {
+        let mut args = vec!["reduce", "simple_pendulum_cartesian", "--keep", "x"];
+        if extra[0] != "--initial" {
+            args.extend(["--initial", "x=0.3"]);
+        }
+        args.extend(extra);
+        let out = eomgen(&args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains(says), "{args:?}: {err}");
+    }
 }
 
 /// `study constraint-methods`' II.2 row, through the library: the reduced model compiled at

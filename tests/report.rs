@@ -125,6 +125,19 @@ fn report_on_three_models_writes_the_page_and_json_and_passes() {
         assert!(html.contains(&format!("<section id=\"{id}\">")), "{id}");
     }
     assert!(html.contains("<math display=\"block\">"));
+    // Each section titles its equations by the derivation they come from: Lagrange's for the
+    // pendulum's energies, momentum balance for the masses' points.
+    for (id, derivation) in [
+        ("simple_pendulum", "Lagrange"),
+        ("three_masses", "momentum balance"),
+    ] {
+        let start = html.find(&format!("<section id=\"{id}\">")).unwrap();
+        let section = &html[start..start + html[start..].find("</section>").unwrap()];
+        assert!(
+            section.contains(&format!("<h3>Equations of motion ({derivation})</h3>")),
+            "{id}: {derivation}"
+        );
+    }
     assert!(
         !html.contains("http://") && !html.contains("https://"),
         "no network"

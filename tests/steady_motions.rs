@@ -620,3 +620,43 @@ fn angular_velocities_can_be_read_in_expressions() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("unknown name `omega_B_z`"), "{err}");
 }
+
+/// A heavy top's steady precessions with the rates held: with `φ̇`, `ψ̇` fixed, `θ̈ = 0` at
+/// `sin θ = 0` and at `cos θ = (I3 ψ̇ φ̇ − m g l)/((I1 − I3) φ̇²)` (Lagrange's equation for θ
+/// in the model file). Held at the rates of the precession at θ = 0.9:
+/// - from guesses 0.5 (near the residual's maximum, where a full Newton step went to
+///   `8π − 0.9`) to 1.2 the search finds θ = 0.9… within 1e-13 of the closed form (the
+///   rounding of θ̈'s terms, 40 rad/s², over its slope 0.3 rad/s² per rad, is 1e-13);
+/// - from 0.3, where the residual leads to the sleeping top at θ = 0 and the Euler angles
+///   are singular, it says so.
+#[test]
+fn a_tops_precession_is_found_on_the_guesss_branch_to_rounding() {
+    let mut m = model("heavy_top");
+    let (i1, i3, mgl): (f64, f64, f64) = (0.02, 0.01, 9.81 * 0.1);
+    let (theta, w3): (f64, f64) = (0.9, 100.0);
+    let c = theta.cos();
+    let phi_dot = (i3 * w3 - (i3 * i3 * w3 * w3 - 4.0 * i1 * mgl * c).sqrt()) / (2.0 * i1 * c);
+    let psi_dot = w3 - phi_dot * c;
+    let expected = ((i3 * psi_dot * phi_dot - mgl) / ((i1 - i3) * phi_dot * phi_dot)).acos();
+    assert!((expected - theta).abs() < 1e-12, "{expected}");
+    let rates = [phi_dot, 0.0, psi_dot];
+    for guess in [0.5, 0.6, 0.8, 1.0, 1.2] {
+        let found =
+            eomgen::find_steady_motion(m.as_mut(), 0.0, &[0.0, guess, 0.0], &rates, &[0, 2])
+                .unwrap_or_else(|e| panic!("from θ = {guess}: {e}"));
+        assert!(
+            (found.q[1] - expected).abs() <= 1e-13,
+            "from θ = {guess}: {} against {expected}",
+            found.q[1]
+        );
+    }
+    let err = eomgen::find_steady_motion(m.as_mut(), 0.0, &[0.0, 0.3, 0.0], &rates, &[0, 2])
+        .expect_err("the sleeping top is at the Euler angles' singularity");
+    let text = err.to_string();
+    assert!(
+        matches!(err, eomgen::SteadyMotionError::Unevaluable { .. })
+            && text.contains("stopped near theta = ")
+            && text.contains("singularity of the coordinates"),
+        "{text}"
+    );
+}

@@ -688,3 +688,45 @@ fn check_never_passes_without_a_second_derivation() {
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(text.contains("not cross-checked"), "{text}");
 }
+
+/// A start whose expression is NaN at the parameters (`sqrt(a − 1)` at a < 1) is named, not
+/// reported as "the right-hand side is not finite" (the sweep's rows) or as forcing that is
+/// not finite at t = 0 (`simulate`): the rows below a = 1 and the run at a = 0 say which
+/// value of which start; the rows at and above a = 1 have the spring's ±2i.
+#[test]
+fn a_start_that_is_nan_at_the_parameters_is_named() {
+    let file = format!(
+        "{}/tests/fixtures/nan_start.yaml",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let out = eomgen(&[
+        "study",
+        "parameter-sweep",
+        &file,
+        "--parameter",
+        "a",
+        "--values",
+        "0..2:5",
+    ]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    let rows: Vec<&str> = text.lines().filter(|l| l.starts_with("    ")).collect();
+    assert_eq!(rows.len(), 5, "{text}");
+    for row in &rows[..2] {
+        assert!(
+            row.contains("failed") && row.contains("the start `rest` of `nan_guess` has x = NaN"),
+            "{row}"
+        );
+    }
+    for row in &rows[2..] {
+        assert!(row.contains("±2.00000000i"), "{row}");
+    }
+    let out = eomgen(&["simulate", &file, "--set", "a=0"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(
+        stderr(&out).contains(
+            "the initial value of `x` is NaN: its expression in the model file's `initial:`"
+        ),
+        "{}",
+        stderr(&out)
+    );
+}

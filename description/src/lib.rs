@@ -93,6 +93,11 @@ pub struct ModelDescription {
     /// Whether every load is conservative and nothing depends explicitly on `t`, so that
     /// `T + V` is a constant of the motion.
     pub conservative: bool,
+    /// The derivation the model's functions are compiled from, as `eomgen equations --method`
+    /// names it: `momentum` (momentum balance, for the kinematic form) or `lagrange`
+    /// (Lagrange's equations, for the energy form and a kinematic file with a written
+    /// potential or generalized forces); empty for a hand-written model.
+    pub derivation: Text,
     /// The derived equations as plain text (`M`, `F`, `T`, `V`).
     pub equations_text: Text,
     /// The derived equations as LaTeX.
@@ -135,6 +140,7 @@ impl ModelDescription {
         events: Cow::Borrowed(&[]),
         events_need_accelerations: false,
         conservative: false,
+        derivation: Cow::Borrowed(""),
         equations_text: Cow::Borrowed(""),
         equations_latex: Cow::Borrowed(""),
         equations_mathml: None,
@@ -151,6 +157,19 @@ impl ModelDescription {
     /// The coordinates' names, in order.
     pub fn coordinate_names(&self) -> Vec<&str> {
         self.coordinates.iter().map(|c| c.as_ref()).collect()
+    }
+
+    /// The name of state entry `i` of `y = (q, q̇)`: a coordinate (`x`) for `i < n`, its rate
+    /// (`x_dot`) for `n ≤ i < 2n`, else the index.
+    pub fn state_name(&self, i: usize) -> String {
+        let n = self.coordinates.len();
+        match self.coordinates.get(i) {
+            Some(c) => c.to_string(),
+            None => match self.coordinates.get(i - n) {
+                Some(c) => format!("{c}_dot"),
+                None => i.to_string(),
+            },
+        }
     }
 
     /// The parameters' names, in file order.
@@ -344,6 +363,8 @@ mod tests {
         assert_eq!(STATIC, owned);
         assert_eq!(owned.num_dofs(), 2);
         assert_eq!(owned.coordinate_index("y"), Some(1));
+        let names: Vec<String> = (0..5).map(|i| owned.state_name(i)).collect();
+        assert_eq!(names, ["x", "y", "x_dot", "y_dot", "4"]);
         assert_eq!(owned.coordinate_index("z"), None);
         assert_eq!(owned.parameter_names(), ["k"]);
         assert_eq!(owned.parameter_defaults(), [2.5]);

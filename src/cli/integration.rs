@@ -7,7 +7,8 @@ use clap::{Args, ValueEnum};
 pub(crate) use eomgen::Method;
 use eomgen::Stabilization;
 use eomgen::analysis::{
-    AddedEvents, FailureCause, Simulation, SimulationError, SimulationOptions, simulate_with_events,
+    AddedEvents, FailureCause, Simulation, SimulationError, SimulationOptions, check_initial_state,
+    simulate_with_events,
 };
 use eomgen::expressions::{ExpressionEvents, set_initial_values};
 use eomgen::{IntegrationError, ModelInfo, OutputTimes};
@@ -207,6 +208,7 @@ pub(super) fn simulation(
     let mut model = find_model(model_name)?;
     set_parameters(model.as_mut(), &args.set)?;
     let mut y0 = model.initial_state();
+    check_initial_state(model.description(), &y0, false).map_err(simulation_error)?;
     set_initial_values(model.as_ref(), &mut y0, &args.init).map_err(usage)?;
     let mut added =
         ExpressionEvents::parse(model.as_mut(), &args.stop_when, &args.event).map_err(usage)?;
@@ -250,6 +252,9 @@ pub(super) fn simulation_error(error: SimulationError) -> CliError {
             has_guesses,
         )),
         SimulationError::InvalidStabilization(e) => CliError::usage(format!("--baumgarte: {e}")),
+        e @ SimulationError::InitialStateNotFinite { given: false, .. } => {
+            CliError::failure(e.to_string())
+        }
         other => CliError::usage(other.to_string()),
     }
 }

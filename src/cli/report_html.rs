@@ -31,6 +31,8 @@ pub(super) struct ModelReport {
     pub dof: usize,
     /// The equations of motion, one `<math>` element per line.
     pub equations: Vec<String>,
+    /// The derivation they come from, as the page titles it (`momentum balance`).
+    pub derivation: &'static str,
     /// Charts.
     pub figures: Vec<Figure>,
     /// The model's animation (a self-contained HTML file relative to the report's
@@ -173,7 +175,11 @@ fn section(h: &mut String, r: &ModelReport) {
         );
     }
     if !r.equations.is_empty() {
-        h.push_str("<h3>Equations of motion (Lagrange)</h3>\n<div class=\"equations\">\n");
+        let _ = writeln!(
+            h,
+            "<h3>Equations of motion ({})</h3>\n<div class=\"equations\">",
+            r.derivation
+        );
         for e in &r.equations {
             // One line each, left-aligned and scrollable: block math would be centred and
             // clipped on the left when wider than the page.

@@ -295,13 +295,22 @@ fn row(
         let e = p
             .iter()
             .zip(r)
-            .map(|(a, b)| {
-                ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
-            })
-            .fold(0.0f64, f64::max);
-        position_error = position_error.max(e);
+            // hypot: no overflow of the squares for positions beyond 1e154 m.
+            .map(|(a, b)| (a[0] - b[0]).hypot(a[1] - b[1]).hypot(a[2] - b[2]))
+            .fold(0.0f64, |m, e| if e.is_nan() { e } else { m.max(e) });
+        position_error = if e.is_nan() { e } else { position_error.max(e) };
         error_history.push((*t, e));
     }
+    // A distance that is not finite measured nothing: the run failed there.
+    let failure = failure.or_else(|| {
+        (!position_error.is_finite()).then(|| {
+            let at = error_history
+                .iter()
+                .find(|(_, e)| !e.is_finite())
+                .map_or(f64::NAN, |(t, _)| *t);
+            format!("the position error is not finite at t = {at} s (the positions overflow)")
+        })
+    });
     let drift = constrained.then(|| {
         solution
             .iter()

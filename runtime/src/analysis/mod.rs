@@ -43,8 +43,8 @@ pub use rolling_contact::{
 pub use roundoff::{EulerRoundoff, RoundoffError, RoundoffOptions, euler_roundoff};
 pub use simulation::{
     AddedEvents, DriftPair, EventSummary, FailureSummary, Simulation, SimulationError,
-    SimulationOptions, SimulationSample, SimulationSummary, WarningSummary, simulate,
-    simulate_with_events,
+    SimulationOptions, SimulationSample, SimulationSummary, WarningSummary, check_initial_state,
+    simulate, simulate_with_events,
 };
 pub use stability::{
     StabilityError, StabilityOptions, StabilityStudy, StiffSpring, stability_study,

@@ -151,6 +151,21 @@ pub enum SimulationError {
     /// The drift control's gains cannot be used (a negative Baumgarte gain).
     #[error(transparent)]
     InvalidStabilization(#[from] StabilizationError),
+    /// An entry of the initial state is not finite: the model file's `initial:` expression
+    /// is outside its domain at these parameters, or the state given has it.
+    #[error(
+        "the initial value of `{name}` is {value}{}",
+        if *given { " in the initial state given" } else { ": its expression in the model file's `initial:` is outside its domain at these parameters (a root or logarithm of a negative number, a division by zero)" }
+    )]
+    InitialStateNotFinite {
+        /// The coordinate or rate (`x`, `x_dot`).
+        name: String,
+        /// The value (NaN or ±inf).
+        value: f64,
+        /// Whether the state was given ([`SimulationOptions::initial_state`]) rather than
+        /// the model's.
+        given: bool,
+    },
 }
 
 /// The result of [`simulate`]: the samples, the drift measures and the events, and the
@@ -228,6 +243,27 @@ pub fn simulate(
     simulate_with_events(model, options, None)
 }
 
+/// Refuses an initial state `y0 = (q, q̇)` with an entry that is not finite, naming it:
+/// `given` says whether the state was given by the caller (else the model file's
+/// `initial:` gave it, at the model's current parameters).
+///
+/// # Errors
+/// [`SimulationError::InitialStateNotFinite`] for the first such entry.
+pub fn check_initial_state(
+    description: &crate::ModelDescription,
+    y0: &[f64],
+    given: bool,
+) -> Result<(), SimulationError> {
+    match y0.iter().position(|v| !v.is_finite()) {
+        Some(i) => Err(SimulationError::InitialStateNotFinite {
+            name: description.state_name(i),
+            value: y0[i],
+            given,
+        }),
+        None => Ok(()),
+    }
+}
+
 /// Simulates `model` from the initial state with `options`, locating the model's own events
 /// and `added` ones: the initial state is made consistent with the constraints
 /// ([`ModelInfo::make_consistent`]), the drift control set
@@ -290,6 +326,7 @@ pub fn simulate_with_events(
             found: y0.len(),
         });
     }
+    check_initial_state(model.description(), &y0, options.initial_state.is_some())?;
     model
         .make_consistent(&mut y0)
         .map_err(|e| inconsistent(model, &e))?;

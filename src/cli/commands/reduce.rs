@@ -74,7 +74,13 @@ pub fn run(args: &ReduceArgs) -> Result<(), CliError> {
         ReduceError::UnknownCoordinate { .. }
         | ReduceError::WrongCount { .. }
         | ReduceError::UnusedBranch { .. }
+        | ReduceError::RepeatedBranch { .. }
+        | ReduceError::BadName { .. }
         | ReduceError::BadInitial { .. } => CliError::usage(e.to_string()),
+        // A start the user gave is their usage error; the file's own is the model's.
+        ReduceError::SingularStart { .. } if !args.initial.is_empty() => {
+            CliError::usage(format!("--initial: {e}"))
+        }
         ReduceError::SingularStart { .. } => CliError::failure(format!(
             "{path}: {e} (--initial {}=VALUE)",
             keep.first().copied().unwrap_or("q")

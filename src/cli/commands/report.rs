@@ -267,6 +267,10 @@ fn report_model(source: &Source, dir: &Path) -> ModelReport {
         header: header_comment(&source.text),
         dof: model.num_dofs(),
         equations: Vec::new(),
+        derivation: match &*model.description().derivation {
+            "momentum" => "momentum balance",
+            _ => "Lagrange",
+        },
         figures: Vec::new(),
         animation: None,
         checks: Vec::new(),

@@ -97,6 +97,7 @@ pub fn describe(model: &SymbolicModel, eom: &EquationsOfMotion, mathml: bool) ->
             .collect(),
         events_need_accelerations: model.events_need_accelerations(),
         conservative: model.conservative,
+        derivation: text(crate::mechanics::preferred_formulation(model).name()),
         equations_text: Cow::Owned(super::equations_text(model, eom)),
         equations_latex: Cow::Owned(super::equations_latex(model, eom)),
         equations_mathml: mathml.then(|| {
@@ -199,6 +200,7 @@ pub fn description_tokens(
             .collect(),
     );
     let (needs, conservative) = (d.events_need_accelerations, d.conservative);
+    let derivation = text(&d.derivation);
     let equations_text = text(&d.equations_text);
     let equations_latex = text(&d.equations_latex);
     let equations_mathml = optional(d.equations_mathml.as_deref().map(texts));
@@ -234,6 +236,7 @@ pub fn description_tokens(
             events: #events,
             events_need_accelerations: #needs,
             conservative: #conservative,
+            derivation: #derivation,
             equations_text: #equations_text,
             equations_latex: #equations_latex,
             equations_mathml: #equations_mathml,

@@ -529,6 +529,7 @@ pub fn check_model(
         model.arena.depends_on(model.kinetic, ts) || model.arena.depends_on(model.potential, ts);
     let Sampled {
         max_rel,
+        row_rel,
         power_rel,
         quadratic,
         states: sampled,
@@ -553,7 +554,7 @@ pub fn check_model(
     for (c, set) in comparisons.iter_mut().zip(&balance_set_of) {
         c.expect_disagreement = set.is_some_and(|s| model.balance_sets[s].expect_disagreement);
     }
-    for (c, set) in comparisons.iter().zip(&balance_set_of) {
+    for (k, (c, set)) in comparisons.iter().zip(&balance_set_of).enumerate() {
         if c.expect_disagreement {
             let which = set.map_or_else(String::new, |s| balance_set_label(&model, s));
             let why = set.and_then(|s| moving_point_form(&model, s));
@@ -599,7 +600,10 @@ pub fn check_model(
                 notes.push(if singular {
                     "the equations of motion written by hand are not independent: their M′ is singular".to_string()
                 } else {
-                    "the equations of motion written by hand disagree with Lagrange: a term is missing, has the wrong sign or the wrong factor (`eomgen equations` prints Lagrange's)".to_string()
+                    format!(
+                        "the equations of motion written by hand disagree with Lagrange{}: a term is missing, has the wrong sign or the wrong factor (`eomgen equations` prints Lagrange's)",
+                        wrong_hand_equations(file, &row_rel[k])
+                    )
                 });
             }
         }
@@ -631,6 +635,26 @@ pub fn check_model(
         report.notes.push(reason.to_string());
     }
     Ok(report)
+}
+
+/// Which hand-written equations fail at Lagrange's accelerations (`row_rel` as
+/// [`Sampled::row_rel`], above the check's tolerance): ` in equation 2 (line 58)`, or nothing
+/// when no single row shows it.
+fn wrong_hand_equations(file: &ModelFile, row_rel: &[f64]) -> String {
+    let wrong: Vec<String> = row_rel
+        .iter()
+        .enumerate()
+        .filter(|(_, r)| r.is_nan() || **r > CHECK_TOLERANCE)
+        .map(|(k, _)| match file.checks.equations_of_motion.get(k) {
+            Some(e) => format!("{} (line {})", k + 1, e.location.line),
+            None => (k + 1).to_string(),
+        })
+        .collect();
+    match wrong.len() {
+        0 => String::new(),
+        1 => format!(" in equation {}", wrong[0]),
+        _ => format!(" in equations {}", wrong.join(", ")),
+    }
 }
 
 /// How the notes of [`check_model`] name a set of balances: `the balances` in the plain
@@ -681,6 +705,11 @@ struct Sampled {
     /// the state, or to 1 if that is smaller (infinite where its `M′` is singular, NaN where
     /// its `M′` or `F′` is not finite at a compared state).
     max_rel: Vec<f64>,
+    /// Per other derivation and per row `k` of its `M′ q̈ = F′`, the largest residual
+    /// `|Σⱼ M′ₖⱼ q̈_L,ⱼ − F′ₖ|` at Lagrange's accelerations relative to the size of its terms
+    /// `Σⱼ |M′ₖⱼ q̈_L,ⱼ| + |F′ₖ|`: which equation of a set is wrong (every true equation of
+    /// motion holds at Lagrange's q̈, to rounding).
+    row_rel: Vec<Vec<f64>>,
     /// The largest `|dE/dt − Σ Qᵢ q̇ᵢ|` along Lagrange's q̈, relative to the largest of
     /// `|dE/dt|`, `|Σ Qᵢ q̇ᵢ|` and `Σ |Fᵢ q̇ᵢ|`.
     power_rel: f64,
@@ -734,6 +763,7 @@ fn sample_states(
     // Xoshiro256++ (portable: the same states for a seed on every platform and release).
     let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
     let mut max_rel: Vec<f64> = vec![0.0; others.len()];
+    let mut row_rel: Vec<Vec<f64>> = vec![vec![0.0; n]; others.len()];
     let mut power_rel: f64 = 0.0;
     let mut quadratic = true;
     let symbols = model.arena.symbols().to_vec();
@@ -776,6 +806,16 @@ fn sample_states(
             continue;
         };
         sampled.compared += 1;
+        for (k, rows) in row_rel.iter_mut().enumerate() {
+            let base = lagrange_len + k * (nn + n);
+            for (i, worst) in rows.iter_mut().enumerate() {
+                let terms = (0..n).map(|j| v[base + i * n + j] * qdd[j]);
+                let residual = terms.clone().sum::<f64>() - v[base + nn + i];
+                let size = terms.map(f64::abs).sum::<f64>() + v[base + nn + i].abs();
+                let rel = residual.abs() / size.max(f64::MIN_POSITIVE);
+                *worst = if rel.is_nan() { rel } else { worst.max(rel) };
+            }
+        }
         for (k, worst) in max_rel.iter_mut().enumerate() {
             let base = lagrange_len + k * (nn + n);
             // The other derivation not finite where Lagrange's is (a function outside its
@@ -827,6 +867,7 @@ fn sample_states(
     }
     Sampled {
         max_rel,
+        row_rel,
         power_rel,
         quadratic,
         states: sampled,

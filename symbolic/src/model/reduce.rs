@@ -210,6 +210,20 @@ pub enum ReduceError {
         /// The name given.
         coordinate: String,
     },
+    /// The same coordinate is given a branch twice.
+    #[error("a branch is given twice for `{coordinate}`")]
+    RepeatedBranch {
+        /// The coordinate.
+        coordinate: String,
+    },
+    /// The reduced model's name is not a name.
+    #[error(
+        "`{name}` is not a model name: a name starts with a letter and contains letters, digits and `_`"
+    )]
+    BadName {
+        /// The name given.
+        name: String,
+    },
     /// An initial value option is malformed or names no kept coordinate or rate.
     #[error("initial value `{name}`: {reason}")]
     BadInitial {
@@ -230,7 +244,7 @@ pub enum ReduceError {
     /// branches of a quadratic constraint meet (`∂y/∂x` infinite), or where a linear one's
     /// coefficient vanishes. The mass matrix is not finite there, so no file is written.
     #[error(
-        "the reduced coordinates are singular at the start ({detail}): the reduced mass matrix is not finite there; give the kept coordinates an initial value away from it"
+        "the reduced coordinates cannot start where the model starts ({detail}): the reduced mass matrix is not finite there; give the kept coordinates an initial value where the eliminated ones are real and regular"
     )]
     SingularStart {
         /// The expression that vanishes there, and which solution it belongs to.
@@ -258,9 +272,10 @@ pub enum ReduceError {
 /// constraints on points or non-holonomic constraints; [`ReduceError::Unsolvable`] naming the
 /// constraint and the coordinate when a constraint is not polynomial of degree ≤ 2 in it
 /// (after squaring a square root) or does not contain it; [`ReduceError::AmbiguousBranch`],
-/// [`ReduceError::UnusedBranch`], [`ReduceError::BadInitial`] for the branch and initial
-/// options; [`ReduceError::UnknownName`]; [`ReduceError::Invalid`] if the result does not
-/// load.
+/// [`ReduceError::UnusedBranch`], [`ReduceError::RepeatedBranch`], [`ReduceError::BadInitial`],
+/// [`ReduceError::BadName`] for the options; [`ReduceError::SingularStart`] where the
+/// eliminated coordinates are singular or not real at the start; [`ReduceError::UnknownName`];
+/// [`ReduceError::Invalid`] if the result does not load.
 ///
 /// # Examples
 /// ```
@@ -281,6 +296,20 @@ pub fn reduce(
     options: &ReduceOptions,
 ) -> Result<ReducedModel, ReduceError> {
     unsupported(file)?;
+    if let Some(name) = options
+        .name
+        .as_ref()
+        .filter(|n| !super::schema::is_identifier(n))
+    {
+        return Err(ReduceError::BadName { name: name.clone() });
+    }
+    for (i, (name, _)) in options.branches.iter().enumerate() {
+        if options.branches[..i].iter().any(|(n, _)| n == name) {
+            return Err(ReduceError::RepeatedBranch {
+                coordinate: name.clone(),
+            });
+        }
+    }
     if file.constraints.is_empty() {
         return Err(ReduceError::NoConstraints {
             model: file.name.value.clone(),
@@ -502,8 +531,9 @@ struct Reducer<'f> {
     /// What every symbol of the eliminated coordinates becomes (`y`, `y_dot`).
     values: FxHashMap<SymbolId, ExprId>,
     /// The eliminated coordinates' solutions, for the singularity check: (coordinate, the
-    /// expression that vanishes where the solution is singular).
-    singular_where: Vec<(String, ExprId)>,
+    /// expression that vanishes where the solution is singular, and whether it is a
+    /// quadratic's discriminant, negative where there is no real solution).
+    singular_where: Vec<(String, ExprId, bool)>,
     /// The names that no longer exist in the reduced file: the eliminated coordinates, their
     /// rates and accelerations, and the multipliers `lambda_<constraint>`.
     eliminated_names: Vec<String>,
@@ -735,7 +765,7 @@ impl<'f> Reducer<'f> {
                 .map(|(c, _)| format!("lambda_{}", c.value)),
         );
         // The singularity expressions in the kept coordinates too.
-        for (_, e) in &mut self.singular_where {
+        for (_, e, _) in &mut self.singular_where {
             *e = self.arena.substitute(*e, &solved);
         }
         Ok(out)
@@ -803,7 +833,7 @@ impl<'f> Reducer<'f> {
             }
         };
         let (root, branch, singular) = match found {
-            Roots::Linear { root, slope } => (root, None, slope),
+            Roots::Linear { root, slope } => (root, None, (slope, false)),
             Roots::Quadratic {
                 plus,
                 minus,
@@ -812,10 +842,11 @@ impl<'f> Reducer<'f> {
                 let (branch, reason) =
                     self.choose_branch(&coordinate, phi, d, [plus, minus], options)?;
                 let root = if branch == Branch::Plus { plus } else { minus };
-                (root, Some((branch, reason)), discriminant)
+                (root, Some((branch, reason)), (discriminant, true))
             }
         };
-        self.singular_where.push((coordinate.clone(), singular));
+        self.singular_where
+            .push((coordinate.clone(), singular.0, singular.1));
         Ok((
             Elimination {
                 coordinate,
@@ -1510,17 +1541,32 @@ impl<'f> Reducer<'f> {
     /// there), if they are.
     fn singular_at(&self, values: &[(super::Located<String>, Expr)]) -> Option<String> {
         let bindings = self.bindings(values);
-        let scale: f64 = self
-            .file
-            .parameters
+        self.singular_where
             .iter()
-            .map(|p| p.value.abs())
-            .fold(1.0, f64::max);
-        self.singular_where.iter().find_map(|(coordinate, e)| {
-            let v = self.arena.eval(*e, &bindings);
-            (v.is_nan() || v.abs() <= 1e-12 * scale * scale)
-                .then(|| format!("{} = {v} where `{coordinate}` is solved", self.print(*e)))
-        })
+            .find_map(|(coordinate, e, discriminant)| {
+                let v = self.arena.eval(*e, &bindings);
+                // The size of the parameters the expression names (a length `l` for
+                // `l² − x²`); a huge force elsewhere in the file does not make `1` small.
+                let scale: f64 = self
+                    .file
+                    .parameters
+                    .iter()
+                    .filter(|p| {
+                        self.arena
+                            .symbol_id(&p.name.value)
+                            .is_some_and(|s| self.arena.depends_on(*e, s))
+                    })
+                    .map(|p| p.value.abs())
+                    .fold(1.0, f64::max);
+                if *discriminant && v < 0.0 {
+                    return Some(format!(
+                        "{} = {v} < 0: no real `{coordinate}` satisfies the constraint",
+                        self.print(*e)
+                    ));
+                }
+                (v.is_nan() || v.abs() <= 1e-12 * scale * scale)
+                    .then(|| format!("{} = {v} where `{coordinate}` is solved", self.print(*e)))
+            })
     }
 
     /// Why an equilibrium's listed values of eliminated coordinates are off their chosen

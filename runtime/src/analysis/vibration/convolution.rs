@@ -392,7 +392,7 @@ pub fn convolution_response(
     if !(options.rtol > 0.0 && options.rtol < 1.0) {
         return Err(invalid("rtol", options.rtol, "in (0, 1)"));
     }
-    let (label, guess) = options.operating_point.start.resolve(model)?;
+    let (label, guess) = options.operating_point.start.resolve_equilibrium(model)?;
     // A base motion read with `w` would enter through its rate too: refused, not dropped.
     let has_w = parameters.contains(&"w") && input != "w";
     let forced = if parameter_input && has_w {

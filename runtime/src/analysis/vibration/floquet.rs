@@ -223,7 +223,7 @@ pub fn floquet_at_equilibrium(
     options: &FloquetStudyOptions,
 ) -> Result<FloquetPoint, FloquetStudyError> {
     check_options(model, options)?;
-    let (name, guess) = options.operating_point.start.resolve(model)?;
+    let (name, guess) = options.operating_point.start.resolve_equilibrium(model)?;
     analyse(model, name, &guess, options, TimeDependence::Required)
 }
 
@@ -531,7 +531,7 @@ pub fn floquet_at_equilibrium_for_sweep(
     axes: [&SweepAxis; 2],
 ) -> Result<FloquetPoint, FloquetStudyError> {
     check_options(model, options)?;
-    let (name, guess) = options.operating_point.start.resolve(model)?;
+    let (name, guess) = options.operating_point.start.resolve_equilibrium(model)?;
     let ys = probe_states(model, &guess);
     let names: Vec<String> = model
         .description()

@@ -348,7 +348,7 @@ pub fn frequency_response_analysis(
             input: input.to_string(),
         });
     }
-    let (label, guess) = options.operating_point.start.resolve(model)?;
+    let (label, guess) = options.operating_point.start.resolve_equilibrium(model)?;
     // The parameter that times the load (the simulation's, else `w`) also says where to read
     // an input's rate column (a base motion through a dashpot).
     let parameters = model.description().parameter_names();

@@ -40,6 +40,48 @@ impl EquilibriumStart {
         &self,
         model: &dyn ModelInfo,
     ) -> Result<(String, Vec<f64>), OperatingPointError> {
+        self.resolve_any(model)
+    }
+
+    /// [`Self::resolve`] for an analysis about an equilibrium: an entry of `equilibria:`
+    /// that holds rates (a steady motion) is refused.
+    ///
+    /// # Errors
+    /// As [`Self::resolve`], and [`OperatingPointError::SteadyMotion`].
+    pub fn resolve_equilibrium(
+        &self,
+        model: &dyn ModelInfo,
+    ) -> Result<(String, Vec<f64>), OperatingPointError> {
+        let (name, guess) = self.resolve_any(model)?;
+        if held_rates(model, self).0.iter().any(|r| *r != 0.0) {
+            return Err(OperatingPointError::SteadyMotion {
+                model: model.description().name.to_string(),
+                name,
+            });
+        }
+        Ok((name, guess))
+    }
+
+    fn resolve_any(
+        &self,
+        model: &dyn ModelInfo,
+    ) -> Result<(String, Vec<f64>), OperatingPointError> {
+        let (name, guess) = self.resolve_unchecked(model)?;
+        if let Some(i) = guess.iter().position(|v| !v.is_finite()) {
+            return Err(OperatingPointError::GuessNotFinite {
+                model: model.description().name.to_string(),
+                name,
+                coordinate: model.description().state_name(i),
+                value: guess[i],
+            });
+        }
+        Ok((name, guess))
+    }
+
+    fn resolve_unchecked(
+        &self,
+        model: &dyn ModelInfo,
+    ) -> Result<(String, Vec<f64>), OperatingPointError> {
         let named = model.equilibrium_guesses();
         match self {
             Self::FirstNamed => Ok(match named.first() {
@@ -204,6 +246,21 @@ pub enum OperatingPointError {
         /// The entry's name.
         name: String,
     },
+    /// The start has an entry that is not finite: the `equilibria:` entry's expression is
+    /// outside its domain at these parameters (or the guess given has it).
+    #[error(
+        "the start `{name}` of `{model}` has {coordinate} = {value}: its expression is outside its domain at these parameters (a root or logarithm of a negative number, a division by zero)"
+    )]
+    GuessNotFinite {
+        /// The model.
+        model: String,
+        /// The entry's name (or the guess's label).
+        name: String,
+        /// The coordinate (or rate) that is not finite.
+        coordinate: String,
+        /// Its value.
+        value: f64,
+    },
     /// The search or a later linearisation failed.
     #[error(transparent)]
     Modal(#[from] ModalError),
@@ -241,17 +298,7 @@ pub fn operating_point(
     model: &dyn ModelInfo,
     options: &OperatingPointOptions,
 ) -> Result<OperatingPoint, OperatingPointError> {
-    let (name, guess) = options.start.resolve(model)?;
-    if held_rates(model, &options.start)
-        .0
-        .iter()
-        .any(|r| *r != 0.0)
-    {
-        return Err(OperatingPointError::SteadyMotion {
-            model: model.description().name.to_string(),
-            name,
-        });
-    }
+    let (name, guess) = options.start.resolve_equilibrium(model)?;
     let equilibrium = find_equilibrium(model, &guess, options.t)?;
     Ok(OperatingPoint {
         name,
