@@ -78,21 +78,21 @@ fn print_report(r: &CheckReport) {
         } else {
             format!("{:.2e}", num(c.max_rel_residual))
         };
-        outln!(
-            "{} {} vs {}: max relative difference of q'' {residual} over {} states; {}",
-            mark(c.passed(TOLERANCE)),
-            c.a,
-            c.b,
-            c.states,
-            if c.expect_disagreement {
-                "expected to disagree"
-            } else {
-                match c.symbolic_equal {
-                    Some(true) => "symbolically equal: yes",
-                    Some(false) => "symbolically equal: no",
-                    None => "symbolically equal: not applicable",
-                }
+        let symbolic = if c.expect_disagreement {
+            "expected to disagree"
+        } else {
+            match c.symbolic_equal {
+                Some(true) => "symbolically equal: yes",
+                Some(false) => "symbolically equal: no",
+                None => "symbolically equal: not applicable",
             }
+        };
+        outln!(
+            "{} {a} vs {b}: relative residual of {b} at {a}'s q'' {residual}, the worst of {} states; {symbolic}",
+            mark(c.passed(TOLERANCE)),
+            c.states,
+            a = c.a,
+            b = c.b,
         );
     }
     if let Some(p) = r.power_balance.as_ref().filter(|_| sampled) {
