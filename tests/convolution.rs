@@ -489,3 +489,75 @@ fn too_few_intervals_are_refused_not_estimated_as_exact() {
     ]);
     assert_eq!(out.status.code(), Some(2));
 }
+
+/// A forcing sampled at multiples of its period (`sin(1000 t)` on `Δ = π/100`, the forced
+/// oscillator's default grid) looks like 0 on the grid: the study returned 0 with an error
+/// estimate of 1e-13 where DOP853 gave 1e-9 to 4e-5 (exit 0). It is refused, and so is
+/// `sin(1e6 t)`, at once rather than after 10⁷ DOP853 steps (110 s). A jump (`step(t − 1)`)
+/// and a square wave's twenty jumps are still taken, with first-order error estimates that
+/// cover their disagreement with DOP853.
+#[test]
+fn a_forcing_faster_than_the_grid_is_refused() {
+    let mut oscillator = model("forced_oscillator");
+    let f = |t: f64| (1000.0 * t).sin();
+    let forcing = Forcing::Function {
+        label: "sin(1000*t)",
+        f: &f,
+    };
+    let err = study(
+        oscillator.as_mut(),
+        "A",
+        forcing,
+        20.0 * std::f64::consts::PI,
+        2000,
+    )
+    .unwrap_err();
+    assert!(
+        matches!(
+            err,
+            ConvolutionError::ForcingUnresolved {
+                intervals: 2000,
+                ..
+            }
+        ),
+        "{err:?}"
+    );
+    for forcing in ["sin(1000*t)", "sin(1e6*t)"] {
+        let out = eomgen(&[
+            "study",
+            "convolution",
+            "forced_oscillator",
+            "--input",
+            "A",
+            "--forcing",
+            forcing,
+        ]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{forcing}: {err}");
+        assert!(
+            err.contains("faster than the grid resolves") && err.contains("--intervals"),
+            "{err}"
+        );
+    }
+    let square = |t: f64| (3.0 * t).sin().signum();
+    let jump = |t: f64| if t >= 1.0 { 1.0 } else { 0.0 };
+    for (label, f) in [
+        ("sign(sin(3*t))", &square as &dyn Fn(f64) -> f64),
+        ("step(t-1)", &jump),
+    ] {
+        let s = study(
+            oscillator.as_mut(),
+            "A",
+            Forcing::Function { label, f },
+            20.0 * std::f64::consts::PI,
+            2000,
+        )
+        .unwrap_or_else(|e| panic!("{label}: {e}"));
+        assert!(
+            s.max_difference <= 100.0 * s.quadrature.error_estimate,
+            "{label}: {} against {}",
+            s.max_difference,
+            s.quadrature.error_estimate
+        );
+    }
+}

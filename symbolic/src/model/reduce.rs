@@ -1097,6 +1097,17 @@ impl<'f> Reducer<'f> {
                 );
                 let _ = writeln!(w, "#   {}_dot = {}", e.coordinate, e.rate);
             }
+            for (coordinate, e, event) in self.moving_singularities() {
+                let _ = writeln!(
+                    w,
+                    "#   singular where {e} = 0: the kept coordinates do not determine {coordinate} there{}",
+                    if event {
+                        format!(" (event `{coordinate}_singular` ends runs)")
+                    } else {
+                        String::new()
+                    }
+                );
+            }
         }
         let _ = writeln!(w, "name: {name}");
         let description = if preserve {
@@ -1451,9 +1462,28 @@ impl<'f> Reducer<'f> {
             let _ = writeln!(w, "equilibria:");
             w.push_str(&equilibria);
         }
-        // Events.
+        // Events: the file's, rewritten, and one that ends runs where a linear solution's
+        // slope crosses 0.
         let mut kept_events: Vec<String> = Vec::new();
         let mut events = String::new();
+        for (coordinate, e, event) in self.moving_singularities() {
+            let name = format!("{coordinate}_singular");
+            notes.push(format!(
+                "the reduced model is singular where {e} = 0 (`{coordinate}` is solved by dividing by it, or by a square root of it): the kept coordinates do not determine `{coordinate}` there, and the motion past it is not unique{}",
+                if event {
+                    format!("; the event `{name}` ends runs there")
+                } else {
+                    String::new()
+                }
+            ));
+            if event && !file.events.iter().any(|ev| ev.name.value == name) {
+                let _ = writeln!(
+                    events,
+                    "  {name}: {{ when: {}, direction: both, terminal: true }}",
+                    flow(&e)
+                );
+            }
+        }
         for ev in &file.events {
             let place = format!("event `{}`", ev.name.value);
             match self.rewrite(&ev.when, &place) {
@@ -1567,6 +1597,26 @@ impl<'f> Reducer<'f> {
                 (v.is_nan() || v.abs() <= 1e-12 * scale * scale)
                     .then(|| format!("{} = {v} where `{coordinate}` is solved", self.print(*e)))
             })
+    }
+
+    /// The singularities of the eliminations that move with the state or the time (not a
+    /// constant of the parameters): `(coordinate, expression, whether an event can find it)`.
+    /// A linear solution's slope changes sign there (a run crossing it needs an event to
+    /// stop: explicit methods step over such a pole); a quadratic's discriminant only
+    /// touches 0 where the motion turns back, so it is noted without an event.
+    fn moving_singularities(&self) -> Vec<(String, String, bool)> {
+        self.singular_where
+            .iter()
+            .filter(|(_, e, _)| {
+                self.arena.symbols().iter().enumerate().any(|(i, s)| {
+                    matches!(
+                        s.kind,
+                        SymbolKind::Coordinate(_) | SymbolKind::Velocity(_) | SymbolKind::Time
+                    ) && self.arena.depends_on(*e, SymbolId(i as u32))
+                })
+            })
+            .map(|(c, e, discriminant)| (c.clone(), self.print(*e), !*discriminant))
+            .collect()
     }
 
     /// Why an equilibrium's listed values of eliminated coordinates are off their chosen

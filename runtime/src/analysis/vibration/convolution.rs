@@ -228,11 +228,130 @@ pub enum ConvolutionError {
         /// Where (s).
         t: f64,
     },
-    /// The DOP853 check failed (also where the forcing is not finite between grid points).
-    #[error(
-        "the direct integration failed (a forcing that is not finite between grid points stops it): {0}"
-    )]
+    /// The DOP853 check failed: a forcing not finite between grid points, or one (or a
+    /// response) that varies faster than the grid, beyond the check's step budget.
+    #[error("the direct integration failed{cause}: {error}", cause = integration_cause(.0), error = .0)]
     Integration(IntegrationError),
+    /// The forcing varies within the grid's intervals: between grid points it is not the
+    /// cubic through its grid values (sampled at two irrational fractions of each interval),
+    /// in more than a tenth of the intervals. Sampled at the grid alone it would alias
+    /// (`sin(1000 t)` on `Δ = π/100` is 0 at every grid point).
+    #[error(
+        "the forcing varies faster than the grid resolves: at t = {t} s it is {value:e}, the cubic through the grid gives {interpolated:e} ({intervals} of {total} intervals differ by more than 1 % of max |f|); raise --intervals above {suggested} or shorten the end time"
+    )]
+    ForcingUnresolved {
+        /// Where the difference is largest (s).
+        t: f64,
+        /// The forcing there.
+        value: f64,
+        /// The cubic through the four nearest grid values there.
+        interpolated: f64,
+        /// Intervals where they differ by more than 1 % of `max |f|`.
+        intervals: usize,
+        /// Intervals of the grid.
+        total: usize,
+        /// Ten times the intervals given, a start for a grid that may resolve it.
+        suggested: usize,
+    },
+    /// The convolution and the DOP853 check disagree by more than either's error allows: the
+    /// result is not trusted.
+    #[error(
+        "the convolution and the direct integration disagree by {max_difference:e} (largest |δq| {scale:e}), beyond the quadrature's error estimate {error_estimate:e} and the check's tolerance: the forcing or the response varies faster than the grid resolves; raise --intervals"
+    )]
+    Disagreement {
+        /// `max |convolution − DOP853|` (units of q).
+        max_difference: f64,
+        /// The larger of the two results' largest `|δq|`.
+        scale: f64,
+        /// The quadrature's Richardson estimate.
+        error_estimate: f64,
+    },
+}
+
+/// What [`ConvolutionError::Integration`] says of its cause.
+fn integration_cause(error: &IntegrationError) -> &'static str {
+    match error {
+        IntegrationError::RhsNonFinite { .. } | IntegrationError::NonFiniteState { .. } => {
+            " (a forcing that is not finite between grid points stops it)"
+        }
+        IntegrationError::TooManySteps { .. } | IntegrationError::StepSizeTooSmall { .. } => {
+            " (the forcing or the response varies faster than the grid resolves)"
+        }
+        _ => "",
+    }
+}
+
+/// The fraction of a grid's intervals where an unresolved forcing is refused
+/// ([`ConvolutionError::ForcingUnresolved`]): a jump (`step(t − 1)`) or a square wave's
+/// twenty jumps differ from the cubic in a few intervals each, aliasing in nearly all.
+const UNRESOLVED_FRACTION: f64 = 0.1;
+
+/// How far the convolution may stray from the DOP853 check before it is refused
+/// ([`ConvolutionError::Disagreement`]): more than this times the quadrature's estimate,
+/// plus [`CHECK_SLACK`] times the check's tolerance, and more than [`DISAGREEMENT_FLOOR`]
+/// of the response.
+const ESTIMATE_SLACK: f64 = 100.0;
+/// See [`ESTIMATE_SLACK`].
+const CHECK_SLACK: f64 = 1e3;
+/// See [`ESTIMATE_SLACK`].
+const DISAGREEMENT_FLOOR: f64 = 1e-6;
+
+/// Refuses a forcing that varies within the grid's intervals: `f` at `t_k + c Δ`,
+/// `c ∈ {0.381966, 0.723607}` (irrational, so that neither a grid-periodic nor a
+/// midpoint-periodic forcing hides), against the cubic through the four nearest grid values
+/// `values`; more than [`UNRESOLVED_FRACTION`] of the intervals off by 1 % of `max |f|` is an
+/// error. Cost: two evaluations of `f` per interval.
+fn check_resolution(
+    forcing: &Forcing<'_>,
+    times: &[f64],
+    values: &[f64],
+    step: f64,
+) -> Result<(), ConvolutionError> {
+    let total = values.len().saturating_sub(1);
+    if total < 3 {
+        return Ok(());
+    }
+    let mut largest = values.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let mut samples = Vec::with_capacity(2 * total);
+    for k in 0..total {
+        for c in [0.381966, 0.723607] {
+            let t = times[k] + c * step;
+            let value = forcing.value(t);
+            if !value.is_finite() {
+                return Err(ConvolutionError::NonFiniteForcing { t, value });
+            }
+            largest = largest.max(value.abs());
+            // The cubic through the four grid values nearest the interval.
+            let start = k.saturating_sub(1).min(total - 3);
+            let s = (t - times[start]) / step;
+            let w = [
+                -(s - 1.0) * (s - 2.0) * (s - 3.0) / 6.0,
+                s * (s - 2.0) * (s - 3.0) / 2.0,
+                -s * (s - 1.0) * (s - 3.0) / 2.0,
+                s * (s - 1.0) * (s - 2.0) / 6.0,
+            ];
+            let cubic: f64 = (0..4).map(|i| w[i] * values[start + i]).sum();
+            samples.push((k, t, value, cubic));
+        }
+    }
+    let off = |(_, _, v, c): &&(usize, f64, f64, f64)| (v - c).abs() > 1e-2 * largest;
+    let mut unresolved: Vec<usize> = samples.iter().filter(off).map(|s| s.0).collect();
+    unresolved.dedup();
+    if largest > 0.0 && unresolved.len() as f64 > UNRESOLVED_FRACTION * total as f64 {
+        let worst = samples
+            .iter()
+            .max_by(|a, b| (a.2 - a.3).abs().total_cmp(&(b.2 - b.3).abs()))
+            .expect("samples");
+        return Err(ConvolutionError::ForcingUnresolved {
+            t: worst.1,
+            value: worst.2,
+            interpolated: worst.3,
+            intervals: unresolved.len(),
+            total,
+            suggested: 10 * total,
+        });
+    }
+    Ok(())
 }
 
 /// The closed form of a one-degree-of-freedom response, where one exists (an impulse or a
@@ -476,6 +595,9 @@ pub fn convolution_response(
             })
             .collect::<Result<_, _>>()?,
     };
+    if let Forcing::Function { .. } = options.forcing {
+        check_resolution(&options.forcing, &times, &forcing_values, step)?;
+    }
     let (convolution, error_estimate, observed_order) = match options.forcing {
         Forcing::Impulse => (impulse_response.clone(), 0.0, None),
         _ => {
@@ -554,6 +676,19 @@ pub fn convolution_response(
         .flatten()
         .zip(direct.iter().flatten())
         .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
+    let scale = direct
+        .iter()
+        .flatten()
+        .fold(max_response, |m, v| m.max(v.abs()));
+    if max_difference > ESTIMATE_SLACK * error_estimate + CHECK_SLACK * options.rtol * scale
+        && max_difference > DISAGREEMENT_FLOOR * scale
+    {
+        return Err(ConvolutionError::Disagreement {
+            max_difference,
+            scale,
+            error_estimate,
+        });
+    }
     let closed_form = closed_form(lin, &forced.input_matrix, &options.forcing, &times).map(
         |(formula, natural_frequency, damping_ratio, values)| {
             let max_difference = values
@@ -767,7 +902,9 @@ fn direct_response(
     let options = IntegratorOptions::default()
         .with_rtol(rtol)
         .with_atol(rtol * scale.max(f64::MIN_POSITIVE))
-        .with_max_steps(10_000_000);
+        // Bounded by the grid: 410 000 steps at the default 2000 intervals, about 4 s; a
+        // forcing that needs more varies faster than the grid resolves.
+        .with_max_steps(10_000 + 200 * times.len());
     let t_end = *times.last().unwrap_or(&0.0);
     let solution = DormandPrince853::new()
         .integrate(
