@@ -660,3 +660,25 @@ fn a_tops_precession_is_found_on_the_guesss_branch_to_rounding() {
         "{text}"
     );
 }
+
+/// A constraint among ignorable coordinates only (a belt `phi1 = phi2` beside a spinning
+/// flywheel) is regular, but dependent coordinates were sought among the non-ignorable ones
+/// only: "0 of 1 dependent coordinates found". It is solved for one of them, and the result
+/// equals the run with `phi2` not declared ignorable: the spring's ±2i (√(k/m), k = 4,
+/// m = 1), to 1e-9 (central differences with Richardson). With both pulleys turning
+/// (`belt_pulleys`), the belt `phi1 − phi2` is kept by the motion, which moves them
+/// together, though not by either alone: it was refused as "not cyclic".
+#[test]
+fn a_constraint_between_ignorable_coordinates_is_regular() {
+    let mut m = fixture_model("belt_spinner.yaml");
+    let (all, _) = steady(m.as_mut(), "spinning");
+    let (kept, _) = steady(m.as_mut(), "spinning_phi2_kept");
+    assert!(holds(&all, Complex::new(0.0, 2.0), 1e-9), "{all:?}");
+    for s in &kept {
+        assert!(holds(&all, *s, 1e-9), "{all:?} against {kept:?}");
+    }
+    let mut turning = fixture_model("belt_pulleys.yaml");
+    let (s, states) = steady(turning.as_mut(), "spinning");
+    assert_eq!(states, ["x", "x_dot"]);
+    assert!(holds(&s, Complex::new(0.0, 2.0), 1e-9), "{s:?}");
+}

@@ -179,6 +179,31 @@ fn an_underflow_from_a_huge_end_time_blames_the_end_time() {
     assert!(!err.contains("stiff"), "{err}");
 }
 
+/// An end time of 1e300 s, where the smallest step that moves t is 3.6e285 s: the first step
+/// was raised to it, so the state overflowed and dp54 and DOP853 reported a right-hand side
+/// not finite at t = 1e285, Radau IIA a Newton failure. Every method now stops at t = 0 with
+/// a step too small, which the hint blames on the end time.
+#[test]
+fn an_end_time_of_1e300_stops_every_method_at_the_start() {
+    for method in ["dp54", "dop853", "vern9", "radau5", "taylor"] {
+        let out = eomgen(&[
+            "simulate",
+            "simple_pendulum",
+            "--t-end",
+            "1e300",
+            "--method",
+            method,
+        ]);
+        let err = stderr(&out);
+        assert_eq!(out.status.code(), Some(1), "{method}: {err}");
+        assert!(
+            err.contains("fell below the smallest usable step at t = 0")
+                && err.contains("the end time 1e300 s is so large"),
+            "{method}: {err}"
+        );
+    }
+}
+
 /// A work–precision study with tolerances far below round-off failed every run (after
 /// minutes) and exited 0: such tolerances are now a usage error (a study whose every run
 /// fails exits 1: `WorkPrecision::every_run_failed`, tested in the library).

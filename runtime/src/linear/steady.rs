@@ -63,10 +63,10 @@ pub enum SteadyMotionError {
         /// What it is: `theta_ddot`, or a constraint's name.
         worst: String,
     },
-    /// The holonomic constraints do not determine dependent coordinates among the
-    /// non-ignorable ones at the point (`Φ_q` restricted to them has rank below `m_h`).
+    /// The holonomic constraints do not determine dependent coordinates at the point (`Φ_q`
+    /// has rank below `m_h`).
     #[error(
-        "the holonomic constraints are singular at the operating point: {found} of {needed} dependent coordinates found among the non-ignorable ones"
+        "the holonomic constraints are singular at the operating point: their Jacobian Φ_q has rank {found}, below their number {needed}"
     )]
     SingularConstraints {
         /// Holonomic constraints.
@@ -434,6 +434,10 @@ fn named_values(names: &[String], q: &[f64], free: &[usize]) -> String {
         .join(", ")
 }
 
+/// The part of [`check_cyclic`] shifted along the motion only: the holonomic constraints'
+/// residuals.
+const JOINT_PART: &str = "the constraints' residuals Φ";
+
 /// The parts of the equations [`check_cyclic`] compares, by name, each flattened.
 type Parts = Vec<(&'static str, DVector<f64>)>;
 
@@ -480,16 +484,15 @@ fn check_cyclic(
         ];
         if constrained {
             let c = model.constraint_equations(t, y);
-            out.push(("the constraints (Φ, their velocity terms and γ)", {
+            out.push((
+                "the constraints' velocity terms and γ",
                 DVector::from_iterator(
-                    c.phi.len() + c.velocity.len() + c.gamma.len(),
-                    c.phi
-                        .iter()
-                        .chain(c.velocity.iter())
-                        .chain(c.gamma.iter())
-                        .copied(),
-                )
-            }));
+                    c.velocity.len() + c.gamma.len(),
+                    c.velocity.iter().chain(c.gamma.iter()).copied(),
+                ),
+            ));
+            // Last: shifted along the motion only (see below).
+            out.push((JOINT_PART, c.phi.clone()));
             out.push((
                 "the constraint Jacobian J",
                 DVector::from_column_slice(c.jacobian.as_slice()),
@@ -515,13 +518,27 @@ fn check_cyclic(
             })
             .collect()
     });
+    // Each moving coordinate alone, for every part but the constraints' residuals Φ; Φ
+    // along the motion, every moving coordinate by `shift · q̇ᵢ/max |q̇|` (a belt
+    // `phi1 − phi2` between pulleys turning together is kept by that, not by one alone).
+    let fastest = moving.iter().fold(0.0f64, |m, &i| m.max(rates[i].abs()));
+    let along = [usize::MAX];
     for (base, at_base) in &bases {
-        for &i in moving {
+        for &i in moving.iter().chain(&along) {
             for shift in CYCLIC_SHIFTS {
                 let mut y = (*base).clone();
-                y[i] += shift;
+                if i == usize::MAX {
+                    for &j in moving {
+                        y[j] += shift * rates[j] / fastest;
+                    }
+                } else {
+                    y[i] += shift;
+                }
                 let Some(shifted) = parts(&y) else { continue };
                 for (p, ((part, a), (_, b))) in at_base.iter().zip(&shifted).enumerate() {
+                    if (*part == JOINT_PART) != (i == usize::MAX) {
+                        continue;
+                    }
                     let scale = sizes[p].max(b.amax());
                     let change = if scale == 0.0 {
                         0.0
@@ -530,11 +547,23 @@ fn check_cyclic(
                     };
                     if change > 1e-9 {
                         let names = model.description().coordinate_names();
-                        return Err(SteadyMotionError::NotCyclic {
-                            coordinate: names
+                        let name = |i: usize| {
+                            names
                                 .get(i)
-                                .map_or_else(|| i.to_string(), |c| c.to_string()),
-                            rate: rates[i],
+                                .map_or_else(|| i.to_string(), |c| c.to_string())
+                        };
+                        let (coordinate, rate) = if i == usize::MAX {
+                            let all: Vec<String> = moving.iter().map(|&j| name(j)).collect();
+                            (
+                                format!("{} (together, along the motion)", all.join(", ")),
+                                fastest,
+                            )
+                        } else {
+                            (name(i), rates[i])
+                        };
+                        return Err(SteadyMotionError::NotCyclic {
+                            coordinate,
+                            rate,
                             part: (*part).to_string(),
                             change,
                             shift,
@@ -609,9 +638,14 @@ pub fn linearize_steady_motion(
         (DMatrix::zeros(0, n), DMatrix::zeros(0, n))
     };
     let phi_q = j_all.rows(0, m_h).into_owned();
-    // Dependent coordinates among the non-ignorable ones, dependent rates preferring the
-    // dependent coordinates' rates and then the ignorable ones'.
-    let coordinate_order: Vec<usize> = (0..n).filter(|i| !ignorable.contains(i)).collect();
+    // Dependent coordinates among the non-ignorable ones first, then the ignorable ones (a
+    // belt `phi1 = phi2` between two pulleys that both turn freely names only ignorable
+    // coordinates; one of them is then dependent, and leaves the ignorable states), dependent
+    // rates preferring the dependent coordinates' rates and then the ignorable ones'.
+    let coordinate_order: Vec<usize> = (0..n)
+        .filter(|i| !ignorable.contains(i))
+        .chain(ignorable.iter().copied())
+        .collect();
     let dependent_q = pivot_columns(&phi_q, &coordinate_order, m_h);
     if dependent_q.len() < m_h {
         return Err(SteadyMotionError::SingularConstraints {

@@ -126,7 +126,8 @@ pub fn damped_summaries(eigenvalues: &[Complex<f64>]) -> Vec<DampedEigenvalueSum
         .map(|s| DampedEigenvalueSummary {
             re: s.re,
             im: s.im,
-            damping_ratio: if s.norm() > 0.0 {
+            // An exact 0 real part is ζ = 0, not −0.
+            damping_ratio: if s.norm() > 0.0 && s.re != 0.0 {
                 -s.re / s.norm()
             } else {
                 0.0
