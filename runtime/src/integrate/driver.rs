@@ -470,19 +470,14 @@ fn initial_step<S: Stepper>(
     if !(h0.is_finite() && h0 > 0.0) {
         h0 = 1e-6;
     }
-    // The probe moves t by at least the smallest usable step; the step returned is not
-    // raised to it: one below it (an end time of 1e300 s, where that step is 3.6e285 s) is
-    // refused by the step loop at t0 as too small, not taken and overflowed.
+    let dt_min = min_step(t0, span);
     let wanted = h0.min(dt_max);
-    if wanted < min_step(t0, span) {
-        return wanted;
-    }
-    h0 = wanted;
+    h0 = wanted.max(dt_min);
     // Two buffers once per integration, not per step.
     let y1: Vec<f64> = y0.iter().zip(f0).map(|(y, f)| y + h0 * f).collect();
     let mut f1 = vec![0.0; n];
     if rhs.eval(t0 + h0, &y1, &mut f1).is_err() {
-        return wanted;
+        return h0;
     }
     let d2 = weighted_rms(n, |i| (f1[i] - f0[i], scale(i))) / h0;
     let d_max = d1.max(d2);
@@ -491,8 +486,18 @@ fn initial_step<S: Stepper>(
     } else {
         (0.01 / d_max).powf(1.0 / f64::from(error_order + 1))
     };
-    // `f64::min` ignores a NaN operand, so the result is a number.
-    (100.0 * h0).min(h1).min(dt_max)
+    // `f64::min`/`max` ignore a NaN operand, so the result is a number.
+    let h = (100.0 * h0).min(h1).min(dt_max);
+    // A sound estimate (the start's derivative of finite norm) below the smallest usable
+    // step: the motion needs steps finer than f64 resolves t near the end time (an end time
+    // of 1e300 s, where that step is 3.6e285 s, and the probe's change of the derivative
+    // overflows). Returned, the step loop refuses it at t0; raised, it would be taken and
+    // overflow the state. A start whose own norm overflows (a push of 1e300 N against an
+    // absolute tolerance) is no evidence, and the step is raised as before.
+    if d1.is_finite() && h < dt_min {
+        return if h > 0.0 { h } else { wanted };
+    }
+    h.max(dt_min)
 }
 
 /// What happens after every accepted step: events are looked for, the samples recorded and

@@ -228,7 +228,7 @@ fn largest(v: &[f64]) -> (f64, usize) {
 ///
 /// The steps are held in a trust region (Dennis & Schnabel, *Numerical Methods for
 /// Unconstrained Optimization and Nonlinear Equations*, 1983, §6.4): each coordinate moves
-/// at most `Δ·max(1, |qⱼ|)`, `Δ` starting at [`FIRST_RADIUS`], halved when the residual falls
+/// at most `Δ·max(1, |qⱼ|)`, `Δ` starting at 0.25, halved when the residual falls
 /// by less than a tenth of what the linear model predicts (or cannot be evaluated) and
 /// doubled when the prediction holds. So the motion found is the one the guess leads to,
 /// not one a flat stretch of the residual throws the first step to (a top's nutation
@@ -305,7 +305,8 @@ pub fn find_steady_motion(
                 let now = sum_of_squares(&r);
                 let expected = now - sum_of_squares(&linear_prediction(&r, &predicted, fraction));
                 let ratio = (now - sum_of_squares(&rt)) / expected;
-                if !(ratio >= 0.1) {
+                // A NaN ratio (no predicted reduction) shrinks the region too.
+                if ratio.is_nan() || ratio < 0.1 {
                     radius = fraction * size / 2.0;
                     continue;
                 }
