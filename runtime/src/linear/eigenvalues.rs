@@ -105,6 +105,10 @@ pub struct LinearStability {
     /// gyroscopic system `M q̈ + G q̇ + K q = 0` (its eigenvalues `±iω` on the imaginary axis;
     /// an unstable one has none). `None` without gyroscopic terms.
     pub gyroscopic_frequencies: Option<Vec<f64>>,
+    /// The largest `|Re s|` (1/s) set to 0 as rounding (below [`ZERO_REAL_PART`] of `|s|`,
+    /// or an eigenvalue at rounding of the largest), 0 when none: a marginal verdict with a
+    /// positive value is decided within rounding, and this is its bound.
+    pub rounded_real_part: f64,
 }
 
 /// Serialises complex numbers as `[re, im]`.
@@ -144,7 +148,7 @@ pub fn linear_stability(lin: &Linearization) -> Result<LinearStability, ModalErr
     let c = &lin.damping_matrix;
     let damping_part = (c + c.transpose()) * 0.5;
     let gyroscopic_part = (c - c.transpose()) * 0.5;
-    let eigenvalues = state_eigenvalues(lin)?;
+    let (eigenvalues, rounded_real_part) = rounded_state_eigenvalues(lin)?;
     let gyroscopic_frequencies = if gyroscopic_part.iter().any(|v| *v != 0.0) {
         let conservative = Linearization {
             damping_matrix: gyroscopic_part.clone(),
@@ -167,6 +171,7 @@ pub fn linear_stability(lin: &Linearization) -> Result<LinearStability, ModalErr
         damping_part,
         gyroscopic_part,
         gyroscopic_frequencies,
+        rounded_real_part,
     })
 }
 
@@ -202,6 +207,12 @@ pub fn verdict(eigenvalues: &[Complex<f64>]) -> Stability {
 /// # Errors
 /// As [`linear_stability`].
 pub fn state_eigenvalues(lin: &Linearization) -> Result<Vec<Complex<f64>>, ModalError> {
+    Ok(rounded_state_eigenvalues(lin)?.0)
+}
+
+/// [`state_eigenvalues`] and the largest `|Re s|` (1/s) it set to 0 as rounding (0 when
+/// none): the margin of a marginal verdict decided within rounding.
+fn rounded_state_eigenvalues(lin: &Linearization) -> Result<(Vec<Complex<f64>>, f64), ModalError> {
     let not_finite = || ModalError::NonFinite { q: lin.q.clone() };
     if lin
         .stiffness_matrix
@@ -212,10 +223,10 @@ pub fn state_eigenvalues(lin: &Linearization) -> Result<Vec<Complex<f64>>, Modal
         return Err(not_finite());
     }
     if let Some((reduced, free)) = without_free_coordinates(lin)? {
-        let mut out = state_eigenvalues(&reduced)?;
+        let (mut out, rounded) = rounded_state_eigenvalues(&reduced)?;
         out.extend(std::iter::repeat_n(Complex::new(0.0, 0.0), 2 * free));
         out.sort_by(|a, b| a.norm().total_cmp(&b.norm()).then(a.im.total_cmp(&b.im)));
-        return Ok(out);
+        return Ok((out, rounded));
     }
     let chol = lin.mass_cholesky()?;
     let l = chol.l();
@@ -234,10 +245,15 @@ pub fn state_eigenvalues(lin: &Linearization) -> Result<Vec<Complex<f64>>, Modal
         return Err(not_finite());
     }
     let (k, c, rigid) = without_rigid_modes(k, c, &lin.q)?;
-    let mut out = normalized_eigenvalues(&k, &c, &lin.q)?;
+    // Without damping or gyroscopic terms and with a symmetric K, s² = −λ is real: an
+    // eigenvalue off the real axis is on the imaginary one by structure, and setting its
+    // rounding-sized real part to 0 decides nothing.
+    let structural = lin.damping_matrix.iter().all(|v| *v == 0.0)
+        && lin.stiffness_matrix == lin.stiffness_matrix.transpose();
+    let (mut out, rounded) = normalized_eigenvalues(&k, &c, &lin.q, structural)?;
     out.extend(std::iter::repeat_n(Complex::new(0.0, 0.0), 2 * rigid));
     out.sort_by(|a, b| a.norm().total_cmp(&b.norm()).then(a.im.total_cmp(&b.im)));
-    Ok(out)
+    Ok((out, rounded))
 }
 
 /// The modes of `ẍ + c ẋ + k x = 0` (mass-normalised, `r × r`) on which neither `k` nor `c`
@@ -308,12 +324,14 @@ fn without_rigid_modes(
 
 /// The eigenvalues of `ẍ + c ẋ + k x = 0` (mass-normalised, `r × r`): the balanced state
 /// matrix's by the Schur form, refined by Newton (see the module documentation); real parts
-/// at rounding set to 0.
+/// at rounding set to 0, the largest so set returned beside them (apart from those of
+/// complex values when `structural`: undamped with a symmetric K, where they are 0 exactly).
 fn normalized_eigenvalues(
     k: &DMatrix<f64>,
     c: &DMatrix<f64>,
     q: &[f64],
-) -> Result<Vec<Complex<f64>>, ModalError> {
+    structural: bool,
+) -> Result<(Vec<Complex<f64>>, f64), ModalError> {
     let r = k.nrows();
     let s = k.amax().sqrt().max(c.amax()).max(f64::MIN_POSITIVE);
     let mut a = DMatrix::zeros(2 * r, 2 * r);
@@ -354,6 +372,7 @@ fn normalized_eigenvalues(
         }
     }
     let largest = values.iter().map(|(v, _)| v.norm()).fold(0.0, f64::max);
+    let mut rounded = 0.0f64;
     let mut out: Vec<Complex<f64>> = values
         .into_iter()
         .map(|(mut v, converged)| {
@@ -365,15 +384,19 @@ fn normalized_eigenvalues(
                 v.norm_sqr() <= ZERO_EIGENVALUE * largest * largest
             };
             if zero {
+                rounded = rounded.max(v.re.abs());
                 v = Complex::new(0.0, 0.0);
             } else if v.re.abs() <= ZERO_REAL_PART * v.norm() {
+                if !(structural && v.im != 0.0) {
+                    rounded = rounded.max(v.re.abs());
+                }
                 v.re = 0.0;
             }
             v
         })
         .collect();
     out.sort_by(|a, b| a.norm().total_cmp(&b.norm()).then(a.im.total_cmp(&b.im)));
-    Ok(out)
+    Ok((out, rounded))
 }
 
 /// The linearisation without its free coordinates, and how many there were; `None` when
@@ -772,5 +795,35 @@ mod tests {
             let sigma = p.singular_values;
             assert!(sigma.min() <= 1e-13 * sigma.max(), "{a}: {sigma}");
         }
+    }
+
+    /// A marginal verdict says when rounding decided it: the particle in a spinning bowl
+    /// (gyroscopic `G`, `K` negative definite) has eigenvalues on the imaginary axis only to
+    /// rounding, and reports the largest real part set to 0 (below 1e-9 of `|s|`, nonzero:
+    /// the Schur form of a non-normal matrix); an undamped symmetric system's eigenvalues are
+    /// imaginary by structure (`s² = −λ` real), and report none.
+    #[test]
+    fn a_marginal_verdict_decided_within_rounding_says_so() {
+        let bowl = Linearization::from_matrices(
+            DMatrix::identity(2, 2),
+            DMatrix::from_row_slice(2, 2, &[-15.19, 0.0, 0.0, -5.38]),
+            DMatrix::from_row_slice(2, 2, &[0.0, -10.0, 10.0, 0.0]),
+        );
+        let s = linear_stability(&bowl).unwrap();
+        assert_eq!(s.stability, Stability::MarginallyStable);
+        let largest = s.eigenvalues.iter().map(|e| e.norm()).fold(0.0, f64::max);
+        assert!(
+            s.rounded_real_part > 0.0 && s.rounded_real_part <= ZERO_REAL_PART * largest,
+            "{}",
+            s.rounded_real_part
+        );
+        let chain = Linearization::from_matrices(
+            DMatrix::identity(2, 2),
+            DMatrix::from_row_slice(2, 2, &[2.0, -1.0, -1.0, 2.0]),
+            DMatrix::zeros(2, 2),
+        );
+        let s = linear_stability(&chain).unwrap();
+        assert_eq!(s.stability, Stability::MarginallyStable);
+        assert_eq!(s.rounded_real_part, 0.0);
     }
 }

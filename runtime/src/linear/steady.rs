@@ -273,8 +273,23 @@ pub fn find_steady_motion(
         if !worst.is_finite() {
             return Err(SteadyMotionError::NonFinite);
         }
-        if worst <= 1e-11 * scale || free.is_empty() {
+        if worst <= 1e-11 * scale {
             break;
+        }
+        if free.is_empty() {
+            // Nothing to adjust: the held state must be steady as it is, its residual at
+            // rounding of the rates' own accelerations (`q̇² |q|`), not of its own size (a
+            // Chaplygin sleigh spinning in place has `v̇ = d ω²`, and is no steady motion).
+            let natural = rates.iter().fold(0.0f64, |m, r| m.max(r * r))
+                * q.iter().fold(1.0f64, |m, v| m.max(v.abs()));
+            if worst <= 1e-10 * (1.0 + natural) {
+                break;
+            }
+            return Err(SteadyMotionError::NotSteady {
+                iterations,
+                residual: worst,
+                worst: residual_name(model, at),
+            });
         }
         let stuck = radius < 1e-15;
         if iterations == 50 || stuck {
@@ -880,12 +895,24 @@ fn remove_states(a: &mut DMatrix<f64>, names: &mut Vec<String>, which: &[usize])
 /// [`ZERO_REAL_PART`] of `|s|` to 0 (`tolerance` widens both, for a matrix taken by
 /// differences). `None` as [`raw_eigenvalues`].
 pub fn general_eigenvalues(a: &DMatrix<f64>, tolerance: f64) -> Option<Vec<Complex<f64>>> {
+    Some(rounded_general_eigenvalues(a, tolerance)?.0)
+}
+
+/// [`general_eigenvalues`] and the largest `|Re s|` it set to 0 (0 when none): the bound of
+/// a marginal verdict decided within rounding.
+fn rounded_general_eigenvalues(
+    a: &DMatrix<f64>,
+    tolerance: f64,
+) -> Option<(Vec<Complex<f64>>, f64)> {
     let mut values = raw_eigenvalues(a)?;
     let largest = values.iter().map(|v| v.norm()).fold(0.0, f64::max);
+    let mut rounded = 0.0f64;
     for v in &mut values {
         if v.norm() <= ZERO_EIGENVALUE.max(tolerance) * largest {
+            rounded = rounded.max(v.re.abs());
             *v = Complex::new(0.0, 0.0);
         } else if v.re.abs() <= ZERO_REAL_PART.max(tolerance) * v.norm() {
+            rounded = rounded.max(v.re.abs());
             v.re = 0.0;
         }
         if v.im.abs() <= ZERO_EIGENVALUE.max(tolerance) * largest {
@@ -893,7 +920,7 @@ pub fn general_eigenvalues(a: &DMatrix<f64>, tolerance: f64) -> Option<Vec<Compl
         }
     }
     values.sort_by(|a, b| a.norm().total_cmp(&b.norm()).then(a.im.total_cmp(&b.im)));
-    Some(values)
+    Some((values, rounded))
 }
 
 /// The eigenvalues of a general real matrix `a` as the balanced Schur form gives them, in its
@@ -924,23 +951,25 @@ pub fn raw_eigenvalues(a: &DMatrix<f64>) -> Option<Vec<Complex<f64>>> {
     Some(values.into_iter().map(|v| v / scale).collect())
 }
 
-/// The eigenvalues of a steady linearisation and its stability verdict.
+/// The eigenvalues of a steady linearisation, its stability verdict and the largest `|Re s|`
+/// (1/s) set to 0 as rounding or as the differences' error (0 when none: a marginal verdict
+/// with a positive value is decided within that bound).
 ///
 /// # Errors
 /// [`SteadyMotionError::EigenvaluesDidNotConverge`] (a state matrix that is not finite, or a
 /// Schur iteration past its bound).
 pub fn steady_stability(
     lin: &SteadyLinearization,
-) -> Result<(Vec<Complex<f64>>, Stability), SteadyMotionError> {
+) -> Result<(Vec<Complex<f64>>, Stability, f64), SteadyMotionError> {
     let tolerance = if lin.exact_jacobian { 0.0 } else { 1e-8 };
     if lin.state_matrix.iter().any(|v| !v.is_finite()) {
         return Err(SteadyMotionError::NonFinite);
     }
-    let eigenvalues = general_eigenvalues(&lin.state_matrix, tolerance).ok_or(
+    let (eigenvalues, rounded) = rounded_general_eigenvalues(&lin.state_matrix, tolerance).ok_or(
         SteadyMotionError::EigenvaluesDidNotConverge {
             size: lin.state_matrix.nrows(),
         },
     )?;
     let stability = verdict(&eigenvalues);
-    Ok((eigenvalues, stability))
+    Ok((eigenvalues, stability, rounded))
 }

@@ -205,8 +205,13 @@ fn steady(
         );
     }
     let verdict = match summary.stability {
-        Stability::Stable { decay_rate } => format!("stable: the slowest decays as e^(-{decay_rate:.6} t)"),
-        Stability::MarginallyStable => "marginally stable: no eigenvalue has a positive real part (stable to linear order only)".to_string(),
+        Stability::Stable { decay_rate } => {
+            format!("stable: the slowest decays as e^(-{decay_rate:.6} t)")
+        }
+        Stability::MarginallyStable => format!(
+            "marginally stable{}: no eigenvalue has a positive real part (stable to linear order only)",
+            within_rounding(summary.rounded_real_part)
+        ),
         Stability::Unstable { growth_rate } => format!("unstable: grows as e^({growth_rate:.6} t)"),
     };
     let _ = writeln!(out, "stability      {verdict}");
@@ -368,6 +373,19 @@ fn print_text(
     }
 }
 
+/// ` (within rounding: |Re s| ≤ 3.2e-15 1/s set to 0)` when a marginal verdict was decided
+/// by setting real parts at rounding to 0, nothing otherwise.
+fn within_rounding(rounded_real_part: f64) -> String {
+    if rounded_real_part > 0.0 {
+        format!(
+            " (within rounding: |Re s| ≤ {:.1e} 1/s set to 0)",
+            num(rounded_real_part)
+        )
+    } else {
+        String::new()
+    }
+}
+
 /// The verdict of the whole linearisation (`C` included) and, with a gyroscopic part, its
 /// size and the frequencies with it.
 fn write_stability(out: &mut impl std::io::Write, s: &eomgen::LinearStability) {
@@ -378,7 +396,8 @@ fn write_stability(out: &mut impl std::io::Write, s: &eomgen::LinearStability) {
             num(decay_rate)
         ),
         Stability::MarginallyStable => format!(
-            "marginally stable: no eigenvalue of the linearisation has Re s > 0, {on_axis} of {} lie on the imaginary axis",
+            "marginally stable{}: no eigenvalue of the linearisation has Re s > 0, {on_axis} of {} lie on the imaginary axis",
+            within_rounding(s.rounded_real_part),
             s.eigenvalues.len()
         ),
         Stability::Unstable { growth_rate } => format!(

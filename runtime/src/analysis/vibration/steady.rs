@@ -56,6 +56,9 @@ pub struct SteadyMotionAnalysis {
     pub eigenvalues: Vec<Complex<f64>>,
     /// The verdict from them.
     pub stability: Stability,
+    /// The largest `|Re s|` (1/s) set to 0 as rounding or as the differences' error, 0 when
+    /// none: a marginal verdict with a positive value is decided within that bound.
+    pub rounded_real_part: f64,
 }
 
 /// [`SteadyMotionAnalysis`] as `eomgen modes --json` prints it.
@@ -73,6 +76,8 @@ pub struct SteadyMotionSummary {
     pub damped_modes: Vec<DampedEigenvalueSummary>,
     /// The verdict (`"verdict"` and its rate).
     pub stability: Stability,
+    /// [`SteadyMotionAnalysis::rounded_real_part`].
+    pub rounded_real_part: f64,
 }
 
 /// A steady motion in a report.
@@ -114,6 +119,7 @@ impl SteadyMotionAnalysis {
             linearization: self.linearization.clone(),
             damped_modes: damped_summaries(&self.eigenvalues),
             stability: self.stability,
+            rounded_real_part: self.rounded_real_part,
         }
     }
 }
@@ -159,7 +165,7 @@ pub fn steady_motion_analysis(
     let steady_motion = find_steady_motion(model, options.t, &guess, &rates, &ignorable)?;
     let linearization =
         linearize_steady_motion(model, options.t, &steady_motion.state(), &ignorable)?;
-    let (eigenvalues, stability) = steady_stability(&linearization)?;
+    let (eigenvalues, stability, rounded_real_part) = steady_stability(&linearization)?;
     Ok(SteadyMotionAnalysis {
         name,
         coordinates: model
@@ -172,5 +178,6 @@ pub fn steady_motion_analysis(
         linearization,
         eigenvalues,
         stability,
+        rounded_real_part,
     })
 }
