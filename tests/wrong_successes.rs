@@ -755,3 +755,37 @@ fn a_start_that_is_nan_at_the_parameters_is_named() {
         stderr(&out)
     );
 }
+
+/// A load that is not finite at t = 0 only (`F0 ln(w1 t)` on the two masses) was reported as
+/// "the linearisation is not finite at q", with a hint to choose another configuration; it
+/// is the instant, and the error says so (the equations are finite at the next time sampled).
+#[test]
+fn a_load_not_finite_at_the_start_only_blames_the_instant() {
+    let source = std::fs::read_to_string(format!(
+        "{}/models/two_masses.yaml",
+        env!("CARGO_MANIFEST_DIR")
+    ))
+    .unwrap();
+    let text = source
+        .replace("vector: [F0*step(t), 0]", "vector: [F0*ln(t*w1), 0]")
+        .replace(
+            "  F0: 1.0    # N, step force amplitude",
+            "  F0: 1.0    # N, step force amplitude\n  w1: 1.0    # 1/s",
+        );
+    assert!(
+        text.contains("ln(t*w1)") && text.contains("w1: 1.0"),
+        "{text}"
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("log_load.yaml");
+    std::fs::write(&path, text).unwrap();
+    let out = eomgen(&["modes", path.to_str().unwrap(), "--at", "x1=0,x2=1"]);
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("the equations are not finite at t = 0 s")
+            && err.contains("a load is outside its domain at that instant")
+            && !err.contains("choose another operating point"),
+        "{err}"
+    );
+}

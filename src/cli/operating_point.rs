@@ -124,6 +124,9 @@ pub(super) fn modal_hint(model: &dyn ModelInfo, e: &eomgen::ModalError) -> Strin
         ModalError::TimeDependentLoad { .. } => format!(
             "a load that changes with t is an input, not part of the modes: `eomgen frf {name}` gives the response to a harmonic load, `eomgen simulate {name}` follows the motion; if the equations balance the load elsewhere, start Newton there: {start}"
         ),
+        ModalError::NotFiniteAtTime { .. } => format!(
+            "a load that changes with t is an input, not part of the modes: `eomgen frf {name}` gives the response to a harmonic load, `eomgen simulate {name}` follows the motion from a time where the load is defined"
+        ),
         ModalError::TimeDependent { .. } => format!(
             "for a periodic dependence, its stability about this operating point is given by `eomgen study floquet {name}` (Floquet multipliers over one period); `eomgen simulate {name}` follows the motion"
         ),

@@ -148,6 +148,19 @@ pub enum ModalError {
         /// The operating point.
         q: Vec<f64>,
     },
+    /// The equations are not finite at the operating point at the time asked for, and are
+    /// at later times: a load outside its domain at that instant (`ln(w t)` at `t = 0`).
+    #[error(
+        "the equations are not finite at t = {t} s at q = {q:?}, though they are at t = {finite_at} s: a load is outside its domain at that instant (ln(w*t), 1/t at t = 0)"
+    )]
+    NotFiniteAtTime {
+        /// The operating point.
+        q: Vec<f64>,
+        /// The time (s).
+        t: f64,
+        /// A later time where they are finite (s).
+        finite_at: f64,
+    },
     /// The model has non-holonomic constraints, which restrict the velocities but not the
     /// configuration: its equilibria are not isolated and the linearisation in `q` is not a
     /// second-order system `M δq̈ + C δq̇ + K δq = 0`.

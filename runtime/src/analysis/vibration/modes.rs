@@ -278,12 +278,14 @@ pub fn modal_analysis(
         Ok(point) => point,
         Err(OperatingPointError::Modal(
             error @ (ModalError::EquilibriumNotFound { .. }
-            | ModalError::EquilibriumAtInfinity { .. }),
+            | ModalError::EquilibriumAtInfinity { .. }
+            | ModalError::NonFinite { .. }),
         )) => {
             // Coefficients that change with t are the reason to give, not Newton's failure
             // on the equations frozen at t₀: checked at the guess.
             // A load that changes with t is the reason too: the equilibrium failed under its
-            // value at t₀, one instant of it.
+            // value at t₀, one instant of it. Equations not finite at the guess at t₀ alone
+            // (`ln(w t)` at 0) are the instant's, not the configuration's.
             let (_, guess) = options.operating_point.start.resolve(model)?;
             if let Some(forcing) = time_dependence(model, &guess, options.operating_point.t)? {
                 return Err(ModalError::TimeDependentLoad {
