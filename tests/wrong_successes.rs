@@ -789,3 +789,44 @@ fn a_load_not_finite_at_the_start_only_blames_the_instant() {
         "{err}"
     );
 }
+
+/// Ziegler's pendulum under a follower force (K not symmetric): the modes table used K's
+/// symmetric part, which is indefinite from p = 2 while the system is stable up to flutter at
+/// p = (7 − 2√2)/2 = 2.0858, so at p = 2.05 it said "unstable, grows as e^(0.131 t)" beside
+/// a "marginally stable" verdict. The modes are now those of `M⁻¹K`, whose ω² are the roots of
+/// `2ω⁴ − (7 − 2p)ω² + 1 = 0` (to 1e-9: an eigenvalue solve); at p = 2.1 (flutter) the table
+/// says it is of the symmetric part only and no row is a verdict.
+#[test]
+fn a_follower_load_has_the_modes_of_m_inv_k() {
+    let file = format!(
+        "{}/tests/fixtures/ziegler_pendulum.yaml",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let p: f64 = 2.05;
+    let b = 7.0 - 2.0 * p;
+    let root = (b * b - 8.0).sqrt();
+    let expected = [((b - root) / 4.0).sqrt(), ((b + root) / 4.0).sqrt()];
+    let out = eomgen(&["modes", &file, "--set", "P=2.05", "--json"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let w: Vec<f64> = json["natural_frequencies"]
+        .as_array()
+        .unwrap_or_else(|| panic!("{json}"))
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect();
+    for (w, e) in w.iter().zip(expected) {
+        assert!((w - e).abs() < 1e-9, "{w:?} against {expected:?}");
+    }
+    let out = eomgen(&["modes", &file, "--set", "P=2.05"]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(!text.contains("unstable"), "{text}");
+    let out = eomgen(&["modes", &file, "--set", "P=2.1"]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("flutter")
+            && text.contains("ω² < 0 for K's symmetric part (no verdict")
+            && text.contains("stability  unstable"),
+        "{text}"
+    );
+}

@@ -769,14 +769,29 @@ pub struct NormalModes {
     pub mode_shapes: DMatrix<f64>,
     /// `‖K − Kᵀ‖_max / ‖K‖_max` before symmetrisation.
     pub stiffness_asymmetry: f64,
+    /// Whether the modes are those of the symmetric part of `K` only, not the system's: `K`
+    /// is not symmetric (follower loads) and `M⁻¹K` has complex eigenvalues (flutter), so the
+    /// system has no real normal modes. Its kinds are then no verdict; the stability of the
+    /// state matrix is.
+    pub symmetric_part_only: bool,
 }
 
 /// The normal modes of a linearisation, by Cholesky reduction to a symmetric eigenproblem.
+/// Where `K` is not symmetric beyond rounding (a follower load), its symmetric part would
+/// give other frequencies, and can be indefinite while the system is stable (Ziegler's
+/// pendulum between P = 2 and its flutter load): the modes are then those of `M⁻¹K`
+/// (lecture 22), `K ψ = ω² M ψ` with real `ω²`, each `ψ` normalised to `ψᵀMψ = 1` (they are
+/// not `M`-orthogonal); if `M⁻¹K` has complex eigenvalues (flutter), the symmetric part's
+/// modes are returned with [`NormalModes::symmetric_part_only`].
 ///
 /// # Errors
 /// [`ModalError::SingularMassMatrix`] if `M` is not positive definite;
 /// [`ModalError::NonFinite`] if the eigensolver fails.
 pub fn normal_modes(lin: &Linearization) -> Result<NormalModes, ModalError> {
+    let asymmetric = lin.stiffness_asymmetry() > STIFFNESS_ASYMMETRY;
+    if asymmetric && let Some(modes) = non_symmetric_modes(lin)? {
+        return Ok(modes);
+    }
     let n = lin.mass_matrix.nrows();
     let k_sym = (&lin.stiffness_matrix + lin.stiffness_matrix.transpose()) * 0.5;
     let chol = lin.mass_cholesky()?;
@@ -842,7 +857,67 @@ pub fn normal_modes(lin: &Linearization) -> Result<NormalModes, ModalError> {
         kinds,
         mode_shapes: shapes,
         stiffness_asymmetry: lin.stiffness_asymmetry(),
+        symmetric_part_only: asymmetric,
     })
+}
+
+/// `K` is symmetric to rounding below this asymmetry ([`Linearization::stiffness_asymmetry`]).
+const STIFFNESS_ASYMMETRY: f64 = 1e-12;
+
+/// The modes of a non-symmetric `K` from `M⁻¹K` ([`normal_modes`]); `None` when an eigenvalue
+/// is complex beyond rounding (`|Im λ| > 1e-12 max |λ|`: flutter).
+fn non_symmetric_modes(lin: &Linearization) -> Result<Option<NormalModes>, ModalError> {
+    let n = lin.mass_matrix.nrows();
+    let chol = lin.mass_cholesky()?;
+    let a = chol.solve(&lin.stiffness_matrix);
+    let values = crate::linalg::eigenvalues(&a).ok_or(ModalError::EigenvaluesDidNotConverge {
+        size: n,
+        q: lin.q.clone(),
+    })?;
+    let largest = values.iter().fold(0.0f64, |m, v| m.max(v.norm()));
+    if values.iter().any(|v| v.im.abs() > 1e-12 * largest) {
+        return Ok(None);
+    }
+    let mut w2s: Vec<f64> = values.iter().map(|v| v.re).collect();
+    w2s.sort_by(f64::total_cmp);
+    let mut shapes = DMatrix::zeros(n, n);
+    let (mut eigenvalues, mut natural_frequencies, mut kinds) =
+        (Vec::new(), Vec::new(), Vec::new());
+    for (col, &w2) in w2s.iter().enumerate() {
+        // The right null vector of K − ω² M: the smallest singular value's.
+        let svd = (&lin.stiffness_matrix - &lin.mass_matrix * w2).svd(false, true);
+        let v_t = svd.v_t.ok_or(ModalError::NonFinite { q: lin.q.clone() })?;
+        let smallest = svd.singular_values.imin();
+        let mut psi = v_t.row(smallest).transpose();
+        let norm = (psi.transpose() * &lin.mass_matrix * &psi)[(0, 0)].sqrt();
+        psi /= norm;
+        if psi[psi.iamax()] < 0.0 {
+            psi = -psi;
+        }
+        if !psi.iter().all(|v| v.is_finite()) {
+            return Err(ModalError::NonFinite { q: lin.q.clone() });
+        }
+        shapes.set_column(col, &psi);
+        let (w2, kind) = if w2.abs() <= EIGENVALUE_ROUNDING * largest {
+            (0.0, ModeKind::ZeroFrequency)
+        } else if w2 < 0.0 {
+            let growth_rate = (-w2).sqrt();
+            (w2, ModeKind::Unstable { growth_rate })
+        } else {
+            (w2, ModeKind::Oscillatory)
+        };
+        eigenvalues.push(w2);
+        natural_frequencies.push(w2.max(0.0).sqrt());
+        kinds.push(kind);
+    }
+    Ok(Some(NormalModes {
+        eigenvalues,
+        natural_frequencies,
+        kinds,
+        mode_shapes: shapes,
+        stiffness_asymmetry: lin.stiffness_asymmetry(),
+        symmetric_part_only: false,
+    }))
 }
 
 /// An eigenvalue `ω²` below this fraction of its own scale ([`is_zero_frequency`]) is a

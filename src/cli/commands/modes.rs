@@ -307,10 +307,16 @@ fn print_text(
     if !undamped {
         print_matrix(stdout, "C", &lin.damping_matrix);
     }
-    if modes.stiffness_asymmetry > 1e-12 {
+    if modes.symmetric_part_only {
         let _ = writeln!(
             stdout,
-            "note       K is not symmetric (‖K − Kᵀ‖/‖K‖ = {:.2e}); its symmetric part is used",
+            "note       K is not symmetric (‖K − Kᵀ‖/‖K‖ = {:.2e}) and M⁻¹K has complex eigenvalues (flutter): the table is of K's symmetric part, not the system's modes; the stability line is the system's",
+            num(modes.stiffness_asymmetry)
+        );
+    } else if modes.stiffness_asymmetry > 1e-12 {
+        let _ = writeln!(
+            stdout,
+            "note       K is not symmetric (‖K − Kᵀ‖/‖K‖ = {:.2e}): the modes are those of M⁻¹K (K ψ = ω² M ψ, each ψᵀMψ = 1; they are not M-orthogonal)",
             num(modes.stiffness_asymmetry)
         );
     }
@@ -328,6 +334,10 @@ fn print_text(
         let note = match modes.kinds[k] {
             ModeKind::Oscillatory => String::new(),
             ModeKind::ZeroFrequency => "  zero-frequency".to_string(),
+            // Of K's symmetric part only: no verdict at all.
+            ModeKind::Unstable { .. } if modes.symmetric_part_only => {
+                "  ω² < 0 for K's symmetric part (no verdict: see the stability line)".to_string()
+            }
             // From K alone: the verdict of the whole linearisation only when C = 0.
             ModeKind::Unstable { growth_rate } if undamped => {
                 format!(
