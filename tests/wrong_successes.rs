@@ -830,3 +830,43 @@ fn a_follower_load_has_the_modes_of_m_inv_k() {
         "{text}"
     );
 }
+
+/// A stability change where an eigenvalue passes through infinity (a spring of stiffness
+/// `k/(a − 1)`: ±2/√(1 − a) real below a = 1, ±2i/√(a − 1) above) was described as "a real
+/// eigenvalue crosses 0"; it is a pole, said so, at a = 1 to 1e-9.
+#[test]
+fn a_pole_in_a_sweep_is_not_a_crossing_of_zero() {
+    use eomgen::analysis::vibration::{
+        Crossing, ParameterSweepOptions, SweepAxis, parameter_sweep,
+    };
+    let file = format!(
+        "{}/tests/fixtures/stiffness_pole.yaml",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let mut model = eomgen::ModelSource::open(&file).unwrap().instantiate();
+    let options = ParameterSweepOptions {
+        axis: SweepAxis::linear("a", 0.0, 2.0, 4).unwrap(),
+        operating_point: eomgen::analysis::vibration::OperatingPointOptions::default(),
+        refine: true,
+    };
+    let sweep = parameter_sweep(model.as_mut(), &options, |_, _| {}).unwrap();
+    let changes = &sweep.stability_changes;
+    assert_eq!(changes.len(), 1, "{changes:?}");
+    let change = &changes[0];
+    assert_eq!(change.eigenvalue, Crossing::Pole);
+    assert!((change.value - 1.0).abs() < 1e-9, "{}", change.value);
+    let out = eomgen(&[
+        "study",
+        "parameter-sweep",
+        &file,
+        "--parameter",
+        "a",
+        "--values",
+        "0..2:4",
+    ]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("passes through infinity") && !text.contains("crosses 0"),
+        "{text}"
+    );
+}

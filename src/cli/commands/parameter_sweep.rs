@@ -159,6 +159,7 @@ fn print_text(sweep: &ParameterSweep, chart: Option<&str>) {
     for c in &sweep.stability_changes {
         let kind = match c.eigenvalue {
             Crossing::Real => "a real eigenvalue crosses 0".to_string(),
+            Crossing::Pole => "a real eigenvalue passes through infinity (a pole: a stiffness or an inertia of the linearisation is singular there)".to_string(),
             Crossing::Complex => format!("a complex pair crosses at ±{:.10}i", c.frequency),
         };
         let direction = match c.direction {

@@ -97,6 +97,9 @@ pub enum Crossing {
     Real,
     /// A complex pair through `±iω` (a flutter: the weave of a bicycle).
     Complex,
+    /// A real eigenvalue through infinity: a pole of the linearisation, where a stiffness or
+    /// an inertia is singular (`k/(a − 1)` at `a = 1`), not a crossing of the axis.
+    Pole,
 }
 
 /// Whether a change makes the operating point more stable as the parameter grows.
@@ -286,8 +289,16 @@ fn locate_change(
         if hi - lo <= 1e-12 * lo.abs().max(hi.abs()).max(1.0) {
             break;
         }
-        let mid = 0.5 * (lo + hi);
-        let Some(point) = at(mid) else { break };
+        // A midpoint where the linearisation fails (a pole exactly there) is moved once.
+        let mut mid = 0.5 * (lo + hi);
+        let point = match at(mid) {
+            Some(point) => point,
+            None => {
+                mid = lo + 0.381_966 * (hi - lo);
+                let Some(point) = at(mid) else { break };
+                point
+            }
+        };
         let count = unstable_count(&point.eigenvalues);
         if count == count_a {
             lo = mid;
@@ -319,7 +330,17 @@ fn locate_change(
         .is_some_and(|s| s.im.abs() > 1e-6 * s.norm());
     let mut value = 0.5 * (lo + hi);
     let mut bracket = [lo, hi];
-    if complex {
+    // Through infinity rather than 0: the crossing eigenvalue near the change is far larger
+    // than at the grid value on the unstable side (it grows without bound towards the pole).
+    let at_grid = unstable_grid
+        .eigenvalues
+        .iter()
+        .filter(|s| s.re > 0.0)
+        .map(|s| s.norm())
+        .fold(f64::INFINITY, f64::min);
+    let pole = !complex && crossing.norm() > 1e3 * at_grid;
+    if pole {
+    } else if complex {
         // Only where the pair comes from (or goes into) the left half-plane: where it meets
         // another pair on the imaginary axis and leaves it (a gyroscopic system's Krein
         // collision, the sleeping top), the real part grows as a square root, and the
@@ -364,7 +385,9 @@ fn locate_change(
     }
     StabilityChange {
         value,
-        eigenvalue: if complex {
+        eigenvalue: if pole {
+            Crossing::Pole
+        } else if complex {
             Crossing::Complex
         } else {
             Crossing::Real
