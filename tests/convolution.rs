@@ -539,6 +539,28 @@ fn a_forcing_faster_than_the_grid_is_refused() {
             "{err}"
         );
     }
+    // A square wave of period 0.2 s on Δ = 0.01 s (ten points per half period, its jumps on
+    // grid points): every jump stays between its interval's grid values, and it is taken
+    // (it was refused in review, its forty per cent of intervals near a jump counted).
+    let fast_square = |t: f64| {
+        if (2.0 * std::f64::consts::PI * t / 0.2).sin() >= 0.0 {
+            1.0
+        } else {
+            0.0
+        }
+    };
+    let s = study(
+        oscillator.as_mut(),
+        "A",
+        Forcing::Function {
+            label: "step(sin(2*pi*t/0.2))",
+            f: &fast_square,
+        },
+        20.0,
+        2000,
+    )
+    .unwrap_or_else(|e| panic!("a square wave of ten points per half period: {e}"));
+    assert!(s.max_difference <= 100.0 * s.quadrature.error_estimate + 1e-6);
     let square = |t: f64| (3.0 * t).sin().signum();
     let jump = |t: f64| if t >= 1.0 { 1.0 } else { 0.0 };
     for (label, f) in [

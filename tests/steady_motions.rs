@@ -706,3 +706,30 @@ fn a_held_state_with_nothing_to_adjust_must_be_steady_as_it_is() {
     assert!(err.to_string().contains("(x_ddot)"), "{err}");
     vibration::steady_motion_analysis(m.as_mut(), &at("straight")).expect("steady");
 }
+
+/// From the review of the trust-region search: an exact guess whose residual is the
+/// rounding of large terms (a bead on a hoop spun at 1000 rad/s, residual 8.7e-11) is a
+/// steady motion, as the guess 0.01 rad off is (both at cos θ = g/(R w²), to 1e-12); and a
+/// state with nothing to adjust is judged by its rates alone, not by the values of its
+/// ignorable coordinates (a pushed particle at x = 1e11 m was "steady, marginally stable").
+#[test]
+fn exact_guesses_are_steady_and_ignorable_values_do_not_excuse_a_residual() {
+    let mut hoop = fixture_model("spun_hoop.yaml");
+    let expected = (9.81f64 / (0.1 * 1e6)).acos();
+    for name in ["exact", "spinning"] {
+        let a = vibration::steady_motion_analysis(hoop.as_mut(), &at(name))
+            .unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert!(
+            (a.steady_motion.q[1] - expected).abs() < 1e-12,
+            "{name}: {}",
+            a.steady_motion.q[1]
+        );
+    }
+    let mut pushed = fixture_model("pushed_particle.yaml");
+    for x in [0.0, 1e11] {
+        pushed.set_parameter("X", x).unwrap();
+        let err = vibration::steady_motion_analysis(pushed.as_mut(), &at("coasting"))
+            .expect_err("pushed: no steady motion");
+        assert!(err.to_string().contains("(x_ddot)"), "X = {x}: {err}");
+    }
+}

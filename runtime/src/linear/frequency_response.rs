@@ -1170,6 +1170,8 @@ pub fn modal_frequency_response(
     let damping = modal_damping(lin, modes);
     let psi = &modes.mode_shapes;
     let k = psi.ncols();
+    // `ψ_kᵀ b`, or the left eigenvectors' for the modes of a non-symmetric K.
+    let forces = crate::linear::response::modal_projector(lin, modes) * b;
     // Scaled by s² as in `frequency_response`: the denominator divided by s².
     let s = frequency_scale(frequency);
     let w = frequency / s;
@@ -1178,7 +1180,7 @@ pub fn modal_frequency_response(
     let mut contributions = DMatrix::zeros(n, k);
     for mode in 0..k {
         let shape = psi.column(mode);
-        let force = shape.dot(b);
+        let force = forces[mode];
         let stiffness = modes.eigenvalues[mode] / s / s;
         let denominator = Complex::new(
             stiffness - w * w,

@@ -149,7 +149,7 @@ pub enum ModalError {
         q: Vec<f64>,
     },
     /// The equations are not finite at the operating point at the time asked for, and are
-    /// at later times: a load outside its domain at that instant (`ln(w t)` at `t = 0`).
+    /// at a later time: a load outside its domain at that instant (`ln(w t)` at `t = 0`).
     #[error(
         "the equations are not finite at t = {t} s at q = {q:?}, though they are at t = {finite_at} s: a load is outside its domain at that instant (ln(w*t), 1/t at t = 0)"
     )]
@@ -883,12 +883,33 @@ fn non_symmetric_modes(lin: &Linearization) -> Result<Option<NormalModes>, Modal
     let mut shapes = DMatrix::zeros(n, n);
     let (mut eigenvalues, mut natural_frequencies, mut kinds) =
         (Vec::new(), Vec::new(), Vec::new());
+    // Each cluster of equal ω² (within 1e-8 of the largest) has as many independent null
+    // vectors of K − ω² M as members, the smallest singular values' right vectors; fewer (a
+    // defective ω², at a divergence–flutter boundary) means no basis of modes.
+    let mut start = 0;
+    let mut cluster: Vec<nalgebra::DVector<f64>> = Vec::new();
     for (col, &w2) in w2s.iter().enumerate() {
-        // The right null vector of K − ω² M: the smallest singular value's.
-        let svd = (&lin.stiffness_matrix - &lin.mass_matrix * w2).svd(false, true);
-        let v_t = svd.v_t.ok_or(ModalError::NonFinite { q: lin.q.clone() })?;
-        let smallest = svd.singular_values.imin();
-        let mut psi = v_t.row(smallest).transpose();
+        if col == start {
+            let end = (col..n)
+                .take_while(|&j| (w2s[j] - w2).abs() <= 1e-8 * largest)
+                .last()
+                .map_or(col + 1, |j| j + 1);
+            let mean = w2s[col..end].iter().sum::<f64>() / (end - col) as f64;
+            let svd = (&lin.stiffness_matrix - &lin.mass_matrix * mean).svd(false, true);
+            let v_t = svd.v_t.ok_or(ModalError::NonFinite { q: lin.q.clone() })?;
+            let mut order: Vec<usize> = (0..n).collect();
+            order.sort_by(|&a, &b| svd.singular_values[a].total_cmp(&svd.singular_values[b]));
+            let top = svd.singular_values.max();
+            if svd.singular_values[order[end - col - 1]] > 1e-6 * top {
+                return Ok(None);
+            }
+            cluster = order[..end - col]
+                .iter()
+                .map(|&i| v_t.row(i).transpose())
+                .collect();
+            start = end;
+        }
+        let mut psi = cluster.remove(0);
         let norm = (psi.transpose() * &lin.mass_matrix * &psi)[(0, 0)].sqrt();
         psi /= norm;
         if psi[psi.iamax()] < 0.0 {

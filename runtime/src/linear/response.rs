@@ -891,11 +891,29 @@ fn modal_initial_values(
     q0: &[f64],
     qdot0: &[f64],
 ) -> (DVector<f64>, DVector<f64>) {
-    let project = modes.mode_shapes.transpose() * &lin.mass_matrix;
+    let project = modal_projector(lin, modes) * &lin.mass_matrix;
     (
         &project * DVector::from_column_slice(q0),
         &project * DVector::from_column_slice(qdot0),
     )
+}
+
+/// The matrix `L` with `L M Ψ = I` that takes a force to modal forces (`L b`) and, times `M`,
+/// a displacement to modal coordinates: `Ψᵀ` for mass-normalised modes of a symmetric `K`;
+/// `Ψ⁻¹ M⁻¹` for the modes of a non-symmetric `K` (follower loads), which are not
+/// `M`-orthogonal (the left eigenvectors of the pencil `(K, M)`, biorthonormal to `Ψ`).
+/// `Ψᵀ` where `Ψ` or `M` cannot be inverted.
+pub(crate) fn modal_projector(lin: &Linearization, modes: &NormalModes) -> DMatrix<f64> {
+    let psi = &modes.mode_shapes;
+    if lin.stiffness_asymmetry() > 1e-12
+        && let (Some(psi_inv), Some(chol)) = (
+            psi.clone().try_inverse(),
+            lin.mass_matrix.clone().cholesky(),
+        )
+    {
+        return chol.solve(&psi_inv.transpose()).transpose();
+    }
+    psi.transpose()
 }
 
 /// The free response with the modal-damping approximation (HW34 (c)): each modal coordinate
@@ -1036,10 +1054,11 @@ impl ModalDamping {
 }
 
 /// `Ĉ = ΨᵀCΨ` of the linearisation's damping matrix on the modes `modes`, and the damping
-/// ratios of keeping only its diagonal (HW34 (c) ii).
+/// ratios of keeping only its diagonal (HW34 (c) ii); `Ĉ = Ψ⁻¹M⁻¹CΨ` for the modes of a
+/// non-symmetric `K`, which are not `M`-orthogonal.
 pub fn modal_damping(lin: &Linearization, modes: &NormalModes) -> ModalDamping {
     let psi = &modes.mode_shapes;
-    let c_hat = psi.transpose() * &lin.damping_matrix * psi;
+    let c_hat = modal_projector(lin, modes) * &lin.damping_matrix * psi;
     let n = c_hat.nrows();
     let diagonal_max = (0..n).fold(0.0f64, |m, k| m.max(c_hat[(k, k)].abs()));
     let mut off_max = 0.0f64;

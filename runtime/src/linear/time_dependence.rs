@@ -150,7 +150,7 @@ fn matrix_change(samples: &[DVector<f64>], n: usize) -> (f64, usize) {
 /// # Errors
 /// [`ModalError::NonFinite`] when a part is not finite at `t₀` itself (a singularity of the
 /// equations at `q`, which is not a change with `t`); [`ModalError::NotFiniteAtTime`] when
-/// it is finite at every later sample (a load such as `ln(w t)` at `t₀ = 0`);
+/// it is finite at a later sample (a load such as `ln(w t)` at `t₀ = 0`);
 /// [`ModalError::TimeDependent`] naming the first part found to change, in the order above
 /// (a rheonomic constraint such as a rod spun at a constant rate written with `t`, a
 /// parametrically excited stiffness such as a pendulum on a shaken pivot);
@@ -185,18 +185,15 @@ pub fn time_dependence(
     };
     // A value that is not finite at `t₀` itself is a singularity of the equations at this
     // configuration (a 0/0: the direction of a rod of zero length, a spring's ends that
-    // coincide), not a change with `t`, unless the same parts are finite at every later
-    // sample: then it is the instant (a load `ln(w t)` at t = 0).
-    let singular = |later_finite: bool| {
-        if later_finite {
-            ModalError::NotFiniteAtTime {
-                q: q.to_vec(),
-                t: t0,
-                finite_at: times[1],
-            }
-        } else {
-            ModalError::NonFinite { q: q.to_vec() }
-        }
+    // coincide), not a change with `t`, unless the same parts are finite at a later sample:
+    // then it is the instant (a load `ln(w t)` at t = 0, `ln(w t − 1)` before t = 1/w).
+    let singular = |finite_at: Option<usize>| match finite_at {
+        Some(k) => ModalError::NotFiniteAtTime {
+            q: q.to_vec(),
+            t: t0,
+            finite_at: times[k],
+        },
+        None => ModalError::NonFinite { q: q.to_vec() },
     };
     let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
     if m > 0 {
@@ -214,7 +211,8 @@ pub fn time_dependence(
         .into_iter()
         .all(finite)
         {
-            let later = constraints[1..].iter().all(|c| {
+            let later = (1..times.len()).find(|&k| {
+                let c = &constraints[k];
                 [c.phi.as_slice(), c.velocity.as_slice(), c.gamma.as_slice()]
                     .into_iter()
                     .all(finite)
@@ -264,7 +262,7 @@ pub fn time_dependence(
             .all(|v| finite(v.as_slice()))
     };
     if !all_finite(0) {
-        return Err(singular((1..times.len()).all(all_finite)));
+        return Err(singular((1..times.len()).find(|&k| all_finite(k))));
     }
     refuse(TimeDependentPart::MassMatrix, matrix_change(&mass, n))?;
     refuse(TimeDependentPart::DampingMatrix, matrix_change(&damping, n))?;

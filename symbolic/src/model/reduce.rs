@@ -244,7 +244,7 @@ pub enum ReduceError {
     /// branches of a quadratic constraint meet (`∂y/∂x` infinite), or where a linear one's
     /// coefficient vanishes. The mass matrix is not finite there, so no file is written.
     #[error(
-        "the reduced coordinates cannot start where the model starts ({detail}): the reduced mass matrix is not finite there; give the kept coordinates an initial value where the eliminated ones are real and regular"
+        "the reduced coordinates are singular or not real where the model starts ({detail}): the reduced mass matrix is not finite there; give the kept coordinates an initial value where the eliminated ones are real and regular"
     )]
     SingularStart {
         /// The expression that vanishes there, and which solution it belongs to.
@@ -1101,7 +1101,7 @@ impl<'f> Reducer<'f> {
                 let _ = writeln!(
                     w,
                     "#   singular where {e} = 0: the kept coordinates do not determine {coordinate} there{}",
-                    if event {
+                    if event.is_some() {
                         format!(" (event `{coordinate}_singular` ends runs)")
                     } else {
                         String::new()
@@ -1470,17 +1470,19 @@ impl<'f> Reducer<'f> {
             let name = format!("{coordinate}_singular");
             notes.push(format!(
                 "the reduced model is singular where {e} = 0 (`{coordinate}` is solved by dividing by it, or by a square root of it): the kept coordinates do not determine `{coordinate}` there, and the motion past it is not unique{}",
-                if event {
+                if event.is_some() {
                     format!("; the event `{name}` ends runs there")
                 } else {
-                    String::new()
+                    "; a run that reaches it fails there".to_string()
                 }
             ));
-            if event && !file.events.iter().any(|ev| ev.name.value == name) {
+            if let Some(when) = event
+                && !file.events.iter().any(|ev| ev.name.value == name)
+            {
                 let _ = writeln!(
                     events,
                     "  {name}: {{ when: {}, direction: both, terminal: true }}",
-                    flow(&e)
+                    flow(&when)
                 );
             }
         }
@@ -1600,11 +1602,14 @@ impl<'f> Reducer<'f> {
     }
 
     /// The singularities of the eliminations that move with the state or the time (not a
-    /// constant of the parameters): `(coordinate, expression, whether an event can find it)`.
-    /// A linear solution's slope changes sign there (a run crossing it needs an event to
-    /// stop: explicit methods step over such a pole); a quadratic's discriminant only
-    /// touches 0 where the motion turns back, so it is noted without an event.
-    fn moving_singularities(&self) -> Vec<(String, String, bool)> {
+    /// constant of the parameters): `(coordinate, expression, the event that ends runs
+    /// there)`. A linear solution's slope changes sign there, and the event is the slope
+    /// itself (explicit methods step over such a pole). A quadratic's discriminant reaches 0
+    /// where the motion leaves the chosen branch (a pendulum kept in `x` that swings past the
+    /// horizontal) and may only touch it, which no event function of the file's units can
+    /// catch short of it: it is noted, and a run that reaches it fails there (the reduced
+    /// mass matrix is not finite).
+    fn moving_singularities(&self) -> Vec<(String, String, Option<String>)> {
         self.singular_where
             .iter()
             .filter(|(_, e, _)| {
@@ -1615,7 +1620,11 @@ impl<'f> Reducer<'f> {
                     ) && self.arena.depends_on(*e, SymbolId(i as u32))
                 })
             })
-            .map(|(c, e, discriminant)| (c.clone(), self.print(*e), !*discriminant))
+            .map(|(c, e, discriminant)| {
+                let text = self.print(*e);
+                let event = (!*discriminant).then(|| text.clone());
+                (c.clone(), text, event)
+            })
             .collect()
     }
 

@@ -162,6 +162,15 @@ pub fn steady_motion_analysis(
 ) -> Result<SteadyMotionAnalysis, SteadyAnalysisError> {
     let (name, guess) = options.start.resolve(model)?;
     let (rates, ignorable) = held_rates(model, &options.start);
+    if let Some(i) = rates.iter().position(|r| !r.is_finite()) {
+        return Err(OperatingPointError::GuessNotFinite {
+            model: model.description().name.to_string(),
+            name,
+            coordinate: model.description().state_name(model.num_dofs() + i),
+            value: rates[i],
+        }
+        .into());
+    }
     let steady_motion = find_steady_motion(model, options.t, &guess, &rates, &ignorable)?;
     let linearization =
         linearize_steady_motion(model, options.t, &steady_motion.state(), &ignorable)?;
