@@ -362,7 +362,8 @@ pub fn find_steady_motion(
 const FIRST_RADIUS: f64 = 0.25;
 
 /// Full Gauss–Newton steps after convergence, each kept only if it lowers the largest
-/// residual (at most four: the convergence is quadratic).
+/// residual and moves the coordinates by more than 1e-12 of their size (at most four: the
+/// convergence is quadratic).
 fn polish(
     model: &mut dyn ModelInfo,
     t: f64,
@@ -376,6 +377,17 @@ fn polish(
             break;
         }
         let (step, _) = gauss_newton_step(model, t, q, rates, free, r)?;
+        // A step below 1e-12 of the coordinates moves them within the rounding of the
+        // differenced Jacobian's solve: an exact guess (the heavy top's precession at π/6)
+        // stays where it is, though such a step may lower a residual that is rounding.
+        let size = free
+            .iter()
+            .enumerate()
+            .map(|(col, &j)| step[col].abs() / q[j].abs().max(1.0))
+            .fold(0.0f64, f64::max);
+        if size <= 1e-12 {
+            break;
+        }
         let trial = moved_by(q, free, &step, 1.0);
         match steady_residuals(model, t, &trial, rates) {
             Ok(rt) if largest(&rt).0 < largest(r).0 => {
