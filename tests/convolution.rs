@@ -561,6 +561,25 @@ fn a_forcing_faster_than_the_grid_is_refused() {
     )
     .unwrap_or_else(|e| panic!("a square wave of ten points per half period: {e}"));
     assert!(s.max_difference <= 100.0 * s.quadrature.error_estimate + 1e-6);
+    // A smooth forcing at 5 points per period (sin(10π t) on Δ = 0.0314…, the default end
+    // time over 200 intervals) is refused: its samples between grid points match neither
+    // the cubic nor either grid value (it was taken, 6 % off, when any sample between the
+    // two grid values counted as resolved).
+    let coarse = |t: f64| (31.4159265 * t).sin();
+    let options = ConvolutionOptions {
+        input: "A".to_string(),
+        forcing: Forcing::Function {
+            label: "sin(31.4159265*t)",
+            f: &coarse,
+        },
+        intervals: 200,
+        ..ConvolutionOptions::default()
+    };
+    let err = convolution_response(oscillator.as_mut(), &options).unwrap_err();
+    assert!(
+        matches!(err, ConvolutionError::ForcingUnresolved { .. }),
+        "{err:?}"
+    );
     let square = |t: f64| (3.0 * t).sin().signum();
     let jump = |t: f64| if t >= 1.0 { 1.0 } else { 0.0 };
     for (label, f) in [

@@ -765,3 +765,43 @@ fn an_equilibrium_analysis_at_a_steady_motion_says_so() {
         );
     }
 }
+
+/// From the second review: the modes of a non-symmetric K beside a stiff uncoupled mode
+/// (ω² = 1e9) keep their own shapes (two soft ω² were merged by a tolerance of 1e-8 of the
+/// largest and given arbitrary vectors, residual 0.94): each `(K − ω²M)ψ` is at rounding of
+/// `|K ψ|` (1e-12). Under flutter (p = 2.1) the modal routes refuse: there are no real modes
+/// to superpose (the FRF's modal sum and modal damping used K's symmetric part, 3.4× off).
+#[test]
+fn follower_load_modes_beside_a_stiff_mode_and_under_flutter() {
+    let file = format!(
+        "{}/tests/fixtures/ziegler_beside_stiff.yaml",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let mut m = eomgen::ModelSource::open(&file).unwrap().instantiate();
+    let lin = eomgen::linearize(m.as_mut(), &[0.0; 3], &[0.0; 3], 0.0).unwrap();
+    let modes = eomgen::normal_modes(&lin).unwrap();
+    for k in 0..3 {
+        let psi = modes.mode_shapes.column(k);
+        let kp = &lin.stiffness_matrix * psi;
+        let residual = &kp - &lin.mass_matrix * psi * modes.eigenvalues[k];
+        assert!(
+            residual.amax() <= 1e-12 * kp.amax(),
+            "mode {k}: residual {} of {}",
+            residual.amax(),
+            kp.amax()
+        );
+    }
+    let ziegler = format!(
+        "{}/tests/fixtures/ziegler_pendulum.yaml",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    for args in [
+        &["frf", &ziegler, "--input", "a", "--modal", "--set", "P=2.1"][..],
+        &["study", "modal-damping", &ziegler, "--set", "P=2.1"][..],
+    ] {
+        let out = eomgen(args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {err}");
+        assert!(err.contains("no real normal modes"), "{args:?}: {err}");
+    }
+}

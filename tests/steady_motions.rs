@@ -733,3 +733,30 @@ fn exact_guesses_are_steady_and_ignorable_values_do_not_excuse_a_residual() {
         assert!(err.to_string().contains("(x_ddot)"), "X = {x}: {err}");
     }
 }
+
+/// From the second review: a residual no free coordinate can change (a push in y, with
+/// only x and y free and y_ddot = F/m everywhere) is not "converged at rounding" because the
+/// step is zero and the guess's residual (a spring of 1e9 N/m) was large: it is refused.
+/// And a pole beside another unstable real eigenvalue is still a pole.
+#[test]
+fn a_residual_out_of_reach_is_not_rounding_and_a_pole_beside_instability_is_a_pole() {
+    let mut m = fixture_model("pushed_beside_stiff.yaml");
+    m.set_parameter("K", 1e9).unwrap();
+    m.set_parameter("F", 1.0).unwrap();
+    let err = vibration::steady_motion_analysis(m.as_mut(), &at("cruise")).unwrap_err();
+    assert!(err.to_string().contains("(y_ddot)"), "{err}");
+    let mut pole = fixture_model("pole_beside_unstable.yaml");
+    let options = ParameterSweepOptions {
+        axis: SweepAxis::linear("a", 0.0, 3.0, 30).unwrap(),
+        operating_point: OperatingPointOptions::default(),
+        refine: true,
+    };
+    let sweep = vibration::parameter_sweep(pole.as_mut(), &options, |_, _| {}).unwrap();
+    assert_eq!(
+        sweep.stability_changes.len(),
+        1,
+        "{:?}",
+        sweep.stability_changes
+    );
+    assert_eq!(sweep.stability_changes[0].eigenvalue, Crossing::Pole);
+}

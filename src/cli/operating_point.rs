@@ -124,6 +124,9 @@ pub(super) fn modal_hint(model: &dyn ModelInfo, e: &eomgen::ModalError) -> Strin
         ModalError::TimeDependentLoad { .. } => format!(
             "a load that changes with t is an input, not part of the modes: `eomgen frf {name}` gives the response to a harmonic load, `eomgen simulate {name}` follows the motion; if the equations balance the load elsewhere, start Newton there: {start}"
         ),
+        ModalError::NoRealModes { .. } => format!(
+            "the system flutters here (`eomgen modes {name}` gives its eigenvalues): its response is computed without modes, by `eomgen frf {name}` without --modal or `eomgen simulate {name}`"
+        ),
         ModalError::NotFiniteAtTime { .. } => format!(
             "a load that changes with t is an input, not part of the modes: `eomgen frf {name}` gives the response to a harmonic load, `eomgen simulate {name}` follows the motion from a time where the load is defined"
         ),

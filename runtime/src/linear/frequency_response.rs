@@ -1166,6 +1166,7 @@ pub fn modal_frequency_response(
     frequency: f64,
 ) -> Result<ModalResponse, FrfError> {
     check_forcing(lin, b.len(), frequency)?;
+    modes.require_real()?;
     let n = b.len();
     let damping = modal_damping(lin, modes);
     let psi = &modes.mode_shapes;

@@ -148,6 +148,15 @@ pub enum ModalError {
         /// The operating point.
         q: Vec<f64>,
     },
+    /// `K` is not symmetric and `M⁻¹K` has complex eigenvalues (flutter): there are no real
+    /// normal modes to superpose ([`NormalModes::symmetric_part_only`]).
+    #[error(
+        "K is not symmetric (‖K − Kᵀ‖/‖K‖ = {asymmetry:.2e}) and M⁻¹K has complex eigenvalues (flutter): there are no real normal modes to superpose"
+    )]
+    NoRealModes {
+        /// `‖K − Kᵀ‖_max / ‖K‖_max`.
+        asymmetry: f64,
+    },
     /// The equations are not finite at the operating point at the time asked for, and are
     /// at a later time: a load outside its domain at that instant (`ln(w t)` at `t = 0`).
     #[error(
@@ -861,6 +870,22 @@ pub fn normal_modes(lin: &Linearization) -> Result<NormalModes, ModalError> {
     })
 }
 
+impl NormalModes {
+    /// For an analysis that superposes the modes (free response, modal damping, the FRF's
+    /// modal sum): the system's own modes, not only its symmetric part's.
+    ///
+    /// # Errors
+    /// [`ModalError::NoRealModes`] when [`Self::symmetric_part_only`].
+    pub fn require_real(&self) -> Result<(), ModalError> {
+        if self.symmetric_part_only {
+            return Err(ModalError::NoRealModes {
+                asymmetry: self.stiffness_asymmetry,
+            });
+        }
+        Ok(())
+    }
+}
+
 /// `K` is symmetric to rounding below this asymmetry ([`Linearization::stiffness_asymmetry`]).
 const STIFFNESS_ASYMMETRY: f64 = 1e-12;
 
@@ -883,15 +908,19 @@ fn non_symmetric_modes(lin: &Linearization) -> Result<Option<NormalModes>, Modal
     let mut shapes = DMatrix::zeros(n, n);
     let (mut eigenvalues, mut natural_frequencies, mut kinds) =
         (Vec::new(), Vec::new(), Vec::new());
-    // Each cluster of equal ω² (within 1e-8 of the largest) has as many independent null
+    // Each cluster of equal ω² (within 1e-8 of their size) has as many independent null
     // vectors of K − ω² M as members, the smallest singular values' right vectors; fewer (a
     // defective ω², at a divergence–flutter boundary) means no basis of modes.
     let mut start = 0;
     let mut cluster: Vec<nalgebra::DVector<f64>> = Vec::new();
     for (col, &w2) in w2s.iter().enumerate() {
         if col == start {
+            // Equal to 1e-8 of their own size (a stiff mode beside soft ones must not merge
+            // the soft ones), or both at rounding of the largest.
             let end = (col..n)
-                .take_while(|&j| (w2s[j] - w2).abs() <= 1e-8 * largest)
+                .take_while(|&j| {
+                    (w2s[j] - w2).abs() <= 1e-8 * w2.abs().max(EIGENVALUE_ROUNDING * largest)
+                })
                 .last()
                 .map_or(col + 1, |j| j + 1);
             let mean = w2s[col..end].iter().sum::<f64>() / (end - col) as f64;

@@ -879,6 +879,7 @@ pub fn response_by_normal_modes(
     check_times(times)?;
     require_undamped(lin)?;
     let modes = normal_modes(lin)?;
+    modes.require_real()?;
     let (eta0, etadot0) = modal_initial_values(lin, &modes, q0, qdot0);
     superpose(&modes.mode_shapes, times, |k, t| {
         undamped_modal_coordinate(modes.kinds[k], modes.eigenvalues[k], eta0[k], etadot0[k], t)

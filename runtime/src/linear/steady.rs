@@ -313,9 +313,15 @@ pub fn find_steady_motion(
             .map(|(col, &j)| step[col].abs() / q[j].abs().max(1.0))
             .fold(0.0f64, f64::max);
         // Converged as far as rounding allows: Newton would move the coordinates by less
-        // than their rounding, with the residual small (an exact guess whose residual is the
-        // rounding of large terms, a hoop spun at 1000 rad/s).
-        if size <= 1e-14 && worst <= 1e-8 * scale {
+        // than their rounding, with the residual small and within reach of the step (an
+        // exact guess whose residual is the rounding of large terms, a hoop spun at
+        // 1000 rad/s). A residual the coordinates cannot change (an acceleration no free
+        // coordinate affects) is not rounding, however small the step.
+        let reachable = linear_prediction(&r, &predicted, 1.0)
+            .iter()
+            .fold(0.0f64, |m, v| m.max(v.abs()))
+            <= 1e-3 * worst;
+        if size <= 1e-14 && worst <= 1e-8 * scale && reachable {
             break;
         }
         let fraction = if size > radius { radius / size } else { 1.0 };

@@ -299,10 +299,11 @@ const DISAGREEMENT_FLOOR: f64 = 1e-6;
 /// Refuses a forcing that varies within the grid's intervals: `f` at `t_k + c Δ`,
 /// `c ∈ {0.381966, 0.723607}` (irrational, so that neither a grid-periodic nor a
 /// midpoint-periodic forcing hides), against the cubic through the four nearest grid values
-/// `values` and outside the interval's own two grid values; more than
-/// [`UNRESOLVED_FRACTION`] of the intervals off by 1 % of `max |f|` both ways is an error (a
-/// jump stays between its interval's values, so a square wave of ten points per half period
-/// is taken). Cost: two evaluations of `f` per interval.
+/// `values` and against the interval's own two grid values; more than
+/// [`UNRESOLVED_FRACTION`] of the intervals off by 1 % of `max |f|` from all three is an
+/// error (a square wave sampled anywhere equals one of its interval's grid values, so one of
+/// ten points per half period is taken; a sine of five points per period is not). Cost: two
+/// evaluations of `f` per interval.
 fn check_resolution(
     forcing: &Forcing<'_>,
     times: &[f64],
@@ -333,15 +334,16 @@ fn check_resolution(
                 s * (s - 1.0) * (s - 2.0) / 6.0,
             ];
             let cubic: f64 = (0..4).map(|i| w[i] * values[start + i]).sum();
-            // Between the interval's own grid values (a jump, a square wave's flat parts) the
-            // grid holds what the rules need; outside them it missed an excursion.
+            // At one of the interval's own grid values (a square wave's flat parts, either
+            // side of a jump) the grid holds what the rules need; elsewhere it missed the
+            // forcing's shape.
             let (a, b) = (values[k], values[k + 1]);
-            let outside = (value - a.max(b)).max(a.min(b) - value).max(0.0);
-            samples.push((k, t, value, cubic, outside));
+            let away = (value - a).abs().min((value - b).abs());
+            samples.push((k, t, value, cubic, away));
         }
     }
-    let off = |(_, _, v, c, outside): &&(usize, f64, f64, f64, f64)| {
-        (v - c).abs() > 1e-2 * largest && *outside > 1e-2 * largest
+    let off = |(_, _, v, c, away): &&(usize, f64, f64, f64, f64)| {
+        (v - c).abs() > 1e-2 * largest && *away > 1e-2 * largest
     };
     let mut unresolved: Vec<usize> = samples.iter().filter(off).map(|s| s.0).collect();
     unresolved.dedup();
@@ -911,9 +913,9 @@ fn direct_response(
         .with_rtol(rtol)
         .with_atol(rtol * scale.max(f64::MIN_POSITIVE))
         // Bounded by the grid: 2 million steps at the default 2000 intervals, about 20 s (an
-        // impulse response over 1e5 s takes 5e5); a forcing that needs more varies faster
-        // than the grid resolves.
-        .with_max_steps(10_000 + 1000 * times.len());
+        // impulse response over 1e5 s takes 5e5), and 4 million at most; a forcing that needs
+        // more varies faster than the grid resolves.
+        .with_max_steps((10_000 + 1000 * times.len()).min(4_000_000));
     let t_end = *times.last().unwrap_or(&0.0);
     let solution = DormandPrince853::new()
         .integrate(

@@ -330,6 +330,7 @@ pub fn modal_damping_study(
 ) -> Result<ModalDampingStudy, ResponseStudyError> {
     let modal = unconstrained_modal_analysis(model, &options.operating_point)?;
     let (lin, modes) = (&modal.linearization, &modal.normal_modes);
+    modes.require_real().map_err(crate::ResponseError::from)?;
     let n = model.num_dofs();
     let approx = modal_damping(lin, modes);
     let exact = exact_damped_modes(lin, modes)?;

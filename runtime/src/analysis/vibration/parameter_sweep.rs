@@ -330,15 +330,11 @@ fn locate_change(
         .is_some_and(|s| s.im.abs() > 1e-6 * s.norm());
     let mut value = 0.5 * (lo + hi);
     let mut bracket = [lo, hi];
-    // Through infinity rather than 0: the crossing eigenvalue near the change is far larger
-    // than at the grid value on the unstable side (it grows without bound towards the pole).
-    let at_grid = unstable_grid
-        .eigenvalues
-        .iter()
-        .filter(|s| s.re > 0.0)
-        .map(|s| s.norm())
-        .fold(f64::INFINITY, f64::min);
-    let pole = !complex && crossing.norm() > 1e3 * at_grid;
+    // Through infinity rather than 0: near the change an eigenvalue is far larger than any
+    // at the grid value on the unstable side (it grows without bound towards the pole),
+    // whichever it is (another unstable one may be nearer the axis).
+    let largest = |p: &PointEigenvalues| p.eigenvalues.iter().fold(0.0f64, |m, s| m.max(s.norm()));
+    let pole = !complex && largest(&side) > 1e3 * largest(unstable_grid);
     if pole {
     } else if complex {
         // Only where the pair comes from (or goes into) the left half-plane: where it meets
