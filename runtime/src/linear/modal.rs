@@ -19,11 +19,17 @@
 //! `M^{-1/2} K M^{-1/2}` route with the Cholesky factor in place of the symmetric root: the same
 //! eigenvalues, and mass-normalised shapes either way). `K` from a Lagrangian system is
 //! symmetric at an equilibrium; an asymmetry (a follower load, or an operating point that is
-//! not an equilibrium) is reported, then `K` is symmetrised (lecture 24, item 1).
+//! not an equilibrium) is reported, and the modes are those of `M⁻¹K` (lecture 22), not of
+//! `K`'s symmetric part, unless `M⁻¹K` has complex eigenvalues (flutter: [`normal_modes`]).
 //!
 //! With holonomic constraints the linearisation is projected onto the null space of the
 //! constraint Jacobian (minimal coordinates; see [`Linearization`]); non-holonomic constraints
 //! are refused ([`ModalError::NonHolonomic`]).
+//!
+//! long: the linearisation (with constraints), its checks, and the normal modes by both routes
+//! (symmetric, and `M⁻¹K` for a non-symmetric `K`) share the error type and the mass
+//! matrix's checks; the modes could be a room of their own, a split left to the issue on the
+//! code's shape.
 
 use nalgebra::{DMatrix, DVector};
 
@@ -773,7 +779,8 @@ pub struct NormalModes {
     pub kinds: Vec<ModeKind>,
     /// `mode_shapes`, `r × r` in the linearisation's coordinates ([`Linearization::to_coordinates`] gives
     /// them in `q`), column `k` the shape of mode `k`, mass-normalised:
-    /// `ΨᵀMΨ = I`; sign fixed so that the largest-magnitude entry is positive.
+    /// `ΨᵀMΨ = I` (for a non-symmetric `K`, each column `ψᵀMψ = 1`, the columns not
+    /// `M`-orthogonal); sign fixed so that the largest-magnitude entry is positive.
     #[serde(serialize_with = "crate::serde_matrix::rows")]
     pub mode_shapes: DMatrix<f64>,
     /// `‖K − Kᵀ‖_max / ‖K‖_max` before symmetrisation.
