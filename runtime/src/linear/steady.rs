@@ -268,6 +268,9 @@ pub fn find_steady_motion(
     // The last point the equations could not be evaluated at: near it the search was held
     // back, and a search that fails is blamed on it.
     let mut refused: Option<(Vec<f64>, RhsError)> = None;
+    // The step and its predicted change at the current `q`, kept while a refused trial
+    // only shrinks the region (the Jacobian costs 2 n evaluations of the equations).
+    let mut at_q: Option<(DVector<f64>, DVector<f64>)> = None;
     loop {
         let (worst, at) = largest(&r);
         if !worst.is_finite() {
@@ -306,7 +309,10 @@ pub fn find_steady_motion(
             });
         }
         iterations += 1;
-        let (step, predicted) = gauss_newton_step(model, t, &q, rates, &free, &r)?;
+        let (step, predicted) = match at_q.take() {
+            Some(cached) => cached,
+            None => gauss_newton_step(model, t, &q, rates, &free, &r)?,
+        };
         let size = free
             .iter()
             .enumerate()
@@ -335,6 +341,7 @@ pub fn find_steady_motion(
                 // A NaN ratio (no predicted reduction) shrinks the region too.
                 if ratio.is_nan() || ratio < 0.1 {
                     radius = fraction * size / 2.0;
+                    at_q = Some((step, predicted));
                     continue;
                 }
                 if ratio >= 0.75 {
@@ -343,10 +350,14 @@ pub fn find_steady_motion(
                 q = trial;
                 r = rt;
             }
-            Ok(_) => radius = fraction * size / 2.0,
+            Ok(_) => {
+                radius = fraction * size / 2.0;
+                at_q = Some((step, predicted));
+            }
             Err(e) => {
                 radius = fraction * size / 2.0;
                 refused = Some((trial, e));
+                at_q = Some((step, predicted));
             }
         }
     }

@@ -351,11 +351,13 @@ fn check_resolution(
     };
     let mut unresolved: Vec<usize> = samples.iter().filter(off).map(|s| s.0).collect();
     unresolved.dedup();
-    if largest > 0.0 && unresolved.len() as f64 > UNRESOLVED_FRACTION * total as f64 {
-        let worst = samples
-            .iter()
-            .max_by(|a, b| (a.2 - a.3).abs().total_cmp(&(b.2 - b.3).abs()))
-            .expect("samples");
+    let worst = samples
+        .iter()
+        .max_by(|a, b| (a.2 - a.3).abs().total_cmp(&(b.2 - b.3).abs()));
+    if let Some(worst) = worst
+        && largest > 0.0
+        && unresolved.len() as f64 > UNRESOLVED_FRACTION * total as f64
+    {
         return Err(ConvolutionError::ForcingUnresolved {
             t: worst.1,
             value: worst.2,
