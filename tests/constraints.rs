@@ -533,22 +533,8 @@ fn a_rolling_contact_along_the_normal_constrains_nothing() {
 /// singular (its slope 1 was compared with the square of the largest parameter).
 #[test]
 fn constraint_methods_measure_a_huge_push_without_overflow() {
-    let source = std::fs::read_to_string(format!(
-        "{}/models/two_masses_rod.yaml",
-        env!("CARGO_MANIFEST_DIR")
-    ))
-    .unwrap();
-    let text = source.replace("  F0: 1.0", "  F0: 1e300");
-    assert_ne!(text, source, "the file's F0 line");
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("pushed.yaml");
-    std::fs::write(&path, text).unwrap();
-    let out = common::eomgen(&[
-        "study",
-        "constraint-methods",
-        path.to_str().unwrap(),
-        "--json",
-    ]);
+    let (_dir, path) = common::edited_model("two_masses_rod", &[("  F0: 1.0", "  F0: 1e300")]);
+    let out = common::eomgen(&["study", "constraint-methods", &path, "--json"]);
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "{err}");
     let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();

@@ -689,19 +689,15 @@ fn a_constraint_between_ignorable_coordinates_is_regular() {
 /// It is refused, naming `x_ddot`; the sleigh's straight motion is still one.
 #[test]
 fn a_held_state_with_nothing_to_adjust_must_be_steady_as_it_is() {
-    let source = std::fs::read_to_string(format!(
-        "{}/models/chaplygin_sleigh.yaml",
-        env!("CARGO_MANIFEST_DIR")
-    ))
-    .unwrap();
-    let text = source.replace(
-        "  straight: { x_dot: v0, ignorable: [x, y, theta] }",
-        "  straight: { x_dot: v0, ignorable: [x, y, theta] }\n  spin: { theta_dot: 1, ignorable: [x, y, theta] }",
+    let straight = "  straight: { x_dot: v0, ignorable: [x, y, theta] }";
+    let spin = "\n  spin: { theta_dot: 1, ignorable: [x, y, theta] }";
+    let (_dir, path) = common::edited_model(
+        "chaplygin_sleigh",
+        &[(straight, &format!("{straight}{spin}"))],
     );
-    assert_ne!(text, source);
-    let mut m: Box<dyn ModelInfo> = Box::new(eomgen::DynFirstOrder::new(
-        eomgen::JitModel::from_source("sleigh.yaml", &text).unwrap_or_else(|e| panic!("{e}")),
-    ));
+    let mut m = eomgen::ModelSource::open(&path)
+        .expect("loads")
+        .instantiate();
     let err = vibration::steady_motion_analysis(m.as_mut(), &at("spin")).unwrap_err();
     assert!(err.to_string().contains("(x_ddot)"), "{err}");
     vibration::steady_motion_analysis(m.as_mut(), &at("straight")).expect("steady");

@@ -769,25 +769,21 @@ fn a_start_that_is_nan_at_the_parameters_is_named() {
 /// is the instant, and the error says so (the equations are finite at the next time sampled).
 #[test]
 fn a_load_not_finite_at_the_start_only_blames_the_instant() {
-    let source = std::fs::read_to_string(format!(
-        "{}/models/two_masses.yaml",
-        env!("CARGO_MANIFEST_DIR")
-    ))
-    .unwrap();
-    let text = source
-        .replace("vector: [F0*step(t), 0]", "vector: [F0*ln(t*w1), 0]")
-        .replace(
-            "  F0: 1.0    # N, step force amplitude",
-            "  F0: 1.0    # N, step force amplitude\n  w1: 1.0    # 1/s",
-        );
-    assert!(
-        text.contains("ln(t*w1)") && text.contains("w1: 1.0"),
-        "{text}"
-    );
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("log_load.yaml");
-    std::fs::write(&path, text).unwrap();
-    let out = eomgen(&["modes", path.to_str().unwrap(), "--at", "x1=0,x2=1"]);
+    let amplitude = "  F0: 1.0    # N, step force amplitude";
+    let edits = |load: &'static str| {
+        common::edited_model(
+            "two_masses",
+            &[
+                ("vector: [F0*step(t), 0]", load),
+                (
+                    amplitude,
+                    "  F0: 1.0    # N, step force amplitude\n  w1: 1.0    # 1/s",
+                ),
+            ],
+        )
+    };
+    let (_dir, path) = edits("vector: [F0*ln(t*w1), 0]");
+    let out = eomgen(&["modes", &path, "--at", "x1=0,x2=1"]);
     let err = stderr(&out);
     assert_eq!(out.status.code(), Some(1), "{err}");
     assert!(
@@ -798,11 +794,8 @@ fn a_load_not_finite_at_the_start_only_blames_the_instant() {
     );
     // A load defined only from t = 1/w1 on, `ln(w1 t − 1)`, is the instant's too (finite at
     // a later sample, not at every one).
-    let later = std::fs::read_to_string(&path)
-        .unwrap()
-        .replace("ln(t*w1)", "ln(t*w1 - 1)");
-    std::fs::write(&path, later).unwrap();
-    let out = eomgen(&["modes", path.to_str().unwrap(), "--at", "x1=0,x2=1"]);
+    let (_later, path) = edits("vector: [F0*ln(t*w1 - 1), 0]");
+    let out = eomgen(&["modes", &path, "--at", "x1=0,x2=1"]);
     let err = stderr(&out);
     assert!(
         err.contains("the equations are not finite at t = 0 s")

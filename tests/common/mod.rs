@@ -29,3 +29,20 @@ pub fn eomgen_ok(args: &[&str]) -> std::process::Output {
     );
     out
 }
+
+/// A bundled model's file (`models/NAME.yaml`) with each `(from, to)` replaced once, written
+/// into a new temporary folder: the folder (removed when dropped) and the file's path. Panics
+/// if a `from` is not in the text, so that an edit that no longer applies fails its test.
+pub fn edited_model(name: &str, edits: &[(&str, &str)]) -> (tempfile::TempDir, String) {
+    let path = format!("{}/models/{name}.yaml", env!("CARGO_MANIFEST_DIR"));
+    let mut text = std::fs::read_to_string(&path).expect("bundled model file");
+    for (from, to) in edits {
+        assert!(text.contains(from), "`{from}` is not in {path}");
+        text = text.replacen(from, to, 1);
+    }
+    let dir = tempfile::tempdir().expect("temporary folder");
+    let file = dir.path().join(format!("{name}.yaml"));
+    std::fs::write(&file, text).expect("written");
+    let file = file.to_str().expect("a UTF-8 path").to_string();
+    (dir, file)
+}
