@@ -46,6 +46,7 @@
 //! ```
 #![warn(missing_docs)]
 
+mod first_order;
 mod interpret;
 mod math;
 mod model;

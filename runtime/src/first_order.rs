@@ -424,13 +424,25 @@ impl<S: DynMechanicalSystem> DynFirstOrder<S> {
 
 impl<S: DynMechanicalSystem> DynFirstOrder<S> {
     /// The right-hand side of an unconstrained system of `N = n` degrees of freedom, as
-    /// `FirstOrder::rhs` computes it.
+    /// `FirstOrder::rhs` computes it: in one call where the system has it fused
+    /// ([`DynMechanicalSystem::first_order_rhs`]), else `M` and `F`, then the solve.
     fn unconstrained_rhs<const N: usize>(
         &mut self,
         t: f64,
         y: &[f64],
         dy: &mut [f64],
     ) -> Result<(), RhsError> {
+        let mut pivots = [0.0; N];
+        if self.system.first_order_rhs(t, y, dy, &mut pivots) {
+            // Not positive, or NaN.
+            if !pivots.iter().all(|&d| d > 0.0) {
+                return Err(RhsError::SingularMassMatrix);
+            }
+            return match dy[N..2 * N].iter().position(|v| !v.is_finite()) {
+                Some(i) => Err(RhsError::NonFinite { index: N + i }),
+                None => Ok(()),
+            };
+        }
         let mut mass = SMatrix::<f64, N, N>::zeros();
         let mut forcing = SVector::<f64, N>::zeros();
         self.system.mass_matrix_and_forcing(
