@@ -46,6 +46,7 @@
 //! ```
 #![warn(missing_docs)]
 
+mod compiled;
 mod first_order;
 mod interpret;
 mod math;
@@ -253,7 +254,8 @@ mod tests {
                 .into_iter()
                 .chain(jacobians.functions())
                 .collect();
-            let code = native::compile(&functions).unwrap_or_else(|e| panic!("{display}: {e}"));
+            let code =
+                native::compile(&functions, None).unwrap_or_else(|e| panic!("{display}: {e}"));
             for (index, (name, function)) in functions.into_iter().enumerate() {
                 let Some(compiled) = code.functions[index] else {
                     assert!(function.tape.outputs.is_empty(), "{display}: {name}");

@@ -1,24 +1,24 @@
 //! [`JitModel`]: a model file loaded, derived and compiled at run time.
 
-use std::cell::RefCell;
+use std::borrow::Cow;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex, OnceLock};
 
-use eomgen_runtime::taylor::{TaylorFunctions, TaylorUnsupported};
+use eomgen_runtime::taylor::{
+    DerivedLists, MotionLayout, MotionSolve, TaylorFunctions, TaylorProgram, TaylorUnsupported,
+    UNROLLED_CAPACITY,
+};
 use eomgen_runtime::{DynMechanicalSystem, ModelDescription, UnknownParameter};
 use eomgen_symbolic::codegen::GenerateError;
-use eomgen_symbolic::codegen::program::{Derivation, FunctionTape, ModelProgram};
-use eomgen_symbolic::codegen::tape::{Input, Instruction};
+use eomgen_symbolic::codegen::program::{Derivation, ModelProgram};
 use eomgen_symbolic::codegen::taylor::{TaylorPlan, taylor_program};
 use eomgen_symbolic::model::{Diagnostic, ReadError, read_model_file};
 
+use crate::compiled::{Compiled, Extent, FusedRhs, HotRoutine, SCRATCH, call, call_native};
 use crate::first_order::first_order_tape;
-use crate::native::{CompileError, NativeCode, NativeFn};
-use crate::taylor::NativeOrders;
-use crate::{Backend, Inputs, interpret, native};
-
-mod recurrences;
-use recurrences::Recurrences;
+use crate::native::CompileError;
+use crate::taylor::{FACTOR_DENSE, FACTOR_DIAGONAL, FACTOR_SMALL, NativeOrders, PairLanes};
+use crate::{Backend, Inputs, interpret};
 
 /// Why a model file could not be made into a run-time model.
 #[derive(Debug, thiserror::Error)]
@@ -100,109 +100,6 @@ enum Routine {
 
 /// Index of the first Jacobian routine.
 const JACOBIANS: usize = Routine::ForcingJacobianQ as usize;
-
-/// Index of the fused right-hand side among the core functions (after the eleven of
-/// [`ModelProgram::functions`], where a small unconstrained model has it).
-const FIRST_ORDER: usize = JACOBIANS;
-
-/// How many values a function reads from each input and writes to each output buffer
-/// (largest index + 1), checked before native code is called.
-#[derive(Debug, Clone, Copy, Default)]
-struct Extent {
-    parameters: usize,
-    q: usize,
-    qdot: usize,
-    acceleration: usize,
-    lambda: usize,
-    out0: usize,
-    out1: usize,
-    /// `f64`s of scratch space the native code needs (0 for none).
-    scratch: usize,
-}
-
-impl Extent {
-    fn of(function: &FunctionTape) -> Extent {
-        let mut e = Extent::default();
-        for instruction in &function.tape.instructions {
-            if let Instruction::Input(input) = instruction {
-                let (slot, i) = match *input {
-                    Input::Parameter(i) => (&mut e.parameters, i),
-                    Input::Coordinate(i) => (&mut e.q, i),
-                    Input::Velocity(i) => (&mut e.qdot, i),
-                    Input::Acceleration(i) => (&mut e.acceleration, i),
-                    Input::Multiplier(i) => (&mut e.lambda, i),
-                    Input::Time => continue,
-                };
-                *slot = (*slot).max(i as usize + 1);
-            }
-        }
-        let split = function.split.min(function.tape.outputs.len());
-        e.out0 = split;
-        e.out1 = function.tape.outputs.len() - split;
-        e
-    }
-
-    #[inline(always)]
-    fn admits(&self, inputs: &Inputs<'_>, out0: usize, out1: usize) -> bool {
-        inputs.parameters.len() >= self.parameters
-            && inputs.q.len() >= self.q
-            && inputs.qdot.len() >= self.qdot
-            && inputs.acceleration.len() >= self.acceleration
-            && inputs.lambda.len() >= self.lambda
-            && out0 >= self.out0
-            && out1 >= self.out1
-    }
-}
-
-/// Functions as native code, or as tapes for the interpreter, with their extents.
-#[derive(Debug)]
-struct Compiled {
-    /// The tapes, kept only when there is no native code (they are what the interpreter
-    /// runs; with native code they would only take memory: megabytes for a long chain).
-    tapes: Vec<FunctionTape>,
-    extents: Vec<Extent>,
-    native: Option<NativeCode>,
-}
-
-impl Compiled {
-    /// Compiles `functions` with `backend` (`None`: native, interpreting on an unsupported
-    /// host, whose reason is returned).
-    fn new(
-        functions: &[(&str, &FunctionTape)],
-        backend: Option<Backend>,
-    ) -> Result<(Compiled, Option<CompileError>), CompileError> {
-        let (native, fallback_reason) = match backend {
-            Some(Backend::Interpreter) => (None, None),
-            forced => match native::compile(functions) {
-                Ok(code) => (Some(code), None),
-                Err(reason @ CompileError::UnsupportedHost { .. })
-                    if forced != Some(Backend::Native) =>
-                {
-                    (None, Some(reason))
-                }
-                Err(e) => return Err(e),
-            },
-        };
-        let mut compiled = Compiled::interpreted(functions);
-        if let Some(native) = &native {
-            for (extent, &scratch) in compiled.extents.iter_mut().zip(&native.scratch) {
-                extent.scratch = scratch;
-            }
-            compiled.tapes = Vec::new();
-        }
-        compiled.native = native;
-        Ok((compiled, fallback_reason))
-    }
-
-    /// The same functions for the interpreter.
-    fn interpreted(functions: &[(&str, &FunctionTape)]) -> Compiled {
-        Compiled {
-            tapes: functions.iter().map(|(_, f)| (*f).clone()).collect(),
-            extents: functions.iter().map(|(_, f)| Extent::of(f)).collect(),
-            native: None,
-        }
-    }
-}
 
 /// The Jacobians, compiled when first needed, and why they are interpreted if they are.
 #[derive(Debug)]
@@ -294,7 +191,7 @@ impl Code {
             };
             let program = derivation.map(Derivation::jacobians).unwrap_or_default();
             let functions = program.functions();
-            match Compiled::new(&functions, self.backend) {
+            match Compiled::new(&functions, None, self.backend) {
                 Ok((compiled, fallback_reason)) => LazyJacobians {
                     compiled,
                     fallback_reason,
@@ -306,94 +203,6 @@ impl Code {
             }
         })
     }
-}
-
-thread_local! {
-    /// The interpreter's values, and the scratch space of large native functions, reused
-    /// between evaluations on a thread.
-    static SCRATCH: RefCell<Vec<f64>> = const { RefCell::new(Vec::new()) };
-}
-
-/// Calls native code `f` of a routine whose extent is `extent`.
-///
-/// # Safety
-/// `f` must be the native code compiled from the tape `extent` was computed from, and
-/// `extent.admits(inputs, out0.len(), out1.len())` must hold.
-#[inline(always)]
-unsafe fn call_native(
-    f: NativeFn,
-    extent: &Extent,
-    inputs: &Inputs<'_>,
-    out0: &mut [f64],
-    out1: &mut [f64],
-) {
-    let (out0, out1) = (out0.as_mut_ptr(), out1.as_mut_ptr());
-    if extent.scratch == 0 {
-        // SAFETY: the tape reads at most `extent` values of each input and writes
-        // `extent.out0` and `extent.out1` values; the caller checked the slices. It uses no
-        // scratch space.
-        unsafe { call(f, inputs, out0, out1, std::ptr::null_mut()) }
-    } else {
-        // SAFETY: as above; `with_scratch` supplies `extent.scratch` values of scratch space.
-        unsafe { with_scratch(f, extent.scratch, inputs, out0, out1) }
-    }
-}
-
-/// The call itself.
-///
-/// # Safety
-/// As [`call_native`], with `scratch` holding the scratch values the code uses.
-#[inline(always)]
-unsafe fn call(
-    f: NativeFn,
-    inputs: &Inputs<'_>,
-    out0: *mut f64,
-    out1: *mut f64,
-    scratch: *mut f64,
-) {
-    // SAFETY: guaranteed by the caller.
-    unsafe {
-        f(
-            inputs.parameters.as_ptr(),
-            inputs.q.as_ptr(),
-            inputs.qdot.as_ptr(),
-            inputs.acceleration.as_ptr(),
-            inputs.lambda.as_ptr(),
-            inputs.t,
-            out0,
-            out1,
-            scratch,
-        )
-    }
-}
-
-/// A call of code that keeps values in the per-thread scratch buffer (functions of more than
-/// 1,500 instructions, `native.rs`): out of line, so that the small functions' calls, inlined
-/// into the caller's right-hand side, stay short.
-///
-/// # Safety
-/// As [`call_native`], with `scratch` the code's scratch size.
-#[cold]
-#[inline(never)]
-unsafe fn with_scratch(
-    f: NativeFn,
-    scratch: usize,
-    inputs: &Inputs<'_>,
-    out0: *mut f64,
-    out1: *mut f64,
-) {
-    SCRATCH.with(|buffer| match buffer.try_borrow_mut() {
-        Ok(mut buffer) => {
-            if buffer.len() < scratch {
-                buffer.resize(scratch, 0.0);
-            }
-            // SAFETY: guaranteed by the caller; the buffer holds `scratch` values.
-            unsafe { call(f, inputs, out0, out1, buffer.as_mut_ptr()) }
-        }
-        // Re-entered on this thread (cannot happen: the code calls no model code).
-        // SAFETY: as above, with a buffer of its own.
-        Err(_) => unsafe { call(f, inputs, out0, out1, vec![0.0; scratch].as_mut_ptr()) },
-    });
 }
 
 /// A model file compiled at run time: the equations of motion of any file, with no rebuild.
@@ -417,38 +226,7 @@ pub struct JitModel {
     mass_and_forcing: Option<HotRoutine>,
     /// The native `ẏ = [q̇; M⁻¹F]` of a small unconstrained model ([`crate::first_order`]),
     /// held here for the same reason.
-    first_order: Option<HotRoutine>,
-}
-
-/// Native code whose call needs only the lengths of `q`, `q̇` and the two outputs checked: it
-/// reads at most the model's parameters (whose number is fixed), no accelerations, no
-/// multipliers, and uses no scratch space. Checking four lengths rather than the whole
-/// [`Extent`] and skipping the scratch buffer keeps the right-hand side's call of
-/// `mass_matrix_and_forcing` short (`benches/runtime_model.rs`).
-#[derive(Debug, Clone, Copy)]
-struct HotRoutine {
-    f: NativeFn,
-    q: usize,
-    qdot: usize,
-    out0: usize,
-    out1: usize,
-}
-
-impl HotRoutine {
-    /// `f` with `extent`, if its call needs no more than four lengths checked (see above).
-    fn new(f: NativeFn, extent: &Extent, parameters: usize) -> Option<HotRoutine> {
-        let simple = extent.parameters <= parameters
-            && extent.acceleration == 0
-            && extent.lambda == 0
-            && extent.scratch == 0;
-        simple.then_some(HotRoutine {
-            f,
-            q: extent.q,
-            qdot: extent.qdot,
-            out0: extent.out0,
-            out1: extent.out1,
-        })
-    }
+    first_order: Option<FusedRhs>,
 }
 
 impl JitModel {
@@ -529,18 +307,18 @@ impl JitModel {
         derivation: Derivation,
         options: LoadOptions,
     ) -> Result<JitModel, LoadError> {
-        // The fused right-hand side is compiled after the model's own functions, in the same
-        // module, where it has native code to run as.
+        // The fused right-hand side, compiled with the model's own functions where they are
+        // compiled.
+        let n = program.num_dofs();
         let fused = (program.description.constraints.is_empty()
             && options.backend != Some(Backend::Interpreter))
-        .then(|| first_order_tape(&program.mass_matrix_and_forcing, program.num_dofs()))
+        .then(|| first_order_tape(&program.mass_matrix_and_forcing, n))
         .flatten();
-        let mut functions = program.functions().to_vec();
-        if let Some(fused) = &fused {
-            functions.push(("first_order_rhs", fused));
-        }
-        let (core, fallback_reason) = Compiled::new(&functions, options.backend)?;
-        drop(functions);
+        let (core, fallback_reason) = Compiled::new(
+            &program.functions(),
+            fused.as_ref().map(|f| (f, n)),
+            options.backend,
+        )?;
         // The tapes live on in `core`; the program keeps the names and constants.
         let mut program = program;
         if options.equations_mathml {
@@ -587,10 +365,13 @@ impl JitModel {
             .as_ref()
             .and_then(|n| n.functions[index])
             .and_then(|f| HotRoutine::new(f, &code.core.extents[index], parameters.len()));
-        let first_order = code.core.native.as_ref().and_then(|native| {
-            let f = (*native.functions.get(FIRST_ORDER)?)?;
-            HotRoutine::new(f, &code.core.extents[FIRST_ORDER], parameters.len())
-        });
+        let first_order = code
+            .core
+            .native
+            .as_ref()
+            .and_then(|native| native.first_order)
+            .zip(fused.as_ref())
+            .and_then(|(f, tape)| FusedRhs::new(f, &Extent::of(tape), n, parameters.len()));
         Ok(JitModel {
             code,
             parameters,
@@ -769,31 +550,22 @@ impl DynMechanicalSystem for JitModel {
     }
     #[inline(always)]
     fn first_order_rhs(&self, t: f64, y: &[f64], dy: &mut [f64], pivots: &mut [f64]) -> bool {
-        let Some(hot) = self.first_order else {
+        let Some(FusedRhs { f, n }) = self.first_order else {
             return false;
         };
-        // `out0` is `ẏ`, of length `2n`.
-        let n = hot.out0 / 2;
-        if y.len() < 2 * n || dy.len() < hot.out0 || pivots.len() < hot.out1 {
+        if y.len() < 2 * n || dy.len() < 2 * n || pivots.len() < n {
             return false;
         }
-        let (q, qdot) = y.split_at(n);
-        if q.len() < hot.q || qdot.len() < hot.qdot {
-            return false;
-        }
-        let inputs = self.inputs(q, qdot, t);
-        // SAFETY: `hot.f` is the native code of the fused tape (`first_order_tape`); it reads
-        // at most `hot.q` and `hot.qdot` values of `q` and `q̇` (checked above), at most
-        // the model's parameters and no accelerations or multipliers (`HotRoutine::new`),
-        // writes `hot.out0` values to `dy` and `hot.out1` to `pivots` (checked above) and
-        // uses no scratch.
+        // SAFETY: `f` is the native code of the fused tape (`first_order_tape`); it reads at
+        // most `2n` values of `y` and the model's parameters, writes `2n` values to `dy` and
+        // `n` to `pivots` (`FusedRhs::new`; the lengths are checked above).
         unsafe {
-            call(
-                hot.f,
-                &inputs,
+            f(
+                self.parameters.as_ptr(),
+                y.as_ptr(),
+                t,
                 dy.as_mut_ptr(),
                 pivots.as_mut_ptr(),
-                std::ptr::null_mut(),
             )
         };
         true
@@ -917,4 +689,199 @@ impl DynMechanicalSystem for JitModel {
         };
         self.run(Routine::EventValues, inputs, out, &mut []);
     }
+}
+
+/// The program of no model: what [`TaylorFunctions::program`] of a [`JitModel`] without
+/// recurrences would read ([`Recurrences`], which [`DynMechanicalSystem::taylor`] never hands
+/// out for such a model).
+static EMPTY_PROGRAM: TaylorProgram = TaylorProgram {
+    slots: 0,
+    coordinates: Cow::Borrowed(&[]),
+    velocities: Cow::Borrowed(&[]),
+    time: None,
+    mass_matrix: Cow::Borrowed(&[]),
+    forcing: Cow::Borrowed(&[]),
+    constant: Cow::Borrowed(&[]),
+    ops: Cow::Borrowed(&[]),
+    derived: DerivedLists {
+        varying_mass_entries: Cow::Borrowed(&[]),
+        inputs: Cow::Borrowed(&[]),
+        convolutions: 0,
+        branch_points: false,
+    },
+};
+
+/// A [`JitModel`] that has recurrences, as its Taylor method ([`TaylorFunctions`]):
+/// [`DynMechanicalSystem::taylor`] hands the model out as this type only then, so that no
+/// caller runs the Taylor method of a model without recurrences.
+#[repr(transparent)]
+struct Recurrences(JitModel);
+
+impl Recurrences {
+    /// `model` as its Taylor method (which reads [`EMPTY_PROGRAM`] without recurrences).
+    fn of(model: &JitModel) -> &Self {
+        // SAFETY: `Recurrences` is `repr(transparent)` over `JitModel`: the same layout.
+        unsafe { &*std::ptr::from_ref(model).cast::<Self>() }
+    }
+}
+
+/// The model's Taylor method: order 0 compiled with the orders (at their stride) or interpreted, orders on
+/// the runtime's kernels (the trait's default `order`, the definitions the compiled model's
+/// code inlines) until they are compiled ([`Code::taylor_orders`]); the same bits.
+impl TaylorFunctions for Recurrences {
+    fn program(&self) -> &TaylorProgram {
+        match &self.0.code.taylor {
+            Ok(plan) => &plan.program,
+            // Not handed out without a plan.
+            Err(_) => &EMPTY_PROGRAM,
+        }
+    }
+    fn order_zero(&self, capacity: usize, series: &mut [f64]) {
+        if let Ok(plan) = &self.0.code.taylor {
+            // Compiled with the orders (at their stride), else interpreted: the same bits.
+            if let Some(Some(orders)) = self.0.code.taylor_orders.get()
+                && capacity == UNROLLED_CAPACITY
+                && series.len() >= plan.order_zero.instructions.len() * UNROLLED_CAPACITY
+            {
+                // SAFETY: `series` holds every instruction's slot at the stride of 25
+                // (checked above) and the caller has written the inputs' order 0;
+                // `parameters` holds the model's parameters, the count the code was
+                // compiled for.
+                unsafe { (orders.order_zero)(series.as_mut_ptr(), self.0.parameters.as_ptr()) };
+                return;
+            }
+            interpret::order_zero_in_place(&plan.order_zero, &self.0.parameters, capacity, series);
+        }
+    }
+    fn orders(
+        &self,
+        solve: &mut MotionSolve<'_>,
+        order: usize,
+        series: &mut [f64],
+        out: &mut [f64],
+    ) -> usize {
+        let (Ok(plan), Some(orders)) = (&self.0.code.taylor, self.0.code.taylor_orders()) else {
+            return 0;
+        };
+        let program = &plan.program;
+        let n = program.coordinates.len();
+        // The code's offsets assume the stride of 25 and every slot present, and the orders
+        // it computes (below `order`, to `highest`) write `out` to the next one.
+        let computed = order.min(orders.highest + 1);
+        if !solve.unrolled()
+            || series.len() < (program.slots + n) * UNROLLED_CAPACITY
+            || out.len() < (computed + 1) * 2 * n
+        {
+            return 0;
+        }
+        // With a diagonal factor, or any of `n ≤ 6`, the code solves in line (the same
+        // operations as `motion_order`'s), else it calls `solve_order`.
+        let (lower, inverse_pivots, mode) = match (solve.small_factor(), solve.diagonal_factor()) {
+            (_, Some(inverse)) if inverse.len() == n => {
+                (std::ptr::null(), inverse.as_ptr(), FACTOR_DIAGONAL)
+            }
+            (Some((lower, inverse)), _) if lower.len() == n * n && inverse.len() == n => {
+                let mode = if solve.dense_factor().is_some() {
+                    FACTOR_DENSE
+                } else {
+                    FACTOR_SMALL
+                };
+                (lower.as_ptr(), inverse.as_ptr(), mode)
+            }
+            _ => (std::ptr::null(), std::ptr::null(), 0),
+        };
+        let mut context = OrderContext {
+            layout: MotionLayout {
+                forcing: &program.forcing,
+                coupled: &program.derived.varying_mass_entries,
+                inputs: &program.derived.inputs,
+                time: program.time,
+                accelerations: program.acceleration_slot(),
+            },
+            solve,
+            series: series.as_mut_ptr(),
+            series_len: series.len(),
+            out: out.as_mut_ptr(),
+            out_len: out.len(),
+        };
+        thread_local! {
+            /// The compiled orders' scratch ([`crate::taylor::PairScratch`]), kept between
+            /// calls on this thread.
+            static SCRATCH: std::cell::RefCell<Vec<PairLanes>> = const { std::cell::RefCell::new(Vec::new()) };
+        }
+        let ran = SCRATCH.try_with(|scratch| {
+            let Ok(mut scratch) = scratch.try_borrow_mut() else {
+                return false;
+            };
+            if scratch.len() < orders.scratch_units {
+                scratch.resize(orders.scratch_units, PairLanes::default());
+            }
+            let scratch = scratch.as_mut_ptr();
+            for function in &orders.orders[..computed] {
+                // SAFETY: `series` holds every slot at the stride of 25 with the orders below
+                // `k` computed (by the calls before this one), and `out` every order the code
+                // writes (checked above); `lower` and `inverse_pivots`, when not null, hold
+                // `n × n` and `n` values that nothing writes during the call; `solve_order` is
+                // called with the context built for it; `scratch` holds the units the orders
+                // use, with the orders below `k` written by the calls before; `series`, `out`
+                // and `scratch` are not used otherwise until the call returns.
+                let status = unsafe {
+                    function(
+                        context.series,
+                        (&raw mut context).cast::<u8>(),
+                        solve_order,
+                        context.out,
+                        lower,
+                        inverse_pivots,
+                        mode,
+                        scratch,
+                    )
+                };
+                if status != 0 {
+                    return false;
+                }
+            }
+            true
+        });
+        if ran != Ok(true) {
+            return 0;
+        }
+        computed
+    }
+    fn fused_orders(&self) -> usize {
+        // None before they are compiled: until then the workspace's stride follows the
+        // kernels' rule (`TaylorProgram::unrolled_code_fits`), as for a model without them.
+        self.0
+            .code
+            .taylor_orders
+            .get()
+            .and_then(Option::as_ref)
+            .map_or(0, |orders| orders.highest)
+    }
+}
+
+/// What the compiled Taylor orders pass to [`solve_order`] between orders.
+struct OrderContext<'a, 'b> {
+    layout: MotionLayout<'a>,
+    solve: &'a mut MotionSolve<'b>,
+    series: *mut f64,
+    series_len: usize,
+    out: *mut f64,
+    out_len: usize,
+}
+
+/// Order `k` of `M a = F` for the compiled Taylor orders
+/// ([`eomgen_runtime::taylor::motion_order_at`]); non-zero if it panicked (the orders then
+/// stop and report none computed, and the step computes them again by the runtime's
+/// kernels: a panic must not unwind through the compiled code).
+extern "C" fn solve_order(context: *mut u8, k: usize) -> u8 {
+    let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        // SAFETY: `context` is the `OrderContext` of the `orders` call in progress,
+        // whose `series` and `out` are exclusively lent to this call chain.
+        let context = unsafe { &mut *context.cast::<OrderContext<'_, '_>>() };
+        let series = unsafe { std::slice::from_raw_parts_mut(context.series, context.series_len) };
+        let out = unsafe { std::slice::from_raw_parts_mut(context.out, context.out_len) };
+        eomgen_runtime::taylor::motion_order_at(&context.layout, context.solve, k, series, out);
+    }));
+    u8::from(result.is_err())
 }

@@ -17,7 +17,7 @@
 //! absolute addresses; `sin_cos` returns its pair in two registers. Outputs are stores at
 //! fixed offsets, except runs of [`ZERO_RUN`] or more consecutive outputs that are the
 //! constant `+0.0` (the structural zeros of a sparse mass matrix or Jacobian), which are one
-//! call of [`math::fill_zero`] each, first thing in the function: the mass matrix of a
+//! call of [`crate::math::fill_zero`] each, first thing in the function: the mass matrix of a
 //! 1000-mass chain is a million outputs, and storing them one by one took Cranelift 6 s to
 //! compile. Cranelift's optimiser (`opt_level = speed`) and register allocator do the
 //! rest; nothing is reassociated or contracted into fused multiply–adds, so the results are
@@ -31,21 +31,19 @@
 //! executable pages when it is dropped (the function pointers die with it: the run-time
 //! model holds both in one `Arc`).
 
-use std::sync::Mutex;
-
 use cranelift_codegen::ir;
 use cranelift_codegen::ir::condcodes::FloatCC;
 use cranelift_codegen::ir::{AbiParam, InstBuilder, MemFlagsData, Signature, UserFuncName, types};
-use cranelift_codegen::settings::{self, Configurable};
 use cranelift_frontend::{FunctionBuilder, FunctionBuilderContext};
-use cranelift_jit::{JITBuilder, JITModule};
-use cranelift_module::{FuncId, Linkage, Module, default_libcall_names};
+use cranelift_jit::JITModule;
+use cranelift_module::{FuncId, Linkage, Module};
 
 use eomgen_symbolic::codegen::program::FunctionTape;
 use eomgen_symbolic::codegen::tape::{Input, Instruction};
 use eomgen_symbolic::expr::Func;
 
-use crate::math;
+mod module;
+pub(crate) use module::{Imports, ModuleMemory, declare_imports, failure, new_module};
 
 /// A compiled function: see the module documentation for its arguments.
 ///
@@ -64,12 +62,32 @@ pub(crate) type NativeFn = unsafe extern "C" fn(
     *mut f64,
 );
 
+/// A compiled right-hand side `ẏ = [q̇; M⁻¹F]` ([`crate::first_order`]): `(parameters, y, t,
+/// ẏ, pivots)`, with `q` the first `n` values of `y` and `q̇` the next `n`.
+///
+/// # Safety
+/// As [`NativeFn`]: `y` and `ẏ` hold `2n` values, `pivots` `n`.
+pub(crate) type FirstOrderFn =
+    unsafe extern "C" fn(*const f64, *const f64, f64, *mut f64, *mut f64);
+
+/// The arguments a compiled function takes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Layout {
+    /// [`NativeFn`]'s nine.
+    Model,
+    /// [`FirstOrderFn`]'s five, for a model of `n` degrees of freedom: no accelerations,
+    /// multipliers or scratch space, and four arguments fewer to pass (the right-hand side is
+    /// called millions of times, and on a model of one or two degrees of freedom the call is a
+    /// good part of it).
+    FirstOrder { n: usize },
+}
+
 /// Functions of more instructions than this keep their shared values in a scratch buffer
 /// instead of registers (see [`build`]).
 const SCRATCH_FROM_INSTRUCTIONS: usize = 1500;
 
 /// Runs of at least this many consecutive outputs that are the constant `+0.0` are written by
-/// one call of [`math::fill_zero`] (see [`zero_runs`]).
+/// one call of [`crate::math::fill_zero`] (see [`zero_runs`]).
 const ZERO_RUN: usize = 16;
 
 /// Why the model's functions could not be compiled to native code.
@@ -106,6 +124,8 @@ pub(crate) struct NativeCode {
     pub(crate) functions: Vec<Option<NativeFn>>,
     /// Per function: how many `f64`s of scratch space it needs (0: none, pass null).
     pub(crate) scratch: Vec<usize>,
+    /// The fused right-hand side, where one was given and compiled.
+    pub(crate) first_order: Option<FirstOrderFn>,
     /// Bytes of machine code (without alignment padding and the module's bookkeeping).
     pub(crate) code_bytes: usize,
     /// The module that owns the executable memory, freed on drop.
@@ -121,89 +141,45 @@ impl std::fmt::Debug for NativeCode {
     }
 }
 
-/// A finalised module's executable memory, freed when dropped (with the function pointers
-/// into it, which its owner holds beside it and never hands out).
-pub(crate) struct ModuleMemory(Mutex<Option<JITModule>>);
-
-impl ModuleMemory {
-    /// Takes `module`, its definitions finalised.
-    pub(crate) fn new(module: JITModule) -> Self {
-        Self(Mutex::new(Some(module)))
-    }
-}
-
-// SAFETY: after `finalize_definitions` the module is never used again except to free its
-// memory in `Drop`, which has exclusive access; the code in it is immutable and reentrant
-// (it reads only its arguments and writes only the buffers it is given), so calling it from
-// several threads at once is sound. The `Mutex` makes the module's own `Sync` moot.
-unsafe impl Send for ModuleMemory {}
-// SAFETY: as above.
-unsafe impl Sync for ModuleMemory {}
-
-impl Drop for ModuleMemory {
-    fn drop(&mut self) {
-        let module = match self.0.get_mut() {
-            Ok(m) => m.take(),
-            Err(poisoned) => poisoned.into_inner().take(),
-        };
-        if let Some(module) = module {
-            // SAFETY: the function pointers into this memory belong to the owner being
-            // dropped with it; nothing else holds them (they never leave the crate).
-            unsafe { module.free_memory() };
-        }
-    }
-}
-
-/// Which helper functions the code calls, by symbol name.
-const HELPERS: [(&str, Func); 13] = [
-    ("eomgen_sin", Func::Sin),
-    ("eomgen_cos", Func::Cos),
-    ("eomgen_tan", Func::Tan),
-    ("eomgen_asin", Func::Asin),
-    ("eomgen_acos", Func::Acos),
-    ("eomgen_atan", Func::Atan),
-    ("eomgen_sinh", Func::Sinh),
-    ("eomgen_cosh", Func::Cosh),
-    ("eomgen_tanh", Func::Tanh),
-    ("eomgen_exp", Func::Exp),
-    ("eomgen_ln", Func::Ln),
-    ("eomgen_sign", Func::Sign),
-    ("eomgen_step", Func::Step),
-];
-
-/// The helpers of [`crate::math`] declared as imports of a module.
-pub(crate) struct Imports {
-    pub(crate) unary: Vec<(Func, FuncId)>,
-    pub(crate) sin_cos: FuncId,
-    pub(crate) powf: FuncId,
-    pub(crate) atan2: FuncId,
-    fill_zero: FuncId,
-}
-
-/// Compiles `functions` (named for errors) into one module; an empty tape gets no code.
+/// Compiles `functions` (named for errors) into one module, an empty tape getting no code,
+/// and `first_order`, a fused right-hand side of a model of `n` degrees of freedom
+/// ([`FirstOrderFn`]; not compiled if it would need scratch space).
 ///
 /// # Errors
 /// [`CompileError`] naming the host or the function Cranelift could not handle.
-pub(crate) fn compile(functions: &[(&str, &FunctionTape)]) -> Result<NativeCode, CompileError> {
+pub(crate) fn compile(
+    functions: &[(&str, &FunctionTape)],
+    first_order: Option<(&FunctionTape, usize)>,
+) -> Result<NativeCode, CompileError> {
     let mut module = new_module()?;
     let imports = declare_imports(&mut module)?;
     let call_conv = module.isa().default_call_conv();
     let pointer = module.target_config().pointer_type();
-    let mut signature = Signature::new(call_conv);
-    for _ in 0..5 {
-        signature.params.push(AbiParam::new(pointer));
-    }
-    signature.params.push(AbiParam::new(types::F64));
-    for _ in 0..3 {
-        signature.params.push(AbiParam::new(pointer));
-    }
+    let signature = |layout: Layout| {
+        let mut signature = Signature::new(call_conv);
+        let (before, after) = match layout {
+            Layout::Model => (5, 3),
+            Layout::FirstOrder { .. } => (2, 2),
+        };
+        let pointers = |k: usize| (0..k).map(|_| AbiParam::new(pointer));
+        signature.params.extend(pointers(before));
+        signature.params.push(AbiParam::new(types::F64));
+        signature.params.extend(pointers(after));
+        signature
+    };
+    let first_order =
+        first_order.filter(|(f, _)| f.tape.instructions.len() <= SCRATCH_FROM_INSTRUCTIONS);
+    let all = functions
+        .iter()
+        .map(|&(name, f)| (name, f, Layout::Model))
+        .chain(first_order.map(|(f, n)| ("first_order_rhs", f, Layout::FirstOrder { n })));
 
     let mut context = module.make_context();
     let mut builder_context = FunctionBuilderContext::new();
     let mut ids: Vec<Option<FuncId>> = Vec::new();
     let mut scratch = Vec::new();
     let mut code_bytes = 0usize;
-    for (index, &(name, function)) in functions.iter().enumerate() {
+    for (index, (name, function, layout)) in all.enumerate() {
         if function.tape.outputs.is_empty() {
             ids.push(None);
             scratch.push(0);
@@ -214,9 +190,9 @@ pub(crate) fn compile(functions: &[(&str, &FunctionTape)]) -> Result<NativeCode,
             .validate()
             .map_err(|reason| failure(name, &reason))?;
         let id = module
-            .declare_function(name, Linkage::Local, &signature)
+            .declare_function(name, Linkage::Local, &signature(layout))
             .map_err(|e| failure(name, &e))?;
-        context.func.signature = signature.clone();
+        context.func.signature = signature(layout);
         context.func.name = UserFuncName::user(0, index as u32);
         scratch.push(build(
             &mut module,
@@ -224,6 +200,7 @@ pub(crate) fn compile(functions: &[(&str, &FunctionTape)]) -> Result<NativeCode,
             &mut builder_context,
             function,
             &imports,
+            layout,
         ));
         if std::env::var_os("EOMGEN_JIT_DISASM").is_some() {
             context.set_disasm(true);
@@ -248,6 +225,12 @@ pub(crate) fn compile(functions: &[(&str, &FunctionTape)]) -> Result<NativeCode,
         .map_err(|e| CompileError::Finalize {
             reason: e.to_string(),
         })?;
+    // The fused right-hand side, if compiled, is the last.
+    let fused = match first_order {
+        Some(_) => ids.pop().flatten(),
+        None => None,
+    };
+    scratch.truncate(functions.len());
     let functions = ids
         .iter()
         .map(|id| {
@@ -259,104 +242,18 @@ pub(crate) fn compile(functions: &[(&str, &FunctionTape)]) -> Result<NativeCode,
             })
         })
         .collect();
+    let first_order = fused.map(|id| {
+        let address = module.get_finalized_function(id);
+        // SAFETY: as above, with the signature of `FirstOrderFn` (`Layout::FirstOrder`).
+        unsafe { std::mem::transmute::<*const u8, FirstOrderFn>(address) }
+    });
     Ok(NativeCode {
         functions,
+        first_order,
         scratch,
         code_bytes,
         _memory: ModuleMemory::new(module),
     })
-}
-
-/// A JIT module for the host, optimising for speed, that resolves the helpers of
-/// [`crate::math`] by their symbol names.
-///
-/// # Errors
-/// [`CompileError::UnsupportedHost`] when Cranelift has no code generator for the host.
-pub(crate) fn new_module() -> Result<JITModule, CompileError> {
-    let mut flags = settings::builder();
-    let set = |flags: &mut settings::Builder, name: &str, value: &str| {
-        flags
-            .set(name, value)
-            .map_err(|e| CompileError::UnsupportedHost {
-                reason: format!("setting {name}={value}: {e}"),
-            })
-    };
-    set(&mut flags, "opt_level", "speed")?;
-    set(&mut flags, "use_colocated_libcalls", "false")?;
-    set(&mut flags, "is_pic", "false")?;
-    // The tapes are built correct by construction; the verifier doubles compile time.
-    set(
-        &mut flags,
-        "enable_verifier",
-        if cfg!(debug_assertions) {
-            "true"
-        } else {
-            "false"
-        },
-    )?;
-    let isa = cranelift_native::builder()
-        .map_err(|reason| CompileError::UnsupportedHost {
-            reason: reason.to_string(),
-        })?
-        .finish(settings::Flags::new(flags))
-        .map_err(|e| CompileError::UnsupportedHost {
-            reason: e.to_string(),
-        })?;
-    let mut builder = JITBuilder::with_isa(isa, default_libcall_names());
-    for (name, f) in HELPERS {
-        builder.symbol(name, math::unary(f) as *const u8);
-    }
-    builder.symbol("eomgen_sin_cos", math::sin_cos as *const u8);
-    builder.symbol("eomgen_powf", math::powf as *const u8);
-    builder.symbol("eomgen_atan2", math::atan2 as *const u8);
-    builder.symbol("eomgen_fill_zero", math::fill_zero as *const u8);
-    Ok(JITModule::new(builder))
-}
-
-/// What a failure of Cranelift on `function` is.
-pub(crate) fn failure(function: &str, e: &dyn std::fmt::Display) -> CompileError {
-    CompileError::Function {
-        function: function.to_string(),
-        reason: e.to_string(),
-    }
-}
-
-/// Declares the helpers the code calls as imports of `module`.
-///
-/// # Errors
-/// [`CompileError::Function`] naming the helper Cranelift could not declare.
-pub(crate) fn declare_imports(module: &mut JITModule) -> Result<Imports, CompileError> {
-    let call_conv = module.isa().default_call_conv();
-    let float_signature = |args: usize, returns: usize| {
-        let mut s = Signature::new(call_conv);
-        s.params
-            .extend((0..args).map(|_| AbiParam::new(types::F64)));
-        s.returns
-            .extend((0..returns).map(|_| AbiParam::new(types::F64)));
-        s
-    };
-    let declare = |module: &mut JITModule, name: &str, signature: &Signature| {
-        module
-            .declare_function(name, Linkage::Import, signature)
-            .map_err(|e| failure(name, &e))
-    };
-    let mut unary = Vec::new();
-    for (name, f) in HELPERS {
-        unary.push((f, declare(module, name, &float_signature(1, 1))?));
-    }
-    let pointer = module.target_config().pointer_type();
-    let mut fill_signature = Signature::new(call_conv);
-    fill_signature.params.push(AbiParam::new(pointer));
-    fill_signature.params.push(AbiParam::new(pointer));
-    let imports = Imports {
-        unary,
-        sin_cos: declare(module, "eomgen_sin_cos", &float_signature(1, 2))?,
-        powf: declare(module, "eomgen_powf", &float_signature(2, 1))?,
-        atan2: declare(module, "eomgen_atan2", &float_signature(2, 1))?,
-        fill_zero: declare(module, "eomgen_fill_zero", &fill_signature)?,
-    };
-
-    Ok(imports)
 }
 
 /// The function's arguments as Cranelift values.
@@ -364,6 +261,9 @@ struct Arguments {
     parameters: ir::Value,
     q: ir::Value,
     qdot: ir::Value,
+    /// Bytes from `qdot` to `q̇₀` (`8n` in a [`Layout::FirstOrder`] function, whose `qdot` is
+    /// `y`).
+    qdot_offset: i32,
     acceleration: ir::Value,
     lambda: ir::Value,
     t: ir::Value,
@@ -414,18 +314,21 @@ impl Values {
         {
             return value;
         }
-        let (base, i) = match input {
-            Input::Parameter(i) => (arguments.parameters, i),
-            Input::Coordinate(i) => (arguments.q, i),
-            Input::Velocity(i) => (arguments.qdot, i),
-            Input::Acceleration(i) => (arguments.acceleration, i),
-            Input::Multiplier(i) => (arguments.lambda, i),
+        let (base, offset, i) = match input {
+            Input::Parameter(i) => (arguments.parameters, 0, i),
+            Input::Coordinate(i) => (arguments.q, 0, i),
+            Input::Velocity(i) => (arguments.qdot, arguments.qdot_offset, i),
+            Input::Acceleration(i) => (arguments.acceleration, 0, i),
+            Input::Multiplier(i) => (arguments.lambda, 0, i),
             Input::Time => return arguments.t,
         };
         // Inputs are aligned, in bounds (the caller's contract) and never alias the outputs.
-        let value = b
-            .ins()
-            .load(types::F64, MemFlagsData::trusted(), base, (i as i32) * 8);
+        let value = b.ins().load(
+            types::F64,
+            MemFlagsData::trusted(),
+            base,
+            offset + (i as i32) * 8,
+        );
         self.loaded[x] = Some((self.calls, value));
         value
     }
@@ -452,30 +355,56 @@ fn build(
     builder_context: &mut FunctionBuilderContext,
     function: &FunctionTape,
     imports: &Imports,
+    layout: Layout,
 ) -> usize {
     let mut b = FunctionBuilder::new(func, builder_context);
     let params = enter(&mut b);
-    let arguments = Arguments {
-        parameters: params[0],
-        q: params[1],
-        qdot: params[2],
-        acceleration: params[3],
-        lambda: params[4],
-        t: params[5],
+    let (arguments, out0, out1, scratch_buffer) = match layout {
+        Layout::Model => (
+            Arguments {
+                parameters: params[0],
+                q: params[1],
+                qdot: params[2],
+                qdot_offset: 0,
+                acceleration: params[3],
+                lambda: params[4],
+                t: params[5],
+            },
+            params[6],
+            params[7],
+            Some(params[8]),
+        ),
+        // The tape reads no accelerations or multipliers (its extent is checked before its
+        // call): `y` stands in for their buffers.
+        Layout::FirstOrder { n } => (
+            Arguments {
+                parameters: params[0],
+                q: params[1],
+                qdot: params[1],
+                qdot_offset: (8 * n) as i32,
+                acceleration: params[1],
+                lambda: params[1],
+                t: params[2],
+            },
+            params[3],
+            params[4],
+            None,
+        ),
     };
     let tape = &function.tape;
     let outputs = OutputBuffers {
-        out0: params[6],
-        out1: params[7],
+        out0,
+        out1,
         split: function.split.min(tape.outputs.len()),
     };
     let count = tape.instructions.len();
     let filled = fill_zero_runs(&mut b, module, imports, tape, &outputs);
-    let (scratch, slots_used) = if count > SCRATCH_FROM_INSTRUCTIONS {
-        let (slots, used) = scratch_slots(tape);
-        (Some((params[8], slots)), used)
-    } else {
-        (None, 0)
+    let (scratch, slots_used) = match scratch_buffer {
+        Some(buffer) if count > SCRATCH_FROM_INSTRUCTIONS => {
+            let (slots, used) = scratch_slots(tape);
+            (Some((buffer, slots)), used)
+        }
+        _ => (None, 0),
     };
     // In a large function each output is stored as soon as it is computed (kept to the end,
     // every output would live through the rest of the function).
@@ -544,7 +473,7 @@ impl OutputBuffers {
 }
 
 /// Writes the long runs of zero outputs ([`zero_runs`]) first, one call of
-/// [`math::fill_zero`] each; returns `filled`, where `filled[j]` says output `j` is written.
+/// [`crate::math::fill_zero`] each; returns `filled`, where `filled[j]` says output `j` is written.
 fn fill_zero_runs(
     b: &mut FunctionBuilder,
     module: &mut JITModule,
@@ -962,8 +891,10 @@ mod tests {
             (&lone_cosine, "sin_cos"),
             (&missing_output, "instructions"),
         ] {
-            let Err(error) = compile(&[("kinetic_energy", &good), ("potential_energy", bad)])
-            else {
+            let Err(error) = compile(
+                &[("kinetic_energy", &good), ("potential_energy", bad)],
+                None,
+            ) else {
                 panic!("a malformed tape does not compile");
             };
             let CompileError::Function { function, reason } = &error else {
@@ -973,7 +904,7 @@ mod tests {
             assert!(reason.contains(what), "{reason}");
             assert!(error.to_string().contains("`potential_energy`"), "{error}");
         }
-        let code = compile(&[("kinetic_energy", &good)]).expect("a good tape compiles");
+        let code = compile(&[("kinetic_energy", &good)], None).expect("a good tape compiles");
         let f = code.functions[0].expect("compiled");
         let (q, mut out) = ([3.0], [0.0]);
         // SAFETY: the tape reads q[0] and writes out[0].
