@@ -49,6 +49,9 @@
 //! that the interpreter's `order_zero_in_place` uses (the same bits); the inputs `q`, `q̇`,
 //! `t` are read from their slots, where the caller has written them.
 //!
+//! With the environment variable `EOMGEN_JIT_DISASM` set, each order's machine code is
+//! printed to standard error as it is compiled, as [`crate::native`] prints the model's.
+//!
 //! # Memory
 //! As for [`crate::native`]: the module owning the code lives in [`NativeOrders`] and is freed
 //! with it.
@@ -209,9 +212,16 @@ pub(crate) fn compile_orders(
             solve_signature.clone(),
             module.target_config(),
         );
+        let disassemble = std::env::var_os("EOMGEN_JIT_DISASM").is_some();
+        context.set_disasm(disassemble);
         module
             .define_function(id, &mut context)
             .map_err(|e| failure(&name, &e))?;
+        if let Some(vcode) = context.compiled_code().and_then(|c| c.vcode.as_ref())
+            && disassemble
+        {
+            eprintln!("== {name}\n{vcode}");
+        }
         module.clear_context(&mut context);
         ids.push(id);
     }
