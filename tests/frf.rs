@@ -805,3 +805,50 @@ fn follower_load_modes_beside_a_stiff_mode_and_under_flutter() {
         assert!(err.contains("no real normal modes"), "{args:?}: {err}");
     }
 }
+
+/// A report names the projector the modes were taken with: `ψ_kᵀb` and `Ĉ = ΨᵀCΨ` for the
+/// `M`-orthonormal modes of a symmetric `K`, `(Ψ⁻¹M⁻¹b)_k` and `Ĉ = Ψ⁻¹M⁻¹CΨ` for the modes
+/// of Ziegler's pendulum under a follower load below flutter (P = 1), which are not
+/// `M`-orthogonal (the left eigenvectors project). Its undamped modes have ζ = 0, not −0.
+#[test]
+fn modal_reports_name_the_projector_of_their_modes() {
+    let ziegler = format!(
+        "{}/tests/fixtures/ziegler_pendulum.yaml",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    for (model, set, input, force, c_hat) in [
+        (ziegler.as_str(), "P=1", "a", "(Ψ⁻¹M⁻¹b)_k", "Ĉ = Ψ⁻¹M⁻¹CΨ"),
+        ("three_masses_forced", "c=0.1", "A", "ψ_kᵀb", "Ĉ = ΨᵀCΨ"),
+    ] {
+        let frf = eomgen(&[
+            "frf",
+            model,
+            "--input",
+            input,
+            "--modal",
+            "--set",
+            set,
+            "--frequency",
+            "1",
+        ]);
+        let text = String::from_utf8_lossy(&frf.stdout);
+        assert!(
+            frf.status.success(),
+            "{model}: {}",
+            String::from_utf8_lossy(&frf.stderr)
+        );
+        assert!(text.contains(force), "{model}: {text}");
+        assert!(
+            !text.contains("-0.0000 "),
+            "{model}: a signed zero ζ: {text}"
+        );
+        let study = eomgen(&["study", "modal-damping", model, "--set", set]);
+        let text = String::from_utf8_lossy(&study.stdout);
+        assert!(
+            study.status.success(),
+            "{model}: {}",
+            String::from_utf8_lossy(&study.stderr)
+        );
+        assert!(text.contains(c_hat), "{model}: {text}");
+    }
+}

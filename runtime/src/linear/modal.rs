@@ -891,6 +891,24 @@ impl NormalModes {
         }
         Ok(())
     }
+
+    /// Whether the mode shapes are `M`-orthonormal (`ΨᵀMΨ = I`): those of a symmetric `K`.
+    /// The modes of a non-symmetric `K` (follower loads; lecture 22) are not, and a force is
+    /// taken to modal forces by `Ψ⁻¹M⁻¹` (the left eigenvectors) instead of `Ψᵀ`.
+    pub fn m_orthogonal(&self) -> bool {
+        self.stiffness_asymmetry <= STIFFNESS_ASYMMETRY
+    }
+
+    /// The matrix that takes a force to modal forces, as text for reports: `Ψᵀ`, or `Ψ⁻¹M⁻¹`
+    /// where the modes are not [`Self::m_orthogonal`]. The modal damping matrix is this
+    /// times `CΨ`.
+    pub fn projector_label(&self) -> &'static str {
+        if self.m_orthogonal() {
+            "Ψᵀ"
+        } else {
+            "Ψ⁻¹M⁻¹"
+        }
+    }
 }
 
 /// `K` is symmetric to rounding below this asymmetry ([`Linearization::stiffness_asymmetry`]).

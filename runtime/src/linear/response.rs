@@ -906,7 +906,7 @@ fn modal_initial_values(
 /// `Ψᵀ` where `Ψ` or `M` cannot be inverted.
 pub(crate) fn modal_projector(lin: &Linearization, modes: &NormalModes) -> DMatrix<f64> {
     let psi = &modes.mode_shapes;
-    if lin.stiffness_asymmetry() > 1e-12
+    if !modes.m_orthogonal()
         && let (Some(psi_inv), Some(chol)) = (
             psi.clone().try_inverse(),
             lin.mass_matrix.clone().cholesky(),
@@ -1080,7 +1080,9 @@ pub fn modal_damping(lin: &Linearization, modes: &NormalModes) -> ModalDamping {
     for k in 0..n {
         let w = modes.natural_frequencies[k];
         if modes.kinds[k] == ModeKind::Oscillatory && w > 0.0 {
-            let zeta = c_hat[(k, k)] / (2.0 * w);
+            // `+ 0.0`: an undamped mode's `Ĉ_kk` can be −0 (a sum of −0 products), and its
+            // ratio is 0, not −0.
+            let zeta = c_hat[(k, k)] / (2.0 * w) + 0.0;
             damping_ratios.push(Some(zeta));
             damped_frequencies.push((zeta.abs() < 1.0).then(|| w * (1.0 - zeta * zeta).sqrt()));
         } else {

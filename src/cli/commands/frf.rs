@@ -10,7 +10,9 @@ use eomgen::analysis::vibration::{
     self, FrfAnalysis, FrfAnalysisError, FrfOptions, FrfOutput, FrfSimulationOptions,
     FrfSimulationPlan, SimulatedPoint, max_simulation_error,
 };
-use eomgen::{FrequencySweep, FrfError, ModalResponse, ModelInfo, PeakAmplitude, phase_degrees};
+use eomgen::{
+    FrequencySweep, FrfError, ModalResponse, ModelInfo, NormalModes, PeakAmplitude, phase_degrees,
+};
 use nalgebra::Complex;
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -363,7 +365,8 @@ fn print_report(
     if !gyroscopic && damping.coupling > 1e-12 {
         let _ = writeln!(
             out,
-            "note       ΨᵀCΨ is not diagonal (off-diagonal {:.2e} of the diagonal): the modal sum drops the coupling",
+            "note       {}CΨ is not diagonal (off-diagonal {:.2e} of the diagonal): the modal sum drops the coupling",
+            modes.projector_label(),
             num(damping.coupling)
         );
     }
@@ -442,13 +445,7 @@ fn write_evaluations(out: &mut impl std::io::Write, args: &FrfArgs, frf: &FrfAna
             }
         }
         if let Some(r) = &e.modal {
-            write_modal(
-                out,
-                outputs,
-                &modes.natural_frequencies,
-                &damping.damping_ratios,
-                r,
-            );
+            write_modal(out, outputs, modes, &damping.damping_ratios, r);
             // As the JSON has it: a non-finite difference is no number.
             if let Some(diff) = e.modal_difference.filter(|d| d.is_finite()) {
                 let _ = writeln!(
@@ -515,10 +512,17 @@ fn polar(z: Complex<f64>) -> String {
 fn write_modal(
     out: &mut impl std::io::Write,
     outputs: &[FrfOutput],
-    natural_frequencies: &[f64],
+    modes: &NormalModes,
     damping_ratios: &[Option<f64>],
     r: &ModalResponse,
 ) {
+    let natural_frequencies = &modes.natural_frequencies;
+    // Row k of the projector times b.
+    let modal_force = if modes.m_orthogonal() {
+        "ψ_kᵀb".to_string()
+    } else {
+        format!("({}b)_k", modes.projector_label())
+    };
     let header: Vec<String> = outputs
         .iter()
         .map(|o| format!("{:>34}", format!("contribution to {}", o.name)))
@@ -529,7 +533,7 @@ fn write_modal(
         "mode",
         "ω_k",
         "ζ_k",
-        "ψ_kᵀb",
+        modal_force,
         "η_k per unit input",
         header.join("  ")
     );

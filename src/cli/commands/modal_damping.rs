@@ -153,6 +153,7 @@ fn print_report(
         modes: per_mode,
         t_end,
         releases: cases,
+        normal_modes,
         ..
     } = study;
     let label = &point.name;
@@ -166,7 +167,8 @@ fn print_report(
     );
     let _ = writeln!(
         stdout,
-        "Ĉ = ΨᵀCΨ  off-diagonal coupling max|Ĉᵢⱼ|/max|Ĉₖₖ| = {:.4e}{}",
+        "Ĉ = {}CΨ  off-diagonal coupling max|Ĉᵢⱼ|/max|Ĉₖₖ| = {:.4e}{}",
+        normal_modes.projector_label(),
         num(approx.coupling),
         if approx.coupling == 0.0 {
             " (diagonal: the modal approximation is exact)"
