@@ -578,3 +578,27 @@ fn expm_bounds_are_never_vacuous() {
     );
     assert!(!study.passed());
 }
+
+/// Under a follower load `K` is not symmetric, and Rayleigh's principle does not hold: on
+/// Ziegler's pendulum at P = 1 the quotient of the shape (1, 1) of `K`'s symmetric part is
+/// 0.1667 against the system's ω₁² = 0.2192, which the study reported as a failed bound with
+/// a stationarity table. It is refused, naming the asymmetry, and nothing is printed on
+/// standard output.
+#[test]
+fn a_rayleigh_study_refuses_a_non_symmetric_stiffness() {
+    let ziegler = format!(
+        "{}/tests/fixtures/ziegler_pendulum.yaml",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let out = eomgen(&[
+        "study", "rayleigh", &ziegler, "--set", "P=1", "--shape", "1,1",
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(err.contains("not symmetric"), "{err}");
+    assert!(
+        out.stdout.is_empty(),
+        "{}",
+        String::from_utf8_lossy(&out.stdout)
+    );
+}

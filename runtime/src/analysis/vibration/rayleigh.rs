@@ -82,6 +82,15 @@ pub enum RayleighError {
         /// The model.
         model: String,
     },
+    /// `K` is not symmetric (a follower load): Rayleigh's quotient bounds and is stationary at
+    /// the frequencies of a symmetric `K` only, and those of `M⁻¹K` are not its extrema.
+    #[error(
+        "the stiffness matrix is not symmetric here (max |K − Kᵀ| / max |K| = {asymmetry:.2e}: a follower load), and Rayleigh's quotient vᵀKv/vᵀMv bounds the natural frequencies of a symmetric K only; `modes` gives this system's frequencies"
+    )]
+    NonSymmetricStiffness {
+        /// `‖K − Kᵀ‖_max / ‖K‖_max`.
+        asymmetry: f64,
+    },
     /// The equilibrium is unstable (`ω² < 0` for some mode): `R` still bounds the lowest
     /// `ω²` from above, but `√R` is no frequency to compare.
     #[error(
@@ -297,7 +306,8 @@ const SAME_FREQUENCY: f64 = 1e-9;
 ///
 /// Zero-frequency modes (a free structure's rigid-body motions) are projected out of `v`
 /// (`M`-orthogonally, with the mass-normalised shapes) before the quotient is taken, and `ω₁`
-/// is then the lowest non-zero frequency. `K` is symmetrised as [`normal_modes`] takes it.
+/// is then the lowest non-zero frequency. `K` is symmetrised as [`normal_modes`] takes it
+/// where it is symmetric to rounding; a `K` that is not (a follower load) is refused.
 ///
 /// [`normal_modes`]: crate::linear::modal::normal_modes
 ///
@@ -305,7 +315,8 @@ const SAME_FREQUENCY: f64 = 1e-9;
 /// [`RayleighError::OperatingPoint`], [`RayleighError::Constrained`],
 /// [`RayleighError::DimensionMismatch`], [`RayleighError::NonFinite`],
 /// [`RayleighError::ZeroShape`], [`RayleighError::OnlyZeroModes`],
-/// [`RayleighError::NoOscillatoryMode`], [`RayleighError::Unstable`].
+/// [`RayleighError::NoOscillatoryMode`], [`RayleighError::Unstable`],
+/// [`RayleighError::NonSymmetricStiffness`].
 ///
 /// # Examples
 /// Three equal masses (`three_masses`, `m = k = 1`): the uniform shape `(1, 1, 1)` gives
@@ -360,6 +371,11 @@ pub fn rayleigh_study(
         });
     }
     let modes = &modal.normal_modes;
+    if !modes.m_orthogonal() {
+        return Err(RayleighError::NonSymmetricStiffness {
+            asymmetry: modes.stiffness_asymmetry,
+        });
+    }
     if let Some((k, _)) = modes
         .kinds
         .iter()
