@@ -92,6 +92,7 @@ pub fn equations(
 ) -> Result<Equations, ListingError> {
     let file = eomgen_symbolic::model::load(path, text).map_err(ListingError::Diagnostics)?;
     let mut model = SymbolicModel::from_file(&file).map_err(ListingError::Diagnostics)?;
+    eomgen_symbolic::mechanics::limit_derivation(&mut model);
     let eom = match derivation {
         Derivation::Lagrange => Lagrange.derive(&mut model),
         Derivation::Momentum => {
@@ -103,6 +104,8 @@ pub fn equations(
             MomentumBalance.derive(&mut model)
         }
     };
+    eomgen_symbolic::mechanics::finish_derivation(&mut model, &file)
+        .map_err(ListingError::Diagnostics)?;
     Ok(Equations {
         model: model.name.clone(),
         method: derivation.name(),

@@ -46,13 +46,16 @@ pub enum GenerateError {
 /// ([`crate::mechanics::preferred_equations`]) and the mass-matrix diagnostics.
 ///
 /// # Errors
-/// [`GenerateError::Diagnostics`] for a model that cannot be lowered or whose mass matrix is
-/// singular ([`crate::mechanics::mass_matrix_diagnostics`]).
+/// [`GenerateError::Diagnostics`] for a model that cannot be lowered, whose derivation grows
+/// past [`crate::mechanics::DERIVATION_OPERAND_LIMIT`] or whose mass matrix is singular
+/// ([`crate::mechanics::mass_matrix_diagnostics`]).
 fn derive(
     file: &crate::model::ModelFile,
 ) -> Result<(SymbolicModel, EquationsOfMotion), GenerateError> {
     let mut model = SymbolicModel::from_file(file).map_err(GenerateError::Diagnostics)?;
+    crate::mechanics::limit_derivation(&mut model);
     let (eom, _) = crate::mechanics::preferred_equations(&mut model);
+    crate::mechanics::finish_derivation(&mut model, file).map_err(GenerateError::Diagnostics)?;
     let problems = crate::mechanics::mass_matrix_diagnostics(&model, &eom, file);
     if !problems.is_empty() {
         return Err(GenerateError::Diagnostics(problems));

@@ -357,6 +357,11 @@ pub struct ExprArena {
     /// the numbers written in the operation alone fail (a located error) or only a rewrite
     /// would have.
     fold_error: std::cell::Cell<Option<FoldError>>,
+    /// The operands of every node created (a node of `k` children counts `k`): the size of
+    /// what the arena holds, and the measure [`Self::limit_operands`] bounds.
+    operands: u64,
+    /// See [`Self::limit_operands`].
+    operand_limit: Option<u64>,
 }
 
 impl ExprArena {
@@ -373,6 +378,29 @@ impl ExprArena {
     /// Whether the arena has no nodes.
     pub fn is_empty(&self) -> bool {
         self.nodes.is_empty()
+    }
+
+    /// Bounds a derivation that would not end in reasonable time and memory (a chain of 3-D
+    /// frames nested many levels deep in relative rotations grows about 15× per level): once
+    /// the nodes created hold more than `limit` operands in all ([`Self::operands`]), every
+    /// sum built is 0, so the derivation runs to its end quickly, and [`Self::over_limit`] is
+    /// true. Its expressions are then meaningless: the caller reports the limit instead of
+    /// using them. `None` lifts the limit (the arena's default); the limit does not undo
+    /// what was built.
+    pub fn limit_operands(&mut self, limit: Option<u64>) {
+        self.operand_limit = limit;
+    }
+
+    /// Whether the limit of [`Self::limit_operands`] was passed, and the arena's expressions
+    /// since are not to be used.
+    pub fn over_limit(&self) -> bool {
+        self.operand_limit
+            .is_some_and(|limit| self.operands > limit)
+    }
+
+    /// The operands of every node created so far (a node of `k` children counts `k`).
+    pub fn operands(&self) -> u64 {
+        self.operands
     }
 
     /// Why folding constants failed since the last call, if it did (and clears it): a
@@ -494,6 +522,7 @@ impl ExprArena {
             return id;
         }
         let node = &self.nodes[index];
+        self.operands += node.children().len() as u64;
         debug_assert!(
             node.children().iter().all(|c| *c < id),
             "children must precede parents"
@@ -636,6 +665,9 @@ impl ExprArena {
 
     /// [`Self::sum`] without the memo.
     fn sum_uncached(&mut self, terms: &[ExprId]) -> ExprId {
+        if self.over_limit() {
+            return self.int(0);
+        }
         let mut constant = Constant::ZERO;
         let mut flat: Vec<ExprId> = Vec::with_capacity(terms.len());
         self.flatten_sum(terms, &mut flat);

@@ -446,16 +446,21 @@ fn timed(
 /// ([`CheckReport::states`]); a report that compared no state does not pass.
 ///
 /// # Errors
-/// The diagnostics of a model that does not lower.
+/// The diagnostics of a model that does not lower, or whose derivations grow past
+/// [`super::DERIVATION_OPERAND_LIMIT`].
 pub fn check_model(
     file: &ModelFile,
     states: usize,
     seed: u64,
 ) -> Result<CheckReport, Vec<Diagnostic>> {
     let mut model = SymbolicModel::from_file(file)?;
+    super::limit_derivation(&mut model);
     let n = model.num_dofs();
     let mut notes = Vec::new();
     let (lagrange, lagrange_stats) = timed(&mut model, &Lagrange, Lagrange.name());
+    if model.arena.over_limit() {
+        super::finish_derivation(&mut model, file)?;
+    }
     let problems = super::mass_matrix_diagnostics(&model, &lagrange, file);
     if !problems.is_empty() {
         return Err(problems);
@@ -508,6 +513,7 @@ pub fn check_model(
             balance_set_of.push(None);
         }
     }
+    super::finish_derivation(&mut model, file)?;
     let symbolic_equal: Vec<Option<bool>> = others
         .iter()
         .map(|(name, b)| {

@@ -11,6 +11,7 @@ pub mod cross_check;
 mod energy;
 pub mod frames;
 mod lagrange;
+mod limit;
 mod lower;
 mod mass;
 mod momentum;
@@ -20,6 +21,7 @@ pub use balances::{HandEquations, UserBalances};
 pub use constraints::{ConstraintEquations, linear_in_rates, redundant_rows};
 pub use energy::{EnergyRate, PowerRoute, energy_routes_skipped};
 pub use lagrange::Lagrange;
+pub use limit::{DERIVATION_OPERAND_LIMIT, finish_derivation, limit_derivation};
 pub use lower::{
     BalanceInfo, BalanceSet, BodyInfo, Equilibrium, EventInfo, LoadInfo, ParameterInfo,
     SpatialBody, SymbolicModel,

@@ -380,7 +380,9 @@ pub fn reduce(
     // The compilers' own check of the mass matrix (at the start, and everywhere), so that
     // the file written is one they compile.
     let mut model = crate::mechanics::SymbolicModel::from_file(&reduced).map_err(invalid)?;
+    crate::mechanics::limit_derivation(&mut model);
     let (eom, _) = crate::mechanics::preferred_equations(&mut model);
+    crate::mechanics::finish_derivation(&mut model, &reduced).map_err(invalid)?;
     let problems = crate::mechanics::mass_matrix_diagnostics(&model, &eom, &reduced);
     if !problems.is_empty() {
         return Err(invalid(problems));
