@@ -58,7 +58,8 @@ pub struct FrfArgs {
     #[arg(long = "frequency", value_name = "W")]
     pub frequencies: Vec<String>,
     /// The response assembled mode by mode, `Σ ψ_k ψ_kᵀ b / (ω_k² − ω² + 2iζ_k ω_k ω)`, with
-    /// each mode's contribution, at the `--frequency` values (default: the damped peaks).
+    /// each mode's contribution, at the `--frequency` values (default: the damped peaks); for
+    /// the modes of a non-symmetric K (a follower load) `ψ_kᵀ b` is row k of `Ψ⁻¹M⁻¹b`.
     #[arg(long)]
     pub modal: bool,
     /// Check K frequencies of the curve (log-spaced over the range) by simulating the full

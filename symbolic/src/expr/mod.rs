@@ -383,8 +383,8 @@ impl ExprArena {
     /// Bounds a derivation that would not end in reasonable time and memory (a chain of 3-D
     /// frames nested many levels deep in relative rotations grows about 15× per level): once
     /// the nodes created hold more than `limit` operands in all ([`Self::operands`]), every
-    /// sum built is 0, so the derivation runs to its end quickly, and [`Self::over_limit`] is
-    /// true. Its expressions are then meaningless: the caller reports the limit instead of
+    /// sum and product built is 0, so the derivation runs to its end quickly, and
+    /// [`Self::over_limit`] is true. Its expressions are then meaningless: the caller reports the limit instead of
     /// using them. `None` lifts the limit (the arena's default); the limit does not undo
     /// what was built.
     pub fn limit_operands(&mut self, limit: Option<u64>) {
@@ -1040,6 +1040,9 @@ impl ExprArena {
 
     /// Canonical product of `factors`.
     pub fn product(&mut self, factors: &[ExprId]) -> ExprId {
+        if self.over_limit() {
+            return self.int(0);
+        }
         // (base, exponent (`None` for 1), the factor itself)
         let mut powers: Vec<(ExprId, Option<ExprId>, ExprId)> =
             Vec::with_capacity(factors.len() + 2);

@@ -415,13 +415,21 @@ fn initial_constraints(model: &SymbolicModel) -> Option<InitialConstraints> {
     worst
 }
 
+///
+/// Each derivation may build [`super::DERIVATION_OPERAND_LIMIT`] operands.
+///
+/// # Errors
+/// The located error of a derivation past that limit ([`super::finish_derivation`]).
 fn timed(
     model: &mut SymbolicModel,
     f: &dyn Formulation,
     name: &str,
-) -> (EquationsOfMotion, DerivationStats) {
+    file: &ModelFile,
+) -> Result<(EquationsOfMotion, DerivationStats), Vec<Diagnostic>> {
     let start = Instant::now();
+    super::limit_derivation(model);
     let eom = f.derive(model);
+    super::finish_derivation(model, file)?;
     let time_s = start.elapsed().as_secs_f64();
     let roots: Vec<ExprId> = eom
         .mass_matrix
@@ -435,7 +443,7 @@ fn timed(
         ops: model.arena.tree_operation_count(&roots),
         ops_after_cse: cse::operation_count(&model.arena, &roots),
     };
-    (eom, stats)
+    Ok((eom, stats))
 }
 
 /// Derives `file` by every applicable formulation and cross-checks them at `states` random
@@ -446,7 +454,7 @@ fn timed(
 /// ([`CheckReport::states`]); a report that compared no state does not pass.
 ///
 /// # Errors
-/// The diagnostics of a model that does not lower, or whose derivations grow past
+/// The diagnostics of a model that does not lower, or one of whose derivations grows past
 /// [`super::DERIVATION_OPERAND_LIMIT`].
 pub fn check_model(
     file: &ModelFile,
@@ -454,13 +462,9 @@ pub fn check_model(
     seed: u64,
 ) -> Result<CheckReport, Vec<Diagnostic>> {
     let mut model = SymbolicModel::from_file(file)?;
-    super::limit_derivation(&mut model);
     let n = model.num_dofs();
     let mut notes = Vec::new();
-    let (lagrange, lagrange_stats) = timed(&mut model, &Lagrange, Lagrange.name());
-    if model.arena.over_limit() {
-        super::finish_derivation(&mut model, file)?;
-    }
+    let (lagrange, lagrange_stats) = timed(&mut model, &Lagrange, Lagrange.name(), file)?;
     let problems = super::mass_matrix_diagnostics(&model, &lagrange, file);
     if !problems.is_empty() {
         return Err(problems);
@@ -470,7 +474,7 @@ pub fn check_model(
     // The index in `model.balance_sets` of each of `others` that is a set of balances.
     let mut balance_set_of: Vec<Option<usize>> = Vec::new();
     if MomentumBalance::applies_to(&model) {
-        let (eom, stats) = timed(&mut model, &MomentumBalance, MomentumBalance.name());
+        let (eom, stats) = timed(&mut model, &MomentumBalance, MomentumBalance.name(), file)?;
         derivations.push(stats);
         others.push((MomentumBalance.name().to_string(), eom));
         balance_set_of.push(None);
@@ -485,14 +489,14 @@ pub fn check_model(
     if UserBalances::applies_to(&model) {
         for set in 0..model.balance_sets.len() {
             let name = model.balance_sets[set].name.clone();
-            let (eom, stats) = timed(&mut model, &UserBalances { set }, &name);
+            let (eom, stats) = timed(&mut model, &UserBalances { set }, &name, file)?;
             derivations.push(stats);
             others.push((name, eom));
             balance_set_of.push(Some(set));
         }
     }
     if HandEquations::applies_to(&model) {
-        let (eom, stats) = timed(&mut model, &HandEquations, HandEquations.name());
+        let (eom, stats) = timed(&mut model, &HandEquations, HandEquations.name(), file)?;
         derivations.push(stats);
         others.push((HandEquations.name().to_string(), eom));
         balance_set_of.push(None);
@@ -507,13 +511,12 @@ pub fn check_model(
             if route.name() == PowerRoute.name() && !PowerRoute::applies_to(&model) {
                 continue;
             }
-            let (eom, stats) = timed(&mut model, route, route.name());
+            let (eom, stats) = timed(&mut model, route, route.name(), file)?;
             derivations.push(stats);
             others.push((route.name().to_string(), eom));
             balance_set_of.push(None);
         }
     }
-    super::finish_derivation(&mut model, file)?;
     let symbolic_equal: Vec<Option<bool>> = others
         .iter()
         .map(|(name, b)| {

@@ -2,27 +2,36 @@
 //! not end in reasonable time and memory.
 //!
 //! The equations of a chain of 3-D frames each turning relative to a turning parent grow
-//! about 15× per level: `check` of such a chain took 0.4, 2.2 and 24 s (29, 122 and 427 MB)
-//! for 6, 7 and 8 levels, and a 10-level chain did not end (2026-11-26; frames with their
-//! angles relative to `N` grow far more slowly). The limit is 3.4 times what the largest
-//! models that end build in `check`: three bodies in relative z-x-z rotations, 11 million
-//! operands in 4.8 s, and the 100-link planar pendulum of `eomgen new`, 4.7 million in
-//! 1.7 s. With it `check` of the 8-level chain stops after 9.7 s (239 MB) and of a 10-level
-//! one after 12.6 s; `simulate`, which derives by momentum balance alone, still runs the
-//! 8-level chain (18.8 s) and stops the 10-level one after 10.7 s. The growth itself is
-//! the subject of another issue; this bounds it.
+//! steeply with each nested rotation: `check` of a chain of single-axis hinges took 0.4, 2.2
+//! and 24 s (29, 122 and 427 MB) for 6, 7 and 8 of them, and a 10-hinge chain did not end
+//! (2026-11-26; frames with their angles relative to `N` grow far more slowly). Each
+//! derivation (Lagrange's, momentum balance, …) may build [`DERIVATION_OPERAND_LIMIT`]
+//! operands. The 8-hinge chain's Lagrange derivation builds 30 million and passes; three
+//! bodies in relative z-x-z rotations, 11 million in all of `check` with a symmetric
+//! inertia, passes, and with an asymmetric one (`I₁ ≠ I₂ ≠ I₃`) its Lagrange derivation is
+//! stopped after 22 s where `check` took 151 s before (its `simulate`, by momentum balance,
+//! still runs: 144 s, 1.2 GB, most of it in planning and compiling); the 10-hinge chain is
+//! stopped after 27 s (`check`) and 22 s (`simulate`), 430 MB. The 100-link planar pendulum
+//! of `eomgen new` builds 4.7 million (1.7 s). What comes after a derivation (the plans,
+//! the native code, the Jacobians that `modes` and the implicit methods derive when first
+//! used) is not bounded here. The growth itself is the subject of another issue.
 
 use super::SymbolicModel;
 use crate::model::{Diagnostic, ModelFile};
 
 /// The operands a model's derivations may build ([`crate::expr::ExprArena::limit_operands`]):
-/// about 200 MB of expressions.
-pub const DERIVATION_OPERAND_LIMIT: u64 = 16_000_000;
+/// about half a gigabyte of expressions, and about a minute of processor time for the
+/// models that reach it.
+pub const DERIVATION_OPERAND_LIMIT: u64 = 40_000_000;
 
-/// Bounds the derivations of `model` to [`DERIVATION_OPERAND_LIMIT`]; call
-/// [`finish_derivation`] once they are done.
+/// Bounds the derivation of `model` that starts now to [`DERIVATION_OPERAND_LIMIT`]
+/// operands more than the arena holds; call [`finish_derivation`] once it is done (before
+/// another is bounded).
 pub fn limit_derivation(model: &mut SymbolicModel) {
-    model.arena.limit_operands(Some(DERIVATION_OPERAND_LIMIT));
+    let now = model.arena.operands();
+    model
+        .arena
+        .limit_operands(Some(now.saturating_add(DERIVATION_OPERAND_LIMIT)));
 }
 
 /// After the derivations begun under [`limit_derivation`]: lifts the limit, or, if it was
@@ -39,36 +48,40 @@ pub fn finish_derivation(
         model.arena.limit_operands(None);
         return Ok(());
     }
-    let built = model.arena.operands();
     let limit = format!(
-        "the equations grew past {} million expression operands (about 200 MB) and their derivation was stopped",
+        "the equations grew past {} million expression operands and their derivation was stopped",
         DERIVATION_OPERAND_LIMIT / 1_000_000
     );
+    // The frame reached through the most rotations from the ground.
     let deepest = file
         .frames
         .iter()
         .map(|f| (chain(file, &f.name.value), f))
-        .max_by_key(|(chain, _)| chain.len());
+        .max_by_key(|(chain, _)| chain.iter().map(|(_, r)| r).sum::<usize>());
     let diagnostic = match deepest {
-        Some((chain, frame)) if chain.len() > 1 => Diagnostic::new(
-            frame.name.location,
-            format!(
-                "{limit} ({built} operands so far): frame `{}` turns relative to a turning frame {} levels deep (N → {}), and such a chain's equations grow about 15× per level",
-                frame.name.value,
-                chain.len(),
-                chain.join(" → ")
-            ),
-        )
-        .with_help(
-            "give the frames of a deep chain their angles relative to N (`parent: N`), whose equations grow far more slowly; a chain of 7 levels relative to each other derives in about 2 s",
-        ),
+        Some((chain, frame)) if chain.iter().map(|(_, r)| r).sum::<usize>() > 1 => {
+            let rotations: usize = chain.iter().map(|(_, r)| r).sum();
+            let path: Vec<&str> = chain.iter().map(|(name, _)| name.as_str()).collect();
+            Diagnostic::new(
+                frame.name.location,
+                format!(
+                    "{limit}: frame `{}` is reached from N through {rotations} rotations nested in {} frame(s) (N → {}), and the equations of nested rotations grow steeply with each one",
+                    frame.name.value,
+                    chain.len(),
+                    path.join(" → ")
+                ),
+            )
+            .with_help(
+                "frames given their angles relative to N (`parent: N`) derive far faster; a chain of 7 single-axis hinges each relative to the one before derives in about 2 s",
+            )
+        }
         _ => {
             let location = file
                 .coordinates
                 .first()
                 .map(|c| c.name.location)
                 .unwrap_or_default();
-            Diagnostic::new(location, format!("{limit} ({built} operands so far)")).with_help(
+            Diagnostic::new(location, limit).with_help(
                 "a model of this size needs fewer coordinates, or fewer bodies coupled to each other",
             )
         }
@@ -76,16 +89,17 @@ pub fn finish_derivation(
     Err(vec![diagnostic])
 }
 
-/// The frames from the ground to `name`, outermost first (a parent that is not a frame of the
-/// file, the ground, ends it; a cycle, which the file's checks refuse, is cut).
-fn chain(file: &ModelFile, name: &str) -> Vec<String> {
+/// The frames from the ground to `name`, outermost first, each with its number of rotations
+/// (a parent that is not a frame of the file, the ground, ends it; a cycle, which the file's
+/// checks refuse, is cut).
+fn chain(file: &ModelFile, name: &str) -> Vec<(String, usize)> {
     let mut out = Vec::new();
     let mut current = name;
     while let Some(frame) = file.frames.iter().find(|f| f.name.value == current) {
         if out.len() > file.frames.len() {
             break;
         }
-        out.push(frame.name.value.clone());
+        out.push((frame.name.value.clone(), frame.rotations.len()));
         current = &frame.parent.value;
     }
     out.reverse();
@@ -137,7 +151,9 @@ mod tests {
         let file = crate::model::load("chain.yaml", &source).unwrap();
         let mut model = SymbolicModel::from_file(&file).unwrap();
         // The lowering's operands and 2,000 more.
-        model.arena.limit_operands(Some(model.arena.operands() + 2_000));
+        model
+            .arena
+            .limit_operands(Some(model.arena.operands() + 2_000));
         let _ = Lagrange.derive(&mut model);
         assert!(model.arena.over_limit());
         let errors = finish_derivation(&mut model, &file).unwrap_err();
@@ -150,7 +166,9 @@ mod tests {
             e.message
         );
         assert!(
-            e.message.contains("`B4`") && e.message.contains("N → B1 → B2 → B3 → B4"),
+            e.message.contains("`B4`")
+                && e.message
+                    .contains("4 rotations nested in 4 frame(s) (N → B1 → B2 → B3 → B4)"),
             "{}",
             e.message
         );

@@ -85,7 +85,7 @@ pub enum RayleighError {
     /// `K` is not symmetric (a follower load): Rayleigh's quotient bounds and is stationary at
     /// the frequencies of a symmetric `K` only, and those of `M⁻¹K` are not its extrema.
     #[error(
-        "the stiffness matrix is not symmetric here (max |K − Kᵀ| / max |K| = {asymmetry:.2e}: a follower load), and Rayleigh's quotient vᵀKv/vᵀMv bounds the natural frequencies of a symmetric K only; `modes` gives this system's frequencies"
+        "the stiffness matrix is not symmetric here (max |K − Kᵀ| / max |K| = {asymmetry:.2e}: a non-conservative load such as a follower force), and Rayleigh's quotient vᵀKv/vᵀMv bounds the natural frequencies of a symmetric K only; `modes` gives this system's eigenvalues"
     )]
     NonSymmetricStiffness {
         /// `‖K − Kᵀ‖_max / ‖K‖_max`.
