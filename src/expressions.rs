@@ -6,6 +6,7 @@
 //! model format); see `docs/model-format.md`.
 
 use eomgen_runtime::analysis::AddedEvents;
+use eomgen_runtime::analysis::vibration::Forcing;
 use eomgen_runtime::{EventDirection, EventSpec, ModelInfo, RhsError, UnknownParameter};
 use eomgen_symbolic::model::parser::{closest, eval_expr, identifiers, parse_expr};
 use eomgen_symbolic::model::{BinOp, Expr, ExprKind, Location};
@@ -702,6 +703,25 @@ impl TimeFunction {
                 ),
             })?;
         Ok(function)
+    }
+
+    /// Calls `run` with this function as the forcing of a convolution study
+    /// ([`eomgen_runtime::analysis::vibration::convolution_response`]): `impulse` and `step`
+    /// by name, else the expression, whose value where it cannot be evaluated is NaN (which
+    /// the study reports as a forcing that is not finite, with its time). The one mapping of
+    /// the command line's `study convolution --forcing` and the Python package's
+    /// `convolution(forcing=…)`.
+    pub fn with_forcing<R>(&self, run: impl FnOnce(Forcing<'_>) -> R) -> R {
+        let function = |t: f64| self.value(t).unwrap_or(f64::NAN);
+        let forcing = match self.name() {
+            Some("impulse") => Forcing::Impulse,
+            Some(_) => Forcing::Step,
+            None => Forcing::Function {
+                label: self.text(),
+                f: &function,
+            },
+        };
+        run(forcing)
     }
 
     /// `impulse` or `step` when the text is one of those names, else `None`.

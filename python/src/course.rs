@@ -165,17 +165,12 @@ fn study_convolution<'py>(
         let model_ref = &mut instance;
         let study = py
             .detach(move || {
-                // A value that is not finite somewhere is the library's error.
-                let function = |t: f64| time_function.value(t).unwrap_or(f64::NAN);
-                let forcing = match time_function.name() {
-                    Some("impulse") => Forcing::Impulse,
-                    Some(_) => Forcing::Step,
-                    None => Forcing::Function {
-                        label: time_function.text(),
-                        f: &function,
-                    },
-                };
-                vibration::convolution_response(model_ref.as_mut(), &with_forcing(&base, forcing))
+                time_function.with_forcing(|forcing| {
+                    vibration::convolution_response(
+                        model_ref.as_mut(),
+                        &with_forcing(&base, forcing),
+                    )
+                })
             })
             .map_err(failure)?;
         return to_python(py, &study, Lists::Arrays);

@@ -8,9 +8,7 @@
 //! text, JSON and a chart.
 
 use clap::Args;
-use eomgen::analysis::vibration::{
-    self, ConvolutionError, ConvolutionOptions, ConvolutionStudy, Forcing,
-};
+use eomgen::analysis::vibration::{self, ConvolutionError, ConvolutionOptions, ConvolutionStudy};
 use eomgen::expressions::TimeFunction;
 use eomgen::{FrfError, ModelInfo};
 
@@ -89,25 +87,19 @@ pub fn run(args: &ConvolutionArgs) -> Result<(), CliError> {
     let mut model = args.point.model(&args.model)?;
     let time_function = TimeFunction::parse(&args.forcing, "--forcing", model.as_ref())
         .map_err(|e| CliError::usage(e.to_string()))?;
-    // A value that is not finite somewhere is the library's error.
-    let function = |t: f64| time_function.value(t).unwrap_or(f64::NAN);
-    let forcing = match time_function.name() {
-        Some("impulse") => Forcing::Impulse,
-        Some(_) => Forcing::Step,
-        None => Forcing::Function {
-            label: time_function.text(),
-            f: &function,
-        },
-    };
-    let options = ConvolutionOptions {
-        operating_point: args.point.options(model.as_ref())?,
-        input: args.input.clone(),
-        forcing,
-        t_end: args.t_end,
-        intervals: args.intervals,
-        rtol: args.rtol,
-    };
-    let study = vibration::convolution_response(model.as_mut(), &options)
+    let operating_point = args.point.options(model.as_ref())?;
+    let study = time_function
+        .with_forcing(|forcing| {
+            let options = ConvolutionOptions {
+                operating_point,
+                input: args.input.clone(),
+                forcing,
+                t_end: args.t_end,
+                intervals: args.intervals,
+                rtol: args.rtol,
+            };
+            vibration::convolution_response(model.as_mut(), &options)
+        })
         .map_err(|e| failure(model.as_ref(), e))?;
     if let Some(path) = &args.plot {
         chart(path, model.as_ref(), &study).map_err(CliError::failure)?;
