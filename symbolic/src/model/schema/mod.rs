@@ -78,9 +78,6 @@ pub const TOP_LEVEL_KEYS: &[&str] = &[
     "minimal_twin",
 ];
 
-/// Keys of the model format (DESIGN.md) that this version does not implement yet.
-pub const LATER_KEYS: &[&str] = &[];
-
 /// Keys of `checks:`.
 pub const CHECK_KEYS: &[&str] = &[
     "equations_of_motion",

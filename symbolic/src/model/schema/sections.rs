@@ -228,23 +228,7 @@ impl Ctx<'_> {
             return None;
         };
 
-        // Rule: keys planned for later versions are recognised and reported once each.
-        for (k, _) in top {
-            if LATER_KEYS.contains(&k.value.as_str()) {
-                self.error(
-                    Diagnostic::new(
-                        k.location,
-                        format!(
-                            "`{}:` is not supported yet by this version of eomgen",
-                            k.value
-                        ),
-                    )
-                    .with_help("it is planned; remove it for now"),
-                );
-            }
-        }
-        let allowed: Vec<&str> = TOP_LEVEL_KEYS.iter().chain(LATER_KEYS).copied().collect();
-        self.unknown_keys(top, "a model file", &allowed, TOP_LEVEL_KEYS);
+        self.unknown_keys(top, "a model file", TOP_LEVEL_KEYS, TOP_LEVEL_KEYS);
 
         let mut file = ModelFile {
             path: path.to_string(),
