@@ -41,10 +41,14 @@ fn bundled_models() -> Vec<&'static str> {
     eomgen::models::ALL.iter().map(|e| e.name).collect()
 }
 
-/// The integration methods' names (`Method::ALL`, in its order).
+/// The integration methods' names and one-line summaries, from the library's method table
+/// (`Method::table`, in its order).
 #[pyfunction]
-fn methods() -> Vec<&'static str> {
-    eomgen::Method::ALL.iter().map(|m| m.name()).collect()
+fn methods() -> Vec<(&'static str, &'static str)> {
+    eomgen::Method::table()
+        .iter()
+        .map(|row| (row.name, row.summary))
+        .collect()
 }
 
 /// The defaults of a simulation, those of `eomgen simulate` without options:

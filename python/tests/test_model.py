@@ -55,6 +55,17 @@ def run_cli(cli, *args):
 # --- opening models --------------------------------------------------------------------------
 
 
+def test_the_methods_are_the_command_lines_with_their_help(cli):
+    """METHODS and METHOD_SUMMARIES are the library's method table: the names and help lines
+    that `eomgen simulate --help` lists, in its order."""
+    text = subprocess.run([cli, "simulate", "--help"], capture_output=True, text=True, check=True).stdout
+    for name, summary in eomgen.METHOD_SUMMARIES.items():
+        assert f"- {name}:" in text and summary.split(",")[0] in text
+    assert list(eomgen.METHOD_SUMMARIES) == list(eomgen.METHODS)
+    assert eomgen.METHODS[:5] == ("euler", "midpoint", "rk4", "bs32", "dp54")
+    assert "Dormand–Prince 5(4)" in eomgen.METHOD_SUMMARIES["dp54"]
+
+
 def test_bundled_model_names_parameters_and_coordinates():
     m = eomgen.load("double_pendulum")
     assert m.name == "double_pendulum"

@@ -18,38 +18,35 @@ use super::model::find_model;
 use super::render::num;
 use super::values::{set_parameters, usage};
 
-/// The `--method` help of each method (clap lists them under "Possible values"; the
-/// methods themselves are [`Method`]).
-fn method_help(method: Method) -> &'static str {
-    match method {
-        Method::Euler => "Explicit Euler, order 1, fixed step `--dt`",
-        Method::Midpoint => "Explicit midpoint, order 2, fixed step `--dt`",
-        Method::Rk4 => "Classical Runge–Kutta 4, fixed step `--dt`",
-        Method::Bs32 => "Bogacki–Shampine 3(2) (ode23), adaptive, Hermite dense output",
-        Method::Dp54 => "Dormand–Prince 5(4), adaptive, dense output (default)",
-        Method::Dop853 => "DOP853, Hairer's Dormand–Prince 8(5,3), adaptive, order-7 dense output",
-        Method::Vern6 => "Verner's most efficient 6(5) pair, adaptive, order-6 dense output",
-        Method::Vern7 => "Verner's most efficient 7(6) pair, adaptive, order-7 dense output",
-        Method::Vern8 => "Verner's most efficient 8(7) pair, adaptive, order-8 dense output",
-        Method::Vern9 => {
-            "Verner's most efficient 9(8) pair, adaptive, order-9 dense output (tolerances of 1e-12 and below)"
-        }
-        Method::Taylor => {
-            "Taylor series of the model's generated recurrences, order and step from the tolerance (Jorba & Zou), the series as dense output; unconstrained models without abs, sign, step"
-        }
-        Method::SymplecticEuler => {
-            "Symplectic Euler, order 1, fixed step `--dt` (symplectic for constant M and velocity-independent forces)"
-        }
-        Method::StormerVerlet => {
-            "Störmer–Verlet (leapfrog in q, q̇), order 2, fixed step `--dt` (symplectic for constant M and velocity-independent forces)"
-        }
-        Method::ImplicitMidpoint => {
-            "Implicit midpoint, order 2, fixed step `--dt`, Newton with the generated Jacobians (symplectic for any M(q))"
-        }
-        Method::Radau5 => {
-            "Radau IIA order 5 (RADAU5), adaptive, L-stable, Newton with the generated Jacobians"
-        }
+/// The names of the methods that are (`adaptive`) or are not adaptive, from the method table,
+/// for the help of `--rtol` and `--dt`: `"bs32, dp54, …"`, the last joined by `joiner`.
+fn method_names(adaptive: bool, joiner: &str) -> String {
+    let names: Vec<&str> = Method::ALL
+        .into_iter()
+        // The Taylor method's tolerance chooses its order, as told in its own help.
+        .filter(|m| m.is_adaptive() == adaptive && *m != Method::Taylor)
+        .map(Method::name)
+        .collect();
+    match names.split_last() {
+        Some((last, rest)) if !rest.is_empty() => format!("{}{joiner}{last}", rest.join(", ")),
+        _ => names.join(", "),
     }
+}
+
+/// `--rtol`'s help.
+fn rtol_help() -> String {
+    format!(
+        "Relative tolerance (adaptive methods: {})",
+        method_names(true, ", ")
+    )
+}
+
+/// `--dt`'s help.
+fn dt_help() -> String {
+    format!(
+        "Step size: the fixed step of {} (default t_end/1000); the initial step of the adaptive methods (default automatic)",
+        method_names(false, " and ")
+    )
 }
 
 /// clap's parser of a method name (`--method`, `--methods`): the names of [`Method::ALL`]
@@ -58,10 +55,8 @@ fn method_help(method: Method) -> &'static str {
 /// (default `t_end/1000`).
 pub(super) fn method_parser() -> impl clap::builder::TypedValueParser<Value = Method> {
     use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser as _};
-    PossibleValuesParser::new(
-        Method::ALL.map(|m| PossibleValue::new(m.name()).help(method_help(m))),
-    )
-    .try_map(|name| name.parse::<Method>())
+    PossibleValuesParser::new(Method::ALL.map(|m| PossibleValue::new(m.name()).help(m.summary())))
+        .try_map(|name| name.parse::<Method>())
 }
 
 /// Drift control of a constrained model (`--stabilization`).
@@ -85,17 +80,14 @@ pub struct IntegrationArgs {
     /// Integration method.
     #[arg(long, value_parser = method_parser(), default_value_t = SimulationOptions::DEFAULT_METHOD)]
     pub method: Method,
-    /// Relative tolerance (adaptive methods: bs32, dp54, dop853, vern6, vern7, vern8, vern9,
-    /// radau5).
-    #[arg(long, default_value_t = SimulationOptions::DEFAULT_RTOL, value_parser = super::values::relative_tolerance, allow_hyphen_values = true)]
+    /// Relative tolerance (`rtol_help`).
+    #[arg(long, help = rtol_help(), default_value_t = SimulationOptions::DEFAULT_RTOL, value_parser = super::values::relative_tolerance, allow_hyphen_values = true)]
     pub rtol: f64,
     /// Absolute tolerance (adaptive methods; implicit-midpoint's scale for components near 0).
     #[arg(long, default_value_t = SimulationOptions::DEFAULT_ATOL, value_parser = super::values::absolute_tolerance, allow_hyphen_values = true)]
     pub atol: f64,
-    /// Step size: the fixed step of euler, midpoint, rk4, symplectic-euler, stormer-verlet and
-    /// implicit-midpoint (default t_end/1000); the initial step of the adaptive methods
-    /// (default automatic).
-    #[arg(long)]
+    /// Step size (`dt_help`).
+    #[arg(long, help = dt_help())]
     pub dt: Option<f64>,
     /// Set a parameter, `NAME=VALUE` (value may be an expression of numbers, pi and the other
     /// parameters); repeatable.

@@ -16,6 +16,7 @@ from ._eomgen import __version__
 from . import sweep
 from ._model import (
     METHODS,
+    METHOD_SUMMARIES,
     Animation,
     Batch,
     Equations,
@@ -33,6 +34,7 @@ from .errors import AnalysisError, EomgenError, IntegrationError, ModelError, Pa
 
 __all__ = [
     "METHODS",
+    "METHOD_SUMMARIES",
     "AnalysisError",
     "Animation",
     "Batch",

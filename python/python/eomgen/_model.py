@@ -16,11 +16,14 @@ from .errors import IntegrationError
 
 ArrayLike = Union[Sequence[float], np.ndarray]
 
-#: The integration methods (``method=``): fixed-step ``euler``, ``midpoint``, ``rk4``,
-#: ``symplectic-euler``, ``stormer-verlet``, ``implicit-midpoint`` (step ``dt``); adaptive
-#: ``bs32``, ``dp54`` (Dormand–Prince 5(4), the default), ``dop853``, ``vern6``, ``vern7``,
-#: ``vern8``, ``vern9`` (Verner's pairs 6(5) … 9(8)) and ``radau5`` (``rtol``/``atol``).
-METHODS = tuple(_eomgen.methods())
+#: The integration methods (``method=``), by name, from the library's method table (the one
+#: ``eomgen simulate --help`` lists): fixed-step ones take ``dt``, adaptive ones
+#: ``rtol``/``atol``; :data:`METHOD_SUMMARIES` says which is which.
+METHODS = tuple(name for name, _ in _eomgen.methods())
+
+#: One line on each method of :data:`METHODS`: its order, step, dense output and what it
+#: suits.
+METHOD_SUMMARIES = dict(_eomgen.methods())
 
 #: ``simulate``'s defaults, those of ``eomgen simulate`` without options: end time (s),
 #: method, tolerances, Baumgarte's gains (1/s).

@@ -89,116 +89,162 @@ pub struct UnknownMethod {
     pub name: String,
 }
 
+/// What the registry holds of one method: a row of the one table that the library, the
+/// CLI's `--help`, the Python package (`eomgen.METHODS`) and the docs read.
+#[derive(Debug, Clone, Copy, Serialize)]
+pub struct MethodInfo {
+    /// The method.
+    pub method: Method,
+    /// The command-line name (`"dp54"`), which [`FromStr`] parses.
+    pub name: &'static str,
+    /// The literature's name (`"Dormand–Prince 5(4)"`), as charts and tables label it.
+    pub display_name: &'static str,
+    /// Whether it controls its step by `rtol`/`atol` (otherwise it takes the fixed step
+    /// `dt`).
+    pub adaptive: bool,
+    /// Whether each step solves a nonlinear system by Newton's method with the model's
+    /// Jacobians.
+    pub implicit: bool,
+    /// One line on the method: order, step, dense output, what it suits (`--method`'s help).
+    pub summary: &'static str,
+    /// A new integrator of the method, with its default settings.
+    #[serde(skip)]
+    pub build: fn() -> Box<dyn Integrator>,
+}
+
+/// A row of [`TABLE`].
+const fn row(
+    method: Method,
+    (name, display_name): (&'static str, &'static str),
+    (adaptive, implicit): (bool, bool),
+    summary: &'static str,
+    build: fn() -> Box<dyn Integrator>,
+) -> MethodInfo {
+    MethodInfo {
+        method,
+        name,
+        display_name,
+        adaptive,
+        implicit,
+        summary,
+        build,
+    }
+}
+
+/// Adaptive or fixed step, explicit or implicit.
+const ADAPTIVE: (bool, bool) = (true, false);
+const FIXED: (bool, bool) = (false, false);
+
+/// The methods, in [`Method`]'s order (the order the CLI lists them): adding a method is a
+/// variant of [`Method`] and a row here.
+#[rustfmt::skip]
+static TABLE: [MethodInfo; 15] = [
+    row(Method::Euler, ("euler", "explicit Euler"), FIXED,
+        "Explicit Euler, order 1, fixed step `--dt`",
+        || Box::new(ExplicitEuler::new())),
+    row(Method::Midpoint, ("midpoint", "explicit midpoint"), FIXED,
+        "Explicit midpoint, order 2, fixed step `--dt`",
+        || Box::new(ExplicitMidpoint::new())),
+    row(Method::Rk4, ("rk4", "RK4"), FIXED,
+        "Classical Runge–Kutta 4, fixed step `--dt`",
+        || Box::new(RungeKutta4::new())),
+    row(Method::Bs32, ("bs32", "Bogacki–Shampine 3(2)"), ADAPTIVE,
+        "Bogacki–Shampine 3(2) (ode23), adaptive, Hermite dense output",
+        || Box::new(BogackiShampine32::new())),
+    row(Method::Dp54, ("dp54", "Dormand–Prince 5(4)"), ADAPTIVE,
+        "Dormand–Prince 5(4), adaptive, dense output (default)",
+        || Box::new(DormandPrince54::new())),
+    row(Method::Dop853, ("dop853", "DOP853"), ADAPTIVE,
+        "DOP853, Hairer's Dormand–Prince 8(5,3), adaptive, order-7 dense output",
+        || Box::new(DormandPrince853::new())),
+    row(Method::Vern6, ("vern6", "Verner 6(5)"), ADAPTIVE,
+        "Verner's most efficient 6(5) pair, adaptive, order-6 dense output",
+        || Box::new(Verner65::new())),
+    row(Method::Vern7, ("vern7", "Verner 7(6)"), ADAPTIVE,
+        "Verner's most efficient 7(6) pair, adaptive, order-7 dense output",
+        || Box::new(Verner76::new())),
+    row(Method::Vern8, ("vern8", "Verner 8(7)"), ADAPTIVE,
+        "Verner's most efficient 8(7) pair, adaptive, order-8 dense output",
+        || Box::new(Verner87::new())),
+    row(Method::Vern9, ("vern9", "Verner 9(8)"), ADAPTIVE,
+        "Verner's most efficient 9(8) pair, adaptive, order-9 dense output (tolerances of 1e-12 and below)",
+        || Box::new(Verner98::new())),
+    row(Method::Taylor, ("taylor", "Taylor"), ADAPTIVE,
+        "Taylor series of the model's generated recurrences, order and step from the tolerance (Jorba & Zou), the series as dense output; unconstrained models without abs, sign, step",
+        || Box::new(Taylor::new())),
+    row(Method::SymplecticEuler, ("symplectic-euler", "symplectic Euler"), FIXED,
+        "Symplectic Euler, order 1, fixed step `--dt` (symplectic for constant M and velocity-independent forces)",
+        || Box::new(SymplecticEuler::new())),
+    row(Method::StormerVerlet, ("stormer-verlet", "Störmer–Verlet"), FIXED,
+        "Störmer–Verlet (leapfrog in q, q̇), order 2, fixed step `--dt` (symplectic for constant M and velocity-independent forces)",
+        || Box::new(StormerVerlet::new())),
+    row(Method::ImplicitMidpoint, ("implicit-midpoint", "implicit midpoint"), (false, true),
+        "Implicit midpoint, order 2, fixed step `--dt`, Newton with the generated Jacobians (symplectic for any M(q))",
+        || Box::new(ImplicitMidpoint::new())),
+    row(Method::Radau5, ("radau5", "Radau IIA 5"), (true, true),
+        "Radau IIA order 5 (RADAU5), adaptive, L-stable, Newton with the generated Jacobians",
+        || Box::new(RadauIIA5::new())),
+];
+
 impl Method {
     /// Every method, in the order the CLI lists them.
-    pub const ALL: [Method; 15] = [
-        Method::Euler,
-        Method::Midpoint,
-        Method::Rk4,
-        Method::Bs32,
-        Method::Dp54,
-        Method::Dop853,
-        Method::Vern6,
-        Method::Vern7,
-        Method::Vern8,
-        Method::Vern9,
-        Method::Taylor,
-        Method::SymplecticEuler,
-        Method::StormerVerlet,
-        Method::ImplicitMidpoint,
-        Method::Radau5,
-    ];
+    pub const ALL: [Method; 15] = {
+        let mut all = [Method::Euler; 15];
+        let mut i = 0;
+        while i < all.len() {
+            all[i] = TABLE[i].method;
+            i += 1;
+        }
+        all
+    };
+
+    /// The method's row of the registry's table.
+    pub fn info(self) -> &'static MethodInfo {
+        // The table is in the variants' order (`every_row_is_its_variants`).
+        &TABLE[self as usize]
+    }
+
+    /// The rows of every method, in [`Method::ALL`]'s order.
+    pub fn table() -> &'static [MethodInfo] {
+        &TABLE
+    }
 
     /// The command-line name (`"dp54"`, `"stormer-verlet"`), which [`FromStr`] parses.
     pub fn name(self) -> &'static str {
-        match self {
-            Method::Euler => "euler",
-            Method::Midpoint => "midpoint",
-            Method::Rk4 => "rk4",
-            Method::Bs32 => "bs32",
-            Method::Dp54 => "dp54",
-            Method::Dop853 => "dop853",
-            Method::Vern6 => "vern6",
-            Method::Vern7 => "vern7",
-            Method::Vern8 => "vern8",
-            Method::Vern9 => "vern9",
-            Method::Taylor => "taylor",
-            Method::SymplecticEuler => "symplectic-euler",
-            Method::StormerVerlet => "stormer-verlet",
-            Method::ImplicitMidpoint => "implicit-midpoint",
-            Method::Radau5 => "radau5",
-        }
+        self.info().name
     }
 
     /// The command-line names of [`Method::ALL`], in order.
     pub fn names() -> Vec<&'static str> {
-        Self::ALL.iter().map(|m| m.name()).collect()
+        TABLE.iter().map(|row| row.name).collect()
     }
 
     /// The literature's name of the method (`"Dormand–Prince 5(4)"`), as charts and tables
     /// label it.
     pub fn display_name(self) -> &'static str {
-        match self {
-            Method::Euler => "explicit Euler",
-            Method::Midpoint => "explicit midpoint",
-            Method::Rk4 => "RK4",
-            Method::Bs32 => "Bogacki–Shampine 3(2)",
-            Method::Dp54 => "Dormand–Prince 5(4)",
-            Method::Dop853 => "DOP853",
-            Method::Vern6 => "Verner 6(5)",
-            Method::Vern7 => "Verner 7(6)",
-            Method::Vern8 => "Verner 8(7)",
-            Method::Vern9 => "Verner 9(8)",
-            Method::Taylor => "Taylor",
-            Method::SymplecticEuler => "symplectic Euler",
-            Method::StormerVerlet => "Störmer–Verlet",
-            Method::ImplicitMidpoint => "implicit midpoint",
-            Method::Radau5 => "Radau IIA 5",
-        }
+        self.info().display_name
+    }
+
+    /// One line on the method (`--method`'s help).
+    pub fn summary(self) -> &'static str {
+        self.info().summary
     }
 
     /// A new integrator of this method, with its default settings.
     pub fn integrator(self) -> Box<dyn Integrator> {
-        match self {
-            Method::Euler => Box::new(ExplicitEuler::new()),
-            Method::Midpoint => Box::new(ExplicitMidpoint::new()),
-            Method::Rk4 => Box::new(RungeKutta4::new()),
-            Method::Bs32 => Box::new(BogackiShampine32::new()),
-            Method::Dp54 => Box::new(DormandPrince54::new()),
-            Method::Dop853 => Box::new(DormandPrince853::new()),
-            Method::Vern6 => Box::new(Verner65::new()),
-            Method::Vern7 => Box::new(Verner76::new()),
-            Method::Vern8 => Box::new(Verner87::new()),
-            Method::Vern9 => Box::new(Verner98::new()),
-            Method::Taylor => Box::new(Taylor::new()),
-            Method::SymplecticEuler => Box::new(SymplecticEuler::new()),
-            Method::StormerVerlet => Box::new(StormerVerlet::new()),
-            Method::ImplicitMidpoint => Box::new(ImplicitMidpoint::new()),
-            Method::Radau5 => Box::new(RadauIIA5::new()),
-        }
+        (self.info().build)()
     }
 
     /// Whether the method controls its step by `rtol`/`atol` (otherwise it takes the fixed
     /// step `dt`).
     pub fn is_adaptive(self) -> bool {
-        matches!(
-            self,
-            Method::Bs32
-                | Method::Dp54
-                | Method::Dop853
-                | Method::Vern6
-                | Method::Vern7
-                | Method::Vern8
-                | Method::Vern9
-                | Method::Taylor
-                | Method::Radau5
-        )
+        self.info().adaptive
     }
 
     /// Whether each step solves a nonlinear system by Newton's method with the model's
     /// Jacobians (implicit midpoint, Radau IIA 5).
     pub fn is_implicit(self) -> bool {
-        matches!(self, Method::ImplicitMidpoint | Method::Radau5)
+        self.info().implicit
     }
 }
 
@@ -229,6 +275,32 @@ impl FromStr for Method {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// `Method::info` indexes the table by the variant's discriminant.
+    #[test]
+    fn every_row_is_its_variants() {
+        for (i, row) in TABLE.iter().enumerate() {
+            assert_eq!(row.method as usize, i, "{}", row.name);
+            assert_eq!(row.method.info().name, row.name);
+        }
+        let mut names = Method::names();
+        names.sort_unstable();
+        names.dedup();
+        assert_eq!(names.len(), TABLE.len());
+    }
+
+    /// The CLI reference describes every method of the table under its command-line name.
+    #[test]
+    fn the_cli_reference_names_every_method() {
+        let reference = include_str!("../../../docs/cli.md");
+        for row in &TABLE {
+            assert!(
+                reference.contains(&format!("`{}`", row.name)),
+                "docs/cli.md does not describe `{}`",
+                row.name
+            );
+        }
+    }
 
     #[test]
     fn every_name_parses_back_to_its_method() {

@@ -7,7 +7,6 @@ use super::controller::PiController;
 use super::driver::{self, Control, Problem};
 use super::error::IntegrationFailure;
 use super::explicit_rk::ExplicitRk;
-use super::options::{IntegratorOptions, OutputTimes};
 use super::solution::Solution;
 use super::tableau::Tableau;
 
@@ -30,7 +29,7 @@ const ERROR_ORDER: u32 = 4;
 /// evaluation of `F`). Each attempted step, accepted or rejected, costs six evaluations of `F`
 /// (FSAL: the seventh stage is the next step's first), plus one at `t0`.
 ///
-/// With [`IntegratorOptions::fixed_step`] the method takes constant steps `dt` (default
+/// With [`IntegratorOptions::fixed_step`](super::IntegratorOptions::fixed_step) the method takes constant steps `dt` (default
 /// `(t_end − t0)/1000`) without error control, like [`RungeKutta4`](super::RungeKutta4);
 /// convergence-order studies use this.
 ///

@@ -12,7 +12,7 @@ use super::dense_output::DenseOutput;
 use super::driver::{self, Control, Problem};
 use super::error::IntegrationFailure;
 use super::linear::{LuFactors, SAME_STEP};
-use super::options::{ErrorWeights, IntegratorOptions, OutputTimes, check_absolute_tolerance};
+use super::options::{ErrorWeights, check_absolute_tolerance};
 use super::solution::Solution;
 use super::stepper::{CheckedRhs, StepEnds, StepFailure, Stepper};
 
@@ -382,19 +382,17 @@ impl Integrator for ImplicitMidpoint {
     fn order(&self) -> u32 {
         2
     }
+}
 
-    fn integrate(
+impl driver::Method for ImplicitMidpoint {
+    fn run(
         &mut self,
+        problem: &Problem<'_>,
         system: &mut dyn OdeSystem,
-        t0: f64,
-        y0: &[f64],
-        t_end: f64,
-        output: &OutputTimes,
-        options: &IntegratorOptions,
     ) -> Result<Solution, IntegrationFailure> {
-        let problem = Problem::new(t0, y0, t_end, output, options);
+        let options = problem.options;
         let (tolerance, iterations) = (self.newton_tolerance, self.max_newton_iterations.max(1));
-        driver::run(&problem, system, Control::Fixed, |shape| {
+        driver::run(problem, system, Control::Fixed, |shape| {
             check_absolute_tolerance(options, shape.dim, "implicit midpoint")?;
             Ok(MidpointStepper::new(shape.dim, tolerance, iterations))
         })

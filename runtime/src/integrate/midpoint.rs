@@ -6,7 +6,6 @@ use super::Integrator;
 use super::driver::{self, Control, Problem};
 use super::error::IntegrationFailure;
 use super::explicit_rk::ExplicitRk;
-use super::options::{IntegratorOptions, OutputTimes};
 use super::solution::Solution;
 use super::tableau::Tableau;
 

@@ -115,11 +115,15 @@ pub use verner::{Verner65, Verner76, Verner87, Verner98};
 pub use crate::ode::{Event, EventDirection, EventSpec};
 
 use crate::ode::OdeSystem;
+use driver::Problem;
 
 /// A method that integrates `ẏ = F(t, y)` forward in time.
 ///
 /// Object safe: the CLI holds methods as `Box<dyn Integrator>`.
-pub trait Integrator {
+///
+/// Sealed: this crate's methods are its implementations. Each supplies its stepper and step
+/// control; the one driver loop behind [`Integrator::integrate`] does the rest.
+pub trait Integrator: driver::Method {
     /// Short name of the method (`"euler"`, `"midpoint"`, `"rk4"`, `"bs32"`, `"dp54"`,
     /// `"dop853"`, `"vern6"`, `"vern7"`, `"vern8"`, `"vern9"`, `"symplectic-euler"`, `"stormer-verlet"`, `"implicit-midpoint"`,
     /// `"radau5"`).
@@ -163,5 +167,7 @@ pub trait Integrator {
         t_end: f64,
         output: &OutputTimes,
         options: &IntegratorOptions,
-    ) -> Result<Solution, IntegrationFailure>;
+    ) -> Result<Solution, IntegrationFailure> {
+        self.run(&Problem::new(t0, y0, t_end, output, options), system)
+    }
 }

@@ -18,7 +18,7 @@ use super::dense_output::DenseOutput;
 use super::driver::{self, Control, Problem};
 use super::error::IntegrationFailure;
 use super::linear::{LuFactors, SAME_STEP};
-use super::options::{ErrorWeights, IntegratorOptions, OutputTimes, check_absolute_tolerance};
+use super::options::{ErrorWeights, check_absolute_tolerance};
 use super::solution::Solution;
 use super::stepper::{CheckedRhs, StepFailure, Stepper};
 
@@ -637,16 +637,16 @@ impl Stepper for RadauStepper {
 /// replaces `rtol` by `rtol' = 0.1 rtol^(2/3)` and `atol` by `rtol' atol/rtol` internally), so
 /// that `rtol` means the same for every method: the local error per step. Given those
 /// internal tolerances, an exact Jacobian and the same starting step
-/// ([`IntegratorOptions::with_dt`]), the method takes `radau5.f`'s steps: the same accepted
+/// ([`IntegratorOptions::with_dt`](super::IntegratorOptions::with_dt)), the method takes `radau5.f`'s steps: the same accepted
 /// and rejected attempts, evaluations of `F` (one more, at the final state), Jacobians and
 /// factorisations (tested on van der Pol's and Robertson's problems,
 /// `runtime/tests/radau5_reference.rs`). Two things can still part them: a maximum step
 /// (`dt_max` caps the proposal after the test for holding the step, radau5.f's `HMAX`
 /// before it), and the end of the interval, where the driver stretches a step by up to 1 %
 /// onto `t_end` (as DOPRI5 does) while radau5.f takes a step only as far as `t_end`
-/// reaches. Dense output ([`OutputTimes::At`]) is the
+/// reaches. Dense output ([`OutputTimes::At`](super::OutputTimes::At)) is the
 /// collocation polynomial of each step (degree 3, continuous extension of order 3). With
-/// [`IntegratorOptions::fixed_step`] the method takes constant steps `dt` without error
+/// [`IntegratorOptions::fixed_step`](super::IntegratorOptions::fixed_step) the method takes constant steps `dt` without error
 /// control; Newton then iterates until it converges, diverges or uses up its iterations, and a
 /// failure is an error at once.
 ///
@@ -735,27 +735,18 @@ impl Integrator for RadauIIA5 {
     fn order(&self) -> u32 {
         5
     }
+}
 
-    fn integrate(
+impl driver::Method for RadauIIA5 {
+    fn run(
         &mut self,
+        problem: &Problem<'_>,
         system: &mut dyn OdeSystem,
-        t0: f64,
-        y0: &[f64],
-        t_end: f64,
-        output: &OutputTimes,
-        options: &IntegratorOptions,
     ) -> Result<Solution, IntegrationFailure> {
-        let problem = Problem::new(t0, y0, t_end, output, options);
-        let control = if options.fixed_step {
-            Control::Fixed
-        } else {
-            Control::Adaptive {
-                controller: &mut self.controller,
-                error_order: ERROR_ORDER,
-            }
-        };
+        let options = problem.options;
+        let control = Control::from_options(options, &mut self.controller, ERROR_ORDER);
         let iterations = self.max_newton_iterations.max(2);
-        driver::run(&problem, system, control, |shape| {
+        driver::run(problem, system, control, |shape| {
             check_absolute_tolerance(options, shape.dim, "Radau IIA (radau5)")?;
             Ok(RadauStepper::new(shape.dim, iterations))
         })

@@ -18,7 +18,7 @@ use super::Integrator;
 use super::dense_output::DenseOutput;
 use super::driver::{self, Control, Problem};
 use super::error::{IntegrationError, IntegrationFailure};
-use super::options::{ErrorWeights, IntegratorOptions, OutputTimes};
+use super::options::ErrorWeights;
 use super::solution::Solution;
 use super::stepper::{CheckedRhs, StepEnds, StepFailure, Stepper, SystemShape};
 
@@ -231,18 +231,15 @@ impl Integrator for SymplecticEuler {
     fn order(&self) -> u32 {
         1
     }
+}
 
-    fn integrate(
+impl driver::Method for SymplecticEuler {
+    fn run(
         &mut self,
+        problem: &Problem<'_>,
         system: &mut dyn OdeSystem,
-        t0: f64,
-        y0: &[f64],
-        t_end: f64,
-        output: &OutputTimes,
-        options: &IntegratorOptions,
     ) -> Result<Solution, IntegrationFailure> {
-        let problem = Problem::new(t0, y0, t_end, output, options);
-        integrate_partitioned(Scheme::SymplecticEuler, self.name(), system, &problem)
+        integrate_partitioned(Scheme::SymplecticEuler, self.name(), system, problem)
     }
 }
 
@@ -317,18 +314,15 @@ impl Integrator for StormerVerlet {
     fn order(&self) -> u32 {
         2
     }
+}
 
-    fn integrate(
+impl driver::Method for StormerVerlet {
+    fn run(
         &mut self,
+        problem: &Problem<'_>,
         system: &mut dyn OdeSystem,
-        t0: f64,
-        y0: &[f64],
-        t_end: f64,
-        output: &OutputTimes,
-        options: &IntegratorOptions,
     ) -> Result<Solution, IntegrationFailure> {
-        let problem = Problem::new(t0, y0, t_end, output, options);
-        integrate_partitioned(Scheme::StormerVerlet, self.name(), system, &problem)
+        integrate_partitioned(Scheme::StormerVerlet, self.name(), system, problem)
     }
 }
 

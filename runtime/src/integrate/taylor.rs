@@ -6,7 +6,7 @@ use super::Integrator;
 use super::dense_output::DenseOutput;
 use super::driver::{self, Control, Problem};
 use super::error::{IntegrationError, IntegrationFailure};
-use super::options::{ErrorWeights, IntegratorOptions, OutputTimes, Tolerance};
+use super::options::{ErrorWeights, IntegratorOptions, Tolerance};
 use super::solution::Solution;
 use super::stepper::{CheckedRhs, StepFailure, Stepper, SystemShape};
 use crate::ode::OdeSystem;
@@ -106,17 +106,15 @@ impl Integrator for Taylor {
     fn order(&self) -> u32 {
         Taylor::order_for_tolerance(IntegratorOptions::DEFAULT_RTOL) as u32
     }
+}
 
-    fn integrate(
+impl driver::Method for Taylor {
+    fn run(
         &mut self,
+        problem: &Problem<'_>,
         system: &mut dyn OdeSystem,
-        t0: f64,
-        y0: &[f64],
-        t_end: f64,
-        output: &OutputTimes,
-        options: &IntegratorOptions,
     ) -> Result<Solution, IntegrationFailure> {
-        let problem = Problem::new(t0, y0, t_end, output, options);
+        let options = problem.options;
         let control = if options.fixed_step {
             Control::Fixed
         } else {
@@ -124,7 +122,7 @@ impl Integrator for Taylor {
         };
         let support = system.taylor_support();
         let (rtol, atol) = (smallest(&options.rtol), smallest(&options.atol));
-        driver::run(&problem, system, control, |shape| {
+        driver::run(problem, system, control, |shape| {
             support.map_err(|reason| IntegrationError::NoTaylorRecurrences {
                 reason: reason.to_string(),
             })?;

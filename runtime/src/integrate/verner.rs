@@ -17,7 +17,7 @@ use super::dense_output::DenseOutput;
 use super::driver::{self, Control, Problem};
 use super::error::IntegrationFailure;
 use super::explicit_rk::{combine, error_ratio, weighted_sum};
-use super::options::{ErrorWeights, IntegratorOptions, OutputTimes};
+use super::options::ErrorWeights;
 use super::solution::Solution;
 use super::stepper::{AttemptTimes, CheckedRhs, StepEnds, StepFailure, Stepper, first_non_finite};
 use super::verner_tableaus::{VERN6, VERN7, VERN8, VERN9, VernerTableau};
@@ -433,7 +433,7 @@ verner_pair!(
     /// `β₁ = 7/(10p)`, `β₂ = 2/(5p)`, unless replaced with
     /// [`with_controller`](Self::with_controller)) proposes the next one. The interpolant
     /// (Verner's, of order 6) costs three more evaluations, made only for steps that contain a
-    /// requested output time or an event. With [`IntegratorOptions::fixed_step`] the method
+    /// requested output time or an event. With [`IntegratorOptions::fixed_step`](super::IntegratorOptions::fixed_step) the method
     /// takes constant steps `dt` without error control.
     ///
     /// # Examples

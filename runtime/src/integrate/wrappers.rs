@@ -1,7 +1,7 @@
 //! The parts every integrator type writes alike, written once: the constructors and
-//! controller accessors of a method with a [`PiController`](super::PiController), and the
-//! [`Integrator`](super::Integrator) implementations that hand a problem to the one driver
-//! loop ([`super::driver::run`]). Each method's file keeps its type, its documentation and its
+//! controller accessors of a method with a [`PiController`](super::PiController), its
+//! [`Integrator`](super::Integrator) name and order, and the [`super::driver::Method`] that
+//! hands a problem to the one driver loop ([`super::driver::run`]) with its stepper. Each method's file keeps its type, its documentation and its
 //! stepper; these macros only spell out the glue.
 
 /// `new`, `with_controller`, `controller`, `Default` and the [`Integrator`](super::Integrator)
@@ -53,26 +53,17 @@ macro_rules! pi_controlled_integrator {
             fn order(&self) -> u32 {
                 $order
             }
+        }
 
-            fn integrate(
+        impl driver::Method for $ty {
+            fn run(
                 &mut self,
+                problem: &Problem<'_>,
                 system: &mut dyn OdeSystem,
-                t0: f64,
-                y0: &[f64],
-                t_end: f64,
-                output: &OutputTimes,
-                options: &IntegratorOptions,
             ) -> Result<Solution, IntegrationFailure> {
-                let problem = Problem::new(t0, y0, t_end, output, options);
-                let control = if options.fixed_step {
-                    Control::Fixed
-                } else {
-                    Control::Adaptive {
-                        controller: &mut self.controller,
-                        error_order: $error_order,
-                    }
-                };
-                driver::run(&problem, system, control, |shape| {
+                let control =
+                    Control::from_options(problem.options, &mut self.controller, $error_order);
+                driver::run(problem, system, control, |shape| {
                     let $dim = shape.dim;
                     Ok($stepper)
                 })
@@ -100,18 +91,15 @@ macro_rules! fixed_step_integrator {
             fn order(&self) -> u32 {
                 $order
             }
+        }
 
-            fn integrate(
+        impl driver::Method for $ty {
+            fn run(
                 &mut self,
+                problem: &Problem<'_>,
                 system: &mut dyn OdeSystem,
-                t0: f64,
-                y0: &[f64],
-                t_end: f64,
-                output: &OutputTimes,
-                options: &IntegratorOptions,
             ) -> Result<Solution, IntegrationFailure> {
-                let problem = Problem::new(t0, y0, t_end, output, options);
-                driver::run(&problem, system, Control::Fixed, |shape| {
+                driver::run(problem, system, Control::Fixed, |shape| {
                     Ok(ExplicitRk::new($tableau, shape.dim))
                 })
             }
