@@ -139,9 +139,9 @@ pub trait OdeSystem {
     /// written as a closure) has none.
     ///
     /// # Errors
-    /// [`TaylorUnsupported`](crate::taylor::TaylorUnsupported) naming what is missing.
-    fn taylor_support(&self) -> Result<(), crate::taylor::TaylorUnsupported> {
-        Err(crate::taylor::TaylorUnsupported::NotGenerated)
+    /// [`TaylorUnsupported`](eomgen_description::taylor::TaylorUnsupported) naming what is missing.
+    fn taylor_support(&self) -> Result<(), eomgen_description::taylor::TaylorUnsupported> {
+        Err(eomgen_description::taylor::TaylorUnsupported::NotGenerated)
     }
 
     /// The Taylor coefficients of the solution through `(t, y)` up to `order`:
@@ -329,7 +329,7 @@ where
         (self.g)(self.system, t, y, added)
     }
 
-    fn taylor_support(&self) -> Result<(), crate::taylor::TaylorUnsupported> {
+    fn taylor_support(&self) -> Result<(), eomgen_description::taylor::TaylorUnsupported> {
         self.system.taylor_support()
     }
 

@@ -26,7 +26,7 @@ use super::lower::{BalanceInfo, LoadInfo};
 use super::momentum::linear_in_accelerations;
 use super::{EquationsOfMotion, Formulation, SymbolicModel};
 use crate::expr::{ExprArena, ExprId};
-use crate::model::AmbForm;
+use crate::model::file::AmbForm;
 
 /// One set of the model's `balances:` as equations of motion: the set at index `set` of
 /// [`SymbolicModel::balance_sets`] (the only one in the plain list form).

@@ -15,7 +15,8 @@ use super::{
 };
 use crate::expr::eval::Evaluator;
 use crate::expr::{ExprId, SymbolKind, cse};
-use crate::model::{AmbForm, Diagnostic, ModelFile};
+use crate::model::diagnostic::Diagnostic;
+use crate::model::file::{AmbForm, ModelFile};
 
 /// Cost and time of one derivation.
 #[derive(Debug, Clone, PartialEq)]

@@ -17,7 +17,8 @@
 //! used) is not bounded here. The growth itself is the subject of another issue.
 
 use super::SymbolicModel;
-use crate::model::{Diagnostic, ModelFile};
+use crate::model::diagnostic::Diagnostic;
+use crate::model::file::ModelFile;
 
 /// The operands a model's derivations may build ([`crate::expr::ExprArena::limit_operands`]):
 /// about half a gigabyte of expressions, and about a minute of processor time for the

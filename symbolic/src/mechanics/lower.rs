@@ -7,12 +7,11 @@ use rustc_hash::FxHashMap;
 use super::constraints::{ConstraintEquations, linear_in_rates, redundant_rows};
 use super::frames::{Frames, Vector3};
 use crate::expr::{Constant, ExprArena, ExprId, Func, SymbolId, SymbolKind};
+use crate::model::ast::{BinOp, Expr, ExprKind};
+use crate::model::diagnostic::Diagnostic;
+use crate::model::file::{BodyKind, FloquetReference, GROUND_FRAME, ModelFile, TorqueValue};
+use crate::model::located::{Located, Location};
 use crate::model::rules::short;
-use crate::model::{
-    BinOp, BodyKind, Diagnostic, Expr, ExprKind, FloquetReference, GROUND_FRAME, ModelFile,
-    TorqueValue,
-};
-use crate::model::{Located, Location};
 
 /// A parameter of a lowered model.
 #[derive(Debug, Clone, PartialEq)]
@@ -121,7 +120,7 @@ pub enum BalanceInfo {
         /// The bodies.
         bodies: Vec<usize>,
         /// How the balance is written.
-        form: crate::model::AmbForm,
+        form: crate::model::file::AmbForm,
         /// The axis `e` of a 3-D balance, in the ground frame's components; `None` in the
         /// plane.
         axis: Option<Vec<ExprId>>,
@@ -271,7 +270,7 @@ pub struct EventInfo {
     /// The event function `g(q, q̇, q̈, λ, t)`.
     pub function: ExprId,
     /// Which crossings count.
-    pub direction: crate::model::Crossing,
+    pub direction: crate::model::file::Crossing,
     /// Whether it ends the integration.
     pub terminal: bool,
 }
@@ -1478,7 +1477,7 @@ impl<'f> Lowering<'f> {
     /// and carried into the ground frame's.
     fn wheel_contact(
         &mut self,
-        wheel: &crate::model::WheelContact,
+        wheel: &crate::model::file::WheelContact,
         points: &Points,
         frames: &Frames,
     ) -> Vec<ExprId> {
@@ -1535,7 +1534,7 @@ impl<'f> Lowering<'f> {
     /// with the wheel's frame.
     fn drawn_wheel(
         &mut self,
-        wheel: &crate::model::WheelContact,
+        wheel: &crate::model::file::WheelContact,
         points: &mut Points,
         frames: &Frames,
     ) -> Vec<[usize; 2]> {
@@ -1674,7 +1673,7 @@ impl<'f> Lowering<'f> {
         &mut self,
         frames: &mut Frames,
         frame: &Located<String>,
-        inertia: &crate::model::InertiaTensor,
+        inertia: &crate::model::file::InertiaTensor,
         terms: &mut Terms,
     ) -> Option<SpatialBody> {
         let Some(f) = frames.index(&frame.value) else {
@@ -1915,7 +1914,7 @@ impl<'f> Lowering<'f> {
                 .filter_map(|name| body_infos.iter().position(|x| x.name == name.value))
                 .collect();
             match &b.kind {
-                crate::model::BalanceKind::Amb {
+                crate::model::file::BalanceKind::Amb {
                     about,
                     form,
                     axis,
@@ -1946,7 +1945,7 @@ impl<'f> Lowering<'f> {
                         )),
                     }
                 }
-                crate::model::BalanceKind::Lmb { along } => {
+                crate::model::file::BalanceKind::Lmb { along } => {
                     let along = along.iter().map(|e| self.expr(e)).collect();
                     balances.push(BalanceInfo::Lmb { along, bodies });
                 }
@@ -2086,7 +2085,7 @@ impl Lowering<'_> {
     /// unknown.
     fn rolling_contact(
         &mut self,
-        r: &crate::model::RollingContact,
+        r: &crate::model::file::RollingContact,
         k: Kinematics<'_>,
     ) -> Vec<(String, ExprId)> {
         let body = k.bodies.iter().find(|b| b.name == r.body.value);

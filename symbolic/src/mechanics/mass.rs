@@ -18,7 +18,8 @@ use rand::{RngExt, SeedableRng};
 
 use crate::expr::SymbolKind;
 use crate::expr::eval::Evaluator;
-use crate::model::{Diagnostic, ModelFile};
+use crate::model::diagnostic::Diagnostic;
+use crate::model::file::ModelFile;
 
 use super::{EquationsOfMotion, SymbolicModel};
 
