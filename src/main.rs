@@ -1,4 +1,5 @@
-//! The `eomgen` command line: list, simulate (more commands arrive with later features).
+//! The `eomgen` command line (`src/cli/`): parses the arguments, calls one library function per
+//! command and renders its report; `eomgen --help` lists the commands, docs/cli.md describes them.
 
 mod cli;
 

@@ -1,0 +1,423 @@
+//! The lowering of the loads: `interactions:`, `springs:`, `dampers:`, `forces:` and `torques:`,
+//! each into its `LoadInfo` and its part of `V` or `Q`.
+
+use super::*;
+
+impl Lowering<'_> {
+    /// `interactions:` — equal and opposite forces `f e` on `B` and `−f e` on `A` along
+    /// `e = d/r`, `d = r_B − r_A`, `r = |d|`, `ṙ = d·ḋ/r`. A magnitude that is a sum of
+    /// powers of `r` times factors constant in the motion (parameters, `t`) is integrated to
+    /// a potential, `V(r) = −∫ f dr` (`−c ln r` for `c/r`), so that `T + V` stays the
+    /// energy; any other enters `Q` as `Qᵢ = f d·∂d/∂qᵢ / r` (its virtual work `f e·δd`).
+    /// Either way momentum balance gets the two forces at the points.
+    ///
+    /// Returns the loads and, per interaction, `(r, f)` at the points' positions, for the
+    /// check of the initial state.
+    pub(super) fn interactions(
+        &mut self,
+        points: &Points,
+        q_symbols: &[SymbolId],
+        terms: &mut Terms,
+    ) -> (Vec<LoadInfo>, Vec<(ExprId, ExprId)>) {
+        let mut loads = Vec::new();
+        let mut at_start = Vec::new();
+        if self.file.interactions.is_empty() {
+            return (loads, at_start);
+        }
+        // Names no model symbol can have (a space is not in a name), substituted away below.
+        let r_symbol = self.arena.declare("interaction r", SymbolKind::Auxiliary);
+        let rdot_symbol = self
+            .arena
+            .declare("interaction r_dot", SymbolKind::Auxiliary);
+        for it in &self.file.interactions {
+            let (Some(a), Some(b)) = (
+                point(points, &it.between[0].value),
+                point(points, &it.between[1].value),
+            ) else {
+                self.errors.push(Diagnostic::new(
+                    it.name.location,
+                    format!("interaction `{}` names an unknown point", it.name.value),
+                ));
+                continue;
+            };
+            let d = self.difference(&points[b].1, &points[a].1);
+            let dd: Vec<ExprId> = d.iter().map(|c| self.arena.time_derivative(*c)).collect();
+            let d2 = self.dot(&d, &d);
+            let r = self.arena.sqrt(d2);
+            let d_dd = self.dot(&d, &dd);
+            let rdot = self.arena.divide(d_dd, r);
+            let (r_local, rdot_local) = (
+                self.arena.symbol_expr(r_symbol),
+                self.arena.symbol_expr(rdot_symbol),
+            );
+            self.locals = vec![
+                ("r".to_string(), r_local),
+                ("r_dot".to_string(), rdot_local),
+            ];
+            let f_of_r = self.expr(&it.magnitude);
+            self.locals.clear();
+            let mut values = FxHashMap::default();
+            values.insert(r_symbol, r);
+            values.insert(rdot_symbol, rdot);
+            let f = self.arena.substitute(f_of_r, &values);
+            // f e on B, −f e on A.
+            let scale = self.arena.divide(f, r);
+            let on_b: Vec<ExprId> = d.iter().map(|c| self.arena.times(scale, *c)).collect();
+            let on_a: Vec<ExprId> = on_b.iter().map(|c| self.arena.neg(*c)).collect();
+            loads.push(LoadInfo::Force {
+                point: b,
+                vector: on_b,
+            });
+            loads.push(LoadInfo::Force {
+                point: a,
+                vector: on_a,
+            });
+            at_start.push((r, f));
+            match self.power_law_potential(f_of_r, r_symbol, rdot_symbol) {
+                Some(v_of_r) => {
+                    let v = self.arena.substitute(v_of_r, &values);
+                    terms.potential.push(v);
+                }
+                None => {
+                    for (i, qs) in q_symbols.iter().enumerate() {
+                        let partial: Vec<ExprId> =
+                            d.iter().map(|x| self.arena.diff(*x, *qs)).collect();
+                        let proj = self.dot(&d, &partial);
+                        if !self.arena.is_zero(proj) {
+                            terms.forces[i].push(self.arena.times(scale, proj));
+                        }
+                    }
+                }
+            }
+        }
+        (loads, at_start)
+    }
+
+    /// `V(r) = −∫ f dr` of a magnitude `f` that is a sum of terms `c rᵏ`, `k` a number and
+    /// `c` free of `r`, `ṙ`, the coordinates and the rates: `−c r^(k+1)/(k+1)`, or `−c ln r`
+    /// for `k = −1`. `None` for any other magnitude (it is not, or not visibly, the
+    /// derivative of a potential of `r`).
+    pub(super) fn power_law_potential(
+        &mut self,
+        f: ExprId,
+        r_symbol: SymbolId,
+        rdot_symbol: SymbolId,
+    ) -> Option<ExprId> {
+        use crate::expr::Node;
+        if self.arena.depends_on(f, rdot_symbol) {
+            return None;
+        }
+        let motion: Vec<SymbolId> = self
+            .arena
+            .coordinates()
+            .iter()
+            .flat_map(|c| [c[0], c[1]])
+            .collect();
+        let f = self.arena.expand(f);
+        let terms: Vec<ExprId> = match self.arena.node(f) {
+            Node::Add(ts) => ts.to_vec(),
+            _ => vec![f],
+        };
+        let mut potential = Vec::new();
+        for term in terms {
+            let factors: Vec<ExprId> = match self.arena.node(term) {
+                Node::Mul(fs) => fs.to_vec(),
+                _ => vec![term],
+            };
+            let mut power = vec![self.arena.int(0)];
+            let mut coefficient = Vec::new();
+            for factor in factors {
+                if !self.arena.depends_on(factor, r_symbol) {
+                    if motion.iter().any(|s| self.arena.depends_on(factor, *s)) {
+                        return None;
+                    }
+                    coefficient.push(factor);
+                    continue;
+                }
+                match self.arena.node(factor).clone() {
+                    Node::Symbol(s) if s == r_symbol => power.push(self.arena.int(1)),
+                    Node::Pow([base, exponent])
+                        if matches!(self.arena.node(base), Node::Symbol(s) if *s == r_symbol)
+                            && self.arena.as_constant(exponent).is_some() =>
+                    {
+                        power.push(exponent);
+                    }
+                    _ => return None,
+                }
+            }
+            let c = self.arena.product(&coefficient);
+            let k = self.arena.sum(&power);
+            let one = self.arena.int(1);
+            let k1 = self.arena.plus(k, one);
+            let r = self.arena.symbol_expr(r_symbol);
+            let integral = if self.arena.is_zero(k1) {
+                let ln = self.arena.func(Func::Ln, r);
+                self.arena.times(c, ln)
+            } else {
+                let rk1 = self.arena.pow(r, k1);
+                let crk1 = self.arena.times(c, rk1);
+                self.arena.divide(crk1, k1)
+            };
+            potential.push(self.arena.neg(integral));
+        }
+        Some(self.arena.sum(&potential))
+    }
+
+    /// Reports an interaction whose points coincide at the initial state (`r = 0`: no
+    /// direction), or whose magnitude is not a finite number there; the parameters at
+    /// their defaults.
+    pub(super) fn check_interactions_at_start(
+        &mut self,
+        at_start: &[(ExprId, ExprId)],
+        parameters: &[ParameterInfo],
+        initial: (&[ExprId], &[ExprId]),
+    ) {
+        if at_start.is_empty() {
+            return;
+        }
+        let mut bindings = vec![0.0; self.arena.symbols().len()];
+        for p in parameters {
+            bindings[p.symbol.index()] = p.default;
+        }
+        let starts: Vec<ExprId> = initial.0.iter().chain(initial.1).copied().collect();
+        let start = crate::expr::eval::Evaluator::new(&self.arena, &starts).eval(&bindings);
+        let n = initial.0.len();
+        for (i, s) in self.arena.symbols().iter().enumerate() {
+            match s.kind {
+                SymbolKind::Coordinate(k) => bindings[i] = start[k as usize],
+                SymbolKind::Velocity(k) => bindings[i] = start[n + k as usize],
+                _ => {}
+            }
+        }
+        let roots: Vec<ExprId> = at_start.iter().flat_map(|(r, f)| [*r, *f]).collect();
+        let values = crate::expr::eval::Evaluator::new(&self.arena, &roots).eval(&bindings);
+        for (it, v) in self.file.interactions.iter().zip(values.chunks(2)) {
+            let (r, f) = (v[0], v[1]);
+            let [a, b] = &it.between;
+            if r == 0.0 {
+                self.errors.push(
+                    Diagnostic::new(
+                        b.location,
+                        format!(
+                            "the points `{}` and `{}` of interaction `{}` coincide at the initial state (r = 0): the line of its force is undefined there",
+                            a.value, b.value, it.name.value
+                        ),
+                    )
+                    .with_help("start the points apart (`initial:`), or check their positions under `points:`"),
+                );
+            } else if !f.is_finite() && r.is_finite() {
+                self.errors.push(
+                    Diagnostic::new(
+                        it.magnitude.location,
+                        format!(
+                            "the magnitude of interaction `{}` is {f} at the initial state (r = {})",
+                            it.name.value,
+                            short(r)
+                        ),
+                    )
+                    .with_help("a magnitude must be a finite number where the motion starts; check the formula and the initial state"),
+                );
+            }
+        }
+    }
+
+    /// Springs: V = ½ k (|r_A − r_B| − ℓ₀)², or ½ k |r_A − r_B|² for zero rest length.
+    pub(super) fn springs(&mut self, points: &Points, terms: &mut Terms) -> Vec<LoadInfo> {
+        let mut loads = Vec::new();
+        for s in &self.file.springs {
+            let (Some(a), Some(b)) = (
+                point(points, &s.between[0].value),
+                point(points, &s.between[1].value),
+            ) else {
+                self.errors.push(Diagnostic::new(
+                    s.name.location,
+                    format!("spring `{}` names an unknown point", s.name.value),
+                ));
+                continue;
+            };
+            let d = self.difference(&points[a].1, &points[b].1);
+            let d2 = self.dot(&d, &d);
+            let k = self.expr(&s.stiffness);
+            let rest = s.rest_length.as_ref().map(|l| self.expr(l));
+            loads.push(LoadInfo::Spring {
+                between: [a, b],
+                stiffness: k,
+                rest_length: rest,
+            });
+            let stretch2 = match rest {
+                None => d2,
+                Some(l0) => {
+                    let len = self.arena.sqrt(d2);
+                    let st = self.arena.minus(len, l0);
+                    let two = self.arena.int(2);
+                    self.arena.pow(st, two)
+                }
+            };
+            terms
+                .potential
+                .push(self.arena.product(&[terms.half, k, stretch2]));
+        }
+        loads
+    }
+
+    /// Dampers along the line AB: F_A = −c (ḋ·e) e with d = r_A − r_B, e = d/|d|, so
+    /// Qᵢ = F_A·∂d/∂qᵢ = −c (d·ḋ)(d·∂d/∂qᵢ)/(d·d).
+    pub(super) fn dampers(
+        &mut self,
+        points: &Points,
+        q_symbols: &[SymbolId],
+        terms: &mut Terms,
+    ) -> Vec<LoadInfo> {
+        let mut loads = Vec::new();
+        for dmp in &self.file.dampers {
+            let (Some(a), Some(b)) = (
+                point(points, &dmp.between[0].value),
+                point(points, &dmp.between[1].value),
+            ) else {
+                self.errors.push(Diagnostic::new(
+                    dmp.name.location,
+                    format!("damper `{}` names an unknown point", dmp.name.value),
+                ));
+                continue;
+            };
+            let d = self.difference(&points[a].1, &points[b].1);
+            let dd: Vec<ExprId> = d.iter().map(|c| self.arena.time_derivative(*c)).collect();
+            let c = self.expr(&dmp.coefficient);
+            loads.push(LoadInfo::Damper {
+                between: [a, b],
+                coefficient: c,
+            });
+            let d2 = self.dot(&d, &d);
+            let rate = self.dot(&d, &dd);
+            let c_rate = self.arena.times(c, rate);
+            let scale = self.arena.divide(c_rate, d2);
+            let scale = self.arena.neg(scale);
+            for (i, qs) in q_symbols.iter().enumerate() {
+                let partial: Vec<ExprId> = d.iter().map(|x| self.arena.diff(*x, *qs)).collect();
+                let proj = self.dot(&d, &partial);
+                if !self.arena.is_zero(proj) {
+                    terms.forces[i].push(self.arena.times(scale, proj));
+                }
+            }
+        }
+        loads
+    }
+
+    /// Forces at points: Qᵢ = F·∂r_P/∂qᵢ (the partial velocity ∂v_P/∂q̇ᵢ); a force written
+    /// in a frame (`in: B`) is carried into the ground frame's components first.
+    pub(super) fn forces(
+        &mut self,
+        points: &Points,
+        frames: &Frames,
+        q_symbols: &[SymbolId],
+        terms: &mut Terms,
+    ) -> Vec<LoadInfo> {
+        let mut loads = Vec::new();
+        for f in &self.file.forces {
+            let Some(ip) = point(points, &f.at.value) else {
+                self.errors.push(Diagnostic::new(
+                    f.at.location,
+                    format!("unknown point `{}`", f.at.value),
+                ));
+                continue;
+            };
+            let mut force: Vec<ExprId> = f.vector.iter().map(|c| self.expr(c)).collect();
+            if let Some(frame) = &f.frame
+                && let (Some(from), &[x, y, z]) = (frames.index(&frame.value), &force[..])
+            {
+                force = frames.express(&mut self.arena, [x, y, z], from, 0).to_vec();
+            }
+            loads.push(LoadInfo::Force {
+                point: ip,
+                vector: force.clone(),
+            });
+            let r = &points[ip].1;
+            for (i, qs) in q_symbols.iter().enumerate() {
+                let partial: Vec<ExprId> = r.iter().map(|x| self.arena.diff(*x, *qs)).collect();
+                let proj = self.dot(&force, &partial);
+                if !self.arena.is_zero(proj) {
+                    terms.forces[i].push(proj);
+                }
+            }
+        }
+        loads
+    }
+
+    /// Torques on planar bodies: Qᵢ = τ ∂θ/∂qᵢ (partial angular velocity); on 3-D bodies
+    /// Qᵢ = τ·∂ω/∂q̇ᵢ, both in the body frame's components.
+    pub(super) fn torques(
+        &mut self,
+        angles: &[(String, ExprId)],
+        body_infos: &[BodyInfo],
+        frames: &Frames,
+        q_symbols: &[SymbolId],
+        terms: &mut Terms,
+    ) -> Vec<LoadInfo> {
+        let mut loads = Vec::new();
+        for tq in &self.file.torques {
+            let value = match &tq.value {
+                TorqueValue::Planar(value) => value,
+                TorqueValue::Spatial { vector, frame, .. } => {
+                    let body = body_infos.iter().position(|b| b.name == tq.body.value);
+                    let Some((b, Some(spatial))) =
+                        body.map(|b| (b, body_infos[b].spatial.as_ref()))
+                    else {
+                        self.errors.push(Diagnostic::new(
+                            tq.body.location,
+                            format!("`{}` is not a 3-D rigid body", tq.body.value),
+                        ));
+                        continue;
+                    };
+                    let from = match frame {
+                        Some(f) => frames.index(&f.value).unwrap_or(0),
+                        None => 0,
+                    };
+                    let [x, y, z] = &vector[..] else { continue };
+                    let v = [x, y, z].map(|c| self.expr(c));
+                    let v = frames.express(&mut self.arena, v, from, spatial.frame);
+                    for i in 0..q_symbols.len() {
+                        let rate = self.arena.coordinates()[i][1];
+                        let partial: Vec<ExprId> = spatial
+                            .angular_velocity
+                            .iter()
+                            .map(|w| self.arena.diff(*w, rate))
+                            .collect();
+                        let proj = self.dot(&v, &partial);
+                        if !self.arena.is_zero(proj) {
+                            terms.forces[i].push(proj);
+                        }
+                    }
+                    loads.push(LoadInfo::SpatialTorque { body: b, vector: v });
+                    continue;
+                }
+            };
+            let Some(th) = angles
+                .iter()
+                .find(|(b, _)| *b == tq.body.value)
+                .map(|(_, a)| *a)
+            else {
+                self.errors.push(Diagnostic::new(
+                    tq.body.location,
+                    format!("`{}` is not a planar rigid body", tq.body.value),
+                ));
+                continue;
+            };
+            let tau = self.expr(value);
+            loads.push(LoadInfo::Torque {
+                body: body_infos
+                    .iter()
+                    .position(|b| b.name == tq.body.value)
+                    .unwrap_or(0),
+                angle: th,
+                value: tau,
+            });
+            for (i, qs) in q_symbols.iter().enumerate() {
+                let partial = self.arena.diff(th, *qs);
+                if !self.arena.is_zero(partial) {
+                    terms.forces[i].push(self.arena.times(tau, partial));
+                }
+            }
+        }
+        loads
+    }
+}

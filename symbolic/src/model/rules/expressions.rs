@@ -1,0 +1,480 @@
+//! The expressions of a model file: every name they use defined where it may be used, the vector
+//! functions of points, and the dimensions of vectors.
+
+use super::*;
+
+impl Checker<'_> {
+    // Rule: every name in an expression is a parameter or `pi`, and where the expression may
+    // depend on the configuration, a coordinate or `t`, and where it may depend on the
+    // motion, a rate `<coordinate>_dot`:
+    // - constant: masses, inertias, `gravity`, initial values;
+    // - configuration (no rates): point positions, `potential`, body angles, stiffnesses,
+    //   rest lengths, damping coefficients;
+    // - motion: `kinetic`, generalized forces, forces, torques.
+    // Accelerations (`_ddot`) appear nowhere: the equations of motion are derived.
+    pub(super) fn expressions(&mut self) {
+        let file = self.file;
+        if let Some(k) = &file.kinetic {
+            self.resolve(k, Depends::Motion, "`kinetic`");
+        }
+        if let Some(v) = &file.potential {
+            self.resolve(v, Depends::Position, "`potential`");
+        }
+        for (k, q) in &file.generalized_forces {
+            self.resolve(
+                q,
+                Depends::Motion,
+                &format!("the generalized force `{}`", k.value),
+            );
+        }
+        self.vectors = false;
+        for p in &file.points {
+            let relative = p.relative.iter().flat_map(|r| &r.vectors);
+            for c in p.position.iter().chain(relative.flat_map(|(_, v)| v)) {
+                self.resolve(
+                    c,
+                    Depends::Position,
+                    &format!("the position of point `{}`", p.name.value),
+                );
+            }
+        }
+        for f in &file.frames {
+            for r in &f.rotations {
+                self.resolve(
+                    &r.angle,
+                    Depends::Position,
+                    &format!("the rotation of frame `{}`", f.name.value),
+                );
+            }
+        }
+        self.vectors = true;
+        for b in &file.bodies {
+            let name = &b.name.value;
+            match &b.kind {
+                BodyKind::Particle { mass, .. } => {
+                    self.resolve(
+                        mass,
+                        Depends::Constant,
+                        &format!("the mass of body `{name}`"),
+                    );
+                }
+                BodyKind::Rigid {
+                    mass,
+                    inertia,
+                    angle,
+                    ..
+                } => {
+                    self.resolve(
+                        mass,
+                        Depends::Constant,
+                        &format!("the mass of body `{name}`"),
+                    );
+                    self.resolve(
+                        inertia,
+                        Depends::Constant,
+                        &format!("the inertia of body `{name}`"),
+                    );
+                    self.resolve(
+                        angle,
+                        Depends::Position,
+                        &format!("the angle of body `{name}`"),
+                    );
+                }
+                BodyKind::Spatial { mass, inertia, .. } => {
+                    self.resolve(
+                        mass,
+                        Depends::Constant,
+                        &format!("the mass of body `{name}`"),
+                    );
+                    for e in inertia.entries.iter().flatten() {
+                        self.resolve(
+                            e,
+                            Depends::Constant,
+                            &format!("the inertia of body `{name}`"),
+                        );
+                    }
+                }
+            }
+        }
+        if let Some(g) = &file.gravity {
+            for c in &g.value {
+                self.resolve(c, Depends::Constant, "`gravity`");
+            }
+        }
+        for s in &file.springs {
+            let name = &s.name.value;
+            self.resolve(
+                &s.stiffness,
+                Depends::Position,
+                &format!("the stiffness of spring `{name}`"),
+            );
+            if let Some(l) = &s.rest_length {
+                self.resolve(
+                    l,
+                    Depends::Position,
+                    &format!("the rest length of spring `{name}`"),
+                );
+            }
+        }
+        for d in &file.dampers {
+            self.resolve(
+                &d.coefficient,
+                Depends::Position,
+                &format!("the coefficient of damper `{}`", d.name.value),
+            );
+        }
+        for f in &file.forces {
+            for c in &f.vector {
+                self.resolve(c, Depends::Motion, &format!("force `{}`", f.name.value));
+            }
+        }
+        for t in &file.torques {
+            for e in t.value.expressions() {
+                self.resolve(e, Depends::Motion, &format!("torque `{}`", t.name.value));
+            }
+        }
+        for (k, e) in &file.initial {
+            self.resolve(
+                e,
+                Depends::Constant,
+                &format!("the initial value of `{}`", k.value),
+            );
+        }
+        for e in &file.events {
+            self.resolve(
+                &e.when,
+                Depends::Event,
+                &format!("the function of event `{}`", e.name.value),
+            );
+        }
+        for q in &file.equilibria {
+            for (c, e) in &q.values {
+                self.resolve(
+                    e,
+                    Depends::Constant,
+                    &format!("`{}` of equilibrium `{}`", c.value, q.name.value),
+                );
+            }
+        }
+    }
+
+    /// Reports every name in `e` that `depends` does not allow; `what` names the expression.
+    pub(super) fn resolve(&mut self, e: &Expr, depends: Depends, what: &str) {
+        let mut ids = Vec::new();
+        identifiers(e, &mut ids);
+        if vectors::uses_vectors(e) {
+            let Some(points) = self.vector_points(e, depends, what) else {
+                return;
+            };
+            ids.retain(|id| !points.contains(id));
+        }
+        for (n, at) in ids {
+            let n = n.as_str();
+            if self.interaction && n == "r" {
+                continue;
+            }
+            if self.interaction && n == "r_dot" {
+                if depends < Depends::Motion {
+                    self.error(
+                        Diagnostic::new(at, format!("{what} cannot depend on the rate `r_dot`"))
+                            .with_help("it may use parameters, coordinates, `t` and `r`"),
+                    );
+                }
+                continue;
+            }
+            let is_param = n == "pi" || self.sets.params.contains(n);
+            let is_coord = self.sets.coords.contains(n);
+            let is_rate = self.sets.rates.contains(n);
+            let is_acceleration =
+                depends >= Depends::Acceleration && self.sets.accelerations.contains(n);
+            let is_multiplier = depends >= Depends::Event && self.sets.multipliers.contains(n);
+            let is_angular_velocity =
+                self.angular_velocities && self.file.angular_velocity_name(n).is_some();
+            let needs = if is_param {
+                Depends::Constant
+            } else if is_coord || n == "t" {
+                Depends::Position
+            } else if is_rate || is_angular_velocity {
+                Depends::Motion
+            } else if is_acceleration {
+                Depends::Acceleration
+            } else if is_multiplier {
+                Depends::Event
+            } else {
+                self.unknown(n, at, depends, what);
+                continue;
+            };
+            if needs <= depends {
+                continue;
+            }
+            let d = match (depends, needs) {
+                (Depends::Constant, _) => {
+                    let kind = match needs {
+                        Depends::Motion => "the rate ",
+                        _ if n == "t" => "the time ",
+                        _ => "the coordinate ",
+                    };
+                    Diagnostic::new(
+                        at,
+                        format!("{what} must be constant, but it uses {kind}`{n}`"),
+                    )
+                    .with_help("use parameters, numbers, `pi` and functions of them")
+                }
+                _ => Diagnostic::new(at, format!("{what} cannot depend on the rate `{n}`"))
+                    .with_help("it may use parameters, coordinates and `t`, not rates"),
+            };
+            self.error(d);
+        }
+    }
+
+    /// The points `e` reads as vectors through the vector functions, with their locations;
+    /// `None` after reporting why it cannot: vectors where they are not allowed (the
+    /// definitions of points and frames, constants), shapes that do not fit
+    /// ([`vectors::check_shapes`]), `vel` where the rates are not allowed.
+    pub(super) fn vector_points(
+        &mut self,
+        e: &Expr,
+        depends: Depends,
+        what: &str,
+    ) -> Option<Vec<(String, Location)>> {
+        if !self.vectors || depends < Depends::Position {
+            let why = if self.vectors {
+                "which must be constant"
+            } else {
+                "which defines the points and frames they read"
+            };
+            self.error(
+                Diagnostic::new(
+                    e.location,
+                    format!("{what} uses the vector functions of points (`dot`, `cross`, `norm`, `distance`, `vel`), {why}"),
+                )
+                .with_help("write the expression with parameters, numbers and functions of them"),
+            );
+            return None;
+        }
+        let dimension = self.file.dimension.unwrap_or(2);
+        let used = match vectors::check_shapes(e, &self.points, dimension, what) {
+            Ok(used) => used,
+            Err(errors) => {
+                errors.into_iter().for_each(|d| self.error(d));
+                return None;
+            }
+        };
+        if depends < Depends::Motion && vectors::uses_velocities(e) {
+            self.error(
+                Diagnostic::new(
+                    e.location,
+                    format!("{what} cannot depend on the rates, but it uses `vel`"),
+                )
+                .with_help("it may use the positions of points, not their velocities"),
+            );
+            return None;
+        }
+        Some(used)
+    }
+
+    pub(super) fn unknown(&mut self, n: &str, at: Location, depends: Depends, what: &str) {
+        if self.incomplete.has_name(n)
+            || n.strip_suffix("_dot")
+                .is_some_and(|q| self.incomplete.has_name(q))
+        {
+            return;
+        }
+        if n.ends_with("_ddot") && depends < Depends::Acceleration {
+            self.error(
+                Diagnostic::new(
+                    at,
+                    format!("accelerations such as `{n}` cannot appear in a model file"),
+                )
+                .with_help(
+                    "the equations of motion are derived: give positions or energies, and loads",
+                ),
+            );
+            return;
+        }
+        // The rate (or acceleration) of something that is not a coordinate: a parameter, `t`,
+        // a point or a body.
+        let stem = n
+            .strip_suffix("_ddot")
+            .or_else(|| n.strip_suffix("_dot"))
+            .filter(|s| !self.sets.coords.contains(*s));
+        if let Some(stem) = stem {
+            let kind = if self.sets.params.contains(stem) {
+                Some("a parameter, which is constant")
+            } else if stem == "t" {
+                Some("the time")
+            } else if self.points.contains(&stem) {
+                Some("a point")
+            } else if self.bodies.contains(&stem) {
+                Some("a body")
+            } else {
+                None
+            };
+            if let Some(kind) = kind {
+                let coordinates = self.coords.join(", ");
+                self.error(
+                    Diagnostic::new(
+                        at,
+                        format!("`{n}` in {what} is a rate of `{stem}`, {kind}, not a coordinate"),
+                    )
+                    .with_help(format!(
+                        "only coordinates have rates (`<coordinate>_dot`; the coordinates are {coordinates}); a quantity that changes in time is a coordinate or a function of `t`"
+                    )),
+                );
+                return;
+            }
+        }
+        if self.points.contains(&n) || self.bodies.contains(&n) {
+            let kind = if self.points.contains(&n) {
+                "point"
+            } else {
+                "body"
+            };
+            self.error(
+                Diagnostic::new(at, format!("`{n}` is a {kind}; {what} cannot use it as a value"))
+                    .with_help("expressions use parameters, coordinates, rates, `t` and `pi`; write the components out"),
+            );
+            return;
+        }
+        if self.section_lost("parameters", self.file.parameters.is_empty())
+            || self.section_lost("coordinates", self.file.coordinates.is_empty())
+        {
+            return;
+        }
+        let mut candidates: Vec<&str> = self.params.clone();
+        if depends >= Depends::Position {
+            candidates.extend(&self.coords);
+            candidates.push("t");
+        }
+        if depends >= Depends::Motion {
+            candidates.extend(self.rates.iter().map(String::as_str));
+        }
+        if depends >= Depends::Acceleration {
+            candidates.extend(self.accelerations.iter().map(String::as_str));
+        }
+        if depends >= Depends::Event {
+            candidates.extend(self.multipliers.iter().map(String::as_str));
+        }
+        candidates.push("pi");
+        let d = Diagnostic::new(at, format!("unknown name `{n}` in {what}"));
+        let d = match closest(n, &candidates) {
+            Some(c) => d.with_help(format!("did you mean `{c}`?")),
+            None => d.with_help(format!(
+                "names here are: {}; declare parameters under `parameters:`",
+                candidates.join(", ")
+            )),
+        };
+        self.error(d);
+    }
+
+    // Rule: all points have the same number of components (2 or 3), and `gravity` and every
+    // force have as many; planar rigid bodies exist only in 2-D models; `gravity` needs
+    // points to act on.
+    pub(super) fn dimensions(&mut self) {
+        let file = self.file;
+        let Some(first) = file.points.first() else {
+            if let Some(g) = &file.gravity
+                && !self.incomplete.has_section("points")
+            {
+                self.error(
+                    Diagnostic::new(g.location, "`gravity` acts on bodies, but the model has no points")
+                        .with_help("add `points:` and `bodies:`, or write the gravitational energy into `potential:`"),
+                );
+            }
+            return;
+        };
+        let dim = first.dimension();
+        for p in &file.points[1..] {
+            if p.dimension() != dim {
+                self.error(
+                    Diagnostic::new(
+                        p.location,
+                        format!(
+                            "point `{}` has {} components but point `{}` has {dim}",
+                            p.name.value,
+                            p.dimension(),
+                            first.name.value
+                        ),
+                    )
+                    .with_help("a model is either planar (`[x, y]`) or spatial (`[x, y, z]`)"),
+                );
+            }
+        }
+        if let Some(g) = &file.gravity
+            && g.value.len() != dim
+        {
+            let example = if dim == 2 { "[0, -g]" } else { "[0, 0, -g]" };
+            self.error(
+                Diagnostic::new(
+                    g.location,
+                    format!(
+                        "`gravity` has {} components but the points have {dim}",
+                        g.value.len()
+                    ),
+                )
+                .with_help(format!("write it like `{example}`")),
+            );
+        }
+        for f in &file.forces {
+            if f.vector.len() != dim {
+                self.error(Diagnostic::new(
+                    f.location,
+                    format!(
+                        "force `{}` has {} components but the points have {dim}",
+                        f.name.value,
+                        f.vector.len()
+                    ),
+                ));
+            }
+        }
+        for b in &file.bodies {
+            match (&b.kind, dim) {
+                (BodyKind::Rigid { .. }, 3) => self.error(
+                    Diagnostic::new(
+                        b.name.location,
+                        format!("body `{}` is a planar rigid body, but the points are 3-D", b.name.value),
+                    )
+                    .with_help("a planar body (`inertia` a number, `angle`) turns in the plane of 2-component points; in 3-D a rigid body has a frame and an inertia tensor: `{ mass: m, com: G, frame: B, inertia: [I1, I2, I3] }`"),
+                ),
+                (BodyKind::Spatial { frame, .. }, 2) => self.error(
+                    Diagnostic::new(
+                        frame.location,
+                        format!("body `{}` is a 3-D rigid body, but the points are planar", b.name.value),
+                    )
+                    .with_help("a 3-D body's centre of mass is a 3-D point (`[x, y, z]` or `{ from: O, B: [0, 0, l] }`); a planar body is `{ mass: m, inertia: I, com: G, angle: theta }`"),
+                ),
+                _ => {}
+            }
+        }
+        for f in &file.forces {
+            if let Some(frame) = &f.frame
+                && f.vector.len() != 3
+            {
+                self.error(
+                    Diagnostic::new(frame.location, format!("force `{}` is written in frame `{}`, which needs 3 components", f.name.value, frame.value))
+                        .with_help("frames are 3-D: write `vector: [Fx, Fy, Fz]`, or leave out `in` for components in the plane"),
+                );
+            }
+        }
+        for t in &file.torques {
+            if let TorqueValue::Spatial {
+                vector, location, ..
+            } = &t.value
+                && vector.len() != 3
+            {
+                self.error(
+                    Diagnostic::new(*location, format!("the vector of torque `{}` has {} components; a torque on a 3-D body has 3", t.name.value, vector.len()))
+                        .with_help("write `vector: [Tx, Ty, Tz]`; a torque on a planar body is `value: tau`"),
+                );
+            }
+        }
+        if dim == 2
+            && let Some(f) = file.frames.first()
+        {
+            self.error(
+                Diagnostic::new(f.name.location, format!("frame `{}` is 3-D, but the points are planar", f.name.value))
+                    .with_help("frames orient 3-D bodies and place 3-D points; a planar model gives its bodies an `angle`"),
+            );
+        }
+    }
+}

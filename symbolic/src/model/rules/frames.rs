@@ -1,0 +1,171 @@
+//! The frames of a model file and the frames and points that other sections name.
+
+use super::*;
+
+impl Checker<'_> {
+    // Rule: frames have distinct names other than the ground `N` and `from`; each frame's
+    // parent is `N` or a frame defined before it (so that frames form a tree); a point
+    // written from another point names one defined before it, and its vectors known frames.
+    pub(super) fn frames(&mut self) {
+        let file = self.file;
+        let mut defined: Vec<&str> = vec![GROUND_FRAME];
+        for f in &file.frames {
+            let n = f.name.value.as_str();
+            if n == GROUND_FRAME || n == "from" {
+                let why = if n == "from" {
+                    "`from` is the key of a point's start"
+                } else {
+                    "`N` is the ground frame"
+                };
+                self.error(
+                    Diagnostic::new(
+                        f.name.location,
+                        format!("frame name `{n}` is reserved: {why}"),
+                    )
+                    .with_help("choose another name"),
+                );
+                continue;
+            }
+            let p = f.parent.value.as_str();
+            if !defined.contains(&p) {
+                let later = file.frames.iter().any(|g| g.name.value == p);
+                let d = if later {
+                    Diagnostic::new(f.parent.location, format!("frame `{n}` is turned from `{p}`, which is not defined before it"))
+                        .with_help("define a frame's parent above it (frames form a tree rooted at the ground frame `N`)")
+                } else {
+                    self.unknown_frame_message(&f.parent, &defined)
+                };
+                self.error(d);
+            }
+            if defined.contains(&n) {
+                self.error(
+                    Diagnostic::new(f.name.location, format!("duplicate frame name `{n}`"))
+                        .with_help("rename one"),
+                );
+            }
+            defined.push(n);
+        }
+        let frames: Vec<&str> = file
+            .frames
+            .iter()
+            .map(|f| f.name.value.as_str())
+            .chain([GROUND_FRAME])
+            .collect();
+        for (i, p) in file.points.iter().enumerate() {
+            if let Some(wheel) = &p.wheel {
+                let earlier = file.points[..i]
+                    .iter()
+                    .any(|q| q.name.value == wheel.centre.value);
+                if !earlier
+                    && file.points[i..]
+                        .iter()
+                        .any(|q| q.name.value == wheel.centre.value)
+                {
+                    self.error(
+                        Diagnostic::new(wheel.centre.location, format!("the wheel of point `{}` is centred at `{}`, which is not defined before it", p.name.value, wheel.centre.value))
+                            .with_help("define the wheel's centre above its contact point"),
+                    );
+                } else {
+                    self.point(&wheel.centre);
+                }
+                self.frame(&wheel.frame, &frames);
+                self.resolve(
+                    &wheel.radius,
+                    Depends::Constant,
+                    &format!("the wheel radius of point `{}`", p.name.value),
+                );
+                continue;
+            }
+            let Some(relative) = &p.relative else {
+                continue;
+            };
+            if let Some(from) = &relative.from {
+                let earlier = file.points[..i].iter().any(|q| q.name.value == from.value);
+                let later = file.points[i..].iter().any(|q| q.name.value == from.value);
+                if later && !earlier {
+                    self.error(
+                        Diagnostic::new(
+                            from.location,
+                            format!(
+                                "point `{}` is measured from `{}`, which is not defined before it",
+                                p.name.value, from.value
+                            ),
+                        )
+                        .with_help("define the point it starts from above it"),
+                    );
+                } else {
+                    self.point(from);
+                }
+            }
+            for (frame, _) in &relative.vectors {
+                self.frame(frame, &frames);
+            }
+        }
+        for b in &file.bodies {
+            if let BodyKind::Spatial { frame, .. } = &b.kind {
+                self.frame(frame, &frames);
+            }
+        }
+        for f in &file.forces {
+            if let Some(frame) = &f.frame {
+                self.frame(frame, &frames);
+            }
+        }
+        for w in &file.draw.wheels {
+            self.point(&w.centre);
+            self.frame(&w.frame, &frames);
+            self.resolve(&w.radius, Depends::Constant, "the radius of a drawn wheel");
+        }
+        for t in &file.torques {
+            if let TorqueValue::Spatial {
+                frame: Some(frame), ..
+            } = &t.value
+            {
+                self.frame(frame, &frames);
+            }
+        }
+    }
+
+    /// Reports `name` if it is not one of `frames`.
+    pub(super) fn frame(&mut self, name: &Located<String>, frames: &[&str]) {
+        if frames.contains(&name.value.as_str()) || self.incomplete.has_name(&name.value) {
+            return;
+        }
+        let d = self.unknown_frame_message(name, frames);
+        self.error(d);
+    }
+
+    /// "unknown frame", with the closest of `frames`.
+    pub(super) fn unknown_frame_message(
+        &self,
+        name: &Located<String>,
+        frames: &[&str],
+    ) -> Diagnostic {
+        let d = Diagnostic::new(name.location, format!("unknown frame `{}`", name.value));
+        match closest(&name.value, frames) {
+            Some(c) => d.with_help(format!("did you mean `{c}`?")),
+            None => d.with_help(format!(
+                "frames are: {} (the ground); declare one under `frames:`",
+                frames.join(", ")
+            )),
+        }
+    }
+
+    /// Reports `name` if it is not a point.
+    pub(super) fn point(&mut self, name: &Located<String>) {
+        let n = name.value.as_str();
+        if self.points.contains(&n)
+            || self.incomplete.has_name(n)
+            || self.section_lost("points", self.points.is_empty())
+        {
+            return;
+        }
+        let d = Diagnostic::new(name.location, format!("unknown point `{n}`"));
+        let d = match closest(n, &self.points) {
+            Some(c) => d.with_help(format!("did you mean `{c}`?")),
+            None if self.points.is_empty() => d.with_help("declare it under `points:`"),
+            None => d.with_help(format!("points are: {}", self.points.join(", "))),
+        };
+        self.error(d);
+    }
+}

@@ -1,0 +1,493 @@
+//! The mechanism of a model file: constraints, equations written by hand, interactions, balances,
+//! masses and inertias, and rolling contacts.
+
+use super::*;
+
+impl Checker<'_> {
+    // Rule: constraints have distinct names; holonomic ones depend on q and t, non-holonomic
+    // ones also on the rates; there are no more constraints than coordinates; `guess` marks
+    // coordinates (not rates) of a model that has constraints.
+    pub(super) fn constraints(&mut self) {
+        let file = self.file;
+        for (k, e) in &file.constraints {
+            self.resolve(e, Depends::Position, &format!("constraint `{}`", k.value));
+        }
+        for (k, e) in &file.nonholonomic {
+            self.resolve(e, Depends::Motion, &format!("constraint `{}`", k.value));
+        }
+        let names = file.constraint_names();
+        let mut seen: Vec<(&str, Location)> = Vec::new();
+        for k in &names {
+            if let Some((_, first)) = seen.iter().find(|(n, _)| *n == k.value) {
+                self.error(
+                    Diagnostic::new(k.location, format!("duplicate constraint name `{}`: already used at {first}", k.value))
+                        .with_help("constraints under `constraints` and `nonholonomic` share one namespace (a rolling contact `roll` names its rows `roll_x`, `roll_y`, …); rename one"),
+                );
+            } else {
+                seen.push((&k.value, k.location));
+            }
+        }
+        for r in &file.rolling {
+            self.rolling_contact(r);
+        }
+        for c in &file.point_constraints {
+            self.point(&c.point);
+            if file.dimension == Some(2) {
+                if let Some(frame) = &c.frame {
+                    self.error(
+                        Diagnostic::new(
+                            frame.location,
+                            format!(
+                                "constraint `{}` is in a planar model, which has no frames",
+                                c.name.value
+                            ),
+                        )
+                        .with_help("leave out `in`: the axes are the plane's x and y"),
+                    );
+                }
+                if c.along.value == Axis::Z {
+                    self.error(
+                        Diagnostic::new(
+                            c.along.location,
+                            format!(
+                                "constraint `{}` is planar, so it has no `z` axis",
+                                c.name.value
+                            ),
+                        )
+                        .with_help("in a planar model `along` is `x` or `y`"),
+                    );
+                }
+            } else if let Some(frame) = &c.frame {
+                let frames: Vec<&str> = file
+                    .frames
+                    .iter()
+                    .map(|f| f.name.value.as_str())
+                    .chain([GROUND_FRAME])
+                    .collect();
+                self.frame(frame, &frames);
+            }
+        }
+        let m = names.len();
+        let n = file.coordinates.len();
+        if m > n && !self.incomplete.has_section("coordinates") {
+            let at = names.get(n).map_or(file.name.location, |k| k.location);
+            self.error(
+                Diagnostic::new(at, format!("{m} constraints on {n} coordinate(s): more constraints than coordinates"))
+                    .with_help("each constraint removes one degree of freedom; remove redundant constraints or add coordinates"),
+            );
+        }
+        for g in &file.initial_guesses {
+            if !self.sets.coords.contains(g.value.as_str()) {
+                self.error(
+                    Diagnostic::new(
+                        g.location,
+                        format!(
+                            "`{}` is not a coordinate: only coordinates take `{{ guess: … }}`",
+                            g.value
+                        ),
+                    )
+                    .with_help(
+                        "the rates of guessed coordinates are solved from the velocity constraints",
+                    ),
+                );
+            } else if m == 0 && !self.incomplete.has_section("constraints") {
+                self.error(
+                    Diagnostic::new(
+                        g.location,
+                        format!(
+                            "`{}` is a guess, but the model has no constraints to solve it from",
+                            g.value
+                        ),
+                    )
+                    .with_help("give its value directly: `initial: { x: 0.5 }`"),
+                );
+            }
+        }
+    }
+
+    // Rule: equations of motion written by hand (`checks: equations_of_motion`) are one per
+    // coordinate and use parameters, coordinates, rates, accelerations and `t`.
+    pub(super) fn hand_equations(&mut self) {
+        let file = self.file;
+        let equations = &file.checks.equations_of_motion;
+        let Some(first) = equations.first() else {
+            return;
+        };
+        let n = file.coordinates.len();
+        if equations.len() != n && !self.incomplete.has_section("checks") {
+            self.error(
+                Diagnostic::new(
+                    first.location,
+                    format!(
+                        "{} equation(s) of motion for {n} coordinate(s): give one per coordinate",
+                        equations.len()
+                    ),
+                )
+                .with_help("write each equation as `lhs = rhs` in the coordinates, rates (`x_dot`) and accelerations (`x_ddot`)"),
+            );
+        }
+        for (i, e) in equations.iter().enumerate() {
+            let what = format!("equation of motion {}", i + 1);
+            self.resolve(&e.lhs, Depends::Acceleration, &what);
+            if let Some(rhs) = &e.rhs {
+                self.resolve(rhs, Depends::Acceleration, &what);
+            }
+        }
+    }
+
+    /// Reports `name` unless it is a parameter; `what` says where it was written.
+    // Rule: an interaction acts between two distinct points of the model; its magnitude is
+    // a function of the motion, where `r` and `r_dot` are the distance and its rate, which
+    // are then no other name of the model.
+    pub(super) fn interactions(&mut self) {
+        let file = self.file;
+        for i in &file.interactions {
+            let name = &i.name.value;
+            i.between.iter().for_each(|p| self.point(p));
+            let [a, b] = &i.between;
+            if a.value == b.value {
+                self.error(
+                    Diagnostic::new(
+                        b.location,
+                        format!("interaction `{name}` acts between `{}` and itself", a.value),
+                    )
+                    .with_help("an interaction acts along the line of two distinct points; name the other point"),
+                );
+            }
+            let what = format!("the magnitude of interaction `{name}`");
+            let mut ids = Vec::new();
+            identifiers(&i.magnitude, &mut ids);
+            for (n, at) in &ids {
+                let taken = if self.sets.params.contains(n.as_str()) {
+                    Some("a parameter")
+                } else if self.sets.coords.contains(n.as_str()) {
+                    Some("a coordinate")
+                } else if n == "r_dot" && self.sets.rates.contains(n.as_str()) {
+                    Some("the rate of coordinate `r`")
+                } else if self.points.contains(&n.as_str()) {
+                    Some("a point")
+                } else {
+                    None
+                };
+                if let Some(kind) = taken
+                    && crate::model::file::INTERACTION_NAMES.contains(&n.as_str())
+                {
+                    self.error(
+                        Diagnostic::new(
+                            *at,
+                            format!("`{n}` in {what} is ambiguous: it names the distance of the points (or its rate), and {kind} of the model"),
+                        )
+                        .with_help("rename the model's `r`, or write the distance as `distance(A, B)` and its rate as `dot(A - B, vel(A) - vel(B))/distance(A, B)`"),
+                    );
+                }
+            }
+            self.interaction = true;
+            self.resolve(&i.magnitude, Depends::Motion, &what);
+            self.interaction = false;
+        }
+    }
+
+    // Rule: user balances name existing bodies (each once per balance) and, for AMB, an
+    // existing point; AMB needs a planar model; an LMB direction has as many components as
+    // the points and depends only on parameters, coordinates and `t`; there are as many
+    // balances as coordinates; and, since only gravity (at each centre of mass) and torques
+    // (which name their body) can be assigned to the chosen bodies, a model with balances has
+    // no point loads (forces, springs, dampers) and no energy-form pieces.
+    pub(super) fn balances(&mut self) {
+        let file = self.file;
+        if file.balances.is_empty() {
+            return;
+        }
+        let n = file.coordinates.len();
+        for set in file.balance_sets() {
+            let count = file.balances.iter().filter(|b| b.set_name() == set).count();
+            let first = file.balances.iter().find(|b| b.set_name() == set);
+            if count != n
+                && let Some(first) = first
+            {
+                let location = first.set.as_ref().map_or(first.location, |s| s.location);
+                let which = match set {
+                    Some(name) => format!("the set `{name}` has "),
+                    None => String::new(),
+                };
+                self.error(
+                    Diagnostic::new(
+                        location,
+                        format!("{which}{count} balance(s) for {n} coordinate(s): the balances must give one equation per coordinate"),
+                    )
+                    .with_help("choose as many balances as coordinates, each free of reaction forces (HW19: AMB/O of both bars and AMB/E of the forearm)"),
+                );
+            }
+        }
+        let point_loads = file
+            .forces
+            .first()
+            .map(|f| (f.name.location, "a force"))
+            .or_else(|| file.springs.first().map(|s| (s.name.location, "a spring")))
+            .or_else(|| file.dampers.first().map(|d| (d.name.location, "a damper")))
+            .or_else(|| {
+                file.interactions
+                    .first()
+                    .map(|i| (i.name.location, "an interaction"))
+            });
+        if let Some((location, what)) = point_loads {
+            self.error(
+                Diagnostic::new(location, format!("{what} in a model with `balances` is not supported yet"))
+                    .with_help("a balance needs to know which body each load acts on; for now balances take gravity and torques only"),
+            );
+        }
+        if file.kinetic.is_some() || file.potential.is_some() || !file.generalized_forces.is_empty()
+        {
+            self.error(
+                Diagnostic::new(file.balances[0].location, "`balances` need the kinematic form, but the model gives `kinetic`, `potential` or `generalized_forces`")
+                    .with_help("describe the mechanism with `points`, `bodies` and loads"),
+            );
+        }
+        for b in &file.balances {
+            let mut seen: Vec<&str> = Vec::new();
+            for body in &b.bodies {
+                if !self.bodies.contains(&body.value.as_str()) {
+                    let d = Diagnostic::new(
+                        body.location,
+                        format!("unknown body `{}` in a balance", body.value),
+                    );
+                    let d = match closest(&body.value, &self.bodies) {
+                        Some(c) => d.with_help(format!("did you mean `{c}`?")),
+                        None => d.with_help(format!("bodies are: {}", self.bodies.join(", "))),
+                    };
+                    self.error(d);
+                } else if seen.contains(&body.value.as_str()) {
+                    self.error(Diagnostic::new(
+                        body.location,
+                        format!("body `{}` is listed twice in this balance", body.value),
+                    ));
+                }
+                seen.push(body.value.as_str());
+            }
+            match &b.kind {
+                BalanceKind::Amb {
+                    about, axis, frame, ..
+                } => {
+                    if !self.points.contains(&about.value.as_str()) {
+                        let d = Diagnostic::new(
+                            about.location,
+                            format!("unknown point `{}`", about.value),
+                        );
+                        let d = match closest(&about.value, &self.points) {
+                            Some(c) => d.with_help(format!("did you mean `{c}`?")),
+                            None => d.with_help(format!("points are: {}", self.points.join(", "))),
+                        };
+                        self.error(d);
+                    }
+                    match (file.dimension, axis) {
+                        (Some(3), None) => self.error(
+                            Diagnostic::new(b.location, "an `amb` balance of a 3-D model needs the `axis` it takes moments about")
+                                .with_help("write `{ amb: { about: O, bodies: [top], axis: [0, 0, 1], in: N } }`: the balance Σ M_O·e = (dH_O/dt)·e along that axis"),
+                        ),
+                        (Some(3), Some(axis)) if axis.value.len() != 3 => self.error(
+                            Diagnostic::new(axis.location, format!("`axis` has {} components; a 3-D axis has 3", axis.value.len()))
+                                .with_help("write `axis: [0, 0, 1]`"),
+                        ),
+                        (Some(2), Some(axis)) => self.error(
+                            Diagnostic::new(axis.location, "an `amb` balance of a planar model takes moments about the normal to the plane: it has no `axis`")
+                                .with_help("leave out `axis` (and `in`)"),
+                        ),
+                        _ => {}
+                    }
+                    if let Some(axis) = axis {
+                        for c in &axis.value {
+                            self.resolve(c, Depends::Position, "the axis of an `amb` balance");
+                        }
+                    }
+                    if let Some(frame) = frame {
+                        let frames: Vec<&str> = file
+                            .frames
+                            .iter()
+                            .map(|f| f.name.value.as_str())
+                            .chain([GROUND_FRAME])
+                            .collect();
+                        self.frame(frame, &frames);
+                    }
+                }
+                BalanceKind::Lmb { along } => {
+                    if let Some(dim) = file.dimension
+                        && along.len() != dim
+                    {
+                        self.error(Diagnostic::new(
+                            b.location,
+                            format!(
+                                "`along` has {} components but the points have {dim}",
+                                along.len()
+                            ),
+                        ));
+                    }
+                    for e in along {
+                        let mut ids = Vec::new();
+                        identifiers(e, &mut ids);
+                        for (name, location) in ids {
+                            let ok = self.sets.params.contains(name.as_str())
+                                || self.sets.coords.contains(name.as_str())
+                                || name == "t"
+                                || name == "pi";
+                            if !ok {
+                                self.error(
+                                    Diagnostic::new(
+                                        location,
+                                        format!("`along` cannot use `{name}`"),
+                                    )
+                                    .with_help(
+                                        "a direction may use parameters, coordinates and `t`",
+                                    ),
+                                );
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    // Rule: a body's mass is positive and its inertia non-negative, when they are constant
+    // expressions of the parameters (evaluated at the defaults).
+    pub(super) fn masses(&mut self) {
+        let file = self.file;
+        for b in &file.bodies {
+            let (mass, inertia) = match &b.kind {
+                BodyKind::Particle { mass, .. } => (mass, None),
+                BodyKind::Rigid { mass, inertia, .. } => (mass, Some(inertia)),
+                BodyKind::Spatial { mass, inertia, .. } => {
+                    self.inertia_tensor(&b.name.value, inertia);
+                    (mass, None)
+                }
+            };
+            if let Some(problem) =
+                evaluate(mass, &file.parameters).and_then(|m| mass_problem(&b.name.value, m))
+            {
+                self.error(
+                    Diagnostic::new(mass.location, problem)
+                        .with_help("a mass must be positive (at the parameters' defaults)"),
+                );
+            }
+            if let Some(inertia) = inertia
+                && let Some(problem) = evaluate(inertia, &file.parameters)
+                    .and_then(|i| planar_inertia_problem(&b.name.value, i))
+            {
+                self.error(Diagnostic::new(inertia.location, problem).with_help(
+                    "a centroidal moment of inertia is ≥ 0 (at the parameters' defaults)",
+                ));
+            }
+        }
+    }
+
+    /// Reports a rolling contact whose body is not a rigid body, whose point is unknown, or
+    /// whose frame is unknown or given in a planar model, and an axis `z` in a planar one.
+    pub(super) fn rolling_contact(&mut self, r: &RollingContact) {
+        let file = self.file;
+        self.point(&r.point);
+        match file.bodies.iter().find(|b| b.name.value == r.body.value) {
+            Some(b) if matches!(b.kind, BodyKind::Particle { .. }) => self.error(
+                Diagnostic::new(r.body.location, format!("rolling contact `{}` names `{}`, which is a particle", r.name.value, r.body.value))
+                    .with_help("a body rolls about its centre of mass: name a rigid body (planar with `angle`, 3-D with `frame`)"),
+            ),
+            Some(_) => {}
+            None if self.incomplete.has_name(&r.body.value)
+                || self.section_lost("bodies", file.bodies.is_empty()) => {}
+            None => {
+                let d = Diagnostic::new(r.body.location, format!("unknown body `{}`", r.body.value));
+                let d = match closest(&r.body.value, &self.bodies) {
+                    Some(c) => d.with_help(format!("did you mean `{c}`?")),
+                    None => d.with_help("declare it under `bodies:` as a rigid body"),
+                };
+                self.error(d);
+            }
+        }
+        let planar = file.dimension == Some(2);
+        if let Some(frame) = &r.frame {
+            if planar {
+                self.error(
+                    Diagnostic::new(
+                        frame.location,
+                        format!(
+                            "rolling contact `{}` is in a planar model, which has no frames",
+                            r.name.value
+                        ),
+                    )
+                    .with_help("leave out `in`: the axes are the plane's x and y"),
+                );
+            } else {
+                let frames: Vec<&str> = file
+                    .frames
+                    .iter()
+                    .map(|f| f.name.value.as_str())
+                    .chain([GROUND_FRAME])
+                    .collect();
+                self.frame(frame, &frames);
+            }
+        }
+        if planar {
+            for a in &r.along {
+                if a.value == Axis::Z {
+                    self.error(
+                        Diagnostic::new(
+                            a.location,
+                            format!(
+                                "rolling contact `{}` is planar, so it has no `z` axis",
+                                r.name.value
+                            ),
+                        )
+                        .with_help("in a planar model `along` lists `x` and `y`"),
+                    );
+                }
+            }
+        }
+    }
+
+    /// Reports a 3-D inertia tensor that is not positive definite at the parameters'
+    /// defaults (Sylvester's criterion on its leading minors), or whose principal moments
+    /// break the triangle inequality `I₃ ≤ I₁ + I₂`, which every mass distribution satisfies.
+    /// (Symmetric it is by construction: each off-diagonal entry is written once.)
+    pub(super) fn inertia_tensor(&mut self, body: &str, inertia: &InertiaTensor) {
+        let parameters = &self.file.parameters;
+        let mut e = [0.0; 6];
+        for ((slot, entry), name) in e
+            .iter_mut()
+            .zip(&inertia.entries)
+            .zip(["xx", "yy", "zz", "xy", "yz", "xz"])
+        {
+            if let Some(x) = entry {
+                match evaluate(x, parameters) {
+                    Some(v) if v.is_finite() => *slot = v,
+                    Some(v) => {
+                        self.error(
+                            Diagnostic::new(
+                                inertia.location,
+                                format!(
+                                    "the inertia of body `{body}` is not finite: its entry {name} is {v} at the parameters' defaults"
+                                ),
+                            )
+                            .with_help("each entry of an inertia tensor is a finite number of kg·m² (check the parameters it is written with: a 0/0, a root of a negative number)"),
+                        );
+                        return;
+                    }
+                    None => return,
+                }
+            }
+        }
+        if let Some(problem) = inertia_problem(body, e) {
+            let at = "at the parameters' defaults";
+            let diagnostic = match problem {
+                InertiaProblem::NotPositiveDefinite(message) => Diagnostic::new(
+                    inertia.location,
+                    format!("{message} {at}"),
+                )
+                .with_help("a rigid body's inertia tensor about its centre of mass is positive definite (its three principal moments are positive); a moment ≤ 0, or an off-diagonal entry as large as the moments it joins, is not"),
+                InertiaProblem::NotARigidBody(message) => Diagnostic::new(
+                    inertia.location,
+                    format!("{message} {at}"),
+                )
+                .with_help("no mass distribution has one principal moment larger than the sum of the other two (in principal axes, I₃ = ∫(x² + y²) dm ≤ ∫(y² + z²) dm + ∫(x² + z²) dm = I₁ + I₂; equal for a flat body); check the moments and their axes"),
+            };
+            self.error(diagnostic);
+        }
+    }
+}

@@ -1,0 +1,382 @@
+//! What a model file compares with: `checks:`, `floquet:` and `outputs:`, and the names they refer
+//! to.
+
+use super::*;
+
+impl Checker<'_> {
+    // Rule: every point named by a body, spring, damper, force or drawing exists; torques
+    // act on planar rigid bodies; generalized forces are keyed by coordinates; initial
+    // values by coordinates or rates.
+    pub(super) fn references(&mut self) {
+        let file = self.file;
+        for b in &file.bodies {
+            self.point(b.kind.com());
+        }
+        for s in &file.springs {
+            s.between.iter().for_each(|p| self.point(p));
+        }
+        for d in &file.dampers {
+            d.between.iter().for_each(|p| self.point(p));
+        }
+        for f in &file.forces {
+            self.point(&f.at);
+        }
+        for l in &file.draw.lines {
+            l.iter().for_each(|p| self.point(p));
+        }
+        for p in &file.draw.trace {
+            self.point(p);
+        }
+        for t in &file.torques {
+            let name = &t.body.value;
+            match file.bodies.iter().find(|b| b.name.value == *name) {
+                Some(b) => match (&b.kind, &t.value) {
+                    (BodyKind::Rigid { .. }, TorqueValue::Planar(_))
+                    | (BodyKind::Spatial { .. }, TorqueValue::Spatial { .. }) => {}
+                    (BodyKind::Rigid { .. }, TorqueValue::Spatial { location, .. }) => self.error(
+                        Diagnostic::new(*location, format!("torque `{}` is a 3-D vector, but `{name}` is a planar rigid body", t.name.value))
+                            .with_help("a torque on a planar body is `value: tau` (counter-clockwise, about the axis normal to the plane)"),
+                    ),
+                    (BodyKind::Spatial { .. }, TorqueValue::Planar(e)) => self.error(
+                        Diagnostic::new(e.location, format!("torque `{}` is a number, but `{name}` is a 3-D rigid body", t.name.value))
+                            .with_help("a torque on a 3-D body is a vector: `{ body: B, vector: [0, 0, T], in: B }`"),
+                    ),
+                    (BodyKind::Particle { .. }, _) => self.error(
+                        Diagnostic::new(
+                            t.body.location,
+                            format!("torque `{}` acts on `{name}`, which is a particle", t.name.value),
+                        )
+                        .with_help("torques act on rigid bodies (planar with `inertia` and `angle`, 3-D with `frame`); apply a force to a particle"),
+                    ),
+                },
+                None if self.incomplete.has_name(name)
+                    || self.section_lost("bodies", file.bodies.is_empty()) => {}
+                None => {
+                    let d = Diagnostic::new(t.body.location, format!("unknown body `{name}`"));
+                    let d = match closest(name, &self.bodies) {
+                        Some(c) => d.with_help(format!("did you mean `{c}`?")),
+                        None => d.with_help("declare it under `bodies:` as a planar rigid body"),
+                    };
+                    self.error(d);
+                }
+            }
+        }
+        let coordinates_lost = self.section_lost("coordinates", self.coords.is_empty());
+        for (k, _) in &file.generalized_forces {
+            let n = k.value.as_str();
+            if self.sets.coords.contains(n) || self.incomplete.has_name(n) || coordinates_lost {
+                continue;
+            }
+            let d = Diagnostic::new(
+                k.location,
+                format!("`{n}` in `generalized_forces` is not a coordinate"),
+            );
+            let d = match closest(n, &self.coords) {
+                Some(c) => d.with_help(format!("did you mean `{c}`?")),
+                None => d.with_help(format!("coordinates are: {}", self.coords.join(", "))),
+            };
+            self.error(d);
+        }
+        for q in &file.equilibria {
+            for (k, _) in &q.values {
+                let n = k.value.as_str();
+                let base = n.strip_suffix("_dot").unwrap_or(n);
+                if self.sets.coords.contains(n)
+                    || self.sets.rates.contains(n)
+                    || self.incomplete.has_name(base)
+                    || coordinates_lost
+                {
+                    continue;
+                }
+                let d = Diagnostic::new(
+                    k.location,
+                    format!(
+                        "`{n}` in equilibrium `{}` is neither a coordinate nor a rate",
+                        q.name.value
+                    ),
+                );
+                let mut candidates: Vec<&str> = self.coords.clone();
+                candidates.extend(self.rates.iter().map(String::as_str));
+                let d = match closest(n, &candidates) {
+                    Some(c) => d.with_help(format!(
+                        "did you mean `{c}`? an equilibrium gives coordinates (a steady motion also the rates it holds, and `ignorable`)"
+                    )),
+                    None => d.with_help(format!("coordinates are: {}", self.coords.join(", "))),
+                };
+                self.error(d);
+            }
+            for k in &q.ignorable {
+                let n = k.value.as_str();
+                if self.sets.coords.contains(n) || self.incomplete.has_name(n) || coordinates_lost {
+                    continue;
+                }
+                let d = Diagnostic::new(
+                    k.location,
+                    format!(
+                        "`{n}` in `ignorable` of `{}` is not a coordinate",
+                        q.name.value
+                    ),
+                );
+                let d = match closest(n, &self.coords) {
+                    Some(c) => d.with_help(format!("did you mean `{c}`?")),
+                    None => d.with_help(format!("coordinates are: {}", self.coords.join(", "))),
+                };
+                self.error(d);
+            }
+        }
+        for (k, _) in &file.initial {
+            let n = k.value.as_str();
+            let base = n.strip_suffix("_dot").unwrap_or(n);
+            if self.sets.coords.contains(n)
+                || self.sets.rates.contains(n)
+                || self.incomplete.has_name(base)
+                || coordinates_lost
+            {
+                continue;
+            }
+            let mut candidates: Vec<&str> = self.coords.clone();
+            candidates.extend(self.rates.iter().map(String::as_str));
+            let d = Diagnostic::new(
+                k.location,
+                format!("`{n}` in `initial` is neither a coordinate nor a rate"),
+            );
+            let d = match closest(n, &candidates) {
+                Some(c) => d.with_help(format!("did you mean `{c}`?")),
+                None => d.with_help(format!(
+                    "initial values are given for: {}",
+                    candidates.join(", ")
+                )),
+            };
+            self.error(d);
+        }
+    }
+
+    // Rule (`floquet:`): each entry names an equilibrium; `axis_units`, `along` and `gives`
+    // name parameters (`along` ≠ `gives`); every expression is a constant of the parameters;
+    // colour components are whole numbers from 0 to 255.
+    pub(super) fn floquet_references(&mut self) {
+        let file = self.file;
+        let equilibria: Vec<&str> = file
+            .equilibria
+            .iter()
+            .map(|e| e.name.value.as_str())
+            .collect();
+        for entry in &file.floquet {
+            let at = &entry.at;
+            if !equilibria.contains(&at.value.as_str())
+                && !self.incomplete.has_section("equilibria")
+            {
+                let d = Diagnostic::new(
+                    at.location,
+                    format!(
+                        "`floquet:` names `{}`, which is not an equilibrium of the model",
+                        at.value
+                    ),
+                );
+                let d = match closest(&at.value, &equilibria) {
+                    Some(c) => d.with_help(format!("did you mean `{c}`?")),
+                    None => d.with_help(
+                        "a `floquet:` entry is keyed by a name of `equilibria:`, as in `equilibria: { upright: { theta: 0 } }`",
+                    ),
+                };
+                self.error(d);
+            }
+            let what = format!("`floquet:` at `{}`", at.value);
+            for (p, _) in &entry.axis_units {
+                self.parameter_name(p, &format!("`axis_units` of {what}"));
+            }
+            for t in &entry.thresholds {
+                let of = format!("threshold `{}` of {what}", t.name.value);
+                self.resolve(&t.value, Depends::Constant, &format!("the value of {of}"));
+                self.resolve(
+                    &t.critical,
+                    Depends::Constant,
+                    &format!("the critical value of {of}"),
+                );
+            }
+            for c in &entry.curves {
+                let of = format!("curve `{}` of {what}", c.name.value);
+                self.parameter_name(&c.along, &format!("`along` of {of}"));
+                self.parameter_name(&c.gives, &format!("`gives` of {of}"));
+                if c.along.value == c.gives.value {
+                    self.error(
+                        Diagnostic::new(
+                            c.gives.location,
+                            format!("{of} gives `{}` along itself", c.gives.value),
+                        )
+                        .with_help("`along` and `gives` name the chart's two parameters: `along: a, gives: w`"),
+                    );
+                }
+                self.resolve(&c.value, Depends::Constant, &format!("the value of {of}"));
+                if let Some(domain) = &c.domain {
+                    self.resolve(domain, Depends::Constant, &format!("`where` of {of}"));
+                }
+                for e in &c.color {
+                    self.resolve(e, Depends::Constant, &format!("the colour of {of}"));
+                    let value = evaluate(e, &file.parameters);
+                    if value.is_some_and(|v| !(0.0..=255.0).contains(&v) || v.fract() != 0.0) {
+                        self.error(
+                            Diagnostic::new(
+                                e.location,
+                                format!("the colour of {of} has a component outside 0 to 255"),
+                            )
+                            .with_help("write red, green and blue as whole numbers from 0 to 255: `color: [0, 150, 60]`"),
+                        );
+                    }
+                }
+            }
+        }
+    }
+
+    // Rule: the reference values of `checks:` are expressions of the parameters (a conserved
+    // quantity may also use coordinates, rates and `t`); `at:` names an entry of
+    // `equilibria:`, `event:` an entry of `events:`, and `final_state` gives coordinates and
+    // rates; `natural_frequencies` lists one value per mode (coordinates minus holonomic
+    // constraints, when there are no non-holonomic ones).
+    pub(super) fn reference_checks(&mut self) {
+        let file = self.file;
+        let checks = &file.checks;
+        for (key, modal) in [
+            ("natural_frequencies", &checks.natural_frequencies),
+            ("damping_ratios", &checks.damping_ratios),
+        ] {
+            let Some(modal) = modal else { continue };
+            for (i, v) in modal.values.iter().enumerate() {
+                self.resolve(v, Depends::Constant, &format!("value {} of `{key}`", i + 1));
+            }
+            if let Some(at) = &modal.at {
+                let names: Vec<&str> = file
+                    .equilibria
+                    .iter()
+                    .map(|e| e.name.value.as_str())
+                    .collect();
+                if !names.contains(&at.value.as_str()) && !self.incomplete.has_section("equilibria")
+                {
+                    let d = Diagnostic::new(
+                        at.location,
+                        format!(
+                            "`at: {}` of `{key}` is not an equilibrium of the model",
+                            at.value
+                        ),
+                    );
+                    let d = match closest(&at.value, &names) {
+                        Some(c) => d.with_help(format!("did you mean `{c}`?")),
+                        None if names.is_empty() => d.with_help(
+                            "name the operating point in `equilibria:`, as in `equilibria: { hanging: { theta: 0 } }`",
+                        ),
+                        None => d.with_help(format!("equilibria are: {}", names.join(", "))),
+                    };
+                    self.error(d);
+                }
+            }
+            let modes = file
+                .coordinates
+                .len()
+                .saturating_sub(file.holonomic_names().len());
+            if key == "natural_frequencies"
+                && file.nonholonomic.is_empty()
+                && file.rolling.is_empty()
+                && modal.values.len() != modes
+                && !self.incomplete.has_section("coordinates")
+                && !self.incomplete.has_section("constraints")
+            {
+                self.error(
+                    Diagnostic::new(
+                        modal.location,
+                        format!(
+                            "`natural_frequencies` lists {} value(s), but the model has {modes} mode(s)",
+                            modal.values.len()
+                        ),
+                    )
+                    .with_help("give every natural frequency in rad/s, ascending, zero-frequency modes as 0"),
+                );
+            }
+        }
+        if let Some(period) = &checks.period {
+            self.resolve(&period.value, Depends::Constant, "the `value` of `period`");
+            let names: Vec<&str> = file.events.iter().map(|e| e.name.value.as_str()).collect();
+            if !names.contains(&period.event.value.as_str())
+                && !self.incomplete.has_section("events")
+            {
+                let d = Diagnostic::new(
+                    period.event.location,
+                    format!(
+                        "`event: {}` of `period` is not an event of the model",
+                        period.event.value
+                    ),
+                );
+                let d = match closest(&period.event.value, &names) {
+                    Some(c) => d.with_help(format!("did you mean `{c}`?")),
+                    None if names.is_empty() => d.with_help(
+                        "define it in `events:`, as in `events: { peak: { when: x_dot, direction: falling } }`",
+                    ),
+                    None => d.with_help(format!("events are: {}", names.join(", "))),
+                };
+                self.error(d);
+            }
+        }
+        if let Some(state) = &checks.final_state {
+            self.resolve(&state.t, Depends::Constant, "the time `t` of `final_state`");
+            for (k, v) in &state.values {
+                self.resolve(
+                    v,
+                    Depends::Constant,
+                    &format!("the value of `{}` in `final_state`", k.value),
+                );
+                let n = k.value.as_str();
+                if self.sets.coords.contains(n)
+                    || self.sets.rates.contains(n)
+                    || self.incomplete.has_section("coordinates")
+                {
+                    continue;
+                }
+                let mut candidates: Vec<&str> = self.coords.clone();
+                candidates.extend(self.rates.iter().map(String::as_str));
+                let d = Diagnostic::new(
+                    k.location,
+                    format!("`{n}` in `final_state` is neither a coordinate nor a rate"),
+                );
+                let d = match closest(n, &candidates) {
+                    Some(c) => d.with_help(format!("did you mean `{c}`?")),
+                    None => d.with_help(format!(
+                        "coordinates and rates are: {}",
+                        candidates.join(", ")
+                    )),
+                };
+                self.error(d);
+            }
+        }
+        self.angular_velocities = false;
+        for c in &checks.conserved {
+            self.resolve(
+                &c.value,
+                Depends::Motion,
+                &format!("conserved quantity `{}`", c.name.value),
+            );
+        }
+        self.angular_velocities = true;
+    }
+
+    // Rule: outputs are functions of the motion, named apart from the columns beside them
+    // in a simulation's output (`t`, the coordinates and rates, `energy`).
+    pub(super) fn outputs(&mut self) {
+        let file = self.file;
+        for o in &file.outputs {
+            let n = o.name.value.as_str();
+            if n == "t"
+                || n == "energy"
+                || self.sets.coords.contains(n)
+                || self.sets.rates.contains(n)
+            {
+                self.error(
+                    Diagnostic::new(
+                        o.name.location,
+                        format!("output name `{n}` is taken: a simulation's output already has a column `{n}`"),
+                    )
+                    .with_help("choose another name, such as `L` or `angular_momentum`"),
+                );
+            }
+            self.resolve(&o.value, Depends::Motion, &format!("output `{n}`"));
+        }
+    }
+}
