@@ -14,6 +14,7 @@ pub mod plan;
 pub mod program;
 pub mod tape;
 pub mod taylor;
+mod taylor_tokens;
 
 pub use describe::{describe, description_tokens};
 pub use listing::{
@@ -379,7 +380,8 @@ pub fn emit(
         .iter()
         .map(|p| ident(&field_name(&p.name)))
         .collect::<Result<Vec<_>, _>>()?;
-    let (accessor, taylor_functions) = taylor::methods(&taylor, &krate, &parameter_fields, &name)?;
+    let (accessor, taylor_functions) =
+        taylor_tokens::methods(&taylor, &krate, &parameter_fields, &name)?;
     methods.extend(accessor);
     let both: Vec<ExprId> = [eom.mass_matrix.clone(), eom.forcing.clone()].concat();
     let stats = EmitStats {

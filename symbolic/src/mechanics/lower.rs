@@ -8,8 +8,9 @@ use super::constraints::{ConstraintEquations, linear_in_rates, redundant_rows};
 use super::frames::{Frames, Vector3};
 use crate::expr::{Constant, ExprArena, ExprId, Func, SymbolId, SymbolKind};
 use crate::model::ast::{BinOp, Expr, ExprKind};
+use crate::model::checks::FloquetReference;
 use crate::model::diagnostic::Diagnostic;
-use crate::model::file::{BodyKind, FloquetReference, GROUND_FRAME, ModelFile, TorqueValue};
+use crate::model::file::{BodyKind, GROUND_FRAME, ModelFile, TorqueValue};
 use crate::model::located::{Located, Location};
 use crate::model::rules::short;
 

@@ -7,6 +7,7 @@
 //! file at once.
 
 pub mod ast;
+pub mod checks;
 pub mod diagnostic;
 pub mod file;
 pub mod located;
@@ -22,6 +23,7 @@ pub mod vectors;
 pub mod yaml;
 
 pub use ast::{BinOp, Expr, ExprKind};
+pub use checks::*;
 pub use diagnostic::{Diagnostic, Diagnostics};
 pub use file::*;
 pub use located::{Located, Location};

@@ -99,7 +99,7 @@ impl Lowering<'_> {
 
     /// A 3-D body's angular velocity (from its frame's rotations) and inertia tensor, with
     /// its rotational kinetic energy `½ ω·I_G ω` (body components) added to `T`.
-    pub(super) fn spatial_body(
+    fn spatial_body(
         &mut self,
         frames: &mut Frames,
         frame: &Located<String>,

@@ -171,7 +171,7 @@ impl Lowering<'_> {
     /// [`crate::mechanics::constraints::residual_where_others_hold`]), from up to six random
     /// configurations at a random `t` (parameters at their defaults); `None` if Newton
     /// converges from none of them.
-    pub(super) fn residual_where_others_hold(
+    fn residual_where_others_hold(
         &mut self,
         eqs: &ConstraintEquations,
         parameters: &[ParameterInfo],

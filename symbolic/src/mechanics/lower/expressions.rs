@@ -125,13 +125,7 @@ impl Lowering<'_> {
     /// Reports `a op b` (its operator at `at`) when its value is undefined for the numbers it
     /// is given: `a / 0`, `0 ^ b` with `b ≤ 0`, a negative number to a non-integer power;
     /// whether it did. (Overflow and underflow are the arena's fold errors.)
-    pub(super) fn check_constants(
-        &mut self,
-        at: Location,
-        op: BinOp,
-        a: ExprId,
-        b: ExprId,
-    ) -> bool {
+    fn check_constants(&mut self, at: Location, op: BinOp, a: ExprId, b: ExprId) -> bool {
         let (x, y) = (
             self.arena.as_constant(a).map(Constant::to_f64),
             self.arena.as_constant(b).map(Constant::to_f64),
@@ -165,7 +159,7 @@ impl Lowering<'_> {
             .push(Diagnostic::new(at, what.to_string()).with_help(help.to_string()));
     }
 
-    pub(super) fn unknown_function(&mut self, e: &Expr, name: &str) -> ExprId {
+    fn unknown_function(&mut self, e: &Expr, name: &str) -> ExprId {
         self.errors.push(Diagnostic::new(
             e.location,
             format!("unknown function or wrong number of arguments in `{name}(…)`"),
@@ -175,7 +169,7 @@ impl Lowering<'_> {
 
     /// A call of a vector function that gives a number: `dot(a, b)`, `cross(a, b)` in the
     /// plane (`a_x b_y − a_y b_x`), `norm(a)`, `distance(A, B)`.
-    pub(super) fn vector_call(&mut self, e: &Expr, func: &str, args: &[Expr]) -> ExprId {
+    fn vector_call(&mut self, e: &Expr, func: &str, args: &[Expr]) -> ExprId {
         let vectors: Vec<Vec<ExprId>> = args.iter().map(|a| self.vector(a)).collect();
         match (func, vectors.as_slice()) {
             ("dot", [a, b]) => self.dot(a, b),

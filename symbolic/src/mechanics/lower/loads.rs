@@ -97,7 +97,7 @@ impl Lowering<'_> {
     /// `c` free of `r`, `ṙ`, the coordinates and the rates: `−c r^(k+1)/(k+1)`, or `−c ln r`
     /// for `k = −1`. `None` for any other magnitude (it is not, or not visibly, the
     /// derivative of a potential of `r`).
-    pub(super) fn power_law_potential(
+    fn power_law_potential(
         &mut self,
         f: ExprId,
         r_symbol: SymbolId,

@@ -111,7 +111,7 @@ impl Reducer<'_> {
     }
 
     /// Solves `phi = 0` for coordinate `i`.
-    pub(super) fn solve_one(
+    fn solve_one(
         &mut self,
         constraint: &str,
         phi: ExprId,
@@ -226,7 +226,7 @@ impl Reducer<'_> {
     }
 
     /// `k² P − R²` for `phi = k √P + R` with `P` polynomial in `d` and `k`, `R` free of it.
-    pub(super) fn rationalize(&mut self, phi: ExprId, d: SymbolId) -> Option<ExprId> {
+    fn rationalize(&mut self, phi: ExprId, d: SymbolId) -> Option<ExprId> {
         let terms: Vec<ExprId> = match self.arena.node(phi) {
             Node::Add(t) => t.to_vec(),
             _ => vec![phi],
@@ -267,7 +267,7 @@ impl Reducer<'_> {
 
     /// The branch of a quadratic solution (see the module documentation). `phi` is the
     /// constraint as written (after earlier substitutions), which the root must satisfy.
-    pub(super) fn choose_branch(
+    fn choose_branch(
         &mut self,
         coordinate: &str,
         phi: ExprId,

@@ -477,7 +477,7 @@ impl Reducer<'_> {
 
     /// The energy form's generalized forces moved onto the kept coordinates by virtual work:
     /// `Q_k + Σ_d Q_d ∂d/∂k`.
-    pub(super) fn generalized_forces(
+    fn generalized_forces(
         &mut self,
         kept: &[String],
     ) -> Result<Vec<(String, String)>, ReduceError> {
@@ -655,7 +655,7 @@ impl Reducer<'_> {
 }
 
 /// `, method: …, rtol: …, t_end: …` of the settings given.
-fn run_settings(run: &crate::model::file::RunSettings, t_end: bool) -> String {
+fn run_settings(run: &crate::model::checks::RunSettings, t_end: bool) -> String {
     let mut s = String::new();
     if let Some(m) = &run.method {
         s.push_str(&format!(", method: {}", m.value));

@@ -231,7 +231,7 @@ impl Checker<'_> {
     /// `None` after reporting why it cannot: vectors where they are not allowed (the
     /// definitions of points and frames, constants), shapes that do not fit
     /// ([`vectors::check_shapes`]), `vel` where the rates are not allowed.
-    pub(super) fn vector_points(
+    fn vector_points(
         &mut self,
         e: &Expr,
         depends: Depends,

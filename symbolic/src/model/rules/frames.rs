@@ -136,11 +136,7 @@ impl Checker<'_> {
     }
 
     /// "unknown frame", with the closest of `frames`.
-    pub(super) fn unknown_frame_message(
-        &self,
-        name: &Located<String>,
-        frames: &[&str],
-    ) -> Diagnostic {
+    fn unknown_frame_message(&self, name: &Located<String>, frames: &[&str]) -> Diagnostic {
         let d = Diagnostic::new(name.location, format!("unknown frame `{}`", name.value));
         match closest(&name.value, frames) {
             Some(c) => d.with_help(format!("did you mean `{c}`?")),

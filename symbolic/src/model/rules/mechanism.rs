@@ -381,7 +381,7 @@ impl Checker<'_> {
 
     /// Reports a rolling contact whose body is not a rigid body, whose point is unknown, or
     /// whose frame is unknown or given in a planar model, and an axis `z` in a planar one.
-    pub(super) fn rolling_contact(&mut self, r: &RollingContact) {
+    fn rolling_contact(&mut self, r: &RollingContact) {
         let file = self.file;
         self.point(&r.point);
         match file.bodies.iter().find(|b| b.name.value == r.body.value) {
@@ -446,7 +446,7 @@ impl Checker<'_> {
     /// defaults (Sylvester's criterion on its leading minors), or whose principal moments
     /// break the triangle inequality `I₃ ≤ I₁ + I₂`, which every mass distribution satisfies.
     /// (Symmetric it is by construction: each off-diagonal entry is written once.)
-    pub(super) fn inertia_tensor(&mut self, body: &str, inertia: &InertiaTensor) {
+    fn inertia_tensor(&mut self, body: &str, inertia: &InertiaTensor) {
         let parameters = &self.file.parameters;
         let mut e = [0.0; 6];
         for ((slot, entry), name) in e

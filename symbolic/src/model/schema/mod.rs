@@ -7,11 +7,12 @@
 //!
 //! One scaffold (`walk`) reads every keyed part of a file: `sections` holds the table of
 //! top-level keys and the sections about the model as a whole, and each group of sections
-//! has its file — the mechanism (`mechanics`), initial state, events and equilibria
-//! (`states`), `checks:` (`checks`) and `floquet:` (`floquet`). How a single value is
-//! read (a name, an expression, a vector) is in `values`; lookups in a map's entries in
-//! `entries`.
+//! has its file — frames and bodies (`bodies`), the rest of the mechanism (`mechanics`),
+//! initial state, events and equilibria (`states`), `checks:` (`checks`) and `floquet:`
+//! (`floquet`). How a single value is read (a name, an expression, a vector) is in `values`;
+//! lookups in a map's entries in `entries`.
 
+mod bodies;
 mod checks;
 mod entries;
 mod floquet;
@@ -24,6 +25,7 @@ mod walk;
 use std::collections::HashMap;
 
 use super::ast::{BinOp, Expr, ExprKind};
+use super::checks::*;
 use super::diagnostic::{Diagnostic, Diagnostics};
 use super::file::*;
 use super::located::{Located, Location};

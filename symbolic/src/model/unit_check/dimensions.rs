@@ -101,7 +101,7 @@ impl Checker<'_> {
     /// the unit of its terms, `vel` divides by s, `cross` multiplies; anything else is
     /// [`Self::dim`]. (The rules checked the shapes: vectors and numbers are where they
     /// belong.)
-    pub(super) fn vector_dim(&mut self, e: &Expr, what: &str) -> Option<Dim> {
+    fn vector_dim(&mut self, e: &Expr, what: &str) -> Option<Dim> {
         let vector = |cx: &Self, e: &Expr| {
             let points: Vec<&str> = cx
                 .file

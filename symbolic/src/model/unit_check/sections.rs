@@ -23,7 +23,7 @@ impl Checker<'_> {
 
     /// Checks `e` against a fixed unit: "`what` is got, but `kind` is want_text" with `help`,
     /// plus the parameter's declaration when `e` is a lone parameter.
-    pub(super) fn fixed(
+    fn fixed(
         &mut self,
         e: &Expr,
         want: Dimension,
@@ -59,7 +59,7 @@ impl Checker<'_> {
 
     /// Checks a value of coordinate `name` or of its rate (`initial:`, `equilibria:`,
     /// `final_state:`).
-    pub(super) fn value_of(&mut self, name: &str, e: &Expr, what: &str) {
+    fn value_of(&mut self, name: &str, e: &Expr, what: &str) {
         let Some(want) = self.motion(name).flatten() else {
             return;
         };
@@ -81,7 +81,7 @@ impl Checker<'_> {
     }
 
     /// Checks that `e` is consistent in itself (its sums, functions and powers).
-    pub(super) fn homogeneous(&mut self, e: &Expr, what: &str) {
+    fn homogeneous(&mut self, e: &Expr, what: &str) {
         self.top(e);
         self.dim(e, what);
     }

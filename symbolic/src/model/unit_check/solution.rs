@@ -59,7 +59,7 @@ impl Checker<'_> {
 
     /// An equation with the solved unknowns substituted: its known part and the unknowns
     /// left (`None` on exponent overflow).
-    pub(super) fn reduce(&self, eq: &Dim) -> Option<(Dimension, Vec<(usize, Rational)>)> {
+    fn reduce(&self, eq: &Dim) -> Option<(Dimension, Vec<(usize, Rational)>)> {
         let mut known = eq.known;
         let mut left = Vec::new();
         for &(i, c) in &eq.unknowns {

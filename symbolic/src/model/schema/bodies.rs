@@ -1,0 +1,373 @@
+//! Frames and bodies: the frames of the mechanism (simple rotations and Euler-angle sequences)
+//! and its bodies (particles, planar rigid bodies and spatial bodies with their inertia tensors).
+
+use super::walk::{Fields, Keyed, Need};
+use super::*;
+
+const BODY_KEYS: &[&str] = &["mass", "at", "inertia", "com", "angle", "frame"];
+const PARTICLE_EXAMPLE: &str = "{ mass: m, at: P }";
+const RIGID_EXAMPLE: &str = "{ mass: m, inertia: m*l^2/12, com: G, angle: theta }";
+const SPATIAL_EXAMPLE: &str = "{ mass: m, com: G, frame: B, inertia: [I1, I2, I3] }";
+const FRAME_EXAMPLE: &str = "{ parent: N, axes: zxz, angles: [psi, theta, phi] }";
+/// The keys of a frame.
+const FRAME: Fields = Fields {
+    kind: "frame",
+    keys: &[
+        ("parent", Need::Optional),
+        ("axis", Need::Optional),
+        ("angle", Need::Optional),
+        ("axes", Need::Optional),
+        ("angles", Need::Optional),
+        ("about", Need::Optional),
+    ],
+    example: FRAME_EXAMPLE,
+};
+
+impl Ctx<'_> {
+    /// `frames:` — `name: { parent, axis, angle }` or `name: { parent, axes, angles, about }`.
+    pub(super) fn frames(&mut self, node: &YamlNode) -> Vec<Frame> {
+        let example = format!("frames: {{ B: {FRAME_EXAMPLE} }}");
+        let spec = Keyed {
+            what: "`frames`",
+            example: &example,
+            names: Some("frame"),
+            drop: true,
+        };
+        self.keyed(node, spec, Self::frame)
+    }
+
+    /// One frame: its parent (the ground `N` if not given) turned by one simple rotation
+    /// (`axis`, `angle`) or by several (`axes: zxz`, `angles: [...]`), each about an axis of
+    /// the newest frame (`about: body`, the default) or of the parent (`about: parent`).
+    fn frame(&mut self, k: &Located<String>, v: &YamlNode) -> Option<Frame> {
+        let f = self.fields(k, v, &FRAME)?;
+        let what = format!("frame `{}`", k.value);
+        let example = format!("{}: {FRAME_EXAMPLE}", k.value);
+        let parent = match get(f, "parent") {
+            Some(n) => self.name(n, "`parent`")?,
+            None => Located::new(GROUND_FRAME.to_string(), k.location),
+        };
+        let single = get(f, "axis").is_some() || get(f, "angle").is_some();
+        let several = get(f, "axes").is_some() || get(f, "angles").is_some();
+        if single == several {
+            let message = if single {
+                format!("{what} has both `axis`/`angle` and `axes`/`angles`")
+            } else {
+                format!("{what} has no rotation")
+            };
+            self.error(Diagnostic::new(k.location, message).with_help(format!(
+                "one simple rotation is `{}: {{ parent: N, axis: z, angle: psi }}`; successive ones `{example}`",
+                k.value
+            )));
+            return None;
+        }
+        let (axes_key, angles_key) = if single {
+            ("axis", "angle")
+        } else {
+            ("axes", "angles")
+        };
+        if !self.require(f, k.location, &what, &[axes_key, angles_key], &example) {
+            return None;
+        }
+        let axes_node = get(f, axes_key)?;
+        let axes = self.axes(axes_node, single)?;
+        let angles: Vec<Expr> = if single {
+            vec![self.expr(get(f, "angle")?, "a rotation angle")?]
+        } else {
+            let node = get(f, "angles")?;
+            let items = self.seq(node, "`angles`", "angles: [psi, theta, phi]")?;
+            if items.len() != axes.len() {
+                self.error(
+                    Diagnostic::new(
+                        node.location,
+                        format!("{what} has {} axes but {} angles", axes.len(), items.len()),
+                    )
+                    .with_help("give one angle per axis, in the same order"),
+                );
+                return None;
+            }
+            let angles: Vec<Option<Expr>> = items
+                .iter()
+                .map(|i| self.expr(i, "a rotation angle"))
+                .collect();
+            angles.into_iter().collect::<Option<_>>()?
+        };
+        let about_parent = match get(f, "about") {
+            None => false,
+            Some(n) => self.choice(n, "`about`", &[("body", false), ("parent", true)])?,
+        };
+        let mut rotations: Vec<SimpleRotation> = axes
+            .into_iter()
+            .zip(angles)
+            .map(|(axis, angle)| SimpleRotation { axis, angle })
+            .collect();
+        // Rotations about the parent's fixed axes in the order a, b, c give the orientation
+        // of rotations about the newest frame's axes in the order c, b, a.
+        if about_parent {
+            rotations.reverse();
+        }
+        Some(Frame {
+            name: k.clone(),
+            parent,
+            rotations,
+        })
+    }
+
+    /// The axes of a frame's rotations: `x`, `y` or `z` (one, for `axis`), or a word of
+    /// them (`zxz`, for `axes`).
+    pub(super) fn axes(&mut self, node: &YamlNode, single: bool) -> Option<Vec<Located<Axis>>> {
+        let what = if single { "`axis`" } else { "`axes`" };
+        let text = match &node.kind {
+            YamlKind::Scalar { text, .. } => text.trim().to_string(),
+            _ => String::new(),
+        };
+        let axes: Option<Vec<Located<Axis>>> = text
+            .chars()
+            .enumerate()
+            .map(|(i, c)| {
+                let axis = match c {
+                    'x' => Axis::X,
+                    'y' => Axis::Y,
+                    'z' => Axis::Z,
+                    _ => return None,
+                };
+                Some(Located::new(axis, node.location.offset(i)))
+            })
+            .collect();
+        match axes {
+            Some(a) if !a.is_empty() && (!single || a.len() == 1) => Some(a),
+            _ => {
+                let help = if single {
+                    "a simple rotation is about the `x`, `y` or `z` axis (write `axis: z`; to turn the other way, negate the angle)"
+                } else {
+                    "write the axes of the successive rotations as one word of `x`, `y` and `z`, as in `axes: zxz` (Euler angles) or `axes: zyx` (yaw, pitch, roll)"
+                };
+                self.error(
+                    Diagnostic::new(
+                        node.location,
+                        format!(
+                            "{what} must be {}, found {}",
+                            if single {
+                                "x, y or z"
+                            } else {
+                                "a word of x, y and z"
+                            },
+                            node.kind.describe()
+                        ),
+                    )
+                    .with_help(help),
+                );
+                None
+            }
+        }
+    }
+
+    /// `bodies:` — `name: { mass, at }` or `name: { mass, inertia, com, angle }`.
+    pub(super) fn bodies(&mut self, node: &YamlNode) -> Vec<Body> {
+        let spec = Keyed {
+            what: "`bodies`",
+            example: "bodies: { bob: { mass: m, at: P } }",
+            names: Some("body"),
+            drop: true,
+        };
+        self.keyed(node, spec, Self::body)
+    }
+
+    /// One body: a particle `{ mass, at }`, or a planar rigid body
+    /// `{ mass, inertia, com, angle }`.
+    pub(super) fn body(&mut self, k: &Located<String>, v: &YamlNode) -> Option<Body> {
+        let what = format!("body `{}`", k.value);
+        let f = self.map(v, &what, &format!("{}: {PARTICLE_EXAMPLE}", k.value))?;
+        self.unknown_keys(f, &what, BODY_KEYS, BODY_KEYS);
+        if get(f, "frame").is_some() {
+            return self.spatial_body(k, f);
+        }
+        if let Some(inertia) = get(f, "inertia")
+            && !matches!(inertia.kind, YamlKind::Scalar { .. })
+        {
+            self.error(
+                Diagnostic::new(
+                    inertia.location,
+                    format!("{what} has an inertia tensor but no `frame`"),
+                )
+                .with_help(format!(
+                    "a planar rigid body has a scalar inertia about the axis normal to the plane (`{RIGID_EXAMPLE}`); a 3-D body has the frame its inertia is written in: `{SPATIAL_EXAMPLE}`"
+                )),
+            );
+            return None;
+        }
+        let rigid_key = ["inertia", "com", "angle"]
+            .into_iter()
+            .find(|r| get(f, r).is_some());
+        let Some(rigid_key) = rigid_key else {
+            // A particle: `{ mass, at }`.
+            let complete = self.require(
+                f,
+                k.location,
+                &what,
+                &["mass", "at"],
+                &format!("{}: {PARTICLE_EXAMPLE}", k.value),
+            );
+            let mass = get(f, "mass").and_then(|n| self.expr(n, "a mass"));
+            let at = get(f, "at").and_then(|n| self.name(n, "`at`"));
+            let (Some(mass), Some(at), true) = (mass, at, complete) else {
+                return None;
+            };
+            return Some(Body {
+                name: k.clone(),
+                kind: BodyKind::Particle { mass, at },
+            });
+        };
+        // A planar rigid body: `{ mass, inertia, com, angle }`.
+        if let Some(at) = get_key(f, "at") {
+            self.error(
+                Diagnostic::new(
+                    at.location,
+                    format!(
+                        "{what} has `{rigid_key}`, so it is a planar rigid body, which has no `at`"
+                    ),
+                )
+                .with_help(format!(
+                    "a rigid body's position is its centre of mass `com`: `{RIGID_EXAMPLE}`; a particle is `{PARTICLE_EXAMPLE}`"
+                )),
+            );
+        }
+        let complete = self.require(
+            f,
+            k.location,
+            &format!("{what} (a planar rigid body, as it has `{rigid_key}`)"),
+            &["mass", "inertia", "com", "angle"],
+            &format!("{}: {RIGID_EXAMPLE}", k.value),
+        );
+        let mass = get(f, "mass").and_then(|n| self.expr(n, "a mass"));
+        let inertia = get(f, "inertia").and_then(|n| self.expr(n, "an inertia"));
+        let com = get(f, "com").and_then(|n| self.name(n, "`com`"));
+        let angle = get(f, "angle").and_then(|n| self.expr(n, "a body angle"));
+        let (Some(mass), Some(inertia), Some(com), Some(angle), true) = (
+            mass,
+            inertia,
+            com,
+            angle,
+            complete && get(f, "at").is_none(),
+        ) else {
+            return None;
+        };
+        Some(Body {
+            name: k.clone(),
+            kind: BodyKind::Rigid {
+                mass,
+                inertia,
+                com,
+                angle,
+            },
+        })
+    }
+
+    /// A 3-D rigid body: `{ mass, com, frame, inertia }`.
+    fn spatial_body(&mut self, k: &Located<String>, f: &Entries) -> Option<Body> {
+        let what = format!("body `{}`", k.value);
+        let example = format!("{}: {SPATIAL_EXAMPLE}", k.value);
+        for (key, planar) in [("angle", true), ("at", false)] {
+            if let Some(at) = get_key(f, key) {
+                let help = if planar {
+                    format!(
+                        "the orientation of a 3-D body is its `frame`, whose rotations give its angular velocity; `angle` is for planar bodies: `{example}`"
+                    )
+                } else {
+                    format!("a rigid body's position is its centre of mass `com`: `{example}`")
+                };
+                self.error(
+                    Diagnostic::new(
+                        at.location,
+                        format!(
+                            "{what} has a `frame`, so it is a 3-D rigid body, which has no `{key}`"
+                        ),
+                    )
+                    .with_help(help),
+                );
+            }
+        }
+        let complete = self.require(
+            f,
+            k.location,
+            &format!("{what} (a 3-D rigid body, as it has `frame`)"),
+            &["mass", "com", "frame", "inertia"],
+            &example,
+        );
+        let mass = get(f, "mass").and_then(|n| self.expr(n, "a mass"));
+        let com = get(f, "com").and_then(|n| self.name(n, "`com`"));
+        let frame = get(f, "frame").and_then(|n| self.name(n, "`frame`"));
+        let inertia = get(f, "inertia").and_then(|n| self.inertia_tensor(n));
+        let (Some(mass), Some(com), Some(frame), Some(inertia), true) = (
+            mass,
+            com,
+            frame,
+            inertia,
+            complete && get(f, "angle").is_none() && get(f, "at").is_none(),
+        ) else {
+            return None;
+        };
+        Some(Body {
+            name: k.clone(),
+            kind: BodyKind::Spatial {
+                mass,
+                com,
+                frame,
+                inertia: Box::new(inertia),
+            },
+        })
+    }
+
+    /// A 3-D inertia tensor: `[Ixx, Iyy, Izz]` (principal axes along the frame's) or
+    /// `{ xx, yy, zz, xy, yz, xz }` (the off-diagonal tensor entries optional, 0 if left out).
+    fn inertia_tensor(&mut self, node: &YamlNode) -> Option<InertiaTensor> {
+        const HELP: &str = "the inertia of a 3-D body about its centre of mass, in its frame's axes, is `[Ixx, Iyy, Izz]` (principal axes) or `{ xx: Ixx, yy: Iyy, zz: Izz, xz: Ixz }` (off-diagonal tensor entries, −∫xz dm, 0 if left out)";
+        let mut entries: [Option<Expr>; 6] = Default::default();
+        match &node.kind {
+            YamlKind::Seq(items) if items.len() == 3 => {
+                for (slot, item) in entries.iter_mut().zip(items) {
+                    *slot = Some(self.expr(item, "a moment of inertia")?);
+                }
+            }
+            YamlKind::Map(map) => {
+                self.unknown_keys(
+                    map,
+                    "a 3-D inertia",
+                    &InertiaTensor::KEYS,
+                    &InertiaTensor::KEYS,
+                );
+                if !self.require(
+                    map,
+                    node.location,
+                    "a 3-D inertia",
+                    &InertiaTensor::KEYS[..3],
+                    "inertia: { xx: Ixx, yy: Iyy, zz: Izz, xz: Ixz }",
+                ) {
+                    return None;
+                }
+                for (slot, key) in entries.iter_mut().zip(InertiaTensor::KEYS) {
+                    if let Some(n) = get(map, key) {
+                        *slot = Some(self.expr(n, "an entry of an inertia tensor")?);
+                    }
+                }
+            }
+            other => {
+                self.error(
+                    Diagnostic::new(
+                        node.location,
+                        format!(
+                            "a 3-D body's inertia must be a list of three moments or a map of tensor entries, found {}",
+                            other.describe()
+                        ),
+                    )
+                    .with_help(HELP),
+                );
+                return None;
+            }
+        }
+        Some(InertiaTensor {
+            entries,
+            location: node.location,
+        })
+    }
+}
