@@ -14,6 +14,9 @@
 //! it prints. The compiler rounds each to the nearest `f64`. The tests of `verner` check the
 //! order conditions, the row sums and the interpolants against these numbers.
 //!
+//! long: a table of coefficients (four pairs of up to 26 stages with their interpolants'
+//! weights), data rather than code; split, it would only scatter one source's numbers.
+//!
 //! Stages are numbered from 0 here (Verner numbers them from 1). Row `i` of `a` holds
 //! `aᵢ₀ … aᵢ,ᵢ₋₁`; the rows after the step's own stages are the interpolant's extra stages.
 //! The interpolant's weights are `bᵢ(θ) = Σₘ rᵢₘ θᵐ`, `m = 1 … degree`, one row of `r` per
