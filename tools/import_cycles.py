@@ -4,10 +4,13 @@
 A file that takes a name defined in another file of the same crate (by `use crate::…`,
 `use super::…`, `use self::…`, a `use` of a child module, or such a path written in code)
 has an arrow to that file; a circle is a strongly connected set of two or more files
-(Tarjan's algorithm). A re-export (`pub use child::Name` in a `lib.rs` or `mod.rs`, or any
-file) is an alias, not a use: an importer of `crate::Name` has its arrow to the file that
-defines `Name`, and the re-exporting file gets none. A glob import (`use super::*`) ties the
-file to the files that define the identifiers it uses from the glob's module.
+(Tarjan's algorithm). Re-exports are not followed: an importer of `crate::Name`, where
+`lib.rs` has `pub use child::Name`, has its arrow to `lib.rs`, the file it names, not to the
+file that defines `Name`; the re-export itself hands the name on and is not a use of it, so
+it gives the re-exporting file no arrow (its other imports and paths in its code do). So a
+file that takes names through its parent's re-exports while the parent's code uses it is a
+circle. A glob import (`use super::*`) ties the file to the files that define, or re-export,
+the identifiers it uses from the glob's module.
 
 Arrows between crates are not followed: the crate graph is acyclic, so a circle stays inside
 one crate. The crate roots are the `lib.rs` and `main.rs` of each source directory; modules
@@ -101,6 +104,7 @@ class FileInfo:
         self.uses = []  # (context module, use tree as (path, alias or None, glob), public)
         self.code_paths = []  # (context module, path)
         self.idents = set()
+        self.code_idents = set()  # identifiers outside the `use` declarations
         self.child_files = []  # (name, context module)
 
 
@@ -175,6 +179,7 @@ def scan(info, source):
     toks = skip_test_items(tokens(source))
     info.idents = {t for t in toks if re.match(r"[A-Za-z_]", t)}
     definitions = {}  # module -> set of names
+    use_spans = []  # token ranges of the `use` declarations
     modules = []  # inline modules (module path)
     scopes = [Scope(info.module, 0)]
     depth = 0
@@ -203,6 +208,7 @@ def scan(info, source):
             j = parse_use_tree(toks, i + 1, [], trees)
             for tree in trees:
                 info.uses.append((scope.module, tree, public))
+            use_spans.append((i, j))
             i = j
             continue
         if at_item_level and t == "mod" and i + 2 < len(toks):
@@ -236,6 +242,11 @@ def scan(info, source):
             i = j
             continue
         i += 1
+    in_use = set()
+    for a, b in use_spans:
+        in_use.update(range(a, b))
+    info.code_idents = {t for n, t in enumerate(toks)
+                        if n not in in_use and re.match(r"[A-Za-z_]", t)}
     return definitions, modules
 
 
@@ -244,8 +255,11 @@ class Crate:
         self.name = name
         self.module_files = {}  # module path -> file path
         self.items = {}  # (module, name) -> file path
-        self.imports = {}  # module -> list of (path, alias, glob, context module, file)
+        self.imports = {}  # module -> list of (path, alias, glob, context module, file, public)
         self.files = {}  # file path -> FileInfo
+        # (re-exporting file, name) -> where the name comes from: a file's own code that uses
+        # a name it re-exports takes it from there.
+        self.reexported = {}
 
 
 def load_crate(root_file, crate_name, excluded):
@@ -277,7 +291,8 @@ def load_crate(root_file, crate_name, excluded):
                     break
         for context, (upath, alias, glob), _public in info.uses:
             key = alias if alias else (upath[-1] if upath and not glob else None)
-            crate.imports.setdefault(context, []).append((upath, key, glob, context, path))
+            crate.imports.setdefault(context, []).append(
+                (upath, key, glob, context, path, _public))
     return crate
 
 
@@ -339,19 +354,27 @@ def resolve_name(crate, module, name, seen):
         return ("module", module + (name,))
     if key in crate.items:
         return ("item", crate.items[key], name)
-    for upath, alias, glob, context, _file in crate.imports.get(module, []):
+    for upath, alias, glob, context, file, public in crate.imports.get(module, []):
         if glob:
             continue
         if alias == name:
             if upath[-1] == "self":
                 upath = upath[:-1]
-            return resolve_path(crate, context, upath, seen)
-    for upath, alias, glob, context, _file in crate.imports.get(module, []):
+            target = resolve_path(crate, context, upath, seen)
+            # A re-exported item is taken from the file that re-exports it.
+            if public and target and target[0] == "item":
+                crate.reexported[(file, name)] = target
+                return ("item", file, name)
+            return target
+    for upath, alias, glob, context, file, public in crate.imports.get(module, []):
         if glob:
             target = resolve_path(crate, context, upath, seen)
             if target and target[0] == "module":
                 found = resolve_name(crate, target[1], name, seen)
                 if found:
+                    if public and found[0] == "item":
+                        crate.reexported[(file, name)] = found
+                        return ("item", file, name)
                     return found
     return None
 
@@ -361,6 +384,8 @@ def arrows(crate):
     edges = {}
 
     def add(src, target):
+        if target and target[0] == "item" and target[1] == src:
+            target = crate.reexported.get((src, target[2]), target)
         if target and target[0] == "item" and target[1] != src:
             edges.setdefault(src, {}).setdefault(target[1], set()).add(target[2])
 
@@ -375,9 +400,17 @@ def arrows(crate):
                 if target[0] != "module":
                     continue
                 for ident in info.idents:
+                    # A name the file defines shadows the glob's.
+                    if crate.items.get((info.module, ident)) == path:
+                        continue
                     add(path, resolve_name(crate, target[1], ident, frozenset()))
             elif not public:
                 add(path, target)
+            else:
+                # A re-export is no use of the name; the file's own code using it is.
+                name = alias if alias else upath[-1]
+                if name in info.code_idents:
+                    add(path, target)
         for context, cpath in info.code_paths:
             add(path, resolve_path(crate, context, cpath, frozenset()))
     return edges

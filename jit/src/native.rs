@@ -43,6 +43,7 @@ use eomgen_symbolic::codegen::tape::{Input, Instruction};
 use eomgen_symbolic::expr::Func;
 
 mod module;
+pub use module::CompileError;
 pub(crate) use module::{Imports, ModuleMemory, declare_imports, failure, new_module};
 
 /// A compiled function: see the module documentation for its arguments.
@@ -89,34 +90,6 @@ const SCRATCH_FROM_INSTRUCTIONS: usize = 1500;
 /// Runs of at least this many consecutive outputs that are the constant `+0.0` are written by
 /// one call of [`crate::math::fill_zero`] (see [`zero_runs`]).
 const ZERO_RUN: usize = 16;
-
-/// Why the model's functions could not be compiled to native code.
-#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
-#[non_exhaustive]
-pub enum CompileError {
-    /// Cranelift has no code generator for this host (the run-time model then interprets
-    /// its tapes).
-    #[error("no native code generator for this host: {reason}")]
-    UnsupportedHost {
-        /// Cranelift's explanation.
-        reason: String,
-    },
-    /// A function could not be compiled: Cranelift failed on it, or its program is
-    /// malformed.
-    #[error("could not compile `{function}` to native code: {reason}")]
-    Function {
-        /// The function of the model (`mass_matrix_and_forcing`, …).
-        function: String,
-        /// Cranelift's message.
-        reason: String,
-    },
-    /// The compiled code could not be made executable (mapping or protecting memory failed).
-    #[error("could not make the compiled code executable: {reason}")]
-    Finalize {
-        /// The operating system's or Cranelift's message.
-        reason: String,
-    },
-}
 
 /// The native code of a model's functions and the memory that holds it.
 pub(crate) struct NativeCode {

@@ -11,8 +11,35 @@ use cranelift_module::{FuncId, Linkage, Module, default_libcall_names};
 
 use eomgen_symbolic::expr::Func;
 
-use super::CompileError;
 use crate::math;
+
+/// Why the model's functions could not be compiled to native code.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[non_exhaustive]
+pub enum CompileError {
+    /// Cranelift has no code generator for this host (the run-time model then interprets
+    /// its tapes).
+    #[error("no native code generator for this host: {reason}")]
+    UnsupportedHost {
+        /// Cranelift's explanation.
+        reason: String,
+    },
+    /// A function could not be compiled: Cranelift failed on it, or its program is
+    /// malformed.
+    #[error("could not compile `{function}` to native code: {reason}")]
+    Function {
+        /// The function of the model (`mass_matrix_and_forcing`, …).
+        function: String,
+        /// Cranelift's message.
+        reason: String,
+    },
+    /// The compiled code could not be made executable (mapping or protecting memory failed).
+    #[error("could not make the compiled code executable: {reason}")]
+    Finalize {
+        /// The operating system's or Cranelift's message.
+        reason: String,
+    },
+}
 
 /// A finalised module's executable memory, freed when dropped (with the function pointers
 /// into it, which its owner holds beside it and never hands out).

@@ -7,26 +7,6 @@ use nalgebra::{DMatrix, DVector};
 use super::modal::*;
 use crate::model_info::ModelInfo;
 
-/// Why Newton's method on the equilibrium equations stopped short of a root.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
-#[non_exhaustive]
-pub enum NewtonStop {
-    /// `∂F/∂q` has a NaN or infinite entry at the iterate.
-    #[error("the Jacobian ∂F/∂q is not finite")]
-    NonFiniteJacobian,
-    /// `∂F/∂q` is zero at the iterate: the forces do not depend on the configuration there
-    /// (no restoring force), so nothing points to an equilibrium.
-    #[error("the Jacobian ∂F/∂q is zero: the forces do not depend on q here")]
-    ZeroJacobian,
-    /// No step along the Newton direction, halved 30 times, reduces `max |F|`: a non-zero
-    /// local minimum of `|F|`, or a singular `∂F/∂q` whose null space the residual leaves.
-    #[error("no step reduces |F|: a non-zero minimum of |F| or a singular ∂F/∂q")]
-    NoDecrease,
-    /// 100 iterations without convergence.
-    #[error("iteration limit")]
-    IterationLimit,
-}
-
 /// An equilibrium `F(q*, 0, t) = 0` (with constraints: `F(q*, 0, t) = Jᵀλ*`, `Φ(q*, t) = 0`)
 /// found by Newton's method.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]

@@ -29,4 +29,5 @@ pub mod modal;
 pub mod monodromy;
 pub mod response;
 pub mod steady;
+mod stops;
 pub mod time_dependence;

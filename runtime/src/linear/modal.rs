@@ -224,7 +224,8 @@ pub enum ModalError {
     },
 }
 
-pub use super::time_dependence::{TimeDependentForcing, TimeDependentPart, time_dependence};
+pub use super::stops::{NewtonStop, TimeDependentForcing, TimeDependentPart};
+pub use super::time_dependence::time_dependence;
 
 /// Below this smallest eigenvalue of the unit-diagonal mass matrix `D^{-1/2} M D^{-1/2}` (its
 /// largest is between 1 and `n`, so this is the inverse of its condition number to within
@@ -237,7 +238,7 @@ pub use super::time_dependence::{TimeDependentForcing, TimeDependentPart, time_d
 /// independent).
 pub const MASS_MATRIX_SINGULARITY: f64 = 1e-13;
 
-pub use super::equilibrium::{Equilibrium, NewtonStop, find_equilibrium};
+pub use super::equilibrium::{Equilibrium, find_equilibrium};
 
 /// The Hessians `∇²Φᵢ(q, t)` (`n × n` each, one per holonomic constraint), exact.
 ///

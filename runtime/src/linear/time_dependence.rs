@@ -7,64 +7,6 @@ use nalgebra::{DMatrix, DVector};
 use super::modal::*;
 use crate::model_info::ModelInfo;
 
-/// A part of the linearised equations found to depend on `t` ([`ModalError::TimeDependent`]).
-#[derive(Debug, Clone, PartialEq, Eq, serde::Serialize)]
-#[serde(tag = "kind", rename_all = "snake_case")]
-#[non_exhaustive]
-pub enum TimeDependentPart {
-    /// The holonomic constraint of this name: `Φ`, its Jacobian `J` or its `γ` (a rheonomic
-    /// constraint).
-    Constraint {
-        /// The constraint's name.
-        name: String,
-        /// Whether `J` changes with `t` (a rod spun at a given rate); `false` when only `Φ`,
-        /// `Φ_t` or `γ` do, a prescribed motion with a constant Jacobian (base excitation,
-        /// `x − a cos wt`), whose modes are those of the system relative to the moving base.
-        jacobian_changes: bool,
-    },
-    /// The mass matrix `M(q*, t)`.
-    MassMatrix,
-    /// The damping coefficients `−∂F/∂q̇ (q*, 0, t)`.
-    DampingMatrix,
-    /// The stiffness coefficients `−∂F/∂q (q*, 0, t)` (parametric excitation).
-    StiffnessMatrix,
-}
-
-impl std::fmt::Display for TimeDependentPart {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            Self::Constraint {
-                name,
-                jacobian_changes: true,
-            } => write!(f, "the constraint `{name}` (its Jacobian J)"),
-            Self::Constraint { name, .. } => write!(
-                f,
-                "the constraint `{name}` (Φ and γ, with a constant Jacobian: a prescribed motion)"
-            ),
-            Self::MassMatrix => f.write_str("the mass matrix M"),
-            Self::DampingMatrix => f.write_str("the damping matrix C = −∂F/∂q̇"),
-            Self::StiffnessMatrix => f.write_str("the stiffness −∂F/∂q"),
-        }
-    }
-}
-
-/// A load that depends on `t` at the operating point and enters neither `M`, `C` nor `K`:
-/// the linearisation is `M δq̈ + C δq̇ + K δq = F(q*, 0, t) − F(q*, 0, t₀)` about the equilibrium
-/// `q*` under the load's value at `t₀` (deflected by it where that value is not 0), and the
-/// modes are those of its left side, the load's variation set aside ([`time_dependence`]).
-#[derive(Debug, Clone, PartialEq, serde::Serialize)]
-pub struct TimeDependentForcing {
-    /// The time `t₀` (s) at which the load is frozen in the equilibrium `F(q*, 0, t₀) = 0`.
-    pub t0: f64,
-    /// The coordinate whose generalized force changes most.
-    pub coordinate: String,
-    /// `max |Fᵢ(q*, 0, t) − Fᵢ(q*, 0, t₀)|` over the sampled times (units of that
-    /// generalized force): the size of the input set aside.
-    pub largest_change: f64,
-    /// The sampled time (s) where it was largest.
-    pub t: f64,
-}
-
 /// Offsets (s) from `t₀` at which [`time_dependence`] samples the equations: spread over
 /// three decades and irrational-looking, so that no forcing is periodic in all of them and
 /// slow and fast ones both change between samples.

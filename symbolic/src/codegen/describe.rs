@@ -98,10 +98,10 @@ pub fn describe(model: &SymbolicModel, eom: &EquationsOfMotion, mathml: bool) ->
         events_need_accelerations: model.events_need_accelerations(),
         conservative: model.conservative,
         derivation: text(crate::mechanics::preferred_formulation(model).name()),
-        equations_text: Cow::Owned(super::equations_text(model, eom)),
-        equations_latex: Cow::Owned(super::equations_latex(model, eom)),
+        equations_text: Cow::Owned(super::listing::equations_text(model, eom)),
+        equations_latex: Cow::Owned(super::listing::equations_latex(model, eom)),
         equations_mathml: mathml.then(|| {
-            super::equations_mathml(model, eom)
+            super::listing::equations_mathml(model, eom)
                 .into_iter()
                 .map(Cow::Owned)
                 .collect()
@@ -132,7 +132,7 @@ pub fn description_tokens(
         .iter()
         .map(|p| {
             let name = text(&p.name);
-            let default = super::float(p.default)?;
+            let default = super::rust_tokens::float(p.default)?;
             Ok(quote!(#krate::Parameter { name: #name, default: #default }))
         })
         .collect::<Result<_, String>>()?;
@@ -166,11 +166,11 @@ pub fn description_tokens(
             .collect(),
     );
     let constraints = texts(&d.constraints);
-    let holonomic = super::index(d.holonomic_constraints);
+    let holonomic = super::rust_tokens::index(d.holonomic_constraints);
     let guesses: Vec<TokenStream> = d
         .initial_guesses
         .iter()
-        .map(|i| super::tokens(&format!("{i}_usize")))
+        .map(|i| super::rust_tokens::tokens(&format!("{i}_usize")))
         .collect::<Result<_, String>>()?;
     let initial_guesses = borrowed(guesses);
     let equilibria = texts(&d.equilibria);
@@ -178,7 +178,7 @@ pub fn description_tokens(
     let ignorable: Vec<TokenStream> = d
         .ignorable_coordinates
         .iter()
-        .map(|[k, c]| super::tokens(&format!("[{k}_usize, {c}_usize]")))
+        .map(|[k, c]| super::rust_tokens::tokens(&format!("[{k}_usize, {c}_usize]")))
         .collect::<Result<_, String>>()?;
     let ignorable_coordinates = borrowed(ignorable);
     let events = borrowed(
@@ -267,7 +267,7 @@ fn optional(value: Option<TokenStream>) -> TokenStream {
 
 /// A float literal, or the error of a non-finite one.
 fn float(v: f64) -> Result<TokenStream, String> {
-    super::float(v)
+    super::rust_tokens::float(v)
 }
 
 /// An optional float literal.

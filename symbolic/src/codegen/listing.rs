@@ -15,6 +15,7 @@
 use std::fmt::Write as _;
 
 use crate::expr::print::{Printer, Syntax};
+use crate::expr::{ExprId, SymbolKind};
 use crate::mechanics::{EquationsOfMotion, SymbolicModel};
 
 /// Whether a constraint restricts positions or only velocities.
@@ -243,4 +244,65 @@ pub fn equations_latex(model: &SymbolicModel, eom: &EquationsOfMotion) -> String
         let _ = writeln!(s, "\\\\\n{} = 0", c.equation);
     }
     s
+}
+
+/// The equations as MathML, one `<math display="block">` element per line: `T = …`,
+/// `V = …`, each generalised force `Q_q = …` that is not zero, then one equation of motion
+/// per coordinate, `Σⱼ M_ij q̈ⱼ + Σₖ J_ki λₖ = F_i` (zero terms left out; the multipliers of
+/// constrained models, `[M Jᵀ; J 0][q̈; λ] = [F; γ]`), and `Φₖ = 0` for each holonomic
+/// constraint. For HTML pages rendered without scripts or network (MathML Core).
+///
+/// The left-hand sides are built as expressions in a copy of the model's arena, so that the
+/// model (and the plans made on its arena) stays as it was.
+pub fn equations_mathml(model: &SymbolicModel, eom: &EquationsOfMotion) -> Vec<String> {
+    let n = eom.num_dofs;
+    let mut arena = model.arena.clone();
+    let mut lhs = Vec::with_capacity(n);
+    let multipliers: Vec<ExprId> = model
+        .constraints
+        .names
+        .iter()
+        .enumerate()
+        .map(|(k, name)| arena.symbol(&format!("lambda_{name}"), SymbolKind::Multiplier(k as u32)))
+        .collect();
+    for i in 0..n {
+        let mut terms = Vec::new();
+        for j in 0..n {
+            let m = eom.mass(i, j);
+            if !arena.is_zero(m) {
+                let acceleration = model.coordinates[j][2];
+                terms.push(arena.product(&[m, acceleration]));
+            }
+        }
+        for (k, lambda) in multipliers.iter().enumerate() {
+            let j = model.constraints.jacobian[k * n + i];
+            if !arena.is_zero(j) {
+                terms.push(arena.product(&[j, *lambda]));
+            }
+        }
+        lhs.push(arena.sum(&terms));
+    }
+    let p = Printer::new(&arena, Syntax::MathMl);
+    let line = |body: String| format!("<math display=\"block\">{body}</math>");
+    let equals = "<mo>=</mo>";
+    let mut out = vec![
+        line(format!("<mi>T</mi>{equals}{}", p.print(model.kinetic))),
+        line(format!("<mi>V</mi>{equals}{}", p.print(model.potential))),
+    ];
+    for (i, q) in model.generalized_forces.iter().enumerate() {
+        if !arena.is_zero(*q) {
+            out.push(line(format!(
+                "<msub><mi>Q</mi>{}</msub>{equals}{}",
+                crate::expr::print::mathml_symbol(&model.coordinate_names[i]),
+                p.print(*q)
+            )));
+        }
+    }
+    for (l, f) in lhs.iter().zip(&eom.forcing) {
+        out.push(line(format!("{}{equals}{}", p.print(*l), p.print(*f))));
+    }
+    for phi in &model.constraints.phi {
+        out.push(line(format!("{}{equals}<mn>0</mn>", p.print(*phi))));
+    }
+    out
 }

@@ -12,6 +12,7 @@ mod describe;
 mod listing;
 pub mod plan;
 pub mod program;
+mod rust_tokens;
 pub mod tape;
 pub mod taylor;
 mod taylor_tokens;
@@ -19,10 +20,10 @@ mod taylor_tokens;
 pub use describe::{describe, description_tokens};
 pub use listing::{
     ConstraintKind, ConstraintListing, EquationsListing, GeneralizedForce, equations_latex,
-    equations_text,
+    equations_mathml, equations_text,
 };
 
-use proc_macro2::{Ident, Literal, TokenStream, TokenTree};
+use proc_macro2::{Literal, TokenStream};
 use quote::quote;
 
 use crate::expr::cse::{CsePlan, Temporary};
@@ -31,6 +32,7 @@ use crate::expr::{ExprArena, ExprId, SymbolId, SymbolKind};
 use crate::mechanics::{EquationsOfMotion, SymbolicModel};
 use crate::model::schema::RUST_KEYWORDS;
 use plan::ModelFunction;
+use rust_tokens::{float, ident, index, tokens};
 
 /// Why [`generate`] produced no code.
 #[derive(Debug, Clone)]
@@ -128,46 +130,6 @@ pub fn local_name(name: &str) -> String {
     } else {
         field_name(name)
     }
-}
-
-/// The tokens of Rust source: an expression of the printer, or a path from [`EmitOptions`].
-///
-/// # Errors
-/// Source that does not tokenize (a bug of the printer, or a bad `crate_path`), with the
-/// source.
-fn tokens(source: &str) -> Result<TokenStream, String> {
-    source
-        .parse()
-        .map_err(|e| format!("generated code does not tokenize ({e}): {source}"))
-}
-
-/// An identifier, raw for `r#name`.
-///
-/// # Errors
-/// A name that is not one identifier (the loader refuses such names, so this is a bug).
-fn ident(name: &str) -> Result<Ident, String> {
-    let mut trees = tokens(name)?.into_iter();
-    match (trees.next(), trees.next()) {
-        (Some(TokenTree::Ident(ident)), None) => Ok(ident),
-        _ => Err(format!("`{name}` is not a Rust identifier")),
-    }
-}
-
-/// An `f64` literal as the printer writes one (`9.81_f64`, `-1.0_f64`).
-///
-/// # Errors
-/// A value that is not finite, which has no literal (the loader refuses such defaults, so
-/// this is a bug).
-fn float(value: f64) -> Result<TokenStream, String> {
-    if !value.is_finite() {
-        return Err(format!("{value} has no Rust literal"));
-    }
-    tokens(&format!("{value:?}_f64"))
-}
-
-/// An index or size, unsuffixed (`3`).
-fn index(i: usize) -> Literal {
-    Literal::usize_unsuffixed(i)
 }
 
 /// One function body: symbol bindings and temporaries, and the returned values (in root
@@ -554,65 +516,4 @@ fn point_stores(model: &SymbolicModel, v: &[TokenStream]) -> TokenStream {
             quote!(if let Some(__p) = __out.get_mut(#i) { *__p = [#(#c),*]; })
         })
         .collect()
-}
-
-/// The equations as MathML, one `<math display="block">` element per line: `T = …`,
-/// `V = …`, each generalised force `Q_q = …` that is not zero, then one equation of motion
-/// per coordinate, `Σⱼ M_ij q̈ⱼ + Σₖ J_ki λₖ = F_i` (zero terms left out; the multipliers of
-/// constrained models, `[M Jᵀ; J 0][q̈; λ] = [F; γ]`), and `Φₖ = 0` for each holonomic
-/// constraint. For HTML pages rendered without scripts or network (MathML Core).
-///
-/// The left-hand sides are built as expressions in a copy of the model's arena, so that the
-/// model (and the plans made on its arena) stays as it was.
-pub fn equations_mathml(model: &SymbolicModel, eom: &EquationsOfMotion) -> Vec<String> {
-    let n = eom.num_dofs;
-    let mut arena = model.arena.clone();
-    let mut lhs = Vec::with_capacity(n);
-    let multipliers: Vec<ExprId> = model
-        .constraints
-        .names
-        .iter()
-        .enumerate()
-        .map(|(k, name)| arena.symbol(&format!("lambda_{name}"), SymbolKind::Multiplier(k as u32)))
-        .collect();
-    for i in 0..n {
-        let mut terms = Vec::new();
-        for j in 0..n {
-            let m = eom.mass(i, j);
-            if !arena.is_zero(m) {
-                let acceleration = model.coordinates[j][2];
-                terms.push(arena.product(&[m, acceleration]));
-            }
-        }
-        for (k, lambda) in multipliers.iter().enumerate() {
-            let j = model.constraints.jacobian[k * n + i];
-            if !arena.is_zero(j) {
-                terms.push(arena.product(&[j, *lambda]));
-            }
-        }
-        lhs.push(arena.sum(&terms));
-    }
-    let p = Printer::new(&arena, Syntax::MathMl);
-    let line = |body: String| format!("<math display=\"block\">{body}</math>");
-    let equals = "<mo>=</mo>";
-    let mut out = vec![
-        line(format!("<mi>T</mi>{equals}{}", p.print(model.kinetic))),
-        line(format!("<mi>V</mi>{equals}{}", p.print(model.potential))),
-    ];
-    for (i, q) in model.generalized_forces.iter().enumerate() {
-        if !arena.is_zero(*q) {
-            out.push(line(format!(
-                "<msub><mi>Q</mi>{}</msub>{equals}{}",
-                crate::expr::print::mathml_symbol(&model.coordinate_names[i]),
-                p.print(*q)
-            )));
-        }
-    }
-    for (l, f) in lhs.iter().zip(&eom.forcing) {
-        out.push(line(format!("{}{equals}{}", p.print(*l), p.print(*f))));
-    }
-    for phi in &model.constraints.phi {
-        out.push(line(format!("{}{equals}<mn>0</mn>", p.print(*phi))));
-    }
-    out
 }

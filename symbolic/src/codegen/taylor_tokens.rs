@@ -97,7 +97,7 @@ pub(super) fn methods(
         };
     };
     // Order 0: the extended tape, every value stored in its slot.
-    let value = |v: u32| super::ident(&format!("__v{v}"));
+    let value = |v: u32| super::rust_tokens::ident(&format!("__v{v}"));
     let mut statements = proc_macro2::TokenStream::new();
     let private = quote!(#krate::__private);
     for (k, instruction) in plan.order_zero.instructions.iter().enumerate() {
@@ -114,7 +114,7 @@ pub(super) fn methods(
             Instruction::Const(c) if c.is_nan() => quote!(f64::NAN),
             Instruction::Const(c) if c.is_infinite() && c > 0.0 => quote!(f64::INFINITY),
             Instruction::Const(c) if c.is_infinite() => quote!(f64::NEG_INFINITY),
-            Instruction::Const(c) => super::float(c)?,
+            Instruction::Const(c) => super::rust_tokens::float(c)?,
             Instruction::Neg(x) => {
                 let x = v(&x)?;
                 quote!(-#x)
@@ -166,9 +166,9 @@ pub(super) fn methods(
                     Func::Sign => quote!(#private::sign(#x)),
                     Func::Step => quote!(#private::step(#x)),
                     other => {
-                        let method = super::ident(other.name())?;
+                        let method = super::rust_tokens::ident(other.name())?;
                         let method = if other == Func::Ln {
-                            super::ident("ln")?
+                            super::rust_tokens::ident("ln")?
                         } else {
                             method
                         };

@@ -16,6 +16,7 @@ mod lower;
 mod mass;
 mod momentum;
 mod numeric;
+mod preferred;
 
 pub use balances::{HandEquations, UserBalances};
 pub use constraints::{ConstraintEquations, linear_in_rates, redundant_rows};
@@ -28,6 +29,7 @@ pub use lower::{
 };
 pub use mass::mass_matrix_diagnostics;
 pub use momentum::MomentumBalance;
+pub use preferred::{preferred_equations, preferred_formulation};
 
 use crate::expr::ExprId;
 
@@ -103,37 +105,6 @@ impl Jacobians {
             mass_product_q,
         }
     }
-}
-
-/// The formulation whose equations generated code uses: momentum balance for a model in the
-/// kinematic form with no written energy or generalized forces
-/// ([`MomentumBalance::applies_to`] and not [`SymbolicModel::uses_energy_form`]), Lagrange
-/// otherwise. (A kinematic file with a written `potential:` or `generalized_forces:` is
-/// cross-checked by momentum balance but generated from Lagrange's equations, as it was
-/// before momentum balance took those terms: its generated code stays as it was.)
-///
-/// The rule needs no derivation, so a model is derived once however it is loaded (the
-/// `model!` macro and the run-time loader both go through [`preferred_equations`]). Both
-/// formulations give the same equations (the test suite and `eomgen check` compare them
-/// symbolically and numerically); momentum balance is chosen because its projections on
-/// shared partial velocities are never larger than Lagrange's derivatives of `T` on the
-/// bundled models and are usually smaller, in `M` and `F` and more so in their Jacobians:
-/// against deriving both and keeping the one with fewer operations of `M` and `F` after CSE
-/// (the rule before issue 18), no bundled model gets more than one more operation, and the
-/// 3-spring line loses 26 in its Jacobians for its one operation in `F`.
-pub fn preferred_formulation(model: &SymbolicModel) -> &'static dyn Formulation {
-    if MomentumBalance::applies_to(model) && !model.uses_energy_form {
-        &MomentumBalance
-    } else {
-        &Lagrange
-    }
-}
-
-/// The equations to generate code from, derived by [`preferred_formulation`] alone; returns
-/// them and the formulation's name.
-pub fn preferred_equations(model: &mut SymbolicModel) -> (EquationsOfMotion, &'static str) {
-    let formulation = preferred_formulation(model);
-    (formulation.derive(model), formulation.name())
 }
 
 /// `(M, F)` as given or multiplied out entry by entry (where that is cheaper as a tree),
