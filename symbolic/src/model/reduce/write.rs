@@ -14,12 +14,45 @@ impl Reducer<'_> {
         notes: &mut Vec<String>,
     ) -> Result<String, ReduceError> {
         use std::fmt::Write as _;
-        let file = self.file;
+        let plan = Plan {
+            name,
+            kept,
+            eliminations,
+            initial,
+            // A file written as it is ([`write_model`]) keeps its constraints and twin.
+            preserve: eliminations.is_empty(),
+        };
         let mut w = String::new();
-        let is_kept = |n: &str| kept.iter().any(|k| k == n);
-        let is_kept_name = |n: &str| is_kept(n) || n.strip_suffix("_dot").is_some_and(is_kept);
-        // A file written as it is ([`write_model`]) keeps its constraints and twin.
-        let preserve = eliminations.is_empty();
+        if !plan.preserve {
+            self.write_header(&mut w, &plan)?;
+        }
+        self.write_identity(&mut w, &plan, notes)?;
+        self.write_energies(&mut w, &plan)?;
+        self.write_mechanism(&mut w)?;
+        self.write_loads(&mut w)?;
+        self.write_outputs_and_constraints(&mut w, &plan, notes)?;
+        self.write_initial_and_draw(&mut w, &plan, notes)?;
+        let kept_equilibria = self.write_equilibria(&mut w, &plan, notes)?;
+        let kept_events = self.write_events(&mut w, notes)?;
+        if !self.file.floquet.is_empty() {
+            notes.push("`floquet:` left out".to_string());
+        }
+        let checks = self.checks(&kept_equilibria, &kept_events, kept, plan.preserve, notes)?;
+        if !checks.is_empty() {
+            let _ = writeln!(w, "checks:");
+            w.push_str(&checks);
+        }
+        Ok(w)
+    }
+
+    /// The header of a reduced file: each elimination, its branch and where the kept
+    /// coordinates no longer determine an eliminated one.
+    fn write_header(&mut self, w: &mut String, p: &Plan<'_>) -> Result<(), ReduceError> {
+        use std::fmt::Write as _;
+        let file = self.file;
+        let kept = p.kept;
+        let eliminations = p.eliminations;
+        let preserve = p.preserve;
         // Header.
         if !preserve {
             let _ = writeln!(
@@ -62,6 +95,23 @@ impl Reducer<'_> {
                 );
             }
         }
+        Ok(())
+    }
+
+    /// `name:` … `coordinates:`: the model's name, description, units, twin, parameters and the
+    /// kept coordinates.
+    fn write_identity(
+        &mut self,
+        w: &mut String,
+        p: &Plan<'_>,
+        notes: &mut Vec<String>,
+    ) -> Result<(), ReduceError> {
+        use std::fmt::Write as _;
+        let file = self.file;
+        let name = p.name;
+        let kept = p.kept;
+        let preserve = p.preserve;
+        let is_kept = |n: &str| p.is_kept(n);
         let _ = writeln!(w, "name: {name}");
         let description = if preserve {
             file.description.clone()
@@ -107,6 +157,14 @@ impl Reducer<'_> {
                 }
             }
         }
+        Ok(())
+    }
+
+    /// `kinetic:`, `potential:` and `generalized_forces:`, rewritten in the kept coordinates.
+    fn write_energies(&mut self, w: &mut String, p: &Plan<'_>) -> Result<(), ReduceError> {
+        use std::fmt::Write as _;
+        let file = self.file;
+        let kept = p.kept;
         if let Some(t) = &file.kinetic {
             let t = self.rewrite(t, "`kinetic:`")?;
             let _ = writeln!(w, "kinetic: {}", scalar(&t));
@@ -124,6 +182,13 @@ impl Reducer<'_> {
                 }
             }
         }
+        Ok(())
+    }
+
+    /// `points:`, `bodies:` and `gravity:`.
+    fn write_mechanism(&mut self, w: &mut String) -> Result<(), ReduceError> {
+        use std::fmt::Write as _;
+        let file = self.file;
         if !file.points.is_empty() {
             let _ = writeln!(w, "points:");
             for p in &file.points {
@@ -182,6 +247,13 @@ impl Reducer<'_> {
                 .collect::<Result<Vec<_>, _>>()?;
             let _ = writeln!(w, "gravity: {}", list(&parts));
         }
+        Ok(())
+    }
+
+    /// `springs:`, `dampers:`, `forces:`, `torques:` and `interactions:`.
+    fn write_loads(&mut self, w: &mut String) -> Result<(), ReduceError> {
+        use std::fmt::Write as _;
+        let file = self.file;
         if !file.springs.is_empty() {
             let _ = writeln!(w, "springs:");
             for s in &file.springs {
@@ -266,6 +338,20 @@ impl Reducer<'_> {
                 );
             }
         }
+        Ok(())
+    }
+
+    /// `outputs:`, and the constraints of a file written as it is (`balances:` is left out).
+    fn write_outputs_and_constraints(
+        &mut self,
+        w: &mut String,
+        p: &Plan<'_>,
+        notes: &mut Vec<String>,
+    ) -> Result<(), ReduceError> {
+        use std::fmt::Write as _;
+        let file = self.file;
+        let eliminations = p.eliminations;
+        let preserve = p.preserve;
         if !file.outputs.is_empty() {
             let mut block = String::new();
             for o in &file.outputs {
@@ -313,6 +399,22 @@ impl Reducer<'_> {
                     .join(", ")
             ));
         }
+        Ok(())
+    }
+
+    /// `initial:` (the kept coordinates' values and rates) and `draw:`.
+    fn write_initial_and_draw(
+        &mut self,
+        w: &mut String,
+        p: &Plan<'_>,
+        notes: &mut Vec<String>,
+    ) -> Result<(), ReduceError> {
+        use std::fmt::Write as _;
+        let file = self.file;
+        let initial = p.initial;
+        let preserve = p.preserve;
+        let is_kept = |n: &str| p.is_kept(n);
+        let is_kept_name = |n: &str| p.is_kept_name(n);
         // Initial values.
         if !initial.is_empty() {
             let parts: Vec<String> = initial
@@ -370,6 +472,20 @@ impl Reducer<'_> {
             }
             let _ = writeln!(w, "draw: {{ {} }}", parts.join(", "));
         }
+        Ok(())
+    }
+
+    /// `equilibria:` on the chosen branches; returns the names of those kept.
+    fn write_equilibria(
+        &mut self,
+        w: &mut String,
+        p: &Plan<'_>,
+        notes: &mut Vec<String>,
+    ) -> Result<Vec<String>, ReduceError> {
+        use std::fmt::Write as _;
+        let file = self.file;
+        let is_kept = |n: &str| p.is_kept(n);
+        let is_kept_name = |n: &str| p.is_kept_name(n);
         // Equilibria on the chosen branches.
         let mut kept_equilibria: Vec<String> = Vec::new();
         let mut equilibria = String::new();
@@ -415,6 +531,18 @@ impl Reducer<'_> {
             let _ = writeln!(w, "equilibria:");
             w.push_str(&equilibria);
         }
+        Ok(kept_equilibria)
+    }
+
+    /// `events:`: the file's, rewritten, and one that ends runs where a linear solution's slope
+    /// crosses 0; returns the names of those kept.
+    fn write_events(
+        &mut self,
+        w: &mut String,
+        notes: &mut Vec<String>,
+    ) -> Result<Vec<String>, ReduceError> {
+        use std::fmt::Write as _;
+        let file = self.file;
         // Events: the file's, rewritten, and one that ends runs where a linear solution's
         // slope crosses 0.
         let mut kept_events: Vec<String> = Vec::new();
@@ -464,15 +592,7 @@ impl Reducer<'_> {
             let _ = writeln!(w, "events:");
             w.push_str(&events);
         }
-        if !file.floquet.is_empty() {
-            notes.push("`floquet:` left out".to_string());
-        }
-        let checks = self.checks(&kept_equilibria, &kept_events, kept, preserve, notes)?;
-        if !checks.is_empty() {
-            let _ = writeln!(w, "checks:");
-            w.push_str(&checks);
-        }
-        Ok(w)
+        Ok(kept_events)
     }
 
     /// The energy form's generalized forces moved onto the kept coordinates by virtual work:
@@ -699,4 +819,26 @@ fn quoted(s: &str) -> String {
 fn list(parts: &[String]) -> String {
     let parts: Vec<String> = parts.iter().map(|p| flow(p)).collect();
     format!("[{}]", parts.join(", "))
+}
+
+/// What writing one file needs beside the reducer: its name, the coordinates kept, the
+/// eliminations and initial values, and whether it is written as it is (nothing eliminated).
+struct Plan<'a> {
+    name: &'a str,
+    kept: &'a [String],
+    eliminations: &'a [Elimination],
+    initial: &'a [(String, Expr)],
+    preserve: bool,
+}
+
+impl Plan<'_> {
+    /// Whether `n` is a kept coordinate.
+    fn is_kept(&self, n: &str) -> bool {
+        self.kept.iter().any(|k| k == n)
+    }
+
+    /// Whether `n` is a kept coordinate or its rate.
+    fn is_kept_name(&self, n: &str) -> bool {
+        self.is_kept(n) || n.strip_suffix("_dot").is_some_and(|c| self.is_kept(c))
+    }
 }
