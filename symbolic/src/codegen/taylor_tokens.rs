@@ -1,7 +1,7 @@
 //! The Taylor method of a `model!`-generated model as Rust tokens: its `taylor` accessor and
 //! its `impl TaylorFunctions`, printed from the [`TaylorPlan`] of [`super::taylor`].
 
-use eomgen_description::taylor::{SeriesOp, Slot, TaylorUnsupported};
+use eomgen_description::taylor::{SeriesOp, Slot, TaylorProgram, TaylorUnsupported};
 
 use super::tape::{Input, Instruction};
 use super::taylor::TaylorPlan;
@@ -26,6 +26,8 @@ use crate::expr::Func;
 ///
 /// # Errors
 /// Only if a constant of the tape is not finite (a bug: the loader refuses such values).
+// Long: most of it is one `quote!` template, the generated `impl TaylorFunctions` as it is
+// printed; split, the template would only be harder to read against its output.
 pub(super) fn methods(
     taylor: &Result<TaylorPlan, TaylorUnsupported>,
     krate: &proc_macro2::TokenStream,
@@ -48,148 +50,14 @@ pub(super) fn methods(
         }
     };
     let program = &plan.program;
-    let slot_list = |slots: &[Option<Slot>]| {
-        let items = slots.iter().map(|s| match s {
-            Some(s) => quote!(::core::option::Option::Some(#s)),
-            None => quote!(::core::option::Option::None),
-        });
-        quote!(#cow::Borrowed(&[#(#items),*]))
-    };
-    let coordinates = slot_list(&program.coordinates);
-    let velocities = slot_list(&program.velocities);
-    let time = match program.time {
-        Some(s) => quote!(::core::option::Option::Some(#s)),
-        None => quote!(::core::option::Option::None),
-    };
-    let mass = program.mass_matrix.iter();
-    let forcing = program.forcing.iter();
-    let constant = program.constant.iter();
-    let ops: Vec<_> = program.ops.iter().map(|op| op_tokens(op, &t)).collect();
-    let slots = program.slots;
-    let derived = &program.derived;
-    let coupled: Vec<_> = derived
-        .varying_mass_entries
-        .iter()
-        .map(|(i, l, slot)| quote!((#i, #l, #slot)))
-        .collect();
-    let inputs: Vec<_> = derived
-        .inputs
-        .iter()
-        .map(|(slot, index)| quote!((#slot, #index)))
-        .collect();
-    let (convolutions, branch_points) = (derived.convolutions, derived.branch_points);
-    let statics = quote! {
-        static PROGRAM: #t::TaylorProgram = #t::TaylorProgram {
-            slots: #slots,
-            coordinates: #coordinates,
-            velocities: #velocities,
-            time: #time,
-            mass_matrix: #cow::Borrowed(&[#(#mass),*]),
-            forcing: #cow::Borrowed(&[#(#forcing),*]),
-            constant: #cow::Borrowed(&[#(#constant),*]),
-            ops: #cow::Borrowed(&[#(#ops),*]),
-            derived: #t::DerivedLists {
-                varying_mass_entries: #cow::Borrowed(&[#(#coupled),*]),
-                inputs: #cow::Borrowed(&[#(#inputs),*]),
-                convolutions: #convolutions,
-                branch_points: #branch_points,
-            },
-        };
-    };
-    // Order 0: the extended tape, every value stored in its slot.
-    let value = |v: u32| super::rust_tokens::ident(&format!("__v{v}"));
-    let mut statements = proc_macro2::TokenStream::new();
-    let private = quote!(#krate::__private);
-    for (k, instruction) in plan.order_zero.instructions.iter().enumerate() {
-        let k32 = k as u32;
-        let name = value(k32)?;
-        let v = |x: &u32| value(*x);
-        let expression = match *instruction {
-            Instruction::Input(Input::Parameter(i)) => {
-                let field = &parameters[i as usize];
-                quote!(self.#field)
-            }
-            Instruction::Input(_) => quote!(__s[#k * __c]),
-            // A constant without a literal (NaN stands for a missing parameter) as `f64`'s.
-            Instruction::Const(c) if c.is_nan() => quote!(f64::NAN),
-            Instruction::Const(c) if c.is_infinite() && c > 0.0 => quote!(f64::INFINITY),
-            Instruction::Const(c) if c.is_infinite() => quote!(f64::NEG_INFINITY),
-            Instruction::Const(c) => super::rust_tokens::float(c)?,
-            Instruction::Neg(x) => {
-                let x = v(&x)?;
-                quote!(-#x)
-            }
-            Instruction::Add(x, y) => {
-                let (x, y) = (v(&x)?, v(&y)?);
-                quote!(#x + #y)
-            }
-            Instruction::Sub(x, y) => {
-                let (x, y) = (v(&x)?, v(&y)?);
-                quote!(#x - #y)
-            }
-            Instruction::Mul(x, y) => {
-                let (x, y) = (v(&x)?, v(&y)?);
-                quote!(#x * #y)
-            }
-            Instruction::Div(x, y) => {
-                let (x, y) = (v(&x)?, v(&y)?);
-                quote!(#x / #y)
-            }
-            Instruction::Sqrt(x) => {
-                let x = v(&x)?;
-                quote!(#x.sqrt())
-            }
-            Instruction::Abs(x) => {
-                let x = v(&x)?;
-                quote!(#x.abs())
-            }
-            Instruction::Powf(x, y) => {
-                let (x, y) = (v(&x)?, v(&y)?);
-                quote!(#x.powf(#y))
-            }
-            Instruction::Atan2(y, x) => {
-                let (y, x) = (v(&y)?, v(&x)?);
-                quote!(#y.atan2(#x))
-            }
-            Instruction::SinCos(x) => {
-                let x = v(&x)?;
-                let cos = value(k32 + 1)?;
-                statements.extend(quote!(let (#name, #cos): (f64, f64) = #private::sin_cos(#x);));
-                continue;
-            }
-            Instruction::CosOfSinCos(_) => continue,
-            Instruction::Call(f, x) => {
-                let x = v(&x)?;
-                match f {
-                    Func::Sin => quote!(#private::sin(#x)),
-                    Func::Cos => quote!(#private::cos(#x)),
-                    Func::Sign => quote!(#private::sign(#x)),
-                    Func::Step => quote!(#private::step(#x)),
-                    other => {
-                        let method = super::rust_tokens::ident(other.name())?;
-                        let method = if other == Func::Ln {
-                            super::rust_tokens::ident("ln")?
-                        } else {
-                            method
-                        };
-                        quote!(#x.#method())
-                    }
-                }
-            }
-        };
-        statements.extend(quote!(let #name: f64 = #expression;));
-    }
-    let stores = plan
-        .order_zero
-        .instructions
-        .iter()
-        .enumerate()
-        .filter(|(_, i)| !matches!(i, Instruction::Input(input) if !matches!(input, Input::Parameter(_))))
-        .map(|(k, _)| {
-            let name = value(k as u32)?;
-            Ok(quote!(__s[#k * __c] = #name;))
-        })
-        .collect::<Result<Vec<_>, String>>()?;
+    let ProgramTokens {
+        statics,
+        time,
+        coupled,
+        inputs,
+        slots,
+    } = program_static(program, &t, &cow);
+    let (statements, stores) = order_zero(plan, krate, parameters)?;
     let calls: Vec<_> = program.ops.iter().map(|op| call_tokens(op, &t)).collect();
     // The orders whose compiled code a step can run (`TaylorProgram::unrolled_code_fits`):
     // compiling the others would only lengthen the build.
@@ -325,6 +193,189 @@ pub(super) fn methods(
         }
     };
     Ok((accessor, implementation))
+}
+
+/// The tokens of a generated model's program: its `static PROGRAM: TaylorProgram` (the
+/// program as constants) and the pieces of it that the fused orders name again.
+struct ProgramTokens {
+    statics: proc_macro2::TokenStream,
+    time: proc_macro2::TokenStream,
+    coupled: Vec<proc_macro2::TokenStream>,
+    inputs: Vec<proc_macro2::TokenStream>,
+    slots: usize,
+}
+
+/// The [`ProgramTokens`] of `program`.
+fn program_static(
+    program: &TaylorProgram,
+    t: &proc_macro2::TokenStream,
+    cow: &proc_macro2::TokenStream,
+) -> ProgramTokens {
+    use quote::quote;
+    let slot_list = |slots: &[Option<Slot>]| {
+        let items = slots.iter().map(|s| match s {
+            Some(s) => quote!(::core::option::Option::Some(#s)),
+            None => quote!(::core::option::Option::None),
+        });
+        quote!(#cow::Borrowed(&[#(#items),*]))
+    };
+    let coordinates = slot_list(&program.coordinates);
+    let velocities = slot_list(&program.velocities);
+    let time = match program.time {
+        Some(s) => quote!(::core::option::Option::Some(#s)),
+        None => quote!(::core::option::Option::None),
+    };
+    let mass = program.mass_matrix.iter();
+    let forcing = program.forcing.iter();
+    let constant = program.constant.iter();
+    let ops: Vec<_> = program.ops.iter().map(|op| op_tokens(op, t)).collect();
+    let slots = program.slots;
+    let derived = &program.derived;
+    let coupled: Vec<_> = derived
+        .varying_mass_entries
+        .iter()
+        .map(|(i, l, slot)| quote!((#i, #l, #slot)))
+        .collect();
+    let inputs: Vec<_> = derived
+        .inputs
+        .iter()
+        .map(|(slot, index)| quote!((#slot, #index)))
+        .collect();
+    let (convolutions, branch_points) = (derived.convolutions, derived.branch_points);
+    let statics = quote! {
+        static PROGRAM: #t::TaylorProgram = #t::TaylorProgram {
+            slots: #slots,
+            coordinates: #coordinates,
+            velocities: #velocities,
+            time: #time,
+            mass_matrix: #cow::Borrowed(&[#(#mass),*]),
+            forcing: #cow::Borrowed(&[#(#forcing),*]),
+            constant: #cow::Borrowed(&[#(#constant),*]),
+            ops: #cow::Borrowed(&[#(#ops),*]),
+            derived: #t::DerivedLists {
+                varying_mass_entries: #cow::Borrowed(&[#(#coupled),*]),
+                inputs: #cow::Borrowed(&[#(#inputs),*]),
+                convolutions: #convolutions,
+                branch_points: #branch_points,
+            },
+        };
+    };
+    ProgramTokens {
+        statics,
+        time,
+        coupled,
+        inputs,
+        slots,
+    }
+}
+
+/// Order 0 of a generated model's series: the statements of the extended tape (each value a
+/// `let __vK: f64`) and the stores of every value but the state's into its slot.
+///
+/// # Errors
+/// Only if a constant of the tape is not finite (a bug: the loader refuses such values).
+// Long: one match arm per instruction kind of the tape, each the Rust of that operation.
+fn order_zero(
+    plan: &TaylorPlan,
+    krate: &proc_macro2::TokenStream,
+    parameters: &[proc_macro2::Ident],
+) -> Result<(proc_macro2::TokenStream, Vec<proc_macro2::TokenStream>), String> {
+    use quote::quote;
+    // Order 0: the extended tape, every value stored in its slot.
+    let value = |v: u32| super::rust_tokens::ident(&format!("__v{v}"));
+    let mut statements = proc_macro2::TokenStream::new();
+    let private = quote!(#krate::__private);
+    for (k, instruction) in plan.order_zero.instructions.iter().enumerate() {
+        let k32 = k as u32;
+        let name = value(k32)?;
+        let v = |x: &u32| value(*x);
+        let expression = match *instruction {
+            Instruction::Input(Input::Parameter(i)) => {
+                let field = &parameters[i as usize];
+                quote!(self.#field)
+            }
+            Instruction::Input(_) => quote!(__s[#k * __c]),
+            // A constant without a literal (NaN stands for a missing parameter) as `f64`'s.
+            Instruction::Const(c) if c.is_nan() => quote!(f64::NAN),
+            Instruction::Const(c) if c.is_infinite() && c > 0.0 => quote!(f64::INFINITY),
+            Instruction::Const(c) if c.is_infinite() => quote!(f64::NEG_INFINITY),
+            Instruction::Const(c) => super::rust_tokens::float(c)?,
+            Instruction::Neg(x) => {
+                let x = v(&x)?;
+                quote!(-#x)
+            }
+            Instruction::Add(x, y) => {
+                let (x, y) = (v(&x)?, v(&y)?);
+                quote!(#x + #y)
+            }
+            Instruction::Sub(x, y) => {
+                let (x, y) = (v(&x)?, v(&y)?);
+                quote!(#x - #y)
+            }
+            Instruction::Mul(x, y) => {
+                let (x, y) = (v(&x)?, v(&y)?);
+                quote!(#x * #y)
+            }
+            Instruction::Div(x, y) => {
+                let (x, y) = (v(&x)?, v(&y)?);
+                quote!(#x / #y)
+            }
+            Instruction::Sqrt(x) => {
+                let x = v(&x)?;
+                quote!(#x.sqrt())
+            }
+            Instruction::Abs(x) => {
+                let x = v(&x)?;
+                quote!(#x.abs())
+            }
+            Instruction::Powf(x, y) => {
+                let (x, y) = (v(&x)?, v(&y)?);
+                quote!(#x.powf(#y))
+            }
+            Instruction::Atan2(y, x) => {
+                let (y, x) = (v(&y)?, v(&x)?);
+                quote!(#y.atan2(#x))
+            }
+            Instruction::SinCos(x) => {
+                let x = v(&x)?;
+                let cos = value(k32 + 1)?;
+                statements.extend(quote!(let (#name, #cos): (f64, f64) = #private::sin_cos(#x);));
+                continue;
+            }
+            Instruction::CosOfSinCos(_) => continue,
+            Instruction::Call(f, x) => {
+                let x = v(&x)?;
+                match f {
+                    Func::Sin => quote!(#private::sin(#x)),
+                    Func::Cos => quote!(#private::cos(#x)),
+                    Func::Sign => quote!(#private::sign(#x)),
+                    Func::Step => quote!(#private::step(#x)),
+                    other => {
+                        let method = super::rust_tokens::ident(other.name())?;
+                        let method = if other == Func::Ln {
+                            super::rust_tokens::ident("ln")?
+                        } else {
+                            method
+                        };
+                        quote!(#x.#method())
+                    }
+                }
+            }
+        };
+        statements.extend(quote!(let #name: f64 = #expression;));
+    }
+    let stores = plan
+        .order_zero
+        .instructions
+        .iter()
+        .enumerate()
+        .filter(|(_, i)| !matches!(i, Instruction::Input(input) if !matches!(input, Input::Parameter(_))))
+        .map(|(k, _)| {
+            let name = value(k as u32)?;
+            Ok(quote!(__s[#k * __c] = #name;))
+        })
+        .collect::<Result<Vec<_>, String>>()?;
+    Ok((statements, stores))
 }
 
 fn unsupported_tokens(
