@@ -4,6 +4,28 @@
 use crate::common;
 use common::{eomgen, eomgen_ok};
 
+/// The CLI reference (docs/cli.md) describes every method of the method table under its
+/// command-line name, and `simulate --help` lists each with its summary.
+#[test]
+fn the_cli_reference_and_the_help_name_every_method() {
+    let reference = include_str!("../docs/cli.md");
+    let out = eomgen_ok(&["simulate", "--help"]);
+    let words = |s: &str| s.split_whitespace().collect::<Vec<_>>().join(" ");
+    let help = words(&String::from_utf8_lossy(&out.stdout));
+    for row in eomgen::Method::table() {
+        assert!(
+            reference.contains(&format!("`{}`", row.name)),
+            "docs/cli.md does not describe `{}`",
+            row.name
+        );
+        assert!(
+            help.contains(&format!("- {}: {}", row.name, words(row.summary))),
+            "`simulate --help` does not list `{}` with its summary",
+            row.name
+        );
+    }
+}
+
 #[test]
 fn list_json_names_every_model() {
     let out = eomgen(&["list", "--json"]);

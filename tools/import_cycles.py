@@ -384,12 +384,20 @@ def arrows(crate):
     edges = {}
 
     def add(src, target):
-        if target and target[0] == "item" and target[1] == src:
-            target = crate.reexported.get((src, target[2]), target)
-        if target and target[0] == "item" and target[1] != src:
-            edges.setdefault(src, {}).setdefault(target[1], set()).add(target[2])
+        if not target or target[0] != "item":
+            return
+        # A name taken through a re-export ties the importer both to the file it names and
+        # to the file that defines the name (for a file's own re-export, to the latter alone).
+        origin = target
+        while (origin[1], origin[2]) in crate.reexported:
+            origin = crate.reexported[(origin[1], origin[2])]
+        for t in {target, origin}:
+            if t[1] != src:
+                edges.setdefault(src, {}).setdefault(t[1], set()).add(t[2])
 
     for path, info in crate.files.items():
+        named = {alias if alias else upath[-1]
+                 for _context, (upath, alias, glob), _public in info.uses if upath and not glob}
         for context, (upath, alias, glob), public in info.uses:
             if upath and upath[-1] == "self":
                 upath = upath[:-1]
@@ -399,9 +407,9 @@ def arrows(crate):
             if glob:
                 if target[0] != "module":
                     continue
-                for ident in info.idents:
-                    # A name the file defines shadows the glob's.
-                    if crate.items.get((info.module, ident)) == path:
+                for ident in info.code_idents if public else info.idents:
+                    # A name the file defines or imports by name shadows the glob's.
+                    if crate.items.get((info.module, ident)) == path or ident in named:
                         continue
                     add(path, resolve_name(crate, target[1], ident, frozenset()))
             elif not public:

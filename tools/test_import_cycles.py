@@ -59,7 +59,7 @@ class ImportCycles(unittest.TestCase):
         self.assertEqual(status, 0, out)
         self.assertIn("no import circle", out)
 
-    def test_reexports_are_not_followed(self):
+    def test_a_reexported_name_ties_to_the_file_named_and_the_file_defining_it(self):
         with tempfile.TemporaryDirectory() as root:
             write_tree(root, LAYERED)
             cwd = os.getcwd()
@@ -69,15 +69,28 @@ class ImportCycles(unittest.TestCase):
                 edges = import_cycles.arrows(crate)
             finally:
                 os.chdir(cwd)
-        # `crate::A` and, through the glob, `B` are taken from lib.rs, the file named; D
-        # is d.rs's own.
-        self.assertEqual(edges["src/c/d.rs"], {"src/lib.rs": {"B"}})
-        self.assertEqual(edges["src/b.rs"], {"src/lib.rs": {"A"}})
+        # `crate::A` and, through the glob, `B`: to lib.rs, which names them, and to the
+        # files that define them; D is d.rs's own.
+        self.assertEqual(edges["src/c/d.rs"], {"src/lib.rs": {"B"}, "src/b.rs": {"B"}})
+        self.assertEqual(edges["src/b.rs"], {"src/lib.rs": {"A"}, "src/a.rs": {"A"}})
         # A re-export hands names on and uses none: lib.rs and c/mod.rs have no arrows.
         self.assertNotIn("src/lib.rs", edges)
         self.assertNotIn("src/c/mod.rs", edges)
         # The comment, the string and the test module of a.rs are not imports.
         self.assertNotIn("src/a.rs", edges)
+
+    def test_siblings_through_their_parents_reexports_are_a_circle(self):
+        files = dict(LAYERED)
+        # a.rs now takes `B` (through the root's re-export) and `D` by a path in code
+        # (through a grouped use of the module): a -> b -> a, and a -> d -> b -> a.
+        files["src/a.rs"] = ("use crate::{B, c::{self as cc}};\npub struct A;\n"
+                             "pub fn f(_: B) { let _ = crate::c::D; let _ = cc::D; }\n")
+        status, out = run(files)
+        self.assertEqual(status, 1, out)
+        self.assertIn("import circle of 3 files: src/a.rs, src/b.rs, src/c/d.rs", out)
+        self.assertIn("src/a.rs -> src/b.rs: B", out)
+        self.assertIn("src/a.rs -> src/c/d.rs: D", out)
+        self.assertIn("src/b.rs -> src/a.rs: A", out)
 
     def test_a_file_through_its_parents_reexport_is_a_circle_when_the_parent_uses_it(self):
         files = dict(LAYERED)
@@ -90,7 +103,7 @@ class ImportCycles(unittest.TestCase):
         self.assertIn("import circle of 2 files: src/b.rs, src/lib.rs", out)
         self.assertIn("src/b.rs -> src/lib.rs: A", out)
         self.assertIn("src/lib.rs -> src/b.rs: B", out)
-        # Used through the re-export, the file named is lib.rs, not a.rs: no circle there.
+        # a.rs imports nothing: it is in no circle.
         self.assertNotIn("src/a.rs ->", out)
 
     def test_super_path_in_code_and_exclusion(self):

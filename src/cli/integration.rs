@@ -80,13 +80,13 @@ pub struct IntegrationArgs {
     /// Integration method.
     #[arg(long, value_parser = method_parser(), default_value_t = SimulationOptions::DEFAULT_METHOD)]
     pub method: Method,
-    /// Relative tolerance (`rtol_help`).
+    /// Relative tolerance; its help, which names the adaptive methods, is `rtol_help`'s.
     #[arg(long, help = rtol_help(), default_value_t = SimulationOptions::DEFAULT_RTOL, value_parser = super::values::relative_tolerance, allow_hyphen_values = true)]
     pub rtol: f64,
     /// Absolute tolerance (adaptive methods; implicit-midpoint's scale for components near 0).
     #[arg(long, default_value_t = SimulationOptions::DEFAULT_ATOL, value_parser = super::values::absolute_tolerance, allow_hyphen_values = true)]
     pub atol: f64,
-    /// Step size (`dt_help`).
+    /// Step size; its help, which names the fixed-step methods, is `dt_help`'s.
     #[arg(long, help = dt_help())]
     pub dt: Option<f64>,
     /// Set a parameter, `NAME=VALUE` (value may be an expression of numbers, pi and the other

@@ -22,10 +22,11 @@ const ERROR_ORDER: u32 = 2;
 /// [`with_controller`](Self::with_controller)) proposes the next step. Three evaluations of
 /// `F` per attempted step (FSAL), plus one at `t0` and one for the automatic first step.
 ///
-/// Dense output ([`OutputTimes::At`](super::OutputTimes::At)) is the cubic Hermite interpolant of the step's end
-/// values and derivatives, which are stages of the step: a continuous extension of order 3
-/// at no extra cost (Bogacki and Shampine's own choice). With
-/// [`IntegratorOptions::fixed_step`](super::IntegratorOptions::fixed_step) the method takes constant steps `dt`.
+/// Dense output ([`OutputTimes::At`](super::OutputTimes::At)) is the cubic Hermite interpolant of
+/// the step's end values and derivatives, which are stages of the step: a continuous extension of
+/// order 3 at no extra cost (Bogacki and Shampine's own choice). With
+/// [`IntegratorOptions::fixed_step`](super::IntegratorOptions::fixed_step) the method takes
+/// constant steps `dt`.
 ///
 /// # Examples
 /// ```

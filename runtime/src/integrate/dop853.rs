@@ -702,10 +702,10 @@ impl Stepper for Dop853Stepper {
 /// [`with_controller`](Self::with_controller)) proposes the next one. The first step is `dt` if
 /// given, else chosen automatically (Hairer–Nørsett–Wanner I, §II.4).
 ///
-/// Dense output ([`OutputTimes::At`](super::OutputTimes::At)) is Hairer's continuous extension of order 7: three
-/// more evaluations of `F`, made only for steps that contain a requested time. With
-/// [`IntegratorOptions::fixed_step`](super::IntegratorOptions::fixed_step) the method takes constant steps `dt` without error control.
-/// `dop853.f`'s stiffness detection is not implemented.
+/// Dense output ([`OutputTimes::At`](super::OutputTimes::At)) is Hairer's continuous extension of
+/// order 7: three more evaluations of `F`, made only for steps that contain a requested time. With
+/// [`IntegratorOptions::fixed_step`](super::IntegratorOptions::fixed_step) the method takes
+/// constant steps `dt` without error control. `dop853.f`'s stiffness detection is not implemented.
 ///
 /// # Examples
 /// ```

@@ -29,9 +29,9 @@ const ERROR_ORDER: u32 = 4;
 /// evaluation of `F`). Each attempted step, accepted or rejected, costs six evaluations of `F`
 /// (FSAL: the seventh stage is the next step's first), plus one at `t0`.
 ///
-/// With [`IntegratorOptions::fixed_step`](super::IntegratorOptions::fixed_step) the method takes constant steps `dt` (default
-/// `(t_end − t0)/1000`) without error control, like [`RungeKutta4`](super::RungeKutta4);
-/// convergence-order studies use this.
+/// With [`IntegratorOptions::fixed_step`](super::IntegratorOptions::fixed_step) the method takes
+/// constant steps `dt` (default `(t_end − t0)/1000`) without error control, like
+/// [`RungeKutta4`](super::RungeKutta4); convergence-order studies use this.
 ///
 /// # Examples
 /// ```

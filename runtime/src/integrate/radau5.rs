@@ -630,25 +630,25 @@ impl Stepper for RadauStepper {
 /// step is recomputed.
 ///
 /// The error estimate is RADAU5's embedded third-order one, `(γ/h I − J)⁻¹(F(t, y) + Σ dₛ zₛ/h)`,
-/// refined by one evaluation of `F` on the first step and after a rejection; steps are
-/// accepted when its weighted RMS norm (scales `atolᵢ + rtolᵢ |yᵢ|` at the step's start) is
-/// below 1, and the [`PredictiveController`] proposes the next one from the error and the
-/// Newton work ([`NewtonWork`]). Unlike `radau5.f`, the tolerances are used as given (RADAU5
-/// replaces `rtol` by `rtol' = 0.1 rtol^(2/3)` and `atol` by `rtol' atol/rtol` internally), so
-/// that `rtol` means the same for every method: the local error per step. Given those
-/// internal tolerances, an exact Jacobian and the same starting step
-/// ([`IntegratorOptions::with_dt`](super::IntegratorOptions::with_dt)), the method takes `radau5.f`'s steps: the same accepted
-/// and rejected attempts, evaluations of `F` (one more, at the final state), Jacobians and
-/// factorisations (tested on van der Pol's and Robertson's problems,
-/// `runtime/tests/radau5_reference.rs`). Two things can still part them: a maximum step
-/// (`dt_max` caps the proposal after the test for holding the step, radau5.f's `HMAX`
-/// before it), and the end of the interval, where the driver stretches a step by up to 1 %
-/// onto `t_end` (as DOPRI5 does) while radau5.f takes a step only as far as `t_end`
-/// reaches. Dense output ([`OutputTimes::At`](super::OutputTimes::At)) is the
-/// collocation polynomial of each step (degree 3, continuous extension of order 3). With
-/// [`IntegratorOptions::fixed_step`](super::IntegratorOptions::fixed_step) the method takes constant steps `dt` without error
-/// control; Newton then iterates until it converges, diverges or uses up its iterations, and a
-/// failure is an error at once.
+/// refined by one evaluation of `F` on the first step and after a rejection; steps are accepted
+/// when its weighted RMS norm (scales `atolᵢ + rtolᵢ |yᵢ|` at the step's start) is below 1, and the
+/// [`PredictiveController`] proposes the next one from the error and the Newton work
+/// ([`NewtonWork`]). Unlike `radau5.f`, the tolerances are used as given (RADAU5 replaces `rtol` by
+/// `rtol' = 0.1 rtol^(2/3)` and `atol` by `rtol' atol/rtol` internally), so that `rtol` means the
+/// same for every method: the local error per step. Given those internal tolerances, an exact
+/// Jacobian and the same starting step
+/// ([`IntegratorOptions::with_dt`](super::IntegratorOptions::with_dt)), the method takes
+/// `radau5.f`'s steps: the same accepted and rejected attempts, evaluations of `F` (one more, at
+/// the final state), Jacobians and factorisations (tested on van der Pol's and Robertson's
+/// problems, `runtime/tests/radau5_reference.rs`). Two things can still part them: a maximum step
+/// (`dt_max` caps the proposal after the test for holding the step, radau5.f's `HMAX` before it),
+/// and the end of the interval, where the driver stretches a step by up to 1 % onto `t_end` (as
+/// DOPRI5 does) while radau5.f takes a step only as far as `t_end` reaches. Dense output
+/// ([`OutputTimes::At`](super::OutputTimes::At)) is the collocation polynomial of each step (degree
+/// 3, continuous extension of order 3). With
+/// [`IntegratorOptions::fixed_step`](super::IntegratorOptions::fixed_step) the method takes
+/// constant steps `dt` without error control; Newton then iterates until it converges, diverges or
+/// uses up its iterations, and a failure is an error at once.
 ///
 /// # Errors
 /// Besides those of every method: [`IntegrationError::NewtonDidNotConverge`] when Newton still

@@ -427,14 +427,14 @@ verner_pair!(
     /// the embedded fifth-order solution, the sixth-order one propagated, dense output of
     /// order 6.
     ///
-    /// Nine stages, first same as last: eight evaluations of `F` per step. The error estimate
-    /// is the RMS norm of `h Σ (bᵢ − b̂ᵢ) kᵢ` over `atol + rtol max(|y|, |y_new|)`; steps are
-    /// accepted when it is at most 1, and the [`PiController`] (OrdinaryDiffEq.jl's defaults,
-    /// `β₁ = 7/(10p)`, `β₂ = 2/(5p)`, unless replaced with
-    /// [`with_controller`](Self::with_controller)) proposes the next one. The interpolant
-    /// (Verner's, of order 6) costs three more evaluations, made only for steps that contain a
-    /// requested output time or an event. With [`IntegratorOptions::fixed_step`](super::IntegratorOptions::fixed_step) the method
-    /// takes constant steps `dt` without error control.
+    /// Nine stages, first same as last: eight evaluations of `F` per step. The error estimate is
+    /// the RMS norm of `h Σ (bᵢ − b̂ᵢ) kᵢ` over `atol + rtol max(|y|, |y_new|)`; steps are accepted
+    /// when it is at most 1, and the [`PiController`] (OrdinaryDiffEq.jl's defaults, `β₁ =
+    /// 7/(10p)`, `β₂ = 2/(5p)`, unless replaced with [`with_controller`](Self::with_controller))
+    /// proposes the next one. The interpolant (Verner's, of order 6) costs three more evaluations,
+    /// made only for steps that contain a requested output time or an event. With
+    /// [`IntegratorOptions::fixed_step`](super::IntegratorOptions::fixed_step) the method takes
+    /// constant steps `dt` without error control.
     ///
     /// # Examples
     /// ```

@@ -1,8 +1,8 @@
-//! The parts every integrator type writes alike, written once: the constructors and
-//! controller accessors of a method with a [`PiController`](super::PiController), its
-//! [`Integrator`](super::Integrator) name and order, and the [`super::driver::Method`] that
-//! hands a problem to the one driver loop ([`super::driver::run`]) with its stepper. Each method's file keeps its type, its documentation and its
-//! stepper; these macros only spell out the glue.
+//! The parts every integrator type writes alike, written once: the constructors and controller
+//! accessors of a method with a [`PiController`](super::PiController), its
+//! [`Integrator`](super::Integrator) name and order, and the [`super::driver::Method`] that hands a
+//! problem to the one driver loop ([`super::driver::run`]) with its stepper. Each method's file
+//! keeps its type, its documentation and its stepper; these macros only spell out the glue.
 
 /// `new`, `with_controller`, `controller`, `Default` and the [`Integrator`](super::Integrator)
 /// implementation of an adaptive explicit pair: a struct with one field

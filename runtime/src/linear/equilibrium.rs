@@ -5,6 +5,7 @@
 use nalgebra::{DMatrix, DVector};
 
 use super::modal::*;
+pub use super::stops::NewtonStop;
 use crate::model_info::ModelInfo;
 
 /// An equilibrium `F(q*, 0, t) = 0` (with constraints: `F(q*, 0, t) = Jᵀλ*`, `Φ(q*, t) = 0`)

@@ -5,6 +5,7 @@
 use nalgebra::{DMatrix, DVector};
 
 use super::modal::*;
+pub use super::stops::{TimeDependentForcing, TimeDependentPart};
 use crate::model_info::ModelInfo;
 
 /// Offsets (s) from `t₀` at which [`time_dependence`] samples the equations: spread over

@@ -4,7 +4,13 @@
 //! `file:line:col`. Maps of the YAML file keep file order (vectors here).
 
 use super::ast::Expr;
-use super::checks::{Checks, FloquetReference};
+// The `checks:` and `floquet:` types live in `checks.rs`; they are named here too, where
+// they were first defined.
+pub use super::checks::{
+    CHECK_METHODS, Checks, ConservedCheck, DEFAULT_CHECK_TOLERANCE, DEFAULT_CONSTRAINT_DRIFT,
+    DEFAULT_ENERGY_DRIFT, DriftCheck, FinalStateCheck, FloquetReference, FloquetThreshold,
+    HandEquation, ModalCheck, PeriodCheck, ReferenceCurve, RunSettings,
+};
 use super::located::{Located, Location};
 
 /// The unit system a model file declares with `units:` (see [`ModelFile::units`]).
