@@ -24,10 +24,7 @@ use nalgebra::{Complex, DMatrix};
 use serde::Serialize;
 
 use crate::analysis::methods::Method;
-use crate::integrate::stability_function::{
-    StabilityPolynomial, implicit_midpoint_stability, partitioned_oscillator_spectral_radius,
-};
-use crate::integrate::{IntegratorOptions, Tableau};
+use crate::integrate::IntegratorOptions;
 use crate::model_info::ModelInfo;
 
 /// The growth of a mode that should not grow, over the whole run, beyond which a fixed step
@@ -118,35 +115,9 @@ impl std::fmt::Display for SimulationWarning {
     }
 }
 
-/// The amplification per step `ρ(z)`, `z = hλ`, of a fixed-step `method`; `None` for an
-/// adaptive method (its step control handles stability).
-fn amplification(method: Method, z: Complex<f64>) -> Option<f64> {
-    let polynomial = |tableau: Tableau| StabilityPolynomial::of_tableau(&tableau).eval(z).norm();
-    match method {
-        Method::Euler => Some(polynomial(Tableau::euler())),
-        Method::Midpoint => Some(polynomial(Tableau::midpoint())),
-        Method::Rk4 => Some(polynomial(Tableau::rk4())),
-        Method::ImplicitMidpoint => Some(implicit_midpoint_stability(z).norm()),
-        // The partitioned methods on the oscillator of frequency |λ| (exact for an undamped
-        // mode, the one they are used for).
-        Method::SymplecticEuler | Method::StormerVerlet => {
-            Some(partitioned_oscillator_spectral_radius(z.norm()))
-        }
-        Method::Bs32
-        | Method::Dp54
-        | Method::Dop853
-        | Method::Vern6
-        | Method::Vern7
-        | Method::Vern8
-        | Method::Vern9
-        | Method::Taylor
-        | Method::Radau5 => None,
-    }
-}
-
 /// `ln ρᴺ` over `t_end` with the step `h` on the mode `λ` (0 where `ρ ≤ 1`).
 fn log_growth(method: Method, lambda: Complex<f64>, h: f64, t_end: f64) -> f64 {
-    let rho = amplification(method, lambda * h).unwrap_or(1.0);
+    let rho = method.amplification(lambda * h).unwrap_or(1.0);
     if rho > 1.0 {
         (t_end / h).ceil() * rho.ln()
     } else {
@@ -246,7 +217,7 @@ pub fn fixed_step_warnings(
             method,
             dt: h,
             eigenvalue: [lambda.re, lambda.im],
-            amplification: amplification(method, lambda * h).unwrap_or(1.0),
+            amplification: method.amplification(lambda * h).unwrap_or(1.0),
             growth: log_growth_h.exp(),
             suggested_dt: lo,
         });
@@ -264,14 +235,24 @@ mod tests {
     #[test]
     fn amplification_matches_the_stability_functions() {
         let i = |y: f64| Complex::new(0.0, y);
-        let euler = amplification(Method::Euler, i(0.5)).unwrap();
+        let euler = Method::Euler.amplification(i(0.5)).unwrap();
         assert!((euler - 1.25f64.sqrt()).abs() < 1e-15);
-        assert!(amplification(Method::Rk4, i(2.0 * 2f64.sqrt() - 1e-6)).unwrap() <= 1.0);
-        assert!(amplification(Method::Rk4, i(2.0 * 2f64.sqrt() + 1e-3)).unwrap() > 1.0);
-        assert_eq!(amplification(Method::StormerVerlet, i(1.99)).unwrap(), 1.0);
-        assert!(amplification(Method::StormerVerlet, i(2.01)).unwrap() > 1.0);
-        assert!((amplification(Method::ImplicitMidpoint, i(100.0)).unwrap() - 1.0).abs() < 1e-12);
-        assert!(amplification(Method::Dp54, i(100.0)).is_none());
+        assert!(
+            Method::Rk4
+                .amplification(i(2.0 * 2f64.sqrt() - 1e-6))
+                .unwrap()
+                <= 1.0
+        );
+        assert!(
+            Method::Rk4
+                .amplification(i(2.0 * 2f64.sqrt() + 1e-3))
+                .unwrap()
+                > 1.0
+        );
+        assert_eq!(Method::StormerVerlet.amplification(i(1.99)).unwrap(), 1.0);
+        assert!(Method::StormerVerlet.amplification(i(2.01)).unwrap() > 1.0);
+        assert!((Method::ImplicitMidpoint.amplification(i(100.0)).unwrap() - 1.0).abs() < 1e-12);
+        assert!(Method::Dp54.amplification(i(100.0)).is_none());
         // Euler's growth over t_end = 10 at ω = 1 is ⌈10/h⌉ ln √(1 + h²): 1.86 at h = 0.4
         // (25 steps), 2.61 at h = 0.6 (17 steps), on either side of ln 10 = 2.30.
         let growth = |h: f64| log_growth(Method::Euler, i(1.0), h, 10.0);

@@ -15,12 +15,16 @@
 use std::fmt;
 use std::str::FromStr;
 
+use nalgebra::Complex;
 use serde::Serialize;
 
+use crate::integrate::stability_function::{
+    StabilityPolynomial, implicit_midpoint_stability, partitioned_oscillator_spectral_radius,
+};
 use crate::integrate::{
     BogackiShampine32, DormandPrince54, DormandPrince853, ExplicitEuler, ExplicitMidpoint,
-    ImplicitMidpoint, Integrator, RadauIIA5, RungeKutta4, StormerVerlet, SymplecticEuler, Taylor,
-    Verner65, Verner76, Verner87, Verner98,
+    ImplicitMidpoint, Integrator, RadauIIA5, RungeKutta4, StormerVerlet, SymplecticEuler, Tableau,
+    Taylor, Verner65, Verner76, Verner87, Verner98,
 };
 
 /// An integration method, by its command-line name.
@@ -109,8 +113,20 @@ pub struct MethodInfo {
     pub summary: &'static str,
     /// A new integrator of the method, with its default settings.
     #[serde(skip)]
-    pub build: fn() -> Box<dyn Integrator>,
+    pub build: Constructor,
+    /// The amplification per step `ρ(z)`, `z = hλ`, of a fixed-step method (the modulus of
+    /// its stability function; for the partitioned methods, the spectral radius of a step on
+    /// the oscillator of frequency `|z|/h`, exact for an undamped mode); `None` for an
+    /// adaptive method, whose step control handles stability.
+    #[serde(skip)]
+    pub amplification: Option<Amplification>,
 }
+
+/// A new integrator of a method, with its default settings ([`MethodInfo::build`]).
+pub type Constructor = fn() -> Box<dyn Integrator>;
+
+/// The amplification per step `ρ(z)` of a fixed-step method ([`MethodInfo::amplification`]).
+pub type Amplification = fn(Complex<f64>) -> f64;
 
 /// A row of [`TABLE`].
 const fn row(
@@ -118,7 +134,7 @@ const fn row(
     (name, display_name): (&'static str, &'static str),
     (adaptive, implicit): (bool, bool),
     summary: &'static str,
-    build: fn() -> Box<dyn Integrator>,
+    (build, amplification): (Constructor, Option<Amplification>),
 ) -> MethodInfo {
     MethodInfo {
         method,
@@ -128,7 +144,13 @@ const fn row(
         implicit,
         summary,
         build,
+        amplification,
     }
+}
+
+/// `|R(z)|` of an explicit tableau.
+fn tableau_amplification(tableau: Tableau, z: Complex<f64>) -> f64 {
+    StabilityPolynomial::of_tableau(&tableau).eval(z).norm()
 }
 
 /// `(adaptive, implicit)` of an explicit method with an error estimate.
@@ -146,49 +168,49 @@ const IMPLICIT_ADAPTIVE: (bool, bool) = (true, true);
 static TABLE: [MethodInfo; 15] = [
     row(Method::Euler, ("euler", "explicit Euler"), FIXED,
         "Explicit Euler, order 1, fixed step `--dt`",
-        || Box::new(ExplicitEuler::new())),
+        (|| Box::new(ExplicitEuler::new()), Some(|z| tableau_amplification(Tableau::euler(), z)))),
     row(Method::Midpoint, ("midpoint", "explicit midpoint"), FIXED,
         "Explicit midpoint, order 2, fixed step `--dt`",
-        || Box::new(ExplicitMidpoint::new())),
+        (|| Box::new(ExplicitMidpoint::new()), Some(|z| tableau_amplification(Tableau::midpoint(), z)))),
     row(Method::Rk4, ("rk4", "RK4"), FIXED,
         "Classical Runge–Kutta 4, fixed step `--dt`",
-        || Box::new(RungeKutta4::new())),
+        (|| Box::new(RungeKutta4::new()), Some(|z| tableau_amplification(Tableau::rk4(), z)))),
     row(Method::Bs32, ("bs32", "Bogacki–Shampine 3(2)"), ADAPTIVE,
         "Bogacki–Shampine 3(2) (ode23), adaptive, Hermite dense output",
-        || Box::new(BogackiShampine32::new())),
+        (|| Box::new(BogackiShampine32::new()), None)),
     row(Method::Dp54, ("dp54", "Dormand–Prince 5(4)"), ADAPTIVE,
         "Dormand–Prince 5(4), adaptive, dense output (default)",
-        || Box::new(DormandPrince54::new())),
+        (|| Box::new(DormandPrince54::new()), None)),
     row(Method::Dop853, ("dop853", "DOP853"), ADAPTIVE,
         "DOP853, Hairer's Dormand–Prince 8(5,3), adaptive, order-7 dense output",
-        || Box::new(DormandPrince853::new())),
+        (|| Box::new(DormandPrince853::new()), None)),
     row(Method::Vern6, ("vern6", "Verner 6(5)"), ADAPTIVE,
         "Verner's most efficient 6(5) pair, adaptive, order-6 dense output",
-        || Box::new(Verner65::new())),
+        (|| Box::new(Verner65::new()), None)),
     row(Method::Vern7, ("vern7", "Verner 7(6)"), ADAPTIVE,
         "Verner's most efficient 7(6) pair, adaptive, order-7 dense output",
-        || Box::new(Verner76::new())),
+        (|| Box::new(Verner76::new()), None)),
     row(Method::Vern8, ("vern8", "Verner 8(7)"), ADAPTIVE,
         "Verner's most efficient 8(7) pair, adaptive, order-8 dense output",
-        || Box::new(Verner87::new())),
+        (|| Box::new(Verner87::new()), None)),
     row(Method::Vern9, ("vern9", "Verner 9(8)"), ADAPTIVE,
         "Verner's most efficient 9(8) pair, adaptive, order-9 dense output (tolerances of 1e-12 and below)",
-        || Box::new(Verner98::new())),
+        (|| Box::new(Verner98::new()), None)),
     row(Method::Taylor, ("taylor", "Taylor"), ADAPTIVE,
         "Taylor series of the model's generated recurrences, order and step from the tolerance (Jorba & Zou), the series as dense output; unconstrained models without abs, sign, step",
-        || Box::new(Taylor::new())),
+        (|| Box::new(Taylor::new()), None)),
     row(Method::SymplecticEuler, ("symplectic-euler", "symplectic Euler"), FIXED,
         "Symplectic Euler, order 1, fixed step `--dt` (symplectic for constant M and velocity-independent forces)",
-        || Box::new(SymplecticEuler::new())),
+        (|| Box::new(SymplecticEuler::new()), Some(|z| partitioned_oscillator_spectral_radius(z.norm())))),
     row(Method::StormerVerlet, ("stormer-verlet", "Störmer–Verlet"), FIXED,
         "Störmer–Verlet (leapfrog in q, q̇), order 2, fixed step `--dt` (symplectic for constant M and velocity-independent forces)",
-        || Box::new(StormerVerlet::new())),
+        (|| Box::new(StormerVerlet::new()), Some(|z| partitioned_oscillator_spectral_radius(z.norm())))),
     row(Method::ImplicitMidpoint, ("implicit-midpoint", "implicit midpoint"), IMPLICIT_FIXED,
         "Implicit midpoint, order 2, fixed step `--dt`, Newton with the generated Jacobians (symplectic for any M(q))",
-        || Box::new(ImplicitMidpoint::new())),
+        (|| Box::new(ImplicitMidpoint::new()), Some(|z| implicit_midpoint_stability(z).norm()))),
     row(Method::Radau5, ("radau5", "Radau IIA 5"), IMPLICIT_ADAPTIVE,
         "Radau IIA order 5 (RADAU5), adaptive, L-stable, Newton with the generated Jacobians",
-        || Box::new(RadauIIA5::new())),
+        (|| Box::new(RadauIIA5::new()), None)),
 ];
 
 impl Method {
@@ -238,6 +260,12 @@ impl Method {
     /// A new integrator of this method, with its default settings.
     pub fn integrator(self) -> Box<dyn Integrator> {
         (self.info().build)()
+    }
+
+    /// The amplification per step `ρ(z)`, `z = hλ`, of a fixed-step method
+    /// ([`MethodInfo::amplification`]); `None` for an adaptive one.
+    pub fn amplification(self, z: Complex<f64>) -> Option<f64> {
+        self.info().amplification.map(|rho| rho(z))
     }
 
     /// Whether the method controls its step by `rtol`/`atol` (otherwise it takes the fixed

@@ -31,7 +31,7 @@ pub use constraint_methods::{
 pub use drift::{ConstraintDrift, EnergyDrift, constraint_drift, energy_drift, energy_drift_at};
 pub use failure::{FailureCause, failure_cause};
 pub use fixed_step::{ENERGY_DRIFT_LIMIT, SimulationWarning, fixed_step_warnings};
-pub use methods::{Method, UnknownMethod};
+pub use methods::{Amplification, Constructor, Method, MethodInfo, UnknownMethod};
 pub use outcome::{NothingMeasured, RunTally, StudyRuns};
 pub use periodic_orbit::{
     NewtonStep, OrbitSamples, PeriodicOrbit, PeriodicOrbitError, PeriodicOrbitOptions,
