@@ -77,30 +77,12 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
         .chart("--plot-phase", args.plot_phase.as_deref())
         .chart("--plot-energy", args.plot_energy.as_deref())
         .check()?;
-    if args.t_out.len() > MAX_OUTPUT_TIMES {
-        return Err(CliError::usage(format!(
-            "--t-out lists {} times; at most {MAX_OUTPUT_TIMES} are allowed",
-            args.t_out.len()
-        )));
-    }
-    let mut times = Vec::with_capacity(args.t_out.len());
-    for t in &args.t_out {
-        times.push(evaluate(t, "--t-out", &|_| None)?);
-    }
-    let output = if times.is_empty() {
-        OutputTimes::Steps
-    } else {
-        OutputTimes::At(times)
-    };
-    let (model, simulation) = simulation(&args.model, &args.run, output)?;
+    let (model, simulation) = simulation(&args.model, &args.run, output_times(&args.t_out)?)?;
     let Simulation {
         solution,
-        energy: report,
-        constraints,
         failure,
         cause,
         warnings,
-        integrator: method_name,
         ..
     } = &simulation;
     for warning in warnings {
@@ -120,87 +102,16 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
             Ok(outputs) => (outputs, None),
             Err(e) => (Vec::new(), Some(e)),
         };
-    if let Some(path) = &args.csv {
-        write_csv(
-            path,
-            model.as_ref(),
-            solution,
-            report,
-            constraints,
-            &outputs,
-            incomplete.as_deref(),
-        )?;
-    }
-    // A companion this run has nothing for is removed when an earlier run of eomgen wrote
-    // it; a file of that name that eomgen did not write is kept, with a warning.
-    if let Some(events) = &events_csv {
-        if solution.events.is_empty() {
-            files::remove_stale_or_warn(events, is_events_csv)?;
-        } else {
-            write_events_csv(events, model.as_ref(), solution)?;
-        }
-    }
-    if let Some(path) = &args.plot {
-        plot::time_histories(path, model.as_ref(), solution, incomplete.as_deref())
-            .map_err(CliError::failure)?;
-    }
-    if let Some(drift_path) = &drift_chart {
-        if constraints.is_empty() {
-            files::remove_stale_or_warn(drift_path, plot::is_own_drift_chart)?;
-        } else {
-            plot::constraint_drift(
-                drift_path,
-                &model.description().name,
-                &solution.t,
-                &constraints.drift,
-                incomplete.as_deref(),
-            )
-            .map_err(CliError::failure)?;
-        }
-    }
-    if let Some(path) = &args.plot_phase {
-        plot::phase_portrait(path, model.as_ref(), solution, incomplete.as_deref())
-            .map_err(CliError::failure)?;
-    }
-    if let Some(path) = &args.plot_energy {
-        plot::energy_drift(
-            path,
-            &model.description().name,
-            &solution.t,
-            &report.energy,
-            report.initial_energy,
-            incomplete.as_deref(),
-        )
-        .map_err(CliError::failure)?;
-    }
-    if args.json {
-        // The wall time is the one figure that differs between two identical runs: only
-        // printed when asked for (`--timing`), so that the JSON is byte-identical otherwise.
-        let mut json = crate::cli::json::sorted(&simulation.summary(model.as_ref()))?;
-        if !args.timing
-            && let Some(stats) = json["stats"].as_object_mut()
-        {
-            stats.remove("wall_time_s");
-        }
-        if !outputs.is_empty()
-            && let Some(object) = json.as_object_mut()
-        {
-            object.insert("outputs".to_string(), crate::cli::json::sorted(&outputs)?);
-            json = crate::cli::json::sorted(&json)?;
-        }
-        crate::cli::json::print_json(&json)?;
-    } else {
-        print_summary(
-            model.as_ref(),
-            method_name,
-            &args.run,
-            solution,
-            report,
-            &outputs,
-        );
-        print_constraint_summary(constraints, args.run.stabilization);
-        print_events(model.as_ref(), solution);
-    }
+    let companions = (events_csv.as_deref(), drift_chart.as_deref());
+    write_files(
+        args,
+        model.as_ref(),
+        &simulation,
+        &outputs,
+        incomplete.as_deref(),
+        companions,
+    )?;
+    print_report(args, model.as_ref(), &simulation, &outputs)?;
     if let Some(e) = &outputs_error {
         output::errln!("error: {e}");
     }
@@ -221,6 +132,144 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
             ),
         )),
     }
+}
+
+/// The samples `--t-out` asks for: every accepted step without it.
+///
+/// # Errors
+/// A usage error for more than [`MAX_OUTPUT_TIMES`] times or a time that does not evaluate.
+fn output_times(t_out: &[String]) -> Result<OutputTimes, CliError> {
+    if t_out.len() > MAX_OUTPUT_TIMES {
+        return Err(CliError::usage(format!(
+            "--t-out lists {} times; at most {MAX_OUTPUT_TIMES} are allowed",
+            t_out.len()
+        )));
+    }
+    let mut times = Vec::with_capacity(t_out.len());
+    for t in t_out {
+        times.push(evaluate(t, "--t-out", &|_| None)?);
+    }
+    Ok(if times.is_empty() {
+        OutputTimes::Steps
+    } else {
+        OutputTimes::At(times)
+    })
+}
+
+/// Writes the files the options ask for (`--csv` and its events file, the charts and the
+/// drift chart beside `--plot`), each noting `incomplete` when the run stopped early; a
+/// companion this run has nothing for is removed when an earlier run of eomgen wrote it.
+///
+/// # Errors
+/// A file that cannot be written or removed.
+fn write_files(
+    args: &SimulateArgs,
+    model: &dyn ModelInfo,
+    simulation: &Simulation,
+    outputs: &[OutputSeries],
+    incomplete: Option<&str>,
+    (events_csv, drift_chart): (Option<&str>, Option<&str>),
+) -> Result<(), CliError> {
+    let Simulation {
+        solution,
+        energy: report,
+        constraints,
+        ..
+    } = simulation;
+    if let Some(path) = &args.csv {
+        write_csv(
+            path,
+            model,
+            solution,
+            report,
+            constraints,
+            outputs,
+            incomplete,
+        )?;
+    }
+    // A companion this run has nothing for is removed when an earlier run of eomgen wrote
+    // it; a file of that name that eomgen did not write is kept, with a warning.
+    if let Some(events) = events_csv {
+        if solution.events.is_empty() {
+            files::remove_stale_or_warn(events, is_events_csv)?;
+        } else {
+            write_events_csv(events, model, solution)?;
+        }
+    }
+    if let Some(path) = &args.plot {
+        plot::time_histories(path, model, solution, incomplete).map_err(CliError::failure)?;
+    }
+    if let Some(drift_path) = drift_chart {
+        if constraints.is_empty() {
+            files::remove_stale_or_warn(drift_path, plot::is_own_drift_chart)?;
+        } else {
+            plot::constraint_drift(
+                drift_path,
+                &model.description().name,
+                &solution.t,
+                &constraints.drift,
+                incomplete,
+            )
+            .map_err(CliError::failure)?;
+        }
+    }
+    if let Some(path) = &args.plot_phase {
+        plot::phase_portrait(path, model, solution, incomplete).map_err(CliError::failure)?;
+    }
+    if let Some(path) = &args.plot_energy {
+        plot::energy_drift(
+            path,
+            &model.description().name,
+            &solution.t,
+            &report.energy,
+            report.initial_energy,
+            incomplete,
+        )
+        .map_err(CliError::failure)?;
+    }
+    Ok(())
+}
+
+/// Prints the run's report: its JSON with `--json` (the wall time only with `--timing`), else
+/// the text summary, the constraints' drift and the events.
+///
+/// # Errors
+/// Standard output that cannot be written.
+fn print_report(
+    args: &SimulateArgs,
+    model: &dyn ModelInfo,
+    simulation: &Simulation,
+    outputs: &[OutputSeries],
+) -> Result<(), CliError> {
+    let Simulation {
+        solution,
+        energy: report,
+        constraints,
+        integrator: method_name,
+        ..
+    } = simulation;
+    if args.json {
+        // The wall time is the one figure that differs between two identical runs: only
+        // printed when asked for (`--timing`), so that the JSON is byte-identical otherwise.
+        let mut json = crate::cli::json::sorted(&simulation.summary(model))?;
+        if !args.timing
+            && let Some(stats) = json["stats"].as_object_mut()
+        {
+            stats.remove("wall_time_s");
+        }
+        if !outputs.is_empty()
+            && let Some(object) = json.as_object_mut()
+        {
+            object.insert("outputs".to_string(), crate::cli::json::sorted(&outputs)?);
+            json = crate::cli::json::sorted(&json)?;
+        }
+        crate::cli::json::print_json(&json)?;
+    } else {
+        print_summary(model, method_name, &args.run, solution, report, outputs);
+        print_constraint_summary(constraints, args.run.stabilization);
+        print_events(model, solution);
+    }
+    Ok(())
 }
 
 fn print_summary(
