@@ -8,8 +8,10 @@ use std::io::Write as _;
 
 use clap::Args;
 use eomgen::analysis::{
-    ConstraintMethods, ConstraintMethodsError, ConstraintMethodsOptions, StudyRuns,
+    ConstraintMethodRow, ConstraintMethods, ConstraintMethodsError, ConstraintMethodsOptions,
+    StudyRuns,
 };
+use eomgen::reduction::ReducedTwin;
 use eomgen::studies::minimal_twin;
 
 use crate::cli::error::CliError;
@@ -82,10 +84,28 @@ pub fn run(args: &ConstraintMethodsArgs) -> Result<(), CliError> {
             .as_ref()
             .zip(label.as_deref())
             .map(|(r, label)| (label, r.instantiate())),
-        twin.as_ref().map(|(name, twin)| (name.as_str(), twin.instantiate())),
+        twin.as_ref()
+            .map(|(name, twin)| (name.as_str(), twin.instantiate())),
         &options,
     )
-    .map_err(|e| match e {
+    .map_err(study_error)?;
+    if let Some(path) = &args.plot {
+        draw_chart(path, &study.model, &study.rows)?;
+    }
+    if args.json {
+        print_json_sorted(&study.summary(&options))?;
+    } else {
+        print_text(args, &study, reduced.as_ref());
+    }
+    study
+        .check_measured()
+        .map_err(|e| CliError::failure(e.to_string()))
+}
+
+/// The CLI's error for a study that could not run: a usage error for what the options or the
+/// model got wrong, a failure otherwise.
+fn study_error(e: ConstraintMethodsError) -> CliError {
+    match e {
         ConstraintMethodsError::NoHolonomicConstraints { model } => CliError::usage(format!(
             "`{model}` has no holonomic constraints to compare methods on; try simple_pendulum_cartesian or two_masses_rod"
         )),
@@ -97,96 +117,102 @@ pub fn run(args: &ConstraintMethodsArgs) -> Result<(), CliError> {
             num(stiffness)
         )),
         other => CliError::failure(other.to_string()),
-    })?;
+    }
+}
+
+/// The chart of `--plot`: each method's largest point position error against time.
+///
+/// # Errors
+/// A chart that cannot be written.
+fn draw_chart(path: &str, model: &str, rows: &[ConstraintMethodRow]) -> Result<(), CliError> {
+    let series: Vec<plot::Series> = rows
+        .iter()
+        .map(|r| plot::Series {
+            name: r.method.clone(),
+            points: r.error_history.clone(),
+        })
+        .collect();
+    let title = format!("{model}: constraint methods, position error");
+    plot::lines(
+        path,
+        &plot::Chart {
+            title: &title,
+            x_desc: "t (s)",
+            y_desc: "largest point position error (m)",
+            log_x: false,
+            log_y: true,
+        },
+        &series,
+    )
+    .map_err(CliError::failure)?;
+    Ok(())
+}
+
+/// The study as a table on standard output, with the II.2 row's eliminations.
+fn print_text(
+    args: &ConstraintMethodsArgs,
+    study: &ConstraintMethods,
+    reduced: Option<&ReducedTwin>,
+) {
     let ConstraintMethods {
         model,
         reference_tol,
         agreement,
         rows,
-    } = &study;
+    } = study;
     let (reference_tol, agreement) = (*reference_tol, *agreement);
-
-    if let Some(path) = &args.plot {
-        let series: Vec<plot::Series> = rows
-            .iter()
-            .map(|r| plot::Series {
-                name: r.method.clone(),
-                points: r.error_history.clone(),
-            })
-            .collect();
-        let title = format!("{model}: constraint methods, position error");
-        plot::lines(
-            path,
-            &plot::Chart {
-                title: &title,
-                x_desc: "t (s)",
-                y_desc: "largest point position error (m)",
-                log_x: false,
-                log_y: true,
-            },
-            &series,
-        )
-        .map_err(CliError::failure)?;
-    }
     let mut stdout = crate::cli::output::stdout();
-    if args.json {
-        print_json_sorted(&study.summary(&options))?;
-    } else {
-        let _ = writeln!(
-            stdout,
-            "model      {} over 0 ≤ t ≤ {} s, Dormand–Prince 5(4) at rtol = atol = {:e}",
-            model,
-            args.t_end,
-            num(args.tol)
-        );
-        let _ = writeln!(
-            stdout,
-            "reference  DAE with Baumgarte at tol {reference_tol:e}; the unstabilised DAE at that tolerance agrees to {agreement:.2e} m",
-            reference_tol = num(reference_tol),
-            agreement = num(agreement)
-        );
-        if let Some(r) = &reduced {
-            for e in &r.reduced.eliminations {
-                let _ = writeln!(
-                    stdout,
-                    "II.2       {} = {} (from `{}`), {}_dot = {}",
-                    e.coordinate, e.solution, e.constraint, e.coordinate, e.rate
-                );
-            }
-        }
-        let _ = writeln!(
-            stdout,
-            "{:<44} {:>12} {:>12} {:>10} {:>8} {:>10}",
-            "method", "pos. err (m)", "max |Φ|", "RHS evals", "steps", "time (ms)"
-        );
-        for r in rows {
-            // A failed run measured nothing: `failed` in its error and drift columns, never
-            // the 0.00 of an empty run.
-            let (error, drift) = if r.failure.is_some() {
-                ("failed".to_string(), "failed".to_string())
-            } else {
-                (
-                    format!("{:.2e}", num(r.position_error)),
-                    r.drift
-                        .map_or("-".to_string(), |d| format!("{d:.2e}", d = num(d))),
-                )
-            };
+    let _ = writeln!(
+        stdout,
+        "model      {} over 0 ≤ t ≤ {} s, Dormand–Prince 5(4) at rtol = atol = {:e}",
+        model,
+        args.t_end,
+        num(args.tol)
+    );
+    let _ = writeln!(
+        stdout,
+        "reference  DAE with Baumgarte at tol {reference_tol:e}; the unstabilised DAE at that tolerance agrees to {agreement:.2e} m",
+        reference_tol = num(reference_tol),
+        agreement = num(agreement)
+    );
+    if let Some(r) = reduced {
+        for e in &r.reduced.eliminations {
             let _ = writeln!(
                 stdout,
-                "{:<44} {:>12} {:>12} {:>10} {:>8} {:>10.3}{}",
-                r.method,
-                error,
-                drift,
-                r.rhs_evals,
-                r.steps,
-                r.wall_time_s * 1e3,
-                r.failure
-                    .as_ref()
-                    .map_or(String::new(), |f| format!("  failed: {f}"))
+                "II.2       {} = {} (from `{}`), {}_dot = {}",
+                e.coordinate, e.solution, e.constraint, e.coordinate, e.rate
             );
         }
     }
-    study
-        .check_measured()
-        .map_err(|e| CliError::failure(e.to_string()))
+    let _ = writeln!(
+        stdout,
+        "{:<44} {:>12} {:>12} {:>10} {:>8} {:>10}",
+        "method", "pos. err (m)", "max |Φ|", "RHS evals", "steps", "time (ms)"
+    );
+    for r in rows {
+        // A failed run measured nothing: `failed` in its error and drift columns, never
+        // the 0.00 of an empty run.
+        let (error, drift) = if r.failure.is_some() {
+            ("failed".to_string(), "failed".to_string())
+        } else {
+            (
+                format!("{:.2e}", num(r.position_error)),
+                r.drift
+                    .map_or("-".to_string(), |d| format!("{d:.2e}", d = num(d))),
+            )
+        };
+        let _ = writeln!(
+            stdout,
+            "{:<44} {:>12} {:>12} {:>10} {:>8} {:>10.3}{}",
+            r.method,
+            error,
+            drift,
+            r.rhs_evals,
+            r.steps,
+            r.wall_time_s * 1e3,
+            r.failure
+                .as_ref()
+                .map_or(String::new(), |f| format!("  failed: {f}"))
+        );
+    }
 }
