@@ -130,23 +130,7 @@ pub fn run(args: &FloquetArgs) -> Result<(), CliError> {
         }
         None => vibration::floquet_at_equilibrium(model.as_mut(), &options),
     }
-    .map_err(|e| match e {
-        FloquetStudyError::UnknownPeriodParameter { ref name, .. } => CliError::usage(format!(
-            "--period-parameter {name}: {e}; name the forcing frequency w (rad/s), T = 2π/w"
-        )),
-        FloquetStudyError::InvalidTolerance { .. } => CliError::usage(format!("--tol: {e}")),
-        FloquetStudyError::Floquet(e @ FloquetError::InvalidStabilityTolerance { .. }) => {
-            CliError::usage(format!("--stability-tolerance: {e}"))
-        }
-        FloquetStudyError::OperatingPoint(e) => {
-            crate::cli::operating_point::point_failure(model.as_ref(), &e)
-        }
-        e => CliError::failure(format!(
-            "`{}` at {label}: {}",
-            model.description().name,
-            analysis_text(model.as_ref(), &e)
-        )),
-    })?;
+    .map_err(|e| study_error(model.as_ref(), &label, e))?;
     let sweep = match axes {
         Some((x, y)) => Some(run_sweep(args, &guess, x, y, &options)?),
         None => None,
@@ -159,30 +143,15 @@ pub fn run(args: &FloquetArgs) -> Result<(), CliError> {
         .unwrap_or_default();
 
     if let Some(path) = &args.plot {
-        match &sweep {
-            Some(FloquetChart { x, y, cells: grid }) => {
-                let title = format!(
-                    "{} at {label}: Floquet stability over {} and {}",
-                    model.description().name,
-                    x.name,
-                    y.name
-                );
-                let labels = [
-                    axis_label(&x.name, &args.period_parameter, references.as_ref()),
-                    axis_label(&y.name, &args.period_parameter, references.as_ref()),
-                ];
-                let curves = references.as_ref().map(|r| (r, model.as_ref()));
-                stability_chart(path, &title, [x, y], &labels, grid, curves)
-            }
-            _ => {
-                let title = format!(
-                    "{} at {label}: Floquet multipliers",
-                    model.description().name
-                );
-                multiplier_chart(path, &title, &point.floquet)
-            }
-        }
-        .map_err(CliError::failure)?;
+        draw(
+            path,
+            args,
+            model.as_ref(),
+            &label,
+            &point,
+            sweep.as_ref(),
+            references.as_ref(),
+        )?;
     }
 
     let report = Report {
@@ -218,6 +187,69 @@ pub fn run(args: &FloquetArgs) -> Result<(), CliError> {
             .map_err(|e| CliError::failure(e.to_string())),
         None => Ok(()),
     }
+}
+
+/// The CLI's error for a Floquet study that could not run: a usage error for an option, the
+/// operating point's failure as the other studies say it, else the analysis' reason.
+fn study_error(model: &dyn ModelInfo, label: &str, e: FloquetStudyError) -> CliError {
+    match e {
+        FloquetStudyError::UnknownPeriodParameter { ref name, .. } => CliError::usage(format!(
+            "--period-parameter {name}: {e}; name the forcing frequency w (rad/s), T = 2π/w"
+        )),
+        FloquetStudyError::InvalidTolerance { .. } => CliError::usage(format!("--tol: {e}")),
+        FloquetStudyError::Floquet(e @ FloquetError::InvalidStabilityTolerance { .. }) => {
+            CliError::usage(format!("--stability-tolerance: {e}"))
+        }
+        FloquetStudyError::OperatingPoint(e) => {
+            crate::cli::operating_point::point_failure(model, &e)
+        }
+        e => CliError::failure(format!(
+            "`{}` at {label}: {}",
+            model.description().name,
+            analysis_text(model, &e)
+        )),
+    }
+}
+
+/// The chart of `--plot`: the stability chart of a sweep, else the multipliers on the unit
+/// circle.
+///
+/// # Errors
+/// A chart that cannot be written.
+fn draw(
+    path: &str,
+    args: &FloquetArgs,
+    model: &dyn ModelInfo,
+    label: &str,
+    point: &FloquetPoint,
+    sweep: Option<&FloquetChart>,
+    references: Option<&FloquetReferences>,
+) -> Result<(), CliError> {
+    match sweep {
+        Some(FloquetChart { x, y, cells: grid }) => {
+            let title = format!(
+                "{} at {label}: Floquet stability over {} and {}",
+                model.description().name,
+                x.name,
+                y.name
+            );
+            let labels = [
+                axis_label(&x.name, &args.period_parameter, references),
+                axis_label(&y.name, &args.period_parameter, references),
+            ];
+            let curves = references.map(|r| (r, model));
+            stability_chart(path, &title, [x, y], &labels, grid, curves)
+        }
+        _ => {
+            let title = format!(
+                "{} at {label}: Floquet multipliers",
+                model.description().name
+            );
+            multiplier_chart(path, &title, &point.floquet)
+        }
+    }
+    .map_err(CliError::failure)?;
+    Ok(())
 }
 
 /// What `study floquet` prints.

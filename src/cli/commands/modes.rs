@@ -240,21 +240,56 @@ fn print_text(
     args: &ModesArgs,
 ) {
     let ModalAnalysis {
-        operating_point: point,
         linearization: lin,
         normal_modes: modes,
-        mode_shapes: shapes,
-        minimal_coordinates: minimal,
-        damping_ratios,
         m_inv_k_relative_difference: route_difference,
-        time_dependent_forcing: forcing,
         stability,
+        ..
+    } = modal;
+    let undamped = modal.is_undamped();
+    print_operating_point(stdout, model, modal, multipliers);
+    print_matrix(stdout, "M", &lin.mass_matrix);
+    print_matrix(stdout, "K", &lin.stiffness_matrix);
+    if !undamped {
+        print_matrix(stdout, "C", &lin.damping_matrix);
+    }
+    print_mode_table(stdout, model, modal);
+    write_stability(stdout, stability);
+    // With a non-symmetric K the table is M⁻¹K's own (or its symmetric part's, under
+    // flutter): the two routes do not compute the same thing, and no check is printed.
+    if modes.stiffness_asymmetry <= 1e-12 {
+        let _ = writeln!(
+            stdout,
+            "check      eigenvalues of M⁻¹K (lecture 22) vs the symmetric Cholesky route (lecture 24): max difference {route_difference:.1e} of max |ω²|",
+            route_difference = num(route_difference)
+        );
+    }
+    for path in charts {
+        let _ = writeln!(stdout, "chart      {path}");
+    }
+    if let Some(path) = &args.animate {
+        let _ = writeln!(stdout, "animation  {path}");
+    }
+}
+
+/// The operating point of `modes`: the model, the equilibrium and Newton's work, a load set
+/// aside, the constraint forces at rest and the entries of the Jacobians that were differenced.
+fn print_operating_point(
+    stdout: &mut impl std::io::Write,
+    model: &dyn ModelInfo,
+    modal: &ModalAnalysis,
+    multipliers: &std::collections::BTreeMap<String, f64>,
+) {
+    let ModalAnalysis {
+        operating_point: point,
+        linearization: lin,
+        minimal_coordinates: minimal,
+        time_dependent_forcing: forcing,
         ..
     } = modal;
     let (label, equilibrium) = (&point.name, &point.equilibrium);
     let names = model.description().coordinate_names();
     let n = model.num_dofs();
-    let undamped = modal.is_undamped();
     let _ = writeln!(
         stdout,
         "model      {} ({} dof)",
@@ -302,11 +337,23 @@ fn print_text(
             lin.differenced_entries
         );
     }
-    print_matrix(stdout, "M", &lin.mass_matrix);
-    print_matrix(stdout, "K", &lin.stiffness_matrix);
-    if !undamped {
-        print_matrix(stdout, "C", &lin.damping_matrix);
-    }
+}
+
+/// The modes of `modes`: the notes on a non-symmetric `K`, then one row per mode (ω, f, ζ and
+/// the mass-normalised shape, with what a zero or unstable mode means).
+fn print_mode_table(
+    stdout: &mut impl std::io::Write,
+    model: &dyn ModelInfo,
+    modal: &ModalAnalysis,
+) {
+    let ModalAnalysis {
+        normal_modes: modes,
+        mode_shapes: shapes,
+        damping_ratios,
+        ..
+    } = modal;
+    let names = model.description().coordinate_names();
+    let undamped = modal.is_undamped();
     if modes.symmetric_part_only {
         let _ = writeln!(
             stdout,
@@ -368,22 +415,6 @@ fn print_text(
             zeta,
             shape.join(", ")
         );
-    }
-    write_stability(stdout, stability);
-    // With a non-symmetric K the table is M⁻¹K's own (or its symmetric part's, under
-    // flutter): the two routes do not compute the same thing, and no check is printed.
-    if modes.stiffness_asymmetry <= 1e-12 {
-        let _ = writeln!(
-            stdout,
-            "check      eigenvalues of M⁻¹K (lecture 22) vs the symmetric Cholesky route (lecture 24): max difference {route_difference:.1e} of max |ω²|",
-            route_difference = num(route_difference)
-        );
-    }
-    for path in charts {
-        let _ = writeln!(stdout, "chart      {path}");
-    }
-    if let Some(path) = &args.animate {
-        let _ = writeln!(stdout, "animation  {path}");
     }
 }
 
