@@ -175,62 +175,8 @@ pub fn run(args: &FrfArgs) -> Result<(), CliError> {
         .chart("--plot", args.plot.as_deref())
         .check()?;
     let mut model = args.point.model(&args.model)?;
-    let lookup = parameter_lookup(model.as_ref());
-    let frequency_range = match &args.freqs {
-        Some(text) => {
-            let (a, b) = text.split_once("..").ok_or_else(|| {
-                CliError::usage(format!(
-                    "--freqs takes LO..HI in rad/s, got `{text}` (for example `--freqs 0.1..10`)"
-                ))
-            })?;
-            let lo = evaluate(a.trim(), "--freqs LO", &lookup)?;
-            let hi = evaluate(b.trim(), "--freqs HI", &lookup)?;
-            Some((
-                frequency("--freqs LO", a.trim(), lo, false)?,
-                frequency("--freqs HI", b.trim(), hi, false)?,
-            ))
-        }
-        None => None,
-    };
-    let mut frequencies = Vec::new();
-    for text in &args.frequencies {
-        let w = evaluate(text, &format!("--frequency {text}"), &lookup)?;
-        frequencies.push(frequency("--frequency", text, w, true)?);
-    }
-    drop(lookup);
-    let simulation = args.simulate.map(|count| FrfSimulationOptions {
-        count,
-        frequency_parameter: args.frequency_parameter.clone(),
-        amplitude: args.amplitude,
-        rtol: args.rtol,
-    });
-    // `--frequency-parameter` also says where to read a parameter input's rate column: without
-    // `--simulate` it is checked here and passed on with no runs, not ignored.
-    let simulation = match (simulation, &args.frequency_parameter) {
-        (None, Some(p)) => {
-            let parameters = model.description().parameter_names();
-            if !parameters.contains(&p.as_str()) {
-                return Err(CliError::usage(format!(
-                    "--frequency-parameter {p}: `{}` has no such parameter (parameters: {})",
-                    model.description().name,
-                    parameters.join(", ")
-                )));
-            }
-            if *p == args.input {
-                return Err(CliError::usage(
-                    "--frequency-parameter must differ from --input",
-                ));
-            }
-            parameters
-                .contains(&args.input.as_str())
-                .then(|| FrfSimulationOptions {
-                    count: 0,
-                    frequency_parameter: Some(p.clone()),
-                    ..FrfSimulationOptions::default()
-                })
-        }
-        (simulation, _) => simulation,
-    };
+    let (frequency_range, frequencies) = frequencies(args, model.as_ref())?;
+    let simulation = simulation_options(args, model.as_ref())?;
     let options = FrfOptions {
         operating_point: args.point.options(model.as_ref())?,
         input: args.input.clone(),
@@ -282,6 +228,84 @@ pub fn run(args: &FrfArgs) -> Result<(), CliError> {
     Ok(())
 }
 
+/// `--freqs LO..HI` and the `--frequency` list (rad/s), evaluated with the model's parameters.
+///
+/// # Errors
+/// A usage error for a range or frequency that does not parse or lies outside [1e-12, 1e12].
+fn frequencies(
+    args: &FrfArgs,
+    model: &dyn ModelInfo,
+) -> Result<(Option<(f64, f64)>, Vec<f64>), CliError> {
+    let lookup = parameter_lookup(model);
+    let frequency_range = match &args.freqs {
+        Some(text) => {
+            let (a, b) = text.split_once("..").ok_or_else(|| {
+                CliError::usage(format!(
+                    "--freqs takes LO..HI in rad/s, got `{text}` (for example `--freqs 0.1..10`)"
+                ))
+            })?;
+            let lo = evaluate(a.trim(), "--freqs LO", &lookup)?;
+            let hi = evaluate(b.trim(), "--freqs HI", &lookup)?;
+            Some((
+                frequency("--freqs LO", a.trim(), lo, false)?,
+                frequency("--freqs HI", b.trim(), hi, false)?,
+            ))
+        }
+        None => None,
+    };
+    let mut frequencies = Vec::new();
+    for text in &args.frequencies {
+        let w = evaluate(text, &format!("--frequency {text}"), &lookup)?;
+        frequencies.push(frequency("--frequency", text, w, true)?);
+    }
+    Ok((frequency_range, frequencies))
+}
+
+/// The simulated points `--simulate` asks for, or, with `--frequency-parameter` alone, none
+/// but where a parameter input's rate is read (checked here, not ignored).
+///
+/// # Errors
+/// A usage error for an unknown `--frequency-parameter` or one equal to `--input`.
+fn simulation_options(
+    args: &FrfArgs,
+    model: &dyn ModelInfo,
+) -> Result<Option<FrfSimulationOptions>, CliError> {
+    let simulation = args.simulate.map(|count| FrfSimulationOptions {
+        count,
+        frequency_parameter: args.frequency_parameter.clone(),
+        amplitude: args.amplitude,
+        rtol: args.rtol,
+    });
+    // `--frequency-parameter` also says where to read a parameter input's rate column: without
+    // `--simulate` it is checked here and passed on with no runs, not ignored.
+    let simulation = match (simulation, &args.frequency_parameter) {
+        (None, Some(p)) => {
+            let parameters = model.description().parameter_names();
+            if !parameters.contains(&p.as_str()) {
+                return Err(CliError::usage(format!(
+                    "--frequency-parameter {p}: `{}` has no such parameter (parameters: {})",
+                    model.description().name,
+                    parameters.join(", ")
+                )));
+            }
+            if *p == args.input {
+                return Err(CliError::usage(
+                    "--frequency-parameter must differ from --input",
+                ));
+            }
+            parameters
+                .contains(&args.input.as_str())
+                .then(|| FrfSimulationOptions {
+                    count: 0,
+                    frequency_parameter: Some(p.clone()),
+                    ..FrfSimulationOptions::default()
+                })
+        }
+        (simulation, _) => simulation,
+    };
+    Ok(simulation)
+}
+
 /// The text of `frf` (and of the simulated points).
 fn print_report(
     out: &mut impl std::io::Write,
@@ -296,8 +320,6 @@ fn print_report(
         operating_point: point,
         outputs,
         forced,
-        normal_modes: modes,
-        modal_damping: damping,
         sweeps,
         ..
     } = frf;
@@ -334,6 +356,33 @@ fn print_report(
             args.input
         );
     }
+    write_modes(out, frf);
+    let _ = writeln!(
+        out,
+        "sweep      {} frequencies from {lo:.6e} to {hi:.6e} rad/s",
+        frf.frequencies.len(),
+        lo = num(lo),
+        hi = num(hi)
+    );
+    write_peaks(out, outputs, sweeps);
+    write_evaluations(out, args, frf);
+    if let Some((points, plan)) = simulated {
+        write_simulated(out, args, outputs, points, plan);
+    }
+    if let Some(path) = &args.plot {
+        let _ = writeln!(out, "chart      {path}");
+    }
+}
+
+/// The modes the response is made of: the undamped ones of `K` with their modal damping, or,
+/// with a gyroscopic `C`, the eigenvalues of the whole linearisation; and the coupling the
+/// modal sum drops.
+fn write_modes(out: &mut impl std::io::Write, frf: &FrfAnalysis) {
+    let FrfAnalysis {
+        normal_modes: modes,
+        modal_damping: damping,
+        ..
+    } = frf;
     let gyroscopic = frf.stability.gyroscopic_frequencies.is_some();
     if gyroscopic {
         // The undamped modes of K are not the system's: the whole linearisation's are.
@@ -370,21 +419,6 @@ fn print_report(
             modes.projector_label(),
             num(damping.coupling)
         );
-    }
-    let _ = writeln!(
-        out,
-        "sweep      {} frequencies from {lo:.6e} to {hi:.6e} rad/s",
-        frf.frequencies.len(),
-        lo = num(lo),
-        hi = num(hi)
-    );
-    write_peaks(out, outputs, sweeps);
-    write_evaluations(out, args, frf);
-    if let Some((points, plan)) = simulated {
-        write_simulated(out, args, outputs, points, plan);
-    }
-    if let Some(path) = &args.plot {
-        let _ = writeln!(out, "chart      {path}");
     }
 }
 

@@ -243,6 +243,12 @@ fn print_text(
         num(orbit.residual_max),
         orbit.iterations
     );
+    print_stability(stdout, orbit);
+}
+
+/// The orbit's energy, its Floquet multipliers with the trivial ones and the symmetries they
+/// count, the stability verdict and the work.
+fn print_stability(stdout: &mut impl std::io::Write, orbit: &PeriodicOrbit) {
     let _ = writeln!(stdout, "energy       T + V = {:.12e} J", num(orbit.energy));
     for (k, m) in orbit.multipliers.iter().enumerate() {
         let label = if k == 0 { "multipliers" } else { "" };
