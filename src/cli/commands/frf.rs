@@ -228,14 +228,14 @@ pub fn run(args: &FrfArgs) -> Result<(), CliError> {
     Ok(())
 }
 
+/// The range of `--freqs` and the list of `--frequency` (rad/s).
+type Frequencies = (Option<(f64, f64)>, Vec<f64>);
+
 /// `--freqs LO..HI` and the `--frequency` list (rad/s), evaluated with the model's parameters.
 ///
 /// # Errors
 /// A usage error for a range or frequency that does not parse or lies outside [1e-12, 1e12].
-fn frequencies(
-    args: &FrfArgs,
-    model: &dyn ModelInfo,
-) -> Result<(Option<(f64, f64)>, Vec<f64>), CliError> {
+fn frequencies(args: &FrfArgs, model: &dyn ModelInfo) -> Result<Frequencies, CliError> {
     let lookup = parameter_lookup(model);
     let frequency_range = match &args.freqs {
         Some(text) => {
