@@ -207,8 +207,37 @@ fn print_text(out: &mut impl std::io::Write, model: &dyn ModelInfo, study: &Conv
             " (order seen on Δ, 2Δ, 4Δ: {p:.2})"
         ))
     );
+    print_table(out, &names, study);
+    let scale = study.max_response;
+    let relative = |d: f64| if scale > 0.0 { d / scale } else { d };
+    let _ = writeln!(
+        out,
+        "largest |δq| = {:.6e}; max |Duhamel − DOP853| = {:.2e} ({:.1e} relative; DOP853 rtol {:.0e}, {} steps)",
+        num(scale),
+        num(study.max_difference),
+        num(relative(study.max_difference)),
+        num(study.direct_rtol),
+        study.direct_steps
+    );
+    if let Some(c) = &study.closed_form {
+        let _ = writeln!(
+            out,
+            "closed form {} (ω = {:.10e} rad/s, ζ = {:.6e}): max |Duhamel − closed form| = {:.2e} ({:.1e} relative)",
+            c.formula,
+            num(c.natural_frequency),
+            num(c.damping_ratio),
+            num(c.max_difference),
+            num(relative(c.max_difference))
+        );
+    }
+}
+
+/// Eleven times of the response, evenly spread: each coordinate by Duhamel's integral and by
+/// DOP853, and the closed form where there is one.
+fn print_table(out: &mut impl std::io::Write, names: &[&str], study: &ConvolutionStudy) {
+    let n = names.len();
     let mut header = format!("{:>12}", "t (s)");
-    for name in &names {
+    for name in names {
         header.push_str(&format!(
             "  {:>16}  {:>16}",
             format!("δ{name} Duhamel"),
@@ -235,27 +264,5 @@ fn print_text(out: &mut impl std::io::Write, model: &dyn ModelInfo, study: &Conv
             line.push_str(&format!("  {:>16.9e}", num(c.values[j])));
         }
         let _ = writeln!(out, "{line}");
-    }
-    let scale = study.max_response;
-    let relative = |d: f64| if scale > 0.0 { d / scale } else { d };
-    let _ = writeln!(
-        out,
-        "largest |δq| = {:.6e}; max |Duhamel − DOP853| = {:.2e} ({:.1e} relative; DOP853 rtol {:.0e}, {} steps)",
-        num(scale),
-        num(study.max_difference),
-        num(relative(study.max_difference)),
-        num(study.direct_rtol),
-        study.direct_steps
-    );
-    if let Some(c) = &study.closed_form {
-        let _ = writeln!(
-            out,
-            "closed form {} (ω = {:.10e} rad/s, ζ = {:.6e}): max |Duhamel − closed form| = {:.2e} ({:.1e} relative)",
-            c.formula,
-            num(c.natural_frequency),
-            num(c.damping_ratio),
-            num(c.max_difference),
-            num(relative(c.max_difference))
-        );
     }
 }

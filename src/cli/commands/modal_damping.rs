@@ -7,7 +7,9 @@
 use clap::Args;
 use eomgen::ModelInfo;
 use eomgen::analysis::StudyRuns;
-use eomgen::analysis::vibration::{ModalDampingOptions, ModalDampingStudy, RayleighFit};
+use eomgen::analysis::vibration::{
+    ModalDampingOptions, ModalDampingStudy, ModeDamping, RayleighFit,
+};
 
 use crate::cli::error::CliError;
 use crate::cli::files::Outputs;
@@ -204,6 +206,32 @@ fn print_report(
             );
         }
     }
+    print_mode_table(stdout, per_mode);
+    let _ = writeln!(
+        stdout,
+        "responses  0 ≤ t ≤ {t_end:.4} s, {samples} samples; max |δq| differences from e^{{At}}, relative to its largest |δq|:"
+    );
+    let _ = writeln!(
+        stdout,
+        "  {:<36} {:>12} {:>14} {:>12}",
+        "release", "DOP853", "diagonal Ĉ", "Rayleigh"
+    );
+    for c in cases {
+        let _ = writeln!(
+            stdout,
+            "  {:<36} {:>12.2e} {:>14.2e} {:>12}",
+            c.name,
+            num(c.integration_vs_exact),
+            num(c.diagonal_vs_exact),
+            c.rayleigh_vs_exact
+                .map_or("-".to_string(), |r| format!("{r:.2e}", r = num(r)))
+        );
+    }
+}
+
+/// Each mode's `ω`, and its `ζ` and `ω_d` exactly, with the diagonal of `Ĉ` and with the
+/// Rayleigh fit.
+fn print_mode_table(stdout: &mut impl std::io::Write, per_mode: &[ModeDamping]) {
     let opt = |v: Option<f64>, width: usize| match v {
         Some(x) => format!("{:>width$.6e}", num(x + 0.0)),
         None => format!("{:>width$}", "-"),
@@ -232,26 +260,6 @@ fn print_report(
             opt(m.diagonal.and_then(|d| d.damped_frequency), 13),
             opt(m.rayleigh.map(|d| d.damping_ratio), 13),
             opt(m.rayleigh.and_then(|d| d.damped_frequency), 13),
-        );
-    }
-    let _ = writeln!(
-        stdout,
-        "responses  0 ≤ t ≤ {t_end:.4} s, {samples} samples; max |δq| differences from e^{{At}}, relative to its largest |δq|:"
-    );
-    let _ = writeln!(
-        stdout,
-        "  {:<36} {:>12} {:>14} {:>12}",
-        "release", "DOP853", "diagonal Ĉ", "Rayleigh"
-    );
-    for c in cases {
-        let _ = writeln!(
-            stdout,
-            "  {:<36} {:>12.2e} {:>14.2e} {:>12}",
-            c.name,
-            num(c.integration_vs_exact),
-            num(c.diagonal_vs_exact),
-            c.rayleigh_vs_exact
-                .map_or("-".to_string(), |r| format!("{r:.2e}", r = num(r)))
         );
     }
 }

@@ -10,7 +10,7 @@
 use clap::Args;
 use eomgen::ModelInfo;
 use eomgen::analysis::vibration::{
-    self, PerturbationDirection, RayleighError, RayleighOptions, RayleighStudy,
+    self, PerturbationDirection, RayleighError, RayleighOptions, RayleighStudy, Stationarity,
 };
 
 use crate::cli::error::CliError;
@@ -179,44 +179,50 @@ fn print_text(stdout: &mut impl std::io::Write, model: &dyn ModelInfo, study: &R
         participation.join(", ")
     );
     if let Some(s) = &study.stationarity {
-        let from = match s.direction {
-            PerturbationDirection::ShapeError => "the shape's own error",
-            PerturbationDirection::NextMode => "the next mode",
-        };
+        print_stationarity(stdout, s);
+    }
+}
+
+/// The stationarity of `R` at the first mode: `R(ψ₁ + ε w)` against its closed form for each
+/// `ε`, and the fitted order of `R − ω₁²` in `ε`.
+fn print_stationarity(stdout: &mut impl std::io::Write, s: &Stationarity) {
+    let from = match s.direction {
+        PerturbationDirection::ShapeError => "the shape's own error",
+        PerturbationDirection::NextMode => "the next mode",
+    };
+    let _ = writeln!(
+        stdout,
+        "stationarity: v = ψ₁ + ε w, w = {from} (‖w‖_M = 1, R(w) = {:.6e}):",
+        num(s.direction_quotient)
+    );
+    let _ = writeln!(
+        stdout,
+        "  {:>8}  {:>20}  {:>11}  {:>11}  {:>11}",
+        "ε", "R", "R − ω₁²", "closed form", "(√R−ω₁)/ω₁"
+    );
+    for p in &s.samples {
         let _ = writeln!(
             stdout,
-            "stationarity: v = ψ₁ + ε w, w = {from} (‖w‖_M = 1, R(w) = {:.6e}):",
-            num(s.direction_quotient)
+            "  {:>8.1e}  {:>20.12e}  {:>11.3e}  {:>11.3e}  {:>11.3e}",
+            num(p.epsilon),
+            num(p.rayleigh_quotient),
+            num(p.excess),
+            num(p.predicted_excess),
+            num(p.relative_error)
         );
-        let _ = writeln!(
-            stdout,
-            "  {:>8}  {:>20}  {:>11}  {:>11}  {:>11}",
-            "ε", "R", "R − ω₁²", "closed form", "(√R−ω₁)/ω₁"
-        );
-        for p in &s.samples {
+    }
+    match s.fitted_order {
+        Some(order) => {
             let _ = writeln!(
                 stdout,
-                "  {:>8.1e}  {:>20.12e}  {:>11.3e}  {:>11.3e}  {:>11.3e}",
-                num(p.epsilon),
-                num(p.rayleigh_quotient),
-                num(p.excess),
-                num(p.predicted_excess),
-                num(p.relative_error)
+                "  fitted order of R − ω₁² in ε: {order:.3} (2: R is stationary at ψ₁)"
             );
         }
-        match s.fitted_order {
-            Some(order) => {
-                let _ = writeln!(
-                    stdout,
-                    "  fitted order of R − ω₁² in ε: {order:.3} (2: R is stationary at ψ₁)"
-                );
-            }
-            None => {
-                let _ = writeln!(
-                    stdout,
-                    "  no order fitted: R − ω₁² is at rounding for every ε"
-                );
-            }
+        None => {
+            let _ = writeln!(
+                stdout,
+                "  no order fitted: R − ω₁² is at rounding for every ε"
+            );
         }
     }
 }
