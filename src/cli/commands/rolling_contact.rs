@@ -13,7 +13,8 @@ use clap::Args;
 use eomgen::ModelInfo;
 use eomgen::analysis::StudyRuns;
 use eomgen::analysis::rolling_contact::{
-    RollingContact, RollingContactError, RollingContactOptions, rolling_contact,
+    FlightPhase, RollingContact, RollingContactError, RollingContactOptions, RollingPhase,
+    rolling_contact,
 };
 
 use crate::cli::error::CliError;
@@ -230,58 +231,69 @@ fn chart(path: &str, study: &RollingContact) -> Result<(), String> {
         },
     ];
     if let Some(f) = study.flight.as_ref().filter(|f| f.flies) {
-        let normal = r
-            .coordinates
-            .iter()
-            .position(|c| *c == r.normal)
-            .ok_or_else(|| format!("no coordinate `{}`", r.normal))?;
-        let mut centre: Vec<(f64, f64)> = r.samples.iter().map(|s| (s.t, s.q[normal])).collect();
-        centre.extend(f.samples.iter().map(|s| (s.t, s.q[normal])));
-        let e0 = r.samples[0].energy;
-        let mut energy: Vec<(f64, f64)> = r.samples.iter().map(|s| (s.t, s.energy - e0)).collect();
-        energy.extend(f.samples.iter().map(|s| (s.t, s.energy - e0)));
-        list.push(Panel {
-            caption: Some(match f.landing_time {
-                Some(t) => format!(
-                    "rolling, then flight from t = {:.5} s to the landing at t = {t:.5} s",
-                    r.lift_off_time
-                ),
-                None => format!(
-                    "rolling, then flight from t = {:.5} s (no landing by {t_end:.3} s)",
-                    r.lift_off_time
-                ),
-            }),
-            y_desc: format!("{} (m)", r.coordinates[normal]),
-            series: vec![
-                Series {
-                    name: format!("centre {}", r.coordinates[normal]),
-                    points: centre,
-                },
-                Series {
-                    name: "G on the closed-form parabola (flight)".to_string(),
-                    points: f.samples.iter().map(|s| (s.t, s.parabola[1])).collect(),
-                },
-                Series {
-                    name: "G integrated (flight)".to_string(),
-                    points: f
-                        .samples
-                        .iter()
-                        .map(|s| (s.t, s.centre_of_mass[1]))
-                        .collect(),
-                },
-            ],
-        });
-        list.push(Panel {
-            caption: Some("energy over both phases (no impulse at the lift-off)".to_string()),
-            y_desc: "E − E(0) (J)".to_string(),
-            series: vec![Series {
-                name: "T + V − E(0)".to_string(),
-                points: energy,
-            }],
-        });
+        list.extend(flight_panels(r, f, t_end)?);
     }
     let title = format!("{}: rolling contact (HW36)", r.model);
     panels(path, &title, &list)
+}
+
+/// The panels of a flight: the normal coordinate of the centre and of `G` (integrated and on
+/// the closed-form parabola), and the energy over both phases.
+///
+/// # Errors
+/// A model whose coordinates do not include the contact's normal one.
+fn flight_panels(r: &RollingPhase, f: &FlightPhase, t_end: f64) -> Result<Vec<Panel>, String> {
+    let mut panels = Vec::new();
+    let normal = r
+        .coordinates
+        .iter()
+        .position(|c| *c == r.normal)
+        .ok_or_else(|| format!("no coordinate `{}`", r.normal))?;
+    let mut centre: Vec<(f64, f64)> = r.samples.iter().map(|s| (s.t, s.q[normal])).collect();
+    centre.extend(f.samples.iter().map(|s| (s.t, s.q[normal])));
+    let e0 = r.samples[0].energy;
+    let mut energy: Vec<(f64, f64)> = r.samples.iter().map(|s| (s.t, s.energy - e0)).collect();
+    energy.extend(f.samples.iter().map(|s| (s.t, s.energy - e0)));
+    panels.push(Panel {
+        caption: Some(match f.landing_time {
+            Some(t) => format!(
+                "rolling, then flight from t = {:.5} s to the landing at t = {t:.5} s",
+                r.lift_off_time
+            ),
+            None => format!(
+                "rolling, then flight from t = {:.5} s (no landing by {t_end:.3} s)",
+                r.lift_off_time
+            ),
+        }),
+        y_desc: format!("{} (m)", r.coordinates[normal]),
+        series: vec![
+            Series {
+                name: format!("centre {}", r.coordinates[normal]),
+                points: centre,
+            },
+            Series {
+                name: "G on the closed-form parabola (flight)".to_string(),
+                points: f.samples.iter().map(|s| (s.t, s.parabola[1])).collect(),
+            },
+            Series {
+                name: "G integrated (flight)".to_string(),
+                points: f
+                    .samples
+                    .iter()
+                    .map(|s| (s.t, s.centre_of_mass[1]))
+                    .collect(),
+            },
+        ],
+    });
+    panels.push(Panel {
+        caption: Some("energy over both phases (no impulse at the lift-off)".to_string()),
+        y_desc: "E − E(0) (J)".to_string(),
+        series: vec![Series {
+            name: "T + V − E(0)".to_string(),
+            points: energy,
+        }],
+    });
+    Ok(panels)
 }
 
 /// The table.
@@ -357,6 +369,12 @@ fn print_text(study: &RollingContact) {
     let Some(f) = &study.flight else {
         return;
     };
+    print_flight(&mut out, r, f);
+}
+
+/// The flight after the lift-off: the release, the flight or why there is none, and the
+/// checks of the flight phase.
+fn print_flight(out: &mut impl std::io::Write, r: &RollingPhase, f: &FlightPhase) {
     let _ = writeln!(
         out,
         "release    {}: from the lift-off state, free of the ground: d²{}/dt² = {:.9} m/s² (0 while rolling)",
