@@ -404,6 +404,8 @@ impl<'f> Lowering<'f> {
     /// The sections are lowered in a fixed order, which this function spells out: the arena
     /// interns each new expression at its first use, so the order fixes every [`ExprId`],
     /// hence the canonical order of sums and products and the generated code.
+    // Long: it calls each section's lowering in the order they depend on each other, then
+    // gathers the forty fields of the lowered model; the work of each is in its own method.
     fn run(mut self) -> Result<SymbolicModel, Vec<Diagnostic>> {
         let file = self.file;
         let time_id = self.arena.time_id();
@@ -421,16 +423,7 @@ impl<'f> Lowering<'f> {
             .map(|c| c.name.value.clone())
             .collect();
         let q_symbols: Vec<SymbolId> = self.arena.coordinates().iter().map(|c| c[0]).collect();
-        let mut frames = self.frames();
-        for f in &file.frames {
-            if let Some(index) = frames.index(&f.name.value) {
-                let w = frames.angular_velocity(&mut self.arena, index);
-                for (axis, c) in ['x', 'y', 'z'].into_iter().zip(w) {
-                    self.angular_velocities
-                        .insert(format!("omega_{}_{axis}", f.name.value), c);
-                }
-            }
-        }
+        let mut frames = self.frames_with_rates();
         let points = self.points(&frames);
         self.points = points.clone();
         let dimension = file.dimension.unwrap_or(2);
@@ -511,42 +504,9 @@ impl<'f> Lowering<'f> {
             && self.kinetic_is_quadratic_in_rates(kinetic)
             && self.constraints_are_workless(&constraints);
 
-        let mut draw_lines: Vec<[usize; 2]> = file
-            .draw
-            .lines
-            .iter()
-            .filter_map(|[a, b]| Some([point(&points, &a.value)?, point(&points, &b.value)?]))
-            .collect();
-        let mut points = points;
-        for w in &file.draw.wheels {
-            draw_lines.extend(self.drawn_wheel(w, &mut points, &frames));
-        }
-        let trace_points = file
-            .draw
-            .trace
-            .iter()
-            .filter_map(|p| point(&points, &p.value))
-            .collect();
+        let (draw_lines, points, trace_points) = self.drawing(points, &frames);
 
-        // The outputs, and conserved quantities that use the vector functions, as text the
-        // runtime evaluates from the state; lowered last, so that they change no identifier
-        // of the equations' expressions.
-        let mut checks = file.checks.describe();
-        for (c, described) in file.checks.conserved.iter().zip(checks.conserved.to_mut()) {
-            if crate::model::vectors::uses_vectors(&c.value) {
-                described.value = self.state_text(&c.value).into();
-            }
-        }
-        let outputs = file
-            .outputs
-            .iter()
-            .map(|o| eomgen_description::outputs::OutputSpec {
-                name: o.name.value.clone().into(),
-                value: self.state_text(&o.value).into(),
-                conserved: o.conserved,
-                tolerance: o.tolerance,
-            })
-            .collect();
+        let (checks, outputs) = self.described_checks_and_outputs();
 
         if !self.errors.is_empty() {
             return Err(self.errors);
@@ -595,6 +555,83 @@ impl<'f> Lowering<'f> {
                 .map(FloquetReference::describe)
                 .collect(),
         })
+    }
+
+    /// The frames, with each frame's angular velocity components `omega_<frame>_<axis>` bound
+    /// for the expressions that name them.
+    fn frames_with_rates(&mut self) -> Frames {
+        let mut frames = self.frames();
+        for f in &self.file.frames {
+            if let Some(index) = frames.index(&f.name.value) {
+                let w = frames.angular_velocity(&mut self.arena, index);
+                for (axis, c) in ['x', 'y', 'z'].into_iter().zip(w) {
+                    self.angular_velocities
+                        .insert(format!("omega_{}_{axis}", f.name.value), c);
+                }
+            }
+        }
+        frames
+    }
+
+    /// What `draw:` draws: its lines between points, the points with the wheels' rims added
+    /// (and their lines), and the points traced.
+    fn drawing(
+        &mut self,
+        points: Points,
+        frames: &Frames,
+    ) -> (Vec<[usize; 2]>, Points, Vec<usize>) {
+        let file = self.file;
+        let mut draw_lines: Vec<[usize; 2]> = file
+            .draw
+            .lines
+            .iter()
+            .filter_map(|[a, b]| Some([point(&points, &a.value)?, point(&points, &b.value)?]))
+            .collect();
+        let mut points = points;
+        for w in &file.draw.wheels {
+            draw_lines.extend(self.drawn_wheel(w, &mut points, frames));
+        }
+        let trace_points = file
+            .draw
+            .trace
+            .iter()
+            .filter_map(|p| point(&points, &p.value))
+            .collect();
+
+        (draw_lines, points, trace_points)
+    }
+
+    /// The file's `checks:` as the description keeps them, and its `outputs:`, with the
+    /// conserved quantities and outputs that use the vector functions as text the runtime
+    /// evaluates from the state.
+    fn described_checks_and_outputs(
+        &mut self,
+    ) -> (
+        eomgen_description::checks::Checks,
+        Vec<eomgen_description::outputs::OutputSpec>,
+    ) {
+        let file = self.file;
+        // The outputs, and conserved quantities that use the vector functions, as text the
+        // runtime evaluates from the state; lowered last, so that they change no identifier
+        // of the equations' expressions.
+        let mut checks = file.checks.describe();
+        for (c, described) in file.checks.conserved.iter().zip(checks.conserved.to_mut()) {
+            if crate::model::vectors::uses_vectors(&c.value) {
+                described.value = self.state_text(&c.value).into();
+            }
+        }
+        let outputs = file
+            .outputs
+            .iter()
+            .map(|o| eomgen_description::outputs::OutputSpec {
+                name: o.name.value.clone().into(),
+                value: self.state_text(&o.value).into(),
+                conserved: o.conserved,
+                tolerance: o.tolerance,
+            })
+            .collect();
+
+        (checks, outputs)
     }
 
     /// Declares the parameters' symbols, in file order.
