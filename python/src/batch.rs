@@ -69,71 +69,14 @@ pub fn simulate_many<'py>(
     threads: Option<usize>,
     keep_failures: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
-    if let Some(n) = threads
-        && !(1..=MAX_THREADS).contains(&n)
-    {
-        return Err(pyo3::exceptions::PyValueError::new_err(format!(
-            "threads must be 1 to {MAX_THREADS}, got {n} (None: one per core)"
-        )));
-    }
-    if t_out.len() > MAX_OUTPUT_TIMES {
-        return Err(pyo3::exceptions::PyValueError::new_err(format!(
-            "t_out has {} times, at most {MAX_OUTPUT_TIMES} are allowed (as `eomgen simulate --t-out`)",
-            t_out.len()
-        )));
-    }
     let dim = 2 * model.fresh()?.num_dofs();
-    let states: Option<Vec<Vec<f64>>> = match &initial_states {
-        Some(a) => {
-            let view = a.as_array();
-            if view.ncols() != dim {
-                return Err(pyo3::exceptions::PyValueError::new_err(format!(
-                    "initial_states must have {dim} columns ([q; q̇]), got {}",
-                    view.ncols()
-                )));
-            }
-            Some(view.rows().into_iter().map(|r| r.to_vec()).collect())
-        }
-        None => None,
-    };
-    let batch = match (&states, &parameters) {
-        (Some(s), Some(p)) if s.len() != p.len() => {
-            return Err(pyo3::exceptions::PyValueError::new_err(format!(
-                "initial_states has {} rows and parameters {} entries: give one per run, or only one of them",
-                s.len(),
-                p.len()
-            )));
-        }
-        (Some(s), _) => s.len(),
-        (None, Some(p)) => p.len(),
-        (None, None) => {
-            return Err(pyo3::exceptions::PyValueError::new_err(
-                "give initial_states (b × 2n), parameters (b dicts), or both",
-            ));
-        }
-    };
-    if batch == 0 {
-        return Err(pyo3::exceptions::PyValueError::new_err(
-            "the batch is empty: a sweep of no run measures nothing",
-        ));
-    }
-    if t_out.is_empty() {
-        return Err(pyo3::exceptions::PyValueError::new_err(
-            "t_out must list at least one output time",
-        ));
-    }
-    // The states and energies returned: refused before any run when they would not fit
-    // (1e5 runs of 1e5 times aborted the interpreter on a failed allocation).
-    let values = batch
-        .checked_mul(t_out.len())
-        .and_then(|v| v.checked_mul(dim + 1));
-    if values.is_none_or(|v| v > MAX_RESULT_VALUES) {
-        return Err(pyo3::exceptions::PyValueError::new_err(format!(
-            "{batch} runs × {} output times × {} values per sample is more than the {MAX_RESULT_VALUES} numbers (800 MB) a batch may return; run it in parts",
-            t_out.len(),
-            dim + 1
-        )));
-    }
+    let (states, batch) = runs(
+        initial_states.as_ref(),
+        parameters.as_deref(),
+        &t_out,
+        threads,
+        dim,
+    )?;
     let base = SimulationOptions {
         method: method(method_name)?,
         t_end,
@@ -240,7 +183,101 @@ pub fn simulate_many<'py>(
         }
         Ok(all)
     });
-    let outcomes = outcomes?;
+    stacked(py, outcomes?, t_out, t_end, dim)
+}
+
+/// The initial states of a batch (one row of `dim` per run) and its number of runs, checked
+/// with the options every run shares.
+///
+/// # Errors
+/// `ValueError` for a thread count, output times, states or parameter sets that are refused,
+/// or a result too large to return.
+fn runs(
+    initial_states: Option<&PyReadonlyArray2<'_, f64>>,
+    parameters: Option<&[Vec<(String, f64)>]>,
+    t_out: &[f64],
+    threads: Option<usize>,
+    dim: usize,
+) -> PyResult<(Option<Vec<Vec<f64>>>, usize)> {
+    if let Some(n) = threads
+        && !(1..=MAX_THREADS).contains(&n)
+    {
+        return Err(pyo3::exceptions::PyValueError::new_err(format!(
+            "threads must be 1 to {MAX_THREADS}, got {n} (None: one per core)"
+        )));
+    }
+    if t_out.len() > MAX_OUTPUT_TIMES {
+        return Err(pyo3::exceptions::PyValueError::new_err(format!(
+            "t_out has {} times, at most {MAX_OUTPUT_TIMES} are allowed (as `eomgen simulate --t-out`)",
+            t_out.len()
+        )));
+    }
+    let states: Option<Vec<Vec<f64>>> = match initial_states {
+        Some(a) => {
+            let view = a.as_array();
+            if view.ncols() != dim {
+                return Err(pyo3::exceptions::PyValueError::new_err(format!(
+                    "initial_states must have {dim} columns ([q; q̇]), got {}",
+                    view.ncols()
+                )));
+            }
+            Some(view.rows().into_iter().map(|r| r.to_vec()).collect())
+        }
+        None => None,
+    };
+    let batch = match (&states, parameters) {
+        (Some(s), Some(p)) if s.len() != p.len() => {
+            return Err(pyo3::exceptions::PyValueError::new_err(format!(
+                "initial_states has {} rows and parameters {} entries: give one per run, or only one of them",
+                s.len(),
+                p.len()
+            )));
+        }
+        (Some(s), _) => s.len(),
+        (None, Some(p)) => p.len(),
+        (None, None) => {
+            return Err(pyo3::exceptions::PyValueError::new_err(
+                "give initial_states (b × 2n), parameters (b dicts), or both",
+            ));
+        }
+    };
+    if batch == 0 {
+        return Err(pyo3::exceptions::PyValueError::new_err(
+            "the batch is empty: a sweep of no run measures nothing",
+        ));
+    }
+    if t_out.is_empty() {
+        return Err(pyo3::exceptions::PyValueError::new_err(
+            "t_out must list at least one output time",
+        ));
+    }
+    // The states and energies returned: refused before any run when they would not fit
+    // (1e5 runs of 1e5 times aborted the interpreter on a failed allocation).
+    let values = batch
+        .checked_mul(t_out.len())
+        .and_then(|v| v.checked_mul(dim + 1));
+    if values.is_none_or(|v| v > MAX_RESULT_VALUES) {
+        return Err(pyo3::exceptions::PyValueError::new_err(format!(
+            "{batch} runs × {} output times × {} values per sample is more than the {MAX_RESULT_VALUES} numbers (800 MB) a batch may return; run it in parts",
+            t_out.len(),
+            dim + 1
+        )));
+    }
+    Ok((states, batch))
+}
+
+/// The outcomes of a batch stacked into the dictionary `simulate_many` returns.
+///
+/// # Errors
+/// A Python object that cannot be built.
+fn stacked(
+    py: Python<'_>,
+    outcomes: Vec<Outcome>,
+    t_out: Vec<f64>,
+    t_end: f64,
+    dim: usize,
+) -> PyResult<Bound<'_, PyDict>> {
+    let (batch, k) = (outcomes.len(), t_out.len());
     let out = PyDict::new(py);
     out.set_item("t", PyArray1::from_vec(py, t_out))?;
     let mut y = Vec::with_capacity(batch * k * dim);
