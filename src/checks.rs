@@ -487,57 +487,11 @@ pub fn motion_checks(
     modes: &mut dyn FnMut(Option<&str>) -> Result<ModesAt, String>,
 ) -> Vec<CheckRow> {
     let mut checks = Vec::new();
-    let default_run = CheckRun::default();
     // The file's reference results, from the model's description (a copy: the model is
     // borrowed mutably below).
     let file_checks = model.description().checks.clone();
 
-    // Generic: energy conservation (conservative models, or where the file asks for it).
-    let energy = &file_checks.energy_drift;
-    if model.description().conservative || energy.is_some() {
-        let (bound, run) = energy
-            .as_ref()
-            .map_or((DEFAULT_ENERGY_DRIFT, default_run), |d| {
-                (d.max, CheckRun::of(&d.run))
-            });
-        let computed = simulations.get(run).and_then(|s| {
-            energy_drift(model, y0, s)
-                .drift
-                .ok_or_else(|| "no samples".to_string())
-        });
-        checks.push(CheckRow::compare(
-            format!(
-                "energy drift max|E − E(0)|/max(T + |V|) ({})",
-                run.describe()
-            ),
-            computed,
-            0.0,
-            bound,
-        ));
-    }
-
-    // Generic: constraint drift (constrained models).
-    let constraint = &file_checks.constraint_drift;
-    if !model.description().constraint_names().is_empty() || constraint.is_some() {
-        let (bound, run) = constraint
-            .as_ref()
-            .map_or((DEFAULT_CONSTRAINT_DRIFT, default_run), |d| {
-                (d.max, CheckRun::of(&d.run))
-            });
-        let computed = simulations.get(run).map(|s| {
-            let (p, v) = constraint_drift(model, s).max_drift();
-            p.max(v)
-        });
-        checks.push(CheckRow::compare(
-            format!(
-                "constraint drift max(|Φ|, |Φ̇|), no stabilisation ({})",
-                run.describe()
-            ),
-            computed,
-            0.0,
-            bound,
-        ));
-    }
+    checks.extend(drift_rows(model, y0, simulations, &file_checks));
 
     // Reference values stated in the file.
     let at_of = |check: &ModalCheck| check.at.as_ref().map(|a| a.to_string());
@@ -560,91 +514,184 @@ pub fn motion_checks(
         checks.extend(modal_rows("damping_ratios", "", check, model, computed));
     }
     if let Some(check) = &file_checks.period {
-        let mut run = CheckRun::of(&check.run);
-        // Without `t_end:`, long enough for two zeros a period apart whatever the phase of
-        // the first: at least PERIODS_PER_RUN expected periods.
-        if check.run.t_end.is_none()
-            && let Ok(period) = expected(&check.value, model)
-            && period.is_finite()
-            && period > 0.0
-        {
-            run.t_end = run.t_end.max(PERIODS_PER_RUN * period);
-        }
-        let event = &*check.event;
-        let computed = simulations.get(run).and_then(|s| {
-            let times: Vec<f64> = s
-                .events
-                .iter()
-                .filter(|e| e.name == event)
-                .map(|e| e.t)
-                .collect();
-            match times.as_slice() {
-                [.., a, b] => Ok(b - a),
-                _ => Err(format!(
-                    "event `{event}` occurred {} time(s) in {} s; a period needs two",
-                    times.len(),
-                    run.t_end
-                )),
-            }
-        });
-        let what = format!(
-            "period between the last two `{event}` events (s) ({})",
-            run.describe()
-        );
-        checks.push(against_expected(
-            what,
-            computed,
-            &check.value,
-            model,
-            check.tolerance,
-        ));
+        checks.push(period_row(model, simulations, check));
     }
     if let Some(check) = &file_checks.final_state {
-        match expected(&check.t, model) {
-            Ok(t) if t.is_finite() && t > 0.0 => {
-                let run = CheckRun {
-                    t_end: t,
-                    ..CheckRun::of(&check.run)
-                };
-                let state = simulations.run(run, Some(vec![t])).and_then(|s| {
-                    s.last()
-                        .filter(|(ts, _)| *ts == t)
-                        .map(|(_, y)| y.to_vec())
-                        .ok_or_else(|| format!("the integration stopped before t = {t}"))
-                });
-                let coordinates = model.description().coordinate_names();
-                let n = coordinates.len();
-                for (k, e) in check.values.iter() {
-                    let index = coordinates.iter().position(|c| *c == k).or_else(|| {
-                        k.strip_suffix("_dot")
-                            .and_then(|b| coordinates.iter().position(|c| *c == b))
-                            .map(|i| n + i)
-                    });
-                    let computed = state.clone().and_then(|y| {
-                        index
-                            .map(|i| y[i])
-                            .ok_or_else(|| format!("`{k}` is not a coordinate or rate"))
-                    });
-                    let what = format!("{k} at t = {} s ({})", fixed(t, 6), run.describe());
-                    checks.push(against_expected(what, computed, e, model, check.tolerance));
-                }
-            }
-            Ok(t) => checks.push(CheckRow::compare(
-                "final_state",
-                Err(format!("t = {t} is not a positive time")),
-                f64::NAN,
-                check.tolerance,
-            )),
-            Err(e) => checks.push(CheckRow::compare(
-                "final_state",
-                Err(e),
-                f64::NAN,
-                check.tolerance,
+        checks.extend(final_state_rows(model, simulations, check));
+    }
+    checks.extend(conserved_rows(
+        model,
+        y0,
+        simulations,
+        &file_checks.conserved,
+    ));
+    checks
+}
+
+/// The drift checks: the energy's for a conservative model (or where the file bounds it),
+/// the constraints' for a constrained one, each over its run without stabilisation.
+fn drift_rows(
+    model: &mut dyn ModelInfo,
+    y0: &[f64],
+    simulations: &mut Simulations,
+    file_checks: &eomgen_runtime::description::checks::Checks,
+) -> Vec<CheckRow> {
+    let mut rows = Vec::new();
+    let default_run = CheckRun::default();
+    // Generic: energy conservation (conservative models, or where the file asks for it).
+    let energy = &file_checks.energy_drift;
+    if model.description().conservative || energy.is_some() {
+        let (bound, run) = energy
+            .as_ref()
+            .map_or((DEFAULT_ENERGY_DRIFT, default_run), |d| {
+                (d.max, CheckRun::of(&d.run))
+            });
+        let computed = simulations.get(run).and_then(|s| {
+            energy_drift(model, y0, s)
+                .drift
+                .ok_or_else(|| "no samples".to_string())
+        });
+        rows.push(CheckRow::compare(
+            format!(
+                "energy drift max|E − E(0)|/max(T + |V|) ({})",
+                run.describe()
+            ),
+            computed,
+            0.0,
+            bound,
+        ));
+    }
+
+    // Generic: constraint drift (constrained models).
+    let constraint = &file_checks.constraint_drift;
+    if !model.description().constraint_names().is_empty() || constraint.is_some() {
+        let (bound, run) = constraint
+            .as_ref()
+            .map_or((DEFAULT_CONSTRAINT_DRIFT, default_run), |d| {
+                (d.max, CheckRun::of(&d.run))
+            });
+        let computed = simulations.get(run).map(|s| {
+            let (p, v) = constraint_drift(model, s).max_drift();
+            p.max(v)
+        });
+        rows.push(CheckRow::compare(
+            format!(
+                "constraint drift max(|Φ|, |Φ̇|), no stabilisation ({})",
+                run.describe()
+            ),
+            computed,
+            0.0,
+            bound,
+        ));
+    }
+    rows
+}
+
+/// The period between the last two occurrences of the check's event, against its
+/// expected value.
+fn period_row(
+    model: &mut dyn ModelInfo,
+    simulations: &mut Simulations,
+    check: &eomgen_runtime::description::checks::PeriodCheck,
+) -> CheckRow {
+    let mut run = CheckRun::of(&check.run);
+    // Without `t_end:`, long enough for two zeros a period apart whatever the phase of
+    // the first: at least PERIODS_PER_RUN expected periods.
+    if check.run.t_end.is_none()
+        && let Ok(period) = expected(&check.value, model)
+        && period.is_finite()
+        && period > 0.0
+    {
+        run.t_end = run.t_end.max(PERIODS_PER_RUN * period);
+    }
+    let event = &*check.event;
+    let computed = simulations.get(run).and_then(|s| {
+        let times: Vec<f64> = s
+            .events
+            .iter()
+            .filter(|e| e.name == event)
+            .map(|e| e.t)
+            .collect();
+        match times.as_slice() {
+            [.., a, b] => Ok(b - a),
+            _ => Err(format!(
+                "event `{event}` occurred {} time(s) in {} s; a period needs two",
+                times.len(),
+                run.t_end
             )),
         }
+    });
+    let what = format!(
+        "period between the last two `{event}` events (s) ({})",
+        run.describe()
+    );
+    against_expected(what, computed, &check.value, model, check.tolerance)
+}
+
+/// Each coordinate or rate of the check at its time, against its expected value.
+fn final_state_rows(
+    model: &mut dyn ModelInfo,
+    simulations: &mut Simulations,
+    check: &eomgen_runtime::description::checks::FinalStateCheck,
+) -> Vec<CheckRow> {
+    let mut rows = Vec::new();
+    match expected(&check.t, model) {
+        Ok(t) if t.is_finite() && t > 0.0 => {
+            let run = CheckRun {
+                t_end: t,
+                ..CheckRun::of(&check.run)
+            };
+            let state = simulations.run(run, Some(vec![t])).and_then(|s| {
+                s.last()
+                    .filter(|(ts, _)| *ts == t)
+                    .map(|(_, y)| y.to_vec())
+                    .ok_or_else(|| format!("the integration stopped before t = {t}"))
+            });
+            let coordinates = model.description().coordinate_names();
+            let n = coordinates.len();
+            for (k, e) in check.values.iter() {
+                let index = coordinates.iter().position(|c| *c == k).or_else(|| {
+                    k.strip_suffix("_dot")
+                        .and_then(|b| coordinates.iter().position(|c| *c == b))
+                        .map(|i| n + i)
+                });
+                let computed = state.clone().and_then(|y| {
+                    index
+                        .map(|i| y[i])
+                        .ok_or_else(|| format!("`{k}` is not a coordinate or rate"))
+                });
+                let what = format!("{k} at t = {} s ({})", fixed(t, 6), run.describe());
+                rows.push(against_expected(what, computed, e, model, check.tolerance));
+            }
+        }
+        Ok(t) => rows.push(CheckRow::compare(
+            "final_state",
+            Err(format!("t = {t} is not a positive time")),
+            f64::NAN,
+            check.tolerance,
+        )),
+        Err(e) => rows.push(CheckRow::compare(
+            "final_state",
+            Err(e),
+            f64::NAN,
+            check.tolerance,
+        )),
     }
+    rows
+}
+
+/// The drift of each `conserved:` quantity and each output declared conserved over the
+/// default run, against its bound.
+fn conserved_rows(
+    model: &mut dyn ModelInfo,
+    y0: &[f64],
+    simulations: &mut Simulations,
+    conserved: &[eomgen_runtime::description::checks::ConservedCheck],
+) -> Vec<CheckRow> {
+    let mut rows = Vec::new();
+    let default_run = CheckRun::default();
     let parameters = parameter_lookup(model);
-    for c in file_checks.conserved.iter() {
+    for c in conserved {
         let value = parse(&c.value);
         let computed = simulations.get(default_run).and_then(|s| {
             let value = value.clone()?;
@@ -658,7 +705,7 @@ pub fn motion_checks(
             }
             Ok(worst)
         });
-        checks.push(CheckRow::compare(
+        rows.push(CheckRow::compare(
             format!(
                 "conserved `{}`: max |Q − Q(0)|/max(1, |Q(0)|) ({})",
                 c.name,
@@ -689,7 +736,7 @@ pub fn motion_checks(
                     .and_then(|o| o.drift)
                     .ok_or_else(|| "no samples".to_string())
             });
-            checks.push(CheckRow::compare(
+            rows.push(CheckRow::compare(
                 format!(
                     "conserved output `{name}`: max |Q − Q(0)|/max(1, |Q(0)|) ({})",
                     default_run.describe()
@@ -700,7 +747,7 @@ pub fn motion_checks(
             ));
         }
     }
-    checks
+    rows
 }
 
 /// The default run of a model's checks, with what a report draws of it.
