@@ -3,6 +3,11 @@
 //! (modal forcing), and the steady state measured by simulating the full model (lecture 21,
 //! HW21, HW34, HW37).
 //!
+//! long: the forced linearisation (the input matrix and its rates), the frequency response
+//! with its peaks, and the modal sum share the scaled dynamic stiffness and the peak search;
+//! the modal sum and the peak search could be rooms of their own, a split left to the issue on
+//! the code's shape.
+//!
 //! # Inputs
 //!
 //! An *input* is a parameter `p` of the model that enters the forcing `F(q, q̇, t)` linearly:
@@ -66,11 +71,6 @@
 //!
 //! is exact (HW37 (c)). For a non-diagonal `Ĉ` the off-diagonal part is dropped (HW34's
 //! approximation); [`ModalDamping::coupling`](crate::ModalDamping::coupling) says how large it was.
-//!
-//! long: the forced linearisation (the input matrix and its rates), the frequency response
-//! with its peaks, and the modal sum share the scaled dynamic stiffness and the peak search;
-//! the modal sum and the peak search could be rooms of their own, a split left to the issue on
-//! the code's shape.
 
 use nalgebra::{Complex, DMatrix, DVector};
 

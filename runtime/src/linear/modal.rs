@@ -1,6 +1,11 @@
 //! Equilibria, exact linearisation into `M δq̈ + C δq̇ + K δq = 0`, and undamped normal modes
 //! (issue 7; lectures 22–26).
 //!
+//! long: the linearisation (with constraints), its checks, and the normal modes by both routes
+//! (symmetric, and `M⁻¹K` for a non-symmetric `K`) share the error type and the mass
+//! matrix's checks; the modes could be a room of their own, a split left to the issue on the
+//! code's shape.
+//!
 //! The linearisation uses the generated Jacobians, so it is exact (no finite differences,
 //! except for an entry of `∂F/∂q` or `∂F/∂q̇` that is not finite where `F` is, a removable
 //! singularity such as quadratic drag's `d|v|/dv` at rest, which is differenced as the
@@ -25,11 +30,6 @@
 //! With holonomic constraints the linearisation is projected onto the null space of the
 //! constraint Jacobian (minimal coordinates; see [`Linearization`]); non-holonomic constraints
 //! are refused ([`ModalError::NonHolonomic`]).
-//!
-//! long: the linearisation (with constraints), its checks, and the normal modes by both routes
-//! (symmetric, and `M⁻¹K` for a non-symmetric `K`) share the error type and the mass
-//! matrix's checks; the modes could be a room of their own, a split left to the issue on the
-//! code's shape.
 
 use nalgebra::{DMatrix, DVector};
 

@@ -2,6 +2,11 @@
 //! lectures 22–26, 32), and damping models compared with the exact damped response (HW34,
 //! lectures 30–33).
 //!
+//! long: the free response by integration, exponential, eigenvectors and modes, and the
+//! damping models compared against it, share the eigenvector clusters and the modal
+//! coordinates; the damping models (Rayleigh, modal) could move to a room of their own, a split
+//! left to the issue on the code's shape.
+//!
 //! For a [`Linearization`] `M δq̈ + C δq̇ + K δq = 0` and initial values `(δq₀, δq̇₀)`:
 //!
 //! - [`response_by_integration`]: numerical integration of `δẏ = A δy`, `y = [δq; δq̇]`, with
@@ -26,11 +31,6 @@
 //! mode); [`exact_damped_modes`], each mode's complex eigenvalue of `A`. For a general state
 //! matrix (HW32) [`state_response_by_eigenvectors`] superposes the complex eigenvector
 //! solutions `e^{λt} v`.
-//!
-//! long: the free response by integration, exponential, eigenvectors and modes, and the
-//! damping models compared against it, share the eigenvector clusters and the modal
-//! coordinates; the damping models (Rayleigh, modal) could move to a room of their own, a split
-//! left to the issue on the code's shape.
 
 use nalgebra::{Complex, DMatrix, DVector};
 

@@ -2,6 +2,11 @@
 //! non-holonomic): a spinning body, a precessing top, a sleigh, disc or bicycle moving
 //! straight at constant speed.
 //!
+//! long: the search for a steady motion (Gauss–Newton with its trust region, polish and the
+//! check that only cyclic coordinates move) and its linearisation share the residuals, the
+//! error type and the held-rate bookkeeping; the search could be a room of its own, a split
+//! left to the issue on the code's shape.
+//!
 //! A *steady motion* holds every rate `q̇*` constant (`q̈ = 0`) while the coordinates that
 //! nothing depends on — *ignorable* (cyclic) coordinates: heading, wheel angles, contact
 //! position, spin angle — drift at their rates and the others stay put. It is an operating
@@ -38,11 +43,6 @@
 //!    stays constant to first order, as the bicycle's forward speed — is left out with its
 //!    column: another exact zero eigenvalue. What remains is the reduced state matrix whose
 //!    eigenvalues decide the stability; what was left out is reported.
-//!
-//! long: the search for a steady motion (Gauss–Newton with its trust region, polish and the
-//! check that only cyclic coordinates move) and its linearisation share the residuals, the
-//! error type and the held-rate bookkeeping; the search could be a room of its own, a split
-//! left to the issue on the code's shape.
 
 use nalgebra::{Complex, DMatrix, DVector};
 use serde::Serialize;

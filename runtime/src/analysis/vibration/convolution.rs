@@ -3,6 +3,10 @@
 //! equilibrium, forced through one input by an arbitrary `f(t)`, solved by Duhamel's integral
 //! over the impulse response and, independently, by DOP853.
 //!
+//! long: the quadrature, its error estimate, the resolution check of the forcing, the DOP853
+//! check and the closed forms share the grid and the impulse response; the checks could be a
+//! room of their own, a split left to the issue on the code's shape.
+//!
 //! # The impulse response
 //!
 //! The input `p` is what [`frequency_response_analysis`](super::frequency_response_analysis)
@@ -48,10 +52,6 @@
 //! ```
 //!
 //! (`h₁ = h/b`; the step response follows from `m s̈ + c ṡ + k s = b`, `ṡ = h`).
-//!
-//! long: the quadrature, its error estimate, the resolution check of the forcing, the DOP853
-//! check and the closed forms share the grid and the impulse response; the checks could be a
-//! room of their own, a split left to the issue on the code's shape.
 
 use nalgebra::{DMatrix, DVector};
 use serde::Serialize;
