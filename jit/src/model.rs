@@ -170,7 +170,10 @@ impl Code {
 
     /// Compiles the Taylor orders; `None` if Cranelift fails or panics on them (the orders
     /// are then the kernels' for good, not a compilation attempted again at every series),
-    /// or no order fits the instruction cache.
+    /// or no order fits the instruction cache. Out of line: inlined, its frame (Cranelift's
+    /// context) made every call of the orders probe its stack.
+    #[cold]
+    #[inline(never)]
     fn compile_orders(&self) -> Option<NativeOrders> {
         let plan = self.taylor.as_ref().ok()?;
         std::panic::catch_unwind(|| {

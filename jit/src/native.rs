@@ -124,7 +124,12 @@ pub(crate) fn compile(
     functions: &[(&str, &FunctionTape)],
     first_order: Option<(&FunctionTape, usize)>,
 ) -> Result<NativeCode, CompileError> {
-    let mut module = new_module()?;
+    let instructions = functions
+        .iter()
+        .map(|(_, f)| f.tape.instructions.len())
+        .chain(first_order.map(|(f, _)| f.tape.instructions.len()))
+        .sum();
+    let mut module = new_module(instructions)?;
     let imports = declare_imports(&mut module)?;
     let call_conv = module.isa().default_call_conv();
     let pointer = module.target_config().pointer_type();

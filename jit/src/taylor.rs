@@ -32,6 +32,16 @@
 //! kernels do, two lanes of one vector, with their operands side by side in a scratch
 //! ([`PairScratch`]).
 //!
+//! Each kernel's sums add their terms from the orders below `k` first (`Σ_{j=1}^{k−1}
+//! a[j] b[k−j]`, then the terms with order `k`). Those first terms need nothing the order
+//! computes, so order `k`'s function adds them for every sum before the ops, a few sums'
+//! chains of additions interleaved (`Emitter::prefixes`), and each op continues its sum from
+//! there: the same additions in the same order, so the same bits, but the long chains of
+//! dependent additions overlap instead of each waiting for the ops before it. With the
+//! orders laid out one after the other (`new_module`), this took the double pendulum and
+//! the heavy top from 1.14–1.21× the time of `model!`'s orders to 1.07–1.14×
+//! (docs/performance.md).
+//!
 //! Why one function per order: in one function for all orders every coefficient stayed in
 //! a register (a Cranelift value) from the order that computed it to the last that read it,
 //! and the register allocator spilled most of them (5,059 16-byte reloads in the double
@@ -181,7 +191,12 @@ pub(crate) fn compile_orders(
             &"the tape has too many instructions for 32-bit offsets",
         ));
     }
-    let mut module = new_module()?;
+    // Order k's code adds about k terms per op: the ops times (H + 1)² bound the terms.
+    let terms = program
+        .ops
+        .len()
+        .saturating_mul((highest + 1) * (highest + 1));
+    let mut module = new_module(terms.saturating_add(plan.order_zero.instructions.len()))?;
     let imports = declare_imports(&mut module)?;
     let call_conv = module.isa().default_call_conv();
     let pointer = module.target_config().pointer_type();
@@ -225,6 +240,11 @@ pub(crate) fn compile_orders(
         module.clear_context(&mut context);
         ids.push(id);
     }
+    let pairs = program
+        .ops
+        .iter()
+        .filter(|op| matches!(op, SeriesOp::SinCos { .. } | SeriesOp::SinhCosh { .. }))
+        .count();
     let mut zero_signature = Signature::new(call_conv);
     zero_signature.params.push(AbiParam::new(pointer));
     zero_signature.params.push(AbiParam::new(pointer));
@@ -262,11 +282,6 @@ pub(crate) fn compile_orders(
     let address = module.get_finalized_function(zero_id);
     // SAFETY: as above, with the signature of `OrderZeroFn`.
     let order_zero = unsafe { std::mem::transmute::<*const u8, OrderZeroFn>(address) };
-    let pairs = program
-        .ops
-        .iter()
-        .filter(|op| matches!(op, SeriesOp::SinCos { .. } | SeriesOp::SinhCosh { .. }))
-        .count();
     Ok(Some(NativeOrders {
         orders,
         order_zero,
@@ -274,6 +289,34 @@ pub(crate) fn compile_orders(
         scratch_units: PairScratch::units(pairs),
         _memory: ModuleMemory::new(module),
     }))
+}
+
+/// The arguments of the orders' code (see the module documentation).
+#[derive(Clone, Copy)]
+struct OrderArgs {
+    series: ir::Value,
+    context: ir::Value,
+    solve: ir::Value,
+    out: ir::Value,
+    lower: ir::Value,
+    inverse_pivots: ir::Value,
+    mode: ir::Value,
+    scratch: ir::Value,
+}
+
+impl OrderArgs {
+    fn new(params: &[ir::Value]) -> Self {
+        OrderArgs {
+            series: params[0],
+            context: params[1],
+            solve: params[2],
+            out: params[3],
+            lower: params[4],
+            inverse_pivots: params[5],
+            mode: params[6],
+            scratch: params[7],
+        }
+    }
 }
 
 /// Writes order `k`'s function (see the module documentation): its ops, then its solve.
@@ -285,23 +328,45 @@ fn build_order(
     solve_signature: Signature,
     target: cranelift_codegen::isa::TargetFrontendConfig,
 ) {
-    let pointer = target.pointer_type();
     let mut b = FunctionBuilder::new(func, builder_context);
     let params = enter(&mut b);
-    let (series, context, solve) = (params[0], params[1], params[2]);
-    let (out, lower, inverse_pivots, mode) = (params[3], params[4], params[5], params[6]);
-    let scratch = params[7];
-    let n = program.coordinates.len();
+    let args = OrderArgs::new(&params);
     let solve_signature = b.import_signature(solve_signature);
-    let mut emitter = Emitter {
-        series,
-        scratch,
-        pairs: 0,
-        known: HashMap::default(),
-    };
+    let done = b.create_block();
+    let status = b.append_block_param(done, types::I8);
+    let mut emitter = Emitter::new(args);
+    emit_order(
+        &mut b,
+        &mut emitter,
+        program,
+        k,
+        (args, solve_signature, done),
+    );
+    let ok = b.ins().iconst(types::I8, 0);
+    b.ins().jump(done, &[ir::BlockArg::Value(ok)]);
+    b.switch_to_block(done);
+    b.seal_block(done);
+    b.ins().return_(&[status]);
+    b.finalize(target);
+}
+
+/// Writes order `k`: its ops, then its solve, continuing in a new block (the current one on
+/// return); a failed call of `solve` jumps to `done` with its status.
+fn emit_order(
+    b: &mut FunctionBuilder,
+    emitter: &mut Emitter,
+    program: &TaylorProgram,
+    k: usize,
+    (args, solve_signature, done): (OrderArgs, ir::SigRef, ir::Block),
+) {
+    let n = program.coordinates.len();
+    emitter.begin_order(b);
+    if k > 1 {
+        emitter.prefixes(b, program, k);
+    }
     if k > 0 {
         for op in program.ops.iter() {
-            emitter.op(&mut b, *op, k);
+            emitter.op(b, *op, k);
         }
     } else {
         // The pairs' order 0, from the series (order 0 wrote them there).
@@ -312,12 +377,13 @@ fn build_order(
             } = *op
             {
                 let p = emitter.next_pair();
-                let (y0, z0) = (emitter.at(&mut b, y, 0), emitter.at(&mut b, z, 0));
-                emitter.store_pair(&mut b, p, 0, (y0, z0));
+                let (y0, z0) = (emitter.at(b, y, 0), emitter.at(b, z, 0));
+                emitter.store_pair(b, p, 0, (y0, z0));
             }
         }
     }
     // Order k of M a = F: in line with the factor `mode` names, else by `solve`.
+    let after = b.create_block();
     let mut test = b.create_block();
     b.ins().jump(test, &[]);
     for (code, factor) in [
@@ -328,35 +394,37 @@ fn build_order(
         b.switch_to_block(test);
         b.seal_block(test);
         let (inline, next) = (b.create_block(), b.create_block());
-        let is = b.ins().icmp_imm_s(IntCC::Equal, mode, code);
+        let is = b.ins().icmp_imm_s(IntCC::Equal, args.mode, code);
         b.ins().brif(is, inline, &[], next, &[]);
         b.switch_to_block(inline);
         b.seal_block(inline);
         // What the branches write differs (and the values of one do not reach the others).
         let before = emitter.known.clone();
         emitter.dense_solve(
-            &mut b,
+            b,
             program,
             (n, k),
-            out,
+            args.out,
             factor,
-            (lower, inverse_pivots),
+            (args.lower, args.inverse_pivots),
         );
         emitter.known = before;
-        let ok = b.ins().iconst(types::I8, 0);
-        b.ins().return_(&[ok]);
+        b.ins().jump(after, &[]);
         test = next;
     }
     let call = test;
     b.switch_to_block(call);
     b.seal_block(call);
+    let pointer = b.func.dfg.value_type(args.context);
     let kv = b.ins().iconst(pointer, k as i64);
     let called = b
         .ins()
-        .call_indirect(solve_signature, solve, &[context, kv]);
+        .call_indirect(solve_signature, args.solve, &[args.context, kv]);
     let status = b.inst_results(called)[0];
-    b.ins().return_(&[status]);
-    b.finalize(target);
+    b.ins()
+        .brif(status, done, &[ir::BlockArg::Value(status)], after, &[]);
+    b.switch_to_block(after);
+    b.seal_block(after);
 }
 
 /// Writes order 0's body (see the module documentation): each instruction's value stored to
@@ -520,9 +588,239 @@ struct Emitter {
     pairs: usize,
     /// `(slot, order) → value` loaded or stored in this order's function.
     known: HashMap<(Slot, usize), ir::Value>,
+    /// The sums whose terms from orders below `k` were added before the ops
+    /// ([`Emitter::prefixes`]), each in a stack slot.
+    prefixes: HashMap<Sum, ir::StackSlot>,
+    /// The bases of [`Emitter::prefixes`]' loads: of the series, of the pair scratch.
+    prefix_base: ir::Value,
+    prefix_scratch: ir::Value,
+}
+
+/// What [`Emitter::prefixes`]' bases add to the series' and the scratch's addresses (16: the
+/// scratch's vector loads stay aligned).
+const PREFIX_BIAS: i32 = 16;
+
+/// How many of [`Emitter::prefixes`]' sums are added term by term in turn: independent
+/// chains of additions that overlap in the processor. The double pendulum's orders ran 3 %
+/// faster with 4 than with 1 (one sum after the other), and no faster with 6, 8, 16 or all.
+const INTERLEAVED_SUMS: usize = 8;
+
+/// A sum of an order's kernels, named for [`Emitter::prefixes`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+enum Sum {
+    /// [`Emitter::sum_of_products`] over `(x, y)` from `j = 1`, weighted or not.
+    Products { x: Slot, y: Slot, weighted: bool },
+    /// [`Emitter::weighted_pair`] of pair `p`.
+    Pair(usize),
+    /// The sum of the power `out = a^exponent` with a constant exponent.
+    Power { out: Slot, a: Slot, exponent: Slot },
+    /// The sum of the varying mass entry at this index.
+    Mass(usize),
 }
 
 impl Emitter {
+    fn new(args: OrderArgs) -> Self {
+        Emitter {
+            series: args.series,
+            scratch: args.scratch,
+            pairs: 0,
+            known: HashMap::default(),
+            prefixes: HashMap::default(),
+            prefix_base: args.series,
+            prefix_scratch: args.scratch,
+        }
+    }
+
+    /// Starts an order: nothing known, no pair met, and the bases of [`Self::prefixes`]'
+    /// loads: the series' and the scratch's addresses plus a constant, so that Cranelift,
+    /// for which both loads are pure, does not merge a load of a partial sum's terms with the
+    /// ops' load of the same coefficient (one value used in both places would keep a register
+    /// from the top of the function to the op).
+    fn begin_order(&mut self, b: &mut FunctionBuilder) {
+        self.known.clear();
+        self.prefixes.clear();
+        self.pairs = 0;
+        self.prefix_base = b.ins().iadd_imm_s(self.series, PREFIX_BIAS as i64);
+        self.prefix_scratch = b.ins().iadd_imm_s(self.scratch, PREFIX_BIAS as i64);
+    }
+
+    /// Adds, before the order's ops, the terms of each of their sums that read only orders
+    /// below `k` (the terms each kernel adds first), and keeps each partial sum in a stack
+    /// slot where the op continues it: the same operations in the same order, but the long
+    /// chains of additions start at the top of the function, where they overlap with each
+    /// other instead of waiting behind the ops whose order `k` they do not need.
+    fn prefixes(&mut self, b: &mut FunctionBuilder, program: &TaylorProgram, k: usize) {
+        let products = |x: Slot, y: Slot, weighted: bool| Sum::Products { x, y, weighted };
+        let mut pair = 0;
+        let mut all: Vec<Sum> = Vec::new();
+        for op in program.ops.iter() {
+            let sums: Vec<Sum> = match *op {
+                SeriesOp::Mul { a, b: y, .. } => vec![products(a, y, false)],
+                SeriesOp::Div { out, b: y, .. } | SeriesOp::ConstantDiv { out, b: y } => {
+                    vec![products(y, out, false)]
+                }
+                SeriesOp::Sqrt { out, .. } => vec![products(out, out, false)],
+                SeriesOp::PowConstant { out, a, exponent } => {
+                    vec![Sum::Power { out, a, exponent }]
+                }
+                SeriesOp::Exp { out, a } => vec![products(a, out, true)],
+                SeriesOp::Ln { out, a } => vec![products(out, a, true)],
+                SeriesOp::SinCos { .. } | SeriesOp::SinhCosh { .. } => {
+                    pair += 1;
+                    vec![Sum::Pair(pair - 1)]
+                }
+                SeriesOp::Tan { out, a, square } | SeriesOp::Tanh { out, a, square } => {
+                    vec![products(a, square, true), products(out, out, false)]
+                }
+                SeriesOp::Asin { out, a, root, .. } => vec![
+                    products(a, a, false),
+                    products(root, root, false),
+                    products(out, root, true),
+                ],
+                SeriesOp::Atan { out, a, square } => {
+                    vec![products(a, a, false), products(out, square, true)]
+                }
+                SeriesOp::Atan2 { out, y, x, norm } => vec![
+                    products(x, x, false),
+                    products(y, y, false),
+                    products(y, x, true),
+                    products(x, y, true),
+                    products(out, norm, true),
+                ],
+                _ => vec![],
+            };
+            for sum in sums {
+                if !all.contains(&sum) {
+                    all.push(sum);
+                }
+            }
+        }
+        for e in 0..program.derived.varying_mass_entries.len() {
+            all.push(Sum::Mass(e));
+        }
+        for sums in all.chunks(INTERLEAVED_SUMS) {
+            self.prefix_group(b, program, sums, k);
+        }
+    }
+
+    /// Term `t` (in the order of addition) of `sum`'s terms of orders below `k`, read through
+    /// the prefix base (see [`Self::prefixes`]).
+    fn prefix_term(
+        &self,
+        b: &mut FunctionBuilder,
+        program: &TaylorProgram,
+        sum: Sum,
+        (k, t): (usize, usize),
+    ) -> ir::Value {
+        let flags = settled();
+        let series = self.prefix_base;
+        let older = move |b: &mut FunctionBuilder, slot: Slot, i: usize| {
+            let offset = ((slot as usize * UNROLLED_CAPACITY + i) * 8) as i32 - PREFIX_BIAS;
+            b.ins().load(types::F64, flags, series, offset)
+        };
+        match sum {
+            Sum::Products { x, y, weighted } => {
+                let j = t + 1;
+                let (u, v) = (older(b, x, j), older(b, y, k - j));
+                Self::product_term(b, (u, v), j, weighted)
+            }
+            Sum::Pair(p) => {
+                let j = t + 1;
+                let w = b.ins().load(
+                    types::F64X2,
+                    flags,
+                    self.prefix_scratch,
+                    PairScratch::weighted(p, j) - PREFIX_BIAS,
+                );
+                let pair = b.ins().load(
+                    types::F64X2,
+                    flags,
+                    self.prefix_scratch,
+                    PairScratch::pair(p, k - j) - PREFIX_BIAS,
+                );
+                b.ins().fmul(w, pair)
+            }
+            Sum::Power { out, a, exponent } => {
+                let j = k - 1 - t;
+                let alpha = older(b, exponent, 0);
+                let (xv, ov) = (older(b, a, k - j), older(b, out, j));
+                Self::power_term(b, (alpha, k, j), xv, ov)
+            }
+            Sum::Mass(e) => {
+                let (_, l, slot) = program.derived.varying_mass_entries[e];
+                let accelerations = program.acceleration_slot();
+                let j = t;
+                let m = older(b, slot, 1 + j);
+                let a = older(b, accelerations + l, k - 1 - j);
+                b.ins().fmul(m, a)
+            }
+        }
+    }
+
+    /// Writes the `k − 1` terms of orders below `k` of each of `sums` ([`INTERLEAVED_SUMS`] or
+    /// fewer), term `t` of every sum before term `t + 1` of any, each partial sum into a stack
+    /// slot of its own.
+    fn prefix_group(
+        &mut self,
+        b: &mut FunctionBuilder,
+        program: &TaylorProgram,
+        sums: &[Sum],
+        k: usize,
+    ) {
+        let zero = Self::constant(b, 0.0);
+        let mut totals: Vec<ir::Value> = sums
+            .iter()
+            .map(|s| {
+                if matches!(s, Sum::Pair(_)) {
+                    b.ins().splat(types::F64X2, zero)
+                } else {
+                    zero
+                }
+            })
+            .collect();
+        for t in 0..k - 1 {
+            for (i, &sum) in sums.iter().enumerate() {
+                let term = self.prefix_term(b, program, sum, (k, t));
+                totals[i] = b.ins().fadd(totals[i], term);
+            }
+        }
+        for (&sum, &value) in sums.iter().zip(&totals) {
+            let size = if matches!(sum, Sum::Pair(_)) { 16 } else { 8 };
+            let slot = b.create_sized_stack_slot(ir::StackSlotData::new(
+                ir::StackSlotKind::ExplicitSlot,
+                size,
+                4,
+            ));
+            b.ins().stack_store(types::I64, value, slot, 0);
+            self.prefixes.insert(sum, slot);
+        }
+    }
+
+    /// The partial sum [`Self::prefix`] kept for `sum`, if any.
+    fn started(&self, b: &mut FunctionBuilder, sum: Sum, ty: ir::Type) -> Option<ir::Value> {
+        let slot = *self.prefixes.get(&sum)?;
+        Some(b.ins().stack_load(types::I64, ty, slot, 0))
+    }
+
+    /// A term `(kα − j(α + 1)) x[k − j] y[j]` of the power with constant exponent `α`, as
+    /// the kernel `pow_constant` computes it.
+    fn power_term(
+        b: &mut FunctionBuilder,
+        (alpha, k, j): (ir::Value, usize, usize),
+        xv: ir::Value,
+        ov: ir::Value,
+    ) -> ir::Value {
+        let kc = Self::constant(b, k as f64);
+        let one = Self::constant(b, 1.0);
+        let ka = b.ins().fmul(alpha, kc);
+        let jc = Self::constant(b, j as f64);
+        let a1 = b.ins().fadd(alpha, one);
+        let ja = b.ins().fmul(a1, jc);
+        let weight = b.ins().fsub(ka, ja);
+        let t = b.ins().fmul(weight, xv);
+        b.ins().fmul(t, ov)
+    }
+
     /// The index of the next pair op in the program's order (see [`PairScratch`]).
     fn next_pair(&mut self) -> usize {
         self.pairs += 1;
@@ -555,9 +853,12 @@ impl Emitter {
             .map(|&slot| self.at(b, slot, k))
             .collect();
         if k > 0 {
-            for &(i, l, slot) in program.derived.varying_mass_entries.iter() {
-                let mut sum = Self::constant(b, 0.0);
-                for j in 0..k {
+            for (e, &(i, l, slot)) in program.derived.varying_mass_entries.iter().enumerate() {
+                let (mut sum, from) = match self.started(b, Sum::Mass(e), types::F64) {
+                    Some(sum) => (sum, k - 1),
+                    None => (Self::constant(b, 0.0), 0),
+                };
+                for j in from..k {
                     let m = self.at(b, slot, 1 + j);
                     let a = self.at(b, accelerations + l, k - 1 - j);
                     let term = b.ins().fmul(m, a);
@@ -666,19 +967,37 @@ impl Emitter {
         range: std::ops::RangeInclusive<usize>,
         weighted: bool,
     ) -> ir::Value {
-        let mut sum = Self::constant(b, 0.0);
-        for j in range {
+        let started = if *range.start() == 1 {
+            self.started(b, Sum::Products { x, y, weighted }, types::F64)
+        } else {
+            None
+        };
+        let (mut sum, from) = match started {
+            Some(sum) => (sum, k),
+            None => (Self::constant(b, 0.0), *range.start()),
+        };
+        for j in from.max(*range.start())..=*range.end() {
             let (u, v) = (self.at(b, x, j), self.at(b, y, k - j));
-            let u = if weighted {
-                let weight = Self::constant(b, j as f64);
-                b.ins().fmul(weight, u)
-            } else {
-                u
-            };
-            let term = b.ins().fmul(u, v);
+            let term = Self::product_term(b, (u, v), j, weighted);
             sum = b.ins().fadd(sum, term);
         }
         sum
+    }
+
+    /// A term of [`Self::sum_of_products`]: `u v`, or `(u j) v` if `weighted`.
+    fn product_term(
+        b: &mut FunctionBuilder,
+        (u, v): (ir::Value, ir::Value),
+        j: usize,
+        weighted: bool,
+    ) -> ir::Value {
+        let u = if weighted {
+            let weight = Self::constant(b, j as f64);
+            b.ins().fmul(u, weight)
+        } else {
+            u
+        };
+        b.ins().fmul(u, v)
     }
 
     /// The kernels' `weighted_convolution_pair` of pair `p` (a sine–cosine or sinh–cosh op
@@ -696,7 +1015,7 @@ impl Emitter {
     ) -> (ir::Value, ir::Value) {
         let xk = self.at(b, x, k);
         let kc = Self::constant(b, k as f64);
-        let weighted = b.ins().fmul(kc, xk);
+        let weighted = b.ins().fmul(xk, kc);
         let newest = b.ins().splat(types::F64X2, weighted);
         b.ins().store(
             MemFlagsData::trusted(),
@@ -704,9 +1023,14 @@ impl Emitter {
             self.scratch,
             PairScratch::weighted(p, k),
         );
-        let zero = Self::constant(b, 0.0);
-        let mut sum = b.ins().splat(types::F64X2, zero);
-        for j in 1..=k {
+        let (mut sum, from) = match self.started(b, Sum::Pair(p), types::F64X2) {
+            Some(sum) => (sum, k),
+            None => {
+                let zero = Self::constant(b, 0.0);
+                (b.ins().splat(types::F64X2, zero), 1)
+            }
+        };
+        for j in from..=k {
             let w = if j == k {
                 newest
             } else {
@@ -828,28 +1152,25 @@ impl Emitter {
                 let (ak, o0) = (self.at(b, a, k), self.at(b, out, 0));
                 let d = b.ins().fsub(ak, sum);
                 let two = Self::constant(b, 2.0);
-                let twice = b.ins().fmul(two, o0);
+                let twice = b.ins().fmul(o0, two);
                 let v = b.ins().fdiv(d, twice);
                 self.put(b, out, k, v);
             }
             SeriesOp::PowConstant { out, a, exponent } => {
                 let alpha = self.at(b, exponent, 0);
                 let kc = Self::constant(b, kf);
-                let one = Self::constant(b, 1.0);
-                let mut sum = Self::constant(b, 0.0);
-                for j in (0..k).rev() {
-                    let ka = b.ins().fmul(kc, alpha);
-                    let jc = Self::constant(b, j as f64);
-                    let a1 = b.ins().fadd(alpha, one);
-                    let ja = b.ins().fmul(jc, a1);
-                    let weight = b.ins().fsub(ka, ja);
+                let power = Sum::Power { out, a, exponent };
+                let (mut sum, from) = match self.started(b, power, types::F64) {
+                    Some(sum) => (sum, 0),
+                    None => (Self::constant(b, 0.0), k - 1),
+                };
+                for j in (0..=from).rev() {
                     let (xv, ov) = (self.at(b, a, k - j), self.at(b, out, j));
-                    let t = b.ins().fmul(weight, xv);
-                    let term = b.ins().fmul(t, ov);
+                    let term = Self::power_term(b, (alpha, k, j), xv, ov);
                     sum = b.ins().fadd(sum, term);
                 }
                 let x0 = self.at(b, a, 0);
-                let d = b.ins().fmul(kc, x0);
+                let d = b.ins().fmul(x0, kc);
                 let v = b.ins().fdiv(sum, d);
                 self.put(b, out, k, v);
             }
@@ -866,9 +1187,9 @@ impl Emitter {
                 };
                 let kc = Self::constant(b, kf);
                 let (xk, x0) = (self.at(b, a, k), self.at(b, a, 0));
-                let kx = b.ins().fmul(kc, xk);
+                let kx = b.ins().fmul(xk, kc);
                 let n = b.ins().fsub(kx, sum);
-                let d = b.ins().fmul(kc, x0);
+                let d = b.ins().fmul(x0, kc);
                 let v = b.ins().fdiv(n, d);
                 self.put(b, out, k, v);
             }
@@ -904,7 +1225,7 @@ impl Emitter {
                 let minus = b.ins().fneg(a2);
                 let n = b.ins().fsub(minus, sum);
                 let two = Self::constant(b, 2.0);
-                let twice = b.ins().fmul(two, r0);
+                let twice = b.ins().fmul(r0, two);
                 let rk = b.ins().fdiv(n, twice);
                 let sign = if acos { -1.0 } else { 1.0 };
                 let sum = if k > 1 {
@@ -914,10 +1235,10 @@ impl Emitter {
                 };
                 let sk = Self::constant(b, sign * kf);
                 let xk = self.at(b, a, k);
-                let sx = b.ins().fmul(sk, xk);
+                let sx = b.ins().fmul(xk, sk);
                 let n = b.ins().fsub(sx, sum);
                 let kc = Self::constant(b, kf);
-                let d = b.ins().fmul(kc, r0);
+                let d = b.ins().fmul(r0, kc);
                 let v = b.ins().fdiv(n, d);
                 self.put(b, root, k, rk);
                 self.put(b, out, k, v);
@@ -932,12 +1253,12 @@ impl Emitter {
                 };
                 let kc = Self::constant(b, kf);
                 let xk = self.at(b, a, k);
-                let kx = b.ins().fmul(kc, xk);
+                let kx = b.ins().fmul(xk, kc);
                 let n = b.ins().fsub(kx, sum);
                 let one = Self::constant(b, 1.0);
                 let sq0 = self.at(b, square, 0);
                 let s = b.ins().fadd(one, sq0);
-                let d = b.ins().fmul(kc, s);
+                let d = b.ins().fmul(s, kc);
                 let v = b.ins().fdiv(n, d);
                 self.put(b, out, k, v);
             }
@@ -957,7 +1278,7 @@ impl Emitter {
                 let n = b.ins().fsub(cross, sum);
                 let kc = Self::constant(b, kf);
                 let n0 = self.at(b, norm, 0);
-                let d = b.ins().fmul(kc, n0);
+                let d = b.ins().fmul(n0, kc);
                 let v = b.ins().fdiv(n, d);
                 self.put(b, out, k, v);
             }
@@ -981,7 +1302,7 @@ impl Emitter {
         let w = self.sum_of_products(b, (a, square, k), 1..=k, true);
         let scaled = Self::over_k(b, w, k);
         let s = Self::constant(b, sign);
-        let signed = b.ins().fmul(s, scaled);
+        let signed = b.ins().fmul(scaled, s);
         let xk = self.at(b, a, k);
         let v = b.ins().fadd(xk, signed);
         self.put(b, out, k, v);

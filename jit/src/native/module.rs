@@ -6,7 +6,7 @@ use std::sync::Mutex;
 
 use cranelift_codegen::ir::{AbiParam, Signature, types};
 use cranelift_codegen::settings::{self, Configurable};
-use cranelift_jit::{JITBuilder, JITModule};
+use cranelift_jit::{ArenaMemoryProvider, JITBuilder, JITModule};
 use cranelift_module::{FuncId, Linkage, Module, default_libcall_names};
 
 use eomgen_symbolic::expr::Func;
@@ -100,12 +100,29 @@ pub(crate) struct Imports {
     pub(crate) fill_zero: FuncId,
 }
 
+/// Address space reserved for a module's code beyond [`CODE_BYTES_PER_INSTRUCTION`] per
+/// instruction of its tapes: 64 MiB.
+const CODE_RESERVE: usize = 64 << 20;
+
+/// Address space reserved for a module's code per instruction of its tapes, far more than
+/// Cranelift emits for one (a few instructions of 4–9 bytes, with its spills).
+pub(crate) const CODE_BYTES_PER_INSTRUCTION: usize = 1024;
+
 /// A JIT module for the host, optimising for speed, that resolves the helpers of
-/// [`crate::math`] by their symbol names.
+/// [`crate::math`] by their symbol names, for tapes of `instructions` instructions in all.
+///
+/// Its functions are laid out one after the other in one region of address space reserved up
+/// front ([`CODE_RESERVE`] plus [`CODE_BYTES_PER_INSTRUCTION`] per instruction; only what the
+/// code uses is ever committed). Cranelift's default gives each function that does not fit
+/// the rest of the last one pages of its own: the double pendulum's Taylor orders, one
+/// function per order, then each started at a page boundary, where the first-level
+/// instruction cache maps the same sets, and ran 3–5 % slower than one after the other
+/// (docs/performance.md).
 ///
 /// # Errors
-/// [`CompileError::UnsupportedHost`] when Cranelift has no code generator for the host.
-pub(crate) fn new_module() -> Result<JITModule, CompileError> {
+/// [`CompileError::UnsupportedHost`] when Cranelift has no code generator for the host or the
+/// address space cannot be reserved.
+pub(crate) fn new_module(instructions: usize) -> Result<JITModule, CompileError> {
     let mut flags = settings::builder();
     let set = |flags: &mut settings::Builder, name: &str, value: &str| {
         flags
@@ -136,6 +153,14 @@ pub(crate) fn new_module() -> Result<JITModule, CompileError> {
             reason: e.to_string(),
         })?;
     let mut builder = JITBuilder::with_isa(isa, default_libcall_names());
+    let reserve = instructions
+        .saturating_mul(CODE_BYTES_PER_INSTRUCTION)
+        .saturating_add(CODE_RESERVE);
+    let memory =
+        ArenaMemoryProvider::new_with_size(reserve).map_err(|e| CompileError::UnsupportedHost {
+            reason: format!("reserving {reserve} bytes for the code: {e}"),
+        })?;
+    builder.memory_provider(Box::new(memory));
     for (name, f) in HELPERS {
         builder.symbol(name, math::unary(f) as *const u8);
     }
