@@ -17,7 +17,9 @@ use eomgen_symbolic::model::{Diagnostic, ReadError, read_model_file};
 use crate::compiled::{Compiled, Extent, FusedRhs, HotRoutine, SCRATCH, call, call_native};
 use crate::first_order::first_order_tape;
 use crate::native::CompileError;
-use crate::taylor::{FACTOR_DENSE, FACTOR_DIAGONAL, FACTOR_SMALL, NativeOrders, PairLanes};
+use crate::taylor::{
+    FACTOR_DENSE, FACTOR_DIAGONAL, FACTOR_SMALL, NativeOrders, OrderFrame, PairLanes,
+};
 use crate::{Backend, Inputs, interpret};
 
 /// Why a model file could not be made into a run-time model.
@@ -820,26 +822,24 @@ impl TaylorFunctions for Recurrences {
                 scratch.resize(orders.scratch_units, PairLanes::default());
             }
             let scratch = scratch.as_mut_ptr();
+            let (series, out) = (context.series, context.out);
+            let frame = OrderFrame {
+                context: (&raw mut context).cast::<u8>(),
+                solve: solve_order,
+                lower,
+                inverse_pivots,
+                factor: mode,
+            };
             for function in &orders.orders[..computed] {
                 // SAFETY: `series` holds every slot at the stride of 25 with the orders below
                 // `k` computed (by the calls before this one), and `out` every order the code
-                // writes (checked above); `lower` and `inverse_pivots`, when not null, hold
-                // `n × n` and `n` values that nothing writes during the call; `solve_order` is
-                // called with the context built for it; `scratch` holds the units the orders
-                // use, with the orders below `k` written by the calls before; `series`, `out`
-                // and `scratch` are not used otherwise until the call returns.
-                let status = unsafe {
-                    function(
-                        context.series,
-                        (&raw mut context).cast::<u8>(),
-                        solve_order,
-                        context.out,
-                        lower,
-                        inverse_pivots,
-                        mode,
-                        scratch,
-                    )
-                };
+                // writes (checked above); `frame`'s `lower` and `inverse_pivots`, when not
+                // null, hold `n × n` and `n` values that nothing writes during the call, and
+                // `solve_order` is called with the context built for it; `scratch` holds the
+                // units the orders use, with the orders below `k` written by the calls
+                // before; `series`, `out`, `scratch` and `frame` are not used otherwise until
+                // the call returns.
+                let status = unsafe { function(series, scratch, out, &raw const frame) };
                 if status != 0 {
                     return false;
                 }

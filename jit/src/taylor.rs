@@ -6,11 +6,11 @@
 //! C calling convention):
 //!
 //! ```text
-//! fn(series: *mut f64, context: *mut u8,
-//!    solve: extern "C" fn(context: *mut u8, k: usize) -> u8,
-//!    out: *mut f64, lower: *const f64, inverse_pivots: *const f64,
-//!    factor: i64, scratch: *mut PairLanes) -> u8
+//! fn(series: *mut f64, scratch: *mut PairLanes, out: *mut f64, frame: *const OrderFrame) -> u8
 //! ```
+//!
+//! with the step's solve in [`OrderFrame`] (`context`, `solve`, `lower`, `inverse_pivots`,
+//! `factor`): four arguments, all in registers.
 //!
 //! Order `k`'s function computes order `k` of every op of the program (none at `k = 0`), then
 //! order `k` of `M a = F` (the accelerations' order `k` into the series, the state's order
@@ -87,21 +87,39 @@ use crate::native::{
 ///
 /// # Safety
 /// `series` holds at least `(program.slots + n) · UNROLLED_CAPACITY` values with the orders
-/// below `k` computed; `out` at least `(k + 2) · 2n`; with `factor` [`FACTOR_DENSE`] or
-/// [`FACTOR_SMALL`], `lower` holds the `n · n` values of `L` and `inverse_pivots` the `n` of
-/// `D⁻¹`, with [`FACTOR_DIAGONAL`] `inverse_pivots` the `n` of `D⁻¹`; `solve` may be called
-/// with `context` for order `k`; `scratch` holds [`NativeOrders::scratch_units`] units
-/// (16-byte aligned) with the orders below `k` written by the orders' functions.
-pub(crate) type OrderFn = unsafe extern "C" fn(
-    *mut f64,
-    *mut u8,
-    extern "C" fn(*mut u8, usize) -> u8,
-    *mut f64,
-    *const f64,
-    *const f64,
-    i64,
-    *mut PairLanes,
-) -> u8;
+/// below `k` computed; `out` at least `(k + 2) · 2n`; `scratch` holds
+/// [`NativeOrders::scratch_units`] units (16-byte aligned) with the orders below `k` written
+/// by the orders' functions; `frame` is valid as [`OrderFrame`] says, and nothing writes it
+/// during the call.
+pub(crate) type OrderFn =
+    unsafe extern "C" fn(*mut f64, *mut PairLanes, *mut f64, *const OrderFrame) -> u8;
+
+/// How an order solves `M a = F` in a step (the orders' fourth argument, [`OrderFn`]).
+#[derive(Debug)]
+#[repr(C)]
+pub(crate) struct OrderFrame {
+    /// What `solve` is called with.
+    pub(crate) context: *mut u8,
+    /// Order `k`'s solve when the code does not solve in line: 0, or a failure's status.
+    pub(crate) solve: extern "C" fn(*mut u8, usize) -> u8,
+    /// With `factor` [`FACTOR_DENSE`] or [`FACTOR_SMALL`], the `n · n` values of `L`
+    /// (row-major), else unused.
+    pub(crate) lower: *const f64,
+    /// With `factor` [`FACTOR_DENSE`], [`FACTOR_SMALL`] or [`FACTOR_DIAGONAL`], the `n`
+    /// values of `D⁻¹`, else unused.
+    pub(crate) inverse_pivots: *const f64,
+    /// Which solve ([`Factor`]'s codes; any other value: call `solve`).
+    pub(crate) factor: i64,
+}
+
+impl OrderFrame {
+    /// The byte offsets of the fields, as the code reads them.
+    const CONTEXT: i32 = 0;
+    const SOLVE: i32 = 8;
+    const LOWER: i32 = 16;
+    const INVERSE_PIVOTS: i32 = 24;
+    const FACTOR: i32 = 32;
+}
 
 /// Two `f64`s aligned for one 16-byte load: the unit of [`PairScratch`].
 #[derive(Debug, Clone, Copy, Default)]
@@ -205,7 +223,7 @@ pub(crate) fn compile_orders(
     solve_signature.params.push(AbiParam::new(pointer));
     solve_signature.returns.push(AbiParam::new(types::I8));
     let mut signature = Signature::new(call_conv);
-    for _ in 0..8 {
+    for _ in 0..4 {
         signature.params.push(AbiParam::new(pointer));
     }
     signature.returns.push(AbiParam::new(types::I8));
@@ -291,31 +309,36 @@ pub(crate) fn compile_orders(
     }))
 }
 
-/// The arguments of the orders' code (see the module documentation).
+/// The arguments of an order's function ([`OrderFn`]), and the factor's code read from its
+/// frame.
 #[derive(Clone, Copy)]
 struct OrderArgs {
     series: ir::Value,
-    context: ir::Value,
-    solve: ir::Value,
-    out: ir::Value,
-    lower: ir::Value,
-    inverse_pivots: ir::Value,
-    mode: ir::Value,
     scratch: ir::Value,
+    out: ir::Value,
+    frame: ir::Value,
+    mode: ir::Value,
 }
 
 impl OrderArgs {
-    fn new(params: &[ir::Value]) -> Self {
+    fn new(b: &mut FunctionBuilder, params: &[ir::Value]) -> Self {
+        let frame = params[3];
+        let mode = b
+            .ins()
+            .load(types::I64, settled(), frame, OrderFrame::FACTOR);
         OrderArgs {
             series: params[0],
-            context: params[1],
-            solve: params[2],
-            out: params[3],
-            lower: params[4],
-            inverse_pivots: params[5],
-            mode: params[6],
-            scratch: params[7],
+            scratch: params[1],
+            out: params[2],
+            frame,
+            mode,
         }
+    }
+
+    /// The pointer at byte `offset` of the frame.
+    fn pointer(&self, b: &mut FunctionBuilder, offset: i32) -> ir::Value {
+        let pointer = b.func.dfg.value_type(self.frame);
+        b.ins().load(pointer, settled(), self.frame, offset)
     }
 }
 
@@ -330,7 +353,7 @@ fn build_order(
 ) {
     let mut b = FunctionBuilder::new(func, builder_context);
     let params = enter(&mut b);
-    let args = OrderArgs::new(&params);
+    let args = OrderArgs::new(&mut b, &params);
     let solve_signature = b.import_signature(solve_signature);
     let done = b.create_block();
     let status = b.append_block_param(done, types::I8);
@@ -400,13 +423,15 @@ fn emit_order(
         b.seal_block(inline);
         // What the branches write differs (and the values of one do not reach the others).
         let before = emitter.known.clone();
+        let lower = args.pointer(b, OrderFrame::LOWER);
+        let inverse_pivots = args.pointer(b, OrderFrame::INVERSE_PIVOTS);
         emitter.dense_solve(
             b,
             program,
             (n, k),
             args.out,
             factor,
-            (args.lower, args.inverse_pivots),
+            (lower, inverse_pivots),
         );
         emitter.known = before;
         b.ins().jump(after, &[]);
@@ -415,11 +440,15 @@ fn emit_order(
     let call = test;
     b.switch_to_block(call);
     b.seal_block(call);
-    let pointer = b.func.dfg.value_type(args.context);
+    let pointer = b.func.dfg.value_type(args.frame);
+    let (context, solve) = (
+        args.pointer(b, OrderFrame::CONTEXT),
+        args.pointer(b, OrderFrame::SOLVE),
+    );
     let kv = b.ins().iconst(pointer, k as i64);
     let called = b
         .ins()
-        .call_indirect(solve_signature, args.solve, &[args.context, kv]);
+        .call_indirect(solve_signature, solve, &[context, kv]);
     let status = b.inst_results(called)[0];
     b.ins()
         .brif(status, done, &[ir::BlockArg::Value(status)], after, &[]);
