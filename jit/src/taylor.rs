@@ -38,9 +38,9 @@
 //! chains of additions interleaved (`Emitter::prefixes`), and each op continues its sum from
 //! there: the same additions in the same order, so the same bits, but the long chains of
 //! dependent additions overlap instead of each waiting for the ops before it. With the
-//! orders laid out one after the other (`new_module`), this took the double pendulum and
-//! the heavy top from 1.14–1.21× the time of `model!`'s orders to 1.07–1.14×
-//! (docs/performance.md).
+//! orders laid out one after the other (`new_module`) and four arguments, whole runs of the
+//! double pendulum and the heavy top went from 1.11–1.22× the time of `model!`'s to
+//! 1.07–1.13× (docs/performance.md).
 //!
 //! Why one function per order: in one function for all orders every coefficient stayed in
 //! a register (a Cranelift value) from the order that computed it to the last that read it,
