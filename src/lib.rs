@@ -45,6 +45,8 @@ pub use nalgebra;
 mod source;
 
 pub mod animation;
+#[cfg(feature = "batch")]
+pub mod batch;
 // The rows of a model file's `checks:` need the run-time loader for the file's model.
 #[cfg(feature = "jit")]
 pub mod checks;

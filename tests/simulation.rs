@@ -173,3 +173,176 @@ fn issue_28_quadratic_drag_from_rest_runs_on_the_implicit_methods() {
         }
     }
 }
+
+/// `eomgen::batch::simulate_batch` over six initial states of the double pendulum, on one
+/// thread, two, and rayon's pool: every run's samples and energies are those of `simulate`
+/// called on its own, to the bit (each run has an instance of its own), and the work of
+/// each run is reported.
+#[test]
+fn a_batch_is_the_serial_loop_to_the_bit() {
+    use eomgen::batch::{BatchOptions, BatchRuns, simulate_batch};
+    let source = eomgen::ModelSource::open("double_pendulum").unwrap();
+    let make = || source.instantiate_send();
+    let y0 = make().initial_state();
+    let states: Vec<Vec<f64>> = (0..6)
+        .map(|i| {
+            let mut y = y0.clone();
+            y[0] += 0.05 * i as f64;
+            y
+        })
+        .collect();
+    let simulation = SimulationOptions {
+        t_end: 2.0,
+        rtol: 1e-10,
+        atol: 1e-10,
+        output: OutputTimes::At(vec![0.5, 1.0, 2.0]),
+        ..SimulationOptions::default()
+    };
+    let runs = BatchRuns {
+        initial_states: Some(states.clone()),
+        parameters: None,
+    };
+    for threads in [Some(1), Some(2), None] {
+        let options = BatchOptions {
+            simulation: simulation.clone(),
+            threads,
+            keep_failures: false,
+        };
+        let report = simulate_batch(&make, &runs, &options, &mut || true).unwrap();
+        assert_eq!(report.state_dimension, 4);
+        assert!(report.ok.iter().all(|&ok| ok) && report.failures.is_empty());
+        assert_eq!(report.t_final, vec![2.0; 6]);
+        for (i, y0) in states.iter().enumerate() {
+            let one = SimulationOptions {
+                initial_state: Some(y0.clone()),
+                ..simulation.clone()
+            };
+            let alone = simulate(make().as_mut(), &one).unwrap();
+            assert_eq!(
+                report.y[i * 12..(i + 1) * 12],
+                alone.solution.y[..],
+                "run {i}"
+            );
+            assert_eq!(report.energy[i * 3..(i + 1) * 3], alone.energy.energy[..]);
+            assert_eq!(report.steps[i], alone.solution.stats.steps as u64);
+        }
+    }
+}
+
+/// A batch over parameters: a run whose integration fails (RK4 with a step of 0.5 s on the
+/// triple pendulum) is a failure with NaN samples past its end; a run that cannot start (a
+/// state off the Cartesian pendulum's circle) is kept as a failure at `t` NaN or stops the
+/// batch with the run's index; an unknown parameter, options no run could use, and a caller
+/// that stops the batch are typed errors.
+#[test]
+fn a_batch_keeps_or_reports_failures_and_refuses_what_no_run_could_use() {
+    use eomgen::batch::{BatchError, BatchOptions, BatchRuns, simulate_batch};
+    let source = eomgen::ModelSource::open("triple_pendulum").unwrap();
+    let make = || source.instantiate_send();
+    let runs = BatchRuns {
+        initial_states: None,
+        parameters: Some(vec![
+            vec![("g".to_string(), 9.81)],
+            vec![("g".to_string(), 1.62)],
+        ]),
+    };
+    let options = BatchOptions {
+        simulation: SimulationOptions {
+            method: Method::Rk4,
+            dt: Some(0.5),
+            t_end: 10.0,
+            output: OutputTimes::At(vec![1.0, 10.0]),
+            ..SimulationOptions::default()
+        },
+        threads: Some(2),
+        keep_failures: true,
+    };
+    let report = simulate_batch(&make, &runs, &options, &mut || true).unwrap();
+    assert_eq!(report.ok, vec![false, false]);
+    assert_eq!(report.failures.len(), 2);
+    assert!(
+        report
+            .failures
+            .iter()
+            .all(|f| f.t.is_finite() && f.t < 10.0)
+    );
+    assert!(report.y[report.y.len() - 6..].iter().all(|v| v.is_nan()));
+    let cartesian = eomgen::ModelSource::open("simple_pendulum_cartesian").unwrap();
+    let make_cartesian = || cartesian.instantiate_send();
+    let y0 = make_cartesian().initial_state();
+    let off_the_circle = BatchRuns {
+        initial_states: Some(vec![y0.clone(), vec![5.0, 5.0, 0.0, 0.0], y0]),
+        parameters: None,
+    };
+    let mut cartesian_options = BatchOptions {
+        simulation: SimulationOptions {
+            t_end: 1.0,
+            output: OutputTimes::At(vec![1.0]),
+            ..SimulationOptions::default()
+        },
+        threads: Some(2),
+        keep_failures: true,
+    };
+    let report = simulate_batch(
+        &make_cartesian,
+        &off_the_circle,
+        &cartesian_options,
+        &mut || true,
+    )
+    .unwrap();
+    assert_eq!(report.ok, vec![true, false, true]);
+    assert_eq!(report.failures.len(), 1);
+    assert!(report.failures[0].run == 1 && report.failures[0].t.is_nan());
+    assert!(report.y[4..8].iter().all(|v| v.is_nan()));
+    cartesian_options.keep_failures = false;
+    let error = simulate_batch(
+        &make_cartesian,
+        &off_the_circle,
+        &cartesian_options,
+        &mut || true,
+    )
+    .unwrap_err();
+    assert!(matches!(error, BatchError::Run { run: 1, .. }), "{error}");
+    assert!(error.to_string().starts_with("run 1: "), "{error}");
+    let unknown = BatchRuns {
+        initial_states: None,
+        parameters: Some(vec![vec![("nope".to_string(), 1.0)]]),
+    };
+    let error = simulate_batch(&make, &unknown, &options, &mut || true).unwrap_err();
+    assert!(
+        matches!(error, BatchError::Parameter { run: 0, .. }),
+        "{error}"
+    );
+    assert!(matches!(
+        simulate_batch(&make, &runs, &options, &mut || false),
+        Err(BatchError::Stopped)
+    ));
+    let refused = |runs: &BatchRuns, options: &BatchOptions, says: &str| match simulate_batch(
+        &make,
+        runs,
+        options,
+        &mut || true,
+    ) {
+        Err(BatchError::Refused(m)) => assert!(m.contains(says), "{m}"),
+        other => panic!("refused ({says}) expected, got {:?}", other.map(|r| r.ok)),
+    };
+    let mut bad = options.clone();
+    bad.threads = Some(0);
+    refused(&runs, &bad, "threads must be 1 to 256");
+    bad = options.clone();
+    bad.simulation.output = OutputTimes::Steps;
+    refused(&runs, &bad, "same output times");
+    bad.simulation.output = OutputTimes::At(Vec::new());
+    refused(&runs, &bad, "at least one output time");
+    let wrong_size = BatchRuns {
+        initial_states: Some(vec![vec![0.0; 5]]),
+        parameters: None,
+    };
+    refused(&wrong_size, &options, "must have 6 columns");
+    refused(&BatchRuns::default(), &options, "give initial_states");
+    let unequal = BatchRuns {
+        initial_states: Some(vec![make().initial_state()]),
+        parameters: runs.parameters.clone(),
+    };
+    refused(&unequal, &options, "give one per run");
+}

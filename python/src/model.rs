@@ -318,7 +318,13 @@ pub(crate) fn run_simulation(
     } else {
         Some(&mut added)
     };
-    simulate_with_events(model, &run.options, added).map_err(|e| match e {
+    simulate_with_events(model, &run.options, added).map_err(simulation_error)
+}
+
+/// A simulation's error as the Python layer raises it: an initial state the constraints
+/// cannot accept as `AnalysisError` with what to do, anything else as `ValueError`.
+pub(crate) fn simulation_error(e: SimulationError) -> RunError {
+    match e {
         e @ SimulationError::InconsistentInitialState { has_guesses, .. } => {
             let what_to_do = if has_guesses {
                 "start Newton from other guesses (initial=…)"
@@ -328,7 +334,7 @@ pub(crate) fn run_simulation(
             RunError::Analysis(format!("{e}; {what_to_do}"))
         }
         e => RunError::Value(e.to_string()),
-    })
+    }
 }
 
 /// A simulation's results for the Python layer: `{"summary", "t", "y", "energy",
