@@ -49,6 +49,7 @@ use crate::expr::{Constant, ExprArena, ExprId, Func, Node, SymbolId, SymbolKind}
 
 mod singular;
 mod solve;
+mod spatial;
 #[cfg(test)]
 mod tests;
 mod write;
@@ -404,15 +405,15 @@ pub fn reduce(
 
 /// The YAML text of `file` as [`reduce`] writes its results, with nothing eliminated: the
 /// writer of reduced files applied to any file it can write, so that a reduced file can be
-/// loaded and written again (a round trip gives the same equations). Comments are not kept
-/// (the parameters' and coordinates' units are); what is left out is listed in the second
-/// value (`checks: equations_of_motion`, `floquet:`, `balances:`).
+/// loaded and written again (a round trip gives the same equations). Every section is
+/// written, 3-D frames, bodies and rolling contacts included; comments are not kept (the
+/// parameters' and coordinates' units are); what is left out is listed in the second value
+/// (`checks: equations_of_motion`, `floquet:`, `balances:`).
 ///
 /// # Errors
-/// [`ReduceError::Unsupported`] as [`reduce`]; [`ReduceError::UnknownName`];
-/// [`ReduceError::Invalid`] if the text written does not load.
+/// [`ReduceError::UnknownName`]; [`ReduceError::Invalid`] if the text written does not
+/// load.
 pub fn write_model(file: &ModelFile) -> Result<(String, Vec<String>), ReduceError> {
-    unsupported(file)?;
     let kept: Vec<String> = file
         .coordinates
         .iter()
@@ -432,7 +433,8 @@ pub fn write_model(file: &ModelFile) -> Result<(String, Vec<String>), ReduceErro
     Ok((text, notes))
 }
 
-/// The parts of the format [`reduce`] does not rewrite.
+/// The parts of the format [`reduce`] does not eliminate through: the writer writes them as
+/// they are ([`write_model`]), but eliminating coordinates there is not checked.
 fn unsupported(file: &ModelFile) -> Result<(), ReduceError> {
     let feature = |f: &str| {
         Err(ReduceError::Unsupported {
@@ -704,4 +706,38 @@ impl<'f> Reducer<'f> {
         let y = self.arena.expand_if_cheaper(y);
         Ok(self.print(y))
     }
+}
+
+// How the writer spells a value in YAML (`write` and `spatial`).
+
+/// A plain scalar where YAML reads it as the text, else in double quotes.
+pub(super) fn scalar(s: &str) -> String {
+    let special = s.is_empty()
+        || s.contains(": ")
+        || s.contains(" #")
+        || s.starts_with([
+            '[', ']', '{', '}', ',', '#', '&', '*', '!', '|', '>', '\'', '"', '%', '@', '`',
+        ])
+        || s.starts_with("- ")
+        || s.ends_with(':');
+    if special { quoted(s) } else { s.to_string() }
+}
+
+/// A scalar inside a flow collection (`[…]`, `{…}`): quoted if it has a flow indicator.
+pub(super) fn flow(s: &str) -> String {
+    if s.contains([',', '[', ']', '{', '}']) {
+        quoted(s)
+    } else {
+        scalar(s)
+    }
+}
+
+fn quoted(s: &str) -> String {
+    format!("\"{}\"", s.replace('\\', "\\\\").replace('"', "\\\""))
+}
+
+/// `[a, b, …]` of expressions.
+pub(super) fn list(parts: &[String]) -> String {
+    let parts: Vec<String> = parts.iter().map(|p| flow(p)).collect();
+    format!("[{}]", parts.join(", "))
 }

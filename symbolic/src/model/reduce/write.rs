@@ -189,16 +189,12 @@ impl Reducer<'_> {
     fn write_mechanism(&mut self, w: &mut String) -> Result<(), ReduceError> {
         use std::fmt::Write as _;
         let file = self.file;
+        self.write_frames(w)?;
         if !file.points.is_empty() {
             let _ = writeln!(w, "points:");
             for p in &file.points {
-                let place = format!("point `{}`", p.name.value);
-                let parts = p
-                    .position
-                    .iter()
-                    .map(|e| self.rewrite(e, &place))
-                    .collect::<Result<Vec<_>, _>>()?;
-                let _ = writeln!(w, "  {}: {}", p.name.value, list(&parts));
+                let text = self.point_text(p)?;
+                let _ = writeln!(w, "  {}: {text}", p.name.value);
             }
         }
         if !file.bodies.is_empty() {
@@ -235,7 +231,16 @@ impl Reducer<'_> {
                             flow(&a)
                         );
                     }
-                    BodyKind::Spatial { .. } => {}
+                    BodyKind::Spatial {
+                        mass,
+                        com,
+                        frame,
+                        inertia,
+                    } => {
+                        let text = self
+                            .spatial_body_text(&place, (mass, &com.value, &frame.value, inertia))?;
+                        let _ = writeln!(w, "  {}: {text}", b.name.value);
+                    }
                 }
             }
         }
@@ -300,10 +305,11 @@ impl Reducer<'_> {
                     .collect::<Result<Vec<_>, _>>()?;
                 let _ = writeln!(
                     w,
-                    "  {}: {{ at: {}, vector: {} }}",
+                    "  {}: {{ at: {}, vector: {}{} }}",
                     f.name.value,
                     f.at.value,
-                    list(&parts)
+                    list(&parts),
+                    spatial::in_frame(f.frame.as_ref())
                 );
             }
         }
@@ -311,15 +317,31 @@ impl Reducer<'_> {
             let _ = writeln!(w, "torques:");
             for t in &file.torques {
                 let place = format!("torque `{}`", t.name.value);
-                if let TorqueValue::Planar(e) = &t.value {
-                    let v = self.rewrite(e, &place)?;
-                    let _ = writeln!(
-                        w,
-                        "  {}: {{ body: {}, value: {} }}",
-                        t.name.value,
-                        t.body.value,
-                        flow(&v)
-                    );
+                match &t.value {
+                    TorqueValue::Planar(e) => {
+                        let v = self.rewrite(e, &place)?;
+                        let _ = writeln!(
+                            w,
+                            "  {}: {{ body: {}, value: {} }}",
+                            t.name.value,
+                            t.body.value,
+                            flow(&v)
+                        );
+                    }
+                    TorqueValue::Spatial { vector, frame, .. } => {
+                        let parts = vector
+                            .iter()
+                            .map(|e| self.rewrite(e, &place))
+                            .collect::<Result<Vec<_>, _>>()?;
+                        let _ = writeln!(
+                            w,
+                            "  {}: {{ body: {}, vector: {}{} }}",
+                            t.name.value,
+                            t.body.value,
+                            list(&parts),
+                            spatial::in_frame(frame.as_ref())
+                        );
+                    }
                 }
             }
         }
@@ -383,11 +405,15 @@ impl Reducer<'_> {
                     .to_string(),
             );
         }
-        if preserve && !file.constraints.is_empty() {
+        if preserve && !(file.constraints.is_empty() && file.point_constraints.is_empty()) {
             let _ = writeln!(w, "constraints:");
             for (name, e) in &file.constraints {
                 let _ = writeln!(w, "  {}: {}", name.value, scalar(&e.to_string()));
             }
+            self.point_constraint_lines(w);
+        }
+        if preserve {
+            self.write_nonholonomic(w)?;
         }
         if !preserve {
             notes.push(format!(
@@ -455,7 +481,8 @@ impl Reducer<'_> {
             );
         }
         // Drawing.
-        if !file.draw.lines.is_empty() || !file.draw.trace.is_empty() {
+        let wheels = self.drawn_wheels()?;
+        if !file.draw.lines.is_empty() || !file.draw.trace.is_empty() || wheels.is_some() {
             let lines: Vec<String> = file
                 .draw
                 .lines
@@ -470,6 +497,7 @@ impl Reducer<'_> {
             if !trace.is_empty() {
                 parts.push(format!("trace: [{}]", trace.join(", ")));
             }
+            parts.extend(wheels);
             let _ = writeln!(w, "draw: {{ {} }}", parts.join(", "));
         }
         Ok(())
@@ -787,38 +815,6 @@ fn run_settings(run: &crate::model::checks::RunSettings, t_end: bool) -> String 
         s.push_str(&format!(", t_end: {t:e}"));
     }
     s
-}
-
-/// A plain scalar where YAML reads it as the text, else in double quotes.
-fn scalar(s: &str) -> String {
-    let special = s.is_empty()
-        || s.contains(": ")
-        || s.contains(" #")
-        || s.starts_with([
-            '[', ']', '{', '}', ',', '#', '&', '*', '!', '|', '>', '\'', '"', '%', '@', '`',
-        ])
-        || s.starts_with("- ")
-        || s.ends_with(':');
-    if special { quoted(s) } else { s.to_string() }
-}
-
-/// A scalar inside a flow collection (`[…]`, `{…}`): quoted if it has a flow indicator.
-fn flow(s: &str) -> String {
-    if s.contains([',', '[', ']', '{', '}']) {
-        quoted(s)
-    } else {
-        scalar(s)
-    }
-}
-
-fn quoted(s: &str) -> String {
-    format!("\"{}\"", s.replace('\\', "\\\\").replace('"', "\\\""))
-}
-
-/// `[a, b, …]` of expressions.
-fn list(parts: &[String]) -> String {
-    let parts: Vec<String> = parts.iter().map(|p| flow(p)).collect();
-    format!("[{}]", parts.join(", "))
 }
 
 /// What writing one file needs beside the reducer: its name, the coordinates kept, the
