@@ -606,6 +606,8 @@ impl Emitter<'_, '_> {
     }
 
     /// Writes instruction `k` of the tape (inputs are loaded at their uses instead).
+    // Long: one arm per tape instruction, each a few lines of Cranelift code; the match is the
+    // instruction set.
     fn instruction(&mut self, k: usize, instruction: Instruction) {
         let value = match instruction {
             // Loaded at its uses.

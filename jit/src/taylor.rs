@@ -193,7 +193,6 @@ pub(crate) fn compile_orders(
     plan: &TaylorPlan,
     parameters: usize,
 ) -> Result<Option<NativeOrders>, CompileError> {
-    const NAME: &str = "taylor_orders";
     const ORDER_ZERO: &str = "taylor_order_zero";
     let program = &plan.program;
     let highest = program.highest_unrolled_order().min(UNROLLED_CAPACITY - 1);
@@ -221,46 +220,14 @@ pub(crate) fn compile_orders(
     let imports = declare_imports(&mut module)?;
     let call_conv = module.isa().default_call_conv();
     let pointer = module.target_config().pointer_type();
-    let mut solve_signature = Signature::new(call_conv);
-    solve_signature.params.push(AbiParam::new(pointer));
-    solve_signature.params.push(AbiParam::new(pointer));
-    solve_signature.returns.push(AbiParam::new(types::I8));
-    let mut signature = Signature::new(call_conv);
-    for _ in 0..4 {
-        signature.params.push(AbiParam::new(pointer));
-    }
-    signature.returns.push(AbiParam::new(types::I8));
     let mut context = module.make_context();
     let mut builder_context = FunctionBuilderContext::new();
-    let mut ids = Vec::with_capacity(highest + 1);
-    for k in 0..=highest {
-        let name = format!("{NAME}_{k}");
-        let id = module
-            .declare_function(&name, Linkage::Local, &signature)
-            .map_err(|e| failure(&name, &e))?;
-        context.func.signature = signature.clone();
-        context.func.name = UserFuncName::user(0, k as u32 + 1);
-        build_order(
-            &mut context.func,
-            &mut builder_context,
-            program,
-            k,
-            solve_signature.clone(),
-            module.target_config(),
-        );
-        let disassemble = std::env::var_os("EOMGEN_JIT_DISASM").is_some();
-        context.set_disasm(disassemble);
-        module
-            .define_function(id, &mut context)
-            .map_err(|e| failure(&name, &e))?;
-        if let Some(vcode) = context.compiled_code().and_then(|c| c.vcode.as_ref())
-            && disassemble
-        {
-            eprintln!("== {name}\n{vcode}");
-        }
-        module.clear_context(&mut context);
-        ids.push(id);
-    }
+    let ids = define_orders(
+        &mut module,
+        (&mut context, &mut builder_context),
+        program,
+        highest,
+    )?;
     let pairs = program
         .ops
         .iter()
@@ -310,6 +277,62 @@ pub(crate) fn compile_orders(
         scratch_units: PairScratch::units(pairs),
         _memory: ModuleMemory::new(module),
     }))
+}
+
+/// Defines the functions of orders `0 …= highest` of `program` in `module` ([`OrderFn`],
+/// see the module documentation), printing each one's machine code with `EOMGEN_JIT_DISASM`
+/// set; returns their ids, order by order.
+///
+/// # Errors
+/// [`CompileError::Function`] naming the order Cranelift failed on.
+fn define_orders(
+    module: &mut JITModule,
+    (context, builder_context): (&mut cranelift_codegen::Context, &mut FunctionBuilderContext),
+    program: &TaylorProgram,
+    highest: usize,
+) -> Result<Vec<cranelift_module::FuncId>, CompileError> {
+    const NAME: &str = "taylor_orders";
+    let call_conv = module.isa().default_call_conv();
+    let pointer = module.target_config().pointer_type();
+    let mut solve_signature = Signature::new(call_conv);
+    solve_signature.params.push(AbiParam::new(pointer));
+    solve_signature.params.push(AbiParam::new(pointer));
+    solve_signature.returns.push(AbiParam::new(types::I8));
+    let mut signature = Signature::new(call_conv);
+    for _ in 0..4 {
+        signature.params.push(AbiParam::new(pointer));
+    }
+    signature.returns.push(AbiParam::new(types::I8));
+    let disassemble = std::env::var_os("EOMGEN_JIT_DISASM").is_some();
+    let mut ids = Vec::with_capacity(highest + 1);
+    for k in 0..=highest {
+        let name = format!("{NAME}_{k}");
+        let id = module
+            .declare_function(&name, Linkage::Local, &signature)
+            .map_err(|e| failure(&name, &e))?;
+        context.func.signature = signature.clone();
+        context.func.name = UserFuncName::user(0, k as u32 + 1);
+        build_order(
+            &mut context.func,
+            builder_context,
+            program,
+            k,
+            solve_signature.clone(),
+            module.target_config(),
+        );
+        context.set_disasm(disassemble);
+        module
+            .define_function(id, context)
+            .map_err(|e| failure(&name, &e))?;
+        if let Some(vcode) = context.compiled_code().and_then(|c| c.vcode.as_ref())
+            && disassemble
+        {
+            eprintln!("== {name}\n{vcode}");
+        }
+        module.clear_context(context);
+        ids.push(id);
+    }
+    Ok(ids)
 }
 
 /// The arguments of an order's function ([`OrderFn`]), and the factor's code read from its
@@ -463,6 +486,8 @@ fn emit_order(
 /// its slot at the stride [`UNROLLED_CAPACITY`] and kept as a Cranelift value for its uses
 /// (the inputs loaded from their slots at each use); a parameter index beyond `parameters`
 /// reads NaN, as the interpreter's.
+// Long: one arm per tape instruction of order 0, each calling the interpreter's helper for the same
+// bits; the match is the instruction set.
 fn build_order_zero(
     module: &mut JITModule,
     func: &mut ir::Function,

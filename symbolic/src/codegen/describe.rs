@@ -118,6 +118,8 @@ pub fn describe(model: &SymbolicModel, eom: &EquationsOfMotion, mathml: bool) ->
 /// # Errors
 /// A parameter default that is not finite, which has no literal (the loader refuses such
 /// values, so this is a bug).
+// Long: one `quote!` of the whole `ModelDescription` literal, field by field in its order; split,
+// the fields would be far from the struct they fill.
 pub fn description_tokens(
     description: &ModelDescription,
     krate: &TokenStream,

@@ -438,6 +438,8 @@ impl<'a> Builder<'a> {
     }
 
     /// The recurrence of the non-constant instruction `out`.
+    // Long: one arm per instruction, each the recurrence it becomes; the match is the table from
+    // instructions to series ops.
     fn op(&mut self, out: Slot, instruction: Instruction) -> Option<SeriesOp> {
         let c = |b: &Self, v: Slot| b.is_constant(v);
         Some(match instruction {

@@ -70,6 +70,7 @@ pub fn generate(name: &str, n: usize) -> Result<String, TemplateError> {
 /// lecture 25) and states its `checks:`: the natural frequencies about `hanging` in closed
 /// form for `n ≤ 3` (for equal bars: `√(3g/(2ℓ))`; HW19's pair; HW39's three), else the
 /// energy drift (`max: 1e-9`), since from `n = 4` the frequencies have no closed form.
+// Long: the text of the generated model file, section by section in the file's order.
 pub fn n_link_pendulum(n: usize) -> String {
     let mut w = String::new();
     let _ = writeln!(

@@ -450,6 +450,8 @@ impl<'a> Builder<'a> {
     }
 
     /// The node that starts with `event`, consuming its children.
+    // Long: one arm per YAML event (scalar, sequence, map, alias), each building its located node;
+    // the match is the event set.
     fn node(&mut self, event: Event<'a>, span: Span) -> YamlNode {
         let loc = location(&span.start);
         match event {

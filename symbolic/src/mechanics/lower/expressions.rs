@@ -17,6 +17,7 @@ impl Lowering<'_> {
     }
 
     /// [`Self::expr`] of a sub-expression.
+    // Long: one arm per kind of expression node of the file's syntax; the match is the syntax.
     pub(super) fn lower(&mut self, e: &Expr) -> ExprId {
         match &e.kind {
             ExprKind::Number { value, text } => {

@@ -255,7 +255,7 @@ impl Reducer<'_> {
         Ok(())
     }
 
-    /// `springs:`, `dampers:`, `forces:`, `torques:` and `interactions:`.
+    /// `springs:` and `dampers:`, then [`Self::write_forces_and_torques`].
     fn write_loads(&mut self, w: &mut String) -> Result<(), ReduceError> {
         use std::fmt::Write as _;
         let file = self.file;
@@ -294,6 +294,14 @@ impl Reducer<'_> {
                 );
             }
         }
+        self.write_forces_and_torques(w)
+    }
+
+    /// `forces:` and `torques:` (3-D ones and those written in frames included) and
+    /// `interactions:`.
+    fn write_forces_and_torques(&mut self, w: &mut String) -> Result<(), ReduceError> {
+        use std::fmt::Write as _;
+        let file = self.file;
         if !file.forces.is_empty() {
             let _ = writeln!(w, "forces:");
             for f in &file.forces {
