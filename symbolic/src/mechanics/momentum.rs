@@ -290,10 +290,6 @@ impl Formulation for MomentumBalance {
     /// # Panics
     /// Never; for a model where [`MomentumBalance::applies_to`] is false a written `kinetic:`
     /// is ignored, so callers check it first.
-    // One piece (about 170 lines): the steps — grouping bodies by partial velocity, the sums
-    // `Σ m a₀` per group, the terms of `M` and `F` per body and per load, and the assembly —
-    // share the kinematics cache, the group sums and the term lists, and run once in this
-    // order; split, each step would take and return all of them.
     fn derive(&self, model: &mut SymbolicModel) -> EquationsOfMotion {
         let n = model.num_dofs();
         let symbols: Vec<_> = (0..n).map(|i| model.coordinate_symbols(i)).collect();
@@ -372,109 +368,16 @@ impl Formulation for MomentumBalance {
                 }
             }
         }
-        for body in &bodies {
-            if let Some((inertia, angle)) = body.rotation {
-                let rates: Vec<ExprId> = symbols.iter().map(|s| arena.diff(angle, s[0])).collect();
-                let omega = arena.time_derivative(angle);
-                let alpha = velocity_product(arena, omega, &symbols, time);
-                for i in 0..n {
-                    if arena.is_zero(rates[i]) {
-                        continue;
-                    }
-                    for j in i..n {
-                        if !arena.is_zero(rates[j]) {
-                            mass_terms[i * n + j]
-                                .push(arena.product(&[inertia, rates[i], rates[j]]));
-                        }
-                    }
-                    let torque = arena.product(&[inertia, alpha, rates[i]]);
-                    forcing_terms[i].push(arena.neg(torque));
-                }
-            }
-        }
-        // 3-D bodies: Euler's equations `I_G α + ω × I_G ω` projected on the partial angular
-        // velocities `Wᵢ = ∂ω/∂q̇ᵢ`, all in the body frame's components (where `I_G` is
-        // constant and `α` is the time derivative of ω's components). With `α = Σ Wⱼ q̈ⱼ +
-        // α₀`: `Mᵢⱼ += Wᵢ·I Wⱼ`, `Fᵢ −= Wᵢ·(I α₀ + ω × I ω)`.
-        for body in &bodies {
-            let Some(spatial) = &body.spatial else {
-                continue;
-            };
-            let w = spatial.angular_velocity;
-            let partial: Vec<Option<Vector3>> = symbols
-                .iter()
-                .map(|s| {
-                    let p = w.map(|c| arena.diff(c, s[1]));
-                    (!p.iter().all(|c| arena.is_zero(*c))).then_some(p)
-                })
-                .collect();
-            let alpha = w.map(|c| velocity_product(arena, c, &symbols, time));
-            let i_alpha = tensor_times(arena, &spatial.inertia, &alpha);
-            let i_w = tensor_times(arena, &spatial.inertia, &w);
-            let gyroscopic = cross(arena, &w, &i_w);
-            let euler: Vec<ExprId> = i_alpha
-                .iter()
-                .zip(&gyroscopic)
-                .map(|(a, b)| arena.plus(*a, *b))
-                .collect();
-            for i in 0..n {
-                let Some(wi) = &partial[i] else { continue };
-                let i_wi = tensor_times(arena, &spatial.inertia, wi);
-                for j in i..n {
-                    if let Some(wj) = &partial[j] {
-                        mass_terms[i * n + j].push(dot_multiplied_out(arena, &i_wi, wj));
-                    }
-                }
-                let inertial = dot_multiplied_out(arena, &euler, wi);
-                forcing_terms[i].push(arena.neg(inertial));
-            }
-        }
-        // The file's written potential and generalized forces: `−∂V/∂qᵢ + Qᵢ`.
-        let (potential, written) = (model_potential, written_forces);
-        for (i, s) in symbols.iter().enumerate() {
-            let dv = arena.diff(potential, s[0]);
-            if !arena.is_zero(dv) {
-                forcing_terms[i].push(arena.neg(dv));
-            }
-            if !arena.is_zero(written[i]) {
-                forcing_terms[i].push(written[i]);
-            }
-        }
-        for load in &loads {
-            // Each load as forces at points (and torques), projected on partial velocities.
-            let LoadForces { forces, torque } =
-                if let LoadInfo::SpatialTorque { body, vector } = load {
-                    // τ·∂ω/∂q̇ᵢ, both in the body frame's components.
-                    if let Some(spatial) = &bodies[*body].spatial {
-                        for (i, s) in symbols.iter().enumerate() {
-                            let partial = spatial.angular_velocity.map(|c| arena.diff(c, s[1]));
-                            let power = dot(arena, vector, &partial);
-                            if !arena.is_zero(power) {
-                                forcing_terms[i].push(power);
-                            }
-                        }
-                    }
-                    LoadForces::default()
-                } else {
-                    load_forces(arena, &points, load)
-                };
-            for (point, f) in &forces {
-                for (i, r) in kinematics.partials(arena, *point).into_iter().enumerate() {
-                    if let Some(r) = r {
-                        forcing_terms[i].push(dot(arena, f, kinematics.vector(r)));
-                    }
-                }
-            }
-            if let Some((angle, value)) = torque {
-                for (i, s) in symbols.iter().enumerate() {
-                    let rate = arena.diff(angle, s[0]);
-                    if !arena.is_zero(rate) {
-                        forcing_terms[i].push(arena.times(value, rate));
-                    }
-                }
-            }
-        }
-
+        let mut terms = Terms {
+            n,
+            mass: mass_terms,
+            forcing: forcing_terms,
+        };
+        terms.rotations(arena, &bodies, (&symbols, time));
+        terms.spatial_bodies(arena, &bodies, (&symbols, time));
+        terms.written(arena, &symbols, (model_potential, &written_forces));
+        terms.loads(arena, &mut kinematics, (&points, &bodies, &loads), &symbols);
+        let (mass_terms, forcing_terms) = (terms.mass, terms.forcing);
         let mut mass_matrix = vec![arena.int(0); n * n];
         for i in 0..n {
             for j in i..n {
@@ -489,6 +392,158 @@ impl Formulation for MomentumBalance {
             num_dofs: n,
             mass_matrix,
             forcing,
+        }
+    }
+}
+
+/// The terms of `M` (`n × n`, `i ≤ j`, row-major) and of `F` as the momentum balance adds them:
+/// the translations' (in [`MomentumBalance::derive`]), then each kind of contribution below, in
+/// this order.
+struct Terms {
+    n: usize,
+    mass: Vec<Vec<ExprId>>,
+    forcing: Vec<Vec<ExprId>>,
+}
+
+impl Terms {
+    /// Planar rigid bodies' rotations: `Mᵢⱼ += I ∂θ/∂qᵢ ∂θ/∂qⱼ`, `Fᵢ −= I α₀ ∂θ/∂qᵢ`.
+    fn rotations(
+        &mut self,
+        arena: &mut ExprArena,
+        bodies: &[BodyInfo],
+        (symbols, time): (&[[SymbolId; 3]], SymbolId),
+    ) {
+        let n = self.n;
+        for body in bodies {
+            if let Some((inertia, angle)) = body.rotation {
+                let rates: Vec<ExprId> = symbols.iter().map(|s| arena.diff(angle, s[0])).collect();
+                let omega = arena.time_derivative(angle);
+                let alpha = velocity_product(arena, omega, symbols, time);
+                for i in 0..n {
+                    if arena.is_zero(rates[i]) {
+                        continue;
+                    }
+                    for j in i..n {
+                        if !arena.is_zero(rates[j]) {
+                            self.mass[i * n + j]
+                                .push(arena.product(&[inertia, rates[i], rates[j]]));
+                        }
+                    }
+                    let torque = arena.product(&[inertia, alpha, rates[i]]);
+                    self.forcing[i].push(arena.neg(torque));
+                }
+            }
+        }
+    }
+
+    /// 3-D bodies: Euler's equations projected on the partial angular velocities.
+    fn spatial_bodies(
+        &mut self,
+        arena: &mut ExprArena,
+        bodies: &[BodyInfo],
+        (symbols, time): (&[[SymbolId; 3]], SymbolId),
+    ) {
+        let n = self.n;
+        // 3-D bodies: Euler's equations `I_G α + ω × I_G ω` projected on the partial angular
+        // velocities `Wᵢ = ∂ω/∂q̇ᵢ`, all in the body frame's components (where `I_G` is
+        // constant and `α` is the time derivative of ω's components). With `α = Σ Wⱼ q̈ⱼ +
+        // α₀`: `Mᵢⱼ += Wᵢ·I Wⱼ`, `Fᵢ −= Wᵢ·(I α₀ + ω × I ω)`.
+        for body in bodies {
+            let Some(spatial) = &body.spatial else {
+                continue;
+            };
+            let w = spatial.angular_velocity;
+            let partial: Vec<Option<Vector3>> = symbols
+                .iter()
+                .map(|s| {
+                    let p = w.map(|c| arena.diff(c, s[1]));
+                    (!p.iter().all(|c| arena.is_zero(*c))).then_some(p)
+                })
+                .collect();
+            let alpha = w.map(|c| velocity_product(arena, c, symbols, time));
+            let i_alpha = tensor_times(arena, &spatial.inertia, &alpha);
+            let i_w = tensor_times(arena, &spatial.inertia, &w);
+            let gyroscopic = cross(arena, &w, &i_w);
+            let euler: Vec<ExprId> = i_alpha
+                .iter()
+                .zip(&gyroscopic)
+                .map(|(a, b)| arena.plus(*a, *b))
+                .collect();
+            for i in 0..n {
+                let Some(wi) = &partial[i] else { continue };
+                let i_wi = tensor_times(arena, &spatial.inertia, wi);
+                for (j, wj) in partial.iter().enumerate().skip(i) {
+                    if let Some(wj) = wj {
+                        self.mass[i * n + j].push(dot_multiplied_out(arena, &i_wi, wj));
+                    }
+                }
+                let inertial = dot_multiplied_out(arena, &euler, wi);
+                self.forcing[i].push(arena.neg(inertial));
+            }
+        }
+    }
+
+    /// The file's written potential `V` and generalized forces `Q`: `Fᵢ += −∂V/∂qᵢ + Qᵢ`.
+    fn written(
+        &mut self,
+        arena: &mut ExprArena,
+        symbols: &[[SymbolId; 3]],
+        (potential, written): (ExprId, &[ExprId]),
+    ) {
+        // The file's written potential and generalized forces: `−∂V/∂qᵢ + Qᵢ`.
+        for (i, s) in symbols.iter().enumerate() {
+            let dv = arena.diff(potential, s[0]);
+            if !arena.is_zero(dv) {
+                self.forcing[i].push(arena.neg(dv));
+            }
+            if !arena.is_zero(written[i]) {
+                self.forcing[i].push(written[i]);
+            }
+        }
+    }
+
+    /// The loads (springs, dampers, forces, torques, interactions), each as forces at points
+    /// and torques, projected on the partial velocities.
+    fn loads(
+        &mut self,
+        arena: &mut ExprArena,
+        kinematics: &mut Kinematics,
+        (points, bodies, loads): (&[Vec<ExprId>], &[BodyInfo], &[LoadInfo]),
+        symbols: &[[SymbolId; 3]],
+    ) {
+        for load in loads {
+            // Each load as forces at points (and torques), projected on partial velocities.
+            let LoadForces { forces, torque } =
+                if let LoadInfo::SpatialTorque { body, vector } = load {
+                    // τ·∂ω/∂q̇ᵢ, both in the body frame's components.
+                    if let Some(spatial) = &bodies[*body].spatial {
+                        for (i, s) in symbols.iter().enumerate() {
+                            let partial = spatial.angular_velocity.map(|c| arena.diff(c, s[1]));
+                            let power = dot(arena, vector, &partial);
+                            if !arena.is_zero(power) {
+                                self.forcing[i].push(power);
+                            }
+                        }
+                    }
+                    LoadForces::default()
+                } else {
+                    load_forces(arena, points, load)
+                };
+            for (point, f) in &forces {
+                for (i, r) in kinematics.partials(arena, *point).into_iter().enumerate() {
+                    if let Some(r) = r {
+                        self.forcing[i].push(dot(arena, f, kinematics.vector(r)));
+                    }
+                }
+            }
+            if let Some((angle, value)) = torque {
+                for (i, s) in symbols.iter().enumerate() {
+                    let rate = arena.diff(angle, s[0]);
+                    if !arena.is_zero(rate) {
+                        self.forcing[i].push(arena.times(value, rate));
+                    }
+                }
+            }
         }
     }
 }
