@@ -44,7 +44,7 @@ use eomgen_symbolic::expr::Func;
 
 mod module;
 pub use module::CompileError;
-pub(crate) use module::{Imports, ModuleMemory, declare_imports, failure, new_module};
+pub(crate) use module::{CodeLayout, Imports, ModuleMemory, declare_imports, failure, new_module};
 
 /// A compiled function: see the module documentation for its arguments.
 ///
@@ -124,12 +124,7 @@ pub(crate) fn compile(
     functions: &[(&str, &FunctionTape)],
     first_order: Option<(&FunctionTape, usize)>,
 ) -> Result<NativeCode, CompileError> {
-    let instructions = functions
-        .iter()
-        .map(|(_, f)| f.tape.instructions.len())
-        .chain(first_order.map(|(f, _)| f.tape.instructions.len()))
-        .sum();
-    let mut module = new_module(instructions)?;
+    let mut module = new_module(CodeLayout::Pages)?;
     let imports = declare_imports(&mut module)?;
     let call_conv = module.isa().default_call_conv();
     let pointer = module.target_config().pointer_type();

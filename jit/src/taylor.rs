@@ -48,8 +48,9 @@
 //! pendulum's code) and took most of the compile. Per order, a coefficient of an earlier
 //! order is loaded from the series where it is first used in that order (what the order
 //! writes, it never reads back from memory: see [`settled`]). The double pendulum's 18
-//! orders compile in 20–30 ms instead of 30–40, and run in 1.15–1.2× the time of `model!`'s
-//! instead of 1.3–1.5× (docs/performance.md, "Build and test cost"). Without Cranelift's
+//! orders then compiled in 20–30 ms instead of 30–40 (14–16 ms since the partial sums below),
+//! and ran in 1.15–1.2× the time of `model!`'s instead of 1.3–1.5× (docs/performance.md,
+//! "Build and test cost"). Without Cranelift's
 //! e-graph pass (`opt_level` `none`: the code repeats no work for it to remove) they compile
 //! in three quarters of the time and run 2–5 % slower.
 //!
@@ -80,7 +81,7 @@ use eomgen_symbolic::codegen::taylor::TaylorPlan;
 use eomgen_symbolic::expr::Func;
 
 use crate::native::{
-    CompileError, Imports, ModuleMemory, declare_imports, enter, failure, new_module,
+    CodeLayout, CompileError, Imports, ModuleMemory, declare_imports, enter, failure, new_module,
 };
 
 mod kernels;
@@ -117,11 +118,11 @@ pub(crate) struct OrderFrame {
 
 impl OrderFrame {
     /// The byte offsets of the fields, as the code reads them.
-    const CONTEXT: i32 = 0;
-    const SOLVE: i32 = 8;
-    const LOWER: i32 = 16;
-    const INVERSE_PIVOTS: i32 = 24;
-    const FACTOR: i32 = 32;
+    const CONTEXT: i32 = std::mem::offset_of!(OrderFrame, context) as i32;
+    const SOLVE: i32 = std::mem::offset_of!(OrderFrame, solve) as i32;
+    const LOWER: i32 = std::mem::offset_of!(OrderFrame, lower) as i32;
+    const INVERSE_PIVOTS: i32 = std::mem::offset_of!(OrderFrame, inverse_pivots) as i32;
+    const FACTOR: i32 = std::mem::offset_of!(OrderFrame, factor) as i32;
 }
 
 /// Two `f64`s aligned for one 16-byte load: the unit of [`PairScratch`].
@@ -211,12 +212,13 @@ pub(crate) fn compile_orders(
             &"the tape has too many instructions for 32-bit offsets",
         ));
     }
-    // Order k's code adds about k terms per op: the ops times (H + 1)² bound the terms.
-    let terms = program
-        .ops
-        .len()
-        .saturating_mul((highest + 1) * (highest + 1));
-    let mut module = new_module(terms.saturating_add(plan.order_zero.instructions.len()))?;
+    // Order k's code adds about k terms per sum (up to five sums an op, and 3n² in its
+    // solve): 8 (ops + n²) (H + 1)² items, 1 KiB each, is ample.
+    let n = program.coordinates.len();
+    let items = (program.ops.len() + n * n)
+        .saturating_mul(8 * (highest + 1) * (highest + 1))
+        .saturating_add(plan.order_zero.instructions.len());
+    let mut module = new_module(CodeLayout::Contiguous(items))?;
     let imports = declare_imports(&mut module)?;
     let call_conv = module.isa().default_call_conv();
     let pointer = module.target_config().pointer_type();

@@ -100,29 +100,38 @@ pub(crate) struct Imports {
     pub(crate) fill_zero: FuncId,
 }
 
-/// Address space reserved for a module's code beyond [`CODE_BYTES_PER_INSTRUCTION`] per
-/// instruction of its tapes: 64 MiB.
+/// Address space reserved for a module's code laid out in one piece, beyond
+/// [`CODE_BYTES_PER_ITEM`] per item of its code: 64 MiB.
 const CODE_RESERVE: usize = 64 << 20;
 
-/// Address space reserved for a module's code per instruction of its tapes, far more than
-/// Cranelift emits for one (a few instructions of 4–9 bytes, with its spills).
-pub(crate) const CODE_BYTES_PER_INSTRUCTION: usize = 1024;
+/// Address space reserved per item of a module's code laid out in one piece (a term of a Taylor
+/// order's sums, an instruction of a tape), far more than Cranelift emits for one (a few
+/// instructions of 4–9 bytes, with its spills).
+const CODE_BYTES_PER_ITEM: usize = 1024;
+
+/// How a module's functions are placed in memory.
+#[derive(Debug, Clone, Copy)]
+pub(crate) enum CodeLayout {
+    /// Cranelift's default: each function that does not fit what is left of the last
+    /// allocation gets pages of its own.
+    Pages,
+    /// One after the other in one region of address space reserved up front for this many
+    /// items of code ([`CODE_RESERVE`] plus [`CODE_BYTES_PER_ITEM`] each; on Linux and macOS
+    /// only what the code uses is committed). The Taylor orders, one function per order, each
+    /// started at a page boundary otherwise, where the first-level instruction cache maps
+    /// the same sets: the double pendulum's ran 3–5 % slower so (docs/performance.md). When
+    /// the region cannot be reserved, the layout is [`CodeLayout::Pages`]; code beyond it
+    /// fails to compile (for the Taylor orders: the runtime's kernels go on).
+    Contiguous(usize),
+}
 
 /// A JIT module for the host, optimising for speed, that resolves the helpers of
-/// [`crate::math`] by their symbol names, for tapes of `instructions` instructions in all.
-///
-/// Its functions are laid out one after the other in one region of address space reserved up
-/// front ([`CODE_RESERVE`] plus [`CODE_BYTES_PER_INSTRUCTION`] per instruction; only what the
-/// code uses is ever committed). Cranelift's default gives each function that does not fit
-/// the rest of the last one pages of its own: the double pendulum's Taylor orders, one
-/// function per order, then each started at a page boundary, where the first-level
-/// instruction cache maps the same sets, and ran 3–5 % slower than one after the other
-/// (docs/performance.md).
+/// [`crate::math`] by their symbol names, its functions placed as `layout` says. Frames larger
+/// than a page are probed in line (a Taylor order keeps its partial sums on the stack).
 ///
 /// # Errors
-/// [`CompileError::UnsupportedHost`] when Cranelift has no code generator for the host or the
-/// address space cannot be reserved.
-pub(crate) fn new_module(instructions: usize) -> Result<JITModule, CompileError> {
+/// [`CompileError::UnsupportedHost`] when Cranelift has no code generator for the host.
+pub(crate) fn new_module(layout: CodeLayout) -> Result<JITModule, CompileError> {
     let mut flags = settings::builder();
     let set = |flags: &mut settings::Builder, name: &str, value: &str| {
         flags
@@ -134,6 +143,8 @@ pub(crate) fn new_module(instructions: usize) -> Result<JITModule, CompileError>
     set(&mut flags, "opt_level", "speed")?;
     set(&mut flags, "use_colocated_libcalls", "false")?;
     set(&mut flags, "is_pic", "false")?;
+    set(&mut flags, "enable_probestack", "true")?;
+    set(&mut flags, "probestack_strategy", "inline")?;
     // The tapes are built correct by construction; the verifier doubles compile time.
     set(
         &mut flags,
@@ -153,14 +164,14 @@ pub(crate) fn new_module(instructions: usize) -> Result<JITModule, CompileError>
             reason: e.to_string(),
         })?;
     let mut builder = JITBuilder::with_isa(isa, default_libcall_names());
-    let reserve = instructions
-        .saturating_mul(CODE_BYTES_PER_INSTRUCTION)
-        .saturating_add(CODE_RESERVE);
-    let memory =
-        ArenaMemoryProvider::new_with_size(reserve).map_err(|e| CompileError::UnsupportedHost {
-            reason: format!("reserving {reserve} bytes for the code: {e}"),
-        })?;
-    builder.memory_provider(Box::new(memory));
+    if let CodeLayout::Contiguous(items) = layout {
+        let reserve = items
+            .saturating_mul(CODE_BYTES_PER_ITEM)
+            .saturating_add(CODE_RESERVE);
+        if let Ok(memory) = ArenaMemoryProvider::new_with_size(reserve) {
+            builder.memory_provider(Box::new(memory));
+        }
+    }
     for (name, f) in HELPERS {
         builder.symbol(name, math::unary(f) as *const u8);
     }

@@ -164,12 +164,13 @@ impl Emitter {
                 size,
                 4,
             ));
-            b.ins().stack_store(types::I64, value, slot, 0);
+            let pointer = b.func.dfg.value_type(self.series);
+            b.ins().stack_store(pointer, value, slot, 0);
             self.prefixes.insert(sum, slot);
         }
     }
 
-    /// The partial sum [`Self::prefix`] kept for `sum`, if any.
+    /// The partial sum [`Self::prefixes`] kept for `sum`, if any.
     pub(super) fn started(
         &self,
         b: &mut FunctionBuilder,
@@ -177,6 +178,7 @@ impl Emitter {
         ty: ir::Type,
     ) -> Option<ir::Value> {
         let slot = *self.prefixes.get(&sum)?;
-        Some(b.ins().stack_load(types::I64, ty, slot, 0))
+        let pointer = b.func.dfg.value_type(self.series);
+        Some(b.ins().stack_load(pointer, ty, slot, 0))
     }
 }
