@@ -65,7 +65,7 @@
 //!   Mathematics (Barcelona 2000), Progr. Math. 201, Birkhäuser 2001, 101–115 (the figure
 //!   eight computed and continued numerically, `T = 6.32591398`).
 
-use nalgebra::{Complex, DMatrix, DVector};
+use nalgebra::{Complex, DMatrix, DVector, Dyn, SVD};
 use serde::Serialize;
 
 use crate::integrate::{DormandPrince853, Integrator, IntegratorOptions, OutputTimes, Stats};
@@ -74,6 +74,8 @@ use crate::linear::monodromy::{
 };
 use crate::model_info::ModelInfo;
 use crate::ode::{OdeSystem, RhsError};
+
+mod newton;
 
 /// Relative floor `ε` of the singular values kept in a Gauss–Newton step: `σ ≤ ε σ_max` is
 /// rank deficiency (the monodromy matrix is integrated to about 1e-12).
@@ -426,6 +428,93 @@ pub fn periodic_orbit(
     model: &mut dyn ModelInfo,
     options: &PeriodicOrbitOptions,
 ) -> Result<PeriodicOrbit, PeriodicOrbitError> {
+    let Setup {
+        name,
+        start,
+        time_dependent,
+        conservative,
+        energy_level,
+        shooting,
+    } = set_up(model, options)?;
+    let final_tol = options.integration_tol;
+    let newton = Newton {
+        shooting: &shooting,
+        options,
+        final_tol,
+    };
+    let mut stats = Stats::default();
+    let Solution {
+        current,
+        iterations,
+        rank: rank_used,
+        history,
+    } = newton.solve(model, start, &mut stats)?;
+    let symmetries = (shooting.n + usize::from(shooting.free_period)) - rank_used;
+    let multipliers = classify_multipliers(model, &current, options, time_dependent)?;
+    let orbit = sample_orbit(model, &current, options, &mut stats)?;
+    let coordinates = model.description().coordinate_names();
+    let state_names = coordinates
+        .iter()
+        .map(|c| c.to_string())
+        .chain(coordinates.iter().map(|c| format!("{c}_dot")))
+        .collect();
+    let residual_max = current.residual.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    Ok(PeriodicOrbit {
+        model: name,
+        period: current.period,
+        fix_period: options.fix_period,
+        state_names,
+        energy: model.energy(0.0, &current.y),
+        initial_state: current.y,
+        residual: current.residual_norm,
+        residual_max,
+        energy_level,
+        conservative,
+        iterations,
+        history,
+        symmetries,
+        multipliers: multipliers.multipliers,
+        unit_multipliers: multipliers.unit_multipliers,
+        unit_multiplier_tolerance: options.unit_multiplier_tolerance,
+        unit_mean_error: multipliers.unit_mean_error,
+        spectral_radius: multipliers.spectral_radius,
+        nontrivial_spectral_radius: multipliers.nontrivial_spectral_radius,
+        stability: multipliers.stability,
+        monodromy_matrix: current.monodromy,
+        orbit,
+        stats,
+    })
+}
+
+/// What [`periodic_orbit`] settles before its first integration.
+struct Setup {
+    /// The model's name.
+    name: String,
+    /// Newton's start `y₀ = [q; q̇]` (`n = 2 num_dofs()` finite entries).
+    start: Vec<f64>,
+    /// Whether `f(t, y)` changes with `t` at the start.
+    time_dependent: bool,
+    /// Whether `T + V` is a constant of the motion (a conservative model, no explicit `t`).
+    conservative: bool,
+    /// The energy level `E` (J) of the energy row (`None` without one).
+    energy_level: Option<f64>,
+    /// The rows and unknowns of the shooting problem.
+    shooting: Shooting,
+}
+
+/// Checks the model and the options and settles the shooting problem of [`periodic_orbit`]:
+/// the start `y₀` (the options' or the model's initial state, `n = 2 num_dofs()` entries),
+/// whether `f` depends on `t` (then the period must be fixed and there is no phase row),
+/// whether the model is conservative and, with the period free in a conservative model, the
+/// energy level `E` (J) of the energy row (the options', or `T + V` at the start). Every
+/// refusal before the first integration comes from here, in the order the checks are made:
+/// [`PeriodicOrbitError::Constrained`], then [`validate`]'s, then
+/// [`PeriodicOrbitError::InvalidStart`], [`PeriodicOrbitError::Rhs`],
+/// [`PeriodicOrbitError::TimeDependent`] and [`PeriodicOrbitError::InvalidEnergy`].
+fn set_up(
+    model: &mut dyn ModelInfo,
+    options: &PeriodicOrbitOptions,
+) -> Result<Setup, PeriodicOrbitError> {
     let name = model.description().name.to_string();
     if !model.description().constraints.is_empty() {
         return Err(PeriodicOrbitError::Constrained {
@@ -466,155 +555,73 @@ pub fn periodic_orbit(
         phase: !time_dependent,
         energy: energy_level,
     };
-    // Far from the orbit the residual needs no 12 digits: Newton's next residual is about
-    // the square of the current one, and each evaluation integrates at 1e-4 of that (at most
-    // LOOSEST_TOL, at least the tolerance asked for), then again more tightly if its residual
-    // turns out smaller than RESOLUTION_FACTOR resolves (`evaluate_resolved`), so that every
-    // step and every comparison of merits uses residuals that are not integration error;
-    // convergence is only declared on an evaluation at the tolerance asked for.
-    let final_tol = options.integration_tol;
-    let tol_for = |merit: f64| final_tol.max((1e-4 * merit * merit).min(LOOSEST_TOL));
-    let mut stats = Stats::default();
-    let mut history = Vec::new();
-    let travel_floor = |y: &[f64]| 1e-9 * (1.0 + norm(y));
-    let mut current = evaluate_resolved(
-        model,
-        &shooting,
+    Ok(Setup {
+        name,
         start,
-        options.period,
-        tol_for(f64::INFINITY),
-        final_tol,
-        &mut stats,
-    )?;
-    let mut iterations = 0;
-    let rank_used = loop {
-        let allowed = options.tol * (1.0 + norm(&current.y));
-        let energy_ok = match (shooting.energy, current.energy_residual) {
-            (Some(e), Some(r)) => r.abs() <= options.tol * (1.0 + e.abs()),
-            _ => true,
-        };
-        let mut step = NewtonStep {
-            residual: current.residual_norm,
-            energy_residual: current.energy_residual,
-            period: current.period,
-            rank: None,
-            damping: None,
-        };
-        let f0 = rhs(model, &current.y)?;
-        let travel = norm(&f0) * current.period;
-        if current.period < 1e-6 * options.period || travel < travel_floor(&current.y) {
-            return Err(PeriodicOrbitError::Collapsed {
-                iterations,
-                period: current.period,
-                travel,
-            });
-        }
-        // The Jacobian at the current iterate, also for the symmetry count at the solution.
-        let jacobian = jacobian(model, &shooting, &current, &f0)?;
-        let svd = jacobian.svd(true, true);
-        let sigma_max = svd.singular_values.max();
-        let cut = (RANK_TOLERANCE * sigma_max).max(SYMMETRY_FACTOR * current.merit);
-        let rank = svd.singular_values.iter().filter(|s| **s > cut).count();
-        if current.residual_norm <= allowed && energy_ok {
-            if current.tol > final_tol {
-                let y = current.y.clone();
-                current = evaluate(model, &shooting, y, current.period, final_tol, &mut stats)?;
-                continue;
-            }
-            history.push(step);
-            break rank;
-        }
-        if iterations >= options.max_iterations {
-            history.push(step);
-            return Err(PeriodicOrbitError::NotConverged {
-                iterations,
-                residual: current.residual_norm,
-                allowed,
-                period: current.period,
-                stalled: false,
-            });
-        }
-        let rhs_vector = right_hand_side(&shooting, &current);
-        // Δ = −J⁺ b over the kept singular values (nalgebra zeroes those ≤ the cut): the
-        // minimum-norm least-squares step, damped until the merit decreases. Far from the
-        // orbit the cut κ‖r‖ may drop a direction the step needs (the period's, when the
-        // residual is large); then the cut is lowered tenfold, twice, then to ε σ_max.
-        let floor = RANK_TOLERANCE * sigma_max;
-        let mut cuts: Vec<f64> = [cut, 0.1 * cut, 0.01 * cut, floor]
-            .into_iter()
-            .filter(|c| *c >= floor)
-            .collect();
-        cuts.dedup();
-        let mut accepted = None;
-        let (mut used_rank, mut damping) = (rank, 1.0);
-        'cuts: for &level in &cuts {
-            let Ok(solution) = svd.solve(&rhs_vector, level) else {
-                break;
-            };
-            let delta = -solution;
-            used_rank = svd.singular_values.iter().filter(|s| **s > level).count();
-            damping = 1.0;
-            // Keep the period within a factor 2 of the current one (its unknown is the
-            // relative change ΔT/T).
-            if shooting.free_period && delta[n].abs() > 0.5 {
-                damping = 0.5 / delta[n].abs();
-            }
-            for _ in 0..MAX_HALVINGS {
-                let y: Vec<f64> = current
-                    .y
-                    .iter()
-                    .zip(delta.iter())
-                    .map(|(y, d)| y + damping * d)
-                    .collect();
-                let period = if shooting.free_period {
-                    current.period * (1.0 + damping * delta[n])
-                } else {
-                    current.period
-                };
-                match evaluate_resolved(
-                    model,
-                    &shooting,
-                    y,
-                    period,
-                    tol_for(current.merit),
-                    final_tol,
-                    &mut stats,
-                ) {
-                    Ok(candidate) if candidate.merit < current.merit => {
-                        accepted = Some(candidate);
-                        break 'cuts;
-                    }
-                    // A failed integration or a larger residual: a shorter step.
-                    Ok(_)
-                    | Err(PeriodicOrbitError::Floquet(FloquetError::IntegrationFailed {
-                        ..
-                    }))
-                    | Err(PeriodicOrbitError::Floquet(FloquetError::NonFinite { .. })) => {
-                        damping *= 0.5;
-                    }
-                    Err(e) => return Err(e),
-                }
-            }
-        }
-        let rank = used_rank;
-        step.rank = Some(rank);
-        step.damping = Some(damping);
-        history.push(step);
-        iterations += 1;
-        match accepted {
-            Some(candidate) => current = candidate,
-            None => {
-                return Err(PeriodicOrbitError::NotConverged {
-                    iterations,
-                    residual: current.residual_norm,
-                    allowed,
-                    period: current.period,
-                    stalled: true,
-                });
-            }
-        }
-    };
-    let symmetries = (n + usize::from(shooting.free_period)) - rank_used;
+        time_dependent,
+        conservative,
+        energy_level,
+        shooting,
+    })
+}
+
+/// The fixed data of the Gauss–Newton iteration of [`periodic_orbit`] (the iteration itself,
+/// [`Newton::solve`], is in the child module `newton`).
+struct Newton<'a> {
+    /// The rows and unknowns.
+    shooting: &'a Shooting,
+    /// The options (period guess, tolerances, most iterations).
+    options: &'a PeriodicOrbitOptions,
+    /// The integration tolerance asked for ([`PeriodicOrbitOptions::integration_tol`]): the
+    /// only one at which convergence is declared.
+    final_tol: f64,
+}
+
+/// Where the Newton iteration of [`periodic_orbit`] ended.
+struct Solution {
+    /// The converged evaluation, at the integration tolerance asked for.
+    current: Evaluation,
+    /// Newton steps taken.
+    iterations: usize,
+    /// The rank of the augmented Jacobian at the solution (for the symmetry count).
+    rank: usize,
+    /// Every iterate, the last one the solution.
+    history: Vec<NewtonStep>,
+}
+
+/// The Floquet multipliers at the solution and what [`PeriodicOrbit`] reports of them.
+struct Multipliers {
+    /// The eigenvalues of `Φ(T)`, largest modulus first.
+    multipliers: Vec<Complex<f64>>,
+    /// `max |μ|`.
+    spectral_radius: f64,
+    /// How many are 1 to within the options' tolerance.
+    unit_multipliers: usize,
+    /// `|mean − 1|` of those (0 if none).
+    unit_mean_error: f64,
+    /// `max |μ|` over the others (1 if none).
+    nontrivial_spectral_radius: f64,
+    /// The stability the others imply.
+    stability: FloquetStability,
+}
+
+/// The Floquet multipliers of the converged evaluation `current` (eigenvalues of its `n × n`
+/// monodromy matrix, tolerance `√integration_tol`), split into the trivial ones (within
+/// [`PeriodicOrbitOptions::unit_multiplier_tolerance`] of 1) and the others, whose spectral
+/// radius sets the stability.
+///
+/// # Errors
+/// [`PeriodicOrbitError::Floquet`] (the eigenvalues), [`PeriodicOrbitError::Rhs`], and
+/// [`PeriodicOrbitError::NoUnitMultiplier`] when an autonomous model's "orbit" keeps neither
+/// a multiplier 1 nor the flow's direction (`Φ f(y₀) = f(y₀)`): the state only closed to the
+/// tolerance near an equilibrium.
+fn classify_multipliers(
+    model: &mut dyn ModelInfo,
+    current: &Evaluation,
+    options: &PeriodicOrbitOptions,
+    time_dependent: bool,
+) -> Result<Multipliers, PeriodicOrbitError> {
+    let final_tol = options.integration_tol;
     let analysis =
         floquet_multipliers(current.monodromy.clone(), current.period, final_tol.sqrt())?;
     let one = Complex::new(1.0, 0.0);
@@ -653,38 +660,13 @@ pub fn periodic_orbit(
         nontrivial.iter().map(|m| m.norm()).fold(0.0, f64::max)
     };
     let stability = FloquetStability::of(nontrivial_spectral_radius, final_tol.sqrt());
-    let orbit = sample_orbit(model, &current, options, &mut stats)?;
-    let coordinates = model.description().coordinate_names();
-    let state_names = coordinates
-        .iter()
-        .map(|c| c.to_string())
-        .chain(coordinates.iter().map(|c| format!("{c}_dot")))
-        .collect();
-    let residual_max = current.residual.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-    Ok(PeriodicOrbit {
-        model: name,
-        period: current.period,
-        fix_period: options.fix_period,
-        state_names,
-        energy: model.energy(0.0, &current.y),
-        initial_state: current.y,
-        residual: current.residual_norm,
-        residual_max,
-        energy_level,
-        conservative,
-        iterations,
-        history,
-        symmetries,
+    Ok(Multipliers {
         multipliers: analysis.multipliers,
-        unit_multipliers,
-        unit_multiplier_tolerance: options.unit_multiplier_tolerance,
-        unit_mean_error,
         spectral_radius: analysis.spectral_radius,
+        unit_multipliers,
+        unit_mean_error,
         nontrivial_spectral_radius,
         stability,
-        monodromy_matrix: current.monodromy,
-        orbit,
-        stats,
     })
 }
 

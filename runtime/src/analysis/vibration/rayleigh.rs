@@ -17,7 +17,7 @@
 
 use serde::Serialize;
 
-use super::modes::{ModalOptions, modal_analysis};
+use super::modes::{ModalAnalysis, ModalOptions, modal_analysis};
 use super::operating_point::{
     OperatingPoint, OperatingPointError, OperatingPointOptions, PointSummary,
 };
@@ -340,13 +340,85 @@ pub fn rayleigh_study(
     model: &dyn ModelInfo,
     options: &RayleighOptions,
 ) -> Result<RayleighStudy, RayleighError> {
-    let name = || model.description().name.to_string();
     let modal = modal_analysis(
         model,
         &ModalOptions {
             operating_point: options.operating_point.clone(),
         },
     )?;
+    check_inputs(model, options, &modal)?;
+    let modes = &modal.normal_modes;
+    let m = &modal.linearization.mass_matrix;
+    let stiffness = &modal.linearization.stiffness_matrix;
+    let k_sym = (stiffness + stiffness.transpose()) * 0.5;
+    let psi = &modes.mode_shapes;
+    let quotient = |v: &DVector<f64>| v.dot(&(&k_sym * v)) / mass_form(m, v);
+    let Projection {
+        scale,
+        projected,
+        zero_modes,
+        zero_mode_fraction,
+        lowest,
+    } = project_shape(model, &options.shape, m, modes)?;
+    let mass = mass_form(m, &projected);
+    let stiffness_form = projected.dot(&(&k_sym * &projected));
+    let rayleigh_quotient = stiffness_form / mass;
+    let omega1 = modes.natural_frequencies[lowest];
+    let w1 = modes.eigenvalues[lowest];
+    let frequency_estimate = rayleigh_quotient.max(0.0).sqrt();
+    let largest = modes.eigenvalues.iter().fold(0.0f64, |a, w| a.max(w.abs()));
+    let excess = rayleigh_quotient - w1;
+    let eta: DVector<f64> = psi.transpose() * (m * &projected);
+    let eta_norm = eta.norm_squared();
+    let modal_participation = eta.iter().map(|e| e * e / eta_norm).collect();
+    let psi1 = psi.column(lowest).into_owned();
+    let (remainder, shape_error) = lowest_eigenspace_error(m, modes, lowest, &projected);
+    let stationarity = stationarity(
+        (m, modes),
+        (lowest, &remainder, projected.norm()),
+        &options.perturbations,
+        &quotient,
+    );
+    Ok(RayleighStudy {
+        shape: options.shape.clone(),
+        projected_shape: projected.iter().map(|x| x * scale).collect(),
+        zero_modes_removed: zero_modes,
+        zero_mode_fraction,
+        stiffness_form: stiffness_form * scale * scale,
+        mass_form: mass * scale * scale,
+        rayleigh_quotient,
+        frequency_estimate,
+        lowest_mode: lowest + 1,
+        natural_frequency: omega1,
+        lowest_mode_shape: psi1.iter().copied().collect(),
+        relative_error: (frequency_estimate - omega1) / omega1,
+        excess,
+        bound_holds: excess >= -1e-12 * largest,
+        shape_error,
+        modal_participation,
+        stationarity,
+        operating_point: modal.operating_point,
+        linearization: modal.linearization,
+        normal_modes: modal.normal_modes,
+    })
+}
+
+/// `vᵀMv`, the squared mass norm of `v` (`n` entries; `M` is `n × n`).
+fn mass_form(m: &DMatrix<f64>, v: &DVector<f64>) -> f64 {
+    v.dot(&(m * v))
+}
+
+/// Refuses what [`rayleigh_study`] cannot take at the equilibrium `modal` found: a model with
+/// constraints ([`RayleighError::Constrained`]), a shape without one finite entry per
+/// coordinate ([`RayleighError::DimensionMismatch`], [`RayleighError::NonFinite`]), a `K`
+/// that is not symmetric ([`RayleighError::NonSymmetricStiffness`]) and an unstable
+/// equilibrium ([`RayleighError::Unstable`]), in that order.
+fn check_inputs(
+    model: &dyn ModelInfo,
+    options: &RayleighOptions,
+    modal: &ModalAnalysis,
+) -> Result<(), RayleighError> {
+    let name = || model.description().name.to_string();
     let n = model.num_dofs();
     if modal.linearization.num_minimal_coordinates() != n {
         return Err(RayleighError::Constrained { model: name() });
@@ -387,22 +459,49 @@ pub fn rayleigh_study(
             eigenvalue: modes.eigenvalues[k],
         });
     }
-    let m = &modal.linearization.mass_matrix;
-    let stiffness = &modal.linearization.stiffness_matrix;
-    let k_sym = (stiffness + stiffness.transpose()) * 0.5;
-    let psi = &modes.mode_shapes;
-    let mass_form = |v: &DVector<f64>| v.dot(&(m * v));
-    let quotient = |v: &DVector<f64>| v.dot(&(&k_sym * v)) / mass_form(v);
+    Ok(())
+}
 
+/// The trial shape scaled and with its zero-frequency modes projected out.
+struct Projection {
+    /// `max |vᵢ|`, the shape's scale (m or rad): the projected shape is `v / scale` with its
+    /// zero-frequency modes removed.
+    scale: f64,
+    /// The projected shape, in units of `scale` (`n` entries).
+    projected: DVector<f64>,
+    /// How many zero-frequency modes were projected out.
+    zero_modes: usize,
+    /// `‖Σ_z ψ_z ψ_zᵀ M v‖_M / ‖v‖_M`.
+    zero_mode_fraction: f64,
+    /// The 0-based index of the lowest oscillatory mode.
+    lowest: usize,
+}
+
+/// `v = shape / max |shapeᵢ|` (`n` entries) with its part along the zero-frequency modes
+/// removed `M`-orthogonally (`M` `n × n`, `modes` mass-normalised), the fraction removed and
+/// the lowest oscillatory mode. Scaling first keeps a shape of 1e300 or 1e-300 from
+/// overflowing or underflowing the forms.
+///
+/// # Errors
+/// [`RayleighError::ZeroShape`] (`vᵀMv` zero or NaN), [`RayleighError::NoOscillatoryMode`]
+/// (of the `model`), [`RayleighError::OnlyZeroModes`] (nothing left after the projection).
+fn project_shape(
+    model: &dyn ModelInfo,
+    shape: &[f64],
+    m: &DMatrix<f64>,
+    modes: &NormalModes,
+) -> Result<Projection, RayleighError> {
+    let n = model.num_dofs();
+    let psi = &modes.mode_shapes;
     // The quotient does not depend on the shape's scale: it is taken of `v / max|vᵢ|`, so a
     // shape of 1e300 or 1e-300 neither overflows nor underflows the forms (the forms and the
     // projected shape are scaled back for the report).
-    let scale = options.shape.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+    let scale = shape.iter().fold(0.0f64, |a, x| a.max(x.abs()));
     if scale == 0.0 {
         return Err(RayleighError::ZeroShape);
     }
-    let v = DVector::from_column_slice(&options.shape) / scale;
-    let full = mass_form(&v);
+    let v = DVector::from_column_slice(shape) / scale;
+    let full = mass_form(m, &v);
     if full.is_nan() || full <= 0.0 {
         return Err(RayleighError::ZeroShape);
     }
@@ -416,9 +515,11 @@ pub fn rayleigh_study(
     for &z in &zero {
         projected -= psi.column(z) * psi.column(z).dot(&mv);
     }
-    let remaining = (mass_form(&projected).max(0.0) / full).sqrt();
+    let remaining = (mass_form(m, &projected).max(0.0) / full).sqrt();
     let Some(lowest) = (0..n).find(|&k| modes.kinds[k] == ModeKind::Oscillatory) else {
-        return Err(RayleighError::NoOscillatoryMode { model: name() });
+        return Err(RayleighError::NoOscillatoryMode {
+            model: model.description().name.to_string(),
+        });
     };
     // Below this the remainder is the rounding of the projection (a few ε of the shape).
     if remaining <= 1e-10 {
@@ -430,24 +531,33 @@ pub fn rayleigh_study(
     let zero_mode_fraction = if zero.is_empty() {
         0.0
     } else {
-        (mass_form(&(&v - &projected)).max(0.0) / full).sqrt()
+        (mass_form(m, &(&v - &projected)).max(0.0) / full).sqrt()
     };
-    let mass = mass_form(&projected);
-    let stiffness_form = projected.dot(&(&k_sym * &projected));
-    let rayleigh_quotient = stiffness_form / mass;
-    let omega1 = modes.natural_frequencies[lowest];
+    Ok(Projection {
+        scale,
+        projected,
+        zero_modes: zero.len(),
+        zero_mode_fraction,
+        lowest,
+    })
+}
+
+/// The projected shape's error from the lowest mode: its remainder `v − P₁v` (`n` entries,
+/// `P₁` the `M`-orthogonal projection onto the eigenspace of `ω₁`, the mode `lowest` and any
+/// of the same frequency) and `tan θ = ‖v − P₁v‖_M / ‖P₁v‖_M` (`None` when `P₁v = 0`).
+fn lowest_eigenspace_error(
+    m: &DMatrix<f64>,
+    modes: &NormalModes,
+    lowest: usize,
+    projected: &DVector<f64>,
+) -> (DVector<f64>, Option<f64>) {
+    let n = projected.len();
+    let psi = &modes.mode_shapes;
     let w1 = modes.eigenvalues[lowest];
-    let frequency_estimate = rayleigh_quotient.max(0.0).sqrt();
-    let largest = modes.eigenvalues.iter().fold(0.0f64, |a, w| a.max(w.abs()));
-    let excess = rayleigh_quotient - w1;
-    let eta: DVector<f64> = psi.transpose() * (m * &projected);
-    let eta_norm = eta.norm_squared();
-    let modal_participation = eta.iter().map(|e| e * e / eta_norm).collect();
-    let psi1 = psi.column(lowest).into_owned();
     // The shape's part in the eigenspace of ω₁ (`ψ₁ (ψ₁ᵀMv)` when ω₁ is simple): with a
     // repeated ω₁ (a ring's pair of modes) any vector of that space is a lowest mode, and the
     // error is measured from the space, not from the one `ψ₁` the solver returned.
-    let mp = m * &projected;
+    let mp = m * projected;
     let mut lowest_part = DVector::zeros(n);
     for k in 0..n {
         if modes.kinds[k] == ModeKind::Oscillatory
@@ -456,38 +566,11 @@ pub fn rayleigh_study(
             lowest_part += psi.column(k) * psi.column(k).dot(&mp);
         }
     }
-    let remainder = &projected - &lowest_part;
-    let remainder_norm = mass_form(&remainder).max(0.0).sqrt();
-    let part_norm = mass_form(&lowest_part).max(0.0).sqrt();
+    let remainder = projected - &lowest_part;
+    let remainder_norm = mass_form(m, &remainder).max(0.0).sqrt();
+    let part_norm = mass_form(m, &lowest_part).max(0.0).sqrt();
     let shape_error = (part_norm > 0.0).then(|| remainder_norm / part_norm);
-    let stationarity = stationarity(
-        (m, modes),
-        (lowest, &remainder, projected.norm()),
-        &options.perturbations,
-        &quotient,
-    );
-    Ok(RayleighStudy {
-        shape: options.shape.clone(),
-        projected_shape: projected.iter().map(|x| x * scale).collect(),
-        zero_modes_removed: zero.len(),
-        zero_mode_fraction,
-        stiffness_form: stiffness_form * scale * scale,
-        mass_form: mass * scale * scale,
-        rayleigh_quotient,
-        frequency_estimate,
-        lowest_mode: lowest + 1,
-        natural_frequency: omega1,
-        lowest_mode_shape: psi1.iter().copied().collect(),
-        relative_error: (frequency_estimate - omega1) / omega1,
-        excess,
-        bound_holds: excess >= -1e-12 * largest,
-        shape_error,
-        modal_participation,
-        stationarity,
-        operating_point: modal.operating_point,
-        linearization: modal.linearization,
-        normal_modes: modal.normal_modes,
-    })
+    (remainder, shape_error)
 }
 
 /// The stationarity test of [`rayleigh_study`]: `w` is the shape's remainder (its part
