@@ -69,7 +69,8 @@ pub struct BatchReport {
     pub stopped_by_event: Vec<RunStop>,
 }
 
-/// A run of a batch that failed (kept with [`BatchOptions::keep_failures`]).
+/// A run of a batch that failed: its integration stopped, or (kept with
+/// [`BatchOptions::keep_failures`]) it could not start.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct RunFailure {
     /// The run's index.
@@ -78,6 +79,11 @@ pub struct RunFailure {
     pub t: f64,
     /// Why.
     pub reason: String,
+    /// For a run whose initial state the constraints could not accept: whether the model
+    /// marks coordinates of its initial state as guesses that Newton solves from (then other
+    /// guesses may start it; else consistent values must be given). `None` for a run that
+    /// started.
+    pub not_started_with_guesses: Option<bool>,
 }
 
 /// A run of a batch that a terminal event ended.
@@ -117,6 +123,9 @@ pub enum BatchError {
     /// The caller asked to stop between chunks of runs.
     #[error("stopped between runs")]
     Stopped,
+    /// The thread pool could not be built.
+    #[error("the thread pool: {0}")]
+    ThreadPool(String),
 }
 
 /// How a run ended.
@@ -124,7 +133,7 @@ enum Ended {
     Reached,
     Event(f64, String),
     Failed(f64, String),
-    NotStarted(String),
+    NotStarted(String, bool),
 }
 
 /// One run's samples, energies, work and end.
@@ -156,7 +165,10 @@ pub fn simulate_batch(
 ) -> Result<BatchReport, BatchError> {
     use rayon::prelude::*;
     let dim = 2 * make().num_dofs();
-    let (t_out, batch) = shape(runs, options, dim)?;
+    let batch = check_batch(runs, options, dim)?;
+    let OutputTimes::At(t_out) = &options.simulation.output else {
+        return Err(BatchError::Refused("no output times".into()));
+    };
     let k = t_out.len();
     let one = |i: usize| -> Result<Outcome, BatchError> {
         let mut model = make();
@@ -182,7 +194,7 @@ pub fn simulate_batch(
             rayon::ThreadPoolBuilder::new()
                 .num_threads(n)
                 .build()
-                .map_err(|e| BatchError::Refused(format!("the thread pool: {e}")))?,
+                .map_err(|e| BatchError::ThreadPool(e.to_string()))?,
         ),
         None => None,
     };
@@ -211,13 +223,18 @@ pub fn simulate_batch(
     ))
 }
 
-/// The output times and the number of runs of a batch, checked with the options every run
-/// shares.
-fn shape<'a>(
+/// The number of runs of the batch `runs` with `options`, for a model whose state has
+/// `state_dimension` values: what [`simulate_batch`] checks before any run, for a caller
+/// that checks its own arguments after these.
+///
+/// # Errors
+/// [`BatchError::Refused`] as [`simulate_batch`] says.
+pub fn check_batch(
     runs: &BatchRuns,
-    options: &'a BatchOptions,
-    dim: usize,
-) -> Result<(&'a [f64], usize), BatchError> {
+    options: &BatchOptions,
+    state_dimension: usize,
+) -> Result<usize, BatchError> {
+    let dim = state_dimension;
     let refused = |m: String| Err(BatchError::Refused(m));
     if let Some(n) = options.threads
         && !(1..=MAX_BATCH_THREADS).contains(&n)
@@ -272,7 +289,7 @@ fn shape<'a>(
             dim + 1
         ));
     }
-    Ok((t_out, batch))
+    Ok(batch)
 }
 
 /// Run `i` of `k` output times of a state of `dim` values, on `model`.
@@ -285,12 +302,12 @@ fn run(
     let simulation = match simulate(model, options) {
         Ok(simulation) => simulation,
         // A state the constraints cannot accept is this run's; kept when asked.
-        Err(e @ SimulationError::InconsistentInitialState { .. }) if keep_failures => {
+        Err(e @ SimulationError::InconsistentInitialState { has_guesses, .. }) if keep_failures => {
             return Ok(Outcome {
                 y: vec![f64::NAN; k * dim],
                 energy: vec![f64::NAN; k],
                 stats: Stats::default(),
-                end: Ended::NotStarted(e.to_string()),
+                end: Ended::NotStarted(e.to_string(), has_guesses),
             });
         }
         Err(source) => return Err(BatchError::Run { run: i, source }),
@@ -346,12 +363,22 @@ fn stacked(outcomes: Vec<Outcome>, t: Vec<f64>, t_end: f64, dim: usize) -> Batch
                 (true, t)
             }
             Ended::Failed(t, reason) => {
-                report.failures.push(RunFailure { run, t, reason });
+                report.failures.push(RunFailure {
+                    run,
+                    t,
+                    reason,
+                    not_started_with_guesses: None,
+                });
                 (false, t)
             }
-            Ended::NotStarted(reason) => {
+            Ended::NotStarted(reason, has_guesses) => {
                 let t = f64::NAN;
-                report.failures.push(RunFailure { run, t, reason });
+                report.failures.push(RunFailure {
+                    run,
+                    t,
+                    reason,
+                    not_started_with_guesses: Some(has_guesses),
+                });
                 (false, t)
             }
         };

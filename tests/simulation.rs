@@ -267,6 +267,7 @@ fn a_batch_keeps_or_reports_failures_and_refuses_what_no_run_could_use() {
             .all(|f| f.t.is_finite() && f.t < 10.0)
     );
     assert!(report.y[report.y.len() - 6..].iter().all(|v| v.is_nan()));
+    assert!(report.failures.iter().all(|f| f.not_started_with_guesses.is_none()));
     let cartesian = eomgen::ModelSource::open("simple_pendulum_cartesian").unwrap();
     let make_cartesian = || cartesian.instantiate_send();
     let y0 = make_cartesian().initial_state();
@@ -293,6 +294,7 @@ fn a_batch_keeps_or_reports_failures_and_refuses_what_no_run_could_use() {
     assert_eq!(report.ok, vec![true, false, true]);
     assert_eq!(report.failures.len(), 1);
     assert!(report.failures[0].run == 1 && report.failures[0].t.is_nan());
+    assert!(report.failures[0].not_started_with_guesses.is_some());
     assert!(report.y[4..8].iter().all(|v| v.is_nan()));
     cartesian_options.keep_failures = false;
     let error = simulate_batch(

@@ -3,15 +3,17 @@
 
 use eomgen::OutputTimes;
 use eomgen::analysis::SimulationOptions;
-use eomgen::batch::{BatchError, BatchOptions, BatchReport, BatchRuns, simulate_batch};
+use eomgen::batch::{
+    BatchError, BatchOptions, BatchReport, BatchRuns, check_batch, simulate_batch,
+};
 use numpy::{PyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
 use crate::convert::matrix;
 use crate::model::{
-    CoreModel, MAX_OUTPUT_TIMES, RunError, check_bodies, method, set_parameter, simulation_error,
-    stabilization,
+    CoreModel, MAX_OUTPUT_TIMES, RunError, check_bodies, method, not_started_hint, set_parameter,
+    simulation_error, stabilization,
 };
 
 /// Runs `b` simulations of `model` and stacks them: see `eomgen.Model.simulate_many`.
@@ -46,31 +48,7 @@ pub fn simulate_many<'py>(
             t_out.len()
         )));
     }
-    let options = BatchOptions {
-        simulation: SimulationOptions {
-            method: method(method_name)?,
-            t_end,
-            rtol,
-            atol,
-            dt,
-            output: OutputTimes::At(t_out),
-            stabilization: stabilization(stabilization_name, baumgarte)?,
-            initial_state: None,
-        },
-        threads,
-        keep_failures,
-    };
-    // Every run's parameters are checked before any runs.
-    if let Some(sets) = &parameters {
-        for set in sets {
-            let mut probe = model.fresh()?;
-            for (name, value) in set {
-                set_parameter(probe.as_mut(), name, *value)?;
-            }
-            let all: Vec<(String, f64)> = model.overrides.iter().chain(set).cloned().collect();
-            check_bodies(probe.as_ref(), &all)?;
-        }
-    }
+    let dim = 2 * model.fresh()?.num_dofs();
     let runs = BatchRuns {
         initial_states: initial_states.as_ref().map(|a| {
             a.as_array()
@@ -81,6 +59,33 @@ pub fn simulate_many<'py>(
         }),
         parameters,
     };
+    let mut options = BatchOptions {
+        simulation: SimulationOptions {
+            t_end,
+            rtol,
+            atol,
+            dt,
+            output: OutputTimes::At(t_out),
+            ..SimulationOptions::default()
+        },
+        threads,
+        keep_failures,
+    };
+    // The batch's shape first, then the method and every run's parameters.
+    check_batch(&runs, &options, dim).map_err(|e| RunError::Value(e.to_string()).into_py())?;
+    options.simulation.method = method(method_name)?;
+    options.simulation.stabilization = stabilization(stabilization_name, baumgarte)?;
+    // Every run's parameters are checked before any runs.
+    if let Some(sets) = &runs.parameters {
+        for set in sets {
+            let mut probe = model.fresh()?;
+            for (name, value) in set {
+                set_parameter(probe.as_mut(), name, *value)?;
+            }
+            let all: Vec<(String, f64)> = model.overrides.iter().chain(set).cloned().collect();
+            check_bodies(probe.as_ref(), &all)?;
+        }
+    }
     let (loaded, overrides) = (model.loaded.clone(), model.overrides.clone());
     let make = move || {
         let mut instance = loaded.source.instantiate_send();
@@ -116,6 +121,9 @@ pub fn simulate_many<'py>(
                 .context(&format!("run {run}"))
                 .into_py());
         }
+        Err(e @ BatchError::ThreadPool(_)) => {
+            return Err(RunError::Analysis(e.to_string()).into_py());
+        }
         Err(e) => return Err(RunError::Value(e.to_string()).into_py()),
     };
     stacked(py, report)
@@ -138,7 +146,11 @@ fn stacked(py: Python<'_>, report: BatchReport) -> PyResult<Bound<'_, PyDict>> {
     out.set_item("rhs_evals", PyArray1::from_vec(py, report.rhs_evals))?;
     let failures = PyList::empty(py);
     for f in report.failures {
-        failures.append((f.run, f.t, f.reason))?;
+        let reason = match f.not_started_with_guesses {
+            Some(guesses) => format!("{}; {}", f.reason, not_started_hint(guesses)),
+            None => f.reason,
+        };
+        failures.append((f.run, f.t, reason))?;
     }
     out.set_item("failures", failures)?;
     out.set_item("t_final", PyArray1::from_vec(py, report.t_final))?;

@@ -326,14 +326,19 @@ pub(crate) fn run_simulation(
 pub(crate) fn simulation_error(e: SimulationError) -> RunError {
     match e {
         e @ SimulationError::InconsistentInitialState { has_guesses, .. } => {
-            let what_to_do = if has_guesses {
-                "start Newton from other guesses (initial=…)"
-            } else {
-                "give the dependent coordinates consistent values (initial=…), or mark them `{ guess: … }` in the model file's `initial:`"
-            };
-            RunError::Analysis(format!("{e}; {what_to_do}"))
+            RunError::Analysis(format!("{e}; {}", not_started_hint(has_guesses)))
         }
         e => RunError::Value(e.to_string()),
+    }
+}
+
+/// What to do about an initial state the constraints cannot accept, for a model that marks
+/// coordinates of its initial state as guesses or not.
+pub(crate) fn not_started_hint(has_guesses: bool) -> &'static str {
+    if has_guesses {
+        "start Newton from other guesses (initial=…)"
+    } else {
+        "give the dependent coordinates consistent values (initial=…), or mark them `{ guess: … }` in the model file's `initial:`"
     }
 }
 

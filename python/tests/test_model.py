@@ -653,7 +653,7 @@ def test_a_batch_refuses_shared_options_and_keeps_runs_that_cannot_start():
     batch = m.simulate_many(initial_states=bad, t_end=1.0, errors="keep")
     assert batch.ok.tolist() == [True, False, True]
     (index, t, reason), = batch.failures
-    assert index == 1 and math.isnan(t) and "violates" in reason
+    assert index == 1 and math.isnan(t) and "violates" in reason and "initial=" in reason
     assert np.isnan(batch.y[1]).all() and np.isfinite(batch.y[[0, 2]]).all()
     with pytest.raises(ValueError, match="threads"):
         m.simulate_many(initial_states=[y0], threads=0)
