@@ -303,6 +303,39 @@ pub fn reduce(
     options: &ReduceOptions,
 ) -> Result<ReducedModel, ReduceError> {
     unsupported(file)?;
+    check_options(options)?;
+    if file.constraints.is_empty() {
+        return Err(ReduceError::NoConstraints {
+            model: file.name.value.clone(),
+        });
+    }
+    let (kept, dependent) = split_coordinates(file, keep)?;
+    let mut r = Reducer::new(file);
+    let eliminations = r.solve(&dependent, options)?;
+    check_branches_used(&eliminations, options)?;
+    let initial = initial_overrides(file, &kept, options)?;
+    if let Some(detail) = r.singular_start(&initial) {
+        return Err(ReduceError::SingularStart { detail });
+    }
+    let name = options
+        .name
+        .clone()
+        .unwrap_or_else(|| format!("{}_in_{}", file.name.value, kept.join("_")));
+    let mut notes = Vec::new();
+    let text = r.write(&name, &kept, &eliminations, &initial, &mut notes)?;
+    let reduced = load_reduced(&name, &text)?;
+    Ok(ReducedModel {
+        text,
+        file: reduced,
+        kept,
+        eliminations,
+        notes,
+    })
+}
+
+/// Checks the options of [`reduce`] on their own: the name of the reduced model is an
+/// identifier and no coordinate is given two branches.
+fn check_options(options: &ReduceOptions) -> Result<(), ReduceError> {
     if let Some(name) = options
         .name
         .as_ref()
@@ -317,11 +350,16 @@ pub fn reduce(
             });
         }
     }
-    if file.constraints.is_empty() {
-        return Err(ReduceError::NoConstraints {
-            model: file.name.value.clone(),
-        });
-    }
+    Ok(())
+}
+
+/// The coordinates kept (names, in the file's order) and the indices of those eliminated,
+/// after checking that `keep` names coordinates of the file and leaves as many to eliminate
+/// as the file has holonomic constraints.
+fn split_coordinates(
+    file: &ModelFile,
+    keep: &[&str],
+) -> Result<(Vec<String>, Vec<usize>), ReduceError> {
     let names: Vec<&str> = file
         .coordinates
         .iter()
@@ -355,8 +393,15 @@ pub fn reduce(
             kept_count: names.len().saturating_sub(file.constraints.len()),
         });
     }
-    let mut r = Reducer::new(file);
-    let eliminations = r.solve(&dependent, options)?;
+    Ok((kept, dependent))
+}
+
+/// Checks that every branch of the options chose the solution of an eliminated coordinate
+/// that has branches.
+fn check_branches_used(
+    eliminations: &[Elimination],
+    options: &ReduceOptions,
+) -> Result<(), ReduceError> {
     for (name, _) in &options.branches {
         if !eliminations
             .iter()
@@ -367,23 +412,19 @@ pub fn reduce(
             });
         }
     }
-    let initial = initial_overrides(file, &kept, options)?;
-    if let Some(detail) = r.singular_start(&initial) {
-        return Err(ReduceError::SingularStart { detail });
-    }
-    let name = options
-        .name
-        .clone()
-        .unwrap_or_else(|| format!("{}_in_{}", file.name.value, kept.join("_")));
-    let mut notes = Vec::new();
-    let text = r.write(&name, &kept, &eliminations, &initial, &mut notes)?;
+    Ok(())
+}
+
+/// Loads the reduced file's `text` (named `name`) and checks that the compilers accept it:
+/// it loads, its derivation finishes and its mass matrix passes their check.
+fn load_reduced(name: &str, text: &str) -> Result<ModelFile, ReduceError> {
     let invalid = |d: Vec<super::Diagnostic>| ReduceError::Invalid {
         messages: d
             .iter()
             .map(|d| format!("{}:{}: {}", d.location.line, d.location.column, d.message))
             .collect(),
     };
-    let reduced = super::load(&format!("{name}.yaml"), &text).map_err(invalid)?;
+    let reduced = super::load(&format!("{name}.yaml"), text).map_err(invalid)?;
     // The compilers' own check of the mass matrix (at the start, and everywhere), so that
     // the file written is one they compile.
     let mut model = crate::mechanics::SymbolicModel::from_file(&reduced).map_err(invalid)?;
@@ -394,13 +435,7 @@ pub fn reduce(
     if !problems.is_empty() {
         return Err(invalid(problems));
     }
-    Ok(ReducedModel {
-        text,
-        file: reduced,
-        kept,
-        eliminations,
-        notes,
-    })
+    Ok(reduced)
 }
 
 /// The YAML text of `file` as [`reduce`] writes its results, with nothing eliminated: the

@@ -130,102 +130,118 @@ impl Shapes<'_> {
                 lhs,
                 rhs,
                 op_location,
-            } => {
-                let (a, b) = (self.shape(lhs), self.shape(rhs));
-                let (a, b) = (a?, b?);
-                use Shape::{Scalar, Vector};
-                let what = self.what;
-                let error = |message: String, help: &str| {
-                    Diagnostic::new(*op_location, message).with_help(help.to_string())
-                };
-                let result = match (op, a, b) {
-                    (_, Scalar, Scalar) => Ok(Scalar),
-                    (BinOp::Add | BinOp::Sub, Vector, Vector) => Ok(Vector),
-                    (BinOp::Add | BinOp::Sub, _, _) => Err(error(
-                        format!("`{}` in {what} adds a vector and a number", op.symbol()),
-                        "vectors add to vectors (`P - O`), numbers to numbers; take `norm(…)` or `dot(…)` of the vector",
-                    )),
-                    (BinOp::Mul, Vector, Vector) => Err(error(
-                        format!("`*` in {what} multiplies two vectors"),
-                        "the scalar product is `dot(a, b)`, the cross product `cross(a, b)`",
-                    )),
-                    (BinOp::Mul, _, _) => Ok(Vector),
-                    (BinOp::Div, Vector, Scalar) => Ok(Vector),
-                    (BinOp::Div, _, Vector) => Err(error(
-                        format!("`/` in {what} divides by a vector"),
-                        "divide by a number, such as `norm(a)`",
-                    )),
-                    (BinOp::Pow, _, _) => Err(error(
-                        format!("`^` in {what} raises a vector to a power"),
-                        "the square of a vector's length is `dot(a, a)`",
-                    )),
-                };
-                match result {
-                    Ok(s) => Some(s),
-                    Err(d) => {
-                        self.errors.push(d);
-                        None
-                    }
-                }
-            }
+            } => self.binary_shape(*op, lhs, rhs, *op_location),
             ExprKind::Call { func, args } if is_vector_function(func) => {
-                let shapes: Vec<Option<Shape>> = args.iter().map(|a| self.shape(a)).collect();
-                for (a, s) in args.iter().zip(&shapes) {
-                    if *s == Some(Shape::Scalar) {
-                        let help = match func.as_str() {
-                            "distance" => {
-                                "`distance(A, B)` takes two points, as in `distance(P1, P2)`"
-                            }
-                            "vel" => "`vel(P)` takes a point (or a vector of points, `vel(P - O)`)",
-                            _ => {
-                                "its arguments are points or vectors of points, as in `P - O` or `vel(P)`"
-                            }
-                        };
-                        self.errors.push(
-                            Diagnostic::new(
-                                a.location,
-                                format!(
-                                    "`{func}` in {} takes vectors, but `{a}` is a number",
-                                    self.what
-                                ),
-                            )
-                            .with_help(help),
-                        );
-                    }
-                }
-                if shapes.iter().any(|s| s != &Some(Shape::Vector)) {
-                    return None;
-                }
-                Some(match func.as_str() {
-                    "vel" => Shape::Vector,
-                    "cross" if self.dimension == 3 => Shape::Vector,
-                    _ => Shape::Scalar,
-                })
+                self.vector_call_shape(func, args)
             }
-            ExprKind::Call { func, args } => {
-                let mut fine = true;
-                for a in args {
-                    match self.shape(a) {
-                        Some(Shape::Scalar) => {}
-                        Some(Shape::Vector) => {
-                            self.errors.push(
-                                Diagnostic::new(
-                                    a.location,
-                                    format!(
-                                        "`{func}` in {} takes a number, but `{a}` is a vector",
-                                        self.what
-                                    ),
-                                )
-                                .with_help(self.reduce_help()),
-                            );
-                            fine = false;
-                        }
-                        None => fine = false,
-                    }
-                }
-                fine.then_some(Shape::Scalar)
+            ExprKind::Call { func, args } => self.scalar_call_shape(func, args),
+        }
+    }
+
+    /// The shape of `lhs op rhs` (the operator at `op_location`): numbers combine freely,
+    /// vectors add to vectors and scale by numbers; anything else is an error.
+    fn binary_shape(
+        &mut self,
+        op: BinOp,
+        lhs: &Expr,
+        rhs: &Expr,
+        op_location: Location,
+    ) -> Option<Shape> {
+        let (a, b) = (self.shape(lhs), self.shape(rhs));
+        let (a, b) = (a?, b?);
+        use Shape::{Scalar, Vector};
+        let what = self.what;
+        let error = |message: String, help: &str| {
+            Diagnostic::new(op_location, message).with_help(help.to_string())
+        };
+        let result = match (op, a, b) {
+            (_, Scalar, Scalar) => Ok(Scalar),
+            (BinOp::Add | BinOp::Sub, Vector, Vector) => Ok(Vector),
+            (BinOp::Add | BinOp::Sub, _, _) => Err(error(
+                format!("`{}` in {what} adds a vector and a number", op.symbol()),
+                "vectors add to vectors (`P - O`), numbers to numbers; take `norm(…)` or `dot(…)` of the vector",
+            )),
+            (BinOp::Mul, Vector, Vector) => Err(error(
+                format!("`*` in {what} multiplies two vectors"),
+                "the scalar product is `dot(a, b)`, the cross product `cross(a, b)`",
+            )),
+            (BinOp::Mul, _, _) => Ok(Vector),
+            (BinOp::Div, Vector, Scalar) => Ok(Vector),
+            (BinOp::Div, _, Vector) => Err(error(
+                format!("`/` in {what} divides by a vector"),
+                "divide by a number, such as `norm(a)`",
+            )),
+            (BinOp::Pow, _, _) => Err(error(
+                format!("`^` in {what} raises a vector to a power"),
+                "the square of a vector's length is `dot(a, a)`",
+            )),
+        };
+        match result {
+            Ok(s) => Some(s),
+            Err(d) => {
+                self.errors.push(d);
+                None
             }
         }
+    }
+
+    /// The shape of a call of the vector function `func`: its arguments must be vectors; `vel`
+    /// (and `cross` in 3-D) gives a vector, the others a number.
+    fn vector_call_shape(&mut self, func: &str, args: &[Expr]) -> Option<Shape> {
+        let shapes: Vec<Option<Shape>> = args.iter().map(|a| self.shape(a)).collect();
+        for (a, s) in args.iter().zip(&shapes) {
+            if *s == Some(Shape::Scalar) {
+                let help = match func {
+                    "distance" => "`distance(A, B)` takes two points, as in `distance(P1, P2)`",
+                    "vel" => "`vel(P)` takes a point (or a vector of points, `vel(P - O)`)",
+                    _ => "its arguments are points or vectors of points, as in `P - O` or `vel(P)`",
+                };
+                self.errors.push(
+                    Diagnostic::new(
+                        a.location,
+                        format!(
+                            "`{func}` in {} takes vectors, but `{a}` is a number",
+                            self.what
+                        ),
+                    )
+                    .with_help(help),
+                );
+            }
+        }
+        if shapes.iter().any(|s| s != &Some(Shape::Vector)) {
+            return None;
+        }
+        Some(match func {
+            "vel" => Shape::Vector,
+            "cross" if self.dimension == 3 => Shape::Vector,
+            _ => Shape::Scalar,
+        })
+    }
+
+    /// The shape of a call of the ordinary function `func`: a number, when its arguments are
+    /// numbers.
+    fn scalar_call_shape(&mut self, func: &str, args: &[Expr]) -> Option<Shape> {
+        let mut fine = true;
+        for a in args {
+            match self.shape(a) {
+                Some(Shape::Scalar) => {}
+                Some(Shape::Vector) => {
+                    self.errors.push(
+                        Diagnostic::new(
+                            a.location,
+                            format!(
+                                "`{func}` in {} takes a number, but `{a}` is a vector",
+                                self.what
+                            ),
+                        )
+                        .with_help(self.reduce_help()),
+                    );
+                    fine = false;
+                }
+                None => fine = false,
+            }
+        }
+        fine.then_some(Shape::Scalar)
     }
 }
 

@@ -21,53 +21,8 @@ impl Reducer<'_> {
         let mut solved: FxHashMap<SymbolId, ExprId> = FxHashMap::default();
         let mut eliminations: Vec<(usize, Elimination, ExprId)> = Vec::new();
         while !unsolved.is_empty() {
-            let mut first_failure: Option<ReduceError> = None;
-            let mut found = None;
-            // Constraints with the fewest unsolved coordinates first.
-            let mut order: Vec<(usize, Vec<usize>, ExprId)> = Vec::new();
-            for (k, (_, phi)) in constraints.iter().enumerate() {
-                let phi = self.arena.substitute(*phi, &solved);
-                let involved: Vec<usize> = unsolved
-                    .iter()
-                    .copied()
-                    .filter(|&i| self.arena.depends_on(phi, self.coordinates[i][0]))
-                    .collect();
-                order.push((k, involved, phi));
-            }
-            order.sort_by_key(|(_, inv, _)| inv.len());
-            'search: for (k, involved, phi) in &order {
-                if involved.is_empty() {
-                    let (name, _) = &constraints[*k];
-                    let coordinate = self.file.coordinates[unsolved[0]].name.value.clone();
-                    first_failure.get_or_insert(ReduceError::Unsolvable {
-                        constraint: name.clone(),
-                        coordinate,
-                        reason: "the constraint does not contain the coordinates to eliminate \
-                                 (after the others are substituted): it constrains the kept \
-                                 coordinates alone; keep other coordinates"
-                            .to_string(),
-                    });
-                    continue;
-                }
-                for &i in involved {
-                    match self.solve_one(&constraints[*k].0, *phi, i, options) {
-                        Ok(found_one) => {
-                            found = Some((*k, i, found_one));
-                            break 'search;
-                        }
-                        Err(e) => {
-                            first_failure.get_or_insert(e);
-                        }
-                    }
-                }
-            }
-            let Some((k, i, (elimination, root))) = found else {
-                return Err(first_failure.unwrap_or_else(|| ReduceError::Unsolvable {
-                    constraint: constraints[0].0.clone(),
-                    coordinate: self.file.coordinates[unsolved[0]].name.value.clone(),
-                    reason: "no constraint contains it".to_string(),
-                }));
-            };
+            let (k, i, (elimination, root)) =
+                self.next_elimination(&constraints, &unsolved, &solved, options)?;
             let q = self.coordinates[i][0];
             let one: FxHashMap<SymbolId, ExprId> = [(q, root)].into_iter().collect();
             for v in solved.values_mut() {
@@ -78,6 +33,78 @@ impl Reducer<'_> {
             unsolved.retain(|&j| j != i);
             eliminations.push((i, elimination, root));
         }
+        Ok(self.finish_eliminations(eliminations, &solved))
+    }
+
+    /// Finds the next constraint to solve and the coordinate it eliminates (the constraints
+    /// with the fewest unsolved coordinates first, with `solved` substituted): its index in
+    /// `constraints`, the coordinate's index, the elimination and its solution; otherwise the
+    /// first failure met.
+    fn next_elimination(
+        &mut self,
+        constraints: &[(String, ExprId)],
+        unsolved: &[usize],
+        solved: &FxHashMap<SymbolId, ExprId>,
+        options: &ReduceOptions,
+    ) -> Result<(usize, usize, (Elimination, ExprId)), ReduceError> {
+        let mut first_failure: Option<ReduceError> = None;
+        let mut found = None;
+        // Constraints with the fewest unsolved coordinates first.
+        let mut order: Vec<(usize, Vec<usize>, ExprId)> = Vec::new();
+        for (k, (_, phi)) in constraints.iter().enumerate() {
+            let phi = self.arena.substitute(*phi, solved);
+            let involved: Vec<usize> = unsolved
+                .iter()
+                .copied()
+                .filter(|&i| self.arena.depends_on(phi, self.coordinates[i][0]))
+                .collect();
+            order.push((k, involved, phi));
+        }
+        order.sort_by_key(|(_, inv, _)| inv.len());
+        'search: for (k, involved, phi) in &order {
+            if involved.is_empty() {
+                let (name, _) = &constraints[*k];
+                let coordinate = self.file.coordinates[unsolved[0]].name.value.clone();
+                first_failure.get_or_insert(ReduceError::Unsolvable {
+                    constraint: name.clone(),
+                    coordinate,
+                    reason: "the constraint does not contain the coordinates to eliminate \
+                             (after the others are substituted): it constrains the kept \
+                             coordinates alone; keep other coordinates"
+                        .to_string(),
+                });
+                continue;
+            }
+            for &i in involved {
+                match self.solve_one(&constraints[*k].0, *phi, i, options) {
+                    Ok(found_one) => {
+                        found = Some((*k, i, found_one));
+                        break 'search;
+                    }
+                    Err(e) => {
+                        first_failure.get_or_insert(e);
+                    }
+                }
+            }
+        }
+        let Some(found) = found else {
+            return Err(first_failure.unwrap_or_else(|| ReduceError::Unsolvable {
+                constraint: constraints[0].0.clone(),
+                coordinate: self.file.coordinates[unsolved[0]].name.value.clone(),
+                reason: "no constraint contains it".to_string(),
+            }));
+        };
+        Ok(found)
+    }
+
+    /// Records the eliminations, in the order solved: their solutions in the kept coordinates
+    /// alone (`solved`) and their rates by the chain rule, the names they remove, and the
+    /// singularity expressions in the kept coordinates.
+    fn finish_eliminations(
+        &mut self,
+        eliminations: Vec<(usize, Elimination, ExprId)>,
+        solved: &FxHashMap<SymbolId, ExprId>,
+    ) -> Vec<Elimination> {
         // Solutions in the kept coordinates alone, and their rates by the chain rule.
         let mut out = Vec::new();
         for (i, mut elimination, _) in eliminations {
@@ -105,9 +132,9 @@ impl Reducer<'_> {
         );
         // The singularity expressions in the kept coordinates too.
         for (_, e, _) in &mut self.singular_where {
-            *e = self.arena.substitute(*e, &solved);
+            *e = self.arena.substitute(*e, solved);
         }
-        Ok(out)
+        out
     }
 
     /// Solves `phi = 0` for coordinate `i`.

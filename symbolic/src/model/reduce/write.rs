@@ -698,6 +698,50 @@ impl Reducer<'_> {
                     .to_string()
             });
         }
+        self.write_modal_checks(&mut w, equilibria, notes);
+        self.write_run_checks(&mut w, events, kept, notes);
+        if !c.conserved.is_empty() {
+            let mut block = String::new();
+            for q in &c.conserved {
+                let place = format!("conserved quantity `{}`", q.name.value);
+                let v = self.rewrite(&q.value, &place)?;
+                let _ = writeln!(
+                    block,
+                    "    {}: {{ value: {}, tolerance: {:e} }}",
+                    q.name.value,
+                    flow(&v),
+                    q.tolerance
+                );
+            }
+            let _ = writeln!(w, "  conserved:");
+            w.push_str(&block);
+        }
+        if let Some(d) = &c.energy_drift {
+            let _ = writeln!(
+                w,
+                "  energy_drift: {{ max: {:e}{} }}",
+                d.max,
+                run_settings(&d.run, true)
+            );
+        }
+        if let Some(d) = c.constraint_drift.as_ref().filter(|_| preserve) {
+            let _ = writeln!(
+                w,
+                "  constraint_drift: {{ max: {:e}{} }}",
+                d.max,
+                run_settings(&d.run, true)
+            );
+        } else if c.constraint_drift.is_some() {
+            notes.push("`checks: constraint_drift` left out (no constraints)".to_string());
+        }
+        Ok(w)
+    }
+
+    /// Writes `natural_frequencies` and `damping_ratios` of `checks:` into `w` when their
+    /// equilibrium is kept (the first one when they name none), noting each left out.
+    fn write_modal_checks(&self, w: &mut String, equilibria: &[String], notes: &mut Vec<String>) {
+        use std::fmt::Write as _;
+        let c = &self.file.checks;
         let first_kept = self
             .file
             .equilibria
@@ -730,6 +774,19 @@ impl Reducer<'_> {
                 m.tolerance
             );
         }
+    }
+
+    /// Writes the `period` (when its event is kept) and the `final_state` (its values of the
+    /// kept coordinates and rates) of `checks:` into `w`, noting what is left out.
+    fn write_run_checks(
+        &self,
+        w: &mut String,
+        events: &[String],
+        kept: &[String],
+        notes: &mut Vec<String>,
+    ) {
+        use std::fmt::Write as _;
+        let c = &self.file.checks;
         if let Some(p) = &c.period {
             if events.contains(&p.event.value) {
                 let _ = writeln!(
@@ -772,41 +829,6 @@ impl Reducer<'_> {
                 );
             }
         }
-        if !c.conserved.is_empty() {
-            let mut block = String::new();
-            for q in &c.conserved {
-                let place = format!("conserved quantity `{}`", q.name.value);
-                let v = self.rewrite(&q.value, &place)?;
-                let _ = writeln!(
-                    block,
-                    "    {}: {{ value: {}, tolerance: {:e} }}",
-                    q.name.value,
-                    flow(&v),
-                    q.tolerance
-                );
-            }
-            let _ = writeln!(w, "  conserved:");
-            w.push_str(&block);
-        }
-        if let Some(d) = &c.energy_drift {
-            let _ = writeln!(
-                w,
-                "  energy_drift: {{ max: {:e}{} }}",
-                d.max,
-                run_settings(&d.run, true)
-            );
-        }
-        if let Some(d) = c.constraint_drift.as_ref().filter(|_| preserve) {
-            let _ = writeln!(
-                w,
-                "  constraint_drift: {{ max: {:e}{} }}",
-                d.max,
-                run_settings(&d.run, true)
-            );
-        } else if c.constraint_drift.is_some() {
-            notes.push("`checks: constraint_drift` left out (no constraints)".to_string());
-        }
-        Ok(w)
     }
 }
 

@@ -400,6 +400,13 @@ impl Checker<'_> {
                 );
             }
         }
+        self.vector_lengths(dim);
+        self.spatial_pieces(dim);
+    }
+
+    /// Checks that `gravity` and every force have `dim` components, as the points do.
+    fn vector_lengths(&mut self, dim: usize) {
+        let file = self.file;
         if let Some(g) = &file.gravity
             && g.value.len() != dim
         {
@@ -427,6 +434,12 @@ impl Checker<'_> {
                 ));
             }
         }
+    }
+
+    /// Checks that the 3-D pieces (3-D bodies, forces written in frames, 3-D torques, frames)
+    /// fit the points' dimension `dim`, and that planar rigid bodies are in a 2-D model.
+    fn spatial_pieces(&mut self, dim: usize) {
+        let file = self.file;
         for b in &file.bodies {
             match (&b.kind, dim) {
                 (BodyKind::Rigid { .. }, 3) => self.error(

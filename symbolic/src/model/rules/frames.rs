@@ -8,6 +8,43 @@ impl Checker<'_> {
     // written from another point names one defined before it, and its vectors known frames.
     pub(super) fn frames(&mut self) {
         let file = self.file;
+        self.frame_tree();
+        let frames: Vec<&str> = file
+            .frames
+            .iter()
+            .map(|f| f.name.value.as_str())
+            .chain([GROUND_FRAME])
+            .collect();
+        self.point_origins(&frames);
+        for b in &file.bodies {
+            if let BodyKind::Spatial { frame, .. } = &b.kind {
+                self.frame(frame, &frames);
+            }
+        }
+        for f in &file.forces {
+            if let Some(frame) = &f.frame {
+                self.frame(frame, &frames);
+            }
+        }
+        for w in &file.draw.wheels {
+            self.point(&w.centre);
+            self.frame(&w.frame, &frames);
+            self.resolve(&w.radius, Depends::Constant, "the radius of a drawn wheel");
+        }
+        for t in &file.torques {
+            if let TorqueValue::Spatial {
+                frame: Some(frame), ..
+            } = &t.value
+            {
+                self.frame(frame, &frames);
+            }
+        }
+    }
+
+    /// Checks the frame names (not reserved, not repeated) and that each frame's parent is the
+    /// ground or a frame defined before it.
+    fn frame_tree(&mut self) {
+        let file = self.file;
         let mut defined: Vec<&str> = vec![GROUND_FRAME];
         for f in &file.frames {
             let n = f.name.value.as_str();
@@ -45,12 +82,12 @@ impl Checker<'_> {
             }
             defined.push(n);
         }
-        let frames: Vec<&str> = file
-            .frames
-            .iter()
-            .map(|f| f.name.value.as_str())
-            .chain([GROUND_FRAME])
-            .collect();
+    }
+
+    /// Checks that each wheel centre and each point a point is measured from are defined
+    /// before it, and that the frames of wheels and of relative vectors are among `frames`.
+    fn point_origins(&mut self, frames: &[&str]) {
+        let file = self.file;
         for (i, p) in file.points.iter().enumerate() {
             if let Some(wheel) = &p.wheel {
                 let earlier = file.points[..i]
@@ -68,7 +105,7 @@ impl Checker<'_> {
                 } else {
                     self.point(&wheel.centre);
                 }
-                self.frame(&wheel.frame, &frames);
+                self.frame(&wheel.frame, frames);
                 self.resolve(
                     &wheel.radius,
                     Depends::Constant,
@@ -98,30 +135,7 @@ impl Checker<'_> {
                 }
             }
             for (frame, _) in &relative.vectors {
-                self.frame(frame, &frames);
-            }
-        }
-        for b in &file.bodies {
-            if let BodyKind::Spatial { frame, .. } = &b.kind {
-                self.frame(frame, &frames);
-            }
-        }
-        for f in &file.forces {
-            if let Some(frame) = &f.frame {
-                self.frame(frame, &frames);
-            }
-        }
-        for w in &file.draw.wheels {
-            self.point(&w.centre);
-            self.frame(&w.frame, &frames);
-            self.resolve(&w.radius, Depends::Constant, "the radius of a drawn wheel");
-        }
-        for t in &file.torques {
-            if let TorqueValue::Spatial {
-                frame: Some(frame), ..
-            } = &t.value
-            {
-                self.frame(frame, &frames);
+                self.frame(frame, frames);
             }
         }
     }

@@ -198,6 +198,22 @@ impl Checker<'_> {
         if file.balances.is_empty() {
             return;
         }
+        self.balance_counts();
+        self.balance_loads();
+        for b in &file.balances {
+            self.balance_bodies(&b.bodies);
+            match &b.kind {
+                BalanceKind::Amb {
+                    about, axis, frame, ..
+                } => self.amb_balance(b.location, about, axis.as_ref(), frame.as_ref()),
+                BalanceKind::Lmb { along } => self.lmb_balance(b.location, along),
+            }
+        }
+    }
+
+    /// Checks that each set of balances has one balance per coordinate.
+    fn balance_counts(&mut self) {
+        let file = self.file;
         let n = file.coordinates.len();
         for set in file.balance_sets() {
             let count = file.balances.iter().filter(|b| b.set_name() == set).count();
@@ -219,6 +235,12 @@ impl Checker<'_> {
                 );
             }
         }
+    }
+
+    /// Checks that a model with balances has no point loads (forces, springs, dampers,
+    /// interactions) and no energy-form pieces.
+    fn balance_loads(&mut self) {
+        let file = self.file;
         let point_loads = file
             .forces
             .first()
@@ -243,105 +265,110 @@ impl Checker<'_> {
                     .with_help("describe the mechanism with `points`, `bodies` and loads"),
             );
         }
-        for b in &file.balances {
-            let mut seen: Vec<&str> = Vec::new();
-            for body in &b.bodies {
-                if !self.bodies.contains(&body.value.as_str()) {
-                    let d = Diagnostic::new(
-                        body.location,
-                        format!("unknown body `{}` in a balance", body.value),
-                    );
-                    let d = match closest(&body.value, &self.bodies) {
-                        Some(c) => d.with_help(format!("did you mean `{c}`?")),
-                        None => d.with_help(format!("bodies are: {}", self.bodies.join(", "))),
-                    };
-                    self.error(d);
-                } else if seen.contains(&body.value.as_str()) {
-                    self.error(Diagnostic::new(
-                        body.location,
-                        format!("body `{}` is listed twice in this balance", body.value),
-                    ));
-                }
-                seen.push(body.value.as_str());
+    }
+
+    /// Checks that the bodies of one balance exist and are each listed once.
+    fn balance_bodies(&mut self, bodies: &[Located<String>]) {
+        let mut seen: Vec<&str> = Vec::new();
+        for body in bodies {
+            if !self.bodies.contains(&body.value.as_str()) {
+                let d = Diagnostic::new(
+                    body.location,
+                    format!("unknown body `{}` in a balance", body.value),
+                );
+                let d = match closest(&body.value, &self.bodies) {
+                    Some(c) => d.with_help(format!("did you mean `{c}`?")),
+                    None => d.with_help(format!("bodies are: {}", self.bodies.join(", "))),
+                };
+                self.error(d);
+            } else if seen.contains(&body.value.as_str()) {
+                self.error(Diagnostic::new(
+                    body.location,
+                    format!("body `{}` is listed twice in this balance", body.value),
+                ));
             }
-            match &b.kind {
-                BalanceKind::Amb {
-                    about, axis, frame, ..
-                } => {
-                    if !self.points.contains(&about.value.as_str()) {
-                        let d = Diagnostic::new(
-                            about.location,
-                            format!("unknown point `{}`", about.value),
-                        );
-                        let d = match closest(&about.value, &self.points) {
-                            Some(c) => d.with_help(format!("did you mean `{c}`?")),
-                            None => d.with_help(format!("points are: {}", self.points.join(", "))),
-                        };
-                        self.error(d);
-                    }
-                    match (file.dimension, axis) {
-                        (Some(3), None) => self.error(
-                            Diagnostic::new(b.location, "an `amb` balance of a 3-D model needs the `axis` it takes moments about")
-                                .with_help("write `{ amb: { about: O, bodies: [top], axis: [0, 0, 1], in: N } }`: the balance Σ M_O·e = (dH_O/dt)·e along that axis"),
-                        ),
-                        (Some(3), Some(axis)) if axis.value.len() != 3 => self.error(
-                            Diagnostic::new(axis.location, format!("`axis` has {} components; a 3-D axis has 3", axis.value.len()))
-                                .with_help("write `axis: [0, 0, 1]`"),
-                        ),
-                        (Some(2), Some(axis)) => self.error(
-                            Diagnostic::new(axis.location, "an `amb` balance of a planar model takes moments about the normal to the plane: it has no `axis`")
-                                .with_help("leave out `axis` (and `in`)"),
-                        ),
-                        _ => {}
-                    }
-                    if let Some(axis) = axis {
-                        for c in &axis.value {
-                            self.resolve(c, Depends::Position, "the axis of an `amb` balance");
-                        }
-                    }
-                    if let Some(frame) = frame {
-                        let frames: Vec<&str> = file
-                            .frames
-                            .iter()
-                            .map(|f| f.name.value.as_str())
-                            .chain([GROUND_FRAME])
-                            .collect();
-                        self.frame(frame, &frames);
-                    }
-                }
-                BalanceKind::Lmb { along } => {
-                    if let Some(dim) = file.dimension
-                        && along.len() != dim
-                    {
-                        self.error(Diagnostic::new(
-                            b.location,
-                            format!(
-                                "`along` has {} components but the points have {dim}",
-                                along.len()
-                            ),
-                        ));
-                    }
-                    for e in along {
-                        let mut ids = Vec::new();
-                        identifiers(e, &mut ids);
-                        for (name, location) in ids {
-                            let ok = self.sets.params.contains(name.as_str())
-                                || self.sets.coords.contains(name.as_str())
-                                || name == "t"
-                                || name == "pi";
-                            if !ok {
-                                self.error(
-                                    Diagnostic::new(
-                                        location,
-                                        format!("`along` cannot use `{name}`"),
-                                    )
-                                    .with_help(
-                                        "a direction may use parameters, coordinates and `t`",
-                                    ),
-                                );
-                            }
-                        }
-                    }
+            seen.push(body.value.as_str());
+        }
+    }
+
+    /// Checks an AMB balance (at `location`): its point exists, it has an `axis` of three
+    /// components exactly in a 3-D model, the axis depends on the configuration only, and
+    /// its frame `in` exists.
+    fn amb_balance(
+        &mut self,
+        location: Location,
+        about: &Located<String>,
+        axis: Option<&Located<Vec<Expr>>>,
+        frame: Option<&Located<String>>,
+    ) {
+        let file = self.file;
+        if !self.points.contains(&about.value.as_str()) {
+            let d = Diagnostic::new(about.location, format!("unknown point `{}`", about.value));
+            let d = match closest(&about.value, &self.points) {
+                Some(c) => d.with_help(format!("did you mean `{c}`?")),
+                None => d.with_help(format!("points are: {}", self.points.join(", "))),
+            };
+            self.error(d);
+        }
+        match (file.dimension, axis) {
+            (Some(3), None) => self.error(
+                Diagnostic::new(location, "an `amb` balance of a 3-D model needs the `axis` it takes moments about")
+                    .with_help("write `{ amb: { about: O, bodies: [top], axis: [0, 0, 1], in: N } }`: the balance Σ M_O·e = (dH_O/dt)·e along that axis"),
+            ),
+            (Some(3), Some(axis)) if axis.value.len() != 3 => self.error(
+                Diagnostic::new(axis.location, format!("`axis` has {} components; a 3-D axis has 3", axis.value.len()))
+                    .with_help("write `axis: [0, 0, 1]`"),
+            ),
+            (Some(2), Some(axis)) => self.error(
+                Diagnostic::new(axis.location, "an `amb` balance of a planar model takes moments about the normal to the plane: it has no `axis`")
+                    .with_help("leave out `axis` (and `in`)"),
+            ),
+            _ => {}
+        }
+        if let Some(axis) = axis {
+            for c in &axis.value {
+                self.resolve(c, Depends::Position, "the axis of an `amb` balance");
+            }
+        }
+        if let Some(frame) = frame {
+            let frames: Vec<&str> = file
+                .frames
+                .iter()
+                .map(|f| f.name.value.as_str())
+                .chain([GROUND_FRAME])
+                .collect();
+            self.frame(frame, &frames);
+        }
+    }
+
+    /// Checks an LMB balance (at `location`): its direction `along` has as many components as
+    /// the points and uses only parameters, coordinates, `t` and `pi`.
+    fn lmb_balance(&mut self, location: Location, along: &[Expr]) {
+        let file = self.file;
+        if let Some(dim) = file.dimension
+            && along.len() != dim
+        {
+            self.error(Diagnostic::new(
+                location,
+                format!(
+                    "`along` has {} components but the points have {dim}",
+                    along.len()
+                ),
+            ));
+        }
+        for e in along {
+            let mut ids = Vec::new();
+            identifiers(e, &mut ids);
+            for (name, location) in ids {
+                let ok = self.sets.params.contains(name.as_str())
+                    || self.sets.coords.contains(name.as_str())
+                    || name == "t"
+                    || name == "pi";
+                if !ok {
+                    self.error(
+                        Diagnostic::new(location, format!("`along` cannot use `{name}`"))
+                            .with_help("a direction may use parameters, coordinates and `t`"),
+                    );
                 }
             }
         }

@@ -27,6 +27,17 @@ impl Checker<'_> {
         for p in &file.draw.trace {
             self.point(p);
         }
+        self.torque_bodies();
+        let coordinates_lost = self.section_lost("coordinates", self.coords.is_empty());
+        self.generalized_force_keys(coordinates_lost);
+        self.equilibrium_keys(coordinates_lost);
+        self.initial_keys(coordinates_lost);
+    }
+
+    /// Checks that each torque acts on an existing rigid body of its kind: a number on a
+    /// planar body, a vector on a 3-D one.
+    fn torque_bodies(&mut self) {
+        let file = self.file;
         for t in &file.torques {
             let name = &t.body.value;
             match file.bodies.iter().find(|b| b.name.value == *name) {
@@ -61,7 +72,12 @@ impl Checker<'_> {
                 }
             }
         }
-        let coordinates_lost = self.section_lost("coordinates", self.coords.is_empty());
+    }
+
+    /// Checks that `generalized_forces` is keyed by coordinates (unless the coordinates were
+    /// lost to an earlier error).
+    fn generalized_force_keys(&mut self, coordinates_lost: bool) {
+        let file = self.file;
         for (k, _) in &file.generalized_forces {
             let n = k.value.as_str();
             if self.sets.coords.contains(n) || self.incomplete.has_name(n) || coordinates_lost {
@@ -77,6 +93,12 @@ impl Checker<'_> {
             };
             self.error(d);
         }
+    }
+
+    /// Checks that each equilibrium gives values of coordinates or rates and that its
+    /// `ignorable` names coordinates.
+    fn equilibrium_keys(&mut self, coordinates_lost: bool) {
+        let file = self.file;
         for q in &file.equilibria {
             for (k, _) in &q.values {
                 let n = k.value.as_str();
@@ -124,6 +146,11 @@ impl Checker<'_> {
                 self.error(d);
             }
         }
+    }
+
+    /// Checks that `initial` gives values of coordinates or rates.
+    fn initial_keys(&mut self, coordinates_lost: bool) {
+        let file = self.file;
         for (k, _) in &file.initial {
             let n = k.value.as_str();
             let base = n.strip_suffix("_dot").unwrap_or(n);
