@@ -267,7 +267,12 @@ fn a_batch_keeps_or_reports_failures_and_refuses_what_no_run_could_use() {
             .all(|f| f.t.is_finite() && f.t < 10.0)
     );
     assert!(report.y[report.y.len() - 6..].iter().all(|v| v.is_nan()));
-    assert!(report.failures.iter().all(|f| f.not_started_with_guesses.is_none()));
+    assert!(
+        report
+            .failures
+            .iter()
+            .all(|f| f.not_started_with_guesses.is_none())
+    );
     let cartesian = eomgen::ModelSource::open("simple_pendulum_cartesian").unwrap();
     let make_cartesian = || cartesian.instantiate_send();
     let y0 = make_cartesian().initial_state();

@@ -598,38 +598,12 @@ pub fn linearize(
         return Err(ModalError::ConstrainedMotion { speed });
     }
     let c = model.constraint_equations(t, &y);
-    let (worst, residual) = c
-        .phi
-        .iter()
-        .map(|v| if v.is_nan() { f64::INFINITY } else { v.abs() })
-        .enumerate()
-        .fold((0, 0.0f64), |b, x| if x.1 > b.1 { x } else { b });
-    if residual > 1e-8 {
-        return Err(ModalError::OffConstraints {
-            constraint: model.description().constraints[worst].to_string(),
-            residual,
-        });
-    }
+    check_on_constraints(model, &c.phi)?;
     let j = c.jacobian.rows(0, m).into_owned();
     if !(finite(&mass) && finite(&j) && finite(&jq) && finite(&jqd)) {
         return Err(ModalError::NonFinite { q: q.to_vec() });
     }
-    // [M Jᵀ; J 0][q̈; λ] = [F; γ] in the minimum-norm sense (redundant constraints leave λ
-    // undetermined; the minimum-norm λ is then used).
-    let mut kkt = DMatrix::zeros(n + m, n + m);
-    kkt.view_mut((0, 0), (n, n)).copy_from(&mass);
-    kkt.view_mut((0, n), (n, m)).copy_from(&j.transpose());
-    kkt.view_mut((n, 0), (m, n)).copy_from(&j);
-    let mut rhs = DVector::zeros(n + m);
-    rhs.rows_mut(0, n).copy_from(&f);
-    rhs.rows_mut(n, m).copy_from(&c.gamma.rows(0, m));
-    let svd = kkt.svd(true, true);
-    let eps = 1e-12 * svd.singular_values.max();
-    let solution = svd
-        .solve(&rhs, eps)
-        .map_err(|_| ModalError::SingularMassMatrix { q: q.to_vec() })?;
-    let qdd = solution.rows(0, n).into_owned();
-    let lambda: Vec<f64> = solution.rows(n, m).iter().copied().collect();
+    let (qdd, lambda) = constrained_accelerations(&mass, &j, &f, &c.gamma, q)?;
     let mut k_full = model.mass_matrix_product_jacobian(t, &y, qdd.as_slice()) - jq;
     for (l, h) in lambda.iter().zip(constraint_hessians(model, q, t)) {
         k_full += h * *l;
@@ -662,6 +636,60 @@ pub fn linearize(
         lagrange_multipliers: lambda,
         differenced_entries,
     })
+}
+
+/// Checks that the state is on the holonomic constraints: every residual `|Φᵢ|` at most
+/// `1e-8` (a NaN counts as infinite).
+///
+/// # Errors
+/// [`ModalError::OffConstraints`] naming the constraint with the largest residual.
+fn check_on_constraints(model: &dyn ModelInfo, phi: &DVector<f64>) -> Result<(), ModalError> {
+    let (worst, residual) = phi
+        .iter()
+        .map(|v| if v.is_nan() { f64::INFINITY } else { v.abs() })
+        .enumerate()
+        .fold((0, 0.0f64), |b, x| if x.1 > b.1 { x } else { b });
+    if residual > 1e-8 {
+        return Err(ModalError::OffConstraints {
+            constraint: model.description().constraints[worst].to_string(),
+            residual,
+        });
+    }
+    Ok(())
+}
+
+/// `q̈` (length `n`) and `λ` (length `m`) from `[M Jᵀ; J 0][q̈; λ] = [F; γ]` (`M` `n × n`,
+/// `J` `m × n`, `F` length `n`, the first `m` entries of `gamma`), solved by SVD in the
+/// minimum-norm sense, singular values below `1e-12` of the largest dropped; `q` (length `n`)
+/// only names the point in the error.
+///
+/// # Errors
+/// [`ModalError::SingularMassMatrix`] when the solve fails.
+fn constrained_accelerations(
+    mass: &DMatrix<f64>,
+    j: &DMatrix<f64>,
+    f: &DVector<f64>,
+    gamma: &DVector<f64>,
+    q: &[f64],
+) -> Result<(DVector<f64>, Vec<f64>), ModalError> {
+    let (n, m) = (q.len(), j.nrows());
+    // [M Jᵀ; J 0][q̈; λ] = [F; γ] in the minimum-norm sense (redundant constraints leave λ
+    // undetermined; the minimum-norm λ is then used).
+    let mut kkt = DMatrix::zeros(n + m, n + m);
+    kkt.view_mut((0, 0), (n, n)).copy_from(mass);
+    kkt.view_mut((0, n), (n, m)).copy_from(&j.transpose());
+    kkt.view_mut((n, 0), (m, n)).copy_from(j);
+    let mut rhs = DVector::zeros(n + m);
+    rhs.rows_mut(0, n).copy_from(f);
+    rhs.rows_mut(n, m).copy_from(&gamma.rows(0, m));
+    let svd = kkt.svd(true, true);
+    let eps = 1e-12 * svd.singular_values.max();
+    let solution = svd
+        .solve(&rhs, eps)
+        .map_err(|_| ModalError::SingularMassMatrix { q: q.to_vec() })?;
+    let qdd = solution.rows(0, n).into_owned();
+    let lambda: Vec<f64> = solution.rows(n, m).iter().copied().collect();
+    Ok((qdd, lambda))
 }
 
 /// A basis `N` (`n × r`) of the null space of `J` (`m × n`) by coordinate partitioning:

@@ -255,15 +255,8 @@ pub fn find_steady_motion(
     ignorable: &[usize],
 ) -> Result<SteadyMotion, SteadyMotionError> {
     let n = guess.len();
-    let names: Vec<String> = (model.description().coordinate_names().into_iter())
-        .map(str::to_string)
-        .collect();
-    if let Some(i) = (0..n.min(rates.len())).find(|&i| rates[i] != 0.0 && !ignorable.contains(&i)) {
-        return Err(SteadyMotionError::HeldRateNotIgnorable {
-            coordinate: names.get(i).cloned().unwrap_or_else(|| i.to_string()),
-            rate: rates[i],
-        });
-    }
+    let names = owned_coordinate_names(model);
+    check_held_rates(&names, n, rates, ignorable)?;
     let free: Vec<usize> = (0..n).filter(|i| !ignorable.contains(i)).collect();
     let mut q = guess.to_vec();
     let mut r = steady_residuals(model, t, &q, rates)?;
@@ -285,53 +278,32 @@ pub fn find_steady_motion(
             break;
         }
         if free.is_empty() {
-            // Nothing to adjust: the held state must be steady as it is, its residual at
-            // rounding of the rates' own accelerations (`q̇²`), not of its own size (a
-            // Chaplygin sleigh spinning in place has `v̇ = d ω²`, and is no steady motion).
-            // The ignorable coordinates' values are arbitrary and do not enter.
-            let natural = rates.iter().fold(0.0f64, |m, r| m.max(r * r));
-            if worst <= 1e-10 * (1.0 + natural) {
-                break;
-            }
-            return Err(SteadyMotionError::NotSteady {
-                iterations,
-                residual: worst,
-                worst: residual_name(model, at),
-            });
+            check_steady_as_held(model, rates, iterations, (worst, at))?;
+            break;
         }
         let stuck = radius < 1e-15;
         if iterations == 50 || stuck {
-            if let Some((point, source)) = refused {
-                return Err(SteadyMotionError::Unevaluable {
-                    at: named_values(&names, &point, &free),
-                    source,
-                });
-            }
-            return Err(SteadyMotionError::NotSteady {
+            return Err(search_failed(
+                model,
+                &names,
+                &free,
+                refused,
                 iterations,
-                residual: worst,
-                worst: residual_name(model, at),
-            });
+                (worst, at),
+            ));
         }
         iterations += 1;
         let (step, predicted) = match at_q.take() {
             Some(cached) => cached,
             None => gauss_newton_step(model, t, &q, rates, &free, &r)?,
         };
-        let size = free
-            .iter()
-            .enumerate()
-            .map(|(col, &j)| step[col].abs() / q[j].abs().max(1.0))
-            .fold(0.0f64, f64::max);
+        let size = relative_step(&q, &free, &step);
         // Converged as far as rounding allows: Newton would move the coordinates by less
         // than their rounding, with the residual small and within reach of the step (an
         // exact guess whose residual is the rounding of large terms, a hoop spun at
         // 1000 rad/s). A residual the coordinates cannot change (an acceleration no free
         // coordinate affects) is not rounding, however small the step.
-        let reachable = linear_prediction(&r, &predicted, 1.0)
-            .iter()
-            .fold(0.0f64, |m, v| m.max(v.abs()))
-            <= 1e-3 * worst;
+        let reachable = within_reach(&r, &predicted, worst);
         if size <= 1e-14 && worst <= 1e-8 * scale && reachable {
             break;
         }
@@ -339,10 +311,7 @@ pub fn find_steady_motion(
         let trial = moved_by(&q, &free, &step, fraction);
         match steady_residuals(model, t, &trial, rates) {
             Ok(rt) if largest(&rt).0.is_finite() => {
-                // Sum-of-squares reduction, achieved against predicted by `r + J δ`.
-                let now = sum_of_squares(&r);
-                let expected = now - sum_of_squares(&linear_prediction(&r, &predicted, fraction));
-                let ratio = (now - sum_of_squares(&rt)) / expected;
+                let ratio = reduction_ratio(&r, &rt, &predicted, fraction);
                 // A NaN ratio (no predicted reduction) shrinks the region too.
                 if ratio.is_nan() || ratio < 0.1 {
                     radius = fraction * size / 2.0;
@@ -367,9 +336,7 @@ pub fn find_steady_motion(
         }
     }
     polish(model, t, &mut q, &mut r, rates, &free)?;
-    let moving: Vec<usize> = (0..n.min(rates.len()))
-        .filter(|&i| rates[i] != 0.0)
-        .collect();
+    let moving = moving_coordinates(n, rates);
     check_cyclic(model, t, &q, rates, &moving)?;
     Ok(SteadyMotion {
         q,
@@ -377,6 +344,118 @@ pub fn find_steady_motion(
         iterations,
         residual: largest(&r).0,
     })
+}
+
+/// The names of `model`'s coordinates (length `n`), owned.
+fn owned_coordinate_names(model: &dyn ModelInfo) -> Vec<String> {
+    (model.description().coordinate_names().into_iter())
+        .map(str::to_string)
+        .collect()
+}
+
+/// The coordinates (indices among the first `n`) whose held rate is nonzero: those that
+/// move in the steady motion.
+fn moving_coordinates(n: usize, rates: &[f64]) -> Vec<usize> {
+    (0..n.min(rates.len()))
+        .filter(|&i| rates[i] != 0.0)
+        .collect()
+}
+
+/// Checks that every rate held nonzero (of the first `n`) is that of an `ignorable`
+/// coordinate, `names` naming the coordinates.
+///
+/// # Errors
+/// [`SteadyMotionError::HeldRateNotIgnorable`] naming the first that is not.
+fn check_held_rates(
+    names: &[String],
+    n: usize,
+    rates: &[f64],
+    ignorable: &[usize],
+) -> Result<(), SteadyMotionError> {
+    if let Some(i) = (0..n.min(rates.len())).find(|&i| rates[i] != 0.0 && !ignorable.contains(&i)) {
+        return Err(SteadyMotionError::HeldRateNotIgnorable {
+            coordinate: names.get(i).cloned().unwrap_or_else(|| i.to_string()),
+            rate: rates[i],
+        });
+    }
+    Ok(())
+}
+
+/// With no free coordinate to adjust, whether the held state is steady as it is: its largest
+/// residual `worst` (at index `at`) within `1e-10 (1 + max q̇ᵢ²)`.
+///
+/// # Errors
+/// [`SteadyMotionError::NotSteady`] naming the residual when it is not.
+fn check_steady_as_held(
+    model: &dyn ModelInfo,
+    rates: &[f64],
+    iterations: usize,
+    (worst, at): (f64, usize),
+) -> Result<(), SteadyMotionError> {
+    // Nothing to adjust: the held state must be steady as it is, its residual at
+    // rounding of the rates' own accelerations (`q̇²`), not of its own size (a
+    // Chaplygin sleigh spinning in place has `v̇ = d ω²`, and is no steady motion).
+    // The ignorable coordinates' values are arbitrary and do not enter.
+    let natural = rates.iter().fold(0.0f64, |m, r| m.max(r * r));
+    if worst <= 1e-10 * (1.0 + natural) {
+        return Ok(());
+    }
+    Err(SteadyMotionError::NotSteady {
+        iterations,
+        residual: worst,
+        worst: residual_name(model, at),
+    })
+}
+
+/// The error of a search that ran out of iterations or of trust region, its largest residual
+/// `worst` at index `at`: [`SteadyMotionError::Unevaluable`] at the last point `refused`, if
+/// any, else [`SteadyMotionError::NotSteady`].
+fn search_failed(
+    model: &dyn ModelInfo,
+    names: &[String],
+    free: &[usize],
+    refused: Option<(Vec<f64>, RhsError)>,
+    iterations: usize,
+    (worst, at): (f64, usize),
+) -> SteadyMotionError {
+    if let Some((point, source)) = refused {
+        return SteadyMotionError::Unevaluable {
+            at: named_values(names, &point, free),
+            source,
+        };
+    }
+    SteadyMotionError::NotSteady {
+        iterations,
+        residual: worst,
+        worst: residual_name(model, at),
+    }
+}
+
+/// The largest move of a `free` coordinate by `step` relative to `max(1, |qⱼ|)`.
+fn relative_step(q: &[f64], free: &[usize], step: &DVector<f64>) -> f64 {
+    free.iter()
+        .enumerate()
+        .map(|(col, &j)| step[col].abs() / q[j].abs().max(1.0))
+        .fold(0.0f64, f64::max)
+}
+
+/// Whether the full step's predicted residual `r + J δ` (`predicted` = `J δ`) is within
+/// `1e-3` of the largest residual `worst`: the residual is one the coordinates can change.
+fn within_reach(r: &[f64], predicted: &DVector<f64>, worst: f64) -> bool {
+    linear_prediction(r, predicted, 1.0)
+        .iter()
+        .fold(0.0f64, |m, v| m.max(v.abs()))
+        <= 1e-3 * worst
+}
+
+/// The trust region's ratio: the reduction of the sum of squares from `r` to `rt` achieved
+/// by the step `fraction · δ`, over the one predicted by `r + fraction · J δ`
+/// (`predicted` = `J δ`); NaN when none is predicted.
+fn reduction_ratio(r: &[f64], rt: &[f64], predicted: &DVector<f64>, fraction: f64) -> f64 {
+    // Sum-of-squares reduction, achieved against predicted by `r + J δ`.
+    let now = sum_of_squares(r);
+    let expected = now - sum_of_squares(&linear_prediction(r, predicted, fraction));
+    (now - sum_of_squares(rt)) / expected
 }
 
 /// The trust region's first radius in [`find_steady_motion`], relative to `max(1, |qⱼ|)`:
@@ -529,35 +608,7 @@ fn check_cyclic(
         .map(|(k, v)| v + 0.1 * (1.0 + (k as f64 * 0.618_033_988_749_895).fract()))
         .collect();
     let constrained = !model.description().constraints.is_empty();
-    let parts = |y: &[f64]| -> Option<Parts> {
-        let (m, f) = model.mass_matrix_and_forcing(t, y);
-        let mut out = vec![
-            (
-                "the mass matrix M",
-                DVector::from_column_slice(m.as_slice()),
-            ),
-            ("the forces F", f),
-        ];
-        if constrained {
-            let c = model.constraint_equations(t, y);
-            out.push((
-                "the constraints' velocity terms and γ",
-                DVector::from_iterator(
-                    c.velocity.len() + c.gamma.len(),
-                    c.velocity.iter().chain(c.gamma.iter()).copied(),
-                ),
-            ));
-            // Last: shifted along the motion only (see below).
-            out.push((JOINT_PART, c.phi.clone()));
-            out.push((
-                "the constraint Jacobian J",
-                DVector::from_column_slice(c.jacobian.as_slice()),
-            ));
-        }
-        out.iter()
-            .all(|(_, v)| v.iter().all(|x| x.is_finite()))
-            .then_some(out)
-    };
+    let parts = |y: &[f64]| cyclic_parts(model, t, constrained, y);
     // Each part's size over both states: at the steady motion itself `F = M q̈` and `Φ` are
     // at rounding, against which a cancellation of a cyclic coordinate in value
     // (`cos² φ + sin² φ`) would look like a change.
@@ -602,21 +653,7 @@ fn check_cyclic(
                         (a - b).amax() / scale
                     };
                     if change > 1e-9 {
-                        let names = model.description().coordinate_names();
-                        let name = |i: usize| {
-                            names
-                                .get(i)
-                                .map_or_else(|| i.to_string(), |c| c.to_string())
-                        };
-                        let (coordinate, rate) = if i == usize::MAX {
-                            let all: Vec<String> = moving.iter().map(|&j| name(j)).collect();
-                            (
-                                format!("{} (together, along the motion)", all.join(", ")),
-                                fastest,
-                            )
-                        } else {
-                            (name(i), rates[i])
-                        };
+                        let (coordinate, rate) = moved_coordinate(model, rates, moving, fastest, i);
                         return Err(SteadyMotionError::NotCyclic {
                             coordinate,
                             rate,
@@ -630,6 +667,66 @@ fn check_cyclic(
         }
     }
     Ok(())
+}
+
+/// The parts of the equations [`check_cyclic`] compares at the state `y` (length `2n`):
+/// `M` and `F`, and when `constrained` the constraints' velocity terms and `γ`, `Φ`
+/// ([`JOINT_PART`]) and `J`, each flattened; `None` when one is not finite.
+fn cyclic_parts(model: &dyn ModelInfo, t: f64, constrained: bool, y: &[f64]) -> Option<Parts> {
+    let (m, f) = model.mass_matrix_and_forcing(t, y);
+    let mut out = vec![
+        (
+            "the mass matrix M",
+            DVector::from_column_slice(m.as_slice()),
+        ),
+        ("the forces F", f),
+    ];
+    if constrained {
+        let c = model.constraint_equations(t, y);
+        out.push((
+            "the constraints' velocity terms and γ",
+            DVector::from_iterator(
+                c.velocity.len() + c.gamma.len(),
+                c.velocity.iter().chain(c.gamma.iter()).copied(),
+            ),
+        ));
+        // Last: shifted along the motion only (see below).
+        out.push((JOINT_PART, c.phi.clone()));
+        out.push((
+            "the constraint Jacobian J",
+            DVector::from_column_slice(c.jacobian.as_slice()),
+        ));
+    }
+    out.iter()
+        .all(|(_, v)| v.iter().all(|x| x.is_finite()))
+        .then_some(out)
+}
+
+/// The name and rate [`SteadyMotionError::NotCyclic`] reports for the coordinate `i` of
+/// [`check_cyclic`]: its own name and held rate, or for `i = usize::MAX` (every `moving`
+/// coordinate shifted together along the motion) all their names and the `fastest` rate.
+fn moved_coordinate(
+    model: &dyn ModelInfo,
+    rates: &[f64],
+    moving: &[usize],
+    fastest: f64,
+    i: usize,
+) -> (String, f64) {
+    let names = model.description().coordinate_names();
+    let name = |i: usize| {
+        names
+            .get(i)
+            .map_or_else(|| i.to_string(), |c| c.to_string())
+    };
+    if i == usize::MAX {
+        let all: Vec<String> = moving.iter().map(|&j| name(j)).collect();
+        (
+            format!("{} (together, along the motion)", all.join(", ")),
+            fastest,
+        )
+    } else {
+        (name(i), rates[i])
+    }
 }
 
 /// The linearisation of a model about a steady motion, restricted to the motions its
@@ -666,8 +763,6 @@ pub struct SteadyLinearization {
 /// dependent coordinates or rates there; [`SteadyMotionError::NotIgnorable`] when an
 /// ignorable coordinate feeds back; [`SteadyMotionError::Rhs`] and
 /// [`SteadyMotionError::NonFinite`] when the equations fail there.
-// One piece: the Jacobian, the partition, the basis of the tangent space and the reduction
-// share the matrices and index lists and run once in this order.
 pub fn linearize_steady_motion(
     model: &mut dyn ModelInfo,
     t: f64,
@@ -678,91 +773,17 @@ pub fn linearize_steady_motion(
     let n = d.coordinates.len();
     let (m, m_h) = (d.constraints.len(), d.holonomic_constraints);
     let (a, exact_jacobian) = state_jacobian(model, t, y)?;
-    // Constraint Jacobians at the point: Φ_q (the first m_h rows of J), J, and V_q by
-    // differences of the velocity residuals.
-    let (j_all, v_q) = if m > 0 {
-        let c = model.constraint_equations(t, y);
-        let v_q = richardson(n, m, y, |yy| {
-            Ok(model
-                .constraint_equations(t, yy)
-                .velocity
-                .as_slice()
-                .to_vec())
-        })?;
-        (c.jacobian, v_q)
-    } else {
-        (DMatrix::zeros(0, n), DMatrix::zeros(0, n))
-    };
-    let phi_q = j_all.rows(0, m_h).into_owned();
-    // Dependent coordinates among the non-ignorable ones first, then the ignorable ones (a
-    // belt `phi1 = phi2` between two pulleys that both turn freely names only ignorable
-    // coordinates; one of them is then dependent, and leaves the ignorable states), dependent
-    // rates preferring the dependent coordinates' rates and then the ignorable ones'.
-    let coordinate_order: Vec<usize> = (0..n)
-        .filter(|i| !ignorable.contains(i))
-        .chain(ignorable.iter().copied())
-        .collect();
-    let dependent_q = pivot_columns(&phi_q, &coordinate_order, m_h);
-    if dependent_q.len() < m_h {
-        return Err(SteadyMotionError::SingularConstraints {
-            needed: m_h,
-            found: dependent_q.len(),
-        });
-    }
-    let mut rate_order: Vec<usize> = dependent_q.clone();
-    for i in ignorable.iter().copied().chain(0..n) {
-        if !rate_order.contains(&i) {
-            rate_order.push(i);
-        }
-    }
-    let dependent_u = pivot_columns(&j_all, &rate_order, m);
-    if dependent_u.len() < m {
-        return Err(SteadyMotionError::SingularVelocityConstraints {
-            needed: m,
-            found: dependent_u.len(),
-        });
-    }
-    let independent_q: Vec<usize> = (0..n).filter(|i| !dependent_q.contains(i)).collect();
-    let independent_u: Vec<usize> = (0..n).filter(|i| !dependent_u.contains(i)).collect();
+    let jacobians = ConstraintJacobians::at(model, t, y, n, m, m_h)?;
+    let split = Partition::choose(&jacobians, ignorable, n, m_h, m)?;
     // The basis N of the tangent space, one column per independent coordinate and rate.
-    let phi_d = select_columns(&phi_q, &dependent_q);
-    let j_d = select_columns(&j_all, &dependent_u);
-    let phi_lu = phi_d.lu();
-    let j_lu = j_d.lu();
+    let basis = split.tangent_basis(&jacobians, n, m_h, m)?;
+    let Partition {
+        dependent_q,
+        dependent_u,
+        independent_q,
+        independent_u,
+    } = split;
     let k = independent_q.len() + independent_u.len();
-    let mut basis = DMatrix::zeros(2 * n, k);
-    for (col, &i) in independent_q.iter().enumerate() {
-        let mut dq = DVector::zeros(n);
-        dq[i] = 1.0;
-        if m_h > 0 {
-            let dd = phi_lu
-                .solve(&phi_q.column(i).into_owned())
-                .ok_or(SteadyMotionError::NonFinite)?;
-            for (r, &c) in dependent_q.iter().enumerate() {
-                dq[c] = -dd[r];
-            }
-        }
-        if m > 0 {
-            let rhs = &v_q * &dq;
-            let du = j_lu.solve(&rhs).ok_or(SteadyMotionError::NonFinite)?;
-            for (r, &c) in dependent_u.iter().enumerate() {
-                basis[(n + c, col)] = -du[r];
-            }
-        }
-        basis.view_mut((0, col), (n, 1)).copy_from(&dq);
-    }
-    for (offset, &j) in independent_u.iter().enumerate() {
-        let col = independent_q.len() + offset;
-        basis[(n + j, col)] = 1.0;
-        if m > 0 {
-            let du = j_lu
-                .solve(&j_all.column(j).into_owned())
-                .ok_or(SteadyMotionError::NonFinite)?;
-            for (r, &c) in dependent_u.iter().enumerate() {
-                basis[(n + c, col)] = -du[r];
-            }
-        }
-    }
     let rows: Vec<usize> = independent_q
         .iter()
         .copied()
@@ -788,6 +809,203 @@ pub fn linearize_steady_motion(
     // small, so that a rate that changes slowly (a sleigh at a speed of 1e-9 m/s) is not
     // taken for a constant one.
     let zero = if exact_jacobian { 1e-13 } else { 1e-10 } * reduced.amax().max(f64::MIN_POSITIVE);
+    let ignorable_coordinates =
+        remove_ignorable_states(&mut reduced, &mut names, &independent_q, ignorable, zero)?;
+    let constant_rates = remove_constant_rates(&mut reduced, &mut names, zero);
+    Ok(SteadyLinearization {
+        states: names,
+        state_matrix: reduced,
+        dependent_coordinates: dependent_q
+            .iter()
+            .map(|&i| d.coordinates[i].to_string())
+            .collect(),
+        dependent_rates: dependent_u
+            .iter()
+            .map(|&i| format!("{}_dot", d.coordinates[i]))
+            .collect(),
+        ignorable_coordinates,
+        constant_rates,
+        exact_jacobian,
+    })
+}
+
+/// The constraint Jacobians of [`linearize_steady_motion`] at the operating point:
+/// `Φ_q` (`m_h × n`, the first `m_h` rows of `J`), `J` (`m × n`) and `V_q` (`m × n`).
+struct ConstraintJacobians {
+    /// `Φ_q` (`m_h × n`).
+    phi_q: DMatrix<f64>,
+    /// `J` (`m × n`), the velocity constraints' Jacobian with respect to `q̇`.
+    j_all: DMatrix<f64>,
+    /// `V_q` (`m × n`), by Richardson-extrapolated differences of the velocity residuals.
+    v_q: DMatrix<f64>,
+}
+
+impl ConstraintJacobians {
+    /// `Φ_q`, `J` and `V_q` of `model` at `(t, y)` (`y` of length `2n`; `m` constraints,
+    /// `m_h` of them holonomic); empty (`0 × n`) when there are no constraints.
+    fn at(
+        model: &mut dyn ModelInfo,
+        t: f64,
+        y: &[f64],
+        n: usize,
+        m: usize,
+        m_h: usize,
+    ) -> Result<Self, SteadyMotionError> {
+        // Constraint Jacobians at the point: Φ_q (the first m_h rows of J), J, and V_q by
+        // differences of the velocity residuals.
+        let (j_all, v_q) = if m > 0 {
+            let c = model.constraint_equations(t, y);
+            let v_q = richardson(n, m, y, |yy| {
+                Ok(model
+                    .constraint_equations(t, yy)
+                    .velocity
+                    .as_slice()
+                    .to_vec())
+            })?;
+            (c.jacobian, v_q)
+        } else {
+            (DMatrix::zeros(0, n), DMatrix::zeros(0, n))
+        };
+        let phi_q = j_all.rows(0, m_h).into_owned();
+        Ok(Self { phi_q, j_all, v_q })
+    }
+}
+
+/// The partition of [`linearize_steady_motion`]: coordinate and rate indices (into `0..n`)
+/// that the constraints make dependent, and the independent ones left.
+struct Partition {
+    /// Coordinates solved from the holonomic constraints (`m_h` of them).
+    dependent_q: Vec<usize>,
+    /// Rates solved from the velocity constraints (`m` of them).
+    dependent_u: Vec<usize>,
+    /// The other coordinates, ascending.
+    independent_q: Vec<usize>,
+    /// The other rates, ascending.
+    independent_u: Vec<usize>,
+}
+
+impl Partition {
+    /// Chooses the dependent coordinates and rates by pivoting on `Φ_q` and `J`.
+    ///
+    /// # Errors
+    /// [`SteadyMotionError::SingularConstraints`] or
+    /// [`SteadyMotionError::SingularVelocityConstraints`] when too few independent columns
+    /// are found.
+    fn choose(
+        jacobians: &ConstraintJacobians,
+        ignorable: &[usize],
+        n: usize,
+        m_h: usize,
+        m: usize,
+    ) -> Result<Self, SteadyMotionError> {
+        // Dependent coordinates among the non-ignorable ones first, then the ignorable ones (a
+        // belt `phi1 = phi2` between two pulleys that both turn freely names only ignorable
+        // coordinates; one of them is then dependent, and leaves the ignorable states), dependent
+        // rates preferring the dependent coordinates' rates and then the ignorable ones'.
+        let coordinate_order: Vec<usize> = (0..n)
+            .filter(|i| !ignorable.contains(i))
+            .chain(ignorable.iter().copied())
+            .collect();
+        let dependent_q = pivot_columns(&jacobians.phi_q, &coordinate_order, m_h);
+        if dependent_q.len() < m_h {
+            return Err(SteadyMotionError::SingularConstraints {
+                needed: m_h,
+                found: dependent_q.len(),
+            });
+        }
+        let mut rate_order: Vec<usize> = dependent_q.clone();
+        for i in ignorable.iter().copied().chain(0..n) {
+            if !rate_order.contains(&i) {
+                rate_order.push(i);
+            }
+        }
+        let dependent_u = pivot_columns(&jacobians.j_all, &rate_order, m);
+        if dependent_u.len() < m {
+            return Err(SteadyMotionError::SingularVelocityConstraints {
+                needed: m,
+                found: dependent_u.len(),
+            });
+        }
+        let independent_q: Vec<usize> = (0..n).filter(|i| !dependent_q.contains(i)).collect();
+        let independent_u: Vec<usize> = (0..n).filter(|i| !dependent_u.contains(i)).collect();
+        Ok(Self {
+            dependent_q,
+            dependent_u,
+            independent_q,
+            independent_u,
+        })
+    }
+
+    /// The basis `N` of the constraints' tangent space (`2n × k`, `k` the independent
+    /// coordinates and rates): `δy = N z`, one column per independent coordinate, then one per
+    /// independent rate.
+    fn tangent_basis(
+        &self,
+        jacobians: &ConstraintJacobians,
+        n: usize,
+        m_h: usize,
+        m: usize,
+    ) -> Result<DMatrix<f64>, SteadyMotionError> {
+        let ConstraintJacobians { phi_q, j_all, v_q } = jacobians;
+        let (dependent_q, dependent_u) = (&self.dependent_q, &self.dependent_u);
+        let (independent_q, independent_u) = (&self.independent_q, &self.independent_u);
+        let phi_d = select_columns(phi_q, dependent_q);
+        let j_d = select_columns(j_all, dependent_u);
+        let phi_lu = phi_d.lu();
+        let j_lu = j_d.lu();
+        let k = independent_q.len() + independent_u.len();
+        let mut basis = DMatrix::zeros(2 * n, k);
+        for (col, &i) in independent_q.iter().enumerate() {
+            let mut dq = DVector::zeros(n);
+            dq[i] = 1.0;
+            if m_h > 0 {
+                let dd = phi_lu
+                    .solve(&phi_q.column(i).into_owned())
+                    .ok_or(SteadyMotionError::NonFinite)?;
+                for (r, &c) in dependent_q.iter().enumerate() {
+                    dq[c] = -dd[r];
+                }
+            }
+            if m > 0 {
+                let rhs = v_q * &dq;
+                let du = j_lu.solve(&rhs).ok_or(SteadyMotionError::NonFinite)?;
+                for (r, &c) in dependent_u.iter().enumerate() {
+                    basis[(n + c, col)] = -du[r];
+                }
+            }
+            basis.view_mut((0, col), (n, 1)).copy_from(&dq);
+        }
+        for (offset, &j) in independent_u.iter().enumerate() {
+            let col = independent_q.len() + offset;
+            basis[(n + j, col)] = 1.0;
+            if m > 0 {
+                let du = j_lu
+                    .solve(&j_all.column(j).into_owned())
+                    .ok_or(SteadyMotionError::NonFinite)?;
+                for (r, &c) in dependent_u.iter().enumerate() {
+                    basis[(n + c, col)] = -du[r];
+                }
+            }
+        }
+        Ok(basis)
+    }
+}
+
+/// Leaves the ignorable coordinates among the states `names` of the reduced state matrix
+/// `reduced` (`k × k`) out, rows and columns, and returns their names; entries at most
+/// `zero` count as zero.
+///
+/// # Errors
+/// [`SteadyMotionError::NotIgnorable`] when an ignorable coordinate's column does not vanish
+/// outside the ignorable coordinates' rows.
+fn remove_ignorable_states(
+    reduced: &mut DMatrix<f64>,
+    names: &mut Vec<String>,
+    independent_q: &[usize],
+    ignorable: &[usize],
+    zero: f64,
+) -> Result<Vec<String>, SteadyMotionError> {
+    let k = names.len();
     // Ignorable coordinates: their columns must vanish outside their own rows.
     let ignorable_states: Vec<usize> = (0..independent_q.len())
         .filter(|&s| ignorable.contains(&independent_q[s]))
@@ -805,30 +1023,26 @@ pub fn linearize_steady_motion(
     }
     let ignorable_coordinates: Vec<String> =
         ignorable_states.iter().map(|&s| names[s].clone()).collect();
-    remove_states(&mut reduced, &mut names, &ignorable_states);
+    remove_states(reduced, names, &ignorable_states);
+    Ok(ignorable_coordinates)
+}
+
+/// Leaves out of `reduced` (square, its states `names`) every rate whose row is zero
+/// (entries at most `zero`), one at a time with its column, and returns their names.
+fn remove_constant_rates(
+    reduced: &mut DMatrix<f64>,
+    names: &mut Vec<String>,
+    zero: f64,
+) -> Vec<String> {
     // Rates that stay constant: zero rows, left out with their columns, one at a time.
     let mut constant_rates = Vec::new();
     while let Some(r) = (0..names.len())
         .find(|&r| names[r].ends_with("_dot") && reduced.row(r).iter().all(|v| v.abs() <= zero))
     {
         constant_rates.push(names[r].clone());
-        remove_states(&mut reduced, &mut names, &[r]);
+        remove_states(reduced, names, &[r]);
     }
-    Ok(SteadyLinearization {
-        states: names,
-        state_matrix: reduced,
-        dependent_coordinates: dependent_q
-            .iter()
-            .map(|&i| d.coordinates[i].to_string())
-            .collect(),
-        dependent_rates: dependent_u
-            .iter()
-            .map(|&i| format!("{}_dot", d.coordinates[i]))
-            .collect(),
-        ignorable_coordinates,
-        constant_rates,
-        exact_jacobian,
-    })
+    constant_rates
 }
 
 /// `∂f/∂y` of the first-order equations at `y` (`2n × 2n`) and whether it is exact.

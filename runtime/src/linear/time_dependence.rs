@@ -72,6 +72,126 @@ fn matrix_change(samples: &[DVector<f64>], n: usize) -> (f64, usize) {
     entrywise_change(samples, &scales)
 }
 
+/// Whether every entry of `v` is finite.
+fn finite(v: &[f64]) -> bool {
+    v.iter().all(|x| x.is_finite())
+}
+
+/// The sampling of [`time_dependence`] at the operating point `q` (length `n`): `t₀` (s) and
+/// the times (s) the equations are evaluated at, `t₀` first.
+struct TimeSamples<'a> {
+    /// The operating point (length `n`).
+    q: &'a [f64],
+    /// The time of the operating point (s).
+    t0: f64,
+    /// `t₀` and `t₀` plus each of [`TIME_OFFSETS`] (s).
+    times: Vec<f64>,
+}
+
+impl TimeSamples<'_> {
+    /// `Ok` when the relative change of `part`, found at sample `k`, is within
+    /// [`TIME_TOLERANCE`].
+    ///
+    /// # Errors
+    /// [`ModalError::TimeDependent`] naming the part and the time of sample `k`.
+    fn refuse(
+        &self,
+        part: TimeDependentPart,
+        (relative_change, k): (f64, usize),
+    ) -> Result<(), ModalError> {
+        if relative_change > TIME_TOLERANCE {
+            Err(ModalError::TimeDependent {
+                part,
+                t0: self.t0,
+                t: self.times[k],
+                relative_change,
+            })
+        } else {
+            Ok(())
+        }
+    }
+
+    /// The error of parts not finite at `t₀`: [`ModalError::NotFiniteAtTime`] when they are
+    /// finite at the sample `finite_at`, else [`ModalError::NonFinite`].
+    fn singular(&self, finite_at: Option<usize>) -> ModalError {
+        // A value that is not finite at `t₀` itself is a singularity of the equations at this
+        // configuration (a 0/0: the direction of a rod of zero length, a spring's ends that
+        // coincide), not a change with `t`, unless the same parts are finite at a later sample:
+        // then it is the instant (a load `ln(w t)` at t = 0, `ln(w t − 1)` before t = 1/w).
+        match finite_at {
+            Some(k) => ModalError::NotFiniteAtTime {
+                q: self.q.to_vec(),
+                t: self.t0,
+                finite_at: self.times[k],
+            },
+            None => ModalError::NonFinite { q: self.q.to_vec() },
+        }
+    }
+
+    /// Checks that each of the `m` holonomic constraints (`Φ`, `J`, `Φ_t`, `γ`) of `model` at
+    /// rest at `y = (q, 0)` (length `2n`) does not change over the samples.
+    ///
+    /// # Errors
+    /// As [`TimeSamples::singular`] when they are not finite at `t₀`, and
+    /// [`ModalError::TimeDependent`] naming the first constraint that changes.
+    fn check_constraints(
+        &self,
+        model: &dyn ModelInfo,
+        y: &[f64],
+        m: usize,
+    ) -> Result<(), ModalError> {
+        let times = &self.times;
+        let constraints: Vec<_> = times
+            .iter()
+            .map(|&t| model.constraint_equations(t, y))
+            .collect();
+        let at_t0 = &constraints[0];
+        if ![
+            at_t0.phi.as_slice(),
+            at_t0.velocity.as_slice(),
+            at_t0.gamma.as_slice(),
+            at_t0.jacobian.as_slice(),
+        ]
+        .into_iter()
+        .all(finite)
+        {
+            let later = (1..times.len()).find(|&k| {
+                let c = &constraints[k];
+                [c.phi.as_slice(), c.velocity.as_slice(), c.gamma.as_slice()]
+                    .into_iter()
+                    .all(finite)
+            });
+            return Err(self.singular(later));
+        }
+        for (i, name) in model
+            .description()
+            .constraint_names()
+            .iter()
+            .take(m)
+            .enumerate()
+        {
+            // The Jacobian apart from Φ, Φ_t and γ: a constant J with a moving Φ is a
+            // prescribed motion (base excitation), which the hint treats differently.
+            let jacobian: Vec<DVector<f64>> = constraints
+                .iter()
+                .map(|c| c.jacobian.row(i).transpose())
+                .collect();
+            let rest: Vec<DVector<f64>> = constraints
+                .iter()
+                .map(|c| DVector::from_vec(vec![c.phi[i], c.velocity[i], c.gamma[i]]))
+                .collect();
+            let jacobian_change = relative_change(&jacobian);
+            let part = |jacobian_changes| TimeDependentPart::Constraint {
+                name: name.to_string(),
+                jacobian_changes,
+            };
+            self.refuse(part(true), jacobian_change)?;
+            self.refuse(part(false), relative_change(&rest))?;
+        }
+        Ok(())
+    }
+}
+
 /// The explicit time dependence of `model`'s equations at rest at `q` (the operating point,
 /// length `n`), from `t₀` (s): evaluated at six later times, each holonomic constraint
 /// (`Φ`, `J`, `Φ_t`, `γ`), then `M(q, t)`, `∂F/∂q̇ (q, 0, t)` and `∂F/∂q (q, 0, t)` must not
@@ -114,84 +234,15 @@ pub fn time_dependence(
     let times: Vec<f64> = std::iter::once(t0)
         .chain(TIME_OFFSETS.iter().map(|offset| t0 + offset))
         .collect();
-    let refuse = |part: TimeDependentPart, (relative_change, k): (f64, usize)| {
-        if relative_change > TIME_TOLERANCE {
-            Err(ModalError::TimeDependent {
-                part,
-                t0,
-                t: times[k],
-                relative_change,
-            })
-        } else {
-            Ok(())
-        }
-    };
-    // A value that is not finite at `t₀` itself is a singularity of the equations at this
-    // configuration (a 0/0: the direction of a rod of zero length, a spring's ends that
-    // coincide), not a change with `t`, unless the same parts are finite at a later sample:
-    // then it is the instant (a load `ln(w t)` at t = 0, `ln(w t − 1)` before t = 1/w).
-    let singular = |finite_at: Option<usize>| match finite_at {
-        Some(k) => ModalError::NotFiniteAtTime {
-            q: q.to_vec(),
-            t: t0,
-            finite_at: times[k],
-        },
-        None => ModalError::NonFinite { q: q.to_vec() },
-    };
-    let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
+    let samples = TimeSamples { q, t0, times };
+    let times = &samples.times;
     if m > 0 {
-        let constraints: Vec<_> = times
-            .iter()
-            .map(|&t| model.constraint_equations(t, &y))
-            .collect();
-        let at_t0 = &constraints[0];
-        if ![
-            at_t0.phi.as_slice(),
-            at_t0.velocity.as_slice(),
-            at_t0.gamma.as_slice(),
-            at_t0.jacobian.as_slice(),
-        ]
-        .into_iter()
-        .all(finite)
-        {
-            let later = (1..times.len()).find(|&k| {
-                let c = &constraints[k];
-                [c.phi.as_slice(), c.velocity.as_slice(), c.gamma.as_slice()]
-                    .into_iter()
-                    .all(finite)
-            });
-            return Err(singular(later));
-        }
-        for (i, name) in model
-            .description()
-            .constraint_names()
-            .iter()
-            .take(m)
-            .enumerate()
-        {
-            // The Jacobian apart from Φ, Φ_t and γ: a constant J with a moving Φ is a
-            // prescribed motion (base excitation), which the hint treats differently.
-            let jacobian: Vec<DVector<f64>> = constraints
-                .iter()
-                .map(|c| c.jacobian.row(i).transpose())
-                .collect();
-            let rest: Vec<DVector<f64>> = constraints
-                .iter()
-                .map(|c| DVector::from_vec(vec![c.phi[i], c.velocity[i], c.gamma[i]]))
-                .collect();
-            let jacobian_change = relative_change(&jacobian);
-            let part = |jacobian_changes| TimeDependentPart::Constraint {
-                name: name.to_string(),
-                jacobian_changes,
-            };
-            refuse(part(true), jacobian_change)?;
-            refuse(part(false), relative_change(&rest))?;
-        }
+        samples.check_constraints(model, &y, m)?;
     }
     let flat = |a: &DMatrix<f64>| DVector::from_column_slice(a.as_slice());
     let (mut mass, mut forcing, mut damping, mut stiffness) =
         (Vec::new(), Vec::new(), Vec::new(), Vec::new());
-    for &t in &times {
+    for &t in times {
         let (m_t, f_t) = model.mass_matrix_and_forcing(t, &y);
         let (jq, jqd, _) = forcing_jacobians(model, t, &y);
         mass.push(flat(&m_t));
@@ -205,11 +256,11 @@ pub fn time_dependence(
             .all(|v| finite(v.as_slice()))
     };
     if !all_finite(0) {
-        return Err(singular((1..times.len()).find(|&k| all_finite(k))));
+        return Err(samples.singular((1..times.len()).find(|&k| all_finite(k))));
     }
-    refuse(TimeDependentPart::MassMatrix, matrix_change(&mass, n))?;
-    refuse(TimeDependentPart::DampingMatrix, matrix_change(&damping, n))?;
-    refuse(
+    samples.refuse(TimeDependentPart::MassMatrix, matrix_change(&mass, n))?;
+    samples.refuse(TimeDependentPart::DampingMatrix, matrix_change(&damping, n))?;
+    samples.refuse(
         TimeDependentPart::StiffnessMatrix,
         matrix_change(&stiffness, n),
     )?;

@@ -328,47 +328,10 @@ pub fn frequency_response_analysis(
     model: &mut dyn ModelInfo,
     options: &FrfOptions,
 ) -> Result<FrfAnalysis, FrfAnalysisError> {
-    if options.points < 2 {
-        return Err(FrfAnalysisError::TooFewPoints {
-            points: options.points,
-        });
-    }
+    let parameter_input = check_frf_input(model, options)?;
     let input = options.input.as_str();
-    let parameter_input = model.description().parameter_names().contains(&input);
-    if !parameter_input && !model.description().coordinate_names().contains(&input) {
-        return Err(FrfAnalysisError::UnknownInput {
-            model: model.description().name.to_string(),
-            input: input.to_string(),
-            parameters: model.description().parameter_names().join(", "),
-            coordinates: model.description().coordinate_names().join(", "),
-        });
-    }
-    if !parameter_input && options.simulation.is_some() {
-        return Err(FrfAnalysisError::SimulationNeedsParameter {
-            input: input.to_string(),
-        });
-    }
     let (label, guess) = options.operating_point.start.resolve_equilibrium(model)?;
-    // The parameter that times the load (the simulation's, else `w`) also says where to read
-    // an input's rate column (a base motion through a dashpot).
-    let parameters = model.description().parameter_names();
-    let frequency_parameter = options
-        .simulation
-        .as_ref()
-        .and_then(|s| s.frequency_parameter.clone())
-        .or_else(|| Some("w".to_string()))
-        .filter(|p| parameter_input && p != input && parameters.contains(&p.as_str()));
-    let forced = match &frequency_parameter {
-        Some(p) => linearize_with_input_rates(model, &guess, &[input], p),
-        None => linearize_with_inputs(model, &guess, &[input]),
-    }
-    .map_err(|e| match e {
-        FrfError::NonlinearInput { .. }
-        | FrfError::InputNotInForcing { .. }
-        | FrfError::InputChangesMassMatrix { .. }
-        | FrfError::InputRateNotConstant { .. } => FrfAnalysisError::Input(e),
-        e => FrfAnalysisError::Frf(e),
-    })?;
+    let forced = forced_linearization(model, options, &guess, parameter_input)?;
     if options.modal && forced.has_input_rates() {
         return Err(FrfAnalysisError::ModalWithInputRate {
             input: input.to_string(),
@@ -418,19 +381,7 @@ pub fn frequency_response_analysis(
             &frequencies,
         )?);
     }
-    let mut evaluation_frequencies = options.frequencies.clone();
-    if options.modal && evaluation_frequencies.is_empty() {
-        for peak in sweeps.iter().flat_map(|s| &s.peaks) {
-            if matches!(peak.amplitude, PeakAmplitude::Finite(_))
-                && !evaluation_frequencies
-                    .iter()
-                    .any(|w: &f64| (w - peak.frequency).abs() <= 1e-6 * peak.frequency)
-            {
-                evaluation_frequencies.push(peak.frequency);
-            }
-        }
-        evaluation_frequencies.sort_by(f64::total_cmp);
-    }
+    let evaluation_frequencies = evaluation_frequencies(options, &sweeps);
     let mut evaluations = Vec::with_capacity(evaluation_frequencies.len());
     let requested: Vec<usize> = outputs.iter().map(|o| o.index).collect();
     let b = options.modal.then(|| b_matrix.column(0).into_owned());
@@ -457,6 +408,93 @@ pub fn frequency_response_analysis(
         evaluations,
         forced,
     })
+}
+
+/// Checks [`frequency_response_analysis`]'s options against `model` before any work: at least
+/// two points, an input that is a parameter or a coordinate, and a simulation only for a
+/// parameter input. Returns whether the input is a parameter.
+///
+/// # Errors
+/// [`FrfAnalysisError::TooFewPoints`], [`FrfAnalysisError::UnknownInput`] and
+/// [`FrfAnalysisError::SimulationNeedsParameter`].
+fn check_frf_input(model: &dyn ModelInfo, options: &FrfOptions) -> Result<bool, FrfAnalysisError> {
+    if options.points < 2 {
+        return Err(FrfAnalysisError::TooFewPoints {
+            points: options.points,
+        });
+    }
+    let input = options.input.as_str();
+    let parameter_input = model.description().parameter_names().contains(&input);
+    if !parameter_input && !model.description().coordinate_names().contains(&input) {
+        return Err(FrfAnalysisError::UnknownInput {
+            model: model.description().name.to_string(),
+            input: input.to_string(),
+            parameters: model.description().parameter_names().join(", "),
+            coordinates: model.description().coordinate_names().join(", "),
+        });
+    }
+    if !parameter_input && options.simulation.is_some() {
+        return Err(FrfAnalysisError::SimulationNeedsParameter {
+            input: input.to_string(),
+        });
+    }
+    Ok(parameter_input)
+}
+
+/// The linearisation of `model` about the equilibrium near `guess` (length `n`) with the
+/// input matrix of `options.input` (`n × 1`), and its rate column when a frequency parameter
+/// (the simulation's, else `w`) times a parameter input.
+///
+/// # Errors
+/// [`FrfAnalysisError::Input`] when the input is not a load amplitude,
+/// [`FrfAnalysisError::Frf`] when the linearisation fails.
+fn forced_linearization(
+    model: &mut dyn ModelInfo,
+    options: &FrfOptions,
+    guess: &[f64],
+    parameter_input: bool,
+) -> Result<ForcedLinearization, FrfAnalysisError> {
+    let input = options.input.as_str();
+    // The parameter that times the load (the simulation's, else `w`) also says where to read
+    // an input's rate column (a base motion through a dashpot).
+    let parameters = model.description().parameter_names();
+    let frequency_parameter = options
+        .simulation
+        .as_ref()
+        .and_then(|s| s.frequency_parameter.clone())
+        .or_else(|| Some("w".to_string()))
+        .filter(|p| parameter_input && p != input && parameters.contains(&p.as_str()));
+    match &frequency_parameter {
+        Some(p) => linearize_with_input_rates(model, guess, &[input], p),
+        None => linearize_with_inputs(model, guess, &[input]),
+    }
+    .map_err(|e| match e {
+        FrfError::NonlinearInput { .. }
+        | FrfError::InputNotInForcing { .. }
+        | FrfError::InputChangesMassMatrix { .. }
+        | FrfError::InputRateNotConstant { .. } => FrfAnalysisError::Input(e),
+        e => FrfAnalysisError::Frf(e),
+    })
+}
+
+/// The frequencies (rad/s) at which [`frequency_response_analysis`] evaluates the response:
+/// `options.frequencies`, or when those are empty and `options.modal` is set, every finite
+/// peak of the `sweeps` (peaks within `1e-6` relative of one taken counted once), ascending.
+fn evaluation_frequencies(options: &FrfOptions, sweeps: &[FrequencySweep]) -> Vec<f64> {
+    let mut evaluation_frequencies = options.frequencies.clone();
+    if options.modal && evaluation_frequencies.is_empty() {
+        for peak in sweeps.iter().flat_map(|s| &s.peaks) {
+            if matches!(peak.amplitude, PeakAmplitude::Finite(_))
+                && !evaluation_frequencies
+                    .iter()
+                    .any(|w: &f64| (w - peak.frequency).abs() <= 1e-6 * peak.frequency)
+            {
+                evaluation_frequencies.push(peak.frequency);
+            }
+        }
+        evaluation_frequencies.sort_by(f64::total_cmp);
+    }
+    evaluation_frequencies
 }
 
 /// The outputs of a frequency response: every coordinate when `requested` is empty, else each

@@ -281,34 +281,7 @@ fn locate_change(
     [(v_a, a), (v_b, b)]: [(f64, &PointEigenvalues); 2],
     [count_a, count_b]: [usize; 2],
 ) -> StabilityChange {
-    let (mut lo, mut hi) = (v_a, v_b);
-    // The eigenvalues on the side with more unstable ones, as near the crossing as the
-    // bisection gets.
-    let mut unstable_side: Option<PointEigenvalues> = None;
-    for _ in 0..200 {
-        if hi - lo <= 1e-12 * lo.abs().max(hi.abs()).max(1.0) {
-            break;
-        }
-        // A midpoint where the linearisation fails (a pole exactly there) is moved once.
-        let mut mid = 0.5 * (lo + hi);
-        let point = match at(mid) {
-            Some(point) => point,
-            None => {
-                mid = lo + 0.381_966 * (hi - lo);
-                let Some(point) = at(mid) else { break };
-                point
-            }
-        };
-        let count = unstable_count(&point.eigenvalues);
-        if count == count_a {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-        if count == count_a.max(count_b) {
-            unstable_side = Some(point);
-        }
-    }
+    let ([lo, hi], unstable_side) = bisect_on_count(at, [v_a, v_b], [count_a, count_b]);
     let (unstable_grid, stable_grid) = if count_a > count_b { (a, b) } else { (b, a) };
     // The crossing eigenvalue: the unstable one nearest the axis on that side.
     let side = unstable_side.unwrap_or_else(|| unstable_grid.clone());
@@ -350,33 +323,9 @@ fn locate_change(
             value = secant_on_real_part(at, crossing, [lo, hi], [v_a, v_b], value);
         }
     } else {
-        // A real eigenvalue through 0: the coefficient of `s^z` in `det(sI − A)` changes
-        // sign there, smooth where the eigenvalue is not (a pair that meets at 0 and leaves
-        // as an imaginary pair, whose real part grows as a square root).
-        let z = zero_count(a).min(zero_count(b));
-        let size = stable_grid.raw.len();
-        let mut coefficient = |v: f64| -> Option<f64> {
-            let raw = at(v)?.raw;
-            (raw.len() == size).then(|| characteristic_coefficient(&raw, z))
-        };
-        if let Some((root, around)) = sign_change(&mut coefficient, [lo, hi], [v_a, v_b]) {
-            // Kept where the crossing eigenvalue (the `z + 1`-th smallest) is near zero, a
-            // thousandth of its size on the stable side (near a crossing where a pair meets at
-            // 0 beside a zero, the computed eigenvalues of the near-triple zero carry
-            // `(ε ‖A‖)^(1/3)`): a slow eigenvalue, or a pole, also changes the coefficient's
-            // sign.
-            let nearest = |raw: &[Complex<f64>]| {
-                let mut m: Vec<f64> = raw.iter().map(|s| s.norm()).collect();
-                m.sort_by(f64::total_cmp);
-                m.get(z).copied()
-            };
-            let there = at(root).and_then(|p| nearest(&p.raw));
-            if let (Some(there), Some(away)) = (there, nearest(&stable_grid.raw))
-                && there <= 1e-3 * away
-            {
-                value = root;
-                bracket = around;
-            }
+        if let Some((root, around)) = real_crossing(at, [a, b], stable_grid, [lo, hi], [v_a, v_b]) {
+            value = root;
+            bracket = around;
         }
     }
     StabilityChange {
@@ -395,21 +344,113 @@ fn locate_change(
         },
         // At the refined value: the pair's frequency where its real part is 0.
         frequency: if complex {
-            at(value)
-                .and_then(|p| {
-                    p.raw
-                        .iter()
-                        .copied()
-                        .min_by(|x, y| (*x - crossing).norm().total_cmp(&(*y - crossing).norm()))
-                })
-                .unwrap_or(crossing)
-                .im
-                .abs()
+            crossing_frequency(at, value, crossing)
         } else {
             0.0
         },
         bracket,
     }
+}
+
+/// Bisection of [`locate_change`] on the number of unstable eigenvalues between the grid
+/// values `[v_a, v_b]` (counts `[count_a, count_b]`) to `1e-12 max(1, |v|)`, at most 200
+/// halvings: the final bracket `[lo, hi]` (`lo` on `v_a`'s side) and the eigenvalues last
+/// found on the side with more unstable ones, if any.
+fn bisect_on_count(
+    at: &mut impl FnMut(f64) -> Option<PointEigenvalues>,
+    [v_a, v_b]: [f64; 2],
+    [count_a, count_b]: [usize; 2],
+) -> ([f64; 2], Option<PointEigenvalues>) {
+    let (mut lo, mut hi) = (v_a, v_b);
+    // The eigenvalues on the side with more unstable ones, as near the crossing as the
+    // bisection gets.
+    let mut unstable_side: Option<PointEigenvalues> = None;
+    for _ in 0..200 {
+        if hi - lo <= 1e-12 * lo.abs().max(hi.abs()).max(1.0) {
+            break;
+        }
+        // A midpoint where the linearisation fails (a pole exactly there) is moved once.
+        let mut mid = 0.5 * (lo + hi);
+        let point = match at(mid) {
+            Some(point) => point,
+            None => {
+                mid = lo + 0.381_966 * (hi - lo);
+                let Some(point) = at(mid) else { break };
+                point
+            }
+        };
+        let count = unstable_count(&point.eigenvalues);
+        if count == count_a {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+        if count == count_a.max(count_b) {
+            unstable_side = Some(point);
+        }
+    }
+    ([lo, hi], unstable_side)
+}
+
+/// A real eigenvalue's crossing of 0 for [`locate_change`]: the sign change of the
+/// characteristic polynomial's coefficient of `s^z` (`z` the zeros both grid points `a`, `b`
+/// share) near the bisection's `[lo, hi]` within the grid values `[v_a, v_b]`, as
+/// `(root, bracket)`; `None` when there is none or the crossing eigenvalue is not near zero
+/// there (above `1e-3` of its size at the grid point `stable_grid`).
+fn real_crossing(
+    at: &mut impl FnMut(f64) -> Option<PointEigenvalues>,
+    [a, b]: [&PointEigenvalues; 2],
+    stable_grid: &PointEigenvalues,
+    [lo, hi]: [f64; 2],
+    [v_a, v_b]: [f64; 2],
+) -> Option<(f64, [f64; 2])> {
+    // A real eigenvalue through 0: the coefficient of `s^z` in `det(sI − A)` changes
+    // sign there, smooth where the eigenvalue is not (a pair that meets at 0 and leaves
+    // as an imaginary pair, whose real part grows as a square root).
+    let z = zero_count(a).min(zero_count(b));
+    let size = stable_grid.raw.len();
+    let mut coefficient = |v: f64| -> Option<f64> {
+        let raw = at(v)?.raw;
+        (raw.len() == size).then(|| characteristic_coefficient(&raw, z))
+    };
+    if let Some((root, around)) = sign_change(&mut coefficient, [lo, hi], [v_a, v_b]) {
+        // Kept where the crossing eigenvalue (the `z + 1`-th smallest) is near zero, a
+        // thousandth of its size on the stable side (near a crossing where a pair meets at
+        // 0 beside a zero, the computed eigenvalues of the near-triple zero carry
+        // `(ε ‖A‖)^(1/3)`): a slow eigenvalue, or a pole, also changes the coefficient's
+        // sign.
+        let nearest = |raw: &[Complex<f64>]| {
+            let mut m: Vec<f64> = raw.iter().map(|s| s.norm()).collect();
+            m.sort_by(f64::total_cmp);
+            m.get(z).copied()
+        };
+        let there = at(root).and_then(|p| nearest(&p.raw));
+        if let (Some(there), Some(away)) = (there, nearest(&stable_grid.raw))
+            && there <= 1e-3 * away
+        {
+            return Some((root, around));
+        }
+    }
+    None
+}
+
+/// `|Im s|` (rad/s) at `value` of the raw eigenvalue nearest `crossing` (a complex pair's
+/// frequency where its real part is 0); `crossing`'s own when `at(value)` fails.
+fn crossing_frequency(
+    at: &mut impl FnMut(f64) -> Option<PointEigenvalues>,
+    value: f64,
+    crossing: Complex<f64>,
+) -> f64 {
+    at(value)
+        .and_then(|p| {
+            p.raw
+                .iter()
+                .copied()
+                .min_by(|x, y| (*x - crossing).norm().total_cmp(&(*y - crossing).norm()))
+        })
+        .unwrap_or(crossing)
+        .im
+        .abs()
 }
 
 /// A complex pair's crossing refined by the secant method on its real part (smooth in the
@@ -618,33 +659,9 @@ pub fn parameter_sweep(
             reason: first.error.clone().unwrap_or_default(),
         });
     }
-    let counts: Vec<Option<usize>> = raws
-        .iter()
-        .map(|seen| seen.as_ref().map(|p| unstable_count(&p.eigenvalues)))
-        .collect();
     let mut stability_changes = Vec::new();
     if options.refine {
-        for k in 1..points.len() {
-            let (Some(count_a), Some(count_b)) = (counts[k - 1], counts[k]) else {
-                continue;
-            };
-            if count_a == count_b {
-                continue;
-            }
-            let grid = [
-                (points[k - 1].value, raws[k - 1].as_ref()),
-                (points[k].value, raws[k].as_ref()),
-            ];
-            let (Some(a), Some(b)) = (grid[0].1, grid[1].1) else {
-                continue;
-            };
-            let change = locate_change(
-                &mut |v: f64| at(model, v).ok(),
-                [(grid[0].0, a), (grid[1].0, b)],
-                [count_a, count_b],
-            );
-            stability_changes.push(change);
-        }
+        stability_changes = refine_changes(&points, &raws, &mut |v: f64| at(model, v).ok());
     }
     let _ = model.set_parameter(name, before);
     Ok(ParameterSweep {
@@ -659,4 +676,37 @@ pub fn parameter_sweep(
         points,
         stability_changes,
     })
+}
+
+/// Every stability change of a sweep, in ascending value: between each two neighbouring
+/// `points` that both gave eigenvalues (`raws`, one per point) and whose numbers of unstable
+/// eigenvalues differ, located by [`locate_change`] with `at(v)` the eigenvalues at `v`.
+fn refine_changes(
+    points: &[SweepPoint],
+    raws: &[Option<PointEigenvalues>],
+    at: &mut impl FnMut(f64) -> Option<PointEigenvalues>,
+) -> Vec<StabilityChange> {
+    let counts: Vec<Option<usize>> = raws
+        .iter()
+        .map(|seen| seen.as_ref().map(|p| unstable_count(&p.eigenvalues)))
+        .collect();
+    let mut stability_changes = Vec::new();
+    for k in 1..points.len() {
+        let (Some(count_a), Some(count_b)) = (counts[k - 1], counts[k]) else {
+            continue;
+        };
+        if count_a == count_b {
+            continue;
+        }
+        let grid = [
+            (points[k - 1].value, raws[k - 1].as_ref()),
+            (points[k].value, raws[k].as_ref()),
+        ];
+        let (Some(a), Some(b)) = (grid[0].1, grid[1].1) else {
+            continue;
+        };
+        let change = locate_change(at, [(grid[0].0, a), (grid[1].0, b)], [count_a, count_b]);
+        stability_changes.push(change);
+    }
+    stability_changes
 }

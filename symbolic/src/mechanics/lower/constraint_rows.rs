@@ -19,6 +19,47 @@ impl Lowering<'_> {
             .iter()
             .map(|(k, e)| (k.value.clone(), self.expr(e)))
             .collect();
+        self.point_constraint_rows(file, &kinematics, &mut holonomic);
+        let mut nonholonomic: Vec<(String, ExprId)> = file
+            .nonholonomic
+            .iter()
+            .map(|(k, e)| (k.value.clone(), self.expr(e)))
+            .collect();
+        for r in &file.rolling {
+            nonholonomic.extend(self.rolling_contact(r, kinematics));
+        }
+        if holonomic.is_empty() && nonholonomic.is_empty() {
+            return ConstraintEquations::default();
+        }
+        let symbols: Vec<[SymbolId; 3]> = self.arena.coordinates().to_vec();
+        for ((k, _), (_, g)) in file.nonholonomic.iter().zip(&nonholonomic) {
+            if !linear_in_rates(&mut self.arena, *g, &symbols) {
+                self.errors.push(
+                    Diagnostic::new(k.location, format!("non-holonomic constraint `{}` is not linear in the rates", k.value))
+                        .with_help("write it as A(q, t) q̇ + b(q, t) = 0: each `x_dot` to the first power, times a function of q and t"),
+                );
+            }
+        }
+        let eqs = ConstraintEquations::derive(&mut self.arena, &symbols, &holonomic, &nonholonomic);
+        // (More constraints than coordinates is the loader's error; after an error in the
+        // constraints themselves the rank test would only repeat it. An error elsewhere does
+        // not stop it: every diagnostic at once.)
+        if self.errors.len() > before {
+            return eqs;
+        }
+        let samples = self.jacobian_samples(&eqs, parameters);
+        self.report_dependent_rows(file, &eqs, parameters, &samples);
+        eqs
+    }
+
+    /// The rows of the constraints on points (`{ point: C, along: z, in: N }`): the point's
+    /// position along the axis, appended to `holonomic` in file order.
+    fn point_constraint_rows(
+        &mut self,
+        file: &ModelFile,
+        kinematics: &Kinematics<'_>,
+        holonomic: &mut Vec<(String, ExprId)>,
+    ) {
         for c in &file.point_constraints {
             let (Some(p), Some(frame)) = (
                 point(kinematics.points, &c.point.value),
@@ -51,34 +92,16 @@ impl Lowering<'_> {
             let phi = self.dot(&r, &e);
             holonomic.push((c.name.value.clone(), phi));
         }
-        let mut nonholonomic: Vec<(String, ExprId)> = file
-            .nonholonomic
-            .iter()
-            .map(|(k, e)| (k.value.clone(), self.expr(e)))
-            .collect();
-        for r in &file.rolling {
-            nonholonomic.extend(self.rolling_contact(r, kinematics));
-        }
-        if holonomic.is_empty() && nonholonomic.is_empty() {
-            return ConstraintEquations::default();
-        }
-        let symbols: Vec<[SymbolId; 3]> = self.arena.coordinates().to_vec();
-        for ((k, _), (_, g)) in file.nonholonomic.iter().zip(&nonholonomic) {
-            if !linear_in_rates(&mut self.arena, *g, &symbols) {
-                self.errors.push(
-                    Diagnostic::new(k.location, format!("non-holonomic constraint `{}` is not linear in the rates", k.value))
-                        .with_help("write it as A(q, t) q̇ + b(q, t) = 0: each `x_dot` to the first power, times a function of q and t"),
-                );
-            }
-        }
-        let eqs = ConstraintEquations::derive(&mut self.arena, &symbols, &holonomic, &nonholonomic);
-        let (m, n) = (eqs.len(), symbols.len());
-        // (More constraints than coordinates is the loader's error; after an error in the
-        // constraints themselves the rank test would only repeat it. An error elsewhere does
-        // not stop it: every diagnostic at once.)
-        if self.errors.len() > before {
-            return eqs;
-        }
+    }
+
+    /// The constraint Jacobian `J` evaluated at up to six random configurations where it is
+    /// finite (of 60 tried; coordinates, rates and `t` uniform in `[−2, 2]`, parameters at
+    /// their defaults), each row-major `m × n`.
+    fn jacobian_samples(
+        &mut self,
+        eqs: &ConstraintEquations,
+        parameters: &[ParameterInfo],
+    ) -> Vec<Vec<f64>> {
         // Rank of J at a few random configurations (parameters at their defaults).
         let mut evaluator = crate::expr::eval::Evaluator::new(&self.arena, &eqs.jacobian);
         let mut rng = <rand::rngs::Xoshiro256PlusPlus as rand::SeedableRng>::seed_from_u64(
@@ -105,8 +128,21 @@ impl Lowering<'_> {
                 samples.push(values);
             }
         }
+        samples
+    }
+
+    /// Reports each constraint whose Jacobian row depends on the others' at every sampled
+    /// configuration: contradictory where the others hold and it does not, else redundant.
+    fn report_dependent_rows(
+        &mut self,
+        file: &ModelFile,
+        eqs: &ConstraintEquations,
+        parameters: &[ParameterInfo],
+        samples: &[Vec<f64>],
+    ) {
+        let (m, n) = (eqs.len(), self.arena.coordinates().len());
         let all: Vec<Located<String>> = file.constraint_names();
-        let dependent = redundant_rows(&samples, m, n);
+        let dependent = redundant_rows(samples, m, n);
         let independent: Vec<usize> = (0..eqs.holonomic)
             .filter(|i| dependent.iter().all(|(d, _)| d != i))
             .collect();
@@ -121,7 +157,7 @@ impl Lowering<'_> {
             // (The constraints it combines come before it, so they are holonomic too.)
             if i < eqs.holonomic
                 && let Some(found) =
-                    self.residual_where_others_hold(&eqs, parameters, &independent, i)
+                    self.residual_where_others_hold(eqs, parameters, &independent, i)
                 && found.contradicts()
             {
                 let residual = found.residual;
@@ -163,7 +199,6 @@ impl Lowering<'_> {
                     .with_help("redundant constraints make the constraint forces indeterminate (the planar-loop trap); remove it"),
             );
         }
-        eqs
     }
 
     /// The residual of the dependent holonomic constraint `dependent` where the

@@ -12,6 +12,8 @@ impl Checker<'_> {
     //   rest lengths, damping coefficients;
     // - motion: `kinetic`, generalized forces, forces, torques.
     // Accelerations (`_ddot`) appear nowhere: the equations of motion are derived.
+    // Long: one list, one call per place in the file where an expression stands, in the file's
+    // order, as unit_check's `walk`; split by section it would only be a longer list.
     pub(super) fn expressions(&mut self) {
         let file = self.file;
         if let Some(k) = &file.kinetic {
