@@ -109,24 +109,24 @@ pub fn simulate_many<'py>(
                 }
             })
         });
-    let report = match report {
-        Ok(report) => report,
-        Err(BatchError::Stopped) => {
-            return Err(
-                interrupted.unwrap_or_else(|| pyo3::exceptions::PyKeyboardInterrupt::new_err(()))
-            );
-        }
-        Err(BatchError::Run { run, source }) => {
-            return Err(simulation_error(source)
-                .context(&format!("run {run}"))
-                .into_py());
-        }
-        Err(e @ BatchError::ThreadPool(_)) => {
-            return Err(RunError::Analysis(e.to_string()).into_py());
-        }
-        Err(e) => return Err(RunError::Value(e.to_string()).into_py()),
-    };
+    let report = report.map_err(|e| batch_error(e, interrupted))?;
     stacked(py, report)
+}
+
+/// A batch's error as the Python layer raises it: the interpreter's own exception when it
+/// stopped the batch (`interrupted`), `AnalysisError` for a run that cannot start (with what
+/// to do) and for a thread pool that cannot be built, `ValueError` for the rest.
+fn batch_error(e: BatchError, interrupted: Option<PyErr>) -> PyErr {
+    match e {
+        BatchError::Stopped => {
+            interrupted.unwrap_or_else(|| pyo3::exceptions::PyKeyboardInterrupt::new_err(()))
+        }
+        BatchError::Run { run, source } => simulation_error(source)
+            .context(&format!("run {run}"))
+            .into_py(),
+        e @ BatchError::ThreadPool(_) => RunError::Analysis(e.to_string()).into_py(),
+        e => RunError::Value(e.to_string()).into_py(),
+    }
 }
 
 /// The report of a batch as the dictionary `simulate_many` returns.

@@ -377,22 +377,7 @@ impl Formulation for MomentumBalance {
         terms.spatial_bodies(arena, &bodies, (&symbols, time));
         terms.written(arena, &symbols, (model_potential, &written_forces));
         terms.loads(arena, &mut kinematics, (&points, &bodies, &loads), &symbols);
-        let (mass_terms, forcing_terms) = (terms.mass, terms.forcing);
-        let mut mass_matrix = vec![arena.int(0); n * n];
-        for i in 0..n {
-            for j in i..n {
-                let m = arena.sum(&mass_terms[i * n + j]);
-                mass_matrix[i * n + j] = m;
-                mass_matrix[j * n + i] = m;
-            }
-        }
-        let forcing: Vec<ExprId> = forcing_terms.iter().map(|t| arena.sum(t)).collect();
-        let (mass_matrix, forcing) = cheaper_of_raw_and_collected(arena, mass_matrix, forcing);
-        EquationsOfMotion {
-            num_dofs: n,
-            mass_matrix,
-            forcing,
-        }
+        terms.equations(arena)
     }
 }
 
@@ -499,6 +484,27 @@ impl Terms {
             if !arena.is_zero(written[i]) {
                 self.forcing[i].push(written[i]);
             }
+        }
+    }
+
+    /// `M` (symmetric, each entry the sum of its terms) and `F`, as given or multiplied out and
+    /// collected, whichever is cheaper ([`cheaper_of_raw_and_collected`]).
+    fn equations(self, arena: &mut ExprArena) -> EquationsOfMotion {
+        let n = self.n;
+        let mut mass_matrix = vec![arena.int(0); n * n];
+        for i in 0..n {
+            for j in i..n {
+                let m = arena.sum(&self.mass[i * n + j]);
+                mass_matrix[i * n + j] = m;
+                mass_matrix[j * n + i] = m;
+            }
+        }
+        let forcing: Vec<ExprId> = self.forcing.iter().map(|t| arena.sum(t)).collect();
+        let (mass_matrix, forcing) = cheaper_of_raw_and_collected(arena, mass_matrix, forcing);
+        EquationsOfMotion {
+            num_dofs: n,
+            mass_matrix,
+            forcing,
         }
     }
 
