@@ -534,10 +534,13 @@ initial: { x1: 0.6, y1: -0.8, x2: 0.9, y2: -1.2 }
 
 /// The writer on every bundled model: writing the text read back gives the same text; the
 /// text, compiled, describes the same model (names, points, drawing with its wheels' rims,
-/// bodies' centres, constraints, equilibria, events, outputs; checks and Floquet references
-/// left aside as the writer notes) and gives the same points' positions, `M`, `F`,
-/// constraint values `Φ`, Jacobian `J`, velocity residuals and `γ` at 20 states about the
-/// start (to 1e-12 relative: the same expressions, derived from sections in another order).
+/// bodies' centres, constraints, equilibria with their guesses, rates and ignorable
+/// coordinates, events by name and direction, outputs; `checks: equations_of_motion`,
+/// `floquet:` and `balances:` left out as the writer notes) and gives the same points'
+/// positions, kinetic and potential energy, `M`, `F`, constraint values `Φ`, Jacobian `J`,
+/// velocity residuals and `γ` at 20 states about the start (to 1e-12 relative: the same
+/// expressions, derived from sections in another order). Event functions are compared by
+/// name only.
 /// Every section is covered: the energy form, frames, points in frames and wheel contacts,
 /// planar and 3-D bodies, springs, dampers, forces and torques (in frames too), interactions,
 /// outputs, constraints on expressions and on points, rolling contacts and other
@@ -596,6 +599,28 @@ fn the_writer_round_trips_the_bundled_models() {
             "{}",
             entry.name
         );
+        assert_eq!(
+            (&da.ignorable_coordinates, da.equilibrium_rates),
+            (&db.ignorable_coordinates, db.equilibrium_rates),
+            "{}",
+            entry.name
+        );
+        let (ga, gb) = (a.equilibrium_guesses(), b.equilibrium_guesses());
+        let (ra, rb) = (a.equilibrium_rates(), b.equilibrium_rates());
+        assert_eq!((ga.len(), ra.len()), (gb.len(), rb.len()), "{}", entry.name);
+        let equilibria = |g: &[(&str, Vec<f64>)], r: &[Vec<f64>]| -> Vec<f64> {
+            g.iter()
+                .flat_map(|(_, q)| q.clone())
+                .chain(r.iter().flatten().copied())
+                .collect()
+        };
+        for (p, q) in equilibria(&ga, &ra).into_iter().zip(equilibria(&gb, &rb)) {
+            assert!(
+                p == q || (p - q).abs() <= 1e-12 * p.abs().max(1.0),
+                "{}: equilibrium {p} vs {q}",
+                entry.name
+            );
+        }
         for k in 0..20 {
             let y: Vec<f64> = y0
                 .iter()
@@ -607,6 +632,14 @@ fn the_writer_round_trips_the_bundled_models() {
                 a.mass_matrix_and_forcing(t, &y),
                 b.mass_matrix_and_forcing(t, &y),
             );
+            let energies = |m: &dyn ModelInfo| [m.kinetic_energy(t, &y), m.potential_energy(t, &y)];
+            for (p, q) in energies(a.as_ref()).into_iter().zip(energies(b.as_ref())) {
+                assert!(
+                    p == q || (p - q).abs() <= 1e-12 * p.abs().max(1.0),
+                    "{}: energy {p} vs {q} at {y:?}",
+                    entry.name
+                );
+            }
             let (pa, pb) = (a.point_positions(t, &y), b.point_positions(t, &y));
             assert_eq!(pa.len(), pb.len(), "{}", entry.name);
             for (p, q) in pa.iter().flatten().zip(pb.iter().flatten()) {

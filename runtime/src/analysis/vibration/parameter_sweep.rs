@@ -322,11 +322,11 @@ fn locate_change(
         if transversal {
             value = secant_on_real_part(at, crossing, [lo, hi], [v_a, v_b], value);
         }
-    } else {
-        if let Some((root, around)) = real_crossing(at, [a, b], stable_grid, [lo, hi], [v_a, v_b]) {
-            value = root;
-            bracket = around;
-        }
+    } else if let Some((root, around)) =
+        real_crossing(at, [a, b], stable_grid, [lo, hi], [v_a, v_b])
+    {
+        value = root;
+        bracket = around;
     }
     StabilityChange {
         value,
