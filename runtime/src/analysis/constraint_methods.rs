@@ -407,21 +407,7 @@ pub fn constraint_methods_with_reduced(
     options: &ConstraintMethodsOptions,
 ) -> Result<ConstraintMethods, ConstraintMethodsError> {
     let mut model = make();
-    if model.description().holonomic_constraints == 0 {
-        return Err(ConstraintMethodsError::NoHolonomicConstraints {
-            model: model.description().name.to_string(),
-        });
-    }
-    let positive = |x: f64| x.is_finite() && x > 0.0;
-    if !positive(options.t_end) || !positive(options.tol) {
-        return Err(ConstraintMethodsError::InvalidOptions {
-            t_end: options.t_end,
-            tol: options.tol,
-        });
-    }
-    if let Some(&stiffness) = options.stiffness.iter().find(|&&k| !positive(k)) {
-        return Err(ConstraintMethodsError::InvalidStiffness { stiffness });
-    }
+    check_study(model.as_ref(), options)?;
     let y0 = model
         .consistent_initial_state()
         .map_err(ConstraintMethodsError::InconsistentStart)?;
@@ -437,94 +423,155 @@ pub fn constraint_methods_with_reduced(
         .collect();
     let names: Vec<&str> = owned.iter().map(String::as_str).collect();
 
-    // Reference: the DAE with Baumgarte at rtol = atol = 1e-13, checked against the
-    // unstabilised DAE at the same tolerance.
-    model.set_stabilization(Stabilization::default_baumgarte());
-    let (reference_solution, failure) =
-        integrate(model.as_mut(), &y0, t_end, &times, REFERENCE_TOL);
-    if let Some(message) = failure {
-        return Err(ConstraintMethodsError::ReferenceFailed { message });
-    }
-    let reference = positions(model.as_ref(), &reference_solution, &names);
-    model.set_stabilization(Stabilization::None);
-    let (check, _) = integrate(model.as_mut(), &y0, t_end, &times, REFERENCE_TOL);
-    let agreement = row(
-        String::new(),
-        model.as_mut(),
-        &check,
-        None,
-        &reference,
-        &names,
-        true,
-    )
-    .position_error;
+    let (reference, agreement) = reference_run(model.as_mut(), &y0, t_end, &times, &names)?;
 
-    let mut rows = Vec::new();
-    for &k in &options.stiffness {
-        let mut m = make();
-        m.set_stabilization(Stabilization::Penalty {
-            stiffness: k,
-            damping: 0.0,
-        });
-        let (s, f) = integrate(m.as_mut(), &y0, t_end, &times, tol);
-        rows.push(row(
-            format!("I: stiff spring k = {k:e}"),
-            m.as_mut(),
-            &s,
-            f,
-            &reference,
-            &names,
-            true,
-        ));
-    }
-    let [alpha, beta] = Stabilization::DEFAULT_BAUMGARTE_GAINS;
-    let baumgarte = if alpha == beta {
-        format!("II.1: DAE, Baumgarte α = β = {alpha}/s")
-    } else {
-        format!("II.1: DAE, Baumgarte α = {alpha}/s, β = {beta}/s")
+    let runs = MethodRuns {
+        t_end,
+        times: &times,
+        tol,
+        reference: &reference,
+        names: &names,
     };
-    for (label, stab) in [
-        (
-            "II.1: DAE, no stabilisation".to_string(),
-            Stabilization::None,
-        ),
-        (baumgarte, Stabilization::default_baumgarte()),
-    ] {
-        let mut m = make();
-        m.set_stabilization(stab);
-        let (s, f) = integrate(m.as_mut(), &y0, t_end, &times, tol);
-        rows.push(row(label, m.as_mut(), &s, f, &reference, &names, true));
-    }
-    if let Some((kept, mut m)) = reduced {
-        let y0 = m.initial_state();
-        let (s, f) = integrate(m.as_mut(), &y0, t_end, &times, tol);
-        rows.push(row(
-            format!("II.2: eliminated, keeping {kept}"),
-            m.as_mut(),
-            &s,
-            f,
-            &reference,
-            &names,
-            false,
-        ));
-    }
-    if let Some((twin, mut m)) = twin {
-        let y0 = m.initial_state();
-        let (s, f) = integrate(m.as_mut(), &y0, t_end, &times, tol);
-        rows.push(row(
-            format!("II.3: minimal coordinates ({twin})"),
-            m.as_mut(),
-            &s,
-            f,
-            &reference,
-            &names,
-            false,
-        ));
-    }
+    let rows = runs.rows(make, reduced, twin, &options.stiffness, &y0);
     Ok(ConstraintMethods {
         model: model.description().name.to_string(),
         reference_tol: REFERENCE_TOL,
         agreement,
         rows,
     })
+}
+
+/// The checks of [`constraint_methods_with_reduced`] before any run, in its order: the model
+/// has holonomic constraints, the end time and tolerance are positive, and so is every
+/// stiffness.
+fn check_study(
+    model: &dyn ModelInfo,
+    options: &ConstraintMethodsOptions,
+) -> Result<(), ConstraintMethodsError> {
+    if model.description().holonomic_constraints == 0 {
+        return Err(ConstraintMethodsError::NoHolonomicConstraints {
+            model: model.description().name.to_string(),
+        });
+    }
+    let positive = |x: f64| x.is_finite() && x > 0.0;
+    if !positive(options.t_end) || !positive(options.tol) {
+        return Err(ConstraintMethodsError::InvalidOptions {
+            t_end: options.t_end,
+            tol: options.tol,
+        });
+    }
+    if let Some(&stiffness) = options.stiffness.iter().find(|&&k| !positive(k)) {
+        return Err(ConstraintMethodsError::InvalidStiffness { stiffness });
+    }
+    Ok(())
+}
+
+/// The positions of the compared points at every sample, as [`positions`] gives them.
+type PointPaths = Vec<Vec<[f64; 3]>>;
+
+/// The reference positions of the points `names` at `times` and their agreement
+/// ([`ConstraintMethods::agreement`]) with the unstabilised DAE at the same tolerance;
+/// leaves `model` unstabilised.
+fn reference_run(
+    model: &mut dyn ModelInfo,
+    y0: &[f64],
+    t_end: f64,
+    times: &[f64],
+    names: &[&str],
+) -> Result<(PointPaths, f64), ConstraintMethodsError> {
+    // Reference: the DAE with Baumgarte at rtol = atol = 1e-13, checked against the
+    // unstabilised DAE at the same tolerance.
+    model.set_stabilization(Stabilization::default_baumgarte());
+    let (reference_solution, failure) = integrate(model, y0, t_end, times, REFERENCE_TOL);
+    if let Some(message) = failure {
+        return Err(ConstraintMethodsError::ReferenceFailed { message });
+    }
+    let reference = positions(model, &reference_solution, names);
+    model.set_stabilization(Stabilization::None);
+    let (check, _) = integrate(model, y0, t_end, times, REFERENCE_TOL);
+    let agreement = row(String::new(), model, &check, None, &reference, names, true).position_error;
+    Ok((reference, agreement))
+}
+
+/// What every method's run shares: the end time, output times and tolerance, and the
+/// reference positions of the points `names` it is measured against.
+struct MethodRuns<'a> {
+    t_end: f64,
+    times: &'a [f64],
+    tol: f64,
+    reference: &'a [Vec<[f64; 3]>],
+    names: &'a [&'a str],
+}
+
+impl MethodRuns<'_> {
+    /// One method's row: `model` integrated from `y0` at the study's tolerance, measured
+    /// against the reference (its drift too if `constrained`).
+    fn run(
+        &self,
+        method: String,
+        model: &mut dyn ModelInfo,
+        y0: &[f64],
+        constrained: bool,
+    ) -> ConstraintMethodRow {
+        let (s, f) = integrate(model, y0, self.t_end, self.times, self.tol);
+        row(
+            method,
+            model,
+            &s,
+            f,
+            self.reference,
+            self.names,
+            constrained,
+        )
+    }
+
+    /// The rows of [`ConstraintMethods::rows`], in their order: method I at every
+    /// `stiffness`, II.1 without and with Baumgarte (each a fresh model from `make`, started
+    /// at `y0`), then II.2 and II.3 from their own initial states if given.
+    fn rows(
+        &self,
+        make: &mut dyn FnMut() -> Box<dyn ModelInfo>,
+        reduced: Option<(&str, Box<dyn ModelInfo>)>,
+        twin: Option<(&str, Box<dyn ModelInfo>)>,
+        stiffness: &[f64],
+        y0: &[f64],
+    ) -> Vec<ConstraintMethodRow> {
+        let mut rows = Vec::new();
+        for &k in stiffness {
+            let mut m = make();
+            m.set_stabilization(Stabilization::Penalty {
+                stiffness: k,
+                damping: 0.0,
+            });
+            rows.push(self.run(format!("I: stiff spring k = {k:e}"), m.as_mut(), y0, true));
+        }
+        let [alpha, beta] = Stabilization::DEFAULT_BAUMGARTE_GAINS;
+        let baumgarte = if alpha == beta {
+            format!("II.1: DAE, Baumgarte α = β = {alpha}/s")
+        } else {
+            format!("II.1: DAE, Baumgarte α = {alpha}/s, β = {beta}/s")
+        };
+        for (label, stab) in [
+            (
+                "II.1: DAE, no stabilisation".to_string(),
+                Stabilization::None,
+            ),
+            (baumgarte, Stabilization::default_baumgarte()),
+        ] {
+            let mut m = make();
+            m.set_stabilization(stab);
+            rows.push(self.run(label, m.as_mut(), y0, true));
+        }
+        if let Some((kept, mut m)) = reduced {
+            let y0 = m.initial_state();
+            let label = format!("II.2: eliminated, keeping {kept}");
+            rows.push(self.run(label, m.as_mut(), &y0, false));
+        }
+        if let Some((twin, mut m)) = twin {
+            let y0 = m.initial_state();
+            let label = format!("II.3: minimal coordinates ({twin})");
+            rows.push(self.run(label, m.as_mut(), &y0, false));
+        }
+        rows
+    }
 }

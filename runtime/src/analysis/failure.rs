@@ -235,54 +235,106 @@ pub fn failure_cause(
     let start_ratio = eigenvalue_ratio(model, 0.0, y0)?;
     // Singular: below an absolute floor, or a millionfold below its value at the start (a
     // badly scaled but regular M keeps its ratio along the motion).
-    let singular = |r: f64| r.is_nan() || r <= SINGULAR_RATIO;
     if singular(ratio) || ratio < DROP * start_ratio {
-        let elsewhere = (0..8).filter_map(|k| {
-            let mut other = y.to_vec();
-            for (i, q) in other.iter_mut().take(n).enumerate() {
-                let sign = if (i + k) % 2 == 0 { 1.0 } else { -1.0 };
-                *q += sign * 0.3 * (1.0 + k as f64 / 4.0);
-            }
-            eigenvalue_ratio(model, t, &other)
-        });
-        let regular_somewhere = std::iter::once(start_ratio)
-            .chain(elsewhere)
-            .any(|r| !singular(r) && r > ratio / DROP);
-        // A negative parameter is a suspect only if M is regular there with its sign turned
-        // (a negative offset or a gravity of -9.81 is not a negative mass).
-        let negative: Vec<(String, f64)> = parameters
-            .iter()
-            .filter(|(_, v)| *v < 0.0)
-            .filter(|(name, value)| {
-                if model.set_parameter(name, -value).is_err() {
-                    return false;
-                }
-                let flipped = eigenvalue_ratio(model, t, y);
-                let _ = model.set_parameter(name, *value);
-                flipped.is_some_and(|f| !singular(f) && f > ratio / DROP)
-            })
-            .cloned()
-            .collect();
-        return Some(if !regular_somewhere {
-            FailureCause::MassMatrixDegenerateEverywhere {
-                suspects: parameters.into_iter().filter(|(_, v)| *v <= 0.0).collect(),
-            }
-        } else if !negative.is_empty() {
-            FailureCause::NegativeParameters {
-                t,
-                eigenvalue_ratio: ratio,
-                suspects: negative,
-            }
-        } else {
-            FailureCause::SingularCoordinates {
-                t,
-                eigenvalue_ratio: ratio,
-            }
-        });
+        return Some(singular_mass_cause(
+            model,
+            t,
+            y,
+            n,
+            (ratio, start_ratio),
+            parameters,
+        ));
     }
     if let Some(cause) = vanishing_inertia(model, t, y, y0) {
         return Some(cause);
     }
+    if let Some(cause) = forcing_not_finite(model, t, y, n) {
+        return Some(cause);
+    }
+    if let IntegrationError::StepSizeTooSmall { dt, .. } = *error
+        && let Some((rho, growth)) = spectral_radius(model.as_ode_mut(), t, y)
+        && (dt * rho < NOT_STIFF || dt * growth > NOT_STIFF)
+    {
+        return Some(FailureCause::NotStiffness {
+            t,
+            step_size: dt,
+            spectral_radius: rho,
+            growth_rate: growth,
+        });
+    }
+    None
+}
+
+/// Whether the eigenvalue ratio `r` of `M` ([`eigenvalue_ratio`]) is that of a singular `M`:
+/// not a number, or at most [`SINGULAR_RATIO`].
+fn singular(r: f64) -> bool {
+    r.is_nan() || r <= SINGULAR_RATIO
+}
+
+/// The cause of [`failure_cause`] when `M` is singular at `(t, y)` (its eigenvalue `ratio`
+/// there, `start_ratio` at the start): a parameter when `M` is singular at the start and at
+/// eight configurations around `y` too, else negative `parameters` when turning their sign
+/// makes it regular, else the coordinates.
+fn singular_mass_cause(
+    model: &mut dyn ModelInfo,
+    t: f64,
+    y: &[f64],
+    n: usize,
+    (ratio, start_ratio): (f64, f64),
+    parameters: Vec<(String, f64)>,
+) -> FailureCause {
+    let elsewhere = (0..8).filter_map(|k| {
+        let mut other = y.to_vec();
+        for (i, q) in other.iter_mut().take(n).enumerate() {
+            let sign = if (i + k) % 2 == 0 { 1.0 } else { -1.0 };
+            *q += sign * 0.3 * (1.0 + k as f64 / 4.0);
+        }
+        eigenvalue_ratio(model, t, &other)
+    });
+    let regular_somewhere = std::iter::once(start_ratio)
+        .chain(elsewhere)
+        .any(|r| !singular(r) && r > ratio / DROP);
+    // A negative parameter is a suspect only if M is regular there with its sign turned
+    // (a negative offset or a gravity of -9.81 is not a negative mass).
+    let negative: Vec<(String, f64)> = parameters
+        .iter()
+        .filter(|(_, v)| *v < 0.0)
+        .filter(|(name, value)| {
+            if model.set_parameter(name, -value).is_err() {
+                return false;
+            }
+            let flipped = eigenvalue_ratio(model, t, y);
+            let _ = model.set_parameter(name, *value);
+            flipped.is_some_and(|f| !singular(f) && f > ratio / DROP)
+        })
+        .cloned()
+        .collect();
+    if !regular_somewhere {
+        FailureCause::MassMatrixDegenerateEverywhere {
+            suspects: parameters.into_iter().filter(|(_, v)| *v <= 0.0).collect(),
+        }
+    } else if !negative.is_empty() {
+        FailureCause::NegativeParameters {
+            t,
+            eigenvalue_ratio: ratio,
+            suspects: negative,
+        }
+    } else {
+        FailureCause::SingularCoordinates {
+            t,
+            eigenvalue_ratio: ratio,
+        }
+    }
+}
+
+/// [`FailureCause::ForcingNotFinite`] if the forcing at `(t, y)`, or `M` or the forcing a
+/// little ahead along the motion, is not finite.
+fn forcing_not_finite(
+    model: &mut dyn ModelInfo,
+    t: f64,
+    y: &[f64],
+    n: usize,
+) -> Option<FailureCause> {
     let (_, forcing) = model.mass_matrix_and_forcing(t, y);
     if forcing.iter().any(|v| !v.is_finite()) {
         return Some(FailureCause::ForcingNotFinite { t, at_state: true });
@@ -298,17 +350,6 @@ pub fn failure_cause(
         if forcing.iter().chain(m.iter()).any(|v| !v.is_finite()) {
             return Some(FailureCause::ForcingNotFinite { t, at_state: false });
         }
-    }
-    if let IntegrationError::StepSizeTooSmall { dt, .. } = *error
-        && let Some((rho, growth)) = spectral_radius(model.as_ode_mut(), t, y)
-        && (dt * rho < NOT_STIFF || dt * growth > NOT_STIFF)
-    {
-        return Some(FailureCause::NotStiffness {
-            t,
-            step_size: dt,
-            spectral_radius: rho,
-            growth_rate: growth,
-        });
     }
     None
 }

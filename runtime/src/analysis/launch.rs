@@ -731,6 +731,45 @@ pub fn launch_study(
     } else {
         options.speeds.clone()
     };
+    check_options(options, &speeds)?;
+    let launcher = Launcher {
+        options,
+        range_index,
+        height_index,
+        num_dofs: model.num_dofs(),
+        num_model_events,
+    };
+    model.set_event_terminal(&options.event, true);
+    let studies: Result<Vec<SpeedStudy>, LaunchError> = speeds
+        .iter()
+        .map(|&speed| launcher.study_speed(model, speed))
+        .collect();
+    model.set_event_terminal(&options.event, was_terminal);
+    let _ = model.set_parameter(&options.angle_parameter, values[angle_index]);
+    let _ = model.set_parameter(&options.speed_parameter, values[speed_index]);
+    Ok(LaunchStudy {
+        model: model.description().name.to_string(),
+        angle_parameter: options.angle_parameter.clone(),
+        speed_parameter: options.speed_parameter.clone(),
+        event: options.event.clone(),
+        range_coordinate: options.range_coordinate.clone(),
+        height_coordinate: options.height_coordinate.clone(),
+        angle_tol: options.angle_tol,
+        rtol: options.rtol,
+        speeds: studies?,
+    })
+}
+
+/// The checks of [`launch_study`]'s options, in its order, once the model's names are found:
+/// every one of `speeds` positive, at least 3 angles, a positive angle tolerance, `rtol` in
+/// `(0, 1)`, a positive maximum time, a shape angle in `(0, π/2)` and at least 2 path
+/// samples.
+///
+/// # Errors
+/// [`LaunchError::InvalidSpeed`], [`LaunchError::TooFewAngles`],
+/// [`LaunchError::InvalidTolerance`], [`LaunchError::InvalidMaxTime`],
+/// [`LaunchError::InvalidShapeAngle`], [`LaunchError::TooFewSamples`].
+fn check_options(options: &LaunchOptions, speeds: &[f64]) -> Result<(), LaunchError> {
     if let Some(&speed) = speeds.iter().find(|v| !(v.is_finite() && **v > 0.0)) {
         return Err(LaunchError::InvalidSpeed { speed });
     }
@@ -766,30 +805,5 @@ pub fn launch_study(
             samples: options.path_samples,
         });
     }
-    let launcher = Launcher {
-        options,
-        range_index,
-        height_index,
-        num_dofs: model.num_dofs(),
-        num_model_events,
-    };
-    model.set_event_terminal(&options.event, true);
-    let studies: Result<Vec<SpeedStudy>, LaunchError> = speeds
-        .iter()
-        .map(|&speed| launcher.study_speed(model, speed))
-        .collect();
-    model.set_event_terminal(&options.event, was_terminal);
-    let _ = model.set_parameter(&options.angle_parameter, values[angle_index]);
-    let _ = model.set_parameter(&options.speed_parameter, values[speed_index]);
-    Ok(LaunchStudy {
-        model: model.description().name.to_string(),
-        angle_parameter: options.angle_parameter.clone(),
-        speed_parameter: options.speed_parameter.clone(),
-        event: options.event.clone(),
-        range_coordinate: options.range_coordinate.clone(),
-        height_coordinate: options.height_coordinate.clone(),
-        angle_tol: options.angle_tol,
-        rtol: options.rtol,
-        speeds: studies?,
-    })
+    Ok(())
 }

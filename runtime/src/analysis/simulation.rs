@@ -12,8 +12,8 @@ use crate::analysis::fixed_step::{ENERGY_DRIFT_LIMIT, SimulationWarning, fixed_s
 use crate::analysis::methods::Method;
 use crate::constrained::{ProjectionError, Stabilization, StabilizationError};
 use crate::integrate::{
-    EventSpec, IntegrationError, IntegrationFailure, IntegratorOptions, OutputTimes, Solution,
-    Stats,
+    EventSpec, IntegrationError, IntegrationFailure, Integrator, IntegratorOptions, OutputTimes,
+    Solution, Stats,
 };
 use crate::model_info::ModelInfo;
 use crate::ode::{RhsError, WithEvents};
@@ -315,21 +315,7 @@ pub fn simulate_with_events(
     added: Option<&mut dyn AddedEvents>,
 ) -> Result<Simulation, SimulationError> {
     options.stabilization.validate()?;
-    let mut y0 = match &options.initial_state {
-        Some(y0) => y0.clone(),
-        None => model.initial_state(),
-    };
-    let expected = 2 * model.num_dofs();
-    if y0.len() != expected {
-        return Err(SimulationError::DimensionMismatch {
-            expected,
-            found: y0.len(),
-        });
-    }
-    check_initial_state(model.description(), &y0, options.initial_state.is_some())?;
-    model
-        .make_consistent(&mut y0)
-        .map_err(|e| inconsistent(model, &e))?;
+    let y0 = consistent_start(model, options)?;
     model.set_stabilization(options.stabilization);
     if !(options.t_end.is_finite() && options.t_end > 0.0) {
         return Err(SimulationError::InvalidEndTime {
@@ -340,34 +326,14 @@ pub fn simulate_with_events(
     let integrator_options = options.integrator_options();
     let mut integrator = options.method.integrator();
     let num_added_events = added.as_ref().map_or(0, |added| added.specs().len());
-    let result = match added {
-        Some(added) => {
-            let specs = added.specs();
-            let mut system = WithEvents::new(
-                model,
-                specs,
-                |m: &mut (dyn ModelInfo + '_), t: f64, y: &[f64], g: &mut [f64]| {
-                    added.values(m, t, y, g)
-                },
-            );
-            integrator.integrate(
-                &mut system,
-                0.0,
-                &y0,
-                options.t_end,
-                &options.output,
-                &integrator_options,
-            )
-        }
-        None => integrator.integrate(
-            model.as_ode_mut(),
-            0.0,
-            &y0,
-            options.t_end,
-            &options.output,
-            &integrator_options,
-        ),
-    };
+    let result = integrate_run(
+        integrator.as_mut(),
+        model,
+        added,
+        &y0,
+        options,
+        &integrator_options,
+    );
     let (solution, failure) = match result {
         Ok(s) => (s, None),
         Err(IntegrationFailure { error, partial }) => (*partial, Some(error)),
@@ -411,6 +377,74 @@ pub fn simulate_with_events(
         options: options.clone(),
         num_added_events,
     })
+}
+
+/// The initial state of a [`simulate_with_events`] run: the given one or the model's, of
+/// `2 n` entries, checked and made consistent with the model's constraints.
+///
+/// # Errors
+/// [`SimulationError::DimensionMismatch`], the errors of [`check_initial_state`], and an
+/// initial state that cannot be made consistent.
+fn consistent_start(
+    model: &mut dyn ModelInfo,
+    options: &SimulationOptions,
+) -> Result<Vec<f64>, SimulationError> {
+    let mut y0 = match &options.initial_state {
+        Some(y0) => y0.clone(),
+        None => model.initial_state(),
+    };
+    let expected = 2 * model.num_dofs();
+    if y0.len() != expected {
+        return Err(SimulationError::DimensionMismatch {
+            expected,
+            found: y0.len(),
+        });
+    }
+    check_initial_state(model.description(), &y0, options.initial_state.is_some())?;
+    model
+        .make_consistent(&mut y0)
+        .map_err(|e| inconsistent(model, &e))?;
+    Ok(y0)
+}
+
+/// Integrates `model`, with the `added` events if any, from `y0` over `[0, t_end]` with
+/// `integrator`, sampled at `options.output`.
+fn integrate_run(
+    integrator: &mut dyn Integrator,
+    model: &mut dyn ModelInfo,
+    added: Option<&mut dyn AddedEvents>,
+    y0: &[f64],
+    options: &SimulationOptions,
+    integrator_options: &IntegratorOptions,
+) -> Result<Solution, IntegrationFailure> {
+    match added {
+        Some(added) => {
+            let specs = added.specs();
+            let mut system = WithEvents::new(
+                model,
+                specs,
+                |m: &mut (dyn ModelInfo + '_), t: f64, y: &[f64], g: &mut [f64]| {
+                    added.values(m, t, y, g)
+                },
+            );
+            integrator.integrate(
+                &mut system,
+                0.0,
+                y0,
+                options.t_end,
+                &options.output,
+                integrator_options,
+            )
+        }
+        None => integrator.integrate(
+            model.as_ode_mut(),
+            0.0,
+            y0,
+            options.t_end,
+            &options.output,
+            integrator_options,
+        ),
+    }
 }
 
 /// What `eomgen simulate --json` prints: a [`Simulation`] summarised for a reader, with the

@@ -961,56 +961,31 @@ pub fn work_precision(
             .collect(),
     );
 
-    // The reference, DOP853 at `reference_tol`, accepted only if Dormand–Prince 5(4) at the
-    // same tolerance (another tableau, error estimator and dense output) agrees with it far
-    // below the target error.
-    let reference_options = IntegratorOptions::default()
-        .with_rtol(options.reference_tol)
-        .with_atol(options.reference_tol)
-        .with_max_steps(MAX_STEPS);
     let mut problem = Problem {
         model,
         y0,
         t_end: options.t_end,
         times,
     };
-    let mut solve = |method: Method, role: &'static str| {
-        problem
-            .solve(method.integrator().as_mut(), &reference_options)
-            .map_err(|f| WorkPrecisionError::ReferenceFailed {
-                role,
-                method,
-                rtol: options.reference_tol,
-                message: f.message,
-            })
-    };
-    let reference = solve(Method::Dop853, "the reference solution")?;
-    let check = solve(Method::Dp54, "the check of the reference")?;
-    // The reference's own error is up to its tolerance per component (`atol + rtol |y|`):
-    // a motion within it leaves no error to resolve.
-    let tol = options.reference_tol;
-    let moves = reference.iter().any(|(_, y)| {
-        y.iter()
-            .zip(&problem.y0)
-            .any(|(a, b)| (a - b).abs() > tol * (1.0 + b.abs()))
-    });
-    if !moves {
-        return Err(WorkPrecisionError::NoMotion {
-            t_end: options.t_end,
-            reference_tol: tol,
-        });
-    }
-    let agreement = state_error(&check, &reference);
-    if agreement.is_nan() || agreement > options.target_error / 100.0 {
-        return Err(WorkPrecisionError::ReferenceNotVerified {
-            reference_tol: options.reference_tol,
-            agreement,
-            target_error: options.target_error,
-        });
-    }
+    let (reference, agreement) = problem.verified_reference(options)?;
 
     let timing = (options.repeats.max(1), options.min_time_s);
-    let plans: Vec<(Method, Vec<Setting>)> = methods
+    let plans = plans(&methods, options);
+    let results = problem.run_plans(plans, timing, &reference, options.target_error, progress);
+    Ok(WorkPrecision {
+        dim: problem.y0.len(),
+        agreement,
+        reference_steps: reference.stats.steps,
+        min_repeats: timing.0,
+        min_time_s: timing.1,
+        results,
+    })
+}
+
+/// The settings each of `methods` runs at, in order: the tolerances for an adaptive method,
+/// the step counts (given or [`default_steps`] of its order) for a fixed-step one.
+fn plans(methods: &[Method], options: &WorkPrecisionOptions) -> Vec<(Method, Vec<Setting>)> {
+    methods
         .iter()
         .map(|&method| {
             let settings: Vec<Setting> = if method.is_adaptive() {
@@ -1033,37 +1008,95 @@ pub fn work_precision(
             };
             (method, settings)
         })
-        .collect();
-    let total: usize = plans.iter().map(|(_, s)| s.len()).sum();
-    let mut done = 0;
-    let results: Vec<MethodRuns> = plans
-        .into_iter()
-        .map(|(method, settings)| {
-            let runs: Vec<SettingRun> = settings
-                .into_iter()
-                .map(|s| {
-                    let run = problem.run(method, s, timing, &reference);
-                    done += 1;
-                    progress(done, total);
-                    run
+        .collect()
+}
+
+impl Problem<'_> {
+    /// The reference solution and its agreement with its check ([`WorkPrecision::agreement`]).
+    ///
+    /// # Errors
+    /// [`WorkPrecisionError::ReferenceFailed`], [`WorkPrecisionError::NoMotion`],
+    /// [`WorkPrecisionError::ReferenceNotVerified`].
+    fn verified_reference(
+        &mut self,
+        options: &WorkPrecisionOptions,
+    ) -> Result<(Solution, f64), WorkPrecisionError> {
+        // The reference, DOP853 at `reference_tol`, accepted only if Dormand–Prince 5(4) at the
+        // same tolerance (another tableau, error estimator and dense output) agrees with it far
+        // below the target error.
+        let reference_options = IntegratorOptions::default()
+            .with_rtol(options.reference_tol)
+            .with_atol(options.reference_tol)
+            .with_max_steps(MAX_STEPS);
+        let mut solve = |method: Method, role: &'static str| {
+            self.solve(method.integrator().as_mut(), &reference_options)
+                .map_err(|f| WorkPrecisionError::ReferenceFailed {
+                    role,
+                    method,
+                    rtol: options.reference_tol,
+                    message: f.message,
                 })
-                .collect();
-            let at_target = at_target(&runs, options.target_error);
-            MethodRuns {
-                method,
-                runs,
-                at_target,
-            }
-        })
-        .collect();
-    Ok(WorkPrecision {
-        dim: problem.y0.len(),
-        agreement,
-        reference_steps: reference.stats.steps,
-        min_repeats: timing.0,
-        min_time_s: timing.1,
-        results,
-    })
+        };
+        let reference = solve(Method::Dop853, "the reference solution")?;
+        let check = solve(Method::Dp54, "the check of the reference")?;
+        // The reference's own error is up to its tolerance per component (`atol + rtol |y|`):
+        // a motion within it leaves no error to resolve.
+        let tol = options.reference_tol;
+        let moves = reference.iter().any(|(_, y)| {
+            y.iter()
+                .zip(&self.y0)
+                .any(|(a, b)| (a - b).abs() > tol * (1.0 + b.abs()))
+        });
+        if !moves {
+            return Err(WorkPrecisionError::NoMotion {
+                t_end: options.t_end,
+                reference_tol: tol,
+            });
+        }
+        let agreement = state_error(&check, &reference);
+        if agreement.is_nan() || agreement > options.target_error / 100.0 {
+            return Err(WorkPrecisionError::ReferenceNotVerified {
+                reference_tol: options.reference_tol,
+                agreement,
+                target_error: options.target_error,
+            });
+        }
+        Ok((reference, agreement))
+    }
+
+    /// Every method's runs at its settings in `plans`, in order, and its work at
+    /// `target_error`; `progress(done, total)` after each run.
+    fn run_plans(
+        &mut self,
+        plans: Vec<(Method, Vec<Setting>)>,
+        timing: (usize, f64),
+        reference: &Solution,
+        target_error: f64,
+        progress: &mut dyn FnMut(usize, usize),
+    ) -> Vec<MethodRuns> {
+        let total: usize = plans.iter().map(|(_, s)| s.len()).sum();
+        let mut done = 0;
+        plans
+            .into_iter()
+            .map(|(method, settings)| {
+                let runs: Vec<SettingRun> = settings
+                    .into_iter()
+                    .map(|s| {
+                        let run = self.run(method, s, timing, reference);
+                        done += 1;
+                        progress(done, total);
+                        run
+                    })
+                    .collect();
+                let at_target = at_target(&runs, target_error);
+                MethodRuns {
+                    method,
+                    runs,
+                    at_target,
+                }
+            })
+            .collect()
+    }
 }
 
 #[cfg(test)]

@@ -300,6 +300,7 @@ impl RadauStepper {
     /// iterations at its observed rate is abandoned early for a smaller step, as in RADAU5;
     /// with fixed steps, where the step cannot shrink, it runs on until it converges,
     /// diverges or uses up its iterations.
+    // Long: pinned bit for bit against radau5.f; a split risks its order of operations.
     fn newton(
         &mut self,
         rhs: &mut CheckedRhs<'_>,

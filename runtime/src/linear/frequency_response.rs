@@ -75,7 +75,7 @@
 use nalgebra::{Complex, DMatrix, DVector};
 
 use crate::integrate::{
-    DormandPrince853, IntegrationError, Integrator, IntegratorOptions, OutputTimes,
+    DormandPrince853, IntegrationError, Integrator, IntegratorOptions, OutputTimes, Solution,
 };
 use crate::linear::eigenvalues::damped_modes;
 use crate::linear::modal::{
@@ -1377,45 +1377,7 @@ fn simulate_inner(
         frequency,
     } = *forcing;
     let n = model.num_dofs();
-    if !(frequency.is_finite() && frequency > 0.0) {
-        return Err(FrfError::InvalidFrequency { frequency });
-    }
-    let checks: [(&'static str, f64, bool, &'static str); 5] = [
-        ("amplitude", amplitude, amplitude.is_finite(), "finite"),
-        (
-            "settling_time",
-            settling_time,
-            settling_time.is_finite() && settling_time >= 0.0,
-            "finite and ≥ 0",
-        ),
-        (
-            "rtol",
-            options.rtol,
-            options.rtol > 0.0 && options.rtol.is_finite(),
-            "finite and > 0",
-        ),
-        (
-            "atol",
-            options.atol,
-            options.atol > 0.0 && options.atol.is_finite(),
-            "finite and > 0",
-        ),
-        (
-            "samples_per_period",
-            options.samples_per_period as f64,
-            options.samples_per_period >= 8 && options.periods >= 1,
-            "≥ 8, with periods ≥ 1",
-        ),
-    ];
-    for (option, value, ok, expected) in checks {
-        if !ok {
-            return Err(FrfError::InvalidOption {
-                option,
-                value,
-                expected,
-            });
-        }
-    }
+    check_steady_state(frequency, amplitude, settling_time, options)?;
     if equilibrium.len() != n {
         return Err(FrfError::DimensionMismatch {
             expected: n,
@@ -1458,6 +1420,80 @@ fn simulate_inner(
             t: solution.last().map_or(0.0, |(t, _)| t),
         });
     }
+    let (complex_amplitudes, means) = harmonic_content(&solution, frequency, n, samples);
+    Ok(SteadyState {
+        frequency,
+        amplitude,
+        settling_time,
+        complex_amplitudes,
+        means,
+        steps: solution.stats.steps,
+        rhs_evals: solution.stats.rhs_evals,
+    })
+}
+
+/// The checks of [`simulate_steady_state`]'s numbers, in its order: a positive finite
+/// `frequency`, a finite `amplitude`, a finite non-negative `settling_time`, positive finite
+/// tolerances and at least 8 samples per period over at least one period.
+///
+/// # Errors
+/// [`FrfError::InvalidFrequency`], [`FrfError::InvalidOption`].
+fn check_steady_state(
+    frequency: f64,
+    amplitude: f64,
+    settling_time: f64,
+    options: &SteadyStateOptions,
+) -> Result<(), FrfError> {
+    if !(frequency.is_finite() && frequency > 0.0) {
+        return Err(FrfError::InvalidFrequency { frequency });
+    }
+    let checks: [(&'static str, f64, bool, &'static str); 5] = [
+        ("amplitude", amplitude, amplitude.is_finite(), "finite"),
+        (
+            "settling_time",
+            settling_time,
+            settling_time.is_finite() && settling_time >= 0.0,
+            "finite and ≥ 0",
+        ),
+        (
+            "rtol",
+            options.rtol,
+            options.rtol > 0.0 && options.rtol.is_finite(),
+            "finite and > 0",
+        ),
+        (
+            "atol",
+            options.atol,
+            options.atol > 0.0 && options.atol.is_finite(),
+            "finite and > 0",
+        ),
+        (
+            "samples_per_period",
+            options.samples_per_period as f64,
+            options.samples_per_period >= 8 && options.periods >= 1,
+            "≥ 8, with periods ≥ 1",
+        ),
+    ];
+    for (option, value, ok, expected) in checks {
+        if !ok {
+            return Err(FrfError::InvalidOption {
+                option,
+                value,
+                expected,
+            });
+        }
+    }
+    Ok(())
+}
+
+/// The complex amplitudes (the first harmonic at `frequency`, `2/samples Σ y e^{−iωt}`) and
+/// the means of the `n` coordinates over the `samples` steady-state samples of `solution`.
+fn harmonic_content(
+    solution: &Solution,
+    frequency: f64,
+    n: usize,
+    samples: usize,
+) -> (Vec<Complex<f64>>, Vec<f64>) {
     let mut complex_amplitudes = vec![Complex::new(0.0, 0.0); n];
     let mut means = vec![0.0; n];
     for (t, y) in solution.iter() {
@@ -1472,15 +1508,7 @@ fn simulate_inner(
         complex_amplitudes[i] *= scale;
         means[i] /= samples as f64;
     }
-    Ok(SteadyState {
-        frequency,
-        amplitude,
-        settling_time,
-        complex_amplitudes,
-        means,
-        steps: solution.stats.steps,
-        rhs_evals: solution.stats.rhs_evals,
-    })
+    (complex_amplitudes, means)
 }
 
 #[cfg(test)]

@@ -265,57 +265,19 @@ pub fn emit(
         n,
         model.coordinate_names.join(", ")
     );
-    let mut fields = Vec::new();
-    let mut defaults = Vec::new();
-    let mut values = Vec::new();
-    let mut setters = Vec::new();
-    for p in &model.parameters {
-        let unit = p
-            .unit
-            .as_deref()
-            .map(|u| format!(" ({u})"))
-            .unwrap_or_default();
-        let field_doc = format!("Parameter `{}`{unit}; default {:?}.", p.name, p.default);
-        let field = ident(&field_name(&p.name))?;
-        let default = float(p.default)?;
-        let parameter = &p.name;
-        fields.push(quote!(#[doc = #field_doc] pub #field: f64,));
-        defaults.push(quote!(#field: #default,));
-        values.push(quote!(self.#field));
-        setters.push(quote!(#parameter => { self.#field = value; Ok(()) }));
-    }
-    let model_name = &model.name;
-    let known = model
-        .parameters
-        .iter()
-        .map(|p| p.name.as_str())
-        .collect::<Vec<_>>()
-        .join(", ");
+    let ParameterTokens {
+        fields,
+        defaults,
+        values,
+        setters,
+    } = parameter_tokens(model)?;
     // Tracking of the model file for rebuilds.
     let tracked = options.tracked_files.iter().map(|f| {
         quote!(
             const _: &[u8] = ::core::include_bytes!(#f);
         )
     });
-    let description = describe::description_tokens(&describe::describe(model, eom, true), &krate)?;
-
-    let mut methods = quote! {
-        fn description(&self) -> &#krate::ModelDescription {
-            static DESCRIPTION: #krate::ModelDescription = #description;
-            &DESCRIPTION
-        }
-        fn parameter_values(&self) -> ::std::vec::Vec<f64> { ::std::vec![#(#values),*] }
-        fn set_parameter(&mut self, name: &str, value: f64) -> ::core::result::Result<(), #krate::UnknownParameter> {
-            match name {
-                #(#setters)*
-                _ => Err(#krate::UnknownParameter {
-                    model: #model_name.to_string(),
-                    name: name.to_string(),
-                    known: #known.to_string(),
-                }),
-            }
-        }
-    };
+    let mut methods = parameter_methods(model, eom, &krate, (&values, &setters))?;
 
     let types = Types {
         na: na.clone(),
@@ -331,27 +293,9 @@ pub fn emit(
             methods.extend(function_method(function, body, model, &types));
         }
     }
-    // The Taylor recurrences, from the tape of `M` and `F` the run-time compiler builds too.
-    let taylor = taylor::taylor_program(
-        &program::mass_matrix_and_forcing_tape(model, &plans.state),
-        n,
-        model.constraints.len(),
-    );
-    let parameter_fields = model
-        .parameters
-        .iter()
-        .map(|p| ident(&field_name(&p.name)))
-        .collect::<Result<Vec<_>, _>>()?;
-    let (accessor, taylor_functions) =
-        taylor_tokens::methods(&taylor, &krate, &parameter_fields, &name)?;
+    let (accessor, taylor_functions) = taylor_items(model, plans, &krate, &name)?;
     methods.extend(accessor);
-    let both: Vec<ExprId> = [eom.mass_matrix.clone(), eom.forcing.clone()].concat();
-    let stats = EmitStats {
-        ops_before_cse: model.arena.tree_operation_count(&both),
-        ops_after_cse: plans
-            .get(ModelFunction::MassMatrixAndForcing)
-            .map_or(0, |(_, plan)| plan.operation_count()),
-    };
+    let stats = emit_stats(model, eom, plans);
     let tokens = quote! {
         #[doc = #doc]
         #[derive(Debug, Clone, Copy, PartialEq)]
@@ -377,6 +321,129 @@ pub fn emit(
     Ok((tokens, stats))
 }
 
+/// The tokens of the model's parameters, one entry per parameter in order.
+struct ParameterTokens {
+    /// The struct's fields, each with its doc comment.
+    fields: Vec<TokenStream>,
+    /// The fields' initializers in `Default`.
+    defaults: Vec<TokenStream>,
+    /// The fields read (`self.field`), for `parameter_values`.
+    values: Vec<TokenStream>,
+    /// The match arms of `set_parameter`.
+    setters: Vec<TokenStream>,
+}
+
+/// The struct's field, default, value and setter of each parameter of `model`.
+///
+/// # Errors
+/// If a parameter's field name or default fails to tokenize.
+fn parameter_tokens(model: &SymbolicModel) -> Result<ParameterTokens, String> {
+    let mut fields = Vec::new();
+    let mut defaults = Vec::new();
+    let mut values = Vec::new();
+    let mut setters = Vec::new();
+    for p in &model.parameters {
+        let unit = p
+            .unit
+            .as_deref()
+            .map(|u| format!(" ({u})"))
+            .unwrap_or_default();
+        let field_doc = format!("Parameter `{}`{unit}; default {:?}.", p.name, p.default);
+        let field = ident(&field_name(&p.name))?;
+        let default = float(p.default)?;
+        let parameter = &p.name;
+        fields.push(quote!(#[doc = #field_doc] pub #field: f64,));
+        defaults.push(quote!(#field: #default,));
+        values.push(quote!(self.#field));
+        setters.push(quote!(#parameter => { self.#field = value; Ok(()) }));
+    }
+    Ok(ParameterTokens {
+        fields,
+        defaults,
+        values,
+        setters,
+    })
+}
+
+/// The first methods of the generated impl: `description`, `parameter_values` (from the
+/// parameters' `values`) and `set_parameter` (from their `setters`).
+///
+/// # Errors
+/// If the description fails to tokenize.
+fn parameter_methods(
+    model: &SymbolicModel,
+    eom: &EquationsOfMotion,
+    krate: &TokenStream,
+    (values, setters): (&[TokenStream], &[TokenStream]),
+) -> Result<TokenStream, String> {
+    let model_name = &model.name;
+    let known = model
+        .parameters
+        .iter()
+        .map(|p| p.name.as_str())
+        .collect::<Vec<_>>()
+        .join(", ");
+    let description = describe::description_tokens(&describe::describe(model, eom, true), krate)?;
+
+    Ok(quote! {
+        fn description(&self) -> &#krate::ModelDescription {
+            static DESCRIPTION: #krate::ModelDescription = #description;
+            &DESCRIPTION
+        }
+        fn parameter_values(&self) -> ::std::vec::Vec<f64> { ::std::vec![#(#values),*] }
+        fn set_parameter(&mut self, name: &str, value: f64) -> ::core::result::Result<(), #krate::UnknownParameter> {
+            match name {
+                #(#setters)*
+                _ => Err(#krate::UnknownParameter {
+                    model: #model_name.to_string(),
+                    name: name.to_string(),
+                    known: #known.to_string(),
+                }),
+            }
+        }
+    })
+}
+
+/// The Taylor accessor method of the generated impl and the free functions it names.
+///
+/// # Errors
+/// If a parameter's field name or the generated code fails to tokenize.
+fn taylor_items(
+    model: &SymbolicModel,
+    plans: &plan::EmitPlans,
+    krate: &TokenStream,
+    name: &proc_macro2::Ident,
+) -> Result<(TokenStream, TokenStream), String> {
+    let n = model.num_dofs();
+    // The Taylor recurrences, from the tape of `M` and `F` the run-time compiler builds too.
+    let taylor = taylor::taylor_program(
+        &program::mass_matrix_and_forcing_tape(model, &plans.state),
+        n,
+        model.constraints.len(),
+    );
+    let parameter_fields = model
+        .parameters
+        .iter()
+        .map(|p| ident(&field_name(&p.name)))
+        .collect::<Result<Vec<_>, _>>()?;
+    taylor_tokens::methods(&taylor, krate, &parameter_fields, name)
+}
+
+/// The operation counts of `M` and `F` of `eom` before and after common subexpressions.
+fn emit_stats(
+    model: &SymbolicModel,
+    eom: &EquationsOfMotion,
+    plans: &plan::EmitPlans,
+) -> EmitStats {
+    let both: Vec<ExprId> = [eom.mass_matrix.clone(), eom.forcing.clone()].concat();
+    EmitStats {
+        ops_before_cse: model.arena.tree_operation_count(&both),
+        ops_after_cse: plans
+            .get(ModelFunction::MassMatrixAndForcing)
+            .map_or(0, |(_, plan)| plan.operation_count()),
+    }
+}
+
 /// The types a generated method names: nalgebra's path, `N` as a literal, and the vector
 /// and matrix types of size `N`.
 struct Types {
@@ -396,6 +463,29 @@ fn function_method(
     model: &SymbolicModel,
     types: &Types,
 ) -> TokenStream {
+    let Body {
+        statements,
+        values: v,
+    } = body;
+    let (signature, result) = signature_and_result(function, &v, model, types);
+    quote! {
+        #[allow(unused_variables, non_snake_case, clippy::all)]
+        #[inline]
+        #signature {
+            #statements
+            #result
+        }
+    }
+}
+
+/// The signature of the method of `function` and the expression or stores that build its
+/// outputs `v` into what the trait returns.
+fn signature_and_result(
+    function: ModelFunction,
+    v: &[TokenStream],
+    model: &SymbolicModel,
+    types: &Types,
+) -> (TokenStream, TokenStream) {
     let Types {
         na,
         dim,
@@ -404,28 +494,24 @@ fn function_method(
         mat_t,
     } = types;
     let n = *n;
-    let Body {
-        statements,
-        values: v,
-    } = body;
     let matrix =
         |v: &[TokenStream]| quote!(#na::SMatrix::<f64, #dim, #dim>::from_row_slice(&[#(#v),*]));
     let vector =
         |v: &[TokenStream]| quote!(#na::SVector::<f64, #dim>::from_column_slice(&[#(#v),*]));
     let q_args = quote!(__q: &#vec_t);
     let qd_args = quote!(__q: &#vec_t, __qdot: &#vec_t);
-    let (signature, result) = match function {
+    match function {
         ModelFunction::InitialState => (quote!(fn initial_state(&self) -> (#vec_t, #vec_t)), {
             let (q, qdot) = (vector(&v[..n]), vector(&v[n..]));
             quote!((#q, #qdot))
         }),
         ModelFunction::MassMatrix => (
             quote!(fn mass_matrix(&self, #q_args, __t: f64) -> #mat_t),
-            matrix(&v),
+            matrix(v),
         ),
         ModelFunction::Forcing => (
             quote!(fn forcing(&self, #qd_args, __t: f64) -> #vec_t),
-            vector(&v),
+            vector(v),
         ),
         ModelFunction::MassMatrixAndForcing => (
             quote!(fn mass_matrix_and_forcing(&self, #qd_args, __t: f64) -> (#mat_t, #vec_t)),
@@ -436,15 +522,15 @@ fn function_method(
         ),
         ModelFunction::ForcingJacobianQ => (
             quote!(fn forcing_jacobian_q(&self, #qd_args, __t: f64) -> #mat_t),
-            matrix(&v),
+            matrix(v),
         ),
         ModelFunction::ForcingJacobianQdot => (
             quote!(fn forcing_jacobian_qdot(&self, #qd_args, __t: f64) -> #mat_t),
-            matrix(&v),
+            matrix(v),
         ),
         ModelFunction::MassMatrixProductJacobian => (
             quote!(fn mass_matrix_product_jacobian(&self, #q_args, __t: f64, __a: &#vec_t) -> #mat_t),
-            matrix(&v),
+            matrix(v),
         ),
         ModelFunction::KineticEnergy => (
             quote!(fn kinetic_energy(&self, #qd_args, __t: f64) -> f64),
@@ -456,40 +542,32 @@ fn function_method(
         ),
         ModelFunction::PointPositions => (
             quote!(fn point_positions(&self, #q_args, __t: f64, __out: &mut [[f64; 3]])),
-            point_stores(model, &v),
+            point_stores(model, v),
         ),
         ModelFunction::ConstraintResiduals => (
             quote!(fn constraint_residuals(&self, #q_args, __t: f64, __out: &mut [f64])),
-            write_out(&v),
+            write_out(v),
         ),
         ModelFunction::ConstraintJacobian => (
             quote!(fn constraint_jacobian(&self, #q_args, __t: f64, __out: &mut [f64])),
-            write_out(&v),
+            write_out(v),
         ),
         ModelFunction::ConstraintVelocityResiduals => (
             quote!(fn constraint_velocity_residuals(&self, #qd_args, __t: f64, __out: &mut [f64])),
-            write_out(&v),
+            write_out(v),
         ),
         ModelFunction::ConstraintGamma => (
             quote!(fn constraint_gamma(&self, #qd_args, __t: f64, __out: &mut [f64])),
-            write_out(&v),
+            write_out(v),
         ),
         ModelFunction::EventValues => (
             quote!(fn event_values(&self, #qd_args, __t: f64, __a: &#vec_t, __lambda: &[f64], __out: &mut [f64])),
-            write_out(&v),
+            write_out(v),
         ),
         ModelFunction::EquilibriumGuesses => (
             quote!(fn equilibrium_guesses(&self, __out: &mut [f64])),
-            write_out(&v),
+            write_out(v),
         ),
-    };
-    quote! {
-        #[allow(unused_variables, non_snake_case, clippy::all)]
-        #[inline]
-        #signature {
-            #statements
-            #result
-        }
     }
 }
 

@@ -70,6 +70,12 @@ impl Formulation for UserBalances {
         let balances = model.balances[range].to_vec();
         let frames = model.frames.clone();
         let arena = &mut model.arena;
+        let planar = Planar {
+            points: &points,
+            bodies: &bodies,
+            loads: &loads,
+            gravity: &gravity,
+        };
         let mut residuals: Vec<Vec<ExprId>> = Vec::with_capacity(balances.len());
         for balance in &balances {
             let mut terms = Vec::new();
@@ -105,90 +111,135 @@ impl Formulation for UserBalances {
                 }
             };
             for &b in chosen {
-                let body = &bodies[b];
-                let r = &points[body.com];
-                let v: Vec<ExprId> = r.iter().map(|c| arena.time_derivative(*c)).collect();
-                let a: Vec<ExprId> = v.iter().map(|c| arena.time_derivative(*c)).collect();
-                let ma: Vec<ExprId> = a.iter().map(|c| arena.times(body.mass, *c)).collect();
-                let mg: Vec<ExprId> = gravity
-                    .as_ref()
-                    .map(|g| g.iter().map(|c| arena.times(body.mass, *c)).collect())
-                    .unwrap_or_default();
-                if let Some(about) = about {
-                    let rel: Vec<ExprId> = r
-                        .iter()
-                        .zip(&points[about])
-                        .map(|(x, y)| arena.minus(*x, *y))
-                        .collect();
-                    if !mg.is_empty() {
-                        let m = cross_z(arena, &rel, &mg);
-                        terms.push(arena.neg(m));
-                    }
-                    match form {
-                        AmbForm::RCrossMa => {
-                            terms.push(cross_z(arena, &rel, &ma));
-                            if let Some((inertia, angle)) = body.rotation {
-                                let w = arena.time_derivative(angle);
-                                let alpha = arena.time_derivative(w);
-                                terms.push(arena.times(inertia, alpha));
-                            }
-                        }
-                        AmbForm::HDot => {
-                            // H_A = r_G/A × m v_G + I ω, differentiated as a whole.
-                            let mv: Vec<ExprId> =
-                                v.iter().map(|c| arena.times(body.mass, *c)).collect();
-                            let mut h = cross_z(arena, &rel, &mv);
-                            if let Some((inertia, angle)) = body.rotation {
-                                let w = arena.time_derivative(angle);
-                                let iw = arena.times(inertia, w);
-                                h = arena.plus(h, iw);
-                            }
-                            terms.push(arena.time_derivative(h));
-                        }
-                        AmbForm::HRelDot => {
-                            // H_A/rel = r_G/A × m (v_G − v_A) + I ω, differentiated as a whole.
-                            let rel_v: Vec<ExprId> = v
-                                .iter()
-                                .zip(&points[about])
-                                .map(|(vg, ra)| {
-                                    let va = arena.time_derivative(*ra);
-                                    let d = arena.minus(*vg, va);
-                                    arena.times(body.mass, d)
-                                })
-                                .collect();
-                            let mut h = cross_z(arena, &rel, &rel_v);
-                            if let Some((inertia, angle)) = body.rotation {
-                                let w = arena.time_derivative(angle);
-                                let iw = arena.times(inertia, w);
-                                h = arena.plus(h, iw);
-                            }
-                            terms.push(arena.time_derivative(h));
-                        }
-                    }
-                    for load in &loads {
-                        if let LoadInfo::Torque {
-                            body: on, value, ..
-                        } = load
-                            && *on == b
-                        {
-                            terms.push(arena.neg(*value));
-                        }
-                    }
-                } else if let Some(e) = &along {
-                    let t: Vec<ExprId> =
-                        ma.iter().zip(e).map(|(x, y)| arena.times(*x, *y)).collect();
-                    terms.push(arena.sum(&t));
-                    if !mg.is_empty() {
-                        let t: Vec<ExprId> =
-                            mg.iter().zip(e).map(|(x, y)| arena.times(*x, *y)).collect();
-                        let s = arena.sum(&t);
-                        terms.push(arena.neg(s));
-                    }
-                }
+                planar.body_terms(arena, b, about, along.as_deref(), form, &mut terms);
             }
             residuals.push(terms);
         }
         linear_in_accelerations(arena, &residuals, &symbols)
+    }
+}
+
+/// What the terms of a planar balance ([`UserBalances`]) are built from: the model's points,
+/// bodies, loads and gravity.
+struct Planar<'a> {
+    /// Each point's position, by index.
+    points: &'a [Vec<ExprId>],
+    /// The model's bodies.
+    bodies: &'a [super::lower::BodyInfo],
+    /// The model's loads.
+    loads: &'a [LoadInfo],
+    /// Gravity's components, if any.
+    gravity: &'a Option<Vec<ExprId>>,
+}
+
+impl Planar<'_> {
+    /// Appends to `terms` the terms of body `b` in an angular momentum balance about the
+    /// point `about` (in the form `form`) or, without `about`, in a linear momentum balance
+    /// along `along`.
+    fn body_terms(
+        &self,
+        arena: &mut ExprArena,
+        b: usize,
+        about: Option<usize>,
+        along: Option<&[ExprId]>,
+        form: AmbForm,
+        terms: &mut Vec<ExprId>,
+    ) {
+        let body = &self.bodies[b];
+        let r = &self.points[body.com];
+        let v: Vec<ExprId> = r.iter().map(|c| arena.time_derivative(*c)).collect();
+        let a: Vec<ExprId> = v.iter().map(|c| arena.time_derivative(*c)).collect();
+        let ma: Vec<ExprId> = a.iter().map(|c| arena.times(body.mass, *c)).collect();
+        let mg: Vec<ExprId> = self
+            .gravity
+            .as_ref()
+            .map(|g| g.iter().map(|c| arena.times(body.mass, *c)).collect())
+            .unwrap_or_default();
+        if let Some(about) = about {
+            self.amb_terms(arena, b, about, form, (&v, &ma, &mg), terms);
+        } else if let Some(e) = along {
+            let t: Vec<ExprId> = ma.iter().zip(e).map(|(x, y)| arena.times(*x, *y)).collect();
+            terms.push(arena.sum(&t));
+            if !mg.is_empty() {
+                let t: Vec<ExprId> = mg.iter().zip(e).map(|(x, y)| arena.times(*x, *y)).collect();
+                let s = arena.sum(&t);
+                terms.push(arena.neg(s));
+            }
+        }
+    }
+
+    /// Appends to `terms` the terms of body `b` in an angular momentum balance about the
+    /// point `about` in the form `form`, given the body's velocity `v`, `m a_G` and `m g`
+    /// (empty without gravity), then the torques on it.
+    fn amb_terms(
+        &self,
+        arena: &mut ExprArena,
+        b: usize,
+        about: usize,
+        form: AmbForm,
+        (v, ma, mg): (&[ExprId], &[ExprId], &[ExprId]),
+        terms: &mut Vec<ExprId>,
+    ) {
+        let body = &self.bodies[b];
+        let r = &self.points[body.com];
+        let rel: Vec<ExprId> = r
+            .iter()
+            .zip(&self.points[about])
+            .map(|(x, y)| arena.minus(*x, *y))
+            .collect();
+        if !mg.is_empty() {
+            let m = cross_z(arena, &rel, mg);
+            terms.push(arena.neg(m));
+        }
+        match form {
+            AmbForm::RCrossMa => {
+                terms.push(cross_z(arena, &rel, ma));
+                if let Some((inertia, angle)) = body.rotation {
+                    let w = arena.time_derivative(angle);
+                    let alpha = arena.time_derivative(w);
+                    terms.push(arena.times(inertia, alpha));
+                }
+            }
+            AmbForm::HDot => {
+                // H_A = r_G/A × m v_G + I ω, differentiated as a whole.
+                let mv: Vec<ExprId> = v.iter().map(|c| arena.times(body.mass, *c)).collect();
+                let mut h = cross_z(arena, &rel, &mv);
+                if let Some((inertia, angle)) = body.rotation {
+                    let w = arena.time_derivative(angle);
+                    let iw = arena.times(inertia, w);
+                    h = arena.plus(h, iw);
+                }
+                terms.push(arena.time_derivative(h));
+            }
+            AmbForm::HRelDot => {
+                // H_A/rel = r_G/A × m (v_G − v_A) + I ω, differentiated as a whole.
+                let rel_v: Vec<ExprId> = v
+                    .iter()
+                    .zip(&self.points[about])
+                    .map(|(vg, ra)| {
+                        let va = arena.time_derivative(*ra);
+                        let d = arena.minus(*vg, va);
+                        arena.times(body.mass, d)
+                    })
+                    .collect();
+                let mut h = cross_z(arena, &rel, &rel_v);
+                if let Some((inertia, angle)) = body.rotation {
+                    let w = arena.time_derivative(angle);
+                    let iw = arena.times(inertia, w);
+                    h = arena.plus(h, iw);
+                }
+                terms.push(arena.time_derivative(h));
+            }
+        }
+        for load in self.loads {
+            if let LoadInfo::Torque {
+                body: on, value, ..
+            } = load
+                && *on == b
+            {
+                terms.push(arena.neg(*value));
+            }
+        }
     }
 }
 

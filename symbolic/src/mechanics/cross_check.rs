@@ -8,13 +8,14 @@ use rand::{RngExt, SeedableRng};
 use rustc_hash::FxHashMap;
 
 use super::BalanceInfo;
+use super::lower::StateBox;
 pub use super::numeric::solve;
 use super::{
     EnergyRate, EquationsOfMotion, Formulation, HandEquations, Lagrange, MomentumBalance,
     PowerRoute, SymbolicModel, UserBalances, energy_routes_skipped,
 };
 use crate::expr::eval::Evaluator;
-use crate::expr::{ExprId, SymbolKind, cse};
+use crate::expr::{ExprId, Symbol, SymbolKind, cse};
 use crate::model::diagnostic::Diagnostic;
 use crate::model::file::{AmbForm, ModelFile};
 
@@ -592,20 +593,7 @@ fn sample_states(
     };
     for _ in 0..states {
         let t = rng.random_range(0.0..5.0);
-        let mut bindings = vec![0.0; symbols.len()];
-        for (i, s) in symbols.iter().enumerate() {
-            bindings[i] = match s.kind {
-                // A parameter whose default is 0 (a forcing amplitude or damping switched
-                // off) would hide every term it multiplies: it takes a value in [0.1, 0.5].
-                SymbolKind::Parameter if defaults[i] == 0.0 => rng.random_range(0.1..0.5),
-                SymbolKind::Parameter => defaults[i] * rng.random_range(0.9..1.1),
-                SymbolKind::Coordinate(_) | SymbolKind::Velocity(_) => {
-                    state_box.at(i, rng.random_range(-2.0..2.0))
-                }
-                SymbolKind::Time => t,
-                _ => 0.0,
-            };
-        }
+        let bindings = draw_bindings(&mut rng, &symbols, &defaults, &state_box, t);
         evaluator.eval_into(&bindings, &mut v);
         let nn = n * n;
         if !v[..nn + n].iter().all(|x| x.is_finite()) {
@@ -619,66 +607,22 @@ fn sample_states(
             continue;
         };
         sampled.compared += 1;
-        // Each row of each other derivation at Lagrange's accelerations: a backward error,
-        // at rounding for a right derivation whatever the conditioning of M (two solves of
-        // a cond(M) = 4e9 system differ by ε·cond(M) = 9e-7 in q̈, each exact to rounding).
-        let mut here = vec![0.0f64; others.len()];
-        for (k, rows) in row_rel.iter_mut().enumerate() {
-            let base = lagrange_len + k * (nn + n);
-            for (i, worst) in rows.iter_mut().enumerate() {
-                let terms = (0..n).map(|j| v[base + i * n + j] * qdd[j]);
-                let residual = terms.clone().sum::<f64>() - v[base + nn + i];
-                let size = terms.map(f64::abs).sum::<f64>() + v[base + nn + i].abs();
-                let rel = residual.abs() / size.max(f64::MIN_POSITIVE);
-                *worst = if rel.is_nan() { rel } else { worst.max(rel) };
-                here[k] = if rel.is_nan() { rel } else { here[k].max(rel) };
-            }
-        }
-        for (k, worst) in max_rel.iter_mut().enumerate() {
-            let base = lagrange_len + k * (nn + n);
-            // The other derivation not finite where Lagrange's is (a function outside its
-            // domain) is a disagreement, not a state to skip: NaN, kept (`max` would drop it).
-            if worst.is_nan() || !v[base..base + nn + n].iter().all(|x| x.is_finite()) {
-                *worst = f64::NAN;
-                continue;
-            }
-            match solve(
-                v[base..base + nn].to_vec(),
-                v[base + nn..base + nn + n].to_vec(),
-            ) {
-                // Its own M′ singular: its equations do not determine q̈.
-                Some(other) if other.iter().any(|x| !x.is_finite()) => *worst = f64::INFINITY,
-                Some(_) if here[k].is_nan() => *worst = f64::NAN,
-                Some(_) => *worst = worst.max(here[k]),
-                None => *worst = f64::INFINITY,
-            }
-        }
+        compare_others(&v, &qdd, (lagrange_len, n), &mut row_rel, &mut max_rel);
         // T homogeneous of degree 2 in q̇?
         let t1 = v[v.len() - 1];
-        let mut doubled = bindings.clone();
-        for (i, s) in symbols.iter().enumerate() {
-            if let SymbolKind::Velocity(_) = s.kind {
-                doubled[i] *= 2.0;
-            }
-        }
-        let t2 = kinetic_only.eval(&doubled)[0];
-        if (t2 - 4.0 * t1).abs() > 1e-9 * (1.0 + t1.abs()) {
+        if homogeneity_fails(&mut kinetic_only, &symbols, &bindings, t1) {
             quadratic = false;
         }
-        // dE/dt with the solved accelerations.
-        let mut with_acc = bindings.clone();
-        for (i, s) in symbols.iter().enumerate() {
-            if let SymbolKind::Acceleration(j) = s.kind {
-                with_acc[i] = qdd[j as usize];
-            }
-        }
-        let w = power_balance.eval(&with_acc);
-        let (de, p) = (w[0], w[1]);
-        let fq: f64 = (0..n)
-            .map(|i| (v[nn + i] * bindings[rate_slots[i]]).abs())
-            .sum();
-        let scale = de.abs().max(p.abs()).max(fq).max(f64::MIN_POSITIVE);
-        power_rel = power_rel.max((de - p).abs() / scale);
+        let forcing = &v[nn..nn + n];
+        let rel = power_residual(
+            &mut power_balance,
+            &symbols,
+            &bindings,
+            &qdd,
+            forcing,
+            &rate_slots,
+        );
+        power_rel = power_rel.max(rel);
     }
     Sampled {
         max_rel,
@@ -687,6 +631,126 @@ fn sample_states(
         quadratic,
         states: sampled,
     }
+}
+
+/// The value of every symbol at one random state at time `t`, drawn from `rng` in the order
+/// of `symbols` (parameters about their `defaults`, coordinates and rates within
+/// `state_box`, every other symbol 0).
+fn draw_bindings(
+    rng: &mut Xoshiro256PlusPlus,
+    symbols: &[Symbol],
+    defaults: &[f64],
+    state_box: &StateBox,
+    t: f64,
+) -> Vec<f64> {
+    let mut bindings = vec![0.0; symbols.len()];
+    for (i, s) in symbols.iter().enumerate() {
+        bindings[i] = match s.kind {
+            // A parameter whose default is 0 (a forcing amplitude or damping switched
+            // off) would hide every term it multiplies: it takes a value in [0.1, 0.5].
+            SymbolKind::Parameter if defaults[i] == 0.0 => rng.random_range(0.1..0.5),
+            SymbolKind::Parameter => defaults[i] * rng.random_range(0.9..1.1),
+            SymbolKind::Coordinate(_) | SymbolKind::Velocity(_) => {
+                state_box.at(i, rng.random_range(-2.0..2.0))
+            }
+            SymbolKind::Time => t,
+            _ => 0.0,
+        };
+    }
+    bindings
+}
+
+/// Compares each other derivation with Lagrange's accelerations `qdd` at one state, whose
+/// values `v` hold Lagrange's `M` and `F` (`n` rows) and then, from `lagrange_len`, each other
+/// derivation's `M′` and `F′`: updates the largest relative residual of each row
+/// (`row_rel`) and of each derivation (`max_rel`).
+fn compare_others(
+    v: &[f64],
+    qdd: &[f64],
+    (lagrange_len, n): (usize, usize),
+    row_rel: &mut [Vec<f64>],
+    max_rel: &mut [f64],
+) {
+    let nn = n * n;
+    // Each row of each other derivation at Lagrange's accelerations: a backward error,
+    // at rounding for a right derivation whatever the conditioning of M (two solves of
+    // a cond(M) = 4e9 system differ by ε·cond(M) = 9e-7 in q̈, each exact to rounding).
+    let mut here = vec![0.0f64; max_rel.len()];
+    for (k, rows) in row_rel.iter_mut().enumerate() {
+        let base = lagrange_len + k * (nn + n);
+        for (i, worst) in rows.iter_mut().enumerate() {
+            let terms = (0..n).map(|j| v[base + i * n + j] * qdd[j]);
+            let residual = terms.clone().sum::<f64>() - v[base + nn + i];
+            let size = terms.map(f64::abs).sum::<f64>() + v[base + nn + i].abs();
+            let rel = residual.abs() / size.max(f64::MIN_POSITIVE);
+            *worst = if rel.is_nan() { rel } else { worst.max(rel) };
+            here[k] = if rel.is_nan() { rel } else { here[k].max(rel) };
+        }
+    }
+    for (k, worst) in max_rel.iter_mut().enumerate() {
+        let base = lagrange_len + k * (nn + n);
+        // The other derivation not finite where Lagrange's is (a function outside its
+        // domain) is a disagreement, not a state to skip: NaN, kept (`max` would drop it).
+        if worst.is_nan() || !v[base..base + nn + n].iter().all(|x| x.is_finite()) {
+            *worst = f64::NAN;
+            continue;
+        }
+        match solve(
+            v[base..base + nn].to_vec(),
+            v[base + nn..base + nn + n].to_vec(),
+        ) {
+            // Its own M′ singular: its equations do not determine q̈.
+            Some(other) if other.iter().any(|x| !x.is_finite()) => *worst = f64::INFINITY,
+            Some(_) if here[k].is_nan() => *worst = f64::NAN,
+            Some(_) => *worst = worst.max(here[k]),
+            None => *worst = f64::INFINITY,
+        }
+    }
+}
+
+/// Whether `T(q, 2q̇)` differs from `4 T(q, q̇)` by more than 1e-9 relative at the state
+/// `bindings`, where `T` is `t1` (false where the difference is NaN).
+fn homogeneity_fails(
+    kinetic_only: &mut Evaluator,
+    symbols: &[Symbol],
+    bindings: &[f64],
+    t1: f64,
+) -> bool {
+    let mut doubled = bindings.to_vec();
+    for (i, s) in symbols.iter().enumerate() {
+        if let SymbolKind::Velocity(_) = s.kind {
+            doubled[i] *= 2.0;
+        }
+    }
+    let t2 = kinetic_only.eval(&doubled)[0];
+    (t2 - 4.0 * t1).abs() > 1e-9 * (1.0 + t1.abs())
+}
+
+/// `|dE/dt − Σ Qᵢ q̇ᵢ|` at the state `bindings` with the solved accelerations `qdd`,
+/// relative to the largest of `|dE/dt|`, `|Σ Qᵢ q̇ᵢ|` and `Σ |Fᵢ q̇ᵢ|` (`forcing` is `F`,
+/// `rate_slots` where each rate is bound).
+fn power_residual(
+    power_balance: &mut Evaluator,
+    symbols: &[Symbol],
+    bindings: &[f64],
+    qdd: &[f64],
+    forcing: &[f64],
+    rate_slots: &[usize],
+) -> f64 {
+    // dE/dt with the solved accelerations.
+    let mut with_acc = bindings.to_vec();
+    for (i, s) in symbols.iter().enumerate() {
+        if let SymbolKind::Acceleration(j) = s.kind {
+            with_acc[i] = qdd[j as usize];
+        }
+    }
+    let w = power_balance.eval(&with_acc);
+    let (de, p) = (w[0], w[1]);
+    let fq: f64 = (0..forcing.len())
+        .map(|i| (forcing[i] * bindings[rate_slots[i]]).abs())
+        .sum();
+    let scale = de.abs().max(p.abs()).max(fq).max(f64::MIN_POSITIVE);
+    (de - p).abs() / scale
 }
 
 /// Each parameter's default at the index of its symbol (0 for every other symbol): looked up

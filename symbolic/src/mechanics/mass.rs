@@ -16,10 +16,11 @@
 use rand::rngs::Xoshiro256PlusPlus;
 use rand::{RngExt, SeedableRng};
 
-use crate::expr::SymbolKind;
 use crate::expr::eval::Evaluator;
+use crate::expr::{Symbol, SymbolKind};
 use crate::model::diagnostic::Diagnostic;
 use crate::model::file::ModelFile;
+use crate::model::located::Location;
 
 use super::{EquationsOfMotion, SymbolicModel};
 
@@ -83,6 +84,21 @@ pub fn mass_matrix_diagnostics(
         return Vec::new();
     }
     let n = eom.num_dofs;
+    let out = no_inertia_diagnostics(model, eom, file);
+    if !out.is_empty() || n == 0 {
+        return out;
+    }
+    numeric_diagnostics(model, eom, file)
+}
+
+/// One diagnostic per coordinate of `file` whose row of the mass matrix of `eom` is
+/// identically zero (telling whether it appears in no energy and no load at all).
+fn no_inertia_diagnostics(
+    model: &SymbolicModel,
+    eom: &EquationsOfMotion,
+    file: &ModelFile,
+) -> Vec<Diagnostic> {
+    let n = eom.num_dofs;
     let arena = &model.arena;
     let mut out = Vec::new();
     for (i, coordinate) in file.coordinates.iter().enumerate().take(n) {
@@ -105,10 +121,20 @@ pub fn mass_matrix_diagnostics(
             "give it inertia (a body that moves with it, or a term in `kinetic`), or remove the coordinate",
         ));
     }
-    if !out.is_empty() || n == 0 {
-        return out;
-    }
+    out
+}
 
+/// The diagnostics of a mass matrix of `eom` singular at every random state tried or at the
+/// initial state of `file` (for a model of at least one degree of freedom whose every
+/// coordinate has inertia).
+fn numeric_diagnostics(
+    model: &SymbolicModel,
+    eom: &EquationsOfMotion,
+    file: &ModelFile,
+) -> Vec<Diagnostic> {
+    let n = eom.num_dofs;
+    let arena = &model.arena;
+    let mut out = Vec::new();
     // Numerically: at random states, then at the initial state.
     let symbols = arena.symbols().to_vec();
     // Each parameter's default at its symbol (not a search by name per symbol: a file of
@@ -123,49 +149,11 @@ pub fn mass_matrix_diagnostics(
     for &(k, v) in &defaults {
         bindings[k] = v;
     }
-    let state_box = model.state_box();
-    let mut rng = Xoshiro256PlusPlus::seed_from_u64(0x6d61_7373);
-    let mut regular = 0;
-    let mut sizes = Vec::with_capacity(STATES);
-    for _ in 0..STATES {
-        for (k, s) in symbols.iter().enumerate() {
-            match s.kind {
-                SymbolKind::Coordinate(_) | SymbolKind::Velocity(_) => {
-                    bindings[k] = state_box.at(k, rng.random_range(-2.0..2.0));
-                }
-                SymbolKind::Time => bindings[k] = rng.random_range(0.0..5.0),
-                _ => {}
-            }
-        }
-        let m = evaluator.eval(&bindings);
-        if positive_definite(&m, n, 0.0) {
-            regular += 1;
-            sizes.push(largest_diagonal(&m, n));
-        }
-    }
-    // The typical size of M where it is regular: the reference at the initial state.
-    sizes.sort_by(f64::total_cmp);
-    let typical = sizes.get(sizes.len() / 2).copied().unwrap_or(0.0);
+    let (regular, typical) = sample_mass_matrix(model, &symbols, &mut evaluator, &mut bindings, n);
     let first = file.coordinates.first().map(|c| c.name.location);
     if regular == 0 {
         if let Some(location) = first {
-            let rates: Vec<String> = file
-                .coordinates
-                .iter()
-                .map(|c| format!("`{}_dot`", c.name.value))
-                .collect();
-            out.push(
-                Diagnostic::new(
-                    location,
-                    format!(
-                        "the mass matrix is singular at every state tried ({STATES} random states): some combination of {} carries no kinetic energy",
-                        rates.join(", ")
-                    ),
-                )
-                .with_help(
-                    "M = ∂²T/∂q̇∂q̇ must be positive definite; use independent coordinates, or make a dependent one a constraint",
-                ),
-            );
+            out.push(singular_everywhere(file, location));
         }
         return out;
     }
@@ -185,33 +173,94 @@ pub fn mass_matrix_diagnostics(
         bindings[q.index()] = v;
     }
     if !positive_definite(&evaluator.eval(&bindings), n, typical) {
-        let location = file
-            .initial
-            .first()
-            .map(|(name, _)| name.location)
-            .or(first);
-        if let Some(location) = location {
-            let point: Vec<String> = file
-                .coordinates
-                .iter()
-                .zip(&q0)
-                .map(|(c, v)| format!("{} = {v}", c.name.value))
-                .collect();
-            out.push(
-                Diagnostic::new(
-                    location,
-                    format!(
-                        "the mass matrix is singular or not finite at the initial state ({})",
-                        point.join(", ")
-                    ),
-                )
-                .with_help(
-                    "the coordinates are singular there; start elsewhere, or choose coordinates that stay regular along the motion",
-                ),
-            );
-        }
+        out.extend(singular_at_start(file, &q0, first));
     }
     out
+}
+
+/// Evaluates the `n × n` mass matrix (by `evaluator`) at [`STATES`] random states about the
+/// start (drawn into `bindings`, which hold the parameters' defaults): the number of states
+/// where it is positive definite, and the median of its largest diagonal entry there (0 if
+/// none).
+fn sample_mass_matrix(
+    model: &SymbolicModel,
+    symbols: &[Symbol],
+    evaluator: &mut Evaluator,
+    bindings: &mut [f64],
+    n: usize,
+) -> (usize, f64) {
+    let state_box = model.state_box();
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(0x6d61_7373);
+    let mut regular = 0;
+    let mut sizes = Vec::with_capacity(STATES);
+    for _ in 0..STATES {
+        for (k, s) in symbols.iter().enumerate() {
+            match s.kind {
+                SymbolKind::Coordinate(_) | SymbolKind::Velocity(_) => {
+                    bindings[k] = state_box.at(k, rng.random_range(-2.0..2.0));
+                }
+                SymbolKind::Time => bindings[k] = rng.random_range(0.0..5.0),
+                _ => {}
+            }
+        }
+        let m = evaluator.eval(bindings);
+        if positive_definite(&m, n, 0.0) {
+            regular += 1;
+            sizes.push(largest_diagonal(&m, n));
+        }
+    }
+    // The typical size of M where it is regular: the reference at the initial state.
+    sizes.sort_by(f64::total_cmp);
+    let typical = sizes.get(sizes.len() / 2).copied().unwrap_or(0.0);
+    (regular, typical)
+}
+
+/// The diagnostic, at `location`, of a mass matrix singular at every random state tried.
+fn singular_everywhere(file: &ModelFile, location: Location) -> Diagnostic {
+    let rates: Vec<String> = file
+        .coordinates
+        .iter()
+        .map(|c| format!("`{}_dot`", c.name.value))
+        .collect();
+    Diagnostic::new(
+        location,
+        format!(
+            "the mass matrix is singular at every state tried ({STATES} random states): some combination of {} carries no kinetic energy",
+            rates.join(", ")
+        ),
+    )
+    .with_help(
+        "M = ∂²T/∂q̇∂q̇ must be positive definite; use independent coordinates, or make a dependent one a constraint",
+    )
+}
+
+/// The diagnostic of a mass matrix singular or not finite at the initial coordinates `q0`,
+/// at the first `initial:` entry of `file` or else at `first` (none without either).
+fn singular_at_start(file: &ModelFile, q0: &[f64], first: Option<Location>) -> Option<Diagnostic> {
+    let location = file
+        .initial
+        .first()
+        .map(|(name, _)| name.location)
+        .or(first);
+    let location = location?;
+    let point: Vec<String> = file
+        .coordinates
+        .iter()
+        .zip(q0)
+        .map(|(c, v)| format!("{} = {v}", c.name.value))
+        .collect();
+    Some(
+        Diagnostic::new(
+            location,
+            format!(
+                "the mass matrix is singular or not finite at the initial state ({})",
+                point.join(", ")
+            ),
+        )
+        .with_help(
+            "the coordinates are singular there; start elsewhere, or choose coordinates that stay regular along the motion",
+        ),
+    )
 }
 
 #[cfg(test)]

@@ -10,7 +10,7 @@ use crate::integrate::{
 use crate::model_info::ModelInfo;
 use crate::ode::OdeFn;
 
-use super::options::{Failure, StabilityError, StabilityOptions};
+use super::options::{Failure, StabilityError, StabilityOptions, StiffSpring};
 
 /// Number of output times of the stiff runs (uniform in `(0, t_end]`).
 pub const STIFF_OUTPUT_TIMES: usize = 100;
@@ -92,7 +92,44 @@ pub(super) fn stiff_runs(
     let mut modes = Vec::new();
     let mut rows = Vec::new();
     for &ratio in &args.stiffness {
-        let names = &args.stiff_spring;
+        let spring = Spring::set_up(model, &args.stiff_spring, ratio)?;
+        for start in ["equilibrium", "rest"] {
+            let (mode, start_rows) = spring.runs(model, args, &output, start)?;
+            modes.push(mode);
+            rows.extend(start_rows);
+        }
+    }
+    Ok((modes, rows))
+}
+
+/// The stiff spring at one `k/m`: the masses, the stiff mode and the stretched coordinate.
+struct Spring {
+    /// The stiffness ratio `k/m` (1/s²).
+    ratio: f64,
+    /// The first mass.
+    m1: f64,
+    /// The second mass.
+    m2: f64,
+    /// The stiff mode's angular frequency (rad/s).
+    omega: f64,
+    /// The spring's static stretch under the force (m).
+    static_stretch: f64,
+    /// The index of the stretched coordinate.
+    x2: usize,
+}
+
+impl Spring {
+    /// Reads the masses and the force of `model` (the parameters `names`), sets its
+    /// stiffness to `ratio · m₁` and finds the stretched coordinate.
+    ///
+    /// # Errors
+    /// [`StabilityError::MissingParameter`], an error of setting the stiffness,
+    /// [`StabilityError::MissingCoordinate`].
+    fn set_up(
+        model: &mut dyn ModelInfo,
+        names: &StiffSpring,
+        ratio: f64,
+    ) -> Result<Self, StabilityError> {
         let parameter = |name: &str, role: &'static str| {
             model
                 .description()
@@ -123,84 +160,118 @@ pub(super) fn stiff_runs(
                 model: model.description().name.to_string(),
                 name: names.stretched.clone(),
             })?;
-        for start in ["equilibrium", "rest"] {
-            let mut y0 = model.initial_state();
-            let position_amplitude = if start == "equilibrium" {
-                y0[x2] += static_stretch;
-                0.0
-            } else {
-                static_stretch * m1.max(m2) / (m1 + m2)
-            };
-            let run = |method: &mut dyn Integrator,
-                       model: &mut dyn ModelInfo,
-                       tol: f64|
-             -> Result<Solution, IntegrationFailure> {
-                let options = IntegratorOptions::default()
-                    .with_rtol(tol)
-                    .with_atol(tol)
-                    .with_max_steps(20_000_000);
-                method.integrate(model.as_ode_mut(), 0.0, &y0, args.t_end, &output, &options)
-            };
-            let reference = run(
-                &mut DormandPrince853::new(),
-                &mut *model,
-                STIFF_REFERENCE_TOL,
-            )
-            .map_err(|e| StabilityError::Reference {
-                k_over_m: ratio,
-                start,
-                message: e.to_string(),
-            })?;
-            modes.push(StiffMode {
-                k_over_m: ratio,
-                start,
-                omega,
-                position_amplitude,
-                velocity_amplitude: omega * position_amplitude,
-                reference_steps: reference.stats.steps,
-            });
-            let methods: [Box<dyn Integrator>; 4] = [
-                Box::new(BogackiShampine32::new()),
-                Box::new(DormandPrince54::new()),
-                Box::new(DormandPrince853::new()),
-                Box::new(RadauIIA5::new()),
-            ];
-            for mut method in methods {
-                let (solution, failure) = match run(method.as_mut(), &mut *model, args.tol) {
-                    Ok(s) => (s, None),
-                    Err(f) => {
-                        let failure = Failure::of(&f);
-                        (*f.partial, Some(failure))
-                    }
-                };
-                let error = |offset: usize| {
-                    failure.is_none().then(|| {
-                        solution
-                            .iter()
-                            .zip(reference.iter())
-                            .flat_map(|((_, y), (_, r))| {
-                                (offset..offset + 2).map(move |i| (y[i] - r[i]).abs())
-                            })
-                            .fold(0.0, f64::max)
-                    })
-                };
-                rows.push(StiffRow {
-                    k_over_m: ratio,
-                    start,
-                    method: method.name(),
-                    steps: solution.stats.steps,
-                    rejected: solution.stats.rejected,
-                    rhs_evals: solution.stats.rhs_evals,
-                    jacobian_evals: solution.stats.jacobian_evals,
-                    lu_decompositions: solution.stats.lu_decompositions,
-                    position_error: error(0),
-                    velocity_error: error(2),
-                    failure,
-                });
-            }
-        }
+        Ok(Self {
+            ratio,
+            m1,
+            m2,
+            omega,
+            static_stretch,
+            x2,
+        })
     }
-    Ok((modes, rows))
+
+    /// The mode's figures and every method's row from `start` (`"equilibrium"` or `"rest"`),
+    /// measured against a DOP853 reference at [`STIFF_REFERENCE_TOL`].
+    ///
+    /// # Errors
+    /// [`StabilityError::Reference`] when the reference fails.
+    fn runs(
+        &self,
+        model: &mut dyn ModelInfo,
+        args: &StabilityOptions,
+        output: &OutputTimes,
+        start: &'static str,
+    ) -> Result<(StiffMode, Vec<StiffRow>), StabilityError> {
+        let (ratio, m1, m2, omega) = (self.ratio, self.m1, self.m2, self.omega);
+        let static_stretch = self.static_stretch;
+        let mut y0 = model.initial_state();
+        let position_amplitude = if start == "equilibrium" {
+            y0[self.x2] += static_stretch;
+            0.0
+        } else {
+            static_stretch * m1.max(m2) / (m1 + m2)
+        };
+        let run = |method: &mut dyn Integrator,
+                   model: &mut dyn ModelInfo,
+                   tol: f64|
+         -> Result<Solution, IntegrationFailure> {
+            let options = IntegratorOptions::default()
+                .with_rtol(tol)
+                .with_atol(tol)
+                .with_max_steps(20_000_000);
+            method.integrate(model.as_ode_mut(), 0.0, &y0, args.t_end, output, &options)
+        };
+        let reference = run(
+            &mut DormandPrince853::new(),
+            &mut *model,
+            STIFF_REFERENCE_TOL,
+        )
+        .map_err(|e| StabilityError::Reference {
+            k_over_m: ratio,
+            start,
+            message: e.to_string(),
+        })?;
+        let mode = StiffMode {
+            k_over_m: ratio,
+            start,
+            omega,
+            position_amplitude,
+            velocity_amplitude: omega * position_amplitude,
+            reference_steps: reference.stats.steps,
+        };
+        let methods: [Box<dyn Integrator>; 4] = [
+            Box::new(BogackiShampine32::new()),
+            Box::new(DormandPrince54::new()),
+            Box::new(DormandPrince853::new()),
+            Box::new(RadauIIA5::new()),
+        ];
+        let mut rows = Vec::new();
+        for mut method in methods {
+            let result = run(method.as_mut(), &mut *model, args.tol);
+            rows.push(stiff_row(ratio, start, method.name(), result, &reference));
+        }
+        Ok((mode, rows))
+    }
+}
+
+/// The row of the method `method` from `start` at `k/m = ratio`: its run's `result`, its
+/// errors against `reference` (`None` when it failed).
+fn stiff_row(
+    ratio: f64,
+    start: &'static str,
+    method: &'static str,
+    result: Result<Solution, IntegrationFailure>,
+    reference: &Solution,
+) -> StiffRow {
+    let (solution, failure) = match result {
+        Ok(s) => (s, None),
+        Err(f) => {
+            let failure = Failure::of(&f);
+            (*f.partial, Some(failure))
+        }
+    };
+    let error = |offset: usize| {
+        failure.is_none().then(|| {
+            solution
+                .iter()
+                .zip(reference.iter())
+                .flat_map(|((_, y), (_, r))| (offset..offset + 2).map(move |i| (y[i] - r[i]).abs()))
+                .fold(0.0, f64::max)
+        })
+    };
+    StiffRow {
+        k_over_m: ratio,
+        start,
+        method,
+        steps: solution.stats.steps,
+        rejected: solution.stats.rejected,
+        rhs_evals: solution.stats.rhs_evals,
+        jacobian_evals: solution.stats.jacobian_evals,
+        lu_decompositions: solution.stats.lu_decompositions,
+        position_error: error(0),
+        velocity_error: error(2),
+        failure,
+    }
 }
 
 /// `ẏ = y²`, `y(0) = 1` (`y = 1/(1 − t)`, infinite at `t = 1`) asked for on `[0, 2]` with

@@ -536,21 +536,7 @@ pub fn expm_study_of(
     })?;
     eigenvalues.sort_by(|x, y| x.re.total_cmp(&y.re).then(x.im.total_cmp(&y.im)));
     let eigenvector_condition = eigenvector_condition(a, &eigenvalues);
-    let eigenvectors = match state_response_by_eigenvectors(a, z0, times) {
-        Ok(states) => EigenvectorOutcome::Computed { states },
-        Err(e @ ResponseError::Defective { .. }) => EigenvectorOutcome::Refused {
-            reason: match eigenvector_condition {
-                None => format!(
-                    "A is defective (an eigenvalue repeated m times has fewer than m eigenvectors, a Jordan block), so no sum of e^{{λt}} v can give its t e^{{λt}} terms; {e}"
-                ),
-                Some(k) => format!(
-                    "κ(V) = {k:.1e}: the eigenvectors are nearly parallel and the superposition would lose about {:.0} digits; {e}",
-                    k.log10()
-                ),
-            },
-        },
-        Err(e) => return Err(e.into()),
-    };
+    let eigenvectors = eigenvector_outcome(a, z0, times, eigenvector_condition)?;
     let norm = |v: &[f64]| v.iter().map(|x| x * x).sum::<f64>().sqrt();
     let final_growth = exponential.last().map_or(1.0, |z| norm(z)) / norm(z0);
     let t_max = times.iter().fold(0.0f64, |m, t| m.max(t.abs()));
@@ -574,31 +560,71 @@ pub fn expm_study_of(
         final_growth,
         differences: Vec::new(),
     };
-    for (i, &ra) in ExpmRoute::ALL.iter().enumerate() {
-        for &rb in &ExpmRoute::ALL[i + 1..] {
-            let (Some(za), Some(zb)) = (study.states(ra), study.states(rb)) else {
-                continue;
-            };
-            let absolute = za
-                .iter()
-                .flatten()
-                .zip(zb.iter().flatten())
-                .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
-            let relative = absolute / scale;
-            let tolerance = expected_difference(ra, rb, tol, eigenvector_condition, horizon);
-            let checked = tolerance < ExpmOptions::LARGEST_BOUND;
-            study.differences.push(RouteDifference {
-                a: ra,
-                b: rb,
-                absolute,
-                relative,
-                tolerance,
-                checked,
-                passed: checked && relative <= tolerance,
-            });
+    study.push_differences(horizon);
+    Ok(study)
+}
+
+/// The eigenvector route of [`expm_study_of`]: its states, or why it is refused (a defective
+/// or ill-conditioned `A`, `eigenvector_condition` being `κ(V)`).
+///
+/// # Errors
+/// [`ExpmStudyError::Response`] for a failure other than [`ResponseError::Defective`].
+fn eigenvector_outcome(
+    a: &DMatrix<f64>,
+    z0: &[f64],
+    times: &[f64],
+    eigenvector_condition: Option<f64>,
+) -> Result<EigenvectorOutcome, ExpmStudyError> {
+    let outcome = match state_response_by_eigenvectors(a, z0, times) {
+        Ok(states) => EigenvectorOutcome::Computed { states },
+        Err(e @ ResponseError::Defective { .. }) => EigenvectorOutcome::Refused {
+            reason: match eigenvector_condition {
+                None => format!(
+                    "A is defective (an eigenvalue repeated m times has fewer than m eigenvectors, a Jordan block), so no sum of e^{{λt}} v can give its t e^{{λt}} terms; {e}"
+                ),
+                Some(k) => format!(
+                    "κ(V) = {k:.1e}: the eigenvectors are nearly parallel and the superposition would lose about {:.0} digits; {e}",
+                    k.log10()
+                ),
+            },
+        },
+        Err(e) => return Err(e.into()),
+    };
+    Ok(outcome)
+}
+
+impl ExpmStudy {
+    /// Pushes the difference of every pair of routes with states to
+    /// [`ExpmStudy::differences`], relative to [`ExpmStudy::scale`] and checked against its
+    /// expected bound at `horizon` (`ρ(A) t_max` times the largest amplification).
+    fn push_differences(&mut self, horizon: f64) {
+        let (scale, tol, eigenvector_condition) =
+            (self.scale, self.tol, self.eigenvector_condition);
+        for (i, &ra) in ExpmRoute::ALL.iter().enumerate() {
+            for &rb in &ExpmRoute::ALL[i + 1..] {
+                let (Some(za), Some(zb)) = (self.states(ra), self.states(rb)) else {
+                    continue;
+                };
+                let absolute = za
+                    .iter()
+                    .flatten()
+                    .zip(zb.iter().flatten())
+                    .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
+                let relative = absolute / scale;
+                let tolerance = expected_difference(ra, rb, tol, eigenvector_condition, horizon);
+                let checked = tolerance < ExpmOptions::LARGEST_BOUND;
+                self.differences.push(RouteDifference {
+                    a: ra,
+                    b: rb,
+                    absolute,
+                    relative,
+                    tolerance,
+                    checked,
+                    passed: checked && relative <= tolerance,
+                });
+            }
         }
     }
-    Ok(study)
 }
 
 /// [`expm_study_of`] on the random problem of [`ExpmOptions`] ([`random_problem`]; or the

@@ -335,7 +335,53 @@ pub fn modal_damping_study(
     let approx = modal_damping(lin, modes);
     let exact = exact_damped_modes(lin, modes)?;
     let rayleigh = rayleigh_fit(model, options.rayleigh_modes, modes, &exact)?;
-    let per_mode = (0..n)
+    let per_mode = mode_dampings(n, modes, &approx, &exact, &rayleigh);
+
+    // The releases: HW34's mode shapes (first coordinate 1, or the largest entry if the
+    // first is zero), or one given deviation.
+    check_tolerance(options.tol)?;
+    let t_end = options
+        .t_end
+        .unwrap_or_else(|| default_duration(modes, 10.0, 5.0));
+    let times = uniform_times(t_end, options.samples)?;
+    let names = model.description().coordinate_names();
+    let starts = release_starts(n, modes, &names, options.initial.as_ref());
+    let diagonal_damping = approx.diagonal();
+    let setting = ReleaseSetting {
+        lin,
+        modes,
+        diagonal_damping: &diagonal_damping,
+        rayleigh: rayleigh.as_ref(),
+        times: &times,
+        tol: options.tol,
+    };
+    let mut releases = Vec::new();
+    for (name, q0, v0) in starts {
+        releases.push(setting.release(name, q0, v0)?);
+    }
+    Ok(ModalDampingStudy {
+        operating_point: modal.operating_point,
+        linearization: modal.linearization,
+        normal_modes: modal.normal_modes,
+        modal_damping: approx,
+        rayleigh,
+        modes: per_mode,
+        t_end,
+        tol: options.tol,
+        releases,
+    })
+}
+
+/// The damping ratios of each of the `n` modes ([`ModalDampingStudy::modes`]): exact, by the
+/// diagonal of `Ĉ` (`approx`) and by the Rayleigh fit for the oscillatory modes.
+fn mode_dampings(
+    n: usize,
+    modes: &NormalModes,
+    approx: &ModalDamping,
+    exact: &[Option<DampedMode>],
+    rayleigh: &Option<RayleighFit>,
+) -> Vec<ModeDamping> {
+    (0..n)
         .map(|k| {
             let w = modes.natural_frequencies[k];
             ModeDamping {
@@ -347,7 +393,7 @@ pub fn modal_damping_study(
                     damping_ratio: z,
                     damped_frequency: approx.damped_frequencies[k],
                 }),
-                rayleigh: match (&rayleigh, modes.kinds[k]) {
+                rayleigh: match (rayleigh, modes.kinds[k]) {
                     (Some(fit), ModeKind::Oscillatory) => {
                         let z = fit.damping.damping_ratio(w);
                         Some(ModalRatio {
@@ -359,18 +405,20 @@ pub fn modal_damping_study(
                 },
             }
         })
-        .collect();
+        .collect()
+}
 
-    // The releases: HW34's mode shapes (first coordinate 1, or the largest entry if the
-    // first is zero), or one given deviation.
-    check_tolerance(options.tol)?;
-    let t_end = options
-        .t_end
-        .unwrap_or_else(|| default_duration(modes, 10.0, 5.0));
-    let times = uniform_times(t_end, options.samples)?;
-    let names = model.description().coordinate_names();
+/// The name, `δq₀` and `δq̇₀` of each release: from each of the `n` mode shapes at rest
+/// (scaled so that its first coordinate, or its largest entry if the first is zero, is 1),
+/// or the one `initial` deviation.
+fn release_starts(
+    n: usize,
+    modes: &NormalModes,
+    names: &[&str],
+    initial: Option<&InitialDeviation>,
+) -> Vec<(String, Vec<f64>, Vec<f64>)> {
     let mut starts: Vec<(String, Vec<f64>, Vec<f64>)> = Vec::new();
-    match &options.initial {
+    match initial {
         None => {
             for k in 0..n {
                 let shape = modes.mode_shapes.column(k);
@@ -394,21 +442,45 @@ pub fn modal_damping_study(
             initial.qdot.clone(),
         )),
     }
-    let diagonal_damping = approx.diagonal();
-    let mut releases = Vec::new();
-    for (name, q0, v0) in starts {
-        let exact_response = response_by_exponential(lin, &q0, &v0, &times)?;
-        let integrated = response_by_integration(lin, &q0, &v0, &times, options.tol)?;
+    starts
+}
+
+/// What every release's responses share: the linearisation and its modes, the diagonal
+/// modal damping, the Rayleigh fit if any, the output times and the DOP853 tolerance.
+struct ReleaseSetting<'a> {
+    lin: &'a Linearization,
+    modes: &'a NormalModes,
+    diagonal_damping: &'a [f64],
+    rayleigh: Option<&'a RayleighFit>,
+    times: &'a [f64],
+    tol: f64,
+}
+
+impl ReleaseSetting<'_> {
+    /// The release `name` from `q0`, `v0`: its exact, integrated, diagonal and Rayleigh
+    /// responses and their differences from the exact one.
+    ///
+    /// # Errors
+    /// [`ResponseStudyError::Response`] when a response cannot be computed.
+    fn release(
+        &self,
+        name: String,
+        q0: Vec<f64>,
+        v0: Vec<f64>,
+    ) -> Result<Release, ResponseStudyError> {
+        let (lin, modes, times) = (self.lin, self.modes, self.times);
+        let exact_response = response_by_exponential(lin, &q0, &v0, times)?;
+        let integrated = response_by_integration(lin, &q0, &v0, times, self.tol)?;
         let diagonal =
-            response_with_modal_damping(lin, modes, &diagonal_damping, &q0, &v0, &times)?;
-        let rayleigh_response = match &rayleigh {
+            response_with_modal_damping(lin, modes, self.diagonal_damping, &q0, &v0, times)?;
+        let rayleigh_response = match self.rayleigh {
             Some(fit) => Some(response_with_modal_damping(
                 lin,
                 modes,
                 &fit.damping.modal_damping(modes),
                 &q0,
                 &v0,
-                &times,
+                times,
             )?),
             None => None,
         };
@@ -420,7 +492,7 @@ pub fn modal_damping_study(
                 .unwrap_or(f64::INFINITY);
             if amplitude > 0.0 { d / amplitude } else { d }
         };
-        releases.push(Release {
+        Ok(Release {
             integration_vs_exact: versus(&integrated),
             diagonal_vs_exact: versus(&diagonal),
             rayleigh_vs_exact: rayleigh_response.as_ref().map(versus),
@@ -432,19 +504,8 @@ pub fn modal_damping_study(
             integrated,
             diagonal,
             rayleigh: rayleigh_response,
-        });
+        })
     }
-    Ok(ModalDampingStudy {
-        operating_point: modal.operating_point,
-        linearization: modal.linearization,
-        normal_modes: modal.normal_modes,
-        modal_damping: approx,
-        rayleigh,
-        modes: per_mode,
-        t_end,
-        tol: options.tol,
-        releases,
-    })
 }
 
 /// The Rayleigh fit `C = αM + βK` to the exact damping ratios of two modes (numbered from 1):

@@ -2,6 +2,7 @@
 //! to.
 
 use super::*;
+use crate::model::checks::{FinalStateCheck, ModalCheck, PeriodCheck};
 
 impl Checker<'_> {
     // Rule: every point named by a body, spring, damper, force or drawing exists; torques
@@ -268,110 +269,13 @@ impl Checker<'_> {
             ("damping_ratios", &checks.damping_ratios),
         ] {
             let Some(modal) = modal else { continue };
-            for (i, v) in modal.values.iter().enumerate() {
-                self.resolve(v, Depends::Constant, &format!("value {} of `{key}`", i + 1));
-            }
-            if let Some(at) = &modal.at {
-                let names: Vec<&str> = file
-                    .equilibria
-                    .iter()
-                    .map(|e| e.name.value.as_str())
-                    .collect();
-                if !names.contains(&at.value.as_str()) && !self.incomplete.has_section("equilibria")
-                {
-                    let d = Diagnostic::new(
-                        at.location,
-                        format!(
-                            "`at: {}` of `{key}` is not an equilibrium of the model",
-                            at.value
-                        ),
-                    );
-                    let d = match closest(&at.value, &names) {
-                        Some(c) => d.with_help(format!("did you mean `{c}`?")),
-                        None if names.is_empty() => d.with_help(
-                            "name the operating point in `equilibria:`, as in `equilibria: { hanging: { theta: 0 } }`",
-                        ),
-                        None => d.with_help(format!("equilibria are: {}", names.join(", "))),
-                    };
-                    self.error(d);
-                }
-            }
-            let modes = file
-                .coordinates
-                .len()
-                .saturating_sub(file.holonomic_names().len());
-            if key == "natural_frequencies"
-                && file.nonholonomic.is_empty()
-                && file.rolling.is_empty()
-                && modal.values.len() != modes
-                && !self.incomplete.has_section("coordinates")
-                && !self.incomplete.has_section("constraints")
-            {
-                self.error(
-                    Diagnostic::new(
-                        modal.location,
-                        format!(
-                            "`natural_frequencies` lists {} value(s), but the model has {modes} mode(s)",
-                            modal.values.len()
-                        ),
-                    )
-                    .with_help("give every natural frequency in rad/s, ascending, zero-frequency modes as 0"),
-                );
-            }
+            self.modal_check(key, modal);
         }
         if let Some(period) = &checks.period {
-            self.resolve(&period.value, Depends::Constant, "the `value` of `period`");
-            let names: Vec<&str> = file.events.iter().map(|e| e.name.value.as_str()).collect();
-            if !names.contains(&period.event.value.as_str())
-                && !self.incomplete.has_section("events")
-            {
-                let d = Diagnostic::new(
-                    period.event.location,
-                    format!(
-                        "`event: {}` of `period` is not an event of the model",
-                        period.event.value
-                    ),
-                );
-                let d = match closest(&period.event.value, &names) {
-                    Some(c) => d.with_help(format!("did you mean `{c}`?")),
-                    None if names.is_empty() => d.with_help(
-                        "define it in `events:`, as in `events: { peak: { when: x_dot, direction: falling } }`",
-                    ),
-                    None => d.with_help(format!("events are: {}", names.join(", "))),
-                };
-                self.error(d);
-            }
+            self.period_check(period);
         }
         if let Some(state) = &checks.final_state {
-            self.resolve(&state.t, Depends::Constant, "the time `t` of `final_state`");
-            for (k, v) in &state.values {
-                self.resolve(
-                    v,
-                    Depends::Constant,
-                    &format!("the value of `{}` in `final_state`", k.value),
-                );
-                let n = k.value.as_str();
-                if self.sets.coords.contains(n)
-                    || self.sets.rates.contains(n)
-                    || self.incomplete.has_section("coordinates")
-                {
-                    continue;
-                }
-                let mut candidates: Vec<&str> = self.coords.clone();
-                candidates.extend(self.rates.iter().map(String::as_str));
-                let d = Diagnostic::new(
-                    k.location,
-                    format!("`{n}` in `final_state` is neither a coordinate nor a rate"),
-                );
-                let d = match closest(n, &candidates) {
-                    Some(c) => d.with_help(format!("did you mean `{c}`?")),
-                    None => d.with_help(format!(
-                        "coordinates and rates are: {}",
-                        candidates.join(", ")
-                    )),
-                };
-                self.error(d);
-            }
+            self.final_state_check(state);
         }
         self.angular_velocities = false;
         for c in &checks.conserved {
@@ -382,6 +286,119 @@ impl Checker<'_> {
             );
         }
         self.angular_velocities = true;
+    }
+
+    /// The `modal` check under `key` (`natural_frequencies` or `damping_ratios`): its values
+    /// are constants, its `at:` an entry of `equilibria:`, and natural frequencies one per mode.
+    fn modal_check(&mut self, key: &str, modal: &ModalCheck) {
+        let file = self.file;
+        for (i, v) in modal.values.iter().enumerate() {
+            self.resolve(v, Depends::Constant, &format!("value {} of `{key}`", i + 1));
+        }
+        if let Some(at) = &modal.at {
+            let names: Vec<&str> = file
+                .equilibria
+                .iter()
+                .map(|e| e.name.value.as_str())
+                .collect();
+            if !names.contains(&at.value.as_str()) && !self.incomplete.has_section("equilibria") {
+                let d = Diagnostic::new(
+                    at.location,
+                    format!(
+                        "`at: {}` of `{key}` is not an equilibrium of the model",
+                        at.value
+                    ),
+                );
+                let d = match closest(&at.value, &names) {
+                    Some(c) => d.with_help(format!("did you mean `{c}`?")),
+                    None if names.is_empty() => d.with_help(
+                        "name the operating point in `equilibria:`, as in `equilibria: { hanging: { theta: 0 } }`",
+                    ),
+                    None => d.with_help(format!("equilibria are: {}", names.join(", "))),
+                };
+                self.error(d);
+            }
+        }
+        let modes = file
+            .coordinates
+            .len()
+            .saturating_sub(file.holonomic_names().len());
+        if key == "natural_frequencies"
+            && file.nonholonomic.is_empty()
+            && file.rolling.is_empty()
+            && modal.values.len() != modes
+            && !self.incomplete.has_section("coordinates")
+            && !self.incomplete.has_section("constraints")
+        {
+            self.error(
+                Diagnostic::new(
+                    modal.location,
+                    format!(
+                        "`natural_frequencies` lists {} value(s), but the model has {modes} mode(s)",
+                        modal.values.len()
+                    ),
+                )
+                .with_help("give every natural frequency in rad/s, ascending, zero-frequency modes as 0"),
+            );
+        }
+    }
+
+    /// The `period` check: its value is a constant and its `event:` an entry of `events:`.
+    fn period_check(&mut self, period: &PeriodCheck) {
+        let file = self.file;
+        self.resolve(&period.value, Depends::Constant, "the `value` of `period`");
+        let names: Vec<&str> = file.events.iter().map(|e| e.name.value.as_str()).collect();
+        if !names.contains(&period.event.value.as_str()) && !self.incomplete.has_section("events") {
+            let d = Diagnostic::new(
+                period.event.location,
+                format!(
+                    "`event: {}` of `period` is not an event of the model",
+                    period.event.value
+                ),
+            );
+            let d = match closest(&period.event.value, &names) {
+                Some(c) => d.with_help(format!("did you mean `{c}`?")),
+                None if names.is_empty() => d.with_help(
+                    "define it in `events:`, as in `events: { peak: { when: x_dot, direction: falling } }`",
+                ),
+                None => d.with_help(format!("events are: {}", names.join(", "))),
+            };
+            self.error(d);
+        }
+    }
+
+    /// The `final_state` check: its time and values are constants, keyed by coordinates and
+    /// rates.
+    fn final_state_check(&mut self, state: &FinalStateCheck) {
+        self.resolve(&state.t, Depends::Constant, "the time `t` of `final_state`");
+        for (k, v) in &state.values {
+            self.resolve(
+                v,
+                Depends::Constant,
+                &format!("the value of `{}` in `final_state`", k.value),
+            );
+            let n = k.value.as_str();
+            if self.sets.coords.contains(n)
+                || self.sets.rates.contains(n)
+                || self.incomplete.has_section("coordinates")
+            {
+                continue;
+            }
+            let mut candidates: Vec<&str> = self.coords.clone();
+            candidates.extend(self.rates.iter().map(String::as_str));
+            let d = Diagnostic::new(
+                k.location,
+                format!("`{n}` in `final_state` is neither a coordinate nor a rate"),
+            );
+            let d = match closest(n, &candidates) {
+                Some(c) => d.with_help(format!("did you mean `{c}`?")),
+                None => d.with_help(format!(
+                    "coordinates and rates are: {}",
+                    candidates.join(", ")
+                )),
+            };
+            self.error(d);
+        }
     }
 
     // Rule: outputs are functions of the motion, named apart from the columns beside them
