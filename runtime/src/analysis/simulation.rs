@@ -174,7 +174,7 @@ pub enum SimulationError {
 pub struct Simulation {
     /// The method used.
     pub method: Method,
-    /// The integrator's own name ([`Integrator::name`](crate::Integrator::name), `"dopri5"`).
+    /// The integrator's own name ([`Integrator::name`], `"dopri5"`).
     pub integrator: &'static str,
     /// The consistent initial state `[q; q̇]` the integration started from.
     pub initial_state: Vec<f64>,
