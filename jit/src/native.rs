@@ -34,6 +34,7 @@
 use cranelift_codegen::ir;
 use cranelift_codegen::ir::condcodes::FloatCC;
 use cranelift_codegen::ir::{AbiParam, InstBuilder, MemFlagsData, Signature, UserFuncName, types};
+use cranelift_codegen::isa::CallConv;
 use cranelift_frontend::{FunctionBuilder, FunctionBuilderContext};
 use cranelift_jit::JITModule;
 use cranelift_module::{FuncId, Linkage, Module};
@@ -126,20 +127,11 @@ pub(crate) fn compile(
 ) -> Result<NativeCode, CompileError> {
     let mut module = new_module(CodeLayout::Pages)?;
     let imports = declare_imports(&mut module)?;
-    let call_conv = module.isa().default_call_conv();
-    let pointer = module.target_config().pointer_type();
-    let signature = |layout: Layout| {
-        let mut signature = Signature::new(call_conv);
-        let (before, after) = match layout {
-            Layout::Model => (5, 3),
-            Layout::FirstOrder { .. } => (2, 2),
-        };
-        let pointers = |k: usize| (0..k).map(|_| AbiParam::new(pointer));
-        signature.params.extend(pointers(before));
-        signature.params.push(AbiParam::new(types::F64));
-        signature.params.extend(pointers(after));
-        signature
-    };
+    let (call_conv, pointer) = (
+        module.isa().default_call_conv(),
+        module.target_config().pointer_type(),
+    );
+    let signature = |layout: Layout| tape_signature(call_conv, pointer, layout);
     let first_order =
         first_order.filter(|(f, _)| f.tape.instructions.len() <= SCRATCH_FROM_INSTRUCTIONS);
     let all = functions
@@ -227,6 +219,21 @@ pub(crate) fn compile(
         code_bytes,
         _memory: ModuleMemory::new(module),
     })
+}
+
+/// The signature of a tape's function of `layout` ([`NativeFn`] or [`FirstOrderFn`]): its
+/// pointers, then `t`, then its other pointers.
+fn tape_signature(call_conv: CallConv, pointer: ir::Type, layout: Layout) -> Signature {
+    let mut signature = Signature::new(call_conv);
+    let (before, after) = match layout {
+        Layout::Model => (5, 3),
+        Layout::FirstOrder { .. } => (2, 2),
+    };
+    let pointers = |k: usize| (0..k).map(|_| AbiParam::new(pointer));
+    signature.params.extend(pointers(before));
+    signature.params.push(AbiParam::new(types::F64));
+    signature.params.extend(pointers(after));
+    signature
 }
 
 /// The function's arguments as Cranelift values.

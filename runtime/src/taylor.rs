@@ -822,6 +822,13 @@ fn series_in(
         }
         accelerations(&layout, &mut solve, k, s, out);
     }
+    all_finite(out, dim)
+}
+
+/// `Ok` when every coefficient in `out` is finite, else the component (of `dim`) of the first
+/// that is not. In line: part of the hot step, in its copy for the host's instruction set.
+#[inline(always)]
+fn all_finite(out: &[f64], dim: usize) -> Result<(), RhsError> {
     // Whether any exponent field is all ones (infinite or NaN), as one OR over the bits
     // (vectorised; a branch per value took 3 % of a double-pendulum step), then where.
     const EXPONENT: u64 = 0x7ff0_0000_0000_0000;
