@@ -1,20 +1,35 @@
 //! One stepper for every explicit Runge–Kutta [`Tableau`]: stages, embedded error estimate,
-//! FSAL reuse and Hermite-based dense output.
+//! FSAL reuse, and dense output by the Hermite interpolant (with Shampine's correction for
+//! DP5(4)) or by the pair's own interpolant with its extra stages (Verner's).
+
+mod interpolant;
+mod sums;
 
 use std::mem::swap;
+
+pub(super) use sums::{combine, error_ratio, sum_fixed, weighted_sum, write_update};
 
 use super::dense_output::{DenseOutput, hermite};
 use super::options::ErrorWeights;
 use super::stepper::{AttemptTimes, CheckedRhs, StepEnds, StepFailure, Stepper, first_non_finite};
-use super::tableau::Tableau;
+use super::tableau::{StageSums, Tableau};
 use crate::ode::RhsError;
+use interpolant::InterpolantState;
 
 /// An explicit Runge–Kutta method given by its tableau, with all buffers allocated once.
 ///
 /// Stage 0 of a step is `F(t, y)` at the current state, kept in `f` (for an FSAL tableau it
 /// is the last stage of the previous step; otherwise it is evaluated when a step is accepted,
-/// which is also what the Hermite dense output needs). Stages `1 … s−1` live in `k`. After an
-/// accepted step, `y_prev`, `f_prev` and `k` describe that step for the dense output.
+/// which is also what the dense output needs). Stages `1 … s−1` live in `k`. After an
+/// accepted step, `y_prev`, `f_prev` and `k` describe that step for the dense output; a pair
+/// with an interpolant appends its extra stages to `k` when the dense output is prepared
+/// ([`Stepper::prepare_dense_output`]), only for a step that contains a requested output
+/// time or an event, as OrdinaryDiffEq.jl's `lazy` option does.
+///
+/// With [`StageSums::Differences`] row `j − 1` of `k` holds the difference `kⱼ − k₀` of stage
+/// `j ≥ 1`, and every sum is taken in the form `Σⱼ wⱼ kⱼ = (Σⱼ wⱼ) k₀ + Σⱼ≥₁ wⱼ (kⱼ − k₀)`:
+/// the rows below (`a_rows`, `b_row`, `error_row`) then carry `Σⱼ wⱼ` (`cᵢ`, 1, 0) in place of
+/// stage 0's weight.
 #[derive(Debug, Clone)]
 pub(crate) struct ExplicitRk {
     tableau: Tableau,
@@ -25,13 +40,25 @@ pub(crate) struct ExplicitRk {
     y_new: Vec<f64>,
     /// Stage input, then the error estimate.
     scratch: Vec<f64>,
-    /// Stages `1 … s−1`, row-major: `(s − 1) × dim`.
+    /// Stages `1 …` of all stages (an interpolant's extra ones included), row-major:
+    /// `(all − 1) × dim`.
     k: Vec<f64>,
+    /// Row `i` of `a` for every stage (an interpolant's extra ones included), as the sums
+    /// take it.
+    a_rows: Vec<Vec<f64>>,
+    /// The weights `b`, as the sums take them.
+    b_row: Vec<f64>,
+    /// The error weights `b − b̂`, as the sums take them, if the tableau has them.
+    error_row: Option<Vec<f64>>,
+    /// Whether the sums are taken with differences ([`StageSums::Differences`]).
+    differences: bool,
     /// The stages compiled for this tableau and dimension, if there is such a copy.
     kernel: Option<Kernel>,
     /// The rows of `k` whose stage has no weight in the candidate nor in the error estimate;
     /// an error-controlled attempt checks only these for finiteness on their own.
     unweighted_rows: Vec<usize>,
+    /// The pair's own interpolant, if it has one (else the Hermite dense output).
+    interpolant: Option<InterpolantState>,
 }
 
 /// The rows of `k` (stage `r + 1` in row `r`) whose stage has a zero weight in `b` and in the
@@ -50,6 +77,16 @@ fn unweighted_rows(tableau: &Tableau) -> Vec<usize> {
         .collect()
 }
 
+/// `weights` as the sums take them: as written, or with stage 0's weight replaced by
+/// `total = Σⱼ wⱼ` in the form with differences.
+fn sum_row(weights: &[f64], total: f64, differences: bool) -> Vec<f64> {
+    let mut row = weights.to_vec();
+    if differences && let Some(first) = row.first_mut() {
+        *first = total;
+    }
+    row
+}
+
 /// Stages `1 … s−1` of an attempt, compiled for one tableau and one dimension: see
 /// [`dopri5_stages`]. A kernel also leaves the error estimate's sum `Σ eᵢ kᵢ` in `scratch`
 /// (the attempt then does not form it again).
@@ -61,22 +98,44 @@ type Kernel = fn(&mut ExplicitRk, &mut CheckedRhs<'_>, f64, f64) -> Result<(), S
 impl ExplicitRk {
     /// A stepper for `tableau` on a system of dimension `dim`.
     pub(crate) fn new(tableau: Tableau, dim: usize) -> Self {
-        let stages = tableau.num_stages();
+        let differences = tableau.sums() == StageSums::Differences;
+        let (c, a): (&[f64], Vec<&[f64]>) = match tableau.interpolant() {
+            Some(interpolant) => (interpolant.c, interpolant.a.to_vec()),
+            None => (
+                tableau.c(),
+                (0..tableau.num_stages()).map(|i| tableau.a(i)).collect(),
+            ),
+        };
+        let a_rows = a
+            .iter()
+            .zip(c)
+            .map(|(row, &ci)| sum_row(row, ci, differences))
+            .collect();
         Self {
             tableau,
             dim,
             ends: StepEnds::new(dim),
             y_new: vec![0.0; dim],
             scratch: vec![0.0; dim],
-            k: vec![0.0; stages.saturating_sub(1) * dim],
+            k: vec![0.0; c.len().saturating_sub(1) * dim],
+            a_rows,
+            b_row: sum_row(tableau.b(), 1.0, differences),
+            error_row: tableau
+                .error_weights()
+                .map(|e| sum_row(e, 0.0, differences)),
+            differences,
             kernel: kernel(&tableau, dim),
             unweighted_rows: unweighted_rows(&tableau),
+            interpolant: tableau
+                .interpolant()
+                .map(|interpolant| InterpolantState::new(interpolant, dim)),
         }
     }
 
     /// Stage `I` (`1 ≤ I < s`) of the tableau `make()` for `D` components: its input
     /// `y + h Σⱼ aᵢⱼ kⱼ` (into `y_new` for the last stage of an FSAL tableau, else `scratch`),
     /// then `F` there into row `I − 1` of `k`, unchecked (see [`CheckedRhs::eval_stage`]).
+    /// For a tableau whose sums are plain.
     #[inline(always)]
     fn stage_fixed<const I: usize, const D: usize>(
         &mut self,
@@ -103,6 +162,45 @@ impl ExplicitRk {
                 Err(CheckedRhs::stage_failure(earlier, D, time, failure))
             }
         }
+    }
+
+    /// Stages `1 … s−1` of an attempt through the general sums: each stage's input, then `F`
+    /// there into its row of `k` (less `k₀` in the form with differences).
+    fn stages(&mut self, rhs: &mut CheckedRhs<'_>, times: AttemptTimes) -> Result<(), StepFailure> {
+        let n = self.dim;
+        let s = self.tableau.num_stages();
+        let c = self.tableau.c();
+        // Row r of k is stage r + 1.
+        let stage_time = |r: usize| times.at(c[r + 1]);
+        for (i, &ci) in c.iter().enumerate().skip(1) {
+            let (earlier, rest) = self.k.split_at_mut((i - 1) * n);
+            // The last stage of an FSAL tableau is evaluated at the candidate itself.
+            let input = if self.tableau.is_fsal() && i == s - 1 {
+                &mut self.y_new
+            } else {
+                &mut self.scratch
+            };
+            // The copies of `combine` for 2, 4, 6 and 8 components keep the sums in registers.
+            combine(
+                input,
+                &self.ends.y,
+                times.h,
+                &self.a_rows[i],
+                &self.ends.f,
+                earlier,
+            );
+            let row = &mut rest[..n];
+            if let Err(failure) = rhs.eval_stage(times.at(ci), input, row) {
+                return Err(CheckedRhs::stage_failure(earlier, n, stage_time, failure));
+            }
+            if self.differences {
+                // A non-finite stage stays non-finite as a difference (k₀ is finite).
+                for (k, &f0) in row.iter_mut().zip(&self.ends.f) {
+                    *k -= f0;
+                }
+            }
+        }
+        Ok(())
     }
 }
 
@@ -149,164 +247,16 @@ fn dopri5_stages<const D: usize>(
     Ok(())
 }
 
-/// `out = Σⱼ wⱼ kⱼ` over the stages that have a weight (zero weights are skipped), where stage
-/// 0 is `first` and stage `j ≥ 1` is row `j − 1` of `k` (rows of `dim`).
-///
-/// The increment is summed on its own before it is added to `y` (see [`combine`]), so that
-/// small stage contributions are not rounded against `|y|` one at a time.
-///
-/// Summed component by component with each sum in a register: summing stage by stage into
-/// `out` makes every addition wait for the previous stage's store to memory, which cost more
-/// than the right-hand side itself on small systems (measured on the double pendulum).
-pub(super) fn weighted_sum(out: &mut [f64], weights: &[f64], first: &[f64], k: &[f64], dim: usize) {
-    // Small systems (most mechanisms) get a copy with the dimension fixed at compile time:
-    // the accumulators live in registers (one vector register for dim 4) and the loops are
-    // unrolled, which on the double pendulum halved the time spent outside the right-hand side.
-    match dim {
-        1 => weighted_sum_fixed::<1>(out, weights, first, k),
-        2 => weighted_sum_fixed::<2>(out, weights, first, k),
-        3 => weighted_sum_fixed::<3>(out, weights, first, k),
-        4 => weighted_sum_fixed::<4>(out, weights, first, k),
-        6 => weighted_sum_fixed::<6>(out, weights, first, k),
-        8 => weighted_sum_fixed::<8>(out, weights, first, k),
-        _ => weighted_sum_any(out, weights, first, k, dim),
-    }
-}
-
-/// [`weighted_sum`] for `D` components (`out`, `first` of length `D`, `k` rows of `D`).
-#[inline(always)]
-fn weighted_sum_fixed<const D: usize>(out: &mut [f64], weights: &[f64], first: &[f64], k: &[f64]) {
-    out[..D].copy_from_slice(&sum_fixed::<D>(weights, first, k));
-}
-
-/// `Σⱼ wⱼ kⱼ` for `D` components, accumulated in an array the compiler keeps in registers.
-#[inline(always)]
-pub(super) fn sum_fixed<const D: usize>(weights: &[f64], first: &[f64], k: &[f64]) -> [f64; D] {
-    let mut acc = [0.0f64; D];
-    let Some((&w0, rest)) = weights.split_first() else {
-        return acc;
-    };
-    // Sliced to `D` so that the indexing below needs no bounds checks.
-    let first = &first[..D];
-    if w0 != 0.0 {
-        for i in 0..D {
-            acc[i] = w0 * first[i];
-        }
-    }
-    for (&w, kj) in rest.iter().zip(k.chunks_exact(D)) {
-        if w != 0.0 {
-            for i in 0..D {
-                acc[i] += w * kj[i];
-            }
-        }
-    }
-    acc
-}
-
-/// [`weighted_sum`] for any dimension.
-fn weighted_sum_any(out: &mut [f64], weights: &[f64], first: &[f64], k: &[f64], dim: usize) {
-    let Some((&w0, rest)) = weights.split_first() else {
-        out.fill(0.0);
-        return;
-    };
-    // `out` has `dim` components, so the loop (and the chunking) runs only for `dim ≥ 1`.
-    for (i, (o, &f)) in out.iter_mut().zip(first).enumerate() {
-        let mut acc = if w0 == 0.0 { 0.0 } else { w0 * f };
-        for (&w, kj) in rest.iter().zip(k.chunks_exact(dim)) {
-            if w != 0.0 {
-                acc += w * kj[i];
-            }
-        }
-        *o = acc;
-    }
-}
-
-/// `error / scale`, the weighted error of one component, by the multiplication
-/// `error · inverse` with `inverse = 1/scale`.
-///
-/// The reciprocal depends only on the ends of the step, so it is formed while the last stage
-/// is evaluated, and the error, which waits for that stage, then waits for a multiplication
-/// instead of a division (on the path from the last stage to the next step's first). Where
-/// the reciprocal overflows (a pure relative tolerance, `atol = 0`, on a component below
-/// ~1e-308 in magnitude) the division is taken instead, so that the error stays finite there
-/// (measured: ẏ = −y with rtol 1e-6, atol 0 fails with a step-size underflow near t = 697
-/// without it). A zero error counts as zero even where the scale is zero (rtol only, y = 0);
-/// a non-zero error there is infinitely large, and the step is rejected.
-#[inline(always)]
-pub(super) fn error_ratio(error: f64, scale: f64, inverse: f64) -> f64 {
-    if error == 0.0 {
-        0.0
-    } else if inverse.is_finite() {
-        error * inverse
-    } else {
-        error / scale
-    }
-}
-
-/// `out = y + h Σⱼ wⱼ kⱼ`.
-pub(super) fn combine(
-    out: &mut [f64],
-    y: &[f64],
-    h: f64,
-    weights: &[f64],
-    first: &[f64],
-    k: &[f64],
-) {
-    match y.len() {
-        2 => combine_fixed::<2>(out, y, h, weights, first, k),
-        4 => combine_fixed::<4>(out, y, h, weights, first, k),
-        6 => combine_fixed::<6>(out, y, h, weights, first, k),
-        8 => combine_fixed::<8>(out, y, h, weights, first, k),
-        _ => {
-            weighted_sum(out, weights, first, k, y.len());
-            for (o, &yi) in out.iter_mut().zip(y) {
-                *o = yi + h * *o;
-            }
-        }
-    }
-}
-
-/// [`combine`] for `D` components, the sum and the update in registers.
-#[inline(always)]
-fn combine_fixed<const D: usize>(
-    out: &mut [f64],
-    y: &[f64],
-    h: f64,
-    weights: &[f64],
-    first: &[f64],
-    k: &[f64],
-) {
-    let sum = sum_fixed::<D>(weights, first, k);
-    write_update::<D>(out, y, h, &sum);
-}
-
-/// `out = y + h · sum` for `D` components, written two at a time.
-///
-/// What is written here is read back at once by the right-hand side, which
-/// ([`FirstOrder::rhs`](crate::OdeSystem::rhs)) loads its state in 16-byte halves; a load is
-/// served from the store buffer only if it lies within one earlier store, so eight-byte
-/// stores of single components stall every stage until they reach the cache. Left to itself
-/// the compiler wrote single components once the tableau was folded into the stage sums, and
-/// DOP853 on the double pendulum ran 15–27 % slower for it.
-#[inline(always)]
-pub(super) fn write_update<const D: usize>(out: &mut [f64], y: &[f64], h: f64, sum: &[f64; D]) {
-    let (out, y) = (&mut out[..D], &y[..D]);
-    for j in 0..D / 2 {
-        let i = 2 * j;
-        let pair = [y[i] + h * sum[i], y[i + 1] + h * sum[i + 1]];
-        out[i..i + 2].copy_from_slice(&pair);
-    }
-    if D % 2 == 1 {
-        out[D - 1] = y[D - 1] + h * sum[D - 1];
-    }
-}
-
 impl DenseOutput for ExplicitRk {
     fn interval(&self) -> (f64, f64) {
         self.ends.interval()
     }
 
     fn interpolate(&self, t: f64, out: &mut [f64]) {
+        if let Some(interpolant) = &self.interpolant {
+            interpolant.interpolate(&self.ends, t, out);
+            return;
+        }
         let h = self.ends.t - self.ends.t_prev;
         if h == 0.0 {
             out.copy_from_slice(&self.ends.y);
@@ -342,6 +292,7 @@ impl Stepper for ExplicitRk {
 
     fn reset(&mut self, rhs: &mut CheckedRhs<'_>, t0: f64, y0: &[f64]) -> Result<(), StepFailure> {
         self.ends.reset(rhs, t0, y0)?;
+        self.invalidate_dense_output();
         Ok(())
     }
 
@@ -352,43 +303,28 @@ impl Stepper for ExplicitRk {
         weights: &ErrorWeights,
         estimate_error: bool,
     ) -> Result<Option<f64>, StepFailure> {
-        let tableau = self.tableau;
         let n = self.dim;
-        let s = tableau.num_stages();
+        let s = self.tableau.num_stages();
         let times = AttemptTimes::new(self.ends.t, t_new);
         let h = times.h;
         self.ends.t_new = t_new;
-        let c = tableau.c();
+        self.invalidate_dense_output();
+        let c = self.tableau.c();
         // Row r of k is stage r + 1.
         let stage_time = |r: usize| times.at(c[r + 1]);
         let compiled = self.kernel.is_some();
         if let Some(kernel) = self.kernel {
             kernel(self, rhs, times.t, times.t_new)?;
         } else {
-            for (i, &ci) in c.iter().enumerate().skip(1) {
-                let (earlier, rest) = self.k.split_at_mut((i - 1) * n);
-                // The last stage of an FSAL tableau is evaluated at the candidate itself.
-                let input = if tableau.is_fsal() && i == s - 1 {
-                    &mut self.y_new
-                } else {
-                    &mut self.scratch
-                };
-                combine(input, &self.ends.y, h, tableau.a(i), &self.ends.f, earlier);
-                if let Err(failure) = rhs.eval_stage(times.at(ci), input, &mut rest[..n]) {
-                    return Err(CheckedRhs::stage_failure(earlier, n, stage_time, failure));
-                }
-            }
+            self.stages(rhs, times)?;
         }
-        let error_weights = if estimate_error {
-            tableau.error_weights()
-        } else {
-            None
-        };
-        if error_weights.is_some() {
+        let stages = &self.k[..s.saturating_sub(1) * n];
+        let error_row = self.error_row.as_deref().filter(|_| estimate_error);
+        if error_row.is_some() {
             // A non-finite stage with a weight in the candidate or in the error estimate makes
             // that one non-finite, which is checked below; only the others are checked here.
             for &row in &self.unweighted_rows {
-                if let Some(index) = first_non_finite(&self.k[row * n..(row + 1) * n]) {
+                if let Some(index) = first_non_finite(&stages[row * n..(row + 1) * n]) {
                     return Err(StepFailure::Rhs {
                         t: stage_time(row),
                         error: RhsError::NonFinite { index },
@@ -396,32 +332,33 @@ impl Stepper for ExplicitRk {
                 }
             }
         } else {
-            CheckedRhs::check_stages(&self.k, n, stage_time)?;
+            CheckedRhs::check_stages(stages, n, stage_time)?;
         }
-        if !tableau.is_fsal() {
+        if !self.tableau.is_fsal() {
             combine(
                 &mut self.y_new,
                 &self.ends.y,
                 h,
-                tableau.b(),
+                &self.b_row,
                 &self.ends.f,
-                &self.k,
+                stages,
             );
         }
         if let Some(index) = first_non_finite(&self.y_new) {
             // A non-finite stage that made it so is reported at its own time.
-            CheckedRhs::check_stages(&self.k, n, stage_time)?;
+            CheckedRhs::check_stages(stages, n, stage_time)?;
             return Err(StepFailure::NonFiniteState { t: t_new, index });
         }
-        let Some(e) = error_weights else {
+        let Some(e) = error_row else {
             return Ok(None);
         };
         if n == 0 {
             return Ok(Some(0.0));
         }
-        // Hairer's norm: RMS over i of errᵢ / (atolᵢ + rtolᵢ · max(|yᵢ|, |y_newᵢ|)).
+        // Hairer's norm (and OrdinaryDiffEq.jl's): RMS over i of errᵢ / (atolᵢ + rtolᵢ ·
+        // max(|yᵢ|, |y_newᵢ|)), errᵢ = h Σ (bⱼ − b̂ⱼ) kⱼ.
         if !compiled {
-            weighted_sum(&mut self.scratch, e, &self.ends.f, &self.k, n);
+            weighted_sum(&mut self.scratch, e, &self.ends.f, stages, n);
         }
         let mut sum = 0.0;
         for i in 0..n {
@@ -434,7 +371,7 @@ impl Stepper for ExplicitRk {
         if !squared.is_finite() {
             // A non-finite stage in the estimate (reported at its time); else a non-zero
             // error where the scale is zero, which is an infinite error.
-            CheckedRhs::check_stages(&self.k, n, stage_time)?;
+            CheckedRhs::check_stages(stages, n, stage_time)?;
         }
         Ok(Some(squared))
     }
@@ -445,9 +382,15 @@ impl Stepper for ExplicitRk {
         // F at the candidate goes into f_prev first, whose old content is no longer needed,
         // so that a failure leaves the current state untouched.
         if self.tableau.is_fsal() {
-            self.ends
-                .f_prev
-                .copy_from_slice(&self.k[(s - 2) * n..(s - 1) * n]);
+            let last = &self.k[(s - 2) * n..(s - 1) * n];
+            if self.differences {
+                // The last stage, F at the candidate, from its difference.
+                for ((f_new, &d), &f0) in self.ends.f_prev.iter_mut().zip(last).zip(&self.ends.f) {
+                    *f_new = d + f0;
+                }
+            } else {
+                self.ends.f_prev.copy_from_slice(last);
+            }
         } else {
             rhs.eval(self.ends.t_new, &self.y_new, &mut self.ends.f_prev)?;
         }
@@ -456,7 +399,15 @@ impl Stepper for ExplicitRk {
         swap(&mut self.ends.y, &mut self.y_new);
         self.ends.t_prev = self.ends.t;
         self.ends.t = self.ends.t_new;
+        self.invalidate_dense_output();
         Ok(())
+    }
+
+    /// The interpolant's extra stages of the last step, for a pair that has one (two, three
+    /// … nine evaluations of `F` for Verner 6(5) … 9(8); `F` at the step's end is already
+    /// known), then its values at its nodes. Nothing for the Hermite dense output.
+    fn prepare_dense_output(&mut self, rhs: &mut CheckedRhs<'_>) -> Result<(), StepFailure> {
+        self.prepare_interpolant(rhs)
     }
 }
 
@@ -464,56 +415,6 @@ impl Stepper for ExplicitRk {
 mod tests {
     use super::*;
     use crate::ode::OdeFn;
-
-    /// The copies of `weighted_sum` compiled for small dimensions add the same products in the
-    /// same order as the general one: equal to the bit, for every dimension they cover, with
-    /// zero weights skipped alike (so taking either path changes no result).
-    #[test]
-    fn the_fixed_dimension_sums_equal_the_general_one_to_the_bit() {
-        let weights = [0.1, 0.0, -2.5, 1.0 / 3.0, 0.0, 7.25, 1e-3];
-        for dim in 1..=9 {
-            let first: Vec<f64> = (0..dim).map(|i| 0.3 + i as f64 / 7.0).collect();
-            let k: Vec<f64> = (0..6 * dim)
-                .map(|i| ((i * 37 % 11) as f64 - 5.0) / 3.0)
-                .collect();
-            let (mut fixed, mut general) = (vec![f64::NAN; dim], vec![f64::NAN; dim]);
-            weighted_sum(&mut fixed, &weights, &first, &k, dim);
-            weighted_sum_any(&mut general, &weights, &first, &k, dim);
-            let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
-            assert_eq!(bits(&fixed), bits(&general), "dim {dim}");
-        }
-    }
-
-    /// `combine`'s copies for 2, 4, 6 and 8 components equal `y + h Σ wⱼ kⱼ` formed by the
-    /// general sum, to the bit; `write_update` also covers odd dimensions (its last component
-    /// alone), which no stage uses today.
-    #[test]
-    fn the_fixed_dimension_updates_equal_the_general_one_to_the_bit() {
-        let weights = [0.1, 0.0, -2.5, 1.0 / 3.0, 0.0, 7.25, 1e-3];
-        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
-        for dim in [2, 4, 6, 8] {
-            let y: Vec<f64> = (0..dim).map(|i| 1.0 - i as f64 / 9.0).collect();
-            let first: Vec<f64> = (0..dim).map(|i| 0.3 + i as f64 / 7.0).collect();
-            let k: Vec<f64> = (0..6 * dim)
-                .map(|i| ((i * 37 % 11) as f64 - 5.0) / 3.0)
-                .collect();
-            let mut fixed = vec![f64::NAN; dim];
-            combine(&mut fixed, &y, 0.125, &weights, &first, &k);
-            let mut general = vec![f64::NAN; dim];
-            weighted_sum_any(&mut general, &weights, &first, &k, dim);
-            for (o, &yi) in general.iter_mut().zip(&y) {
-                *o = yi + 0.125 * *o;
-            }
-            assert_eq!(bits(&fixed), bits(&general), "dim {dim}");
-        }
-        let (y, sum) = ([1.0, 2.0, 3.0], [0.5, -1.0, 4.0]);
-        let mut out = [f64::NAN; 3];
-        write_update::<3>(&mut out, &y, 0.25, &sum);
-        assert_eq!(out, [1.125, 1.75, 4.0]);
-        let mut one = [f64::NAN];
-        write_update::<1>(&mut one, &[2.0], 0.5, &[3.0]);
-        assert_eq!(one, [3.5]);
-    }
 
     /// The DP5(4) stages compiled for 2, 4, 6 and 8 components give the same steps as the
     /// general stages, to the bit, over several error-controlled attempts of a nonlinear
@@ -623,6 +524,9 @@ mod tests {
     #[test]
     fn a_non_finite_stage_without_weight_is_still_reported() {
         assert_eq!(unweighted_rows(&Tableau::dopri5()), vec![0]);
+        // Verner 6(5)'s stages at c = 0.06 and 0.0960…: the form with differences keeps the
+        // tableau's zero weights.
+        assert_eq!(unweighted_rows(&Tableau::vern6()), vec![0, 1]);
         for dim in [2, 3] {
             expect_nan_stage_at(dim, 0.2 * 0.1);
         }

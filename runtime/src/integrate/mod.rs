@@ -88,7 +88,6 @@ mod symplectic;
 mod tableau;
 mod taylor;
 mod verner;
-mod verner_tableaus;
 
 pub use bs32::BogackiShampine32;
 pub use controller::{
@@ -107,7 +106,6 @@ pub use solution::{Solution, Stats};
 pub use symplectic::{StormerVerlet, SymplecticEuler};
 pub use tableau::Tableau;
 pub use taylor::Taylor;
-pub(crate) use verner::verner_methods;
 pub use verner::{Verner65, Verner76, Verner87, Verner98};
 
 // The event types belong to the ODE interface (`OdeSystem::event_specs`); the root finding is

@@ -32,9 +32,10 @@ use nalgebra::Complex;
 
 use super::error::{IntegrationError, IntegrationFailure};
 use super::options::{IntegratorOptions, OutputTimes};
-use super::tableau::Tableau;
+use super::tableau::{StageSums, Tableau};
 use super::{
     BogackiShampine32, DormandPrince54, ExplicitEuler, ExplicitMidpoint, Integrator, RungeKutta4,
+    Verner65, Verner76, Verner87, Verner98,
 };
 use crate::ode::OdeFn;
 
@@ -74,15 +75,38 @@ impl StabilityPolynomial {
     /// `R(z)` of an explicit tableau: `rₖ = bᵀAᵏ⁻¹𝟙` (Hairer–Wanner II, Prop. IV.2.11,
     /// expanded as a Neumann series, which terminates because `A` is strictly lower
     /// triangular).
+    ///
+    /// For a tableau whose stepper sums with differences (Verner's pairs), the products are
+    /// taken in that form too, `(Av)ᵢ = cᵢ v₀ + Σⱼ≥₁ aᵢⱼ (vⱼ − v₀)` and
+    /// `bᵀv = v₀ + Σⱼ≥₁ bⱼ (vⱼ − v₀)`, so that `A𝟙 = c` and `bᵀ𝟙 = 1` hold exactly (with the
+    /// rounded coefficients summed plainly, `bᵀA𝟙` of Verner 6(5) is off by 6.5e-12).
     pub fn of_tableau(tableau: &Tableau) -> Self {
         let s = tableau.num_stages();
         let b = tableau.b();
+        let c = tableau.c();
+        let differences = tableau.sums() == StageSums::Differences;
+        // `w · v` in the stepper's form; `total` is `Σ wⱼ` (`cᵢ` for a row of `A`).
+        let product = |w: &[f64], total: f64, v: &[f64]| -> f64 {
+            if differences {
+                if w.is_empty() {
+                    return 0.0;
+                }
+                total * v[0]
+                    + w.iter()
+                        .zip(v)
+                        .skip(1)
+                        .map(|(w, vj)| w * (vj - v[0]))
+                        .sum::<f64>()
+            } else {
+                w.iter().zip(v).map(|(w, vj)| w * vj).sum()
+            }
+        };
         let mut power = vec![1.0; s]; // Aᵏ⁻¹𝟙
         let mut coefficients = vec![1.0];
         for _ in 0..s {
-            coefficients.push(b.iter().zip(&power).map(|(b, p)| b * p).sum());
+            coefficients.push(product(b, 1.0, &power));
             power = (0..s)
-                .map(|i| tableau.a(i).iter().zip(&power).map(|(a, p)| a * p).sum())
+                .map(|i| product(tableau.a(i), c[i], &power))
                 .collect();
         }
         Self { coefficients }
@@ -258,14 +282,19 @@ impl StabilityPolynomial {
 }
 
 /// The explicit Runge–Kutta methods whose tableau is public, each with its integrator:
-/// explicit Euler, explicit midpoint, RK4, Bogacki–Shampine 3(2), Dormand–Prince 5(4).
-pub fn explicit_tableau_methods() -> [(Tableau, Box<dyn Integrator>); 5] {
+/// explicit Euler, explicit midpoint, RK4, Bogacki–Shampine 3(2), Dormand–Prince 5(4), and
+/// Verner's 6(5), 7(6), 8(7) and 9(8), in that order.
+pub fn explicit_tableau_methods() -> [(Tableau, Box<dyn Integrator>); 9] {
     [
         (Tableau::euler(), Box::new(ExplicitEuler::new())),
         (Tableau::midpoint(), Box::new(ExplicitMidpoint::new())),
         (Tableau::rk4(), Box::new(RungeKutta4::new())),
         (Tableau::bs32(), Box::new(BogackiShampine32::new())),
         (Tableau::dopri5(), Box::new(DormandPrince54::new())),
+        (Tableau::vern6(), Box::new(Verner65::new())),
+        (Tableau::vern7(), Box::new(Verner76::new())),
+        (Tableau::vern8(), Box::new(Verner87::new())),
+        (Tableau::vern9(), Box::new(Verner98::new())),
     ]
 }
 

@@ -26,7 +26,12 @@
 /// Dense output over a step is the cubic Hermite interpolant of `(y, F(t, y))` and
 /// `(y₁, F(t + h, y₁))`, plus, when the tableau has one, a quartic correction
 /// `θ²(1 − θ)² h Σᵢ dᵢ kᵢ` at `t + θh` (this is how Hairer writes Shampine's continuous
-/// extension of the Dormand–Prince pair).
+/// extension of the Dormand–Prince pair); or, for Verner's pairs, an interpolant of the
+/// pair's order with extra stages of its own (see [`Tableau::vern6`]).
+///
+/// Every explicit Runge–Kutta method of the crate but DOP853 is one of these rows, stepped by
+/// one stepper. DOP853 keeps its own: its error estimate combines two embedded solutions
+/// nonlinearly, and its steps are pinned bit for bit against Hairer's code.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Tableau {
     name: &'static str,
@@ -41,6 +46,67 @@ pub struct Tableau {
     error_weights: Option<&'static [f64]>,
     dense_correction: Option<&'static [f64]>,
     fsal: bool,
+    /// How the stage sums are formed.
+    sums: StageSums,
+    /// The interpolant with extra stages, for a pair that has one (Verner's).
+    interpolant: Option<&'static Interpolant>,
+}
+
+/// How a stepper forms the stage sums `Σⱼ wⱼ kⱼ` of a tableau.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum StageSums {
+    /// As written.
+    Plain,
+    /// With differences, `Σⱼ wⱼ kⱼ = (Σⱼ wⱼ) k₀ + Σⱼ≥₁ wⱼ (kⱼ − k₀)`, where `Σⱼ aᵢⱼ = cᵢ`,
+    /// `Σ bⱼ = 1` and `Σ (bⱼ − b̂ⱼ) = 0` are exact: the coefficients' rounding then multiplies
+    /// differences of size `O(h)` rather than the stages. For pairs whose coefficients are
+    /// large (Verner 6(5): `aᵢⱼ` up to 207 and `b` of ±73 on two stages at `c = 0.9995` and
+    /// 1), where in the plain form the rounding of the row sums alone (the stages' times off
+    /// by ~1e-14 h) left a floor of 1.2e-12 on the global error of 6(5) with constant steps
+    /// over `[0, 8]` (the test system of `tests/verner.rs`, whatever the step count), and
+    /// 5e-14 for 8(7).
+    Differences,
+}
+
+/// An interpolant of a pair's order over its step, with stages of its own (Verner's): its
+/// weights `bᵢ(θ)` at `t + θh` over all the stages, those of the step and the extra ones.
+///
+/// Stages `0 … s − 1` make a step; `F` at the step's end is stage `s − 1` for an FSAL pair,
+/// else stage `s` (the first extra stage, whose row of `a` is `b`, and the next step's first
+/// stage). The remaining rows of `a` are the extra stages, evaluated from the step's start.
+#[derive(Debug, PartialEq)]
+pub(crate) struct Interpolant {
+    /// Nodes of all stages, the extra ones included.
+    pub(crate) c: &'static [f64],
+    /// Row `i`: `aᵢ₀ … aᵢ,ᵢ₋₁`, for all stages.
+    pub(crate) a: &'static [&'static [f64]],
+    /// Degree of the weights `bᵢ(θ)` in θ.
+    pub(crate) degree: usize,
+    /// `rᵢₘ` of `bᵢ(θ) = Σₘ rᵢₘ θᵐ` (`m = 1 … degree`), stage-major: `all stages × degree`,
+    /// as the source publishes them. The stepper uses `node_weights`, computed from these;
+    /// the tests check the order conditions on these and the one against the other.
+    #[cfg_attr(not(test), allow(dead_code))]
+    pub(crate) r: &'static [f64],
+    /// Nodes `θ₁ < … < θ_degree = 1` at which the interpolant is represented.
+    pub(crate) nodes: &'static [f64],
+    /// `bᵢ(θⱼ)`, node-major: `degree × all stages`.
+    pub(crate) node_weights: &'static [f64],
+}
+
+impl Interpolant {
+    /// Number of stages, the extra ones included.
+    pub(crate) fn num_all_stages(&self) -> usize {
+        self.c.len()
+    }
+
+    /// The weights `bᵢ(θ)` at `θ`, one per stage.
+    #[cfg(test)]
+    pub(crate) fn weights(&self, theta: f64) -> Vec<f64> {
+        self.r
+            .chunks_exact(self.degree)
+            .map(|r| r.iter().rev().fold(0.0, |acc, &x| acc * theta + x) * theta)
+            .collect()
+    }
 }
 
 /// Explicit Euler, `c`.
@@ -176,6 +242,8 @@ impl Tableau {
             error_weights: None,
             dense_correction: None,
             fsal: false,
+            sums: StageSums::Plain,
+            interpolant: None,
         }
     }
 
@@ -203,6 +271,8 @@ impl Tableau {
             error_weights: None,
             dense_correction: None,
             fsal: false,
+            sums: StageSums::Plain,
+            interpolant: None,
         }
     }
 
@@ -238,6 +308,8 @@ impl Tableau {
             error_weights: Some(&BS32_ERROR),
             dense_correction: None,
             fsal: true,
+            sums: StageSums::Plain,
+            interpolant: None,
         }
     }
 
@@ -269,6 +341,8 @@ impl Tableau {
             error_weights: None,
             dense_correction: None,
             fsal: false,
+            sums: StageSums::Plain,
+            interpolant: None,
         }
     }
 
@@ -312,10 +386,13 @@ impl Tableau {
             error_weights: Some(&DOPRI5_ERROR),
             dense_correction: Some(&DOPRI5_DENSE),
             fsal: true,
+            sums: StageSums::Plain,
+            interpolant: None,
         }
     }
 
-    /// Short name of the method (`"euler"`, `"midpoint"`, `"rk4"`, `"bs32"`, `"dp54"`), as a front end selects it.
+    /// Short name of the method (`"euler"`, `"midpoint"`, `"rk4"`, `"bs32"`, `"dp54"`,
+    /// `"vern6"` … `"vern9"`), as a front end selects it.
     pub fn name(&self) -> &'static str {
         self.name
     }
@@ -372,7 +449,29 @@ impl Tableau {
     pub(crate) fn dense_correction(&self) -> Option<&'static [f64]> {
         self.dense_correction
     }
+
+    /// How the stage sums are formed.
+    pub(crate) fn sums(&self) -> StageSums {
+        self.sums
+    }
+
+    /// The interpolant with extra stages, if the pair has one.
+    pub(crate) fn interpolant(&self) -> Option<&'static Interpolant> {
+        self.interpolant
+    }
+
+    /// The stage that is `F` at the step's end, for a pair with an interpolant: `s − 1` for
+    /// an FSAL pair, else `s` (the interpolant's first extra stage).
+    pub(crate) fn end_stage(&self) -> usize {
+        if self.fsal {
+            self.num_stages() - 1
+        } else {
+            self.num_stages()
+        }
+    }
 }
+
+mod verner;
 
 #[cfg(test)]
 pub(crate) mod tests {

@@ -1,5 +1,5 @@
 //! The coefficients of Verner's "most efficient" Runge–Kutta pairs 6(5), 7(6), 8(7) and 9(8)
-//! with their interpolants, as [`VernerTableau`]s.
+//! with their interpolants, as [`Tableau`]s.
 //!
 //! Source: J. H. Verner's "Refuge for Runge–Kutta pairs", <https://www.sfu.ca/~jverner/>
 //! (the coefficient sets are the author's copyright; they may be used in software that
@@ -28,103 +28,107 @@
 // checked against it.
 #![allow(clippy::excessive_precision)]
 
-use crate::integrate::stability_function::StabilityPolynomial;
+use super::{Interpolant, StageSums, Tableau};
 
-/// The coefficients of one of Verner's pairs with its interpolant (the numbers below).
-///
-/// Stages `0 … stages − 1` make a step; `F` at the step's end is stage `stages − 1` for an
-/// FSAL pair (the 6(5)), else stage `stages` (the first of the interpolant's extra stages,
-/// whose row of `a` is `b`, and the next step's first stage). The remaining rows of `a` are the
-/// interpolant's extra stages, evaluated from the step's start.
-#[derive(Debug)]
-pub(crate) struct VernerTableau {
-    /// Order `p` of the propagated solution (the embedded one has order `p − 1`).
-    pub(crate) order: u32,
-    /// Number `s` of stages of a step.
-    pub(crate) stages: usize,
-    /// Whether the last stage of a step is `F` at its end (first same as last).
-    pub(crate) fsal: bool,
-    /// Nodes of all stages, the interpolant's included.
-    pub(crate) c: &'static [f64],
-    /// Row `i`: `aᵢ₀ … aᵢ,ᵢ₋₁`, for all stages.
-    pub(crate) a: &'static [&'static [f64]],
-    /// Weights `b` of the propagated solution, `s` entries.
-    pub(crate) b: &'static [f64],
-    /// `b − b̂`, `s` entries.
-    pub(crate) error: &'static [f64],
-    /// Degree of the interpolant's weights `bᵢ(θ)` in θ.
-    pub(crate) degree: usize,
-    /// `rᵢₘ` of `bᵢ(θ) = Σₘ rᵢₘ θᵐ` (`m = 1 … degree`), stage-major: `num_all_stages × degree`,
-    /// as Verner publishes them. The stepper uses `node_weights`, computed from these; the
-    /// tests check the order conditions on these and the one against the other.
-    #[cfg_attr(not(test), allow(dead_code))]
-    pub(crate) interpolant: &'static [f64],
-    /// Nodes `θ₁ < … < θ_degree = 1` at which the interpolant is represented.
-    pub(crate) nodes: &'static [f64],
-    /// `bᵢ(θⱼ)`, node-major: `degree × num_all_stages`.
-    pub(crate) node_weights: &'static [f64],
+impl Tableau {
+    /// Verner's "most efficient" 6(5) pair: nine stages, FSAL (eight evaluations per
+    /// step); three extra stages for the interpolant of order 6.
+    ///
+    /// See [`Tableau::vern9`] on the form of its sums, on `b̂`, and for the source.
+    pub fn vern6() -> Self {
+        verner_pair(
+            "vern6",
+            6,
+            9,
+            true,
+            &VERN6_B,
+            &VERN6_ERROR,
+            &VERN6_INTERPOLANT,
+        )
+    }
+
+    /// Verner's "most efficient" 7(6) pair: ten stages (the tenth only in the error
+    /// estimate); six extra stages for the interpolant of order 7, the first of them F at
+    /// the step's end.
+    ///
+    /// See [`Tableau::vern9`] on the form of its sums, on `b̂`, and for the source.
+    pub fn vern7() -> Self {
+        verner_pair(
+            "vern7",
+            7,
+            10,
+            false,
+            &VERN7_B,
+            &VERN7_ERROR,
+            &VERN7_INTERPOLANT,
+        )
+    }
+
+    /// Verner's "most efficient" 8(7) pair: thirteen stages; eight extra stages for the
+    /// interpolant of order 8, the first of them F at the step's end.
+    ///
+    /// See [`Tableau::vern9`] on the form of its sums, on `b̂`, and for the source.
+    pub fn vern8() -> Self {
+        verner_pair(
+            "vern8",
+            8,
+            13,
+            false,
+            &VERN8_B,
+            &VERN8_ERROR,
+            &VERN8_INTERPOLANT,
+        )
+    }
+
+    /// Verner's "most efficient" 9(8) pair: sixteen stages; ten extra stages for the
+    /// interpolant of order 9, the first of them F at the step's end.
+    ///
+    /// The stepper takes the sums of Verner's pairs with differences, `Σⱼ wⱼ kⱼ = (Σⱼ wⱼ) k₀ +
+    /// Σⱼ≥₁ wⱼ (kⱼ − k₀)`, so that the rounding of their large coefficients multiplies
+    /// differences of size `O(h)` rather than the stages. Their embedded weights `b̂` are given
+    /// through `b − b̂` alone ([`Tableau::b_embedded`] is `None`).
+    ///
+    /// # References
+    /// J. H. Verner, "Numerically optimal Runge–Kutta pairs with interpolants", Numer.
+    /// Algorithms 53(2–3), 383–396, 2010, doi:10.1007/s11075-009-9290-3; the coefficients
+    /// from <https://www.sfu.ca/~jverner/> (see this module).
+    pub fn vern9() -> Self {
+        verner_pair(
+            "vern9",
+            9,
+            16,
+            false,
+            &VERN9_B,
+            &VERN9_ERROR,
+            &VERN9_INTERPOLANT,
+        )
+    }
 }
 
-impl VernerTableau {
-    /// Number of stages, the interpolant's included.
-    pub(crate) fn num_all_stages(&self) -> usize {
-        self.c.len()
-    }
-
-    /// The stage that is `F` at the step's end.
-    pub(crate) fn end_stage(&self) -> usize {
-        if self.fsal {
-            self.stages - 1
-        } else {
-            self.stages
-        }
-    }
-
-    /// The interpolant's weights `bᵢ(θ)` at `θ`, one per stage.
-    #[cfg(test)]
-    pub(crate) fn interpolant_weights(&self, theta: f64) -> Vec<f64> {
-        self.interpolant
-            .chunks_exact(self.degree)
-            .map(|r| r.iter().rev().fold(0.0, |acc, &x| acc * theta + x) * theta)
-            .collect()
-    }
-
-    /// The stability polynomial `R(z) = 1 + Σₖ (bᵀAᵏ⁻¹𝟙) zᵏ` of the step's tableau (Hairer–Wanner
-    /// II, Prop. IV.2.11), of degree `s`, in the form with differences the stepper uses
-    /// ([`VernerStepper`]): `(Av)ᵢ = cᵢ v₀ + Σⱼ≥₁ aᵢⱼ (vⱼ − v₀)` and
-    /// `bᵀv = v₀ + Σⱼ≥₁ bⱼ (vⱼ − v₀)`, so that `A𝟙 = c` and `bᵀ𝟙 = 1` hold exactly (with the
-    /// rounded coefficients summed plainly, `bᵀA𝟙` of 6(5) is off by 6.5e-12).
-    pub(crate) fn stability_polynomial(&self) -> StabilityPolynomial {
-        let s = self.stages;
-        let weighted = |w: &[f64], v: &[f64]| -> f64 {
-            v[0] + w
-                .iter()
-                .zip(v)
-                .skip(1)
-                .map(|(w, vj)| w * (vj - v[0]))
-                .sum::<f64>()
-        };
-        let mut power = vec![1.0; s];
-        let mut coefficients = vec![1.0];
-        for _ in 0..s {
-            coefficients.push(weighted(self.b, &power));
-            power = (0..s)
-                .map(|i| {
-                    let row = self.a[i];
-                    if row.is_empty() {
-                        return 0.0;
-                    }
-                    self.c[i] * power[0]
-                        + row
-                            .iter()
-                            .zip(&power)
-                            .skip(1)
-                            .map(|(a, vj)| a * (vj - power[0]))
-                            .sum::<f64>()
-                })
-                .collect();
-        }
-        StabilityPolynomial::from_coefficients(coefficients)
+/// One of Verner's pairs, order `order`(`order − 1`), whose step takes the first `stages` of
+/// its interpolant's stages, with the weights `b` and `b − b̂` (`error`).
+fn verner_pair(
+    name: &'static str,
+    order: u32,
+    stages: usize,
+    fsal: bool,
+    b: &'static [f64],
+    error: &'static [f64],
+    interpolant: &'static Interpolant,
+) -> Tableau {
+    Tableau {
+        name,
+        order,
+        embedded_order: Some(order - 1),
+        c: &interpolant.c[..stages],
+        a: &interpolant.a[..stages],
+        b,
+        b_embedded: None,
+        error_weights: Some(error),
+        dense_correction: None,
+        fsal,
+        sums: StageSums::Differences,
+        interpolant: Some(interpolant),
     }
 }
 
@@ -436,17 +440,12 @@ static VERN6_NODE_WEIGHTS: [f64; 72] = [
     -4.346725957836821936404377e-70,
 ];
 
-/// Verner's "most efficient" 6(5) pair: nine stages, FSAL (eight evaluations per step); three extra stages for the interpolant of order 6.
-pub(super) static VERN6: VernerTableau = VernerTableau {
-    order: 6,
-    stages: 9,
-    fsal: true,
+/// Verner 6(5): the interpolant of order 6 over all 12 stages.
+static VERN6_INTERPOLANT: Interpolant = Interpolant {
     c: &VERN6_C,
     a: &VERN6_A,
-    b: &VERN6_B,
-    error: &VERN6_ERROR,
     degree: 6,
-    interpolant: &VERN6_R,
+    r: &VERN6_R,
     nodes: &VERN6_NODES,
     node_weights: &VERN6_NODE_WEIGHTS,
 };
@@ -913,17 +912,12 @@ static VERN7_NODE_WEIGHTS: [f64; 112] = [
     4.0e-38,
 ];
 
-/// Verner's "most efficient" 7(6) pair: ten stages (the tenth only in the error estimate); six extra stages for the interpolant of order 7, the first of them F at the step's end.
-pub(super) static VERN7: VernerTableau = VernerTableau {
-    order: 7,
-    stages: 10,
-    fsal: false,
+/// Verner 7(6): the interpolant of order 7 over all 16 stages.
+static VERN7_INTERPOLANT: Interpolant = Interpolant {
     c: &VERN7_C,
     a: &VERN7_A,
-    b: &VERN7_B,
-    error: &VERN7_ERROR,
     degree: 7,
-    interpolant: &VERN7_R,
+    r: &VERN7_R,
     nodes: &VERN7_NODES,
     node_weights: &VERN7_NODE_WEIGHTS,
 };
@@ -1620,17 +1614,12 @@ static VERN8_NODE_WEIGHTS: [f64; 168] = [
     2.5e-37,
 ];
 
-/// Verner's "most efficient" 8(7) pair: thirteen stages; eight extra stages for the interpolant of order 8, the first of them F at the step's end.
-pub(super) static VERN8: VernerTableau = VernerTableau {
-    order: 8,
-    stages: 13,
-    fsal: false,
+/// Verner 8(7): the interpolant of order 8 over all 21 stages.
+static VERN8_INTERPOLANT: Interpolant = Interpolant {
     c: &VERN8_C,
     a: &VERN8_A,
-    b: &VERN8_B,
-    error: &VERN8_ERROR,
     degree: 8,
-    interpolant: &VERN8_R,
+    r: &VERN8_R,
     nodes: &VERN8_NODES,
     node_weights: &VERN8_NODE_WEIGHTS,
 };
@@ -2606,17 +2595,12 @@ static VERN9_NODE_WEIGHTS: [f64; 234] = [
     -1.124e-36,
 ];
 
-/// Verner's "most efficient" 9(8) pair: sixteen stages; ten extra stages for the interpolant of order 9, the first of them F at the step's end.
-pub(super) static VERN9: VernerTableau = VernerTableau {
-    order: 9,
-    stages: 16,
-    fsal: false,
+/// Verner 9(8): the interpolant of order 9 over all 26 stages.
+static VERN9_INTERPOLANT: Interpolant = Interpolant {
     c: &VERN9_C,
     a: &VERN9_A,
-    b: &VERN9_B,
-    error: &VERN9_ERROR,
     degree: 9,
-    interpolant: &VERN9_R,
+    r: &VERN9_R,
     nodes: &VERN9_NODES,
     node_weights: &VERN9_NODE_WEIGHTS,
 };
