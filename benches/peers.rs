@@ -614,20 +614,16 @@ fn anchor_runs(y0: &[f64; 4], reference: &[f64; 4]) -> Vec<Outcome> {
     chosen
 }
 
-fn main() {
-    let mut criterion = Criterion::default()
-        .sample_size(20)
-        .warm_up_time(Duration::from_millis(500))
-        .measurement_time(Duration::from_secs(1))
-        .configure_from_args();
-    let started = SystemTime::now();
+/// A comparison of one eomgen method with its peer: the title, our runs and the peer's, one
+/// per tolerance of [`TOLERANCES`].
+type Pair = (&'static str, Vec<Outcome>, Vec<Outcome>);
 
-    let model = CountedRhs::new();
-    let initial = ModelInfo::initial_state(&*model.system.borrow());
-    let y0: [f64; 4] = [initial[0], initial[1], initial[2], initial[3]];
-    let reference = Run::EomgenDop853(REFERENCE_TOLERANCE).final_state(&model, &y0);
-    let peer_reference = Run::PeerDop853(REFERENCE_TOLERANCE).final_state(&model, &y0);
-    let dp54_reference = Run::EomgenDp54(REFERENCE_TOLERANCE).final_state(&model, &y0);
+/// The reference `y(10)` (our DOP853 at [`REFERENCE_TOLERANCE`]) and the report's line about
+/// it: its differences from ode_solvers' Dop853 and our DP5(4) at the same tolerance.
+fn reference_solution(model: &CountedRhs, y0: &[f64; 4]) -> ([f64; 4], String) {
+    let reference = Run::EomgenDop853(REFERENCE_TOLERANCE).final_state(model, y0);
+    let peer_reference = Run::PeerDop853(REFERENCE_TOLERANCE).final_state(model, y0);
+    let dp54_reference = Run::EomgenDp54(REFERENCE_TOLERANCE).final_state(model, y0);
     let reference_note = format!(
         "reference: eomgen DOP853 at {REFERENCE_TOLERANCE:e} = {reference:?}; differs from \
          ode_solvers Dop853 at {REFERENCE_TOLERANCE:e} by {:.1e}, from eomgen DP5(4) at \
@@ -635,14 +631,18 @@ fn main() {
         max_difference(&reference, &peer_reference),
         max_difference(&reference, &dp54_reference),
     );
+    (reference, reference_note)
+}
 
+/// Both pairs' tolerance sweeps: Dormand–Prince 5(4) against Dopri5, DOP853 against Dop853.
+fn sweep_pairs(y0: &[f64; 4], reference: &[f64; 4]) -> Vec<Pair> {
     let sweep = |method: fn(f64) -> Run| -> Vec<Outcome> {
         TOLERANCES
             .iter()
-            .map(|&tol| outcome(method(tol), &y0, &reference))
+            .map(|&tol| outcome(method(tol), y0, reference))
             .collect()
     };
-    let mut pairs = vec![
+    vec![
         (
             "Dormand–Prince 5(4): eomgen dp54 vs ode_solvers Dopri5",
             sweep(Run::EomgenDp54),
@@ -653,12 +653,18 @@ fn main() {
             sweep(Run::EomgenDop853),
             sweep(Run::PeerDop853),
         ),
-    ];
-    let mut anchor = anchor_runs(&y0, &reference);
-    anchor.push(outcome(Run::EomgenRk4(1e-3), &y0, &reference));
-    eprintln!("{}", report(&reference_note, &pairs, &anchor));
+    ]
+}
 
-    let rhs = CountedRhs::new();
+/// Times every run of `pairs` (group [`GROUP`]) and of `anchor` (group [`ANCHOR_GROUP`])
+/// with criterion.
+fn bench_runs(
+    criterion: &mut Criterion,
+    pairs: &[Pair],
+    anchor: &[Outcome],
+    rhs: &CountedRhs,
+    y0: &[f64; 4],
+) {
     let paired: Vec<Run> = pairs
         .iter()
         .flat_map(|(_, ours, theirs)| ours.iter().chain(theirs))
@@ -671,38 +677,81 @@ fn main() {
             group.bench_with_input(
                 BenchmarkId::new(run.name(), format!("{:e}", run.setting())),
                 &run,
-                |b, run| b.iter(|| black_box(run.final_state(&rhs, black_box(&y0)))),
+                |b, run| b.iter(|| black_box(run.final_state(rhs, black_box(y0)))),
             );
         }
         group.finish();
     }
+}
 
-    for (_, ours, theirs) in &mut pairs {
+/// Sets the median time of every outcome of `pairs`, then of `anchor`, to
+/// `median(group, run)`, the group being the run's criterion group ([`GROUP`],
+/// [`ANCHOR_GROUP`]).
+fn set_medians(
+    pairs: &mut [Pair],
+    anchor: &mut [Outcome],
+    median: impl Fn(&str, Run) -> Option<f64>,
+) {
+    for (_, ours, theirs) in pairs {
         for outcome in ours.iter_mut().chain(theirs.iter_mut()) {
-            outcome.median = criterion_median(GROUP, outcome.run, started);
+            outcome.median = median(GROUP, outcome.run);
         }
     }
-    for outcome in &mut anchor {
-        outcome.median = criterion_median(ANCHOR_GROUP, outcome.run, started);
+    for outcome in anchor {
+        outcome.median = median(ANCHOR_GROUP, outcome.run);
     }
-    let mut table = report(&reference_note, &pairs, &anchor);
+}
 
-    // The same comparisons timed interleaved (see `interleaved_medians`).
+/// The runs of the interleaved timing: each pair's runs, ours and the peer's alternating by
+/// tolerance, then the anchor's.
+fn interleaved_runs(pairs: &[Pair], anchor: &[Outcome]) -> Vec<Run> {
     let mut runs: Vec<Run> = pairs
         .iter()
         .flat_map(|(_, ours, theirs)| ours.iter().zip(theirs).flat_map(|(a, b)| [a.run, b.run]))
         .collect();
     runs.extend(anchor.iter().map(|o| o.run));
+    runs
+}
+
+/// Writes `table` to `<criterion dir>/peers-table.txt`, saying on stderr where (or why not).
+fn write_table(table: &str) {
+    let path = criterion_dir().join("peers-table.txt");
+    match std::fs::create_dir_all(criterion_dir()).and_then(|()| std::fs::write(&path, table)) {
+        Ok(()) => eprintln!("written to {}", path.display()),
+        Err(e) => eprintln!("cannot write {}: {e}", path.display()),
+    }
+}
+
+fn main() {
+    let mut criterion = Criterion::default()
+        .sample_size(20)
+        .warm_up_time(Duration::from_millis(500))
+        .measurement_time(Duration::from_secs(1))
+        .configure_from_args();
+    let started = SystemTime::now();
+
+    let model = CountedRhs::new();
+    let initial = ModelInfo::initial_state(&*model.system.borrow());
+    let y0: [f64; 4] = [initial[0], initial[1], initial[2], initial[3]];
+    let (reference, reference_note) = reference_solution(&model, &y0);
+
+    let mut pairs = sweep_pairs(&y0, &reference);
+    let mut anchor = anchor_runs(&y0, &reference);
+    anchor.push(outcome(Run::EomgenRk4(1e-3), &y0, &reference));
+    eprintln!("{}", report(&reference_note, &pairs, &anchor));
+
+    let rhs = CountedRhs::new();
+    bench_runs(&mut criterion, &pairs, &anchor, &rhs, &y0);
+    set_medians(&mut pairs, &mut anchor, |group, run| {
+        criterion_median(group, run, started)
+    });
+    let mut table = report(&reference_note, &pairs, &anchor);
+
+    // The same comparisons timed interleaved (see `interleaved_medians`).
+    let runs = interleaved_runs(&pairs, &anchor);
     let medians = interleaved_medians(&runs, &rhs, &y0, ROUNDS);
     let median_of = |run: Run| runs.iter().position(|&r| r == run).map(|i| medians[i]);
-    for (_, ours, theirs) in &mut pairs {
-        for outcome in ours.iter_mut().chain(theirs.iter_mut()) {
-            outcome.median = median_of(outcome.run);
-        }
-    }
-    for outcome in &mut anchor {
-        outcome.median = median_of(outcome.run);
-    }
+    set_medians(&mut pairs, &mut anchor, |_, run| median_of(run));
     let _ = writeln!(
         table,
         "\nInterleaved: medians of {ROUNDS} rounds, each running every configuration once \
@@ -727,10 +776,6 @@ fn main() {
         &reference,
     ));
     eprintln!("{table}");
-    let path = criterion_dir().join("peers-table.txt");
-    match std::fs::create_dir_all(criterion_dir()).and_then(|()| std::fs::write(&path, &table)) {
-        Ok(()) => eprintln!("written to {}", path.display()),
-        Err(e) => eprintln!("cannot write {}: {e}", path.display()),
-    }
+    write_table(&table);
     criterion.final_summary();
 }

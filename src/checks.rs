@@ -863,6 +863,20 @@ fn check_start(model: &dyn ModelInfo, at: Option<&str>) -> Result<EquilibriumSta
     })
 }
 
+/// The rows and notes of the derivation cross-checks of `file` ([`derivation_checks`]), or
+/// one failed row with the diagnostics of the file at `path` (text `text`) when they fail.
+fn derivation_rows(path: &str, text: &str, file: &ModelFile) -> (Vec<CheckRow>, Vec<String>) {
+    derivation_checks(file).unwrap_or_else(|d| {
+        let row = CheckRow::compare(
+            "derivations agree",
+            Err(diagnostics_text(path, text, &d)),
+            0.0,
+            DERIVATION_TOLERANCE,
+        );
+        (vec![row], Vec::new())
+    })
+}
+
 /// Runs every check of one model (`eomgen report`'s section of it): the derivation
 /// cross-checks of the file at `path` (whose text is `text`, for the diagnostics), then, from
 /// the consistent initial state of `source`'s equations, the default run, energy and
@@ -887,25 +901,14 @@ fn check_start(model: &dyn ModelInfo, at: Option<&str>) -> Result<EquilibriumSta
 /// ```
 pub fn model_report(path: &str, text: &str, file: &ModelFile, source: &ModelSource) -> ModelChecks {
     let started = std::time::Instant::now();
+    let (rows, notes) = derivation_rows(path, text, file);
     let mut out = ModelChecks {
-        rows: Vec::new(),
-        notes: Vec::new(),
+        rows,
+        notes,
         default_run: None,
         mode_shapes: None,
         time_s: 0.0,
     };
-    match derivation_checks(file) {
-        Ok((rows, notes)) => {
-            out.rows.extend(rows);
-            out.notes.extend(notes);
-        }
-        Err(d) => out.rows.push(CheckRow::compare(
-            "derivations agree",
-            Err(diagnostics_text(path, text, &d)),
-            0.0,
-            DERIVATION_TOLERANCE,
-        )),
-    }
     let mut model = source.instantiate();
     let y0 = match model.consistent_initial_state() {
         Ok(y0) => y0,

@@ -303,19 +303,25 @@ fn failure_hint(
     cause: Option<&FailureCause>,
     args: &IntegrationArgs,
 ) -> String {
-    let method = args.method;
-    let explicit = !method.is_implicit();
-    let adaptive = method.is_adaptive();
     // Settings that make the run impossible come first: whatever the model shows where a
     // run with them stopped is their consequence (an end time of 1e300 s made a first step
     // of 3.6e285 s, and then an infinite state, read as a division by zero).
-    let coarse_end = || {
-        format!(
-            "the end time {:e} s is so large that f64 resolves t only to about {:.1e} s near it, coarser than the steps the motion needs; shorten --t-end (or rescale time in the model)",
-            args.t_end,
-            16.0 * f64::EPSILON * args.t_end
-        )
-    };
+    if let Some(hint) = settings_hint(error, args) {
+        return hint;
+    }
+    // What the model shows where the run stopped comes before any guess about the method.
+    if let Some(cause) = cause {
+        return cause_hint(cause);
+    }
+    error_hint(error, args)
+}
+
+/// The hint when the settings make the run impossible: an end time too large for `f64` to
+/// resolve the steps near it, or tolerances that a step collapsing at the start points to
+/// (`--rtol` below what `f64` delivers, `--atol 0`); `None` when the settings explain
+/// nothing.
+fn settings_hint(error: &IntegrationError, args: &IntegrationArgs) -> Option<String> {
+    let adaptive = args.method.is_adaptive();
     // Beyond 2.8e14 s, t is resolved to a second or worse near the end: a failure within the
     // first such step is the end time's (the first step is at least that long).
     let resolution = 16.0 * f64::EPSILON * args.t_end;
@@ -324,7 +330,7 @@ fn failure_hint(
             .t()
             .is_some_and(|t| t == 0.0 || t.abs() >= 1e-3 * resolution)
     {
-        return coarse_end();
+        return Some(coarse_end_hint(args.t_end));
     }
     // The tolerances explain a step that collapsed at the start, not a run that met something
     // in the model on its way (a blow-up at t = 2.38 stops the same at --rtol 1e-16 and 1e-10).
@@ -333,34 +339,55 @@ fn failure_hint(
         IntegrationError::StepSizeTooSmall { .. } | IntegrationError::TooManySteps { .. }
     ) && error.t() == Some(0.0);
     if collapsed && adaptive && args.rtol < eomgen::analysis::work_precision::SMALLEST_TOLERANCE {
-        return format!(
+        return Some(format!(
             "--rtol {:e} is below what f64 delivers (its rounding, 1.1e-16 per operation, accumulates over a step to more than that): use --rtol 1e-15 or larger",
             args.rtol
-        );
+        ));
     }
     if collapsed && adaptive && args.atol == 0.0 {
-        return format!(
+        return Some(format!(
             "--atol 0 leaves --rtol {:e} alone in control, and a component that starts at 0 (a rate at rest) then asks for its error relative to 0: give --atol above 0 (such as 1e-12)",
             args.rtol
-        );
+        ));
     }
-    // What the model shows where the run stopped comes before any guess about the method.
-    if let Some(cause) = cause {
-        let what_to_do = match cause {
-            FailureCause::MassMatrixDegenerateEverywhere { .. } => {
-                "check the parameters (--set) and that every coordinate moves some mass"
-            }
-            FailureCause::NegativeParameters { .. } => "masses and inertias must be positive",
-            FailureCause::SingularCoordinates { .. } | FailureCause::InertiaVanishes { .. } => {
-                "choose coordinates that stay regular there, or add the motion as a constraint"
-            }
-            _ => "check the model's expressions and the initial state near that t",
-        };
-        return format!("{cause}; {what_to_do}");
-    }
+    None
+}
+
+/// The hint that an end time `t_end` (s) is too large: `f64` resolves `t` near it only to
+/// `16 ε t_end`.
+fn coarse_end_hint(t_end: f64) -> String {
+    format!(
+        "the end time {:e} s is so large that f64 resolves t only to about {:.1e} s near it, coarser than the steps the motion needs; shorten --t-end (or rescale time in the model)",
+        t_end,
+        16.0 * f64::EPSILON * t_end
+    )
+}
+
+/// The hint of what the model shows where the run stopped: the cause, then what to do.
+fn cause_hint(cause: &FailureCause) -> String {
+    let what_to_do = match cause {
+        FailureCause::MassMatrixDegenerateEverywhere { .. } => {
+            "check the parameters (--set) and that every coordinate moves some mass"
+        }
+        FailureCause::NegativeParameters { .. } => "masses and inertias must be positive",
+        FailureCause::SingularCoordinates { .. } | FailureCause::InertiaVanishes { .. } => {
+            "choose coordinates that stay regular there, or add the motion as a constraint"
+        }
+        _ => "check the model's expressions and the initial state near that t",
+    };
+    format!("{cause}; {what_to_do}")
+}
+
+/// The hint by the integration error alone, with the method (explicit or implicit, adaptive
+/// or fixed-step) and the settings, when neither the settings ([`settings_hint`]) nor the
+/// model ([`cause_hint`]) explain the failure.
+fn error_hint(error: &IntegrationError, args: &IntegrationArgs) -> String {
+    let method = args.method;
+    let explicit = !method.is_implicit();
+    let adaptive = method.is_adaptive();
     let hint = match error {
         IntegrationError::StepSizeTooSmall { .. } if args.t_end >= COARSE_TIME_END => {
-            return coarse_end();
+            return coarse_end_hint(args.t_end);
         }
         IntegrationError::StepSizeTooSmall { .. } if adaptive && args.rtol >= LOOSE_RTOL => {
             return format!(

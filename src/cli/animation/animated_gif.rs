@@ -2,8 +2,9 @@
 //! ([`eomgen::animation`]) drawn frame by frame with plotters, a fixed palette, and each
 //! frame only the rectangle that changed.
 
-use eomgen::animation::{Animation, grid_step};
+use eomgen::animation::{Animation, Clip, Scene, grid_step};
 use eomgen::text::significant;
+use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use crate::cli::error::CliError;
@@ -35,12 +36,41 @@ pub(crate) fn write_gif(animation: &Animation, path: &str, clip: usize) -> Resul
     plot::register_font().map_err(fail)?;
     let scene = animation.scene();
     let clip = &animation.clips()[clip];
-    let (x0, x1, y0, y1) = animation.bounding_box();
-    let per_pixel = (x1 - x0).max(y1 - y0) / f64::from(GIF_SIDE);
-    let width = ((x1 - x0) / per_pixel).round().max(240.0) as u32;
-    let height = ((y1 - y0) / per_pixel).round().max(80.0) as u32 + GIF_CAPTION;
-    // The frame step: a frame interval of at least 1/GIF_MAX_FPS s and at most
-    // GIF_MAX_FRAMES frames.
+    let view = Viewport::new(animation.bounding_box());
+    let (width, height) = (view.width, view.height);
+    let n = clip.times().len();
+    let (step, delay) = frame_step_and_delay(clip);
+    let palette = Palette::new();
+    // Encoded in memory (at most GIF_MAX_FRAMES frames of a small picture) and written
+    // atomically.
+    let mut encoder = gif::Encoder::new(Vec::new(), width as u16, height as u16, &palette.rgb)
+        .map_err(|e| fail(e.to_string()))?;
+    encoder
+        .set_repeat(gif::Repeat::Infinite)
+        .map_err(|e| fail(e.to_string()))?;
+    let mut buffer = vec![0u8; (width * height * 3) as usize];
+    let mut previous: Vec<u8> = Vec::new();
+    let mut k = 0;
+    while k < n {
+        draw_frame(&mut buffer, &view, scene, clip, k).map_err(fail)?;
+        let indices = palette.map(&buffer);
+        let mut frame = changed_rectangle(&previous, &indices, width as usize);
+        frame.delay = delay;
+        frame.dispose = gif::DisposalMethod::Keep;
+        encoder
+            .write_frame(&frame)
+            .map_err(|e| fail(e.to_string()))?;
+        previous = indices;
+        k += step;
+    }
+    let bytes = encoder.into_inner().map_err(|e| fail(e.to_string()))?;
+    Ok(crate::cli::files::write(path, &bytes)?)
+}
+
+/// The GIF's frame step (every `step`-th frame of `clip` is drawn) and the delay between
+/// drawn frames (hundredths of a second, in [2, 6000]): a frame interval of at least
+/// 1/[`GIF_MAX_FPS`] s of `t` and at most [`GIF_MAX_FRAMES`] frames, played in real time.
+fn frame_step_and_delay(clip: &Clip) -> (usize, u16) {
     let t = clip.times();
     let n = t.len();
     let dt = if n > 1 {
@@ -54,99 +84,143 @@ pub(crate) fn write_gif(animation: &Animation, path: &str, clip: usize) -> Resul
     let delay = (100.0 * dt * step as f64 / clip.rate())
         .round()
         .clamp(2.0, 6000.0) as u16;
-    let palette = Palette::new();
-    // Encoded in memory (at most GIF_MAX_FRAMES frames of a small picture) and written
-    // atomically.
-    let mut encoder = gif::Encoder::new(Vec::new(), width as u16, height as u16, &palette.rgb)
-        .map_err(|e| fail(e.to_string()))?;
-    encoder
-        .set_repeat(gif::Repeat::Infinite)
-        .map_err(|e| fail(e.to_string()))?;
-    let to_pixel = |(x, y): (f64, f64)| -> (i32, i32) {
-        (
-            ((x - x0) / per_pixel).round() as i32,
-            (GIF_CAPTION as f64 + (y1 - y) / per_pixel).round() as i32,
-        )
-    };
-    let mut buffer = vec![0u8; (width * height * 3) as usize];
-    let rgb = |(r, g, b): (u8, u8, u8)| RGBColor(r, g, b);
-    let mut previous: Vec<u8> = Vec::new();
-    let mut k = 0;
-    while k < n {
-        {
-            let root = BitMapBackend::with_buffer(&mut buffer, (width, height)).into_drawing_area();
-            let err = |e: DrawingAreaErrorKind<_>| fail(format!("drawing failed: {e}"));
-            root.fill(&WHITE).map_err(err)?;
-            let step_m = grid_step((x1 - x0).max(y1 - y0));
-            for i in (x0 / step_m).ceil() as i64..=(x1 / step_m).floor() as i64 {
-                let x = i as f64 * step_m;
-                root.draw(&PathElement::new(
-                    vec![to_pixel((x, y0)), to_pixel((x, y1))],
-                    rgb(GRID),
-                ))
-                .map_err(err)?;
-            }
-            for i in (y0 / step_m).ceil() as i64..=(y1 / step_m).floor() as i64 {
-                let y = i as f64 * step_m;
-                root.draw(&PathElement::new(
-                    vec![to_pixel((x0, y)), to_pixel((x1, y))],
-                    rgb(GRID),
-                ))
-                .map_err(err)?;
-            }
-            let frame = &clip.frames()[k];
-            for trail in clip.trails() {
-                let path: Vec<(i32, i32)> = trail[..=k * clip.trail_substeps()]
-                    .iter()
-                    .map(|p| to_pixel(*p))
-                    .collect();
-                root.draw(&PathElement::new(path, rgb(TRACE).stroke_width(2)))
-                    .map_err(err)?;
-            }
-            for [a, b] in scene.lines() {
-                root.draw(&PathElement::new(
-                    vec![to_pixel(frame[*a]), to_pixel(frame[*b])],
-                    rgb(LINK).stroke_width(5),
-                ))
-                .map_err(err)?;
-            }
-            for &d in scene.dots() {
-                root.draw(&Circle::new(to_pixel(frame[d]), 5, rgb(JOINT).filled()))
-                    .map_err(err)?;
-            }
-            for c in scene.centre_points() {
-                root.draw(&Circle::new(
-                    to_pixel(frame[c]),
-                    8,
-                    rgb(JOINT).stroke_width(2),
-                ))
-                .map_err(err)?;
-            }
-            let caption = match clip.energy() {
-                Some(energy) => format!(
-                    "{}   t = {:.2} s   E = {} J",
-                    scene.model(),
-                    t[k],
-                    significant(energy[k])
-                ),
-                None => format!("{}, {}   t = {:.3} s", scene.model(), clip.label(), t[k]),
-            };
-            root.draw(&Text::new(caption, (10, 7), ("sans-serif", 16).into_font()))
-                .map_err(err)?;
-            root.present().map_err(err)?;
+    (step, delay)
+}
+
+/// The GIF's picture of the run's box: equal scales, its larger side [`GIF_SIDE`] px (at
+/// least 240 × 80 px), under a band of [`GIF_CAPTION`] px for the caption.
+struct Viewport {
+    /// The box `(x0, x1, y0, y1)` (m).
+    x0: f64,
+    x1: f64,
+    y0: f64,
+    y1: f64,
+    /// Metres per pixel.
+    per_pixel: f64,
+    /// Size of the image (px), the caption band included.
+    width: u32,
+    height: u32,
+}
+
+impl Viewport {
+    /// The viewport of the box `(x0, x1, y0, y1)` (m).
+    fn new((x0, x1, y0, y1): (f64, f64, f64, f64)) -> Self {
+        let per_pixel = (x1 - x0).max(y1 - y0) / f64::from(GIF_SIDE);
+        let width = ((x1 - x0) / per_pixel).round().max(240.0) as u32;
+        let height = ((y1 - y0) / per_pixel).round().max(80.0) as u32 + GIF_CAPTION;
+        Self {
+            x0,
+            x1,
+            y0,
+            y1,
+            per_pixel,
+            width,
+            height,
         }
-        let indices = palette.map(&buffer);
-        let mut frame = changed_rectangle(&previous, &indices, width as usize);
-        frame.delay = delay;
-        frame.dispose = gif::DisposalMethod::Keep;
-        encoder
-            .write_frame(&frame)
-            .map_err(|e| fail(e.to_string()))?;
-        previous = indices;
-        k += step;
     }
-    let bytes = encoder.into_inner().map_err(|e| fail(e.to_string()))?;
-    Ok(crate::cli::files::write(path, &bytes)?)
+
+    /// The pixel of the point `(x, y)` (m): x to the right from the box's left side, y down
+    /// from its top, below the caption band.
+    fn pixel(&self, (x, y): (f64, f64)) -> (i32, i32) {
+        (
+            ((x - self.x0) / self.per_pixel).round() as i32,
+            (GIF_CAPTION as f64 + (self.y1 - y) / self.per_pixel).round() as i32,
+        )
+    }
+}
+
+/// Draws frame `k` of `clip` into `buffer` (RGB, the size of `view`): the grid, the traces
+/// up to the frame, the links, joints and centres of mass, and the caption (the model and
+/// `t`, with the energy of a simulation or the clip's name).
+///
+/// # Errors
+/// A failure of plotters, as `drawing failed: …`.
+fn draw_frame(
+    buffer: &mut [u8],
+    view: &Viewport,
+    scene: &Scene,
+    clip: &Clip,
+    k: usize,
+) -> Result<(), String> {
+    let root = BitMapBackend::with_buffer(buffer, (view.width, view.height)).into_drawing_area();
+    let err = |e: DrawingAreaErrorKind<_>| format!("drawing failed: {e}");
+    root.fill(&WHITE).map_err(err)?;
+    draw_grid(&root, view)?;
+    let frame = &clip.frames()[k];
+    for trail in clip.trails() {
+        let path: Vec<(i32, i32)> = trail[..=k * clip.trail_substeps()]
+            .iter()
+            .map(|p| view.pixel(*p))
+            .collect();
+        root.draw(&PathElement::new(path, rgb(TRACE).stroke_width(2)))
+            .map_err(err)?;
+    }
+    for [a, b] in scene.lines() {
+        root.draw(&PathElement::new(
+            vec![view.pixel(frame[*a]), view.pixel(frame[*b])],
+            rgb(LINK).stroke_width(5),
+        ))
+        .map_err(err)?;
+    }
+    for &d in scene.dots() {
+        root.draw(&Circle::new(view.pixel(frame[d]), 5, rgb(JOINT).filled()))
+            .map_err(err)?;
+    }
+    for c in scene.centre_points() {
+        root.draw(&Circle::new(
+            view.pixel(frame[c]),
+            8,
+            rgb(JOINT).stroke_width(2),
+        ))
+        .map_err(err)?;
+    }
+    let t = clip.times();
+    let caption = match clip.energy() {
+        Some(energy) => format!(
+            "{}   t = {:.2} s   E = {} J",
+            scene.model(),
+            t[k],
+            significant(energy[k])
+        ),
+        None => format!("{}, {}   t = {:.3} s", scene.model(), clip.label(), t[k]),
+    };
+    root.draw(&Text::new(caption, (10, 7), ("sans-serif", 16).into_font()))
+        .map_err(err)?;
+    root.present().map_err(err)?;
+    Ok(())
+}
+
+/// The grid of the GIF's background: vertical and horizontal lines across `view`'s box at
+/// the multiples of [`grid_step`] of its larger side.
+///
+/// # Errors
+/// A failure of plotters, as `drawing failed: …`.
+fn draw_grid(root: &DrawingArea<BitMapBackend<'_>, Shift>, view: &Viewport) -> Result<(), String> {
+    let err = |e: DrawingAreaErrorKind<_>| format!("drawing failed: {e}");
+    let (x0, x1, y0, y1) = (view.x0, view.x1, view.y0, view.y1);
+    let step_m = grid_step((x1 - x0).max(y1 - y0));
+    for i in (x0 / step_m).ceil() as i64..=(x1 / step_m).floor() as i64 {
+        let x = i as f64 * step_m;
+        root.draw(&PathElement::new(
+            vec![view.pixel((x, y0)), view.pixel((x, y1))],
+            rgb(GRID),
+        ))
+        .map_err(err)?;
+    }
+    for i in (y0 / step_m).ceil() as i64..=(y1 / step_m).floor() as i64 {
+        let y = i as f64 * step_m;
+        root.draw(&PathElement::new(
+            vec![view.pixel((x0, y)), view.pixel((x1, y))],
+            rgb(GRID),
+        ))
+        .map_err(err)?;
+    }
+    Ok(())
+}
+
+/// The plotters colour of an `(r, g, b)` triple such as [`LINK`].
+fn rgb((r, g, b): (u8, u8, u8)) -> RGBColor {
+    RGBColor(r, g, b)
 }
 
 /// A GIF frame of the pixels of `current` (palette indices, rows of `width`) inside the

@@ -22,6 +22,7 @@ use eomgen::{
     ModelInfo, ThresholdPrediction,
 };
 use plotters::coord::Shift;
+use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 use rayon::prelude::*;
 
@@ -575,6 +576,9 @@ fn edges(values: &[f64]) -> Vec<f64> {
     e
 }
 
+/// The stability chart over the two axes of the sweep: each cell coloured by its stability
+/// ([`draw_cells`]), the references of the model file's `floquet:` block as curves
+/// ([`draw_reference_curves`]), and the legend.
 fn draw_stability<DB: DrawingBackend>(
     root: DrawingArea<DB, plotters::coord::Shift>,
     title: &str,
@@ -608,6 +612,48 @@ where
         .label_style(("sans-serif", 14))
         .draw()
         .map_err(err)?;
+    draw_cells(&mut chart, grid, [&xe, &ye])?;
+    if let Some((references, model)) = references {
+        let axes = [
+            ChartAxis {
+                name: &x.name,
+                lo: x0,
+                hi: x1,
+            },
+            ChartAxis {
+                name: &y.name,
+                lo: y0,
+                hi: y1,
+            },
+        ];
+        draw_reference_curves(&mut chart, references, model, axes)?;
+    }
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperMiddle)
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .label_font(("sans-serif", 14))
+        .draw()
+        .map_err(err)?;
+    root.present().map_err(err)?;
+    Ok(())
+}
+
+/// A chart with linear scales on both axes (the stability chart over the two parameters).
+type LinearChart<'a, DB> = ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
+
+/// The cells of the stability chart between `cell_edges` (x, y), one series (and legend
+/// entry) per kind: asymptotically stable, marginal, unstable (yellow to dark red by
+/// log₁₀ ρ, up to the largest on the chart) and failed.
+fn draw_cells<DB: DrawingBackend>(
+    chart: &mut LinearChart<'_, DB>,
+    grid: &[Vec<Cell>],
+    cell_edges: [&[f64]; 2],
+) -> Result<(), String>
+where
+    DB::ErrorType: 'static,
+{
     let log_max = grid
         .iter()
         .flatten()
@@ -627,32 +673,10 @@ where
             (60.0 * (1.0 - s)) as u8,
         )
     };
-    let mut cells = |pick: &dyn Fn(&Cell) -> Option<RGBColor>, label: &str, legend: RGBColor| {
-        let rects: Vec<_> = grid
-            .iter()
-            .enumerate()
-            .flat_map(|(i, col)| {
-                col.iter()
-                    .enumerate()
-                    .filter_map(move |(j, c)| pick(c).map(|color| (i, j, color)))
-            })
-            .map(|(i, j, color)| {
-                Rectangle::new([(xe[i], ye[j]), (xe[i + 1], ye[j + 1])], color.filled())
-            })
-            .collect();
-        if rects.is_empty() {
-            return Ok(());
-        }
-        chart
-            .draw_series(rects)
-            .map_err(err)?
-            .label(label)
-            .legend(move |(px, py)| {
-                Rectangle::new([(px, py - 6), (px + 16, py + 6)], legend.filled())
-            });
-        Ok::<(), String>(())
-    };
-    cells(
+    draw_cell_series(
+        chart,
+        grid,
+        cell_edges,
         &|c| {
             matches!(c, Ok(c) if c.stability == FloquetStability::AsymptoticallyStable)
                 .then_some(stable_color)
@@ -660,7 +684,10 @@ where
         "asymptotically stable (ρ < 1)",
         stable_color,
     )?;
-    cells(
+    draw_cell_series(
+        chart,
+        grid,
+        cell_edges,
         &|c| {
             matches!(c, Ok(c) if c.stability == FloquetStability::Marginal)
                 .then_some(marginal_color)
@@ -668,7 +695,10 @@ where
         "marginal (|μ| = 1 within tol): stable",
         marginal_color,
     )?;
-    cells(
+    draw_cell_series(
+        chart,
+        grid,
+        cell_edges,
         &|c| match c {
             Ok(c) if c.stability == FloquetStability::Unstable => Some(unstable(c.spectral_radius)),
             _ => None,
@@ -676,49 +706,81 @@ where
         &format!("unstable, yellow→red with log₁₀ ρ up to {log_max:.2}"),
         unstable(10f64.powf(0.5 * log_max)),
     )?;
-    cells(
+    draw_cell_series(
+        chart,
+        grid,
+        cell_edges,
         &|c| c.is_err().then_some(RGBColor(160, 160, 160)),
         "analysis failed",
         RGBColor(160, 160, 160),
-    )?;
-    if let Some((references, model)) = references {
-        let curves = references.curves(
-            model,
-            ChartAxis {
-                name: &x.name,
-                lo: x0,
-                hi: x1,
-            },
-            ChartAxis {
-                name: &y.name,
-                lo: y0,
-                hi: y1,
-            },
-        );
-        for curve in curves {
-            if curve.points.len() < 2 {
-                continue;
-            }
-            let [r, g, b] = curve.color;
-            let color = RGBColor(r, g, b);
-            chart
-                .draw_series(LineSeries::new(curve.points, color.stroke_width(3)))
-                .map_err(err)?
-                .label(curve.label)
-                .legend(move |(px, py)| {
-                    PathElement::new(vec![(px, py), (px + 16, py)], color.stroke_width(3))
-                });
-        }
+    )
+}
+
+/// One series of the stability chart: a filled rectangle between the cell edges
+/// `[xe, ye]` for each cell that `pick` gives a colour, labelled `label` in the legend with
+/// a swatch of `legend`; nothing (and no legend entry) when no cell is picked.
+fn draw_cell_series<DB: DrawingBackend>(
+    chart: &mut LinearChart<'_, DB>,
+    grid: &[Vec<Cell>],
+    [xe, ye]: [&[f64]; 2],
+    pick: &dyn Fn(&Cell) -> Option<RGBColor>,
+    label: &str,
+    legend: RGBColor,
+) -> Result<(), String>
+where
+    DB::ErrorType: 'static,
+{
+    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| format!("plotting failed: {e}");
+    let rects: Vec<_> = grid
+        .iter()
+        .enumerate()
+        .flat_map(|(i, col)| {
+            col.iter()
+                .enumerate()
+                .filter_map(move |(j, c)| pick(c).map(|color| (i, j, color)))
+        })
+        .map(|(i, j, color)| {
+            Rectangle::new([(xe[i], ye[j]), (xe[i + 1], ye[j + 1])], color.filled())
+        })
+        .collect();
+    if rects.is_empty() {
+        return Ok(());
     }
     chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperMiddle)
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .label_font(("sans-serif", 14))
-        .draw()
-        .map_err(err)?;
-    root.present().map_err(err)?;
+        .draw_series(rects)
+        .map_err(err)?
+        .label(label)
+        .legend(move |(px, py)| Rectangle::new([(px, py - 6), (px + 16, py + 6)], legend.filled()));
+    Ok(())
+}
+
+/// The curves of the model file's `floquet:` references over the chart's axes (Kapitza's
+/// boundary, the Mathieu chart's edges), each in its colour with a legend entry; curves of
+/// fewer than two points are left out.
+fn draw_reference_curves<DB: DrawingBackend>(
+    chart: &mut LinearChart<'_, DB>,
+    references: &FloquetReferences,
+    model: &dyn ModelInfo,
+    [x, y]: [ChartAxis<'_>; 2],
+) -> Result<(), String>
+where
+    DB::ErrorType: 'static,
+{
+    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| format!("plotting failed: {e}");
+    for curve in references.curves(model, x, y) {
+        if curve.points.len() < 2 {
+            continue;
+        }
+        let [r, g, b] = curve.color;
+        let color = RGBColor(r, g, b);
+        chart
+            .draw_series(LineSeries::new(curve.points, color.stroke_width(3)))
+            .map_err(err)?
+            .label(curve.label)
+            .legend(move |(px, py)| {
+                PathElement::new(vec![(px, py), (px + 16, py)], color.stroke_width(3))
+            });
+    }
     Ok(())
 }
 

@@ -691,6 +691,8 @@ fn segments(points: impl Iterator<Item = (f64, Option<f64>)>, log_y: bool) -> Ve
     out
 }
 
+/// The Bode chart under its title: |H| (log) over log ω in the upper panel
+/// ([`draw_amplitude`]), the phase in degrees in the lower one ([`draw_phase`]).
 fn draw_bode<DB: DrawingBackend>(
     root: DrawingArea<DB, plotters::coord::Shift>,
     title: &str,
@@ -721,109 +723,22 @@ where
             )
         })
         .collect();
-    let bounds = |sets: &[Vec<Vec<(f64, f64)>>], extra: &[(f64, f64)]| {
-        let mut b = (
-            f64::INFINITY,
-            f64::NEG_INFINITY,
-            f64::INFINITY,
-            f64::NEG_INFINITY,
-        );
-        for &(x, y) in sets.iter().flatten().flatten().chain(extra) {
-            b = (b.0.min(x), b.1.max(x), b.2.min(y), b.3.max(y));
-        }
-        b
-    };
-    let sim_amp: Vec<(f64, f64)> = simulated
-        .unwrap_or(&[])
-        .iter()
-        .flat_map(|p| {
-            p.values
-                .iter()
-                .map(move |v| (p.frequency, v.simulated.norm()))
-        })
-        .filter(|(_, a)| *a > 0.0)
-        .collect();
+    let sim_amp = simulated_amplitudes(simulated);
     let (x_lo, x_hi, a_lo, a_hi) = bounds(&amplitude, &sim_amp);
     if !(x_lo.is_finite() && a_lo.is_finite()) {
         return Err("nothing to plot: no finite |H|".to_string());
     }
     let (x0, x1) = plot::range(x_lo, x_hi, true);
     let (a0, a1) = plot::range(a_lo, a_hi, true);
-    let color = |i: usize| Palette99::pick(i).to_rgba();
-    {
-        let mut chart = ChartBuilder::on(&upper)
-            .margin(12)
-            .x_label_area_size(30)
-            .y_label_area_size(90)
-            .build_cartesian_2d((x0..x1).log_scale(), (a0..a1).log_scale())
-            .map_err(err)?;
-        chart
-            .configure_mesh()
-            .y_desc("|H| (output per unit input)")
-            .x_label_formatter(&|v| plot::tick(*v, true))
-            .y_label_formatter(&|v| plot::tick(*v, true))
-            .label_style(("sans-serif", 14))
-            .draw()
-            .map_err(err)?;
-        for (i, segs) in amplitude.iter().enumerate() {
-            let c = color(i);
-            for (j, seg) in segs.iter().enumerate() {
-                let series = chart
-                    .draw_series(LineSeries::new(seg.iter().copied(), c.stroke_width(2)))
-                    .map_err(err)?;
-                if j == 0 {
-                    series.label(outputs[i].name.clone()).legend(move |(x, y)| {
-                        PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(2))
-                    });
-                }
-            }
-        }
-        // Undamped resonances: |H| → ∞, marked by a thin vertical line.
-        for (i, s) in sweeps.iter().enumerate() {
-            let c = color(i).mix(0.5);
-            for p in &s.peaks {
-                if p.amplitude == PeakAmplitude::Unbounded {
-                    chart
-                        .draw_series(LineSeries::new(
-                            [(p.frequency, a0), (p.frequency, a1)],
-                            c.stroke_width(1),
-                        ))
-                        .map_err(err)?;
-                }
-            }
-        }
-        if let Some(points) = simulated {
-            let mut first = true;
-            for (i, _) in outputs.iter().enumerate() {
-                let c = color(i);
-                let dots: Vec<(f64, f64)> = points
-                    .iter()
-                    .map(|p| (p.frequency, p.values[i].simulated.norm()))
-                    .filter(|(_, a)| *a > 0.0)
-                    .collect();
-                let series = chart
-                    .draw_series(
-                        dots.into_iter()
-                            .map(|p| Circle::new(p, 5, c.stroke_width(2))),
-                    )
-                    .map_err(err)?;
-                if first {
-                    first = false;
-                    series
-                        .label("simulated steady state")
-                        .legend(move |(x, y)| Circle::new((x + 10, y), 5, BLACK.stroke_width(2)));
-                }
-            }
-        }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::LowerLeft)
-            .background_style(WHITE.mix(0.8))
-            .border_style(BLACK)
-            .label_font(("sans-serif", 14))
-            .draw()
-            .map_err(err)?;
-    }
+    draw_amplitude(
+        &upper,
+        (x0, x1),
+        (a0, a1),
+        &amplitude,
+        outputs,
+        sweeps,
+        simulated,
+    )?;
     let (_, _, p_lo, p_hi) = bounds(&phase, &[]);
     draw_phase(
         &lower,
@@ -835,6 +750,147 @@ where
         simulated,
     )?;
     root.present().map_err(err)?;
+    Ok(())
+}
+
+/// The bounding box `(x_min, x_max, y_min, y_max)` of the points of `sets` (curves in
+/// segments) and `extra`; infinite (min +∞, max −∞) when there are none.
+fn bounds(sets: &[Vec<Vec<(f64, f64)>>], extra: &[(f64, f64)]) -> (f64, f64, f64, f64) {
+    let mut b = (
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+    );
+    for &(x, y) in sets.iter().flatten().flatten().chain(extra) {
+        b = (b.0.min(x), b.1.max(x), b.2.min(y), b.3.max(y));
+    }
+    b
+}
+
+/// The simulated steady-state amplitudes `(ω, |output|)` of every output at every simulated
+/// frequency, those above 0 only (they go on a log scale).
+fn simulated_amplitudes(simulated: Option<&[SimulatedPoint]>) -> Vec<(f64, f64)> {
+    simulated
+        .unwrap_or(&[])
+        .iter()
+        .flat_map(|p| {
+            p.values
+                .iter()
+                .map(move |v| (p.frequency, v.simulated.norm()))
+        })
+        .filter(|(_, a)| *a > 0.0)
+        .collect()
+}
+
+/// A chart with log scales on both axes (the Bode chart's |H| over ω).
+type LogLogChart<'a, DB> = ChartContext<'a, DB, Cartesian2d<LogCoord<f64>, LogCoord<f64>>>;
+
+/// The Bode chart's upper panel: |H| over log ω, both on log scales (`amplitude` in segments,
+/// each undamped resonance a thin vertical line, the simulated points as circles), with the
+/// legend.
+fn draw_amplitude<DB: DrawingBackend>(
+    upper: &DrawingArea<DB, plotters::coord::Shift>,
+    (x0, x1): (f64, f64),
+    (a0, a1): (f64, f64),
+    amplitude: &[Vec<Vec<(f64, f64)>>],
+    outputs: &[FrfOutput],
+    sweeps: &[FrequencySweep],
+    simulated: Option<&[SimulatedPoint]>,
+) -> Result<(), String>
+where
+    DB::ErrorType: 'static,
+{
+    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| format!("plotting failed: {e}");
+    let color = |i: usize| Palette99::pick(i).to_rgba();
+    let mut chart = ChartBuilder::on(upper)
+        .margin(12)
+        .x_label_area_size(30)
+        .y_label_area_size(90)
+        .build_cartesian_2d((x0..x1).log_scale(), (a0..a1).log_scale())
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .y_desc("|H| (output per unit input)")
+        .x_label_formatter(&|v| plot::tick(*v, true))
+        .y_label_formatter(&|v| plot::tick(*v, true))
+        .label_style(("sans-serif", 14))
+        .draw()
+        .map_err(err)?;
+    for (i, segs) in amplitude.iter().enumerate() {
+        let c = color(i);
+        for (j, seg) in segs.iter().enumerate() {
+            let series = chart
+                .draw_series(LineSeries::new(seg.iter().copied(), c.stroke_width(2)))
+                .map_err(err)?;
+            if j == 0 {
+                series.label(outputs[i].name.clone()).legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(2))
+                });
+            }
+        }
+    }
+    // Undamped resonances: |H| → ∞, marked by a thin vertical line.
+    for (i, s) in sweeps.iter().enumerate() {
+        let c = color(i).mix(0.5);
+        for p in &s.peaks {
+            if p.amplitude == PeakAmplitude::Unbounded {
+                chart
+                    .draw_series(LineSeries::new(
+                        [(p.frequency, a0), (p.frequency, a1)],
+                        c.stroke_width(1),
+                    ))
+                    .map_err(err)?;
+            }
+        }
+    }
+    if let Some(points) = simulated {
+        draw_simulated_amplitudes(&mut chart, outputs, points)?;
+    }
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::LowerLeft)
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .label_font(("sans-serif", 14))
+        .draw()
+        .map_err(err)?;
+    Ok(())
+}
+
+/// The simulated steady-state amplitudes of the Bode chart's upper panel: a circle per
+/// output and simulated frequency (above 0), in the output's colour, with one legend entry.
+fn draw_simulated_amplitudes<DB: DrawingBackend>(
+    chart: &mut LogLogChart<'_, DB>,
+    outputs: &[FrfOutput],
+    points: &[SimulatedPoint],
+) -> Result<(), String>
+where
+    DB::ErrorType: 'static,
+{
+    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| format!("plotting failed: {e}");
+    let color = |i: usize| Palette99::pick(i).to_rgba();
+    let mut first = true;
+    for (i, _) in outputs.iter().enumerate() {
+        let c = color(i);
+        let dots: Vec<(f64, f64)> = points
+            .iter()
+            .map(|p| (p.frequency, p.values[i].simulated.norm()))
+            .filter(|(_, a)| *a > 0.0)
+            .collect();
+        let series = chart
+            .draw_series(
+                dots.into_iter()
+                    .map(|p| Circle::new(p, 5, c.stroke_width(2))),
+            )
+            .map_err(err)?;
+        if first {
+            first = false;
+            series
+                .label("simulated steady state")
+                .legend(move |(x, y)| Circle::new((x + 10, y), 5, BLACK.stroke_width(2)));
+        }
+    }
     Ok(())
 }
 
