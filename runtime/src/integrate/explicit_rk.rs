@@ -14,7 +14,7 @@ use super::options::ErrorWeights;
 use super::stepper::{AttemptTimes, CheckedRhs, StepEnds, StepFailure, Stepper, first_non_finite};
 use super::tableau::{StageSums, Tableau};
 use crate::ode::RhsError;
-use interpolant::InterpolantState;
+use interpolant::{InterpolantState, LastStep};
 
 /// An explicit Runge–Kutta method given by its tableau, with all buffers allocated once.
 ///
@@ -161,6 +161,14 @@ impl ExplicitRk {
                 let time = |r: usize| times.at(c[r + 1]);
                 Err(CheckedRhs::stage_failure(earlier, D, time, failure))
             }
+        }
+    }
+
+    /// Marks the interpolant of the last step, if there is one, as not prepared (after a new
+    /// attempt, step or start).
+    fn invalidate_dense_output(&mut self) {
+        if let Some(state) = &mut self.interpolant {
+            state.invalidate();
         }
     }
 
@@ -407,7 +415,17 @@ impl Stepper for ExplicitRk {
     /// … nine evaluations of `F` for Verner 6(5) … 9(8); `F` at the step's end is already
     /// known), then its values at its nodes. Nothing for the Hermite dense output.
     fn prepare_dense_output(&mut self, rhs: &mut CheckedRhs<'_>) -> Result<(), StepFailure> {
-        self.prepare_interpolant(rhs)
+        let Some(state) = &mut self.interpolant else {
+            return Ok(());
+        };
+        let step = LastStep {
+            tableau: &self.tableau,
+            ends: &self.ends,
+            k: &mut self.k,
+            scratch: &mut self.scratch,
+            a_rows: &self.a_rows,
+        };
+        state.prepare(step, rhs)
     }
 }
 

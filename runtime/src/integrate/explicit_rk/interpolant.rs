@@ -3,15 +3,15 @@
 //! barycentrically.
 
 use super::super::stepper::{CheckedRhs, StepEnds, StepFailure};
-use super::super::tableau::Interpolant;
-use super::{ExplicitRk, combine, weighted_sum};
+use super::super::tableau::{Interpolant, Tableau};
+use super::sums::{combine, weighted_sum};
 
 /// The interpolant of the last accepted step, once prepared.
 #[derive(Debug, Clone)]
 pub(super) struct InterpolantState {
     interpolant: &'static Interpolant,
     /// `bᵢ(θⱼ)` by node, with stage 0's weight replaced by `θⱼ` (the form with differences,
-    /// see [`ExplicitRk::prepare_interpolant`]), `degree × all stages`.
+    /// see [`InterpolantState::prepare`]), `degree × all stages`.
     node_weights: Vec<f64>,
     /// Barycentric weights of the nodes `0, θ₁, …, θ_degree`.
     barycentric: Vec<f64>,
@@ -106,73 +106,78 @@ impl InterpolantState {
     }
 }
 
-impl ExplicitRk {
-    /// Marks the interpolant of the last step as not prepared (after a new attempt, step or
-    /// start).
-    pub(super) fn invalidate_dense_output(&mut self) {
-        if let Some(state) = &mut self.interpolant {
-            state.ready = false;
-        }
+/// What [`InterpolantState::prepare`] reads of the stepper's last step, and the buffers it
+/// fills: its ends, its stages (to which the extra ones are appended), a scratch of `dim`
+/// values, and the rows of `a` of all stages as the sums take them.
+pub(super) struct LastStep<'a> {
+    pub(super) tableau: &'a Tableau,
+    pub(super) ends: &'a StepEnds,
+    pub(super) k: &'a mut [f64],
+    pub(super) scratch: &'a mut [f64],
+    pub(super) a_rows: &'a [Vec<f64>],
+}
+
+impl InterpolantState {
+    /// Marks the interpolant as not prepared (after a new attempt, step or start).
+    pub(super) fn invalidate(&mut self) {
+        self.ready = false;
     }
 
     /// The interpolant's extra stages of the last step (`F` at the step's end is already
-    /// known), then its values at its nodes `h Σᵢ bᵢ(θⱼ) kᵢ`. Nothing without an
-    /// interpolant, or when it is prepared.
+    /// known), then its values at its nodes `h Σᵢ bᵢ(θⱼ) kᵢ`. Nothing when it is prepared.
     ///
     /// The extra stages are kept as differences `kᵢ − k₀` like the step's (the pairs with an
     /// interpolant sum with differences).
-    pub(super) fn prepare_interpolant(
+    pub(super) fn prepare(
         &mut self,
+        step: LastStep<'_>,
         rhs: &mut CheckedRhs<'_>,
     ) -> Result<(), StepFailure> {
-        let Some(state) = &mut self.interpolant else {
-            return Ok(());
-        };
-        if state.ready || self.ends.t == self.ends.t_prev {
+        let LastStep {
+            tableau,
+            ends,
+            k,
+            scratch,
+            a_rows,
+        } = step;
+        if self.ready || ends.t == ends.t_prev {
             return Ok(());
         }
-        let n = self.dim;
+        let n = scratch.len();
         if n == 0 {
-            state.ready = true;
+            self.ready = true;
             return Ok(());
         }
-        let interpolant = state.interpolant;
+        let interpolant = self.interpolant;
         let all = interpolant.num_all_stages();
-        let h = self.ends.t - self.ends.t_prev;
-        let end = self.tableau.end_stage();
-        if !self.tableau.is_fsal() {
-            let row = &mut self.k[(end - 1) * n..end * n];
-            for ((k, &f1), &f0) in row.iter_mut().zip(&self.ends.f).zip(&self.ends.f_prev) {
+        let h = ends.t - ends.t_prev;
+        let end = tableau.end_stage();
+        if !tableau.is_fsal() {
+            let row = &mut k[(end - 1) * n..end * n];
+            for ((k, &f1), &f0) in row.iter_mut().zip(&ends.f).zip(&ends.f_prev) {
                 *k = f1 - f0;
             }
         }
-        for i in end + 1..all {
-            let (earlier, rest) = self.k.split_at_mut((i - 1) * n);
-            combine(
-                &mut self.scratch,
-                &self.ends.y_prev,
-                h,
-                &self.a_rows[i],
-                &self.ends.f_prev,
-                earlier,
-            );
-            let t = self.ends.t_prev + interpolant.c[i] * h;
+        for (i, (a_row, &c)) in a_rows.iter().zip(interpolant.c).enumerate().skip(end + 1) {
+            let (earlier, rest) = k.split_at_mut((i - 1) * n);
+            combine(scratch, &ends.y_prev, h, a_row, &ends.f_prev, earlier);
+            let t = ends.t_prev + c * h;
             let row = &mut rest[..n];
-            rhs.eval(t, &self.scratch, row)?;
-            for (k, &f0) in row.iter_mut().zip(&self.ends.f_prev) {
+            rhs.eval(t, scratch, row)?;
+            for (k, &f0) in row.iter_mut().zip(&ends.f_prev) {
                 *k -= f0;
             }
         }
         // The values at the nodes as h (θⱼ k₀ + Σᵢ≥₁ bᵢ(θⱼ) (kᵢ − k₀)), equal to
         // h Σᵢ bᵢ(θⱼ) kᵢ since Σᵢ bᵢ(θ) = θ.
-        for (j, weights) in state.node_weights.chunks_exact(all).enumerate() {
-            let row = &mut state.dense[j * n..(j + 1) * n];
-            weighted_sum(row, weights, &self.ends.f_prev, &self.k, n);
+        for (j, weights) in self.node_weights.chunks_exact(all).enumerate() {
+            let row = &mut self.dense[j * n..(j + 1) * n];
+            weighted_sum(row, weights, &ends.f_prev, k, n);
             for v in row.iter_mut() {
                 *v *= h;
             }
         }
-        state.ready = true;
+        self.ready = true;
         Ok(())
     }
 }
