@@ -41,7 +41,7 @@ use rustc_hash::FxHashMap;
 use serde::Serialize;
 
 use super::ast::{Expr, ExprKind};
-use super::file::{BodyKind, Crossing, ModelFile, TorqueValue};
+use super::file::{BodyKind, ModelFile, TorqueValue};
 use super::parser::{eval_expr, parse_expr};
 use super::{BinOp, Location};
 use crate::expr::print::{Printer, Syntax};
@@ -49,7 +49,6 @@ use crate::expr::{Constant, ExprArena, ExprId, Func, Node, SymbolId, SymbolKind}
 
 mod singular;
 mod solve;
-mod spatial;
 #[cfg(test)]
 mod tests;
 mod write;
@@ -439,11 +438,12 @@ fn load_reduced(name: &str, text: &str) -> Result<ModelFile, ReduceError> {
 }
 
 /// The YAML text of `file` as [`reduce`] writes its results, with nothing eliminated: the
-/// writer of reduced files applied to any file it can write, so that a reduced file can be
-/// loaded and written again (a round trip gives the same equations). Every section is
-/// written, 3-D frames, bodies and rolling contacts included; comments are not kept (the
-/// parameters' and coordinates' units are); what is left out is listed in the second value
-/// (`checks: equations_of_motion`, `floquet:`, `balances:`).
+/// schema's writer ([`super::schema::write_file`], the table that reads a file) with
+/// the reducer's expressions, so that a reduced file can be loaded and written again (a
+/// round trip gives the same equations). Every section is written, 3-D frames, bodies and
+/// rolling contacts included; comments are not kept (the parameters' and coordinates' units
+/// are); what is left out is listed in the second value (`checks: equations_of_motion`,
+/// `floquet:`, `balances:`).
 ///
 /// # Errors
 /// [`ReduceError::UnknownName`]; [`ReduceError::Invalid`] if the text written does not
@@ -741,38 +741,4 @@ impl<'f> Reducer<'f> {
         let y = self.arena.expand_if_cheaper(y);
         Ok(self.print(y))
     }
-}
-
-// How the writer spells a value in YAML (`write` and `spatial`).
-
-/// A plain scalar where YAML reads it as the text, else in double quotes.
-pub(super) fn scalar(s: &str) -> String {
-    let special = s.is_empty()
-        || s.contains(": ")
-        || s.contains(" #")
-        || s.starts_with([
-            '[', ']', '{', '}', ',', '#', '&', '*', '!', '|', '>', '\'', '"', '%', '@', '`',
-        ])
-        || s.starts_with("- ")
-        || s.ends_with(':');
-    if special { quoted(s) } else { s.to_string() }
-}
-
-/// A scalar inside a flow collection (`[…]`, `{…}`): quoted if it has a flow indicator.
-pub(super) fn flow(s: &str) -> String {
-    if s.contains([',', '[', ']', '{', '}']) {
-        quoted(s)
-    } else {
-        scalar(s)
-    }
-}
-
-fn quoted(s: &str) -> String {
-    format!("\"{}\"", s.replace('\\', "\\\\").replace('"', "\\\""))
-}
-
-/// `[a, b, …]` of expressions.
-pub(super) fn list(parts: &[String]) -> String {
-    let parts: Vec<String> = parts.iter().map(|p| flow(p)).collect();
-    format!("[{}]", parts.join(", "))
 }

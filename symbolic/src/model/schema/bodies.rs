@@ -2,6 +2,7 @@
 //! and its bodies (particles, planar rigid bodies and spatial bodies with their inertia tensors).
 
 use super::walk::{Fields, Keyed, Need};
+use super::write::{NotRewritten, Writer, flow, list};
 use super::*;
 
 const BODY_KEYS: &[&str] = &["mass", "at", "inertia", "com", "angle", "frame"];
@@ -369,5 +370,139 @@ impl Ctx<'_> {
             entries,
             location: node.location,
         })
+    }
+}
+
+/// The writers of `frames:` and `bodies:`, and the text of a wheel.
+impl Writer<'_> {
+    /// `frames:`, each as its successive rotations about the newest frame's axes (a frame
+    /// written `about: parent` was read into that order, which gives the same orientation).
+    pub(super) fn write_frames(&mut self, file: &ModelFile) -> Result<(), NotRewritten> {
+        if file.frames.is_empty() {
+            return Ok(());
+        }
+        self.line("frames:");
+        for frame in &file.frames {
+            let text = self.frame_text(frame)?;
+            self.line(format_args!("  {}: {text}", frame.name.value));
+        }
+        Ok(())
+    }
+
+    /// `{ parent: P, axis: z, angle: … }`, or `axes:` and `angles:` for several rotations.
+    fn frame_text(&mut self, frame: &Frame) -> Result<String, NotRewritten> {
+        let place = format!("frame `{}`", frame.name.value);
+        let angles = frame
+            .rotations
+            .iter()
+            .map(|r| self.expr(&r.angle, &place))
+            .collect::<Result<Vec<_>, _>>()?;
+        let axes: String = frame
+            .rotations
+            .iter()
+            .map(|r| r.axis.value.letter())
+            .collect();
+        Ok(match angles.as_slice() {
+            [angle] => format!(
+                "{{ parent: {}, axis: {axes}, angle: {} }}",
+                frame.parent.value,
+                flow(angle)
+            ),
+            _ => format!(
+                "{{ parent: {}, axes: {axes}, angles: {} }}",
+                frame.parent.value,
+                list(&angles)
+            ),
+        })
+    }
+
+    /// `bodies:`: particles, planar rigid bodies and 3-D bodies.
+    pub(super) fn write_bodies(&mut self, file: &ModelFile) -> Result<(), NotRewritten> {
+        if file.bodies.is_empty() {
+            return Ok(());
+        }
+        self.line("bodies:");
+        for b in &file.bodies {
+            let place = format!("body `{}`", b.name.value);
+            let text = match &b.kind {
+                BodyKind::Particle { mass, at } => {
+                    let m = self.expr(mass, &place)?;
+                    format!("{{ mass: {}, at: {} }}", flow(&m), at.value)
+                }
+                BodyKind::Rigid {
+                    mass,
+                    inertia,
+                    com,
+                    angle,
+                } => {
+                    let m = self.expr(mass, &place)?;
+                    let i = self.expr(inertia, &place)?;
+                    let a = self.expr(angle, &place)?;
+                    format!(
+                        "{{ mass: {}, inertia: {}, com: {}, angle: {} }}",
+                        flow(&m),
+                        flow(&i),
+                        com.value,
+                        flow(&a)
+                    )
+                }
+                BodyKind::Spatial {
+                    mass,
+                    com,
+                    frame,
+                    inertia,
+                } => self.spatial_body_text(&place, (mass, &com.value, &frame.value, inertia))?,
+            };
+            self.line(format_args!("  {}: {text}", b.name.value));
+        }
+        Ok(())
+    }
+
+    /// A 3-D body: `{ mass: m, com: G, frame: B, inertia: … }`, the inertia as three moments
+    /// when its products are not written, else as the map of the entries written.
+    fn spatial_body_text(
+        &mut self,
+        place: &str,
+        (mass, com, frame, inertia): (&Expr, &str, &str, &InertiaTensor),
+    ) -> Result<String, NotRewritten> {
+        let mass = self.expr(mass, place)?;
+        let mut entries = Vec::new();
+        for (key, entry) in InertiaTensor::KEYS.iter().zip(&inertia.entries) {
+            if let Some(e) = entry {
+                entries.push((*key, self.expr(e, place)?));
+            }
+        }
+        let principal = inertia.entries[3..].iter().all(Option::is_none)
+            && inertia.entries[..3].iter().all(Option::is_some);
+        let inertia = if principal {
+            let moments: Vec<String> = entries.into_iter().map(|(_, e)| e).collect();
+            list(&moments)
+        } else {
+            let parts: Vec<String> = entries
+                .into_iter()
+                .map(|(k, e)| format!("{k}: {}", flow(&e)))
+                .collect();
+            format!("{{ {} }}", parts.join(", "))
+        };
+        Ok(format!(
+            "{{ mass: {}, com: {com}, frame: {frame}, inertia: {inertia} }}",
+            flow(&mass)
+        ))
+    }
+
+    /// `{ centre: G, frame: R, axle: y, radius: r }`.
+    pub(super) fn wheel_text(
+        &mut self,
+        wheel: &WheelContact,
+        place: &str,
+    ) -> Result<String, NotRewritten> {
+        let radius = self.expr(&wheel.radius, place)?;
+        Ok(format!(
+            "{{ centre: {}, frame: {}, axle: {}, radius: {} }}",
+            wheel.centre.value,
+            wheel.frame.value,
+            wheel.axle.value.letter(),
+            flow(&radius)
+        ))
     }
 }

@@ -3,6 +3,7 @@
 //! drifts), one reader per key from one table ([`CHECKS`]).
 
 use super::walk::{Fields, Keyed, Need};
+use super::write::{NotRewritten, Writer, flow, list};
 use super::*;
 
 /// How one key of `checks:` is read into [`Checks`].
@@ -303,6 +304,154 @@ impl Ctx<'_> {
             location: node.location,
         })
     }
+}
+
+/// The writer of `checks:`: the reference values that still apply to what is written.
+impl Writer<'_> {
+    /// `checks:`, after the equilibria and events it may name; `equations_of_motion` is
+    /// left out (noted), and so is each value whose equilibrium or event is.
+    pub(super) fn write_checks(&mut self, file: &ModelFile) -> Result<(), NotRewritten> {
+        let c = &file.checks;
+        let mut block = String::new();
+        if !c.equations_of_motion.is_empty() {
+            self.notes.push(if self.preserve() {
+                "`checks: equations_of_motion` left out".to_string()
+            } else {
+                "`checks: equations_of_motion` left out (written in the eliminated coordinates)"
+                    .to_string()
+            });
+        }
+        self.modal_checks(&mut block, file);
+        self.run_checks(&mut block, c);
+        if !c.conserved.is_empty() {
+            let mut conserved = String::new();
+            for q in &c.conserved {
+                let place = format!("conserved quantity `{}`", q.name.value);
+                let v = self.expr(&q.value, &place)?;
+                conserved.push_str(&format!(
+                    "    {}: {{ value: {}, tolerance: {:e} }}\n",
+                    q.name.value,
+                    flow(&v),
+                    q.tolerance
+                ));
+            }
+            block.push_str("  conserved:\n");
+            block.push_str(&conserved);
+        }
+        if let Some(d) = &c.energy_drift {
+            block.push_str(&format!(
+                "  energy_drift: {{ max: {:e}{} }}\n",
+                d.max,
+                run_settings(&d.run, true)
+            ));
+        }
+        match &c.constraint_drift {
+            Some(d) if self.preserve() => block.push_str(&format!(
+                "  constraint_drift: {{ max: {:e}{} }}\n",
+                d.max,
+                run_settings(&d.run, true)
+            )),
+            Some(_) => self
+                .notes
+                .push("`checks: constraint_drift` left out (no constraints)".to_string()),
+            None => {}
+        }
+        self.block("checks", &block);
+        Ok(())
+    }
+
+    /// `natural_frequencies` and `damping_ratios` into `block` when their equilibrium is
+    /// written (the first one when they name none), noting each left out.
+    fn modal_checks(&mut self, block: &mut String, file: &ModelFile) {
+        let c = &file.checks;
+        let first_written = file
+            .equilibria
+            .first()
+            .is_none_or(|e| self.kept_equilibria.contains(&e.name.value));
+        for (key, modal) in [
+            ("natural_frequencies", &c.natural_frequencies),
+            ("damping_ratios", &c.damping_ratios),
+        ] {
+            let Some(m) = modal else { continue };
+            let written = match &m.at {
+                Some(a) => self.kept_equilibria.contains(&a.value),
+                None => first_written,
+            };
+            if !written {
+                self.notes.push(format!(
+                    "`checks: {key}` left out: its equilibrium is left out"
+                ));
+                continue;
+            }
+            let values: Vec<String> = m.values.iter().map(|e| e.to_string()).collect();
+            block.push_str(&format!("  {key}: {{ "));
+            if let Some(a) = &m.at {
+                block.push_str(&format!("at: {}, ", a.value));
+            }
+            block.push_str(&format!(
+                "values: {}, tolerance: {:e} }}\n",
+                list(&values),
+                m.tolerance
+            ));
+        }
+    }
+
+    /// The `period` (when its event is written) and the `final_state` (its values of the
+    /// kept coordinates and rates) into `block`, noting what is left out.
+    fn run_checks(&mut self, block: &mut String, c: &Checks) {
+        if let Some(p) = &c.period {
+            if self.kept_events.contains(&p.event.value) {
+                block.push_str(&format!(
+                    "  period: {{ event: {}, value: {}, tolerance: {:e}{} }}\n",
+                    p.event.value,
+                    flow(&p.value.to_string()),
+                    p.tolerance,
+                    run_settings(&p.run, true)
+                ));
+            } else {
+                self.notes
+                    .push("`checks: period` left out: its event is left out".to_string());
+            }
+        }
+        if let Some(f) = &c.final_state {
+            let values: Vec<String> = f
+                .values
+                .iter()
+                .filter(|(n, _)| self.is_kept_name(&n.value))
+                .map(|(n, e)| format!("{}: {}", n.value, flow(&e.to_string())))
+                .collect();
+            if values.len() < f.values.len() {
+                self.notes.push(
+                    "`checks: final_state` keeps only the values of the kept coordinates"
+                        .to_string(),
+                );
+            }
+            if !values.is_empty() {
+                block.push_str(&format!(
+                    "  final_state: {{ t: {}, values: {{ {} }}, tolerance: {:e}{} }}\n",
+                    flow(&f.t.to_string()),
+                    values.join(", "),
+                    f.tolerance,
+                    run_settings(&f.run, false)
+                ));
+            }
+        }
+    }
+}
+
+/// `, method: …, rtol: …, t_end: …` of the settings given.
+fn run_settings(run: &RunSettings, t_end: bool) -> String {
+    let mut s = String::new();
+    if let Some(m) = &run.method {
+        s.push_str(&format!(", method: {}", m.value));
+    }
+    if let Some(r) = run.rtol {
+        s.push_str(&format!(", rtol: {r:e}"));
+    }
+    if t_end && let Some(t) = run.t_end {
+        s.push_str(&format!(", t_end: {t:e}"));
+    }
+    s
 }
 
 #[cfg(test)]

@@ -2,6 +2,7 @@
 //! reference thresholds and curves drawn on them.
 
 use super::walk::{Fields, Keyed, Need};
+use super::write::{NotRewritten, Writer};
 use super::*;
 
 /// The keys of a `floquet:` entry.
@@ -165,5 +166,15 @@ impl Ctx<'_> {
                 domain,
             })
         })
+    }
+}
+
+impl Writer<'_> {
+    /// `floquet:` is not written (its orbits are the file's), noted.
+    pub(super) fn write_floquet(&mut self, file: &ModelFile) -> Result<(), NotRewritten> {
+        if !file.floquet.is_empty() {
+            self.notes.push("`floquet:` left out".to_string());
+        }
+        Ok(())
     }
 }

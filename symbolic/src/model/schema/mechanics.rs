@@ -3,6 +3,7 @@
 //! (its frames and bodies: `bodies.rs`).
 
 use super::walk::{Fields, Keyed, Need};
+use super::write::{NotRewritten, Writer, axes_list, flow, in_frame, list, scalar};
 use super::*;
 
 /// The keys of a spring.
@@ -671,5 +672,229 @@ impl Ctx<'_> {
             }
         }
         out
+    }
+}
+
+/// The writers of the mechanism's points, loads and constraints.
+impl Writer<'_> {
+    /// `points:`.
+    pub(super) fn write_points(&mut self, file: &ModelFile) -> Result<(), NotRewritten> {
+        if file.points.is_empty() {
+            return Ok(());
+        }
+        self.line("points:");
+        for p in &file.points {
+            let text = self.point_text(p)?;
+            self.line(format_args!("  {}: {text}", p.name.value));
+        }
+        Ok(())
+    }
+
+    /// A point's value: its components, the point plus vectors in frames, or a wheel contact.
+    fn point_text(&mut self, p: &Point) -> Result<String, NotRewritten> {
+        let place = format!("point `{}`", p.name.value);
+        if let Some(wheel) = &p.wheel {
+            return Ok(format!("{{ wheel: {} }}", self.wheel_text(wheel, &place)?));
+        }
+        if let Some(RelativePosition { from, vectors }) = &p.relative {
+            let mut parts = Vec::new();
+            if let Some(from) = from {
+                parts.push(format!("from: {}", from.value));
+            }
+            for (frame, vector) in vectors {
+                let components = self.exprs(vector, &place)?;
+                parts.push(format!("{}: {}", frame.value, list(&components)));
+            }
+            return Ok(format!("{{ {} }}", parts.join(", ")));
+        }
+        let parts = self.exprs(&p.position, &place)?;
+        Ok(list(&parts))
+    }
+
+    /// `springs:`.
+    pub(super) fn write_springs(&mut self, file: &ModelFile) -> Result<(), NotRewritten> {
+        if file.springs.is_empty() {
+            return Ok(());
+        }
+        self.line("springs:");
+        for s in &file.springs {
+            let place = format!("spring `{}`", s.name.value);
+            let k = self.expr(&s.stiffness, &place)?;
+            let mut text = format!(
+                "  {}: {{ between: [{}, {}], stiffness: {}",
+                s.name.value,
+                s.between[0].value,
+                s.between[1].value,
+                flow(&k)
+            );
+            if let Some(l0) = &s.rest_length {
+                let l0 = self.expr(l0, &place)?;
+                text.push_str(&format!(", rest_length: {}", flow(&l0)));
+            }
+            self.line(format_args!("{text} }}"));
+        }
+        Ok(())
+    }
+
+    /// `dampers:`.
+    pub(super) fn write_dampers(&mut self, file: &ModelFile) -> Result<(), NotRewritten> {
+        if file.dampers.is_empty() {
+            return Ok(());
+        }
+        self.line("dampers:");
+        for d in &file.dampers {
+            let place = format!("damper `{}`", d.name.value);
+            let c = self.expr(&d.coefficient, &place)?;
+            self.line(format_args!(
+                "  {}: {{ between: [{}, {}], coefficient: {} }}",
+                d.name.value,
+                d.between[0].value,
+                d.between[1].value,
+                flow(&c)
+            ));
+        }
+        Ok(())
+    }
+
+    /// `forces:` (3-D ones and those written in frames included).
+    pub(super) fn write_forces(&mut self, file: &ModelFile) -> Result<(), NotRewritten> {
+        if file.forces.is_empty() {
+            return Ok(());
+        }
+        self.line("forces:");
+        for f in &file.forces {
+            let place = format!("force `{}`", f.name.value);
+            let parts = self.exprs(&f.vector, &place)?;
+            self.line(format_args!(
+                "  {}: {{ at: {}, vector: {}{} }}",
+                f.name.value,
+                f.at.value,
+                list(&parts),
+                in_frame(f.frame.as_ref())
+            ));
+        }
+        Ok(())
+    }
+
+    /// `torques:`, planar and 3-D.
+    pub(super) fn write_torques(&mut self, file: &ModelFile) -> Result<(), NotRewritten> {
+        if file.torques.is_empty() {
+            return Ok(());
+        }
+        self.line("torques:");
+        for t in &file.torques {
+            let place = format!("torque `{}`", t.name.value);
+            let value = match &t.value {
+                TorqueValue::Planar(e) => format!("value: {}", flow(&self.expr(e, &place)?)),
+                TorqueValue::Spatial { vector, frame, .. } => {
+                    let parts = self.exprs(vector, &place)?;
+                    format!("vector: {}{}", list(&parts), in_frame(frame.as_ref()))
+                }
+            };
+            self.line(format_args!(
+                "  {}: {{ body: {}, {value} }}",
+                t.name.value, t.body.value
+            ));
+        }
+        Ok(())
+    }
+
+    /// `interactions:`.
+    pub(super) fn write_interactions(&mut self, file: &ModelFile) -> Result<(), NotRewritten> {
+        if file.interactions.is_empty() {
+            return Ok(());
+        }
+        self.line("interactions:");
+        for f in &file.interactions {
+            let place = format!("interaction `{}`", f.name.value);
+            let magnitude = self.expr(&f.magnitude, &place)?;
+            self.line(format_args!(
+                "  {}: {{ between: [{}, {}], magnitude: {} }}",
+                f.name.value,
+                f.between[0].value,
+                f.between[1].value,
+                flow(&magnitude)
+            ));
+        }
+        Ok(())
+    }
+
+    /// `balances:` is not written: the model is derived by Lagrange's equations, noted.
+    pub(super) fn write_balances(&mut self, file: &ModelFile) -> Result<(), NotRewritten> {
+        if !file.balances.is_empty() {
+            self.notes.push(
+                "`balances:` left out: the reduced model is derived by Lagrange's equations"
+                    .to_string(),
+            );
+        }
+        Ok(())
+    }
+
+    /// `constraints:` (expressions, then constraints on points) of a file written as it is;
+    /// the eliminations noted otherwise.
+    pub(super) fn write_constraints(&mut self, file: &ModelFile) -> Result<(), NotRewritten> {
+        if !self.preserve() {
+            let eliminated: Vec<String> = self
+                .edits
+                .eliminated
+                .iter()
+                .map(|(constraint, coordinate)| format!("`{constraint}` gives {coordinate}"))
+                .collect();
+            self.notes.push(format!(
+                "`constraints:` eliminated: {}",
+                eliminated.join(", ")
+            ));
+            return Ok(());
+        }
+        if file.constraints.is_empty() && file.point_constraints.is_empty() {
+            return Ok(());
+        }
+        self.line("constraints:");
+        for (name, e) in &file.constraints {
+            self.line(format_args!("  {}: {}", name.value, scalar(&e.to_string())));
+        }
+        for c in &file.point_constraints {
+            self.line(format_args!(
+                "  {}: {{ point: {}, along: {}{} }}",
+                c.name.value,
+                c.point.value,
+                c.along.value.letter(),
+                in_frame(c.frame.as_ref())
+            ));
+        }
+        Ok(())
+    }
+
+    /// `nonholonomic:` of a file written as it is: the constraints written as expressions,
+    /// then the rolling contacts.
+    pub(super) fn write_nonholonomic(&mut self, file: &ModelFile) -> Result<(), NotRewritten> {
+        if !self.preserve() || (file.nonholonomic.is_empty() && file.rolling.is_empty()) {
+            return Ok(());
+        }
+        self.line("nonholonomic:");
+        for (name, e) in &file.nonholonomic {
+            let place = format!("non-holonomic constraint `{}`", name.value);
+            let text = self.expr(e, &place)?;
+            self.line(format_args!("  {}: {}", name.value, flow(&text)));
+        }
+        for RollingContact {
+            name,
+            body,
+            point,
+            along,
+            frame,
+        } in &file.rolling
+        {
+            let axes: Vec<Axis> = along.iter().map(|a| a.value).collect();
+            self.line(format_args!(
+                "  {}: {{ body: {}, point: {}, along: {}{} }}",
+                name.value,
+                body.value,
+                point.value,
+                axes_list(&axes),
+                in_frame(frame.as_ref())
+            ));
+        }
+        Ok(())
     }
 }

@@ -11,6 +11,9 @@
 //! initial state, events and equilibria (`states`), `checks:` (`checks`) and `floquet:`
 //! (`floquet`). How a single value is read (a name, an expression, a vector) is in `values`;
 //! lookups in a map's entries in `entries`.
+//!
+//! The same table writes a [`ModelFile`] back as text ([`write_file`]): each section's
+//! writer sits beside its reader, and `reduce` writes its results through it.
 
 mod bodies;
 mod checks;
@@ -21,6 +24,9 @@ mod sections;
 mod states;
 mod values;
 mod walk;
+pub mod write;
+
+pub use sections::write_file;
 
 use std::collections::HashMap;
 

@@ -3,9 +3,10 @@
 //! coordinates, expressions by name and drawing.
 
 use super::walk::{Fields, Keyed, Need};
+use super::write::{Edits, NotRewritten, Rewrite, Writer, list, scalar};
 use super::*;
 
-/// How one top-level key of a model file is read.
+/// How one top-level key of a model file is read, and written.
 struct Section {
     /// The key.
     key: &'static str,
@@ -14,11 +15,17 @@ struct Section {
     /// Reports the key missing from the file's map (`top`, which starts at the location
     /// given); `None` when the key may be left out.
     missing: Option<fn(&mut Ctx<'_>, &Entries, Location)>,
+    /// Writes the section of a model (nothing when it has none), or notes why it is left
+    /// out.
+    write: WriteSection,
 }
 
-/// Every top-level key, in the order the sections are read (a section may use one read
-/// before it: `minimal_twin` the name). The order the keys are listed to the user in is
-/// [`TOP_LEVEL_KEYS`]'s.
+/// Writes one section of a model file ([`Section::write`]).
+type WriteSection = fn(&mut Writer<'_>, &ModelFile) -> Result<(), NotRewritten>;
+
+/// Every top-level key, in the order the sections are read and written (a section may use
+/// one read before it: `minimal_twin` the name; `checks:` is written after the equilibria and
+/// events it names). The order the keys are listed to the user in is [`TOP_LEVEL_KEYS`]'s.
 const SECTIONS: &[Section] = &[
     Section {
         key: "name",
@@ -36,20 +43,13 @@ const SECTIONS: &[Section] = &[
                 );
             }
         }),
+        write: |w, file| w.write_name(file),
     },
     Section {
         key: "description",
         read: |cx, n, file| file.description = cx.description(n),
         missing: None,
-    },
-    Section {
-        key: "minimal_twin",
-        read: |cx, n, file| {
-            file.minimal_twin = cx
-                .name(n, "`minimal_twin`")
-                .and_then(|twin| cx.minimal_twin(twin, &file.name));
-        },
-        missing: None,
+        write: |w, file| w.write_description(file),
     },
     Section {
         key: "units",
@@ -59,11 +59,23 @@ const SECTIONS: &[Section] = &[
                 .map(|u| Located::new(u, n.location));
         },
         missing: None,
+        write: |w, file| w.write_units(file),
+    },
+    Section {
+        key: "minimal_twin",
+        read: |cx, n, file| {
+            file.minimal_twin = cx
+                .name(n, "`minimal_twin`")
+                .and_then(|twin| cx.minimal_twin(twin, &file.name));
+        },
+        missing: None,
+        write: |w, file| w.write_minimal_twin(file),
     },
     Section {
         key: "parameters",
         read: |cx, n, file| file.parameters = cx.parameters(n),
         missing: None,
+        write: |w, file| w.write_parameters(file),
     },
     Section {
         key: "coordinates",
@@ -78,16 +90,19 @@ const SECTIONS: &[Section] = &[
                 );
             }
         }),
+        write: |w, file| w.write_coordinates(file),
     },
     Section {
         key: "kinetic",
         read: |cx, n, file| file.kinetic = cx.expr(n, "`kinetic`"),
         missing: None,
+        write: |w, file| w.write_kinetic(file),
     },
     Section {
         key: "potential",
         read: |cx, n, file| file.potential = cx.expr(n, "`potential`"),
         missing: None,
+        write: |w, file| w.write_potential(file),
     },
     Section {
         key: "generalized_forces",
@@ -100,21 +115,25 @@ const SECTIONS: &[Section] = &[
             );
         },
         missing: None,
+        write: |w, file| w.write_generalized_forces(file),
     },
     Section {
         key: "frames",
         read: |cx, n, file| file.frames = cx.frames(n),
         missing: None,
+        write: |w, file| w.write_frames(file),
     },
     Section {
         key: "points",
         read: |cx, n, file| file.points = cx.points(n),
         missing: None,
+        write: |w, file| w.write_points(file),
     },
     Section {
         key: "bodies",
         read: |cx, n, file| file.bodies = cx.bodies(n),
         missing: None,
+        write: |w, file| w.write_bodies(file),
     },
     Section {
         key: "gravity",
@@ -124,83 +143,117 @@ const SECTIONS: &[Section] = &[
                 .map(|g| Located::new(g, n.location));
         },
         missing: None,
+        write: |w, file| w.write_gravity(file),
     },
     Section {
         key: "springs",
         read: |cx, n, file| file.springs = cx.springs(n),
         missing: None,
+        write: |w, file| w.write_springs(file),
     },
     Section {
         key: "dampers",
         read: |cx, n, file| file.dampers = cx.dampers(n),
         missing: None,
+        write: |w, file| w.write_dampers(file),
     },
     Section {
         key: "forces",
         read: |cx, n, file| file.forces = cx.forces(n),
         missing: None,
+        write: |w, file| w.write_forces(file),
     },
     Section {
         key: "torques",
         read: |cx, n, file| file.torques = cx.torques(n),
         missing: None,
+        write: |w, file| w.write_torques(file),
     },
     Section {
         key: "interactions",
         read: |cx, n, file| file.interactions = cx.interactions(n),
         missing: None,
+        write: |w, file| w.write_interactions(file),
     },
     Section {
         key: "outputs",
         read: |cx, n, file| file.outputs = cx.outputs(n),
         missing: None,
-    },
-    Section {
-        key: "constraints",
-        read: |cx, n, file| (file.constraints, file.point_constraints) = cx.holonomic(n),
-        missing: None,
-    },
-    Section {
-        key: "nonholonomic",
-        read: |cx, n, file| (file.nonholonomic, file.rolling) = cx.nonholonomic(n),
-        missing: None,
-    },
-    Section {
-        key: "initial",
-        read: |cx, n, file| (file.initial, file.initial_guesses) = cx.initial(n),
-        missing: None,
-    },
-    Section {
-        key: "draw",
-        read: |cx, n, file| file.draw = cx.draw(n),
-        missing: None,
+        write: |w, file| w.write_outputs(file),
     },
     Section {
         key: "balances",
         read: |cx, n, file| file.balances = cx.balances(n),
         missing: None,
+        write: |w, file| w.write_balances(file),
     },
     Section {
-        key: "checks",
-        read: |cx, n, file| file.checks = cx.checks(n),
+        key: "constraints",
+        read: |cx, n, file| (file.constraints, file.point_constraints) = cx.holonomic(n),
         missing: None,
+        write: |w, file| w.write_constraints(file),
     },
     Section {
-        key: "events",
-        read: |cx, n, file| file.events = cx.events(n),
+        key: "nonholonomic",
+        read: |cx, n, file| (file.nonholonomic, file.rolling) = cx.nonholonomic(n),
         missing: None,
+        write: |w, file| w.write_nonholonomic(file),
+    },
+    Section {
+        key: "initial",
+        read: |cx, n, file| (file.initial, file.initial_guesses) = cx.initial(n),
+        missing: None,
+        write: |w, file| w.write_initial(file),
+    },
+    Section {
+        key: "draw",
+        read: |cx, n, file| file.draw = cx.draw(n),
+        missing: None,
+        write: |w, file| w.write_draw(file),
     },
     Section {
         key: "equilibria",
         read: |cx, n, file| file.equilibria = cx.equilibria(n),
         missing: None,
+        write: |w, file| w.write_equilibria(file),
+    },
+    Section {
+        key: "events",
+        read: |cx, n, file| file.events = cx.events(n),
+        missing: None,
+        write: |w, file| w.write_events(file),
     },
     Section {
         key: "floquet",
         read: |cx, n, file| file.floquet = cx.floquet(n),
         missing: None,
+        write: |w, file| w.write_floquet(file),
+    },
+    Section {
+        key: "checks",
+        read: |cx, n, file| file.checks = cx.checks(n),
+        missing: None,
+        write: |w, file| w.write_checks(file),
     },
 ];
+
+/// The YAML text of `file`, every section of the table that reads a file in its order, with
+/// its expressions through `rewrite` and `edits` applied; and the notes on what was left out
+/// or changed.
+///
+/// # Errors
+/// The [`NotRewritten`] of an expression that a section cannot leave out.
+pub fn write_file(
+    file: &ModelFile,
+    rewrite: &mut dyn Rewrite,
+    edits: &Edits,
+) -> Result<(String, Vec<String>), NotRewritten> {
+    let mut writer = Writer::new(rewrite, edits);
+    for section in SECTIONS {
+        (section.write)(&mut writer, file)?;
+    }
+    Ok((writer.w, writer.notes))
+}
 
 /// The keys of a parameter written as a map.
 const PARAMETER: Fields = Fields {
@@ -601,6 +654,168 @@ impl Ctx<'_> {
             }
         }
         draw
+    }
+}
+
+/// The writers of the sections about the model as a whole ([`SECTIONS`]).
+impl Writer<'_> {
+    /// A transformer's header, then `name:`.
+    fn write_name(&mut self, file: &ModelFile) -> Result<(), NotRewritten> {
+        self.w.push_str(&self.edits.header);
+        let name = self.edits.name.as_deref().unwrap_or(&file.name.value);
+        self.line(format_args!("name: {name}"));
+        Ok(())
+    }
+
+    /// `description:`.
+    fn write_description(&mut self, file: &ModelFile) -> Result<(), NotRewritten> {
+        let description = self
+            .edits
+            .description
+            .as_deref()
+            .unwrap_or(&file.description);
+        self.line(format_args!("description: {}", scalar(description)));
+        Ok(())
+    }
+
+    /// `units: SI`, if given.
+    fn write_units(&mut self, file: &ModelFile) -> Result<(), NotRewritten> {
+        if file.units.is_some() {
+            self.line("units: SI");
+        }
+        Ok(())
+    }
+
+    /// `minimal_twin:` of a file written as it is (a reduced model is minimal itself).
+    fn write_minimal_twin(&mut self, file: &ModelFile) -> Result<(), NotRewritten> {
+        match &file.minimal_twin {
+            Some(twin) if self.preserve() => {
+                self.line(format_args!("minimal_twin: {}", twin.value))
+            }
+            Some(_) => self
+                .notes
+                .push("`minimal_twin:` left out (the reduced model is minimal)".to_string()),
+            None => {}
+        }
+        Ok(())
+    }
+
+    /// `parameters:`, each default with its unit as a comment.
+    fn write_parameters(&mut self, file: &ModelFile) -> Result<(), NotRewritten> {
+        if file.parameters.is_empty() {
+            return Ok(());
+        }
+        self.line("parameters:");
+        for p in &file.parameters {
+            let value = format!("  {}: {}", p.name.value, scalar(&p.default.to_string()));
+            match &p.unit {
+                Some(u) => self.line(format_args!("{value}  # {}", u.value)),
+                None => self.line(value),
+            }
+        }
+        Ok(())
+    }
+
+    /// `coordinates:`, those kept, each with its unit or comment.
+    fn write_coordinates(&mut self, file: &ModelFile) -> Result<(), NotRewritten> {
+        self.line("coordinates:");
+        for c in &file.coordinates {
+            if !self.is_kept(&c.name.value) {
+                continue;
+            }
+            match (&c.unit, &c.comment) {
+                (Some(u), _) => self.line(format_args!(
+                    "  - {{ name: {}, unit: {} }}",
+                    c.name.value, u.value
+                )),
+                (None, Some(comment)) => {
+                    self.line(format_args!("  - {}  # {}", c.name.value, comment.trim()));
+                }
+                (None, None) => self.line(format_args!("  - {}", c.name.value)),
+            }
+        }
+        Ok(())
+    }
+
+    /// `kinetic:`.
+    fn write_kinetic(&mut self, file: &ModelFile) -> Result<(), NotRewritten> {
+        if let Some(t) = &file.kinetic {
+            let t = self.expr(t, "`kinetic:`")?;
+            self.line(format_args!("kinetic: {}", scalar(&t)));
+        }
+        Ok(())
+    }
+
+    /// `potential:`.
+    fn write_potential(&mut self, file: &ModelFile) -> Result<(), NotRewritten> {
+        if let Some(v) = &file.potential {
+            let v = self.expr(v, "`potential:`")?;
+            self.line(format_args!("potential: {}", scalar(&v)));
+        }
+        Ok(())
+    }
+
+    /// `generalized_forces:`, as the transformer gives them, else each rewritten.
+    fn write_generalized_forces(&mut self, file: &ModelFile) -> Result<(), NotRewritten> {
+        if file.generalized_forces.is_empty() {
+            return Ok(());
+        }
+        let forces = match self.rewritten_generalized_forces(file)? {
+            Some(forces) => forces,
+            None => {
+                let mut forces = Vec::new();
+                for (name, e) in &file.generalized_forces {
+                    let place = format!("generalized force `{}`", name.value);
+                    forces.push((name.value.clone(), self.expr(e, &place)?));
+                }
+                forces
+            }
+        };
+        if !forces.is_empty() {
+            self.line("generalized_forces:");
+            for (k, q) in forces {
+                self.line(format_args!("  {k}: {}", scalar(&q)));
+            }
+        }
+        Ok(())
+    }
+
+    /// `gravity:`.
+    fn write_gravity(&mut self, file: &ModelFile) -> Result<(), NotRewritten> {
+        if let Some(g) = &file.gravity {
+            let parts = self.exprs(&g.value, "`gravity:`")?;
+            self.line(format_args!("gravity: {}", list(&parts)));
+        }
+        Ok(())
+    }
+
+    /// `draw:`: its lines, traces and wheels.
+    fn write_draw(&mut self, file: &ModelFile) -> Result<(), NotRewritten> {
+        let mut wheels = Vec::new();
+        for wheel in &file.draw.wheels {
+            wheels.push(self.wheel_text(wheel, "`draw: wheels:`")?);
+        }
+        let lines: Vec<String> = file
+            .draw
+            .lines
+            .iter()
+            .map(|[a, b]| format!("[{}, {}]", a.value, b.value))
+            .collect();
+        let trace: Vec<&str> = file.draw.trace.iter().map(|p| p.value.as_str()).collect();
+        let mut parts = Vec::new();
+        if !lines.is_empty() {
+            parts.push(format!("lines: [{}]", lines.join(", ")));
+        }
+        if !trace.is_empty() {
+            parts.push(format!("trace: [{}]", trace.join(", ")));
+        }
+        if !wheels.is_empty() {
+            parts.push(format!("wheels: [{}]", wheels.join(", ")));
+        }
+        if !parts.is_empty() {
+            self.line(format_args!("draw: {{ {} }}", parts.join(", ")));
+        }
+        Ok(())
     }
 }
 

@@ -2,6 +2,7 @@
 //! state that cross zero) and equilibria.
 
 use super::walk::{Fields, Keyed, Need};
+use super::write::{NotRewritten, Writer, flow, scalar};
 use super::*;
 
 /// The keys of an output written as a map.
@@ -209,5 +210,160 @@ impl Ctx<'_> {
                 ignorable,
             })
         })
+    }
+}
+
+/// The writers of `outputs:`, `initial:`, `equilibria:` and `events:`.
+impl Writer<'_> {
+    /// `outputs:`, each left out (and noted) where it cannot be rewritten.
+    pub(super) fn write_outputs(&mut self, file: &ModelFile) -> Result<(), NotRewritten> {
+        let mut block = String::new();
+        for o in &file.outputs {
+            let place = format!("output `{}`", o.name.value);
+            match self.expr(&o.value, &place) {
+                Ok(v) if o.conserved => block.push_str(&format!(
+                    "  {}: {{ value: {}, conserved: true, tolerance: {:e} }}\n",
+                    o.name.value,
+                    flow(&v),
+                    o.tolerance
+                )),
+                Ok(v) => block.push_str(&format!("  {}: {}\n", o.name.value, scalar(&v))),
+                Err(e) => self
+                    .notes
+                    .push(format!("output `{}` left out: {}", o.name.value, e.message)),
+            }
+        }
+        self.block("outputs", &block);
+        Ok(())
+    }
+
+    /// `initial:`: the values and rates given (guesses marked as such in a file written as it
+    /// is), noting the rates of eliminated coordinates left out.
+    pub(super) fn write_initial(&mut self, file: &ModelFile) -> Result<(), NotRewritten> {
+        let initial: Vec<(String, Expr)> = match &self.edits.initial {
+            Some(initial) => initial.clone(),
+            None => file
+                .initial
+                .iter()
+                .map(|(n, e)| (n.value.clone(), e.clone()))
+                .collect(),
+        };
+        let preserve = self.preserve();
+        if !initial.is_empty() {
+            let parts: Vec<String> = initial
+                .iter()
+                .map(|(n, e)| {
+                    if preserve && file.initial_guesses.iter().any(|g| g.value == *n) {
+                        format!("{n}: {{ guess: {} }}", flow(&e.to_string()))
+                    } else {
+                        format!("{n}: {}", flow(&e.to_string()))
+                    }
+                })
+                .collect();
+            self.line(format_args!("initial: {{ {} }}", parts.join(", ")));
+        }
+        let dropped_rates: Vec<&str> = file
+            .initial
+            .iter()
+            .map(|(n, _)| n.value.as_str())
+            .filter(|n| !self.is_kept_name(n) && n.ends_with("_dot"))
+            .collect();
+        if !dropped_rates.is_empty() {
+            self.notes.push(format!(
+                "the initial rates of eliminated coordinates ({}) are left out: the kept rates \
+                 alone set the motion",
+                dropped_rates.join(", ")
+            ));
+        }
+        if !preserve && file.initial_guesses.iter().any(|g| self.is_kept(&g.value)) {
+            self.notes.push(
+                "a kept coordinate's initial value was a guess; the reduced file starts at \
+                 the guess"
+                    .to_string(),
+            );
+        }
+        Ok(())
+    }
+
+    /// `equilibria:`, less those the transformer leaves out (noted), each with the values of
+    /// the kept coordinates and its ignorable ones.
+    pub(super) fn write_equilibria(&mut self, file: &ModelFile) -> Result<(), NotRewritten> {
+        let mut block = String::new();
+        for eq in &file.equilibria {
+            let dropped = self
+                .edits
+                .dropped_equilibria
+                .iter()
+                .find(|(name, _)| *name == eq.name.value);
+            if let Some((_, note)) = dropped {
+                self.notes.push(note.clone());
+                continue;
+            }
+            let mut parts: Vec<String> = eq
+                .values
+                .iter()
+                .filter(|(n, _)| self.is_kept_name(&n.value))
+                .map(|(n, e)| format!("{}: {}", n.value, flow(&e.to_string())))
+                .collect();
+            let ignorable: Vec<&str> = eq
+                .ignorable
+                .iter()
+                .map(|n| n.value.as_str())
+                .filter(|n| self.is_kept(n))
+                .collect();
+            if !ignorable.is_empty() {
+                parts.push(format!("ignorable: [{}]", ignorable.join(", ")));
+            }
+            block.push_str(&format!(
+                "  {}: {{ {} }}\n",
+                eq.name.value,
+                parts.join(", ")
+            ));
+            self.kept_equilibria.push(eq.name.value.clone());
+        }
+        self.block("equilibria", &block);
+        Ok(())
+    }
+
+    /// `events:`: those that end runs where the transformer's coordinates are singular
+    /// (each noted), then the file's, each left out (and noted) where it cannot be
+    /// rewritten.
+    pub(super) fn write_events(&mut self, file: &ModelFile) -> Result<(), NotRewritten> {
+        let mut block = String::new();
+        for (note, event) in &self.edits.singular {
+            self.notes.push(note.clone());
+            if let Some((name, when)) = event
+                && !file.events.iter().any(|ev| ev.name.value == *name)
+            {
+                block.push_str(&format!(
+                    "  {name}: {{ when: {}, direction: both, terminal: true }}\n",
+                    flow(when)
+                ));
+            }
+        }
+        for ev in &file.events {
+            let place = format!("event `{}`", ev.name.value);
+            match self.expr(&ev.when, &place) {
+                Ok(g) => {
+                    let direction = match ev.direction {
+                        Crossing::Rising => "rising",
+                        Crossing::Falling => "falling",
+                        Crossing::Both => "both",
+                    };
+                    block.push_str(&format!(
+                        "  {}: {{ when: {}, direction: {direction}, terminal: {} }}\n",
+                        ev.name.value,
+                        flow(&g),
+                        ev.terminal
+                    ));
+                    self.kept_events.push(ev.name.value.clone());
+                }
+                Err(e) => self
+                    .notes
+                    .push(format!("event `{}` left out: {}", ev.name.value, e.message)),
+            }
+        }
+        self.block("events", &block);
+        Ok(())
     }
 }
