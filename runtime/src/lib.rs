@@ -24,6 +24,7 @@
 //! - the model types above: [`system`], [`dynamic`], [`first_order`], [`model_info`], [`ode`],
 //!   [`constrained`] (the index-1 solve with constraints and drift control);
 //! - [`integrate`]: the integrators, step-size control, events and dense output;
+//! - [`hybrid`]: motions through impacts at unilateral contacts ([`hybrid::impact()`]);
 //! - [`linear`]: the building blocks of the linear analyses (linearisation and modes,
 //!   responses, `H(ω)`, monodromy), functions of matrices;
 //! - [`analysis`]: the analyses, each one call with typed options, a `Serialize` report and a
@@ -62,6 +63,7 @@ pub mod constrained;
 pub mod dynamic;
 pub mod first_order;
 pub mod functions;
+pub mod hybrid;
 pub mod integrate;
 pub mod linalg;
 pub mod linear;

@@ -3,6 +3,7 @@
 
 mod common;
 mod events;
+mod impacts;
 mod integrators;
 mod methods;
 mod radau5_reference;
