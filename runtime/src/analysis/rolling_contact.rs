@@ -853,7 +853,7 @@ fn drift(values: &[(f64, f64)]) -> f64 {
 }
 
 /// The rolling phase's samples and their `(T + V, T + |V|)` pairs (J), from
-/// [`contact_samples`].
+/// `rolling::contact_samples`.
 type ContactRows = (Vec<ContactSample>, Vec<(f64, f64)>);
 
 #[cfg(test)]

@@ -1,5 +1,6 @@
 //! Butcher tableaus of explicit Runge–Kutta methods, with the coefficients as exact rationals
-//! as printed in their sources.
+//! as printed in their sources (Verner's pairs, in tableau/verner.rs, also as the decimals
+//! their source prints).
 
 /// The coefficients of an explicit Runge–Kutta method, with an optional embedded error
 /// estimator and dense-output correction.
@@ -430,7 +431,9 @@ impl Tableau {
         self.b
     }
 
-    /// The weights `b̂` of the embedded solution, `s` entries, if any.
+    /// The weights `b̂` of the embedded solution, `s` entries, if the tableau gives them:
+    /// `None` without an embedded solution, and for Verner's pairs, which give `b − b̂` alone
+    /// (their [`embedded_order`](Self::embedded_order) is `Some`).
     pub fn b_embedded(&self) -> Option<&'static [f64]> {
         self.b_embedded
     }
@@ -728,6 +731,37 @@ pub(crate) mod tests {
                 (None, None) => {}
                 _ => panic!("{}: embedded weights and order go together", tableau.name()),
             }
+        }
+    }
+
+    /// Every row's embedded solution is described consistently: an embedded order with error
+    /// weights `b − b̂` of `s` entries, and `b̂` itself, when given, equal to `b` less them;
+    /// neither without an estimator. (Verner's orders are checked in `verner`'s tests.)
+    #[test]
+    fn every_row_describes_its_embedded_solution_consistently() {
+        let rows = crate::integrate::stability_function::explicit_tableau_methods();
+        assert_eq!(rows.len(), 9);
+        for (tableau, _) in rows {
+            let name = tableau.name();
+            match (tableau.embedded_order(), tableau.error_weights()) {
+                (Some(p), Some(e)) => {
+                    assert_eq!(p + 1, tableau.order(), "{name}");
+                    assert_eq!(e.len(), tableau.num_stages(), "{name}");
+                    if let Some(b_hat) = tableau.b_embedded() {
+                        for ((e, b), b_hat) in e.iter().zip(tableau.b()).zip(b_hat) {
+                            assert!((e - (b - b_hat)).abs() < 1e-16, "{name}");
+                        }
+                    }
+                }
+                (None, None) => assert!(tableau.b_embedded().is_none(), "{name}"),
+                _ => panic!("{name}: embedded order and error weights go together"),
+            }
+            assert_eq!(tableau.b().len(), tableau.num_stages(), "{name}");
+            assert_eq!(
+                tableau.interpolant().is_some(),
+                name.starts_with("vern"),
+                "{name}"
+            );
         }
     }
 

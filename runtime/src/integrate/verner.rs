@@ -5,7 +5,8 @@
 //! A step propagates the higher-order solution (local extrapolation) and estimates its error
 //! by the embedded one. The interpolant needs stages beyond the step's: they are evaluated
 //! only for a step that contains a requested output time or an event
-//! ([`Stepper::prepare_dense_output`]), as OrdinaryDiffEq.jl's `lazy` option does.
+//! ([`Stepper::prepare_dense_output`](super::stepper::Stepper::prepare_dense_output)), as
+//! OrdinaryDiffEq.jl's `lazy` option does.
 
 use super::Integrator;
 use super::controller::PiController;
@@ -586,7 +587,10 @@ mod tests {
     /// `eᶻ` to order `p` exactly (not `p + 1`: its degree is `s`).
     #[test]
     fn stability_polynomials_match_the_implementation() {
-        for (tableau, mut method) in explicit_tableau_methods().into_iter().skip(5) {
+        for (tableau, mut method) in explicit_tableau_methods()
+            .into_iter()
+            .filter(|(t, _)| t.interpolant().is_some())
+        {
             let (polynomial, stages) = (
                 StabilityPolynomial::of_tableau(&tableau),
                 tableau.num_stages(),

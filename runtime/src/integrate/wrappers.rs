@@ -6,8 +6,8 @@
 
 /// `new`, `with_controller`, `controller`, `Default` and the [`Integrator`](super::Integrator)
 /// implementation of an adaptive explicit pair: a struct with one field
-/// `controller: PiController`, adaptive unless [`IntegratorOptions::fixed_step`]
-/// (super::IntegratorOptions::fixed_step), whose stepper is `$stepper` for a system of
+/// `controller: PiController`, adaptive unless
+/// [`IntegratorOptions::fixed_step`](super::IntegratorOptions::fixed_step), whose stepper is `$stepper` for a system of
 /// dimension `$dim`.
 macro_rules! pi_controlled_integrator {
     (

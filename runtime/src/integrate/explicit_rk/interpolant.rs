@@ -26,7 +26,7 @@ impl InterpolantState {
     pub(super) fn new(interpolant: &'static Interpolant, dim: usize) -> Self {
         let all = interpolant.num_all_stages();
         // Stage 0's weight is replaced by that of the differences (see
-        // `prepare_interpolant`): Σᵢ bᵢ(θⱼ) = θⱼ.
+        // `InterpolantState::prepare`): Σᵢ bᵢ(θⱼ) = θⱼ.
         let mut node_weights = interpolant.node_weights.to_vec();
         for (row, &theta) in node_weights.chunks_exact_mut(all).zip(interpolant.nodes) {
             row[0] = theta;

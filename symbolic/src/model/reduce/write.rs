@@ -29,6 +29,9 @@ impl Rewriter<'_, '_> {
 
 impl Rewrite for Rewriter<'_, '_> {
     fn expr(&mut self, e: &Expr, place: &str) -> Result<String, NotRewritten> {
+        // Only the error of the expression that stops the writing is returned: one left out
+        // with a note before it is forgotten.
+        self.error = None;
         let result = self.reducer.rewrite(e, place);
         self.keep_error(result)
     }
@@ -37,6 +40,7 @@ impl Rewrite for Rewriter<'_, '_> {
         &mut self,
         _file: &ModelFile,
     ) -> Result<Option<Vec<(String, String)>>, NotRewritten> {
+        self.error = None;
         let result = self.reducer.generalized_forces(self.kept);
         self.keep_error(result).map(Some)
     }

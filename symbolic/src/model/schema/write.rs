@@ -4,7 +4,7 @@
 //!
 //! The writer writes expressions through a [`Rewrite`], so that a transformer (`reduce`) can
 //! write them in other coordinates, and takes what a transformer changes beyond expressions
-//! as [`Edits`]; with none (`Edits::default()`) the file is written as it is. Every value is
+//! as [`Edits`]; with none (`Edits::default()`) every section of the file is written. Every value is
 //! written in the form the schema reads, and what the text cannot carry is said in notes.
 
 use std::fmt::Write as _;
@@ -31,15 +31,6 @@ pub trait Rewrite {
     ) -> Result<Option<Vec<(String, String)>>, NotRewritten> {
         let _ = file;
         Ok(None)
-    }
-}
-
-/// Every expression as it is.
-pub struct AsWritten;
-
-impl Rewrite for AsWritten {
-    fn expr(&mut self, e: &Expr, _place: &str) -> Result<String, NotRewritten> {
-        Ok(e.to_string())
     }
 }
 
