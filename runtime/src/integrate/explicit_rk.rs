@@ -286,17 +286,7 @@ impl DenseOutput for ExplicitRk {
 }
 
 impl Stepper for ExplicitRk {
-    fn t(&self) -> f64 {
-        self.ends.t
-    }
-
-    fn y(&self) -> &[f64] {
-        &self.ends.y
-    }
-
-    fn derivative(&self) -> &[f64] {
-        &self.ends.f
-    }
+    stepper_state_from_ends!();
 
     fn reset(&mut self, rhs: &mut CheckedRhs<'_>, t0: f64, y0: &[f64]) -> Result<(), StepFailure> {
         self.ends.reset(rhs, t0, y0)?;

@@ -2,7 +2,8 @@
 //! accessors of a method with a [`PiController`](super::PiController), its
 //! [`Integrator`](super::Integrator) name and order, and the [`super::driver::Method`] that hands a
 //! problem to the one driver loop ([`super::driver::run`]) with its stepper. Each method's file
-//! keeps its type, its documentation and its stepper; these macros only spell out the glue.
+//! keeps its type, its documentation and its stepper; these macros only spell out the glue
+//! (and a stepper that keeps its ends in `StepEnds` its state accessors).
 
 /// `new`, `with_controller`, `controller`, `Default` and the [`Integrator`](super::Integrator)
 /// implementation of an adaptive explicit pair: a struct with one field
@@ -103,6 +104,24 @@ macro_rules! fixed_step_integrator {
                     Ok(ExplicitRk::new($tableau, shape.dim))
                 })
             }
+        }
+    };
+}
+
+/// `Stepper::{t, y, derivative}` of a stepper that keeps its step's ends in a field
+/// `ends: StepEnds`: the current time, state and `F` there.
+macro_rules! stepper_state_from_ends {
+    () => {
+        fn t(&self) -> f64 {
+            self.ends.t
+        }
+
+        fn y(&self) -> &[f64] {
+            &self.ends.y
+        }
+
+        fn derivative(&self) -> &[f64] {
+            &self.ends.f
         }
     };
 }
