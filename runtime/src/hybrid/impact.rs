@@ -14,14 +14,18 @@
 //! sticking: G_T q̇⁺ = 0, |Λ_T| ≤ μ Λ_N;  else sliding: Λ_T = ±μ Λ_N
 //! ```
 //!
-//! solved as one linear system (the impact's KKT matrix) by [`lu_solve`]. For one contact
-//! without friction or held constraints this is `Λ_N = −(1 + e) G_N q̇⁻ / (G_N M⁻¹ G_Nᵀ)`, and
-//! the kinetic energy lost `½ (1 − e²) (G_N q̇⁻)² / (G_N M⁻¹ G_Nᵀ) ≥ 0`.
+//! The impact is followed in impulse space (Routh's method): with `W` the inverse mass seen
+//! through the held constraints (`M w = D + Aᵀ λ`, `A w = 0`, one KKT solve by [`lu_solve`]
+//! per row), the velocities are linear in the impulses, and the normal impulse `p` grows from
+//! 0 while the contact slides against its slip (`dΛ_T = ∓μ dp`), sticks once the slip stops
+//! (if the cone holds the tangential impulse that sticking needs, else the slip reverses),
+//! until Newton's law `G_N q̇ = −e G_N q̇⁻` is met. For one contact without friction or held
+//! constraints this is `Λ_N = −(1 + e) G_N q̇⁻ / (G_N M⁻¹ G_Nᵀ)`, and the kinetic energy lost
+//! `½ (1 − e²) (G_N q̇⁻)² / (G_N M⁻¹ G_Nᵀ) ≥ 0`.
 //!
-//! A sliding impact keeps the direction of the sticking impulse that the cone could not
-//! supply (against the slip before the impact where the contact cannot stick at all). Newton's kinematic restitution with friction can be inconsistent (Stronge 2000,
-//! §4): the slip can stop or reverse during the impact, the normal impulse can turn negative,
-//! or the energy can grow. Each is returned as an error, never as a result.
+//! Newton's kinematic restitution with friction can still be inconsistent (Stronge 2000, §4):
+//! the normal velocity may not grow with the normal impulse (a Painlevé-type case), or the
+//! impact may add kinetic energy. Each is returned as an error, never as a result.
 //!
 //! # References
 //! - E. T. Whittaker, *Analytical Dynamics*, 4th ed., 1937, §94 (impulsive motion in
@@ -65,10 +69,14 @@ pub struct ContactFriction<'a> {
 pub enum ImpactMode {
     /// No friction at the contact.
     Frictionless,
-    /// The tangential velocity ends at 0, with `|Λ_T| ≤ μ Λ_N`.
+    /// The tangential velocity ends at 0 (from the start, or once the slip stopped), with the
+    /// tangential impulse inside the cone all along.
     Sticking,
-    /// The contact slides through the impact, `|Λ_T| = μ Λ_N`.
+    /// The contact slides one way through the impact, `|Λ_T| = μ Λ_N`.
     Sliding,
+    /// The slip stops during the impact and, the cone being too narrow to hold it, starts
+    /// again the other way.
+    Reversing,
 }
 
 /// The velocities after an impact, its impulses and the energy it took.
@@ -139,27 +147,19 @@ pub enum ImpactError {
         "the impact equations are singular: the contact's normal or tangent depends on the constraints that hold, or the mass matrix is singular"
     )]
     Singular,
-    /// The normal impulse would pull (`Λ_N < 0`): no consistent impact with this contact
-    /// mode (with friction, a Painlevé-type inconsistency).
-    #[error("the normal impulse would pull ({normal_impulse}) in the {mode:?} impact")]
-    Pulling {
-        /// `Λ_N`.
-        normal_impulse: f64,
-        /// The mode tried.
-        mode: ImpactMode,
-    },
-    /// The slip would stop or reverse during a sliding impact, where kinematic restitution
-    /// with friction has no consistent solution of one sliding direction.
+    /// No pushing normal impulse meets Newton's law: the normal velocity does not grow
+    /// with the normal impulse in the contact's mode (with friction, a Painlevé-type
+    /// inconsistency).
     #[error(
-        "the slip reverses during the impact (tangential velocity {before} → {after} against the friction impulse {impulse})"
+        "no pushing normal impulse meets Newton's law in the {mode:?} phase (normal velocity {normal_velocity} m/s, growing at {rate} per unit impulse)"
     )]
-    SlipReversal {
-        /// `G_T q̇⁻`.
-        before: f64,
-        /// `G_T q̇⁺`.
-        after: f64,
-        /// `Λ_T`.
-        impulse: f64,
+    Pulling {
+        /// `G_N q̇` where it stops growing.
+        normal_velocity: f64,
+        /// `d(G_N q̇)/dΛ_N` in that phase (≤ 0).
+        rate: f64,
+        /// The phase.
+        mode: ImpactMode,
     },
     /// The impact would add kinetic energy (kinematic restitution with friction can).
     #[error("the impact would gain kinetic energy: {before} J → {after} J")]
@@ -176,20 +176,16 @@ pub enum ImpactError {
 /// it, `holding` (`r × n`, row-major, the rows `A` of their velocity form: holonomic and
 /// non-holonomic constraints and contacts already closed). See the module's equations.
 ///
-/// With friction the sticking impact is tried first; where its tangential impulse leaves the
-/// cone `|Λ_T| ≤ μ Λ_N`, the sliding impact on the cone's edge in the same direction.
-///
 /// # Errors
 /// [`ImpactError`]: wrong lengths, NaN or infinite inputs, `e ∉ [0, 1]`, `μ < 0`, a contact
 /// that is not closing, singular equations, and the inconsistencies of kinematic restitution
-/// with friction (a pulling normal impulse, a reversing slip, a gain of energy).
+/// with friction (no pushing normal impulse, a gain of energy).
 pub fn impact(
     mass_matrix: &[f64],
     qdot: &[f64],
     contact: &ImpactContact<'_>,
     holding: &[f64],
 ) -> Result<ImpactReport, ImpactError> {
-    let n = qdot.len();
     check_inputs(mass_matrix, qdot, contact, holding)?;
     let normal_before = dot(contact.normal, qdot);
     if normal_before >= 0.0 {
@@ -197,59 +193,57 @@ pub fn impact(
             normal_velocity: normal_before,
         });
     }
-    let holding: Vec<&[f64]> = if n == 0 {
-        Vec::new()
-    } else {
-        holding.chunks_exact(n).collect()
+    let n = qdot.len();
+    let held: Vec<&[f64]> = holding.chunks_exact(n).collect();
+    let normal = response(mass_matrix, &held, contact.normal)?;
+    let tangent = match &contact.friction {
+        Some(f) => Some((f, response(mass_matrix, &held, f.tangent)?)),
+        None => None,
     };
-    let kkt = Kkt {
-        mass_matrix,
-        qdot,
-        normal: contact.normal,
-        normal_target: -contact.restitution * normal_before,
-        holding: &holding,
-    };
-    let Outcome {
-        mode,
-        qdot: after,
-        normal_impulse,
-        tangential_impulse,
-        held,
-    } = match contact.friction {
+    let target = -contact.restitution * normal_before;
+    let process = match &tangent {
         None => {
-            let (after, impulses) = kkt.solve(None)?;
-            Outcome {
+            let rate = Rate::of(contact.normal, &normal.velocity);
+            if !rate.is_positive() {
+                // The held rows fix the normal velocity.
+                return Err(ImpactError::Singular);
+            }
+            let normal_impulse =
+                phase_to_target(normal_before, rate, target, ImpactMode::Frictionless)?;
+            Process {
                 mode: ImpactMode::Frictionless,
-                qdot: after,
-                normal_impulse: impulses[0],
+                normal_impulse,
                 tangential_impulse: 0.0,
-                held: impulses[1..].to_vec(),
             }
         }
-        Some(friction) => kkt.frictional(&friction)?,
+        Some((f, t)) => {
+            let rates = Rates {
+                nn: Rate::of(contact.normal, &normal.velocity),
+                nt: Rate::of(contact.normal, &t.velocity),
+                tt: Rate::of(f.tangent, &t.velocity),
+            };
+            routh(
+                normal_before,
+                dot(f.tangent, qdot),
+                target,
+                f.coefficient,
+                rates,
+            )?
+        }
     };
-    if normal_impulse < 0.0 {
-        return Err(ImpactError::Pulling {
-            normal_impulse,
-            mode,
-        });
+    let (p, q) = (process.normal_impulse, process.tangential_impulse);
+    let mut after = qdot.to_vec();
+    let mut held_impulses: Vec<f64> = normal.held.iter().map(|l| l * p).collect();
+    for (v, w) in after.iter_mut().zip(&normal.velocity) {
+        *v += w * p;
     }
-    let tangential_velocity = match contact.friction {
-        Some(f) => [dot(f.tangent, qdot), dot(f.tangent, &after)],
-        None => [0.0, 0.0],
-    };
-    // Sliding, the friction impulse opposes the slip: a final tangential velocity along it
-    // means the slip stopped or reversed within the impact.
-    let [v_before, v_after] = tangential_velocity;
-    let slip_scale = v_before.abs() + normal_before.abs();
-    if mode == ImpactMode::Sliding
-        && v_after * tangential_impulse > ROUNDING * slip_scale * tangential_impulse.abs()
-    {
-        return Err(ImpactError::SlipReversal {
-            before: v_before,
-            after: v_after,
-            impulse: tangential_impulse,
-        });
+    if let Some((_, t)) = &tangent {
+        for (v, w) in after.iter_mut().zip(&t.velocity) {
+            *v += w * q;
+        }
+        for (h, l) in held_impulses.iter_mut().zip(&t.held) {
+            *h += l * q;
+        }
     }
     let kinetic_energy = [
         kinetic_energy(mass_matrix, qdot),
@@ -261,13 +255,17 @@ pub fn impact(
             after: kinetic_energy[1],
         });
     }
+    let tangential_velocity = match &contact.friction {
+        Some(f) => [dot(f.tangent, qdot), dot(f.tangent, &after)],
+        None => [0.0, 0.0],
+    };
     Ok(ImpactReport {
         normal_velocity: [normal_before, dot(contact.normal, &after)],
         qdot: after,
-        mode,
-        normal_impulse,
-        tangential_impulse,
-        holding_impulses: held,
+        mode: process.mode,
+        normal_impulse: p,
+        tangential_impulse: q,
+        holding_impulses: held_impulses,
         tangential_velocity,
         energy_lost: kinetic_energy[0] - kinetic_energy[1],
         kinetic_energy,
@@ -342,114 +340,181 @@ fn kinetic_energy(mass_matrix: &[f64], v: &[f64]) -> f64 {
     0.5 * quadratic
 }
 
-/// The tangent row of a frictional impact.
-enum Tangent<'a> {
-    /// `G_T q̇⁺ = 0`, with its own impulse.
-    Sticking(&'a [f64]),
-    /// No tangent row; the normal impulse acts along `G_N + slope · G_T` (`slope = ±μ`).
-    Sliding(&'a [f64], f64),
-}
-
-/// What an impact's equations gave: the mode, `q̇⁺` and the impulses.
-struct Outcome {
-    mode: ImpactMode,
-    qdot: Vec<f64>,
-    normal_impulse: f64,
-    tangential_impulse: f64,
-    /// `Λ_A`.
+/// The response to a unit generalized impulse along a row `D`: the change of speeds
+/// `w = W Dᵀ` and the impulses of the held rows.
+struct Response {
+    velocity: Vec<f64>,
     held: Vec<f64>,
 }
 
-/// The impact's equations without their tangent row.
-struct Kkt<'a> {
-    mass_matrix: &'a [f64],
-    qdot: &'a [f64],
-    normal: &'a [f64],
-    /// `−e G_N q̇⁻`.
-    normal_target: f64,
-    holding: &'a [&'a [f64]],
+/// [`Response`] to `direction`: `M w − Aᵀ λ = Dᵀ`, `A w = 0`.
+fn response(
+    mass_matrix: &[f64],
+    held: &[&[f64]],
+    direction: &[f64],
+) -> Result<Response, ImpactError> {
+    let n = direction.len();
+    let k = n + held.len();
+    let mut matrix = vec![0.0; k * k];
+    let mut rhs = vec![0.0; k];
+    for r in 0..n {
+        for c in 0..n {
+            matrix[r * k + c] = mass_matrix[r + c * n];
+        }
+        rhs[r] = direction[r];
+    }
+    for (j, row) in held.iter().enumerate() {
+        for (i, &a) in row.iter().enumerate() {
+            matrix[i * k + n + j] = -a;
+            matrix[(n + j) * k + i] = a;
+        }
+    }
+    let mut pivots = vec![0; k];
+    lu_solve(&mut matrix, &mut rhs, &mut pivots, k).ok_or(ImpactError::Singular)?;
+    if rhs.iter().any(|v| !v.is_finite()) {
+        return Err(ImpactError::Singular);
+    }
+    let held = rhs.split_off(n);
+    Ok(Response {
+        velocity: rhs,
+        held,
+    })
 }
 
-impl Kkt<'_> {
-    /// The impact with `friction`: sticking if its tangential impulse lies in the cone, else
-    /// sliding on the cone's edge in the direction of the sticking impulse that it could not
-    /// supply; where the contact cannot stick (its tangent velocity is set by the other rows,
-    /// so that the sticking equations are singular), against the slip before the impact.
-    fn frictional(&self, friction: &ContactFriction<'_>) -> Result<Outcome, ImpactError> {
-        let sticking = self.solve(Some(Tangent::Sticking(friction.tangent))).ok();
-        if let Some((after, impulses)) = &sticking
-            && impulses[1].abs() <= friction.coefficient * impulses[0]
-        {
-            return Ok(Outcome {
-                mode: ImpactMode::Sticking,
-                qdot: after.clone(),
-                normal_impulse: impulses[0],
-                tangential_impulse: impulses[1],
-                held: impulses[2..].to_vec(),
-            });
+/// A velocity's change per unit impulse, `G W Dᵀ`, with the size of the products it sums
+/// (`Σ |Gᵢ wᵢ|`), against which a rate that rounding left near 0 is told from a true one.
+#[derive(Debug, Clone, Copy)]
+struct Rate {
+    value: f64,
+    size: f64,
+}
+
+impl Rate {
+    /// `row · w`.
+    fn of(row: &[f64], w: &[f64]) -> Self {
+        Self {
+            value: dot(row, w),
+            size: row.iter().zip(w).map(|(a, b)| (a * b).abs()).sum(),
         }
-        let direction = match &sticking {
-            Some((_, impulses)) => impulses[1],
-            None => -dot(friction.tangent, self.qdot),
-        };
-        if direction == 0.0 {
-            return Err(ImpactError::Singular);
-        }
-        let slope = direction.signum() * friction.coefficient;
-        let (after, impulses) = self.solve(Some(Tangent::Sliding(friction.tangent, slope)))?;
-        Ok(Outcome {
-            mode: ImpactMode::Sliding,
-            qdot: after,
-            normal_impulse: impulses[0],
-            tangential_impulse: slope * impulses[0],
-            held: impulses[1..].to_vec(),
-        })
     }
 
-    /// `q̇⁺` and the impulses: `Λ_N`, then `Λ_T` if sticking, then `Λ_A`; from
-    /// `M q̇⁺ − Σ Dⱼᵀ Λⱼ = M q̇⁻`, `Wⱼ q̇⁺ = wⱼ`, with `Dⱼ` the direction of impulse `j` and
-    /// `Wⱼ` its velocity row (equal but for the sliding normal).
-    fn solve(&self, tangent: Option<Tangent<'_>>) -> Result<(Vec<f64>, Vec<f64>), ImpactError> {
-        let n = self.qdot.len();
-        let mut normal_direction = self.normal.to_vec();
-        if let Some(Tangent::Sliding(t, slope)) = &tangent {
-            for (d, ti) in normal_direction.iter_mut().zip(t.iter()) {
-                *d += slope * ti;
-            }
-        }
-        // (direction, velocity row, target).
-        let mut rows: Vec<(&[f64], &[f64], f64)> =
-            vec![(&normal_direction, self.normal, self.normal_target)];
-        if let Some(Tangent::Sticking(t)) = tangent {
-            rows.push((t, t, 0.0));
-        }
-        for row in self.holding {
-            rows.push((row, row, dot(row, self.qdot)));
-        }
-        let k = n + rows.len();
-        let mut matrix = vec![0.0; k * k];
-        let mut rhs = vec![0.0; k];
-        for r in 0..n {
-            for c in 0..n {
-                matrix[r * k + c] = self.mass_matrix[r + c * n];
-            }
-            rhs[r] = (0..n)
-                .map(|c| self.mass_matrix[r + c * n] * self.qdot[c])
-                .sum();
-        }
-        for (j, (direction, velocity, target)) in rows.iter().enumerate() {
-            for i in 0..n {
-                matrix[i * k + n + j] = -direction[i];
-                matrix[(n + j) * k + i] = velocity[i];
-            }
-            rhs[n + j] = *target;
-        }
-        let mut pivots = vec![0; k];
-        lu_solve(&mut matrix, &mut rhs, &mut pivots, k).ok_or(ImpactError::Singular)?;
-        if rhs.iter().any(|v| !v.is_finite()) {
-            return Err(ImpactError::Singular);
-        }
-        let impulses = rhs.split_off(n);
-        Ok((rhs, impulses))
+    /// Whether it is positive beyond the rounding of its products (false for NaN).
+    fn is_positive(self) -> bool {
+        self.value > ROUNDING * self.size
     }
+
+    /// `self + k · other`.
+    fn plus(self, k: f64, other: Rate) -> Self {
+        Self {
+            value: self.value + k * other.value,
+            size: self.size + k.abs() * other.size,
+        }
+    }
+}
+
+/// How the normal and tangential velocities change per unit impulse: `G_N W G_Nᵀ`,
+/// `G_N W G_Tᵀ` (= `G_T W G_Nᵀ`) and `G_T W G_Tᵀ`.
+#[derive(Debug, Clone, Copy)]
+struct Rates {
+    nn: Rate,
+    nt: Rate,
+    tt: Rate,
+}
+
+/// The impulses of the whole impact and how it ended.
+struct Process {
+    mode: ImpactMode,
+    normal_impulse: f64,
+    tangential_impulse: f64,
+}
+
+/// The normal impulse that takes the normal velocity from `from` to `target` at `rate` per
+/// unit impulse.
+///
+/// # Errors
+/// [`ImpactError::Pulling`] where the rate is not positive beyond rounding.
+fn phase_to_target(
+    from: f64,
+    rate: Rate,
+    target: f64,
+    mode: ImpactMode,
+) -> Result<f64, ImpactError> {
+    if !rate.is_positive() {
+        return Err(ImpactError::Pulling {
+            normal_velocity: from,
+            rate: rate.value,
+            mode,
+        });
+    }
+    Ok((target - from) / rate.value)
+}
+
+/// Routh's process in impulse space for a contact with friction `mu`: from the normal and
+/// tangential velocities `v_n < 0` and `v_t`, the normal impulse `p` grows until the normal
+/// velocity reaches `target` (Newton's law). While the contact slips (`v_t ≠ 0`), friction
+/// opposes it, `dΛ_T = −sign(v_t) μ dp`; when the slip stops it sticks, if
+/// `|G_T W G_Nᵀ| ≤ μ G_T W G_Tᵀ` (the tangential impulse sticking needs lies in the cone),
+/// else it slips again the other way.
+///
+/// # Errors
+/// [`ImpactError::Pulling`] where the normal velocity does not grow in the phase that must
+/// reach the target; [`ImpactError::Singular`] where sticking needs `G_T W G_Tᵀ = 0`.
+fn routh(v_n: f64, v_t: f64, target: f64, mu: f64, a: Rates) -> Result<Process, ImpactError> {
+    let (mut p, mut q, mut normal) = (0.0, 0.0, v_n);
+    if v_t != 0.0 {
+        let s = -v_t.signum() * mu;
+        let (normal_rate, tangent_rate) = (a.nn.plus(s, a.nt), a.nt.plus(s, a.tt));
+        // The impulse at which the slip stops, if it does.
+        let stops = if tangent_rate.value * v_t < 0.0 {
+            -v_t / tangent_rate.value
+        } else {
+            f64::INFINITY
+        };
+        let to_target = phase_to_target(v_n, normal_rate, target, ImpactMode::Sliding);
+        match to_target {
+            Ok(done) if done <= stops => {
+                return Ok(Process {
+                    mode: ImpactMode::Sliding,
+                    normal_impulse: done,
+                    tangential_impulse: s * done,
+                });
+            }
+            Err(error) if stops.is_infinite() => return Err(error),
+            _ => {}
+        }
+        p = stops;
+        q = s * stops;
+        normal = v_n + normal_rate.value * stops;
+        if normal >= target {
+            // The slip stops where the target is met (rounding).
+            return Ok(Process {
+                mode: ImpactMode::Sticking,
+                normal_impulse: p,
+                tangential_impulse: q,
+            });
+        }
+    }
+    if !a.tt.is_positive() {
+        return Err(ImpactError::Singular);
+    }
+    // The tangential impulse per unit normal impulse that keeps the slip at 0.
+    let ratio = -a.nt.value / a.tt.value;
+    let (mode, slope) = if ratio.abs() <= mu {
+        (ImpactMode::Sticking, ratio)
+    } else {
+        // Slipping in the direction the normal impulse drives it, friction against it.
+        (ImpactMode::Reversing, -a.nt.value.signum() * mu)
+    };
+    let mode = if mode == ImpactMode::Reversing && v_t == 0.0 {
+        ImpactMode::Sliding
+    } else {
+        mode
+    };
+    let rate = a.nn.plus(slope, a.nt);
+    let more = phase_to_target(normal, rate, target, mode)?;
+    Ok(Process {
+        mode,
+        normal_impulse: p + more,
+        tangential_impulse: q + slope * more,
+    })
 }
