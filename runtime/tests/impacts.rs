@@ -298,3 +298,99 @@ proptest! {
         }
     }
 }
+
+/// The impact of [`impact`] against the same impact computed another way: the normal
+/// impulse stepped in 2·10⁴ small increments, each applying friction against the slip of the
+/// moment (or, once the slip has changed sign within an increment, the tangential impulse
+/// that holds it at 0 if the cone allows, else friction the other way), until Newton's law
+/// is met. On 100 random systems of 2 and 3 freedoms with `μ` in [0, 1.5], where both
+/// succeed, the speeds agree to four increments' change of the speeds (the stepped process is
+/// off by one at each change of mode and one at the end).
+#[test]
+fn the_impulse_process_matches_small_increments() {
+    let mut seed = 2024u64;
+    let mut rnd = || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        (seed % 2_000_000) as f64 / 1_000_000.0 - 1.0
+    };
+    let (mut compared, mut modes) = (0, std::collections::BTreeMap::new());
+    for case in 0..100 {
+        let n = 2 + case % 2;
+        let b: Vec<f64> = (0..n * n).map(|_| rnd()).collect();
+        let mass = spd(&b, n);
+        let normal: Vec<f64> = (0..n).map(|_| rnd()).collect();
+        let tangent: Vec<f64> = (0..n).map(|_| rnd()).collect();
+        let mut qdot: Vec<f64> = (0..n).map(|_| rnd()).collect();
+        let dot = |a: &[f64], b: &[f64]| -> f64 { a.iter().zip(b).map(|(x, y)| x * y).sum() };
+        if dot(&normal, &qdot) > 0.0 {
+            qdot.iter_mut().for_each(|v| *v = -*v);
+        }
+        let (e, mu) = ((rnd() + 1.0) / 2.0, 0.75 * (rnd() + 1.0));
+        let contact = ImpactContact {
+            normal: &normal,
+            restitution: e,
+            friction: Some(ContactFriction {
+                tangent: &tangent,
+                coefficient: mu,
+            }),
+        };
+        let Ok(r) = impact(&mass, &qdot, &contact, &[]) else {
+            continue;
+        };
+        // W = M⁻¹ and the responses to unit normal and tangential impulses.
+        let inverse = nalgebra::DMatrix::from_column_slice(n, n, &mass)
+            .try_inverse()
+            .unwrap();
+        let w_n = &inverse * nalgebra::DVector::from_column_slice(&normal);
+        let w_t = &inverse * nalgebra::DVector::from_column_slice(&tangent);
+        let (a_nt, a_tt) = (dot(&normal, w_t.as_slice()), dot(&tangent, w_t.as_slice()));
+        let target = -e * dot(&normal, &qdot);
+        let dp = r.normal_impulse / 20_000.0;
+        let mut v = qdot.clone();
+        let mut stuck = false;
+        let mut guard = 0;
+        while dot(&normal, &v) < target && guard < 40_000 {
+            guard += 1;
+            let slip = dot(&tangent, &v);
+            let ratio = -a_nt / a_tt;
+            let dq = if stuck {
+                if ratio.abs() <= mu {
+                    ratio
+                } else {
+                    -a_nt.signum() * mu
+                }
+            } else {
+                -slip.signum() * mu
+            };
+            let next: Vec<f64> = (0..n)
+                .map(|i| v[i] + w_n[i] * dp + w_t[i] * dq * dp)
+                .collect();
+            if !stuck && dot(&tangent, &next) * slip < 0.0 {
+                stuck = true;
+            }
+            v = next;
+        }
+        if guard >= 40_000 {
+            continue;
+        }
+        // One increment's change of the speeds: the stepped process is off by at most one
+        // at each change of mode and one at the end.
+        let step = (0..n)
+            .map(|i| (w_n[i].abs() + mu * w_t[i].abs()) * dp)
+            .fold(0.0f64, f64::max);
+        for (a, b) in r.qdot.iter().zip(&v) {
+            assert!(
+                (a - b).abs() <= 4.0 * step,
+                "case {case}: {:?} vs {v:?} ({:?}), increment {step:e}",
+                r.qdot,
+                r.mode
+            );
+        }
+        compared += 1;
+        *modes.entry(format!("{:?}", r.mode)).or_insert(0) += 1;
+    }
+    println!("compared {compared}: {modes:?}");
+    assert!(compared >= 50 && modes.len() == 3, "{compared}: {modes:?}");
+}
