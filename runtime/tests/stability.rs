@@ -24,7 +24,7 @@ use eomgen_runtime::integrate::stability_function::{
 use eomgen_runtime::{
     DormandPrince54, DormandPrince853, ExplicitEuler, ExplicitMidpoint, ImplicitMidpoint,
     Integrator, IntegratorOptions, ModeKind, OutputTimes, RadauIIA5, StormerVerlet,
-    SymplecticEuler, Tableau,
+    SymplecticEuler, Tableau, Verner76, Verner87,
 };
 use nalgebra::Complex;
 
@@ -81,8 +81,8 @@ fn explicit_stability_limits_match_theory_to_one_percent() {
         ];
         for (equation, theory, at_detection) in cases {
             if theory == 0.0 {
-                // Empty interval (Euler and the midpoint rule on the imaginary axis: see the
-                // amplification test; Verner 7(6) and 8(7) there too, not measured).
+                // No interval from 0 (Euler, the midpoint rule, Verner 7(6) and 8(7) on the
+                // imaginary axis): see the amplification test.
                 continue;
             }
             let measured = measured_limit(method.as_mut(), equation, &TEST, 1e-5)
@@ -180,21 +180,31 @@ fn tableau_polynomials_match_the_implementations() {
     }
 }
 
-/// Explicit Euler and midpoint have no stable `hω > 0` on the oscillator: their measured
-/// per-step amplification over 50 steps equals `|R(ihω)| > 1` (`√(1 + θ²)`, `√(1 + θ⁴/4)`) to
-/// 1e-12 relative (the step matrix is `|R|` times a rotation, so the only error is rounding,
-/// ~ε per step, and the 50th root divides it by 50).
+/// Explicit Euler and midpoint have no stable `hω > 0` on the oscillator, and Verner 7(6) and
+/// 8(7) none near 0: their measured per-step amplification over 50 steps equals
+/// `|R(ihω)| > 1` (`√(1 + θ²)`, `√(1 + θ⁴/4)` for the first two; for Verner's, 1 + 1.7e-9 and
+/// 1 + 5.4e-7 at 0.5 and 1 for 7(6), 1 + 6.7e-9 and 1 + 9.9e-7 at 1 and 2 for 8(7), where
+/// their growth is large enough for the bound to resolve) to 1e-12 relative (the step matrix
+/// is `|R|` times a rotation, so the only error is rounding, ~ε per step, and the 50th root
+/// divides it by 50). (Verner 7(6) is stable again at 2, `|R| = 1 − 1.5e-5`.)
 #[test]
-fn euler_and_midpoint_amplify_by_their_stability_function() {
-    for (tableau, mut method) in [
+fn methods_without_an_imaginary_interval_amplify_by_their_stability_function() {
+    for (tableau, mut method, steps) in [
         (
             Tableau::euler(),
             Box::new(ExplicitEuler::new()) as Box<dyn Integrator>,
+            &[0.1, 0.5, 1.0, 2.0][..],
         ),
-        (Tableau::midpoint(), Box::new(ExplicitMidpoint::new())),
+        (
+            Tableau::midpoint(),
+            Box::new(ExplicitMidpoint::new()),
+            &[0.1, 0.5, 1.0, 2.0],
+        ),
+        (Tableau::vern7(), Box::new(Verner76::new()), &[0.5, 1.0]),
+        (Tableau::vern8(), Box::new(Verner87::new()), &[1.0, 2.0]),
     ] {
         let r = StabilityPolynomial::of_tableau(&tableau);
-        for h in [0.1, 0.5, 1.0, 2.0] {
+        for &h in steps {
             let measured = amplification(method.as_mut(), TestEquation::Oscillator, h, 50).unwrap();
             let theory = r.eval(Complex::new(0.0, h)).norm();
             assert!(theory > 1.0);
