@@ -1,6 +1,9 @@
 //! The coefficients of Verner's "most efficient" Runge–Kutta pairs 6(5), 7(6), 8(7) and 9(8)
 //! with their interpolants, as [`Tableau`]s.
 //!
+//! long: a table of coefficients (four pairs of up to 26 stages with their interpolants'
+//! weights), data rather than code; split, it would only scatter one source's numbers.
+//!
 //! Source: J. H. Verner's "Refuge for Runge–Kutta pairs", <https://www.sfu.ca/~jverner/>
 //! (the coefficient sets are the author's copyright; they may be used in software that
 //! acknowledges the source and gives this address); the pairs are those of J. H. Verner,
@@ -13,9 +16,6 @@
 //! rational or algebraic value; a coefficient the source gives as a decimal, with every digit
 //! it prints. The compiler rounds each to the nearest `f64`. The tests of `verner` check the
 //! order conditions, the row sums and the interpolants against these numbers.
-//!
-//! long: a table of coefficients (four pairs of up to 26 stages with their interpolants'
-//! weights), data rather than code; split, it would only scatter one source's numbers.
 //!
 //! Stages are numbered from 0 here (Verner numbers them from 1). Row `i` of `a` holds
 //! `aᵢ₀ … aᵢ,ᵢ₋₁`; the rows after the step's own stages are the interpolant's extra stages.
