@@ -10,6 +10,7 @@ use crate::expr::{Constant, ExprArena, ExprId, Func, SymbolId, SymbolKind};
 use crate::model::ast::{BinOp, Expr, ExprKind};
 use crate::model::checks::FloquetReference;
 use crate::model::diagnostic::Diagnostic;
+use crate::model::elements::{self, contact::ContactInfo};
 use crate::model::file::{BodyKind, GROUND_FRAME, ModelFile, TorqueValue};
 use crate::model::located::{Located, Location};
 use crate::model::rules::short;
@@ -215,6 +216,8 @@ pub struct SymbolicModel {
     pub hand_equations: Vec<ExprId>,
     /// Holonomic and non-holonomic constraints at the acceleration level (empty if none).
     pub constraints: ConstraintEquations,
+    /// Unilateral contacts (`contacts:`), in file order.
+    pub contacts: Vec<ContactInfo>,
     /// Coordinates whose initial value is a guess to be solved from the constraints.
     pub initial_guesses: Vec<usize>,
     /// The file's `events:` (empty if none).
@@ -472,6 +475,11 @@ impl<'f> Lowering<'f> {
                     .symbol(&format!("lambda_{name}"), SymbolKind::Multiplier(i as u32));
             }
         }
+        let contacts: Vec<ContactInfo> = file
+            .contacts
+            .iter()
+            .filter_map(|c| c.lower(&mut self))
+            .collect();
         let events = self.events();
         let equilibria = self.equilibria(&coordinate_names);
         let initial_guesses: Vec<usize> = file
@@ -544,6 +552,7 @@ impl<'f> Lowering<'f> {
             written_forces,
             hand_equations,
             constraints,
+            contacts,
             initial_guesses,
             events,
             equilibria,
@@ -724,6 +733,22 @@ impl<'f> Lowering<'f> {
 
 /// The points of a model: name and position, in file order.
 type Points = Vec<(String, Vec<ExprId>)>;
+
+/// The lowering as an element's context ([`elements::Lower`]).
+impl elements::Lower for Lowering<'_> {
+    fn arena(&mut self) -> &mut ExprArena {
+        &mut self.arena
+    }
+    fn expr(&mut self, e: &Expr) -> ExprId {
+        Lowering::expr(self, e)
+    }
+    fn point(&self, name: &str) -> Option<Vec<ExprId>> {
+        point(&self.points, name).map(|i| self.points[i].1.clone())
+    }
+    fn error(&mut self, d: Diagnostic) {
+        self.errors.push(d);
+    }
+}
 
 /// The index of the point called `name`.
 fn point(points: &Points, name: &str) -> Option<usize> {

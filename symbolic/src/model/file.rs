@@ -4,6 +4,7 @@
 //! `file:line:col`. Maps of the YAML file keep file order (vectors here).
 
 use super::ast::Expr;
+pub use super::elements::contact::{Contact, Gap};
 // The `checks:` and `floquet:` types live in `checks.rs`; they are named here too, where
 // they were first defined.
 pub use super::checks::{
@@ -607,6 +608,8 @@ pub struct ModelFile {
     /// `nonholonomic:` entries that are rolling contacts, in file order (their constraints
     /// come after those of [`Self::nonholonomic`]).
     pub rolling: Vec<RollingContact>,
+    /// `contacts:` — unilateral contacts, in file order.
+    pub contacts: Vec<Contact>,
     /// Coordinates whose `initial:` value is only a guess (`theta2: { guess: 0.5 }`): the
     /// runtime solves them, and their rates, from the constraints.
     pub initial_guesses: Vec<Located<String>>,

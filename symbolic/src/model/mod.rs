@@ -9,6 +9,7 @@
 pub mod ast;
 pub mod checks;
 pub mod diagnostic;
+pub mod elements;
 pub mod file;
 pub mod located;
 pub mod parser;

@@ -8,6 +8,7 @@ use rustc_hash::FxHashSet;
 
 use super::ast::{Expr, FUNCTIONS};
 use super::diagnostic::{Diagnostic, Diagnostics};
+use super::elements::{self, Depends};
 use super::file::{
     Axis, BalanceKind, BodyKind, GROUND_FRAME, InertiaTensor, ModelFile, Parameter, RollingContact,
     TorqueValue,
@@ -68,6 +69,9 @@ pub(crate) fn check_parts(
     checker.reference_checks();
     checker.floquet_references();
     checker.constraints();
+    for contact in &file.contacts {
+        contact.rules(&mut checker);
+    }
     checker.interactions();
     checker.outputs();
     let units = super::unit_check::check(file);
@@ -94,21 +98,6 @@ pub fn evaluate(expr: &Expr, parameters: &[Parameter]) -> Option<f64> {
             .map(|p| p.value)
     })
     .ok()
-}
-
-/// What an expression may depend on.
-#[derive(Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
-enum Depends {
-    /// Parameters, numbers, `pi` and functions.
-    Constant,
-    /// Also coordinates and `t` (a configuration).
-    Position,
-    /// Also rates (`x_dot`).
-    Motion,
-    /// Also accelerations (`x_ddot`): only equations of motion written by hand.
-    Acceleration,
-    /// Also constraint forces (`lambda_<constraint>`): only event functions.
-    Event,
 }
 
 struct Checker<'f> {
@@ -316,4 +305,23 @@ fn principal_moments([xx, yy, zz, xy, yz, xz]: [f64; 6]) -> [f64; 3] {
     };
     e.sort_by(f64::total_cmp);
     e
+}
+
+/// The rules pass as an element's context ([`elements::Rules`]).
+impl elements::Rules for Checker<'_> {
+    fn point(&mut self, name: &Located<String>) {
+        Checker::point(self, name);
+    }
+    fn expression(&mut self, e: &Expr, depends: Depends, what: &str) {
+        self.resolve(e, depends, what);
+    }
+    fn value(&self, e: &Expr) -> Option<f64> {
+        evaluate(e, &self.file.parameters)
+    }
+    fn dimension(&self) -> usize {
+        self.file.dimension.unwrap_or(2)
+    }
+    fn error(&mut self, d: Diagnostic) {
+        Checker::error(self, d);
+    }
 }

@@ -36,10 +36,7 @@ impl Rewrite for Rewriter<'_, '_> {
         self.keep_error(result)
     }
 
-    fn generalized_forces(
-        &mut self,
-        _file: &ModelFile,
-    ) -> Result<Option<Vec<(String, String)>>, NotRewritten> {
+    fn generalized_forces(&mut self) -> Result<Option<Vec<(String, String)>>, NotRewritten> {
         self.error = None;
         let result = self.reducer.generalized_forces(self.kept);
         self.keep_error(result).map(Some)

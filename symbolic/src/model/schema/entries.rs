@@ -6,10 +6,10 @@ use super::super::parser::closest;
 use super::super::yaml::YamlNode;
 
 /// The entries of a YAML map, in file order.
-pub(super) type Entries = [(Located<String>, YamlNode)];
+pub(crate) type Entries = [(Located<String>, YamlNode)];
 
 /// The value of `key` in `entries`.
-pub(super) fn get<'n>(entries: &'n Entries, key: &str) -> Option<&'n YamlNode> {
+pub(crate) fn get<'n>(entries: &'n Entries, key: &str) -> Option<&'n YamlNode> {
     entries.iter().find(|(k, _)| k.value == key).map(|(_, v)| v)
 }
 

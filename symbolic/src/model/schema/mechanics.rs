@@ -3,7 +3,7 @@
 //! (its frames and bodies: `bodies.rs`).
 
 use super::walk::{Fields, Keyed, Need};
-use super::write::{NotRewritten, Writer, axes_list, flow, in_frame, list, scalar};
+use super::write::{NotRewritten, Writer, flow, list, scalar};
 use super::*;
 
 /// The keys of a spring.
@@ -897,4 +897,18 @@ impl Writer<'_> {
         }
         Ok(())
     }
+}
+
+/// `, in: F` for a frame other than the ground's, else nothing.
+fn in_frame(frame: Option<&Located<String>>) -> String {
+    match frame {
+        Some(f) if f.value != GROUND_FRAME => format!(", in: {}", f.value),
+        _ => String::new(),
+    }
+}
+
+/// `[x, y]` of axes.
+fn axes_list(axes: &[Axis]) -> String {
+    let letters: Vec<String> = axes.iter().map(|a| a.letter().to_string()).collect();
+    format!("[{}]", letters.join(", "))
 }

@@ -17,16 +17,18 @@
 
 mod bodies;
 mod checks;
-mod entries;
+pub(crate) mod entries;
 mod floquet;
 mod mechanics;
 mod sections;
 mod states;
 mod values;
-mod walk;
+pub(crate) mod walk;
 pub mod write;
 
 pub use sections::write_file;
+pub(crate) use walk::Ctx;
+pub use walk::Incomplete;
 
 use std::collections::HashMap;
 
@@ -80,6 +82,7 @@ pub const TOP_LEVEL_KEYS: &[&str] = &[
     "checks",
     "constraints",
     "nonholonomic",
+    "contacts",
     "events",
     "equilibria",
     "floquet",
@@ -110,31 +113,6 @@ pub struct Built {
     pub diagnostics: Vec<Diagnostic>,
 }
 
-/// Parts of a model that the schema pass left out because of an error it already reported.
-///
-/// The cross-object checks treat them as present, so that one mistake gives one message
-/// (a point with a malformed position is not also an "unknown point" for the body at it).
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct Incomplete {
-    /// Names of parameters, coordinates, points and bodies whose entries were left out.
-    pub names: Vec<String>,
-    /// Top-level keys with at least one reported error (including required keys that are
-    /// missing).
-    pub sections: Vec<String>,
-}
-
-impl Incomplete {
-    /// Whether the entry called `name` was left out.
-    pub fn has_name(&self, name: &str) -> bool {
-        self.names.iter().any(|n| n == name)
-    }
-
-    /// Whether the top-level key `section` had an error.
-    pub fn has_section(&self, section: &str) -> bool {
-        self.sections.iter().any(|s| s == section)
-    }
-}
-
 /// Builds the typed model from the YAML tree of `path`.
 ///
 /// # Errors
@@ -150,13 +128,7 @@ pub fn build(path: &str, source: &str, root: &YamlNode) -> Result<ModelFile, Vec
 /// Builds as much of the typed model as the YAML tree allows, with every diagnostic and a
 /// record of what was left out (see [`Built`]).
 pub fn build_partial(path: &str, source: &str, root: &YamlNode) -> Built {
-    let mut cx = Ctx {
-        source,
-        lines: source.lines().collect(),
-        diagnostics: Diagnostics::new(),
-        incomplete: Incomplete::default(),
-        section: "",
-    };
+    let mut cx = Ctx::new(source);
     let file = cx.model(path, root);
     let diagnostics = cx.diagnostics.finish().err().unwrap_or_default();
     Built {
@@ -253,40 +225,6 @@ fn to_snake_case(s: &str) -> String {
         trimmed.to_string()
     } else {
         format!("model_{trimmed}").trim_end_matches('_').to_string()
-    }
-}
-
-/// The state of the pass: the source, what was found wrong, and what was left out.
-struct Ctx<'s> {
-    source: &'s str,
-    /// The lines of `source`, looked up by number (1-based) with [`Ctx::line`].
-    lines: Vec<&'s str>,
-    diagnostics: Diagnostics,
-    incomplete: Incomplete,
-    /// The top-level key being read; every error marks it incomplete.
-    section: &'static str,
-}
-
-impl<'s> Ctx<'s> {
-    /// The text of line `line` (1-based) of the source, empty past its end.
-    fn line(&self, line: u32) -> &'s str {
-        line.checked_sub(1)
-            .and_then(|i| self.lines.get(i as usize))
-            .copied()
-            .unwrap_or_default()
-    }
-
-    fn error(&mut self, d: Diagnostic) {
-        self.diagnostics.push(d);
-        if !self.section.is_empty() && !self.incomplete.has_section(self.section) {
-            self.incomplete.sections.push(self.section.to_string());
-        }
-    }
-
-    fn drop_name(&mut self, name: &str) {
-        if !self.incomplete.has_name(name) {
-            self.incomplete.names.push(name.to_string());
-        }
     }
 }
 

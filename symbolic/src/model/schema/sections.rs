@@ -5,6 +5,7 @@
 use super::walk::{Fields, Keyed, Need};
 use super::write::{Edits, NotRewritten, Rewrite, Writer, list, scalar};
 use super::*;
+use crate::model::elements::contact;
 
 /// How one top-level key of a model file is read, and written.
 struct Section {
@@ -200,6 +201,12 @@ const SECTIONS: &[Section] = &[
         write: |w, file| w.write_nonholonomic(file),
     },
     Section {
+        key: contact::KEY,
+        read: |cx, n, file| file.contacts = contact::read(cx, n),
+        missing: None,
+        write: |w, file| contact::write(w, &file.contacts),
+    },
+    Section {
         key: "initial",
         read: |cx, n, file| (file.initial, file.initial_guesses) = cx.initial(n),
         missing: None,
@@ -314,6 +321,7 @@ impl Ctx<'_> {
             checks: Checks::default(),
             constraints: Vec::new(),
             nonholonomic: Vec::new(),
+            contacts: Vec::new(),
             initial_guesses: Vec::new(),
             events: Vec::new(),
             equilibria: Vec::new(),
@@ -760,7 +768,7 @@ impl Writer<'_> {
         if file.generalized_forces.is_empty() {
             return Ok(());
         }
-        let forces = match self.rewritten_generalized_forces(file)? {
+        let forces = match self.rewritten_generalized_forces()? {
             Some(forces) => forces,
             None => {
                 let mut forces = Vec::new();

@@ -98,7 +98,7 @@ impl Ctx<'_> {
     }
 
     /// A name (identifier) written as a value, such as the point of `at: P`.
-    pub(super) fn name(&mut self, node: &YamlNode, what: &str) -> Option<Located<String>> {
+    pub(crate) fn name(&mut self, node: &YamlNode, what: &str) -> Option<Located<String>> {
         let t = match &node.kind {
             YamlKind::Scalar { text, .. } => Located::new(text.trim().to_string(), node.location),
             other => {
@@ -138,7 +138,7 @@ impl Ctx<'_> {
     }
 
     /// An expression written as a scalar; its locations are exact even across lines.
-    pub(super) fn expr(&mut self, node: &YamlNode, what: &str) -> Option<Expr> {
+    pub(crate) fn expr(&mut self, node: &YamlNode, what: &str) -> Option<Expr> {
         let text = self.scalar_expr_text(node, what)?;
         self.parse_part(node, &text, 0, text.chars().count())
     }
@@ -198,7 +198,7 @@ impl Ctx<'_> {
     }
 
     /// A list of 2 or 3 expressions.
-    pub(super) fn vector(
+    pub(crate) fn vector(
         &mut self,
         node: &YamlNode,
         what: &str,

@@ -8,9 +8,79 @@
 use super::entries::listed;
 use super::*;
 
+/// Parts of a model that the schema pass left out because of an error it already reported.
+///
+/// The cross-object checks treat them as present, so that one mistake gives one message
+/// (a point with a malformed position is not also an "unknown point" for the body at it).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Incomplete {
+    /// Names of parameters, coordinates, points and bodies whose entries were left out.
+    pub names: Vec<String>,
+    /// Top-level keys with at least one reported error (including required keys that are
+    /// missing).
+    pub sections: Vec<String>,
+}
+
+impl Incomplete {
+    /// Whether the entry called `name` was left out.
+    pub fn has_name(&self, name: &str) -> bool {
+        self.names.iter().any(|n| n == name)
+    }
+
+    /// Whether the top-level key `section` had an error.
+    pub fn has_section(&self, section: &str) -> bool {
+        self.sections.iter().any(|s| s == section)
+    }
+}
+
+/// The state of the pass: the source, what was found wrong, and what was left out.
+pub(crate) struct Ctx<'s> {
+    pub(super) source: &'s str,
+    /// The lines of `source`, looked up by number (1-based) with [`Ctx::line`].
+    pub(super) lines: Vec<&'s str>,
+    pub(super) diagnostics: Diagnostics,
+    pub(super) incomplete: Incomplete,
+    /// The top-level key being read; every error marks it incomplete.
+    pub(super) section: &'static str,
+}
+
+impl<'s> Ctx<'s> {
+    /// The pass over `source`, with nothing found yet.
+    pub(super) fn new(source: &'s str) -> Self {
+        Self {
+            source,
+            lines: source.lines().collect(),
+            diagnostics: Diagnostics::new(),
+            incomplete: Incomplete::default(),
+            section: "",
+        }
+    }
+
+    /// The text of line `line` (1-based) of the source, empty past its end.
+    pub(super) fn line(&self, line: u32) -> &'s str {
+        line.checked_sub(1)
+            .and_then(|i| self.lines.get(i as usize))
+            .copied()
+            .unwrap_or_default()
+    }
+
+    pub(crate) fn error(&mut self, d: Diagnostic) {
+        self.diagnostics.push(d);
+        if !self.section.is_empty() && !self.incomplete.has_section(self.section) {
+            self.incomplete.sections.push(self.section.to_string());
+        }
+    }
+
+    pub(super) fn drop_name(&mut self, name: &str) {
+        if !self.incomplete.has_name(name) {
+            self.incomplete.names.push(name.to_string());
+        }
+    }
+}
+
 /// Whether an entry must have a key.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(super) enum Need {
+pub(crate) enum Need {
     /// Reported when missing.
     Required,
     /// May be left out.
@@ -19,33 +89,33 @@ pub(super) enum Need {
 
 /// The keys of one kind of entry (a spring, a check, …): every key it takes, in the order
 /// messages list them, and whether it needs it.
-pub(super) struct Fields {
+pub(crate) struct Fields {
     /// What the entry is, for messages: `"spring"`.
-    pub(super) kind: &'static str,
+    pub(crate) kind: &'static str,
     /// Its keys.
-    pub(super) keys: &'static [(&'static str, Need)],
+    pub(crate) keys: &'static [(&'static str, Need)],
     /// How to write one, after `name: ` (`{ between: [A, B], stiffness: k }`).
-    pub(super) example: &'static str,
+    pub(crate) example: &'static str,
 }
 
 /// A map of named entries (`springs: { s1: {…}, s2: {…} }`): how [`Ctx::keyed`] walks it.
-pub(super) struct Keyed<'a> {
+pub(crate) struct Keyed<'a> {
     /// The map as messages name it (`` `springs` ``).
-    pub(super) what: &'a str,
+    pub(crate) what: &'a str,
     /// The map written out, for the message when it is not a map.
-    pub(super) example: &'a str,
+    pub(crate) example: &'a str,
     /// What an entry is called when its key must be a name (`"point"`); `None` when any key
     /// is taken as it is.
-    pub(super) names: Option<&'a str>,
+    pub(crate) names: Option<&'a str>,
     /// Whether an entry that cannot be read is recorded as left out ([`Incomplete::names`]).
-    pub(super) drop: bool,
+    pub(crate) drop: bool,
 }
 
 impl Ctx<'_> {
     /// Walks the map of named entries `node`: reports a value that is not a map and keys that
     /// are not names (when `spec` asks for names), and reads each entry with `read`, in file
     /// order; the entries read.
-    pub(super) fn keyed<T>(
+    pub(crate) fn keyed<T>(
         &mut self,
         node: &YamlNode,
         spec: Keyed<'_>,
@@ -72,7 +142,7 @@ impl Ctx<'_> {
 
     /// The fields of the entry `k: v` of kind `spec`, or `None` if it is not a map or lacks a
     /// key it needs; reports the keys it does not take.
-    pub(super) fn fields<'n>(
+    pub(crate) fn fields<'n>(
         &mut self,
         k: &Located<String>,
         v: &'n YamlNode,

@@ -19,17 +19,13 @@ pub trait Rewrite {
     /// [`NotRewritten`] if it cannot be written there; the implementor keeps its own error.
     fn expr(&mut self, e: &Expr, place: &str) -> Result<String, NotRewritten>;
 
-    /// `generalized_forces:` of `file` as the transformer writes them, by coordinate; `None`
-    /// (the default): the file's, each through [`Rewrite::expr`]. Called where the section
-    /// is written.
+    /// `generalized_forces:` as the transformer writes them, by coordinate; `None` (the
+    /// default): the file's, each through [`Rewrite::expr`]. Called where the section is
+    /// written.
     ///
     /// # Errors
     /// [`NotRewritten`] if they cannot be written.
-    fn generalized_forces(
-        &mut self,
-        file: &ModelFile,
-    ) -> Result<Option<Vec<(String, String)>>, NotRewritten> {
-        let _ = file;
+    fn generalized_forces(&mut self) -> Result<Option<Vec<(String, String)>>, NotRewritten> {
         Ok(None)
     }
 }
@@ -94,12 +90,11 @@ impl<'a> Writer<'a> {
         }
     }
 
-    /// `generalized_forces:` of `file` as the [`Rewrite`] writes them, if it does.
+    /// `generalized_forces:` as the [`Rewrite`] writes them, if it does.
     pub(crate) fn rewritten_generalized_forces(
         &mut self,
-        file: &ModelFile,
     ) -> Result<Option<Vec<(String, String)>>, NotRewritten> {
-        self.rewrite.generalized_forces(file)
+        self.rewrite.generalized_forces()
     }
 
     /// `e` through the [`Rewrite`].
@@ -181,18 +176,4 @@ fn quoted(s: &str) -> String {
 pub(crate) fn list(parts: &[String]) -> String {
     let parts: Vec<String> = parts.iter().map(|p| flow(p)).collect();
     format!("[{}]", parts.join(", "))
-}
-
-/// `, in: F` for a frame other than the ground's, else nothing.
-pub(crate) fn in_frame(frame: Option<&Located<String>>) -> String {
-    match frame {
-        Some(f) if f.value != GROUND_FRAME => format!(", in: {}", f.value),
-        _ => String::new(),
-    }
-}
-
-/// `[x, y]` of axes.
-pub(crate) fn axes_list(axes: &[Axis]) -> String {
-    let letters: Vec<String> = axes.iter().map(|a| a.letter().to_string()).collect();
-    format!("[{}]", letters.join(", "))
 }

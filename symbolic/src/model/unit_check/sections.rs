@@ -2,6 +2,7 @@
 //! events, outputs and `checks:`, walked in file order.
 
 use super::*;
+use crate::model::elements;
 
 impl Checker<'_> {
     /// Checks `e` against the unit its key requires; a value written with numbers only is
@@ -335,6 +336,9 @@ impl Checker<'_> {
                 self.constraints.push((k.value, Some(velocity), false));
             }
         }
+        for c in &file.contacts {
+            c.units(self);
+        }
         for (k, e) in &file.initial {
             self.value_of(&k.value, e, &format!("the initial value of `{}`", k.value));
         }
@@ -448,5 +452,20 @@ impl Checker<'_> {
         for c in &checks.conserved {
             self.homogeneous(&c.value, &format!("conserved quantity `{}`", c.name.value));
         }
+    }
+}
+
+/// The unit check as an element's context ([`elements::Units`]).
+impl elements::Units for Checker<'_> {
+    fn fixed(
+        &mut self,
+        e: &Expr,
+        want: Dimension,
+        what: &str,
+        kind: &str,
+        want_text: &str,
+        help: &str,
+    ) {
+        Checker::fixed(self, e, want, what, kind, want_text, help);
     }
 }

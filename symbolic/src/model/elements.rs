@@ -1,0 +1,83 @@
+//! Model elements, one module each.
+//!
+//! An element module owns everything about one kind of entry of a model file: its typed
+//! form, how it is read and written (side by side), its rules, its equations of dimension
+//! under `units: SI`, its kinematics, and what it gives the derivations and the description.
+//! It names none of the stages. Each stage hands it a context through one of the traits
+//! below, which the stage implements ([`Rules`] by the rules pass, [`Units`] by the unit
+//! check, [`Lower`] by the lowering in `mechanics`). So an element sits below the stages that
+//! iterate over it and above the scaffolds it reads and writes with (the schema's `Ctx`,
+//! its `Fields`, the `Writer`), and a new kind is one module plus one line in each stage's
+//! loop and one row in the schema's `SECTIONS`.
+//!
+//! The kinds here: [`contact`] (unilateral contacts). The older kinds (bodies, springs,
+//! constraints, …) are still spread over the stage files; ARCHITECTURE.md's recipe says how
+//! a kind moves here.
+
+pub mod contact;
+
+use super::ast::Expr;
+use super::diagnostic::Diagnostic;
+use super::located::Located;
+use super::units::Dimension;
+use crate::expr::{ExprArena, ExprId};
+
+/// What an expression of a model file may depend on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+pub(crate) enum Depends {
+    /// Parameters, numbers, `pi` and functions.
+    Constant,
+    /// Also coordinates and `t` (a configuration).
+    Position,
+    /// Also rates (`x_dot`).
+    Motion,
+    /// Also accelerations (`x_ddot`): only equations of motion written by hand.
+    Acceleration,
+    /// Also constraint forces (`lambda_<constraint>`): only event functions.
+    Event,
+}
+
+/// What an element's rules ask of the file around it (the rules pass implements it).
+pub(crate) trait Rules {
+    /// Reports `name` unless it is a point of the model (or one left out for an error
+    /// already reported).
+    fn point(&mut self, name: &Located<String>);
+    /// Checks the names and functions of `e` and that it depends on no more than `depends`;
+    /// `what` names it in messages ("the restitution of contact `floor`").
+    fn expression(&mut self, e: &Expr, depends: Depends, what: &str);
+    /// The value of `e` with the parameters at their defaults; `None` if it is not constant
+    /// or names what is not known (reported by [`Rules::expression`]).
+    fn value(&self, e: &Expr) -> Option<f64>;
+    /// The spatial dimension of the model's points (2 or 3).
+    fn dimension(&self) -> usize;
+    /// Reports a mistake.
+    fn error(&mut self, d: Diagnostic);
+}
+
+/// What an element's equations of dimension ask of the unit check (`units: SI`).
+pub(crate) trait Units {
+    /// Checks that `e` has the dimension `want`: "`what` is …, but `kind` is `want_text`",
+    /// with `help`.
+    fn fixed(
+        &mut self,
+        e: &Expr,
+        want: Dimension,
+        what: &str,
+        kind: &str,
+        want_text: &str,
+        help: &str,
+    );
+}
+
+/// What an element's kinematics ask of the lowering into the expression arena.
+pub(crate) trait Lower {
+    /// The arena the model's expressions live in.
+    fn arena(&mut self) -> &mut ExprArena;
+    /// `e` lowered into the arena.
+    fn expr(&mut self, e: &Expr) -> ExprId;
+    /// The position of the point `name` in the ground frame's components (2 or 3); `None` if
+    /// there is no such point.
+    fn point(&self, name: &str) -> Option<Vec<ExprId>>;
+    /// Reports a mistake found while lowering.
+    fn error(&mut self, d: Diagnostic);
+}

@@ -1,0 +1,546 @@
+//! Unilateral contacts (`contacts:`): a gap `g(q, t) ≥ 0` that may close with an impact and
+//! open again, with Newton's coefficient of restitution and optionally Coulomb's friction.
+//!
+//! ```yaml
+//! contacts:
+//!   floor: { gap: y, restitution: e }
+//!   foot:  { point: F, above: { normal: [0, 1], through: [0, 0] }, restitution: 0, friction: mu }
+//!   rim:   { point: B, inside: { centre: [0, 0], radius: R }, restitution: 1 }
+//! ```
+//!
+//! The gap is written directly, or as a point of the model above a line (a plane in 3-D),
+//! `g = n̂·(P − O)`, or inside or outside a circle (a sphere in 3-D), `g = R − |P − C|` or
+//! `|P − C| − R`. While `g > 0` the contact is open; it closes with an impact when `g`
+//! reaches 0 with `ġ < 0`. The impact law is `eomgen_runtime::hybrid::impact`'s (Newton's
+//! restitution on the striking contact, Routh's process with friction).
+//!
+//! Source: Pfeiffer & Glocker, *Multibody Dynamics with Unilateral Contacts* (1996), ch. 4;
+//! Brogliato, *Nonsmooth Mechanics* (3rd ed., 2016), §4.1 for the gap and its Jacobian.
+
+use crate::expr::ExprId;
+use crate::model::ast::Expr;
+use crate::model::diagnostic::Diagnostic;
+use crate::model::elements::{Depends, Lower, Rules, Units};
+use crate::model::located::Located;
+use crate::model::schema::entries::get;
+use crate::model::schema::walk::{Ctx, Fields, Keyed, Need};
+use crate::model::schema::write::{NotRewritten, Writer, flow, list};
+use crate::model::units::Dimension;
+use crate::model::yaml::YamlNode;
+
+/// The key of the section.
+pub(crate) const KEY: &str = "contacts";
+
+/// A unilateral contact: `name: { gap: g, restitution: e, friction: mu }`, or with
+/// `point: P` and `above:`, `inside:` or `outside:` in place of `gap:`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Contact {
+    /// Name.
+    pub name: Located<String>,
+    /// The gap `g(q, t)` (m), `≥ 0` while the contact is open.
+    pub gap: Gap,
+    /// Newton's coefficient of restitution `e ∈ [0, 1]` (1: elastic, 0: plastic), constant.
+    pub restitution: Expr,
+    /// Coulomb's friction coefficient `μ ≥ 0`, constant; `None`: frictionless.
+    pub friction: Option<Expr>,
+}
+
+/// How a contact's gap is written.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Gap {
+    /// `gap: g`, any expression of the coordinates and `t`.
+    Written(Expr),
+    /// `point: P, above: { normal: n, through: O }`: `g = n̂·(P − O)`, `n̂ = n/|n|`; `O` is
+    /// the origin when left out.
+    Above {
+        /// The point.
+        point: Located<String>,
+        /// The normal `n`, pointing to the open side (2 or 3 components).
+        normal: Located<Vec<Expr>>,
+        /// A point `O` of the line or plane.
+        through: Option<Located<Vec<Expr>>>,
+    },
+    /// `point: P, inside: { centre: C, radius: R }` (`g = R − |P − C|`) or `outside:`
+    /// (`g = |P − C| − R`).
+    Circle {
+        /// The point.
+        point: Located<String>,
+        /// Whether the point stays inside the circle (or sphere).
+        inside: bool,
+        /// The centre `C`.
+        centre: Located<Vec<Expr>>,
+        /// The radius `R` (m).
+        radius: Expr,
+    },
+}
+
+/// The keys of a contact.
+const CONTACT: Fields = Fields {
+    kind: "contact",
+    keys: &[
+        ("gap", Need::Optional),
+        ("point", Need::Optional),
+        ("above", Need::Optional),
+        ("inside", Need::Optional),
+        ("outside", Need::Optional),
+        ("restitution", Need::Required),
+        ("friction", Need::Optional),
+    ],
+    example: "{ gap: y, restitution: e, friction: mu }",
+};
+
+/// The keys of `above:`.
+const ABOVE: Fields = Fields {
+    kind: "the line or plane",
+    keys: &[("normal", Need::Required), ("through", Need::Optional)],
+    example: "{ normal: [0, 1], through: [0, 0] }",
+};
+
+/// The keys of `inside:` and `outside:`.
+const CIRCLE: Fields = Fields {
+    kind: "the circle or sphere",
+    keys: &[("centre", Need::Required), ("radius", Need::Required)],
+    example: "{ centre: [0, 0], radius: R }",
+};
+
+/// The surfaces a point may be kept to, as keys.
+const SURFACES: [&str; 3] = ["above", "inside", "outside"];
+
+/// `contacts:`, in file order.
+pub(crate) fn read(cx: &mut Ctx<'_>, node: &YamlNode) -> Vec<Contact> {
+    let example = format!("contacts: {{ floor: {} }}", CONTACT.example);
+    let spec = Keyed {
+        what: "`contacts`",
+        example: &example,
+        names: Some("contact"),
+        drop: false,
+    };
+    cx.keyed(node, spec, |cx, k, v| {
+        let f = cx.fields(k, v, &CONTACT)?;
+        let what = format!("contact `{}`", k.value);
+        let gap = read_gap(cx, k, f, &what);
+        let restitution =
+            get(f, "restitution").and_then(|n| cx.expr(n, "a coefficient of restitution"));
+        let friction = match get(f, "friction") {
+            Some(n) => cx.expr(n, "a friction coefficient").map(Some),
+            None => Some(None),
+        };
+        Some(Contact {
+            name: k.clone(),
+            gap: gap?,
+            restitution: restitution?,
+            friction: friction?,
+        })
+    })
+}
+
+/// The gap of the contact `k` whose keys are `f`: `gap:`, or `point:` with one surface.
+fn read_gap(
+    cx: &mut Ctx<'_>,
+    k: &Located<String>,
+    f: &crate::model::schema::entries::Entries,
+    what: &str,
+) -> Option<Gap> {
+    let surfaces: Vec<&(Located<String>, YamlNode)> = f
+        .iter()
+        .filter(|(key, _)| SURFACES.contains(&key.value.as_str()))
+        .collect();
+    let written = f.iter().find(|(key, _)| key.value == "gap");
+    let point = f.iter().find(|(key, _)| key.value == "point");
+    let shape_help = "write the gap itself (`gap: y`), or a point and where it stays: `point: P, above: { normal: [0, 1] }`, `inside:` or `outside: { centre: [0, 0], radius: R }`";
+    match (written, point, surfaces.as_slice()) {
+        (Some((_, g)), None, []) => cx.expr(g, "a gap").map(Gap::Written),
+        (None, Some((_, p)), [(surface, value)]) => {
+            let point = cx.name(p, "the point of a contact");
+            let gap = match surface.value.as_str() {
+                "above" => read_above(cx, surface, value, point.clone()),
+                side => read_circle(cx, surface, value, point.clone(), side == "inside"),
+            };
+            point.and(gap)
+        }
+        (Some((g, _)), _, _) if point.is_some() || !surfaces.is_empty() => {
+            cx.error(
+                Diagnostic::new(g.location, format!("{what} has both `gap` and a point"))
+                    .with_help(shape_help),
+            );
+            None
+        }
+        (None, Some((p, _)), []) => {
+            cx.error(
+                Diagnostic::new(
+                    p.location,
+                    format!("{what} names a point but not where it stays"),
+                )
+                .with_help(shape_help),
+            );
+            None
+        }
+        (None, None, [(s, _), ..]) | (None, Some(_), [_, (s, _), ..]) => {
+            let message = if point.is_none() {
+                format!("{what} has `{}` but no `point`", s.value)
+            } else {
+                format!("{what} has more than one of `above`, `inside` and `outside`")
+            };
+            cx.error(Diagnostic::new(s.location, message).with_help(shape_help));
+            None
+        }
+        _ => {
+            cx.error(
+                Diagnostic::new(k.location, format!("{what} has no gap")).with_help(shape_help),
+            );
+            None
+        }
+    }
+}
+
+/// A located list of 2 or 3 expressions.
+fn located_vector(
+    cx: &mut Ctx<'_>,
+    node: &YamlNode,
+    what: &str,
+    example: &str,
+) -> Option<Located<Vec<Expr>>> {
+    cx.vector(node, what, example)
+        .map(|v| Located::new(v, node.location))
+}
+
+/// `above: { normal, through }` of `point`.
+fn read_above(
+    cx: &mut Ctx<'_>,
+    key: &Located<String>,
+    node: &YamlNode,
+    point: Option<Located<String>>,
+) -> Option<Gap> {
+    let f = cx.fields(key, node, &ABOVE)?;
+    let normal = get(f, "normal").and_then(|n| located_vector(cx, n, "a normal", "[0, 1]"));
+    let through = match get(f, "through") {
+        Some(n) => located_vector(cx, n, "a point of the line or plane", "[0, 0]").map(Some),
+        None => Some(None),
+    };
+    Some(Gap::Above {
+        point: point?,
+        normal: normal?,
+        through: through?,
+    })
+}
+
+/// `inside:` or `outside: { centre, radius }` of `point`.
+fn read_circle(
+    cx: &mut Ctx<'_>,
+    key: &Located<String>,
+    node: &YamlNode,
+    point: Option<Located<String>>,
+    inside: bool,
+) -> Option<Gap> {
+    let f = cx.fields(key, node, &CIRCLE)?;
+    let centre = get(f, "centre").and_then(|n| located_vector(cx, n, "a centre", "[0, 0]"));
+    let radius = get(f, "radius").and_then(|n| cx.expr(n, "a radius"));
+    Some(Gap::Circle {
+        point: point?,
+        inside,
+        centre: centre?,
+        radius: radius?,
+    })
+}
+
+/// `contacts:`, in the form [`read`] reads.
+pub(crate) fn write(w: &mut Writer<'_>, contacts: &[Contact]) -> Result<(), NotRewritten> {
+    if contacts.is_empty() {
+        return Ok(());
+    }
+    w.line("contacts:");
+    for c in contacts {
+        let place = format!("contact `{}`", c.name.value);
+        let vector = |w: &mut Writer<'_>, v: &[Expr]| w.exprs(v, &place).map(|v| list(&v));
+        let gap = match &c.gap {
+            Gap::Written(g) => format!("gap: {}", flow(&w.expr(g, &place)?)),
+            Gap::Above {
+                point,
+                normal,
+                through,
+            } => {
+                let mut surface = format!("normal: {}", vector(w, &normal.value)?);
+                if let Some(o) = through {
+                    surface.push_str(&format!(", through: {}", vector(w, &o.value)?));
+                }
+                format!("point: {}, above: {{ {surface} }}", point.value)
+            }
+            Gap::Circle {
+                point,
+                inside,
+                centre,
+                radius,
+            } => format!(
+                "point: {}, {}: {{ centre: {}, radius: {} }}",
+                point.value,
+                if *inside { "inside" } else { "outside" },
+                vector(w, &centre.value)?,
+                flow(&w.expr(radius, &place)?)
+            ),
+        };
+        let mut text = format!(
+            "  {}: {{ {gap}, restitution: {}",
+            c.name.value,
+            flow(&w.expr(&c.restitution, &place)?)
+        );
+        if let Some(mu) = &c.friction {
+            text.push_str(&format!(", friction: {}", flow(&w.expr(mu, &place)?)));
+        }
+        w.line(format_args!("{text} }}"));
+    }
+    Ok(())
+}
+
+impl Contact {
+    /// The rules of a contact: its point exists; the gap depends on the configuration and
+    /// `t` only; `0 ≤ e ≤ 1` and `μ ≥ 0`, constant; vectors of the model's dimension; a
+    /// normal that is not zero and a radius that is positive (at the parameters' defaults).
+    pub(crate) fn rules(&self, cx: &mut dyn Rules) {
+        let name = &self.name.value;
+        let what = |part: &str| format!("the {part} of contact `{name}`");
+        match &self.gap {
+            Gap::Written(g) => cx.expression(g, Depends::Position, &what("gap")),
+            Gap::Above {
+                point,
+                normal,
+                through,
+            } => {
+                cx.point(point);
+                self.vector_rules(cx, normal, &what("normal"));
+                if let Some(o) = through {
+                    self.vector_rules(cx, o, &what("point `through`"));
+                }
+                let values: Option<Vec<f64>> = normal.value.iter().map(|c| cx.value(c)).collect();
+                if let Some(values) = values
+                    && values.iter().all(|c| *c == 0.0)
+                {
+                    cx.error(
+                        Diagnostic::new(normal.location, format!("{} is zero", what("normal")))
+                            .with_help("the normal points from the line or plane to the side where the point may go, as `[0, 1]` above a floor"),
+                    );
+                }
+            }
+            Gap::Circle {
+                point,
+                centre,
+                radius,
+                ..
+            } => {
+                cx.point(point);
+                self.vector_rules(cx, centre, &what("centre"));
+                cx.expression(radius, Depends::Position, &what("radius"));
+                if let Some(r) = cx.value(radius)
+                    && r.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater)
+                {
+                    cx.error(
+                        Diagnostic::new(radius.location, format!("{} is {r}", what("radius")))
+                            .with_help("a radius is positive"),
+                    );
+                }
+            }
+        }
+        self.coefficient_rules(cx, &self.restitution, "coefficient of restitution");
+        if let Some(mu) = &self.friction {
+            self.coefficient_rules(cx, mu, "friction coefficient");
+        }
+    }
+
+    /// A vector of a contact's surface: the model's dimension, configuration and `t` only.
+    fn vector_rules(&self, cx: &mut dyn Rules, v: &Located<Vec<Expr>>, what: &str) {
+        for c in &v.value {
+            cx.expression(c, Depends::Position, what);
+        }
+        let dimension = cx.dimension();
+        if v.value.len() != dimension {
+            cx.error(
+                Diagnostic::new(
+                    v.location,
+                    format!(
+                        "{what} has {} components, but the model's points have {dimension}",
+                        v.value.len()
+                    ),
+                )
+                .with_help(format!(
+                    "write it with {dimension} components, as the points' positions are"
+                )),
+            );
+        }
+    }
+
+    /// `e` (the restitution) or `μ`: constant, and in its range at the defaults.
+    fn coefficient_rules(&self, cx: &mut dyn Rules, e: &Expr, kind: &str) {
+        let what = format!("the {kind} of contact `{}`", self.name.value);
+        cx.expression(e, Depends::Constant, &what);
+        let Some(value) = cx.value(e) else {
+            return;
+        };
+        let restitution = kind.contains("restitution");
+        let inside = if restitution {
+            (0.0..=1.0).contains(&value)
+        } else {
+            value >= 0.0 && value.is_finite()
+        };
+        if !inside {
+            let (range, help) = if restitution {
+                (
+                    "between 0 and 1",
+                    "Newton's coefficient is the ratio of the gap's rates after and before an impact: 1 for an elastic impact, 0 for a plastic one",
+                )
+            } else {
+                (
+                    "0 or more",
+                    "Coulomb's friction coefficient is the ratio of the largest tangential force to the normal force; leave `friction` out for a frictionless contact",
+                )
+            };
+            cx.error(
+                Diagnostic::new(
+                    e.location,
+                    format!("{what} is {value}, but it must be {range}"),
+                )
+                .with_help(help),
+            );
+        }
+    }
+
+    /// The equations of dimension: the gap, the surface's points and the radius are
+    /// lengths; `e` and `μ` are numbers.
+    pub(crate) fn units(&self, cx: &mut dyn Units) {
+        let name = &self.name.value;
+        let length = |cx: &mut dyn Units, e: &Expr, part: &str| {
+            cx.fixed(
+                e,
+                Dimension::METRE,
+                &format!("the {part} of contact `{name}`"),
+                "a length",
+                "m",
+                "a gap is the distance the contact may still close, in m",
+            );
+        };
+        match &self.gap {
+            Gap::Written(g) => length(cx, g, "gap"),
+            Gap::Above { through, .. } => {
+                for c in through.iter().flat_map(|o| &o.value) {
+                    length(cx, c, "point `through`");
+                }
+            }
+            Gap::Circle { centre, radius, .. } => {
+                for c in &centre.value {
+                    length(cx, c, "centre");
+                }
+                length(cx, radius, "radius");
+            }
+        }
+        for (e, kind) in [
+            (Some(&self.restitution), "coefficient of restitution"),
+            (self.friction.as_ref(), "friction coefficient"),
+        ] {
+            if let Some(e) = e {
+                cx.fixed(
+                    e,
+                    Dimension::ONE,
+                    &format!("the {kind} of contact `{name}`"),
+                    "a number",
+                    "1",
+                    "a coefficient of restitution or friction is a ratio and has no unit",
+                );
+            }
+        }
+    }
+
+    /// The contact as expressions: its gap `g(q, t)`; `None` (with the mistake reported)
+    /// if it names an unknown point.
+    pub(crate) fn lower(&self, cx: &mut dyn Lower) -> Option<ContactInfo> {
+        let gap = match &self.gap {
+            Gap::Written(g) => cx.expr(g),
+            Gap::Above {
+                point,
+                normal,
+                through,
+            } => {
+                let p = position(cx, point)?;
+                let n: Vec<ExprId> = normal.value.iter().map(|c| cx.expr(c)).collect();
+                let d = match through {
+                    Some(o) => difference(cx, &p, &o.value),
+                    None => p,
+                };
+                let nd = dot(cx, &n, &d);
+                let nn = dot(cx, &n, &n);
+                let arena = cx.arena();
+                let length = arena.sqrt(nn);
+                arena.divide(nd, length)
+            }
+            Gap::Circle {
+                point,
+                inside,
+                centre,
+                radius,
+            } => {
+                let p = position(cx, point)?;
+                let d = difference(cx, &p, &centre.value);
+                let dd = dot(cx, &d, &d);
+                let r = cx.expr(radius);
+                let arena = cx.arena();
+                let distance = arena.sqrt(dd);
+                if *inside {
+                    arena.minus(r, distance)
+                } else {
+                    arena.minus(distance, r)
+                }
+            }
+        };
+        let restitution = cx.expr(&self.restitution);
+        let friction = self.friction.as_ref().map(|mu| cx.expr(mu));
+        Some(ContactInfo {
+            name: self.name.value.clone(),
+            gap,
+            restitution,
+            friction,
+        })
+    }
+}
+
+/// The position of `point`, or `None` with the mistake reported.
+fn position(cx: &mut dyn Lower, point: &Located<String>) -> Option<Vec<ExprId>> {
+    let p = cx.point(&point.value);
+    if p.is_none() {
+        cx.error(Diagnostic::new(
+            point.location,
+            format!(
+                "contact point `{}` is not a point of the model",
+                point.value
+            ),
+        ));
+    }
+    p
+}
+
+/// `p − o`, `o` as written.
+fn difference(cx: &mut dyn Lower, p: &[ExprId], o: &[Expr]) -> Vec<ExprId> {
+    p.iter()
+        .zip(o)
+        .map(|(&p, o)| {
+            let o = cx.expr(o);
+            cx.arena().minus(p, o)
+        })
+        .collect()
+}
+
+/// `a · b`.
+fn dot(cx: &mut dyn Lower, a: &[ExprId], b: &[ExprId]) -> ExprId {
+    let arena = cx.arena();
+    let terms: Vec<ExprId> = a.iter().zip(b).map(|(&a, &b)| arena.times(a, b)).collect();
+    arena.sum(&terms)
+}
+
+/// A contact as expressions of the model's arena.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ContactInfo {
+    /// Name.
+    pub name: String,
+    /// The gap `g(q, t)` (m).
+    pub gap: ExprId,
+    /// Newton's coefficient of restitution `e`.
+    pub restitution: ExprId,
+    /// Coulomb's friction coefficient `μ`; `None`: frictionless.
+    pub friction: Option<ExprId>,
+}
