@@ -8,6 +8,7 @@ mod cli_fuzz;
 mod common;
 mod compiled_models;
 mod constraints;
+mod contacts;
 mod convolution;
 mod determinism;
 mod events;

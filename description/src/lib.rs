@@ -87,6 +87,12 @@ pub struct ModelDescription {
     /// The file's `events:`: names, directions and whether each ends the integration, in
     /// file order (lecture 17, HW21, HW36).
     pub events: List<EventSpec>,
+    /// The file's unilateral `contacts:` names, in file order (`m_c` of them): the gaps
+    /// `g(q, t) ≥ 0` whose values, rates, Jacobian and coefficients the model's contact
+    /// functions give in this order. Empty for a model without contacts, and then left out
+    /// of the serialized description.
+    #[serde(skip_serializing_if = "<[Text]>::is_empty")]
+    pub contacts: List<Text>,
     /// Whether an event function reads the accelerations `q̈` or the constraint forces `λ`
     /// (the first-order form then solves for them before evaluating the events).
     pub events_need_accelerations: bool,
@@ -138,6 +144,7 @@ impl ModelDescription {
         equilibrium_rates: false,
         ignorable_coordinates: Cow::Borrowed(&[]),
         events: Cow::Borrowed(&[]),
+        contacts: Cow::Borrowed(&[]),
         events_need_accelerations: false,
         conservative: false,
         derivation: Cow::Borrowed(""),

@@ -95,9 +95,12 @@ enum Routine {
     ConstraintGamma = 8,
     EventValues = 9,
     EquilibriumGuesses = 10,
-    ForcingJacobianQ = 11,
-    ForcingJacobianQdot = 12,
-    MassMatrixProductJacobian = 13,
+    ContactGaps = 11,
+    ContactJacobian = 12,
+    ContactCoefficients = 13,
+    ForcingJacobianQ = 14,
+    ForcingJacobianQdot = 15,
+    MassMatrixProductJacobian = 16,
 }
 
 /// Index of the first Jacobian routine.
@@ -662,6 +665,30 @@ impl DynMechanicalSystem for JitModel {
     fn equilibrium_guesses(&self, out: &mut [f64]) {
         self.run(
             Routine::EquilibriumGuesses,
+            self.inputs(&[], &[], 0.0),
+            out,
+            &mut [],
+        );
+    }
+    fn contact_gaps(&self, q: &[f64], qdot: &[f64], t: f64, out: &mut [f64]) {
+        self.run(
+            Routine::ContactGaps,
+            self.inputs(q, qdot, t),
+            out,
+            &mut [],
+        );
+    }
+    fn contact_jacobian(&self, q: &[f64], t: f64, out: &mut [f64]) {
+        self.run(
+            Routine::ContactJacobian,
+            self.inputs(q, &[], t),
+            out,
+            &mut [],
+        );
+    }
+    fn contact_coefficients(&self, out: &mut [f64]) {
+        self.run(
+            Routine::ContactCoefficients,
             self.inputs(&[], &[], 0.0),
             out,
             &mut [],

@@ -102,6 +102,19 @@ pub trait DynMechanicalSystem {
     fn constraint_gamma(&self, q: &[f64], qdot: &[f64], t: f64, out: &mut [f64]);
     /// The guesses of [`ModelDescription::equilibria`], `n` coordinates each, one after the other.
     fn equilibrium_guesses(&self, out: &mut [f64]);
+    /// [`MechanicalSystem::contact_gaps`]: `g`, then `ġ` (`2 m_c`) into `out`. The default
+    /// (a model without contacts) writes nothing.
+    fn contact_gaps(&self, q: &[f64], qdot: &[f64], t: f64, out: &mut [f64]) {
+        let _ = (q, qdot, t, out);
+    }
+    /// [`MechanicalSystem::contact_jacobian`]: `G` (`m_c × n`, row-major) into `out`.
+    fn contact_jacobian(&self, q: &[f64], t: f64, out: &mut [f64]) {
+        let _ = (q, t, out);
+    }
+    /// [`MechanicalSystem::contact_coefficients`]: `[e₁, μ₁, …]` (`2 m_c`) into `out`.
+    fn contact_coefficients(&self, out: &mut [f64]) {
+        let _ = out;
+    }
     /// The event functions `gᵢ(q, q̇, q̈, λ, t)` into `out` (one per event); `lambda` may be
     /// shorter than `m` (a function that reads a missing multiplier gets NaN).
     fn event_values(
@@ -237,6 +250,16 @@ impl<S: MechanicalSystem<N>, const N: usize> DynMechanicalSystem for StaticSyste
     }
     fn equilibrium_guesses(&self, out: &mut [f64]) {
         self.0.equilibrium_guesses(out);
+    }
+    fn contact_gaps(&self, q: &[f64], qdot: &[f64], t: f64, out: &mut [f64]) {
+        self.0
+            .contact_gaps(&vector::<N>(q), &vector::<N>(qdot), t, out);
+    }
+    fn contact_jacobian(&self, q: &[f64], t: f64, out: &mut [f64]) {
+        self.0.contact_jacobian(&vector::<N>(q), t, out);
+    }
+    fn contact_coefficients(&self, out: &mut [f64]) {
+        self.0.contact_coefficients(out);
     }
     fn event_values(
         &self,

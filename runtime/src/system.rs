@@ -137,6 +137,25 @@ pub trait MechanicalSystem<const N: usize> {
         let _ = out;
     }
 
+    /// The gaps `g(q, t)` (m) of the unilateral contacts ([`ModelDescription::contacts`],
+    /// `m_c` of them), then their rates `ġ = G q̇ + ∂g/∂t` (m/s), into `out` (`2 m_c`
+    /// entries). A contact is open while `g > 0` and strikes when `g` reaches 0 with `ġ < 0`
+    /// (Pfeiffer & Glocker 1996, ch. 4).
+    fn contact_gaps(&self, q: &SVector<f64, N>, qdot: &SVector<f64, N>, t: f64, out: &mut [f64]) {
+        let _ = (q, qdot, t, out);
+    }
+    /// The contacts' Jacobian `G = ∂g/∂q` (`m_c × N`, row-major into `out`), the rows of the
+    /// impact law `M (q̇⁺ − q̇⁻) = Gᵀ Λ` ([`crate::hybrid::impact`]).
+    fn contact_jacobian(&self, q: &SVector<f64, N>, t: f64, out: &mut [f64]) {
+        let _ = (q, t, out);
+    }
+    /// Each contact's coefficient of restitution `e ∈ [0, 1]` and of Coulomb friction
+    /// `μ ≥ 0` (0 when frictionless), `[e₁, μ₁, e₂, μ₂, …]` into `out` (`2 m_c` entries), at
+    /// the model's parameters.
+    fn contact_coefficients(&self, out: &mut [f64]) {
+        let _ = out;
+    }
+
     /// The event functions `gᵢ(q, q̇, q̈, λ, t)` into `out` (one per [`ModelDescription::events`]
     /// entry).
     ///

@@ -95,6 +95,7 @@ pub fn describe(model: &SymbolicModel, eom: &EquationsOfMotion, mathml: bool) ->
                 terminal: e.terminal,
             })
             .collect(),
+        contacts: model.contacts.iter().map(|c| text(&c.name)).collect(),
         events_need_accelerations: model.events_need_accelerations(),
         conservative: model.conservative,
         derivation: text(crate::mechanics::preferred_formulation(model).name()),
@@ -201,6 +202,7 @@ pub fn description_tokens(
             })
             .collect(),
     );
+    let contacts = texts(&d.contacts);
     let (needs, conservative) = (d.events_need_accelerations, d.conservative);
     let derivation = text(&d.derivation);
     let equations_text = text(&d.equations_text);
@@ -236,6 +238,7 @@ pub fn description_tokens(
             equilibrium_rates: #equilibrium_rates,
             ignorable_coordinates: #ignorable_coordinates,
             events: #events,
+            contacts: #contacts,
             events_need_accelerations: #needs,
             conservative: #conservative,
             derivation: #derivation,

@@ -568,6 +568,18 @@ fn signature_and_result(
             quote!(fn equilibrium_guesses(&self, __out: &mut [f64])),
             write_out(v),
         ),
+        ModelFunction::ContactGaps => (
+            quote!(fn contact_gaps(&self, #qd_args, __t: f64, __out: &mut [f64])),
+            write_out(v),
+        ),
+        ModelFunction::ContactJacobian => (
+            quote!(fn contact_jacobian(&self, #q_args, __t: f64, __out: &mut [f64])),
+            write_out(v),
+        ),
+        ModelFunction::ContactCoefficients => (
+            quote!(fn contact_coefficients(&self, __out: &mut [f64])),
+            write_out(v),
+        ),
     }
 }
 

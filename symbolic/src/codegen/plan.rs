@@ -55,11 +55,17 @@ pub enum ModelFunction {
     /// `n` values per named equilibrium (`2 n`, coordinates then rates, when one is a steady
     /// motion).
     EquilibriumGuesses,
+    /// The contacts' gaps `g` (m_c), then their rates `ġ` (m_c).
+    ContactGaps,
+    /// The contacts' Jacobian `G = ∂g/∂q` (m_c × n, row-major).
+    ContactJacobian,
+    /// Each contact's coefficient of restitution `e` and of friction `μ` (2 m_c).
+    ContactCoefficients,
 }
 
 impl ModelFunction {
     /// Every function, in the macro's order.
-    pub const ALL: [ModelFunction; 16] = [
+    pub const ALL: [ModelFunction; 19] = [
         ModelFunction::InitialState,
         ModelFunction::MassMatrix,
         ModelFunction::Forcing,
@@ -76,12 +82,15 @@ impl ModelFunction {
         ModelFunction::ConstraintGamma,
         ModelFunction::EventValues,
         ModelFunction::EquilibriumGuesses,
+        ModelFunction::ContactGaps,
+        ModelFunction::ContactJacobian,
+        ModelFunction::ContactCoefficients,
     ];
 
     /// The functions of the state that every compilation plans, first and in this order
     /// ([`plan_state`]): all but the exact Jacobians and `mass_matrix` and `forcing` apart
     /// (a backend evaluates both in one).
-    pub const STATE: [ModelFunction; 11] = [
+    pub const STATE: [ModelFunction; 14] = [
         ModelFunction::InitialState,
         ModelFunction::MassMatrixAndForcing,
         ModelFunction::KineticEnergy,
@@ -93,6 +102,9 @@ impl ModelFunction {
         ModelFunction::ConstraintGamma,
         ModelFunction::EventValues,
         ModelFunction::EquilibriumGuesses,
+        ModelFunction::ContactGaps,
+        ModelFunction::ContactJacobian,
+        ModelFunction::ContactCoefficients,
     ];
 
     /// The exact Jacobians ([`plan_jacobians`]), which the run-time compiler plans only when
@@ -122,6 +134,9 @@ impl ModelFunction {
             ModelFunction::ConstraintGamma => "constraint_gamma",
             ModelFunction::EventValues => "event_values",
             ModelFunction::EquilibriumGuesses => "equilibrium_guesses",
+            ModelFunction::ContactGaps => "contact_gaps",
+            ModelFunction::ContactJacobian => "contact_jacobian",
+            ModelFunction::ContactCoefficients => "contact_coefficients",
         }
     }
 
@@ -165,6 +180,21 @@ impl ModelFunction {
             ModelFunction::EventValues => {
                 unless_empty(model.events.iter().map(|e| e.function).collect())
             }
+            ModelFunction::ContactGaps => unless_empty(
+                (model.contacts.iter().map(|c| c.gap))
+                    .chain(model.contacts.iter().map(|c| c.rate))
+                    .collect(),
+            ),
+            ModelFunction::ContactJacobian => unless_empty(
+                (model.contacts.iter())
+                    .flat_map(|c| c.jacobian.iter().copied())
+                    .collect(),
+            ),
+            ModelFunction::ContactCoefficients => unless_empty(
+                (model.contacts.iter())
+                    .flat_map(|c| [c.restitution, c.friction])
+                    .collect(),
+            ),
             // With a steady motion among them, each entry's rates follow its coordinates
             // ([`ModelDescription::equilibrium_rates`](eomgen_description::ModelDescription)).
             ModelFunction::EquilibriumGuesses => unless_empty(

@@ -57,6 +57,9 @@ impl FunctionTape {
 /// | `constraint_velocity_residuals`, `constraint_gamma` | (m) |
 /// | `event_values` | `g` (e); `q̈` as the acceleration inputs, `λ` as the multipliers |
 /// | `equilibrium_guesses` | `n` per named equilibrium |
+/// | `contact_gaps` | `g` (m_c), then `ġ` (m_c) |
+/// | `contact_jacobian` | `G = ∂g/∂q` (m_c × n, row-major) |
+/// | `contact_coefficients` | `e`, `μ` per contact (2 m_c) |
 #[derive(Debug, Clone, PartialEq)]
 pub struct ModelProgram {
     /// Everything about the model that is not a function of the state ([`super::describe`]).
@@ -83,6 +86,12 @@ pub struct ModelProgram {
     pub event_values: FunctionTape,
     /// Equilibrium guesses.
     pub equilibrium_guesses: FunctionTape,
+    /// The contacts' gaps and their rates.
+    pub contact_gaps: FunctionTape,
+    /// The contacts' Jacobian.
+    pub contact_jacobian: FunctionTape,
+    /// The contacts' coefficients of restitution and friction.
+    pub contact_coefficients: FunctionTape,
 }
 
 impl ModelProgram {
@@ -133,6 +142,9 @@ impl ModelProgram {
             constraint_gamma: single(F::ConstraintGamma),
             event_values: single(F::EventValues),
             equilibrium_guesses: single(F::EquilibriumGuesses),
+            contact_gaps: single(F::ContactGaps),
+            contact_jacobian: single(F::ContactJacobian),
+            contact_coefficients: single(F::ContactCoefficients),
         }
     }
 
@@ -151,6 +163,9 @@ impl ModelProgram {
             &mut self.constraint_gamma,
             &mut self.event_values,
             &mut self.equilibrium_guesses,
+            &mut self.contact_gaps,
+            &mut self.contact_jacobian,
+            &mut self.contact_coefficients,
         ] {
             *tape = FunctionTape::default();
         }
@@ -163,7 +178,7 @@ impl ModelProgram {
 
     /// Every function with its name, in the order of the table above (the Jacobians, planned
     /// apart, not among them).
-    pub fn functions(&self) -> [(&'static str, &FunctionTape); 11] {
+    pub fn functions(&self) -> [(&'static str, &FunctionTape); 14] {
         [
             ("initial_state", &self.initial_state),
             ("mass_matrix_and_forcing", &self.mass_matrix_and_forcing),
@@ -179,6 +194,9 @@ impl ModelProgram {
             ("constraint_gamma", &self.constraint_gamma),
             ("event_values", &self.event_values),
             ("equilibrium_guesses", &self.equilibrium_guesses),
+            ("contact_gaps", &self.contact_gaps),
+            ("contact_jacobian", &self.contact_jacobian),
+            ("contact_coefficients", &self.contact_coefficients),
         ]
     }
 }

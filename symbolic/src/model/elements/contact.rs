@@ -489,10 +489,19 @@ impl Contact {
             }
         };
         let restitution = cx.expr(&self.restitution);
-        let friction = self.friction.as_ref().map(|mu| cx.expr(mu));
+        let friction = match &self.friction {
+            Some(mu) => cx.expr(mu),
+            None => cx.arena().int(0),
+        };
+        let arena = cx.arena();
+        let coordinates = arena.coordinates().to_vec();
+        let jacobian = coordinates.iter().map(|s| arena.diff(gap, s[0])).collect();
+        let rate = arena.time_derivative(gap);
         Some(ContactInfo {
             name: self.name.value.clone(),
             gap,
+            jacobian,
+            rate,
             restitution,
             friction,
         })
@@ -539,8 +548,12 @@ pub struct ContactInfo {
     pub name: String,
     /// The gap `g(q, t)` (m).
     pub gap: ExprId,
+    /// Its Jacobian `G = ∂g/∂q` (one entry per coordinate).
+    pub jacobian: Vec<ExprId>,
+    /// Its rate `ġ = G q̇ + ∂g/∂t` (m/s).
+    pub rate: ExprId,
     /// Newton's coefficient of restitution `e`.
     pub restitution: ExprId,
-    /// Coulomb's friction coefficient `μ`; `None`: frictionless.
-    pub friction: Option<ExprId>,
+    /// Coulomb's friction coefficient `μ` (0 for a frictionless contact).
+    pub friction: ExprId,
 }
