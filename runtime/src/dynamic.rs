@@ -107,7 +107,8 @@ pub trait DynMechanicalSystem {
     fn contact_gaps(&self, q: &[f64], qdot: &[f64], t: f64, out: &mut [f64]) {
         let _ = (q, qdot, t, out);
     }
-    /// [`MechanicalSystem::contact_jacobian`]: `G` (`m_c × n`, row-major) into `out`.
+    /// [`MechanicalSystem::contact_jacobian`]: `G`, then `T` (`2 m_c × n`, row-major) into
+    /// `out`.
     fn contact_jacobian(&self, q: &[f64], t: f64, out: &mut [f64]) {
         let _ = (q, t, out);
     }

@@ -57,7 +57,8 @@ pub enum ModelFunction {
     EquilibriumGuesses,
     /// The contacts' gaps `g` (m_c), then their rates `ġ` (m_c).
     ContactGaps,
-    /// The contacts' Jacobian `G = ∂g/∂q` (m_c × n, row-major).
+    /// The contacts' Jacobian `G = ∂g/∂q` (m_c × n, row-major), then their slips' rows `T`
+    /// (m_c × n; a row of zeros for a frictionless contact).
     ContactJacobian,
     /// Each contact's coefficient of restitution `e` and of friction `μ` (2 m_c).
     ContactCoefficients,
@@ -188,6 +189,12 @@ impl ModelFunction {
             ModelFunction::ContactJacobian => unless_empty(
                 (model.contacts.iter())
                     .flat_map(|c| c.jacobian.iter().copied())
+                    .chain(
+                        model
+                            .contacts
+                            .iter()
+                            .flat_map(|c| c.tangent.iter().copied()),
+                    )
                     .collect(),
             ),
             ModelFunction::ContactCoefficients => unless_empty(

@@ -58,7 +58,7 @@ impl FunctionTape {
 /// | `event_values` | `g` (e); `q̈` as the acceleration inputs, `λ` as the multipliers |
 /// | `equilibrium_guesses` | `n` per named equilibrium |
 /// | `contact_gaps` | `g` (m_c), then `ġ` (m_c) |
-/// | `contact_jacobian` | `G = ∂g/∂q` (m_c × n, row-major) |
+/// | `contact_jacobian` | `G = ∂g/∂q` (m_c × n), then the slips' rows `T` (m_c × n), row-major |
 /// | `contact_coefficients` | `e`, `μ` per contact (2 m_c) |
 #[derive(Debug, Clone, PartialEq)]
 pub struct ModelProgram {

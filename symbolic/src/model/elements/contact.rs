@@ -342,6 +342,18 @@ impl Contact {
         self.coefficient_rules(cx, &self.restitution, "coefficient of restitution");
         if let Some(mu) = &self.friction {
             self.coefficient_rules(cx, mu, "friction coefficient");
+            let what = format!("contact `{name}` has friction");
+            if matches!(self.gap, Gap::Written(_)) {
+                cx.error(
+                    Diagnostic::new(mu.location, format!("{what}, but a written gap has no direction of slip"))
+                        .with_help("write the contact as a point and its surface (`point: P, above: { normal: [0, 1] }`), whose slip is along the surface, or leave `friction` out"),
+                );
+            } else if cx.dimension() != 2 {
+                cx.error(
+                    Diagnostic::new(mu.location, format!("{what}, but friction is taken in the plane only: a contact in 3-D slips in two directions, which the impact law does not take yet"))
+                        .with_help("leave `friction` out of a contact between 3-D points"),
+                );
+            }
         }
     }
 
@@ -450,8 +462,10 @@ impl Contact {
     /// The contact as expressions: its gap `g(q, t)`; `None` (with the mistake reported)
     /// if it names an unknown point.
     pub(crate) fn lower(&self, cx: &mut dyn Lower) -> Option<ContactInfo> {
-        let gap = match &self.gap {
-            Gap::Written(g) => cx.expr(g),
+        // The gap, and for a point the point and the direction `u` across the surface (the
+        // normal, or the point from the centre), whose perpendicular is the slip's.
+        let (gap, across) = match &self.gap {
+            Gap::Written(g) => (cx.expr(g), None),
             Gap::Above {
                 point,
                 normal,
@@ -461,13 +475,13 @@ impl Contact {
                 let n: Vec<ExprId> = normal.value.iter().map(|c| cx.expr(c)).collect();
                 let d = match through {
                     Some(o) => difference(cx, &p, &o.value),
-                    None => p,
+                    None => p.clone(),
                 };
                 let nd = dot(cx, &n, &d);
                 let nn = dot(cx, &n, &n);
                 let arena = cx.arena();
                 let length = arena.sqrt(nn);
-                arena.divide(nd, length)
+                (arena.divide(nd, length), Some((p, n)))
             }
             Gap::Circle {
                 point,
@@ -481,11 +495,12 @@ impl Contact {
                 let r = cx.expr(radius);
                 let arena = cx.arena();
                 let distance = arena.sqrt(dd);
-                if *inside {
+                let gap = if *inside {
                     arena.minus(r, distance)
                 } else {
                     arena.minus(distance, r)
-                }
+                };
+                (gap, Some((p, d)))
             }
         };
         let restitution = cx.expr(&self.restitution);
@@ -494,13 +509,42 @@ impl Contact {
             None => cx.arena().int(0),
         };
         let arena = cx.arena();
-        let coordinates = arena.coordinates().to_vec();
-        let jacobian = coordinates.iter().map(|s| arena.diff(gap, s[0])).collect();
+        let coordinates: Vec<_> = arena.coordinates().iter().map(|s| s[0]).collect();
+        let jacobian = coordinates.iter().map(|&q| arena.diff(gap, q)).collect();
         let rate = arena.time_derivative(gap);
+        // The slip's row in the plane (the rules refuse friction elsewhere): `t̂ · ∂P/∂q`,
+        // `t̂ = (−u_y, u_x)/|u|`.
+        let tangent = match (&self.friction, across) {
+            (Some(_), Some((p, u))) if p.len() == 2 && u.len() == 2 => {
+                let uu = dot(cx, &u, &u);
+                let arena = cx.arena();
+                let length = arena.sqrt(uu);
+                let minus_uy = arena.neg(u[1]);
+                let t = [arena.divide(minus_uy, length), arena.divide(u[0], length)];
+                let row = coordinates
+                    .iter()
+                    .map(|&q| {
+                        let parts: Vec<ExprId> = (0..2)
+                            .map(|k| {
+                                let dp = arena.diff(p[k], q);
+                                arena.times(t[k], dp)
+                            })
+                            .collect();
+                        arena.sum(&parts)
+                    })
+                    .collect();
+                row
+            }
+            _ => {
+                let zero = cx.arena().int(0);
+                vec![zero; coordinates.len()]
+            }
+        };
         Some(ContactInfo {
             name: self.name.value.clone(),
             gap,
             jacobian,
+            tangent,
             rate,
             restitution,
             friction,
@@ -550,6 +594,10 @@ pub struct ContactInfo {
     pub gap: ExprId,
     /// Its Jacobian `G = ∂g/∂q` (one entry per coordinate).
     pub jacobian: Vec<ExprId>,
+    /// The row `T` of its slip `v_t = T q̇` along the surface (in the plane: `t̂ · ∂P/∂q`,
+    /// `t̂` the normal turned a quarter-turn counter-clockwise); zeros for a frictionless
+    /// contact.
+    pub tangent: Vec<ExprId>,
     /// Its rate `ġ = G q̇ + ∂g/∂t` (m/s).
     pub rate: ExprId,
     /// Newton's coefficient of restitution `e`.
