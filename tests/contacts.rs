@@ -157,3 +157,153 @@ fn an_impact_from_the_models_own_rows_obeys_newtons_law() {
     let lost = lost + 0.5 * m * 0.25;
     assert!((r.energy_lost - lost).abs() <= 1e-14 * lost, "{r:?}");
 }
+
+const BALL: &str = concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/tests/fixtures/bouncing_ball.yaml"
+);
+
+/// The bouncing ball's closed forms (`h = 1 m`, `g = 9.81 m/s²`): the `k`-th impact time
+/// `t₁ + Σ_{j<k} 2 eʲ v₀/g` and the accumulation time `t∞ = t₁ + (2 e v₀/g)/(1 − e)`.
+fn ball_times(e: f64, k: usize) -> (Vec<f64>, f64) {
+    let (g, h) = (9.81_f64, 1.0_f64);
+    let (t1, v0) = ((2.0 * h / g).sqrt(), (2.0 * g * h).sqrt());
+    let mut times = vec![t1];
+    for j in 1..k {
+        let last = times[j - 1];
+        times.push(last + 2.0 * e.powi(j as i32) * v0 / g);
+    }
+    (times, t1 + 2.0 * e * v0 / g / (1.0 - e))
+}
+
+/// A run of the ball to `t_end` with `method` at `rtol = atol = tol` and `e`, `μ` set.
+fn ball_run(
+    method: eomgen::analysis::Method,
+    tol: f64,
+    (e, mu): (f64, f64),
+    t_end: f64,
+) -> eomgen::analysis::Simulation {
+    let mut model = eomgen::DynFirstOrder::new(JitModel::load(BALL).unwrap());
+    eomgen::ModelInfo::set_parameter(&mut model, "e", e).unwrap();
+    eomgen::ModelInfo::set_parameter(&mut model, "mu", mu).unwrap();
+    let options = eomgen::analysis::SimulationOptions {
+        method,
+        t_end,
+        rtol: tol,
+        atol: tol,
+        ..Default::default()
+    };
+    eomgen::analysis::simulate(&mut model, &options).unwrap()
+}
+
+/// Through impacts with every adaptive method (each restarted after every impact): the
+/// first six impact times equal the closed form to 1e-7 s at tolerance 1e-10, each impact
+/// reverses `ẏ` with the factor `e` (to 1e-12 relative: the impact law itself), the energy
+/// lost at each is `½ m (1 − e²) ẏ⁻²`, and the drift of `E` plus the losses stays at the
+/// integration's level (below 1e-8).
+#[test]
+fn a_bouncing_ball_strikes_at_the_closed_form_times_with_every_adaptive_method() {
+    let (times, _) = ball_times(0.8, 6);
+    for method in eomgen::analysis::Method::ALL {
+        if !method.is_adaptive() {
+            continue;
+        }
+        let run = ball_run(method, 1e-10, (0.8, 0.0), 3.0);
+        assert!(
+            run.failure.is_none() && run.contact_stop.is_none(),
+            "{method:?}"
+        );
+        assert_eq!(run.transitions.len(), 6, "{method:?}");
+        for (tr, t) in run.transitions.iter().zip(&times) {
+            assert!((tr.t - t).abs() < 1e-7, "{method:?}: {} vs {t}", tr.t);
+            let [before, after] = tr.normal_velocity;
+            assert!(
+                (after + 0.8 * before).abs() <= 1e-12 * before.abs(),
+                "{tr:?}"
+            );
+            let lost = 0.5 * (1.0 - 0.64) * before * before;
+            assert!((tr.energy_lost - lost).abs() <= 1e-12 * lost, "{tr:?}");
+            // The sample before the impact and the one after share its time.
+            assert_eq!(run.solution.t[tr.sample - 1], tr.t);
+            assert_eq!(run.solution.t[tr.sample], tr.t);
+        }
+        assert!(
+            run.energy.drift.unwrap() < 1e-8,
+            "{method:?}: {:?}",
+            run.energy.drift
+        );
+    }
+}
+
+/// Past the accumulation time the run stops at the contact, where the impacts accumulate:
+/// the stop time plus the closed form of the flights left after it, `(2 e |ġ⁻|/g)/(1 − e)`,
+/// is `t∞` to 1e-8 s, for `e = 0.5` and `0.8`. A plastic ball (`e = 0`) stops at its first
+/// impact, at `t₁`, having lost all its vertical energy `m g h`.
+#[test]
+fn impacts_accumulate_at_the_zeno_time_and_a_plastic_ball_stays_down() {
+    for e in [0.5, 0.8] {
+        let (_, t_inf) = ball_times(e, 1);
+        let run = ball_run(eomgen::analysis::Method::Dp54, 1e-12, (e, 0.0), 6.0);
+        let Some(eomgen::hybrid::ContactStop::Closed {
+            t,
+            speed,
+            accumulating: true,
+            ..
+        }) = run.contact_stop
+        else {
+            panic!("{:?}", run.contact_stop);
+        };
+        let left = 2.0 * e * speed / 9.81 / (1.0 - e);
+        assert!(
+            (t + left - t_inf).abs() < 1e-8,
+            "e = {e}: {t} + {left} vs {t_inf}"
+        );
+    }
+    let (times, _) = ball_times(0.0, 1);
+    let run = ball_run(eomgen::analysis::Method::Dp54, 1e-12, (0.0, 0.0), 3.0);
+    assert!(matches!(
+        run.contact_stop,
+        Some(eomgen::hybrid::ContactStop::Closed {
+            accumulating: false,
+            ..
+        })
+    ));
+    assert_eq!(run.transitions.len(), 1);
+    assert!((run.transitions[0].t - times[0]).abs() < 1e-9);
+    assert!((run.transitions[0].energy_lost - 9.81).abs() < 1e-9);
+}
+
+/// With friction on the floor the first impact sticks: the impulse `m · 0.5` that stops the
+/// slip is inside `μ Λ_N` for `μ = 0.3`, so `ẋ = 0` after it and the ball bounces in place;
+/// with `μ = 0.05` it slides on the cone's edge, `ẋ⁺ = 0.5 − μ (1 + e) v₀`.
+#[test]
+fn friction_at_the_impact_sticks_or_slides() {
+    let v0 = (2.0 * 9.81_f64).sqrt();
+    let run = ball_run(eomgen::analysis::Method::Dp54, 1e-10, (0.8, 0.3), 1.0);
+    let first = &run.transitions[0];
+    assert_eq!(first.mode, ImpactMode::Sticking);
+    assert!(first.qdot[1][0].abs() < 1e-14, "{first:?}");
+    let run = ball_run(eomgen::analysis::Method::Dp54, 1e-10, (0.8, 0.05), 1.0);
+    let first = &run.transitions[0];
+    assert_eq!(first.mode, ImpactMode::Sliding);
+    let slid = 0.5 - 0.05 * 1.8 * v0;
+    assert!(
+        (first.qdot[1][0] - slid).abs() < 1e-9,
+        "{first:?} vs {slid}"
+    );
+}
+
+/// A start inside the floor is refused, naming the contact.
+#[test]
+fn a_start_inside_a_contact_is_refused() {
+    let mut model = eomgen::DynFirstOrder::new(JitModel::load(BALL).unwrap());
+    let options = eomgen::analysis::SimulationOptions {
+        initial_state: Some(vec![0.0, -0.01, 0.0, 0.0]),
+        ..Default::default()
+    };
+    let error = eomgen::analysis::simulate(&mut model, &options).unwrap_err();
+    assert!(
+        matches!(&error, eomgen::analysis::SimulationError::StartsInsideContact { contact, gap } if contact == "floor" && *gap == -0.01),
+        "{error}"
+    );
+}

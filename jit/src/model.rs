@@ -671,12 +671,7 @@ impl DynMechanicalSystem for JitModel {
         );
     }
     fn contact_gaps(&self, q: &[f64], qdot: &[f64], t: f64, out: &mut [f64]) {
-        self.run(
-            Routine::ContactGaps,
-            self.inputs(q, qdot, t),
-            out,
-            &mut [],
-        );
+        self.run(Routine::ContactGaps, self.inputs(q, qdot, t), out, &mut []);
     }
     fn contact_jacobian(&self, q: &[f64], t: f64, out: &mut [f64]) {
         self.run(

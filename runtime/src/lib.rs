@@ -124,6 +124,6 @@ pub use linear::steady::{
     SteadyLinearization, SteadyMotion, SteadyMotionError, find_steady_motion, general_eigenvalues,
     linearize_steady_motion, steady_stability,
 };
-pub use model_info::{ConstraintValues, ModelInfo, ModelSummary};
+pub use model_info::{ConstraintValues, ContactValues, ModelInfo, ModelSummary};
 pub use ode::{OdeFn, OdeSystem, RhsError, WithEvents};
 pub use system::{BodyCentre, MechanicalSystem, ModelDescription, UnknownParameter};

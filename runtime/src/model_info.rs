@@ -108,6 +108,13 @@ pub trait ModelInfo: OdeSystem {
     /// `Φ` (length `m_h`), `J` (`m × n`), the velocity residuals and `γ` (length `m`) at
     /// `(t, y)`; see [`constraint_jacobian`](crate::MechanicalSystem::constraint_jacobian) and siblings.
     fn constraint_equations(&self, t: f64, y: &[f64]) -> ConstraintValues;
+    /// The unilateral contacts at `(t, y)` ([`ModelDescription::contacts`]): gaps, their
+    /// rates, rows and coefficients ([`crate::MechanicalSystem::contact_gaps`] and
+    /// siblings); empty without contacts.
+    fn contact_values(&self, t: f64, y: &[f64]) -> ContactValues;
+    /// The contacts' gaps `g` then their rates `ġ` at `(t, y)` into `out` (`2 m_c`
+    /// entries): [`crate::MechanicalSystem::contact_gaps`] alone.
+    fn contact_gaps(&self, t: f64, y: &[f64], out: &mut [f64]);
     /// Makes `y = [q; q̇]` (at `t = 0`) consistent with the constraints (issue 5, item 3): the
     /// coordinates marked `{ guess: … }` and their rates are solved by Newton from
     /// `Φ(q, 0) = 0` and the velocity constraints, the others held. Without guesses, `y` must
@@ -170,6 +177,27 @@ pub struct ConstraintValues {
     pub velocity: DVector<f64>,
     /// `γ` of `J q̈ = γ` (length `m`).
     pub gamma: DVector<f64>,
+}
+
+/// A model's unilateral contacts at one state ([`ModelInfo::contact_values`]).
+///
+/// # Shapes
+/// `m_c` contacts and `n` coordinates: `gaps`, `rates`, `restitution`, `friction` have `m_c`
+/// entries; `normal` (`G = ∂g/∂q`) and `tangent` (the slips' rows `T`) `m_c × n`, row-major.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ContactValues {
+    /// `g(q, t)` (m).
+    pub gaps: Vec<f64>,
+    /// `ġ = G q̇ + ∂g/∂t` (m/s).
+    pub rates: Vec<f64>,
+    /// `G`, row-major.
+    pub normal: Vec<f64>,
+    /// `T`, row-major (zeros for a frictionless contact).
+    pub tangent: Vec<f64>,
+    /// Newton's coefficients of restitution `e`.
+    pub restitution: Vec<f64>,
+    /// Coulomb's coefficients `μ` (0: frictionless).
+    pub friction: Vec<f64>,
 }
 
 /// A first-order form `y = [q; q̇]` of a mechanical system, as [`ModelInfo`] is written over
@@ -345,6 +373,35 @@ impl<F: FirstOrderForm> ModelInfo for F {
                 true
             }
             None => false,
+        }
+    }
+    fn contact_gaps(&self, t: f64, y: &[f64], out: &mut [f64]) {
+        let system = self.dyn_system();
+        let n = system.num_dofs();
+        system.contact_gaps(&y[..n], &y[n..2 * n], t, out);
+    }
+    fn contact_values(&self, t: f64, y: &[f64]) -> ContactValues {
+        let system = self.dyn_system();
+        let n = system.num_dofs();
+        let (q, qdot) = (&y[..n], &y[n..2 * n]);
+        let m = system.description().contacts.len();
+        let mut gaps = vec![0.0; 2 * m];
+        let mut rows = vec![0.0; 2 * m * n];
+        let mut coefficients = vec![0.0; 2 * m];
+        if m > 0 {
+            system.contact_gaps(q, qdot, t, &mut gaps);
+            system.contact_jacobian(q, t, &mut rows);
+            system.contact_coefficients(&mut coefficients);
+        }
+        let rates = gaps.split_off(m);
+        let tangent = rows.split_off(m * n);
+        ContactValues {
+            gaps,
+            rates,
+            normal: rows,
+            tangent,
+            restitution: coefficients.iter().step_by(2).copied().collect(),
+            friction: coefficients.iter().skip(1).step_by(2).copied().collect(),
         }
     }
     fn constraint_equations(&self, t: f64, y: &[f64]) -> ConstraintValues {

@@ -1,7 +1,7 @@
 //! The model loader on valid files: contents, locations, units and comments; and never a
 //! panic on any input.
 
-use eomgen_symbolic::model::{BodyKind, Expr, ExprKind, Location, ModelFile, load};
+use eomgen_symbolic::model::{BodyKind, Expr, ExprKind, Gap, Location, ModelFile, load};
 use proptest::prelude::*;
 
 const DOUBLE_PENDULUM: &str = include_str!("fixtures/double_pendulum.yaml");
@@ -185,6 +185,22 @@ fn every_supported_section_loads() {
     assert_eq!(file.torques.len(), 1);
     assert_eq!(file.torques[0].body.value, "crank");
     assert_eq!(file.draw.trace.len(), 1);
+    let contacts: Vec<&str> = file
+        .contacts
+        .iter()
+        .map(|c| c.name.value.as_str())
+        .collect();
+    assert_eq!(contacts, ["stop", "tip", "guard"]);
+    assert!(matches!(file.contacts[0].gap, Gap::Written(_)));
+    assert!(
+        matches!(&file.contacts[1].gap, Gap::Above { point, through: Some(_), .. } if point.value == "A")
+    );
+    assert!(matches!(
+        &file.contacts[2].gap,
+        Gap::Circle { point, inside: true, .. } if point.value == "B"
+    ));
+    assert_eq!(file.contacts[1].restitution.location, at(37, 78));
+    assert!(file.contacts[0].friction.is_none() && file.contacts[1].friction.is_some());
     assert_eq!(file.initial.len(), 3);
     assert!(file.potential.is_some());
     assert_eq!(

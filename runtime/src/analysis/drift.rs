@@ -31,6 +31,30 @@ pub struct EnergyDrift {
 }
 
 impl EnergyDrift {
+    /// Measures [`Self::drift`] on `E` plus the energy lost at impacts (a run through
+    /// impacts, [`crate::hybrid::run`]): `losses` are `(first sample after the impact, J
+    /// lost)` in sample order, so that only the smooth phases' drift is measured. `energy`
+    /// keeps the energy itself.
+    pub fn add_losses(&mut self, losses: impl Iterator<Item = (usize, f64)>) {
+        let mut losses = losses.peekable();
+        let mut lost = 0.0;
+        let mut deviation: f64 = 0.0;
+        for (k, e) in self.energy.iter().enumerate() {
+            while let Some(&(_, l)) = losses.peek().filter(|(sample, _)| *sample <= k) {
+                lost += l;
+                losses.next();
+            }
+            deviation = deviation.max((e + lost - self.initial_energy).abs());
+        }
+        if self.drift.is_some() {
+            self.drift = Some(if self.scale > 0.0 {
+                deviation / self.scale
+            } else {
+                deviation
+            });
+        }
+    }
+
     /// `(E − E(0)) / scale` at every sample (the absolute deviation when the scale is 0),
     /// signed.
     pub fn relative(&self) -> Vec<f64> {

@@ -376,16 +376,6 @@ struct Evaluation {
     tol: f64,
 }
 
-fn accumulate(total: &mut Stats, add: &Stats) {
-    total.steps += add.steps;
-    total.rejected += add.rejected;
-    total.rhs_evals += add.rhs_evals;
-    total.jacobian_evals += add.jacobian_evals;
-    total.lu_decompositions += add.lu_decompositions;
-    total.event_evals += add.event_evals;
-    total.wall_time_s += add.wall_time_s;
-}
-
 fn norm(v: &[f64]) -> f64 {
     v.iter().map(|x| x * x).sum::<f64>().sqrt()
 }
@@ -791,7 +781,7 @@ fn evaluate(
         return Err(FloquetError::NonFinite { row: 0, column: 0 }.into());
     }
     let (monodromy, end, run) = monodromy_matrix(model.as_ode_mut(), &y, 0.0, period, &options)?;
-    accumulate(stats, &run);
+    stats.accumulate(&run);
     let residual: Vec<f64> = end.iter().zip(&y).map(|(a, b)| a - b).collect();
     let residual_norm = norm(&residual);
     let energy_residual = shooting.energy.map(|e| model.energy(0.0, &y) - e);
@@ -898,7 +888,7 @@ fn sample_orbit(
             &integrator_options,
         )
         .map_err(FloquetError::from)?;
-    accumulate(stats, &solution.stats);
+    stats.accumulate(&solution.stats);
     let mut orbit = OrbitSamples {
         t: Vec::with_capacity(samples),
         y: Vec::with_capacity(samples),

@@ -11,6 +11,7 @@ use crate::analysis::failure::{FailureCause, failure_cause};
 use crate::analysis::fixed_step::{ENERGY_DRIFT_LIMIT, SimulationWarning, fixed_step_warnings};
 use crate::analysis::methods::Method;
 use crate::constrained::{ProjectionError, Stabilization, StabilizationError};
+use crate::hybrid::run::{ContactStop, HybridRecord, Transition, integrate_through_impacts};
 use crate::integrate::{
     EventSpec, IntegrationError, IntegrationFailure, Integrator, IntegratorOptions, OutputTimes,
     Solution, Stats,
@@ -151,6 +152,16 @@ pub enum SimulationError {
     /// The drift control's gains cannot be used (a negative Baumgarte gain).
     #[error(transparent)]
     InvalidStabilization(#[from] StabilizationError),
+    /// The initial state is inside a unilateral contact: its gap is negative.
+    #[error(
+        "the initial state is inside contact `{contact}`: its gap is {gap:e} (a gap is 0 or more, 0 where the contact touches)"
+    )]
+    StartsInsideContact {
+        /// The contact.
+        contact: String,
+        /// Its gap there (m).
+        gap: f64,
+    },
     /// An entry of the initial state is not finite: the model file's `initial:` expression
     /// is outside its domain at these parameters, or the state given has it.
     #[error(
@@ -206,6 +217,13 @@ pub struct Simulation {
     /// for [`simulate`]; not serialised).
     #[serde(skip)]
     pub num_added_events: usize,
+    /// The impacts at the model's contacts, in time order (a model with `contacts:`;
+    /// [`integrate_through_impacts`]).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub transitions: Vec<Transition>,
+    /// Why the run stopped at a contact before `t_end`, if it did.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub contact_stop: Option<ContactStop>,
 }
 
 fn serialize_failure<S: Serializer>(
@@ -322,18 +340,32 @@ pub fn simulate_with_events(
             t_end: options.t_end,
         });
     }
+    starts_outside_contacts(model, &y0, options.atol)?;
     let warnings = fixed_step_warnings(model, options.method, &y0, options.dt, options.t_end);
     let integrator_options = options.integrator_options();
     let mut integrator = options.method.integrator();
     let num_added_events = added.as_ref().map_or(0, |added| added.specs().len());
-    let result = integrate_run(
-        integrator.as_mut(),
-        model,
-        added,
-        &y0,
-        options,
-        &integrator_options,
-    );
+    let (result, hybrid) = if model.description().contacts.is_empty() {
+        let run = integrate_run(
+            integrator.as_mut(),
+            model,
+            added,
+            &y0,
+            options,
+            &integrator_options,
+        );
+        (run, HybridRecord::default())
+    } else {
+        integrate_through_impacts(
+            integrator.as_mut(),
+            model,
+            added,
+            (0.0, &y0),
+            options.t_end,
+            &options.output,
+            &integrator_options,
+        )
+    };
     let (solution, failure) = match result {
         Ok(s) => (s, None),
         Err(IntegrationFailure { error, partial }) => (*partial, Some(error)),
@@ -347,7 +379,15 @@ pub fn simulate_with_events(
         };
         failure_cause(model, e, t, &y, &y0)
     });
-    let energy = energy_drift(model, &y0, &solution);
+    let mut energy = energy_drift(model, &y0, &solution);
+    if !hybrid.transitions.is_empty() {
+        energy.add_losses(
+            hybrid
+                .transitions
+                .iter()
+                .map(|tr| (tr.sample, tr.energy_lost)),
+        );
+    }
     let constraints = constraint_drift(model, &solution);
     let mut warnings = warnings;
     if model.description().conservative
@@ -376,7 +416,34 @@ pub fn simulate_with_events(
         cause,
         options: options.clone(),
         num_added_events,
+        transitions: hybrid.transitions,
+        contact_stop: hybrid.stop,
     })
+}
+
+/// Refuses an initial state inside a contact: a gap below `−atol` (the run's absolute
+/// tolerance, the rounding a gap written as 0 may carry).
+///
+/// # Errors
+/// [`SimulationError::StartsInsideContact`] for the first such contact.
+fn starts_outside_contacts(
+    model: &dyn ModelInfo,
+    y0: &[f64],
+    atol: f64,
+) -> Result<(), SimulationError> {
+    let contacts = &model.description().contacts;
+    if contacts.is_empty() {
+        return Ok(());
+    }
+    let mut values = vec![0.0; 2 * contacts.len()];
+    model.contact_gaps(0.0, y0, &mut values);
+    match values[..contacts.len()].iter().position(|&g| g.is_nan() || g < -atol) {
+        Some(c) => Err(SimulationError::StartsInsideContact {
+            contact: contacts[c].to_string(),
+            gap: values[c],
+        }),
+        None => Ok(()),
+    }
 }
 
 /// The initial state of a [`simulate_with_events`] run: the given one or the model's, of
@@ -503,6 +570,22 @@ pub struct SimulationSummary {
     /// The warnings, each serialised as [`SimulationWarning`] with its `message` added.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub warnings: Vec<WarningSummary>,
+    /// The impacts at the model's contacts, in time order (models with contacts only).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub transitions: Vec<Transition>,
+    /// Why the run stopped at a contact, `{"kind", …, "message"}` (when it did).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub contact_stop: Option<ContactStopSummary>,
+}
+
+/// A [`ContactStop`] with its message.
+#[derive(Debug, Clone, Serialize)]
+pub struct ContactStopSummary {
+    /// The stop.
+    #[serde(flatten)]
+    pub stop: ContactStop,
+    /// Its message.
+    pub message: String,
 }
 
 /// One sample of a [`SimulationSummary`].
@@ -668,6 +751,11 @@ impl Simulation {
                     .map(|k| self.solution.events[k].name.clone())
             }),
             error: self.failure.as_ref().map(FailureSummary::from),
+            transitions: self.transitions.clone(),
+            contact_stop: self.contact_stop.as_ref().map(|stop| ContactStopSummary {
+                stop: stop.clone(),
+                message: stop.to_string(),
+            }),
             warnings: self
                 .warnings
                 .iter()

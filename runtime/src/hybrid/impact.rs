@@ -103,7 +103,8 @@ pub struct ImpactReport {
 }
 
 /// Why an impact could not be computed.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[derive(Debug, Clone, PartialEq, Serialize, thiserror::Error)]
+#[serde(tag = "kind", rename_all = "snake_case")]
 pub enum ImpactError {
     /// A slice has the wrong length.
     #[error("{what} has {found} entries, expected {expected}")]

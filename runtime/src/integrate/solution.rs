@@ -76,6 +76,20 @@ pub struct Solution {
     pub terminated_by_event: Option<usize>,
 }
 
+impl Stats {
+    /// Adds the work of `other` (a later phase of the same run) to this one.
+    pub(crate) fn accumulate(&mut self, other: &Stats) {
+        self.steps += other.steps;
+        self.rejected += other.rejected;
+        self.rhs_evals += other.rhs_evals;
+        self.jacobian_evals += other.jacobian_evals;
+        self.lu_decompositions += other.lu_decompositions;
+        self.event_evals += other.event_evals;
+        self.taylor_series += other.taylor_series;
+        self.wall_time_s += other.wall_time_s;
+    }
+}
+
 impl Solution {
     /// An empty solution of dimension `dim`.
     pub(crate) fn new(dim: usize) -> Self {

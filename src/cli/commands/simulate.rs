@@ -95,6 +95,9 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
         Some(t) if !e.to_string().contains("t = ") => format!("incomplete: {e} at t = {t}"),
         _ => format!("incomplete: {e}"),
     });
+    // A run that stopped at a contact is incomplete too (its stop says where and why).
+    let incomplete = incomplete
+        .or_else(|| (simulation.contact_stop.as_ref()).map(|stop| format!("incomplete: {stop}")));
     // The file's `outputs:` at every sample; one that cannot be evaluated (not a number
     // where the run went) fails the command after everything else is written.
     let (outputs, outputs_error) =
@@ -120,7 +123,14 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
             "the outputs of `{}` could not be evaluated along the run",
             model.description().name
         ))),
-        None => Ok(()),
+        None => match &simulation.contact_stop {
+            Some(stop) => Err(CliError::failure(format!(
+                "the run of `{}` stopped before its end time: {stop}; the {} samples computed before it were kept",
+                model.description().name,
+                solution.len()
+            ))),
+            None => Ok(()),
+        },
         Some(e) => Err(failure_error(
             &model.description().name,
             e,
@@ -268,8 +278,43 @@ fn print_report(
         print_summary(model, method_name, &args.run, solution, report, outputs);
         print_constraint_summary(constraints, args.run.stabilization);
         print_events(model, solution);
+        print_impacts(simulation);
     }
     Ok(())
+}
+
+/// The impacts at the model's contacts (time, contact, how it ended, `ġ` before and after,
+/// the impulses and the energy lost), and why the run stopped at a contact.
+fn print_impacts(simulation: &Simulation) {
+    let transitions = &simulation.transitions;
+    if !transitions.is_empty() {
+        let lost: f64 = transitions.iter().map(|tr| tr.energy_lost).sum();
+        outln!(
+            "impacts    {} (energy lost {:.6e} J):",
+            transitions.len(),
+            num(lost)
+        );
+        for tr in transitions {
+            let tangential = if tr.tangential_impulse == 0.0 {
+                String::new()
+            } else {
+                format!(", tangential {:.6e} N*s", num(tr.tangential_impulse))
+            };
+            outln!(
+                "           {:<16} t = {:.15e}   {:?}, g_dot {:.9e} -> {:.9e} m/s, normal impulse {:.6e} N*s{tangential}, lost {:.6e} J",
+                tr.contact,
+                num(tr.t),
+                tr.mode,
+                num(tr.normal_velocity[0]),
+                num(tr.normal_velocity[1]),
+                num(tr.normal_impulse),
+                num(tr.energy_lost)
+            );
+        }
+    }
+    if let Some(stop) = &simulation.contact_stop {
+        outln!("stopped    {stop}");
+    }
 }
 
 fn print_summary(

@@ -521,7 +521,7 @@ impl Contact {
                 let length = arena.sqrt(uu);
                 let minus_uy = arena.neg(u[1]);
                 let t = [arena.divide(minus_uy, length), arena.divide(u[0], length)];
-                let row = coordinates
+                coordinates
                     .iter()
                     .map(|&q| {
                         let parts: Vec<ExprId> = (0..2)
@@ -532,8 +532,7 @@ impl Contact {
                             .collect();
                         arena.sum(&parts)
                     })
-                    .collect();
-                row
+                    .collect()
             }
             _ => {
                 let zero = cx.arena().int(0);
