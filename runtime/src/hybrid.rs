@@ -12,7 +12,8 @@
 //!   Springer, 2004, doi:10.1007/978-3-540-44398-8.
 
 pub mod impact;
+mod phase;
 pub mod run;
 
 pub use impact::{ImpactContact, ImpactError, ImpactMode, ImpactReport, impact};
-pub use run::{ContactStop, HybridRecord, Transition, integrate_through_impacts};
+pub use run::{ContactStop, HybridRecord, Transition, TransitionKind, integrate_through_impacts};

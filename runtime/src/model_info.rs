@@ -74,6 +74,8 @@ pub trait ModelInfo: OdeSystem {
     fn point_positions(&self, t: f64, y: &[f64]) -> Vec<[f64; 3]>;
     /// Upcast to the first-order system for an integrator.
     fn as_ode_mut(&mut self) -> &mut dyn OdeSystem;
+    /// The first-order system, borrowed.
+    fn as_ode(&self) -> &dyn OdeSystem;
     /// `M` (`n × n`) and `F` (`n`) at `(t, y)`.
     fn mass_matrix_and_forcing(&self, t: f64, y: &[f64]) -> (DMatrix<f64>, DVector<f64>);
     /// The exact Jacobians `(∂F/∂q, ∂F/∂q̇)`, each `n × n`, at `(t, y)`.
@@ -112,7 +114,7 @@ pub trait ModelInfo: OdeSystem {
     /// rates, rows and coefficients ([`crate::MechanicalSystem::contact_gaps`] and
     /// siblings); empty without contacts.
     fn contact_values(&self, t: f64, y: &[f64]) -> ContactValues;
-    /// The contacts' gaps `g` then their rates `ġ` at `(t, y)` into `out` (`2 m_c`
+    /// The contacts' gaps `g`, their rates `ġ` and `γ` at `(t, y)` into `out` (`3 m_c`
     /// entries): [`crate::MechanicalSystem::contact_gaps`] alone.
     fn contact_gaps(&self, t: f64, y: &[f64], out: &mut [f64]);
     /// Makes `y = [q; q̇]` (at `t = 0`) consistent with the constraints (issue 5, item 3): the
@@ -182,7 +184,7 @@ pub struct ConstraintValues {
 /// A model's unilateral contacts at one state ([`ModelInfo::contact_values`]).
 ///
 /// # Shapes
-/// `m_c` contacts and `n` coordinates: `gaps`, `rates`, `restitution`, `friction` have `m_c`
+/// `m_c` contacts and `n` coordinates: `gaps`, `rates`, `gamma`, `restitution`, `friction` have `m_c`
 /// entries; `normal` (`G = ∂g/∂q`) and `tangent` (the slips' rows `T`) `m_c × n`, row-major.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ContactValues {
@@ -190,6 +192,8 @@ pub struct ContactValues {
     pub gaps: Vec<f64>,
     /// `ġ = G q̇ + ∂g/∂t` (m/s).
     pub rates: Vec<f64>,
+    /// `γ` of `G q̈ = γ` (m/s²).
+    pub gamma: Vec<f64>,
     /// `G`, row-major.
     pub normal: Vec<f64>,
     /// `T`, row-major (zeros for a frictionless contact).
@@ -282,6 +286,9 @@ impl<F: FirstOrderForm> ModelInfo for F {
         out
     }
     fn as_ode_mut(&mut self) -> &mut dyn OdeSystem {
+        self
+    }
+    fn as_ode(&self) -> &dyn OdeSystem {
         self
     }
     fn mass_matrix_and_forcing(&self, t: f64, y: &[f64]) -> (DMatrix<f64>, DVector<f64>) {
@@ -385,7 +392,7 @@ impl<F: FirstOrderForm> ModelInfo for F {
         let n = system.num_dofs();
         let (q, qdot) = (&y[..n], &y[n..2 * n]);
         let m = system.description().contacts.len();
-        let mut gaps = vec![0.0; 2 * m];
+        let mut gaps = vec![0.0; 3 * m];
         let mut rows = vec![0.0; 2 * m * n];
         let mut coefficients = vec![0.0; 2 * m];
         if m > 0 {
@@ -393,11 +400,13 @@ impl<F: FirstOrderForm> ModelInfo for F {
             system.contact_jacobian(q, t, &mut rows);
             system.contact_coefficients(&mut coefficients);
         }
+        let gamma = gaps.split_off(2 * m);
         let rates = gaps.split_off(m);
         let tangent = rows.split_off(m * n);
         ContactValues {
             gaps,
             rates,
+            gamma,
             normal: rows,
             tangent,
             restitution: coefficients.iter().step_by(2).copied().collect(),

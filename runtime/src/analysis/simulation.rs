@@ -435,9 +435,12 @@ fn starts_outside_contacts(
     if contacts.is_empty() {
         return Ok(());
     }
-    let mut values = vec![0.0; 2 * contacts.len()];
+    let mut values = vec![0.0; 3 * contacts.len()];
     model.contact_gaps(0.0, y0, &mut values);
-    match values[..contacts.len()].iter().position(|&g| g.is_nan() || g < -atol) {
+    match values[..contacts.len()]
+        .iter()
+        .position(|&g| g.is_nan() || g < -atol)
+    {
         Some(c) => Err(SimulationError::StartsInsideContact {
             contact: contacts[c].to_string(),
             gap: values[c],

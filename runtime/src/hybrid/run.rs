@@ -7,10 +7,13 @@
 //! give the velocities after it; the configuration does not jump. The integrator then starts
 //! afresh from that state, as a new initial value problem, so every method restarts cleanly.
 //!
-//! A contact that stays closed ends the run, with the time and the reason
-//! ([`ContactStop`]): after a plastic impact (`ġ⁺ = 0`) or when the impacts accumulate (a
-//! ball bouncing with `e < 1` strikes infinitely often before a finite time; Zeno). Holding a
-//! closed contact as a constraint while its force pushes (a contact phase) comes later.
+//! A contact closes for good when an impact leaves it at zero normal speed (a plastic
+//! impact), or when its impacts accumulate (a ball bouncing with `e < 1` strikes infinitely
+//! often before a finite time, Zeno): below [`ACCUMULATION_RATIO`] of its largest striking
+//! speed the last impact is taken as plastic. The contact is then held as a constraint
+//! ([`super::phase`]) while its normal force pushes, and opens again where the force falls
+//! through 0. Friction in a closed contact (Coulomb's stick and slip) is not simulated yet:
+//! such a contact ends the run ([`ContactStop::FrictionInContact`]).
 //!
 //! Source: Pfeiffer & Glocker (1996), ch. 4 and 7 (the event-driven scheme); Leine &
 //! Nijmeijer (2004), §2.4 (Zeno).
@@ -18,9 +21,10 @@
 use serde::Serialize;
 
 use super::impact::{ContactFriction, ImpactContact, ImpactError, ImpactMode, impact};
-use crate::integrate::{Integrator, IntegratorOptions, OutputTimes, Solution};
+use super::phase::ContactPhase;
+use crate::integrate::{Integrator, IntegratorOptions, OutputTimes, Solution, Tolerance};
 use crate::model_info::ModelInfo;
-use crate::ode::{EventDirection, EventSpec, WithEvents};
+use crate::ode::{EventDirection, EventSpec, RhsError, WithEvents};
 use crate::{IntegrationFailure, analysis::AddedEvents};
 
 /// A contact's striking speed below this fraction of the largest that contact has struck
@@ -32,14 +36,29 @@ pub const ACCUMULATION_RATIO: f64 = 1e-6;
 /// The most impacts one run takes before it stops ([`ContactStop::TooManyImpacts`]).
 pub const MAX_IMPACTS: usize = 100_000;
 
-/// One impact of a run: where, the velocities before and after, the impulses and the energy
-/// lost.
+/// What happened at a contact.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum TransitionKind {
+    /// An impact after which the contact opens again.
+    Impact,
+    /// An impact after which the contact stays closed (plastic, or where impacts
+    /// accumulate): a contact phase begins.
+    Closes,
+    /// The closed contact's normal force fell through 0: it opens, with no jump.
+    LiftOff,
+}
+
+/// One transition of a run at a contact: where, what, the velocities before and after, the
+/// impulses and the energy lost (0 and the same velocities at a lift-off).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Transition {
-    /// Time of the impact (s).
+    /// Time (s).
     pub t: f64,
-    /// The contact that struck ([`crate::ModelDescription::contacts`]).
+    /// The contact ([`crate::ModelDescription::contacts`]).
     pub contact: String,
+    /// What happened.
+    pub kind: TransitionKind,
     /// How the impact ended: without friction, sticking, sliding, or reversing its slip.
     pub mode: ImpactMode,
     /// `q̇` before and after (`n` entries each).
@@ -63,21 +82,16 @@ pub struct Transition {
 #[serde(tag = "kind", rename_all = "snake_case")]
 #[non_exhaustive]
 pub enum ContactStop {
-    /// The contact stays closed: a plastic impact left it at `ġ = 0`, or the impacts
-    /// accumulate (the striking speed fell below [`ACCUMULATION_RATIO`] of its largest).
+    /// A contact with friction closes: Coulomb's stick and slip in a closed contact are not
+    /// simulated yet.
     #[error(
-        "contact `{contact}` stays closed from t = {t} ({}): holding a closed contact while its force pushes is not simulated yet, so the run stops here",
-        if *accumulating { format!("impacts accumulate there: the striking speed fell to {speed:.3e} m/s") } else { "the impact left it at zero normal speed".to_string() }
+        "contact `{contact}` closes at t = {t} and has friction: stick and slip in a closed contact are not simulated yet, so the run stops here"
     )]
-    Closed {
+    FrictionInContact {
         /// The contact.
         contact: String,
         /// Time (s).
         t: f64,
-        /// The striking speed `|ġ⁻|` (m/s).
-        speed: f64,
-        /// Whether the impacts accumulate (else a plastic impact closed it).
-        accumulating: bool,
     },
     /// The impact law has no answer at this state.
     #[error("the impact at contact `{contact}` at t = {t} has no answer: {error}")]
@@ -123,157 +137,268 @@ pub struct HybridRecord {
 pub fn integrate_through_impacts(
     integrator: &mut dyn Integrator,
     model: &mut dyn ModelInfo,
-    mut added: Option<&mut dyn AddedEvents>,
+    added: Option<&mut dyn AddedEvents>,
     (t0, y0): (f64, &[f64]),
     t_end: f64,
     output: &OutputTimes,
     options: &IntegratorOptions,
 ) -> (Result<Solution, IntegrationFailure>, HybridRecord) {
-    let n = model.num_dofs();
     let contacts: Vec<String> = (model.description().contacts.iter())
         .map(|c| c.to_string())
         .collect();
-    let own = model.description().events.len();
-    let added_specs = added.as_mut().map_or_else(Vec::new, |a| a.specs());
-    let first_contact = own + added_specs.len();
-    let mut specs = added_specs.clone();
-    specs.extend(
-        contacts
-            .iter()
-            .map(|c| EventSpec::new(c.clone(), EventDirection::Falling, true)),
-    );
-    let mut record = HybridRecord::default();
-    let mut fastest = vec![0.0_f64; contacts.len()];
-    let mut whole: Option<Solution> = None;
-    let (mut t, mut y) = (t0, y0.to_vec());
-    // The contact struck at the phase's start, with its gap there: `(contact, gap)`.
-    let mut struck: Option<(usize, f64)> = None;
-    let mut values = vec![0.0; 2 * contacts.len()];
+    let closed = touching(model, (t0, y0), options);
+    let mut run = Run {
+        closed,
+        fastest: vec![0.0; contacts.len()],
+        contacts,
+        struck: None,
+        record: HybridRecord::default(),
+        whole: None,
+        t: t0,
+        y: y0.to_vec(),
+        added,
+    };
     loop {
-        let t0_phase = t;
-        let phase = {
-            let added = &mut added;
-            let count = added_specs.len();
-            let mut system = WithEvents::new(
-                model,
-                specs.clone(),
-                |m: &mut (dyn ModelInfo + '_), t: f64, y: &[f64], g: &mut [f64]| {
-                    let (outer, gaps) = g.split_at_mut(count);
-                    if let Some(added) = added.as_deref_mut() {
-                        added.values(m, t, y, outer)?;
-                    }
-                    contact_gaps(
-                        m,
-                        (t, y),
-                        struck.map(|(c, g)| (c, t0_phase, g)),
-                        &mut values,
-                        gaps,
-                    );
-                    Ok(())
-                },
-            );
-            let output = match output {
-                OutputTimes::Steps => OutputTimes::Steps,
-                OutputTimes::At(times) if whole.is_some() => {
-                    OutputTimes::At(times.iter().copied().filter(|&s| s > t).collect())
-                }
-                OutputTimes::At(times) => OutputTimes::At(times.clone()),
-            };
-            integrator.integrate(&mut system, t, &y, t_end, &output, options)
-        };
-        let phase = match phase {
+        let phase = run.phase(integrator, model, (t_end, output), options);
+        let (phase, strike) = match phase {
             Ok(phase) => phase,
             Err(IntegrationFailure { error, partial }) => {
-                let partial = append(whole, *partial);
-                return (
-                    Err(IntegrationFailure {
-                        error,
-                        partial: Box::new(partial),
-                    }),
-                    record,
-                );
+                let partial = append(run.whole, *partial);
+                let failure = IntegrationFailure {
+                    error,
+                    partial: Box::new(partial),
+                };
+                return (Err(failure), run.record);
             }
         };
-        let (phase, strike) = take_strike(phase, first_contact);
-        let solution = append(whole, phase);
-        let Some((c, at, state)) = strike else {
-            return (Ok(solution), record);
-        };
+        let solution = append(run.whole.take(), phase);
         let sample = solution.len();
-        whole = Some(solution);
-        if record.transitions.len() >= MAX_IMPACTS {
-            record.stop = Some(ContactStop::TooManyImpacts {
-                count: record.transitions.len(),
+        run.whole = Some(solution);
+        let Some((c, at, state)) = strike else {
+            break;
+        };
+        if run.record.transitions.len() >= MAX_IMPACTS {
+            run.record.stop = Some(ContactStop::TooManyImpacts {
+                count: run.record.transitions.len(),
                 t: at,
             });
             break;
         }
-        match strike_contact(model, &contacts, c, at, &state, &mut fastest[c]) {
-            Ok(mut transition) => {
-                transition.sample = sample;
-                struck = Some((c, model.contact_values(at, &state).gaps[c]));
-                y = state;
-                y[n..2 * n].copy_from_slice(&transition.qdot[1]);
-                t = at;
-                let closed = transition.normal_velocity[1] <= 0.0;
-                let speed = -transition.normal_velocity[0];
-                record.transitions.push(transition);
-                if closed {
-                    if let Some(w) = whole.as_mut() {
-                        w.push(t, &y);
-                    }
-                    record.stop = Some(ContactStop::Closed {
-                        contact: contacts[c].clone(),
-                        t: at,
-                        speed,
-                        accumulating: false,
-                    });
-                    break;
-                }
-            }
-            Err(stop) => {
-                record.stop = Some(stop);
-                break;
-            }
+        if let Err(stop) = run.transition(model, c, (at, state), sample) {
+            run.record.stop = Some(stop);
+            break;
         }
     }
-    (Ok(whole.unwrap_or_else(|| Solution::new(2 * n))), record)
+    let n = model.num_dofs();
+    let solution = run.whole.unwrap_or_else(|| Solution::new(2 * n));
+    (Ok(solution), run.record)
 }
 
-/// The contacts' event functions at `(t, y)` into `gaps` (one per contact): each gap, but for
-/// the contact `c` struck at the phase's start `(t*, g*)`, `(g − g*)/(t − t*)` (its rate `ġ`
-/// at `t*`). That contact leaves with `ġ⁺ > 0` from a gap of 0 (to rounding, of either
-/// sign), so its gap would start at a zero that the sign test between two steps cannot see
-/// past: a short flight that rises and lands within one step would be missed. The quotient
-/// starts at `ġ⁺ > 0` and turns negative where the gap returns to `g*` (within rounding of
-/// 0). `values` is scratch of `2 m_c` entries.
-fn contact_gaps(
+/// The transition that ended a phase: the contact, the time and the state there.
+type Strike = (usize, f64, Vec<f64>);
+
+/// The state of a run through impacts between its phases.
+struct Run<'a> {
+    /// The contacts' names.
+    contacts: Vec<String>,
+    /// Which contacts are closed (held in the phase).
+    closed: Vec<bool>,
+    /// Each contact's largest striking speed so far (m/s).
+    fastest: Vec<f64>,
+    /// The contact whose event function starts the phase at a zero, with its gap there
+    /// (see [`contact_events`]).
+    struck: Option<(usize, f64)>,
+    /// The transitions so far.
+    record: HybridRecord,
+    /// The samples of the phases so far.
+    whole: Option<Solution>,
+    /// Where the next phase starts.
+    t: f64,
+    y: Vec<f64>,
+    /// The events added to the model's own.
+    added: Option<&'a mut dyn AddedEvents>,
+}
+
+impl Run<'_> {
+    /// The next phase, from `(t, y)` to `t_end` or the first transition at a contact: its
+    /// samples (without the contacts' events), and the contact, time and state of the
+    /// transition if one ended it.
+    fn phase(
+        &mut self,
+        integrator: &mut dyn Integrator,
+        model: &mut dyn ModelInfo,
+        (t_end, output): (f64, &OutputTimes),
+        options: &IntegratorOptions,
+    ) -> Result<(Solution, Option<Strike>), IntegrationFailure> {
+        let added_specs = self.added.as_ref().map_or_else(Vec::new, |a| a.specs());
+        let count = added_specs.len();
+        let first_contact = model.as_ode().event_specs().len() + count;
+        let mut specs = added_specs;
+        specs.extend(
+            (self.contacts.iter())
+                .map(|c| EventSpec::new(c.clone(), EventDirection::Falling, true)),
+        );
+        let closed: Vec<usize> = (0..self.closed.len()).filter(|&c| self.closed[c]).collect();
+        let (start, struck, added) = (self.t, self.struck, &mut self.added);
+        let mut phase = ContactPhase::new(model, closed);
+        let mut values = vec![0.0; 3 * self.contacts.len()];
+        let mut system = WithEvents::new(
+            &mut phase,
+            specs,
+            |p: &mut ContactPhase<'_>, t: f64, y: &[f64], g: &mut [f64]| {
+                let (outer, contacts) = g.split_at_mut(count);
+                if let Some(added) = added.as_deref_mut() {
+                    added.values(p.model, t, y, outer)?;
+                }
+                let struck = struck.map(|(c, g)| (c, start, g));
+                contact_events(p, (t, y), struck, &mut values, contacts)
+            },
+        );
+        let output = match output {
+            OutputTimes::At(times) if self.whole.is_some() => {
+                OutputTimes::At(times.iter().copied().filter(|&s| s > start).collect())
+            }
+            other => other.clone(),
+        };
+        let phase = integrator.integrate(&mut system, start, &self.y, t_end, &output, options)?;
+        Ok(take_strike(phase, first_contact))
+    }
+
+    /// The transition at contact `c` at `(t, y)`: a lift-off if it is closed, else an
+    /// impact, which may close it; the next phase starts after it. `sample` is the index
+    /// the next phase's first sample will have.
+    fn transition(
+        &mut self,
+        model: &mut dyn ModelInfo,
+        c: usize,
+        (t, y): (f64, Vec<f64>),
+        sample: usize,
+    ) -> Result<(), ContactStop> {
+        let n = model.num_dofs();
+        let gap = model.contact_values(t, &y).gaps[c];
+        self.struck = Some((c, gap));
+        let transition = if self.closed[c] {
+            self.closed[c] = false;
+            Transition {
+                t,
+                contact: self.contacts[c].clone(),
+                kind: TransitionKind::LiftOff,
+                mode: ImpactMode::Frictionless,
+                qdot: [y[n..2 * n].to_vec(), y[n..2 * n].to_vec()],
+                normal_velocity: [0.0; 2],
+                normal_impulse: 0.0,
+                tangential_impulse: 0.0,
+                energy_lost: 0.0,
+                sample,
+            }
+        } else {
+            let mut transition = strike_contact(
+                model,
+                &self.contacts,
+                (c, &self.closed),
+                (t, &y),
+                &mut self.fastest[c],
+            )?;
+            transition.sample = sample;
+            if transition.kind == TransitionKind::Closes {
+                if model.contact_values(t, &y).friction[c] > 0.0 {
+                    self.record.transitions.push(transition);
+                    return Err(ContactStop::FrictionInContact {
+                        contact: self.contacts[c].clone(),
+                        t,
+                    });
+                }
+                self.closed[c] = true;
+                self.struck = None;
+            }
+            transition
+        };
+        self.y = y;
+        self.y[n..2 * n].copy_from_slice(&transition.qdot[1]);
+        self.t = t;
+        self.record.transitions.push(transition);
+        Ok(())
+    }
+}
+
+/// Which contacts start closed: touching (`|g| ≤ atol`, the smallest absolute tolerance),
+/// not moving apart or into each other (`|ġ| ≤ atol` per second), and with a normal force
+/// that pushes when they are held (all touching contacts held together). A ball at rest on
+/// its floor starts closed; one that touches it while moving along it too.
+fn touching(
     model: &mut dyn ModelInfo,
+    (t, y): (f64, &[f64]),
+    options: &IntegratorOptions,
+) -> Vec<bool> {
+    let atol = match &options.atol {
+        Tolerance::Scalar(a) => *a,
+        Tolerance::PerComponent(a) => a.iter().copied().fold(f64::INFINITY, f64::min),
+    };
+    let values = model.contact_values(t, y);
+    let candidates: Vec<usize> = (0..values.gaps.len())
+        .filter(|&c| values.gaps[c].abs() <= atol && values.rates[c].abs() <= atol)
+        .collect();
+    let mut closed = vec![false; values.gaps.len()];
+    if candidates.is_empty() {
+        return closed;
+    }
+    if let Ok((_, forces)) = ContactPhase::new(model, candidates.clone()).solve(t, y) {
+        for (&c, force) in candidates.iter().zip(forces) {
+            closed[c] = force > 0.0;
+        }
+    }
+    closed
+}
+
+/// The contacts' event functions at `(t, y)` into `events` (one per contact): an open
+/// contact's gap, a closed one's normal force `λ_N` (it opens where `λ_N` falls through 0).
+///
+/// The contact `c` struck or released at the phase's start `(t*, g*)` gives
+/// `(g − g*)/(t − t*)` instead (its rate `ġ` at `t*`): it leaves from a gap of 0 (to
+/// rounding, of either sign), so its gap would start at a zero that the sign test between
+/// two steps cannot see past, and a short flight that rises and lands within one step would
+/// be missed. The quotient starts at `ġ⁺ ≥ 0` and turns negative where the gap returns to
+/// `g*` (within rounding of 0). `values` is scratch of `3 m_c` entries.
+///
+/// # Errors
+/// As [`ContactPhase::solve`], with a contact closed.
+fn contact_events(
+    phase: &mut ContactPhase<'_>,
     (t, y): (f64, &[f64]),
     struck: Option<(usize, f64, f64)>,
     values: &mut [f64],
-    gaps: &mut [f64],
-) {
-    model.contact_gaps(t, y, values);
-    let m = gaps.len();
-    gaps.copy_from_slice(&values[..m]);
+    events: &mut [f64],
+) -> Result<(), RhsError> {
+    phase.model.contact_gaps(t, y, values);
+    let m = events.len();
+    events.copy_from_slice(&values[..m]);
     if let Some((c, start, gap)) = struck {
-        gaps[c] = if t > start {
+        events[c] = if t > start {
             (values[c] - gap) / (t - start)
         } else {
             values[m + c]
         };
     }
+    if !phase.closed.is_empty() {
+        let (_, forces) = phase.solve(t, y)?;
+        for (&c, force) in phase.closed.iter().zip(forces) {
+            events[c] = force;
+        }
+    }
+    Ok(())
 }
 
-/// The impact of contact `c` at `(t, y)`: the velocities after it, or why the run stops
-/// there. `fastest` is the largest striking speed of the contact so far (updated).
+/// The impact of contact `c` at `(t, y)`, the closed contacts (`closed`) and the model's
+/// constraints held through it: the velocities after it, and whether the contact stays
+/// closed ([`TransitionKind::Closes`]: after a plastic impact, or below
+/// [`ACCUMULATION_RATIO`] of its largest striking speed, where the impact is taken as
+/// plastic; and its normal force then pushes). `fastest` is the contact's largest striking
+/// speed so far (updated).
 fn strike_contact(
     model: &mut dyn ModelInfo,
     contacts: &[String],
-    c: usize,
-    t: f64,
-    y: &[f64],
+    (c, closed): (usize, &[bool]),
+    (t, y): (f64, &[f64]),
     fastest: &mut f64,
 ) -> Result<Transition, ContactStop> {
     let n = model.num_dofs();
@@ -281,20 +406,16 @@ fn strike_contact(
     let values = model.contact_values(t, y);
     let speed = -values.rates[c];
     *fastest = fastest.max(speed);
-    if speed.is_nan() || speed <= ACCUMULATION_RATIO * *fastest {
-        return Err(ContactStop::Closed {
-            contact: contact.clone(),
-            t,
-            speed,
-            accumulating: true,
-        });
-    }
-    let (mass, _) = model.mass_matrix_and_forcing(t, y);
-    let held = model.constraint_equations(t, y).jacobian;
-    let held: Vec<f64> = (0..held.nrows())
+    let accumulating = speed.is_nan() || speed <= ACCUMULATION_RATIO * *fastest;
+    let own = model.constraint_equations(t, y).jacobian;
+    let mut held: Vec<f64> = (0..own.nrows())
         .flat_map(|i| (0..n).map(move |j| (i, j)))
-        .map(|(i, j)| held[(i, j)])
+        .map(|(i, j)| own[(i, j)])
         .collect();
+    for k in (0..closed.len()).filter(|&k| closed[k]) {
+        held.extend_from_slice(&values.normal[k * n..(k + 1) * n]);
+    }
+    let qdot = &y[n..2 * n];
     let normal = &values.normal[c * n..(c + 1) * n];
     let tangent = &values.tangent[c * n..(c + 1) * n];
     let friction = (values.friction[c] > 0.0).then_some(ContactFriction {
@@ -303,26 +424,60 @@ fn strike_contact(
     });
     let law = ImpactContact {
         normal,
-        restitution: values.restitution[c],
+        restitution: if accumulating {
+            0.0
+        } else {
+            values.restitution[c]
+        },
         friction,
     };
-    let qdot = &y[n..2 * n];
-    let r = impact(mass.as_slice(), qdot, &law, &held).map_err(|error| ContactStop::Impact {
-        contact: contact.clone(),
-        t,
-        error,
-    })?;
-    Ok(Transition {
+    let mut transition = Transition {
         t,
         contact: contact.clone(),
-        mode: r.mode,
-        qdot: [qdot.to_vec(), r.qdot],
-        normal_velocity: r.normal_velocity,
-        normal_impulse: r.normal_impulse,
-        tangential_impulse: r.tangential_impulse,
-        energy_lost: r.energy_lost,
+        kind: TransitionKind::Closes,
+        mode: ImpactMode::Frictionless,
+        qdot: [qdot.to_vec(), qdot.to_vec()],
+        normal_velocity: [-speed, -speed],
+        normal_impulse: 0.0,
+        tangential_impulse: 0.0,
+        energy_lost: 0.0,
         sample: 0,
-    })
+    };
+    // A graze (`ġ⁻ ≥ 0` at the located zero, within rounding) closes without an impulse.
+    if speed > 0.0 {
+        let (mass, _) = model.mass_matrix_and_forcing(t, y);
+        let r =
+            impact(mass.as_slice(), qdot, &law, &held).map_err(|error| ContactStop::Impact {
+                contact: contact.clone(),
+                t,
+                error,
+            })?;
+        transition.mode = r.mode;
+        transition.qdot[1] = r.qdot;
+        transition.normal_velocity = r.normal_velocity;
+        transition.normal_impulse = r.normal_impulse;
+        transition.tangential_impulse = r.tangential_impulse;
+        transition.energy_lost = r.energy_lost;
+    }
+    if transition.normal_velocity[1] > 0.0 {
+        transition.kind = TransitionKind::Impact;
+        return Ok(transition);
+    }
+    // Closed only where its force pushes; else it leaves (`g̈ > 0`) from the impact.
+    let mut state = y.to_vec();
+    state[n..2 * n].copy_from_slice(&transition.qdot[1]);
+    let mut with = closed.to_vec();
+    with[c] = true;
+    let held: Vec<usize> = (0..with.len()).filter(|&k| with[k]).collect();
+    let at = held.iter().position(|&k| k == c).unwrap_or_default();
+    let pushes = ContactPhase::new(model, held)
+        .solve(t, &state)
+        .map(|(_, forces)| forces[at] > 0.0)
+        .unwrap_or(false);
+    if !pushes {
+        transition.kind = TransitionKind::Impact;
+    }
+    Ok(transition)
 }
 
 /// `phase` without its contacts' events (an impact is a [`Transition`], not an event), and

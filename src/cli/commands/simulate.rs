@@ -2,6 +2,7 @@
 
 use clap::Args;
 use eomgen::analysis::{ConstraintDrift, EnergyDrift, Simulation};
+use eomgen::hybrid::TransitionKind;
 use eomgen::outputs::{OutputSeries, evaluate_outputs};
 use eomgen::{ModelInfo, OutputTimes, Solution};
 
@@ -290,7 +291,7 @@ fn print_impacts(simulation: &Simulation) {
     if !transitions.is_empty() {
         let lost: f64 = transitions.iter().map(|tr| tr.energy_lost).sum();
         outln!(
-            "impacts    {} (energy lost {:.6e} J):",
+            "contacts   {} transitions (energy lost {:.6e} J):",
             transitions.len(),
             num(lost)
         );
@@ -300,8 +301,21 @@ fn print_impacts(simulation: &Simulation) {
             } else {
                 format!(", tangential {:.6e} N*s", num(tr.tangential_impulse))
             };
+            if tr.kind == TransitionKind::LiftOff {
+                outln!(
+                    "           {:<16} t = {:.15e}   lifts off (its normal force falls through 0)",
+                    tr.contact,
+                    num(tr.t)
+                );
+                continue;
+            }
+            let closes = if tr.kind == TransitionKind::Closes {
+                ", stays closed"
+            } else {
+                ""
+            };
             outln!(
-                "           {:<16} t = {:.15e}   {:?}, g_dot {:.9e} -> {:.9e} m/s, normal impulse {:.6e} N*s{tangential}, lost {:.6e} J",
+                "           {:<16} t = {:.15e}   {:?}{closes}, g_dot {:.9e} -> {:.9e} m/s, normal impulse {:.6e} N*s{tangential}, lost {:.6e} J",
                 tr.contact,
                 num(tr.t),
                 tr.mode,

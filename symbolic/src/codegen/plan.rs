@@ -55,7 +55,7 @@ pub enum ModelFunction {
     /// `n` values per named equilibrium (`2 n`, coordinates then rates, when one is a steady
     /// motion).
     EquilibriumGuesses,
-    /// The contacts' gaps `g` (m_c), then their rates `ġ` (m_c).
+    /// The contacts' gaps `g` (m_c), their rates `ġ` (m_c), then `γ` of `G q̈ = γ` (m_c).
     ContactGaps,
     /// The contacts' Jacobian `G = ∂g/∂q` (m_c × n, row-major), then their slips' rows `T`
     /// (m_c × n; a row of zeros for a frictionless contact).
@@ -184,6 +184,7 @@ impl ModelFunction {
             ModelFunction::ContactGaps => unless_empty(
                 (model.contacts.iter().map(|c| c.gap))
                     .chain(model.contacts.iter().map(|c| c.rate))
+                    .chain(model.contacts.iter().map(|c| c.gamma))
                     .collect(),
             ),
             ModelFunction::ContactJacobian => unless_empty(

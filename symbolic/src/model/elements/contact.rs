@@ -512,6 +512,13 @@ impl Contact {
         let coordinates: Vec<_> = arena.coordinates().iter().map(|s| s[0]).collect();
         let jacobian = coordinates.iter().map(|&q| arena.diff(gap, q)).collect();
         let rate = arena.time_derivative(gap);
+        // `g̈ = G q̈ − γ`: `γ = −g̈` at `q̈ = 0`, as a holonomic constraint's.
+        let second = arena.time_derivative(rate);
+        let at_rest: rustc_hash::FxHashMap<_, _> = (arena.coordinates().to_vec().iter())
+            .map(|s| (s[2], arena.int(0)))
+            .collect();
+        let rest = arena.substitute(second, &at_rest);
+        let gamma = arena.neg(rest);
         // The slip's row in the plane (the rules refuse friction elsewhere): `t̂ · ∂P/∂q`,
         // `t̂ = (−u_y, u_x)/|u|`.
         let tangent = match (&self.friction, across) {
@@ -545,6 +552,7 @@ impl Contact {
             jacobian,
             tangent,
             rate,
+            gamma,
             restitution,
             friction,
         })
@@ -599,6 +607,8 @@ pub struct ContactInfo {
     pub tangent: Vec<ExprId>,
     /// Its rate `ġ = G q̇ + ∂g/∂t` (m/s).
     pub rate: ExprId,
+    /// `γ` of `G q̈ = γ` while it is closed (`g̈ = 0`): `−g̈` at `q̈ = 0` (m/s²).
+    pub gamma: ExprId,
     /// Newton's coefficient of restitution `e`.
     pub restitution: ExprId,
     /// Coulomb's friction coefficient `μ` (0 for a frictionless contact).
