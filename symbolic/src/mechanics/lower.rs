@@ -504,7 +504,9 @@ impl<'f> Lowering<'f> {
 
         let explicit_time =
             self.arena.depends_on(kinetic, time_id) || self.arena.depends_on(potential, time_id);
+        // Impacts lose energy (unless `e = 1` without friction, which a parameter may change).
         let conservative = file.dampers.is_empty()
+            && file.contacts.is_empty()
             && file.forces.is_empty()
             && file.torques.is_empty()
             && generalized_forces.iter().all(|q| self.arena.is_zero(*q))
