@@ -44,6 +44,21 @@ pub struct ConstraintListing {
     pub gamma: String,
 }
 
+/// A unilateral contact as printed: its gap, the gap's row `G` and its coefficients.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct ContactListing {
+    /// The contact's name in the file.
+    pub name: String,
+    /// The gap `g(q, t) ≥ 0` (m).
+    pub gap: String,
+    /// Its row `G = ∂g/∂q` (length `n`), the direction of its normal impulse `Gᵀ Λ_N`.
+    pub jacobian: Vec<String>,
+    /// Newton's coefficient of restitution `e`.
+    pub restitution: String,
+    /// Coulomb's friction coefficient `μ` (`0` for a frictionless contact).
+    pub friction: String,
+}
+
 /// A generalized force that is not zero.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct GeneralizedForce {
@@ -76,6 +91,9 @@ pub struct EquationsListing {
     /// The constraints, holonomic then non-holonomic; empty for an unconstrained model, whose
     /// equations are `M q̈ = F`.
     pub constraints: Vec<ConstraintListing>,
+    /// The unilateral contacts (`contacts:`); left out of the JSON when there are none.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub contacts: Vec<ContactListing>,
 }
 
 impl EquationsListing {
@@ -119,6 +137,15 @@ impl EquationsListing {
                 .collect(),
             forcing: eom.forcing.iter().map(|f| p.print(*f)).collect(),
             constraints,
+            contacts: (model.contacts.iter())
+                .map(|c| ContactListing {
+                    name: c.name.clone(),
+                    gap: p.print(c.gap),
+                    jacobian: c.jacobian.iter().map(|g| p.print(*g)).collect(),
+                    restitution: p.print(c.restitution),
+                    friction: p.print(c.friction),
+                })
+                .collect(),
         }
     }
 }
@@ -170,6 +197,25 @@ pub fn equations_text(model: &SymbolicModel, eom: &EquationsOfMotion) -> String 
                 ConstraintKind::Nonholonomic => "non-holonomic: A q' + b = 0",
             };
             let _ = writeln!(s, "  {}: {} = 0 ({what})", c.name, c.equation);
+        }
+    }
+    if !e.contacts.is_empty() {
+        let _ = writeln!(
+            s,
+            "contacts (unilateral: g >= 0; an impact where g = 0 and g' < 0, impulse G^T Lambda_N)"
+        );
+        for c in &e.contacts {
+            let _ = writeln!(s, "  g[{}] = {}", c.name, c.gap);
+            for (j, entry) in c.jacobian.iter().enumerate() {
+                if entry != "0" {
+                    let _ = writeln!(s, "  G[{},{}] = {entry}", c.name, e.coordinates[j]);
+                }
+            }
+            let _ = writeln!(
+                s,
+                "  e[{}] = {}, mu[{}] = {}",
+                c.name, c.restitution, c.name, c.friction
+            );
         }
     }
     debug_assert!(e.mass_matrix.len() == n);

@@ -479,9 +479,8 @@ impl Contact {
                 };
                 let nd = dot(cx, &n, &d);
                 let nn = dot(cx, &n, &n);
-                let arena = cx.arena();
-                let length = arena.sqrt(nn);
-                (arena.divide(nd, length), Some((p, n)))
+                let length = exact_sqrt(cx.arena(), nn);
+                (cx.arena().divide(nd, length), Some((p, n)))
             }
             Gap::Circle {
                 point,
@@ -524,8 +523,8 @@ impl Contact {
         let tangent = match (&self.friction, across) {
             (Some(_), Some((p, u))) if p.len() == 2 && u.len() == 2 => {
                 let uu = dot(cx, &u, &u);
+                let length = exact_sqrt(cx.arena(), uu);
                 let arena = cx.arena();
-                let length = arena.sqrt(uu);
                 let minus_uy = arena.neg(u[1]);
                 let t = [arena.divide(minus_uy, length), arena.divide(u[0], length)];
                 coordinates
@@ -572,6 +571,23 @@ fn position(cx: &mut dyn Lower, point: &Located<String>) -> Option<Vec<ExprId>> 
         ));
     }
     p
+}
+
+/// `√x`, exact where `x` is the square of a rational (`|[0, 2]| = 2`, not `sqrt(4)`: the
+/// listing reads as a textbook's).
+fn exact_sqrt(arena: &mut crate::expr::ExprArena, x: ExprId) -> ExprId {
+    if let Some(crate::expr::Constant::Rational { num, den }) = arena.as_constant(x)
+        && let (Some(a), Some(b)) = (integer_sqrt(num), integer_sqrt(den))
+    {
+        return arena.constant(crate::expr::Constant::Rational { num: a, den: b });
+    }
+    arena.sqrt(x)
+}
+
+/// `√n` if `n ≥ 0` is a perfect square.
+fn integer_sqrt(n: i64) -> Option<i64> {
+    let r = (n.max(0) as f64).sqrt().round() as i64;
+    (n >= 0 && r.checked_mul(r) == Some(n)).then_some(r)
 }
 
 /// `p − o`, `o` as written.
