@@ -196,6 +196,23 @@ def test_events_stop_a_run():
     assert abs((sol.events[0]["q"][0] + 0.5) / 2 - hanging) < 1e-9
 
 
+def test_a_bouncing_ball_lists_its_impacts_and_rests():
+    # Dropped from h = 1 m with e = 0.8: impacts at t1 = sqrt(2h/g), then after flights of
+    # 2 e^k v0/g; they accumulate at t_inf = t1 + (2 e v0/g)/(1 - e), where the contact
+    # closes and the ball rests (y = 0) for the rest of the run.
+    g, e = 9.81, 0.8
+    t1, v0 = math.sqrt(2 / g), math.sqrt(2 * g)
+    sol = eomgen.load("bouncing_ball").simulate(t_end=6.0, rtol=1e-12, atol=1e-12)
+    impacts = [tr for tr in sol.transitions if tr["kind"] == "impact"]
+    assert abs(impacts[0]["t"] - t1) < 1e-9
+    assert abs(impacts[1]["t"] - (t1 + 2 * e * v0 / g)) < 1e-9
+    assert abs(impacts[0]["normal_velocity"][1] + e * impacts[0]["normal_velocity"][0]) < 1e-12
+    closes = sol.transitions[-1]
+    assert closes["kind"] == "closes" and abs(closes["t"] - (t1 + 2 * e * v0 / g / (1 - e))) < 1e-5
+    assert sol.contact_stop is None
+    assert abs(sol.q[-1, 1]) < 1e-9 and sol.t[-1] == 6.0
+
+
 def test_a_failing_integration_raises_with_the_partial_solution():
     m = eomgen.load("triple_pendulum")
     with pytest.raises(eomgen.IntegrationError) as info:

@@ -71,8 +71,10 @@ pub struct Transition {
     pub tangential_impulse: f64,
     /// The kinetic energy lost (J), `≥ 0`.
     pub energy_lost: f64,
-    /// Index into the run's samples of the first sample after the impact (the sample before
-    /// it has the same time and the state before).
+    /// Index into the run's samples of the first sample after the transition. With every
+    /// step sampled ([`OutputTimes::Steps`]) it is at the transition's time, and so is the
+    /// sample before it, with the state before; with requested times
+    /// ([`OutputTimes::At`]) it is the first requested time after the transition.
     pub sample: usize,
 }
 
