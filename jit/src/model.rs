@@ -79,7 +79,7 @@ pub struct LoadOptions {
     pub eager_taylor: bool,
 }
 
-/// The functions of a model: the first eleven in the order of [`ModelProgram::functions`],
+/// The functions of a model: the first fourteen in the order of [`ModelProgram::functions`],
 /// then the Jacobians in the order of
 /// [`JacobianProgram::functions`](eomgen_symbolic::codegen::program::JacobianProgram::functions).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

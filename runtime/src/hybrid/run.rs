@@ -7,7 +7,7 @@
 //! give the velocities after it; the configuration does not jump. The integrator then starts
 //! afresh from that state, as a new initial value problem, so every method restarts cleanly.
 //!
-//! A contact closes for good when an impact leaves it at zero normal speed (a plastic
+//! A contact closes when an impact leaves it at zero normal speed (a plastic
 //! impact), or when its impacts accumulate (a ball bouncing with `e < 1` strikes infinitely
 //! often before a finite time, Zeno): below [`ACCUMULATION_RATIO`] of its largest striking
 //! speed the last impact is taken as plastic. The contact is then held as a constraint
@@ -20,10 +20,12 @@
 
 use serde::Serialize;
 
-use super::impact::{ContactFriction, ImpactContact, ImpactError, ImpactMode, impact};
+use super::impact::{
+    ContactFriction, ImpactContact, ImpactError, ImpactMode, ImpactReport, impact,
+};
 use super::phase::ContactPhase;
 use crate::integrate::{Integrator, IntegratorOptions, OutputTimes, Solution, Tolerance};
-use crate::model_info::ModelInfo;
+use crate::model_info::{ContactValues, ModelInfo};
 use crate::ode::{EventDirection, EventSpec, RhsError, WithEvents};
 use crate::{IntegrationFailure, analysis::AddedEvents};
 
@@ -95,6 +97,17 @@ pub enum ContactStop {
         /// Time (s).
         t: f64,
     },
+    /// A contact is closed and the method integrates only free phases (the Taylor method,
+    /// whose recurrences have no constraint rows).
+    #[error(
+        "a contact is closed at t = {t}, and the {method} method integrates free motions only: choose another method (dop853, for one) for a run with contact phases"
+    )]
+    MethodInContact {
+        /// The method.
+        method: &'static str,
+        /// Time (s).
+        t: f64,
+    },
     /// The impact law has no answer at this state.
     #[error("the impact at contact `{contact}` at t = {t} has no answer: {error}")]
     Impact {
@@ -148,19 +161,40 @@ pub fn integrate_through_impacts(
     let contacts: Vec<String> = (model.description().contacts.iter())
         .map(|c| c.to_string())
         .collect();
-    let closed = touching(model, (t0, y0), options);
+    let atol = match &options.atol {
+        Tolerance::Scalar(a) => *a,
+        Tolerance::PerComponent(a) => a.iter().copied().fold(f64::INFINITY, f64::min),
+    };
     let mut run = Run {
-        closed,
+        closed: vec![false; contacts.len()],
         fastest: vec![0.0; contacts.len()],
         contacts,
-        struck: None,
+        starting: Vec::new(),
         record: HybridRecord::default(),
         whole: None,
         t: t0,
         y: y0.to_vec(),
         added,
+        atol,
     };
-    loop {
+    run.closed = touching(model, (t0, y0), atol);
+    let friction = model.contact_values(t0, y0).friction;
+    if let Some(c) = (0..run.closed.len()).find(|&c| run.closed[c] && friction[c] > 0.0) {
+        run.record.stop = Some(ContactStop::FrictionInContact {
+            contact: run.contacts[c].clone(),
+            t: t0,
+        });
+    } else if let Err(stop) = run.settle(model, 0) {
+        run.record.stop = Some(stop);
+    }
+    while run.record.stop.is_none() {
+        if run.closed.contains(&true) && integrator.name() == "taylor" {
+            run.record.stop = Some(ContactStop::MethodInContact {
+                method: integrator.name(),
+                t: run.t,
+            });
+            break;
+        }
         let phase = run.phase(integrator, model, (t_end, output), options);
         let (phase, strike) = match phase {
             Ok(phase) => phase,
@@ -186,13 +220,25 @@ pub fn integrate_through_impacts(
             });
             break;
         }
-        if let Err(stop) = run.transition(model, c, (at, state), sample) {
+        let result = run
+            .transition(model, c, (at, state), sample)
+            .and_then(|()| run.settle(model, sample));
+        if let Err(stop) = result {
             run.record.stop = Some(stop);
             break;
         }
+        // A transition at the end time ends the run there, with the state after it.
+        if run.t >= t_end {
+            if let (Some(w), OutputTimes::Steps) = (run.whole.as_mut(), output) {
+                w.push(run.t, &run.y);
+            }
+            break;
+        }
     }
-    let n = model.num_dofs();
-    let solution = run.whole.unwrap_or_else(|| Solution::new(2 * n));
+    let mut solution = run.whole.unwrap_or_else(|| Solution::new(y0.len()));
+    if solution.is_empty() {
+        solution.push(run.t, &run.y);
+    }
     (Ok(solution), run.record)
 }
 
@@ -207,9 +253,9 @@ struct Run<'a> {
     closed: Vec<bool>,
     /// Each contact's largest striking speed so far (m/s).
     fastest: Vec<f64>,
-    /// The contact whose event function starts the phase at a zero, with its gap there
-    /// (see [`contact_events`]).
-    struck: Option<(usize, f64)>,
+    /// The open contacts whose event functions start the phase at a zero, with their gaps
+    /// there (see [`contact_events`]).
+    starting: Vec<(usize, f64)>,
     /// The transitions so far.
     record: HybridRecord,
     /// The samples of the phases so far.
@@ -219,6 +265,8 @@ struct Run<'a> {
     y: Vec<f64>,
     /// The events added to the model's own.
     added: Option<&'a mut dyn AddedEvents>,
+    /// The smallest absolute tolerance of the run: a gap within it of 0 touches.
+    atol: f64,
 }
 
 impl Run<'_> {
@@ -241,7 +289,10 @@ impl Run<'_> {
                 .map(|c| EventSpec::new(c.clone(), EventDirection::Falling, true)),
         );
         let closed: Vec<usize> = (0..self.closed.len()).filter(|&c| self.closed[c]).collect();
-        let (start, struck, added) = (self.t, self.struck, &mut self.added);
+        let (start, added) = (self.t, &mut self.added);
+        let starting: Vec<(usize, f64, f64)> = (self.starting.iter())
+            .map(|&(c, g)| (c, start, g))
+            .collect();
         let mut phase = ContactPhase::new(model, closed);
         let mut values = vec![0.0; 3 * self.contacts.len()];
         let mut system = WithEvents::new(
@@ -252,8 +303,7 @@ impl Run<'_> {
                 if let Some(added) = added.as_deref_mut() {
                     added.values(p.model, t, y, outer)?;
                 }
-                let struck = struck.map(|(c, g)| (c, start, g));
-                contact_events(p, (t, y), struck, &mut values, contacts)
+                contact_events(p, (t, y), &starting, &mut values, contacts)
             },
         );
         let output = match output {
@@ -277,8 +327,6 @@ impl Run<'_> {
         sample: usize,
     ) -> Result<(), ContactStop> {
         let n = model.num_dofs();
-        let gap = model.contact_values(t, &y).gaps[c];
-        self.struck = Some((c, gap));
         let transition = if self.closed[c] {
             self.closed[c] = false;
             Transition {
@@ -297,9 +345,9 @@ impl Run<'_> {
             let mut transition = strike_contact(
                 model,
                 &self.contacts,
-                (c, &self.closed),
+                (c, &mut self.closed),
                 (t, &y),
-                &mut self.fastest[c],
+                (&mut self.fastest[c], self.atol),
             )?;
             transition.sample = sample;
             if transition.kind == TransitionKind::Closes {
@@ -311,7 +359,6 @@ impl Run<'_> {
                     });
                 }
                 self.closed[c] = true;
-                self.struck = None;
             }
             transition
         };
@@ -321,21 +368,51 @@ impl Run<'_> {
         self.record.transitions.push(transition);
         Ok(())
     }
+
+    /// Resolves, one after another, every open contact that touches at `(t, y)` (`g ≤
+    /// atol`) and moves into its surface (`ġ < 0`): a corner struck by a ball, or a run
+    /// started on a surface it moves into. Then notes the open contacts that start the next
+    /// phase at a zero. (Simultaneous impacts are taken in the order of the contacts, each
+    /// with the closed ones held: a documented rule, not Moreau's or an LCP's.)
+    ///
+    /// # Errors
+    /// As [`Self::transition`].
+    fn settle(&mut self, model: &mut dyn ModelInfo, sample: usize) -> Result<(), ContactStop> {
+        // The contact just released leaves at zero normal speed (to rounding): it is not
+        // struck again at once.
+        let released = match self.record.transitions.last() {
+            Some(tr) if tr.kind == TransitionKind::LiftOff && tr.t == self.t => {
+                self.contacts.iter().position(|c| *c == tr.contact)
+            }
+            _ => None,
+        };
+        for _ in 0..=2 * self.contacts.len() {
+            let values = model.contact_values(self.t, &self.y);
+            let striking = (0..self.contacts.len()).find(|&k| {
+                !self.closed[k]
+                    && Some(k) != released
+                    && values.gaps[k] <= self.atol
+                    && values.rates[k] < 0.0
+            });
+            let Some(k) = striking else {
+                break;
+            };
+            self.transition(model, k, (self.t, self.y.clone()), sample)?;
+        }
+        let values = model.contact_values(self.t, &self.y);
+        self.starting = (0..self.contacts.len())
+            .filter(|&k| !self.closed[k] && values.gaps[k].abs() <= self.atol)
+            .map(|k| (k, values.gaps[k]))
+            .collect();
+        Ok(())
+    }
 }
 
-/// Which contacts start closed: touching (`|g| ≤ atol`, the smallest absolute tolerance),
-/// not moving apart or into each other (`|ġ| ≤ atol` per second), and with a normal force
-/// that pushes when they are held (all touching contacts held together). A ball at rest on
-/// its floor starts closed; one that touches it while moving along it too.
-fn touching(
-    model: &mut dyn ModelInfo,
-    (t, y): (f64, &[f64]),
-    options: &IntegratorOptions,
-) -> Vec<bool> {
-    let atol = match &options.atol {
-        Tolerance::Scalar(a) => *a,
-        Tolerance::PerComponent(a) => a.iter().copied().fold(f64::INFINITY, f64::min),
-    };
+/// Which contacts start closed: touching (`|g| ≤ atol`), with a normal speed within `atol`
+/// of 0 (in m/s), and with a normal force that pushes when they are held (all touching
+/// contacts held together; none if that is singular). A ball at rest on its floor starts
+/// closed; one that touches it while moving along it too.
+fn touching(model: &mut dyn ModelInfo, (t, y): (f64, &[f64]), atol: f64) -> Vec<bool> {
     let values = model.contact_values(t, y);
     let candidates: Vec<usize> = (0..values.gaps.len())
         .filter(|&c| values.gaps[c].abs() <= atol && values.rates[c].abs() <= atol)
@@ -355,26 +432,27 @@ fn touching(
 /// The contacts' event functions at `(t, y)` into `events` (one per contact): an open
 /// contact's gap, a closed one's normal force `λ_N` (it opens where `λ_N` falls through 0).
 ///
-/// The contact `c` struck or released at the phase's start `(t*, g*)` gives
-/// `(g − g*)/(t − t*)` instead (its rate `ġ` at `t*`): it leaves from a gap of 0 (to
-/// rounding, of either sign), so its gap would start at a zero that the sign test between
-/// two steps cannot see past, and a short flight that rises and lands within one step would
-/// be missed. The quotient starts at `ġ⁺ ≥ 0` and turns negative where the gap returns to
-/// `g*` (within rounding of 0). `values` is scratch of `3 m_c` entries.
+/// An open contact at a zero at the phase's start `(t*, g*)` (`starting`: struck, released
+/// or touching there) gives `(g − g*)/(t − t*)` instead (its rate `ġ` at `t*`): it leaves
+/// from a gap of 0 (to rounding, of either sign), so its gap would start at a zero that the
+/// sign test between two steps cannot see past, and a short flight that rises and lands
+/// within one step would be missed. The quotient starts at `ġ⁺ ≥ 0` and turns negative
+/// where the gap returns to `g*` (within rounding of 0). `values` is scratch of `3 m_c`
+/// entries.
 ///
 /// # Errors
 /// As [`ContactPhase::solve`], with a contact closed.
 fn contact_events(
     phase: &mut ContactPhase<'_>,
     (t, y): (f64, &[f64]),
-    struck: Option<(usize, f64, f64)>,
+    starting: &[(usize, f64, f64)],
     values: &mut [f64],
     events: &mut [f64],
 ) -> Result<(), RhsError> {
     phase.model.contact_gaps(t, y, values);
     let m = events.len();
     events.copy_from_slice(&values[..m]);
-    if let Some((c, start, gap)) = struck {
+    for &(c, start, gap) in starting {
         events[c] = if t > start {
             (values[c] - gap) / (t - start)
         } else {
@@ -394,14 +472,15 @@ fn contact_events(
 /// constraints held through it: the velocities after it, and whether the contact stays
 /// closed ([`TransitionKind::Closes`]: after a plastic impact, or below
 /// [`ACCUMULATION_RATIO`] of its largest striking speed, where the impact is taken as
-/// plastic; and its normal force then pushes). `fastest` is the contact's largest striking
-/// speed so far (updated).
+/// plastic; and its normal force then pushes). A closed contact whose impulse would pull is
+/// released (and the impact solved again without it). `fastest` is the contact's largest
+/// striking speed so far (updated); a strike at `graze` (m/s) or slower has no impulse.
 fn strike_contact(
     model: &mut dyn ModelInfo,
     contacts: &[String],
-    (c, closed): (usize, &[bool]),
+    (c, closed): (usize, &mut [bool]),
     (t, y): (f64, &[f64]),
-    fastest: &mut f64,
+    (fastest, graze): (&mut f64, f64),
 ) -> Result<Transition, ContactStop> {
     let n = model.num_dofs();
     let contact = &contacts[c];
@@ -409,30 +488,12 @@ fn strike_contact(
     let speed = -values.rates[c];
     *fastest = fastest.max(speed);
     let accumulating = speed.is_nan() || speed <= ACCUMULATION_RATIO * *fastest;
-    let own = model.constraint_equations(t, y).jacobian;
-    let mut held: Vec<f64> = (0..own.nrows())
-        .flat_map(|i| (0..n).map(move |j| (i, j)))
-        .map(|(i, j)| own[(i, j)])
-        .collect();
-    for k in (0..closed.len()).filter(|&k| closed[k]) {
-        held.extend_from_slice(&values.normal[k * n..(k + 1) * n]);
-    }
-    let qdot = &y[n..2 * n];
-    let normal = &values.normal[c * n..(c + 1) * n];
-    let tangent = &values.tangent[c * n..(c + 1) * n];
-    let friction = (values.friction[c] > 0.0).then_some(ContactFriction {
-        tangent,
-        coefficient: values.friction[c],
-    });
-    let law = ImpactContact {
-        normal,
-        restitution: if accumulating {
-            0.0
-        } else {
-            values.restitution[c]
-        },
-        friction,
+    let restitution = if accumulating {
+        0.0
+    } else {
+        values.restitution[c]
     };
+    let qdot = &y[n..2 * n];
     let mut transition = Transition {
         t,
         contact: contact.clone(),
@@ -445,14 +506,15 @@ fn strike_contact(
         energy_lost: 0.0,
         sample: 0,
     };
-    // A graze (`ġ⁻ ≥ 0` at the located zero, within rounding) closes without an impulse.
-    if speed > 0.0 {
-        let (mass, _) = model.mass_matrix_and_forcing(t, y);
+    // A graze (`|ġ⁻| ≤ atol`, in m/s) closes without an impulse where its force pushes.
+    if speed > graze {
         let r =
-            impact(mass.as_slice(), qdot, &law, &held).map_err(|error| ContactStop::Impact {
-                contact: contact.clone(),
-                t,
-                error,
+            impact_holding(model, (c, closed), (t, y), restitution, &values).map_err(|error| {
+                ContactStop::Impact {
+                    contact: contact.clone(),
+                    t,
+                    error,
+                }
             })?;
         transition.mode = r.mode;
         transition.qdot[1] = r.qdot;
@@ -461,11 +523,12 @@ fn strike_contact(
         transition.tangential_impulse = r.tangential_impulse;
         transition.energy_lost = r.energy_lost;
     }
-    if transition.normal_velocity[1] > 0.0 {
+    // After a plastic impact the normal speed is 0 to rounding, of either sign: the contact
+    // closes where its force pushes, else it leaves (`g̈ > 0`) from the impact.
+    if restitution > 0.0 {
         transition.kind = TransitionKind::Impact;
         return Ok(transition);
     }
-    // Closed only where its force pushes; else it leaves (`g̈ > 0`) from the impact.
     let mut state = y.to_vec();
     state[n..2 * n].copy_from_slice(&transition.qdot[1]);
     let mut with = closed.to_vec();
@@ -480,6 +543,50 @@ fn strike_contact(
         transition.kind = TransitionKind::Impact;
     }
     Ok(transition)
+}
+
+/// The impact law at contact `c` with the model's constraints and the closed contacts held;
+/// a closed contact whose impulse pulls (`Λ < 0`) is released (`closed[k] = false`) and the
+/// impact solved again, until none pulls.
+fn impact_holding(
+    model: &mut dyn ModelInfo,
+    (c, closed): (usize, &mut [bool]),
+    (t, y): (f64, &[f64]),
+    restitution: f64,
+    values: &ContactValues,
+) -> Result<ImpactReport, ImpactError> {
+    let n = model.num_dofs();
+    let (mass, _) = model.mass_matrix_and_forcing(t, y);
+    let own = model.constraint_equations(t, y).jacobian;
+    let own_rows: Vec<f64> = (0..own.nrows())
+        .flat_map(|i| (0..n).map(move |j| (i, j)))
+        .map(|(i, j)| own[(i, j)])
+        .collect();
+    let friction = (values.friction[c] > 0.0).then_some(ContactFriction {
+        tangent: &values.tangent[c * n..(c + 1) * n],
+        coefficient: values.friction[c],
+    });
+    let law = ImpactContact {
+        normal: &values.normal[c * n..(c + 1) * n],
+        restitution,
+        friction,
+    };
+    loop {
+        let held: Vec<usize> = (0..closed.len()).filter(|&k| closed[k]).collect();
+        let mut rows = own_rows.clone();
+        for &k in &held {
+            rows.extend_from_slice(&values.normal[k * n..(k + 1) * n]);
+        }
+        let r = impact(mass.as_slice(), &y[n..2 * n], &law, &rows)?;
+        let pulling = (held.iter().enumerate())
+            .filter(|&(i, _)| r.holding_impulses[own.nrows() + i] < 0.0)
+            .map(|(_, &k)| k)
+            .next();
+        match pulling {
+            Some(k) => closed[k] = false,
+            None => return Ok(r),
+        }
+    }
 }
 
 /// `phase` without its contacts' events (an impact is a [`Transition`], not an event), and

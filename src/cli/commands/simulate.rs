@@ -368,6 +368,8 @@ fn print_summary(
         if let Some(d) = report.drift {
             let note = if model.description().conservative {
                 ""
+            } else if !model.description().contacts.is_empty() {
+                " (of E plus the energy lost at impacts)"
             } else {
                 " (not conserved: the model has non-conservative loads or explicit time dependence)"
             };

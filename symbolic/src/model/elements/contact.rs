@@ -339,6 +339,7 @@ impl Contact {
                 }
             }
         }
+        self.fixed_surface(cx);
         self.coefficient_rules(cx, &self.restitution, "coefficient of restitution");
         if let Some(mu) = &self.friction {
             self.coefficient_rules(cx, mu, "friction coefficient");
@@ -353,6 +354,36 @@ impl Contact {
                     Diagnostic::new(mu.location, format!("{what}, but friction is taken in the plane only: a contact in 3-D slips in two directions, which the impact law does not take yet"))
                         .with_help("leave `friction` out of a contact between 3-D points"),
                 );
+            }
+        }
+    }
+
+    /// The gap may not depend on `t`: Newton's law on a moving surface needs the surface's
+    /// own speed in the impact law (`ġ⁺ = −e ġ⁻` with `ġ = G q̇ + ∂g/∂t`), which is not there
+    /// yet.
+    fn fixed_surface(&self, cx: &mut dyn Rules) {
+        let parts: Vec<&Expr> = match &self.gap {
+            Gap::Written(g) => vec![g],
+            Gap::Above {
+                normal, through, ..
+            } => normal
+                .value
+                .iter()
+                .chain(through.iter().flat_map(|o| &o.value))
+                .collect(),
+            Gap::Circle { centre, radius, .. } => {
+                centre.value.iter().chain(std::iter::once(radius)).collect()
+            }
+        };
+        for e in parts {
+            let mut names = Vec::new();
+            crate::model::parser::identifiers(e, &mut names);
+            if let Some((_, at)) = names.iter().find(|(name, _)| name == "t") {
+                cx.error(
+                    Diagnostic::new(*at, format!("contact `{}` moves with `t`, but impacts on a moving surface are not simulated yet", self.name.value))
+                        .with_help("write a surface fixed in the ground frame; a moving one (a belt, a shaken table) needs its own speed in the impact law"),
+                );
+                return;
             }
         }
     }
