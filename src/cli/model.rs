@@ -13,6 +13,31 @@ pub(super) fn find_model(name_or_path: &str) -> Result<Box<dyn eomgen::ModelInfo
     Ok(open_model(name_or_path)?.instantiate())
 }
 
+/// The model `name_or_path` names, for a study that integrates or linearises the smooth
+/// equations and does not take unilateral contacts into account: refused, with the reason,
+/// for a model with `contacts:` (a result that ignored them would be wrong).
+pub(super) fn find_smooth_model(
+    name_or_path: &str,
+    study: &str,
+) -> Result<Box<dyn eomgen::ModelInfo>, CliError> {
+    let model = find_model(name_or_path)?;
+    smooth_only(model.as_ref(), study)?;
+    Ok(model)
+}
+
+/// Refuses a model with unilateral contacts for `study` (see [`find_smooth_model`]).
+pub(super) fn smooth_only(model: &dyn eomgen::ModelInfo, study: &str) -> Result<(), CliError> {
+    let contacts = &model.description().contacts;
+    if contacts.is_empty() {
+        return Ok(());
+    }
+    Err(CliError::usage(format!(
+        "`{}` has unilateral contacts ({}), which {study} does not take into account yet (it would use the smooth equations as if they were not there); `eomgen simulate` and `animate` run through the impacts",
+        model.description().name,
+        contacts.join(", ")
+    )))
+}
+
 /// [`eomgen::ModelSource::open`] with its errors as the CLI reports them. A model is loaded
 /// and compiled once per process: the commands that simulate a model several times (`report`,
 /// the studies, `animate`) name it again by its path, and each use gets a fresh instance of

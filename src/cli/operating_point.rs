@@ -8,7 +8,7 @@ use eomgen::ModelInfo;
 use eomgen::analysis::vibration::{EquilibriumStart, OperatingPointError, OperatingPointOptions};
 
 use super::error::CliError;
-use super::model::find_model;
+use super::model::find_smooth_model;
 use super::values::{evaluate, parameter_lookup, set_parameters, split_assignment};
 
 /// `--at` and `--set`, the same in `modes`, `frf` and the modal studies (`free-response`,
@@ -31,7 +31,7 @@ impl OperatingPointArgs {
     /// # Errors
     /// An unknown model, or a bad `--set` (see [`set_parameters`]).
     pub(super) fn model(&self, name: &str) -> Result<Box<dyn ModelInfo>, CliError> {
-        let mut model = find_model(name)?;
+        let mut model = find_smooth_model(name, "a linearisation")?;
         set_parameters(model.as_mut(), &self.set)?;
         Ok(model)
     }

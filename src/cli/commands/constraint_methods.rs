@@ -48,6 +48,7 @@ pub fn run(args: &ConstraintMethodsArgs) -> Result<(), CliError> {
     // The twin is read too: its file, named in the model's, is an input no output may
     // overwrite, so it is found before the outputs are checked.
     let source = crate::cli::model::open_model(&args.model)?;
+    crate::cli::model::smooth_only(source.instantiate().as_ref(), "`study constraint-methods`")?;
     let twin = minimal_twin(&source).map_err(|e| CliError::failure(e.to_string()))?;
     let twin_file = match &twin {
         Some((_, eomgen::ModelSource::File { path, .. })) => Some(path.as_str()),

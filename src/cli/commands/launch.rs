@@ -15,7 +15,7 @@ use eomgen::analysis::launch::{LaunchError, LaunchOptions, LaunchStudy, Shot, la
 use crate::cli::error::CliError;
 use crate::cli::files::Outputs;
 use crate::cli::json::print_json_sorted;
-use crate::cli::model::find_model;
+use crate::cli::model::find_smooth_model;
 use crate::cli::plot::{Chart, Series, lines};
 use crate::cli::values::{evaluate, parameter_lookup, set_parameters};
 
@@ -86,7 +86,7 @@ pub fn run(args: &LaunchArgs) -> Result<(), CliError> {
         .chart("--plot", args.plot.as_deref())
         .chart("--range-plot", args.range_plot.as_deref())
         .check()?;
-    let mut model = find_model(&args.model)?;
+    let mut model = find_smooth_model(&args.model, "`study launch`")?;
     set_parameters(model.as_mut(), &args.set)?;
     let options = LaunchOptions {
         speeds: args.speeds.clone(),

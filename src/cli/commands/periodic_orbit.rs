@@ -15,7 +15,7 @@ use eomgen::expressions::{split_assignment, split_list};
 use crate::cli::error::CliError;
 use crate::cli::files::Outputs;
 use crate::cli::json::print_json_sorted;
-use crate::cli::model::find_model;
+use crate::cli::model::find_smooth_model;
 use crate::cli::plot::{Chart, Series, lines};
 use crate::cli::render::num;
 use crate::cli::values::{evaluate, parameter_lookup, set_parameters, usage};
@@ -67,7 +67,7 @@ pub fn run(args: &PeriodicOrbitArgs) -> Result<(), CliError> {
         .input(&args.model)
         .chart("--plot", args.plot.as_deref())
         .check()?;
-    let mut model = find_model(&args.model)?;
+    let mut model = find_smooth_model(&args.model, "`study periodic-orbit`")?;
     set_parameters(model.as_mut(), &args.set)?;
     let initial = model.initial_state();
     let start = guess(model.as_ref(), &args.guess)?;

@@ -81,7 +81,7 @@ pub struct RollingContactArgs {
 
 /// Runs `study rolling-contact`; exits 1 when a check fails.
 pub fn run(args: &RollingContactArgs) -> Result<(), CliError> {
-    let mut rolling = find_model(&args.model)?;
+    let mut rolling = crate::cli::model::find_smooth_model(&args.model, "`study rolling-contact`")?;
     set_parameters(rolling.as_mut(), &args.set)?;
     let mut flight = match args.after_lift_off {
         true => {

@@ -15,7 +15,7 @@ use eomgen::analysis::work_precision::{
 
 use crate::cli::error::CliError;
 use crate::cli::integration::Method;
-use crate::cli::model::find_model;
+use crate::cli::model::find_smooth_model;
 use crate::cli::plot;
 use crate::cli::render::num;
 
@@ -220,7 +220,7 @@ pub fn run(args: &WorkPrecisionArgs) -> Result<(), CliError> {
     }
     options.tolerances = parse_tols(&args.tols)?;
     options.steps = args.steps.as_deref().map(parse_steps).transpose()?;
-    let mut model = find_model(&args.model)?;
+    let mut model = find_smooth_model(&args.model, "`study work-precision`")?;
     // The runs take seconds to minutes: a bar on a terminal, nothing otherwise.
     let bar = crate::cli::render::progress_bar(
         0,
