@@ -181,6 +181,25 @@ pub struct ConstraintValues {
     pub gamma: DVector<f64>,
 }
 
+/// Event functions added to a model's own `events:` for one simulation (the CLI's
+/// `--stop-when` and `--event`, compiled from expressions by the facade crate).
+pub trait AddedEvents {
+    /// The specs of the added events, in order.
+    fn specs(&self) -> Vec<EventSpec>;
+    /// The added functions' values at `(t, y)` into `g` (one entry per spec); may read the
+    /// model (for `q̈` or the constraint forces).
+    ///
+    /// # Errors
+    /// As the right-hand side, when a quantity the functions need cannot be computed.
+    fn values(
+        &mut self,
+        model: &mut dyn ModelInfo,
+        t: f64,
+        y: &[f64],
+        g: &mut [f64],
+    ) -> Result<(), RhsError>;
+}
+
 /// A model's unilateral contacts at one state ([`ModelInfo::contact_values`]).
 ///
 /// # Shapes

@@ -148,7 +148,7 @@ pub trait MechanicalSystem<const N: usize> {
     /// The contacts' Jacobian `G = ∂g/∂q` (`m_c × N`), then the rows `T` of their slips
     /// `v_t = T q̇` (`m_c × N`; zeros for a frictionless contact), row-major into `out`
     /// (`2 m_c × N`): the rows of the impact law `M (q̇⁺ − q̇⁻) = Gᵀ Λ_N + Tᵀ Λ_T`
-    /// ([`crate::hybrid::impact`]).
+    /// ([`crate::hybrid::impact()`]).
     fn contact_jacobian(&self, q: &SVector<f64, N>, t: f64, out: &mut [f64]) {
         let _ = (q, t, out);
     }

@@ -13,11 +13,11 @@ use crate::analysis::methods::Method;
 use crate::constrained::{ProjectionError, Stabilization, StabilizationError};
 use crate::hybrid::run::{ContactStop, HybridRecord, Transition, integrate_through_impacts};
 use crate::integrate::{
-    EventSpec, IntegrationError, IntegrationFailure, Integrator, IntegratorOptions, OutputTimes,
-    Solution, Stats,
+    IntegrationError, IntegrationFailure, Integrator, IntegratorOptions, OutputTimes, Solution,
+    Stats,
 };
 use crate::model_info::ModelInfo;
-use crate::ode::{RhsError, WithEvents};
+use crate::ode::WithEvents;
 
 /// Options of [`simulate`]: method, end time, step control, output times, drift control and
 /// initial state.
@@ -95,24 +95,7 @@ impl SimulationOptions {
     }
 }
 
-/// Event functions added to a model's own `events:` for one simulation (the CLI's
-/// `--stop-when` and `--event`, compiled from expressions by the facade crate).
-pub trait AddedEvents {
-    /// The specs of the added events, in order.
-    fn specs(&self) -> Vec<EventSpec>;
-    /// The added functions' values at `(t, y)` into `g` (one entry per spec); may read the
-    /// model (for `q̈` or the constraint forces).
-    ///
-    /// # Errors
-    /// As the right-hand side, when a quantity the functions need cannot be computed.
-    fn values(
-        &mut self,
-        model: &mut dyn ModelInfo,
-        t: f64,
-        y: &[f64],
-        g: &mut [f64],
-    ) -> Result<(), RhsError>;
-}
+pub use crate::model_info::AddedEvents;
 
 /// Why a simulation could not start.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

@@ -11,7 +11,7 @@
 //! impact), or when its impacts accumulate (a ball bouncing with `e < 1` strikes infinitely
 //! often before a finite time, Zeno): below [`ACCUMULATION_RATIO`] of its largest striking
 //! speed the last impact is taken as plastic. The contact is then held as a constraint
-//! ([`super::phase`]) while its normal force pushes, and opens again where the force falls
+//! (a contact phase) while its normal force pushes, and opens again where the force falls
 //! through 0. Friction in a closed contact (Coulomb's stick and slip) is not simulated yet:
 //! such a contact ends the run ([`ContactStop::FrictionInContact`]).
 //!
@@ -24,10 +24,10 @@ use super::impact::{
     ContactFriction, ImpactContact, ImpactError, ImpactMode, ImpactReport, impact,
 };
 use super::phase::ContactPhase;
+use crate::IntegrationFailure;
 use crate::integrate::{Integrator, IntegratorOptions, OutputTimes, Solution, Tolerance};
-use crate::model_info::{ContactValues, ModelInfo};
+use crate::model_info::{AddedEvents, ContactValues, ModelInfo};
 use crate::ode::{EventDirection, EventSpec, RhsError, WithEvents};
-use crate::{IntegrationFailure, analysis::AddedEvents};
 
 /// A contact's striking speed below this fraction of the largest that contact has struck
 /// with in the run (or exactly 0 after an impact) closes it for good: the impacts accumulate.
