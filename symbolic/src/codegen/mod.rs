@@ -480,6 +480,8 @@ fn function_method(
 
 /// The signature of the method of `function` and the expression or stores that build its
 /// outputs `v` into what the trait returns.
+// Long: one arm per `ModelFunction` (nineteen), each the trait method's signature beside the
+// shape of its result; a table, kept whole so that a signature is read next to its outputs.
 fn signature_and_result(
     function: ModelFunction,
     v: &[TokenStream],
