@@ -25,7 +25,7 @@ const MU: f64 = 0.3;
 /// `[g; ġ]`, `G` and the coefficients of a model at `(q, q̇)`.
 fn contact_functions(model: &dyn DynMechanicalSystem, q: &[f64], qdot: &[f64]) -> [Vec<f64>; 3] {
     let m = model.description().contacts.len();
-    let mut gaps = vec![f64::NAN; 3 * m];
+    let mut gaps = vec![f64::NAN; 4 * m];
     let mut jacobian = vec![f64::NAN; 2 * m * 2];
     let mut coefficients = vec![f64::NAN; 2 * m];
     model.contact_gaps(q, qdot, 0.0, &mut gaps);
@@ -60,6 +60,9 @@ fn closed_forms(q: [f64; 2], qdot: [f64; 2]) -> [Vec<f64>; 3] {
             0.0,
             0.0,
             bowl_gamma,
+            0.0,
+            0.0,
+            0.0,
         ],
         vec![
             0.0,
@@ -113,7 +116,7 @@ fn gaps_rates_jacobian_and_coefficients_match_closed_forms_on_every_backend() {
                 );
             }
         }
-        let mut from_macro = [vec![0.0; 9], vec![0.0; 12], vec![0.0; 6]];
+        let mut from_macro = [vec![0.0; 12], vec![0.0; 12], vec![0.0; 6]];
         let (sq, sqdot) = (SVector::from(q), SVector::from(qdot));
         macro_model.contact_gaps(&sq, &sqdot, 0.0, &mut from_macro[0]);
         macro_model.contact_jacobian(&sq, 0.0, &mut from_macro[1]);
@@ -422,13 +425,14 @@ fn fixture_run(
 fn no_run_goes_through_a_contact() {
     use eomgen::analysis::Method;
     type Case<'a> = (&'a str, &'a [(&'a str, f64)], f64);
-    let runs: [Case; 6] = [
+    let runs: [Case; 7] = [
         ("bouncing_ball", &[("e", 0.0)], 3.0),
         ("bouncing_ball", &[("e", 0.5)], 3.0),
         ("loop_the_loop", &[("e", 0.0)], 4.0),
         ("loop_the_loop", &[("e", 0.5)], 4.0),
         ("contacts_corner", &[], 6.0),
         ("contacts_ramp", &[], 2.0),
+        ("rimless_wheel", &[], 3.0),
     ];
     for (name, set, t_end) in runs {
         for method in [
@@ -514,4 +518,73 @@ fn an_impact_at_the_start_or_at_the_end_time() {
     let (t, y) = ended.solution.last().unwrap();
     assert_eq!(t, impact);
     assert!(y[1].abs() < 1e-12, "{y:?}");
+}
+
+/// A rimless wheel (six spokes, hub inertia `I`) stepping on a slope in full coordinates:
+/// each foot lands plastically and sticks, and the foot behind is released (held, sticking,
+/// it would fix the wheel; holding it would pull). Angular momentum about the new foot is
+/// kept: `θ̇⁺/θ̇⁻ = (I + m l² cos 2α)/(I + m l²)` at every landing, to 1e-12, for `I = 0.1`
+/// and `0.4` (Coleman, Chatterjee & Ruina 1997 for `I = 0`). Between landings the wheel
+/// pivots on its foot: `E` plus the losses holds to 1e-9, and no foot goes below the slope.
+#[test]
+fn a_rimless_wheel_keeps_its_angular_momentum_about_the_new_foot() {
+    use eomgen::hybrid::TransitionKind;
+    let alpha = std::f64::consts::PI / 6.0;
+    for inertia in [0.1, 0.4] {
+        let run = fixture_run(
+            "rimless_wheel",
+            eomgen::analysis::Method::Dop853,
+            (1e-12, 3.0),
+            &[("I", inertia)],
+            None,
+        );
+        assert!(
+            run.failure.is_none() && run.contact_stop.is_none(),
+            "{:?}",
+            run.contact_stop
+        );
+        let landings: Vec<_> = (run.transitions.iter())
+            .filter(|tr| tr.kind == TransitionKind::Closes)
+            .collect();
+        assert!(landings.len() >= 2, "{:?}", run.transitions);
+        let ratio = (inertia + (2.0 * alpha).cos()) / (inertia + 1.0);
+        for tr in &landings {
+            let [before, after] = &tr.qdot;
+            assert!((after[2] / before[2] - ratio).abs() < 1e-12, "{tr:?}");
+            let released = (run.transitions.iter())
+                .filter(|r| r.t == tr.t && r.kind == TransitionKind::LiftOff)
+                .count();
+            assert_eq!(released, 1, "{:?}", run.transitions);
+        }
+        assert!(run.energy.drift.unwrap() < 1e-9, "{:?}", run.energy.drift);
+    }
+}
+
+/// A block at rest on an incline sticks while `tan β ≤ μ`: at `β = 0.3`, `μ = 0.5` it stays
+/// where it is (its position within 1e-12 after 2 s); at `β = 0.6` (`tan β = 0.68`) the
+/// friction cone cannot hold it and the run stops at once, saying that it would slide.
+#[test]
+fn a_block_on_an_incline_sticks_inside_the_friction_cone() {
+    use eomgen::analysis::Method;
+    let run = fixture_run("contacts_incline", Method::Dop853, (1e-10, 2.0), &[], None);
+    assert!(
+        run.failure.is_none() && run.contact_stop.is_none(),
+        "{:?}",
+        run.contact_stop
+    );
+    let (t, y) = run.solution.last().unwrap();
+    assert_eq!(t, 2.0);
+    assert!(y.iter().all(|v| v.abs() < 1e-12), "{y:?}");
+    let run = fixture_run(
+        "contacts_incline",
+        Method::Dop853,
+        (1e-10, 2.0),
+        &[("beta", 0.6)],
+        None,
+    );
+    assert!(
+        matches!(&run.contact_stop, Some(eomgen::hybrid::ContactStop::FrictionInContact { contact, t }) if contact == "incline" && *t == 0.0),
+        "{:?}",
+        run.contact_stop
+    );
 }

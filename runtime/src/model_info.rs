@@ -114,7 +114,7 @@ pub trait ModelInfo: OdeSystem {
     /// rates, rows and coefficients ([`crate::MechanicalSystem::contact_gaps`] and
     /// siblings); empty without contacts.
     fn contact_values(&self, t: f64, y: &[f64]) -> ContactValues;
-    /// The contacts' gaps `g`, their rates `ġ` and `γ` at `(t, y)` into `out` (`3 m_c`
+    /// The contacts' gaps `g`, their rates `ġ`, `γ` and `γ_T` at `(t, y)` into `out` (`4 m_c`
     /// entries): [`crate::MechanicalSystem::contact_gaps`] alone.
     fn contact_gaps(&self, t: f64, y: &[f64], out: &mut [f64]);
     /// Makes `y = [q; q̇]` (at `t = 0`) consistent with the constraints (issue 5, item 3): the
@@ -203,7 +203,8 @@ pub trait AddedEvents {
 /// A model's unilateral contacts at one state ([`ModelInfo::contact_values`]).
 ///
 /// # Shapes
-/// `m_c` contacts and `n` coordinates: `gaps`, `rates`, `gamma`, `restitution`, `friction` have `m_c`
+/// `m_c` contacts and `n` coordinates: `gaps`, `rates`, `gamma`, `tangent_gamma`,
+/// `restitution`, `friction` have `m_c`
 /// entries; `normal` (`G = ∂g/∂q`) and `tangent` (the slips' rows `T`) `m_c × n`, row-major.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ContactValues {
@@ -213,6 +214,8 @@ pub struct ContactValues {
     pub rates: Vec<f64>,
     /// `γ` of `G q̈ = γ` (m/s²).
     pub gamma: Vec<f64>,
+    /// `γ_T` of `T q̈ = γ_T` (m/s²; 0 without friction).
+    pub tangent_gamma: Vec<f64>,
     /// `G`, row-major.
     pub normal: Vec<f64>,
     /// `T`, row-major (zeros for a frictionless contact).
@@ -411,7 +414,7 @@ impl<F: FirstOrderForm> ModelInfo for F {
         let n = system.num_dofs();
         let (q, qdot) = (&y[..n], &y[n..2 * n]);
         let m = system.description().contacts.len();
-        let mut gaps = vec![0.0; 3 * m];
+        let mut gaps = vec![0.0; 4 * m];
         let mut rows = vec![0.0; 2 * m * n];
         let mut coefficients = vec![0.0; 2 * m];
         if m > 0 {
@@ -419,6 +422,7 @@ impl<F: FirstOrderForm> ModelInfo for F {
             system.contact_jacobian(q, t, &mut rows);
             system.contact_coefficients(&mut coefficients);
         }
+        let tangent_gamma = gaps.split_off(3 * m);
         let gamma = gaps.split_off(2 * m);
         let rates = gaps.split_off(m);
         let tangent = rows.split_off(m * n);
@@ -426,6 +430,7 @@ impl<F: FirstOrderForm> ModelInfo for F {
             gaps,
             rates,
             gamma,
+            tangent_gamma,
             normal: rows,
             tangent,
             restitution: coefficients.iter().step_by(2).copied().collect(),

@@ -138,8 +138,9 @@ pub trait MechanicalSystem<const N: usize> {
     }
 
     /// The gaps `g(q, t)` (m) of the unilateral contacts ([`ModelDescription::contacts`],
-    /// `m_c` of them), their rates `ġ = G q̇ + ∂g/∂t` (m/s), then `γ` of `G q̈ = γ` (the
-    /// closed contact's acceleration condition `g̈ = 0`, m/s²), into `out` (`3 m_c`
+    /// `m_c` of them), their rates `ġ = G q̇ + ∂g/∂t` (m/s), `γ` of `G q̈ = γ` (the closed
+    /// contact's acceleration condition `g̈ = 0`, m/s²), then `γ_T` of `T q̈ = γ_T` (a
+    /// sticking contact's `v̇_t = 0`, m/s²; 0 without friction), into `out` (`4 m_c`
     /// entries). A contact is open while `g > 0` and strikes when `g` reaches 0 with `ġ < 0`
     /// (Pfeiffer & Glocker 1996, ch. 4).
     fn contact_gaps(&self, q: &SVector<f64, N>, qdot: &SVector<f64, N>, t: f64, out: &mut [f64]) {

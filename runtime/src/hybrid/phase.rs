@@ -29,34 +29,64 @@ pub(crate) struct ContactPhase<'m> {
     pub(crate) model: &'m mut dyn ModelInfo,
     /// The closed contacts (indices into the model's contacts), ascending.
     pub(crate) closed: Vec<usize>,
+    /// For each of [`Self::closed`], whether it sticks: its slip `v_t = T q̇` is held at 0
+    /// too (a contact with friction), with the tangential force `λ_T` as its multiplier.
+    pub(crate) sticking: Vec<bool>,
     /// The model's own events (with the terminal flags set on it).
     specs: Vec<EventSpec>,
 }
 
+/// The forces of a closed contact: normal `λ_N` (pushing when positive) and tangential `λ_T`
+/// (0 unless it sticks), N.
+pub(crate) type ContactForces = (f64, f64);
+
 impl<'m> ContactPhase<'m> {
-    /// `model` with the contacts `closed` held.
-    pub(crate) fn new(model: &'m mut dyn ModelInfo, closed: Vec<usize>) -> Self {
+    /// `model` with the contacts `closed` held, those marked in `sticking` without slip.
+    pub(crate) fn new(
+        model: &'m mut dyn ModelInfo,
+        closed: Vec<usize>,
+        sticking: Vec<bool>,
+    ) -> Self {
         let specs = model.as_ode().event_specs().to_vec();
         Self {
             model,
             closed,
+            sticking,
             specs,
         }
     }
 
-    /// `q̈` (`n`) and the closed contacts' normal forces `λ_N` (one per closed contact, in
-    /// the order of [`Self::closed`]) at `(t, y)`.
+    /// The rows held besides the model's: `(contact, tangential)` for each closed contact's
+    /// normal row, then its slip's row if it sticks.
+    fn rows(&self) -> Vec<(usize, bool)> {
+        let mut rows = Vec::new();
+        for (&c, &stick) in self.closed.iter().zip(&self.sticking) {
+            rows.push((c, false));
+            if stick {
+                rows.push((c, true));
+            }
+        }
+        rows
+    }
+
+    /// `q̈` (`n`) and the closed contacts' forces (one pair per closed contact, in the order
+    /// of [`Self::closed`]) at `(t, y)`.
     ///
     /// # Errors
     /// [`RhsError::SingularConstraintMatrix`] if the matrix is singular (contacts that
     /// repeat each other or the model's constraints).
-    pub(crate) fn solve(&self, t: f64, y: &[f64]) -> Result<(Vec<f64>, Vec<f64>), RhsError> {
+    pub(crate) fn solve(
+        &self,
+        t: f64,
+        y: &[f64],
+    ) -> Result<(Vec<f64>, Vec<ContactForces>), RhsError> {
         let n = self.model.num_dofs();
         let (mass, forcing) = self.model.mass_matrix_and_forcing(t, y);
         let own = self.model.constraint_equations(t, y);
         let contacts = self.model.contact_values(t, y);
+        let rows = self.rows();
         let m = own.jacobian.nrows();
-        let k = m + self.closed.len();
+        let k = m + rows.len();
         let mut matrix = DMatrix::<f64>::zeros(n + k, n + k);
         let mut rhs = DVector::<f64>::zeros(n + k);
         matrix.view_mut((0, 0), (n, n)).copy_from(&mass);
@@ -68,14 +98,20 @@ impl<'m> ContactPhase<'m> {
             }
             rhs[n + i] = own.gamma[i];
         }
-        for (r, &c) in self.closed.iter().enumerate() {
-            let row = m + r;
+        for (r, &(c, tangential)) in rows.iter().enumerate() {
+            let (row, gamma) = if tangential {
+                (
+                    &contacts.tangent[c * n..(c + 1) * n],
+                    contacts.tangent_gamma[c],
+                )
+            } else {
+                (&contacts.normal[c * n..(c + 1) * n], contacts.gamma[c])
+            };
             for j in 0..n {
-                let g = contacts.normal[c * n + j];
-                matrix[(n + row, j)] = g;
-                matrix[(j, n + row)] = g;
+                matrix[(n + m + r, j)] = row[j];
+                matrix[(j, n + m + r)] = row[j];
             }
-            rhs[n + row] = contacts.gamma[c];
+            rhs[n + m + r] = gamma;
         }
         let solution = matrix
             .lu()
@@ -83,10 +119,17 @@ impl<'m> ContactPhase<'m> {
             .filter(|x| x.iter().all(|v| v.is_finite()))
             .ok_or(RhsError::SingularConstraintMatrix)?;
         let accelerations = solution.rows(0, n).iter().copied().collect();
-        let normal_forces = (0..self.closed.len())
-            .map(|r| -solution[n + m + r])
-            .collect();
-        Ok((accelerations, normal_forces))
+        let mut forces = vec![(0.0, 0.0); self.closed.len()];
+        let mut r = n + m;
+        for (i, &stick) in self.sticking.iter().enumerate() {
+            forces[i].0 = -solution[r];
+            r += 1;
+            if stick {
+                forces[i].1 = -solution[r];
+                r += 1;
+            }
+        }
+        Ok((accelerations, forces))
     }
 }
 
@@ -124,7 +167,8 @@ impl OdeSystem for ContactPhase<'_> {
 
     /// The model's own drift control (its projection onto its constraints, if it has
     /// one), then the closed contacts' positions and speeds projected onto `g = 0` and
-    /// `ġ = 0` (`Δq = −Gᵀ (G Gᵀ)⁻¹ g`, then the same for `q̇`; one Gauss–Newton step each,
+    /// `ġ = 0`, and a sticking one's speeds onto `v_t = 0` (`Δq = −Gᵀ (G Gᵀ)⁻¹ g`, then the
+    /// same for `q̇` with the rows `G` and `T`; one Gauss–Newton step each,
     /// which a step's drift needs): held at the acceleration level alone, a closed contact
     /// drifts off its surface with the integration error.
     fn after_step(&mut self, t: f64, y: &mut [f64]) -> Result<bool, RhsError> {
@@ -135,15 +179,26 @@ impl OdeSystem for ContactPhase<'_> {
         let n = self.model.num_dofs();
         for level in 0..2 {
             let values = self.model.contact_values(t, y);
-            let k = self.closed.len();
-            let rows = DMatrix::from_fn(k, n, |r, j| values.normal[self.closed[r] * n + j]);
-            let residual = DVector::from_fn(k, |r, _| {
-                let c = self.closed[r];
-                if level == 0 {
-                    values.gaps[c]
+            // Positions onto `g = 0`; speeds onto `ġ = 0` and, where it sticks, `v_t = 0`.
+            let held: Vec<(usize, bool)> = (self.rows().into_iter())
+                .filter(|&(_, tangential)| level == 1 || !tangential)
+                .collect();
+            let k = held.len();
+            let row_of = |r: usize, j: usize| {
+                let (c, tangential) = held[r];
+                let rows = if tangential {
+                    &values.tangent
                 } else {
-                    values.rates[c]
-                }
+                    &values.normal
+                };
+                rows[c * n + j]
+            };
+            let rows = DMatrix::from_fn(k, n, row_of);
+            let qdot = &y[n..2 * n];
+            let residual = DVector::from_fn(k, |r, _| match (level, held[r]) {
+                (0, (c, _)) => values.gaps[c],
+                (_, (c, false)) => values.rates[c],
+                (_, (c, true)) => (0..n).map(|j| values.tangent[c * n + j] * qdot[j]).sum(),
             });
             let gram = &rows * rows.transpose();
             let multipliers = gram

@@ -86,10 +86,10 @@ pub struct Transition {
 #[serde(tag = "kind", rename_all = "snake_case")]
 #[non_exhaustive]
 pub enum ContactStop {
-    /// A contact with friction closes: Coulomb's stick and slip in a closed contact are not
-    /// simulated yet.
+    /// A closed contact with friction would slide (it closes with a slip, or its sticking
+    /// force leaves the friction cone): sliding in a closed contact is not simulated yet.
     #[error(
-        "contact `{contact}` closes at t = {t} and has friction: stick and slip in a closed contact are not simulated yet, so the run stops here"
+        "contact `{contact}` slides while closed at t = {t}: Coulomb's sliding friction in a closed contact is not simulated yet (sticking is), so the run stops here"
     )]
     FrictionInContact {
         /// The contact.
@@ -167,6 +167,7 @@ pub fn integrate_through_impacts(
     };
     let mut run = Run {
         closed: vec![false; contacts.len()],
+        sticking: vec![false; contacts.len()],
         fastest: vec![0.0; contacts.len()],
         contacts,
         starting: Vec::new(),
@@ -177,9 +178,11 @@ pub fn integrate_through_impacts(
         added,
         atol,
     };
-    run.closed = touching(model, (t0, y0), atol);
+    (run.closed, run.sticking) = touching(model, (t0, y0), atol);
     let friction = model.contact_values(t0, y0).friction;
-    if let Some(c) = (0..run.closed.len()).find(|&c| run.closed[c] && friction[c] > 0.0) {
+    let sliding =
+        (0..run.closed.len()).find(|&c| run.closed[c] && friction[c] > 0.0 && !run.sticking[c]);
+    if let Some(c) = sliding {
         run.record.stop = Some(ContactStop::FrictionInContact {
             contact: run.contacts[c].clone(),
             t: t0,
@@ -251,6 +254,8 @@ struct Run<'a> {
     contacts: Vec<String>,
     /// Which contacts are closed (held in the phase).
     closed: Vec<bool>,
+    /// Which closed contacts stick (their slip held at 0 too).
+    sticking: Vec<bool>,
     /// Each contact's largest striking speed so far (m/s).
     fastest: Vec<f64>,
     /// The open contacts whose event functions start the phase at a zero, with their gaps
@@ -289,12 +294,14 @@ impl Run<'_> {
                 .map(|c| EventSpec::new(c.clone(), EventDirection::Falling, true)),
         );
         let closed: Vec<usize> = (0..self.closed.len()).filter(|&c| self.closed[c]).collect();
+        let sticking: Vec<bool> = closed.iter().map(|&c| self.sticking[c]).collect();
+        let friction = model.contact_values(self.t, &self.y).friction;
         let (start, added) = (self.t, &mut self.added);
         let starting: Vec<(usize, f64, f64)> = (self.starting.iter())
             .map(|&(c, g)| (c, start, g))
             .collect();
-        let mut phase = ContactPhase::new(model, closed);
-        let mut values = vec![0.0; 3 * self.contacts.len()];
+        let mut phase = ContactPhase::new(model, closed, sticking);
+        let mut values = vec![0.0; 4 * self.contacts.len()];
         let mut system = WithEvents::new(
             &mut phase,
             specs,
@@ -303,7 +310,7 @@ impl Run<'_> {
                 if let Some(added) = added.as_deref_mut() {
                     added.values(p.model, t, y, outer)?;
                 }
-                contact_events(p, (t, y), &starting, &mut values, contacts)
+                contact_events(p, (t, y), (&starting, &friction), &mut values, contacts)
             },
         );
         let output = match output {
@@ -327,8 +334,16 @@ impl Run<'_> {
         sample: usize,
     ) -> Result<(), ContactStop> {
         let n = model.num_dofs();
+        let mut released = Vec::new();
         let transition = if self.closed[c] {
+            if self.sticking[c] && self.slips(model, c, (t, &y)) {
+                return Err(ContactStop::FrictionInContact {
+                    contact: self.contacts[c].clone(),
+                    t,
+                });
+            }
             self.closed[c] = false;
+            self.sticking[c] = false;
             Transition {
                 t,
                 contact: self.contacts[c].clone(),
@@ -342,16 +357,39 @@ impl Run<'_> {
                 sample,
             }
         } else {
+            let before = self.closed.clone();
             let mut transition = strike_contact(
                 model,
                 &self.contacts,
-                (c, &mut self.closed),
+                (c, &mut self.closed, &mut self.sticking),
                 (t, &y),
                 (&mut self.fastest[c], self.atol),
             )?;
             transition.sample = sample;
+            // The closed contacts the impact released (held, they would have pulled), listed
+            // after it.
+            for k in (0..before.len()).filter(|&k| before[k] && !self.closed[k]) {
+                let qdot = transition.qdot[1].clone();
+                released.push(Transition {
+                    t,
+                    contact: self.contacts[k].clone(),
+                    kind: TransitionKind::LiftOff,
+                    mode: ImpactMode::Frictionless,
+                    qdot: [qdot.clone(), qdot],
+                    normal_velocity: [0.0; 2],
+                    normal_impulse: 0.0,
+                    tangential_impulse: 0.0,
+                    energy_lost: 0.0,
+                    sample,
+                });
+            }
             if transition.kind == TransitionKind::Closes {
-                if model.contact_values(t, &y).friction[c] > 0.0 {
+                let values = model.contact_values(t, &y);
+                let n = model.num_dofs();
+                let slip: f64 = (0..n)
+                    .map(|j| values.tangent[c * n + j] * transition.qdot[1][j])
+                    .sum();
+                if values.friction[c] > 0.0 && (slip.is_nan() || slip.abs() > self.atol) {
                     self.record.transitions.push(transition);
                     return Err(ContactStop::FrictionInContact {
                         contact: self.contacts[c].clone(),
@@ -359,6 +397,7 @@ impl Run<'_> {
                     });
                 }
                 self.closed[c] = true;
+                self.sticking[c] = values.friction[c] > 0.0;
             }
             transition
         };
@@ -366,6 +405,53 @@ impl Run<'_> {
         self.y[n..2 * n].copy_from_slice(&transition.qdot[1]);
         self.t = t;
         self.record.transitions.push(transition);
+        self.record.transitions.extend(released);
+        Ok(())
+    }
+
+    /// Whether the sticking contact `c`, at the zero of its event, starts to slip (the cone
+    /// `|λ_T| ≤ μ λ_N` fails first) rather than lift off (`λ_N` falls to 0 first).
+    fn slips(&self, model: &mut dyn ModelInfo, c: usize, (t, y): (f64, &[f64])) -> bool {
+        let closed: Vec<usize> = (0..self.closed.len()).filter(|&k| self.closed[k]).collect();
+        let sticking: Vec<bool> = closed.iter().map(|&k| self.sticking[k]).collect();
+        let at = closed.iter().position(|&k| k == c).unwrap_or_default();
+        let mu = model.contact_values(t, y).friction[c];
+        match ContactPhase::new(model, closed, sticking).solve(t, y) {
+            Ok((_, forces)) => {
+                let (normal, tangential) = forces[at];
+                mu * normal - tangential.abs() < normal
+            }
+            Err(_) => false,
+        }
+    }
+
+    /// The closed contacts' forces where a phase starts: a sticking contact whose force is
+    /// already outside its cone (`|λ_T| > μ λ_N`) would slide at once, so the run stops
+    /// there; its event function, `min(λ_N, μ λ_N − |λ_T|)`, would start below 0 and never be
+    /// seen to cross. (A normal force that pulls at the start is caught where the contact
+    /// closes: it stays open then.)
+    ///
+    /// # Errors
+    /// [`ContactStop::FrictionInContact`] for such a contact.
+    fn check_closed(&self, model: &mut dyn ModelInfo) -> Result<(), ContactStop> {
+        let closed: Vec<usize> = (0..self.closed.len()).filter(|&k| self.closed[k]).collect();
+        if !closed.iter().any(|&k| self.sticking[k]) {
+            return Ok(());
+        }
+        let sticking: Vec<bool> = closed.iter().map(|&k| self.sticking[k]).collect();
+        let friction = model.contact_values(self.t, &self.y).friction;
+        let phase = ContactPhase::new(model, closed.clone(), sticking);
+        let Ok((_, forces)) = phase.solve(self.t, &self.y) else {
+            return Ok(());
+        };
+        for (&c, (normal, tangential)) in closed.iter().zip(forces) {
+            if self.sticking[c] && friction[c] * normal - tangential.abs() < 0.0 {
+                return Err(ContactStop::FrictionInContact {
+                    contact: self.contacts[c].clone(),
+                    t: self.t,
+                });
+            }
+        }
         Ok(())
     }
 
@@ -399,6 +485,7 @@ impl Run<'_> {
             };
             self.transition(model, k, (self.t, self.y.clone()), sample)?;
         }
+        self.check_closed(model)?;
         let values = model.contact_values(self.t, &self.y);
         self.starting = (0..self.contacts.len())
             .filter(|&k| !self.closed[k] && values.gaps[k].abs() <= self.atol)
@@ -408,36 +495,49 @@ impl Run<'_> {
     }
 }
 
-/// Which contacts start closed: touching (`|g| ≤ atol`), with a normal speed within `atol`
-/// of 0 (in m/s), and with a normal force that pushes when they are held (all touching
-/// contacts held together; none if that is singular). A ball at rest on its floor starts
-/// closed; one that touches it while moving along it too.
-fn touching(model: &mut dyn ModelInfo, (t, y): (f64, &[f64]), atol: f64) -> Vec<bool> {
+/// Which contacts start closed, and which of those stick: touching (`|g| ≤ atol`), with a
+/// normal speed within `atol` of 0 (in m/s), and with a normal force that pushes when they
+/// are held (all touching contacts held together, a contact with friction and no slip
+/// (`|v_t| ≤ atol`) sticking; none if that is singular). A ball at rest on its floor starts
+/// closed; one that touches it while moving along it too (and, with friction, then stops the
+/// run: sliding in a closed contact is not simulated yet).
+fn touching(model: &mut dyn ModelInfo, (t, y): (f64, &[f64]), atol: f64) -> (Vec<bool>, Vec<bool>) {
     let values = model.contact_values(t, y);
-    let candidates: Vec<usize> = (0..values.gaps.len())
+    let n = model.num_dofs();
+    let m = values.gaps.len();
+    let candidates: Vec<usize> = (0..m)
         .filter(|&c| values.gaps[c].abs() <= atol && values.rates[c].abs() <= atol)
         .collect();
-    let mut closed = vec![false; values.gaps.len()];
+    let slip = |c: usize| -> f64 { (0..n).map(|j| values.tangent[c * n + j] * y[n + j]).sum() };
+    let sticks: Vec<bool> = (candidates.iter())
+        .map(|&c| values.friction[c] > 0.0 && slip(c).abs() <= atol)
+        .collect();
+    let (mut closed, mut sticking) = (vec![false; m], vec![false; m]);
     if candidates.is_empty() {
-        return closed;
+        return (closed, sticking);
     }
-    if let Ok((_, forces)) = ContactPhase::new(model, candidates.clone()).solve(t, y) {
-        for (&c, force) in candidates.iter().zip(forces) {
-            closed[c] = force > 0.0;
+    if let Ok((_, forces)) =
+        ContactPhase::new(model, candidates.clone(), sticks.clone()).solve(t, y)
+    {
+        for ((&c, (normal, _)), stick) in candidates.iter().zip(forces).zip(sticks) {
+            closed[c] = normal > 0.0;
+            sticking[c] = closed[c] && stick;
         }
     }
-    closed
+    (closed, sticking)
 }
 
 /// The contacts' event functions at `(t, y)` into `events` (one per contact): an open
-/// contact's gap, a closed one's normal force `λ_N` (it opens where `λ_N` falls through 0).
+/// contact's gap, a closed one's normal force `λ_N` (it opens where `λ_N` falls through 0),
+/// and a sticking one's `min(λ_N, μ λ_N − |λ_T|)` (it opens, or starts to slip, where that
+/// falls through 0; `friction` holds each contact's `μ`).
 ///
 /// An open contact at a zero at the phase's start `(t*, g*)` (`starting`: struck, released
 /// or touching there) gives `(g − g*)/(t − t*)` instead (its rate `ġ` at `t*`): it leaves
 /// from a gap of 0 (to rounding, of either sign), so its gap would start at a zero that the
 /// sign test between two steps cannot see past, and a short flight that rises and lands
 /// within one step would be missed. The quotient starts at `ġ⁺ ≥ 0` and turns negative
-/// where the gap returns to `g*` (within rounding of 0). `values` is scratch of `3 m_c`
+/// where the gap returns to `g*` (within rounding of 0). `values` is scratch of `4 m_c`
 /// entries.
 ///
 /// # Errors
@@ -445,7 +545,7 @@ fn touching(model: &mut dyn ModelInfo, (t, y): (f64, &[f64]), atol: f64) -> Vec<
 fn contact_events(
     phase: &mut ContactPhase<'_>,
     (t, y): (f64, &[f64]),
-    starting: &[(usize, f64, f64)],
+    (starting, friction): (&[(usize, f64, f64)], &[f64]),
     values: &mut [f64],
     events: &mut [f64],
 ) -> Result<(), RhsError> {
@@ -461,8 +561,14 @@ fn contact_events(
     }
     if !phase.closed.is_empty() {
         let (_, forces) = phase.solve(t, y)?;
-        for (&c, force) in phase.closed.iter().zip(forces) {
-            events[c] = force;
+        for ((&c, (normal, tangential)), &stick) in
+            phase.closed.iter().zip(forces).zip(&phase.sticking)
+        {
+            events[c] = if stick {
+                normal.min(friction[c] * normal - tangential.abs())
+            } else {
+                normal
+            };
         }
     }
     Ok(())
@@ -478,7 +584,7 @@ fn contact_events(
 fn strike_contact(
     model: &mut dyn ModelInfo,
     contacts: &[String],
-    (c, closed): (usize, &mut [bool]),
+    (c, closed, sticking): (usize, &mut [bool], &mut [bool]),
     (t, y): (f64, &[f64]),
     (fastest, graze): (&mut f64, f64),
 ) -> Result<Transition, ContactStop> {
@@ -508,14 +614,18 @@ fn strike_contact(
     };
     // A graze (`|ġ⁻| ≤ atol`, in m/s) closes without an impulse where its force pushes.
     if speed > graze {
-        let r =
-            impact_holding(model, (c, closed), (t, y), restitution, &values).map_err(|error| {
-                ContactStop::Impact {
-                    contact: contact.clone(),
-                    t,
-                    error,
-                }
-            })?;
+        let r = impact_holding(
+            model,
+            (c, closed, sticking),
+            (t, y),
+            (restitution, graze),
+            &values,
+        )
+        .map_err(|error| ContactStop::Impact {
+            contact: contact.clone(),
+            t,
+            error,
+        })?;
         transition.mode = r.mode;
         transition.qdot[1] = r.qdot;
         transition.normal_velocity = r.normal_velocity;
@@ -534,10 +644,19 @@ fn strike_contact(
     let mut with = closed.to_vec();
     with[c] = true;
     let held: Vec<usize> = (0..with.len()).filter(|&k| with[k]).collect();
+    let sticks: Vec<bool> = (held.iter())
+        .map(|&k| {
+            if k == c {
+                values.friction[c] > 0.0
+            } else {
+                sticking[k]
+            }
+        })
+        .collect();
     let at = held.iter().position(|&k| k == c).unwrap_or_default();
-    let pushes = ContactPhase::new(model, held)
+    let pushes = ContactPhase::new(model, held, sticks)
         .solve(t, &state)
-        .map(|(_, forces)| forces[at] > 0.0)
+        .map(|(_, forces)| forces[at].0 > 0.0)
         .unwrap_or(false);
     if !pushes {
         transition.kind = TransitionKind::Impact;
@@ -545,14 +664,18 @@ fn strike_contact(
     Ok(transition)
 }
 
-/// The impact law at contact `c` with the model's constraints and the closed contacts held;
-/// a closed contact whose impulse pulls (`Λ < 0`) is released (`closed[k] = false`) and the
-/// impact solved again, until none pulls.
+/// The impact law at contact `c` with the model's constraints and the closed contacts held
+/// (their normal rows, and the slips' rows of those that stick), choosing which closed
+/// contacts hold by an active set: a held contact whose normal impulse pulls (`Λ < 0`) is
+/// released, a released one that would move into its surface (`ġ⁺ < −graze`) is held again,
+/// and where holding them all leaves the impact no answer (a rimless wheel's old foot held,
+/// sticking, fixes the wheel) they all start released. `closed` and `sticking` end as the
+/// contacts that held.
 fn impact_holding(
     model: &mut dyn ModelInfo,
-    (c, closed): (usize, &mut [bool]),
+    (c, closed, sticking): (usize, &mut [bool], &mut [bool]),
     (t, y): (f64, &[f64]),
-    restitution: f64,
+    (restitution, graze): (f64, f64),
     values: &ContactValues,
 ) -> Result<ImpactReport, ImpactError> {
     let n = model.num_dofs();
@@ -571,22 +694,53 @@ fn impact_holding(
         restitution,
         friction,
     };
-    loop {
-        let held: Vec<usize> = (0..closed.len()).filter(|&k| closed[k]).collect();
+    let was_closed = closed.to_vec();
+    let mut hold = closed.to_vec();
+    let mut last_error = None;
+    for _ in 0..=2 * (closed.len() + 1) {
         let mut rows = own_rows.clone();
-        for &k in &held {
+        // For each held contact, the index of its normal row among the held rows.
+        let mut normal_rows = Vec::new();
+        for k in (0..hold.len()).filter(|&k| hold[k]) {
+            normal_rows.push((k, rows.len() / n));
             rows.extend_from_slice(&values.normal[k * n..(k + 1) * n]);
+            if sticking[k] {
+                rows.extend_from_slice(&values.tangent[k * n..(k + 1) * n]);
+            }
         }
-        let r = impact(mass.as_slice(), &y[n..2 * n], &law, &rows)?;
-        let pulling = (held.iter().enumerate())
-            .filter(|&(i, _)| r.holding_impulses[own.nrows() + i] < 0.0)
-            .map(|(_, &k)| k)
-            .next();
-        match pulling {
-            Some(k) => closed[k] = false,
-            None => return Ok(r),
+        let r = match impact(mass.as_slice(), &y[n..2 * n], &law, &rows) {
+            Ok(r) => r,
+            Err(ImpactError::Singular) if hold.contains(&true) => {
+                last_error = Some(ImpactError::Singular);
+                hold.fill(false);
+                continue;
+            }
+            Err(e) => return Err(e),
+        };
+        if let Some(&(k, _)) = normal_rows
+            .iter()
+            .find(|&&(_, row)| r.holding_impulses[row] < 0.0)
+        {
+            hold[k] = false;
+            continue;
         }
+        let entering = (0..hold.len()).find(|&k| {
+            was_closed[k] && !hold[k] && {
+                let rate: f64 = (0..n).map(|j| values.normal[k * n + j] * r.qdot[j]).sum();
+                rate < -graze
+            }
+        });
+        if let Some(k) = entering {
+            hold[k] = true;
+            continue;
+        }
+        closed.copy_from_slice(&hold);
+        for (stick, &held) in sticking.iter_mut().zip(&hold) {
+            *stick &= held;
+        }
+        return Ok(r);
     }
+    Err(last_error.unwrap_or(ImpactError::Singular))
 }
 
 /// `phase` without its contacts' events (an impact is a [`Transition`], not an event), and

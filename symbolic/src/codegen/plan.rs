@@ -55,7 +55,8 @@ pub enum ModelFunction {
     /// `n` values per named equilibrium (`2 n`, coordinates then rates, when one is a steady
     /// motion).
     EquilibriumGuesses,
-    /// The contacts' gaps `g` (m_c), their rates `ġ` (m_c), then `γ` of `G q̈ = γ` (m_c).
+    /// The contacts' gaps `g` (m_c), their rates `ġ` (m_c), `γ` of `G q̈ = γ` (m_c), then
+    /// `γ_T` of `T q̈ = γ_T` (m_c).
     ContactGaps,
     /// The contacts' Jacobian `G = ∂g/∂q` (m_c × n, row-major), then their slips' rows `T`
     /// (m_c × n; a row of zeros for a frictionless contact).
@@ -185,6 +186,7 @@ impl ModelFunction {
                 (model.contacts.iter().map(|c| c.gap))
                     .chain(model.contacts.iter().map(|c| c.rate))
                     .chain(model.contacts.iter().map(|c| c.gamma))
+                    .chain(model.contacts.iter().map(|c| c.tangent_gamma))
                     .collect(),
             ),
             ModelFunction::ContactJacobian => unless_empty(

@@ -576,6 +576,21 @@ impl Contact {
                 vec![zero; coordinates.len()]
             }
         };
+        // `γ_T` of `T q̈ = γ_T` while it sticks (`v̇_t = 0`, `v_t = T q̇`): `−v̇_t` at `q̈ = 0`.
+        let arena = cx.arena();
+        let rates: Vec<ExprId> = (arena.coordinates().to_vec().iter())
+            .map(|s| arena.symbol_expr(s[1]))
+            .collect();
+        let slip_terms: Vec<ExprId> = (tangent.iter().zip(&rates))
+            .map(|(&t, &v)| arena.times(t, v))
+            .collect();
+        let slip = arena.sum(&slip_terms);
+        let slip_rate = arena.time_derivative(slip);
+        let at_rest: rustc_hash::FxHashMap<_, _> = (arena.coordinates().to_vec().iter())
+            .map(|s| (s[2], arena.int(0)))
+            .collect();
+        let rest = arena.substitute(slip_rate, &at_rest);
+        let tangent_gamma = arena.neg(rest);
         Some(ContactInfo {
             name: self.name.value.clone(),
             gap,
@@ -583,6 +598,7 @@ impl Contact {
             tangent,
             rate,
             gamma,
+            tangent_gamma,
             restitution,
             friction,
         })
@@ -656,6 +672,9 @@ pub struct ContactInfo {
     pub rate: ExprId,
     /// `γ` of `G q̈ = γ` while it is closed (`g̈ = 0`): `−g̈` at `q̈ = 0` (m/s²).
     pub gamma: ExprId,
+    /// `γ_T` of `T q̈ = γ_T` while it sticks (the slip `v_t = T q̇` held at 0): `−v̇_t` at
+    /// `q̈ = 0` (m/s²; 0 for a frictionless contact).
+    pub tangent_gamma: ExprId,
     /// Newton's coefficient of restitution `e`.
     pub restitution: ExprId,
     /// Coulomb's friction coefficient `μ` (0 for a frictionless contact).
