@@ -560,31 +560,62 @@ fn a_rimless_wheel_keeps_its_angular_momentum_about_the_new_foot() {
     }
 }
 
-/// A block at rest on an incline sticks while `tan β ≤ μ`: at `β = 0.3`, `μ = 0.5` it stays
-/// where it is (its position within 1e-12 after 2 s); at `β = 0.6` (`tan β = 0.68`) the
-/// friction cone cannot hold it and the run stops at once, saying that it would slide.
+/// Coulomb friction in a closed contact. A block at rest on an incline sticks while
+/// `tan β ≤ μ`: at `β = 0.3`, `μ = 0.5` it stays where it is (within 1e-12 after 2 s). At
+/// `β = 0.6` (`tan β = 0.68`) the cone cannot hold it: it slips at once and slides with
+/// `ẍ = g (sin β − μ cos β)`, `x = ½ ẍ t²` to 1e-9. On a level floor, pushed at `v₀ = 2 m/s`,
+/// it slides to a stop at `t = v₀/(μ g)`, `x = v₀²/(2 μ g)`, and sticks there (to 1e-9).
 #[test]
-fn a_block_on_an_incline_sticks_inside_the_friction_cone() {
+fn a_block_sticks_slips_and_stops_with_coulomb_friction() {
     use eomgen::analysis::Method;
+    use eomgen::hybrid::TransitionKind;
+    let (g, mu) = (9.81_f64, 0.5_f64);
     let run = fixture_run("contacts_incline", Method::Dop853, (1e-10, 2.0), &[], None);
     assert!(
         run.failure.is_none() && run.contact_stop.is_none(),
         "{:?}",
         run.contact_stop
     );
+    assert!(run.transitions.is_empty(), "{:?}", run.transitions);
     let (t, y) = run.solution.last().unwrap();
     assert_eq!(t, 2.0);
     assert!(y.iter().all(|v| v.abs() < 1e-12), "{y:?}");
+    let beta = 0.6_f64;
     let run = fixture_run(
         "contacts_incline",
         Method::Dop853,
-        (1e-10, 2.0),
-        &[("beta", 0.6)],
+        (1e-12, 2.0),
+        &[("beta", beta)],
         None,
     );
-    assert!(
-        matches!(&run.contact_stop, Some(eomgen::hybrid::ContactStop::FrictionInContact { contact, t }) if contact == "incline" && *t == 0.0),
+    assert_eq!(
+        run.transitions[0].kind,
+        TransitionKind::Slip,
         "{:?}",
-        run.contact_stop
+        run.transitions
+    );
+    assert_eq!(run.transitions[0].t, 0.0);
+    let a = g * (beta.sin() - mu * beta.cos());
+    let (t, y) = run.solution.last().unwrap();
+    assert!(
+        (y[0] - 0.5 * a * t * t).abs() < 1e-9 && y[1].abs() < 1e-9,
+        "{y:?}"
+    );
+    let v0 = 2.0;
+    let run = fixture_run(
+        "contacts_incline",
+        Method::Dop853,
+        (1e-12, 1.0),
+        &[("beta", 0.0)],
+        Some(vec![0.0, 0.0, v0, 0.0]),
+    );
+    let stop = (run.transitions.iter())
+        .find(|tr| tr.kind == TransitionKind::Stick)
+        .unwrap_or_else(|| panic!("{:?}", run.transitions));
+    assert!((stop.t - v0 / (mu * g)).abs() < 1e-9, "{stop:?}");
+    let (_, y) = run.solution.last().unwrap();
+    assert!(
+        (y[0] - v0 * v0 / (2.0 * mu * g)).abs() < 1e-9 && y[2].abs() < 1e-9,
+        "{y:?}"
     );
 }

@@ -23,35 +23,43 @@ use crate::model_info::ModelInfo;
 use crate::ode::{EventSpec, OdeSystem, RhsError};
 use eomgen_description::taylor::TaylorUnsupported;
 
+/// How a closed contact is held.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum Hold {
+    /// Its normal row alone (frictionless).
+    Normal,
+    /// Its normal row and its slip's row: it sticks, the tangential force `λ_T` its
+    /// multiplier, while `|λ_T| ≤ μ λ_N`.
+    Stick,
+    /// Its normal row, sliding with `s = ±1` the sign of its slip `v_t = T q̇`: the force on
+    /// the system is `(G − μ s T)ᵀ λ_N` (Coulomb's kinetic friction opposes the slip).
+    Slide(f64),
+}
+
 /// A model with the contacts `closed` held ([`OdeSystem`]); its own events are the model's.
 pub(crate) struct ContactPhase<'m> {
     /// The model.
     pub(crate) model: &'m mut dyn ModelInfo,
     /// The closed contacts (indices into the model's contacts), ascending.
     pub(crate) closed: Vec<usize>,
-    /// For each of [`Self::closed`], whether it sticks: its slip `v_t = T q̇` is held at 0
-    /// too (a contact with friction), with the tangential force `λ_T` as its multiplier.
-    pub(crate) sticking: Vec<bool>,
+    /// For each of [`Self::closed`], how it is held.
+    pub(crate) holds: Vec<Hold>,
     /// The model's own events (with the terminal flags set on it).
     specs: Vec<EventSpec>,
 }
 
 /// The forces of a closed contact: normal `λ_N` (pushing when positive) and tangential `λ_T`
-/// (0 unless it sticks), N.
+/// (along `T`; `−μ s λ_N` while it slides, 0 without friction), N.
 pub(crate) type ContactForces = (f64, f64);
 
 impl<'m> ContactPhase<'m> {
-    /// `model` with the contacts `closed` held, those marked in `sticking` without slip.
-    pub(crate) fn new(
-        model: &'m mut dyn ModelInfo,
-        closed: Vec<usize>,
-        sticking: Vec<bool>,
-    ) -> Self {
+    /// `model` with the contacts `closed` held as `holds` says.
+    pub(crate) fn new(model: &'m mut dyn ModelInfo, closed: Vec<usize>, holds: Vec<Hold>) -> Self {
         let specs = model.as_ode().event_specs().to_vec();
         Self {
             model,
             closed,
-            sticking,
+            holds,
             specs,
         }
     }
@@ -60,9 +68,9 @@ impl<'m> ContactPhase<'m> {
     /// normal row, then its slip's row if it sticks.
     fn rows(&self) -> Vec<(usize, bool)> {
         let mut rows = Vec::new();
-        for (&c, &stick) in self.closed.iter().zip(&self.sticking) {
+        for (&c, &hold) in self.closed.iter().zip(&self.holds) {
             rows.push((c, false));
-            if stick {
+            if hold == Hold::Stick {
                 rows.push((c, true));
             }
         }
@@ -107,9 +115,14 @@ impl<'m> ContactPhase<'m> {
             } else {
                 (&contacts.normal[c * n..(c + 1) * n], contacts.gamma[c])
             };
+            // The force's direction: the row itself, but `G − μ s T` for a sliding contact.
+            let slide = match self.hold_of(c) {
+                Hold::Slide(s) if !tangential => contacts.friction[c] * s,
+                _ => 0.0,
+            };
             for j in 0..n {
                 matrix[(n + m + r, j)] = row[j];
-                matrix[(j, n + m + r)] = row[j];
+                matrix[(j, n + m + r)] = row[j] - slide * contacts.tangent[c * n + j];
             }
             rhs[n + m + r] = gamma;
         }
@@ -121,15 +134,24 @@ impl<'m> ContactPhase<'m> {
         let accelerations = solution.rows(0, n).iter().copied().collect();
         let mut forces = vec![(0.0, 0.0); self.closed.len()];
         let mut r = n + m;
-        for (i, &stick) in self.sticking.iter().enumerate() {
+        for (i, (&c, &hold)) in self.closed.iter().zip(&self.holds).enumerate() {
             forces[i].0 = -solution[r];
             r += 1;
-            if stick {
-                forces[i].1 = -solution[r];
-                r += 1;
+            match hold {
+                Hold::Stick => {
+                    forces[i].1 = -solution[r];
+                    r += 1;
+                }
+                Hold::Slide(s) => forces[i].1 = -contacts.friction[c] * s * forces[i].0,
+                Hold::Normal => {}
             }
         }
         Ok((accelerations, forces))
+    }
+
+    /// How the closed contact `c` is held.
+    fn hold_of(&self, c: usize) -> Hold {
+        (self.closed.iter().position(|&k| k == c)).map_or(Hold::Normal, |i| self.holds[i])
     }
 }
 

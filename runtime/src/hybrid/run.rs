@@ -12,8 +12,11 @@
 //! often before a finite time, Zeno): below [`ACCUMULATION_RATIO`] of its largest striking
 //! speed the last impact is taken as plastic. The contact is then held as a constraint
 //! (a contact phase) while its normal force pushes, and opens again where the force falls
-//! through 0. Friction in a closed contact (Coulomb's stick and slip) is not simulated yet:
-//! such a contact ends the run ([`ContactStop::FrictionInContact`]).
+//! through 0. With friction a closed contact sticks (its slip held at 0 while the tangential
+//! force stays in the cone `|λ_T| ≤ μ λ_N`) or slides (the force `(G − μ s T)ᵀ λ_N`, `s` the
+//! slip's sign), switching by events: stick to slip where the force leaves the cone, slip
+//! to stick (or to a slip the other way) where the slip stops (Leine & Nijmeijer 2004,
+//! §5.1: the switch model of Coulomb's law, without smoothing).
 //!
 //! Source: Pfeiffer & Glocker (1996), ch. 4 and 7 (the event-driven scheme); Leine &
 //! Nijmeijer (2004), §2.4 (Zeno).
@@ -23,7 +26,7 @@ use serde::Serialize;
 use super::impact::{
     ContactFriction, ImpactContact, ImpactError, ImpactMode, ImpactReport, impact,
 };
-use super::phase::ContactPhase;
+use super::phase::{ContactPhase, Hold};
 use crate::IntegrationFailure;
 use crate::integrate::{Integrator, IntegratorOptions, OutputTimes, Solution, Tolerance};
 use crate::model_info::{AddedEvents, ContactValues, ModelInfo};
@@ -49,6 +52,11 @@ pub enum TransitionKind {
     Closes,
     /// The closed contact's normal force fell through 0: it opens, with no jump.
     LiftOff,
+    /// The closed contact's slip stopped and the friction cone holds it: it sticks.
+    Stick,
+    /// The closed contact starts to slide: its sticking force left the friction cone, or its
+    /// slip stopped where the cone cannot hold it (it slides the other way).
+    Slip,
 }
 
 /// One transition of a run at a contact: where, what, the velocities before and after, the
@@ -86,17 +94,6 @@ pub struct Transition {
 #[serde(tag = "kind", rename_all = "snake_case")]
 #[non_exhaustive]
 pub enum ContactStop {
-    /// A closed contact with friction would slide (it closes with a slip, or its sticking
-    /// force leaves the friction cone): sliding in a closed contact is not simulated yet.
-    #[error(
-        "contact `{contact}` slides while closed at t = {t}: Coulomb's sliding friction in a closed contact is not simulated yet (sticking is), so the run stops here"
-    )]
-    FrictionInContact {
-        /// The contact.
-        contact: String,
-        /// Time (s).
-        t: f64,
-    },
     /// A contact is closed and the method integrates only free phases (the Taylor method,
     /// whose recurrences have no constraint rows).
     #[error(
@@ -167,7 +164,7 @@ pub fn integrate_through_impacts(
     };
     let mut run = Run {
         closed: vec![false; contacts.len()],
-        sticking: vec![false; contacts.len()],
+        holds: vec![Hold::Normal; contacts.len()],
         fastest: vec![0.0; contacts.len()],
         contacts,
         starting: Vec::new(),
@@ -178,16 +175,8 @@ pub fn integrate_through_impacts(
         added,
         atol,
     };
-    (run.closed, run.sticking) = touching(model, (t0, y0), atol);
-    let friction = model.contact_values(t0, y0).friction;
-    let sliding =
-        (0..run.closed.len()).find(|&c| run.closed[c] && friction[c] > 0.0 && !run.sticking[c]);
-    if let Some(c) = sliding {
-        run.record.stop = Some(ContactStop::FrictionInContact {
-            contact: run.contacts[c].clone(),
-            t: t0,
-        });
-    } else if let Err(stop) = run.settle(model, 0) {
+    (run.closed, run.holds) = touching(model, (t0, y0), atol);
+    if let Err(stop) = run.settle(model, 0) {
         run.record.stop = Some(stop);
     }
     while run.record.stop.is_none() {
@@ -254,8 +243,8 @@ struct Run<'a> {
     contacts: Vec<String>,
     /// Which contacts are closed (held in the phase).
     closed: Vec<bool>,
-    /// Which closed contacts stick (their slip held at 0 too).
-    sticking: Vec<bool>,
+    /// How each closed contact is held (frictionless, sticking or sliding).
+    holds: Vec<Hold>,
     /// Each contact's largest striking speed so far (m/s).
     fastest: Vec<f64>,
     /// The open contacts whose event functions start the phase at a zero, with their gaps
@@ -294,13 +283,13 @@ impl Run<'_> {
                 .map(|c| EventSpec::new(c.clone(), EventDirection::Falling, true)),
         );
         let closed: Vec<usize> = (0..self.closed.len()).filter(|&c| self.closed[c]).collect();
-        let sticking: Vec<bool> = closed.iter().map(|&c| self.sticking[c]).collect();
+        let holds: Vec<Hold> = closed.iter().map(|&c| self.holds[c]).collect();
         let friction = model.contact_values(self.t, &self.y).friction;
         let (start, added) = (self.t, &mut self.added);
         let starting: Vec<(usize, f64, f64)> = (self.starting.iter())
             .map(|&(c, g)| (c, start, g))
             .collect();
-        let mut phase = ContactPhase::new(model, closed, sticking);
+        let mut phase = ContactPhase::new(model, closed, holds);
         let mut values = vec![0.0; 4 * self.contacts.len()];
         let mut system = WithEvents::new(
             &mut phase,
@@ -336,18 +325,15 @@ impl Run<'_> {
         let n = model.num_dofs();
         let mut released = Vec::new();
         let transition = if self.closed[c] {
-            if self.sticking[c] && self.slips(model, c, (t, &y)) {
-                return Err(ContactStop::FrictionInContact {
-                    contact: self.contacts[c].clone(),
-                    t,
-                });
+            let kind = self.switch(model, c, (t, &y));
+            if kind == TransitionKind::LiftOff {
+                self.closed[c] = false;
+                self.holds[c] = Hold::Normal;
             }
-            self.closed[c] = false;
-            self.sticking[c] = false;
             Transition {
                 t,
                 contact: self.contacts[c].clone(),
-                kind: TransitionKind::LiftOff,
+                kind,
                 mode: ImpactMode::Frictionless,
                 qdot: [y[n..2 * n].to_vec(), y[n..2 * n].to_vec()],
                 normal_velocity: [0.0; 2],
@@ -361,7 +347,7 @@ impl Run<'_> {
             let mut transition = strike_contact(
                 model,
                 &self.contacts,
-                (c, &mut self.closed, &mut self.sticking),
+                (c, &mut self.closed, &mut self.holds),
                 (t, &y),
                 (&mut self.fastest[c], self.atol),
             )?;
@@ -384,20 +370,8 @@ impl Run<'_> {
                 });
             }
             if transition.kind == TransitionKind::Closes {
-                let values = model.contact_values(t, &y);
-                let n = model.num_dofs();
-                let slip: f64 = (0..n)
-                    .map(|j| values.tangent[c * n + j] * transition.qdot[1][j])
-                    .sum();
-                if values.friction[c] > 0.0 && (slip.is_nan() || slip.abs() > self.atol) {
-                    self.record.transitions.push(transition);
-                    return Err(ContactStop::FrictionInContact {
-                        contact: self.contacts[c].clone(),
-                        t,
-                    });
-                }
                 self.closed[c] = true;
-                self.sticking[c] = values.friction[c] > 0.0;
+                self.holds[c] = closing_hold(model, c, (t, &transition.qdot[1]), self.atol, &y);
             }
             transition
         };
@@ -409,50 +383,93 @@ impl Run<'_> {
         Ok(())
     }
 
-    /// Whether the sticking contact `c`, at the zero of its event, starts to slip (the cone
-    /// `|λ_T| ≤ μ λ_N` fails first) rather than lift off (`λ_N` falls to 0 first).
-    fn slips(&self, model: &mut dyn ModelInfo, c: usize, (t, y): (f64, &[f64])) -> bool {
+    /// The switch at the closed contact `c`, at the zero of its event function: a lift-off
+    /// where `λ_N` reached 0 first; for a sticking contact whose force left the cone, a slip
+    /// (it slides against the force it needed, `s = −sign λ_T`); for a sliding contact whose
+    /// slip stopped, a stick where the cone holds the force sticking needs, else a slip the
+    /// other way. Updates [`Self::holds`].
+    fn switch(
+        &mut self,
+        model: &mut dyn ModelInfo,
+        c: usize,
+        (t, y): (f64, &[f64]),
+    ) -> TransitionKind {
         let closed: Vec<usize> = (0..self.closed.len()).filter(|&k| self.closed[k]).collect();
-        let sticking: Vec<bool> = closed.iter().map(|&k| self.sticking[k]).collect();
         let at = closed.iter().position(|&k| k == c).unwrap_or_default();
-        let mu = model.contact_values(t, y).friction[c];
-        match ContactPhase::new(model, closed, sticking).solve(t, y) {
-            Ok((_, forces)) => {
-                let (normal, tangential) = forces[at];
-                mu * normal - tangential.abs() < normal
+        let values = model.contact_values(t, y);
+        let n = model.num_dofs();
+        let mu = values.friction[c];
+        let slip: f64 = (0..n).map(|j| values.tangent[c * n + j] * y[n + j]).sum();
+        let mut holds: Vec<Hold> = closed.iter().map(|&k| self.holds[k]).collect();
+        let forces = |model: &mut dyn ModelInfo, holds: &[Hold]| {
+            ContactPhase::new(model, closed.clone(), holds.to_vec())
+                .solve(t, y)
+                .map(|(_, forces)| forces[at])
+                .unwrap_or((0.0, 0.0))
+        };
+        let (normal, tangential) = forces(model, &holds);
+        let next = match self.holds[c] {
+            Hold::Normal => None,
+            Hold::Stick if mu * normal - tangential.abs() < normal => {
+                Some(Hold::Slide(-tangential.signum()))
             }
-            Err(_) => false,
+            Hold::Stick => None,
+            Hold::Slide(s) if normal <= s * slip => None,
+            Hold::Slide(_) => {
+                holds[at] = Hold::Stick;
+                let (normal, tangential) = forces(model, &holds);
+                Some(if mu * normal - tangential.abs() >= 0.0 {
+                    Hold::Stick
+                } else {
+                    Hold::Slide(-tangential.signum())
+                })
+            }
+        };
+        match next {
+            None => TransitionKind::LiftOff,
+            Some(hold) => {
+                self.holds[c] = hold;
+                if hold == Hold::Stick {
+                    TransitionKind::Stick
+                } else {
+                    TransitionKind::Slip
+                }
+            }
         }
     }
 
-    /// The closed contacts' forces where a phase starts: a sticking contact whose force is
-    /// already outside its cone (`|λ_T| > μ λ_N`) would slide at once, so the run stops
-    /// there; its event function, `min(λ_N, μ λ_N − |λ_T|)`, would start below 0 and never be
-    /// seen to cross. (A normal force that pulls at the start is caught where the contact
-    /// closes: it stays open then.)
-    ///
-    /// # Errors
-    /// [`ContactStop::FrictionInContact`] for such a contact.
-    fn check_closed(&self, model: &mut dyn ModelInfo) -> Result<(), ContactStop> {
+    /// Where a phase starts, a sticking contact whose force is already outside its cone
+    /// (`|λ_T| > μ λ_N`) slides at once (its event function, `min(λ_N, μ λ_N − |λ_T|)`,
+    /// would start below 0 and never be seen to cross): it slips, recorded at `sample`.
+    fn check_closed(&mut self, model: &mut dyn ModelInfo, sample: usize) {
         let closed: Vec<usize> = (0..self.closed.len()).filter(|&k| self.closed[k]).collect();
-        if !closed.iter().any(|&k| self.sticking[k]) {
-            return Ok(());
+        let holds: Vec<Hold> = closed.iter().map(|&k| self.holds[k]).collect();
+        if !holds.contains(&Hold::Stick) {
+            return;
         }
-        let sticking: Vec<bool> = closed.iter().map(|&k| self.sticking[k]).collect();
         let friction = model.contact_values(self.t, &self.y).friction;
-        let phase = ContactPhase::new(model, closed.clone(), sticking);
+        let phase = ContactPhase::new(model, closed.clone(), holds);
         let Ok((_, forces)) = phase.solve(self.t, &self.y) else {
-            return Ok(());
+            return;
         };
+        let n = model.num_dofs();
         for (&c, (normal, tangential)) in closed.iter().zip(forces) {
-            if self.sticking[c] && friction[c] * normal - tangential.abs() < 0.0 {
-                return Err(ContactStop::FrictionInContact {
-                    contact: self.contacts[c].clone(),
+            if self.holds[c] == Hold::Stick && friction[c] * normal - tangential.abs() < 0.0 {
+                self.holds[c] = Hold::Slide(-tangential.signum());
+                self.record.transitions.push(Transition {
                     t: self.t,
+                    contact: self.contacts[c].clone(),
+                    kind: TransitionKind::Slip,
+                    mode: ImpactMode::Frictionless,
+                    qdot: [self.y[n..2 * n].to_vec(), self.y[n..2 * n].to_vec()],
+                    normal_velocity: [0.0; 2],
+                    normal_impulse: 0.0,
+                    tangential_impulse: 0.0,
+                    energy_lost: 0.0,
+                    sample,
                 });
             }
         }
-        Ok(())
     }
 
     /// Resolves, one after another, every open contact that touches at `(t, y)` (`g ≤
@@ -485,7 +502,7 @@ impl Run<'_> {
             };
             self.transition(model, k, (self.t, self.y.clone()), sample)?;
         }
-        self.check_closed(model)?;
+        self.check_closed(model, sample);
         let values = model.contact_values(self.t, &self.y);
         self.starting = (0..self.contacts.len())
             .filter(|&k| !self.closed[k] && values.gaps[k].abs() <= self.atol)
@@ -495,42 +512,64 @@ impl Run<'_> {
     }
 }
 
-/// Which contacts start closed, and which of those stick: touching (`|g| ≤ atol`), with a
-/// normal speed within `atol` of 0 (in m/s), and with a normal force that pushes when they
-/// are held (all touching contacts held together, a contact with friction and no slip
-/// (`|v_t| ≤ atol`) sticking; none if that is singular). A ball at rest on its floor starts
-/// closed; one that touches it while moving along it too (and, with friction, then stops the
-/// run: sliding in a closed contact is not simulated yet).
-fn touching(model: &mut dyn ModelInfo, (t, y): (f64, &[f64]), atol: f64) -> (Vec<bool>, Vec<bool>) {
+/// Which contacts start closed, and how: touching (`|g| ≤ atol`), with a normal speed within
+/// `atol` of 0 (in m/s), and with a normal force that pushes when they are held (all
+/// touching contacts held together; none if that is singular). A contact with friction
+/// sticks if it does not slip (`|v_t| ≤ atol`), else slides. A ball at rest on its floor
+/// starts closed; one that touches it while moving along it too.
+fn touching(model: &mut dyn ModelInfo, (t, y): (f64, &[f64]), atol: f64) -> (Vec<bool>, Vec<Hold>) {
     let values = model.contact_values(t, y);
-    let n = model.num_dofs();
     let m = values.gaps.len();
     let candidates: Vec<usize> = (0..m)
         .filter(|&c| values.gaps[c].abs() <= atol && values.rates[c].abs() <= atol)
         .collect();
-    let slip = |c: usize| -> f64 { (0..n).map(|j| values.tangent[c * n + j] * y[n + j]).sum() };
-    let sticks: Vec<bool> = (candidates.iter())
-        .map(|&c| values.friction[c] > 0.0 && slip(c).abs() <= atol)
-        .collect();
-    let (mut closed, mut sticking) = (vec![false; m], vec![false; m]);
+    let (mut closed, mut holds) = (vec![false; m], vec![Hold::Normal; m]);
     if candidates.is_empty() {
-        return (closed, sticking);
+        return (closed, holds);
     }
-    if let Ok((_, forces)) =
-        ContactPhase::new(model, candidates.clone(), sticks.clone()).solve(t, y)
-    {
-        for ((&c, (normal, _)), stick) in candidates.iter().zip(forces).zip(sticks) {
+    let wanted: Vec<Hold> = (candidates.iter())
+        .map(|&c| closing_hold(model, c, (t, &y[y.len() / 2..]), atol, y))
+        .collect();
+    let phase = ContactPhase::new(model, candidates.clone(), wanted.clone());
+    if let Ok((_, forces)) = phase.solve(t, y) {
+        for ((&c, (normal, _)), hold) in candidates.iter().zip(forces).zip(wanted) {
             closed[c] = normal > 0.0;
-            sticking[c] = closed[c] && stick;
+            if closed[c] {
+                holds[c] = hold;
+            }
         }
     }
-    (closed, sticking)
+    (closed, holds)
+}
+
+/// How contact `c` is held when it closes at `(t, y)` with speeds `qdot`: frictionless, or
+/// with friction sticking where its slip is within `atol` of 0, else sliding with its slip's
+/// sign.
+fn closing_hold(
+    model: &mut dyn ModelInfo,
+    c: usize,
+    (t, qdot): (f64, &[f64]),
+    atol: f64,
+    y: &[f64],
+) -> Hold {
+    let values = model.contact_values(t, y);
+    let n = model.num_dofs();
+    if values.friction[c] <= 0.0 {
+        return Hold::Normal;
+    }
+    let slip: f64 = (0..n).map(|j| values.tangent[c * n + j] * qdot[j]).sum();
+    if slip.abs() <= atol {
+        Hold::Stick
+    } else {
+        Hold::Slide(slip.signum())
+    }
 }
 
 /// The contacts' event functions at `(t, y)` into `events` (one per contact): an open
 /// contact's gap, a closed one's normal force `λ_N` (it opens where `λ_N` falls through 0),
-/// and a sticking one's `min(λ_N, μ λ_N − |λ_T|)` (it opens, or starts to slip, where that
-/// falls through 0; `friction` holds each contact's `μ`).
+/// a sticking one's `min(λ_N, μ λ_N − |λ_T|)` (it opens, or starts to slip, where that falls
+/// through 0), a sliding one's `min(λ_N, s v_t)` (it opens, or its slip stops); `friction`
+/// holds each contact's `μ`.
 ///
 /// An open contact at a zero at the phase's start `(t*, g*)` (`starting`: struck, released
 /// or touching there) gives `(g − g*)/(t − t*)` instead (its rate `ġ` at `t*`): it leaves
@@ -561,13 +600,22 @@ fn contact_events(
     }
     if !phase.closed.is_empty() {
         let (_, forces) = phase.solve(t, y)?;
-        for ((&c, (normal, tangential)), &stick) in
-            phase.closed.iter().zip(forces).zip(&phase.sticking)
+        let slides = phase.holds.iter().any(|h| matches!(h, Hold::Slide(_)));
+        let tangent = if slides {
+            phase.model.contact_values(t, y).tangent
+        } else {
+            Vec::new()
+        };
+        let n = y.len() / 2;
+        for ((&c, (normal, tangential)), &hold) in phase.closed.iter().zip(forces).zip(&phase.holds)
         {
-            events[c] = if stick {
-                normal.min(friction[c] * normal - tangential.abs())
-            } else {
-                normal
+            events[c] = match hold {
+                Hold::Normal => normal,
+                Hold::Stick => normal.min(friction[c] * normal - tangential.abs()),
+                Hold::Slide(s) => {
+                    let slip: f64 = (0..n).map(|j| tangent[c * n + j] * y[n + j]).sum();
+                    normal.min(s * slip)
+                }
             };
         }
     }
@@ -584,7 +632,7 @@ fn contact_events(
 fn strike_contact(
     model: &mut dyn ModelInfo,
     contacts: &[String],
-    (c, closed, sticking): (usize, &mut [bool], &mut [bool]),
+    (c, closed, holds): (usize, &mut [bool], &mut [Hold]),
     (t, y): (f64, &[f64]),
     (fastest, graze): (&mut f64, f64),
 ) -> Result<Transition, ContactStop> {
@@ -616,7 +664,7 @@ fn strike_contact(
     if speed > graze {
         let r = impact_holding(
             model,
-            (c, closed, sticking),
+            (c, closed, holds),
             (t, y),
             (restitution, graze),
             &values,
@@ -644,17 +692,12 @@ fn strike_contact(
     let mut with = closed.to_vec();
     with[c] = true;
     let held: Vec<usize> = (0..with.len()).filter(|&k| with[k]).collect();
-    let sticks: Vec<bool> = (held.iter())
-        .map(|&k| {
-            if k == c {
-                values.friction[c] > 0.0
-            } else {
-                sticking[k]
-            }
-        })
+    let closing = closing_hold(model, c, (t, &state[n..2 * n]), graze, y);
+    let wanted: Vec<Hold> = (held.iter())
+        .map(|&k| if k == c { closing } else { holds[k] })
         .collect();
     let at = held.iter().position(|&k| k == c).unwrap_or_default();
-    let pushes = ContactPhase::new(model, held, sticks)
+    let pushes = ContactPhase::new(model, held, wanted)
         .solve(t, &state)
         .map(|(_, forces)| forces[at].0 > 0.0)
         .unwrap_or(false);
@@ -673,7 +716,7 @@ fn strike_contact(
 /// contacts that held.
 fn impact_holding(
     model: &mut dyn ModelInfo,
-    (c, closed, sticking): (usize, &mut [bool], &mut [bool]),
+    (c, closed, holds): (usize, &mut [bool], &mut [Hold]),
     (t, y): (f64, &[f64]),
     (restitution, graze): (f64, f64),
     values: &ContactValues,
@@ -704,7 +747,7 @@ fn impact_holding(
         for k in (0..hold.len()).filter(|&k| hold[k]) {
             normal_rows.push((k, rows.len() / n));
             rows.extend_from_slice(&values.normal[k * n..(k + 1) * n]);
-            if sticking[k] {
+            if holds[k] == Hold::Stick {
                 rows.extend_from_slice(&values.tangent[k * n..(k + 1) * n]);
             }
         }
@@ -735,8 +778,10 @@ fn impact_holding(
             continue;
         }
         closed.copy_from_slice(&hold);
-        for (stick, &held) in sticking.iter_mut().zip(&hold) {
-            *stick &= held;
+        for (h, &held) in holds.iter_mut().zip(&hold) {
+            if !held {
+                *h = Hold::Normal;
+            }
         }
         return Ok(r);
     }

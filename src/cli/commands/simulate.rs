@@ -301,9 +301,15 @@ fn print_impacts(simulation: &Simulation) {
             } else {
                 format!(", tangential {:.6e} N*s", num(tr.tangential_impulse))
             };
-            if tr.kind == TransitionKind::LiftOff {
+            let switch = match tr.kind {
+                TransitionKind::LiftOff => Some("lifts off (its normal force falls through 0)"),
+                TransitionKind::Stick => Some("sticks (its slip stops inside the friction cone)"),
+                TransitionKind::Slip => Some("slips (the friction cone cannot hold it)"),
+                TransitionKind::Impact | TransitionKind::Closes => None,
+            };
+            if let Some(switch) = switch {
                 outln!(
-                    "           {:<16} t = {:.15e}   lifts off (its normal force falls through 0)",
+                    "           {:<16} t = {:.15e}   {switch}",
                     tr.contact,
                     num(tr.t)
                 );
