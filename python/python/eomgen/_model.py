@@ -886,8 +886,8 @@ class Solution:
             ``jacobian_evals``, ``lu_decompositions``, ``event_evals``, ``wall_time_s``.
         events: the located events, each ``{"name", "t", "direction", "terminal", "q",
             "qdot"}``.
-        transitions: a model with contacts: each impact, closing or lift-off, in time
-            order, ``{"t", "contact", "kind", "mode", "qdot", "normal_velocity",
+        transitions: a model with contacts: each impact, closing, lift-off, stick or
+            slip, in time order, ``{"t", "contact", "kind", "mode", "qdot", "normal_velocity",
             "normal_impulse", "tangential_impulse", "energy_lost", "sample"}``.
         contact_stop: why the run stopped at a contact before its end time, or ``None``.
         lagrange_multipliers: a constrained model's ``λ`` at every sample, ``(k, m)``
@@ -928,8 +928,8 @@ class Solution:
 
     @property
     def transitions(self) -> List[dict]:
-        """The transitions at the model's contacts (impacts, closings, lift-offs), in time
-        order; ``qdot`` is ``[before, after]``, ``sample`` the index of the first sample
+        """The transitions at the model's contacts (impacts, closings, lift-offs, sticks
+        and slips), in time order; ``qdot`` is ``[before, after]``, ``sample`` the index of the first sample
         after it (the one before has the same time)."""
         return self.summary_header.get("transitions") or []
 
