@@ -522,7 +522,7 @@ fn an_impact_at_the_start_or_at_the_end_time() {
 
 /// A rimless wheel (six spokes, hub inertia `I`) stepping on a slope in full coordinates:
 /// each foot lands plastically and sticks, and the foot behind is released (held, sticking,
-/// it would fix the wheel; holding it would pull). Angular momentum about the new foot is
+/// it would fix the wheel, so the active set starts with all released). Angular momentum about the new foot is
 /// kept: `θ̇⁺/θ̇⁻ = (I + m l² cos 2α)/(I + m l²)` at every landing, to 1e-12, for `I = 0.1`
 /// and `0.4` (Coleman, Chatterjee & Ruina 1997 for `I = 0`). Between landings the wheel
 /// pivots on its foot: `E` plus the losses holds to 1e-9, and no foot goes below the slope.
@@ -617,5 +617,78 @@ fn a_block_sticks_slips_and_stops_with_coulomb_friction() {
     assert!(
         (y[0] - v0 * v0 / (2.0 * mu * g)).abs() < 1e-9 && y[2].abs() < 1e-9,
         "{y:?}"
+    );
+}
+
+/// Contacts with friction in harder cases. A box standing on two rough feet (their slip rows
+/// repeat each other) stays at rest, and pushed at 1 m/s it slides to a stop at
+/// `v₀/(μ g)` and stays there, its energy never growing (to 1e-9). A block on a rough floor
+/// (`μ = 2`) pulled up by `k t` lifts off at `t = m g/k` (a lift-off, not a slip, though
+/// `μ > 1`). A rod sliding on a very rough floor has no consistent mode (Painlevé), and the
+/// run stops at once saying so.
+#[test]
+fn friction_with_repeated_rows_lift_off_and_painleve() {
+    use eomgen::analysis::Method;
+    use eomgen::hybrid::{ContactStop, TransitionKind};
+    let g = 9.81_f64;
+    let run = fixture_run("contacts_box", Method::Dp54, (1e-10, 1.0), &[], None);
+    assert!(
+        run.failure.is_none() && run.contact_stop.is_none(),
+        "{:?} {:?}",
+        run.failure,
+        run.contact_stop
+    );
+    let (_, y) = run.solution.last().unwrap();
+    assert!(
+        y.iter().enumerate().all(|(i, v)| if i == 1 {
+            (v - 0.2).abs() < 1e-12
+        } else {
+            v.abs() < 1e-12
+        }),
+        "{y:?}"
+    );
+    let run = fixture_run(
+        "contacts_box",
+        Method::Dp54,
+        (1e-12, 3.0),
+        &[],
+        Some(vec![0.0, 0.2, 0.0, 1.0, 0.0, 0.0]),
+    );
+    assert!(
+        run.failure.is_none() && run.contact_stop.is_none(),
+        "{:?} {:?}",
+        run.failure,
+        run.contact_stop
+    );
+    let stop = run
+        .transitions
+        .iter()
+        .find(|tr| tr.kind == TransitionKind::Stick)
+        .unwrap();
+    assert!((stop.t - 1.0 / (0.5 * g)).abs() < 1e-9, "{stop:?}");
+    let (_, y) = run.solution.last().unwrap();
+    assert!(
+        (y[0] - 1.0 / (2.0 * 0.5 * g)).abs() < 1e-9 && y[3].abs() < 1e-9,
+        "{y:?}"
+    );
+    assert!(
+        run.energy.energy.windows(2).all(|w| w[1] <= w[0] + 1e-9),
+        "the energy grew"
+    );
+    let run = fixture_run(
+        "contacts_lifted",
+        Method::Dop853,
+        (1e-12, 6.0),
+        &[("mu", 2.0), ("k", 2.0)],
+        None,
+    );
+    let off = &run.transitions[0];
+    assert_eq!(off.kind, TransitionKind::LiftOff, "{:?}", run.transitions);
+    assert!((off.t - g / 2.0).abs() < 1e-9, "{off:?}");
+    let run = fixture_run("contacts_painleve", Method::Dp54, (1e-10, 1.0), &[], None);
+    assert!(
+        matches!(&run.contact_stop, Some(ContactStop::NoConsistentMode { contact, t }) if contact == "floor" && *t == 0.0),
+        "{:?}",
+        run.contact_stop
     );
 }

@@ -126,9 +126,16 @@ impl<'m> ContactPhase<'m> {
             }
             rhs[n + m + r] = gamma;
         }
-        let solution = matrix
-            .lu()
-            .solve(&rhs)
+        // Rows that repeat each other (a box standing, sticking, on two feet: their slips'
+        // rows are equal) leave the matrix singular but the equations consistent: `q̈` is
+        // still unique and the multipliers are taken of least norm (an even share), by the
+        // SVD. A matrix near singular is treated so too (an LU pivot below 1e-12 of the
+        // largest entry).
+        let scale = matrix.amax().max(f64::MIN_POSITIVE);
+        let lu = matrix.clone().lu();
+        let pivots_fine = (0..n + k).all(|i| lu.u()[(i, i)].abs() > 1e-12 * scale);
+        let solution = if pivots_fine { lu.solve(&rhs) } else { None }
+            .or_else(|| matrix.svd(true, true).solve(&rhs, 1e-12 * scale).ok())
             .filter(|x| x.iter().all(|v| v.is_finite()))
             .ok_or(RhsError::SingularConstraintMatrix)?;
         let accelerations = solution.rows(0, n).iter().copied().collect();
@@ -223,10 +230,12 @@ impl OdeSystem for ContactPhase<'_> {
                 (_, (c, true)) => (0..n).map(|j| values.tangent[c * n + j] * qdot[j]).sum(),
             });
             let gram = &rows * rows.transpose();
+            // Least norm where rows repeat each other (two feet's equal slip rows).
+            let scale = gram.amax().max(f64::MIN_POSITIVE);
             let multipliers = gram
-                .lu()
-                .solve(&residual)
-                .ok_or(RhsError::SingularConstraintMatrix)?;
+                .svd(true, true)
+                .solve(&residual, 1e-12 * scale)
+                .map_err(|_| RhsError::SingularConstraintMatrix)?;
             let correction = rows.transpose() * multipliers;
             for j in 0..n {
                 y[level * n + j] -= correction[j];

@@ -94,6 +94,17 @@ pub struct Transition {
 #[serde(tag = "kind", rename_all = "snake_case")]
 #[non_exhaustive]
 pub enum ContactStop {
+    /// A contact that touches, with its gap closing in the free motion, would have to pull
+    /// to stay closed: no mode is consistent (Painlevé's paradox with friction).
+    #[error(
+        "contact `{contact}` at t = {t} can be neither open (the motion would move into it) nor closed (its force would pull): no consistent contact mode (Painlevé's paradox with friction), so the run stops here"
+    )]
+    NoConsistentMode {
+        /// The contact.
+        contact: String,
+        /// Time (s).
+        t: f64,
+    },
     /// A contact is closed and the method integrates only free phases (the Taylor method,
     /// whose recurrences have no constraint rows).
     #[error(
@@ -408,7 +419,10 @@ impl Run<'_> {
                 .unwrap_or((0.0, 0.0))
         };
         let (normal, tangential) = forces(model, &holds);
+        // Its normal force reached 0 first (or pulls): it lifts off, whatever its friction.
+        let lifts = normal <= 0.0 || normal <= mu * normal - tangential.abs();
         let next = match self.holds[c] {
+            _ if lifts => None,
             Hold::Normal => None,
             Hold::Stick if mu * normal - tangential.abs() < normal => {
                 Some(Hold::Slide(-tangential.signum()))
@@ -438,38 +452,134 @@ impl Run<'_> {
         }
     }
 
-    /// Where a phase starts, a sticking contact whose force is already outside its cone
-    /// (`|λ_T| > μ λ_N`) slides at once (its event function, `min(λ_N, μ λ_N − |λ_T|)`,
-    /// would start below 0 and never be seen to cross): it slips, recorded at `sample`.
-    fn check_closed(&mut self, model: &mut dyn ModelInfo, sample: usize) {
-        let closed: Vec<usize> = (0..self.closed.len()).filter(|&k| self.closed[k]).collect();
-        let holds: Vec<Hold> = closed.iter().map(|&k| self.holds[k]).collect();
-        if !holds.contains(&Hold::Stick) {
-            return;
-        }
-        let friction = model.contact_values(self.t, &self.y).friction;
-        let phase = ContactPhase::new(model, closed.clone(), holds);
-        let Ok((_, forces)) = phase.solve(self.t, &self.y) else {
-            return;
-        };
+    /// The closed contacts' holds decided afresh where a phase starts, at `(t, y)`: a
+    /// contact whose normal force pulls is released; a contact with friction sticks where its
+    /// slip is within `atol` of 0, else slides with its slip's sign (so a slide never starts
+    /// against its slip); a sticking contact whose force is outside its cone slides against
+    /// the force it needed, `s = −sign λ_T` (its event function would start below 0 and never
+    /// be seen to cross). Each change is recorded at `sample`.
+    fn redecide(&mut self, model: &mut dyn ModelInfo, sample: usize) {
         let n = model.num_dofs();
-        for (&c, (normal, tangential)) in closed.iter().zip(forces) {
-            if self.holds[c] == Hold::Stick && friction[c] * normal - tangential.abs() < 0.0 {
-                self.holds[c] = Hold::Slide(-tangential.signum());
-                self.record.transitions.push(Transition {
-                    t: self.t,
-                    contact: self.contacts[c].clone(),
-                    kind: TransitionKind::Slip,
-                    mode: ImpactMode::Frictionless,
-                    qdot: [self.y[n..2 * n].to_vec(), self.y[n..2 * n].to_vec()],
-                    normal_velocity: [0.0; 2],
-                    normal_impulse: 0.0,
-                    tangential_impulse: 0.0,
-                    energy_lost: 0.0,
-                    sample,
-                });
+        let values = model.contact_values(self.t, &self.y);
+        for c in (0..self.closed.len()).filter(|&c| self.closed[c]) {
+            if values.friction[c] > 0.0 {
+                let slip: f64 = (0..n)
+                    .map(|j| values.tangent[c * n + j] * self.y[n + j])
+                    .sum();
+                self.holds[c] = if slip.abs() <= self.atol {
+                    Hold::Stick
+                } else {
+                    Hold::Slide(slip.signum())
+                };
             }
         }
+        for _ in 0..=2 * self.closed.len() {
+            let closed: Vec<usize> = (0..self.closed.len()).filter(|&k| self.closed[k]).collect();
+            if closed.is_empty() {
+                return;
+            }
+            let holds: Vec<Hold> = closed.iter().map(|&k| self.holds[k]).collect();
+            let Ok((_, forces)) =
+                ContactPhase::new(model, closed.clone(), holds).solve(self.t, &self.y)
+            else {
+                return;
+            };
+            let pulling = (closed.iter().zip(&forces)).find(|(_, f)| f.0 < 0.0);
+            let outside = (closed.iter().zip(&forces)).find(|&(&c, f)| {
+                self.holds[c] == Hold::Stick && values.friction[c] * f.0 - f.1.abs() < 0.0
+            });
+            let (c, kind) = match (pulling, outside) {
+                (Some((&c, _)), _) => {
+                    self.closed[c] = false;
+                    self.holds[c] = Hold::Normal;
+                    (c, TransitionKind::LiftOff)
+                }
+                (None, Some((&c, f))) => {
+                    self.holds[c] = Hold::Slide(-f.1.signum());
+                    (c, TransitionKind::Slip)
+                }
+                (None, None) => return,
+            };
+            self.record.transitions.push(Transition {
+                t: self.t,
+                contact: self.contacts[c].clone(),
+                kind,
+                mode: ImpactMode::Frictionless,
+                qdot: [self.y[n..2 * n].to_vec(), self.y[n..2 * n].to_vec()],
+                normal_velocity: [0.0; 2],
+                normal_impulse: 0.0,
+                tangential_impulse: 0.0,
+                energy_lost: 0.0,
+                sample,
+            });
+        }
+    }
+
+    /// The open contacts that touch at `(t, y)` with no normal speed (`|g|`, `|ġ| ≤ atol`) and
+    /// whose gap the free motion would close (`g̈ < 0` with them open): each closes where its
+    /// normal force then pushes (recorded at `sample`); where it would pull too, the contact
+    /// can be neither open nor closed (Painlevé's paradox with friction), and the run stops.
+    ///
+    /// # Errors
+    /// [`ContactStop::NoConsistentMode`] for such a contact.
+    fn close_touching(
+        &mut self,
+        model: &mut dyn ModelInfo,
+        sample: usize,
+        released: Option<usize>,
+    ) -> Result<(), ContactStop> {
+        let n = model.num_dofs();
+        for c in 0..self.closed.len() {
+            let values = model.contact_values(self.t, &self.y);
+            let touches = values.gaps[c].abs() <= self.atol && values.rates[c].abs() <= self.atol;
+            if self.closed[c] || Some(c) == released || !touches {
+                continue;
+            }
+            let mut closed: Vec<usize> =
+                (0..self.closed.len()).filter(|&k| self.closed[k]).collect();
+            let holds: Vec<Hold> = closed.iter().map(|&k| self.holds[k]).collect();
+            let Ok((free, _)) =
+                ContactPhase::new(model, closed.clone(), holds.clone()).solve(self.t, &self.y)
+            else {
+                continue;
+            };
+            let closing: f64 = (0..n)
+                .map(|j| values.normal[c * n + j] * free[j])
+                .sum::<f64>()
+                - values.gamma[c];
+            if closing >= 0.0 {
+                continue;
+            }
+            let hold = closing_hold(model, c, (self.t, &self.y[n..2 * n]), self.atol, &self.y);
+            let at = closed.partition_point(|&k| k < c);
+            closed.insert(at, c);
+            let mut holds = holds;
+            holds.insert(at, hold);
+            let pushes = ContactPhase::new(model, closed, holds)
+                .solve(self.t, &self.y)
+                .is_ok_and(|(_, forces)| forces[at].0 > 0.0);
+            if !pushes {
+                return Err(ContactStop::NoConsistentMode {
+                    contact: self.contacts[c].clone(),
+                    t: self.t,
+                });
+            }
+            self.closed[c] = true;
+            self.holds[c] = hold;
+            self.record.transitions.push(Transition {
+                t: self.t,
+                contact: self.contacts[c].clone(),
+                kind: TransitionKind::Closes,
+                mode: ImpactMode::Frictionless,
+                qdot: [self.y[n..2 * n].to_vec(), self.y[n..2 * n].to_vec()],
+                normal_velocity: [0.0; 2],
+                normal_impulse: 0.0,
+                tangential_impulse: 0.0,
+                energy_lost: 0.0,
+                sample,
+            });
+        }
+        Ok(())
     }
 
     /// Resolves, one after another, every open contact that touches at `(t, y)` (`g ≤
@@ -502,7 +612,8 @@ impl Run<'_> {
             };
             self.transition(model, k, (self.t, self.y.clone()), sample)?;
         }
-        self.check_closed(model, sample);
+        self.close_touching(model, sample, released)?;
+        self.redecide(model, sample);
         let values = model.contact_values(self.t, &self.y);
         self.starting = (0..self.contacts.len())
             .filter(|&k| !self.closed[k] && values.gaps[k].abs() <= self.atol)
@@ -739,6 +850,9 @@ fn impact_holding(
     };
     let was_closed = closed.to_vec();
     let mut hold = closed.to_vec();
+    // After all were released, a contact held again holds its normal row alone (where it
+    // sticks or slides is decided afresh after the impact).
+    let mut demoted = false;
     let mut last_error = None;
     for _ in 0..=2 * (closed.len() + 1) {
         let mut rows = own_rows.clone();
@@ -747,7 +861,7 @@ fn impact_holding(
         for k in (0..hold.len()).filter(|&k| hold[k]) {
             normal_rows.push((k, rows.len() / n));
             rows.extend_from_slice(&values.normal[k * n..(k + 1) * n]);
-            if holds[k] == Hold::Stick {
+            if holds[k] == Hold::Stick && !demoted {
                 rows.extend_from_slice(&values.tangent[k * n..(k + 1) * n]);
             }
         }
@@ -756,6 +870,7 @@ fn impact_holding(
             Err(ImpactError::Singular) if hold.contains(&true) => {
                 last_error = Some(ImpactError::Singular);
                 hold.fill(false);
+                demoted = true;
                 continue;
             }
             Err(e) => return Err(e),
@@ -779,12 +894,14 @@ fn impact_holding(
         }
         closed.copy_from_slice(&hold);
         for (h, &held) in holds.iter_mut().zip(&hold) {
-            if !held {
+            if !held || demoted {
                 *h = Hold::Normal;
             }
         }
         return Ok(r);
     }
+    // Holding and releasing the closed contacts both fail (one pulls when held and moves in
+    // when released): the impact needs a complementarity solve, not there yet.
     Err(last_error.unwrap_or(ImpactError::Singular))
 }
 

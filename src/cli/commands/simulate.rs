@@ -375,7 +375,7 @@ fn print_summary(
             let note = if model.description().conservative {
                 ""
             } else if !model.description().contacts.is_empty() {
-                " (of E plus the energy lost at impacts)"
+                " (of E plus the energy lost at impacts; friction's work while sliding is not added)"
             } else {
                 " (not conserved: the model has non-conservative loads or explicit time dependence)"
             };

@@ -544,32 +544,10 @@ impl Contact {
         let rate = arena.time_derivative(gap);
         // `g̈ = G q̈ − γ`: `γ = −g̈` at `q̈ = 0`, as a holonomic constraint's.
         let second = arena.time_derivative(rate);
-        let at_rest: rustc_hash::FxHashMap<_, _> = (arena.coordinates().to_vec().iter())
-            .map(|s| (s[2], arena.int(0)))
-            .collect();
-        let rest = arena.substitute(second, &at_rest);
-        let gamma = arena.neg(rest);
-        // The slip's row in the plane (the rules refuse friction elsewhere): `t̂ · ∂P/∂q`,
-        // `t̂ = (−u_y, u_x)/|u|`.
+        let gamma = minus_at_rest(arena, second);
         let tangent = match (&self.friction, across) {
             (Some(_), Some((p, u))) if p.len() == 2 && u.len() == 2 => {
-                let uu = dot(cx, &u, &u);
-                let length = exact_sqrt(cx.arena(), uu);
-                let arena = cx.arena();
-                let minus_uy = arena.neg(u[1]);
-                let t = [arena.divide(minus_uy, length), arena.divide(u[0], length)];
-                coordinates
-                    .iter()
-                    .map(|&q| {
-                        let parts: Vec<ExprId> = (0..2)
-                            .map(|k| {
-                                let dp = arena.diff(p[k], q);
-                                arena.times(t[k], dp)
-                            })
-                            .collect();
-                        arena.sum(&parts)
-                    })
-                    .collect()
+                slip_row(cx, &p, &u, &coordinates)
             }
             _ => {
                 let zero = cx.arena().int(0);
@@ -586,11 +564,7 @@ impl Contact {
             .collect();
         let slip = arena.sum(&slip_terms);
         let slip_rate = arena.time_derivative(slip);
-        let at_rest: rustc_hash::FxHashMap<_, _> = (arena.coordinates().to_vec().iter())
-            .map(|s| (s[2], arena.int(0)))
-            .collect();
-        let rest = arena.substitute(slip_rate, &at_rest);
-        let tangent_gamma = arena.neg(rest);
+        let tangent_gamma = minus_at_rest(arena, slip_rate);
         Some(ContactInfo {
             name: self.name.value.clone(),
             gap,
@@ -603,6 +577,42 @@ impl Contact {
             friction,
         })
     }
+}
+
+/// `−e` at `q̈ = 0`: the `γ` of an acceleration condition `e = A q̈ − γ = 0`.
+fn minus_at_rest(arena: &mut crate::expr::ExprArena, e: ExprId) -> ExprId {
+    let at_rest: rustc_hash::FxHashMap<_, _> = (arena.coordinates().to_vec().iter())
+        .map(|s| (s[2], arena.int(0)))
+        .collect();
+    let rest = arena.substitute(e, &at_rest);
+    arena.neg(rest)
+}
+
+/// The slip's row `T = t̂ · ∂P/∂q` of the point `p` in the plane, `t̂ = (−u_y, u_x)/|u|` (the
+/// direction `u` across the surface turned a quarter-turn), one entry per coordinate.
+fn slip_row(
+    cx: &mut dyn Lower,
+    p: &[ExprId],
+    u: &[ExprId],
+    coordinates: &[crate::expr::SymbolId],
+) -> Vec<ExprId> {
+    let uu = dot(cx, u, u);
+    let length = exact_sqrt(cx.arena(), uu);
+    let arena = cx.arena();
+    let minus_uy = arena.neg(u[1]);
+    let t = [arena.divide(minus_uy, length), arena.divide(u[0], length)];
+    coordinates
+        .iter()
+        .map(|&q| {
+            let parts: Vec<ExprId> = (0..2)
+                .map(|k| {
+                    let dp = arena.diff(p[k], q);
+                    arena.times(t[k], dp)
+                })
+                .collect();
+            arena.sum(&parts)
+        })
+        .collect()
 }
 
 /// The position of `point`, or `None` with the mistake reported.
