@@ -302,7 +302,7 @@ fn print_impacts(simulation: &Simulation) {
                 format!(", tangential {:.6e} N*s", num(tr.tangential_impulse))
             };
             let switch = match tr.kind {
-                TransitionKind::LiftOff => Some("lifts off (its normal force falls through 0)"),
+                TransitionKind::LiftOff => Some("lifts off (opens with no jump)"),
                 TransitionKind::Stick => Some("sticks (its slip stops inside the friction cone)"),
                 TransitionKind::Slip => Some("slips (the friction cone cannot hold it)"),
                 TransitionKind::Impact | TransitionKind::Closes => None,
