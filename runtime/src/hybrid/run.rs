@@ -88,6 +88,25 @@ pub struct Transition {
     pub sample: usize,
 }
 
+impl Transition {
+    /// A switch with no jump at contact `contact` (a lift-off, a stick, a slip, a closing
+    /// without impulse): the same speeds `qdot` before and after, no impulse, nothing lost.
+    fn switch(t: f64, contact: String, kind: TransitionKind, qdot: &[f64], sample: usize) -> Self {
+        Self {
+            t,
+            contact,
+            kind,
+            mode: ImpactMode::Frictionless,
+            qdot: [qdot.to_vec(), qdot.to_vec()],
+            normal_velocity: [0.0; 2],
+            normal_impulse: 0.0,
+            tangential_impulse: 0.0,
+            energy_lost: 0.0,
+            sample,
+        }
+    }
+}
+
 /// Why a run through impacts stopped before its end time, other than a failed integration or
 /// a terminal event.
 #[derive(Debug, Clone, PartialEq, Serialize, thiserror::Error)]
@@ -341,18 +360,7 @@ impl Run<'_> {
                 self.closed[c] = false;
                 self.holds[c] = Hold::Normal;
             }
-            Transition {
-                t,
-                contact: self.contacts[c].clone(),
-                kind,
-                mode: ImpactMode::Frictionless,
-                qdot: [y[n..2 * n].to_vec(), y[n..2 * n].to_vec()],
-                normal_velocity: [0.0; 2],
-                normal_impulse: 0.0,
-                tangential_impulse: 0.0,
-                energy_lost: 0.0,
-                sample,
-            }
+            Transition::switch(t, self.contacts[c].clone(), kind, &y[n..2 * n], sample)
         } else {
             let before = self.closed.clone();
             let mut transition = strike_contact(
@@ -366,19 +374,13 @@ impl Run<'_> {
             // The closed contacts the impact released (held, they would have pulled), listed
             // after it.
             for k in (0..before.len()).filter(|&k| before[k] && !self.closed[k]) {
-                let qdot = transition.qdot[1].clone();
-                released.push(Transition {
+                released.push(Transition::switch(
                     t,
-                    contact: self.contacts[k].clone(),
-                    kind: TransitionKind::LiftOff,
-                    mode: ImpactMode::Frictionless,
-                    qdot: [qdot.clone(), qdot],
-                    normal_velocity: [0.0; 2],
-                    normal_impulse: 0.0,
-                    tangential_impulse: 0.0,
-                    energy_lost: 0.0,
+                    self.contacts[k].clone(),
+                    TransitionKind::LiftOff,
+                    &transition.qdot[1],
                     sample,
-                });
+                ));
             }
             if transition.kind == TransitionKind::Closes {
                 self.closed[c] = true;
@@ -500,18 +502,13 @@ impl Run<'_> {
                 }
                 (None, None) => return,
             };
-            self.record.transitions.push(Transition {
-                t: self.t,
-                contact: self.contacts[c].clone(),
+            self.record.transitions.push(Transition::switch(
+                self.t,
+                self.contacts[c].clone(),
                 kind,
-                mode: ImpactMode::Frictionless,
-                qdot: [self.y[n..2 * n].to_vec(), self.y[n..2 * n].to_vec()],
-                normal_velocity: [0.0; 2],
-                normal_impulse: 0.0,
-                tangential_impulse: 0.0,
-                energy_lost: 0.0,
+                &self.y[n..2 * n],
                 sample,
-            });
+            ));
         }
     }
 
@@ -566,18 +563,13 @@ impl Run<'_> {
             }
             self.closed[c] = true;
             self.holds[c] = hold;
-            self.record.transitions.push(Transition {
-                t: self.t,
-                contact: self.contacts[c].clone(),
-                kind: TransitionKind::Closes,
-                mode: ImpactMode::Frictionless,
-                qdot: [self.y[n..2 * n].to_vec(), self.y[n..2 * n].to_vec()],
-                normal_velocity: [0.0; 2],
-                normal_impulse: 0.0,
-                tangential_impulse: 0.0,
-                energy_lost: 0.0,
+            self.record.transitions.push(Transition::switch(
+                self.t,
+                self.contacts[c].clone(),
+                TransitionKind::Closes,
+                &self.y[n..2 * n],
                 sample,
-            });
+            ));
         }
         Ok(())
     }
