@@ -464,6 +464,63 @@ fn no_run_goes_through_a_contact() {
     }
 }
 
+/// A pendulum bob on its rod (`contacts_pendulum.yaml`) strikes a rough floor at
+/// `θ_c = acos(h/l)`: with `μ = 0.4 < tan θ_c` its slip reverses and it rebounds at
+/// `e` times its approach speed (1e-8, the rod's drift), and with `μ = 0.5` or 2 friction
+/// locks it (`Jammed`): the contact closes, sticking, and the bob rests there to the end,
+/// its energy `−m g h` (1e-8), the whole kinetic energy of the strike lost.
+#[test]
+fn friction_locks_a_pendulum_bob_on_a_rough_floor() {
+    use eomgen::analysis::Method;
+    use eomgen::hybrid::TransitionKind;
+    let (g, h) = (9.81, 0.9_f64);
+    let theta = h.acos();
+    // The bob's speed at the floor, from its fall from 1.2 rad.
+    let speed = (2.0 * g * (h - 1.2_f64.cos())).sqrt();
+    let run = fixture_run(
+        "contacts_pendulum",
+        Method::Dp54,
+        (1e-10, 0.5),
+        &[("mu", 0.4)],
+        None,
+    );
+    let first = &run.transitions[0];
+    assert_eq!(first.mode, ImpactMode::Reversing, "{first:?}");
+    let approach = speed * theta.sin();
+    assert!(
+        (first.normal_velocity[0] + approach).abs() < 1e-8,
+        "{first:?}"
+    );
+    assert!(
+        (first.normal_velocity[1] - 0.5 * approach).abs() < 1e-8,
+        "{first:?}"
+    );
+    for mu in [0.5, 2.0] {
+        let run = fixture_run(
+            "contacts_pendulum",
+            Method::Dp54,
+            (1e-10, 2.0),
+            &[("mu", mu)],
+            None,
+        );
+        assert!(
+            run.contact_stop.is_none(),
+            "μ = {mu}: {:?}",
+            run.contact_stop
+        );
+        let first = &run.transitions[0];
+        assert_eq!(first.mode, ImpactMode::Jammed, "{first:?}");
+        assert_eq!(first.kind, TransitionKind::Closes, "{first:?}");
+        assert!(
+            (first.energy_lost - 0.5 * speed * speed).abs() < 1e-8,
+            "{first:?}"
+        );
+        let last = run.solution.iter().last().unwrap().1;
+        assert!(last[2].abs() < 1e-8 && last[3].abs() < 1e-8, "{last:?}");
+        assert!((last[1] + h).abs() < 1e-8, "{last:?}");
+    }
+}
+
 /// Two walls struck at the same instant (a corner, `e = 1`, no gravity) are taken one after
 /// the other: the ball leaves along the line it came in on, `(0.7, 0.7) → (−0.7, −0.7)`,
 /// to 1e-12. At a ramp, the floor held through the impact would pull, so it is released:

@@ -1,7 +1,7 @@
 //! The impact law (`hybrid::impact`) against closed forms: a rebounding ball, two bodies on
 //! a line, the rimless wheel's change of support (angular momentum about the new foot), a
-//! sliding impact, a pendulum held by its rod; and, on random systems, Newton's law, the held
-//! constraints and a kinetic energy that never grows.
+//! sliding impact, a pendulum held by its rod, one locked by friction; and, on random
+//! systems, Newton's law, the held constraints and a kinetic energy that never grows.
 
 use eomgen_runtime::hybrid::impact;
 use eomgen_runtime::hybrid::impact::{ContactFriction, ImpactContact, ImpactError, ImpactMode};
@@ -161,6 +161,48 @@ fn a_pendulum_held_by_its_rod_rebounds_in_its_one_freedom() {
     }
 }
 
+/// The bob of a pendulum (rod `l` from the origin, `x ẋ + y ẏ = 0` held) strikes a rough
+/// floor at `θ` from the vertical, moving along its circle: its slip `v_T = ẋ` and normal
+/// speed `v_N = ẏ` are both `∝ θ̇`, so the slip stops with the approach. Below `μ = tan θ`
+/// the slip reverses and Newton's law is met, `θ̇⁺ = −e θ̇⁻` (1e-13); from `tan θ` up
+/// friction locks the bob (the friction angle exceeds the angle of incidence), and the
+/// impact ends with it at rest, closed and sticking, every joule of `½ m l² θ̇²` lost.
+#[test]
+fn friction_locks_a_pendulum_striking_a_rough_floor_above_mu_tan_theta() {
+    let (m, l, theta, thetadot, e) = (0.7, 1.3, 0.45_f64, -2.0, 0.5);
+    let (x, y) = (l * theta.sin(), -l * theta.cos());
+    let v = [thetadot * l * theta.cos(), thetadot * l * theta.sin()];
+    let mass = scaled_identity(2, m);
+    let locking = theta.tan();
+    for (mu, locked) in [(0.9 * locking, false), (1.1 * locking, true), (5.0, true)] {
+        let contact = ImpactContact {
+            normal: &[0.0, 1.0],
+            restitution: e,
+            friction: Some(ContactFriction {
+                tangent: &[1.0, 0.0],
+                coefficient: mu,
+            }),
+        };
+        let r = impact(&mass, &v, &contact, &[x / l, y / l]).unwrap();
+        let kinetic = 0.5 * m * (l * thetadot).powi(2);
+        if locked {
+            assert_eq!(r.mode, ImpactMode::Jammed, "μ = {mu}");
+            assert!(r.qdot.iter().all(|v| v.abs() < 1e-13), "{r:?}");
+            assert!(close(r.energy_lost, kinetic, 1e-13), "{r:?}");
+            assert!(r.tangential_impulse.abs() <= mu * r.normal_impulse * (1.0 + 1e-12));
+        } else {
+            assert_eq!(r.mode, ImpactMode::Reversing, "μ = {mu}");
+            for (after, before) in r.qdot.iter().zip(v) {
+                assert!(close(*after, -e * before, 1e-13), "μ = {mu}: {r:?}");
+            }
+            assert!(
+                close(r.energy_lost, (1.0 - e * e) * kinetic, 1e-13),
+                "{r:?}"
+            );
+        }
+    }
+}
+
 /// Bad input gets a typed error: lengths, NaN, `e` and `μ` out of range, a contact that opens,
 /// a normal that depends on the held rows.
 #[test]
@@ -258,7 +300,9 @@ proptest! {
                 let size = qdot.iter().fold(1e-300f64, |m, v| m.max(v.abs()));
                 let dot = |a: &[f64], b: &[f64]| -> f64 { a.iter().zip(b).map(|(x, y)| x * y).sum() };
                 let scale = |row: &[f64]| size * row.iter().map(|v| v.abs()).sum::<f64>();
-                prop_assert!((dot(&normal, &r.qdot) + e * dot(&normal, &qdot)).abs() <= 1e-9 * scale(&normal));
+                // Newton's law, or, where friction locked the contact, a normal speed of 0.
+                let newton = if r.mode == ImpactMode::Jammed { 0.0 } else { e };
+                prop_assert!((dot(&normal, &r.qdot) + newton * dot(&normal, &qdot)).abs() <= 1e-9 * scale(&normal));
                 for row in rows.chunks_exact(n) {
                     prop_assert!((dot(row, &r.qdot) - dot(row, &qdot)).abs() <= 1e-9 * scale(row));
                 }
@@ -275,6 +319,10 @@ proptest! {
                         (r.tangential_impulse.abs() - mu.unwrap() * r.normal_impulse).abs()
                             <= 1e-12 * r.normal_impulse
                     ),
+                    ImpactMode::Jammed => {
+                        prop_assert!(r.tangential_impulse.abs() <= cone);
+                        prop_assert!(dot(&tangent, &r.qdot).abs() <= 1e-9 * scale(&tangent));
+                    }
                     ImpactMode::Reversing => {
                         prop_assert!(r.tangential_impulse.abs() <= cone);
                         // The slip ends the other way round.

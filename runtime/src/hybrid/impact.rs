@@ -25,7 +25,11 @@
 //!
 //! Newton's kinematic restitution with friction can still be inconsistent (Stronge 2000, §4):
 //! the normal velocity may not grow with the normal impulse (a Painlevé-type case), or the
-//! impact may add kinetic energy. Each is returned as an error, never as a result.
+//! impact may add kinetic energy. Each is returned as an error, never as a result. One case
+//! has an answer: where the slip stops and sticking fixes the normal velocity as well (the
+//! normal row depends on the tangent row through the held constraints), with the cone wide
+//! enough to hold, friction locks the contact and the impact ends there ([`ImpactMode::Jammed`]:
+//! the velocities after it are those at the end of the compression, the restitution lost).
 //!
 //! # References
 //! - E. T. Whittaker, *Analytical Dynamics*, 4th ed., 1937, §94 (impulsive motion in
@@ -41,6 +45,13 @@ use crate::constrained::lu_solve;
 /// reversed slip counts as rounding: about 100 rounding units of the quantities it compares
 /// (the KKT solve loses a few digits to its condition number).
 const ROUNDING: f64 = 1e-12;
+
+/// The largest normal velocity, relative to the one before the impact, that a contact locked
+/// by friction ([`ImpactMode::Jammed`]) may keep: in exact arithmetic it is the velocity of
+/// the held rows along the normal, zero on a consistent state, so what is left is their drift
+/// (the integration's tolerance, 1e-8 of the approach on a rod held to `atol` 1e-10). Above
+/// it the locked contact would still be closing, and the impact is refused.
+const LOCKED: f64 = 1e-6;
 
 /// The striking contact of an impact.
 #[derive(Debug, Clone, Copy)]
@@ -77,6 +88,13 @@ pub enum ImpactMode {
     /// The slip stops during the impact and, the cone being too narrow to hold it, starts
     /// again the other way.
     Reversing,
+    /// The slip stops during the compression where sticking also fixes the normal velocity
+    /// (the contact's normal row depends on its tangent row through the constraints that
+    /// hold: a bob on a rod, one freedom), and the cone holds it: friction locks the contact
+    /// (the friction angle exceeds the angle between the motion and the normal, `μ ≥ tan θ`),
+    /// no pushing impulse can open it, and the impact ends there, closed and sticking. The
+    /// restitution Newton's law asks for is lost: `G_N q̇⁺ = 0`, not `−e G_N q̇⁻`.
+    Jammed,
 }
 
 /// The velocities after an impact, its impulses and the energy it took.
@@ -404,6 +422,11 @@ impl Rate {
         self.value > ROUNDING * self.size
     }
 
+    /// Whether it is 0 to the rounding of its products.
+    fn is_zero(self) -> bool {
+        self.value.abs() <= ROUNDING * self.size
+    }
+
     /// `self + k · other`.
     fn plus(self, k: f64, other: Rate) -> Self {
         Self {
@@ -512,6 +535,15 @@ fn routh(v_n: f64, v_t: f64, target: f64, mu: f64, a: Rates) -> Result<Process, 
         mode
     };
     let rate = a.nn.plus(slope, a.nt);
+    if mode == ImpactMode::Sticking && rate.is_zero() && normal.abs() <= LOCKED * v_n.abs() {
+        // Sticking fixes the normal velocity, at the end of the compression (to the held
+        // rows' drift): friction locks the contact, and no impulse opens it.
+        return Ok(Process {
+            mode: ImpactMode::Jammed,
+            normal_impulse: p,
+            tangential_impulse: q,
+        });
+    }
     let more = phase_to_target(normal, rate, target, mode)?;
     Ok(Process {
         mode,

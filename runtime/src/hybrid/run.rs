@@ -727,7 +727,8 @@ fn contact_events(
 
 /// The impact of contact `c` at `(t, y)`, the closed contacts (`closed`) and the model's
 /// constraints held through it: the velocities after it, and whether the contact stays
-/// closed ([`TransitionKind::Closes`]: after a plastic impact, or below
+/// closed ([`TransitionKind::Closes`]: after a plastic impact or one that friction locked
+/// ([`ImpactMode::Jammed`]), or below
 /// [`ACCUMULATION_RATIO`] of its largest striking speed, where the impact is taken as
 /// plastic; and its normal force then pushes). A closed contact whose impulse would pull is
 /// released (and the impact solved again without it). `fastest` is the contact's largest
@@ -784,9 +785,10 @@ fn strike_contact(
         transition.tangential_impulse = r.tangential_impulse;
         transition.energy_lost = r.energy_lost;
     }
-    // After a plastic impact the normal speed is 0 to rounding, of either sign: the contact
-    // closes where its force pushes, else it leaves (`g̈ > 0`) from the impact.
-    if restitution > 0.0 {
+    // After a plastic impact, or one that friction locked, the normal speed is 0 to
+    // rounding, of either sign: the contact closes where its force pushes, else it leaves
+    // (`g̈ > 0`) from the impact.
+    if restitution > 0.0 && transition.mode != ImpactMode::Jammed {
         transition.kind = TransitionKind::Impact;
         return Ok(transition);
     }
