@@ -550,6 +550,58 @@ fn simultaneous_strikes_and_released_contacts() {
     );
 }
 
+/// Housner's rocking block (`models/rocking_block.yaml`), two shapes: the first impact comes
+/// at `ω₁² = (3g/2R)(cos(α − θ₀) − cos α)` (1e-9), every impact multiplies the rate by
+/// `1 − (3/2) sin² α` with the corner behind released (1e-12, over the first ten), and
+/// once the impacts have accumulated the block stands on both corners where it was flat,
+/// at rest (1e-8).
+#[test]
+fn a_rocking_block_loses_housners_ratio_at_each_impact_and_comes_to_rest() {
+    use eomgen::analysis::Method;
+    use eomgen::hybrid::TransitionKind;
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/models/rocking_block.yaml");
+    for (b, h, theta0) in [(0.2, 0.5, 0.2), (0.3, 0.4, 0.5)] {
+        let mut model = eomgen::DynFirstOrder::new(JitModel::load(path).unwrap());
+        for (k, v) in [("b", b), ("h", h), ("theta0", theta0)] {
+            eomgen::ModelInfo::set_parameter(&mut model, k, v).unwrap();
+        }
+        let options = eomgen::analysis::SimulationOptions {
+            method: Method::Dop853,
+            t_end: 6.0,
+            rtol: 1e-12,
+            atol: 1e-12,
+            ..Default::default()
+        };
+        let run = eomgen::analysis::simulate(&mut model, &options).unwrap();
+        assert!(run.contact_stop.is_none(), "{:?}", run.contact_stop);
+        let (alpha, radius) = (f64::atan2(b, h), f64::hypot(b, h));
+        let ratio = 1.0 - 1.5 * alpha.sin().powi(2);
+        let strikes: Vec<_> = (run.transitions.iter())
+            .filter(|tr| tr.normal_impulse > 0.0)
+            .collect();
+        let first = -(1.5 * 9.81 / radius * ((alpha - theta0).cos() - alpha.cos())).sqrt();
+        assert!(
+            (strikes[0].qdot[0][2] - first).abs() < 1e-9,
+            "{:?}",
+            strikes[0]
+        );
+        for (k, strike) in strikes.iter().take(10).enumerate() {
+            assert_eq!(strike.kind, TransitionKind::Closes, "{strike:?}");
+            let [before, after] = [strike.qdot[0][2], strike.qdot[1][2]];
+            assert!(
+                (after / before - ratio).abs() < 1e-12,
+                "impact {k}: {} against {ratio}",
+                after / before
+            );
+        }
+        let last = run.solution.iter().last().unwrap().1;
+        let rest = [b, h, 0.0, 0.0, 0.0, 0.0];
+        for (value, expected) in last.iter().zip(rest) {
+            assert!((value - expected).abs() < 1e-8, "{last:?}");
+        }
+    }
+}
+
 /// A start on the floor moving into it is an impact at the start; a run whose end time is an
 /// impact's ends there (it failed on an empty time span once).
 #[test]
