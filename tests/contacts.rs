@@ -602,6 +602,57 @@ fn a_rocking_block_loses_housners_ratio_at_each_impact_and_comes_to_rest() {
     }
 }
 
+/// A disc on a line (`disc:`), as a uniform disc (`models/eccentric_cylinder_skipping.yaml`
+/// with its centre of mass at its centre, `I = M R²/2`) released on the ramp `γ = 0.3`: with
+/// `μ = 2` it sticks, which is rolling, `ẍ = (2/3) g sin γ` and `x + R θ` constant; with
+/// `μ = 0.05 < (1/3) tan γ` it slides from the start, `ẍ = g (sin γ − μ cos γ)` and
+/// `θ̈ = −2 μ g cos γ/R`; each over 1 s, to 1e-9 (tolerance 1e-12).
+#[test]
+fn a_disc_on_a_ramp_rolls_or_slides_by_its_friction() {
+    use eomgen::analysis::Method;
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/models/eccentric_cylinder_skipping.yaml"
+    );
+    let (g, gamma, r) = (10.0, 0.3_f64, 1.0);
+    for mu in [2.0, 0.05] {
+        let mut model = eomgen::DynFirstOrder::new(JitModel::load(path).unwrap());
+        for (k, v) in [("e", 0.0), ("IG", 0.5), ("mu", mu)] {
+            eomgen::ModelInfo::set_parameter(&mut model, k, v).unwrap();
+        }
+        let options = eomgen::analysis::SimulationOptions {
+            method: Method::Dop853,
+            t_end: 1.0,
+            rtol: 1e-12,
+            atol: 1e-12,
+            ..Default::default()
+        };
+        let run = eomgen::analysis::simulate(&mut model, &options).unwrap();
+        assert!(run.contact_stop.is_none(), "{:?}", run.contact_stop);
+        let (x0, theta0) = (
+            -r * std::f64::consts::FRAC_PI_2,
+            std::f64::consts::FRAC_PI_2,
+        );
+        let (along, turning) = if mu > gamma.tan() / 3.0 {
+            let a = 2.0 / 3.0 * g * gamma.sin();
+            (a, -a / r)
+        } else {
+            (
+                g * (gamma.sin() - mu * gamma.cos()),
+                -2.0 * mu * g * gamma.cos() / r,
+            )
+        };
+        for (t, y) in run.solution.iter() {
+            let x = x0 + 0.5 * along * t * t;
+            let theta = theta0 + 0.5 * turning * t * t;
+            assert!(
+                (y[0] - x).abs() < 1e-9 && (y[2] - theta).abs() < 1e-9 && (y[1] - r).abs() < 1e-9,
+                "μ = {mu}, t = {t}: {y:?} against x = {x}, θ = {theta}"
+            );
+        }
+    }
+}
+
 /// A start on the floor moving into it is an impact at the start; a run whose end time is an
 /// impact's ends there (it failed on an empty time span once).
 #[test]

@@ -684,11 +684,13 @@ fn contact_parts(c: &Contact) -> Vec<String> {
             point,
             normal,
             through,
+            disc,
         } => format!(
-            "{} above normal {} through {:?}",
+            "{} above normal {} through {:?} disc {:?}",
             point.value,
             list(&normal.value),
-            through.as_ref().map(|o| list(&o.value))
+            through.as_ref().map(|o| list(&o.value)),
+            disc.as_ref().map(|d| format!("{} {}", d.radius, d.angle))
         ),
         Gap::Circle {
             point,
@@ -711,14 +713,15 @@ fn contact_parts(c: &Contact) -> Vec<String> {
 }
 
 /// `contacts:` round-trips: a model with a written gap and a point above a line (with and
-/// without `through`), inside and outside a circle, with and without friction, written
+/// without `through`), inside and outside a circle, a disc on a line, with and without
+/// friction, written
 /// ([`write_model`]) and read back has the same contacts (names, forms, points, vectors, `e`
 /// and `μ`), and writing that again gives the same text.
 #[test]
 fn the_writer_round_trips_contacts() {
-    let source = "name: ball_in_a_bowl\nparameters: { m: 1.0, g: 9.81, R: 2.0, e: 0.8, mu: 0.3 }\ncoordinates: [x, y]\npoints: { B: [x, y] }\nbodies: { ball: { mass: m, at: B } }\ngravity: [0, -g]\ncontacts:\n  floor: { gap: y + R/2, restitution: e }\n  wall: { point: B, above: { normal: [-1, 0], through: [R/2, 0] }, restitution: 0, friction: mu }\n  roof: { point: B, above: { normal: [0, -1] }, restitution: e^2 }\n  bowl: { point: B, inside: { centre: [0, 0], radius: R }, restitution: 1, friction: 0 }\n  post: { point: B, outside: { centre: [0, -R/2], radius: R/8 }, restitution: e/2, friction: 2*mu }\ninitial: { x: 0, y: -R/4 }\n";
+    let source = "name: ball_in_a_bowl\nparameters: { m: 1.0, g: 9.81, R: 2.0, e: 0.8, mu: 0.3 }\ncoordinates: [x, y]\npoints: { B: [x, y] }\nbodies: { ball: { mass: m, at: B } }\ngravity: [0, -g]\ncontacts:\n  floor: { gap: y + R/2, restitution: e }\n  wall: { point: B, above: { normal: [-1, 0], through: [R/2, 0] }, restitution: 0, friction: mu }\n  roof: { point: B, above: { normal: [0, -1] }, restitution: e^2 }\n  bowl: { point: B, inside: { centre: [0, 0], radius: R }, restitution: 1, friction: 0 }\n  post: { point: B, outside: { centre: [0, -R/2], radius: R/8 }, restitution: e/2, friction: 2*mu }\n  wheel: { disc: { centre: B, radius: R/4, angle: -x/R }, above: { normal: [0, 1], through: [0, -R] }, restitution: 0, friction: mu }\ninitial: { x: 0, y: -R/4 }\n";
     let original = file("ball_in_a_bowl.yaml", source);
-    assert_eq!(original.contacts.len(), 5);
+    assert_eq!(original.contacts.len(), 6);
     let (text, _) = write_model(&original).expect("writes");
     let again = file("again.yaml", &text);
     let (twice, _) = write_model(&again).expect("writes again");

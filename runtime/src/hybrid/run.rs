@@ -463,6 +463,9 @@ impl Run<'_> {
     fn redecide(&mut self, model: &mut dyn ModelInfo, sample: usize) {
         let n = model.num_dofs();
         let values = model.contact_values(self.t, &self.y);
+        // A slide just decided by a switch here (its slip still 0) is decided again the same
+        // way, and not recorded twice.
+        let before = self.holds.clone();
         for c in (0..self.closed.len()).filter(|&c| self.closed[c]) {
             if values.friction[c] > 0.0 {
                 let slip: f64 = (0..n)
@@ -498,6 +501,9 @@ impl Run<'_> {
                 }
                 (None, Some((&c, f))) => {
                     self.holds[c] = Hold::Slide(-f.1.signum());
+                    if before[c] == self.holds[c] {
+                        continue;
+                    }
                     (c, TransitionKind::Slip)
                 }
                 (None, None) => return,
@@ -575,7 +581,9 @@ impl Run<'_> {
     }
 
     /// Resolves, one after another, every open contact that touches at `(t, y)` (`g ≤
-    /// atol`) and moves into its surface (`ġ < 0`): a corner struck by a ball, or a run
+    /// atol`) and moves into its surface (`ġ < −atol`; slower, it is touching, and closes or
+    /// not by its force below, so that a contact left at `ġ = 0` by a plastic impact is not
+    /// struck again by the rounding of `ġ`): a corner struck by a ball, or a run
     /// started on a surface it moves into. Then notes the open contacts that start the next
     /// phase at a zero. (Simultaneous impacts are taken in the order of the contacts, each
     /// with the closed ones held: a documented rule, not Moreau's or an LCP's.)
@@ -597,7 +605,7 @@ impl Run<'_> {
                 !self.closed[k]
                     && Some(k) != released
                     && values.gaps[k] <= self.atol
-                    && values.rates[k] < 0.0
+                    && values.rates[k] < -self.atol
             });
             let Some(k) = striking else {
                 break;

@@ -51,14 +51,17 @@ pub enum Gap {
     /// `gap: g`, any expression of the coordinates and `t`.
     Written(Expr),
     /// `point: P, above: { normal: n, through: O }`: `g = n̂·(P − O)`, `n̂ = n/|n|`; `O` is
-    /// the origin when left out.
+    /// the origin when left out. With `disc: { centre: P, radius: R, angle: θ }` instead of
+    /// `point:`, a disc about `P` on the line: `g = n̂·(P − O) − R`.
     Above {
-        /// The point.
+        /// The point (a disc's centre).
         point: Located<String>,
         /// The normal `n`, pointing to the open side (2 or 3 components).
         normal: Located<Vec<Expr>>,
         /// A point `O` of the line or plane.
         through: Option<Located<Vec<Expr>>>,
+        /// The disc about `point`, if the contact is a disc's.
+        disc: Option<Disc>,
     },
     /// `point: P, inside: { centre: C, radius: R }` (`g = R − |P − C|`) or `outside:`
     /// (`g = |P − C| − R`).
@@ -74,12 +77,26 @@ pub enum Gap {
     },
 }
 
+/// A disc touching a line (`disc: { centre: P, radius: R, angle: θ }`), in the plane: a
+/// wheel or a cylinder rolling, sliding or flying (HW36, lecture 17). Its gap is the centre's
+/// distance from the line less `R`, and it slips as its own material point in contact moves,
+/// `v_t = t̂ · Ṗ − R θ̇` (`t̂` the normal turned a quarter-turn counter-clockwise, `θ` the
+/// disc's rotation counter-clockwise): rolling is sticking.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Disc {
+    /// The radius `R` (m), constant.
+    pub radius: Expr,
+    /// The disc's rotation `θ(q)` (rad, counter-clockwise), as its body's `angle:`.
+    pub angle: Expr,
+}
+
 /// The keys of a contact.
 const CONTACT: Fields = Fields {
     kind: "contact",
     keys: &[
         ("gap", Need::Optional),
         ("point", Need::Optional),
+        ("disc", Need::Optional),
         ("above", Need::Optional),
         ("inside", Need::Optional),
         ("outside", Need::Optional),
@@ -94,6 +111,17 @@ const ABOVE: Fields = Fields {
     kind: "the line or plane",
     keys: &[("normal", Need::Required), ("through", Need::Optional)],
     example: "{ normal: [0, 1], through: [0, 0] }",
+};
+
+/// The keys of `disc:`.
+const DISC: Fields = Fields {
+    kind: "the disc",
+    keys: &[
+        ("centre", Need::Required),
+        ("radius", Need::Required),
+        ("angle", Need::Required),
+    ],
+    example: "{ centre: C, radius: R, angle: theta }",
 };
 
 /// The keys of `inside:` and `outside:`.
@@ -146,10 +174,54 @@ fn read_gap(
         .filter(|(key, _)| SURFACES.contains(&key.value.as_str()))
         .collect();
     let written = f.iter().find(|(key, _)| key.value == "gap");
-    let point = f.iter().find(|(key, _)| key.value == "point");
-    let shape_help = "write the gap itself (`gap: y`), or a point and where it stays: `point: P, above: { normal: [0, 1] }`, `inside:` or `outside: { centre: [0, 0], radius: R }`";
+    let points: Vec<&(Located<String>, YamlNode)> = f
+        .iter()
+        .filter(|(key, _)| key.value == "point" || key.value == "disc")
+        .collect();
+    let shape_help = "write the gap itself (`gap: y`), or a point and where it stays: `point: P, above: { normal: [0, 1] }`, `inside:` or `outside: { centre: [0, 0], radius: R }`, or a disc on a line: `disc: { centre: C, radius: R, angle: theta }, above: { normal: [0, 1] }`";
+    if let [_, (second, _), ..] = points.as_slice() {
+        cx.error(
+            Diagnostic::new(
+                second.location,
+                format!("{what} has both `point` and `disc`"),
+            )
+            .with_help(shape_help),
+        );
+        return None;
+    }
+    let point = points.first().copied();
     match (written, point, surfaces.as_slice()) {
         (Some((_, g)), None, []) => cx.expr(g, "a gap").map(Gap::Written),
+        (None, Some((key, p)), [(surface, value)]) if key.value == "disc" => {
+            if surface.value != "above" {
+                cx.error(
+                    Diagnostic::new(
+                        surface.location,
+                        format!(
+                            "{what} is a disc `{}` a circle, but a disc rolls on a line only",
+                            surface.value
+                        ),
+                    )
+                    .with_help("write the line it rolls on: `above: { normal: [0, 1] }`"),
+                );
+                return None;
+            }
+            let (centre, disc) = read_disc(cx, key, p)?;
+            match read_above(cx, surface, value, Some(centre))? {
+                Gap::Above {
+                    point,
+                    normal,
+                    through,
+                    ..
+                } => Some(Gap::Above {
+                    point,
+                    normal,
+                    through,
+                    disc: Some(disc),
+                }),
+                other => Some(other),
+            }
+        }
         (None, Some((_, p)), [(surface, value)]) => {
             let point = cx.name(p, "the point of a contact");
             let gap = match surface.value.as_str() {
@@ -221,7 +293,27 @@ fn read_above(
         point: point?,
         normal: normal?,
         through: through?,
+        disc: None,
     })
+}
+
+/// `disc: { centre, radius, angle }`: the centre's point and the disc.
+fn read_disc(
+    cx: &mut Ctx<'_>,
+    key: &Located<String>,
+    node: &YamlNode,
+) -> Option<(Located<String>, Disc)> {
+    let f = cx.fields(key, node, &DISC)?;
+    let centre = get(f, "centre").and_then(|n| cx.name(n, "the centre of a disc"));
+    let radius = get(f, "radius").and_then(|n| cx.expr(n, "a radius"));
+    let angle = get(f, "angle").and_then(|n| cx.expr(n, "an angle"));
+    Some((
+        centre?,
+        Disc {
+            radius: radius?,
+            angle: angle?,
+        },
+    ))
 }
 
 /// `inside:` or `outside: { centre, radius }` of `point`.
@@ -258,12 +350,22 @@ pub(crate) fn write(w: &mut Writer<'_>, contacts: &[Contact]) -> Result<(), NotR
                 point,
                 normal,
                 through,
+                disc,
             } => {
                 let mut surface = format!("normal: {}", vector(w, &normal.value)?);
                 if let Some(o) = through {
                     surface.push_str(&format!(", through: {}", vector(w, &o.value)?));
                 }
-                format!("point: {}, above: {{ {surface} }}", point.value)
+                let what = match disc {
+                    Some(d) => format!(
+                        "disc: {{ centre: {}, radius: {}, angle: {} }}",
+                        point.value,
+                        flow(&w.expr(&d.radius, &place)?),
+                        flow(&w.expr(&d.angle, &place)?)
+                    ),
+                    None => format!("point: {}", point.value),
+                };
+                format!("{what}, above: {{ {surface} }}")
             }
             Gap::Circle {
                 point,
@@ -304,8 +406,12 @@ impl Contact {
                 point,
                 normal,
                 through,
+                disc,
             } => {
                 cx.point(point);
+                if let Some(d) = disc {
+                    self.disc_rules(cx, d);
+                }
                 self.vector_rules(cx, normal, &what("normal"));
                 if let Some(o) = through {
                     self.vector_rules(cx, o, &what("point `through`"));
@@ -329,14 +435,7 @@ impl Contact {
                 cx.point(point);
                 self.vector_rules(cx, centre, &what("centre"));
                 cx.expression(radius, Depends::Position, &what("radius"));
-                if let Some(r) = cx.value(radius)
-                    && r.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater)
-                {
-                    cx.error(
-                        Diagnostic::new(radius.location, format!("{} is {r}", what("radius")))
-                            .with_help("a radius is positive"),
-                    );
-                }
+                positive_radius(cx, radius, &what("radius"));
             }
         }
         self.fixed_surface(cx);
@@ -358,6 +457,21 @@ impl Contact {
         }
     }
 
+    /// A disc's radius is a positive constant, its angle a function of the configuration,
+    /// and it rolls in the plane.
+    fn disc_rules(&self, cx: &mut dyn Rules, disc: &Disc) {
+        let what = |part: &str| format!("the {part} of contact `{}`'s disc", self.name.value);
+        cx.expression(&disc.radius, Depends::Constant, &what("radius"));
+        positive_radius(cx, &disc.radius, &what("radius"));
+        cx.expression(&disc.angle, Depends::Position, &what("angle"));
+        if cx.dimension() != 2 {
+            cx.error(
+                Diagnostic::new(disc.angle.location, format!("contact `{}` is a disc, but a disc rolls in the plane only", self.name.value))
+                    .with_help("a body rolling in 3-D touches the plane at a point that moves over its surface: write it as a rolling constraint (`constraints:`), or the contact as a point above the plane"),
+            );
+        }
+    }
+
     /// The gap may not depend on `t`: Newton's law on a moving surface needs the surface's
     /// own speed in the impact law (`ġ⁺ = −e ġ⁻` with `ġ = G q̇ + ∂g/∂t`), which is not there
     /// yet.
@@ -365,11 +479,15 @@ impl Contact {
         let parts: Vec<&Expr> = match &self.gap {
             Gap::Written(g) => vec![g],
             Gap::Above {
-                normal, through, ..
+                normal,
+                through,
+                disc,
+                ..
             } => normal
                 .value
                 .iter()
                 .chain(through.iter().flat_map(|o| &o.value))
+                .chain(disc.iter().flat_map(|d| [&d.radius, &d.angle]))
                 .collect(),
             Gap::Circle { centre, radius, .. } => {
                 centre.value.iter().chain(std::iter::once(radius)).collect()
@@ -461,9 +579,20 @@ impl Contact {
         };
         match &self.gap {
             Gap::Written(g) => length(cx, g, "gap"),
-            Gap::Above { through, .. } => {
+            Gap::Above { through, disc, .. } => {
                 for c in through.iter().flat_map(|o| &o.value) {
                     length(cx, c, "point `through`");
+                }
+                if let Some(d) = disc {
+                    length(cx, &d.radius, "disc's radius");
+                    cx.fixed(
+                        &d.angle,
+                        Dimension::ONE,
+                        &format!("the disc's angle of contact `{name}`"),
+                        "an angle",
+                        "rad",
+                        "a disc's angle is its rotation, in rad, as its body's `angle:`",
+                    );
                 }
             }
             Gap::Circle { centre, radius, .. } => {
@@ -495,12 +624,15 @@ impl Contact {
     pub(crate) fn lower(&self, cx: &mut dyn Lower) -> Option<ContactInfo> {
         // The gap, and for a point the point and the direction `u` across the surface (the
         // normal, or the point from the centre), whose perpendicular is the slip's.
+        // A disc's radius and angle: its own point in contact moves by `−R θ̇` along `t̂`.
+        let mut rolling = None;
         let (gap, across) = match &self.gap {
             Gap::Written(g) => (cx.expr(g), None),
             Gap::Above {
                 point,
                 normal,
                 through,
+                disc,
             } => {
                 let p = position(cx, point)?;
                 let n: Vec<ExprId> = normal.value.iter().map(|c| cx.expr(c)).collect();
@@ -511,7 +643,13 @@ impl Contact {
                 let nd = dot(cx, &n, &d);
                 let nn = dot(cx, &n, &n);
                 let length = exact_sqrt(cx.arena(), nn);
-                (cx.arena().divide(nd, length), Some((p, n)))
+                let mut gap = cx.arena().divide(nd, length);
+                if let Some(disc) = disc {
+                    let (radius, angle) = (cx.expr(&disc.radius), cx.expr(&disc.angle));
+                    gap = cx.arena().minus(gap, radius);
+                    rolling = Some((radius, angle));
+                }
+                (gap, Some((p, n)))
             }
             Gap::Circle {
                 point,
@@ -547,7 +685,16 @@ impl Contact {
         let gamma = minus_at_rest(arena, second);
         let tangent = match (&self.friction, across) {
             (Some(_), Some((p, u))) if p.len() == 2 && u.len() == 2 => {
-                slip_row(cx, &p, &u, &coordinates)
+                let mut row = slip_row(cx, &p, &u, &coordinates);
+                if let Some((radius, angle)) = rolling {
+                    let arena = cx.arena();
+                    for (t, &q) in row.iter_mut().zip(&coordinates) {
+                        let turning = arena.diff(angle, q);
+                        let turning = arena.times(radius, turning);
+                        *t = arena.minus(*t, turning);
+                    }
+                }
+                row
             }
             _ => {
                 let zero = cx.arena().int(0);
@@ -576,6 +723,18 @@ impl Contact {
             restitution,
             friction,
         })
+    }
+}
+
+/// A radius positive at the parameters' defaults, else the mistake reported.
+fn positive_radius(cx: &mut dyn Rules, radius: &Expr, what: &str) {
+    if let Some(r) = cx.value(radius)
+        && r.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater)
+    {
+        cx.error(
+            Diagnostic::new(radius.location, format!("{what} is {r}"))
+                .with_help("a radius is positive"),
+        );
     }
 }
 
