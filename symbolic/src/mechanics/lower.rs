@@ -452,8 +452,8 @@ impl<'f> Lowering<'f> {
             .map(|g| g.value.iter().map(|c| self.expr(c)).collect());
         let (body_infos, angles) =
             self.bodies(&points, &mut frames, gravity.as_deref(), &mut terms);
-        let mut loads = self.springs(&points, &mut terms);
-        loads.extend(self.dampers(&points, &q_symbols, &mut terms));
+        let mut loads = self.springs(&mut terms);
+        loads.extend(self.dampers(&mut terms));
         loads.extend(self.forces(&points, &frames, &q_symbols, &mut terms));
         loads.extend(self.torques(&angles, &body_infos, &frames, &q_symbols, &mut terms));
         let (interaction_loads, interactions_at_start) =
@@ -746,6 +746,12 @@ impl elements::Lower for Lowering<'_> {
     }
     fn point(&self, name: &str) -> Option<Vec<ExprId>> {
         point(&self.points, name).map(|i| self.points[i].1.clone())
+    }
+    fn point_index(&self, name: &str) -> Option<usize> {
+        point(&self.points, name)
+    }
+    fn point_at(&self, i: usize) -> Vec<ExprId> {
+        self.points[i].1.clone()
     }
     fn error(&mut self, d: Diagnostic) {
         self.errors.push(d);

@@ -50,6 +50,7 @@ use super::frames::{Vector3, cross, tensor_times};
 use super::lower::{BodyInfo, LoadInfo};
 use super::{EquationsOfMotion, Formulation, SymbolicModel};
 use crate::expr::{ExprArena, ExprId, SymbolId};
+use crate::model::elements::{damper, spring};
 
 /// Momentum balance of each body projected on the partial velocities (Kane / d'Alembert).
 #[derive(Debug, Clone, Copy, Default)]
@@ -625,17 +626,7 @@ pub(crate) fn load_forces(
             rest_length,
         } => {
             let d = separation(arena, points, *pa, *pb);
-            let scale = match rest_length {
-                None => arena.neg(*stiffness),
-                Some(l0) => {
-                    let d2 = dot(arena, &d, &d);
-                    let len = arena.sqrt(d2);
-                    let ratio = arena.divide(*l0, len);
-                    let one = arena.int(1);
-                    let s = arena.minus(ratio, one);
-                    arena.times(*stiffness, s)
-                }
-            };
+            let scale = spring::force_scale(arena, &d, *stiffness, *rest_length);
             out.forces
                 .extend(equal_and_opposite(arena, *pa, *pb, &d, scale));
         }
@@ -644,12 +635,8 @@ pub(crate) fn load_forces(
             coefficient,
         } => {
             let d = separation(arena, points, *pa, *pb);
-            let dd: Vec<ExprId> = d.iter().map(|c| arena.time_derivative(*c)).collect();
-            let rate = dot(arena, &d, &dd);
-            let d2 = dot(arena, &d, &d);
-            let cr = arena.times(*coefficient, rate);
-            let q = arena.divide(cr, d2);
-            let scale = arena.neg(q);
+            let rate_of: Vec<ExprId> = d.iter().map(|c| arena.time_derivative(*c)).collect();
+            let scale = damper::force_scale(arena, (&d, &rate_of), *coefficient);
             out.forces
                 .extend(equal_and_opposite(arena, *pa, *pb, &d, scale));
         }

@@ -10,11 +10,13 @@
 //! its `Fields`, the `Writer`), and a new kind is one module plus one line in each stage's
 //! loop and one row in the schema's `SECTIONS`.
 //!
-//! The kinds here: [`contact`] (unilateral contacts). The older kinds (bodies, springs,
-//! constraints, …) are still spread over the stage files; ARCHITECTURE.md's recipe says how
-//! a kind moves here.
+//! The kinds here: [`contact`] (unilateral contacts), [`spring`] and [`damper`]. The older
+//! kinds (bodies, forces, constraints, …) are still spread over the stage files;
+//! ARCHITECTURE.md's recipe says how a kind moves here.
 
 pub mod contact;
+pub mod damper;
+pub mod spring;
 
 use super::ast::Expr;
 use super::diagnostic::Diagnostic;
@@ -78,6 +80,44 @@ pub(crate) trait Lower {
     /// The position of the point `name` in the ground frame's components (2 or 3); `None` if
     /// there is no such point.
     fn point(&self, name: &str) -> Option<Vec<ExprId>>;
+    /// The index of the point `name` among the model's points; `None` if there is none.
+    fn point_index(&self, name: &str) -> Option<usize>;
+    /// The position of the point of index `i` (from [`Lower::point_index`]).
+    fn point_at(&self, i: usize) -> Vec<ExprId>;
     /// Reports a mistake found while lowering.
     fn error(&mut self, d: Diagnostic);
+}
+
+/// The end points' indices of a load `between: [A, B]` and `d = r_A − r_B`; `None` (with
+/// the mistake reported at `name`) if either is not a point: "`kind` `name` names an
+/// unknown point".
+pub(crate) fn between(
+    cx: &mut dyn Lower,
+    ends: &[Located<String>; 2],
+    name: &Located<String>,
+    kind: &str,
+) -> Option<([usize; 2], Vec<ExprId>)> {
+    let (Some(a), Some(b)) = (
+        cx.point_index(&ends[0].value),
+        cx.point_index(&ends[1].value),
+    ) else {
+        cx.error(Diagnostic::new(
+            name.location,
+            format!("{kind} `{}` names an unknown point", name.value),
+        ));
+        return None;
+    };
+    let (ra, rb) = (cx.point_at(a), cx.point_at(b));
+    Some(([a, b], difference(cx.arena(), &ra, &rb)))
+}
+
+/// `a − b`, component by component.
+pub(crate) fn difference(arena: &mut ExprArena, a: &[ExprId], b: &[ExprId]) -> Vec<ExprId> {
+    a.iter().zip(b).map(|(x, y)| arena.minus(*x, *y)).collect()
+}
+
+/// `a · b`.
+pub(crate) fn dot(arena: &mut ExprArena, a: &[ExprId], b: &[ExprId]) -> ExprId {
+    let terms: Vec<ExprId> = a.iter().zip(b).map(|(x, y)| arena.times(*x, *y)).collect();
+    arena.sum(&terms)
 }

@@ -5,6 +5,8 @@
 
 use super::ast::Expr;
 pub use super::elements::contact::{Contact, Gap};
+pub use super::elements::damper::Damper;
+pub use super::elements::spring::Spring;
 // The `checks:` and `floquet:` types live in `checks.rs`; they are named here too, where
 // they were first defined.
 pub use super::checks::{
@@ -290,31 +292,6 @@ pub struct Body {
     pub name: Located<String>,
     /// Particle or planar rigid body.
     pub kind: BodyKind,
-}
-
-/// A linear spring between two points: `{ between: [A, B], stiffness: k, rest_length: l0 }`.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Spring {
-    /// Name.
-    pub name: Located<String>,
-    /// The two end points.
-    pub between: [Located<String>; 2],
-    /// Stiffness `k` (N/m).
-    pub stiffness: Expr,
-    /// Rest length `ℓ₀` (m); `None` means zero rest length.
-    pub rest_length: Option<Expr>,
-}
-
-/// A linear viscous damper between two points, acting along the line of the points:
-/// `{ between: [A, B], coefficient: c }`.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Damper {
-    /// Name.
-    pub name: Located<String>,
-    /// The two end points.
-    pub between: [Located<String>; 2],
-    /// Damping coefficient `c` (N·s/m).
-    pub coefficient: Expr,
 }
 
 /// A force between two points (`interactions:`): `{ between: [A, B], magnitude: f }`, equal

@@ -69,6 +69,12 @@ pub(crate) fn check_parts(
     checker.reference_checks();
     checker.floquet_references();
     checker.constraints();
+    for spring in &file.springs {
+        spring.rules(&mut checker);
+    }
+    for damper in &file.dampers {
+        damper.rules(&mut checker);
+    }
     for contact in &file.contacts {
         contact.rules(&mut checker);
     }

@@ -221,84 +221,33 @@ impl Lowering<'_> {
         }
     }
 
-    /// Springs: V = ½ k (|r_A − r_B| − ℓ₀)², or ½ k |r_A − r_B|² for zero rest length.
-    pub(super) fn springs(&mut self, points: &Points, terms: &mut Terms) -> Vec<LoadInfo> {
+    /// Springs (`elements::spring`): their potentials into `V`.
+    pub(super) fn springs(&mut self, terms: &mut Terms) -> Vec<LoadInfo> {
+        let file = self.file;
         let mut loads = Vec::new();
-        for s in &self.file.springs {
-            let (Some(a), Some(b)) = (
-                point(points, &s.between[0].value),
-                point(points, &s.between[1].value),
-            ) else {
-                self.errors.push(Diagnostic::new(
-                    s.name.location,
-                    format!("spring `{}` names an unknown point", s.name.value),
-                ));
-                continue;
-            };
-            let d = self.difference(&points[a].1, &points[b].1);
-            let d2 = self.dot(&d, &d);
-            let k = self.expr(&s.stiffness);
-            let rest = s.rest_length.as_ref().map(|l| self.expr(l));
+        for s in file.springs.iter().filter_map(|s| s.lower(self)) {
+            terms.potential.push(s.potential);
             loads.push(LoadInfo::Spring {
-                between: [a, b],
-                stiffness: k,
-                rest_length: rest,
+                between: s.between,
+                stiffness: s.stiffness,
+                rest_length: s.rest_length,
             });
-            let stretch2 = match rest {
-                None => d2,
-                Some(l0) => {
-                    let len = self.arena.sqrt(d2);
-                    let st = self.arena.minus(len, l0);
-                    let two = self.arena.int(2);
-                    self.arena.pow(st, two)
-                }
-            };
-            terms
-                .potential
-                .push(self.arena.product(&[terms.half, k, stretch2]));
         }
         loads
     }
 
-    /// Dampers along the line AB: F_A = −c (ḋ·e) e with d = r_A − r_B, e = d/|d|, so
-    /// Qᵢ = F_A·∂d/∂qᵢ = −c (d·ḋ)(d·∂d/∂qᵢ)/(d·d).
-    pub(super) fn dampers(
-        &mut self,
-        points: &Points,
-        q_symbols: &[SymbolId],
-        terms: &mut Terms,
-    ) -> Vec<LoadInfo> {
+    /// Dampers (`elements::damper`): their generalized forces into `Q`.
+    pub(super) fn dampers(&mut self, terms: &mut Terms) -> Vec<LoadInfo> {
+        let file = self.file;
         let mut loads = Vec::new();
-        for dmp in &self.file.dampers {
-            let (Some(a), Some(b)) = (
-                point(points, &dmp.between[0].value),
-                point(points, &dmp.between[1].value),
-            ) else {
-                self.errors.push(Diagnostic::new(
-                    dmp.name.location,
-                    format!("damper `{}` names an unknown point", dmp.name.value),
-                ));
-                continue;
-            };
-            let d = self.difference(&points[a].1, &points[b].1);
-            let dd: Vec<ExprId> = d.iter().map(|c| self.arena.time_derivative(*c)).collect();
-            let c = self.expr(&dmp.coefficient);
-            loads.push(LoadInfo::Damper {
-                between: [a, b],
-                coefficient: c,
-            });
-            let d2 = self.dot(&d, &d);
-            let rate = self.dot(&d, &dd);
-            let c_rate = self.arena.times(c, rate);
-            let scale = self.arena.divide(c_rate, d2);
-            let scale = self.arena.neg(scale);
-            for (i, qs) in q_symbols.iter().enumerate() {
-                let partial: Vec<ExprId> = d.iter().map(|x| self.arena.diff(*x, *qs)).collect();
-                let proj = self.dot(&d, &partial);
-                if !self.arena.is_zero(proj) {
-                    terms.forces[i].push(self.arena.times(scale, proj));
-                }
+        for d in file.dampers.iter().filter_map(|d| d.lower(self)) {
+            for (forces, q) in terms.forces.iter_mut().zip(d.generalized_forces) {
+                forces.extend(q);
             }
+            loads.push(LoadInfo::Damper {
+                between: d.between,
+                coefficient: d.coefficient,
+            });
         }
         loads
     }

@@ -640,8 +640,8 @@ impl Contact {
                     Some(o) => difference(cx, &p, &o.value),
                     None => p.clone(),
                 };
-                let nd = dot(cx, &n, &d);
-                let nn = dot(cx, &n, &n);
+                let nd = super::dot(cx.arena(), &n, &d);
+                let nn = super::dot(cx.arena(), &n, &n);
                 let length = exact_sqrt(cx.arena(), nn);
                 let mut gap = cx.arena().divide(nd, length);
                 if let Some(disc) = disc {
@@ -659,7 +659,7 @@ impl Contact {
             } => {
                 let p = position(cx, point)?;
                 let d = difference(cx, &p, &centre.value);
-                let dd = dot(cx, &d, &d);
+                let dd = super::dot(cx.arena(), &d, &d);
                 let r = cx.expr(radius);
                 let arena = cx.arena();
                 let distance = arena.sqrt(dd);
@@ -755,7 +755,7 @@ fn slip_row(
     u: &[ExprId],
     coordinates: &[crate::expr::SymbolId],
 ) -> Vec<ExprId> {
-    let uu = dot(cx, u, u);
+    let uu = super::dot(cx.arena(), u, u);
     let length = exact_sqrt(cx.arena(), uu);
     let arena = cx.arena();
     let minus_uy = arena.neg(u[1]);
@@ -815,13 +815,6 @@ fn difference(cx: &mut dyn Lower, p: &[ExprId], o: &[Expr]) -> Vec<ExprId> {
             cx.arena().minus(p, o)
         })
         .collect()
-}
-
-/// `a · b`.
-fn dot(cx: &mut dyn Lower, a: &[ExprId], b: &[ExprId]) -> ExprId {
-    let arena = cx.arena();
-    let terms: Vec<ExprId> = a.iter().zip(b).map(|(&a, &b)| arena.times(a, b)).collect();
-    arena.sum(&terms)
 }
 
 /// A contact as expressions of the model's arena.

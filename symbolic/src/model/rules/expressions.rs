@@ -103,28 +103,6 @@ impl Checker<'_> {
                 self.resolve(c, Depends::Constant, "`gravity`");
             }
         }
-        for s in &file.springs {
-            let name = &s.name.value;
-            self.resolve(
-                &s.stiffness,
-                Depends::Position,
-                &format!("the stiffness of spring `{name}`"),
-            );
-            if let Some(l) = &s.rest_length {
-                self.resolve(
-                    l,
-                    Depends::Position,
-                    &format!("the rest length of spring `{name}`"),
-                );
-            }
-        }
-        for d in &file.dampers {
-            self.resolve(
-                &d.coefficient,
-                Depends::Position,
-                &format!("the coefficient of damper `{}`", d.name.value),
-            );
-        }
         for f in &file.forces {
             for c in &f.vector {
                 self.resolve(c, Depends::Motion, &format!("force `{}`", f.name.value));

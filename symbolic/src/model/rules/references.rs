@@ -5,19 +5,14 @@ use super::*;
 use crate::model::checks::{FinalStateCheck, ModalCheck, PeriodCheck};
 
 impl Checker<'_> {
-    // Rule: every point named by a body, spring, damper, force or drawing exists; torques
+    // Rule: every point named by a body, force or drawing exists (springs and dampers: their
+    // own rules); torques
     // act on planar rigid bodies; generalized forces are keyed by coordinates; initial
     // values by coordinates or rates.
     pub(super) fn references(&mut self) {
         let file = self.file;
         for b in &file.bodies {
             self.point(b.kind.com());
-        }
-        for s in &file.springs {
-            s.between.iter().for_each(|p| self.point(p));
-        }
-        for d in &file.dampers {
-            d.between.iter().for_each(|p| self.point(p));
         }
         for f in &file.forces {
             self.point(&f.at);

@@ -6,24 +6,6 @@ use super::walk::{Fields, Keyed, Need};
 use super::write::{NotRewritten, Writer, flow, list, scalar};
 use super::*;
 
-/// The keys of a spring.
-const SPRING: Fields = Fields {
-    kind: "spring",
-    keys: &[
-        ("between", Need::Required),
-        ("stiffness", Need::Required),
-        ("rest_length", Need::Optional),
-    ],
-    example: "{ between: [A, B], stiffness: k, rest_length: l0 }",
-};
-
-/// The keys of a damper.
-const DAMPER: Fields = Fields {
-    kind: "damper",
-    keys: &[("between", Need::Required), ("coefficient", Need::Required)],
-    example: "{ between: [A, B], coefficient: c }",
-};
-
 /// The names of the other derivations that `eomgen check` lists beside a named set of
 /// balances, which a set may not take.
 const RESERVED_SET_NAMES: [&str; 5] = ["lagrange", "momentum", "by_hand", "energy", "power"];
@@ -336,54 +318,6 @@ impl Ctx<'_> {
             point: point?,
             along: along?,
             frame: frame?,
-        })
-    }
-
-    /// `springs:` — `name: { between, stiffness, rest_length }`.
-    pub(super) fn springs(&mut self, node: &YamlNode) -> Vec<Spring> {
-        let example = format!("springs: {{ s: {} }}", SPRING.example);
-        let spec = Keyed {
-            what: "`springs`",
-            example: &example,
-            names: None,
-            drop: false,
-        };
-        self.keyed(node, spec, |cx, k, v| {
-            let f = cx.fields(k, v, &SPRING)?;
-            let between = get(f, "between").and_then(|n| cx.point_pair(n, "`between`"));
-            let stiffness = get(f, "stiffness").and_then(|n| cx.expr(n, "a stiffness"));
-            let rest_length = match get(f, "rest_length") {
-                Some(n) => cx.expr(n, "a rest length").map(Some),
-                None => Some(None),
-            };
-            Some(Spring {
-                name: k.clone(),
-                between: between?,
-                stiffness: stiffness?,
-                rest_length: rest_length?,
-            })
-        })
-    }
-
-    /// `dampers:` — `name: { between, coefficient }`.
-    pub(super) fn dampers(&mut self, node: &YamlNode) -> Vec<Damper> {
-        let example = format!("dampers: {{ d: {} }}", DAMPER.example);
-        let spec = Keyed {
-            what: "`dampers`",
-            example: &example,
-            names: None,
-            drop: false,
-        };
-        self.keyed(node, spec, |cx, k, v| {
-            let f = cx.fields(k, v, &DAMPER)?;
-            let between = get(f, "between").and_then(|n| cx.point_pair(n, "`between`"));
-            let coefficient =
-                get(f, "coefficient").and_then(|n| cx.expr(n, "a damping coefficient"));
-            Some(Damper {
-                name: k.clone(),
-                between: between?,
-                coefficient: coefficient?,
-            })
         })
     }
 
@@ -709,51 +643,6 @@ impl Writer<'_> {
         }
         let parts = self.exprs(&p.position, &place)?;
         Ok(list(&parts))
-    }
-
-    /// `springs:`.
-    pub(super) fn write_springs(&mut self, file: &ModelFile) -> Result<(), NotRewritten> {
-        if file.springs.is_empty() {
-            return Ok(());
-        }
-        self.line("springs:");
-        for s in &file.springs {
-            let place = format!("spring `{}`", s.name.value);
-            let k = self.expr(&s.stiffness, &place)?;
-            let mut text = format!(
-                "  {}: {{ between: [{}, {}], stiffness: {}",
-                s.name.value,
-                s.between[0].value,
-                s.between[1].value,
-                flow(&k)
-            );
-            if let Some(l0) = &s.rest_length {
-                let l0 = self.expr(l0, &place)?;
-                text.push_str(&format!(", rest_length: {}", flow(&l0)));
-            }
-            self.line(format_args!("{text} }}"));
-        }
-        Ok(())
-    }
-
-    /// `dampers:`.
-    pub(super) fn write_dampers(&mut self, file: &ModelFile) -> Result<(), NotRewritten> {
-        if file.dampers.is_empty() {
-            return Ok(());
-        }
-        self.line("dampers:");
-        for d in &file.dampers {
-            let place = format!("damper `{}`", d.name.value);
-            let c = self.expr(&d.coefficient, &place)?;
-            self.line(format_args!(
-                "  {}: {{ between: [{}, {}], coefficient: {} }}",
-                d.name.value,
-                d.between[0].value,
-                d.between[1].value,
-                flow(&c)
-            ));
-        }
-        Ok(())
     }
 
     /// `forces:` (3-D ones and those written in frames included).

@@ -5,7 +5,7 @@
 use super::walk::{Fields, Keyed, Need};
 use super::write::{Edits, NotRewritten, Rewrite, Writer, list, scalar};
 use super::*;
-use crate::model::elements::contact;
+use crate::model::elements::{contact, damper, spring};
 
 /// How one top-level key of a model file is read, and written.
 struct Section {
@@ -147,16 +147,16 @@ const SECTIONS: &[Section] = &[
         write: |w, file| w.write_gravity(file),
     },
     Section {
-        key: "springs",
-        read: |cx, n, file| file.springs = cx.springs(n),
+        key: spring::KEY,
+        read: |cx, n, file| file.springs = spring::read(cx, n),
         missing: None,
-        write: |w, file| w.write_springs(file),
+        write: |w, file| spring::write(w, &file.springs),
     },
     Section {
-        key: "dampers",
-        read: |cx, n, file| file.dampers = cx.dampers(n),
+        key: damper::KEY,
+        read: |cx, n, file| file.dampers = damper::read(cx, n),
         missing: None,
-        write: |w, file| w.write_dampers(file),
+        write: |w, file| damper::write(w, &file.dampers),
     },
     Section {
         key: "forces",

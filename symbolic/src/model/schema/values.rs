@@ -273,7 +273,7 @@ impl Ctx<'_> {
     }
 
     /// `[A, B]`: two point names.
-    pub(super) fn point_pair(
+    pub(crate) fn point_pair(
         &mut self,
         node: &YamlNode,
         what: &str,

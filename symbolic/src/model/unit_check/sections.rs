@@ -241,35 +241,10 @@ impl Checker<'_> {
             }
         }
         for s in &file.springs {
-            let name = &s.name.value;
-            self.fixed(
-                &s.stiffness,
-                Dimension::STIFFNESS,
-                &format!("the stiffness of spring `{name}`"),
-                "a spring stiffness",
-                "N/m",
-                "a spring pulls with stiffness × stretch, N/m × m = N",
-            );
-            if let Some(l) = &s.rest_length {
-                self.fixed(
-                    l,
-                    Dimension::METRE,
-                    &format!("the rest length of spring `{name}`"),
-                    "a length",
-                    "m",
-                    "a rest length is the distance between the spring's points when it is relaxed",
-                );
-            }
+            s.units(self);
         }
         for d in &file.dampers {
-            self.fixed(
-                &d.coefficient,
-                Dimension::DAMPING,
-                &format!("the coefficient of damper `{}`", d.name.value),
-                "a damping coefficient",
-                "N*s/m",
-                "a damper pushes with coefficient × rate of stretch, N*s/m × m/s = N",
-            );
+            d.units(self);
         }
         for f in &file.forces {
             for (axis, c) in AXES.iter().zip(&f.vector) {
