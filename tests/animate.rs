@@ -127,6 +127,45 @@ fn page_is_self_contained_and_deterministic() {
     assert!(size < 500_000, "{size} bytes");
 }
 
+/// A bouncing ball's page lists its impacts: the times and energies of `simulate --json`'s
+/// transitions (to the page's rounding, 1e-10 s), in order; and its energy drift is measured
+/// on `E` plus the energy lost (every frame's within 1e-9, where `E` alone falls by most of
+/// `E₀` through the impacts).
+#[test]
+fn a_bouncing_balls_page_marks_its_impacts() {
+    let page = scratch("ball.html");
+    run_ok(&["animate", "bouncing_ball", "--t-end", "5", "-o", &page]);
+    let data = data_of(&std::fs::read_to_string(&page).expect("page"));
+    let clip = &data["clips"][0];
+    let events = clip["ev"].as_array().expect("transitions in the page");
+    let json: Value = serde_json::from_str(&run_ok(&[
+        "simulate",
+        "bouncing_ball",
+        "--t-end",
+        "5",
+        "--json",
+    ]))
+    .expect("JSON");
+    let transitions = json["transitions"].as_array().expect("transitions");
+    assert_eq!(events.len(), transitions.len());
+    assert!(events.len() > 20, "{} transitions", events.len());
+    for (e, tr) in events.iter().zip(transitions) {
+        let t = tr["t"].as_f64().unwrap();
+        assert!(
+            (e[0].as_f64().unwrap() - t).abs() < 1e-10,
+            "{e:?} against {tr:?}"
+        );
+        assert!(
+            e[1].as_str().unwrap().starts_with("impact at `floor`"),
+            "{e:?}"
+        );
+    }
+    let drift = numbers(&clip["de"]);
+    assert!(drift.iter().all(|d| d.abs() < 1e-9), "{drift:?}");
+    let energy = numbers(&clip["e"]);
+    assert!(energy.last().unwrap() < &(0.2 * energy[0]), "{energy:?}");
+}
+
 /// Every frame of the triple pendulum keeps its bars 1 m long (the positions are rounded to
 /// 1e-11 of the picture, so 1e-9 has a margin of 100), the frames are at k / fps, and at
 /// three frames the points and the energy agree with the closed-form geometry and energy of

@@ -11,6 +11,7 @@
   var centres = D.centres.map(function (_, i) { return $('c' + i); });
   var play = $('play'), speed = $('speed'), scrub = $('scrub'), choice = $('clip');
   var time = $('time'), frame = $('frame'), energy = $('energy'), drift = $('drift');
+  var event = $('event'), marks = $('marks');
   var clip = null, k = 0, clock = 0, playing = true, last = null, paths = [];
 
   function select(c) {
@@ -23,9 +24,30 @@
       for (var j = 0; j < a.length; j++) { a[j] = xy[2 * j] + ',' + xy[2 * j + 1]; }
       return a;
     });
+    // A tick under the slider at each transition of the contacts (impact, lift-off, stick,
+    // slip), its text as a tooltip.
+    marks.textContent = '';
+    align();
+    var span = clip.t[clip.t.length - 1] - clip.t[0];
+    (clip.ev || []).forEach(function (e) {
+      var tick = document.createElement('span');
+      tick.style.left = (span > 0 ? 100 * (e[0] - clip.t[0]) / span : 0) + '%';
+      tick.title = 't = ' + e[0] + ' s: ' + e[1];
+      marks.appendChild(tick);
+    });
     clock = 0;
     show(0);
   }
+
+  // The strip of ticks spans the slider's track.
+  function align() {
+    var r = scrub.getBoundingClientRect();
+    marks.style.marginLeft = '0px';
+    var m = marks.getBoundingClientRect();
+    marks.style.marginLeft = (r.left - m.left) + 'px';
+    marks.style.width = r.width + 'px';
+  }
+  window.addEventListener('resize', align);
 
   function show(j) {
     k = j;
@@ -59,6 +81,12 @@
       energy.textContent = '';
       drift.textContent = '';
     }
+    // The latest transition at or before this frame, and how many there have been.
+    var seen = 0, ev = clip.ev || [];
+    while (seen < ev.length && ev[seen][0] <= t) { seen++; }
+    event.textContent = seen > 0
+      ? 'transition ' + seen + ' / ' + ev.length + ' at t = ' + Number(ev[seen - 1][0]).toFixed(4) + ' s: ' + ev[seen - 1][1]
+      : (ev.length > 0 ? ev.length + ' transitions ahead' : '');
   }
 
   // The last frame at or before the clip's start plus `c` seconds.

@@ -87,7 +87,8 @@ impl Animation {
 <label>speed <select id="speed">{speeds}</select></label>
 <input id="scrub" type="range" min="0" max="{last_frame}" step="1" value="0" aria-label="frame">
 </div>
-<div class="readout"><span id="time" data-t="0">t = 0 s</span><span id="energy"></span><span id="drift"></span><span id="frame" data-frame="0">frame 1 / {frames}</span><span class="hint">{view}grid {grid} m · space: play/pause · ←/→: step</span></div>
+<div id="marks" title="the contacts' transitions over the run"></div>
+<div class="readout"><span id="time" data-t="0">t = 0 s</span><span id="energy"></span><span id="drift"></span><span id="event"></span><span id="frame" data-frame="0">frame 1 / {frames}</span><span class="hint">{view}grid {grid} m · space: play/pause · ←/→: step</span></div>
 <pre id="errors"></pre>
 <script>
 const DATA = {data};
@@ -188,6 +189,20 @@ const DATA = {data};
                         .collect::<Vec<_>>()
                         .join(",")
                 );
+            }
+            if !clip.transitions.is_empty() {
+                // The contacts' transitions, `[t, text]` (names are identifiers, the text
+                // is escaped as JSON all the same).
+                let events: Vec<(String, String)> = (clip.transitions.iter())
+                    .map(|(t, text)| (p(*t), text.clone()))
+                    .collect();
+                let list: Vec<String> = (events.iter())
+                    .map(|(t, text)| {
+                        let text = serde_json::to_string(text).unwrap_or_default();
+                        format!("[{t},{text}]")
+                    })
+                    .collect();
+                let _ = write!(data, ",\n\"ev\":[{}]", list.join(","));
             }
             data.push('}');
         }

@@ -373,6 +373,9 @@ pub struct Clip {
     rate: f64,
     /// The period of a mode's cycle (s; the clip loops over one cycle).
     period: Option<f64>,
+    /// A simulation's transitions at its contacts (impacts, lift-offs, stick and slip), in
+    /// time order: `(t, what happened)`.
+    transitions: Vec<(f64, String)>,
 }
 
 impl Clip {
@@ -413,6 +416,13 @@ impl Clip {
     /// The energy `E = T + V` (J) at every frame of a simulation; `None` for a mode.
     pub fn energy(&self) -> Option<&[f64]> {
         self.energy.as_ref().map(|e| e.energy.as_slice())
+    }
+
+    /// A simulation's transitions at its contacts, in time order: `(t, text)` with `t` in s
+    /// and the text as the page shows it ("impact at `floor`, 0.2472 J lost"); empty for a
+    /// model without contacts and for a mode.
+    pub fn transitions(&self) -> &[(f64, String)] {
+        &self.transitions
     }
 }
 
@@ -522,6 +532,8 @@ pub fn simulation_animation(
     let mut frames = Vec::with_capacity(samples / sub + 1);
     let mut frame_states = Vec::with_capacity(samples / sub + 1);
     let mut trail = vec![Vec::with_capacity(samples); scene.traces.len()];
+    // Each frame's sample, for the energy lost at impacts before it.
+    let mut frame_samples = Vec::with_capacity(samples / sub + 1);
     for (j, (tk, y)) in solution.iter().take(samples).enumerate() {
         let frame = scene.project(&model.point_positions(tk, y));
         for (path, &p) in trail.iter_mut().zip(&scene.traces) {
@@ -533,10 +545,24 @@ pub fn simulation_animation(
         t.push(tk);
         frames.push(frame);
         frame_states.push((tk, y));
+        frame_samples.push(j);
     }
-    // The energy and its drift over the frames.
-    let energy_drift = energy_drift_at(model, &simulation.initial_state, frame_states.into_iter());
-    let drift = energy_drift.relative();
+    // The energy and its drift over the frames, of `E` plus the energy lost at impacts
+    // (as `eomgen simulate` measures it): the integration's error, not the impacts'.
+    let mut energy_drift =
+        energy_drift_at(model, &simulation.initial_state, frame_states.into_iter());
+    let lost = lost_by_frame(simulation, &frame_samples);
+    let mut drift = energy_drift.relative();
+    if energy_drift.scale > 0.0 {
+        for (d, l) in drift.iter_mut().zip(&lost) {
+            *d += l / energy_drift.scale;
+        }
+    }
+    let losses = (simulation.transitions.iter()).map(|tr| (tr.sample, tr.energy_lost));
+    let losses: Vec<(usize, f64)> = losses
+        .map(|(s, l)| (frame_samples.partition_point(|&j| j < s), l))
+        .collect();
+    energy_drift.add_losses(losses.into_iter());
     let max_drift = energy_drift.drift.unwrap_or(0.0);
     let (e0, energy) = (energy_drift.initial_energy, energy_drift.energy);
     let method = format!(
@@ -544,7 +570,9 @@ pub fn simulation_animation(
         simulation.integrator,
         step_control(&simulation.options)
     );
-    let conserved = if model.description().conservative {
+    let conserved = if !simulation.transitions.is_empty() {
+        " (of E plus the energy lost at impacts)"
+    } else if model.description().conservative {
         ""
     } else {
         " (not conserved: non-conservative loads or explicit time dependence)"
@@ -577,11 +605,52 @@ pub fn simulation_animation(
         energy: Some(Energy { energy, drift }),
         rate: 1.0,
         period: None,
+        transitions: simulation
+            .transitions
+            .iter()
+            .map(describe_transition)
+            .collect(),
     };
     Ok(Some(Animation {
         scene,
         clips: vec![clip],
     }))
+}
+
+/// The energy lost at impacts before each frame (J), the frame at sample `frame_samples[k]`
+/// (a transition's `sample` is the first sample after it).
+fn lost_by_frame(simulation: &Simulation, frame_samples: &[usize]) -> Vec<f64> {
+    let mut lost = 0.0;
+    let mut transitions = simulation.transitions.iter().peekable();
+    (frame_samples.iter())
+        .map(|&j| {
+            while let Some(tr) = transitions.next_if(|tr| tr.sample <= j) {
+                lost += tr.energy_lost;
+            }
+            lost
+        })
+        .collect()
+}
+
+/// A transition as the page lists it: "impact at `floor`, 0.2472 J lost", "`floor` lifts
+/// off", "`floor` sticks", "`floor` slips".
+fn describe_transition(tr: &eomgen_runtime::hybrid::Transition) -> (f64, String) {
+    use eomgen_runtime::hybrid::TransitionKind;
+    let c = &tr.contact;
+    let text = match tr.kind {
+        TransitionKind::Impact | TransitionKind::Closes => {
+            let closes = if tr.kind == TransitionKind::Closes {
+                ", stays closed"
+            } else {
+                ""
+            };
+            format!("impact at `{c}`{closes}, {} J lost", short(tr.energy_lost))
+        }
+        TransitionKind::LiftOff => format!("`{c}` lifts off"),
+        TransitionKind::Stick => format!("`{c}` sticks"),
+        TransitionKind::Slip => format!("`{c}` slips"),
+    };
+    (tr.t, text)
 }
 
 /// [`AnimationError::PointNotFinite`] at the first frame of `frames` with a coordinate that
@@ -692,6 +761,7 @@ pub fn modes_animation(
             energy: None,
             rate: period / MODE_CYCLE_SECONDS,
             period: Some(period),
+            transitions: Vec::new(),
         });
     }
     if clips.is_empty() {
