@@ -22,10 +22,10 @@ const R: f64 = 2.0;
 const E: f64 = 0.8;
 const MU: f64 = 0.3;
 
-/// `[g; ġ]`, `G` and the coefficients of a model at `(q, q̇)`.
+/// `[g; ġ; γ; γ_T; v_s]`, `G` and the coefficients of a model at `(q, q̇)`.
 fn contact_functions(model: &dyn DynMechanicalSystem, q: &[f64], qdot: &[f64]) -> [Vec<f64>; 3] {
     let m = model.description().contacts.len();
-    let mut gaps = vec![f64::NAN; 4 * m];
+    let mut gaps = vec![f64::NAN; 5 * m];
     let mut jacobian = vec![f64::NAN; 2 * m * 2];
     let mut coefficients = vec![f64::NAN; 2 * m];
     model.contact_gaps(q, qdot, 0.0, &mut gaps);
@@ -60,6 +60,10 @@ fn closed_forms(q: [f64; 2], qdot: [f64; 2]) -> [Vec<f64>; 3] {
             0.0,
             0.0,
             bowl_gamma,
+            0.0,
+            0.0,
+            0.0,
+            // The surfaces' speeds: all fixed.
             0.0,
             0.0,
             0.0,
@@ -116,7 +120,7 @@ fn gaps_rates_jacobian_and_coefficients_match_closed_forms_on_every_backend() {
                 );
             }
         }
-        let mut from_macro = [vec![0.0; 12], vec![0.0; 12], vec![0.0; 6]];
+        let mut from_macro = [vec![0.0; 15], vec![0.0; 12], vec![0.0; 6]];
         let (sq, sqdot) = (SVector::from(q), SVector::from(qdot));
         macro_model.contact_gaps(&sq, &sqdot, 0.0, &mut from_macro[0]);
         macro_model.contact_jacobian(&sq, 0.0, &mut from_macro[1]);
@@ -163,6 +167,7 @@ fn an_impact_from_the_models_own_rows_obeys_newtons_law() {
         friction: Some(ContactFriction {
             tangent: &jacobian[6..8],
             coefficient: coefficients[1],
+            surface_velocity: 0.0,
         }),
         ..contact
     };
@@ -331,6 +336,30 @@ fn a_start_inside_a_contact_is_refused() {
         matches!(&error, eomgen::analysis::SimulationError::StartsInsideContact { contact, gap } if contact == "floor" && *gap == -0.01),
         "{error}"
     );
+}
+
+/// A surface may move along itself (a belt), not across: a table shaken up and down is
+/// refused where it is written, naming the contact, since Newton's law on a moving surface
+/// needs the surface's speed in the impact law.
+#[test]
+fn a_surface_moving_across_itself_is_refused_where_it_is_written() {
+    let text = "name: ball\nparameters: { m: 1.0, g: 9.81, e: 0.8, a: 0.01, w: 20.0 }\ncoordinates: [x, y]\npoints: { B: [x, y] }\nbodies: { ball: { mass: m, at: B } }\ngravity: [0, -g]\ncontacts:\n  table: { point: B, above: { normal: [0, 1], through: [0, a*sin(w*t)] }, restitution: e }\n";
+    let Err(eomgen::LoadError::Diagnostics { diagnostics, .. }) =
+        JitModel::from_source("shaken.yaml", text)
+    else {
+        panic!("a shaken table loaded");
+    };
+    assert_eq!(diagnostics.len(), 1, "{diagnostics:?}");
+    let d = &diagnostics[0];
+    assert_eq!((d.location.line, d.location.column), (8, 56));
+    assert!(
+        d.message
+            .contains("contact `table`'s surface moves across itself with `t`"),
+        "{}",
+        d.message
+    );
+    let belt = text.replace("through: [0, a*sin(w*t)]", "through: [a*sin(w*t), 0]");
+    assert!(JitModel::from_source("belt.yaml", &belt).is_ok());
 }
 
 /// A ball held inside a loop of radius `R` from its bottom at `v₀ = √(3.5 g R)` lifts off
@@ -648,6 +677,57 @@ fn a_disc_on_a_ramp_rolls_or_slides_by_its_friction() {
             assert!(
                 (y[0] - x).abs() < 1e-9 && (y[2] - theta).abs() < 1e-9 && (y[1] - r).abs() < 1e-9,
                 "μ = {mu}, t = {t}: {y:?} against x = {x}, θ = {theta}"
+            );
+        }
+    }
+}
+
+/// A block on a spring riding a belt (`contacts_belt.yaml`: the floor a line moving along
+/// itself at `v_b`): it slides, sticks where its speed reaches the belt's at
+/// `ω t₁ = asin(v_b/(x_k ω))`, slips at `t₂ = t₁ + (x_k − x₁)/v_b` where the spring pulls
+/// `μ m g`, and from there swings as `x_k + (v_b/ω) sin ω(t − t₂)`, its speed touching the
+/// belt's once a period without sticking again (`x_k = μ m g/k`): the switch times to 1e-9,
+/// the motion to 1e-8 over 10 s, with three methods.
+#[test]
+fn a_block_on_a_moving_belt_sticks_and_slips_at_the_closed_form_times() {
+    use eomgen::analysis::Method;
+    use eomgen::hybrid::TransitionKind;
+    let (k, g, mu, vb) = (10.0_f64, 9.81, 0.3, 0.5);
+    let omega = k.sqrt();
+    let xk = mu * g / k;
+    let t1 = (vb / (xk * omega)).asin() / omega;
+    let x1 = xk * (1.0 - (omega * t1).cos());
+    let t2 = t1 + (xk - x1) / vb;
+    let x = |t: f64| -> f64 {
+        if t <= t1 {
+            xk * (1.0 - (omega * t).cos())
+        } else if t <= t2 {
+            x1 + vb * (t - t1)
+        } else {
+            xk + vb / omega * (omega * (t - t2)).sin()
+        }
+    };
+    for method in [Method::Dop853, Method::Dp54, Method::Radau5] {
+        let run = fixture_run("contacts_belt", method, (1e-12, 10.0), &[], None);
+        assert!(
+            run.contact_stop.is_none(),
+            "{method:?}: {:?}",
+            run.contact_stop
+        );
+        let kinds: Vec<_> = run.transitions.iter().map(|tr| (tr.kind, tr.t)).collect();
+        assert_eq!(kinds.len(), 2, "{method:?}: {kinds:?}");
+        assert_eq!(kinds[0].0, TransitionKind::Stick);
+        assert_eq!(kinds[1].0, TransitionKind::Slip);
+        assert!(
+            (kinds[0].1 - t1).abs() < 1e-9 && (kinds[1].1 - t2).abs() < 1e-9,
+            "{method:?}: {kinds:?}"
+        );
+        for (t, y) in run.solution.iter() {
+            assert!(
+                (y[0] - x(t)).abs() < 1e-8,
+                "{method:?}, t = {t}: {} against {}",
+                y[0],
+                x(t)
             );
         }
     }

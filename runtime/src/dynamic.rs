@@ -102,7 +102,7 @@ pub trait DynMechanicalSystem {
     fn constraint_gamma(&self, q: &[f64], qdot: &[f64], t: f64, out: &mut [f64]);
     /// The guesses of [`ModelDescription::equilibria`], `n` coordinates each, one after the other.
     fn equilibrium_guesses(&self, out: &mut [f64]);
-    /// [`MechanicalSystem::contact_gaps`]: `g`, `ġ`, `γ`, then `γ_T` (`4 m_c`) into `out`. The default
+    /// [`MechanicalSystem::contact_gaps`]: `g`, `ġ`, `γ`, `γ_T`, then `v_s` (`5 m_c`) into `out`. The default
     /// (a model without contacts) writes nothing.
     fn contact_gaps(&self, q: &[f64], qdot: &[f64], t: f64, out: &mut [f64]) {
         let _ = (q, qdot, t, out);

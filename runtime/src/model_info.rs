@@ -114,8 +114,8 @@ pub trait ModelInfo: OdeSystem {
     /// rates, rows and coefficients ([`crate::MechanicalSystem::contact_gaps`] and
     /// siblings); empty without contacts.
     fn contact_values(&self, t: f64, y: &[f64]) -> ContactValues;
-    /// The contacts' gaps `g`, their rates `ġ`, `γ` and `γ_T` at `(t, y)` into `out` (`4 m_c`
-    /// entries): [`crate::MechanicalSystem::contact_gaps`] alone.
+    /// The contacts' gaps `g`, their rates `ġ`, `γ`, `γ_T` and the surfaces' speeds `v_s` at
+    /// `(t, y)` into `out` (`5 m_c` entries): [`crate::MechanicalSystem::contact_gaps`] alone.
     fn contact_gaps(&self, t: f64, y: &[f64], out: &mut [f64]);
     /// Makes `y = [q; q̇]` (at `t = 0`) consistent with the constraints (issue 5, item 3): the
     /// coordinates marked `{ guess: … }` and their rates are solved by Newton from
@@ -216,6 +216,8 @@ pub struct ContactValues {
     pub gamma: Vec<f64>,
     /// `γ_T` of `T q̈ = γ_T` (m/s²; 0 without friction).
     pub tangent_gamma: Vec<f64>,
+    /// `v_s`, the speed of each surface's material along it (m/s; a belt's, else 0).
+    pub surface_velocity: Vec<f64>,
     /// `G`, row-major.
     pub normal: Vec<f64>,
     /// `T`, row-major (zeros for a frictionless contact).
@@ -224,6 +226,16 @@ pub struct ContactValues {
     pub restitution: Vec<f64>,
     /// Coulomb's coefficients `μ` (0: frictionless).
     pub friction: Vec<f64>,
+}
+
+impl ContactValues {
+    /// The slip of contact `c` at speeds `qdot` (`n` entries): `v_t = T q̇ − v_s` (m/s), its
+    /// velocity along the surface relative to the surface's material.
+    pub fn slip(&self, c: usize, qdot: &[f64]) -> f64 {
+        let n = qdot.len();
+        let row = &self.tangent[c * n..(c + 1) * n];
+        row.iter().zip(qdot).map(|(a, b)| a * b).sum::<f64>() - self.surface_velocity[c]
+    }
 }
 
 /// A first-order form `y = [q; q̇]` of a mechanical system, as [`ModelInfo`] is written over
@@ -414,7 +426,7 @@ impl<F: FirstOrderForm> ModelInfo for F {
         let n = system.num_dofs();
         let (q, qdot) = (&y[..n], &y[n..2 * n]);
         let m = system.description().contacts.len();
-        let mut gaps = vec![0.0; 4 * m];
+        let mut gaps = vec![0.0; 5 * m];
         let mut rows = vec![0.0; 2 * m * n];
         let mut coefficients = vec![0.0; 2 * m];
         if m > 0 {
@@ -422,6 +434,7 @@ impl<F: FirstOrderForm> ModelInfo for F {
             system.contact_jacobian(q, t, &mut rows);
             system.contact_coefficients(&mut coefficients);
         }
+        let surface_velocity = gaps.split_off(4 * m);
         let tangent_gamma = gaps.split_off(3 * m);
         let gamma = gaps.split_off(2 * m);
         let rates = gaps.split_off(m);
@@ -431,6 +444,7 @@ impl<F: FirstOrderForm> ModelInfo for F {
             rates,
             gamma,
             tangent_gamma,
+            surface_velocity,
             normal: rows,
             tangent,
             restitution: coefficients.iter().step_by(2).copied().collect(),

@@ -139,15 +139,16 @@ pub trait MechanicalSystem<const N: usize> {
 
     /// The gaps `g(q, t)` (m) of the unilateral contacts ([`ModelDescription::contacts`],
     /// `m_c` of them), their rates `ġ = G q̇ + ∂g/∂t` (m/s), `γ` of `G q̈ = γ` (the closed
-    /// contact's acceleration condition `g̈ = 0`, m/s²), then `γ_T` of `T q̈ = γ_T` (a
-    /// sticking contact's `v̇_t = 0`, m/s²; 0 without friction), into `out` (`4 m_c`
-    /// entries). A contact is open while `g > 0` and strikes when `g` reaches 0 with `ġ < 0`
+    /// contact's acceleration condition `g̈ = 0`, m/s²), `γ_T` of `T q̈ = γ_T` (a
+    /// sticking contact's `v̇_t = 0`, m/s²; 0 without friction), then `v_s`, the speed of the
+    /// surface's material along it (a belt's, m/s; the slip is `v_t = T q̇ − v_s`), into
+    /// `out` (`5 m_c` entries). A contact is open while `g > 0` and strikes when `g` reaches 0 with `ġ < 0`
     /// (Pfeiffer & Glocker 1996, ch. 4).
     fn contact_gaps(&self, q: &SVector<f64, N>, qdot: &SVector<f64, N>, t: f64, out: &mut [f64]) {
         let _ = (q, qdot, t, out);
     }
     /// The contacts' Jacobian `G = ∂g/∂q` (`m_c × N`), then the rows `T` of their slips
-    /// `v_t = T q̇` (`m_c × N`; zeros for a frictionless contact), row-major into `out`
+    /// `v_t = T q̇ − v_s` (`m_c × N`; zeros for a frictionless contact), row-major into `out`
     /// (`2 m_c × N`): the rows of the impact law `M (q̇⁺ − q̇⁻) = Gᵀ Λ_N + Tᵀ Λ_T`
     /// ([`crate::hybrid::impact()`]).
     fn contact_jacobian(&self, q: &SVector<f64, N>, t: f64, out: &mut [f64]) {

@@ -96,6 +96,7 @@ fn the_rimless_wheel_keeps_its_angular_momentum_about_the_new_foot() {
             friction: Some(ContactFriction {
                 tangent: &tangent,
                 coefficient: 10.0,
+                surface_velocity: 0.0,
             }),
         };
         let r = impact(&mass, &qdot, &contact, &[]).unwrap();
@@ -125,6 +126,7 @@ fn a_sliding_impact_takes_mu_times_the_normal_impulse() {
         friction: Some(ContactFriction {
             tangent: &[1.0, 0.0],
             coefficient: mu,
+            surface_velocity: 0.0,
         }),
     };
     let r = impact(&mass, &[2.0, -1.0], &contact(0.2), &[]).unwrap();
@@ -181,6 +183,7 @@ fn friction_locks_a_pendulum_striking_a_rough_floor_above_mu_tan_theta() {
             friction: Some(ContactFriction {
                 tangent: &[1.0, 0.0],
                 coefficient: mu,
+                surface_velocity: 0.0,
             }),
         };
         let r = impact(&mass, &v, &contact, &[x / l, y / l]).unwrap();
@@ -234,6 +237,7 @@ fn bad_impacts_are_refused() {
         friction: Some(ContactFriction {
             tangent: &[1.0, 0.0],
             coefficient: -0.1,
+            surface_velocity: 0.0,
         }),
         ..good
     };
@@ -293,7 +297,7 @@ proptest! {
         let contact = ImpactContact {
             normal: &normal,
             restitution: e,
-            friction: mu.map(|coefficient| ContactFriction { tangent: &tangent, coefficient }),
+            friction: mu.map(|coefficient| ContactFriction { tangent: &tangent, coefficient, surface_velocity: 0.0 }),
         };
         match impact(&mass, &qdot, &contact, &rows) {
             Ok(r) => {
@@ -382,6 +386,7 @@ fn the_impulse_process_matches_small_increments() {
             friction: Some(ContactFriction {
                 tangent: &tangent,
                 coefficient: mu,
+                surface_velocity: 0.0,
             }),
         };
         let Ok(r) = impact(&mass, &qdot, &contact, &[]) else {

@@ -418,7 +418,7 @@ fn starts_outside_contacts(
     if contacts.is_empty() {
         return Ok(());
     }
-    let mut values = vec![0.0; 4 * contacts.len()];
+    let mut values = vec![0.0; 5 * contacts.len()];
     model.contact_gaps(0.0, y0, &mut values);
     match values[..contacts.len()]
         .iter()

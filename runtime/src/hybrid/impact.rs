@@ -72,6 +72,16 @@ pub struct ContactFriction<'a> {
     pub tangent: &'a [f64],
     /// The friction coefficient `μ ≥ 0`.
     pub coefficient: f64,
+    /// `v_s`, the speed of the surface's material along the tangent (a belt's; 0 for a
+    /// fixed surface): the contact slips at `v_t = G_T q̇ − v_s` (m/s).
+    pub surface_velocity: f64,
+}
+
+impl ContactFriction<'_> {
+    /// The slip `v_t = G_T q̇ − v_s` at speeds `qdot`.
+    fn slip(&self, qdot: &[f64]) -> f64 {
+        dot(self.tangent, qdot) - self.surface_velocity
+    }
 }
 
 /// How the contact behaved in the impact.
@@ -112,7 +122,7 @@ pub struct ImpactReport {
     pub holding_impulses: Vec<f64>,
     /// `G_N q̇⁻` and `G_N q̇⁺`, the normal velocity before and after.
     pub normal_velocity: [f64; 2],
-    /// `G_T q̇⁻` and `G_T q̇⁺`, the tangential velocity before and after (0 without friction).
+    /// The slips `G_T q̇⁻ − v_s` and `G_T q̇⁺ − v_s` before and after (0 without friction).
     pub tangential_velocity: [f64; 2],
     /// `½ q̇ᵀ M q̇` before and after (J).
     pub kinetic_energy: [f64; 2],
@@ -241,13 +251,7 @@ pub fn impact(
                 nt: Rate::of(contact.normal, &t.velocity),
                 tt: Rate::of(f.tangent, &t.velocity),
             };
-            routh(
-                normal_before,
-                dot(f.tangent, qdot),
-                target,
-                f.coefficient,
-                rates,
-            )?
+            routh(normal_before, f.slip(qdot), target, f.coefficient, rates)?
         }
     };
     let (p, q) = (process.normal_impulse, process.tangential_impulse);
@@ -275,7 +279,7 @@ pub fn impact(
         });
     }
     let tangential_velocity = match &contact.friction {
-        Some(f) => [dot(f.tangent, qdot), dot(f.tangent, &after)],
+        Some(f) => [f.slip(qdot), f.slip(&after)],
         None => [0.0, 0.0],
     };
     Ok(ImpactReport {

@@ -227,7 +227,7 @@ impl OdeSystem for ContactPhase<'_> {
             let residual = DVector::from_fn(k, |r, _| match (level, held[r]) {
                 (0, (c, _)) => values.gaps[c],
                 (_, (c, false)) => values.rates[c],
-                (_, (c, true)) => (0..n).map(|j| values.tangent[c * n + j] * qdot[j]).sum(),
+                (_, (c, true)) => values.slip(c, qdot),
             });
             let gram = &rows * rows.transpose();
             // Least norm where rows repeat each other (two feet's equal slip rows).

@@ -320,7 +320,7 @@ impl Run<'_> {
             .map(|&(c, g)| (c, start, g))
             .collect();
         let mut phase = ContactPhase::new(model, closed, holds);
-        let mut values = vec![0.0; 4 * self.contacts.len()];
+        let mut values = vec![0.0; 5 * self.contacts.len()];
         let mut system = WithEvents::new(
             &mut phase,
             specs,
@@ -412,7 +412,7 @@ impl Run<'_> {
         let values = model.contact_values(t, y);
         let n = model.num_dofs();
         let mu = values.friction[c];
-        let slip: f64 = (0..n).map(|j| values.tangent[c * n + j] * y[n + j]).sum();
+        let slip = values.slip(c, &y[n..2 * n]);
         let mut holds: Vec<Hold> = closed.iter().map(|&k| self.holds[k]).collect();
         let forces = |model: &mut dyn ModelInfo, holds: &[Hold]| {
             ContactPhase::new(model, closed.clone(), holds.to_vec())
@@ -466,11 +466,20 @@ impl Run<'_> {
         // A slide just decided by a switch here (its slip still 0) is decided again the same
         // way, and not recorded twice.
         let before = self.holds.clone();
+        // A contact that starts to slip here has no slip yet: it keeps the slide its switch
+        // chose (at the cone's edge, deciding it again would be rounding's choice).
+        let slipping_here: Vec<String> = (self.record.transitions.iter().rev())
+            .take_while(|tr| tr.t == self.t)
+            .filter(|tr| tr.kind == TransitionKind::Slip)
+            .map(|tr| tr.contact.clone())
+            .collect();
         for c in (0..self.closed.len()).filter(|&c| self.closed[c]) {
+            if slipping_here.contains(&self.contacts[c]) && matches!(self.holds[c], Hold::Slide(_))
+            {
+                continue;
+            }
             if values.friction[c] > 0.0 {
-                let slip: f64 = (0..n)
-                    .map(|j| values.tangent[c * n + j] * self.y[n + j])
-                    .sum();
+                let slip = values.slip(c, &self.y[n..2 * n]);
                 self.holds[c] = if slip.abs() <= self.atol {
                     Hold::Stick
                 } else {
@@ -664,11 +673,10 @@ fn closing_hold(
     y: &[f64],
 ) -> Hold {
     let values = model.contact_values(t, y);
-    let n = model.num_dofs();
     if values.friction[c] <= 0.0 {
         return Hold::Normal;
     }
-    let slip: f64 = (0..n).map(|j| values.tangent[c * n + j] * qdot[j]).sum();
+    let slip = values.slip(c, qdot);
     if slip.abs() <= atol {
         Hold::Stick
     } else {
@@ -687,7 +695,7 @@ fn closing_hold(
 /// from a gap of 0 (to rounding, of either sign), so its gap would start at a zero that the
 /// sign test between two steps cannot see past, and a short flight that rises and lands
 /// within one step would be missed. The quotient starts at `ġ⁺ ≥ 0` and turns negative
-/// where the gap returns to `g*` (within rounding of 0). `values` is scratch of `4 m_c`
+/// where the gap returns to `g*` (within rounding of 0). `values` is scratch of `5 m_c`
 /// entries.
 ///
 /// # Errors
@@ -712,11 +720,7 @@ fn contact_events(
     if !phase.closed.is_empty() {
         let (_, forces) = phase.solve(t, y)?;
         let slides = phase.holds.iter().any(|h| matches!(h, Hold::Slide(_)));
-        let tangent = if slides {
-            phase.model.contact_values(t, y).tangent
-        } else {
-            Vec::new()
-        };
+        let sliding = slides.then(|| phase.model.contact_values(t, y));
         let n = y.len() / 2;
         for ((&c, (normal, tangential)), &hold) in phase.closed.iter().zip(forces).zip(&phase.holds)
         {
@@ -724,7 +728,7 @@ fn contact_events(
                 Hold::Normal => normal,
                 Hold::Stick => normal.min(friction[c] * normal - tangential.abs()),
                 Hold::Slide(s) => {
-                    let slip: f64 = (0..n).map(|j| tangent[c * n + j] * y[n + j]).sum();
+                    let slip = (sliding.as_ref()).map_or(0.0, |v| v.slip(c, &y[n..2 * n]));
                     normal.min(s * slip)
                 }
             };
@@ -844,6 +848,7 @@ fn impact_holding(
     let friction = (values.friction[c] > 0.0).then_some(ContactFriction {
         tangent: &values.tangent[c * n..(c + 1) * n],
         coefficient: values.friction[c],
+        surface_velocity: values.surface_velocity[c],
     });
     let law = ImpactContact {
         normal: &values.normal[c * n..(c + 1) * n],

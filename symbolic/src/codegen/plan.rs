@@ -187,6 +187,7 @@ impl ModelFunction {
                     .chain(model.contacts.iter().map(|c| c.rate))
                     .chain(model.contacts.iter().map(|c| c.gamma))
                     .chain(model.contacts.iter().map(|c| c.tangent_gamma))
+                    .chain(model.contacts.iter().map(|c| c.surface_velocity))
                     .collect(),
             ),
             ModelFunction::ContactJacobian => unless_empty(

@@ -57,7 +57,7 @@ impl FunctionTape {
 /// | `constraint_velocity_residuals`, `constraint_gamma` | (m) |
 /// | `event_values` | `g` (e); `q̈` as the acceleration inputs, `λ` as the multipliers |
 /// | `equilibrium_guesses` | `n` per named equilibrium |
-/// | `contact_gaps` | `g`, `ġ`, `γ` of `G q̈ = γ`, then `γ_T` of `T q̈ = γ_T` (m_c each) |
+/// | `contact_gaps` | `g`, `ġ`, `γ` of `G q̈ = γ`, `γ_T` of `T q̈ = γ_T`, then the surface's speed `v_s` (m_c each) |
 /// | `contact_jacobian` | `G = ∂g/∂q` (m_c × n), then the slips' rows `T` (m_c × n), row-major |
 /// | `contact_coefficients` | `e`, `μ` per contact (2 m_c) |
 #[derive(Debug, Clone, PartialEq)]

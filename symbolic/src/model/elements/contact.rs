@@ -472,21 +472,16 @@ impl Contact {
         }
     }
 
-    /// The gap may not depend on `t`: Newton's law on a moving surface needs the surface's
-    /// own speed in the impact law (`ġ⁺ = −e ġ⁻` with `ġ = G q̇ + ∂g/∂t`), which is not there
-    /// yet.
+    /// The gap may not depend on `t`: Newton's law on a surface moving across itself needs
+    /// the surface's own speed in the impact law (`ġ⁺ = −e ġ⁻` with `ġ = G q̇ + ∂g/∂t`),
+    /// which is not there yet. A line may move along itself (a belt: `through` with `t`,
+    /// whose gap the lowering checks does not change): its material's speed enters the slip.
     fn fixed_surface(&self, cx: &mut dyn Rules) {
         let parts: Vec<&Expr> = match &self.gap {
             Gap::Written(g) => vec![g],
-            Gap::Above {
-                normal,
-                through,
-                disc,
-                ..
-            } => normal
+            Gap::Above { normal, disc, .. } => normal
                 .value
                 .iter()
-                .chain(through.iter().flat_map(|o| &o.value))
                 .chain(disc.iter().flat_map(|d| [&d.radius, &d.angle]))
                 .collect(),
             Gap::Circle { centre, radius, .. } => {
@@ -499,7 +494,7 @@ impl Contact {
             if let Some((_, at)) = names.iter().find(|(name, _)| name == "t") {
                 cx.error(
                     Diagnostic::new(*at, format!("contact `{}` moves with `t`, but impacts on a moving surface are not simulated yet", self.name.value))
-                        .with_help("write a surface fixed in the ground frame; a moving one (a belt, a shaken table) needs its own speed in the impact law"),
+                        .with_help("write a surface fixed in the ground frame, or one moving along itself as a belt does (`above: { normal: [0, 1], through: [v*t, 0] }`); a surface moving across itself (a shaken table) needs its own speed in the impact law"),
                 );
                 return;
             }
@@ -626,6 +621,8 @@ impl Contact {
         // normal, or the point from the centre), whose perpendicular is the slip's.
         // A disc's radius and angle: its own point in contact moves by `−R θ̇` along `t̂`.
         let mut rolling = None;
+        // The speed of the surface's material along `t̂` (a belt's), 0 for a fixed one.
+        let mut surface = None;
         let (gap, across) = match &self.gap {
             Gap::Written(g) => (cx.expr(g), None),
             Gap::Above {
@@ -644,6 +641,9 @@ impl Contact {
                 let nn = super::dot(cx.arena(), &n, &n);
                 let length = exact_sqrt(cx.arena(), nn);
                 let mut gap = cx.arena().divide(nd, length);
+                if let Some(o) = through {
+                    surface = self.moving_line(cx, o, (&n, length), gap);
+                }
                 if let Some(disc) = disc {
                     let (radius, angle) = (cx.expr(&disc.radius), cx.expr(&disc.angle));
                     gap = cx.arena().minus(gap, radius);
@@ -701,14 +701,20 @@ impl Contact {
                 vec![zero; coordinates.len()]
             }
         };
-        // `γ_T` of `T q̈ = γ_T` while it sticks (`v̇_t = 0`, `v_t = T q̇`): `−v̇_t` at `q̈ = 0`.
+        // `γ_T` of `T q̈ = γ_T` while it sticks (`v̇_t = 0`, `v_t = T q̇ − v_s`): `−v̇_t` at
+        // `q̈ = 0`.
         let arena = cx.arena();
+        let surface_velocity = match (&self.friction, surface) {
+            (Some(_), Some(v)) => v,
+            _ => arena.int(0),
+        };
         let rates: Vec<ExprId> = (arena.coordinates().to_vec().iter())
             .map(|s| arena.symbol_expr(s[1]))
             .collect();
-        let slip_terms: Vec<ExprId> = (tangent.iter().zip(&rates))
+        let mut slip_terms: Vec<ExprId> = (tangent.iter().zip(&rates))
             .map(|(&t, &v)| arena.times(t, v))
             .collect();
+        slip_terms.push(arena.neg(surface_velocity));
         let slip = arena.sum(&slip_terms);
         let slip_rate = arena.time_derivative(slip);
         let tangent_gamma = minus_at_rest(arena, slip_rate);
@@ -720,9 +726,41 @@ impl Contact {
             rate,
             gamma,
             tangent_gamma,
+            surface_velocity,
             restitution,
             friction,
         })
+    }
+
+    /// The speed `v_s = t̂ · Ȯ` along the line of its point `O` (`through`), `t̂` the normal
+    /// turned a quarter-turn counter-clockwise: a belt's. The gap `gap` may not change with
+    /// `t` (the line moving across itself), else the mistake is reported at `through`. `None`
+    /// where `O` is fixed or the model is 3-D.
+    fn moving_line(
+        &self,
+        cx: &mut dyn Lower,
+        through: &Located<Vec<Expr>>,
+        (n, length): (&[ExprId], ExprId),
+        gap: ExprId,
+    ) -> Option<ExprId> {
+        let o: Vec<ExprId> = through.value.iter().map(|c| cx.expr(c)).collect();
+        let arena = cx.arena();
+        let t = arena.time_id();
+        if !o.iter().any(|&c| arena.depends_on(c, t)) {
+            return None;
+        }
+        let across = arena.diff(gap, t);
+        if !arena.is_zero(across) || o.len() != 2 {
+            cx.error(
+                Diagnostic::new(through.location, format!("contact `{}`'s surface moves across itself with `t`, but impacts on a moving surface are not simulated yet", self.name.value))
+                    .with_help("a line may move along itself, as a belt does (`through: [v*t, 0]` on `normal: [0, 1]`), in the plane; a surface moving across itself (a shaken table) needs its own speed in the impact law"),
+            );
+            return None;
+        }
+        let speed: Vec<ExprId> = o.iter().map(|&c| arena.diff(c, t)).collect();
+        let minus_ny = arena.neg(n[1]);
+        let along = super::dot(arena, &[minus_ny, n[0]], &speed);
+        Some(arena.divide(along, length))
     }
 }
 
@@ -834,9 +872,12 @@ pub struct ContactInfo {
     pub rate: ExprId,
     /// `γ` of `G q̈ = γ` while it is closed (`g̈ = 0`): `−g̈` at `q̈ = 0` (m/s²).
     pub gamma: ExprId,
-    /// `γ_T` of `T q̈ = γ_T` while it sticks (the slip `v_t = T q̇` held at 0): `−v̇_t` at
-    /// `q̈ = 0` (m/s²; 0 for a frictionless contact).
+    /// `γ_T` of `T q̈ = γ_T` while it sticks (the slip `v_t = T q̇ − v_s` held at 0): `−v̇_t`
+    /// at `q̈ = 0` (m/s²; 0 for a frictionless contact).
     pub tangent_gamma: ExprId,
+    /// `v_s`, the speed of the surface's material along `t̂` (a belt's, m/s): the contact
+    /// slips at `v_t = T q̇ − v_s`. 0 for a fixed surface and a frictionless contact.
+    pub surface_velocity: ExprId,
     /// Newton's coefficient of restitution `e`.
     pub restitution: ExprId,
     /// Coulomb's friction coefficient `μ` (0 for a frictionless contact).
