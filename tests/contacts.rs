@@ -338,6 +338,40 @@ fn a_start_inside_a_contact_is_refused() {
     );
 }
 
+/// Two sequences of bounces (`contacts_kicked_ball.yaml`: a ball rests, is lifted off by a
+/// push and lands again at a thousandth of its first speed): each is taken as accumulated
+/// at a millionth of its own first striking speed, so both take as many impacts (21 at
+/// `e = 0.5`, to one), where measuring the second against the first drop's speed would end
+/// it after half as many.
+#[test]
+fn a_contact_lifted_off_after_resting_starts_a_new_sequence_of_impacts() {
+    use eomgen::analysis::Method;
+    use eomgen::hybrid::TransitionKind;
+    let run = fixture_run(
+        "contacts_kicked_ball",
+        Method::Dop853,
+        (1e-12, 4.0),
+        &[],
+        None,
+    );
+    assert!(run.contact_stop.is_none(), "{:?}", run.contact_stop);
+    let kinds: Vec<TransitionKind> = run.transitions.iter().map(|tr| tr.kind).collect();
+    let lift = kinds
+        .iter()
+        .position(|k| *k == TransitionKind::LiftOff)
+        .expect("a lift-off");
+    let closes: Vec<usize> = (0..kinds.len())
+        .filter(|&k| kinds[k] == TransitionKind::Closes)
+        .collect();
+    assert_eq!(closes.len(), 2, "{kinds:?}");
+    let (first, second) = (closes[0] + 1, closes[1] - lift);
+    assert!(first.abs_diff(second) <= 1, "{first} and {second} impacts");
+    let speeds: Vec<f64> = (run.transitions[lift + 1..].iter())
+        .map(|tr| -tr.normal_velocity[0])
+        .collect();
+    assert!(speeds[0] < 1e-2 && speeds[0] > 1e-3, "{speeds:?}");
+}
+
 /// A surface may move along itself (a belt), not across: a table shaken up and down is
 /// refused where it is written, naming the contact, since Newton's law on a moving surface
 /// needs the surface's speed in the impact law.

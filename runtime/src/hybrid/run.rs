@@ -33,7 +33,9 @@ use crate::model_info::{AddedEvents, ContactValues, ModelInfo};
 use crate::ode::{EventDirection, EventSpec, RhsError, WithEvents};
 
 /// A contact's striking speed below this fraction of the largest that contact has struck
-/// with in the run (or exactly 0 after an impact) closes it for good: the impacts accumulate.
+/// with since it last opened from a contact phase (or since the start; or exactly 0 after an
+/// impact) closes it for good: the impacts accumulate. A contact that rests and is lifted
+/// off again starts a new sequence of strikes, measured afresh.
 /// At `e = 0.8` a ball reaches it after 62 bounces, `(1 − e)⁻¹ · 2 · 10⁻⁶ v₀/g` before the
 /// accumulation time.
 pub const ACCUMULATION_RATIO: f64 = 1e-6;
@@ -359,6 +361,7 @@ impl Run<'_> {
             if kind == TransitionKind::LiftOff {
                 self.closed[c] = false;
                 self.holds[c] = Hold::Normal;
+                self.fastest[c] = 0.0;
             }
             Transition::switch(t, self.contacts[c].clone(), kind, &y[n..2 * n], sample)
         } else {
@@ -374,6 +377,7 @@ impl Run<'_> {
             // The closed contacts the impact released (held, they would have pulled), listed
             // after it.
             for k in (0..before.len()).filter(|&k| before[k] && !self.closed[k]) {
+                self.fastest[k] = 0.0;
                 released.push(Transition::switch(
                     t,
                     self.contacts[k].clone(),
@@ -506,6 +510,7 @@ impl Run<'_> {
                 (Some((&c, _)), _) => {
                     self.closed[c] = false;
                     self.holds[c] = Hold::Normal;
+                    self.fastest[c] = 0.0;
                     (c, TransitionKind::LiftOff)
                 }
                 (None, Some((&c, f))) => {
