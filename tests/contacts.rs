@@ -27,7 +27,7 @@ fn contact_functions(model: &dyn DynMechanicalSystem, q: &[f64], qdot: &[f64]) -
     let m = model.description().contacts.len();
     let mut gaps = vec![f64::NAN; 5 * m];
     let mut jacobian = vec![f64::NAN; 2 * m * 2];
-    let mut coefficients = vec![f64::NAN; 2 * m];
+    let mut coefficients = vec![f64::NAN; 3 * m];
     model.contact_gaps(q, qdot, 0.0, &mut gaps);
     model.contact_jacobian(q, 0.0, &mut jacobian);
     model.contact_coefficients(&mut coefficients);
@@ -82,7 +82,7 @@ fn closed_forms(q: [f64; 2], qdot: [f64; 2]) -> [Vec<f64>; 3] {
             0.0,
             0.0,
         ],
-        vec![E, MU, 1.0, 0.0, 0.0, 0.0],
+        vec![E, MU, MU, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0],
     ]
 }
 
@@ -120,7 +120,7 @@ fn gaps_rates_jacobian_and_coefficients_match_closed_forms_on_every_backend() {
                 );
             }
         }
-        let mut from_macro = [vec![0.0; 15], vec![0.0; 12], vec![0.0; 6]];
+        let mut from_macro = [vec![0.0; 15], vec![0.0; 12], vec![0.0; 9]];
         let (sq, sqdot) = (SVector::from(q), SVector::from(qdot));
         macro_model.contact_gaps(&sq, &sqdot, 0.0, &mut from_macro[0]);
         macro_model.contact_jacobian(&sq, 0.0, &mut from_macro[1]);
@@ -149,7 +149,7 @@ fn an_impact_from_the_models_own_rows_obeys_newtons_law() {
     let mass = model.mass_matrix(&q, 0.0);
     let mut jacobian = [0.0; 12];
     model.contact_jacobian(&q, 0.0, &mut jacobian);
-    let mut coefficients = [0.0; 6];
+    let mut coefficients = [0.0; 9];
     model.contact_coefficients(&mut coefficients);
     let contact = ImpactContact {
         normal: &jacobian[..2],
@@ -167,6 +167,7 @@ fn an_impact_from_the_models_own_rows_obeys_newtons_law() {
         friction: Some(ContactFriction {
             tangent: &jacobian[6..8],
             coefficient: coefficients[1],
+            static_coefficient: coefficients[1],
             surface_velocity: 0.0,
         }),
         ..contact
@@ -370,6 +371,49 @@ fn a_contact_lifted_off_after_resting_starts_a_new_sequence_of_impacts() {
         .map(|tr| -tr.normal_velocity[0])
         .collect();
     assert!(speeds[0] < 1e-2 && speeds[0] > 1e-3, "{speeds:?}");
+}
+
+/// The belt with a static coefficient above the kinetic one (`μ_s = 0.4`, `μ = 0.3`): a
+/// stick–slip cycle. It sticks until the spring pulls `μ_s m g` (`x_s`), slips along the
+/// swing about `x_k = μ m g/k` until its speed is the belt's again, at `2x_k − x_s` after
+/// `(2π − 2 atan(A ω/v_b))/ω` (`A = x_s − x_k`), sticks, and rides to `x_s` in
+/// `2A/v_b`: the switch times of three cycles to 1e-9.
+#[test]
+fn a_block_on_a_belt_with_static_friction_sticks_and_slips_in_a_cycle() {
+    use eomgen::analysis::Method;
+    use eomgen::hybrid::TransitionKind;
+    let (k, g, mu, mus, vb) = (10.0_f64, 9.81, 0.3, 0.4, 0.5);
+    let omega = k.sqrt();
+    let (xk, xs) = (mu * g / k, mus * g / k);
+    let t1 = (vb / (xk * omega)).asin() / omega;
+    let x1 = xk * (1.0 - (omega * t1).cos());
+    let a = xs - xk;
+    let slipping = (2.0 * std::f64::consts::PI - 2.0 * (a * omega / vb).atan()) / omega;
+    let sticking = 2.0 * a / vb;
+    let mut expected = vec![
+        (TransitionKind::Stick, t1),
+        (TransitionKind::Slip, t1 + (xs - x1) / vb),
+    ];
+    for _ in 0..3 {
+        let last = expected.last().unwrap().1;
+        expected.push((TransitionKind::Stick, last + slipping));
+        expected.push((TransitionKind::Slip, last + slipping + sticking));
+    }
+    let t_end = expected.last().unwrap().1 + 0.1;
+    let run = fixture_run(
+        "contacts_belt",
+        Method::Dop853,
+        (1e-12, t_end),
+        &[("mus", mus)],
+        None,
+    );
+    assert!(run.contact_stop.is_none(), "{:?}", run.contact_stop);
+    let got: Vec<_> = run.transitions.iter().map(|tr| (tr.kind, tr.t)).collect();
+    assert_eq!(got.len(), expected.len(), "{got:?}");
+    for ((kind, t), (want, at)) in got.iter().zip(&expected) {
+        assert_eq!(kind, want, "{got:?}");
+        assert!((t - at).abs() < 1e-9, "{t} against {at}");
+    }
 }
 
 /// A surface may move along itself (a belt), not across: a table shaken up and down is

@@ -112,7 +112,7 @@ pub trait DynMechanicalSystem {
     fn contact_jacobian(&self, q: &[f64], t: f64, out: &mut [f64]) {
         let _ = (q, t, out);
     }
-    /// [`MechanicalSystem::contact_coefficients`]: `[e₁, μ₁, …]` (`2 m_c`) into `out`.
+    /// [`MechanicalSystem::contact_coefficients`]: `[e₁, μ₁, μ_s1, …]` (`3 m_c`) into `out`.
     fn contact_coefficients(&self, out: &mut [f64]) {
         let _ = out;
     }

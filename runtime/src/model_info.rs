@@ -224,8 +224,10 @@ pub struct ContactValues {
     pub tangent: Vec<f64>,
     /// Newton's coefficients of restitution `e`.
     pub restitution: Vec<f64>,
-    /// Coulomb's coefficients `μ` (0: frictionless).
+    /// Coulomb's coefficients `μ` (0: frictionless), with which a contact slides.
     pub friction: Vec<f64>,
+    /// The static coefficients `μ_s ≥ μ` of the sticking cones (`μ` unless given).
+    pub static_friction: Vec<f64>,
 }
 
 impl ContactValues {
@@ -428,7 +430,7 @@ impl<F: FirstOrderForm> ModelInfo for F {
         let m = system.description().contacts.len();
         let mut gaps = vec![0.0; 5 * m];
         let mut rows = vec![0.0; 2 * m * n];
-        let mut coefficients = vec![0.0; 2 * m];
+        let mut coefficients = vec![0.0; 3 * m];
         if m > 0 {
             system.contact_gaps(q, qdot, t, &mut gaps);
             system.contact_jacobian(q, t, &mut rows);
@@ -447,8 +449,9 @@ impl<F: FirstOrderForm> ModelInfo for F {
             surface_velocity,
             normal: rows,
             tangent,
-            restitution: coefficients.iter().step_by(2).copied().collect(),
-            friction: coefficients.iter().skip(1).step_by(2).copied().collect(),
+            restitution: coefficients.iter().step_by(3).copied().collect(),
+            friction: coefficients.iter().skip(1).step_by(3).copied().collect(),
+            static_friction: coefficients.iter().skip(2).step_by(3).copied().collect(),
         }
     }
     fn constraint_equations(&self, t: f64, y: &[f64]) -> ConstraintValues {

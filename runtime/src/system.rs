@@ -155,7 +155,8 @@ pub trait MechanicalSystem<const N: usize> {
         let _ = (q, t, out);
     }
     /// Each contact's coefficient of restitution `e ∈ [0, 1]` and of Coulomb friction
-    /// `μ ≥ 0` (0 when frictionless), `[e₁, μ₁, e₂, μ₂, …]` into `out` (`2 m_c` entries), at
+    /// `μ ≥ 0` (0 when frictionless) and its static coefficient `μ_s ≥ μ` (`μ` unless the file
+    /// gives `static_friction:`), `[e₁, μ₁, μ_s1, e₂, …]` into `out` (`3 m_c` entries), at
     /// the model's parameters.
     fn contact_coefficients(&self, out: &mut [f64]) {
         let _ = out;

@@ -96,6 +96,7 @@ fn the_rimless_wheel_keeps_its_angular_momentum_about_the_new_foot() {
             friction: Some(ContactFriction {
                 tangent: &tangent,
                 coefficient: 10.0,
+                static_coefficient: 10.0,
                 surface_velocity: 0.0,
             }),
         };
@@ -126,6 +127,7 @@ fn a_sliding_impact_takes_mu_times_the_normal_impulse() {
         friction: Some(ContactFriction {
             tangent: &[1.0, 0.0],
             coefficient: mu,
+            static_coefficient: mu,
             surface_velocity: 0.0,
         }),
     };
@@ -183,6 +185,7 @@ fn friction_locks_a_pendulum_striking_a_rough_floor_above_mu_tan_theta() {
             friction: Some(ContactFriction {
                 tangent: &[1.0, 0.0],
                 coefficient: mu,
+                static_coefficient: mu,
                 surface_velocity: 0.0,
             }),
         };
@@ -237,6 +240,7 @@ fn bad_impacts_are_refused() {
         friction: Some(ContactFriction {
             tangent: &[1.0, 0.0],
             coefficient: -0.1,
+            static_coefficient: -0.1,
             surface_velocity: 0.0,
         }),
         ..good
@@ -297,7 +301,7 @@ proptest! {
         let contact = ImpactContact {
             normal: &normal,
             restitution: e,
-            friction: mu.map(|coefficient| ContactFriction { tangent: &tangent, coefficient, surface_velocity: 0.0 }),
+            friction: mu.map(|coefficient| ContactFriction { tangent: &tangent, coefficient, static_coefficient: coefficient, surface_velocity: 0.0 }),
         };
         match impact(&mass, &qdot, &contact, &rows) {
             Ok(r) => {
@@ -386,6 +390,7 @@ fn the_impulse_process_matches_small_increments() {
             friction: Some(ContactFriction {
                 tangent: &tangent,
                 coefficient: mu,
+                static_coefficient: mu,
                 surface_velocity: 0.0,
             }),
         };

@@ -70,8 +70,11 @@ pub struct ImpactContact<'a> {
 pub struct ContactFriction<'a> {
     /// `G_T` (`n` entries): `G_T q̇` is the tangential velocity of the contact point.
     pub tangent: &'a [f64],
-    /// The friction coefficient `μ ≥ 0`.
+    /// The friction coefficient `μ ≥ 0`, with which the contact slides.
     pub coefficient: f64,
+    /// The static coefficient `μ_s ≥ μ`: once its slip stops, the contact sticks if the
+    /// tangential impulse sticking needs is within `μ_s` times the normal one.
+    pub static_coefficient: f64,
     /// `v_s`, the speed of the surface's material along the tangent (a belt's; 0 for a
     /// fixed surface): the contact slips at `v_t = G_T q̇ − v_s` (m/s).
     pub surface_velocity: f64,
@@ -251,7 +254,11 @@ pub fn impact(
                 nt: Rate::of(contact.normal, &t.velocity),
                 tt: Rate::of(f.tangent, &t.velocity),
             };
-            routh(normal_before, f.slip(qdot), target, f.coefficient, rates)?
+            routh(
+                (normal_before, f.slip(qdot), target),
+                (f.coefficient, f.static_coefficient.max(f.coefficient)),
+                rates,
+            )?
         }
     };
     let (p, q) = (process.normal_impulse, process.tangential_impulse);
@@ -477,17 +484,21 @@ fn phase_to_target(
     Ok((target - from) / rate.value)
 }
 
-/// Routh's process in impulse space for a contact with friction `mu`: from the normal and
-/// tangential velocities `v_n < 0` and `v_t`, the normal impulse `p` grows until the normal
-/// velocity reaches `target` (Newton's law). While the contact slips (`v_t ≠ 0`), friction
-/// opposes it, `dΛ_T = −sign(v_t) μ dp`; when the slip stops it sticks, if
-/// `|G_T W G_Nᵀ| ≤ μ G_T W G_Tᵀ` (the tangential impulse sticking needs lies in the cone),
-/// else it slips again the other way.
+/// Routh's process in impulse space for a contact with friction `mu` (`μ`, and `μ_s ≥ μ` for
+/// sticking): from the normal and tangential velocities `v_n < 0` and `v_t`, the normal
+/// impulse `p` grows until the normal velocity reaches `target` (Newton's law). While the
+/// contact slips (`v_t ≠ 0`), friction opposes it, `dΛ_T = −sign(v_t) μ dp`; when the slip
+/// stops it sticks, if `|G_T W G_Nᵀ| ≤ μ_s G_T W G_Tᵀ` (the tangential impulse sticking needs
+/// lies in the static cone), else it slips again the other way.
 ///
 /// # Errors
 /// [`ImpactError::Pulling`] where the normal velocity does not grow in the phase that must
 /// reach the target; [`ImpactError::Singular`] where sticking needs `G_T W G_Tᵀ = 0`.
-fn routh(v_n: f64, v_t: f64, target: f64, mu: f64, a: Rates) -> Result<Process, ImpactError> {
+fn routh(
+    (v_n, v_t, target): (f64, f64, f64),
+    (mu, mu_static): (f64, f64),
+    a: Rates,
+) -> Result<Process, ImpactError> {
     let (mut p, mut q, mut normal) = (0.0, 0.0, v_n);
     if v_t != 0.0 {
         let s = -v_t.signum() * mu;
@@ -527,7 +538,7 @@ fn routh(v_n: f64, v_t: f64, target: f64, mu: f64, a: Rates) -> Result<Process, 
     }
     // The tangential impulse per unit normal impulse that keeps the slip at 0.
     let ratio = -a.nt.value / a.tt.value;
-    let (mode, slope) = if ratio.abs() <= mu {
+    let (mode, slope) = if ratio.abs() <= mu_static {
         (ImpactMode::Sticking, ratio)
     } else {
         // Slipping in the direction the normal impulse drives it, friction against it.

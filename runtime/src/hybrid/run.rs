@@ -316,7 +316,8 @@ impl Run<'_> {
         );
         let closed: Vec<usize> = (0..self.closed.len()).filter(|&c| self.closed[c]).collect();
         let holds: Vec<Hold> = closed.iter().map(|&c| self.holds[c]).collect();
-        let friction = model.contact_values(self.t, &self.y).friction;
+        // The sticking cones' coefficients, `μ_s`, for the sticking contacts' events.
+        let friction = model.contact_values(self.t, &self.y).static_friction;
         let (start, added) = (self.t, &mut self.added);
         let starting: Vec<(usize, f64, f64)> = (self.starting.iter())
             .map(|&(c, g)| (c, start, g))
@@ -415,7 +416,8 @@ impl Run<'_> {
         let at = closed.iter().position(|&k| k == c).unwrap_or_default();
         let values = model.contact_values(t, y);
         let n = model.num_dofs();
-        let mu = values.friction[c];
+        // The sticking cone's coefficient, `μ_s`.
+        let mu = values.static_friction[c];
         let slip = values.slip(c, &y[n..2 * n]);
         let mut holds: Vec<Hold> = closed.iter().map(|&k| self.holds[k]).collect();
         let forces = |model: &mut dyn ModelInfo, holds: &[Hold]| {
@@ -426,7 +428,8 @@ impl Run<'_> {
         };
         let (normal, tangential) = forces(model, &holds);
         // Its normal force reached 0 first (or pulls): it lifts off, whatever its friction.
-        let lifts = normal <= 0.0 || normal <= mu * normal - tangential.abs();
+        let lifts = normal <= 0.0
+            || (self.holds[c] == Hold::Stick && normal <= mu * normal - tangential.abs());
         let next = match self.holds[c] {
             _ if lifts => None,
             Hold::Normal => None,
@@ -504,7 +507,7 @@ impl Run<'_> {
             };
             let pulling = (closed.iter().zip(&forces)).find(|(_, f)| f.0 < 0.0);
             let outside = (closed.iter().zip(&forces)).find(|&(&c, f)| {
-                self.holds[c] == Hold::Stick && values.friction[c] * f.0 - f.1.abs() < 0.0
+                self.holds[c] == Hold::Stick && values.static_friction[c] * f.0 - f.1.abs() < 0.0
             });
             let (c, kind) = match (pulling, outside) {
                 (Some((&c, _)), _) => {
@@ -853,6 +856,7 @@ fn impact_holding(
     let friction = (values.friction[c] > 0.0).then_some(ContactFriction {
         tangent: &values.tangent[c * n..(c + 1) * n],
         coefficient: values.friction[c],
+        static_coefficient: values.static_friction[c],
         surface_velocity: values.surface_velocity[c],
     });
     let law = ImpactContact {

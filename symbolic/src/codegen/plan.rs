@@ -203,7 +203,7 @@ impl ModelFunction {
             ),
             ModelFunction::ContactCoefficients => unless_empty(
                 (model.contacts.iter())
-                    .flat_map(|c| [c.restitution, c.friction])
+                    .flat_map(|c| [c.restitution, c.friction, c.static_friction])
                     .collect(),
             ),
             // With a steady motion among them, each entry's rates follow its coordinates

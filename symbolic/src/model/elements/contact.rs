@@ -43,6 +43,9 @@ pub struct Contact {
     pub restitution: Expr,
     /// Coulomb's friction coefficient `μ ≥ 0`, constant; `None`: frictionless.
     pub friction: Option<Expr>,
+    /// The static coefficient `μ_s ≥ μ` (`static_friction:`): a sticking contact holds while
+    /// `|λ_T| ≤ μ_s λ_N`, and slides with `μ`; `None`: `μ_s = μ`.
+    pub static_friction: Option<Expr>,
 }
 
 /// How a contact's gap is written.
@@ -102,6 +105,7 @@ const CONTACT: Fields = Fields {
         ("outside", Need::Optional),
         ("restitution", Need::Required),
         ("friction", Need::Optional),
+        ("static_friction", Need::Optional),
     ],
     example: "{ gap: y, restitution: e, friction: mu }",
 };
@@ -153,11 +157,16 @@ pub(crate) fn read(cx: &mut Ctx<'_>, node: &YamlNode) -> Vec<Contact> {
             Some(n) => cx.expr(n, "a friction coefficient").map(Some),
             None => Some(None),
         };
+        let static_friction = match get(f, "static_friction") {
+            Some(n) => cx.expr(n, "a static friction coefficient").map(Some),
+            None => Some(None),
+        };
         Some(Contact {
             name: k.clone(),
             gap: gap?,
             restitution: restitution?,
             friction: friction?,
+            static_friction: static_friction?,
         })
     })
 }
@@ -388,6 +397,12 @@ pub(crate) fn write(w: &mut Writer<'_>, contacts: &[Contact]) -> Result<(), NotR
         if let Some(mu) = &c.friction {
             text.push_str(&format!(", friction: {}", flow(&w.expr(mu, &place)?)));
         }
+        if let Some(mu) = &c.static_friction {
+            text.push_str(&format!(
+                ", static_friction: {}",
+                flow(&w.expr(mu, &place)?)
+            ));
+        }
         w.line(format_args!("{text} }}"));
     }
     Ok(())
@@ -454,6 +469,31 @@ impl Contact {
                         .with_help("leave `friction` out of a contact between 3-D points"),
                 );
             }
+        }
+        self.static_friction_rules(cx);
+    }
+
+    /// `μ_s`: a constant no smaller than `μ`, with `friction:` given.
+    fn static_friction_rules(&self, cx: &mut dyn Rules) {
+        let Some(mu_s) = &self.static_friction else {
+            return;
+        };
+        let name = &self.name.value;
+        self.coefficient_rules(cx, mu_s, "static friction coefficient");
+        let Some(mu) = &self.friction else {
+            cx.error(
+                Diagnostic::new(mu_s.location, format!("contact `{name}` has `static_friction` but no `friction`"))
+                    .with_help("give the kinetic coefficient too: `friction: mu, static_friction: mu_s`, with `mu_s` at least `mu`"),
+            );
+            return;
+        };
+        if let (Some(s), Some(k)) = (cx.value(mu_s), cx.value(mu))
+            && s < k
+        {
+            cx.error(
+                Diagnostic::new(mu_s.location, format!("the static friction coefficient of contact `{name}` is {s}, below its friction coefficient {k}"))
+                    .with_help("a contact that sticks holds at least the force it slides with: `static_friction` is at least `friction`"),
+            );
         }
     }
 
@@ -600,6 +640,7 @@ impl Contact {
         for (e, kind) in [
             (Some(&self.restitution), "coefficient of restitution"),
             (self.friction.as_ref(), "friction coefficient"),
+            (self.static_friction.as_ref(), "static friction coefficient"),
         ] {
             if let Some(e) = e {
                 cx.fixed(
@@ -676,6 +717,10 @@ impl Contact {
             Some(mu) => cx.expr(mu),
             None => cx.arena().int(0),
         };
+        let static_friction = match &self.static_friction {
+            Some(mu) => cx.expr(mu),
+            None => friction,
+        };
         let arena = cx.arena();
         let coordinates: Vec<_> = arena.coordinates().iter().map(|s| s[0]).collect();
         let jacobian = coordinates.iter().map(|&q| arena.diff(gap, q)).collect();
@@ -729,6 +774,7 @@ impl Contact {
             surface_velocity,
             restitution,
             friction,
+            static_friction,
         })
     }
 
@@ -882,4 +928,6 @@ pub struct ContactInfo {
     pub restitution: ExprId,
     /// Coulomb's friction coefficient `μ` (0 for a frictionless contact).
     pub friction: ExprId,
+    /// The static coefficient `μ_s ≥ μ` of the sticking cone (`μ` unless given).
+    pub static_friction: ExprId,
 }
