@@ -160,6 +160,17 @@ fn a_bouncing_balls_page_marks_its_impacts() {
             "{e:?}"
         );
     }
+    // Each transition's frame is the first after its sample: its time at or after the
+    // transition's (frames are at k/fps).
+    let times = numbers(&clip["t"]);
+    for e in events {
+        let frame = e[2].as_u64().unwrap() as usize;
+        assert!(times[frame] >= e[0].as_f64().unwrap() - 1e-12, "{e:?}");
+        assert!(
+            frame == 0 || times[frame - 1] <= e[0].as_f64().unwrap() + 1e-12,
+            "{e:?}"
+        );
+    }
     let drift = numbers(&clip["de"]);
     assert!(drift.iter().all(|d| d.abs() < 1e-9), "{drift:?}");
     let energy = numbers(&clip["e"]);

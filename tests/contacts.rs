@@ -416,6 +416,32 @@ fn a_block_on_a_belt_with_static_friction_sticks_and_slips_in_a_cycle() {
     }
 }
 
+/// A block dropped onto the moving belt (`e = 0.5`, from 0.2 m): each impact's friction
+/// drags it towards the belt's speed, which can give it kinetic energy; what the impact
+/// itself may not add is more than the belt's work `Λ_T v_s` (`v_s = −v_b` along the
+/// floor's tangent `(−1, 0)`), and the run goes on through its bounces to rest on the belt.
+#[test]
+fn a_block_dropped_on_a_belt_gains_no_more_than_the_belts_work() {
+    use eomgen::analysis::Method;
+    let run = fixture_run(
+        "contacts_belt",
+        Method::Dop853,
+        (1e-10, 2.0),
+        &[("e", 0.5)],
+        Some(vec![0.0, 0.2, 0.0, 0.0]),
+    );
+    assert!(run.contact_stop.is_none(), "{:?}", run.contact_stop);
+    let impacts: Vec<_> = (run.transitions.iter())
+        .filter(|tr| tr.normal_impulse > 0.0)
+        .collect();
+    assert!(impacts.len() > 5, "{impacts:?}");
+    assert!(impacts.iter().any(|tr| tr.energy_lost < 0.0), "{impacts:?}");
+    for tr in &impacts {
+        let belt = tr.tangential_impulse * -0.5;
+        assert!(-tr.energy_lost <= belt + 1e-12, "{tr:?}");
+    }
+}
+
 /// A surface may move along itself (a belt), not across: a table shaken up and down is
 /// refused where it is written, naming the contact, since Newton's law on a moving surface
 /// needs the surface's speed in the impact law.

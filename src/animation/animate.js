@@ -76,14 +76,14 @@
     frame.setAttribute('data-frame', String(j));
     if (clip.e) {
       energy.textContent = 'E = ' + clip.e[j].toPrecision(9) + ' J';
-      drift.textContent = '(E − E₀) / max(T + |V|) = ' + clip.de[j].toExponential(2);
+      drift.textContent = (clip.ev ? '(E + lost − E₀)' : '(E − E₀)') + ' / max(T + |V|) = ' + clip.de[j].toExponential(2);
     } else {
       energy.textContent = '';
       drift.textContent = '';
     }
-    // The latest transition at or before this frame, and how many there have been.
+    // The latest transition this frame shows the state after, and how many there have been.
     var seen = 0, ev = clip.ev || [];
-    while (seen < ev.length && ev[seen][0] <= t) { seen++; }
+    while (seen < ev.length && ev[seen][2] <= j) { seen++; }
     event.textContent = seen > 0
       ? 'transition ' + seen + ' / ' + ev.length + ' at t = ' + Number(ev[seen - 1][0]).toFixed(4) + ' s: ' + ev[seen - 1][1]
       : (ev.length > 0 ? ev.length + ' transitions ahead' : '');

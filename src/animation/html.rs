@@ -191,15 +191,12 @@ const DATA = {data};
                 );
             }
             if !clip.transitions.is_empty() {
-                // The contacts' transitions, `[t, text]` (names are identifiers, the text
-                // is escaped as JSON all the same).
-                let events: Vec<(String, String)> = (clip.transitions.iter())
-                    .map(|(t, text)| (p(*t), text.clone()))
-                    .collect();
-                let list: Vec<String> = (events.iter())
-                    .map(|(t, text)| {
+                // The contacts' transitions, `[t, text, first frame after it]` (names are
+                // identifiers, the text is escaped as JSON all the same).
+                let list: Vec<String> = (clip.transitions.iter())
+                    .map(|(t, text, frame)| {
                         let text = serde_json::to_string(text).unwrap_or_default();
-                        format!("[{t},{text}]")
+                        format!("[{},{text},{frame}]", p(*t))
                     })
                     .collect();
                 let _ = write!(data, ",\n\"ev\":[{}]", list.join(","));

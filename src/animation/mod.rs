@@ -374,8 +374,8 @@ pub struct Clip {
     /// The period of a mode's cycle (s; the clip loops over one cycle).
     period: Option<f64>,
     /// A simulation's transitions at its contacts (impacts, lift-offs, stick and slip), in
-    /// time order: `(t, what happened)`.
-    transitions: Vec<(f64, String)>,
+    /// time order: `(t, what happened, the first frame after it)`.
+    transitions: Vec<(f64, String, usize)>,
 }
 
 impl Clip {
@@ -418,10 +418,11 @@ impl Clip {
         self.energy.as_ref().map(|e| e.energy.as_slice())
     }
 
-    /// A simulation's transitions at its contacts, in time order: `(t, text)` with `t` in s
-    /// and the text as the page shows it ("impact at `floor`, 0.2472 J lost"); empty for a
-    /// model without contacts and for a mode.
-    pub fn transitions(&self) -> &[(f64, String)] {
+    /// A simulation's transitions at its contacts, in time order: `(t, text, frame)` with
+    /// `t` in s, the text as the page shows it ("impact at `floor`, 0.2472 J lost") and the
+    /// first frame that shows the state after it (a frame at the transition's own time shows
+    /// the state before it); empty for a model without contacts and for a mode.
+    pub fn transitions(&self) -> &[(f64, String, usize)] {
         &self.transitions
     }
 }
@@ -571,7 +572,7 @@ pub fn simulation_animation(
         step_control(&simulation.options)
     );
     let conserved = if !simulation.transitions.is_empty() {
-        " (of E plus the energy lost at impacts)"
+        " (of E plus the energy lost at impacts; friction's work while sliding is not added)"
     } else if model.description().conservative {
         ""
     } else {
@@ -605,10 +606,11 @@ pub fn simulation_animation(
         energy: Some(Energy { energy, drift }),
         rate: 1.0,
         period: None,
-        transitions: simulation
-            .transitions
-            .iter()
-            .map(describe_transition)
+        transitions: (simulation.transitions.iter())
+            .map(|tr| {
+                let (t, text) = describe_transition(tr);
+                (t, text, frame_samples.partition_point(|&j| j < tr.sample))
+            })
             .collect(),
     };
     Ok(Some(Animation {

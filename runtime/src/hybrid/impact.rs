@@ -104,9 +104,11 @@ pub enum ImpactMode {
     /// The slip stops during the compression where sticking also fixes the normal velocity
     /// (the contact's normal row depends on its tangent row through the constraints that
     /// hold: a bob on a rod, one freedom), and the cone holds it: friction locks the contact
-    /// (the friction angle exceeds the angle between the motion and the normal, `μ ≥ tan θ`),
-    /// no pushing impulse can open it, and the impact ends there, closed and sticking. The
-    /// restitution Newton's law asks for is lost: `G_N q̇⁺ = 0`, not `−e G_N q̇⁻`.
+    /// (the impulse that sticks it lies along the rod, at `θ` from the normal, inside the
+    /// cone for `μ ≥ tan θ`), no pushing impulse can open it, and the impact ends there,
+    /// closed and sticking. The restitution Newton's law asks for is lost: `G_N q̇⁺ = 0`, not
+    /// `−e G_N q̇⁻`. (With `e = 0` the compression's end is the impact's end anyway, and the
+    /// impact is listed by how it slid or stuck on the way.)
     Jammed,
 }
 
@@ -193,7 +195,8 @@ pub enum ImpactError {
         /// The phase.
         mode: ImpactMode,
     },
-    /// The impact would add kinetic energy (kinematic restitution with friction can).
+    /// The impact would add kinetic energy beyond the work of the moving surfaces and
+    /// constraints (kinematic restitution with friction can).
     #[error("the impact would gain kinetic energy: {before} J → {after} J")]
     EnergyGain {
         /// `T⁻` (J).
@@ -279,7 +282,16 @@ pub fn impact(
         kinetic_energy(mass_matrix, qdot),
         kinetic_energy(mass_matrix, &after),
     ];
-    if kinetic_energy[1] > kinetic_energy[0] * (1.0 + ROUNDING) {
+    // The work the moving parts do: a belt's (`Λ_T v_s`) and the held rows' that move
+    // (`Λ_A · A q̇`, which the impact keeps); the rest of `T⁺ − T⁻` is the impact's own, never
+    // a gain (`½ Λ·(v⁻ + v⁺)` on the contact's own slip and normal speed).
+    let supplied = match &contact.friction {
+        Some(f) => q * f.surface_velocity,
+        None => 0.0,
+    } + (held.iter().zip(&held_impulses))
+        .map(|(row, impulse)| impulse * dot(row, qdot))
+        .sum::<f64>();
+    if kinetic_energy[1] - supplied > kinetic_energy[0] * (1.0 + ROUNDING) {
         return Err(ImpactError::EnergyGain {
             before: kinetic_energy[0],
             after: kinetic_energy[1],

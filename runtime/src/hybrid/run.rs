@@ -357,6 +357,10 @@ impl Run<'_> {
     ) -> Result<(), ContactStop> {
         let n = model.num_dofs();
         let mut released = Vec::new();
+        let mut y = y;
+        if !self.closed[c] {
+            held_velocities(model, t, &mut y);
+        }
         let transition = if self.closed[c] {
             let kind = self.switch(model, c, (t, &y));
             if kind == TransitionKind::LiftOff {
@@ -830,6 +834,37 @@ fn strike_contact(
         transition.kind = TransitionKind::Impact;
     }
     Ok(transition)
+}
+
+/// The speeds of `y` projected onto the model's own velocity constraints (`J q̇ + Φ_t = 0`
+/// and `A q̇ + b = 0`) as an impulse would move them, `q̇ ← q̇ − M⁻¹Jᵀ (J M⁻¹Jᵀ)⁻¹ (J q̇ + Φ_t)`:
+/// the state an impact starts from is the dense output's, off the constraints by the
+/// integration's drift, and the rows held through the impact keep what they had (a
+/// pendulum bob's rod its drift, which would decide whether friction locks it). Left as it
+/// is where the projection is singular.
+fn held_velocities(model: &mut dyn ModelInfo, t: f64, y: &mut [f64]) {
+    let n = model.num_dofs();
+    let constraints = model.constraint_equations(t, y);
+    if constraints.jacobian.nrows() == 0 {
+        return;
+    }
+    let (mass, _) = model.mass_matrix_and_forcing(t, y);
+    let Some(lu) = Some(mass.lu()).filter(|lu| lu.is_invertible()) else {
+        return;
+    };
+    let Some(w) = lu.solve(&constraints.jacobian.transpose()) else {
+        return;
+    };
+    let schur = &constraints.jacobian * &w;
+    let Some(impulses) = schur.lu().solve(&constraints.velocity) else {
+        return;
+    };
+    let correction = w * impulses;
+    if correction.iter().all(|v| v.is_finite()) {
+        for (v, d) in y[n..2 * n].iter_mut().zip(correction.iter()) {
+            *v -= d;
+        }
+    }
 }
 
 /// The impact law at contact `c` with the model's constraints and the closed contacts held

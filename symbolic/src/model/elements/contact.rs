@@ -712,6 +712,9 @@ impl Contact {
                 (gap, Some((p, d)))
             }
         };
+        if self.friction.is_some() {
+            self.surface_fixed_in_the_coordinates(cx);
+        }
         let restitution = cx.expr(&self.restitution);
         let friction = match &self.friction {
             Some(mu) => cx.expr(mu),
@@ -776,6 +779,33 @@ impl Contact {
             friction,
             static_friction,
         })
+    }
+
+    /// A contact with friction slips against its surface as the ground frame sees it (or as a
+    /// belt's `t` moves it): a surface carried by the coordinates (a floor on a cart) would
+    /// need the slip relative to it, which is not there yet, and is reported.
+    fn surface_fixed_in_the_coordinates(&self, cx: &mut dyn Lower) {
+        let parts: Vec<&Located<Vec<Expr>>> = match &self.gap {
+            Gap::Written(_) => Vec::new(),
+            Gap::Above {
+                normal, through, ..
+            } => std::iter::once(normal).chain(through).collect(),
+            Gap::Circle { centre, .. } => vec![centre],
+        };
+        for part in parts {
+            let lowered: Vec<ExprId> = part.value.iter().map(|c| cx.expr(c)).collect();
+            let arena = cx.arena();
+            let coordinates: Vec<_> = arena.coordinates().iter().map(|s| s[0]).collect();
+            let moves =
+                (lowered.iter()).any(|&e| coordinates.iter().any(|&q| arena.depends_on(e, q)));
+            if moves {
+                cx.error(
+                    Diagnostic::new(part.location, format!("contact `{}` has friction on a surface that moves with the coordinates, but its slip is taken against a surface fixed in the ground frame", self.name.value))
+                        .with_help("write the surface fixed (or moving along itself with `t`, as a belt), or leave `friction` out; a floor carried by a body needs the slip relative to it, which is not there yet"),
+                );
+                return;
+            }
+        }
     }
 
     /// The speed `v_s = t̂ · Ȯ` along the line of its point `O` (`through`), `t̂` the normal

@@ -8,7 +8,9 @@
 //! With `d = r_A − r_B`, the spring stores `V = ½ k (|d| − ℓ₀)²` (`½ k |d|²` without a rest
 //! length), which Lagrange's equations take from the potential; momentum balance takes its
 //! two forces instead, `F_A = k (ℓ₀/|d| − 1) d` (`−k d`) and `F_B = −F_A`. Both come from
-//! this module, so the two derivations cannot disagree about what a spring is.
+//! this module. They are the same spring where `k` and `ℓ₀` are constant; a stiffness that
+//! depends on the configuration makes `V`'s gradient differ from that force law, and
+//! `eomgen check` reports the two derivations apart.
 
 use super::{Lower, Rules, Units, between, dot};
 use crate::expr::{Constant, ExprArena, ExprId};
