@@ -458,7 +458,7 @@ fn a_surface_moving_across_itself_is_refused_where_it_is_written() {
     assert_eq!((d.location.line, d.location.column), (8, 56));
     assert!(
         d.message
-            .contains("contact `table`'s surface moves across itself with `t`"),
+            .contains("contact `table`'s surface moves with `t` other than along itself"),
         "{}",
         d.message
     );

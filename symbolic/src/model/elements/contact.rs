@@ -828,7 +828,7 @@ impl Contact {
         let across = arena.diff(gap, t);
         if !arena.is_zero(across) || o.len() != 2 {
             cx.error(
-                Diagnostic::new(through.location, format!("contact `{}`'s surface moves across itself with `t`, but impacts on a moving surface are not simulated yet", self.name.value))
+                Diagnostic::new(through.location, format!("contact `{}`'s surface moves with `t` other than along itself in the plane, but impacts on a moving surface are not simulated yet", self.name.value))
                     .with_help("a line may move along itself, as a belt does (`through: [v*t, 0]` on `normal: [0, 1]`), in the plane; a surface moving across itself (a shaken table) needs its own speed in the impact law"),
             );
             return None;
