@@ -416,6 +416,48 @@ fn a_block_on_a_belt_with_static_friction_sticks_and_slips_in_a_cycle() {
     }
 }
 
+/// HW36's eccentric cylinder (`models/eccentric_cylinder_skipping.yaml`) lifts off five times
+/// in 8 s with `μ = 0.8`; with `μ = 2` it lands, rolls, and where its force leaves the cone
+/// after the first landing the slide it would start has no bounded normal force (Painlevé):
+/// the run stops there with that reason (it ended in a step size too small, its energy
+/// rising 10⁹-fold, before), keeping the samples before it.
+#[test]
+fn the_skipping_cylinder_skips_or_stops_on_painleves_paradox() {
+    use eomgen::analysis::Method;
+    use eomgen::hybrid::{ContactStop, TransitionKind};
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/models/eccentric_cylinder_skipping.yaml"
+    );
+    let run = |mu: f64| {
+        let mut model = eomgen::DynFirstOrder::new(JitModel::load(path).unwrap());
+        eomgen::ModelInfo::set_parameter(&mut model, "mu", mu).unwrap();
+        let options = eomgen::analysis::SimulationOptions {
+            method: Method::Dp54,
+            t_end: 8.0,
+            ..Default::default()
+        };
+        eomgen::analysis::simulate(&mut model, &options).unwrap()
+    };
+    let skipping = run(0.8);
+    assert!(
+        skipping.contact_stop.is_none(),
+        "{:?}",
+        skipping.contact_stop
+    );
+    let lift_offs = (skipping.transitions.iter())
+        .filter(|tr| tr.kind == TransitionKind::LiftOff)
+        .count();
+    assert_eq!(lift_offs, 5, "{:?}", skipping.transitions);
+    let stopped = run(2.0);
+    let Some(ContactStop::SlidingPainleve { contact, t }) = &stopped.contact_stop else {
+        panic!("{:?}", stopped.contact_stop);
+    };
+    assert_eq!(contact, "floor");
+    assert!(*t > 3.5 && *t < 4.5, "{t}");
+    assert_eq!(stopped.solution.t.last(), Some(t));
+}
+
 /// A block dropped onto the moving belt (`e = 0.5`, from 0.2 m): each impact's friction
 /// drags it towards the belt's speed, which can give it kinetic energy; what the impact
 /// itself may not add is more than the belt's work `Λ_T v_s` (`v_s = −v_b` along the

@@ -156,6 +156,57 @@ impl<'m> ContactPhase<'m> {
         Ok((accelerations, forces))
     }
 
+    /// For the sliding contact `c` at `(t, y)`, how its normal acceleration answers its own
+    /// normal force while it slides, relative to how it would without friction:
+    /// `b = G W (G − μ s T)ᵀ / G W Gᵀ`, `W` the inverse mass through the other rows held.
+    /// At `b ≤ 0` sliding has no consistent normal force (it grows without bound as `b → 0`):
+    /// Painlevé's paradox (Génot & Brogliato 1999). `None` where `W` is singular.
+    pub(crate) fn sliding_response(&self, c: usize, t: f64, y: &[f64]) -> Option<f64> {
+        let Hold::Slide(s) = self.hold_of(c) else {
+            return None;
+        };
+        let n = self.model.num_dofs();
+        let (mass, _) = self.model.mass_matrix_and_forcing(t, y);
+        let own = self.model.constraint_equations(t, y);
+        let contacts = self.model.contact_values(t, y);
+        let own_rows: Vec<Vec<f64>> = (0..own.jacobian.nrows())
+            .map(|i| (0..n).map(|j| own.jacobian[(i, j)]).collect())
+            .collect();
+        let mut held: Vec<&[f64]> = own_rows.iter().map(Vec::as_slice).collect();
+        for (k, tangential) in self.rows() {
+            if k == c {
+                continue;
+            }
+            let rows = if tangential {
+                &contacts.tangent
+            } else {
+                &contacts.normal
+            };
+            held.push(&rows[k * n..(k + 1) * n]);
+        }
+        let m = held.len();
+        let mut matrix = DMatrix::<f64>::zeros(n + m, n + m);
+        matrix.view_mut((0, 0), (n, n)).copy_from(&mass);
+        for (i, row) in held.iter().enumerate() {
+            for j in 0..n {
+                matrix[(n + i, j)] = row[j];
+                matrix[(j, n + i)] = row[j];
+            }
+        }
+        let normal = &contacts.normal[c * n..(c + 1) * n];
+        let tangent = &contacts.tangent[c * n..(c + 1) * n];
+        let mu_s = contacts.friction[c] * s;
+        let rhs = DMatrix::from_fn(n + m, 2, |i, col| match (i < n, col) {
+            (true, 0) => normal[i],
+            (true, _) => normal[i] - mu_s * tangent[i],
+            _ => 0.0,
+        });
+        let w = matrix.lu().solve(&rhs)?;
+        let along = |col: usize| (0..n).map(|j| normal[j] * w[(j, col)]).sum::<f64>();
+        let frictionless = along(0);
+        (frictionless > 0.0).then(|| along(1) / frictionless)
+    }
+
     /// How the closed contact `c` is held.
     fn hold_of(&self, c: usize) -> Hold {
         (self.closed.iter().position(|&k| k == c)).map_or(Hold::Normal, |i| self.holds[i])

@@ -40,6 +40,13 @@ use crate::ode::{EventDirection, EventSpec, RhsError, WithEvents};
 /// accumulation time.
 pub const ACCUMULATION_RATIO: f64 = 1e-6;
 
+/// The response of a sliding contact's normal acceleration to its own normal force, relative
+/// to the frictionless one, `G W (G − μ s T)ᵀ / G W Gᵀ`, below which the run stops
+/// ([`ContactStop::SlidingPainleve`]): where it reaches 0 the normal force needed is
+/// unbounded. Its event is located to the tolerance; this is the margin for deciding that
+/// it, not the normal force or the slip, reached 0.
+pub const PAINLEVE_RESPONSE: f64 = 1e-6;
+
 /// The most impacts one run takes before it stops ([`ContactStop::TooManyImpacts`]).
 pub const MAX_IMPACTS: usize = 100_000;
 
@@ -121,6 +128,19 @@ pub enum ContactStop {
         "contact `{contact}` at t = {t} can be neither open (the motion would move into it) nor closed (its force would pull): no consistent contact mode (Painlevé's paradox with friction), so the run stops here"
     )]
     NoConsistentMode {
+        /// The contact.
+        contact: String,
+        /// Time (s).
+        t: f64,
+    },
+    /// A sliding contact's normal force would grow without bound: its normal acceleration no
+    /// longer answers its own normal force with friction against the slip
+    /// ([`PAINLEVE_RESPONSE`]; Painlevé's paradox while sliding, where the motion goes on
+    /// only through an impulse, an impact without collision, which is not there).
+    #[error(
+        "contact `{contact}` at t = {t} would slide where sliding has no bounded normal force (Painlevé's paradox: with friction against the slip, the normal acceleration no longer answers the normal force); the motion goes on only through an impulsive force, which is not simulated, so the run stops here"
+    )]
+    SlidingPainleve {
         /// The contact.
         contact: String,
         /// Time (s).
@@ -362,7 +382,7 @@ impl Run<'_> {
             held_velocities(model, t, &mut y);
         }
         let transition = if self.closed[c] {
-            let kind = self.switch(model, c, (t, &y));
+            let kind = self.switch(model, c, (t, &y))?;
             if kind == TransitionKind::LiftOff {
                 self.closed[c] = false;
                 self.holds[c] = Hold::Normal;
@@ -415,9 +435,20 @@ impl Run<'_> {
         model: &mut dyn ModelInfo,
         c: usize,
         (t, y): (f64, &[f64]),
-    ) -> TransitionKind {
+    ) -> Result<TransitionKind, ContactStop> {
         let closed: Vec<usize> = (0..self.closed.len()).filter(|&k| self.closed[k]).collect();
         let at = closed.iter().position(|&k| k == c).unwrap_or_default();
+        if matches!(self.holds[c], Hold::Slide(_)) {
+            let holds: Vec<Hold> = closed.iter().map(|&k| self.holds[k]).collect();
+            let response =
+                ContactPhase::new(model, closed.clone(), holds).sliding_response(c, t, y);
+            if response.is_some_and(|b| b <= PAINLEVE_RESPONSE) {
+                return Err(ContactStop::SlidingPainleve {
+                    contact: self.contacts[c].clone(),
+                    t,
+                });
+            }
+        }
         let values = model.contact_values(t, y);
         let n = model.num_dofs();
         // The sticking cone's coefficient, `μ_s`.
@@ -452,7 +483,7 @@ impl Run<'_> {
                 })
             }
         };
-        match next {
+        Ok(match next {
             None => TransitionKind::LiftOff,
             Some(hold) => {
                 self.holds[c] = hold;
@@ -462,7 +493,7 @@ impl Run<'_> {
                     TransitionKind::Slip
                 }
             }
-        }
+        })
     }
 
     /// The closed contacts' holds decided afresh where a phase starts, at `(t, y)`: a
@@ -635,6 +666,20 @@ impl Run<'_> {
         }
         self.close_touching(model, sample, released)?;
         self.redecide(model, sample);
+        // A slide that starts where its normal force is already unbounded (its event would
+        // start below 0 and never be seen to cross) stops the run here.
+        let closed: Vec<usize> = (0..self.closed.len()).filter(|&k| self.closed[k]).collect();
+        let holds: Vec<Hold> = closed.iter().map(|&k| self.holds[k]).collect();
+        let phase = ContactPhase::new(model, closed.clone(), holds);
+        for &c in &closed {
+            if (phase.sliding_response(c, self.t, &self.y)).is_some_and(|b| b <= PAINLEVE_RESPONSE)
+            {
+                return Err(ContactStop::SlidingPainleve {
+                    contact: self.contacts[c].clone(),
+                    t: self.t,
+                });
+            }
+        }
         let values = model.contact_values(self.t, &self.y);
         self.starting = (0..self.contacts.len())
             .filter(|&k| !self.closed[k] && values.gaps[k].abs() <= self.atol)
@@ -741,7 +786,8 @@ fn contact_events(
                 Hold::Stick => normal.min(friction[c] * normal - tangential.abs()),
                 Hold::Slide(s) => {
                     let slip = (sliding.as_ref()).map_or(0.0, |v| v.slip(c, &y[n..2 * n]));
-                    normal.min(s * slip)
+                    let response = phase.sliding_response(c, t, y).unwrap_or(1.0);
+                    normal.min(s * slip).min(response)
                 }
             };
         }
