@@ -26,11 +26,11 @@ use serde::Serialize;
 use super::impact::{
     ContactFriction, ImpactContact, ImpactError, ImpactMode, ImpactReport, impact,
 };
-use super::phase::{ContactPhase, Hold};
+use super::phase::{ContactPhase, Hold, closing_hold, contact_events, touching};
 use crate::IntegrationFailure;
 use crate::integrate::{Integrator, IntegratorOptions, OutputTimes, Solution, Tolerance};
 use crate::model_info::{AddedEvents, ContactValues, ModelInfo};
-use crate::ode::{EventDirection, EventSpec, RhsError, WithEvents};
+use crate::ode::{EventDirection, EventSpec, WithEvents};
 
 /// A contact's striking speed below this fraction of the largest that contact has struck
 /// with since it last opened from a contact phase (or since the start; or exactly 0 after an
@@ -687,112 +687,6 @@ impl Run<'_> {
             .collect();
         Ok(())
     }
-}
-
-/// Which contacts start closed, and how: touching (`|g| ≤ atol`), with a normal speed within
-/// `atol` of 0 (in m/s), and with a normal force that pushes when they are held (all
-/// touching contacts held together; none if that is singular). A contact with friction
-/// sticks if it does not slip (`|v_t| ≤ atol`), else slides. A ball at rest on its floor
-/// starts closed; one that touches it while moving along it too.
-fn touching(model: &mut dyn ModelInfo, (t, y): (f64, &[f64]), atol: f64) -> (Vec<bool>, Vec<Hold>) {
-    let values = model.contact_values(t, y);
-    let m = values.gaps.len();
-    let candidates: Vec<usize> = (0..m)
-        .filter(|&c| values.gaps[c].abs() <= atol && values.rates[c].abs() <= atol)
-        .collect();
-    let (mut closed, mut holds) = (vec![false; m], vec![Hold::Normal; m]);
-    if candidates.is_empty() {
-        return (closed, holds);
-    }
-    let wanted: Vec<Hold> = (candidates.iter())
-        .map(|&c| closing_hold(model, c, (t, &y[y.len() / 2..]), atol, y))
-        .collect();
-    let phase = ContactPhase::new(model, candidates.clone(), wanted.clone());
-    if let Ok((_, forces)) = phase.solve(t, y) {
-        for ((&c, (normal, _)), hold) in candidates.iter().zip(forces).zip(wanted) {
-            closed[c] = normal > 0.0;
-            if closed[c] {
-                holds[c] = hold;
-            }
-        }
-    }
-    (closed, holds)
-}
-
-/// How contact `c` is held when it closes at `(t, y)` with speeds `qdot`: frictionless, or
-/// with friction sticking where its slip is within `atol` of 0, else sliding with its slip's
-/// sign.
-fn closing_hold(
-    model: &mut dyn ModelInfo,
-    c: usize,
-    (t, qdot): (f64, &[f64]),
-    atol: f64,
-    y: &[f64],
-) -> Hold {
-    let values = model.contact_values(t, y);
-    if values.friction[c] <= 0.0 {
-        return Hold::Normal;
-    }
-    let slip = values.slip(c, qdot);
-    if slip.abs() <= atol {
-        Hold::Stick
-    } else {
-        Hold::Slide(slip.signum())
-    }
-}
-
-/// The contacts' event functions at `(t, y)` into `events` (one per contact): an open
-/// contact's gap, a closed one's normal force `λ_N` (it opens where `λ_N` falls through 0),
-/// a sticking one's `min(λ_N, μ λ_N − |λ_T|)` (it opens, or starts to slip, where that falls
-/// through 0), a sliding one's `min(λ_N, s v_t)` (it opens, or its slip stops); `friction`
-/// holds each contact's `μ`.
-///
-/// An open contact at a zero at the phase's start `(t*, g*)` (`starting`: struck, released
-/// or touching there) gives `(g − g*)/(t − t*)` instead (its rate `ġ` at `t*`): it leaves
-/// from a gap of 0 (to rounding, of either sign), so its gap would start at a zero that the
-/// sign test between two steps cannot see past, and a short flight that rises and lands
-/// within one step would be missed. The quotient starts at `ġ⁺ ≥ 0` and turns negative
-/// where the gap returns to `g*` (within rounding of 0). `values` is scratch of `5 m_c`
-/// entries.
-///
-/// # Errors
-/// As [`ContactPhase::solve`], with a contact closed.
-fn contact_events(
-    phase: &mut ContactPhase<'_>,
-    (t, y): (f64, &[f64]),
-    (starting, friction): (&[(usize, f64, f64)], &[f64]),
-    values: &mut [f64],
-    events: &mut [f64],
-) -> Result<(), RhsError> {
-    phase.model.contact_gaps(t, y, values);
-    let m = events.len();
-    events.copy_from_slice(&values[..m]);
-    for &(c, start, gap) in starting {
-        events[c] = if t > start {
-            (values[c] - gap) / (t - start)
-        } else {
-            values[m + c]
-        };
-    }
-    if !phase.closed.is_empty() {
-        let (_, forces) = phase.solve(t, y)?;
-        let slides = phase.holds.iter().any(|h| matches!(h, Hold::Slide(_)));
-        let sliding = slides.then(|| phase.model.contact_values(t, y));
-        let n = y.len() / 2;
-        for ((&c, (normal, tangential)), &hold) in phase.closed.iter().zip(forces).zip(&phase.holds)
-        {
-            events[c] = match hold {
-                Hold::Normal => normal,
-                Hold::Stick => normal.min(friction[c] * normal - tangential.abs()),
-                Hold::Slide(s) => {
-                    let slip = (sliding.as_ref()).map_or(0.0, |v| v.slip(c, &y[n..2 * n]));
-                    let response = phase.sliding_response(c, t, y).unwrap_or(1.0);
-                    normal.min(s * slip).min(response)
-                }
-            };
-        }
-    }
-    Ok(())
 }
 
 /// The impact of contact `c` at `(t, y)`, the closed contacts (`closed`) and the model's
