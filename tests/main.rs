@@ -15,6 +15,7 @@ mod events;
 mod expm_rayleigh;
 mod floquet;
 mod frf;
+mod friction;
 mod integrators_models;
 mod interactions;
 mod json_schemas;
