@@ -195,7 +195,7 @@ const DATA = {data};
                 // identifiers, the text is escaped as JSON all the same).
                 let list: Vec<String> = (clip.transitions.iter())
                     .map(|(t, text, frame)| {
-                        let text = serde_json::to_string(text).unwrap_or_default();
+                        let text = serde_json::Value::String(text.clone()).to_string();
                         format!("[{},{text},{frame}]", p(*t))
                     })
                     .collect();

@@ -146,6 +146,18 @@ pub enum ContactStop {
         /// Time (s).
         t: f64,
     },
+    /// The equations of the contact phase that a switch at this contact must decide from
+    /// have no finite solution (held rows that contradict each other, or a mass matrix
+    /// singular on the motions they allow).
+    #[error(
+        "the contact phase at contact `{contact}` at t = {t} has no finite solution (the rows held contradict each other, or the mass matrix is singular on the motions they allow), so the run stops here"
+    )]
+    Unsolved {
+        /// The contact.
+        contact: String,
+        /// Time (s).
+        t: f64,
+    },
     /// A contact is closed and the method integrates only free phases (the Taylor method,
     /// whose recurrences have no constraint rows).
     #[error(
@@ -455,13 +467,19 @@ impl Run<'_> {
         let mu = values.static_friction[c];
         let slip = values.slip(c, &y[n..2 * n]);
         let mut holds: Vec<Hold> = closed.iter().map(|&k| self.holds[k]).collect();
+        // A phase that cannot be solved here (its forces not finite) decides nothing: the
+        // run stops, rather than read a failed solve as a lift-off or a stick.
+        let unsolved = || ContactStop::Unsolved {
+            contact: self.contacts[c].clone(),
+            t,
+        };
         let forces = |model: &mut dyn ModelInfo, holds: &[Hold]| {
             ContactPhase::new(model, closed.clone(), holds.to_vec())
                 .solve(t, y)
                 .map(|(_, forces)| forces[at])
-                .unwrap_or((0.0, 0.0))
+                .map_err(|_| unsolved())
         };
-        let (normal, tangential) = forces(model, &holds);
+        let (normal, tangential) = forces(model, &holds)?;
         // Its normal force reached 0 first (or pulls): it lifts off, whatever its friction.
         let lifts = normal <= 0.0
             || (self.holds[c] == Hold::Stick && normal <= mu * normal - tangential.abs());
@@ -475,7 +493,7 @@ impl Run<'_> {
             Hold::Slide(s) if normal <= s * slip => None,
             Hold::Slide(_) => {
                 holds[at] = Hold::Stick;
-                let (normal, tangential) = forces(model, &holds);
+                let (normal, tangential) = forces(model, &holds)?;
                 Some(if mu * normal - tangential.abs() >= 0.0 {
                     Hold::Stick
                 } else {
