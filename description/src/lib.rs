@@ -93,6 +93,12 @@ pub struct ModelDescription {
     /// of the serialized description.
     #[serde(skip_serializing_if = "<[Text]>::is_empty")]
     pub contacts: List<Text>,
+    /// The contacts of [`Self::contacts`] that change the support where they strike (a
+    /// walker's foot landing: `support:`), in contact order; their values are the model's
+    /// `support_changes`. Empty for most models, and then left out of the serialized
+    /// description.
+    #[serde(skip_serializing_if = "<[Text]>::is_empty")]
+    pub supports: List<Text>,
     /// Whether an event function reads the accelerations `q̈` or the constraint forces `λ`
     /// (the first-order form then solves for them before evaluating the events).
     pub events_need_accelerations: bool,
@@ -145,6 +151,7 @@ impl ModelDescription {
         ignorable_coordinates: Cow::Borrowed(&[]),
         events: Cow::Borrowed(&[]),
         contacts: Cow::Borrowed(&[]),
+        supports: Cow::Borrowed(&[]),
         events_need_accelerations: false,
         conservative: false,
         derivation: Cow::Borrowed(""),

@@ -79,7 +79,7 @@ pub struct LoadOptions {
     pub eager_taylor: bool,
 }
 
-/// The functions of a model: the first fourteen in the order of [`ModelProgram::functions`],
+/// The functions of a model: the first fifteen in the order of [`ModelProgram::functions`],
 /// then the Jacobians in the order of
 /// [`JacobianProgram::functions`](eomgen_symbolic::codegen::program::JacobianProgram::functions).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -98,9 +98,10 @@ enum Routine {
     ContactGaps = 11,
     ContactJacobian = 12,
     ContactCoefficients = 13,
-    ForcingJacobianQ = 14,
-    ForcingJacobianQdot = 15,
-    MassMatrixProductJacobian = 16,
+    SupportChanges = 14,
+    ForcingJacobianQ = 15,
+    ForcingJacobianQdot = 16,
+    MassMatrixProductJacobian = 17,
 }
 
 /// Index of the first Jacobian routine.
@@ -685,6 +686,14 @@ impl DynMechanicalSystem for JitModel {
         self.run(
             Routine::ContactCoefficients,
             self.inputs(&[], &[], 0.0),
+            out,
+            &mut [],
+        );
+    }
+    fn support_changes(&self, q: &[f64], t: f64, out: &mut [f64]) {
+        self.run(
+            Routine::SupportChanges,
+            self.inputs(q, &[], t),
             out,
             &mut [],
         );

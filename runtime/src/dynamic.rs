@@ -116,6 +116,10 @@ pub trait DynMechanicalSystem {
     fn contact_coefficients(&self, out: &mut [f64]) {
         let _ = out;
     }
+    /// [`MechanicalSystem::support_changes`] into `out`.
+    fn support_changes(&self, q: &[f64], t: f64, out: &mut [f64]) {
+        let _ = (q, t, out);
+    }
     /// The event functions `gᵢ(q, q̇, q̈, λ, t)` into `out` (one per event); `lambda` may be
     /// shorter than `m` (a function that reads a missing multiplier gets NaN).
     fn event_values(
@@ -261,6 +265,9 @@ impl<S: MechanicalSystem<N>, const N: usize> DynMechanicalSystem for StaticSyste
     }
     fn contact_coefficients(&self, out: &mut [f64]) {
         self.0.contact_coefficients(out);
+    }
+    fn support_changes(&self, q: &[f64], t: f64, out: &mut [f64]) {
+        self.0.support_changes(&vector::<N>(q), t, out);
     }
     fn event_values(
         &self,

@@ -14,6 +14,7 @@
 pub mod impact;
 mod phase;
 pub mod run;
+pub mod support;
 
 pub use impact::{ImpactContact, ImpactError, ImpactMode, ImpactReport, impact};
 pub use run::{ContactStop, HybridRecord, Transition, TransitionKind, integrate_through_impacts};

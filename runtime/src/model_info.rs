@@ -117,6 +117,10 @@ pub trait ModelInfo: OdeSystem {
     /// The contacts' gaps `g`, their rates `ġ`, `γ`, `γ_T` and the surfaces' speeds `v_s` at
     /// `(t, y)` into `out` (`5 m_c` entries): [`crate::MechanicalSystem::contact_gaps`] alone.
     fn contact_gaps(&self, t: f64, y: &[f64], out: &mut [f64]);
+    /// The changes of support's values at `(t, q)` into `out`
+    /// ([`crate::MechanicalSystem::support_changes`]; read them with
+    /// [`crate::hybrid::support::SupportValues::of`]).
+    fn support_changes(&self, t: f64, q: &[f64], out: &mut [f64]);
     /// Makes `y = [q; q̇]` (at `t = 0`) consistent with the constraints (issue 5, item 3): the
     /// coordinates marked `{ guess: … }` and their rates are solved by Newton from
     /// `Φ(q, 0) = 0` and the velocity constraints, the others held. Without guesses, `y` must
@@ -422,6 +426,9 @@ impl<F: FirstOrderForm> ModelInfo for F {
         let system = self.dyn_system();
         let n = system.num_dofs();
         system.contact_gaps(&y[..n], &y[n..2 * n], t, out);
+    }
+    fn support_changes(&self, t: f64, q: &[f64], out: &mut [f64]) {
+        self.dyn_system().support_changes(q, t, out);
     }
     fn contact_values(&self, t: f64, y: &[f64]) -> ContactValues {
         let system = self.dyn_system();

@@ -559,7 +559,7 @@ pub fn simulation_animation(
             *d += l / energy_drift.scale;
         }
     }
-    let losses = (simulation.transitions.iter()).map(|tr| (tr.sample, tr.energy_lost));
+    let losses = (simulation.transitions.iter()).map(|tr| (tr.sample, tr.energy_drop()));
     let losses: Vec<(usize, f64)> = losses
         .map(|(s, l)| (frame_samples.partition_point(|&j| j < s), l))
         .collect();
@@ -627,7 +627,7 @@ fn lost_by_frame(simulation: &Simulation, frame_samples: &[usize]) -> Vec<f64> {
     (frame_samples.iter())
         .map(|&j| {
             while let Some(tr) = transitions.next_if(|tr| tr.sample <= j) {
-                lost += tr.energy_lost;
+                lost += tr.energy_drop();
             }
             lost
         })
@@ -651,6 +651,9 @@ fn describe_transition(tr: &eomgen_runtime::hybrid::Transition) -> (f64, String)
         TransitionKind::LiftOff => format!("`{c}` lifts off"),
         TransitionKind::Stick => format!("`{c}` sticks"),
         TransitionKind::Slip => format!("`{c}` slips"),
+        TransitionKind::SupportChange => {
+            format!("`{c}` lands: a step, {} J lost", short(tr.energy_lost))
+        }
     };
     (tr.t, text)
 }

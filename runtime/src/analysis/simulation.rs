@@ -368,7 +368,7 @@ pub fn simulate_with_events(
             hybrid
                 .transitions
                 .iter()
-                .map(|tr| (tr.sample, tr.energy_lost)),
+                .map(|tr| (tr.sample, tr.energy_drop())),
         );
     }
     let constraints = constraint_drift(model, &solution);

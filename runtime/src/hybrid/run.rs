@@ -27,6 +27,7 @@ use super::impact::{
     ContactFriction, ImpactContact, ImpactError, ImpactMode, ImpactReport, impact,
 };
 use super::phase::{ContactPhase, Hold, closing_hold, contact_events, touching};
+use super::support::{SupportError, change_support};
 use crate::IntegrationFailure;
 use crate::integrate::{Integrator, IntegratorOptions, OutputTimes, Solution, Tolerance};
 use crate::model_info::{AddedEvents, ContactValues, ModelInfo};
@@ -66,6 +67,10 @@ pub enum TransitionKind {
     /// The closed contact starts to slide: its sticking force left the friction cone, or its
     /// slip stopped where the cone cannot hold it (it slides the other way).
     Slip,
+    /// A walker's foot landed and became the stance foot, the old one left the ground, and
+    /// the coordinates were relabelled about the new one ([`super::support`]): the speeds
+    /// before and after are in the old and the new coordinates.
+    SupportChange,
 }
 
 /// One transition of a run at a contact: where, what, the velocities before and after, the
@@ -90,6 +95,10 @@ pub struct Transition {
     pub tangential_impulse: f64,
     /// The kinetic energy lost (J), `≥ 0`.
     pub energy_lost: f64,
+    /// How far the potential energy's datum moved (J): `V(q⁺) − V(q⁻)` at a change of
+    /// support, whose coordinates are taken about the new stance foot; 0 at every other
+    /// transition.
+    pub datum_shift: f64,
     /// Index into the run's samples of the first sample after the transition. With every
     /// step sampled ([`OutputTimes::Steps`]) it is at the transition's time, and so is the
     /// sample before it, with the state before; with requested times
@@ -111,8 +120,16 @@ impl Transition {
             normal_impulse: 0.0,
             tangential_impulse: 0.0,
             energy_lost: 0.0,
+            datum_shift: 0.0,
             sample,
         }
+    }
+
+    /// The drop of the model's `T + V` across the transition (J): the energy lost, less the
+    /// datum's shift at a change of support. A run's energy plus these drops is conserved
+    /// where nothing else does work.
+    pub fn energy_drop(&self) -> f64 {
+        self.energy_lost - self.datum_shift
     }
 }
 
@@ -178,6 +195,17 @@ pub enum ContactStop {
         t: f64,
         /// Why.
         error: ImpactError,
+    },
+    /// A change of support has no answer that the model's assumptions allow, or another
+    /// contact is closed when it strikes.
+    #[error("the change of support at contact `{contact}` at t = {t} has no answer: {error}")]
+    Support {
+        /// The contact.
+        contact: String,
+        /// Time (s).
+        t: f64,
+        /// Why.
+        error: SupportError,
     },
     /// More than [`MAX_IMPACTS`] impacts.
     #[error("the run took {count} impacts and stops at t = {t}")]
@@ -388,6 +416,10 @@ impl Run<'_> {
         sample: usize,
     ) -> Result<(), ContactStop> {
         let n = model.num_dofs();
+        let supports = &model.description().supports;
+        if let Some(which) = supports.iter().position(|s| **s == *self.contacts[c]) {
+            return self.change_support(model, (c, which), (t, y), sample);
+        }
         let mut released = Vec::new();
         let mut y = y;
         if !self.closed[c] {
@@ -434,6 +466,53 @@ impl Run<'_> {
         self.t = t;
         self.record.transitions.push(transition);
         self.record.transitions.extend(released);
+        Ok(())
+    }
+
+    /// The change of support `which` at contact `c` at `(t, y)` ([`change_support`]); the
+    /// next phase starts after it, in the relabelled coordinates.
+    fn change_support(
+        &mut self,
+        model: &mut dyn ModelInfo,
+        (c, which): (usize, usize),
+        (t, y): (f64, Vec<f64>),
+        sample: usize,
+    ) -> Result<(), ContactStop> {
+        let n = model.num_dofs();
+        let stop = |error| ContactStop::Support {
+            contact: self.contacts[c].clone(),
+            t,
+            error,
+        };
+        if let Some(k) = self.closed.iter().position(|&closed| closed) {
+            return Err(stop(SupportError::Closed {
+                contact: self.contacts[k].clone(),
+            }));
+        }
+        let values = model.contact_values(t, &y);
+        let friction = values.friction[c];
+        let change = change_support(model, which, t, &y, friction).map_err(stop)?;
+        let after: Vec<f64> = change.q.iter().chain(&change.qdot).copied().collect();
+        let potential = |y: &[f64]| model.energy(t, y) - model.kinetic_energy(t, y);
+        self.record.transitions.push(Transition {
+            t,
+            contact: self.contacts[c].clone(),
+            kind: TransitionKind::SupportChange,
+            mode: if friction > 0.0 {
+                ImpactMode::Sticking
+            } else {
+                ImpactMode::Frictionless
+            },
+            qdot: [y[n..2 * n].to_vec(), change.qdot.clone()],
+            normal_velocity: [values.rates[c], 0.0],
+            normal_impulse: change.normal_impulse,
+            tangential_impulse: change.tangential_impulse,
+            energy_lost: change.energy_lost,
+            datum_shift: potential(&after) - potential(&y),
+            sample,
+        });
+        self.y = after;
+        self.t = t;
         Ok(())
     }
 
@@ -744,6 +823,7 @@ fn strike_contact(
         normal_impulse: 0.0,
         tangential_impulse: 0.0,
         energy_lost: 0.0,
+        datum_shift: 0.0,
         sample: 0,
     };
     // A graze (`|ġ⁻| ≤ atol`, in m/s) closes without an impulse where its force pushes.

@@ -305,7 +305,9 @@ fn print_impacts(simulation: &Simulation) {
                 TransitionKind::LiftOff => Some("lifts off (opens with no jump)"),
                 TransitionKind::Stick => Some("sticks (its slip stops inside the friction cone)"),
                 TransitionKind::Slip => Some("slips (the friction cone cannot hold it)"),
-                TransitionKind::Impact | TransitionKind::Closes => None,
+                TransitionKind::Impact | TransitionKind::Closes | TransitionKind::SupportChange => {
+                    None
+                }
             };
             if let Some(switch) = switch {
                 outln!(
@@ -315,10 +317,10 @@ fn print_impacts(simulation: &Simulation) {
                 );
                 continue;
             }
-            let closes = if tr.kind == TransitionKind::Closes {
-                ", stays closed"
-            } else {
-                ""
+            let closes = match tr.kind {
+                TransitionKind::Closes => ", stays closed",
+                TransitionKind::SupportChange => ", lands: the new stance foot",
+                _ => "",
             };
             outln!(
                 "           {:<16} t = {:.15e}   {:?}{closes}, g_dot {:.9e} -> {:.9e} m/s, normal impulse {:.6e} N*s{tangential}, lost {:.6e} J",

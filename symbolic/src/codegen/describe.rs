@@ -96,6 +96,10 @@ pub fn describe(model: &SymbolicModel, eom: &EquationsOfMotion, mathml: bool) ->
             })
             .collect(),
         contacts: model.contacts.iter().map(|c| text(&c.name)).collect(),
+        supports: (model.contacts.iter())
+            .filter(|c| c.support.is_some())
+            .map(|c| text(&c.name))
+            .collect(),
         events_need_accelerations: model.events_need_accelerations(),
         conservative: model.conservative,
         derivation: text(crate::mechanics::preferred_formulation(model).name()),
@@ -203,6 +207,7 @@ pub fn description_tokens(
             .collect(),
     );
     let contacts = texts(&d.contacts);
+    let supports = texts(&d.supports);
     let (needs, conservative) = (d.events_need_accelerations, d.conservative);
     let derivation = text(&d.derivation);
     let equations_text = text(&d.equations_text);
@@ -239,6 +244,7 @@ pub fn description_tokens(
             ignorable_coordinates: #ignorable_coordinates,
             events: #events,
             contacts: #contacts,
+            supports: #supports,
             events_need_accelerations: #needs,
             conservative: #conservative,
             derivation: #derivation,

@@ -582,6 +582,10 @@ fn signature_and_result(
             quote!(fn contact_coefficients(&self, __out: &mut [f64])),
             write_out(v),
         ),
+        ModelFunction::SupportChanges => (
+            quote!(fn support_changes(&self, #q_args, __t: f64, __out: &mut [f64])),
+            write_out(v),
+        ),
     }
 }
 

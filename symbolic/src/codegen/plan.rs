@@ -63,11 +63,14 @@ pub enum ModelFunction {
     ContactJacobian,
     /// Each contact's coefficient of restitution `e` and of friction `μ` (2 m_c).
     ContactCoefficients,
+    /// Each change of support's values, in contact order
+    /// ([`crate::model::elements::support::block`]).
+    SupportChanges,
 }
 
 impl ModelFunction {
     /// Every function, in the macro's order.
-    pub const ALL: [ModelFunction; 19] = [
+    pub const ALL: [ModelFunction; 20] = [
         ModelFunction::InitialState,
         ModelFunction::MassMatrix,
         ModelFunction::Forcing,
@@ -87,12 +90,13 @@ impl ModelFunction {
         ModelFunction::ContactGaps,
         ModelFunction::ContactJacobian,
         ModelFunction::ContactCoefficients,
+        ModelFunction::SupportChanges,
     ];
 
     /// The functions of the state that every compilation plans, first and in this order
     /// ([`plan_state`]): all but the exact Jacobians and `mass_matrix` and `forcing` apart
     /// (a backend evaluates both in one).
-    pub const STATE: [ModelFunction; 14] = [
+    pub const STATE: [ModelFunction; 15] = [
         ModelFunction::InitialState,
         ModelFunction::MassMatrixAndForcing,
         ModelFunction::KineticEnergy,
@@ -107,6 +111,7 @@ impl ModelFunction {
         ModelFunction::ContactGaps,
         ModelFunction::ContactJacobian,
         ModelFunction::ContactCoefficients,
+        ModelFunction::SupportChanges,
     ];
 
     /// The exact Jacobians ([`plan_jacobians`]), which the run-time compiler plans only when
@@ -139,6 +144,7 @@ impl ModelFunction {
             ModelFunction::ContactGaps => "contact_gaps",
             ModelFunction::ContactJacobian => "contact_jacobian",
             ModelFunction::ContactCoefficients => "contact_coefficients",
+            ModelFunction::SupportChanges => "support_changes",
         }
     }
 
@@ -204,6 +210,12 @@ impl ModelFunction {
             ModelFunction::ContactCoefficients => unless_empty(
                 (model.contacts.iter())
                     .flat_map(|c| [c.restitution, c.friction, c.static_friction])
+                    .collect(),
+            ),
+            ModelFunction::SupportChanges => unless_empty(
+                (model.contacts.iter())
+                    .filter_map(|c| c.support.as_ref())
+                    .flat_map(|s| s.block.iter().copied())
                     .collect(),
             ),
             // With a steady motion among them, each entry's rates follow its coordinates

@@ -60,6 +60,7 @@ impl FunctionTape {
 /// | `contact_gaps` | `g`, `ġ`, `γ` of `G q̈ = γ`, `γ_T` of `T q̈ = γ_T`, then the surface's speed `v_s` (m_c each) |
 /// | `contact_jacobian` | `G = ∂g/∂q` (m_c × n), then the slips' rows `T` (m_c × n), row-major |
 /// | `contact_coefficients` | `e`, `μ` per contact (2 m_c) |
+/// | `support_changes` | each change of support's values ([`crate::model::elements::support::block`]) |
 #[derive(Debug, Clone, PartialEq)]
 pub struct ModelProgram {
     /// Everything about the model that is not a function of the state ([`super::describe`]).
@@ -92,6 +93,8 @@ pub struct ModelProgram {
     pub contact_jacobian: FunctionTape,
     /// The contacts' coefficients of restitution and friction.
     pub contact_coefficients: FunctionTape,
+    /// The changes of support's values.
+    pub support_changes: FunctionTape,
 }
 
 impl ModelProgram {
@@ -145,6 +148,7 @@ impl ModelProgram {
             contact_gaps: single(F::ContactGaps),
             contact_jacobian: single(F::ContactJacobian),
             contact_coefficients: single(F::ContactCoefficients),
+            support_changes: single(F::SupportChanges),
         }
     }
 
@@ -166,6 +170,7 @@ impl ModelProgram {
             &mut self.contact_gaps,
             &mut self.contact_jacobian,
             &mut self.contact_coefficients,
+            &mut self.support_changes,
         ] {
             *tape = FunctionTape::default();
         }
@@ -178,7 +183,7 @@ impl ModelProgram {
 
     /// Every function with its name, in the order of the table above (the Jacobians, planned
     /// apart, not among them).
-    pub fn functions(&self) -> [(&'static str, &FunctionTape); 14] {
+    pub fn functions(&self) -> [(&'static str, &FunctionTape); 15] {
         [
             ("initial_state", &self.initial_state),
             ("mass_matrix_and_forcing", &self.mass_matrix_and_forcing),
@@ -197,6 +202,7 @@ impl ModelProgram {
             ("contact_gaps", &self.contact_gaps),
             ("contact_jacobian", &self.contact_jacobian),
             ("contact_coefficients", &self.contact_coefficients),
+            ("support_changes", &self.support_changes),
         ]
     }
 }

@@ -489,6 +489,7 @@ impl<'f> Lowering<'f> {
             .collect();
 
         let kinetic = self.arena.sum(&terms.kinetic);
+        let contacts = self.support_blocks(contacts, &body_infos, &points, kinetic);
         let potential = self.arena.sum(&terms.potential);
         let generalized_forces: Vec<ExprId> = terms
             .forces
@@ -566,6 +567,54 @@ impl<'f> Lowering<'f> {
                 .map(FloquetReference::describe)
                 .collect(),
         })
+    }
+
+    /// The contacts with each change of support's values derived
+    /// ([`elements::support::block`]), from the bodies' masses at their centres and the
+    /// kinetic energy. A change of support needs a mechanism of bodies free of constraints,
+    /// else the mistake is reported at the contact.
+    fn support_blocks(
+        &mut self,
+        mut contacts: Vec<ContactInfo>,
+        bodies: &[BodyInfo],
+        points: &Points,
+        kinetic: ExprId,
+    ) -> Vec<ContactInfo> {
+        let file = self.file;
+        for (c, written) in contacts.iter_mut().zip(&file.contacts) {
+            let Some(support) = c.support.as_mut() else {
+                continue;
+            };
+            let at = written.name.location;
+            let what = format!("contact `{}` changes the support", c.name);
+            let reason = if file.kinetic.is_some() || bodies.is_empty() {
+                Some((
+                    "its kinetic energy is written, not its bodies",
+                    "write the mechanism's masses as `bodies:` at points, so that the impulse at the landing foot can be derived",
+                ))
+            } else if !file.constraints.is_empty()
+                || !file.point_constraints.is_empty()
+                || !file.nonholonomic.is_empty()
+                || !file.rolling.is_empty()
+            {
+                Some((
+                    "the model has constraints",
+                    "write the walker in minimal coordinates about its stance foot, without `constraints:`",
+                ))
+            } else {
+                None
+            };
+            if let Some((why, help)) = reason {
+                self.errors
+                    .push(Diagnostic::new(at, format!("{what}, but {why}")).with_help(help));
+                continue;
+            }
+            let masses: Vec<(ExprId, Vec<ExprId>)> = (bodies.iter())
+                .map(|b| (b.mass, points[b.com].1.clone()))
+                .collect();
+            support.block = elements::support::block(&mut self.arena, support, &masses, kinetic);
+        }
+        contacts
     }
 
     /// The frames, with each frame's angular velocity components `omega_<frame>_<axis>` bound
@@ -752,6 +801,11 @@ impl elements::Lower for Lowering<'_> {
     }
     fn point_at(&self, i: usize) -> Vec<ExprId> {
         self.points[i].1.clone()
+    }
+    fn coordinate_names(&self) -> Vec<String> {
+        (self.file.coordinates.iter())
+            .map(|c| c.name.value.clone())
+            .collect()
     }
     fn error(&mut self, d: Diagnostic) {
         self.errors.push(d);

@@ -10,13 +10,15 @@
 //! its `Fields`, the `Writer`), and a new kind is one module plus one line in each stage's
 //! loop and one row in the schema's `SECTIONS`.
 //!
-//! The kinds here: [`contact`] (unilateral contacts), [`spring`] and [`damper`]. The older
+//! The kinds here: [`contact`] (unilateral contacts) and its [`support`] (a change of
+//! support), [`spring`] and [`damper`]. The older
 //! kinds (bodies, forces, constraints, …) are still spread over the stage files;
 //! ARCHITECTURE.md's recipe says how a kind moves here.
 
 pub mod contact;
 pub mod damper;
 pub mod spring;
+pub mod support;
 
 use super::ast::Expr;
 use super::diagnostic::Diagnostic;
@@ -52,6 +54,8 @@ pub(crate) trait Rules {
     fn value(&self, e: &Expr) -> Option<f64>;
     /// The spatial dimension of the model's points (2 or 3).
     fn dimension(&self) -> usize;
+    /// The model's coordinates, in file order.
+    fn coordinates(&self) -> Vec<String>;
     /// Reports a mistake.
     fn error(&mut self, d: Diagnostic);
 }
@@ -84,6 +88,8 @@ pub(crate) trait Lower {
     fn point_index(&self, name: &str) -> Option<usize>;
     /// The position of the point of index `i` (from [`Lower::point_index`]).
     fn point_at(&self, i: usize) -> Vec<ExprId>;
+    /// The model's coordinates, in file order.
+    fn coordinate_names(&self) -> Vec<String>;
     /// Reports a mistake found while lowering.
     fn error(&mut self, d: Diagnostic);
 }

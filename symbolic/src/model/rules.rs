@@ -327,6 +327,11 @@ impl elements::Rules for Checker<'_> {
     fn dimension(&self) -> usize {
         self.file.dimension.unwrap_or(2)
     }
+    fn coordinates(&self) -> Vec<String> {
+        (self.file.coordinates.iter())
+            .map(|c| c.name.value.clone())
+            .collect()
+    }
     fn error(&mut self, d: Diagnostic) {
         Checker::error(self, d);
     }

@@ -20,6 +20,7 @@
 use crate::expr::ExprId;
 use crate::model::ast::Expr;
 use crate::model::diagnostic::Diagnostic;
+use crate::model::elements::support::{Support, SupportInfo};
 use crate::model::elements::{Depends, Lower, Rules, Units};
 use crate::model::located::Located;
 use crate::model::schema::entries::get;
@@ -46,6 +47,9 @@ pub struct Contact {
     /// The static coefficient `μ_s ≥ μ` (`static_friction:`): a sticking contact holds while
     /// `|λ_T| ≤ μ_s λ_N`, and slides with `μ`; `None`: `μ_s = μ`.
     pub static_friction: Option<Expr>,
+    /// A change of support where it strikes (`support:`, [`super::support`]); `None`: an
+    /// impact by Newton's law.
+    pub support: Option<Support>,
 }
 
 /// How a contact's gap is written.
@@ -106,6 +110,7 @@ const CONTACT: Fields = Fields {
         ("restitution", Need::Required),
         ("friction", Need::Optional),
         ("static_friction", Need::Optional),
+        ("support", Need::Optional),
     ],
     example: "{ gap: y, restitution: e, friction: mu }",
 };
@@ -161,12 +166,17 @@ pub(crate) fn read(cx: &mut Ctx<'_>, node: &YamlNode) -> Vec<Contact> {
             Some(n) => cx.expr(n, "a static friction coefficient").map(Some),
             None => Some(None),
         };
+        let support = match get(f, "support") {
+            Some(n) => super::support::read(cx, k, n).map(Some),
+            None => Some(None),
+        };
         Some(Contact {
             name: k.clone(),
             gap: gap?,
             restitution: restitution?,
             friction: friction?,
             static_friction: static_friction?,
+            support: support?,
         })
     })
 }
@@ -403,6 +413,12 @@ pub(crate) fn write(w: &mut Writer<'_>, contacts: &[Contact]) -> Result<(), NotR
                 flow(&w.expr(mu, &place)?)
             ));
         }
+        if let Some(s) = &c.support {
+            text.push_str(&format!(
+                ", support: {}",
+                super::support::write(w, s, &place)?
+            ));
+        }
         w.line(format_args!("{text} }}"));
     }
     Ok(())
@@ -471,6 +487,15 @@ impl Contact {
             }
         }
         self.static_friction_rules(cx);
+        if let Some(s) = &self.support {
+            let shape = match &self.gap {
+                Gap::Written(_) => (false, false),
+                Gap::Above { disc, .. } => (disc.is_none(), disc.is_none()),
+                Gap::Circle { .. } => (true, false),
+            };
+            let restitution = cx.value(&self.restitution);
+            s.rules(cx, name, shape, restitution);
+        }
     }
 
     /// `μ_s`: a constant no smaller than `μ`, with `friction:` given.
@@ -664,6 +689,7 @@ impl Contact {
         let mut rolling = None;
         // The speed of the surface's material along `t̂` (a belt's), 0 for a fixed one.
         let mut surface = None;
+        let mut foot = (None, None);
         let (gap, across) = match &self.gap {
             Gap::Written(g) => (cx.expr(g), None),
             Gap::Above {
@@ -690,6 +716,7 @@ impl Contact {
                     gap = cx.arena().minus(gap, radius);
                     rolling = Some((radius, angle));
                 }
+                foot = (Some(p.clone()), Some(n.clone()));
                 (gap, Some((p, n)))
             }
             Gap::Circle {
@@ -699,6 +726,7 @@ impl Contact {
                 radius,
             } => {
                 let p = position(cx, point)?;
+                foot.0 = Some(p.clone());
                 let d = difference(cx, &p, &centre.value);
                 let dd = super::dot(cx.arena(), &d, &d);
                 let r = cx.expr(radius);
@@ -766,6 +794,13 @@ impl Contact {
         let slip = arena.sum(&slip_terms);
         let slip_rate = arena.time_derivative(slip);
         let tangent_gamma = minus_at_rest(arena, slip_rate);
+        let support = match &self.support {
+            Some(s) => {
+                let coordinates = cx.coordinate_names();
+                Some(s.lower(cx, &coordinates, foot)?)
+            }
+            None => None,
+        };
         Some(ContactInfo {
             name: self.name.value.clone(),
             gap,
@@ -778,6 +813,7 @@ impl Contact {
             restitution,
             friction,
             static_friction,
+            support,
         })
     }
 
@@ -960,4 +996,6 @@ pub struct ContactInfo {
     pub friction: ExprId,
     /// The static coefficient `μ_s ≥ μ` of the sticking cone (`μ` unless given).
     pub static_friction: ExprId,
+    /// The change of support where it strikes, if it is one.
+    pub support: Option<SupportInfo>,
 }
