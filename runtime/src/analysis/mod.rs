@@ -12,6 +12,7 @@ pub mod constraint_methods;
 pub mod drift;
 pub mod failure;
 pub mod fixed_step;
+pub mod gait;
 pub mod launch;
 pub mod methods;
 pub mod outcome;
@@ -31,6 +32,7 @@ pub use constraint_methods::{
 pub use drift::{ConstraintDrift, EnergyDrift, constraint_drift, energy_drift, energy_drift_at};
 pub use failure::{FailureCause, failure_cause};
 pub use fixed_step::{ENERGY_DRIFT_LIMIT, SimulationWarning, fixed_step_warnings};
+pub use gait::{Gait, GaitError, GaitOptions, gait};
 pub use methods::{Amplification, Constructor, Method, MethodInfo, UnknownMethod};
 pub use outcome::{NothingMeasured, RunTally, StudyRuns};
 pub use periodic_orbit::{

@@ -295,15 +295,42 @@ pub struct FloquetAnalysis {
 }
 
 /// `ẏ = F(t, y)` with its variational equations `Φ̇ = (∂F/∂y) Φ`: the state `[y; vec Φ]`
-/// (`Φ` column-major).
-struct Variational<'a> {
-    system: &'a mut dyn OdeSystem,
+/// (`Φ` column-major). Also the flow of a gait's smooth phases
+/// ([`crate::analysis::gait`]).
+pub(crate) struct Variational<'a, S: OdeSystem + ?Sized = dyn OdeSystem> {
+    /// The system.
+    pub(crate) system: &'a mut S,
     n: usize,
     jac: Vec<f64>,
-    jacobian_missing: bool,
+    /// Whether the system had no exact Jacobian where it was asked for.
+    pub(crate) jacobian_missing: bool,
 }
 
-impl OdeSystem for Variational<'_> {
+impl<'a, S: OdeSystem + ?Sized> Variational<'a, S> {
+    /// The variational flow of `system` (`n = system.dim()`).
+    pub(crate) fn new(system: &'a mut S) -> Self {
+        let n = system.dim();
+        Self {
+            system,
+            n,
+            jac: vec![0.0; n * n],
+            jacobian_missing: false,
+        }
+    }
+
+    /// `[y₀; vec I]`, the start of the flow from `y0`.
+    pub(crate) fn start(&self, y0: &[f64]) -> Vec<f64> {
+        let n = self.n;
+        let mut start = vec![0.0; n + n * n];
+        start[..n].copy_from_slice(y0);
+        for i in 0..n {
+            start[n + i + i * n] = 1.0;
+        }
+        start
+    }
+}
+
+impl<S: OdeSystem + ?Sized> OdeSystem for Variational<'_, S> {
     fn dim(&self) -> usize {
         self.n + self.n * self.n
     }

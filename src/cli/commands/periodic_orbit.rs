@@ -9,13 +9,14 @@
 
 use clap::Args;
 use eomgen::ModelInfo;
-use eomgen::analysis::{PeriodicOrbit, PeriodicOrbitError, PeriodicOrbitOptions, periodic_orbit};
+use eomgen::analysis::{
+    GaitError, GaitOptions, PeriodicOrbit, PeriodicOrbitError, PeriodicOrbitOptions, periodic_orbit,
+};
 use eomgen::expressions::{split_assignment, split_list};
 
 use crate::cli::error::CliError;
 use crate::cli::files::Outputs;
 use crate::cli::json::print_json_sorted;
-use crate::cli::model::find_smooth_model;
 use crate::cli::plot::{Chart, Series, lines};
 use crate::cli::render::num;
 use crate::cli::values::{evaluate, parameter_lookup, set_parameters, usage};
@@ -59,6 +60,10 @@ pub struct PeriodicOrbitArgs {
     /// Chart of the model's points over one period, y against x (.svg or .png).
     #[arg(long, value_name = "FILE")]
     pub plot: Option<String>,
+    /// For a model with a change of support (`support:`): the landings in one period of the
+    /// gait (1: a period-one gait; 2 after a period doubling).
+    #[arg(long, default_value_t = 1)]
+    pub steps: usize,
 }
 
 /// Runs `study periodic-orbit`.
@@ -67,7 +72,11 @@ pub fn run(args: &PeriodicOrbitArgs) -> Result<(), CliError> {
         .input(&args.model)
         .chart("--plot", args.plot.as_deref())
         .check()?;
-    let mut model = find_smooth_model(&args.model, "`study periodic-orbit`")?;
+    let mut model = crate::cli::model::find_model(&args.model)?;
+    if !model.description().supports.is_empty() {
+        return run_gait(args, model);
+    }
+    crate::cli::model::smooth_only(model.as_ref(), "`study periodic-orbit`")?;
     set_parameters(model.as_mut(), &args.set)?;
     let initial = model.initial_state();
     let start = guess(model.as_ref(), &args.guess)?;
@@ -118,6 +127,105 @@ pub fn run(args: &PeriodicOrbitArgs) -> Result<(), CliError> {
         );
         Ok(())
     }
+}
+
+/// `study periodic-orbit` on a model with a change of support: its gait
+/// ([`eomgen::analysis::gait()`]) from the model's initial state with `--guess` applied.
+fn run_gait(args: &PeriodicOrbitArgs, mut model: Box<dyn ModelInfo>) -> Result<(), CliError> {
+    set_parameters(model.as_mut(), &args.set)?;
+    for (given, flag) in [
+        (args.period.is_some(), "--period"),
+        (args.fix_period, "--fix-period"),
+        (args.energy.is_some(), "--energy"),
+        (args.plot.is_some(), "--plot"),
+    ] {
+        if given {
+            return Err(CliError::usage(format!(
+                "{flag} does not apply to a gait: its period is the time of its steps, found with it (`{}` changes its support)",
+                model.description().name
+            )));
+        }
+    }
+    let options = GaitOptions {
+        start: Some(guess(model.as_ref(), &args.guess)?),
+        steps: args.steps,
+        tol: args.tol,
+        max_iterations: args.max_iterations,
+        ..GaitOptions::default()
+    };
+    let gait = eomgen::analysis::gait(model.as_mut(), &options).map_err(|e| match e {
+        GaitError::InvalidOptions { .. } => CliError::usage(e.to_string()),
+        e => CliError::failure(format!("`{}`: {e}", model.description().name)),
+    })?;
+    if args.json {
+        return print_json_sorted(&gait);
+    }
+    use std::io::Write as _;
+    let mut out = crate::cli::output::stdout();
+    let _ = writeln!(
+        out,
+        "model        {} ({} dof), a gait of {} step{} per period",
+        gait.model,
+        gait.state_names.len() / 2,
+        gait.step_times.len(),
+        if gait.step_times.len() == 1 { "" } else { "s" }
+    );
+    let _ = writeln!(
+        out,
+        "method       Newton on the return map P(y) − y = 0 (y just after a landing), its Jacobian from the variational equations and a saltation matrix at each landing; DOP853 on y and Φ"
+    );
+    for (k, r) in gait.residuals.iter().enumerate() {
+        let label = if k == 0 { "newton" } else { "" };
+        let _ = writeln!(out, "{label:<12} {k:<3} ‖P(y) − y‖ = {:.3e}", num(r));
+    }
+    let steps: Vec<String> = (gait.step_times.iter())
+        .map(|t| format!("{t:.12}"))
+        .collect();
+    let _ = writeln!(
+        out,
+        "period       T = {:.12} s (steps {})",
+        gait.period,
+        steps.join(", ")
+    );
+    for (i, (name, value)) in gait.state_names.iter().zip(&gait.state).enumerate() {
+        let label = if i == 0 { "state y*" } else { "" };
+        let _ = writeln!(out, "{label:<12} {name:<10} = {:+.12e}", num(value));
+    }
+    let lost: Vec<String> = (gait.energy_lost.iter())
+        .map(|e| format!("{:.9e}", num(e)))
+        .collect();
+    let _ = writeln!(
+        out,
+        "landings     kinetic energy lost {} J",
+        lost.join(", ")
+    );
+    for (k, l) in gait.eigenvalues.iter().enumerate() {
+        let label = if k == 0 { "eigenvalues" } else { "" };
+        let _ = writeln!(
+            out,
+            "{label:<12} λ{:<3} = {:+.9} {:+.9}i   |λ| = {:.9}",
+            k + 1,
+            l.re,
+            l.im,
+            l.norm()
+        );
+    }
+    let _ = writeln!(
+        out,
+        "             (of ∂P/∂y; one is 0, the flow's direction. The Floquet multipliers of the monodromy matrix are the others and 1)"
+    );
+    let _ = writeln!(
+        out,
+        "stability    {} (max |λ| = {:.9})",
+        gait.stability.as_str(),
+        gait.spectral_radius
+    );
+    let _ = writeln!(
+        out,
+        "work         {} steps, {} right-hand sides (with Φ), {:.3} s",
+        gait.stats.steps, gait.stats.rhs_evals, gait.stats.wall_time_s
+    );
+    Ok(())
 }
 
 /// The model's initial state with `--guess` applied; an unknown name is a usage error that
