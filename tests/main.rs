@@ -16,6 +16,7 @@ mod expm_rayleigh;
 mod floquet;
 mod frf;
 mod friction;
+mod gaits;
 mod integrators_models;
 mod interactions;
 mod json_schemas;

@@ -29,7 +29,7 @@
 use nalgebra::{Complex, DMatrix, DVector};
 use serde::Serialize;
 
-use crate::hybrid::support::{SupportError, change_support, reset_jacobian};
+use crate::hybrid::support::{SupportError, SupportValues, change_support, reset_jacobian};
 use crate::integrate::{DormandPrince853, Integrator, IntegratorOptions, OutputTimes, Stats};
 use crate::linear::monodromy::{FloquetOptions, FloquetStability, Variational};
 use crate::model_info::ModelInfo;
@@ -185,13 +185,21 @@ pub enum GaitError {
     },
 }
 
-/// One pass of the return map from `y0`: `P(y0)`, its Jacobian and the monodromy matrix.
-struct Pass {
-    end: Vec<f64>,
-    return_map: DMatrix<f64>,
-    monodromy: DMatrix<f64>,
-    step_times: Vec<f64>,
-    energy_lost: Vec<f64>,
+/// One pass of the return map from `y0` ([`return_map`]).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ReturnMap {
+    /// `P(y0)`, `[q; q̇]` just after the last landing.
+    pub end: Vec<f64>,
+    /// `∂P/∂y` at `y0` (`2n × 2n`).
+    #[serde(serialize_with = "crate::serde_matrix::rows")]
+    pub return_map: DMatrix<f64>,
+    /// The monodromy matrix `∏ S Φ` from `y0` (`2n × 2n`).
+    #[serde(serialize_with = "crate::serde_matrix::rows")]
+    pub monodromy: DMatrix<f64>,
+    /// Each step's duration (s).
+    pub step_times: Vec<f64>,
+    /// The kinetic energy lost at each landing (J).
+    pub energy_lost: Vec<f64>,
 }
 
 /// Finds the gait of `model` near [`GaitOptions::start`]: the fixed point of its return map
@@ -309,7 +317,7 @@ fn distance(a: &[f64], b: &[f64]) -> f64 {
 fn report(
     model: &dyn ModelInfo,
     (name, y): (String, Vec<f64>),
-    pass: Pass,
+    pass: ReturnMap,
     (residuals, iterations): (Vec<f64>, usize),
     options: &GaitOptions,
     stats: Stats,
@@ -347,15 +355,22 @@ fn eigenvalues(m: &DMatrix<f64>) -> Vec<Complex<f64>> {
     values
 }
 
-/// `P(y0)` through [`GaitOptions::steps`] steps, with its Jacobian and the monodromy matrix.
-fn return_map(
+/// `P(y0)` through [`GaitOptions::steps`] steps, with its Jacobian and the monodromy matrix
+/// (see the module documentation), the integrations' work added to `stats`.
+///
+/// # Shapes
+/// `y0`: `2n`, just after a landing.
+///
+/// # Errors
+/// [`GaitError::NoLanding`], [`GaitError::Support`], [`GaitError::Saltation`].
+pub fn return_map(
     model: &mut dyn ModelInfo,
     y0: &[f64],
     options: &GaitOptions,
     stats: &mut Stats,
-) -> Result<Pass, GaitError> {
+) -> Result<ReturnMap, GaitError> {
     let dim = y0.len();
-    let mut pass = Pass {
+    let mut pass = ReturnMap {
         end: y0.to_vec(),
         return_map: DMatrix::identity(dim, dim),
         monodromy: DMatrix::identity(dim, dim),
@@ -423,7 +438,9 @@ fn return_map(
 /// variational equations integrated until the first change of support's gap falls through 0.
 type Landing = ((usize, usize), Vec<f64>, (DMatrix<f64>, f64));
 
-/// Integrates step `step` from `(t0, y0)` to its landing (see [`Landing`]).
+/// Integrates step `step` from `(t0, y0)` to its landing (see [`Landing`]). A zero of a
+/// landing gap where the file's `when:` is not positive is passed (the foot scuffs), and the
+/// integration goes on from it.
 fn flow_to_landing(
     model: &mut dyn ModelInfo,
     (t0, y0): (f64, &[f64]),
@@ -432,6 +449,7 @@ fn flow_to_landing(
     stats: &mut Stats,
 ) -> Result<Landing, GaitError> {
     let dim = y0.len();
+    let n = dim / 2;
     let description = model.description().clone();
     let supports: Vec<(usize, usize)> = (description.supports.iter().enumerate())
         .filter_map(|(which, s)| {
@@ -439,63 +457,106 @@ fn flow_to_landing(
             Some((c, which))
         })
         .collect();
-    let contacts = description.contacts.len();
-    let specs = (supports.iter())
-        .map(|&(c, _)| {
-            EventSpec::new(
-                description.contacts[c].to_string(),
-                EventDirection::Falling,
-                true,
-            )
-        })
-        .collect();
-    let mut gaps = vec![0.0; 5 * contacts];
-    let mut flow = Variational::new(model);
-    let start = flow.start(y0);
-    let own = crate::ode::OdeSystem::event_specs(&flow).len();
-    let landing_gaps = supports.clone();
-    let mut system = WithEvents::new(
-        &mut flow,
-        specs,
-        |v: &mut Variational<'_, dyn ModelInfo>, t: f64, y: &[f64], g: &mut [f64]| {
-            v.system.contact_gaps(t, &y[..dim], &mut gaps);
-            for (out, &(c, _)) in g.iter_mut().zip(&landing_gaps) {
-                *out = gaps[c];
-            }
-            Ok(())
-        },
-    );
-    let integrator_options = IntegratorOptions::default()
-        .with_rtol(options.floquet.rtol)
-        .with_atol(options.floquet.atol)
-        .with_max_steps(options.floquet.max_steps);
-    let t_end = t0 + options.max_step_time;
-    let result = DormandPrince853::new().integrate(
-        &mut system,
-        t0,
-        &start,
-        t_end,
-        &OutputTimes::At(vec![t_end]),
-        &integrator_options,
-    );
     let no_landing = |reason: Option<String>| GaitError::NoLanding {
         step,
         t: t0,
         within: options.max_step_time,
         reason,
     };
-    let solution = result.map_err(|f| no_landing(Some(f.error.to_string())))?;
+    let integrator_options = IntegratorOptions::default()
+        .with_rtol(options.floquet.rtol)
+        .with_atol(options.floquet.atol)
+        .with_max_steps(options.floquet.max_steps);
+    let t_end = t0 + options.max_step_time;
+    let mut flow = Variational::new(model);
+    let (mut t, mut state) = (t0, flow.start(y0));
+    // At most this many passes (scuffs) in one step.
+    for _ in 0..100 {
+        let (landing, event) = next_zero(
+            &mut flow,
+            &supports,
+            (t, &state),
+            (t_end, options.floquet.atol),
+            &integrator_options,
+            stats,
+        )
+        .map_err(|reason| no_landing(Some(reason)))?
+        .ok_or_else(|| no_landing(None))?;
+        let (_, which) = landing;
+        let passes = SupportValues::of(&*flow.system, which, event.0, &event.1[..n]).when <= 0.0;
+        if !passes {
+            let phi = DMatrix::from_column_slice(dim, dim, &event.1[dim..]);
+            return Ok((landing, event.1[..dim].to_vec(), (phi, event.0 - t0)));
+        }
+        (t, state) = event;
+    }
+    Err(no_landing(Some(
+        "the foot passed through the ground 100 times".into(),
+    )))
+}
+
+/// The first falling zero after `t0` of a landing gap (`supports`: `(contact, support)`
+/// pairs) along the variational flow from `state` (`[y; vec Φ]`), with the time and the flow's
+/// state there; `None` if none comes before `t_end`. A gap at a zero at `t0` (the step's
+/// start, or a foot that passed: within `touch` of 0) is watched as `(g − g₀)/(t − t₀)`, as a run through impacts
+/// does (`hybrid::run`), so that the zero it leaves is not found again.
+///
+/// # Errors
+/// The integration's failure, as text.
+fn next_zero<'m>(
+    flow: &mut Variational<'_, dyn ModelInfo + 'm>,
+    supports: &[(usize, usize)],
+    (t0, state): (f64, &[f64]),
+    (t_end, touch): (f64, f64),
+    options: &IntegratorOptions,
+    stats: &mut Stats,
+) -> Result<Option<((usize, usize), (f64, Vec<f64>))>, String> {
+    let contacts = flow.system.description().contacts.len();
+    let dim = 2 * flow.system.num_dofs();
+    let mut gaps = vec![0.0; 5 * contacts];
+    flow.system.contact_gaps(t0, &state[..dim], &mut gaps);
+    let starting: Vec<Option<f64>> = (supports.iter())
+        .map(|&(c, _)| (gaps[c].abs() <= touch).then_some(gaps[c]))
+        .collect();
+    let specs = (supports.iter())
+        .map(|&(c, _)| {
+            let name = flow.system.description().contacts[c].to_string();
+            EventSpec::new(name, EventDirection::Falling, true)
+        })
+        .collect();
+    let own = crate::ode::OdeSystem::event_specs(&*flow).len();
+    let mut system = WithEvents::new(
+        flow,
+        specs,
+        |v: &mut Variational<'_, dyn ModelInfo + 'm>, t: f64, y: &[f64], g: &mut [f64]| {
+            v.system.contact_gaps(t, &y[..dim], &mut gaps);
+            for ((out, &(c, _)), start) in g.iter_mut().zip(supports).zip(&starting) {
+                *out = match start {
+                    Some(g0) if t > t0 => (gaps[c] - g0) / (t - t0),
+                    Some(_) => gaps[contacts + c],
+                    None => gaps[c],
+                };
+            }
+            Ok(())
+        },
+    );
+    let solution = DormandPrince853::new()
+        .integrate(
+            &mut system,
+            t0,
+            state,
+            t_end,
+            &OutputTimes::At(vec![t_end]),
+            options,
+        )
+        .map_err(|f| f.error.to_string())?;
     add(stats, &solution.stats);
     let Some(k) = solution.terminated_by_event else {
-        return Err(no_landing(None));
+        return Ok(None);
     };
     let event = &solution.events[k];
-    let Some(&landing) = supports.get(event.index.wrapping_sub(own)) else {
-        return Err(no_landing(None));
-    };
-    let y = event.y[..dim].to_vec();
-    let phi = DMatrix::from_column_slice(dim, dim, &event.y[dim..]);
-    Ok((landing, y, (phi, event.t - t0)))
+    Ok((supports.get(event.index.wrapping_sub(own)))
+        .map(|&landing| (landing, (event.t, event.y.clone()))))
 }
 
 /// Adds `more`'s work to `stats`.

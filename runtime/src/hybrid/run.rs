@@ -27,7 +27,7 @@ use super::impact::{
     ContactFriction, ImpactContact, ImpactError, ImpactMode, ImpactReport, impact,
 };
 use super::phase::{ContactPhase, Hold, closing_hold, contact_events, touching};
-use super::support::{SupportError, change_support};
+use super::support::{SupportError, SupportValues, change_support};
 use crate::IntegrationFailure;
 use crate::integrate::{Integrator, IntegratorOptions, OutputTimes, Solution, Tolerance};
 use crate::model_info::{AddedEvents, ContactValues, ModelInfo};
@@ -489,6 +489,13 @@ impl Run<'_> {
                 contact: self.contacts[k].clone(),
             }));
         }
+        // Where the file's `when:` is not positive the foot passes (scuffing): the phase
+        // goes on from here, the contact open at a zero.
+        if SupportValues::of(model, which, t, &y[..n]).when <= 0.0 {
+            self.y = y;
+            self.t = t;
+            return Ok(());
+        }
         let values = model.contact_values(t, &y);
         let friction = values.friction[c];
         let change = change_support(model, which, t, &y, friction).map_err(stop)?;
@@ -671,6 +678,7 @@ impl Run<'_> {
     /// whose gap the free motion would close (`g̈ < 0` with them open): each closes where its
     /// normal force then pushes (recorded at `sample`); where it would pull too, the contact
     /// can be neither open nor closed (Painlevé's paradox with friction), and the run stops.
+    /// A change of support (`lands`) never closes.
     ///
     /// # Errors
     /// [`ContactStop::NoConsistentMode`] for such a contact.
@@ -679,12 +687,13 @@ impl Run<'_> {
         model: &mut dyn ModelInfo,
         sample: usize,
         released: Option<usize>,
+        lands: &[bool],
     ) -> Result<(), ContactStop> {
         let n = model.num_dofs();
         for c in 0..self.closed.len() {
             let values = model.contact_values(self.t, &self.y);
             let touches = values.gaps[c].abs() <= self.atol && values.rates[c].abs() <= self.atol;
-            if self.closed[c] || Some(c) == released || !touches {
+            if self.closed[c] || Some(c) == released || lands[c] || !touches {
                 continue;
             }
             let mut closed: Vec<usize> =
@@ -748,10 +757,16 @@ impl Run<'_> {
             }
             _ => None,
         };
+        // A change of support lands at its event only (a foot that passes is left open).
+        let supports = &model.description().supports;
+        let lands: Vec<bool> = (self.contacts.iter())
+            .map(|c| supports.iter().any(|s| **s == **c))
+            .collect();
         for _ in 0..=2 * self.contacts.len() {
             let values = model.contact_values(self.t, &self.y);
             let striking = (0..self.contacts.len()).find(|&k| {
                 !self.closed[k]
+                    && !lands[k]
                     && Some(k) != released
                     && values.gaps[k] <= self.atol
                     && values.rates[k] < -self.atol
@@ -761,7 +776,7 @@ impl Run<'_> {
             };
             self.transition(model, k, (self.t, self.y.clone()), sample)?;
         }
-        self.close_touching(model, sample, released)?;
+        self.close_touching(model, sample, released, &lands)?;
         self.redecide(model, sample);
         // A slide that starts where its normal force is already unbounded (its event would
         // start below 0 and never be seen to cross) stops the run here.

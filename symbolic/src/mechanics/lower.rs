@@ -489,7 +489,7 @@ impl<'f> Lowering<'f> {
             .collect();
 
         let kinetic = self.arena.sum(&terms.kinetic);
-        let contacts = self.support_blocks(contacts, &body_infos, &points, kinetic);
+        let contacts = self.support_blocks(contacts, &body_infos, &points);
         let potential = self.arena.sum(&terms.potential);
         let generalized_forces: Vec<ExprId> = terms
             .forces
@@ -570,15 +570,13 @@ impl<'f> Lowering<'f> {
     }
 
     /// The contacts with each change of support's values derived
-    /// ([`elements::support::block`]), from the bodies' masses at their centres and the
-    /// kinetic energy. A change of support needs a mechanism of bodies free of constraints,
+    /// ([`elements::support::block`]), from the bodies' masses, centres and angles. A change of support needs a mechanism of bodies free of constraints,
     /// else the mistake is reported at the contact.
     fn support_blocks(
         &mut self,
         mut contacts: Vec<ContactInfo>,
         bodies: &[BodyInfo],
         points: &Points,
-        kinetic: ExprId,
     ) -> Vec<ContactInfo> {
         let file = self.file;
         for (c, written) in contacts.iter_mut().zip(&file.contacts) {
@@ -587,7 +585,8 @@ impl<'f> Lowering<'f> {
             };
             let at = written.name.location;
             let what = format!("contact `{}` changes the support", c.name);
-            let reason = if file.kinetic.is_some() || bodies.is_empty() {
+            let spatial = bodies.iter().any(|b| b.spatial.is_some());
+            let reason = if file.kinetic.is_some() || bodies.is_empty() || spatial {
                 Some((
                     "its kinetic energy is written, not its bodies",
                     "write the mechanism's masses as `bodies:` at points, so that the impulse at the landing foot can be derived",
@@ -609,10 +608,16 @@ impl<'f> Lowering<'f> {
                     .push(Diagnostic::new(at, format!("{what}, but {why}")).with_help(help));
                 continue;
             }
-            let masses: Vec<(ExprId, Vec<ExprId>)> = (bodies.iter())
-                .map(|b| (b.mass, points[b.com].1.clone()))
+            let masses: Vec<elements::support::Mass> = (bodies.iter())
+                .map(|b| (b.mass, points[b.com].1.clone(), b.rotation))
                 .collect();
-            support.block = elements::support::block(&mut self.arena, support, &masses, kinetic);
+            match elements::support::block(&mut self.arena, support, &masses) {
+                Some(block) => support.block = block,
+                None => self.errors.push(
+                    Diagnostic::new(at, format!("{what}, but its `relabel` is not an invertible affine map of the coordinates"))
+                        .with_help("write each coordinate after the change as a sum of the coordinates before times constants, plus a constant (`theta: theta - phi`, `phi: -phi`, `theta: theta - 2*alpha`), so that no two give the same"),
+                ),
+            }
         }
         contacts
     }

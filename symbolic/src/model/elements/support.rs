@@ -13,19 +13,20 @@
 //! origin, as the walking literature writes it. When the contact strikes, the landing foot
 //! `S` takes a plastic impulse and sticks, and the stance foot is released: in the extended
 //! coordinates `(p₀, q)` of the mechanism with its stance foot free at `p₀`,
-//! `M_e (q̇_e⁺ − q̇_e⁻) = J_Sᵀ Λ` with `J_S q̇_e⁺ = 0` (`J_S = [I, F]`, `F = ∂r_S/∂q`).
-//! Written in the speeds `q̇` alone (`p₀` follows from the landing foot held:
-//! `ṗ₀⁺ = −F q̇⁺`), the law is `P q̇⁺ = Q q̇⁻` with
+//! `M_e (q̇_e⁺ − q̇_e⁻) = J_Sᵀ Λ` with `S` held after it (`J_S = [I, ∂r_S/∂q]`). The
+//! coordinates are then relabelled for the new stance foot, `q⁺ = R(q)` as the file writes
+//! it. Projected on the motions that keep `S` (which eliminates `Λ`) and written in the new
+//! coordinates, the law is
 //!
-//! - `P = M − FᵀK − KᵀF + m FᵀF`, the mass matrix about the landing foot;
-//! - `Q = M − FᵀK`, the angular momenta about it, kept;
+//! `M(q⁺) q̇⁺ = H(q) q̇⁻`, `H = Σ mᵢ Jᵢ(q⁺)ᵀ Jᵢ(q) + Iᵢ aᵢ(q⁺)ᵀ aᵢ(q)`:
 //!
-//! `m` the total mass and `K = ∂(Σ mᵢ rᵢ)/∂q` the Jacobian of the linear momentum. Then the
-//! coordinates are relabelled for the new stance foot: `q⁺ = R(q)` as the file writes it,
-//! `q̇⁺ = (∂R/∂q) v`. The runtime applies it (`eomgen_runtime::hybrid`), checks the landing
-//! impulse pushes (and stays in the friction cone, with `friction:`), the stance foot
+//! the momenta of every mass about the new foot are kept (`Jᵢ = ∂rᵢ/∂q` of a centre,
+//! `aᵢ = ∂θᵢ/∂q` of a body's angle; `Jᵢ(q⁺)` is `∂(rᵢ − r_S)/∂q⁺` where `R` puts the mechanism
+//! where it was). For the rimless wheel it is the angular momentum about the new foot,
+//! `ω⁺ = cos 2α ω⁻`. The runtime applies it (`eomgen_runtime::hybrid::support`), checks the
+//! landing impulse pushes (and stays in the friction cone, with `friction:`), the stance foot
 //! leaves, and `R` puts the mechanism where it was, and takes the saltation matrix of the
-//! gait's return map from the derivatives of `P`, `Q` and `R`, which this module derives.
+//! gait's return map from the derivatives of `M(q⁺)` and `H`, which this module derives.
 //!
 //! Source: Grizzle, Abba & Plestan, IEEE TAC 46 (2001), §III (the impact model in extended
 //! coordinates); Garcia, Chatterjee, Ruina & Coleman, J. Biomech. Eng. 120 (1998), eq. 4
@@ -54,6 +55,10 @@ pub struct Support {
     pub normal: Option<Located<Vec<Expr>>>,
     /// The coordinates after the change, by name, as expressions of those before.
     pub relabel: Vec<(Located<String>, Expr)>,
+    /// Where a strike lands (`when:`, a function of the configuration): only where it is
+    /// positive; elsewhere the foot passes (the simplest walker's scuffing at mid-stance).
+    /// `None`: everywhere.
+    pub when: Option<Expr>,
 }
 
 /// The keys of `support:`.
@@ -63,6 +68,7 @@ const SUPPORT: Fields = Fields {
         ("foot", Need::Optional),
         ("normal", Need::Optional),
         ("relabel", Need::Required),
+        ("when", Need::Optional),
     ],
     example: "{ foot: S, normal: [0, 1], relabel: { theta: -theta, phi: -phi } }",
 };
@@ -89,11 +95,16 @@ pub(crate) fn read(cx: &mut Ctx<'_>, key: &Located<String>, node: &YamlNode) -> 
             Some((k.clone(), cx.expr(v, "a coordinate after the change")?))
         })
     });
+    let when = match get(f, "when") {
+        Some(n) => cx.expr(n, "where the foot lands").map(Some),
+        None => Some(None),
+    };
     Some(Support {
         at: key.location,
         foot: foot?,
         normal: normal?,
         relabel: relabel?,
+        when: when?,
     })
 }
 
@@ -111,6 +122,9 @@ pub(crate) fn write(w: &mut Writer<'_>, s: &Support, place: &str) -> Result<Stri
         relabel.push(format!("{}: {}", name.value, flow(&w.expr(e, place)?)));
     }
     parts.push(format!("relabel: {{ {} }}", relabel.join(", ")));
+    if let Some(when) = &s.when {
+        parts.push(format!("when: {}", flow(&w.expr(when, place)?)));
+    }
     Ok(format!("{{ {} }}", parts.join(", ")))
 }
 
@@ -168,6 +182,13 @@ impl Support {
             None => {}
         }
         self.relabel_rules(cx, &what);
+        if let Some(when) = &self.when {
+            cx.expression(
+                when,
+                Depends::Position,
+                &format!("where contact `{contact}` lands"),
+            );
+        }
     }
 
     /// Every coordinate once in `relabel`, each by an expression of the configuration.
@@ -244,10 +265,15 @@ impl Support {
             let (_, e) = self.relabel.iter().find(|(n, _)| &n.value == c)?;
             relabel.push(cx.expr(e));
         }
+        let when = match &self.when {
+            Some(w) => cx.expr(w),
+            None => cx.arena().int(1),
+        };
         Some(SupportInfo {
             foot,
             normal,
             relabel,
+            when,
             block: Vec::new(),
         })
     }
@@ -262,112 +288,200 @@ pub struct SupportInfo {
     pub normal: Vec<ExprId>,
     /// The coordinates after the change, `R(q)`, one per coordinate.
     pub relabel: Vec<ExprId>,
+    /// Positive where a strike lands (1 when the file gives no `when:`).
+    pub when: ExprId,
     /// What the runtime evaluates ([`block`]); empty until the model's masses are lowered.
     pub block: Vec<ExprId>,
 }
 
 /// The number of values in one change of support's [`block`], for `n` coordinates.
 pub fn block_len(n: usize) -> usize {
-    7 + 5 * n + 3 * n * n + 3 * n * n * n
+    10 + 7 * n + 3 * n * n + 2 * n * n * n
 }
 
-/// The values the runtime needs at a change of support, of the mechanism whose masses are
-/// `masses` (mass, position) and whose kinetic energy is `kinetic`, in this order (`n`
-/// coordinates; matrices row-major; `∂X/∂q` as `n` matrices, one per `q_k`):
+/// A mass of the mechanism as [`block`] reads it: its mass, its centre's position, and for a
+/// planar rigid body its centroidal inertia and angle.
+pub(crate) type Mass = (ExprId, Vec<ExprId>, Option<(ExprId, ExprId)>);
+
+/// The values the runtime needs at a change of support of the mechanism made of `masses`, in
+/// this order (`n` coordinates; matrices row-major; `∂X/∂q` as `n` matrices, one per `q_k`;
+/// `q⁺ = R(q) = A q + c`), or `None` where `R` is not affine or `A` is singular:
 ///
 /// | values | count |
 /// |---|---|
 /// | `m`, the total mass (kg) | 1 |
 /// | `n̂` | 2 |
-/// | `Σ mᵢ rᵢ` (kg·m) | 2 |
+/// | `Σ mᵢ rᵢ` at `q` and at `q⁺` (kg·m) | 2 + 2 |
 /// | `r_S` (m) | 2 |
 /// | `K = ∂(Σ mᵢ rᵢ)/∂q` | 2n |
+/// | `K⁺ = Σ mᵢ Gᵢ`, the momentum about `S` in the new speeds | 2n |
 /// | `F = ∂r_S/∂q` | 2n |
-/// | `P = M − FᵀK − KᵀF + m FᵀF` | n² |
-/// | `Q = M − FᵀK` | n² |
-/// | `∂P/∂q_k`, `∂Q/∂q_k` | n³ each |
+/// | `M⁺ = Σ wᵢ Gᵢᵀ Gᵢ`, the mass matrix after the change | n² |
+/// | `H = Σ wᵢ Gᵢᵀ Jᵢ` | n² |
+/// | `∂H/∂q_k`, `∂M⁺/∂q_k` | n³ each |
 /// | `R(q)` | n |
-/// | `∂R/∂q` | n² |
-/// | `∂²R/∂q_k∂q` | n³ |
+/// | `A = ∂R/∂q` | n² |
+/// | `when`, positive where a strike lands | 1 |
+///
+/// Each mass gives rows: its centre's two, `Jᵢ = ∂rᵢ/∂q` with `Gᵢ = ∂(rᵢ − r_S)/∂q A⁻¹`
+/// (weight `mᵢ`), and a rigid body's angle, `Jᵢ = ∂θᵢ/∂q`, `Gᵢ = Jᵢ A⁻¹` (weight `Iᵢ`).
+/// The law after a plastic landing that keeps the new foot and frees the old is
+/// `M⁺ q̇⁺ = H q̇⁻`: the momenta of every mass about the new foot, in the new coordinates.
+/// Written there, each relative position `rᵢ − r_S` is differentiated before it is summed, so a
+/// foot of small mass `β` keeps a row of order `β` of its own (the limit of massless legs),
+/// where the same law in the old coordinates would take it from a difference of order 1 and
+/// lose `ε/β` of it.
 pub(crate) fn block(
     arena: &mut ExprArena,
     s: &SupportInfo,
-    masses: &[(ExprId, Vec<ExprId>)],
-    kinetic: ExprId,
-) -> Vec<ExprId> {
+    masses: &[Mass],
+) -> Option<Vec<ExprId>> {
     let symbols = arena.coordinates().to_vec();
     let q: Vec<_> = symbols.iter().map(|s| s[0]).collect();
     let n = q.len();
-    let mass_terms: Vec<ExprId> = masses.iter().map(|(m, _)| *m).collect();
+    let jacobian = |arena: &mut ExprArena, v: &[ExprId]| -> Vec<ExprId> {
+        (v.iter())
+            .flat_map(|&e| q.iter().map(move |&qj| (e, qj)))
+            .collect::<Vec<_>>()
+            .into_iter()
+            .map(|(e, qj)| arena.diff(e, qj))
+            .collect()
+    };
+    let derivatives = |arena: &mut ExprArena, x: &[ExprId]| -> Vec<ExprId> {
+        (q.iter())
+            .flat_map(|&qk| x.iter().map(move |&e| (e, qk)))
+            .collect::<Vec<_>>()
+            .into_iter()
+            .map(|(e, qk)| arena.diff(e, qk))
+            .collect()
+    };
+    let a = jacobian(arena, &s.relabel);
+    if derivatives(arena, &a).iter().any(|&e| !arena.is_zero(e)) {
+        return None;
+    }
+    let inverse = inverse(arena, &a, n)?;
+    let mass_terms: Vec<ExprId> = masses.iter().map(|(m, ..)| *m).collect();
     let m = arena.sum(&mass_terms);
     let moment: Vec<ExprId> = (0..2)
-        .map(|a| {
+        .map(|c| {
             let terms: Vec<ExprId> = (masses.iter())
-                .map(|(mi, r)| arena.times(*mi, r[a]))
+                .map(|(mi, r, _)| arena.times(*mi, r[c]))
                 .collect();
             arena.sum(&terms)
         })
         .collect();
-    let jacobian = |arena: &mut ExprArena, v: &[ExprId]| -> Vec<ExprId> {
-        (v.iter())
-            .flat_map(|&e| q.iter().map(|&qj| (e, qj)).collect::<Vec<_>>())
-            .map(|(e, qj)| arena.diff(e, qj))
-            .collect()
-    };
+    let relabelled: rustc_hash::FxHashMap<_, _> =
+        q.iter().copied().zip(s.relabel.iter().copied()).collect();
+    let moment_after: Vec<ExprId> = (moment.iter())
+        .map(|&e| arena.substitute(e, &relabelled))
+        .collect();
     let k = jacobian(arena, &moment);
     let f = jacobian(arena, &s.foot);
-    let mut mass = Vec::with_capacity(n * n);
-    for si in &symbols {
-        let ti = arena.diff(kinetic, si[1]);
-        for sj in &symbols {
-            mass.push(arena.diff(ti, sj[1]));
-        }
-    }
-    // `(Aᵀ B)_ij = Σ_a A_ai B_aj` over the two components.
-    let ta_b = |arena: &mut ExprArena, a: &[ExprId], b: &[ExprId], i: usize, j: usize| {
-        let terms = [arena.times(a[i], b[j]), arena.times(a[n + i], b[n + j])];
-        arena.sum(&terms)
-    };
-    let (mut p, mut qm) = (Vec::with_capacity(n * n), Vec::with_capacity(n * n));
-    for i in 0..n {
-        for j in 0..n {
-            let fk = ta_b(arena, &f, &k, i, j);
-            let kf = ta_b(arena, &k, &f, i, j);
-            let ff = ta_b(arena, &f, &f, i, j);
-            let mff = arena.times(m, ff);
-            let minus_fk = arena.neg(fk);
-            let minus_kf = arena.neg(kf);
-            p.push(arena.sum(&[mass[i * n + j], minus_fk, minus_kf, mff]));
-            qm.push(arena.sum(&[mass[i * n + j], minus_fk]));
-        }
-    }
-    let derivatives = |arena: &mut ExprArena, x: &[ExprId]| -> Vec<ExprId> {
-        (q.iter())
-            .flat_map(|&qk| x.iter().map(move |&e| (e, qk)).collect::<Vec<_>>())
-            .map(|(e, qk)| arena.diff(e, qk))
+    // The rows `(w, J, G)`.
+    let times_inverse = |arena: &mut ExprArena, row: &[ExprId]| -> Vec<ExprId> {
+        (0..n)
+            .map(|j| {
+                let terms: Vec<ExprId> = (0..n)
+                    .map(|i| arena.times(row[i], inverse[i * n + j]))
+                    .collect();
+                arena.sum(&terms)
+            })
             .collect()
     };
-    let dp = derivatives(arena, &p);
-    let dq = derivatives(arena, &qm);
-    let rq = jacobian(arena, &s.relabel);
-    let drq = derivatives(arena, &rq);
+    let mut rows: Vec<(ExprId, Vec<ExprId>, Vec<ExprId>)> = Vec::new();
+    let mut k_after = vec![Vec::new(); 2];
+    for (mi, r, rotation) in masses {
+        for c in 0..2 {
+            let relative = arena.minus(r[c], s.foot[c]);
+            let d = jacobian(arena, &[relative]);
+            let g = times_inverse(arena, &d);
+            k_after[c].push((*mi, g.clone()));
+            rows.push((*mi, jacobian(arena, &[r[c]]), g));
+        }
+        if let Some((inertia, angle)) = rotation {
+            let j = jacobian(arena, &[*angle]);
+            let g = times_inverse(arena, &j);
+            rows.push((*inertia, j, g));
+        }
+    }
+    let k_after: Vec<ExprId> = (k_after.iter())
+        .flat_map(|parts| {
+            (0..n)
+                .map(|j| parts.iter().map(|(mi, g)| (*mi, g[j])).collect::<Vec<_>>())
+                .collect::<Vec<_>>()
+        })
+        .map(|terms| {
+            let products: Vec<ExprId> = terms.iter().map(|(mi, g)| arena.times(*mi, *g)).collect();
+            arena.sum(&products)
+        })
+        .collect();
+    let (mut mass_after, mut h) = (Vec::with_capacity(n * n), Vec::with_capacity(n * n));
+    for i in 0..n {
+        for j in 0..n {
+            let (mut mm, mut hh) = (Vec::new(), Vec::new());
+            for (w, jr, g) in &rows {
+                let gg = arena.times(g[i], g[j]);
+                mm.push(arena.times(*w, gg));
+                let gj = arena.times(g[i], jr[j]);
+                hh.push(arena.times(*w, gj));
+            }
+            mass_after.push(arena.sum(&mm));
+            h.push(arena.sum(&hh));
+        }
+    }
+    let dh = derivatives(arena, &h);
+    let dm = derivatives(arena, &mass_after);
     let mut out = vec![m];
     for part in [
         &s.normal[..],
         &moment,
+        &moment_after,
         &s.foot,
         &k,
+        &k_after,
         &f,
-        &p,
-        &qm,
-        &dp,
-        &dq,
+        &mass_after,
+        &h,
+        &dh,
+        &dm,
         &s.relabel,
-        &rq,
-        &drq,
+        &a,
     ] {
         out.extend_from_slice(part);
     }
+    out.push(s.when);
     debug_assert_eq!(out.len(), block_len(n));
-    out
+    Some(out)
+}
+
+/// The inverse of the `n × n` matrix `a` (row-major) of constant expressions, by Gauss–Jordan
+/// elimination on the expressions (each pivot the first entry of its column that is not
+/// identically 0); `None` if it is singular.
+fn inverse(arena: &mut ExprArena, a: &[ExprId], n: usize) -> Option<Vec<ExprId>> {
+    let mut m: Vec<Vec<ExprId>> = (0..n)
+        .map(|i| {
+            let mut row = a[i * n..(i + 1) * n].to_vec();
+            row.extend((0..n).map(|j| arena.int(i64::from(i == j))));
+            row
+        })
+        .collect();
+    for c in 0..n {
+        let p = (c..n).find(|&r| !arena.is_zero(m[r][c]))?;
+        m.swap(c, p);
+        let pivot = m[c][c];
+        for j in 0..2 * n {
+            m[c][j] = arena.divide(m[c][j], pivot);
+        }
+        for r in (0..n).filter(|&r| r != c) {
+            let factor = m[r][c];
+            if arena.is_zero(factor) {
+                continue;
+            }
+            for j in 0..2 * n {
+                let t = arena.times(factor, m[c][j]);
+                m[r][j] = arena.minus(m[r][j], t);
+            }
+        }
+    }
+    Some(m.into_iter().flat_map(|row| row[n..].to_vec()).collect())
 }

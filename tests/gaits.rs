@@ -1,0 +1,189 @@
+//! Gaits through changes of support (`support:`): the rimless wheel's steady rolling and the
+//! eigenvalue of its return map against their closed forms (two spoke counts and slopes), the
+//! return map's Jacobian (variational equations and saltation matrices) against central
+//! differences of the map itself, and Garcia's simplest walker against the limit equations
+//! integrated by SciPy (tools/simplest_walker_reference.py).
+
+use eomgen::analysis::{GaitOptions, Method, SimulationOptions, gait, return_map, simulate};
+use eomgen::hybrid::TransitionKind;
+use eomgen::{DynFirstOrder, JitModel, ModelInfo};
+
+/// The bundled model `name` with `set` applied.
+fn model(name: &str, set: &[(&str, f64)]) -> DynFirstOrder<JitModel> {
+    let path = format!("{}/models/{name}.yaml", env!("CARGO_MANIFEST_DIR"));
+    let mut model = DynFirstOrder::new(JitModel::load(&path).unwrap());
+    for (k, v) in set {
+        model.set_parameter(k, *v).unwrap();
+    }
+    model
+}
+
+/// The rimless wheel's steady rolling (a point-mass hub): each step starts at `θ = −α` with
+/// `ω* = cot 2α √(4 (g/l) sin α sin γ)`, and the return map's eigenvalue is `cos² 2α`
+/// (Coleman, Chatterjee & Ruina 1997), for eight spokes on γ = 0.1 and six on γ = 0.2, from
+/// a start 30 % off. Tolerance 1e-9 (Newton's 1e-10, DOP853 at 1e-12).
+#[test]
+fn the_rimless_wheel_rolls_at_the_closed_form_rate_and_its_eigenvalue_is_cos_squared_two_alpha() {
+    let (g, l) = (9.81, 1.0);
+    for (spokes, gamma) in [(8.0, 0.1), (6.0, 0.2)] {
+        let alpha = std::f64::consts::PI / spokes;
+        let mut wheel = model("rimless_wheel", &[("alpha", alpha), ("gamma", gamma)]);
+        let omega = (4.0 * g / l * alpha.sin() * gamma.sin()).sqrt() / (2.0 * alpha).tan();
+        let options = GaitOptions {
+            start: Some(vec![-alpha, 1.3 * omega]),
+            ..GaitOptions::default()
+        };
+        let found = gait(&mut wheel, &options).unwrap();
+        assert!((found.state[0] + alpha).abs() < 1e-9, "{:?}", found.state);
+        assert!(
+            (found.state[1] - omega).abs() < 1e-9 * omega,
+            "{} vs {omega}",
+            found.state[1]
+        );
+        let expected = (2.0 * alpha).cos().powi(2);
+        let lambda = found.eigenvalues[0];
+        assert!(
+            (lambda.re - expected).abs() < 1e-9 && lambda.im.abs() < 1e-9,
+            "{lambda}"
+        );
+        assert!(
+            found.eigenvalues[1].norm() < 1e-9,
+            "{:?}",
+            found.eigenvalues
+        );
+        // The monodromy's multipliers: 1 (the flow) and the same cos² 2α.
+        let mut moduli: Vec<f64> = found.floquet_multipliers.iter().map(|m| m.norm()).collect();
+        moduli.sort_by(f64::total_cmp);
+        assert!((moduli[0] - expected).abs() < 1e-9 && (moduli[1] - 1.0).abs() < 1e-9);
+        assert!(found.stability.is_stable());
+    }
+}
+
+/// Central differences of `P` about `y` (step `h`), column by column.
+fn central_differences(model: &mut dyn ModelInfo, y: &[f64], h: f64) -> Vec<Vec<f64>> {
+    let options = GaitOptions::default();
+    let mut stats = Default::default();
+    (0..y.len())
+        .map(|k| {
+            let mut shifted = [y.to_vec(), y.to_vec()];
+            shifted[0][k] += h;
+            shifted[1][k] -= h;
+            let [plus, minus] = shifted.map(|s| {
+                return_map(model, &s, &options, &mut stats)
+                    .unwrap_or_else(|e| panic!("{s:?}: {e}"))
+                    .end
+            });
+            plus.iter()
+                .zip(&minus)
+                .map(|(p, m)| (p - m) / (2.0 * h))
+                .collect()
+        })
+        .collect()
+}
+
+/// The return map's Jacobian from the variational equations and the saltation matrices
+/// agrees with central differences of the map (step 1e-5, error `O(h²)` and `ε/h`) to 1e-6
+/// relative to its largest entry, off the gait and on it, for the rimless wheel and for the
+/// simplest walker (whose step passes a scuff and lands at a heel strike).
+#[test]
+fn the_saltation_jacobian_matches_central_differences_of_the_return_map() {
+    let cases: [(&str, &[(&str, f64)], Vec<f64>); 3] = [
+        ("rimless_wheel", &[], vec![-0.39, 1.5]),
+        (
+            "simplest_walker",
+            &[],
+            vec![0.2003, 0.4006, -0.1998, -0.0158],
+        ),
+        (
+            "simplest_walker",
+            &[("beta", 1e-3)],
+            vec![0.1985, 0.3970, -0.1985, -0.0154],
+        ),
+    ];
+    for (name, set, y) in cases {
+        let mut m = model(name, set);
+        let mut stats = Default::default();
+        let exact = return_map(&mut m, &y, &GaitOptions::default(), &mut stats).unwrap();
+        let differences = central_differences(&mut m, &y, 1e-5);
+        let scale = exact.return_map.amax();
+        for (k, column) in differences.iter().enumerate() {
+            for (i, d) in column.iter().enumerate() {
+                let e = exact.return_map[(i, k)];
+                assert!(
+                    (e - d).abs() < 1e-6 * scale,
+                    "{name} {set:?}: ∂P{i}/∂y{k} = {e} by saltation, {d} by differences"
+                );
+            }
+        }
+    }
+}
+
+/// Garcia's simplest walker at γ = 0.009 (feet of mass 1e-9 of the hip's for the paper's
+/// limit): the long-period gait and its eigenvalues against the limit's own equations
+/// integrated by SciPy (tools/simplest_walker_reference.py, whose eigenvalues come from
+/// central differences, good to about 1e-7): state to 1e-8, period to 1e-8, eigenvalues to
+/// 1e-6.
+#[test]
+fn the_simplest_walker_walks_garcias_gait_with_its_eigenvalues() {
+    let mut walker = model("simplest_walker", &[]);
+    let found = gait(&mut walker, &GaitOptions::default()).unwrap();
+    let reference = [
+        0.2003109005442575,
+        0.400621801088515,
+        -0.1998324730049286,
+        -0.015822999948309113,
+    ];
+    for (y, r) in found.state.iter().zip(reference) {
+        assert!((y - r).abs() < 1e-8, "{:?}", found.state);
+    }
+    assert!(
+        (found.period - 3.8824637528542985).abs() < 1e-8,
+        "{}",
+        found.period
+    );
+    let lambda = found.eigenvalues[0];
+    assert!((lambda.re + 0.19009983955098966).abs() < 1e-6, "{lambda}");
+    assert!(
+        (lambda.im.abs() - 0.5575987834114509).abs() < 1e-6,
+        "{lambda}"
+    );
+    assert!(
+        found.eigenvalues[2].norm() < 1e-6,
+        "{:?}",
+        found.eigenvalues
+    );
+    assert!(found.stability.is_stable());
+}
+
+/// A run of the rimless wheel through its landings (`simulate`): each landing keeps the
+/// angular momentum about the new foot (`θ̇⁺ = cos 2α θ̇⁻` for a point-mass hub, to 1e-12),
+/// loses `½ m l² (1 − cos² 2α) θ̇⁻²`, and `T + V` with the losses and the datum's moves
+/// added is conserved to the tolerance's level.
+#[test]
+fn a_run_of_the_rimless_wheel_keeps_the_angular_momentum_about_each_new_foot() {
+    let mut wheel = model("rimless_wheel", &[]);
+    let alpha = std::f64::consts::PI / 8.0;
+    let options = SimulationOptions {
+        method: Method::Dop853,
+        t_end: 5.0,
+        rtol: 1e-10,
+        atol: 1e-10,
+        ..Default::default()
+    };
+    let run = simulate(&mut wheel, &options).unwrap();
+    let landings: Vec<_> = (run.transitions.iter())
+        .filter(|tr| tr.kind == TransitionKind::SupportChange)
+        .collect();
+    assert_eq!(landings.len(), 6);
+    for tr in landings {
+        let (before, after) = (tr.qdot[0][0], tr.qdot[1][0]);
+        assert!((after - (2.0 * alpha).cos() * before).abs() < 1e-12 * before);
+        let lost = 0.5 * (1.0 - (2.0 * alpha).cos().powi(2)) * before * before;
+        assert!(
+            (tr.energy_lost - lost).abs() < 1e-12,
+            "{} vs {lost}",
+            tr.energy_lost
+        );
+    }
+    assert!(run.energy.drift.unwrap() < 1e-8, "{:?}", run.energy.drift);
+}
