@@ -438,6 +438,10 @@ pub fn return_map(
 /// variational equations integrated until the first change of support's gap falls through 0.
 type Landing = ((usize, usize), Vec<f64>, (DMatrix<f64>, f64));
 
+/// A zero of a landing gap along the variational flow: the landing `(contact, support)`, and
+/// the time and `[y; vec Φ]` there.
+type Zero = ((usize, usize), (f64, Vec<f64>));
+
 /// Integrates step `step` from `(t0, y0)` to its landing (see [`Landing`]). A zero of a
 /// landing gap where the file's `when:` is not positive is passed (the foot scuffs), and the
 /// integration goes on from it.
@@ -510,7 +514,7 @@ fn next_zero<'m>(
     (t_end, touch): (f64, f64),
     options: &IntegratorOptions,
     stats: &mut Stats,
-) -> Result<Option<((usize, usize), (f64, Vec<f64>))>, String> {
+) -> Result<Option<Zero>, String> {
     let contacts = flow.system.description().contacts.len();
     let dim = 2 * flow.system.num_dofs();
     let mut gaps = vec![0.0; 5 * contacts];

@@ -690,10 +690,10 @@ impl Run<'_> {
         lands: &[bool],
     ) -> Result<(), ContactStop> {
         let n = model.num_dofs();
-        for c in 0..self.closed.len() {
+        for (c, &lands) in lands.iter().enumerate() {
             let values = model.contact_values(self.t, &self.y);
             let touches = values.gaps[c].abs() <= self.atol && values.rates[c].abs() <= self.atol;
-            if self.closed[c] || Some(c) == released || lands[c] || !touches {
+            if self.closed[c] || Some(c) == released || lands || !touches {
                 continue;
             }
             let mut closed: Vec<usize> =

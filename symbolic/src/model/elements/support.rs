@@ -469,19 +469,18 @@ fn inverse(arena: &mut ExprArena, a: &[ExprId], n: usize) -> Option<Vec<ExprId>>
         let p = (c..n).find(|&r| !arena.is_zero(m[r][c]))?;
         m.swap(c, p);
         let pivot = m[c][c];
-        for j in 0..2 * n {
-            m[c][j] = arena.divide(m[c][j], pivot);
-        }
+        let row: Vec<ExprId> = m[c].iter().map(|&e| arena.divide(e, pivot)).collect();
         for r in (0..n).filter(|&r| r != c) {
             let factor = m[r][c];
             if arena.is_zero(factor) {
                 continue;
             }
-            for j in 0..2 * n {
-                let t = arena.times(factor, m[c][j]);
-                m[r][j] = arena.minus(m[r][j], t);
+            for (e, &p) in m[r].iter_mut().zip(&row) {
+                let t = arena.times(factor, p);
+                *e = arena.minus(*e, t);
             }
         }
+        m[c] = row;
     }
     Some(m.into_iter().flat_map(|row| row[n..].to_vec()).collect())
 }
