@@ -87,7 +87,8 @@ fn central_differences(model: &mut dyn ModelInfo, y: &[f64], h: f64) -> Vec<Vec<
 /// simplest walker (whose step passes a scuff and lands at a heel strike).
 #[test]
 fn the_saltation_jacobian_matches_central_differences_of_the_return_map() {
-    let cases: [(&str, &[(&str, f64)], Vec<f64>); 3] = [
+    type Case<'a> = (&'a str, &'a [(&'a str, f64)], Vec<f64>);
+    let cases: [Case; 3] = [
         ("rimless_wheel", &[], vec![-0.39, 1.5]),
         (
             "simplest_walker",
