@@ -26,6 +26,10 @@
 //! walker's gait and its eigenvalues); Bhounsule, DCDIS B 21 (2014) (variational equations
 //! against finite differences for the rimless wheel and the simplest walker).
 
+mod sweep;
+
+pub use sweep::{GaitBifurcation, GaitStabilityChange, GaitSweep, GaitSweepPoint, gait_sweep};
+
 use nalgebra::{Complex, DMatrix, DVector};
 use serde::Serialize;
 
@@ -121,6 +125,14 @@ pub enum GaitError {
     NoSupport {
         /// The model.
         model: String,
+    },
+    /// The swept parameter is not the model's.
+    #[error("the model has no parameter `{name}`; its parameters are {parameters}")]
+    UnknownParameter {
+        /// The name given.
+        name: String,
+        /// The model's parameters.
+        parameters: String,
     },
     /// The settings are out of range.
     #[error("{what}")]

@@ -32,7 +32,10 @@ pub use constraint_methods::{
 pub use drift::{ConstraintDrift, EnergyDrift, constraint_drift, energy_drift, energy_drift_at};
 pub use failure::{FailureCause, failure_cause};
 pub use fixed_step::{ENERGY_DRIFT_LIMIT, SimulationWarning, fixed_step_warnings};
-pub use gait::{Gait, GaitError, GaitOptions, ReturnMap, gait, return_map};
+pub use gait::{
+    Gait, GaitBifurcation, GaitError, GaitOptions, GaitStabilityChange, GaitSweep, GaitSweepPoint,
+    ReturnMap, gait, gait_sweep, return_map,
+};
 pub use methods::{Amplification, Constructor, Method, MethodInfo, UnknownMethod};
 pub use outcome::{NothingMeasured, RunTally, StudyRuns};
 pub use periodic_orbit::{

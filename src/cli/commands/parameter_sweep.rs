@@ -13,6 +13,7 @@ use eomgen::analysis::vibration::{
     self, Crossing, Direction, ParameterSweep, ParameterSweepError, ParameterSweepOptions,
     SweepAxis,
 };
+use eomgen::analysis::{GaitBifurcation, GaitError, GaitOptions};
 use eomgen::{ModelInfo, Stability};
 
 use crate::cli::error::CliError;
@@ -42,6 +43,10 @@ pub struct ParameterSweepArgs {
     /// Print JSON.
     #[arg(long)]
     pub json: bool,
+    /// For a model with a change of support (`support:`): the landings in one period of the
+    /// gait followed (1: a period-one gait; 2 after a period doubling).
+    #[arg(long, default_value_t = 1)]
+    pub steps: usize,
 }
 
 /// Runs `study parameter-sweep`.
@@ -50,6 +55,11 @@ pub fn run(args: &ParameterSweepArgs) -> Result<(), CliError> {
         .input(&args.model)
         .chart("--plot", args.plot.as_deref())
         .check()?;
+    let found = crate::cli::model::find_model(&args.model)?;
+    if !found.description().supports.is_empty() {
+        return gait_sweep(args, found);
+    }
+    drop(found);
     let mut model = args.point.model(&args.model)?;
     let axis = parse_values(&args.parameter, &args.values, model.as_ref())?;
     let options = ParameterSweepOptions {
@@ -87,6 +97,102 @@ pub fn run(args: &ParameterSweepArgs) -> Result<(), CliError> {
         });
     }
     print_text(&sweep, args.plot.as_deref());
+    Ok(())
+}
+
+/// `study parameter-sweep` on a model with a change of support: its gait followed over the
+/// parameter from the model's initial state ([`eomgen::analysis::gait_sweep()`]).
+fn gait_sweep(args: &ParameterSweepArgs, mut model: Box<dyn ModelInfo>) -> Result<(), CliError> {
+    if args.point.at.is_some() || args.plot.is_some() {
+        return Err(CliError::usage(format!(
+            "--at and --plot do not apply to a gait (`{}` changes its support): the sweep follows the gait from the model's initial state",
+            model.description().name
+        )));
+    }
+    crate::cli::values::set_parameters(model.as_mut(), &args.point.set)?;
+    let axis = parse_values(&args.parameter, &args.values, model.as_ref())?;
+    let options = GaitOptions {
+        steps: args.steps,
+        ..GaitOptions::default()
+    };
+    let bar = crate::cli::render::progress_bar(
+        axis.values.len(),
+        "{msg} [{bar:40}] {pos}/{len} values",
+        "gait sweep",
+        args.json,
+    );
+    let sweep = eomgen::analysis::gait_sweep(model.as_mut(), &axis, &options, |done, _| {
+        bar.set_position(done as u64);
+    });
+    bar.finish_and_clear();
+    let sweep = sweep.map_err(|e| match e {
+        GaitError::UnknownParameter { .. } => CliError::usage(format!("--parameter: {e}")),
+        GaitError::InvalidOptions { .. } => CliError::usage(e.to_string()),
+        e => CliError::failure(format!("`{}`: {e}", model.description().name)),
+    })?;
+    if args.json {
+        return print_json_sorted(&sweep);
+    }
+    let mut out = crate::cli::output::stdout();
+    let _ = writeln!(
+        out,
+        "{}: its gait of {} step{} per period against {}, the eigenvalues λ of the return map (|λ| < 1: stable)",
+        sweep.model,
+        sweep.steps,
+        if sweep.steps == 1 { "" } else { "s" },
+        sweep.parameter
+    );
+    for p in &sweep.points {
+        let verdict = p.stability.map_or("failed", |s| s.as_str());
+        let tail = match (&p.error, p.period) {
+            (Some(e), _) => e.clone(),
+            (None, period) => {
+                let values: Vec<String> = (p.eigenvalues.iter())
+                    .filter(|l| l.im >= 0.0 && l.norm() > 1e-9)
+                    .map(|l| {
+                        if l.im == 0.0 {
+                            decimals(l.re, 8)
+                        } else {
+                            format!("{}±{}i", decimals(l.re, 8), decimals(l.im, 8))
+                        }
+                    })
+                    .collect();
+                format!(
+                    "T = {:.9}  {}",
+                    period.unwrap_or(f64::NAN),
+                    values.join("  ")
+                )
+            }
+        };
+        let _ = writeln!(out, "{:>14}  {verdict:<22} {tail}", decimals(p.value, 8));
+    }
+    if sweep.stability_changes.is_empty() {
+        let _ = writeln!(out, "stability changes: none in this range");
+    }
+    for c in &sweep.stability_changes {
+        let kind = match c.kind {
+            GaitBifurcation::PeriodDoubling => "a period doubling (an eigenvalue through −1)",
+            GaitBifurcation::Fold => "a fold (an eigenvalue through +1)",
+            GaitBifurcation::NeimarkSacker => {
+                "a Neimark–Sacker bifurcation (a complex pair leaves the unit circle)"
+            }
+        };
+        let direction = if c.stable_below {
+            "stable below"
+        } else {
+            "stable above"
+        };
+        let _ = writeln!(
+            out,
+            "stability change  {} = {} (in [{}, {}]): {kind}, {direction}; λ = {:.6}{:+.6}i",
+            sweep.parameter,
+            decimals(c.value, 10),
+            decimals(c.bracket[0], 10),
+            decimals(c.bracket[1], 10),
+            c.eigenvalue[0],
+            c.eigenvalue[1]
+        );
+    }
     Ok(())
 }
 
