@@ -188,3 +188,26 @@ fn a_run_of_the_rimless_wheel_keeps_the_angular_momentum_about_each_new_foot() {
     }
     assert!(run.energy.drift.unwrap() < 1e-8, "{:?}", run.energy.drift);
 }
+
+/// The simplest walker's gait followed over the slope loses its stability by a period
+/// doubling (an eigenvalue through −1) at γ = 0.0150884 (Garcia et al. 1998: "about
+/// 0.0151"), located by bisection to 1e-7 of the limit equations' own (SciPy, with
+/// eigenvalues by central differences: tools/simplest_walker_reference.py).
+#[test]
+fn the_simplest_walkers_gait_period_doubles_near_gamma_0_0151() {
+    use eomgen::analysis::vibration::SweepAxis;
+    use eomgen::analysis::{GaitBifurcation, gait_sweep};
+    let mut walker = model("simplest_walker", &[]);
+    let axis = SweepAxis::linear("gamma", 0.009, 0.017, 5).unwrap();
+    let sweep = gait_sweep(&mut walker, &axis, &GaitOptions::default(), |_, _| {}).unwrap();
+    assert!(sweep.points.iter().all(|p| p.error.is_none()), "{:?}", sweep.points);
+    let [change] = sweep.stability_changes.as_slice() else {
+        panic!("{:?}", sweep.stability_changes);
+    };
+    assert_eq!(change.kind, GaitBifurcation::PeriodDoubling);
+    assert!(change.stable_below);
+    assert!((change.value - 0.015088438009377567).abs() < 1e-7, "{}", change.value);
+    assert!((change.eigenvalue[0] + 1.0).abs() < 1e-4, "{:?}", change.eigenvalue);
+    // The parameter is restored.
+    assert_eq!(walker.parameter_values()[4], 0.009);
+}

@@ -12,7 +12,8 @@ The fixed point of the map on the state just after a heel strike (theta, theta',
 2 theta there) is found by Newton with a Jacobian by central differences, the integration by
 SciPy's DOP853 at rtol = atol = 1e-13; the eigenvalues are those of that 3 x 3 Jacobian (the
 map's fourth direction, phi - 2 theta, is fixed at 0 by the heel strike). Prints JSON for
-gamma = 0.009 (the values tests/gaits.rs compares against).
+gamma = 0.009, and the slope of the period doubling (an eigenvalue at -1, by bisection):
+the values tests/gaits.rs compares against.
 
 Run: python3 tools/simplest_walker_reference.py   (needs numpy, scipy)
 """
@@ -69,13 +70,30 @@ def gait(gamma, x):
     return x
 
 
+def period_doubling(lo, hi, x):
+    """The slope where the gait's most negative eigenvalue reaches -1, by bisection (the
+    gait followed from `x`)."""
+    for _ in range(30):
+        mid = 0.5 * (lo + hi)
+        x = gait(mid, x)
+        if min(np.linalg.eigvals(jacobian(x, mid)).real) > -1:
+            lo = mid
+        else:
+            hi = mid
+    return 0.5 * (lo + hi)
+
+
 def main():
     gamma = 0.009
     x = gait(gamma, np.array([0.2003, -0.1998, -0.0158]))
     end, period = step(x, gamma)
     eig = np.linalg.eigvals(jacobian(x, gamma))
     eig = sorted(eig, key=lambda z: (-abs(z), -z.imag))
+    x15 = x
+    for g in np.linspace(0.009, 0.015, 7):
+        x15 = gait(g, x15)
     print(json.dumps({
+        "period_doubling_gamma": period_doubling(0.015, 0.016, x15),
         "gamma": gamma,
         "theta": x[0], "theta_dot": x[1], "phi": 2 * x[0], "phi_dot": x[2],
         "period": period,
