@@ -200,14 +200,59 @@ fn the_simplest_walkers_gait_period_doubles_near_gamma_0_0151() {
     let mut walker = model("simplest_walker", &[]);
     let axis = SweepAxis::linear("gamma", 0.009, 0.017, 5).unwrap();
     let sweep = gait_sweep(&mut walker, &axis, &GaitOptions::default(), |_, _| {}).unwrap();
-    assert!(sweep.points.iter().all(|p| p.error.is_none()), "{:?}", sweep.points);
+    assert!(
+        sweep.points.iter().all(|p| p.error.is_none()),
+        "{:?}",
+        sweep.points
+    );
     let [change] = sweep.stability_changes.as_slice() else {
         panic!("{:?}", sweep.stability_changes);
     };
     assert_eq!(change.kind, GaitBifurcation::PeriodDoubling);
     assert!(change.stable_below);
-    assert!((change.value - 0.015088438009377567).abs() < 1e-7, "{}", change.value);
-    assert!((change.eigenvalue[0] + 1.0).abs() < 1e-4, "{:?}", change.eigenvalue);
+    assert!(
+        (change.value - 0.015088438009377567).abs() < 1e-7,
+        "{}",
+        change.value
+    );
+    assert!(
+        (change.eigenvalue[0] + 1.0).abs() < 1e-4,
+        "{:?}",
+        change.eigenvalue
+    );
     // The parameter is restored.
     assert_eq!(walker.parameter_values()[4], 0.009);
+}
+
+/// Mistakes a change of support can only show once the model is lowered get located
+/// errors: a `relabel` that is not an invertible affine map, and a model with constraints.
+#[test]
+fn a_change_of_support_that_cannot_be_derived_is_refused_where_it_is_written() {
+    for (name, line, column, message) in [
+        (
+            "broken-support-relabel-not-affine",
+            10,
+            73,
+            "its `relabel` is not an invertible affine map of the coordinates",
+        ),
+        (
+            "broken-support-with-constraints",
+            10,
+            73,
+            "but the model has constraints",
+        ),
+    ] {
+        let path = format!("{}/tests/fixtures/{name}.yaml", env!("CARGO_MANIFEST_DIR"));
+        let Err(eomgen::LoadError::Diagnostics { diagnostics, .. }) = JitModel::load(&path) else {
+            panic!("{name} loaded");
+        };
+        assert_eq!(diagnostics.len(), 1, "{diagnostics:?}");
+        let d = &diagnostics[0];
+        assert!(d.message.contains(message), "{name}: {}", d.message);
+        assert_eq!(
+            (d.location.line, d.location.column),
+            (line, column),
+            "{name}"
+        );
+    }
 }

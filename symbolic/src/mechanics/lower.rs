@@ -583,7 +583,10 @@ impl<'f> Lowering<'f> {
             let Some(support) = c.support.as_mut() else {
                 continue;
             };
-            let at = written.name.location;
+            let at = written
+                .support
+                .as_ref()
+                .map_or(written.name.location, |s| s.at);
             let what = format!("contact `{}` changes the support", c.name);
             let spatial = bodies.iter().any(|b| b.spatial.is_some());
             let reason = if file.kinetic.is_some() || bodies.is_empty() || spatial {

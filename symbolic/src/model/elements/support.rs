@@ -47,7 +47,7 @@ use super::{Depends, Lower, Rules};
 /// `support:` of a contact.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Support {
-    /// Where `support:` is written.
+    /// Where the value of `support:` is written.
     pub at: crate::model::located::Location,
     /// The landing foot (`foot:`); the contact's point when left out.
     pub foot: Option<Located<String>>,
@@ -73,7 +73,7 @@ const SUPPORT: Fields = Fields {
     example: "{ foot: S, normal: [0, 1], relabel: { theta: -theta, phi: -phi } }",
 };
 
-/// `support:` of the contact `key`.
+/// `support:` of the contact `key` (`node` its value).
 pub(crate) fn read(cx: &mut Ctx<'_>, key: &Located<String>, node: &YamlNode) -> Option<Support> {
     let f = cx.fields(key, node, &SUPPORT)?;
     let foot = match get(f, "foot") {
@@ -100,7 +100,7 @@ pub(crate) fn read(cx: &mut Ctx<'_>, key: &Located<String>, node: &YamlNode) -> 
         None => Some(None),
     };
     Some(Support {
-        at: key.location,
+        at: node.location,
         foot: foot?,
         normal: normal?,
         relabel: relabel?,
