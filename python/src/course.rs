@@ -17,7 +17,7 @@ use eomgen::analysis::rolling_contact::{RollingContactOptions, rolling_contact};
 use eomgen::analysis::vibration::{
     self, ConvolutionOptions, ExpmOptions, Forcing, OperatingPointOptions, RayleighOptions,
 };
-use eomgen::analysis::{PeriodicOrbitOptions, periodic_orbit};
+use eomgen::analysis::{GaitOptions, PeriodicOrbitOptions, gait, periodic_orbit};
 use eomgen::expressions::{TimeFunction, evaluate, parameter_lookup, split_list};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -319,7 +319,7 @@ fn model_period(model: &dyn ModelInfo) -> PyResult<f64> {
 /// multipliers (`eomgen study periodic-orbit`).
 #[pyfunction]
 #[allow(clippy::too_many_arguments)]
-#[pyo3(signature = (model, start = None, period = None, fix_period = false, energy = None, tol = None, max_iterations = None, integration_tol = None, samples = None, unit_multiplier_tolerance = None))]
+#[pyo3(signature = (model, start = None, period = None, fix_period = false, energy = None, tol = None, max_iterations = None, integration_tol = None, samples = None, unit_multiplier_tolerance = None, steps = 1))]
 fn study_periodic_orbit<'py>(
     py: Python<'py>,
     model: &CoreModel,
@@ -332,9 +332,42 @@ fn study_periodic_orbit<'py>(
     integration_tol: Option<f64>,
     samples: Option<usize>,
     unit_multiplier_tolerance: Option<f64>,
+    steps: usize,
 ) -> PyResult<Bound<'py, PyAny>> {
     let mut instance = model.fresh()?;
     let initial = instance.initial_state();
+    if !instance.description().supports.is_empty() {
+        // A gait: the fixed point of the return map through `steps` landings.
+        if period.is_some() || fix_period || energy.is_some() {
+            return Err(PyValueError::new_err(
+                "period, fix_period and energy do not apply to a gait: its period is the time of its steps",
+            ));
+        }
+        let defaults = GaitOptions::default();
+        let options = GaitOptions {
+            start: Some(match start {
+                Some(y) if y.len() == initial.len() => finite("start", &y)?.to_vec(),
+                Some(y) => {
+                    return Err(PyValueError::new_err(format!(
+                        "the start must have {} entries ([q; q̇]), got {}",
+                        initial.len(),
+                        y.len()
+                    )));
+                }
+                None => initial,
+            }),
+            steps,
+            tol: tol.unwrap_or(defaults.tol),
+            max_iterations: max_iterations.unwrap_or(defaults.max_iterations),
+            ..defaults
+        };
+        let name = instance.description().name.to_string();
+        let model_ref = &mut instance;
+        let found = py
+            .detach(move || gait(model_ref.as_mut(), &options))
+            .map_err(|e| analysis_error(format!("`{name}`: {e}")))?;
+        return to_python(py, &found, Lists::Arrays);
+    }
     let start = match start {
         Some(y) if y.len() != initial.len() => {
             return Err(PyValueError::new_err(format!(

@@ -90,9 +90,10 @@ fn study_work_precision<'py>(
 }
 
 /// Eigenvalues of an operating point against one parameter, with the stability changes
-/// (`eomgen study parameter-sweep`).
+/// (`eomgen study parameter-sweep`); for a model with a change of support, its gait of
+/// `steps` landings followed over the parameter.
 #[pyfunction]
-#[pyo3(signature = (model, parameter, values, at = None, refine = true))]
+#[pyo3(signature = (model, parameter, values, at = None, refine = true, steps = 1))]
 fn study_parameter_sweep<'py>(
     py: Python<'py>,
     model: &CoreModel,
@@ -100,6 +101,7 @@ fn study_parameter_sweep<'py>(
     values: Vec<f64>,
     at: Option<&Bound<'py, PyAny>>,
     refine: bool,
+    steps: usize,
 ) -> PyResult<Bound<'py, PyAny>> {
     let ascending = values
         .windows(2)
@@ -115,15 +117,37 @@ fn study_parameter_sweep<'py>(
             values.len()
         )));
     }
+    let axis = SweepAxis {
+        name: parameter,
+        values,
+    };
+    let mut instance = model.fresh()?;
+    if !instance.description().supports.is_empty() {
+        // A gait followed over the parameter from the model's initial state.
+        if at.is_some() {
+            return Err(pyo3::exceptions::PyValueError::new_err(
+                "at does not apply to a gait: the sweep follows it from the model's initial state",
+            ));
+        }
+        let options = eomgen::analysis::GaitOptions {
+            steps,
+            ..Default::default()
+        };
+        let sweep = py
+            .detach(|| eomgen::analysis::gait_sweep(instance.as_mut(), &axis, &options, |_, _| {}))
+            .map_err(|e| match e {
+                e @ eomgen::analysis::GaitError::UnknownParameter { .. } => {
+                    crate::errors::parameter_error(e)
+                }
+                e => analysis_error(e),
+            })?;
+        return to_python(py, &sweep, Lists::Arrays);
+    }
     let options = ParameterSweepOptions {
-        axis: SweepAxis {
-            name: parameter,
-            values,
-        },
+        axis,
         operating_point: point(at)?,
         refine,
     };
-    let mut instance = model.fresh()?;
     let sweep = py
         .detach(|| vibration::parameter_sweep(instance.as_mut(), &options, |_, _| {}))
         .map_err(|e| match e {

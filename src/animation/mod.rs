@@ -535,8 +535,22 @@ pub fn simulation_animation(
     let mut trail = vec![Vec::with_capacity(samples); scene.traces.len()];
     // Each frame's sample, for the energy lost at impacts before it.
     let mut frame_samples = Vec::with_capacity(samples / sub + 1);
+    // A walker's coordinates are about its stance foot: each change of support moves their
+    // origin to the landing foot, and the drawing follows it (`offset` from sample `next.0`).
+    let mut landings = (simulation.transitions.iter())
+        .filter_map(|tr| Some((tr.sample, tr.foot?)))
+        .peekable();
+    let mut offset = [0.0; 2];
     for (j, (tk, y)) in solution.iter().take(samples).enumerate() {
-        let frame = scene.project(&model.point_positions(tk, y));
+        while let Some((_, foot)) = landings.next_if(|(s, _)| *s <= j) {
+            offset = [offset[0] + foot[0], offset[1] + foot[1]];
+        }
+        let mut positions = model.point_positions(tk, y);
+        for p in &mut positions {
+            p[0] += offset[0];
+            p[1] += offset[1];
+        }
+        let frame = scene.project(&positions);
         for (path, &p) in trail.iter_mut().zip(&scene.traces) {
             path.push(frame[p]);
         }

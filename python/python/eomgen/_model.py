@@ -603,18 +603,23 @@ class Model:
             t_end, samples, target_error, reference_tol, repeats, min_time_s)
 
     def parameter_sweep(self, parameter: str, values: ArrayLike,
-                        at: Optional[Union[str, ArrayLike]] = None, refine: bool = True) -> dict:
+                        at: Optional[Union[str, ArrayLike]] = None, refine: bool = True,
+                        steps: int = 1) -> dict:
         """The eigenvalues of an equilibrium or steady motion against one parameter
         (``eomgen study parameter-sweep``), with every stability change located by
-        bisection (``stability_changes``). ``values`` ascending. Returns the ``--json``
-        report with numeric lists as numpy arrays.
+        bisection (``stability_changes``). ``values`` ascending. For a model with a change
+        of support (a walker), its gait of ``steps`` landings per period followed over the
+        parameter from the initial state, with the return map's eigenvalues and each change
+        of stability named (``period_doubling``, ``fold``, ``neimark_sacker``). Returns the
+        ``--json`` report with numeric lists as numpy arrays.
 
         Raises:
             ParameterError: an unknown parameter.
             AnalysisError: no value of the sweep could be analysed.
         """
         return _eomgen.study_parameter_sweep(
-            self._core, str(parameter), [float(v) for v in np.atleast_1d(values)], _at(at), bool(refine))
+            self._core, str(parameter), [float(v) for v in np.atleast_1d(values)], _at(at), bool(refine),
+            int(steps))
 
     def frf(self, input: str, outputs: Sequence[str] = (), frequency_range: Optional[Tuple[float, float]] = None,
             points: Optional[int] = None, frequencies: Sequence[float] = (), modal: bool = False,
@@ -775,7 +780,7 @@ class Model:
                        energy: Optional[Union[float, str]] = None, tol: Optional[float] = None,
                        max_iterations: Optional[int] = None, integration_tol: Optional[float] = None,
                        samples: Optional[int] = None,
-                       unit_multiplier_tolerance: Optional[float] = None) -> dict:
+                       unit_multiplier_tolerance: Optional[float] = None, steps: int = 1) -> dict:
         """A periodic orbit found by shooting (``eomgen study periodic-orbit``; HW5, HW7,
         HW39): Gauss–Newton on the flow map and its monodromy matrix with a phase condition
         and, with the period free in a conservative model, the energy fixed. Returns its
@@ -800,6 +805,12 @@ class Model:
             samples: samples of the orbit over one period (default 400).
             unit_multiplier_tolerance: ``|μ − 1|`` below which a multiplier is trivial
                 (default 1e-3).
+            steps: for a model with a change of support (a walker, a rimless wheel), the
+                landings in one period of its gait (default 1). Such a model's gait is the
+                fixed point of its return map from the state just after a landing, with the
+                map's Jacobian from the variational equations and a saltation matrix at each
+                landing, its ``eigenvalues``, ``floquet_multipliers`` and ``stability``;
+                ``period``, ``fix_period`` and ``energy`` do not apply.
 
         Raises:
             AnalysisError: Newton did not converge, a constrained model, a time-dependent
@@ -810,7 +821,7 @@ class Model:
         return _eomgen.study_periodic_orbit(
             self._core, start, period, bool(fix_period), energy, tol,
             None if max_iterations is None else int(max_iterations), integration_tol,
-            None if samples is None else int(samples), unit_multiplier_tolerance)
+            None if samples is None else int(samples), unit_multiplier_tolerance, int(steps))
 
     def rolling_contact(self, after_lift_off: bool = False, flight: Optional[Union[str, "Model"]] = None,
                         mu: Optional[ArrayLike] = None, ground: Optional[str] = None,

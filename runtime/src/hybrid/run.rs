@@ -99,6 +99,11 @@ pub struct Transition {
     /// support, whose coordinates are taken about the new stance foot; 0 at every other
     /// transition.
     pub datum_shift: f64,
+    /// At a change of support, where the new stance foot is in the old one's coordinates
+    /// (m): the origin of the coordinates moves there (a drawing of the walk adds it up).
+    /// `None` at every other transition.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub foot: Option<[f64; 2]>,
     /// Index into the run's samples of the first sample after the transition. With every
     /// step sampled ([`OutputTimes::Steps`]) it is at the transition's time, and so is the
     /// sample before it, with the state before; with requested times
@@ -121,6 +126,7 @@ impl Transition {
             tangential_impulse: 0.0,
             energy_lost: 0.0,
             datum_shift: 0.0,
+            foot: None,
             sample,
         }
     }
@@ -516,6 +522,7 @@ impl Run<'_> {
             tangential_impulse: change.tangential_impulse,
             energy_lost: change.energy_lost,
             datum_shift: potential(&after) - potential(&y),
+            foot: Some(change.foot),
             sample,
         });
         self.y = after;
@@ -839,6 +846,7 @@ fn strike_contact(
         tangential_impulse: 0.0,
         energy_lost: 0.0,
         datum_shift: 0.0,
+        foot: None,
         sample: 0,
     };
     // A graze (`|ġ⁻| ≤ atol`, in m/s) closes without an impulse where its force pushes.

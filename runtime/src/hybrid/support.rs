@@ -138,6 +138,9 @@ pub struct SupportChange {
     pub release_velocity: f64,
     /// The kinetic energy lost (J).
     pub energy_lost: f64,
+    /// Where the new stance foot is in the old one's coordinates, `r_S` (m): the origin of
+    /// the new coordinates.
+    pub foot: [f64; 2],
 }
 
 /// Why a change of support has no answer that the model's assumptions allow.
@@ -249,6 +252,7 @@ pub fn change_support(
         normal_impulse,
         tangential_impulse,
         release_velocity,
+        foot: s.foot,
     })
 }
 
