@@ -102,5 +102,40 @@ def main():
     }, indent=2))
 
 
+def bench():
+    """SciPy's times for what benches/gait.rs times in eomgen, on the limit's equations (the
+    same gait): one step of the map with its Jacobian by central differences (7 steps), the
+    gait from the same rough guess, and the gait followed over 100 slopes (each from the
+    last); medians of 5 runs, in one process."""
+    import statistics
+    import time
+
+    def median(f, runs=5):
+        times = []
+        for _ in range(runs):
+            t0 = time.perf_counter()
+            f()
+            times.append(time.perf_counter() - t0)
+        return statistics.median(times)
+
+    x = np.array([0.2003109005442575, -0.1998324730049286, -0.015822999948309113])
+    rough = np.array([0.198, -0.1998, -0.0142])
+    one = median(lambda: step(x, 0.009))
+    with_jacobian = median(lambda: (step(x, 0.009), jacobian(x, 0.009)))
+    fixed = median(lambda: gait(0.009, rough))
+
+    def sweep():
+        y = x
+        for g in np.linspace(0.001, 0.0149, 100):
+            y = gait(g, y)
+
+    swept = median(sweep, runs=1)
+    print(json.dumps({
+        "one_step_s": one, "one_step_with_jacobian_s": with_jacobian,
+        "gait_from_rough_guess_s": fixed, "sweep_100_slopes_s": swept,
+    }, indent=2))
+
+
 if __name__ == "__main__":
-    main()
+    import sys
+    bench() if "--bench" in sys.argv else main()
