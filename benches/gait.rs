@@ -25,7 +25,12 @@ fn walker() -> DynFirstOrder<JitModel> {
 
 fn main() {
     let mut model = walker();
-    let on_gait = vec![0.2003109003941, 0.4006218007882, -0.1998324730785, -0.01582299993073];
+    let on_gait = vec![
+        0.2003109003941,
+        0.4006218007882,
+        -0.1998324730785,
+        -0.01582299993073,
+    ];
     let rough = vec![0.198, 0.4006, -0.1998, -0.0142];
     let options = GaitOptions::default();
     let rough_options = GaitOptions {

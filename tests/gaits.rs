@@ -56,6 +56,10 @@ fn the_rimless_wheel_rolls_at_the_closed_form_rate_and_its_eigenvalue_is_cos_squ
         moduli.sort_by(f64::total_cmp);
         assert!((moduli[0] - expected).abs() < 1e-9 && (moduli[1] - 1.0).abs() < 1e-9);
         assert!(found.stability.is_stable());
+        // The landing loses what gravity gave over the step: m g sin γ · 2 l sin α.
+        let work = g * gamma.sin() * 2.0 * l * alpha.sin();
+        let lost = found.energy_lost[0];
+        assert!((lost - work).abs() < 1e-9 * work, "{lost} vs {work}");
     }
 }
 
@@ -154,6 +158,15 @@ fn the_simplest_walker_walks_garcias_gait_with_its_eigenvalues() {
         found.eigenvalues
     );
     assert!(found.stability.is_stable());
+    // Over one step of a periodic gait the heel strike loses what gravity gave: the total
+    // mass times g sin γ times the centre of mass's advance, one step length 2 l sin θ*.
+    let (beta, gamma) = (1e-9, 0.009_f64);
+    let work = (1.0 + 2.0 * beta) * gamma.sin() * 2.0 * found.state[0].sin();
+    assert!(
+        (found.energy_lost[0] - work).abs() < 1e-12,
+        "{} vs {work}",
+        found.energy_lost[0]
+    );
 }
 
 /// A run of the rimless wheel through its landings (`simulate`): each landing keeps the

@@ -29,9 +29,10 @@ use serde::Serialize;
 
 use crate::model_info::ModelInfo;
 
-/// How far the relabelling may move the mechanism, relative to the landing foot's distance
-/// from the stance foot (and its kinetic energy, relative to itself), before the change of
-/// support is refused: rounding, not a wrong `relabel:`.
+/// How far the relabelling may move the mechanism's centre of mass, relative to its size
+/// (the centre of mass's and the landing foot's distances from the stance foot), or change
+/// its mass matrix, relative to the largest entry, before the change of support is refused:
+/// rounding, not a wrong `relabel:`.
 pub const RELABEL_TOLERANCE: f64 = 1e-8;
 
 /// One change of support's values at a configuration (see the module documentation and
@@ -266,7 +267,10 @@ fn check_relabel(
     s: &SupportValues,
     q: &[f64],
 ) -> Result<(), SupportError> {
-    let length = s.foot[0].hypot(s.foot[1]).max(f64::MIN_POSITIVE);
+    // On the scale of the mechanism: the centre of mass's and the landing foot's distances
+    // from the stance foot (a foot that lands beside the stance foot is near 0).
+    let length = (s.moment[0].hypot(s.moment[1]) / s.mass + s.foot[0].hypot(s.foot[1]))
+        .max(f64::MIN_POSITIVE);
     let moment = [0, 1].map(|a| s.moment_after[a] - (s.moment[a] - s.mass * s.foot[a]));
     let difference = moment[0].hypot(moment[1]) / (s.mass * length);
     if difference.is_nan() || difference > RELABEL_TOLERANCE {
