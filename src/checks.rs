@@ -18,7 +18,7 @@ use crate::text::fixed;
 use eomgen_runtime::analysis::vibration::{
     EquilibriumStart, ModalAnalysis, ModalOptions, OperatingPointOptions, modal_analysis,
 };
-use eomgen_runtime::analysis::{EnergyDrift, RunTally, StudyRuns, constraint_drift, energy_drift};
+use eomgen_runtime::analysis::{EnergyDrift, RunTally, Simulation, StudyRuns, constraint_drift};
 use eomgen_runtime::description::checks::{ModalCheck, RunSettings};
 use eomgen_runtime::{Linearization, ModelInfo, OutputTimes, Solution, damped_modes};
 use eomgen_symbolic::mechanics::cross_check::check_model;
@@ -179,7 +179,7 @@ impl Default for CheckRun {
 /// [`SAMPLES`] uniform times, with the file's events located on the way.
 pub struct Simulations {
     source: ModelSource,
-    done: Vec<(CheckRun, Result<Solution, String>)>,
+    done: Vec<(CheckRun, Result<Simulation, String>)>,
 }
 
 impl Simulations {
@@ -196,11 +196,20 @@ impl Simulations {
     /// # Errors
     /// Why the simulation could not start or did not reach its end, as text.
     pub fn get(&mut self, run: CheckRun) -> Result<&Solution, String> {
+        self.simulation(run).map(|s| &s.solution)
+    }
+
+    /// The whole simulation of `run` (computed the first time it is asked for): its
+    /// solution, and its energy drift with the energy lost at impacts added.
+    ///
+    /// # Errors
+    /// As [`Self::get`].
+    pub fn simulation(&mut self, run: CheckRun) -> Result<&Simulation, String> {
         let k = match self.done.iter().position(|(d, _)| *d == run) {
             Some(k) => k,
             None => {
-                let solution = self.run(run, None);
-                self.done.push((run, solution));
+                let simulation = self.simulate(run, None);
+                self.done.push((run, simulation));
                 self.done.len() - 1
             }
         };
@@ -212,6 +221,12 @@ impl Simulations {
     /// # Errors
     /// Why the simulation could not start or did not reach its end, as text.
     pub fn run(&self, run: CheckRun, times: Option<Vec<f64>>) -> Result<Solution, String> {
+        self.simulate(run, times).map(|s| s.solution)
+    }
+
+    /// [`Self::run`], the whole simulation. A run that stopped at a contact (a transition
+    /// without an answer) did not reach its end, and is an error.
+    fn simulate(&self, run: CheckRun, times: Option<Vec<f64>>) -> Result<Simulation, String> {
         let times = times.unwrap_or_else(|| {
             (0..SAMPLES)
                 .map(|k| run.t_end * k as f64 / (SAMPLES - 1) as f64)
@@ -227,9 +242,10 @@ impl Simulations {
         };
         let mut model = self.source.instantiate();
         let simulation = simulate(model.as_mut(), &options).map_err(|e| e.to_string())?;
-        match simulation.failure {
-            None => Ok(simulation.solution),
-            Some(error) => Err(format!("the integration failed: {error}")),
+        match (&simulation.failure, &simulation.contact_stop) {
+            (Some(error), _) => Err(format!("the integration failed: {error}")),
+            (None, Some(stop)) => Err(format!("the run stopped: {stop}")),
+            (None, None) => Ok(simulation),
         }
     }
 }
@@ -491,7 +507,7 @@ pub fn motion_checks(
     // borrowed mutably below).
     let file_checks = model.description().checks.clone();
 
-    checks.extend(drift_rows(model, y0, simulations, &file_checks));
+    checks.extend(drift_rows(model, simulations, &file_checks));
 
     // Reference values stated in the file.
     let at_of = |check: &ModalCheck| check.at.as_ref().map(|a| a.to_string());
@@ -532,7 +548,6 @@ pub fn motion_checks(
 /// the constraints' for a constrained one, each over its run without stabilisation.
 fn drift_rows(
     model: &mut dyn ModelInfo,
-    y0: &[f64],
     simulations: &mut Simulations,
     file_checks: &eomgen_runtime::description::checks::Checks,
 ) -> Vec<CheckRow> {
@@ -546,11 +561,11 @@ fn drift_rows(
             .map_or((DEFAULT_ENERGY_DRIFT, default_run), |d| {
                 (d.max, CheckRun::of(&d.run))
             });
-        let computed = simulations.get(run).and_then(|s| {
-            energy_drift(model, y0, s)
-                .drift
-                .ok_or_else(|| "no samples".to_string())
-        });
+        // Of `E` plus the energy lost at impacts (and the datum's moves at changes of
+        // support), as `eomgen simulate` measures it.
+        let computed = simulations
+            .simulation(run)
+            .and_then(|s| (s.energy.drift).ok_or_else(|| "no samples".to_string()));
         rows.push(CheckRow::compare(
             format!(
                 "energy drift max|E − E(0)|/max(T + |V|) ({})",
@@ -928,11 +943,12 @@ pub fn model_report(path: &str, text: &str, file: &ModelFile, source: &ModelSour
     };
     let mut simulations = Simulations::new(source.clone());
     let run = CheckRun::default();
-    out.default_run = Some(simulations.get(run).map(|solution| {
+    out.default_run = Some(simulations.simulation(run).map(|simulation| {
+        let solution = &simulation.solution;
         DefaultRun {
             run,
             solution: solution.clone(),
-            energy: energy_drift(model.as_ref(), &y0, solution),
+            energy: simulation.energy.clone(),
             constraint_drift: (!model.description().constraint_names().is_empty())
                 .then(|| constraint_drift(model.as_mut(), solution).drift),
         }

@@ -207,6 +207,35 @@ def test_periodic_orbit_errors():
         eomgen.load("figure_eight").periodic_orbit(period=-1.0)
 
 
+# --- gaits ---------------------------------------------------------------------------------------
+
+
+def test_a_gait_equals_the_command_line_json(cli):
+    m = eomgen.load("rimless_wheel")
+    assert_report_equals_json(m.periodic_orbit(guess={"theta_dot": 2.0}),
+                              cli_report(cli, "study", "periodic-orbit", "rimless_wheel", "--guess", "theta_dot=2"))
+
+
+def test_the_rimless_wheel_rolls_at_its_closed_form_with_eigenvalue_cos_squared_two_alpha():
+    # omega* = cot(2 alpha) sqrt(4 (g/l) sin(alpha) sin(gamma)), the return map's eigenvalue
+    # cos^2(2 alpha) = 0.5 for eight spokes (Coleman, Chatterjee & Ruina 1997), to 1e-9.
+    alpha, gamma, g = np.pi / 8, 0.1, 9.81
+    gait = eomgen.load("rimless_wheel").periodic_orbit(guess={"theta_dot": 2.0})
+    omega = np.sqrt(4 * g * np.sin(alpha) * np.sin(gamma)) / np.tan(2 * alpha)
+    assert abs(gait["state"][1] - omega) < 1e-9
+    assert abs(gait["eigenvalues"][0] - 0.5) < 1e-9
+    assert gait["stability"] == "asymptotically_stable"
+
+
+def test_the_simplest_walker_period_doubles_near_gamma_0_0151():
+    sweep = eomgen.load("simplest_walker").parameter_sweep("gamma", np.linspace(0.012, 0.017, 3))
+    [change] = sweep["stability_changes"]
+    assert change["kind"] == "period_doubling" and change["stable_below"]
+    assert abs(change["value"] - 0.015088438) < 1e-7
+    with pytest.raises(eomgen.ParameterError):
+        eomgen.load("simplest_walker").parameter_sweep("slope", [0.01])
+
+
 # --- study rolling-contact ---------------------------------------------------------------------
 
 
