@@ -57,6 +57,19 @@ pub struct ContactListing {
     pub restitution: String,
     /// Coulomb's friction coefficient `μ` (`0` for a frictionless contact).
     pub friction: String,
+    /// For a change of support, the coordinates after it (`R(q)`, one per coordinate), and
+    /// where it lands (`when`, `1` when the file gives none); left out of the JSON otherwise.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub support: Option<SupportListing>,
+}
+
+/// A change of support as `equations` prints it.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct SupportListing {
+    /// The coordinates after the change, in coordinate order.
+    pub relabel: Vec<String>,
+    /// Where a strike lands (positive).
+    pub when: String,
 }
 
 /// A generalized force that is not zero.
@@ -144,6 +157,10 @@ impl EquationsListing {
                     jacobian: c.jacobian.iter().map(|g| p.print(*g)).collect(),
                     restitution: p.print(c.restitution),
                     friction: p.print(c.friction),
+                    support: c.support.as_ref().map(|s| SupportListing {
+                        relabel: s.relabel.iter().map(|r| p.print(*r)).collect(),
+                        when: p.print(s.when),
+                    }),
                 })
                 .collect(),
         }
@@ -216,6 +233,18 @@ pub fn equations_text(model: &SymbolicModel, eom: &EquationsOfMotion) -> String 
                 "  e[{}] = {}, mu[{}] = {}",
                 c.name, c.restitution, c.name, c.friction
             );
+            if let Some(support) = &c.support {
+                let after: Vec<String> = (e.coordinates.iter().zip(&support.relabel))
+                    .map(|(q, r)| format!("{q} -> {r}"))
+                    .collect();
+                let _ = writeln!(
+                    s,
+                    "  {} changes the support where {} > 0: the landing foot sticks, the stance foot leaves, {}",
+                    c.name,
+                    support.when,
+                    after.join(", ")
+                );
+            }
         }
     }
     debug_assert!(e.mass_matrix.len() == n);
