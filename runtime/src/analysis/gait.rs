@@ -39,6 +39,10 @@ use crate::linear::monodromy::{FloquetOptions, FloquetStability, Variational};
 use crate::model_info::ModelInfo;
 use crate::ode::{EventDirection, EventSpec, WithEvents};
 
+/// The shortest step (s, relative to `1 + |t|`): a landing sooner is the foot striking where
+/// the step starts, not a step.
+const MIN_STEP: f64 = 1e-9;
+
 /// Settings of [`gait`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct GaitOptions {
@@ -501,6 +505,13 @@ fn flow_to_landing(
         let (_, which) = landing;
         let passes = SupportValues::of(&*flow.system, which, event.0, &event.1[..n]).when <= 0.0;
         if !passes {
+            // A landing where the step starts is no step: the foot is on the ground,
+            // moving into it (a start on the guard, or a walker that has fallen).
+            if event.0 - t0 <= MIN_STEP * (1.0 + t0.abs()) {
+                return Err(no_landing(Some(
+                    "the foot lands where the step starts: a step of no time".into(),
+                )));
+            }
             let phi = DMatrix::from_column_slice(dim, dim, &event.1[dim..]);
             return Ok((landing, event.1[..dim].to_vec(), (phi, event.0 - t0)));
         }
