@@ -63,7 +63,7 @@ def derive():
     s = sp.symbols("th ph thd phd")
     sub = dict(zip(list(qd) + list(q), s[2:] + s[:2]))
     sub2 = lambda e: e.subs({qdi: s[2 + i] for i, qdi in enumerate(qd)}).subs(dict(zip(q, s[:2])))
-    acc = sp.lambdify(s, [sub2(A), sub2(rhs)], "numpy")
+    acc = sp.lambdify(s, list(sub2(A.LUsolve(rhs))), "numpy")
     energy = sp.lambdify(s, [sub2(T), sub2(V)], "numpy")
     com_x = sp.lambdify(s[:2], sub2(sum(mi * p[0] for mi, p in masses) / (M + 2 * m)), "numpy")
     foot_f = sp.lambdify(s[:2], list(sub2(foot)), "numpy")
@@ -96,9 +96,7 @@ ACC, ENERGY, COM_X, FOOT, IMPACT = derive()
 
 
 def f(_t, y):
-    A, r = ACC(*y)
-    qdd = np.linalg.solve(np.array(A, dtype=float), np.array(r, dtype=float).ravel())
-    return [y[2], y[3], qdd[0], qdd[1]]
+    return [y[2], y[3], *ACC(*y)]
 
 
 def strike(_t, y):
@@ -113,7 +111,7 @@ OPTS = dict(method="DOP853", rtol=1e-13, atol=1e-13)
 def swing(y0):
     """Integrate from y0 to the heel strike: (time, state just before it)."""
     t, y = 0.0, np.array(y0, dtype=float)
-    while True:
+    while t < 5:
         sol = solve_ivp(f, [t, t + 10], y, events=strike, **OPTS)
         if not sol.t_events[0].size:
             raise RuntimeError("no heel strike")
@@ -122,6 +120,7 @@ def swing(y0):
             return t, y
         sol = solve_ivp(f, [t, t + 1e-3], y, **OPTS)   # past the crossing with theta >= 0
         t, y = sol.t[-1], sol.y[:, -1]
+    raise RuntimeError("no heel strike")
 
 
 def step(x):
