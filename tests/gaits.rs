@@ -269,3 +269,55 @@ fn a_change_of_support_that_cannot_be_derived_is_refused_where_it_is_written() {
         );
     }
 }
+
+/// Goswami, Thuilot & Espiau's compass gait (m = 5 kg legs, M = 10 kg hip, a = b = 0.5 m) on
+/// 3°: its stable period-one gait and eigenvalues against a derivation of its own (SymPy's
+/// Lagrange equations and the heel strike from the two angular-momentum conditions written
+/// by hand, SciPy's DOP853 at 1e-13: tools/compass_gait_reference.py, whose eigenvalues are by
+/// central differences): the state and period to 1e-10, the eigenvalues to 1e-7, the energy
+/// lost to 1e-10 (it is also the work of gravity over the step). Goswami et al. give the
+/// gait's leg angles from the vertical as 0.218 and −0.323 rad, and its rates −1.091 and
+/// −0.377 rad/s.
+#[test]
+fn the_compass_gait_walks_goswamis_gait() {
+    let mut walker = model("compass_gait", &[]);
+    let found = gait(&mut walker, &GaitOptions::default()).unwrap();
+    let reference = [
+        0.2710286804988182,
+        0.5420573609976364,
+        -1.092383589883546,
+        -0.7150096409764602,
+    ];
+    for (y, r) in found.state.iter().zip(reference) {
+        assert!((y - r).abs() < 1e-10, "{:?}", found.state);
+    }
+    assert!(
+        (found.period - 0.7343463911587371).abs() < 1e-10,
+        "{}",
+        found.period
+    );
+    let expected = [
+        (-0.19972612605643097, 0.5444760621133835),
+        (0.131572622356698, 0.0),
+    ];
+    let lambda = found.eigenvalues[0];
+    assert!((lambda.re - expected[0].0).abs() < 1e-7, "{lambda}");
+    assert!((lambda.im.abs() - expected[0].1).abs() < 1e-7, "{lambda}");
+    let third = found.eigenvalues[2];
+    assert!(
+        (third.re - expected[1].0).abs() < 1e-7 && third.im == 0.0,
+        "{third}"
+    );
+    assert!(
+        (found.energy_lost[0] - 5.498121984723131).abs() < 1e-10,
+        "{:?}",
+        found.energy_lost
+    );
+    // The leg angles from the vertical: θ − γ and −θ − γ (γ = 3°).
+    let gamma = std::f64::consts::PI / 60.0;
+    assert!(
+        (found.state[0] - gamma - 0.218).abs() < 1e-3
+            && (-found.state[0] - gamma + 0.323).abs() < 1e-3
+    );
+    assert!(found.stability.is_stable());
+}

@@ -20,11 +20,11 @@ the hip; pre-impact velocities with the old stance foot fixed, post-impact ones 
 one fixed, then theta+ = theta- - phi-, phi+ = -phi-.
 
 The fixed point of the map on the state just after a heel strike (theta, theta', phi')
-(phi = 2 theta there) is found from the guess (0.25, -1, -0.5) by Newton with a Jacobian by central differences (h = 1e-6),
-integration by SciPy's DOP853 at rtol = atol = 1e-13; the eigenvalues are those of that 3 x 3
-Jacobian. Checks: the residual, and that the kinetic energy lost at the strike equals the
-work of gravity over a step, (M + 2m) g sin(gamma) times the centre of mass's displacement
-down the slope.
+(phi = 2 theta there) is found from the guess (0.25, -1, -0.5) by Newton with a Jacobian by
+central differences (h = 1e-6), integration by SciPy's DOP853 at rtol = atol = 1e-13; the
+eigenvalues are those of that 3 x 3 Jacobian. Checks: the residual, and that the kinetic
+energy lost at the strike equals the work of gravity over a step, (M + 2m) g sin(gamma) times
+the centre of mass's displacement down the slope.
 
 Run: python3 tools/compass_gait_reference.py   (needs numpy, scipy, sympy)
 """
@@ -80,10 +80,10 @@ def derive():
     v_pre = [vel(p, th0, ph0, thd, phd) for p in pre[:3]]
     v_post = [vel(p, thn, phn, u1, u2).subs(at) for p in post[:3]]
     post = [p.subs(at) for p in post[:3]]
-    mass_pre, mass_post = [m, M, m], [m, M, m]
+    mass = [m, M, m]
     # (1) whole walker about the landing foot S
-    L1_pre = sum(mi * cross(r - S, v) for mi, r, v in zip(mass_pre, pre[:3], v_pre))
-    L1_post = sum(mi * cross(r - S, v) for mi, r, v in zip(mass_post, post, v_post))
+    L1_pre = sum(mi * cross(r - S, v) for mi, r, v in zip(mass, pre[:3], v_pre))
+    L1_post = sum(mi * cross(r - S, v) for mi, r, v in zip(mass, post, v_post))
     # (2) old stance leg (mass pre[0], post[2]) about the hip
     L2_pre = m * cross(pre[0] - pre[1], v_pre[0])
     L2_post = m * cross(post[2] - post[1], v_post[2])
