@@ -274,14 +274,22 @@ fn a_change_of_support_that_cannot_be_derived_is_refused_where_it_is_written() {
 /// 3°: its stable period-one gait and eigenvalues against a derivation of its own (SymPy's
 /// Lagrange equations and the heel strike from the two angular-momentum conditions written
 /// by hand, SciPy's DOP853 at 1e-13: tools/compass_gait_reference.py, whose eigenvalues are by
-/// central differences): the state and period to 1e-10, the eigenvalues to 1e-7, the energy
-/// lost to 1e-10 (it is also the work of gravity over the step). Goswami et al. give the
+/// central differences), from a start off it with Newton to 1e-12: the state and period to
+/// 1e-10, the eigenvalues to 1e-7, the energy lost to 1e-10 (it is also the work of gravity
+/// over the step). Goswami et al. give the
 /// gait's leg angles from the vertical as 0.218 and −0.323 rad, and its rates −1.091 and
 /// −0.377 rad/s.
 #[test]
 fn the_compass_gait_walks_goswamis_gait() {
     let mut walker = model("compass_gait", &[]);
-    let found = gait(&mut walker, &GaitOptions::default()).unwrap();
+    // From a start off the gait (the file starts on it).
+    let options = GaitOptions {
+        start: Some(vec![0.26, 0.53, -1.0, -0.6]),
+        tol: 1e-12,
+        ..GaitOptions::default()
+    };
+    let found = gait(&mut walker, &options).unwrap();
+    assert!(found.iterations >= 3, "{:?}", found.residuals);
     let reference = [
         0.2710286804988182,
         0.5420573609976364,
@@ -320,4 +328,27 @@ fn the_compass_gait_walks_goswamis_gait() {
             && (-found.state[0] - gamma + 0.323).abs() < 1e-3
     );
     assert!(found.stability.is_stable());
+}
+
+/// Past the period doubling the simplest walker's swing foot can pass over the stance foot
+/// with the stance leg past the normal (the legs crossing at φ = 0): that zero of the foot's
+/// height is no landing (a foot within 1e-6 of the walker's size of the stance foot passes),
+/// so the walk goes on, every landing a step of at least 0.3 leg lengths.
+#[test]
+fn a_swing_foot_passing_over_the_stance_foot_does_not_land() {
+    let mut walker = model("simplest_walker", &[("gamma", 0.0165)]);
+    let options = SimulationOptions {
+        method: Method::Dop853,
+        t_end: 30.0,
+        rtol: 1e-10,
+        atol: 1e-10,
+        ..Default::default()
+    };
+    let run = simulate(&mut walker, &options).unwrap();
+    assert!(run.contact_stop.is_none(), "{:?}", run.contact_stop);
+    let steps: Vec<f64> = (run.transitions.iter())
+        .filter_map(|tr| tr.foot.map(|f| f[0].hypot(f[1])))
+        .collect();
+    assert!(steps.len() >= 6, "{steps:?}");
+    assert!(steps.iter().all(|&s| s > 0.3), "{steps:?}");
 }

@@ -343,6 +343,11 @@ fn study_periodic_orbit<'py>(
                 "period, fix_period and energy do not apply to a gait: its period is the time of its steps",
             ));
         }
+        if integration_tol.is_some() || samples.is_some() || unit_multiplier_tolerance.is_some() {
+            return Err(PyValueError::new_err(
+                "integration_tol, samples and unit_multiplier_tolerance do not apply to a gait (its integration is DOP853 at 1e-12, and it has no trivial multipliers to count)",
+            ));
+        }
         let defaults = GaitOptions::default();
         let options = GaitOptions {
             start: Some(match start {

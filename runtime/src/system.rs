@@ -163,10 +163,10 @@ pub trait MechanicalSystem<const N: usize> {
     }
     /// The values of each change of support ([`ModelDescription::supports`]), in contact
     /// order, into `out` (`eomgen_symbolic::model::elements::support::block_len(N)` each):
-    /// the total mass, the ground's normal, the first moment of mass and the landing foot
-    /// with their Jacobians, the matrices `P` and `Q` of the impact law `P q̇⁺ = Q q̇⁻` and
-    /// their derivatives, and the relabelling `R(q)` with its first and second derivatives
-    /// ([`crate::hybrid::support`]).
+    /// the total mass, the ground's normal, the first moment of mass (before and after) and
+    /// the landing foot with their Jacobians, the matrices `M(q⁺)` and `H` of the impact law
+    /// `M(q⁺) q̇⁺ = H q̇⁻` and their derivatives, the relabelling `R(q)` and its Jacobian, and
+    /// `when` ([`crate::hybrid::support`]).
     fn support_changes(&self, q: &SVector<f64, N>, t: f64, out: &mut [f64]) {
         let _ = (q, t, out);
     }

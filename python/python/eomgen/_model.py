@@ -610,8 +610,9 @@ class Model:
         bisection (``stability_changes``). ``values`` ascending. For a model with a change
         of support (a walker), its gait of ``steps`` landings per period followed over the
         parameter from the initial state, with the return map's eigenvalues and each change
-        of stability named (``period_doubling``, ``fold``, ``neimark_sacker``). Returns the
-        ``--json`` report with numeric lists as numpy arrays.
+        of stability named (``period_doubling``, ``fold``, ``neimark_sacker``; always
+        bisected, ``refine`` and ``at`` do not apply). Returns the ``--json`` report with
+        numeric lists as numpy arrays.
 
         Raises:
             ParameterError: an unknown parameter.
@@ -810,7 +811,8 @@ class Model:
                 fixed point of its return map from the state just after a landing, with the
                 map's Jacobian from the variational equations and a saltation matrix at each
                 landing, its ``eigenvalues``, ``floquet_multipliers`` and ``stability``;
-                ``period``, ``fix_period`` and ``energy`` do not apply.
+                ``period``, ``fix_period``, ``energy``, ``integration_tol``, ``samples`` and
+                ``unit_multiplier_tolerance`` do not apply (a ValueError).
 
         Raises:
             AnalysisError: Newton did not converge, a constrained model, a time-dependent

@@ -138,6 +138,36 @@ pub enum GaitError {
         /// The model's parameters.
         parameters: String,
     },
+    /// The model has what a gait's return map does not take: another contact, or a
+    /// dependence on `t` (the map restarts each step at `t = 0`).
+    #[error(
+        "`{model}` {what}: a gait's return map takes an autonomous model whose only contacts change its support"
+    )]
+    Unsupported {
+        /// The model.
+        model: String,
+        /// What it has.
+        what: String,
+    },
+    /// Newton's matrix `∂P/∂y − I` is singular (a multiplier at 1: a fold, or a family of
+    /// gaits).
+    #[error(
+        "no gait: Newton's matrix ∂P/∂y − I is singular at iteration {iteration} (‖P(y) − y‖ = {residual:.3e}): the return map has an eigenvalue at 1 there"
+    )]
+    Singular {
+        /// The iteration.
+        iteration: usize,
+        /// The residual there.
+        residual: f64,
+    },
+    /// No value of a sweep has a gait.
+    #[error("no value of the sweep has a gait; at the first, {value}: {reason}")]
+    NothingFound {
+        /// The first value.
+        value: f64,
+        /// Why no gait was found there.
+        reason: String,
+    },
     /// The settings are out of range.
     #[error("{what}")]
     InvalidOptions {
@@ -245,6 +275,7 @@ pub fn gait(model: &mut dyn ModelInfo, options: &GaitOptions) -> Result<Gait, Ga
             found: y.len(),
         });
     }
+    supported(model, &y, name.clone())?;
     let mut stats = Stats::default();
     let mut residuals = Vec::new();
     let allowed = |y: &[f64]| options.tol * y.iter().fold(1.0f64, |m, v| m.max(v.abs()));
@@ -269,8 +300,12 @@ pub fn gait(model: &mut dyn ModelInfo, options: &GaitOptions) -> Result<Gait, Ga
         // lower the residual.
         let r = DVector::from_iterator(dim, pass.end.iter().zip(&y).map(|(p, y)| p - y));
         let a = &pass.return_map - DMatrix::identity(dim, dim);
-        let Some(step) = a.lu().solve(&(-r)) else {
-            break;
+        let solved = a.lu().solve(&(-r));
+        let Some(step) = solved.filter(|s| s.iter().all(|v| v.is_finite())) else {
+            return Err(GaitError::Singular {
+                iteration,
+                residual,
+            });
         };
         let mut damping = 1.0;
         loop {
@@ -296,6 +331,40 @@ pub fn gait(model: &mut dyn ModelInfo, options: &GaitOptions) -> Result<Gait, Ga
         residual,
         allowed: allowed(&y),
     })
+}
+
+/// Refuses a model with a contact that does not change its support (the return map watches
+/// only the landings) or whose equations depend on `t` (probed at `y` at three times).
+fn supported(model: &mut dyn ModelInfo, y: &[f64], name: String) -> Result<(), GaitError> {
+    let d = model.description();
+    if d.contacts.len() > d.supports.len() {
+        let other: Vec<String> = (d.contacts.iter())
+            .filter(|c| !d.supports.contains(c))
+            .map(|c| format!("`{c}`"))
+            .collect();
+        return Err(GaitError::Unsupported {
+            model: name,
+            what: format!(
+                "has contacts that do not change its support ({})",
+                other.join(", ")
+            ),
+        });
+    }
+    let ode = model.as_ode_mut();
+    let mut at = |t: f64| {
+        let mut f = vec![0.0; y.len()];
+        ode.rhs(t, y, &mut f).ok().map(|()| f)
+    };
+    if let (Some(f0), Some(f1), Some(f2)) = (at(0.0), at(0.37), at(1.3)) {
+        let scale = 1.0 + f0.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        if distance(&f0, &f1).max(distance(&f0, &f2)) > 1e-12 * scale {
+            return Err(GaitError::Unsupported {
+                model: name,
+                what: "depends on t".into(),
+            });
+        }
+    }
+    Ok(())
 }
 
 /// The settings in range.
@@ -400,14 +469,13 @@ pub fn return_map(
         let (t_hit, n) = (t + phi.1, model.num_dofs());
         let phi = phi.0;
         let values = model.contact_values(t_hit, &y);
-        let friction = values.friction[c];
-        let change = change_support(model, which, t_hit, &y, friction).map_err(|error| {
-            GaitError::Support {
+        let law = (values.restitution[c], values.static_friction[c]);
+        let change =
+            change_support(model, which, t_hit, &y, law).map_err(|error| GaitError::Support {
                 step,
                 t: t_hit,
                 error,
-            }
-        })?;
+            })?;
         let after: Vec<f64> = change.q.iter().chain(&change.qdot).copied().collect();
         let saltation_error = |rate| GaitError::Saltation {
             step,
@@ -503,7 +571,7 @@ fn flow_to_landing(
         .map_err(|reason| no_landing(Some(reason)))?
         .ok_or_else(|| no_landing(None))?;
         let (_, which) = landing;
-        let passes = SupportValues::of(&*flow.system, which, event.0, &event.1[..n]).when <= 0.0;
+        let passes = !SupportValues::of(&*flow.system, which, event.0, &event.1[..n]).lands();
         if !passes {
             // A landing where the step starts is no step: the foot is on the ground,
             // moving into it (a start on the guard, or a walker that has fallen).

@@ -274,6 +274,13 @@ pub fn integrate_through_impacts(
         atol,
     };
     (run.closed, run.holds) = touching(model, (t0, y0), atol);
+    // A change of support is never held closed: it lands at its event, or passes.
+    let supports = &model.description().supports;
+    for (c, name) in run.contacts.iter().enumerate() {
+        if supports.iter().any(|s| **s == **name) {
+            run.closed[c] = false;
+        }
+    }
     if let Err(stop) = run.settle(model, 0) {
         run.record.stop = Some(stop);
     }
@@ -495,27 +502,25 @@ impl Run<'_> {
                 contact: self.contacts[k].clone(),
             }));
         }
-        // Where the file's `when:` is not positive the foot passes (scuffing): the phase
-        // goes on from here, the contact open at a zero.
-        if SupportValues::of(model, which, t, &y[..n]).when <= 0.0 {
+        // Where the file's `when:` is not positive, or the foot passes over the stance foot,
+        // it does not land (scuffing): the phase goes on from here, the contact open at a
+        // zero.
+        if !SupportValues::of(model, which, t, &y[..n]).lands() {
             self.y = y;
             self.t = t;
             return Ok(());
         }
         let values = model.contact_values(t, &y);
-        let friction = values.friction[c];
-        let change = change_support(model, which, t, &y, friction).map_err(stop)?;
+        let law = (values.restitution[c], values.static_friction[c]);
+        let change = change_support(model, which, t, &y, law).map_err(stop)?;
         let after: Vec<f64> = change.q.iter().chain(&change.qdot).copied().collect();
         let potential = |y: &[f64]| model.energy(t, y) - model.kinetic_energy(t, y);
         self.record.transitions.push(Transition {
             t,
             contact: self.contacts[c].clone(),
             kind: TransitionKind::SupportChange,
-            mode: if friction > 0.0 {
-                ImpactMode::Sticking
-            } else {
-                ImpactMode::Frictionless
-            },
+            // The landing foot sticks, whether or not the file bounds its friction.
+            mode: ImpactMode::Sticking,
             qdot: [y[n..2 * n].to_vec(), change.qdot.clone()],
             normal_velocity: [values.rates[c], 0.0],
             normal_impulse: change.normal_impulse,

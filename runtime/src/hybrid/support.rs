@@ -35,6 +35,15 @@ use crate::model_info::ModelInfo;
 /// rounding, not a wrong `relabel:`.
 pub const RELABEL_TOLERANCE: f64 = 1e-8;
 
+/// A landing foot within this fraction of the mechanism's size of the stance foot does not
+/// land ([`SupportValues::lands`]): the swing foot passing over the stance foot.
+pub const COINCIDENT: f64 = 1e-6;
+
+/// The old stance foot leaves the ground when its speed into it is below this fraction of
+/// the speeds at play (the landing foot's before the impact, the stance foot's after): a
+/// speed of 0 rounds either way.
+pub const RELEASE_TOLERANCE: f64 = 1e-9;
+
 /// One change of support's values at a configuration (see the module documentation and
 /// `eomgen_symbolic::model::elements::support::block`).
 #[derive(Debug, Clone, PartialEq)]
@@ -112,6 +121,20 @@ impl SupportValues {
         }
     }
 
+    /// Whether a strike here lands: the file's `when` is positive, and the landing foot is
+    /// away from the stance foot (more than [`COINCIDENT`] of the mechanism's size: a swing
+    /// foot passing over the stance foot, the legs crossing, is no step).
+    pub fn lands(&self) -> bool {
+        self.when > 0.0 && self.foot[0].hypot(self.foot[1]) > COINCIDENT * self.size()
+    }
+
+    /// The mechanism's size (m): its centre of mass's and the landing foot's distances from
+    /// the stance foot.
+    fn size(&self) -> f64 {
+        (self.moment[0].hypot(self.moment[1]) / self.mass + self.foot[0].hypot(self.foot[1]))
+            .max(f64::MIN_POSITIVE)
+    }
+
     /// `t̂`, the normal turned a quarter-turn counter-clockwise.
     fn tangent(&self) -> [f64; 2] {
         [-self.normal[1], self.normal[0]]
@@ -179,6 +202,14 @@ pub enum SupportError {
         /// `n̂ · ṗ₀⁺` (m/s).
         release_velocity: f64,
     },
+    /// The contact's coefficient of restitution (at the parameters' values) is not 0.
+    #[error(
+        "its coefficient of restitution is {restitution}, but the landing foot sticks: a change of support is plastic"
+    )]
+    NotPlastic {
+        /// `e`.
+        restitution: f64,
+    },
     /// Another contact is closed where the foot lands (a change of support is taken from a
     /// free swing only).
     #[error(
@@ -201,7 +232,8 @@ pub enum SupportError {
 }
 
 /// Applies change of support `which` at `(t, y)` (`y = [q; q̇]` just before the strike), with
-/// the landing foot's friction coefficient `friction` (0: its sticking is not checked).
+/// the contact's coefficient of restitution `restitution` (which must be 0: the foot sticks)
+/// and its sticking cone's `friction` (`μ_s`; 0: the foot's sticking is not checked).
 ///
 /// # Errors
 /// [`SupportError`] where the model's assumptions fail (see the module documentation).
@@ -210,10 +242,14 @@ pub fn change_support(
     which: usize,
     t: f64,
     y: &[f64],
-    friction: f64,
+    (restitution, friction): (f64, f64),
 ) -> Result<SupportChange, SupportError> {
     let n = model.num_dofs();
+    if restitution != 0.0 {
+        return Err(SupportError::NotPlastic { restitution });
+    }
     let s = SupportValues::of(model, which, t, &y[..n]);
+    check_relabel(model, t, &s)?;
     let before = DVector::from_row_slice(&y[n..2 * n]);
     let finite = |v: &DVector<f64>| v.iter().all(|x| x.is_finite());
     let after = (s.mass_matrix_after.clone().lu())
@@ -239,12 +275,13 @@ pub fn change_support(
         .ok_or(SupportError::Singular)?;
     let release = &s.foot_jacobian * &old;
     let release_velocity = -(normal[0] * release[0] + normal[1] * release[1]);
-    if release_velocity < 0.0 {
+    let landing = &s.foot_jacobian * &before;
+    let speeds = release.norm().max(landing.norm());
+    if release_velocity < -RELEASE_TOLERANCE * speeds {
         return Err(SupportError::StanceStays { release_velocity });
     }
     let q_after: Vec<f64> = s.relabel.iter().copied().collect();
     let qdot_after: Vec<f64> = after.iter().copied().collect();
-    check_relabel(model, t, &s, &q_after)?;
     let state: Vec<f64> = q_after.iter().chain(&qdot_after).copied().collect();
     Ok(SupportChange {
         energy_lost: model.kinetic_energy(t, y) - model.kinetic_energy(t, &state),
@@ -257,20 +294,14 @@ pub fn change_support(
     })
 }
 
-/// Checks that `R` puts the mechanism where it was about the new stance foot (its first
-/// moment of mass `Σ mᵢ rᵢ` becomes `Σ mᵢ rᵢ − m r_S`; the landing foot of the new labels
-/// need not be the old stance foot: a rimless wheel's next spoke is another), and that the
-/// bodies carry the model's whole mass matrix there.
-fn check_relabel(
-    model: &dyn ModelInfo,
-    t: f64,
-    s: &SupportValues,
-    q: &[f64],
-) -> Result<(), SupportError> {
-    // On the scale of the mechanism: the centre of mass's and the landing foot's distances
-    // from the stance foot (a foot that lands beside the stance foot is near 0).
-    let length = (s.moment[0].hypot(s.moment[1]) / s.mass + s.foot[0].hypot(s.foot[1]))
-        .max(f64::MIN_POSITIVE);
+/// Checks that `R` puts the mechanism where it was about the new stance foot: its first
+/// moment of mass `Σ mᵢ rᵢ` becomes `Σ mᵢ rᵢ − m r_S` (the landing foot of the new labels
+/// need not be the old stance foot: a rimless wheel's next spoke is another), and the mass
+/// matrix the bodies give about the new foot is the model's at `R(q)`, entry by entry
+/// relative to `√(M_ii M_jj)`, so that a body of small mass is checked too.
+fn check_relabel(model: &dyn ModelInfo, t: f64, s: &SupportValues) -> Result<(), SupportError> {
+    let q: Vec<f64> = s.relabel.iter().copied().collect();
+    let length = s.size();
     let moment = [0, 1].map(|a| s.moment_after[a] - (s.moment[a] - s.mass * s.foot[a]));
     let difference = moment[0].hypot(moment[1]) / (s.mass * length);
     if difference.is_nan() || difference > RELABEL_TOLERANCE {
@@ -281,8 +312,14 @@ fn check_relabel(
     }
     let state: Vec<f64> = q.iter().copied().chain(vec![0.0; q.len()]).collect();
     let (mass_matrix, _) = model.mass_matrix_and_forcing(t, &state);
-    let scale = mass_matrix.amax().max(f64::MIN_POSITIVE);
-    let difference = (mass_matrix - &s.mass_matrix_after).amax() / scale;
+    let n = q.len();
+    let difference = (0..n)
+        .flat_map(|i| (0..n).map(move |j| (i, j)))
+        .map(|(i, j)| {
+            let scale = (mass_matrix[(i, i)] * mass_matrix[(j, j)]).abs().sqrt();
+            (mass_matrix[(i, j)] - s.mass_matrix_after[(i, j)]).abs() / scale.max(f64::MIN_POSITIVE)
+        })
+        .fold(0.0f64, |m, d| if d.is_nan() { f64::NAN } else { m.max(d) });
     if difference.is_nan() || difference > RELABEL_TOLERANCE {
         return Err(SupportError::Relabel {
             what: "the mass matrix of the bodies",

@@ -48,7 +48,8 @@ pub struct PeriodicOrbitArgs {
     /// start, not the orbit sought.
     #[arg(long, value_name = "E|start", allow_hyphen_values = true)]
     pub energy: Option<String>,
-    /// Newton's tolerance: ‖φ_T(y₀) − y₀‖ ≤ tol (1 + ‖y₀‖), in [1e-12, 1e-3].
+    /// Newton's tolerance: ‖φ_T(y₀) − y₀‖ ≤ tol (1 + ‖y₀‖), in [1e-12, 1e-3] (for a gait,
+    /// ‖P(y) − y‖∞ ≤ tol · max(1, ‖y‖∞), in [1e-14, 1e-3]).
     #[arg(long, default_value_t = 1e-10, allow_hyphen_values = true)]
     pub tol: f64,
     /// Most Newton iterations.

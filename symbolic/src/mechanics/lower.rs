@@ -579,8 +579,11 @@ impl<'f> Lowering<'f> {
         points: &Points,
     ) -> Vec<ContactInfo> {
         let file = self.file;
-        for (c, written) in contacts.iter_mut().zip(&file.contacts) {
+        for c in contacts.iter_mut() {
             let Some(support) = c.support.as_mut() else {
+                continue;
+            };
+            let Some(written) = file.contacts.iter().find(|w| w.name.value == c.name) else {
                 continue;
             };
             let at = written

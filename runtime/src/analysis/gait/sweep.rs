@@ -53,7 +53,8 @@ pub enum GaitBifurcation {
 /// A change of stability between two values, located by bisection.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct GaitStabilityChange {
-    /// The value where the largest `|λ|` reaches 1 (the bracket's middle).
+    /// The value where the largest `|λ|` reaches 1 (the middle of the bracket where
+    /// `ρ − 1` changes sign).
     pub value: f64,
     /// The bracket `[lo, hi]` it is in.
     pub bracket: [f64; 2],
@@ -109,7 +110,11 @@ pub fn gait_sweep(
         let found = at(model, &axis.name, value, start, options);
         match &found {
             Ok(g) => branch.push((value, g.state.clone())),
-            Err(GaitError::NoSupport { .. } | GaitError::InvalidOptions { .. }) => {
+            Err(
+                GaitError::NoSupport { .. }
+                | GaitError::InvalidOptions { .. }
+                | GaitError::Unsupported { .. },
+            ) => {
                 first_error = found.as_ref().err().cloned();
             }
             Err(_) => {}
@@ -120,6 +125,13 @@ pub fn gait_sweep(
         }
         points.push(point(value, found));
         progress(k + 1, axis.values.len());
+    }
+    if let Some(first) = points.first().filter(|_| branch.is_empty()) {
+        let _ = model.set_parameter(&axis.name, original);
+        return Err(GaitError::NothingFound {
+            value: first.value,
+            reason: first.error.clone().unwrap_or_default(),
+        });
     }
     let stability_changes = (0..points.len().saturating_sub(1))
         .filter_map(|k| change(model, &axis.name, (&points[k], &points[k + 1]), options))
@@ -211,15 +223,18 @@ fn change(
     } else {
         a.eigenvalues[0]
     };
+    // On the sign of `ρ − 1` (the verdict's tolerance would move the point by it).
+    let below = a.spectral_radius? < 1.0;
     for _ in 0..BISECTIONS {
         let mid = 0.5 * (lo.0 + hi.0);
         let Ok(g) = at(model, name, mid, Some(lo.1.clone()), options) else {
             break;
         };
-        if !g.stability.is_stable() {
+        let inside = g.spectral_radius < 1.0;
+        if inside != stable_below {
             unstable = g.eigenvalues[0];
         }
-        if g.stability.is_stable() == stable_below {
+        if inside == below {
             lo = (mid, g.state);
         } else {
             hi = (mid, g.state);

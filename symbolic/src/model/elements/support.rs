@@ -323,14 +323,16 @@ pub(crate) type Mass = (ExprId, Vec<ExprId>, Option<(ExprId, ExprId)>);
 /// | `A = ∂R/∂q` | n² |
 /// | `when`, positive where a strike lands | 1 |
 ///
-/// Each mass gives rows: its centre's two, `Jᵢ = ∂rᵢ/∂q` with `Gᵢ = ∂(rᵢ − r_S)/∂q A⁻¹`
-/// (weight `mᵢ`), and a rigid body's angle, `Jᵢ = ∂θᵢ/∂q`, `Gᵢ = Jᵢ A⁻¹` (weight `Iᵢ`).
+/// Each mass gives rows: its centre's two, `Jᵢ = ∂rᵢ/∂q` with `Gᵢ = ∂(rᵢ − r_S)/∂q⁺`
+/// (weight `mᵢ`), and a rigid body's angle, `Jᵢ = ∂θᵢ/∂q`, `Gᵢ = ∂θᵢ/∂q⁺` (weight `Iᵢ`),
+/// each `Gᵢ` differentiated in the new coordinates (`q = A⁻¹ (q⁺ − c)`) and evaluated at
+/// `q⁺ = R(q)`.
 /// The law after a plastic landing that keeps the new foot and frees the old is
 /// `M⁺ q̇⁺ = H q̇⁻`: the momenta of every mass about the new foot, in the new coordinates.
-/// Written there, each relative position `rᵢ − r_S` is differentiated before it is summed, so a
-/// foot of small mass `β` keeps a row of order `β` of its own (the limit of massless legs),
-/// where the same law in the old coordinates would take it from a difference of order 1 and
-/// lose `ε/β` of it.
+/// Written there, each relative position `rᵢ − r_S` is differentiated in the new coordinates
+/// before anything is summed, so a foot of small mass `β` keeps a row of order `β` of its own
+/// (the limit of massless legs), where the same law in the old coordinates would take it from
+/// a difference of order 1 and lose `ε/β` of it.
 pub(crate) fn block(
     arena: &mut ExprArena,
     s: &SupportInfo,
@@ -377,15 +379,31 @@ pub(crate) fn block(
         .collect();
     let k = jacobian(arena, &moment);
     let f = jacobian(arena, &s.foot);
-    // The rows `(w, J, G)`.
-    let times_inverse = |arena: &mut ExprArena, row: &[ExprId]| -> Vec<ExprId> {
-        (0..n)
-            .map(|j| {
-                let terms: Vec<ExprId> = (0..n)
-                    .map(|i| arena.times(row[i], inverse[i * n + j]))
-                    .collect();
-                arena.sum(&terms)
-            })
+    // `G = ∂x/∂q⁺` at `q⁺ = R(q)` of a quantity `x(q)`: `x` written in the new coordinates
+    // (`q = A⁻¹ (q⁺ − c)`, `c = R(0)`), differentiated there, then evaluated at `R(q)`. A part
+    // of the mechanism that the new coordinates do not move (a walker's hip under the new
+    // swing leg's angle) then has its entry exactly 0, not a difference that rounds to 0.
+    let zero: rustc_hash::FxHashMap<_, _> = q.iter().map(|&qi| (qi, arena.int(0))).collect();
+    let offset: Vec<ExprId> = (s.relabel.iter())
+        .map(|&r| arena.substitute(r, &zero))
+        .collect();
+    let back: rustc_hash::FxHashMap<_, _> = (0..n)
+        .map(|i| {
+            let terms: Vec<ExprId> = (0..n)
+                .map(|j| {
+                    let qj = arena.symbol_expr(q[j]);
+                    let shifted = arena.minus(qj, offset[j]);
+                    arena.times(inverse[i * n + j], shifted)
+                })
+                .collect();
+            (q[i], arena.sum(&terms))
+        })
+        .collect();
+    let in_new = |arena: &mut ExprArena, x: ExprId| -> Vec<ExprId> {
+        let written = arena.substitute(x, &back);
+        let g = jacobian(arena, &[written]);
+        g.iter()
+            .map(|&e| arena.substitute(e, &relabelled))
             .collect()
     };
     let mut rows: Vec<(ExprId, Vec<ExprId>, Vec<ExprId>)> = Vec::new();
@@ -393,14 +411,13 @@ pub(crate) fn block(
     for (mi, r, rotation) in masses {
         for c in 0..2 {
             let relative = arena.minus(r[c], s.foot[c]);
-            let d = jacobian(arena, &[relative]);
-            let g = times_inverse(arena, &d);
+            let g = in_new(arena, relative);
             k_after[c].push((*mi, g.clone()));
             rows.push((*mi, jacobian(arena, &[r[c]]), g));
         }
         if let Some((inertia, angle)) = rotation {
             let j = jacobian(arena, &[*angle]);
-            let g = times_inverse(arena, &j);
+            let g = in_new(arena, *angle);
             rows.push((*inertia, j, g));
         }
     }
