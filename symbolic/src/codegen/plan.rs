@@ -64,7 +64,7 @@ pub enum ModelFunction {
     /// Each contact's coefficient of restitution `e` and of friction `μ` (2 m_c).
     ContactCoefficients,
     /// Each change of support's values, in contact order
-    /// ([`crate::model::elements::support::block`]).
+    /// (`block` of [`crate::model::elements::support`]).
     SupportChanges,
 }
 

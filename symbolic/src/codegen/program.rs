@@ -60,7 +60,7 @@ impl FunctionTape {
 /// | `contact_gaps` | `g`, `ġ`, `γ` of `G q̈ = γ`, `γ_T` of `T q̈ = γ_T`, then the surface's speed `v_s` (m_c each) |
 /// | `contact_jacobian` | `G = ∂g/∂q` (m_c × n), then the slips' rows `T` (m_c × n), row-major |
 /// | `contact_coefficients` | `e`, `μ` per contact (2 m_c) |
-/// | `support_changes` | each change of support's values ([`crate::model::elements::support::block`]) |
+/// | `support_changes` | each change of support's values (`block` of [`crate::model::elements::support`]) |
 #[derive(Debug, Clone, PartialEq)]
 pub struct ModelProgram {
     /// Everything about the model that is not a function of the state ([`super::describe`]).

@@ -290,11 +290,13 @@ pub struct SupportInfo {
     pub relabel: Vec<ExprId>,
     /// Positive where a strike lands (1 when the file gives no `when:`).
     pub when: ExprId,
-    /// What the runtime evaluates ([`block`]); empty until the model's masses are lowered.
+    /// What the runtime evaluates (its number: [`block_len`]); empty until the
+    /// model's masses are lowered.
     pub block: Vec<ExprId>,
 }
 
-/// The number of values in one change of support's [`block`], for `n` coordinates.
+/// The number of values in one change of support's block (the values the model's
+/// `support_changes` writes, in the order of `block`), for `n` coordinates.
 pub fn block_len(n: usize) -> usize {
     10 + 7 * n + 3 * n * n + 2 * n * n * n
 }
