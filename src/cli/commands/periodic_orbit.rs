@@ -213,7 +213,22 @@ fn run_gait(args: &PeriodicOrbitArgs, mut model: Box<dyn ModelInfo>) -> Result<(
     }
     let _ = writeln!(
         out,
-        "             (of ∂P/∂y; one is 0, the flow's direction. The Floquet multipliers of the monodromy matrix are the others and 1)"
+        "             (of ∂P/∂y; one is 0, the flow's direction)"
+    );
+    for (k, m) in gait.floquet_multipliers.iter().enumerate() {
+        let label = if k == 0 { "multipliers" } else { "" };
+        let _ = writeln!(
+            out,
+            "{label:<12} μ{:<3} = {:+.9} {:+.9}i   |μ| = {:.9}",
+            k + 1,
+            m.re,
+            m.im,
+            m.norm()
+        );
+    }
+    let _ = writeln!(
+        out,
+        "             (Floquet multipliers, of the monodromy matrix through the landings: the same and 1 for the flow)"
     );
     let _ = writeln!(
         out,
