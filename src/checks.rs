@@ -12,15 +12,14 @@
 use serde::Serialize;
 
 use crate::ModelSource;
-use crate::analysis::{Method, SimulationOptions, simulate};
 use crate::expressions::{evaluate, parameter_lookup, split_assignment};
 use crate::text::fixed;
 use eomgen_runtime::analysis::vibration::{
     EquilibriumStart, ModalAnalysis, ModalOptions, OperatingPointOptions, modal_analysis,
 };
-use eomgen_runtime::analysis::{EnergyDrift, RunTally, Simulation, StudyRuns, constraint_drift};
-use eomgen_runtime::description::checks::{ModalCheck, RunSettings};
-use eomgen_runtime::{Linearization, ModelInfo, OutputTimes, Solution, damped_modes};
+use eomgen_runtime::analysis::{EnergyDrift, RunTally, StudyRuns, constraint_drift};
+use eomgen_runtime::description::checks::ModalCheck;
+use eomgen_runtime::{Linearization, ModelInfo, Solution, damped_modes};
 use eomgen_symbolic::mechanics::cross_check::check_model;
 use eomgen_symbolic::model::parser::eval_expr;
 use eomgen_symbolic::model::parser::parse_expr;
@@ -36,12 +35,6 @@ pub const DERIVATION_TOLERANCE: f64 = eomgen_symbolic::mechanics::cross_check::C
 pub const DERIVATION_STATES: usize = 100;
 /// Seed of the derivation cross-checks' random states, as `eomgen check`'s.
 pub const DERIVATION_SEED: u64 = eomgen_symbolic::mechanics::cross_check::CHECK_SEED;
-/// Default end time of a check's simulation (s).
-pub const DEFAULT_T_END: f64 = 10.0;
-/// Default relative and absolute tolerance of a check's simulation.
-pub const DEFAULT_RTOL: f64 = 1e-12;
-/// Samples of a check's simulation (uniform in t, both ends included).
-pub const SAMPLES: usize = 1001;
 /// Expected periods a `period:` check integrates at least, when its file gives no `t_end:`
 /// (two zeros one period apart fit whatever the phase of the first, with a period to spare).
 pub const PERIODS_PER_RUN: f64 = 3.0;
@@ -131,121 +124,6 @@ impl CheckRow {
             tolerance,
             passed,
             note,
-        }
-    }
-}
-
-/// How a check integrates: method, `rtol = atol`, end time (the file's `run:` settings).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-pub struct CheckRun {
-    /// The method (default: DOP853).
-    pub method: Method,
-    /// Relative and absolute tolerance (default: [`DEFAULT_RTOL`]).
-    pub rtol: f64,
-    /// End time (s) (default: [`DEFAULT_T_END`]).
-    pub t_end: f64,
-}
-
-impl CheckRun {
-    /// The run a check's `run:` settings ask for, the defaults filling in.
-    pub fn of(settings: &RunSettings) -> Self {
-        let method = settings
-            .method
-            .as_ref()
-            .and_then(|m| m.parse::<Method>().ok())
-            .unwrap_or(Method::Dop853);
-        Self {
-            method,
-            rtol: settings.rtol.unwrap_or(DEFAULT_RTOL),
-            t_end: settings.t_end.unwrap_or(DEFAULT_T_END),
-        }
-    }
-
-    /// `dop853, rtol 1e-12, 10 s`, as the rows name their settings.
-    pub fn describe(&self) -> String {
-        let method = self.method.name();
-        format!("{method}, rtol {:e}, {} s", self.rtol, fixed(self.t_end, 6))
-    }
-}
-
-impl Default for CheckRun {
-    fn default() -> Self {
-        Self::of(&RunSettings::default())
-    }
-}
-
-/// The simulations of one model that its checks (and a report's figures) share, each run
-/// once: a fresh instance of the model from its consistent initial state, sampled at
-/// [`SAMPLES`] uniform times, with the file's events located on the way.
-pub struct Simulations {
-    source: ModelSource,
-    done: Vec<(CheckRun, Result<Simulation, String>)>,
-}
-
-impl Simulations {
-    /// No simulation of `source` yet.
-    pub fn new(source: ModelSource) -> Self {
-        Self {
-            source,
-            done: Vec::new(),
-        }
-    }
-
-    /// The solution of `run` (computed the first time it is asked for).
-    ///
-    /// # Errors
-    /// Why the simulation could not start or did not reach its end, as text.
-    pub fn get(&mut self, run: CheckRun) -> Result<&Solution, String> {
-        self.simulation(run).map(|s| &s.solution)
-    }
-
-    /// The whole simulation of `run` (computed the first time it is asked for): its
-    /// solution, and its energy drift with the energy lost at impacts added.
-    ///
-    /// # Errors
-    /// As [`Self::get`].
-    pub fn simulation(&mut self, run: CheckRun) -> Result<&Simulation, String> {
-        let k = match self.done.iter().position(|(d, _)| *d == run) {
-            Some(k) => k,
-            None => {
-                let simulation = self.simulate(run, None);
-                self.done.push((run, simulation));
-                self.done.len() - 1
-            }
-        };
-        self.done[k].1.as_ref().map_err(Clone::clone)
-    }
-
-    /// Runs `run` sampled at `times` (default: [`SAMPLES`] uniform times), not kept.
-    ///
-    /// # Errors
-    /// Why the simulation could not start or did not reach its end, as text.
-    pub fn run(&self, run: CheckRun, times: Option<Vec<f64>>) -> Result<Solution, String> {
-        self.simulate(run, times).map(|s| s.solution)
-    }
-
-    /// [`Self::run`], the whole simulation. A run that stopped at a contact (a transition
-    /// without an answer) did not reach its end, and is an error.
-    fn simulate(&self, run: CheckRun, times: Option<Vec<f64>>) -> Result<Simulation, String> {
-        let times = times.unwrap_or_else(|| {
-            (0..SAMPLES)
-                .map(|k| run.t_end * k as f64 / (SAMPLES - 1) as f64)
-                .collect()
-        });
-        let options = SimulationOptions {
-            method: run.method,
-            t_end: run.t_end,
-            rtol: run.rtol,
-            atol: run.rtol,
-            output: OutputTimes::At(times),
-            ..SimulationOptions::default()
-        };
-        let mut model = self.source.instantiate();
-        let simulation = simulate(model.as_mut(), &options).map_err(|e| e.to_string())?;
-        match (&simulation.failure, &simulation.contact_stop) {
-            (Some(error), _) => Err(format!("the integration failed: {error}")),
-            (None, Some(stop)) => Err(format!("the run stopped: {stop}")),
-            (None, None) => Ok(simulation),
         }
     }
 }
@@ -1007,5 +885,7 @@ pub fn model_report(path: &str, text: &str, file: &ModelFile, source: &ModelSour
     out
 }
 
+mod simulations;
+pub use simulations::{CheckRun, DEFAULT_RTOL, DEFAULT_T_END, SAMPLES, Simulations};
 #[cfg(test)]
 mod tests;

@@ -13,8 +13,10 @@
 
 pub mod impact;
 mod phase;
+pub mod record;
 pub mod run;
 pub mod support;
 
 pub use impact::{ImpactContact, ImpactError, ImpactMode, ImpactReport, impact};
-pub use run::{ContactStop, HybridRecord, Transition, TransitionKind, integrate_through_impacts};
+pub use record::{ContactStop, HybridRecord, Transition, TransitionKind};
+pub use run::integrate_through_impacts;

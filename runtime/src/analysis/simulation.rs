@@ -11,7 +11,7 @@ use crate::analysis::failure::{FailureCause, failure_cause};
 use crate::analysis::fixed_step::{ENERGY_DRIFT_LIMIT, SimulationWarning, fixed_step_warnings};
 use crate::analysis::methods::Method;
 use crate::constrained::{ProjectionError, Stabilization, StabilizationError};
-use crate::hybrid::run::{ContactStop, HybridRecord, Transition, integrate_through_impacts};
+use crate::hybrid::{ContactStop, HybridRecord, Transition, integrate_through_impacts};
 use crate::integrate::{
     IntegrationError, IntegrationFailure, Integrator, IntegratorOptions, OutputTimes, Solution,
     Stats,

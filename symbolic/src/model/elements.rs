@@ -127,3 +127,20 @@ pub(crate) fn dot(arena: &mut ExprArena, a: &[ExprId], b: &[ExprId]) -> ExprId {
     let terms: Vec<ExprId> = a.iter().zip(b).map(|(x, y)| arena.times(*x, *y)).collect();
     arena.sum(&terms)
 }
+
+/// `√x`, exact where `x` is the square of a rational (`|[0, 2]| = 2`, not `sqrt(4)`: the
+/// listing reads as a textbook's).
+pub(crate) fn exact_sqrt(arena: &mut ExprArena, x: ExprId) -> ExprId {
+    if let Some(crate::expr::Constant::Rational { num, den }) = arena.as_constant(x)
+        && let (Some(a), Some(b)) = (integer_sqrt(num), integer_sqrt(den))
+    {
+        return arena.constant(crate::expr::Constant::Rational { num: a, den: b });
+    }
+    arena.sqrt(x)
+}
+
+/// `√n` if `n ≥ 0` is a perfect square.
+fn integer_sqrt(n: i64) -> Option<i64> {
+    let r = (n.max(0) as f64).sqrt().round() as i64;
+    (n >= 0 && r.checked_mul(r) == Some(n)).then_some(r)
+}

@@ -706,7 +706,7 @@ impl Contact {
                 };
                 let nd = super::dot(cx.arena(), &n, &d);
                 let nn = super::dot(cx.arena(), &n, &n);
-                let length = exact_sqrt(cx.arena(), nn);
+                let length = super::exact_sqrt(cx.arena(), nn);
                 let mut gap = cx.arena().divide(nd, length);
                 if let Some(o) = through {
                     surface = self.moving_line(cx, o, (&n, length), gap);
@@ -906,7 +906,7 @@ fn slip_row(
     coordinates: &[crate::expr::SymbolId],
 ) -> Vec<ExprId> {
     let uu = super::dot(cx.arena(), u, u);
-    let length = exact_sqrt(cx.arena(), uu);
+    let length = super::exact_sqrt(cx.arena(), uu);
     let arena = cx.arena();
     let minus_uy = arena.neg(u[1]);
     let t = [arena.divide(minus_uy, length), arena.divide(u[0], length)];
@@ -937,23 +937,6 @@ fn position(cx: &mut dyn Lower, point: &Located<String>) -> Option<Vec<ExprId>> 
         ));
     }
     p
-}
-
-/// `√x`, exact where `x` is the square of a rational (`|[0, 2]| = 2`, not `sqrt(4)`: the
-/// listing reads as a textbook's).
-fn exact_sqrt(arena: &mut crate::expr::ExprArena, x: ExprId) -> ExprId {
-    if let Some(crate::expr::Constant::Rational { num, den }) = arena.as_constant(x)
-        && let (Some(a), Some(b)) = (integer_sqrt(num), integer_sqrt(den))
-    {
-        return arena.constant(crate::expr::Constant::Rational { num: a, den: b });
-    }
-    arena.sqrt(x)
-}
-
-/// `√n` if `n ≥ 0` is a perfect square.
-fn integer_sqrt(n: i64) -> Option<i64> {
-    let r = (n.max(0) as f64).sqrt().round() as i64;
-    (n >= 0 && r.checked_mul(r) == Some(n)).then_some(r)
 }
 
 /// `p − o`, `o` as written.
