@@ -470,8 +470,9 @@ pub fn return_map(
         let phi = phi.0;
         let values = model.contact_values(t_hit, &y);
         let law = (values.restitution[c], values.static_friction[c]);
+        let s = SupportValues::of(model, which, t_hit, &y[..n]);
         let change =
-            change_support(model, which, t_hit, &y, law).map_err(|error| GaitError::Support {
+            change_support(model, &s, (t_hit, &y), law).map_err(|error| GaitError::Support {
                 step,
                 t: t_hit,
                 error,
@@ -482,7 +483,7 @@ pub fn return_map(
             t: t_hit,
             rate,
         };
-        let reset = reset_jacobian(model, which, t_hit, &y).ok_or(saltation_error(f64::NAN))?;
+        let reset = reset_jacobian(&s, &y).ok_or(saltation_error(f64::NAN))?;
         let (mut before_field, mut after_field) = (vec![0.0; dim], vec![0.0; dim]);
         let ode = model.as_ode_mut();
         let fields = (ode.rhs(t_hit, &y, &mut before_field))

@@ -323,14 +323,15 @@ impl Run<'_> {
         // Where the file's `when:` is not positive, or the foot passes over the stance foot,
         // it does not land (scuffing): the phase goes on from here, the contact open at a
         // zero.
-        if !SupportValues::of(model, which, t, &y[..n]).lands() {
+        let s = SupportValues::of(model, which, t, &y[..n]);
+        if !s.lands() {
             self.y = y;
             self.t = t;
             return Ok(());
         }
         let values = model.contact_values(t, &y);
         let law = (values.restitution[c], values.static_friction[c]);
-        let change = change_support(model, which, t, &y, law).map_err(stop)?;
+        let change = change_support(model, &s, (t, &y), law).map_err(stop)?;
         let after: Vec<f64> = change.q.iter().chain(&change.qdot).copied().collect();
         let potential = |y: &[f64]| model.energy(t, y) - model.kinetic_energy(t, y);
         self.record.transitions.push(Transition {

@@ -231,7 +231,8 @@ pub enum SupportError {
     },
 }
 
-/// Applies change of support `which` at `(t, y)` (`y = [q; q̇]` just before the strike), with
+/// Applies the change of support whose values at `q` are `s` ([`SupportValues::of`]) at
+/// `(t, y)` (`y = [q; q̇]` just before the strike), with
 /// the contact's coefficient of restitution `restitution` (which must be 0: the foot sticks)
 /// and its sticking cone's `friction` (`μ_s`; 0: the foot's sticking is not checked).
 ///
@@ -239,17 +240,15 @@ pub enum SupportError {
 /// [`SupportError`] where the model's assumptions fail (see the module documentation).
 pub fn change_support(
     model: &dyn ModelInfo,
-    which: usize,
-    t: f64,
-    y: &[f64],
+    s: &SupportValues,
+    (t, y): (f64, &[f64]),
     (restitution, friction): (f64, f64),
 ) -> Result<SupportChange, SupportError> {
     let n = model.num_dofs();
     if restitution != 0.0 {
         return Err(SupportError::NotPlastic { restitution });
     }
-    let s = SupportValues::of(model, which, t, &y[..n]);
-    check_relabel(model, t, &s)?;
+    check_relabel(model, t, s)?;
     let before = DVector::from_row_slice(&y[n..2 * n]);
     let finite = |v: &DVector<f64>| v.iter().all(|x| x.is_finite());
     let after = (s.mass_matrix_after.clone().lu())
@@ -329,8 +328,9 @@ fn check_relabel(model: &dyn ModelInfo, t: f64, s: &SupportValues) -> Result<(),
     Ok(())
 }
 
-/// `∂Δ/∂y` (2n × 2n) of the reset `Δ(q, q̇) = (R(q), M(R(q))⁻¹ H(q) q̇)` of change of support
-/// `which` at `(t, y)` (the state before it), exactly, from the derived derivatives of
+/// `∂Δ/∂y` (2n × 2n) of the reset `Δ(q, q̇) = (R(q), M(R(q))⁻¹ H(q) q̇)` of the change of
+/// support whose values at `q` are `s`, at `y = [q; q̇]` (the state before it), exactly, from
+/// the derived derivatives of
 /// `M(R(q))` and `H`:
 ///
 /// - `∂q⁺/∂q = ∂R/∂q`, `∂q⁺/∂q̇ = 0`;
@@ -338,14 +338,8 @@ fn check_relabel(model: &dyn ModelInfo, t: f64, s: &SupportValues) -> Result<(),
 /// - `∂q̇⁺/∂q̇ = M⁺⁻¹ H`.
 ///
 /// `None` where `M(q⁺)` is singular.
-pub fn reset_jacobian(
-    model: &dyn ModelInfo,
-    which: usize,
-    t: f64,
-    y: &[f64],
-) -> Option<DMatrix<f64>> {
-    let n = model.num_dofs();
-    let s = SupportValues::of(model, which, t, &y[..n]);
+pub fn reset_jacobian(s: &SupportValues, y: &[f64]) -> Option<DMatrix<f64>> {
+    let n = y.len() / 2;
     let qdot = DVector::from_row_slice(&y[n..2 * n]);
     let lu = s.mass_matrix_after.clone().lu();
     let after = lu.solve(&(&s.h * &qdot))?;

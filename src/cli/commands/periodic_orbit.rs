@@ -200,32 +200,12 @@ fn run_gait(args: &PeriodicOrbitArgs, mut model: Box<dyn ModelInfo>) -> Result<(
         "landings     kinetic energy lost {} J",
         lost.join(", ")
     );
-    for (k, l) in gait.eigenvalues.iter().enumerate() {
-        let label = if k == 0 { "eigenvalues" } else { "" };
-        let _ = writeln!(
-            out,
-            "{label:<12} λ{:<3} = {:+.9} {:+.9}i   |λ| = {:.9}",
-            k + 1,
-            l.re,
-            l.im,
-            l.norm()
-        );
-    }
+    complex_rows(&mut out, "eigenvalues", 'λ', &gait.eigenvalues);
     let _ = writeln!(
         out,
         "             (of ∂P/∂y; one is 0, the flow's direction)"
     );
-    for (k, m) in gait.floquet_multipliers.iter().enumerate() {
-        let label = if k == 0 { "multipliers" } else { "" };
-        let _ = writeln!(
-            out,
-            "{label:<12} μ{:<3} = {:+.9} {:+.9}i   |μ| = {:.9}",
-            k + 1,
-            m.re,
-            m.im,
-            m.norm()
-        );
-    }
+    complex_rows(&mut out, "multipliers", 'μ', &gait.floquet_multipliers);
     let _ = writeln!(
         out,
         "             (Floquet multipliers, of the monodromy matrix through the landings: the same and 1 for the flow)"
@@ -370,21 +350,31 @@ fn print_text(
     print_stability(stdout, orbit);
 }
 
+/// One row per complex value, `label` on the first: `μ1 = re im i   |μ| = …`.
+fn complex_rows(
+    out: &mut impl std::io::Write,
+    label: &str,
+    symbol: char,
+    values: &[eomgen::nalgebra::Complex<f64>],
+) {
+    for (k, v) in values.iter().enumerate() {
+        let label = if k == 0 { label } else { "" };
+        let _ = writeln!(
+            out,
+            "{label:<12} {symbol}{:<3} = {:+.9} {:+.9}i   |{symbol}| = {:.9}",
+            k + 1,
+            v.re,
+            v.im,
+            v.norm()
+        );
+    }
+}
+
 /// The orbit's energy, its Floquet multipliers with the trivial ones and the symmetries they
 /// count, the stability verdict and the work.
 fn print_stability(stdout: &mut impl std::io::Write, orbit: &PeriodicOrbit) {
     let _ = writeln!(stdout, "energy       T + V = {:.12e} J", num(orbit.energy));
-    for (k, m) in orbit.multipliers.iter().enumerate() {
-        let label = if k == 0 { "multipliers" } else { "" };
-        let _ = writeln!(
-            stdout,
-            "{label:<12} μ{:<3} = {:+.9} {:+.9}i   |μ| = {:.9}",
-            k + 1,
-            m.re,
-            m.im,
-            m.norm()
-        );
-    }
+    complex_rows(stdout, "multipliers", 'μ', &orbit.multipliers);
     let _ = writeln!(
         stdout,
         "trivial μ    {} of {} within {:e} of 1, their mean off by {:.1e} (a Hamiltonian system: a pair for the time shift and the energy, one per further symmetry with its conserved momentum)",
