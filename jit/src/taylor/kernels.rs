@@ -245,10 +245,17 @@ impl Emitter {
         k: usize,
         (y, z): (ir::Value, ir::Value),
     ) {
-        let flags = MemFlagsData::trusted();
-        let offset = PairScratch::pair(p, k);
-        b.ins().store(flags, y, self.scratch, offset);
-        b.ins().store(flags, z, self.scratch, offset + 8);
+        // One 16-byte store, as the orders above load it: two 8-byte stores read back by one
+        // 16-byte load cannot be forwarded from the store buffer, and the load waits for
+        // both stores to reach the cache.
+        let lanes = b.ins().scalar_to_vector(types::F64X2, y);
+        let lanes = b.ins().insertlane(lanes, z, 1);
+        b.ins().store(
+            MemFlagsData::trusted(),
+            lanes,
+            self.scratch,
+            PairScratch::pair(p, k),
+        );
     }
 
     /// `cauchy`: `(Σ_{j=1}^{k−1} a[j] b[k − j] + a[0] b[k]) + a[k] b[0]`.
@@ -390,8 +397,10 @@ impl Emitter {
                 let p = self.next_pair();
                 let (ws, wc) = self.weighted_pair(b, p, a, k);
                 let vs = Self::over_k(b, ws, k);
-                let minus = b.ins().fneg(wc);
-                let vc = Self::over_k(b, minus, k);
+                // `(−wc)·(1/k)` as `wc·(−1/k)`: the same bits (negation is exact and rounding
+                // is symmetric), one multiplication instead of a sign mask and a multiplication.
+                let minus_r = Self::constant(b, -(1.0 / k as f64));
+                let vc = b.ins().fmul(wc, minus_r);
                 self.put(b, sin, k, vs);
                 self.put(b, cos, k, vc);
                 self.store_pair(b, p, k, (vc, vs));
