@@ -17,9 +17,7 @@ use eomgen_symbolic::model::{Diagnostic, ReadError, read_model_file};
 use crate::compiled::{Compiled, Extent, FusedRhs, HotRoutine, SCRATCH, call, call_native};
 use crate::first_order::first_order_tape;
 use crate::native::CompileError;
-use crate::taylor::{
-    FACTOR_DENSE, FACTOR_DIAGONAL, FACTOR_SMALL, NativeOrders, OrderFrame, PairLanes,
-};
+use crate::taylor::{FACTOR_DENSE, FACTOR_DIAGONAL, FACTOR_SMALL, NativeOrders, OrderFrame};
 use crate::{Backend, Inputs, interpret};
 
 /// Why a model file could not be made into a run-time model.
@@ -826,6 +824,8 @@ impl TaylorFunctions for Recurrences {
             }
             _ => (std::ptr::null(), std::ptr::null(), 0),
         };
+        // The scratch of the workspace, kept between steps.
+        let scratch = solve.lanes(orders.scratch_units).as_mut_ptr();
         let mut context = OrderContext {
             layout: MotionLayout {
                 forcing: &program.forcing,
@@ -840,45 +840,26 @@ impl TaylorFunctions for Recurrences {
             out: out.as_mut_ptr(),
             out_len: out.len(),
         };
-        thread_local! {
-            /// The compiled orders' scratch ([`crate::taylor::PairScratch`]), kept between
-            /// calls on this thread.
-            static SCRATCH: std::cell::RefCell<Vec<PairLanes>> = const { std::cell::RefCell::new(Vec::new()) };
-        }
-        let ran = SCRATCH.try_with(|scratch| {
-            let Ok(mut scratch) = scratch.try_borrow_mut() else {
-                return false;
-            };
-            if scratch.len() < orders.scratch_units {
-                scratch.resize(orders.scratch_units, PairLanes::default());
+        let (series, out) = (context.series, context.out);
+        let frame = OrderFrame {
+            context: (&raw mut context).cast::<u8>(),
+            solve: solve_order,
+            lower,
+            inverse_pivots,
+            factor: mode,
+        };
+        for function in &orders.orders[..computed] {
+            // SAFETY: `series` holds every slot at the stride of 25 with the orders below `k`
+            // computed (by the calls before this one), and `out` every order the code writes
+            // (checked above); `frame`'s `lower` and `inverse_pivots`, when not null, hold
+            // `n × n` and `n` values that nothing writes during the call, and `solve_order`
+            // is called with the context built for it; `scratch` holds the units the orders
+            // use, with the orders below `k` written by the calls before; `series`, `out`,
+            // `scratch` and `frame` are not used otherwise until the call returns.
+            let status = unsafe { function(series, scratch, out, &raw const frame) };
+            if status != 0 {
+                return 0;
             }
-            let scratch = scratch.as_mut_ptr();
-            let (series, out) = (context.series, context.out);
-            let frame = OrderFrame {
-                context: (&raw mut context).cast::<u8>(),
-                solve: solve_order,
-                lower,
-                inverse_pivots,
-                factor: mode,
-            };
-            for function in &orders.orders[..computed] {
-                // SAFETY: `series` holds every slot at the stride of 25 with the orders below
-                // `k` computed (by the calls before this one), and `out` every order the code
-                // writes (checked above); `frame`'s `lower` and `inverse_pivots`, when not
-                // null, hold `n × n` and `n` values that nothing writes during the call, and
-                // `solve_order` is called with the context built for it; `scratch` holds the
-                // units the orders use, with the orders below `k` written by the calls
-                // before; `series`, `out`, `scratch` and `frame` are not used otherwise until
-                // the call returns.
-                let status = unsafe { function(series, scratch, out, &raw const frame) };
-                if status != 0 {
-                    return false;
-                }
-            }
-            true
-        });
-        if ran != Ok(true) {
-            return 0;
         }
         computed
     }

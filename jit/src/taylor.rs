@@ -125,10 +125,9 @@ impl OrderFrame {
     const FACTOR: i32 = std::mem::offset_of!(OrderFrame, factor) as i32;
 }
 
-/// Two `f64`s aligned for one 16-byte load: the unit of [`PairScratch`].
-#[derive(Debug, Clone, Copy, Default)]
-#[repr(C, align(16))]
-pub(crate) struct PairLanes(pub(crate) [f64; 2]);
+/// Two `f64`s aligned for one 16-byte load: the unit of [`PairScratch`], in the workspace
+/// of the step ([`eomgen_runtime::taylor::MotionSolve::lanes`]).
+pub(crate) use eomgen_runtime::taylor::Lanes as PairLanes;
 
 /// The layout of the orders' scratch: for the `p`-th sine–cosine or sinh–cosh op of the
 /// program, [`UNROLLED_CAPACITY`] units `(y[i], z[i])` (its cosine and sine, or cosh and

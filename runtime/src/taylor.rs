@@ -604,7 +604,15 @@ pub struct TaylorWorkspace {
     rhs: Vec<f64>,
     /// `1 / (k + 1)` for `k = 0 … capacity − 1`.
     reciprocals: Vec<f64>,
+    /// A run-time backend's scratch ([`MotionSolve::lanes`]), kept between steps.
+    lanes: Vec<Lanes>,
 }
+
+/// Two values side by side, aligned for one 16-byte load: the unit of the scratch a run-time
+/// backend's compiled orders keep between orders ([`MotionSolve::lanes`]).
+#[derive(Debug, Clone, Copy, Default)]
+#[repr(C, align(16))]
+pub struct Lanes(pub [f64; 2]);
 
 impl TaylorWorkspace {
     /// Empty buffers.
@@ -751,6 +759,7 @@ fn series_in(
         nonzeros,
         rhs,
         reciprocals,
+        lanes,
         ..
     } = workspace;
     debug_assert!(
@@ -812,6 +821,7 @@ fn series_in(
         inverse_pivots,
         reciprocals,
         rhs,
+        lanes,
     };
     // The model's fused orders (compiled models with the unrolled stride), then the rest one
     // order at a time: order k of the ops (none at 0), of q̈, and order k + 1 of the state.
@@ -876,11 +886,24 @@ pub struct MotionSolve<'a> {
     inverse_pivots: &'a [f64],
     reciprocals: &'a [f64],
     rhs: &'a mut [f64],
+    lanes: &'a mut Vec<Lanes>,
 }
 
 impl MotionSolve<'_> {
+    /// At least `units` of the workspace's scratch for a run-time backend, kept between
+    /// steps (grown when a backend asks for more, never shrunk): what the orders of one step
+    /// wrote is there for the orders above, in that step.
+    #[inline]
+    pub fn lanes(&mut self, units: usize) -> &mut [Lanes] {
+        if self.lanes.len() < units {
+            self.lanes.resize(units, Lanes::default());
+        }
+        &mut self.lanes[..]
+    }
+
     /// Whether the workspace has the stride of the code compiled for each order
     /// ([`UNROLLED_CAPACITY`]), the one [`motion_order`] with `K ≠ 0` needs.
+    #[inline]
     pub fn unrolled(&self) -> bool {
         self.c == UNROLLED_CAPACITY
     }
@@ -889,6 +912,7 @@ impl MotionSolve<'_> {
     /// with them as a dense factor in registers — `n ≤ 6` and no zero below `L`'s diagonal —
     /// for a run-time backend that does the same: `L z = b` row by row, `z ← D⁻¹ z`, then
     /// `Lᵀ x = z` from the last row up; `None` when it solves over `L`'s non-zero entries.
+    #[inline]
     pub fn dense_factor(&self) -> Option<(&[f64], &[f64])> {
         (self.n <= FIXED_DEGREES && self.dense).then(|| {
             (
@@ -902,6 +926,7 @@ impl MotionSolve<'_> {
     /// below its diagonal too, whose updates a run-time backend that solves with it must skip
     /// (as [`motion_order`]'s solve over `L`'s non-zero entries does: `b − 0·x` is not `b` for
     /// `b = −0` or `x` infinite); `None` for larger `n`.
+    #[inline]
     pub fn small_factor(&self) -> Option<(&[f64], &[f64])> {
         (self.n <= FIXED_DEGREES).then(|| {
             (
@@ -914,6 +939,7 @@ impl MotionSolve<'_> {
     /// `D⁻¹` when `L` is the identity (no non-zero entry below its diagonal: a diagonal `M`),
     /// whose solve is then `x = D⁻¹ b` alone, for a run-time backend that does the same;
     /// `None` otherwise.
+    #[inline]
     pub fn diagonal_factor(&self) -> Option<&[f64]> {
         self.nonzeros
             .is_empty()
