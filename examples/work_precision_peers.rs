@@ -13,20 +13,26 @@
 //!     --tols 1e-2,1e-3,1e-4 --reps 5 [--reference reference.json] [--host-features off]
 //! ```
 //!
+//! With `--from-file on` (a build with `--features jit`), eomgen's side and ode_solvers'
+//! run the model loaded from its file and compiled at run time by Cranelift, the path of the
+//! command line and of Python, instead of the copy `model!` compiled into this program.
+//!
 //! Models: `double_pendulum` (`models/double_pendulum.yaml`, HW19, 4 states) and
 //! `figure_eight` (`models/figure_eight.yaml`, HW7, 12 states), with the files' default
-//! parameters and initial states, as compiled into this program by `model!`.
+//! parameters and initial states, as compiled into this program by `model!` (or loaded from
+//! the files, with `--from-file on`).
 //!
 //! Methods: every adaptive [`Method`] by its command-line name (`dp54`, `dop853`, and any
 //! method added to [`Method::ALL`] later), run through [`Method::integrator`] with
 //! `rtol = atol = tol`, at most 10⁶ steps, every accepted step recorded
-//! ([`OutputTimes::Steps`]), the system passed as its concrete [`FirstOrder`] type (as the
-//! command line and `benches/peers.rs` do); and `ode_solvers-dop853`, `ode_solvers-dopri5`:
+//! ([`OutputTimes::Steps`]), the system passed as its concrete type ([`FirstOrder`] of the
+//! `model!` struct, as `benches/peers.rs` does, or with `--from-file on` `DynFirstOrder` of
+//! the file's `JitModel`, as the command line does); and `ode_solvers-dop853`, `ode_solvers-dopri5`:
 //! ode_solvers' Dop853 and Dopri5 with `rtol = atol = tol` and their default controllers
 //! (the settings of `benches/peers.rs`: safety 0.9, Dop853 `beta = 0`, step ratio in
 //! `[0.333, 6]`, Dopri5 `beta = 0.04`, `[0.2, 10]`, `h_max = t_end`, automatic first step,
-//! at most 10⁶ steps, `OutputType::Sparse`), calling the same [`FirstOrder`] right-hand
-//! side through a `RefCell` (ode_solvers' `System::system` takes `&self`). Fixed-step
+//! at most 10⁶ steps, `OutputType::Sparse`), calling the same right-hand side through a
+//! `RefCell` (ode_solvers' `System::system` takes `&self`). Fixed-step
 //! methods have no tolerance and are rejected.
 //!
 //! `run` prints, for each method and tolerance, one line
@@ -125,7 +131,7 @@ struct Measurement {
 }
 
 /// `y(t_end)` of ode_solvers' `$solver` (`Dop853` or `Dopri5`) on `$system` (a
-/// `&RefCell<FirstOrder<…>>`) from `$y0` (a `&[f64]` of length `$dim`) at `rtol = atol =
+/// `&RefCell` of the first-order system) from `$y0` (a `&[f64]` of length `$dim`) at `rtol = atol =
 /// $tol`, with the controller's `beta` and step-ratio bounds; `(state, evaluations, accepted,
 /// rejected)` or the solver's error message.
 macro_rules! peer_run {
@@ -296,9 +302,9 @@ fn reference(path: &str, model: &str) -> Result<(f64, Vec<f64>), String> {
 
 /// The subcommands for one model type: `initial`, `rhs`, `run`.
 macro_rules! command {
-    ($dim:literal, $model:ty, $name:expr, $command:expr, $opts:expr) => {{
+    ($dim:literal, $system:expr, $name:expr, $command:expr, $opts:expr) => {{
         let (name, command, opts): (&str, &str, &[(String, String)]) = ($name, $command, $opts);
-        let system = RefCell::new(FirstOrder::new(<$model>::default()));
+        let system = RefCell::new($system);
         let y0 = ModelInfo::initial_state(&*system.borrow());
         match command {
             "initial" => {
@@ -410,13 +416,61 @@ fn main_inner() -> Result<(), String> {
         .ok_or("usage: work_precision_peers initial|rhs|run --model NAME [options]")?;
     let opts = options(rest)?;
     let model = option(&opts, "model").ok_or("--model is required")?;
+    match option(&opts, "from-file") {
+        None | Some("off") => {}
+        Some("on") => return from_file(model, command, &opts),
+        Some(other) => return Err(format!("--from-file: `{other}`, not on or off")),
+    }
     match model {
-        "double_pendulum" => command!(4, DoublePendulum, model, command, &opts),
-        "figure_eight" => command!(12, FigureEight, model, command, &opts),
+        "double_pendulum" => command!(
+            4,
+            FirstOrder::new(DoublePendulum::default()),
+            model,
+            command,
+            &opts
+        ),
+        "figure_eight" => command!(
+            12,
+            FirstOrder::new(FigureEight::default()),
+            model,
+            command,
+            &opts
+        ),
         _ => Err(format!(
             "unknown model `{model}` (valid: double_pendulum, figure_eight)"
         )),
     }
+}
+
+/// The subcommand on the model loaded from its file and compiled at run time (`--from-file
+/// on`; the build needs `--features jit`): the path of the command line and of Python, with
+/// its Taylor orders compiled from the first series (`LoadOptions::eager_taylor`), as after
+/// the first steps of any run.
+#[cfg(feature = "jit")]
+fn from_file(model: &str, command: &str, opts: &[(String, String)]) -> Result<(), String> {
+    let load = |name: &str| {
+        let path = format!("{}/models/{name}.yaml", env!("CARGO_MANIFEST_DIR"));
+        let options = eomgen::LoadOptions {
+            eager_taylor: true,
+            ..eomgen::LoadOptions::default()
+        };
+        eomgen::JitModel::load_with(&path, options)
+            .map(eomgen::DynFirstOrder::new)
+            .map_err(|e| format!("{path}: {e}"))
+    };
+    match model {
+        "double_pendulum" => command!(4, load(model)?, model, command, opts),
+        "figure_eight" => command!(12, load(model)?, model, command, opts),
+        _ => Err(format!(
+            "unknown model `{model}` (valid: double_pendulum, figure_eight)"
+        )),
+    }
+}
+
+/// Without the `jit` feature there is no run-time compiler to load a file with.
+#[cfg(not(feature = "jit"))]
+fn from_file(_: &str, _: &str, _: &[(String, String)]) -> Result<(), String> {
+    Err("--from-file on needs the build's `jit` feature (`--features jit`)".into())
 }
 
 fn main() -> ExitCode {

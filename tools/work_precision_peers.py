@@ -4,7 +4,9 @@ Codes compared, on the same model, initial state and reference:
 - eomgen's adaptive methods, by their `Method` names (`--methods dp54,dop853`; methods added
   later are included by name), and ode_solvers 0.6.2's Dop853 (`--peers
   ode_solvers-dop853`, optionally `ode_solvers-dopri5`), both measured by the Rust program of
-  examples/work_precision_peers.rs on the model compiled by `model!`;
+  examples/work_precision_peers.rs on the model compiled by `model!` (with `--from-file`,
+  on the model loaded from its file and compiled at run time, the command line's path: build
+  the example with `--features jit`);
 - heyoka's `taylor_adaptive` (tools/heyoka_peer.py, imported: its integrators are built and
   compiled once per tolerance and reused, so compile time is not in the timings; it is
   reported separately: by default heyoka's on-disk cache of compiled code, $XDG_CACHE_HOME/heyoka,
@@ -40,7 +42,7 @@ Usage (from the repository root):
         [--methods dp54,dop853] [--peers ode_solvers-dop853] [--rounds 7] [--reps 5] \
         [--per-decade 2] [--reference /tmp/peers-out/reference.json] \
         [--out /tmp/peers-out/work_precision_peers.md] [--svg /tmp/peers-out/work_precision_peers.svg] \
-        [--raw /tmp/peers-out/raw.jsonl] [--warm-cache] [--heyoka-high-accuracy]
+        [--raw /tmp/peers-out/raw.jsonl] [--warm-cache] [--heyoka-high-accuracy] [--from-file]
 Without --out the markdown is printed. The chart (log-log, error against median time, one
 line per method) is drawn with matplotlib.
 """
@@ -75,13 +77,16 @@ def tolerances(per_decade):
     return [10.0 ** (-k / per_decade) for k in range(2 * per_decade, 15 * per_decade + 1)]
 
 
-def rust_batch(binary, methods, tols, reps, reference):
-    """The Rust program's results for the double-pendulum sweep and the figure eight."""
+def rust_batch(binary, methods, tols, reps, reference, from_file=False):
+    """The Rust program's results for the double-pendulum sweep and the figure eight
+    (`from_file`: the models loaded from their files and compiled at run time)."""
     results = []
     for model, model_tols in ((DP, tols), (FE, [FE_TOL])):
         cmd = [binary, "run", "--model", model, "--t-end", repr(heyoka_peer.T_END[model]),
                "--methods", ",".join(methods), "--tols", ",".join(map(repr, model_tols)),
                "--reps", str(reps), "--reference", str(reference)]
+        if from_file:
+            cmd += ["--from-file", "on"]
         out = subprocess.run(cmd, capture_output=True, text=True)
         if out.returncode != 0:
             raise RuntimeError(f"{' '.join(cmd)} failed: {out.stderr}")
@@ -279,6 +284,10 @@ def main():
     parser.add_argument("--heyoka-high-accuracy", action="store_true",
                         help="run heyoka with high_accuracy=True (each step's polynomial "
                              "summed with compensation)")
+    parser.add_argument("--from-file", action="store_true",
+                        help="eomgen's models loaded from their files and compiled at run "
+                             "time (the command line's path; build the example with "
+                             "--features jit)")
     parser.add_argument("--warm-cache", action="store_true",
                         help="let heyoka use its on-disk cache of compiled integrators")
     args = parser.parse_args()
@@ -304,7 +313,7 @@ def main():
     rounds = []
     for r in range(args.rounds):
         batches = [lambda: rust_batch(args.binary, methods + peers, tols, args.reps,
-                                      args.reference),
+                                      args.reference, args.from_file),
                    lambda: heyoka_batch(peer, tols, args.reps)]
         if r % 2:
             batches.reverse()
@@ -317,7 +326,8 @@ def main():
     load = os.getloadavg()
     meta = (f"{time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}, {platform.machine()}, "
             f"{os.cpu_count()} cores, load average {load[0]:.1f} at the end; heyoka "
-            f"{heyoka_peer.hy.__version__}.")
+            f"{heyoka_peer.hy.__version__}; eomgen's models "
+            f"{'loaded from their files' if args.from_file else 'compiled by model!'}.")
     text, sweeps = report(merged, methods, peers, tols, args, meta)
     if args.out:
         Path(args.out).write_text(text)

@@ -854,8 +854,10 @@ impl TaylorFunctions for Recurrences {
             // (checked above); `frame`'s `lower` and `inverse_pivots`, when not null, hold
             // `n × n` and `n` values that nothing writes during the call, and `solve_order`
             // is called with the context built for it; `scratch` holds the units the orders
-            // use, with the orders below `k` written by the calls before; `series`, `out`,
-            // `scratch` and `frame` are not used otherwise until the call returns.
+            // use, with the orders below `k` written by the calls before, and nothing
+            // `solve_order` reaches (`motion_order_at`) touches the workspace's lanes, so
+            // they are not reallocated under the code; `series`, `out`, `scratch` and `frame`
+            // are not used otherwise until the call returns.
             let status = unsafe { function(series, scratch, out, &raw const frame) };
             if status != 0 {
                 return 0;

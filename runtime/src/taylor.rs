@@ -873,7 +873,8 @@ pub struct MotionLayout<'a> {
     pub accelerations: Slot,
 }
 
-/// `M⁰`'s factor and the stride of one [`series_of_motion`], for [`motion_order`].
+/// `M⁰`'s factor and the stride of one [`series_of_motion`], for [`motion_order`], and the
+/// workspace's scratch for a run-time backend's compiled orders ([`Self::lanes`]).
 #[derive(Debug)]
 pub struct MotionSolve<'a> {
     n: usize,

@@ -248,7 +248,7 @@ impl Emitter {
         // One 16-byte store, as the orders above load it: two 8-byte stores read back by one
         // 16-byte load cannot be forwarded from the store buffer, and the load waits for
         // both stores to reach the cache.
-        let lanes = b.ins().scalar_to_vector(types::F64X2, y);
+        let lanes = b.ins().splat(types::F64X2, y);
         let lanes = b.ins().insertlane(lanes, z, 1);
         b.ins().store(
             MemFlagsData::trusted(),
@@ -397,8 +397,9 @@ impl Emitter {
                 let p = self.next_pair();
                 let (ws, wc) = self.weighted_pair(b, p, a, k);
                 let vs = Self::over_k(b, ws, k);
-                // `(−wc)·(1/k)` as `wc·(−1/k)`: the same bits (negation is exact and rounding
-                // is symmetric), one multiplication instead of a sign mask and a multiplication.
+                // `(−wc)·(1/k)` as `wc·(−1/k)`: the same bits for every `wc` but NaN (negation
+                // is exact and rounding symmetric; a NaN keeps its sign, and any NaN fails the
+                // step), one multiplication instead of a sign mask and a multiplication.
                 let minus_r = Self::constant(b, -(1.0 / k as f64));
                 let vc = b.ins().fmul(wc, minus_r);
                 self.put(b, sin, k, vs);
