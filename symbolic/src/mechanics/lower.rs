@@ -386,6 +386,8 @@ struct Lowering<'f> {
     points: Points,
     /// Names bound while lowering one expression: an interaction's `r` and `r_dot`.
     locals: Vec<(String, ExprId)>,
+    /// The frames, once lowered with the bodies, for the elements ([`elements::Lower`]).
+    frames: Frames,
 }
 
 impl<'f> Lowering<'f> {
@@ -398,6 +400,7 @@ impl<'f> Lowering<'f> {
             allow_accelerations: false,
             points: Vec::new(),
             locals: Vec::new(),
+            frames: Frames::default(),
         }
     }
 
@@ -454,7 +457,8 @@ impl<'f> Lowering<'f> {
             self.bodies(&points, &mut frames, gravity.as_deref(), &mut terms);
         let mut loads = self.springs(&mut terms);
         loads.extend(self.dampers(&mut terms));
-        loads.extend(self.forces(&points, &frames, &q_symbols, &mut terms));
+        self.frames = frames.clone();
+        loads.extend(self.forces(&mut terms));
         loads.extend(self.torques(&angles, &body_infos, &frames, &q_symbols, &mut terms));
         let (interaction_loads, interactions_at_start) =
             self.interactions(&points, &q_symbols, &mut terms);
@@ -812,6 +816,10 @@ impl elements::Lower for Lowering<'_> {
     }
     fn point_at(&self, i: usize) -> Vec<ExprId> {
         self.points[i].1.clone()
+    }
+    fn in_ground(&mut self, frame: &str, v: [ExprId; 3]) -> Option<[ExprId; 3]> {
+        let from = self.frames.index(frame)?;
+        Some(self.frames.express(&mut self.arena, v, from, 0))
     }
     fn coordinate_names(&self) -> Vec<String> {
         (self.file.coordinates.iter())

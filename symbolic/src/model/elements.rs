@@ -11,12 +11,13 @@
 //! loop and one row in the schema's `SECTIONS`.
 //!
 //! The kinds here: [`contact`] (unilateral contacts) and its [`support`] (a change of
-//! support), [`spring`] and [`damper`]. The older
-//! kinds (bodies, forces, constraints, …) are still spread over the stage files;
+//! support), [`spring`], [`damper`] and [`force`]. The older
+//! kinds (bodies, torques, constraints, …) are still spread over the stage files;
 //! ARCHITECTURE.md's recipe says how a kind moves here.
 
 pub mod contact;
 pub mod damper;
+pub mod force;
 pub mod spring;
 pub mod support;
 
@@ -25,6 +26,18 @@ use super::diagnostic::Diagnostic;
 use super::located::Located;
 use super::units::Dimension;
 use crate::expr::{ExprArena, ExprId};
+
+/// The name of the ground (Newtonian) frame, predefined in every 3-D model.
+pub const GROUND_FRAME: &str = "N";
+
+/// `, in: F` for a frame other than the ground's, else nothing: how a vector written in a
+/// frame ends its entry.
+pub(crate) fn in_frame(frame: Option<&Located<String>>) -> String {
+    match frame {
+        Some(f) if f.value != GROUND_FRAME => format!(", in: {}", f.value),
+        _ => String::new(),
+    }
+}
 
 /// What an expression of a model file may depend on.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
@@ -46,6 +59,9 @@ pub(crate) trait Rules {
     /// Reports `name` unless it is a point of the model (or one left out for an error
     /// already reported).
     fn point(&mut self, name: &Located<String>);
+    /// Reports `name` unless it is a frame of the model or the ground (or one left out for
+    /// an error already reported).
+    fn frame(&mut self, name: &Located<String>);
     /// Checks the names and functions of `e` and that it depends on no more than `depends`;
     /// `what` names it in messages ("the restitution of contact `floor`").
     fn expression(&mut self, e: &Expr, depends: Depends, what: &str);
@@ -88,6 +104,9 @@ pub(crate) trait Lower {
     fn point_index(&self, name: &str) -> Option<usize>;
     /// The position of the point of index `i` (from [`Lower::point_index`]).
     fn point_at(&self, i: usize) -> Vec<ExprId>;
+    /// The vector of components `v` in the frame `frame` as components in the ground frame;
+    /// `None` if there is no such frame (reported by the rules).
+    fn in_ground(&mut self, frame: &str, v: [ExprId; 3]) -> Option<[ExprId; 3]>;
     /// The model's coordinates, in file order.
     fn coordinate_names(&self) -> Vec<String>;
     /// Reports a mistake found while lowering.

@@ -6,6 +6,7 @@
 use super::ast::Expr;
 pub use super::elements::contact::{Contact, Gap};
 pub use super::elements::damper::Damper;
+pub use super::elements::force::Force;
 pub use super::elements::spring::Spring;
 // The `checks:` and `floquet:` types live in `checks.rs`; they are named here too, where
 // they were first defined.
@@ -96,8 +97,7 @@ pub struct RelativePosition {
     pub vectors: Vec<(Located<String>, Vec<Expr>)>,
 }
 
-/// The name of the ground (Newtonian) frame, predefined in every 3-D model.
-pub const GROUND_FRAME: &str = "N";
+pub use super::elements::GROUND_FRAME;
 
 /// An axis of a frame.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -327,22 +327,6 @@ pub struct OutputDef {
     pub conserved: bool,
     /// Bound on the drift `max |Q(t) − Q(0)| / max(1, |Q(0)|)` of a conserved output.
     pub tolerance: f64,
-}
-
-/// A force applied at a point: `{ at: P, vector: [Fx, Fy] }`, components any expression of
-/// `q`, `q̇` and `t`.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Force {
-    /// Name.
-    pub name: Located<String>,
-    /// Point of application.
-    pub at: Located<String>,
-    /// Components (N), as many as the model's dimension.
-    pub vector: Vec<Expr>,
-    /// The frame the components are written in (`in: B`); `None`: the ground frame.
-    pub frame: Option<Located<String>>,
-    /// Where the vector list starts.
-    pub location: Location,
 }
 
 /// A torque on a rigid body: `{ body: B, value: tau }` (N·m, counter-clockwise) on a planar

@@ -78,6 +78,9 @@ pub(crate) fn check_parts(
     for contact in &file.contacts {
         contact.rules(&mut checker);
     }
+    for force in &file.forces {
+        force.rules(&mut checker);
+    }
     checker.interactions();
     checker.outputs();
     let units = super::unit_check::check(file);
@@ -317,6 +320,13 @@ fn principal_moments([xx, yy, zz, xy, yz, xz]: [f64; 6]) -> [f64; 3] {
 impl elements::Rules for Checker<'_> {
     fn point(&mut self, name: &Located<String>) {
         Checker::point(self, name);
+    }
+    fn frame(&mut self, name: &Located<String>) {
+        let frames: Vec<&str> = (self.file.frames.iter())
+            .map(|f| f.name.value.as_str())
+            .chain([GROUND_FRAME])
+            .collect();
+        Checker::frame(self, name, &frames);
     }
     fn expression(&mut self, e: &Expr, depends: Depends, what: &str) {
         self.resolve(e, depends, what);

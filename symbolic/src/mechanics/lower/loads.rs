@@ -252,41 +252,17 @@ impl Lowering<'_> {
         loads
     }
 
-    /// Forces at points: Qᵢ = F·∂r_P/∂qᵢ (the partial velocity ∂v_P/∂q̇ᵢ); a force written
-    /// in a frame (`in: B`) is carried into the ground frame's components first.
-    pub(super) fn forces(
-        &mut self,
-        points: &Points,
-        frames: &Frames,
-        q_symbols: &[SymbolId],
-        terms: &mut Terms,
-    ) -> Vec<LoadInfo> {
+    /// Forces at points (`elements::force`): their generalized forces into `Q`.
+    pub(super) fn forces(&mut self, terms: &mut Terms) -> Vec<LoadInfo> {
+        let file = self.file;
         let mut loads = Vec::new();
-        for f in &self.file.forces {
-            let Some(ip) = point(points, &f.at.value) else {
-                self.errors.push(Diagnostic::new(
-                    f.at.location,
-                    format!("unknown point `{}`", f.at.value),
-                ));
-                continue;
-            };
-            let mut force: Vec<ExprId> = f.vector.iter().map(|c| self.expr(c)).collect();
-            if let Some(frame) = &f.frame
-                && let (Some(from), &[x, y, z]) = (frames.index(&frame.value), &force[..])
-            {
-                force = frames.express(&mut self.arena, [x, y, z], from, 0).to_vec();
-            }
+        for f in file.forces.iter().filter_map(|f| f.lower(self)) {
             loads.push(LoadInfo::Force {
-                point: ip,
-                vector: force.clone(),
+                point: f.point,
+                vector: f.vector,
             });
-            let r = &points[ip].1;
-            for (i, qs) in q_symbols.iter().enumerate() {
-                let partial: Vec<ExprId> = r.iter().map(|x| self.arena.diff(*x, *qs)).collect();
-                let proj = self.dot(&force, &partial);
-                if !self.arena.is_zero(proj) {
-                    terms.forces[i].push(proj);
-                }
+            for (forces, q) in terms.forces.iter_mut().zip(f.generalized_forces) {
+                forces.extend(q);
             }
         }
         loads

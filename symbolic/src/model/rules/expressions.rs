@@ -103,11 +103,6 @@ impl Checker<'_> {
                 self.resolve(c, Depends::Constant, "`gravity`");
             }
         }
-        for f in &file.forces {
-            for c in &f.vector {
-                self.resolve(c, Depends::Motion, &format!("force `{}`", f.name.value));
-            }
-        }
         for t in &file.torques {
             for e in t.value.expressions() {
                 self.resolve(e, Depends::Motion, &format!("torque `{}`", t.name.value));
@@ -403,16 +398,7 @@ impl Checker<'_> {
             );
         }
         for f in &file.forces {
-            if f.vector.len() != dim {
-                self.error(Diagnostic::new(
-                    f.location,
-                    format!(
-                        "force `{}` has {} components but the points have {dim}",
-                        f.name.value,
-                        f.vector.len()
-                    ),
-                ));
-            }
+            f.dimension_rules(self, dim);
         }
     }
 
@@ -437,16 +423,6 @@ impl Checker<'_> {
                     .with_help("a 3-D body's centre of mass is a 3-D point (`[x, y, z]` or `{ from: O, B: [0, 0, l] }`); a planar body is `{ mass: m, inertia: I, com: G, angle: theta }`"),
                 ),
                 _ => {}
-            }
-        }
-        for f in &file.forces {
-            if let Some(frame) = &f.frame
-                && f.vector.len() != 3
-            {
-                self.error(
-                    Diagnostic::new(frame.location, format!("force `{}` is written in frame `{}`, which needs 3 components", f.name.value, frame.value))
-                        .with_help("frames are 3-D: write `vector: [Fx, Fy, Fz]`, or leave out `in` for components in the plane"),
-                );
             }
         }
         for t in &file.torques {

@@ -21,11 +21,6 @@ impl Checker<'_> {
                 self.frame(frame, &frames);
             }
         }
-        for f in &file.forces {
-            if let Some(frame) = &f.frame {
-                self.frame(frame, &frames);
-            }
-        }
         for w in &file.draw.wheels {
             self.point(&w.centre);
             self.frame(&w.frame, &frames);

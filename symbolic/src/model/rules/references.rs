@@ -14,9 +14,6 @@ impl Checker<'_> {
         for b in &file.bodies {
             self.point(b.kind.com());
         }
-        for f in &file.forces {
-            self.point(&f.at);
-        }
         for l in &file.draw.lines {
             l.iter().for_each(|p| self.point(p));
         }

@@ -5,6 +5,7 @@
 use super::walk::{Fields, Keyed, Need};
 use super::write::{NotRewritten, Writer, flow, list, scalar};
 use super::*;
+use crate::model::elements::in_frame;
 
 /// The names of the other derivations that `eomgen check` lists beside a named set of
 /// balances, which a set may not take.
@@ -15,17 +16,6 @@ const INTERACTION: Fields = Fields {
     kind: "interaction",
     keys: &[("between", Need::Required), ("magnitude", Need::Required)],
     example: "{ between: [P1, P2], magnitude: -G*m1*m2/r^2 }",
-};
-
-/// The keys of a force.
-const FORCE: Fields = Fields {
-    kind: "force",
-    keys: &[
-        ("at", Need::Required),
-        ("vector", Need::Required),
-        ("in", Need::Optional),
-    ],
-    example: "{ at: P, vector: [F0*cos(w*t), 0] }",
 };
 
 /// The keys of a torque (`value` on a planar body, `vector` and `in` on a 3-D one).
@@ -343,41 +333,6 @@ impl Ctx<'_> {
         })
     }
 
-    /// `forces:` — `name: { at, vector }`.
-    pub(super) fn forces(&mut self, node: &YamlNode) -> Vec<Force> {
-        let example = format!("forces: {{ push: {} }}", FORCE.example);
-        let spec = Keyed {
-            what: "`forces`",
-            example: &example,
-            names: None,
-            drop: false,
-        };
-        self.keyed(node, spec, |cx, k, v| {
-            let f = cx.fields(k, v, &FORCE)?;
-            let at = get(f, "at").and_then(|n| cx.name(n, "`at`"));
-            let vector = get(f, "vector").and_then(|n| {
-                cx.vector(
-                    n,
-                    &format!("the vector of force `{}`", k.value),
-                    "vector: [Fx, Fy]",
-                )
-                .map(|x| (x, n.location))
-            });
-            let frame = match get(f, "in") {
-                Some(n) => cx.name(n, "`in`").map(Some),
-                None => Some(None),
-            };
-            let (vector, location) = vector?;
-            Some(Force {
-                name: k.clone(),
-                at: at?,
-                vector,
-                frame: frame?,
-                location,
-            })
-        })
-    }
-
     /// `torques:` — `name: { body, value }`.
     pub(super) fn torques(&mut self, node: &YamlNode) -> Vec<Torque> {
         let example = format!("torques: {{ motor: {} }}", TORQUE.example);
@@ -645,26 +600,6 @@ impl Writer<'_> {
         Ok(list(&parts))
     }
 
-    /// `forces:` (3-D ones and those written in frames included).
-    pub(super) fn write_forces(&mut self, file: &ModelFile) -> Result<(), NotRewritten> {
-        if file.forces.is_empty() {
-            return Ok(());
-        }
-        self.line("forces:");
-        for f in &file.forces {
-            let place = format!("force `{}`", f.name.value);
-            let parts = self.exprs(&f.vector, &place)?;
-            self.line(format_args!(
-                "  {}: {{ at: {}, vector: {}{} }}",
-                f.name.value,
-                f.at.value,
-                list(&parts),
-                in_frame(f.frame.as_ref())
-            ));
-        }
-        Ok(())
-    }
-
     /// `torques:`, planar and 3-D.
     pub(super) fn write_torques(&mut self, file: &ModelFile) -> Result<(), NotRewritten> {
         if file.torques.is_empty() {
@@ -785,14 +720,6 @@ impl Writer<'_> {
             ));
         }
         Ok(())
-    }
-}
-
-/// `, in: F` for a frame other than the ground's, else nothing.
-fn in_frame(frame: Option<&Located<String>>) -> String {
-    match frame {
-        Some(f) if f.value != GROUND_FRAME => format!(", in: {}", f.value),
-        _ => String::new(),
     }
 }
 

@@ -5,7 +5,7 @@
 use super::walk::{Fields, Keyed, Need};
 use super::write::{Edits, NotRewritten, Rewrite, Writer, list, scalar};
 use super::*;
-use crate::model::elements::{contact, damper, spring};
+use crate::model::elements::{contact, damper, force, spring};
 
 /// How one top-level key of a model file is read, and written.
 struct Section {
@@ -159,10 +159,10 @@ const SECTIONS: &[Section] = &[
         write: |w, file| damper::write(w, &file.dampers),
     },
     Section {
-        key: "forces",
-        read: |cx, n, file| file.forces = cx.forces(n),
+        key: force::KEY,
+        read: |cx, n, file| file.forces = force::read(cx, n),
         missing: None,
-        write: |w, file| w.write_forces(file),
+        write: |w, file| force::write(w, &file.forces),
     },
     Section {
         key: "torques",

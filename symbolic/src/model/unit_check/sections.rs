@@ -247,16 +247,7 @@ impl Checker<'_> {
             d.units(self);
         }
         for f in &file.forces {
-            for (axis, c) in AXES.iter().zip(&f.vector) {
-                self.fixed(
-                    c,
-                    Dimension::NEWTON,
-                    &format!("the {axis} component of force `{}`", f.name.value),
-                    "a force",
-                    "N",
-                    "a force is mass × acceleration, kg*m/s^2 = N",
-                );
-            }
+            f.units(self);
         }
         self.interaction = true;
         for i in &file.interactions {
