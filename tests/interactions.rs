@@ -536,3 +536,59 @@ fn an_output_of_a_frames_angular_velocity_is_evaluated() {
         assert!((wx - expected).abs() < 1e-14, "{wx} vs {expected}");
     }
 }
+
+/// A force written in a frame (`in: B`) is the same force as its components written in the
+/// ground frame by hand: `F_N = R_z(ψ) R_y(θ) F_B` on a point `l` along `B`'s `x` axis, at
+/// random states (`M` and `F` to 1e-13 relative). Both files put the point at the same place
+/// (the second writes `r_P = l (cos ψ cos θ, sin ψ cos θ, −sin θ)`), so a rotation applied
+/// the wrong way round or not at all changes `F`.
+#[test]
+fn a_force_written_in_a_frame_is_its_rotated_components() {
+    use eomgen::DynMechanicalSystem;
+    let header = "parameters: { m: 1.3, l: 0.7, g: 9.81, F1: 0.4, F2: -1.1, F3: 0.8 }
+coordinates: [psi, theta]
+frames:
+  A: { parent: N, axis: z, angle: psi }
+  B: { parent: A, axis: y, angle: theta }
+bodies:
+  mass: { mass: m, at: P }
+gravity: [0, 0, -g]
+";
+    let in_frame = format!(
+        "name: in_frame\n{header}points:
+  O: [0, 0, 0]
+  P: {{ from: O, B: [l, 0, 0] }}
+forces:
+  push: {{ at: P, vector: [F1*sin(t), F2, F3*psi_dot], in: B }}
+"
+    );
+    let by_hand = format!(
+        "name: by_hand\n{header}points:
+  P: [l*cos(psi)*cos(theta), l*sin(psi)*cos(theta), -l*sin(theta)]
+forces:
+  push:
+    at: P
+    vector:
+      - cos(psi)*(cos(theta)*F1*sin(t) + sin(theta)*F3*psi_dot) - sin(psi)*F2
+      - sin(psi)*(cos(theta)*F1*sin(t) + sin(theta)*F3*psi_dot) + cos(psi)*F2
+      - -sin(theta)*F1*sin(t) + cos(theta)*F3*psi_dot
+"
+    );
+    let a = JitModel::from_source("in_frame.yaml", &in_frame).unwrap_or_else(|e| panic!("{e}"));
+    let b = JitModel::from_source("by_hand.yaml", &by_hand).unwrap_or_else(|e| panic!("{e}"));
+    let mut rng = seeded_rng(11);
+    for _ in 0..20 {
+        let q = [rng.random_range(-3.0..3.0), rng.random_range(-1.4..1.4)];
+        let qdot = [rng.random_range(-2.0..2.0), rng.random_range(-2.0..2.0)];
+        let t = rng.random_range(0.0..5.0);
+        let (mut ma, mut fa, mut mb, mut fb) = ([0.0; 4], [0.0; 2], [0.0; 4], [0.0; 2]);
+        a.mass_matrix_and_forcing(&q, &qdot, t, &mut ma, &mut fa);
+        b.mass_matrix_and_forcing(&q, &qdot, t, &mut mb, &mut fb);
+        for (x, y) in ma.iter().zip(&mb).chain(fa.iter().zip(&fb)) {
+            assert!(
+                (x - y).abs() <= 1e-13 * (1.0 + y.abs()),
+                "at q = {q:?}, q̇ = {qdot:?}, t = {t}: {ma:?} {fa:?} against {mb:?} {fb:?}"
+            );
+        }
+    }
+}
