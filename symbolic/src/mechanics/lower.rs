@@ -11,7 +11,7 @@ use crate::model::ast::{BinOp, Expr, ExprKind};
 use crate::model::checks::FloquetReference;
 use crate::model::diagnostic::Diagnostic;
 use crate::model::elements::{self, contact::ContactInfo};
-use crate::model::file::{BodyKind, GROUND_FRAME, ModelFile, TorqueValue};
+use crate::model::file::{BodyKind, GROUND_FRAME, ModelFile};
 use crate::model::located::{Located, Location};
 use crate::model::rules::short;
 
@@ -388,6 +388,8 @@ struct Lowering<'f> {
     locals: Vec<(String, ExprId)>,
     /// The frames, once lowered with the bodies, for the elements ([`elements::Lower`]).
     frames: Frames,
+    /// The bodies, once lowered, for the elements.
+    bodies: Vec<BodyInfo>,
 }
 
 impl<'f> Lowering<'f> {
@@ -401,6 +403,7 @@ impl<'f> Lowering<'f> {
             points: Vec::new(),
             locals: Vec::new(),
             frames: Frames::default(),
+            bodies: Vec::new(),
         }
     }
 
@@ -453,13 +456,13 @@ impl<'f> Lowering<'f> {
             .gravity
             .as_ref()
             .map(|g| g.value.iter().map(|c| self.expr(c)).collect());
-        let (body_infos, angles) =
-            self.bodies(&points, &mut frames, gravity.as_deref(), &mut terms);
+        let body_infos = self.bodies(&points, &mut frames, gravity.as_deref(), &mut terms);
         let mut loads = self.springs(&mut terms);
         loads.extend(self.dampers(&mut terms));
         self.frames = frames.clone();
+        self.bodies = body_infos.clone();
         loads.extend(self.forces(&mut terms));
-        loads.extend(self.torques(&angles, &body_infos, &frames, &q_symbols, &mut terms));
+        loads.extend(self.torques(&mut terms));
         let (interaction_loads, interactions_at_start) =
             self.interactions(&points, &q_symbols, &mut terms);
         loads.extend(interaction_loads);
@@ -817,9 +820,23 @@ impl elements::Lower for Lowering<'_> {
     fn point_at(&self, i: usize) -> Vec<ExprId> {
         self.points[i].1.clone()
     }
-    fn in_ground(&mut self, frame: &str, v: [ExprId; 3]) -> Option<[ExprId; 3]> {
-        let from = self.frames.index(frame)?;
-        Some(self.frames.express(&mut self.arena, v, from, 0))
+    fn frame_index(&self, name: &str) -> Option<usize> {
+        self.frames.index(name)
+    }
+    fn express(&mut self, v: [ExprId; 3], from: usize, to: usize) -> [ExprId; 3] {
+        self.frames.express(&mut self.arena, v, from, to)
+    }
+    fn body_index(&self, name: &str) -> Option<usize> {
+        self.bodies.iter().position(|b| b.name == name)
+    }
+    fn planar_angle(&self, name: &str) -> Option<ExprId> {
+        let body = self.bodies.iter().find(|b| b.name == name)?;
+        body.rotation.map(|(_, angle)| angle)
+    }
+    fn spatial_body(&self, name: &str) -> Option<(usize, usize, [ExprId; 3])> {
+        let index = self.body_index(name)?;
+        let spatial = self.bodies[index].spatial.as_ref()?;
+        Some((index, spatial.frame, spatial.angular_velocity))
     }
     fn coordinate_names(&self) -> Vec<String> {
         (self.file.coordinates.iter())

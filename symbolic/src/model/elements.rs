@@ -11,8 +11,8 @@
 //! loop and one row in the schema's `SECTIONS`.
 //!
 //! The kinds here: [`contact`] (unilateral contacts) and its [`support`] (a change of
-//! support), [`spring`], [`damper`] and [`force`]. The older
-//! kinds (bodies, torques, constraints, …) are still spread over the stage files;
+//! support), [`spring`], [`damper`], [`force`] and [`torque`]. The older
+//! kinds (bodies, constraints, …) are still spread over the stage files;
 //! ARCHITECTURE.md's recipe says how a kind moves here.
 
 pub mod contact;
@@ -20,6 +20,7 @@ pub mod damper;
 pub mod force;
 pub mod spring;
 pub mod support;
+pub mod torque;
 
 use super::ast::Expr;
 use super::diagnostic::Diagnostic;
@@ -54,6 +55,28 @@ pub(crate) enum Depends {
     Event,
 }
 
+/// What kind of body a name is, for the rules of the loads on bodies ([`Rules::body`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum BodyShape {
+    /// A particle (`at:`).
+    Particle,
+    /// A planar rigid body (`inertia` a number, `angle`).
+    Planar,
+    /// A 3-D rigid body (`frame`, an inertia tensor).
+    Spatial,
+}
+
+/// What [`Rules::body`] finds under a name.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub(crate) enum BodyLookup {
+    /// A body of this kind.
+    Found(BodyShape),
+    /// None, but an error already reported explains it (the name or the section was lost).
+    Excused,
+    /// None: no such body, with the closest name if one is close.
+    Unknown(Option<String>),
+}
+
 /// What an element's rules ask of the file around it (the rules pass implements it).
 pub(crate) trait Rules {
     /// Reports `name` unless it is a point of the model (or one left out for an error
@@ -62,6 +85,8 @@ pub(crate) trait Rules {
     /// Reports `name` unless it is a frame of the model or the ground (or one left out for
     /// an error already reported).
     fn frame(&mut self, name: &Located<String>);
+    /// The body called `name`: its kind, or why there is none.
+    fn body(&self, name: &str) -> BodyLookup;
     /// Checks the names and functions of `e` and that it depends on no more than `depends`;
     /// `what` names it in messages ("the restitution of contact `floor`").
     fn expression(&mut self, e: &Expr, depends: Depends, what: &str);
@@ -104,9 +129,20 @@ pub(crate) trait Lower {
     fn point_index(&self, name: &str) -> Option<usize>;
     /// The position of the point of index `i` (from [`Lower::point_index`]).
     fn point_at(&self, i: usize) -> Vec<ExprId>;
-    /// The vector of components `v` in the frame `frame` as components in the ground frame;
-    /// `None` if there is no such frame (reported by the rules).
-    fn in_ground(&mut self, frame: &str, v: [ExprId; 3]) -> Option<[ExprId; 3]>;
+    /// The index of the frame `name` among the model's frames (0: the ground); `None` if
+    /// there is no such frame (reported by the rules).
+    fn frame_index(&self, name: &str) -> Option<usize>;
+    /// The vector of components `v` in the frame of index `from` as components in the frame
+    /// of index `to`.
+    fn express(&mut self, v: [ExprId; 3], from: usize, to: usize) -> [ExprId; 3];
+    /// The index of the body `name` among the model's bodies.
+    fn body_index(&self, name: &str) -> Option<usize>;
+    /// The angle `θ` of the planar rigid body `name`; `None` if it is not one.
+    fn planar_angle(&self, name: &str) -> Option<ExprId>;
+    /// The index, the frame's index and the angular velocity (in the body frame's
+    /// components, linear in the rates) of the 3-D rigid body `name`; `None` if it is not
+    /// one.
+    fn spatial_body(&self, name: &str) -> Option<(usize, usize, [ExprId; 3])>;
     /// The model's coordinates, in file order.
     fn coordinate_names(&self) -> Vec<String>;
     /// Reports a mistake found while lowering.

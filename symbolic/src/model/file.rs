@@ -8,6 +8,7 @@ pub use super::elements::contact::{Contact, Gap};
 pub use super::elements::damper::Damper;
 pub use super::elements::force::Force;
 pub use super::elements::spring::Spring;
+pub use super::elements::torque::{Torque, TorqueValue};
 // The `checks:` and `floquet:` types live in `checks.rs`; they are named here too, where
 // they were first defined.
 pub use super::checks::{
@@ -327,44 +328,6 @@ pub struct OutputDef {
     pub conserved: bool,
     /// Bound on the drift `max |Q(t) − Q(0)| / max(1, |Q(0)|)` of a conserved output.
     pub tolerance: f64,
-}
-
-/// A torque on a rigid body: `{ body: B, value: tau }` (N·m, counter-clockwise) on a planar
-/// body, `{ body: B, vector: [Tx, Ty, Tz], in: F }` on a 3-D one.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Torque {
-    /// Name.
-    pub name: Located<String>,
-    /// The body it acts on.
-    pub body: Located<String>,
-    /// Torque (N·m).
-    pub value: TorqueValue,
-}
-
-/// The value of a [`Torque`].
-#[derive(Debug, Clone, PartialEq)]
-pub enum TorqueValue {
-    /// `value: tau` — about the axis normal to the plane, counter-clockwise (planar models).
-    Planar(Expr),
-    /// `vector: [Tx, Ty, Tz]` in the frame `in:` (the ground frame if `None`).
-    Spatial {
-        /// Components (N·m).
-        vector: Vec<Expr>,
-        /// The frame of the components.
-        frame: Option<Located<String>>,
-        /// Where the vector list starts.
-        location: Location,
-    },
-}
-
-impl TorqueValue {
-    /// Every expression of the value.
-    pub fn expressions(&self) -> Vec<&Expr> {
-        match self {
-            TorqueValue::Planar(e) => vec![e],
-            TorqueValue::Spatial { vector, .. } => vector.iter().collect(),
-        }
-    }
 }
 
 /// Which momentum balance a [`Balance`] writes.

@@ -11,7 +11,6 @@ use super::diagnostic::{Diagnostic, Diagnostics};
 use super::elements::{self, Depends};
 use super::file::{
     Axis, BalanceKind, BodyKind, GROUND_FRAME, InertiaTensor, ModelFile, Parameter, RollingContact,
-    TorqueValue,
 };
 use super::located::{Located, Location};
 use super::parser::{closest, eval_expr, identifiers};
@@ -80,6 +79,9 @@ pub(crate) fn check_parts(
     }
     for force in &file.forces {
         force.rules(&mut checker);
+    }
+    for torque in &file.torques {
+        torque.rules(&mut checker);
     }
     checker.interactions();
     checker.outputs();
@@ -327,6 +329,23 @@ impl elements::Rules for Checker<'_> {
             .chain([GROUND_FRAME])
             .collect();
         Checker::frame(self, name, &frames);
+    }
+    fn body(&self, name: &str) -> elements::BodyLookup {
+        use elements::{BodyLookup, BodyShape};
+        let file = self.file;
+        match file.bodies.iter().find(|b| b.name.value == name) {
+            Some(b) => BodyLookup::Found(match b.kind {
+                BodyKind::Particle { .. } => BodyShape::Particle,
+                BodyKind::Rigid { .. } => BodyShape::Planar,
+                BodyKind::Spatial { .. } => BodyShape::Spatial,
+            }),
+            None if self.incomplete.has_name(name)
+                || self.section_lost("bodies", file.bodies.is_empty()) =>
+            {
+                BodyLookup::Excused
+            }
+            None => BodyLookup::Unknown(closest(name, &self.bodies).map(str::to_string)),
+        }
     }
     fn expression(&mut self, e: &Expr, depends: Depends, what: &str) {
         self.resolve(e, depends, what);

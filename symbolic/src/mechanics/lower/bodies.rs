@@ -29,17 +29,16 @@ impl Lowering<'_> {
     }
 
     /// Bodies: T = ½ m v_G·v_G (+ ½ I ω² for planar rigid bodies, + ½ ω·I_G ω for 3-D
-    /// ones), V = −m g·r_G. Returns the bodies and the angle of each planar rigid body, by
-    /// name.
+    /// ones), V = −m g·r_G. Returns the bodies (a planar rigid body's angle in its
+    /// `rotation`).
     pub(super) fn bodies(
         &mut self,
         points: &Points,
         frames: &mut Frames,
         gravity: Option<&[ExprId]>,
         terms: &mut Terms,
-    ) -> (Vec<BodyInfo>, Vec<(String, ExprId)>) {
+    ) -> Vec<BodyInfo> {
         let half = terms.half;
-        let mut angles: Vec<(String, ExprId)> = Vec::new();
         let mut body_infos: Vec<BodyInfo> = Vec::new();
         for body in &self.file.bodies {
             let (mass, at, rigid) = match &body.kind {
@@ -78,7 +77,6 @@ impl Lowering<'_> {
                 let two = self.arena.int(2);
                 let w2 = self.arena.pow(w, two);
                 terms.kinetic.push(self.arena.product(&[half, i, w2]));
-                angles.push((body.name.value.clone(), th));
             }
             let spatial = match &body.kind {
                 BodyKind::Spatial { frame, inertia, .. } => {
@@ -94,7 +92,7 @@ impl Lowering<'_> {
                 spatial,
             });
         }
-        (body_infos, angles)
+        body_infos
     }
 
     /// A 3-D body's angular velocity (from its frame's rotations) and inertia tensor, with

@@ -2,6 +2,7 @@
 //! each into its `LoadInfo` and its part of `V` or `Q`.
 
 use super::*;
+use crate::model::elements::torque::TorqueInfo;
 
 impl Lowering<'_> {
     /// `interactions:` — equal and opposite forces `f e` on `B` and `−f e` on `A` along
@@ -268,80 +269,22 @@ impl Lowering<'_> {
         loads
     }
 
-    /// Torques on planar bodies: Qᵢ = τ ∂θ/∂qᵢ (partial angular velocity); on 3-D bodies
-    /// Qᵢ = τ·∂ω/∂q̇ᵢ, both in the body frame's components.
-    pub(super) fn torques(
-        &mut self,
-        angles: &[(String, ExprId)],
-        body_infos: &[BodyInfo],
-        frames: &Frames,
-        q_symbols: &[SymbolId],
-        terms: &mut Terms,
-    ) -> Vec<LoadInfo> {
+    /// Torques on rigid bodies (`elements::torque`): their generalized forces into `Q`.
+    pub(super) fn torques(&mut self, terms: &mut Terms) -> Vec<LoadInfo> {
+        let file = self.file;
         let mut loads = Vec::new();
-        for tq in &self.file.torques {
-            let value = match &tq.value {
-                TorqueValue::Planar(value) => value,
-                TorqueValue::Spatial { vector, frame, .. } => {
-                    let body = body_infos.iter().position(|b| b.name == tq.body.value);
-                    let Some((b, Some(spatial))) =
-                        body.map(|b| (b, body_infos[b].spatial.as_ref()))
-                    else {
-                        self.errors.push(Diagnostic::new(
-                            tq.body.location,
-                            format!("`{}` is not a 3-D rigid body", tq.body.value),
-                        ));
-                        continue;
-                    };
-                    let from = match frame {
-                        Some(f) => frames.index(&f.value).unwrap_or(0),
-                        None => 0,
-                    };
-                    let [x, y, z] = &vector[..] else { continue };
-                    let v = [x, y, z].map(|c| self.expr(c));
-                    let v = frames.express(&mut self.arena, v, from, spatial.frame);
-                    for i in 0..q_symbols.len() {
-                        let rate = self.arena.coordinates()[i][1];
-                        let partial: Vec<ExprId> = spatial
-                            .angular_velocity
-                            .iter()
-                            .map(|w| self.arena.diff(*w, rate))
-                            .collect();
-                        let proj = self.dot(&v, &partial);
-                        if !self.arena.is_zero(proj) {
-                            terms.forces[i].push(proj);
-                        }
-                    }
-                    loads.push(LoadInfo::SpatialTorque { body: b, vector: v });
-                    continue;
-                }
-            };
-            let Some(th) = angles
-                .iter()
-                .find(|(b, _)| *b == tq.body.value)
-                .map(|(_, a)| *a)
-            else {
-                self.errors.push(Diagnostic::new(
-                    tq.body.location,
-                    format!("`{}` is not a planar rigid body", tq.body.value),
-                ));
-                continue;
-            };
-            let tau = self.expr(value);
-            loads.push(LoadInfo::Torque {
-                body: body_infos
-                    .iter()
-                    .position(|b| b.name == tq.body.value)
-                    .unwrap_or(0),
-                angle: th,
-                value: tau,
-            });
-            for (i, qs) in q_symbols.iter().enumerate() {
-                let partial = self.arena.diff(th, *qs);
-                if !self.arena.is_zero(partial) {
-                    terms.forces[i].push(self.arena.times(tau, partial));
-                }
+        for t in file.torques.iter().filter_map(|t| t.lower(self)) {
+            for (forces, q) in terms.forces.iter_mut().zip(t.generalized_forces()) {
+                forces.extend(*q);
             }
+            loads.push(match t {
+                TorqueInfo::Planar {
+                    body, angle, value, ..
+                } => LoadInfo::Torque { body, angle, value },
+                TorqueInfo::Spatial { body, vector, .. } => {
+                    LoadInfo::SpatialTorque { body, vector }
+                }
+            });
         }
         loads
     }

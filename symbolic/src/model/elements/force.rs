@@ -191,9 +191,9 @@ impl Force {
         let mut vector: Vec<ExprId> = self.vector.iter().map(|c| cx.expr(c)).collect();
         if let Some(frame) = &self.frame
             && let &[x, y, z] = &vector[..]
-            && let Some(ground) = cx.in_ground(&frame.value, [x, y, z])
+            && let Some(from) = cx.frame_index(&frame.value)
         {
-            vector = ground.to_vec();
+            vector = cx.express([x, y, z], from, 0).to_vec();
         }
         let r = cx.point_at(point);
         let arena = cx.arena();

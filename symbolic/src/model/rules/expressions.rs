@@ -103,11 +103,6 @@ impl Checker<'_> {
                 self.resolve(c, Depends::Constant, "`gravity`");
             }
         }
-        for t in &file.torques {
-            for e in t.value.expressions() {
-                self.resolve(e, Depends::Motion, &format!("torque `{}`", t.name.value));
-            }
-        }
         for (k, e) in &file.initial {
             self.resolve(
                 e,
@@ -426,16 +421,7 @@ impl Checker<'_> {
             }
         }
         for t in &file.torques {
-            if let TorqueValue::Spatial {
-                vector, location, ..
-            } = &t.value
-                && vector.len() != 3
-            {
-                self.error(
-                    Diagnostic::new(*location, format!("the vector of torque `{}` has {} components; a torque on a 3-D body has 3", t.name.value, vector.len()))
-                        .with_help("write `vector: [Tx, Ty, Tz]`; a torque on a planar body is `value: tau`"),
-                );
-            }
+            t.dimension_rules(self);
         }
         if dim == 2
             && let Some(f) = file.frames.first()

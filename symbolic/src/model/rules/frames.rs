@@ -26,14 +26,6 @@ impl Checker<'_> {
             self.frame(&w.frame, &frames);
             self.resolve(&w.radius, Depends::Constant, "the radius of a drawn wheel");
         }
-        for t in &file.torques {
-            if let TorqueValue::Spatial {
-                frame: Some(frame), ..
-            } = &t.value
-            {
-                self.frame(frame, &frames);
-            }
-        }
     }
 
     /// Checks the frame names (not reserved, not repeated) and that each frame's parent is the

@@ -20,51 +20,10 @@ impl Checker<'_> {
         for p in &file.draw.trace {
             self.point(p);
         }
-        self.torque_bodies();
         let coordinates_lost = self.section_lost("coordinates", self.coords.is_empty());
         self.generalized_force_keys(coordinates_lost);
         self.equilibrium_keys(coordinates_lost);
         self.initial_keys(coordinates_lost);
-    }
-
-    /// Checks that each torque acts on an existing rigid body of its kind: a number on a
-    /// planar body, a vector on a 3-D one.
-    fn torque_bodies(&mut self) {
-        let file = self.file;
-        for t in &file.torques {
-            let name = &t.body.value;
-            match file.bodies.iter().find(|b| b.name.value == *name) {
-                Some(b) => match (&b.kind, &t.value) {
-                    (BodyKind::Rigid { .. }, TorqueValue::Planar(_))
-                    | (BodyKind::Spatial { .. }, TorqueValue::Spatial { .. }) => {}
-                    (BodyKind::Rigid { .. }, TorqueValue::Spatial { location, .. }) => self.error(
-                        Diagnostic::new(*location, format!("torque `{}` is a 3-D vector, but `{name}` is a planar rigid body", t.name.value))
-                            .with_help("a torque on a planar body is `value: tau` (counter-clockwise, about the axis normal to the plane)"),
-                    ),
-                    (BodyKind::Spatial { .. }, TorqueValue::Planar(e)) => self.error(
-                        Diagnostic::new(e.location, format!("torque `{}` is a number, but `{name}` is a 3-D rigid body", t.name.value))
-                            .with_help("a torque on a 3-D body is a vector: `{ body: B, vector: [0, 0, T], in: B }`"),
-                    ),
-                    (BodyKind::Particle { .. }, _) => self.error(
-                        Diagnostic::new(
-                            t.body.location,
-                            format!("torque `{}` acts on `{name}`, which is a particle", t.name.value),
-                        )
-                        .with_help("torques act on rigid bodies (planar with `inertia` and `angle`, 3-D with `frame`); apply a force to a particle"),
-                    ),
-                },
-                None if self.incomplete.has_name(name)
-                    || self.section_lost("bodies", file.bodies.is_empty()) => {}
-                None => {
-                    let d = Diagnostic::new(t.body.location, format!("unknown body `{name}`"));
-                    let d = match closest(name, &self.bodies) {
-                        Some(c) => d.with_help(format!("did you mean `{c}`?")),
-                        None => d.with_help("declare it under `bodies:` as a planar rigid body"),
-                    };
-                    self.error(d);
-                }
-            }
-        }
     }
 
     /// Checks that `generalized_forces` is keyed by coordinates (unless the coordinates were

@@ -22,7 +22,7 @@ pub(super) fn misspelt(entries: &Entries, key: &str) -> bool {
 }
 
 /// The key `key` itself, for its location.
-pub(super) fn get_key<'n>(entries: &'n Entries, key: &str) -> Option<&'n Located<String>> {
+pub(crate) fn get_key<'n>(entries: &'n Entries, key: &str) -> Option<&'n Located<String>> {
     entries.iter().find(|(k, _)| k.value == key).map(|(k, _)| k)
 }
 

@@ -18,18 +18,6 @@ const INTERACTION: Fields = Fields {
     example: "{ between: [P1, P2], magnitude: -G*m1*m2/r^2 }",
 };
 
-/// The keys of a torque (`value` on a planar body, `vector` and `in` on a 3-D one).
-const TORQUE: Fields = Fields {
-    kind: "torque",
-    keys: &[
-        ("body", Need::Required),
-        ("value", Need::Optional),
-        ("vector", Need::Optional),
-        ("in", Need::Optional),
-    ],
-    example: "{ body: arm, value: tau0*sin(w*t) }",
-};
-
 /// The keys of a rolling contact.
 const ROLLING: Fields = Fields {
     kind: "rolling contact",
@@ -333,58 +321,6 @@ impl Ctx<'_> {
         })
     }
 
-    /// `torques:` — `name: { body, value }`.
-    pub(super) fn torques(&mut self, node: &YamlNode) -> Vec<Torque> {
-        let example = format!("torques: {{ motor: {} }}", TORQUE.example);
-        let spec = Keyed {
-            what: "`torques`",
-            example: &example,
-            names: None,
-            drop: false,
-        };
-        self.keyed(node, spec, |cx, k, v| {
-            let f = cx.fields(k, v, &TORQUE)?;
-            let body = get(f, "body").and_then(|n| cx.name(n, "`body`"));
-            let what = format!("torque `{}`", k.value);
-            let value = match (get(f, "value"), get(f, "vector")) {
-                (Some(n), None) => {
-                    if let Some(i) = get_key(f, "in") {
-                        cx.error(
-                            Diagnostic::new(i.location, format!("{what} has a `value`, which is about the axis normal to the plane, so it has no frame `in`"))
-                                .with_help("a torque on a 3-D body is `{ body: B, vector: [Tx, Ty, Tz], in: B }`"),
-                        );
-                        return None;
-                    }
-                    cx.expr(n, "a torque").map(TorqueValue::Planar)
-                }
-                (None, Some(n)) => {
-                    let frame = match get(f, "in") {
-                        Some(i) => Some(cx.name(i, "`in`")?),
-                        None => None,
-                    };
-                    let vector = cx.vector(n, &format!("the vector of {what}"), "vector: [0, 0, T]")?;
-                    Some(TorqueValue::Spatial {
-                        vector,
-                        frame,
-                        location: n.location,
-                    })
-                }
-                (Some(_), Some(_)) | (None, None) => {
-                    cx.error(
-                        Diagnostic::new(k.location, format!("{what} needs one of `value` (planar bodies) and `vector` (3-D bodies)"))
-                            .with_help("on a planar body `{ body: arm, value: tau }` (counter-clockwise); on a 3-D body `{ body: B, vector: [Tx, Ty, Tz], in: B }`"),
-                    );
-                    None
-                }
-            };
-            Some(Torque {
-                name: k.clone(),
-                body: body?,
-                value: value?,
-            })
-        })
-    }
-
     /// `balances:` — a list of `amb: { about, bodies, form }` (angular momentum balance) and
     /// `lmb: { bodies, along }` (linear momentum balance), one set; or a map of named sets,
     /// `{ NAME: [ … ], … }`, each such a list (several derivations of the same equations).
@@ -598,29 +534,6 @@ impl Writer<'_> {
         }
         let parts = self.exprs(&p.position, &place)?;
         Ok(list(&parts))
-    }
-
-    /// `torques:`, planar and 3-D.
-    pub(super) fn write_torques(&mut self, file: &ModelFile) -> Result<(), NotRewritten> {
-        if file.torques.is_empty() {
-            return Ok(());
-        }
-        self.line("torques:");
-        for t in &file.torques {
-            let place = format!("torque `{}`", t.name.value);
-            let value = match &t.value {
-                TorqueValue::Planar(e) => format!("value: {}", flow(&self.expr(e, &place)?)),
-                TorqueValue::Spatial { vector, frame, .. } => {
-                    let parts = self.exprs(vector, &place)?;
-                    format!("vector: {}{}", list(&parts), in_frame(frame.as_ref()))
-                }
-            };
-            self.line(format_args!(
-                "  {}: {{ body: {}, {value} }}",
-                t.name.value, t.body.value
-            ));
-        }
-        Ok(())
     }
 
     /// `interactions:`.

@@ -5,7 +5,7 @@
 use super::walk::{Fields, Keyed, Need};
 use super::write::{Edits, NotRewritten, Rewrite, Writer, list, scalar};
 use super::*;
-use crate::model::elements::{contact, damper, force, spring};
+use crate::model::elements::{contact, damper, force, spring, torque};
 
 /// How one top-level key of a model file is read, and written.
 struct Section {
@@ -165,10 +165,10 @@ const SECTIONS: &[Section] = &[
         write: |w, file| force::write(w, &file.forces),
     },
     Section {
-        key: "torques",
-        read: |cx, n, file| file.torques = cx.torques(n),
+        key: torque::KEY,
+        read: |cx, n, file| file.torques = torque::read(cx, n),
         missing: None,
-        write: |w, file| w.write_torques(file),
+        write: |w, file| torque::write(w, &file.torques),
     },
     Section {
         key: "interactions",

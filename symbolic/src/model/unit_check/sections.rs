@@ -265,22 +265,7 @@ impl Checker<'_> {
             self.homogeneous(&o.value, &format!("output `{}`", o.name.value));
         }
         for t in &file.torques {
-            for (i, e) in t.value.expressions().into_iter().enumerate() {
-                let what = match &t.value {
-                    TorqueValue::Planar(_) => format!("torque `{}`", t.name.value),
-                    TorqueValue::Spatial { .. } => {
-                        format!("the {} component of torque `{}`", AXES[i], t.name.value)
-                    }
-                };
-                self.fixed(
-                    e,
-                    Dimension::JOULE,
-                    &what,
-                    "a torque",
-                    "N*m",
-                    "a torque is force × lever arm, N*m",
-                );
-            }
+            t.units(self);
         }
         self.constraints.clear();
         for (holonomic, list) in [(true, &file.constraints), (false, &file.nonholonomic)] {
