@@ -33,7 +33,7 @@
 //! (the simplest walker's heel strike); Coleman, Chatterjee & Ruina, Dynamics and Stability
 //! of Systems 12 (1997) (the rimless wheel's).
 
-use crate::expr::{ExprArena, ExprId};
+use crate::expr::{ExprArena, ExprId, SymbolId};
 use crate::model::ast::Expr;
 use crate::model::diagnostic::Diagnostic;
 use crate::model::located::Located;
@@ -41,6 +41,7 @@ use crate::model::schema::entries::get;
 use crate::model::schema::walk::{Ctx, Fields, Keyed, Need};
 use crate::model::schema::write::{NotRewritten, Writer, flow, list};
 use crate::model::yaml::YamlNode;
+use rustc_hash::FxHashMap;
 
 use super::{Depends, Lower, Rules};
 
@@ -340,27 +341,13 @@ pub(crate) fn block(
     s: &SupportInfo,
     masses: &[Mass],
 ) -> Option<Vec<ExprId>> {
-    let symbols = arena.coordinates().to_vec();
-    let q: Vec<_> = symbols.iter().map(|s| s[0]).collect();
+    let q: Vec<_> = arena.coordinates().iter().map(|s| s[0]).collect();
     let n = q.len();
-    let jacobian = |arena: &mut ExprArena, v: &[ExprId]| -> Vec<ExprId> {
-        (v.iter())
-            .flat_map(|&e| q.iter().map(move |&qj| (e, qj)))
-            .collect::<Vec<_>>()
-            .into_iter()
-            .map(|(e, qj)| arena.diff(e, qj))
-            .collect()
-    };
-    let derivatives = |arena: &mut ExprArena, x: &[ExprId]| -> Vec<ExprId> {
-        (q.iter())
-            .flat_map(|&qk| x.iter().map(move |&e| (e, qk)))
-            .collect::<Vec<_>>()
-            .into_iter()
-            .map(|(e, qk)| arena.diff(e, qk))
-            .collect()
-    };
-    let a = jacobian(arena, &s.relabel);
-    if derivatives(arena, &a).iter().any(|&e| !arena.is_zero(e)) {
+    let a = jacobian(arena, &q, &s.relabel);
+    if derivatives(arena, &q, &a)
+        .iter()
+        .any(|&e| !arena.is_zero(e))
+    {
         return None;
     }
     let inverse = inverse(arena, &a, n)?;
@@ -374,82 +361,22 @@ pub(crate) fn block(
             arena.sum(&terms)
         })
         .collect();
-    let relabelled: rustc_hash::FxHashMap<_, _> =
-        q.iter().copied().zip(s.relabel.iter().copied()).collect();
+    let relabelled: FxHashMap<_, _> = q.iter().copied().zip(s.relabel.iter().copied()).collect();
     let moment_after: Vec<ExprId> = (moment.iter())
         .map(|&e| arena.substitute(e, &relabelled))
         .collect();
-    let k = jacobian(arena, &moment);
-    let f = jacobian(arena, &s.foot);
-    // `G = ∂x/∂q⁺` at `q⁺ = R(q)` of a quantity `x(q)`: `x` written in the new coordinates
-    // (`q = A⁻¹ (q⁺ − c)`, `c = R(0)`), differentiated there, then evaluated at `R(q)`. A part
-    // of the mechanism that the new coordinates do not move (a walker's hip under the new
-    // swing leg's angle) then has its entry exactly 0, not a difference that rounds to 0.
-    let zero: rustc_hash::FxHashMap<_, _> = q.iter().map(|&qi| (qi, arena.int(0))).collect();
-    let offset: Vec<ExprId> = (s.relabel.iter())
-        .map(|&r| arena.substitute(r, &zero))
-        .collect();
-    let back: rustc_hash::FxHashMap<_, _> = (0..n)
-        .map(|i| {
-            let terms: Vec<ExprId> = (0..n)
-                .map(|j| {
-                    let qj = arena.symbol_expr(q[j]);
-                    let shifted = arena.minus(qj, offset[j]);
-                    arena.times(inverse[i * n + j], shifted)
-                })
-                .collect();
-            (q[i], arena.sum(&terms))
-        })
-        .collect();
-    let in_new = |arena: &mut ExprArena, x: ExprId| -> Vec<ExprId> {
-        let written = arena.substitute(x, &back);
-        let g = jacobian(arena, &[written]);
-        g.iter()
-            .map(|&e| arena.substitute(e, &relabelled))
-            .collect()
+    let k = jacobian(arena, &q, &moment);
+    let f = jacobian(arena, &q, &s.foot);
+    let back = old_in_new(arena, s, &q, &inverse);
+    let new = NewCoordinates {
+        q: &q,
+        back: &back,
+        relabelled: &relabelled,
     };
-    let mut rows: Vec<(ExprId, Vec<ExprId>, Vec<ExprId>)> = Vec::new();
-    let mut k_after = vec![Vec::new(); 2];
-    for (mi, r, rotation) in masses {
-        for c in 0..2 {
-            let relative = arena.minus(r[c], s.foot[c]);
-            let g = in_new(arena, relative);
-            k_after[c].push((*mi, g.clone()));
-            rows.push((*mi, jacobian(arena, &[r[c]]), g));
-        }
-        if let Some((inertia, angle)) = rotation {
-            let j = jacobian(arena, &[*angle]);
-            let g = in_new(arena, *angle);
-            rows.push((*inertia, j, g));
-        }
-    }
-    let k_after: Vec<ExprId> = (k_after.iter())
-        .flat_map(|parts| {
-            (0..n)
-                .map(|j| parts.iter().map(|(mi, g)| (*mi, g[j])).collect::<Vec<_>>())
-                .collect::<Vec<_>>()
-        })
-        .map(|terms| {
-            let products: Vec<ExprId> = terms.iter().map(|(mi, g)| arena.times(*mi, *g)).collect();
-            arena.sum(&products)
-        })
-        .collect();
-    let (mut mass_after, mut h) = (Vec::with_capacity(n * n), Vec::with_capacity(n * n));
-    for i in 0..n {
-        for j in 0..n {
-            let (mut mm, mut hh) = (Vec::new(), Vec::new());
-            for (w, jr, g) in &rows {
-                let gg = arena.times(g[i], g[j]);
-                mm.push(arena.times(*w, gg));
-                let gj = arena.times(g[i], jr[j]);
-                hh.push(arena.times(*w, gj));
-            }
-            mass_after.push(arena.sum(&mm));
-            h.push(arena.sum(&hh));
-        }
-    }
-    let dh = derivatives(arena, &h);
-    let dm = derivatives(arena, &mass_after);
+    let (rows, k_after) = impact_rows(arena, s, masses, &new);
+    let (mass_after, h) = impact_matrices(arena, &rows, n);
+    let dh = derivatives(arena, &q, &h);
+    let dm = derivatives(arena, &q, &mass_after);
     let mut out = vec![m];
     for part in [
         &s.normal[..],
@@ -471,6 +398,142 @@ pub(crate) fn block(
     out.push(s.when);
     debug_assert_eq!(out.len(), block_len(n));
     Some(out)
+}
+
+/// `∂vᵢ/∂qⱼ`, row-major (`i` the row).
+fn jacobian(arena: &mut ExprArena, q: &[SymbolId], v: &[ExprId]) -> Vec<ExprId> {
+    (v.iter())
+        .flat_map(|&e| q.iter().map(move |&qj| (e, qj)))
+        .collect::<Vec<_>>()
+        .into_iter()
+        .map(|(e, qj)| arena.diff(e, qj))
+        .collect()
+}
+
+/// `∂x/∂q_k` for each `k` in turn, each a copy of `x`'s layout.
+fn derivatives(arena: &mut ExprArena, q: &[SymbolId], x: &[ExprId]) -> Vec<ExprId> {
+    (q.iter())
+        .flat_map(|&qk| x.iter().map(move |&e| (e, qk)))
+        .collect::<Vec<_>>()
+        .into_iter()
+        .map(|(e, qk)| arena.diff(e, qk))
+        .collect()
+}
+
+/// The old coordinates written in the new ones, `q = A⁻¹ (q⁺ − c)` with `c = R(0)`, as a
+/// substitution of each `qᵢ` (`inverse` is `A⁻¹`, row-major).
+fn old_in_new(
+    arena: &mut ExprArena,
+    s: &SupportInfo,
+    q: &[SymbolId],
+    inverse: &[ExprId],
+) -> FxHashMap<SymbolId, ExprId> {
+    let n = q.len();
+    let zero: FxHashMap<_, _> = q.iter().map(|&qi| (qi, arena.int(0))).collect();
+    let offset: Vec<ExprId> = (s.relabel.iter())
+        .map(|&r| arena.substitute(r, &zero))
+        .collect();
+    (0..n)
+        .map(|i| {
+            let terms: Vec<ExprId> = (0..n)
+                .map(|j| {
+                    let qj = arena.symbol_expr(q[j]);
+                    let shifted = arena.minus(qj, offset[j]);
+                    arena.times(inverse[i * n + j], shifted)
+                })
+                .collect();
+            (q[i], arena.sum(&terms))
+        })
+        .collect()
+}
+
+/// The new coordinates of a change of support, for [`NewCoordinates::jacobian`].
+struct NewCoordinates<'a> {
+    /// The old coordinates.
+    q: &'a [SymbolId],
+    /// Each old coordinate written in the new ones ([`old_in_new`]).
+    back: &'a FxHashMap<SymbolId, ExprId>,
+    /// Each old coordinate's relabelled value `R(q)`.
+    relabelled: &'a FxHashMap<SymbolId, ExprId>,
+}
+
+impl NewCoordinates<'_> {
+    /// `G = ∂x/∂q⁺` at `q⁺ = R(q)` of a quantity `x(q)`: `x` written in the new coordinates,
+    /// differentiated there, then evaluated at `R(q)`. A part of the mechanism that the new
+    /// coordinates do not move (a walker's hip under the new swing leg's angle) then has its
+    /// entry exactly 0, not a difference that rounds to 0.
+    fn jacobian(&self, arena: &mut ExprArena, x: ExprId) -> Vec<ExprId> {
+        let written = arena.substitute(x, self.back);
+        let g = jacobian(arena, self.q, &[written]);
+        g.iter()
+            .map(|&e| arena.substitute(e, self.relabelled))
+            .collect()
+    }
+}
+
+/// A row of the impact law: a mass (or a planar body's inertia), the Jacobian of its
+/// coordinate (a position component or the angle) in the old coordinates, and `G` of its
+/// position relative to the new foot (or of its angle) in the new ones.
+type ImpactRow = (ExprId, Vec<ExprId>, Vec<ExprId>);
+
+/// The impact law's rows, mass by mass, and `K⁺ = Σ mᵢ Gᵢ` (two rows of `n`, row-major).
+fn impact_rows(
+    arena: &mut ExprArena,
+    s: &SupportInfo,
+    masses: &[Mass],
+    new: &NewCoordinates<'_>,
+) -> (Vec<ImpactRow>, Vec<ExprId>) {
+    let n = new.q.len();
+    let mut rows: Vec<ImpactRow> = Vec::new();
+    let mut k_after = vec![Vec::new(); 2];
+    for (mi, r, rotation) in masses {
+        for c in 0..2 {
+            let relative = arena.minus(r[c], s.foot[c]);
+            let g = new.jacobian(arena, relative);
+            k_after[c].push((*mi, g.clone()));
+            rows.push((*mi, jacobian(arena, new.q, &[r[c]]), g));
+        }
+        if let Some((inertia, angle)) = rotation {
+            let j = jacobian(arena, new.q, &[*angle]);
+            let g = new.jacobian(arena, *angle);
+            rows.push((*inertia, j, g));
+        }
+    }
+    let k_after: Vec<ExprId> = (k_after.iter())
+        .flat_map(|parts| {
+            (0..n)
+                .map(|j| parts.iter().map(|(mi, g)| (*mi, g[j])).collect::<Vec<_>>())
+                .collect::<Vec<_>>()
+        })
+        .map(|terms| {
+            let products: Vec<ExprId> = terms.iter().map(|(mi, g)| arena.times(*mi, *g)).collect();
+            arena.sum(&products)
+        })
+        .collect();
+    (rows, k_after)
+}
+
+/// `M⁺ = Σ w GᵀG` and `H = Σ w GᵀJ` over the rows, each `n × n` row-major.
+fn impact_matrices(
+    arena: &mut ExprArena,
+    rows: &[ImpactRow],
+    n: usize,
+) -> (Vec<ExprId>, Vec<ExprId>) {
+    let (mut mass_after, mut h) = (Vec::with_capacity(n * n), Vec::with_capacity(n * n));
+    for i in 0..n {
+        for j in 0..n {
+            let (mut mm, mut hh) = (Vec::new(), Vec::new());
+            for (w, jr, g) in rows {
+                let gg = arena.times(g[i], g[j]);
+                mm.push(arena.times(*w, gg));
+                let gj = arena.times(g[i], jr[j]);
+                hh.push(arena.times(*w, gj));
+            }
+            mass_after.push(arena.sum(&mm));
+            h.push(arena.sum(&hh));
+        }
+    }
+    (mass_after, h)
 }
 
 /// The inverse of the `n × n` matrix `a` (row-major) of constant expressions, by Gauss–Jordan
