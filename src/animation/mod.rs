@@ -580,33 +580,12 @@ pub fn simulation_animation(
     energy_drift.add_losses(losses.into_iter());
     let max_drift = energy_drift.drift.unwrap_or(0.0);
     let (e0, energy) = (energy_drift.initial_energy, energy_drift.energy);
-    let method = format!(
-        "{} ({})",
-        simulation.integrator,
-        step_control(&simulation.options)
-    );
-    let conserved = if !simulation.transitions.is_empty() {
-        " (of E plus the energy lost at impacts; friction's work while sliding is not added)"
-    } else if model.description().conservative {
-        ""
-    } else {
-        " (not conserved: non-conservative loads or explicit time dependence)"
-    };
-    // "Over the frames": the drift sampled at the frame times, which can be smaller than
-    // `eomgen simulate`'s, taken over every step.
-    // A minus sign, not a hyphen, in the exponent: no line break inside the number.
-    let max_drift = format!("{max_drift:.2e}").replace('-', "−");
-    let info = format!(
-        "{method}; {} frames at {} fps of simulated time, t = 0 … {} s; E(0) = {} J, max |E − E₀| / max(T + |V|) over the frames = {max_drift}{conserved}{}",
-        t.len(),
-        short(options.fps),
-        short(t[t.len() - 1]),
-        short(e0),
-        if scene.three_d {
-            "; isometric view"
-        } else {
-            ""
-        }
+    let info = simulation_info(
+        model,
+        simulation,
+        options,
+        (&t, e0, max_drift),
+        scene.three_d,
     );
     check_finite(&scene.model, &frames)?;
     check_finite(&scene.model, &trail)?;
@@ -631,6 +610,42 @@ pub fn simulation_animation(
         scene,
         clips: vec![clip],
     }))
+}
+
+/// The info line of a simulation's clip: the method and its step control, the frames, `E(0)`
+/// and the largest drift over the frames (`(t, e0, max_drift)`), what the drift is of, and
+/// the view.
+fn simulation_info(
+    model: &dyn ModelInfo,
+    simulation: &Simulation,
+    options: &AnimationOptions,
+    (t, e0, max_drift): (&[f64], f64, f64),
+    three_d: bool,
+) -> String {
+    let method = format!(
+        "{} ({})",
+        simulation.integrator,
+        step_control(&simulation.options)
+    );
+    let conserved = if !simulation.transitions.is_empty() {
+        " (of E plus the energy lost at impacts; friction's work while sliding is not added)"
+    } else if model.description().conservative {
+        ""
+    } else {
+        " (not conserved: non-conservative loads or explicit time dependence)"
+    };
+    // "Over the frames": the drift sampled at the frame times, which can be smaller than
+    // `eomgen simulate`'s, taken over every step.
+    // A minus sign, not a hyphen, in the exponent: no line break inside the number.
+    let max_drift = format!("{max_drift:.2e}").replace('-', "−");
+    format!(
+        "{method}; {} frames at {} fps of simulated time, t = 0 … {} s; E(0) = {} J, max |E − E₀| / max(T + |V|) over the frames = {max_drift}{conserved}{}",
+        t.len(),
+        short(options.fps),
+        short(t[t.len() - 1]),
+        short(e0),
+        if three_d { "; isometric view" } else { "" }
+    )
 }
 
 /// The energy lost at impacts before each frame (J), the frame at sample `frame_samples[k]`

@@ -431,6 +431,7 @@ fn pin(solution: &Solution) -> Pin {
 /// bound: a run that lost the orbit, which passes close to the moon, misses it by order 1)
 /// and every run with requested times ends on the same state, to the bit, as the run
 /// that records every step.
+// Long: most of it is the table of pinned step counts, ends and hashes, one row per run.
 #[test]
 fn dormand_prince_runs_are_pinned_to_the_bit() {
     let options = IntegratorOptions::default().with_rtol(1e-9).with_atol(1e-9);
