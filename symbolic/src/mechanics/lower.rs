@@ -833,7 +833,7 @@ impl elements::Lower for Lowering<'_> {
         let body = self.bodies.iter().find(|b| b.name == name)?;
         body.rotation.map(|(_, angle)| angle)
     }
-    fn spatial_body(&self, name: &str) -> Option<(usize, usize, [ExprId; 3])> {
+    fn rigid_body_3d(&self, name: &str) -> Option<(usize, usize, [ExprId; 3])> {
         let index = self.body_index(name)?;
         let spatial = self.bodies[index].spatial.as_ref()?;
         Some((index, spatial.frame, spatial.angular_velocity))

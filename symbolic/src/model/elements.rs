@@ -142,7 +142,7 @@ pub(crate) trait Lower {
     /// The index, the frame's index and the angular velocity (in the body frame's
     /// components, linear in the rates) of the 3-D rigid body `name`; `None` if it is not
     /// one.
-    fn spatial_body(&self, name: &str) -> Option<(usize, usize, [ExprId; 3])>;
+    fn rigid_body_3d(&self, name: &str) -> Option<(usize, usize, [ExprId; 3])>;
     /// The model's coordinates, in file order.
     fn coordinate_names(&self) -> Vec<String>;
     /// Reports a mistake found while lowering.

@@ -324,10 +324,7 @@ impl elements::Rules for Checker<'_> {
         Checker::point(self, name);
     }
     fn frame(&mut self, name: &Located<String>) {
-        let frames: Vec<&str> = (self.file.frames.iter())
-            .map(|f| f.name.value.as_str())
-            .chain([GROUND_FRAME])
-            .collect();
+        let frames = frames::frame_names(self.file);
         Checker::frame(self, name, &frames);
     }
     fn body(&self, name: &str) -> elements::BodyLookup {

@@ -329,7 +329,7 @@ impl Torque {
         vector: &[Expr],
         frame: Option<&Located<String>>,
     ) -> Option<TorqueInfo> {
-        let Some((body, body_frame, omega)) = cx.spatial_body(&self.body.value) else {
+        let Some((body, body_frame, omega)) = cx.rigid_body_3d(&self.body.value) else {
             cx.error(Diagnostic::new(
                 self.body.location,
                 format!("`{}` is not a 3-D rigid body", self.body.value),

@@ -10,7 +10,8 @@ impl Checker<'_> {
     // - constant: masses, inertias, `gravity`, initial values;
     // - configuration (no rates): point positions, `potential`, body angles, stiffnesses,
     //   rest lengths, damping coefficients;
-    // - motion: `kinetic`, generalized forces, forces, torques.
+    // - motion: `kinetic`, generalized forces (forces and torques: their own rules, in
+    //   elements/).
     // Accelerations (`_ddot`) appear nowhere: the equations of motion are derived.
     // Long: one list, one call per place in the file where an expression stands, in the file's
     // order, as unit_check's `walk`; split by section it would only be a longer list.
@@ -374,7 +375,8 @@ impl Checker<'_> {
         self.spatial_pieces(dim);
     }
 
-    /// Checks that `gravity` and every force have `dim` components, as the points do.
+    /// Checks that `gravity` and every force have `dim` components, as the points do (and a
+    /// force written in a frame 3: `Force::dimension_rules`).
     fn vector_lengths(&mut self, dim: usize) {
         let file = self.file;
         if let Some(g) = &file.gravity
@@ -397,7 +399,7 @@ impl Checker<'_> {
         }
     }
 
-    /// Checks that the 3-D pieces (3-D bodies, forces written in frames, 3-D torques, frames)
+    /// Checks that the 3-D pieces (3-D bodies, 3-D torques, frames)
     /// fit the points' dimension `dim`, and that planar rigid bodies are in a 2-D model.
     fn spatial_pieces(&mut self, dim: usize) {
         let file = self.file;

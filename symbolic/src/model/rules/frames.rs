@@ -9,12 +9,7 @@ impl Checker<'_> {
     pub(super) fn frames(&mut self) {
         let file = self.file;
         self.frame_tree();
-        let frames: Vec<&str> = file
-            .frames
-            .iter()
-            .map(|f| f.name.value.as_str())
-            .chain([GROUND_FRAME])
-            .collect();
+        let frames = frame_names(file);
         self.point_origins(&frames);
         for b in &file.bodies {
             if let BodyKind::Spatial { frame, .. } = &b.kind {
@@ -165,4 +160,12 @@ impl Checker<'_> {
         };
         self.error(d);
     }
+}
+
+/// The frames a model may name: its own, in file order, then the ground.
+pub(super) fn frame_names(file: &ModelFile) -> Vec<&str> {
+    (file.frames.iter())
+        .map(|f| f.name.value.as_str())
+        .chain([GROUND_FRAME])
+        .collect()
 }

@@ -5,10 +5,9 @@ use super::*;
 use crate::model::checks::{FinalStateCheck, ModalCheck, PeriodCheck};
 
 impl Checker<'_> {
-    // Rule: every point named by a body, force or drawing exists (springs and dampers: their
-    // own rules); torques
-    // act on planar rigid bodies; generalized forces are keyed by coordinates; initial
-    // values by coordinates or rates.
+    // Rule: every point named by a body or a drawing exists (springs, dampers, forces and
+    // torques: their own rules, in elements/); generalized forces are keyed by coordinates;
+    // initial values by coordinates or rates.
     pub(super) fn references(&mut self) {
         let file = self.file;
         for b in &file.bodies {
