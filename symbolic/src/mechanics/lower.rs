@@ -431,7 +431,6 @@ impl<'f> Lowering<'f> {
             .iter()
             .map(|c| c.name.value.clone())
             .collect();
-        let q_symbols: Vec<SymbolId> = self.arena.coordinates().iter().map(|c| c[0]).collect();
         let mut frames = self.frames_with_rates();
         let points = self.points(&frames);
         self.points = points.clone();
@@ -463,8 +462,7 @@ impl<'f> Lowering<'f> {
         self.bodies = body_infos.clone();
         loads.extend(self.forces(&mut terms));
         loads.extend(self.torques(&mut terms));
-        let (interaction_loads, interactions_at_start) =
-            self.interactions(&points, &q_symbols, &mut terms);
+        let (interaction_loads, interactions_at_start) = self.interactions(&mut terms);
         loads.extend(interaction_loads);
         let balances = self.balances(&points, &body_infos, &frames);
         let balance_sets = balance_sets(self.file);
@@ -810,6 +808,14 @@ impl elements::Lower for Lowering<'_> {
     }
     fn expr(&mut self, e: &Expr) -> ExprId {
         Lowering::expr(self, e)
+    }
+    fn expr_with(&mut self, e: &Expr, locals: &[(&str, ExprId)]) -> ExprId {
+        self.locals = (locals.iter())
+            .map(|(name, value)| (name.to_string(), *value))
+            .collect();
+        let value = Lowering::expr(self, e);
+        self.locals.clear();
+        value
     }
     fn point(&self, name: &str) -> Option<Vec<ExprId>> {
         point(&self.points, name).map(|i| self.points[i].1.clone())

@@ -11,13 +11,14 @@
 //! loop and one row in the schema's `SECTIONS`.
 //!
 //! The kinds here: [`contact`] (unilateral contacts) and its [`support`] (a change of
-//! support), [`spring`], [`damper`], [`force`] and [`torque`]. The older
-//! kinds (bodies, constraints, …) are still spread over the stage files;
+//! support), [`spring`], [`damper`], [`force`], [`torque`] and [`interaction`]. The
+//! older kinds (bodies, constraints, …) are still spread over the stage files;
 //! ARCHITECTURE.md's recipe says how a kind moves here.
 
 pub mod contact;
 pub mod damper;
 pub mod force;
+pub mod interaction;
 pub mod spring;
 pub mod support;
 pub mod torque;
@@ -27,6 +28,10 @@ use super::diagnostic::Diagnostic;
 use super::located::Located;
 use super::units::Dimension;
 use crate::expr::{ExprArena, ExprId};
+use crate::model::schema::entries::get;
+use crate::model::schema::walk::{Ctx, Fields, Keyed};
+use crate::model::schema::write::{NotRewritten, Writer, flow};
+use crate::model::yaml::YamlNode;
 
 /// The name of the ground (Newtonian) frame, predefined in every 3-D model.
 pub const GROUND_FRAME: &str = "N";
@@ -90,6 +95,12 @@ pub(crate) trait Rules {
     /// Checks the names and functions of `e` and that it depends on no more than `depends`;
     /// `what` names it in messages ("the restitution of contact `floor`").
     fn expression(&mut self, e: &Expr, depends: Depends, what: &str);
+    /// [`Rules::expression`] of an interaction's magnitude, where `r` and `r_dot` are the
+    /// distance of its points and its rate.
+    fn expression_of_distance(&mut self, e: &Expr, depends: Depends, what: &str);
+    /// What of the model `name` is ("a parameter", "a coordinate", "a point", or for
+    /// `r_dot` "the rate of coordinate `r`"), if anything.
+    fn name_kind(&self, name: &str) -> Option<&'static str>;
     /// The value of `e` with the parameters at their defaults; `None` if it is not constant
     /// or names what is not known (reported by [`Rules::expression`]).
     fn value(&self, e: &Expr) -> Option<f64>;
@@ -114,6 +125,9 @@ pub(crate) trait Units {
         want_text: &str,
         help: &str,
     );
+    /// From `on` until it is called with `false`, `r` and `r_dot` are an interaction's
+    /// distance (m) and its rate (m/s).
+    fn distance(&mut self, on: bool);
 }
 
 /// What an element's kinematics ask of the lowering into the expression arena.
@@ -122,6 +136,8 @@ pub(crate) trait Lower {
     fn arena(&mut self) -> &mut ExprArena;
     /// `e` lowered into the arena.
     fn expr(&mut self, e: &Expr) -> ExprId;
+    /// `e` lowered with the names of `locals` standing for their expressions.
+    fn expr_with(&mut self, e: &Expr, locals: &[(&str, ExprId)]) -> ExprId;
     /// The position of the point `name` in the ground frame's components (2 or 3); `None` if
     /// there is no such point.
     fn point(&self, name: &str) -> Option<Vec<ExprId>>;
@@ -170,6 +186,63 @@ pub(crate) fn between(
     };
     let (ra, rb) = (cx.point_at(a), cx.point_at(b));
     Some(([a, b], difference(cx.arena(), &ra, &rb)))
+}
+
+/// A load between two points with one expression, as read: its name, its points and the
+/// expression.
+pub(crate) type BetweenEntry = (Located<String>, [Located<String>; 2], Expr);
+
+/// The entries of a section of loads between two points with one expression each,
+/// `section: { name: { between: [A, B], <key>: e } }`, in file order (`fields` the entry's
+/// keys, `example` a name for the section's example); `what(name)` says what the
+/// expression is, in messages.
+pub(crate) fn read_between(
+    cx: &mut Ctx<'_>,
+    node: &YamlNode,
+    (section, fields, example): (&str, &Fields, &str),
+    key: &str,
+    what: impl Fn(&str) -> String,
+) -> Vec<BetweenEntry> {
+    let example = format!("{section}: {{ {example}: {} }}", fields.example);
+    let spec = Keyed {
+        what: &format!("`{section}`"),
+        example: &example,
+        names: None,
+        drop: false,
+    };
+    cx.keyed(node, spec, |cx, k, v| {
+        let f = cx.fields(k, v, fields)?;
+        let between = get(f, "between").and_then(|n| cx.point_pair(n, "`between`"));
+        let value = get(f, key).and_then(|n| cx.expr(n, &what(&k.value)));
+        Some((k.clone(), between?, value?))
+    })
+}
+
+/// `section:` of loads between two points with one expression each, in the form
+/// [`read_between`] reads: `name: { between: [A, B], <key>: e }` (`kind` names an entry in a
+/// note on what could not be written).
+pub(crate) fn write_between<'e>(
+    w: &mut Writer<'_>,
+    (section, kind, key): (&str, &str, &str),
+    entries: impl IntoIterator<Item = (&'e Located<String>, &'e [Located<String>; 2], &'e Expr)>,
+) -> Result<(), NotRewritten> {
+    let mut entries = entries.into_iter().peekable();
+    if entries.peek().is_none() {
+        return Ok(());
+    }
+    w.line(format_args!("{section}:"));
+    for (name, [a, b], e) in entries {
+        let place = format!("{kind} `{}`", name.value);
+        let value = w.expr(e, &place)?;
+        w.line(format_args!(
+            "  {}: {{ between: [{}, {}], {key}: {} }}",
+            name.value,
+            a.value,
+            b.value,
+            flow(&value)
+        ));
+    }
+    Ok(())
 }
 
 /// `a − b`, component by component.

@@ -7,6 +7,7 @@ use super::ast::Expr;
 pub use super::elements::contact::{Contact, Gap};
 pub use super::elements::damper::Damper;
 pub use super::elements::force::Force;
+pub use super::elements::interaction::{INTERACTION_NAMES, Interaction};
 pub use super::elements::spring::Spring;
 pub use super::elements::torque::{Torque, TorqueValue};
 // The `checks:` and `floquet:` types live in `checks.rs`; they are named here too, where
@@ -294,25 +295,6 @@ pub struct Body {
     /// Particle or planar rigid body.
     pub kind: BodyKind,
 }
-
-/// A force between two points (`interactions:`): `{ between: [A, B], magnitude: f }`, equal
-/// and opposite forces along the line of the points, `f e` on `B` and `−f e` on `A` with
-/// `e = (B − A)/r` and `r = |B − A|`: `f > 0` pushes the points apart, `f < 0` pulls them
-/// together (gravity is `-G*m1*m2/r^2`). The magnitude is any expression of `r`, its rate
-/// `r_dot` (`ṙ = e·(v_B − v_A)`), the parameters, coordinates, rates and `t` (lectures 3–7:
-/// central forces and many particles).
-#[derive(Debug, Clone, PartialEq)]
-pub struct Interaction {
-    /// Name.
-    pub name: Located<String>,
-    /// The two points `[A, B]`.
-    pub between: [Located<String>; 2],
-    /// The magnitude `f` (N), positive apart.
-    pub magnitude: Expr,
-}
-
-/// The names an interaction's magnitude reads for the distance of its points and its rate.
-pub const INTERACTION_NAMES: [&str; 2] = ["r", "r_dot"];
 
 /// One `outputs:` entry: a named expression of the state evaluated along a simulation,
 /// `name: expr` or `name: { value: expr, conserved: true, tolerance: 1e-9 }`.

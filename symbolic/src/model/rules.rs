@@ -83,7 +83,9 @@ pub(crate) fn check_parts(
     for torque in &file.torques {
         torque.rules(&mut checker);
     }
-    checker.interactions();
+    for interaction in &file.interactions {
+        interaction.rules(&mut checker);
+    }
     checker.outputs();
     let units = super::unit_check::check(file);
     // A unit mistake at the place of another mistake is its consequence (`initial: { theta:
@@ -346,6 +348,24 @@ impl elements::Rules for Checker<'_> {
     }
     fn expression(&mut self, e: &Expr, depends: Depends, what: &str) {
         self.resolve(e, depends, what);
+    }
+    fn expression_of_distance(&mut self, e: &Expr, depends: Depends, what: &str) {
+        self.interaction = true;
+        self.resolve(e, depends, what);
+        self.interaction = false;
+    }
+    fn name_kind(&self, n: &str) -> Option<&'static str> {
+        if self.sets.params.contains(n) {
+            Some("a parameter")
+        } else if self.sets.coords.contains(n) {
+            Some("a coordinate")
+        } else if n == "r_dot" && self.sets.rates.contains(n) {
+            Some("the rate of coordinate `r`")
+        } else if self.points.contains(&n) {
+            Some("a point")
+        } else {
+            None
+        }
     }
     fn value(&self, e: &Expr) -> Option<f64> {
         evaluate(e, &self.file.parameters)

@@ -2,166 +2,41 @@
 //! each into its `LoadInfo` and its part of `V` or `Q`.
 
 use super::*;
+use crate::model::elements::interaction::{self, InteractionTerms};
 use crate::model::elements::torque::TorqueInfo;
 
 impl Lowering<'_> {
-    /// `interactions:` — equal and opposite forces `f e` on `B` and `−f e` on `A` along
-    /// `e = d/r`, `d = r_B − r_A`, `r = |d|`, `ṙ = d·ḋ/r`. A magnitude that is a sum of
-    /// powers of `r` times factors constant in the motion (parameters, `t`) is integrated to
-    /// a potential, `V(r) = −∫ f dr` (`−c ln r` for `c/r`), so that `T + V` stays the
-    /// energy; any other enters `Q` as `Qᵢ = f d·∂d/∂qᵢ / r` (its virtual work `f e·δd`).
-    /// Either way momentum balance gets the two forces at the points.
-    ///
-    /// Returns the loads and, per interaction, `(r, f)` at the points' positions, for the
-    /// check of the initial state.
+    /// Interactions (`elements::interaction`): a power law's potential into `V`, any other
+    /// magnitude's generalized forces into `Q`, and `(r, f)` of each for
+    /// [`Self::check_interactions_at_start`].
     pub(super) fn interactions(
         &mut self,
-        points: &Points,
-        q_symbols: &[SymbolId],
         terms: &mut Terms,
     ) -> (Vec<LoadInfo>, Vec<(ExprId, ExprId)>) {
+        let file = self.file;
         let mut loads = Vec::new();
         let mut at_start = Vec::new();
-        if self.file.interactions.is_empty() {
-            return (loads, at_start);
-        }
-        // Names no model symbol can have (a space is not in a name), substituted away below.
-        let r_symbol = self.arena.declare("interaction r", SymbolKind::Auxiliary);
-        let rdot_symbol = self
-            .arena
-            .declare("interaction r_dot", SymbolKind::Auxiliary);
-        for it in &self.file.interactions {
-            let (Some(a), Some(b)) = (
-                point(points, &it.between[0].value),
-                point(points, &it.between[1].value),
-            ) else {
-                self.errors.push(Diagnostic::new(
-                    it.name.location,
-                    format!("interaction `{}` names an unknown point", it.name.value),
-                ));
-                continue;
-            };
-            let d = self.difference(&points[b].1, &points[a].1);
-            let dd: Vec<ExprId> = d.iter().map(|c| self.arena.time_derivative(*c)).collect();
-            let d2 = self.dot(&d, &d);
-            let r = self.arena.sqrt(d2);
-            let d_dd = self.dot(&d, &dd);
-            let rdot = self.arena.divide(d_dd, r);
-            let (r_local, rdot_local) = (
-                self.arena.symbol_expr(r_symbol),
-                self.arena.symbol_expr(rdot_symbol),
-            );
-            self.locals = vec![
-                ("r".to_string(), r_local),
-                ("r_dot".to_string(), rdot_local),
-            ];
-            let f_of_r = self.expr(&it.magnitude);
-            self.locals.clear();
-            let mut values = FxHashMap::default();
-            values.insert(r_symbol, r);
-            values.insert(rdot_symbol, rdot);
-            let f = self.arena.substitute(f_of_r, &values);
-            // f e on B, −f e on A.
-            let scale = self.arena.divide(f, r);
-            let on_b: Vec<ExprId> = d.iter().map(|c| self.arena.times(scale, *c)).collect();
-            let on_a: Vec<ExprId> = on_b.iter().map(|c| self.arena.neg(*c)).collect();
+        for it in interaction::lower(self, &file.interactions) {
+            let [a, b] = it.between;
             loads.push(LoadInfo::Force {
                 point: b,
-                vector: on_b,
+                vector: it.on_b,
             });
             loads.push(LoadInfo::Force {
                 point: a,
-                vector: on_a,
+                vector: it.on_a,
             });
-            at_start.push((r, f));
-            match self.power_law_potential(f_of_r, r_symbol, rdot_symbol) {
-                Some(v_of_r) => {
-                    let v = self.arena.substitute(v_of_r, &values);
-                    terms.potential.push(v);
-                }
-                None => {
-                    for (i, qs) in q_symbols.iter().enumerate() {
-                        let partial: Vec<ExprId> =
-                            d.iter().map(|x| self.arena.diff(*x, *qs)).collect();
-                        let proj = self.dot(&d, &partial);
-                        if !self.arena.is_zero(proj) {
-                            terms.forces[i].push(self.arena.times(scale, proj));
-                        }
+            at_start.push(it.at_start);
+            match it.lagrange {
+                InteractionTerms::Potential(v) => terms.potential.push(v),
+                InteractionTerms::Forces(forces) => {
+                    for (terms, q) in terms.forces.iter_mut().zip(forces) {
+                        terms.extend(q);
                     }
                 }
             }
         }
         (loads, at_start)
-    }
-
-    /// `V(r) = −∫ f dr` of a magnitude `f` that is a sum of terms `c rᵏ`, `k` a number and
-    /// `c` free of `r`, `ṙ`, the coordinates and the rates: `−c r^(k+1)/(k+1)`, or `−c ln r`
-    /// for `k = −1`. `None` for any other magnitude (it is not, or not visibly, the
-    /// derivative of a potential of `r`).
-    fn power_law_potential(
-        &mut self,
-        f: ExprId,
-        r_symbol: SymbolId,
-        rdot_symbol: SymbolId,
-    ) -> Option<ExprId> {
-        use crate::expr::Node;
-        if self.arena.depends_on(f, rdot_symbol) {
-            return None;
-        }
-        let motion: Vec<SymbolId> = self
-            .arena
-            .coordinates()
-            .iter()
-            .flat_map(|c| [c[0], c[1]])
-            .collect();
-        let f = self.arena.expand(f);
-        let terms: Vec<ExprId> = match self.arena.node(f) {
-            Node::Add(ts) => ts.to_vec(),
-            _ => vec![f],
-        };
-        let mut potential = Vec::new();
-        for term in terms {
-            let factors: Vec<ExprId> = match self.arena.node(term) {
-                Node::Mul(fs) => fs.to_vec(),
-                _ => vec![term],
-            };
-            let mut power = vec![self.arena.int(0)];
-            let mut coefficient = Vec::new();
-            for factor in factors {
-                if !self.arena.depends_on(factor, r_symbol) {
-                    if motion.iter().any(|s| self.arena.depends_on(factor, *s)) {
-                        return None;
-                    }
-                    coefficient.push(factor);
-                    continue;
-                }
-                match self.arena.node(factor).clone() {
-                    Node::Symbol(s) if s == r_symbol => power.push(self.arena.int(1)),
-                    Node::Pow([base, exponent])
-                        if matches!(self.arena.node(base), Node::Symbol(s) if *s == r_symbol)
-                            && self.arena.as_constant(exponent).is_some() =>
-                    {
-                        power.push(exponent);
-                    }
-                    _ => return None,
-                }
-            }
-            let c = self.arena.product(&coefficient);
-            let k = self.arena.sum(&power);
-            let one = self.arena.int(1);
-            let k1 = self.arena.plus(k, one);
-            let r = self.arena.symbol_expr(r_symbol);
-            let integral = if self.arena.is_zero(k1) {
-                let ln = self.arena.func(Func::Ln, r);
-                self.arena.times(c, ln)
-            } else {
-                let rk1 = self.arena.pow(r, k1);
-                let crk1 = self.arena.times(c, rk1);
-                self.arena.divide(crk1, k1)
-            };
-            potential.push(self.arena.neg(integral));
-        }
-        Some(self.arena.sum(&potential))
     }
 
     /// Reports an interaction whose points coincide at the initial state (`r = 0`: no

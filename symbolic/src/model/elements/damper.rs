@@ -10,14 +10,13 @@
 //! generalized forces `Qᵢ = F_A·∂d/∂qᵢ`, momentum balance as the two forces: both from
 //! `force_scale`.
 
-use super::{Lower, Rules, Units, between, dot};
+use super::{Lower, Rules, Units, between, dot, read_between, write_between};
 use crate::expr::{ExprArena, ExprId};
 use crate::model::ast::Expr;
 use crate::model::elements::Depends;
 use crate::model::located::Located;
-use crate::model::schema::entries::get;
-use crate::model::schema::walk::{Ctx, Fields, Keyed, Need};
-use crate::model::schema::write::{NotRewritten, Writer, flow};
+use crate::model::schema::walk::{Ctx, Fields, Need};
+use crate::model::schema::write::{NotRewritten, Writer};
 use crate::model::units::Dimension;
 use crate::model::yaml::YamlNode;
 
@@ -45,43 +44,23 @@ const FIELDS: Fields = Fields {
 
 /// `dampers:` — `name: { between, coefficient }`, in file order.
 pub(crate) fn read(cx: &mut Ctx<'_>, node: &YamlNode) -> Vec<Damper> {
-    let example = format!("dampers: {{ d: {} }}", FIELDS.example);
-    let spec = Keyed {
-        what: "`dampers`",
-        example: &example,
-        names: None,
-        drop: false,
-    };
-    cx.keyed(node, spec, |cx, k, v| {
-        let f = cx.fields(k, v, &FIELDS)?;
-        let between = get(f, "between").and_then(|n| cx.point_pair(n, "`between`"));
-        let coefficient = get(f, "coefficient").and_then(|n| cx.expr(n, "a damping coefficient"));
-        Some(Damper {
-            name: k.clone(),
-            between: between?,
-            coefficient: coefficient?,
+    let what = |_: &str| "a damping coefficient".to_string();
+    read_between(cx, node, (KEY, &FIELDS, "d"), "coefficient", what)
+        .into_iter()
+        .map(|(name, between, coefficient)| Damper {
+            name,
+            between,
+            coefficient,
         })
-    })
+        .collect()
 }
 
 /// `dampers:`, in the form [`read`] reads.
 pub(crate) fn write(w: &mut Writer<'_>, dampers: &[Damper]) -> Result<(), NotRewritten> {
-    if dampers.is_empty() {
-        return Ok(());
-    }
-    w.line("dampers:");
-    for d in dampers {
-        let place = format!("damper `{}`", d.name.value);
-        let c = w.expr(&d.coefficient, &place)?;
-        w.line(format_args!(
-            "  {}: {{ between: [{}, {}], coefficient: {} }}",
-            d.name.value,
-            d.between[0].value,
-            d.between[1].value,
-            flow(&c)
-        ));
-    }
-    Ok(())
+    let entries = dampers
+        .iter()
+        .map(|d| (&d.name, &d.between, &d.coefficient));
+    write_between(w, (KEY, "damper", "coefficient"), entries)
 }
 
 /// A damper as expressions of the model's arena.

@@ -135,58 +135,6 @@ impl Checker<'_> {
         }
     }
 
-    /// Reports `name` unless it is a parameter; `what` says where it was written.
-    // Rule: an interaction acts between two distinct points of the model; its magnitude is
-    // a function of the motion, where `r` and `r_dot` are the distance and its rate, which
-    // are then no other name of the model.
-    pub(super) fn interactions(&mut self) {
-        let file = self.file;
-        for i in &file.interactions {
-            let name = &i.name.value;
-            i.between.iter().for_each(|p| self.point(p));
-            let [a, b] = &i.between;
-            if a.value == b.value {
-                self.error(
-                    Diagnostic::new(
-                        b.location,
-                        format!("interaction `{name}` acts between `{}` and itself", a.value),
-                    )
-                    .with_help("an interaction acts along the line of two distinct points; name the other point"),
-                );
-            }
-            let what = format!("the magnitude of interaction `{name}`");
-            let mut ids = Vec::new();
-            identifiers(&i.magnitude, &mut ids);
-            for (n, at) in &ids {
-                let taken = if self.sets.params.contains(n.as_str()) {
-                    Some("a parameter")
-                } else if self.sets.coords.contains(n.as_str()) {
-                    Some("a coordinate")
-                } else if n == "r_dot" && self.sets.rates.contains(n.as_str()) {
-                    Some("the rate of coordinate `r`")
-                } else if self.points.contains(&n.as_str()) {
-                    Some("a point")
-                } else {
-                    None
-                };
-                if let Some(kind) = taken
-                    && crate::model::file::INTERACTION_NAMES.contains(&n.as_str())
-                {
-                    self.error(
-                        Diagnostic::new(
-                            *at,
-                            format!("`{n}` in {what} is ambiguous: it names the distance of the points (or its rate), and {kind} of the model"),
-                        )
-                        .with_help("rename the model's `r`, or write the distance as `distance(A, B)` and its rate as `dot(A - B, vel(A) - vel(B))/distance(A, B)`"),
-                    );
-                }
-            }
-            self.interaction = true;
-            self.resolve(&i.magnitude, Depends::Motion, &what);
-            self.interaction = false;
-        }
-    }
-
     // Rule: user balances name existing bodies (each once per balance) and, for AMB, an
     // existing point; AMB needs a planar model; an LMB direction has as many components as
     // the points and depends only on parameters, coordinates and `t`; there are as many

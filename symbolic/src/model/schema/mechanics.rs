@@ -11,13 +11,6 @@ use crate::model::elements::in_frame;
 /// balances, which a set may not take.
 const RESERVED_SET_NAMES: [&str; 5] = ["lagrange", "momentum", "by_hand", "energy", "power"];
 
-/// The keys of an interaction.
-const INTERACTION: Fields = Fields {
-    kind: "interaction",
-    keys: &[("between", Need::Required), ("magnitude", Need::Required)],
-    example: "{ between: [P1, P2], magnitude: -G*m1*m2/r^2 }",
-};
-
 /// The keys of a rolling contact.
 const ROLLING: Fields = Fields {
     kind: "rolling contact",
@@ -299,28 +292,6 @@ impl Ctx<'_> {
         })
     }
 
-    /// `interactions:` — `name: { between, magnitude }`.
-    pub(super) fn interactions(&mut self, node: &YamlNode) -> Vec<Interaction> {
-        let example = format!("interactions: {{ gravity: {} }}", INTERACTION.example);
-        let spec = Keyed {
-            what: "`interactions`",
-            example: &example,
-            names: None,
-            drop: false,
-        };
-        self.keyed(node, spec, |cx, k, v| {
-            let f = cx.fields(k, v, &INTERACTION)?;
-            let between = get(f, "between").and_then(|n| cx.point_pair(n, "`between`"));
-            let magnitude = get(f, "magnitude")
-                .and_then(|n| cx.expr(n, &format!("the magnitude of interaction `{}`", k.value)));
-            Some(Interaction {
-                name: k.clone(),
-                between: between?,
-                magnitude: magnitude?,
-            })
-        })
-    }
-
     /// `balances:` — a list of `amb: { about, bodies, form }` (angular momentum balance) and
     /// `lmb: { bodies, along }` (linear momentum balance), one set; or a map of named sets,
     /// `{ NAME: [ … ], … }`, each such a list (several derivations of the same equations).
@@ -534,26 +505,6 @@ impl Writer<'_> {
         }
         let parts = self.exprs(&p.position, &place)?;
         Ok(list(&parts))
-    }
-
-    /// `interactions:`.
-    pub(super) fn write_interactions(&mut self, file: &ModelFile) -> Result<(), NotRewritten> {
-        if file.interactions.is_empty() {
-            return Ok(());
-        }
-        self.line("interactions:");
-        for f in &file.interactions {
-            let place = format!("interaction `{}`", f.name.value);
-            let magnitude = self.expr(&f.magnitude, &place)?;
-            self.line(format_args!(
-                "  {}: {{ between: [{}, {}], magnitude: {} }}",
-                f.name.value,
-                f.between[0].value,
-                f.between[1].value,
-                flow(&magnitude)
-            ));
-        }
-        Ok(())
     }
 
     /// `balances:` is not written: the model is derived by Lagrange's equations, noted.

@@ -5,7 +5,7 @@
 use super::walk::{Fields, Keyed, Need};
 use super::write::{Edits, NotRewritten, Rewrite, Writer, list, scalar};
 use super::*;
-use crate::model::elements::{contact, damper, force, spring, torque};
+use crate::model::elements::{contact, damper, force, interaction, spring, torque};
 
 /// How one top-level key of a model file is read, and written.
 struct Section {
@@ -171,10 +171,10 @@ const SECTIONS: &[Section] = &[
         write: |w, file| torque::write(w, &file.torques),
     },
     Section {
-        key: "interactions",
-        read: |cx, n, file| file.interactions = cx.interactions(n),
+        key: interaction::KEY,
+        read: |cx, n, file| file.interactions = interaction::read(cx, n),
         missing: None,
-        write: |w, file| w.write_interactions(file),
+        write: |w, file| interaction::write(w, &file.interactions),
     },
     Section {
         key: "outputs",

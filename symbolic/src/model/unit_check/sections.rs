@@ -249,18 +249,9 @@ impl Checker<'_> {
         for f in &file.forces {
             f.units(self);
         }
-        self.interaction = true;
         for i in &file.interactions {
-            self.fixed(
-                &i.magnitude,
-                Dimension::NEWTON,
-                &format!("the magnitude of interaction `{}`", i.name.value),
-                "a force",
-                "N",
-                "an interaction's magnitude is a force, with `r` in m and `r_dot` in m/s",
-            );
+            i.units(self);
         }
-        self.interaction = false;
         for o in &file.outputs {
             self.homogeneous(&o.value, &format!("output `{}`", o.name.value));
         }
@@ -418,5 +409,8 @@ impl elements::Units for Checker<'_> {
         help: &str,
     ) {
         Checker::fixed(self, e, want, what, kind, want_text, help);
+    }
+    fn distance(&mut self, on: bool) {
+        self.interaction = on;
     }
 }
