@@ -6,9 +6,9 @@ use crate::model::elements::interaction::{self, InteractionTerms};
 use crate::model::elements::torque::TorqueInfo;
 
 impl Lowering<'_> {
-    /// Interactions (`elements::interaction`): a power law's potential into `V`, any other
-    /// magnitude's generalized forces into `Q`, and `(r, f)` of each for
-    /// [`Self::check_interactions_at_start`].
+    /// Interactions (`elements::interaction`): their two forces for momentum balance, a power
+    /// law's potential into `V`, any other magnitude's generalized forces into `Q`, and
+    /// `(r, f)` of each for [`Self::check_interactions_at_start`].
     pub(super) fn interactions(
         &mut self,
         terms: &mut Terms,

@@ -1,5 +1,5 @@
-//! The mechanism of a model file: constraints, equations written by hand, interactions, balances,
-//! masses and inertias, and rolling contacts.
+//! The mechanism of a model file: constraints, equations written by hand, balances, masses and
+//! inertias, and rolling contacts (interactions: `model/elements/interaction.rs`).
 
 use super::*;
 
