@@ -10,7 +10,7 @@ use crate::expr::{Constant, ExprArena, ExprId, Func, SymbolId, SymbolKind};
 use crate::model::ast::{BinOp, Expr, ExprKind};
 use crate::model::checks::FloquetReference;
 use crate::model::diagnostic::Diagnostic;
-use crate::model::elements::{self, contact::ContactInfo};
+use crate::model::elements::{self, contact::ContactInfo, gravity};
 use crate::model::file::{BodyKind, GROUND_FRAME, ModelFile};
 use crate::model::located::{Located, Location};
 use crate::model::rules::short;
@@ -451,10 +451,8 @@ impl<'f> Lowering<'f> {
             .iter()
             .map(|terms| self.arena.sum(terms))
             .collect();
-        let gravity: Option<Vec<ExprId>> = file
-            .gravity
-            .as_ref()
-            .map(|g| g.value.iter().map(|c| self.expr(c)).collect());
+        let gravity: Option<Vec<ExprId>> =
+            file.gravity.as_ref().map(|g| gravity::lower(g, &mut self));
         let body_infos = self.bodies(&points, &mut frames, gravity.as_deref(), &mut terms);
         let mut loads = self.springs(&mut terms);
         loads.extend(self.dampers(&mut terms));

@@ -11,13 +11,15 @@
 //! loop and one row in the schema's `SECTIONS`.
 //!
 //! The kinds here: [`contact`] (unilateral contacts) and its [`support`] (a change of
-//! support), [`spring`], [`damper`], [`force`], [`torque`] and [`interaction`]. The
+//! support), [`spring`], [`damper`], [`force`], [`torque`], [`interaction`] and
+//! [`gravity`]. The
 //! older kinds (bodies, constraints, …) are still spread over the stage files;
 //! ARCHITECTURE.md's recipe says how a kind moves here.
 
 pub mod contact;
 pub mod damper;
 pub mod force;
+pub mod gravity;
 pub mod interaction;
 pub mod spring;
 pub mod support;
@@ -108,6 +110,9 @@ pub(crate) trait Rules {
     fn dimension(&self) -> usize;
     /// The model's coordinates, in file order.
     fn coordinates(&self) -> Vec<String>;
+    /// Whether the section `key` was left incomplete by an error already reported (so what
+    /// it lacks is not reported again).
+    fn section_incomplete(&self, key: &str) -> bool;
     /// Reports a mistake.
     fn error(&mut self, d: Diagnostic);
 }

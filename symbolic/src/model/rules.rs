@@ -378,6 +378,9 @@ impl elements::Rules for Checker<'_> {
             .map(|c| c.name.value.clone())
             .collect()
     }
+    fn section_incomplete(&self, key: &str) -> bool {
+        self.incomplete.has_section(key)
+    }
     fn error(&mut self, d: Diagnostic) {
         Checker::error(self, d);
     }

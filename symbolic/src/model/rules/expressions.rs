@@ -2,6 +2,7 @@
 //! functions of points, and the dimensions of vectors.
 
 use super::*;
+use crate::model::elements::gravity;
 
 impl Checker<'_> {
     // Rule: every name in an expression is a parameter or `pi`, and where the expression may
@@ -100,9 +101,7 @@ impl Checker<'_> {
             }
         }
         if let Some(g) = &file.gravity {
-            for c in &g.value {
-                self.resolve(c, Depends::Constant, "`gravity`");
-            }
+            gravity::rules(g, self);
         }
         for (k, e) in &file.initial {
             self.resolve(
@@ -344,13 +343,8 @@ impl Checker<'_> {
     pub(super) fn dimensions(&mut self) {
         let file = self.file;
         let Some(first) = file.points.first() else {
-            if let Some(g) = &file.gravity
-                && !self.incomplete.has_section("points")
-            {
-                self.error(
-                    Diagnostic::new(g.location, "`gravity` acts on bodies, but the model has no points")
-                        .with_help("add `points:` and `bodies:`, or write the gravitational energy into `potential:`"),
-                );
+            if let Some(g) = &file.gravity {
+                gravity::dimension_rules(g, self, None);
             }
             return;
         };
@@ -379,20 +373,8 @@ impl Checker<'_> {
     /// force written in a frame 3: `Force::dimension_rules`).
     fn vector_lengths(&mut self, dim: usize) {
         let file = self.file;
-        if let Some(g) = &file.gravity
-            && g.value.len() != dim
-        {
-            let example = if dim == 2 { "[0, -g]" } else { "[0, 0, -g]" };
-            self.error(
-                Diagnostic::new(
-                    g.location,
-                    format!(
-                        "`gravity` has {} components but the points have {dim}",
-                        g.value.len()
-                    ),
-                )
-                .with_help(format!("write it like `{example}`")),
-            );
+        if let Some(g) = &file.gravity {
+            gravity::dimension_rules(g, self, Some(dim));
         }
         for f in &file.forces {
             f.dimension_rules(self, dim);

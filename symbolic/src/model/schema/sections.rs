@@ -3,9 +3,9 @@
 //! coordinates, expressions by name and drawing.
 
 use super::walk::{Fields, Keyed, Need};
-use super::write::{Edits, NotRewritten, Rewrite, Writer, list, scalar};
+use super::write::{Edits, NotRewritten, Rewrite, Writer, scalar};
 use super::*;
-use crate::model::elements::{contact, damper, force, interaction, spring, torque};
+use crate::model::elements::{contact, damper, force, gravity, interaction, spring, torque};
 
 /// How one top-level key of a model file is read, and written.
 struct Section {
@@ -137,14 +137,10 @@ const SECTIONS: &[Section] = &[
         write: |w, file| w.write_bodies(file),
     },
     Section {
-        key: "gravity",
-        read: |cx, n, file| {
-            file.gravity = cx
-                .vector(n, "`gravity`", "gravity: [0, -g]")
-                .map(|g| Located::new(g, n.location));
-        },
+        key: gravity::KEY,
+        read: |cx, n, file| file.gravity = gravity::read(cx, n),
         missing: None,
-        write: |w, file| w.write_gravity(file),
+        write: |w, file| gravity::write(w, file.gravity.as_ref()),
     },
     Section {
         key: spring::KEY,
@@ -784,15 +780,6 @@ impl Writer<'_> {
             for (k, q) in forces {
                 self.line(format_args!("  {k}: {}", scalar(&q)));
             }
-        }
-        Ok(())
-    }
-
-    /// `gravity:`.
-    fn write_gravity(&mut self, file: &ModelFile) -> Result<(), NotRewritten> {
-        if let Some(g) = &file.gravity {
-            let parts = self.exprs(&g.value, "`gravity:`")?;
-            self.line(format_args!("gravity: {}", list(&parts)));
         }
         Ok(())
     }

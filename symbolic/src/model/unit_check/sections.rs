@@ -2,7 +2,7 @@
 //! events, outputs and `checks:`, walked in file order.
 
 use super::*;
-use crate::model::elements;
+use crate::model::elements::{self, gravity};
 
 impl Checker<'_> {
     /// Checks `e` against the unit its key requires; a value written with numbers only is
@@ -229,16 +229,7 @@ impl Checker<'_> {
             }
         }
         if let Some(g) = &file.gravity {
-            for (axis, c) in AXES.iter().zip(&g.value) {
-                self.fixed(
-                    c,
-                    Dimension::ACCELERATION,
-                    &format!("the {axis} component of `gravity`"),
-                    "an acceleration",
-                    "m/s^2",
-                    "gravity is the acceleration of free fall, as in `[0, -g]` with `g: 9.81  # m/s^2`",
-                );
-            }
+            gravity::units(g, self);
         }
         for s in &file.springs {
             s.units(self);
