@@ -12,9 +12,8 @@
 //!
 //! The kinds here: [`contact`] (unilateral contacts) and its [`support`] (a change of
 //! support), [`spring`], [`damper`], [`force`], [`torque`], [`interaction`] and
-//! [`gravity`]. The
-//! older kinds (bodies, constraints, …) are still spread over the stage files;
-//! ARCHITECTURE.md's recipe says how a kind moves here.
+//! [`gravity`]. The older kinds (bodies, constraints, …) are still spread over the stage
+//! files; ARCHITECTURE.md's recipe says how a kind moves here.
 
 pub mod contact;
 pub mod damper;
@@ -34,6 +33,9 @@ use crate::model::schema::entries::get;
 use crate::model::schema::walk::{Ctx, Fields, Keyed};
 use crate::model::schema::write::{NotRewritten, Writer, flow};
 use crate::model::yaml::YamlNode;
+
+/// The names of a vector's components, in order (messages: "the x component of …").
+pub(crate) const AXES: [&str; 3] = ["x", "y", "z"];
 
 /// The name of the ground (Newtonian) frame, predefined in every 3-D model.
 pub const GROUND_FRAME: &str = "N";
@@ -248,6 +250,28 @@ pub(crate) fn write_between<'e>(
         ));
     }
     Ok(())
+}
+
+/// Per symbol `sᵢ` of `symbols`, `v·∂r/∂sᵢ` (times `scale` if given), `None` where the
+/// projection is 0: the generalized forces `Qᵢ = F·∂r_P/∂qᵢ` of a force `F` at a point `r_P`
+/// (the partial velocities), or `Qᵢ = τ·∂ω/∂q̇ᵢ` of a torque with the rates as symbols.
+/// Each symbol's terms are built before the next symbol's.
+pub(crate) fn projections(
+    arena: &mut ExprArena,
+    symbols: &[crate::expr::SymbolId],
+    (v, r): (&[ExprId], &[ExprId]),
+    scale: Option<ExprId>,
+) -> Vec<Option<ExprId>> {
+    (symbols.iter())
+        .map(|&s| {
+            let partial: Vec<ExprId> = r.iter().map(|x| arena.diff(*x, s)).collect();
+            let projection = dot(arena, v, &partial);
+            (!arena.is_zero(projection)).then(|| match scale {
+                Some(scale) => arena.times(scale, projection),
+                None => projection,
+            })
+        })
+        .collect()
 }
 
 /// `a − b`, component by component.

@@ -463,7 +463,7 @@ fn unit_part(text: &str) -> &str {
 }
 
 /// Component names for messages.
-const AXES: [&str; 3] = ["x", "y", "z"];
+use super::elements::AXES;
 
 impl<'f> Checker<'f> {
     /// Both passes over `file`, with the unit of `undeclared` (if any) treated as unknown.

@@ -10,7 +10,7 @@
 //! generalized forces `Qᵢ = F_A·∂d/∂qᵢ`, momentum balance as the two forces: both from
 //! `force_scale`.
 
-use super::{Lower, Rules, Units, between, dot, read_between, write_between};
+use super::{Lower, Rules, Units, between, dot, projections, read_between, write_between};
 use crate::expr::{ExprArena, ExprId};
 use crate::model::ast::Expr;
 use crate::model::elements::Depends;
@@ -108,14 +108,7 @@ impl Damper {
         let arena = cx.arena();
         let scale = force_scale(arena, (&d, &rate_of), c);
         let coordinates: Vec<_> = arena.coordinates().iter().map(|s| s[0]).collect();
-        let generalized_forces = coordinates
-            .iter()
-            .map(|&q| {
-                let partial: Vec<ExprId> = d.iter().map(|x| arena.diff(*x, q)).collect();
-                let projection = dot(arena, &d, &partial);
-                (!arena.is_zero(projection)).then(|| arena.times(scale, projection))
-            })
-            .collect();
+        let generalized_forces = projections(arena, &coordinates, (&d, &d), Some(scale));
         Some(DamperInfo {
             between: [a, b],
             coefficient: c,

@@ -12,7 +12,7 @@
 //! is carried into the ground frame's components first. Components may depend on the
 //! configuration, the rates and `t`.
 
-use super::{Depends, Lower, Rules, Units, dot, in_frame};
+use super::{AXES, Depends, Lower, Rules, Units, in_frame, projections};
 use crate::expr::ExprId;
 use crate::model::ast::Expr;
 use crate::model::diagnostic::Diagnostic;
@@ -52,9 +52,6 @@ const FIELDS: Fields = Fields {
     ],
     example: "{ at: P, vector: [F0*cos(w*t), 0] }",
 };
-
-/// The names of the components, in order.
-const AXES: [&str; 3] = ["x", "y", "z"];
 
 /// `forces:` — `name: { at, vector, in }`, in file order.
 pub(crate) fn read(cx: &mut Ctx<'_>, node: &YamlNode) -> Vec<Force> {
@@ -198,14 +195,7 @@ impl Force {
         let r = cx.point_at(point);
         let arena = cx.arena();
         let coordinates: Vec<_> = arena.coordinates().iter().map(|s| s[0]).collect();
-        let generalized_forces = coordinates
-            .iter()
-            .map(|&q| {
-                let partial: Vec<ExprId> = r.iter().map(|x| arena.diff(*x, q)).collect();
-                let projection = dot(arena, &vector, &partial);
-                (!arena.is_zero(projection)).then_some(projection)
-            })
-            .collect();
+        let generalized_forces = projections(arena, &coordinates, (&vector, &r), None);
         Some(ForceInfo {
             point,
             vector,

@@ -9,7 +9,7 @@
 //! balance the forces `m g`, both from the bodies' lowering with the vector this module
 //! lowers.
 
-use super::{Depends, Lower, Rules, Units};
+use super::{AXES, Depends, Lower, Rules, Units};
 use crate::expr::ExprId;
 use crate::model::ast::Expr;
 use crate::model::diagnostic::Diagnostic;
@@ -21,9 +21,6 @@ use crate::model::yaml::YamlNode;
 
 /// The key of the section.
 pub(crate) const KEY: &str = "gravity";
-
-/// The names of the components, in order.
-const AXES: [&str; 3] = ["x", "y", "z"];
 
 /// `gravity: [gx, gy]` (or three components), located at the list.
 pub(crate) fn read(cx: &mut Ctx<'_>, node: &YamlNode) -> Option<Located<Vec<Expr>>> {

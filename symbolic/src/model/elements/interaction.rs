@@ -13,7 +13,9 @@
 //! that is a sum of powers of `r` as the potential `V(r) = −∫ f dr`, any other as the
 //! generalized forces `Qᵢ = (f/r) d·∂d/∂qᵢ`; momentum balance takes the two forces.
 
-use super::{Depends, Lower, Rules, Units, difference, dot, read_between, write_between};
+use super::{
+    Depends, Lower, Rules, Units, difference, dot, projections, read_between, write_between,
+};
 use crate::expr::{ExprArena, ExprId, Func, SymbolId, SymbolKind};
 use crate::model::ast::Expr;
 use crate::model::diagnostic::Diagnostic;
@@ -199,16 +201,7 @@ pub(crate) fn lower(cx: &mut dyn Lower, interactions: &[Interaction]) -> Vec<Int
             Some(v_of_r) => InteractionTerms::Potential(arena.substitute(v_of_r, &values)),
             None => {
                 let coordinates: Vec<_> = arena.coordinates().iter().map(|s| s[0]).collect();
-                InteractionTerms::Forces(
-                    (coordinates.iter())
-                        .map(|&q| {
-                            let partial: Vec<ExprId> =
-                                d.iter().map(|x| arena.diff(*x, q)).collect();
-                            let projection = dot(arena, &d, &partial);
-                            (!arena.is_zero(projection)).then(|| arena.times(scale, projection))
-                        })
-                        .collect(),
-                )
+                InteractionTerms::Forces(projections(arena, &coordinates, (&d, &d), Some(scale)))
             }
         };
         out.push(InteractionInfo {

@@ -11,7 +11,7 @@
 //! `Qᵢ = τ·∂ω/∂q̇ᵢ`, both vectors in the body frame's components (the vector is carried from
 //! its frame `in:` there first). Momentum balance takes the torque itself on its body.
 
-use super::{BodyLookup, BodyShape, Depends, Lower, Rules, Units, dot, in_frame};
+use super::{AXES, BodyLookup, BodyShape, Depends, Lower, Rules, Units, in_frame, projections};
 use crate::expr::ExprId;
 use crate::model::ast::Expr;
 use crate::model::diagnostic::Diagnostic;
@@ -74,9 +74,6 @@ const FIELDS: Fields = Fields {
     ],
     example: "{ body: arm, value: tau0*sin(w*t) }",
 };
-
-/// The names of the components, in order.
-const AXES: [&str; 3] = ["x", "y", "z"];
 
 /// `torques:` — `name: { body, value }` or `name: { body, vector, in }`, in file order.
 pub(crate) fn read(cx: &mut Ctx<'_>, node: &YamlNode) -> Vec<Torque> {
@@ -342,14 +339,7 @@ impl Torque {
         let v = cx.express(v, from, body_frame);
         let arena = cx.arena();
         let rates: Vec<_> = arena.coordinates().iter().map(|s| s[1]).collect();
-        let generalized_forces = rates
-            .iter()
-            .map(|&rate| {
-                let partial: Vec<ExprId> = omega.iter().map(|w| arena.diff(*w, rate)).collect();
-                let projection = dot(arena, &v, &partial);
-                (!arena.is_zero(projection)).then_some(projection)
-            })
-            .collect();
+        let generalized_forces = projections(arena, &rates, (&v, &omega), None);
         Some(TorqueInfo::Spatial {
             body,
             vector: v,
