@@ -10,7 +10,7 @@ use crate::expr::{Constant, ExprArena, ExprId, Func, SymbolId, SymbolKind};
 use crate::model::ast::{BinOp, Expr, ExprKind};
 use crate::model::checks::FloquetReference;
 use crate::model::diagnostic::Diagnostic;
-use crate::model::elements::{self, contact::ContactInfo, gravity};
+use crate::model::elements::{self, contact::ContactInfo, frame, gravity};
 use crate::model::file::{BodyKind, GROUND_FRAME, ModelFile};
 use crate::model::located::{Located, Location};
 use crate::model::rules::short;
@@ -638,9 +638,9 @@ impl<'f> Lowering<'f> {
         for f in &self.file.frames {
             if let Some(index) = frames.index(&f.name.value) {
                 let w = frames.angular_velocity(&mut self.arena, index);
-                for (axis, c) in ['x', 'y', 'z'].into_iter().zip(w) {
+                for (axis, c) in elements::AXES.into_iter().zip(w) {
                     self.angular_velocities
-                        .insert(format!("omega_{}_{axis}", f.name.value), c);
+                        .insert(frame::angular_velocity_name(&f.name.value, axis), c);
                 }
             }
         }
@@ -736,11 +736,7 @@ impl<'f> Lowering<'f> {
                 ));
                 continue;
             };
-            let rotations = f
-                .rotations
-                .iter()
-                .map(|r| (r.axis.value.index(), self.expr(&r.angle)))
-                .collect();
+            let rotations = frame::lower(f, self);
             frames.add(&f.name.value, parent, rotations);
         }
         frames

@@ -10,14 +10,16 @@
 //! its `Fields`, the `Writer`), and a new kind is one module plus one line in each stage's
 //! loop and one row in the schema's `SECTIONS`.
 //!
-//! The kinds here: [`contact`] (unilateral contacts) and its [`support`] (a change of
-//! support), [`spring`], [`damper`], [`force`], [`torque`], [`interaction`] and
-//! [`gravity`]. The older kinds (bodies, constraints, …) are still spread over the stage
-//! files; ARCHITECTURE.md's recipe says how a kind moves here.
+//! The kinds here: [`frame`] (reference frames), [`contact`] (unilateral contacts) and its
+//! [`support`] (a change of support), [`spring`], [`damper`], [`force`], [`torque`],
+//! [`interaction`] and [`gravity`]. The older kinds (bodies, constraints, the written
+//! energies) are still spread over the stage files; ARCHITECTURE.md's recipe says how a kind
+//! moves here.
 
 pub mod contact;
 pub mod damper;
 pub mod force;
+pub mod frame;
 pub mod gravity;
 pub mod interaction;
 pub mod spring;
@@ -46,6 +48,33 @@ pub(crate) fn in_frame(frame: Option<&Located<String>>) -> String {
     match frame {
         Some(f) if f.value != GROUND_FRAME => format!(", in: {}", f.value),
         _ => String::new(),
+    }
+}
+
+/// An axis of a frame.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Axis {
+    /// The frame's x axis.
+    X,
+    /// The frame's y axis.
+    Y,
+    /// The frame's z axis.
+    Z,
+}
+
+impl Axis {
+    /// 0, 1, 2 for x, y, z.
+    pub fn index(self) -> usize {
+        match self {
+            Axis::X => 0,
+            Axis::Y => 1,
+            Axis::Z => 2,
+        }
+    }
+
+    /// `x`, `y` or `z`.
+    pub fn letter(self) -> char {
+        ['x', 'y', 'z'][self.index()]
     }
 }
 
@@ -94,6 +123,8 @@ pub(crate) trait Rules {
     /// Reports `name` unless it is a frame of the model or the ground (or one left out for
     /// an error already reported).
     fn frame(&mut self, name: &Located<String>);
+    /// "unknown frame `name`", with the closest of `frames` (the frames it may name there).
+    fn unknown_frame(&self, name: &Located<String>, frames: &[&str]) -> Diagnostic;
     /// The body called `name`: its kind, or why there is none.
     fn body(&self, name: &str) -> BodyLookup;
     /// Checks the names and functions of `e` and that it depends on no more than `depends`;

@@ -99,58 +99,8 @@ pub struct RelativePosition {
     pub vectors: Vec<(Located<String>, Vec<Expr>)>,
 }
 
-pub use super::elements::GROUND_FRAME;
-
-/// An axis of a frame.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Axis {
-    /// The frame's x axis.
-    X,
-    /// The frame's y axis.
-    Y,
-    /// The frame's z axis.
-    Z,
-}
-
-impl Axis {
-    /// 0, 1, 2 for x, y, z.
-    pub fn index(self) -> usize {
-        match self {
-            Axis::X => 0,
-            Axis::Y => 1,
-            Axis::Z => 2,
-        }
-    }
-
-    /// `x`, `y` or `z`.
-    pub fn letter(self) -> char {
-        ['x', 'y', 'z'][self.index()]
-    }
-}
-
-/// One simple rotation: the new frame is the previous one turned by `angle` (rad, right-hand
-/// rule) about `axis`, an axis fixed in both.
-#[derive(Debug, Clone, PartialEq)]
-pub struct SimpleRotation {
-    /// The axis.
-    pub axis: Located<Axis>,
-    /// The angle (rad), an expression of the parameters, coordinates and `t`.
-    pub angle: Expr,
-}
-
-/// A reference frame: its parent turned by successive simple rotations (Kane & Levinson,
-/// *Dynamics: Theory and Applications*, 1985, §1.7–1.9).
-#[derive(Debug, Clone, PartialEq)]
-pub struct Frame {
-    /// Name.
-    pub name: Located<String>,
-    /// The parent frame ([`GROUND_FRAME`] or a frame defined earlier in the file).
-    pub parent: Located<String>,
-    /// The rotations in the order they are applied, each about an axis of the frame the
-    /// previous ones produced (body-fixed; `about: parent` is stored here already reversed,
-    /// which gives the same orientation).
-    pub rotations: Vec<SimpleRotation>,
-}
+pub use super::elements::frame::{Frame, SimpleRotation};
+pub use super::elements::{Axis, GROUND_FRAME};
 
 /// Rolling without slip, `nonholonomic: { roll: { body: wheel, point: C, along: [x, y], in: N } }`:
 /// the velocity of the material point of `body` that is at `point`,
@@ -536,16 +486,7 @@ impl ModelFile {
     /// of the frame's angular velocity in the ground frame along its own axis (rad/s), with
     /// `<frame>` one of [`Self::frames`].
     pub fn angular_velocity_name(&self, name: &str) -> Option<(&Frame, Axis)> {
-        let rest = name.strip_prefix("omega_")?;
-        let (frame, axis) = rest.rsplit_once('_')?;
-        let axis = match axis {
-            "x" => Axis::X,
-            "y" => Axis::Y,
-            "z" => Axis::Z,
-            _ => return None,
-        };
-        let frame = self.frames.iter().find(|f| f.name.value == frame)?;
-        Some((frame, axis))
+        super::elements::frame::angular_velocity_of(&self.frames, name)
     }
 
     /// The names of every non-holonomic constraint, located: the expressions', then each

@@ -329,6 +329,9 @@ impl elements::Rules for Checker<'_> {
         let frames = frames::frame_names(self.file);
         Checker::frame(self, name, &frames);
     }
+    fn unknown_frame(&self, name: &Located<String>, frames: &[&str]) -> Diagnostic {
+        self.unknown_frame_message(name, frames)
+    }
     fn body(&self, name: &str) -> elements::BodyLookup {
         use elements::{BodyLookup, BodyShape};
         let file = self.file;

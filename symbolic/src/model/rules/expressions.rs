@@ -2,7 +2,7 @@
 //! functions of points, and the dimensions of vectors.
 
 use super::*;
-use crate::model::elements::gravity;
+use crate::model::elements::{frame, gravity};
 
 impl Checker<'_> {
     // Rule: every name in an expression is a parameter or `pi`, and where the expression may
@@ -42,15 +42,7 @@ impl Checker<'_> {
                 );
             }
         }
-        for f in &file.frames {
-            for r in &f.rotations {
-                self.resolve(
-                    &r.angle,
-                    Depends::Position,
-                    &format!("the rotation of frame `{}`", f.name.value),
-                );
-            }
-        }
+        frame::angle_rules(&file.frames, self);
         self.vectors = true;
         for b in &file.bodies {
             let name = &b.name.value;

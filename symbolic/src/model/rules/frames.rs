@@ -1,6 +1,7 @@
 //! The frames of a model file and the frames and points that other sections name.
 
 use super::*;
+use crate::model::elements::frame;
 
 impl Checker<'_> {
     // Rule: frames have distinct names other than the ground `N` and `from`; each frame's
@@ -8,7 +9,7 @@ impl Checker<'_> {
     // written from another point names one defined before it, and its vectors known frames.
     pub(super) fn frames(&mut self) {
         let file = self.file;
-        self.frame_tree();
+        frame::rules(&file.frames, self);
         let frames = frame_names(file);
         self.point_origins(&frames);
         for b in &file.bodies {
@@ -20,49 +21,6 @@ impl Checker<'_> {
             self.point(&w.centre);
             self.frame(&w.frame, &frames);
             self.resolve(&w.radius, Depends::Constant, "the radius of a drawn wheel");
-        }
-    }
-
-    /// Checks the frame names (not reserved, not repeated) and that each frame's parent is the
-    /// ground or a frame defined before it.
-    fn frame_tree(&mut self) {
-        let file = self.file;
-        let mut defined: Vec<&str> = vec![GROUND_FRAME];
-        for f in &file.frames {
-            let n = f.name.value.as_str();
-            if n == GROUND_FRAME || n == "from" {
-                let why = if n == "from" {
-                    "`from` is the key of a point's start"
-                } else {
-                    "`N` is the ground frame"
-                };
-                self.error(
-                    Diagnostic::new(
-                        f.name.location,
-                        format!("frame name `{n}` is reserved: {why}"),
-                    )
-                    .with_help("choose another name"),
-                );
-                continue;
-            }
-            let p = f.parent.value.as_str();
-            if !defined.contains(&p) {
-                let later = file.frames.iter().any(|g| g.name.value == p);
-                let d = if later {
-                    Diagnostic::new(f.parent.location, format!("frame `{n}` is turned from `{p}`, which is not defined before it"))
-                        .with_help("define a frame's parent above it (frames form a tree rooted at the ground frame `N`)")
-                } else {
-                    self.unknown_frame_message(&f.parent, &defined)
-                };
-                self.error(d);
-            }
-            if defined.contains(&n) {
-                self.error(
-                    Diagnostic::new(f.name.location, format!("duplicate frame name `{n}`"))
-                        .with_help("rename one"),
-                );
-            }
-            defined.push(n);
         }
     }
 
@@ -132,7 +90,11 @@ impl Checker<'_> {
     }
 
     /// "unknown frame", with the closest of `frames`.
-    fn unknown_frame_message(&self, name: &Located<String>, frames: &[&str]) -> Diagnostic {
+    pub(super) fn unknown_frame_message(
+        &self,
+        name: &Located<String>,
+        frames: &[&str],
+    ) -> Diagnostic {
         let d = Diagnostic::new(name.location, format!("unknown frame `{}`", name.value));
         match closest(&name.value, frames) {
             Some(c) => d.with_help(format!("did you mean `{c}`?")),

@@ -1,7 +1,7 @@
-//! Frames and bodies: the frames of the mechanism (simple rotations and Euler-angle sequences)
-//! and its bodies (particles, planar rigid bodies and spatial bodies with their inertia tensors).
+//! The bodies of a model file: particles, planar rigid bodies and spatial bodies with their
+//! inertia tensors.
 
-use super::walk::{Fields, Keyed, Need};
+use super::walk::Keyed;
 use super::write::{NotRewritten, Writer, flow, list};
 use super::*;
 
@@ -9,160 +9,8 @@ const BODY_KEYS: &[&str] = &["mass", "at", "inertia", "com", "angle", "frame"];
 const PARTICLE_EXAMPLE: &str = "{ mass: m, at: P }";
 const RIGID_EXAMPLE: &str = "{ mass: m, inertia: m*l^2/12, com: G, angle: theta }";
 const SPATIAL_EXAMPLE: &str = "{ mass: m, com: G, frame: B, inertia: [I1, I2, I3] }";
-const FRAME_EXAMPLE: &str = "{ parent: N, axes: zxz, angles: [psi, theta, phi] }";
-/// The keys of a frame.
-const FRAME: Fields = Fields {
-    kind: "frame",
-    keys: &[
-        ("parent", Need::Optional),
-        ("axis", Need::Optional),
-        ("angle", Need::Optional),
-        ("axes", Need::Optional),
-        ("angles", Need::Optional),
-        ("about", Need::Optional),
-    ],
-    example: FRAME_EXAMPLE,
-};
 
 impl Ctx<'_> {
-    /// `frames:` — `name: { parent, axis, angle }` or `name: { parent, axes, angles, about }`.
-    pub(super) fn frames(&mut self, node: &YamlNode) -> Vec<Frame> {
-        let example = format!("frames: {{ B: {FRAME_EXAMPLE} }}");
-        let spec = Keyed {
-            what: "`frames`",
-            example: &example,
-            names: Some("frame"),
-            drop: true,
-        };
-        self.keyed(node, spec, Self::frame)
-    }
-
-    /// One frame: its parent (the ground `N` if not given) turned by one simple rotation
-    /// (`axis`, `angle`) or by several (`axes: zxz`, `angles: [...]`), each about an axis of
-    /// the newest frame (`about: body`, the default) or of the parent (`about: parent`).
-    fn frame(&mut self, k: &Located<String>, v: &YamlNode) -> Option<Frame> {
-        let f = self.fields(k, v, &FRAME)?;
-        let what = format!("frame `{}`", k.value);
-        let example = format!("{}: {FRAME_EXAMPLE}", k.value);
-        let parent = match get(f, "parent") {
-            Some(n) => self.name(n, "`parent`")?,
-            None => Located::new(GROUND_FRAME.to_string(), k.location),
-        };
-        let single = get(f, "axis").is_some() || get(f, "angle").is_some();
-        let several = get(f, "axes").is_some() || get(f, "angles").is_some();
-        if single == several {
-            let message = if single {
-                format!("{what} has both `axis`/`angle` and `axes`/`angles`")
-            } else {
-                format!("{what} has no rotation")
-            };
-            self.error(Diagnostic::new(k.location, message).with_help(format!(
-                "one simple rotation is `{}: {{ parent: N, axis: z, angle: psi }}`; successive ones `{example}`",
-                k.value
-            )));
-            return None;
-        }
-        let (axes_key, angles_key) = if single {
-            ("axis", "angle")
-        } else {
-            ("axes", "angles")
-        };
-        if !self.require(f, k.location, &what, &[axes_key, angles_key], &example) {
-            return None;
-        }
-        let axes_node = get(f, axes_key)?;
-        let axes = self.axes(axes_node, single)?;
-        let angles: Vec<Expr> = if single {
-            vec![self.expr(get(f, "angle")?, "a rotation angle")?]
-        } else {
-            let node = get(f, "angles")?;
-            let items = self.seq(node, "`angles`", "angles: [psi, theta, phi]")?;
-            if items.len() != axes.len() {
-                self.error(
-                    Diagnostic::new(
-                        node.location,
-                        format!("{what} has {} axes but {} angles", axes.len(), items.len()),
-                    )
-                    .with_help("give one angle per axis, in the same order"),
-                );
-                return None;
-            }
-            let angles: Vec<Option<Expr>> = items
-                .iter()
-                .map(|i| self.expr(i, "a rotation angle"))
-                .collect();
-            angles.into_iter().collect::<Option<_>>()?
-        };
-        let about_parent = match get(f, "about") {
-            None => false,
-            Some(n) => self.choice(n, "`about`", &[("body", false), ("parent", true)])?,
-        };
-        let mut rotations: Vec<SimpleRotation> = axes
-            .into_iter()
-            .zip(angles)
-            .map(|(axis, angle)| SimpleRotation { axis, angle })
-            .collect();
-        // Rotations about the parent's fixed axes in the order a, b, c give the orientation
-        // of rotations about the newest frame's axes in the order c, b, a.
-        if about_parent {
-            rotations.reverse();
-        }
-        Some(Frame {
-            name: k.clone(),
-            parent,
-            rotations,
-        })
-    }
-
-    /// The axes of a frame's rotations: `x`, `y` or `z` (one, for `axis`), or a word of
-    /// them (`zxz`, for `axes`).
-    pub(super) fn axes(&mut self, node: &YamlNode, single: bool) -> Option<Vec<Located<Axis>>> {
-        let what = if single { "`axis`" } else { "`axes`" };
-        let text = match &node.kind {
-            YamlKind::Scalar { text, .. } => text.trim().to_string(),
-            _ => String::new(),
-        };
-        let axes: Option<Vec<Located<Axis>>> = text
-            .chars()
-            .enumerate()
-            .map(|(i, c)| {
-                let axis = match c {
-                    'x' => Axis::X,
-                    'y' => Axis::Y,
-                    'z' => Axis::Z,
-                    _ => return None,
-                };
-                Some(Located::new(axis, node.location.offset(i)))
-            })
-            .collect();
-        match axes {
-            Some(a) if !a.is_empty() && (!single || a.len() == 1) => Some(a),
-            _ => {
-                let help = if single {
-                    "a simple rotation is about the `x`, `y` or `z` axis (write `axis: z`; to turn the other way, negate the angle)"
-                } else {
-                    "write the axes of the successive rotations as one word of `x`, `y` and `z`, as in `axes: zxz` (Euler angles) or `axes: zyx` (yaw, pitch, roll)"
-                };
-                self.error(
-                    Diagnostic::new(
-                        node.location,
-                        format!(
-                            "{what} must be {}, found {}",
-                            if single {
-                                "x, y or z"
-                            } else {
-                                "a word of x, y and z"
-                            },
-                            node.kind.describe()
-                        ),
-                    )
-                    .with_help(help),
-                );
-                None
-            }
-        }
-    }
-
     /// `bodies:` — `name: { mass, at }` or `name: { mass, inertia, com, angle }`.
     pub(super) fn bodies(&mut self, node: &YamlNode) -> Vec<Body> {
         let spec = Keyed {
@@ -373,49 +221,8 @@ impl Ctx<'_> {
     }
 }
 
-/// The writers of `frames:` and `bodies:`, and the text of a wheel.
+/// The writer of `bodies:`, and the text of a wheel.
 impl Writer<'_> {
-    /// `frames:`, each as its successive rotations about the newest frame's axes (a frame
-    /// written `about: parent` was read into that order, which gives the same orientation).
-    pub(super) fn write_frames(&mut self, file: &ModelFile) -> Result<(), NotRewritten> {
-        if file.frames.is_empty() {
-            return Ok(());
-        }
-        self.line("frames:");
-        for frame in &file.frames {
-            let text = self.frame_text(frame)?;
-            self.line(format_args!("  {}: {text}", frame.name.value));
-        }
-        Ok(())
-    }
-
-    /// `{ parent: P, axis: z, angle: … }`, or `axes:` and `angles:` for several rotations.
-    fn frame_text(&mut self, frame: &Frame) -> Result<String, NotRewritten> {
-        let place = format!("frame `{}`", frame.name.value);
-        let angles = frame
-            .rotations
-            .iter()
-            .map(|r| self.expr(&r.angle, &place))
-            .collect::<Result<Vec<_>, _>>()?;
-        let axes: String = frame
-            .rotations
-            .iter()
-            .map(|r| r.axis.value.letter())
-            .collect();
-        Ok(match angles.as_slice() {
-            [angle] => format!(
-                "{{ parent: {}, axis: {axes}, angle: {} }}",
-                frame.parent.value,
-                flow(angle)
-            ),
-            _ => format!(
-                "{{ parent: {}, axes: {axes}, angles: {} }}",
-                frame.parent.value,
-                list(&angles)
-            ),
-        })
-    }
-
     /// `bodies:`: particles, planar rigid bodies and 3-D bodies.
     pub(super) fn write_bodies(&mut self, file: &ModelFile) -> Result<(), NotRewritten> {
         if file.bodies.is_empty() {

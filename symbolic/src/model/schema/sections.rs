@@ -5,7 +5,7 @@
 use super::walk::{Fields, Keyed, Need};
 use super::write::{Edits, NotRewritten, Rewrite, Writer, scalar};
 use super::*;
-use crate::model::elements::{contact, damper, force, gravity, interaction, spring, torque};
+use crate::model::elements::{contact, damper, force, frame, gravity, interaction, spring, torque};
 
 /// How one top-level key of a model file is read, and written.
 struct Section {
@@ -119,10 +119,10 @@ const SECTIONS: &[Section] = &[
         write: |w, file| w.write_generalized_forces(file),
     },
     Section {
-        key: "frames",
-        read: |cx, n, file| file.frames = cx.frames(n),
+        key: frame::KEY,
+        read: |cx, n, file| file.frames = frame::read(cx, n),
         missing: None,
-        write: |w, file| w.write_frames(file),
+        write: |w, file| frame::write(w, &file.frames),
     },
     Section {
         key: "points",

@@ -54,7 +54,7 @@ pub(super) fn cut_in_source(source: &str, end: Location) -> bool {
 
 impl Ctx<'_> {
     /// The items of the list `node`; reports anything else.
-    pub(super) fn seq<'n>(
+    pub(crate) fn seq<'n>(
         &mut self,
         node: &'n YamlNode,
         what: &str,
@@ -294,8 +294,57 @@ impl Ctx<'_> {
         Some([a?, b?])
     }
 
+    /// Axes of a frame: `x`, `y` or `z` (one, for `axis`, `along` or `axle`), or a word of
+    /// them (`zxz`, for a frame's successive rotations, `axes`).
+    pub(crate) fn axes(&mut self, node: &YamlNode, single: bool) -> Option<Vec<Located<Axis>>> {
+        let what = if single { "`axis`" } else { "`axes`" };
+        let text = match &node.kind {
+            YamlKind::Scalar { text, .. } => text.trim().to_string(),
+            _ => String::new(),
+        };
+        let axes: Option<Vec<Located<Axis>>> = text
+            .chars()
+            .enumerate()
+            .map(|(i, c)| {
+                let axis = match c {
+                    'x' => Axis::X,
+                    'y' => Axis::Y,
+                    'z' => Axis::Z,
+                    _ => return None,
+                };
+                Some(Located::new(axis, node.location.offset(i)))
+            })
+            .collect();
+        match axes {
+            Some(a) if !a.is_empty() && (!single || a.len() == 1) => Some(a),
+            _ => {
+                let help = if single {
+                    "a simple rotation is about the `x`, `y` or `z` axis (write `axis: z`; to turn the other way, negate the angle)"
+                } else {
+                    "write the axes of the successive rotations as one word of `x`, `y` and `z`, as in `axes: zxz` (Euler angles) or `axes: zyx` (yaw, pitch, roll)"
+                };
+                self.error(
+                    Diagnostic::new(
+                        node.location,
+                        format!(
+                            "{what} must be {}, found {}",
+                            if single {
+                                "x, y or z"
+                            } else {
+                                "a word of x, y and z"
+                            },
+                            node.kind.describe()
+                        ),
+                    )
+                    .with_help(help),
+                );
+                None
+            }
+        }
+    }
+
     /// One of a few words, as a scalar; an error lists them (with a "did you mean").
-    pub(super) fn choice<T: Copy>(
+    pub(crate) fn choice<T: Copy>(
         &mut self,
         node: &YamlNode,
         what: &str,

@@ -188,7 +188,7 @@ impl Ctx<'_> {
     }
 
     /// Reports every key of `required` missing from `entries`; `Ok` when none is missing.
-    pub(super) fn require(
+    pub(crate) fn require(
         &mut self,
         entries: &Entries,
         at: Location,

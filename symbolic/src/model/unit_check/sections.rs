@@ -2,7 +2,7 @@
 //! events, outputs and `checks:`, walked in file order.
 
 use super::*;
-use crate::model::elements::{self, gravity};
+use crate::model::elements::{self, frame, gravity};
 
 impl Checker<'_> {
     /// Checks `e` against the unit its key requires; a value written with numbers only is
@@ -163,18 +163,7 @@ impl Checker<'_> {
                 );
             }
         }
-        for f in &file.frames {
-            for r in &f.rotations {
-                self.fixed(
-                    &r.angle,
-                    Dimension::ONE,
-                    &format!("the rotation angle of frame `{}`", f.name.value),
-                    "an angle",
-                    "rad (a pure number)",
-                    "a rotation angle is an angle coordinate, or a function of the coordinates that gives a pure number",
-                );
-            }
-        }
+        frame::units(&file.frames, self);
         for b in &file.bodies {
             let name = &b.name.value;
             let (mass, inertia_angle) = match &b.kind {

@@ -1,0 +1,313 @@
+//! Reference frames (`frames:`): a frame is its parent turned by successive simple rotations
+//! (Kane & Levinson, *Dynamics: Theory and Applications*, 1985, §1.7–1.9; rotations and
+//! rotating coordinate systems are lectures 11 and 20 of the course).
+//!
+//! ```yaml
+//! frames:
+//!   A: { parent: N, axis: z, angle: psi }                     # one simple rotation
+//!   B: { parent: A, axes: xz, angles: [theta, phi] }          # successive ones, body-fixed
+//!   C: { parent: N, axes: zyx, angles: [a, b, c], about: parent }
+//! ```
+//!
+//! The frames form a tree rooted at the ground frame `N`. The kinematics engine
+//! (`mechanics::frames`) composes their rotation matrices and angular velocities; this module
+//! gives it each frame's rotations as expressions, and names the components of a frame's
+//! angular velocity that expressions may read, `omega_<frame>_<axis>`.
+
+use super::{Axis, Depends, GROUND_FRAME, Lower, Rules, Units};
+use crate::expr::ExprId;
+use crate::model::ast::Expr;
+use crate::model::diagnostic::Diagnostic;
+use crate::model::located::Located;
+use crate::model::schema::entries::get;
+use crate::model::schema::walk::{Ctx, Fields, Keyed, Need};
+use crate::model::schema::write::{NotRewritten, Writer, flow, list};
+use crate::model::units::Dimension;
+use crate::model::yaml::YamlNode;
+
+/// The key of the section.
+pub(crate) const KEY: &str = "frames";
+
+/// One simple rotation: the new frame is the previous one turned by `angle` (rad, right-hand
+/// rule) about `axis`, an axis fixed in both.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SimpleRotation {
+    /// The axis.
+    pub axis: Located<Axis>,
+    /// The angle (rad), an expression of the parameters, coordinates and `t`.
+    pub angle: Expr,
+}
+
+/// A reference frame: its parent turned by successive simple rotations (Kane & Levinson,
+/// *Dynamics: Theory and Applications*, 1985, §1.7–1.9).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Frame {
+    /// Name.
+    pub name: Located<String>,
+    /// The parent frame ([`GROUND_FRAME`] or a frame defined earlier in the file).
+    pub parent: Located<String>,
+    /// The rotations in the order they are applied, each about an axis of the frame the
+    /// previous ones produced (body-fixed; `about: parent` is stored here already reversed,
+    /// which gives the same orientation).
+    pub rotations: Vec<SimpleRotation>,
+}
+
+/// An example of a frame, in messages.
+pub(crate) const EXAMPLE: &str = "{ parent: N, axes: zxz, angles: [psi, theta, phi] }";
+
+/// The keys of a frame.
+const FIELDS: Fields = Fields {
+    kind: "frame",
+    keys: &[
+        ("parent", Need::Optional),
+        ("axis", Need::Optional),
+        ("angle", Need::Optional),
+        ("axes", Need::Optional),
+        ("angles", Need::Optional),
+        ("about", Need::Optional),
+    ],
+    example: EXAMPLE,
+};
+
+/// `frames:` — `name: { parent, axis, angle }` or `name: { parent, axes, angles, about }`, in
+/// file order.
+pub(crate) fn read(cx: &mut Ctx<'_>, node: &YamlNode) -> Vec<Frame> {
+    let example = format!("frames: {{ B: {EXAMPLE} }}");
+    let spec = Keyed {
+        what: "`frames`",
+        example: &example,
+        names: Some("frame"),
+        drop: true,
+    };
+    cx.keyed(node, spec, read_frame)
+}
+
+/// One frame: its parent (the ground `N` if not given) turned by one simple rotation
+/// (`axis`, `angle`) or by several (`axes: zxz`, `angles: [...]`), each about an axis of the
+/// newest frame (`about: body`, the default) or of the parent (`about: parent`).
+fn read_frame(cx: &mut Ctx<'_>, k: &Located<String>, v: &YamlNode) -> Option<Frame> {
+    let f = cx.fields(k, v, &FIELDS)?;
+    let what = format!("frame `{}`", k.value);
+    let example = format!("{}: {EXAMPLE}", k.value);
+    let parent = match get(f, "parent") {
+        Some(n) => cx.name(n, "`parent`")?,
+        None => Located::new(GROUND_FRAME.to_string(), k.location),
+    };
+    let single = get(f, "axis").is_some() || get(f, "angle").is_some();
+    let several = get(f, "axes").is_some() || get(f, "angles").is_some();
+    if single == several {
+        let message = if single {
+            format!("{what} has both `axis`/`angle` and `axes`/`angles`")
+        } else {
+            format!("{what} has no rotation")
+        };
+        cx.error(Diagnostic::new(k.location, message).with_help(format!(
+            "one simple rotation is `{}: {{ parent: N, axis: z, angle: psi }}`; successive ones `{example}`",
+            k.value
+        )));
+        return None;
+    }
+    let (axes_key, angles_key) = if single {
+        ("axis", "angle")
+    } else {
+        ("axes", "angles")
+    };
+    if !cx.require(f, k.location, &what, &[axes_key, angles_key], &example) {
+        return None;
+    }
+    let axes = cx.axes(get(f, axes_key)?, single)?;
+    let angles: Vec<Expr> = if single {
+        vec![cx.expr(get(f, "angle")?, "a rotation angle")?]
+    } else {
+        let node = get(f, "angles")?;
+        let items = cx.seq(node, "`angles`", "angles: [psi, theta, phi]")?;
+        if items.len() != axes.len() {
+            cx.error(
+                Diagnostic::new(
+                    node.location,
+                    format!("{what} has {} axes but {} angles", axes.len(), items.len()),
+                )
+                .with_help("give one angle per axis, in the same order"),
+            );
+            return None;
+        }
+        let angles: Vec<Option<Expr>> = items
+            .iter()
+            .map(|i| cx.expr(i, "a rotation angle"))
+            .collect();
+        angles.into_iter().collect::<Option<_>>()?
+    };
+    let about_parent = match get(f, "about") {
+        None => false,
+        Some(n) => cx.choice(n, "`about`", &[("body", false), ("parent", true)])?,
+    };
+    let mut rotations: Vec<SimpleRotation> = axes
+        .into_iter()
+        .zip(angles)
+        .map(|(axis, angle)| SimpleRotation { axis, angle })
+        .collect();
+    // Rotations about the parent's fixed axes in the order a, b, c give the orientation of
+    // rotations about the newest frame's axes in the order c, b, a.
+    if about_parent {
+        rotations.reverse();
+    }
+    Some(Frame {
+        name: k.clone(),
+        parent,
+        rotations,
+    })
+}
+
+/// `frames:`, each as its successive rotations about the newest frame's axes (a frame written
+/// `about: parent` was read into that order, which gives the same orientation).
+pub(crate) fn write(w: &mut Writer<'_>, frames: &[Frame]) -> Result<(), NotRewritten> {
+    if frames.is_empty() {
+        return Ok(());
+    }
+    w.line("frames:");
+    for frame in frames {
+        let text = frame_text(w, frame)?;
+        w.line(format_args!("  {}: {text}", frame.name.value));
+    }
+    Ok(())
+}
+
+/// `{ parent: P, axis: z, angle: … }`, or `axes:` and `angles:` for several rotations.
+fn frame_text(w: &mut Writer<'_>, frame: &Frame) -> Result<String, NotRewritten> {
+    let place = format!("frame `{}`", frame.name.value);
+    let angles = frame
+        .rotations
+        .iter()
+        .map(|r| w.expr(&r.angle, &place))
+        .collect::<Result<Vec<_>, _>>()?;
+    let axes: String = frame
+        .rotations
+        .iter()
+        .map(|r| r.axis.value.letter())
+        .collect();
+    Ok(match angles.as_slice() {
+        [angle] => format!(
+            "{{ parent: {}, axis: {axes}, angle: {} }}",
+            frame.parent.value,
+            flow(angle)
+        ),
+        _ => format!(
+            "{{ parent: {}, axes: {axes}, angles: {} }}",
+            frame.parent.value,
+            list(&angles)
+        ),
+    })
+}
+
+/// The frames' names are distinct and neither the ground's `N` nor `from` (a point's key),
+/// and each frame's parent is `N` or a frame defined before it, so that the frames form a
+/// tree rooted at the ground.
+pub(crate) fn rules(frames: &[Frame], cx: &mut dyn Rules) {
+    let mut defined: Vec<&str> = vec![GROUND_FRAME];
+    for f in frames {
+        let n = f.name.value.as_str();
+        if n == GROUND_FRAME || n == "from" {
+            let why = if n == "from" {
+                "`from` is the key of a point's start"
+            } else {
+                "`N` is the ground frame"
+            };
+            cx.error(
+                Diagnostic::new(
+                    f.name.location,
+                    format!("frame name `{n}` is reserved: {why}"),
+                )
+                .with_help("choose another name"),
+            );
+            continue;
+        }
+        let p = f.parent.value.as_str();
+        if !defined.contains(&p) {
+            let later = frames.iter().any(|g| g.name.value == p);
+            let d = if later {
+                Diagnostic::new(
+                    f.parent.location,
+                    format!("frame `{n}` is turned from `{p}`, which is not defined before it"),
+                )
+                .with_help(
+                    "define a frame's parent above it (frames form a tree rooted at the ground frame `N`)",
+                )
+            } else {
+                // Listed as everywhere else: the file's frames, then the ground.
+                let mut known = defined[1..].to_vec();
+                known.push(GROUND_FRAME);
+                cx.unknown_frame(&f.parent, &known)
+            };
+            cx.error(d);
+        }
+        if defined.contains(&n) {
+            cx.error(
+                Diagnostic::new(f.name.location, format!("duplicate frame name `{n}`"))
+                    .with_help("rename one"),
+            );
+        }
+        defined.push(n);
+    }
+}
+
+/// The rotation angles are functions of the configuration (no rates).
+pub(crate) fn angle_rules(frames: &[Frame], cx: &mut dyn Rules) {
+    for f in frames {
+        for r in &f.rotations {
+            cx.expression(
+                &r.angle,
+                Depends::Position,
+                &format!("the rotation of frame `{}`", f.name.value),
+            );
+        }
+    }
+}
+
+/// The rotation angles are pure numbers (rad).
+pub(crate) fn units(frames: &[Frame], cx: &mut dyn Units) {
+    for f in frames {
+        for r in &f.rotations {
+            cx.fixed(
+                &r.angle,
+                Dimension::ONE,
+                &format!("the rotation angle of frame `{}`", f.name.value),
+                "an angle",
+                "rad (a pure number)",
+                "a rotation angle is an angle coordinate, or a function of the coordinates that gives a pure number",
+            );
+        }
+    }
+}
+
+/// The frame's rotations as the kinematics engine takes them: per rotation, the axis's index
+/// (0, 1, 2 for x, y, z) and the angle lowered (rad).
+pub(crate) fn lower(f: &Frame, cx: &mut dyn Lower) -> Vec<(usize, ExprId)> {
+    f.rotations
+        .iter()
+        .map(|r| (r.axis.value.index(), cx.expr(&r.angle)))
+        .collect()
+}
+
+/// `omega_<frame>_<axis>`: the name by which expressions read the component of `frame`'s
+/// angular velocity in the ground frame along the axis `axis` (`x`, `y` or `z`), rad/s.
+pub(crate) fn angular_velocity_name(frame: &str, axis: &str) -> String {
+    format!("omega_{frame}_{axis}")
+}
+
+/// The frame of `frames` and the axis that `name` reads if it is an
+/// [`angular_velocity_name`].
+pub(crate) fn angular_velocity_of<'f>(
+    frames: &'f [Frame],
+    name: &str,
+) -> Option<(&'f Frame, Axis)> {
+    let rest = name.strip_prefix("omega_")?;
+    let (frame, axis) = rest.rsplit_once('_')?;
+    let axis = match axis {
+        "x" => Axis::X,
+        "y" => Axis::Y,
+        "z" => Axis::Z,
+        _ => return None,
+    };
+    let frame = frames.iter().find(|f| f.name.value == frame)?;
+    Some((frame, axis))
+}
