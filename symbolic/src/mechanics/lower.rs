@@ -10,10 +10,10 @@ use crate::expr::{Constant, ExprArena, ExprId, Func, SymbolId, SymbolKind};
 use crate::model::ast::{BinOp, Expr, ExprKind};
 use crate::model::checks::FloquetReference;
 use crate::model::diagnostic::Diagnostic;
+use crate::model::diagnostic::short;
 use crate::model::elements::{self, contact::ContactInfo, frame, gravity};
-use crate::model::file::{BodyKind, GROUND_FRAME, ModelFile};
+use crate::model::file::{GROUND_FRAME, ModelFile};
 use crate::model::located::{Located, Location};
-use crate::model::rules::short;
 
 mod bodies;
 mod constraint_rows;
@@ -37,32 +37,7 @@ pub struct ParameterInfo {
     pub symbol: SymbolId,
 }
 
-/// A body of the kinematic form, as expressions.
-#[derive(Debug, Clone, PartialEq)]
-pub struct BodyInfo {
-    /// Name.
-    pub name: String,
-    /// Mass (kg).
-    pub mass: ExprId,
-    /// Index into [`SymbolicModel::points`] of the centre of mass (or the particle).
-    pub com: usize,
-    /// `(centroidal inertia, angle)` of a planar rigid body; `None` for a particle.
-    pub rotation: Option<(ExprId, ExprId)>,
-    /// The orientation and inertia of a 3-D rigid body; `None` for a particle or a planar
-    /// body.
-    pub spatial: Option<SpatialBody>,
-}
-
-/// A 3-D rigid body's frame, angular velocity and inertia, all in the body frame's axes.
-#[derive(Debug, Clone, PartialEq)]
-pub struct SpatialBody {
-    /// Index of its frame in [`SymbolicModel::frames`].
-    pub frame: usize,
-    /// `^N ω^B` (rad/s) in the body frame's components, linear in the rates.
-    pub angular_velocity: Vector3,
-    /// The inertia tensor about the centre of mass (kg·m²): `[xx, yy, zz, xy, yz, xz]`.
-    pub inertia: [ExprId; 6],
-}
+pub use crate::model::elements::body::{BodyInfo, SpatialBody};
 
 /// A load of the kinematic form, kept as a force or torque (not a potential), for the
 /// momentum-balance derivation.
@@ -386,7 +361,8 @@ struct Lowering<'f> {
     points: Points,
     /// Names bound while lowering one expression: an interaction's `r` and `r_dot`.
     locals: Vec<(String, ExprId)>,
-    /// The frames, once lowered with the bodies, for the elements ([`elements::Lower`]).
+    /// The frames, once lowered (before the bodies and the loads), for the elements
+    /// ([`elements::Lower`]).
     frames: Frames,
     /// The bodies, once lowered, for the elements.
     bodies: Vec<BodyInfo>,
@@ -431,9 +407,11 @@ impl<'f> Lowering<'f> {
             .iter()
             .map(|c| c.name.value.clone())
             .collect();
-        let mut frames = self.frames_with_rates();
+        let frames = self.frames_with_rates();
         let points = self.points(&frames);
         self.points = points.clone();
+        // The frames and points as the elements read them (`elements::Lower`).
+        self.frames = frames;
         let dimension = file.dimension.unwrap_or(2);
 
         let mut terms = Terms {
@@ -453,10 +431,10 @@ impl<'f> Lowering<'f> {
             .collect();
         let gravity: Option<Vec<ExprId>> =
             file.gravity.as_ref().map(|g| gravity::lower(g, &mut self));
-        let body_infos = self.bodies(&points, &mut frames, gravity.as_deref(), &mut terms);
+        let body_infos = self.bodies(gravity.as_deref(), &mut terms);
         let mut loads = self.springs(&mut terms);
         loads.extend(self.dampers(&mut terms));
-        self.frames = frames.clone();
+        let frames = self.frames.clone();
         self.bodies = body_infos.clone();
         loads.extend(self.forces(&mut terms));
         loads.extend(self.torques(&mut terms));
@@ -825,6 +803,9 @@ impl elements::Lower for Lowering<'_> {
     }
     fn express(&mut self, v: [ExprId; 3], from: usize, to: usize) -> [ExprId; 3] {
         self.frames.express(&mut self.arena, v, from, to)
+    }
+    fn angular_velocity(&mut self, frame: usize) -> [ExprId; 3] {
+        self.frames.angular_velocity(&mut self.arena, frame)
     }
     fn body_index(&self, name: &str) -> Option<usize> {
         self.bodies.iter().position(|b| b.name == name)

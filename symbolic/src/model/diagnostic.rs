@@ -204,6 +204,17 @@ impl Drop for Diagnostics {
     }
 }
 
+/// A number in a diagnostic: 6 decimals between 1e-3 and 1e6 (trailing zeros dropped, as `1`,
+/// `-0.5`, `0.001235`), 6 significant digits outside (`1.20000e-7`).
+pub(crate) fn short(v: f64) -> String {
+    if v != 0.0 && (v.abs() < 1e-3 || v.abs() >= 1e6) {
+        format!("{v:.5e}")
+    } else {
+        let s = format!("{v:.6}");
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -256,5 +267,23 @@ mod tests {
         );
         assert!(lines[2].contains("…aaa") && lines[2].ends_with("bbb…"));
         assert!(lines[0].contains("aaa…bbb"), "{}", lines[0]);
+    }
+
+    #[test]
+    fn numbers_in_diagnostics_print_short() {
+        for (v, s) in [
+            (0.0, "0"),
+            (1.0, "1"),
+            (-0.5, "-0.5"),
+            (0.001, "0.001"),
+            (0.000_999_9, "9.99900e-4"),
+            (1.2e-7, "1.20000e-7"),
+            (999_999.0, "999999"),
+            (1e6, "1.00000e6"),
+            (-2.5e6, "-2.50000e6"),
+            (1.0 / 3.0, "0.333333"),
+        ] {
+            assert_eq!(short(v), s, "{v}");
+        }
     }
 }

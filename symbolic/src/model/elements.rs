@@ -10,12 +10,13 @@
 //! its `Fields`, the `Writer`), and a new kind is one module plus one line in each stage's
 //! loop and one row in the schema's `SECTIONS`.
 //!
-//! The kinds here: [`frame`] (reference frames), [`contact`] (unilateral contacts) and its
-//! [`support`] (a change of support), [`spring`], [`damper`], [`force`], [`torque`],
-//! [`interaction`] and [`gravity`]. The older kinds (bodies, constraints, the written
-//! energies) are still spread over the stage files; ARCHITECTURE.md's recipe says how a kind
-//! moves here.
+//! The kinds here: [`frame`] (reference frames), [`body`] (particles, planar and 3-D rigid
+//! bodies), [`contact`] (unilateral contacts) and its [`support`] (a change of support),
+//! [`spring`], [`damper`], [`force`], [`torque`], [`interaction`] and [`gravity`]. The older
+//! kinds (constraints, the written energies) are still spread over the stage files;
+//! ARCHITECTURE.md's recipe says how a kind moves here.
 
+pub mod body;
 pub mod contact;
 pub mod damper;
 pub mod force;
@@ -189,6 +190,9 @@ pub(crate) trait Lower {
     /// The vector of components `v` in the frame of index `from` as components in the frame
     /// of index `to`.
     fn express(&mut self, v: [ExprId; 3], from: usize, to: usize) -> [ExprId; 3];
+    /// `^N ω^F`, the angular velocity of the frame of index `frame` in the ground frame, in
+    /// the components of `frame` itself (rad/s), linear in the rates.
+    fn angular_velocity(&mut self, frame: usize) -> [ExprId; 3];
     /// The index of the body `name` among the model's bodies.
     fn body_index(&self, name: &str) -> Option<usize>;
     /// The angle `θ` of the planar rigid body `name`; `None` if it is not one.

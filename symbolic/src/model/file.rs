@@ -4,6 +4,7 @@
 //! `file:line:col`. Maps of the YAML file keep file order (vectors here).
 
 use super::ast::Expr;
+pub use super::elements::body::{Body, BodyKind, InertiaTensor};
 pub use super::elements::contact::{Contact, Gap};
 pub use super::elements::damper::Damper;
 pub use super::elements::force::Force;
@@ -165,85 +166,6 @@ impl RollingContact {
             })
             .collect()
     }
-}
-
-/// A 3-D inertia tensor about a body's centre of mass in the body's frame (kg·m²): the
-/// moments `xx, yy, zz` and the tensor's off-diagonal entries `xy, yz, xz` (which are the
-/// negatives of the products of inertia `∫xy dm`); absent entries are 0.
-#[derive(Debug, Clone, PartialEq)]
-pub struct InertiaTensor {
-    /// `[xx, yy, zz, xy, yz, xz]`; `None` for an entry not written (0).
-    pub entries: [Option<Expr>; 6],
-    /// Where the inertia is written.
-    pub location: Location,
-}
-
-impl InertiaTensor {
-    /// The names of the entries, in [`InertiaTensor::entries`]'s order.
-    pub const KEYS: [&'static str; 6] = ["xx", "yy", "zz", "xy", "yz", "xz"];
-}
-
-/// What kind of body.
-#[derive(Debug, Clone, PartialEq)]
-pub enum BodyKind {
-    /// A point mass at `at`: `{ mass: m, at: P }`.
-    Particle {
-        /// Mass (kg).
-        mass: Expr,
-        /// The point where the mass sits.
-        at: Located<String>,
-    },
-    /// A planar rigid body: `{ mass: m, inertia: I_G, com: G, angle: theta }`.
-    Rigid {
-        /// Mass (kg).
-        mass: Expr,
-        /// Centroidal moment of inertia about the axis normal to the plane (kg·m²).
-        inertia: Expr,
-        /// Centre-of-mass point.
-        com: Located<String>,
-        /// Orientation angle (rad), counter-clockwise; an expression in `q` and `t`.
-        angle: Expr,
-    },
-    /// A rigid body in 3-D: `{ mass: m, com: G, frame: B, inertia: [I1, I2, I3] }`.
-    Spatial {
-        /// Mass (kg).
-        mass: Expr,
-        /// Centre-of-mass point.
-        com: Located<String>,
-        /// The frame fixed in the body.
-        frame: Located<String>,
-        /// Inertia tensor about the centre of mass, in the body frame's axes (boxed: six
-        /// expressions would make every body as large).
-        inertia: Box<InertiaTensor>,
-    },
-}
-
-impl BodyKind {
-    /// The body's mass.
-    pub fn mass(&self) -> &Expr {
-        match self {
-            BodyKind::Particle { mass, .. }
-            | BodyKind::Rigid { mass, .. }
-            | BodyKind::Spatial { mass, .. } => mass,
-        }
-    }
-
-    /// The point of its mass: `at` of a particle, `com` of a rigid body.
-    pub fn com(&self) -> &Located<String> {
-        match self {
-            BodyKind::Particle { at, .. } => at,
-            BodyKind::Rigid { com, .. } | BodyKind::Spatial { com, .. } => com,
-        }
-    }
-}
-
-/// A body of the kinematic form.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Body {
-    /// Name.
-    pub name: Located<String>,
-    /// Particle or planar rigid body.
-    pub kind: BodyKind,
 }
 
 /// One `outputs:` entry: a named expression of the state evaluated along a simulation,

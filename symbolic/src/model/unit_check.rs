@@ -32,7 +32,7 @@ use std::collections::HashMap;
 
 use super::ast::{BinOp, Expr, ExprKind};
 use super::diagnostic::Diagnostic;
-use super::file::{BalanceKind, BodyKind, InertiaTensor, ModelFile};
+use super::file::{BalanceKind, ModelFile};
 use super::located::Location;
 use super::parser::identifiers;
 use super::units::{Dimension, Rational, parse_unit};

@@ -2,7 +2,7 @@
 //! functions of points, and the dimensions of vectors.
 
 use super::*;
-use crate::model::elements::{frame, gravity};
+use crate::model::elements::{body, frame, gravity};
 
 impl Checker<'_> {
     // Rule: every name in an expression is a parameter or `pi`, and where the expression may
@@ -44,54 +44,7 @@ impl Checker<'_> {
         }
         frame::angle_rules(&file.frames, self);
         self.vectors = true;
-        for b in &file.bodies {
-            let name = &b.name.value;
-            match &b.kind {
-                BodyKind::Particle { mass, .. } => {
-                    self.resolve(
-                        mass,
-                        Depends::Constant,
-                        &format!("the mass of body `{name}`"),
-                    );
-                }
-                BodyKind::Rigid {
-                    mass,
-                    inertia,
-                    angle,
-                    ..
-                } => {
-                    self.resolve(
-                        mass,
-                        Depends::Constant,
-                        &format!("the mass of body `{name}`"),
-                    );
-                    self.resolve(
-                        inertia,
-                        Depends::Constant,
-                        &format!("the inertia of body `{name}`"),
-                    );
-                    self.resolve(
-                        angle,
-                        Depends::Position,
-                        &format!("the angle of body `{name}`"),
-                    );
-                }
-                BodyKind::Spatial { mass, inertia, .. } => {
-                    self.resolve(
-                        mass,
-                        Depends::Constant,
-                        &format!("the mass of body `{name}`"),
-                    );
-                    for e in inertia.entries.iter().flatten() {
-                        self.resolve(
-                            e,
-                            Depends::Constant,
-                            &format!("the inertia of body `{name}`"),
-                        );
-                    }
-                }
-            }
-        }
+        body::expression_rules(&file.bodies, self);
         if let Some(g) = &file.gravity {
             gravity::rules(g, self);
         }

@@ -1,7 +1,7 @@
 //! The frames of a model file and the frames and points that other sections name.
 
 use super::*;
-use crate::model::elements::frame;
+use crate::model::elements::{body, frame};
 
 impl Checker<'_> {
     // Rule: frames have distinct names other than the ground `N` and `from`; each frame's
@@ -12,11 +12,7 @@ impl Checker<'_> {
         frame::rules(&file.frames, self);
         let frames = frame_names(file);
         self.point_origins(&frames);
-        for b in &file.bodies {
-            if let BodyKind::Spatial { frame, .. } = &b.kind {
-                self.frame(frame, &frames);
-            }
-        }
+        body::frame_rules(&file.bodies, self);
         for w in &file.draw.wheels {
             self.point(&w.centre);
             self.frame(&w.frame, &frames);

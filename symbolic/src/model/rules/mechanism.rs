@@ -2,6 +2,7 @@
 //! inertias, and rolling contacts (interactions: `model/elements/interaction.rs`).
 
 use super::*;
+use crate::model::elements::body;
 
 impl Checker<'_> {
     // Rule: constraints have distinct names; holonomic ones depend on q and t, non-holonomic
@@ -322,36 +323,10 @@ impl Checker<'_> {
         }
     }
 
-    // Rule: a body's mass is positive and its inertia non-negative, when they are constant
-    // expressions of the parameters (evaluated at the defaults).
+    // Rule: a body's mass is positive and its inertia a physical body's, when they are
+    // constant expressions of the parameters (evaluated at the defaults).
     pub(super) fn masses(&mut self) {
-        let file = self.file;
-        for b in &file.bodies {
-            let (mass, inertia) = match &b.kind {
-                BodyKind::Particle { mass, .. } => (mass, None),
-                BodyKind::Rigid { mass, inertia, .. } => (mass, Some(inertia)),
-                BodyKind::Spatial { mass, inertia, .. } => {
-                    self.inertia_tensor(&b.name.value, inertia);
-                    (mass, None)
-                }
-            };
-            if let Some(problem) =
-                evaluate(mass, &file.parameters).and_then(|m| mass_problem(&b.name.value, m))
-            {
-                self.error(
-                    Diagnostic::new(mass.location, problem)
-                        .with_help("a mass must be positive (at the parameters' defaults)"),
-                );
-            }
-            if let Some(inertia) = inertia
-                && let Some(problem) = evaluate(inertia, &file.parameters)
-                    .and_then(|i| planar_inertia_problem(&b.name.value, i))
-            {
-                self.error(Diagnostic::new(inertia.location, problem).with_help(
-                    "a centroidal moment of inertia is ≥ 0 (at the parameters' defaults)",
-                ));
-            }
-        }
+        body::value_rules(&self.file.bodies, self);
     }
 
     /// Reports a rolling contact whose body is not a rigid body, whose point is unknown, or
@@ -414,55 +389,6 @@ impl Checker<'_> {
                     );
                 }
             }
-        }
-    }
-
-    /// Reports a 3-D inertia tensor that is not positive definite at the parameters'
-    /// defaults (Sylvester's criterion on its leading minors), or whose principal moments
-    /// break the triangle inequality `I₃ ≤ I₁ + I₂`, which every mass distribution satisfies.
-    /// (Symmetric it is by construction: each off-diagonal entry is written once.)
-    fn inertia_tensor(&mut self, body: &str, inertia: &InertiaTensor) {
-        let parameters = &self.file.parameters;
-        let mut e = [0.0; 6];
-        for ((slot, entry), name) in e
-            .iter_mut()
-            .zip(&inertia.entries)
-            .zip(["xx", "yy", "zz", "xy", "yz", "xz"])
-        {
-            if let Some(x) = entry {
-                match evaluate(x, parameters) {
-                    Some(v) if v.is_finite() => *slot = v,
-                    Some(v) => {
-                        self.error(
-                            Diagnostic::new(
-                                inertia.location,
-                                format!(
-                                    "the inertia of body `{body}` is not finite: its entry {name} is {v} at the parameters' defaults"
-                                ),
-                            )
-                            .with_help("each entry of an inertia tensor is a finite number of kg·m² (check the parameters it is written with: a 0/0, a root of a negative number)"),
-                        );
-                        return;
-                    }
-                    None => return,
-                }
-            }
-        }
-        if let Some(problem) = inertia_problem(body, e) {
-            let at = "at the parameters' defaults";
-            let diagnostic = match problem {
-                InertiaProblem::NotPositiveDefinite(message) => Diagnostic::new(
-                    inertia.location,
-                    format!("{message} {at}"),
-                )
-                .with_help("a rigid body's inertia tensor about its centre of mass is positive definite (its three principal moments are positive); a moment ≤ 0, or an off-diagonal entry as large as the moments it joins, is not"),
-                InertiaProblem::NotARigidBody(message) => Diagnostic::new(
-                    inertia.location,
-                    format!("{message} {at}"),
-                )
-                .with_help("no mass distribution has one principal moment larger than the sum of the other two (in principal axes, I₃ = ∫(x² + y²) dm ≤ ∫(y² + z²) dm + ∫(x² + z²) dm = I₁ + I₂; equal for a flat body); check the moments and their axes"),
-            };
-            self.error(diagnostic);
         }
     }
 }

@@ -2,46 +2,7 @@
 
 use super::*;
 
-/// The principal moments against diagonal tensors and a rotated one: `diag(1, 2, 3)`
-/// rotated by 30° about `z` (`xx = 1.25`, `yy = 1.75`, `xy = 0.25·√3 · (−1)`) keeps its
-/// eigenvalues 1, 2, 3 to 1e-14.
-#[test]
-fn principal_moments_are_the_eigenvalues() {
-    assert_eq!(
-        principal_moments([3.0, 1.0, 2.0, 0.0, 0.0, 0.0]),
-        [1.0, 2.0, 3.0]
-    );
-    let (c, s) = (30f64.to_radians().cos(), 30f64.to_radians().sin());
-    let (xx, yy, xy) = (
-        c * c + 2.0 * s * s,
-        s * s + 2.0 * c * c,
-        (1.0 - 2.0) * c * s,
-    );
-    let e = principal_moments([xx, yy, 3.0, xy, 0.0, 0.0]);
-    for (got, want) in e.iter().zip([1.0, 2.0, 3.0]) {
-        assert!((got - want).abs() < 1e-14, "{e:?}");
-    }
-}
-
 use crate::model::{schema, yaml};
-
-#[test]
-fn numbers_in_diagnostics_print_short() {
-    for (v, s) in [
-        (0.0, "0"),
-        (1.0, "1"),
-        (-0.5, "-0.5"),
-        (0.001, "0.001"),
-        (0.000_999_9, "9.99900e-4"),
-        (1.2e-7, "1.20000e-7"),
-        (999_999.0, "999999"),
-        (1e6, "1.00000e6"),
-        (-2.5e6, "-2.50000e6"),
-        (1.0 / 3.0, "0.333333"),
-    ] {
-        assert_eq!(short(v), s, "{v}");
-    }
-}
 
 fn errors(src: &str) -> Vec<String> {
     let root = yaml::parse(src).unwrap();

@@ -592,3 +592,22 @@ fn axes_list(axes: &[Axis]) -> String {
     let letters: Vec<String> = axes.iter().map(|a| a.letter().to_string()).collect();
     format!("[{}]", letters.join(", "))
 }
+
+/// The text of a wheel, in a point's entry and in `draw: wheels:`.
+impl Writer<'_> {
+    /// `{ centre: G, frame: R, axle: y, radius: r }`.
+    pub(super) fn wheel_text(
+        &mut self,
+        wheel: &WheelContact,
+        place: &str,
+    ) -> Result<String, NotRewritten> {
+        let radius = self.expr(&wheel.radius, place)?;
+        Ok(format!(
+            "{{ centre: {}, frame: {}, axle: {}, radius: {} }}",
+            wheel.centre.value,
+            wheel.frame.value,
+            wheel.axle.value.letter(),
+            flow(&radius)
+        ))
+    }
+}

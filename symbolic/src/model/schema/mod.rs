@@ -15,7 +15,6 @@
 //! The same table writes a [`ModelFile`] back as text ([`write_file`]): each section's
 //! writer sits beside its reader, and `reduce` writes its results through it.
 
-mod bodies;
 mod checks;
 pub(crate) mod entries;
 mod floquet;
@@ -39,7 +38,7 @@ use super::file::*;
 use super::located::{Located, Location};
 use super::parser::{closest, eval_expr, identifiers, parse_expr_mapped};
 use super::yaml::{YamlKind, YamlNode, char_locations_in_lines, trailing_comment_of_line};
-use entries::{Entries, get, get_key, misspelt};
+use entries::{Entries, get, misspelt};
 
 /// Expressions by name, in file order.
 type KeyedExprs = Vec<(Located<String>, Expr)>;

@@ -5,7 +5,9 @@
 use super::walk::{Fields, Keyed, Need};
 use super::write::{Edits, NotRewritten, Rewrite, Writer, scalar};
 use super::*;
-use crate::model::elements::{contact, damper, force, frame, gravity, interaction, spring, torque};
+use crate::model::elements::{
+    body, contact, damper, force, frame, gravity, interaction, spring, torque,
+};
 
 /// How one top-level key of a model file is read, and written.
 struct Section {
@@ -131,10 +133,10 @@ const SECTIONS: &[Section] = &[
         write: |w, file| w.write_points(file),
     },
     Section {
-        key: "bodies",
-        read: |cx, n, file| file.bodies = cx.bodies(n),
+        key: body::KEY,
+        read: |cx, n, file| file.bodies = body::read(cx, n),
         missing: None,
-        write: |w, file| w.write_bodies(file),
+        write: |w, file| body::write(w, &file.bodies),
     },
     Section {
         key: gravity::KEY,

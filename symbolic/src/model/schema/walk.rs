@@ -164,7 +164,7 @@ impl Ctx<'_> {
     }
 
     /// Reports every key of `entries` that is not in `allowed`.
-    pub(super) fn unknown_keys(
+    pub(crate) fn unknown_keys(
         &mut self,
         entries: &Entries,
         what: &str,
@@ -215,7 +215,7 @@ impl Ctx<'_> {
     }
 
     /// The entries of the map `node` (none for an empty value); reports anything else.
-    pub(super) fn map<'n>(
+    pub(crate) fn map<'n>(
         &mut self,
         node: &'n YamlNode,
         what: &str,

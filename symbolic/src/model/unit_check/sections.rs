@@ -2,7 +2,7 @@
 //! events, outputs and `checks:`, walked in file order.
 
 use super::*;
-use crate::model::elements::{self, frame, gravity};
+use crate::model::elements::{self, body, frame, gravity};
 
 impl Checker<'_> {
     /// Checks `e` against the unit its key requires; a value written with numbers only is
@@ -164,59 +164,7 @@ impl Checker<'_> {
             }
         }
         frame::units(&file.frames, self);
-        for b in &file.bodies {
-            let name = &b.name.value;
-            let (mass, inertia_angle) = match &b.kind {
-                BodyKind::Particle { mass, .. } => (mass, None),
-                BodyKind::Spatial { mass, inertia, .. } => {
-                    for (key, e) in InertiaTensor::KEYS.iter().zip(&inertia.entries) {
-                        if let Some(e) = e {
-                            self.fixed(
-                                e,
-                                Dimension::INERTIA,
-                                &format!("the `{key}` inertia of body `{name}`"),
-                                "a moment of inertia",
-                                "kg*m^2",
-                                "an entry of an inertia tensor is mass × length², as in `m*r^2/2` for a disc about its axis",
-                            );
-                        }
-                    }
-                    (mass, None)
-                }
-                BodyKind::Rigid {
-                    mass,
-                    inertia,
-                    angle,
-                    ..
-                } => (mass, Some((inertia, angle))),
-            };
-            self.fixed(
-                mass,
-                Dimension::KILOGRAM,
-                &format!("the mass of body `{name}`"),
-                "a mass",
-                "kg",
-                "a body's mass is in kg",
-            );
-            if let Some((inertia, angle)) = inertia_angle {
-                self.fixed(
-                    inertia,
-                    Dimension::INERTIA,
-                    &format!("the inertia of body `{name}`"),
-                    "a moment of inertia",
-                    "kg*m^2",
-                    "a moment of inertia is mass × length², as in `m*l^2/12` for a uniform bar about its centre",
-                );
-                self.fixed(
-                    angle,
-                    Dimension::ONE,
-                    &format!("the angle of body `{name}`"),
-                    "an angle",
-                    "rad (a pure number)",
-                    "a body's angle is an angle coordinate, or a function of the coordinates that gives a pure number",
-                );
-            }
-        }
+        body::units(&file.bodies, self);
         if let Some(g) = &file.gravity {
             gravity::units(g, self);
         }
