@@ -12,13 +12,14 @@
 //!
 //! The kinds here: [`frame`] (reference frames), [`body`] (particles, planar and 3-D rigid
 //! bodies), [`contact`] (unilateral contacts) and its [`support`] (a change of support),
-//! [`spring`], [`damper`], [`force`], [`torque`], [`interaction`] and [`gravity`]. The older
-//! kinds (constraints, the written energies) are still spread over the stage files;
+//! [`spring`], [`damper`], [`force`], [`torque`], [`interaction`], [`gravity`] and the
+//! written [`energy`]. The constraints are still spread over the stage files;
 //! ARCHITECTURE.md's recipe says how a kind moves here.
 
 pub mod body;
 pub mod contact;
 pub mod damper;
+pub mod energy;
 pub mod force;
 pub mod frame;
 pub mod gravity;
@@ -164,6 +165,9 @@ pub(crate) trait Units {
         want_text: &str,
         help: &str,
     );
+    /// Checks that `q` has the dimension of a generalized force of the coordinate `name`: J
+    /// per the coordinate's unit (N for a length, N·m for an angle).
+    fn generalized_force(&mut self, name: &Located<String>, q: &Expr);
     /// From `on` until it is called with `false`, `r` and `r_dot` are an interaction's
     /// distance (m) and its rate (m/s).
     fn distance(&mut self, on: bool);

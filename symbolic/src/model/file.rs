@@ -404,6 +404,16 @@ pub struct ModelFile {
 }
 
 impl ModelFile {
+    /// The energy form as written: `kinetic:` (J), `potential:` (J) and `generalized_forces:`
+    /// by coordinate name.
+    pub fn written_energies(&self) -> super::elements::energy::Written<'_> {
+        (
+            self.kinetic.as_ref(),
+            self.potential.as_ref(),
+            &self.generalized_forces,
+        )
+    }
+
     /// The frame and axis that `name` reads if it is `omega_<frame>_<axis>`, the component
     /// of the frame's angular velocity in the ground frame along its own axis (rad/s), with
     /// `<frame>` one of [`Self::frames`].

@@ -2,29 +2,17 @@
 //! and `V`.
 
 use super::*;
+use crate::model::elements::energy;
 
 impl Lowering<'_> {
-    /// The energies and generalized forces written as such (`kinetic:`, `potential:`,
-    /// `generalized_forces:`).
+    /// The energies and generalized forces written as such (`elements::energy`).
     pub(super) fn energies_written(&mut self, terms: &mut Terms, coordinate_names: &[String]) {
         let file = self.file;
-        if let Some(k) = &file.kinetic {
-            let e = self.expr(k);
-            terms.kinetic.push(e);
-        }
-        if let Some(v) = &file.potential {
-            let e = self.expr(v);
-            terms.potential.push(e);
-        }
-        for (name, q) in &file.generalized_forces {
-            let e = self.expr(q);
-            match coordinate_names.iter().position(|c| *c == name.value) {
-                Some(i) => terms.forces[i].push(e),
-                None => self.errors.push(Diagnostic::new(
-                    name.location,
-                    format!("`{}` is not a coordinate", name.value),
-                )),
-            }
+        let lowered = energy::lower(file.written_energies(), coordinate_names, self);
+        terms.kinetic.extend(lowered.kinetic);
+        terms.potential.extend(lowered.potential);
+        for (i, q) in lowered.forces {
+            terms.forces[i].push(q);
         }
     }
 

@@ -2,7 +2,7 @@
 //! functions of points, and the dimensions of vectors.
 
 use super::*;
-use crate::model::elements::{body, frame, gravity};
+use crate::model::elements::{body, energy, frame, gravity};
 
 impl Checker<'_> {
     // Rule: every name in an expression is a parameter or `pi`, and where the expression may
@@ -18,19 +18,7 @@ impl Checker<'_> {
     // order, as unit_check's `walk`; split by section it would only be a longer list.
     pub(super) fn expressions(&mut self) {
         let file = self.file;
-        if let Some(k) = &file.kinetic {
-            self.resolve(k, Depends::Motion, "`kinetic`");
-        }
-        if let Some(v) = &file.potential {
-            self.resolve(v, Depends::Position, "`potential`");
-        }
-        for (k, q) in &file.generalized_forces {
-            self.resolve(
-                q,
-                Depends::Motion,
-                &format!("the generalized force `{}`", k.value),
-            );
-        }
+        energy::rules(file.written_energies(), self);
         self.vectors = false;
         for p in &file.points {
             let relative = p.relative.iter().flat_map(|r| &r.vectors);

@@ -6,7 +6,7 @@ use super::walk::{Fields, Keyed, Need};
 use super::write::{Edits, NotRewritten, Rewrite, Writer, scalar};
 use super::*;
 use crate::model::elements::{
-    body, contact, damper, force, frame, gravity, interaction, spring, torque,
+    body, contact, damper, energy, force, frame, gravity, interaction, spring, torque,
 };
 
 /// How one top-level key of a model file is read, and written.
@@ -96,29 +96,22 @@ const SECTIONS: &[Section] = &[
         write: |w, file| w.write_coordinates(file),
     },
     Section {
-        key: "kinetic",
-        read: |cx, n, file| file.kinetic = cx.expr(n, "`kinetic`"),
+        key: energy::KINETIC,
+        read: |cx, n, file| file.kinetic = energy::read_energy(cx, n, energy::KINETIC),
         missing: None,
-        write: |w, file| w.write_kinetic(file),
+        write: |w, file| energy::write_energy(w, energy::KINETIC, file.kinetic.as_ref()),
     },
     Section {
-        key: "potential",
-        read: |cx, n, file| file.potential = cx.expr(n, "`potential`"),
+        key: energy::POTENTIAL,
+        read: |cx, n, file| file.potential = energy::read_energy(cx, n, energy::POTENTIAL),
         missing: None,
-        write: |w, file| w.write_potential(file),
+        write: |w, file| energy::write_energy(w, energy::POTENTIAL, file.potential.as_ref()),
     },
     Section {
-        key: "generalized_forces",
-        read: |cx, n, file| {
-            file.generalized_forces = cx.keyed_exprs(
-                n,
-                "`generalized_forces`",
-                "generalized_forces: { x: -c*x_dot }",
-                "a generalized force",
-            );
-        },
+        key: energy::GENERALIZED_FORCES,
+        read: |cx, n, file| file.generalized_forces = energy::read_generalized_forces(cx, n),
         missing: None,
-        write: |w, file| w.write_generalized_forces(file),
+        write: |w, file| energy::write_generalized_forces(w, &file.generalized_forces),
     },
     Section {
         key: frame::KEY,
@@ -602,7 +595,7 @@ impl Ctx<'_> {
 
     /// A map of names to expressions (`generalized_forces`, `constraints`, `nonholonomic`):
     /// `what` names it and `example` writes it in messages, `item` names one value.
-    pub(super) fn keyed_exprs(
+    pub(crate) fn keyed_exprs(
         &mut self,
         node: &YamlNode,
         what: &str,
@@ -738,49 +731,6 @@ impl Writer<'_> {
                     self.line(format_args!("  - {}  # {}", c.name.value, comment.trim()));
                 }
                 (None, None) => self.line(format_args!("  - {}", c.name.value)),
-            }
-        }
-        Ok(())
-    }
-
-    /// `kinetic:`.
-    fn write_kinetic(&mut self, file: &ModelFile) -> Result<(), NotRewritten> {
-        if let Some(t) = &file.kinetic {
-            let t = self.expr(t, "`kinetic:`")?;
-            self.line(format_args!("kinetic: {}", scalar(&t)));
-        }
-        Ok(())
-    }
-
-    /// `potential:`.
-    fn write_potential(&mut self, file: &ModelFile) -> Result<(), NotRewritten> {
-        if let Some(v) = &file.potential {
-            let v = self.expr(v, "`potential:`")?;
-            self.line(format_args!("potential: {}", scalar(&v)));
-        }
-        Ok(())
-    }
-
-    /// `generalized_forces:`, as the transformer gives them, else each rewritten.
-    fn write_generalized_forces(&mut self, file: &ModelFile) -> Result<(), NotRewritten> {
-        if file.generalized_forces.is_empty() {
-            return Ok(());
-        }
-        let forces = match self.rewritten_generalized_forces()? {
-            Some(forces) => forces,
-            None => {
-                let mut forces = Vec::new();
-                for (name, e) in &file.generalized_forces {
-                    let place = format!("generalized force `{}`", name.value);
-                    forces.push((name.value.clone(), self.expr(e, &place)?));
-                }
-                forces
-            }
-        };
-        if !forces.is_empty() {
-            self.line("generalized_forces:");
-            for (k, q) in forces {
-                self.line(format_args!("  {k}: {}", scalar(&q)));
             }
         }
         Ok(())

@@ -2,7 +2,8 @@
 //! events, outputs and `checks:`, walked in file order.
 
 use super::*;
-use crate::model::elements::{self, body, frame, gravity};
+use crate::model::elements::{self, body, energy, frame, gravity};
+use crate::model::located::Located;
 
 impl Checker<'_> {
     /// Checks `e` against the unit its key requires; a value written with numbers only is
@@ -93,50 +94,7 @@ impl Checker<'_> {
     // passes rely on this one order; split by section it would only be a longer list.
     pub(super) fn walk(&mut self) {
         let file = self.file;
-        let j = Dimension::JOULE;
-        if let Some(k) = &file.kinetic {
-            self.fixed(
-                k,
-                j,
-                "`kinetic`",
-                "an energy",
-                "J",
-                "kinetic energy is mass × speed² / 2, kg*(m/s)^2 = J: check the powers of the rates and the units of the parameters",
-            );
-        }
-        if let Some(v) = &file.potential {
-            self.fixed(
-                v,
-                j,
-                "`potential`",
-                "an energy",
-                "J",
-                "potential energy is force × length, N*m = J, as in `m*g*h` or `k*x^2/2`",
-            );
-        }
-        for (k, q) in &file.generalized_forces {
-            let Some(coordinate) = self.motion(&k.value).flatten() else {
-                self.homogeneous(q, &format!("the generalized force of `{}`", k.value));
-                continue;
-            };
-            let want = Dim::of(j).div(&coordinate);
-            let (name, at) = (k.value.clone(), q.location);
-            let what = format!("the generalized force of `{name}`");
-            self.key(q, want, &what, |got, want| {
-                Diagnostic::new(
-                    at,
-                    format!(
-                        "{what} is {}, but `{name}` is {}, so it must be {}",
-                        show(got),
-                        show_coordinate(j.checked_div(want).unwrap_or(Dimension::ONE)),
-                        show_load(want)
-                    ),
-                )
-                .with_help(format!(
-                    "the virtual work `Q δ{name}` is an energy (J), so a generalized force is J per unit of its coordinate: N for a length, N*m for an angle"
-                ))
-            });
-        }
+        energy::units(file.written_energies(), self);
         for p in &file.points {
             let relative = p.relative.iter().flat_map(|r| &r.vectors);
             let in_frames = relative.flat_map(|(_, v)| AXES.iter().zip(v));
@@ -337,6 +295,30 @@ impl elements::Units for Checker<'_> {
         help: &str,
     ) {
         Checker::fixed(self, e, want, what, kind, want_text, help);
+    }
+    fn generalized_force(&mut self, k: &Located<String>, q: &Expr) {
+        let j = Dimension::JOULE;
+        let Some(coordinate) = self.motion(&k.value).flatten() else {
+            self.homogeneous(q, &format!("the generalized force of `{}`", k.value));
+            return;
+        };
+        let want = Dim::of(j).div(&coordinate);
+        let (name, at) = (k.value.clone(), q.location);
+        let what = format!("the generalized force of `{name}`");
+        self.key(q, want, &what, |got, want| {
+            Diagnostic::new(
+                at,
+                format!(
+                    "{what} is {}, but `{name}` is {}, so it must be {}",
+                    show(got),
+                    show_coordinate(j.checked_div(want).unwrap_or(Dimension::ONE)),
+                    show_load(want)
+                ),
+            )
+            .with_help(format!(
+                "the virtual work `Q δ{name}` is an energy (J), so a generalized force is J per unit of its coordinate: N for a length, N*m for an angle"
+            ))
+        });
     }
     fn distance(&mut self, on: bool) {
         self.interaction = on;
