@@ -13,10 +13,12 @@
 //! The kinds here: [`frame`] (reference frames), [`body`] (particles, planar and 3-D rigid
 //! bodies), [`contact`] (unilateral contacts) and its [`support`] (a change of support),
 //! [`spring`], [`damper`], [`force`], [`torque`], [`interaction`], [`gravity`] and the
-//! written [`energy`]. The constraints are still spread over the stage files;
-//! ARCHITECTURE.md's recipe says how a kind moves here.
+//! written [`energy`], and the holonomic [`constraint`]s. The non-holonomic constraints and
+//! rolling contacts are still spread over the stage files; ARCHITECTURE.md's recipe says how
+//! a kind moves here.
 
 pub mod body;
+pub mod constraint;
 pub mod contact;
 pub mod damper;
 pub mod energy;
@@ -141,8 +143,8 @@ pub(crate) trait Rules {
     /// The value of `e` with the parameters at their defaults; `None` if it is not constant
     /// or names what is not known (reported by [`Rules::expression`]).
     fn value(&self, e: &Expr) -> Option<f64>;
-    /// The spatial dimension of the model's points (2 or 3).
-    fn dimension(&self) -> usize;
+    /// The spatial dimension of the model's points (2 or 3); `None` when it has none.
+    fn dimension(&self) -> Option<usize>;
     /// The model's coordinates, in file order.
     fn coordinates(&self) -> Vec<String>;
     /// Whether the section `key` was left incomplete by an error already reported (so what

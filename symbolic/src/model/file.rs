@@ -5,6 +5,7 @@
 
 use super::ast::Expr;
 pub use super::elements::body::{Body, BodyKind, InertiaTensor};
+pub use super::elements::constraint::PointConstraint;
 pub use super::elements::contact::{Contact, Gap};
 pub use super::elements::damper::Damper;
 pub use super::elements::force::Force;
@@ -119,21 +120,6 @@ pub struct RollingContact {
     /// The axes along which the contact point's velocity vanishes.
     pub along: Vec<Located<Axis>>,
     /// The frame of the axes; `None`: the ground frame.
-    pub frame: Option<Located<String>>,
-}
-
-/// A holonomic constraint on a point, `constraints: { on_ground: { point: C, along: z, in: N } }`:
-/// the point's position along the axis `along` of frame `in` (the ground frame if not given)
-/// is 0 — a contact point kept on the ground plane.
-#[derive(Debug, Clone, PartialEq)]
-pub struct PointConstraint {
-    /// The constraint's name.
-    pub name: Located<String>,
-    /// The point.
-    pub point: Located<String>,
-    /// The axis.
-    pub along: Located<Axis>,
-    /// The frame of the axis; `None`: the ground frame.
     pub frame: Option<Located<String>>,
 }
 

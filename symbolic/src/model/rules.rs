@@ -254,8 +254,8 @@ impl elements::Rules for Checker<'_> {
     fn value(&self, e: &Expr) -> Option<f64> {
         evaluate(e, &self.file.parameters)
     }
-    fn dimension(&self) -> usize {
-        self.file.dimension.unwrap_or(2)
+    fn dimension(&self) -> Option<usize> {
+        self.file.dimension
     }
     fn coordinates(&self) -> Vec<String> {
         (self.file.coordinates.iter())

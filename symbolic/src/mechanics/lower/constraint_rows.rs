@@ -2,6 +2,7 @@
 //! they are independent, linear in the rates and workless.
 
 use super::*;
+use crate::model::elements::constraint;
 
 impl Lowering<'_> {
     /// Lowers `constraints:` and `nonholonomic:`, differentiates them, and reports a
@@ -14,12 +15,7 @@ impl Lowering<'_> {
         kinematics: Kinematics<'_>,
     ) -> ConstraintEquations {
         let before = self.errors.len();
-        let mut holonomic: Vec<(String, ExprId)> = file
-            .constraints
-            .iter()
-            .map(|(k, e)| (k.value.clone(), self.expr(e)))
-            .collect();
-        self.point_constraint_rows(file, &kinematics, &mut holonomic);
+        let holonomic = constraint::rows(&file.constraints, &file.point_constraints, self);
         let mut nonholonomic: Vec<(String, ExprId)> = file
             .nonholonomic
             .iter()
@@ -50,48 +46,6 @@ impl Lowering<'_> {
         let samples = self.jacobian_samples(&eqs, parameters);
         self.report_dependent_rows(file, &eqs, parameters, &samples);
         eqs
-    }
-
-    /// The rows of the constraints on points (`{ point: C, along: z, in: N }`): the point's
-    /// position along the axis, appended to `holonomic` in file order.
-    fn point_constraint_rows(
-        &mut self,
-        file: &ModelFile,
-        kinematics: &Kinematics<'_>,
-        holonomic: &mut Vec<(String, ExprId)>,
-    ) {
-        for c in &file.point_constraints {
-            let (Some(p), Some(frame)) = (
-                point(kinematics.points, &c.point.value),
-                match &c.frame {
-                    Some(f) => kinematics.frames.index(&f.value),
-                    None => Some(0),
-                },
-            ) else {
-                self.errors.push(Diagnostic::new(
-                    c.name.location,
-                    format!(
-                        "constraint `{}` names an unknown point or frame",
-                        c.name.value
-                    ),
-                ));
-                continue;
-            };
-            let r = kinematics.points[p].1.clone();
-            let (zero, one) = (self.arena.int(0), self.arena.int(1));
-            let mut e = vec![zero; r.len()];
-            if let Some(slot) = e.get_mut(c.along.value.index()) {
-                *slot = one;
-            }
-            if r.len() == 3 {
-                e = kinematics
-                    .frames
-                    .express(&mut self.arena, [e[0], e[1], e[2]], frame, 0)
-                    .to_vec();
-            }
-            let phi = self.dot(&r, &e);
-            holonomic.push((c.name.value.clone(), phi));
-        }
     }
 
     /// The constraint Jacobian `J` evaluated at up to six random configurations where it is

@@ -237,7 +237,7 @@ impl Contact {
                     Diagnostic::new(mu.location, format!("{what}, but a written gap has no direction of slip"))
                         .with_help("write the contact as a point and its surface (`point: P, above: { normal: [0, 1] }`), whose slip is along the surface, or leave `friction` out"),
                 );
-            } else if cx.dimension() != 2 {
+            } else if cx.dimension().unwrap_or(2) != 2 {
                 cx.error(
                     Diagnostic::new(mu.location, format!("{what}, but friction is taken in the plane only: a contact in 3-D slips in two directions, which the impact law does not take yet"))
                         .with_help("leave `friction` out of a contact between 3-D points"),
@@ -287,7 +287,7 @@ impl Contact {
         cx.expression(&disc.radius, Depends::Constant, &what("radius"));
         positive_radius(cx, &disc.radius, &what("radius"));
         cx.expression(&disc.angle, Depends::Position, &what("angle"));
-        if cx.dimension() != 2 {
+        if cx.dimension().unwrap_or(2) != 2 {
             cx.error(
                 Diagnostic::new(disc.angle.location, format!("contact `{}` is a disc, but a disc rolls in the plane only", self.name.value))
                     .with_help("a body rolling in 3-D touches the plane at a point that moves over its surface: write it as a rolling constraint (`constraints:`), or the contact as a point above the plane"),
@@ -329,7 +329,7 @@ impl Contact {
         for c in &v.value {
             cx.expression(c, Depends::Position, what);
         }
-        let dimension = cx.dimension();
+        let dimension = cx.dimension().unwrap_or(2);
         if v.value.len() != dimension {
             cx.error(
                 Diagnostic::new(

@@ -142,7 +142,7 @@ impl Support {
         restitution: Option<f64>,
     ) {
         let what = format!("contact `{contact}` changes the support");
-        if cx.dimension() != 2 {
+        if cx.dimension().unwrap_or(2) != 2 {
             cx.error(
                 Diagnostic::new(
                     self.at,

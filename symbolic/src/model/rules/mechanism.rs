@@ -2,7 +2,7 @@
 //! inertias, and rolling contacts (interactions: `model/elements/interaction.rs`).
 
 use super::*;
-use crate::model::elements::body;
+use crate::model::elements::{body, constraint};
 
 impl Checker<'_> {
     // Rule: constraints have distinct names; holonomic ones depend on q and t, non-holonomic
@@ -10,9 +10,7 @@ impl Checker<'_> {
     // coordinates (not rates) of a model that has constraints.
     pub(super) fn constraints(&mut self) {
         let file = self.file;
-        for (k, e) in &file.constraints {
-            self.resolve(e, Depends::Position, &format!("constraint `{}`", k.value));
-        }
+        constraint::expression_rules(&file.constraints, self);
         for (k, e) in &file.nonholonomic {
             self.resolve(e, Depends::Motion, &format!("constraint `{}`", k.value));
         }
@@ -31,43 +29,7 @@ impl Checker<'_> {
         for r in &file.rolling {
             self.rolling_contact(r);
         }
-        for c in &file.point_constraints {
-            self.point(&c.point);
-            if file.dimension == Some(2) {
-                if let Some(frame) = &c.frame {
-                    self.error(
-                        Diagnostic::new(
-                            frame.location,
-                            format!(
-                                "constraint `{}` is in a planar model, which has no frames",
-                                c.name.value
-                            ),
-                        )
-                        .with_help("leave out `in`: the axes are the plane's x and y"),
-                    );
-                }
-                if c.along.value == Axis::Z {
-                    self.error(
-                        Diagnostic::new(
-                            c.along.location,
-                            format!(
-                                "constraint `{}` is planar, so it has no `z` axis",
-                                c.name.value
-                            ),
-                        )
-                        .with_help("in a planar model `along` is `x` or `y`"),
-                    );
-                }
-            } else if let Some(frame) = &c.frame {
-                let frames: Vec<&str> = file
-                    .frames
-                    .iter()
-                    .map(|f| f.name.value.as_str())
-                    .chain([GROUND_FRAME])
-                    .collect();
-                self.frame(frame, &frames);
-            }
-        }
+        constraint::point_rules(&file.point_constraints, self);
         let m = names.len();
         let n = file.coordinates.len();
         if m > n && !self.incomplete.has_section("coordinates") {

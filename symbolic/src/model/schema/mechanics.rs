@@ -3,7 +3,7 @@
 //! interactions: their modules in `model/elements/`).
 
 use super::walk::{Fields, Keyed, Need};
-use super::write::{NotRewritten, Writer, flow, list, scalar};
+use super::write::{NotRewritten, Writer, flow, list};
 use super::*;
 use crate::model::elements::in_frame;
 
@@ -21,17 +21,6 @@ const ROLLING: Fields = Fields {
         ("in", Need::Optional),
     ],
     example: "{ body: wheel, point: C, along: [x, y], in: N }",
-};
-
-/// The keys of a constraint on a point.
-const POINT_CONSTRAINT: Fields = Fields {
-    kind: "constraint on a point",
-    keys: &[
-        ("point", Need::Required),
-        ("along", Need::Required),
-        ("in", Need::Optional),
-    ],
-    example: "{ point: C, along: z, in: N }",
 };
 
 /// The keys of a wheel's contact point.
@@ -167,48 +156,6 @@ impl Ctx<'_> {
             return None;
         }
         complete.then_some(RelativePosition { from, vectors })
-    }
-
-    /// `constraints:` — `name: Φ(q, t)` (an expression), or a point kept on a plane
-    /// `name: { point, along, in }`.
-    pub(super) fn holonomic(
-        &mut self,
-        node: &YamlNode,
-    ) -> (Vec<(Located<String>, Expr)>, Vec<PointConstraint>) {
-        let spec = Keyed {
-            what: "`constraints`",
-            example: "constraints: { rod: sqrt(x^2 + y^2) - l }",
-            names: None,
-            drop: false,
-        };
-        let mut on_points = Vec::new();
-        let expressions = self.keyed(node, spec, |cx, k, v| {
-            if matches!(v.kind, YamlKind::Map(_)) {
-                if let Some(c) = cx.point_constraint(k, v) {
-                    on_points.push(c);
-                }
-                return None;
-            }
-            cx.expr(v, "a holonomic constraint").map(|e| (k.clone(), e))
-        });
-        (expressions, on_points)
-    }
-
-    /// A constraint on a point: `{ point: C, along: z, in: N }`.
-    fn point_constraint(&mut self, k: &Located<String>, v: &YamlNode) -> Option<PointConstraint> {
-        let f = self.fields(k, v, &POINT_CONSTRAINT)?;
-        let point = get(f, "point").and_then(|n| self.name(n, "`point`"));
-        let along = get(f, "along").and_then(|n| self.axes(n, true).and_then(|mut a| a.pop()));
-        let frame = match get(f, "in") {
-            Some(n) => Some(Some(self.name(n, "`in`")?)),
-            None => Some(None),
-        };
-        Some(PointConstraint {
-            name: k.clone(),
-            point: point?,
-            along: along?,
-            frame: frame?,
-        })
     }
 
     /// A wheel's contact point: `{ centre, frame, axle, radius }`.
@@ -514,41 +461,6 @@ impl Writer<'_> {
                 "`balances:` left out: the reduced model is derived by Lagrange's equations"
                     .to_string(),
             );
-        }
-        Ok(())
-    }
-
-    /// `constraints:` (expressions, then constraints on points) of a file written as it is;
-    /// the eliminations noted otherwise.
-    pub(super) fn write_constraints(&mut self, file: &ModelFile) -> Result<(), NotRewritten> {
-        if !self.preserve() {
-            let eliminated: Vec<String> = self
-                .edits
-                .eliminated
-                .iter()
-                .map(|(constraint, coordinate)| format!("`{constraint}` gives {coordinate}"))
-                .collect();
-            self.notes.push(format!(
-                "`constraints:` eliminated: {}",
-                eliminated.join(", ")
-            ));
-            return Ok(());
-        }
-        if file.constraints.is_empty() && file.point_constraints.is_empty() {
-            return Ok(());
-        }
-        self.line("constraints:");
-        for (name, e) in &file.constraints {
-            self.line(format_args!("  {}: {}", name.value, scalar(&e.to_string())));
-        }
-        for c in &file.point_constraints {
-            self.line(format_args!(
-                "  {}: {{ point: {}, along: {}{} }}",
-                c.name.value,
-                c.point.value,
-                c.along.value.letter(),
-                in_frame(c.frame.as_ref())
-            ));
         }
         Ok(())
     }

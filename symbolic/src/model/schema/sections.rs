@@ -6,7 +6,7 @@ use super::walk::{Fields, Keyed, Need};
 use super::write::{Edits, NotRewritten, Rewrite, Writer, scalar};
 use super::*;
 use crate::model::elements::{
-    body, contact, damper, energy, force, frame, gravity, interaction, spring, torque,
+    body, constraint, contact, damper, energy, force, frame, gravity, interaction, spring, torque,
 };
 
 /// How one top-level key of a model file is read, and written.
@@ -180,10 +180,10 @@ const SECTIONS: &[Section] = &[
         write: |w, file| w.write_balances(file),
     },
     Section {
-        key: "constraints",
-        read: |cx, n, file| (file.constraints, file.point_constraints) = cx.holonomic(n),
+        key: constraint::KEY,
+        read: |cx, n, file| (file.constraints, file.point_constraints) = constraint::read(cx, n),
         missing: None,
-        write: |w, file| w.write_constraints(file),
+        write: |w, file| constraint::write(w, &file.constraints, &file.point_constraints),
     },
     Section {
         key: "nonholonomic",
