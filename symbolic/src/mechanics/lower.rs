@@ -444,12 +444,7 @@ impl<'f> Lowering<'f> {
         let balance_sets = balance_sets(self.file);
         let hand_equations = self.hand_equations();
 
-        let kinematics = Kinematics {
-            points: &points,
-            bodies: &body_infos,
-            frames: &frames,
-        };
-        let constraints = self.constraints(file, &parameters, kinematics);
+        let constraints = self.constraints(file, &parameters);
         if !file.events.is_empty() {
             for (i, name) in constraints.names.iter().enumerate() {
                 self.arena
@@ -810,6 +805,9 @@ impl elements::Lower for Lowering<'_> {
     fn body_index(&self, name: &str) -> Option<usize> {
         self.bodies.iter().position(|b| b.name == name)
     }
+    fn body_centre(&self, name: &str) -> Option<usize> {
+        self.bodies.iter().find(|b| b.name == name).map(|b| b.com)
+    }
     fn planar_angle(&self, name: &str) -> Option<ExprId> {
         let body = self.bodies.iter().find(|b| b.name == name)?;
         body.rotation.map(|(_, angle)| angle)
@@ -844,14 +842,6 @@ struct Terms {
     forces: Vec<Vec<ExprId>>,
     /// The constant ½.
     half: ExprId,
-}
-
-/// What a rolling contact reads of the lowered model: the points, the bodies and the frames.
-#[derive(Clone, Copy)]
-struct Kinematics<'a> {
-    points: &'a Points,
-    bodies: &'a [BodyInfo],
-    frames: &'a Frames,
 }
 
 /// The sets of the file's `balances:` with their ranges in the lowered list: each set's

@@ -13,9 +13,8 @@
 //! The kinds here: [`frame`] (reference frames), [`body`] (particles, planar and 3-D rigid
 //! bodies), [`contact`] (unilateral contacts) and its [`support`] (a change of support),
 //! [`spring`], [`damper`], [`force`], [`torque`], [`interaction`], [`gravity`] and the
-//! written [`energy`], and the holonomic [`constraint`]s. The non-holonomic constraints and
-//! rolling contacts are still spread over the stage files; ARCHITECTURE.md's recipe says how
-//! a kind moves here.
+//! written [`energy`], the holonomic [`constraint`]s and the [`nonholonomic`] ones with the
+//! rolling contacts. ARCHITECTURE.md's recipe says how a kind is added.
 
 pub mod body;
 pub mod constraint;
@@ -26,6 +25,7 @@ pub mod force;
 pub mod frame;
 pub mod gravity;
 pub mod interaction;
+pub mod nonholonomic;
 pub mod spring;
 pub mod support;
 pub mod torque;
@@ -201,6 +201,9 @@ pub(crate) trait Lower {
     fn angular_velocity(&mut self, frame: usize) -> [ExprId; 3];
     /// The index of the body `name` among the model's bodies.
     fn body_index(&self, name: &str) -> Option<usize>;
+    /// The index of the point at the centre of mass of the body `name` (a particle's own
+    /// point); `None` if there is no such body.
+    fn body_centre(&self, name: &str) -> Option<usize>;
     /// The angle `θ` of the planar rigid body `name`; `None` if it is not one.
     fn planar_angle(&self, name: &str) -> Option<ExprId>;
     /// The index, the frame's index and the angular velocity (in the body frame's
@@ -234,6 +237,94 @@ pub(crate) fn between(
     };
     let (ra, rb) = (cx.point_at(a), cx.point_at(b));
     Some(([a, b], difference(cx.arena(), &ra, &rb)))
+}
+
+/// The expressions of a section of constraints, by name, in file order.
+pub type Expressions = Vec<(Located<String>, Expr)>;
+
+/// A section of constraints whose entries are expressions or maps of one kind
+/// (`constraints:`, `nonholonomic:`): `name: e` (`item` names it in messages), or
+/// `name: { … }` read by `map`; the expressions and what `map` read, each in file order.
+pub(crate) fn read_expressions_or<T>(
+    cx: &mut Ctx<'_>,
+    node: &YamlNode,
+    (what, example, item): (&str, &str, &str),
+    mut map: impl FnMut(&mut Ctx<'_>, &Located<String>, &YamlNode) -> Option<T>,
+) -> (Expressions, Vec<T>) {
+    let spec = Keyed {
+        what,
+        example,
+        names: None,
+        drop: false,
+    };
+    let mut maps = Vec::new();
+    let expressions = cx.keyed(node, spec, |cx, k, v| {
+        if matches!(v.kind, crate::model::yaml::YamlKind::Map(_)) {
+            if let Some(m) = map(cx, k, v) {
+                maps.push(m);
+            }
+            return None;
+        }
+        cx.expr(v, item).map(|e| (k.clone(), e))
+    });
+    (expressions, maps)
+}
+
+/// The axes of a constraint on a point or a rolling contact (`what`, as "constraint
+/// `floor`"): in a planar model it has no frame `in:` and no `z` axis (`along_help` says
+/// what `along` is there), in 3-D its frame is one of the model's.
+pub(crate) fn axes_rules(
+    what: &str,
+    (frame, along): (Option<&Located<String>>, &[Located<Axis>]),
+    along_help: &str,
+    cx: &mut dyn Rules,
+) {
+    if cx.dimension() != Some(2) {
+        if let Some(frame) = frame {
+            cx.frame(frame);
+        }
+        return;
+    }
+    if let Some(frame) = frame {
+        cx.error(
+            Diagnostic::new(
+                frame.location,
+                format!("{what} is in a planar model, which has no frames"),
+            )
+            .with_help("leave out `in`: the axes are the plane's x and y"),
+        );
+    }
+    for a in along.iter().filter(|a| a.value == Axis::Z) {
+        cx.error(
+            Diagnostic::new(
+                a.location,
+                format!("{what} is planar, so it has no `z` axis"),
+            )
+            .with_help(along_help),
+        );
+    }
+}
+
+/// Constraints written as expressions depend on no more than `depends`.
+pub(crate) fn expression_rules(
+    expressions: &[(Located<String>, Expr)],
+    depends: Depends,
+    cx: &mut dyn Rules,
+) {
+    for (k, e) in expressions {
+        cx.expression(e, depends, &format!("constraint `{}`", k.value));
+    }
+}
+
+/// Constraints written as expressions, lowered, by name in file order.
+pub(crate) fn expression_rows(
+    expressions: &[(Located<String>, Expr)],
+    cx: &mut dyn Lower,
+) -> Vec<(String, ExprId)> {
+    expressions
+        .iter()
+        .map(|(k, e)| (k.value.clone(), cx.expr(e)))
+        .collect()
 }
 
 /// A load between two points with one expression, as read: its name, its points and the

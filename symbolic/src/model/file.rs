@@ -10,6 +10,7 @@ pub use super::elements::contact::{Contact, Gap};
 pub use super::elements::damper::Damper;
 pub use super::elements::force::Force;
 pub use super::elements::interaction::{INTERACTION_NAMES, Interaction};
+pub use super::elements::nonholonomic::RollingContact;
 pub use super::elements::spring::Spring;
 pub use super::elements::torque::{Torque, TorqueValue};
 // The `checks:` and `floquet:` types live in `checks.rs`; they are named here too, where
@@ -104,25 +105,6 @@ pub struct RelativePosition {
 pub use super::elements::frame::{Frame, SimpleRotation};
 pub use super::elements::{Axis, GROUND_FRAME};
 
-/// Rolling without slip, `nonholonomic: { roll: { body: wheel, point: C, along: [x, y], in: N } }`:
-/// the velocity of the material point of `body` that is at `point`,
-/// `v_G + ω × (r_C − r_G)`, has no component along the axes `along` of frame `in` (the
-/// ground frame if not given). One constraint per axis, named `roll_x`, `roll_y`, … after the
-/// entry and the axis, after the constraints written as expressions.
-#[derive(Debug, Clone, PartialEq)]
-pub struct RollingContact {
-    /// The entry's name (the constraints are `<name>_<axis>`).
-    pub name: Located<String>,
-    /// The rigid body that rolls (planar or 3-D).
-    pub body: Located<String>,
-    /// The point of contact (a point of `points:`).
-    pub point: Located<String>,
-    /// The axes along which the contact point's velocity vanishes.
-    pub along: Vec<Located<Axis>>,
-    /// The frame of the axes; `None`: the ground frame.
-    pub frame: Option<Located<String>>,
-}
-
 /// A wheel's contact point, `points: { C: { wheel: { centre: F, frame: H, axle: y, radius: r } } }`:
 /// the point of the circle of radius `radius` about `centre`, in the plane normal to the axis
 /// `axle` of `frame`, that is lowest (farthest along the ground frame's `−z`) — where a
@@ -137,21 +119,6 @@ pub struct WheelContact {
     pub axle: Located<Axis>,
     /// The radius (m), a constant expression.
     pub radius: Expr,
-}
-
-impl RollingContact {
-    /// The names of its constraints, `<name>_<axis>`, located at the entry.
-    pub fn constraint_names(&self) -> Vec<Located<String>> {
-        self.along
-            .iter()
-            .map(|a| {
-                Located::new(
-                    format!("{}_{}", self.name.value, a.value.letter()),
-                    self.name.location,
-                )
-            })
-            .collect()
-    }
 }
 
 /// One `outputs:` entry: a named expression of the state evaluated along a simulation,

@@ -9,9 +9,7 @@ use rustc_hash::FxHashSet;
 use super::ast::{Expr, FUNCTIONS};
 use super::diagnostic::{Diagnostic, Diagnostics};
 use super::elements::{self, Depends};
-use super::file::{
-    Axis, BalanceKind, BodyKind, GROUND_FRAME, ModelFile, Parameter, RollingContact,
-};
+use super::file::{BalanceKind, BodyKind, GROUND_FRAME, ModelFile, Parameter};
 use super::located::{Located, Location};
 use super::parser::{closest, eval_expr, identifiers};
 use super::schema::{self, Incomplete, UNRAW_KEYWORDS};

@@ -2,7 +2,7 @@
 //! they are independent, linear in the rates and workless.
 
 use super::*;
-use crate::model::elements::constraint;
+use crate::model::elements::{constraint, nonholonomic};
 
 impl Lowering<'_> {
     /// Lowers `constraints:` and `nonholonomic:`, differentiates them, and reports a
@@ -12,18 +12,10 @@ impl Lowering<'_> {
         &mut self,
         file: &ModelFile,
         parameters: &[ParameterInfo],
-        kinematics: Kinematics<'_>,
     ) -> ConstraintEquations {
         let before = self.errors.len();
         let holonomic = constraint::rows(&file.constraints, &file.point_constraints, self);
-        let mut nonholonomic: Vec<(String, ExprId)> = file
-            .nonholonomic
-            .iter()
-            .map(|(k, e)| (k.value.clone(), self.expr(e)))
-            .collect();
-        for r in &file.rolling {
-            nonholonomic.extend(self.rolling_contact(r, kinematics));
-        }
+        let nonholonomic = nonholonomic::rows(&file.nonholonomic, &file.rolling, self);
         if holonomic.is_empty() && nonholonomic.is_empty() {
             return ConstraintEquations::default();
         }

@@ -10,17 +10,21 @@
 //! Each gives one row of `Φ`; the mechanics differentiates them into the constraint Jacobian
 //! `J = ∂Φ/∂q` and `γ`, solves for the multipliers `λ` (named `lambda_<constraint>`) and
 //! checks that the rows are independent. The expressions come first, then the constraints on
-//! points, both in file order.
+//! points, both in file order. Their units are checked with the other constraints' by the unit
+//! check (unit_check/sections.rs), which gives each multiplier its unit from its row's.
 
-use super::{Axis, Depends, Lower, Rules, dot, in_frame};
+use super::{
+    Axis, Depends, Expressions, Lower, Rules, axes_rules, dot, expression_rows, in_frame,
+    read_expressions_or,
+};
 use crate::expr::ExprId;
 use crate::model::ast::Expr;
 use crate::model::diagnostic::Diagnostic;
 use crate::model::located::Located;
 use crate::model::schema::entries::get;
-use crate::model::schema::walk::{Ctx, Fields, Keyed, Need};
+use crate::model::schema::walk::{Ctx, Fields, Need};
 use crate::model::schema::write::{NotRewritten, Writer, scalar};
-use crate::model::yaml::{YamlKind, YamlNode};
+use crate::model::yaml::YamlNode;
 
 /// The key of the section.
 pub(crate) const KEY: &str = "constraints";
@@ -40,9 +44,6 @@ pub struct PointConstraint {
     pub frame: Option<Located<String>>,
 }
 
-/// The constraints written as expressions, by name, in file order.
-pub type Expressions = Vec<(Located<String>, Expr)>;
-
 /// The keys of a constraint on a point.
 const POINT_FIELDS: Fields = Fields {
     kind: "constraint on a point",
@@ -57,23 +58,12 @@ const POINT_FIELDS: Fields = Fields {
 /// `constraints:` — `name: Φ(q, t)` (an expression), or a point kept on a plane
 /// `name: { point, along, in }`.
 pub(crate) fn read(cx: &mut Ctx<'_>, node: &YamlNode) -> (Expressions, Vec<PointConstraint>) {
-    let spec = Keyed {
-        what: "`constraints`",
-        example: "constraints: { rod: sqrt(x^2 + y^2) - l }",
-        names: None,
-        drop: false,
-    };
-    let mut on_points = Vec::new();
-    let expressions = cx.keyed(node, spec, |cx, k, v| {
-        if matches!(v.kind, YamlKind::Map(_)) {
-            if let Some(c) = read_point(cx, k, v) {
-                on_points.push(c);
-            }
-            return None;
-        }
-        cx.expr(v, "a holonomic constraint").map(|e| (k.clone(), e))
-    });
-    (expressions, on_points)
+    let what = (
+        "`constraints`",
+        "constraints: { rod: sqrt(x^2 + y^2) - l }",
+        "a holonomic constraint",
+    );
+    read_expressions_or(cx, node, what, read_point)
 }
 
 /// A constraint on a point: `{ point: C, along: z, in: N }`.
@@ -134,9 +124,7 @@ pub(crate) fn write(
 
 /// The expressions depend on the configuration and `t` only.
 pub(crate) fn expression_rules(expressions: &[(Located<String>, Expr)], cx: &mut dyn Rules) {
-    for (k, e) in expressions {
-        cx.expression(e, Depends::Position, &format!("constraint `{}`", k.value));
-    }
+    super::expression_rules(expressions, Depends::Position, cx);
 }
 
 /// A constraint on a point names a point of the model; in a planar model it has no frame and
@@ -144,34 +132,12 @@ pub(crate) fn expression_rules(expressions: &[(Located<String>, Expr)], cx: &mut
 pub(crate) fn point_rules(on_points: &[PointConstraint], cx: &mut dyn Rules) {
     for c in on_points {
         cx.point(&c.point);
-        if cx.dimension() == Some(2) {
-            if let Some(frame) = &c.frame {
-                cx.error(
-                    Diagnostic::new(
-                        frame.location,
-                        format!(
-                            "constraint `{}` is in a planar model, which has no frames",
-                            c.name.value
-                        ),
-                    )
-                    .with_help("leave out `in`: the axes are the plane's x and y"),
-                );
-            }
-            if c.along.value == Axis::Z {
-                cx.error(
-                    Diagnostic::new(
-                        c.along.location,
-                        format!(
-                            "constraint `{}` is planar, so it has no `z` axis",
-                            c.name.value
-                        ),
-                    )
-                    .with_help("in a planar model `along` is `x` or `y`"),
-                );
-            }
-        } else if let Some(frame) = &c.frame {
-            cx.frame(frame);
-        }
+        axes_rules(
+            &format!("constraint `{}`", c.name.value),
+            (c.frame.as_ref(), std::slice::from_ref(&c.along)),
+            "in a planar model `along` is `x` or `y`",
+            cx,
+        );
     }
 }
 
@@ -184,10 +150,7 @@ pub(crate) fn rows(
     on_points: &[PointConstraint],
     cx: &mut dyn Lower,
 ) -> Vec<(String, ExprId)> {
-    let mut rows: Vec<(String, ExprId)> = expressions
-        .iter()
-        .map(|(k, e)| (k.value.clone(), cx.expr(e)))
-        .collect();
+    let mut rows = expression_rows(expressions, cx);
     for c in on_points {
         let (Some(p), Some(frame)) = (
             cx.point_index(&c.point.value),

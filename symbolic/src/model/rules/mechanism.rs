@@ -2,7 +2,7 @@
 //! inertias, and rolling contacts (interactions: `model/elements/interaction.rs`).
 
 use super::*;
-use crate::model::elements::{body, constraint};
+use crate::model::elements::{body, constraint, nonholonomic};
 
 impl Checker<'_> {
     // Rule: constraints have distinct names; holonomic ones depend on q and t, non-holonomic
@@ -11,9 +11,7 @@ impl Checker<'_> {
     pub(super) fn constraints(&mut self) {
         let file = self.file;
         constraint::expression_rules(&file.constraints, self);
-        for (k, e) in &file.nonholonomic {
-            self.resolve(e, Depends::Motion, &format!("constraint `{}`", k.value));
-        }
+        nonholonomic::expression_rules(&file.nonholonomic, self);
         let names = file.constraint_names();
         let mut seen: Vec<(&str, Location)> = Vec::new();
         for k in &names {
@@ -26,9 +24,7 @@ impl Checker<'_> {
                 seen.push((&k.value, k.location));
             }
         }
-        for r in &file.rolling {
-            self.rolling_contact(r);
-        }
+        nonholonomic::rolling_rules(&file.rolling, self);
         constraint::point_rules(&file.point_constraints, self);
         let m = names.len();
         let n = file.coordinates.len();
@@ -289,68 +285,5 @@ impl Checker<'_> {
     // constant expressions of the parameters (evaluated at the defaults).
     pub(super) fn masses(&mut self) {
         body::value_rules(&self.file.bodies, self);
-    }
-
-    /// Reports a rolling contact whose body is not a rigid body, whose point is unknown, or
-    /// whose frame is unknown or given in a planar model, and an axis `z` in a planar one.
-    fn rolling_contact(&mut self, r: &RollingContact) {
-        let file = self.file;
-        self.point(&r.point);
-        match file.bodies.iter().find(|b| b.name.value == r.body.value) {
-            Some(b) if matches!(b.kind, BodyKind::Particle { .. }) => self.error(
-                Diagnostic::new(r.body.location, format!("rolling contact `{}` names `{}`, which is a particle", r.name.value, r.body.value))
-                    .with_help("a body rolls about its centre of mass: name a rigid body (planar with `angle`, 3-D with `frame`)"),
-            ),
-            Some(_) => {}
-            None if self.incomplete.has_name(&r.body.value)
-                || self.section_lost("bodies", file.bodies.is_empty()) => {}
-            None => {
-                let d = Diagnostic::new(r.body.location, format!("unknown body `{}`", r.body.value));
-                let d = match closest(&r.body.value, &self.bodies) {
-                    Some(c) => d.with_help(format!("did you mean `{c}`?")),
-                    None => d.with_help("declare it under `bodies:` as a rigid body"),
-                };
-                self.error(d);
-            }
-        }
-        let planar = file.dimension == Some(2);
-        if let Some(frame) = &r.frame {
-            if planar {
-                self.error(
-                    Diagnostic::new(
-                        frame.location,
-                        format!(
-                            "rolling contact `{}` is in a planar model, which has no frames",
-                            r.name.value
-                        ),
-                    )
-                    .with_help("leave out `in`: the axes are the plane's x and y"),
-                );
-            } else {
-                let frames: Vec<&str> = file
-                    .frames
-                    .iter()
-                    .map(|f| f.name.value.as_str())
-                    .chain([GROUND_FRAME])
-                    .collect();
-                self.frame(frame, &frames);
-            }
-        }
-        if planar {
-            for a in &r.along {
-                if a.value == Axis::Z {
-                    self.error(
-                        Diagnostic::new(
-                            a.location,
-                            format!(
-                                "rolling contact `{}` is planar, so it has no `z` axis",
-                                r.name.value
-                            ),
-                        )
-                        .with_help("in a planar model `along` lists `x` and `y`"),
-                    );
-                }
-            }
-        }
     }
 }

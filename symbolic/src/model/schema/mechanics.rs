@@ -5,23 +5,10 @@
 use super::walk::{Fields, Keyed, Need};
 use super::write::{NotRewritten, Writer, flow, list};
 use super::*;
-use crate::model::elements::in_frame;
 
 /// The names of the other derivations that `eomgen check` lists beside a named set of
 /// balances, which a set may not take.
 const RESERVED_SET_NAMES: [&str; 5] = ["lagrange", "momentum", "by_hand", "energy", "power"];
-
-/// The keys of a rolling contact.
-const ROLLING: Fields = Fields {
-    kind: "rolling contact",
-    keys: &[
-        ("body", Need::Required),
-        ("point", Need::Required),
-        ("along", Need::Required),
-        ("in", Need::Optional),
-    ],
-    example: "{ body: wheel, point: C, along: [x, y], in: N }",
-};
 
 /// The keys of a wheel's contact point.
 const WHEEL: Fields = Fields {
@@ -174,68 +161,6 @@ impl Ctx<'_> {
             frame: frame?,
             axle: axle?,
             radius: radius?,
-        })
-    }
-
-    /// `nonholonomic:` — `name: A(q, t) q̇ + b(q, t)` (an expression), or a rolling contact
-    /// `name: { body, point, along, in }`.
-    pub(super) fn nonholonomic(
-        &mut self,
-        node: &YamlNode,
-    ) -> (Vec<(Located<String>, Expr)>, Vec<RollingContact>) {
-        let spec = Keyed {
-            what: "`nonholonomic`",
-            example: "nonholonomic: { no_side_slip: -sin(theta)*x_dot + cos(theta)*y_dot }",
-            names: None,
-            drop: false,
-        };
-        let mut rolling = Vec::new();
-        let expressions = self.keyed(node, spec, |cx, k, v| {
-            if matches!(v.kind, YamlKind::Map(_)) {
-                if let Some(r) = cx.rolling_contact(k, v) {
-                    rolling.push(r);
-                }
-                return None;
-            }
-            cx.expr(v, "a non-holonomic constraint")
-                .map(|e| (k.clone(), e))
-        });
-        (expressions, rolling)
-    }
-
-    /// A rolling contact: `{ body, point, along: [x, y], in: N }`.
-    fn rolling_contact(&mut self, k: &Located<String>, v: &YamlNode) -> Option<RollingContact> {
-        let f = self.fields(k, v, &ROLLING)?;
-        let body = get(f, "body").and_then(|n| self.name(n, "`body`"));
-        let point = get(f, "point").and_then(|n| self.name(n, "`point`"));
-        let frame = match get(f, "in") {
-            Some(n) => Some(Some(self.name(n, "`in`")?)),
-            None => Some(None),
-        };
-        let along = get(f, "along").and_then(|n| {
-            let items = self.seq(n, "`along`", "along: [x, y]")?;
-            let axes: Option<Vec<Located<Axis>>> = items
-                .iter()
-                .map(|i| self.axes(i, true).and_then(|mut a| a.pop()))
-                .collect();
-            match axes {
-                Some(a) if !a.is_empty() => Some(a),
-                Some(_) => {
-                    self.error(
-                        Diagnostic::new(n.location, "`along` names no axis")
-                            .with_help("list the axes along which the contact point does not slip, as in `along: [x, y]`"),
-                    );
-                    None
-                }
-                None => None,
-            }
-        });
-        Some(RollingContact {
-            name: k.clone(),
-            body: body?,
-            point: point?,
-            along: along?,
-            frame: frame?,
         })
     }
 
@@ -464,45 +389,6 @@ impl Writer<'_> {
         }
         Ok(())
     }
-
-    /// `nonholonomic:` of a file written as it is: the constraints written as expressions,
-    /// then the rolling contacts.
-    pub(super) fn write_nonholonomic(&mut self, file: &ModelFile) -> Result<(), NotRewritten> {
-        if !self.preserve() || (file.nonholonomic.is_empty() && file.rolling.is_empty()) {
-            return Ok(());
-        }
-        self.line("nonholonomic:");
-        for (name, e) in &file.nonholonomic {
-            let place = format!("non-holonomic constraint `{}`", name.value);
-            let text = self.expr(e, &place)?;
-            self.line(format_args!("  {}: {}", name.value, flow(&text)));
-        }
-        for RollingContact {
-            name,
-            body,
-            point,
-            along,
-            frame,
-        } in &file.rolling
-        {
-            let axes: Vec<Axis> = along.iter().map(|a| a.value).collect();
-            self.line(format_args!(
-                "  {}: {{ body: {}, point: {}, along: {}{} }}",
-                name.value,
-                body.value,
-                point.value,
-                axes_list(&axes),
-                in_frame(frame.as_ref())
-            ));
-        }
-        Ok(())
-    }
-}
-
-/// `[x, y]` of axes.
-fn axes_list(axes: &[Axis]) -> String {
-    let letters: Vec<String> = axes.iter().map(|a| a.letter().to_string()).collect();
-    format!("[{}]", letters.join(", "))
 }
 
 /// The text of a wheel, in a point's entry and in `draw: wheels:`.

@@ -6,7 +6,8 @@ use super::walk::{Fields, Keyed, Need};
 use super::write::{Edits, NotRewritten, Rewrite, Writer, scalar};
 use super::*;
 use crate::model::elements::{
-    body, constraint, contact, damper, energy, force, frame, gravity, interaction, spring, torque,
+    body, constraint, contact, damper, energy, force, frame, gravity, interaction, nonholonomic,
+    spring, torque,
 };
 
 /// How one top-level key of a model file is read, and written.
@@ -186,10 +187,10 @@ const SECTIONS: &[Section] = &[
         write: |w, file| constraint::write(w, &file.constraints, &file.point_constraints),
     },
     Section {
-        key: "nonholonomic",
-        read: |cx, n, file| (file.nonholonomic, file.rolling) = cx.nonholonomic(n),
+        key: nonholonomic::KEY,
+        read: |cx, n, file| (file.nonholonomic, file.rolling) = nonholonomic::read(cx, n),
         missing: None,
-        write: |w, file| w.write_nonholonomic(file),
+        write: |w, file| nonholonomic::write(w, &file.nonholonomic, &file.rolling),
     },
     Section {
         key: contact::KEY,
