@@ -89,7 +89,7 @@ impl Checker<'_> {
     }
 
     /// Both passes visit every expression of the file in the same order.
-    // Long: one piece (about 200 lines): a list, one call per place in the file where an
+    // Long: one piece (about 100 lines): a list, one call per place in the file where an
     // expression stands, with the dimension it must have and how the message names it. Both
     // passes rely on this one order; split by section it would only be a longer list.
     pub(super) fn walk(&mut self) {
