@@ -3,8 +3,9 @@
 //! An element module owns everything about one kind of entry of a model file: its typed
 //! form, how it is read and written (side by side), its rules, its equations of dimension
 //! under `units: SI`, its kinematics, and what it gives the derivations and the description.
-//! It names none of the stages. Each stage hands it a context through one of the traits
-//! below, which the stage implements (`Rules` by the rules pass, `Units` by the unit check,
+//! It names none of the stages (it may use the kinematics engine's pure helpers,
+//! `mechanics::frames::{cross, tensor_times}`). Each stage hands it a context through one of
+//! the traits below, which the stage implements (`Rules` by the rules pass, `Units` by the unit check,
 //! `Lower` by the lowering in `mechanics`). So an element sits below the stages that
 //! iterate over it and above the scaffolds it reads and writes with (the schema's `Ctx`,
 //! its `Fields`, the `Writer`), and a new kind is one module plus one line in each stage's

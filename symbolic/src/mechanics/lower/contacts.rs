@@ -1,5 +1,5 @@
-//! The lowering of wheel contacts (`points:` on a rolling wheel) and of rolling contacts
-//! (`nonholonomic:` entries), with what they draw.
+//! The lowering of wheel contacts (`points:` on a rolling wheel), with what they draw (rolling
+//! contacts, `nonholonomic:` entries: `model/elements/nonholonomic.rs`).
 
 use super::*;
 

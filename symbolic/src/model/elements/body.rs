@@ -98,6 +98,15 @@ impl BodyKind {
             BodyKind::Rigid { com, .. } | BodyKind::Spatial { com, .. } => com,
         }
     }
+
+    /// The kind as the rules of loads on bodies see it.
+    pub(crate) fn shape(&self) -> BodyShape {
+        match self {
+            BodyKind::Particle { .. } => BodyShape::Particle,
+            BodyKind::Rigid { .. } => BodyShape::Planar,
+            BodyKind::Spatial { .. } => BodyShape::Spatial,
+        }
+    }
 }
 
 /// A body of the kinematic form.
@@ -107,17 +116,6 @@ pub struct Body {
     pub name: Located<String>,
     /// A particle, a planar rigid body or a 3-D one.
     pub kind: BodyKind,
-}
-
-impl BodyKind {
-    /// The kind as the rules of loads on bodies see it.
-    pub(crate) fn shape(&self) -> BodyShape {
-        match self {
-            BodyKind::Particle { .. } => BodyShape::Particle,
-            BodyKind::Rigid { .. } => BodyShape::Planar,
-            BodyKind::Spatial { .. } => BodyShape::Spatial,
-        }
-    }
 }
 
 /// The frame of each 3-D body is a frame of the model.

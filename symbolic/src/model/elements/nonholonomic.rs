@@ -218,8 +218,8 @@ pub(crate) fn rows(
 /// `e_k` of its frame, by name; none (reported) when its body, point or frame is unknown or
 /// the body is not a rigid body of the model's dimension.
 fn rolling_rows(r: &RollingContact, cx: &mut dyn Lower) -> Vec<(String, ExprId)> {
-    let name = &r.body.value;
-    let centre = cx.body_centre(name);
+    let body = &r.body.value;
+    let centre = cx.body_centre(body);
     let contact = cx.point_index(&r.point.value);
     let frame = match &r.frame {
         Some(f) => cx.frame_index(&f.value),
@@ -240,7 +240,7 @@ fn rolling_rows(r: &RollingContact, cx: &mut dyn Lower) -> Vec<(String, ExprId)>
     let offset = difference(arena, &contact, &centre);
     let velocity: Vec<ExprId> = centre.iter().map(|c| arena.time_derivative(*c)).collect();
     // ω × r: in 3-D with ω carried into the ground frame; in the plane ω = θ̇ about z.
-    let spin: Vec<ExprId> = match (cx.rigid_body_3d(name), cx.planar_angle(name), offset.len()) {
+    let spin: Vec<ExprId> = match (cx.rigid_body_3d(body), cx.planar_angle(body), offset.len()) {
         (Some((_, body_frame, w)), _, 3) => {
             let w = cx.express(w, body_frame, 0);
             let r3 = [offset[0], offset[1], offset[2]];

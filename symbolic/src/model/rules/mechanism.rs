@@ -1,5 +1,6 @@
-//! The mechanism of a model file: constraints, equations written by hand, balances, masses and
-//! inertias, and rolling contacts (interactions: `model/elements/interaction.rs`).
+//! The mechanism of a model file: the rules across its constraints (names, count, guesses),
+//! equations written by hand and balances; each element's own rules (constraints, rolling
+//! contacts, masses and inertias) are in `model/elements/`, called from here in file order.
 
 use super::*;
 use crate::model::elements::{body, constraint, nonholonomic};

@@ -1,6 +1,6 @@
-//! The mechanism's points, constraints and contacts and the momentum balances chosen for its
-//! equations (its frames and bodies: `bodies.rs`; springs, dampers, forces, torques and
-//! interactions: their modules in `model/elements/`).
+//! The mechanism's points (with wheel contact points) and the momentum balances chosen for its
+//! equations (the model elements, frames, bodies, constraints and loads among them: their
+//! modules in `model/elements/`).
 
 use super::walk::{Fields, Keyed, Need};
 use super::write::{NotRewritten, Writer, flow, list};

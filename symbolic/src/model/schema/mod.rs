@@ -7,9 +7,10 @@
 //!
 //! One scaffold (`walk`) reads every keyed part of a file: `sections` holds the table of
 //! top-level keys and the sections about the model as a whole, and each group of sections
-//! has its file — frames and bodies (`bodies`), the rest of the mechanism (`mechanics`),
-//! initial state, events and equilibria (`states`), `checks:` (`checks`) and `floquet:`
-//! (`floquet`). How a single value is read (a name, an expression, a vector) is in `values`;
+//! has its file — points and balances (`mechanics`), initial state, events and equilibria
+//! (`states`), `checks:` (`checks`) and `floquet:` (`floquet`); the model elements (frames,
+//! bodies, energies, constraints, loads, contacts) read and write themselves in
+//! `model/elements/`. How a single value is read (a name, an expression, a vector) is in `values`;
 //! lookups in a map's entries in `entries`.
 //!
 //! The same table writes a [`ModelFile`] back as text ([`write_file`]): each section's

@@ -14,7 +14,8 @@ const PARTICLE_EXAMPLE: &str = "{ mass: m, at: P }";
 const RIGID_EXAMPLE: &str = "{ mass: m, inertia: m*l^2/12, com: G, angle: theta }";
 const SPATIAL_EXAMPLE: &str = "{ mass: m, com: G, frame: B, inertia: [I1, I2, I3] }";
 
-/// `bodies:` — `name: { mass, at }` or `name: { mass, inertia, com, angle }`.
+/// `bodies:` — `name: { mass, at }`, `name: { mass, inertia, com, angle }` or
+/// `name: { mass, com, frame, inertia }`.
 pub(crate) fn read(cx: &mut Ctx<'_>, node: &YamlNode) -> Vec<Body> {
     let spec = Keyed {
         what: "`bodies`",
@@ -25,8 +26,8 @@ pub(crate) fn read(cx: &mut Ctx<'_>, node: &YamlNode) -> Vec<Body> {
     cx.keyed(node, spec, read_body)
 }
 
-/// One body: a particle `{ mass, at }`, or a planar rigid body
-/// `{ mass, inertia, com, angle }`.
+/// One body: a particle `{ mass, at }`, a planar rigid body `{ mass, inertia, com, angle }`,
+/// or, with a `frame`, a 3-D one ([`read_spatial`]).
 fn read_body(cx: &mut Ctx<'_>, k: &Located<String>, v: &YamlNode) -> Option<Body> {
     let what = format!("body `{}`", k.value);
     let f = cx.map(v, &what, &format!("{}: {PARTICLE_EXAMPLE}", k.value))?;
