@@ -11,7 +11,7 @@ use crate::model::ast::{BinOp, Expr, ExprKind};
 use crate::model::checks::FloquetReference;
 use crate::model::diagnostic::Diagnostic;
 use crate::model::diagnostic::short;
-use crate::model::elements::{self, contact::ContactInfo, frame, gravity};
+use crate::model::elements::{self, contact::ContactInfo, frame, gravity, point};
 use crate::model::file::{GROUND_FRAME, ModelFile};
 use crate::model::located::{Located, Location};
 
@@ -407,11 +407,10 @@ impl<'f> Lowering<'f> {
             .iter()
             .map(|c| c.name.value.clone())
             .collect();
-        let frames = self.frames_with_rates();
-        let points = self.points(&frames);
+        // The frames and then the points, as the elements read them (`elements::Lower`).
+        self.frames = self.frames_with_rates();
+        let points = point::lower(&file.points, &mut self);
         self.points = points.clone();
-        // The frames and points as the elements read them (`elements::Lower`).
-        self.frames = frames;
         let dimension = file.dimension.unwrap_or(2);
 
         let mut terms = Terms {
@@ -713,55 +712,6 @@ impl<'f> Lowering<'f> {
             frames.add(&f.name.value, parent, rotations);
         }
         frames
-    }
-
-    /// The points' positions in the ground frame, by name, in file order: a list of
-    /// components as written, or a point plus vectors in frames carried into the ground
-    /// frame's components.
-    fn points(&mut self, frames: &Frames) -> Points {
-        let mut points: Points = Vec::new();
-        for p in &self.file.points {
-            if let Some(wheel) = &p.wheel {
-                let r = self.wheel_contact(wheel, &points, frames);
-                points.push((p.name.value.clone(), r));
-                continue;
-            }
-            let Some(relative) = &p.relative else {
-                let r = p.position.iter().map(|c| self.expr(c)).collect();
-                points.push((p.name.value.clone(), r));
-                continue;
-            };
-            let zero = self.arena.int(0);
-            let mut r: Vec<ExprId> = match &relative.from {
-                Some(from) => match point(&points, &from.value) {
-                    Some(i) => points[i].1.clone(),
-                    None => {
-                        self.errors.push(Diagnostic::new(
-                            from.location,
-                            format!("unknown point `{}`", from.value),
-                        ));
-                        vec![zero; 3]
-                    }
-                },
-                None => vec![zero; 3],
-            };
-            for (frame, v) in &relative.vectors {
-                let Some(f) = frames.index(&frame.value) else {
-                    self.errors.push(Diagnostic::new(
-                        frame.location,
-                        format!("unknown frame `{}`", frame.value),
-                    ));
-                    continue;
-                };
-                let v = [&v[0], &v[1], &v[2]].map(|c| self.expr(c));
-                let v = frames.express(&mut self.arena, v, f, 0);
-                for (x, c) in r.iter_mut().zip(v) {
-                    *x = self.arena.plus(*x, c);
-                }
-            }
-            points.push((p.name.value.clone(), r));
-        }
-        points
     }
 }
 

@@ -11,8 +11,8 @@
 //! its `Fields`, the `Writer`), and a new kind is one module plus one line in each stage's
 //! loop and one row in the schema's `SECTIONS`.
 //!
-//! The kinds here: [`frame`] (reference frames), [`body`] (particles, planar and 3-D rigid
-//! bodies), [`contact`] (unilateral contacts) and its [`support`] (a change of support),
+//! The kinds here: [`point`] (the points, which every other element reads), [`frame`]
+//! (reference frames), [`body`] (particles, planar and 3-D rigid bodies), [`contact`] (unilateral contacts) and its [`support`] (a change of support),
 //! [`spring`], [`damper`], [`force`], [`torque`], [`interaction`], [`gravity`] and the
 //! written [`energy`], the holonomic [`constraint`]s and the [`nonholonomic`] ones with the
 //! rolling contacts. ARCHITECTURE.md's recipe says how a kind is added.
@@ -27,6 +27,7 @@ pub mod frame;
 pub mod gravity;
 pub mod interaction;
 pub mod nonholonomic;
+pub mod point;
 pub mod spring;
 pub mod support;
 pub mod torque;

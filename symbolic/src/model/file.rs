@@ -11,6 +11,7 @@ pub use super::elements::damper::Damper;
 pub use super::elements::force::Force;
 pub use super::elements::interaction::{INTERACTION_NAMES, Interaction};
 pub use super::elements::nonholonomic::RollingContact;
+pub use super::elements::point::{Point, RelativePosition, WheelContact};
 pub use super::elements::spring::Spring;
 pub use super::elements::torque::{Torque, TorqueValue};
 // The `checks:` and `floquet:` types live in `checks.rs`; they are named here too, where
@@ -63,63 +64,8 @@ pub struct Coordinate {
     pub unit: Option<Located<String>>,
 }
 
-/// A named point: a position expression in `q` and `t` with 2 or 3 components, or (in 3-D)
-/// another point plus vectors written in frames.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Point {
-    /// Name.
-    pub name: Located<String>,
-    /// Components `[x, y]` or `[x, y, z]` (m) in the ground frame; empty for a point written
-    /// as a point plus vectors (`{ from: O, B: [0, 0, l] }`).
-    pub position: Vec<Expr>,
-    /// The point plus vectors form: `{ from: O, B: [0, 0, l], N: [x, 0, 0] }`; `None` for a
-    /// list of components.
-    pub relative: Option<RelativePosition>,
-    /// The contact point of a wheel: `{ wheel: { centre, frame, axle, radius } }`.
-    pub wheel: Option<WheelContact>,
-    /// Where the position list or map starts.
-    pub location: Location,
-}
-
-impl Point {
-    /// Number of components: 3 for a point written as a point plus vectors in frames.
-    pub fn dimension(&self) -> usize {
-        if self.relative.is_some() || self.wheel.is_some() {
-            3
-        } else {
-            self.position.len()
-        }
-    }
-}
-
-/// A point written as another point plus vectors in frames:
-/// `r_P = r_from + Σ_F [v_F]_F` (each vector's components along the axes of frame F).
-#[derive(Debug, Clone, PartialEq)]
-pub struct RelativePosition {
-    /// The point it is measured from; `None`: the origin.
-    pub from: Option<Located<String>>,
-    /// Vectors by frame (`N` is the ground), each three components (m), in file order.
-    pub vectors: Vec<(Located<String>, Vec<Expr>)>,
-}
-
 pub use super::elements::frame::{Frame, SimpleRotation};
 pub use super::elements::{Axis, GROUND_FRAME};
-
-/// A wheel's contact point, `points: { C: { wheel: { centre: F, frame: H, axle: y, radius: r } } }`:
-/// the point of the circle of radius `radius` about `centre`, in the plane normal to the axis
-/// `axle` of `frame`, that is lowest (farthest along the ground frame's `−z`) — where a
-/// knife-edge wheel touches a horizontal ground (Meijaard et al. 2007, §3).
-#[derive(Debug, Clone, PartialEq)]
-pub struct WheelContact {
-    /// The wheel's centre (a point).
-    pub centre: Located<String>,
-    /// A frame in which the axle is fixed.
-    pub frame: Located<String>,
-    /// The axle's axis in that frame.
-    pub axle: Located<Axis>,
-    /// The radius (m), a constant expression.
-    pub radius: Expr,
-}
 
 /// One `outputs:` entry: a named expression of the state evaluated along a simulation,
 /// `name: expr` or `name: { value: expr, conserved: true, tolerance: 1e-9 }`.

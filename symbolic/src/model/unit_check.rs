@@ -462,9 +462,6 @@ fn unit_part(text: &str) -> &str {
     text.split(',').next().unwrap_or_default()
 }
 
-/// Component names for messages.
-use super::elements::AXES;
-
 impl<'f> Checker<'f> {
     /// Both passes over `file`, with the unit of `undeclared` (if any) treated as unknown.
     fn run(file: &'f ModelFile, undeclared: Option<Target>) -> Self {

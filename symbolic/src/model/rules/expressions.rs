@@ -2,7 +2,7 @@
 //! functions of points, and the dimensions of vectors.
 
 use super::*;
-use crate::model::elements::{body, energy, frame, gravity};
+use crate::model::elements::{body, energy, frame, gravity, point};
 
 impl Checker<'_> {
     // Rule: every name in an expression is a parameter or `pi`, and where the expression may
@@ -20,16 +20,7 @@ impl Checker<'_> {
         let file = self.file;
         energy::rules(file.written_energies(), self);
         self.vectors = false;
-        for p in &file.points {
-            let relative = p.relative.iter().flat_map(|r| &r.vectors);
-            for c in p.position.iter().chain(relative.flat_map(|(_, v)| v)) {
-                self.resolve(
-                    c,
-                    Depends::Position,
-                    &format!("the position of point `{}`", p.name.value),
-                );
-            }
-        }
+        point::expression_rules(&file.points, self);
         frame::angle_rules(&file.frames, self);
         self.vectors = true;
         body::expression_rules(&file.bodies, self);
@@ -275,29 +266,12 @@ impl Checker<'_> {
     // points to act on.
     pub(super) fn dimensions(&mut self) {
         let file = self.file;
-        let Some(first) = file.points.first() else {
+        let Some(dim) = point::dimension_rules(&file.points, self) else {
             if let Some(g) = &file.gravity {
                 gravity::dimension_rules(g, self, None);
             }
             return;
         };
-        let dim = first.dimension();
-        for p in &file.points[1..] {
-            if p.dimension() != dim {
-                self.error(
-                    Diagnostic::new(
-                        p.location,
-                        format!(
-                            "point `{}` has {} components but point `{}` has {dim}",
-                            p.name.value,
-                            p.dimension(),
-                            first.name.value
-                        ),
-                    )
-                    .with_help("a model is either planar (`[x, y]`) or spatial (`[x, y, z]`)"),
-                );
-            }
-        }
         self.vector_lengths(dim);
         self.spatial_pieces(dim);
     }

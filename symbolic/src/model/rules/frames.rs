@@ -1,7 +1,7 @@
 //! The frames of a model file and the frames and points that other sections name.
 
 use super::*;
-use crate::model::elements::{body, frame};
+use crate::model::elements::{body, frame, point};
 
 impl Checker<'_> {
     // Rule: frames have distinct names other than the ground `N` and `from`; each frame's
@@ -11,68 +11,12 @@ impl Checker<'_> {
         let file = self.file;
         frame::rules(&file.frames, self);
         let frames = frame_names(file);
-        self.point_origins(&frames);
+        point::origin_rules(&file.points, self);
         body::frame_rules(&file.bodies, self);
         for w in &file.draw.wheels {
             self.point(&w.centre);
             self.frame(&w.frame, &frames);
             self.resolve(&w.radius, Depends::Constant, "the radius of a drawn wheel");
-        }
-    }
-
-    /// Checks that each wheel centre and each point a point is measured from are defined
-    /// before it, and that the frames of wheels and of relative vectors are among `frames`.
-    fn point_origins(&mut self, frames: &[&str]) {
-        let file = self.file;
-        for (i, p) in file.points.iter().enumerate() {
-            if let Some(wheel) = &p.wheel {
-                let earlier = file.points[..i]
-                    .iter()
-                    .any(|q| q.name.value == wheel.centre.value);
-                if !earlier
-                    && file.points[i..]
-                        .iter()
-                        .any(|q| q.name.value == wheel.centre.value)
-                {
-                    self.error(
-                        Diagnostic::new(wheel.centre.location, format!("the wheel of point `{}` is centred at `{}`, which is not defined before it", p.name.value, wheel.centre.value))
-                            .with_help("define the wheel's centre above its contact point"),
-                    );
-                } else {
-                    self.point(&wheel.centre);
-                }
-                self.frame(&wheel.frame, frames);
-                self.resolve(
-                    &wheel.radius,
-                    Depends::Constant,
-                    &format!("the wheel radius of point `{}`", p.name.value),
-                );
-                continue;
-            }
-            let Some(relative) = &p.relative else {
-                continue;
-            };
-            if let Some(from) = &relative.from {
-                let earlier = file.points[..i].iter().any(|q| q.name.value == from.value);
-                let later = file.points[i..].iter().any(|q| q.name.value == from.value);
-                if later && !earlier {
-                    self.error(
-                        Diagnostic::new(
-                            from.location,
-                            format!(
-                                "point `{}` is measured from `{}`, which is not defined before it",
-                                p.name.value, from.value
-                            ),
-                        )
-                        .with_help("define the point it starts from above it"),
-                    );
-                } else {
-                    self.point(from);
-                }
-            }
-            for (frame, _) in &relative.vectors {
-                self.frame(frame, frames);
-            }
         }
     }
 

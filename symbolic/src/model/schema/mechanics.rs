@@ -2,25 +2,13 @@
 //! equations (the model elements, frames, bodies, constraints and loads among them: their
 //! modules in `model/elements/`).
 
-use super::walk::{Fields, Keyed, Need};
-use super::write::{NotRewritten, Writer, flow, list};
+use super::walk::{Fields, Need};
+use super::write::{NotRewritten, Writer};
 use super::*;
 
 /// The names of the other derivations that `eomgen check` lists beside a named set of
 /// balances, which a set may not take.
 const RESERVED_SET_NAMES: [&str; 5] = ["lagrange", "momentum", "by_hand", "energy", "power"];
-
-/// The keys of a wheel's contact point.
-const WHEEL: Fields = Fields {
-    kind: "wheel contact",
-    keys: &[
-        ("centre", Need::Required),
-        ("frame", Need::Required),
-        ("axle", Need::Required),
-        ("radius", Need::Required),
-    ],
-    example: "{ centre: F, frame: H, axle: y, radius: r }",
-};
 
 /// The keys of an angular momentum balance.
 const AMB: Fields = Fields {
@@ -43,127 +31,6 @@ const LMB: Fields = Fields {
 };
 
 impl Ctx<'_> {
-    /// `points:` — `name: [x, y]` or `name: [x, y, z]`.
-    pub(super) fn points(&mut self, node: &YamlNode) -> Vec<Point> {
-        let spec = Keyed {
-            what: "`points`",
-            example: "points: { O: [0, 0], P: [l*cos(q), l*sin(q)] }",
-            names: Some("point"),
-            drop: true,
-        };
-        self.keyed(node, spec, |cx, k, v| {
-            if let YamlKind::Map(entries) = &v.kind {
-                if let [(key, wheel)] = entries.as_slice()
-                    && key.value == "wheel"
-                {
-                    let what = Located::new(format!("{}'s wheel", k.value), key.location);
-                    let wheel = cx.wheel_contact(&what, wheel)?;
-                    return Some(Point {
-                        name: k.clone(),
-                        position: Vec::new(),
-                        relative: None,
-                        wheel: Some(wheel),
-                        location: v.location,
-                    });
-                }
-                let relative = cx.relative_position(k, entries, v.location)?;
-                return Some(Point {
-                    name: k.clone(),
-                    position: Vec::new(),
-                    relative: Some(relative),
-                    wheel: None,
-                    location: v.location,
-                });
-            }
-            let position = cx.vector(
-                v,
-                &format!("point `{}`", k.value),
-                "P: [l*cos(q), l*sin(q)]",
-            )?;
-            Some(Point {
-                name: k.clone(),
-                position,
-                relative: None,
-                wheel: None,
-                location: v.location,
-            })
-        })
-    }
-
-    /// A point written as a point plus vectors in frames: `{ from: O, B: [0, 0, l] }`.
-    fn relative_position(
-        &mut self,
-        k: &Located<String>,
-        entries: &Entries,
-        at: Location,
-    ) -> Option<RelativePosition> {
-        let what = format!("point `{}`", k.value);
-        let example = format!("{}: {{ from: O, B: [0, 0, l] }}", k.value);
-        let mut from = None;
-        let mut vectors = Vec::new();
-        let mut complete = true;
-        for (key, value) in entries {
-            if key.value == "from" {
-                match self.name(value, "`from`") {
-                    Some(p) => from = Some(p),
-                    None => complete = false,
-                }
-                continue;
-            }
-            if !self.key_name(key, "a frame") {
-                complete = false;
-                continue;
-            }
-            let in_frame = format!("the vector of {what} in frame `{}`", key.value);
-            match self.vector(value, &in_frame, "B: [0, 0, l]") {
-                Some(v) if v.len() == 3 => vectors.push((key.clone(), v)),
-                Some(v) => {
-                    self.error(
-                        Diagnostic::new(
-                            value.location,
-                            format!("{in_frame} has {} components; a vector in a frame has 3", v.len()),
-                        )
-                        .with_help("write its components along the frame's x, y and z axes, as in `B: [0, 0, l]`"),
-                    );
-                    complete = false;
-                }
-                None => complete = false,
-            }
-        }
-        if from.is_none() && vectors.is_empty() && complete {
-            self.error(
-                Diagnostic::new(
-                    at,
-                    format!("{what} is a map with neither `from` nor a vector"),
-                )
-                .with_help(format!(
-                    "a point is a list `[x, y, z]` or a point plus vectors in frames: `{example}`"
-                )),
-            );
-            return None;
-        }
-        complete.then_some(RelativePosition { from, vectors })
-    }
-
-    /// A wheel's contact point: `{ centre, frame, axle, radius }`.
-    pub(super) fn wheel_contact(
-        &mut self,
-        k: &Located<String>,
-        v: &YamlNode,
-    ) -> Option<WheelContact> {
-        let f = self.fields(k, v, &WHEEL)?;
-        let centre = get(f, "centre").and_then(|n| self.name(n, "`centre`"));
-        let frame = get(f, "frame").and_then(|n| self.name(n, "`frame`"));
-        let axle = get(f, "axle").and_then(|n| self.axes(n, true).and_then(|mut a| a.pop()));
-        let radius = get(f, "radius").and_then(|n| self.expr(n, "a wheel radius"));
-        Some(WheelContact {
-            centre: centre?,
-            frame: frame?,
-            axle: axle?,
-            radius: radius?,
-        })
-    }
-
     /// `balances:` — a list of `amb: { about, bodies, form }` (angular momentum balance) and
     /// `lmb: { bodies, along }` (linear momentum balance), one set; or a map of named sets,
     /// `{ NAME: [ … ], … }`, each such a list (several derivations of the same equations).
@@ -343,42 +210,8 @@ impl Ctx<'_> {
     }
 }
 
-/// The writers of the mechanism's points, loads and constraints.
+/// The writer of the balances.
 impl Writer<'_> {
-    /// `points:`.
-    pub(super) fn write_points(&mut self, file: &ModelFile) -> Result<(), NotRewritten> {
-        if file.points.is_empty() {
-            return Ok(());
-        }
-        self.line("points:");
-        for p in &file.points {
-            let text = self.point_text(p)?;
-            self.line(format_args!("  {}: {text}", p.name.value));
-        }
-        Ok(())
-    }
-
-    /// A point's value: its components, the point plus vectors in frames, or a wheel contact.
-    fn point_text(&mut self, p: &Point) -> Result<String, NotRewritten> {
-        let place = format!("point `{}`", p.name.value);
-        if let Some(wheel) = &p.wheel {
-            return Ok(format!("{{ wheel: {} }}", self.wheel_text(wheel, &place)?));
-        }
-        if let Some(RelativePosition { from, vectors }) = &p.relative {
-            let mut parts = Vec::new();
-            if let Some(from) = from {
-                parts.push(format!("from: {}", from.value));
-            }
-            for (frame, vector) in vectors {
-                let components = self.exprs(vector, &place)?;
-                parts.push(format!("{}: {}", frame.value, list(&components)));
-            }
-            return Ok(format!("{{ {} }}", parts.join(", ")));
-        }
-        let parts = self.exprs(&p.position, &place)?;
-        Ok(list(&parts))
-    }
-
     /// `balances:` is not written: the model is derived by Lagrange's equations, noted.
     pub(super) fn write_balances(&mut self, file: &ModelFile) -> Result<(), NotRewritten> {
         if !file.balances.is_empty() {
@@ -388,24 +221,5 @@ impl Writer<'_> {
             );
         }
         Ok(())
-    }
-}
-
-/// The text of a wheel, in a point's entry and in `draw: wheels:`.
-impl Writer<'_> {
-    /// `{ centre: G, frame: R, axle: y, radius: r }`.
-    pub(super) fn wheel_text(
-        &mut self,
-        wheel: &WheelContact,
-        place: &str,
-    ) -> Result<String, NotRewritten> {
-        let radius = self.expr(&wheel.radius, place)?;
-        Ok(format!(
-            "{{ centre: {}, frame: {}, axle: {}, radius: {} }}",
-            wheel.centre.value,
-            wheel.frame.value,
-            wheel.axle.value.letter(),
-            flow(&radius)
-        ))
     }
 }

@@ -7,7 +7,7 @@ use super::write::{Edits, NotRewritten, Rewrite, Writer, scalar};
 use super::*;
 use crate::model::elements::{
     body, constraint, contact, damper, energy, force, frame, gravity, interaction, nonholonomic,
-    spring, torque,
+    point, spring, torque,
 };
 
 /// How one top-level key of a model file is read, and written.
@@ -121,10 +121,10 @@ const SECTIONS: &[Section] = &[
         write: |w, file| frame::write(w, &file.frames),
     },
     Section {
-        key: "points",
-        read: |cx, n, file| file.points = cx.points(n),
+        key: point::KEY,
+        read: |cx, n, file| file.points = point::read(cx, n),
         missing: None,
-        write: |w, file| w.write_points(file),
+        write: |w, file| point::write(w, &file.points),
     },
     Section {
         key: body::KEY,
@@ -648,7 +648,7 @@ impl Ctx<'_> {
         }) {
             for w in wheels {
                 let k = Located::new("wheel".to_string(), w.location);
-                if let Some(wheel) = self.wheel_contact(&k, w) {
+                if let Some(wheel) = point::read_wheel(self, &k, w) {
                     draw.wheels.push(wheel);
                 }
             }
@@ -741,7 +741,7 @@ impl Writer<'_> {
     fn write_draw(&mut self, file: &ModelFile) -> Result<(), NotRewritten> {
         let mut wheels = Vec::new();
         for wheel in &file.draw.wheels {
-            wheels.push(self.wheel_text(wheel, "`draw: wheels:`")?);
+            wheels.push(point::wheel_text(self, wheel, "`draw: wheels:`")?);
         }
         let lines: Vec<String> = file
             .draw

@@ -123,7 +123,7 @@ impl Ctx<'_> {
     }
 
     /// A name written as a key, such as a point's in `points: { P: … }`.
-    pub(super) fn key_name(&mut self, key: &Located<String>, what: &str) -> bool {
+    pub(crate) fn key_name(&mut self, key: &Located<String>, what: &str) -> bool {
         if is_identifier(&key.value) {
             return true;
         }

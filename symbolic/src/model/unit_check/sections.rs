@@ -2,7 +2,7 @@
 //! events, outputs and `checks:`, walked in file order.
 
 use super::*;
-use crate::model::elements::{self, body, energy, frame, gravity};
+use crate::model::elements::{self, body, energy, frame, gravity, point};
 use crate::model::located::Located;
 
 impl Checker<'_> {
@@ -95,32 +95,7 @@ impl Checker<'_> {
     pub(super) fn walk(&mut self) {
         let file = self.file;
         energy::units(file.written_energies(), self);
-        for p in &file.points {
-            let relative = p.relative.iter().flat_map(|r| &r.vectors);
-            let in_frames = relative.flat_map(|(_, v)| AXES.iter().zip(v));
-            for (axis, c) in AXES.iter().zip(&p.position).chain(in_frames) {
-                self.fixed(
-                    c,
-                    Dimension::METRE,
-                    &format!("the {axis} component of point `{}`", p.name.value),
-                    "a position",
-                    "m",
-                    "positions are lengths: check the units of the parameters in it",
-                );
-            }
-        }
-        for p in &file.points {
-            if let Some(wheel) = &p.wheel {
-                self.fixed(
-                    &wheel.radius,
-                    Dimension::METRE,
-                    &format!("the wheel radius of point `{}`", p.name.value),
-                    "a length",
-                    "m",
-                    "a wheel's radius is a length",
-                );
-            }
-        }
+        point::units(&file.points, self);
         frame::units(&file.frames, self);
         body::units(&file.bodies, self);
         if let Some(g) = &file.gravity {
