@@ -361,8 +361,8 @@ struct Lowering<'f> {
     points: Points,
     /// Names bound while lowering one expression: an interaction's `r` and `r_dot`.
     locals: Vec<(String, ExprId)>,
-    /// The frames, once lowered (before the bodies and the loads), for the elements
-    /// ([`elements::Lower`]).
+    /// The frames, once lowered (before the points, the bodies and the loads), for the
+    /// elements ([`elements::Lower`]).
     frames: Frames,
     /// The bodies, once lowered, for the elements.
     bodies: Vec<BodyInfo>,

@@ -12,10 +12,11 @@
 //! loop and one row in the schema's `SECTIONS`.
 //!
 //! The kinds here: [`point`] (the points, which every other element reads), [`frame`]
-//! (reference frames), [`body`] (particles, planar and 3-D rigid bodies), [`contact`] (unilateral contacts) and its [`support`] (a change of support),
-//! [`spring`], [`damper`], [`force`], [`torque`], [`interaction`], [`gravity`] and the
-//! written [`energy`], the holonomic [`constraint`]s and the [`nonholonomic`] ones with the
-//! rolling contacts. ARCHITECTURE.md's recipe says how a kind is added.
+//! (reference frames), [`body`] (particles, planar and 3-D rigid bodies), [`contact`]
+//! (unilateral contacts) and its [`support`] (a change of support), [`spring`], [`damper`],
+//! [`force`], [`torque`], [`interaction`], [`gravity`] and the written [`energy`], the
+//! holonomic [`constraint`]s and the [`nonholonomic`] ones with the rolling contacts.
+//! ARCHITECTURE.md's recipe says how a kind is added.
 
 pub mod body;
 pub mod constraint;

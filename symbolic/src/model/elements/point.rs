@@ -9,8 +9,8 @@
 //!   C: { wheel: { centre: W, frame: H, axle: y, radius: r } }
 //! ```
 //!
-//! The points are lowered first, in file order (a point may start from one above it), and
-//! every element then reads them through [`super::Lower::point`].
+//! The points are lowered right after the frames, in file order (a point may start from one
+//! above it), and every element then reads them through `Lower::point`.
 
 use super::{AXES, Axis, Depends, Lower, Rules, Units, dot};
 use crate::expr::ExprId;

@@ -1,6 +1,5 @@
-//! The mechanism's points (with wheel contact points) and the momentum balances chosen for its
-//! equations (the model elements, frames, bodies, constraints and loads among them: their
-//! modules in `model/elements/`).
+//! The momentum balances chosen for a model's equations (the model elements, points, frames,
+//! bodies, constraints and loads among them: their modules in `model/elements/`).
 
 use super::walk::{Fields, Need};
 use super::write::{NotRewritten, Writer};
