@@ -85,6 +85,18 @@ impl Axis {
     }
 }
 
+/// The frame `in: F` of an entry written in a frame: `Some(None)` when the entry has none,
+/// `None` (reported) when it is not a name.
+pub(crate) fn read_in(
+    cx: &mut Ctx<'_>,
+    f: &crate::model::schema::entries::Entries,
+) -> Option<Option<Located<String>>> {
+    match get(f, "in") {
+        Some(n) => cx.name(n, "`in`").map(Some),
+        None => Some(None),
+    }
+}
+
 /// What an expression of a model file may depend on.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
 pub(crate) enum Depends {

@@ -15,7 +15,7 @@
 
 use super::{
     Axis, Depends, Expressions, Lower, Rules, axes_rules, dot, expression_rows, in_frame,
-    read_expressions_or,
+    read_expressions_or, read_in,
 };
 use crate::expr::ExprId;
 use crate::model::ast::Expr;
@@ -71,15 +71,12 @@ fn read_point(cx: &mut Ctx<'_>, k: &Located<String>, v: &YamlNode) -> Option<Poi
     let f = cx.fields(k, v, &POINT_FIELDS)?;
     let point = get(f, "point").and_then(|n| cx.name(n, "`point`"));
     let along = get(f, "along").and_then(|n| cx.axes(n, true).and_then(|mut a| a.pop()));
-    let frame = match get(f, "in") {
-        Some(n) => Some(Some(cx.name(n, "`in`")?)),
-        None => Some(None),
-    };
+    let frame = read_in(cx, f)?;
     Some(PointConstraint {
         name: k.clone(),
         point: point?,
         along: along?,
-        frame: frame?,
+        frame,
     })
 }
 

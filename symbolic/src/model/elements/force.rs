@@ -12,7 +12,7 @@
 //! is carried into the ground frame's components first. Components may depend on the
 //! configuration, the rates and `t`.
 
-use super::{AXES, Depends, Lower, Rules, Units, in_frame, projections};
+use super::{AXES, Depends, Lower, Rules, Units, in_frame, projections, read_in};
 use crate::expr::ExprId;
 use crate::model::ast::Expr;
 use crate::model::diagnostic::Diagnostic;
@@ -73,10 +73,7 @@ pub(crate) fn read(cx: &mut Ctx<'_>, node: &YamlNode) -> Vec<Force> {
             )
             .map(|x| (x, n.location))
         });
-        let frame = match get(f, "in") {
-            Some(n) => cx.name(n, "`in`").map(Some),
-            None => Some(None),
-        };
+        let frame = read_in(cx, f);
         let (vector, location) = vector?;
         Some(Force {
             name: k.clone(),

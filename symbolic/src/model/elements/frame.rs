@@ -250,32 +250,32 @@ pub(crate) fn rules(frames: &[Frame], cx: &mut dyn Rules) {
     }
 }
 
+/// Every rotation angle with its frame's name, in file order.
+fn angles(frames: &[Frame]) -> impl Iterator<Item = (&str, &Expr)> {
+    frames
+        .iter()
+        .flat_map(|f| (f.rotations.iter()).map(move |r| (f.name.value.as_str(), &r.angle)))
+}
+
 /// The rotation angles are functions of the configuration (no rates).
 pub(crate) fn angle_rules(frames: &[Frame], cx: &mut dyn Rules) {
-    for f in frames {
-        for r in &f.rotations {
-            cx.expression(
-                &r.angle,
-                Depends::Position,
-                &format!("the rotation of frame `{}`", f.name.value),
-            );
-        }
+    for (frame, angle) in angles(frames) {
+        let what = format!("the rotation of frame `{frame}`");
+        cx.expression(angle, Depends::Position, &what);
     }
 }
 
 /// The rotation angles are pure numbers (rad).
 pub(crate) fn units(frames: &[Frame], cx: &mut dyn Units) {
-    for f in frames {
-        for r in &f.rotations {
-            cx.fixed(
-                &r.angle,
-                Dimension::ONE,
-                &format!("the rotation angle of frame `{}`", f.name.value),
-                "an angle",
-                "rad (a pure number)",
-                "a rotation angle is an angle coordinate, or a function of the coordinates that gives a pure number",
-            );
-        }
+    for (frame, angle) in angles(frames) {
+        cx.fixed(
+            angle,
+            Dimension::ONE,
+            &format!("the rotation angle of frame `{frame}`"),
+            "an angle",
+            "rad (a pure number)",
+            "a rotation angle is an angle coordinate, or a function of the coordinates that gives a pure number",
+        );
     }
 }
 

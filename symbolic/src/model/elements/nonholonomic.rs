@@ -15,7 +15,7 @@
 
 use super::{
     Axis, BodyLookup, BodyShape, Depends, Expressions, Lower, Rules, axes_rules, difference, dot,
-    expression_rows, in_frame, read_expressions_or,
+    expression_rows, in_frame, read_expressions_or, read_in,
 };
 use crate::expr::ExprId;
 use crate::mechanics::frames::cross;
@@ -92,10 +92,7 @@ fn read_rolling(cx: &mut Ctx<'_>, k: &Located<String>, v: &YamlNode) -> Option<R
     let f = cx.fields(k, v, &ROLLING_FIELDS)?;
     let body = get(f, "body").and_then(|n| cx.name(n, "`body`"));
     let point = get(f, "point").and_then(|n| cx.name(n, "`point`"));
-    let frame = match get(f, "in") {
-        Some(n) => Some(Some(cx.name(n, "`in`")?)),
-        None => Some(None),
-    };
+    let frame = read_in(cx, f)?;
     let along = get(f, "along").and_then(|n| {
         let items = cx.seq(n, "`along`", "along: [x, y]")?;
         let axes: Option<Vec<Located<Axis>>> = items
@@ -119,7 +116,7 @@ fn read_rolling(cx: &mut Ctx<'_>, k: &Located<String>, v: &YamlNode) -> Option<R
         body: body?,
         point: point?,
         along: along?,
-        frame: frame?,
+        frame,
     })
 }
 

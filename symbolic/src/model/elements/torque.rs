@@ -11,7 +11,9 @@
 //! `Qᵢ = τ·∂ω/∂q̇ᵢ`, both vectors in the body frame's components (the vector is carried from
 //! its frame `in:` there first). Momentum balance takes the torque itself on its body.
 
-use super::{AXES, BodyLookup, BodyShape, Depends, Lower, Rules, Units, in_frame, projections};
+use super::{
+    AXES, BodyLookup, BodyShape, Depends, Lower, Rules, Units, in_frame, projections, read_in,
+};
 use crate::expr::ExprId;
 use crate::model::ast::Expr;
 use crate::model::diagnostic::Diagnostic;
@@ -100,10 +102,7 @@ pub(crate) fn read(cx: &mut Ctx<'_>, node: &YamlNode) -> Vec<Torque> {
                 cx.expr(n, "a torque").map(TorqueValue::Planar)
             }
             (None, Some(n)) => {
-                let frame = match get(f, "in") {
-                    Some(i) => Some(cx.name(i, "`in`")?),
-                    None => None,
-                };
+                let frame = read_in(cx, f)?;
                 let vector = cx.vector(n, &format!("the vector of {what}"), "vector: [0, 0, T]")?;
                 Some(TorqueValue::Spatial {
                     vector,

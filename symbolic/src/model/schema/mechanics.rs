@@ -4,6 +4,7 @@
 use super::walk::{Fields, Need};
 use super::write::{NotRewritten, Writer};
 use super::*;
+use crate::model::elements::read_in;
 
 /// The names of the other derivations that `eomgen check` lists beside a named set of
 /// balances, which a set may not take.
@@ -178,10 +179,7 @@ impl Ctx<'_> {
                             .map(|v| Some(Located::new(v, n.location))),
                         None => Some(None),
                     })
-                    .zip(match get(f, "in") {
-                        Some(n) => self.name(n, "`in`").map(Some),
-                        None => Some(None),
-                    })
+                    .zip(read_in(self, f))
                     .map(|(((about, form), axis), frame)| BalanceKind::Amb {
                         about,
                         form,
