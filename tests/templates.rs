@@ -192,14 +192,48 @@ fn mass_chains_have_the_closed_form_frequencies() {
     }
 }
 
+/// The universal-joint chains (issue 52): about `hanging` (every angle 0) a chain of slender
+/// bars in universal joints is two planar chains of uniform bars, one per joint axis (the
+/// spin about a bar's axis and its inertia `m w²/6` enter at second order), so its
+/// frequencies are [`pendulum_frequencies_by_hand`]'s, each twice; the hanging chain is
+/// stable. For N = 1…4 (8 coordinates): the derivation of 3-D bodies nested `2N` rotations
+/// deep, linearised, against `M` and `K` written by hand for the planar chain.
+#[test]
+fn universal_joint_chains_hang_with_the_planar_chains_frequencies_twice() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    for n in 1..=4 {
+        let (path, _) = generated(dir.path(), "universal-joint-chain", n);
+        let source = ModelSource::open(path.to_str().unwrap()).expect("the file loads");
+        let hanging = modes_at(&source, "hanging");
+        let label = format!("n = {n} hanging");
+        assert!(hanging.operating_point.q().iter().all(|q| q.abs() < 1e-12));
+        let twice: Vec<f64> = pendulum_frequencies_by_hand(n)
+            .into_iter()
+            .flat_map(|w| [w, w])
+            .collect();
+        assert_frequencies(&label, &hanging.normal_modes.natural_frequencies, &twice);
+        assert!(
+            matches!(hanging.stability.stability, Stability::MarginallyStable),
+            "{label}: {:?}",
+            hanging.stability.stability
+        );
+    }
+}
+
 /// Every generated file's own checks pass (`eomgen report`'s rows: the derivations agree,
 /// energy is conserved, the stated frequencies are met), and each states what it should: the
 /// frequencies where a closed form exists, else the energy drift.
 #[test]
 fn generated_files_pass_their_checks() {
     let dir = tempfile::tempdir().expect("a temporary directory");
-    for template in ["n-link-pendulum", "n-mass-chain"] {
-        for n in SIZES {
+    // The universal-joint chain to 3 joints (6 coordinates of 3-D bodies: its energy-drift
+    // run is the slowest of these in a debug build).
+    for (template, sizes) in [
+        ("n-link-pendulum", SIZES),
+        ("n-mass-chain", SIZES),
+        ("universal-joint-chain", 1..=3),
+    ] {
+        for n in sizes {
             let (path, text) = generated(dir.path(), template, n);
             let path = path.to_str().unwrap();
             let file = eomgen_symbolic::model::load(path, &text).expect("the file loads");
@@ -219,9 +253,15 @@ fn generated_files_pass_their_checks() {
                 .filter(|r| r.check.starts_with("natural_frequencies"))
                 .count();
             let closed_form = template == "n-mass-chain" || n <= 3;
+            // Two angles per universal joint.
+            let coordinates = if template == "universal-joint-chain" {
+                2 * n
+            } else {
+                n
+            };
             assert_eq!(
                 frequencies,
-                if closed_form { n } else { 0 },
+                if closed_form { coordinates } else { 0 },
                 "{template} {n}: frequency rows"
             );
             assert!(

@@ -66,7 +66,8 @@ enum Command {
     /// Frequency response from a load parameter to coordinates: Bode chart, resonance peaks,
     /// modal contributions (`--modal`), points checked by simulation (`--simulate K`).
     Frf(commands::frf::FrfArgs),
-    /// Print a generated model file: `n-link-pendulum N` or `n-mass-chain N`.
+    /// Print a generated model file: `n-link-pendulum N`, `n-mass-chain N` or
+    /// `universal-joint-chain N`.
     New(commands::equations::NewArgs),
     /// Eliminate a model's holonomic constraints (method II.2): solve them for the
     /// coordinates not kept (`--keep x`) and write the model file in minimal coordinates.

@@ -33,6 +33,10 @@
 //! formulation, are also checked against the closed form (see [`check_against_closed_form`]),
 //! so a wrong generator cannot produce plausible timings.
 //!
+//! - the `universal_joint_chain` group times `check` (both derivations and their comparison)
+//!   of the chain of 3-D bodies in relative rotations of `eomgen new universal-joint-chain N`
+//!   for N = 2, 4, 6, 8 joints (issue 52).
+//!
 //! Run with `cargo bench -p eomgen-symbolic --bench derivation`; the side-by-side SymPy
 //! figures come from `tools/sympy_n_link.py`, the compile time of the generated code from
 //! `tools/compile_time.sh`.
@@ -47,7 +51,7 @@ use eomgen_symbolic::expr::cse::{self, CsePlan};
 use eomgen_symbolic::expr::eval::Evaluator;
 use eomgen_symbolic::mechanics::{
     EquationsOfMotion, Formulation, Jacobians, Lagrange, MomentumBalance, SymbolicModel,
-    preferred_equations,
+    cross_check, preferred_equations,
 };
 use eomgen_symbolic::model;
 
@@ -364,5 +368,37 @@ fn formulations(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, derivation, formulations);
+/// Joint counts of the `universal_joint_chain` group.
+const JOINTS: [usize; 4] = [2, 4, 6, 8];
+
+/// `eomgen check` of the chain of `eomgen new universal-joint-chain N` (issue 52), the
+/// library call the command makes ([`cross_check::check_model`], 200 states): both
+/// derivations of a chain of 3-D bodies in relative rotations, their comparison and the power
+/// balance, from the loaded file. Before the timed runs, one run per size reports each
+/// derivation's operations after CSE and checks that the two derivations agree (to 1e-12).
+/// The growth from 2 to 8 joints is the figure of docs/performance.md ("Derivations of 3-D
+/// chains"); it was exponential (×15 per joint) before the expansion's caps.
+fn universal_joint_chain(c: &mut Criterion) {
+    let mut group = c.benchmark_group("universal_joint_chain");
+    group.sample_size(10);
+    for n in JOINTS {
+        let source = eomgen_symbolic::model::templates::universal_joint_chain(n);
+        let file = model::load("chain.yaml", &source).expect("the generated chain loads");
+        let report = cross_check::check_model(&file, 200, 7).expect("derives");
+        let comparison = &report.comparisons[0];
+        assert!(comparison.max_rel_residual < 1e-12, "{report:?}");
+        let ops: Vec<String> = report
+            .derivations
+            .iter()
+            .map(|d| format!("{} {} ops after CSE", d.name, d.ops_after_cse))
+            .collect();
+        eprintln!("universal_joint_chain_{n}: {}", ops.join(", "));
+        group.bench_function(format!("check_{n}"), |b| {
+            b.iter(|| cross_check::check_model(black_box(&file), 200, 7).expect("derives"))
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, derivation, formulations, universal_joint_chain);
 criterion_main!(benches);

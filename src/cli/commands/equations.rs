@@ -43,7 +43,7 @@ pub struct EquationsArgs {
 /// Options of `eomgen new`.
 #[derive(Debug, Args)]
 pub struct NewArgs {
-    /// `n-link-pendulum` or `n-mass-chain`.
+    /// `n-link-pendulum`, `n-mass-chain` or `universal-joint-chain`.
     pub template: String,
     /// Size (number of bars or masses), at least 1.
     pub n: usize,

@@ -7,6 +7,21 @@
 //! canonical sum and vanish. Expansion can also swell an expression, so it is capped, and
 //! [`ExprArena::expand_if_cheaper`] keeps whichever form costs fewer operations;
 //! [`ExprArena::expand_time_varying`] leaves constant-in-time sums alone.
+//!
+//! Two caps guard against growth:
+//! - a product of three or more sums stays a product past [`MAX_TERMS`] terms, unless the
+//!   count is quadratic in its input (a square such as `v·v`, up to [`MAX_QUADRATIC_TERMS`]);
+//! - a sum or product whose expansion would have more than [`DEEP_TERMS`] terms from sums
+//!   nested more than [`DEEP_NESTING`] levels deep in products stays as it is. The terms of
+//!   such an expansion double with each level, although the expression (a DAG, each level
+//!   sharing the one below) grows by a constant: the components of a point of a chain of
+//!   3-D bodies in relative rotations, each rotation `cos a vⱼ − sin a vₖ` with `vⱼ` and `vₖ`
+//!   the previous rotation's sums, have `4ᴺ` terms multiplied out for `N` two-axis joints. Kept
+//!   nested, the chain's equations grow as a power of `N` (docs/performance.md, "Derivations
+//!   of 3-D chains").
+//!
+//! Both caps are decided from the expression's shape before anything is built
+//! ([`ExprArena::expansion_shape`], memoised per node).
 
 use super::{ExprArena, ExprId, Node};
 
@@ -20,13 +35,83 @@ const MAX_TERMS: usize = 512;
 /// square of its input, and a 40-link chain's `|v|²` alone has 1600 terms.
 const MAX_QUADRATIC_TERMS: usize = 1 << 16;
 
+/// Most terms an expansion may produce from sums nested more than [`DEEP_NESTING`] levels
+/// deep in products. Chosen on the universal-joint chains of `eomgen new
+/// universal-joint-chain` (N = 2…8, `check` time and operations after CSE of both
+/// derivations, best at 16–64) while leaving every bundled model's equations as they were
+/// except the Whipple bicycle's, whose Lagrange form halves (8,061 → 3,875 operations after
+/// CSE).
+const DEEP_TERMS: usize = 64;
+
+/// How deeply sums may nest in products before [`DEEP_TERMS`] applies: a planar chain's
+/// kinetic energy `Σ ½ m v·v` nests two levels (the sum `v`, its square, the sum over
+/// bodies) and multiplies out whatever its size, which its Lagrange derivation needs to
+/// cancel terms and sum the masses of a chain (1 caps the 40-link pendulum's `T` and costs it
+/// 11× the operations).
+const DEEP_NESTING: usize = 2;
+
 /// Which sums [`ExprArena::expand`] multiplies out.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Expansion {
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub(super) enum Expansion {
     /// Every sum.
     Full,
     /// Only sums that change in time; a constant-in-time sum such as `R − r` stays a factor.
     TimeVarying,
+}
+
+impl Expansion {
+    /// [`DEEP_TERMS`] for the derivations' time-varying expansion; for the full expansion of
+    /// the symbolic equality proof and of [`ExprArena::expand_if_cheaper`], 4,096 (a bound on
+    /// their work: uncapped, `check` of 8 universal joints took 14 s, nearly all in them;
+    /// every bundled model's proof stays within it).
+    fn deep_terms(self) -> usize {
+        match self {
+            Self::Full => 4096,
+            Self::TimeVarying => DEEP_TERMS,
+        }
+    }
+}
+
+/// What the expansion of an expression would produce, known before it is built.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) struct Shape {
+    /// Terms of the expansion (an upper bound: like terms may merge), saturating.
+    terms: usize,
+    /// How many levels of sums nest in products on the way to its deepest term.
+    nesting: usize,
+    /// Whether the expansion is not done (the expression is kept as it is), by the caps.
+    kept: bool,
+}
+
+impl Shape {
+    const ATOM: Self = Self {
+        terms: 1,
+        nesting: 0,
+        kept: false,
+    };
+
+    /// The shape of a product of factors of these shapes, by [`ExprArena::multiply_out`]'s
+    /// rule.
+    fn product(factors: &[Self]) -> Self {
+        let (mut terms, mut inputs, mut nesting, mut sums) = (1usize, 0usize, 0, 0);
+        for f in factors {
+            nesting = nesting.max(f.nesting);
+            if f.terms > 1 {
+                sums += 1;
+                terms = terms.saturating_mul(f.terms);
+                inputs = inputs.saturating_add(f.terms);
+            }
+        }
+        let quadratic = terms <= MAX_QUADRATIC_TERMS && terms <= inputs.saturating_mul(inputs);
+        if terms > MAX_TERMS && !quadratic {
+            return Self::ATOM;
+        }
+        Self {
+            terms,
+            nesting: nesting + usize::from(sums > 0),
+            kept: false,
+        }
+    }
 }
 
 impl ExprArena {
@@ -54,7 +139,9 @@ impl ExprArena {
         if let Some(&x) = memo.get(&e) {
             return x;
         }
+        let kept = self.expansion_shape(e, mode).kept;
         let result = match self.node(e) {
+            _ if kept => e,
             Node::Add(terms) => {
                 let terms = terms.to_vec();
                 let t: Vec<ExprId> = terms.iter().map(|&t| self.expand_as(t, mode)).collect();
@@ -84,6 +171,79 @@ impl ExprArena {
             Expansion::TimeVarying => self.expand_time_varying_memo.insert(e, result),
         };
         result
+    }
+
+    /// The [`Shape`] of `e`'s expansion in `mode`, from the shapes of its operands (memoised;
+    /// linear in the size of the DAG). An expansion past [`DEEP_TERMS`] and [`DEEP_NESTING`]
+    /// is kept, and then counts as its own terms (a sum's) or one.
+    fn expansion_shape(&mut self, e: ExprId, mode: Expansion) -> Shape {
+        if mode == Expansion::TimeVarying && !self.contains_time_varying(e) {
+            return Shape::ATOM;
+        }
+        if let Some(&shape) = self.expansion_shapes.get(&(e, mode)) {
+            return shape;
+        }
+        let shape = match self.node(e) {
+            Node::Add(terms) => {
+                let terms = terms.to_vec();
+                terms.iter().fold(
+                    Shape {
+                        terms: 0,
+                        ..Shape::ATOM
+                    },
+                    |sum, &t| {
+                        let s = self.expansion_shape(t, mode);
+                        Shape {
+                            terms: sum.terms.saturating_add(s.terms),
+                            nesting: sum.nesting.max(s.nesting),
+                            kept: false,
+                        }
+                    },
+                )
+            }
+            Node::Mul(factors) => {
+                let factors = factors.to_vec();
+                let shapes: Vec<Shape> = factors
+                    .iter()
+                    .map(|&f| self.expansion_shape(f, mode))
+                    .collect();
+                Shape::product(&shapes)
+            }
+            &Node::Pow([b, n]) => match self.as_constant(n).and_then(|c| c.as_integer()) {
+                Some(k @ 2..=3) => {
+                    let base = self.expansion_shape(b, mode);
+                    Shape::product(&vec![base; k as usize])
+                }
+                _ => Shape::ATOM,
+            },
+            _ => Shape::ATOM,
+        };
+        let shape = if shape.terms > mode.deep_terms() && shape.nesting > DEEP_NESTING {
+            let terms = match self.node(e) {
+                Node::Add(t) => t.len(),
+                _ => 1,
+            };
+            Shape {
+                terms,
+                nesting: 0,
+                kept: true,
+            }
+        } else {
+            shape
+        };
+        self.expansion_shapes.insert((e, mode), shape);
+        shape
+    }
+
+    /// Whether [`Self::expand_time_varying`] multiplies `e` out (it is not kept by the
+    /// caps) with its sums nested at most two levels deep in products: false for
+    /// the components of a point or a partial velocity of a chain of 3-D bodies in relative
+    /// rotations past its second rotation, whose products are then best left as products
+    /// (momentum balance: 570,514 operations after CSE for 8 universal joints with its dot
+    /// products multiplied out, 63,090 with them left as products).
+    pub fn expands_shallowly(&mut self, e: ExprId) -> bool {
+        let shape = self.expansion_shape(e, Expansion::TimeVarying);
+        !shape.kept && shape.nesting <= DEEP_NESTING
     }
 
     /// Whether `e` is a sum that `mode` multiplies out.

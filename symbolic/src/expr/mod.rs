@@ -345,6 +345,8 @@ pub struct ExprArena {
     dt_memo: FxHashMap<ExprId, ExprId>,
     expand_memo: FxHashMap<ExprId, ExprId>,
     expand_time_varying_memo: FxHashMap<ExprId, ExprId>,
+    /// What each expansion would produce, per node and mode (`expand`'s caps).
+    expansion_shapes: FxHashMap<(ExprId, expand::Expansion), expand::Shape>,
     /// Canonical sums of two terms, by their (ordered) terms: collecting a chain adds one mass
     /// to the same long sum of masses once per joint above it, and each such sum would
     /// otherwise flatten, sort and merge the long one again.
@@ -383,8 +385,9 @@ impl ExprArena {
         self.nodes.is_empty()
     }
 
-    /// Bounds a derivation that would not end in reasonable time and memory (a chain of 3-D
-    /// frames nested many levels deep in relative rotations grows about 15× per level): once
+    /// Bounds a derivation that would not end in reasonable time and memory (a guard for what
+    /// the expansion's caps miss; before them, a chain of 3-D frames nested in relative
+    /// rotations grew about 15× per level): once
     /// the nodes created hold more than `limit` operands in all ([`Self::operands`]), every
     /// sum and product built is 0, so the derivation runs to its end quickly, and
     /// [`Self::over_limit`] is true. Its expressions are then meaningless: the caller reports the limit instead of

@@ -251,6 +251,77 @@ fn long_squares_are_multiplied_out() {
     assert_eq!(a.expand(w3), w3);
 }
 
+/// A vector carried through rotations nested in rotations (a point of a chain of 3-D bodies
+/// in relative rotations, each rotation `cos q vⱼ − sin q vₖ` of the sums before it) is
+/// multiplied out while its expansion is small or shallow, and its parts are kept as they are
+/// past the caps (more than 64 terms from sums nested more than two levels deep), where its
+/// terms would
+/// grow by a constant factor with each rotation (here, turning `(0, 0, 1)` about x and y in
+/// turn, as the Fibonacci numbers: 3 terms at four rotations, 55 at ten, 144 at twelve).
+/// Kept or not, the expansion equals the input at a random state (to 1e-12).
+#[test]
+fn nested_rotations_are_kept_past_the_expansion_caps() {
+    let mut a = ExprArena::new();
+    let angles: Vec<ExprId> = (0..12).map(|i| a.coordinate(&format!("q{i}"))[0]).collect();
+    let (zero, one) = (a.int(0), a.int(1));
+    let mut v = [zero, zero, one];
+    let bindings: Vec<f64> = (0..a.symbols().len())
+        .map(|k| 0.37 * k as f64 - 1.1)
+        .collect();
+    let mut expanded = Vec::new();
+    for (level, &q) in angles.iter().enumerate() {
+        // About x, then y, then x, …
+        let (j, k) = if level % 2 == 0 { (1, 2) } else { (2, 0) };
+        let (c, s) = (a.cos(q), a.sin(q));
+        let (cj, sk, sj, ck) = (
+            a.times(c, v[j]),
+            a.times(s, v[k]),
+            a.times(s, v[j]),
+            a.times(c, v[k]),
+        );
+        v[j] = a.minus(cj, sk);
+        v[k] = a.plus(sj, ck);
+        let x = a.expand_time_varying(v[k]);
+        assert!(
+            close(a.eval(x, &bindings), a.eval(v[k], &bindings), 1e-12),
+            "level {level}"
+        );
+        expanded.push((v[k], x));
+    }
+    let terms = |a: &ExprArena, e: ExprId| match a.node(e) {
+        Node::Add(t) => t.len(),
+        _ => 1,
+    };
+    // Four rotations: multiplied out into its monomials, none of them holding a sum.
+    let (input, x) = expanded[3];
+    assert_ne!(input, x);
+    let Node::Add(monomials) = a.node(x) else {
+        panic!("not multiplied out: {:?}", a.node(x));
+    };
+    assert_eq!(monomials.len(), 3);
+    for &m in monomials {
+        if let Node::Mul(factors) = a.node(m) {
+            assert!(factors.iter().all(|&f| !matches!(a.node(f), Node::Add(_))));
+        }
+    }
+    // Ten: 55 terms, multiplied out. Eleven and twelve (89 and 144 terms): the sums of the
+    // rotation before are kept, so the expansion stops at them, fewer terms, some holding a
+    // sum.
+    let (input, x) = expanded[9];
+    assert_eq!(terms(&a, x), 55, "{input:?}");
+    for (&(_, x), full) in expanded[10..].iter().zip([89, 144]) {
+        assert!(terms(&a, x) < full, "{} terms", terms(&a, x));
+        let Node::Add(monomials) = a.node(x) else {
+            panic!("not a sum: {:?}", a.node(x));
+        };
+        let holds_a_sum = |m: ExprId| match a.node(m) {
+            Node::Mul(factors) => factors.iter().any(|&f| matches!(a.node(f), Node::Add(_))),
+            _ => false,
+        };
+        assert!(monomials.iter().any(|&m| holds_a_sum(m)));
+    }
+}
+
 /// The cached small integers are the hash-consed constants, and integers at the ends of the
 /// range do not overflow the cache's slot arithmetic.
 #[test]

@@ -1,20 +1,18 @@
 //! A bound on the size of a derivation, with a located error in place of a run that would
 //! not end in reasonable time and memory.
 //!
-//! The equations of a chain of 3-D frames each turning relative to a turning parent grow
-//! steeply with each nested rotation: `check` of a chain of single-axis hinges took 0.4, 2.2
-//! and 24 s (29, 122 and 427 MB) for 6, 7 and 8 of them, and a 10-hinge chain did not end
-//! (2026-11-26; frames with their angles relative to `N` grow far more slowly). Each
-//! derivation (Lagrange's, momentum balance, …) may build [`DERIVATION_OPERAND_LIMIT`]
-//! operands. The 8-hinge chain's Lagrange derivation builds 30 million and passes; three
-//! bodies in relative z-x-z rotations, 11 million in all of `check` with a symmetric
-//! inertia, passes, and with an asymmetric one (`I₁ ≠ I₂ ≠ I₃`) its Lagrange derivation is
-//! stopped after 22 s where `check` took 151 s before (its `simulate`, by momentum balance,
-//! still runs: 144 s, 1.2 GB, most of it in planning and compiling); the 10-hinge chain is
-//! stopped after 27 s (`check`) and 22 s (`simulate`), 430 MB. The 100-link planar pendulum
-//! of `eomgen new` builds 4.7 million (1.7 s). What comes after a derivation (the plans,
-//! the native code, the Jacobians that `modes` and the implicit methods derive when first
-//! used) is not bounded here. The growth itself is the subject of another issue.
+//! The equations of a chain of 3-D frames each turning relative to a turning parent grew
+//! exponentially with each nested rotation while expansion multiplied the rotations out:
+//! `check` of a chain of single-axis hinges took 0.4, 2.2 and 24 s for 6, 7 and 8 of them,
+//! and a 10-hinge chain did not end (2026-11-26). The expansion's caps
+//! ([`crate::expr::ExprArena::expand_time_varying`], `expr/expand.rs`) now keep such
+//! rotations nested: 0.04, 0.03 and 0.08 s for 6, 8 and 10 hinges, 0.2 s for 16, and three
+//! bodies in relative z-x-z rotations with an asymmetric inertia check in 0.01 s where they
+//! took 8 s (docs/performance.md, "Derivations of 3-D chains"). The bound stays, as a
+//! guard for what the caps do not catch: each derivation (Lagrange's, momentum balance, …)
+//! may build [`DERIVATION_OPERAND_LIMIT`] operands. What comes after a derivation (the
+//! plans, the native code, the Jacobians that `modes` and the implicit methods derive when
+//! first used) is not bounded here.
 
 use super::SymbolicModel;
 use crate::model::diagnostic::Diagnostic;

@@ -163,8 +163,13 @@ impl<'a> Kinematics<'a> {
 }
 
 /// `a·b`, multiplied out where it changes in time (so that products of sines and cosines of
-/// two angles meet as the terms of one sum and become functions of their difference).
+/// two angles meet as the terms of one sum and become functions of their difference), unless
+/// a component is nested too deeply to multiply out ([`ExprArena::expands_shallowly`]: a
+/// point of a chain of 3-D bodies in relative rotations), when the products are kept.
 fn dot_multiplied_out(arena: &mut ExprArena, a: &[ExprId], b: &[ExprId]) -> ExprId {
+    if !a.iter().chain(b).all(|&c| arena.expands_shallowly(c)) {
+        return dot(arena, a, b);
+    }
     let terms: Vec<ExprId> = a
         .iter()
         .zip(b)
