@@ -112,7 +112,7 @@ pub struct EquationsListing {
 impl EquationsListing {
     /// Prints the equations `eom` of `model` in `syntax`.
     pub fn of(model: &SymbolicModel, eom: &EquationsOfMotion, syntax: Syntax) -> Self {
-        let p = Printer::new(&model.arena, syntax);
+        let p = Printer::for_display(&model.arena, syntax);
         let n = eom.num_dofs;
         let c = &model.constraints;
         let constraints = (0..c.len())
@@ -255,7 +255,7 @@ pub fn equations_text(model: &SymbolicModel, eom: &EquationsOfMotion) -> String 
 /// `M q̈ + Jᵀλ = F`, `J q̈ = γ` and each constraint's equation `= 0`.
 pub fn equations_latex(model: &SymbolicModel, eom: &EquationsOfMotion) -> String {
     let e = EquationsListing::of(model, eom, Syntax::Latex);
-    let p = Printer::new(&model.arena, Syntax::Latex);
+    let p = Printer::for_display(&model.arena, Syntax::Latex);
     let n = e.coordinates.len();
     let bmatrix = |rows: &[String]| {
         format!(
@@ -357,7 +357,7 @@ pub fn equations_mathml(model: &SymbolicModel, eom: &EquationsOfMotion) -> Vec<S
         }
         lhs.push(arena.sum(&terms));
     }
-    let p = Printer::new(&arena, Syntax::MathMl);
+    let p = Printer::for_display(&arena, Syntax::MathMl);
     let line = |body: String| format!("<math display=\"block\">{body}</math>");
     let equals = "<mo>=</mo>";
     let mut out = vec![

@@ -38,7 +38,17 @@ pub struct Printer<'a> {
     symbol_name: Box<dyn Fn(SymbolId) -> String + 'a>,
     temporary: Box<dyn Fn(ExprId) -> Option<String> + 'a>,
     helpers: String,
+    /// See [`Printer::for_display`].
+    display_limit: Option<u64>,
 }
+
+/// The most operations (as a tree, [`ExprArena::tree_operation_count`]) of an expression that
+/// [`Printer::for_display`] prints: about 200 kB of text on one line. Past it a printed tree
+/// is no use to a reader, and for a chain of 3-D bodies in relative rotations, whose
+/// equations share subexpressions level by level, it costs time and memory exponential in
+/// the chain (8 universal joints: 10⁸ operations as trees, 68,408 after CSE). Among the
+/// bundled models only seven entries of the Whipple bicycle's `F` and `γ` pass it.
+pub const DISPLAY_LIMIT: u64 = 20_000;
 
 impl<'a> Printer<'a> {
     /// A printer that names symbols by their declared name (LaTeX: [`latex_symbol`]).
@@ -54,6 +64,18 @@ impl<'a> Printer<'a> {
             symbol_name,
             temporary: Box::new(|_| None),
             helpers: "crate".to_string(),
+            display_limit: None,
+        }
+    }
+
+    /// A printer for people to read (equation listings, reports): an expression of more than
+    /// [`DISPLAY_LIMIT`] operations as a tree is printed as a note that says so and how many
+    /// (the generated code, `equations --rust`, prints it with its shared subexpressions
+    /// named).
+    pub fn for_display(arena: &'a ExprArena, syntax: Syntax) -> Self {
+        Self {
+            display_limit: Some(DISPLAY_LIMIT),
+            ..Self::new(arena, syntax)
         }
     }
 
@@ -77,6 +99,19 @@ impl<'a> Printer<'a> {
 
     /// `expr` printed in full (temporaries still referenced by name if configured).
     pub fn print(&self, expr: ExprId) -> String {
+        if let Some(limit) = self.display_limit {
+            let operations = self.arena.tree_operation_count(&[expr]);
+            if operations > limit {
+                let note = format!(
+                    "[not printed: {operations} operations as a tree; `equations --rust` prints it with its shared subexpressions]"
+                );
+                return match self.syntax {
+                    Syntax::Latex => format!("\\text{{{}}}", note.replace('`', "")),
+                    Syntax::MathMl => format!("<mtext>{}</mtext>", note.replace('`', "")),
+                    Syntax::Text | Syntax::Rust => note,
+                };
+            }
+        }
         self.operand(expr).0
     }
 

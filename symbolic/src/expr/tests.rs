@@ -322,6 +322,45 @@ fn nested_rotations_are_kept_past_the_expansion_caps() {
     }
 }
 
+/// A display printer prints an expression as a tree up to `DISPLAY_LIMIT` operations and a
+/// note past it (a DAG whose tree doubles per level: `e ← e·sin(e) + x`, 16 levels), in every
+/// syntax; the code printer (`Printer::new`) still prints it whole, and below the limit both
+/// print the same.
+#[test]
+fn display_printers_print_a_note_past_the_limit() {
+    use super::print::DISPLAY_LIMIT;
+    let mut a = ExprArena::new();
+    let x = a.coordinate("x")[0];
+    let mut e = x;
+    let mut small = None;
+    for _ in 0..16 {
+        let s = a.sin(e);
+        let p = a.times(e, s);
+        e = a.plus(p, x);
+        if a.tree_operation_count(&[e]) <= DISPLAY_LIMIT {
+            small = Some(e);
+        }
+    }
+    let (small, operations) = (
+        small.expect("a level under the limit"),
+        a.tree_operation_count(&[e]),
+    );
+    assert!(operations > DISPLAY_LIMIT);
+    for syntax in [Syntax::Text, Syntax::Latex, Syntax::MathMl] {
+        let shown = Printer::for_display(&a, syntax).print(e);
+        assert!(
+            shown.contains(&format!("not printed: {operations} operations")),
+            "{shown}"
+        );
+        assert!(shown.len() < 200, "{shown}");
+        assert_eq!(
+            Printer::for_display(&a, syntax).print(small),
+            Printer::new(&a, syntax).print(small)
+        );
+    }
+    assert!(Printer::new(&a, Syntax::Text).print(e).len() > 100_000);
+}
+
 /// The cached small integers are the hash-consed constants, and integers at the ends of the
 /// range do not overflow the cache's slot arithmetic.
 #[test]
