@@ -234,7 +234,7 @@ fn issue_18_lagrange_is_compact_on_long_chains() {
 /// a power of the joints, not exponentially, and its two derivations agree. Multiplied out,
 /// the rotations made 74,370 operations after CSE at 3 joints and 1,114,843 at 4 (×15 per
 /// joint; 8 did not end). Now, from 4 joints to 8, each derivation's operations after CSE
-/// grow at most 2^3.5 ≈ 11.3× (Lagrange 9,832 → 82,059, momentum balance 13,294 → 68,408),
+/// grow at most 2^3.5 ≈ 11.3× (Lagrange 9,832 → 82,059, momentum balance 13,294 → 72,457),
 /// and stay under 100,000 at 8. Past its operand limit (the exponential growth back) the
 /// check is an error, so this fails rather than hangs.
 #[test]
@@ -261,6 +261,56 @@ fn universal_joint_chains_grow_as_a_power_of_the_joints() {
             "{four:?} → {eight:?}: ×{growth:.1}"
         );
     }
+}
+
+/// Issue 52's caps leave planar chains alone: a 5-link pendulum written in relative angles
+/// (each bar's angle the sum of the joint angles above it, its velocities products of rates
+/// and sums) has its kinetic energy multiplied out as before, so Lagrange's equations cost
+/// 675 operations after CSE. Counting its `½ m` as a level of nesting kept `T` and cost
+/// 1,251.
+#[test]
+fn planar_chains_in_relative_angles_are_multiplied_out() {
+    let n = 5;
+    let angle = |i: usize| {
+        (1..=i)
+            .map(|k| format!("q{k}"))
+            .collect::<Vec<_>>()
+            .join("+")
+    };
+    let mut source = format!(
+        "name: relative\ndescription: A planar chain in relative angles.\nparameters: {{ m: 1.0, l: 1.0, g: 10.0 }}\ncoordinates: [{}]\npoints:\n",
+        (1..=n)
+            .map(|i| format!("q{i}"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
+    for i in 1..=n {
+        let sum = |f: &str| -> String {
+            (1..i)
+                .map(|j| format!("l*{f}({}) + ", angle(j)))
+                .collect::<String>()
+        };
+        source += &format!(
+            "  G{i}: [{}l/2*cos({a}), {}l/2*sin({a})]\n",
+            sum("cos"),
+            sum("sin"),
+            a = angle(i)
+        );
+    }
+    source += "bodies:\n";
+    for i in 1..=n {
+        source += &format!(
+            "  b{i}: {{ mass: m, inertia: m*l^2/12, com: G{i}, angle: {} }}\n",
+            angle(i)
+        );
+    }
+    source += "gravity: [0, -g]\ninitial: { q1: 0.3 }\n";
+    let file = eomgen_symbolic::model::load("relative.yaml", &source).expect("loads");
+    let report =
+        eomgen_symbolic::mechanics::cross_check::check_model(&file, 20, 7).expect("derives");
+    assert!(report.comparisons[0].max_rel_residual < 1e-12, "{report:?}");
+    let lagrange = ops_after_cse(&report, "lagrange");
+    assert!(lagrange <= 700, "{lagrange} operations after CSE");
 }
 
 /// The formulation generated code uses is chosen without deriving: momentum balance for a

@@ -45,7 +45,7 @@ pub struct EquationsArgs {
 pub struct NewArgs {
     /// `n-link-pendulum`, `n-mass-chain` or `universal-joint-chain`.
     pub template: String,
-    /// Size (number of bars or masses), at least 1.
+    /// Size (number of bars, masses or joints), at least 1.
     pub n: usize,
 }
 

@@ -13,15 +13,20 @@
 //!   count is quadratic in its input (a square such as `v·v`, up to [`MAX_QUADRATIC_TERMS`]);
 //! - a sum or product whose expansion would have more than [`DEEP_TERMS`] terms from sums
 //!   nested more than [`DEEP_NESTING`] levels deep in products stays as it is. The terms of
-//!   such an expansion double with each level, although the expression (a DAG, each level
-//!   sharing the one below) grows by a constant: the components of a point of a chain of
-//!   3-D bodies in relative rotations, each rotation `cos a vⱼ − sin a vₖ` with `vⱼ` and `vₖ`
-//!   the previous rotation's sums, have `4ᴺ` terms multiplied out for `N` two-axis joints. Kept
-//!   nested, the chain's equations grow as a power of `N` (docs/performance.md, "Derivations
-//!   of 3-D chains").
+//!   such an expansion grow by a constant factor with each level (at most 2), although the
+//!   expression (a DAG, each level sharing the one below) grows by a constant: the components
+//!   of a point of a chain of 3-D bodies in relative rotations, each rotation
+//!   `cos a vⱼ − sin a vₖ` with `vⱼ` and `vₖ` the previous rotation's sums, have terms
+//!   exponential in the rotations multiplied out (up to `2` per rotation; 1.6 for rotations
+//!   about x and y in turn). Kept nested, the chain's equations grow as a power of the joints
+//!   (docs/performance.md, "Derivations of 3-D chains").
 //!
-//! Both caps are decided from the expression's shape before anything is built
-//! ([`ExprArena::expansion_shape`], memoised per node).
+//! Both caps are decided from the expression's estimated shape before anything is built
+//! ([`ExprArena::expansion_shape`], memoised per node). The estimate counts a square's
+//! terms as `t²` and like terms as distinct, so it can be above the real count; `expand`
+//! decides [`MAX_TERMS`] again from the real one. `expand` of an expansion that kept parts
+//! may multiply out more of them (it is not idempotent); the zero tests use
+//! [`ExprArena::expand`], which keeps nothing past [`MAX_TERMS`].
 
 use super::{ExprArena, ExprId, Node};
 
@@ -39,34 +44,46 @@ const MAX_QUADRATIC_TERMS: usize = 1 << 16;
 /// deep in products. Chosen on the universal-joint chains of `eomgen new
 /// universal-joint-chain` (N = 2…8, `check` time and operations after CSE of both
 /// derivations, best at 16–64) while leaving every bundled model's equations as they were
-/// except the Whipple bicycle's, whose Lagrange form halves (8,061 → 3,875 operations after
-/// CSE).
+/// except the Whipple bicycle's, whose equations became cheaper (Lagrange's 8,061 → 3,875
+/// operations after CSE, momentum balance's 8,815 → 5,623).
 const DEEP_TERMS: usize = 64;
 
-/// How deeply sums may nest in products before [`DEEP_TERMS`] applies: a planar chain's
-/// kinetic energy `Σ ½ m v·v` nests two levels (the sum `v`, its square, the sum over
-/// bodies) and multiplies out whatever its size, which its Lagrange derivation needs to
-/// cancel terms and sum the masses of a chain (1 caps the 40-link pendulum's `T` and costs it
-/// 11× the operations).
+/// [`DEEP_TERMS`] for the full expansion of the symbolic equality proof and of
+/// [`ExprArena::expand_if_cheaper`] ([`ExprArena::expand_bounded`]): a bound on their work
+/// (uncapped, `check` of 8 universal joints took 14 s, nearly all in them; every bundled
+/// model's proof stays within it). [`ExprArena::expand`], which the zero tests of the
+/// lowering and the reduction use, has no such bound.
+const BOUNDED_DEEP_TERMS: usize = 4096;
+
+/// How deeply sums may nest in products before [`DEEP_TERMS`] applies. A level is a product
+/// of a sum with another sum or a time-varying factor (a rate, a sine), or with constants
+/// when the sum's terms multiply more than two sines and cosines: each simple rotation
+/// `cos a vⱼ − sin a vₖ` of a sum is a level, and so is a mass times a 3-D body's nested
+/// velocities. A planar chain's kinetic energy `Σ ½ m v·v` nests at most two levels (`v·v`,
+/// and the rates times sums in `v` with relative angles) and is multiplied out whatever its
+/// size, which its Lagrange derivation needs to cancel terms and sum the masses of a chain
+/// (counting `½ m` as a level cost a 5-link chain in relative angles 1.9× the operations,
+/// and 1 level the 40-link pendulum 11×).
 const DEEP_NESTING: usize = 2;
 
-/// Which sums [`ExprArena::expand`] multiplies out.
+/// Which sums [`ExprArena::expand`] multiplies out, and within which bound.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub(super) enum Expansion {
-    /// Every sum.
+    /// Every sum, with no bound but [`MAX_TERMS`].
     Full,
-    /// Only sums that change in time; a constant-in-time sum such as `R − r` stays a factor.
+    /// Every sum, within [`BOUNDED_DEEP_TERMS`].
+    Bounded,
+    /// Only sums that change in time, within [`DEEP_TERMS`]; a constant-in-time sum such as
+    /// `R − r` stays a factor.
     TimeVarying,
 }
 
 impl Expansion {
-    /// [`DEEP_TERMS`] for the derivations' time-varying expansion; for the full expansion of
-    /// the symbolic equality proof and of [`ExprArena::expand_if_cheaper`], 4,096 (a bound on
-    /// their work: uncapped, `check` of 8 universal joints took 14 s, nearly all in them;
-    /// every bundled model's proof stays within it).
+    /// The most terms of an expansion of sums nested past [`DEEP_NESTING`].
     fn deep_terms(self) -> usize {
         match self {
-            Self::Full => 4096,
+            Self::Full => usize::MAX,
+            Self::Bounded => BOUNDED_DEEP_TERMS,
             Self::TimeVarying => DEEP_TERMS,
         }
     }
@@ -77,47 +94,96 @@ impl Expansion {
 pub(super) struct Shape {
     /// Terms of the expansion (an upper bound: like terms may merge), saturating.
     terms: usize,
-    /// How many levels of sums nest in products on the way to its deepest term.
+    /// How many levels of sums nest in products on the way to its deepest term (see
+    /// [`DEEP_NESTING`]).
     nesting: usize,
     /// Whether the expansion is not done (the expression is kept as it is), by the caps.
     kept: bool,
+    /// Whether it changes in time (a constant-in-time factor, such as a mass, does not make a
+    /// product a level of nesting).
+    varying: bool,
+    /// The most time-varying functions (sines, cosines, …) multiplied in one term.
+    degree: usize,
 }
 
 impl Shape {
+    /// A symbol or function: one term, no nesting.
     const ATOM: Self = Self {
         terms: 1,
         nesting: 0,
         kept: false,
+        varying: true,
+        degree: 0,
+    };
+
+    /// A factor constant in time (in [`Expansion::TimeVarying`], which leaves it alone).
+    const CONSTANT: Self = Self {
+        varying: false,
+        ..Self::ATOM
     };
 
     /// The shape of a product of factors of these shapes, by [`ExprArena::multiply_out`]'s
-    /// rule.
+    /// rule. A product left unexpanded by [`MAX_TERMS`] is one term at the nesting its
+    /// expansion would have had.
     fn product(factors: &[Self]) -> Self {
         let (mut terms, mut inputs, mut nesting, mut sums) = (1usize, 0usize, 0, 0);
+        let mut other_varying = false;
+        let mut degree = 0usize;
         for f in factors {
+            degree = degree.saturating_add(f.degree);
             nesting = nesting.max(f.nesting);
             if f.terms > 1 {
                 sums += 1;
                 terms = terms.saturating_mul(f.terms);
                 inputs = inputs.saturating_add(f.terms);
+            } else if f.varying {
+                other_varying = true;
             }
         }
+        let sum_degree = factors
+            .iter()
+            .filter(|f| f.terms > 1)
+            .map(|f| f.degree)
+            .max()
+            .unwrap_or(0);
+        // A sum times constants is a level only when the sum multiplies more than two
+        // functions in a term (a rotation's, not a planar chain's `cos θᵢ cos θⱼ`).
+        let level = sums > 1 || (sums == 1 && (other_varying || sum_degree > 2));
+        let nesting = nesting + usize::from(level);
+        let varying = factors.iter().any(|f| f.varying);
         let quadratic = terms <= MAX_QUADRATIC_TERMS && terms <= inputs.saturating_mul(inputs);
         if terms > MAX_TERMS && !quadratic {
-            return Self::ATOM;
+            return Self {
+                nesting,
+                varying,
+                degree,
+                ..Self::ATOM
+            };
         }
         Self {
             terms,
-            nesting: nesting + usize::from(sums > 0),
+            nesting,
             kept: false,
+            varying,
+            degree,
         }
     }
 }
 
 impl ExprArena {
-    /// `e` with products of sums and small powers of sums multiplied out (memoised).
+    /// `e` with products of sums and small powers of sums multiplied out (memoised), with no
+    /// bound but the 512-term cap on products of three or more sums: for the tests that a
+    /// difference is exactly zero.
     pub fn expand(&mut self, e: ExprId) -> ExprId {
         self.expand_as(e, Expansion::Full)
+    }
+
+    /// [`Self::expand`] within a bound on its work: a sum or product whose expansion would
+    /// have more than 4,096 terms from sums nested more than two levels deep is kept as it
+    /// is. For the symbolic equality proof of `check`, which then fails (and the numeric
+    /// comparison decides), and [`Self::expand_if_cheaper`].
+    pub fn expand_bounded(&mut self, e: ExprId) -> ExprId {
+        self.expand_as(e, Expansion::Bounded)
     }
 
     /// `e` with products of time-varying sums multiplied out, constant-in-time sums kept as
@@ -134,6 +200,7 @@ impl ExprArena {
         }
         let memo = match mode {
             Expansion::Full => &self.expand_memo,
+            Expansion::Bounded => &self.expand_bounded_memo,
             Expansion::TimeVarying => &self.expand_time_varying_memo,
         };
         if let Some(&x) = memo.get(&e) {
@@ -168,6 +235,7 @@ impl ExprArena {
         };
         match mode {
             Expansion::Full => self.expand_memo.insert(e, result),
+            Expansion::Bounded => self.expand_bounded_memo.insert(e, result),
             Expansion::TimeVarying => self.expand_time_varying_memo.insert(e, result),
         };
         result
@@ -178,7 +246,7 @@ impl ExprArena {
     /// is kept, and then counts as its own terms (a sum's) or one.
     fn expansion_shape(&mut self, e: ExprId, mode: Expansion) -> Shape {
         if mode == Expansion::TimeVarying && !self.contains_time_varying(e) {
-            return Shape::ATOM;
+            return Shape::CONSTANT;
         }
         if let Some(&shape) = self.expansion_shapes.get(&(e, mode)) {
             return shape;
@@ -189,7 +257,7 @@ impl ExprArena {
                 terms.iter().fold(
                     Shape {
                         terms: 0,
-                        ..Shape::ATOM
+                        ..Shape::CONSTANT
                     },
                     |sum, &t| {
                         let s = self.expansion_shape(t, mode);
@@ -197,6 +265,8 @@ impl ExprArena {
                             terms: sum.terms.saturating_add(s.terms),
                             nesting: sum.nesting.max(s.nesting),
                             kept: false,
+                            varying: sum.varying || s.varying,
+                            degree: sum.degree.max(s.degree),
                         }
                     },
                 )
@@ -214,19 +284,22 @@ impl ExprArena {
                     let base = self.expansion_shape(b, mode);
                     Shape::product(&vec![base; k as usize])
                 }
-                _ => Shape::ATOM,
+                _ => self.atom_shape(e),
             },
-            _ => Shape::ATOM,
+            _ => self.atom_shape(e),
         };
         let shape = if shape.terms > mode.deep_terms() && shape.nesting > DEEP_NESTING {
             let terms = match self.node(e) {
                 Node::Add(t) => t.len(),
                 _ => 1,
             };
+            // What contains it counts its nesting afresh from here.
             Shape {
                 terms,
                 nesting: 0,
                 kept: true,
+                varying: true,
+                degree: 0,
             }
         } else {
             shape
@@ -235,12 +308,27 @@ impl ExprArena {
         shape
     }
 
+    /// The shape of a node the expansion does not enter (a symbol, constant or function).
+    fn atom_shape(&self, e: ExprId) -> Shape {
+        if !self.contains_time_varying(e) {
+            Shape::CONSTANT
+        } else if matches!(self.node(e), Node::Func(..)) {
+            Shape {
+                degree: 1,
+                ..Shape::ATOM
+            }
+        } else {
+            Shape::ATOM
+        }
+    }
+
     /// Whether [`Self::expand_time_varying`] multiplies `e` out (it is not kept by the
-    /// caps) with its sums nested at most two levels deep in products: false for
-    /// the components of a point or a partial velocity of a chain of 3-D bodies in relative
-    /// rotations past its second rotation, whose products are then best left as products
+    /// caps) with its sums nested at most two levels deep in products (counted from the
+    /// parts the caps keep, which are factors to it): false for the components of a point or
+    /// a partial velocity of a chain of 3-D bodies in relative rotations past its second
+    /// rotation, whose products are then best left as products
     /// (momentum balance: 570,514 operations after CSE for 8 universal joints with its dot
-    /// products multiplied out, 63,090 with them left as products).
+    /// products multiplied out, 72,457 with them left as products).
     pub fn expands_shallowly(&mut self, e: ExprId) -> bool {
         let shape = self.expansion_shape(e, Expansion::TimeVarying);
         !shape.kept && shape.nesting <= DEEP_NESTING
@@ -249,7 +337,7 @@ impl ExprArena {
     /// Whether `e` is a sum that `mode` multiplies out.
     fn is_distributed(&self, e: ExprId, mode: Expansion) -> bool {
         matches!(self.node(e), Node::Add(_))
-            && (mode == Expansion::Full || self.contains_time_varying(e))
+            && (mode != Expansion::TimeVarying || self.contains_time_varying(e))
     }
 
     /// Π factors with every sum factor (that `mode` multiplies out) distributed, unless that
@@ -327,7 +415,7 @@ impl ExprArena {
 
     /// The expansion of `e` if it evaluates with fewer operations (as a tree), else `e`.
     pub fn expand_if_cheaper(&mut self, e: ExprId) -> ExprId {
-        let x = self.expand(e);
+        let x = self.expand_bounded(e);
         if self.tree_operation_count(&[x]) < self.tree_operation_count(&[e]) {
             x
         } else {

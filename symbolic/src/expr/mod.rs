@@ -345,6 +345,7 @@ pub struct ExprArena {
     dt_memo: FxHashMap<ExprId, ExprId>,
     expand_memo: FxHashMap<ExprId, ExprId>,
     expand_time_varying_memo: FxHashMap<ExprId, ExprId>,
+    expand_bounded_memo: FxHashMap<ExprId, ExprId>,
     /// What each expansion would produce, per node and mode (`expand`'s caps).
     expansion_shapes: FxHashMap<(ExprId, expand::Expansion), expand::Shape>,
     /// Canonical sums of two terms, by their (ordered) terms: collecting a chain adds one mass

@@ -99,14 +99,18 @@ impl<'a> Printer<'a> {
 
     /// `expr` printed in full (temporaries still referenced by name if configured).
     pub fn print(&self, expr: ExprId) -> String {
-        if let Some(limit) = self.display_limit {
+        // Code is printed whole, whatever its size.
+        if let Some(limit) = self.display_limit.filter(|_| self.syntax != Syntax::Rust) {
             let operations = self.arena.tree_operation_count(&[expr]);
             if operations > limit {
                 let note = format!(
                     "[not printed: {operations} operations as a tree; `equations --rust` prints it with its shared subexpressions]"
                 );
                 return match self.syntax {
-                    Syntax::Latex => format!("\\text{{{}}}", note.replace('`', "")),
+                    // `--` would print as an en dash in LaTeX.
+                    Syntax::Latex => {
+                        format!("\\text{{{}}}", note.replace('`', "").replace("--", "-{}-"))
+                    }
                     Syntax::MathMl => format!("<mtext>{}</mtext>", note.replace('`', "")),
                     Syntax::Text | Syntax::Rust => note,
                 };

@@ -304,11 +304,12 @@ fn nested_rotations_are_kept_past_the_expansion_caps() {
             assert!(factors.iter().all(|&f| !matches!(a.node(f), Node::Add(_))));
         }
     }
-    // Ten: 55 terms, multiplied out. Eleven and twelve (89 and 144 terms): the sums of the
-    // rotation before are kept, so the expansion stops at them, fewer terms, some holding a
-    // sum.
+    // Ten: 55 terms, multiplied out. Eleven (89 terms): kept, the sum itself. Twelve (144):
+    // its parts from the rotation before are kept, so the expansion stops at them, fewer
+    // terms, some holding a sum.
     let (input, x) = expanded[9];
     assert_eq!(terms(&a, x), 55, "{input:?}");
+    assert_eq!(expanded[10].0, expanded[10].1);
     for (&(_, x), full) in expanded[10..].iter().zip([89, 144]) {
         assert!(terms(&a, x) < full, "{} terms", terms(&a, x));
         let Node::Add(monomials) = a.node(x) else {

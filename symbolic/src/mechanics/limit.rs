@@ -6,9 +6,10 @@
 //! `check` of a chain of single-axis hinges took 0.4, 2.2 and 24 s for 6, 7 and 8 of them,
 //! and a 10-hinge chain did not end (2026-11-26). The expansion's caps
 //! ([`crate::expr::ExprArena::expand_time_varying`], `expr/expand.rs`) now keep such
-//! rotations nested: 0.04, 0.03 and 0.08 s for 6, 8 and 10 hinges, 0.2 s for 16, and three
-//! bodies in relative z-x-z rotations with an asymmetric inertia check in 0.01 s where they
-//! took 8 s (docs/performance.md, "Derivations of 3-D chains"). The bound stays, as a
+//! rotations nested: 6, 8 and 10 hinges check in 0.04–0.08 s and 16 in 2.6 s, and three
+//! bodies in relative z-x-z rotations with an asymmetric inertia in 0.02 s where they took
+//! 8.3 s
+//! (docs/performance.md, "Derivations of 3-D chains"). The bound stays, as a
 //! guard for what the caps do not catch: each derivation (Lagrange's, momentum balance, …)
 //! may build [`DERIVATION_OPERAND_LIMIT`] operands. What comes after a derivation (the
 //! plans, the native code, the Jacobians that `modes` and the implicit methods derive when
@@ -71,7 +72,7 @@ pub fn finish_derivation(
                 ),
             )
             .with_help(
-                "frames given their angles relative to N (`parent: N`) derive far faster; a chain of 7 single-axis hinges each relative to the one before derives in about 2 s",
+                "frames given their angles relative to N (`parent: N`) keep the equations shallower; a chain of 10 single-axis hinges each relative to the one before derives in well under a second",
             )
         }
         _ => {

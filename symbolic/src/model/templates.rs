@@ -19,9 +19,9 @@ pub const TEMPLATES: &[&str] = &["n-link-pendulum", "n-mass-chain", "universal-j
 /// once 200, is 100. The mass chain's file and equations grow as `n` (its `M` is diagonal,
 /// and every quadratic pass over it has been taken out): 1000 masses check in ~3 s. The
 /// universal-joint chain's equations grow as about `n³` in operations (3-D bodies in
-/// relative rotations, nested `2n` rotations deep): 12 joints check in ~1 s and simulate in
-/// ~3 s; at 16, `check` takes ~3 s but a first simulation ~17 s, nearly all of it Cranelift
-/// compiling the 600,000-operation right-hand side, so the limit is 12.
+/// relative rotations, nested `2n` rotations deep): 12 joints check in ~1.7 s and simulate
+/// in ~4 s; at 16, `check` takes ~7 s and a first simulation ~17 s, nearly all of it
+/// Cranelift compiling the 600,000-operation right-hand side, so the limit is 12.
 pub const MAX_SIZES: [usize; 3] = [100, 1_000, 12];
 
 /// Why [`generate`] wrote no file.
@@ -321,6 +321,7 @@ pub fn n_mass_chain(n: usize) -> String {
 /// uniform bars, one swinging in y–z (the `a`s) and one in x–z (the `b`s), with the relative
 /// angles of the joints: the file checks each of [`n_link_pendulum`]'s closed-form frequencies
 /// twice for `n ≤ 3`, and from `n = 4` the energy drift.
+// Long: the text of the generated model file, section by section in the file's order.
 pub fn universal_joint_chain(n: usize) -> String {
     let mut w = String::new();
     let _ = writeln!(

@@ -42,7 +42,7 @@ pub fn check_model(
                     .chain(lagrange.forcing.iter().zip(&b.forcing))
                     .all(|(x, y)| {
                         let d = arena.minus(*x, *y);
-                        let e = arena.expand(d);
+                        let e = arena.expand_bounded(d);
                         arena.is_zero(e)
                     })
             })
