@@ -232,9 +232,9 @@ fn issue_18_lagrange_is_compact_on_long_chains() {
 /// Issue 52 (derivations that scale in 3-D): a chain of bars joined by universal joints, whose
 /// points lie two rotations deeper per joint, derives in a number of operations that grows as
 /// a power of the joints, not exponentially, and its two derivations agree. Multiplied out,
-/// the rotations made 74,370 operations after CSE at 3 joints and 1,114,843 at 4 (×15 per
-/// joint; 8 did not end). Now, from 4 joints to 8, each derivation's operations after CSE
-/// grow at most 2^3.5 ≈ 11.3× (Lagrange 9,832 → 82,059, momentum balance 13,294 → 72,457),
+/// the rotations made 33,244 operations after CSE (Lagrange) at 3 joints and 517,133 at 4
+/// (×16–21 per joint; 8 did not end). Now, from 4 joints to 8, each derivation's operations after CSE
+/// grow at most 2^3.5 ≈ 11.3× (Lagrange 9,832 → 82,059, momentum balance 13,294 → 68,408),
 /// and stay under 100,000 at 8. Past its operand limit (the exponential growth back) the
 /// check is an error, so this fails rather than hangs.
 #[test]
@@ -310,7 +310,8 @@ fn planar_chains_in_relative_angles_are_multiplied_out() {
         eomgen_symbolic::mechanics::cross_check::check_model(&file, 20, 7).expect("derives");
     assert!(report.comparisons[0].max_rel_residual < 1e-12, "{report:?}");
     let lagrange = ops_after_cse(&report, "lagrange");
-    assert!(lagrange <= 700, "{lagrange} operations after CSE");
+    // 675 now; the margin leaves room for CSE changes and fails at the kept form's 1,251.
+    assert!(lagrange <= 800, "{lagrange} operations after CSE");
 }
 
 /// The formulation generated code uses is chosen without deriving: momentum balance for a

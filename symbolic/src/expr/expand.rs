@@ -11,7 +11,8 @@
 //! Two caps guard against growth:
 //! - a product of three or more sums stays a product past [`MAX_TERMS`] terms, unless the
 //!   count is quadratic in its input (a square such as `v·v`, up to [`MAX_QUADRATIC_TERMS`]);
-//! - a sum or product whose expansion would have more than [`DEEP_TERMS`] terms from sums
+//! - a sum or product whose expansion would have more than [`DEEP_TERMS`] terms (4,096 in
+//!   [`ExprArena::expand_bounded`], none in [`ExprArena::expand`]) from sums
 //!   nested more than [`DEEP_NESTING`] levels deep in products stays as it is. The terms of
 //!   such an expansion grow by a constant factor with each level (at most 2), although the
 //!   expression (a DAG, each level sharing the one below) grows by a constant: the components
@@ -25,8 +26,10 @@
 //! ([`ExprArena::expansion_shape`], memoised per node). The estimate counts a square's
 //! terms as `t²` and like terms as distinct, so it can be above the real count; `expand`
 //! decides [`MAX_TERMS`] again from the real one. `expand` of an expansion that kept parts
-//! may multiply out more of them (it is not idempotent); the zero tests use
-//! [`ExprArena::expand`], which keeps nothing past [`MAX_TERMS`].
+//! may multiply out more of them (it is not idempotent). [`ExprArena::expand`], for where
+//! every term must be seen (the lowering's zero tests, the reduction's coefficients), has no
+//! depth cap; the symbolic equality proof uses [`ExprArena::expand_bounded`], and a kept part
+//! only makes it fail, never succeed wrongly.
 
 use super::{ExprArena, ExprId, Node};
 
@@ -57,9 +60,9 @@ const BOUNDED_DEEP_TERMS: usize = 4096;
 
 /// How deeply sums may nest in products before [`DEEP_TERMS`] applies. A level is a product
 /// of a sum with another sum or a time-varying factor (a rate, a sine), or with constants
-/// when the sum's terms multiply more than two sines and cosines: each simple rotation
-/// `cos a vⱼ − sin a vₖ` of a sum is a level, and so is a mass times a 3-D body's nested
-/// velocities. A planar chain's kinetic energy `Σ ½ m v·v` nests at most two levels (`v·v`,
+/// when the sum's terms multiply more than two sines and cosines (or it holds a kept part,
+/// which counts as a rotation's): each simple rotation `cos a vⱼ − sin a vₖ` of a sum is a
+/// level, and so is a mass times a 3-D body's nested velocities. A planar chain's kinetic energy `Σ ½ m v·v` nests at most two levels (`v·v`,
 /// and the rates times sums in `v` with relative angles) and is multiplied out whatever its
 /// size, which its Lagrange derivation needs to cancel terms and sum the masses of a chain
 /// (counting `½ m` as a level cost a 5-link chain in relative angles 1.9× the operations,
@@ -172,8 +175,9 @@ impl Shape {
 
 impl ExprArena {
     /// `e` with products of sums and small powers of sums multiplied out (memoised), with no
-    /// bound but the 512-term cap on products of three or more sums: for the tests that a
-    /// difference is exactly zero.
+    /// bound on how deeply sums nest (products stay capped at 512 terms, 65,536 for one that
+    /// is quadratic in its input): for where every term must be seen, the tests that a
+    /// difference is exactly zero, the coefficients and radicands of the reduction.
     pub fn expand(&mut self, e: ExprId) -> ExprId {
         self.expand_as(e, Expansion::Full)
     }
@@ -206,7 +210,8 @@ impl ExprArena {
         if let Some(&x) = memo.get(&e) {
             return x;
         }
-        let kept = self.expansion_shape(e, mode).kept;
+        // The full expansion keeps nothing by depth: no shape to estimate.
+        let kept = mode != Expansion::Full && self.expansion_shape(e, mode).kept;
         let result = match self.node(e) {
             _ if kept => e,
             Node::Add(terms) => {
@@ -242,8 +247,9 @@ impl ExprArena {
     }
 
     /// The [`Shape`] of `e`'s expansion in `mode`, from the shapes of its operands (memoised;
-    /// linear in the size of the DAG). An expansion past [`DEEP_TERMS`] and [`DEEP_NESTING`]
-    /// is kept, and then counts as its own terms (a sum's) or one.
+    /// linear in the size of the DAG). An expansion past the mode's term bound
+    /// ([`DEEP_TERMS`], [`BOUNDED_DEEP_TERMS`]) and [`DEEP_NESTING`] is kept, and then counts
+    /// as its own terms (a sum's) or one.
     fn expansion_shape(&mut self, e: ExprId, mode: Expansion) -> Shape {
         if mode == Expansion::TimeVarying && !self.contains_time_varying(e) {
             return Shape::CONSTANT;
@@ -293,13 +299,14 @@ impl ExprArena {
                 Node::Add(t) => t.len(),
                 _ => 1,
             };
-            // What contains it counts its nesting afresh from here.
+            // What contains it counts its nesting afresh from here, and takes it for a
+            // rotation's sum (more than two sines and cosines a term), never a planar one.
             Shape {
                 terms,
                 nesting: 0,
                 kept: true,
                 varying: true,
-                degree: 0,
+                degree: DEEP_NESTING + 1,
             }
         } else {
             shape
@@ -312,7 +319,7 @@ impl ExprArena {
     fn atom_shape(&self, e: ExprId) -> Shape {
         if !self.contains_time_varying(e) {
             Shape::CONSTANT
-        } else if matches!(self.node(e), Node::Func(..)) {
+        } else if matches!(self.node(e), Node::Func(..) | Node::Atan2(..)) {
             Shape {
                 degree: 1,
                 ..Shape::ATOM
@@ -328,7 +335,7 @@ impl ExprArena {
     /// a partial velocity of a chain of 3-D bodies in relative rotations past its second
     /// rotation, whose products are then best left as products
     /// (momentum balance: 570,514 operations after CSE for 8 universal joints with its dot
-    /// products multiplied out, 72,457 with them left as products).
+    /// products multiplied out, 68,408 with them left as products).
     pub fn expands_shallowly(&mut self, e: ExprId) -> bool {
         let shape = self.expansion_shape(e, Expansion::TimeVarying);
         !shape.kept && shape.nesting <= DEEP_NESTING

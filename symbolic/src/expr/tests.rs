@@ -360,6 +360,16 @@ fn display_printers_print_a_note_past_the_limit() {
         );
     }
     assert!(Printer::new(&a, Syntax::Text).print(e).len() > 100_000);
+    // Code is printed whole; LaTeX's `--` would be an en dash.
+    assert_eq!(
+        Printer::for_display(&a, Syntax::Rust).print(e),
+        Printer::new(&a, Syntax::Rust).print(e)
+    );
+    let latex = Printer::for_display(&a, Syntax::Latex).print(e);
+    assert!(
+        latex.contains("-{}-rust") && !latex.contains("--"),
+        "{latex}"
+    );
 }
 
 /// The cached small integers are the hash-consed constants, and integers at the ends of the

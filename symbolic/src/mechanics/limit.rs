@@ -6,7 +6,7 @@
 //! `check` of a chain of single-axis hinges took 0.4, 2.2 and 24 s for 6, 7 and 8 of them,
 //! and a 10-hinge chain did not end (2026-11-26). The expansion's caps
 //! ([`crate::expr::ExprArena::expand_time_varying`], `expr/expand.rs`) now keep such
-//! rotations nested: 6, 8 and 10 hinges check in 0.04–0.08 s and 16 in 2.6 s, and three
+//! rotations nested: 6, 8 and 10 hinges check in 0.03–0.06 s and 16 in 0.3 s, and three
 //! bodies in relative z-x-z rotations with an asymmetric inertia in 0.02 s where they took
 //! 8.3 s
 //! (docs/performance.md, "Derivations of 3-D chains"). The bound stays, as a
@@ -72,7 +72,7 @@ pub fn finish_derivation(
                 ),
             )
             .with_help(
-                "frames given their angles relative to N (`parent: N`) keep the equations shallower; a chain of 10 single-axis hinges each relative to the one before derives in well under a second",
+                "frames given their angles relative to N (`parent: N`) keep the equations shallower; a chain of 16 single-axis hinges each relative to the one before derives in well under a second",
             )
         }
         _ => {

@@ -19,8 +19,8 @@ pub const TEMPLATES: &[&str] = &["n-link-pendulum", "n-mass-chain", "universal-j
 /// once 200, is 100. The mass chain's file and equations grow as `n` (its `M` is diagonal,
 /// and every quadratic pass over it has been taken out): 1000 masses check in ~3 s. The
 /// universal-joint chain's equations grow as about `n³` in operations (3-D bodies in
-/// relative rotations, nested `2n` rotations deep): 12 joints check in ~1.7 s and simulate
-/// in ~4 s; at 16, `check` takes ~7 s and a first simulation ~17 s, nearly all of it
+/// relative rotations, nested `2n` rotations deep): 12 joints check in ~1 s and simulate
+/// in ~3 s; at 16, `check` takes ~3 s and a first simulation ~17 s, nearly all of it
 /// Cranelift compiling the 600,000-operation right-hand side, so the limit is 12.
 pub const MAX_SIZES: [usize; 3] = [100, 1_000, 12];
 
