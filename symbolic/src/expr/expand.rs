@@ -305,7 +305,7 @@ impl ExprArena {
                 terms,
                 nesting: 0,
                 kept: true,
-                varying: true,
+                varying: shape.varying,
                 degree: DEEP_NESTING + 1,
             }
         } else {
