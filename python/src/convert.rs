@@ -43,6 +43,46 @@ pub fn to_python<'py, T: Serialize + ?Sized>(
     value_to_python(py, &value, lists)
 }
 
+/// A report whose conversion to Python objects waits for its first use: what a call returns
+/// beside arrays that are the result itself (a simulation's summary: names, parameters,
+/// stats, events), so that a call whose caller reads only the arrays does not pay for the
+/// dicts. Calling it gives the report as [`to_python`] with [`Lists::Plain`] does (a new
+/// object at each call; the Python layer keeps the first).
+#[pyclass(frozen, module = "eomgen._eomgen")]
+pub struct DeferredReport {
+    /// The report, serialised on call.
+    report: Box<dyn ErasedReport>,
+}
+
+/// A report that can be held without its type: `Serialize` is not object safe.
+trait ErasedReport: Send + Sync {
+    /// The report as `to_python` gives it.
+    fn to_python<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>>;
+}
+
+impl<T: Serialize + Send + Sync> ErasedReport for T {
+    fn to_python<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        to_python(py, self, Lists::Plain)
+    }
+}
+
+impl DeferredReport {
+    /// `report`, converted when the Python layer first calls it.
+    pub fn new<T: Serialize + Send + Sync + 'static>(report: T) -> DeferredReport {
+        DeferredReport {
+            report: Box::new(report),
+        }
+    }
+}
+
+#[pymethods]
+impl DeferredReport {
+    /// The report as dicts, lists, floats and strings.
+    fn __call__<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.report.to_python(py)
+    }
+}
+
 /// A JSON value as a Python object (see [`Lists`]).
 ///
 /// # Errors

@@ -14,7 +14,7 @@ use numpy::{PyArray1, PyReadonlyArray1};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
 
-use crate::convert::{Lists, matrix, to_python};
+use crate::convert::{DeferredReport, Lists, matrix, to_python};
 use crate::errors::{analysis_error, model_error, open_error, parameter_error};
 
 /// A model as opened: the compiled code, how it was named, and the file's text (what a
@@ -164,6 +164,31 @@ impl CoreModel {
 
 /// Most output times per run: `eomgen simulate --t-out`'s limit (docs/cli.md).
 pub(crate) const MAX_OUTPUT_TIMES: usize = 100_000;
+
+/// Output times as `t_out` gives them: a time, a sequence of times, or a 1-D array (s); read
+/// here rather than converted in Python, where `[float(t) for t in np.atleast_1d(t_out)]`
+/// cost a microsecond per call.
+///
+/// # Errors
+/// `TypeError` for anything else (a 2-D array, a string).
+pub(crate) fn output_times(t_out: &Bound<'_, PyAny>) -> PyResult<Vec<f64>> {
+    if let Ok(array) = t_out.extract::<PyReadonlyArray1<'_, f64>>() {
+        // Any strides (`times[::2]`).
+        return Ok(array.as_array().to_vec());
+    }
+    if let Ok(time) = t_out.extract::<f64>() {
+        return Ok(vec![time]);
+    }
+    t_out.extract::<Vec<f64>>().map_err(|_| {
+        pyo3::exceptions::PyTypeError::new_err(format!(
+            "t_out must be a time or a 1-D sequence of times (s), got {}",
+            t_out
+                .get_type()
+                .name()
+                .map_or_else(|_| "an object".to_string(), |n| n.to_string())
+        ))
+    })
+}
 
 /// An instance of `loaded` with `overrides` set, in order.
 pub(crate) fn instantiate(
@@ -342,8 +367,10 @@ pub(crate) fn not_started_hint(has_guesses: bool) -> &'static str {
     }
 }
 
-/// A simulation's results for the Python layer: `{"summary", "t", "y", "energy",
-/// "lagrange_multipliers", "constraint_drift"}`.
+/// A simulation's results for the Python layer: `{"summary", "error", "t", "y", "energy",
+/// "lagrange_multipliers", "constraint_drift"}`; `summary` is a [`DeferredReport`] (called,
+/// `simulate --json`'s report without its samples), `error` the report's `error` (a failed
+/// run only).
 pub(crate) fn simulation_dict<'py>(
     py: Python<'py>,
     model: &dyn ModelInfo,
@@ -351,10 +378,13 @@ pub(crate) fn simulation_dict<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     let dim = 2 * model.num_dofs();
     let out = PyDict::new(py);
-    out.set_item(
-        "summary",
-        to_python(py, &simulation.summary_without_samples(model), Lists::Plain)?,
-    )?;
+    // The summary becomes dicts when the Python layer first reads it; the failure, which
+    // every call reads, at once.
+    let summary = simulation.summary_without_samples(model);
+    if let Some(error) = &summary.error {
+        out.set_item("error", to_python(py, error, Lists::Plain)?)?;
+    }
+    out.set_item("summary", DeferredReport::new(summary))?;
     // What the model shows where a failed run stopped (a singular mass matrix, a forcing
     // out of its domain), for the exception's message.
     if let Some(cause) = &simulation.cause {
@@ -580,8 +610,9 @@ impl CoreModel {
         &self,
         py: Python<'py>,
         args: RunArgs,
-        t_out: Option<Vec<f64>>,
+        t_out: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyDict>> {
+        let t_out = t_out.map(output_times).transpose()?;
         if let Some(times) = &t_out
             && times.len() > MAX_OUTPUT_TIMES
         {

@@ -237,6 +237,29 @@ def test_bad_options_raise_value_errors():
         m.simulate(t_out=[2.0, 1.0])
 
 
+def test_output_times_are_read_in_any_form():
+    # A time, a tuple, a strided array and an integer array are the list they hold.
+    m = eomgen.load("simple_pendulum")
+    reference = m.simulate(t_end=1.0, t_out=[0.0, 0.5, 1.0])
+    times = np.linspace(0.0, 1.0, 5)
+    for t_out in ((0.0, 0.5, 1.0), times[::2]):
+        assert np.array_equal(m.simulate(t_end=1.0, t_out=t_out).y, reference.y), t_out
+    assert np.array_equal(m.simulate(t_end=1.0, t_out=1.0).y, reference.y[[2]])
+    assert np.array_equal(m.simulate(t_end=1.0, t_out=np.array([0, 1])).t, [0.0, 1.0])
+    for bad in ("0.5", np.zeros((2, 2)), [[0.5]], [0.5, "x"]):
+        with pytest.raises(TypeError, match="t_out must be a time or a 1-D sequence"):
+            m.simulate(t_end=1.0, t_out=bad)
+
+
+def test_a_solution_pickles_with_its_summary():
+    # The summary's dicts are made on first use; a pickled solution carries them made.
+    sol = eomgen.load("double_pendulum").simulate(t_end=1.0)
+    again = pickle.loads(pickle.dumps(sol))
+    assert again.summary_header == sol.summary_header and again.stats["steps"] > 0
+    assert np.array_equal(again.y, sol.y) and np.array_equal(again.q, sol.q)
+    assert again.q.base is again.y or again.q.base is again.y.base
+
+
 # --- evaluations --------------------------------------------------------------------------------
 
 

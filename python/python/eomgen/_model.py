@@ -6,6 +6,7 @@ arguments, documents shapes and units, and wraps the reports in small result obj
 
 from __future__ import annotations
 
+import functools
 import math
 from typing import Callable, Dict, Iterable, List, Mapping, Optional, Sequence, Tuple, Union
 
@@ -320,9 +321,10 @@ class Model:
                 event expression that does not parse.
         """
         args = self._run_args(t_end, method, rtol, atol, dt, initial, stabilization, baumgarte, stop_when, events)
-        result = self._core.simulate(args, None if t_out is None else [float(t) for t in np.atleast_1d(t_out)])
+        result = self._core.simulate(args, t_out)
         solution = Solution(result, self.num_dofs)
-        self._raise_failure(solution, f"the {len(solution.t)} samples computed before it were kept")
+        if solution._failure is not None:
+            self._raise_failure(solution, f"the {len(solution.t)} samples computed before it were kept")
         return solution
 
     def _run_args(self, t_end, method, rtol, atol, dt, initial, stabilization, baumgarte, stop_when, events) -> dict:
@@ -343,7 +345,7 @@ class Model:
     def _raise_failure(self, solution: "Solution", kept: str, animation: Optional["Animation"] = None) -> None:
         """Raises the failure of `solution`'s run, if it stopped early: `IntegrationError`
         (`ValueError` for options refused before the first step)."""
-        failure = solution.summary_header.get("error")
+        failure = solution._failure
         if failure is None:
             return
         t = failure.get("t")
@@ -912,11 +914,13 @@ class Solution:
     """
 
     def __init__(self, result: dict, num_dofs: int):
-        self.summary_header = result["summary"]
+        # The summary's dicts are made at its first use (`summary_header`); the failure at once.
+        self._header = None
+        self._deferred_header = result["summary"]
+        self._failure = result.get("error")
         self.t = result["t"]
         self.y = result["y"]
-        self.q = self.y[:, :num_dofs]
-        self.qdot = self.y[:, num_dofs:]
+        self._num_dofs = num_dofs
         self.energy = result["energy"]
         self.lagrange_multipliers = result.get("lagrange_multipliers")
         self._solved = result.get("multipliers_solved")
@@ -928,6 +932,33 @@ class Solution:
         #: not positive definite, a forcing out of its domain), or ``None``.
         self.cause = result.get("cause")
         self._summary = None
+
+    def __getstate__(self) -> dict:
+        """Pickled with the summary's dicts (the deferred report is not picklable) and
+        without the views of ``y``, which unpickling makes again."""
+        state = dict(self.__dict__)
+        state["_header"] = self.summary_header
+        state["_deferred_header"] = None
+        state.pop("q", None)
+        state.pop("qdot", None)
+        return state
+
+    @functools.cached_property
+    def q(self) -> np.ndarray:
+        """The coordinates, ``(k, n)`` (a view of ``y``)."""
+        return self.y[:, :self._num_dofs]
+
+    @functools.cached_property
+    def qdot(self) -> np.ndarray:
+        """The rates, ``(k, n)`` (a view of ``y``)."""
+        return self.y[:, self._num_dofs:]
+
+    @property
+    def summary_header(self) -> dict:
+        """The report as ``eomgen simulate --json`` prints it, without the samples."""
+        if self._header is None:
+            self._header = self._deferred_header()
+        return self._header
 
     @property
     def stats(self) -> dict:
