@@ -19,8 +19,10 @@
 //!
 //! Models: `double_pendulum` (`models/double_pendulum.yaml`, HW19, 4 states) and
 //! `figure_eight` (`models/figure_eight.yaml`, HW7, 12 states), with the files' default
-//! parameters and initial states, as compiled into this program by `model!` (or loaded from
-//! the files, with `--from-file on`).
+//! parameters and initial states, as compiled into this program by `model!`; with
+//! `--from-file on`, any bundled model or model file of 4, 6, 10, 12 or 16 states (the panel
+//! of `tools/peer_panel.py`), `--name` labelling its lines, and `--set theta_dot=5.0,…`
+//! changing its initial state by coordinate or rate name (for `initial`, `rhs` and `run`).
 //!
 //! Methods: every adaptive [`Method`] by its command-line name (`dp54`, `dop853`, and any
 //! method added to [`Method::ALL`] later), run through [`Method::integrator`] with
@@ -300,12 +302,38 @@ fn reference(path: &str, model: &str) -> Result<(f64, Vec<f64>), String> {
     Ok((t_end, state))
 }
 
+/// Changes `y0 = [q; q̇]` by `name=value` pairs (comma-separated), each a coordinate's name
+/// or a rate's (`theta_dot`).
+fn set_initial(coordinates: &[&str], y0: &mut [f64], changes: &str) -> Result<(), String> {
+    let n = coordinates.len();
+    for change in changes.split(',') {
+        let (name, value) = change
+            .split_once('=')
+            .ok_or_else(|| format!("--set: `{change}` is not name=value"))?;
+        let value: f64 = value.parse().map_err(|e| format!("--set {name}: {e}"))?;
+        let (base, offset) = name.strip_suffix("_dot").map_or((name, 0), |b| (b, n));
+        let i = coordinates.iter().position(|c| *c == base).ok_or_else(|| {
+            format!(
+                "--set: no coordinate `{base}` (valid: {})",
+                coordinates.join(", ")
+            )
+        })?;
+        y0[offset + i] = value;
+    }
+    Ok(())
+}
+
 /// The subcommands for one model type: `initial`, `rhs`, `run`.
 macro_rules! command {
     ($dim:literal, $system:expr, $name:expr, $command:expr, $opts:expr) => {{
         let (name, command, opts): (&str, &str, &[(String, String)]) = ($name, $command, $opts);
         let system = RefCell::new($system);
-        let y0 = ModelInfo::initial_state(&*system.borrow());
+        let mut y0 = ModelInfo::initial_state(&*system.borrow());
+        if let Some(changes) = option(opts, "set") {
+            let borrowed = system.borrow();
+            let names = ModelInfo::description(&*borrowed).coordinate_names();
+            set_initial(&names, &mut y0, changes)?;
+        }
         match command {
             "initial" => {
                 println!("{}", json!({"model": name, "initial_state": y0}));
@@ -418,7 +446,10 @@ fn main_inner() -> Result<(), String> {
     let model = option(&opts, "model").ok_or("--model is required")?;
     match option(&opts, "from-file") {
         None | Some("off") => {}
-        Some("on") => return from_file(model, command, &opts),
+        Some("on") => {
+            let name = option(&opts, "name").unwrap_or(model);
+            return from_file(model, name, command, &opts);
+        }
         Some(other) => return Err(format!("--from-file: `{other}`, not on or off")),
     }
     match model {
@@ -445,31 +476,44 @@ fn main_inner() -> Result<(), String> {
 /// The subcommand on the model loaded from its file and compiled at run time (`--from-file
 /// on`; the build needs `--features jit`): the path of the command line and of Python, with
 /// its Taylor orders compiled from the first series (`LoadOptions::eager_taylor`), as after
-/// the first steps of any run.
+/// the first steps of any run. `model` is a bundled model's name or a model file's path
+/// (`.yaml`); `name` labels the output lines and picks the reference (`--name`, default the
+/// model). The states of the panel of `tools/peer_panel.py` have 4, 6, 10, 12 and 16
+/// components (ode_solvers' state is a fixed-size vector, one copy of its code per size).
 #[cfg(feature = "jit")]
-fn from_file(model: &str, command: &str, opts: &[(String, String)]) -> Result<(), String> {
-    let load = |name: &str| {
-        let path = format!("{}/models/{name}.yaml", env!("CARGO_MANIFEST_DIR"));
-        let options = eomgen::LoadOptions {
-            eager_taylor: true,
-            ..eomgen::LoadOptions::default()
-        };
-        eomgen::JitModel::load_with(&path, options)
-            .map(eomgen::DynFirstOrder::new)
-            .map_err(|e| format!("{path}: {e}"))
+fn from_file(
+    model: &str,
+    name: &str,
+    command: &str,
+    opts: &[(String, String)],
+) -> Result<(), String> {
+    let path = if model.ends_with(".yaml") {
+        model.to_string()
+    } else {
+        format!("{}/models/{model}.yaml", env!("CARGO_MANIFEST_DIR"))
     };
-    match model {
-        "double_pendulum" => command!(4, load(model)?, model, command, opts),
-        "figure_eight" => command!(12, load(model)?, model, command, opts),
-        _ => Err(format!(
-            "unknown model `{model}` (valid: double_pendulum, figure_eight)"
+    let options = eomgen::LoadOptions {
+        eager_taylor: true,
+        ..eomgen::LoadOptions::default()
+    };
+    let system = eomgen::JitModel::load_with(&path, options)
+        .map(eomgen::DynFirstOrder::new)
+        .map_err(|e| format!("{path}: {e}"))?;
+    match 2 * ModelInfo::num_dofs(&system) {
+        4 => command!(4, system, name, command, opts),
+        6 => command!(6, system, name, command, opts),
+        10 => command!(10, system, name, command, opts),
+        12 => command!(12, system, name, command, opts),
+        16 => command!(16, system, name, command, opts),
+        dim => Err(format!(
+            "{path}: {dim} states; this program runs models of 4, 6, 10, 12 or 16"
         )),
     }
 }
 
 /// Without the `jit` feature there is no run-time compiler to load a file with.
 #[cfg(not(feature = "jit"))]
-fn from_file(_: &str, _: &str, _: &[(String, String)]) -> Result<(), String> {
+fn from_file(_: &str, _: &str, _: &str, _: &[(String, String)]) -> Result<(), String> {
     Err("--from-file on needs the build's `jit` feature (`--features jit`)".into())
 }
 

@@ -13,16 +13,19 @@ Codes compared, on the same model, initial state and reference:
   is pointed at an empty temporary directory so that these are first compilations;
   `--warm-cache` keeps the user's cache).
 
-Problems: the HW19 double pendulum (models/double_pendulum.yaml) from its initial state to
-t = 10 s at tolerances rtol = atol = tol = 1e-2 ... 1e-15 (`--per-decade` values per decade),
-error = max |y_i(10) - y_ref_i| over [theta1, theta2, theta1_dot, theta2_dot] (rad, rad/s;
-the norm of benches/peers.rs); and the figure-eight three-body orbit
-(models/figure_eight.yaml) over 10 periods (t = 63.2591398) at tol = 1e-14: time, relative
-energy drift |E(T) - E(0)| / |E(0)| and final-state error (with the fastest single run
-beside the median: on a shared machine a run that loses its core to another process shows as
-a second mode of the times). The reference final states are
-computed in multiple precision (tools/heyoka_peer.py reference: 170 bits, checked against 210
-bits; 45 digits written) from the same double initial states, once, into --reference.
+Problems: the panel of tools/peer_panel.py (double pendulum, figure eight, heavy top off
+its steady precession, a Kepler orbit at e = 0.9 from a file, a 5-link chain, the benchmark
+bicycle), or the `--models` named, each from its initial state (with the panel's changes) to
+its end time, every one swept over the same tolerances rtol = atol = tol (`--per-decade` values
+per decade from `--loosest` to `--tightest`); error = max |y_i(t_end) - y_ref_i| over the whole
+state [q; q'] (the norm of benches/peers.rs). With `--from-file` (the panel's default: its
+Kepler orbit and chain exist only as files) eomgen's side loads each model from its file and
+compiles it at run time, the command line's path. The reference final states are computed in
+multiple precision by heyoka (tools/heyoka_peer.py reference: 170 bits, checked against 210
+bits; 45 digits written) from the same double initial states, once, into --reference; for a
+model heyoka cannot express (the bicycle's constraints) by eomgen itself, Vern9 at
+rtol = atol = 1e-15, with its disagreement with DOP853 and Vern9 at 1e-14 as its uncertainty
+(targets below ten times that are not reported).
 
 Timing: `--rounds` rounds alternate the two batches (Rust program, heyoka; the order reversed
 on odd rounds), so a drift of the shared machine's speed falls on every code alike; each batch
@@ -34,17 +37,21 @@ Equal error (the rule of docs/performance.md): for a target error E, a method's 
 time at the loosest tolerance from which every tighter tolerance of the sweep gives an error
 <= E (no interpolation; "-" if there is none). The ratios heyoka / eomgen-best and
 ode_solvers / eomgen-best (> 1: eomgen cheaper) are taken at targets 1e-2 ... 1e-10, where
-eomgen-best is the cheapest of eomgen's methods at that target.
+eomgen-best is the cheapest of eomgen's methods at that target. The panel's goals (issue
+"ahead of heyoka on models nobody tuned for"): heyoka / eomgen-best >= 1.0 at every target
+1e-4 ... 1e-10 on every model heyoka can express, >= 1.3 at 1e-8 and tighter; the report's
+first table gives that ratio per model and target, and a verdict.
 
-Usage (from the repository root):
-    CARGO_TARGET_DIR=... cargo build --release --no-default-features --example work_precision_peers
-    python tools/work_precision_peers.py --binary $CARGO_TARGET_DIR/release/examples/work_precision_peers \
-        [--methods dp54,dop853] [--peers ode_solvers-dop853] [--rounds 7] [--reps 5] \
-        [--per-decade 2] [--reference /tmp/peers-out/reference.json] \
-        [--out /tmp/peers-out/work_precision_peers.md] [--svg /tmp/peers-out/work_precision_peers.svg] \
-        [--raw /tmp/peers-out/raw.jsonl] [--warm-cache] [--heyoka-high-accuracy] [--from-file]
+Usage (from the repository root; the driver and heyoka_peer need a Python with heyoka, sympy,
+pyyaml, matplotlib and the eomgen package):
+    cargo build --release --no-default-features --features jit --example work_precision_peers
+    python tools/work_precision_peers.py --binary target/release/examples/work_precision_peers \
+        --from-file [--models double_pendulum,kepler_e09] [--methods dp54,dop853,vern9,taylor] \
+        [--peers ode_solvers-dop853] [--rounds 5] [--reps 3] [--per-decade 2] \
+        [--reference /tmp/peers-out/reference.json] [--out table.md] [--svg panel.svg] \
+        [--raw raw.jsonl] [--warm-cache] [--heyoka-high-accuracy]
 Without --out the markdown is printed. The chart (log-log, error against median time, one
-line per method) is drawn with matplotlib.
+panel per model, one line per method) is drawn with matplotlib.
 """
 import argparse
 import atexit
@@ -67,36 +74,89 @@ heyoka_peer = None
 HEYOKA_METHOD = None
 
 ROOT = Path(__file__).resolve().parent.parent
-DP, FE = "double_pendulum", "figure_eight"
-FE_TOL = 1e-14
+import peer_panel  # noqa: E402  (the panel: tools/peer_panel.py)
+
 TARGETS = [10.0 ** -k for k in range(2, 11)]
+# The panel's goals: heyoka / eomgen-best at these targets.
+GOAL_TARGETS = [10.0 ** -k for k in range(4, 11)]
+GOAL_ALL, GOAL_TIGHT, TIGHT_FROM = 1.0, 1.3, 1e-8
 
 
-def tolerances(per_decade):
-    """1e-2 ... 1e-15 with `per_decade` values per decade, loosest first."""
-    return [10.0 ** (-k / per_decade) for k in range(2 * per_decade, 15 * per_decade + 1)]
+def tolerances(per_decade, loosest=2, tightest=15):
+    """1e-`loosest` ... 1e-`tightest` with `per_decade` values per decade, loosest first."""
+    return [10.0 ** (-k / per_decade)
+            for k in range(loosest * per_decade, tightest * per_decade + 1)]
 
 
-def rust_batch(binary, methods, tols, reps, reference, from_file=False):
-    """The Rust program's results for the double-pendulum sweep and the figure eight
-    (`from_file`: the models loaded from their files and compiled at run time)."""
+def rust_command(binary, e, command, from_file):
+    """The Rust program's command line for panel entry `e` (without the subcommand's own
+    options)."""
+    cmd = [binary, command, "--model", peer_panel.model_argument(e) if from_file else e["model"],
+           "--name", e["name"]]
+    if from_file:
+        cmd += ["--from-file", "on"]
+    changes = peer_panel.set_argument(e)
+    if changes:
+        cmd += ["--set", changes]
+    return cmd
+
+
+def run_rust(cmd):
+    out = subprocess.run(cmd, capture_output=True, text=True)
+    if out.returncode != 0:
+        raise RuntimeError(f"{' '.join(cmd)} failed: {out.stderr}")
+    return [json.loads(line) for line in out.stdout.splitlines() if line.strip()]
+
+
+def rust_batch(binary, entries, methods, tols, reps, reference, from_file):
+    """The Rust program's results: every entry, method and tolerance."""
     results = []
-    for model, model_tols in ((DP, tols), (FE, [FE_TOL])):
-        cmd = [binary, "run", "--model", model, "--t-end", repr(heyoka_peer.T_END[model]),
-               "--methods", ",".join(methods), "--tols", ",".join(map(repr, model_tols)),
-               "--reps", str(reps), "--reference", str(reference)]
-        if from_file:
-            cmd += ["--from-file", "on"]
-        out = subprocess.run(cmd, capture_output=True, text=True)
-        if out.returncode != 0:
-            raise RuntimeError(f"{' '.join(cmd)} failed: {out.stderr}")
-        results += [json.loads(line) for line in out.stdout.splitlines() if line.strip()]
+    for e in entries:
+        cmd = rust_command(binary, e, "run", from_file) + [
+            "--t-end", repr(e["t_end"]), "--methods", ",".join(methods),
+            "--tols", ",".join(map(repr, tols)), "--reps", str(reps), "--reference", str(reference)]
+        results += run_rust(cmd)
     return results
 
 
-def heyoka_batch(peer, tols, reps):
-    """heyoka's results for the same jobs."""
-    return peer.run([(DP, tol) for tol in tols] + [(FE, FE_TOL)], reps)
+def heyoka_batch(peer, entries, tols, reps):
+    """heyoka's results for the entries it can express."""
+    return peer.run([(e["name"], tol) for e in entries if e["heyoka"] for tol in tols], reps)
+
+
+def eomgen_reference(binary, e, from_file):
+    """(state, uncertainty) at t_end of a model heyoka cannot express: eomgen's Vern9 at
+    rtol = atol = 1e-15, and its largest difference from Vern9 at 1e-14 and DOP853 at 1e-15."""
+    cmd = rust_command(binary, e, "run", from_file) + [
+        "--t-end", repr(e["t_end"]), "--methods", "vern9,dop853", "--tols", "1e-14,1e-15",
+        "--reps", "1"]
+    runs = {(r["method"], r["tol"]): r for r in run_rust(cmd)}
+    best = runs[("vern9", 1e-15)]["final_state"]
+    others = [runs[("vern9", 1e-14)]["final_state"], runs[("dop853", 1e-15)]["final_state"]]
+    spread = max(abs(a - b) for o in others for a, b in zip(o, best))
+    return best, spread
+
+
+def references(args, entries):
+    """The reference file (written when missing) and the targets each model can be judged
+    at: {name: smallest target}."""
+    path = Path(args.reference)
+    data = json.loads(path.read_text()) if path.exists() else {}
+    missing = [e for e in entries if e["name"] not in data]
+    mp = [e["name"] for e in missing if e["heyoka"]]
+    if mp:
+        tmp = path.with_suffix(".heyoka.json")
+        heyoka_peer.command_reference(argparse.Namespace(out=str(tmp), models=mp))
+        data.update(json.loads(tmp.read_text()))
+    for e in missing:
+        if not e["heyoka"]:
+            state, spread = eomgen_reference(args.binary, e, args.from_file)
+            data[e["name"]] = {"t_end": e["t_end"], "state": [repr(x) for x in state],
+                               "uncertainty": spread, "by": "eomgen vern9 1e-15"}
+    if missing:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text(json.dumps(data, indent=1) + "\n")
+    return {e["name"]: 10 * data[e["name"]].get("uncertainty", 0.0) for e in entries}
 
 
 def key(result):
@@ -145,92 +205,106 @@ def fmt_ratio(a, b):
     return "-" if a is None or b is None else f"{a / b:.2f}"
 
 
-def report(merged, methods, peers, tols, args, meta):
-    """The markdown text: equal-error table, the sweep, the figure eight."""
-    all_methods = methods + peers + [HEYOKA_METHOD]
-    sweeps = {m: sorted([merged[(m, DP, t)] for t in tols if (m, DP, t) in merged],
-                        key=lambda r: -r["tol"]) for m in all_methods}
-    lines = []
-    w = lines.append
-    w(f"Work-precision, double pendulum (HW19 defaults) 0 -> 10 s; error = max|y(10) - y_ref| "
-      f"(rad, rad/s) against a 45-digit reference; time = median over {args.rounds} "
-      f"alternating rounds of the median of {args.reps} runs. {meta}")
-    w("")
-    w("Cost at equal error: the time at the loosest tolerance from which every tighter one "
-      "meets the target (tolerance in parentheses); ratios > 1: eomgen cheaper.")
-    w("")
-    head = ["target error"] + [f"eomgen {m}" for m in methods] + \
-        [p for p in peers] + [label(HEYOKA_METHOD), "eomgen best"] + \
-        [f"{p} / eomgen best" for p in peers] + ["heyoka / eomgen best"]
-    w("| " + " | ".join(head) + " |")
-    w("|" + "---|" * len(head))
+def costs_of(merged, name, methods, tols, target):
+    """{method: the run that meets `target` at equal error (or None)} on model `name`."""
+    out = {}
+    for m in methods:
+        sweep = sorted([merged[(m, name, t)] for t in tols if (m, name, t) in merged],
+                       key=lambda r: -r["tol"])
+        out[m] = cost_at(sweep, target) if sweep else None
+    return out
+
+
+def best_of(costs, methods):
+    """(time, method) of the cheapest of eomgen's `methods` in `costs`, or None."""
+    found = [(costs[m]["time_s"], m) for m in methods if costs.get(m) is not None]
+    return min(found) if found else None
+
+
+def panel_table(merged, entries, methods, peer_name, tols, floors, goals=True):
+    """Rows of `peer_name` / eomgen-best per model and target, and (`goals`) the goals'
+    verdict."""
+    w = []
+    head = ["model"] + [f"{t:.0e}" for t in TARGETS] + (["goals"] if goals else [])
+    w.append("| " + " | ".join(head) + " |")
+    w.append("|" + "---|" * len(head))
+    verdicts = {}
+    for e in entries:
+        if peer_name == HEYOKA_METHOD and not e["heyoka"]:
+            continue
+        row, ok, judged = [e["name"]], True, 0
+        for target in TARGETS:
+            if target < floors[e["name"]]:
+                row.append("(ref.)")
+                continue
+            costs = costs_of(merged, e["name"], methods + [peer_name], tols, target)
+            best = best_of(costs, methods)
+            peer = costs[peer_name]
+            if best is None or peer is None:
+                row.append("-" if best is None else f"— ({best[1]})")
+                if target in GOAL_TARGETS and best is None:
+                    ok = False
+                continue
+            ratio = peer["time_s"] / best[0]
+            row.append(f"{ratio:.2f} ({best[1]})")
+            if any(abs(target - g) < 1e-20 for g in GOAL_TARGETS):
+                judged += 1
+                ok &= ratio >= (GOAL_TIGHT if target <= TIGHT_FROM * 1.0001 else GOAL_ALL)
+        verdicts[e["name"]] = ok and judged > 0
+        if goals:
+            row.append("met" if verdicts[e["name"]] else "not met")
+        w.append("| " + " | ".join(row) + " |")
+    return w, verdicts
+
+
+def model_details(merged, e, methods, peers, tols, floors):
+    """The cost at equal error of every code on model `e`, one row per target."""
+    codes = methods + peers + ([HEYOKA_METHOD] if e["heyoka"] else [])
+    w = [f"**{e['name']}** ({e['why']}; 0 → {e['t_end']:.6g} s"
+         + (f", initial {e['set']}" if e["set"] else "") + ")", ""]
+    head = ["target"] + [label(m) for m in codes]
+    w.append("| " + " | ".join(head) + " |")
+    w.append("|" + "---|" * len(head))
     for target in TARGETS:
-        costs = {m: cost_at(sweeps[m], target) for m in all_methods}
-        cell = {m: "-" if costs[m] is None else
-                f"{fmt_time(costs[m]['time_s'])} ({costs[m]['tol']:.0e})" for m in all_methods}
-        eomgen = [(costs[m]["time_s"], m) for m in methods if costs[m] is not None]
-        best = min(eomgen) if eomgen else None
-        row = [f"{target:.0e}"] + [cell[m] for m in methods] + [cell[p] for p in peers] + \
-            [cell[HEYOKA_METHOD], "-" if best is None else best[1]]
-        best_t = best[0] if best else None
-        row += [fmt_ratio(costs[p]["time_s"] if costs[p] else None, best_t) for p in peers]
-        hy_cost = costs[HEYOKA_METHOD]
-        row += [fmt_ratio(hy_cost["time_s"] if hy_cost else None, best_t)]
-        w("| " + " | ".join(row) + " |")
-    w("")
-    w("The sweep (error, median time, RHS evaluations or Taylor steps × order):")
-    w("")
-    head = ["tol"] + all_methods
-    w("| " + " | ".join(head) + " |")
-    w("|" + "---|" * len(head))
-    for tol in tols:
-        row = [f"{tol:.1e}"]
-        for m in all_methods:
-            r = merged.get((m, DP, tol))
-            if r is None:
-                row.append("")
-            elif "failed" in r:
-                row.append("failed")
-            elif r["rhs_evals"] is not None:
-                row.append(f"{r['error']:.1e}, {fmt_time(r['time_s'])}, {r['rhs_evals']} RHS")
-            else:
-                row.append(f"{r['error']:.1e}, {fmt_time(r['time_s'])}, "
-                           f"{r['steps']} × {r['order']}")
-        w("| " + " | ".join(row) + " |")
-    w("")
-    w(f"Figure eight (HW7), 10 periods (t = {heyoka_peer.T_END[FE]}), tol = {FE_TOL:.0e}:")
-    w("")
-    w("| method | time (median) | fastest run | RHS evaluations / steps | relative energy drift "
-      "| final-state error |")
-    w("|---|---|---|---|---|---|")
-    for m in all_methods:
-        r = merged.get((m, FE, FE_TOL))
-        if r is None:
+        if target < floors[e["name"]]:
             continue
-        if "failed" in r:
-            w(f"| {m} | failed: {r['failed']} | | | | |")
-            continue
-        work = f"{r['rhs_evals']} RHS, {r['steps']} steps" if r["rhs_evals"] is not None \
-            else f"{r['steps']} steps of order {r['order']}"
-        w(f"| {m} | {fmt_time(r['time_s'])} | {fmt_time(r.get('min_s'))} | {work} | {r['energy_drift']:.1e} | "
-          f"{r['error']:.1e} |")
-    w("")
-    builds = [(r["tol"], r["model"], r["construct_s"]) for r in merged.values()
-              if r.get("construct_s") is not None]
+        costs = costs_of(merged, e["name"], codes, tols, target)
+        cells = ["-" if costs[m] is None else
+                 f"{fmt_time(costs[m]['time_s'])} ({costs[m]['tol']:.0e})" for m in codes]
+        w.append("| " + " | ".join([f"{target:.0e}"] + cells) + " |")
+    w.append("")
+    return w
+
+
+def report(merged, entries, methods, peers, tols, floors, args, meta):
+    """The markdown text: the panel's ratios and verdicts, then each model's costs."""
+    w = [f"Work-precision panel. {meta}", "",
+         "heyoka / eomgen-best at equal error (> 1: eomgen cheaper; the cheapest eomgen method "
+         "in parentheses). Goals: ≥ 1.0 at every target 1e-4 … 1e-10, ≥ 1.3 at 1e-8 and "
+         "tighter. \"(ref.)\": below ten times the reference's uncertainty.", ""]
+    rows, verdicts = panel_table(merged, entries, methods, HEYOKA_METHOD, tols, floors)
+    w += rows + [""]
+    for p in peers:
+        w += [f"{label(p)} / eomgen-best at equal error:", ""]
+        w += panel_table(merged, entries, methods, p, tols, floors, goals=False)[0] + [""]
+    w += ["Cost at equal error of each code (median time; the loosest tolerance from which "
+          "every tighter one meets the target, in parentheses):", ""]
+    for e in entries:
+        w += model_details(merged, e, methods, peers, tols, floors)
+    builds = {}
+    for r in merged.values():
+        if r.get("construct_s") is not None:
+            builds.setdefault(r["model"], []).append(r["construct_s"])
     if builds:
-        dp_builds = [b for _, model, b in builds if model == DP]
-        orders = [r["order"] for r in sweeps[HEYOKA_METHOD] if "order" in r]
-        cache = "from heyoka's on-disk cache" if args.warm_cache else \
-            "first compilation, empty cache"
-        w(f"heyoka construction (Taylor decomposition + LLVM compilation, {cache}) per "
-          f"tolerance, not in the times above: double pendulum {min(dp_builds):.2f}–{max(dp_builds):.2f} s "
-          f"(Taylor orders {min(orders)}–{max(orders)}); figure "
-          f"eight {[b for _, model, b in builds if model == FE][0]:.2f} s.")
+        cache = "from heyoka's on-disk cache" if args.warm_cache else "first compilation, empty cache"
+        w.append(f"heyoka construction (Taylor decomposition + LLVM compilation, {cache}) per "
+                 "tolerance, not in the times above: " + "; ".join(
+                     f"{k} {min(v):.2f}–{max(v):.2f} s" for k, v in builds.items()) + ".")
     overheads = [r["call_overhead_s"] for r in merged.values() if "call_overhead_s" in r]
     if overheads:
-        w(f"The Python call of heyoka's propagate_until costs {fmt_time(min(overheads))}–"
-          f"{fmt_time(max(overheads))} (a call that takes no step), included in its times.")
-    return "\n".join(lines) + "\n", sweeps
+        w.append(f"The Python call of heyoka's propagate_until costs {fmt_time(min(overheads))}–"
+                 f"{fmt_time(max(overheads))} (a call that takes no step), included in its times.")
+    return "\n".join(w) + "\n", verdicts
 
 
 def label(method):
@@ -238,45 +312,54 @@ def label(method):
     if method.startswith("ode_solvers-"):
         return "ode_solvers " + method.split("-", 1)[1].capitalize()
     if method == HEYOKA_METHOD:
-        return "heyoka taylor_adaptive" + (
-            " (high_accuracy)" if method == heyoka_peer.METHOD_HIGH_ACCURACY else "")
+        return "heyoka" + (" (high_accuracy)" if method == heyoka_peer.METHOD_HIGH_ACCURACY else "")
     return "eomgen " + method
 
 
-def chart(sweeps, path, title):
-    """A log-log SVG: error against median time, one line per method."""
+def chart(merged, entries, codes, tols, path):
+    """A log-log SVG, one panel per model: error against median time, one line per code."""
     import matplotlib
     matplotlib.use("svg")
     import matplotlib.pyplot as plt
-    fig, ax = plt.subplots(figsize=(7, 5))
+    cols = 3
+    rows = (len(entries) + cols - 1) // cols
+    fig, axes = plt.subplots(rows, cols, figsize=(4.2 * cols, 3.4 * rows), squeeze=False)
     markers = "os^Dv<>ph*"
-    for i, (method, sweep) in enumerate(sweeps.items()):
-        pts = [(r["error"], r["time_s"]) for r in sweep
-               if "failed" not in r and r["error"] and r["error"] > 0]
-        if pts:
-            ax.loglog([p[0] for p in pts], [p[1] * 1e3 for p in pts],
-                      marker=markers[i % len(markers)], markersize=4, label=label(method))
-    ax.set_xlabel("error at t = 10 s, max |y - y_ref| (rad, rad/s)")
-    ax.set_ylabel("time (ms)")
-    ax.set_title(title, fontsize=10)
-    ax.invert_xaxis()
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend()
+    for ax, e in zip(axes.flat, entries):
+        for i, m in enumerate(codes):
+            pts = sorted((r["error"], r["time_s"]) for t in tols
+                         for r in [merged.get((m, e["name"], t))]
+                         if r and "failed" not in r and r["error"] and r["error"] > 0)
+            if pts:
+                ax.loglog([p[0] for p in pts], [p[1] * 1e3 for p in pts],
+                          marker=markers[i % len(markers)], markersize=3, label=label(m))
+        ax.set_title(e["name"], fontsize=9)
+        ax.set_xlabel("error at t_end", fontsize=8)
+        ax.set_ylabel("time (ms)", fontsize=8)
+        ax.invert_xaxis()
+        ax.grid(True, which="both", alpha=0.3)
+    for ax in list(axes.flat)[len(entries):]:
+        ax.axis("off")
+    axes.flat[0].legend(fontsize=7)
     fig.tight_layout()
     fig.savefig(path, metadata={"Date": None})
     plt.close(fig)
 
 
-def main():
+def parse_args():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     target = os.environ.get("CARGO_TARGET_DIR", str(ROOT / "target"))
     parser.add_argument("--binary",
                         default=str(Path(target) / "release/examples/work_precision_peers"))
-    parser.add_argument("--methods", default="dp54,dop853")
+    parser.add_argument("--models", default=",".join(e["name"] for e in peer_panel.PANEL),
+                        help="panel entries (tools/peer_panel.py), comma-separated")
+    parser.add_argument("--methods", default="dp54,dop853,vern9,taylor")
     parser.add_argument("--peers", default="ode_solvers-dop853")
-    parser.add_argument("--rounds", type=int, default=7)
-    parser.add_argument("--reps", type=int, default=5)
+    parser.add_argument("--rounds", type=int, default=5)
+    parser.add_argument("--reps", type=int, default=3)
     parser.add_argument("--per-decade", type=int, default=2)
+    parser.add_argument("--loosest", type=int, default=3, help="loosest tolerance 1e-K")
+    parser.add_argument("--tightest", type=int, default=14, help="tightest tolerance 1e-K")
     parser.add_argument("--reference", default="/tmp/peers-out/reference.json")
     parser.add_argument("--out")
     parser.add_argument("--svg")
@@ -287,10 +370,14 @@ def main():
     parser.add_argument("--from-file", action="store_true",
                         help="eomgen's models loaded from their files and compiled at run "
                              "time (the command line's path; build the example with "
-                             "--features jit)")
+                             "--features jit; needed for the panel's file models)")
     parser.add_argument("--warm-cache", action="store_true",
                         help="let heyoka use its on-disk cache of compiled integrators")
-    args = parser.parse_args()
+    return parser.parse_args()
+
+
+def main():
+    args = parse_args()
     if not args.warm_cache:
         # heyoka keeps compiled code in $XDG_CACHE_HOME/heyoka; an empty one makes the
         # reported construction times those of a first compilation.
@@ -299,22 +386,22 @@ def main():
     global heyoka_peer, HEYOKA_METHOD
     import heyoka_peer as module
     heyoka_peer = module
+    entries = [peer_panel.entry(n) for n in args.models.split(",") if n]
     methods = [m for m in args.methods.split(",") if m]
     peers = [p for p in args.peers.split(",") if p]
-    tols = tolerances(args.per_decade)
-    if not Path(args.reference).exists():
-        heyoka_peer.command_reference(argparse.Namespace(out=args.reference))
+    tols = tolerances(args.per_decade, args.loosest, args.tightest)
+    floors = references(args, entries)
     peer = heyoka_peer.HeyokaPeer(heyoka_peer.load_reference(args.reference),
                                   high_accuracy=args.heyoka_high_accuracy)
     HEYOKA_METHOD = peer.method
     start = time.perf_counter()
-    heyoka_batch(peer, tols, 1)  # builds and compiles every integrator once
+    heyoka_batch(peer, entries, tols, 1)  # builds and compiles every integrator once
     print(f"heyoka integrators built in {time.perf_counter() - start:.1f} s", file=sys.stderr)
     rounds = []
     for r in range(args.rounds):
-        batches = [lambda: rust_batch(args.binary, methods + peers, tols, args.reps,
+        batches = [lambda: rust_batch(args.binary, entries, methods + peers, tols, args.reps,
                                       args.reference, args.from_file),
-                   lambda: heyoka_batch(peer, tols, args.reps)]
+                   lambda: heyoka_batch(peer, entries, tols, args.reps)]
         if r % 2:
             batches.reverse()
         for batch in batches:
@@ -326,15 +413,18 @@ def main():
     load = os.getloadavg()
     meta = (f"{time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}, {platform.machine()}, "
             f"{os.cpu_count()} cores, load average {load[0]:.1f} at the end; heyoka "
-            f"{heyoka_peer.hy.__version__}; eomgen's models "
-            f"{'loaded from their files' if args.from_file else 'compiled by model!'}.")
-    text, sweeps = report(merged, methods, peers, tols, args, meta)
+            f"{heyoka_peer.hy.__version__}; tolerances 1e-{args.loosest} … 1e-{args.tightest}, "
+            f"{args.per_decade} per decade; {args.rounds} alternating rounds of {args.reps} runs; "
+            f"eomgen's models {'loaded from their files' if args.from_file else 'compiled by model!'}.")
+    text, verdicts = report(merged, entries, methods, peers, tols, floors, args, meta)
     if args.out:
         Path(args.out).write_text(text)
     else:
         print(text)
     if args.svg:
-        chart(sweeps, args.svg, "Double pendulum 0–10 s: work–precision (median times)")
+        chart(merged, entries, methods + peers + [HEYOKA_METHOD], tols, args.svg)
+    print("goals: " + ", ".join(f"{k} {'met' if v else 'not met'}" for k, v in verdicts.items()),
+          file=sys.stderr)
     return 0
 
 
