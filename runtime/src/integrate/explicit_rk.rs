@@ -7,7 +7,9 @@ mod sums;
 
 use std::mem::swap;
 
-pub(super) use sums::{combine, error_ratio, sum_fixed, weighted_sum, write_update};
+pub(super) use sums::{
+    combine, combine_any, error_ratio, sum_fixed, weighted_sum, weighted_sum_any, write_update,
+};
 
 use super::dense_output::{DenseOutput, hermite};
 use super::options::ErrorWeights;

@@ -141,9 +141,9 @@ fn coupled(dim: usize) -> OdeFn<impl FnMut(f64, &[f64], &mut [f64])> {
     })
 }
 
-/// The stages compiled for 2, 4, 6 and 8 components equal the general ones to the bit:
-/// every stage, the increment, the candidate and the fifth-order error sum (which the
-/// compiled stages leave in `scratch` and `attempt` forms for the general ones).
+/// The stages compiled for 2, 4, 6 and 8 components equal the general ones (any dimension,
+/// in blocks of four) to the bit: every stage, the increment, the candidate and the
+/// fifth-order error sum (which both leave in `scratch`).
 #[test]
 fn the_compiled_stages_equal_the_general_ones_to_the_bit() {
     fn check<const D: usize>() {
@@ -156,15 +156,8 @@ fn the_compiled_stages_equal_the_general_ones_to_the_bit() {
         compiled.reset(&mut rhs, 0.2, &y0).unwrap();
         general.reset(&mut rhs, 0.2, &y0).unwrap();
         compiled.stages_fixed::<D>(&mut rhs, times).unwrap();
-        general.stages_any(&mut rhs, times).unwrap();
+        general.stages_fixed::<0>(&mut rhs, times).unwrap();
         let rows = (STAGES - 1) * D;
-        stage_sum(
-            &mut general.scratch,
-            &ERROR_FIFTH,
-            &general.ends.f,
-            &general.k[..rows],
-            D,
-        );
         let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
         for (name, a, b) in [
             ("stages", &compiled.k[..rows], &general.k[..rows]),
@@ -234,7 +227,8 @@ fn plain_step<F: FnMut(f64, &[f64], &mut [f64])>(
 /// it to 7, 6 or 11.
 #[test]
 fn the_error_estimate_is_dop853s_and_of_order_8() {
-    for dim in [2, 3] {
+    // 2: the compiled stages; 3 and 10: the blocked ones (a block of 3; two of 4 and one of 2).
+    for dim in [2, 3, 10] {
         let y0: Vec<f64> = (0..dim).map(|i| 0.3 + 0.1 * i as f64).collect();
         let tol = 1e-6;
         let weights = ErrorWeights::uniform(dim, tol, tol);
