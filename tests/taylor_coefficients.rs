@@ -614,3 +614,34 @@ fn the_orders_are_compiled_after_the_kernels_series_with_the_same_bits() {
     );
     assert_eq!(series(), first, "a series by the compiled orders");
 }
+
+/// A constant mass matrix is factored once and its factors reused while its entries keep
+/// their bits: after a parameter changes `M` (the figure eight's `M = m I`), the series of the
+/// same instance equal a fresh instance's to the bit, and differ from those before the change
+/// (so stale factors would fail this).
+#[test]
+fn a_constant_mass_matrix_is_factored_again_when_a_parameter_changes_it() {
+    use eomgen::OdeSystem;
+    let path = format!("{}/models/figure_eight.yaml", env!("CARGO_MANIFEST_DIR"));
+    let load =
+        || DynFirstOrder::new(JitModel::load(&path).unwrap_or_else(|e| panic!("{path}: {e}")));
+    let order = 10;
+    let series = |model: &mut DynFirstOrder<JitModel>, y: &[f64]| {
+        let mut out = vec![f64::NAN; (order + 1) * y.len()];
+        model
+            .taylor_coefficients(0.0, y, order, &mut out)
+            .expect("the series");
+        out
+    };
+    let mut model = load();
+    let y = ModelInfo::initial_state(&model);
+    let before = series(&mut model, &y);
+    assert_eq!(series(&mut model, &y), before, "the reused factors");
+    model.set_parameter("m", 2.0).expect("m");
+    let after = series(&mut model, &y);
+    let mut fresh = load();
+    fresh.set_parameter("m", 2.0).expect("m");
+    let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+    assert_eq!(bits(&after), bits(&series(&mut fresh, &y)));
+    assert_ne!(bits(&after), bits(&before));
+}
