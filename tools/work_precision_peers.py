@@ -137,12 +137,24 @@ def eomgen_reference(binary, e, from_file):
     return best, spread
 
 
+def initial_state(binary, e, from_file):
+    """Entry `e`'s initial state as the Rust program starts from it."""
+    return run_rust(rust_command(binary, e, "initial", from_file))[0]["initial_state"]
+
+
 def references(args, entries):
-    """The reference file (written when missing) and the targets each model can be judged
-    at: {name: smallest target}."""
+    """The reference file (its entries written when missing, or when the panel's end time or
+    initial state is no longer theirs) and the targets each model can be judged at:
+    {name: smallest target}."""
     path = Path(args.reference)
     data = json.loads(path.read_text()) if path.exists() else {}
-    missing = [e for e in entries if e["name"] not in data]
+
+    def current(e):
+        r = data.get(e["name"])
+        return (r is not None and r["t_end"] == e["t_end"]
+                and [float(x) for x in r.get("initial_state", [])]
+                == initial_state(args.binary, e, args.from_file))
+    missing = [e for e in entries if not current(e)]
     mp = [e["name"] for e in missing if e["heyoka"]]
     if mp:
         tmp = path.with_suffix(".heyoka.json")
@@ -151,8 +163,10 @@ def references(args, entries):
     for e in missing:
         if not e["heyoka"]:
             state, spread = eomgen_reference(args.binary, e, args.from_file)
-            data[e["name"]] = {"t_end": e["t_end"], "state": [repr(x) for x in state],
-                               "uncertainty": spread, "by": "eomgen vern9 1e-15"}
+            data[e["name"]] = {
+                "t_end": e["t_end"], "state": [repr(x) for x in state],
+                "initial_state": [repr(x) for x in initial_state(args.binary, e, args.from_file)],
+                "uncertainty": spread, "by": "eomgen vern9 1e-15"}
     if missing:
         path.parent.mkdir(parents=True, exist_ok=True)
         path.write_text(json.dumps(data, indent=1) + "\n")
