@@ -645,3 +645,34 @@ fn a_constant_mass_matrix_is_factored_again_when_a_parameter_changes_it() {
     assert_eq!(bits(&after), bits(&series(&mut fresh, &y)));
     assert_ne!(bits(&after), bits(&before));
 }
+
+/// One workspace serving a model with a constant `M`, then one whose `M` varies (the same
+/// number of coordinates), then the first again: the first's series equal those of a fresh
+/// workspace to the bit (the second's factors are not taken for the first's).
+#[test]
+fn a_workspace_shared_by_two_models_never_reuses_the_others_factors() {
+    use eomgen::DynMechanicalSystem;
+    use eomgen::taylor::{TaylorWorkspace, series_of_motion};
+    let kepler = JitModel::from_source(
+        "kepler.yaml",
+        "name: kepler\nparameters: { mu: 1.0 }\ncoordinates: [x, y]\n\
+         kinetic: (x_dot^2 + y_dot^2)/2\npotential: -mu/sqrt(x^2 + y^2)\n\
+         initial: { x: 0.1, y_dot: 4.0 }\n",
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    let path = format!("{}/models/double_pendulum.yaml", env!("CARGO_MANIFEST_DIR"));
+    let pendulum = JitModel::load(&path).unwrap_or_else(|e| panic!("{path}: {e}"));
+    let order = 8;
+    let run = |model: &JitModel, workspace: &mut TaylorWorkspace, y: &[f64]| {
+        let mut out = vec![f64::NAN; (order + 1) * 4];
+        let taylor = model.taylor().expect("recurrences");
+        series_of_motion(taylor, workspace, 0.0, y, order, &mut out).expect("the series");
+        out.iter().map(|x| x.to_bits()).collect::<Vec<_>>()
+    };
+    let (yk, yp) = ([0.1, 0.0, 0.0, 4.0], [0.3, 1.2, -0.5, 0.7]);
+    let mut shared = TaylorWorkspace::new();
+    let first = run(&kepler, &mut shared, &yk);
+    run(&pendulum, &mut shared, &yp);
+    assert_eq!(run(&kepler, &mut shared, &yk), first);
+    assert_eq!(run(&kepler, &mut TaylorWorkspace::new(), &yk), first);
+}

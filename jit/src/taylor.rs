@@ -668,6 +668,8 @@ const INTERLEAVED_SUMS: usize = 8;
 enum Sum {
     /// [`Emitter::sum_of_products`] over `(x, y)` from `j = 1`, weighted or not.
     Products { x: Slot, y: Slot, weighted: bool },
+    /// [`Emitter::square`]'s half sum over `x`: `j = 1 … ⌊(k − 1)/2⌋`.
+    Square { x: Slot },
     /// [`Emitter::weighted_pair`] of pair `p`.
     Pair(usize),
     /// The sum of the power `out = a^exponent` with a constant exponent.

@@ -170,7 +170,7 @@ pub(crate) const MAX_OUTPUT_TIMES: usize = 100_000;
 /// cost a microsecond per call.
 ///
 /// # Errors
-/// `TypeError` for anything else (a 2-D array, a string).
+/// `TypeError` for anything else (a 2-D array, a string, bytes).
 pub(crate) fn output_times(t_out: &Bound<'_, PyAny>) -> PyResult<Vec<f64>> {
     if let Ok(array) = t_out.extract::<PyReadonlyArray1<'_, f64>>() {
         // Any strides (`times[::2]`).
@@ -179,7 +179,15 @@ pub(crate) fn output_times(t_out: &Bound<'_, PyAny>) -> PyResult<Vec<f64>> {
     if let Ok(time) = t_out.extract::<f64>() {
         return Ok(vec![time]);
     }
-    t_out.extract::<Vec<f64>>().map_err(|_| {
+    // Bytes are sequences of integers to Python; as times they are a mistake.
+    let bytes = t_out.is_instance_of::<pyo3::types::PyBytes>()
+        || t_out.is_instance_of::<pyo3::types::PyByteArray>();
+    let times = if bytes {
+        Err(())
+    } else {
+        t_out.extract::<Vec<f64>>().map_err(|_| ())
+    };
+    times.map_err(|()| {
         pyo3::exceptions::PyTypeError::new_err(format!(
             "t_out must be a time or a 1-D sequence of times (s), got {}",
             t_out

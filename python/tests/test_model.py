@@ -246,7 +246,7 @@ def test_output_times_are_read_in_any_form():
         assert np.array_equal(m.simulate(t_end=1.0, t_out=t_out).y, reference.y), t_out
     assert np.array_equal(m.simulate(t_end=1.0, t_out=1.0).y, reference.y[[2]])
     assert np.array_equal(m.simulate(t_end=1.0, t_out=np.array([0, 1])).t, [0.0, 1.0])
-    for bad in ("0.5", np.zeros((2, 2)), [[0.5]], [0.5, "x"]):
+    for bad in ("0.5", b"\x00\x01", bytearray(b"\x01"), np.zeros((2, 2)), [[0.5]], [0.5, "x"]):
         with pytest.raises(TypeError, match="t_out must be a time or a 1-D sequence"):
             m.simulate(t_end=1.0, t_out=bad)
 
@@ -258,6 +258,14 @@ def test_a_solution_pickles_with_its_summary():
     assert again.summary_header == sol.summary_header and again.stats["steps"] > 0
     assert np.array_equal(again.y, sol.y) and np.array_equal(again.q, sol.q)
     assert again.q.base is again.y or again.q.base is again.y.base
+    # A solution pickled by an earlier version (its summary as `summary_header`, `q` and
+    # `qdot` as arrays) unpickles with its summary.
+    old = {k: v for k, v in sol.__dict__.items() if not k.startswith("_")}
+    old.update(summary_header=sol.summary_header, q=sol.q.copy(), qdot=sol.qdot.copy(),
+               _solved=None, _summary=None)
+    earlier = eomgen.Solution.__new__(eomgen.Solution)
+    earlier.__setstate__(old)
+    assert earlier.stats == sol.stats and np.array_equal(earlier.qdot, sol.qdot)
 
 
 # --- evaluations --------------------------------------------------------------------------------

@@ -283,6 +283,34 @@ impl Emitter {
         b.ins().fadd(sum, last)
     }
 
+    /// The kernels' `square`: `(2 h + [k even] x[k/2]²) + 2 (x[0] x[k])`, `h` the sum of
+    /// `x[j] x[k − j]` for `j = 1 … ⌊(k − 1)/2⌋` (started by [`Self::prefixes`]).
+    pub(super) fn square(&mut self, b: &mut FunctionBuilder, x: Slot, k: usize) -> ir::Value {
+        let half = match self.started(b, Sum::Square { x }, types::F64) {
+            Some(sum) => sum,
+            None => {
+                let mut sum = Self::constant(b, 0.0);
+                for j in 1..=(k - 1) / 2 {
+                    let (u, v) = (self.at(b, x, j), self.at(b, x, k - j));
+                    let term = b.ins().fmul(u, v);
+                    sum = b.ins().fadd(sum, term);
+                }
+                sum
+            }
+        };
+        let mut sum = b.ins().fadd(half, half);
+        if k.is_multiple_of(2) {
+            let middle = self.at(b, x, k / 2);
+            let term = b.ins().fmul(middle, middle);
+            sum = b.ins().fadd(sum, term);
+        }
+        let (x0, xk) = (self.at(b, x, 0), self.at(b, x, k));
+        let product = b.ins().fmul(x0, xk);
+        let two = Self::constant(b, 2.0);
+        let last = b.ins().fmul(two, product);
+        b.ins().fadd(sum, last)
+    }
+
     /// `v · (1/k)`.
     pub(super) fn over_k(b: &mut FunctionBuilder, v: ir::Value, k: usize) -> ir::Value {
         let r = Self::constant(b, 1.0 / k as f64);
@@ -316,7 +344,11 @@ impl Emitter {
                 self.put(b, out, k, v);
             }
             SeriesOp::Mul { out, a, b: y } => {
-                let v = self.cauchy(b, a, y, k);
+                let v = if a == y {
+                    self.square(b, a, k)
+                } else {
+                    self.cauchy(b, a, y, k)
+                };
                 self.put(b, out, k, v);
             }
             SeriesOp::Scale { out, a, constant } => {

@@ -28,6 +28,7 @@ impl Emitter {
         let mut all: Vec<Sum> = Vec::new();
         for op in program.ops.iter() {
             let sums: Vec<Sum> = match *op {
+                SeriesOp::Mul { a, b: y, .. } if a == y => vec![Sum::Square { x: a }],
                 SeriesOp::Mul { a, b: y, .. } => vec![products(a, y, false)],
                 SeriesOp::Div { out, b: y, .. } | SeriesOp::ConstantDiv { out, b: y } => {
                     vec![products(y, out, false)]
@@ -97,6 +98,11 @@ impl Emitter {
                 let (u, v) = (older(b, x, j), older(b, y, k - j));
                 Self::product_term(b, (u, v), j, weighted)
             }
+            Sum::Square { x } => {
+                let j = t + 1;
+                let (u, v) = (older(b, x, j), older(b, x, k - j));
+                b.ins().fmul(u, v)
+            }
             Sum::Pair(p) => {
                 let j = t + 1;
                 let w = b.ins().load(
@@ -130,7 +136,8 @@ impl Emitter {
         }
     }
 
-    /// Writes the `k − 1` terms of orders below `k` of each of `sums` ([`INTERLEAVED_SUMS`] or
+    /// Writes the terms of orders below `k` of each of `sums` (`k − 1`, a square's
+    /// `⌊(k − 1)/2⌋`) ([`INTERLEAVED_SUMS`] or
     /// fewer), term `t` of every sum before term `t + 1` of any, each partial sum into a stack
     /// slot of its own.
     pub(super) fn prefix_group(
@@ -151,10 +158,17 @@ impl Emitter {
                 }
             })
             .collect();
+        // A square's half sum has ⌊(k − 1)/2⌋ terms, every other sum k − 1.
+        let terms = |sum: &Sum| match sum {
+            Sum::Square { .. } => (k - 1) / 2,
+            _ => k - 1,
+        };
         for t in 0..k - 1 {
             for (i, &sum) in sums.iter().enumerate() {
-                let term = self.prefix_term(b, program, sum, (k, t));
-                totals[i] = b.ins().fadd(totals[i], term);
+                if t < terms(&sum) {
+                    let term = self.prefix_term(b, program, sum, (k, t));
+                    totals[i] = b.ins().fadd(totals[i], term);
+                }
             }
         }
         for (&sum, &value) in sums.iter().zip(&totals) {

@@ -943,6 +943,17 @@ class Solution:
         state.pop("qdot", None)
         return state
 
+    def __setstate__(self, state: dict) -> None:
+        """Unpickles this version's state, or an earlier one's (its summary as
+        ``summary_header``, ``q`` and ``qdot`` kept as arrays)."""
+        if "_deferred_header" not in state:
+            header = state.pop("summary_header")
+            num_dofs = state["q"].shape[1]
+            state = {k: v for k, v in state.items() if k not in ("q", "qdot")}
+            state.update(_header=header, _deferred_header=None, _failure=header.get("error"),
+                         _num_dofs=num_dofs)
+        self.__dict__.update(state)
+
     @functools.cached_property
     def q(self) -> np.ndarray:
         """The coordinates, ``(k, n)`` (a view of ``y``)."""
