@@ -20,8 +20,8 @@
 //! Models: `double_pendulum` (`models/double_pendulum.yaml`, HW19, 4 states) and
 //! `figure_eight` (`models/figure_eight.yaml`, HW7, 12 states), with the files' default
 //! parameters and initial states, as compiled into this program by `model!`; with
-//! `--from-file on`, any bundled model or model file of 4, 6, 10, 12 or 16 states (the panel
-//! of `tools/peer_panel.py`), `--name` labelling its lines, and `--set theta_dot=5.0,…`
+//! `--from-file on`, any bundled model or model file of 2, 4, 6, 10, 12 or 16 states (the
+//! panel of `tools/peer_panel.py`, the cases of `tools/taylor_ops_bench.py`), `--name` labelling its lines, and `--set theta_dot=5.0,…`
 //! changing its initial state by coordinate or rate name (for `initial`, `rhs` and `run`).
 //!
 //! Methods: every adaptive [`Method`] by its command-line name (`dp54`, `dop853`, and any
@@ -479,7 +479,8 @@ fn main_inner() -> Result<(), String> {
 /// the first steps of any run. `model` is a bundled model's name or a model file's path
 /// (`.yaml`); `name` labels the output lines and picks the reference (`--name`, default the
 /// model). The states of the panel of `tools/peer_panel.py` have 4, 6, 10, 12 and 16
-/// components (ode_solvers' state is a fixed-size vector, one copy of its code per size).
+/// components, those of `tools/taylor_ops_bench.py` 2 (ode_solvers' state is a fixed-size
+/// vector, one copy of its code per size).
 #[cfg(feature = "jit")]
 fn from_file(
     model: &str,
@@ -500,13 +501,14 @@ fn from_file(
         .map(eomgen::DynFirstOrder::new)
         .map_err(|e| format!("{path}: {e}"))?;
     match 2 * ModelInfo::num_dofs(&system) {
+        2 => command!(2, system, name, command, opts),
         4 => command!(4, system, name, command, opts),
         6 => command!(6, system, name, command, opts),
         10 => command!(10, system, name, command, opts),
         12 => command!(12, system, name, command, opts),
         16 => command!(16, system, name, command, opts),
         dim => Err(format!(
-            "{path}: {dim} states; this program runs models of 4, 6, 10, 12 or 16"
+            "{path}: {dim} states; this program runs models of 2, 4, 6, 10, 12 or 16"
         )),
     }
 }
