@@ -5,6 +5,7 @@ use crate::common;
 
 use eomgen_symbolic::expr::SymbolKind;
 use eomgen_symbolic::expr::eval::Evaluator;
+use eomgen_symbolic::expr::print::{Printer, Syntax};
 use eomgen_symbolic::mechanics::cross_check::solve;
 use eomgen_symbolic::mechanics::{
     EquationsOfMotion, Formulation, Lagrange, MomentumBalance, SymbolicModel,
@@ -261,6 +262,28 @@ fn universal_joint_chains_grow_as_a_power_of_the_joints() {
             "{four:?} → {eight:?}: ×{growth:.1}"
         );
     }
+}
+
+/// A body in z-x-z Euler angles has the textbook mass matrix: the heavy top's `M₁₁` is
+/// `I₁ sin²θ + I₃ cos²θ` with no sine or cosine of the precession φ or the spin ψ (the
+/// Pythagorean identity folds `sin²θ cos²φ + sin²θ sin²φ`, whose first `sin²` factor has no
+/// partner), and both derivations cost 32 or fewer operations after CSE (52 before the fold,
+/// 42 for the equations written by hand).
+#[test]
+fn euler_angle_bodies_have_the_textbook_mass_matrix() {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../models/heavy_top.yaml");
+    let source = std::fs::read_to_string(path).expect("the heavy top");
+    let file = eomgen_symbolic::model::load("heavy_top.yaml", &source).expect("loads");
+    let report =
+        eomgen_symbolic::mechanics::cross_check::check_model(&file, 20, 7).expect("derives");
+    for name in ["lagrange", "momentum"] {
+        let ops = ops_after_cse(&report, name);
+        assert!(ops <= 32, "{name}: {ops} operations after CSE");
+    }
+    let (model, eom) = derive(&source, &Lagrange);
+    let m11 = eom.mass_matrix[0];
+    let printed = Printer::new(&model.arena, Syntax::Text).print(m11);
+    assert_eq!(printed, "I1*sin(theta)^2 + I3*cos(theta)^2");
 }
 
 /// Issue 52's caps leave planar chains alone: a 5-link pendulum written in relative angles

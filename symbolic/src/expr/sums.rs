@@ -158,9 +158,11 @@ impl ExprArena {
         }
     }
 
-    /// If `rest` is `sin²u · X` (a power or a product with such a factor), returns `u` and the
-    /// other factors `X` (sorted ids).
-    fn sine_square_factor(&self, rest: ExprId) -> Option<(ExprId, Vec<ExprId>)> {
+    /// Each way of reading `rest` as `sin²u · X` (a power, or a product with one or more such
+    /// factors): `u` and the other factors `X` (sorted ids), one per `sin²` factor. A term
+    /// with two (`sin²θ cos²φ` beside `sin²θ sin²φ`, the heavy top's `M`) pairs with its
+    /// partner through either.
+    fn sine_square_factors(&self, rest: ExprId) -> Vec<(ExprId, Vec<ExprId>)> {
         let is_sin2 = |arena: &Self, f: ExprId| match arena.node(f) {
             Node::Pow([b, e]) if arena.as_constant(*e) == Some(Constant::int(2)) => {
                 match arena.node(*b) {
@@ -171,22 +173,25 @@ impl ExprArena {
             _ => None,
         };
         if let Some(u) = is_sin2(self, rest) {
-            return Some((u, Vec::new()));
+            return vec![(u, Vec::new())];
         }
-        if let Node::Mul(factors) = self.node(rest) {
-            for (i, &f) in factors.iter().enumerate() {
-                if let Some(u) = is_sin2(self, f) {
-                    let others = factors
-                        .iter()
-                        .enumerate()
-                        .filter(|(j, _)| *j != i)
-                        .map(|(_, x)| *x)
-                        .collect();
-                    return Some((u, others));
-                }
-            }
-        }
-        None
+        let Node::Mul(factors) = self.node(rest) else {
+            return Vec::new();
+        };
+        factors
+            .iter()
+            .enumerate()
+            .filter_map(|(i, &f)| {
+                let u = is_sin2(self, f)?;
+                let others = factors
+                    .iter()
+                    .enumerate()
+                    .filter(|(j, _)| *j != i)
+                    .map(|(_, x)| *x)
+                    .collect();
+                Some((u, others))
+            })
+            .collect()
     }
 
     /// Pythagorean identity on collected sum terms: `c·X·sin²u + c·X·cos²u = c·X`.
@@ -213,27 +218,14 @@ impl ExprArena {
             if c.is_zero() {
                 continue;
             }
-            let Some((u, others)) = self.sine_square_factor(rest) else {
-                continue;
-            };
-            let Some(cos) = self.lookup(NodeRef::Func(Func::Cos, u)) else {
-                continue;
-            };
-            let Some(two) = self.lookup(NodeRef::Const(Constant::int(2))) else {
-                continue;
-            };
-            let Some(cos2) = self.lookup(NodeRef::Pow([cos, two])) else {
-                continue;
-            };
-            let partner = if others.is_empty() {
-                Some(cos2)
-            } else {
-                let mut factors = others.clone();
-                factors.push(cos2);
-                factors.sort();
-                self.lookup(NodeRef::Mul(&factors))
-            };
-            let Some(partner) = partner.filter(|p| collected.get(p) == Some(&c)) else {
+            let Some((others, partner)) =
+                self.sine_square_factors(rest)
+                    .into_iter()
+                    .find_map(|(u, others)| {
+                        let partner = self.cosine_square_partner(u, &others)?;
+                        (collected.get(&partner) == Some(&c)).then_some((others, partner))
+                    })
+            else {
                 continue;
             };
             // Zeroed, not removed: removing from the middle of an `IndexMap` moves every later
@@ -263,8 +255,23 @@ impl ExprArena {
         }
     }
 
+    /// The term `X·cos²u` if its node exists (looked up in the hash-cons table, never made):
+    /// the partner of `X·sin²u` in the Pythagorean identity.
+    fn cosine_square_partner(&self, u: ExprId, others: &[ExprId]) -> Option<ExprId> {
+        let cos = self.lookup(NodeRef::Func(Func::Cos, u))?;
+        let two = self.lookup(NodeRef::Const(Constant::int(2)))?;
+        let cos2 = self.lookup(NodeRef::Pow([cos, two]))?;
+        if others.is_empty() {
+            return Some(cos2);
+        }
+        let mut factors = others.to_vec();
+        factors.push(cos2);
+        factors.sort();
+        self.lookup(NodeRef::Mul(&factors))
+    }
+
     /// Whether `rest` is `sin²u` or a product with such a factor (a cheap pre-filter of
-    /// [`Self::sine_square_factor`]).
+    /// [`Self::sine_square_factors`]).
     fn has_sine_square(&self, rest: ExprId) -> bool {
         let is_sin2 = |f: &ExprId| match self.node(*f) {
             Node::Pow([b, _]) => matches!(self.node(*b), Node::Func(Func::Sin, _)),

@@ -102,6 +102,28 @@ fn pythagorean_identity_collapses_in_sums() {
     assert!(matches!(a.node(e), Node::Add(_)));
 }
 
+/// A term with two `sin²` factors pairs with its partner through either: `sin²θ cos²φ +
+/// sin²θ sin²φ = sin²θ` (the heavy top's `M₁₁`, whose first `sin²` factor, `sin²θ`, has no
+/// `cos²θ` partner there), and so does `sin²θ sin²φ + cos²θ sin²φ = sin²φ`.
+#[test]
+fn pythagorean_identity_pairs_through_any_sine_square() {
+    let mut a = ExprArena::new();
+    let [theta, _, _] = a.coordinate("theta");
+    let [phi, _, _] = a.coordinate("phi");
+    let m = a.symbol("m", SymbolKind::Parameter);
+    let two = a.int(2);
+    let (st, sp, cp, ct) = (a.sin(theta), a.sin(phi), a.cos(phi), a.cos(theta));
+    let [st2, sp2, cp2, ct2] = [st, sp, cp, ct].map(|f| a.pow(f, two));
+    let cos_term = a.product(&[m, st2, cp2]);
+    let sin_term = a.product(&[m, st2, sp2]);
+    let expected = a.times(m, st2);
+    assert_eq!(a.plus(cos_term, sin_term), expected);
+    let first = a.product(&[m, st2, sp2]);
+    let second = a.product(&[m, ct2, sp2]);
+    let expected = a.times(m, sp2);
+    assert_eq!(a.plus(first, second), expected);
+}
+
 #[test]
 fn trig_parity_shares_one_node() {
     let (mut a, x, _, _, _) = arena_xy();
