@@ -235,7 +235,7 @@ fn issue_18_lagrange_is_compact_on_long_chains() {
 /// a power of the joints, not exponentially, and its two derivations agree. Multiplied out,
 /// the rotations made 33,244 operations after CSE (Lagrange) at 3 joints and 517,133 at 4
 /// (×16–21 per joint; 8 did not end). Now, from 4 joints to 8, each derivation's operations after CSE
-/// grow at most 2^3.5 ≈ 11.3× (Lagrange 9,832 → 82,059, momentum balance 13,294 → 68,408),
+/// grow at most 2^3.5 ≈ 11.3× (Lagrange 9,820 → 82,047, momentum balance 11,973 → 67,087),
 /// and stay under 100,000 at 8. Past its operand limit (the exponential growth back) the
 /// check is an error, so this fails rather than hangs.
 #[test]

@@ -228,31 +228,77 @@ impl ExprArena {
             else {
                 continue;
             };
+            // The sum first: a coefficient that would overflow leaves both terms as they are.
+            let x = match others.len() {
+                0 => None,
+                1 => Some(others[0]),
+                _ => Some(self.add(Node::Mul(others.into()))),
+            };
+            let before = x.map_or(*constant, |x| {
+                collected.get(&x).copied().unwrap_or(Constant::ZERO)
+            });
+            let sum = match before.checked_add(c) {
+                Ok(sum) => sum,
+                Err(e) => {
+                    self.fold_failed(e);
+                    continue;
+                }
+            };
             // Zeroed, not removed: removing from the middle of an `IndexMap` moves every later
             // entry, quadratic in the number of terms; zero terms are dropped at the end.
             zero_term(collected, rest);
             zero_term(collected, partner);
-            match others.len() {
-                0 => {
-                    *constant = constant.checked_add(c).unwrap_or_else(|e| {
-                        self.fold_failed(e);
-                        *constant
-                    });
-                }
-                _ => {
-                    let x = if others.len() == 1 {
-                        others[0]
-                    } else {
-                        self.add(Node::Mul(others.into()))
-                    };
-                    let entry = collected.entry(x).or_insert(Constant::ZERO);
-                    *entry = entry.checked_add(c).unwrap_or(*entry);
-                    if self.has_sine_square(x) {
-                        pending.push(x);
-                    }
+            let Some(x) = x else {
+                *constant = sum;
+                continue;
+            };
+            collected.insert(x, sum);
+            // `x` may now pair: through a sin² factor of its own, or as the cos² partner of a
+            // term examined before it existed (`X·sin²v` beside the new `X·cos²v`).
+            if self.has_sine_square(x) {
+                pending.push(x);
+            }
+            pending.extend(
+                self.sine_square_partners(x)
+                    .into_iter()
+                    .filter(|t| collected.get(t).is_some_and(|c| !c.is_zero())),
+            );
+        }
+    }
+
+    /// The terms `X·sin²v` that exist for each way of reading `term` as `X·cos²v` (looked up,
+    /// never made): those the Pythagorean identity pairs `term` with.
+    fn sine_square_partners(&self, term: ExprId) -> Vec<ExprId> {
+        let cos_square = |arena: &Self, f: ExprId| match arena.node(f) {
+            Node::Pow([b, e]) if arena.as_constant(*e) == Some(Constant::int(2)) => {
+                match arena.node(*b) {
+                    Node::Func(Func::Cos, v) => Some((*v, *e)),
+                    _ => None,
                 }
             }
+            _ => None,
+        };
+        let sin_square = |arena: &Self, (v, two): (ExprId, ExprId)| {
+            let sin = arena.lookup(NodeRef::Func(Func::Sin, v))?;
+            arena.lookup(NodeRef::Pow([sin, two]))
+        };
+        if let Some(cos2) = cos_square(self, term) {
+            return sin_square(self, cos2).into_iter().collect();
         }
+        let Node::Mul(factors) = self.node(term) else {
+            return Vec::new();
+        };
+        factors
+            .iter()
+            .enumerate()
+            .filter_map(|(i, &f)| {
+                let sin2 = sin_square(self, cos_square(self, f)?)?;
+                let mut swapped: Vec<ExprId> = factors.to_vec();
+                swapped[i] = sin2;
+                swapped.sort();
+                self.lookup(NodeRef::Mul(&swapped))
+            })
+            .collect()
     }
 
     /// The term `X·cos²u` if its node exists (looked up in the hash-cons table, never made):

@@ -104,7 +104,8 @@ fn pythagorean_identity_collapses_in_sums() {
 
 /// A term with two `sin²` factors pairs with its partner through either: `sin²θ cos²φ +
 /// sin²θ sin²φ = sin²θ` (the heavy top's `M₁₁`, whose first `sin²` factor, `sin²θ`, has no
-/// `cos²θ` partner there), and so does `sin²θ sin²φ + cos²θ sin²φ = sin²φ`.
+/// `cos²θ` partner there), and so does `sin²θ sin²φ + cos²θ sin²φ = sin²φ`; a term a fold
+/// makes is paired in turn, with a term met before it too.
 #[test]
 fn pythagorean_identity_pairs_through_any_sine_square() {
     let mut a = ExprArena::new();
@@ -122,6 +123,16 @@ fn pythagorean_identity_pairs_through_any_sine_square() {
     let second = a.product(&[m, ct2, sp2]);
     let expected = a.times(m, sp2);
     assert_eq!(a.plus(first, second), expected);
+    // Every product of sin² or cos² of θ and of φ: 1 (two folds make the terms of a third).
+    let four = [[st2, sp2], [st2, cp2], [ct2, sp2], [ct2, cp2]].map(|[x, y]| a.times(x, y));
+    assert_eq!(a.sum(&four), a.int(1));
+    // A fold that makes the cos² partner of a term examined before it: m sin²θ beside
+    // m cos²θ cos²φ + m cos²θ sin²φ = m cos²θ (a spring's length² written in spherical
+    // coordinates about another axis), whatever the order the terms are met in.
+    let lone = a.times(m, st2);
+    let pair = [a.product(&[m, ct2, cp2]), a.product(&[m, ct2, sp2])];
+    assert_eq!(a.sum(&[lone, pair[0], pair[1]]), m);
+    assert_eq!(a.sum(&[pair[1], pair[0], lone]), m);
 }
 
 #[test]
