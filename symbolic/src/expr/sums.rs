@@ -158,38 +158,50 @@ impl ExprArena {
         }
     }
 
-    /// Each way of reading `rest` as `sin²u · X` (a power, or a product with one or more such
-    /// factors): `u` and the other factors `X` (sorted ids), one per `sin²` factor. A term
-    /// with two (`sin²θ cos²φ` beside `sin²θ sin²φ`, the heavy top's `M`) pairs with its
-    /// partner through either.
-    fn sine_square_factors(&self, rest: ExprId) -> Vec<(ExprId, Vec<ExprId>)> {
-        let is_sin2 = |arena: &Self, f: ExprId| match arena.node(f) {
-            Node::Pow([b, e]) if arena.as_constant(*e) == Some(Constant::int(2)) => {
-                match arena.node(*b) {
-                    Node::Func(Func::Sin, u) => Some(*u),
+    /// Each way of reading `term` as `f(u)² · X` for `f` = `func` (sine or cosine): `u` and
+    /// where the square stands, `None` when it is the whole term, else its index among the
+    /// factors of the product `term`.
+    fn trig_squares(&self, term: ExprId, func: Func) -> Vec<(Option<usize>, ExprId)> {
+        let square = |f: ExprId| match self.node(f) {
+            Node::Pow([b, e]) if self.as_constant(*e) == Some(Constant::int(2)) => {
+                match self.node(*b) {
+                    Node::Func(g, u) if *g == func => Some(*u),
                     _ => None,
                 }
             }
             _ => None,
         };
-        if let Some(u) = is_sin2(self, rest) {
-            return vec![(u, Vec::new())];
+        if let Some(u) = square(term) {
+            return vec![(None, u)];
         }
-        let Node::Mul(factors) = self.node(rest) else {
+        let Node::Mul(factors) = self.node(term) else {
             return Vec::new();
         };
         factors
             .iter()
             .enumerate()
-            .filter_map(|(i, &f)| {
-                let u = is_sin2(self, f)?;
-                let others = factors
-                    .iter()
-                    .enumerate()
-                    .filter(|(j, _)| *j != i)
-                    .map(|(_, x)| *x)
-                    .collect();
-                Some((u, others))
+            .filter_map(|(i, &f)| square(f).map(|u| (Some(i), u)))
+            .collect()
+    }
+
+    /// Each way of reading `rest` as `sin²u · X` (a power, or a product with one or more such
+    /// factors): `u` and the other factors `X` (sorted ids), one per `sin²` factor. A term
+    /// with two (`sin²θ cos²φ` beside `sin²θ sin²φ`, the heavy top's `M`) pairs with its
+    /// partner through either.
+    fn sine_square_factors(&self, rest: ExprId) -> Vec<(ExprId, Vec<ExprId>)> {
+        self.trig_squares(rest, Func::Sin)
+            .into_iter()
+            .map(|(at, u)| {
+                let others = match (at, self.node(rest)) {
+                    (Some(i), Node::Mul(factors)) => factors
+                        .iter()
+                        .enumerate()
+                        .filter(|(j, _)| *j != i)
+                        .map(|(_, x)| *x)
+                        .collect(),
+                    _ => Vec::new(),
+                };
+                (u, others)
             })
             .collect()
     }
@@ -269,30 +281,20 @@ impl ExprArena {
     /// The terms `X·sin²v` that exist for each way of reading `term` as `X·cos²v` (looked up,
     /// never made): those the Pythagorean identity pairs `term` with.
     fn sine_square_partners(&self, term: ExprId) -> Vec<ExprId> {
-        let cos_square = |arena: &Self, f: ExprId| match arena.node(f) {
-            Node::Pow([b, e]) if arena.as_constant(*e) == Some(Constant::int(2)) => {
-                match arena.node(*b) {
-                    Node::Func(Func::Cos, v) => Some((*v, *e)),
-                    _ => None,
-                }
-            }
-            _ => None,
-        };
-        let sin_square = |arena: &Self, (v, two): (ExprId, ExprId)| {
-            let sin = arena.lookup(NodeRef::Func(Func::Sin, v))?;
-            arena.lookup(NodeRef::Pow([sin, two]))
-        };
-        if let Some(cos2) = cos_square(self, term) {
-            return sin_square(self, cos2).into_iter().collect();
-        }
-        let Node::Mul(factors) = self.node(term) else {
+        let Some(two) = self.lookup(NodeRef::Const(Constant::int(2))) else {
             return Vec::new();
         };
-        factors
-            .iter()
-            .enumerate()
-            .filter_map(|(i, &f)| {
-                let sin2 = sin_square(self, cos_square(self, f)?)?;
+        let sin_square = |v: ExprId| {
+            let sin = self.lookup(NodeRef::Func(Func::Sin, v))?;
+            self.lookup(NodeRef::Pow([sin, two]))
+        };
+        self.trig_squares(term, Func::Cos)
+            .into_iter()
+            .filter_map(|(at, v)| {
+                let sin2 = sin_square(v)?;
+                let (Some(i), Node::Mul(factors)) = (at, self.node(term)) else {
+                    return Some(sin2);
+                };
                 let mut swapped: Vec<ExprId> = factors.to_vec();
                 swapped[i] = sin2;
                 swapped.sort();

@@ -80,18 +80,7 @@ pub(in crate::integrate) fn weighted_sum_any(
     k: &[f64],
     dim: usize,
 ) {
-    let whole = dim - dim % BLOCK;
-    for base in (0..whole).step_by(BLOCK) {
-        out[base..base + BLOCK]
-            .copy_from_slice(&sum_strided::<BLOCK>(weights, first, k, dim, base));
-    }
-    let out = &mut out[whole..dim];
-    match dim - whole {
-        0 => {}
-        1 => out.copy_from_slice(&sum_strided::<1>(weights, first, k, dim, whole)),
-        2 => out.copy_from_slice(&sum_strided::<2>(weights, first, k, dim, whole)),
-        _ => out.copy_from_slice(&sum_strided::<3>(weights, first, k, dim, whole)),
-    }
+    blocks(Store(out), (weights, first, k), dim);
 }
 
 /// `out = y + h Σⱼ wⱼ kⱼ` for any dimension, in the blocks of [`weighted_sum_any`], each
@@ -106,20 +95,54 @@ pub(in crate::integrate) fn combine_any(
     k: &[f64],
     dim: usize,
 ) {
-    // Written out rather than through a closure per block, which the compiler did not
-    // inline: the coefficients of a stage were then not constants (8 % of a DOP853 run of a
-    // 5-link chain in that closure).
+    blocks(Update { out, y, h }, (weights, first, k), dim);
+}
+
+/// Where a block's sum goes: [`Store`] or [`Update`]. A trait, monomorphised for each width,
+/// rather than a closure per block, which the compiler did not inline: the coefficients of a
+/// stage were then not constants (8 % of a DOP853 run of a 5-link chain in that closure).
+trait BlockSink {
+    /// Writes the sum of components `base … base + B − 1`.
+    fn write<const B: usize>(&mut self, base: usize, sum: &[f64; B]);
+}
+
+/// The sums themselves into `out`.
+struct Store<'a>(&'a mut [f64]);
+
+impl BlockSink for Store<'_> {
+    #[inline(always)]
+    fn write<const B: usize>(&mut self, base: usize, sum: &[f64; B]) {
+        self.0[base..base + B].copy_from_slice(sum);
+    }
+}
+
+/// `out = y + h · sum`.
+struct Update<'a> {
+    out: &'a mut [f64],
+    y: &'a [f64],
+    h: f64,
+}
+
+impl BlockSink for Update<'_> {
+    #[inline(always)]
+    fn write<const B: usize>(&mut self, base: usize, sum: &[f64; B]) {
+        write_update::<B>(&mut self.out[base..], &self.y[base..], self.h, sum);
+    }
+}
+
+/// The sums `Σⱼ wⱼ kⱼ` of `dim` components in blocks of [`BLOCK`] and the rest, each into
+/// `sink`.
+#[inline(always)]
+fn blocks(mut sink: impl BlockSink, (weights, first, k): (&[f64], &[f64], &[f64]), dim: usize) {
     let whole = dim - dim % BLOCK;
     for base in (0..whole).step_by(BLOCK) {
-        let sum = sum_strided::<BLOCK>(weights, first, k, dim, base);
-        write_update::<BLOCK>(&mut out[base..], &y[base..], h, &sum);
+        sink.write(base, &sum_strided::<BLOCK>(weights, first, k, dim, base));
     }
-    let (out, y) = (&mut out[whole..], &y[whole..]);
     match dim - whole {
         0 => {}
-        1 => write_update::<1>(out, y, h, &sum_strided::<1>(weights, first, k, dim, whole)),
-        2 => write_update::<2>(out, y, h, &sum_strided::<2>(weights, first, k, dim, whole)),
-        _ => write_update::<3>(out, y, h, &sum_strided::<3>(weights, first, k, dim, whole)),
+        1 => sink.write(whole, &sum_strided::<1>(weights, first, k, dim, whole)),
+        2 => sink.write(whole, &sum_strided::<2>(weights, first, k, dim, whole)),
+        _ => sink.write(whole, &sum_strided::<3>(weights, first, k, dim, whole)),
     }
 }
 
