@@ -3,7 +3,8 @@
 
 For each model file `models/*.yaml` this computes the Taylor coefficients
 `y_i^[k] = y_i^(k)(t0)/k!`, k = 0..12, of the solution of `M(q, t) q'' = F(q, q', t)` through a
-fixed state `(t0, y)`, `y = [q; q']`, at 50 significant digits, and writes them to
+fixed state `(t0, y)`, `y = [q; q']`, at 50 significant digits (with constraints, of the
+index-1 system `[M J^T; J 0][q''; lambda] = [F; gamma]`), and writes them to
 `tests/data/taylor_coefficients.json`, which `tests/taylor_coefficients.rs` compares with
 `OdeSystem::taylor_coefficients` of the model compiled at run time from its file and of the
 same file compiled by `eomgen::model!` (the models of `tests/compiled_models.rs`) or
@@ -20,8 +21,9 @@ power series of mpmath numbers:
   (`f(x0 + h) = sum_j f^(j)(x0)/j! h^j`, closed-form derivatives), `tan`, `tanh` as quotients,
   `asin`, `acos`, `atan`, `atan2` by integrating their derivative along the series
   (`f(x(tau)) = f(x0) + int f'(x) x' dtau`);
-* `M(tau) a(tau) = F(tau)` solved order by order with mpmath's LU solver, and
-  `q^[k+1] = q'^[k]/(k+1)`, `q'^[k+1] = a^[k]/(k+1)`.
+* `M(tau) a(tau) = F(tau)` solved order by order with mpmath's LU solver (with constraints,
+  `[M J^T; J 0](tau) [a; lambda](tau) = [F; gamma](tau)`, the constraints' rows and gamma read
+  from `equations.constraints`), and `q^[k+1] = q'^[k]/(k+1)`, `q'^[k+1] = a^[k]/(k+1)`.
 
 Each model's coefficients are cross-checked against a second, unrelated route: mpmath's own
 ODE Taylor method (`mpmath.calculus.odes.ode_taylor`: Euler steps of size 2^-130 at
@@ -36,9 +38,12 @@ CRC-32 of the model's name), each rounded to an IEEE double; parameters are the 
 defaults rounded to doubles, as the model holds them. Constants in the equations text are
 taken as SymPy reads them (integers and fractions exact, decimals as doubles).
 
-Skipped (recorded with a reason): models with constraints, models whose `M` or `F` use a
-function without a Taylor recurrence (`abs`, `sign`, `step`) or a power with a non-constant
-exponent.
+The state of a constrained model is off its constraints (the perturbation): the index-1
+system is an ODE there too, and its series is what the Taylor method follows.
+
+Skipped (recorded with a reason): models whose equations use a function without a Taylor
+recurrence (`abs`, `sign`, `step`) or a power with a non-constant exponent, and models
+whose listing leaves an expression out as too long to print (the Whipple bicycle).
 
 Regenerate (from the repository root; about a minute):
 
@@ -420,11 +425,13 @@ class Model:
         self.parameter_names = list((source.get("parameters") or {}).keys())
         self.source = source
 
+    def constraint_texts(self):
+        return [t for c in self.constraints for t in c["jacobian"] + [c["gamma"]]]
+
     def skip_reason(self):
-        if self.constraints:
-            names = ", ".join(c.get("name", "?") for c in self.constraints)
-            return f"constraints ({len(self.constraints)}: {names})", None
-        text = " ".join(sum(self.mass_text, []) + self.forcing_text)
+        text = " ".join(sum(self.mass_text, []) + self.forcing_text + self.constraint_texts())
+        if "[not printed" in text:
+            return "an expression of its listing is too long to print", None
         missing = [f for f in functions_used(text) if f in NO_RECURRENCE]
         if missing:
             return "functions without a Taylor recurrence: " + ", ".join(missing), missing
@@ -439,6 +446,9 @@ class Model:
         symbols = {s.name: s for s in self.sym_q + self.sym_v + self.sym_p + [self.sym_t]}
         self.M = [[parse(self.mass_text[i][j], symbols) for j in range(n)] for i in range(n)]
         self.F = [parse(self.forcing_text[i], symbols) for i in range(n)]
+        self.m = len(self.constraints)
+        self.J = [[parse(c["jacobian"][j], symbols) for j in range(n)] for c in self.constraints]
+        self.gamma = [parse(c["gamma"], symbols) for c in self.constraints]
         # Parameters: the file's defaults, in order (a default may use earlier ones).
         exact = {}
         for name, value in (self.source.get("parameters") or {}).items():
@@ -479,32 +489,55 @@ class Model:
             def coeff(x, j):
                 return x.c[j] if isinstance(x, Series) else (x if j == 0 else mpf(0))
 
-            Ms = [[ev(self.M[i][j]) for j in range(n)] for i in range(n)]
-            Fs = [ev(self.F[i]) for i in range(n)]
-            M0 = mpmath.matrix(n, n)
-            for i in range(n):
-                for j in range(n):
-                    M0[i, j] = coeff(Ms[i][j], 0)
-            rhs = mpmath.matrix(n, 1)
-            for i in range(n):
-                s = coeff(Fs[i], k)
-                for l in range(n):
+            # [M J^T; J 0] and [F; gamma] as series, then the Cauchy product solved for
+            # order k of [a; lambda].
+            m = self.m
+            size = n + m
+            Js = [[ev(self.J[r][j]) for j in range(n)] for r in range(m)]
+            As = [[None] * size for _ in range(size)]
+            for i in range(size):
+                for j in range(size):
+                    if i < n and j < n:
+                        As[i][j] = ev(self.M[i][j])
+                    elif i >= n and j < n:
+                        As[i][j] = Js[i - n][j]
+                    elif i < n:
+                        As[i][j] = Js[j - n][i]
+                    else:
+                        As[i][j] = mpf(0)
+            bs = [ev(self.F[i]) for i in range(n)] + [ev(g) for g in self.gamma]
+            A0 = mpmath.matrix(size, size)
+            for i in range(size):
+                for j in range(size):
+                    A0[i, j] = coeff(As[i][j], 0)
+            rhs = mpmath.matrix(size, 1)
+            for i in range(size):
+                s = coeff(bs[i], k)
+                for l in range(size):
                     for j in range(1, k + 1):
-                        s -= coeff(Ms[i][l], j) * acc[k - j][l]
+                        s -= coeff(As[i][l], j) * acc[k - j][l]
                 rhs[i] = s
-            a = mpmath.lu_solve(M0, rhs)
-            acc.append([a[i] for i in range(n)])
+            a = mpmath.lu_solve(A0, rhs)
+            acc.append([a[i] for i in range(size)])
             for i in range(n):
                 q[i].append(v[i][k] / (k + 1))
                 v[i].append(a[i] / (k + 1))
         return [(q[i] if i < n else v[i - n])[k] for k in range(order + 1) for i in range(dim)]
 
-    # Second route: mpmath's ODE Taylor method on y' = [q'; M^-1 F].
+    # Second route: mpmath's ODE Taylor method on y' = [q'; a], a from M a = F (with
+    # constraints, [M J^T; J 0][a; lambda] = [F; gamma]) solved at each evaluation.
     def ode_taylor_coefficients(self, t0, y, order):
-        n = self.n
+        n, m = self.n, self.m
         args = self.sym_p + self.sym_q + self.sym_v + [self.sym_t]
-        Mf = sympy.lambdify(args, sympy.Matrix(self.M), modules="mpmath")
-        Ff = sympy.lambdify(args, sympy.Matrix(self.F), modules="mpmath")
+        blocks = sympy.Matrix(self.M)
+        right = sympy.Matrix(self.F)
+        if m:
+            jac = sympy.Matrix(self.J)
+            blocks = sympy.Matrix(sympy.BlockMatrix([[blocks, jac.T],
+                                                     [jac, sympy.zeros(m, m)]]))
+            right = right.col_join(sympy.Matrix(self.gamma))
+        Mf = sympy.lambdify(args, blocks, modules="mpmath")
+        Ff = sympy.lambdify(args, right, modules="mpmath")
         pvals = [self.parameters[s] for s in self.sym_p]
 
         def derivs(t, yy):
@@ -621,6 +654,7 @@ def main():
         print(f"{model.name}: dim {2 * model.n}, routes agree to {mpmath.nstr(cross, 3)}, "
               f"largest |c| {mpmath.nstr(biggest, 3)}", file=sys.stderr)
         entry.update({
+            "constraints": model.m,
             "dim": 2 * model.n,
             "t": double_text(T0),
             "y": [double_text(v) for v in model.y],

@@ -232,9 +232,15 @@ pub enum SeriesOp {
 /// A model's Taylor recurrences, with where the state goes in and `M` and `F` come out.
 ///
 /// # Shapes
-/// `n` degrees of freedom; `coordinates`, `velocities`: `n` slots each (or `None` for an
-/// input the equations do not read); `mass_matrix`: `n × n` slots, **column-major**;
-/// `forcing`: `n` slots. A slot marked constant ([`Self::constant`]) holds only order 0.
+/// `n` degrees of freedom and `m` constraints; `coordinates`, `velocities`: `n` slots each
+/// (or `None` for an input the equations do not read); `mass_matrix`: `(n + m) × (n + m)`
+/// slots, **column-major**; `forcing`: `n + m` slots. A slot marked constant
+/// ([`Self::constant`]) holds only order 0.
+///
+/// With constraints (`m > 0`) the matrix is the index-1 system's `[M Jᵀ; J 0]` and the
+/// right-hand side `[F; γ]` (Haug, *Computer-Aided Kinematics and Dynamics of Mechanical
+/// Systems*, §6.3; lectures 8–11), solved as a series for `[q̈; λ]` in the same way as
+/// `M q̈ = F` ([`Self::multipliers`] gives `m`).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct TaylorProgram {
     /// Number of slots: the series a workspace holds.
@@ -245,9 +251,9 @@ pub struct TaylorProgram {
     pub velocities: List<Option<Slot>>,
     /// Where `t` is read (`t^[0] = t₀`, `t^[1] = 1`, the rest 0).
     pub time: Option<Slot>,
-    /// `M` entry by entry, column-major.
+    /// `M` entry by entry, column-major (`[M Jᵀ; J 0]` with constraints).
     pub mass_matrix: List<Slot>,
-    /// `F`.
+    /// `F` (`[F; γ]` with constraints).
     pub forcing: List<Slot>,
     /// Whether each slot is constant (its orders above 0 are never written nor read).
     pub constant: List<bool>,
@@ -329,11 +335,12 @@ impl TaylorProgram {
 
     /// [`Self::derived`] as its other fields give it.
     pub fn derive(&self) -> DerivedLists {
-        let n = self.forcing.len();
+        let k = self.forcing.len();
+        let n = self.coordinates.len();
         let mut varying = Vec::new();
-        for i in 0..n {
-            for l in 0..n {
-                let slot = self.mass_matrix[i + l * n];
+        for i in 0..k {
+            for l in 0..k {
+                let slot = self.mass_matrix[i + l * k];
                 if !self.constant[slot as usize] {
                     varying.push((i as u32, l as u32, slot));
                 }
@@ -364,9 +371,16 @@ impl TaylorProgram {
     }
 
     /// The slot of the series of the first acceleration `q̈₀` in a workspace of
-    /// `slots + n` series: `q̈ᵢ`'s is this plus `i`, after the program's own slots.
+    /// `slots + n + m` series: `q̈ᵢ`'s is this plus `i`, after the program's own slots, and
+    /// the multiplier `λⱼ`'s this plus `n + j`.
     pub fn acceleration_slot(&self) -> Slot {
         self.slots as Slot
+    }
+
+    /// `m`, the constraints whose multipliers the series solves for with the accelerations
+    /// (0 for `M q̈ = F`).
+    pub fn multipliers(&self) -> usize {
+        self.forcing.len().saturating_sub(self.coordinates.len())
     }
 
     /// The highest order `k` whose code compiled for `k` a step of this program can run: the
@@ -409,7 +423,8 @@ fn convolutions(op: &SeriesOp) -> usize {
 /// Why a model has no Taylor recurrences.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize)]
 pub enum TaylorUnsupported {
-    /// The model has constraints: the Taylor method integrates `M q̈ = F` only.
+    /// The model has constraints, and its code has no recurrences for them (a model
+    /// compiled by `model!`; the run-time compiler's have them).
     Constraints {
         /// How many.
         count: usize,
@@ -422,6 +437,13 @@ pub enum TaylorUnsupported {
     },
     /// The model was written by hand, without a program.
     NotGenerated,
+    /// The constraints are stabilised in a way the recurrences do not follow: Baumgarte's
+    /// terms and the penalty's springs are not in the series of `[M Jᵀ; J 0][q̈; λ] = [F; γ]`
+    /// (no stabilisation, or projection after each step, are).
+    Stabilization {
+        /// The stabilisation's name.
+        name: Cow<'static, str>,
+    },
 }
 
 impl std::fmt::Display for TaylorUnsupported {
@@ -429,8 +451,8 @@ impl std::fmt::Display for TaylorUnsupported {
         match self {
             TaylorUnsupported::Constraints { count } => write!(
                 f,
-                "the model has {count} constraint(s); the Taylor method integrates unconstrained \
-                 equations M q̈ = F only"
+                "the model has {count} constraint(s), and its compiled code has no Taylor \
+                 recurrences for them (compile it at run time: a model file has them)"
             ),
             TaylorUnsupported::Functions { names } => {
                 let list: Vec<String> = names.iter().map(|n| format!("`{n}`")).collect();
@@ -444,6 +466,11 @@ impl std::fmt::Display for TaylorUnsupported {
             TaylorUnsupported::NotGenerated => {
                 write!(f, "the model has no generated Taylor recurrences")
             }
+            TaylorUnsupported::Stabilization { name } => write!(
+                f,
+                "the Taylor method follows the constraints with no stabilisation or with \
+                 projection, not with `{name}`"
+            ),
         }
     }
 }

@@ -11,7 +11,7 @@ use eomgen_runtime::taylor::{
 use eomgen_runtime::{DynMechanicalSystem, ModelDescription, UnknownParameter};
 use eomgen_symbolic::codegen::GenerateError;
 use eomgen_symbolic::codegen::program::{Derivation, ModelProgram};
-use eomgen_symbolic::codegen::taylor::{TaylorPlan, taylor_program};
+use eomgen_symbolic::codegen::taylor::TaylorPlan;
 use eomgen_symbolic::model::{Diagnostic, ReadError, read_model_file};
 
 use crate::compiled::{Compiled, Extent, FusedRhs, HotRoutine, SCRATCH, call, call_native};
@@ -337,11 +337,7 @@ impl JitModel {
                     .collect(),
             );
         }
-        let taylor = taylor_program(
-            &program.mass_matrix_and_forcing,
-            program.num_dofs(),
-            program.description.constraints.len(),
-        );
+        let taylor = program.taylor_plan();
         program.clear_tapes();
         let parameters: Vec<f64> = program.description.parameter_defaults();
         let code = Arc::new(Code {

@@ -196,7 +196,9 @@ pub(crate) fn compile_orders(
     const ORDER_ZERO: &str = "taylor_order_zero";
     let program = &plan.program;
     let highest = program.highest_unrolled_order().min(UNROLLED_CAPACITY - 1);
-    if highest == 0 {
+    // The orders' code solves `M q̈ = F` in line; a constrained model's series (`[M Jᵀ; J 0]`
+    // for `[q̈; λ]`) stay the kernels'.
+    if highest == 0 || program.multipliers() > 0 {
         return Ok(None);
     }
     // The order-0 code indexes the series by the tape's operands unchecked: each must be an

@@ -221,7 +221,7 @@ impl<S: MechanicalSystem<N>, const N: usize> OdeSystem for FirstOrder<S, N> {
     }
 
     fn taylor_support(&self) -> Result<(), crate::taylor::TaylorUnsupported> {
-        taylor_support(StaticSystem::from_ref(&self.system)).map(|_| ())
+        taylor_support(StaticSystem::from_ref(&self.system), self.stabilization).map(|_| ())
     }
 
     fn taylor_coefficients(
@@ -232,11 +232,13 @@ impl<S: MechanicalSystem<N>, const N: usize> OdeSystem for FirstOrder<S, N> {
         out: &mut [f64],
     ) -> Result<(), RhsError> {
         let system = StaticSystem::from_ref(&self.system);
-        taylor_coefficients(system, &mut self.taylor, t, y, order, out)
+        let stabilization = self.stabilization;
+        taylor_coefficients(system, stabilization, &mut self.taylor, t, y, order, out)
     }
 
     fn taylor_branch_step(&self, order: usize, h: f64) -> f64 {
-        taylor_branch_step(StaticSystem::from_ref(&self.system), &self.taylor, order, h)
+        let system = StaticSystem::from_ref(&self.system);
+        taylor_branch_step(system, self.stabilization, &self.taylor, order, h)
     }
 
     fn event_values(&mut self, t: f64, y: &[f64], g: &mut [f64]) -> Result<(), RhsError> {
@@ -532,7 +534,7 @@ impl<S: DynMechanicalSystem> OdeSystem for DynFirstOrder<S> {
     }
 
     fn taylor_support(&self) -> Result<(), crate::taylor::TaylorUnsupported> {
-        taylor_support(&self.system).map(|_| ())
+        taylor_support(&self.system, self.stabilization).map(|_| ())
     }
 
     fn taylor_coefficients(
@@ -542,11 +544,20 @@ impl<S: DynMechanicalSystem> OdeSystem for DynFirstOrder<S> {
         order: usize,
         out: &mut [f64],
     ) -> Result<(), RhsError> {
-        taylor_coefficients(&self.system, &mut self.taylor, t, y, order, out)
+        let stabilization = self.stabilization;
+        taylor_coefficients(
+            &self.system,
+            stabilization,
+            &mut self.taylor,
+            t,
+            y,
+            order,
+            out,
+        )
     }
 
     fn taylor_branch_step(&self, order: usize, h: f64) -> f64 {
-        taylor_branch_step(&self.system, &self.taylor, order, h)
+        taylor_branch_step(&self.system, self.stabilization, &self.taylor, order, h)
     }
 
     fn event_values(&mut self, t: f64, y: &[f64], g: &mut [f64]) -> Result<(), RhsError> {
@@ -591,13 +602,24 @@ impl<S: DynMechanicalSystem> FirstOrderForm for DynFirstOrder<S> {
 }
 
 /// [`OdeSystem::taylor_support`](crate::OdeSystem::taylor_support) of a first-order form:
-/// the system's Taylor method, refused with constraints.
+/// the system's Taylor method. With constraints its series are those of the index-1 system
+/// `[M Jᵀ; J 0][q̈; λ] = [F; γ]`: the drift is left as it is ([`Stabilization::None`]) or
+/// projected away after each step ([`Stabilization::Projection`]); Baumgarte's terms and the
+/// penalty's springs are refused, not in the recurrences.
 fn taylor_support<S: DynMechanicalSystem + ?Sized>(
     system: &S,
+    stabilization: Stabilization,
 ) -> Result<&dyn TaylorFunctions, TaylorUnsupported> {
-    let count = system.description().constraints.len();
-    if count > 0 {
-        return Err(TaylorUnsupported::Constraints { count });
+    let constrained = !system.description().constraints.is_empty();
+    if constrained
+        && !matches!(
+            stabilization,
+            Stabilization::None | Stabilization::Projection
+        )
+    {
+        return Err(TaylorUnsupported::Stabilization {
+            name: std::borrow::Cow::Borrowed(stabilization.name()),
+        });
     }
     system.taylor()
 }
@@ -606,13 +628,15 @@ fn taylor_support<S: DynMechanicalSystem + ?Sized>(
 /// form.
 fn taylor_coefficients<S: DynMechanicalSystem + ?Sized>(
     system: &S,
+    stabilization: Stabilization,
     workspace: &mut TaylorWorkspace,
     t: f64,
     y: &[f64],
     order: usize,
     out: &mut [f64],
 ) -> Result<(), RhsError> {
-    let taylor = taylor_support(system).map_err(|_| RhsError::NonFinite { index: 0 })?;
+    let taylor =
+        taylor_support(system, stabilization).map_err(|_| RhsError::NonFinite { index: 0 })?;
     crate::taylor::series_of_motion(taylor, workspace, t, y, order, out)
 }
 
@@ -620,11 +644,12 @@ fn taylor_coefficients<S: DynMechanicalSystem + ?Sized>(
 /// form.
 fn taylor_branch_step<S: DynMechanicalSystem + ?Sized>(
     system: &S,
+    stabilization: Stabilization,
     workspace: &TaylorWorkspace,
     order: usize,
     h: f64,
 ) -> f64 {
-    match taylor_support(system) {
+    match taylor_support(system, stabilization) {
         Ok(taylor) => crate::taylor::branch_step(taylor.program(), workspace, order, h),
         Err(_) => h,
     }

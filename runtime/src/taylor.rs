@@ -653,7 +653,9 @@ impl TaylorWorkspace {
     /// stride is [`UNROLLED_CAPACITY`], the one the kernels compiled for each order run with,
     /// when [`TaylorProgram::unrolled_code_fits`] or the model has `fused` orders (and
     /// `order` is within the stride), else any other (so that they do not).
-    fn fit(&mut self, program: &TaylorProgram, n: usize, order: usize, fused: usize) {
+    /// `unknowns` is the series solve's: `n`, or `n + m` with `m` constraints.
+    fn fit(&mut self, program: &TaylorProgram, unknowns: usize, order: usize, fused: usize) {
+        let n = unknowns;
         // With fused orders (a compiled model's), those run compiled for each order and the
         // rest as loops at the same stride, whatever the order (to its limit): the fused
         // code alone is what must fit the instruction cache.
@@ -779,7 +781,9 @@ fn series_in(
     let program = model.program();
     let n = program.coordinates.len();
     let dim = 2 * n;
-    workspace.fit(program, n, order, model.fused_orders());
+    // The unknowns of each order: `q̈`, then the multipliers `λ` of a constrained model.
+    let unknowns = program.forcing.len();
+    workspace.fit(program, unknowns, order, model.fused_orders());
     let c = workspace.capacity;
     let TaylorWorkspace {
         series: s,
@@ -815,19 +819,28 @@ fn series_in(
     }
     model.order_zero(c, s);
     let mass = |e: usize| s[program.mass_matrix[e] as usize * c];
+    let factors = Factors {
+        unknowns,
+        positive: n,
+        lower,
+        pivots,
+        inverse_pivots,
+        nonzeros,
+    };
     if program.derived.varying_mass_entries.is_empty() {
         // A constant M: factored again only when its entries changed (new parameters).
-        let same = factored_mass.len() == n * n
-            && (0..n * n).all(|e| mass(e).to_bits() == factored_mass[e].to_bits());
+        let entries = unknowns * unknowns;
+        let same = factored_mass.len() == entries
+            && (0..entries).all(|e| mass(e).to_bits() == factored_mass[e].to_bits());
         if !same {
             factored_mass.clear();
-            factor_mass(n, mass, lower, pivots, inverse_pivots, nonzeros)?;
-            factored_mass.extend((0..n * n).map(mass));
+            factor_mass(mass, factors)?;
+            factored_mass.extend((0..entries).map(mass));
         }
     } else {
         // The factors become another M's.
         factored_mass.clear();
-        factor_mass(n, mass, lower, pivots, inverse_pivots, nonzeros)?;
+        factor_mass(mass, factors)?;
     }
     let layout = MotionLayout {
         forcing: &program.forcing,
@@ -837,13 +850,15 @@ fn series_in(
         accelerations: program.acceleration_slot(),
     };
     let mut solve = MotionSolve {
-        n,
+        n: unknowns,
+        coordinates: n,
         c,
         // A factor with a zero below its diagonal is solved over the list of its non-zero
         // entries (faster for a sparse one: the figure eight's diagonal M; and the dense
         // loops never meet a zero, whose `b − 0·x` would not be `b` to the bit for `b = −0`
-        // or `x` infinite).
-        dense: 2 * nonzeros.len() >= n * n.saturating_sub(1),
+        // or `x` infinite). With constraints, always: the dense solve's unknowns are `q̈`
+        // alone.
+        dense: unknowns == n && 2 * nonzeros.len() >= n * n.saturating_sub(1),
         nonzeros,
         lower,
         inverse_pivots,
@@ -905,7 +920,10 @@ pub struct MotionLayout<'a> {
 /// workspace's scratch for a run-time backend's compiled orders ([`Self::lanes`]).
 #[derive(Debug)]
 pub struct MotionSolve<'a> {
+    /// The unknowns of each order: `n` accelerations, then `m` multipliers.
     n: usize,
+    /// `n`.
+    coordinates: usize,
     c: usize,
     /// `L` has no zero below its diagonal.
     dense: bool,
@@ -957,7 +975,7 @@ impl MotionSolve<'_> {
     /// `b = −0` or `x` infinite); `None` for larger `n`.
     #[inline]
     pub fn small_factor(&self) -> Option<(&[f64], &[f64])> {
-        (self.n <= FIXED_DEGREES).then(|| {
+        (self.n <= FIXED_DEGREES && self.n == self.coordinates).then(|| {
             (
                 &self.lower[..self.n * self.n],
                 &self.inverse_pivots[..self.n],
@@ -970,8 +988,7 @@ impl MotionSolve<'_> {
     /// `None` otherwise.
     #[inline]
     pub fn diagonal_factor(&self) -> Option<&[f64]> {
-        self.nonzeros
-            .is_empty()
+        (self.nonzeros.is_empty() && self.n == self.coordinates)
             .then(|| &self.inverse_pivots[..self.n])
     }
 }
@@ -1102,7 +1119,7 @@ fn dense_order<const N: usize, const K: usize>(
             b[j] -= lower[i * N + j] * b[i];
         }
     }
-    next_order(layout, solve.reciprocals, k, c, s, &b, out);
+    next_order(layout, solve.reciprocals, k, c, s, &b, N, out);
 }
 
 /// [`motion_order`] over `L`'s non-zero entries, any `n`.
@@ -1121,11 +1138,22 @@ fn sparse_order<const K: usize>(
     }
     coupled_sums::<K>(k, c, s, layout, b);
     self::solve(solve.nonzeros, solve.inverse_pivots, b);
-    next_order(layout, solve.reciprocals, k, c, s, b, out);
+    next_order(
+        layout,
+        solve.reciprocals,
+        k,
+        c,
+        s,
+        b,
+        solve.coordinates,
+        out,
+    );
 }
 
-/// Stores `a^[k] = b` and the state's order `k + 1` (see [`motion_order`]).
+/// Stores `a^[k] = b` (`[q̈^[k]; λ^[k]]` with constraints) and the state's order `k + 1` (see
+/// [`motion_order`]); `n` is the number of coordinates (`b`'s first `n` entries are `q̈^[k]`).
 #[inline(always)]
+#[allow(clippy::too_many_arguments)] // the solve's pieces, inlined into each variant
 fn next_order(
     layout: &MotionLayout<'_>,
     reciprocals: &[f64],
@@ -1133,9 +1161,9 @@ fn next_order(
     c: usize,
     s: &mut [f64],
     b: &[f64],
+    n: usize,
     out: &mut [f64],
 ) {
-    let n = b.len();
     let dim = 2 * n;
     let inverse = reciprocals[k];
     let (now, next) = out[k * dim..(k + 2) * dim].split_at_mut(dim);
@@ -1144,6 +1172,9 @@ fn next_order(
         put(s, c, layout.accelerations + i as Slot, k, b[i]);
         q_next[i] = now[n + i] * inverse;
         v_next[i] = b[i] * inverse;
+    }
+    for (i, &multiplier) in b.iter().enumerate().skip(n) {
+        put(s, c, layout.accelerations + i as Slot, k, multiplier);
     }
     if k + 1 < c {
         for &(slot, index) in layout.inputs {
@@ -1185,20 +1216,46 @@ fn coupled_sums<const K: usize>(
     }
 }
 
-/// [`factor`] of `M` (entry `e` column-major is `mass(e)`), then the list of the factor's
+/// Where [`factor_mass`] writes the factor of an `unknowns × unknowns` matrix whose first
+/// `positive` pivots are positive and the rest negative (see [`factor`]).
+struct Factors<'a> {
+    unknowns: usize,
+    positive: usize,
+    lower: &'a mut [f64],
+    pivots: &'a mut [f64],
+    inverse_pivots: &'a mut [f64],
+    nonzeros: &'a mut Vec<(u32, u32, f64)>,
+}
+
+/// [`factor`] of `M` (entry `e` column-major is `mass(e)`; `[M Jᵀ; J 0]` with constraints,
+/// [`RhsError::SingularConstraintMatrix`] when a pivot of its constraints' block fails), then the list of the factor's
 /// entries below the diagonal that are not zero, which the solves of every order visit (a
 /// model's `M` is often sparse: bodies that do not share a coordinate).
 #[inline(always)]
-fn factor_mass(
-    n: usize,
-    mass: impl Fn(usize) -> f64,
-    lower: &mut [f64],
-    pivots: &mut [f64],
-    inverse_pivots: &mut [f64],
-    nonzeros: &mut Vec<(u32, u32, f64)>,
-) -> Result<(), RhsError> {
-    factor(n, |i, j| mass(i + j * n), lower, pivots, inverse_pivots)
-        .ok_or(RhsError::SingularMassMatrix)?;
+fn factor_mass(mass: impl Fn(usize) -> f64, factors: Factors<'_>) -> Result<(), RhsError> {
+    let Factors {
+        unknowns: n,
+        positive,
+        lower,
+        pivots,
+        inverse_pivots,
+        nonzeros,
+    } = factors;
+    factor(
+        n,
+        positive,
+        |i, j| mass(i + j * n),
+        lower,
+        pivots,
+        inverse_pivots,
+    )
+    .map_err(|pivot| {
+        if pivot < positive {
+            RhsError::SingularMassMatrix
+        } else {
+            RhsError::SingularConstraintMatrix
+        }
+    })?;
     nonzeros.clear();
     for i in 0..n {
         for (j, &l) in lower[i * n..i * n + i].iter().enumerate() {
@@ -1212,16 +1269,25 @@ fn factor_mass(
 
 /// `L D Lᵀ` of the symmetric `n × n` matrix `m(i, j)` (lower triangle read) into `lower`
 /// (row-major, unit diagonal implied), `pivots` (`D`) and `inverse_pivots` (`D⁻¹`, so that
-/// each order's solve multiplies where it would divide); `None` unless positive definite.
+/// each order's solve multiplies where it would divide), with the first `positive` pivots
+/// positive and the rest negative; else `Err` with the first pivot that is not.
+///
+/// With `positive = n` that is `M` positive definite. With `positive = n` coordinates and
+/// `m` constraints, `[M Jᵀ; J 0]` factors so exactly when `M` is positive definite and `J`
+/// has full row rank: the last `m` pivots are those of the Schur complement `−J M⁻¹ Jᵀ`,
+/// negative definite (the range-space method; Nocedal & Wright, *Numerical Optimization*,
+/// 2nd ed., §16.2, and §16.1 on the inertia of such a matrix), so no pivoting is needed and
+/// the factor's solves are `M`'s and those of the complement.
 #[inline]
 fn factor(
     n: usize,
+    positive: usize,
     m: impl Fn(usize, usize) -> f64,
     lower: &mut [f64],
     pivots: &mut [f64],
     inverse_pivots: &mut [f64],
-) -> Option<()> {
-    if n == 2 {
+) -> Result<(), usize> {
+    if n == 2 && positive == 2 {
         // The second pivot as `det M / M₁₁`, so that its reciprocal `M₁₁ / det M` does not
         // wait for the first (the two divisions run side by side; one after the other they
         // lay on the path from a step's order 0 to its order 1). Only where `det M` and that
@@ -1238,7 +1304,7 @@ fn factor(
             lower[2] = m21 * inverse;
             pivots[1] = det * inverse;
             inverse_pivots[1] = second;
-            return Some(());
+            return Ok(());
         }
     }
     for j in 0..n {
@@ -1246,9 +1312,10 @@ fn factor(
         for k in 0..j {
             d -= lower[j * n + k] * lower[j * n + k] * pivots[k];
         }
-        // Not positive, or NaN.
-        if d.is_nan() || d <= 0.0 {
-            return None;
+        // Not of its sign (positive, then negative), or NaN.
+        let signed = if j < positive { d } else { -d };
+        if signed.is_nan() || signed <= 0.0 {
+            return Err(j);
         }
         let inverse = 1.0 / d;
         pivots[j] = d;
@@ -1261,7 +1328,7 @@ fn factor(
             lower[i * n + j] = v * inverse;
         }
     }
-    Some(())
+    Ok(())
 }
 
 /// Solves `L D Lᵀ x = b` in place, with `L`'s entries below the diagonal that are not zero
@@ -1426,7 +1493,7 @@ mod tests {
         for m in cases {
             let n = (m.len() as f64).sqrt() as usize;
             let (mut lower, mut d, mut inverse) = (vec![0.0; n * n], vec![0.0; n], vec![0.0; n]);
-            factor(n, |i, j| m[i + j * n], &mut lower, &mut d, &mut inverse).expect("a factor");
+            factor(n, n, |i, j| m[i + j * n], &mut lower, &mut d, &mut inverse).expect("a factor");
             let l = |i: usize, j: usize| match i.cmp(&j) {
                 std::cmp::Ordering::Equal => 1.0,
                 std::cmp::Ordering::Greater => lower[i * n + j],
@@ -1452,7 +1519,7 @@ mod tests {
         for scale in [1e160, 1e200, 1e-160, 1e-170] {
             let m = [scale, 0.5 * scale, 0.5 * scale, scale];
             let (mut lower, mut d, mut inverse) = ([0.0; 4], [0.0; 2], [0.0; 2]);
-            factor(2, |i, j| m[i + j * 2], &mut lower, &mut d, &mut inverse).expect("a factor");
+            factor(2, 2, |i, j| m[i + j * 2], &mut lower, &mut d, &mut inverse).expect("a factor");
             assert_eq!((d[0], lower[2]), (scale, 0.5), "{scale:e}");
             assert!(
                 (d[1] / (0.75 * scale) - 1.0).abs() < 4.0 * f64::EPSILON,
@@ -1473,7 +1540,7 @@ mod tests {
             let n = (m.len() as f64).sqrt() as usize;
             let (mut lower, mut d, mut inverse) = (vec![0.0; n * n], vec![0.0; n], vec![0.0; n]);
             assert!(
-                factor(n, |i, j| m[i + j * n], &mut lower, &mut d, &mut inverse).is_none(),
+                factor(n, n, |i, j| m[i + j * n], &mut lower, &mut d, &mut inverse).is_err(),
                 "{m:?}"
             );
         }

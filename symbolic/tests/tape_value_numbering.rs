@@ -9,7 +9,7 @@
 
 use eomgen_symbolic::codegen::program::ModelProgram;
 use eomgen_symbolic::codegen::tape::{Instruction, Tape};
-use eomgen_symbolic::codegen::taylor::{TaylorPlan, taylor_program};
+use eomgen_symbolic::codegen::taylor::TaylorPlan;
 
 /// An operation's kind and operands, commutative ones sorted; `None` for inputs and
 /// constants.
@@ -38,14 +38,11 @@ fn repeated(tape: &Tape, len: usize) -> Option<(usize, usize)> {
     None
 }
 
-/// The model's program and its Taylor plan (`None` with constraints or functions without a
-/// recurrence).
+/// The model's program and its Taylor plan (`None` with functions without a recurrence).
 fn plan(source: &str) -> (ModelProgram, Option<TaylorPlan>) {
     let file = eomgen_symbolic::model::load("m.yaml", source).unwrap();
     let program = ModelProgram::from_file(&file).unwrap().0;
-    let n = program.num_dofs();
-    let constraints = program.description.constraints.len();
-    let taylor = taylor_program(&program.mass_matrix_and_forcing, n, constraints).ok();
+    let taylor = program.taylor_plan().ok();
     (program, taylor)
 }
 
@@ -64,7 +61,7 @@ fn no_taylor_program_of_a_bundled_model_repeats_an_operation_of_its_tape() {
         let (program, Some(taylor)) = plan(&std::fs::read_to_string(path).unwrap()) else {
             continue;
         };
-        let tape = &program.mass_matrix_and_forcing.tape;
+        let tape = &program.taylor_tape().tape;
         // The tape's own instructions come first in order 0, the auxiliary ones after.
         let own = tape.numbered().instructions.len();
         if let Some((first, repeat)) = repeated(&taylor.order_zero, own) {

@@ -416,11 +416,16 @@ fn taylor_items(
 ) -> Result<(TokenStream, TokenStream), String> {
     let n = model.num_dofs();
     // The Taylor recurrences, from the tape of `M` and `F` the run-time compiler builds too.
-    let taylor = taylor::taylor_program(
-        &program::mass_matrix_and_forcing_tape(model, &plans.state),
-        n,
-        model.constraints.len(),
-    );
+    // The compiled code's fused orders solve `M q̈ = F` only: a constrained model's series
+    // are the run-time compiler's.
+    let taylor = match model.constraints.len() {
+        0 => taylor::taylor_program(
+            &program::mass_matrix_and_forcing_tape(model, &plans.state),
+            n,
+            0,
+        ),
+        count => Err(eomgen_description::taylor::TaylorUnsupported::Constraints { count }),
+    };
     let parameter_fields = model
         .parameters
         .iter()

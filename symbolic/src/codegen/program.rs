@@ -14,7 +14,7 @@ use eomgen_description::ModelDescription;
 
 use super::GenerateError;
 use super::plan::{ModelFunction, ModelPlans};
-use super::tape::{Instruction, Tape};
+use super::tape::{Input, Instruction, Tape, Value};
 
 /// One function of a model, as a tape and the layout of its outputs.
 ///
@@ -181,6 +181,36 @@ impl ModelProgram {
         self.description.num_dofs()
     }
 
+    /// The tape the Taylor recurrences are built from: [`Self::mass_matrix_and_forcing`]
+    /// without constraints, else [`constrained_motion_tape`] of it, of `J` and of `γ`.
+    pub fn taylor_tape(&self) -> std::borrow::Cow<'_, FunctionTape> {
+        if self.description.constraints.is_empty() {
+            std::borrow::Cow::Borrowed(&self.mass_matrix_and_forcing)
+        } else {
+            std::borrow::Cow::Owned(constrained_motion_tape(
+                &self.mass_matrix_and_forcing,
+                &self.constraint_jacobian,
+                &self.constraint_gamma,
+                self.num_dofs(),
+            ))
+        }
+    }
+
+    /// The model's Taylor recurrences ([`super::taylor::taylor_program`] of
+    /// [`Self::taylor_tape`]), with its constraints' multipliers when it has any.
+    ///
+    /// # Errors
+    /// As [`super::taylor::taylor_program`].
+    pub fn taylor_plan(
+        &self,
+    ) -> Result<super::taylor::TaylorPlan, eomgen_description::taylor::TaylorUnsupported> {
+        super::taylor::taylor_program(
+            &self.taylor_tape(),
+            self.num_dofs(),
+            self.description.constraints.len(),
+        )
+    }
+
     /// Every function with its name, in the order of the table above (the Jacobians, planned
     /// apart, not among them).
     pub fn functions(&self) -> [(&'static str, &FunctionTape); 15] {
@@ -307,6 +337,83 @@ pub fn mass_matrix_and_forcing_tape(model: &SymbolicModel, plans: &ModelPlans) -
     outputs.extend_from_slice(forcing);
     tape.outputs = outputs;
     FunctionTape { tape, split: n * n }
+}
+
+/// The tape of a constrained model's index-1 system for the Taylor recurrences
+/// ([`super::taylor::taylor_program`]): `[M Jᵀ; J 0]` column-major (`(n + m) × (n + m)`),
+/// then `[F; γ]` (`n + m`), from the tapes of `M` and `F` (`motion`, as
+/// [`mass_matrix_and_forcing_tape`] gives it), of `J` (`m × n`, row-major) and of `γ` (`m`).
+///
+/// The three tapes are concatenated, each input read once (the later tapes' reads of an input
+/// become the first's), so that value numbering ([`Tape::numbered`]) shares what `M`, `F`,
+/// `J` and `γ` compute alike (the sines and cosines of the coordinates): every output keeps
+/// the bits of the tape it comes from.
+pub fn constrained_motion_tape(
+    motion: &FunctionTape,
+    jacobian: &FunctionTape,
+    gamma: &FunctionTape,
+    n: usize,
+) -> FunctionTape {
+    let m = gamma.tape.outputs.len();
+    let k = n + m;
+    let mut tape = motion.tape.clone();
+    let mut inputs: rustc_hash::FxHashMap<Input, Value> = tape
+        .instructions
+        .iter()
+        .enumerate()
+        .filter_map(|(v, i)| match i {
+            Instruction::Input(input) => Some((*input, v as Value)),
+            _ => None,
+        })
+        .collect();
+    let jacobian = append(&mut tape, &mut inputs, &jacobian.tape);
+    let gamma = append(&mut tape, &mut inputs, &gamma.tape);
+    tape.instructions.push(Instruction::Const(0.0));
+    let zero = (tape.instructions.len() - 1) as Value;
+    let (mass, forcing) = motion
+        .tape
+        .outputs
+        .split_at((n * n).min(motion.tape.outputs.len()));
+    let mut outputs = Vec::with_capacity(k * k + k);
+    for c in 0..k {
+        for r in 0..k {
+            outputs.push(match (r < n, c < n) {
+                (true, true) => mass[r + c * n],
+                (false, true) => jacobian[(r - n) * n + c],
+                (true, false) => jacobian[(c - n) * n + r],
+                (false, false) => zero,
+            });
+        }
+    }
+    outputs.extend_from_slice(forcing);
+    outputs.extend_from_slice(&gamma);
+    tape.outputs = outputs;
+    FunctionTape { tape, split: k * k }
+}
+
+/// Appends `other`'s instructions to `tape`, an input `tape` reads already (listed in
+/// `inputs`) read from there; the values of `other`'s outputs in `tape`.
+fn append(
+    tape: &mut Tape,
+    inputs: &mut rustc_hash::FxHashMap<Input, Value>,
+    other: &Tape,
+) -> Vec<Value> {
+    let mut values: Vec<Value> = Vec::with_capacity(other.instructions.len());
+    for instruction in &other.instructions {
+        let value = match *instruction {
+            Instruction::Input(input) => *inputs.entry(input).or_insert_with(|| {
+                tape.instructions.push(*instruction);
+                (tape.instructions.len() - 1) as Value
+            }),
+            _ => {
+                let renumbered = instruction.map_operands(|v| values[v as usize]);
+                tape.instructions.push(renumbered);
+                (tape.instructions.len() - 1) as Value
+            }
+        };
+        values.push(value);
+    }
+    other.outputs.iter().map(|&v| values[v as usize]).collect()
 }
 
 /// The outputs of a row-major `n × n` matrix in column-major order.

@@ -1,4 +1,5 @@
-//! A model's Taylor recurrences ([`TaylorProgram`]) from the tape of `M` and `F`.
+//! A model's Taylor recurrences ([`TaylorProgram`]) from the tape of `M` and `F` (with
+//! constraints, of `[M Jᵀ; J 0]` and `[F; γ]`).
 //!
 //! The tape of [`ModelFunction::MassMatrixAndForcing`](super::plan::ModelFunction) — the plan
 //! both backends compile — numbered ([`Tape::numbered`]: an operation the lowering repeats,
@@ -41,21 +42,20 @@ pub struct TaylorPlan {
 }
 
 /// Builds the Taylor recurrences of the tape of `M` (column-major, `n × n`) and `F` (`n`), the
-/// run-time compiler's [`ModelProgram::mass_matrix_and_forcing`](super::program::ModelProgram).
+/// run-time compiler's [`ModelProgram::mass_matrix_and_forcing`](super::program::ModelProgram),
+/// or, with `multipliers = m > 0` constraints, of `[M Jᵀ; J 0]` (column-major,
+/// `(n + m) × (n + m)`) and `[F; γ]` ([`super::program::constrained_motion_tape`]).
 ///
 /// # Errors
-/// [`TaylorUnsupported::Constraints`] if `constraints > 0`;
 /// [`TaylorUnsupported::Functions`] naming each function without a recurrence (`abs`, `sign`,
 /// `step`, `pow` with a variable exponent) that the equations apply to the state or time (of
 /// parameters alone they are constants, computed once at order 0).
 pub fn taylor_program(
     tape: &FunctionTape,
     n: usize,
-    constraints: usize,
+    multipliers: usize,
 ) -> Result<TaylorPlan, TaylorUnsupported> {
-    if constraints > 0 {
-        return Err(TaylorUnsupported::Constraints { count: constraints });
-    }
+    let k = n + multipliers;
     // Each value a series: a repeated operation would cost a convolution per order.
     let numbered = tape.tape.numbered();
     let mut builder = Builder::new(&numbered);
@@ -66,7 +66,7 @@ pub fn taylor_program(
         });
     }
     let outputs = &numbered.outputs;
-    let (mass, forcing) = outputs.split_at((n * n).min(outputs.len()));
+    let (mass, forcing) = outputs.split_at((k * k).min(outputs.len()));
     let Builder {
         order_zero,
         constant,
