@@ -196,9 +196,7 @@ pub(crate) fn compile_orders(
     const ORDER_ZERO: &str = "taylor_order_zero";
     let program = &plan.program;
     let highest = program.highest_unrolled_order().min(UNROLLED_CAPACITY - 1);
-    // The orders' code solves `M q̈ = F` in line; a constrained model's series (`[M Jᵀ; J 0]`
-    // for `[q̈; λ]`) stay the kernels'.
-    if highest == 0 || program.multipliers() > 0 {
+    if highest == 0 {
         return Ok(None);
     }
     // The order-0 code indexes the series by the tape's operands unchecked: each must be an
@@ -434,15 +432,21 @@ fn emit_order(
             }
         }
     }
-    // Order k of M a = F: in line with the factor `mode` names, else by `solve`.
+    // Order k of M a = F: in line with the factor `mode` names, else by `solve` (always with
+    // constraints: the unknowns `[q̈; λ]` of `[M Jᵀ; J 0]` are not the in-line solves').
     let after = b.create_block();
     let mut test = b.create_block();
     b.ins().jump(test, &[]);
-    for (code, factor) in [
-        (FACTOR_DENSE, Factor::Dense),
-        (FACTOR_SMALL, Factor::Small),
-        (FACTOR_DIAGONAL, Factor::Diagonal),
-    ] {
+    let inline: &[(i64, Factor)] = if program.multipliers() == 0 {
+        &[
+            (FACTOR_DENSE, Factor::Dense),
+            (FACTOR_SMALL, Factor::Small),
+            (FACTOR_DIAGONAL, Factor::Diagonal),
+        ]
+    } else {
+        &[]
+    };
+    for &(code, factor) in inline {
         b.switch_to_block(test);
         b.seal_block(test);
         let (inline, next) = (b.create_block(), b.create_block());

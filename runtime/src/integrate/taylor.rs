@@ -57,10 +57,21 @@ use crate::ode::OdeSystem;
 /// The step's polynomial, evaluated the same way with the carry of the step's start (`θ = 1`
 /// gives the step's end to the bit): output times and events are located on it.
 ///
+/// # Constraints
+/// A model with constraints is integrated in its index-1 form `[M Jᵀ; J 0][q̈; λ] = [F; γ]`,
+/// whose series the recurrences solve order by order with the multipliers
+/// ([`crate::taylor::series_of_motion`]), the form every other method integrates. The
+/// constraints then drift as they do under any method (by the truncation error of each step,
+/// not corrected), unless [`crate::Stabilization::Projection`] projects each step's end onto
+/// them (the next step's series then starts there). Baumgarte's terms and the penalty's
+/// springs are not in the recurrences and are refused.
+///
 /// # Errors
 /// As every [`Integrator`], and [`IntegrationError::NoTaylorRecurrences`] before any step for a
-/// system without recurrences (equations given as a closure; a model with constraints, or
-/// whose equations use `abs`, `sign`, `step` or a power with a variable exponent).
+/// system without recurrences: equations given as a closure; a model whose equations use
+/// `abs`, `sign`, `step` or a power with a variable exponent; constraints stabilised by
+/// Baumgarte's terms or the penalty, or in a model compiled by `model!` (whose code has the
+/// recurrences of `M q̈ = F` only; its file compiled at run time has them).
 ///
 /// # Source
 /// À. Jorba, M. Zou, *A software package for the numerical integration of ODEs by means of
