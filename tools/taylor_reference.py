@@ -637,7 +637,7 @@ def main():
             c = model.series_coefficients(T0, model.y, ORDER)
         except VariableExponent as error:
             entry["skip"] = str(error)
-            entry["constraints"] = 0
+            entry["constraints"] = len(model.constraints)
             print(f"{model.name}: skipped: {error}", file=sys.stderr)
             entries.append(entry)
             continue

@@ -239,7 +239,7 @@ pub enum SeriesOp {
 ///
 /// With constraints (`m > 0`) the matrix is the index-1 system's `[M Jᵀ; J 0]` and the
 /// right-hand side `[F; γ]` (Haug, *Computer-Aided Kinematics and Dynamics of Mechanical
-/// Systems*, §6.3; lectures 8–11), solved as a series for `[q̈; λ]` in the same way as
+/// Systems*, §6.3), solved as a series for `[q̈; λ]` in the same way as
 /// `M q̈ = F` ([`Self::multipliers`] gives `m`).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct TaylorProgram {
@@ -319,9 +319,9 @@ impl TaylorProgram {
     /// instruction cache holds, the unrolled code is slower than the loops. Measured on one
     /// machine (2 cores, 32 KiB instruction cache; time of a run against the loops', same
     /// runs, when the programs were larger than today's): the double pendulum (24 ops,
-    /// w = 12; 20 and 10 now) at orders 8, 12, 15 (sizes 504, 1056, 1596) in 0.74, 0.71, 0.75,
+    /// w = 12; 19 and 10 now) at orders 8, 12, 15 (sizes 504, 1056, 1596) in 0.74, 0.71, 0.75,
     /// at 18 and 20 (2244, 2736) 1.09 and 1.2× the loops' time; the figure eight (58 ops,
-    /// w = 21; 44 and 15 now, its pulls formed once) at orders 8 and 12 (994, 2024) in 0.73
+    /// w = 21; 40 and 15 now, its pulls formed once) at orders 8 and 12 (994, 2024) in 0.73
     /// and 0.77, at 15 and 18 (3017, 4199) 1.1×.
     pub fn unrolled_code_fits(&self, order: usize) -> bool {
         order <= UNROLLED_ORDERS + 1 && self.unrolled_code_size(order) <= UNROLLED_CODE_BUDGET
@@ -437,6 +437,11 @@ pub enum TaylorUnsupported {
     },
     /// The model was written by hand, without a program.
     NotGenerated,
+    /// Contacts are closed: the Taylor method integrates a hybrid model's free phases only.
+    Contacts {
+        /// How many.
+        count: usize,
+    },
     /// The constraints are stabilised in a way the recurrences do not follow: Baumgarte's
     /// terms and the penalty's springs are not in the series of `[M Jᵀ; J 0][q̈; λ] = [F; γ]`
     /// (no stabilisation, or projection after each step, are).
@@ -451,8 +456,8 @@ impl std::fmt::Display for TaylorUnsupported {
         match self {
             TaylorUnsupported::Constraints { count } => write!(
                 f,
-                "the model has {count} constraint(s), and its compiled code has no Taylor \
-                 recurrences for them (compile it at run time: a model file has them)"
+                "the model has {count} constraint(s), and the code `model!` compiled has no Taylor \
+                 recurrences for them (load its file at run time, whose code has them)"
             ),
             TaylorUnsupported::Functions { names } => {
                 let list: Vec<String> = names.iter().map(|n| format!("`{n}`")).collect();
@@ -466,10 +471,15 @@ impl std::fmt::Display for TaylorUnsupported {
             TaylorUnsupported::NotGenerated => {
                 write!(f, "the model has no generated Taylor recurrences")
             }
+            TaylorUnsupported::Contacts { count } => write!(
+                f,
+                "{count} contact(s) are closed, and its series cover the free phases only"
+            ),
             TaylorUnsupported::Stabilization { name } => write!(
                 f,
-                "the Taylor method follows the constraints with no stabilisation or with \
-                 projection, not with `{name}`"
+                "its constraints can be left as they are or projected after each step \
+                 (stabilisation `none` or `projection`), not stabilised by `{name}`, whose \
+                 terms the recurrences do not have"
             ),
         }
     }

@@ -11,7 +11,7 @@ use eomgen_runtime::taylor::{
 use eomgen_runtime::{DynMechanicalSystem, ModelDescription, UnknownParameter};
 use eomgen_symbolic::codegen::GenerateError;
 use eomgen_symbolic::codegen::program::{Derivation, ModelProgram};
-use eomgen_symbolic::codegen::taylor::TaylorPlan;
+use eomgen_symbolic::codegen::taylor::{TaylorPlan, model_taylor_plan};
 use eomgen_symbolic::model::{Diagnostic, ReadError, read_model_file};
 
 use crate::compiled::{Compiled, Extent, FusedRhs, HotRoutine, SCRATCH, call, call_native};
@@ -337,7 +337,7 @@ impl JitModel {
                     .collect(),
             );
         }
-        let taylor = program.taylor_plan();
+        let taylor = model_taylor_plan(&program);
         program.clear_tapes();
         let parameters: Vec<f64> = program.description.parameter_defaults();
         let code = Arc::new(Code {
@@ -799,7 +799,7 @@ impl TaylorFunctions for Recurrences {
         // it computes (below `order`, to `highest`) write `out` to the next one.
         let computed = order.min(orders.highest + 1);
         if !solve.unrolled()
-            || series.len() < (program.slots + n) * UNROLLED_CAPACITY
+            || series.len() < (program.slots + program.forcing.len()) * UNROLLED_CAPACITY
             || out.len() < (computed + 1) * 2 * n
         {
             return 0;

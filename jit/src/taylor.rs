@@ -212,8 +212,8 @@ pub(crate) fn compile_orders(
         ));
     }
     // Order k's code adds about k terms per sum (up to five sums an op, and 3n² in its
-    // solve): 8 (ops + n²) (H + 1)² items, 1 KiB each, is ample.
-    let n = program.coordinates.len();
+    // solve, n the unknowns): 8 (ops + n²) (H + 1)² items, 1 KiB each, is ample.
+    let n = program.forcing.len();
     let items = (program.ops.len() + n * n)
         .saturating_mul(8 * (highest + 1) * (highest + 1))
         .saturating_add(plan.order_zero.instructions.len());

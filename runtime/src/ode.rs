@@ -149,8 +149,8 @@ pub trait OdeSystem {
     /// [`Taylor`](crate::Taylor) method ([`crate::taylor::series_of_motion`]).
     ///
     /// # Errors
-    /// [`RhsError::SingularMassMatrix`], [`RhsError::NonFinite`] (a coefficient, by
-    /// component); the default, for a system without recurrences, is
+    /// [`RhsError::SingularMassMatrix`], [`RhsError::SingularConstraintMatrix`],
+    /// [`RhsError::NonFinite`] (a coefficient, by component); the default, for a system without recurrences, is
     /// [`RhsError::NonFinite`] at component 0 (the Taylor method checks
     /// [`taylor_support`](Self::taylor_support) before it asks).
     fn taylor_coefficients(

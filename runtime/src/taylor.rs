@@ -613,7 +613,7 @@ pub fn evaluate_order(ops: &[SeriesOp], k: usize, capacity: usize, s: &mut [f64]
 #[derive(Debug, Clone, Default)]
 pub struct TaylorWorkspace {
     capacity: usize,
-    /// The program's slots, then one per acceleration `q̈ᵢ`
+    /// The program's slots, then one per acceleration `q̈ᵢ` and one per multiplier `λⱼ`
     /// ([`TaylorProgram::acceleration_slot`]).
     series: Vec<f64>,
     lower: Vec<f64>,
@@ -633,6 +633,10 @@ pub struct TaylorWorkspace {
     /// factoring again (11 % of a figure-eight step at order 5 went into factoring its
     /// constant diagonal `M`).
     factored_mass: Vec<f64>,
+    /// The coordinates `n` of the program the factors are for: of `[M Jᵀ; J 0]` the first `n`
+    /// pivots are positive, the rest negative, so the same bits factor otherwise for another
+    /// `n`.
+    coordinates: usize,
 }
 
 /// Two values side by side, aligned for one 16-byte load: the unit of the scratch a run-time
@@ -680,9 +684,10 @@ impl TaylorWorkspace {
             self.reciprocals
                 .extend((0..capacity).map(|k| 1.0 / (k + 1) as f64));
         }
-        if self.lower.len() != n * n {
+        if self.lower.len() != n * n || self.coordinates != program.coordinates.len() {
             self.factored_mass.clear();
         }
+        self.coordinates = program.coordinates.len();
         self.lower.resize(n * n, 0.0);
         self.pivots.resize(n, 0.0);
         self.inverse_pivots.resize(n, 0.0);
@@ -750,8 +755,13 @@ with_host_features! {
     /// The Taylor coefficients of the motion through `(t, y)`, `y = [q; q̇]` (`2n` entries), up
     /// to `order`: `out[k · 2n + i] = yᵢ^[k]` for `k = 0 … order` (so `out[..2n] = y`).
     ///
+    /// With `m` constraints the program's matrix and right-hand side are `[M Jᵀ; J 0]` and
+    /// `[F; γ]` ([`TaylorProgram`]), and each order solves for `[q̈; λ]`.
+    ///
     /// # Errors
     /// [`RhsError::SingularMassMatrix`] if `M(q, t)` is not positive definite;
+    /// [`RhsError::SingularConstraintMatrix`] if, with constraints, `J` has dependent rows
+    /// (`−J M⁻¹ Jᵀ` is not negative definite);
     /// [`RhsError::NonFinite`] with the component of the first coefficient that is not finite.
     ///
     /// # Panics
@@ -904,7 +914,8 @@ fn all_finite(out: &[f64], dim: usize) -> Result<(), RhsError> {
 /// into straight-line code).
 #[derive(Debug, Clone, Copy)]
 pub struct MotionLayout<'a> {
-    /// `F`'s slots ([`TaylorProgram::forcing`]), one per coordinate.
+    /// `F`'s slots ([`TaylorProgram::forcing`]), one per coordinate, then `γ`'s, one per
+    /// constraint.
     pub forcing: &'a [Slot],
     /// [`DerivedLists::varying_mass_entries`].
     pub coupled: &'a [(u32, u32, Slot)],
@@ -1514,6 +1525,54 @@ mod tests {
                 }
             }
         }
+        // The index-1 matrix `[M Jᵀ; J 0]` of two coordinates and one constraint: positive
+        // pivots for `M`, a negative one for `−J M⁻¹ Jᵀ`, and `L D Lᵀ` reproduces it. (Entry
+        // `(r, c)`, each row and column from 2 on a constraint `j`.)
+        let index_one = |m: [f64; 4], j: [f64; 2]| {
+            move |r: usize, c: usize| match (r < 2, c < 2) {
+                (true, true) => m[r + 2 * c],
+                (true, false) => j[r],
+                (false, true) => j[c],
+                (false, false) => 0.0,
+            }
+        };
+        let (m, j) = ([4.0, 1.0, 1.0, 3.0], [0.6, 0.8]);
+        let kkt = index_one(m, j);
+        let (mut lower, mut d, mut inverse) = (vec![0.0; 9], vec![0.0; 3], vec![0.0; 3]);
+        factor(3, 2, kkt, &mut lower, &mut d, &mut inverse).expect("a factor");
+        assert!(d[0] > 0.0 && d[1] > 0.0 && d[2] < 0.0, "{d:?}");
+        // −J M⁻¹ Jᵀ with M⁻¹ = [3 −1; −1 4] / 11.
+        let schur = -(3.0 * 0.36 - 2.0 * 0.48 + 4.0 * 0.64) / 11.0;
+        assert!(
+            (d[2] - schur).abs() <= 4.0 * f64::EPSILON * schur.abs(),
+            "{d:?}"
+        );
+        for r in 0..3 {
+            for c in 0..3 {
+                let l = |i: usize, k: usize| match i.cmp(&k) {
+                    std::cmp::Ordering::Equal => 1.0,
+                    std::cmp::Ordering::Greater => lower[i * 3 + k],
+                    std::cmp::Ordering::Less => 0.0,
+                };
+                let v: f64 = (0..3).map(|k| l(r, k) * d[k] * l(c, k)).sum();
+                assert!(
+                    (v - kkt(r, c)).abs() <= 8.0 * f64::EPSILON * 4.0,
+                    "({r}, {c}) {v}"
+                );
+            }
+        }
+        // The same constraint twice (dependent rows, a 4 × 4 matrix): the second constraint's
+        // pivot is 0, the constraints' block fails (index ≥ n); an `M` that is not positive
+        // definite fails within the coordinates' block (index < n).
+        let (mut lower, mut d, mut inverse) = (vec![0.0; 16], vec![0.0; 4], vec![0.0; 4]);
+        let dependent = factor(4, 2, index_one(m, j), &mut lower, &mut d, &mut inverse);
+        assert_eq!(dependent, Err(3));
+        let indefinite = index_one([1.0, 2.0, 2.0, 1.0], j);
+        let (mut lower, mut d, mut inverse) = (vec![0.0; 9], vec![0.0; 3], vec![0.0; 3]);
+        assert_eq!(
+            factor(3, 2, indefinite, &mut lower, &mut d, &mut inverse),
+            Err(1)
+        );
         // Beyond the closed form's range (`M₁₁ M₂₂` overflows or underflows): the loop's
         // factor, exact for these diagonal and scaled matrices.
         for scale in [1e160, 1e200, 1e-160, 1e-170] {

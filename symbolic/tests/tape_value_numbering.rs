@@ -9,7 +9,7 @@
 
 use eomgen_symbolic::codegen::program::ModelProgram;
 use eomgen_symbolic::codegen::tape::{Instruction, Tape};
-use eomgen_symbolic::codegen::taylor::TaylorPlan;
+use eomgen_symbolic::codegen::taylor::{TaylorPlan, model_taylor_plan};
 
 /// An operation's kind and operands, commutative ones sorted; `None` for inputs and
 /// constants.
@@ -42,7 +42,7 @@ fn repeated(tape: &Tape, len: usize) -> Option<(usize, usize)> {
 fn plan(source: &str) -> (ModelProgram, Option<TaylorPlan>) {
     let file = eomgen_symbolic::model::load("m.yaml", source).unwrap();
     let program = ModelProgram::from_file(&file).unwrap().0;
-    let taylor = program.taylor_plan().ok();
+    let taylor = model_taylor_plan(&program).ok();
     (program, taylor)
 }
 

@@ -69,8 +69,12 @@ impl Emitter {
                 }
             }
         }
-        for e in 0..program.derived.varying_mass_entries.len() {
-            all.push(Sum::Mass(e));
+        // The solve's sums, which only the in-line solves continue (a constrained program
+        // has none: the runtime's solve forms its own).
+        if program.multipliers() == 0 {
+            for e in 0..program.derived.varying_mass_entries.len() {
+                all.push(Sum::Mass(e));
+            }
         }
         for sums in all.chunks(INTERLEAVED_SUMS) {
             self.prefix_group(b, program, sums, k);

@@ -197,7 +197,7 @@ static TABLE: [MethodInfo; 15] = [
         "Verner's most efficient 9(8) pair, adaptive, order-9 dense output (tolerances of 1e-12 and below)",
         (|| Box::new(Verner98::new()), None)),
     row(Method::Taylor, ("taylor", "Taylor"), ADAPTIVE,
-        "Taylor series of the model's generated recurrences, order and step from the tolerance (Jorba & Zou), the series as dense output; unconstrained models without abs, sign, step",
+        "Taylor series of the model's generated recurrences, order and step from the tolerance (Jorba & Zou), the series as dense output; models without abs, sign, step (constraints: none or projection)",
         (|| Box::new(Taylor::new()), None)),
     row(Method::SymplecticEuler, ("symplectic-euler", "symplectic Euler"), FIXED,
         "Symplectic Euler, order 1, fixed step `--dt` (symplectic for constant M and velocity-independent forces)",

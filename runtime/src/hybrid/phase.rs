@@ -312,7 +312,7 @@ impl OdeSystem for ContactPhase<'_> {
         if self.closed.is_empty() {
             return self.model.as_ode().taylor_support();
         }
-        Err(TaylorUnsupported::Constraints {
+        Err(TaylorUnsupported::Contacts {
             count: self.closed.len(),
         })
     }

@@ -143,7 +143,7 @@ pub enum ContactStop {
         t: f64,
     },
     /// A contact is closed and the method integrates only free phases (the Taylor method,
-    /// whose recurrences have no constraint rows).
+    /// whose recurrences have no contact rows).
     #[error(
         "a contact is closed at t = {t}, and the {method} method integrates free motions only: choose another method (dop853, for one) for a run with contact phases"
     )]

@@ -111,8 +111,9 @@ pub enum IntegrationError {
     },
     /// The Taylor method needs the system's Taylor recurrences
     /// ([`OdeSystem::taylor_support`](crate::OdeSystem::taylor_support)), and this one has
-    /// none: equations given as a closure, a model with constraints, or equations that use a
-    /// function without a recurrence (the reason says which).
+    /// none: equations given as a closure, equations that use a function without a
+    /// recurrence, constraints stabilised by Baumgarte's terms or the penalty, a constrained
+    /// model compiled by `model!`, closed contacts (the reason says which).
     #[error("the Taylor method cannot integrate this system: {reason}")]
     NoTaylorRecurrences {
         /// Why, naming what is missing.

@@ -181,8 +181,9 @@ impl ModelProgram {
         self.description.num_dofs()
     }
 
-    /// The tape the Taylor recurrences are built from: [`Self::mass_matrix_and_forcing`]
-    /// without constraints, else [`constrained_motion_tape`] of it, of `J` and of `γ`.
+    /// The tape the Taylor recurrences are built from ([`super::taylor::model_taylor_plan`]):
+    /// [`Self::mass_matrix_and_forcing`] without constraints, else [`constrained_motion_tape`]
+    /// of it, of `J` and of `γ`.
     pub fn taylor_tape(&self) -> std::borrow::Cow<'_, FunctionTape> {
         if self.description.constraints.is_empty() {
             std::borrow::Cow::Borrowed(&self.mass_matrix_and_forcing)
@@ -194,21 +195,6 @@ impl ModelProgram {
                 self.num_dofs(),
             ))
         }
-    }
-
-    /// The model's Taylor recurrences ([`super::taylor::taylor_program`] of
-    /// [`Self::taylor_tape`]), with its constraints' multipliers when it has any.
-    ///
-    /// # Errors
-    /// As [`super::taylor::taylor_program`].
-    pub fn taylor_plan(
-        &self,
-    ) -> Result<super::taylor::TaylorPlan, eomgen_description::taylor::TaylorUnsupported> {
-        super::taylor::taylor_program(
-            &self.taylor_tape(),
-            self.num_dofs(),
-            self.description.constraints.len(),
-        )
     }
 
     /// Every function with its name, in the order of the table above (the Jacobians, planned

@@ -27,7 +27,7 @@ use crate::expr::Func;
 
 use rustc_hash::{FxHashMap, FxHashSet};
 
-use super::program::FunctionTape;
+use super::program::{FunctionTape, ModelProgram};
 use super::tape::{Input, Instruction, Tape};
 
 /// The Taylor recurrences of a model's `M q̈ = F` and the order-0 tape they extend.
@@ -99,6 +99,19 @@ pub fn taylor_program(
         program,
         order_zero,
     })
+}
+
+/// A run-time model's Taylor recurrences: [`taylor_program`] of
+/// [`ModelProgram::taylor_tape`], with the constraints' multipliers when it has any.
+///
+/// # Errors
+/// As [`taylor_program`].
+pub fn model_taylor_plan(program: &ModelProgram) -> Result<TaylorPlan, TaylorUnsupported> {
+    taylor_program(
+        &program.taylor_tape(),
+        program.num_dofs(),
+        program.description.constraints.len(),
+    )
 }
 
 /// `slots` padded or cut to `n` entries.
@@ -437,21 +450,44 @@ impl<'a> Builder<'a> {
         slot
     }
 
+    /// `z` when slot `v` is the tape's `−z` of a series `z`.
+    fn negation_of(&self, v: Slot) -> Option<Slot> {
+        match self.tape.instructions.get(v as usize) {
+            Some(&Instruction::Neg(z)) if !self.is_constant(z) => Some(z),
+            _ => None,
+        }
+    }
+
     /// The recurrence of the non-constant instruction `out`.
     // Long: one arm per instruction, each the recurrence it becomes; the match is the table from
     // instructions to series ops.
     fn op(&mut self, out: Slot, instruction: Instruction) -> Option<SeriesOp> {
         let c = |b: &Self, v: Slot| b.is_constant(v);
+        // A negation read by a sum is folded into it: `a + (−z)` is `a − z`, `(−z) + b` is
+        // `b − z`, `a − (−z)` is `a + z` and `−(−z)` is `z`, each to the bit (IEEE 754
+        // defines `x − y` as `x + (−y)`, and addition commutes), one op per order fewer (the
+        // figure eight's differences of positions are written `x₂ + (−x₁)`); the
+        // negation's own op goes if nothing else reads it ([`live_ops`]).
         Some(match instruction {
             Instruction::Input(_) | Instruction::Const(_) => return None,
-            Instruction::Neg(a) => SeriesOp::Neg { out, a },
+            Instruction::Neg(a) => match self.negation_of(a) {
+                Some(z) => SeriesOp::Copy { out, a: z },
+                None => SeriesOp::Neg { out, a },
+            },
             Instruction::Add(a, b) => match (c(self, a), c(self, b)) {
-                (false, false) => SeriesOp::Add { out, a, b },
+                (false, false) => match (self.negation_of(a), self.negation_of(b)) {
+                    (_, Some(z)) => SeriesOp::Sub { out, a, b: z },
+                    (Some(z), None) => SeriesOp::Sub { out, a: b, b: z },
+                    (None, None) => SeriesOp::Add { out, a, b },
+                },
                 (false, true) => SeriesOp::Copy { out, a },
                 _ => SeriesOp::Copy { out, a: b },
             },
             Instruction::Sub(a, b) => match (c(self, a), c(self, b)) {
-                (false, false) => SeriesOp::Sub { out, a, b },
+                (false, false) => match self.negation_of(b) {
+                    Some(z) => SeriesOp::Add { out, a, b: z },
+                    None => SeriesOp::Sub { out, a, b },
+                },
                 (false, true) => SeriesOp::Copy { out, a },
                 _ => SeriesOp::Neg { out, a: b },
             },

@@ -396,6 +396,9 @@ fn unsupported_tokens(
             quote!(#t::TaylorUnsupported::Functions { names: #cow::Borrowed(&[#(#names),*]) })
         }
         TaylorUnsupported::NotGenerated => quote!(#t::TaylorUnsupported::NotGenerated),
+        TaylorUnsupported::Contacts { count } => {
+            quote!(#t::TaylorUnsupported::Contacts { count: #count })
+        }
         TaylorUnsupported::Stabilization { name } => {
             let name: &str = name;
             quote!(#t::TaylorUnsupported::Stabilization { name: #cow::Borrowed(#name) })
