@@ -11,6 +11,11 @@
 //!   motion, the reduced linearisation by differences, its eigenvalues).
 //! - `sweep_201`: `eomgen study parameter-sweep whipple_bicycle --at upright --parameter v
 //!   --values 0..10:201`: 201 analyses and the bisections of the weave and capsize speeds.
+//! - `integrate/*`: 0–5 s from the file's state at `rtol = atol = 1e-8` with the Taylor method
+//!   (the index-1 system's series, `[M Jᵀ; J 0][q̈; λ] = [F; γ]`), Verner 9(8) and DOP853:
+//!   what docs/performance.md's "The Taylor method with constraints" charts. At the same
+//!   tolerance (not the same error), 2026-11-27: Taylor 8.7 ms, Verner 9(8) 1.84 ms, DOP853
+//!   0.75 ms.
 //!
 //! Run with `cargo bench --bench bicycle`.
 
@@ -113,5 +118,35 @@ fn stability(c: &mut Criterion) {
     println!("whipple_bicycle: {n} coordinates");
 }
 
-criterion_group!(benches, derive, stability);
+fn integrate(c: &mut Criterion) {
+    use eomgen::analysis::{SimulationOptions, simulate};
+    use eomgen::{DynFirstOrder, Method};
+    let model = JitModel::load(bicycle_file()).expect("the bicycle loads");
+    let mut system = DynFirstOrder::new(model);
+    let mut group = c.benchmark_group("integrate");
+    group.sample_size(10);
+    for (name, method) in [
+        ("taylor", Method::Taylor),
+        ("vern9", Method::Vern9),
+        ("dop853", Method::Dop853),
+    ] {
+        let options = SimulationOptions {
+            method,
+            t_end: 5.0,
+            rtol: 1e-8,
+            atol: 1e-8,
+            ..SimulationOptions::default()
+        };
+        group.bench_function(name, |b| {
+            b.iter(|| {
+                let run = simulate(&mut system, black_box(&options)).expect("starts");
+                assert!(run.failure.is_none(), "{name}: {:?}", run.failure);
+                run
+            })
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, derive, stability, integrate);
 criterion_main!(benches);
