@@ -13,7 +13,8 @@
 //!   --values 0..10:201`: 201 analyses and the bisections of the weave and capsize speeds.
 //! - `integrate/*`: 0–5 s from the file's state at `rtol = atol = 1e-8` with the Taylor method
 //!   (the index-1 system's series, `[M Jᵀ; J 0][q̈; λ] = [F; γ]`), Verner 9(8) and DOP853:
-//!   what docs/performance.md's "The Taylor method with constraints" charts. At the same
+//!   the model and methods docs/performance.md's "The Taylor method with constraints"
+//!   charts (there over 10 s and nine tolerances). At the same
 //!   tolerance (not the same error), 2026-11-27: Taylor 8.7 ms, Verner 9(8) 1.84 ms, DOP853
 //!   0.75 ms.
 //!

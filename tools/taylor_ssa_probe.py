@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Where the figure eight's Taylor step loses to heyoka: the same recurrences as straight-line
 code with every coefficient a value of its own (SSA), compiled by LLVM (rustc) and by
-Cranelift, against the workspace-in-memory code eomgen runs.
+Cranelift, against the workspace-in-memory code eomgen runs. Not used by the product.
 
 Writes a standalone Cargo project into DIR with two binaries and runs both:
 
@@ -11,15 +11,24 @@ Writes a standalone Cargo project into DIR with two binaries and runs both:
   `FunctionBuilder` (the version eomgen's run-time compiler uses) and timed; it writes its
   machine code to `disasm.txt`.
 
-Both print the time of one series (orders 0 … 12 of the 12-component state) and the same
+Both print the time of one series (orders 0 … 12 of the 12-component state) and its 12
 order-12 coefficients (the recurrences are eomgen's: serial sums, squares as half sums, the
-power's weights α(k − j) − j; order 0's r⁻³ as 1/(r²√r²) in both).
+power's weights α(k − j) − j; order 0's r⁻³ as 1/(r²√r²) in both; no mass solve and no
+G m² scaling, unit masses: a few operations fewer than eomgen's program). The state is the
+one of models/figure_eight.yaml mirrored through the origin (the same motion turned by π).
 
     python3 tools/taylor_ssa_probe.py /tmp/probe        # builds and runs both (offline)
 
+Needs cargo, with the cranelift 0.135.8 crates in its cache (eomgen's run-time compiler's
+version: `cargo build` of the workspace puts them there), and Python's standard library.
+For the other rows of docs/performance.md's table, build `llvm` again with
+`RUSTFLAGS="-C llvm-args=-vectorize-slp=false"`, with `-C target-cpu=native` added, and with
+`-C llvm-args=-fp-contract=fast` added to that (FMA: other bits).
+
 What it showed (2026-11-27, 2-core AMD EPYC with AVX-512): LLVM 225 ns a series, Cranelift
 494 ns (its code: 2,172 16-byte spill moves among 5,037 instructions), eomgen's per-order
-compiled code about 600 ns, heyoka's whole step 290 ns. LLVM's code pairs the x and y
+compiled code about 600 ns (the orders' share of its step in `perf`), heyoka's whole step
+290 ns (tools/work_precision_peers.py, the figure eight at tol 1e-9). LLVM's code pairs the x and y
 components into two-lane vectors (mulpd/addpd: its SLP vectoriser); without that pairing
 (`RUSTFLAGS="-C llvm-args=-vectorize-slp=false"`) it takes 610 ns, and 278 ns when it may
 use the host's 32 registers (`-C target-cpu=native`). See docs/performance.md, the panel.
@@ -136,7 +145,7 @@ fn time(mut series: impl FnMut(&[f64; 12], &mut [f64; 156])) {
         }
         println!("{:.1} ns per series", t.elapsed().as_nanos() as f64 / n as f64);
     }
-    println!("order 12: {:?}", &out[144..147]);
+    println!("order 12: {:?}", &out[144..156]);
 }
 """
 
@@ -248,7 +257,8 @@ def main():
     with open(os.path.join(out, "Cargo.toml"), "w") as f:
         f.write(CARGO)
     print(f"{len(ops)} operations", flush=True)
-    subprocess.run(["cargo", "build", "--release", "--offline", "-q"], cwd=out, check=True)
+    subprocess.run(["cargo", "build", "--release", "--offline", "-q", "--target-dir", "target"],
+                   cwd=out, check=True)
     for name in ("llvm", "cranelift"):
         print(f"== {name}", flush=True)
         subprocess.run([os.path.join("target", "release", name)], cwd=out, check=True)

@@ -1,5 +1,6 @@
 //! Taylor series of the motion: the recurrences of a model's [`TaylorProgram`] run order by
-//! order, and `M q̈ = F` solved as a series.
+//! order, and `M q̈ = F` solved as a series (with `m` constraints, the index-1 system
+//! `[M Jᵀ; J 0][q̈; λ] = [F; γ]`, its `n + m` unknowns in place of `q̈`'s `n`, the same way).
 //!
 //! long: the kernels of every op, their dispatch and the series of the motion share private
 //! helpers that must inline into the fused orders (`known`, `at`, `put`, the convolutions) and
@@ -866,7 +867,7 @@ fn series_in(
         // A factor with a zero below its diagonal is solved over the list of its non-zero
         // entries (faster for a sparse one: the figure eight's diagonal M; and the dense
         // loops never meet a zero, whose `b − 0·x` would not be `b` to the bit for `b = −0`
-        // or `x` infinite). With constraints, always: the dense solve's unknowns are `q̈`
+        // or `x` infinite). With constraints, always the sparse solve: the dense solve's unknowns are `q̈`
         // alone.
         dense: unknowns == n && 2 * nonzeros.len() >= n * n.saturating_sub(1),
         nonzeros,

@@ -30,7 +30,8 @@ use rustc_hash::{FxHashMap, FxHashSet};
 use super::program::{FunctionTape, ModelProgram};
 use super::tape::{Input, Instruction, Tape};
 
-/// The Taylor recurrences of a model's `M q̈ = F` and the order-0 tape they extend.
+/// The Taylor recurrences of a model's `M q̈ = F` (with constraints, `[M Jᵀ; J 0][q̈; λ] =
+/// [F; γ]`) and the order-0 tape they extend.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TaylorPlan {
     /// The recurrences of orders `k ≥ 1` and the slots of the state, `M` and `F`.
@@ -464,8 +465,9 @@ impl<'a> Builder<'a> {
     fn op(&mut self, out: Slot, instruction: Instruction) -> Option<SeriesOp> {
         let c = |b: &Self, v: Slot| b.is_constant(v);
         // A negation read by a sum is folded into it: `a + (−z)` is `a − z`, `(−z) + b` is
-        // `b − z`, `a − (−z)` is `a + z` and `−(−z)` is `z`, each to the bit (IEEE 754
-        // defines `x − y` as `x + (−y)`, and addition commutes), one op per order fewer (the
+        // `b − z`, `a − (−z)` is `a + z` and `−(−z)` is `z`, each to the bit for every value
+        // but a NaN's sign (IEEE 754 defines `x − y` as `x + (−y)`, and addition commutes; a
+        // NaN stays a NaN, and a series that is not finite stops the step), one op per order fewer (the
         // figure eight's differences of positions are written `x₂ + (−x₁)`); the
         // negation's own op goes if nothing else reads it ([`live_ops`]).
         Some(match instruction {
