@@ -7,11 +7,14 @@ Writes a standalone Cargo project into DIR with two binaries and runs both:
 
 * `llvm`: the series of the figure eight (three unit masses, G = 1) to order 12 as one Rust
   function of `let` bindings, one per coefficient, emitted by this script;
-* `cranelift`: the same operations as an op list (`program.txt`), built with Cranelift's
-  `FunctionBuilder` (the version eomgen's run-time compiler uses) and timed; it writes its
-  machine code to `disasm.txt`.
+* `cranelift PROGRAM`: an op list built with Cranelift's `FunctionBuilder` (the version
+  eomgen's run-time compiler uses) and timed, its machine code written to `PROGRAM.disasm`:
+  `program.txt`, the same operations as `llvm`'s, one value each; and `paired.txt`, the same
+  arithmetic with each body's x and y components as the two lanes of one vector (positions,
+  velocities, differences, squares' sums, pulls; the powers' recurrences scalar), which is
+  what LLVM's SLP vectoriser does to the first.
 
-Both print the time of one series (orders 0 … 12 of the 12-component state) and its 12
+Each prints the time of one series (orders 0 … 12 of the 12-component state) and its 12
 order-12 coefficients (the recurrences are eomgen's: serial sums, squares as half sums, the
 power's weights α(k − j) − j; order 0's r⁻³ as 1/(r²√r²) in both; no mass solve and no
 G m² scaling, unit masses: a few operations fewer than eomgen's program). The state is the
@@ -26,7 +29,8 @@ For the other rows of docs/performance.md's table, build `llvm` again with
 `-C llvm-args=-fp-contract=fast` added to that (FMA: other bits).
 
 What it showed (2026-11-27, 2-core AMD EPYC with AVX-512): LLVM 225 ns a series, Cranelift
-494 ns (its code: 2,172 16-byte spill moves among 5,037 instructions), eomgen's per-order
+494 ns (its code: 2,172 16-byte spill moves among 5,037 instructions), Cranelift with x and
+y paired 203 ns, all three with the same order-12 coefficients; eomgen's per-order
 compiled code about 600 ns (the orders' share of its step in `perf`), heyoka's whole step
 290 ns (tools/work_precision_peers.py, the figure eight at tol 1e-9). LLVM's code pairs the x and y
 components into two-lane vectors (mulpd/addpd: its SLP vectoriser); without that pairing
@@ -109,6 +113,67 @@ def program():
     return ops
 
 
+def paired_program():
+    """`program()` with x and y in the lanes of one two-lane vector (`Vin i` loads `y[i]` and
+    `y[i + 1]`, `V+ V- V* Vn` lane by lane, `Vsplat a` both lanes `a`, `lane0 a`, `lane1 a`,
+    `Vout i a`): each lane runs its scalar operations in the same order."""
+    ops, v = [], {}
+
+    def emit(line):
+        ops.append(line)
+        return len(ops) - 1
+
+    def op(o, *args):
+        return emit(" ".join([o] + [str(a) for a in args]))
+
+    def const(x):
+        return emit(f"c {x!r}")
+
+    for c in range(3):
+        v[f"Q{c}_0"] = op("Vin", 2 * c)
+        v[f"W{c}_0"] = op("Vin", 6 + 2 * c)
+    zero = const(0.0)
+    vzero = op("Vsplat", zero)
+    for k in range(P):
+        for n, (i, j) in enumerate(PAIRS):
+            v[f"D{n}_{k}"] = op("V-", v[f"Q{j}_{k}"], v[f"Q{i}_{k}"])
+            s = vzero
+            for m in range((k + 1) // 2):
+                s = op("V+", s, op("V*", v[f"D{n}_{m}"], v[f"D{n}_{k - m}"]))
+            if (k + 1) // 2:
+                s = op("V*", op("Vsplat", const(2.0)), s)
+            if k % 2 == 0:
+                h = v[f"D{n}_{k // 2}"]
+                s = op("V+", s, op("V*", h, h))
+            v[f"r{n}_{k}"] = op("+", op("lane0", s), op("lane1", s))
+            if k == 0:
+                r = v[f"r{n}_0"]
+                v[f"p{n}_0"] = op("/", const(1.0), op("*", r, op("s", r)))
+            else:
+                s = zero
+                for jj in range(k):
+                    w = ALPHA * (k - jj) - jj
+                    s = op("+", s, op("*", op("*", const(w), v[f"r{n}_{k - jj}"]), v[f"p{n}_{jj}"]))
+                v[f"p{n}_{k}"] = op("/", s, op("*", const(float(k)), v[f"r{n}_0"]))
+            v[f"P{n}_{k}"] = op("Vsplat", v[f"p{n}_{k}"])
+            s = vzero
+            for jj in range(k + 1):
+                s = op("V+", s, op("V*", v[f"D{n}_{jj}"], v[f"P{n}_{k - jj}"]))
+            v[f"F{n}_{k}"] = s
+        inverse = op("Vsplat", const(1.0 / (k + 1)))
+        g = lambda name: v[f"{name}_{k}"]  # noqa: E731
+        acc = [op("V+", g("F0"), g("F1")), op("V-", g("F2"), g("F0")),
+               op("V-", op("Vn", g("F1")), g("F2"))]
+        for c in range(3):
+            v[f"Q{c}_{k + 1}"] = op("V*", v[f"W{c}_{k}"], inverse)
+            v[f"W{c}_{k + 1}"] = op("V*", acc[c], inverse)
+    for k in range(P + 1):
+        for c in range(3):
+            op("Vout", k * 12 + 2 * c, v[f"Q{c}_{k}"])
+            op("Vout", k * 12 + 6 + 2 * c, v[f"W{c}_{k}"])
+    return ops
+
+
 def rust_body(ops):
     """The op list as `let` bindings."""
     lines = []
@@ -157,7 +222,8 @@ use cranelift_jit::{JITBuilder, JITModule};
 use cranelift_module::{Linkage, Module};
 
 fn main() {
-    let text = std::fs::read_to_string("program.txt").expect("program.txt");
+    let path = std::env::args().nth(1).expect("an op list");
+    let text = std::fs::read_to_string(&path).expect("the op list reads");
     let mut flags = settings::builder();
     flags.set("opt_level", "speed").unwrap();
     let isa = cranelift_native::builder().unwrap().finish(settings::Flags::new(flags)).unwrap();
@@ -191,6 +257,15 @@ fn main() {
                 "s" => { let x = v[a(1)]; b.ins().sqrt(x) }
                 "n" => { let x = v[a(1)]; b.ins().fneg(x) }
                 "out" => { let x = v[a(2)]; b.ins().store(flags, x, out, (a(1) * 8) as i32); x }
+                "Vin" => b.ins().load(types::F64X2, flags, y, (a(1) * 8) as i32),
+                "Vout" => { let x = v[a(2)]; b.ins().store(flags, x, out, (a(1) * 8) as i32); x }
+                "V+" => { let (x, z) = (v[a(1)], v[a(2)]); b.ins().fadd(x, z) }
+                "V-" => { let (x, z) = (v[a(1)], v[a(2)]); b.ins().fsub(x, z) }
+                "V*" => { let (x, z) = (v[a(1)], v[a(2)]); b.ins().fmul(x, z) }
+                "Vn" => { let x = v[a(1)]; b.ins().fneg(x) }
+                "Vsplat" => { let x = v[a(1)]; b.ins().splat(types::F64X2, x) }
+                "lane0" => { let x = v[a(1)]; b.ins().extractlane(x, 0) }
+                "lane1" => { let x = v[a(1)]; b.ins().extractlane(x, 1) }
                 other => panic!("unknown op {other}"),
             };
             v.push(value);
@@ -202,7 +277,7 @@ fn main() {
     let id = module.declare_function("series", Linkage::Local, &ctx.func.signature).unwrap();
     module.define_function(id, &mut ctx).unwrap();
     if let Some(code) = ctx.compiled_code() {
-        std::fs::write("disasm.txt", code.vcode.clone().unwrap_or_default()).unwrap();
+        std::fs::write(format!("{path}.disasm"), code.vcode.clone().unwrap_or_default()).unwrap();
     }
     module.clear_context(&mut ctx);
     module.finalize_definitions().unwrap();
@@ -248,6 +323,8 @@ def main():
     state = "const STATE: [f64; 12] = [" + ", ".join(repr(x) for x in STATE) + "];\n"
     with open(os.path.join(out, "program.txt"), "w") as f:
         f.write("\n".join(ops) + "\n")
+    with open(os.path.join(out, "paired.txt"), "w") as f:
+        f.write("\n".join(paired_program()) + "\n")
     with open(os.path.join(out, "llvm.rs"), "w") as f:
         f.write(state + TIMING + "\n#[inline(never)]\n#[allow(clippy::all)]\n"
                 "fn series(y: &[f64; 12], out: &mut [f64; 156]) {\n" + rust_body(ops) + "\n}\n"
@@ -259,9 +336,9 @@ def main():
     print(f"{len(ops)} operations", flush=True)
     subprocess.run(["cargo", "build", "--release", "--offline", "-q", "--target-dir", "target"],
                    cwd=out, check=True)
-    for name in ("llvm", "cranelift"):
-        print(f"== {name}", flush=True)
-        subprocess.run([os.path.join("target", "release", name)], cwd=out, check=True)
+    for name, args in (("llvm", []), ("cranelift", ["program.txt"]), ("cranelift", ["paired.txt"])):
+        print(f"== {name} {' '.join(args)}", flush=True)
+        subprocess.run([os.path.join("target", "release", name)] + args, cwd=out, check=True)
 
 
 if __name__ == "__main__":
