@@ -126,9 +126,10 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
         ))),
         None => match &simulation.contact_stop {
             Some(stop) => Err(CliError::failure(format!(
-                "the run of `{}` stopped before its end time: {stop}; the {} samples computed before it were kept",
+                "the run of `{}` stopped before its end time: {stop}; {} computed before it {} kept",
                 model.description().name,
-                solution.len()
+                samples(solution.len()),
+                if solution.len() == 1 { "was" } else { "were" }
             ))),
             None => Ok(()),
         },
@@ -138,10 +139,20 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
             cause.as_ref(),
             &args.run,
             &format!(
-                "the {} samples computed before it were kept",
-                solution.len()
+                "{} computed before it {} kept",
+                samples(solution.len()),
+                if solution.len() == 1 { "was" } else { "were" }
             ),
         )),
+    }
+}
+
+/// `the N samples` (`the sample` for one), for the messages of a run that stopped early.
+fn samples(n: usize) -> String {
+    if n == 1 {
+        "the sample".to_string()
+    } else {
+        format!("the {n} samples")
     }
 }
 
