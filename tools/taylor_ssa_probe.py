@@ -49,6 +49,21 @@ STATE = [0.97000436, -0.24308753, -0.97000436, 0.24308753, 0.0, 0.0, 0.466203685
          0.466203685, 0.43236573, -0.93240737, -0.86473146]
 
 
+def power(op, const, v, at, zero):
+    """Order `k` of pair `n`'s `p = r^α` (`v["p{n}_{j}"]` of `r = v["r{n}_{j}"]`), scalar in
+    both programs: order 0 as `1/(r √r)`, then eomgen's recurrence with the weights
+    α(k − j) − j and one division by `k r⁰`."""
+    n, k = at
+    if k == 0:
+        r = v[f"r{n}_0"]
+        return op("/", const(1.0), op("*", r, op("s", r)))
+    s = zero
+    for jj in range(k):
+        w = ALPHA * (k - jj) - jj
+        s = op("+", s, op("*", op("*", const(w), v[f"r{n}_{k - jj}"]), v[f"p{n}_{jj}"]))
+    return op("/", s, op("*", const(float(k)), v[f"r{n}_0"]))
+
+
 def program():
     """The series as an op list: one value a line (`in i`, `c x`, `+ a b`, `- a b`, `* a b`,
     `/ a b`, `s a` for √, `n a` for −a, `out i a`), values numbered by line."""
@@ -84,15 +99,7 @@ def program():
                     s = op("+", s, op("*", h, h))
                 squares[d] = s
             v[f"r{n}_{k}"] = op("+", squares["dx"], squares["dy"])
-            if k == 0:
-                r = v[f"r{n}_0"]
-                v[f"p{n}_0"] = op("/", const(1.0), op("*", r, op("s", r)))
-            else:
-                s = zero
-                for jj in range(k):
-                    w = ALPHA * (k - jj) - jj
-                    s = op("+", s, op("*", op("*", const(w), v[f"r{n}_{k - jj}"]), v[f"p{n}_{jj}"]))
-                v[f"p{n}_{k}"] = op("/", s, op("*", const(float(k)), v[f"r{n}_0"]))
+            v[f"p{n}_{k}"] = power(op, const, v, (n, k), zero)
             for d, f in (("dx", "fx"), ("dy", "fy")):
                 s = zero
                 for jj in range(k + 1):
@@ -146,15 +153,7 @@ def paired_program():
                 h = v[f"D{n}_{k // 2}"]
                 s = op("V+", s, op("V*", h, h))
             v[f"r{n}_{k}"] = op("+", op("lane0", s), op("lane1", s))
-            if k == 0:
-                r = v[f"r{n}_0"]
-                v[f"p{n}_0"] = op("/", const(1.0), op("*", r, op("s", r)))
-            else:
-                s = zero
-                for jj in range(k):
-                    w = ALPHA * (k - jj) - jj
-                    s = op("+", s, op("*", op("*", const(w), v[f"r{n}_{k - jj}"]), v[f"p{n}_{jj}"]))
-                v[f"p{n}_{k}"] = op("/", s, op("*", const(float(k)), v[f"r{n}_0"]))
+            v[f"p{n}_{k}"] = power(op, const, v, (n, k), zero)
             v[f"P{n}_{k}"] = op("Vsplat", v[f"p{n}_{k}"])
             s = vzero
             for jj in range(k + 1):
