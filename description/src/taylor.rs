@@ -393,6 +393,15 @@ impl TaylorProgram {
     }
 }
 
+impl SeriesOp {
+    /// The convolutions its kernel sums per order (see [`DerivedLists::convolutions`]): 0
+    /// for an op of order `k` alone (a sum, a scaling), 1 for a product, quotient, root,
+    /// power, exponential or logarithm, up to 5 for `atan2`.
+    pub fn convolutions(&self) -> usize {
+        convolutions(self)
+    }
+}
+
 /// The convolutions per order of one op (see [`DerivedLists::convolutions`]).
 fn convolutions(op: &SeriesOp) -> usize {
     match op {

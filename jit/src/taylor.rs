@@ -60,6 +60,19 @@
 //! that the interpreter's `order_zero_in_place` uses (the same bits); the inputs `q`, `q̇`,
 //! `t` are read from their slots, where the caller has written them.
 //!
+//! # Pairs
+//! Two ops of the same kind that do not depend on each other run as the two lanes of one
+//! 2-wide vector ([`pairing`]: a body's `x` and `y` components, found as an SLP vectoriser
+//! finds them). Each lane runs its op's kernel, the same operations in the same order, so the
+//! bits are the scalar code's; each lane is also stored to its own slot, for the ops, the
+//! solve and the kernels of the orders above `H` that read it alone. The paired operands'
+//! orders sit side by side in the scratch after the sine–cosine pairs' (the lane slots),
+//! one 16-byte load a term. On the figure eight (36 of its 40 ops paired) whole runs took
+//! 0.88–0.91× the time at tolerances 1e-6 to 1e-12 and 1.02–1.04× at 1e-3, where a step
+//! has 5 orders (docs/performance.md, "The panel"). With the environment variable
+//! `EOMGEN_JIT_UNPAIRED` set, every op runs alone (the same bits), to measure what the pairs
+//! buy.
+//!
 //! With the environment variable `EOMGEN_JIT_DISASM` set, each order's machine code is
 //! printed to standard error as it is compiled, as [`crate::native`] prints the model's.
 //!
@@ -85,7 +98,10 @@ use crate::native::{
 };
 
 mod kernels;
+mod pairing;
 mod prefixes;
+
+use pairing::{LaneSlot, Pairing, Unit};
 
 /// One compiled order `k`: see the module documentation for the arguments.
 ///
@@ -134,7 +150,9 @@ pub(crate) use eomgen_runtime::taylor::Lanes as PairLanes;
 /// sinh, order `i` side by side) then as many `(i x[i], i x[i])` (its argument's order `i`
 /// weighted by `i`, in both lanes): what the kernels' `weighted_convolution_pair` reads as
 /// vectors, each one 16-byte load here instead of two loads and two shuffles. Order `k`'s
-/// function writes order `k` of each, order 0's function the pairs' order 0.
+/// function writes order `k` of each, order 0's function the pairs' order 0. After them,
+/// [`UNROLLED_CAPACITY`] units for each lane slot of the paired ops ([`pairing`],
+/// [`Layout::lane_offset`]).
 pub(crate) struct PairScratch;
 
 impl PairScratch {
@@ -223,17 +241,13 @@ pub(crate) fn compile_orders(
     let pointer = module.target_config().pointer_type();
     let mut context = module.make_context();
     let mut builder_context = FunctionBuilderContext::new();
+    let layout = Layout::new(program);
     let ids = define_orders(
         &mut module,
         (&mut context, &mut builder_context),
-        program,
+        (program, &layout),
         highest,
     )?;
-    let pairs = program
-        .ops
-        .iter()
-        .filter(|op| matches!(op, SeriesOp::SinCos { .. } | SeriesOp::SinhCosh { .. }))
-        .count();
     let mut zero_signature = Signature::new(call_conv);
     zero_signature.params.push(AbiParam::new(pointer));
     zero_signature.params.push(AbiParam::new(pointer));
@@ -275,7 +289,7 @@ pub(crate) fn compile_orders(
         orders,
         order_zero,
         highest,
-        scratch_units: PairScratch::units(pairs),
+        scratch_units: layout.scratch_units(),
         _memory: ModuleMemory::new(module),
     }))
 }
@@ -289,7 +303,7 @@ pub(crate) fn compile_orders(
 fn define_orders(
     module: &mut JITModule,
     (context, builder_context): (&mut cranelift_codegen::Context, &mut FunctionBuilderContext),
-    program: &TaylorProgram,
+    (program, layout): (&TaylorProgram, &Layout),
     highest: usize,
 ) -> Result<Vec<cranelift_module::FuncId>, CompileError> {
     const NAME: &str = "taylor_orders";
@@ -316,7 +330,7 @@ fn define_orders(
         build_order(
             &mut context.func,
             builder_context,
-            program,
+            (program, layout),
             k,
             solve_signature.clone(),
             module.target_config(),
@@ -373,7 +387,7 @@ impl OrderArgs {
 fn build_order(
     func: &mut ir::Function,
     builder_context: &mut FunctionBuilderContext,
-    program: &TaylorProgram,
+    (program, layout): (&TaylorProgram, &Layout),
     k: usize,
     solve_signature: Signature,
     target: cranelift_codegen::isa::TargetFrontendConfig,
@@ -384,7 +398,7 @@ fn build_order(
     let solve_signature = b.import_signature(solve_signature);
     let done = b.create_block();
     let status = b.append_block_param(done, types::I8);
-    let mut emitter = Emitter::new(args);
+    let mut emitter = Emitter::new(args, layout);
     emit_order(
         &mut b,
         &mut emitter,
@@ -415,21 +429,28 @@ fn emit_order(
         emitter.prefixes(b, program, k);
     }
     if k > 0 {
-        for op in program.ops.iter() {
-            emitter.op(b, *op, k);
+        for unit in emitter.layout.pairing.units.clone() {
+            match unit {
+                Unit::Single(op) => emitter.op(b, op, k),
+                Unit::Pair(op) => emitter.paired(b, op, k),
+            }
         }
     } else {
-        // The pairs' order 0, from the series (order 0 wrote them there).
+        // The pairs' and the lane slots' order 0, from the series (order 0 wrote them
+        // there).
         for op in program.ops.iter() {
             if let SeriesOp::SinCos { sin: z, cos: y, .. }
             | SeriesOp::SinhCosh {
                 sinh: z, cosh: y, ..
             } = *op
             {
-                let p = emitter.next_pair();
+                let p = emitter.pair_of(z);
                 let (y0, z0) = (emitter.at(b, y, 0), emitter.at(b, z, 0));
                 emitter.store_pair(b, p, 0, (y0, z0));
             }
+        }
+        for v in 0..emitter.layout.pairing.lanes.len() {
+            emitter.gather(b, emitter.layout.pairing.base + v as Slot, 0);
         }
     }
     // Order k of M a = F: in line with the factor `mode` names, else by `solve` (always with
@@ -643,13 +664,56 @@ pub(crate) const FACTOR_SMALL: i64 = 2;
 /// [`Factor::Diagonal`]'s code.
 pub(crate) const FACTOR_DIAGONAL: i64 = 3;
 
+/// Where a program's orders keep what they share: the sine–cosine pairs' operands
+/// ([`PairScratch`]) and, after them, the lane slots' orders ([`pairing`]).
+struct Layout {
+    /// The ops as they run, alone or paired.
+    pairing: Pairing,
+    /// The index among the pair ops of each sine–cosine or sinh–cosh op, by its `sin` slot.
+    pair_ops: HashMap<Slot, usize>,
+}
+
+impl Layout {
+    fn new(program: &TaylorProgram) -> Self {
+        let pair_ops = program
+            .ops
+            .iter()
+            .filter_map(|op| match *op {
+                SeriesOp::SinCos { sin, .. } | SeriesOp::SinhCosh { sinh: sin, .. } => Some(sin),
+                _ => None,
+            })
+            .enumerate()
+            .map(|(p, sin)| (sin, p))
+            .collect();
+        let base = (program.slots + program.forcing.len()) as Slot;
+        let pairing = if std::env::var_os("EOMGEN_JIT_UNPAIRED").is_some() {
+            Pairing::none(program)
+        } else {
+            Pairing::new(program, base)
+        };
+        Layout { pairing, pair_ops }
+    }
+
+    /// The units of scratch the orders use.
+    fn scratch_units(&self) -> usize {
+        PairScratch::units(self.pair_ops.len()) + self.pairing.lanes.len() * UNROLLED_CAPACITY
+    }
+
+    /// The byte offset in the scratch of order `i` of the lane slot `slot`.
+    fn lane_offset(&self, slot: Slot, i: usize) -> i32 {
+        let v = (slot - self.pairing.base) as usize;
+        ((PairScratch::units(self.pair_ops.len()) + v * UNROLLED_CAPACITY + i) * 16) as i32
+    }
+}
+
 /// Writes the kernels' arithmetic, with the coefficients known in registers.
-struct Emitter {
+struct Emitter<'a> {
     series: ir::Value,
-    /// The scratch of the pair ops ([`PairScratch`]).
+    /// The scratch of the pair ops ([`PairScratch`]) and the lane slots.
     scratch: ir::Value,
-    /// Pair ops met so far in this order.
-    pairs: usize,
+    layout: &'a Layout,
+    /// 2 while a paired op is written (its values are 2-wide vectors), else 1.
+    width: usize,
     /// `(slot, order) → value` loaded or stored in this order's function.
     known: HashMap<(Slot, usize), ir::Value>,
     /// The sums whose terms from orders below `k` were added before the ops
@@ -684,12 +748,13 @@ enum Sum {
     Mass(usize),
 }
 
-impl Emitter {
-    fn new(args: OrderArgs) -> Self {
+impl<'a> Emitter<'a> {
+    fn new(args: OrderArgs, layout: &'a Layout) -> Self {
         Emitter {
             series: args.series,
             scratch: args.scratch,
-            pairs: 0,
+            layout,
+            width: 1,
             known: HashMap::default(),
             prefixes: HashMap::default(),
             prefix_base: args.series,

@@ -4,11 +4,81 @@
 
 use super::*;
 
-impl Emitter {
-    /// The index of the next pair op in the program's order (see [`PairScratch`]).
-    pub(super) fn next_pair(&mut self) -> usize {
-        self.pairs += 1;
-        self.pairs - 1
+impl Emitter<'_> {
+    /// The index among the pair ops, in the program's order, of the sine–cosine or
+    /// sinh–cosh op writing `sin` (see [`PairScratch`]).
+    pub(super) fn pair_of(&self, sin: Slot) -> usize {
+        self.layout.pair_ops[&sin]
+    }
+
+    /// The type of the values written: `f64`, or two in a vector while a paired op is
+    /// written.
+    pub(super) fn ty(&self) -> ir::Type {
+        if self.width == 2 {
+            types::F64X2
+        } else {
+            types::F64
+        }
+    }
+
+    /// The lane slot `slot` (see [`pairing`]), if it is one.
+    pub(super) fn lane(&self, slot: Slot) -> Option<LaneSlot> {
+        self.layout.pairing.lane(slot).copied()
+    }
+
+    /// Order `k` of paired op `op` (over lane slots): its operands' lane slots that no
+    /// paired op writes gathered first, if this order has not yet, then its kernel over
+    /// vectors.
+    pub(super) fn paired(&mut self, b: &mut FunctionBuilder, op: SeriesOp, k: usize) {
+        let operands: [Slot; 2] = match op {
+            SeriesOp::Neg { a, .. }
+            | SeriesOp::Copy { a, .. }
+            | SeriesOp::Sqrt { a, .. }
+            | SeriesOp::Exp { a, .. }
+            | SeriesOp::Ln { a, .. }
+            | SeriesOp::ConstantDiv { b: a, .. } => [a, a],
+            SeriesOp::Add { a, b: y, .. }
+            | SeriesOp::Sub { a, b: y, .. }
+            | SeriesOp::Mul { a, b: y, .. }
+            | SeriesOp::Div { a, b: y, .. }
+            | SeriesOp::Scale { a, constant: y, .. }
+            | SeriesOp::DivByConstant { a, constant: y, .. }
+            | SeriesOp::PowConstant { a, exponent: y, .. } => [a, y],
+            _ => [Slot::MAX, Slot::MAX],
+        };
+        for slot in operands {
+            if let Some(lane) = self.lane(slot)
+                && !lane.written
+                && lane.series
+                && !self.known.contains_key(&(slot, k))
+            {
+                self.gather(b, slot, k);
+            }
+        }
+        self.width = 2;
+        self.op(b, op, k);
+        self.width = 1;
+    }
+
+    /// Order `i` of lane slot `slot` from its two slots, into the scratch if it is read there
+    /// ([`LaneSlot::history`], or order 0 of a constant).
+    pub(super) fn gather(&mut self, b: &mut FunctionBuilder, slot: Slot, i: usize) {
+        let Some(lane) = self.lane(slot) else { return };
+        let width = std::mem::replace(&mut self.width, 1);
+        let (x, y) = (self.at(b, lane.slots.0, i), self.at(b, lane.slots.1, i));
+        self.width = width;
+        let v = b.ins().splat(types::F64X2, x);
+        let v = if lane.slots.0 == lane.slots.1 {
+            v
+        } else {
+            b.ins().insertlane(v, y, 1)
+        };
+        if lane.history || (i == 0 && !lane.series) {
+            let offset = self.layout.lane_offset(slot, i);
+            b.ins()
+                .store(MemFlagsData::trusted(), v, self.scratch, offset);
+        }
+        self.known.insert((slot, i), v);
     }
 
     /// `motion_order`'s solve of order `k` with `factor` (`dense_order`, or `sparse_order`,
@@ -40,7 +110,7 @@ impl Emitter {
             for (e, &(i, l, slot)) in program.derived.varying_mass_entries.iter().enumerate() {
                 let (mut sum, from) = match self.started(b, Sum::Mass(e), types::F64) {
                     Some(sum) => (sum, k - 1),
-                    None => (Self::constant(b, 0.0), 0),
+                    None => (self.constant(b, 0.0), 0),
                 };
                 for j in from..k {
                     let m = self.at(b, slot, 1 + j);
@@ -90,7 +160,7 @@ impl Emitter {
                 }
             }
         }
-        let inverse = Self::constant(b, 1.0 / (k + 1) as f64);
+        let inverse = self.constant(b, 1.0 / (k + 1) as f64);
         let dim = 2 * n;
         let mut next = Vec::with_capacity(dim);
         for i in 0..n {
@@ -112,33 +182,65 @@ impl Emitter {
                 self.put(b, slot, k + 1, next[index as usize]);
             }
             if let Some(slot) = program.time {
-                let v = Self::constant(b, if k == 0 { 1.0 } else { 0.0 });
+                let v = self.constant(b, if k == 0 { 1.0 } else { 0.0 });
                 self.put(b, slot, k + 1, v);
             }
         }
     }
 
-    /// Order `i` of `slot`.
+    /// Order `i` of `slot`: of a lane slot, both lanes in a vector; of any other slot, its
+    /// value (in both lanes of a vector while a paired op is written).
     pub(super) fn at(&mut self, b: &mut FunctionBuilder, slot: Slot, i: usize) -> ir::Value {
         if let Some(&v) = self.known.get(&(slot, i)) {
-            return v;
+            return if self.width == 2 && self.lane(slot).is_none() {
+                b.ins().splat(types::F64X2, v)
+            } else {
+                v
+            };
         }
-        let offset = ((slot as usize * UNROLLED_CAPACITY + i) * 8) as i32;
-        let v = b.ins().load(types::F64, settled(), self.series, offset);
+        let v = if self.lane(slot).is_some() {
+            let offset = self.layout.lane_offset(slot, i);
+            b.ins().load(types::F64X2, settled(), self.scratch, offset)
+        } else {
+            let offset = ((slot as usize * UNROLLED_CAPACITY + i) * 8) as i32;
+            b.ins().load(types::F64, settled(), self.series, offset)
+        };
         self.known.insert((slot, i), v);
+        if self.width == 2 && self.lane(slot).is_none() {
+            return b.ins().splat(types::F64X2, v);
+        }
         v
     }
 
-    /// Writes `v` as order `k` of `slot`.
+    /// Writes `v` as order `k` of `slot`: of a lane slot, into the scratch and each lane into
+    /// its own slot.
     pub(super) fn put(&mut self, b: &mut FunctionBuilder, slot: Slot, k: usize, v: ir::Value) {
+        if let Some(lane) = self.lane(slot) {
+            if lane.history {
+                let offset = self.layout.lane_offset(slot, k);
+                b.ins()
+                    .store(MemFlagsData::trusted(), v, self.scratch, offset);
+            }
+            self.known.insert((slot, k), v);
+            let (x, y) = (b.ins().extractlane(v, 0), b.ins().extractlane(v, 1));
+            self.put(b, lane.slots.0, k, x);
+            self.put(b, lane.slots.1, k, y);
+            return;
+        }
         let offset = ((slot as usize * UNROLLED_CAPACITY + k) * 8) as i32;
         b.ins()
             .store(MemFlagsData::trusted(), v, self.series, offset);
         self.known.insert((slot, k), v);
     }
 
-    pub(super) fn constant(b: &mut FunctionBuilder, x: f64) -> ir::Value {
-        b.ins().f64const(x)
+    /// `x`, in both lanes of a vector while a paired op is written.
+    pub(super) fn constant(&self, b: &mut FunctionBuilder, x: f64) -> ir::Value {
+        let v = b.ins().f64const(x);
+        if self.width == 2 {
+            b.ins().splat(types::F64X2, v)
+        } else {
+            v
+        }
     }
 
     /// The kernels' `convolution` (`Σ_{j ∈ range} a[j] b[k − j]`) or, if `weighted`, their
@@ -152,17 +254,17 @@ impl Emitter {
         weighted: bool,
     ) -> ir::Value {
         let started = if *range.start() == 1 {
-            self.started(b, Sum::Products { x, y, weighted }, types::F64)
+            self.started(b, Sum::Products { x, y, weighted }, self.ty())
         } else {
             None
         };
         let (mut sum, from) = match started {
             Some(sum) => (sum, k),
-            None => (Self::constant(b, 0.0), *range.start()),
+            None => (self.constant(b, 0.0), *range.start()),
         };
         for j in from.max(*range.start())..=*range.end() {
             let (u, v) = (self.at(b, x, j), self.at(b, y, k - j));
-            let term = Self::product_term(b, (u, v), j, weighted);
+            let term = self.product_term(b, (u, v), j, weighted);
             sum = b.ins().fadd(sum, term);
         }
         sum
@@ -170,13 +272,14 @@ impl Emitter {
 
     /// A term of [`Self::sum_of_products`]: `u v`, or `(u j) v` if `weighted`.
     pub(super) fn product_term(
+        &self,
         b: &mut FunctionBuilder,
         (u, v): (ir::Value, ir::Value),
         j: usize,
         weighted: bool,
     ) -> ir::Value {
         let u = if weighted {
-            let weight = Self::constant(b, j as f64);
+            let weight = self.constant(b, j as f64);
             b.ins().fmul(u, weight)
         } else {
             u
@@ -198,7 +301,7 @@ impl Emitter {
         k: usize,
     ) -> (ir::Value, ir::Value) {
         let xk = self.at(b, x, k);
-        let kc = Self::constant(b, k as f64);
+        let kc = self.constant(b, k as f64);
         let weighted = b.ins().fmul(xk, kc);
         let newest = b.ins().splat(types::F64X2, weighted);
         b.ins().store(
@@ -210,7 +313,7 @@ impl Emitter {
         let (mut sum, from) = match self.started(b, Sum::Pair(p), types::F64X2) {
             Some(sum) => (sum, k),
             None => {
-                let zero = Self::constant(b, 0.0);
+                let zero = self.constant(b, 0.0);
                 (b.ins().splat(types::F64X2, zero), 1)
             }
         };
@@ -269,7 +372,7 @@ impl Emitter {
         let older = if k > 1 {
             self.sum_of_products(b, (x, y, k), 1..=k - 1, false)
         } else {
-            Self::constant(b, 0.0)
+            self.constant(b, 0.0)
         };
         let (x0, yk, xk, y0) = (
             self.at(b, x, 0),
@@ -286,10 +389,10 @@ impl Emitter {
     /// The kernels' `square`: `(2 h + [k even] x[k/2]²) + 2 (x[0] x[k])`, `h` the sum of
     /// `x[j] x[k − j]` for `j = 1 … ⌊(k − 1)/2⌋` (started by [`Self::prefixes`]).
     pub(super) fn square(&mut self, b: &mut FunctionBuilder, x: Slot, k: usize) -> ir::Value {
-        let half = match self.started(b, Sum::Square { x }, types::F64) {
+        let half = match self.started(b, Sum::Square { x }, self.ty()) {
             Some(sum) => sum,
             None => {
-                let mut sum = Self::constant(b, 0.0);
+                let mut sum = self.constant(b, 0.0);
                 for j in 1..=(k - 1) / 2 {
                     let (u, v) = (self.at(b, x, j), self.at(b, x, k - j));
                     let term = b.ins().fmul(u, v);
@@ -306,14 +409,14 @@ impl Emitter {
         }
         let (x0, xk) = (self.at(b, x, 0), self.at(b, x, k));
         let product = b.ins().fmul(x0, xk);
-        let two = Self::constant(b, 2.0);
+        let two = self.constant(b, 2.0);
         let last = b.ins().fmul(two, product);
         b.ins().fadd(sum, last)
     }
 
     /// `v · (1/k)`.
-    pub(super) fn over_k(b: &mut FunctionBuilder, v: ir::Value, k: usize) -> ir::Value {
-        let r = Self::constant(b, 1.0 / k as f64);
+    pub(super) fn over_k(&self, b: &mut FunctionBuilder, v: ir::Value, k: usize) -> ir::Value {
+        let r = self.constant(b, 1.0 / k as f64);
         b.ins().fmul(v, r)
     }
 
@@ -379,26 +482,26 @@ impl Emitter {
                 let sum = if k > 1 {
                     self.sum_of_products(b, (out, out, k), 1..=k - 1, false)
                 } else {
-                    Self::constant(b, 0.0)
+                    self.constant(b, 0.0)
                 };
                 let (ak, o0) = (self.at(b, a, k), self.at(b, out, 0));
                 let d = b.ins().fsub(ak, sum);
-                let two = Self::constant(b, 2.0);
+                let two = self.constant(b, 2.0);
                 let twice = b.ins().fmul(o0, two);
                 let v = b.ins().fdiv(d, twice);
                 self.put(b, out, k, v);
             }
             SeriesOp::PowConstant { out, a, exponent } => {
                 let alpha = self.at(b, exponent, 0);
-                let kc = Self::constant(b, kf);
+                let kc = self.constant(b, kf);
                 let power = Sum::Power { out, a, exponent };
-                let (mut sum, from) = match self.started(b, power, types::F64) {
+                let (mut sum, from) = match self.started(b, power, self.ty()) {
                     Some(sum) => (sum, 0),
-                    None => (Self::constant(b, 0.0), k - 1),
+                    None => (self.constant(b, 0.0), k - 1),
                 };
                 for j in (0..=from).rev() {
                     let (xv, ov) = (self.at(b, a, k - j), self.at(b, out, j));
-                    let term = Self::power_term(b, (alpha, k, j), xv, ov);
+                    let term = self.power_term(b, (alpha, k, j), xv, ov);
                     sum = b.ins().fadd(sum, term);
                 }
                 let x0 = self.at(b, a, 0);
@@ -408,16 +511,16 @@ impl Emitter {
             }
             SeriesOp::Exp { out, a } => {
                 let w = self.sum_of_products(b, (a, out, k), 1..=k, true);
-                let v = Self::over_k(b, w, k);
+                let v = self.over_k(b, w, k);
                 self.put(b, out, k, v);
             }
             SeriesOp::Ln { out, a } => {
                 let sum = if k > 1 {
                     self.sum_of_products(b, (out, a, k), 1..=k - 1, true)
                 } else {
-                    Self::constant(b, 0.0)
+                    self.constant(b, 0.0)
                 };
-                let kc = Self::constant(b, kf);
+                let kc = self.constant(b, kf);
                 let (xk, x0) = (self.at(b, a, k), self.at(b, a, 0));
                 let kx = b.ins().fmul(xk, kc);
                 let n = b.ins().fsub(kx, sum);
@@ -426,23 +529,23 @@ impl Emitter {
                 self.put(b, out, k, v);
             }
             SeriesOp::SinCos { sin, cos, a } => {
-                let p = self.next_pair();
+                let p = self.pair_of(sin);
                 let (ws, wc) = self.weighted_pair(b, p, a, k);
-                let vs = Self::over_k(b, ws, k);
+                let vs = self.over_k(b, ws, k);
                 // `(−wc)·(1/k)` as `wc·(−1/k)`: the same bits for every `wc` but NaN (negation
                 // is exact and rounding symmetric; a NaN keeps its sign, and any NaN fails the
                 // step), one multiplication instead of a sign mask and a multiplication.
-                let minus_r = Self::constant(b, -(1.0 / k as f64));
+                let minus_r = self.constant(b, -(1.0 / k as f64));
                 let vc = b.ins().fmul(wc, minus_r);
                 self.put(b, sin, k, vs);
                 self.put(b, cos, k, vc);
                 self.store_pair(b, p, k, (vc, vs));
             }
             SeriesOp::SinhCosh { sinh, cosh, a } => {
-                let p = self.next_pair();
+                let p = self.pair_of(sinh);
                 let (ws, wc) = self.weighted_pair(b, p, a, k);
-                let vs = Self::over_k(b, ws, k);
-                let vc = Self::over_k(b, wc, k);
+                let vs = self.over_k(b, ws, k);
+                let vc = self.over_k(b, wc, k);
                 self.put(b, sinh, k, vs);
                 self.put(b, cosh, k, vc);
                 self.store_pair(b, p, k, (vc, vs));
@@ -454,25 +557,25 @@ impl Emitter {
                 let sum = if k > 1 {
                     self.sum_of_products(b, (root, root, k), 1..=k - 1, false)
                 } else {
-                    Self::constant(b, 0.0)
+                    self.constant(b, 0.0)
                 };
                 let r0 = self.at(b, root, 0);
                 let minus = b.ins().fneg(a2);
                 let n = b.ins().fsub(minus, sum);
-                let two = Self::constant(b, 2.0);
+                let two = self.constant(b, 2.0);
                 let twice = b.ins().fmul(r0, two);
                 let rk = b.ins().fdiv(n, twice);
                 let sign = if acos { -1.0 } else { 1.0 };
                 let sum = if k > 1 {
                     self.sum_of_products(b, (out, root, k), 1..=k - 1, true)
                 } else {
-                    Self::constant(b, 0.0)
+                    self.constant(b, 0.0)
                 };
-                let sk = Self::constant(b, sign * kf);
+                let sk = self.constant(b, sign * kf);
                 let xk = self.at(b, a, k);
                 let sx = b.ins().fmul(xk, sk);
                 let n = b.ins().fsub(sx, sum);
-                let kc = Self::constant(b, kf);
+                let kc = self.constant(b, kf);
                 let d = b.ins().fmul(r0, kc);
                 let v = b.ins().fdiv(n, d);
                 self.put(b, root, k, rk);
@@ -484,13 +587,13 @@ impl Emitter {
                 let sum = if k > 1 {
                     self.sum_of_products(b, (out, square, k), 1..=k - 1, true)
                 } else {
-                    Self::constant(b, 0.0)
+                    self.constant(b, 0.0)
                 };
-                let kc = Self::constant(b, kf);
+                let kc = self.constant(b, kf);
                 let xk = self.at(b, a, k);
                 let kx = b.ins().fmul(xk, kc);
                 let n = b.ins().fsub(kx, sum);
-                let one = Self::constant(b, 1.0);
+                let one = self.constant(b, 1.0);
                 let sq0 = self.at(b, square, 0);
                 let s = b.ins().fadd(one, sq0);
                 let d = b.ins().fmul(s, kc);
@@ -508,17 +611,17 @@ impl Emitter {
                 let sum = if k > 1 {
                     self.sum_of_products(b, (out, norm, k), 1..=k - 1, true)
                 } else {
-                    Self::constant(b, 0.0)
+                    self.constant(b, 0.0)
                 };
                 let n = b.ins().fsub(cross, sum);
-                let kc = Self::constant(b, kf);
+                let kc = self.constant(b, kf);
                 let n0 = self.at(b, norm, 0);
                 let d = b.ins().fmul(n0, kc);
                 let v = b.ins().fdiv(n, d);
                 self.put(b, out, k, v);
             }
             SeriesOp::Zero { out } => {
-                let v = Self::constant(b, 0.0);
+                let v = self.constant(b, 0.0);
                 self.put(b, out, k, v);
             }
         }
@@ -535,8 +638,8 @@ impl Emitter {
         sign: f64,
     ) {
         let w = self.sum_of_products(b, (a, square, k), 1..=k, true);
-        let scaled = Self::over_k(b, w, k);
-        let s = Self::constant(b, sign);
+        let scaled = self.over_k(b, w, k);
+        let s = self.constant(b, sign);
         let signed = b.ins().fmul(scaled, s);
         let xk = self.at(b, a, k);
         let v = b.ins().fadd(xk, signed);
@@ -548,15 +651,16 @@ impl Emitter {
     /// A term `(kα − j(α + 1)) x[k − j] y[j]` of the power with constant exponent `α`, as
     /// the kernel `pow_constant` computes it.
     pub(super) fn power_term(
+        &self,
         b: &mut FunctionBuilder,
         (alpha, k, j): (ir::Value, usize, usize),
         xv: ir::Value,
         ov: ir::Value,
     ) -> ir::Value {
-        let kc = Self::constant(b, k as f64);
-        let one = Self::constant(b, 1.0);
+        let kc = self.constant(b, k as f64);
+        let one = self.constant(b, 1.0);
         let ka = b.ins().fmul(alpha, kc);
-        let jc = Self::constant(b, j as f64);
+        let jc = self.constant(b, j as f64);
         let a1 = b.ins().fadd(alpha, one);
         let ja = b.ins().fmul(a1, jc);
         let weight = b.ins().fsub(ka, ja);
