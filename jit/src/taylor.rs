@@ -188,7 +188,8 @@ pub(crate) struct NativeOrders {
     pub(crate) order_zero: OrderZeroFn,
     /// The highest order it computes, `H`.
     pub(crate) highest: usize,
-    /// The units of scratch the orders use ([`PairScratch::units`]).
+    /// The units of scratch the orders use: the sine–cosine pairs' and the lane slots'
+    /// ([`PairScratch`]).
     pub(crate) scratch_units: usize,
     _memory: ModuleMemory,
 }

@@ -61,7 +61,7 @@ impl Emitter<'_> {
     }
 
     /// Order `i` of lane slot `slot` from its two slots, into the scratch if it is read there
-    /// ([`LaneSlot::history`], or order 0 of a constant).
+    /// ([`LaneSlot::history`], or order 0 of one read as a constant).
     pub(super) fn gather(&mut self, b: &mut FunctionBuilder, slot: Slot, i: usize) {
         let Some(lane) = self.lane(slot) else { return };
         let width = std::mem::replace(&mut self.width, 1);
@@ -73,7 +73,7 @@ impl Emitter<'_> {
         } else {
             b.ins().insertlane(v, y, 1)
         };
-        if lane.history || (i == 0 && !lane.series) {
+        if lane.history || (i == 0 && lane.constant) {
             let offset = self.layout.lane_offset(slot, i);
             b.ins()
                 .store(MemFlagsData::trusted(), v, self.scratch, offset);

@@ -65,11 +65,14 @@ pub(super) struct LaneSlot {
     pub(super) slots: (Slot, Slot),
     /// Whether a paired op writes it (else it is gathered from its two slots).
     pub(super) written: bool,
-    /// Whether it is read above order 0.
+    /// Whether it is read above order 0 (as a series, not a constant).
     pub(super) series: bool,
+    /// Whether it is read as a constant (its order 0, at every order), so that its order 0 is
+    /// kept in the scratch.
+    pub(super) constant: bool,
     /// Whether an op reads its orders below the op's own (a convolution's terms), so that
     /// each order is kept in the scratch; else order `k` lives in registers only, in order
-    /// `k`'s function (and order 0 in the scratch if it is read as a constant).
+    /// `k`'s function.
     pub(super) history: bool,
 }
 
@@ -314,8 +317,10 @@ impl<'a> Search<'a> {
         if x.kind != y.kind || x.same != y.same {
             return false;
         }
-        // Two ops of the same operands compute the same values: nothing to gain.
-        if (0..x.count).all(|i| x.operands[i].0 == y.operands[i].0) {
+        // Two ops of the same operands compute the same values (but two quotients `c / b` of
+        // constants `c` that the op does not name): nothing to gain.
+        let same_values = !matches!(x.kind, SeriesOp::ConstantDiv { .. });
+        if same_values && (0..x.count).all(|i| x.operands[i].0 == y.operands[i].0) {
             return false;
         }
         !self.reaches(a, b) && !self.reaches(b, a)
@@ -495,6 +500,7 @@ impl Pairing {
                         slots,
                         written: false,
                         series: false,
+                        constant: false,
                         history: false,
                     });
                     base + (pairing.lanes.len() - 1) as Slot
@@ -502,6 +508,7 @@ impl Pairing {
                 let entry = &mut pairing.lanes[(number - base) as usize];
                 entry.written |= written;
                 entry.series |= read != Read::Constant;
+                entry.constant |= read == Read::Constant;
                 entry.history |= read == Read::History;
                 number
             };
@@ -704,6 +711,36 @@ mod tests {
             pairing.units[0],
             Unit::Single(SeriesOp::Mul { out: 3, .. })
         ));
+    }
+
+    /// Two powers of other bases and exponents: the bases' and outputs' orders are kept
+    /// (their kernels read the orders below), the exponents' order 0 alone.
+    #[test]
+    fn lane_slots_keep_the_orders_their_readers_read() {
+        let ops = vec![
+            SeriesOp::PowConstant {
+                out: 3,
+                a: 0,
+                exponent: 6,
+            },
+            SeriesOp::PowConstant {
+                out: 4,
+                a: 1,
+                exponent: 10,
+            },
+            SeriesOp::Add { out: 5, a: 3, b: 4 },
+        ];
+        let p = program(13, ops, [5, 5]);
+        let pairing = Pairing::new(&p, 20);
+        assert!(runs_in_order(&p, &pairing));
+        let lane = |slots: (Slot, Slot)| *pairing.lanes.iter().find(|l| l.slots == slots).unwrap();
+        let (bases, exponents, powers) = (lane((0, 1)), lane((6, 10)), lane((3, 4)));
+        assert!(!bases.written && bases.series && bases.history && !bases.constant);
+        assert!(
+            !exponents.written && !exponents.series && !exponents.history && exponents.constant
+        );
+        assert!(powers.written && powers.series && powers.history && !powers.constant);
+        assert_eq!(pairing.lanes.len(), 3);
     }
 
     #[test]

@@ -4,7 +4,7 @@
 use super::*;
 
 impl Emitter<'_> {
-    /// Starts an order: nothing known, no pair met, and the bases of [`Self::prefixes`]'
+    /// Starts an order: nothing known, and the bases of [`Self::prefixes`]'
     /// loads: the series' and the scratch's addresses plus a constant, so that Cranelift,
     /// for which both loads are pure, does not merge a load of a partial sum's terms with the
     /// ops' load of the same coefficient (one value used in both places would keep a register
