@@ -281,9 +281,10 @@ pub struct DerivedLists {
     /// The convolutions per order of the ops: one for a product, quotient or power, two for
     /// a sine–cosine pair, …, five for `atan2` ([`TaylorProgram::unrolled_code_size`]'s `w`).
     pub convolutions: usize,
-    /// Whether an op has a branch point (a square root, `asin`/`acos`'s root, a power): the
-    /// runtime's `branch_step` looks at the series only then.
-    pub branch_points: bool,
+    /// The index in the ops of each op with a branch point (a square root, `asin`/`acos`'s
+    /// root, a power), in order: what the runtime's `branch_step` looks at, each step (a walk
+    /// over every op was most of its cost on the figure eight: 40 ops, 3 powers).
+    pub branch_points: List<u32>,
 }
 
 /// The orders `k = 1 …` this many that the Taylor kernels are compiled for with `k` known
@@ -356,17 +357,19 @@ impl TaylorProgram {
             }
         }
         let convolutions = self.ops.iter().map(convolutions).sum();
-        let branch_points = self.ops.iter().any(|op| {
-            matches!(
-                op,
-                SeriesOp::Sqrt { .. } | SeriesOp::Asin { .. } | SeriesOp::PowConstant { .. }
-            )
-        });
+        let branch_points = (0..self.ops.len() as u32)
+            .filter(|&i| {
+                matches!(
+                    self.ops[i as usize],
+                    SeriesOp::Sqrt { .. } | SeriesOp::Asin { .. } | SeriesOp::PowConstant { .. }
+                )
+            })
+            .collect();
         DerivedLists {
             varying_mass_entries: List::Owned(varying),
             inputs: List::Owned(inputs),
             convolutions,
-            branch_points,
+            branch_points: List::Owned(branch_points),
         }
     }
 
@@ -573,7 +576,7 @@ mod tests {
                 varying_mass_entries: List::Owned(vec![(0, 1, 5), (1, 0, 5)]),
                 inputs: List::Owned(vec![(2, 2), (1, 1), (3, 3)]),
                 convolutions: 3,
-                branch_points: false,
+                branch_points: List::Owned(vec![]),
             }
         );
         let rooted = TaylorProgram {
@@ -581,7 +584,7 @@ mod tests {
             ..program
         }
         .with_derived();
-        assert!(rooted.derived.branch_points);
+        assert_eq!(rooted.derived.branch_points, List::Owned(vec![0]));
         assert_eq!(rooted.derived.convolutions, 1);
     }
 }

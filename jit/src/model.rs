@@ -737,7 +737,7 @@ static EMPTY_PROGRAM: TaylorProgram = TaylorProgram {
         varying_mass_entries: Cow::Borrowed(&[]),
         inputs: Cow::Borrowed(&[]),
         convolutions: 0,
-        branch_points: false,
+        branch_points: Cow::Borrowed(&[]),
     },
 };
 

@@ -1394,7 +1394,7 @@ pub fn branch_step(
 ) -> f64 {
     // Through a constant series the step is infinite: nothing to bound; nor without a root
     // or power.
-    if !h.is_finite() || order == 0 || !program.derived.branch_points {
+    if !h.is_finite() || order == 0 || program.derived.branch_points.is_empty() {
         return h;
     }
     let c = workspace.capacity;
@@ -1409,8 +1409,8 @@ pub fn branch_step(
         OneMinusSquare(Slot),
     }
     let mut limit = h;
-    for op in program.ops.iter() {
-        let (out, argument, alpha) = match *op {
+    for &index in program.derived.branch_points.iter() {
+        let (out, argument, alpha) = match program.ops[index as usize] {
             SeriesOp::Sqrt { out, a } => (out, Argument::Slot(a), 0.5),
             SeriesOp::Asin { a, root, .. } => (root, Argument::OneMinusSquare(a), 0.5),
             SeriesOp::PowConstant { out, a, exponent } => {

@@ -241,7 +241,8 @@ fn program_static(
         .iter()
         .map(|(slot, index)| quote!((#slot, #index)))
         .collect();
-    let (convolutions, branch_points) = (derived.convolutions, derived.branch_points);
+    let convolutions = derived.convolutions;
+    let branch_points = derived.branch_points.iter();
     let statics = quote! {
         static PROGRAM: #t::TaylorProgram = #t::TaylorProgram {
             slots: #slots,
@@ -256,7 +257,7 @@ fn program_static(
                 varying_mass_entries: #cow::Borrowed(&[#(#coupled),*]),
                 inputs: #cow::Borrowed(&[#(#inputs),*]),
                 convolutions: #convolutions,
-                branch_points: #branch_points,
+                branch_points: #cow::Borrowed(&[#(#branch_points),*]),
             },
         };
     };
