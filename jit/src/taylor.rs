@@ -68,8 +68,9 @@
 //! solve and the kernels of the orders above `H` that read it alone. The paired operands'
 //! orders sit side by side in the scratch after the sine–cosine pairs' (the lane slots),
 //! one 16-byte load a term. On the figure eight (36 of its 40 ops paired) whole runs took
-//! 0.88–0.91× the time at tolerances 1e-6 to 1e-12 and 1.02–1.04× at 1e-3, where a step
-//! has 5 orders (docs/performance.md, "The panel"). With the environment variable
+//! 0.86–0.89× the time at tolerances 1e-6 to 1e-12 and 0.95× at 1e-3; over twelve models,
+//! 0.78–0.98× at 1e-9 and 1e-12 and up to 1.09× at 1e-3, where a step computes orders 0–4
+//! (docs/performance.md, "The panel"). With the environment variable
 //! `EOMGEN_JIT_UNPAIRED` set, every op runs alone (the same bits), to measure what the pairs
 //! buy.
 //!

@@ -1410,7 +1410,11 @@ pub fn branch_step(
     }
     let mut limit = h;
     for &index in program.derived.branch_points.iter() {
-        let (out, argument, alpha) = match program.ops[index as usize] {
+        // An index past the ops (a `derived` not made from this program) names no op.
+        let Some(&op) = program.ops.get(index as usize) else {
+            continue;
+        };
+        let (out, argument, alpha) = match op {
             SeriesOp::Sqrt { out, a } => (out, Argument::Slot(a), 0.5),
             SeriesOp::Asin { a, root, .. } => (root, Argument::OneMinusSquare(a), 0.5),
             SeriesOp::PowConstant { out, a, exponent } => {
