@@ -507,6 +507,80 @@ fn compiled_orders_of_every_op_kind_are_the_kernels_bits() {
     }
 }
 
+/// Every bundled model's compiled orders, and the panel's model files' (loaded with
+/// `eager_taylor`: compiled by Cranelift from the first series, independent ops of one kind
+/// paired in the two lanes of a vector), compute the runtime's kernels' bits (the interpreter
+/// backend's series) at orders across the compiled ones, from three states. The figure eight
+/// pairs 36 of its 40 ops, the Kepler orbit 8 of 10 (`jit/src/taylor/pairing.rs`).
+#[test]
+fn every_models_compiled_orders_are_the_kernels_bits() {
+    use eomgen::{Backend, DynMechanicalSystem, OdeSystem};
+    let root = env!("CARGO_MANIFEST_DIR");
+    let mut files: Vec<String> = eomgen::models::ALL
+        .iter()
+        .map(|m| format!("{root}/{}", m.file))
+        .collect();
+    files.push(format!("{root}/tools/panel/kepler_e09.yaml"));
+    files.push(format!("{root}/tools/panel/five_link_chain.yaml"));
+    let mut compiled = 0;
+    for path in &files {
+        let load =
+            |options| JitModel::load_with(path, options).unwrap_or_else(|e| panic!("{path}: {e}"));
+        let native = load(LoadOptions {
+            eager_taylor: true,
+            ..LoadOptions::default()
+        });
+        let Ok(taylor) = native.taylor() else {
+            continue;
+        };
+        let highest = taylor.program().highest_unrolled_order();
+        if highest == 0 || taylor.program().multipliers() > 0 && path.contains("bicycle") {
+            continue;
+        }
+        compiled += 1;
+        let mut native = DynFirstOrder::new(native);
+        let mut kernels = DynFirstOrder::new(load(LoadOptions {
+            backend: Some(Backend::Interpreter),
+            ..LoadOptions::default()
+        }));
+        let y0 = ModelInfo::initial_state(&native);
+        for (shift, order) in [highest + 1, 3, highest.min(12)].into_iter().enumerate() {
+            let y: Vec<f64> = y0
+                .iter()
+                .enumerate()
+                .map(|(i, v)| v + 1e-2 * ((shift + 1) * (i + 1)) as f64)
+                .collect();
+            let dim = y.len();
+            let (mut a, mut b) = (
+                vec![f64::NAN; (order + 1) * dim],
+                vec![f64::NAN; (order + 1) * dim],
+            );
+            let (x, z) = (
+                native.taylor_coefficients(0.1, &y, order, &mut a),
+                kernels.taylor_coefficients(0.1, &y, order, &mut b),
+            );
+            assert_eq!(
+                x.is_ok(),
+                z.is_ok(),
+                "{path} to order {order}: {x:?} against {z:?}"
+            );
+            for (j, (x, z)) in a.iter().zip(&b).enumerate() {
+                assert_eq!(
+                    x.to_bits(),
+                    z.to_bits(),
+                    "{path} to order {order}: order {}, component {}: compiled {x:e}, kernels {z:e}",
+                    j / dim,
+                    j % dim
+                );
+            }
+        }
+    }
+    assert!(
+        compiled >= 30,
+        "only {compiled} models have compiled orders"
+    );
+}
+
 /// The Taylor method's copy of its code for AVX2 and FMA (`eomgen::taylor::host_features`:
 /// the runtime's series of the motion, Horner's rule and step rule and, in an optimised
 /// build, each model's fused orders) computes the bits of the code for any x86-64: the
