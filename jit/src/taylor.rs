@@ -431,10 +431,11 @@ fn emit_order(
         emitter.prefixes(b, program, k);
     }
     if k > 0 {
-        for unit in emitter.layout.pairing.units.clone() {
-            match unit {
+        let layout = emitter.layout;
+        for unit in &layout.pairing.units {
+            match *unit {
                 Unit::Single(op) => emitter.op(b, op, k),
-                Unit::Pair(op) => emitter.paired(b, op, k),
+                Unit::Pair { op, gathered } => emitter.paired(b, op, gathered, k),
             }
         }
     } else {

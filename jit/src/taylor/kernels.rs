@@ -26,32 +26,18 @@ impl Emitter<'_> {
         self.layout.pairing.lane(slot).copied()
     }
 
-    /// Order `k` of paired op `op` (over lane slots): its operands' lane slots that no
-    /// paired op writes gathered first, if this order has not yet, then its kernel over
-    /// vectors.
-    pub(super) fn paired(&mut self, b: &mut FunctionBuilder, op: SeriesOp, k: usize) {
-        let operands: [Slot; 2] = match op {
-            SeriesOp::Neg { a, .. }
-            | SeriesOp::Copy { a, .. }
-            | SeriesOp::Sqrt { a, .. }
-            | SeriesOp::Exp { a, .. }
-            | SeriesOp::Ln { a, .. }
-            | SeriesOp::ConstantDiv { b: a, .. } => [a, a],
-            SeriesOp::Add { a, b: y, .. }
-            | SeriesOp::Sub { a, b: y, .. }
-            | SeriesOp::Mul { a, b: y, .. }
-            | SeriesOp::Div { a, b: y, .. }
-            | SeriesOp::Scale { a, constant: y, .. }
-            | SeriesOp::DivByConstant { a, constant: y, .. }
-            | SeriesOp::PowConstant { a, exponent: y, .. } => [a, y],
-            _ => [Slot::MAX, Slot::MAX],
-        };
-        for slot in operands {
-            if let Some(lane) = self.lane(slot)
-                && !lane.written
-                && lane.series
-                && !self.known.contains_key(&(slot, k))
-            {
+    /// Order `k` of paired op `op` (over lane slots): the lane slots `gathered` first (those
+    /// of its operands that no paired op writes, [`Unit::Pair`]), if this order has not yet,
+    /// then its kernel over vectors.
+    pub(super) fn paired(
+        &mut self,
+        b: &mut FunctionBuilder,
+        op: SeriesOp,
+        gathered: [Option<Slot>; 2],
+        k: usize,
+    ) {
+        for slot in gathered.into_iter().flatten() {
+            if !self.known.contains_key(&(slot, k)) {
                 self.gather(b, slot, k);
             }
         }

@@ -56,7 +56,13 @@ pub(super) enum Unit {
     /// One op of the program.
     Single(SeriesOp),
     /// Two ops as one, over lane slots (see the module documentation).
-    Pair(SeriesOp),
+    Pair {
+        /// The op over lane slots.
+        op: SeriesOp,
+        /// Its operands' lane slots that no paired op writes, read above order 0: gathered
+        /// from their two slots at each order, before it runs.
+        gathered: [Option<Slot>; 2],
+    },
 }
 
 /// A lane slot (see the module documentation).
@@ -66,8 +72,6 @@ pub(super) struct LaneSlot {
     pub(super) slots: (Slot, Slot),
     /// Whether a paired op writes it (else it is gathered from its two slots).
     pub(super) written: bool,
-    /// Whether it is read above order 0 (as a series, not a constant).
-    pub(super) series: bool,
     /// Whether it is read as a constant (its order 0, at every order), so that its order 0 is
     /// kept in the scratch.
     pub(super) constant: bool,
@@ -237,8 +241,8 @@ struct Search<'a> {
     /// The ops that read each slot.
     readers: HashMap<Slot, Vec<usize>>,
     partner: Vec<Option<usize>>,
-    /// The pairs, lane 0's op first, in the order found.
-    pairs: Vec<(usize, usize)>,
+    /// Whether each paired op runs in lane 0.
+    first: Vec<bool>,
     /// `(s, t)` of each pair's outputs, lane 0 first.
     written: HashSet<(Slot, Slot)>,
     /// For each slot written in lane 0, the slots written beside it in lane 1.
@@ -280,7 +284,7 @@ impl<'a> Search<'a> {
             writer,
             readers,
             partner: vec![None; ops.len()],
-            pairs: Vec::new(),
+            first: vec![false; ops.len()],
             written: HashSet::new(),
             beside: HashMap::new(),
         }
@@ -307,33 +311,31 @@ impl<'a> Search<'a> {
         false
     }
 
-    /// Whether unpaired ops `a` and `b` have the same shape and may run as one unit.
-    fn fits(&self, a: usize, b: usize) -> bool {
+    /// The shapes of unpaired ops `a` and `b` if they are alike and may run as one unit.
+    fn fits(&self, a: usize, b: usize) -> Option<(Shape, Shape)> {
         if a == b || self.partner[a].is_some() || self.partner[b].is_some() {
-            return false;
+            return None;
         }
-        let (Some(x), Some(y)) = (&self.shapes[a], &self.shapes[b]) else {
-            return false;
-        };
+        let (x, y) = (self.shapes[a]?, self.shapes[b]?);
         if x.kind != y.kind || x.same != y.same {
-            return false;
+            return None;
         }
         // Two ops of the same operands compute the same values (but two quotients `c / b` of
         // constants `c` that the op does not name): nothing to gain.
         let same_values = !matches!(x.kind, SeriesOp::ConstantDiv { .. });
         if same_values && (0..x.count).all(|i| x.operands[i].0 == y.operands[i].0) {
-            return false;
+            return None;
         }
-        !self.reaches(a, b) && !self.reaches(b, a)
+        (!self.reaches(a, b) && !self.reaches(b, a)).then_some((x, y))
     }
 
-    fn pair(&mut self, a: usize, b: usize) {
+    /// Pairs `a` (lane 0, of shape `x`) with `b` (lane 1, `y`).
+    fn pair(&mut self, (a, x): (usize, Shape), (b, y): (usize, Shape)) {
         self.partner[a] = Some(b);
         self.partner[b] = Some(a);
-        self.pairs.push((a, b));
-        let (x, y) = (self.shapes[a].unwrap().out, self.shapes[b].unwrap().out);
-        self.written.insert((x, y));
-        self.beside.entry(x).or_default().push(y);
+        self.first[a] = true;
+        self.written.insert((x.out, y.out));
+        self.beside.entry(x.out).or_default().push(y.out);
     }
 
     /// Pass 1: pairs down from the slots `s` (lane 0) and `t` (lane 1).
@@ -343,11 +345,10 @@ impl<'a> Search<'a> {
             let (Some(&a), Some(&b)) = (self.writer.get(&s), self.writer.get(&t)) else {
                 continue;
             };
-            if !self.fits(a, b) {
+            let Some((x, y)) = self.fits(a, b) else {
                 continue;
-            }
-            self.pair(a, b);
-            let (x, y) = (self.shapes[a].unwrap(), self.shapes[b].unwrap());
+            };
+            self.pair((a, x), (b, y));
             for i in 0..x.count {
                 let ((u, read), (v, _)) = (x.operands[i], y.operands[i]);
                 if read != Read::Constant && u != v {
@@ -382,8 +383,11 @@ impl<'a> Search<'a> {
                     let (u, v) = (x.operands[i].0, y.operands[i].0);
                     u == v || self.written.contains(&(u, v))
                 });
-                if alike && self.fits(a, b) {
-                    self.pair(a, b);
+                if !alike {
+                    continue;
+                }
+                if let Some((x, y)) = self.fits(a, b) {
+                    self.pair((a, x), (b, y));
                     found = true;
                     break;
                 }
@@ -405,9 +409,9 @@ impl<'a> Search<'a> {
                     self.partner[b].is_none() && self.shapes[b].is_some_and(|y| y.kind == kind)
                 })
                 .take(PARTNERS_TRIED)
-                .find(|&b| self.fits(a, b));
-            if let Some(b) = partner {
-                self.pair(a, b);
+                .find_map(|b| self.fits(a, b).map(|shapes| (b, shapes)));
+            if let Some((b, (x, y))) = partner {
+                self.pair((a, x), (b, y));
             }
         }
     }
@@ -489,18 +493,13 @@ impl Pairing {
                 continue;
             };
             // Lane 0 is the op the search put first.
-            let (a, b) = if search.pairs.contains(&(u, p)) {
-                (u, p)
-            } else {
-                (p, u)
-            };
+            let (a, b) = if search.first[u] { (u, p) } else { (p, u) };
             let (x, y) = (search.shapes[a]?, search.shapes[b]?);
             let mut lane = |slots: (Slot, Slot), written: bool, read: Read| {
                 let number = *numbers.entry(slots).or_insert_with(|| {
                     pairing.lanes.push(LaneSlot {
                         slots,
                         written: false,
-                        series: false,
                         constant: false,
                         history: false,
                     });
@@ -508,19 +507,27 @@ impl Pairing {
                 });
                 let entry = &mut pairing.lanes[(number - base) as usize];
                 entry.written |= written;
-                entry.series |= read != Read::Constant;
                 entry.constant |= read == Read::Constant;
                 entry.history |= read == Read::History;
-                number
+                (number, entry.written)
             };
             // A slot both ops read is read as it is, into both lanes.
+            let mut gathered = [None; 2];
             let operands: Vec<Slot> = (0..x.count)
                 .map(|i| {
                     let ((s, read), (t, _)) = (x.operands[i], y.operands[i]);
-                    if s == t { s } else { lane((s, t), false, read) }
+                    if s == t {
+                        return s;
+                    }
+                    let (number, written) = lane((s, t), false, read);
+                    // Its writer, if any, runs before: what it wrote is known here.
+                    if read != Read::Constant && !written {
+                        gathered[i] = Some(number);
+                    }
+                    number
                 })
                 .collect();
-            let out = lane(
+            let (out, _) = lane(
                 (x.out, y.out),
                 true,
                 if x.recursive {
@@ -529,9 +536,10 @@ impl Pairing {
                     Read::Current
                 },
             );
-            pairing
-                .units
-                .push(Unit::Pair(with_slots(ops[a], out, &operands)));
+            pairing.units.push(Unit::Pair {
+                op: with_slots(ops[a], out, &operands),
+                gathered,
+            });
         }
         Some(pairing)
     }
@@ -539,7 +547,6 @@ impl Pairing {
     /// The lane slot `slot`, if it is one.
     pub(super) fn lane(&self, slot: Slot) -> Option<&LaneSlot> {
         slot.checked_sub(self.base)
-            .filter(|_| !self.lanes.is_empty())
             .and_then(|v| self.lanes.get(v as usize))
     }
 }
@@ -603,7 +610,7 @@ mod tests {
         for unit in &pairing.units {
             let (op, lanes) = match *unit {
                 Unit::Single(op) => (op, 1),
-                Unit::Pair(op) => (op, 2),
+                Unit::Pair { op, .. } => (op, 2),
             };
             let (reads, writes) = reads_writes(&op);
             let real = |slot: Slot| -> Vec<Slot> {
@@ -634,7 +641,7 @@ mod tests {
             .units
             .iter()
             .filter_map(|u| match u {
-                Unit::Pair(op) => Some(*op),
+                Unit::Pair { op, .. } => Some(*op),
                 Unit::Single(_) => None,
             })
             .collect();
@@ -658,7 +665,10 @@ mod tests {
                     .units
                     .iter()
                     .find_map(|u| match *u {
-                        Unit::Pair(SeriesOp::Mul { out, b: 7, .. }) => Some(out),
+                        Unit::Pair {
+                            op: SeriesOp::Mul { out, b: 7, .. },
+                            ..
+                        } => Some(out),
                         _ => None,
                     })
                     .unwrap(),
@@ -673,7 +683,22 @@ mod tests {
         );
         // The position is gathered (no op writes it), and read at every order below.
         let position = pairing.lanes.iter().find(|l| l.slots == (0, 1)).unwrap();
-        assert!(!position.written && position.series && position.history);
+        assert!(!position.written && position.history);
+        // ... by each paired op that reads it, before it runs.
+        let number = 20
+            + pairing
+                .lanes
+                .iter()
+                .position(|l| l.slots == (0, 1))
+                .unwrap() as Slot;
+        let gathering = pairing
+            .units
+            .iter()
+            .filter(
+                |u| matches!(u, Unit::Pair { gathered, .. } if gathered.contains(&Some(number))),
+            )
+            .count();
+        assert_eq!(gathering, 2, "{:?}", pairing.units);
     }
 
     #[test]
@@ -702,7 +727,7 @@ mod tests {
             pairing
                 .units
                 .iter()
-                .filter(|u| matches!(u, Unit::Pair(_)))
+                .filter(|u| matches!(u, Unit::Pair { .. }))
                 .count(),
             1,
             "{:?}",
@@ -736,11 +761,9 @@ mod tests {
         assert!(runs_in_order(&p, &pairing));
         let lane = |slots: (Slot, Slot)| *pairing.lanes.iter().find(|l| l.slots == slots).unwrap();
         let (bases, exponents, powers) = (lane((0, 1)), lane((6, 10)), lane((3, 4)));
-        assert!(!bases.written && bases.series && bases.history && !bases.constant);
-        assert!(
-            !exponents.written && !exponents.series && !exponents.history && exponents.constant
-        );
-        assert!(powers.written && powers.series && powers.history && !powers.constant);
+        assert!(!bases.written && bases.history && !bases.constant);
+        assert!(!exponents.written && !exponents.history && exponents.constant);
+        assert!(powers.written && powers.history && !powers.constant);
         assert_eq!(pairing.lanes.len(), 3);
     }
 

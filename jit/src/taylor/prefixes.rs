@@ -24,7 +24,7 @@ impl Emitter<'_> {
     pub(super) fn prefixes(&mut self, b: &mut FunctionBuilder, program: &TaylorProgram, k: usize) {
         let mut all: Vec<Sum> = Vec::new();
         for unit in self.layout.pairing.units.iter() {
-            let (Unit::Single(op) | Unit::Pair(op)) = unit;
+            let (Unit::Single(op) | Unit::Pair { op, .. }) = unit;
             for sum in self.sums(op) {
                 if !all.contains(&sum) {
                     all.push(sum);
