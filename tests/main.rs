@@ -13,6 +13,7 @@ mod convolution;
 mod determinism;
 mod events;
 mod expm_rayleigh;
+mod export;
 mod floquet;
 mod frf;
 mod friction;

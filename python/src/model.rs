@@ -742,6 +742,25 @@ impl CoreModel {
         ))
     }
 
+    /// The equations as source code in `language` (`c`, `matlab` or `python`), as
+    /// `eomgen equations --c` (`--matlab`, `--python`) prints them
+    /// ([`eomgen::listing::export`]).
+    fn export(&self, py: Python<'_>, language: &str) -> PyResult<String> {
+        use eomgen::listing::{Language, ListingError, export};
+        let Some(language) = Language::ALL.into_iter().find(|l| l.name() == language) else {
+            return Err(pyo3::exceptions::PyValueError::new_err(format!(
+                "language must be `c`, `matlab` or `python`, got `{language}`"
+            )));
+        };
+        let path = self.loaded.source.path().to_string();
+        let text = self.loaded.text.clone();
+        let code = py.detach(|| export(&path, &text, language));
+        code.map_err(|e| match e {
+            ListingError::Diagnostics(d) => model_error(py, &path, &text, &d),
+            e => pyo3::exceptions::PyValueError::new_err(e.to_string()),
+        })
+    }
+
     /// The right-hand side `ẏ = f(t, y)` of the first-order form, `y = [q; q̇]` (`2n`).
     fn rhs<'py>(
         &self,

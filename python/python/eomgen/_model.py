@@ -560,6 +560,16 @@ class Model:
         listing, text, latex_document = self._core.equations(str(method))
         return Equations(latex_document if latex else text, latex_document, listing)
 
+    def export(self, language: str) -> str:
+        """The equations as source code for another tool: ``language`` is ``"c"`` (C99),
+        ``"matlab"`` (a MATLAB/Octave function file, saved as ``NAME.m``) or ``"python"``
+        (a NumPy module), as ``eomgen equations --c`` (``--matlab``, ``--python``) prints
+        them: ``M`` and ``F``, the right-hand side, the exact Jacobians, ``T``, ``V``, the
+        points and the constraints as functions of ``(t, q, qd, p)``, with the parameters'
+        values from the file. For example, ``namespace = {}; exec(m.export("python"),
+        namespace); namespace["rhs"](0.0, namespace["initial_state"]())``."""
+        return self._core.export(str(language))
+
     # --- evaluations for users' own solvers --------------------------------------------------
 
     def rhs(self, t: float, y: ArrayLike) -> np.ndarray:

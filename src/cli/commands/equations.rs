@@ -1,12 +1,12 @@
-//! `eomgen equations MODEL|FILE [--method lagrange|momentum] [--latex|--rust]` and
-//! `eomgen new TEMPLATE N`.
+//! `eomgen equations MODEL|FILE [--method lagrange|momentum] [--latex|--json|--rust|--c|--matlab|--python]`
+//! and `eomgen new TEMPLATE N`.
 
 use clap::{Args, ValueEnum};
 
 use crate::cli::error::CliError;
 use crate::cli::model::{diagnostics_error, read_model};
 use crate::cli::output::out;
-use eomgen::listing::{Derivation, ListingError, equations};
+use eomgen::listing::{Derivation, Language, ListingError, equations, export};
 use eomgen_symbolic::codegen::GenerateError;
 use eomgen_symbolic::model::templates;
 
@@ -36,8 +36,20 @@ pub struct EquationsArgs {
     pub json: bool,
     /// Print the Rust that `eomgen::model!` generates for the file (formatted; the same
     /// pipeline as the macro, with the file tracked by its path as shown).
-    #[arg(long, conflicts_with = "method")]
+    #[arg(long, conflicts_with_all = ["method", "latex", "json"])]
     pub rust: bool,
+    /// Print the equations as C99 (`<math.h>`): M and F, the right-hand side of the
+    /// first-order form, the exact Jacobians, T, V, the points and the constraints, as
+    /// functions of (t, q, qd, p) prefixed with the model's name, matrices row-major.
+    #[arg(long = "c", conflicts_with_all = ["method", "latex", "json", "rust", "matlab", "python"])]
+    pub c: bool,
+    /// Print the same as a MATLAB/Octave function file (save it as NAME.m; `NAME()` returns
+    /// the functions as handles: `ode45(model.rhs, [0 10], model.initial_state())`).
+    #[arg(long, conflicts_with_all = ["method", "latex", "json", "rust", "python"])]
+    pub matlab: bool,
+    /// Print the same as a Python module (NumPy).
+    #[arg(long, conflicts_with_all = ["method", "latex", "json", "rust"])]
+    pub python: bool,
 }
 
 /// Options of `eomgen new`.
@@ -67,6 +79,23 @@ pub fn run(args: &EquationsArgs) -> Result<(), CliError> {
         let code = syn::parse2::<syn::File>(tokens)
             .map_err(|e| CliError::failure(format!("the generated code does not parse: {e}")))?;
         out!("{}", prettyplease::unparse(&code));
+        return Ok(());
+    }
+    let language = if args.c {
+        Some(Language::C)
+    } else if args.matlab {
+        Some(Language::Matlab)
+    } else if args.python {
+        Some(Language::Python)
+    } else {
+        None
+    };
+    if let Some(language) = language {
+        let code = export(&display, &source, language).map_err(|e| match e {
+            ListingError::Diagnostics(d) => diagnostics_error(&display, &source, &d),
+            e => CliError::failure(e.to_string()),
+        })?;
+        out!("{code}");
         return Ok(());
     }
     let derivation = match args.method {

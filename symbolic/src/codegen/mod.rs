@@ -9,6 +9,7 @@
 //! deterministic: it depends only on the model file.
 
 mod describe;
+pub mod export;
 mod listing;
 pub mod plan;
 pub mod program;
