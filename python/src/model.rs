@@ -680,6 +680,44 @@ impl CoreModel {
         Ok(("equilibrium".into(), to_python(py, &summary, Lists::Plain)?))
     }
 
+    /// The state-space model `δẏ = A δy + B u`, `z = C δy + D u` from `inputs` to `outputs`
+    /// about the equilibrium whose Newton search starts at `at` (found with the inputs at
+    /// 0): `eomgen modes --input … --output … --json`'s `state_space` ([`eomgen::state_space`]).
+    fn state_space<'py>(
+        &self,
+        py: Python<'py>,
+        at: Option<&Bound<'py, PyAny>>,
+        label: Option<String>,
+        inputs: Vec<String>,
+        outputs: Vec<String>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let options = OperatingPointOptions {
+            start: equilibrium_start(at, label)?,
+            t: 0.0,
+        };
+        let mut model = self.fresh()?;
+        let state_space = py.detach(|| {
+            let modal = vibration::modal_analysis(
+                model.as_ref(),
+                &ModalOptions {
+                    operating_point: options,
+                },
+            )
+            .map_err(|e| e.to_string())?;
+            let inputs: Vec<&str> = inputs.iter().map(String::as_str).collect();
+            let outputs: Vec<&str> = outputs.iter().map(String::as_str).collect();
+            eomgen::state_space(
+                model.as_mut(),
+                &modal.operating_point.guess,
+                &inputs,
+                &outputs,
+            )
+            .map_err(|e| e.to_string())
+        });
+        let state_space = state_space.map_err(|e| point_error(model.as_ref(), e))?;
+        to_python(py, &state_space, Lists::Plain)
+    }
+
     /// The cross-check of the derivations at `states` random states: what
     /// `eomgen check --json` prints (with `timing`, the derivation times too).
     #[pyo3(signature = (states = eomgen_symbolic::mechanics::cross_check::DEFAULT_CHECK_STATES, timing = false))]

@@ -56,3 +56,4 @@ def test_export_names_the_languages():
     assert model.export("matlab").startswith("function model = double_pendulum()")
     with pytest.raises(ValueError, match="language must be"):
         model.export("fortran")
+

@@ -775,3 +775,16 @@ def test_the_docs_session_runs():
     # ω⁴ − 60 ω² + 2700/7 = 0: the page's [2.7059…, 7.2579…].
     w2 = 30 + np.array([-1.0, 1.0]) * math.sqrt(900 - 2700 / 7)
     np.testing.assert_allclose(namespace["modes"].natural_frequencies, np.sqrt(w2), rtol=1e-12)
+
+
+def test_state_space_of_the_forced_oscillator_is_its_closed_form():
+    """``Model.state_space`` (``modes --input``): ``A = [0 1; -k/m -c/m]``, ``B = [0; 1/m]``."""
+    model = eomgen.load("forced_oscillator").with_parameters(m=2.0, c=0.5, k=3.0)
+    ss = model.state_space("A", outputs=["x", "x_dot"])
+    np.testing.assert_allclose(ss["a"], [[0.0, 1.0], [-1.5, -0.25]], rtol=0, atol=1e-15)
+    np.testing.assert_allclose(ss["b"], [[0.0], [0.5]], rtol=0, atol=1e-15)
+    np.testing.assert_array_equal(ss["c"], np.eye(2))
+    np.testing.assert_array_equal(ss["d"], np.zeros((2, 1)))
+    assert ss["inputs"] == ["A"] and ss["outputs"] == ["x", "x_dot"]
+    with pytest.raises(eomgen.AnalysisError, match="not a coordinate"):
+        model.state_space("A", outputs=["y"])

@@ -120,6 +120,7 @@ pub use linear::response::{
     response_with_modal_damping, state_response_by_eigenvectors, state_response_by_exponential,
     state_response_by_integration,
 };
+pub use linear::state_space::{StateSpace, state_space};
 pub use linear::steady::{
     SteadyLinearization, SteadyMotion, SteadyMotionError, find_steady_motion, general_eigenvalues,
     linearize_steady_motion, steady_stability,

@@ -521,6 +521,32 @@ class Model:
             return SteadyMotion(summary)
         return Modes(summary)
 
+    def state_space(self, inputs: Union[str, Sequence[str]], outputs: Sequence[str] = (),
+                    at: Optional[Union[str, Mapping[str, float], ArrayLike]] = None) -> dict:
+        """The linearisation about an equilibrium as a state-space model
+        ``δẏ = A δy + B u``, ``z = C δy + D u`` (``y = [q; q̇]``), as ``eomgen modes --input
+        … --output … --json`` gives it: a dict with ``states``, ``inputs``, ``outputs``,
+        ``equilibrium`` and the NumPy arrays ``a`` (``2n × 2n``), ``b`` (``2n × r``), ``c``
+        (``o × 2n``) and ``d`` (``o × r``, zero).
+
+        Args:
+            inputs: parameters that enter the forcing linearly (load amplitudes, read at
+                ``t = 0``), or coordinates' names (a unit generalized force on each).
+            outputs: coordinates, or rates ``NAME_dot`` (default: every coordinate).
+            at: where Newton starts, as for :meth:`modes`; the equilibrium is found with
+                the inputs at 0.
+
+        Raises:
+            AnalysisError: no equilibrium, a constrained model, an input that is not a
+                load amplitude, an unknown output.
+        """
+        inputs = [inputs] if isinstance(inputs, str) else [str(i) for i in inputs]
+        at, label = self._operating_point(at)
+        result = self._core.state_space(at, label, inputs, [str(o) for o in outputs])
+        for key in ("a", "b", "c", "d"):
+            result[key] = np.array(result[key], dtype=float).reshape(len(result[key]), -1)
+        return result
+
     def _operating_point(self, at):
         """`at` for the library: a name, or coordinates (a dict's, others 0) with a label."""
         if isinstance(at, Mapping):

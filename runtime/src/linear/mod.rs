@@ -13,6 +13,8 @@
 //!   and damping models (modal, Rayleigh) against the exact damped modes;
 //! - [`frequency_response`]: input matrices of load parameters, `H(ω) = (K − ω²M + iωC)⁻¹ B`,
 //!   resonance peaks, modal sums, and the steady state of the full model by simulation;
+//! - [`state_space`]: the forced linearisation as `δẏ = A δy + B u`, `z = C δy + D u` with
+//!   named inputs and outputs, for control design;
 //! - [`steady`]: steady motions (constant rates, ignorable coordinates drifting) and their
 //!   linearisation restricted to the constraints, holonomic and non-holonomic;
 //! - [`monodromy`]: the monodromy matrix of a periodic linearisation, Floquet multipliers and
@@ -28,6 +30,7 @@ pub mod frequency_response;
 pub mod modal;
 pub mod monodromy;
 pub mod response;
+pub mod state_space;
 pub mod steady;
 mod stops;
 pub mod time_dependence;

@@ -31,6 +31,16 @@ pub struct ModesArgs {
     /// with a mode selector.
     #[arg(long, value_name = "FILE.html")]
     pub animate: Option<String>,
+    /// Also give the state-space model `dy/dt = A y + B u`, `z = C y + D u` about the
+    /// equilibrium found with the inputs at 0, for this input: a parameter that enters the
+    /// forcing linearly (a load amplitude) or a coordinate's name (a unit generalized force on
+    /// it); repeatable, one column of B each.
+    #[arg(long, value_name = "NAME")]
+    pub input: Vec<String>,
+    /// An output of the state-space model: a coordinate, or its rate `NAME_dot`; repeatable
+    /// (default: every coordinate). Needs --input.
+    #[arg(long, value_name = "NAME", requires = "input")]
+    pub output: Vec<String>,
 }
 
 /// Runs `modes`.
@@ -41,6 +51,12 @@ pub fn run(args: &ModesArgs) -> Result<(), CliError> {
     let num_dofs = model.num_dofs();
     let options = args.point.options(model.as_ref())?;
     if vibration::is_steady_motion(model.as_ref(), &options.start) {
+        if !args.input.is_empty() {
+            return Err(CliError::usage(format!(
+                "--input: `{}` at this operating point is a steady motion (or has non-holonomic constraints); the state-space model is given about an equilibrium of an unconstrained model",
+                model.description().name
+            )));
+        }
         if args.plot.is_some() || args.animate.is_some() {
             return Err(CliError::usage(format!(
                 "`{}` at this operating point is a steady motion (or has non-holonomic constraints): its modes are eigenvectors of the reduced state matrix, which --plot and --animate do not draw",
@@ -78,6 +94,14 @@ pub fn run(args: &ModesArgs) -> Result<(), CliError> {
     // Mode shapes in the model's coordinates (δq = N z with constraints).
     let shapes_q = modal.mode_shape_matrix();
     let summary = modal.summary(model.as_ref());
+    let state_space = match args.input.is_empty() {
+        true => None,
+        false => Some(state_space(
+            model.as_mut(),
+            &modal.operating_point.guess,
+            args,
+        )?),
+    };
     let charts = match &args.plot {
         Some(prefix) => {
             let charts = crate::cli::mode_plot::mode_charts(
@@ -107,6 +131,7 @@ pub fn run(args: &ModesArgs) -> Result<(), CliError> {
     if args.json {
         print_json_sorted(&ModesJson {
             summary,
+            state_space,
             charts: &charts,
             animation: &args.animate,
         })
@@ -119,7 +144,46 @@ pub fn run(args: &ModesArgs) -> Result<(), CliError> {
             &charts,
             args,
         );
+        if let Some(ss) = &state_space {
+            print_state_space(&mut stdout, ss);
+        }
         Ok(())
+    }
+}
+
+/// The state-space model of `args`' inputs and outputs about the equilibrium near `guess`
+/// ([`eomgen::state_space`]).
+fn state_space(
+    model: &mut dyn ModelInfo,
+    guess: &[f64],
+    args: &ModesArgs,
+) -> Result<eomgen::StateSpace, CliError> {
+    let inputs: Vec<&str> = args.input.iter().map(String::as_str).collect();
+    let outputs: Vec<&str> = args.output.iter().map(String::as_str).collect();
+    eomgen::state_space(model, guess, &inputs, &outputs).map_err(|e| match e {
+        eomgen::FrfError::Modal(m) => crate::cli::operating_point::modal_failure(model, &m),
+        e @ eomgen::FrfError::UnknownOutput { .. } => CliError::usage(format!("--output: {e}")),
+        e @ eomgen::FrfError::Constrained { .. } => CliError::usage(format!("--input: {e}")),
+        e => CliError::usage(format!("--input: {e}")),
+    })
+}
+
+/// The state-space model's text: what the state, inputs and outputs are, then A, B, C, D.
+fn print_state_space(stdout: &mut impl std::io::Write, ss: &eomgen::StateSpace) {
+    let _ = writeln!(
+        stdout,
+        "state space  dy/dt = A y + B u, z = C y + D u about q* = [{}] (the inputs at 0)",
+        ss.equilibrium
+            .iter()
+            .map(|x| format!("{:.10e}", num(*x)))
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
+    let _ = writeln!(stdout, "             y = [{}]", ss.states.join(", "));
+    let _ = writeln!(stdout, "             u = [{}]", ss.inputs.join(", "));
+    let _ = writeln!(stdout, "             z = [{}]", ss.outputs.join(", "));
+    for (name, matrix) in [("A", &ss.a), ("B", &ss.b), ("C", &ss.c), ("D", &ss.d)] {
+        print_matrix(stdout, name, matrix);
     }
 }
 
@@ -224,6 +288,9 @@ fn steady(
 struct ModesJson<'a> {
     #[serde(flatten)]
     summary: eomgen::analysis::vibration::ModesSummary,
+    /// The state-space model of `--input` and `--output` (absent without `--input`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    state_space: Option<eomgen::StateSpace>,
     /// The mode-shape charts written (`--plot`).
     charts: &'a [String],
     /// The animation page written (`--animate`).
