@@ -907,8 +907,33 @@ fn state_space_transfer_function_is_the_frequency_response() {
     }
 }
 
+/// A base motion `Y cos ωt` through a spring and a dashpot enters through its rate too:
+/// `m ẍ + c ẋ + k x = k y + c ẏ`. The state-space model then takes `x₂ = ẋ − (c/m) y`, and
+/// its transfer functions are the closed forms, the transmissibility
+/// `(k + iωc)/(k − mω² + iωc)` to `x` and `iω` times it to `ẋ` (the rate output reading
+/// `D = c/m`), within 1e-13 at four frequencies (lecture 38).
+#[test]
+fn state_space_of_a_base_motion_carries_its_rate() {
+    let mut m = model("base_excited_oscillator");
+    let ss = eomgen::state_space(m.as_mut(), &[0.0], &["Y"], &["x", "x_dot"]).unwrap();
+    assert!(ss.input_rates);
+    let (mass, k, c) = (1.0, 1.0, 0.4);
+    assert!((ss.d[(1, 0)] - c / mass).abs() <= 1e-15, "D = {}", ss.d);
+    for w in [0.2, 1.0, 1.4142135623730951, 3.0] {
+        let i_w = Complex::new(0.0, w);
+        let resolvent = DMatrix::<Complex<f64>>::identity(2, 2) * i_w - ss.a.map(Complex::from);
+        let state = resolvent.lu().solve(&ss.b.map(Complex::from)).unwrap();
+        let h = ss.c.map(Complex::from) * state + ss.d.map(Complex::from);
+        let t = (k + i_w * c) / (k - mass * w * w + i_w * c);
+        for (row, e) in [t, i_w * t].iter().enumerate() {
+            let difference = (h[(row, 0)] - e).norm() / e.norm();
+            assert!(difference <= 1e-13, "ω = {w}: {} vs {e}", h[(row, 0)]);
+        }
+    }
+}
+
 /// `modes --input` adds the state-space model to the text and to the JSON (`state_space`,
-/// its matrices by rows); an unknown output and a steady motion are usage errors.
+/// its matrices by rows); an unknown output and a constrained model are usage errors.
 #[test]
 fn modes_gives_the_state_space_model_of_named_inputs_and_outputs() {
     let out = eomgen_ok(&[
@@ -934,7 +959,7 @@ fn modes_gives_the_state_space_model_of_named_inputs_and_outputs() {
     );
     let text = eomgen_ok(&["modes", "forced_oscillator", "--input", "A"]);
     let text = String::from_utf8(text.stdout).unwrap();
-    assert!(text.contains("state space  dy/dt = A y + B u"), "{text}");
+    assert!(text.contains("state space  dx/dt = A x + B u"), "{text}");
     let bad = eomgen(&[
         "modes",
         "forced_oscillator",
@@ -946,6 +971,8 @@ fn modes_gives_the_state_space_model_of_named_inputs_and_outputs() {
     assert_eq!(bad.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&bad.stderr).contains("--output"));
     assert!(json.get("charts").is_some());
+    let constrained = eomgen(&["modes", "four_bar", "--input", "theta2"]);
+    assert_eq!(constrained.status.code(), Some(2));
     let plain = eomgen_ok(&["modes", "forced_oscillator", "--json"]);
     let plain: serde_json::Value = serde_json::from_slice(&plain.stdout).unwrap();
     assert!(plain.get("state_space").is_none());

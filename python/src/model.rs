@@ -691,28 +691,16 @@ impl CoreModel {
         inputs: Vec<String>,
         outputs: Vec<String>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let options = OperatingPointOptions {
-            start: equilibrium_start(at, label)?,
-            t: 0.0,
-        };
+        let start = equilibrium_start(at, label)?;
         let mut model = self.fresh()?;
         let state_space = py.detach(|| {
-            let modal = vibration::modal_analysis(
-                model.as_ref(),
-                &ModalOptions {
-                    operating_point: options,
-                },
-            )
-            .map_err(|e| e.to_string())?;
+            let (_, guess) = start
+                .resolve_equilibrium(model.as_ref())
+                .map_err(|e| e.to_string())?;
             let inputs: Vec<&str> = inputs.iter().map(String::as_str).collect();
             let outputs: Vec<&str> = outputs.iter().map(String::as_str).collect();
-            eomgen::state_space(
-                model.as_mut(),
-                &modal.operating_point.guess,
-                &inputs,
-                &outputs,
-            )
-            .map_err(|e| e.to_string())
+            eomgen::state_space(model.as_mut(), &guess, &inputs, &outputs)
+                .map_err(|e| e.to_string())
         });
         let state_space = state_space.map_err(|e| point_error(model.as_ref(), e))?;
         to_python(py, &state_space, Lists::Plain)

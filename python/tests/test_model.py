@@ -788,3 +788,38 @@ def test_state_space_of_the_forced_oscillator_is_its_closed_form():
     assert ss["inputs"] == ["A"] and ss["outputs"] == ["x", "x_dot"]
     with pytest.raises(eomgen.AnalysisError, match="not a coordinate"):
         model.state_space("A", outputs=["y"])
+
+
+def test_rich_displays_show_the_modes_the_verdict_and_the_run():
+    """Jupyter's displays: the modes' table and verdict, a steady motion's eigenvalues, a
+    solution's summary and last state; ``.eigenvalues`` of a steady motion hold each complex
+    eigenvalue with its conjugate, as the state matrix's spectrum does."""
+    modes = eomgen.load("double_pendulum").modes("hanging")
+    page = modes._repr_html_()
+    assert "<table>" in page and "marginally stable" in page and "2.705943" in page
+    s = modes.state_eigenvalues
+    assert len(s) == 4 and np.allclose(sorted(s.imag), [-7.257952078965088, -2.705943757628079, 2.705943757628079, 7.257952078965088])
+    steady = eomgen.load("rolling_disc").modes()
+    assert isinstance(steady, eomgen.SteadyMotion)
+    full, half = steady.eigenvalues, steady.damped_eigenvalues
+    assert len(full) == len(half) + int(np.sum(half.imag != 0.0))
+    assert np.allclose(np.sort_complex(full), np.sort_complex(np.conj(full)))
+    assert "<table>" in steady._repr_html_() and "stability" in steady._repr_html_()
+    run = eomgen.load("double_pendulum").simulate(t_end=0.5)
+    page = run._repr_html_()
+    assert "double_pendulum" in page and "theta2" in page and f"{run.q[-1, 1]:.10g}" in page
+
+
+def test_plots_draw_one_panel_per_coordinate():
+    matplotlib = pytest.importorskip("matplotlib")
+    matplotlib.use("Agg")
+    run = eomgen.load("heavy_top").simulate(t_end=0.5)
+    fig = run.plot(rates=True)
+    assert len(fig.axes) == 2 * 3
+    assert [ax.get_ylabel() for ax in fig.axes[::2]] == run.summary_header["coordinates"]
+    fig = run.plot(["theta"])
+    assert len(fig.axes) == 1
+    with pytest.raises(ValueError, match="not a coordinate"):
+        run.plot(["nope"])
+    fig = eomgen.load("double_pendulum").modes("hanging").plot()
+    assert len(fig.axes[0].lines) == 2 + 1

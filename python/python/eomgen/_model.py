@@ -7,6 +7,7 @@ arguments, documents shapes and units, and wraps the reports in small result obj
 from __future__ import annotations
 
 import functools
+import html
 import math
 from typing import Callable, Dict, Iterable, List, Mapping, Optional, Sequence, Tuple, Union
 
@@ -925,6 +926,30 @@ class Model:
         return hash((argument, text, tuple(overrides)))
 
 
+def _html_table(headers: Sequence[str], rows: Iterable[Sequence[object]]) -> str:
+    """An HTML table (cells escaped) for the rich displays of Jupyter."""
+    head = "".join(f"<th>{html.escape(str(h))}</th>" for h in headers)
+    body = "".join("<tr>" + "".join(f"<td>{html.escape(str(c))}</td>" for c in row) + "</tr>"
+                   for row in rows)
+    return f"<table><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>"
+
+
+def _verdict(stability: Optional[dict]) -> str:
+    """The stability verdict in words (``marginally stable``), or ``-``."""
+    if not stability or "verdict" not in stability:
+        return "-"
+    return str(stability["verdict"]).replace("_", " ")
+
+
+def _pyplot(what: str):
+    """``matplotlib.pyplot``, or an ImportError that says how to get it."""
+    try:
+        import matplotlib.pyplot as plt
+    except ImportError as e:  # pragma: no cover - depends on the environment
+        raise ImportError(f"{what} needs matplotlib: pip install matplotlib") from e
+    return plt
+
+
 class Solution:
     """The samples of one simulation, with its energy, work and events.
 
@@ -1069,6 +1094,65 @@ class Solution:
     def __len__(self) -> int:
         return len(self.t)
 
+    def _repr_html_(self) -> str:
+        """The run's summary and its last state, for Jupyter."""
+        h, stats = self.summary_header, self.stats
+        k = len(self.t)
+        lines = [
+            f"<b>eomgen.Solution</b> of <code>{html.escape(str(h['model']))}</code> by "
+            f"{html.escape(str(h.get('method', '-')))} (rtol {h.get('rtol', '-')}, atol {h.get('atol', '-')})",
+            f"{k} samples, t = {self.t[0]:.6g} … {self.t[-1]:.6g} s" if k else "no samples",
+            f"{stats.get('steps', 0)} steps ({stats.get('rejected', 0)} rejected), "
+            f"{stats.get('rhs_evals', 0)} RHS evaluations, {stats.get('wall_time_s', 0) * 1e3:.3g} ms",
+        ]
+        if self.energy_drift is not None:
+            lines.append(f"energy drift {self.energy_drift:.3e} (relative)")
+        for w in self.warnings:
+            lines.append(f"warning: {html.escape(str(w.get('message', w)))}")
+        if self._failure:
+            lines.append(f"<b>failed</b>: {html.escape(str(self._failure))}")
+        table = ""
+        if k:
+            names = list(h.get("coordinates", [f"q{i}" for i in range(self._num_dofs)]))
+            table = _html_table(["coordinate", f"q(t = {self.t[-1]:.6g})", "q̇"],
+                                ((c, f"{self.q[-1, i]:.10g}", f"{self.qdot[-1, i]:.10g}")
+                                 for i, c in enumerate(names)))
+        return "<br>".join(lines) + table
+
+    def plot(self, coordinates: Optional[Sequence[str]] = None, rates: bool = False):
+        """One panel per coordinate against ``t`` (and its rate with ``rates``), so that a
+        large spin does not flatten a small nutation; needs matplotlib. Returns the
+        figure.
+
+        Args:
+            coordinates: the coordinates to draw, by name (default: all).
+            rates: also draw each coordinate's rate, in a second column.
+
+        Raises:
+            ValueError: a name that is not a coordinate. ImportError: no matplotlib.
+        """
+        plt = _pyplot("Solution.plot")
+        names = list(self.summary_header["coordinates"])
+        chosen = names if coordinates is None else [str(c) for c in coordinates]
+        for c in chosen:
+            if c not in names:
+                raise ValueError(f"`{c}` is not a coordinate (coordinates: {', '.join(names)})")
+        columns = 2 if rates else 1
+        fig, axes = plt.subplots(len(chosen), columns, sharex=True, squeeze=False,
+                                 figsize=(6.4 * columns, 1.8 * len(chosen) + 0.8))
+        for row, c in enumerate(chosen):
+            i = names.index(c)
+            axes[row, 0].plot(self.t, self.q[:, i])
+            axes[row, 0].set_ylabel(c)
+            if rates:
+                axes[row, 1].plot(self.t, self.qdot[:, i])
+                axes[row, 1].set_ylabel(f"{c}_dot")
+        for col in range(columns):
+            axes[-1, col].set_xlabel("t (s)")
+        fig.suptitle(str(self.summary_header["model"]))
+        fig.tight_layout()
+        return fig
+
     def __repr__(self) -> str:
         return (f"eomgen.Solution({self.summary_header['model']!r}, {len(self.t)} samples, "
                 f"t = {self.t[0] if len(self.t) else '-'} … {self.t[-1] if len(self.t) else '-'}, "
@@ -1193,6 +1277,42 @@ class Modes:
         """The eigenvalues ``s`` of the state matrix with ``Im s ≥ 0`` (complex)."""
         return np.array([complex(d["re"], d["im"]) for d in self.summary["damped_modes"]])
 
+    @property
+    def state_eigenvalues(self) -> np.ndarray:
+        """Every eigenvalue ``s`` of the state matrix ``A = [0 I; −M⁻¹K −M⁻¹C]`` (complex,
+        ``2r``), each complex one with its conjugate: what the stability verdict reads."""
+        return np.array([complex(re, im) for re, im in self.stability["eigenvalues"]])
+
+    def _repr_html_(self) -> str:
+        """The modes as a table (ω, f, ζ, kind) and the verdict, for Jupyter."""
+        point = self.summary["operating_point"]
+        q = ", ".join(f"{c} = {v:.6g}" for c, v in zip(self.coordinates, self.equilibrium))
+        rows = []
+        for k, w in enumerate(self.natural_frequencies):
+            zeta = self.damping_ratios[k] if k < len(self.damping_ratios) else float("nan")
+            kind = self.kinds[k].get("kind", "-") if k < len(self.kinds) else "-"
+            rows.append((k + 1, f"{w:.8g}", f"{self.frequencies_hz[k]:.6g}", f"{zeta:.4g}", kind))
+        return (f"<b>eomgen.Modes</b> of <code>{html.escape(self.summary['model'])}</code> at "
+                f"{html.escape(str(point['name']))}: {html.escape(q)}"
+                + _html_table(["mode", "ω (rad/s, undamped)", "f (Hz)", "ζ", "kind"], rows)
+                + f"stability: <b>{html.escape(_verdict(self.stability))}</b>")
+
+    def plot(self):
+        """The mass-normalised mode shapes, one line per mode over the coordinates; needs
+        matplotlib. Returns the figure."""
+        plt = _pyplot("Modes.plot")
+        fig, ax = plt.subplots(figsize=(6.4, 3.6))
+        x = np.arange(len(self.coordinates))
+        for k, w in enumerate(self.natural_frequencies):
+            ax.plot(x, self.mode_shapes[:, k], marker="o", label=f"mode {k + 1}: ω = {w:.4g} rad/s")
+        ax.axhline(0.0, color="0.6", linewidth=0.8)
+        ax.set_xticks(x, self.coordinates)
+        ax.set_ylabel("ψ (mass-normalised)")
+        ax.set_title(f"{self.summary['model']} at {self.summary['operating_point']['name']}")
+        ax.legend(fontsize="small")
+        fig.tight_layout()
+        return fig
+
     def __repr__(self) -> str:
         freqs = ", ".join(f"{w:.6g}" for w in self.natural_frequencies)
         return f"eomgen.Modes({self.summary['model']!r} at {self.summary['operating_point']['name']!r}: ω = [{freqs}] rad/s)"
@@ -1204,16 +1324,37 @@ class SteadyMotion:
     steady motion).
 
     Attributes:
-        eigenvalues: the eigenvalues ``s`` of the reduced state matrix with ``Im s ≥ 0``
-            (complex): each complex pair once, each real eigenvalue once, as the report
-            lists them.
+        eigenvalues: every eigenvalue ``s`` of the reduced state matrix (complex), each
+            complex one followed by its conjugate.
+        damped_eigenvalues: those with ``Im s ≥ 0``: each complex pair once, each real
+            eigenvalue once, as the report lists them (with ``damping_ratios``).
+        damping_ratios: ``ζ`` of each of ``damped_eigenvalues``.
         summary: the report as ``eomgen modes --json`` prints it.
     """
 
     def __init__(self, summary: dict):
         self.summary = summary
-        self.eigenvalues = np.array([complex(d["re"], d["im"]) for d in summary["damped_modes"]])
+        modes = summary["damped_modes"]
+        self.damped_eigenvalues = np.array([complex(d["re"], d["im"]) for d in modes])
+        self.damping_ratios = np.array([d["damping_ratio"] for d in modes], dtype=float)
+        full = []
+        for s in self.damped_eigenvalues:
+            full.append(s)
+            if s.imag != 0.0:
+                full.append(s.conjugate())
+        self.eigenvalues = np.array(full)
         self.stability = summary.get("stability")
+
+    def _repr_html_(self) -> str:
+        """The steady motion, its eigenvalues (Re s, Im s, ζ) and the verdict, for Jupyter."""
+        point = self.summary["operating_point"]
+        held = ", ".join(f"{c} = {v:.6g}" for c, v in point.get("qdot", {}).items())
+        rows = [(k + 1, f"{s.real:.8g}", f"{s.imag:.8g}", f"{z:.4g}")
+                for k, (s, z) in enumerate(zip(self.damped_eigenvalues, self.damping_ratios))]
+        return (f"<b>eomgen.SteadyMotion</b> of <code>{html.escape(self.summary['model'])}</code> at "
+                f"{html.escape(str(point.get('name', '-')))}" + (f"; rates held {html.escape(held)}" if held else "")
+                + _html_table(["eigenvalue", "Re s (1/s)", "Im s (rad/s, ≥ 0)", "ζ"], rows)
+                + f"stability: <b>{html.escape(_verdict(self.stability))}</b>")
 
     def __repr__(self) -> str:
         return f"eomgen.SteadyMotion({self.summary['model']!r}: {len(self.eigenvalues)} eigenvalues)"

@@ -163,7 +163,10 @@ fn state_space(
     eomgen::state_space(model, guess, &inputs, &outputs).map_err(|e| match e {
         eomgen::FrfError::Modal(m) => crate::cli::operating_point::modal_failure(model, &m),
         e @ eomgen::FrfError::UnknownOutput { .. } => CliError::usage(format!("--output: {e}")),
-        e @ eomgen::FrfError::Constrained { .. } => CliError::usage(format!("--input: {e}")),
+        eomgen::FrfError::Constrained { .. } => CliError::usage(format!(
+            "--input: `{}` has constraints; the state-space model is given for unconstrained models (write the model in independent coordinates, or see `eomgen reduce`)",
+            model.description().name
+        )),
         e => CliError::usage(format!("--input: {e}")),
     })
 }
@@ -172,14 +175,14 @@ fn state_space(
 fn print_state_space(stdout: &mut impl std::io::Write, ss: &eomgen::StateSpace) {
     let _ = writeln!(
         stdout,
-        "state space  dy/dt = A y + B u, z = C y + D u about q* = [{}] (the inputs at 0)",
+        "state space  dx/dt = A x + B u, z = C x + D u about q* = [{}] (the inputs at 0)",
         ss.equilibrium
             .iter()
             .map(|x| format!("{:.10e}", num(*x)))
             .collect::<Vec<_>>()
             .join(", ")
     );
-    let _ = writeln!(stdout, "             y = [{}]", ss.states.join(", "));
+    let _ = writeln!(stdout, "             x = [{}]", ss.states.join(", "));
     let _ = writeln!(stdout, "             u = [{}]", ss.inputs.join(", "));
     let _ = writeln!(stdout, "             z = [{}]", ss.outputs.join(", "));
     for (name, matrix) in [("A", &ss.a), ("B", &ss.b), ("C", &ss.c), ("D", &ss.d)] {

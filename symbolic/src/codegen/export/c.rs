@@ -4,6 +4,9 @@ use std::fmt::Write;
 
 use super::{Arg, Exported, Function, Language, body, literal_in, operand};
 
+/// The most `double`s of the right-hand side's workspace kept on the stack (32 kB).
+const STACK_WORKSPACE: usize = 4096;
+
 impl Exported<'_> {
     /// The C source (see [`Language::C`]).
     pub(super) fn c(&self) -> String {
@@ -19,10 +22,10 @@ impl Exported<'_> {
         };
         let _ = writeln!(
             s,
-            " *\n * Each function is named {0}_<function> and writes its outputs to the arrays it is\n * given (matrices row-major: M[i*n + j]); {returns} 0, or 1 where the\n * linear system is singular. Compile with: cc -O2 -c {0}.c (link with -lm).\n */",
+            " *\n * Each function is named {0}_<function> and writes its outputs to the arrays it is\n * given (matrices row-major: M[i*n + j]); {returns} 0, 1 where a pivot\n * of the linear system (Gaussian elimination with partial pivoting) is zero or not finite, or\n * 2 where memory for it is lacking. Compile with: cc -O2 -c {0}.c (link with -lm).\n */",
             self.name
         );
-        s.push_str("#include <math.h>\n\n");
+        s.push_str("#include <math.h>\n#include <stdlib.h>\n\n");
         let prefix = &self.name;
         let _ = writeln!(
             s,
@@ -92,17 +95,31 @@ impl Exported<'_> {
         let prefix = &self.name;
         let (n, m) = (self.n(), self.m());
         let k = n + m;
+        let (nn, kk, mn) = (n * n, k * k, m * n);
+        // `M`, `A` and `J` on the stack up to 32 kB, else from the heap (a 1000-mass chain's
+        // would take 16 MB of stack).
+        let heap = nn + kk + mn > STACK_WORKSPACE;
         let _ = writeln!(
             s,
-            "/* q'' and, with constraints, lambda into x ({k}) at (t, q, qd); 1 where singular. */\nstatic int {prefix}_accelerations(double t, const double *q, const double *qd, const double *p, double *x)\n{{\n    double M[{nn}], A[{kk}];\n    int i, j;\n    {prefix}_mass_matrix_and_forcing(t, q, qd, p, M, x);",
-            nn = n * n,
-            kk = k * k
+            "/* q'' and, with constraints, lambda into x ({k}) at (t, q, qd): 0; 1 where a pivot of the\n * linear system is zero or not finite; 2 where memory for it is lacking. */\nstatic int {prefix}_accelerations(double t, const double *q, const double *qd, const double *p, double *x)\n{{"
+        );
+        if heap {
+            let _ = writeln!(
+                s,
+                "    double *M = (double *)malloc(sizeof(double) * {});\n    if (M == NULL) {{\n        return 2;\n    }}",
+                nn + kk + mn
+            );
+        } else {
+            let _ = writeln!(s, "    double M[{}];", nn + kk + mn);
+        }
+        let _ = writeln!(
+            s,
+            "    double *A = M + {nn};\n    double *J = A + {kk};\n    int i, j, status;\n    (void)J;\n    {prefix}_mass_matrix_and_forcing(t, q, qd, p, M, x);"
         );
         if m > 0 {
             let _ = writeln!(
                 s,
-                "    double J[{}];\n    {prefix}_constraint_jacobian(t, q, p, J);\n    {prefix}_constraint_gamma(t, q, qd, p, x + {n});",
-                m * n
+                "    {prefix}_constraint_jacobian(t, q, p, J);\n    {prefix}_constraint_gamma(t, q, qd, p, x + {n});"
             );
         }
         let _ = writeln!(
@@ -115,15 +132,19 @@ impl Exported<'_> {
                 "    for (i = 0; i < {m}; ++i) {{\n        for (j = 0; j < {n}; ++j) {{\n            A[({n} + i) * {k} + j] = J[i * {n} + j];\n            A[j * {k} + {n} + i] = J[i * {n} + j];\n        }}\n    }}"
             );
         }
+        let _ = writeln!(s, "    status = {prefix}_solve({k}, A, x);");
+        if heap {
+            s.push_str("    free(M);\n");
+        }
         let _ = writeln!(
             s,
-            "    return {prefix}_solve({k}, A, x);\n}}\n\n/* dy/dt = [qd; q''] ({two}) at (t, y); 0, or 1 where the linear system is singular. */\nint {prefix}_rhs(double t, const double *y, const double *p, double *ydot)\n{{\n    double x[{k}];\n    int i;\n    if ({prefix}_accelerations(t, y, y + {n}, p, x) != 0) {{\n        return 1;\n    }}\n    for (i = 0; i < {n}; ++i) {{\n        ydot[i] = y[{n} + i];\n        ydot[{n} + i] = x[i];\n    }}\n    return 0;\n}}",
+            "    return status;\n}}\n\n/* dy/dt = [qd; q''] ({two}) at (t, y): the status of {prefix}_accelerations. */\nint {prefix}_rhs(double t, const double *y, const double *p, double *ydot)\n{{\n    double x[{k}];\n    int i, status = {prefix}_accelerations(t, y, y + {n}, p, x);\n    if (status != 0) {{\n        return status;\n    }}\n    for (i = 0; i < {n}; ++i) {{\n        ydot[i] = y[{n} + i];\n        ydot[{n} + i] = x[i];\n    }}\n    return 0;\n}}",
             two = 2 * n
         );
         if m > 0 {
             let _ = writeln!(
                 s,
-                "\n/* lambda ({m}) at (t, q, qd); 0, or 1 where the linear system is singular. */\nint {prefix}_multipliers(double t, const double *q, const double *qd, const double *p, double *lambda)\n{{\n    double x[{k}];\n    int i;\n    if ({prefix}_accelerations(t, q, qd, p, x) != 0) {{\n        return 1;\n    }}\n    for (i = 0; i < {m}; ++i) {{\n        lambda[i] = x[{n} + i];\n    }}\n    return 0;\n}}"
+                "\n/* lambda ({m}) at (t, q, qd): the status of {prefix}_accelerations. */\nint {prefix}_multipliers(double t, const double *q, const double *qd, const double *p, double *lambda)\n{{\n    double x[{k}];\n    int i, status = {prefix}_accelerations(t, q, qd, p, x);\n    if (status != 0) {{\n        return status;\n    }}\n    for (i = 0; i < {m}; ++i) {{\n        lambda[i] = x[{n} + i];\n    }}\n    return 0;\n}}"
             );
         }
     }

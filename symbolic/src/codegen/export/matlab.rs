@@ -5,17 +5,68 @@ use std::fmt::Write;
 use super::{Exported, Language, Output, Shape, body, literal_in, operand};
 use crate::codegen::tape::{Tape, Value};
 
+/// The names a model's MATLAB function must not take: the file's local functions and
+/// MATLAB's keywords.
+const RESERVED: &[&str] = &[
+    "parameters",
+    "rhs",
+    "accelerations",
+    "multipliers",
+    "real_or_nan",
+    "initial_state",
+    "mass_matrix_and_forcing",
+    "kinetic_energy",
+    "potential_energy",
+    "point_positions",
+    "forcing_jacobian_q",
+    "forcing_jacobian_qdot",
+    "mass_matrix_product_jacobian",
+    "constraint_residuals",
+    "constraint_jacobian",
+    "constraint_gamma",
+    "break",
+    "case",
+    "catch",
+    "classdef",
+    "continue",
+    "else",
+    "elseif",
+    "end",
+    "for",
+    "function",
+    "global",
+    "if",
+    "otherwise",
+    "parfor",
+    "persistent",
+    "return",
+    "spmd",
+    "switch",
+    "try",
+    "while",
+];
+
 impl Exported<'_> {
+    /// The model's MATLAB function name: its name, with `_model` after one that is
+    /// [`RESERVED`].
+    fn matlab_name(&self) -> String {
+        if RESERVED.contains(&self.name.as_str()) {
+            format!("{}_model", self.name)
+        } else {
+            self.name.clone()
+        }
+    }
+
     /// The MATLAB/Octave function file (see [`Language::Matlab`]).
     pub(super) fn matlab(&self) -> String {
-        let mut s = format!("function model = {}()\n", self.name);
+        let name = self.matlab_name();
+        let mut s = format!("function model = {name}()\n");
         for line in self.header(Language::Matlab) {
             let _ = writeln!(s, "{}", format!("% {line}").trim_end());
         }
         let _ = writeln!(
             s,
-            "%\n% Save as {0}.m. model = {0}() returns the functions as handles and the\n% parameters' values: [t, y] = ode45(model.rhs, [0 10], model.initial_state()).\n% Every function takes the parameters p last, defaulting to model.parameters.",
-            self.name
+            "%\n% Save as {name}.m. model = {name}() returns the functions as handles and the\n% parameters' values: [t, y] = ode45(model.rhs, [0 10], model.initial_state()).\n% Every function takes the parameters p last, defaulting to model.parameters."
         );
         let quoted = |v: &[String]| {
             v.iter()
@@ -37,6 +88,7 @@ impl Exported<'_> {
             let _ = writeln!(s, "model.{0} = @{0};", f.name);
         }
         s.push_str("end\n\n");
+        s.push_str("function y = real_or_nan(y)\n% NaN where MATLAB's result is complex (eomgen, C and NumPy give NaN there).\nif ~isreal(y), y = NaN; end\nend\n\n");
         let _ = writeln!(
             s,
             "function p = parameters()\n% The parameters' values in the file, in the order of p.\np = [{}];\nend\n",

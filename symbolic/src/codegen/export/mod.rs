@@ -278,6 +278,8 @@ struct Exported<'a> {
     holonomic: usize,
     points: Vec<String>,
     initial_state: Function<'a>,
+    /// What the model has that is not exported (contacts, events), as header lines.
+    omitted: Vec<String>,
     /// Whether some initial values are the file's guesses (`{ guess: … }`), which eomgen
     /// solves with their rates from the constraints before integrating.
     guesses: bool,
@@ -382,6 +384,7 @@ impl<'a> Exported<'a> {
             holonomic: d.holonomic_constraints,
             points: d.points.iter().map(|p| p.to_string()).collect(),
             guesses: !d.initial_guesses.is_empty(),
+            omitted: omitted(d),
             initial_state: Function {
                 name: "initial_state",
                 doc: format!("y(0) = [q(0); qd(0)] ({})", 2 * n),
@@ -442,12 +445,19 @@ impl<'a> Exported<'a> {
                 lines.push(format!("  {}: {c}", entry("lambda", i)));
             }
         }
+        if m > 0 {
+            lines.push(
+                "rhs integrates the index-1 system: the constraints drift by each step's error, as under any such integration (eomgen projects or stabilises them)."
+                    .to_string(),
+            );
+        }
         if !self.points.is_empty() {
             lines.push(format!(
                 "Points (rows of point_positions): {}",
                 self.points.join(", ")
             ));
         }
+        lines.extend(self.omitted.iter().cloned());
         lines.push(String::new());
         lines.push("Functions:".to_string());
         lines.push(format!(
@@ -477,6 +487,22 @@ impl<'a> Exported<'a> {
         }
         lines
     }
+}
+
+/// What a model has that the export leaves out, one sentence each.
+fn omitted(d: &eomgen_description::ModelDescription) -> Vec<String> {
+    let mut lines = Vec::new();
+    if !d.contacts.is_empty() {
+        lines.push(format!(
+            "Not exported: the contacts ({}), their impacts, friction and changes of support; rhs is the motion while none is closed.",
+            d.contacts.join(", ")
+        ));
+    }
+    if !d.events.is_empty() {
+        let names: Vec<&str> = d.events.iter().map(|e| e.name.as_ref()).collect();
+        lines.push(format!("Not exported: the events ({}).", names.join(", ")));
+    }
+    lines
 }
 
 /// The constraints' functions of a constrained model (`Φ` where some are holonomic, `J`,
@@ -545,8 +571,13 @@ fn body(s: &mut String, f: &Function, language: Language, prefix: &str) {
             Instruction::Sqrt(a) => call(function_name(language, "sqrt", prefix).as_str(), a),
             Instruction::Abs(a) => call(function_name(language, "abs", prefix).as_str(), a),
             Instruction::Call(g, a) => match (language, g) {
+                // 0 for NaN, as eomgen's `sign` and `step`.
                 (Language::Matlab, Func::Step) => format!("double({} >= 0)", x(a)),
-                (Language::Python, Func::Step) => format!("np.heaviside({}, 1.0)", x(a)),
+                (Language::Matlab, Func::Sign) => {
+                    format!("double({0} > 0) - double({0} < 0)", x(a))
+                }
+                (Language::Python, Func::Step) => format!("_step({})", x(a)),
+                (Language::Python, Func::Sign) => format!("_sign({})", x(a)),
                 _ => call(function_name(language, g.name(), prefix).as_str(), a),
             },
             Instruction::Powf(a, b) => match language {
@@ -563,6 +594,19 @@ fn body(s: &mut String, f: &Function, language: Language, prefix: &str) {
                 Instruction::SinCos(a) => call(function_name(language, "cos", prefix).as_str(), a),
                 _ => format!("cos({})", x(sc)),
             },
+        };
+        // MATLAB gives a complex number where the others give NaN (a negative base's real
+        // power, the square root or logarithm of a negative number, asin or acos past ±1).
+        let complex_in_matlab = matches!(
+            instruction,
+            Instruction::Powf(..)
+                | Instruction::Sqrt(_)
+                | Instruction::Call(Func::Ln | Func::Asin | Func::Acos, _)
+        );
+        let expr = if language == Language::Matlab && complex_in_matlab {
+            format!("real_or_nan({expr})")
+        } else {
+            expr
         };
         let _ = match language {
             Language::C => writeln!(s, "    const double v{k} = {expr};"),
@@ -695,6 +739,33 @@ mod tests {
         assert_eq!(identifier("double_pendulum"), "double_pendulum");
         assert_eq!(identifier("2-link arm"), "model_2_link_arm");
         assert_eq!(identifier("_x"), "model__x");
+    }
+
+    /// MATLAB's `sqrt`, `^`, `log`, `asin` and `acos` of arguments out of their real domain
+    /// return NaN, as eomgen's do, not a complex number; `sign` is 0 for NaN in MATLAB and
+    /// Python; a model named as one of the file's local functions gets another name.
+    #[test]
+    fn out_of_domain_values_and_clashing_names_are_handled() {
+        let source = "name: rhs\ncoordinates: [x]\nkinetic: x_dot^2/2\npotential: sqrt(x) + x^1.5 + ln(x) + asin(x) + acos(x) + sign(x)\ninitial: {x: 0.5}\n";
+        let file = crate::model::load("rhs.yaml", source).unwrap();
+        let matlab = export(&file, "rhs.yaml", Language::Matlab).unwrap();
+        assert!(
+            matlab.starts_with("function model = rhs_model()"),
+            "{matlab}"
+        );
+        for f in ["sqrt(", "log(", "asin(", "acos("] {
+            assert!(
+                matlab.contains(&format!("real_or_nan({f}")),
+                "{f}: {matlab}"
+            );
+        }
+        assert!(matlab.contains("real_or_nan(q(1) ^ 1.5)"), "{matlab}");
+        assert!(
+            matlab.contains("double(q(1) > 0) - double(q(1) < 0)"),
+            "{matlab}"
+        );
+        let python = export(&file, "rhs.yaml", Language::Python).unwrap();
+        assert!(python.contains("_sign(q[0])"), "{python}");
     }
 
     #[test]

@@ -13,7 +13,7 @@ impl Exported<'_> {
             let _ = writeln!(s, "{line}");
         }
         s.push_str(
-            "\nEvery function takes the parameters p last, defaulting to PARAMETERS; matrices are\n2-D NumPy arrays.\n\"\"\"\n\nimport numpy as np\n\n",
+            "\nEvery function takes the parameters p last, defaulting to PARAMETERS; matrices are\n2-D NumPy arrays.\n\"\"\"\n\nimport numpy as np\n\n\ndef _sign(x):\n    \"\"\"-1, 0 or 1 (0 for NaN, as eomgen's sign).\"\"\"\n    return float(x > 0) - float(x < 0)\n\n\ndef _step(x):\n    \"\"\"1 for x >= 0, else 0 (also for NaN, as eomgen's step).\"\"\"\n    return float(x >= 0)\n\n\n",
         );
         let names = |v: Vec<String>| {
             v.iter()
