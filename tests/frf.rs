@@ -919,7 +919,7 @@ fn state_space_of_a_base_motion_carries_its_rate() {
     assert!(ss.input_rates);
     let (mass, k, c) = (1.0, 1.0, 0.4);
     assert!((ss.d[(1, 0)] - c / mass).abs() <= 1e-15, "D = {}", ss.d);
-    for w in [0.2, 1.0, 1.4142135623730951, 3.0] {
+    for w in [0.2, 1.0, std::f64::consts::SQRT_2, 3.0] {
         let i_w = Complex::new(0.0, w);
         let resolvent = DMatrix::<Complex<f64>>::identity(2, 2) * i_w - ss.a.map(Complex::from);
         let state = resolvent.lu().solve(&ss.b.map(Complex::from)).unwrap();

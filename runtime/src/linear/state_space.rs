@@ -104,11 +104,7 @@ pub fn state_space(
             .collect::<Result<_, FrfError>>()?
     };
     // The rate columns are read as `frf` reads them by default: with the model's `w`.
-    let has_w = model
-        .description()
-        .parameter_names()
-        .iter()
-        .any(|p| *p == "w");
+    let has_w = model.description().parameter_names().contains(&"w");
     let forced = if has_w {
         linearize_with_input_rates(model, guess, inputs, "w")?
     } else {
