@@ -1463,3 +1463,47 @@ fn issue_28_a_trailing_slash_is_refused_and_dash_is_standard_output() {
     let written: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();
     assert!(written.is_empty(), "wrote {written:?}");
 }
+
+/// `simulate --plot` draws one panel per coordinate, each on its own scale, and
+/// `--plot-coordinates` chooses coordinates and rates in order (issue 53: a spin of hundreds
+/// of radians no longer flattens a nutation); an unknown name is a usage error before any
+/// file is written.
+#[test]
+fn time_charts_have_a_panel_per_coordinate_and_draw_what_is_asked() {
+    let dir = tempfile::tempdir().unwrap();
+    let svg = dir.path().join("top.svg").to_string_lossy().to_string();
+    let labels = |file: &str| {
+        let text = std::fs::read_to_string(file).unwrap();
+        ["phi", "theta", "psi", "psi_dot"]
+            .into_iter()
+            .filter(|name| text.contains(&format!(">\n{name}\n</text>")))
+            .collect::<Vec<_>>()
+    };
+    let out = run(&["simulate", "heavy_top", "--t-end", "0.5", "--plot", &svg]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert_eq!(labels(&svg), ["phi", "theta", "psi"]);
+    let out = run(&[
+        "simulate",
+        "heavy_top",
+        "--t-end",
+        "0.5",
+        "--plot",
+        &svg,
+        "--plot-coordinates",
+        "theta,psi_dot",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert_eq!(labels(&svg), ["theta", "psi_dot"]);
+    let other = dir.path().join("other.svg").to_string_lossy().to_string();
+    let bad = run(&[
+        "simulate",
+        "heavy_top",
+        "--plot",
+        &other,
+        "--plot-coordinates",
+        "nope",
+    ]);
+    assert_eq!(bad.status.code(), Some(2));
+    assert!(stderr(&bad).contains("`nope` is neither a coordinate nor a rate"));
+    assert!(!std::path::Path::new(&other).exists());
+}

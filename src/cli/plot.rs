@@ -90,8 +90,11 @@ impl<'a> Chart<'a> {
     }
 }
 
-/// Plots every coordinate against time, one line each, into `path` (`.svg` or `.png`), with
-/// `note` (why the run is incomplete, if it is) drawn in red above the chart.
+/// Plots the coordinates and rates `shown` against time into `path` (`.svg` or `.png`), one
+/// panel each with its own scale (a spin of hundreds of radians beside a nutation of
+/// hundredths), stacked over a shared time axis, with `note` (why the run is incomplete, if
+/// it is) drawn in red above them. `shown` names components of the state `[q; q̇]` by their
+/// index, empty for every coordinate.
 ///
 /// # Errors
 /// An unknown extension, an empty solution, or a failure to write the file.
@@ -99,18 +102,81 @@ pub fn time_histories(
     path: &str,
     model: &dyn ModelInfo,
     solution: &Solution,
+    shown: &[usize],
     note: Option<&str>,
 ) -> Result<(), String> {
-    let title = format!("{}: coordinates against time", model.description().name);
-    per_coordinate(
+    if solution.is_empty() {
+        return Err("nothing to plot: the solution has no samples".to_string());
+    }
+    let names = model.description().coordinate_names();
+    let n = names.len();
+    let label = |i: usize| match i < n {
+        true => names[i].to_string(),
+        false => format!("{}_dot", names[i - n]),
+    };
+    let indices: Vec<usize> = match shown.is_empty() {
+        true => (0..n).collect(),
+        false => shown.to_vec(),
+    };
+    let panels: Vec<Series> = indices
+        .iter()
+        .map(|&i| Series {
+            name: label(i),
+            points: solution.iter().map(|(t, y)| (t, y[i])).collect(),
+        })
+        .collect();
+    let title = format!("{}: against time", model.description().name);
+    let height = (60 + 170 * panels.len()).max(600) as u32;
+    write_chart(
         path,
-        &Chart::linear(&title, "t (s)", "q (m or rad)"),
-        model,
-        solution,
-        |name| name.to_string(),
-        |t, y, i, _| (t, y[i]),
-        note,
+        (960, height),
+        &Panels {
+            title: &title,
+            panels: &panels,
+            note,
+        },
     )
+}
+
+/// The stacked panels of [`time_histories`]: one series each, over `t`.
+struct Panels<'a> {
+    title: &'a str,
+    panels: &'a [Series],
+    note: Option<&'a str>,
+}
+
+impl Drawing for Panels<'_> {
+    fn draw<DB: DrawingBackend>(&self, root: DrawingArea<DB, Shift>) -> Result<(), String>
+    where
+        DB::ErrorType: 'static,
+    {
+        let err = |e: DrawingAreaErrorKind<DB::ErrorType>| format!("plotting failed: {e}");
+        root.fill(&WHITE).map_err(err)?;
+        // The note above everything, in its own band, as on the other charts.
+        let root = match self.note {
+            Some(note) => {
+                root.draw(&Text::new(
+                    note.to_string(),
+                    (12, 6),
+                    ("sans-serif", 16).into_font().color(&RED),
+                ))
+                .map_err(err)?;
+                root.margin(24, 0, 0, 0)
+            }
+            None => root,
+        };
+        let titled = root.titled(self.title, ("sans-serif", 22)).map_err(err)?;
+        for (area, series) in titled
+            .split_evenly((self.panels.len(), 1))
+            .iter()
+            .zip(self.panels)
+        {
+            let chart = Chart::linear("", "t (s)", &series.name);
+            draw_on(area, &chart, std::slice::from_ref(series), None)?;
+        }
+        root.present().map_err(err)?;
+        Ok(())
+    }
 }
 
 /// Draws one line per coordinate `i` of `model` into `path`: its name `name(coordinate)`,
@@ -406,6 +472,24 @@ where
 {
     let err = |e: DrawingAreaErrorKind<DB::ErrorType>| format!("plotting failed: {e}");
     root.fill(&WHITE).map_err(err)?;
+    draw_on(&root, chart, series, note)?;
+    root.present().map_err(err)?;
+    Ok(())
+}
+
+/// [`draw`] on a part of a picture, which the caller fills and presents (a panel of
+/// [`time_histories`]); a chart with an empty title has no caption.
+fn draw_on<DB: DrawingBackend>(
+    root: &DrawingArea<DB, plotters::coord::Shift>,
+    chart: &Chart<'_>,
+    series: &[Series],
+    note: Option<&str>,
+) -> Result<(), String>
+where
+    DB::ErrorType: 'static,
+{
+    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| format!("plotting failed: {e}");
+    let root = root.clone();
     // The note goes above the chart, in its own band, so no line can hide it.
     let root = match note {
         Some(note) => {
@@ -446,8 +530,10 @@ where
     };
     let (y0, y1) = range(y_lo, y_hi, chart.log_y);
     let mut builder = ChartBuilder::on(&root);
+    if !chart.title.is_empty() {
+        builder.caption(chart.title, ("sans-serif", 22));
+    }
     builder
-        .caption(chart.title, ("sans-serif", 22))
         .margin(12)
         .x_label_area_size(45)
         .y_label_area_size(90);
@@ -489,7 +575,6 @@ where
             finish!(builder.build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale()))
         }
     }
-    root.present().map_err(err)?;
     Ok(())
 }
 

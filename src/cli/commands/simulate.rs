@@ -41,10 +41,14 @@ pub struct SimulateArgs {
     /// and drift of a constrained model, then the model's `outputs:`).
     #[arg(long, value_name = "FILE")]
     pub csv: Option<String>,
-    /// Plot the coordinates against time (.svg or .png); a constrained model also gets its
-    /// constraint drift in `FILE-drift.svg`.
+    /// Plot the coordinates against time (.svg or .png), one panel each with its own scale;
+    /// a constrained model also gets its constraint drift in `FILE-drift.svg`.
     #[arg(long, value_name = "FILE")]
     pub plot: Option<String>,
+    /// What --plot draws, one panel each: coordinates and rates (`theta,phi_dot`), in this
+    /// order (default: every coordinate).
+    #[arg(long, value_name = "NAMES", requires = "plot")]
+    pub plot_coordinates: Option<String>,
     /// Plot the phase portrait, each rate against its coordinate (.svg or .png).
     #[arg(long, value_name = "FILE")]
     pub plot_phase: Option<String>,
@@ -178,6 +182,37 @@ fn output_times(t_out: &[String]) -> Result<OutputTimes, CliError> {
     })
 }
 
+/// The components of the state `[q; q̇]` that `--plot-coordinates` names (`theta`,
+/// `phi_dot`), by index; empty without it (every coordinate).
+///
+/// # Errors
+/// A usage error naming a name that is neither a coordinate nor a rate.
+fn shown_components(model: &dyn ModelInfo, names: Option<&str>) -> Result<Vec<usize>, CliError> {
+    let Some(names) = names else {
+        return Ok(Vec::new());
+    };
+    let coordinates = model.description().coordinate_names();
+    let n = coordinates.len();
+    names
+        .split(',')
+        .map(str::trim)
+        .map(|name| {
+            let rate = name.strip_suffix("_dot");
+            coordinates
+                .iter()
+                .position(|c| *c == name)
+                .or_else(|| rate.and_then(|r| coordinates.iter().position(|c| *c == r)).map(|i| n + i))
+                .ok_or_else(|| {
+                    CliError::usage(format!(
+                        "--plot-coordinates: `{name}` is neither a coordinate nor a rate of `{}` (coordinates: {})",
+                        model.description().name,
+                        coordinates.join(", ")
+                    ))
+                })
+        })
+        .collect()
+}
+
 /// Writes the files the options ask for (`--csv` and its events file, the charts and the
 /// drift chart beside `--plot`), each noting `incomplete` when the run stopped early; a
 /// companion this run has nothing for is removed when an earlier run of eomgen wrote it.
@@ -198,6 +233,7 @@ fn write_files(
         constraints,
         ..
     } = simulation;
+    let shown = shown_components(model, args.plot_coordinates.as_deref())?;
     if let Some(path) = &args.csv {
         write_csv(
             path,
@@ -219,7 +255,8 @@ fn write_files(
         }
     }
     if let Some(path) = &args.plot {
-        plot::time_histories(path, model, solution, incomplete).map_err(CliError::failure)?;
+        plot::time_histories(path, model, solution, &shown, incomplete)
+            .map_err(CliError::failure)?;
     }
     if let Some(drift_path) = drift_chart {
         if constraints.is_empty() {
