@@ -442,6 +442,20 @@ pub(super) fn tick(v: f64, log: bool) -> String {
     }
 }
 
+/// The offset a linear axis `[y0, y1]` labels its ticks from, where its span is below 1e-4
+/// of its values (a nutation of 1e-7 rad about 0.5236 rad, whose ticks four decimals would
+/// print alike): the middle of the axis to the digits the span leaves, shown in the axis's
+/// description (`theta − 0.52359878`) while the ticks read the differences (`+1.0e-7`).
+pub(super) fn tick_offset(y0: f64, y1: f64, log: bool) -> Option<f64> {
+    let (span, middle) = (y1 - y0, 0.5 * (y0 + y1));
+    if log || span.is_nan() || span <= 0.0 || !middle.is_finite() || span >= 1e-4 * middle.abs() {
+        return None;
+    }
+    let decimals = (-(span / 10.0).log10()).ceil().clamp(0.0, 15.0) as i32;
+    let scale = 10f64.powi(decimals);
+    Some((middle * scale).round() / scale)
+}
+
 /// `[lo, hi]` padded by 5 % (or a factor for log axes), with a unit range for a constant.
 pub(super) fn range(lo: f64, hi: f64, log: bool) -> (f64, f64) {
     if log {
@@ -529,6 +543,11 @@ where
         (x_lo, x_lo + 1.0)
     };
     let (y0, y1) = range(y_lo, y_hi, chart.log_y);
+    let y_offset = tick_offset(y0, y1, chart.log_y);
+    let y_desc = match y_offset {
+        Some(offset) => format!("{} − {offset}", chart.y_desc),
+        None => chart.y_desc.to_string(),
+    };
     let mut builder = ChartBuilder::on(&root);
     if !chart.title.is_empty() {
         builder.caption(chart.title, ("sans-serif", 22));
@@ -543,9 +562,12 @@ where
             let (log_x, log_y) = (chart.log_x, chart.log_y);
             ctx.configure_mesh()
                 .x_desc(chart.x_desc)
-                .y_desc(chart.y_desc)
+                .y_desc(y_desc.as_str())
                 .x_label_formatter(&|v| tick(*v, log_x))
-                .y_label_formatter(&|v| tick(*v, log_y))
+                .y_label_formatter(&|v| match y_offset {
+                    Some(offset) => format!("{:+.2e}", *v - offset),
+                    None => tick(*v, log_y),
+                })
                 .label_style(("sans-serif", 14))
                 .draw()
                 .map_err(err)?;
@@ -769,6 +791,20 @@ pub fn constraint_drift(
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn a_narrow_axis_labels_its_ticks_from_an_offset() {
+        use super::tick_offset;
+        // A nutation of 2e-7 rad about 0.5236 rad: an offset to 8 decimals.
+        let offset = tick_offset(0.5235986, 0.5235988, false).unwrap();
+        assert!((offset - 0.5235987).abs() < 1e-12, "{offset}");
+        // An axis wide beside its values, a log axis or a constant has none.
+        assert_eq!(tick_offset(0.2, 0.4, false), None);
+        assert_eq!(tick_offset(1e-9, 1e-8, true), None);
+        assert_eq!(tick_offset(0.5, 0.5, false), None);
+        // Around zero there is nothing to take off.
+        assert_eq!(tick_offset(-1e-9, 1e-9, false), None);
+    }
+
     use super::*;
 
     /// A PNG written here carries the software chunk where [`is_own_png`] looks for it and
