@@ -794,9 +794,9 @@ mod tests {
     #[test]
     fn a_narrow_axis_labels_its_ticks_from_an_offset() {
         use super::tick_offset;
-        // A nutation of 2e-7 rad about 0.5236 rad: an offset to 8 decimals.
-        let offset = tick_offset(0.5235986, 0.5235988, false).unwrap();
-        assert!((offset - 0.5235987).abs() < 1e-12, "{offset}");
+        // A nutation of 2e-7 rad about 0.7236 rad: an offset to 8 decimals.
+        let offset = tick_offset(0.7235986, 0.7235988, false).unwrap();
+        assert!((offset - 0.7235987).abs() < 1e-12, "{offset}");
         // An axis wide beside its values, a log axis or a constant has none.
         assert_eq!(tick_offset(0.2, 0.4, false), None);
         assert_eq!(tick_offset(1e-9, 1e-8, true), None);
