@@ -1317,3 +1317,49 @@ fn named(name: &str) -> eomgen::analysis::vibration::OperatingPointOptions {
         ..Default::default()
     }
 }
+
+/// A rotation about an oblique axis (`axis: [0, 0.6, 0.8]`, issue 53): a pendulum hinged
+/// about an axis at `a` from the vertical (`cos a = 0.8`) swings under `g sin a`, so
+/// `ω = √(0.6 g / L)` (`tests/fixtures/oblique_hinge_pendulum.yaml`), to 1e-12; both
+/// derivations agree (`check`), and an axis of two components is a located model-file error.
+#[test]
+fn an_oblique_hinge_axis_gives_the_tilted_pendulums_frequency() {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/fixtures/oblique_hinge_pendulum.yaml"
+    );
+    let m = eomgen::DynFirstOrder::new(eomgen::JitModel::load(path).unwrap());
+    let q = find_equilibrium(&m, &[0.1], 0.0).unwrap().q;
+    assert!(q[0].abs() < 1e-12, "{q:?}");
+    let lin = linearize(&m, &q, &[0.0], 0.0).unwrap();
+    let w = normal_modes(&lin).unwrap().natural_frequencies[0];
+    let expected = (0.6 * 9.81_f64 / 0.5).sqrt();
+    assert!(
+        (w - expected).abs() <= 1e-12 * expected,
+        "{w} vs {expected}"
+    );
+    eomgen_ok(&["check", path]);
+    let dir = tempfile::tempdir().unwrap();
+    let bad = dir.path().join("bad.yaml");
+    let text = std::fs::read_to_string(path).unwrap();
+    std::fs::write(
+        &bad,
+        text.replace("axis: [0, 0.6, 0.8]", "axis: [0.6, 0.8]"),
+    )
+    .unwrap();
+    let out = eomgen(&["check", bad.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2));
+    let message = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        message.contains("bad.yaml:15:25:") && message.contains("3 components"),
+        "{message}"
+    );
+    std::fs::write(&bad, text.replace("axis: [0, 0.6, 0.8]", "axis: [0, 0, 0]")).unwrap();
+    let out = eomgen(&["check", bad.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2));
+    let message = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        message.contains("bad.yaml:15:25:") && message.contains("zero vector"),
+        "{message}"
+    );
+}

@@ -24,6 +24,21 @@ use crate::expr::{ExprArena, ExprId};
 /// A 3-vector of expressions: components along the axes of some frame.
 pub type Vector3 = [ExprId; 3];
 
+/// The axis of a simple rotation, fixed in the frames before and after it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RotationAxis {
+    /// The frame's own axis `0`, `1` or `2` (x, y, z).
+    Principal(usize),
+    /// An oblique axis: its unit vector's components (constants), the same in both frames.
+    Unit(Vector3),
+}
+
+impl From<usize> for RotationAxis {
+    fn from(axis: usize) -> Self {
+        RotationAxis::Principal(axis)
+    }
+}
+
 /// The frames of a model: index 0 is the ground frame `N`, the others follow in file order.
 #[derive(Debug, Clone, Default)]
 pub struct Frames {
@@ -32,7 +47,7 @@ pub struct Frames {
     /// Parent of each frame (index); the ground's is itself.
     parents: Vec<usize>,
     /// Each frame's rotations from its parent, in the order they are applied: `(axis, angle)`.
-    rotations: Vec<Vec<(usize, ExprId)>>,
+    rotations: Vec<Vec<(RotationAxis, ExprId)>>,
 }
 
 impl Frames {
@@ -45,12 +60,18 @@ impl Frames {
         }
     }
 
-    /// Adds frame `name`, turned from `parent` (an index) by `rotations` (axis index 0–2 and
-    /// angle, in the order applied); returns its index.
-    pub fn add(&mut self, name: &str, parent: usize, rotations: Vec<(usize, ExprId)>) -> usize {
+    /// Adds frame `name`, turned from `parent` (an index) by `rotations` (an axis, its index
+    /// 0–2 or an oblique unit vector, and an angle, in the order applied); returns its index.
+    pub fn add<A: Into<RotationAxis>>(
+        &mut self,
+        name: &str,
+        parent: usize,
+        rotations: Vec<(A, ExprId)>,
+    ) -> usize {
         self.names.push(name.to_string());
         self.parents.push(parent);
-        self.rotations.push(rotations);
+        self.rotations
+            .push(rotations.into_iter().map(|(a, e)| (a.into(), e)).collect());
         self.names.len() - 1
     }
 
@@ -101,7 +122,15 @@ impl Frames {
             for &(axis, angle) in &self.rotations[f] {
                 w = rotate(arena, w, axis, angle, true);
                 let rate = arena.time_derivative(angle);
-                w[axis] = arena.plus(w[axis], rate);
+                match axis {
+                    RotationAxis::Principal(i) => w[i] = arena.plus(w[i], rate),
+                    RotationAxis::Unit(k) => {
+                        for (wi, ki) in w.iter_mut().zip(k) {
+                            let part = arena.times(ki, rate);
+                            *wi = arena.plus(*wi, part);
+                        }
+                    }
+                }
             }
         }
         w
@@ -113,10 +142,14 @@ impl Frames {
 fn rotate(
     arena: &mut ExprArena,
     v: Vector3,
-    axis: usize,
+    axis: RotationAxis,
     angle: ExprId,
     into_turned: bool,
 ) -> Vector3 {
+    let axis = match axis {
+        RotationAxis::Principal(i) => i,
+        RotationAxis::Unit(k) => return rotate_oblique(arena, v, k, angle, into_turned),
+    };
     let (j, k) = ((axis + 1) % 3, (axis + 2) % 3);
     if arena.is_zero(v[j]) && arena.is_zero(v[k]) {
         return v;
@@ -132,6 +165,34 @@ fn rotate(
     let mut out = v;
     out[j] = arena.minus(cj, sk);
     out[k] = arena.plus(sj, ck);
+    out
+}
+
+/// [`rotate`] about the unit vector `k` by Rodrigues' formula (Kane & Levinson §1.2):
+/// `v′ = cos a v + sin a (k × v) + (1 − cos a)(k · v) k` back into the frame before the
+/// rotation, with `−sin a` into the turned frame.
+fn rotate_oblique(
+    arena: &mut ExprArena,
+    v: Vector3,
+    k: Vector3,
+    angle: ExprId,
+    into_turned: bool,
+) -> Vector3 {
+    let (c, s) = (arena.cos(angle), arena.sin(angle));
+    let s = if into_turned { arena.neg(s) } else { s };
+    let kxv = cross(arena, &k, &v);
+    let products: Vec<ExprId> = k.iter().zip(&v).map(|(a, b)| arena.times(*a, *b)).collect();
+    let kv = arena.sum(&products);
+    let one = arena.int(1);
+    let versine = arena.minus(one, c);
+    let along = arena.times(versine, kv);
+    let mut out = v;
+    for i in 0..3 {
+        let cv = arena.times(c, v[i]);
+        let sk = arena.times(s, kxv[i]);
+        let ak = arena.times(along, k[i]);
+        out[i] = arena.sum(&[cv, sk, ak]);
+    }
     out
 }
 
@@ -173,6 +234,65 @@ mod tests {
             bindings[s[1].0 as usize] = rates[i];
         }
         v.map(|e| arena.eval(e, &bindings))
+    }
+
+    /// A rotation by `a` about the oblique unit axis `k = (0, sin b, cos b)` is the z rotation
+    /// conjugated by an x rotation, `R_x(−b) R_z(a) R_x(b)`: carried to the ground, a vector
+    /// and the angular velocity agree with that chain of three principal rotations to
+    /// rounding, and the angular velocity is `ȧ k` in the ground's components.
+    #[test]
+    fn an_oblique_axis_is_a_conjugated_principal_rotation() {
+        let mut arena = ExprArena::new();
+        let [a, _, _] = arena.coordinate("a");
+        let (sb, cb) = (0.6, 0.8);
+        let b = f64::atan2(sb, cb);
+        let k = [arena.float(0.0), arena.float(sb), arena.float(cb)];
+        let (minus_b, plus_b) = (arena.float(-b), arena.float(b));
+        let mut frames = Frames::ground("N");
+        let oblique = frames.add("B", 0, vec![(RotationAxis::Unit(k), a)]);
+        let chain = frames.add(
+            "C",
+            0,
+            vec![
+                (RotationAxis::Principal(0), minus_b),
+                (RotationAxis::Principal(2), a),
+                (RotationAxis::Principal(0), plus_b),
+            ],
+        );
+        let v = [arena.float(0.3), arena.float(-1.2), arena.float(0.7)];
+        let (from_oblique, from_chain) = (
+            frames.express(&mut arena, v, oblique, 0),
+            frames.express(&mut arena, v, chain, 0),
+        );
+        let w = frames.angular_velocity(&mut arena, oblique);
+        let w_ground = frames.express(&mut arena, w, oblique, 0);
+        let w_chain = frames.angular_velocity(&mut arena, chain);
+        let w_chain_ground = frames.express(&mut arena, w_chain, chain, 0);
+        for (q, r) in [(0.4, 1.7), (-2.1, -0.3)] {
+            let (x, y) = (
+                numbers(&arena, &from_oblique, &[q], &[r]),
+                numbers(&arena, &from_chain, &[q], &[r]),
+            );
+            let (wo, wc) = (
+                numbers(&arena, &w_ground, &[q], &[r]),
+                numbers(&arena, &w_chain_ground, &[q], &[r]),
+            );
+            for i in 0..3 {
+                assert!((x[i] - y[i]).abs() < 1e-14, "{x:?} {y:?}");
+                assert!((wo[i] - wc[i]).abs() < 1e-14, "{wo:?} {wc:?}");
+            }
+            let expected = [0.0, sb * r, cb * r];
+            for i in 0..3 {
+                assert!((wo[i] - expected[i]).abs() < 1e-15, "{wo:?}");
+            }
+            // The axis is fixed: carried up it is unchanged.
+            let kk = frames.express(&mut arena, k, oblique, 0);
+            let kn = numbers(&arena, &kk, &[q], &[r]);
+            assert!(
+                (kn[1] - sb).abs() < 1e-15 && (kn[2] - cb).abs() < 1e-15,
+                "{kn:?}"
+            );
+        }
     }
 
     /// A z-x-z (Euler angle) chain: the angular velocity in the body's components is the

@@ -16,6 +16,7 @@
 
 use super::{Axis, Depends, GROUND_FRAME, Lower, Rules, Units};
 use crate::expr::ExprId;
+use crate::mechanics::frames::RotationAxis;
 use crate::model::ast::Expr;
 use crate::model::diagnostic::Diagnostic;
 use crate::model::located::Located;
@@ -23,7 +24,7 @@ use crate::model::schema::entries::get;
 use crate::model::schema::walk::{Ctx, Fields, Keyed, Need};
 use crate::model::schema::write::{NotRewritten, Writer, flow, list};
 use crate::model::units::Dimension;
-use crate::model::yaml::YamlNode;
+use crate::model::yaml::{YamlKind, YamlNode};
 
 /// The key of the section.
 pub(crate) const KEY: &str = "frames";
@@ -32,10 +33,14 @@ pub(crate) const KEY: &str = "frames";
 /// rule) about `axis`, an axis fixed in both.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SimpleRotation {
-    /// The axis.
+    /// The axis (for a rotation about `direction`, where it is written).
     pub axis: Located<Axis>,
     /// The angle (rad), an expression of the parameters, coordinates and `t`.
     pub angle: Expr,
+    /// An oblique axis, `axis: [a, b, c]`: the components, in the frame before the rotation
+    /// (and after: the axis is fixed in both), of a constant vector the rotation turns about
+    /// (normalised where lowered; any length but zero). `None` for `x`, `y` or `z`.
+    pub direction: Option<[Expr; 3]>,
 }
 
 /// A reference frame: its parent turned by successive simple rotations (Kane & Levinson,
@@ -115,7 +120,15 @@ fn read_frame(cx: &mut Ctx<'_>, k: &Located<String>, v: &YamlNode) -> Option<Fra
     if !cx.require(f, k.location, &what, &[axes_key, angles_key], &example) {
         return None;
     }
-    let axes = cx.axes(get(f, axes_key)?, single)?;
+    // `axis: [a, b, c]`: one rotation about an oblique axis, its components constants.
+    let oblique = match (&get(f, axes_key)?.kind, single) {
+        (YamlKind::Seq(items), true) => Some(oblique_axis(cx, get(f, axes_key)?, items)?),
+        _ => None,
+    };
+    let axes = match oblique {
+        Some(_) => vec![Located::new(Axis::Z, get(f, axes_key)?.location)],
+        None => cx.axes(get(f, axes_key)?, single)?,
+    };
     let angles: Vec<Expr> = if single {
         vec![cx.expr(get(f, "angle")?, "a rotation angle")?]
     } else {
@@ -144,7 +157,11 @@ fn read_frame(cx: &mut Ctx<'_>, k: &Located<String>, v: &YamlNode) -> Option<Fra
     let mut rotations: Vec<SimpleRotation> = axes
         .into_iter()
         .zip(angles)
-        .map(|(axis, angle)| SimpleRotation { axis, angle })
+        .map(|(axis, angle)| SimpleRotation {
+            axis,
+            angle,
+            direction: oblique.clone(),
+        })
         .collect();
     // Rotations about the parent's fixed axes in the order a, b, c give the orientation of
     // rotations about the newest frame's axes in the order c, b, a.
@@ -156,6 +173,30 @@ fn read_frame(cx: &mut Ctx<'_>, k: &Located<String>, v: &YamlNode) -> Option<Fra
         parent,
         rotations,
     })
+}
+
+/// The components `[a, b, c]` of an oblique axis (`axis: [0, 0.6, 0.8]`): three expressions of
+/// the parameters.
+fn oblique_axis(cx: &mut Ctx<'_>, node: &YamlNode, items: &[YamlNode]) -> Option<[Expr; 3]> {
+    if items.len() != 3 {
+        cx.error(
+            Diagnostic::new(
+                node.location,
+                format!(
+                    "an oblique `axis` has 3 components (in the parent frame), found {}",
+                    items.len()
+                ),
+            )
+            .with_help("write `axis: [0, 0.6, 0.8]`, or `axis: z` for a frame's own axis"),
+        );
+        return None;
+    }
+    let parts: Vec<Option<Expr>> = items
+        .iter()
+        .map(|i| cx.expr(i, "a component of a rotation axis"))
+        .collect();
+    let parts: Vec<Expr> = parts.into_iter().collect::<Option<_>>()?;
+    parts.try_into().ok()
 }
 
 /// `frames:`, each as its successive rotations about the newest frame's axes (a frame written
@@ -180,11 +221,21 @@ fn frame_text(w: &mut Writer<'_>, frame: &Frame) -> Result<String, NotRewritten>
         .iter()
         .map(|r| w.expr(&r.angle, &place))
         .collect::<Result<Vec<_>, _>>()?;
-    let axes: String = frame
-        .rotations
-        .iter()
-        .map(|r| r.axis.value.letter())
-        .collect();
+    let axes: String = match frame.rotations.as_slice() {
+        [
+            SimpleRotation {
+                direction: Some(parts),
+                ..
+            },
+        ] => {
+            let parts = parts
+                .iter()
+                .map(|p| w.expr(p, &place))
+                .collect::<Result<Vec<_>, _>>()?;
+            list(&parts)
+        }
+        rotations => rotations.iter().map(|r| r.axis.value.letter()).collect(),
+    };
     Ok(match angles.as_slice() {
         [angle] => format!(
             "{{ parent: {}, axis: {axes}, angle: {} }}",
@@ -257,11 +308,23 @@ fn angles(frames: &[Frame]) -> impl Iterator<Item = (&str, &Expr)> {
         .flat_map(|f| (f.rotations.iter()).map(move |r| (f.name.value.as_str(), &r.angle)))
 }
 
-/// The rotation angles are functions of the configuration (no rates).
+/// The rotation angles are functions of the configuration (no rates); an oblique axis's
+/// components are constants.
 pub(crate) fn angle_rules(frames: &[Frame], cx: &mut dyn Rules) {
     for (frame, angle) in angles(frames) {
         let what = format!("the rotation of frame `{frame}`");
         cx.expression(angle, Depends::Position, &what);
+    }
+    for f in frames {
+        for part in f
+            .rotations
+            .iter()
+            .filter_map(|r| r.direction.as_ref())
+            .flatten()
+        {
+            let what = format!("the rotation axis of frame `{}`", f.name.value);
+            cx.expression(part, Depends::Constant, &what);
+        }
     }
 }
 
@@ -279,12 +342,39 @@ pub(crate) fn units(frames: &[Frame], cx: &mut dyn Units) {
     }
 }
 
-/// The frame's rotations as the kinematics engine takes them: per rotation, the axis's index
-/// (0, 1, 2 for x, y, z) and the angle lowered (rad).
-pub(crate) fn lower(f: &Frame, cx: &mut dyn Lower) -> Vec<(usize, ExprId)> {
+/// The frame's rotations as the kinematics engine takes them: per rotation, the axis (its
+/// index 0, 1, 2 for x, y, z, or an oblique axis's unit vector, its components divided by
+/// their norm) and the angle lowered (rad).
+pub(crate) fn lower(f: &Frame, cx: &mut dyn Lower) -> Vec<(RotationAxis, ExprId)> {
     f.rotations
         .iter()
-        .map(|r| (r.axis.value.index(), cx.expr(&r.angle)))
+        .map(|r| {
+            let axis = match &r.direction {
+                None => RotationAxis::Principal(r.axis.value.index()),
+                Some(parts) => {
+                    let v = parts.clone().map(|p| cx.expr(&p));
+                    let arena = cx.arena();
+                    let squares: Vec<ExprId> = v.iter().map(|&c| arena.times(c, c)).collect();
+                    let sum = arena.sum(&squares);
+                    if arena.is_zero(sum) {
+                        cx.error(
+                            Diagnostic::new(
+                                r.axis.location,
+                                format!(
+                                    "the rotation axis of frame `{}` is the zero vector",
+                                    f.name.value
+                                ),
+                            )
+                            .with_help("give the axis a direction, as in `axis: [0, 0.6, 0.8]`"),
+                        );
+                    }
+                    let arena = cx.arena();
+                    let norm = arena.sqrt(sum);
+                    RotationAxis::Unit(v.map(|c| arena.divide(c, norm)))
+                }
+            };
+            (axis, cx.expr(&r.angle))
+        })
         .collect()
 }
 
