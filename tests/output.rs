@@ -1506,4 +1506,31 @@ fn time_charts_have_a_panel_per_coordinate_and_draw_what_is_asked() {
     assert_eq!(bad.status.code(), Some(2));
     assert!(stderr(&bad).contains("`nope` is neither a coordinate nor a rate"));
     assert!(!std::path::Path::new(&other).exists());
+    // A 20-mass chain: the first 12 coordinates, and a warning that says so.
+    let chain = dir.path().join("chain.yaml");
+    let text = run(&["new", "n-mass-chain", "20"]);
+    std::fs::write(&chain, &text.stdout).unwrap();
+    let chain = chain.to_string_lossy().to_string();
+    let out = run(&["simulate", &chain, "--t-end", "0.1", "--plot", &svg]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("the first 12 of the 20 coordinates"),
+        "{}",
+        stderr(&out)
+    );
+    let many: Vec<String> = (1..=13).map(|i| format!("x{i}")).collect();
+    let bad = run(&[
+        "simulate",
+        &chain,
+        "--plot",
+        &other,
+        "--plot-coordinates",
+        &many.join(","),
+    ]);
+    assert_eq!(bad.status.code(), Some(2));
+    assert!(
+        stderr(&bad).contains("at most 12 panels"),
+        "{}",
+        stderr(&bad)
+    );
 }

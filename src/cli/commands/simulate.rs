@@ -182,17 +182,34 @@ fn output_times(t_out: &[String]) -> Result<OutputTimes, CliError> {
     })
 }
 
+/// The most panels of a `--plot` chart: the first coordinates by default (a warning says
+/// so), the most `--plot-coordinates` may name. Twelve panels of 170 px make a chart of
+/// about 2,100 px.
+const MAX_PANELS: usize = 12;
+
 /// The components of the state `[q; q̇]` that `--plot-coordinates` names (`theta`,
-/// `phi_dot`), by index; empty without it (every coordinate).
+/// `phi_dot`), by index; empty without it (every coordinate, or the first [`MAX_PANELS`]).
 ///
 /// # Errors
 /// A usage error naming a name that is neither a coordinate nor a rate.
 fn shown_components(model: &dyn ModelInfo, names: Option<&str>) -> Result<Vec<usize>, CliError> {
-    let Some(names) = names else {
-        return Ok(Vec::new());
-    };
     let coordinates = model.description().coordinate_names();
     let n = coordinates.len();
+    let Some(names) = names else {
+        if n > MAX_PANELS {
+            output::errln!(
+                "warning: --plot draws the first {MAX_PANELS} of the {n} coordinates, one panel each; --plot-coordinates names the ones to draw"
+            );
+            return Ok((0..MAX_PANELS).collect());
+        }
+        return Ok(Vec::new());
+    };
+    let count = names.split(',').count();
+    if count > MAX_PANELS {
+        return Err(CliError::usage(format!(
+            "--plot-coordinates names {count} coordinates and rates; a chart has at most {MAX_PANELS} panels (draw the others in a second chart)"
+        )));
+    }
     names
         .split(',')
         .map(str::trim)
