@@ -153,9 +153,24 @@ pub fn equations(
 /// # References
 /// Lectures 8–11 (`M q̈ = F`, and the index-1 system of a constrained model).
 pub fn export(path: &str, text: &str, language: Language) -> Result<String, ListingError> {
+    export_with_parameters(path, text, language, &[])
+}
+
+/// [`export`] with the parameters `values` names set to those values in the exported
+/// defaults (the file's values otherwise): what a model whose parameters were set after
+/// loading exports (the Python package's `Model.with_parameters(...).export(...)`).
+///
+/// # Errors
+/// As [`export`]; [`ListingError::Export`] for a name that is not a parameter.
+pub fn export_with_parameters(
+    path: &str,
+    text: &str,
+    language: Language,
+    values: &[(String, f64)],
+) -> Result<String, ListingError> {
     use eomgen_symbolic::codegen::GenerateError;
     let file = eomgen_symbolic::model::load(path, text).map_err(ListingError::Diagnostics)?;
-    eomgen_symbolic::codegen::export::export(&file, path, language).map_err(|e| match e {
+    eomgen_symbolic::codegen::export::export(&file, path, language, values).map_err(|e| match e {
         GenerateError::Diagnostics(d) => ListingError::Diagnostics(d),
         GenerateError::Emit(reason) => ListingError::Export { reason },
     })

@@ -769,10 +769,10 @@ impl CoreModel {
     }
 
     /// The equations as source code in `language` (`c`, `matlab` or `python`), as
-    /// `eomgen equations --c` (`--matlab`, `--python`) prints them
-    /// ([`eomgen::listing::export`]).
+    /// `eomgen equations --c` (`--matlab`, `--python`) prints them, with the parameters this
+    /// model has set as the exported defaults ([`eomgen::listing::export_with_parameters`]).
     fn export(&self, py: Python<'_>, language: &str) -> PyResult<String> {
-        use eomgen::listing::{Language, ListingError, export};
+        use eomgen::listing::{Language, ListingError, export_with_parameters};
         let Some(language) = Language::ALL.into_iter().find(|l| l.name() == language) else {
             return Err(pyo3::exceptions::PyValueError::new_err(format!(
                 "language must be `c`, `matlab` or `python`, got `{language}`"
@@ -780,7 +780,8 @@ impl CoreModel {
         };
         let path = self.loaded.source.path().to_string();
         let text = self.loaded.text.clone();
-        let code = py.detach(|| export(&path, &text, language));
+        let overrides = self.overrides.clone();
+        let code = py.detach(|| export_with_parameters(&path, &text, language, &overrides));
         code.map_err(|e| match e {
             ListingError::Diagnostics(d) => model_error(py, &path, &text, &d),
             e => pyo3::exceptions::PyValueError::new_err(e.to_string()),

@@ -57,3 +57,12 @@ def test_export_names_the_languages():
     with pytest.raises(ValueError, match="language must be"):
         model.export("fortran")
 
+
+
+def test_export_carries_the_parameters_set_on_the_model():
+    """``with_parameters(...).export(...)``: the exported defaults are the model's values."""
+    model = eomgen.load("double_pendulum").with_parameters(l1=1.5, g=9.81)
+    code = _module(model)
+    assert dict(zip(code["PARAMETER_NAMES"], code["PARAMETERS"])) == model.parameters
+    y = model.initial_state() + 0.1
+    assert _close(code["rhs"](0.3, y), model.rhs(0.3, y)) <= TOLERANCE

@@ -592,8 +592,9 @@ class Model:
         ``"matlab"`` (a MATLAB/Octave function file, saved as ``NAME.m``) or ``"python"``
         (a NumPy module), as ``eomgen equations --c`` (``--matlab``, ``--python``) prints
         them: ``M`` and ``F``, the right-hand side, the exact Jacobians, ``T``, ``V``, the
-        points and the constraints as functions of ``(t, q, qd, p)``, with the parameters'
-        values from the file. For example, ``namespace = {}; exec(m.export("python"),
+        points and the constraints as functions of ``(t, q, qd, p)``, with this model's
+        parameter values (the file's, or those set by :meth:`with_parameters`) as the
+        defaults. For example, ``namespace = {}; exec(m.export("python"),
         namespace); namespace["rhs"](0.0, namespace["initial_state"]())``."""
         return self._core.export(str(language))
 

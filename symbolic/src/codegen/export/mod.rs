@@ -86,20 +86,35 @@ impl Language {
 
 /// The equations of a loaded model file as source code in `language` (see the module
 /// documentation for the functions and their shapes). `source_display` names the file in
-/// the code's header.
+/// the code's header; `values` replace the file's values of the parameters they name in the
+/// exported defaults (a model whose parameters were set after loading).
 ///
 /// # Errors
 /// [`GenerateError::Diagnostics`] for a model that cannot be derived (as `eomgen::model!`
-/// reports it); [`GenerateError::Emit`] if a function reads an input its exported signature
-/// does not have (a bug of the exporter, named in the message).
+/// reports it); [`GenerateError::Emit`] for a name of `values` that is not a parameter, or
+/// if a function reads an input its exported signature does not have (a bug of the
+/// exporter, named in the message).
 pub fn export(
     file: &ModelFile,
     source_display: &str,
     language: Language,
+    values: &[(String, f64)],
 ) -> Result<String, GenerateError> {
     let (program, derivation) = ModelProgram::from_file(file)?;
     let jacobians = derivation.jacobians();
-    let model = Exported::new(&program, &jacobians, source_display);
+    let mut model = Exported::new(&program, &jacobians, source_display);
+    for (name, value) in values {
+        match model.parameters.iter_mut().find(|(n, _)| n == name) {
+            Some(slot) => slot.1 = *value,
+            None => {
+                let known: Vec<&str> = model.parameters.iter().map(|(n, _)| n.as_str()).collect();
+                return Err(GenerateError::Emit(format!(
+                    "`{name}` is not a parameter of the model (parameters: {})",
+                    known.join(", ")
+                )));
+            }
+        }
+    }
     for function in &model.functions {
         function.check_inputs().map_err(GenerateError::Emit)?;
     }
@@ -748,7 +763,7 @@ mod tests {
     fn out_of_domain_values_and_clashing_names_are_handled() {
         let source = "name: rhs\ncoordinates: [x]\nkinetic: x_dot^2/2\npotential: sqrt(x) + x^1.5 + ln(x) + asin(x) + acos(x) + sign(x)\ninitial: {x: 0.5}\n";
         let file = crate::model::load("rhs.yaml", source).unwrap();
-        let matlab = export(&file, "rhs.yaml", Language::Matlab).unwrap();
+        let matlab = export(&file, "rhs.yaml", Language::Matlab, &[]).unwrap();
         assert!(
             matlab.starts_with("function model = rhs_model()"),
             "{matlab}"
@@ -764,7 +779,7 @@ mod tests {
             matlab.contains("double(q(1) > 0) - double(q(1) < 0)"),
             "{matlab}"
         );
-        let python = export(&file, "rhs.yaml", Language::Python).unwrap();
+        let python = export(&file, "rhs.yaml", Language::Python, &[]).unwrap();
         assert!(python.contains("_sign(q[0])"), "{python}");
     }
 
