@@ -152,19 +152,8 @@ impl Drawing for Panels<'_> {
     {
         let err = |e: DrawingAreaErrorKind<DB::ErrorType>| format!("plotting failed: {e}");
         root.fill(&WHITE).map_err(err)?;
-        // The note above everything, in its own band, as on the other charts.
-        let root = match self.note {
-            Some(note) => {
-                root.draw(&Text::new(
-                    note.to_string(),
-                    (12, 6),
-                    ("sans-serif", 16).into_font().color(&RED),
-                ))
-                .map_err(err)?;
-                root.margin(24, 0, 0, 0)
-            }
-            None => root,
-        };
+        // The note above everything, as on the other charts.
+        let root = note_band(root, self.note)?;
         let titled = root.titled(self.title, ("sans-serif", 22)).map_err(err)?;
         for (area, series) in titled
             .split_evenly((self.panels.len(), 1))
@@ -491,6 +480,27 @@ where
     Ok(())
 }
 
+/// `note` (why a run is incomplete), in red in a band of its own at the top of `root`, so
+/// that no line can hide it; the rest of `root` below it (all of it without a note).
+fn note_band<DB: DrawingBackend>(
+    root: DrawingArea<DB, Shift>,
+    note: Option<&str>,
+) -> Result<DrawingArea<DB, Shift>, String>
+where
+    DB::ErrorType: 'static,
+{
+    let Some(note) = note else {
+        return Ok(root);
+    };
+    root.draw(&Text::new(
+        note.to_string(),
+        (12, 6),
+        ("sans-serif", 16).into_font().color(&RED),
+    ))
+    .map_err(|e| format!("plotting failed: {e}"))?;
+    Ok(root.margin(24, 0, 0, 0))
+}
+
 /// [`draw`] on a part of a picture, which the caller fills and presents (a panel of
 /// [`time_histories`]); a chart with an empty title has no caption.
 fn draw_on<DB: DrawingBackend>(
@@ -503,20 +513,7 @@ where
     DB::ErrorType: 'static,
 {
     let err = |e: DrawingAreaErrorKind<DB::ErrorType>| format!("plotting failed: {e}");
-    let root = root.clone();
-    // The note goes above the chart, in its own band, so no line can hide it.
-    let root = match note {
-        Some(note) => {
-            root.draw(&Text::new(
-                note.to_string(),
-                (12, 6),
-                ("sans-serif", 16).into_font().color(&RED),
-            ))
-            .map_err(err)?;
-            root.margin(24, 0, 0, 0)
-        }
-        None => root,
-    };
+    let root = note_band(root.clone(), note)?;
     let (mut x_lo, mut x_hi, mut y_lo, mut y_hi) = (
         f64::INFINITY,
         f64::NEG_INFINITY,

@@ -571,13 +571,14 @@ fn body(s: &mut String, f: &Function, language: Language, prefix: &str) {
     let live = f.live();
     let tape = f.tape;
     for (k, instruction) in tape.instructions.iter().enumerate() {
-        if !live[k] || matches!(instruction, Instruction::Input(_) | Instruction::Const(_)) {
+        if !live[k] {
             continue;
         }
         let x = |v: Value| operand(tape, v, language);
         let call = |name: &str, v: Value| format!("{name}({})", x(v));
         let expr = match *instruction {
-            Instruction::Input(_) | Instruction::Const(_) => unreachable!("skipped above"),
+            // Written where they are used (`operand`).
+            Instruction::Input(_) | Instruction::Const(_) => continue,
             Instruction::Neg(a) => format!("-{}", x(a)),
             Instruction::Add(a, b) => format!("{} + {}", x(a), x(b)),
             Instruction::Sub(a, b) => format!("{} - {}", x(a), x(b)),
