@@ -84,6 +84,22 @@ pub struct ModelDescription {
     /// `[entry, coordinate]` index pairs (a steady motion's cyclic coordinates, which its
     /// linearisation leaves out).
     pub ignorable_coordinates: List<[usize; 2]>,
+    /// The coordinates each entry of `equilibria:` holds at its value (`lean: { held: 0.1 }`)
+    /// where the search would find them, as `[entry, coordinate]` index pairs. Empty for
+    /// most models, and then left out of the serialized description.
+    #[serde(skip_serializing_if = "<[[usize; 2]]>::is_empty")]
+    pub held_coordinates: List<[usize; 2]>,
+    /// The rates each entry of `equilibria:` leaves to the search (`front_wheel_dot:
+    /// { guess: 17 }`) where it would hold them, as `[entry, coordinate]` index pairs. Empty
+    /// for most models, and then left out of the serialized description.
+    #[serde(skip_serializing_if = "<[[usize; 2]]>::is_empty")]
+    pub solved_rates: List<[usize; 2]>,
+    /// The steady turns of `equilibria:` (`turning: { angle: yaw, plane: [x, y] }`), as
+    /// `[entry, angle, a, b]` indices: in entry `entry` the rates of coordinates `a` and `b`
+    /// are constant in the frame turned by coordinate `angle`. Empty for most models, and
+    /// then left out of the serialized description.
+    #[serde(skip_serializing_if = "<[[usize; 4]]>::is_empty")]
+    pub turning_frames: List<[usize; 4]>,
     /// The file's `events:`: names, directions and whether each ends the integration, in
     /// file order (lecture 17, HW21, HW36).
     pub events: List<EventSpec>,
@@ -149,6 +165,9 @@ impl ModelDescription {
         equilibria: Cow::Borrowed(&[]),
         equilibrium_rates: false,
         ignorable_coordinates: Cow::Borrowed(&[]),
+        held_coordinates: Cow::Borrowed(&[]),
+        solved_rates: Cow::Borrowed(&[]),
+        turning_frames: Cow::Borrowed(&[]),
         events: Cow::Borrowed(&[]),
         contacts: Cow::Borrowed(&[]),
         supports: Cow::Borrowed(&[]),

@@ -17,6 +17,8 @@
 //!   named inputs and outputs, for control design;
 //! - [`steady`]: steady motions (constant rates, ignorable coordinates drifting) and their
 //!   linearisation restricted to the constraints, holonomic and non-holonomic;
+//! - [`turning`]: steady turns, whose rates are constant in a frame turning with the motion,
+//!   and their linearisation in that frame;
 //! - [`monodromy`]: the monodromy matrix of a periodic linearisation, Floquet multipliers and
 //!   the stability they imply.
 //!
@@ -34,3 +36,4 @@ pub mod state_space;
 pub mod steady;
 mod stops;
 pub mod time_dependence;
+pub mod turning;

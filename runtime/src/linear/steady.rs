@@ -48,6 +48,7 @@ use nalgebra::{Complex, DMatrix, DVector};
 use serde::Serialize;
 
 use super::eigenvalues::{Stability, ZERO_EIGENVALUE, ZERO_REAL_PART, verdict};
+use super::turning::TurningFrame;
 use crate::model_info::ModelInfo;
 use crate::ode::RhsError;
 
@@ -158,13 +159,55 @@ pub enum SteadyMotionError {
     },
 }
 
-/// A steady motion: coordinates `q*` and rates `q̇*` at which `q̈ = 0` and the constraints
-/// hold.
+/// What a steady motion holds and what its search finds (an entry of the file's
+/// `equilibria:` that holds rates).
+#[derive(Debug, Clone, PartialEq, Default, Serialize)]
+pub struct SteadyMotionSpec {
+    /// The rates `q̇*` held (length `n`); those of [`Self::solved_rates`] are the search's
+    /// starting guesses instead.
+    pub rates: Vec<f64>,
+    /// The coordinates nothing depends on (indices): they may move, and the linearisation
+    /// leaves them out.
+    pub ignorable: Vec<usize>,
+    /// Coordinates held at their guess (indices) where the search would find them (a
+    /// bicycle's lean, whose turn's speed is then found).
+    pub held_coordinates: Vec<usize>,
+    /// Coordinates whose rates the search finds (indices) where it would hold them (rates
+    /// fixed by rolling constraints, such as a front wheel's in a turn).
+    pub solved_rates: Vec<usize>,
+    /// The frame of a steady turn: the rates of two coordinates constant in it, not in the
+    /// ground.
+    pub turning: Option<TurningFrame>,
+}
+
+impl SteadyMotionSpec {
+    /// The spec that holds `rates` (length `n`), with the coordinates `ignorable`: every other
+    /// coordinate found, every rate held, no turn.
+    pub fn holding(rates: &[f64], ignorable: &[usize]) -> Self {
+        Self {
+            rates: rates.to_vec(),
+            ignorable: ignorable.to_vec(),
+            ..Self::default()
+        }
+    }
+
+    /// The entries of `y = (q, q̇)` (length `2n`) the search finds: the coordinates neither
+    /// ignorable nor held, then the solved rates (`n + i`).
+    pub fn unknowns(&self, n: usize) -> Vec<usize> {
+        (0..n)
+            .filter(|i| !self.ignorable.contains(i) && !self.held_coordinates.contains(i))
+            .chain(self.solved_rates.iter().map(|i| n + i))
+            .collect()
+    }
+}
+
+/// A steady motion: coordinates `q*` and rates `q̇*` at which `q̈ = 0` (in a steady turn,
+/// the plane's `q̈` is the turn's `Ω S q̇`) and the constraints hold.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct SteadyMotion {
     /// `q*` (length `n`).
     pub q: Vec<f64>,
-    /// `q̇*` (length `n`), as held.
+    /// `q̇*` (length `n`): as held, and as found for the rates the search finds.
     pub qdot: Vec<f64>,
     /// Gauss–Newton iterations.
     pub iterations: usize,
@@ -179,20 +222,23 @@ impl SteadyMotion {
     }
 }
 
-/// `[q̈; Φ; V]` at `(q, q̇)`: the residuals of a steady motion.
+/// `[q̈; Φ; V]` at the state `y = (q, q̇)` (length `2n`): the residuals of a steady motion,
+/// the plane's `q̈` less the turn's `Ω S q̇` in a steady turn.
 fn steady_residuals(
     model: &mut dyn ModelInfo,
     t: f64,
-    q: &[f64],
-    qdot: &[f64],
+    y: &[f64],
+    turning: Option<&TurningFrame>,
 ) -> Result<Vec<f64>, RhsError> {
-    let n = q.len();
-    let y: Vec<f64> = q.iter().chain(qdot).copied().collect();
+    let n = y.len() / 2;
     let mut dy = vec![0.0; 2 * n];
-    model.as_ode_mut().rhs(t, &y, &mut dy)?;
+    model.as_ode_mut().rhs(t, y, &mut dy)?;
     let mut r = dy[n..].to_vec();
+    if let Some(frame) = turning {
+        frame.residuals(y, &mut r);
+    }
     if !model.description().constraints.is_empty() {
-        let c = model.constraint_equations(t, &y);
+        let c = model.constraint_equations(t, y);
         r.extend(c.phi.iter());
         r.extend(c.velocity.iter());
     }
@@ -227,26 +273,11 @@ fn largest(v: &[f64]) -> (f64, usize) {
 
 /// Finds a steady motion near `guess` (length `n`) with the rates `rates` (length `n`)
 /// held: Gauss–Newton on the coordinates that are not `ignorable` (indices) so that
-/// `q̈ = 0`, `Φ = 0` and the velocity constraints hold, with central-difference Jacobians and
-/// least-squares steps (SVD, singular values below `1e-12 σ_max` dropped, so that directions
-/// the residuals do not see stay at their guess). An equilibrium is the case `rates = 0`.
-///
-/// The steps are held in a trust region (Dennis & Schnabel, *Numerical Methods for
-/// Unconstrained Optimization and Nonlinear Equations*, 1983, §6.4): each coordinate moves
-/// at most `Δ·max(1, |qⱼ|)`, `Δ` starting at 0.25, halved when the residual falls
-/// by less than a tenth of what the linear model predicts (or cannot be evaluated) and
-/// doubled when the prediction holds. So the motion found is the one the guess leads to,
-/// not one a flat stretch of the residual throws the first step to (a top's nutation
-/// `θ = 0.5` near the residual's maximum gave `θ = 8π − 0.9`). Once the largest residual is
-/// below `1e-11 (1 + s)`, `s` its size at the guess, full steps continue while they reduce
-/// it: the coordinates are found to rounding, not to the tolerance.
+/// `q̈ = 0`, `Φ = 0` and the velocity constraints hold; [`find_steady_motion_with`] with
+/// [`SteadyMotionSpec::holding`]. An equilibrium is the case `rates = 0`.
 ///
 /// # Errors
-/// [`SteadyMotionError::NotSteady`] naming the largest residual when it does not converge
-/// within 50 iterations or no step reduces it; [`SteadyMotionError::Unevaluable`] when the
-/// search is stopped by a point where the equations cannot be evaluated (a singularity of
-/// the coordinates, as Euler angles at `θ = 0`); [`SteadyMotionError::Rhs`] when they cannot
-/// be evaluated at the guess.
+/// As [`find_steady_motion_with`].
 pub fn find_steady_motion(
     model: &mut dyn ModelInfo,
     t: f64,
@@ -254,21 +285,67 @@ pub fn find_steady_motion(
     rates: &[f64],
     ignorable: &[usize],
 ) -> Result<SteadyMotion, SteadyMotionError> {
+    find_steady_motion_with(
+        model,
+        t,
+        guess,
+        &SteadyMotionSpec::holding(rates, ignorable),
+    )
+}
+
+/// Finds the steady motion `spec` describes near `guess` (length `n`): Gauss–Newton on the
+/// coordinates neither ignorable nor held and on the rates to be found, so that `q̈ = 0`
+/// (for a steady turn, the plane's `q̈ = Ω S q̇`), `Φ = 0` and the velocity constraints hold,
+/// with central-difference Jacobians and least-squares steps (SVD, singular values below
+/// `1e-12 σ_max` dropped, so that directions the residuals do not see stay at their guess).
+///
+/// The steps are held in a trust region (Dennis & Schnabel, *Numerical Methods for
+/// Unconstrained Optimization and Nonlinear Equations*, 1983, §6.4): each unknown moves
+/// at most `Δ·max(1, |yⱼ|)`, `Δ` starting at 0.25, halved when the residual falls
+/// by less than a tenth of what the linear model predicts (or cannot be evaluated) and
+/// doubled when the prediction holds. So the motion found is the one the guess leads to,
+/// not one a flat stretch of the residual throws the first step to (a top's nutation
+/// `θ = 0.5` near the residual's maximum gave `θ = 8π − 0.9`). Once the largest residual is
+/// below `1e-11 (1 + s)`, `s` its size at the guess, full steps continue while they reduce
+/// it: the unknowns are found to rounding, not to the tolerance.
+///
+/// # Errors
+/// [`SteadyMotionError::NotSteady`] naming the largest residual when it does not converge
+/// within 50 iterations or no step reduces it; [`SteadyMotionError::Unevaluable`] when the
+/// search is stopped by a point where the equations cannot be evaluated (a singularity of
+/// the coordinates, as Euler angles at `θ = 0`); [`SteadyMotionError::Rhs`] when they cannot
+/// be evaluated at the guess; [`SteadyMotionError::HeldRateNotIgnorable`] when the motion
+/// moves a coordinate not declared ignorable; [`SteadyMotionError::NotCyclic`] when a moving
+/// coordinate (or the turn) changes the equations.
+pub fn find_steady_motion_with(
+    model: &mut dyn ModelInfo,
+    t: f64,
+    guess: &[f64],
+    spec: &SteadyMotionSpec,
+) -> Result<SteadyMotion, SteadyMotionError> {
     let n = guess.len();
-    let names = owned_coordinate_names(model);
-    check_held_rates(&names, n, rates, ignorable)?;
-    let free: Vec<usize> = (0..n).filter(|i| !ignorable.contains(i)).collect();
-    let mut q = guess.to_vec();
-    let mut r = steady_residuals(model, t, &q, rates)?;
+    let names = owned_state_names(model);
+    let held: Vec<f64> = (0..n)
+        .map(|i| match spec.solved_rates.contains(&i) {
+            true => 0.0,
+            false => spec.rates.get(i).copied().unwrap_or(0.0),
+        })
+        .collect();
+    check_held_rates(&names, n, &held, &spec.ignorable)?;
+    let turning = spec.turning.as_ref();
+    let free = spec.unknowns(n);
+    let mut y: Vec<f64> = guess.iter().chain(&spec.rates).copied().collect();
+    y.resize(2 * n, 0.0);
+    let mut r = steady_residuals(model, t, &y, turning)?;
     let scale = 1.0 + largest(&r).0;
     let mut radius = FIRST_RADIUS;
     let mut iterations = 0;
     // The last point the equations could not be evaluated at: near it the search was held
     // back, and a search that fails is blamed on it.
     let mut refused: Option<(Vec<f64>, RhsError)> = None;
-    // The step and its predicted change at the current `q`, kept while a refused trial
-    // only shrinks the region (the Jacobian costs 2 n evaluations of the equations).
-    let mut at_q: Option<(DVector<f64>, DVector<f64>)> = None;
+    // The step and its predicted change at the current `y`, kept while a refused trial
+    // only shrinks the region (the Jacobian costs 2 k evaluations of the equations).
+    let mut at_y: Option<(DVector<f64>, DVector<f64>)> = None;
     loop {
         let (worst, at) = largest(&r);
         if !worst.is_finite() {
@@ -278,7 +355,7 @@ pub fn find_steady_motion(
             break;
         }
         if free.is_empty() {
-            check_steady_as_held(model, rates, iterations, (worst, at))?;
+            check_steady_as_held(model, &spec.rates, iterations, (worst, at))?;
             break;
         }
         let stuck = radius < 1e-15;
@@ -293,64 +370,136 @@ pub fn find_steady_motion(
             ));
         }
         iterations += 1;
-        let (step, predicted) = match at_q.take() {
+        let (step, predicted) = match at_y.take() {
             Some(cached) => cached,
-            None => gauss_newton_step(model, t, &q, rates, &free, &r)?,
+            None => gauss_newton_step(model, t, &y, turning, &free, &r)?,
         };
-        let size = relative_step(&q, &free, &step);
-        // Converged as far as rounding allows: Newton would move the coordinates by less
+        let size = relative_step(&y, &free, &step);
+        // Converged as far as rounding allows: Newton would move the unknowns by less
         // than their rounding, with the residual small and within reach of the step (an
         // exact guess whose residual is the rounding of large terms, a hoop spun at
-        // 1000 rad/s). A residual the coordinates cannot change (an acceleration no free
+        // 1000 rad/s). A residual the unknowns cannot change (an acceleration no free
         // coordinate affects) is not rounding, however small the step.
         let reachable = within_reach(&r, &predicted, worst);
         if size <= 1e-14 && worst <= 1e-8 * scale && reachable {
             break;
         }
         let fraction = if size > radius { radius / size } else { 1.0 };
-        let trial = moved_by(&q, &free, &step, fraction);
-        match steady_residuals(model, t, &trial, rates) {
+        let trial = moved_by(&y, &free, &step, fraction);
+        match steady_residuals(model, t, &trial, turning) {
             Ok(rt) if largest(&rt).0.is_finite() => {
                 let ratio = reduction_ratio(&r, &rt, &predicted, fraction);
                 // A NaN ratio (no predicted reduction) shrinks the region too.
                 if ratio.is_nan() || ratio < 0.1 {
                     radius = fraction * size / 2.0;
-                    at_q = Some((step, predicted));
+                    at_y = Some((step, predicted));
                     continue;
                 }
                 if ratio >= 0.75 {
                     radius = radius.max(2.0 * fraction * size);
                 }
-                q = trial;
+                y = trial;
                 r = rt;
             }
             Ok(_) => {
                 radius = fraction * size / 2.0;
-                at_q = Some((step, predicted));
+                at_y = Some((step, predicted));
             }
             Err(e) => {
                 radius = fraction * size / 2.0;
                 refused = Some((trial, e));
-                at_q = Some((step, predicted));
+                at_y = Some((step, predicted));
             }
         }
     }
-    polish(model, t, &mut q, &mut r, rates, &free)?;
-    let moving = moving_coordinates(n, rates);
-    check_cyclic(model, t, &q, rates, &moving)?;
+    polish(model, t, &mut y, &mut r, turning, &free)?;
+    let (q, rates) = (y[..n].to_vec(), y[n..].to_vec());
+    // A rate found must move only an ignorable coordinate, as a held one.
+    check_held_rates(&names, n, &rates, &spec.ignorable)?;
+    let mut moving = moving_coordinates(n, &rates);
+    if let Some(frame) = turning {
+        // The turn moves its angle together with the plane's rates: checked as a symmetry.
+        moving.retain(|&i| i != frame.angle);
+        check_turning_symmetry(model, t, &y, frame)?;
+    }
+    check_cyclic(model, t, &q, &rates, &moving)?;
     Ok(SteadyMotion {
         q,
-        qdot: rates.to_vec(),
+        qdot: rates,
         iterations,
         residual: largest(&r).0,
     })
 }
 
-/// The names of `model`'s coordinates (length `n`), owned.
-fn owned_coordinate_names(model: &dyn ModelInfo) -> Vec<String> {
-    (model.description().coordinate_names().into_iter())
-        .map(str::to_string)
+/// The names of `model`'s states (length `2n`: the coordinates, then their rates), owned.
+fn owned_state_names(model: &dyn ModelInfo) -> Vec<String> {
+    let d = model.description();
+    (0..2 * d.coordinates.len())
+        .map(|i| d.state_name(i))
         .collect()
+}
+
+/// Checks that a steady turn is one: that the accelerations at the state turned by the
+/// angle `s` ([`TurningFrame::turn_state`]) are those at `y` turned by `s`, at the turn `y`
+/// and at a state near it, for the shifts [`CYCLIC_SHIFTS`], within 1e-9 of the largest
+/// (as [`check_cyclic`]). A state where the equations fail is skipped.
+///
+/// # Errors
+/// [`SteadyMotionError::NotCyclic`] naming the turning angle.
+fn check_turning_symmetry(
+    model: &mut dyn ModelInfo,
+    t: f64,
+    y: &[f64],
+    frame: &TurningFrame,
+) -> Result<(), SteadyMotionError> {
+    let n = y.len() / 2;
+    let near: Vec<f64> = (y.iter().enumerate())
+        .map(|(k, v)| v + 0.1 * (1.0 + (k as f64 * 0.618_033_988_749_895).fract()))
+        .collect();
+    let mut accelerations = |y: &[f64]| -> Option<Vec<f64>> {
+        let mut dy = vec![0.0; 2 * n];
+        model.as_ode_mut().rhs(t, y, &mut dy).ok()?;
+        dy[n..]
+            .iter()
+            .all(|v| v.is_finite())
+            .then(|| dy[n..].to_vec())
+    };
+    for base in [y.to_vec(), near] {
+        let Some(at_base) = accelerations(&base) else {
+            continue;
+        };
+        for shift in CYCLIC_SHIFTS {
+            let Some(turned) = accelerations(&frame.turn_state(&base, n, shift)) else {
+                continue;
+            };
+            let expected = frame.turn_accelerations(&at_base, shift);
+            let size = (expected.iter().chain(&turned)).fold(0.0f64, |m, v| m.max(v.abs()));
+            let change = (expected.iter().zip(&turned))
+                .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()))
+                / size.max(f64::MIN_POSITIVE);
+            if change > 1e-9 {
+                let names = model.description().coordinate_names();
+                let name = |i: usize| {
+                    names
+                        .get(i)
+                        .map_or_else(|| i.to_string(), |c| c.to_string())
+                };
+                return Err(SteadyMotionError::NotCyclic {
+                    coordinate: format!(
+                        "{} (turning {} and {} with it)",
+                        name(frame.angle),
+                        name(frame.plane[0]),
+                        name(frame.plane[1])
+                    ),
+                    rate: frame.rate(y, n),
+                    part: "the accelerations".to_string(),
+                    change,
+                    shift,
+                });
+            }
+        }
+    }
+    Ok(())
 }
 
 /// The coordinates (indices among the first `n`) whose held rate is nonzero: those that
@@ -431,11 +580,11 @@ fn search_failed(
     }
 }
 
-/// The largest move of a `free` coordinate by `step` relative to `max(1, |qⱼ|)`.
-fn relative_step(q: &[f64], free: &[usize], step: &DVector<f64>) -> f64 {
+/// The largest move of a `free` entry of the state `y` by `step` relative to `max(1, |yⱼ|)`.
+fn relative_step(y: &[f64], free: &[usize], step: &DVector<f64>) -> f64 {
     free.iter()
         .enumerate()
-        .map(|(col, &j)| step[col].abs() / q[j].abs().max(1.0))
+        .map(|(col, &j)| step[col].abs() / y[j].abs().max(1.0))
         .fold(0.0f64, f64::max)
 }
 
@@ -463,36 +612,31 @@ fn reduction_ratio(r: &[f64], rt: &[f64], predicted: &DVector<f64>, fraction: f6
 const FIRST_RADIUS: f64 = 0.25;
 
 /// Full Gauss–Newton steps after convergence, each kept only if it lowers the largest
-/// residual and moves the coordinates by more than 1e-12 of their size (at most four: the
+/// residual and moves the unknowns by more than 1e-12 of their size (at most four: the
 /// convergence is quadratic).
 fn polish(
     model: &mut dyn ModelInfo,
     t: f64,
-    q: &mut Vec<f64>,
+    y: &mut Vec<f64>,
     r: &mut Vec<f64>,
-    rates: &[f64],
+    turning: Option<&TurningFrame>,
     free: &[usize],
 ) -> Result<(), SteadyMotionError> {
     for _ in 0..4 {
         if free.is_empty() || largest(r).0 == 0.0 {
             break;
         }
-        let (step, _) = gauss_newton_step(model, t, q, rates, free, r)?;
-        // A step below 1e-12 of the coordinates moves them within the rounding of the
+        let (step, _) = gauss_newton_step(model, t, y, turning, free, r)?;
+        // A step below 1e-12 of the unknowns moves them within the rounding of the
         // differenced Jacobian's solve: an exact guess (the heavy top's precession at π/6)
         // stays where it is, though such a step may lower a residual that is rounding.
-        let size = free
-            .iter()
-            .enumerate()
-            .map(|(col, &j)| step[col].abs() / q[j].abs().max(1.0))
-            .fold(0.0f64, f64::max);
-        if size <= 1e-12 {
+        if relative_step(y, free, &step) <= 1e-12 {
             break;
         }
-        let trial = moved_by(q, free, &step, 1.0);
-        match steady_residuals(model, t, &trial, rates) {
+        let trial = moved_by(y, free, &step, 1.0);
+        match steady_residuals(model, t, &trial, turning) {
             Ok(rt) if largest(&rt).0 < largest(r).0 => {
-                *q = trial;
+                *y = trial;
                 *r = rt;
             }
             _ => break,
@@ -501,25 +645,25 @@ fn polish(
     Ok(())
 }
 
-/// The least-squares Gauss–Newton step `δ` (on the `free` coordinates) that makes `r + J δ`
-/// smallest, `J` by central differences, and `J δ`.
+/// The least-squares Gauss–Newton step `δ` (on the `free` entries of the state `y`) that
+/// makes `r + J δ` smallest, `J` by central differences, and `J δ`.
 fn gauss_newton_step(
     model: &mut dyn ModelInfo,
     t: f64,
-    q: &[f64],
-    rates: &[f64],
+    y: &[f64],
+    turning: Option<&TurningFrame>,
     free: &[usize],
     r: &[f64],
 ) -> Result<(DVector<f64>, DVector<f64>), SteadyMotionError> {
     let mut jac = DMatrix::zeros(r.len(), free.len());
     for (col, &j) in free.iter().enumerate() {
-        let h = 1e-6 * q[j].abs().max(1.0);
-        let (mut up, mut down) = (q.to_vec(), q.to_vec());
+        let h = 1e-6 * y[j].abs().max(1.0);
+        let (mut up, mut down) = (y.to_vec(), y.to_vec());
         up[j] += h;
         down[j] -= h;
         let (ru, rd) = (
-            steady_residuals(model, t, &up, rates)?,
-            steady_residuals(model, t, &down, rates)?,
+            steady_residuals(model, t, &up, turning)?,
+            steady_residuals(model, t, &down, turning)?,
         );
         for i in 0..r.len() {
             jac[(i, col)] = (ru[i] - rd[i]) / (2.0 * h);
@@ -537,9 +681,9 @@ fn gauss_newton_step(
     Ok((step, predicted))
 }
 
-/// `q` with its `free` entries moved by `fraction · step`.
-fn moved_by(q: &[f64], free: &[usize], step: &DVector<f64>, fraction: f64) -> Vec<f64> {
-    let mut out = q.to_vec();
+/// `y` with its `free` entries moved by `fraction · step`.
+fn moved_by(y: &[f64], free: &[usize], step: &DVector<f64>, fraction: f64) -> Vec<f64> {
+    let mut out = y.to_vec();
     for (col, &j) in free.iter().enumerate() {
         out[j] += fraction * step[col];
     }
@@ -558,12 +702,12 @@ fn sum_of_squares(v: &[f64]) -> f64 {
     v.iter().map(|x| x * x).sum()
 }
 
-/// `name = value, …` for the `free` coordinates of `q`.
-fn named_values(names: &[String], q: &[f64], free: &[usize]) -> String {
+/// `name = value, …` for the `free` entries of the state `y`, `names` naming them.
+fn named_values(names: &[String], y: &[f64], free: &[usize]) -> String {
     free.iter()
         .map(|&j| {
             let name = names.get(j).cloned().unwrap_or_else(|| j.to_string());
-            format!("{name} = {:e}", q[j])
+            format!("{name} = {:e}", y[j])
         })
         .collect::<Vec<_>>()
         .join(", ")
@@ -769,6 +913,22 @@ pub fn linearize_steady_motion(
     y: &[f64],
     ignorable: &[usize],
 ) -> Result<SteadyLinearization, SteadyMotionError> {
+    linearize_steady_motion_with(model, t, y, &SteadyMotionSpec::holding(&[], ignorable))
+}
+
+/// Linearises `model` about the steady motion `y* = (q*, q̇*)` (length `2n`) of `spec` at
+/// time `t`, leaving out its ignorable coordinates; for a steady turn, in the turning frame
+/// ([`crate::linear::turning`]). See the module documentation for the method.
+///
+/// # Errors
+/// As [`linearize_steady_motion`].
+pub fn linearize_steady_motion_with(
+    model: &mut dyn ModelInfo,
+    t: f64,
+    y: &[f64],
+    spec: &SteadyMotionSpec,
+) -> Result<SteadyLinearization, SteadyMotionError> {
+    let ignorable = spec.ignorable.as_slice();
     let d = model.description().clone();
     let n = d.coordinates.len();
     let (m, m_h) = (d.constraints.len(), d.holonomic_constraints);
@@ -789,8 +949,13 @@ pub fn linearize_steady_motion(
         .copied()
         .chain(independent_u.iter().map(|j| n + j))
         .collect();
-    let a_basis = &a * &basis;
-    let mut reduced = DMatrix::from_fn(k, k, |r, c| a_basis[(rows[r], c)]);
+    let mut reduced = match &spec.turning {
+        None => {
+            let a_basis = &a * &basis;
+            DMatrix::from_fn(k, k, |r, c| a_basis[(rows[r], c)])
+        }
+        Some(frame) => turning_reduced(frame, &a, &basis, y, &rows)?,
+    };
     if reduced.iter().any(|v| !v.is_finite()) {
         return Err(SteadyMotionError::NonFinite);
     }
@@ -827,6 +992,29 @@ pub fn linearize_steady_motion(
         constant_rates,
         exact_jacobian,
     })
+}
+
+/// The reduced state matrix of a steady turn (`k × k`): `(P N_z)⁻¹ P A_z N_z`, with `A_z`
+/// and `N_z = T⁻¹ N` the state matrix `a` and the tangent basis `basis` (`2n × k`) taken
+/// to the turning frame at `y` ([`TurningFrame::state_matrix`]) and `P` picking the state
+/// entries `rows`. `P N_z = I` unless the plane's rates are independent states.
+fn turning_reduced(
+    frame: &TurningFrame,
+    a: &DMatrix<f64>,
+    basis: &DMatrix<f64>,
+    y: &[f64],
+    rows: &[usize],
+) -> Result<DMatrix<f64>, SteadyMotionError> {
+    let k = rows.len();
+    let (a_z, t_inverse) = frame.state_matrix(a, y);
+    let basis_z = t_inverse * basis;
+    let a_basis = a_z * &basis_z;
+    let picked = DMatrix::from_fn(k, k, |r, c| basis_z[(rows[r], c)]);
+    let moved = DMatrix::from_fn(k, k, |r, c| a_basis[(rows[r], c)]);
+    picked
+        .lu()
+        .solve(&moved)
+        .ok_or(SteadyMotionError::NonFinite)
 }
 
 /// The constraint Jacobians of [`linearize_steady_motion`] at the operating point:
@@ -1104,8 +1292,12 @@ fn richardson(
     }
 }
 
-/// Up to `count` columns of `a`, taken greedily in the order `order` where each adds to the
-/// rank (its part orthogonal to the columns taken is above `1e-9` of the largest column).
+/// Up to `count` columns of `a`, taken greedily: at each step the first column in the order
+/// `order` whose part orthogonal to the columns taken is at least half the largest such
+/// part among those left (and above `1e-9` of the largest column). The order is kept where
+/// the columns are of like size, and a column that adds to the rank only weakly (a bicycle's
+/// lean in the front contact's constraint, near upright) is passed over for a better one
+/// (its pitch): a partial pivoting, so that the dependent entries are well conditioned.
 fn pivot_columns(a: &DMatrix<f64>, order: &[usize], count: usize) -> Vec<usize> {
     let size = order
         .iter()
@@ -1113,20 +1305,28 @@ fn pivot_columns(a: &DMatrix<f64>, order: &[usize], count: usize) -> Vec<usize> 
         .fold(0.0, f64::max);
     let mut taken: Vec<usize> = Vec::new();
     let mut basis: Vec<DVector<f64>> = Vec::new();
-    for &j in order {
-        if taken.len() == count {
+    while taken.len() < count {
+        let orthogonal: Vec<(usize, DVector<f64>)> = (order.iter())
+            .filter(|j| !taken.contains(j))
+            .map(|&j| {
+                let mut v = a.column(j).into_owned();
+                for b in &basis {
+                    let p = b.dot(&v);
+                    v -= b * p;
+                }
+                (j, v)
+            })
+            .collect();
+        let best = orthogonal.iter().map(|(_, v)| v.norm()).fold(0.0, f64::max);
+        if !(best > 1e-9 * size && best > 0.0) {
             break;
         }
-        let mut v = a.column(j).into_owned();
-        for b in &basis {
-            let p = b.dot(&v);
-            v -= b * p;
-        }
+        let Some((j, v)) = orthogonal.into_iter().find(|(_, v)| v.norm() >= 0.5 * best) else {
+            break;
+        };
         let norm = v.norm();
-        if norm > 1e-9 * size && norm > 0.0 {
-            basis.push(v / norm);
-            taken.push(j);
-        }
+        basis.push(v / norm);
+        taken.push(j);
     }
     taken
 }

@@ -215,13 +215,33 @@ fn steady(
             .join(", ")
     };
     let lin = &summary.linearization;
+    let (found, held): (std::collections::BTreeMap<String, f64>, _) =
+        (p.qdot.clone().into_iter()).partition(|(k, _)| p.found_rates.contains(k));
     let _ = writeln!(
         out,
         "steady motion  {}: {}; rates held {}",
         p.name,
         show(&p.q),
-        show(&p.qdot)
+        show(&held)
     );
+    if !found.is_empty() {
+        let _ = writeln!(out, "rates found    {}", show(&found));
+    }
+    if !p.held_coordinates.is_empty() {
+        let _ = writeln!(
+            out,
+            "held           {} (at the value given, not found)",
+            p.held_coordinates.join(", ")
+        );
+    }
+    if let Some(turn) = &p.turning {
+        let [a, b] = &turn.plane;
+        let _ = writeln!(
+            out,
+            "turning frame  {a}_dot, {b}_dot held in the frame turned by {}: Ω = {}_dot = {} rad/s, radius {}; linearised in that frame",
+            turn.angle, turn.angle, turn.rate, turn.radius
+        );
+    }
     let _ = writeln!(
         out,
         "found          {} Gauss–Newton iterations, largest residual {:.3e}",

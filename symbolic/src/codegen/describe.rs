@@ -82,6 +82,15 @@ pub fn describe(model: &SymbolicModel, eom: &EquationsOfMotion, mathml: bool) ->
             .enumerate()
             .flat_map(|(k, e)| e.ignorable.iter().map(move |&c| [k, c]))
             .collect(),
+        held_coordinates: (model.equilibria.iter().enumerate())
+            .flat_map(|(k, e)| e.held.iter().map(move |&c| [k, c]))
+            .collect(),
+        solved_rates: (model.equilibria.iter().enumerate())
+            .flat_map(|(k, e)| e.solved.iter().map(move |&c| [k, c]))
+            .collect(),
+        turning_frames: (model.equilibria.iter().enumerate())
+            .filter_map(|(k, e)| e.turning.map(|[a, x, y]| [k, a, x, y]))
+            .collect(),
         events: model
             .events
             .iter()
@@ -188,6 +197,20 @@ pub fn description_tokens(
         .map(|[k, c]| super::rust_tokens::tokens(&format!("[{k}_usize, {c}_usize]")))
         .collect::<Result<_, String>>()?;
     let ignorable_coordinates = borrowed(ignorable);
+    let index_rows = |rows: Vec<String>| -> Result<TokenStream, String> {
+        let rows: Vec<TokenStream> = (rows.iter())
+            .map(|r| super::rust_tokens::tokens(r))
+            .collect::<Result<_, String>>()?;
+        Ok(borrowed(rows))
+    };
+    let pair = |[k, c]: &[usize; 2]| format!("[{k}_usize, {c}_usize]");
+    let held_coordinates = index_rows(d.held_coordinates.iter().map(pair).collect())?;
+    let solved_rates = index_rows(d.solved_rates.iter().map(pair).collect())?;
+    let turning_frames = index_rows(
+        (d.turning_frames.iter())
+            .map(|[k, a, x, y]| format!("[{k}_usize, {a}_usize, {x}_usize, {y}_usize]"))
+            .collect(),
+    )?;
     let events = borrowed(
         d.events
             .iter()
@@ -242,6 +265,9 @@ pub fn description_tokens(
             equilibria: #equilibria,
             equilibrium_rates: #equilibrium_rates,
             ignorable_coordinates: #ignorable_coordinates,
+            held_coordinates: #held_coordinates,
+            solved_rates: #solved_rates,
+            turning_frames: #turning_frames,
             events: #events,
             contacts: #contacts,
             supports: #supports,

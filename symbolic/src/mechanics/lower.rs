@@ -220,6 +220,13 @@ pub struct Equilibrium {
     pub rates: Vec<ExprId>,
     /// Indices of the coordinates the linearisation leaves out (`ignorable:`).
     pub ignorable: Vec<usize>,
+    /// Indices of the coordinates the search holds at their value (`{ held: … }`).
+    pub held: Vec<usize>,
+    /// Indices of the coordinates whose rates the search finds (`{ guess: … }`).
+    pub solved: Vec<usize>,
+    /// A steady turn's frame (`turning:`): the turning angle's index and the two plane
+    /// coordinates' indices.
+    pub turning: Option<[usize; 3]>,
 }
 
 /// The box in which the derivation checks draw random states (`eomgen check`, the mass

@@ -217,6 +217,30 @@ pub struct EquilibriumDef {
     /// `ignorable: [phi]` — coordinates that a steady motion's linearisation leaves out
     /// (cyclic coordinates: nothing else depends on them).
     pub ignorable: Vec<Located<String>>,
+    /// Coordinates written `{ held: value }`: kept at their value by the search instead of
+    /// found (the lean of a bicycle's steady turn, whose speed is then found).
+    pub held: Vec<Located<String>>,
+    /// Rates written `{ guess: value }`: found by the search instead of held (the rates the
+    /// rolling constraints fix, such as a bicycle's front wheel rate in a turn).
+    pub solved: Vec<Located<String>>,
+    /// `turning: { angle: yaw, plane: [x, y] }` — a steady turn: the rates of the `plane`
+    /// coordinates are constant in the frame turned by `angle`, not in the ground.
+    pub turning: Option<TurningDef>,
+}
+
+/// The turning frame of a steady turn (a relative equilibrium): the rates `(ȧ, ḃ)` of two
+/// Cartesian coordinates are constant in the frame turned by the angle `angle` about the
+/// normal of their plane, so that in the ground they turn at `angle`'s rate: `ä = −Ω ḃ`,
+/// `b̈ = Ω ȧ`, `Ω` the angle's rate.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TurningDef {
+    /// The coordinate whose rate turns the frame (a heading).
+    pub angle: Located<String>,
+    /// The two coordinates whose rates are constant in the turning frame, in the order
+    /// that makes a positive `angle` turn the first toward the second.
+    pub plane: Vec<Located<String>>,
+    /// Where the `turning:` key is.
+    pub at: Location,
 }
 
 /// A whole model file after the schema pass.

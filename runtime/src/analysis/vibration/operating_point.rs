@@ -111,17 +111,23 @@ impl EquilibriumStart {
     }
 }
 
+/// The index of `start`'s entry in the file's `equilibria:` (`None` for a guess, or a name
+/// not there).
+fn entry_index(model: &dyn ModelInfo, start: &EquilibriumStart) -> Option<usize> {
+    let d = model.description();
+    match start {
+        EquilibriumStart::FirstNamed => (!d.equilibria.is_empty()).then_some(0),
+        EquilibriumStart::Named(name) => d.equilibria.iter().position(|e| e == name),
+        EquilibriumStart::Guess { .. } => None,
+    }
+}
+
 /// The rates an operating point holds and the coordinates it declares ignorable: those of
 /// its entry of `equilibria:` (none for a guess).
 pub fn held_rates(model: &dyn ModelInfo, start: &EquilibriumStart) -> (Vec<f64>, Vec<usize>) {
     let n = model.num_dofs();
     let d = model.description();
-    let entry = match start {
-        EquilibriumStart::FirstNamed => (!d.equilibria.is_empty()).then_some(0),
-        EquilibriumStart::Named(name) => d.equilibria.iter().position(|e| e == name),
-        EquilibriumStart::Guess { .. } => None,
-    };
-    match entry {
+    match entry_index(model, start) {
         Some(k) => (
             model
                 .equilibrium_rates()
@@ -135,6 +141,36 @@ pub fn held_rates(model: &dyn ModelInfo, start: &EquilibriumStart) -> (Vec<f64>,
                 .collect(),
         ),
         None => (vec![0.0; n], Vec::new()),
+    }
+}
+
+/// What the operating point `start` holds and finds as a steady motion: its entry's rates,
+/// ignorable and held coordinates, found rates and turning frame
+/// ([`crate::linear::steady::SteadyMotionSpec`]); only rates of 0 for a guess.
+pub fn steady_motion_spec(
+    model: &dyn ModelInfo,
+    start: &EquilibriumStart,
+) -> crate::linear::steady::SteadyMotionSpec {
+    let (rates, ignorable) = held_rates(model, start);
+    let d = model.description();
+    let entry = entry_index(model, start);
+    let of_entry = |pairs: &[[usize; 2]]| -> Vec<usize> {
+        (pairs.iter())
+            .filter(|[e, _]| Some(*e) == entry)
+            .map(|[_, c]| *c)
+            .collect()
+    };
+    crate::linear::steady::SteadyMotionSpec {
+        rates,
+        ignorable,
+        held_coordinates: of_entry(&d.held_coordinates),
+        solved_rates: of_entry(&d.solved_rates),
+        turning: (d.turning_frames.iter())
+            .find(|[e, ..]| Some(*e) == entry)
+            .map(|&[_, angle, a, b]| crate::linear::turning::TurningFrame {
+                angle,
+                plane: [a, b],
+            }),
     }
 }
 

@@ -18,12 +18,14 @@
 //! count is: it is decided by the eigenvalues' signs, which the reduced matrices give to
 //! rounding away from the crossing.
 
+use std::collections::BTreeMap;
+
 use nalgebra::Complex;
 use serde::Serialize;
 
 use super::floquet::SweepAxis;
 use super::operating_point::{OperatingPointError, OperatingPointOptions};
-use super::steady::{SteadyAnalysisError, is_steady_motion, steady_motion_analysis};
+use super::steady::{SteadyAnalysisError, is_steady_motion, steady_motion_analysis_from};
 use crate::linear::eigenvalues::{Stability, linear_stability};
 use crate::linear::modal::ModalError;
 use crate::linear::modal::linearize;
@@ -87,6 +89,11 @@ pub struct SweepPoint {
     pub stability: Option<Stability>,
     /// Why the operating point or its linearisation failed there (`None` when it did not).
     pub error: Option<String>,
+    /// What a steady motion's search found there, by name (the coordinates it finds and the
+    /// rates it finds: a bicycle turn's lean and speed); empty for an equilibrium or a
+    /// failure, and then left out of the JSON.
+    #[serde(skip_serializing_if = "BTreeMap::is_empty")]
+    pub found: BTreeMap<String, f64>,
 }
 
 /// How an eigenvalue crossed the imaginary axis.
@@ -197,6 +204,10 @@ pub struct PointEigenvalues {
     /// The eigenvalues of the state matrix with nothing set to 0, by which a change of sign
     /// is located.
     pub raw: Vec<Complex<f64>>,
+    /// The steady motion's state `(q*, q̇*)` (length `2n`); `None` for an equilibrium.
+    pub state: Option<Vec<f64>>,
+    /// [`SweepPoint::found`].
+    pub found: BTreeMap<String, f64>,
 }
 
 /// Why the eigenvalues at one value could not be found.
@@ -224,8 +235,18 @@ pub fn eigenvalues_at(
     model: &mut dyn ModelInfo,
     options: &OperatingPointOptions,
 ) -> Result<PointEigenvalues, SweepPointError> {
+    eigenvalues_from(model, options, None)
+}
+
+/// [`eigenvalues_at`], a steady motion's search started from the state `from` where given
+/// ([`steady_motion_analysis_from`]).
+fn eigenvalues_from(
+    model: &mut dyn ModelInfo,
+    options: &OperatingPointOptions,
+    from: Option<&[f64]>,
+) -> Result<PointEigenvalues, SweepPointError> {
     if is_steady_motion(model, &options.start) {
-        let a = steady_motion_analysis(model, options)?;
+        let a = steady_motion_analysis_from(model, options, from)?;
         let raw = raw_eigenvalues(&a.linearization.state_matrix).ok_or(
             ModalError::EigenvaluesDidNotConverge {
                 size: a.linearization.state_matrix.nrows(),
@@ -236,6 +257,8 @@ pub fn eigenvalues_at(
             eigenvalues: a.eigenvalues,
             stability: a.stability,
             raw,
+            state: Some(a.steady_motion.state()),
+            found: a.found,
         });
     }
     let point = super::operating_point::operating_point(model, options)?;
@@ -254,6 +277,8 @@ pub fn eigenvalues_at(
         eigenvalues: s.eigenvalues,
         stability: s.stability,
         raw,
+        state: None,
+        found: BTreeMap::new(),
     })
 }
 
@@ -613,23 +638,31 @@ pub fn parameter_sweep(
         });
     };
     let before = model.parameter_values()[index];
-    let at = |model: &mut dyn ModelInfo, value: f64| {
+    // The steady motion found last: the next value's search starts there, so that the
+    // sweep follows one family of steady motions (continuation) instead of starting every
+    // value from the entry's guess.
+    let mut last: Option<Vec<f64>> = None;
+    let at = |model: &mut dyn ModelInfo, value: f64, from: Option<&[f64]>| {
         // The name is known, so setting it cannot fail.
         let _ = model.set_parameter(name, value);
-        eigenvalues_at(model, &options.operating_point)
+        eigenvalues_from(model, &options.operating_point, from)
     };
     let total = options.axis.values.len();
     let mut points = Vec::with_capacity(total);
     // Per point, its eigenvalues (the verdict's and the raw ones).
     let mut raws: Vec<Option<PointEigenvalues>> = Vec::with_capacity(total);
     for (k, &value) in options.axis.values.iter().enumerate() {
-        points.push(match at(model, value) {
+        points.push(match at(model, value, last.as_deref()) {
             Ok(found) => {
+                if let Some(y) = &found.state {
+                    last = Some(y.clone());
+                }
                 let point = SweepPoint {
                     value,
                     eigenvalues: found.eigenvalues.clone(),
                     stability: Some(found.stability),
                     error: None,
+                    found: found.found.clone(),
                 };
                 raws.push(Some(found));
                 point
@@ -645,6 +678,7 @@ pub fn parameter_sweep(
                     eigenvalues: Vec::new(),
                     stability: None,
                     error: Some(reason.to_string()),
+                    found: BTreeMap::new(),
                 }
             }
         });
@@ -661,7 +695,9 @@ pub fn parameter_sweep(
     }
     let mut stability_changes = Vec::new();
     if options.refine {
-        stability_changes = refine_changes(&points, &raws, &mut |v: f64| at(model, v).ok());
+        stability_changes = refine_changes(&points, &raws, &mut |v: f64, from: Option<&[f64]>| {
+            at(model, v, from).ok()
+        });
     }
     let _ = model.set_parameter(name, before);
     Ok(ParameterSweep {
@@ -680,11 +716,12 @@ pub fn parameter_sweep(
 
 /// Every stability change of a sweep, in ascending value: between each two neighbouring
 /// `points` that both gave eigenvalues (`raws`, one per point) and whose numbers of unstable
-/// eigenvalues differ, located by [`locate_change`] with `at(v)` the eigenvalues at `v`.
+/// eigenvalues differ, located by [`locate_change`] with `at(v, from)` the eigenvalues at
+/// `v`, a steady motion's search started from the state `from` (the lower neighbour's).
 fn refine_changes(
     points: &[SweepPoint],
     raws: &[Option<PointEigenvalues>],
-    at: &mut impl FnMut(f64) -> Option<PointEigenvalues>,
+    at: &mut impl FnMut(f64, Option<&[f64]>) -> Option<PointEigenvalues>,
 ) -> Vec<StabilityChange> {
     let counts: Vec<Option<usize>> = raws
         .iter()
@@ -705,7 +742,12 @@ fn refine_changes(
         let (Some(a), Some(b)) = (grid[0].1, grid[1].1) else {
             continue;
         };
-        let change = locate_change(at, [(grid[0].0, a), (grid[1].0, b)], [count_a, count_b]);
+        let from = a.state.clone();
+        let change = locate_change(
+            &mut |v: f64| at(v, from.as_deref()),
+            [(grid[0].0, a), (grid[1].0, b)],
+            [count_a, count_b],
+        );
         stability_changes.push(change);
     }
     stability_changes

@@ -10,12 +10,12 @@ use serde::Serialize;
 
 use super::modes::DampedEigenvalueSummary;
 use super::operating_point::{
-    EquilibriumStart, OperatingPointError, OperatingPointOptions, held_rates,
+    EquilibriumStart, OperatingPointError, OperatingPointOptions, steady_motion_spec,
 };
 use crate::linear::eigenvalues::Stability;
 use crate::linear::steady::{
-    SteadyLinearization, SteadyMotion, SteadyMotionError, find_steady_motion,
-    linearize_steady_motion, steady_stability,
+    SteadyLinearization, SteadyMotion, SteadyMotionError, find_steady_motion_with,
+    linearize_steady_motion_with, steady_stability,
 };
 use crate::model_info::ModelInfo;
 
@@ -37,7 +37,26 @@ pub enum SteadyAnalysisError {
 pub fn is_steady_motion(model: &dyn ModelInfo, start: &EquilibriumStart) -> bool {
     let d = model.description();
     let non_holonomic = d.constraints.len() > d.holonomic_constraints;
-    non_holonomic || held_rates(model, start).0.iter().any(|r| *r != 0.0)
+    let spec = steady_motion_spec(model, start);
+    non_holonomic
+        || spec.rates.iter().any(|r| *r != 0.0)
+        || spec.turning.is_some()
+        || !spec.solved_rates.is_empty()
+}
+
+/// The frame of a steady turn as a report gives it.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SteadyTurn {
+    /// The turning angle (a heading).
+    pub angle: String,
+    /// The two coordinates whose rates are constant in the turning frame.
+    pub plane: [String; 2],
+    /// The turn's rate `Ω` (rad/s), the angle's rate: positive turns the first plane
+    /// coordinate toward the second.
+    pub rate: f64,
+    /// The radius (in the plane coordinates' unit) of the circle the plane's point runs on,
+    /// `|v|/|Ω|`; infinite when `Ω = 0`.
+    pub radius: f64,
 }
 
 /// A steady motion, its reduced linearisation and stability.
@@ -47,6 +66,16 @@ pub struct SteadyMotionAnalysis {
     pub name: String,
     /// The model's coordinates.
     pub coordinates: Vec<String>,
+    /// Coordinates held at their value (`{ held: … }`) rather than found.
+    pub held_coordinates: Vec<String>,
+    /// Rates found (`{ guess: … }`) rather than held.
+    pub found_rates: Vec<String>,
+    /// A steady turn's frame, in which the plane's rates are held and the linearisation is
+    /// taken; `None` for a steady motion whose rates are constant in the ground.
+    pub turning: Option<SteadyTurn>,
+    /// What the search found, by name: the coordinates neither ignorable nor held, and the
+    /// rates found.
+    pub found: BTreeMap<String, f64>,
     /// The steady motion found.
     pub steady_motion: SteadyMotion,
     /// The reduced linearisation there.
@@ -93,6 +122,15 @@ pub struct SteadyPointSummary {
     pub iterations: usize,
     /// Largest residual left.
     pub residual: f64,
+    /// [`SteadyMotionAnalysis::held_coordinates`]; left out when empty.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub held_coordinates: Vec<String>,
+    /// [`SteadyMotionAnalysis::found_rates`]; left out when empty.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub found_rates: Vec<String>,
+    /// [`SteadyMotionAnalysis::turning`]; left out when `None`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub turning: Option<SteadyTurn>,
 }
 
 impl SteadyMotionAnalysis {
@@ -115,6 +153,9 @@ impl SteadyMotionAnalysis {
                     .collect(),
                 iterations: self.steady_motion.iterations,
                 residual: self.steady_motion.residual,
+                held_coordinates: self.held_coordinates.clone(),
+                found_rates: self.found_rates.clone(),
+                turning: self.turning.clone(),
             },
             linearization: self.linearization.clone(),
             damped_modes: damped_summaries(&self.eigenvalues),
@@ -160,29 +201,86 @@ pub fn steady_motion_analysis(
     model: &mut dyn ModelInfo,
     options: &OperatingPointOptions,
 ) -> Result<SteadyMotionAnalysis, SteadyAnalysisError> {
-    let (name, guess) = options.start.resolve(model)?;
-    let (rates, ignorable) = held_rates(model, &options.start);
-    if let Some(i) = rates.iter().position(|r| !r.is_finite()) {
+    steady_motion_analysis_from(model, options, None)
+}
+
+/// [`steady_motion_analysis`] with the search started from the state `from` (`(q, q̇)`,
+/// length `2n`) where given: the coordinates it finds and the rates it finds start there,
+/// while what the entry holds is held at the entry's values. A parameter sweep follows a
+/// family of steady motions (a bicycle's turns as its lean grows) by starting each value
+/// from the motion found at the one before.
+///
+/// # Errors
+/// As [`steady_motion_analysis`].
+pub fn steady_motion_analysis_from(
+    model: &mut dyn ModelInfo,
+    options: &OperatingPointOptions,
+    from: Option<&[f64]>,
+) -> Result<SteadyMotionAnalysis, SteadyAnalysisError> {
+    let (name, mut guess) = options.start.resolve(model)?;
+    let mut spec = steady_motion_spec(model, &options.start);
+    let n = guess.len();
+    if let Some(y) = from.filter(|y| y.len() == 2 * n) {
+        for i in (0..n).filter(|i| !spec.held_coordinates.contains(i)) {
+            guess[i] = y[i];
+        }
+        for &i in &spec.solved_rates {
+            if let Some(rate) = spec.rates.get_mut(i) {
+                *rate = y[n + i];
+            }
+        }
+    }
+    if let Some(i) = spec.rates.iter().position(|r| !r.is_finite()) {
         return Err(OperatingPointError::GuessNotFinite {
             model: model.description().name.to_string(),
             name,
             coordinate: model.description().state_name(model.num_dofs() + i),
-            value: rates[i],
+            value: spec.rates[i],
         }
         .into());
     }
-    let steady_motion = find_steady_motion(model, options.t, &guess, &rates, &ignorable)?;
+    let steady_motion = find_steady_motion_with(model, options.t, &guess, &spec)?;
     let linearization =
-        linearize_steady_motion(model, options.t, &steady_motion.state(), &ignorable)?;
+        linearize_steady_motion_with(model, options.t, &steady_motion.state(), &spec)?;
     let (eigenvalues, stability, rounded_real_part) = steady_stability(&linearization)?;
+    let coordinates: Vec<String> = (model.description().coordinates.iter())
+        .map(|c| c.to_string())
+        .collect();
+    let turning = spec.turning.map(|frame| {
+        let [a, b] = frame.plane;
+        let rate = steady_motion.qdot[frame.angle];
+        let speed = steady_motion.qdot[a].hypot(steady_motion.qdot[b]);
+        SteadyTurn {
+            angle: coordinates[frame.angle].clone(),
+            plane: [coordinates[a].clone(), coordinates[b].clone()],
+            rate,
+            radius: if rate == 0.0 {
+                f64::INFINITY
+            } else {
+                speed / rate.abs()
+            },
+        }
+    });
+    let found = (spec.unknowns(n).into_iter())
+        .map(|j| match j < n {
+            true => (coordinates[j].clone(), steady_motion.q[j]),
+            false => (
+                format!("{}_dot", coordinates[j - n]),
+                steady_motion.qdot[j - n],
+            ),
+        })
+        .collect();
     Ok(SteadyMotionAnalysis {
         name,
-        coordinates: model
-            .description()
-            .coordinates
-            .iter()
-            .map(|c| c.to_string())
+        found,
+        held_coordinates: (spec.held_coordinates.iter())
+            .map(|&i| coordinates[i].clone())
             .collect(),
+        found_rates: (spec.solved_rates.iter())
+            .map(|&i| format!("{}_dot", coordinates[i]))
+            .collect(),
+        turning,
+        coordinates,
         steady_motion,
         linearization,
         eigenvalues,

@@ -136,16 +136,31 @@ impl Lowering<'_> {
                         rates[i] = value;
                     }
                 }
-                let ignorable = q
-                    .ignorable
-                    .iter()
-                    .filter_map(|c| coordinate_names.iter().position(|x| *x == c.value))
-                    .collect();
+                let index = |c: &str| coordinate_names.iter().position(|x| *x == c);
+                let indices = |names: &[Located<String>]| -> Vec<usize> {
+                    names.iter().filter_map(|c| index(&c.value)).collect()
+                };
+                // A solved rate is named `q_dot`: the index of `q`.
+                let rate_indices = |names: &[Located<String>]| -> Vec<usize> {
+                    (names.iter())
+                        .filter_map(|c| index(c.value.strip_suffix("_dot")?))
+                        .collect()
+                };
+                let turning = q.turning.as_ref().and_then(|t| {
+                    Some([
+                        index(&t.angle.value)?,
+                        index(&t.plane.first()?.value)?,
+                        index(&t.plane.get(1)?.value)?,
+                    ])
+                });
                 Equilibrium {
                     name: q.name.value.clone(),
                     guess,
                     rates,
-                    ignorable,
+                    ignorable: indices(&q.ignorable),
+                    held: indices(&q.held),
+                    solved: rate_indices(&q.solved),
+                    turning,
                 }
             })
             .collect()

@@ -2,6 +2,7 @@
 //! to.
 
 use super::*;
+use crate::model::EquilibriumDef;
 use crate::model::checks::{FinalStateCheck, ModalCheck, PeriodCheck};
 
 impl Checker<'_> {
@@ -95,6 +96,59 @@ impl Checker<'_> {
                     None => d.with_help(format!("coordinates are: {}", self.coords.join(", "))),
                 };
                 self.error(d);
+            }
+            if !coordinates_lost {
+                self.steady_marks(q);
+            }
+        }
+    }
+
+    /// Checks an equilibrium's marks: `{ held: … }` only on coordinates, `{ guess: … }` only
+    /// on rates, and a `turning:` frame of three distinct coordinates, each `ignorable`.
+    fn steady_marks(&mut self, q: &EquilibriumDef) {
+        let name = &q.name.value;
+        for k in &q.held {
+            if !self.sets.coords.contains(k.value.as_str()) {
+                self.error(
+                    Diagnostic::new(k.location, format!("`{}` in equilibrium `{name}` is held, but only a coordinate can be: a rate is held unless marked", k.value))
+                        .with_help(format!("write `{}: value` to hold a rate, or `{{ guess: value }}` for the search to find it", k.value)),
+                );
+            }
+        }
+        for k in &q.solved {
+            if !self.sets.rates.contains(k.value.as_str()) {
+                self.error(
+                    Diagnostic::new(k.location, format!("`{}` in equilibrium `{name}` is marked a guess, but only a rate can be: a coordinate is a guess unless held", k.value))
+                        .with_help(format!("write `{}: value` for a coordinate the search finds, or `{{ held: value }}` to hold it", k.value)),
+                );
+            }
+        }
+        let Some(turning) = &q.turning else { return };
+        let names: Vec<&Located<String>> = std::iter::once(&turning.angle)
+            .chain(&turning.plane)
+            .collect();
+        for (i, k) in names.iter().enumerate() {
+            let n = k.value.as_str();
+            if !self.sets.coords.contains(n) {
+                let d = Diagnostic::new(
+                    k.location,
+                    format!("`{n}` in `turning` of `{name}` is not a coordinate"),
+                );
+                let d = match closest(n, &self.coords) {
+                    Some(c) => d.with_help(format!("did you mean `{c}`?")),
+                    None => d.with_help(format!("coordinates are: {}", self.coords.join(", "))),
+                };
+                self.error(d);
+            } else if names[..i].iter().any(|o| o.value == n) {
+                self.error(
+                    Diagnostic::new(k.location, format!("`{n}` appears twice in `turning` of `{name}`"))
+                        .with_help("the turning angle and the two plane coordinates are three different coordinates: `turning: { angle: yaw, plane: [x, y] }`"),
+                );
+            } else if !q.ignorable.iter().any(|o| o.value == n) {
+                self.error(
+                    Diagnostic::new(k.location, format!("`{n}` turns in the steady turn `{name}` but is not in its `ignorable`"))
+                        .with_help(format!("a steady turn moves its turning angle and plane coordinates, which nothing may depend on: add `{n}` to `ignorable`")),
+                );
             }
         }
     }

@@ -180,7 +180,9 @@ impl Ctx<'_> {
     }
 
     /// `equilibria:` — `name: { coordinate: value, … }`; a steady motion also gives rates
-    /// (`phi_dot: Omega`) and the coordinates it leaves out (`ignorable: [phi]`).
+    /// (`phi_dot: Omega`) and the coordinates it leaves out (`ignorable: [phi]`). A coordinate
+    /// written `{ held: value }` is held, a rate written `{ guess: value }` is found, and
+    /// `turning: { angle: yaw, plane: [x, y] }` makes the entry a steady turn.
     pub(super) fn equilibria(&mut self, node: &YamlNode) -> Vec<EquilibriumDef> {
         let spec = Keyed {
             what: "`equilibria`",
@@ -193,6 +195,8 @@ impl Ctx<'_> {
             let entries = cx.map(v, &what, &format!("{}: {{ theta: pi }}", k.value))?;
             let mut ignorable = Vec::new();
             let mut values = Vec::new();
+            let (mut held, mut solved) = (Vec::new(), Vec::new());
+            let mut turning = None;
             for (c, e) in entries {
                 if c.value == "ignorable" {
                     if let Some(items) = cx.seq(e, "`ignorable`", "ignorable: [phi]") {
@@ -200,16 +204,98 @@ impl Ctx<'_> {
                     }
                     continue;
                 }
-                if let Some(e) = cx.expr(e, &format!("the value of `{}` in {what}", c.value)) {
-                    values.push((c.clone(), e));
+                if c.value == "turning" {
+                    turning = cx.turning(c, e, &what);
+                    continue;
                 }
+                let value_what = format!("the value of `{}` in {what}", c.value);
+                let (node, mark) = match marked_value(e) {
+                    Some((mark, inner)) => (inner, Some(mark)),
+                    None if matches!(e.kind, YamlKind::Map(_)) => {
+                        cx.error(
+                            Diagnostic::new(e.location, format!("{value_what} is an expression, `{{ held: value }}` or `{{ guess: value }}`"))
+                                .with_help("`lean: { held: 0.1 }` holds a coordinate that the search would find; `front_wheel_dot: { guess: 17 }` finds a rate that it would hold"),
+                        );
+                        continue;
+                    }
+                    None => (e, None),
+                };
+                let Some(expr) = cx.expr(node, &value_what) else { continue };
+                match mark {
+                    Some("held") => held.push(c.clone()),
+                    Some(_) => solved.push(c.clone()),
+                    None => {}
+                }
+                values.push((c.clone(), expr));
             }
             Some(EquilibriumDef {
                 name: k.clone(),
                 values,
                 ignorable,
+                held,
+                solved,
+                turning,
             })
         })
+    }
+
+    /// `turning: { angle: yaw, plane: [x, y] }` of the equilibrium `what`, at the key `key`.
+    fn turning(
+        &mut self,
+        key: &Located<String>,
+        node: &YamlNode,
+        what: &str,
+    ) -> Option<TurningDef> {
+        let example = "turning: { angle: yaw, plane: [x, y] }";
+        let entries = self.map(node, &format!("`turning` of {what}"), example)?;
+        let (mut angle, mut plane) = (None, None);
+        for (k, v) in entries {
+            match k.value.as_str() {
+                "angle" => angle = self.name(v, "a coordinate"),
+                "plane" => {
+                    let items = self.seq(v, "`plane`", "plane: [x, y]")?;
+                    let names: Vec<_> = items
+                        .iter()
+                        .filter_map(|i| self.name(i, "a coordinate"))
+                        .collect();
+                    if names.len() != 2 {
+                        self.error(
+                            Diagnostic::new(v.location, format!("`plane` of `turning` names {} coordinates, not two", names.len()))
+                                .with_help("name the two Cartesian coordinates whose rates turn with the frame: `plane: [x, y]`"),
+                        );
+                        return None;
+                    }
+                    plane = Some(names);
+                }
+                other => {
+                    self.error(
+                        Diagnostic::new(
+                            k.location,
+                            format!("unknown key `{other}` in `turning` of {what}"),
+                        )
+                        .with_help(format!("`turning` takes `angle` and `plane`: `{example}`")),
+                    );
+                    return None;
+                }
+            }
+        }
+        match (angle, plane) {
+            (Some(angle), Some(plane)) => Some(TurningDef {
+                angle,
+                plane,
+                at: key.location,
+            }),
+            _ => {
+                self.error(
+                    Diagnostic::new(
+                        node.location,
+                        format!("`turning` of {what} needs `angle` and `plane`"),
+                    )
+                    .with_help(format!("write it like `{example}`")),
+                );
+                None
+            }
+        }
     }
 }
 
@@ -303,7 +389,16 @@ impl Writer<'_> {
                 .values
                 .iter()
                 .filter(|(n, _)| self.is_kept_name(&n.value))
-                .map(|(n, e)| format!("{}: {}", n.value, flow(&e.to_string())))
+                .map(|(n, e)| {
+                    let value = flow(&e.to_string());
+                    if eq.held.iter().any(|h| h.value == n.value) {
+                        format!("{}: {{ held: {value} }}", n.value)
+                    } else if eq.solved.iter().any(|h| h.value == n.value) {
+                        format!("{}: {{ guess: {value} }}", n.value)
+                    } else {
+                        format!("{}: {value}", n.value)
+                    }
+                })
                 .collect();
             let ignorable: Vec<&str> = eq
                 .ignorable
@@ -313,6 +408,24 @@ impl Writer<'_> {
                 .collect();
             if !ignorable.is_empty() {
                 parts.push(format!("ignorable: [{}]", ignorable.join(", ")));
+            }
+            if let Some(t) = &eq.turning {
+                let names: Vec<&str> = std::iter::once(&t.angle)
+                    .chain(&t.plane)
+                    .map(|n| n.value.as_str())
+                    .collect();
+                if names.iter().all(|n| self.is_kept(n)) {
+                    parts.push(format!(
+                        "turning: {{ angle: {}, plane: [{}] }}",
+                        names[0],
+                        names[1..].join(", ")
+                    ));
+                } else {
+                    self.notes.push(format!(
+                        "the steady turn `{}` lost its turning frame: a coordinate of it was removed",
+                        eq.name.value
+                    ));
+                }
             }
             block.push_str(&format!(
                 "  {}: {{ {} }}\n",
@@ -365,5 +478,17 @@ impl Writer<'_> {
         }
         self.block("events", &block);
         Ok(())
+    }
+}
+
+/// The mark and value of `{ held: value }` or `{ guess: value }`; `None` for anything else.
+fn marked_value(node: &YamlNode) -> Option<(&'static str, &YamlNode)> {
+    let YamlKind::Map(inner) = &node.kind else {
+        return None;
+    };
+    match inner.as_slice() {
+        [(k, v)] if k.value == "held" => Some(("held", v)),
+        [(k, v)] if k.value == "guess" => Some(("guess", v)),
+        _ => None,
     }
 }
