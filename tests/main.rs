@@ -37,6 +37,7 @@ mod runtime_models;
 mod simulation;
 mod stability;
 mod steady_motions;
+mod steady_turns;
 mod taylor;
 mod taylor_coefficients;
 mod taylor_kernels;

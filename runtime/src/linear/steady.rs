@@ -994,10 +994,12 @@ pub fn linearize_steady_motion_with(
     })
 }
 
-/// The reduced state matrix of a steady turn (`k × k`): `(P N_z)⁻¹ P A_z N_z`, with `A_z`
+/// The reduced state matrix of a steady turn (`k × k`): `P A_z N_z (P N_z)⁻¹`, with `A_z`
 /// and `N_z = T⁻¹ N` the state matrix `a` and the tangent basis `basis` (`2n × k`) taken
 /// to the turning frame at `y` ([`TurningFrame::state_matrix`]) and `P` picking the state
-/// entries `rows`. `P N_z = I` unless the plane's rates are independent states.
+/// entries `rows`: the linearised flow in the independent entries `P δz` of the turning
+/// frame's state (`δz = N_z w` with `w` the independent entries of `δy`, so
+/// `P δz = (P N_z) w`). `P N_z = I` unless the plane's rates are independent states.
 fn turning_reduced(
     frame: &TurningFrame,
     a: &DMatrix<f64>,
@@ -1011,10 +1013,11 @@ fn turning_reduced(
     let a_basis = a_z * &basis_z;
     let picked = DMatrix::from_fn(k, k, |r, c| basis_z[(rows[r], c)]);
     let moved = DMatrix::from_fn(k, k, |r, c| a_basis[(rows[r], c)]);
-    picked
-        .lu()
-        .solve(&moved)
-        .ok_or(SteadyMotionError::NonFinite)
+    // moved · picked⁻¹, as (picked⁻ᵀ movedᵀ)ᵀ.
+    let solved = (picked.transpose().lu())
+        .solve(&moved.transpose())
+        .ok_or(SteadyMotionError::NonFinite)?;
+    Ok(solved.transpose())
 }
 
 /// The constraint Jacobians of [`linearize_steady_motion`] at the operating point:
