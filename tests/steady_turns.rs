@@ -357,7 +357,7 @@ fn a_turn_the_model_is_not_symmetric_under_is_refused() {
         .expect_err("not a steady turn")
         .to_string();
     assert!(
-        error.contains("`psi (turning x and y with it)` moves in the steady motion"),
+        error.contains("turns `x` and `y` with `psi`, but the equations are not symmetric"),
         "{error}"
     );
 }

@@ -367,6 +367,22 @@ def test_modes_from_a_guess_and_at_a_steady_motion():
     steady = eomgen.load("chaplygin_sleigh").modes()
     assert isinstance(steady, eomgen.SteadyMotion)
     assert steady.eigenvalues.size >= 1
+    assert steady.turning is None and steady.found_rates == []
+
+
+def test_a_coin_in_a_steady_turn():
+    """The rolling disc's steady turn from Python: the same report as the command line, the
+    turning frame and the rates found, and the nodding frequency of the Kane derivation
+    (``tools/coin_turn_reference.py``) to 1e-9."""
+    turn = eomgen.load("rolling_disc").modes("turning")
+    assert isinstance(turn, eomgen.SteadyMotion)
+    assert turn.turning["angle"] == "yaw" and turn.turning["plane"] == ["x", "y"]
+    assert turn.turning["rate"] == -1.0 and abs(turn.turning["radius"] - 1.5) < 1e-13
+    assert turn.found_rates == ["x_dot", "y_dot"] and turn.held_coordinates == []
+    nonzero = turn.eigenvalues[np.abs(turn.eigenvalues) > 0]
+    assert np.allclose(np.abs(nonzero.imag), 9.6499221962793447639, rtol=0, atol=1e-9)
+    page = turn._repr_html_()
+    assert "held in the frame turned by yaw" in page and "rates found x_dot = 1.5" in page
 
 
 # --- derivations -------------------------------------------------------------------------------

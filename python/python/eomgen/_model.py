@@ -1330,11 +1330,23 @@ class SteadyMotion:
         damped_eigenvalues: those with ``Im s ≥ 0``: each complex pair once, each real
             eigenvalue once, as the report lists them (with ``damping_ratios``).
         damping_ratios: ``ζ`` of each of ``damped_eigenvalues``.
+        turning: for a steady turn (an entry with ``turning:``), the frame in which the
+            plane's rates are held and the linearisation is taken: ``{"angle", "plane",
+            "rate", "radius"}`` (``rate`` Ω in rad/s, ``radius`` ``|v|/|Ω|``); ``None``
+            otherwise.
+        found_rates: the rates the search found (``{ guess: … }`` in the entry) rather than
+            held.
+        held_coordinates: the coordinates held at their value (``{ held: … }``) rather than
+            found.
         summary: the report as ``eomgen modes --json`` prints it.
     """
 
     def __init__(self, summary: dict):
         self.summary = summary
+        point = summary["operating_point"]
+        self.turning = point.get("turning")
+        self.found_rates = list(point.get("found_rates", []))
+        self.held_coordinates = list(point.get("held_coordinates", []))
         modes = summary["damped_modes"]
         self.damped_eigenvalues = np.array([complex(d["re"], d["im"]) for d in modes])
         self.damping_ratios = np.array([d["damping_ratio"] for d in modes], dtype=float)
@@ -1349,11 +1361,20 @@ class SteadyMotion:
     def _repr_html_(self) -> str:
         """The steady motion, its eigenvalues (Re s, Im s, ζ) and the verdict, for Jupyter."""
         point = self.summary["operating_point"]
-        held = ", ".join(f"{c} = {v:.6g}" for c, v in point.get("qdot", {}).items())
+        rates = point.get("qdot", {}).items()
+        held = ", ".join(f"{c} = {v:.6g}" for c, v in rates if c not in self.found_rates)
+        found = ", ".join(f"{c} = {v:.6g}" for c, v in rates if c in self.found_rates)
         rows = [(k + 1, f"{s.real:.8g}", f"{s.imag:.8g}", f"{z:.4g}")
                 for k, (s, z) in enumerate(zip(self.damped_eigenvalues, self.damping_ratios))]
+        turn = ""
+        if self.turning:
+            a, b = self.turning["plane"]
+            turn = (f"<br>{html.escape(a)}_dot, {html.escape(b)}_dot held in the frame turned by "
+                    f"{html.escape(self.turning['angle'])}: Ω = {self.turning['rate']:.6g} rad/s, "
+                    f"radius {self.turning['radius']:.6g}; linearised in that frame")
         return (f"<b>eomgen.SteadyMotion</b> of <code>{html.escape(self.summary['model'])}</code> at "
                 f"{html.escape(str(point.get('name', '-')))}" + (f"; rates held {html.escape(held)}" if held else "")
+                + (f"; rates found {html.escape(found)}" if found else "") + turn
                 + _html_table(["eigenvalue", "Re s (1/s)", "Im s (rad/s, ≥ 0)", "ζ"], rows)
                 + f"stability: <b>{html.escape(_verdict(self.stability))}</b>")
 
