@@ -1,6 +1,6 @@
 //! The equations of motion of a model file as text and LaTeX, or as code for other tools
 //! (C, MATLAB/Octave, Python): what `eomgen equations` prints, and what the Python package's
-//! `Model.equations` and `Model.export` return.
+//! `Model.equations` and `Model.export` return; and its kinematics (`eomgen kinematics`).
 
 use eomgen_symbolic::codegen::{EquationsListing, equations_latex, equations_text};
 use eomgen_symbolic::expr::print::Syntax;
@@ -9,6 +9,12 @@ use eomgen_symbolic::model::Diagnostic;
 use serde::Serialize;
 
 pub use eomgen_symbolic::codegen::export::Language;
+
+mod kinematics;
+
+pub use kinematics::{
+    FrameListing, Kinematics, KinematicsListing, KinematicsOptions, PointListing, kinematics,
+};
 
 /// Which derivation to list.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -67,6 +73,16 @@ pub enum ListingError {
     NoMomentumForm {
         /// The model's name.
         model: String,
+    },
+    /// A frame or point asked for is not in the model file.
+    #[error("the model has no {kind} `{name}` (its {kind}s: {})", known.join(", "))]
+    UnknownName {
+        /// `frame` or `point`.
+        kind: &'static str,
+        /// The name asked for.
+        name: String,
+        /// The file's names of that kind.
+        known: Vec<String>,
     },
     /// The exporter could not write a function (a bug of the exporter: the reason names the
     /// function).

@@ -60,6 +60,10 @@ enum Command {
     /// Print a model's equations of motion M q'' = F (+ J^T lambda and J q'' = gamma with
     /// constraints) as text, LaTeX or JSON, derived at run time.
     Equations(commands::equations::EquationsArgs),
+    /// Print a model's kinematics: the angular velocity and acceleration of its frames, the
+    /// position, velocity and acceleration of its points, and their partial velocities, as
+    /// text, LaTeX or JSON.
+    Kinematics(commands::equations::KinematicsArgs),
     /// Equilibrium, exact linearisation (M, C, K), natural frequencies, mode shapes and
     /// damping ratios at an operating point (`--at hanging`).
     Modes(commands::modes::ModesArgs),
@@ -158,6 +162,7 @@ pub fn run() -> ExitCode {
         Command::Animate(args) => animate::run(&args),
         Command::Check(args) => check::run(&args),
         Command::Equations(args) => equations::run(&args),
+        Command::Kinematics(args) => equations::run_kinematics(&args),
         Command::New(args) => equations::new(&args),
         Command::Modes(args) => modes::run(&args),
         Command::Frf(args) => frf::run(&args),

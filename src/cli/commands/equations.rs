@@ -1,12 +1,15 @@
-//! `eomgen equations MODEL|FILE [--method lagrange|momentum] [--latex|--json|--rust|--c|--matlab|--python]`
-//! and `eomgen new TEMPLATE N`.
+//! `eomgen equations MODEL|FILE [--method lagrange|momentum] [--latex|--json|--rust|--c|--matlab|--python]`,
+//! `eomgen kinematics MODEL|FILE [--frame F]… [--point P]… [--partial] [--latex|--json]` and
+//! `eomgen new TEMPLATE N`.
 
 use clap::{Args, ValueEnum};
 
 use crate::cli::error::CliError;
 use crate::cli::model::{diagnostics_error, read_model};
 use crate::cli::output::out;
-use eomgen::listing::{Derivation, Language, ListingError, equations, export};
+use eomgen::listing::{
+    Derivation, KinematicsOptions, Language, ListingError, equations, export, kinematics,
+};
 use eomgen_symbolic::codegen::GenerateError;
 use eomgen_symbolic::model::templates;
 
@@ -50,6 +53,51 @@ pub struct EquationsArgs {
     /// Print the same as a Python module (NumPy).
     #[arg(long, conflicts_with_all = ["method", "latex", "json", "rust"])]
     pub python: bool,
+}
+
+/// Options of `eomgen kinematics`.
+#[derive(Debug, Args)]
+pub struct KinematicsArgs {
+    /// A bundled model's name, or the path of a model file.
+    pub model: String,
+    /// A frame to list (repeatable; default: every frame of the file's `frames:`).
+    #[arg(long = "frame", value_name = "FRAME")]
+    pub frames: Vec<String>,
+    /// A point to list (repeatable; default: every point of the file's `points:`).
+    #[arg(long = "point", value_name = "POINT")]
+    pub points: Vec<String>,
+    /// Also list the partial velocities ∂v/∂q̇ᵢ and ∂ω/∂q̇ᵢ.
+    #[arg(long)]
+    pub partial: bool,
+    /// Print LaTeX (amsmath) instead of text.
+    #[arg(long)]
+    pub latex: bool,
+    /// Print JSON: `{"model", "coordinates", "frames", "points", "latex"}`.
+    #[arg(long, conflicts_with = "latex")]
+    pub json: bool,
+}
+
+/// Runs `kinematics`.
+pub fn run_kinematics(args: &KinematicsArgs) -> Result<(), CliError> {
+    let (display, source) = read_model(&args.model)?;
+    let options = KinematicsOptions {
+        frames: args.frames.clone(),
+        points: args.points.clone(),
+        partial: args.partial,
+    };
+    let listing = kinematics(&display, &source, &options).map_err(|e| match e {
+        ListingError::Diagnostics(d) => diagnostics_error(&display, &source, &d),
+        e @ ListingError::UnknownName { .. } => CliError::usage(e.to_string()),
+        e => CliError::failure(e.to_string()),
+    })?;
+    if args.json {
+        crate::cli::json::print_json(&listing)?;
+    } else if args.latex {
+        out!("{}", listing.latex_document);
+    } else {
+        out!("{}", listing.text);
+    }
+    Ok(())
 }
 
 /// Options of `eomgen new`.

@@ -75,6 +75,11 @@ impl Frames {
         self.names.len() - 1
     }
 
+    /// The frames' names, the ground's first.
+    pub fn names(&self) -> &[String] {
+        &self.names
+    }
+
     /// The index of the frame called `name`.
     pub fn index(&self, name: &str) -> Option<usize> {
         self.names.iter().position(|n| n == name)
@@ -130,6 +135,51 @@ impl Frames {
                             *wi = arena.plus(*wi, part);
                         }
                     }
+                }
+            }
+        }
+        w
+    }
+}
+
+impl Frames {
+    /// `^N ω^F` in the ground's components (rad/s): the sum of the simple angular velocities
+    /// `ȧ e` of the rotations from `N` down to `frame`, each axis `e` carried up to `N`
+    /// through the rotations before it (Kane & Levinson §2.4, the addition theorem), so that
+    /// each term keeps only the angles above its own rotation (`φ̇ N.z + θ̇ A.x + ψ̇ B.z` for
+    /// Euler angles, rather than the frame's components turned back through every angle).
+    pub fn angular_velocity_in_ground(&self, arena: &mut ExprArena, frame: usize) -> Vector3 {
+        let zero = arena.int(0);
+        let one = arena.int(1);
+        let mut w = [zero; 3];
+        let path = self.path(frame);
+        for (depth, &f) in path.iter().enumerate().skip(1) {
+            for (j, &(axis, angle)) in self.rotations[f].iter().enumerate() {
+                let rate = arena.time_derivative(angle);
+                if arena.is_zero(rate) {
+                    continue;
+                }
+                // The axis in the frame its rotation turns (the same before and after it).
+                let mut e = match axis {
+                    RotationAxis::Principal(i) => {
+                        let mut e = [zero; 3];
+                        e[i] = one;
+                        e
+                    }
+                    RotationAxis::Unit(k) => k,
+                };
+                // Up through the frame's rotations before it, then through its ancestors'.
+                for &(a, angle) in self.rotations[f][..j].iter().rev() {
+                    e = rotate(arena, e, a, angle, false);
+                }
+                for &g in path[1..depth].iter().rev() {
+                    for &(a, angle) in self.rotations[g].iter().rev() {
+                        e = rotate(arena, e, a, angle, false);
+                    }
+                }
+                for (wi, ei) in w.iter_mut().zip(e) {
+                    let part = arena.times(ei, rate);
+                    *wi = arena.plus(*wi, part);
                 }
             }
         }

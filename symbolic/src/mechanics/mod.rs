@@ -10,6 +10,7 @@ mod constraints;
 pub mod cross_check;
 mod energy;
 pub mod frames;
+mod kinematics;
 mod lagrange;
 mod limit;
 mod lower;
@@ -21,6 +22,7 @@ mod preferred;
 pub use balances::{HandEquations, UserBalances};
 pub use constraints::{ConstraintEquations, linear_in_rates, redundant_rows};
 pub use energy::{EnergyRate, PowerRoute, energy_routes_skipped};
+pub use kinematics::{FrameKinematics, PointKinematics};
 pub use lagrange::Lagrange;
 pub use limit::{DERIVATION_OPERAND_LIMIT, finish_derivation, limit_derivation};
 pub use lower::{

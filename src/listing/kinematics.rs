@@ -1,0 +1,257 @@
+//! Kinematics on demand (`eomgen kinematics`, the Python package's `Model.kinematics`): the
+//! angular velocity and acceleration of a model's frames, the position, velocity and
+//! acceleration of its points and their partial velocities, printed as text and LaTeX from
+//! [`eomgen_symbolic::mechanics::SymbolicModel::frame_kinematics`] and
+//! [`eomgen_symbolic::mechanics::SymbolicModel::point_kinematics`].
+
+use std::fmt::Write as _;
+
+use eomgen_symbolic::expr::ExprId;
+use eomgen_symbolic::expr::print::{Printer, Syntax};
+use eomgen_symbolic::mechanics::SymbolicModel;
+use serde::Serialize;
+
+use super::ListingError;
+
+/// What [`kinematics`] lists.
+#[derive(Debug, Clone, PartialEq, Eq, Default, Serialize)]
+pub struct KinematicsOptions {
+    /// The frames, by name (empty: every frame of the file's `frames:`).
+    pub frames: Vec<String>,
+    /// The points, by name (empty: every point of the file's `points:`).
+    pub points: Vec<String>,
+    /// Whether to list the partial velocities `∂v/∂q̇ᵢ` and `∂ω/∂q̇ᵢ` too.
+    pub partial: bool,
+}
+
+/// One frame's angular motion in the ground frame `N`, each vector as its three components.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FrameListing {
+    /// The frame's name.
+    pub name: String,
+    /// `^N ω^F` in the frame's own components (rad/s).
+    pub angular_velocity: Vec<String>,
+    /// `^N ω^F` in `N`'s components (rad/s).
+    pub angular_velocity_ground: Vec<String>,
+    /// `^N α^F` in the frame's own components (rad/s²).
+    pub angular_acceleration: Vec<String>,
+    /// `∂ω/∂q̇ᵢ` in the frame's components, per coordinate `qᵢ` (in coordinate order); empty
+    /// unless asked for, and then left out of the JSON.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub partial_angular_velocities: Vec<Vec<String>>,
+}
+
+/// One point's motion in the ground frame `N`, in `N`'s components (two for a planar model).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PointListing {
+    /// The point's name.
+    pub name: String,
+    /// `r_P` (m).
+    pub position: Vec<String>,
+    /// `^N v_P` (m/s).
+    pub velocity: Vec<String>,
+    /// `^N a_P` (m/s²).
+    pub acceleration: Vec<String>,
+    /// `∂v_P/∂q̇ᵢ` per coordinate `qᵢ` (in coordinate order); empty unless asked for, and
+    /// then left out of the JSON.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub partial_velocities: Vec<Vec<String>>,
+}
+
+/// The frames and points listed in one syntax.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct KinematicsListing {
+    /// The frames asked for, in the file's order.
+    pub frames: Vec<FrameListing>,
+    /// The points asked for, in the file's order.
+    pub points: Vec<PointListing>,
+}
+
+/// A model's kinematics, as `eomgen kinematics --json` prints it: `{"model", "coordinates",
+/// "frames", "points", "latex": {"frames", "points"}}`, the expressions in the model file's
+/// syntax (they parse back with the model parser, and with SymPy once `^` is `**`), rates
+/// named `x_dot` and accelerations `x_ddot`.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Kinematics {
+    /// The model's name.
+    pub model: String,
+    /// The coordinates `qᵢ`, the order of the partial velocities.
+    pub coordinates: Vec<String>,
+    /// The frames and points in the model file's syntax.
+    #[serde(flatten)]
+    pub listing: KinematicsListing,
+    /// The same in LaTeX.
+    pub latex: KinematicsListing,
+    /// The listing as `eomgen kinematics` prints it (not serialised).
+    #[serde(skip)]
+    pub text: String,
+    /// The listing as `eomgen kinematics --latex` prints it (not serialised).
+    #[serde(skip)]
+    pub latex_document: String,
+}
+
+/// Loads the model file `text` (`path` names it in diagnostics) and lists the kinematics
+/// `options` asks for: each frame's `^N ω^F` (in its own and in `N`'s components) and
+/// `^N α^F`, each point's position, velocity and acceleration in `N`, and with
+/// `options.partial` the partial velocities with the coordinate rates as generalized
+/// speeds.
+///
+/// # Errors
+/// [`ListingError::Diagnostics`] for a file with mistakes; [`ListingError::UnknownName`] for
+/// a frame or point the file does not have.
+///
+/// # Examples
+/// ```
+/// use eomgen::listing::{KinematicsOptions, kinematics};
+/// let text = eomgen::models::find("heavy_top").unwrap().source;
+/// let options = KinematicsOptions { frames: vec!["B".into()], ..Default::default() };
+/// let k = kinematics("heavy_top.yaml", text, &options)?;
+/// assert_eq!(k.listing.frames[0].angular_velocity.len(), 3);
+/// # Ok::<(), eomgen::listing::ListingError>(())
+/// ```
+///
+/// # References
+/// Kane & Levinson, *Dynamics: Theory and Applications* (1985), §§2.1–2.7, 2.14; lecture 18.
+pub fn kinematics(
+    path: &str,
+    text: &str,
+    options: &KinematicsOptions,
+) -> Result<Kinematics, ListingError> {
+    let file = eomgen_symbolic::model::load(path, text).map_err(ListingError::Diagnostics)?;
+    let mut model = SymbolicModel::from_file(&file).map_err(ListingError::Diagnostics)?;
+    let file_frames: Vec<String> = file.frames.iter().map(|f| f.name.value.clone()).collect();
+    let file_points: Vec<String> = file.points.iter().map(|p| p.name.value.clone()).collect();
+    let frames = chosen("frame", &options.frames, &file_frames)?;
+    let points = chosen("point", &options.points, &file_points)?;
+    let mut frame_exprs = Vec::new();
+    for name in &frames {
+        let Some(index) = model.frame_names().iter().position(|f| f == name) else {
+            continue;
+        };
+        frame_exprs.push(model.frame_kinematics(index));
+    }
+    let mut point_exprs = Vec::new();
+    for name in &points {
+        let Some(index) = model.points.iter().position(|(p, _)| p == name) else {
+            continue;
+        };
+        point_exprs.push(model.point_kinematics(index));
+    }
+    let list = |syntax: Syntax| {
+        let p = Printer::for_display(&model.arena, syntax);
+        let show = |v: &[ExprId]| v.iter().map(|&e| p.print(e)).collect::<Vec<_>>();
+        KinematicsListing {
+            frames: (frame_exprs.iter())
+                .map(|f| FrameListing {
+                    name: f.name.clone(),
+                    angular_velocity: show(&f.angular_velocity),
+                    angular_velocity_ground: show(&f.angular_velocity_ground),
+                    angular_acceleration: show(&f.angular_acceleration),
+                    partial_angular_velocities: match options.partial {
+                        true => f.partial_angular_velocities.iter().map(|w| show(w)).collect(),
+                        false => Vec::new(),
+                    },
+                })
+                .collect(),
+            points: (point_exprs.iter())
+                .map(|k| PointListing {
+                    name: k.name.clone(),
+                    position: show(&k.position),
+                    velocity: show(&k.velocity),
+                    acceleration: show(&k.acceleration),
+                    partial_velocities: match options.partial {
+                        true => k.partial_velocities.iter().map(|v| show(v)).collect(),
+                        false => Vec::new(),
+                    },
+                })
+                .collect(),
+        }
+    };
+    let listing = list(Syntax::Text);
+    let latex = list(Syntax::Latex);
+    let coordinates = model.coordinate_names.clone();
+    Ok(Kinematics {
+        text: render_text(&model.name, &coordinates, &listing),
+        latex_document: render_latex(&coordinates, &latex),
+        model: model.name.clone(),
+        coordinates,
+        listing,
+        latex,
+    })
+}
+
+/// The names asked for (`asked`), checked against the file's (`known`), or all of them.
+fn chosen(kind: &'static str, asked: &[String], known: &[String]) -> Result<Vec<String>, ListingError> {
+    if asked.is_empty() {
+        return Ok(known.to_vec());
+    }
+    match asked.iter().find(|a| !known.contains(a)) {
+        Some(name) => Err(ListingError::UnknownName {
+            kind,
+            name: name.clone(),
+            known: known.to_vec(),
+        }),
+        None => Ok(known.iter().filter(|k| asked.contains(k)).cloned().collect()),
+    }
+}
+
+/// `[a, b, c]`.
+fn vector(v: &[String]) -> String {
+    format!("[{}]", v.join(", "))
+}
+
+/// The listing as `eomgen kinematics` prints it.
+fn render_text(model: &str, coordinates: &[String], k: &KinematicsListing) -> String {
+    let mut out = String::new();
+    let _ = writeln!(out, "kinematics of `{model}` in the ground frame N");
+    for f in &k.frames {
+        let _ = writeln!(out, "\nframe {} (angular velocity in rad/s, acceleration in rad/s^2)", f.name);
+        let _ = writeln!(out, "  omega ({} components) = {}", f.name, vector(&f.angular_velocity));
+        let _ = writeln!(out, "  omega (N components) = {}", vector(&f.angular_velocity_ground));
+        let _ = writeln!(out, "  alpha ({} components) = {}", f.name, vector(&f.angular_acceleration));
+        for (q, w) in coordinates.iter().zip(&f.partial_angular_velocities) {
+            let _ = writeln!(out, "  d omega/d {q}_dot = {}", vector(w));
+        }
+    }
+    for p in &k.points {
+        let _ = writeln!(out, "\npoint {} (N components: m, m/s, m/s^2)", p.name);
+        let _ = writeln!(out, "  r = {}", vector(&p.position));
+        let _ = writeln!(out, "  v = {}", vector(&p.velocity));
+        let _ = writeln!(out, "  a = {}", vector(&p.acceleration));
+        for (q, v) in coordinates.iter().zip(&p.partial_velocities) {
+            let _ = writeln!(out, "  d v/d {q}_dot = {}", vector(v));
+        }
+    }
+    out
+}
+
+/// A column vector in LaTeX.
+fn latex_vector(v: &[String]) -> String {
+    format!("\\begin{{bmatrix}} {} \\end{{bmatrix}}", v.join(" \\\\ "))
+}
+
+/// The listing as `eomgen kinematics --latex` prints it: an amsmath document body.
+fn render_latex(coordinates: &[String], k: &KinematicsListing) -> String {
+    let symbol = eomgen_symbolic::expr::print::latex_symbol;
+    let mut out = String::from("\\begin{align*}\n");
+    for f in &k.frames {
+        let frame = symbol(&f.name);
+        let _ = writeln!(out, "{{}}^{{N}}\\boldsymbol{{\\omega}}^{{{frame}}} &= {} \\quad (\\text{{in }} {frame}) \\\\", latex_vector(&f.angular_velocity));
+        let _ = writeln!(out, "{{}}^{{N}}\\boldsymbol{{\\omega}}^{{{frame}}} &= {} \\quad (\\text{{in }} N) \\\\", latex_vector(&f.angular_velocity_ground));
+        let _ = writeln!(out, "{{}}^{{N}}\\boldsymbol{{\\alpha}}^{{{frame}}} &= {} \\quad (\\text{{in }} {frame}) \\\\", latex_vector(&f.angular_acceleration));
+        for (q, w) in coordinates.iter().zip(&f.partial_angular_velocities) {
+            let _ = writeln!(out, "\\frac{{\\partial\\, {{}}^{{N}}\\boldsymbol{{\\omega}}^{{{frame}}}}}{{\\partial \\dot{{{}}}}} &= {} \\\\", symbol(q), latex_vector(w));
+        }
+    }
+    for p in &k.points {
+        let point = symbol(&p.name);
+        let _ = writeln!(out, "\\mathbf{{r}}_{{{point}}} &= {} \\\\", latex_vector(&p.position));
+        let _ = writeln!(out, "{{}}^{{N}}\\mathbf{{v}}_{{{point}}} &= {} \\\\", latex_vector(&p.velocity));
+        let _ = writeln!(out, "{{}}^{{N}}\\mathbf{{a}}_{{{point}}} &= {} \\\\", latex_vector(&p.acceleration));
+        for (q, v) in coordinates.iter().zip(&p.partial_velocities) {
+            let _ = writeln!(out, "\\frac{{\\partial\\, {{}}^{{N}}\\mathbf{{v}}_{{{point}}}}}{{\\partial \\dot{{{}}}}} &= {} \\\\", symbol(q), latex_vector(v));
+        }
+    }
+    out.push_str("\\end{align*}\n");
+    out
+}
