@@ -768,6 +768,38 @@ impl CoreModel {
         ))
     }
 
+    /// The kinematics of `frames` and `points` (every one of the file's when empty), with
+    /// the partial velocities when `partial`: `(listing, text, latex)`, the listing
+    /// `{"model", "coordinates", "frames", "points", "latex"}` as `eomgen kinematics --json`
+    /// prints it ([`eomgen::listing::kinematics`]).
+    #[pyo3(signature = (frames, points, partial))]
+    fn kinematics<'py>(
+        &self,
+        py: Python<'py>,
+        frames: Vec<String>,
+        points: Vec<String>,
+        partial: bool,
+    ) -> PyResult<(Bound<'py, PyAny>, String, String)> {
+        use eomgen::listing::{KinematicsOptions, ListingError, kinematics};
+        let path = self.loaded.source.path().to_string();
+        let text = self.loaded.text.clone();
+        let options = KinematicsOptions {
+            frames,
+            points,
+            partial,
+        };
+        let listing = py.detach(|| kinematics(&path, &text, &options));
+        let listing = listing.map_err(|e| match e {
+            ListingError::Diagnostics(d) => model_error(py, &path, &text, &d),
+            e => pyo3::exceptions::PyValueError::new_err(e.to_string()),
+        })?;
+        Ok((
+            to_python(py, &listing, Lists::Plain)?,
+            listing.text,
+            listing.latex_document,
+        ))
+    }
+
     /// The equations as source code in `language` (`c`, `matlab` or `python`), as
     /// `eomgen equations --c` (`--matlab`, `--python`) prints them, with the parameters this
     /// model has set as the exported defaults ([`eomgen::listing::export_with_parameters`]).

@@ -148,7 +148,11 @@ pub fn kinematics(
                     angular_velocity_ground: show(&f.angular_velocity_ground),
                     angular_acceleration: show(&f.angular_acceleration),
                     partial_angular_velocities: match options.partial {
-                        true => f.partial_angular_velocities.iter().map(|w| show(w)).collect(),
+                        true => f
+                            .partial_angular_velocities
+                            .iter()
+                            .map(|w| show(w))
+                            .collect(),
                         false => Vec::new(),
                     },
                 })
@@ -181,7 +185,11 @@ pub fn kinematics(
 }
 
 /// The names asked for (`asked`), checked against the file's (`known`), or all of them.
-fn chosen(kind: &'static str, asked: &[String], known: &[String]) -> Result<Vec<String>, ListingError> {
+fn chosen(
+    kind: &'static str,
+    asked: &[String],
+    known: &[String],
+) -> Result<Vec<String>, ListingError> {
     if asked.is_empty() {
         return Ok(known.to_vec());
     }
@@ -191,7 +199,11 @@ fn chosen(kind: &'static str, asked: &[String], known: &[String]) -> Result<Vec<
             name: name.clone(),
             known: known.to_vec(),
         }),
-        None => Ok(known.iter().filter(|k| asked.contains(k)).cloned().collect()),
+        None => Ok(known
+            .iter()
+            .filter(|k| asked.contains(k))
+            .cloned()
+            .collect()),
     }
 }
 
@@ -205,10 +217,28 @@ fn render_text(model: &str, coordinates: &[String], k: &KinematicsListing) -> St
     let mut out = String::new();
     let _ = writeln!(out, "kinematics of `{model}` in the ground frame N");
     for f in &k.frames {
-        let _ = writeln!(out, "\nframe {} (angular velocity in rad/s, acceleration in rad/s^2)", f.name);
-        let _ = writeln!(out, "  omega ({} components) = {}", f.name, vector(&f.angular_velocity));
-        let _ = writeln!(out, "  omega (N components) = {}", vector(&f.angular_velocity_ground));
-        let _ = writeln!(out, "  alpha ({} components) = {}", f.name, vector(&f.angular_acceleration));
+        let _ = writeln!(
+            out,
+            "\nframe {} (angular velocity in rad/s, acceleration in rad/s^2)",
+            f.name
+        );
+        let _ = writeln!(
+            out,
+            "  omega ({} components) = {}",
+            f.name,
+            vector(&f.angular_velocity)
+        );
+        let _ = writeln!(
+            out,
+            "  omega (N components) = {}",
+            vector(&f.angular_velocity_ground)
+        );
+        let _ = writeln!(
+            out,
+            "  alpha ({} components) = {}",
+            f.name,
+            vector(&f.angular_acceleration)
+        );
         for (q, w) in coordinates.iter().zip(&f.partial_angular_velocities) {
             let _ = writeln!(out, "  d omega/d {q}_dot = {}", vector(w));
         }
@@ -236,20 +266,54 @@ fn render_latex(coordinates: &[String], k: &KinematicsListing) -> String {
     let mut out = String::from("\\begin{align*}\n");
     for f in &k.frames {
         let frame = symbol(&f.name);
-        let _ = writeln!(out, "{{}}^{{N}}\\boldsymbol{{\\omega}}^{{{frame}}} &= {} \\quad (\\text{{in }} {frame}) \\\\", latex_vector(&f.angular_velocity));
-        let _ = writeln!(out, "{{}}^{{N}}\\boldsymbol{{\\omega}}^{{{frame}}} &= {} \\quad (\\text{{in }} N) \\\\", latex_vector(&f.angular_velocity_ground));
-        let _ = writeln!(out, "{{}}^{{N}}\\boldsymbol{{\\alpha}}^{{{frame}}} &= {} \\quad (\\text{{in }} {frame}) \\\\", latex_vector(&f.angular_acceleration));
+        let _ = writeln!(
+            out,
+            "{{}}^{{N}}\\boldsymbol{{\\omega}}^{{{frame}}} &= {} \\quad (\\text{{in }} {frame}) \\\\",
+            latex_vector(&f.angular_velocity)
+        );
+        let _ = writeln!(
+            out,
+            "{{}}^{{N}}\\boldsymbol{{\\omega}}^{{{frame}}} &= {} \\quad (\\text{{in }} N) \\\\",
+            latex_vector(&f.angular_velocity_ground)
+        );
+        let _ = writeln!(
+            out,
+            "{{}}^{{N}}\\boldsymbol{{\\alpha}}^{{{frame}}} &= {} \\quad (\\text{{in }} {frame}) \\\\",
+            latex_vector(&f.angular_acceleration)
+        );
         for (q, w) in coordinates.iter().zip(&f.partial_angular_velocities) {
-            let _ = writeln!(out, "\\frac{{\\partial\\, {{}}^{{N}}\\boldsymbol{{\\omega}}^{{{frame}}}}}{{\\partial \\dot{{{}}}}} &= {} \\\\", symbol(q), latex_vector(w));
+            let _ = writeln!(
+                out,
+                "\\frac{{\\partial\\, {{}}^{{N}}\\boldsymbol{{\\omega}}^{{{frame}}}}}{{\\partial \\dot{{{}}}}} &= {} \\\\",
+                symbol(q),
+                latex_vector(w)
+            );
         }
     }
     for p in &k.points {
         let point = symbol(&p.name);
-        let _ = writeln!(out, "\\mathbf{{r}}_{{{point}}} &= {} \\\\", latex_vector(&p.position));
-        let _ = writeln!(out, "{{}}^{{N}}\\mathbf{{v}}_{{{point}}} &= {} \\\\", latex_vector(&p.velocity));
-        let _ = writeln!(out, "{{}}^{{N}}\\mathbf{{a}}_{{{point}}} &= {} \\\\", latex_vector(&p.acceleration));
+        let _ = writeln!(
+            out,
+            "\\mathbf{{r}}_{{{point}}} &= {} \\\\",
+            latex_vector(&p.position)
+        );
+        let _ = writeln!(
+            out,
+            "{{}}^{{N}}\\mathbf{{v}}_{{{point}}} &= {} \\\\",
+            latex_vector(&p.velocity)
+        );
+        let _ = writeln!(
+            out,
+            "{{}}^{{N}}\\mathbf{{a}}_{{{point}}} &= {} \\\\",
+            latex_vector(&p.acceleration)
+        );
         for (q, v) in coordinates.iter().zip(&p.partial_velocities) {
-            let _ = writeln!(out, "\\frac{{\\partial\\, {{}}^{{N}}\\mathbf{{v}}_{{{point}}}}}{{\\partial \\dot{{{}}}}} &= {} \\\\", symbol(q), latex_vector(v));
+            let _ = writeln!(
+                out,
+                "\\frac{{\\partial\\, {{}}^{{N}}\\mathbf{{v}}_{{{point}}}}}{{\\partial \\dot{{{}}}}} &= {} \\\\",
+                symbol(q),
+                latex_vector(v)
+            );
         }
     }
     out.push_str("\\end{align*}\n");

@@ -587,6 +587,24 @@ class Model:
         listing, text, latex_document = self._core.equations(str(method))
         return Equations(latex_document if latex else text, latex_document, listing)
 
+    def kinematics(self, frames=None, points=None, partial: bool = False) -> dict:
+        """The kinematics of the model's frames and points, as ``eomgen kinematics --json``
+        gives it: for each frame ``F`` (default: every frame of the file's ``frames:``) its
+        angular velocity ``^N ω^F`` in its own components (``"angular_velocity"``, rad/s,
+        SymPy's ``F.ang_vel_in(N)``) and in the ground's (``"angular_velocity_ground"``) and
+        its angular acceleration in its own components; for each point ``P`` (default: every
+        point) its position, velocity ``^N v_P`` (``P.vel(N)``) and acceleration in the
+        ground's components; with ``partial``, the partial velocities ``∂v/∂q̇ᵢ`` and
+        ``∂ω/∂q̇ᵢ`` per coordinate. Each component is an expression string in the model
+        file's syntax (``x_dot``, ``x_ddot``, ``^`` for powers), ``"latex"`` holds the same
+        in LaTeX, and ``"text"`` the listing as the command line prints it.
+
+        Raises ``ValueError`` for a frame or point the file does not have."""
+        listing, text, _ = self._core.kinematics(
+            [str(f) for f in (frames or [])], [str(p) for p in (points or [])], bool(partial))
+        listing["text"] = text
+        return listing
+
     def export(self, language: str) -> str:
         """The equations as source code for another tool: ``language`` is ``"c"`` (C99),
         ``"matlab"`` (a MATLAB/Octave function file, saved as ``NAME.m``) or ``"python"``

@@ -381,5 +381,19 @@ mod tests {
         let back = frames.express(&mut a, z, 0, b);
         let got = numbers(&a, &back, &q, &r);
         assert!((got[0]).abs() < 1e-15 && got[1].abs() < 1e-15 && (got[2] - 1.0).abs() < 1e-15);
+        // In N's components, summed rotation by rotation: φ̇ N.z + θ̇ A.x + ψ̇ B.z, equal to
+        // the body components carried up (Goldstein §4.9), and of that textbook form.
+        let summed = frames.angular_velocity_in_ground(&mut a, b);
+        let carried = frames.express(&mut a, w, b, 0);
+        let (got, want) = (numbers(&a, &summed, &q, &r), numbers(&a, &carried, &q, &r));
+        let textbook = [
+            r[1] * q[0].cos() + r[2] * st * q[0].sin(),
+            r[1] * q[0].sin() - r[2] * st * q[0].cos(),
+            r[0] + r[2] * ct,
+        ];
+        for i in 0..3 {
+            assert!((got[i] - want[i]).abs() < 1e-14, "{got:?} {want:?}");
+            assert!((got[i] - textbook[i]).abs() < 1e-14, "{got:?} {textbook:?}");
+        }
     }
 }

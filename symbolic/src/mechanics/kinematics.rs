@@ -56,7 +56,9 @@ impl SymbolicModel {
     /// The kinematics of the frame `frame` (an index into [`Self::frame_names`]).
     pub fn frame_kinematics(&mut self, frame: usize) -> FrameKinematics {
         let w = self.frames.angular_velocity(&mut self.arena, frame);
-        let ground = self.frames.angular_velocity_in_ground(&mut self.arena, frame);
+        let ground = self
+            .frames
+            .angular_velocity_in_ground(&mut self.arena, frame);
         let alpha = w.map(|c| self.arena.time_derivative(c));
         let partial_angular_velocities = (0..self.num_dofs())
             .map(|i| {
