@@ -54,8 +54,9 @@ fn a_rolling_coins_turn_has_the_closed_forms_lean_and_kanes_eigenvalues() {
     assert!((lean - 0.2201646358312328062697032).abs() < 1e-14, "{lean}");
     let turn = a.turning.as_ref().expect("a steady turn");
     assert_eq!((turn.angle.as_str(), turn.rate), ("yaw", -1.0));
-    assert!((turn.radius - 1.5).abs() < 1e-13, "{}", turn.radius);
-    let radius_g = turn.radius - r * lean.sin();
+    let radius = turn.radius.expect("a circle");
+    assert!((radius - 1.5).abs() < 1e-13, "{radius}");
+    let radius_g = radius - r * lean.sin();
     let v = turn.rate.abs() * radius_g;
     let closed = v * v * (1.5 / radius_g + r * lean.sin() / (4.0 * radius_g * radius_g));
     assert!((g * lean.tan() - closed).abs() < 1e-13 * closed, "{closed}");
@@ -74,7 +75,7 @@ fn a_rolling_coins_turn_has_the_closed_forms_lean_and_kanes_eigenvalues() {
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(text.contains("rates found    x_dot = 1.5"), "{text}");
     assert!(
-        text.contains("x_dot, y_dot held in the frame turned by yaw: Ω = yaw_dot = -1 rad/s"),
+        text.contains("x_dot, y_dot constant in the frame turned by yaw: Ω = yaw_dot = -1 rad/s"),
         "{text}"
     );
 }
@@ -360,4 +361,185 @@ fn a_turn_the_model_is_not_symmetric_under_is_refused() {
         error.contains("turns `x` and `y` with `psi`, but the equations are not symmetric"),
         "{error}"
     );
+}
+
+/// A Chaplygin sleigh turning under a body-fixed thrust and yaw moment
+/// (`tests/fixtures/sleigh_turn.yaml`): its knife edge makes one of the contact point's
+/// rates dependent and leaves the other a state measured in the turning frame, which one
+/// depending on the heading. Linearised at the headings 0, 1, π/2 and 3 rad, the
+/// eigenvalues equal those of the body-frame closed form
+/// `[−k/m, 2 d w; −m d w/(I + m d²), −(m d u + dr)/(I + m d²)]` at the turn's `u` and `w`
+/// to 1e-9 (central differences), and the turn satisfies `u = u0 + m d w²/k` and
+/// `m d u w = Ms − dr w` to 1e-12.
+#[test]
+fn a_sleigh_turning_with_one_plane_rate_constrained_has_its_closed_form_at_every_heading() {
+    let path = format!(
+        "{}/tests/fixtures/sleigh_turn.yaml",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let (m_, i_, d, k, u0, ms, dr) = (1.0, 0.1, 0.5, 3.0, 2.0, 0.4, 0.3);
+    for heading in [0.0, 1.0, std::f64::consts::FRAC_PI_2, 3.0] {
+        let mut m = file_model(&path);
+        m.set_parameter("heading", heading).expect("heading");
+        let a = vibration::steady_motion_analysis(m.as_mut(), &at("turn")).expect("turns");
+        let qd = &a.steady_motion.qdot;
+        let (c, s) = (heading.cos(), heading.sin());
+        let (u, w) = (qd[0] * c + qd[1] * s, qd[2]);
+        assert!(
+            (-qd[0] * s + qd[1] * c).abs() < 1e-12,
+            "side slip at {heading}"
+        );
+        assert!((u - u0 - m_ * d * w * w / k).abs() < 1e-12, "{u}, {w}");
+        assert!((m_ * d * u * w - (ms - dr * w)).abs() < 1e-12, "{u}, {w}");
+        let j = i_ + m_ * d * d;
+        let closed = nalgebra::Matrix2::new(
+            -k / m_,
+            2.0 * d * w,
+            -m_ * d * w / j,
+            -(m_ * d * u + dr) / j,
+        );
+        let mut want: Vec<f64> = closed.complex_eigenvalues().iter().map(|z| z.re).collect();
+        want.sort_by(f64::total_cmp);
+        let mut got: Vec<f64> = a.eigenvalues.iter().map(|z| z.re).collect();
+        got.sort_by(f64::total_cmp);
+        assert_eq!(
+            a.linearization.states.len(),
+            2,
+            "{:?}",
+            a.linearization.states
+        );
+        for (g, w) in got.iter().zip(&want) {
+            assert!(
+                (g - w).abs() < 1e-9,
+                "heading {heading}: {got:?} against {want:?}"
+            );
+        }
+    }
+}
+
+/// The cornering body linearised at a heading of 1 rad instead of 0: the turning frame's
+/// rates are then the ground-aligned components at that instant, not the body frame's, and
+/// the eigenvalues are the same to 1e-12.
+#[test]
+fn a_turn_linearised_at_another_heading_has_the_same_eigenvalues() {
+    let (_dir, path) = {
+        let text = std::fs::read_to_string(format!(
+            "{}/tests/fixtures/cornering_body.yaml",
+            env!("CARGO_MANIFEST_DIR")
+        ))
+        .expect("fixture");
+        let text = text
+            .replace(
+                "    x_dot: { guess: 2 }\n",
+                "    psi: 1\n    x_dot: { guess: 2*cos(1) }\n",
+            )
+            .replace(
+                "    y_dot: { guess: 0 }\n",
+                "    y_dot: { guess: 2*sin(1) }\n",
+            );
+        let dir = tempfile::tempdir().expect("folder");
+        let file = dir.path().join("cornering_body.yaml");
+        std::fs::write(&file, text).expect("written");
+        let file = file.to_str().expect("UTF-8").to_string();
+        (dir, file)
+    };
+    let base = format!(
+        "{}/tests/fixtures/cornering_body.yaml",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let eigen = |path: &str| {
+        let mut m = file_model(path);
+        let a = vibration::steady_motion_analysis(m.as_mut(), &at("cornering")).expect("turns");
+        let mut s = a.eigenvalues.clone();
+        s.sort_by(|a, b| a.re.total_cmp(&b.re).then(a.im.total_cmp(&b.im)));
+        (s, a.steady_motion.q[2])
+    };
+    let ((zero, psi0), (one, psi1)) = (eigen(&base), eigen(&path));
+    assert_eq!((psi0, psi1), (0.0, 1.0));
+    for (a, b) in zero.iter().zip(&one) {
+        assert!((a - b).norm() < 1e-12, "{zero:?} against {one:?}");
+    }
+}
+
+/// Sweeps of steady motions that hold no value of a family start every value from the
+/// entry's own guess, as before continuation existed: the heavy top's precession over its
+/// nutation angle is found at every value (marginally stable), the spun hoop's sweep stays on
+/// its branch (no stability change), and every value of the conical spring's sweep is the
+/// motion found from the entry's guess alone.
+#[test]
+fn sweeps_of_entries_without_held_values_start_from_the_entrys_guess() {
+    let sweep = |m: &mut dyn ModelInfo, point: &str, name: &str, values: Vec<f64>| {
+        let options = ParameterSweepOptions {
+            axis: SweepAxis {
+                name: name.to_string(),
+                values,
+            },
+            operating_point: at(point),
+            refine: true,
+        };
+        vibration::parameter_sweep(m, &options, |_, _| {}).expect("sweeps")
+    };
+    let mut top = model("heavy_top");
+    let values = (0..10).map(|k| 0.1 + 0.13 * f64::from(k)).collect();
+    let s = sweep(top.as_mut(), "precessing", "theta0", values);
+    for p in &s.points {
+        assert!(p.error.is_none(), "θ0 = {}: {:?}", p.value, p.error);
+        assert!(
+            matches!(p.stability, Some(Stability::MarginallyStable)),
+            "{p:?}"
+        );
+    }
+    let fixture = |name: &str| {
+        file_model(&format!(
+            "{}/tests/fixtures/{name}",
+            env!("CARGO_MANIFEST_DIR")
+        ))
+    };
+    let mut hoop = fixture("spun_hoop.yaml");
+    let s = sweep(
+        hoop.as_mut(),
+        "spinning",
+        "w",
+        (0..6).map(|k| 5.0 + 5.0 * f64::from(k)).collect(),
+    );
+    assert!(s.stability_changes.is_empty(), "{:?}", s.stability_changes);
+    // Each value as `modes --set k=…` finds it alone.
+    let mut spring = fixture("conical_spring.yaml");
+    let values: Vec<f64> = (0..10).map(|k| 20.0 + 20.0 * f64::from(k)).collect();
+    let s = sweep(spring.as_mut(), "conical", "k", values);
+    for p in &s.points {
+        let mut alone = fixture("conical_spring.yaml");
+        alone.set_parameter("k", p.value).expect("k");
+        let a = vibration::steady_motion_analysis(alone.as_mut(), &at("conical")).expect("found");
+        assert_eq!(p.eigenvalues, a.eigenvalues, "k = {}", p.value);
+    }
+}
+
+/// A bicycle's turn at a lean of 1e-7 rad, so near straight running that its accelerations
+/// at the turn are of the size of rounding, is still recognised as symmetric under turning;
+/// and a coin "turning" at a heading rate of 0 is straight rolling, reported with no radius.
+#[test]
+fn nearly_straight_turns_are_turns_and_a_straight_one_has_no_radius() {
+    let (_dir, path) = common::edited_model(
+        "whipple_bicycle",
+        &[("    lean: { held: 0.1 }\n", "    lean: { held: 1e-7 }\n")],
+    );
+    let mut m = file_model(&path);
+    let a = vibration::steady_motion_analysis(m.as_mut(), &at("turning")).expect("a turn");
+    let v = a.steady_motion.qdot[index(m.as_ref(), "x")];
+    assert!((v - 6.02426201538837).abs() < 1e-6, "{v}");
+    let (_dir2, path2) = common::edited_model(
+        "rolling_disc",
+        &[(
+            "    lean: 0.3\n    yaw_dot: -1\n",
+            "    lean: 0\n    yaw_dot: 0\n",
+        )],
+    );
+    let out = common::eomgen_ok(&["modes", &path2, "--at", "turning", "--json"]);
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON");
+    let turning = &json["operating_point"]["turning"];
+    assert_eq!(turning["rate"], 0.0);
+    assert!(turning.get("radius").is_none(), "{turning}");
+    let text = common::eomgen_ok(&["modes", &path2, "--at", "turning"]);
+    assert!(String::from_utf8_lossy(&text.stdout).contains("radius infinite (straight)"));
 }

@@ -382,7 +382,7 @@ def test_a_coin_in_a_steady_turn():
     nonzero = turn.eigenvalues[np.abs(turn.eigenvalues) > 0]
     assert np.allclose(np.abs(nonzero.imag), 9.6499221962793447639, rtol=0, atol=1e-9)
     page = turn._repr_html_()
-    assert "held in the frame turned by yaw" in page and "rates found x_dot = 1.5" in page
+    assert "constant in the frame turned by yaw" in page and "rates found x_dot = 1.5" in page
 
 
 # --- derivations -------------------------------------------------------------------------------

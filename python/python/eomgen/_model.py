@@ -1350,8 +1350,8 @@ class SteadyMotion:
         damping_ratios: ``ζ`` of each of ``damped_eigenvalues``.
         turning: for a steady turn (an entry with ``turning:``), the frame in which the
             plane's rates are held and the linearisation is taken: ``{"angle", "plane",
-            "rate", "radius"}`` (``rate`` Ω in rad/s, ``radius`` ``|v|/|Ω|``); ``None``
-            otherwise.
+            "rate", "radius"}`` (``rate`` Ω in rad/s, ``radius`` ``|v|/|Ω|``, absent when
+            Ω = 0); ``None`` otherwise.
         found_rates: the rates the search found (``{ guess: … }`` in the entry) rather than
             held.
         held_coordinates: the coordinates held at their value (``{ held: … }``) rather than
@@ -1387,9 +1387,11 @@ class SteadyMotion:
         turn = ""
         if self.turning:
             a, b = self.turning["plane"]
-            turn = (f"<br>{html.escape(a)}_dot, {html.escape(b)}_dot held in the frame turned by "
+            radius = self.turning.get("radius")
+            radius = "infinite (straight)" if radius is None else f"{radius:.6g}"
+            turn = (f"<br>{html.escape(a)}_dot, {html.escape(b)}_dot constant in the frame turned by "
                     f"{html.escape(self.turning['angle'])}: Ω = {self.turning['rate']:.6g} rad/s, "
-                    f"radius {self.turning['radius']:.6g}; linearised in that frame")
+                    f"radius {radius}; linearised in that frame")
         return (f"<b>eomgen.SteadyMotion</b> of <code>{html.escape(self.summary['model'])}</code> at "
                 f"{html.escape(str(point.get('name', '-')))}" + (f"; rates held {html.escape(held)}" if held else "")
                 + (f"; rates found {html.escape(found)}" if found else "") + turn

@@ -137,7 +137,7 @@ pub enum SteadyMotionError {
     /// state turned about the plane's normal are not the turned accelerations, so the turn
     /// changes the equations and is no steady motion.
     #[error(
-        "the steady turn turns `{plane_a}` and `{plane_b}` with `{angle}`, but the equations are not symmetric under turning: at the state turned by {shift} rad the accelerations differ from the turned ones by {change:.1e} (relative to the largest); a steady turn needs forces that turn with the motion, with nothing fixed to the ground's directions"
+        "the steady turn turns `{plane_a}` and `{plane_b}` with `{angle}`, but the equations are not symmetric under turning: at the state turned by {shift} rad the accelerations differ from the turned ones by {change:.1e} (relative to the largest); a steady turn needs forces that turn with the motion, with nothing fixed to the ground's directions, and `plane` in the order that a positive `{angle}` turns `{plane_a}` toward `{plane_b}`"
     )]
     NotSymmetric {
         /// The turning angle.
@@ -162,6 +162,15 @@ pub enum SteadyMotionError {
         at: String,
         /// Why the equations failed there.
         source: RhsError,
+    },
+    /// What the steady motion holds names a coordinate the model does not have (an index
+    /// past its `n` coordinates, from a spec built by hand).
+    #[error("the steady motion's spec names coordinate {index}, but the model has {n}")]
+    SpecOutOfRange {
+        /// The index given.
+        index: usize,
+        /// The model's number of coordinates.
+        n: usize,
     },
     /// The right-hand side failed at (or near) the point.
     #[error("the equations cannot be evaluated at the operating point: {0}")]
@@ -200,6 +209,22 @@ pub struct SteadyMotionSpec {
 }
 
 impl SteadyMotionSpec {
+    /// Checks that every index of the spec is one of `n` coordinates.
+    ///
+    /// # Errors
+    /// [`SteadyMotionError::SpecOutOfRange`] for the first that is not.
+    pub fn check(&self, n: usize) -> Result<(), SteadyMotionError> {
+        let turning = (self.turning.iter()).flat_map(|f| [f.angle, f.plane[0], f.plane[1]]);
+        let all = (self.ignorable.iter().chain(&self.held_coordinates))
+            .chain(&self.solved_rates)
+            .copied()
+            .chain(turning);
+        match all.into_iter().find(|&i| i >= n) {
+            Some(index) => Err(SteadyMotionError::SpecOutOfRange { index, n }),
+            None => Ok(()),
+        }
+    }
+
     /// The spec that holds `rates` (length `n`), with the coordinates `ignorable`: every other
     /// coordinate found, every rate held, no turn.
     pub fn holding(rates: &[f64], ignorable: &[usize]) -> Self {
@@ -297,6 +322,7 @@ pub fn linearize_steady_motion_with(
     spec: &SteadyMotionSpec,
 ) -> Result<SteadyLinearization, SteadyMotionError> {
     let ignorable = spec.ignorable.as_slice();
+    spec.check(y.len() / 2)?;
     let d = model.description().clone();
     let n = d.coordinates.len();
     let (m, m_h) = (d.constraints.len(), d.holonomic_constraints);

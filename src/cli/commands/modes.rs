@@ -217,13 +217,11 @@ fn steady(
     let lin = &summary.linearization;
     let (found, held): (std::collections::BTreeMap<String, f64>, _) =
         (p.qdot.clone().into_iter()).partition(|(k, _)| p.found_rates.contains(k));
-    let _ = writeln!(
-        out,
-        "steady motion  {}: {}; rates held {}",
-        p.name,
-        show(&p.q),
-        show(&held)
-    );
+    let held_text = match held.is_empty() {
+        true => String::new(),
+        false => format!("; rates held {}", show(&held)),
+    };
+    let _ = writeln!(out, "steady motion  {}: {}{held_text}", p.name, show(&p.q));
     if !found.is_empty() {
         let _ = writeln!(out, "rates found    {}", show(&found));
     }
@@ -236,10 +234,13 @@ fn steady(
     }
     if let Some(turn) = &p.turning {
         let [a, b] = &turn.plane;
+        let radius = turn
+            .radius
+            .map_or_else(|| "infinite (straight)".to_string(), |r| r.to_string());
         let _ = writeln!(
             out,
-            "turning frame  {a}_dot, {b}_dot held in the frame turned by {}: Ω = {}_dot = {} rad/s, radius {}; linearised in that frame",
-            turn.angle, turn.angle, turn.rate, turn.radius
+            "turning frame  {a}_dot, {b}_dot constant in the frame turned by {}: Ω = {}_dot = {} rad/s, radius {radius}; linearised in that frame",
+            turn.angle, turn.angle, turn.rate
         );
     }
     let _ = writeln!(

@@ -4,7 +4,9 @@
 //! by bisection.
 //!
 //! At every value the operating point is found again (its rates, expressions of the
-//! parameters, follow the value) and linearised as `eomgen modes` does: the reduced state
+//! parameters, follow the value; a family picked by a held value — an entry that holds a
+//! coordinate, finds a rate or turns — from the motion found at the value before) and
+//! linearised as `eomgen modes` does: the reduced state
 //! matrix of [`crate::linear::steady`] for a steady motion or a model with non-holonomic
 //! constraints, and the state matrix of `M δq̈ + C δq̇ + K δq = 0`
 //! ([`crate::linear::eigenvalues`]) for an equilibrium.
@@ -638,14 +640,25 @@ pub fn parameter_sweep(
         });
     };
     let before = model.parameter_values()[index];
-    // The steady motion found last: the next value's search starts there, so that the
-    // sweep follows one family of steady motions (continuation) instead of starting every
-    // value from the entry's guess.
+    // A family of steady motions picked by a held value (a bicycle's turns as their held
+    // lean grows: an entry that holds a coordinate, finds a rate or turns) is followed from
+    // value to value: each value's search starts from the motion found at the one before
+    // (continuation), and from the entry's guess if that fails. Any other entry starts from
+    // its own guess at every value, whose held rates (expressions of the parameter) may
+    // lead elsewhere than the last motion found.
+    let spec = super::operating_point::steady_motion_spec(model, &options.operating_point.start);
+    let follow = spec.turning.is_some()
+        || !spec.held_coordinates.is_empty()
+        || !spec.solved_rates.is_empty();
     let mut last: Option<Vec<f64>> = None;
     let at = |model: &mut dyn ModelInfo, value: f64, from: Option<&[f64]>| {
         // The name is known, so setting it cannot fail.
         let _ = model.set_parameter(name, value);
-        eigenvalues_from(model, &options.operating_point, from)
+        let from = from.filter(|_| follow);
+        match eigenvalues_from(model, &options.operating_point, from) {
+            Err(_) if from.is_some() => eigenvalues_from(model, &options.operating_point, None),
+            found => found,
+        }
     };
     let total = options.axis.values.len();
     let mut points = Vec::with_capacity(total);

@@ -42,6 +42,7 @@ pub fn is_steady_motion(model: &dyn ModelInfo, start: &EquilibriumStart) -> bool
         || spec.rates.iter().any(|r| *r != 0.0)
         || spec.turning.is_some()
         || !spec.solved_rates.is_empty()
+        || !spec.held_coordinates.is_empty()
 }
 
 /// The frame of a steady turn as a report gives it.
@@ -55,8 +56,9 @@ pub struct SteadyTurn {
     /// coordinate toward the second.
     pub rate: f64,
     /// The radius (in the plane coordinates' unit) of the circle the plane's point runs on,
-    /// `|v|/|Ω|`; infinite when `Ω = 0`.
-    pub radius: f64,
+    /// `|v|/|Ω|`; `None` (left out of the JSON) when `Ω = 0`, a straight line.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub radius: Option<f64>,
 }
 
 /// A steady motion, its reduced linearisation and stability.
@@ -254,11 +256,7 @@ pub fn steady_motion_analysis_from(
             angle: coordinates[frame.angle].clone(),
             plane: [coordinates[a].clone(), coordinates[b].clone()],
             rate,
-            radius: if rate == 0.0 {
-                f64::INFINITY
-            } else {
-                speed / rate.abs()
-            },
+            radius: (rate != 0.0).then(|| speed / rate.abs()),
         }
     });
     let found = (spec.unknowns(n).into_iter())

@@ -112,6 +112,7 @@ pub fn find_steady_motion_with(
     spec: &SteadyMotionSpec,
 ) -> Result<SteadyMotion, SteadyMotionError> {
     let n = guess.len();
+    spec.check(n)?;
     let names = owned_state_names(model);
     let held: Vec<f64> = (0..n)
         .map(|i| match spec.solved_rates.contains(&i) {
@@ -230,7 +231,9 @@ fn owned_state_names(model: &dyn ModelInfo) -> Vec<String> {
 /// Checks that a steady turn is one: that the accelerations at the state turned by the
 /// angle `s` ([`TurningFrame::turn_state`]) are those at `y` turned by `s`, at the turn `y`
 /// and at a state near it, for the shifts [`CYCLIC_SHIFTS`], within 1e-9 of the largest
-/// (as [`check_cyclic`]). A state where the equations fail is skipped.
+/// acceleration over all of them (as [`check_cyclic`]: at the turn itself the accelerations
+/// are the turn's `Ω |v|` and rounding, which a turn near straight running makes tiny). A
+/// state where the equations fail is skipped.
 ///
 /// # Errors
 /// [`SteadyMotionError::NotSymmetric`].
@@ -252,34 +255,38 @@ fn check_turning_symmetry(
             .all(|v| v.is_finite())
             .then(|| dy[n..].to_vec())
     };
+    // (shift, the accelerations turned, the accelerations at the turned state).
+    let mut compared: Vec<(f64, Vec<f64>, Vec<f64>)> = Vec::new();
     for base in [y.to_vec(), near] {
         let Some(at_base) = accelerations(&base) else {
             continue;
         };
         for shift in CYCLIC_SHIFTS {
-            let Some(turned) = accelerations(&frame.turn_state(&base, n, shift)) else {
-                continue;
-            };
-            let expected = frame.turn_accelerations(&at_base, shift);
-            let size = (expected.iter().chain(&turned)).fold(0.0f64, |m, v| m.max(v.abs()));
-            let change = (expected.iter().zip(&turned))
-                .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()))
-                / size.max(f64::MIN_POSITIVE);
-            if change > 1e-9 {
-                let names = model.description().coordinate_names();
-                let name = |i: usize| {
-                    names
-                        .get(i)
-                        .map_or_else(|| i.to_string(), |c| c.to_string())
-                };
-                return Err(SteadyMotionError::NotSymmetric {
-                    angle: name(frame.angle),
-                    plane_a: name(frame.plane[0]),
-                    plane_b: name(frame.plane[1]),
-                    change,
-                    shift,
-                });
+            if let Some(turned) = accelerations(&frame.turn_state(&base, n, shift)) {
+                compared.push((shift, frame.turn_accelerations(&at_base, shift), turned));
             }
+        }
+    }
+    let size = (compared.iter())
+        .flat_map(|(_, a, b)| a.iter().chain(b))
+        .fold(0.0f64, |m, v| m.max(v.abs()));
+    for (shift, expected, turned) in &compared {
+        let change = (expected.iter().zip(turned)).fold(0.0f64, |m, (a, b)| m.max((a - b).abs()))
+            / size.max(f64::MIN_POSITIVE);
+        if change > 1e-9 {
+            let names = model.description().coordinate_names();
+            let name = |i: usize| {
+                names
+                    .get(i)
+                    .map_or_else(|| i.to_string(), |c| c.to_string())
+            };
+            return Err(SteadyMotionError::NotSymmetric {
+                angle: name(frame.angle),
+                plane_a: name(frame.plane[0]),
+                plane_b: name(frame.plane[1]),
+                change,
+                shift: *shift,
+            });
         }
     }
     Ok(())

@@ -107,7 +107,15 @@ impl Checker<'_> {
     /// on rates, and a `turning:` frame of three distinct coordinates, each `ignorable`.
     fn steady_marks(&mut self, q: &EquilibriumDef) {
         let name = &q.name.value;
+        let moves = q.turning.is_some() || q.values.iter().any(|(k, _)| k.value.ends_with("_dot"));
         for k in &q.held {
+            if self.sets.coords.contains(k.value.as_str()) && !moves {
+                self.error(
+                    Diagnostic::new(k.location, format!("`{}` is held, but equilibrium `{name}` gives no rate: an equilibrium's coordinates are all found", k.value))
+                        .with_help("`{ held: value }` picks one steady motion of a family (give the rates it holds, or `turning:`); for an equilibrium write the coordinate's guess"),
+                );
+                continue;
+            }
             if !self.sets.coords.contains(k.value.as_str()) {
                 self.error(
                     Diagnostic::new(k.location, format!("`{}` in equilibrium `{name}` is held, but only a coordinate can be: a rate is held unless marked", k.value))
@@ -120,6 +128,14 @@ impl Checker<'_> {
                 self.error(
                     Diagnostic::new(k.location, format!("`{}` in equilibrium `{name}` is marked a guess, but only a rate can be: a coordinate is a guess unless held", k.value))
                         .with_help(format!("write `{}: value` for a coordinate the search finds, or `{{ held: value }}` to hold it", k.value)),
+                );
+                continue;
+            }
+            let base = k.value.strip_suffix("_dot").unwrap_or(&k.value);
+            if !q.ignorable.iter().any(|i| i.value == base) {
+                self.error(
+                    Diagnostic::new(k.location, format!("`{}` in equilibrium `{name}` is to be found, but `{base}` is not in its `ignorable`: a steady motion moves only ignorable coordinates, and holds the other rates at 0", k.value))
+                        .with_help(format!("add `{base}` to `ignorable` if nothing depends on it, or leave `{}` out (held at 0)", k.value)),
                 );
             }
         }
