@@ -13,7 +13,8 @@ pub use eomgen_symbolic::codegen::export::Language;
 mod kinematics;
 
 pub use kinematics::{
-    FrameListing, Kinematics, KinematicsListing, KinematicsOptions, PointListing, kinematics,
+    FrameListing, Kinematics, KinematicsListing, KinematicsOptions, PointListing, ReactionListing,
+    ReactionRequest, kinematics,
 };
 
 /// Which derivation to list.
@@ -74,6 +75,10 @@ pub enum ListingError {
         /// The model's name.
         model: String,
     },
+    /// A reaction asked for names a body or point the model does not have, or the model has
+    /// loads that cannot be attributed to bodies.
+    #[error(transparent)]
+    Reaction(#[from] eomgen_symbolic::mechanics::ReactionError),
     /// A frame or point asked for is not in the model file.
     #[error("the model has no {kind} `{name}` (its {kind}s: {})", known.join(", "))]
     UnknownName {

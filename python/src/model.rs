@@ -769,24 +769,29 @@ impl CoreModel {
     }
 
     /// The kinematics of `frames` and `points` (every one of the file's when empty), with
-    /// the partial velocities when `partial`: `(listing, text, latex)`, the listing
+    /// the partial velocities when `partial` and the `reactions` (bodies, point): `(listing,
+    /// text, latex)`, the listing
     /// `{"model", "coordinates", "frames", "points", "latex"}` as `eomgen kinematics --json`
     /// prints it ([`eomgen::listing::kinematics`]).
-    #[pyo3(signature = (frames, points, partial))]
+    #[pyo3(signature = (frames, points, partial, reactions))]
     fn kinematics<'py>(
         &self,
         py: Python<'py>,
         frames: Vec<String>,
         points: Vec<String>,
         partial: bool,
+        reactions: Vec<(Vec<String>, String)>,
     ) -> PyResult<(Bound<'py, PyAny>, String, String)> {
-        use eomgen::listing::{KinematicsOptions, ListingError, kinematics};
+        use eomgen::listing::{KinematicsOptions, ListingError, ReactionRequest, kinematics};
         let path = self.loaded.source.path().to_string();
         let text = self.loaded.text.clone();
         let options = KinematicsOptions {
             frames,
             points,
             partial,
+            reactions: (reactions.into_iter())
+                .map(|(bodies, at)| ReactionRequest { bodies, at })
+                .collect(),
         };
         let listing = py.detach(|| kinematics(&path, &text, &options));
         let listing = listing.map_err(|e| match e {

@@ -136,3 +136,78 @@ def test_kinematics_from_the_command_line_and_unknown_names(cli):
     assert bad.returncode == 2 and "has no point `Q` (its points: O, G)" in bad.stderr
     with pytest.raises(ValueError, match="no frame `Z`"):
         eomgen.load("heavy_top").kinematics(frames=["Z"])
+
+
+def _evaluate(texts, names, values):
+    return np.array([float(sp.parse_expr(e.replace("^", "**"), local_dict=names).subs(values))
+                     for e in texts])
+
+
+def _names(model, coordinates):
+    names = {p: sp.Symbol(p) for p in model.parameters}
+    for c in coordinates:
+        for suffix in ("", "_dot", "_ddot"):
+            names[c + suffix] = sp.Symbol(c + suffix)
+    return names
+
+
+def test_the_heavy_tops_pivot_reaction():
+    """The heavy top's pivot at O is a ball joint: with the accelerations the equations of
+    motion give (``Model.rhs``) at random states, the reaction's moment about O vanishes (to
+    1e-12 of the weight's moment ``m g l``), and its force is ``m a_G − m g`` with ``a_G``
+    SymPy's second derivative of ``G``'s position."""
+    m = eomgen.load("heavy_top")
+    listing = m.kinematics(frames=[], points=["G"], reactions=[("top", "O")])
+    (reaction,) = listing["reactions"]
+    assert reaction["bodies"] == ["top"] and reaction["at"] == "O"
+    coordinates = listing["coordinates"]
+    names = _names(m, coordinates)
+    p = m.parameters
+    rng = np.random.default_rng(3)
+    t = me.dynamicsymbols._t
+    q = {c: me.dynamicsymbols(c) for c in coordinates}
+    N, _, points = _heavy_top(q, {"l": p["l"]})
+    a_g = points["G"].dt(N).dt(N).to_matrix(N)
+    for _ in range(3):
+        state = np.concatenate([rng.uniform(0.3, 1.2, 3), rng.uniform(-2, 2, 3)])
+        qdd = m.rhs(0.0, state)[3:]
+        values = {names[k]: v for k, v in p.items()}
+        subs = {}
+        for i, c in enumerate(coordinates):
+            values[names[c]], values[names[c + "_dot"]], values[names[c + "_ddot"]] = state[i], state[3 + i], qdd[i]
+            subs.update({q[c].diff(t, 2): qdd[i], q[c].diff(t): state[3 + i], q[c]: state[i]})
+        moment = _evaluate(reaction["moment"], names, values)
+        assert np.max(np.abs(moment)) < 1e-12 * p["m"] * p["g"] * p["l"], moment
+        force = _evaluate(reaction["force"], names, values)
+        want = p["m"] * np.array([float(c.subs(subs)) for c in a_g]) - p["m"] * np.array([0, 0, -p["g"]])
+        assert np.allclose(force, want, rtol=0, atol=1e-12 * p["m"] * p["g"]), (force, want)
+
+
+def test_the_rolling_discs_contact_reaction_is_its_constraint_force():
+    """The rolling disc's reaction at its contact C: along the ground it is the rolling
+    constraint's force, ``−λ`` (the multipliers of a simulation, where ``M q̈ = F − Jᵀλ``),
+    vertically ``m (a_Gz + g)``, and its moment about C vanishes (a point contact), at three
+    samples of a run, to 1e-9 of the weight (the run's rtol)."""
+    m = eomgen.load("rolling_disc")
+    listing = m.kinematics(frames=[], points=[], reactions=[("disc", "C")])
+    (reaction,) = listing["reactions"]
+    coordinates = listing["coordinates"]
+    names = _names(m, coordinates)
+    p = m.parameters
+    run = m.simulate(t_end=1.0, rtol=1e-11, atol=1e-11)
+    n = len(coordinates)
+    weight = p["m"] * p["g"]
+    for k in (0, len(run.t) // 2, len(run.t) - 1):
+        state = np.concatenate([run.q[k], run.qdot[k]])
+        qdd = m.rhs(run.t[k], state)[n:]
+        values = {names[c]: v for c, v in p.items()}
+        for i, c in enumerate(coordinates):
+            values[names[c]], values[names[c + "_dot"]], values[names[c + "_ddot"]] = state[i], state[n + i], qdd[i]
+        force = _evaluate(reaction["force"], names, values)
+        lam = run.lagrange_multipliers[k]
+        assert np.allclose(force[:2], -lam, rtol=0, atol=1e-9 * weight), (force, lam)
+        assert force[2] > 0.5 * weight
+        moment = _evaluate(reaction["moment"], names, values)
+        assert np.max(np.abs(moment)) < 1e-9 * weight * p["r"], moment
+    with pytest.raises(ValueError, match="no body `wheel`"):
+        m.kinematics(reactions=[("wheel", "C")])

@@ -22,6 +22,32 @@ pub struct KinematicsOptions {
     pub points: Vec<String>,
     /// Whether to list the partial velocities `∂v/∂q̇ᵢ` and `∂ω/∂q̇ᵢ` too.
     pub partial: bool,
+    /// The reactions to list: the force and moment on a set of bodies at a point besides
+    /// gravity and their own torques (a joint the model leaves implicit).
+    pub reactions: Vec<ReactionRequest>,
+}
+
+/// A reaction [`kinematics`] lists: on the bodies `bodies`, the moment about the point `at`.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+pub struct ReactionRequest {
+    /// The bodies, by name.
+    pub bodies: Vec<String>,
+    /// The point, by name.
+    pub at: String,
+}
+
+/// One reaction as [`kinematics`] lists it
+/// ([`eomgen_symbolic::mechanics::Reaction`]): expressions of `q`, `q̇` and `q̈`.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ReactionListing {
+    /// The bodies it acts on.
+    pub bodies: Vec<String>,
+    /// The point the moment is about.
+    pub at: String,
+    /// `R = Σ m a_G − Σ m g` in `N`'s components (N).
+    pub force: Vec<String>,
+    /// `M_P` in `N`'s components (N·m; its `z` component alone in a planar model).
+    pub moment: Vec<String>,
 }
 
 /// One frame's angular motion in the ground frame `N`, each vector as its three components.
@@ -65,6 +91,9 @@ pub struct KinematicsListing {
     pub frames: Vec<FrameListing>,
     /// The points asked for, in the file's order.
     pub points: Vec<PointListing>,
+    /// The reactions asked for, in the order asked; left out of the JSON when none.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub reactions: Vec<ReactionListing>,
 }
 
 /// A model's kinematics, as `eomgen kinematics --json` prints it: `{"model", "coordinates",
@@ -98,7 +127,8 @@ pub struct Kinematics {
 ///
 /// # Errors
 /// [`ListingError::Diagnostics`] for a file with mistakes; [`ListingError::UnknownName`] for
-/// a frame or point the file does not have.
+/// a frame or point the file does not have; [`ListingError::Reaction`] for a reaction that
+/// cannot be computed.
 ///
 /// # Examples
 /// ```
@@ -137,6 +167,10 @@ pub fn kinematics(
         };
         point_exprs.push(model.point_kinematics(index));
     }
+    let reactions = (options.reactions.iter())
+        .map(|r| model.reaction(&r.bodies, &r.at))
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(ListingError::Reaction)?;
     let list = |syntax: Syntax| {
         let p = Printer::for_display(&model.arena, syntax);
         let show = |v: &[ExprId]| v.iter().map(|&e| p.print(e)).collect::<Vec<_>>();
@@ -167,6 +201,14 @@ pub fn kinematics(
                         true => k.partial_velocities.iter().map(|v| show(v)).collect(),
                         false => Vec::new(),
                     },
+                })
+                .collect(),
+            reactions: (reactions.iter())
+                .map(|r| ReactionListing {
+                    bodies: r.bodies.clone(),
+                    at: r.at.clone(),
+                    force: show(&r.force),
+                    moment: show(&r.moment),
                 })
                 .collect(),
         }
@@ -243,6 +285,16 @@ fn render_text(model: &str, coordinates: &[String], k: &KinematicsListing) -> St
             let _ = writeln!(out, "  d omega/d {q}_dot = {}", vector(w));
         }
     }
+    for r in &k.reactions {
+        let _ = writeln!(
+            out,
+            "\nreaction on {} at {} (besides gravity and their torques; N components, N and N*m)",
+            r.bodies.join(" + "),
+            r.at
+        );
+        let _ = writeln!(out, "  R = {}", vector(&r.force));
+        let _ = writeln!(out, "  M_{} = {}", r.at, vector(&r.moment));
+    }
     for p in &k.points {
         let _ = writeln!(out, "\npoint {} (N components: m, m/s, m/s^2)", p.name);
         let _ = writeln!(out, "  r = {}", vector(&p.position));
@@ -315,6 +367,19 @@ fn render_latex(coordinates: &[String], k: &KinematicsListing) -> String {
                 latex_vector(v)
             );
         }
+    }
+    for r in &k.reactions {
+        let at = symbol(&r.at);
+        let _ = writeln!(
+            out,
+            "\\mathbf{{R}}_{{{at}}} &= {} \\\\",
+            latex_vector(&r.force)
+        );
+        let _ = writeln!(
+            out,
+            "\\mathbf{{M}}_{{{at}}} &= {} \\\\",
+            latex_vector(&r.moment)
+        );
     }
     out.push_str("\\end{align*}\n");
     out

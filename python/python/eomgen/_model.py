@@ -587,7 +587,7 @@ class Model:
         listing, text, latex_document = self._core.equations(str(method))
         return Equations(latex_document if latex else text, latex_document, listing)
 
-    def kinematics(self, frames=None, points=None, partial: bool = False) -> dict:
+    def kinematics(self, frames=None, points=None, partial: bool = False, reactions=None) -> dict:
         """The kinematics of the model's frames and points, as ``eomgen kinematics --json``
         gives it: for each frame ``F`` (default: every frame of the file's ``frames:``) its
         angular velocity ``^N ω^F`` in its own components (``"angular_velocity"``, rad/s,
@@ -599,9 +599,18 @@ class Model:
         file's syntax (``x_dot``, ``x_ddot``, ``^`` for powers), ``"latex"`` holds the same
         in LaTeX, and ``"text"`` the listing as the command line prints it.
 
-        Raises ``ValueError`` for a frame or point the file does not have."""
+        ``reactions`` lists ``(bodies, point)`` pairs (``bodies`` a name or a list of names):
+        for each, ``"reactions"`` gives the force ``R = Σ m a_G − Σ m g`` and the moment about
+        the point that act on those bodies besides gravity and their own torques — the
+        reaction of a pivot the model leaves implicit — as expressions of ``q``, ``q̇`` and
+        ``q̈`` (``eomgen kinematics --reaction BODY@POINT``).
+
+        Raises ``ValueError`` for a frame, point or body the file does not have, or a reaction
+        of a model whose forces, springs or dampers act at points rather than on bodies."""
+        pairs = [([b] if isinstance(b, str) else [str(x) for x in b], str(at))
+                 for b, at in (reactions or [])]
         listing, text, _ = self._core.kinematics(
-            [str(f) for f in (frames or [])], [str(p) for p in (points or [])], bool(partial))
+            [str(f) for f in (frames or [])], [str(p) for p in (points or [])], bool(partial), pairs)
         listing["text"] = text
         return listing
 

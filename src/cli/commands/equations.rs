@@ -8,7 +8,8 @@ use crate::cli::error::CliError;
 use crate::cli::model::{diagnostics_error, read_model};
 use crate::cli::output::out;
 use eomgen::listing::{
-    Derivation, KinematicsOptions, Language, ListingError, equations, export, kinematics,
+    Derivation, KinematicsOptions, Language, ListingError, ReactionRequest, equations, export,
+    kinematics,
 };
 use eomgen_symbolic::codegen::GenerateError;
 use eomgen_symbolic::model::templates;
@@ -69,6 +70,11 @@ pub struct KinematicsArgs {
     /// Also list the partial velocities ∂v/∂q̇ᵢ and ∂ω/∂q̇ᵢ.
     #[arg(long)]
     pub partial: bool,
+    /// A reaction to list, `BODY@POINT` or `BODY+BODY@POINT` (repeatable): the force and the
+    /// moment about POINT that act on the bodies besides gravity and their own torques (a
+    /// pivot the model leaves implicit), in terms of q, q̇ and q̈.
+    #[arg(long = "reaction", value_name = "BODIES@POINT")]
+    pub reactions: Vec<String>,
     /// Print LaTeX (amsmath) instead of text.
     #[arg(long)]
     pub latex: bool,
@@ -80,14 +86,28 @@ pub struct KinematicsArgs {
 /// Runs `kinematics`.
 pub fn run_kinematics(args: &KinematicsArgs) -> Result<(), CliError> {
     let (display, source) = read_model(&args.model)?;
+    let reactions = (args.reactions.iter())
+        .map(|r| match r.split_once('@') {
+            Some((bodies, at)) if !bodies.is_empty() && !at.is_empty() => Ok(ReactionRequest {
+                bodies: bodies.split('+').map(|b| b.trim().to_string()).collect(),
+                at: at.trim().to_string(),
+            }),
+            _ => Err(CliError::usage(format!(
+                "--reaction `{r}`: write the bodies and the point as `BODY@POINT` or `BODY+BODY@POINT`"
+            ))),
+        })
+        .collect::<Result<Vec<_>, _>>()?;
     let options = KinematicsOptions {
         frames: args.frames.clone(),
         points: args.points.clone(),
         partial: args.partial,
+        reactions,
     };
     let listing = kinematics(&display, &source, &options).map_err(|e| match e {
         ListingError::Diagnostics(d) => diagnostics_error(&display, &source, &d),
-        e @ ListingError::UnknownName { .. } => CliError::usage(e.to_string()),
+        e @ (ListingError::UnknownName { .. } | ListingError::Reaction(_)) => {
+            CliError::usage(e.to_string())
+        }
         e => CliError::failure(e.to_string()),
     })?;
     if args.json {

@@ -101,3 +101,179 @@ impl SymbolicModel {
         }
     }
 }
+
+/// The resultant force and moment that everything but gravity and the bodies' own torques
+/// exerts on a set of bodies — at a pivot the model leaves implicit, the joint's reaction —
+/// from their momentum balances (Newton–Euler; Kane & Levinson §§4.1–4.4):
+///
+/// ```text
+/// R   = Σ m a_G − Σ m g
+/// M_P = Σ [(r_G − r_P) × m a_G + Ḣ_G] − Σ (r_G − r_P) × m g − Σ τ
+/// ```
+///
+/// with `Ḣ_G = I α + ω × I ω` of a 3-D body (in its frame, carried to `N`) and `I θ̈` of a
+/// planar one, as expressions of `q`, `q̇` and `q̈` (whose values the equations of motion
+/// give).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Reaction {
+    /// The bodies' names.
+    pub bodies: Vec<String>,
+    /// The point the moment is taken about.
+    pub at: String,
+    /// `R` in `N`'s components (N): 2 for a planar model, 3 for a spatial one.
+    pub force: Vec<ExprId>,
+    /// `M_P` in `N`'s components (N·m): the `z` component alone for a planar model.
+    pub moment: Vec<ExprId>,
+}
+
+/// Why a reaction cannot be computed.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[non_exhaustive]
+pub enum ReactionError {
+    /// A body of the set is not the model's.
+    #[error("the model has no body `{name}` (its bodies: {})", known.join(", "))]
+    UnknownBody {
+        /// The name asked for.
+        name: String,
+        /// The model's bodies.
+        known: Vec<String>,
+    },
+    /// The point is not the model's.
+    #[error("the model has no point `{name}` (its points: {})", known.join(", "))]
+    UnknownPoint {
+        /// The name asked for.
+        name: String,
+        /// The model's points.
+        known: Vec<String>,
+    },
+    /// The model has loads whose share on the set its file does not say.
+    #[error(
+        "the reaction is what acts on the bodies besides gravity and their own torques, but `{model}` also has {what}, which the file does not attribute to bodies: it cannot be separated out"
+    )]
+    UnattributedLoads {
+        /// The model.
+        model: String,
+        /// Forces, springs, dampers or generalized forces.
+        what: &'static str,
+    },
+}
+
+impl SymbolicModel {
+    /// The reaction on the bodies `bodies` (names) about the point `at`: see [`Reaction`].
+    ///
+    /// # Errors
+    /// [`ReactionError::UnknownBody`] or [`ReactionError::UnknownPoint`] for a name the model
+    /// does not have; [`ReactionError::UnattributedLoads`] when it has forces, springs,
+    /// dampers or written generalized forces (acting at points, not on bodies).
+    pub fn reaction(&mut self, bodies: &[String], at: &str) -> Result<Reaction, ReactionError> {
+        use super::LoadInfo;
+        use super::frames::{cross, tensor_times};
+        let known: Vec<String> = self.bodies.iter().map(|b| b.name.clone()).collect();
+        let chosen = (bodies.iter())
+            .map(|name| {
+                known
+                    .iter()
+                    .position(|k| k == name)
+                    .ok_or_else(|| ReactionError::UnknownBody {
+                        name: name.clone(),
+                        known: known.clone(),
+                    })
+            })
+            .collect::<Result<Vec<usize>, _>>()?;
+        let p = (self.points.iter().position(|(n, _)| n == at)).ok_or_else(|| {
+            ReactionError::UnknownPoint {
+                name: at.to_string(),
+                known: self.points.iter().map(|(n, _)| n.clone()).collect(),
+            }
+        })?;
+        let unattributed = (self.loads.iter()).find_map(|l| match l {
+            LoadInfo::Force { .. } => Some("forces"),
+            LoadInfo::Spring { .. } => Some("springs"),
+            LoadInfo::Damper { .. } => Some("dampers"),
+            _ => None,
+        });
+        let written = self.written_forces.iter().any(|f| !self.arena.is_zero(*f));
+        if let Some(what) = unattributed.or(written.then_some("generalized forces")) {
+            return Err(ReactionError::UnattributedLoads {
+                model: self.name.clone(),
+                what,
+            });
+        }
+        let dim = self.points[p].1.len();
+        let zero = self.arena.int(0);
+        let arena = &mut self.arena;
+        let pad = |v: &[ExprId]| [v[0], v[1], if v.len() > 2 { v[2] } else { zero }];
+        let mut force = [zero; 3];
+        let mut moment = [zero; 3];
+        let add = |arena: &mut crate::expr::ExprArena, sum: &mut [ExprId; 3], v: [ExprId; 3]| {
+            for (s, x) in sum.iter_mut().zip(v) {
+                *s = arena.plus(*s, x);
+            }
+        };
+        let at_point = pad(&self.points[p].1);
+        for &b in &chosen {
+            let body = &self.bodies[b];
+            let r = pad(&self.points[body.com].1);
+            let a = r.map(|c| {
+                let v = arena.time_derivative(c);
+                arena.time_derivative(v)
+            });
+            let mut net = a.map(|c| arena.times(body.mass, c));
+            if let Some(g) = &self.gravity {
+                let g = pad(g);
+                net = [0, 1, 2].map(|i| {
+                    let w = arena.times(body.mass, g[i]);
+                    arena.minus(net[i], w)
+                });
+            }
+            add(arena, &mut force, net);
+            let rel = [0, 1, 2].map(|i| arena.minus(r[i], at_point[i]));
+            let arm = cross(arena, &rel, &net);
+            add(arena, &mut moment, arm);
+            if let Some((inertia, angle)) = body.rotation {
+                let rate = arena.time_derivative(angle);
+                let accel = arena.time_derivative(rate);
+                let spin = arena.times(inertia, accel);
+                add(arena, &mut moment, [zero, zero, spin]);
+            }
+            if let Some(s) = &body.spatial {
+                let w = s.angular_velocity;
+                let alpha = w.map(|c| arena.time_derivative(c));
+                let i_alpha = tensor_times(arena, &s.inertia, &alpha);
+                let i_w = tensor_times(arena, &s.inertia, &w);
+                let gyro = cross(arena, &w, &i_w);
+                let h_dot = [0, 1, 2].map(|i| arena.plus(i_alpha[i], gyro[i]));
+                let h_dot = self.frames.express(arena, h_dot, s.frame, 0);
+                add(arena, &mut moment, h_dot);
+            }
+            for load in &self.loads {
+                match load {
+                    LoadInfo::Torque {
+                        body: on, value, ..
+                    } if *on == b => {
+                        let minus = arena.neg(*value);
+                        add(arena, &mut moment, [zero, zero, minus]);
+                    }
+                    LoadInfo::SpatialTorque { body: on, vector } if *on == b => {
+                        if let Some(s) = &body.spatial {
+                            let tau = self.frames.express(arena, *vector, s.frame, 0);
+                            let minus = tau.map(|c| arena.neg(c));
+                            add(arena, &mut moment, minus);
+                        }
+                    }
+                    _ => {}
+                }
+            }
+        }
+        Ok(Reaction {
+            bodies: bodies.to_vec(),
+            at: at.to_string(),
+            force: force[..dim].to_vec(),
+            moment: if dim == 2 {
+                vec![moment[2]]
+            } else {
+                moment.to_vec()
+            },
+        })
+    }
+}

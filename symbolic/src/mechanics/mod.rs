@@ -22,7 +22,7 @@ mod preferred;
 pub use balances::{HandEquations, UserBalances};
 pub use constraints::{ConstraintEquations, linear_in_rates, redundant_rows};
 pub use energy::{EnergyRate, PowerRoute, energy_routes_skipped};
-pub use kinematics::{FrameKinematics, PointKinematics};
+pub use kinematics::{FrameKinematics, PointKinematics, Reaction, ReactionError};
 pub use lagrange::Lagrange;
 pub use limit::{DERIVATION_OPERAND_LIMIT, finish_derivation, limit_derivation};
 pub use lower::{
