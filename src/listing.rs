@@ -137,6 +137,7 @@ pub fn equations(
     };
     eomgen_symbolic::mechanics::finish_derivation(&mut model, &file)
         .map_err(ListingError::Diagnostics)?;
+    let eom = eomgen_symbolic::codegen::readable_equations(&mut model, &eom);
     Ok(Equations {
         model: model.name.clone(),
         method: derivation.name(),

@@ -171,6 +171,33 @@ pub fn kinematics(
         .map(|r| model.reaction(&r.bodies, &r.at))
         .collect::<Result<Vec<_>, _>>()
         .map_err(ListingError::Reaction)?;
+    for f in &mut frame_exprs {
+        let parts = [
+            &mut f.angular_velocity,
+            &mut f.angular_velocity_ground,
+            &mut f.angular_acceleration,
+        ];
+        for v in parts
+            .into_iter()
+            .chain(f.partial_angular_velocities.iter_mut())
+        {
+            *v = v.map(|x| model.arena.readable(x));
+        }
+    }
+    for k in &mut point_exprs {
+        let parts = [&mut k.position, &mut k.velocity, &mut k.acceleration];
+        for v in parts.into_iter().chain(k.partial_velocities.iter_mut()) {
+            for x in v.iter_mut() {
+                *x = model.arena.readable(*x);
+            }
+        }
+    }
+    let mut reactions = reactions;
+    for r in &mut reactions {
+        for x in r.force.iter_mut().chain(r.moment.iter_mut()) {
+            *x = model.arena.readable(*x);
+        }
+    }
     let list = |syntax: Syntax| {
         let p = Printer::for_display(&model.arena, syntax);
         let show = |v: &[ExprId]| v.iter().map(|&e| p.print(e)).collect::<Vec<_>>();

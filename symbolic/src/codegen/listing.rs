@@ -167,6 +167,40 @@ impl EquationsListing {
     }
 }
 
+/// `eom` and `model`'s energies, generalized forces, constraint and contact expressions in
+/// the forms a person reads ([`crate::expr::ExprArena::readable`]: multiplied out where that
+/// cancels, `sin² + cos² = 1`, common factors pulled out; each the shorter of that and the
+/// written form), for the listings: the values are unchanged, and `model` is then for
+/// printing only (its expressions are no longer the shapes the code generator shares).
+pub fn readable_equations(model: &mut SymbolicModel, eom: &EquationsOfMotion) -> EquationsOfMotion {
+    let arena = &mut model.arena;
+    let each = |arena: &mut crate::expr::ExprArena, v: &mut Vec<ExprId>| {
+        for x in v.iter_mut() {
+            *x = arena.readable(*x);
+        }
+    };
+    let mut mass_matrix = eom.mass_matrix.clone();
+    let mut forcing = eom.forcing.clone();
+    each(arena, &mut mass_matrix);
+    each(arena, &mut forcing);
+    each(arena, &mut model.generalized_forces);
+    let c = &mut model.constraints;
+    for v in [&mut c.phi, &mut c.jacobian, &mut c.velocity, &mut c.gamma] {
+        each(arena, v);
+    }
+    for contact in &mut model.contacts {
+        each(arena, &mut contact.jacobian);
+        contact.gap = arena.readable(contact.gap);
+    }
+    model.kinetic = arena.readable(model.kinetic);
+    model.potential = arena.readable(model.potential);
+    EquationsOfMotion {
+        num_dofs: eom.num_dofs,
+        mass_matrix,
+        forcing,
+    }
+}
+
 /// The equations as text: `q`, `T`, `V`, `Q`, then `M` (upper triangle) and `F` entry by
 /// entry; for a constrained model `M q'' + J^T lambda = F` and `J q'' = gamma` with the
 /// non-zero entries of `J`, each `γ`, and each constraint's equation.

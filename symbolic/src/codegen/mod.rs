@@ -21,7 +21,7 @@ mod taylor_tokens;
 pub use describe::{describe, description_tokens};
 pub use listing::{
     ConstraintKind, ConstraintListing, EquationsListing, GeneralizedForce, equations_latex,
-    equations_mathml, equations_text,
+    equations_mathml, equations_text, readable_equations,
 };
 
 use proc_macro2::{Literal, TokenStream};

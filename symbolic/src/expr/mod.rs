@@ -35,6 +35,7 @@ mod diff;
 pub mod eval;
 mod expand;
 pub mod print;
+mod simplify;
 pub mod trig;
 
 pub use constant::{Constant, FoldError, fold};
