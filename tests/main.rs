@@ -11,6 +11,7 @@ mod constraints;
 mod contacts;
 mod convolution;
 mod determinism;
+mod euler_parameters;
 mod events;
 mod expm_rayleigh;
 mod export;

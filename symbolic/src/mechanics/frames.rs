@@ -31,6 +31,10 @@ pub enum RotationAxis {
     Principal(usize),
     /// An oblique axis: its unit vector's components (constants), the same in both frames.
     Unit(Vector3),
+    /// Euler parameters: the vector part `(e1, e2, e3)` of the rotation, whose scalar part
+    /// `e0` is the rotation's "angle" (Kane & Levinson §1.3; the rotation is the one of the
+    /// normalised parameters, so a drift of their norm does not deform the frame).
+    Quaternion(Vector3),
 }
 
 impl From<usize> for RotationAxis {
@@ -135,6 +139,12 @@ impl Frames {
                             *wi = arena.plus(*wi, part);
                         }
                     }
+                    RotationAxis::Quaternion(e) => {
+                        let own = quaternion_rate(arena, e, angle, false);
+                        for (wi, part) in w.iter_mut().zip(own) {
+                            *wi = arena.plus(*wi, part);
+                        }
+                    }
                 }
             }
         }
@@ -150,23 +160,22 @@ impl Frames {
     /// Euler angles, rather than the frame's components turned back through every angle).
     pub fn angular_velocity_in_ground(&self, arena: &mut ExprArena, frame: usize) -> Vector3 {
         let zero = arena.int(0);
-        let one = arena.int(1);
         let mut w = [zero; 3];
         let path = self.path(frame);
         for (depth, &f) in path.iter().enumerate().skip(1) {
             for (j, &(axis, angle)) in self.rotations[f].iter().enumerate() {
                 let rate = arena.time_derivative(angle);
-                if arena.is_zero(rate) {
-                    continue;
-                }
-                // The axis in the frame its rotation turns (the same before and after it).
+                // The rotation's own angular velocity in the frame before it: its rate about
+                // its axis (the same before and after it), or the Euler parameters' rates.
                 let mut e = match axis {
+                    RotationAxis::Quaternion(e) => quaternion_rate(arena, e, angle, true),
+                    _ if arena.is_zero(rate) => continue,
                     RotationAxis::Principal(i) => {
                         let mut e = [zero; 3];
-                        e[i] = one;
+                        e[i] = rate;
                         e
                     }
-                    RotationAxis::Unit(k) => k,
+                    RotationAxis::Unit(k) => k.map(|c| arena.times(c, rate)),
                 };
                 // Up through the frame's rotations before it, then through its ancestors'.
                 for &(a, angle) in self.rotations[f][..j].iter().rev() {
@@ -178,8 +187,7 @@ impl Frames {
                     }
                 }
                 for (wi, ei) in w.iter_mut().zip(e) {
-                    let part = arena.times(ei, rate);
-                    *wi = arena.plus(*wi, part);
+                    *wi = arena.plus(*wi, ei);
                 }
             }
         }
@@ -199,6 +207,7 @@ fn rotate(
     let axis = match axis {
         RotationAxis::Principal(i) => i,
         RotationAxis::Unit(k) => return rotate_oblique(arena, v, k, angle, into_turned),
+        RotationAxis::Quaternion(e) => return rotate_quaternion(arena, v, e, angle, into_turned),
     };
     let (j, k) = ((axis + 1) % 3, (axis + 2) % 3);
     if arena.is_zero(v[j]) && arena.is_zero(v[k]) {
@@ -216,6 +225,58 @@ fn rotate(
     out[j] = arena.minus(cj, sk);
     out[k] = arena.plus(sj, ck);
     out
+}
+
+/// [`rotate`] by the Euler parameters `(e0, e)` (Kane & Levinson §1.3, eq. 1.3.3, normalised):
+/// back into the frame before the rotation `v′ = ((e0² − e·e) v + 2 (e·v) e + 2 e0 e × v)/|q|²`,
+/// into the turned frame the same with `−e0`, `|q|² = e0² + e·e`.
+fn rotate_quaternion(
+    arena: &mut ExprArena,
+    v: Vector3,
+    e: Vector3,
+    e0: ExprId,
+    into_turned: bool,
+) -> Vector3 {
+    let s = if into_turned { arena.neg(e0) } else { e0 };
+    let e0_squared = arena.times(e0, e0);
+    let products: Vec<ExprId> = e.iter().map(|c| arena.times(*c, *c)).collect();
+    let e_squared = arena.sum(&products);
+    let norm = arena.plus(e0_squared, e_squared);
+    let scale = arena.minus(e0_squared, e_squared);
+    let dots: Vec<ExprId> = e.iter().zip(&v).map(|(a, b)| arena.times(*a, *b)).collect();
+    let ev = arena.sum(&dots);
+    let two = arena.int(2);
+    let exv = cross(arena, &e, &v);
+    [0, 1, 2].map(|i| {
+        let a = arena.times(scale, v[i]);
+        let b = arena.product(&[two, ev, e[i]]);
+        let c = arena.product(&[two, s, exv[i]]);
+        let sum = arena.sum(&[a, b, c]);
+        arena.divide(sum, norm)
+    })
+}
+
+/// The angular velocity of a rotation by the Euler parameters `(e0, e)` relative to the frame
+/// before it: `2 (e0 ė − ė0 e ∓ e × ė)/|q|²` in the turned frame's components (`−`) or in the
+/// frame before it (`+`, `in_parent`) (Kane & Levinson §2.1, eq. 2.1.9, for any norm).
+fn quaternion_rate(arena: &mut ExprArena, e: Vector3, e0: ExprId, in_parent: bool) -> Vector3 {
+    let e_dot = e.map(|c| arena.time_derivative(c));
+    let e0_dot = arena.time_derivative(e0);
+    let exd = cross(arena, &e, &e_dot);
+    let e0_squared = arena.times(e0, e0);
+    let products: Vec<ExprId> = e.iter().map(|c| arena.times(*c, *c)).collect();
+    let e_squared = arena.sum(&products);
+    let norm = arena.plus(e0_squared, e_squared);
+    let two = arena.int(2);
+    [0, 1, 2].map(|i| {
+        let a = arena.times(e0, e_dot[i]);
+        let b = arena.times(e0_dot, e[i]);
+        let c = if in_parent { exd[i] } else { arena.neg(exd[i]) };
+        let b = arena.neg(b);
+        let sum = arena.sum(&[a, b, c]);
+        let twice = arena.times(two, sum);
+        arena.divide(twice, norm)
+    })
 }
 
 /// [`rotate`] about the unit vector `k` by Rodrigues' formula (Kane & Levinson §1.2):

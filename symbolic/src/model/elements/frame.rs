@@ -41,6 +41,10 @@ pub struct SimpleRotation {
     /// (and after: the axis is fixed in both), of a constant vector the rotation turns about
     /// (normalised where lowered; any length but zero). `None` for `x`, `y` or `z`.
     pub direction: Option<[Expr; 3]>,
+    /// Euler parameters, `quaternion: [e0, e1, e2, e3]`: the vector part `[e1, e2, e3]`, the
+    /// scalar part `e0` being [`Self::angle`]; the rotation is then the one they give (in
+    /// `axis` only its location is meant). `None` for a simple rotation.
+    pub quaternion: Option<[Expr; 3]>,
 }
 
 /// A reference frame: its parent turned by successive simple rotations (Kane & Levinson,
@@ -70,6 +74,7 @@ const FIELDS: Fields = Fields {
         ("axes", Need::Optional),
         ("angles", Need::Optional),
         ("about", Need::Optional),
+        ("quaternion", Need::Optional),
     ],
     example: EXAMPLE,
 };
@@ -100,6 +105,20 @@ fn read_frame(cx: &mut Ctx<'_>, k: &Located<String>, v: &YamlNode) -> Option<Fra
     };
     let single = get(f, "axis").is_some() || get(f, "angle").is_some();
     let several = get(f, "axes").is_some() || get(f, "angles").is_some();
+    if let Some(node) = get(f, "quaternion") {
+        if single || several || get(f, "about").is_some() {
+            cx.error(
+                Diagnostic::new(k.location, format!("{what} has both `quaternion` and rotation angles"))
+                    .with_help(format!("a frame is turned either by Euler parameters, `{}: {{ parent: N, quaternion: [e0, e1, e2, e3] }}`, or by simple rotations", k.value)),
+            );
+            return None;
+        }
+        return Some(Frame {
+            name: k.clone(),
+            parent,
+            rotations: vec![quaternion(cx, node)?],
+        });
+    }
     if single == several {
         let message = if single {
             format!("{what} has both `axis`/`angle` and `axes`/`angles`")
@@ -161,6 +180,7 @@ fn read_frame(cx: &mut Ctx<'_>, k: &Located<String>, v: &YamlNode) -> Option<Fra
             axis,
             angle,
             direction: oblique.clone(),
+            quaternion: None,
         })
         .collect();
     // Rotations about the parent's fixed axes in the order a, b, c give the orientation of
@@ -173,6 +193,69 @@ fn read_frame(cx: &mut Ctx<'_>, k: &Located<String>, v: &YamlNode) -> Option<Fra
         parent,
         rotations,
     })
+}
+
+/// `quaternion: [e0, e1, e2, e3]`: the frame's orientation in Euler parameters (expressions of
+/// the coordinates, normally four coordinates), as one rotation.
+fn quaternion(cx: &mut Ctx<'_>, node: &YamlNode) -> Option<SimpleRotation> {
+    let example = "quaternion: [e0, e1, e2, e3]";
+    let items = cx.seq(node, "`quaternion`", example)?;
+    if items.len() != 4 {
+        cx.error(
+            Diagnostic::new(node.location, format!("`quaternion` has 4 Euler parameters, found {}", items.len()))
+                .with_help("write the scalar part first: `quaternion: [e0, e1, e2, e3]`, e0 = cos(θ/2) and (e1, e2, e3) = sin(θ/2) times the rotation's axis"),
+        );
+        return None;
+    }
+    let parts: Vec<Option<Expr>> = (items.iter())
+        .map(|i| cx.expr(i, "an Euler parameter"))
+        .collect();
+    let mut parts: Vec<Expr> = parts.into_iter().collect::<Option<_>>()?;
+    let vector: [Expr; 3] = parts.split_off(1).try_into().ok()?;
+    let scalar = parts.pop()?;
+    Some(SimpleRotation {
+        axis: Located::new(Axis::Z, node.location),
+        angle: scalar,
+        direction: None,
+        quaternion: Some(vector),
+    })
+}
+
+/// The generated constraint that keeps a frame's Euler parameters of unit norm,
+/// `e0² + e1² + e2² + e3² − 1 = 0`, named `<frame>_unit` and located at the frame's name; `None`
+/// for a frame of simple rotations.
+pub(crate) fn unit_norm(frame: &Frame) -> Option<(Located<String>, Expr)> {
+    let [rotation] = frame.rotations.as_slice() else {
+        return None;
+    };
+    let vector = rotation.quaternion.as_ref()?;
+    let at = frame.name.location;
+    let binary = |op, lhs: Expr, rhs: Expr| Expr {
+        kind: crate::model::ast::ExprKind::Binary {
+            op,
+            lhs: Box::new(lhs),
+            rhs: Box::new(rhs),
+            op_location: at,
+        },
+        location: at,
+    };
+    let number = |value: f64| Expr {
+        kind: crate::model::ast::ExprKind::Number {
+            value,
+            text: format!("{value}"),
+        },
+        location: at,
+    };
+    use crate::model::ast::BinOp;
+    let square = |e: &Expr| binary(BinOp::Pow, e.clone(), number(2.0));
+    let sum = std::iter::once(&rotation.angle)
+        .chain(vector.iter())
+        .map(square)
+        .reduce(|a, b| binary(BinOp::Add, a, b))?;
+    Some((
+        Located::new(format!("{}_unit", frame.name.value), at),
+        binary(BinOp::Sub, sum, number(1.0)),
+    ))
 }
 
 /// The components `[a, b, c]` of an oblique axis (`axis: [0, 0.6, 0.8]`): three expressions of
@@ -216,6 +299,24 @@ pub(crate) fn write(w: &mut Writer<'_>, frames: &[Frame]) -> Result<(), NotRewri
 /// `{ parent: P, axis: z, angle: … }`, or `axes:` and `angles:` for several rotations.
 fn frame_text(w: &mut Writer<'_>, frame: &Frame) -> Result<String, NotRewritten> {
     let place = format!("frame `{}`", frame.name.value);
+    if let [
+        SimpleRotation {
+            angle,
+            quaternion: Some(vector),
+            ..
+        },
+    ] = frame.rotations.as_slice()
+    {
+        let parts = std::iter::once(angle)
+            .chain(vector.iter())
+            .map(|p| w.expr(p, &place))
+            .collect::<Result<Vec<_>, _>>()?;
+        return Ok(format!(
+            "{{ parent: {}, quaternion: {} }}",
+            frame.parent.value,
+            list(&parts)
+        ));
+    }
     let angles = frame
         .rotations
         .iter()
@@ -316,6 +417,13 @@ pub(crate) fn angle_rules(frames: &[Frame], cx: &mut dyn Rules) {
         cx.expression(angle, Depends::Position, &what);
     }
     for f in frames {
+        for part in (f.rotations.iter())
+            .filter_map(|r| r.quaternion.as_ref())
+            .flatten()
+        {
+            let what = format!("the Euler parameters of frame `{}`", f.name.value);
+            cx.expression(part, Depends::Position, &what);
+        }
         for part in f
             .rotations
             .iter()
@@ -330,6 +438,21 @@ pub(crate) fn angle_rules(frames: &[Frame], cx: &mut dyn Rules) {
 
 /// The rotation angles are pure numbers (rad).
 pub(crate) fn units(frames: &[Frame], cx: &mut dyn Units) {
+    for f in frames {
+        for part in (f.rotations.iter())
+            .filter_map(|r| r.quaternion.as_ref())
+            .flatten()
+        {
+            cx.fixed(
+                part,
+                Dimension::ONE,
+                &format!("an Euler parameter of frame `{}`", f.name.value),
+                "an Euler parameter",
+                "a pure number",
+                "Euler parameters are pure numbers, e0 = cos(θ/2) and (e1, e2, e3) = sin(θ/2) times a unit axis",
+            );
+        }
+    }
     for (frame, angle) in angles(frames) {
         cx.fixed(
             angle,
@@ -349,6 +472,10 @@ pub(crate) fn lower(f: &Frame, cx: &mut dyn Lower) -> Vec<(RotationAxis, ExprId)
     f.rotations
         .iter()
         .map(|r| {
+            if let Some(vector) = &r.quaternion {
+                let v = vector.clone().map(|p| cx.expr(&p));
+                return (RotationAxis::Quaternion(v), cx.expr(&r.angle));
+            }
             let axis = match &r.direction {
                 None => RotationAxis::Principal(r.axis.value.index()),
                 Some(parts) => {

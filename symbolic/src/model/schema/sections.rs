@@ -184,7 +184,19 @@ const SECTIONS: &[Section] = &[
         key: constraint::KEY,
         read: |cx, n, file| (file.constraints, file.point_constraints) = constraint::read(cx, n),
         missing: None,
-        write: |w, file| constraint::write(w, &file.constraints, &file.point_constraints),
+        write: |w, file| {
+            // The constraints the frames in Euler parameters generate are written with them.
+            let written: Vec<_> = (file.constraints.iter())
+                .filter(|(k, _)| {
+                    !file.frames.iter().any(|f| {
+                        frame::unit_norm(f)
+                            .is_some_and(|(g, _)| g.value == k.value && g.location == k.location)
+                    })
+                })
+                .cloned()
+                .collect();
+            constraint::write(w, &written, &file.point_constraints)
+        },
     },
     Section {
         key: nonholonomic::KEY,
@@ -332,6 +344,9 @@ impl Ctx<'_> {
         }
         self.section = "";
         file.dimension = file.points.first().map(Point::dimension);
+        // A frame in Euler parameters keeps them of unit norm by a constraint of its own.
+        let generated: Vec<_> = file.frames.iter().filter_map(frame::unit_norm).collect();
+        file.constraints.extend(generated);
         Some(file)
     }
 
