@@ -13,6 +13,7 @@ trigsimp runs past `--seconds`.
 import argparse
 import json
 import multiprocessing
+import re
 import subprocess
 
 import sympy as sp
@@ -45,10 +46,16 @@ def normal(text):
     return text.replace(" ", "").replace("**", "^")
 
 
+FUNCTIONS = {"sin", "cos", "tan", "asin", "acos", "atan", "atan2", "sinh", "cosh", "tanh",
+             "exp", "ln", "sqrt", "abs", "sign", "pi"}
+
+
 def simplify(text, out):
-    names = {}
-    expr = sp.parse_expr(text.replace("^", "**"), local_dict=names, transformations="all"
-                         if False else sp.parsing.sympy_parser.standard_transformations)
+    # Every name a symbol (a parameter `I` is not the imaginary unit), `ln` the logarithm.
+    names = {n: sp.Symbol(n) for n in re.findall(r"[A-Za-z_][A-Za-z_0-9]*", text)
+             if n not in FUNCTIONS}
+    names["ln"] = sp.log
+    expr = sp.parse_expr(text.replace("^", "**"), local_dict=names)
     out.put(normal(sp.sstr(sp.trigsimp(expr))))
 
 

@@ -211,3 +211,8 @@ def test_the_rolling_discs_contact_reaction_is_its_constraint_force():
         assert np.max(np.abs(moment)) < 1e-9 * weight * p["r"], moment
     with pytest.raises(ValueError, match="no body `wheel`"):
         m.kinematics(reactions=[("wheel", "C")])
+    # "BODY@POINT" is the same request; loads the file does not attribute to bodies (a
+    # written potential, a spring) are refused rather than counted as a reaction.
+    assert m.kinematics(reactions=["disc@C"])["reactions"] == listing["reactions"]
+    with pytest.raises(ValueError, match="written potential"):
+        eomgen.load("central_force").kinematics(reactions=["particle@O"])

@@ -171,6 +171,7 @@ pub fn kinematics(
         .map(|r| model.reaction(&r.bodies, &r.at))
         .collect::<Result<Vec<_>, _>>()
         .map_err(ListingError::Reaction)?;
+    let start = model.arena.len();
     for f in &mut frame_exprs {
         let parts = [
             &mut f.angular_velocity,
@@ -181,21 +182,21 @@ pub fn kinematics(
             .into_iter()
             .chain(f.partial_angular_velocities.iter_mut())
         {
-            *v = v.map(|x| model.arena.readable(x));
+            *v = v.map(|x| model.arena.readable_within(x, start));
         }
     }
     for k in &mut point_exprs {
         let parts = [&mut k.position, &mut k.velocity, &mut k.acceleration];
         for v in parts.into_iter().chain(k.partial_velocities.iter_mut()) {
             for x in v.iter_mut() {
-                *x = model.arena.readable(*x);
+                *x = model.arena.readable_within(*x, start);
             }
         }
     }
     let mut reactions = reactions;
     for r in &mut reactions {
         for x in r.force.iter_mut().chain(r.moment.iter_mut()) {
-            *x = model.arena.readable(*x);
+            *x = model.arena.readable_within(*x, start);
         }
     }
     let list = |syntax: Syntax| {
@@ -266,7 +267,10 @@ fn chosen(
         Some(name) => Err(ListingError::UnknownName {
             kind,
             name: name.clone(),
-            known: known.to_vec(),
+            known: match known.is_empty() {
+                true => vec![format!("none: the file has no `{kind}s:`")],
+                false => known.to_vec(),
+            },
         }),
         None => Ok(known
             .iter()
@@ -397,14 +401,18 @@ fn render_latex(coordinates: &[String], k: &KinematicsListing) -> String {
     }
     for r in &k.reactions {
         let at = symbol(&r.at);
+        let on = (r.bodies.iter())
+            .map(|b| format!("\\text{{{b}}}"))
+            .collect::<Vec<_>>()
+            .join("+");
         let _ = writeln!(
             out,
-            "\\mathbf{{R}}_{{{at}}} &= {} \\\\",
+            "\\mathbf{{R}}_{{{at}}}^{{{on}}} &= {} \\\\",
             latex_vector(&r.force)
         );
         let _ = writeln!(
             out,
-            "\\mathbf{{M}}_{{{at}}} &= {} \\\\",
+            "\\mathbf{{M}}_{{{at}}}^{{{on}}} &= {} \\\\",
             latex_vector(&r.moment)
         );
     }

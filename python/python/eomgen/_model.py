@@ -599,7 +599,8 @@ class Model:
         file's syntax (``x_dot``, ``x_ddot``, ``^`` for powers), ``"latex"`` holds the same
         in LaTeX, and ``"text"`` the listing as the command line prints it.
 
-        ``reactions`` lists ``(bodies, point)`` pairs (``bodies`` a name or a list of names):
+        ``reactions`` lists ``(bodies, point)`` pairs (``bodies`` a name or a list of names) or
+        ``"BODY@POINT"`` strings (``"a+b@O"`` for two bodies):
         for each, ``"reactions"`` gives the force ``R = Σ m a_G − Σ m g`` and the moment about
         the point that act on those bodies besides gravity and their own torques — the
         reaction of a pivot the model leaves implicit — as expressions of ``q``, ``q̇`` and
@@ -607,8 +608,16 @@ class Model:
 
         Raises ``ValueError`` for a frame, point or body the file does not have, or a reaction
         of a model whose forces, springs or dampers act at points rather than on bodies."""
-        pairs = [([b] if isinstance(b, str) else [str(x) for x in b], str(at))
-                 for b, at in (reactions or [])]
+        pairs = []
+        for r in reactions or []:
+            if isinstance(r, str):
+                bodies, sep, at = r.partition("@")
+                if not sep or not bodies or not at:
+                    raise ValueError(f"reaction {r!r}: write it as 'BODY@POINT' or ('BODY', 'POINT')")
+                pairs.append((bodies.split("+"), at))
+            else:
+                bodies, at = r
+                pairs.append(([bodies] if isinstance(bodies, str) else [str(x) for x in bodies], str(at)))
         listing, text, _ = self._core.kinematics(
             [str(f) for f in (frames or [])], [str(p) for p in (points or [])], bool(partial), pairs)
         listing["text"] = text

@@ -170,13 +170,15 @@ impl EquationsListing {
 /// `eom` and `model`'s energies, generalized forces, constraint and contact expressions in
 /// the forms a person reads ([`crate::expr::ExprArena::readable`]: multiplied out where that
 /// cancels, `sin² + cos² = 1`, common factors pulled out; each the shorter of that and the
-/// written form), for the listings: the values are unchanged, and `model` is then for
-/// printing only (its expressions are no longer the shapes the code generator shares).
+/// written form), for the listings, within a budget of arena growth
+/// ([`crate::expr::ExprArena::readable_within`]): the values are unchanged, and `model` is then
+/// for printing only (its expressions are no longer the shapes the code generator shares).
 pub fn readable_equations(model: &mut SymbolicModel, eom: &EquationsOfMotion) -> EquationsOfMotion {
     let arena = &mut model.arena;
+    let start = arena.len();
     let each = |arena: &mut crate::expr::ExprArena, v: &mut Vec<ExprId>| {
         for x in v.iter_mut() {
-            *x = arena.readable(*x);
+            *x = arena.readable_within(*x, start);
         }
     };
     let mut mass_matrix = eom.mass_matrix.clone();
@@ -190,10 +192,10 @@ pub fn readable_equations(model: &mut SymbolicModel, eom: &EquationsOfMotion) ->
     }
     for contact in &mut model.contacts {
         each(arena, &mut contact.jacobian);
-        contact.gap = arena.readable(contact.gap);
+        contact.gap = arena.readable_within(contact.gap, start);
     }
-    model.kinetic = arena.readable(model.kinetic);
-    model.potential = arena.readable(model.potential);
+    model.kinetic = arena.readable_within(model.kinetic, start);
+    model.potential = arena.readable_within(model.potential, start);
     EquationsOfMotion {
         num_dofs: eom.num_dofs,
         mass_matrix,

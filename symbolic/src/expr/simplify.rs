@@ -24,9 +24,25 @@ use super::{Constant, ExprArena, ExprId, Node};
 /// Most operations (written out as a tree) of an expression that [`ExprArena::readable`]
 /// multiplies out: past this the expansion's cost is not worth a form that would print
 /// longer than the limit of a listing anyway.
-const MOST_OPERATIONS: u64 = 20_000;
+const MOST_OPERATIONS: u64 = 4_000;
+
+/// Most nodes the readable forms of one listing may add to the arena
+/// ([`ExprArena::readable_within`]): past it, the rest is printed as derived. Chosen so that
+/// the listing of a model whose entries are many and deep (a chain of six universal joints,
+/// three nested frames in Euler parameters) stays within a second or so.
+pub const READABLE_BUDGET: usize = 200_000;
 
 impl ExprArena {
+    /// [`Self::readable`] while the arena has grown by less than [`READABLE_BUDGET`] nodes
+    /// since it had `start` (its [`ExprArena::len`] when the listing began); `e` itself past
+    /// that.
+    pub fn readable_within(&mut self, e: ExprId, start: usize) -> ExprId {
+        if self.len() > start + READABLE_BUDGET {
+            return e;
+        }
+        self.readable(e)
+    }
+
     /// The shorter to print of `e` and its multiplied-out, collected form (see the module
     /// documentation); `e` itself when it is larger than [`MOST_OPERATIONS`].
     pub fn readable(&mut self, e: ExprId) -> ExprId {

@@ -565,6 +565,17 @@ fn sample_states(
     for (_, b) in others {
         roots.extend(b.mass_matrix.iter().chain(&b.forcing));
     }
+    // The constraints' J and γ, for a model whose M is singular off the constraints (Euler
+    // parameters: nothing moves along their norm), compared through the KKT system.
+    let constraint_start = roots.len();
+    let m = model.constraints.len();
+    roots.extend(
+        model
+            .constraints
+            .jacobian
+            .iter()
+            .chain(&model.constraints.gamma),
+    );
     roots.push(model.kinetic);
     let mut evaluator = Evaluator::new(&model.arena, &roots);
     // The power balance at the solved accelerations, apart: re-evaluating every root for it
@@ -600,14 +611,49 @@ fn sample_states(
             sampled.not_finite += 1;
             continue;
         }
-        let Some(qdd) = solve(v[..nn].to_vec(), v[nn..nn + n].to_vec())
+        let constraints = (m > 0).then(|| &v[constraint_start..constraint_start + m * n + m]);
+        // With constraints, a derivation whose M is singular (as along the norm of Euler
+        // parameters, where nothing moves) sends every derivation through the KKT system.
+        let regular = |base: usize| {
+            solve(
+                v[base..base + nn].to_vec(),
+                v[base + nn..base + nn + n].to_vec(),
+            )
             .filter(|qdd| qdd.iter().all(|x| x.is_finite()))
-        else {
-            sampled.singular += 1;
-            continue;
+        };
+        let others_regular =
+            (0..others.len()).all(|k| regular(lagrange_len + k * (nn + n)).is_some());
+        let unconstrained = regular(0).filter(|_| constraints.is_none() || others_regular);
+        let qdd = match (unconstrained, constraints) {
+            (Some(qdd), _) => {
+                compare_others(&v, &qdd, (lagrange_len, n), &mut row_rel, &mut max_rel);
+                qdd
+            }
+            // M singular, as it is along the norm of Euler parameters: the accelerations the
+            // constraints determine, of each derivation, compared.
+            (None, Some(jg)) => match kkt_accelerations(&v[..nn + n], jg, n, m) {
+                Some(qdd) => {
+                    compare_constrained(
+                        &v,
+                        &qdd,
+                        jg,
+                        (lagrange_len, n, m),
+                        &mut row_rel,
+                        &mut max_rel,
+                    );
+                    qdd
+                }
+                None => {
+                    sampled.singular += 1;
+                    continue;
+                }
+            },
+            (None, None) => {
+                sampled.singular += 1;
+                continue;
+            }
         };
         sampled.compared += 1;
-        compare_others(&v, &qdd, (lagrange_len, n), &mut row_rel, &mut max_rel);
         // T homogeneous of degree 2 in q̇?
         let t1 = v[v.len() - 1];
         if homogeneity_fails(&mut kinetic_only, &symbols, &bindings, t1) {
@@ -704,6 +750,59 @@ fn compare_others(
             Some(_) if here[k].is_nan() => *worst = f64::NAN,
             Some(_) => *worst = worst.max(here[k]),
             None => *worst = f64::INFINITY,
+        }
+    }
+}
+
+/// `q̈` of `[M Jᵀ; J 0][q̈; λ] = [F; γ]`, `mf` holding `M` (`n × n`, row-major) and `F`, `jg`
+/// holding `J` (`m × n`) and `γ`; `None` where the system is singular or the result not
+/// finite.
+fn kkt_accelerations(mf: &[f64], jg: &[f64], n: usize, m: usize) -> Option<Vec<f64>> {
+    let k = n + m;
+    let mut a = vec![0.0; k * k];
+    let mut b = vec![0.0; k];
+    for r in 0..n {
+        for c in 0..n {
+            a[r * k + c] = mf[r * n + c];
+        }
+        b[r] = mf[n * n + r];
+    }
+    for i in 0..m {
+        for c in 0..n {
+            let j = jg[i * n + c];
+            a[(n + i) * k + c] = j;
+            a[c * k + n + i] = j;
+        }
+        b[n + i] = jg[m * n + i];
+    }
+    let x = solve(a, b)?;
+    let qdd = x[..n].to_vec();
+    qdd.iter().all(|v| v.is_finite()).then_some(qdd)
+}
+
+/// [`compare_others`] for a model whose `M` is singular off its constraints: each other
+/// derivation's accelerations from the KKT system with the same `J` and `γ` (`jg`, `m`
+/// constraints) against Lagrange's `qdd`, relative to the largest of them and 1.
+fn compare_constrained(
+    v: &[f64],
+    qdd: &[f64],
+    jg: &[f64],
+    (lagrange_len, n, m): (usize, usize, usize),
+    row_rel: &mut [Vec<f64>],
+    max_rel: &mut [f64],
+) {
+    let nn = n * n;
+    let scale = qdd.iter().fold(1.0f64, |s, x| s.max(x.abs()));
+    for (k, (rows, worst)) in row_rel.iter_mut().zip(max_rel.iter_mut()).enumerate() {
+        let base = lagrange_len + k * (nn + n);
+        let Some(other) = kkt_accelerations(&v[base..base + nn + n], jg, n, m) else {
+            *worst = f64::INFINITY;
+            continue;
+        };
+        for (i, row) in rows.iter_mut().enumerate() {
+            let rel = (other[i] - qdd[i]).abs() / scale;
+            *row = if rel.is_nan() { rel } else { row.max(rel) };
+            *worst = if rel.is_nan() { rel } else { worst.max(rel) };
         }
     }
 }

@@ -146,14 +146,14 @@ pub enum ReactionError {
         /// The model's points.
         known: Vec<String>,
     },
-    /// The model has loads whose share on the set its file does not say.
+    /// The model has loads (or energies) whose share on the set its file does not say.
     #[error(
         "the reaction is what acts on the bodies besides gravity and their own torques, but `{model}` also has {what}, which the file does not attribute to bodies: it cannot be separated out"
     )]
     UnattributedLoads {
         /// The model.
         model: String,
-        /// Forces, springs, dampers or generalized forces.
+        /// Forces, springs, dampers, generalized forces or a written energy.
         what: &'static str,
     },
 }
@@ -163,8 +163,9 @@ impl SymbolicModel {
     ///
     /// # Errors
     /// [`ReactionError::UnknownBody`] or [`ReactionError::UnknownPoint`] for a name the model
-    /// does not have; [`ReactionError::UnattributedLoads`] when it has forces, springs,
-    /// dampers or written generalized forces (acting at points, not on bodies).
+    /// does not have; [`ReactionError::UnattributedLoads`] when it has forces, interactions,
+    /// springs, dampers, written generalized forces or a written potential or kinetic energy
+    /// (acting at points or on coordinates, not on bodies).
     pub fn reaction(&mut self, bodies: &[String], at: &str) -> Result<Reaction, ReactionError> {
         use super::LoadInfo;
         use super::frames::{cross, tensor_times};
@@ -186,14 +187,23 @@ impl SymbolicModel {
                 known: self.points.iter().map(|(n, _)| n.clone()).collect(),
             }
         })?;
+        let mut chosen = chosen;
+        chosen.dedup();
+        chosen.sort_unstable();
+        chosen.dedup();
         let unattributed = (self.loads.iter()).find_map(|l| match l {
-            LoadInfo::Force { .. } => Some("forces"),
+            LoadInfo::Force { .. } => Some("forces or interactions"),
             LoadInfo::Spring { .. } => Some("springs"),
             LoadInfo::Damper { .. } => Some("dampers"),
             _ => None,
         });
         let written = self.written_forces.iter().any(|f| !self.arena.is_zero(*f));
-        if let Some(what) = unattributed.or(written.then_some("generalized forces")) {
+        let potential = !self.arena.is_zero(self.written_potential);
+        let unattributed = unattributed
+            .or(written.then_some("generalized forces"))
+            .or(potential.then_some("a written potential"))
+            .or(self.kinetic_written.then_some("a written kinetic energy"));
+        if let Some(what) = unattributed {
             return Err(ReactionError::UnattributedLoads {
                 model: self.name.clone(),
                 what,

@@ -221,6 +221,20 @@ fn quaternion(cx: &mut Ctx<'_>, node: &YamlNode) -> Option<SimpleRotation> {
     })
 }
 
+/// Whether a frame in Euler parameters has a coordinate among their expressions (names in
+/// `coordinates`): then its unit norm is a constraint on the coordinates.
+pub(crate) fn moves_with_coordinates(frame: &Frame, coordinates: &[&str]) -> bool {
+    let mut names = Vec::new();
+    for r in &frame.rotations {
+        if let Some(vector) = &r.quaternion {
+            for e in std::iter::once(&r.angle).chain(vector) {
+                crate::model::parser::identifiers(e, &mut names);
+            }
+        }
+    }
+    names.iter().any(|(n, _)| coordinates.contains(&n.as_str()))
+}
+
 /// The generated constraint that keeps a frame's Euler parameters of unit norm,
 /// `e0² + e1² + e2² + e3² − 1 = 0`, named `<frame>_unit` and located at the frame's name; `None`
 /// for a frame of simple rotations.

@@ -344,8 +344,17 @@ impl Ctx<'_> {
         }
         self.section = "";
         file.dimension = file.points.first().map(Point::dimension);
-        // A frame in Euler parameters keeps them of unit norm by a constraint of its own.
-        let generated: Vec<_> = file.frames.iter().filter_map(frame::unit_norm).collect();
+        // A frame in Euler parameters keeps them of unit norm by a constraint of its own
+        // (where they are coordinates: a rotation given in `t` alone needs none), unless the
+        // file names one so.
+        let coordinates: Vec<&str> = (file.coordinates.iter())
+            .map(|c| c.name.value.as_str())
+            .collect();
+        let generated: Vec<_> = (file.frames.iter())
+            .filter(|f| frame::moves_with_coordinates(f, &coordinates))
+            .filter_map(frame::unit_norm)
+            .filter(|(name, _)| !file.constraints.iter().any(|(k, _)| k.value == name.value))
+            .collect();
         file.constraints.extend(generated);
         Some(file)
     }
