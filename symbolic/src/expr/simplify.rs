@@ -30,10 +30,10 @@ const MOST_OPERATIONS: u64 = 4_000;
 /// ([`ExprArena::readable_within`]): past it, the rest is printed as derived. Chosen so that
 /// the listing of a model whose entries are many and deep (a chain of six universal joints,
 /// three nested frames in Euler parameters) stays within a second or so.
-pub const READABLE_BUDGET: usize = 200_000;
+const READABLE_BUDGET: usize = 200_000;
 
 impl ExprArena {
-    /// [`Self::readable`] while the arena has grown by less than [`READABLE_BUDGET`] nodes
+    /// [`Self::readable`] while the arena has grown by less than `READABLE_BUDGET` (200,000) nodes
     /// since it had `start` (its [`ExprArena::len`] when the listing began); `e` itself past
     /// that.
     pub fn readable_within(&mut self, e: ExprId, start: usize) -> ExprId {
@@ -44,7 +44,8 @@ impl ExprArena {
     }
 
     /// The shorter to print of `e` and its multiplied-out, collected form (see the module
-    /// documentation); `e` itself when it is larger than [`MOST_OPERATIONS`].
+    /// documentation); `e` itself when it is larger than `MOST_OPERATIONS` (4,000 operations
+    /// written out as a tree).
     pub fn readable(&mut self, e: ExprId) -> ExprId {
         if self.tree_operation_count(&[e]) > MOST_OPERATIONS {
             return e;
