@@ -5,12 +5,14 @@
 use eomgen_symbolic::codegen::{EquationsListing, equations_latex, equations_text};
 use eomgen_symbolic::expr::print::Syntax;
 use eomgen_symbolic::mechanics::{Formulation, Lagrange, MomentumBalance, SymbolicModel};
-use eomgen_symbolic::model::Diagnostic;
 use serde::Serialize;
 
 pub use eomgen_symbolic::codegen::export::Language;
 
+mod error;
 mod kinematics;
+
+pub use error::ListingError;
 
 pub use kinematics::{
     FrameListing, Kinematics, KinematicsListing, KinematicsOptions, PointListing, ReactionListing,
@@ -58,44 +60,6 @@ pub struct Equations {
     /// serialised).
     #[serde(skip)]
     pub latex_document: String,
-}
-
-/// Why [`equations`] could not list a model's equations.
-#[derive(Debug, Clone, thiserror::Error)]
-#[non_exhaustive]
-pub enum ListingError {
-    /// The file has mistakes (located diagnostics).
-    #[error("{} error(s) in the model file", .0.len())]
-    Diagnostics(Vec<Diagnostic>),
-    /// Momentum balance was asked of a model it cannot derive.
-    #[error(
-        "`{model}` has no bodies or writes `kinetic:`, which momentum balance cannot derive from; use the Lagrange derivation"
-    )]
-    NoMomentumForm {
-        /// The model's name.
-        model: String,
-    },
-    /// A reaction asked for names a body or point the model does not have, or the model has
-    /// loads that cannot be attributed to bodies.
-    #[error(transparent)]
-    Reaction(#[from] eomgen_symbolic::mechanics::ReactionError),
-    /// A frame or point asked for is not in the model file.
-    #[error("the model has no {kind} `{name}` (its {kind}s: {})", known.join(", "))]
-    UnknownName {
-        /// `frame` or `point`.
-        kind: &'static str,
-        /// The name asked for.
-        name: String,
-        /// The file's names of that kind.
-        known: Vec<String>,
-    },
-    /// The exporter could not write a function (a bug of the exporter: the reason names the
-    /// function).
-    #[error("the model's code could not be exported: {reason}")]
-    Export {
-        /// Why.
-        reason: String,
-    },
 }
 
 /// Loads the model file `text` (`path` names it in diagnostics) and derives its equations

@@ -11,7 +11,7 @@ use eomgen_symbolic::expr::print::{Printer, Syntax};
 use eomgen_symbolic::mechanics::SymbolicModel;
 use serde::Serialize;
 
-use super::ListingError;
+use super::error::ListingError;
 
 /// What [`kinematics`] lists.
 #[derive(Debug, Clone, PartialEq, Eq, Default, Serialize)]
