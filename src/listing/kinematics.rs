@@ -133,7 +133,8 @@ pub struct Kinematics {
 /// # Examples
 /// ```
 /// use eomgen::listing::{KinematicsOptions, kinematics};
-/// let text = eomgen::models::find("heavy_top").unwrap().source;
+/// let Some(top) = eomgen::models::find("heavy_top") else { return Ok(()) };
+/// let text = top.source;
 /// let options = KinematicsOptions { frames: vec!["B".into()], ..Default::default() };
 /// let k = kinematics("heavy_top.yaml", text, &options)?;
 /// assert_eq!(k.listing.frames[0].angular_velocity.len(), 3);
@@ -343,78 +344,58 @@ fn latex_vector(v: &[String]) -> String {
     format!("\\begin{{bmatrix}} {} \\end{{bmatrix}}", v.join(" \\\\ "))
 }
 
-/// The listing as `eomgen kinematics --latex` prints it: an amsmath document body.
+/// The listing as `eomgen kinematics --latex` prints it: an amsmath document body, one
+/// `lhs &= [v] \\` row per vector.
 fn render_latex(coordinates: &[String], k: &KinematicsListing) -> String {
     let symbol = eomgen_symbolic::expr::print::latex_symbol;
-    let mut out = String::from("\\begin{align*}\n");
+    let mut rows: Vec<(String, &[String])> = Vec::new();
+    let partial = |of: &str, q: &str| {
+        format!(
+            "\\frac{{\\partial\\, {of}}}{{\\partial \\dot{{{}}}}}",
+            symbol(q)
+        )
+    };
     for f in &k.frames {
         let frame = symbol(&f.name);
-        let _ = writeln!(
-            out,
-            "{{}}^{{N}}\\boldsymbol{{\\omega}}^{{{frame}}} &= {} \\quad (\\text{{in }} {frame}) \\\\",
-            latex_vector(&f.angular_velocity)
-        );
-        let _ = writeln!(
-            out,
-            "{{}}^{{N}}\\boldsymbol{{\\omega}}^{{{frame}}} &= {} \\quad (\\text{{in }} N) \\\\",
-            latex_vector(&f.angular_velocity_ground)
-        );
-        let _ = writeln!(
-            out,
-            "{{}}^{{N}}\\boldsymbol{{\\alpha}}^{{{frame}}} &= {} \\quad (\\text{{in }} {frame}) \\\\",
-            latex_vector(&f.angular_acceleration)
-        );
+        let omega = format!("{{}}^{{N}}\\boldsymbol{{\\omega}}^{{{frame}}}");
+        rows.push((
+            format!("{omega} \\quad (\\text{{in }} {frame})"),
+            &f.angular_velocity,
+        ));
+        rows.push((
+            format!("{omega} \\quad (\\text{{in }} N)"),
+            &f.angular_velocity_ground,
+        ));
+        let alpha =
+            format!("{{}}^{{N}}\\boldsymbol{{\\alpha}}^{{{frame}}} \\quad (\\text{{in }} {frame})");
+        rows.push((alpha, &f.angular_acceleration));
         for (q, w) in coordinates.iter().zip(&f.partial_angular_velocities) {
-            let _ = writeln!(
-                out,
-                "\\frac{{\\partial\\, {{}}^{{N}}\\boldsymbol{{\\omega}}^{{{frame}}}}}{{\\partial \\dot{{{}}}}} &= {} \\\\",
-                symbol(q),
-                latex_vector(w)
-            );
+            rows.push((partial(&omega, q), w));
         }
     }
     for p in &k.points {
         let point = symbol(&p.name);
-        let _ = writeln!(
-            out,
-            "\\mathbf{{r}}_{{{point}}} &= {} \\\\",
-            latex_vector(&p.position)
-        );
-        let _ = writeln!(
-            out,
-            "{{}}^{{N}}\\mathbf{{v}}_{{{point}}} &= {} \\\\",
-            latex_vector(&p.velocity)
-        );
-        let _ = writeln!(
-            out,
-            "{{}}^{{N}}\\mathbf{{a}}_{{{point}}} &= {} \\\\",
-            latex_vector(&p.acceleration)
-        );
+        let velocity = format!("{{}}^{{N}}\\mathbf{{v}}_{{{point}}}");
+        rows.push((format!("\\mathbf{{r}}_{{{point}}}"), &p.position));
+        rows.push((velocity.clone(), &p.velocity));
+        rows.push((
+            format!("{{}}^{{N}}\\mathbf{{a}}_{{{point}}}"),
+            &p.acceleration,
+        ));
         for (q, v) in coordinates.iter().zip(&p.partial_velocities) {
-            let _ = writeln!(
-                out,
-                "\\frac{{\\partial\\, {{}}^{{N}}\\mathbf{{v}}_{{{point}}}}}{{\\partial \\dot{{{}}}}} &= {} \\\\",
-                symbol(q),
-                latex_vector(v)
-            );
+            rows.push((partial(&velocity, q), v));
         }
     }
     for r in &k.reactions {
         let at = symbol(&r.at);
-        let on = (r.bodies.iter())
-            .map(|b| format!("\\text{{{b}}}"))
-            .collect::<Vec<_>>()
-            .join("+");
-        let _ = writeln!(
-            out,
-            "\\mathbf{{R}}_{{{at}}}^{{{on}}} &= {} \\\\",
-            latex_vector(&r.force)
-        );
-        let _ = writeln!(
-            out,
-            "\\mathbf{{M}}_{{{at}}}^{{{on}}} &= {} \\\\",
-            latex_vector(&r.moment)
-        );
+        let on: Vec<String> = r.bodies.iter().map(|b| format!("\\text{{{b}}}")).collect();
+        let on = on.join("+");
+        rows.push((format!("\\mathbf{{R}}_{{{at}}}^{{{on}}}"), &r.force));
+        rows.push((format!("\\mathbf{{M}}_{{{at}}}^{{{on}}}"), &r.moment));
+    }
+    let mut out = String::from("\\begin{align*}\n");
+    for (lhs, v) in rows {
+        let _ = writeln!(out, "{lhs} &= {} \\\\", latex_vector(v));
     }
     out.push_str("\\end{align*}\n");
     out

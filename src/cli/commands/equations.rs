@@ -110,12 +110,29 @@ pub fn run_kinematics(args: &KinematicsArgs) -> Result<(), CliError> {
         }
         e => CliError::failure(e.to_string()),
     })?;
-    if args.json {
-        crate::cli::json::print_json(&listing)?;
-    } else if args.latex {
-        out!("{}", listing.latex_document);
+    show(
+        &listing,
+        args.json,
+        args.latex,
+        &listing.text,
+        &listing.latex_document,
+    )
+}
+
+/// Prints a listing as JSON, as its LaTeX document or as its text.
+fn show(
+    listing: &impl serde::Serialize,
+    json: bool,
+    latex: bool,
+    text: &str,
+    latex_document: &str,
+) -> Result<(), CliError> {
+    if json {
+        crate::cli::json::print_json(listing)?;
+    } else if latex {
+        out!("{latex_document}");
     } else {
-        out!("{}", listing.text);
+        out!("{text}");
     }
     Ok(())
 }
@@ -177,14 +194,13 @@ pub fn run(args: &EquationsArgs) -> Result<(), CliError> {
         )),
         e => CliError::failure(e.to_string()),
     })?;
-    if args.json {
-        crate::cli::json::print_json(&listing)?;
-    } else if args.latex {
-        out!("{}", listing.latex_document);
-    } else {
-        out!("{}", listing.text);
-    }
-    Ok(())
+    show(
+        &listing,
+        args.json,
+        args.latex,
+        &listing.text,
+        &listing.latex_document,
+    )
 }
 
 /// Runs `new`: prints the generated file, which names its equilibria (`hanging` and

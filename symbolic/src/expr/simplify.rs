@@ -50,17 +50,17 @@ impl ExprArena {
         if self.tree_operation_count(&[e]) > MOST_OPERATIONS {
             return e;
         }
-        let flat = self.flattened(e, &mut FxHashMap::default());
+        let flat = self.sums_rewritten(e, Self::flattened_sum);
         let expanded = self.expand_bounded(flat);
         let collected = self.collect_time_varying(expanded);
         let mut candidates = vec![flat, expanded, collected];
         for x in [flat, collected] {
-            let over = self.over_common_denominator(x, &mut FxHashMap::default());
+            let over = self.sums_rewritten(x, Self::over_common_denominator);
             candidates.push(over);
         }
         for x in [expanded, collected] {
-            let one = self.cosines_squared_out(x, &mut FxHashMap::default());
-            let over = self.over_common_denominator(one, &mut FxHashMap::default());
+            let one = self.sums_rewritten(x, Self::pair_squares);
+            let over = self.sums_rewritten(one, Self::over_common_denominator);
             candidates.extend([one, over]);
         }
         let length =
@@ -74,134 +74,87 @@ impl ExprArena {
         })
     }
 
-    /// `e` with every number times a sum, `c (a + b)`, multiplied into the sum it stands in
-    /// (`x − (y + 2l/3)` → `x − y − 2l/3`), through the whole expression (memoised in `memo`).
-    fn flattened(&mut self, e: ExprId, memo: &mut FxHashMap<ExprId, ExprId>) -> ExprId {
-        if let Some(&done) = memo.get(&e) {
-            return done;
+    /// `e` rebuilt bottom up (memoised) with each sum of (rebuilt) terms made by `rule`, and
+    /// every other node by the canonical constructors: the walk the printing forms share.
+    fn sums_rewritten(&mut self, e: ExprId, rule: fn(&mut Self, &[ExprId]) -> ExprId) -> ExprId {
+        let mut memo: FxHashMap<ExprId, ExprId> = FxHashMap::default();
+        for x in self.reachable(&[e]) {
+            let node = self.node(x).clone();
+            let children: Vec<ExprId> = node.children().iter().map(|c| memo[c]).collect();
+            let out = match node {
+                Node::Add(_) => rule(self, &children),
+                Node::Mul(_) => self.product(&children),
+                Node::Pow(_) => self.pow(children[0], children[1]),
+                Node::Func(f, _) => self.func(f, children[0]),
+                Node::Atan2(_) => self.atan2(children[0], children[1]),
+                Node::Const(_) | Node::Pi | Node::Symbol(_) => x,
+            };
+            memo.insert(x, out);
         }
-        let node = self.node(e).clone();
-        let children: Vec<ExprId> = (node.children().iter())
-            .map(|&c| self.flattened(c, memo))
-            .collect();
-        let out = match node {
-            Node::Add(_) => {
-                let mut terms = Vec::with_capacity(children.len());
-                for t in children {
-                    let (c, rest) = self.split_coefficient(t);
-                    match rest.map(|r| self.node(r).clone()) {
-                        Some(Node::Add(inner)) => {
-                            let k = self.constant(c);
-                            for &x in inner.iter() {
-                                terms.push(self.times(k, x));
-                            }
-                        }
-                        _ => terms.push(t),
-                    }
-                }
-                self.sum(&terms)
-            }
-            Node::Mul(_) => self.product(&children),
-            Node::Pow(_) => self.pow(children[0], children[1]),
-            Node::Func(f, _) => self.func(f, children[0]),
-            Node::Atan2(_) => self.add(Node::Atan2([children[0], children[1]])),
-            _ => e,
-        };
-        memo.insert(e, out);
-        out
+        memo.get(&e).copied().unwrap_or(e)
     }
 
-    /// `e` with every sum whose terms' coefficients are fractions with a common denominator
-    /// `d > 1` written `(Σ d cᵢ tᵢ)/d` (`(5 sin θ₁ + 3 sin θ₂)/2`), through the whole
-    /// expression (memoised in `memo`).
-    fn over_common_denominator(
-        &mut self,
-        e: ExprId,
-        memo: &mut FxHashMap<ExprId, ExprId>,
-    ) -> ExprId {
-        if let Some(&done) = memo.get(&e) {
-            return done;
-        }
-        let node = self.node(e).clone();
-        let children: Vec<ExprId> = (node.children().iter())
-            .map(|&c| self.over_common_denominator(c, memo))
-            .collect();
-        let out = match node {
-            Node::Add(_) => {
-                let split: Vec<(Constant, Option<ExprId>)> = children
-                    .iter()
-                    .map(|&t| self.split_coefficient(t))
-                    .collect();
-                let denominator = split.iter().try_fold(1i64, |d, (c, _)| match c {
-                    Constant::Rational { den, .. } => Some(lcm(d, *den)?),
-                    Constant::Float(_) => None,
-                });
-                match denominator {
-                    Some(d) if d > 1 => {
-                        let scaled: Option<Vec<ExprId>> = (split.iter())
-                            .map(|&(c, rest)| {
-                                let Constant::Rational { num, den } = c else {
-                                    return None;
-                                };
-                                let k = Constant::int(num.checked_mul(d / den)?);
-                                Some(match rest {
-                                    Some(r) => self.with_coefficient(k, r),
-                                    None => self.constant(k),
-                                })
-                            })
-                            .collect();
-                        match scaled {
-                            Some(terms) => {
-                                let sum = self.sum(&terms);
-                                let inverse = Constant::rational(1, d).map(|c| self.constant(c));
-                                match inverse {
-                                    Some(k) => self.add(Node::Mul([k, sum].into())),
-                                    None => self.sum(&children),
-                                }
-                            }
-                            None => self.sum(&children),
-                        }
+    /// The sum of `terms` with every number times a sum, `c (a + b)`, multiplied into it
+    /// (`x − (y + 2l/3)` → `x − y − 2l/3`).
+    fn flattened_sum(&mut self, terms: &[ExprId]) -> ExprId {
+        let mut out = Vec::with_capacity(terms.len());
+        for &t in terms {
+            let (c, rest) = self.split_coefficient(t);
+            match rest.map(|r| self.node(r).clone()) {
+                Some(Node::Add(inner)) => {
+                    let k = self.constant(c);
+                    for &x in inner.iter() {
+                        out.push(self.times(k, x));
                     }
-                    _ => self.sum(&children),
                 }
+                _ => out.push(t),
             }
-            Node::Mul(_) => self.product(&children),
-            Node::Pow(_) => self.pow(children[0], children[1]),
-            Node::Func(f, _) => self.func(f, children[0]),
-            Node::Atan2(_) => self.add(Node::Atan2([children[0], children[1]])),
-            _ => e,
-        };
-        memo.insert(e, out);
-        out
+        }
+        self.sum(&out)
+    }
+
+    /// The sum of `terms`, written `(Σ d cᵢ tᵢ)/d` where their coefficients are fractions
+    /// with a common denominator `d > 1` (`(5 sin θ₁ + 3 sin θ₂)/2`).
+    fn over_common_denominator(&mut self, terms: &[ExprId]) -> ExprId {
+        self.scaled_by_denominator(terms)
+            .unwrap_or_else(|| self.sum(terms))
+    }
+
+    /// `(Σ d cᵢ tᵢ)/d` of [`Self::over_common_denominator`]; `None` where the terms have no
+    /// common denominator above 1 (a float coefficient, or one past `i64`).
+    fn scaled_by_denominator(&mut self, terms: &[ExprId]) -> Option<ExprId> {
+        let split: Vec<(Constant, Option<ExprId>)> =
+            terms.iter().map(|&t| self.split_coefficient(t)).collect();
+        let d = split.iter().try_fold(1i64, |d, (c, _)| match c {
+            Constant::Rational { den, .. } => lcm(d, *den),
+            Constant::Float(_) => None,
+        })?;
+        if d <= 1 {
+            return None;
+        }
+        let mut scaled = Vec::with_capacity(split.len());
+        for (c, rest) in split {
+            let Constant::Rational { num, den } = c else {
+                return None;
+            };
+            let k = Constant::int(num.checked_mul(d / den)?);
+            scaled.push(match rest {
+                Some(r) => self.with_coefficient(k, r),
+                None => self.constant(k),
+            });
+        }
+        let sum = self.sum(&scaled);
+        let inverse = self.constant(Constant::rational(1, d)?);
+        // Interned as it stands: the number `1/d` times the sum, printed `(…)/d`.
+        Some(self.add(Node::Mul([inverse, sum].into())))
     }
 }
 
 impl ExprArena {
-    /// `e` with every pair of terms `a X sin²u + b X cos²u` of a sum (numbers `a ≠ b`, the
-    /// same rest `X`) written `b X + (a − b) X sin²u` (`sin² + cos² = 1` with unlike
-    /// coefficients: `m r² (6 sin² λ + cos² λ)/4 = m r² (1 + 5 sin² λ)/4`), through the whole
-    /// expression (memoised in `memo`). The canonical sum already does `a = b`.
-    fn cosines_squared_out(&mut self, e: ExprId, memo: &mut FxHashMap<ExprId, ExprId>) -> ExprId {
-        if let Some(&done) = memo.get(&e) {
-            return done;
-        }
-        let node = self.node(e).clone();
-        let children: Vec<ExprId> = (node.children().iter())
-            .map(|&c| self.cosines_squared_out(c, memo))
-            .collect();
-        let out = match node {
-            Node::Add(_) => self.pair_squares(&children),
-            Node::Mul(_) => self.product(&children),
-            Node::Pow(_) => self.pow(children[0], children[1]),
-            Node::Func(f, _) => self.func(f, children[0]),
-            Node::Atan2(_) => self.add(Node::Atan2([children[0], children[1]])),
-            _ => e,
-        };
-        memo.insert(e, out);
-        out
-    }
-
-    /// The sum of `terms` with the pairs of [`Self::cosines_squared_out`] rewritten.
+    /// The sum of `terms` with every pair `a X sin²u + b X cos²u` (numbers `a ≠ b`, the same
+    /// rest `X`) written `b X + (a − b) X sin²u` (`sin² + cos² = 1` with unlike coefficients:
+    /// `m r² (6 sin² λ + cos² λ)/4 = m r² (1 + 5 sin² λ)/4`); the canonical sum already does
+    /// `a = b`.
     fn pair_squares(&mut self, terms: &[ExprId]) -> ExprId {
         // Per term: its coefficient, and for a factor `sin(u)²` or `cos(u)²` the rest of it,
         // `u` and which.

@@ -299,16 +299,7 @@ fn spatial_amb(
                 let moment = cross(arena, &rel, &three(&ma));
                 terms.push(project(arena, &moment));
                 if let Some(s) = &body.spatial {
-                    let w = s.angular_velocity;
-                    let alpha = w.map(|c| arena.time_derivative(c));
-                    let i_alpha = tensor_times(arena, &s.inertia, &alpha);
-                    let i_w = tensor_times(arena, &s.inertia, &w);
-                    let gyro = cross(arena, &w, &i_w);
-                    let mut h_dot = i_alpha;
-                    for (x, y) in h_dot.iter_mut().zip(gyro) {
-                        *x = arena.plus(*x, y);
-                    }
-                    let h_dot = frames.express(arena, h_dot, s.frame, 0);
+                    let h_dot = angular_momentum_rate(arena, frames, s);
                     terms.push(project(arena, &h_dot));
                 }
             }
@@ -351,6 +342,23 @@ fn spatial_amb(
         }
     }
     terms
+}
+
+/// `Ḣ_G = I α + ω × I ω` of a 3-D body about its centre of mass (Euler's equations; Kane &
+/// Levinson §4.11), computed in its frame and carried to the ground's components.
+pub(super) fn angular_momentum_rate(
+    arena: &mut ExprArena,
+    frames: &super::frames::Frames,
+    body: &super::SpatialBody,
+) -> super::frames::Vector3 {
+    use super::frames::{cross, tensor_times};
+    let w = body.angular_velocity;
+    let alpha = w.map(|c| arena.time_derivative(c));
+    let i_alpha = tensor_times(arena, &body.inertia, &alpha);
+    let i_w = tensor_times(arena, &body.inertia, &w);
+    let gyro = cross(arena, &w, &i_w);
+    let h_dot = [0, 1, 2].map(|i| arena.plus(i_alpha[i], gyro[i]));
+    frames.express(arena, h_dot, body.frame, 0)
 }
 
 /// The equations of motion the file states as derived by hand (`checks:

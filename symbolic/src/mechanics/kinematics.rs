@@ -168,7 +168,7 @@ impl SymbolicModel {
     /// (acting at points or on coordinates, not on bodies).
     pub fn reaction(&mut self, bodies: &[String], at: &str) -> Result<Reaction, ReactionError> {
         use super::LoadInfo;
-        use super::frames::{cross, tensor_times};
+        use super::frames::cross;
         let known: Vec<String> = self.bodies.iter().map(|b| b.name.clone()).collect();
         let chosen = (bodies.iter())
             .map(|name| {
@@ -247,13 +247,7 @@ impl SymbolicModel {
                 add(arena, &mut moment, [zero, zero, spin]);
             }
             if let Some(s) = &body.spatial {
-                let w = s.angular_velocity;
-                let alpha = w.map(|c| arena.time_derivative(c));
-                let i_alpha = tensor_times(arena, &s.inertia, &alpha);
-                let i_w = tensor_times(arena, &s.inertia, &w);
-                let gyro = cross(arena, &w, &i_w);
-                let h_dot = [0, 1, 2].map(|i| arena.plus(i_alpha[i], gyro[i]));
-                let h_dot = self.frames.express(arena, h_dot, s.frame, 0);
+                let h_dot = super::balances::angular_momentum_rate(arena, &self.frames, s);
                 add(arena, &mut moment, h_dot);
             }
             for load in &self.loads {
