@@ -2,6 +2,7 @@
 //! the whole crate, so one binary is built once rather than once per file).
 
 mod animate;
+mod animation3d;
 mod browser;
 mod cli;
 mod cli_fuzz;

@@ -145,6 +145,10 @@ pub struct ModelDescription {
     pub floquet: List<floquet::FloquetReference>,
     /// The file's `outputs:`, in file order.
     pub outputs: List<outputs::OutputSpec>,
+    /// The frames of the 3-D bodies and their ancestors, parents before children (the
+    /// ground `N` left out): what the 3-D view composes each body's orientation from. Empty
+    /// for a model without 3-D bodies.
+    pub frames: List<FrameSpec>,
 }
 
 impl ModelDescription {
@@ -180,6 +184,7 @@ impl ModelDescription {
         checks: checks::Checks::NONE,
         floquet: Cow::Borrowed(&[]),
         outputs: Cow::Borrowed(&[]),
+        frames: Cow::Borrowed(&[]),
     };
 
     /// The number of degrees of freedom `n` (the number of coordinates).
@@ -292,6 +297,73 @@ pub struct BodyCentre {
     /// particle, the moment of a planar body, or a 3-D body's tensor `[xx, yy, zz, xy, yz,
     /// xz]` in its frame's axes.
     pub inertia: List<Text>,
+    /// A 3-D body's frame (one of [`ModelDescription::frames`]); empty for a particle or a
+    /// planar body.
+    pub frame: Text,
+    /// The shape the 3-D view draws it as (the file's `draw: shapes:`); `None`: a default
+    /// from its inertia.
+    pub shape: Option<Shape>,
+}
+
+/// A reference frame as its parent turned by successive rotations (Kane & Levinson,
+/// *Dynamics: Theory and Applications*, 1985, §1.7–1.9): `R = R₁ R₂ … Rₖ`, where `Rᵢ` takes
+/// components in the frame after rotation `i` to components in the frame before it.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+pub struct FrameSpec {
+    /// Its name in the model file.
+    pub name: Text,
+    /// Its parent frame (`N` for the ground).
+    pub parent: Text,
+    /// Its rotations from the parent, in the order applied.
+    pub rotations: List<RotationSpec>,
+}
+
+/// One rotation of a [`FrameSpec`], its expressions in the model file's syntax (functions of
+/// the coordinates, the parameters and `t`).
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+pub struct RotationSpec {
+    /// A simple rotation: the unit vector of its axis, the same in both frames
+    /// (`["1", "0", "0"]` for `x`). Euler parameters: the vector part `[e1, e2, e3]`.
+    pub axis: [Text; 3],
+    /// A simple rotation: the angle (rad, right-hand rule about `axis`). Euler parameters:
+    /// the scalar part `e0`.
+    pub angle: Text,
+    /// Whether the rotation is given by Euler parameters (normalised where used), rather
+    /// than by an axis and an angle.
+    pub quaternion: bool,
+}
+
+/// The shape the 3-D view draws a body as, centred at its centre of mass and fixed in its
+/// frame (the model file's `draw: shapes:`); sizes (m) are expressions of the parameters.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+#[serde(tag = "kind", rename_all = "lowercase")]
+pub enum Shape {
+    /// A box with sides `[a, b, c]` along the frame's x, y and z.
+    Box {
+        /// The side lengths (m).
+        sides: [Text; 3],
+    },
+    /// A cylinder of `radius` and `length` along the frame's axis `axis` (0, 1, 2: x, y, z).
+    Cylinder {
+        /// The radius (m).
+        radius: Text,
+        /// The length (m).
+        length: Text,
+        /// The axis of symmetry.
+        axis: usize,
+    },
+    /// A thin disc of `radius` normal to the frame's axis `axis` (0, 1, 2: x, y, z).
+    Disc {
+        /// The radius (m).
+        radius: Text,
+        /// The normal.
+        axis: usize,
+    },
+    /// A sphere of `radius`.
+    Sphere {
+        /// The radius (m).
+        radius: Text,
+    },
 }
 
 /// Which zero crossings of an event function count.

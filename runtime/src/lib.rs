@@ -127,4 +127,7 @@ pub use linear::steady::{
 };
 pub use model_info::{ConstraintValues, ContactValues, ModelInfo, ModelSummary};
 pub use ode::{OdeFn, OdeSystem, RhsError, WithEvents};
-pub use system::{BodyCentre, MechanicalSystem, ModelDescription, UnknownParameter};
+pub use system::{
+    BodyCentre, FrameSpec, MechanicalSystem, ModelDescription, RotationSpec, Shape,
+    UnknownParameter,
+};

@@ -22,7 +22,7 @@ pub struct UnknownParameter {
     pub known: String,
 }
 
-pub use eomgen_description::{BodyCentre, ModelDescription};
+pub use eomgen_description::{BodyCentre, FrameSpec, ModelDescription, RotationSpec, Shape};
 
 /// Equations of motion `M(q, t) q̈ = F(q, q̇, t)` of a mechanism with `N` degrees of freedom.
 ///

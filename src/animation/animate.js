@@ -64,6 +64,9 @@
       centres[i].setAttribute('cx', xy[2 * p]); centres[i].setAttribute('cy', xy[2 * p + 1]);
     });
     traces.forEach(function (e, i) { e.setAttribute('points', paths[i].slice(0, j * clip.sub + 1).join(' ')); });
+    // The 3-D view, once loaded, draws the same frame (`animate3d.js`).
+    window.eomgenPlayer = { clip: clip, k: j };
+    if (window.eomgenShow3d) { window.eomgenShow3d(clip, j); }
     scrub.value = String(j);
     var t = clip.t[j];
     if (clip.period) {

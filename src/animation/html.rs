@@ -11,6 +11,9 @@ use crate::text::{escape, fixed, short};
 const STYLE: &str = include_str!("animate.css");
 const HOOKS: &str = include_str!("animate_hooks.js");
 const PLAYER: &str = include_str!("animate.js");
+/// The 3-D view's script, and three.js for it, gzipped (assets/three/README.md).
+const VIEW_3D: &str = include_str!("animate3d.js");
+const THREE_GZ: &[u8] = include_bytes!("../../assets/three/three-subset.js.gz");
 
 /// A JSON string literal safe inside `<script>` (no `</script>`).
 fn json_string(s: &str) -> String {
@@ -32,7 +35,14 @@ impl Animation {
         let view_decimals = (5 - magnitude).clamp(0, 17) as usize;
         let p = |v: f64| fixed(v, decimals);
         let v = |v: f64| fixed(v, view_decimals);
-        let data = self.data_json(&p);
+        let mut data = self.data_json(&p);
+        if scene.three_d {
+            // The 3-D view's data: the grid step, the bodies, then each clip's points,
+            // paths and poses in space (after the planar data, which the fallback draws).
+            data.pop();
+            data.pop();
+            data.push_str(&self.space_json(&p, grid_step(span)));
+        }
 
         let step = grid_step(span);
         let svg = self.scene_svg((x0, x1, y0, y1), &p, &v);
@@ -61,10 +71,23 @@ impl Animation {
             .join("");
         let last_frame = self.clips[0].t.len() - 1;
         let view = if scene.three_d {
-            "isometric view: across (x − y) cos 30°, up z + (x + y) sin 30°; "
+            "3-D: drag to turn, scroll to zoom, right-drag to pan (isometric drawing without WebGL: across (x − y) cos 30°, up z + (x + y) sin 30°); "
         } else {
             ""
         };
+        let (views, view_3d) = if scene.three_d {
+            use base64::Engine as _;
+            let three = base64::engine::general_purpose::STANDARD.encode(THREE_GZ);
+            (
+                "<canvas id=\"view3d\" hidden></canvas>\n<span id=\"views\" hidden>view <button type=\"button\" data-view=\"iso\">iso</button><button type=\"button\" data-view=\"top\">top</button><button type=\"button\" data-view=\"side\">side</button></span>",
+                format!(
+                    "<script id=\"three-gz\" type=\"application/octet-stream\">{three}</script>\n<script>\n{VIEW_3D}</script>\n"
+                ),
+            )
+        } else {
+            ("", String::new())
+        };
+        let (canvas, views) = views.split_once('\n').unwrap_or(("", ""));
         format!(
             r#"<!DOCTYPE html>
 <html lang="en">
@@ -81,21 +104,23 @@ impl Animation {
 <h1>{title}</h1>
 <p id="info">{info}</p>
 {svg}
+{canvas}
 <div class="controls">
 {choice}
+{views}
 <button id="play" type="button" title="play or pause (space)">Pause</button>
 <label>speed <select id="speed">{speeds}</select></label>
 <input id="scrub" type="range" min="0" max="{last_frame}" step="1" value="0" aria-label="frame">
 </div>
 <div id="marks" title="the contacts' transitions over the run"></div>
-<div class="readout"><span id="time" data-t="0">t = 0 s</span><span id="energy"></span><span id="drift"></span><span id="event"></span><span id="frame" data-frame="0">frame 1 / {frames}</span><span class="hint">{view}grid {grid} m · space: play/pause · ←/→: step</span></div>
+<div class="readout"><span id="time" data-t="0">t = 0 s</span><span id="energy"></span><span id="drift"></span><span id="event"></span><span id="frame" data-frame="0">frame 1 / {frames}</span><span class="hint">{view}grid {grid} m · space: play/pause · ←/→: step</span><span id="view-note"></span></div>
 <pre id="errors"></pre>
 <script>
 const DATA = {data};
 </script>
 <script>
 {PLAYER}</script>
-</body>
+{view_3d}</body>
 </html>
 "#,
             title = escape(&scene.title),
@@ -205,6 +230,80 @@ const DATA = {data};
         }
         data.push_str("]}");
         data
+    }
+
+    /// The end of the player's data for a 3-D scene, in place of the closing `]}` of
+    /// [`Self::data_json`]: per clip (`space`, in the clips' order) its 3-D points (`xyz`),
+    /// paths (`trail3`) and poses
+    /// (`pose`, per body `[x, y, z, qx, qy, qz, qw]`), then the grid step (m) and the bodies
+    /// (their solids in m, the solid's quaternion in the body frame, the largest dimension).
+    fn space_json(&self, p: &dyn Fn(f64) -> String, grid: f64) -> String {
+        let unit = |v: f64| fixed(v, 12);
+        let flat = |list: &[[f64; 3]]| {
+            (list.iter().flatten())
+                .map(|v| p(*v))
+                .collect::<Vec<_>>()
+                .join(",")
+        };
+        let mut out = "],\"space\":[".to_string();
+        for (c, clip) in self.clips.iter().enumerate() {
+            let Some(space) = &clip.space else { continue };
+            let frames: Vec<String> = (space.points.iter())
+                .map(|f| format!("[{}]", flat(f)))
+                .collect();
+            let trails: Vec<String> = (space.trail.iter())
+                .map(|t| format!("[{}]", flat(t)))
+                .collect();
+            let poses: Vec<String> = (space.poses.iter())
+                .map(|f| {
+                    let numbers: Vec<String> = (f.iter())
+                        .flat_map(|b| {
+                            let (position, turn) = b.split_at(3);
+                            position
+                                .iter()
+                                .map(|v| p(*v))
+                                .chain(turn.iter().map(|v| unit(*v)))
+                        })
+                        .collect();
+                    format!("[{}]", numbers.join(","))
+                })
+                .collect();
+            let _ = write!(
+                out,
+                "{}{{\"xyz\":[{}],\n\"trail3\":[{}],\n\"pose\":[{}]}}",
+                if c == 0 { "" } else { ",\n" },
+                frames.join(",\n"),
+                trails.join(",\n"),
+                poses.join(",\n")
+            );
+        }
+        let bodies: Vec<String> = (self.scene.bodies().iter())
+            .map(|b| {
+                let solid = match b.solid {
+                    super::pose::Solid::Box([a, b, c]) => {
+                        format!("[\"box\",{},{},{}]", p(a), p(b), p(c))
+                    }
+                    super::pose::Solid::Cylinder { radius, length } => {
+                        format!("[\"cylinder\",{},{}]", p(radius), p(length))
+                    }
+                    super::pose::Solid::Sphere(r) => format!("[\"sphere\",{}]", p(r)),
+                };
+                let local: Vec<String> = b.local_quaternion().iter().map(|v| unit(*v)).collect();
+                format!(
+                    "{{\"name\":{},\"solid\":{solid},\"local\":[{}],\"extent\":{},\"inertia\":{}}}",
+                    json_string(&b.name),
+                    local.join(","),
+                    p(b.extent()),
+                    b.from_inertia
+                )
+            })
+            .collect();
+        let _ = write!(
+            out,
+            "],\"grid\":{grid:e},\"bodies\":[{}]}}",
+            bodies.join(",")
+        );
+        out
     }
 
     /// The picture: the grid over the box `(x0, x1, y0, y1)` and the mechanism at the first

@@ -49,6 +49,7 @@ use drawing::{Frame, Layout};
 
 pub mod drawing;
 mod html;
+pub mod pose;
 
 /// Frames per second of simulated time by default ([`AnimationOptions::fps`]): `eomgen
 /// animate` without `--fps`, and the report's animations.
@@ -178,6 +179,15 @@ pub enum AnimationError {
         /// The frame (from 0) of the clip where it happened.
         frame: usize,
     },
+    /// An expression of the model's description that the 3-D view evaluates (a frame's
+    /// rotation, a shape's size, a body's inertia) does not parse or evaluate.
+    #[error("`{model}`: {what}")]
+    Description {
+        /// The model's name.
+        model: String,
+        /// What is wrong.
+        what: String,
+    },
     /// The normal modes to animate are none.
     #[error("`{model}` has no modes to animate")]
     NoModes {
@@ -208,6 +218,8 @@ pub struct Scene {
     centres: Vec<(usize, bool, String)>,
     /// Isometric view of a 3-D model.
     three_d: bool,
+    /// The 3-D bodies, their solids and orientations (a 3-D model's scene only).
+    poses: Option<pose::Poses>,
     /// Indices of the drawn points among the model's points.
     model_points: Vec<usize>,
 }
@@ -293,6 +305,7 @@ impl Scene {
                 .map(|(i, rigid, body)| (local(*i), *rigid, body.clone()))
                 .collect(),
             three_d: false,
+            poses: None,
             model_points: used,
         })
     }
@@ -317,6 +330,40 @@ impl Scene {
             .iter()
             .map(|&i| layout.project(positions[i]))
             .collect()
+    }
+
+    /// Makes the scene a 3-D one: isometric projections, and the 3-D view's points and bodies.
+    ///
+    /// # Errors
+    /// As [`pose::Poses::of`].
+    fn make_three_d(&mut self, model: &dyn ModelInfo) -> Result<(), AnimationError> {
+        self.three_d = true;
+        self.poses = Some(pose::Poses::of(model)?);
+        Ok(())
+    }
+
+    /// The 3-D view's data of one configuration: the drawn points' positions (from the model's
+    /// `positions`) and the bodies' poses at `(t, q)`; `None` for a planar scene.
+    ///
+    /// # Errors
+    /// As [`pose::Poses::at`].
+    fn space_frame(
+        &self,
+        model: &dyn ModelInfo,
+        t: f64,
+        q: &[f64],
+        positions: &[[f64; 3]],
+    ) -> Result<Option<(Vec<[f64; 3]>, Vec<[f64; 7]>)>, AnimationError> {
+        let Some(poses) = &self.poses else {
+            return Ok(None);
+        };
+        let points = self.model_points.iter().map(|&i| positions[i]).collect();
+        Ok(Some((points, poses.at(model, t, q, positions)?)))
+    }
+
+    /// The 3-D bodies drawn, with their solids (empty for a planar scene).
+    pub fn bodies(&self) -> &[pose::DrawnBody] {
+        self.poses.as_ref().map_or(&[], |p| &p.bodies)
     }
 
     /// The model's name.
@@ -376,6 +423,38 @@ pub struct Clip {
     /// A simulation's transitions at its contacts (impacts, lift-offs, stick and slip), in
     /// time order: `(t, what happened, the first frame after it)`.
     transitions: Vec<(f64, String, usize)>,
+    /// The 3-D view's data (a 3-D scene only).
+    space: Option<Space>,
+}
+
+/// The 3-D view's data of a clip: positions in the ground's axes (m), not projected.
+#[derive(Debug, Clone, PartialEq, Default)]
+struct Space {
+    /// Per frame, every drawn point's `[x, y, z]`, in [`Scene::names`] order.
+    points: Vec<Vec<[f64; 3]>>,
+    /// Per traced point, its path, sampled as [`Clip::trail`].
+    trail: Vec<Vec<[f64; 3]>>,
+    /// Per frame, each body's centre and orientation, `[x, y, z, qx, qy, qz, qw]`, in
+    /// [`Scene::bodies`] order.
+    poses: Vec<Vec<[f64; 7]>>,
+}
+
+impl Space {
+    /// Adds one frame's points and poses (`None` for a planar scene: nothing to add).
+    fn push(&mut self, frame: Option<(Vec<[f64; 3]>, Vec<[f64; 7]>)>) {
+        if let Some((points, poses)) = frame {
+            self.points.push(points);
+            self.poses.push(poses);
+        }
+    }
+
+    /// Whether every number is finite.
+    fn is_finite(&self) -> bool {
+        let points = self.points.iter().chain(&self.trail).flatten().flatten();
+        points
+            .chain(self.poses.iter().flatten().flatten())
+            .all(|v| v.is_finite())
+    }
 }
 
 impl Clip {
@@ -526,9 +605,15 @@ pub fn simulation_animation(
         0 => return Ok(None),
         m => (m - 1) / sub * sub + 1,
     };
-    scene.three_d = solution
+    if solution
         .iter()
-        .any(|(t, y)| model.point_positions(t, y).iter().any(|p| p[2] != 0.0));
+        .any(|(t, y)| model.point_positions(t, y).iter().any(|p| p[2] != 0.0))
+    {
+        scene.make_three_d(model)?;
+    }
+    let n = model.description().num_dofs();
+    let mut space = Space::default();
+    let mut space_trail = vec![Vec::new(); if scene.three_d { scene.traces.len() } else { 0 }];
     let mut t = Vec::with_capacity(samples / sub + 1);
     let mut frames = Vec::with_capacity(samples / sub + 1);
     let mut frame_states = Vec::with_capacity(samples / sub + 1);
@@ -554,9 +639,13 @@ pub fn simulation_animation(
         for (path, &p) in trail.iter_mut().zip(&scene.traces) {
             path.push(frame[p]);
         }
+        for (path, &p) in space_trail.iter_mut().zip(&scene.traces) {
+            path.push(positions[scene.model_points[p]]);
+        }
         if j % sub != 0 {
             continue;
         }
+        space.push(scene.space_frame(model, tk, &y[..n], &positions)?);
         t.push(tk);
         frames.push(frame);
         frame_states.push((tk, y));
@@ -589,6 +678,9 @@ pub fn simulation_animation(
     );
     check_finite(&scene.model, &frames)?;
     check_finite(&scene.model, &trail)?;
+    space.trail = space_trail;
+    let space = scene.three_d.then_some(space);
+    check_space(&scene.model, space.as_ref())?;
     let clip = Clip {
         label: "simulation".to_string(),
         info,
@@ -605,6 +697,7 @@ pub fn simulation_animation(
                 (t, text, frame_samples.partition_point(|&j| j < tr.sample))
             })
             .collect(),
+        space,
     };
     Ok(Some(Animation {
         scene,
@@ -687,6 +780,18 @@ fn describe_transition(tr: &eomgen_runtime::hybrid::Transition) -> (f64, String)
     (tr.t, text)
 }
 
+/// [`AnimationError::PointNotFinite`] when a number of the 3-D view's data is not finite (its
+/// first frame is named: the projected frames, checked first, name the first one).
+fn check_space(model: &str, space: Option<&Space>) -> Result<(), AnimationError> {
+    match space {
+        Some(s) if !s.is_finite() => Err(AnimationError::PointNotFinite {
+            model: model.to_string(),
+            frame: 0,
+        }),
+        _ => Ok(()),
+    }
+}
+
 /// [`AnimationError::PointNotFinite`] at the first frame of `frames` with a coordinate that
 /// is not finite.
 fn check_finite(model: &str, frames: &[Frame]) -> Result<(), AnimationError> {
@@ -730,7 +835,9 @@ pub fn modes_animation(
     c_left_out: bool,
 ) -> Result<Animation, AnimationError> {
     let mut scene = Scene::of(model, &[])?;
-    scene.three_d = drawing::is_three_d(model, q, shapes);
+    if drawing::is_three_d(model, q, shapes) {
+        scene.make_three_d(model)?;
+    }
     // The mode scale measures the displacement of the drawn points.
     let layout = Layout {
         lines: Vec::new(),
@@ -752,16 +859,21 @@ pub fn modes_animation(
         let t: Vec<f64> = (0..=MODE_FRAMES)
             .map(|j| period * j as f64 / MODE_FRAMES as f64)
             .collect();
-        let frames: Vec<Frame> = t
-            .iter()
-            .enumerate()
-            .map(|(j, _)| {
-                let phase = std::f64::consts::TAU * j as f64 / MODE_FRAMES as f64;
-                let amplitude = s.unwrap_or(0.0) * phase.sin();
-                scene.project(&positions(&drawing::displaced(q, &psi, amplitude)))
-            })
-            .collect();
+        let mut frames: Vec<Frame> = Vec::with_capacity(t.len());
+        let mut space = Space::default();
+        for j in 0..t.len() {
+            let phase = std::f64::consts::TAU * j as f64 / MODE_FRAMES as f64;
+            let qk = drawing::displaced(q, &psi, s.unwrap_or(0.0) * phase.sin());
+            let at = positions(&qk);
+            frames.push(scene.project(&at));
+            space.push(scene.space_frame(model, 0.0, &qk, &at)?);
+        }
         check_finite(&scene.model, &frames)?;
+        space.trail = (scene.traces.iter())
+            .map(|&p| space.points.iter().map(|f| f[p]).collect())
+            .collect();
+        let space = scene.three_d.then_some(space);
+        check_space(&scene.model, space.as_ref())?;
         let described = drawing::describe(k + 1, omega, kind, c_left_out);
         let motion = match s {
             Some(s) => format!("q* + {} ψ{} sin(ω t)", short(s), k + 1),
@@ -796,6 +908,7 @@ pub fn modes_animation(
             rate: period / MODE_CYCLE_SECONDS,
             period: Some(period),
             transitions: Vec::new(),
+            space,
         });
     }
     if clips.is_empty() {

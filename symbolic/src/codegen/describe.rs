@@ -11,7 +11,8 @@ use quote::quote;
 use eomgen_description::checks::{Checks, DriftCheck, ModalCheck, RunSettings};
 use eomgen_description::floquet::FloquetReference;
 use eomgen_description::{
-    BodyCentre, EventDirection, EventSpec, ModelDescription, Parameter, Text,
+    BodyCentre, EventDirection, EventSpec, FrameSpec, List, ModelDescription, Parameter,
+    RotationSpec, Shape, Text,
 };
 
 use crate::mechanics::{EquationsOfMotion, SymbolicModel};
@@ -68,6 +69,12 @@ pub fn describe(model: &SymbolicModel, eom: &EquationsOfMotion, mathml: bool) ->
                         (Some((inertia, _)), None) => vec![expression(*inertia)].into(),
                         (None, None) => Cow::Borrowed(&[]),
                     },
+                    frame: (b.spatial.as_ref())
+                        .and_then(|s| model.frames.names().get(s.frame))
+                        .map_or(Cow::Borrowed(""), |f| text(f)),
+                    shape: (model.shapes.iter())
+                        .find(|(body, _)| *body == b.name)
+                        .map(|(_, shape)| shape.clone()),
                 })
             })
             .collect(),
@@ -123,7 +130,55 @@ pub fn describe(model: &SymbolicModel, eom: &EquationsOfMotion, mathml: bool) ->
         checks: model.checks.clone(),
         floquet: Cow::Owned(model.floquet.clone()),
         outputs: Cow::Owned(model.outputs.clone()),
+        frames: drawn_frames(model, &printer),
     }
+}
+
+/// The frames of the 3-D bodies and their ancestors, parents first (the ground left out),
+/// their rotations' axes and angles printed in the file's syntax
+/// ([`ModelDescription::frames`]).
+fn drawn_frames(
+    model: &SymbolicModel,
+    printer: &crate::expr::print::Printer<'_>,
+) -> List<FrameSpec> {
+    use crate::mechanics::frames::RotationAxis;
+    let frames = &model.frames;
+    let mut used = vec![false; frames.names().len()];
+    for b in &model.bodies {
+        let mut f = match &b.spatial {
+            Some(s) => s.frame,
+            None => continue,
+        };
+        while f != 0 && !used[f] {
+            used[f] = true;
+            f = frames.parent(f);
+        }
+    }
+    let print = |e: crate::expr::ExprId| -> Text { Cow::Owned(printer.print(e)) };
+    let unit = |i: usize| -> [Text; 3] {
+        [0, 1, 2].map(|k| Cow::Borrowed(if k == i { "1" } else { "0" }))
+    };
+    (1..frames.names().len())
+        .filter(|&f| used[f])
+        .map(|f| FrameSpec {
+            name: Cow::Owned(frames.names()[f].clone()),
+            parent: Cow::Owned(frames.names()[frames.parent(f)].clone()),
+            rotations: (frames.rotations(f).iter())
+                .map(|&(axis, angle)| {
+                    let (axis, quaternion) = match axis {
+                        RotationAxis::Principal(i) => (unit(i), false),
+                        RotationAxis::Unit(k) => (k.map(print), false),
+                        RotationAxis::Quaternion(e) => (e.map(print), true),
+                    };
+                    RotationSpec {
+                        axis,
+                        angle: print(angle),
+                        quaternion,
+                    }
+                })
+                .collect(),
+        })
+        .collect()
 }
 
 /// A Rust expression that builds `description` in a `static` (every string and list
@@ -171,12 +226,16 @@ pub fn description_tokens(
                 let (body, point, rigid) = (text(&c.body), text(&c.point), c.rigid);
                 let mass = text(&c.mass);
                 let inertia = texts(&c.inertia);
+                let frame = text(&c.frame);
+                let shape = optional(c.shape.as_ref().map(|s| shape_tokens(s, krate)));
                 quote!(#krate::BodyCentre {
                     body: #body,
                     point: #point,
                     rigid: #rigid,
                     mass: #mass,
                     inertia: #inertia,
+                    frame: #frame,
+                    shape: #shape,
                 })
             })
             .collect(),
@@ -249,6 +308,7 @@ pub fn description_tokens(
             .map(|o| output_tokens(o, krate))
             .collect::<Result<_, String>>()?,
     );
+    let frames = borrowed(d.frames.iter().map(|f| frame_tokens(f, krate)).collect());
     Ok(quote! {
         #krate::ModelDescription {
             name: #name,
@@ -280,8 +340,50 @@ pub fn description_tokens(
             checks: #checks,
             floquet: #floquet,
             outputs: #outputs,
+            frames: #frames,
         }
     })
+}
+
+/// One of [`ModelDescription::frames`] as a Rust expression for a `static`.
+fn frame_tokens(f: &FrameSpec, krate: &TokenStream) -> TokenStream {
+    let (name, parent) = (text(&f.name), text(&f.parent));
+    let rotations = borrowed(
+        (f.rotations.iter())
+            .map(|r| {
+                let axis = r.axis.iter().map(|a| text(a));
+                let (angle, quaternion) = (text(&r.angle), r.quaternion);
+                quote!(#krate::RotationSpec { axis: [#(#axis),*], angle: #angle, quaternion: #quaternion })
+            })
+            .collect(),
+    );
+    quote!(#krate::FrameSpec { name: #name, parent: #parent, rotations: #rotations })
+}
+
+/// A body's [`Shape`] as a Rust expression for a `static`.
+fn shape_tokens(s: &Shape, krate: &TokenStream) -> TokenStream {
+    match s {
+        Shape::Box { sides } => {
+            let sides = sides.iter().map(|a| text(a));
+            quote!(#krate::Shape::Box { sides: [#(#sides),*] })
+        }
+        Shape::Cylinder {
+            radius,
+            length,
+            axis,
+        } => {
+            let (radius, length) = (text(radius), text(length));
+            quote!(#krate::Shape::Cylinder { radius: #radius, length: #length, axis: #axis })
+        }
+        Shape::Disc { radius, axis } => {
+            let radius = text(radius);
+            quote!(#krate::Shape::Disc { radius: #radius, axis: #axis })
+        }
+        Shape::Sphere { radius } => {
+            let radius = text(radius);
+            quote!(#krate::Shape::Sphere { radius: #radius })
+        }
+    }
 }
 
 /// A string in a `static`.

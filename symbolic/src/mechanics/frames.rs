@@ -84,6 +84,17 @@ impl Frames {
         &self.names
     }
 
+    /// The parent (an index) of the frame of index `frame`; the ground's is itself.
+    pub fn parent(&self, frame: usize) -> usize {
+        self.parents[frame]
+    }
+
+    /// The rotations that turn the parent of the frame of index `frame` into it, in the order
+    /// applied: `(axis, angle)`.
+    pub fn rotations(&self, frame: usize) -> &[(RotationAxis, ExprId)] {
+        &self.rotations[frame]
+    }
+
     /// The index of the frame called `name`.
     pub fn index(&self, name: &str) -> Option<usize> {
         self.names.iter().position(|n| n == name)

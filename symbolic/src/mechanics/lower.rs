@@ -166,6 +166,8 @@ pub struct SymbolicModel {
     pub trace_points: Vec<usize>,
     /// Bodies of the kinematic form.
     pub bodies: Vec<BodyInfo>,
+    /// The file's `draw: shapes:`, by body name, as the model's description keeps them.
+    pub shapes: Vec<(String, eomgen_description::Shape)>,
     /// Gravity vector (m/s²), if given.
     pub gravity: Option<Vec<ExprId>>,
     /// Springs, dampers, forces and torques as loads.
@@ -525,6 +527,9 @@ impl<'f> Lowering<'f> {
             draw_lines,
             trace_points,
             bodies: body_infos,
+            shapes: (file.draw.shapes.iter())
+                .map(|s| (s.body.value.clone(), s.describe()))
+                .collect(),
             gravity,
             loads,
             balances,

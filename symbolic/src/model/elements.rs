@@ -29,6 +29,7 @@ pub mod gravity;
 pub mod interaction;
 pub mod nonholonomic;
 pub mod point;
+pub mod shape;
 pub mod spring;
 pub mod support;
 pub mod torque;

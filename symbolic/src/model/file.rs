@@ -164,6 +164,8 @@ pub struct Draw {
     /// Wheels drawn as circles with four spokes (3-D models): each a circle of `radius`
     /// about `centre` in the plane normal to the axis `axle` of `frame`, turning with it.
     pub wheels: Vec<WheelContact>,
+    /// The shapes the 3-D view draws bodies as (`shapes:`).
+    pub shapes: Vec<super::elements::shape::DrawnShape>,
 }
 
 /// Which zero crossings of an event function count (`direction:` of an `events:` entry).

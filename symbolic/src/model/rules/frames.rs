@@ -1,7 +1,7 @@
 //! The frames of a model file and the frames and points that other sections name.
 
 use super::*;
-use crate::model::elements::{body, frame, point};
+use crate::model::elements::{body, frame, point, shape};
 
 impl Checker<'_> {
     // Rule: frames have distinct names other than the ground `N` and `from`; each frame's
@@ -18,6 +18,7 @@ impl Checker<'_> {
             self.frame(&w.frame, &frames);
             self.resolve(&w.radius, Depends::Constant, "the radius of a drawn wheel");
         }
+        shape::rules(&file.draw.shapes, self);
     }
 
     /// Reports `name` if it is not one of `frames`.

@@ -7,7 +7,7 @@ use super::write::{Edits, NotRewritten, Rewrite, Writer, scalar};
 use super::*;
 use crate::model::elements::{
     body, constraint, contact, damper, energy, force, frame, gravity, interaction, nonholonomic,
-    point, spring, torque,
+    point, shape, spring, torque,
 };
 
 /// How one top-level key of a model file is read, and written.
@@ -645,7 +645,7 @@ impl Ctx<'_> {
         let Some(f) = self.map(node, "`draw`", "draw: { lines: [[O, P]], trace: [P] }") else {
             return draw;
         };
-        const KEYS: [&str; 3] = ["lines", "trace", "wheels"];
+        const KEYS: [&str; 4] = ["lines", "trace", "wheels", "shapes"];
         self.unknown_keys(f, "`draw`", &KEYS, &KEYS);
         if let Some(lines) =
             get(f, "lines").and_then(|n| self.seq(n, "`lines`", "lines: [[O, E], [E, H]]"))
@@ -676,6 +676,9 @@ impl Ctx<'_> {
                     draw.wheels.push(wheel);
                 }
             }
+        }
+        if let Some(shapes) = get(f, "shapes") {
+            draw.shapes = shape::read(self, shapes);
         }
         draw
     }
@@ -784,6 +787,7 @@ impl Writer<'_> {
         if !wheels.is_empty() {
             parts.push(format!("wheels: [{}]", wheels.join(", ")));
         }
+        parts.extend(shape::write(self, &file.draw.shapes)?);
         if !parts.is_empty() {
             self.line(format_args!("draw: {{ {} }}", parts.join(", ")));
         }

@@ -415,7 +415,7 @@ impl Ctx<'_> {
     }
 
     /// A list of expressions.
-    pub(super) fn expr_list(
+    pub(crate) fn expr_list(
         &mut self,
         node: &YamlNode,
         what: &str,
