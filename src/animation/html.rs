@@ -79,7 +79,7 @@ impl Animation {
             use base64::Engine as _;
             let three = base64::engine::general_purpose::STANDARD.encode(THREE_GZ);
             (
-                "<canvas id=\"view3d\" hidden></canvas>\n<span id=\"views\" hidden>view <button type=\"button\" data-view=\"iso\">iso</button><button type=\"button\" data-view=\"top\">top</button><button type=\"button\" data-view=\"side\">side</button></span>",
+                "<canvas id=\"view3d\" hidden></canvas>\n<span id=\"views\" hidden>view <button type=\"button\" data-view=\"iso\">iso</button><button type=\"button\" data-view=\"top\">top</button><button type=\"button\" data-view=\"side\">side</button> <label title=\"keep the mechanism in the middle of the view\"><input id=\"follow\" type=\"checkbox\"> follow</label></span>",
                 format!(
                     "<script id=\"three-gz\" type=\"application/octet-stream\">{three}</script>\n<script>\n{VIEW_3D}</script>\n"
                 ),
@@ -113,7 +113,7 @@ impl Animation {
 <input id="scrub" type="range" min="0" max="{last_frame}" step="1" value="0" aria-label="frame">
 </div>
 <div id="marks" title="the contacts' transitions over the run"></div>
-<div class="readout"><span id="time" data-t="0">t = 0 s</span><span id="energy"></span><span id="drift"></span><span id="event"></span><span id="frame" data-frame="0">frame 1 / {frames}</span><span class="hint">{view}grid {grid} m · space: play/pause · ←/→: step</span><span id="view-note"></span></div>
+<div class="readout"><span id="time" data-t="0">t = 0 s</span><span id="energy"></span><span id="drift"></span><span id="event"></span><span id="frame" data-frame="0">frame 1 / {frames}</span><span class="hint">{view}<span id="grid-step">grid {grid} m</span> · space: play/pause · ←/→: step</span><span id="view-note"></span></div>
 <pre id="errors"></pre>
 <script>
 const DATA = {data};

@@ -7,8 +7,12 @@
 //! sampled by the integrator's dense output, with `t` and the energy), a small stylesheet and
 //! a small script are inline, and the drawing is inline SVG whose view box is the bounding
 //! box of the whole run, so that both axes have one scale and nothing leaves the picture.
-//! 3-D models are drawn in the isometric view of the mode-shape charts
-//! ([`drawing::Layout::project`]). Numbers are written with a fixed number of decimals
+//! A 3-D model's page draws it in WebGL ([`pose`]): each 3-D body as a solid (the file's
+//! `draw: shapes:`, or the box of its inertia) turned with its frame, with the frame's axes,
+//! the `draw:` lines and traced paths in space, a grid in the ground plane, an orbit camera
+//! and iso, top and side views (three.js, vendored and gzipped inside the page:
+//! assets/three/README.md). Without WebGL the page keeps the isometric drawing of the
+//! mode-shape charts ([`drawing::Layout::project`]), which the GIF also draws. Numbers are written with a fixed number of decimals
 //! (positions to 10⁻¹¹ of the picture's size; times and energies to full precision), so the
 //! file is byte-identical across runs.
 //!
@@ -737,7 +741,7 @@ fn simulation_info(
         short(options.fps),
         short(t[t.len() - 1]),
         short(e0),
-        if three_d { "; isometric view" } else { "" }
+        if three_d { "; 3-D view" } else { "" }
     )
 }
 
