@@ -1,4 +1,4 @@
-//! The bundled models: every file of `models/`, embedded as text and compiled at run time
+//! The bundled models: every file of `models/`, embedded as deflated text and compiled at run time
 //! (Cranelift) at its first use in a process, as any model file is.
 //!
 //! Nothing of a bundled model is compiled into the library: a program that wants a model's
@@ -19,8 +19,9 @@ pub struct ModelEntry {
     pub name: &'static str,
     /// The file as it is shown in messages and diagnostics: `models/<file name>`.
     pub file: &'static str,
-    /// The text of the model file.
-    pub source: &'static str,
+    /// The text of the model file ([`ModelEntry::source`]): for a bundled model, inflated
+    /// from the program at its first use (the same address at every call).
+    pub text: fn() -> &'static str,
     /// Builds the model with its default parameters (`Send`, so that a thread pool or
     /// another language's threads may own it), compiling the file at the first call in the
     /// process ([`ModelEntry::model`]).
@@ -32,6 +33,11 @@ pub struct ModelEntry {
 }
 
 impl ModelEntry {
+    /// The text of the model file.
+    pub fn source(&self) -> &'static str {
+        (self.text)()
+    }
+
     /// The model compiled with the default [`LoadOptions`]: compiled at the first call in
     /// the process, then a clone of the same code (cheap: clones share the compiled code),
     /// for an entry of [`ALL`] or a copy of one.
@@ -73,12 +79,13 @@ impl ModelEntry {
     /// embedded text, by its address, and the same file). A `ModelEntry` written elsewhere
     /// is compiled, never served from the cache.
     fn index(&self) -> Option<usize> {
+        let text = self.source();
         ALL.iter()
-            .position(|e| std::ptr::eq(e.source, self.source) && e.file == self.file)
+            .position(|e| std::ptr::eq(e.source(), text) && e.file == self.file)
     }
 
     fn compile(&self, options: LoadOptions) -> Result<JitModel, LoadError> {
-        JitModel::from_source_with(self.file, self.source, options)
+        JitModel::from_source_with(self.file, self.source(), options)
     }
 }
 
@@ -91,13 +98,14 @@ impl ModelEntry {
     /// # Errors
     /// [`LoadError::Diagnostics`] if the file has mistakes (a defect of the bundle).
     pub fn summary(&self) -> Result<ModelSummary, LoadError> {
-        let file = eomgen_symbolic::model::load(self.file, self.source).map_err(|diagnostics| {
-            LoadError::Diagnostics {
-                path: self.file.to_string(),
-                text: self.source.to_string(),
-                diagnostics,
-            }
-        })?;
+        let file =
+            eomgen_symbolic::model::load(self.file, self.source()).map_err(|diagnostics| {
+                LoadError::Diagnostics {
+                    path: self.file.to_string(),
+                    text: self.source().to_string(),
+                    diagnostics,
+                }
+            })?;
         Ok(ModelSummary {
             name: file.name.value,
             dof: file.coordinates.len(),
@@ -114,6 +122,19 @@ pub fn find(name: &str) -> Option<&'static ModelEntry> {
 /// The compiled code of each bundled model, by its index in [`ALL`], once compiled (the
 /// error as text if it could not be).
 static COMPILED: [OnceLock<Result<JitModel, String>>; COUNT] = [const { OnceLock::new() }; COUNT];
+
+/// The text of the `index`-th bundled model, inflated at the first call (empty if the
+/// embedded data were corrupt, which the bundled models' tests exclude: loading it then
+/// reports an empty file).
+fn text(index: usize) -> &'static str {
+    static TEXTS: [OnceLock<String>; COUNT] = [const { OnceLock::new() }; COUNT];
+    TEXTS[index].get_or_init(|| {
+        miniz_oxide::inflate::decompress_to_vec_zlib(DEFLATED[index])
+            .ok()
+            .and_then(|bytes| String::from_utf8(bytes).ok())
+            .unwrap_or_default()
+    })
+}
 
 /// [`ModelEntry::make`] of the `index`-th bundled model.
 fn instantiate(index: usize) -> Box<dyn ModelInfo + Send> {

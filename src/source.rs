@@ -123,7 +123,7 @@ impl ModelSource {
     pub fn bytes(&self) -> std::io::Result<std::borrow::Cow<'static, [u8]>> {
         match self {
             ModelSource::Bundled { entry, .. } => {
-                Ok(std::borrow::Cow::Borrowed(entry.source.as_bytes()))
+                Ok(std::borrow::Cow::Borrowed(entry.source().as_bytes()))
             }
             ModelSource::File { path, .. } => read_file(path).map(std::borrow::Cow::Owned),
         }
@@ -176,7 +176,7 @@ impl Resolved {
     /// The operating system's error when the file cannot be read.
     pub fn bytes(&self) -> std::io::Result<std::borrow::Cow<'static, [u8]>> {
         match self {
-            Resolved::Bundled(entry) => Ok(std::borrow::Cow::Borrowed(entry.source.as_bytes())),
+            Resolved::Bundled(entry) => Ok(std::borrow::Cow::Borrowed(entry.source().as_bytes())),
             Resolved::File(path) => read_file(path).map(std::borrow::Cow::Owned),
         }
     }

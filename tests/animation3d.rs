@@ -28,7 +28,7 @@ fn load(name: &str) -> (Box<dyn ModelInfo>, String, String) {
     if let Some(entry) = eomgen::models::find(name) {
         return (
             (entry.make)(),
-            entry.source.to_string(),
+            entry.source().to_string(),
             format!("{name}.yaml"),
         );
     }

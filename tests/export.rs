@@ -307,7 +307,7 @@ fn exported_c_computes_what_eomgen_computes_on_every_bundled_model() {
     let mut expected: Values = Vec::new();
     let mut models = Vec::new();
     for (k, entry) in eomgen::models::ALL.iter().enumerate() {
-        let code = export(entry.file, entry.source, Language::C)
+        let code = export(entry.file, entry.source(), Language::C)
             .unwrap_or_else(|e| panic!("{}: {e}", entry.name));
         source.push_str(&code);
         let model = entry.model().unwrap();
@@ -404,7 +404,7 @@ fn exported_matlab_computes_what_eomgen_computes_under_octave() {
     let mut expected: Values = Vec::new();
     let mut models = Vec::new();
     for (k, entry) in eomgen::models::ALL.iter().enumerate() {
-        let code = export(entry.file, entry.source, Language::Matlab)
+        let code = export(entry.file, entry.source(), Language::Matlab)
             .unwrap_or_else(|e| panic!("{}: {e}", entry.name));
         std::fs::write(dir.path().join(format!("{}.m", entry.name)), code).unwrap();
         let model = entry.model().unwrap();

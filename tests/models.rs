@@ -62,7 +62,7 @@ fn generated_code_equals_engine_evaluation() {
     let mut rng = seeded_rng(0x9E37_79B9_7F4A_7C15);
     for (entry, generated) in generated_models() {
         let file =
-            eomgen_symbolic::model::load(entry.file, entry.source).expect("bundled model loads");
+            eomgen_symbolic::model::load(entry.file, entry.source()).expect("bundled model loads");
         let mut model = SymbolicModel::from_file(&file).expect("bundled model lowers");
         let eom = Lagrange.derive(&mut model);
         let jac = Jacobians::of(&mut model, &eom);
@@ -265,7 +265,7 @@ fn every_model_simulates_from_its_initial_state() {
 fn point_positions_equal_engine_evaluation() {
     let mut rng = seeded_rng(2024);
     for (entry, generated) in generated_models() {
-        let file = eomgen_symbolic::model::load(entry.file, entry.source).expect("loads");
+        let file = eomgen_symbolic::model::load(entry.file, entry.source()).expect("loads");
         let model = SymbolicModel::from_file(&file).expect("lowers");
         assert_eq!(
             generated.description().point_names().len(),
@@ -394,7 +394,7 @@ fn every_bundled_model_compiles() {
             .model()
             .unwrap_or_else(|e| panic!("{}: {e}", entry.file));
         assert_eq!(model.backend(), eomgen::Backend::Native, "{}", entry.name);
-        let file = eomgen_symbolic::model::load(entry.file, entry.source).expect("loads");
+        let file = eomgen_symbolic::model::load(entry.file, entry.source()).expect("loads");
         assert_eq!(file.name.value, entry.name, "{}", entry.file);
         assert_eq!(
             eomgen::models::find(entry.name).map(|e| e.file),

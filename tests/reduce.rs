@@ -14,7 +14,7 @@ use eomgen_symbolic::model::reduce::{
 use eomgen_symbolic::model::{Contact, Expr, Gap, ModelFile};
 
 fn source(name: &str) -> &'static str {
-    eomgen::models::find(name).expect("bundled model").source
+    eomgen::models::find(name).expect("bundled model").source()
 }
 
 fn file(name: &str, text: &str) -> ModelFile {

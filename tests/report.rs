@@ -336,7 +336,7 @@ fn compact(n: &Node) -> String {
 #[test]
 fn mathml_of_the_simple_pendulum_equation() {
     let entry = eomgen::models::find("simple_pendulum").expect("bundled");
-    let file = eomgen_symbolic::model::load(entry.file, entry.source).expect("loads");
+    let file = eomgen_symbolic::model::load(entry.file, entry.source()).expect("loads");
     let mut model = SymbolicModel::from_file(&file).expect("lowers");
     let eom = Lagrange.derive(&mut model);
     let lines = equations_mathml(&model, &eom);

@@ -149,7 +149,7 @@ fn compare(name: &str, compiled: &mut dyn ModelInfo, runtime: &mut dyn ModelInfo
 }
 
 /// The file of a bundled model in this source tree (the program itself compiles the text
-/// embedded in it, `entry.source`).
+/// embedded in it, `entry.source()`).
 fn bundled_file(entry: &eomgen::models::ModelEntry) -> String {
     format!("{}/{}", env!("CARGO_MANIFEST_DIR"), entry.file)
 }

@@ -313,7 +313,7 @@ fn models_without_coefficients_say_why() {
         let source = eomgen::models::ALL
             .iter()
             .find(|m| m.file == entry.file)
-            .map(|m| m.source)
+            .map(|m| m.source())
             .unwrap_or_default();
         for (how, support) in [
             ("compiled", compiled.taylor_support()),

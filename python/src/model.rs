@@ -55,7 +55,7 @@ const MAX_CACHED_FILES: usize = 64;
 fn open(argument: &str, text: Option<&str>) -> Result<Loaded, eomgen::OpenError> {
     if let Some(text) = text {
         if let Some(entry) = eomgen::models::find(argument)
-            && entry.source == text
+            && entry.source() == text
         {
             return Ok(Loaded {
                 source: ModelSource::Bundled {
@@ -82,7 +82,7 @@ fn open(argument: &str, text: Option<&str>) -> Result<Loaded, eomgen::OpenError>
                 model: entry.model()?,
             },
             argument: argument.to_string(),
-            text: entry.source.to_string(),
+            text: entry.source().to_string(),
         }),
         eomgen::Resolved::File(path) => {
             // Read once: the text compiled is the text a pickle carries.

@@ -13,7 +13,7 @@ use eomgen_runtime::ModelInfo;
 use eomgen_runtime::description::{FrameSpec, RotationSpec, Shape};
 use eomgen_symbolic::model::parser::{eval_expr, parse_expr};
 use eomgen_symbolic::model::{Expr, Location};
-use nalgebra::{Matrix3, SymmetricEigen, UnitQuaternion, Vector3};
+use nalgebra::{DMatrix, Matrix3, Rotation3, UnitQuaternion, Vector3};
 
 use super::AnimationError;
 use crate::expressions::parameter_lookup;
@@ -210,7 +210,7 @@ impl Poses {
             .bodies
             .iter()
             .map(|b| {
-                let q = UnitQuaternion::from_matrix(&frames[b.frame]);
+                let q = quaternion(&frames[b.frame]);
                 let p = points[b.centre];
                 [p[0], p[1], p[2], q.i, q.j, q.k, q.w]
             })
@@ -247,7 +247,7 @@ impl Poses {
 impl DrawnBody {
     /// The unit quaternion `[x, y, z, w]` of the solid's axes in the body frame's.
     pub fn local_quaternion(&self) -> [f64; 4] {
-        let q = UnitQuaternion::from_matrix(&self.local);
+        let q = quaternion(&self.local);
         [q.i, q.j, q.k, q.w]
     }
 
@@ -259,6 +259,12 @@ impl DrawnBody {
             Solid::Sphere(r) => 2.0 * r,
         }
     }
+}
+
+/// The unit quaternion of a rotation matrix (orthonormal to rounding: the closed form, not
+/// `from_matrix`'s iteration).
+fn quaternion(r: &Matrix3<f64>) -> UnitQuaternion<f64> {
+    UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(*r))
 }
 
 /// The rotation taking a cylinder's own y axis onto the frame's axis `axis` (0, 1, 2).
@@ -279,8 +285,11 @@ fn y_onto(axis: usize) -> Matrix3<f64> {
 /// as a small sphere.
 fn inertia_box(m: f64, i: [f64; 6]) -> (Solid, Matrix3<f64>) {
     let [xx, yy, zz, xy, yz, xz] = i;
-    let tensor = Matrix3::new(xx, xy, xz, xy, yy, yz, xz, yz, zz);
-    let eigen = SymmetricEigen::new(tensor);
+    let tensor = DMatrix::from_row_slice(3, 3, &[xx, xy, xz, xy, yy, yz, xz, yz, zz]);
+    // The runtime's bounded solver: the one the modes use (none of its own in the program).
+    let Some(eigen) = eomgen_runtime::linalg::symmetric_eigen(tensor) else {
+        return (Solid::Sphere(0.0), Matrix3::identity());
+    };
     let p = eigen.eigenvalues;
     let squares = [0, 1, 2].map(|k| 6.0 * (p[(k + 1) % 3] + p[(k + 2) % 3] - p[k]) / m);
     let largest = squares.iter().copied().fold(0.0, f64::max).sqrt();
@@ -288,10 +297,10 @@ fn inertia_box(m: f64, i: [f64; 6]) -> (Solid, Matrix3<f64>) {
         return (Solid::Sphere(0.0), Matrix3::identity());
     }
     let sides = squares.map(|s| s.max(0.0).sqrt().max(largest / 20.0));
-    let mut axes = eigen.eigenvectors;
+    let v = &eigen.eigenvectors;
+    let column = |k: usize| Vector3::new(v[(0, k)], v[(1, k)], v[(2, k)]);
     // A proper rotation: the third axis the cross product of the first two.
-    let third = axes.column(0).cross(&axes.column(1));
-    axes.set_column(2, &third);
+    let axes = Matrix3::from_columns(&[column(0), column(1), column(0).cross(&column(1))]);
     (Solid::Box(sides), axes)
 }
 

@@ -145,7 +145,7 @@ pub(super) fn read_model(model: &str) -> Result<(String, String), CliError> {
     let display = resolved.path().to_string();
     let source = match &resolved {
         // Embedded in the binary: no file is read.
-        eomgen::Resolved::Bundled(entry) => entry.source.to_string(),
+        eomgen::Resolved::Bundled(entry) => entry.source().to_string(),
         eomgen::Resolved::File(path) => {
             super::files::read_input(path);
             eomgen_symbolic::model::read_model_file(std::path::Path::new(path)).map_err(

@@ -47,11 +47,21 @@ pub(super) fn write_chart(
     }
 }
 
-static FONT: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
+/// The charts' font, zlib-compressed (assets/fonts/README.md): 104 KB of the program
+/// instead of 185 KB, inflated once, at the first chart, in about a millisecond.
+static FONT_ZLIB: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf.zlib");
+
+/// The font inflated (`None` if the embedded data were corrupt, which the tests exclude).
+fn font() -> Option<&'static [u8]> {
+    static FONT: std::sync::OnceLock<Option<Vec<u8>>> = std::sync::OnceLock::new();
+    FONT.get_or_init(|| miniz_oxide::inflate::decompress_to_vec_zlib(FONT_ZLIB).ok())
+        .as_deref()
+}
 
 /// Registers the bundled DejaVu Sans as plotters' `sans-serif`.
 pub(super) fn register_font() -> Result<(), String> {
-    plotters::style::register_font("sans-serif", FontStyle::Normal, FONT)
+    let font = font().ok_or_else(|| "the bundled font could not be inflated".to_string())?;
+    plotters::style::register_font("sans-serif", FontStyle::Normal, font)
         .map_err(|_| "the bundled font could not be loaded".to_string())
 }
 

@@ -134,7 +134,7 @@ pub struct Kinematics {
 /// ```
 /// use eomgen::listing::{KinematicsOptions, kinematics};
 /// let Some(top) = eomgen::models::find("heavy_top") else { return Ok(()) };
-/// let text = top.source;
+/// let text = top.source();
 /// let options = KinematicsOptions { frames: vec!["B".into()], ..Default::default() };
 /// let k = kinematics("heavy_top.yaml", text, &options)?;
 /// assert_eq!(k.listing.frames[0].angular_velocity.len(), 3);
