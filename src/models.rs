@@ -81,7 +81,7 @@ impl ModelEntry {
     fn index(&self) -> Option<usize> {
         let text = self.source();
         ALL.iter()
-            .position(|e| std::ptr::eq(e.source(), text) && e.file == self.file)
+            .position(|e| e.file == self.file && std::ptr::eq(e.source(), text))
     }
 
     fn compile(&self, options: LoadOptions) -> Result<JitModel, LoadError> {

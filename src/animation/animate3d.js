@@ -8,13 +8,16 @@
   'use strict';
   var D = DATA;
   D.clips.forEach(function (c, i) {
-    var s = D.space[i];
+    var s = D.space[i] || { xyz: [], trail3: [], pose: [] };
     c.xyz = s.xyz; c.trail3 = s.trail3; c.pose = s.pose;
   });
   function $(id) { return document.getElementById(id); }
 
   function fallback(why) {
     document.body.setAttribute('data-view', 'svg');
+    $('scene').style.display = '';
+    $('view3d').hidden = true;
+    $('views').hidden = true;
     $('view-note').textContent = '3-D view unavailable (' + why + '); isometric drawing shown';
   }
 
@@ -118,11 +121,14 @@
     var near = follow.checked ? box.own : size;
     var scene = new T.Scene();
     scene.background = new T.Color(0xfcfcfc);
-    var camera = new T.PerspectiveCamera(35, 1, size / 200, size * 200);
+    var camera = new T.PerspectiveCamera(35, 1, Math.min(size, box.own) / 200, size * 200);
     camera.up.set(0, 0, 1);
     var light = new T.DirectionalLight(0xffffff, 2.2);
     light.position.set(-0.5, 1, 2);
+    // The light shines along the camera's view: its target moves with the camera.
     camera.add(light);
+    camera.add(light.target);
+    light.target.position.set(0, 0, -1);
     scene.add(camera);
     scene.add(new T.AmbientLight(0xffffff, 1.1));
 
@@ -133,7 +139,13 @@
     var raw = near / 10, power = Math.pow(10, Math.floor(Math.log10(raw))), m = raw / power;
     var step = power * (m < 1.5 ? 1 : m < 3.5 ? 2 : m < 7.5 ? 5 : 10);
     var cells = Math.min(200, Math.max(2, 2 * Math.ceil(1.5 * size / step / 2)));
-    scene.add(grid(T, cells, step, [Math.round(c[0] / step) * step, Math.round(c[1] / step) * step, floor]));
+    var floorGrid = grid(T, cells, step, [0, 0, floor]);
+    // Centred under `at`, on the grid's own lines.
+    function centreGrid(at) {
+      floorGrid.position.set(Math.round(at[0] / step) * step, Math.round(at[1] / step) * step, 0);
+    }
+    centreGrid(c);
+    scene.add(floorGrid);
     $('grid-step').textContent = 'grid ' + Number(step.toPrecision(3)) + ' m';
     var ground = new T.AxesHelper(0.25 * near);
     ground.position.set(0, 0, floor);
@@ -177,6 +189,14 @@
       scene.add(m);
       return m;
     });
+    // The centres of the particles and planar bodies.
+    var particleGeometry = new T.SphereGeometry(0.025 * near, 16, 12);
+    var particleMaterial = new T.MeshLambertMaterial({ color: 0x555555 });
+    var particles = D.particles.map(function () {
+      var m = new T.Mesh(particleGeometry, particleMaterial);
+      scene.add(m);
+      return m;
+    });
     var traces = [];
 
     function selectTraces(clip) {
@@ -205,6 +225,7 @@
       lineGeometry.attributes.position.needsUpdate = true;
       lineGeometry.computeBoundingSphere();
       dots.forEach(function (p, i) { joints[i].position.set(xyz[3 * p], xyz[3 * p + 1], xyz[3 * p + 2]); });
+      D.particles.forEach(function (p, i) { particles[i].position.set(xyz[3 * p], xyz[3 * p + 1], xyz[3 * p + 2]); });
       groups.forEach(function (g, i) {
         var o = 7 * i;
         g.position.set(pose[o], pose[o + 1], pose[o + 2]);
@@ -212,6 +233,7 @@
       });
       traces.forEach(function (t) { t.geometry.setDrawRange(0, k * clip.sub + 1); });
       if (follow.checked) { aim(frameBox(xyz, pose).centre); }
+      resize();
       render();
     }
 
@@ -221,6 +243,7 @@
       camera.position.set(camera.position.x + to[0] - t.x, camera.position.y + to[1] - t.y, camera.position.z + to[2] - t.z);
       t.set(to[0], to[1], to[2]);
       c = to;
+      centreGrid(to);
       controls.update();
     }
 
@@ -235,10 +258,10 @@
 
     // iso: the isometric drawing's direction (x to the right and down, y to the left);
     // top: down the z axis, y up; side: along y, x to the right, z up.
-    var views = { iso: [-1, -1, 1], top: [0, 0, 1], side: [0, -1, 0] };
+    // (The top view is a hair off the vertical: the orbit keeps z up.)
+    var views = { iso: [-1, -1, 1], top: [0, -1e-3, 1], side: [0, -1, 0] };
     function view(name) {
       var d = views[name], n = Math.hypot(d[0], d[1], d[2]), r = 2.6 * near;
-      camera.up.set(0, name === 'top' ? 1 : 0, name === 'top' ? 0 : 1);
       camera.position.set(c[0] + r * d[0] / n, c[1] + r * d[1] / n, c[2] + r * d[2] / n);
       camera.lookAt(c[0], c[1], c[2]);
       controls.update();
@@ -249,9 +272,13 @@
       b.addEventListener('click', function () { view(b.getAttribute('data-view')); });
     });
 
+    // The canvas's size in CSS pixels, followed at each frame too: it changes when the lines
+    // above it do (another clip's info).
+    var shape = [0, 0];
     function resize() {
       var w = canvas.clientWidth, h = canvas.clientHeight;
-      if (w > 0 && h > 0) {
+      if (w > 0 && h > 0 && (w !== shape[0] || h !== shape[1])) {
+        shape = [w, h];
         renderer.setSize(w, h, false);
         camera.aspect = w / h;
         camera.updateProjectionMatrix();
@@ -259,11 +286,12 @@
       }
     }
     window.addEventListener('resize', resize);
+
     window.eomgenShow3d = show;
     resize();
     // The first view: the page address's `#top`, `#side` or `#iso` (the default).
     var first = window.location.hash.slice(1);
-    view(views[first] ? first : 'iso');
+    view(Object.prototype.hasOwnProperty.call(views, first) ? first : 'iso');
     var now = window.eomgenPlayer;
     if (now) { show(now.clip, now.k); }
   }

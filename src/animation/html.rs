@@ -37,11 +37,11 @@ impl Animation {
         let v = |v: f64| fixed(v, view_decimals);
         let mut data = self.data_json(&p);
         if scene.three_d {
-            // The 3-D view's data: the grid step, the bodies, then each clip's points,
-            // paths and poses in space (after the planar data, which the fallback draws).
+            // The 3-D view's data: each clip's points, paths and poses in space, the bodies
+            // and the particles (after the planar data, which the fallback draws).
             data.pop();
             data.pop();
-            data.push_str(&self.space_json(&p, grid_step(span)));
+            data.push_str(&self.space_json(&p));
         }
 
         let step = grid_step(span);
@@ -235,9 +235,10 @@ const DATA = {data};
     /// The end of the player's data for a 3-D scene, in place of the closing `]}` of
     /// [`Self::data_json`]: per clip (`space`, in the clips' order) its 3-D points (`xyz`),
     /// paths (`trail3`) and poses
-    /// (`pose`, per body `[x, y, z, qx, qy, qz, qw]`), then the grid step (m) and the bodies
-    /// (their solids in m, the solid's quaternion in the body frame, the largest dimension).
-    fn space_json(&self, p: &dyn Fn(f64) -> String, grid: f64) -> String {
+    /// (`pose`, per body `[x, y, z, qx, qy, qz, qw]`), then the bodies (their solids in m,
+    /// the solid's quaternion in the body frame, the largest dimension) and the centres
+    /// marked with a dot (`particles`, indices of drawn points).
+    fn space_json(&self, p: &dyn Fn(f64) -> String) -> String {
         let unit = |v: f64| fixed(v, 12);
         let flat = |list: &[[f64; 3]]| {
             (list.iter().flatten())
@@ -247,7 +248,14 @@ const DATA = {data};
         };
         let mut out = "],\"space\":[".to_string();
         for (c, clip) in self.clips.iter().enumerate() {
-            let Some(space) = &clip.space else { continue };
+            if c > 0 {
+                out.push_str(",\n");
+            }
+            // Every clip of a 3-D scene has its space; `null` keeps the lists aligned.
+            let Some(space) = &clip.space else {
+                out.push_str("null");
+                continue;
+            };
             let frames: Vec<String> = (space.points.iter())
                 .map(|f| format!("[{}]", flat(f)))
                 .collect();
@@ -270,8 +278,7 @@ const DATA = {data};
                 .collect();
             let _ = write!(
                 out,
-                "{}{{\"xyz\":[{}],\n\"trail3\":[{}],\n\"pose\":[{}]}}",
-                if c == 0 { "" } else { ",\n" },
+                "{{\"xyz\":[{}],\n\"trail3\":[{}],\n\"pose\":[{}]}}",
                 frames.join(",\n"),
                 trails.join(",\n"),
                 poses.join(",\n")
@@ -298,10 +305,23 @@ const DATA = {data};
                 )
             })
             .collect();
+        // The centres the 3-D view marks with a dot: those of the bodies it draws no solid
+        // for (particles, planar bodies).
+        let drawn: Vec<&str> = self
+            .scene
+            .bodies()
+            .iter()
+            .map(|b| b.name.as_str())
+            .collect();
+        let particles: Vec<String> = (self.scene.centres.iter())
+            .filter(|(_, _, body)| !drawn.contains(&body.as_str()))
+            .map(|(i, _, _)| i.to_string())
+            .collect();
         let _ = write!(
             out,
-            "],\"grid\":{grid:e},\"bodies\":[{}]}}",
-            bodies.join(",")
+            "],\"bodies\":[{}],\"particles\":[{}]}}",
+            bodies.join(","),
+            particles.join(",")
         );
         out
     }

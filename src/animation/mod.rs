@@ -452,12 +452,10 @@ impl Space {
         }
     }
 
-    /// Whether every number is finite.
-    fn is_finite(&self) -> bool {
-        let points = self.points.iter().chain(&self.trail).flatten().flatten();
-        points
-            .chain(self.poses.iter().flatten().flatten())
-            .all(|v| v.is_finite())
+    /// The first frame with a pose that is not finite, if any (the points and paths are
+    /// checked in their projections first).
+    fn first_not_finite(&self) -> Option<usize> {
+        (self.poses.iter()).position(|f| !f.iter().flatten().all(|v| v.is_finite()))
     }
 }
 
@@ -616,7 +614,8 @@ pub fn simulation_animation(
         scene.make_three_d(model)?;
     }
     let n = model.description().num_dofs();
-    let mut space = Space::default();
+    // The 3-D view's frames: `(t, y, positions)`, posed once every point is known finite.
+    let mut in_space = Vec::new();
     let mut space_trail = vec![Vec::new(); if scene.three_d { scene.traces.len() } else { 0 }];
     let mut t = Vec::with_capacity(samples / sub + 1);
     let mut frames = Vec::with_capacity(samples / sub + 1);
@@ -649,7 +648,9 @@ pub fn simulation_animation(
         if j % sub != 0 {
             continue;
         }
-        space.push(scene.space_frame(model, tk, &y[..n], &positions)?);
+        if scene.three_d {
+            in_space.push((tk, y, positions));
+        }
         t.push(tk);
         frames.push(frame);
         frame_states.push((tk, y));
@@ -682,7 +683,13 @@ pub fn simulation_animation(
     );
     check_finite(&scene.model, &frames)?;
     check_finite(&scene.model, &trail)?;
-    space.trail = space_trail;
+    let mut space = Space {
+        trail: space_trail,
+        ..Space::default()
+    };
+    for (tk, y, positions) in &in_space {
+        space.push(scene.space_frame(model, *tk, &y[..n], positions)?);
+    }
     let space = scene.three_d.then_some(space);
     check_space(&scene.model, space.as_ref())?;
     let clip = Clip {
@@ -784,15 +791,15 @@ fn describe_transition(tr: &eomgen_runtime::hybrid::Transition) -> (f64, String)
     (tr.t, text)
 }
 
-/// [`AnimationError::PointNotFinite`] when a number of the 3-D view's data is not finite (its
-/// first frame is named: the projected frames, checked first, name the first one).
+/// [`AnimationError::PointNotFinite`] at the first frame where a pose of the 3-D view is not
+/// finite.
 fn check_space(model: &str, space: Option<&Space>) -> Result<(), AnimationError> {
-    match space {
-        Some(s) if !s.is_finite() => Err(AnimationError::PointNotFinite {
+    match space.and_then(Space::first_not_finite) {
+        Some(frame) => Err(AnimationError::PointNotFinite {
             model: model.to_string(),
-            frame: 0,
+            frame,
         }),
-        _ => Ok(()),
+        None => Ok(()),
     }
 }
 
@@ -864,15 +871,19 @@ pub fn modes_animation(
             .map(|j| period * j as f64 / MODE_FRAMES as f64)
             .collect();
         let mut frames: Vec<Frame> = Vec::with_capacity(t.len());
-        let mut space = Space::default();
+        let mut configurations = Vec::with_capacity(t.len());
         for j in 0..t.len() {
             let phase = std::f64::consts::TAU * j as f64 / MODE_FRAMES as f64;
             let qk = drawing::displaced(q, &psi, s.unwrap_or(0.0) * phase.sin());
             let at = positions(&qk);
             frames.push(scene.project(&at));
-            space.push(scene.space_frame(model, 0.0, &qk, &at)?);
+            configurations.push((qk, at));
         }
         check_finite(&scene.model, &frames)?;
+        let mut space = Space::default();
+        for (qk, at) in &configurations {
+            space.push(scene.space_frame(model, 0.0, qk, at)?);
+        }
         space.trail = (scene.traces.iter())
             .map(|&p| space.points.iter().map(|f| f[p]).collect())
             .collect();

@@ -44,8 +44,8 @@ pub struct DrawnBody {
     pub solid: Solid,
     /// Whether the solid is the default from the inertia (no `draw: shapes:` entry).
     pub from_inertia: bool,
-    /// Index of its frame among the parsed frames.
-    frame: usize,
+    /// Index of its frame among the parsed frames; `None` for the ground frame itself.
+    frame: Option<usize>,
     /// The solid's axes in the body frame (columns): a cylinder's y onto its axis, a box
     /// from the inertia onto the principal axes.
     local: Matrix3<f64>,
@@ -65,8 +65,9 @@ enum Rotation {
 /// The orientations of a model's 3-D bodies at any state.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Poses {
-    /// Each frame's parent (an index into this list, `None` for the ground) and rotations.
-    frames: Vec<(Option<usize>, Vec<Rotation>)>,
+    /// Each frame's name, parent (an index into this list, `None` for the ground) and
+    /// rotations.
+    frames: Vec<(String, Option<usize>, Vec<Rotation>)>,
     /// The bodies drawn, in the description's order.
     pub bodies: Vec<DrawnBody>,
 }
@@ -87,7 +88,8 @@ impl Poses {
         let names: Vec<&str> = description.frames.iter().map(|f| &*f.name).collect();
         let mut frames = Vec::with_capacity(names.len());
         for f in description.frames.iter() {
-            frames.push(parse_frame(f, &names).map_err(error)?);
+            let (parent, rotations) = parse_frame(f, &names).map_err(error)?;
+            frames.push((f.name.to_string(), parent, rotations));
         }
         let lookup = parameter_lookup(model);
         let value = |text: &str, what: &str| -> Result<f64, AnimationError> {
@@ -100,9 +102,12 @@ impl Poses {
         };
         let mut bodies = Vec::new();
         for c in description.body_centres.iter() {
-            let Some(frame) = names.iter().position(|n| *n == &*c.frame) else {
+            // A particle or a planar body has no frame; a 3-D body's frame is among the
+            // described frames, or the ground itself (which they leave out).
+            if c.frame.is_empty() {
                 continue;
-            };
+            }
+            let frame = names.iter().position(|n| *n == &*c.frame);
             let Some(centre) = description.point_index(&c.point) else {
                 continue;
             };
@@ -159,7 +164,7 @@ impl Poses {
     /// ground's.
     ///
     /// # Errors
-    /// A message when an angle is not finite or a name is unknown.
+    /// A message naming the frame and `t` when an angle is not finite or a name is unknown.
     fn orientations(
         &self,
         model: &dyn ModelInfo,
@@ -178,10 +183,11 @@ impl Poses {
             }
         };
         let mut out: Vec<Matrix3<f64>> = Vec::with_capacity(self.frames.len());
-        for (parent, rotations) in &self.frames {
+        for (name, parent, rotations) in &self.frames {
             let mut r = parent.map_or(Matrix3::identity(), |p| out[p]);
             for rotation in rotations {
-                r *= rotation_matrix(rotation, &lookup)?;
+                r *= rotation_matrix(rotation, &lookup)
+                    .map_err(|e| format!("frame `{name}` at t = {t}: {e}"))?;
             }
             out.push(r);
         }
@@ -210,7 +216,9 @@ impl Poses {
             .bodies
             .iter()
             .map(|b| {
-                let q = quaternion(&frames[b.frame]);
+                let q = b
+                    .frame
+                    .map_or(UnitQuaternion::identity(), |f| quaternion(&frames[f]));
                 let p = points[b.centre];
                 [p[0], p[1], p[2], q.i, q.j, q.k, q.w]
             })

@@ -11,13 +11,14 @@
 //!     ball: { sphere: r }
 //! ```
 
-use super::{Axis, BodyLookup, BodyShape, Depends, Rules};
+use super::{Axis, BodyLookup, BodyShape, Depends, Rules, Units};
 use crate::model::ast::Expr;
 use crate::model::diagnostic::Diagnostic;
 use crate::model::located::Located;
 use crate::model::schema::entries::get;
 use crate::model::schema::walk::{Ctx, Keyed};
-use crate::model::schema::write::{NotRewritten, Writer, list};
+use crate::model::schema::write::{NotRewritten, Writer, flow, list};
+use crate::model::units::Dimension;
 use crate::model::yaml::YamlNode;
 use eomgen_description::Shape;
 
@@ -131,7 +132,9 @@ fn read_shape(cx: &mut Ctx<'_>, k: &Located<String>, v: &YamlNode) -> Option<Dra
     };
     let axis = match get(f, "axis") {
         Some(n) if matches!(size, ShapeSize::Cylinder(..) | ShapeSize::Disc(_)) => {
-            Some(cx.axes(n, true)?.pop()?)
+            let options = [("x", Axis::X), ("y", Axis::Y), ("z", Axis::Z)];
+            let axis = cx.choice(n, &format!("the axis of {what}"), &options)?;
+            Some(Located::new(axis, n.location))
         }
         Some(n) => {
             cx.error(
@@ -178,7 +181,7 @@ pub(crate) fn rules(shapes: &[DrawnShape], cx: &mut dyn Rules) {
             BodyLookup::Found(BodyShape::Spatial) | BodyLookup::Excused => {}
             BodyLookup::Found(_) => cx.error(
                 Diagnostic::new(s.body.location, format!("`{name}` in `draw: shapes:` is not a 3-D rigid body"))
-                    .with_help("shapes are drawn for bodies with a `frame:` and an inertia tensor; the 3-D view draws particles as dots"),
+                    .with_help("shapes are drawn for bodies with a `frame:` and an inertia tensor; the 3-D view marks a particle's or a planar body's centre with a dot"),
             ),
             BodyLookup::Unknown(closest) => {
                 let d = Diagnostic::new(s.body.location, format!("`draw: shapes:` names an unknown body `{name}`"));
@@ -215,6 +218,22 @@ pub(crate) fn rules(shapes: &[DrawnShape], cx: &mut dyn Rules) {
     }
 }
 
+/// Under `units: SI`, every size of a shape is a length (m).
+pub(crate) fn units(shapes: &[DrawnShape], cx: &mut dyn Units) {
+    for s in shapes {
+        for (what, e) in s.sizes() {
+            cx.fixed(
+                e,
+                Dimension::METRE,
+                &format!("the {what} of the shape of `{}`", s.body.value),
+                "a length",
+                "m",
+                "a drawn shape's sizes are lengths",
+            );
+        }
+    }
+}
+
 /// `shapes: { body: { … }, … }`, as `draw:` writes it; `None` when there is none.
 pub(crate) fn write(
     w: &mut Writer<'_>,
@@ -234,8 +253,8 @@ pub(crate) fn write(
                     list(&w.exprs(&[r.clone(), l.clone()], &place)?)
                 )
             }
-            ShapeSize::Disc(r) => format!("disc: {}", w.expr(r, &place)?),
-            ShapeSize::Sphere(r) => format!("sphere: {}", w.expr(r, &place)?),
+            ShapeSize::Disc(r) => format!("disc: {}", flow(&w.expr(r, &place)?)),
+            ShapeSize::Sphere(r) => format!("sphere: {}", flow(&w.expr(r, &place)?)),
         };
         let axis = s
             .axis

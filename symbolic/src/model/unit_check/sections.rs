@@ -2,7 +2,7 @@
 //! events, outputs and `checks:`, walked in file order.
 
 use super::*;
-use crate::model::elements::{self, body, energy, frame, gravity, point};
+use crate::model::elements::{self, body, energy, frame, gravity, point, shape};
 use crate::model::located::Located;
 
 impl Checker<'_> {
@@ -119,6 +119,7 @@ impl Checker<'_> {
         for t in &file.torques {
             t.units(self);
         }
+        shape::units(&file.draw.shapes, self);
         self.constraints.clear();
         for (holonomic, list) in [(true, &file.constraints), (false, &file.nonholonomic)] {
             for (k, e) in list {
