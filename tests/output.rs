@@ -1465,9 +1465,9 @@ fn issue_28_a_trailing_slash_is_refused_and_dash_is_standard_output() {
 }
 
 /// `simulate --plot` draws one panel per coordinate, each on its own scale, and
-/// `--plot-coordinates` chooses coordinates and rates in order (issue 53: a spin of hundreds
-/// of radians no longer flattens a nutation); an unknown name is a usage error before any
-/// file is written.
+/// `--plot-coordinates` chooses coordinates, rates and outputs in order (issue 53: a spin of
+/// hundreds of radians no longer flattens a nutation); an unknown name is a usage error before
+/// any file is written.
 #[test]
 fn time_charts_have_a_panel_per_coordinate_and_draw_what_is_asked() {
     let dir = tempfile::tempdir().unwrap();
@@ -1504,8 +1504,28 @@ fn time_charts_have_a_panel_per_coordinate_and_draw_what_is_asked() {
         "nope",
     ]);
     assert_eq!(bad.status.code(), Some(2));
-    assert!(stderr(&bad).contains("`nope` is neither a coordinate nor a rate"));
+    assert!(stderr(&bad).contains("`nope` is neither a coordinate, a rate nor an output"));
     assert!(!std::path::Path::new(&other).exists());
+    // The file's outputs have panels too: the central force's radius beside x.
+    let orbit = dir.path().join("orbit.svg").to_string_lossy().to_string();
+    let out = run(&[
+        "simulate",
+        "central_force",
+        "--t-end",
+        "1",
+        "--plot",
+        &orbit,
+        "--plot-coordinates",
+        "radius,x",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = std::fs::read_to_string(&orbit).unwrap();
+    let at = |name: &str| text.find(&format!(">\n{name}\n</text>"));
+    assert!(
+        at("radius").is_some() && at("x").is_some() && at("y").is_none(),
+        "panels"
+    );
+    assert!(at("radius") < at("x"), "in the order asked");
     // A 20-mass chain: the first 12 coordinates, and a warning that says so.
     let chain = dir.path().join("chain.yaml");
     let text = run(&["new", "n-mass-chain", "20"]);

@@ -1,5 +1,6 @@
 //! Charts with plotters: SVG or PNG chosen by the file extension.
 
+use eomgen::outputs::OutputSeries;
 use eomgen::{ModelInfo, Solution};
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -104,37 +105,56 @@ impl<'a> Chart<'a> {
 /// panel each with its own scale (a spin of hundreds of radians beside a nutation of
 /// hundredths), stacked over a shared time axis, with `note` (why the run is incomplete, if
 /// it is) drawn in red above them. `shown` names components of the state `[q; q̇]` by their
-/// index, empty for every coordinate.
+/// index, or the model's output `k` (`outputs`, the run's, at every sample) as `2n + k`;
+/// empty for every coordinate.
 ///
 /// # Errors
-/// An unknown extension, an empty solution, or a failure to write the file.
+/// An unknown extension, an empty solution, an output not among `outputs`, or a failure to
+/// write the file.
 pub fn time_histories(
     path: &str,
     model: &dyn ModelInfo,
     solution: &Solution,
+    outputs: &[OutputSeries],
     shown: &[usize],
     note: Option<&str>,
 ) -> Result<(), String> {
     if solution.is_empty() {
         return Err("nothing to plot: the solution has no samples".to_string());
     }
-    let names = model.description().coordinate_names();
+    let d = model.description();
+    let names = d.coordinate_names();
     let n = names.len();
-    let label = |i: usize| match i < n {
-        true => names[i].to_string(),
-        false => format!("{}_dot", names[i - n]),
-    };
     let indices: Vec<usize> = match shown.is_empty() {
         true => (0..n).collect(),
         false => shown.to_vec(),
     };
-    let panels: Vec<Series> = indices
-        .iter()
-        .map(|&i| Series {
-            name: label(i),
-            points: solution.iter().map(|(t, y)| (t, y[i])).collect(),
-        })
-        .collect();
+    let mut panels: Vec<Series> = Vec::with_capacity(indices.len());
+    for &i in &indices {
+        if i < 2 * n {
+            let name = match i < n {
+                true => names[i].to_string(),
+                false => format!("{}_dot", names[i - n]),
+            };
+            let points = solution.iter().map(|(t, y)| (t, y[i])).collect();
+            panels.push(Series { name, points });
+            continue;
+        }
+        // An output of the file, at every sample (evaluated with the run's report).
+        let name = d.outputs.get(i - 2 * n).map_or("", |o| &*o.name);
+        let Some(series) = outputs.iter().find(|o| o.name == name) else {
+            return Err(format!(
+                "the output `{name}` could not be evaluated along the run"
+            ));
+        };
+        let points = (solution.t.iter().copied())
+            .zip(series.values.iter().copied())
+            .collect();
+        panels.push(Series {
+            name: name.to_string(),
+            points,
+        });
+    }
     let title = format!("{}: against time", model.description().name);
     let height = (60 + 170 * panels.len()).max(600) as u32;
     write_chart(

@@ -330,7 +330,7 @@ fn draw_default_run(
         (
             "time.svg",
             format!("Coordinates against time ({})", run.run.describe()),
-            plot::time_histories(&path("time.svg"), model, solution, &[], None),
+            plot::time_histories(&path("time.svg"), model, solution, &[], &[], None),
         ),
         (
             "phase.svg",

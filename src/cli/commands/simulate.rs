@@ -187,11 +187,12 @@ fn output_times(t_out: &[String]) -> Result<OutputTimes, CliError> {
 /// about 2,100 px.
 const MAX_PANELS: usize = 12;
 
-/// The components of the state `[q; q̇]` that `--plot-coordinates` names (`theta`,
-/// `phi_dot`), by index; empty without it (every coordinate, or the first [`MAX_PANELS`]).
+/// The components of the state `[q; q̇]` and the model's `outputs:` that `--plot-coordinates`
+/// names (`theta`, `phi_dot`, `L_z`), by index (`2n + k` for the output `k`); empty without
+/// it (every coordinate, or the first [`MAX_PANELS`]).
 ///
 /// # Errors
-/// A usage error naming a name that is neither a coordinate nor a rate.
+/// A usage error naming a name that is neither a coordinate, a rate nor an output.
 fn shown_components(model: &dyn ModelInfo, names: Option<&str>) -> Result<Vec<usize>, CliError> {
     let coordinates = model.description().coordinate_names();
     let n = coordinates.len();
@@ -207,23 +208,32 @@ fn shown_components(model: &dyn ModelInfo, names: Option<&str>) -> Result<Vec<us
     let count = names.split(',').count();
     if count > MAX_PANELS {
         return Err(CliError::usage(format!(
-            "--plot-coordinates names {count} coordinates and rates; a chart has at most {MAX_PANELS} panels (draw the others in a second chart)"
+            "--plot-coordinates names {count} coordinates, rates and outputs; a chart has at most {MAX_PANELS} panels (draw the others in a second chart)"
         )));
     }
+    let outputs: Vec<&str> = (model.description().outputs.iter())
+        .map(|o| &*o.name)
+        .collect();
+    let known = match outputs.is_empty() {
+        true => format!("coordinates: {}", coordinates.join(", ")),
+        false => format!(
+            "coordinates: {}; outputs: {}",
+            coordinates.join(", "),
+            outputs.join(", ")
+        ),
+    };
     names
         .split(',')
         .map(str::trim)
         .map(|name| {
             let rate = name.strip_suffix("_dot");
-            coordinates
-                .iter()
-                .position(|c| *c == name)
+            (coordinates.iter().position(|c| *c == name))
                 .or_else(|| rate.and_then(|r| coordinates.iter().position(|c| *c == r)).map(|i| n + i))
+                .or_else(|| outputs.iter().position(|o| *o == name).map(|k| 2 * n + k))
                 .ok_or_else(|| {
                     CliError::usage(format!(
-                        "--plot-coordinates: `{name}` is neither a coordinate nor a rate of `{}` (coordinates: {})",
+                        "--plot-coordinates: `{name}` is neither a coordinate, a rate nor an output of `{}` ({known})",
                         model.description().name,
-                        coordinates.join(", ")
                     ))
                 })
         })
@@ -272,7 +282,7 @@ fn write_files(
         }
     }
     if let Some(path) = &args.plot {
-        plot::time_histories(path, model, solution, &shown, incomplete)
+        plot::time_histories(path, model, solution, outputs, &shown, incomplete)
             .map_err(CliError::failure)?;
     }
     if let Some(drift_path) = drift_chart {
