@@ -75,19 +75,7 @@ impl Animation {
         } else {
             ""
         };
-        let (views, view_3d) = if scene.three_d {
-            use base64::Engine as _;
-            let three = base64::engine::general_purpose::STANDARD.encode(THREE_GZ);
-            (
-                "<canvas id=\"view3d\" hidden></canvas>\n<span id=\"views\" hidden>view <button type=\"button\" data-view=\"iso\">iso</button><button type=\"button\" data-view=\"top\">top</button><button type=\"button\" data-view=\"side\">side</button> <label title=\"keep the mechanism in the middle of the view\"><input id=\"follow\" type=\"checkbox\"> follow</label></span>",
-                format!(
-                    "<script id=\"three-gz\" type=\"application/octet-stream\">{three}</script>\n<script>\n{VIEW_3D}</script>\n"
-                ),
-            )
-        } else {
-            ("", String::new())
-        };
-        let (canvas, views) = views.split_once('\n').unwrap_or(("", ""));
+        let (canvas, views, view_3d) = self.view_3d_parts();
         format!(
             r#"<!DOCTYPE html>
 <html lang="en">
@@ -230,6 +218,23 @@ const DATA = {data};
         }
         data.push_str("]}");
         data
+    }
+
+    /// A 3-D scene's canvas, its view buttons and its scripts (three.js in base64, then the
+    /// view); nothing for a planar scene.
+    fn view_3d_parts(&self) -> (&'static str, &'static str, String) {
+        if !self.scene.three_d {
+            return ("", "", String::new());
+        }
+        use base64::Engine as _;
+        let three = base64::engine::general_purpose::STANDARD.encode(THREE_GZ);
+        (
+            "<canvas id=\"view3d\" hidden></canvas>",
+            "<span id=\"views\" hidden>view <button type=\"button\" data-view=\"iso\">iso</button><button type=\"button\" data-view=\"top\">top</button><button type=\"button\" data-view=\"side\">side</button> <label title=\"keep the mechanism in the middle of the view\"><input id=\"follow\" type=\"checkbox\"> follow</label></span>",
+            format!(
+                "<script id=\"three-gz\" type=\"application/octet-stream\">{three}</script>\n<script>\n{VIEW_3D}</script>\n"
+            ),
+        )
     }
 
     /// The end of the player's data for a 3-D scene, in place of the closing `]}` of

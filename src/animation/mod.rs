@@ -357,7 +357,7 @@ impl Scene {
         t: f64,
         q: &[f64],
         positions: &[[f64; 3]],
-    ) -> Result<Option<(Vec<[f64; 3]>, Vec<[f64; 7]>)>, AnimationError> {
+    ) -> Result<Option<SpaceFrame>, AnimationError> {
         let Some(poses) = &self.poses else {
             return Ok(None);
         };
@@ -431,6 +431,10 @@ pub struct Clip {
     space: Option<Space>,
 }
 
+/// One frame of the 3-D view: the drawn points' `[x, y, z]` (m) and the bodies' poses
+/// `[x, y, z, qx, qy, qz, qw]`.
+type SpaceFrame = (Vec<[f64; 3]>, Vec<[f64; 7]>);
+
 /// The 3-D view's data of a clip: positions in the ground's axes (m), not projected.
 #[derive(Debug, Clone, PartialEq, Default)]
 struct Space {
@@ -445,7 +449,7 @@ struct Space {
 
 impl Space {
     /// Adds one frame's points and poses (`None` for a planar scene: nothing to add).
-    fn push(&mut self, frame: Option<(Vec<[f64; 3]>, Vec<[f64; 7]>)>) {
+    fn push(&mut self, frame: Option<SpaceFrame>) {
         if let Some((points, poses)) = frame {
             self.points.push(points);
             self.poses.push(poses);
@@ -656,24 +660,7 @@ pub fn simulation_animation(
         frame_states.push((tk, y));
         frame_samples.push(j);
     }
-    // The energy and its drift over the frames, of `E` plus the energy lost at impacts
-    // (as `eomgen simulate` measures it): the integration's error, not the impacts'.
-    let mut energy_drift =
-        energy_drift_at(model, &simulation.initial_state, frame_states.into_iter());
-    let lost = lost_by_frame(simulation, &frame_samples);
-    let mut drift = energy_drift.relative();
-    if energy_drift.scale > 0.0 {
-        for (d, l) in drift.iter_mut().zip(&lost) {
-            *d += l / energy_drift.scale;
-        }
-    }
-    let losses = (simulation.transitions.iter()).map(|tr| (tr.sample, tr.energy_drop()));
-    let losses: Vec<(usize, f64)> = losses
-        .map(|(s, l)| (frame_samples.partition_point(|&j| j < s), l))
-        .collect();
-    energy_drift.add_losses(losses.into_iter());
-    let max_drift = energy_drift.drift.unwrap_or(0.0);
-    let (e0, energy) = (energy_drift.initial_energy, energy_drift.energy);
+    let (energy, e0, max_drift) = frame_energies(model, simulation, frame_states, &frame_samples);
     let info = simulation_info(
         model,
         simulation,
@@ -699,7 +686,7 @@ pub fn simulation_animation(
         frames,
         trail,
         sub,
-        energy: Some(Energy { energy, drift }),
+        energy: Some(energy),
         rate: 1.0,
         period: None,
         transitions: (simulation.transitions.iter())
@@ -714,6 +701,38 @@ pub fn simulation_animation(
         scene,
         clips: vec![clip],
     }))
+}
+
+/// The energy `E` and its drift at the frames `(t, y)` of `simulation` (their samples
+/// `frame_samples`), of `E` plus the energy lost at impacts before each (as `eomgen simulate`
+/// measures it: the integration's error, not the impacts'); with `E(0)` and the largest
+/// drift.
+fn frame_energies<'a>(
+    model: &dyn ModelInfo,
+    simulation: &Simulation,
+    frame_states: Vec<(f64, &'a [f64])>,
+    frame_samples: &[usize],
+) -> (Energy, f64, f64) {
+    let mut energy_drift =
+        energy_drift_at(model, &simulation.initial_state, frame_states.into_iter());
+    let lost = lost_by_frame(simulation, frame_samples);
+    let mut drift = energy_drift.relative();
+    if energy_drift.scale > 0.0 {
+        for (d, l) in drift.iter_mut().zip(&lost) {
+            *d += l / energy_drift.scale;
+        }
+    }
+    let losses = (simulation.transitions.iter()).map(|tr| (tr.sample, tr.energy_drop()));
+    let losses: Vec<(usize, f64)> = losses
+        .map(|(s, l)| (frame_samples.partition_point(|&j| j < s), l))
+        .collect();
+    energy_drift.add_losses(losses.into_iter());
+    let max_drift = energy_drift.drift.unwrap_or(0.0);
+    let energy = Energy {
+        energy: energy_drift.energy,
+        drift,
+    };
+    (energy, energy_drift.initial_energy, max_drift)
 }
 
 /// The info line of a simulation's clip: the method and its step control, the frames, `E(0)`
@@ -951,89 +970,4 @@ pub fn grid_step(span: f64) -> f64 {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    mod undrawn {
-        eomgen::model!("../../tests/fixtures/undrawn_pendulum.yaml");
-    }
-    mod energy_form {
-        eomgen::model!("../../symbolic/tests/fixtures/damped_oscillator.yaml");
-    }
-
-    /// A model with points but no `draw:` block: an error that says what to add, naming the
-    /// model's points.
-    #[test]
-    fn a_model_without_draw_gets_an_error_naming_what_to_add() {
-        let model = eomgen_runtime::FirstOrder::new(undrawn::UndrawnPendulum::default());
-        let e = Scene::of(&model, &[]).expect_err("no draw: block");
-        assert!(matches!(e, AnimationError::NothingToDraw { .. }), "{e:?}");
-        let message = e.to_string();
-        assert!(message.contains("has no `draw:` block"), "{message}");
-        assert!(message.contains("draw: { lines: [[O, P]]"), "{message}");
-        // Tracing a point is enough to animate it; a misspelt point is an error.
-        let scene = Scene::of(&model, &["P".to_string()]).expect("traced point");
-        assert_eq!(scene.names, ["P"]);
-        let e = Scene::of(&model, &["Q".to_string()]).expect_err("no such point");
-        assert!(
-            e.to_string().contains("has no point `Q` (points: O, P)"),
-            "{e}"
-        );
-        // ... also before the simulation.
-        let options = AnimationOptions {
-            trace: vec![" Q".to_string()],
-            ..AnimationOptions::default()
-        };
-        let e = frame_times(&model, 1.0, &options).expect_err("no such point");
-        assert_eq!(
-            e.to_string(),
-            "--trace  Q: `undrawn_pendulum` has no point `Q` (points: O, P)"
-        );
-    }
-
-    /// An energy-form model has no points at all.
-    #[test]
-    fn a_model_without_points_gets_an_error() {
-        let model = eomgen_runtime::FirstOrder::new(energy_form::DampedOscillator::default());
-        let e = Scene::of(&model, &[]).expect_err("no points");
-        assert!(e.to_string().contains("has no points"), "{e}");
-    }
-
-    /// Frames at `k / fps` up to `t_end`, a rounding below a frame time keeping it; with a
-    /// traced point four samples per frame; `fps` and the frame count checked.
-    #[test]
-    fn frame_times_are_checked_and_uniform() {
-        let model = eomgen_runtime::FirstOrder::new(undrawn::UndrawnPendulum::default());
-        let traced = AnimationOptions {
-            fps: 10.0,
-            trace: vec!["P".to_string()],
-        };
-        let times = frame_times(&model, 1.0 - 1e-15, &traced).expect("times");
-        assert_eq!(times.len(), 41);
-        assert_eq!(times[4], 0.1);
-        assert_eq!(times[40], 1.0 - 1e-15);
-        assert_eq!(traced.frame_count(0.95), Ok(10));
-        let bad = AnimationOptions {
-            fps: 0.0,
-            ..AnimationOptions::default()
-        };
-        assert_eq!(
-            bad.frame_count(1.0).unwrap_err().to_string(),
-            "--fps must be a positive number of frames per second, got 0"
-        );
-        assert_eq!(
-            AnimationOptions::default()
-                .frame_count(1e4)
-                .unwrap_err()
-                .to_string(),
-            "--t-end 10000 at --fps 30 gives more than 100000 frames; lower --fps"
-        );
-    }
-
-    #[test]
-    fn grid_steps_are_round() {
-        assert_eq!(grid_step(6.0), 0.5);
-        assert_eq!(grid_step(1.2), 0.1);
-        assert_eq!(grid_step(30.0), 2.0);
-    }
-}
+mod tests;

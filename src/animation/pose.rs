@@ -375,7 +375,7 @@ fn rotation_matrix(
             let e = vector(e)?;
             let e0 = evaluate(e0, lookup, "an Euler parameter")?;
             let norm = e0 * e0 + e.norm_squared();
-            if !(norm > 0.0) {
+            if norm.is_nan() || norm <= 0.0 {
                 return Err("the Euler parameters are all zero".to_string());
             }
             Ok((Matrix3::identity() * (e0 * e0 - e.norm_squared())
