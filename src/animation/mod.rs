@@ -707,10 +707,10 @@ pub fn simulation_animation(
 /// `frame_samples`), of `E` plus the energy lost at impacts before each (as `eomgen simulate`
 /// measures it: the integration's error, not the impacts'); with `E(0)` and the largest
 /// drift.
-fn frame_energies<'a>(
+fn frame_energies(
     model: &dyn ModelInfo,
     simulation: &Simulation,
-    frame_states: Vec<(f64, &'a [f64])>,
+    frame_states: Vec<(f64, &[f64])>,
     frame_samples: &[usize],
 ) -> (Energy, f64, f64) {
     let mut energy_drift =
