@@ -689,6 +689,18 @@ def test_animate_modes_writes_the_command_line_page(cli, tmp_path):
     assert eomgen.load("three_masses").animate_modes().html == page.read_text(encoding="utf-8")
 
 
+def test_a_3d_model_is_animated_in_webgl_as_the_command_line_does(cli, tmp_path):
+    page = tmp_path / "top.html"
+    out = subprocess.run([cli, "animate", "heavy_top", "--t-end", "1", "-o", str(page)], capture_output=True,
+                         text=True, timeout=600)
+    assert out.returncode == 0, out.stderr
+    html = eomgen.load("heavy_top").animate(t_end=1.0).html
+    assert html == page.read_text(encoding="utf-8")
+    # The 3-D view's canvas, three.js and the top's disc (its file's `draw: shapes:`).
+    assert '<canvas id="view3d"' in html and 'id="three-gz"' in html
+    assert '"solid":["cylinder",' in html
+
+
 def test_a_failed_animation_keeps_its_frames(cli, tmp_path):
     page = tmp_path / "tp.html"
     out = subprocess.run([cli, "animate", "triple_pendulum", "--method", "rk4", "--dt", "0.5", "-o", str(page)],
